@@ -1,0 +1,56 @@
+"""What the closed loop produces, frame by frame: the data the viewer and the summary read.
+
+The loop (``fpga_robotics.loop``) fills these; ``fpga_robotics.viz`` logs them to rerun.
+Positions are in metres in the world frame (x right, y up, top-down view), headings in radians
+counter-clockwise from +x, times in seconds of simulated time.
+"""
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .sim.backends.base import FrameResult
+
+__all__ = ["WorldMap", "PersonState", "FrameRecord"]
+
+
+@dataclass(frozen=True)
+class WorldMap:
+    """Static geometry of a scenario, drawn once in the top-down map."""
+
+    walls: list  # [((x0, y0), (x1, y1)), ...] wall segments
+    obstacles: list  # [[(x, y), ...], ...] furniture polygons (closed, counter-clockwise)
+    obstacle_colors: list  # [(r, g, b), ...] one uint8 colour per obstacle
+    bounds: tuple  # (xmin, ymin, xmax, ymax)
+
+
+@dataclass(frozen=True)
+class PersonState:
+    name: str
+    x: float
+    y: float
+    radius: float
+    is_target: bool
+
+
+@dataclass(frozen=True, eq=False)
+class FrameRecord:
+    """One camera frame of the closed loop: what the FPGA saw, decided, and what the robot did."""
+
+    frame: int  # frame index, 0-based
+    sim_time: float  # simulated time of the capture, s
+    camera_rgb: np.ndarray  # (H, W, 3) uint8, the rendered camera image as captured
+    color_sel: int  # 3-bit colour select in force for this frame
+    result: FrameResult  # the design's outputs for this frame
+    robot_x: float
+    robot_y: float
+    robot_heading: float
+    robot_v: float  # measured linear speed of the robot, m/s
+    robot_w: float  # measured angular speed of the robot, rad/s
+    cmd_v: float  # V commanded by the design's DPS through the robot's kinematics, m/s
+    cmd_w: float  # W commanded, rad/s
+    camera_hfov: float  # horizontal field of view, rad
+    people: list = field(default_factory=list)  # [PersonState, ...]
+    target_distance: float | None = None  # robot centre to target person centre, m
+    target_in_view: bool = False  # the target person is geometrically in the camera's view
+    events: list = field(default_factory=list)  # ["target found", "collision with wall", ...]

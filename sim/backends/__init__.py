@@ -1,0 +1,1 @@
+"""Simulation backends of ``FollowTarget`` behind one frame-level interface."""

@@ -1,0 +1,110 @@
+"""The one interface through which host code drives the design, whatever simulates it.
+
+A backend simulates ``FollowTarget`` for given ``FollowTargetParams`` and processes whole
+frames: it streams the pixels row-major, one per clock, with optional blanking (``valid`` low)
+after every line and after the frame, then keeps clocking until the frame's results are on the
+outputs. State (motor controller, lost counter) persists across frames as in hardware;
+``reset()`` returns to the power-on state.
+
+Cycle accounting, shared by every backend so that ``cycles`` is comparable bit for bit:
+a frame of H lines takes ``H * (W + line_blank)`` input cycles (each line's W pixel cycles are
+followed by ``line_blank`` idle cycles). The driver then runs idle cycles until both
+``frame_blank`` idle cycles have passed and the motor outputs show the frame's values.
+``FrameResult.cycles`` counts every clock edge of the call.
+"""
+
+from abc import ABC, abstractmethod
+from dataclasses import dataclass
+
+import numpy as np
+
+from ...hw.params import FollowTargetParams
+from ...hw.pixel import color_select_value
+from ..frames import to_rgb444
+
+__all__ = ["FrameResult", "DesignBackend", "BackendError"]
+
+
+class BackendError(RuntimeError):
+    """A backend cannot be built or run (missing tool, failed compile, hung design)."""
+
+
+@dataclass(frozen=True, eq=False)
+class FrameResult:
+    """What the design produced for one frame."""
+
+    filtered: np.ndarray  # (H, W) uint16, packed RGB444: the pixel where it matched, else 0
+    found: bool
+    proximity: int
+    centroid_x: int
+    centroid_leds: int
+    motor_left: int  # signed DPS
+    motor_right: int  # signed DPS
+    cycles: int
+
+    def outputs(self):
+        """The per-frame scalar outputs as a tuple (for comparisons across backends)."""
+        return (
+            self.found,
+            self.proximity,
+            self.centroid_x,
+            self.centroid_leds,
+            self.motor_left,
+            self.motor_right,
+            self.cycles,
+        )
+
+    def __eq__(self, other):
+        if not isinstance(other, FrameResult):
+            return NotImplemented
+        return self.outputs() == other.outputs() and np.array_equal(self.filtered, other.filtered)
+
+
+class DesignBackend(ABC):
+    """Base of every backend. Subclasses implement ``_reset`` and ``_run_frame``."""
+
+    #: Name used by ``get_backend`` and the CLI.
+    name = "abstract"
+
+    def __init__(self, params=None, *, line_blank=0, frame_blank=0):
+        self.params = params if params is not None else FollowTargetParams()
+        if not isinstance(self.params, FollowTargetParams):
+            raise TypeError("params must be a FollowTargetParams")
+        for label, value in (("line_blank", line_blank), ("frame_blank", frame_blank)):
+            if isinstance(value, bool) or not isinstance(value, int) or value < 0:
+                raise ValueError(f"{label} must be an int >= 0, got {value!r}")
+        self.line_blank = line_blank
+        self.frame_blank = frame_blank
+        self.frames_processed = 0
+
+    def reset(self):
+        """Synchronous reset of the whole design, as after power-on."""
+        self._reset()
+        self.frames_processed = 0
+
+    def process_frame(self, frame, color_sel="red"):
+        """Run one frame through the design and return its ``FrameResult``.
+
+        ``frame`` is RGB888 (H, W, 3) uint8 or packed RGB444 (H, W); ``color_sel`` a colour
+        name or its 3-bit code.
+        """
+        packed = to_rgb444(frame, self.params.width, self.params.height)
+        result = self._run_frame(packed, color_select_value(color_sel))
+        self.frames_processed += 1
+        return result
+
+    def close(self):
+        """Release resources (compiled models, trace files)."""
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+    @abstractmethod
+    def _reset(self): ...
+
+    @abstractmethod
+    def _run_frame(self, packed, color_sel):
+        """Process a validated (H, W) uint16 frame; return a ``FrameResult``."""

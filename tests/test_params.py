@@ -1,0 +1,68 @@
+"""FollowTargetParams: the contract's defaults, scaling, and clear validation errors."""
+
+import pytest
+
+from fpga_robotics.hw.params import FollowTargetParams
+
+
+def test_defaults_are_the_published_values_at_160x120():
+    p = FollowTargetParams()
+    assert (p.width, p.height) == (160, 120)
+    assert (p.margin_x, p.margin_y) == (16, 8)
+    assert (p.window_width, p.window_height, p.bin_width) == (128, 104, 16)
+    assert p.min_pixels == 128
+    assert p.proximity_thresholds == (128, 256, 512, 1024, 2048, 4096, 6144)
+    assert p.base_dps == (0, 400, 300, 200, 150, 100, -100, -150)
+    assert (p.kp_num, p.kp_shift, p.max_dps, p.lost_frames, p.search_dps) == (3, 0, 512, 15, 250)
+    assert p.x_bits == 8  # centroid_x is 8 bits at 160x120 (hw-spec port table)
+
+
+@pytest.mark.parametrize("w,h,scale,mx,my", [(320, 240, 4, 32, 16), (640, 480, 16, 64, 32)])
+def test_defaults_scale_with_the_frame_area(w, h, scale, mx, my):
+    p = FollowTargetParams(width=w, height=h)
+    assert p.area_scale == scale
+    assert (p.margin_x, p.margin_y) == (mx, my)
+    assert p.min_pixels == 128 * scale
+    assert p.proximity_thresholds[-1] == 6144 * scale
+
+
+def test_small_geometries_keep_the_160x120_thresholds():
+    p = FollowTargetParams(width=40, height=30)
+    assert p.area_scale == 1 and p.min_pixels == 128
+
+
+def test_replace_recomputes_geometry_defaults_but_keeps_explicit_values():
+    p = FollowTargetParams(kp_num=5).replace(width=320, height=240)
+    assert p.kp_num == 5 and p.margin_x == 32 and p.min_pixels == 512
+    assert p.replace(min_pixels=7).min_pixels == 7
+
+
+@pytest.mark.parametrize(
+    "kwargs,message",
+    [
+        ({"width": 164}, "divisible by 8"),
+        ({"margin_x": 80}, "leaves no window"),
+        ({"diff_min": 16}, "diff_min must be <= 15"),
+        ({"diff_min": -1}, "diff_min must be >= 0"),
+        ({"min_pixels": 0}, "min_pixels must be >= 1"),
+        ({"proximity_thresholds": (1, 2, 3)}, "needs 7 values"),
+        ({"proximity_thresholds": (7, 6, 5, 4, 3, 2, 1)}, "non-decreasing"),
+        ({"proximity_thresholds": (-1, 2, 3, 4, 5, 6, 7)}, ">= 0"),
+        ({"base_dps": (0, 1, 2)}, "needs 8 values"),
+        ({"base_dps": (0, 1, 2, 3, 4, 5, 6, 40000)}, "base_dps[7] must be <= 32767"),
+        ({"max_dps": 1 << 15}, "max_dps must be <= 32767"),
+        ({"kp_shift": 16}, "kp_shift must be <= 15"),
+        ({"lost_frames": 0}, "lost_frames must be >= 1"),
+    ],
+)
+def test_bad_values_raise_clear_errors(kwargs, message):
+    with pytest.raises(ValueError) as info:
+        FollowTargetParams(**kwargs)
+    assert message in str(info.value)
+
+
+def test_wrong_types_raise_type_error():
+    with pytest.raises(TypeError, match="width must be an int"):
+        FollowTargetParams(width=160.0)
+    with pytest.raises(TypeError, match="kp_num must be an int"):
+        FollowTargetParams(kp_num=True)
