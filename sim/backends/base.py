@@ -22,11 +22,25 @@ from ...hw.params import FollowTargetParams
 from ...hw.pixel import color_select_value
 from ..frames import to_rgb444
 
-__all__ = ["FrameResult", "DesignBackend", "BackendError"]
+__all__ = ["FrameResult", "DesignBackend", "BackendError", "WaveformRequest"]
 
 
 class BackendError(RuntimeError):
     """A backend cannot be built or run (missing tool, failed compile, hung design)."""
+
+
+@dataclass(frozen=True)
+class WaveformRequest:
+    """Write a waveform of the frames ``first_frame`` .. ``last_frame`` (inclusive, counted
+    from 0 since construction or the last reset) to ``path`` (``.vcd``, or ``.fst`` where the
+    backend supports it). Nothing is traced outside that range."""
+
+    path: str
+    first_frame: int = 0
+    last_frame: int = 0
+
+    def covers(self, frame_index):
+        return self.first_frame <= frame_index <= self.last_frame
 
 
 @dataclass(frozen=True, eq=False)
@@ -66,15 +80,18 @@ class DesignBackend(ABC):
     #: Name used by ``get_backend`` and the CLI.
     name = "abstract"
 
-    def __init__(self, params=None, *, line_blank=0, frame_blank=0):
+    def __init__(self, params=None, *, line_blank=0, frame_blank=0, waveform=None):
         self.params = params if params is not None else FollowTargetParams()
         if not isinstance(self.params, FollowTargetParams):
             raise TypeError("params must be a FollowTargetParams")
         for label, value in (("line_blank", line_blank), ("frame_blank", frame_blank)):
             if isinstance(value, bool) or not isinstance(value, int) or value < 0:
                 raise ValueError(f"{label} must be an int >= 0, got {value!r}")
+        if waveform is not None and not isinstance(waveform, WaveformRequest):
+            raise TypeError("waveform must be a WaveformRequest or None")
         self.line_blank = line_blank
         self.frame_blank = frame_blank
+        self.waveform = waveform
         self.frames_processed = 0
 
     def reset(self):
