@@ -167,6 +167,36 @@ class FollowTargetParams:
         """Bits of ``SX``, the sum of the column index of every counted pixel."""
         return max(1, (self.window_pixels * (self.width - 1)).bit_length())
 
+    # Latencies of the gateware, in clock cycles (see docs/hardware.md) ------------------------
+
+    @property
+    def filter_latency(self):
+        """A pixel sampled on ``pixels`` at edge k is sampled on ``filtered`` at edge
+        k + filter_latency (one register after the colour comparison)."""
+        return 1
+
+    @property
+    def divider_cycles(self):
+        """Steps of the sequential divider computing ``centroid_x``: one per quotient bit."""
+        return self.x_bits
+
+    @property
+    def result_latency(self):
+        """The frame's last pixel sampled at edge P: ``frame_done`` and the per-frame outputs
+        show the new values right after edge P + result_latency.
+
+        Stages: colour filter (1), tracker position/window stage (1), accumulate (1),
+        snapshot and divider load (1), divider (``divider_cycles``), output register (1)
+        minus the shared edge: ``x_bits + 4``.
+        """
+        return self.divider_cycles + 4
+
+    @property
+    def motor_latency(self):
+        """Motor outputs show the new frame's values right after edge
+        P + result_latency + motor_latency: one register after ``frame_done``."""
+        return 1
+
     def replace(self, **changes):
         """A copy with some parameters changed; derived defaults are recomputed."""
         values = {f.name: getattr(self, f.name) for f in fields(self) if f.init}
