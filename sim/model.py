@@ -1,0 +1,295 @@
+"""Golden model of ``FollowTarget`` in numpy, written from docs/hw-spec.md (not from the RTL).
+
+Reading of the contract where it leaves room (the gateware must agree):
+
+- Lost counter: on every frame without the target the counter of consecutive lost frames is
+  incremented *before* the decision, and the design searches as soon as the count is
+  ``>= lost_frames``. So the frame on which the count *reaches* ``lost_frames`` already searches:
+  with ``lost_frames = 15`` lost frames 1..14 hold the last command and the 15th consecutive lost
+  frame is the first that searches; with ``lost_frames = 1`` the first lost frame searches. A
+  found frame sets the counter back to 0. The counter saturates at ``lost_frames`` (its value
+  beyond that never changes an output).
+- Holding "the last command" means the motor outputs keep whatever they showed (a tracking
+  command, a search command, or 0 after reset). ``last_side`` changes only on found frames;
+  after reset it is "left", so a design that never saw the target searches to the left
+  (``left = -search_dps, right = +search_dps``).
+- Search speeds are ``+-search_dps`` exactly (no saturation to ``max_dps``), as written.
+- ``found`` (``N >= min_pixels``) and ``proximity`` are independent: a found frame with
+  proximity 0 (possible only when ``min_pixels`` is below the first threshold) uses
+  ``base_dps[0]``.
+- ``turn = (kp_num * e) >> kp_shift`` is a floor division by ``2**kp_shift`` (rounds towards
+  minus infinity for negative ``e``), then ``base +- turn`` saturate to ``[-max_dps, max_dps]``.
+
+Everything is vectorised per frame: the colour filter is one lookup in a 4096-entry table per
+colour (built from the contract's formulas), the tracker a few numpy reductions.
+"""
+
+from dataclasses import dataclass
+from functools import lru_cache
+
+import numpy as np
+
+from ..hw.params import FollowTargetParams
+from ..hw.pixel import color_select_value
+from .frames import FrameError, to_rgb444, unpack_rgb444
+
+__all__ = [
+    "FollowTargetModel",
+    "ModelFrame",
+    "MotorModel",
+    "TrackerResult",
+    "centroid_leds",
+    "color_match",
+    "filter_frame",
+    "match_table",
+    "proximity_level",
+    "track_frame",
+]
+
+#: ``centroid_leds`` when the target is centred (LEDs 3 and 4).
+LEDS_CENTRED = 0b0001_1000
+
+
+def _match_formula(r, g, b, color_sel, diff_min, similar_max, white_min):
+    """The contract's colour table on signed int arrays ``r, g, b`` (0..15)."""
+    d, s = diff_min, similar_max
+    if color_sel == 0b000:
+        return np.ones(np.shape(r), bool)
+    if color_sel == 0b100:
+        return r - np.maximum(g, b) >= d
+    if color_sel == 0b010:
+        return g - np.maximum(r, b) >= d
+    if color_sel == 0b001:
+        return b - np.maximum(r, g) >= d
+    if color_sel == 0b110:
+        return (np.abs(r - g) <= s) & (np.minimum(r, g) - b >= d)
+    if color_sel == 0b101:
+        return (np.abs(r - b) <= s) & (np.minimum(r, b) - g >= d)
+    if color_sel == 0b011:
+        return (np.abs(g - b) <= s) & (np.minimum(g, b) - r >= d)
+    # 0b111, white
+    hi = np.maximum(np.maximum(r, g), b)
+    lo = np.minimum(np.minimum(r, g), b)
+    return (hi - lo <= s) & (lo >= white_min)
+
+
+@lru_cache(maxsize=64)
+def _cached_table(color_sel, diff_min, similar_max, white_min):
+    r, g, b = unpack_rgb444(np.arange(4096))
+    table = _match_formula(r, g, b, color_sel, diff_min, similar_max, white_min)
+    table.flags.writeable = False
+    return table
+
+
+def match_table(color_sel, params):
+    """Read-only bool array of 4096 entries: does packed pixel ``p`` match ``color_sel``?"""
+    sel = color_select_value(color_sel)
+    return _cached_table(sel, params.diff_min, params.similar_max, params.white_min)
+
+
+def _check_packed(packed, params):
+    if not isinstance(packed, np.ndarray) or packed.ndim != 2 or packed.dtype.kind != "u":
+        raise FrameError(
+            "the model takes a packed RGB444 frame: an (H, W) numpy array of unsigned ints "
+            "(convert RGB888 with fpga_robotics.sim.frames.to_rgb444)"
+        )
+    if packed.shape != (params.height, params.width):
+        raise FrameError(
+            f"a packed RGB444 frame must have shape ({params.height}, {params.width}) for a "
+            f"{params.width}x{params.height} design, got {packed.shape}"
+        )
+
+
+def color_match(packed, color_sel, params):
+    """Bool (H, W): which pixels of a packed RGB444 frame match colour ``color_sel``."""
+    _check_packed(packed, params)
+    return match_table(color_sel, params)[packed]
+
+
+def filter_frame(packed, color_sel, params):
+    """The filtered frame, uint16 (H, W): the pixel where it matches, else 0."""
+    match = color_match(packed, color_sel, params)
+    return np.where(match, packed, np.uint16(0)).astype(np.uint16, copy=False)
+
+
+@dataclass(frozen=True)
+class TrackerResult:
+    """Per-frame tracker outputs and the counts they come from.
+
+    Attributes
+    ----------
+    found, proximity, centroid_x, centroid_leds
+        The design's outputs.
+    count
+        ``N``: matching pixels in the window.
+    bins
+        ``(h0, ..., h7)``: matching pixels per bin of window columns, left to right.
+    sum_x
+        ``SX``: sum of the frame column index of every counted pixel.
+    """
+
+    found: bool
+    proximity: int
+    centroid_x: int
+    centroid_leds: int
+    count: int
+    bins: tuple
+    sum_x: int
+
+    @property
+    def left_count(self):
+        """``L = h0 + h1 + h2 + h3``."""
+        return sum(self.bins[:4])
+
+    @property
+    def right_count(self):
+        """``R = h4 + h5 + h6 + h7``."""
+        return sum(self.bins[4:])
+
+
+def proximity_level(count, thresholds):
+    """How many thresholds satisfy ``count >= t`` (0..7)."""
+    return sum(1 for t in thresholds if count >= t)
+
+
+def centroid_leds(bins, count, found):
+    """The published LED code (bit 0 = leftmost LED) from the bins and ``N``."""
+    if not found:
+        return 0
+    left, right = sum(bins[:4]), sum(bins[4:])
+    half = count >> 1
+    if abs(left - right) < (count >> 4):
+        return LEDS_CENTRED
+    if left > right:
+        acc = 0
+        for led in range(3):
+            acc += bins[led]
+            if acc >= half:
+                return 1 << led
+        return 1 << 3
+    acc = 0
+    for led in (7, 6, 5):
+        acc += bins[led]
+        if acc >= half:
+            return 1 << led
+    return 1 << 4
+
+
+def track_frame(match, params):
+    """Tracker outputs of one frame from its (H, W) bool match mask."""
+    if match.shape != (params.height, params.width):
+        raise FrameError(
+            f"the match mask must have shape ({params.height}, {params.width}), got {match.shape}"
+        )
+    mx, my = params.margin_x, params.margin_y
+    window = match[my : params.height - my, mx : params.width - mx]
+    columns = np.count_nonzero(window, axis=0)
+    bins = tuple(int(v) for v in columns.reshape(8, params.bin_width).sum(axis=1))
+    count = sum(bins)
+    sum_x = int(columns @ np.arange(mx, params.width - mx))
+    found = count >= params.min_pixels
+    return TrackerResult(
+        found=found,
+        proximity=proximity_level(count, params.proximity_thresholds),
+        centroid_x=sum_x // count if found else 0,
+        centroid_leds=centroid_leds(bins, count, found),
+        count=count,
+        bins=bins,
+        sum_x=sum_x,
+    )
+
+
+class MotorModel:
+    """The per-frame motor controller, with its state across frames.
+
+    Parameters
+    ----------
+    params : FollowTargetParams
+
+    Attributes
+    ----------
+    left, right : int
+        Current motor outputs (signed DPS); 0 after reset.
+    lost_count : int
+        Consecutive frames without the target (saturates at ``lost_frames``).
+    last_side : str
+        ``"left"`` or ``"right"``: side of the last seen target; ``"left"`` after reset.
+    """
+
+    def __init__(self, params):
+        if not isinstance(params, FollowTargetParams):
+            raise TypeError("params must be a FollowTargetParams")
+        self.params = params
+        self.reset()
+
+    def reset(self):
+        self.left = 0
+        self.right = 0
+        self.lost_count = 0
+        self.last_side = "left"
+
+    def _saturate(self, v):
+        m = self.params.max_dps
+        return max(-m, min(m, v))
+
+    @property
+    def searching(self):
+        """True while the outputs are the search command (lost for ``lost_frames`` or more)."""
+        return self.lost_count >= self.params.lost_frames
+
+    def step(self, tracker):
+        """Update on one frame's ``TrackerResult``; return ``(left, right)``."""
+        p = self.params
+        if tracker.found:
+            self.lost_count = 0
+            base = p.base_dps[tracker.proximity]
+            e = tracker.centroid_x - p.width // 2
+            turn = (p.kp_num * e) >> p.kp_shift  # Python's >> on ints is arithmetic
+            self.left = self._saturate(base + turn)
+            self.right = self._saturate(base - turn)
+            self.last_side = "right" if e >= 0 else "left"
+        else:
+            self.lost_count = min(self.lost_count + 1, p.lost_frames)
+            if self.searching:
+                s = p.search_dps if self.last_side == "right" else -p.search_dps
+                self.left, self.right = s, -s
+            # else: hold the last command
+        return self.left, self.right
+
+
+@dataclass(frozen=True, eq=False)
+class ModelFrame:
+    """What the model produced for one frame."""
+
+    filtered: np.ndarray
+    tracker: TrackerResult
+    motor_left: int
+    motor_right: int
+
+
+class FollowTargetModel:
+    """The whole design, frame by frame: filter, tracker and motor controller with state.
+
+    Parameters
+    ----------
+    params : FollowTargetParams, optional
+        Defaults to ``FollowTargetParams()``.
+    """
+
+    def __init__(self, params=None):
+        self.params = params if params is not None else FollowTargetParams()
+        self.motor = MotorModel(self.params)
+
+    def reset(self):
+        """Back to the power-on state (motor outputs 0, last side left, lost count 0)."""
+        self.motor.reset()
+
+    def process(self, packed, color_sel):
+        """Process one frame (packed RGB444 (H, W), or RGB888 (H, W, 3)); return a ModelFrame."""
+        p = self.params
+        packed = to_rgb444(packed, p.width, p.height)
+        match = match_table(color_sel, p)[packed]
+        filtered = np.where(match, packed, np.uint16(0)).astype(np.uint16, copy=False)
+        tracker = track_frame(match, p)
+        left, right = self.motor.step(tracker)
+        return ModelFrame(filtered, tracker, left, right)
