@@ -1,0 +1,263 @@
+"""The robot's world: a top-down pymunk simulation in metres and seconds.
+
+The robot is a dynamic disc driven by pymunk's control-body idiom: a kinematic control body
+moves at the twist the wheels ask for, and a ``PivotJoint`` and a ``GearJoint`` (no position
+correction, ``max_bias = 0``) pull the robot towards that velocity with at most the
+robot's traction force and torque. The robot's velocity is never written directly, so walls,
+furniture and people stop it. People are kinematic bodies on scripted paths; walls and
+furniture are static shapes. Collisions of the robot are counted per kind from pymunk
+collision handlers.
+"""
+
+import math
+
+import numpy as np
+import pymunk
+
+from ...records import PersonState, WorldMap
+from ..scene import CameraPose, Cylinder, Scene
+from .config import WorldConfigError, parse_world_config
+from .lighting import LightingSchedule
+from .motors import SimMotors
+from .people import PersonPath, person_bands
+from .room import add_static_shapes, map_data, scene_walls
+
+__all__ = ["MAX_SUBSTEP", "World"]
+
+#: ``step(dt)`` splits longer steps into equal sub-steps no longer than this, s.
+MAX_SUBSTEP = 0.01
+
+_ROBOT, _WALL, _FURNITURE, _PERSON = 1, 2, 3, 4
+_KINDS = ("person", "wall", "furniture")
+_FRICTION = 0.5
+
+
+class _Person:
+    __slots__ = ("bands", "body", "config", "path", "shape")
+
+    def __init__(self, config, path, body, shape):
+        self.config = config
+        self.path = path
+        self.body = body
+        self.shape = shape
+        self.bands = person_bands(config)
+
+
+class World:
+    """A room with a robot and walking people, advanced in fixed steps.
+
+    Build it with ``World.from_config(cfg, seed)``; see docs/scenarios.md for ``cfg``.
+
+    Parameters
+    ----------
+    config : WorldConfig
+        A validated configuration (``config.parse_world_config``).
+    seed : int
+        Fixes every random choice (people's speed jitter).
+
+    Attributes
+    ----------
+    time : float
+        Simulated time, s.
+    robot_spec : RobotSpec
+        The robot's geometry, mass and motor power.
+    motors : SimMotors
+        The wheel motors (``set_wheel_dps`` is forwarded to them).
+    """
+
+    def __init__(self, config, seed=0):
+        if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
+            raise ValueError(f"seed must be a non-negative integer, got {seed!r}")
+        self.config = config
+        self.seed = int(seed)
+        self.rng = np.random.default_rng(self.seed)
+        self.time = 0.0
+        self._time_error = 0.0  # Kahan compensation: many small steps add up exactly
+        self.robot_spec = spec = config.robot.spec
+        self.motors = SimMotors(spec)
+        self.lighting = LightingSchedule(config.lighting)
+
+        self.space = space = pymunk.Space()
+        space.gravity = (0.0, 0.0)
+        space.iterations = 10
+
+        # The robot and its control body (pymunk's tank example idiom).
+        self.robot_body = body = pymunk.Body(spec.mass, spec.moment)
+        body.position = config.robot.start
+        body.angle = config.robot.heading
+        self.robot_shape = shape = pymunk.Circle(body, spec.body_radius)
+        shape.collision_type = _ROBOT
+        shape.friction = _FRICTION
+        shape.elasticity = 0.0
+        self.control_body = control = pymunk.Body(body_type=pymunk.Body.KINEMATIC)
+        control.position = config.robot.start
+        control.angle = config.robot.heading
+        pivot = pymunk.PivotJoint(control, body, (0.0, 0.0), (0.0, 0.0))
+        pivot.max_bias = 0.0  # velocity control only: never pull towards a position
+        pivot.max_force = spec.traction_force
+        gear = pymunk.GearJoint(control, body, 0.0, 1.0)
+        gear.max_bias = 0.0
+        gear.max_force = spec.traction_torque
+        space.add(body, shape, control, pivot, gear)
+
+        self._names = add_static_shapes(space, config.room, wall_type=_WALL,
+                                        furniture_type=_FURNITURE, friction=_FRICTION)
+        self.people = []
+        for pc in config.people:
+            path = PersonPath(pc, self.rng)
+            pbody = pymunk.Body(body_type=pymunk.Body.KINEMATIC)
+            pbody.position = path.position(0.0)
+            pshape = pymunk.Circle(pbody, pc.radius)
+            pshape.collision_type = _PERSON
+            pshape.friction = _FRICTION
+            pshape.elasticity = 0.0
+            space.add(pbody, pshape)
+            self._names[pshape] = ("person", pc.name)
+            self.people.append(_Person(pc, path, pbody, pshape))
+        self._target = next((p for p in self.people if p.config.target), None)
+
+        for hit in space.shape_query(shape):
+            kind, name = self._names[hit.shape]
+            what = f"{kind} {name!r}" if name else kind
+            raise WorldConfigError(f"robot.start {list(config.robot.start)} overlaps the {what}")
+
+        self._counts = dict.fromkeys(_KINDS, 0)
+        self._events = []
+        for ctype in (_WALL, _FURNITURE, _PERSON):
+            space.on_collision(_ROBOT, ctype, begin=self._on_begin)
+
+        self._static_walls = scene_walls(config.room)
+        self._world_map = WorldMap(*map_data(config.room))
+
+    @classmethod
+    def from_config(cls, cfg=None, seed=0):
+        """Validate ``cfg`` (sections ``room``, ``robot``, ``people``, ``lighting``) and build
+        the world; raises ``WorldConfigError`` naming the offending key."""
+        return cls(parse_world_config(cfg), seed)
+
+    # -- physics ------------------------------------------------------------------------
+
+    def _on_begin(self, arbiter, space, data):
+        kind, name = self._names[arbiter.shapes[1]]
+        self._counts[kind] += 1
+        self._events.append(f"collision with {kind} {name!r}" if name else f"collision with {kind}")
+
+    def step(self, dt):
+        """Advance the world by ``dt`` seconds (split into sub-steps of at most
+        ``MAX_SUBSTEP``)."""
+        if not dt > 0 or not math.isfinite(dt):
+            raise ValueError(f"dt must be a positive number of seconds, got {dt!r}")
+        n = max(1, math.ceil(dt / MAX_SUBSTEP - 1e-9))
+        h = dt / n
+        for _ in range(n):
+            self._substep(h)
+
+    def _substep(self, h):
+        spec = self.robot_spec
+        wl, wr = self.motors.step(h)
+        r = spec.wheel_radius
+        v = r * (wl + wr) * 0.5
+        w = r * (wr - wl) / spec.wheel_separation
+        body = self.robot_body
+        a = body.angle
+        control = self.control_body
+        control.velocity = (v * math.cos(a), v * math.sin(a))
+        control.angular_velocity = w
+        t1 = self._advance_time(h)
+        for person in self.people:
+            x, y = person.path.position(t1)
+            px, py = person.body.position
+            # Arrive exactly on the script at t1; the velocity lets contacts push the robot.
+            person.body.velocity = ((x - px) / h, (y - py) / h)
+        self.space.step(h)
+        self.time = t1
+
+    def _advance_time(self, h):
+        y = h - self._time_error
+        t = self.time + y
+        self._time_error = (t - self.time) - y
+        return t
+
+    # -- motors -------------------------------------------------------------------------
+
+    def set_wheel_dps(self, left_dps, right_dps):
+        """Wheel speed targets in degrees per second (the design's SET_MOTOR_DPS values)."""
+        self.motors.set_wheel_dps(left_dps, right_dps)
+
+    def commanded_twist(self):
+        """``(v, w)`` of the current DPS command by the real kinematics."""
+        return self.motors.commanded_twist()
+
+    def wheel_speeds(self):
+        """The motors' current wheel speeds ``(left, right)``, rad/s (after ramp and clamp)."""
+        return self.motors.wheel_speeds()
+
+    # -- state --------------------------------------------------------------------------
+
+    def robot_pose(self):
+        """``(x, y, heading)``: m, m, rad in [-pi, pi)."""
+        body = self.robot_body
+        x, y = body.position
+        heading = (body.angle + math.pi) % (2 * math.pi) - math.pi
+        return float(x), float(y), heading
+
+    def robot_velocity(self):
+        """Measured ``(v, w)``: forward speed (m/s) and turn rate (rad/s) of the body."""
+        body = self.robot_body
+        vx, vy = body.velocity
+        a = body.angle
+        return vx * math.cos(a) + vy * math.sin(a), body.angular_velocity
+
+    def camera_pose(self):
+        """The robot's camera as ``sim.scene.CameraPose`` (mount from ``robot_spec``)."""
+        spec = self.robot_spec
+        x, y, heading = self.robot_pose()
+        return CameraPose(x=x + spec.camera_forward * math.cos(heading),
+                          y=y + spec.camera_forward * math.sin(heading), heading=heading,
+                          height=spec.camera_height, tilt=spec.camera_tilt)
+
+    def people_states(self):
+        """Every person's position, as ``records.PersonState``."""
+        states = []
+        for p in self.people:
+            x, y = p.body.position
+            states.append(PersonState(p.config.name, float(x), float(y), p.config.radius,
+                                      p.config.target))
+        return states
+
+    def target_position(self):
+        """``(x, y)`` of the target person, or None if there is none."""
+        if self._target is None:
+            return None
+        x, y = self._target.body.position
+        return float(x), float(y)
+
+    def lighting_at(self, t=None):
+        """``sim.scene.Lighting`` at ``t`` (default: now)."""
+        return self.lighting.at(self.time if t is None else t)
+
+    def scene(self):
+        """What the camera sees now, as ``sim.scene.Scene``."""
+        room = self.config.room
+        cylinders = []
+        for p in self.people:
+            x, y = p.body.position
+            cylinders.append(Cylinder(x=float(x), y=float(y), radius=p.config.radius,
+                                      bands=p.bands))
+        return Scene(walls=self._static_walls, cylinders=tuple(cylinders),
+                     floor_color=tuple(room.floor_color),
+                     ceiling_color=tuple(room.ceiling_color), ceiling_height=room.height,
+                     lighting=self.lighting.at(self.time))
+
+    def world_map(self):
+        """Static geometry for the viewer's top-down map (``records.WorldMap``)."""
+        return self._world_map
+
+    def drain_events(self):
+        """Collision events since the last call, e.g. ``"collision with wall"``."""
+        events, self._events = self._events, []
+        return events
+
+    def collision_counts(self):
+        """Robot collisions since the start, per kind: ``{"person", "wall", "furniture"}``."""
+        return dict(self._counts)
