@@ -1,12 +1,238 @@
-"""``python -m fpga_robotics.run``: the closed-loop demo (placeholder until the loop lands)."""
+"""``python -m fpga_robotics.run``: run a scenario in closed loop (or the design on real frames).
 
+Headless and faster than real time by default; prints a progress bar on stderr and a human
+summary at the end; ``--summary PATH`` writes the same as JSON. Exit status: 0 when the
+scenario's checks pass, 1 when they fail, 2 for a usage error (bad argument, unknown scenario
+or key, malformed file, unopenable source, missing simulator).
+"""
+
+import argparse
+import json
+import os
 import sys
+import tempfile
+import time
+from pathlib import Path
 
 from .errors import UsageError, run_cli
+from .hw.pixel import COLOR_SELECT
+
+__all__ = ["Progress", "build_parser", "main", "write_json_atomic"]
+
+BACKEND_CHOICES = ("auto", "model", "pysim", "cxxrtl", "verilator")
+
+
+def build_parser():
+    p = argparse.ArgumentParser(
+        prog="python -m fpga_robotics.run",
+        description="Run the FollowTarget design in closed loop with a simulated robot, camera "
+                    "and people, and check the scenario's pass criteria.",
+    )
+    p.add_argument("--scenario", default="follow_person", metavar="NAME|PATH",
+                   help="a shipped scenario (see --list-scenarios) or a .toml file "
+                        "(default: follow_person)")
+    p.add_argument("--list-scenarios", action="store_true", help="list the shipped scenarios")
+    p.add_argument("--backend", default="auto", choices=BACKEND_CHOICES,
+                   help="design simulator (default auto: the fastest compiled one available)")
+    p.add_argument("--resolution", metavar="WxH", help="camera and design resolution")
+    p.add_argument("--color", choices=tuple(COLOR_SELECT), help="initial colour select")
+    p.add_argument("--duration", type=float, metavar="S", help="simulated seconds")
+    p.add_argument("--seed", type=int, metavar="N", help="random seed (default: the scenario's)")
+    p.add_argument("--realtime", action="store_true", help="pace the simulation to the clock")
+    p.add_argument("--summary", metavar="PATH", help="write the summary as JSON")
+    p.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
+                   help="override a scenario value, e.g. robot.mass=12 (repeatable; TOML values)")
+    p.add_argument("--rerun", default="auto", metavar="MODE",
+                   help="viewer: save:PATH.rrd, spawn, connect[:URL], serve, off; default auto = "
+                        "spawn with a display, else save:runs/<scenario>.rrd")
+    p.add_argument("--log-every", type=int, default=1, metavar="N",
+                   help="log every Nth frame's images to the viewer (default 1)")
+    p.add_argument("--source", metavar="camera:N|VIDEO|FOLDER",
+                   help="run the design on real frames instead of the simulation (no physics)")
+    p.add_argument("--max-frames", type=int, metavar="N", help="with --source: stop after N")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    return p
+
+
+class Progress:
+    """A progress bar on stderr: redrawn in place on a terminal, a few plain lines otherwise."""
+
+    def __init__(self, label, stream=None):
+        self.stream = stream if stream is not None else sys.stderr
+        self.tty = bool(getattr(self.stream, "isatty", lambda: False)())
+        self.label = label
+        self.start = time.perf_counter()
+        self._last_draw = 0.0
+        self._last_decile = -1
+
+    def __call__(self, done, total):
+        now = time.perf_counter()
+        if total is None:  # open-ended source
+            if self.tty and (now - self._last_draw > 0.1):
+                self.stream.write(f"\r{self.label}: {done} frames")
+                self.stream.flush()
+                self._last_draw = now
+            return
+        if self.tty:
+            if now - self._last_draw < 0.1 and done < total:
+                return
+            self._last_draw = now
+            width = 30
+            filled = int(width * done / total)
+            rate = done / max(now - self.start, 1e-9)
+            self.stream.write(f"\r{self.label} [{'#' * filled}{'.' * (width - filled)}] "
+                              f"{done}/{total} frames, {rate:.0f} fps")
+            self.stream.flush()
+        else:
+            decile = 10 * done // total
+            if decile != self._last_decile and decile % 2 == 0:
+                self._last_decile = decile
+                self.stream.write(f"{self.label}: {10 * decile}% ({done}/{total} frames)\n")
+                self.stream.flush()
+
+    def finish(self):
+        if self.tty:
+            self.stream.write("\n")
+            self.stream.flush()
+
+
+def write_json_atomic(path, data):
+    """Write ``data`` as JSON to ``path`` through a temporary file and a rename."""
+    path = Path(path)
+    directory = path.parent if str(path.parent) else Path(".")
+    directory.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=directory)
+    try:
+        with os.fdopen(fd, "w") as f:
+            json.dump(data, f, indent=2)
+            f.write("\n")
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def _overrides(args):
+    from .scenario import parse_resolution
+
+    items = list(args.overrides)
+    if args.resolution is not None:
+        w, h = parse_resolution(args.resolution)
+        items.append(f'camera.resolution="{w}x{h}"')
+    if args.duration is not None:
+        if not args.duration > 0:
+            raise UsageError(f"--duration must be > 0 seconds, got {args.duration}")
+        items.append(f"sim.duration={float(args.duration)!r}")
+    if args.color is not None:
+        items.append(f'color.initial="{args.color}"')
+    return items
+
+
+def _open_backend(name, params):
+    from .loop import make_backend
+    from .sim.backends.base import BackendError
+
+    try:
+        return make_backend(name, params)
+    except (BackendError, ValueError, ImportError) as exc:
+        raise UsageError(f"backend {name!r} cannot run here: {exc}") from None
+
+
+def _open_recorder(args, name):
+    if args.rerun == "off":
+        return None
+    if args.log_every < 1:
+        raise UsageError(f"--log-every must be >= 1, got {args.log_every}")
+    from .viz import open_recorder
+
+    return open_recorder(args.rerun, default_path=f"runs/{name}.rrd", app_id="fpga_robotics",
+                         log_every=args.log_every)
+
+
+def _list_scenarios():
+    from .scenario import shipped_scenarios
+
+    shipped = shipped_scenarios()
+    width = max(len(n) for n in shipped)
+    for name, (_path, desc) in shipped.items():
+        print(f"{name:<{width}}  {desc}")
+    return 0
+
+
+def _run_source(args, scenario):
+    from .sources import open_source, run_source
+
+    params = scenario.params
+    source = open_source(args.source, params.width, params.height)
+    try:
+        design = _open_backend(args.backend, params)
+        recorder = None
+        try:
+            recorder = _open_recorder(args, Path(str(args.source).replace(":", "_")).stem)
+            progress = None if args.quiet else Progress("frames")
+            out = run_source(source, design, color=scenario.color_initial, recorder=recorder,
+                             progress=progress, max_frames=args.max_frames,
+                             hfov=scenario.camera.hfov)
+            if progress is not None:
+                progress.finish()
+        finally:
+            design.close()
+            where = recorder.close() if recorder is not None else None
+    finally:
+        source.close()
+    print(f"source {out['source']} ({out['source_kind']})  backend {out['backend']}  "
+          f"{out['resolution']}  colour {out['color']}")
+    if out["frames"]:
+        print(f"  {out['frames']} frames, {out['ms_per_frame']:.2f} ms/frame "
+              f"(design {out['design_ms_per_frame']:.2f} ms)")
+        print(f"  target found in {out['found_frames']} frames ({out['found_fraction']:.0%}), "
+              f"mean proximity {out['mean_proximity']:.2f}")
+    else:
+        print("  no frames")
+    if where:
+        print(where)
+    if args.summary:
+        write_json_atomic(args.summary, out)
+    return 0
 
 
 def main(argv=None):
-    raise UsageError("the closed loop is not built yet; see the README for what works today")
+    args = build_parser().parse_args(argv)
+    if args.list_scenarios:
+        return _list_scenarios()
+
+    from .loop import run_scenario
+    from .scenario import load_scenario
+    from .summary import format_summary
+
+    scenario = load_scenario(args.scenario, _overrides(args))
+    if args.source is not None:
+        return _run_source(args, scenario)
+    if args.max_frames is not None:
+        raise UsageError("--max-frames only applies with --source (use --duration)")
+
+    t0 = time.perf_counter()
+    design = _open_backend(args.backend, scenario.params)
+    setup = time.perf_counter() - t0
+    recorder = None
+    try:
+        recorder = _open_recorder(args, scenario.name)
+        progress = None if args.quiet else Progress(scenario.name)
+        result = run_scenario(scenario, seed=args.seed, backend=design, recorder=recorder,
+                              progress=progress, realtime=args.realtime)
+        if progress is not None:
+            progress.finish()
+    finally:
+        design.close()
+        where = recorder.close() if recorder is not None else None
+    summary = dict(result.summary)
+    summary["backend_setup_s"] = round(setup, 3)
+    print(format_summary(summary))
+    if where:
+        print(where)
+    if args.summary:
+        write_json_atomic(args.summary, summary)
+    return 0 if summary["verdict"] == "pass" else 1
 
 
 if __name__ == "__main__":

@@ -1,0 +1,179 @@
+"""What a closed-loop run measured, the scenario's checks against it, and the verdict.
+
+``metrics(traj, events, ...)`` reduces the per-frame trajectory to numbers;
+``evaluate_checks(checks, metrics)`` compares them with the scenario's limits. Each check
+says what it measured, its limit and whether it passed, so that a failing verdict explains
+itself. ``format_summary`` is the human version printed by the runner.
+"""
+
+import numpy as np
+
+__all__ = [
+    "CHECKS",
+    "TIMING_FIELDS",
+    "compute_metrics",
+    "evaluate_checks",
+    "format_summary",
+    "verdict",
+]
+
+#: Pass criteria a scenario may state in its ``[checks]`` table: name → (type, meaning).
+CHECKS = {
+    "acquired_within_s": (float, "the design reports the target found within this time"),
+    "mean_distance_max_m": (float, "mean robot-to-target distance (centres) at most this"),
+    "min_distance_min_m": (float, "closest robot-to-target distance (centres) at least this"),
+    "max_person_collisions": (int, "at most this many collisions with a person"),
+    "max_wall_collisions": (int, "at most this many collisions with a wall"),
+    "max_furniture_collisions": (int, "at most this many collisions with furniture"),
+    "target_in_view_min_fraction": (float, "the target is in the camera's view this often"),
+    "found_min_fraction": (float, "after first acquisition, the design reports found this often"),
+    "reacquired_within_s": (
+        float,
+        ("the design lost the target and searched at least once, and every loss ended with the "
+        "target found again within this time"),
+    ),
+}
+
+#: Summary fields that depend on the machine, not on the simulation.
+TIMING_FIELDS = ("wall_time_s", "ms_per_frame", "realtime_factor")
+
+
+def _round(x, digits=4):
+    return None if x is None else round(float(x), digits)
+
+
+def compute_metrics(traj, events, collisions, frame_period):
+    """Reduce a run to numbers.
+
+    Parameters
+    ----------
+    traj : dict of numpy arrays, one entry per camera frame
+        ``t``, ``x``, ``y``, ``found``, ``target_distance`` (NaN without target),
+        ``target_in_view``.
+    events : list of (frame, time, text)
+    collisions : dict kind → count
+    frame_period : float
+    """
+    t = traj["t"]
+    n = len(t)
+    dist = traj["target_distance"]
+    valid = ~np.isnan(dist)
+    found = traj["found"]
+    first = int(np.argmax(found)) if found.any() else None
+    acquired_at = float(t[first]) if first is not None else None
+    found_after = float(found[first:].mean()) if first is not None else 0.0
+    path = float(np.hypot(np.diff(traj["x"]), np.diff(traj["y"])).sum()) if n > 1 else 0.0
+
+    # Loss episodes: from a "target lost" to the next "target found".
+    episodes = []  # (lost_time, found_time or None, searched)
+    open_ep = None
+    for _frame, time, text in events:
+        if text == "target lost":
+            open_ep = [time, None, False]
+            episodes.append(open_ep)
+        elif text == "search started" and open_ep is not None:
+            open_ep[2] = True
+        elif text == "target found" and open_ep is not None:
+            open_ep[1] = time
+            open_ep = None
+    end_time = float(t[-1]) + frame_period if n else 0.0
+    reacq = [round(f - lost, 4) for lost, f, _ in episodes if f is not None]
+    unrecovered = [round(end_time - lost, 4) for lost, f, _ in episodes if f is None]
+    return {
+        "min_distance_m": _round(dist[valid].min()) if valid.any() else None,
+        "mean_distance_m": _round(dist[valid].mean()) if valid.any() else None,
+        "target_in_view_fraction": _round(traj["target_in_view"].mean()) if n else 0.0,
+        "found_fraction": _round(found.mean()) if n else 0.0,
+        "found_after_acquisition_fraction": _round(found_after),
+        "acquired_at_s": _round(acquired_at),
+        "collisions": dict(collisions),
+        "losses": len(episodes),
+        "searches": sum(1 for _, _, text in events if text == "search started"),
+        "searched_losses": sum(1 for ep in episodes if ep[2]),
+        "reacquire_times_s": reacq,
+        "unrecovered_losses_s": unrecovered,
+        "path_length_m": _round(path),
+    }
+
+
+def _check(name, passed, value, limit, text):
+    return {"name": name, "passed": bool(passed), "value": value, "limit": limit, "text": text}
+
+
+def evaluate_checks(checks, m):
+    """The scenario's checks against the metrics ``m``: a list of result dicts, in order."""
+    out = []
+    for name, limit in checks.items():
+        if name == "acquired_within_s":
+            v = m["acquired_at_s"]
+            ok = v is not None and v <= limit
+            text = (f"target first found at {v:.2f} s (limit {limit} s)" if v is not None
+                    else "the target was never found")
+        elif name == "mean_distance_max_m":
+            v = m["mean_distance_m"]
+            ok = v is not None and v <= limit
+            text = f"mean distance {v} m (limit <= {limit} m)"
+        elif name == "min_distance_min_m":
+            v = m["min_distance_m"]
+            ok = v is not None and v >= limit
+            text = f"min distance {v} m (limit >= {limit} m)"
+        elif name.startswith("max_") and name.endswith("_collisions"):
+            kind = name[len("max_"): -len("_collisions")]
+            v = int(m["collisions"].get(kind, 0))
+            ok = v <= limit
+            text = f"{v} collision(s) with {kind} (limit {limit})"
+        elif name == "target_in_view_min_fraction":
+            v = m["target_in_view_fraction"]
+            ok = v >= limit
+            text = f"target in view {v:.0%} of frames (limit >= {limit:.0%})"
+        elif name == "found_min_fraction":
+            v = m["found_after_acquisition_fraction"]
+            ok = m["acquired_at_s"] is not None and v >= limit
+            text = f"found in {v:.0%} of frames after acquisition (limit >= {limit:.0%})"
+        elif name == "reacquired_within_s":
+            times = m["reacquire_times_s"]
+            late = [u for u in m["unrecovered_losses_s"] if u > limit]
+            v = max(times) if times else None
+            ok = m["searched_losses"] >= 1 and all(x <= limit for x in times) and not late
+            if m["searched_losses"] == 0:
+                text = "the target was never lost long enough for the design to search"
+            elif late:
+                text = f"target lost and not found again for {max(late):.2f} s (limit {limit} s)"
+            else:
+                text = (f"{len(times)} re-acquisition(s), slowest {v:.2f} s after the loss "
+                        f"(limit {limit} s)")
+        else:  # validated by the scenario loader; keep a clear message anyway
+            raise ValueError(f"unknown check {name!r}")
+        out.append(_check(name, ok, v, limit, text))
+    return out
+
+
+def verdict(check_results):
+    return "pass" if all(c["passed"] for c in check_results) else "fail"
+
+
+def format_summary(s):
+    """The human summary printed at the end of a run (several lines)."""
+    lines = [
+        f"scenario {s['scenario']}  backend {s['backend']}  {s['resolution']}  seed {s['seed']}",
+        (f"  {s['frames']} frames, {s['sim_time_s']:.1f} s simulated in {s['wall_time_s']:.2f} s"
+        f" ({s['ms_per_frame']:.2f} ms/frame, {s['realtime_factor']:.1f}x real time)"),
+    ]
+    acq = s["acquired_at_s"]
+    lines.append(
+        "  target: "
+        + (f"first found at {acq:.2f} s" if acq is not None else "never found")
+        + f", in view {s['target_in_view_fraction']:.0%}, found {s['found_fraction']:.0%}"
+        + f", {s['searches']} search(es)"
+    )
+    if s["min_distance_m"] is not None:
+        lines.append(
+            f"  distance: min {s['min_distance_m']:.2f} m, mean {s['mean_distance_m']:.2f} m; "
+            f"path {s['path_length_m']:.1f} m"
+        )
+    coll = ", ".join(f"{k} {v}" for k, v in s["collisions"].items()) or "none"
+    lines.append(f"  collisions: {coll}")
+    for c in s["checks"]:
+        lines.append(f"  [{'ok' if c['passed'] else 'FAIL'}] {c['name']}: {c['text']}")
+    lines.append(f"verdict: {s['verdict'].upper()}")
+    return "\n".join(lines)
