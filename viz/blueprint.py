@@ -1,0 +1,82 @@
+"""The default viewer layout, built from code.
+
+Left, what the board sees and decides (like the paper's GUI): the camera frame and the design's
+filtered frame side by side, the proximity and centroid LEDs under them, then the wheels' DPS
+and the robot's V and W. Right, the world: the top-down map, and under it the tracker's
+outputs and the event log.
+"""
+
+import rerun.blueprint as rrb
+
+from . import paths as P
+
+__all__ = ["default_blueprint"]
+
+_TIMELINE = "sim_time"
+
+
+def _trail_range():
+    # A trail is logged as one segment per frame; show every segment up to the time cursor.
+    return rrb.VisibleTimeRanges(
+        [
+            rrb.VisibleTimeRange(
+                timeline,
+                start=rrb.TimeRangeBoundary.infinite(),
+                end=rrb.TimeRangeBoundary.cursor_relative(),
+            )
+            for timeline in ("frame", "sim_time")
+        ]
+    )
+
+
+def default_blueprint(bounds=None):
+    """The layout sent to the viewer; ``bounds`` ``(xmin, ymin, xmax, ymax)`` frame the map."""
+    map_kwargs = {}
+    if bounds is not None:
+        xmin, ymin, xmax, ymax = (float(v) for v in bounds)
+        pad = 0.05 * max(xmax - xmin, ymax - ymin)
+        # The map is drawn with y flipped (the viewer's 2D y axis points down).
+        map_kwargs["visual_bounds"] = rrb.VisualBounds2D(
+            x_range=[xmin - pad, xmax + pad], y_range=[-ymax - pad, -ymin + pad]
+        )
+    board = rrb.Vertical(
+        rrb.Horizontal(
+            rrb.Spatial2DView(origin=P.CAMERA_RAW, name="Camera"),
+            rrb.Spatial2DView(origin=P.CAMERA_FILTERED, name="Filtered (design output)"),
+        ),
+        rrb.Horizontal(
+            rrb.Spatial2DView(origin=P.LEDS_PROXIMITY, name="Proximity LEDs"),
+            rrb.Spatial2DView(origin=P.LEDS_CENTROID, name="Centroid LEDs"),
+            column_shares=[7, 8],
+        ),
+        rrb.Horizontal(
+            rrb.TimeSeriesView(origin=P.MOTORS_DPS, name="Wheel DPS (left, right)"),
+            rrb.TimeSeriesView(origin=P.TWIST_V, name="V m/s (commanded, measured)"),
+            rrb.TimeSeriesView(origin=P.TWIST_W, name="W rad/s (commanded, measured)"),
+        ),
+        row_shares=[4, 1, 3],
+        name="Board",
+    )
+    world = rrb.Vertical(
+        rrb.Spatial2DView(
+            origin=P.MAP,
+            name="World (top-down)",
+            overrides={P.TRAIL_ROBOT: _trail_range(), P.TRAIL_TARGET: _trail_range()},
+            **map_kwargs,
+        ),
+        rrb.Horizontal(
+            rrb.Tabs(
+                rrb.TimeSeriesView(origin=P.DESIGN_TRACKING, name="found, proximity"),
+                rrb.TimeSeriesView(origin=P.DESIGN_CENTROID_X, name="centroid_x"),
+                rrb.TimeSeriesView(origin=P.TARGET_DISTANCE, name="target distance m"),
+            ),
+            rrb.TextLogView(origin=P.EVENTS, name="Events"),
+        ),
+        row_shares=[3, 1],
+        name="World",
+    )
+    return rrb.Blueprint(
+        rrb.Horizontal(board, world, column_shares=[1, 1]),
+        rrb.TimePanel(timeline=_TIMELINE),
+        collapse_panels=False,
+    )

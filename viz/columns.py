@@ -1,0 +1,103 @@
+"""Per-frame rows buffered and sent to rerun as columns, one ``send_columns`` per entity.
+
+A ``rr.log`` call costs tens of microseconds of Python, whatever its size; a frame has about
+fifteen small entities. Buffering their rows and sending each entity's rows as one column
+every few frames (or every 0.1 s, so a live viewer lags by at most that) keeps logging far
+below a millisecond per frame. Each row keeps its own ``frame`` and ``sim_time``, so the
+recording is the same as with one ``rr.log`` per row.
+"""
+
+import time
+
+import numpy as np
+import rerun as rr
+
+__all__ = ["ColumnBuffer", "arrows", "images", "points", "scalars", "strips", "time_ns"]
+
+#: Send when this many frames are buffered or this much wall time passed since the last send.
+MAX_FRAMES = 32
+MAX_SECONDS = 0.1
+
+
+def time_ns(seconds):
+    """Simulated seconds as a ``timedelta64[ns]`` (the same value for rows and images)."""
+    return np.timedelta64(round(float(seconds) * 1e9), "ns")
+
+
+def scalars(rows):
+    """Rows of equal-length float tuples -> ``Scalars`` column (one series per position)."""
+    return rr.Scalars.columns(scalars=np.asarray(rows, dtype=np.float64))
+
+
+def images(rows):
+    """Rows of equal-shape uint8 images -> ``Image`` buffer column (format logged static)."""
+    return rr.Image.columns(buffer=np.stack(rows).reshape(len(rows), -1))
+
+
+def arrows(rows):
+    """Rows ``(ox, oy, vx, vy)`` -> one arrow per row."""
+    a = np.asarray(rows, dtype=np.float32)
+    return rr.Arrows2D.columns(origins=a[:, :2], vectors=a[:, 2:])
+
+
+def strips(rows):
+    """Rows of one line strip each (equal point counts) -> one strip per row."""
+    return rr.LineStrips2D.columns(strips=np.asarray(rows, dtype=np.float32))
+
+
+def points(rows):
+    """Rows of ``(positions, radii, colors, labels)`` lists -> a point batch per row."""
+    lengths = [len(r[0]) for r in rows]
+    cols = rr.Points2D.columns(
+        positions=np.asarray([p for r in rows for p in r[0]], dtype=np.float32).reshape(-1, 2),
+        radii=np.asarray([x for r in rows for x in r[1]], dtype=np.float32),
+        colors=np.asarray([c for r in rows for c in r[2]], dtype=np.uint8).reshape(-1, 3),
+        labels=[s for r in rows for s in r[3]],
+    )
+    return cols.partition(lengths)
+
+
+class _Rows:
+    __slots__ = ("data", "frames", "times")
+
+    def __init__(self):
+        self.frames, self.times, self.data = [], [], []
+
+
+class ColumnBuffer:
+    """Buffer rows per entity path; ``builders[path](rows)`` turns them into columns."""
+
+    def __init__(self, stream, builders):
+        self._stream = stream
+        self._builders = builders
+        self._rows = {path: _Rows() for path in builders}
+        self._frames = 0
+        self._last_send = time.monotonic()
+
+    def add(self, path, frame, t_ns, row):
+        r = self._rows[path]
+        r.frames.append(frame)
+        r.times.append(t_ns)
+        r.data.append(row)
+
+    def end_frame(self):
+        """Count a frame; send when enough frames or time have gone by."""
+        self._frames += 1
+        if self._frames >= MAX_FRAMES or time.monotonic() - self._last_send >= MAX_SECONDS:
+            self.flush()
+
+    def flush(self):
+        for path, r in self._rows.items():
+            if not r.frames:
+                continue
+            self._stream.send_columns(
+                path,
+                indexes=[
+                    rr.TimeColumn("frame", sequence=r.frames),
+                    rr.TimeColumn("sim_time", duration=np.array(r.times, dtype="timedelta64[ns]")),
+                ],
+                columns=self._builders[path](r.data),
+            )
+            self._rows[path] = _Rows()
+        self._frames = 0
+        self._last_send = time.monotonic()

@@ -1,0 +1,357 @@
+"""The display connector: log every ``FrameRecord`` of a closed-loop run to rerun.
+
+One ``Recorder`` owns one ``rerun.RecordingStream`` (never the global one), so several runs in
+one process stay apart. Timelines: ``frame`` (sequence, the frame index) and ``sim_time``
+(duration, simulated seconds); rerun's wall-clock ``log_time`` is left out so a recording
+depends only on the run.
+
+What is logged per frame (entity paths in ``viz.paths``):
+
+- every ``log_every``-th frame (``frame % log_every == 0``): the camera frame and the design's
+  filtered frame, raw up to 160x120 and JPEG above (``jpeg_quality``);
+- every frame: the LEDs (small images), the scalar series (found, proximity, centroid_x,
+  DPS, V, W, target distance), the robot, field of view, people and trails on the map, and
+  the frame's events. They are small, and decimating them would hide short events.
+"""
+
+import math
+import os
+import sys
+import uuid
+
+import rerun as rr
+
+from ..errors import UsageError
+from . import paths as P
+from .blueprint import default_blueprint
+from .columns import ColumnBuffer, arrows, images, points, scalars, strips, time_ns
+from .images import check_jpeg_quality, filtered_rgb, image_archetype
+from .leds import centroid_image, proximity_image
+from .modes import parse_mode
+from .sinks import (
+    SinkUnavailable,
+    attach_connect,
+    attach_save,
+    attach_serve,
+    attach_spawn,
+)
+
+__all__ = ["Recorder", "open_recorder"]
+
+_WALL_COLOR = (200, 200, 200)
+_ROBOT_COLOR = (60, 160, 255)
+_FOV_COLOR = (255, 220, 60)
+_TARGET_COLOR = (255, 70, 70)
+_PERSON_COLOR = (170, 170, 190)
+_TRAIL_ROBOT_COLOR = (60, 160, 255)
+_TRAIL_TARGET_COLOR = (255, 110, 110)
+_SERIES_COLORS = {
+    P.DESIGN_TRACKING: [(80, 220, 80), (255, 170, 30)],
+    P.MOTORS_DPS: [(80, 170, 255), (255, 120, 80)],
+    P.TWIST_V: [(160, 160, 160), (80, 200, 255)],
+    P.TWIST_W: [(160, 160, 160), (80, 200, 255)],
+    P.DESIGN_CENTROID_X: [(255, 220, 60)],
+    P.TARGET_DISTANCE: [(255, 110, 110)],
+}
+_COLUMN_BUILDERS = {
+    P.LEDS_PROXIMITY: images,
+    P.LEDS_CENTROID: images,
+    P.DESIGN_TRACKING: scalars,
+    P.DESIGN_CENTROID_X: scalars,
+    P.MOTORS_DPS: scalars,
+    P.TWIST_V: scalars,
+    P.TWIST_W: scalars,
+    P.TARGET_DISTANCE: scalars,
+    P.MAP_ROBOT: arrows,
+    P.MAP_FOV: strips,
+    P.MAP_PEOPLE: points,
+    P.TRAIL_ROBOT: strips,
+    P.TRAIL_TARGET: strips,
+}
+_DEFAULT_RAY = 1.0  # length of the field-of-view rays when no world map gave a scale, m
+
+
+def _check_log_every(n):
+    if isinstance(n, bool) or not isinstance(n, int) or n < 1:
+        raise UsageError(f"log_every must be an integer >= 1, got {n!r}")
+    return n
+
+
+def _xy(x, y):
+    # World (y up) to the viewer's 2D coordinates (y down).
+    return (float(x), -float(y))
+
+
+def _event_level(text):
+    return rr.TextLogLevel.WARN if "collision" in text.lower() else rr.TextLogLevel.INFO
+
+
+class Recorder:
+    """Logs a run's world map and frames to one rerun sink; see ``open_recorder``.
+
+    Attributes
+    ----------
+    mode : str
+        The sink actually in use: ``save``, ``spawn``, ``connect``, ``serve`` or ``off``.
+    path : str or None
+        The ``.rrd`` file written (``save``), else ``None``.
+    notice : str or None
+        Why the requested sink was replaced by a file, if it was.
+    frames_logged, images_logged : int
+        ``log_frame`` calls, and how many of them logged the camera images.
+    """
+
+    def __init__(
+        self,
+        stream,
+        mode,
+        *,
+        path=None,
+        temp_path=None,
+        description="",
+        notice=None,
+        log_every=1,
+        jpeg_quality=None,
+    ):
+        self._stream = stream
+        self.mode = mode
+        self.path = path
+        self._temp_path = temp_path
+        self._description = description
+        self.notice = notice
+        self.log_every = log_every
+        self.jpeg_quality = jpeg_quality
+        self.frames_logged = 0
+        self.images_logged = 0
+        self._closed = False
+        self._message = None
+        self._ray = _DEFAULT_RAY
+        self._blueprint_sent = False
+        self._last_robot = None
+        self._last_target = None
+        if stream is not None:
+            self._columns = ColumnBuffer(stream, _COLUMN_BUILDERS)
+            self._log_static_styles()
+
+    # Setup -------------------------------------------------------------------------------------
+
+    def _log_static_styles(self):
+        log = self._stream.log
+        for path, names in P.SERIES.items():
+            log(path, rr.SeriesLines(names=list(names), colors=_SERIES_COLORS[path]), static=True)
+        for path, img in (
+            (P.LEDS_PROXIMITY, proximity_image(0)),
+            (P.LEDS_CENTROID, centroid_image(0)),
+        ):
+            fmt = rr.components.ImageFormat(
+                width=img.shape[1], height=img.shape[0], color_model="RGB", channel_datatype="U8"
+            )
+            log(path, rr.Image.from_fields(format=fmt), static=True)
+        log(P.MAP_ROBOT, rr.Arrows2D.from_fields(colors=_ROBOT_COLOR, radii=0.03), static=True)
+        log(P.MAP_FOV, rr.LineStrips2D.from_fields(colors=_FOV_COLOR, radii=0.01), static=True)
+        for path, color in (
+            (P.TRAIL_ROBOT, _TRAIL_ROBOT_COLOR),
+            (P.TRAIL_TARGET, _TRAIL_TARGET_COLOR),
+        ):
+            log(path, rr.LineStrips2D.from_fields(colors=color, radii=0.01), static=True)
+
+    def _send_blueprint(self, bounds=None):
+        self._stream.send_blueprint(default_blueprint(bounds))
+        self._blueprint_sent = True
+
+    def log_world_map(self, world_map):
+        """Draw the static geometry (walls, furniture) and frame the map view on its bounds."""
+        if self._stream is None or self._closed:
+            return
+        log = self._stream.log
+        walls = [[_xy(*a), _xy(*b)] for a, b in world_map.walls]
+        if walls:
+            log(P.MAP_WALLS, rr.LineStrips2D(walls, colors=_WALL_COLOR, radii=0.02), static=True)
+        polygons = [
+            [_xy(*p) for p in poly] + [_xy(*poly[0])] for poly in world_map.obstacles if poly
+        ]
+        if polygons:
+            colors = [tuple(int(c) for c in col) for col in world_map.obstacle_colors]
+            log(
+                P.MAP_FURNITURE,
+                rr.LineStrips2D(polygons, colors=colors or None, radii=0.015),
+                static=True,
+            )
+        xmin, ymin, xmax, ymax = world_map.bounds
+        self._ray = 0.25 * max(xmax - xmin, ymax - ymin)
+        self._send_blueprint(world_map.bounds)
+
+    # Per frame ---------------------------------------------------------------------------------
+
+    def log_frame(self, record):
+        """Log one ``FrameRecord`` at its ``frame`` and ``sim_time``."""
+        if self._stream is None or self._closed:
+            return
+        if not self._blueprint_sent:
+            self._send_blueprint()
+        frame = int(record.frame)
+        t = time_ns(record.sim_time)
+        res = record.result
+
+        def add(path, row):
+            self._columns.add(path, frame, t, row)
+
+        if frame % self.log_every == 0 or record.events:
+            s = self._stream
+            s.set_time("frame", sequence=frame)
+            s.set_time("sim_time", duration=t)
+            if frame % self.log_every == 0:
+                s.log(P.CAMERA_RAW, image_archetype(record.camera_rgb, self.jpeg_quality))
+                filtered = filtered_rgb(res.filtered)
+                s.log(P.CAMERA_FILTERED, image_archetype(filtered, self.jpeg_quality))
+                self.images_logged += 1
+            for text in record.events:
+                s.log(P.EVENTS, rr.TextLog(str(text), level=_event_level(str(text))))
+
+        add(P.LEDS_PROXIMITY, proximity_image(res.proximity))
+        add(P.LEDS_CENTROID, centroid_image(res.centroid_leds))
+        add(P.DESIGN_TRACKING, (float(bool(res.found)), float(res.proximity)))
+        add(P.DESIGN_CENTROID_X, (float(res.centroid_x),))
+        add(P.MOTORS_DPS, (float(res.motor_left), float(res.motor_right)))
+        add(P.TWIST_V, (float(record.cmd_v), float(record.robot_v)))
+        add(P.TWIST_W, (float(record.cmd_w), float(record.robot_w)))
+        if record.target_distance is not None:
+            add(P.TARGET_DISTANCE, (float(record.target_distance),))
+        self._add_map(record, add)
+        self.frames_logged += 1
+        self._columns.end_frame()
+
+    def _add_map(self, record, add):
+        x, y = _xy(record.robot_x, record.robot_y)
+        h = float(record.robot_heading)
+        reach = self._ray
+        # Heading (world, counter-clockwise) -> viewer direction (cos h, -sin h).
+        c, s = math.cos(h), math.sin(h)
+        add(P.MAP_ROBOT, (x, y, 0.4 * reach * c, -0.4 * reach * s))
+        half = 0.5 * float(record.camera_hfov)
+        left = (x + reach * math.cos(h + half), y - reach * math.sin(h + half))
+        right = (x + reach * math.cos(h - half), y - reach * math.sin(h - half))
+        add(P.MAP_FOV, (left, (x, y), right))
+
+        target = None
+        if record.people:
+            positions, radii, colors, labels = [], [], [], []
+            for person in record.people:
+                positions.append(_xy(person.x, person.y))
+                radii.append(float(person.radius))
+                colors.append(_TARGET_COLOR if person.is_target else _PERSON_COLOR)
+                labels.append(str(person.name))
+                if person.is_target:
+                    target = positions[-1]
+            add(P.MAP_PEOPLE, (positions, radii, colors, labels))
+
+        # Trails: one segment per frame; the map view shows all segments up to the cursor.
+        pos = (x, y)
+        add(P.TRAIL_ROBOT, (self._last_robot or pos, pos))
+        self._last_robot = pos
+        if target is not None:
+            add(P.TRAIL_TARGET, (self._last_target or target, target))
+        self._last_target = target
+
+    # End ---------------------------------------------------------------------------------------
+
+    def close(self):
+        """Finish the recording and return one line saying where it went and how to open it.
+
+        A saved file appears under its final name only now (it was written to a temporary
+        file beside it). Calling ``close`` again returns the same line.
+        """
+        if self._closed:
+            return self._message
+        self._closed = True
+        if self._stream is None:
+            self._message = "viewer off: nothing was recorded"
+            return self._message
+        s = self._stream
+        try:
+            self._columns.flush()
+            s.flush(timeout_sec=30.0)
+        finally:
+            s.disconnect()
+        frames = f"{self.frames_logged} frames ({self.images_logged} with images)"
+        if self.mode == "save":
+            os.replace(self._temp_path, self.path)
+            size = os.path.getsize(self.path)
+            per = size / self.frames_logged if self.frames_logged else 0
+            msg = (
+                f"saved {frames} to {self.path} ({size / 1e6:.1f} MB, {per / 1e3:.1f} kB/frame); "
+                f"open it with: rerun {self.path}"
+            )
+        else:
+            msg = f"{self._description}: {frames}"
+        if self.notice:
+            msg = f"{self.notice}; {msg}"
+        self._message = msg
+        return msg
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, exc_type, exc, tb):
+        # On an error the data logged so far is still saved: it shows what led up to it.
+        self.close()
+        return False
+
+    def __repr__(self):
+        where = self.path if self.mode == "save" else self._description
+        return f"Recorder(mode={self.mode!r}, {where!r}, frames_logged={self.frames_logged})"
+
+
+def open_recorder(mode, *, default_path, app_id="fpga_robotics", log_every=1, jpeg_quality=None):
+    """Open a recorder for ``mode`` (see ``viz.modes``); returns a ``Recorder``.
+
+    Parameters
+    ----------
+    mode : str or None
+        ``save:PATH.rrd``, ``save``, ``spawn``, ``connect``, ``connect:URL``, ``serve``, ``off``
+        or ``auto``/``None`` (``spawn`` with a display, else ``save`` to ``default_path``).
+    default_path : str
+        The ``.rrd`` file for ``save`` without a path, and for any sink that cannot work
+        here (the recorder then saves there and says so in ``notice`` and on stderr).
+    app_id : str
+        rerun application id (the viewer groups recordings and layouts by it).
+    log_every : int
+        Log the camera images of every ``log_every``-th frame; everything else every frame.
+    jpeg_quality : int or None
+        ``None`` raw up to 160x120 and JPEG quality 85 above; ``0`` always raw; 1..100 always
+        JPEG at that quality.
+
+    Raises
+    ------
+    UsageError
+        A malformed mode, ``log_every`` or ``jpeg_quality``.
+    """
+    parsed = parse_mode(mode, default_path)
+    log_every = _check_log_every(log_every)
+    jpeg_quality = check_jpeg_quality(jpeg_quality)
+    options = {"log_every": log_every, "jpeg_quality": jpeg_quality}
+    if parsed.kind == "off":
+        return Recorder(None, "off", description="viewer off", **options)
+
+    stream = rr.RecordingStream(app_id, recording_id=uuid.uuid4())
+    stream.set_log_time_enabled(False)
+    if parsed.kind == "save":
+        tmp = attach_save(stream, parsed.path)
+        return Recorder(stream, "save", path=parsed.path, temp_path=tmp, **options)
+    try:
+        if parsed.kind == "spawn":
+            description = attach_spawn(stream)
+        elif parsed.kind == "connect":
+            description = attach_connect(stream, parsed.url)
+        else:
+            description = attach_serve(stream)
+    except SinkUnavailable as exc:
+        if parsed.path is None:
+            raise UsageError(
+                f"viewer mode {parsed.kind!r} cannot work here ({exc}); use save:PATH.rrd"
+            ) from None
+        notice = f"{parsed.kind}: {exc}, so the recording was saved to a file instead"
+        print(f"fpga_robotics.viz: {notice} ({parsed.path})", file=sys.stderr)
+        tmp = attach_save(stream, parsed.path)
+        return Recorder(stream, "save", path=parsed.path, temp_path=tmp, notice=notice, **options)
+    return Recorder(stream, parsed.kind, description=description, **options)

@@ -1,0 +1,162 @@
+"""Attach a ``rerun.RecordingStream`` to the sink a ``Mode`` asks for, or say why it cannot.
+
+Every sink that cannot work here (no display, a viewer that fails to start, nobody listening
+at a URL, a busy port) raises ``SinkUnavailable`` with the reason; the recorder then saves to
+its default file instead and tells the user, so data is never lost silently.
+"""
+
+import os
+import shutil
+import socket
+import subprocess
+import sys
+import tempfile
+import time
+import uuid
+from urllib.parse import quote, urlsplit
+
+import rerun as rr
+
+from .modes import DEFAULT_VIEWER_PORT, DEFAULT_WEB_PORT, display_available, port_is_listening
+
+__all__ = ["SinkUnavailable", "attach_connect", "attach_save", "attach_serve", "attach_spawn"]
+
+#: How long a spawned viewer may take to listen, and how long it must then stay alive.
+SPAWN_TIMEOUT_S = 20.0
+SPAWN_SETTLE_S = 1.0
+_LOCALHOST = "127.0.0.1"
+
+
+class SinkUnavailable(RuntimeError):
+    """The requested sink cannot work here; the message says why."""
+
+
+def temp_path_for(path):
+    """A hidden temporary file next to ``path`` (same file system, so the final rename is atomic)."""
+    folder, name = os.path.split(os.path.abspath(path))
+    return os.path.join(folder, f".{name}.{uuid.uuid4().hex[:8]}.partial")
+
+
+def attach_save(stream, path):
+    """Stream to a temporary file beside ``path``; returns the temporary path (rename on close)."""
+    folder = os.path.dirname(os.path.abspath(path))
+    os.makedirs(folder, exist_ok=True)
+    tmp = temp_path_for(path)
+    stream.save(tmp)
+    return tmp
+
+
+def viewer_command(port):
+    """The command that starts a native rerun viewer listening on ``port``."""
+    exe = shutil.which("rerun")
+    base = [exe] if exe else [sys.executable, "-m", "rerun"]
+    return base + ["--port", str(port), "--memory-limit", "75%", "--expect-data-soon"]
+
+
+def _last_line(fileobj):
+    fileobj.seek(0)
+    lines = [
+        ln.strip() for ln in fileobj.read().decode(errors="replace").splitlines() if ln.strip()
+    ]
+    errors = [ln for ln in lines if "error" in ln.lower()]
+    return (errors or lines or ["(no output)"])[-1][:300]
+
+
+def _start_viewer(port):
+    try:
+        cmd = viewer_command(port)
+    except Exception as exc:  # noqa: BLE001 - any failure to locate the viewer is reported
+        raise SinkUnavailable(f"cannot find the rerun viewer: {exc}") from None
+    env = dict(os.environ, RERUN_APP_ONLY="true")
+    with tempfile.TemporaryFile() as errlog:
+        try:
+            proc = subprocess.Popen(
+                cmd,
+                stdin=subprocess.DEVNULL,
+                stdout=subprocess.DEVNULL,
+                stderr=errlog,
+                env=env,
+                start_new_session=True,  # the viewer outlives the run
+            )
+        except OSError as exc:
+            raise SinkUnavailable(f"cannot start the rerun viewer ({cmd[0]}): {exc}") from None
+        deadline = time.monotonic() + SPAWN_TIMEOUT_S
+        listening_since = None
+        while True:
+            code = proc.poll()
+            if code is not None:
+                raise SinkUnavailable(
+                    f"the rerun viewer exited with code {code}: {_last_line(errlog)}"
+                )
+            now = time.monotonic()
+            if listening_since is None and port_is_listening(_LOCALHOST, port):
+                listening_since = now
+            # A viewer can bind its port and only then fail to open a window: wait a moment.
+            if listening_since is not None and now - listening_since >= SPAWN_SETTLE_S:
+                return proc
+            if now > deadline:
+                proc.terminate()
+                raise SinkUnavailable(
+                    f"the rerun viewer did not listen on port {port} within {SPAWN_TIMEOUT_S:.0f} s"
+                )
+            time.sleep(0.05)
+
+
+def attach_spawn(stream, port=DEFAULT_VIEWER_PORT):
+    """Open a native viewer (or reuse one already listening on ``port``) and stream to it.
+
+    Returns a description of what happened.
+    """
+    url = f"rerun+http://{_LOCALHOST}:{port}/proxy"
+    if port_is_listening(_LOCALHOST, port):
+        stream.connect_grpc(url)
+        return f"streamed to the rerun viewer already running on port {port}"
+    if not display_available():
+        raise SinkUnavailable(
+            "no display to open a viewer window (DISPLAY and WAYLAND_DISPLAY unset)"
+        )
+    _start_viewer(port)
+    stream.connect_grpc(url)
+    return "streamed to a rerun viewer window (spawned)"
+
+
+def attach_connect(stream, url):
+    """Stream to the viewer at ``url`` after checking that something listens there."""
+    parts = urlsplit(url)
+    default_port = 443 if parts.scheme == "rerun+https" else DEFAULT_VIEWER_PORT
+    port = parts.port or default_port
+    if not port_is_listening(parts.hostname, port, timeout=1.0):
+        raise SinkUnavailable(f"no rerun viewer is listening at {url} (start one with `rerun`)")
+    stream.connect_grpc(url)
+    return f"streamed to the rerun viewer at {url}"
+
+
+def _free_port():
+    with socket.socket() as s:
+        s.bind((_LOCALHOST, 0))
+        return s.getsockname()[1]
+
+
+def attach_serve(stream, grpc_port=DEFAULT_VIEWER_PORT, web_port=DEFAULT_WEB_PORT):
+    """Host a gRPC server and the web viewer on localhost; returns how to open them."""
+    # rerun's default ports may be taken by another run or viewer: then any free port.
+    if port_is_listening(_LOCALHOST, grpc_port):
+        grpc_port = _free_port()
+    if port_is_listening(_LOCALHOST, web_port):
+        web_port = _free_port()
+    try:
+        url = stream.serve_grpc(grpc_port=grpc_port)
+    except Exception as exc:  # noqa: BLE001 - reported, and the recorder saves instead
+        raise SinkUnavailable(f"cannot serve gRPC on port {grpc_port}: {exc}") from None
+    try:
+        rr.serve_web_viewer(web_port=web_port, open_browser=False, connect_to=url)
+        web = f"http://localhost:{web_port}/?url={quote(url, safe='')}"
+        return (
+            f"served live: open {web} in a browser, or run `rerun {url}`; "
+            f"the server stops when this process exits"
+        )
+    except Exception as exc:  # noqa: BLE001 - the gRPC server still works without it
+        return (
+            f"served live at {url} (run `rerun {url}`); the web viewer could not start: {exc}; "
+            f"the server stops when this process exits"
+        )
