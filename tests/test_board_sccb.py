@@ -108,7 +108,7 @@ def test_custom_table_and_device_id():
 
 @pytest.mark.parametrize("kwargs,message", [
     ({"table": [], "quarter_period": 2, "reset_wait": 0}, "empty"),
-    ({"table": [RegisterWrite(0x100, 0, "")], "quarter_period": 2, "reset_wait": 0}, "bytes"),
+    ({"table": [RegisterWrite(0x100, 0, "")], "quarter_period": 2, "reset_wait": 0}, "a byte"),
     ({"table": OV7670_INIT, "quarter_period": 0, "reset_wait": 0}, "quarter_period"),
     ({"table": OV7670_INIT, "quarter_period": 2, "reset_wait": -1}, "reset_wait"),
 ])

@@ -27,6 +27,7 @@ from amaranth.lib.fifo import AsyncFIFO
 from amaranth.lib.wiring import In, Out
 
 from ..pixel import FramedPixel, PixelStream
+from ._checks import check_int
 
 __all__ = ["OV7670Capture"]
 
@@ -54,8 +55,7 @@ class OV7670Capture(wiring.Component):
     """
 
     def __init__(self, *, pclk_domain="pclk", fifo_depth=16):
-        if isinstance(fifo_depth, bool) or not isinstance(fifo_depth, int) or fifo_depth < 4:
-            raise ValueError(f"fifo_depth must be an int >= 4, got {fifo_depth!r}")
+        check_int(self, "fifo_depth", fifo_depth, 4)
         self.pclk_domain = pclk_domain
         self.fifo_depth = fifo_depth
         super().__init__({

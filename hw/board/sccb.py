@@ -21,6 +21,8 @@ from amaranth.hdl import Cat, Const, Module, Signal
 from amaranth.lib import wiring
 from amaranth.lib.wiring import Out
 
+from ._checks import check_int
+
 __all__ = ["OV7670_INIT", "OV7670_SCCB_ID", "RegisterWrite", "SCCBInit"]
 
 #: The OV7670's SCCB write ID (7-bit address 0x21, R/W bit 0).
@@ -93,25 +95,22 @@ class SCCBInit(wiring.Component):
 
     def __init__(self, table=OV7670_INIT, *, quarter_period, reset_wait, startup_wait=0,
                  device_id=OV7670_SCCB_ID):
-        self._MustUse__silence = True  # a constructor that raises leaves nothing to use
         table = tuple(table)
         if not table:
+            self._MustUse__silence = True
             raise ValueError("the SCCB register table is empty")
         for i, w in enumerate(table):
-            if not (0 <= w.reg <= 0xFF and 0 <= w.value <= 0xFF):
-                raise ValueError(f"table entry {i}: register and value must be bytes, got {w}")
-        for name, v, lo in (("quarter_period", quarter_period, 1), ("reset_wait", reset_wait, 0),
-                            ("startup_wait", startup_wait, 0)):
-            if isinstance(v, bool) or not isinstance(v, int) or v < lo:
-                raise ValueError(f"{name} must be an int >= {lo}, got {v!r}")
-        if not 0 <= device_id <= 0xFF:
-            raise ValueError(f"device_id must be a byte, got {device_id!r}")
+            check_int(self, f"table[{i}].reg (a byte)", w.reg, 0, 0xFF)
+            check_int(self, f"table[{i}].value (a byte)", w.value, 0, 0xFF)
+        check_int(self, "quarter_period", quarter_period, 1)
+        check_int(self, "reset_wait", reset_wait, 0)
+        check_int(self, "startup_wait", startup_wait, 0)
+        check_int(self, "device_id", device_id, 0, 0xFF)
         self.table = table
         self.quarter_period = quarter_period
         self.reset_wait = reset_wait
         self.startup_wait = startup_wait
         self.device_id = device_id
-        self._MustUse__silence = False
         super().__init__({
             "sioc": Out(1, init=1),
             "siod_o": Out(1, init=1),
