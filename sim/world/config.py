@@ -144,10 +144,16 @@ def _check_number(value, path, *, gt=None, ge=None, le=None, unit=""):
         " " + " and ".join(bounds) if bounds else "")
     if not _is_number(value) or not math.isfinite(value):
         raise WorldConfigError(f"{path} must be {what}, got {_show(value)}")
-    if ((gt is not None and not value > gt) or (ge is not None and not value >= ge)
-            or (le is not None and not value <= le)):
-        raise WorldConfigError(f"{path} must be {' and '.join(bounds)}, got {value!r}")
+    for ok, bound in ((gt is None or value > gt, f"> {gt}"), (ge is None or value >= ge, f">= {ge}"),
+                      (le is None or value <= le, f"<= {le}")):
+        if not ok:
+            raise WorldConfigError(f"{path} must be {bound}, got {value!r}")
     return float(value)
+
+
+def _fmt(point):
+    return "[" + ", ".join(f"{c:g}" for c in point) + "]"
+
 
 
 def _check_vector(value, path, n, what, **bounds):
@@ -262,7 +268,7 @@ def _parse_room(section):
     for i, f in enumerate(furniture):
         x, y = f.center
         if not (0 < x < width and 0 < y < depth):
-            raise WorldConfigError(f"room.furniture[{i}].center {list(f.center)} is outside "
+            raise WorldConfigError(f"room.furniture[{i}].center {_fmt(f.center)} is outside "
                                    f"the room (0..{width:g} x 0..{depth:g} m)")
     t.finish()
     return RoomConfig(width, depth, height, wall_color, floor_color, ceiling_color, furniture)
@@ -301,7 +307,7 @@ def _parse_robot(section, room):
     spec = base.with_overrides(**fields)
     if not _inside(start, spec.body_radius, room):
         raise WorldConfigError(
-            f"robot.start {list(start)} puts the robot (radius {spec.body_radius:g} m) outside "
+            f"robot.start {_fmt(start)} puts the robot (radius {spec.body_radius:g} m) outside "
             f"the room (0..{room.width:g} x 0..{room.depth:g} m)")
     return RobotConfig(spec, tuple(start), heading)
 
@@ -355,7 +361,7 @@ def _parse_person(item, path, index, room):
     for i, p in enumerate(waypoints):
         if not _inside(p, radius, room):
             raise WorldConfigError(
-                f"{path}.waypoints[{i}] {list(p)} puts the person (radius {radius:g} m) outside "
+                f"{path}.waypoints[{i}] {_fmt(p)} puts the person (radius {radius:g} m) outside "
                 f"the room (0..{room.width:g} x 0..{room.depth:g} m)")
     return PersonConfig(name, target, waypoints, speed, jitter, pauses, loop, start_delay,
                         radius, height, shirt, trousers, skin)

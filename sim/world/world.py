@@ -119,7 +119,8 @@ class World:
         for hit in space.shape_query(shape):
             kind, name = self._names[hit.shape]
             what = f"{kind} {name!r}" if name else kind
-            raise WorldConfigError(f"robot.start {list(config.robot.start)} overlaps the {what}")
+            x, y = config.robot.start
+            raise WorldConfigError(f"robot.start [{x:g}, {y:g}] overlaps the {what}")
 
         self._counts = dict.fromkeys(_KINDS, 0)
         self._events = []
