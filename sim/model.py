@@ -13,7 +13,9 @@ Reading of the contract where it leaves room (the gateware must agree):
   command, a search command, or 0 after reset). ``last_side`` changes only on found frames;
   after reset it is "left", so a design that never saw the target searches to the left
   (``left = -search_dps, right = +search_dps``).
-- Search speeds are ``+-search_dps`` exactly (no saturation to ``max_dps``), as written.
+- Search speeds are ``+-search_dps`` exactly (no saturation to ``max_dps``), as written, taken
+  as 16-bit two's complement like every motor output: only ``search_dps = -32768`` is affected
+  (its negation wraps to -32768).
 - ``found`` (``N >= min_pixels``) and ``proximity`` are independent: a found frame with
   proximity 0 (possible only when ``min_pixels`` is below the first threshold) uses
   ``base_dps[0]``.
@@ -199,6 +201,11 @@ def track_frame(match, params):
     )
 
 
+def _wrap16(v):
+    """``v`` as a signed 16-bit register holds it."""
+    return ((v + (1 << 15)) & 0xFFFF) - (1 << 15)
+
+
 class MotorModel:
     """The per-frame motor controller, with its state across frames.
 
@@ -252,7 +259,7 @@ class MotorModel:
             self.lost_count = min(self.lost_count + 1, p.lost_frames)
             if self.searching:
                 s = p.search_dps if self.last_side == "right" else -p.search_dps
-                self.left, self.right = s, -s
+                self.left, self.right = _wrap16(s), _wrap16(-s)
             # else: hold the last command
         return self.left, self.right
 

@@ -372,6 +372,14 @@ def test_lost_frames_1_searches_on_the_first_lost_frame():
     assert m.step(NOT_SEEN) == (-30, 30)  # right side, with a negative search speed
 
 
+def test_search_speed_is_a_16_bit_value():
+    m = MotorModel(FollowTargetParams(lost_frames=1, search_dps=-(2**15)))
+    # -(-32768) does not fit in 16 bits: the register holds -32768 on both wheels.
+    assert m.step(NOT_SEEN) == (-(2**15), -(2**15))
+    m = MotorModel(FollowTargetParams(lost_frames=1, search_dps=2**15 - 1))
+    assert m.step(NOT_SEEN) == (-(2**15) + 1, 2**15 - 1)
+
+
 def test_default_lost_frames_holds_14_frames_and_searches_on_the_15th():
     m = MotorModel(FollowTargetParams())
     tracking = m.step(_seen(40))  # left of centre
