@@ -112,3 +112,16 @@ def test_seed_must_be_a_non_negative_integer():
         World.from_config({}, seed=-1)
     with pytest.raises(ValueError, match="seed"):
         World.from_config({}, seed=1.5)
+
+
+def test_the_documented_examples_load():
+    import pathlib
+    import re
+    import tomllib
+
+    doc = pathlib.Path(__file__).parents[1] / "docs" / "scenarios.md"
+    blocks = re.findall(r"```toml\n(.*?)```", doc.read_text(), re.S)
+    assert len(blocks) >= 2
+    for block in blocks:
+        world = World.from_config(tomllib.loads(block), seed=0)
+        world.step(0.1)

@@ -107,3 +107,18 @@ def test_first_person_is_the_target_unless_told():
     assert world.target_position() == (2.0, 2.0)
     cfg["people"][1]["target"] = False
     assert World.from_config(cfg, seed=0).target_position() is None
+
+
+def test_a_persons_jitter_does_not_depend_on_the_others():
+    walker = {"name": "a", "waypoints": [[1, 1], [5, 1]], "speed_jitter": 0.3, "pause": 0}
+    other = {"name": "b", "waypoints": [[1, 4], [6, 4]], "speed_jitter": 0.3, "pause": 0}
+
+    def track(people):
+        world = World.from_config({"people": people}, seed=9)
+        out = []
+        for _ in range(20 * 20):
+            world.step(1 / 20)
+            out.append(world.people_states()[0].x)
+        return out
+
+    assert track([walker]) == track([walker, other])

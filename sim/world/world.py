@@ -70,7 +70,6 @@ class World:
             raise ValueError(f"seed must be a non-negative integer, got {seed!r}")
         self.config = config
         self.seed = int(seed)
-        self.rng = np.random.default_rng(self.seed)
         self.time = 0.0
         self._time_error = 0.0  # Kahan compensation: many small steps add up exactly
         self.robot_spec = spec = config.robot.spec
@@ -103,8 +102,11 @@ class World:
         self._names = add_static_shapes(space, config.room, wall_type=_WALL,
                                         furniture_type=_FURNITURE, friction=_FRICTION)
         self.people = []
-        for pc in config.people:
-            path = PersonPath(pc, self.rng)
+        # One generator per person, so a person's jitter does not depend on the others or on
+        # the order in which their paths are queried.
+        streams = np.random.SeedSequence(self.seed).spawn(len(config.people))
+        for pc, stream in zip(config.people, streams):
+            path = PersonPath(pc, np.random.default_rng(stream))
             pbody = pymunk.Body(body_type=pymunk.Body.KINEMATIC)
             pbody.position = path.position(0.0)
             pshape = pymunk.Circle(pbody, pc.radius)
