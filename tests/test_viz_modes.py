@@ -1,0 +1,185 @@
+"""Viewer modes: parsing, bad strings, and falling back to a file when no viewer can show the run."""
+
+import socket
+import sys
+
+import numpy as np
+import pytest
+from fpga_robotics.sim.backends.base import FrameResult
+from fpga_robotics.viz import open_recorder, parse_mode, sinks
+from fpga_robotics.viz import paths as P
+from fpga_robotics.viz.modes import DEFAULT_CONNECT_URL, display_available, port_is_listening
+from fpga_robotics.viz.readback import read_rrd
+
+from fpga_robotics.errors import UsageError
+from fpga_robotics.records import FrameRecord
+
+
+def frame(i):
+    result = FrameResult(
+        filtered=np.zeros((24, 32), np.uint16),
+        found=False,
+        proximity=0,
+        centroid_x=0,
+        centroid_leds=0,
+        motor_left=10 * i,
+        motor_right=-10 * i,
+        cycles=1,
+    )
+    return FrameRecord(
+        frame=i,
+        sim_time=0.1 * i,
+        camera_rgb=np.full((24, 32, 3), i, np.uint8),
+        color_sel=4,
+        result=result,
+        robot_x=0.0,
+        robot_y=0.0,
+        robot_heading=0.0,
+        robot_v=0.0,
+        robot_w=0.0,
+        cmd_v=0.0,
+        cmd_w=0.0,
+        camera_hfov=1.0,
+    )
+
+
+def free_port():
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+@pytest.mark.parametrize(
+    "text, kind, path, url",
+    [
+        ("save:out/run.rrd", "save", "out/run.rrd", None),
+        ("save", "save", "d.rrd", None),
+        ("SPAWN", "spawn", "d.rrd", None),
+        ("connect", "connect", "d.rrd", DEFAULT_CONNECT_URL),
+        (
+            "connect:rerun+http://10.0.0.2:9000/proxy",
+            "connect",
+            "d.rrd",
+            "rerun+http://10.0.0.2:9000/proxy",
+        ),
+        ("serve", "serve", "d.rrd", None),
+        ("off", "off", "d.rrd", None),
+    ],
+)
+def test_parse_valid_modes(text, kind, path, url):
+    mode = parse_mode(text, "d.rrd")
+    assert (mode.kind, mode.path, mode.url) == (kind, path, url)
+
+
+@pytest.mark.parametrize(
+    "text, hint",
+    [
+        ("", "unknown viewer mode"),
+        ("sav", "unknown viewer mode"),
+        ("show", "save:PATH.rrd"),
+        ("save:", "empty"),
+        ("save:run.txt", "does not end in .rrd"),
+        ("spawn:now", "takes no argument"),
+        ("off:1", "takes no argument"),
+        ("connect:http://localhost:9876", "not a rerun viewer URL"),
+        ("connect:rerun+http://localhost:port/proxy", "port"),
+        (42, "must be a string"),
+    ],
+)
+def test_bad_modes_are_usage_errors(text, hint):
+    with pytest.raises(UsageError, match=hint):
+        parse_mode(text, "d.rrd")
+
+
+@pytest.mark.parametrize(
+    "kwargs",
+    [
+        {"log_every": 0},
+        {"log_every": "2"},
+        {"log_every": True},
+        {"jpeg_quality": 101},
+        {"jpeg_quality": -1},
+        {"jpeg_quality": "high"},
+    ],
+)
+def test_bad_options_are_usage_errors(kwargs, tmp_path):
+    with pytest.raises(UsageError):
+        open_recorder("off", default_path=str(tmp_path / "x.rrd"), **kwargs)
+
+
+def test_auto_picks_spawn_only_with_a_display():
+    no_display = {"HOME": "/root"}
+    assert not display_available(no_display, "linux")
+    assert parse_mode("auto", "d.rrd", environ=no_display, platform="linux").kind == "save"
+    assert parse_mode(None, "d.rrd", environ=no_display, platform="linux").path == "d.rrd"
+    for env in ({"DISPLAY": ":0"}, {"WAYLAND_DISPLAY": "wayland-0"}):
+        assert parse_mode("auto", "d.rrd", environ=env, platform="linux").kind == "spawn"
+    assert display_available({}, "darwin")
+
+
+def no_viewer_running(monkeypatch):
+    # A viewer somebody left open on the default port would be reused: pretend there is none.
+    monkeypatch.setattr(sinks, "port_is_listening", lambda *a, **k: False)
+
+
+def test_spawn_without_display_saves_to_the_default_file(tmp_path, monkeypatch, capsys):
+    monkeypatch.delenv("DISPLAY", raising=False)
+    monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
+    monkeypatch.setattr(sys, "platform", "linux")
+    no_viewer_running(monkeypatch)
+    path = tmp_path / "fallback.rrd"
+    rec = open_recorder("spawn", default_path=str(path))
+    assert rec.mode == "save"
+    assert "no display" in capsys.readouterr().err
+    for i in range(3):
+        rec.log_frame(frame(i))
+    msg = rec.close()
+    assert "spawn" in msg and "no display" in msg and "saved" in msg and str(path) in msg
+    assert read_rrd(str(path)).entities[P.MOTORS_DPS].frames == [0, 1, 2]
+
+
+def test_spawn_whose_viewer_fails_saves_to_the_default_file(tmp_path, monkeypatch):
+    monkeypatch.setenv("DISPLAY", ":99")
+    no_viewer_running(monkeypatch)
+    failing = [sys.executable, "-c", "import sys; sys.exit('Error: Failed to open X server')"]
+    monkeypatch.setattr(sinks, "viewer_command", lambda port: failing)
+    path = tmp_path / "fallback.rrd"
+    rec = open_recorder("spawn", default_path=str(path))
+    rec.log_frame(frame(0))
+    msg = rec.close()
+    assert "exited with code 1" in msg and "Failed to open X server" in msg
+    assert path.exists()
+
+
+def test_spawn_without_any_file_to_fall_back_on_is_a_usage_error(monkeypatch):
+    monkeypatch.delenv("DISPLAY", raising=False)
+    monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
+    monkeypatch.setattr(sys, "platform", "linux")
+    no_viewer_running(monkeypatch)
+    with pytest.raises(UsageError, match="save:PATH.rrd"):
+        open_recorder("spawn", default_path=None)
+
+
+def test_connect_with_nobody_listening_saves_to_the_default_file(tmp_path):
+    url = f"rerun+http://127.0.0.1:{free_port()}/proxy"
+    path = tmp_path / "fallback.rrd"
+    rec = open_recorder(f"connect:{url}", default_path=str(path))
+    assert rec.mode == "save"
+    rec.log_frame(frame(0))
+    msg = rec.close()
+    assert f"no rerun viewer is listening at {url}" in msg and path.exists()
+
+
+def test_serve_hosts_grpc_and_web_viewer(tmp_path):
+    rec = open_recorder("serve", default_path=str(tmp_path / "unused.rrd"))
+    try:
+        assert rec.mode == "serve"
+        desc = rec._description
+        assert "rerun+http://" in desc and "http://localhost:" in desc
+        grpc_port = int(desc.split("rerun+http://")[1].split(":")[1].split("/")[0])
+        assert port_is_listening("127.0.0.1", grpc_port)
+        rec.log_frame(frame(0))
+    finally:
+        msg = rec.close()
+    assert "1 frames" in msg
+    assert not (tmp_path / "unused.rrd").exists()

@@ -1,0 +1,123 @@
+"""Read a saved recording back (tests, checks) and summarise it: ``python -m fpga_robotics.viz.readback FILE.rrd``.
+
+Built on ``rerun.chunk.RrdReader``. Every temporal row of an entity is returned with its
+``frame`` and ``sim_time`` (ns), sorted by frame; each component value is the list of its
+instances (plain Python values), except byte blobs (image buffers, JPEG data), which come
+back as uint8 numpy arrays.
+"""
+
+import os
+import sys
+from dataclasses import dataclass, field
+
+import numpy as np
+import pyarrow as pa
+from rerun.chunk import RrdReader
+
+from ..errors import UsageError, run_cli
+
+__all__ = ["EntityRows", "Recording", "main", "read_rrd"]
+
+_INDEX_COLUMNS = ("frame", "sim_time", "log_time", "log_tick")
+
+
+@dataclass
+class EntityRows:
+    """The temporal rows of one entity: ``frames[i]``, ``sim_time_ns[i]``, ``values[component][i]``."""
+
+    frames: list = field(default_factory=list)
+    sim_time_ns: list = field(default_factory=list)
+    values: dict = field(default_factory=dict)
+
+    def __len__(self):
+        return len(self.frames)
+
+
+@dataclass
+class Recording:
+    """A recording read back: temporal rows and static values per entity path (no leading /)."""
+
+    entities: dict
+    static: dict
+    blueprints: int
+    size_bytes: int
+
+
+def _is_blob(t):
+    return pa.types.is_list(t) and pa.types.is_uint8(t.value_type)
+
+
+def _row_values(column):
+    """One Python value per row: the list of the row's instances."""
+    out = []
+    blob = _is_blob(column.type.value_type)
+    for i in range(len(column)):
+        if not column[i].is_valid:
+            out.append(None)
+        elif blob:
+            out.append([np.asarray(x.values) for x in column[i].values])
+        else:
+            out.append(column[i].values.to_pylist())
+    return out
+
+
+def read_rrd(path):
+    """Read the first recording in ``path``; returns a ``Recording``."""
+    if not os.path.isfile(path):
+        raise FileNotFoundError(f"no recording at {path}")
+    reader = RrdReader(path)
+    entities, static = {}, {}
+    for chunk in reader.stream():
+        name = chunk.entity_path.lstrip("/")
+        batch = chunk.to_record_batch()
+        comps = [
+            f.name
+            for f in batch.schema
+            if f.name not in _INDEX_COLUMNS and (f.metadata or {}).get(b"rerun:kind") == b"data"
+        ]
+        if chunk.is_static:
+            target = static.setdefault(name, {})
+            for c in comps:
+                target[c] = _row_values(batch.column(c))[-1]
+            continue
+        rows = entities.setdefault(name, EntityRows())
+        n = batch.num_rows
+        frames = batch.column("frame").to_pylist() if "frame" in batch.schema.names else [None] * n
+        if "sim_time" in batch.schema.names:
+            times = batch.column("sim_time").cast(pa.int64()).to_pylist()
+        else:
+            times = [None] * n
+        start = len(rows.frames)
+        rows.frames.extend(frames)
+        rows.sim_time_ns.extend(times)
+        for c in comps:
+            rows.values.setdefault(c, [None] * start).extend(_row_values(batch.column(c)))
+        for c, vals in rows.values.items():
+            vals.extend([None] * (len(rows.frames) - len(vals)))
+    for rows in entities.values():
+        order = sorted(
+            range(len(rows.frames)), key=lambda i: (rows.frames[i] is None, rows.frames[i])
+        )
+        rows.frames = [rows.frames[i] for i in order]
+        rows.sim_time_ns = [rows.sim_time_ns[i] for i in order]
+        rows.values = {c: [v[i] for i in order] for c, v in rows.values.items()}
+    return Recording(entities, static, len(reader.blueprints()), os.path.getsize(path))
+
+
+def main(argv=None):
+    if not argv or len(argv) != 1:
+        raise UsageError("usage: python -m fpga_robotics.viz.readback FILE.rrd")
+    rec = read_rrd(argv[0])
+    frames = max((len(r) for p, r in rec.entities.items() if p.startswith("design/")), default=0)
+    print(f"{argv[0]}: {rec.size_bytes / 1e6:.2f} MB, {frames} frames", end="")
+    print(f", {rec.size_bytes / frames / 1e3:.1f} kB/frame" if frames else "")
+    print(f"blueprints: {rec.blueprints}")
+    for path in sorted(rec.entities):
+        print(f"  {path:22s} {len(rec.entities[path]):6d} rows")
+    for path in sorted(rec.static):
+        print(f"  {path:22s} static: {', '.join(sorted(rec.static[path]))}")
+    return 0
+
+
+if __name__ == "__main__":
+    run_cli(main, sys.argv[1:], prog="fpga_robotics.viz.readback")
