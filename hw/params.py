@@ -122,7 +122,8 @@ class FollowTargetParams:
         _check_int("kp_shift", self.kp_shift, 0, 15)
         _check_int("max_dps", self.max_dps, 0, _INT16_MAX)
         _check_int("lost_frames", self.lost_frames, 1, (1 << 16) - 1)
-        _check_int("search_dps", self.search_dps, _INT16_MIN, _INT16_MAX)
+        # -32768 is excluded: searching the other way negates it, which would wrap in 16 bits.
+        _check_int("search_dps", self.search_dps, -_INT16_MAX, _INT16_MAX)
 
     # Window geometry -------------------------------------------------------------------------
 
