@@ -53,6 +53,7 @@ def test_replace_recomputes_geometry_defaults_but_keeps_explicit_values():
         ({"max_dps": 1 << 15}, "max_dps must be <= 32767"),
         ({"kp_shift": 16}, "kp_shift must be <= 15"),
         ({"lost_frames": 0}, "lost_frames must be >= 1"),
+        ({"search_dps": -(1 << 15)}, "search_dps must be >= -32767"),
     ],
 )
 def test_bad_values_raise_clear_errors(kwargs, message):
