@@ -3,12 +3,12 @@
 import math
 
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
 
 from fpga_robotics.sim.world import GOPIGO3, TURTLEBOT2, dps_to_twist, twist_to_wheels
 from fpga_robotics.sim.world.kinematics import wheels_to_twist
 from fpga_robotics.sim.world.motors import SimMotors, WheelMotor
-from hypothesis import given
-from hypothesis import strategies as st
 
 
 def test_robot_geometry_is_the_real_one():

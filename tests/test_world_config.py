@@ -1,6 +1,9 @@
 """World configuration: defaults, and a clear WorldConfigError naming the key for bad input."""
 
 import math
+import pathlib
+import re
+import tomllib
 
 import pytest
 
@@ -107,6 +110,12 @@ def test_robot_starting_inside_furniture_is_an_error():
         World.from_config(cfg, seed=0)
 
 
+def test_robot_starting_on_a_person_is_an_error():
+    cfg = {"people": [{"name": "ann", "waypoints": [[1.7, 3.0], [5, 3]]}]}
+    with pytest.raises(WorldConfigError, match="overlaps the person 'ann'"):
+        World.from_config(cfg, seed=0)
+
+
 def test_seed_must_be_a_non_negative_integer():
     with pytest.raises(ValueError, match="seed"):
         World.from_config({}, seed=-1)
@@ -115,12 +124,8 @@ def test_seed_must_be_a_non_negative_integer():
 
 
 def test_the_documented_examples_load():
-    import pathlib
-    import re
-    import tomllib
-
     doc = pathlib.Path(__file__).parents[1] / "docs" / "scenarios.md"
-    blocks = re.findall(r"```toml\n(.*?)```", doc.read_text(), re.S)
+    blocks = re.findall(r"```toml\n(.*?)```", doc.read_text(), re.DOTALL)
     assert len(blocks) >= 2
     for block in blocks:
         world = World.from_config(tomllib.loads(block), seed=0)
