@@ -1,0 +1,92 @@
+"""Sequential (restoring) integer divider: one quotient bit per clock cycle."""
+
+from amaranth import Cat, Module, Mux, Signal
+from amaranth.lib import wiring
+from amaranth.lib.wiring import In, Out
+
+__all__ = ["SequentialDivider"]
+
+
+class SequentialDivider(wiring.Component):
+    """Unsigned ``dividend // divisor`` for a quotient known to fit ``quotient_bits`` bits.
+
+    Only ``quotient_bits`` steps are needed, not ``dividend_bits``: the partial remainder starts
+    as ``dividend >> quotient_bits``, which is below ``divisor`` when the quotient fits. The
+    caller guarantees ``dividend < divisor << quotient_bits`` (the centroid ``SX // N`` is at
+    most ``width - 1``); otherwise, or for a zero divisor, ``quotient`` is meaningless but the
+    divider still finishes on time.
+
+    Parameters
+    ----------
+    dividend_bits, divisor_bits, quotient_bits : int
+        Operand and result widths (each at least 1).
+
+    Members
+    -------
+    start : ``In(1)``
+        Load ``dividend`` and ``divisor`` (sampled at this edge only: they may change
+        afterwards) and begin; a ``start`` while busy restarts.
+    dividend : ``In(dividend_bits)``
+    divisor : ``In(divisor_bits)``
+    quotient : ``Out(quotient_bits)``
+        Valid from ``done`` until the next ``start``.
+    busy : ``Out(1)``
+        High while steps remain.
+    done : ``Out(1)``
+        One-cycle strobe: right after edge S + ``latency`` when ``start`` was sampled at edge S.
+    """
+
+    def __init__(self, dividend_bits, divisor_bits, quotient_bits):
+        for name, value in (("dividend_bits", dividend_bits), ("divisor_bits", divisor_bits),
+                            ("quotient_bits", quotient_bits)):
+            if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+                raise ValueError(f"{name} must be an int >= 1, got {value!r}")
+        self.dividend_bits = dividend_bits
+        self.divisor_bits = divisor_bits
+        self.quotient_bits = quotient_bits
+        super().__init__({
+            "start": In(1),
+            "dividend": In(dividend_bits),
+            "divisor": In(divisor_bits),
+            "quotient": Out(quotient_bits),
+            "busy": Out(1),
+            "done": Out(1),
+        })
+
+    @property
+    def latency(self):
+        """Cycles from the ``start`` edge to the edge after which ``done`` is high."""
+        return self.quotient_bits
+
+    def elaborate(self, platform):
+        m = Module()
+        q_bits = self.quotient_bits
+
+        rem = Signal(self.divisor_bits)  # partial remainder, always < divisor
+        low = Signal(q_bits)  # dividend bits still to bring down; quotient bits shift in
+        steps = Signal(range(q_bits + 1))
+        divisor = Signal(self.divisor_bits)  # held: the inputs may change once started
+
+        trial = Cat(low[-1], rem)  # rem * 2 + next dividend bit
+        fits = trial >= divisor
+
+        m.d.comb += [
+            self.quotient.eq(low),
+            self.busy.eq(steps != 0),
+        ]
+        m.d.sync += self.done.eq(0)
+        with m.If(self.start):
+            m.d.sync += [
+                rem.eq(self.dividend >> q_bits),
+                low.eq(self.dividend[:q_bits]),
+                divisor.eq(self.divisor),
+                steps.eq(q_bits),
+            ]
+        with m.Elif(steps != 0):
+            m.d.sync += [
+                rem.eq(Mux(fits, trial - divisor, trial)),
+                low.eq(Cat(fits, low[:-1])),
+                steps.eq(steps - 1),
+                self.done.eq(steps == 1),
+            ]
+        return m

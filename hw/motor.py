@@ -1,0 +1,109 @@
+"""Motor controller: per-frame wheel speeds (DPS) from the tracker's results."""
+
+from amaranth import Array, Const, Module, Mux, Signal, signed
+from amaranth.lib import wiring
+from amaranth.lib.wiring import In, Out
+
+from .params import FollowTargetParams
+
+__all__ = ["MotorController"]
+
+#: Width of the motor outputs (signed DPS).
+DPS_BITS = 16
+
+
+def _wrap16(value):
+    """A Python int as the 16-bit two's complement value the output register will hold."""
+    return ((value + (1 << 15)) & 0xFFFF) - (1 << 15)
+
+
+class MotorController(wiring.Component):
+    """Proportional steering with a lost-target search, updated once per frame.
+
+    On ``update`` (the tracker's ``frame_done``):
+
+    - found: ``e = centroid_x - width // 2``, ``turn = (kp_num * e) >> kp_shift`` (arithmetic),
+      ``left = base_dps[proximity] + turn``, ``right = base_dps[proximity] - turn``, each
+      saturated to ``[-max_dps, max_dps]``; the lost count returns to 0 and ``last_side``
+      becomes right when ``e >= 0``, else left;
+    - not found: the lost count goes up by one (saturating at ``lost_frames``). Below
+      ``lost_frames`` the outputs hold; from ``lost_frames`` on they are the search command,
+      turning in place towards ``last_side`` at ``search_dps`` (``left = +search_dps`` for
+      right).
+
+    After reset the outputs are 0, the lost count 0 and ``last_side`` left.
+
+    Parameters
+    ----------
+    params : FollowTargetParams
+
+    Members
+    -------
+    update : ``In(1)``
+        The tracker's ``frame_done``.
+    found : ``In(1)``
+    proximity : ``In(3)``
+    centroid_x : ``In(params.x_bits)``
+        The tracker's results, valid while ``update`` is high.
+    left, right : ``Out(signed(16))``
+        Wheel speeds in DPS; they load at the edge that samples ``update``.
+    last_side : ``Out(1)``
+        1 when the target was last seen on the right half (``e >= 0``), 0 for left.
+    lost_count : ``Out(range(lost_frames + 1))``
+        Consecutive frames without the target, saturating at ``lost_frames``.
+    """
+
+    def __init__(self, params):
+        if not isinstance(params, FollowTargetParams):
+            raise TypeError(f"params must be a FollowTargetParams, not {params!r}")
+        self.params = params
+        super().__init__({
+            "update": In(1),
+            "found": In(1),
+            "proximity": In(3),
+            "centroid_x": In(params.x_bits),
+            "left": Out(signed(DPS_BITS)),
+            "right": Out(signed(DPS_BITS)),
+            "last_side": Out(1),
+            "lost_count": Out(range(params.lost_frames + 1)),
+        })
+
+    @property
+    def latency(self):
+        """Outputs show the new values right after the edge that samples ``update``."""
+        return 1
+
+    def elaborate(self, platform):
+        m = Module()
+        p = self.params
+
+        # e, turn and base +- turn are computed wide enough never to overflow before the
+        # saturation (the published design lost bits here).
+        e = self.centroid_x - (p.width // 2)  # signed(x_bits + 1)
+        turn = (e * p.kp_num) >> p.kp_shift
+        base = Array(Const(v, signed(DPS_BITS)) for v in p.base_dps)[self.proximity]
+
+        def saturate(v):
+            lim = p.max_dps
+            return Mux(v > lim, lim, Mux(v < -lim, -lim, v))
+
+        search = _wrap16(p.search_dps)
+        neg_search = _wrap16(-p.search_dps)
+        lost_next = Mux(self.lost_count == p.lost_frames, p.lost_frames, self.lost_count + 1)
+
+        with m.If(self.update):
+            with m.If(self.found):
+                m.d.sync += [
+                    self.left.eq(saturate(base + turn)),
+                    self.right.eq(saturate(base - turn)),
+                    self.last_side.eq(e >= 0),
+                    self.lost_count.eq(0),
+                ]
+            with m.Else():
+                m.d.sync += self.lost_count.eq(lost_next)
+                with m.If(lost_next == p.lost_frames):
+                    m.d.sync += [
+                        self.left.eq(Mux(self.last_side, search, neg_search)),
+                        self.right.eq(Mux(self.last_side, neg_search, search)),
+                    ]
+        return m
