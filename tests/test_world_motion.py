@@ -9,6 +9,8 @@ steps of ``DT``.
 import math
 
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from fpga_robotics.sim.world import TURTLEBOT2, World
 
@@ -204,3 +206,24 @@ def test_step_splits_long_steps():
     assert a.robot_pose() == pytest.approx(b.robot_pose(), abs=1e-9)
     with pytest.raises(ValueError, match="dt"):
         a.step(0.0)
+
+
+@settings(max_examples=15, deadline=None)
+@given(st.lists(st.tuples(st.integers(-1500, 1500), st.integers(-1500, 1500)),
+                min_size=5, max_size=5), st.sampled_from(["turtlebot2", "gopigo3"]))
+def test_no_command_sequence_gets_the_robot_out_of_the_room(commands, model):
+    room = {"width": 3.0, "depth": 2.5,
+            "furniture": [{"name": "box", "center": [2.2, 1.2], "size": [0.5, 0.5]}]}
+    world = World.from_config({"room": room, "robot": {"model": model, "start": [0.8, 1.2]},
+                               "people": [{"waypoints": [[1.5, 0.5], [1.5, 2.0]]}]}, seed=1)
+    r = world.robot_spec.body_radius
+    for left, right in commands:
+        world.set_wheel_dps(left, right)
+        for _ in range(300):
+            world.step(DT)
+            x, y, _ = world.robot_pose()
+            assert r - 0.02 < x < 3.0 - r + 0.02
+            assert r - 0.02 < y < 2.5 - r + 0.02
+            # never into the box: centre-to-box distance at least the body radius
+            gap = math.hypot(max(abs(x - 2.2) - 0.25, 0.0), max(abs(y - 1.2) - 0.25, 0.0))
+            assert gap > r - 0.02
