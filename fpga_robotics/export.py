@@ -8,7 +8,6 @@ a bad value prints what is wrong and exits with code 2.
 
 import argparse
 import os
-import sys
 import tempfile
 from dataclasses import fields
 
@@ -20,8 +19,15 @@ from .errors import UsageError, run_cli
 from .hw.params import FollowTargetParams
 from .hw.top import FollowTarget
 
-__all__ = ["generate_verilog", "verilog_ports", "build_parser", "params_from_args", "main",
-           "write_atomically", "TOP_NAME"]
+__all__ = [
+    "TOP_NAME",
+    "build_parser",
+    "generate_verilog",
+    "main",
+    "params_from_args",
+    "verilog_ports",
+    "write_atomically",
+]
 
 #: Name of the Verilog module.
 TOP_NAME = "follow_target"

@@ -1,6 +1,6 @@
 """Motor controller: per-frame wheel speeds (DPS) from the tracker's results."""
 
-from amaranth import Array, Const, Module, Mux, Signal, signed
+from amaranth import Array, Const, Module, Mux, signed
 from amaranth.lib import wiring
 from amaranth.lib.wiring import In, Out
 

@@ -25,7 +25,7 @@ from .color_filter import MatchStream
 from .divider import SequentialDivider
 from .params import FollowTargetParams
 
-__all__ = ["FrameTracker", "LEDS_CENTRED"]
+__all__ = ["LEDS_CENTRED", "FrameTracker"]
 
 #: ``centroid_leds`` when the target is centred: the two middle LEDs.
 LEDS_CENTRED = 0b0001_1000

@@ -25,13 +25,13 @@ from amaranth.sim import Simulator
 __all__ = [
     "Step",
     "WatchdogTimeout",
-    "pack_transfer",
+    "edges_where",
     "frame_schedule",
     "lines_schedule",
+    "pack_transfer",
     "run_schedule",
-    "stream_put",
     "stream_get",
-    "edges_where",
+    "stream_put",
     "unpack_lanes",
 ]
 
