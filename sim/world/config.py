@@ -133,21 +133,18 @@ def _is_number(value):
 
 def _check_number(value, path, *, gt=None, ge=None, le=None, unit=""):
     """Return ``value`` as a float if it is a finite number within the bounds."""
-    bounds = []
-    if gt is not None:
-        bounds.append(f"> {gt:g}")
-    if ge is not None:
-        bounds.append(f">= {ge:g}")
-    if le is not None:
-        bounds.append(f"<= {le:g}")
-    what = "a number" + (f" in {unit}" if unit else "") + (
-        " " + " and ".join(bounds) if bounds else "")
-    if not _is_number(value) or not math.isfinite(value):
+    finite = _is_number(value) and math.isfinite(value)
+    checks = [(f"> {b:g}", finite and value > b) for b in (gt,) if b is not None]
+    checks += [(f">= {b:g}", finite and value >= b) for b in (ge,) if b is not None]
+    checks += [(f"<= {b:g}", finite and value <= b) for b in (le,) if b is not None]
+    if not finite:
+        what = "a number" + (f" in {unit}" if unit else "")
+        if checks:
+            what += " " + " and ".join(text for text, _ in checks)
         raise WorldConfigError(f"{path} must be {what}, got {_show(value)}")
-    for ok, bound in ((gt is None or value > gt, f"> {gt}"), (ge is None or value >= ge, f">= {ge}"),
-                      (le is None or value <= le, f"<= {le}")):
+    for text, ok in checks:
         if not ok:
-            raise WorldConfigError(f"{path} must be {bound}, got {value!r}")
+            raise WorldConfigError(f"{path} must be {text}, got {value!r}")
     return float(value)
 
 

@@ -32,7 +32,7 @@ def rad_to_dps(rad_s):
 
 
 def wheels_to_twist(left_rad_s, right_rad_s, wheel_radius, wheel_separation):
-    """Robot twist ``(v, w)`` (m/s, rad/s, counter-clockwise positive) from wheel speeds in rad/s."""
+    """Robot twist ``(v, w)`` (m/s, rad/s counter-clockwise) from wheel speeds in rad/s."""
     v = wheel_radius * (left_rad_s + right_rad_s) / 2.0
     w = wheel_radius * (right_rad_s - left_rad_s) / wheel_separation
     return v, w
