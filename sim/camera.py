@@ -1,0 +1,463 @@
+"""SimCamera: a forward-looking pinhole camera on the robot, ray cast from a ``Scene`` in numpy.
+
+The world is 2.5-D: vertical walls standing on the floor, upright cylinders (people) made of
+coloured bands, a flat floor and a flat ceiling. That lets the renderer cast one ray per image
+column instead of one per pixel:
+
+1. For each column, intersect its ray (in the ground plane) with every wall segment and every
+   cylinder; a hit's *depth* is its distance along the camera's forward axis.
+2. Keep the ``max_layers`` nearest hits per column (a room wall, floor to ceiling, ends the
+   list: whatever lies behind it is farther than it).
+3. A hit at depth ``p`` spanning heights ``z0..z1`` covers the rows whose rays pass through
+   that height range at that depth: a contiguous run of rows given by the pinhole formula
+   ``row = H/2 - 0.5 - f * (z - h) / p`` (tilt aside). Each column therefore splits into a few
+   runs of rows, each showing the nearest hit that covers it, or the floor / ceiling.
+4. The runs are painted with a cumulative sum down the columns and one palette lookup, so the
+   per-pixel work is a handful of whole-image numpy operations whatever the scene.
+
+Conventions: pixel ``(row, col)`` has its centre at ``(col + 0.5, row + 0.5)``; the optical axis
+passes through the image centre ``(W/2, H/2)``; the focal length in pixels is
+``f = (W/2) / tan(hfov/2)`` for both axes (square pixels). Image right is the camera's right, so
+turning the camera left (heading +) moves the world to the right in the image.
+
+Tilt is applied as a rotation of each column's vertical ray fan (``elevation = atan(v/f) +
+tilt``): exact at the centre column and with the camera level (tilt 0, the usual case); with
+tilt, vertical edges stay vertical instead of converging (no keystone).
+"""
+
+import functools
+import math
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+
+from .scene import CameraPose, Scene
+
+__all__ = ["CameraRenderer", "render", "DEFAULT_HFOV", "DEFAULT_MAX_LAYERS"]
+
+#: Horizontal field of view of the published system's camera, radians.
+DEFAULT_HFOV = 1.047
+#: Depth layers composited per column (nearest hits kept).
+DEFAULT_MAX_LAYERS = 6
+#: Hits closer than this (metres along the forward axis) are ignored (near clipping plane).
+NEAR = 1e-3
+# Keep every ray at least this far (radians) from looking straight up or down.
+_VERTICAL_MARGIN = 0.02
+
+
+@dataclass(frozen=True)
+class _Walls:
+    """Wall segments of a scene as arrays, shape (N,) each; built once per walls tuple."""
+
+    x0: np.ndarray
+    y0: np.ndarray
+    ex: np.ndarray  # segment vector x1 - x0
+    ey: np.ndarray
+    length: np.ndarray
+    height: np.ndarray
+    albedo: np.ndarray  # (N, 3)
+
+
+@dataclass(frozen=True)
+class _Cylinders:
+    """Cylinders as arrays (C,), and their bands flattened to arrays (B,)."""
+
+    x: np.ndarray
+    y: np.ndarray
+    radius: np.ndarray
+    band_owner: np.ndarray  # cylinder index of each band
+    band_z0: np.ndarray
+    band_z1: np.ndarray
+    band_albedo: np.ndarray  # (B, 3)
+
+
+def _albedo(color, what):
+    try:
+        rgb = tuple(float(c) for c in color)
+    except TypeError:
+        rgb = ()
+    if len(rgb) != 3 or not all(math.isfinite(c) and c >= 0.0 for c in rgb):
+        raise ValueError(f"{what} colour must be three albedos (r, g, b) >= 0, got {color!r}")
+    return rgb
+
+
+def _walls_arrays(walls):
+    n = len(walls)
+    a = np.empty((n, 6))
+    albedo = np.empty((n, 3))
+    for i, w in enumerate(walls):
+        a[i] = (w.x0, w.y0, w.x1 - w.x0, w.y1 - w.y0, 0.0, w.height)
+        albedo[i] = _albedo(w.color, f"wall {i}")
+    a[:, 4] = np.hypot(a[:, 2], a[:, 3])
+    if not np.all(np.isfinite(a)):
+        raise ValueError("wall coordinates and heights must be finite numbers")
+    if np.any(a[:, 4] <= 0.0):
+        i = int(np.argmin(a[:, 4]))
+        raise ValueError(f"wall {i} has zero length ({walls[i]}); give it two distinct ends")
+    return _Walls(a[:, 0], a[:, 1], a[:, 2], a[:, 3], a[:, 4], a[:, 5], albedo)
+
+
+def _cylinder_arrays(cylinders):
+    centres = np.empty((len(cylinders), 3))
+    owner, z, albedo = [], [], []
+    for i, c in enumerate(cylinders):
+        centres[i] = (c.x, c.y, c.radius)
+        for band in c.bands:
+            owner.append(i)
+            z.append((band.z0, band.z1))
+            albedo.append(_albedo(band.color, f"cylinder {i} band"))
+    if not np.all(np.isfinite(centres)) or np.any(centres[:, 2] <= 0.0):
+        raise ValueError("cylinders need finite centres and a radius > 0")
+    z = np.asarray(z, dtype=float).reshape(-1, 2)
+    return _Cylinders(
+        centres[:, 0],
+        centres[:, 1],
+        centres[:, 2],
+        np.asarray(owner, dtype=np.intp),
+        z[:, 0],
+        z[:, 1],
+        np.asarray(albedo, dtype=float).reshape(-1, 3),
+    )
+
+
+def _check_int(name, value, lo):
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+        raise TypeError(f"{name} must be an int, not {type(value).__name__} {value!r}")
+    if value < lo:
+        raise ValueError(f"{name} must be >= {lo}, got {value}")
+
+
+class CameraRenderer:
+    """Pinhole camera renderer for one image size, with its per-resolution tables cached.
+
+    Parameters
+    ----------
+    width, height : int
+        Image size in pixels.
+    hfov : float
+        Horizontal field of view, radians (0 < hfov < pi). The vertical field of view follows
+        from square pixels: ``2 * atan((height/2) / f)``.
+    max_layers : int
+        Depth layers composited per column: the nearest ``max_layers`` wall / band hits in a
+        column are drawn, farther ones are not (their rows would show floor or ceiling).
+        Each wall crossed and each band of a person crossed is one hit.
+
+    Attributes
+    ----------
+    focal : float
+        Focal length in pixels, ``(width/2) / tan(hfov/2)``.
+    column_angles : np.ndarray
+        (width,) angle of each column's ray from the optical axis, radians, positive to the
+        left (counter-clockwise, like the heading).
+
+    Notes
+    -----
+    ``render`` is not thread safe (it reuses scratch buffers); use one renderer per thread.
+    """
+
+    def __init__(self, width, height, hfov=DEFAULT_HFOV, *, max_layers=DEFAULT_MAX_LAYERS):
+        _check_int("width", width, 1)
+        _check_int("height", height, 1)
+        _check_int("max_layers", max_layers, 1)
+        if not (isinstance(hfov, (int, float)) and 0.0 < hfov < math.pi):
+            raise ValueError(f"hfov must be an angle in radians between 0 and pi, got {hfov!r}")
+        self.width = int(width)
+        self.height = int(height)
+        self.hfov = float(hfov)
+        self.max_layers = int(max_layers)
+        self.focal = (self.width / 2) / math.tan(self.hfov / 2)
+        # Lateral offset (to the right) of each column's ray per metre forward.
+        self._slope = (np.arange(self.width) + 0.5 - self.width / 2) / self.focal
+        self._slope_sq1 = 1.0 + self._slope**2
+        self.column_angles = -np.arctan(self._slope)
+        # Continuous row of the optical axis, and the vertical half field of view.
+        self._row_axis = self.height / 2 - 0.5
+        self._half_vfov = math.atan((self.height / 2) / self.focal)
+        # Scratch: run starts are counted into a (H+1, W) grid, then summed down the columns.
+        # Run ids go up to width * runs per column; int16 sums faster when they fit.
+        runs = 2 * self.max_layers + 2
+        self._id_dtype = np.int16 if self.width * runs < 2**15 else np.int32
+        self._counts = np.zeros((self.height + 1, self.width), dtype=self._id_dtype)
+        self._run_ids = np.empty((self.height, self.width), dtype=self._id_dtype)
+        self._one = self._id_dtype(1)  # a typed scalar keeps np.add.at on its fast path
+        self._noise = np.empty((self.height, self.width, 3), dtype=np.int16)
+        self._cols = np.arange(self.width)
+        self._col_index = self._cols[:, None]  # row selector for per-column gathers
+        self._walls_key = self._walls = None
+        self._cyls_key = self._cyls = None
+
+    def __repr__(self):
+        return (
+            f"CameraRenderer(width={self.width}, height={self.height}, hfov={self.hfov}, "
+            f"max_layers={self.max_layers})"
+        )
+
+    def row_elevations(self, tilt=0.0):
+        """(height,) elevation of each row's ray at the centre column, radians (up positive)."""
+        v = self.height / 2 - (np.arange(self.height) + 0.5)
+        return np.arctan(v / self.focal) + tilt
+
+    # -- scene geometry, converted once per walls / cylinders tuple -------------------------
+
+    def _geometry(self, scene):
+        if scene.walls is not self._walls_key:
+            self._walls = _walls_arrays(scene.walls)
+            self._walls_key = scene.walls
+        if scene.cylinders is not self._cyls_key:
+            self._cyls = _cylinder_arrays(scene.cylinders)
+            self._cyls_key = scene.cylinders
+        return self._walls, self._cyls
+
+    # -- rows covered by a height range at a depth -------------------------------------------
+
+    def _rows_of(self, slope, tilt):
+        """Continuous image row where a ray with vertical slope ``dz/depth`` lands."""
+        if tilt == 0.0:
+            return self._row_axis - self.focal * slope
+        lim = math.pi / 2 - 1e-6
+        return self._row_axis - self.focal * np.tan(np.clip(np.arctan(slope) - tilt, -lim, lim))
+
+    # -- the frame ---------------------------------------------------------------------------
+
+    def render(self, scene, pose, noise_std=0.0, rng=None):
+        """Render ``scene`` seen from ``pose``.
+
+        Parameters
+        ----------
+        scene : Scene
+        pose : CameraPose
+        noise_std : float
+            Standard deviation of additive Gaussian sensor noise, in 8-bit units (0 = none).
+        rng : numpy.random.Generator
+            Required when ``noise_std > 0``; the noise is a function of its state only.
+
+        Returns
+        -------
+        np.ndarray
+            (height, width, 3) uint8 RGB image.
+        """
+        if not isinstance(scene, Scene):
+            raise TypeError(f"scene must be a fpga_robotics.sim.scene.Scene, not {type(scene)}")
+        if not isinstance(pose, CameraPose):
+            raise TypeError(f"pose must be a fpga_robotics.sim.scene.CameraPose, not {type(pose)}")
+        ids, palette = self._runs(scene, pose)
+        # One 4-byte palette lookup per pixel, then RGBA -> RGB: ~3x faster than taking
+        # 3-byte rows; cvtColor returns a fresh contiguous image.
+        rgba = palette.take(ids).view(np.uint8).reshape(self.height, self.width, 4)
+        image = cv2.cvtColor(rgba, cv2.COLOR_RGBA2RGB)
+        if noise_std:
+            self._add_noise(image, noise_std, rng)
+        return image
+
+    def _add_noise(self, image, noise_std, rng):
+        if not (math.isfinite(noise_std) and noise_std > 0):
+            raise ValueError(f"noise_std must be a finite number >= 0, got {noise_std!r}")
+        if not isinstance(rng, np.random.Generator):
+            raise ValueError(
+                "noise_std > 0 needs rng=numpy.random.Generator (e.g. np.random.default_rng(seed))"
+                " so that the noise is reproducible"
+            )
+        # OpenCV draws the normals ~3x faster than numpy; its (thread-local) generator is
+        # seeded from ``rng`` each frame, so the noise still follows the caller's seed.
+        cv2.setRNGSeed(int(rng.integers(0, 2**31 - 1)))
+        # A 2-D single-channel view: a scalar std for a 3-channel Mat would only hit channel 0.
+        cv2.randn(self._noise.reshape(self.height, -1), 0.0, float(noise_std))
+        cv2.add(image, self._noise, dst=image, dtype=cv2.CV_8U)  # saturating
+
+    def _runs(self, scene, pose):
+        """Per-pixel run ids (H, W) and the palette (runs, 3) uint8 they index."""
+        W, H = self.width, self.height
+        cx, cy, h, tilt = float(pose.x), float(pose.y), float(pose.height), float(pose.tilt)
+        ceiling = float(scene.ceiling_height)
+        if not (0.0 < h < ceiling):
+            raise ValueError(
+                f"camera height {h} m must be between the floor (0) and the ceiling "
+                f"({ceiling} m)"
+            )
+        if abs(tilt) + self._half_vfov > math.pi / 2 - _VERTICAL_MARGIN:
+            raise ValueError(
+                f"camera tilt {tilt:.3f} rad with a vertical field of view of "
+                f"{2 * self._half_vfov:.3f} rad would look straight up or down; keep "
+                f"|tilt| below {math.pi / 2 - _VERTICAL_MARGIN - self._half_vfov:.3f} rad"
+            )
+        ambient, intensity, light = _light(scene.lighting)
+        walls, cyls = self._geometry(scene)
+        ch, sh = math.cos(pose.heading), math.sin(pose.heading)
+        # Column ray directions with a forward component of 1: the ray parameter is the depth.
+        dx = (ch + self._slope * sh)[:, None]
+        dy = (sh - self._slope * ch)[:, None]
+
+        depths, shades = [], []
+        z0s, z1s, albedos = [], [], []
+        with np.errstate(divide="ignore", invalid="ignore"):
+            if len(walls.x0):
+                qx, qy = walls.x0 - cx, walls.y0 - cy
+                denom = dx * walls.ey - dy * walls.ex
+                t = (qx * walls.ey - qy * walls.ex) / denom
+                s = (qx * dy - qy * dx) / denom
+                depths.append(np.where((s >= 0.0) & (s <= 1.0) & (t > NEAR), t, np.inf))
+                # Unit normal turned towards the camera (the camera's side of the wall line).
+                side = np.where(walls.ey * qx - walls.ex * qy > 0.0, -1.0, 1.0) / walls.length
+                ndotl = side * (walls.ey * light[0] - walls.ex * light[1])
+                shade = ambient + intensity * np.maximum(0.0, -ndotl)
+                shades.append(np.broadcast_to(shade, (W, len(shade))))
+                z0s.append(np.zeros(len(shade)))
+                z1s.append(walls.height)
+                albedos.append(walls.albedo)
+            if len(cyls.band_owner):
+                qx, qy, r = cx - cyls.x, cy - cyls.y, cyls.radius
+                b = dx * qx + dy * qy
+                c = qx * qx + qy * qy - r * r  # > 0: camera outside the cylinder
+                disc = b * b - self._slope_sq1[:, None] * c
+                t = (-b - np.sqrt(disc)) / self._slope_sq1[:, None]
+                t = np.where((disc >= 0.0) & (t > NEAR) & (c > 0.0), t, np.inf)
+                # Outward normal at the hit point, (q + t d) / r (horizontal).
+                ndotl = ((qx + t * dx) * light[0] + (qy + t * dy) * light[1]) / r
+                shade = ambient + intensity * np.maximum(0.0, -np.nan_to_num(ndotl))
+                own = cyls.band_owner
+                depths.append(t[:, own])
+                shades.append(shade[:, own])
+                z0s.append(cyls.band_z0)
+                z1s.append(cyls.band_z1)
+                albedos.append(cyls.band_albedo)
+
+        floor_rgb = _lit(scene.floor_color, ambient + intensity * max(0.0, -light[2]), "floor")
+        ceil_rgb = _lit(scene.ceiling_color, ambient + intensity * max(0.0, light[2]), "ceiling")
+        horizon = min(H, max(0, math.ceil(self._rows_of(0.0, tilt))))  # first floor row
+
+        if not depths:  # an empty scene: floor and ceiling only
+            return self._paint_background(horizon, floor_rgb, ceil_rgb)
+
+        depth = np.concatenate(depths, axis=1) if len(depths) > 1 else depths[0]
+        shade = np.concatenate(shades, axis=1) if len(shades) > 1 else shades[0]
+        z0 = np.concatenate(z0s) if len(z0s) > 1 else z0s[0]
+        z1 = np.concatenate(z1s) if len(z1s) > 1 else z1s[0]
+        albedo = np.concatenate(albedos) if len(albedos) > 1 else albedos[0]
+        # The floor and ceiling hide anything below 0 or above the ceiling.
+        z0 = np.maximum(z0, 0.0)
+        z1 = np.minimum(z1, ceiling)
+        n = depth.shape[1]
+
+        # Candidates: the 2k nearest hits of each column, nearest first, and their rows.
+        k = min(self.max_layers, n)
+        m = min(2 * k, n)
+        ci = self._col_index
+        if n > m:
+            cand = np.argpartition(depth, m - 1, axis=1)[:, :m]
+            cand = cand[ci, np.argsort(depth[ci, cand], axis=1)]
+        else:
+            cand = np.argsort(depth, axis=1)
+        row_start, row_end = self._rows_covered(depth[ci, cand], z0[cand], z1[cand], h, tilt)
+        # A candidate whose rows all lie within those of a nearer one is hidden: a box's far
+        # side behind its near side, a wall behind a taller one. Drop those (and misses) before
+        # keeping the k nearest, so that they do not use up the layer budget.
+        hidden = (
+            (row_start[:, :, None] <= row_start[:, None, :])
+            & (row_end[:, :, None] >= row_end[:, None, :])
+            & _nearer(m)
+        ).any(axis=1)
+        hidden |= row_start >= row_end
+        keep = np.argsort(hidden, axis=1, kind="stable")[:, :k]  # visible first, by depth
+        # Layer k is a sentinel covering every row: "no surface here".
+        sel = np.zeros((W, k + 1), dtype=np.intp)
+        rs = np.zeros((W, k + 1), dtype=np.intp)
+        re = np.full((W, k + 1), H + 1, dtype=np.intp)
+        sel[:, :k] = cand[ci, keep]
+        gone = hidden[ci, keep]
+        rs[:, :k] = np.where(gone, H, row_start[ci, keep])
+        re[:, :k] = np.where(gone, H, row_end[ci, keep])
+
+        # Each column splits into runs at the layers' edges and the horizon; a run shows the
+        # nearest layer covering its first row, else ceiling (above the horizon) or floor.
+        starts = np.empty((W, 2 * k + 2), dtype=np.intp)
+        starts[:, 0] = 0
+        starts[:, 1] = horizon
+        starts[:, 2 : k + 2] = rs[:, :k]
+        starts[:, k + 2 :] = re[:, :k]
+        starts.sort(axis=1)
+        s = starts[:, :, None]
+        layer = ((rs[:, None, :] <= s) & (s < re[:, None, :])).argmax(axis=2)  # (W, runs)
+        surf = sel[ci, layer]
+        lit = albedo[surf] * shade[ci, surf][:, :, None]
+        background = np.where((starts >= horizon)[:, :, None], floor_rgb, ceil_rgb)
+        colors = np.where((layer < k)[:, :, None], lit, background)
+        return self._paint_runs(starts), _packed_palette(colors)
+
+    def _rows_covered(self, depth, z0, z1, h, tilt):
+        """Rows ``row_start <= row < row_end`` where surfaces at ``depth`` spanning heights
+        ``z0..z1`` are seen (pixel centres inside the span); (H, H) for no hit."""
+        H = self.height
+        hit = np.isfinite(depth)
+        p = np.where(hit, depth, 1.0)
+        row_start = np.ceil(self._rows_of((z1 - h) / p, tilt))
+        row_end = np.floor(self._rows_of((z0 - h) / p, tilt)) + 1.0
+        row_start = np.where(hit, np.clip(row_start, 0, H), H).astype(np.intp)
+        row_end = np.where(hit, np.clip(row_end, 0, H), H).astype(np.intp)
+        return row_start, row_end
+
+    def _paint_runs(self, starts):
+        """Run id of every pixel: column c's runs are c*R .. c*R+R-1, starting at ``starts``."""
+        W, runs = self.width, starts.shape[1]
+        counts = self._counts
+        counts.fill(0)
+        counts[0] = self._cols * runs
+        # Every run start after the first adds one; starts equal to H land in the spare row.
+        np.add.at(counts.reshape(-1), (starts[:, 1:] * W + self._cols[:, None]).ravel(), self._one)
+        np.cumsum(counts[:-1], axis=0, out=self._run_ids)
+        return self._run_ids
+
+    def _paint_background(self, horizon, floor_rgb, ceil_rgb):
+        starts = np.empty((self.width, 2), dtype=np.intp)
+        starts[:, 0] = 0
+        starts[:, 1] = horizon
+        palette = np.empty((self.width, 2, 3))
+        palette[:, 0] = ceil_rgb if horizon > 0 else floor_rgb
+        palette[:, 1] = floor_rgb
+        return self._paint_runs(starts), _packed_palette(palette)
+
+
+@functools.lru_cache(maxsize=64)
+def _nearer(m):
+    """(m, m) bool: candidate i is nearer than candidate j (both sorted by depth)."""
+    return np.triu(np.ones((m, m), dtype=bool), 1)
+
+
+def _light(lighting):
+    ambient, intensity = float(lighting.ambient), float(lighting.intensity)
+    d = np.asarray(lighting.direction, dtype=float)
+    norm = float(np.linalg.norm(d)) if d.shape == (3,) else 0.0
+    if not (math.isfinite(norm) and norm > 0.0):
+        raise ValueError(
+            f"lighting.direction must be a non-zero (dx, dy, dz) vector, got {lighting.direction!r}"
+        )
+    if not (ambient >= 0.0 and intensity >= 0.0):
+        raise ValueError(
+            f"lighting.ambient and lighting.intensity must be >= 0, got {ambient}, {intensity}"
+        )
+    return ambient, intensity, d / norm
+
+
+def _lit(color, shade, what):
+    return np.asarray(_albedo(color, what)) * shade
+
+
+def _packed_palette(rgb):
+    """Linear colours (..., 3) to 8-bit (rounded, clipped), packed as RGBA uint32, flat."""
+    rgba = np.zeros(rgb.shape[:-1] + (4,), dtype=np.uint8)
+    rgba[..., :3] = np.clip(rgb * 255.0 + 0.5, 0.0, 255.0)
+    return rgba.reshape(-1, 4).view(np.uint32).ravel()
+
+
+@functools.lru_cache(maxsize=8)
+def _renderer(width, height, hfov):
+    return CameraRenderer(width, height, hfov)
+
+
+def render(scene, pose, width, height, hfov=DEFAULT_HFOV, *, noise_std=0.0, rng=None):
+    """Render ``scene`` from ``pose`` at ``width`` x ``height``; (height, width, 3) uint8.
+
+    Convenience wrapper around a cached :class:`CameraRenderer` per (width, height, hfov).
+    ``noise_std`` (8-bit units) adds Gaussian sensor noise drawn from ``rng`` (required then).
+    """
+    return _renderer(width, height, hfov).render(scene, pose, noise_std=noise_std, rng=rng)
