@@ -2,6 +2,7 @@
 
 import numpy as np
 import pytest
+
 from fpga_robotics.viz.leds import CELL, GAP, cell_centre, centroid_image, proximity_image
 
 

@@ -5,14 +5,14 @@ import sys
 
 import numpy as np
 import pytest
+
+from fpga_robotics.errors import UsageError
+from fpga_robotics.records import FrameRecord
 from fpga_robotics.sim.backends.base import FrameResult
 from fpga_robotics.viz import open_recorder, parse_mode, sinks
 from fpga_robotics.viz import paths as P
 from fpga_robotics.viz.modes import DEFAULT_CONNECT_URL, display_available, port_is_listening
 from fpga_robotics.viz.readback import read_rrd
-
-from fpga_robotics.errors import UsageError
-from fpga_robotics.records import FrameRecord
 
 
 def frame(i):

@@ -10,14 +10,14 @@ import os
 import cv2
 import numpy as np
 import pytest
+
+from fpga_robotics.records import FrameRecord, PersonState, WorldMap
 from fpga_robotics.sim.backends.base import FrameResult
 from fpga_robotics.sim.frames import rgb444_to_rgb888
 from fpga_robotics.viz import open_recorder
 from fpga_robotics.viz import paths as P
 from fpga_robotics.viz.leds import CELL, GAP, cell_centre
 from fpga_robotics.viz.readback import read_rrd
-
-from fpga_robotics.records import FrameRecord, PersonState, WorldMap
 
 PER_FRAME = [
     P.LEDS_PROXIMITY,
@@ -307,6 +307,8 @@ def test_file_appears_only_when_closed(tmp_path):
     assert os.listdir(path.parent) == ["atomic.rrd"]  # no temporary file left behind
     assert str(path) in msg and f"rerun {path}" in msg and "3 frames" in msg
     assert rec.close() == msg  # closing twice is harmless
+    with pytest.raises(RuntimeError, match="closed"):
+        rec.log_frame(make_frames(1)[0])
 
 
 def test_context_manager_saves_on_error(tmp_path):

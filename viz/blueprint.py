@@ -77,6 +77,8 @@ def default_blueprint(bounds=None):
     )
     return rrb.Blueprint(
         rrb.Horizontal(board, world, column_shares=[1, 1]),
-        rrb.TimePanel(timeline=_TIMELINE),
-        collapse_panels=False,
+        # The views get the room: the blueprint tree and selection panels start collapsed.
+        rrb.BlueprintPanel(state="collapsed"),
+        rrb.SelectionPanel(state="collapsed"),
+        rrb.TimePanel(timeline=_TIMELINE, state="expanded"),
     )

@@ -133,6 +133,10 @@ class Recorder:
             self._columns = ColumnBuffer(stream, _COLUMN_BUILDERS)
             self._log_static_styles()
 
+    def _check_open(self):
+        if self._closed:
+            raise RuntimeError("this recorder is closed; open a new one with open_recorder")
+
     # Setup -------------------------------------------------------------------------------------
 
     def _log_static_styles(self):
@@ -161,7 +165,8 @@ class Recorder:
 
     def log_world_map(self, world_map):
         """Draw the static geometry (walls, furniture) and frame the map view on its bounds."""
-        if self._stream is None or self._closed:
+        self._check_open()
+        if self._stream is None:
             return
         log = self._stream.log
         walls = [[_xy(*a), _xy(*b)] for a, b in world_map.walls]
@@ -185,7 +190,8 @@ class Recorder:
 
     def log_frame(self, record):
         """Log one ``FrameRecord`` at its ``frame`` and ``sim_time``."""
-        if self._stream is None or self._closed:
+        self._check_open()
+        if self._stream is None:
             return
         if not self._blueprint_sent:
             self._send_blueprint()

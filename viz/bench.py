@@ -1,0 +1,154 @@
+"""``python -m fpga_robotics.viz.bench``: what logging to rerun adds per frame, to a file sink.
+
+For each resolution, a run of synthetic frames (a moving target over a noisy background, the
+design's filtered frame from the golden model) is logged with ``Recorder.log_frame`` to a
+temporary ``.rrd``. Printed per resolution: the median and mean milliseconds of a
+``log_frame`` call (the mean includes the column sends every few frames), the median over
+``--repeats`` runs of each, and the file size per frame.
+"""
+
+import argparse
+import math
+import os
+import statistics
+import sys
+import tempfile
+import time
+
+import numpy as np
+
+from ..errors import UsageError, run_cli
+from ..hw.params import FollowTargetParams
+from ..hw.pixel import COLOR_SELECT
+from ..records import FrameRecord, PersonState, WorldMap
+from ..sim import synthetic
+from ..sim.backends.base import FrameResult
+from ..sim.frames import to_rgb444
+from ..sim.model import FollowTargetModel
+from .recorder import open_recorder
+
+__all__ = ["main"]
+
+RESOLUTIONS = ((160, 120), (640, 480))
+_WORLD = WorldMap(
+    walls=[((0, 0), (8, 0)), ((8, 0), (8, 6)), ((8, 6), (0, 6)), ((0, 6), (0, 0))],
+    obstacles=[[(2, 2), (3, 2), (3, 2.6), (2, 2.6)]],
+    obstacle_colors=[(140, 90, 50)],
+    bounds=(0, 0, 8, 6),
+)
+
+
+def make_records(width, height, n, seed=0):
+    """``n`` FrameRecords: a red target drifting across a noisy frame, through the model."""
+    rng = np.random.default_rng(seed)
+    params = FollowTargetParams(width=width, height=height)
+    model = FollowTargetModel(params)
+    red = COLOR_SELECT["red"]
+    records = []
+    for i in range(n):
+        cx = width * (0.2 + 0.6 * (0.5 + 0.5 * math.sin(i / 15)))
+        rgb = synthetic.blob_frame(width, height, "red", cx=cx, radius=height / 6, rng=rng)
+        out = model.process(to_rgb444(rgb, width, height), red)
+        t = out.tracker
+        result = FrameResult(
+            filtered=out.filtered,
+            found=t.found,
+            proximity=t.proximity,
+            centroid_x=t.centroid_x,
+            centroid_leds=t.centroid_leds,
+            motor_left=out.motor_left,
+            motor_right=out.motor_right,
+            cycles=0,
+        )
+        records.append(
+            FrameRecord(
+                frame=i,
+                sim_time=i / 30,
+                camera_rgb=rgb,
+                color_sel=red,
+                result=result,
+                robot_x=2 + 0.01 * i,
+                robot_y=3.0,
+                robot_heading=0.01 * i,
+                robot_v=0.2,
+                robot_w=0.05,
+                cmd_v=0.21,
+                cmd_w=0.06,
+                camera_hfov=1.047,
+                people=[
+                    PersonState("target", 5 + 0.01 * i, 3.2, 0.25, True),
+                    PersonState("walker", 6, 1 + 0.01 * i, 0.25, False),
+                ],
+                target_distance=3.0,
+                target_in_view=True,
+                events=["target found"] if i == 0 else [],
+            )
+        )
+    return records
+
+
+def bench_once(records, folder, **options):
+    """Log ``records`` to a new file; returns (per-call seconds, close seconds, file bytes)."""
+    path = os.path.join(folder, f"bench-{time.monotonic_ns()}.rrd")
+    rec = open_recorder(f"save:{path}", default_path=path, **options)
+    rec.log_world_map(_WORLD)
+    times = []
+    for r in records:
+        t0 = time.perf_counter()
+        rec.log_frame(r)
+        times.append(time.perf_counter() - t0)
+    t0 = time.perf_counter()
+    rec.close()
+    close_s = time.perf_counter() - t0
+    size = os.path.getsize(path)
+    os.remove(path)
+    return times, close_s, size
+
+
+def _positive(text):
+    value = int(text)
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"must be >= 1, got {value}")
+    return value
+
+
+def main(argv=None):
+    p = argparse.ArgumentParser(prog="python -m fpga_robotics.viz.bench", description=__doc__)
+    p.add_argument("--frames", type=_positive, default=300, help="frames per run (default 300)")
+    p.add_argument("--repeats", type=_positive, default=5, help="runs per setting (default 5)")
+    p.add_argument("--log-every", type=_positive, default=1, help="image decimation (default 1)")
+    p.add_argument(
+        "--jpeg-quality", type=int, default=None, help="0 raw, 1..100 JPEG (default: auto)"
+    )
+    try:
+        args = p.parse_args(argv)
+    except SystemExit as exc:
+        if exc.code:
+            raise UsageError("bad arguments (see --help)") from None
+        return 0
+    options = {"log_every": args.log_every, "jpeg_quality": args.jpeg_quality}
+    print(
+        f"viz logging cost per frame, file sink, {args.frames} frames x {args.repeats} runs, "
+        f"log_every={args.log_every}, jpeg_quality={args.jpeg_quality or 'auto'}"
+    )
+    with tempfile.TemporaryDirectory(prefix="viz-bench-") as folder:
+        for width, height in RESOLUTIONS:
+            records = make_records(width, height, args.frames)
+            bench_once(records[:20], folder, **options)  # warm-up (imports, caches)
+            medians, means, sizes = [], [], []
+            for _ in range(args.repeats):
+                times, _close, size = bench_once(records, folder, **options)
+                medians.append(statistics.median(times) * 1e3)
+                means.append(statistics.fmean(times) * 1e3)
+                sizes.append(size / len(records))
+            print(
+                f"  {width}x{height}: median {statistics.median(medians):.3f} ms/frame, "
+                f"mean {statistics.median(means):.3f} ms/frame "
+                f"(runs' medians {min(medians):.3f}..{max(medians):.3f}), "
+                f"{statistics.median(sizes) / 1e3:.1f} kB/frame"
+            )
+    return 0
+
+
+if __name__ == "__main__":
+    run_cli(main, sys.argv[1:], prog="fpga_robotics.viz.bench")
