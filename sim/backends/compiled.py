@@ -1,0 +1,225 @@
+"""Shared Python side of the compiled backends: loading a harness library through ctypes and
+running whole frames in it (one call per frame, the frame passed as a pointer).
+
+Subclasses say how to build the library (``_build``) for a ``DesignSource`` and variant:
+``"plain"`` (no tracing code at all, the fast one) or ``"vcd"``/``"fst"`` (a separate build
+with a waveform writer, made only when a ``WaveformRequest`` asks for it).
+"""
+
+import ctypes
+import os
+from pathlib import Path
+
+import numpy as np
+
+from . import build_cache
+from .base import BackendError, DesignBackend, FrameResult
+from .designs import DesignSource
+
+__all__ = ["CompiledBackend", "HARNESS_DIR", "ABI_VERSION"]
+
+#: Directory of the C++ harness sources (package data).
+HARNESS_DIR = Path(__file__).resolve().parent
+#: Must match ``fr::ABI_VERSION`` in frame_driver.h.
+ABI_VERSION = 1
+
+# Layout of the argument and result arrays (enums Arg and Out in frame_driver.h).
+_N_ARGS, _N_OUT = 7, 10
+_STATUS = {
+    1: "the design never raised frame_done (watchdog after {cycles} cycles): it hung or "
+    "its result latency is far from the documented one",
+    2: "the design produced more filtered pixels than the frame has",
+    3: "the design produced {filtered} filtered pixels for a frame of {pixels}",
+    4: "filtered pixel {bad} carries wrong first/last framing flags",
+    5: "the harness rejected the frame arguments",
+}
+
+_VP = ctypes.c_void_p
+
+
+class _Library:
+    """A loaded harness library and its C entry points."""
+
+    def __init__(self, path):
+        try:
+            lib = ctypes.CDLL(str(path))
+        except OSError as exc:
+            raise BackendError(f"cannot load the compiled model {path}: {exc}") from None
+        for name, restype, argtypes in (
+            ("fr_abi_version", ctypes.c_int, []),
+            ("fr_traced", ctypes.c_int, []),
+            ("fr_create", _VP, []),
+            ("fr_destroy", None, [_VP]),
+            ("fr_reset", None, [_VP]),
+            ("fr_trace_open", ctypes.c_int, [_VP, ctypes.c_char_p]),
+            ("fr_trace_enable", None, [_VP, ctypes.c_int]),
+            ("fr_trace_close", None, [_VP]),
+            ("fr_run_frame", ctypes.c_int, [_VP, _VP, _VP, _VP, _VP]),
+        ):
+            try:
+                fn = getattr(lib, name)
+            except AttributeError:
+                raise BackendError(f"the compiled model {path} lacks {name}()") from None
+            fn.restype = restype
+            fn.argtypes = argtypes
+        if lib.fr_abi_version() != ABI_VERSION:
+            raise BackendError(f"the compiled model {path} has an unexpected harness ABI")
+        self.lib = lib
+        self.path = path
+
+
+class CompiledBackend(DesignBackend):
+    """A backend whose clock loop runs in a compiled C++ harness.
+
+    Parameters
+    ----------
+    params : FollowTargetParams, optional
+    line_blank, frame_blank : int
+        Idle cycles after every line and after the frame (see ``DesignBackend``).
+    waveform : WaveformRequest, optional
+        Trace these frames into a VCD (or FST where supported); uses a separate traced build.
+    design : str
+        ``"follow_target"`` (default) or ``"passthrough"`` (the benchmark's reference design).
+    """
+
+    #: Waveform formats (file suffixes) this flow can write.
+    waveform_formats = (".vcd",)
+
+    def __init__(self, params=None, *, line_blank=0, frame_blank=0, waveform=None,
+                 design="follow_target"):
+        super().__init__(params, line_blank=line_blank, frame_blank=frame_blank,
+                         waveform=waveform)
+        self.source = DesignSource(self.params, design)
+        variant = "plain"
+        if waveform is not None:
+            suffix = Path(waveform.path).suffix.lower()
+            if suffix not in self.waveform_formats:
+                raise BackendError(
+                    f"the {self.name} backend writes waveforms as "
+                    f"{' or '.join(self.waveform_formats)}, not {suffix or 'no suffix'!r} "
+                    f"({waveform.path})"
+                )
+            if waveform.last_frame < waveform.first_frame or waveform.first_frame < 0:
+                raise ValueError(
+                    f"waveform frames must satisfy 0 <= first_frame <= last_frame, got "
+                    f"{waveform.first_frame}..{waveform.last_frame}"
+                )
+            variant = suffix[1:]
+        self.variant = variant
+        self._handle = None
+        self._trace_state = "idle"  # idle -> open -> done
+        self._trace_tmp = None
+        self._library = self._load(variant)
+        self._handle = self._library.lib.fr_create()
+        if not self._handle:
+            raise BackendError(f"the {self.name} model could not be created")
+        p = self.params
+        self._filtered = np.zeros((p.height, p.width), np.uint16)
+        self._out = np.zeros(_N_OUT, np.int64)
+        self._args = np.array(
+            [
+                p.width,
+                p.height,
+                0,
+                line_blank,
+                frame_blank,
+                self.source.motor_latency,
+                self.source.watchdog_edges(line_blank, frame_blank),
+            ],
+            np.int64,
+        )
+        assert len(self._args) == _N_ARGS
+
+    # Building ----------------------------------------------------------------------------------
+
+    def _load(self, variant):
+        """Build (or find in the cache) and load the library; a damaged entry that passes the
+        manifest check but does not load is rebuilt once."""
+        for attempt in range(2):
+            entry = self._build_entry(variant)
+            try:
+                return _Library(entry.file(self.library_name))
+            except BackendError:
+                if attempt or entry.built:
+                    raise
+                build_cache.invalidate(entry)
+        raise AssertionError("unreachable")
+
+    library_name = "libfollow_target.so"
+
+    def _build_entry(self, variant):
+        """Return the ``CacheEntry`` holding ``library_name`` for this design and variant."""
+        raise NotImplementedError
+
+    # Running -----------------------------------------------------------------------------------
+
+    def _reset(self):
+        self._library.lib.fr_reset(self._handle)
+
+    def _run_frame(self, packed, color_sel):
+        lib = self._library.lib
+        index = self.frames_processed
+        tracing = self.waveform is not None and self.waveform.covers(index)
+        if tracing and self._trace_state == "idle":
+            self._open_trace()
+        if self._trace_state == "open":
+            lib.fr_trace_enable(self._handle, int(tracing))
+        self._args[2] = color_sel
+        filtered = np.empty_like(self._filtered)
+        status = lib.fr_run_frame(
+            self._handle,
+            packed.ctypes.data,
+            self._args.ctypes.data,
+            filtered.ctypes.data,
+            self._out.ctypes.data,
+        )
+        out = self._out
+        if tracing and index >= self.waveform.last_frame:
+            self._finish_trace()
+        if status != 0:
+            message = _STATUS.get(status, f"harness status {status}").format(
+                cycles=int(out[0]), filtered=int(out[7]), pixels=packed.size, bad=int(out[9])
+            )
+            raise BackendError(f"{self.name}: frame {index}: {message}")
+        return FrameResult(
+            filtered=filtered,
+            found=bool(out[1]),
+            proximity=int(out[2]),
+            centroid_x=int(out[3]),
+            centroid_leds=int(out[4]),
+            motor_left=int(out[5]),
+            motor_right=int(out[6]),
+            cycles=int(out[0]),
+        )
+
+    # Waveforms ---------------------------------------------------------------------------------
+
+    def _open_trace(self):
+        path = Path(self.waveform.path)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        # Written under a temporary name and renamed when complete.
+        self._trace_tmp = path.with_name(f".{path.name}.partial{path.suffix}")
+        if self._library.lib.fr_trace_open(self._handle, str(self._trace_tmp).encode()) != 0:
+            raise BackendError(f"cannot write the waveform {path}")
+        self._trace_state = "open"
+
+    def _finish_trace(self):
+        if self._trace_state != "open":
+            return
+        self._library.lib.fr_trace_close(self._handle)
+        os.replace(self._trace_tmp, self.waveform.path)
+        self._trace_state = "done"
+
+    def close(self):
+        """Write out a waveform still being traced and free the model."""
+        if self._handle is not None:
+            if self._trace_state == "open":
+                self._finish_trace()
+            self._library.lib.fr_destroy(self._handle)
+            self._handle = None
+
+    def __del__(self):
+        try:
+            self.close()
+        except Exception:
+            pass

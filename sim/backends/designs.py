@@ -1,0 +1,94 @@
+"""The designs the compiled backends can build: ``FollowTarget`` (what every backend
+simulates) and ``PassThrough`` (the benchmark's one-pixel-per-clock reference). Both have the
+port list of hw-spec.md, so one harness drives either.
+"""
+
+from amaranth.hdl import Const, Value, ValueCastable
+
+from ...hw.params import FollowTargetParams
+
+__all__ = ["DESIGNS", "DesignSource", "TOP_NAME", "component_ports"]
+
+#: Module name of the top in the generated Verilog and C++.
+TOP_NAME = "follow_target"
+
+#: Designs that ``design=`` accepts.
+DESIGNS = ("follow_target", "passthrough")
+
+
+def component_ports(component):
+    """``[Value]`` of a component's ports in signature order, leaving out constant members
+    (``ready`` of non-stallable streams, which the back-ends reject as ports)."""
+    ports = []
+    for _path, _member, value in component.signature.flatten(component):
+        if isinstance(value, ValueCastable):
+            value = value.as_value()
+        value = Value.cast(value)
+        if not isinstance(value, Const):
+            ports.append(value)
+    return ports
+
+
+class DesignSource:
+    """One design at one parameter set: its latencies and generated sources.
+
+    Parameters
+    ----------
+    params : FollowTargetParams
+    design : str
+        ``"follow_target"`` or ``"passthrough"``.
+    """
+
+    def __init__(self, params, design="follow_target"):
+        if not isinstance(params, FollowTargetParams):
+            raise TypeError("params must be a FollowTargetParams")
+        if design not in DESIGNS:
+            raise ValueError(f"unknown design {design!r}; choose one of: {', '.join(DESIGNS)}")
+        self.params = params
+        self.design = design
+        latencies = params if design == "follow_target" else self._passthrough_class()
+        self.filter_latency = latencies.filter_latency
+        self.result_latency = latencies.result_latency
+        self.motor_latency = latencies.motor_latency
+
+    @staticmethod
+    def _passthrough_class():
+        from .passthrough import PassThrough
+
+        return PassThrough
+
+    def component(self):
+        if self.design == "follow_target":
+            from ...hw.top import FollowTarget
+
+            return FollowTarget(self.params)
+        return self._passthrough_class()(self.params)
+
+    def verilog(self):
+        """Verilog text, top module ``follow_target``."""
+        if self.design == "follow_target":
+            from ...export import generate_verilog
+
+            return generate_verilog(self.params)
+        from amaranth.back import verilog
+
+        top = self.component()
+        return verilog.convert(top, name=TOP_NAME, ports=component_ports(top), emit_src=False)
+
+    def cxxrtl(self):
+        """CXXRTL C++ text (``amaranth.back.cxxrtl``), top class ``p_follow__target``."""
+        from amaranth.back import cxxrtl
+
+        top = self.component()
+        return cxxrtl.convert(top, name=TOP_NAME, ports=component_ports(top), emit_src=False)
+
+    def watchdog_edges(self, line_blank, frame_blank):
+        """Edges after which a frame without ``frame_done`` counts as hung: the expected
+        length plus a generous margin, so a wrong latency shows as a cycle mismatch first."""
+        p = self.params
+        pixel_edges = p.height * (p.width + line_blank)
+        expected = max(
+            pixel_edges + frame_blank,
+            pixel_edges - line_blank + self.result_latency + self.motor_latency,
+        )
+        return expected + 4 * (self.result_latency + self.motor_latency) + 4096

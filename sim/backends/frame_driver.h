@@ -1,0 +1,169 @@
+// Frame driver shared by the compiled backends: the whole clock loop of one frame runs here,
+// so Python makes one call per frame. The cycle accounting is the one of
+// sim/backends/base.py and docs/backends.md:
+//   edges are numbered 1.. within a call; line y's pixels are sampled at edges
+//   y*(W+lb)+1 .. y*(W+lb)+W, then lb idle edges; the last pixel is sampled at edge
+//   P = H*(W+lb) - lb. The driver sees frame_done itself (first edge D >= P after which it is
+//   high) and stops after max(H*(W+lb) + frame_blank, D + motor_latency) edges.
+//
+// A simulator adapter `S` provides:
+//   set_inputs(valid, payload, color_sel), set_rst(bool)
+//   settle()   clock low, evaluate: outputs show the state after the last edge and the
+//              combinational response to the inputs that the next edge samples
+//   edge()     clock high, evaluate: one rising edge
+//   filtered_valid(), filtered_payload(), frame_done(), and the result outputs.
+#ifndef FPGA_ROBOTICS_FRAME_DRIVER_H
+#define FPGA_ROBOTICS_FRAME_DRIVER_H
+
+#include <cstdint>
+
+#define FR_EXPORT extern "C" __attribute__((visibility("default")))
+
+namespace fr {
+
+// Bump when the argument or result layout changes (checked by the Python side).
+constexpr int ABI_VERSION = 1;
+
+enum Arg { A_WIDTH, A_HEIGHT, A_COLOR_SEL, A_LINE_BLANK, A_FRAME_BLANK, A_MOTOR_LATENCY,
+           A_WATCHDOG, A_COUNT };
+enum Out { O_CYCLES, O_FOUND, O_PROXIMITY, O_CENTROID_X, O_CENTROID_LEDS, O_MOTOR_LEFT,
+           O_MOTOR_RIGHT, O_FILTERED, O_DONE_EDGE, O_BAD_INDEX, O_COUNT };
+enum Status { OK = 0, NO_FRAME_DONE = 1, TOO_MANY_FILTERED = 2, TOO_FEW_FILTERED = 3,
+              BAD_FILTERED_FLAGS = 4, BAD_ARGUMENTS = 5 };
+
+constexpr uint16_t FIRST = 1u << 12, LAST = 1u << 13, PIXEL = 0x0FFF;
+
+template <class S>
+class FrameRun {
+public:
+    FrameRun(S &sim, const int64_t *args, uint16_t *filtered)
+        : sim(sim), width(args[A_WIDTH]), height(args[A_HEIGHT]),
+          color_sel(static_cast<uint8_t>(args[A_COLOR_SEL])), filtered(filtered),
+          capacity(args[A_WIDTH] * args[A_HEIGHT]) {}
+
+    // One clock cycle: present the inputs, settle, observe, then the rising edge.
+    inline void cycle(bool valid, uint16_t payload) {
+        sim.set_inputs(valid, payload, color_sel);
+        sim.settle();
+        observe();
+        sim.edge();
+        ++edges;
+    }
+
+    inline void observe() {
+        if (done_edge < 0 && edges >= last_pixel_edge && sim.frame_done())
+            done_edge = edges;
+        if (sim.filtered_valid()) {
+            if (n_filtered >= capacity) {
+                status = status ? status : TOO_MANY_FILTERED;
+                return;
+            }
+            uint16_t p = sim.filtered_payload();
+            int64_t x = n_filtered % width;
+            uint16_t expect = (n_filtered == 0 ? FIRST : 0) | (x == width - 1 ? LAST : 0);
+            if ((p & (FIRST | LAST)) != expect && status == OK) {
+                status = BAD_FILTERED_FLAGS;
+                bad_index = n_filtered;
+            }
+            filtered[n_filtered++] = p & PIXEL;
+        }
+    }
+
+    int run(const uint16_t *frame, int64_t line_blank, int64_t frame_blank,
+            int64_t motor_latency, int64_t watchdog, int64_t *out) {
+        const int64_t pixel_edges = height * (width + line_blank);
+        const int64_t min_edges = pixel_edges + frame_blank;
+        last_pixel_edge = pixel_edges - line_blank;
+        for (int64_t y = 0; y < height; ++y) {
+            const uint16_t *row = frame + y * width;
+            uint16_t first = y == 0 ? FIRST : 0;
+            cycle(true, (row[0] & PIXEL) | first | (width == 1 ? LAST : 0));
+            for (int64_t x = 1; x < width - 1; ++x)
+                cycle(true, row[x] & PIXEL);
+            if (width > 1)
+                cycle(true, (row[width - 1] & PIXEL) | LAST);
+            for (int64_t i = 0; i < line_blank; ++i)
+                cycle(false, 0);
+        }
+        // Idle until frame_blank has passed and the motors show the frame's values.
+        for (;;) {
+            sim.set_inputs(false, 0, color_sel);
+            sim.settle();
+            if (done_edge < 0 && edges >= last_pixel_edge && sim.frame_done())
+                done_edge = edges;
+            if (done_edge >= 0 && edges >= min_edges && edges >= done_edge + motor_latency)
+                break;
+            if (edges >= watchdog) {
+                status = NO_FRAME_DONE;
+                break;
+            }
+            observe();
+            sim.edge();
+            ++edges;
+        }
+        if (status == OK && n_filtered < capacity)
+            status = TOO_FEW_FILTERED;
+        out[O_CYCLES] = edges;
+        out[O_FOUND] = sim.found();
+        out[O_PROXIMITY] = sim.proximity();
+        out[O_CENTROID_X] = sim.centroid_x();
+        out[O_CENTROID_LEDS] = sim.centroid_leds();
+        out[O_MOTOR_LEFT] = static_cast<int16_t>(sim.motor_left());
+        out[O_MOTOR_RIGHT] = static_cast<int16_t>(sim.motor_right());
+        out[O_FILTERED] = n_filtered;
+        out[O_DONE_EDGE] = done_edge;
+        out[O_BAD_INDEX] = bad_index;
+        return status;
+    }
+
+private:
+    S &sim;
+    const int64_t width, height;
+    const uint8_t color_sel;
+    uint16_t *filtered;
+    const int64_t capacity;
+    int64_t edges = 0, done_edge = -1, n_filtered = 0, bad_index = -1, last_pixel_edge = 0;
+    int status = OK;
+};
+
+template <class S>
+int run_frame(S &sim, const uint16_t *frame, const int64_t *args, uint16_t *filtered,
+              int64_t *out) {
+    if (args[A_WIDTH] < 1 || args[A_HEIGHT] < 1 || args[A_LINE_BLANK] < 0 ||
+        args[A_FRAME_BLANK] < 0 || args[A_MOTOR_LATENCY] < 0)
+        return BAD_ARGUMENTS;
+    FrameRun<S> run(sim, args, filtered);
+    return run.run(frame, args[A_LINE_BLANK], args[A_FRAME_BLANK], args[A_MOTOR_LATENCY],
+                   args[A_WATCHDOG], out);
+}
+
+// Synchronous reset: rst high for one rising edge, not counted in any frame.
+template <class S>
+void reset(S &sim) {
+    sim.set_inputs(false, 0, 0);
+    sim.set_rst(true);
+    sim.settle();
+    sim.edge();
+    sim.set_rst(false);
+}
+
+}  // namespace fr
+
+// The C entry points every harness exports, given its adapter type `SIM`.
+#define FR_DEFINE_C_API(SIM)                                                                  \
+    FR_EXPORT int fr_abi_version() { return fr::ABI_VERSION; }                                \
+    FR_EXPORT int fr_traced() { return SIM::traced; }                                         \
+    FR_EXPORT void *fr_create() { return new SIM(); }                                         \
+    FR_EXPORT void fr_destroy(void *h) { delete static_cast<SIM *>(h); }                      \
+    FR_EXPORT void fr_reset(void *h) { fr::reset(*static_cast<SIM *>(h)); }                   \
+    FR_EXPORT int fr_trace_open(void *h, const char *path) {                                  \
+        return static_cast<SIM *>(h)->trace_open(path);                                       \
+    }                                                                                         \
+    FR_EXPORT void fr_trace_enable(void *h, int on) { static_cast<SIM *>(h)->trace_enable(on); } \
+    FR_EXPORT void fr_trace_close(void *h) { static_cast<SIM *>(h)->trace_close(); }          \
+    FR_EXPORT int fr_run_frame(void *h, const uint16_t *frame, const int64_t *args,           \
+                               uint16_t *filtered, int64_t *out) {                            \
+        return fr::run_frame(*static_cast<SIM *>(h), frame, args, filtered, out);             \
+    }
+
+#endif
