@@ -34,7 +34,7 @@ import numpy as np
 
 from .scene import CameraPose, Scene
 
-__all__ = ["CameraRenderer", "render", "DEFAULT_HFOV", "DEFAULT_MAX_LAYERS"]
+__all__ = ["DEFAULT_HFOV", "DEFAULT_MAX_LAYERS", "CameraRenderer", "render"]
 
 #: Horizontal field of view of the published system's camera, radians.
 DEFAULT_HFOV = 1.047
@@ -254,7 +254,7 @@ class CameraRenderer:
         if not (math.isfinite(noise_std) and noise_std > 0):
             raise ValueError(f"noise_std must be a finite number >= 0, got {noise_std!r}")
         if not isinstance(rng, np.random.Generator):
-            raise ValueError(
+            raise TypeError(
                 "noise_std > 0 needs rng=numpy.random.Generator (e.g. np.random.default_rng(seed))"
                 " so that the noise is reproducible"
             )

@@ -372,7 +372,7 @@ def test_red_shirt_of_the_default_person_passes_the_red_filter():
         dist = 3.0
         pose = CameraPose(person.x + dist * math.cos(angle), person.y + dist * math.sin(angle),
                           angle + math.pi, height=0.3)
-        noise = dict(noise_std=2.0, rng=np.random.default_rng(k)) if k % 2 else {}
+        noise = {"noise_std": 2.0, "rng": np.random.default_rng(k)} if k % 2 else {}
         r, g, b = unpack_rgb444(to_rgb444(renderer.render(scene, pose, **noise), w, h))
         red = (r - np.maximum(g, b)) >= 6  # hw-spec colour filter, color_sel red, D = 6
         near = dist - person.radius
@@ -434,7 +434,7 @@ def test_noise_saturates_instead_of_wrapping():
 
 
 def test_noise_without_a_generator_is_refused():
-    with pytest.raises(ValueError, match="rng"):
+    with pytest.raises(TypeError, match="rng"):
         render(scene_of(), CameraPose(0, 0, 0), 16, 12, noise_std=1.0)
 
 
@@ -460,3 +460,18 @@ def test_bad_pose_and_scene():
         r.render(scene_of(lighting=Lighting(direction=(0, 0, 0))), CameraPose(0, 0, 0))
     with pytest.raises(TypeError, match="CameraPose"):
         r.render(scene_of(), (0, 0, 0))
+
+
+# -- benchmark CLI ---------------------------------------------------------------------------
+
+
+def test_benchmark_cli_prints_a_line_per_size(capsys):
+    from fpga_robotics.errors import UsageError
+    from fpga_robotics.sim.camera_bench import main
+
+    assert main(["--frames", "2", "--repeats", "1", "--sizes", "32x24,40x30"]) == 0
+    lines = capsys.readouterr().out.strip().splitlines()
+    assert [ln.split()[0] for ln in lines[-2:]] == ["32x24", "40x30"]
+    assert all(float(v) > 0 for v in lines[-1].split()[1:])
+    with pytest.raises(UsageError, match="WIDTHxHEIGHT"):
+        main(["--sizes", "160by120"])

@@ -1,0 +1,124 @@
+"""Benchmark of the camera renderer: median milliseconds per frame at several resolutions.
+
+    python -m fpga_robotics.sim.camera_bench [--frames 60] [--repeats 5] [--noise 2.0]
+                                             [--sizes 160x120,320x240,640x480]
+
+The scene is a typical room: 8 m x 6 m walls (2.5 m), four pieces of furniture made of four
+walls each (a 1.2 m wooden divider among them) and three people. The camera drives a loop
+through the room turning as it goes, so every frame sees a different view; each repeat renders
+the whole loop and the figure reported is the median over every frame of every repeat.
+"""
+
+import argparse
+import math
+import statistics
+import time
+
+import numpy as np
+
+from ..errors import UsageError, run_cli
+from .camera import DEFAULT_HFOV, CameraRenderer
+from .scene import Band, CameraPose, Cylinder, Lighting, Scene, Wall
+
+__all__ = ["benchmark", "camera_loop", "main", "typical_scene"]
+
+DEFAULT_SIZES = ((160, 120), (320, 240), (640, 480))
+
+
+def _box(cx, cy, length, width, angle, height, color):
+    c, s = math.cos(angle), math.sin(angle)
+    pts = [(-length / 2, -width / 2), (length / 2, -width / 2), (length / 2, width / 2),
+           (-length / 2, width / 2)]
+    pts = [(cx + c * x - s * y, cy + s * x + c * y) for x, y in pts]
+    return [Wall(*pts[i], *pts[(i + 1) % 4], height, color) for i in range(4)]
+
+
+def _person(x, y, shirt):
+    return Cylinder(x, y, 0.2, (Band(0.0, 0.85, (0.15, 0.15, 0.22)), Band(0.85, 1.45, shirt),
+                                Band(1.5, 1.75, (0.87, 0.68, 0.56))))
+
+
+def typical_scene():
+    """The benchmark room as a :class:`~fpga_robotics.sim.scene.Scene`."""
+    walls = _box(4.0, 3.0, 8.0, 6.0, 0.0, 2.5, (0.8, 0.78, 0.72))
+    walls += _box(5.5, 4.2, 1.6, 0.05, 0.3, 1.2, (0.55, 0.27, 0.15))  # wooden divider
+    walls += _box(1.2, 5.2, 1.2, 0.6, 0.0, 0.9, (0.45, 0.42, 0.38))  # cupboard
+    walls += _box(6.8, 1.0, 1.0, 1.0, 0.0, 0.75, (0.35, 0.3, 0.25))  # table
+    walls += _box(3.0, 1.2, 0.5, 0.5, 0.6, 0.45, (0.3, 0.35, 0.6))  # stool
+    people = (_person(4.5, 3.5, (0.85, 0.1, 0.1)), _person(6.5, 4.8, (0.2, 0.5, 0.25)),
+              _person(2.0, 2.8, (0.25, 0.3, 0.7)))
+    return Scene(walls=tuple(walls), cylinders=people,
+                 lighting=Lighting(ambient=0.6, intensity=0.5, direction=(1.0, 0.5, -1.0)))
+
+
+def camera_loop(frames):
+    """``frames`` camera poses on an ellipse through the room, looking ahead and inwards."""
+    poses = []
+    for i in range(frames):
+        a = 2 * math.pi * i / frames
+        x, y = 4.0 + 2.2 * math.cos(a), 3.0 + 1.5 * math.sin(a)
+        poses.append(CameraPose(x, y, a + 2.2 + 0.5 * math.sin(3 * a), height=0.3))
+    return poses
+
+
+def benchmark(width, height, *, frames=60, repeats=5, noise_std=0.0, hfov=DEFAULT_HFOV):
+    """Per-frame render times in milliseconds (``frames * repeats`` of them)."""
+    renderer = CameraRenderer(width, height, hfov)
+    scene, poses = typical_scene(), camera_loop(frames)
+    rng = np.random.default_rng(0)
+    for pose in poses[:5]:  # warm-up: caches, allocator
+        renderer.render(scene, pose, noise_std=noise_std, rng=rng)
+    times = []
+    for _ in range(repeats):
+        for pose in poses:
+            t0 = time.perf_counter()
+            renderer.render(scene, pose, noise_std=noise_std, rng=rng)
+            times.append((time.perf_counter() - t0) * 1e3)
+    return times
+
+
+def _size(text):
+    try:
+        w, h = (int(v) for v in text.lower().split("x"))
+    except ValueError:
+        raise UsageError(f"a size is WIDTHxHEIGHT, e.g. 160x120; got {text!r}") from None
+    if w < 1 or h < 1:
+        raise UsageError(f"a size needs a positive width and height, got {text!r}")
+    return w, h
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(prog="python -m fpga_robotics.sim.camera_bench",
+                                 description=__doc__.split("\n\n")[0])
+    ap.add_argument("--frames", type=int, default=60, help="poses per loop (default 60)")
+    ap.add_argument("--repeats", type=int, default=5, help="loops per size (default 5)")
+    ap.add_argument("--noise", type=float, default=2.0,
+                    help="also time with sensor noise of this std, 8-bit units (0: skip)")
+    ap.add_argument("--sizes", default=",".join(f"{w}x{h}" for w, h in DEFAULT_SIZES),
+                    help="comma-separated WIDTHxHEIGHT list")
+    args = ap.parse_args(argv)
+    if args.frames < 1 or args.repeats < 1:
+        raise UsageError("--frames and --repeats must be >= 1")
+    if not (math.isfinite(args.noise) and args.noise >= 0):
+        raise UsageError(f"--noise must be a number >= 0, got {args.noise}")
+    sizes = [_size(s) for s in args.sizes.split(",") if s.strip()]
+    print(f"camera renderer, typical room ({len(typical_scene().walls)} walls, 3 people), "
+          f"{args.frames} poses x {args.repeats} repeats; milliseconds per frame")
+    header = f"{'size':>9}  {'median':>7}  {'p90':>7}"
+    if args.noise:
+        header += f"  {'+noise median':>13}"
+    print(header)
+    for w, h in sizes:
+        times = benchmark(w, h, frames=args.frames, repeats=args.repeats)
+        line = (f"{w:>4}x{h:<4}  {statistics.median(times):7.3f}  "
+                f"{np.percentile(times, 90):7.3f}")
+        if args.noise:
+            noisy = benchmark(w, h, frames=args.frames, repeats=args.repeats,
+                              noise_std=args.noise)
+            line += f"  {statistics.median(noisy):13.3f}"
+        print(line, flush=True)
+    return 0
+
+
+if __name__ == "__main__":
+    run_cli(main, prog="camera_bench")
