@@ -171,6 +171,7 @@ def run_scenario(scenario, *, seed=None, backend="auto", recorder=None, progress
                 world.step(dt)
                 step += 1
             t = step * dt
+            motors.apply_due(step)  # commands that take effect at this very instant
 
             # Capture and process.
             rx, ry, heading = world.robot_pose()
@@ -185,6 +186,7 @@ def run_scenario(scenario, *, seed=None, backend="auto", recorder=None, progress
             events += design_events.update(bool(result.found))
             apply_step = round((k * period + sim.actuation_delay) / dt)
             motors.schedule(apply_step, result.motor_left, result.motor_right)
+            motors.apply_due(step)  # a zero delay acts now
 
             # Measure.
             v, w = world.robot_velocity()

@@ -19,11 +19,10 @@ Top-level keys: ``name``, ``description``, ``seed`` (default seed of a run).
 import copy
 import difflib
 import math
+import tomllib
 from dataclasses import dataclass, fields
 from importlib import resources
 from pathlib import Path
-
-import tomllib
 
 from .errors import UsageError
 from .hw.params import FollowTargetParams
@@ -50,7 +49,7 @@ _DESIGN_KEYS = tuple(f.name for f in fields(FollowTargetParams) if f.init and f.
 
 #: Defaults of the application's sections (a key absent here is unknown).
 DEFAULTS = {
-    "sim": {"duration": 20.0, "physics_dt": 0.005, "actuation_delay": None},
+    "sim": {"duration": 20.0, "physics_dt": 1.0 / 240.0, "actuation_delay": None},
     "camera": {
         "resolution": "160x120",
         "fps": 30.0,

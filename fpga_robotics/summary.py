@@ -90,6 +90,7 @@ def compute_metrics(traj, events, collisions, frame_period):
         "losses": len(episodes),
         "searches": sum(1 for _, _, text in events if text == "search started"),
         "searched_losses": sum(1 for ep in episodes if ep[2]),
+        "searched_reacquisitions": sum(1 for ep in episodes if ep[2] and ep[1] is not None),
         "reacquire_times_s": reacq,
         "unrecovered_losses_s": unrecovered,
         "path_length_m": _round(path),
@@ -134,11 +135,13 @@ def evaluate_checks(checks, m):
             times = m["reacquire_times_s"]
             late = [u for u in m["unrecovered_losses_s"] if u > limit]
             v = max(times) if times else None
-            ok = m["searched_losses"] >= 1 and all(x <= limit for x in times) and not late
+            ok = m["searched_reacquisitions"] >= 1 and all(x <= limit for x in times) and not late
             if m["searched_losses"] == 0:
                 text = "the target was never lost long enough for the design to search"
             elif late:
                 text = f"target lost and not found again for {max(late):.2f} s (limit {limit} s)"
+            elif m["searched_reacquisitions"] == 0:
+                text = "the design searched but the run ended before it found the target again"
             else:
                 text = (f"{len(times)} re-acquisition(s), slowest {v:.2f} s after the loss "
                         f"(limit {limit} s)")
