@@ -181,6 +181,7 @@ class CameraRenderer:
         self._counts = np.zeros((self.height + 1, self.width), dtype=self._id_dtype)
         self._run_ids = np.empty((self.height, self.width), dtype=self._id_dtype)
         self._one = self._id_dtype(1)  # a typed scalar keeps np.add.at on its fast path
+        self._row_dtype = np.int16 if self.height < 2**15 - 2 else np.int32
         self._noise = np.empty((self.height, self.width, 3), dtype=np.int16)
         self._cols = np.arange(self.width)
         self._col_index = self._cols[:, None]  # row selector for per-column gathers
@@ -313,8 +314,9 @@ class CameraRenderer:
                 t = (-b - np.sqrt(disc)) / self._slope_sq1[:, None]
                 t = np.where((disc >= 0.0) & (t > NEAR) & (c > 0.0), t, np.inf)
                 # Outward normal at the hit point, (q + t d) / r (horizontal).
-                ndotl = ((qx + t * dx) * light[0] + (qy + t * dy) * light[1]) / r
-                shade = ambient + intensity * np.maximum(0.0, -np.nan_to_num(ndotl))
+                th = np.where(t < np.inf, t, 0.0)  # keeps misses finite (they are not drawn)
+                ndotl = ((qx + th * dx) * light[0] + (qy + th * dy) * light[1]) / r
+                shade = ambient + intensity * np.maximum(0.0, -ndotl)
                 own = cyls.band_owner
                 depths.append(t[:, own])
                 shades.append(shade[:, own])
@@ -339,9 +341,13 @@ class CameraRenderer:
         z1 = np.minimum(z1, ceiling)
         n = depth.shape[1]
 
-        # Candidates: the 2k nearest hits of each column, nearest first, and their rows.
-        k = min(self.max_layers, n)
-        m = min(2 * k, n)
+        # Usually every hit of a column fits in the layer budget: then draw them all. Else
+        # take the 2k nearest as candidates and drop the hidden ones first (below).
+        most = int(np.count_nonzero(depth < np.inf, axis=1).max())
+        if most == 0:
+            return self._paint_background(horizon, floor_rgb, ceil_rgb)
+        k = min(self.max_layers, most)
+        m = min(2 * k, most)
         ci = self._col_index
         if n > m:
             cand = np.argpartition(depth, m - 1, axis=1)[:, :m]
@@ -349,28 +355,38 @@ class CameraRenderer:
         else:
             cand = np.argsort(depth, axis=1)
         row_start, row_end = self._rows_covered(depth[ci, cand], z0[cand], z1[cand], h, tilt)
-        # A candidate whose rows all lie within those of a nearer one is hidden: a box's far
-        # side behind its near side, a wall behind a taller one. Drop those (and misses) before
-        # keeping the k nearest, so that they do not use up the layer budget.
-        hidden = (
-            (row_start[:, :, None] <= row_start[:, None, :])
-            & (row_end[:, :, None] >= row_end[:, None, :])
-            & _nearer(m)
-        ).any(axis=1)
-        hidden |= row_start >= row_end
-        keep = np.argsort(hidden, axis=1, kind="stable")[:, :k]  # visible first, by depth
+        if m == k:
+            sel = cand  # (W, k) surface of each layer, nearest first
+        else:
+            # A candidate whose rows all lie within those of a nearer one is hidden: a box's
+            # far side behind its near side, a wall behind a taller one. Drop those (and
+            # misses) before keeping the k nearest, so they do not use up the layer budget.
+            hidden = (
+                (row_start[:, :, None] <= row_start[:, None, :])
+                & (row_end[:, :, None] >= row_end[:, None, :])
+                & _nearer(m)
+            ).any(axis=1)
+            hidden |= row_start >= row_end
+            keep = np.argsort(hidden, axis=1, kind="stable")[:, :k]  # visible first, by depth
+            sel = cand[ci, keep]
+            gone = hidden[ci, keep]
+            row_start = np.where(gone, H, row_start[ci, keep])
+            row_end = np.where(gone, H, row_end[ci, keep])
         # Layer k is a sentinel covering every row: "no surface here".
-        sel = np.zeros((W, k + 1), dtype=np.intp)
-        rs = np.zeros((W, k + 1), dtype=np.intp)
-        re = np.full((W, k + 1), H + 1, dtype=np.intp)
-        sel[:, :k] = cand[ci, keep]
-        gone = hidden[ci, keep]
-        rs[:, :k] = np.where(gone, H, row_start[ci, keep])
-        re[:, :k] = np.where(gone, H, row_end[ci, keep])
+        rs = np.zeros((W, k + 1), dtype=self._row_dtype)
+        re = np.full((W, k + 1), H + 1, dtype=self._row_dtype)
+        rs[:, :k] = row_start
+        re[:, :k] = row_end
+        # Colour of each layer, then the ceiling (k) and the floor (k + 1), per column.
+        colors = np.empty((W, k + 2, 3))
+        colors[:, :k] = albedo[sel] * shade[ci, sel][:, :, None]
+        colors[:, k] = ceil_rgb
+        colors[:, k + 1] = floor_rgb
+        colors = _packed_colors(colors)
 
         # Each column splits into runs at the layers' edges and the horizon; a run shows the
         # nearest layer covering its first row, else ceiling (above the horizon) or floor.
-        starts = np.empty((W, 2 * k + 2), dtype=np.intp)
+        starts = np.empty((W, 2 * k + 2), dtype=self._row_dtype)
         starts[:, 0] = 0
         starts[:, 1] = horizon
         starts[:, 2 : k + 2] = rs[:, :k]
@@ -378,11 +394,8 @@ class CameraRenderer:
         starts.sort(axis=1)
         s = starts[:, :, None]
         layer = ((rs[:, None, :] <= s) & (s < re[:, None, :])).argmax(axis=2)  # (W, runs)
-        surf = sel[ci, layer]
-        lit = albedo[surf] * shade[ci, surf][:, :, None]
-        background = np.where((starts >= horizon)[:, :, None], floor_rgb, ceil_rgb)
-        colors = np.where((layer < k)[:, :, None], lit, background)
-        return self._paint_runs(starts), _packed_palette(colors)
+        layer += (layer == k) & (starts >= horizon)  # no surface: ceiling or floor
+        return self._paint_runs(starts), colors[ci, layer].ravel()
 
     def _rows_covered(self, depth, z0, z1, h, tilt):
         """Rows ``row_start <= row < row_end`` where surfaces at ``depth`` spanning heights
@@ -392,8 +405,8 @@ class CameraRenderer:
         p = np.where(hit, depth, 1.0)
         row_start = np.ceil(self._rows_of((z1 - h) / p, tilt))
         row_end = np.floor(self._rows_of((z0 - h) / p, tilt)) + 1.0
-        row_start = np.where(hit, np.clip(row_start, 0, H), H).astype(np.intp)
-        row_end = np.where(hit, np.clip(row_end, 0, H), H).astype(np.intp)
+        row_start = np.where(hit, np.clip(row_start, 0, H), H).astype(self._row_dtype)
+        row_end = np.where(hit, np.clip(row_end, 0, H), H).astype(self._row_dtype)
         return row_start, row_end
 
     def _paint_runs(self, starts):
@@ -403,18 +416,19 @@ class CameraRenderer:
         counts.fill(0)
         counts[0] = self._cols * runs
         # Every run start after the first adds one; starts equal to H land in the spare row.
-        np.add.at(counts.reshape(-1), (starts[:, 1:] * W + self._cols[:, None]).ravel(), self._one)
+        pos = starts[:, 1:].astype(np.intp) * W + self._col_index
+        np.add.at(counts.reshape(-1), pos.ravel(), self._one)
         np.cumsum(counts[:-1], axis=0, out=self._run_ids)
         return self._run_ids
 
     def _paint_background(self, horizon, floor_rgb, ceil_rgb):
-        starts = np.empty((self.width, 2), dtype=np.intp)
+        starts = np.empty((self.width, 2), dtype=self._row_dtype)
         starts[:, 0] = 0
         starts[:, 1] = horizon
         palette = np.empty((self.width, 2, 3))
         palette[:, 0] = ceil_rgb if horizon > 0 else floor_rgb
         palette[:, 1] = floor_rgb
-        return self._paint_runs(starts), _packed_palette(palette)
+        return self._paint_runs(starts), _packed_colors(palette).ravel()
 
 
 @functools.lru_cache(maxsize=64)
@@ -442,11 +456,11 @@ def _lit(color, shade, what):
     return np.asarray(_albedo(color, what)) * shade
 
 
-def _packed_palette(rgb):
-    """Linear colours (..., 3) to 8-bit (rounded, clipped), packed as RGBA uint32, flat."""
+def _packed_colors(rgb):
+    """Linear colours (..., 3) to 8-bit (rounded, clipped), packed as RGBA uint32 (...)."""
     rgba = np.zeros(rgb.shape[:-1] + (4,), dtype=np.uint8)
     rgba[..., :3] = np.clip(rgb * 255.0 + 0.5, 0.0, 255.0)
-    return rgba.reshape(-1, 4).view(np.uint32).ravel()
+    return rgba.view(np.uint32)[..., 0]
 
 
 @functools.lru_cache(maxsize=8)

@@ -146,6 +146,24 @@ def test_default_layer_budget_matches_reference_on_a_typical_room():
     assert mismatch_fraction(got, reference_render(scene, pose, 80, 60)) < 0.005
 
 
+def stepped_boxes():
+    """Four boxes in a row, each taller than the one before, then the back wall: 9 hits in
+    the middle columns, 5 of them visible (the boxes' far sides are hidden)."""
+    walls = [Wall(9.0, -9, 9.0, 9, 2.5, GREEN)]
+    for i, height in enumerate((0.4, 0.8, 1.2, 1.6)):
+        x = 2.0 + 1.5 * i
+        walls += box(x, -1.0, x + 0.5, 1.0, height, (0.2 * i + 0.2, 0.3, 0.8 - 0.15 * i))
+    return scene_of(walls, ceiling_height=2.5), CameraPose(0.0, 0.0, 0.0, height=0.3)
+
+
+def test_hidden_far_sides_do_not_use_up_the_layer_budget():
+    scene, pose = stepped_boxes()
+    ref = reference_render(scene, pose, 64, 48)
+    assert mismatch_fraction(CameraRenderer(64, 48, max_layers=5).render(scene, pose), ref) == 0
+    # With fewer layers than visible surfaces the farthest ones are lost (floor/ceiling).
+    assert mismatch_fraction(CameraRenderer(64, 48, max_layers=3).render(scene, pose), ref) > 0.01
+
+
 # -- output ----------------------------------------------------------------------------------
 
 
