@@ -1,5 +1,7 @@
 """Viewer modes: parsing, bad strings, and falling back to a file when no viewer can show the run."""
 
+import os
+import signal
 import socket
 import sys
 
@@ -158,6 +160,41 @@ def test_spawn_without_any_file_to_fall_back_on_is_a_usage_error(monkeypatch):
     no_viewer_running(monkeypatch)
     with pytest.raises(UsageError, match="save:PATH.rrd"):
         open_recorder("spawn", default_path=None)
+
+
+def test_spawn_starts_a_viewer_and_streams_to_it(tmp_path, monkeypatch):
+    # A gRPC-only rerun stands in for the viewer window (no display or GPU needed).
+    monkeypatch.setenv("DISPLAY", ":99")
+    port = free_port()
+    monkeypatch.setattr(sinks, "VIEWER_PORT", port)
+    real_command = sinks.viewer_command
+    monkeypatch.setattr(sinks, "viewer_command", lambda p: [*real_command(p), "--serve-grpc"])
+    rec = open_recorder("spawn", default_path=str(tmp_path / "unused.rrd"))
+    try:
+        assert rec.mode == "spawn" and rec.viewer_pid is not None
+        assert port_is_listening("127.0.0.1", port)
+        rec.log_frame(frame(0))
+        msg = rec.close()
+        assert f"port {port}" in msg and "1 frames" in msg
+        assert not (tmp_path / "unused.rrd").exists()
+    finally:
+        if rec.viewer_pid is not None:
+            os.kill(
+                rec.viewer_pid, signal.SIGKILL
+            )  # the viewer ignores SIGTERM while a client is connected
+
+
+def test_connect_streams_to_a_listening_viewer(tmp_path):
+    server = open_recorder("serve", default_path=str(tmp_path / "a.rrd"))
+    try:
+        url = server._description.split("`rerun ")[1].split("`")[0]
+        rec = open_recorder(f"connect:{url}", default_path=str(tmp_path / "b.rrd"))
+        assert rec.mode == "connect"
+        rec.log_frame(frame(0))
+        assert f"streamed to the rerun viewer at {url}" in rec.close()
+    finally:
+        server.close()
+    assert not (tmp_path / "b.rrd").exists()
 
 
 def test_connect_with_nobody_listening_saves_to_the_default_file(tmp_path):

@@ -99,6 +99,8 @@ class Recorder:
         Why the requested sink was replaced by a file, if it was.
     frames_logged, images_logged : int
         ``log_frame`` calls, and how many of them logged the camera images.
+    viewer_pid : int or None
+        The viewer process ``spawn`` started (it outlives the run), if any.
     """
 
     def __init__(
@@ -123,6 +125,7 @@ class Recorder:
         self.jpeg_quality = jpeg_quality
         self.frames_logged = 0
         self.images_logged = 0
+        self.viewer_pid = None
         self._closed = False
         self._message = None
         self._ray = _DEFAULT_RAY
@@ -344,9 +347,10 @@ def open_recorder(mode, *, default_path, app_id="fpga_robotics", log_every=1, jp
     if parsed.kind == "save":
         tmp = attach_save(stream, parsed.path)
         return Recorder(stream, "save", path=parsed.path, temp_path=tmp, **options)
+    viewer_pid = None
     try:
         if parsed.kind == "spawn":
-            description = attach_spawn(stream)
+            description, viewer_pid = attach_spawn(stream)
         elif parsed.kind == "connect":
             description = attach_connect(stream, parsed.url)
         else:
@@ -360,4 +364,6 @@ def open_recorder(mode, *, default_path, app_id="fpga_robotics", log_every=1, jp
         print(f"fpga_robotics.viz: {notice} ({parsed.path})", file=sys.stderr)
         tmp = attach_save(stream, parsed.path)
         return Recorder(stream, "save", path=parsed.path, temp_path=tmp, notice=notice, **options)
-    return Recorder(stream, parsed.kind, description=description, **options)
+    rec = Recorder(stream, parsed.kind, description=description, **options)
+    rec.viewer_pid = viewer_pid
+    return rec

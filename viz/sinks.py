@@ -9,7 +9,6 @@ import os
 import shutil
 import socket
 import subprocess
-import sys
 import tempfile
 import time
 import uuid
@@ -46,10 +45,26 @@ def attach_save(stream, path):
     return tmp
 
 
+def _viewer_binary():
+    # The binary itself rather than the `rerun` console script, which would run it as a child:
+    # then the pid we know is the viewer's own.
+    try:
+        import rerun_cli
+
+        exe = os.path.join(os.path.dirname(rerun_cli.__file__), "rerun")
+        if os.path.isfile(exe) and os.access(exe, os.X_OK):
+            return exe
+    except ImportError:
+        pass
+    exe = shutil.which("rerun")
+    if exe is None:
+        raise SinkUnavailable("the rerun viewer is not installed (pip install rerun-sdk)")
+    return exe
+
+
 def viewer_command(port):
     """The command that starts a native rerun viewer listening on ``port``."""
-    exe = shutil.which("rerun")
-    base = [exe] if exe else [sys.executable, "-m", "rerun"]
+    base = [_viewer_binary()]
     return base + ["--port", str(port), "--memory-limit", "75%", "--expect-data-soon"]
 
 
@@ -63,10 +78,7 @@ def _last_line(fileobj):
 
 
 def _start_viewer(port):
-    try:
-        cmd = viewer_command(port)
-    except Exception as exc:  # noqa: BLE001 - any failure to locate the viewer is reported
-        raise SinkUnavailable(f"cannot find the rerun viewer: {exc}") from None
+    cmd = viewer_command(port)
     env = dict(os.environ, RERUN_APP_ONLY="true")
     with tempfile.TemporaryFile() as errlog:
         try:
@@ -102,22 +114,27 @@ def _start_viewer(port):
             time.sleep(0.05)
 
 
-def attach_spawn(stream, port=DEFAULT_VIEWER_PORT):
+#: The port a spawned viewer listens on (rerun's default).
+VIEWER_PORT = DEFAULT_VIEWER_PORT
+
+
+def attach_spawn(stream, port=None):
     """Open a native viewer (or reuse one already listening on ``port``) and stream to it.
 
-    Returns a description of what happened.
+    Returns a description of what happened and the pid of the viewer started (or ``None``).
     """
+    port = VIEWER_PORT if port is None else port
     url = f"rerun+http://{_LOCALHOST}:{port}/proxy"
     if port_is_listening(_LOCALHOST, port):
         stream.connect_grpc(url)
-        return f"streamed to the rerun viewer already running on port {port}"
+        return f"streamed to the rerun viewer already running on port {port}", None
     if not display_available():
         raise SinkUnavailable(
             "no display to open a viewer window (DISPLAY and WAYLAND_DISPLAY unset)"
         )
-    _start_viewer(port)
+    proc = _start_viewer(port)
     stream.connect_grpc(url)
-    return "streamed to a rerun viewer window (spawned)"
+    return f"streamed to a new rerun viewer (pid {proc.pid}, port {port})", proc.pid
 
 
 def attach_connect(stream, url):
