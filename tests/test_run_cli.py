@@ -1,0 +1,143 @@
+"""``python -m fpga_robotics.run``: arguments, errors (one line, exit 2) and the summary file."""
+
+import json
+import subprocess
+import sys
+
+import pytest
+
+from fpga_robotics.errors import run_cli
+from fpga_robotics.run import main
+
+SHIPPED = ("follow_person", "divider", "lighting", "heavy_robot", "lost_target")
+REQUIRED = (
+    "scenario", "backend", "resolution", "seed", "sim_time_s", "frames", "wall_time_s",
+    "ms_per_frame", "realtime_factor", "min_distance_m", "mean_distance_m",
+    "target_in_view_fraction", "collisions", "verdict", "checks",
+)
+
+
+def run(argv, capsys):
+    """Call the CLI as ``python -m`` does; return (exit code, stdout, stderr)."""
+    with pytest.raises(SystemExit) as info:
+        run_cli(main, argv, prog="fpga_robotics.run")
+    out, err = capsys.readouterr()
+    return info.value.code, out, err
+
+
+def usage_error(argv, capsys):
+    code, _out, err = run(argv, capsys)
+    assert code == 2, err
+    assert "Traceback" not in err
+    return err
+
+
+def test_unknown_scenario_lists_the_shipped_ones(capsys):
+    err = usage_error(["--scenario", "folow_person"], capsys)
+    assert "unknown scenario 'folow_person'" in err
+    assert all(name in err for name in SHIPPED)
+    assert len(err.strip().splitlines()) == 1
+
+
+def test_malformed_scenario_file_names_its_line(tmp_path, capsys):
+    path = tmp_path / "bad.toml"
+    path.write_text('name = "bad"\n[sim]\nduration = = 3\n')
+    err = usage_error(["--scenario", str(path)], capsys)
+    assert "malformed TOML" in err and "line 3" in err and str(path) in err
+
+
+def test_unknown_set_key_shows_close_matches(capsys):
+    err = usage_error(["--set", "design.kp_nm=2", "--rerun", "off"], capsys)
+    assert "design.kp_nm" in err and "design.kp_num" in err
+
+
+def test_bad_set_value_names_the_key(capsys):
+    err = usage_error(["--set", "robot.mass=-3", "--rerun", "off"], capsys)
+    assert "robot.mass" in err
+
+
+@pytest.mark.parametrize("res", ["160", "160x", "x120", "axb", "0x120"])
+def test_bad_resolution(res, capsys):
+    err = usage_error(["--resolution", res, "--rerun", "off"], capsys)
+    assert "WIDTHxHEIGHT" in err
+
+
+def test_resolution_the_design_cannot_take_is_a_clear_error(capsys):
+    # A window of 161 - 2*16 = 129 columns cannot be split into 8 equal bins.
+    err = usage_error(["--resolution", "161x120", "--rerun", "off"], capsys)
+    assert "divisible by 8" in err
+
+
+def test_unopenable_camera(capsys):
+    err = usage_error(["--source", "camera:97", "--rerun", "off"], capsys)
+    assert "cannot open camera 97" in err
+
+
+def test_missing_and_undecodable_video(tmp_path, capsys):
+    err = usage_error(["--source", str(tmp_path / "none.avi"), "--rerun", "off"], capsys)
+    assert "no such file" in err
+    junk = tmp_path / "junk.avi"
+    junk.write_bytes(b"not a video at all" * 10)
+    err = usage_error(["--source", str(junk), "--rerun", "off"], capsys)
+    assert "cannot read video" in err
+
+
+def test_bad_duration_and_log_every(capsys):
+    assert "--duration" in usage_error(["--duration", "0", "--rerun", "off"], capsys)
+    err = usage_error(["--log-every", "0", "--duration", "0.1", "--backend", "model"], capsys)
+    assert "log-every" in err or "log_every" in err
+
+
+def test_list_scenarios(capsys):
+    code, out, _ = run(["--list-scenarios"], capsys)
+    assert code == 0
+    names = [line.split()[0] for line in out.splitlines()]
+    assert set(SHIPPED) <= set(names)
+
+
+def test_a_short_run_writes_its_summary_atomically(tmp_path, capsys):
+    path = tmp_path / "out" / "s.json"
+    code, out, _ = run(["--backend", "model", "--duration", "2", "--seed", "4", "--rerun", "off",
+                        "--color", "red", "--summary", str(path), "--quiet"], capsys)
+    assert code == 0
+    s = json.loads(path.read_text())
+    for key in REQUIRED:
+        assert key in s, key
+    assert (s["scenario"], s["backend"], s["resolution"], s["seed"]) == (
+        "follow_person", "model", "160x120", 4)
+    assert s["frames"] == 60 and s["sim_time_s"] == pytest.approx(2.0)
+    assert s["verdict"] == "pass" and all(c["passed"] for c in s["checks"])
+    assert s["realtime_factor"] == pytest.approx(s["sim_time_s"] / s["wall_time_s"], rel=1e-2)
+    assert list(path.parent.iterdir()) == [path]  # no temporary file left behind
+    assert "verdict: PASS" in out
+
+
+def test_a_failing_check_exits_1(tmp_path, capsys):
+    path = tmp_path / "s.json"
+    code, out, _ = run(["--backend", "model", "--duration", "1", "--rerun", "off", "--quiet",
+                        "--set", "checks.mean_distance_max_m=0.5", "--summary", str(path)],
+                       capsys)
+    assert code == 1
+    s = json.loads(path.read_text())
+    bad = [c for c in s["checks"] if not c["passed"]]
+    assert s["verdict"] == "fail" and [c["name"] for c in bad] == ["mean_distance_max_m"]
+    assert "[FAIL] mean_distance_max_m" in out
+
+
+def test_saves_a_recording_where_asked(tmp_path, capsys):
+    rrd = tmp_path / "run.rrd"
+    code, out, _ = run(["--backend", "model", "--duration", "0.5", "--rerun", f"save:{rrd}",
+                        "--log-every", "5", "--quiet"], capsys)
+    assert code == 0
+    assert rrd.exists() and rrd.stat().st_size > 0
+    assert str(rrd) in out
+
+
+def test_module_entry_point_prints_one_line_and_exits_2():
+    proc = subprocess.run(
+        [sys.executable, "-m", "fpga_robotics.run", "--scenario", "nope", "--rerun", "off"],
+        capture_output=True, text=True, timeout=120, check=False,
+    )
+    assert proc.returncode == 2
+    assert proc.stderr.startswith("fpga_robotics.run: error: unknown scenario 'nope'")
+    assert "Traceback" not in proc.stderr

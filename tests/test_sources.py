@@ -1,0 +1,129 @@
+"""Frames from a video file or an image folder, resized and run through the design."""
+
+import json
+
+import cv2
+import numpy as np
+import pytest
+
+from fpga_robotics.errors import UsageError, run_cli
+from fpga_robotics.hw.params import FollowTargetParams
+from fpga_robotics.run import main
+from fpga_robotics.sim.backends.model import ModelBackend
+from fpga_robotics.sim.model import FollowTargetModel
+from fpga_robotics.sources import open_source, run_source
+
+W, H = 160, 120
+
+
+def scene_bgr(k, size=(480, 640)):
+    """A grey room with a red block that moves right by 40 px a frame; frame 3 is empty."""
+    img = np.full((*size, 3), 110, np.uint8)
+    img[::7, :] = 90  # some texture, so that resizing has something to blend
+    if k != 3:
+        x0 = 120 + 40 * k
+        img[150:400, x0:x0 + 120] = (30, 30, 220)  # BGR: red
+    return img
+
+
+@pytest.fixture
+def folder(tmp_path):
+    d = tmp_path / "frames"
+    d.mkdir()
+    for k in range(5):
+        cv2.imwrite(str(d / f"f{k:03d}.png"), scene_bgr(k))
+    (d / "notes.txt").write_text("not an image")
+    return d
+
+
+@pytest.fixture
+def video(tmp_path):
+    path = tmp_path / "clip.avi"
+    writer = cv2.VideoWriter(str(path), cv2.VideoWriter_fourcc(*"MJPG"), 30, (640, 480))
+    assert writer.isOpened()
+    for k in range(5):
+        writer.write(scene_bgr(k))
+    writer.release()
+    return path
+
+
+def expected_rgb(bgr):
+    return cv2.cvtColor(cv2.resize(bgr, (W, H), interpolation=cv2.INTER_LINEAR),
+                        cv2.COLOR_BGR2RGB)
+
+
+def test_folder_frames_are_resized_and_converted_to_rgb(folder):
+    src = open_source(str(folder), W, H)
+    frames = list(src)
+    assert len(frames) == 5 and src.kind == "folder"
+    for k, f in enumerate(frames):
+        assert f.shape == (H, W, 3) and f.dtype == np.uint8
+        assert np.array_equal(f, expected_rgb(scene_bgr(k)))
+    # Red lands in the R channel (index 0) after the BGR -> RGB swap.
+    assert frames[0][70, 45].tolist() == [220, 30, 30]
+
+
+def test_video_frames_come_back_in_order(video):
+    src = open_source(str(video), W, H)
+    frames = list(src)
+    src.close()
+    assert src.kind == "video" and len(frames) == 5
+    for k, f in enumerate(frames):
+        # MJPG is lossy: compare with the original, allowing JPEG error.
+        diff = np.abs(f.astype(int) - expected_rgb(scene_bgr(k)).astype(int))
+        assert diff.mean() < 4, k
+
+
+def test_run_source_matches_the_golden_model_frame_by_frame(folder):
+    params = FollowTargetParams(width=W, height=H)
+    out = run_source(open_source(str(folder), W, H), ModelBackend(params), color="red")
+    model = FollowTargetModel(params)
+    for k, f in enumerate(open_source(str(folder), W, H)):
+        m = model.process(f, 0b100)
+        r = out["results"][k]
+        assert (r["found"], r["proximity"], r["centroid_x"], r["motor_left"],
+                r["motor_right"]) == (m.tracker.found, m.tracker.proximity,
+                                      m.tracker.centroid_x, m.motor_left, m.motor_right)
+    found = [r["found"] for r in out["results"]]
+    assert found == [True, True, True, False, True]
+    # The block moves right: so does the centroid (scaled by 160/640).
+    cx = [r["centroid_x"] for r in out["results"] if r["found"]]
+    assert cx == sorted(cx) and abs(cx[0] - (120 + 60) / 4) <= 1
+    assert out["frames"] == 5 and out["found_fraction"] == 0.8
+
+
+def test_max_frames_stops_early(video):
+    params = FollowTargetParams(width=W, height=H)
+    out = run_source(open_source(str(video), W, H), ModelBackend(params), max_frames=2)
+    assert out["frames"] == 2
+
+
+def test_empty_folder_and_bad_specs_are_usage_errors(tmp_path):
+    with pytest.raises(UsageError, match="holds no images"):
+        open_source(str(tmp_path), W, H)
+    with pytest.raises(UsageError, match="device number"):
+        open_source("camera:front", W, H)
+    with pytest.raises(UsageError, match="no such file"):
+        open_source(str(tmp_path / "x.mp4"), W, H)
+
+
+def test_cli_runs_a_video_and_writes_the_results(video, tmp_path, capsys):
+    path = tmp_path / "src.json"
+    with pytest.raises(SystemExit) as info:
+        run_cli(main, ["--source", str(video), "--backend", "model", "--rerun", "off",
+                       "--summary", str(path), "--quiet"])
+    out, _ = capsys.readouterr()
+    assert info.value.code == 0
+    s = json.loads(path.read_text())
+    assert s["frames"] == 5 and s["found_frames"] == 4 and s["source_kind"] == "video"
+    assert "found in 4 frames" in out
+
+
+def test_cli_folder_at_another_resolution(folder, tmp_path, capsys):
+    path = tmp_path / "src.json"
+    with pytest.raises(SystemExit) as info:
+        run_cli(main, ["--source", str(folder), "--backend", "model", "--rerun", "off",
+                       "--resolution", "320x240", "--summary", str(path), "--quiet"])
+    assert info.value.code == 0
+    s = json.loads(path.read_text())
+    assert s["resolution"] == "320x240" and s["found_frames"] == 4
