@@ -6,14 +6,18 @@ column instead of one per pixel:
 
 1. For each column, intersect its ray (in the ground plane) with every wall segment and every
    cylinder; a hit's *depth* is its distance along the camera's forward axis.
-2. Keep the ``max_layers`` nearest hits per column (a room wall, floor to ceiling, ends the
-   list: whatever lies behind it is farther than it).
+2. Keep the ``max_layers`` nearest hits per column as its depth layers. When a column has
+   more hits than that, hits hidden behind a single nearer one (a box's far side) are
+   dropped first, so they do not use up the budget.
 3. A hit at depth ``p`` spanning heights ``z0..z1`` covers the rows whose rays pass through
    that height range at that depth: a contiguous run of rows given by the pinhole formula
    ``row = H/2 - 0.5 - f * (z - h) / p`` (tilt aside). Each column therefore splits into a few
    runs of rows, each showing the nearest hit that covers it, or the floor / ceiling.
 4. The runs are painted with a cumulative sum down the columns and one palette lookup, so the
-   per-pixel work is a handful of whole-image numpy operations whatever the scene.
+   per-pixel work is a handful of whole-image operations whatever the scene.
+
+Lighting is Lambertian with ambient (``Scene.lighting``); sensor noise is optional, seeded by
+the caller's generator. docs/camera.md has the details and the measured speed.
 
 Conventions: pixel ``(row, col)`` has its centre at ``(col + 0.5, row + 0.5)``; the optical axis
 passes through the image centre ``(W/2, H/2)``; the focal length in pixels is
@@ -27,6 +31,7 @@ tilt, vertical edges stay vertical instead of converging (no keystone).
 
 import functools
 import math
+import numbers
 from dataclasses import dataclass
 
 import cv2
@@ -160,7 +165,7 @@ class CameraRenderer:
         _check_int("width", width, 1)
         _check_int("height", height, 1)
         _check_int("max_layers", max_layers, 1)
-        if not (isinstance(hfov, (int, float)) and 0.0 < hfov < math.pi):
+        if isinstance(hfov, bool) or not isinstance(hfov, numbers.Real) or not 0 < hfov < math.pi:
             raise ValueError(f"hfov must be an angle in radians between 0 and pi, got {hfov!r}")
         self.width = int(width)
         self.height = int(height)
@@ -267,9 +272,11 @@ class CameraRenderer:
         cv2.add(image, self._noise, dst=image, dtype=cv2.CV_8U)  # saturating
 
     def _runs(self, scene, pose):
-        """Per-pixel run ids (H, W) and the palette (runs, 3) uint8 they index."""
+        """Per-pixel run ids (H, W) and the flat palette of packed RGBA uint32 they index."""
         W, H = self.width, self.height
         cx, cy, h, tilt = float(pose.x), float(pose.y), float(pose.height), float(pose.tilt)
+        if not all(map(math.isfinite, (cx, cy, h, tilt, pose.heading))):
+            raise ValueError(f"camera pose must be finite numbers, got {pose}")
         ceiling = float(scene.ceiling_height)
         if not (0.0 < h < ceiling):
             raise ValueError(

@@ -493,3 +493,8 @@ def test_benchmark_cli_prints_a_line_per_size(capsys):
     assert all(float(v) > 0 for v in lines[-1].split()[1:])
     with pytest.raises(UsageError, match="WIDTHxHEIGHT"):
         main(["--sizes", "160by120"])
+
+
+def test_non_finite_pose_is_refused():
+    with pytest.raises(ValueError, match="finite"):
+        render(scene_of(), CameraPose(0, float("nan"), 0), 16, 12)
