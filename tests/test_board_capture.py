@@ -6,6 +6,7 @@ import random
 import pytest
 from amaranth.hdl import ClockDomain, Module
 from amaranth.sim import Simulator
+
 from fpga_robotics.hw.board.ov7670_capture import OV7670Capture
 
 # Blanking (in PCLK cycles) of the simulated camera; small but with every phase present.

@@ -3,6 +3,7 @@ camera does: START/STOP conditions, bits sampled on SIOC rising edges, ID 0x42, 
 
 import pytest
 from amaranth.sim import Simulator
+
 from fpga_robotics.hw.board.sccb import OV7670_INIT, OV7670_SCCB_ID, RegisterWrite, SCCBInit
 
 QUARTER = 3

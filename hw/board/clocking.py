@@ -8,7 +8,7 @@ synchroniser's flip-flops start asserted, so the design always sees a reset firs
 
 from dataclasses import dataclass
 
-from amaranth.hdl import ClockDomain, ClockSignal, Elaboratable, Instance, Module, Signal
+from amaranth.hdl import ClockSignal, Elaboratable, Instance, Module, Signal
 from amaranth.lib.cdc import ResetSynchronizer
 
 __all__ = ["ECP5PLL", "BoardClocking", "PLLParams", "ecp5_pll_params"]
@@ -130,7 +130,8 @@ class ECP5PLL(Elaboratable):
 
 
 class BoardClocking(Elaboratable):
-    """The ``sync`` domain at ``sys_clk_freq`` from the board oscillator, with reset.
+    """Drives the clock and reset of the ``sync`` domain (defined by the parent) at
+    ``sys_clk_freq`` from the board oscillator.
 
     Parameters
     ----------
@@ -151,7 +152,6 @@ class BoardClocking(Elaboratable):
 
     def elaborate(self, platform):
         m = Module()
-        m.domains.sync = ClockDomain("sync")
         locked = Signal()
         if self.pll_params is None:
             m.d.comb += [ClockSignal("sync").eq(self.clk_in), locked.eq(1)]
@@ -162,5 +162,7 @@ class BoardClocking(Elaboratable):
                 ClockSignal("sync").eq(pll.clk_out),
                 locked.eq(pll.locked),
             ]
+            if platform is not None:  # the requirement nextpnr checks the design clock against
+                platform.add_clock_constraint(pll.clk_out, self.sys_clk_freq)
         m.submodules.reset_sync = ResetSynchronizer(self.reset_in | ~locked, domain="sync")
         return m

@@ -142,10 +142,9 @@ class SPIByteMaster(wiring.Component):
                 with m.Else():
                     m.d.sync += timer.eq(self.half_period - 1)  # hold time after the last edge
                     m.next = "RELEASE"
-            with m.State("RELEASE"):
-                with m.If(timer == 0):
-                    m.d.sync += [self.cs.eq(0), timer.eq(2 * self.half_period)]
-                    m.next = "IDLE"
+            with m.State("RELEASE"), m.If(timer == 0):
+                m.d.sync += [self.cs.eq(0), timer.eq(2 * self.half_period)]
+                m.next = "IDLE"
         return m
 
 
@@ -251,16 +250,15 @@ class GoPiGo3Motors(wiring.Component):
                     m.d.sync += [limits.eq(1), port.eq(MOTOR_LEFT), value.eq(limit_ticks),
                                  byte.eq(0)]
                     m.next = "SEND"
-            with m.State("IDLE"):
-                with m.If(pending):
-                    m.d.sync += pending.eq(0)
-                    m.d.sync += [
-                        limits.eq(0), port.eq(MOTOR_LEFT), value.eq(next_left),
-                        cur_right.eq(next_right), right_next.eq(1), byte.eq(0),
-                    ]
-                    with m.If(self.update):  # a new update in this very cycle stays pending
-                        m.d.sync += pending.eq(1)
-                    m.next = "SEND"
+            with m.State("IDLE"), m.If(pending):
+                m.d.sync += pending.eq(0)
+                m.d.sync += [
+                    limits.eq(0), port.eq(MOTOR_LEFT), value.eq(next_left),
+                    cur_right.eq(next_right), right_next.eq(1), byte.eq(0),
+                ]
+                with m.If(self.update):  # a new update in this very cycle stays pending
+                    m.d.sync += pending.eq(1)
+                m.next = "SEND"
             with m.State("SEND"):
                 m.d.comb += [spi.bytes.valid.eq(1), self.busy.eq(1)]
                 with m.If(spi.bytes.ready):

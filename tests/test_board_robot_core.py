@@ -1,0 +1,121 @@
+"""The robot's logic end to end, as on the board but without pins: a simulated OV7670 sends
+frames byte by byte; the GoPiGo3 messages decoded from the SPI wires and the LEDs must match
+the golden model of ``FollowTarget`` (speeds x 2 in ticks), so the board path adds no error."""
+
+import numpy as np
+import pytest
+from amaranth.hdl import ClockDomain, Module
+from amaranth.sim import Simulator
+
+from fpga_robotics.hw.board.robot_core import RobotCore, RobotTiming
+from fpga_robotics.hw.board.sccb import RegisterWrite
+from fpga_robotics.hw.params import FollowTargetParams
+from fpga_robotics.sim.model import FollowTargetModel
+
+PARAMS = FollowTargetParams(width=48, height=16)
+TIMING = RobotTiming.from_cycles(xclk_half=2, sccb_quarter=2, spi_half=2, camera_wait=5,
+                                 reset_wait=10, motor_wait=30)
+TABLE = [RegisterWrite(0x12, 0x80, "reset", True), RegisterWrite(0x8C, 0x02, "rgb444")]
+HBLANK, VSYNC_CYCLES = 4, 6
+
+
+def red_blob_frame(x0, x1, y0, y1, seed):
+    rng = np.random.default_rng(seed)
+    # Dull background (never red: r - max(g, b) < 6), a saturated red rectangle.
+    r = rng.integers(0, 6, (PARAMS.height, PARAMS.width))
+    g = rng.integers(4, 10, (PARAMS.height, PARAMS.width))
+    b = rng.integers(4, 10, (PARAMS.height, PARAMS.width))
+    r[y0:y1, x0:x1], g[y0:y1, x0:x1], b[y0:y1, x0:x1] = 15, 2, 3
+    return ((r << 8) | (g << 4) | b).astype(np.uint16)
+
+
+def ticks_bytes(dps):
+    t = max(-32768, min(32767, 2 * dps)) & 0xFFFF
+    return [t >> 8, t & 0xFF]
+
+
+def test_camera_to_gopigo3_matches_golden_model():
+    frames = [red_blob_frame(26, 44, 2, 14, seed=1), red_blob_frame(6, 20, 3, 13, seed=2),
+              red_blob_frame(0, 0, 0, 0, seed=3)]
+    model = FollowTargetModel(PARAMS)
+    expected_msgs = [[0x08, 0x0F, port, 0, 0x04, 0x00] for port in (1, 2)]
+    expected_leds = []
+    for frame in frames:
+        out = model.process(frame, 0b100)
+        expected_msgs += [[0x08, 0x0E, 1, *ticks_bytes(out.motor_left)],
+                          [0x08, 0x0E, 2, *ticks_bytes(out.motor_right)]]
+        expected_leds.append(out.tracker.centroid_leds)
+    # The scene must exercise the controller: found on one side, then the other, then lost.
+    assert expected_leds[0] != 0 and expected_leds[1] != 0 and expected_leds[2] == 0
+
+    core = RobotCore(PARAMS, TIMING, sccb_table=TABLE)
+    m = Module()
+    m.domains.sync = ClockDomain("sync")
+    m.domains.pclk = ClockDomain("pclk")
+    m.submodules.core = core
+    sim = Simulator(m)
+    sim.add_clock(20e-9, domain="sync")
+    sim.add_clock(80e-9, domain="pclk", phase=31e-9)
+    msgs, leds_after_frame, xclk_edges = [], [], []
+    state = {"camera_done": False}
+
+    async def camera(ctx):
+        ctx.set(core.switches, 0)  # all switches off: follow red
+        for _ in range(5):
+            await ctx.tick("pclk")
+        for frame in frames:
+            ctx.set(core.cam_vsync, 1)
+            for _ in range(VSYNC_CYCLES):
+                await ctx.tick("pclk")
+            ctx.set(core.cam_vsync, 0)
+            for row in frame:
+                for p in row.tolist():
+                    for byte in ((p >> 8) & 0xF, p & 0xFF):
+                        ctx.set(core.cam_href, 1)
+                        ctx.set(core.cam_data, byte)
+                        await ctx.tick("pclk")
+                ctx.set(core.cam_href, 0)
+                for _ in range(HBLANK):
+                    await ctx.tick("pclk")
+            # Vertical blanking long enough for the SPI messages of this frame.
+            for _ in range(400):
+                await ctx.tick("pclk")
+            leds_after_frame.append(ctx.get(core.leds))
+        state["camera_done"] = True
+
+    async def spi_peripheral(ctx):
+        prev_sclk, prev_cs, prev_xclk, cycle = 0, 0, 0, 0
+        current, shift, nbits = [], 0, 0
+        async for _clk, _rst, sclk, copi, cs, xclk in ctx.tick("sync").sample(
+                core.spi_sclk, core.spi_copi, core.spi_cs, core.xclk):
+            cycle += 1
+            if cs and not prev_cs:
+                current, shift, nbits = [], 0, 0
+            if sclk and not prev_sclk and cs:
+                shift, nbits = (shift << 1) | copi, nbits + 1
+                if nbits == 8:
+                    current.append(shift)
+                    shift, nbits = 0, 0
+            if prev_cs and not cs:
+                msgs.append(current)
+            if xclk != prev_xclk:
+                xclk_edges.append(cycle)
+            prev_sclk, prev_cs, prev_xclk = sclk, cs, xclk
+
+    sim.add_testbench(camera)
+    sim.add_process(spi_peripheral)
+    bytes_per_frame = PARAMS.height * (2 * PARAMS.width + HBLANK) + VSYNC_CYCLES + 400
+    sim.run_until((len(frames) * bytes_per_frame + 200) * 80e-9 * 1.2)  # watchdog
+    assert state["camera_done"], "the simulated camera did not finish in time"
+    assert msgs == expected_msgs
+    assert leds_after_frame == expected_leds
+    # XCLK toggles every xclk_half design clock cycles.
+    assert set(np.diff(xclk_edges[5:]).tolist()) == {TIMING.xclk_half}
+
+
+def test_robot_timing_from_clock():
+    t = RobotTiming(50e6)
+    assert (t.xclk_half, t.sccb_quarter, t.spi_half) == (2, 125, 50)
+    assert t.reset_wait == 500_000
+    with pytest.raises(ValueError, match="even multiple"):
+        RobotTiming(60e6)
