@@ -4,6 +4,7 @@ import os
 import signal
 import socket
 import sys
+from urllib.parse import parse_qs, urlsplit
 
 import numpy as np
 import pytest
@@ -187,7 +188,7 @@ def test_spawn_starts_a_viewer_and_streams_to_it(tmp_path, monkeypatch):
 def test_connect_streams_to_a_listening_viewer(tmp_path):
     server = open_recorder("serve", default_path=str(tmp_path / "a.rrd"))
     try:
-        url = server._description.split("`rerun ")[1].split("`")[0]
+        url = server.live_url
         rec = open_recorder(f"connect:{url}", default_path=str(tmp_path / "b.rrd"))
         assert rec.mode == "connect"
         rec.log_frame(frame(0))
@@ -207,14 +208,17 @@ def test_connect_with_nobody_listening_saves_to_the_default_file(tmp_path):
     assert f"no rerun viewer is listening at {url}" in msg and path.exists()
 
 
-def test_serve_hosts_grpc_and_web_viewer(tmp_path):
+def test_serve_hosts_grpc_and_web_viewer(tmp_path, capsys):
     rec = open_recorder("serve", default_path=str(tmp_path / "unused.rrd"))
     try:
         assert rec.mode == "serve"
-        desc = rec._description
-        assert "rerun+http://" in desc and "http://localhost:" in desc
-        grpc_port = int(desc.split("rerun+http://")[1].split(":")[1].split("/")[0])
-        assert port_is_listening("127.0.0.1", grpc_port)
+        grpc = urlsplit(rec.live_url)
+        assert grpc.scheme == "rerun+http" and grpc.path == "/proxy"
+        assert port_is_listening("127.0.0.1", grpc.port)
+        web = urlsplit(rec.web_url)
+        assert port_is_listening("127.0.0.1", web.port)
+        assert parse_qs(web.query)["url"] == [rec.live_url]
+        assert rec.live_url in capsys.readouterr().err  # said when it starts
         rec.log_frame(frame(0))
     finally:
         msg = rec.close()

@@ -101,6 +101,8 @@ class Recorder:
         ``log_frame`` calls, and how many of them logged the camera images.
     viewer_pid : int or None
         The viewer process ``spawn`` started (it outlives the run), if any.
+    live_url, web_url : str or None
+        For ``serve``: the gRPC URL (``rerun URL`` opens it) and the web viewer's address.
     """
 
     def __init__(
@@ -126,6 +128,7 @@ class Recorder:
         self.frames_logged = 0
         self.images_logged = 0
         self.viewer_pid = None
+        self.live_url = self.web_url = None
         self._closed = False
         self._message = None
         self._ray = _DEFAULT_RAY
@@ -347,14 +350,17 @@ def open_recorder(mode, *, default_path, app_id="fpga_robotics", log_every=1, jp
     if parsed.kind == "save":
         tmp = attach_save(stream, parsed.path)
         return Recorder(stream, "save", path=parsed.path, temp_path=tmp, **options)
-    viewer_pid = None
+    viewer_pid = grpc_url = web_url = None
     try:
         if parsed.kind == "spawn":
             description, viewer_pid = attach_spawn(stream)
         elif parsed.kind == "connect":
             description = attach_connect(stream, parsed.url)
         else:
-            description = attach_serve(stream)
+            grpc_url, web_url, how = attach_serve(stream)
+            # Said now, not at the end: the point of serving is to watch while it runs.
+            print(f"fpga_robotics.viz: serving live: {how}", file=sys.stderr)
+            description = f"served live at {grpc_url} (closed at the end of the run)"
     except SinkUnavailable as exc:
         if parsed.path is None:
             raise UsageError(
@@ -365,5 +371,5 @@ def open_recorder(mode, *, default_path, app_id="fpga_robotics", log_every=1, jp
         tmp = attach_save(stream, parsed.path)
         return Recorder(stream, "save", path=parsed.path, temp_path=tmp, notice=notice, **options)
     rec = Recorder(stream, parsed.kind, description=description, **options)
-    rec.viewer_pid = viewer_pid
+    rec.viewer_pid, rec.live_url, rec.web_url = viewer_pid, grpc_url, web_url
     return rec

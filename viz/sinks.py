@@ -155,7 +155,10 @@ def _free_port():
 
 
 def attach_serve(stream, grpc_port=DEFAULT_VIEWER_PORT, web_port=DEFAULT_WEB_PORT):
-    """Host a gRPC server and the web viewer on localhost; returns how to open them."""
+    """Host a gRPC server and the web viewer on localhost.
+
+    Returns ``(grpc_url, web_url or None, how_to_open)``.
+    """
     # rerun's default ports may be taken by another run or viewer: then any free port.
     if port_is_listening(_LOCALHOST, grpc_port):
         grpc_port = _free_port()
@@ -168,12 +171,8 @@ def attach_serve(stream, grpc_port=DEFAULT_VIEWER_PORT, web_port=DEFAULT_WEB_POR
     try:
         rr.serve_web_viewer(web_port=web_port, open_browser=False, connect_to=url)
         web = f"http://localhost:{web_port}/?url={quote(url, safe='')}"
-        return (
-            f"served live: open {web} in a browser, or run `rerun {url}`; "
-            f"the server stops when this process exits"
-        )
+        how = f"open {web} in a browser, or run `rerun {url}`"
     except Exception as exc:  # noqa: BLE001 - the gRPC server still works without it
-        return (
-            f"served live at {url} (run `rerun {url}`); the web viewer could not start: {exc}; "
-            f"the server stops when this process exits"
-        )
+        web = None
+        how = f"run `rerun {url}` (the web viewer could not start: {exc})"
+    return url, web, how
