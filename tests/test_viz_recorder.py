@@ -11,6 +11,7 @@ import cv2
 import numpy as np
 import pytest
 
+from fpga_robotics.errors import UsageError
 from fpga_robotics.records import FrameRecord, PersonState, WorldMap
 from fpga_robotics.sim.backends.base import FrameResult
 from fpga_robotics.sim.frames import rgb444_to_rgb888
@@ -309,6 +310,13 @@ def test_file_appears_only_when_closed(tmp_path):
     assert rec.close() == msg  # closing twice is harmless
     with pytest.raises(RuntimeError, match="closed"):
         rec.log_frame(make_frames(1)[0])
+
+
+def test_unwritable_folder_is_a_usage_error(tmp_path):
+    blocker = tmp_path / "file"
+    blocker.write_text("not a folder")
+    with pytest.raises(UsageError, match="cannot write the recording"):
+        open_recorder(f"save:{blocker}/run.rrd", default_path=str(tmp_path / "d.rrd"))
 
 
 def test_context_manager_saves_on_error(tmp_path):

@@ -16,6 +16,7 @@ from urllib.parse import quote, urlsplit
 
 import rerun as rr
 
+from ..errors import UsageError
 from .modes import DEFAULT_VIEWER_PORT, DEFAULT_WEB_PORT, display_available, port_is_listening
 
 __all__ = ["SinkUnavailable", "attach_connect", "attach_save", "attach_serve", "attach_spawn"]
@@ -33,15 +34,21 @@ class SinkUnavailable(RuntimeError):
 def temp_path_for(path):
     """A hidden temporary file next to ``path`` (same file system, so the final rename is atomic)."""
     folder, name = os.path.split(os.path.abspath(path))
-    return os.path.join(folder, f".{name}.{uuid.uuid4().hex[:8]}.partial")
+    # Hidden, and still ending in .rrd: ignored by git like any recording, openable if salvaged.
+    return os.path.join(folder, f".{name}.{uuid.uuid4().hex[:8]}.partial.rrd")
 
 
 def attach_save(stream, path):
     """Stream to a temporary file beside ``path``; returns the temporary path (rename on close)."""
     folder = os.path.dirname(os.path.abspath(path))
-    os.makedirs(folder, exist_ok=True)
     tmp = temp_path_for(path)
-    stream.save(tmp)
+    try:
+        os.makedirs(folder, exist_ok=True)
+        with open(tmp, "wb"):  # fail here, with a clear message, if the folder is not writable
+            pass
+        stream.save(tmp)
+    except OSError as exc:
+        raise UsageError(f"cannot write the recording {path}: {exc.strerror or exc}") from None
     return tmp
 
 
