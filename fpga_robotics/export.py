@@ -1,6 +1,7 @@
 """Export ``FollowTarget`` as one self-contained Verilog file.
 
     python -m fpga_robotics.export -o build/follow_target.v [--width 320 --height 240 ...]
+    python -m fpga_robotics.export --board ulx3s-85f -o DIR [--bitstream]   (board top + LPF)
 
 Every ``FollowTargetParams`` field is an option (``--diff-min 5``, ``--base-dps 0,400,...``);
 a bad value prints what is wrong and exits with code 2.
@@ -15,6 +16,7 @@ from amaranth.back import verilog
 from amaranth.hdl import Const, Value, ValueCastable
 from amaranth.lib import wiring
 
+from .board_build import add_board_arguments, run_board
 from .errors import UsageError, run_cli
 from .hw.params import FollowTargetParams
 from .hw.top import FollowTarget
@@ -131,7 +133,9 @@ def build_parser():
     )
     parser.add_argument("-o", "--output", default=os.path.join("build", f"{TOP_NAME}.v"),
                         help="output Verilog file (default: %(default)s); its directory is "
-                             "created if missing")
+                             "created if missing; with --board: the output directory "
+                             "(default build/<board>)")
+    add_board_arguments(parser)
     add_param_arguments(parser)
     return parser
 
@@ -140,6 +144,13 @@ def main(argv=None):
     parser = build_parser()
     args = parser.parse_args(argv)  # a bad option: argparse's message and exit code 2
     params = params_from_args(args)
+    if args.board is not None:  # a board top instead (fpga_robotics.board_build)
+        out_dir = args.output
+        if out_dir == parser.get_default("output"):
+            out_dir = os.path.join("build", args.board)
+        return run_board(args, params, out_dir)
+    if args.bitstream:
+        raise UsageError("--bitstream needs --board NAME (e.g. --board ulx3s-85f)")
     text = generate_verilog(params)
     write_atomically(args.output, text)
     print(f"wrote {args.output} ({params.width}x{params.height}, module {TOP_NAME})")

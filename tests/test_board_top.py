@@ -2,6 +2,7 @@
 published pin, the PLL and switch logic are right, the CLI handles bad input, and (slow) the
 whole open flow (Yosys, nextpnr-ecp5, ecppack via YoWASP) meets timing."""
 
+import json
 import re
 import subprocess
 import sys
@@ -12,7 +13,6 @@ from amaranth.sim import Simulator
 from fpga_robotics.board_build import (
     BuildReport,
     ClockTiming,
-    build_bitstream,
     export_board,
     main,
     parse_nextpnr_report,
@@ -20,7 +20,6 @@ from fpga_robotics.board_build import (
 from fpga_robotics.errors import UsageError
 from fpga_robotics.hw.board.clocking import ecp5_pll_params
 from fpga_robotics.hw.board.color_select import SwitchColorSelect
-from fpga_robotics.hw.params import FollowTargetParams
 from fpga_robotics.hw.pixel import COLOR_SELECT
 
 # The published pin assignment (ulx3s_v20.lpf of the published robot), transcribed here
@@ -122,16 +121,34 @@ def test_report_parsing_and_timing_verdict():
     assert BuildReport(clocks=[ClockTiming("x", 50.0, 50.0)]).timing_ok
 
 
+def test_export_cli_board_option(tmp_path):
+    from fpga_robotics.export import main as export_main
+
+    assert export_main(["--board", "ulx3s-85f", "-o", str(tmp_path)]) == 0
+    assert (tmp_path / "ulx3s_follow_target.v").stat().st_size > 10_000
+    assert "LOCATE COMP" in (tmp_path / "ulx3s_follow_target.lpf").read_text()
+    with pytest.raises(UsageError, match="supported boards: ulx3s-85f"):
+        export_main(["--board", "ulx3s-12f", "-o", str(tmp_path / "x")])
+    with pytest.raises(UsageError, match="--bitstream needs --board"):
+        export_main(["--bitstream"])
+
+
 @pytest.mark.slow
 def test_bitstream_build_meets_timing(tmp_path):
-    """Full open flow on the real board top (about 2-3 minutes on 2 cores)."""
-    report = build_bitstream("ulx3s-85f", str(tmp_path), FollowTargetParams(), seed=1,
-                             log=lambda *_: None)
-    print(report.format())
+    """The full open flow on the real board top, through the documented command (about
+    2-3 minutes on 2 cores); nothing is cached, the build directory is fresh."""
+    proc = subprocess.run(
+        [sys.executable, "-m", "fpga_robotics.export", "--board", "ulx3s-85f", "-o",
+         str(tmp_path), "--bitstream", "--seed", "1"],
+        capture_output=True, text=True, timeout=1200, check=False)
+    print(proc.stdout, proc.stderr)
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    assert "PASS" in proc.stdout and "FAIL" not in proc.stdout
+    report = parse_nextpnr_report(
+        json.loads((tmp_path / "ulx3s_follow_target.report.json").read_text()))
     assert report.timing_ok, report.format()
-    assert {c.required_mhz for c in report.clocks} == {50.0, 12.5}
+    assert sorted(c.required_mhz for c in report.clocks) == [12.5, 50.0]
     assert report.resource("TRELLIS_COMB")[0] > 500
     assert report.resource("TRELLIS_FF")[0] > 200
     assert report.resource("EHXPLLL")[0] == 1
-    bit = tmp_path / "ulx3s_follow_target.bit"
-    assert bit.stat().st_size > 10_000
+    assert (tmp_path / "ulx3s_follow_target.bit").stat().st_size > 10_000
