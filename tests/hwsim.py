@@ -28,8 +28,12 @@ __all__ = [
     "edges_where",
     "frame_schedule",
     "lines_schedule",
+    "match_lines_schedule",
+    "match_transfer",
     "pack_transfer",
+    "run_follow_target",
     "run_schedule",
+    "small_params",
     "stream_get",
     "stream_put",
     "unpack_lanes",
@@ -226,3 +230,30 @@ def run_follow_target(dut, frames, color_sels, *, line_blank=0, frame_gap=0, tai
     }
     trace = run_schedule(dut, dut.pixels, schedule, probes, tail=tail)
     return trace, last_index
+
+
+def small_params(**changes):
+    """A small geometry for fast tests: 48x12, window 40x10 (8 bins of 5 columns), small
+    thresholds so that every proximity level occurs, ``lost_frames=3``."""
+    from fpga_robotics.hw.params import FollowTargetParams
+
+    values = {
+        "width": 48, "height": 12, "margin_x": 4, "margin_y": 1, "min_pixels": 8,
+        "proximity_thresholds": (8, 16, 32, 64, 128, 200, 300), "lost_frames": 3,
+    }
+    values.update(changes)
+    return FollowTargetParams(**values)
+
+
+def match_transfer(match, first=False, last=False):
+    """The ``MatchFlags`` payload: ``match`` bit 0, ``first`` bit 1, ``last`` bit 2."""
+    return int(bool(match)) | (int(first) << 1) | (int(last) << 2)
+
+
+def match_lines_schedule(lines, *, line_blank=0, first=True, gaps=None):
+    """Like ``lines_schedule`` for the tracker's match stream; ``lines`` hold bools."""
+    schedule = lines_schedule([[int(bool(v)) for v in line] for line in lines],
+                              line_blank=line_blank, first=first, gaps=gaps)
+    return [None if e is None else match_transfer(e & 1, (e >> FIRST_BIT) & 1,
+                                                  (e >> LAST_BIT) & 1)
+            for e in schedule]
