@@ -129,8 +129,8 @@ def run_schedule(dut, drive, schedule, probes, *, static=None, tail=64, watchdog
         ``(signal, value)`` set before that edge (other inputs), ``payload`` as above.
     probes : dict
         ``{name: value}`` to record after every edge.
-    static : dict
-        ``{signal: value}`` set once at the start (e.g. ``color_sel``).
+    static : list
+        ``(signal, value)`` pairs set once at the start (e.g. ``color_sel``).
     tail : int
         Idle edges after the schedule.
     watchdog : int
@@ -149,7 +149,7 @@ def run_schedule(dut, drive, schedule, probes, *, static=None, tail=64, watchdog
     done = []
 
     async def bench(ctx):
-        for signal, value in (static or {}).items():
+        for signal, value in static or ():
             ctx.set(signal, value)
         for t in range(total):
             entry = schedule[t] if t < len(schedule) else None
