@@ -18,13 +18,14 @@ the number of edges, so a hung design fails the test instead of hanging CI.
 from typing import NamedTuple
 
 import numpy as np
-from amaranth import Value
+from amaranth import ClockDomain, Elaboratable, Module, Signal, Value
 from amaranth.hdl import ValueCastable
 from amaranth.sim import Simulator
 
 __all__ = [
     "Step",
     "WatchdogTimeout",
+    "WithReset",
     "edges_where",
     "frame_schedule",
     "lines_schedule",
@@ -55,6 +56,22 @@ class Step(NamedTuple):
 
 class WatchdogTimeout(AssertionError):
     """The simulation ran longer than its watchdog allows."""
+
+
+class WithReset(Elaboratable):
+    """Wraps a design in an explicit ``sync`` domain whose reset a testbench can drive
+    (``ctx.set(wrapper.rst, 1)``)."""
+
+    def __init__(self, dut):
+        self.dut = dut
+        self.rst = Signal()
+
+    def elaborate(self, platform):
+        m = Module()
+        m.domains.sync = cd = ClockDomain("sync")
+        m.d.comb += cd.rst.eq(self.rst)
+        m.submodules.dut = self.dut
+        return m
 
 
 def _cast(value):
