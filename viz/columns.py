@@ -12,7 +12,17 @@ import time
 import numpy as np
 import rerun as rr
 
-__all__ = ["ColumnBuffer", "arrows", "images", "points", "scalars", "strips", "time_ns"]
+__all__ = [
+    "ColumnBuffer",
+    "arrows",
+    "images",
+    "jpegs",
+    "points",
+    "rgb_images",
+    "scalars",
+    "strips",
+    "time_ns",
+]
 
 #: Send when this many frames are buffered or this much wall time passed since the last send.
 MAX_FRAMES = 32
@@ -32,6 +42,22 @@ def scalars(rows):
 def images(rows):
     """Rows of equal-shape uint8 images -> ``Image`` buffer column (format logged static)."""
     return rr.Image.columns(buffer=np.stack(rows).reshape(len(rows), -1))
+
+
+def rgb_images(rows):
+    """Rows of RGB888 images (any sizes) -> ``Image`` buffer and format columns."""
+    formats = [
+        rr.components.ImageFormat(
+            width=r.shape[1], height=r.shape[0], color_model="RGB", channel_datatype="U8"
+        )
+        for r in rows
+    ]
+    return rr.Image.columns(buffer=[r.reshape(-1) for r in rows], format=formats)
+
+
+def jpegs(rows):
+    """Rows of JPEG bytes -> ``EncodedImage`` columns."""
+    return rr.EncodedImage.columns(blob=rows, media_type=["image/jpeg"] * len(rows))
 
 
 def arrows(rows):
@@ -65,7 +91,11 @@ class _Rows:
 
 
 class ColumnBuffer:
-    """Buffer rows per entity path; ``builders[path](rows)`` turns them into columns."""
+    """Buffer rows per key; ``builders[key](rows)`` turns them into columns.
+
+    A key is an entity path, or ``(path, variant)`` when one entity takes rows of different
+    kinds (raw or JPEG images): each variant is sent as its own columns.
+    """
 
     def __init__(self, stream, builders):
         self._stream = stream
@@ -87,17 +117,17 @@ class ColumnBuffer:
             self.flush()
 
     def flush(self):
-        for path, r in self._rows.items():
+        for key, r in self._rows.items():
             if not r.frames:
                 continue
             self._stream.send_columns(
-                path,
+                key if isinstance(key, str) else key[0],
                 indexes=[
                     rr.TimeColumn("frame", sequence=r.frames),
                     rr.TimeColumn("sim_time", duration=np.array(r.times, dtype="timedelta64[ns]")),
                 ],
-                columns=self._builders[path](r.data),
+                columns=self._builders[key](r.data),
             )
-            self._rows[path] = _Rows()
+            self._rows[key] = _Rows()
         self._frames = 0
         self._last_send = time.monotonic()

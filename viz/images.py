@@ -1,8 +1,7 @@
-"""Frames to rerun images: raw for small frames, JPEG above, and the design's RGB444 output."""
+"""Frames to logged images: raw for small frames, JPEG above; the design's RGB444 as RGB888."""
 
 import cv2
 import numpy as np
-import rerun as rr
 
 from ..errors import UsageError
 from ..sim.frames import rgb444_to_rgb888
@@ -12,7 +11,6 @@ __all__ = [
     "RAW_MAX_PIXELS",
     "check_jpeg_quality",
     "filtered_rgb",
-    "image_archetype",
     "uses_jpeg",
 ]
 
@@ -43,19 +41,19 @@ def uses_jpeg(width, height, quality):
     return quality > 0
 
 
-def image_archetype(rgb, quality):
-    """``rr.Image`` of an RGB888 frame, or ``rr.EncodedImage`` (JPEG) when ``uses_jpeg``."""
+def encode_frame(rgb, quality):
+    """``("raw", a private copy of rgb)`` or ``("jpeg", bytes)`` when ``uses_jpeg``.
+
+    The copy matters: the row is sent a few frames later, and the caller may reuse its array.
+    """
     h, w = rgb.shape[:2]
-    if not uses_jpeg(w, h, quality):
-        return rr.Image(rgb, color_model="RGB")
-    q = AUTO_JPEG_QUALITY if quality is None else quality
-    # OpenCV encodes BGR; it is several times faster than Pillow (rr.Image.compress).
-    ok, buf = cv2.imencode(
-        ".jpg", cv2.cvtColor(rgb, cv2.COLOR_RGB2BGR), [cv2.IMWRITE_JPEG_QUALITY, q]
-    )
-    if not ok:
-        return rr.Image(rgb, color_model="RGB")
-    return rr.EncodedImage(contents=buf.tobytes(), media_type="image/jpeg")
+    if uses_jpeg(w, h, quality):
+        q = AUTO_JPEG_QUALITY if quality is None else quality
+        bgr = cv2.cvtColor(rgb, cv2.COLOR_RGB2BGR)
+        ok, buf = cv2.imencode(".jpg", bgr, [cv2.IMWRITE_JPEG_QUALITY, q])
+        if ok:
+            return "jpeg", buf.tobytes()
+    return "raw", np.array(rgb, dtype=np.uint8, order="C", copy=True)
 
 
 def filtered_rgb(packed):

@@ -24,8 +24,18 @@ import rerun as rr
 from ..errors import UsageError
 from . import paths as P
 from .blueprint import default_blueprint
-from .columns import ColumnBuffer, arrows, images, points, scalars, strips, time_ns
-from .images import check_jpeg_quality, filtered_rgb, image_archetype
+from .columns import (
+    ColumnBuffer,
+    arrows,
+    images,
+    jpegs,
+    points,
+    rgb_images,
+    scalars,
+    strips,
+    time_ns,
+)
+from .images import check_jpeg_quality, encode_frame, filtered_rgb
 from .leds import centroid_image, proximity_image
 from .modes import parse_mode
 from .sinks import (
@@ -54,6 +64,10 @@ _SERIES_COLORS = {
     P.TARGET_DISTANCE: [(255, 110, 110)],
 }
 _COLUMN_BUILDERS = {
+    (P.CAMERA_RAW, "raw"): rgb_images,
+    (P.CAMERA_RAW, "jpeg"): jpegs,
+    (P.CAMERA_FILTERED, "raw"): rgb_images,
+    (P.CAMERA_FILTERED, "jpeg"): jpegs,
     P.LEDS_PROXIMITY: images,
     P.LEDS_CENTROID: images,
     P.DESIGN_TRACKING: scalars,
@@ -208,15 +222,17 @@ class Recorder:
         def add(path, row):
             self._columns.add(path, frame, t, row)
 
-        if frame % self.log_every == 0 or record.events:
+        if frame % self.log_every == 0:
+            q = self.jpeg_quality
+            kind, data = encode_frame(record.camera_rgb, q)
+            add((P.CAMERA_RAW, kind), data)
+            kind, data = encode_frame(filtered_rgb(res.filtered), q)
+            add((P.CAMERA_FILTERED, kind), data)
+            self.images_logged += 1
+        if record.events:
             s = self._stream
             s.set_time("frame", sequence=frame)
             s.set_time("sim_time", duration=t)
-            if frame % self.log_every == 0:
-                s.log(P.CAMERA_RAW, image_archetype(record.camera_rgb, self.jpeg_quality))
-                filtered = filtered_rgb(res.filtered)
-                s.log(P.CAMERA_FILTERED, image_archetype(filtered, self.jpeg_quality))
-                self.images_logged += 1
             for text in record.events:
                 s.log(P.EVENTS, rr.TextLog(str(text), level=_event_level(str(text))))
 
