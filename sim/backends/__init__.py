@@ -17,14 +17,14 @@ from .base import BackendError, DesignBackend, FrameResult, WaveformRequest
 __all__ = [
     "BACKEND_NAMES",
     "COMPILED_BACKENDS",
-    "get_backend",
-    "backend_class",
-    "available_backends",
-    "fastest_backend_name",
     "BackendError",
     "DesignBackend",
     "FrameResult",
     "WaveformRequest",
+    "available_backends",
+    "backend_class",
+    "fastest_backend_name",
+    "get_backend",
 ]
 
 #: Every backend name, in the order of a typical speed ranking (slowest last is not implied).
@@ -43,9 +43,7 @@ _CLASSES = {
 def backend_class(name):
     """The ``DesignBackend`` subclass called ``name``; ``ValueError`` for an unknown name."""
     if name not in _CLASSES:
-        raise ValueError(
-            f"unknown backend {name!r}; choose one of: {', '.join(BACKEND_NAMES)}"
-        )
+        raise ValueError(f"unknown backend {name!r}; choose one of: {', '.join(BACKEND_NAMES)}")
     module, cls = _CLASSES[name]
     return getattr(importlib.import_module(f".{module}", __name__), cls)
 

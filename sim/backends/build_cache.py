@@ -23,7 +23,7 @@ from pathlib import Path
 
 from .base import BackendError
 
-__all__ = ["CACHE_ENV", "cache_root", "build_key", "CacheEntry", "get_or_build", "invalidate"]
+__all__ = ["CACHE_ENV", "CacheEntry", "build_key", "cache_root", "get_or_build", "invalidate"]
 
 CACHE_ENV = "FPGA_ROBOTICS_CACHE"
 _MANIFEST = "manifest.json"

@@ -6,9 +6,12 @@ Subclasses say how to build the library (``_build``) for a ``DesignSource`` and 
 with a waveform writer, made only when a ``WaveformRequest`` asks for it).
 """
 
+import contextlib
 import ctypes
 import os
+from collections.abc import Callable
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 
@@ -16,10 +19,12 @@ from . import build_cache
 from .base import BackendError, DesignBackend, FrameResult
 from .designs import DesignSource
 
-__all__ = ["CompiledBackend", "HARNESS_DIR", "ABI_VERSION"]
+__all__ = ["ABI_VERSION", "HARNESS_DIR", "LIBRARY_NAME", "BuildPlan", "CompiledBackend"]
 
 #: Directory of the C++ harness sources (package data).
 HARNESS_DIR = Path(__file__).resolve().parent
+#: File name of the harness library in a cache entry.
+LIBRARY_NAME = "libfollow_target.so"
 #: Must match ``fr::ABI_VERSION`` in frame_driver.h.
 ABI_VERSION = 1
 
@@ -35,6 +40,15 @@ _STATUS = {
 }
 
 _VP = ctypes.c_void_p
+
+
+class BuildPlan(NamedTuple):
+    """Arguments of ``build_cache.get_or_build``: entry name, key, files and build function."""
+
+    name: str
+    key: str
+    files: list
+    build: Callable
 
 
 class _Library:
@@ -85,10 +99,10 @@ class CompiledBackend(DesignBackend):
     #: Waveform formats (file suffixes) this flow can write.
     waveform_formats = (".vcd",)
 
-    def __init__(self, params=None, *, line_blank=0, frame_blank=0, waveform=None,
-                 design="follow_target"):
-        super().__init__(params, line_blank=line_blank, frame_blank=frame_blank,
-                         waveform=waveform)
+    def __init__(
+        self, params=None, *, line_blank=0, frame_blank=0, waveform=None, design="follow_target"
+    ):
+        super().__init__(params, line_blank=line_blank, frame_blank=frame_blank, waveform=waveform)
         self.source = DesignSource(self.params, design)
         variant = "plain"
         if waveform is not None:
@@ -136,19 +150,20 @@ class CompiledBackend(DesignBackend):
         """Build (or find in the cache) and load the library; a damaged entry that passes the
         manifest check but does not load is rebuilt once."""
         for attempt in range(2):
-            entry = self._build_entry(variant)
+            entry = build_cache.get_or_build(*self.build_plan(self.source, variant))
+            #: The cache entry in use (``built`` tells whether this construction built it).
+            self.cache_entry = entry
             try:
-                return _Library(entry.file(self.library_name))
+                return _Library(entry.file(LIBRARY_NAME))
             except BackendError:
                 if attempt or entry.built:
                     raise
                 build_cache.invalidate(entry)
         raise AssertionError("unreachable")
 
-    library_name = "libfollow_target.so"
-
-    def _build_entry(self, variant):
-        """Return the ``CacheEntry`` holding ``library_name`` for this design and variant."""
+    @staticmethod
+    def build_plan(source, variant):
+        """``BuildPlan`` of the library ``LIBRARY_NAME`` for a ``DesignSource`` and variant."""
         raise NotImplementedError
 
     # Running -----------------------------------------------------------------------------------
@@ -219,7 +234,6 @@ class CompiledBackend(DesignBackend):
             self._handle = None
 
     def __del__(self):
-        try:
+        # Interpreter shutdown may have torn down ctypes or os already: nothing to save then.
+        with contextlib.suppress(AttributeError, TypeError, OSError, BackendError):
             self.close()
-        except Exception:
-            pass

@@ -7,18 +7,28 @@ import hashlib
 import re
 
 from . import build_cache
-from .compiled import ABI_VERSION, HARNESS_DIR, CompiledBackend
+from .base import BackendError
+from .compiled import ABI_VERSION, HARNESS_DIR, LIBRARY_NAME, BuildPlan, CompiledBackend
 from .toolchain import cxxrtl_include_dir, find_compiler, run_tool
 
-__all__ = ["CxxrtlBackend", "CXX_FLAGS", "output_sources", "ports_header"]
+__all__ = ["CXX_FLAGS", "CxxrtlBackend", "cxxrtl_build_plan", "output_sources", "ports_header"]
 
 #: Compiler flags of the model. -O2 measured fastest here (-O3 was several times slower);
 #: -fvisibility=hidden lets the compiler treat the model as private to the library.
 CXX_FLAGS = ("-std=c++17", "-O2", "-fPIC", "-fvisibility=hidden", "-shared")
 
 _HARNESS_FILES = ("cxxrtl_harness.cpp", "frame_driver.h")
-_OUTPUTS = ("filtered__valid", "filtered__payload", "frame_done", "found", "proximity",
-            "centroid_x", "centroid_leds", "motor_left", "motor_right")
+_OUTPUTS = (
+    "filtered__valid",
+    "filtered__payload",
+    "frame_done",
+    "found",
+    "proximity",
+    "centroid_x",
+    "centroid_leds",
+    "motor_left",
+    "motor_right",
+)
 
 
 def _mangle(name):
@@ -27,7 +37,7 @@ def _mangle(name):
 
 
 def _eval_body(source):
-    body = source[source.index("::eval(performer *performer) {"):]
+    body = source[source.index("::eval(performer *performer) {") :]
     return body[: body.index("\n}\n")]
 
 
@@ -65,8 +75,8 @@ def output_sources(source):
         if re.search(rf"/\*output\*/ wire<\d+> {mangled};", source):
             sources[port] = mangled
             continue
-        found = re.findall(rf"^\t{mangled} = (p_\w+)\.curr;$", body, re.M)
-        if len(found) != 1 or len(re.findall(rf"^\s*{mangled} = ", body, re.M)) != 1:
+        found = re.findall(rf"^\t{mangled} = (p_\w+)\.curr;$", body, re.MULTILINE)
+        if len(found) != 1 or len(re.findall(rf"^\s*{mangled} = ", body, re.MULTILINE)) != 1:
             return None
         sources[port] = found[0]
     if _edge_only_wires(source, set(sources.values())) != set(sources.values()):
@@ -86,46 +96,62 @@ def ports_header(source):
     return "\n".join(lines) + "\n"
 
 
+def cxxrtl_build_plan(design, variant, flags=None):
+    """The ``BuildPlan`` of a ``DesignSource`` in variant ``"plain"`` or ``"vcd"``;
+    ``flags`` replaces ``CXX_FLAGS``."""
+    compiler = find_compiler()
+    include = cxxrtl_include_dir()
+    source = design.cxxrtl()
+    if "struct p_follow__target" not in source:
+        raise BackendError("the CXXRTL output has no p_follow__target module")
+    header = ports_header(source)
+    flags = list(CXX_FLAGS if flags is None else flags)
+    if variant != "plain":
+        flags.append("-DFR_TRACE")
+    harness = {f: (HARNESS_DIR / f).read_text() for f in _HARNESS_FILES}
+    key = build_cache.build_key(
+        {
+            "flow": "cxxrtl",
+            "abi": ABI_VERSION,
+            "source": hashlib.sha256((source + header).encode()).hexdigest(),
+            "harness": {f: hashlib.sha256(t.encode()).hexdigest() for f, t in harness.items()},
+            "params": design.params.as_dict(),
+            "design": design.design,
+            "flags": flags,
+            "compiler": compiler.version,
+            "runtime": str(include),
+        }
+    )
+
+    def build(directory):
+        (directory / "design.cc").write_text(source)
+        (directory / "fr_ports.h").write_text(header)
+        for name, text in harness.items():
+            (directory / name).write_text(text)
+        run_tool(
+            [
+                compiler.path,
+                *flags,
+                f"-I{directory}",
+                f"-I{include}",
+                directory / "cxxrtl_harness.cpp",
+                "-o",
+                directory / LIBRARY_NAME,
+            ],
+            cwd=directory,
+            what=f"compiling the CXXRTL model ({compiler.path})",
+        )
+
+    return BuildPlan(f"cxxrtl-{design.design}-{variant}", key, [LIBRARY_NAME], build)
+
+
 class CxxrtlBackend(CompiledBackend):
-    """``FollowTarget`` compiled with CXXRTL. See ``CompiledBackend`` for the parameters."""
+    """``FollowTarget`` compiled with CXXRTL. See ``CompiledBackend`` for the parameters;
+    waveforms are ``.vcd`` (CXXRTL's VCD writer)."""
 
     name = "cxxrtl"
     waveform_formats = (".vcd",)
 
-    def _build_entry(self, variant):
-        compiler = find_compiler()
-        include = cxxrtl_include_dir()
-        source = self.source.cxxrtl()
-        if "struct p_follow__target" not in source:
-            raise RuntimeError("the CXXRTL output has no p_follow__target module")
-        header = ports_header(source)
-        flags = list(CXX_FLAGS) + (["-DFR_TRACE"] if variant != "plain" else [])
-        harness = {f: (HARNESS_DIR / f).read_text() for f in _HARNESS_FILES}
-        key = build_cache.build_key(
-            {
-                "flow": "cxxrtl",
-                "abi": ABI_VERSION,
-                "source": hashlib.sha256((source + header).encode()).hexdigest(),
-                "harness": {f: hashlib.sha256(t.encode()).hexdigest() for f, t in harness.items()},
-                "params": self.params.as_dict(),
-                "design": self.source.design,
-                "flags": flags,
-                "compiler": compiler.version,
-                "runtime": str(include),
-            }
-        )
-
-        def build(directory):
-            (directory / "design.cc").write_text(source)
-            (directory / "fr_ports.h").write_text(header)
-            for name, text in harness.items():
-                (directory / name).write_text(text)
-            run_tool(
-                [compiler.path, *flags, f"-I{directory}", f"-I{include}",
-                 directory / "cxxrtl_harness.cpp", "-o", directory / self.library_name],
-                cwd=directory,
-                what=f"compiling the CXXRTL model ({compiler.path})",
-            )
-
-        name = f"cxxrtl-{self.source.design}-{variant}"
-        return build_cache.get_or_build(name, key, [self.library_name], build)
+    @staticmethod
+    def build_plan(design, variant):
+        return cxxrtl_build_plan(design, variant)

@@ -3,11 +3,13 @@ simulates) and ``PassThrough`` (the benchmark's one-pixel-per-clock reference). 
 port list of hw-spec.md, so one harness drives either.
 """
 
+import functools
+
 from amaranth.hdl import Const, Value, ValueCastable
 
 from ...hw.params import FollowTargetParams
 
-__all__ = ["DESIGNS", "DesignSource", "TOP_NAME", "component_ports"]
+__all__ = ["DESIGNS", "TOP_NAME", "DesignSource", "component_ports"]
 
 #: Module name of the top in the generated Verilog and C++.
 TOP_NAME = "follow_target"
@@ -66,6 +68,13 @@ class DesignSource:
 
     def verilog(self):
         """Verilog text, top module ``follow_target``."""
+        return _generated(self.params, self.design, "verilog")
+
+    def cxxrtl(self):
+        """CXXRTL C++ text (``amaranth.back.cxxrtl``), top class ``p_follow__target``."""
+        return _generated(self.params, self.design, "cxxrtl")
+
+    def _verilog(self):
         if self.design == "follow_target":
             from ...export import generate_verilog
 
@@ -75,8 +84,7 @@ class DesignSource:
         top = self.component()
         return verilog.convert(top, name=TOP_NAME, ports=component_ports(top), emit_src=False)
 
-    def cxxrtl(self):
-        """CXXRTL C++ text (``amaranth.back.cxxrtl``), top class ``p_follow__target``."""
+    def _cxxrtl(self):
         from amaranth.back import cxxrtl
 
         top = self.component()
@@ -92,3 +100,11 @@ class DesignSource:
             pixel_edges - line_blank + self.result_latency + self.motor_latency,
         )
         return expected + 4 * (self.result_latency + self.motor_latency) + 4096
+
+
+@functools.lru_cache(maxsize=16)
+def _generated(params, design, language):
+    """Generated source text, kept per process: elaboration and Yosys take a second or two,
+    and a cached build still needs the source to check its key."""
+    source = DesignSource(params, design)
+    return source._verilog() if language == "verilog" else source._cxxrtl()

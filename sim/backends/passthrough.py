@@ -95,4 +95,3 @@ class PassThrough(wiring.Component):
                     # The count including the pixel being sampled.
                     m.d.sync += [ended.eq(1), total.eq(Mux(pix.first, 1, count + 1))]
         return m
-

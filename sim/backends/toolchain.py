@@ -16,12 +16,12 @@ from .base import BackendError
 
 __all__ = [
     "Compiler",
+    "cxxrtl_include_dir",
     "find_compiler",
     "find_make",
+    "run_tool",
     "verilator_root",
     "verilator_version",
-    "cxxrtl_include_dir",
-    "run_tool",
 ]
 
 _INSTALL_HINT = (
@@ -59,7 +59,7 @@ def find_compiler():
     return Compiler(path, _compiler_version(path))
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def _compiler_version(path):
     try:
         out = subprocess.run(
@@ -111,15 +111,14 @@ def verilator_version():
 
 def cxxrtl_include_dir():
     """The CXXRTL runtime headers shipped with Amaranth's builtin Yosys."""
-    from amaranth._toolchain.yosys import find_yosys
+    from amaranth._toolchain.yosys import YosysError, find_yosys
 
     try:
         yosys = find_yosys(lambda ver: ver >= (0, 40))
         share = Path(yosys.data_dir())
-    except Exception as exc:  # amaranth raises its own YosysError
+    except YosysError as exc:
         raise BackendError(
-            f"no Yosys with the CXXRTL runtime found ({exc}); install "
-            f"`amaranth[builtin-yosys]`"
+            f"no Yosys with the CXXRTL runtime found ({exc}); install `amaranth[builtin-yosys]`"
         ) from None
     include = share / "include" / "backends" / "cxxrtl" / "runtime"
     if not (include / "cxxrtl" / "cxxrtl.h").exists():
@@ -132,6 +131,7 @@ def run_tool(argv, *, cwd, env=None, what):
     try:
         proc = subprocess.run(
             [str(a) for a in argv],
+            check=False,
             cwd=cwd,
             env=env,
             stdout=subprocess.PIPE,
