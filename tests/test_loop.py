@@ -186,3 +186,32 @@ def test_a_looser_colour_filter_takes_the_divider_for_the_person():
     assert good.summary["target_in_view_fraction"] > 0.95
     assert loose.summary["target_in_view_fraction"] < 0.7
     assert loose.summary["verdict"] == "fail" and good.summary["verdict"] == "pass"
+
+
+@pytest.mark.slow
+def test_a_compiled_backend_drives_the_robot_exactly_as_the_model_does():
+    """The compiled design is bit exact, so the whole closed loop must be identical."""
+    from fpga_robotics.sim.backends import (
+        COMPILED_BACKENDS,
+        BackendError,
+        available_backends,
+        get_backend,
+    )
+
+    names = [n for n in COMPILED_BACKENDS if n in available_backends()]
+    if not names:
+        pytest.skip("no C++ compiler / verilator here: no compiled backend")
+    s = load_scenario("lost_target", ["sim.duration=6"])
+    try:
+        design = get_backend(names[0], s.params)
+    except BackendError as exc:
+        pytest.skip(f"{names[0]} cannot build here: {exc}")
+    with design:
+        compiled = run_scenario(s, seed=2, backend=design)
+    model = run_scenario(s, seed=2, backend="model")
+    assert compiled.summary["backend"] == names[0]
+    assert compiled.events == model.events
+    for name in TRAJECTORY_FIELDS:
+        assert np.array_equal(compiled.trajectory[name], model.trajectory[name],
+                              equal_nan=True), name
+    assert "search started" in [e for _, _, e in compiled.events]

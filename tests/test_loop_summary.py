@@ -1,0 +1,144 @@
+"""Metrics and checks from hand-made trajectories, and the progress bar."""
+
+import io
+
+import numpy as np
+import pytest
+
+from fpga_robotics.run import Progress, write_json_atomic
+from fpga_robotics.summary import compute_metrics, evaluate_checks, format_summary, verdict
+
+PERIOD = 0.1
+
+
+def trajectory(found, dist, in_view=None, x=None):
+    n = len(found)
+    return {
+        "t": np.arange(n) * PERIOD,
+        "x": np.zeros(n) if x is None else np.asarray(x, float),
+        "y": np.zeros(n),
+        "found": np.asarray(found, bool),
+        "target_distance": np.asarray(dist, float),
+        "target_in_view": np.ones(n, bool) if in_view is None else np.asarray(in_view, bool),
+    }
+
+
+def test_distances_fractions_and_path():
+    tr = trajectory([0, 1, 1, 0], [2.0, 1.0, np.nan, 3.0], in_view=[1, 1, 0, 0],
+                    x=[0.0, 0.3, 0.7, 0.7])
+    m = compute_metrics(tr, [], {"person": 1, "wall": 0}, PERIOD)
+    assert m["min_distance_m"] == 1.0 and m["mean_distance_m"] == 2.0  # NaN ignored
+    assert m["target_in_view_fraction"] == 0.5 and m["found_fraction"] == 0.5
+    assert m["acquired_at_s"] == pytest.approx(0.1)
+    assert m["found_after_acquisition_fraction"] == pytest.approx(2 / 3, abs=1e-4)
+    assert m["path_length_m"] == pytest.approx(0.7)
+    assert m["collisions"] == {"person": 1, "wall": 0}
+
+
+def test_no_target_at_all():
+    m = compute_metrics(trajectory([0, 0], [np.nan, np.nan]), [], {}, PERIOD)
+    assert m["min_distance_m"] is None and m["acquired_at_s"] is None
+    checks = evaluate_checks({"acquired_within_s": 1.0, "mean_distance_max_m": 2.0}, m)
+    assert [c["passed"] for c in checks] == [False, False]
+    assert "never found" in checks[0]["text"]
+
+
+def events(*items):
+    return [(round(t / PERIOD), t, text) for t, text in items]
+
+
+def test_loss_episodes_and_reacquisition():
+    tr = trajectory([1] * 100, [1.0] * 100)
+    ev = events((0.0, "target found"), (2.0, "target lost"), (3.5, "search started"),
+                (4.0, "target found"), (6.0, "target lost"), (6.5, "target found"))
+    m = compute_metrics(tr, ev, {}, PERIOD)
+    assert m["losses"] == 2 and m["searched_losses"] == 1 and m["searches"] == 1
+    assert m["reacquire_times_s"] == [2.0, 0.5] and m["unrecovered_losses_s"] == []
+    (c,) = evaluate_checks({"reacquired_within_s": 3.0}, m)
+    assert c["passed"] and c["value"] == 2.0
+    (c,) = evaluate_checks({"reacquired_within_s": 1.5}, m)
+    assert not c["passed"]
+
+
+def test_reacquisition_needs_a_search_that_ended():
+    tr = trajectory([1] * 100, [1.0] * 100)  # 10 s
+    short = compute_metrics(tr, events((0.0, "target found"), (2.0, "target lost"),
+                                       (2.2, "target found")), {}, PERIOD)
+    (c,) = evaluate_checks({"reacquired_within_s": 5.0}, short)
+    assert not c["passed"] and "never lost long enough" in c["text"]
+    open_end = compute_metrics(tr, events((0.0, "target found"), (8.0, "target lost"),
+                                          (9.5, "search started")), {}, PERIOD)
+    assert open_end["unrecovered_losses_s"] == [2.0]  # run ends at 10.0 s
+    (c,) = evaluate_checks({"reacquired_within_s": 5.0}, open_end)
+    assert not c["passed"] and "ended before" in c["text"]
+    (c,) = evaluate_checks({"reacquired_within_s": 1.0}, open_end)
+    assert not c["passed"] and "not found again for 2.00 s" in c["text"]
+
+
+def test_each_check_compares_with_its_limit():
+    m = compute_metrics(trajectory([1, 1, 1, 1], [1.0, 0.8, 0.6, 1.4], in_view=[1, 1, 1, 0]),
+                        [], {"person": 0, "wall": 2, "furniture": 0}, PERIOD)
+    limits = {
+        "acquired_within_s": 0.0,
+        "mean_distance_max_m": 0.9,       # mean 0.95: fails
+        "min_distance_min_m": 0.6,        # min 0.6: passes (inclusive)
+        "max_person_collisions": 0,
+        "max_wall_collisions": 1,          # 2: fails
+        "max_furniture_collisions": 0,
+        "target_in_view_min_fraction": 0.75,
+        "found_min_fraction": 1.0,
+    }
+    checks = evaluate_checks(limits, m)
+    assert [c["name"] for c in checks] == list(limits)
+    assert {c["name"]: c["passed"] for c in checks} == {
+        "acquired_within_s": True, "mean_distance_max_m": False, "min_distance_min_m": True,
+        "max_person_collisions": True, "max_wall_collisions": False,
+        "max_furniture_collisions": True, "target_in_view_min_fraction": True,
+        "found_min_fraction": True,
+    }
+    assert verdict(checks) == "fail" and verdict([c for c in checks if c["passed"]]) == "pass"
+    assert verdict([]) == "pass"
+
+
+def test_human_summary_mentions_failures():
+    m = compute_metrics(trajectory([1, 1], [1.0, 1.0]), [], {"person": 1}, PERIOD)
+    checks = evaluate_checks({"max_person_collisions": 0}, m)
+    s = {"scenario": "x", "backend": "model", "resolution": "160x120", "seed": 0,
+         "frames": 2, "sim_time_s": 0.2, "wall_time_s": 0.01, "ms_per_frame": 5.0,
+         "realtime_factor": 20.0, **m, "checks": checks, "verdict": verdict(checks)}
+    text = format_summary(s)
+    assert "[FAIL] max_person_collisions: 1 collision(s) with person" in text
+    assert text.endswith("verdict: FAIL")
+
+
+class FakeTTY(io.StringIO):
+    def isatty(self):
+        return True
+
+
+def test_progress_redraws_in_place_on_a_terminal_and_prints_lines_otherwise():
+    tty = FakeTTY()
+    p = Progress("run", stream=tty)
+    for k in range(1, 11):
+        p._last_draw = 0.0  # do not throttle in the test
+        p(k, 10)
+    p.finish()
+    out = tty.getvalue()
+    assert out.count("\r") == 10 and "10/10 frames" in out and out.endswith("\n")
+    plain = io.StringIO()
+    p = Progress("run", stream=plain)
+    for k in range(1, 101):
+        p(k, 100)
+    lines = plain.getvalue().splitlines()
+    assert "\r" not in plain.getvalue()
+    assert lines[0].startswith("run: 0%") and lines[-1] == "run: 100% (100/100 frames)"
+    assert len(lines) == 6
+
+
+def test_write_json_atomic_leaves_nothing_behind_on_failure(tmp_path):
+    path = tmp_path / "s.json"
+    write_json_atomic(path, {"a": 1})
+    with pytest.raises(TypeError):
+        write_json_atomic(path, {"a": object()})
+    assert path.read_text().strip().replace(" ", "").replace("\n", "") == '{"a":1}'
+    assert list(tmp_path.iterdir()) == [path]
