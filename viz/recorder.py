@@ -82,6 +82,7 @@ _COLUMN_BUILDERS = {
     P.TRAIL_ROBOT: strips,
     P.TRAIL_TARGET: strips,
 }
+_FLUSH_TIMEOUT_S = 15.0  # at close: a viewer that went away must not hang the run for long
 _DEFAULT_RAY = 1.0  # length of the field-of-view rays when no world map gave a scale, m
 
 
@@ -296,9 +297,12 @@ class Recorder:
             self._message = "viewer off: nothing was recorded"
             return self._message
         s = self._stream
+        problem = None
         try:
             self._columns.flush()
-            s.flush(timeout_sec=30.0)
+            s.flush(timeout_sec=_FLUSH_TIMEOUT_S)
+        except Exception as exc:  # noqa: BLE001 - e.g. a viewer closed mid-run: say so
+            problem = f"not everything may have arrived ({type(exc).__name__}: {exc})"
         finally:
             s.disconnect()
         frames = f"{self.frames_logged} frames ({self.images_logged} with images)"
@@ -314,6 +318,8 @@ class Recorder:
             msg = f"{self._description}: {frames}"
         if self.notice:
             msg = f"{self.notice}; {msg}"
+        if problem:
+            msg = f"{msg}; {problem}"
         self._message = msg
         return msg
 
