@@ -18,6 +18,7 @@ from fpga_robotics.sim.frames import rgb444_to_rgb888
 from fpga_robotics.viz import open_recorder
 from fpga_robotics.viz import paths as P
 from fpga_robotics.viz.leds import CELL, GAP, cell_centre
+from fpga_robotics.viz.readback import main as readback_main
 from fpga_robotics.viz.readback import read_rrd
 
 PER_FRAME = [
@@ -358,3 +359,13 @@ def test_off_records_nothing(tmp_path):
         rec.log_frame(f)
     assert "nothing was recorded" in rec.close()
     assert not path.exists()
+
+
+def test_readback_summary(saved, capsys):
+    path = saved[0]
+    assert readback_main([str(path)]) == 0
+    out = capsys.readouterr().out
+    assert "12 frames" in out and "blueprints: 1" in out
+    assert f"{P.MOTORS_DPS:22s}     12 rows" in out
+    with pytest.raises(UsageError):
+        readback_main([])
