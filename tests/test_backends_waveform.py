@@ -1,0 +1,115 @@
+"""Waveforms on demand from the compiled backends: only the requested frames, every port in
+the file, and nothing traced (a different build) when no waveform is asked for."""
+
+import struct
+
+import numpy as np
+import pytest
+
+from fpga_robotics.hw.params import FollowTargetParams
+from fpga_robotics.sim import synthetic
+from fpga_robotics.sim.backends import BackendError, WaveformRequest, get_backend
+
+PARAMS = FollowTargetParams(
+    width=40, height=16, min_pixels=4, proximity_thresholds=(4, 8, 16, 32, 64, 96, 128)
+)
+PORTS = {
+    "clk", "rst", "pixels__valid", "pixels__payload", "color_sel", "filtered__valid",
+    "filtered__payload", "frame_done", "found", "proximity", "centroid_x", "centroid_leds",
+    "motor_left", "motor_right",
+}
+
+
+def read_vcd(path):
+    """``(names by id code, {id code: [(time, value)]}, [times])`` of a VCD file."""
+    names, changes, times = {}, {}, []
+    time = None
+    in_header = True
+    with open(path) as f:
+        for line in f:
+            tokens = line.split()
+            if not tokens:
+                continue
+            if in_header:
+                if tokens[0] == "$var":
+                    code, name = tokens[3], tokens[4]
+                    names.setdefault(code, set()).add(name)
+                elif tokens[0] == "$enddefinitions":
+                    in_header = False
+                continue
+            if tokens[0].startswith("#"):
+                time = int(tokens[0][1:])
+                times.append(time)
+            elif tokens[0][0] in "01xz" and len(tokens) == 1:
+                changes.setdefault(tokens[0][1:], []).append((time, tokens[0][0]))
+            elif tokens[0][0] == "b" and len(tokens) == 2:
+                changes.setdefault(tokens[1], []).append((time, tokens[0][1:]))
+    return names, changes, times
+
+
+def frames():
+    rng = np.random.default_rng(5)
+    return synthetic.scenario("centre", 40, 16, n_frames=4, rng=rng).frames
+
+
+@pytest.mark.parametrize("name", ["cxxrtl", "verilator"])
+def test_vcd_holds_the_ports_and_only_the_requested_frames(name, tmp_path):
+    path = tmp_path / "wave" / f"{name}.vcd"
+    with get_backend(name, PARAMS, waveform=WaveformRequest(str(path), 1, 2)) as b:
+        results = [b.process_frame(f) for f in frames()]
+        assert b._library.lib.fr_traced() == 1
+    cycles = [r.cycles for r in results]
+    names, changes, times = read_vcd(path)
+    all_names = set().union(*names.values())
+    assert PORTS <= all_names, f"ports missing from the VCD: {PORTS - all_names}"
+    # Time counts half clock cycles from construction: frame 0 (and its final settle) came
+    # before the trace, frames 1 and 2 are in it, frame 3 is not.
+    start = 2 * cycles[0] + 1
+    assert min(times) >= start
+    assert max(times) - min(times) <= 2 * (cycles[1] + cycles[2]) + 2
+    assert max(times) - min(times) >= 2 * (cycles[1] + cycles[2]) - 2
+    # frame_done pulses once per traced frame.
+    code = next(c for c, n in names.items() if "frame_done" in n)
+    rises = [t for t, v in changes[code] if v == "1"]
+    assert len(rises) == 2
+
+
+def test_untraced_build_has_no_tracing():
+    with get_backend("cxxrtl", PARAMS) as b:
+        assert b._library.lib.fr_traced() == 0
+        assert b.variant == "plain"
+
+
+def test_waveform_format_and_range_errors(tmp_path):
+    with pytest.raises(BackendError, match=r"\.vcd"):
+        get_backend("cxxrtl", PARAMS, waveform=WaveformRequest(str(tmp_path / "w.fst")))
+    with pytest.raises(BackendError, match=r"\.vcd or \.fst"):
+        get_backend("verilator", PARAMS, waveform=WaveformRequest(str(tmp_path / "w.ghw")))
+    with pytest.raises(ValueError, match="first_frame <= last_frame"):
+        get_backend("cxxrtl", PARAMS, waveform=WaveformRequest(str(tmp_path / "w.vcd"), 3, 1))
+
+
+@pytest.mark.slow
+def test_verilator_fst(tmp_path):
+    path = tmp_path / "v.fst"
+    try:
+        b = get_backend("verilator", PARAMS, waveform=WaveformRequest(str(path), 0, 1))
+    except BackendError as exc:
+        if "lz4" in str(exc):
+            pytest.skip(str(exc))
+        raise
+    with b:
+        for f in frames()[:3]:
+            b.process_frame(f)
+    data = path.read_bytes()
+    # An FST file is a sequence of blocks: type byte, then a big-endian length that counts
+    # itself; the first is the header block (type 0).
+    assert data[0] == 0
+    offset, types = 0, []
+    while offset < len(data):
+        types.append(data[offset])
+        (length,) = struct.unpack(">Q", data[offset + 1 : offset + 9])
+        assert length >= 8
+        offset += 1 + length
+    assert offset == len(data)
+    assert 1 in types or 5 in types or 8 in types  # a value-change block
