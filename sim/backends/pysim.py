@@ -119,7 +119,7 @@ class PysimBackend(DesignBackend):
         self._harness = _Harness(self.dut, fast=waveform is None)
         self._sim = Simulator(self._harness)
         self._sim.add_clock(PERIOD)
-        self._sim.add_testbench(self._testbench)
+        self._started = False  # the testbench is added with the first job (see _submit)
         self._job = None
         self._outcome = None
         self._broken = None
@@ -157,6 +157,11 @@ class PysimBackend(DesignBackend):
             raise BackendError(
                 f"the pysim simulation failed earlier ({self._broken}); create a new backend"
             )
+        if not self._started:
+            # Added lazily: Amaranth creates the coroutine right away, and a backend that
+            # never ran would otherwise warn about a coroutine never awaited.
+            self._sim.add_testbench(self._testbench)
+            self._started = True
         self._job = job
         self._outcome = None
         advance = self._sim.advance

@@ -1,0 +1,153 @@
+"""The ``pysim`` backend against the ``model`` backend: every output, the filtered frame and the
+cycle count (which checks the documented latencies), state across frames, reset, blanking,
+waveforms of chosen frames only, and the frame_done watchdog."""
+
+import numpy as np
+import pytest
+from amaranth import Module
+from hwsim import small_params
+from vcd.reader import TokenKind, tokenize
+
+from fpga_robotics.hw.params import FollowTargetParams
+from fpga_robotics.hw.top import FollowTarget
+from fpga_robotics.sim import synthetic
+from fpga_robotics.sim.backends.base import BackendError, WaveformRequest
+from fpga_robotics.sim.backends.model import ModelBackend
+from fpga_robotics.sim.backends.pysim import PERIOD, PysimBackend
+from fpga_robotics.sim.frames import FrameError
+
+
+def sequence(p, seed, n_lost=None):
+    """(frame, colour) pairs: targets, then enough empty frames to search, random frames."""
+    rng = np.random.default_rng(seed)
+    out = []
+    for colour, cx in (("red", p.width * 0.8), ("blue", p.width * 0.2), ("white", p.width / 2)):
+        out.append((synthetic.blob_frame(p.width, p.height, colour, cx=cx,
+                                         radius=p.height / 3, rng=rng), colour))
+    for _ in range(p.lost_frames + 1 if n_lost is None else n_lost):
+        out.append((synthetic.empty_frame(p.width, p.height, rng=rng), "red"))
+    out.append((synthetic.random_frame(p.width, p.height, rng=rng), "none"))
+    out.append((synthetic.random_frame(p.width, p.height, rng=rng), "cyan"))
+    return out
+
+
+@pytest.mark.parametrize("line_blank,frame_blank", [(0, 0), (3, 5), (0, 400)])
+def test_frames_match_the_model_backend(line_blank, frame_blank):
+    p = small_params()
+    frames = sequence(p, seed=line_blank + frame_blank)
+    with PysimBackend(p, line_blank=line_blank, frame_blank=frame_blank) as sim, \
+            ModelBackend(p, line_blank=line_blank, frame_blank=frame_blank) as model:
+        for frame, colour in frames:
+            got, want = sim.process_frame(frame, colour), model.process_frame(frame, colour)
+            assert got.outputs() == want.outputs()
+            assert np.array_equal(got.filtered, want.filtered)
+            assert got.filtered.dtype == np.uint16 and got.filtered.shape == (p.height, p.width)
+
+
+def test_reset_returns_to_the_power_on_state():
+    p = small_params(lost_frames=2)
+    frames = sequence(p, seed=9)
+    with PysimBackend(p) as sim, ModelBackend(p) as model:
+        for frame, colour in frames[:4]:
+            sim.process_frame(frame, colour)
+            model.process_frame(frame, colour)
+        sim.reset()
+        model.reset()
+        assert sim.frames_processed == 0
+        for frame, colour in frames[4:]:
+            assert sim.process_frame(frame, colour) == model.process_frame(frame, colour)
+
+
+def test_packed_and_rgb888_frames_give_the_same_result():
+    p = small_params()
+    frame, colour = sequence(p, seed=2)[0]
+    with PysimBackend(p) as a, PysimBackend(p) as b:
+        assert a.process_frame(frame, colour) == b.process_frame(
+            synthetic.as_rgb444(frame), colour)
+
+
+def test_wrong_frame_shape_is_a_clear_error():
+    p = small_params()
+    with PysimBackend(p) as sim, pytest.raises(FrameError, match="shape"):
+        sim.process_frame(np.zeros((p.height + 1, p.width, 3), np.uint8))
+
+
+def test_full_size_frame_matches_the_model():
+    p = FollowTargetParams()
+    rng = np.random.default_rng(1)
+    frame = synthetic.blob_frame(160, 120, "magenta", cx=30, cy=70, radius=22, rng=rng)
+    with PysimBackend(p, line_blank=2) as sim, ModelBackend(p, line_blank=2) as model:
+        got, want = sim.process_frame(frame, "magenta"), model.process_frame(frame, "magenta")
+    assert got == want and got.found
+
+
+def vcd_times_and_names(path):
+    times, names = [], set()
+    with open(path, "rb") as f:
+        for token in tokenize(f):
+            if token.kind is TokenKind.CHANGE_TIME:
+                times.append(token.time_change)
+            elif token.kind is TokenKind.VAR:
+                names.add(token.var.reference)
+    return times, names
+
+
+def test_waveform_covers_only_the_requested_frames(tmp_path):
+    p = small_params()
+    frames = sequence(p, seed=4)[:4]
+    path = tmp_path / "frames_1_2.vcd"
+    request = WaveformRequest(str(path), first_frame=1, last_frame=2)
+    with PysimBackend(p, line_blank=1, waveform=request) as traced, \
+            PysimBackend(p, line_blank=1) as plain:
+        results = []
+        for i, (frame, colour) in enumerate(frames):
+            results.append(traced.process_frame(frame, colour))
+            assert results[-1] == plain.process_frame(frame, colour)
+            if i == 2:
+                assert path.exists()  # complete once the last requested frame is done
+        size_after_frame_2 = path.stat().st_size
+    assert path.stat().st_size == size_after_frame_2  # frame 3 was not traced
+    times, names = vcd_times_and_names(path)
+    assert {"frame_done", "pixels__payload", "motor_left", "centroid_x"} <= names
+    # Rising edge n of the simulation is at (n - 1/2) periods; frame 1 starts after the last
+    # edge of frame 0 and frame 2 ends with edge c0 + c1 + c2 (plus the clock's next fall).
+    fs = round(PERIOD * 1e15)
+    c0, c1, c2 = (r.cycles for r in results[:3])
+    changes = [t for t in times if t > 0]  # time 0 holds the values dumped at the start
+    assert min(changes) > (c0 - 0.5) * fs
+    assert max(changes) <= (c0 + c1 + c2 + 0.5) * fs
+    assert max(changes) >= (c0 + c1 + c2 - 0.5) * fs
+
+
+@pytest.mark.parametrize("path,message", [("wave.fst", ".vcd"), ("missing/wave.vcd", "directory")])
+def test_bad_waveform_requests_are_clear_errors(tmp_path, path, message):
+    with pytest.raises(BackendError, match=message):
+        PysimBackend(small_params(), waveform=WaveformRequest(str(tmp_path / path)))
+
+
+class _NeverDone(FollowTarget):
+    """A broken design: filters nothing and never strobes frame_done."""
+
+    def elaborate(self, platform):
+        m = Module()
+        # The parts exist but are left unconnected: frame_done stays 0.
+        m.submodules += [self.color_filter, self.tracker, self.motor]
+        m.d.sync += [
+            self.filtered.valid.eq(self.pixels.valid),
+            self.filtered.payload.eq(self.pixels.payload),
+        ]
+        return m
+
+
+def test_a_hung_design_fails_with_a_backend_error(monkeypatch):
+    from fpga_robotics.sim.backends import pysim
+
+    monkeypatch.setattr(pysim, "FollowTarget", _NeverDone)
+    p = small_params()
+    frame, colour = sequence(p, seed=1)[0]
+    with PysimBackend(p) as sim:
+        with pytest.raises(BackendError, match="frame_done did not come"):
+            sim.process_frame(frame, colour)
+        # The watchdog leaves the simulator usable: the next call fails the same way.
+        with pytest.raises(BackendError, match="frame_done did not come"):
+            sim.process_frame(frame, colour)
