@@ -54,14 +54,8 @@ class RunResult:
 
 def make_backend(name, params):
     """A ``DesignBackend`` by name ("auto" = the fastest available compiled one)."""
-    try:
-        from .sim.backends import fastest_backend_name, get_backend
-    except ImportError:  # registry not available: the golden model is always there
-        from .sim.backends.model import ModelBackend
+    from .sim.backends import fastest_backend_name, get_backend
 
-        if name not in ("auto", "model"):
-            raise
-        return ModelBackend(params)
     if name == "auto":
         name = fastest_backend_name()
     return get_backend(name, params)

@@ -205,6 +205,8 @@ def main(argv=None):
     from .scenario import load_scenario
     from .summary import format_summary
 
+    if args.seed is not None and args.seed < 0:
+        raise UsageError(f"--seed must be >= 0, got {args.seed}")
     scenario = load_scenario(args.scenario, _overrides(args))
     if args.source is not None:
         return _run_source(args, scenario)

@@ -419,12 +419,11 @@ def _color(value, where):
 
 def _check_world(world):
     """Validate the world's sections now, so that a bad value is reported at load time."""
+    from .sim.world import World, WorldConfigError
+
     try:
-        from .sim.world.config import WorldConfigError, parse_world_config
-    except ImportError:  # the world is not installed: it validates when it is built
-        return
-    try:
-        parse_world_config(copy.deepcopy(world))
+        # Building it also finds placement errors (a robot starting inside a person).
+        World.from_config(copy.deepcopy(world), 0)
     except WorldConfigError as exc:
         raise ScenarioError(str(exc)) from None
 

@@ -215,3 +215,21 @@ def test_a_compiled_backend_drives_the_robot_exactly_as_the_model_does():
         assert np.array_equal(compiled.trajectory[name], model.trajectory[name],
                               equal_nan=True), name
     assert "search started" in [e for _, _, e in compiled.events]
+
+
+def test_camera_pose_and_field_of_view_geometry():
+    from fpga_robotics.sim_camera import camera_pose, in_view
+
+    pose = camera_pose((1.0, 2.0, math.pi / 2), height=0.3, forward=0.1, tilt=0.05)
+    assert (pose.x, pose.y, pose.height, pose.tilt) == pytest.approx((1.0, 2.1, 0.3, 0.05))
+    hfov = math.radians(60)
+    # Straight ahead, 2 m away: in view. 29 deg off-axis: in; 40 deg: the centre is out but a
+    # 0.5 m radius still reaches into the view (asin(0.5/2) = 14.5 deg); behind: out.
+    ahead = (pose.x, pose.y + 2.0)
+    assert in_view(pose, hfov, *ahead, 0.2)
+    for deg, radius, expect in ((29, 0.0, True), (31, 0.0, False), (40, 0.5, True),
+                                (40, 0.1, False), (180, 0.2, False)):
+        a = math.pi / 2 + math.radians(deg)
+        p = (pose.x + 2 * math.cos(a), pose.y + 2 * math.sin(a))
+        assert in_view(pose, hfov, *p, radius) is expect, deg
+    assert in_view(pose, hfov, pose.x, pose.y - 0.1, 0.2)  # the camera is inside the body

@@ -141,3 +141,7 @@ def test_module_entry_point_prints_one_line_and_exits_2():
     assert proc.returncode == 2
     assert proc.stderr.startswith("fpga_robotics.run: error: unknown scenario 'nope'")
     assert "Traceback" not in proc.stderr
+
+
+def test_negative_seed(capsys):
+    assert "--seed" in usage_error(["--seed", "-1", "--rerun", "off"], capsys)

@@ -179,3 +179,8 @@ def test_actuation_delay_can_be_zero(tmp_path):
     s = load_scenario(write(tmp_path, MINIMAL), ["sim.actuation_delay=0.0"])
     assert s.sim.actuation_delay == 0.0
     assert math.isclose(s.camera.frame_period, 1 / 30)
+
+
+def test_placement_errors_are_found_at_load_time():
+    with pytest.raises(ScenarioError, match="overlaps"):
+        load_scenario("follow_person", ["robot.start=[4.0, 3.0]"])
