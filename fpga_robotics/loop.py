@@ -151,6 +151,7 @@ def run_scenario(scenario, *, seed=None, backend="auto", recorder=None, progress
     events_all = []
     design_events = _DesignEvents(params.lost_frames)
     want_records = recorder is not None or on_frame is not None
+    target_radius = next((p.radius for p in world.people_states() if p.is_target), 0.0)
     if recorder is not None:
         recorder.log_world_map(world.world_map())
 
@@ -186,8 +187,7 @@ def run_scenario(scenario, *, seed=None, backend="auto", recorder=None, progress
             v, w = world.robot_velocity()
             cmd_v, cmd_w = world.commanded_twist()
             target = world.target_position()
-            people = world.people_states() if (want_records or target is not None) else []
-            target_radius = next((p.radius for p in people if p.is_target), 0.0)
+            people = world.people_states() if want_records else []
             if target is not None:
                 tx, ty = target
                 dist = math.hypot(tx - rx, ty - ry)
