@@ -32,6 +32,7 @@ tilt, vertical edges stay vertical instead of converging (no keystone).
 import functools
 import math
 import numbers
+import statistics
 from dataclasses import dataclass
 
 import cv2
@@ -47,6 +48,8 @@ DEFAULT_HFOV = 1.047
 DEFAULT_MAX_LAYERS = 6
 #: Hits closer than this (metres along the forward axis) are ignored (near clipping plane).
 NEAR = 1e-3
+# Sensor noise is drawn in blocks of about this many values (cache-sized).
+_NOISE_BLOCK = 32768
 # Keep every ray at least this far (radians) from looking straight up or down.
 _VERTICAL_MARGIN = 0.02
 
@@ -187,7 +190,11 @@ class CameraRenderer:
         self._run_ids = np.empty((self.height, self.width), dtype=self._id_dtype)
         self._one = self._id_dtype(1)  # a typed scalar keeps np.add.at on its fast path
         self._row_dtype = np.int16 if self.height < 2**15 - 2 else np.int32
-        self._noise = np.empty((self.height, self.width, 3), dtype=np.int16)
+        self._rgba = np.empty((self.height, self.width), dtype=np.uint32)
+        self._rgba_bytes = self._rgba.view(np.uint8).reshape(self.height, self.width, 4)
+        self._noise_rows = max(1, _NOISE_BLOCK // (3 * self.width))
+        self._noise = np.empty((self._noise_rows, self.width, 3), dtype=np.int8)
+        self._noise_std = self._noise_levels = None
         self._cols = np.arange(self.width)
         self._col_index = self._cols[:, None]  # row selector for per-column gathers
         self._walls_key = self._walls = None
@@ -249,9 +256,9 @@ class CameraRenderer:
             raise TypeError(f"pose must be a fpga_robotics.sim.scene.CameraPose, not {type(pose)}")
         ids, palette = self._runs(scene, pose)
         # One 4-byte palette lookup per pixel, then RGBA -> RGB: ~3x faster than taking
-        # 3-byte rows; cvtColor returns a fresh contiguous image.
-        rgba = palette.take(ids).view(np.uint8).reshape(self.height, self.width, 4)
-        image = cv2.cvtColor(rgba, cv2.COLOR_RGBA2RGB)
+        # 3-byte rows; cvtColor returns a fresh image for the caller.
+        palette.take(ids, out=self._rgba)
+        image = cv2.cvtColor(self._rgba_bytes, cv2.COLOR_RGBA2RGB)
         if noise_std:
             self._add_noise(image, noise_std, rng)
         return image
@@ -264,12 +271,25 @@ class CameraRenderer:
                 "noise_std > 0 needs rng=numpy.random.Generator (e.g. np.random.default_rng(seed))"
                 " so that the noise is reproducible"
             )
-        # OpenCV draws the normals ~3x faster than numpy; its (thread-local) generator is
-        # seeded from ``rng`` each frame, so the noise still follows the caller's seed.
-        cv2.setRNGSeed(int(rng.integers(0, 2**31 - 1)))
-        # A 2-D single-channel view: a scalar std for a 3-channel Mat would only hit channel 0.
-        cv2.randn(self._noise.reshape(self.height, -1), 0.0, float(noise_std))
-        cv2.add(image, self._noise, dst=image, dtype=cv2.CV_8U)  # saturating
+        # Inverse-CDF sampling: 16 random bits of the caller's generator per value pick one of
+        # 65536 equally likely quantiles of N(0, std), rounded to 8-bit levels. The raw bits
+        # come 8 bytes at a time (several times faster than drawing normals). Blocks of rows
+        # keep the bits, the indices and the noise in cache.
+        table = self._noise_table(float(noise_std))
+        bits = rng.bit_generator.random_raw
+        step = self._noise_rows
+        for r in range(0, self.height, step):
+            rows = image[r : r + step]
+            idx = bits(-(-rows.size // 4)).view(np.uint16)[: rows.size].reshape(rows.shape)
+            noise = table.take(idx, out=self._noise[: rows.shape[0]])
+            cv2.add(rows, noise, dst=rows, dtype=cv2.CV_8U)  # saturating at 0 and 255
+
+    def _noise_table(self, noise_std):
+        if self._noise_std != noise_std:
+            levels = np.clip(np.rint(noise_std * _normal_quantiles()), -127, 127)
+            self._noise_levels = levels.astype(np.int8)
+            self._noise_std = noise_std
+        return self._noise_levels
 
     def _runs(self, scene, pose):
         """Per-pixel run ids (H, W) and the flat palette of packed RGBA uint32 they index."""
@@ -436,6 +456,13 @@ class CameraRenderer:
         palette[:, 0] = ceil_rgb if horizon > 0 else floor_rgb
         palette[:, 1] = floor_rgb
         return self._paint_runs(starts), _packed_colors(palette).ravel()
+
+
+@functools.lru_cache(maxsize=1)
+def _normal_quantiles():
+    """The 65536 quantiles of N(0, 1) at probabilities (i + 0.5) / 65536 (|q| < 4.4)."""
+    inv_cdf = statistics.NormalDist().inv_cdf
+    return np.array([inv_cdf((i + 0.5) / 65536) for i in range(65536)])
 
 
 @functools.lru_cache(maxsize=64)
