@@ -412,10 +412,20 @@ def test_red_filter_of_the_golden_model_agrees():
     from fpga_robotics.sim.world import World
 
     world = World.from_config({}, seed=0)
-    img = render(world.scene(), world.camera_pose(), 160, 120)
+    scene = world.scene()
+    (person,) = scene.cylinders
+    # Look at the target from 2.4 m, from the robot's side of it.
+    rx, ry, _ = world.robot_pose()
+    away = math.atan2(ry - person.y, rx - person.x)
+    pose = CameraPose(person.x + 2.4 * math.cos(away), person.y + 2.4 * math.sin(away),
+                      away + math.pi)
+    img = render(scene, pose, 160, 120)
     match = model.color_match(to_rgb444(img, 160, 120), COLOR_SELECT["red"], FollowTargetParams())
+    r, g, b = unpack_rgb444(to_rgb444(img, 160, 120))
+    mine = r - np.maximum(g, b) >= 6
+    np.testing.assert_array_equal(match, mine)
     cols = np.nonzero(match)[1]
-    assert match.sum() > 200  # the shirt of the target 2.4 m ahead
+    assert match.sum() > 200  # the shirt, centred
     assert abs(cols.mean() + 0.5 - 80) <= 1.0
 
 
