@@ -14,7 +14,8 @@ from fpga_robotics.sim.model import FollowTargetModel
 
 PARAMS = FollowTargetParams(width=48, height=16)
 TIMING = RobotTiming.from_cycles(xclk_half=2, sccb_quarter=2, spi_half=2, camera_wait=5,
-                                 reset_wait=10, motor_wait=30)
+                                 reset_wait=8000, motor_wait=30)
+# A short table with a long reset wait: the SCCB phase outlasts one camera frame.
 TABLE = [RegisterWrite(0x12, 0x80, "reset", True), RegisterWrite(0x8C, 0x02, "rgb444")]
 HBLANK, VSYNC_CYCLES = 4, 6
 
@@ -61,27 +62,36 @@ def test_camera_to_gopigo3_matches_golden_model():
 
     async def camera(ctx):
         ctx.set(core.switches, 0)  # all switches off: follow red
-        for _ in range(5):
+        # While the registers are being written the camera already sends frames (in its
+        # power-on format); here a whole-red frame that would make the robot back off if it
+        # reached the design. It must be ignored.
+        assert not ctx.get(core.camera_ready)
+        await send_frame(ctx, np.full((PARAMS.height, PARAMS.width), 0xF00, np.uint16),
+                         blank=0)
+        assert not ctx.get(core.camera_ready), "the junk frame must fit in the SCCB time"
+        while not ctx.get(core.camera_ready):
             await ctx.tick("pclk")
         for frame in frames:
-            ctx.set(core.cam_vsync, 1)
-            for _ in range(VSYNC_CYCLES):
-                await ctx.tick("pclk")
-            ctx.set(core.cam_vsync, 0)
-            for row in frame:
-                for p in row.tolist():
-                    for byte in ((p >> 8) & 0xF, p & 0xFF):
-                        ctx.set(core.cam_href, 1)
-                        ctx.set(core.cam_data, byte)
-                        await ctx.tick("pclk")
-                ctx.set(core.cam_href, 0)
-                for _ in range(HBLANK):
-                    await ctx.tick("pclk")
-            # Vertical blanking long enough for the SPI messages of this frame.
-            for _ in range(400):
-                await ctx.tick("pclk")
+            await send_frame(ctx, frame, blank=400)  # blanking long enough for the SPI messages
             leds_after_frame.append(ctx.get(core.leds))
         state["camera_done"] = True
+
+    async def send_frame(ctx, frame, blank):
+        ctx.set(core.cam_vsync, 1)
+        for _ in range(VSYNC_CYCLES):
+            await ctx.tick("pclk")
+        ctx.set(core.cam_vsync, 0)
+        for row in frame:
+            for p in row.tolist():
+                for byte in ((p >> 8) & 0xF, p & 0xFF):
+                    ctx.set(core.cam_href, 1)
+                    ctx.set(core.cam_data, byte)
+                    await ctx.tick("pclk")
+            ctx.set(core.cam_href, 0)
+            for _ in range(HBLANK):
+                await ctx.tick("pclk")
+        for _ in range(blank):
+            await ctx.tick("pclk")
 
     async def spi_peripheral(ctx):
         prev_sclk, prev_cs, prev_xclk, cycle = 0, 0, 0, 0
@@ -105,7 +115,9 @@ def test_camera_to_gopigo3_matches_golden_model():
     sim.add_testbench(camera)
     sim.add_process(spi_peripheral)
     bytes_per_frame = PARAMS.height * (2 * PARAMS.width + HBLANK) + VSYNC_CYCLES + 400
-    sim.run_until((len(frames) * bytes_per_frame + 200) * 80e-9 * 1.2)  # watchdog
+    sccb_cycles = TIMING.reset_wait + 1000
+    sim.run_until(((len(frames) + 1) * bytes_per_frame + 200) * 80e-9 * 1.2
+                  + sccb_cycles * 20e-9)  # watchdog
     assert state["camera_done"], "the simulated camera did not finish in time"
     assert msgs == expected_msgs
     assert leds_after_frame == expected_leds

@@ -1,7 +1,9 @@
 """Everything on the robot's FPGA except pins and clock generation, so it can be simulated.
 
 ``RobotCore`` = camera control (XCLK divider, SCCB initialisation) + pixel capture with its
-clock crossing + ``FollowTarget`` (unchanged) + colour selection + the GoPiGo3 SPI link.
+clock crossing + ``FollowTarget`` (unchanged) + colour selection + the GoPiGo3 SPI link. Pixels reach
+``FollowTarget`` only once the camera's registers are written (``camera_ready``); the design
+itself ignores everything until the next ``first``.
 It runs in ``sync`` (the design clock) and ``pclk`` (the camera's byte clock), both supplied
 by the board top, which also connects the members below to pins.
 """
@@ -149,8 +151,13 @@ class RobotCore(wiring.Component):
             capture.vsync.eq(self.cam_vsync),
             self.overflow.eq(capture.overflow),
         ]
+        # Until the register table is written the camera sends its power-on format (YUV,
+        # VGA): drop those bytes, so that only RGB444 frames ever reach the design.
         m.submodules.design = design = self.design
-        wiring.connect(m, capture.pixels, design.pixels)
+        m.d.comb += [
+            design.pixels.valid.eq(capture.pixels.valid & sccb.done),
+            design.pixels.payload.eq(capture.pixels.payload),
+        ]
 
         m.submodules.color_select = color = SwitchColorSelect()
         m.d.comb += [color.switches.eq(self.switches), design.color_sel.eq(color.color_sel)]
