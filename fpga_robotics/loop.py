@@ -122,7 +122,7 @@ def run_scenario(scenario, *, seed=None, backend="auto", recorder=None, progress
         mount_height=cam.mount_height if cam.mount_height is not None else spec.camera_height,
         mount_forward=(cam.mount_forward if cam.mount_forward is not None
                        else spec.camera_forward),
-        tilt=cam.tilt if cam.tilt is not None else getattr(spec, "camera_tilt", 0.0),
+        tilt=cam.tilt if cam.tilt is not None else spec.camera_tilt,
         noise_std=cam.noise_std,
         # A stream of its own, so that camera noise never shifts the world's randomness.
         rng=np.random.default_rng([seed, 0xCA3E]),
