@@ -2,40 +2,35 @@
 
 Pipeline (one pixel per cycle at most, never stalls):
 
-1. framing: the position of each pixel from its ``first``/``last`` flags, geometry checks,
-   window and bin membership (registered);
-2. accumulate ``N``, ``h0..h7`` and ``SX`` (a ``first`` reloads them instead of adding);
+1-2. ``WindowCounter``: framing, window and bins (registered), then the running counts
+     ``N``, ``h0..h7`` and ``SX`` (see there for malformed framing: such a frame never ends,
+     so it produces no ``frame_done`` and its counts are reloaded at the next ``first``);
 3. at the end of a well-formed frame, snapshot the counts and start the divider, so the next
    frame can start accumulating on the very next cycle;
 4. after the divider, all per-frame outputs load together with the one-cycle ``frame_done``.
 
-Malformed framing: a frame is abandoned (no ``frame_done``, counts discarded) as soon as a line
-ends early (``last`` before column ``width - 1``) or runs long (no ``last`` at column
-``width - 1``). A frame ends at the ``last`` of line ``height - 1``; pixels after that, and
-pixels before the first ``first`` after reset or after an abandoned frame, are ignored until
-the next ``first``. A ``first`` always restarts the frame. A frame with too few lines never
-reaches its end, so it produces nothing and is discarded by the next ``first``.
+The per-pixel and per-frame halves are separate modules on purpose: Amaranth's simulator
+re-evaluates a module's combinational logic when any of its inputs changes, so the per-frame
+logic (LED code, proximity) is not recomputed for every pixel.
 """
 
-from amaranth import Cat, Const, Module, Mux, Signal
+from amaranth import Const, Module, Mux, Signal
 from amaranth.lib import data, wiring
 from amaranth.lib.wiring import In, Out
 
 from .color_filter import MatchStream
 from .divider import SequentialDivider
 from .params import FollowTargetParams
+from .window_counter import FrameCounts, WindowCounter
 
-__all__ = ["LEDS_CENTRED", "FrameTracker"]
+__all__ = ["LEDS_CENTRED", "FrameTracker", "TrackerResults"]
 
 #: ``centroid_leds`` when the target is centred: the two middle LEDs.
 LEDS_CENTRED = 0b0001_1000
 
-#: Cycles of stages 1-3 above, from a pixel sampled on ``matches`` to the divider's start edge.
-_STAGES_BEFORE_DIVIDER = 2
-
 
 class FrameTracker(wiring.Component):
-    """Target tracker of ``FollowTarget``.
+    """Target tracker of ``FollowTarget``: ``WindowCounter`` followed by ``TrackerResults``.
 
     Parameters
     ----------
@@ -65,101 +60,97 @@ class FrameTracker(wiring.Component):
         if not isinstance(params, FollowTargetParams):
             raise TypeError(f"params must be a FollowTargetParams, not {params!r}")
         self.params = params
-        p = params
+        self.counter = WindowCounter(params)
+        self.results = TrackerResults(params)
         super().__init__({
             "matches": In(MatchStream()),
-            "frame_done": Out(1),
-            "found": Out(1),
-            "proximity": Out(3),
-            "centroid_x": Out(p.x_bits),
-            "centroid_leds": Out(8),
-            "count": Out(p.count_bits),
-            "bins": Out(data.ArrayLayout(p.count_bits, 8)),
-            "sum_x": Out(p.sum_x_bits),
+            **_result_members(params),
         })
 
     @property
     def latency(self):
         """Last pixel of a frame sampled on ``matches`` at edge P: ``frame_done`` and the
         results show right after edge P + ``latency``."""
-        return _STAGES_BEFORE_DIVIDER + 1 + self.params.divider_cycles
+        return self.counter.latency + self.results.latency
+
+    def elaborate(self, platform):
+        m = Module()
+        m.submodules.counter = counter = self.counter
+        m.submodules.results = results = self.results
+        wiring.connect(m, wiring.flipped(self.matches), counter.matches)
+        wiring.connect(m, counter.counts, results.counts)
+        for name in _result_members(self.params):
+            m.d.comb += getattr(self, name).eq(getattr(results, name))
+        return m
+
+
+def _result_members(p):
+    return {
+        "frame_done": Out(1),
+        "found": Out(1),
+        "proximity": Out(3),
+        "centroid_x": Out(p.x_bits),
+        "centroid_leds": Out(8),
+        "count": Out(p.count_bits),
+        "bins": Out(data.ArrayLayout(p.count_bits, 8)),
+        "sum_x": Out(p.sum_x_bits),
+    }
+
+
+class TrackerResults(wiring.Component):
+    """Per-frame results from a frame's counts: snapshot, divider, LED code, proximity.
+
+    The snapshot loads on ``counts.end`` together with the divider's start, so the next frame
+    may start counting on the very next cycle. When the divider is done, every output loads at
+    once with the one-cycle ``frame_done``.
+
+    Parameters
+    ----------
+    params : FollowTargetParams
+
+    Members
+    -------
+    counts : ``In(FrameCounts(params))``
+    frame_done, found, proximity, centroid_x, centroid_leds, count, bins, sum_x : ``Out``
+        As in ``FrameTracker``.
+    """
+
+    def __init__(self, params):
+        if not isinstance(params, FollowTargetParams):
+            raise TypeError(f"params must be a FollowTargetParams, not {params!r}")
+        self.params = params
+        super().__init__({
+            "counts": In(FrameCounts(params)),
+            **_result_members(params),
+        })
+
+    @property
+    def latency(self):
+        """``counts.end`` shows right after edge E: ``frame_done`` right after edge
+        E + ``latency``: the snapshot and divider start at E + 1, the divider's
+        ``divider_cycles`` steps, the output register."""
+        return 2 + self.params.divider_cycles
 
     def elaborate(self, platform):
         m = Module()
         p = self.params
-        W, H = p.width, p.height
-        mx, my, bw = p.margin_x, p.margin_y, p.bin_width
+        counts = self.counts
 
-        # --- Stage 1: framing and window -----------------------------------------------------
-        valid = self.matches.valid
-        first = self.matches.payload.first
-        last = self.matches.payload.last
-
-        x = Signal(p.x_bits)  # position of the next pixel of the frame in progress
-        y = Signal(p.y_bits)
-        active = Signal()  # a well-formed frame is in progress
-        px = Mux(first, 0, x)
-        py = Mux(first, 0, y)
-        in_frame = valid & (first | active)
-        line_end = px == W - 1
-        shape_ok = line_end == last  # neither a short nor a long line
-        frame_end = in_frame & shape_ok & last & (py == H - 1)
-
-        with m.If(in_frame):
-            with m.If(~shape_ok):
-                m.d.sync += active.eq(0)  # abandon the frame until the next `first`
-            with m.Elif(last):
-                m.d.sync += [x.eq(0), y.eq(py + 1), active.eq(py != H - 1)]
-            with m.Else():
-                m.d.sync += [x.eq(px + 1), y.eq(py), active.eq(1)]
-
-        in_rows = (py >= my) & (py < H - my)
-        in_bin = Cat(
-            (px >= mx + k * bw) & (px < mx + (k + 1) * bw) for k in range(8)
-        )
-        a_restart = Signal()  # this pixel starts a frame: reload the counts
-        a_count = Signal()  # this pixel counts
-        a_bin = Signal(8)  # one-hot bin of a counted pixel
-        a_x = Signal(p.x_bits)
-        a_end = Signal()  # last pixel of a well-formed frame
-        m.d.sync += [
-            a_restart.eq(valid & first),
-            a_count.eq(in_frame & shape_ok & self.matches.payload.match & in_rows
-                       & in_bin.any()),
-            a_end.eq(frame_end),
-        ]
-        with m.If(valid):
-            m.d.sync += [a_bin.eq(in_bin), a_x.eq(px)]
-
-        # --- Stage 2: accumulate -------------------------------------------------------------
-        n = Signal(p.count_bits)
-        h = [Signal(p.count_bits, name=f"h{k}") for k in range(8)]
-        sx = Signal(p.sum_x_bits)
-        b_end = Signal()
-        m.d.sync += b_end.eq(a_end)
-        with m.If(a_restart):
-            m.d.sync += [
-                n.eq(a_count),
-                sx.eq(Mux(a_count, a_x, 0)),
-                *(h[k].eq(a_count & a_bin[k]) for k in range(8)),
-            ]
-        with m.Elif(a_count):
-            m.d.sync += [n.eq(n + 1), sx.eq(sx + a_x)]
-            for k in range(8):
-                with m.If(a_bin[k]):
-                    m.d.sync += h[k].eq(h[k] + 1)
-
-        # --- Stage 3: snapshot and divide ----------------------------------------------------
+        # --- Snapshot and divide -----------------------------------------------------------
         m.submodules.divider = div = SequentialDivider(p.sum_x_bits, p.count_bits, p.x_bits)
-        m.d.comb += [div.start.eq(b_end), div.dividend.eq(sx), div.divisor.eq(n)]
-        with m.If(b_end):
+        m.d.comb += [
+            div.start.eq(counts.end),
+            div.dividend.eq(counts.sum_x),
+            div.divisor.eq(counts.count),
+        ]
+        with m.If(counts.end):
             m.d.sync += [
-                self.count.eq(n),
-                self.sum_x.eq(sx),
-                *(self.bins[k].eq(h[k]) for k in range(8)),
+                self.count.eq(counts.count),
+                self.sum_x.eq(counts.sum_x),
+                self.bins.eq(counts.bins),
             ]
 
-        # --- Stage 4: results from the snapshot, loaded when the divider is done ------------
+        # --- Results from the snapshot, loaded when the divider is done ---------------------
         count = self.count
         bins = [self.bins[k] for k in range(8)]
         found = count >= p.min_pixels
