@@ -233,3 +233,13 @@ def test_camera_pose_and_field_of_view_geometry():
         p = (pose.x + 2 * math.cos(a), pose.y + 2 * math.sin(a))
         assert in_view(pose, hfov, *p, radius) is expect, deg
     assert in_view(pose, hfov, pose.x, pose.y - 0.1, 0.2)  # the camera is inside the body
+
+
+@pytest.mark.parametrize("name", ["follow_person", "divider", "lighting", "heavy_robot",
+                                  "lost_target"])
+def test_every_shipped_scenario_passes_with_the_default_design(name):
+    s = load_scenario(name)
+    assert s.data["design"] == {}  # the default design
+    r = run_scenario(s, backend="model")
+    failed = [c["text"] for c in r.summary["checks"] if not c["passed"]]
+    assert r.summary["verdict"] == "pass", failed
