@@ -184,3 +184,11 @@ def test_actuation_delay_can_be_zero(tmp_path):
 def test_placement_errors_are_found_at_load_time():
     with pytest.raises(ScenarioError, match="overlaps"):
         load_scenario("follow_person", ["robot.start=[4.0, 3.0]"])
+
+
+def test_a_world_section_the_file_lacks_can_be_set():
+    assert "lighting" not in load_scenario("follow_person").world
+    s = load_scenario("follow_person", ["lighting.ambient=0.3"])
+    assert s.world["lighting"] == {"ambient": 0.3}
+    with pytest.raises(ScenarioError, match="did you mean 'ambient'"):
+        load_scenario("follow_person", ["lighting.ambiant=0.3"])
