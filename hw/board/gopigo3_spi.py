@@ -116,19 +116,19 @@ class SPIByteMaster(wiring.Component):
                         bit.eq(0), self.cs.eq(1), timer.eq(self.half_period - 1),
                     ]
                     m.next = "LOW"
-            with m.State("LOW"):  # SCLK low, data set up
-                with m.If(timer == 0):
-                    m.d.sync += [self.sclk.eq(1), timer.eq(self.half_period - 1)]
-                    m.next = "HIGH"
-            with m.State("HIGH"):  # the peripheral sampled on the rising edge
-                with m.If(timer == 0):
-                    m.d.sync += self.sclk.eq(0)
-                    with m.If(bit != 7):
-                        m.d.sync += [shift.eq(shift << 1), bit.eq(bit + 1),
-                                     timer.eq(self.half_period - 1)]
-                        m.next = "LOW"
-                    with m.Else():
-                        m.next = "NEXT"
+            with m.State("LOW"), m.If(timer == 0):
+                # SCLK low for half a period with the data set up
+                m.d.sync += [self.sclk.eq(1), timer.eq(self.half_period - 1)]
+                m.next = "HIGH"
+            with m.State("HIGH"), m.If(timer == 0):
+                # SCLK high: the peripheral sampled COPI on the rising edge
+                m.d.sync += self.sclk.eq(0)
+                with m.If(bit != 7):
+                    m.d.sync += [shift.eq(shift << 1), bit.eq(bit + 1),
+                                 timer.eq(self.half_period - 1)]
+                    m.next = "LOW"
+                with m.Else():
+                    m.next = "NEXT"
             with m.State("NEXT"):
                 with m.If(~end):
                     # Same message: take the next byte at once, with the falling edge.

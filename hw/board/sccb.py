@@ -164,16 +164,15 @@ class SCCBInit(wiring.Component):
                 with m.Elif(tick):
                     m.d.sync += quarter.eq(0)
                     m.next = "START"
-            with m.State("START"):
+            with m.State("START"), m.If(tick):
                 # Quarter 1: SIOD falls with SIOC high; quarter 3: SIOC falls.
-                with m.If(tick):
-                    m.d.sync += quarter.eq(quarter + 1)
-                    with m.Switch(quarter):
-                        with m.Case(1):
-                            m.d.sync += self.siod_o.eq(0)
-                        with m.Case(3):
-                            m.d.sync += [self.sioc.eq(0), bit.eq(0)]
-                            m.next = "BITS"
+                m.d.sync += quarter.eq(quarter + 1)
+                with m.Switch(quarter):
+                    with m.Case(1):
+                        m.d.sync += self.siod_o.eq(0)
+                    with m.Case(3):
+                        m.d.sync += [self.sioc.eq(0), bit.eq(0)]
+                        m.next = "BITS"
             with m.State("BITS"), m.If(tick):
                 m.d.sync += quarter.eq(quarter + 1)
                 with m.Switch(quarter):
@@ -187,23 +186,22 @@ class SCCBInit(wiring.Component):
                             m.next = "STOP"
                         with m.Else():
                             m.d.sync += bit.eq(bit + 1)
-            with m.State("STOP"):
+            with m.State("STOP"), m.If(tick):
                 # Quarter 0: drive SIOD low; 1: SIOC rises; 3: SIOD rises with SIOC high.
-                with m.If(tick):
-                    m.d.sync += quarter.eq(quarter + 1)
-                    with m.Switch(quarter):
-                        with m.Case(0):
-                            m.d.sync += [self.siod_o.eq(0), self.siod_oe.eq(1)]
-                        with m.Case(1):
-                            m.d.sync += self.sioc.eq(1)
-                        with m.Case(3):
-                            m.d.sync += [self.siod_o.eq(1), index.eq(index + 1)]
-                            # Bus free for at least one bit time before the next START.
-                            with m.If(wait_after):
-                                m.d.sync += wait.eq(max(self.reset_wait, gap))
-                            with m.Else():
-                                m.d.sync += wait.eq(gap)
-                            m.next = "WAIT"
+                m.d.sync += quarter.eq(quarter + 1)
+                with m.Switch(quarter):
+                    with m.Case(0):
+                        m.d.sync += [self.siod_o.eq(0), self.siod_oe.eq(1)]
+                    with m.Case(1):
+                        m.d.sync += self.sioc.eq(1)
+                    with m.Case(3):
+                        m.d.sync += [self.siod_o.eq(1), index.eq(index + 1)]
+                        # Bus free for at least one bit time before the next START.
+                        with m.If(wait_after):
+                            m.d.sync += wait.eq(max(self.reset_wait, gap))
+                        with m.Else():
+                            m.d.sync += wait.eq(gap)
+                        m.next = "WAIT"
             with m.State("DONE"):
                 m.d.comb += self.done.eq(1)
         return m
