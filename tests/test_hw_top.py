@@ -180,3 +180,39 @@ def test_signature_widths_follow_the_geometry(size):
     assert len(dut.pixels.payload.as_value()) == 14
     assert dut.motor_left.shape().signed and len(dut.motor_left) == 16
     Fragment.get(dut, platform=None)  # and it elaborates at that size
+
+
+def random_params(rng):
+    """A random but valid parameter set at a small geometry."""
+    width = int(rng.choice([16, 24, 32, 40, 56]))
+    margins = [m for m in range(width // 2) if (width - 2 * m) % 8 == 0 and width > 2 * m]
+    height = int(rng.integers(2, 9))
+    thresholds = tuple(sorted(int(t) for t in rng.integers(0, width * height, 7)))
+    return FollowTargetParams(
+        width=width, height=height,
+        margin_x=int(rng.choice(margins)), margin_y=int(rng.integers(0, (height - 1) // 2 + 1)),
+        diff_min=int(rng.integers(0, 16)), similar_max=int(rng.integers(0, 16)),
+        white_min=int(rng.integers(0, 16)),
+        min_pixels=int(rng.integers(1, width * height)), proximity_thresholds=thresholds,
+        base_dps=tuple(int(v) for v in rng.integers(-600, 600, 8)),
+        kp_num=int(rng.integers(-60, 61)), kp_shift=int(rng.integers(0, 5)),
+        max_dps=int(rng.integers(0, 700)), lost_frames=int(rng.integers(1, 4)),
+        search_dps=int(rng.integers(-300, 301)),
+    )
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_random_parameter_sets_match_the_model(seed):
+    rng = np.random.default_rng(100 + seed)
+    p = random_params(rng)
+    frames, sels = [], []
+    for i in range(6):
+        if i in (2, 3):  # no target: lost frames
+            rgb = synthetic.empty_frame(p.width, p.height, rng=rng)
+        else:
+            rgb = synthetic.random_frame(p.width, p.height, rng=rng)
+        frames.append(packed(rgb, p))
+        sels.append(int(rng.integers(0, 8)))
+    dut = FollowTarget(p)
+    trace, last = run_follow_target(dut, frames, sels, line_blank=int(rng.integers(0, 3)))
+    check_against_model(p, frames, sels, trace, last)
