@@ -158,6 +158,7 @@ def run_scenario(scenario, *, seed=None, backend="auto", recorder=None, progress
     color = scenario.color_at(0.0)
     step = 0
     wall_start = time.perf_counter()
+    cpu_start = time.process_time()
     try:
         for k in range(n_frames):
             capture_step = round(k * period / dt)
@@ -234,6 +235,7 @@ def run_scenario(scenario, *, seed=None, backend="auto", recorder=None, progress
         if owns_backend:
             design.close()
     wall = time.perf_counter() - wall_start
+    cpu = time.process_time() - cpu_start
 
     sim_time = total_steps * dt
     metrics = compute_metrics(traj, events_all, world.collision_counts(), period)
@@ -253,6 +255,8 @@ def run_scenario(scenario, *, seed=None, backend="auto", recorder=None, progress
         "wall_time_s": round(wall, 4),
         "ms_per_frame": round(1000.0 * wall / max(1, n_frames), 4),
         "realtime_factor": round(sim_time / wall, 3) if wall > 0 else None,
+        # CPU time of this process: the cost per frame on a machine busy with other work.
+        "cpu_ms_per_frame": round(1000.0 * cpu / max(1, n_frames), 4),
         **metrics,
         "events": len(events_all),
         "verdict": verdict(checks),

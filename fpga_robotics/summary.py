@@ -35,7 +35,9 @@ CHECKS = {
 }
 
 #: Summary fields that depend on the machine, not on the simulation.
-TIMING_FIELDS = ("wall_time_s", "ms_per_frame", "realtime_factor", "backend_setup_s")
+TIMING_FIELDS = (
+    "wall_time_s", "ms_per_frame", "realtime_factor", "cpu_ms_per_frame", "backend_setup_s",
+)
 
 
 def _round(x, digits=4):
