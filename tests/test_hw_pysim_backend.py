@@ -2,6 +2,9 @@
 cycle count (which checks the documented latencies), state across frames, reset, blanking,
 waveforms of chosen frames only, and the frame_done watchdog."""
 
+import gc
+import os
+
 import numpy as np
 import pytest
 from amaranth import Module
@@ -103,10 +106,13 @@ def test_waveform_covers_only_the_requested_frames(tmp_path):
         for i, (frame, colour) in enumerate(frames):
             results.append(traced.process_frame(frame, colour))
             assert results[-1] == plain.process_frame(frame, colour)
+            if i == 1:
+                assert not path.exists()  # written under a temporary name until complete
             if i == 2:
                 assert path.exists()  # complete once the last requested frame is done
         size_after_frame_2 = path.stat().st_size
     assert path.stat().st_size == size_after_frame_2  # frame 3 was not traced
+    assert sorted(os.listdir(tmp_path)) == [path.name]  # no temporary file left
     times, names = vcd_times_and_names(path)
     assert {"frame_done", "pixels__payload", "motor_left", "centroid_x"} <= names
     # Rising edge n of the simulation is at (n - 1/2) periods; frame 1 starts after the last
@@ -151,3 +157,14 @@ def test_a_hung_design_fails_with_a_backend_error(monkeypatch):
         # The watchdog leaves the simulator usable: the next call fails the same way.
         with pytest.raises(BackendError, match="frame_done did not come"):
             sim.process_frame(frame, colour)
+
+
+def test_an_unfinished_waveform_leaves_no_file_behind(tmp_path):
+    p = small_params()
+    frame, colour = sequence(p, seed=3)[0]
+    sim = PysimBackend(p, waveform=WaveformRequest(str(tmp_path / "w.vcd"), 0, 5))
+    sim.process_frame(frame, colour)
+    assert len(os.listdir(tmp_path)) == 1 and not (tmp_path / "w.vcd").exists()
+    del sim  # dropped before the last requested frame, without close()
+    gc.collect()
+    assert os.listdir(tmp_path) == []

@@ -21,6 +21,8 @@ through its public API; this backend starts them later through the simulation en
 """
 
 import os
+import tempfile
+import weakref
 
 import numpy as np
 from amaranth import Cat, ClockDomain, Elaboratable, Module, Mux, Signal, Value
@@ -186,8 +188,16 @@ class PysimBackend(DesignBackend):
                 "this Amaranth version cannot start a waveform in mid-simulation; "
                 "use the model, cxxrtl or verilator backend for waveforms"
             )
+        # Written under a temporary name and renamed when complete, so that an interrupted
+        # run never leaves a half-written file at the requested path.
+        path = os.path.abspath(os.fspath(self.waveform.path))
+        fd, self._vcd_tmp = tempfile.mkstemp(
+            prefix=".tmp-", suffix=os.path.basename(path), dir=os.path.dirname(path)
+        )
+        os.close(fd)
+        self._vcd_cleanup = weakref.finalize(self, _remove_if_exists, self._vcd_tmp)
         self._vcd = engine.write_vcd(
-            vcd_file=os.fspath(self.waveform.path), gtkw_file=None, traces=(), fs_per_delta=0
+            vcd_file=self._vcd_tmp, gtkw_file=None, traces=(), fs_per_delta=0
         )
         self._vcd.__enter__()
 
@@ -196,6 +206,8 @@ class PysimBackend(DesignBackend):
             vcd, self._vcd = self._vcd, None
             self._traced = True
             vcd.__exit__(None, None, None)
+            os.replace(self._vcd_tmp, os.fspath(self.waveform.path))
+            self._vcd_cleanup.detach()
 
     # --- simulation side (runs inside the simulator) -----------------------------------------
 
@@ -334,6 +346,13 @@ class PysimBackend(DesignBackend):
             self._collect_fast(ctx, lines)
         elif ctx.get(self.dut.filtered.valid):
             lines.append(ctx.get(Value.cast(self.dut.filtered.payload)))
+
+
+def _remove_if_exists(path):
+    try:
+        os.unlink(path)
+    except FileNotFoundError:
+        pass
 
 
 def _count_pixels(lines, fast, width):
