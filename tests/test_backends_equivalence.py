@@ -76,8 +76,15 @@ def assert_same(reference, results, name):
     assert len(reference) == len(results)
     for i, (ref, got) in enumerate(zip(reference, results, strict=True)):
         if got.outputs() != ref.outputs():
-            fields = ("found", "proximity", "centroid_x", "centroid_leds", "motor_left",
-                      "motor_right", "cycles")
+            fields = (
+                "found",
+                "proximity",
+                "centroid_x",
+                "centroid_leds",
+                "motor_left",
+                "motor_right",
+                "cycles",
+            )
             diff = {
                 f: (r, g)
                 for f, r, g in zip(fields, ref.outputs(), got.outputs(), strict=True)

@@ -14,9 +14,20 @@ PARAMS = FollowTargetParams(
     width=40, height=16, min_pixels=4, proximity_thresholds=(4, 8, 16, 32, 64, 96, 128)
 )
 PORTS = {
-    "clk", "rst", "pixels__valid", "pixels__payload", "color_sel", "filtered__valid",
-    "filtered__payload", "frame_done", "found", "proximity", "centroid_x", "centroid_leds",
-    "motor_left", "motor_right",
+    "clk",
+    "rst",
+    "pixels__valid",
+    "pixels__payload",
+    "color_sel",
+    "filtered__valid",
+    "filtered__payload",
+    "frame_done",
+    "found",
+    "proximity",
+    "centroid_x",
+    "centroid_leds",
+    "motor_left",
+    "motor_right",
 }
 
 

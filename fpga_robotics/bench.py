@@ -1,0 +1,262 @@
+"""Benchmark of the simulation backends.
+
+    python -m fpga_robotics.bench [--backends model,cxxrtl] [--resolutions 160x120]
+                                  [--frames 30] [--json bench.json]
+
+For every backend and resolution it runs seeded synthetic frames through ``FollowTarget`` and
+prints the median milliseconds per frame and the simulated clock cycles per second. In the
+same run it measures a trivial one-pixel-per-clock design (``PassThrough``: registers the
+pixel and counts) through the same compiled flows: the practical limit of this machine.
+Builds (or cache loads) happen before timing and are reported separately.
+"""
+
+import argparse
+import gc
+import json
+import os
+import platform
+import statistics
+import sys
+import time
+
+import numpy as np
+
+from .errors import UsageError, run_cli
+from .hw.params import FollowTargetParams
+from .sim import synthetic
+from .sim.backends import BACKEND_NAMES, COMPILED_BACKENDS, BackendError, get_backend
+
+__all__ = ["main", "measure", "parse_resolutions"]
+
+DEFAULT_RESOLUTIONS = "160x120,320x240,640x480"
+#: pysim takes about a second per 160x120 frame: fewer frames, and larger sizes only on request.
+PYSIM_DEFAULT_FRAMES = 3
+PYSIM_DEFAULT_MAX_PIXELS = 160 * 120
+#: Targets of the compiled backends (issue 3), checked in the summary.
+TARGET_MS = {(160, 120): 0.4, (640, 480): 6.0}
+TARGET_TRIVIAL_FRACTION = 0.5
+TARGET_PYSIM_MS_160 = 1000.0
+
+
+def parse_resolutions(text):
+    sizes = []
+    for item in text.split(","):
+        try:
+            w, h = (int(v) for v in item.lower().split("x"))
+        except ValueError:
+            raise UsageError(
+                f"bad resolution {item!r}: write WIDTHxHEIGHT, e.g. 160x120,640x480"
+            ) from None
+        sizes.append((w, h))
+    return sizes
+
+
+def bench_frames(width, height, count, seed):
+    """Frames a robot would see: a target sweeping across a noisy background."""
+    rng = np.random.default_rng(seed)
+    states = synthetic.scenario_states("sweep", width, height, n_frames=count)
+    return [synthetic.as_rgb444(f) for f in synthetic.sequence(width, height, states, rng=rng)]
+
+
+def measure(backend, frames):
+    """Median ms per frame and cycles per second over ``frames`` (after one warm-up frame)."""
+    backend.process_frame(frames[0])
+    times, cycles = [], []
+    gc_was_enabled = gc.isenabled()
+    gc.disable()
+    try:
+        for frame in frames:
+            start = time.perf_counter()
+            result = backend.process_frame(frame)
+            times.append(time.perf_counter() - start)
+            cycles.append(result.cycles)
+    finally:
+        if gc_was_enabled:
+            gc.enable()
+    median = statistics.median(times)
+    return {
+        "frames": len(frames),
+        "ms_per_frame": median * 1e3,
+        "cycles_per_frame": int(statistics.median(cycles)),
+        "cycles_per_second": statistics.median(c / t for c, t in zip(cycles, times, strict=True)),
+    }
+
+
+def run_one(name, params, frames, design):
+    kwargs = {"design": design} if design != "follow_target" else {}
+    start = time.perf_counter()
+    backend = get_backend(name, params, **kwargs)
+    build_s = time.perf_counter() - start
+    with backend:
+        figures = measure(backend, frames)
+    figures.update(
+        backend=name,
+        design=design,
+        width=params.width,
+        height=params.height,
+        build_or_load_s=build_s,
+    )
+    return figures
+
+
+def build_parser():
+    parser = argparse.ArgumentParser(
+        prog="python -m fpga_robotics.bench",
+        description="Median ms per frame and simulated cycles per second of every backend.",
+    )
+    parser.add_argument(
+        "--backends",
+        default=",".join(BACKEND_NAMES),
+        help=f"comma-separated subset of {','.join(BACKEND_NAMES)} (default: all)",
+    )
+    parser.add_argument(
+        "--resolutions", default=DEFAULT_RESOLUTIONS, help=f"default {DEFAULT_RESOLUTIONS}"
+    )
+    parser.add_argument("--frames", type=int, default=30, help="timed frames per case (30)")
+    parser.add_argument(
+        "--pysim-frames",
+        type=int,
+        default=PYSIM_DEFAULT_FRAMES,
+        help=f"timed frames for pysim ({PYSIM_DEFAULT_FRAMES})",
+    )
+    parser.add_argument(
+        "--pysim-max-pixels",
+        type=int,
+        default=PYSIM_DEFAULT_MAX_PIXELS,
+        help="skip pysim above this many pixels a frame (default 19200 = 160x120; "
+        "640x480 takes about 16 s a frame)",
+    )
+    parser.add_argument(
+        "--no-trivial",
+        action="store_true",
+        help="skip the trivial one-pixel-per-clock reference design",
+    )
+    parser.add_argument("--seed", type=int, default=0, help="seed of the synthetic frames")
+    parser.add_argument("--json", metavar="PATH", help="also write the figures to PATH")
+    return parser
+
+
+def _format_row(r):
+    label = r["backend"] + (" (trivial)" if r["design"] == "passthrough" else "")
+    return (
+        f"{label:<22} {r['width']:>4}x{r['height']:<4} {r['frames']:>6} "
+        f"{r['ms_per_frame']:>10.3f} {r['cycles_per_second'] / 1e6:>10.2f} "
+        f"{r['build_or_load_s']:>8.1f}"
+    )
+
+
+def summary(results):
+    """Lines comparing the figures with the targets of the compiled backends."""
+    lines = []
+    by = {(r["backend"], r["design"], r["width"], r["height"]): r for r in results}
+    for (w, h), target in TARGET_MS.items():
+        compiled = [
+            by[(n, "follow_target", w, h)]
+            for n in COMPILED_BACKENDS
+            if (n, "follow_target", w, h) in by
+        ]
+        if compiled:
+            best = min(compiled, key=lambda r: r["ms_per_frame"])
+            verdict = "met" if best["ms_per_frame"] <= target else "MISSED"
+            lines.append(
+                f"target {w}x{h}: fastest compiled ({best['backend']}) "
+                f"{best['ms_per_frame']:.3f} ms <= {target} ms: {verdict}"
+            )
+            trivial = by.get((best["backend"], "passthrough", w, h))
+            if trivial:
+                frac = best["cycles_per_second"] / trivial["cycles_per_second"]
+                verdict = "met" if frac >= TARGET_TRIVIAL_FRACTION else "MISSED"
+                lines.append(
+                    f"target {w}x{h}: {best['backend']} runs at {frac:.2f} of the trivial "
+                    f"design's cycle rate (>= {TARGET_TRIVIAL_FRACTION}): {verdict}"
+                )
+    pysim = by.get(("pysim", "follow_target", 160, 120))
+    if pysim:
+        verdict = "met" if pysim["ms_per_frame"] <= TARGET_PYSIM_MS_160 else "MISSED"
+        lines.append(
+            f"target 160x120: pysim {pysim['ms_per_frame']:.0f} ms <= "
+            f"{TARGET_PYSIM_MS_160:.0f} ms: {verdict}"
+        )
+    return lines
+
+
+def main(argv=None):
+    args = build_parser().parse_args(argv)
+    names = [n.strip() for n in args.backends.split(",") if n.strip()]
+    for n in names:
+        if n not in BACKEND_NAMES:
+            raise UsageError(f"unknown backend {n!r}; choose from {', '.join(BACKEND_NAMES)}")
+    sizes = parse_resolutions(args.resolutions)
+    if args.frames < 1 or args.pysim_frames < 1:
+        raise UsageError("--frames and --pysim-frames must be at least 1")
+    if args.json:
+        directory = os.path.dirname(os.path.abspath(args.json))
+        if not os.path.isdir(directory):
+            raise UsageError(f"cannot write {args.json}: no directory {directory}")
+
+    results, notes = [], []
+    header = (
+        f"{'backend':<22} {'size':>9} {'frames':>6} {'ms/frame':>10} {'Mcycles/s':>10} "
+        f"{'build s':>8}"
+    )
+    print(header)
+    print("-" * len(header))
+    for w, h in sizes:
+        try:
+            params = FollowTargetParams(width=w, height=h)
+        except (TypeError, ValueError) as exc:
+            raise UsageError(f"resolution {w}x{h}: {exc}") from None
+        frames = bench_frames(w, h, args.frames, args.seed)
+        cases = [(n, "follow_target") for n in names]
+        if not args.no_trivial:
+            cases += [(n, "passthrough") for n in names if n in COMPILED_BACKENDS]
+        for name, design in cases:
+            case_frames = frames
+            if name == "pysim":
+                if w * h > args.pysim_max_pixels:
+                    notes.append(
+                        f"pysim skipped at {w}x{h} (about {w * h / 19200:.0f} s a frame); "
+                        f"raise --pysim-max-pixels to include it"
+                    )
+                    continue
+                case_frames = frames[: args.pysim_frames]
+            try:
+                r = run_one(name, params, case_frames, design)
+            except BackendError as exc:
+                raise UsageError(f"the {name} backend cannot run here: {exc}") from None
+            results.append(r)
+            print(_format_row(r), flush=True)
+    for line in notes + summary(results):
+        print(line)
+    if args.json:
+        _write_json(args.json, results, notes)
+        print(f"figures written to {args.json}")
+    return 0
+
+
+def _write_json(path, results, notes):
+    from .sim.backends.toolchain import find_compiler
+
+    try:
+        compiler = find_compiler().version
+    except BackendError:
+        compiler = None
+    data = {
+        "machine": {
+            "platform": platform.platform(),
+            "python": platform.python_version(),
+            "cpus": os.cpu_count(),
+            "compiler": compiler,
+        },
+        "results": results,
+        "notes": notes,
+        "summary": summary(results),
+    }
+    tmp = f"{path}.partial"
+    with open(tmp, "w") as f:
+        json.dump(data, f, indent=1)
+    os.replace(tmp, path)
+
+
+if __name__ == "__main__":
+    run_cli(main, sys.argv[1:], prog="python -m fpga_robotics.bench")
