@@ -135,3 +135,8 @@ def test_malformed_list_is_an_argparse_error(tmp_path, capsys):
         main(["-o", str(tmp_path / "x.v"), "--base-dps", "0,fast"])
     assert exit_info.value.code == 2
     assert "comma-separated integers" in capsys.readouterr().err
+
+
+def test_output_is_deterministic():
+    # Same parameters, same text (build caches key on it).
+    assert generate_verilog() == generate_verilog()

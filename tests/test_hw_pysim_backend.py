@@ -168,3 +168,17 @@ def test_an_unfinished_waveform_leaves_no_file_behind(tmp_path):
     del sim  # dropped before the last requested frame, without close()
     gc.collect()
     assert os.listdir(tmp_path) == []
+
+
+@pytest.mark.parametrize("size", [
+    (320, 240),
+    pytest.param((640, 480), marks=pytest.mark.slow),
+])
+def test_larger_geometries_match_the_model(size):
+    w, h = size
+    p = FollowTargetParams(width=w, height=h)
+    rng = np.random.default_rng(w)
+    frame = synthetic.blob_frame(w, h, "yellow", cx=w * 0.7, cy=h / 2, radius=h / 4, rng=rng)
+    with PysimBackend(p) as sim, ModelBackend(p) as model:
+        got, want = sim.process_frame(frame, "yellow"), model.process_frame(frame, "yellow")
+    assert got == want and got.found and got.centroid_x > w // 2
