@@ -243,3 +243,16 @@ def test_every_shipped_scenario_passes_with_the_default_design(name):
     r = run_scenario(s, backend="model")
     failed = [c["text"] for c in r.summary["checks"] if not c["passed"]]
     assert r.summary["verdict"] == "pass", failed
+
+
+def test_the_steering_gain_grows_with_the_resolution():
+    """``kp_num`` is DPS per pixel of centroid error: at 320x240 a radian of error is twice
+    the pixels, so the robot turns twice as hard and keeps up with the person who escapes
+    it at 160x120 (lost_target then fails: the loss it is meant to test never happens)."""
+    low = run_scenario(load_scenario("lost_target", ["sim.duration=6"]), backend="model")
+    high = run_scenario(load_scenario("lost_target", ["sim.duration=6",
+                                                      'camera.resolution="320x240"']),
+                        backend="model")
+    assert low.summary["searches"] == 1 and high.summary["searches"] == 0
+    assert high.trajectory["found"].all()
+    assert np.abs(high.trajectory["w"]).max() > 1.5 * np.abs(low.trajectory["w"][:100]).max()
