@@ -34,6 +34,7 @@ __all__ = [
     "pack_transfer",
     "run_follow_target",
     "run_schedule",
+    "run_testbench",
     "small_params",
     "stream_get",
     "stream_put",
@@ -114,25 +115,44 @@ def edges_where(trace, name):
 
 
 async def stream_put(ctx, stream, payload):
-    """Present one transfer on a non-stallable stream, sampled at the next edge."""
-    ctx.set(stream.payload, payload)
+    """Present one transfer on a non-stallable stream, sampled at the next edge. ``payload``
+    is an int (the raw bits) or what the payload's layout accepts."""
+    ctx.set(_cast(stream.payload) if isinstance(payload, int) else stream.payload, payload)
     ctx.set(stream.valid, 1)
     await ctx.tick()
     ctx.set(stream.valid, 0)
 
 
 async def stream_get(ctx, stream, *, timeout=1000):
-    """Wait (at most ``timeout`` edges) for a transfer on a non-stallable stream; return its
-    payload as an int."""
-    for _ in range(timeout):
-        await ctx.tick()
+    """Take the next transfer of a non-stallable stream (waiting at most ``timeout`` edges):
+    a transfer happens at the edge where ``valid`` is high. Returns the payload as an int,
+    after that edge."""
+    payload = _cast(stream.payload)
+    for _ in range(timeout + 1):
         if ctx.get(stream.valid):
-            return ctx.get(_cast(stream.payload))
+            value = ctx.get(payload)
+            await ctx.tick()
+            return value
+        await ctx.tick()
     raise WatchdogTimeout(f"no transfer on the stream within {timeout} edges")
 
 
-def run_schedule(dut, drive, schedule, probes, *, static=None, tail=64, watchdog=None,
-                 vcd=None):
+def run_testbench(dut, bench, *, watchdog):
+    """Simulate ``dut`` with the async testbench ``bench`` and a watchdog that fails the run
+    after ``watchdog`` edges."""
+
+    async def watchdog_bench(ctx):
+        await ctx.delay(watchdog * PERIOD)  # one timer, no per-edge cost
+        raise WatchdogTimeout(f"simulation still running after {watchdog} edges")
+
+    sim = Simulator(dut)
+    sim.add_clock(PERIOD)
+    sim.add_testbench(bench)
+    sim.add_testbench(watchdog_bench, background=True)
+    sim.run()
+
+
+def run_schedule(dut, drive, schedule, probes, *, static=None, tail=64, watchdog=None):
     """Clock ``dut`` through ``schedule`` and return the traced probes.
 
     Parameters
@@ -184,19 +204,7 @@ def run_schedule(dut, drive, schedule, probes, *, static=None, tail=64, watchdog
                 trace[name].append(ctx.get(value))
         done.append(True)
 
-    async def watchdog_bench(ctx):
-        await ctx.delay(limit * PERIOD)  # one timer, no per-edge cost
-        raise WatchdogTimeout(f"simulation still running after {limit} edges")
-
-    sim = Simulator(dut)
-    sim.add_clock(PERIOD)
-    sim.add_testbench(bench)
-    sim.add_testbench(watchdog_bench, background=True)
-    if vcd:
-        with sim.write_vcd(vcd):
-            sim.run()
-    else:
-        sim.run()
+    run_testbench(dut, bench, watchdog=limit)
     assert done, "testbench did not finish"
     return {name: _as_array(values) for name, values in trace.items()}
 

@@ -10,7 +10,10 @@ from hwsim import (
     edges_where,
     pack_transfer,
     run_schedule,
+    run_testbench,
     small_params,
+    stream_get,
+    stream_put,
 )
 from scalar_reference import scalar_match
 
@@ -118,3 +121,22 @@ def test_color_select_is_sampled_with_each_pixel():
                          {"valid": dut.filtered.valid, "payload": dut.filtered.payload}, tail=3)
     assert list(trace["payload"][edges_where(trace, "valid")]) == [red, green, 0]
 
+
+
+def test_single_transfers_with_stream_helpers():
+    # One pixel at a time through the shared put/get helpers; the get's timeout is the
+    # latency: the filtered pixel is there right after the edge that took the input.
+    p = small_params()
+    dut = ColorFilter(p)
+    pixels = [0xF11, 0x1F1, 0xE22, 0x000]
+    got = []
+
+    async def bench(ctx):
+        ctx.set(dut.color_sel, COLOR_SELECT["red"])
+        for value in pixels:
+            await stream_put(ctx, dut.pixels, pack_transfer(value, last=True))
+            got.append(await stream_get(ctx, dut.filtered, timeout=p.filter_latency - 1))
+
+    run_testbench(dut, bench, watchdog=50)
+    expected = [v if scalar_match(v, COLOR_SELECT["red"]) else 0 for v in pixels]
+    assert got == [pack_transfer(v, last=True) for v in expected]

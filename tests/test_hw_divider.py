@@ -4,8 +4,7 @@
 import random
 
 import pytest
-from amaranth.sim import Simulator
-from hwsim import PERIOD, WatchdogTimeout
+from hwsim import WatchdogTimeout, run_testbench
 
 from fpga_robotics.hw.divider import SequentialDivider
 
@@ -42,15 +41,7 @@ def divide_all(cases, dividend_bits, divisor_bits, quotient_bits, *, change_inpu
             assert ctx.get(dut.quotient) == quotient, "the quotient holds"
             out.append((quotient, edges - 1))
 
-    async def watchdog(ctx):
-        await ctx.delay(limit * PERIOD)
-        raise WatchdogTimeout(f"still running after {limit} edges")
-
-    sim = Simulator(dut)
-    sim.add_clock(PERIOD)
-    sim.add_testbench(bench)
-    sim.add_testbench(watchdog, background=True)
-    sim.run()
+    run_testbench(dut, bench, watchdog=limit)
     return out
 
 

@@ -3,8 +3,7 @@ counter, search direction, reset state and latency."""
 
 import numpy as np
 import pytest
-from amaranth.sim import Simulator
-from hwsim import PERIOD, WatchdogTimeout, WithReset, small_params
+from hwsim import WithReset, run_testbench, small_params
 
 from fpga_robotics.hw.motor import MotorController
 from fpga_robotics.hw.params import FollowTargetParams
@@ -46,15 +45,7 @@ def run_motor(params, frames, *, idle=3, reset_after=None):
             await ctx.tick().repeat(idle)
             assert (ctx.get(dut.left), ctx.get(dut.right)) == after
 
-    async def watchdog(ctx):
-        await ctx.delay(limit * PERIOD)
-        raise WatchdogTimeout(f"still running after {limit} edges")
-
-    sim = Simulator(top)
-    sim.add_clock(PERIOD)
-    sim.add_testbench(bench)
-    sim.add_testbench(watchdog, background=True)
-    sim.run()
+    run_testbench(top, bench, watchdog=limit)
     return out
 
 
