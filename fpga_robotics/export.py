@@ -151,8 +151,16 @@ def main(argv=None):
         return run_board(args, params, out_dir)
     if args.bitstream:
         raise UsageError("--bitstream needs --board NAME (e.g. --board ulx3s-85f)")
+    if os.path.isdir(args.output):
+        raise UsageError(
+            f"{args.output} is a directory; give the Verilog file's path, e.g. "
+            f"{os.path.join(args.output, TOP_NAME + '.v')}"
+        )
     text = generate_verilog(params)
-    write_atomically(args.output, text)
+    try:
+        write_atomically(args.output, text)
+    except OSError as exc:
+        raise UsageError(f"cannot write {args.output}: {exc.strerror or exc}") from None
     print(f"wrote {args.output} ({params.width}x{params.height}, module {TOP_NAME})")
     return 0
 

@@ -140,3 +140,15 @@ def test_malformed_list_is_an_argparse_error(tmp_path, capsys):
 def test_output_is_deterministic():
     # Same parameters, same text (build caches key on it).
     assert generate_verilog() == generate_verilog()
+
+
+def test_output_path_errors_are_usage_errors(tmp_path):
+    blocker = tmp_path / "file"
+    blocker.write_text("")
+    for out, message in ((tmp_path, "is a directory"), (blocker / "x.v", "cannot write")):
+        result = subprocess.run(
+            [sys.executable, "-m", "fpga_robotics.export", "-o", str(out)],
+            capture_output=True, text=True, timeout=300, check=False,
+        )
+        assert result.returncode == 2 and message in result.stderr, result.stderr
+        assert "Traceback" not in result.stderr
