@@ -372,10 +372,10 @@ def test_lost_frames_1_searches_on_the_first_lost_frame():
     assert m.step(NOT_SEEN) == (-30, 30)  # right side, with a negative search speed
 
 
-def test_search_speed_is_a_16_bit_value():
-    m = MotorModel(FollowTargetParams(lost_frames=1, search_dps=-(2**15)))
-    # -(-32768) does not fit in 16 bits: the register holds -32768 on both wheels.
-    assert m.step(NOT_SEEN) == (-(2**15), -(2**15))
+def test_search_speed_extremes_negate_without_wrapping():
+    # search_dps is limited to +-32767 (params), so both wheels' values fit 16 bits.
+    m = MotorModel(FollowTargetParams(lost_frames=1, search_dps=-(2**15) + 1))
+    assert m.step(NOT_SEEN) == (2**15 - 1, -(2**15) + 1)  # last_side left after reset
     m = MotorModel(FollowTargetParams(lost_frames=1, search_dps=2**15 - 1))
     assert m.step(NOT_SEEN) == (-(2**15) + 1, 2**15 - 1)
 
