@@ -7,7 +7,7 @@ import sys
 
 import pytest
 
-from fpga_robotics.export import generate_verilog, main
+from fpga_robotics.export import default_file_mode, generate_verilog, main
 from fpga_robotics.hw.params import FollowTargetParams
 from fpga_robotics.sim.backends.toolchain import verilator_root
 
@@ -99,6 +99,7 @@ def test_cli_writes_one_file_and_creates_the_directory(tmp_path, capsys):
     assert "module follow_target(" in text and text.count("endmodule") >= 1
     assert top_ports(text)["centroid_x"] == ("output", 9)
     assert os.listdir(out.parent) == ["ft.v"]  # no temporary file left behind
+    assert out.stat().st_mode & 0o777 == default_file_mode()  # not mkstemp's private 0600
     assert "wrote" in capsys.readouterr().out
 
 

@@ -113,6 +113,7 @@ def test_waveform_covers_only_the_requested_frames(tmp_path):
         size_after_frame_2 = path.stat().st_size
     assert path.stat().st_size == size_after_frame_2  # frame 3 was not traced
     assert sorted(os.listdir(tmp_path)) == [path.name]  # no temporary file left
+    assert path.stat().st_mode & 0o077 != 0  # a normal file, not mkstemp's private 0600
     times, names = vcd_times_and_names(path)
     assert {"frame_done", "pixels__payload", "motor_left", "centroid_x"} <= names
     # Rising edge n of the simulation is at (n - 1/2) periods; frame 1 starts after the last

@@ -12,12 +12,12 @@ collects the filtered pixels of a line into another wide signal that the testben
 per line. Only the few cycles after the frame's last pixel are stepped one by one, to detect
 ``frame_done``.
 
-When a ``WaveformRequest`` is given, the harness's wide signals would swamp the VCD, so the
-design is driven directly instead, one pixel per testbench step (about twice as slow); the VCD
-then holds every signal of the design (and the small harness) from the start of frame
-``first_frame`` to the end of frame ``last_frame``. Amaranth only starts waveforms at time 0
-through its public API; this backend starts them later through the simulation engine's own
-``write_vcd`` (Amaranth 0.5), which dumps the current values first.
+A ``WaveformRequest`` gets a VCD of every signal of the design from the start of frame
+``first_frame`` to the end of frame ``last_frame``. The harness's signals have private (empty)
+names, which Amaranth leaves out of waveforms, so the wide line signals do not swamp the file.
+Amaranth only starts waveforms at time 0 through its public API; this backend starts them later
+through the simulation engine's own ``write_vcd`` (Amaranth 0.5), which dumps the current
+values first.
 """
 
 import os
@@ -25,7 +25,7 @@ import tempfile
 import weakref
 
 import numpy as np
-from amaranth import Cat, ClockDomain, Elaboratable, Module, Mux, Signal, Value
+from amaranth import Cat, ClockDomain, Const, Elaboratable, Module, Mux, Signal, Value
 from amaranth.sim import Simulator
 
 from ...hw.top import FollowTarget
@@ -48,20 +48,19 @@ WATCHDOG_MARGIN = 1024
 
 
 class _Harness(Elaboratable):
-    """Simulation-only wrapper: the clock domain, and (``fast``) the line-at-a-time driver and
-    collector."""
+    """Simulation-only wrapper: the clock domain with its reset, and the line-at-a-time pixel
+    driver and filtered-line collector. Its own signals have private names (``name=""``):
+    they stay out of waveforms."""
 
-    def __init__(self, dut, fast):
+    def __init__(self, dut):
         self.dut = dut
-        self.fast = fast
         width = dut.params.width
-        self.rst = Signal()
-        self.done_count = Signal(16)  # frame_done pulses seen (mod 2**16)
-        if fast:
-            self.line = Signal(LANE * width)  # payload of pixel x in lane x
-            self.line_valid = Signal()
-            self.captured = Signal(LANE * width)  # the last complete line of `filtered`
-            self.captured_lines = Signal(16)  # complete lines collected (mod 2**16)
+        self.rst = Signal(name="")
+        self.done_count = Signal(16, name="")  # frame_done pulses seen (mod 2**16)
+        self.line = Signal(LANE * width, name="")  # payload of pixel x in lane x
+        self.line_valid = Signal(name="")
+        self.captured = Signal(LANE * width, name="")  # the last complete line of `filtered`
+        self.captured_lines = Signal(16, name="")  # complete lines collected (mod 2**16)
 
     def elaborate(self, platform):
         m = Module()
@@ -70,11 +69,9 @@ class _Harness(Elaboratable):
         m.submodules.dut = dut = self.dut
         with m.If(dut.frame_done):
             m.d.sync += self.done_count.eq(self.done_count + 1)
-        if not self.fast:
-            return m
 
         width = dut.params.width
-        index = Signal(range(width))  # pixel of the line on the input now
+        index = Signal(range(width), name="")  # pixel of the line on the input now
         with m.If(self.line_valid):
             m.d.sync += index.eq(Mux(index == width - 1, 0, index + 1))
         m.d.comb += [
@@ -82,9 +79,10 @@ class _Harness(Elaboratable):
             dut.pixels.payload.eq(self.line.word_select(index, LANE)),
         ]
 
-        shift = Signal(LANE * width)  # filtered payloads of the line so far, newest on top
-        count = Signal(range(width))
-        shifted = Cat(shift[LANE:], Value.cast(dut.filtered.payload), Signal(LANE - 14))
+        # Filtered payloads of the line so far, newest on top; a full line is copied out.
+        shift = Signal(LANE * width, name="")
+        count = Signal(range(width), name="")
+        shifted = Cat(shift[LANE:], Value.cast(dut.filtered.payload), Const(0, LANE - 14))
         with m.If(dut.filtered.valid):
             m.d.sync += shift.eq(shifted)
             with m.If(count == width - 1):
@@ -118,7 +116,7 @@ class PysimBackend(DesignBackend):
         if waveform is not None:
             _check_waveform(waveform)
         self.dut = FollowTarget(self.params)
-        self._harness = _Harness(self.dut, fast=waveform is None)
+        self._harness = _Harness(self.dut)
         self._sim = Simulator(self._harness)
         self._sim.add_clock(PERIOD)
         self._started = False  # the testbench is added with the first job (see _submit)
@@ -206,6 +204,7 @@ class PysimBackend(DesignBackend):
             vcd, self._vcd = self._vcd, None
             self._traced = True
             vcd.__exit__(None, None, None)
+            os.chmod(self._vcd_tmp, _default_file_mode())  # mkstemp made it private
             os.replace(self._vcd_tmp, os.fspath(self.waveform.path))
             self._vcd_cleanup.detach()
 
@@ -240,10 +239,7 @@ class PysimBackend(DesignBackend):
         lanes = packed | self._lane_flags
         done_before = ctx.get(harness.done_count)
 
-        if harness.fast:
-            lines = await self._stream_fast(ctx, lanes)
-        else:
-            lines = await self._stream_traced(ctx, lanes)
+        lines = await self._stream_lines(ctx, lanes)
         edge = height * (width + lb)  # edges so far in this call
         if ctx.get(harness.done_count) != done_before:
             raise BackendError("frame_done came before the frame's last pixel was sampled")
@@ -265,24 +261,19 @@ class PysimBackend(DesignBackend):
                 done_edge = edge
         end = max(height * (width + lb) + self.frame_blank, done_edge + p.motor_latency)
         while edge < end:
-            if harness.fast and len(lines) >= height:
+            if len(lines) >= height:
                 await ctx.tick().repeat(end - edge)
                 edge = end
             else:
                 await self._tick_collect(ctx, lines)
                 edge += 1
-        if harness.fast:
-            self._collect_fast(ctx, lines)
-        if len(lines) != height * (1 if harness.fast else width):
+        self._collect_line(ctx, lines)
+        if len(lines) != height:
             raise BackendError(
-                f"the design put out {_count_pixels(lines, harness.fast, width)} filtered "
-                f"pixels for a frame of {width * height}"
+                f"the design put out {len(lines)} complete filtered lines (of {width} pixels) "
+                f"for a frame of {height}"
             )
-
-        if harness.fast:
-            filtered = np.frombuffer(b"".join(lines), dtype="<u2").reshape(height, width)
-        else:
-            filtered = np.array(lines, dtype=np.uint16).reshape(height, width)
+        filtered = np.frombuffer(b"".join(lines), dtype="<u2").reshape(height, width)
         flags = filtered & (FIRST | LAST)
         if not np.array_equal(flags, self._lane_flags):
             raise BackendError("the filtered stream's first/last flags differ from the input's")
@@ -297,24 +288,24 @@ class PysimBackend(DesignBackend):
             cycles=end,
         )
 
-    async def _stream_fast(self, ctx, lanes):
+    async def _stream_lines(self, ctx, lanes):
+        """Drive the frame one line at a time; return the filtered lines collected so far."""
         harness, lb = self._harness, self.line_blank
         width = self.params.width
         lines = []
         self._captured_seen = ctx.get(harness.captured_lines)
-        rows = lanes.astype("<u2", copy=False)
-        for row in rows:
+        for row in lanes.astype("<u2", copy=False):
             ctx.set(harness.line, int.from_bytes(row.tobytes(), "little"))
             ctx.set(harness.line_valid, 1)
             await ctx.tick().repeat(width)
             ctx.set(harness.line_valid, 0)
-            self._collect_fast(ctx, lines)
+            self._collect_line(ctx, lines)
             if lb:
                 await ctx.tick().repeat(lb)
         return lines
 
-    def _collect_fast(self, ctx, lines):
-        """Take the harness's newest complete line, if there is one we have not read."""
+    def _collect_line(self, ctx, lines):
+        """Take the harness's newest complete filtered line, if there is one not yet read."""
         harness = self._harness
         seen = ctx.get(harness.captured_lines)
         new = (seen - self._captured_seen) & 0xFFFF
@@ -325,27 +316,16 @@ class PysimBackend(DesignBackend):
         self._captured_seen = seen
         lines.append(ctx.get(harness.captured).to_bytes(LANE // 8 * self.params.width, "little"))
 
-    async def _stream_traced(self, ctx, lanes):
-        dut, lb = self.dut, self.line_blank
-        payload = Value.cast(dut.pixels.payload)
-        lines = []
-        for row in lanes.tolist():
-            ctx.set(dut.pixels.valid, 1)
-            for value in row:
-                ctx.set(payload, value)
-                await self._tick_collect(ctx, lines)
-            ctx.set(dut.pixels.valid, 0)
-            for _ in range(lb):
-                await self._tick_collect(ctx, lines)
-        return lines
-
     async def _tick_collect(self, ctx, lines):
-        """One edge; in traced mode also collect a filtered transfer, in fast mode a line."""
+        """One edge, then collect a filtered line if one has completed."""
         await ctx.tick()
-        if self._harness.fast:
-            self._collect_fast(ctx, lines)
-        elif ctx.get(self.dut.filtered.valid):
-            lines.append(ctx.get(Value.cast(self.dut.filtered.payload)))
+        self._collect_line(ctx, lines)
+
+
+def _default_file_mode():
+    umask = os.umask(0)
+    os.umask(umask)
+    return 0o666 & ~umask
 
 
 def _remove_if_exists(path):
@@ -353,10 +333,6 @@ def _remove_if_exists(path):
         os.unlink(path)
     except FileNotFoundError:
         pass
-
-
-def _count_pixels(lines, fast, width):
-    return len(lines) * width if fast else len(lines)
 
 
 def _check_waveform(waveform):
