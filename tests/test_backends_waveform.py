@@ -63,7 +63,7 @@ def frames():
     return synthetic.scenario("centre", 40, 16, n_frames=4, rng=rng).frames
 
 
-@pytest.mark.parametrize("name", ["cxxrtl", "verilator"])
+@pytest.mark.parametrize("name", ["cxxrtl", pytest.param("verilator", marks=pytest.mark.slow)])
 def test_vcd_holds_the_ports_and_only_the_requested_frames(name, tmp_path):
     path = tmp_path / "wave" / f"{name}.vcd"
     with get_backend(name, PARAMS, waveform=WaveformRequest(str(path), 1, 2)) as b:
