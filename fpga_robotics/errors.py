@@ -13,8 +13,9 @@ class UsageError(Exception):
 
 
 def run_cli(main, argv=None, prog=None):
-    """Call ``main(argv)``; print a ``UsageError`` (or ``ValueError``/``TypeError`` from
-    parameter validation, or a missing file) as one line and exit 2, without a traceback."""
+    """Call ``main(argv)``; print a ``UsageError``, a ``FrameError`` or a missing file as one
+    line and exit 2, without a traceback. CLIs convert parameter ``ValueError``s into
+    ``UsageError`` themselves, so that a bug elsewhere still shows its traceback."""
     from .sim.frames import FrameError
 
     name = prog or "fpga_robotics"
