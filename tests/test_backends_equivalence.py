@@ -175,3 +175,32 @@ def test_watchdog_turns_a_missing_frame_done_into_backend_error():
         b._args[1] = SMALL_A.height - 1
         with pytest.raises(BackendError, match="never raised frame_done"):
             b.process_frame(np.zeros((16, 40), np.uint16))
+
+
+@pytest.mark.parametrize("name", ["cxxrtl", pytest.param("verilator", marks=pytest.mark.slow)])
+def test_both_harness_loops_agree_with_hand_computed_pass_through(name):
+    """The one-evaluation loop (outputs are flip-flops) and the general two-evaluation loop
+    (combinational outputs) give the same, hand-computable results for the pass-through
+    design: filtered = the frame, motor_left = the pixel count, cycles = pixels + blanking
+    (its result latency is 1, motor latency 0)."""
+    from fpga_robotics.sim.backends.cxxrtl import output_sources
+    from fpga_robotics.sim.backends.designs import DesignSource
+
+    p = FollowTargetParams(width=40, height=16)
+    assert output_sources(DesignSource(p, "passthrough").cxxrtl()) is not None
+    assert output_sources(DesignSource(p, "passthrough_comb").cxxrtl()) is None
+    rng = np.random.default_rng(11)
+    frames = [rng.integers(0, 4096, (16, 40), dtype=np.uint16) for _ in range(3)]
+    for line_blank, frame_blank in BLANKINGS:
+        expected_cycles = max(
+            16 * (40 + line_blank) + frame_blank, 16 * (40 + line_blank) - line_blank + 1
+        )
+        for design in ("passthrough", "passthrough_comb"):
+            with get_backend(
+                name, p, design=design, line_blank=line_blank, frame_blank=frame_blank
+            ) as b:
+                for frame in frames:
+                    r = b.process_frame(frame)
+                    assert np.array_equal(r.filtered, frame), design
+                    assert (r.found, r.motor_left, r.centroid_leds) == (True, 640, 640 & 0xFF)
+                    assert r.cycles == expected_cycles, design

@@ -62,6 +62,7 @@ class _Library:
         for name, restype, argtypes in (
             ("fr_abi_version", ctypes.c_int, []),
             ("fr_traced", ctypes.c_int, []),
+            ("fr_evals_per_cycle", ctypes.c_int, []),
             ("fr_create", _VP, []),
             ("fr_destroy", None, [_VP]),
             ("fr_reset", None, [_VP]),
@@ -80,6 +81,8 @@ class _Library:
             raise BackendError(f"the compiled model {path} has an unexpected harness ABI")
         self.lib = lib
         self.path = path
+        #: Simulator evaluations per clock cycle (1 when every output is a flip-flop).
+        self.evals_per_cycle = lib.fr_evals_per_cycle()
 
 
 class CompiledBackend(DesignBackend):

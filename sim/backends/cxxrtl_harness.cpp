@@ -23,7 +23,14 @@ namespace {
 
 using Top = cxxrtl_design::p_follow__target;
 
+#if defined(FR_REGISTERED_OUTPUTS) && !defined(FR_TRACE)
+constexpr int EVALS_PER_CYCLE = 1;
+#else
+constexpr int EVALS_PER_CYCLE = 2;
+#endif
+
 struct Sim {
+    static constexpr int evals_per_cycle = EVALS_PER_CYCLE;
     Top top;
 
     inline void set_inputs(bool valid, uint16_t payload, uint8_t color_sel) {
@@ -34,7 +41,7 @@ struct Sim {
     inline void set_rst(bool on) { top.p_rst.set<bool>(on); }
     inline void settle() {
         top.p_clk.set<bool>(false);
-#if defined(FR_REGISTERED_OUTPUTS) && !defined(FR_TRACE)
+#if defined(FR_REGISTERED_OUTPUTS) && !defined(FR_TRACE)  // EVALS_PER_CYCLE == 1
         // Nothing changed since the edge's commit() but the clock: record it as commit() would.
         top.prev_p_clk = top.p_clk;
 #else

@@ -15,7 +15,7 @@ __all__ = ["DESIGNS", "TOP_NAME", "DesignSource", "component_ports"]
 TOP_NAME = "follow_target"
 
 #: Designs that ``design=`` accepts.
-DESIGNS = ("follow_target", "passthrough")
+DESIGNS = ("follow_target", "passthrough", "passthrough_comb")
 
 
 def component_ports(component):
@@ -38,7 +38,8 @@ class DesignSource:
     ----------
     params : FollowTargetParams
     design : str
-        ``"follow_target"`` or ``"passthrough"``.
+        ``"follow_target"``, ``"passthrough"`` (the benchmark's trivial design) or
+        ``"passthrough_comb"`` (the same with combinational outputs, for tests).
     """
 
     def __init__(self, params, design="follow_target"):
@@ -64,7 +65,9 @@ class DesignSource:
             from ...hw.top import FollowTarget
 
             return FollowTarget(self.params)
-        return self._passthrough_class()(self.params)
+        return self._passthrough_class()(
+            self.params, registered_outputs=self.design == "passthrough"
+        )
 
     def verilog(self):
         """Verilog text, top module ``follow_target``."""

@@ -153,6 +153,7 @@ void reset(S &sim) {
 #define FR_DEFINE_C_API(SIM)                                                                  \
     FR_EXPORT int fr_abi_version() { return fr::ABI_VERSION; }                                \
     FR_EXPORT int fr_traced() { return SIM::traced; }                                         \
+    FR_EXPORT int fr_evals_per_cycle() { return SIM::evals_per_cycle; }                       \
     FR_EXPORT void *fr_create() { return new SIM(); }                                         \
     FR_EXPORT void fr_destroy(void *h) { delete static_cast<SIM *>(h); }                      \
     FR_EXPORT void fr_reset(void *h) { fr::reset(*static_cast<SIM *>(h)); }                   \

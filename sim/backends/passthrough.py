@@ -7,7 +7,7 @@ machine (the benchmark's reference), and to exercise the harness before the real
 It is gateware: it imports nothing from the host side.
 """
 
-from amaranth import Module, Mux, Signal, unsigned
+from amaranth import Module, Mux, ResetSignal, Signal, unsigned
 from amaranth.lib import wiring
 from amaranth.lib.wiring import In, Out
 
@@ -23,6 +23,9 @@ class PassThrough(wiring.Component):
     ----------
     params : FollowTargetParams
         Only ``width``, ``height`` and ``x_bits`` are used.
+    registered_outputs : bool
+        False makes every output combinational (through logic that also reads ``rst``), with
+        the same values in every frame: it exercises the harnesses' general two-evaluation loop.
 
     Members
     -------
@@ -32,8 +35,8 @@ class PassThrough(wiring.Component):
         ``pixels`` one cycle later, unchanged.
     frame_done, found, proximity, centroid_x, centroid_leds, motor_left, motor_right : Out
         ``frame_done`` pulses two cycles after the frame's last pixel (so that the last
-        filtered pixel is out before the results, as the frame driver requires); the others show the
-        pixel count's low bits (``found`` when the count is non-zero).
+        filtered pixel is out before the results, as the frame driver requires); the others
+        show the pixel count's low bits (``found`` when the count is non-zero).
     """
 
     #: Latencies in the sense of ``FollowTargetParams`` (see docs/backends.md).
@@ -41,8 +44,9 @@ class PassThrough(wiring.Component):
     result_latency = 1
     motor_latency = 0
 
-    def __init__(self, params):
+    def __init__(self, params, *, registered_outputs=True):
         self.params = params
+        self.registered_outputs = registered_outputs
         super().__init__(
             {
                 "pixels": In(PixelStream()),
@@ -61,25 +65,43 @@ class PassThrough(wiring.Component):
     def elaborate(self, platform):
         m = Module()
         p = self.params
+        ports = {
+            "filtered_valid": self.filtered.valid,
+            "filtered_payload": self.filtered.payload.as_value(),
+            "frame_done": self.frame_done,
+            "found": self.found,
+            "proximity": self.proximity,
+            "centroid_x": self.centroid_x,
+            "centroid_leds": self.centroid_leds,
+            "motor_left": self.motor_left,
+            "motor_right": self.motor_right,
+        }
+        if self.registered_outputs:
+            out = ports
+        else:
+            # Test variant: every output goes through logic that also reads the `rst` input,
+            # so the outputs are combinational (and 0 during reset, which no frame observes).
+            out = {name: Signal.like(port, name=f"{name}_q") for name, port in ports.items()}
+            m.d.comb += [ports[n].eq(Mux(ResetSignal(), 0, out[n])) for n in ports]
+
         count = Signal(unsigned((p.pixels_per_frame).bit_length()))
         line = Signal(range(p.height + 1))
-
         total = Signal.like(count)
         ended = Signal()  # the frame's last pixel was sampled at the previous edge
         m.d.sync += [
-            self.filtered.valid.eq(self.pixels.valid),
-            self.filtered.payload.eq(self.pixels.payload),
+            out["filtered_valid"].eq(self.pixels.valid),
+            out["filtered_payload"].eq(self.pixels.payload),
             ended.eq(0),
-            self.frame_done.eq(ended),
+            out["frame_done"].eq(ended),
         ]
         with m.If(ended):
             m.d.sync += [
-                self.found.eq(total != 0),
-                self.proximity.eq(total[:3]),
-                self.centroid_x.eq(total[: p.x_bits]),
-                self.centroid_leds.eq(total[:8]),
-                self.motor_left.eq(total[:16]),
-                self.motor_right.eq(~total[:16]),
+                out["found"].eq(total != 0),
+                out["proximity"].eq(total[:3]),
+                out["centroid_x"].eq(total[: p.x_bits]),
+                out["centroid_leds"].eq(total[:8]),
+                out["motor_left"].eq(total[:16]),
+                out["motor_right"].eq(~total[:16]),
             ]
         with m.If(self.pixels.valid):
             pix = self.pixels.payload

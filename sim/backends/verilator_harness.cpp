@@ -57,6 +57,7 @@ constexpr bool ONE_EVAL = false;
 #endif
 
 struct Sim {
+    static constexpr int evals_per_cycle = ONE_EVAL ? 1 : 2;
     std::unique_ptr<VerilatedContext> context;
     std::unique_ptr<Vfollow_target> top;
 
