@@ -13,6 +13,7 @@ followed by ``line_blank`` idle cycles). The driver then runs idle cycles until 
 ``FrameResult.cycles`` counts every clock edge of the call.
 """
 
+import os
 from abc import ABC, abstractmethod
 from dataclasses import dataclass
 
@@ -22,7 +23,7 @@ from ...hw.params import FollowTargetParams
 from ...hw.pixel import color_select_value
 from ..frames import to_rgb444
 
-__all__ = ["FrameResult", "DesignBackend", "BackendError", "WaveformRequest"]
+__all__ = ["BackendError", "DesignBackend", "FrameResult", "WaveformRequest"]
 
 
 class BackendError(RuntimeError):
@@ -41,6 +42,26 @@ class WaveformRequest:
 
     def covers(self, frame_index):
         return self.first_frame <= frame_index <= self.last_frame
+
+    def check(self, backend_name, suffixes=(".vcd",), hint=""):
+        """Raise ``BackendError`` unless a backend writing ``suffixes`` can honour this request.
+
+        ``hint`` names where to turn for other formats (e.g. "or the verilator backend for
+        .fst")."""
+        path = os.fspath(self.path)
+        if not path.endswith(tuple(suffixes)):
+            raise BackendError(
+                f"the {backend_name} backend writes {'/'.join(suffixes)} waveforms only, got "
+                f"{path!r}; use a {suffixes[0]} path{f' ({hint})' if hint else ''}"
+            )
+        directory = os.path.dirname(os.path.abspath(path))
+        if not os.path.isdir(directory):
+            raise BackendError(f"cannot write the waveform: no directory {directory!r}")
+        if self.last_frame < self.first_frame:
+            raise BackendError(
+                f"the waveform's last_frame ({self.last_frame}) is before its first_frame "
+                f"({self.first_frame})"
+            )
 
 
 @dataclass(frozen=True, eq=False)

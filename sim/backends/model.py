@@ -9,10 +9,9 @@ reconstructed from the model at cycle level (see ``model_waveform``); it cannot 
 signals: use the ``pysim``, ``cxxrtl`` or ``verilator`` backend for those.
 """
 
-import os
 
 from ..model import FollowTargetModel
-from .base import BackendError, DesignBackend, FrameResult
+from .base import DesignBackend, FrameResult
 from .model_waveform import ModelWaveformWriter
 
 __all__ = ["ModelBackend", "frame_cycles"]
@@ -50,20 +49,7 @@ class ModelBackend(DesignBackend):
     def __init__(self, params=None, *, line_blank=0, frame_blank=0, waveform=None):
         super().__init__(params, line_blank=line_blank, frame_blank=frame_blank, waveform=waveform)
         if waveform is not None:
-            path = os.fspath(waveform.path)
-            if not path.endswith(".vcd"):
-                raise BackendError(
-                    f"the model backend writes .vcd waveforms only, got {path!r}; use a .vcd "
-                    f"path, or the pysim/cxxrtl/verilator backend for other formats"
-                )
-            directory = os.path.dirname(os.path.abspath(path))
-            if not os.path.isdir(directory):
-                raise BackendError(f"cannot write the waveform: no directory {directory!r}")
-            if waveform.last_frame < waveform.first_frame:
-                raise BackendError(
-                    f"the waveform's last_frame ({waveform.last_frame}) is before its "
-                    f"first_frame ({waveform.first_frame})"
-                )
+            waveform.check("model", hint="or the pysim/cxxrtl/verilator backend for other formats")
         self.model = FollowTargetModel(self.params)
         self._cycles = frame_cycles(self.params, line_blank, frame_blank)
         self._tracer = None

@@ -114,7 +114,7 @@ class PysimBackend(DesignBackend):
     def __init__(self, params=None, *, line_blank=0, frame_blank=0, waveform=None):
         super().__init__(params, line_blank=line_blank, frame_blank=frame_blank, waveform=waveform)
         if waveform is not None:
-            _check_waveform(waveform)
+            waveform.check("pysim", hint="or the verilator backend for .fst")
         self.dut = FollowTarget(self.params)
         self._harness = _Harness(self.dut)
         self._sim = Simulator(self._harness)
@@ -333,23 +333,6 @@ def _remove_if_exists(path):
         os.unlink(path)
     except FileNotFoundError:
         pass
-
-
-def _check_waveform(waveform):
-    path = os.fspath(waveform.path)
-    if not path.endswith(".vcd"):
-        raise BackendError(
-            f"the pysim backend writes .vcd waveforms only, got {path!r}; use a .vcd path "
-            f"(or the verilator backend for .fst)"
-        )
-    directory = os.path.dirname(os.path.abspath(path))
-    if not os.path.isdir(directory):
-        raise BackendError(f"cannot write the waveform: no directory {directory!r}")
-    if waveform.last_frame < waveform.first_frame:
-        raise BackendError(
-            f"the waveform's last_frame ({waveform.last_frame}) is before its first_frame "
-            f"({waveform.first_frame})"
-        )
 
 
 def benchmark(params=None, *, frames=7, line_blank=0, frame_blank=0, seed=0):
