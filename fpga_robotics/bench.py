@@ -58,15 +58,20 @@ def bench_frames(width, height, count, seed):
     return [synthetic.as_rgb444(f) for f in synthetic.sequence(width, height, states, rng=rng)]
 
 
-def measure(backend, frames):
+def measure(backend, frames, min_seconds=0.0):
     """Median ms per frame (wall clock and CPU time) and cycles per second (wall clock) over
-    ``frames``, after one warm-up frame."""
+    ``frames``, after one warm-up frame; the frames repeat until ``min_seconds`` have passed,
+    so that a short burst of other work on a shared machine cannot decide the median."""
     backend.process_frame(frames[0])
     times, cpu_times, cycles = [], [], []
     gc_was_enabled = gc.isenabled()
     gc.disable()
+    begin = time.perf_counter()
     try:
-        for frame in frames:
+        n = 0
+        while n < len(frames) or time.perf_counter() - begin < min_seconds:
+            frame = frames[n % len(frames)]
+            n += 1
             start, cpu_start = time.perf_counter(), time.thread_time()
             result = backend.process_frame(frame)
             times.append(time.perf_counter() - start)
@@ -77,7 +82,7 @@ def measure(backend, frames):
             gc.enable()
     median = statistics.median(times)
     return {
-        "frames": len(frames),
+        "frames": len(times),
         "ms_per_frame": median * 1e3,
         # CPU time of this thread: the same on a quiet machine, and steadier on a busy one.
         "cpu_ms_per_frame": statistics.median(cpu_times) * 1e3,
@@ -86,13 +91,13 @@ def measure(backend, frames):
     }
 
 
-def run_one(name, params, frames, design):
+def run_one(name, params, frames, design, min_seconds=0.0):
     kwargs = {"design": design} if design != "follow_target" else {}
     start = time.perf_counter()
     backend = get_backend(name, params, **kwargs)
     build_s = time.perf_counter() - start
     with backend:
-        figures = measure(backend, frames)
+        figures = measure(backend, frames, min_seconds)
     figures.update(
         backend=name,
         design=design,
@@ -116,7 +121,15 @@ def build_parser():
     parser.add_argument(
         "--resolutions", default=DEFAULT_RESOLUTIONS, help=f"default {DEFAULT_RESOLUTIONS}"
     )
-    parser.add_argument("--frames", type=int, default=30, help="timed frames per case (30)")
+    parser.add_argument(
+        "--frames", type=int, default=30, help="distinct timed frames per case (30)"
+    )
+    parser.add_argument(
+        "--min-seconds",
+        type=float,
+        default=1.0,
+        help="repeat the frames until each case has run this long (1.0; not for pysim)",
+    )
     parser.add_argument(
         "--pysim-frames",
         type=int,
@@ -226,8 +239,9 @@ def main(argv=None):
                     )
                     continue
                 case_frames = frames[: args.pysim_frames]
+            min_seconds = 0.0 if name == "pysim" else args.min_seconds
             try:
-                r = run_one(name, params, case_frames, design)
+                r = run_one(name, params, case_frames, design, min_seconds)
             except BackendError as exc:
                 raise UsageError(f"the {name} backend cannot run here: {exc}") from None
             results.append(r)

@@ -18,6 +18,8 @@ def test_bench_prints_and_writes_figures(tmp_path, capsys):
             "40x16,48x24",
             "--frames",
             "3",
+            "--min-seconds",
+            "0",
             "--json",
             str(path),
         ]
