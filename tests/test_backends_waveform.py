@@ -65,7 +65,7 @@ def frames():
 
 @pytest.mark.parametrize("name", ["cxxrtl", pytest.param("verilator", marks=pytest.mark.slow)])
 def test_vcd_holds_the_ports_and_only_the_requested_frames(name, tmp_path):
-    path = tmp_path / "wave" / f"{name}.vcd"
+    path = tmp_path / f"{name}.vcd"
     with get_backend(name, PARAMS, waveform=WaveformRequest(str(path), 1, 2)) as b:
         results = [b.process_frame(f) for f in frames()]
         assert b._library.lib.fr_traced() == 1
@@ -92,12 +92,14 @@ def test_untraced_build_has_no_tracing():
 
 
 def test_waveform_format_and_range_errors(tmp_path):
-    with pytest.raises(BackendError, match=r"\.vcd"):
+    with pytest.raises(BackendError, match=r"\.vcd waveforms only.*verilator backend for \.fst"):
         get_backend("cxxrtl", PARAMS, waveform=WaveformRequest(str(tmp_path / "w.fst")))
-    with pytest.raises(BackendError, match=r"\.vcd or \.fst"):
+    with pytest.raises(BackendError, match=r"\.vcd/\.fst waveforms only"):
         get_backend("verilator", PARAMS, waveform=WaveformRequest(str(tmp_path / "w.ghw")))
-    with pytest.raises(ValueError, match="first_frame <= last_frame"):
+    with pytest.raises(BackendError, match="before its first_frame"):
         get_backend("cxxrtl", PARAMS, waveform=WaveformRequest(str(tmp_path / "w.vcd"), 3, 1))
+    with pytest.raises(BackendError, match="no directory"):
+        get_backend("cxxrtl", PARAMS, waveform=WaveformRequest(str(tmp_path / "no" / "w.vcd")))
 
 
 @pytest.mark.slow

@@ -109,19 +109,11 @@ class CompiledBackend(DesignBackend):
         self.source = DesignSource(self.params, design)
         variant = "plain"
         if waveform is not None:
-            suffix = Path(waveform.path).suffix.lower()
-            if suffix not in self.waveform_formats:
-                raise BackendError(
-                    f"the {self.name} backend writes waveforms as "
-                    f"{' or '.join(self.waveform_formats)}, not {suffix or 'no suffix'!r} "
-                    f"({waveform.path})"
-                )
-            if waveform.last_frame < waveform.first_frame or waveform.first_frame < 0:
-                raise ValueError(
-                    f"waveform frames must satisfy 0 <= first_frame <= last_frame, got "
-                    f"{waveform.first_frame}..{waveform.last_frame}"
-                )
-            variant = suffix[1:]
+            others = (
+                "or the verilator backend for .fst" if ".fst" not in self.waveform_formats else ""
+            )
+            waveform.check(self.name, self.waveform_formats, others)
+            variant = Path(waveform.path).suffix.lower()[1:]
         self.variant = variant
         self._handle = None
         self._trace_state = "idle"  # idle -> open -> done
@@ -214,7 +206,6 @@ class CompiledBackend(DesignBackend):
 
     def _open_trace(self):
         path = Path(self.waveform.path)
-        path.parent.mkdir(parents=True, exist_ok=True)
         # Written under a temporary name and renamed when complete.
         self._trace_tmp = path.with_name(f".{path.name}.partial{path.suffix}")
         if self._library.lib.fr_trace_open(self._handle, str(self._trace_tmp).encode()) != 0:
