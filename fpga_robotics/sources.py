@@ -44,6 +44,8 @@ class FrameSource:
             if not index.isdigit():
                 raise UsageError(f"--source camera:N needs a device number, got {self.spec!r}")
             self.kind = "camera"
+            # OpenCV's own warnings would print before our message; keep only its errors.
+            cv2.utils.logging.setLogLevel(cv2.utils.logging.LOG_LEVEL_ERROR)
             self._cap = cv2.VideoCapture(int(index))
             if not self._cap.isOpened():
                 self._cap.release()
