@@ -137,15 +137,21 @@ class TrackerResults(wiring.Component):
         counts = self.counts
 
         # --- Snapshot and divide -----------------------------------------------------------
+        # N is the sum of the bins, added up only when a frame ends: written out twice, so
+        # that each use is its own expression under its `end` condition and the compiled
+        # simulators compute it in that cycle only (a shared net would be computed every clock).
+        def frame_count():
+            return sum(counts.bins[k] for k in range(8))
+
         m.submodules.divider = div = SequentialDivider(p.sum_x_bits, p.count_bits, p.x_bits)
         m.d.comb += [
             div.start.eq(counts.end),
             div.dividend.eq(counts.sum_x),
-            div.divisor.eq(counts.count),
+            div.divisor.eq(frame_count()),
         ]
         with m.If(counts.end):
             m.d.sync += [
-                self.count.eq(counts.count),
+                self.count.eq(frame_count()),
                 self.sum_x.eq(counts.sum_x),
                 self.bins.eq(counts.bins),
             ]

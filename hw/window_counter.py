@@ -1,6 +1,6 @@
 """Per-pixel half of the target tracker: framing, window, and the running counts of a frame."""
 
-from amaranth import Cat, Module, Mux, Signal
+from amaranth import Cat, Const, Module, Mux, Signal
 from amaranth.lib import data, wiring
 from amaranth.lib.wiring import In, Out
 
@@ -11,12 +11,11 @@ __all__ = ["FrameCounts", "WindowCounter"]
 
 
 def FrameCounts(params):
-    """Signature of a frame's running counts (source side): ``end`` is a one-cycle strobe
-    when ``count`` (``N``), ``bins`` (``h0..h7``) and ``sum_x`` (``SX``) are those of a
-    complete, well-formed frame."""
+    """Signature of a frame's counts (source side): ``end`` is a one-cycle strobe when
+    ``bins`` (``h0..h7``) and ``sum_x`` (``SX``) are those of a complete, well-formed frame.
+    ``N`` is the sum of the bins (every window column is in exactly one bin)."""
     return wiring.Signature({
         "end": Out(1),
-        "count": Out(params.count_bits),
         "bins": Out(data.ArrayLayout(params.count_bits, 8)),
         "sum_x": Out(params.sum_x_bits),
     })
@@ -28,9 +27,17 @@ class WindowCounter(wiring.Component):
     Two register stages, one pixel per cycle at most, never stalls:
 
     1. framing: the position of each pixel from its ``first``/``last`` flags, the geometry
-       checks, window and bin membership;
-    2. accumulate ``N``, ``h0..h7`` and ``SX``; a ``first`` reloads them instead of adding,
+       checks, window membership and the bin boundaries;
+    2. accumulate ``h0..h7`` and ``SX``; a ``first`` reloads them instead of adding,
        so nothing of an earlier (complete, abandoned or cut short) frame leaks into a frame.
+
+    Built for simulation speed (the compiled simulators evaluate all of it every clock):
+    per pixel there is one comparison of the column with the next bin boundary (a register,
+    not eight pairs of constants), one add into a per-bin accumulator and one masked add
+    into ``SX``. The accumulator is added into a bin only at the bin's last column; the
+    bins then rotate by one place, so the bin being filled is always the first and after
+    the eight bins of a line they are back in order. The row's window membership is a
+    register updated at line ends.
 
     Malformed framing: a frame is abandoned (no ``end``) as soon as a line ends early
     (``last`` before column ``width - 1``) or runs long (no ``last`` at column
@@ -46,9 +53,10 @@ class WindowCounter(wiring.Component):
     -------
     matches : ``In(MatchStream())``
     counts : ``Out(FrameCounts(params))``
-        The running counts. ``counts.end`` shows right after edge P + ``latency`` when the
-        frame's last pixel was sampled at edge P; the counts change again from the next
-        frame's first counted pixel on.
+        The counts. ``counts.end`` shows right after edge P + ``latency`` when the frame's
+        last pixel was sampled at edge P; the counts are only meaningful while ``end`` is high
+        (in between, the bins are rotated and the current bin's count is still in the
+        accumulator).
     """
 
     def __init__(self, params):
@@ -71,6 +79,17 @@ class WindowCounter(wiring.Component):
         p = self.params
         W, H = p.width, p.height
         mx, my, bw = p.margin_x, p.margin_y, p.bin_width
+        first_boundary = mx + bw - 1  # last column of bin 0
+        last_boundary = W - mx - 1  # last column of bin 7
+        # Column 0 (a `first`) is never a bin's last column (width >= 16 makes bw >= 2 when
+        # margin_x is 0), so a reload never has to add into a bin at the same time.
+        assert first_boundary > 0
+
+        def at_least(v, low):  # no constant-true comparison in the Verilog (lint)
+            return v >= low if low > 0 else Const(1, 1)
+
+        def rows_window(y):  # is row y inside margin_y (only at line starts)
+            return at_least(y, my) & (y < H - my)
 
         # --- Stage 1: framing and window -------------------------------------------------
         valid = self.matches.valid
@@ -79,53 +98,67 @@ class WindowCounter(wiring.Component):
 
         x = Signal(p.x_bits)  # position of the next pixel of the frame in progress
         y = Signal(p.y_bits)
+        row_in = Signal()  # row y is inside margin_y
+        boundary = Signal(p.x_bits, init=first_boundary)  # next bin's last column in row y
         active = Signal()  # a well-formed frame is in progress
         px = Signal(p.x_bits)  # position of the pixel on the input now
         py = Signal(p.y_bits)
         m.d.comb += [px.eq(Mux(first, 0, x)), py.eq(Mux(first, 0, y))]
+        row = Mux(first, int(my == 0), row_in)
         in_frame = valid & (first | active)
         shape_ok = (px == W - 1) == last  # neither a short nor a long line
+        at_boundary = px == boundary  # never at a `first` (column 0)
 
         with m.If(in_frame):
             with m.If(~shape_ok):
                 m.d.sync += active.eq(0)  # abandon the frame until the next `first`
             with m.Elif(last):
-                m.d.sync += [x.eq(0), y.eq(py + 1), active.eq(py != H - 1)]
+                m.d.sync += [
+                    x.eq(0), y.eq(py + 1), active.eq(py != H - 1),
+                    row_in.eq(rows_window(py + 1)),
+                ]
             with m.Else():
-                m.d.sync += [x.eq(px + 1), y.eq(py), active.eq(1)]
+                m.d.sync += [x.eq(px + 1), y.eq(py), active.eq(1), row_in.eq(row)]
+            with m.If(first):
+                m.d.sync += boundary.eq(first_boundary)
+            with m.Elif(at_boundary):
+                # After bin 7 the next boundary is bin 0's of the next line.
+                m.d.sync += boundary.eq(
+                    Mux(boundary == last_boundary, first_boundary, boundary + bw))
 
         a_restart = Signal()  # this pixel starts a frame: reload the counts
         a_count = Signal()  # this pixel counts
-        a_bin = Signal(8)  # one-hot bin of a counted pixel
+        a_flush = Signal()  # this pixel is the last column of a bin
         a_x = Signal(p.x_bits)
         a_end = Signal()  # last pixel of a well-formed frame
-        m.d.sync += [a_restart.eq(0), a_count.eq(0), a_end.eq(0)]
+        m.d.sync += [a_restart.eq(0), a_count.eq(0), a_flush.eq(0), a_end.eq(0)]
         with m.If(valid):
-            in_bin = Cat((px >= mx + k * bw) & (px < mx + (k + 1) * bw) for k in range(8))
-            in_rows = (py >= my) & (py < H - my)
             counted = in_frame & shape_ok
+            in_cols = at_least(px, mx) & (px <= last_boundary)
             m.d.sync += [
                 a_restart.eq(first),
-                a_count.eq(counted & self.matches.payload.match & in_rows & in_bin.any()),
+                a_count.eq(counted & self.matches.payload.match & row & in_cols),
+                a_flush.eq(counted & at_boundary),
                 a_end.eq(counted & last & (py == H - 1)),
-                a_bin.eq(in_bin),
                 a_x.eq(px),
             ]
 
         # --- Stage 2: accumulate ---------------------------------------------------------
         counts = self.counts
-        n, sx = counts.count, counts.sum_x
-        h = [counts.bins[k] for k in range(8)]
+        cb = p.count_bits
+        bins, sx = counts.bins.as_value(), counts.sum_x
+        acc = Signal(range(bw + 1))  # matching pixels so far in the current bin and line
         m.d.sync += counts.end.eq(a_end)
         with m.If(a_restart):
-            m.d.sync += [
-                n.eq(a_count),
-                sx.eq(Mux(a_count, a_x, 0)),
-                *(h[k].eq(a_count & a_bin[k]) for k in range(8)),
-            ]
-        with m.Elif(a_count):
-            m.d.sync += [n.eq(n + 1), sx.eq(sx + a_x)]
-            for k in range(8):
-                with m.If(a_bin[k]):
-                    m.d.sync += h[k].eq(h[k] + 1)
+            m.d.sync += [bins.eq(0), acc.eq(a_count), sx.eq(0)]  # a `first` is at column 0
+        with m.Else():
+            # A masked add rather than a conditional one: no branch on the pixel data.
+            m.d.sync += sx.eq(sx + (a_x & a_count.replicate(p.x_bits)))
+            with m.If(a_flush):
+                m.d.sync += [
+                    bins.eq(Cat(bins[cb:], (bins[:cb] + acc + a_count)[:cb])),
+                    acc.eq(0),
+                ]
+            with m.Else():
+                m.d.sync += acc.eq(acc + a_count)
         return m
