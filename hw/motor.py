@@ -1,6 +1,6 @@
 """Motor controller: per-frame wheel speeds (DPS) from the tracker's results."""
 
-from amaranth import Array, Const, Module, Mux, signed
+from amaranth import Const, Module, Mux, signed
 from amaranth.lib import wiring
 from amaranth.lib.wiring import In, Out
 
@@ -77,11 +77,24 @@ class MotorController(wiring.Component):
         m = Module()
         p = self.params
 
-        # e, turn and base +- turn are computed wide enough never to overflow before the
+        # Everything below is only needed in the cycle of `update`, once a frame. The
+        # expressions are rebuilt for each use (functions, not shared nets) and the base
+        # speed is a multiplexer tree, not an `Array` (which becomes a ROM read port): the
+        # compiled simulators then compute them inside the `update` branch only (simulation
+        # speed). e, turn and base +- turn are wide enough never to overflow before the
         # saturation (the published design lost bits here).
-        e = self.centroid_x - (p.width // 2)  # signed(x_bits + 1)
-        turn = (e * p.kp_num) >> p.kp_shift
-        base = Array(Const(v, signed(DPS_BITS)) for v in p.base_dps)[self.proximity]
+        def e():
+            return self.centroid_x - (p.width // 2)  # signed(x_bits + 1)
+
+        def turn():
+            return (e() * p.kp_num) >> p.kp_shift
+
+        def base():
+            values = [Const(v, signed(DPS_BITS)) for v in p.base_dps]
+            for bit in range(3):
+                values = [Mux(self.proximity[bit], hi, lo)
+                          for lo, hi in zip(values[0::2], values[1::2])]
+            return values[0]
 
         def saturate(v):
             lim = p.max_dps
@@ -89,21 +102,22 @@ class MotorController(wiring.Component):
 
         search = _wrap16(p.search_dps)
         neg_search = _wrap16(-p.search_dps)
-        lost_next = Mux(self.lost_count == p.lost_frames, p.lost_frames, self.lost_count + 1)
 
         with m.If(self.update):
             with m.If(self.found):
                 m.d.sync += [
-                    self.left.eq(saturate(base + turn)),
-                    self.right.eq(saturate(base - turn)),
-                    self.last_side.eq(e >= 0),
+                    self.left.eq(saturate(base() + turn())),
+                    self.right.eq(saturate(base() - turn())),
+                    self.last_side.eq(e() >= 0),
                     self.lost_count.eq(0),
                 ]
+            # This frame reaches the limit (no constant-true comparison when it is 1: lint).
+            with m.Elif(self.lost_count >= p.lost_frames - 1 if p.lost_frames > 1 else 1):
+                m.d.sync += [
+                    self.lost_count.eq(p.lost_frames),
+                    self.left.eq(Mux(self.last_side, search, neg_search)),
+                    self.right.eq(Mux(self.last_side, neg_search, search)),
+                ]
             with m.Else():
-                m.d.sync += self.lost_count.eq(lost_next)
-                with m.If(lost_next == p.lost_frames):
-                    m.d.sync += [
-                        self.left.eq(Mux(self.last_side, search, neg_search)),
-                        self.right.eq(Mux(self.last_side, neg_search, search)),
-                    ]
+                m.d.sync += self.lost_count.eq(self.lost_count + 1)
         return m
