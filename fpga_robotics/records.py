@@ -11,7 +11,7 @@ import numpy as np
 
 from .sim.backends.base import FrameResult
 
-__all__ = ["WorldMap", "PersonState", "FrameRecord"]
+__all__ = ["FrameRecord", "PersonState", "WorldMap"]
 
 
 @dataclass(frozen=True)

@@ -8,7 +8,7 @@ Every value is validated on construction with an error that says what is wrong.
 
 from dataclasses import dataclass, field, fields
 
-__all__ = ["FollowTargetParams", "DEFAULT_PROXIMITY_THRESHOLDS", "DEFAULT_BASE_DPS"]
+__all__ = ["DEFAULT_BASE_DPS", "DEFAULT_PROXIMITY_THRESHOLDS", "FollowTargetParams"]
 
 #: Proximity thresholds at 160x120 (pixels in the window); scaled by ``area_scale``.
 DEFAULT_PROXIMITY_THRESHOLDS = (128, 256, 512, 1024, 2048, 4096, 6144)

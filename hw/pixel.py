@@ -8,7 +8,7 @@ The stream cannot be stalled (``always_ready``): a camera does not wait.
 
 from amaranth.lib import data, stream
 
-__all__ = ["RGB444", "FramedPixel", "PixelStream", "COLOR_SELECT", "color_select_value"]
+__all__ = ["COLOR_SELECT", "RGB444", "FramedPixel", "PixelStream", "color_select_value"]
 
 
 #: One RGB444 pixel, 12 bits. Struct fields are laid out LSB first.

@@ -7,7 +7,7 @@ and goes back to 8 bits as ``c << 4``.
 
 import numpy as np
 
-__all__ = ["FrameError", "to_rgb444", "rgb444_to_rgb888", "unpack_rgb444"]
+__all__ = ["FrameError", "rgb444_to_rgb888", "to_rgb444", "unpack_rgb444"]
 
 
 class FrameError(ValueError):

@@ -10,7 +10,7 @@ Colours are albedos as (r, g, b) floats in 0..1; the lights decide the final bri
 
 from dataclasses import dataclass, field
 
-__all__ = ["Wall", "Cylinder", "Band", "Lighting", "Scene", "CameraPose"]
+__all__ = ["Band", "CameraPose", "Cylinder", "Lighting", "Scene", "Wall"]
 
 
 @dataclass(frozen=True)

@@ -22,7 +22,8 @@ def test_round_trip_is_c_shifted_left_by_four():
     rgb = rgb444_to_rgb888(packed)
     assert rgb.shape == (3, 16, 3) and rgb.dtype == np.uint8
     r, g, b = unpack_rgb444(packed)
-    assert np.array_equal(rgb[..., 0], r << 4) and np.array_equal(rgb[..., 2], b << 4)
+    assert np.array_equal(rgb[..., 0], r << 4) and np.array_equal(rgb[..., 1], g << 4)
+    assert np.array_equal(rgb[..., 2], b << 4)
     assert np.array_equal(to_rgb444(rgb, 16, 3), packed)
 
 

@@ -2,6 +2,10 @@
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from scalar_reference import loop_track, scalar_match
+
 from fpga_robotics.hw.params import FollowTargetParams
 from fpga_robotics.hw.pixel import COLOR_SELECT
 from fpga_robotics.sim import synthetic
@@ -15,9 +19,6 @@ from fpga_robotics.sim.model import (
     filter_frame,
     track_frame,
 )
-from hypothesis import given, settings
-from hypothesis import strategies as st
-from scalar_reference import loop_track, scalar_match
 
 # A 64x64 frame holds each of the 4096 RGB444 values exactly once.
 ALL_PIXELS = np.arange(4096, dtype=np.uint16).reshape(64, 64)

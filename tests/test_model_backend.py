@@ -4,6 +4,8 @@ import os
 
 import numpy as np
 import pytest
+from vcd.reader import TokenKind, tokenize
+
 from fpga_robotics.hw.params import FollowTargetParams
 from fpga_robotics.sim import synthetic
 from fpga_robotics.sim.backends.base import (
@@ -16,7 +18,6 @@ from fpga_robotics.sim.backends.model import ModelBackend
 from fpga_robotics.sim.backends.model_waveform import CLOCK_PERIOD_NS
 from fpga_robotics.sim.frames import FrameError
 from fpga_robotics.sim.model import FollowTargetModel
-from vcd.reader import TokenKind, tokenize
 
 
 class _Latencies(FollowTargetParams):

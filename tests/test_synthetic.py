@@ -2,10 +2,11 @@
 
 import numpy as np
 import pytest
+from scalar_reference import scalar_match
+
 from fpga_robotics.hw.pixel import COLOR_SELECT
 from fpga_robotics.sim import synthetic
 from fpga_robotics.sim.frames import to_rgb444
-from scalar_reference import scalar_match
 
 COLOURS = [c for c in COLOR_SELECT if c != "none"]
 
