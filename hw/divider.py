@@ -1,7 +1,7 @@
 """Sequential (restoring) integer divider: one quotient bit per clock cycle."""
 
 from amaranth import Cat, Module, Mux, Signal
-from amaranth.lib import wiring
+from amaranth.lib import data, wiring
 from amaranth.lib.wiring import In, Out
 
 __all__ = ["SequentialDivider"]
@@ -62,9 +62,15 @@ class SequentialDivider(wiring.Component):
         m = Module()
         q_bits = self.quotient_bits
 
-        rem = Signal(self.divisor_bits)  # partial remainder, always < divisor
-        low = Signal(q_bits)  # dividend bits still to bring down; quotient bits shift in
-        steps = Signal(range(q_bits + 1))
+        # One packed register (fewer registers for the compiled simulators to commit).
+        # `steps` is q_bits + 1 at the start, a step is taken while it is above 1, and 1 is
+        # the `done` cycle, so `done` needs no register of its own.
+        state = Signal(data.StructLayout({
+            "rem": self.divisor_bits,  # partial remainder, always < divisor
+            "low": q_bits,  # dividend bits still to bring down; quotient bits shift in
+            "steps": range(q_bits + 2),
+        }))
+        rem, low, steps = state.rem, state.low, state.steps
         divisor = Signal(self.divisor_bits)  # held: the inputs may change once started
 
         trial = Cat(low[-1], rem)  # rem * 2 + next dividend bit
@@ -72,21 +78,22 @@ class SequentialDivider(wiring.Component):
 
         m.d.comb += [
             self.quotient.eq(low),
-            self.busy.eq(steps != 0),
+            self.busy.eq(steps > 1),
+            self.done.eq(steps == 1),
         ]
-        m.d.sync += self.done.eq(0)
         with m.If(self.start):
             m.d.sync += [
                 rem.eq(self.dividend >> q_bits),
                 low.eq(self.dividend[:q_bits]),
                 divisor.eq(self.divisor),
-                steps.eq(q_bits),
+                steps.eq(q_bits + 1),
             ]
-        with m.Elif(steps != 0):
+        with m.Elif(steps > 1):
             m.d.sync += [
                 rem.eq(Mux(fits, trial - divisor, trial)),
                 low.eq(Cat(fits, low[:-1])),
                 steps.eq(steps - 1),
-                self.done.eq(steps == 1),
             ]
+        with m.Elif(steps == 1):
+            m.d.sync += steps.eq(0)
         return m

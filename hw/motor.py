@@ -1,7 +1,7 @@
 """Motor controller: per-frame wheel speeds (DPS) from the tracker's results."""
 
-from amaranth import Const, Module, Mux, signed
-from amaranth.lib import wiring
+from amaranth import Const, Module, Mux, Signal, signed
+from amaranth.lib import data, wiring
 from amaranth.lib.wiring import In, Out
 
 from .params import FollowTargetParams
@@ -100,24 +100,31 @@ class MotorController(wiring.Component):
             lim = p.max_dps
             return Mux(v > lim, lim, Mux(v < -lim, -lim, v))
 
-        search = _wrap16(p.search_dps)
-        neg_search = _wrap16(-p.search_dps)
+        # Full-width constants: the selected one is the register's value as it is.
+        search = Const(_wrap16(p.search_dps), signed(DPS_BITS))
+        neg_search = Const(_wrap16(-p.search_dps), signed(DPS_BITS))
+
+        # The two state fields in one register (one register fewer to commit every cycle).
+        lost = Signal(data.StructLayout({
+            "count": range(p.lost_frames + 1), "right_side": 1,
+        }))
+        m.d.comb += [self.lost_count.eq(lost.count), self.last_side.eq(lost.right_side)]
 
         with m.If(self.update):
             with m.If(self.found):
                 m.d.sync += [
                     self.left.eq(saturate(base() + turn())),
                     self.right.eq(saturate(base() - turn())),
-                    self.last_side.eq(e() >= 0),
-                    self.lost_count.eq(0),
+                    lost.right_side.eq(e() >= 0),
+                    lost.count.eq(0),
                 ]
             # This frame reaches the limit (no constant-true comparison when it is 1: lint).
-            with m.Elif(self.lost_count >= p.lost_frames - 1 if p.lost_frames > 1 else 1):
+            with m.Elif(lost.count >= p.lost_frames - 1 if p.lost_frames > 1 else 1):
                 m.d.sync += [
-                    self.lost_count.eq(p.lost_frames),
-                    self.left.eq(Mux(self.last_side, search, neg_search)),
-                    self.right.eq(Mux(self.last_side, neg_search, search)),
+                    lost.count.eq(p.lost_frames),
+                    self.left.eq(Mux(lost.right_side, search, neg_search)),
+                    self.right.eq(Mux(lost.right_side, neg_search, search)),
                 ]
             with m.Else():
-                m.d.sync += self.lost_count.eq(self.lost_count + 1)
+                m.d.sync += lost.count.eq(lost.count + 1)
         return m

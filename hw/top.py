@@ -45,7 +45,8 @@ class FollowTarget(wiring.Component):
         self.params = params
         # Built here rather than in elaborate() so that tests and waveforms can reach them.
         self.color_filter = ColorFilter(params)
-        self.tracker = FrameTracker(params)
+        # Without the tracker's inspection outputs, which nothing here reads (simulation speed).
+        self.tracker = FrameTracker(params, inspect=False)
         self.motor = MotorController(params)
         super().__init__({
             "pixels": In(PixelStream()),

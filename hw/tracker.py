@@ -2,12 +2,16 @@
 
 Pipeline (one pixel per cycle at most, never stalls):
 
-1-2. ``WindowCounter``: framing, window and bins (registered), then the running counts
-     ``N``, ``h0..h7`` and ``SX`` (see there for malformed framing: such a frame never ends,
-     so it produces no ``frame_done`` and its counts are reloaded at the next ``first``);
-3. at the end of a well-formed frame, snapshot the counts and start the divider, so the next
-   frame can start accumulating on the very next cycle;
-4. after the divider, all per-frame outputs load together with the one-cycle ``frame_done``.
+1. ``WindowCounter``: framing, window, bins and the counts ``h0..h7`` and ``SX`` in one
+   register stage (see there for malformed framing: such a frame never ends, so it
+   produces no ``frame_done`` and its counts are reloaded at the next ``first``);
+2. at the end of a well-formed frame the divider (``SX // N``) starts and every other
+   result is computed into a pending register, so the next frame can start accumulating on
+   the very next cycle;
+3. after the divider, all per-frame outputs load together with the one-cycle ``frame_done``.
+
+Every stage is kept small and registered for simulation speed: the compiled simulators
+(CXXRTL, Verilator) evaluate all logic and commit every register on every clock.
 
 The per-pixel and per-frame halves are separate modules on purpose: Amaranth's simulator
 re-evaluates a module's combinational logic when any of its inputs changes, so the per-frame
@@ -36,6 +40,10 @@ class FrameTracker(wiring.Component):
     ----------
     params : FollowTargetParams
         Geometry, margins, ``min_pixels`` and ``proximity_thresholds``.
+    inspect : bool, optional
+        Also output ``count``, ``bins`` and ``sum_x`` (default). ``FollowTarget`` leaves
+        them out: three wide registers that nothing reads, which the compiled simulators
+        would still copy and compare on every clock.
 
     Members
     -------
@@ -51,20 +59,21 @@ class FrameTracker(wiring.Component):
     count : ``Out(params.count_bits)``
     bins : ``Out(data.ArrayLayout(params.count_bits, 8))``
     sum_x : ``Out(params.sum_x_bits)``
-        ``N``, ``h0..h7`` and ``SX`` of the last complete frame, for inspection. They load
-        ``params.divider_cycles + 1`` cycles before ``frame_done`` and hold until the next
-        frame's end.
+        ``N``, ``h0..h7`` and ``SX`` of the last complete frame, for inspection (only with
+        ``inspect``). They load ``params.divider_cycles + 2`` cycles before ``frame_done``
+        and hold until the next frame's end.
     """
 
-    def __init__(self, params):
+    def __init__(self, params, *, inspect=True):
         if not isinstance(params, FollowTargetParams):
             raise TypeError(f"params must be a FollowTargetParams, not {params!r}")
         self.params = params
+        self.inspect = bool(inspect)
         self.counter = WindowCounter(params)
-        self.results = TrackerResults(params)
+        self.results = TrackerResults(params, inspect=inspect)
         super().__init__({
             "matches": In(MatchStream()),
-            **_result_members(params),
+            **_result_members(params, self.inspect),
         })
 
     @property
@@ -79,34 +88,46 @@ class FrameTracker(wiring.Component):
         m.submodules.results = results = self.results
         wiring.connect(m, wiring.flipped(self.matches), counter.matches)
         wiring.connect(m, counter.counts, results.counts)
-        for name in _result_members(self.params):
+        for name in _result_members(self.params, self.inspect):
             m.d.comb += getattr(self, name).eq(getattr(results, name))
         return m
 
 
-def _result_members(p):
-    return {
+def _result_members(p, inspect):
+    members = {
         "frame_done": Out(1),
         "found": Out(1),
         "proximity": Out(3),
         "centroid_x": Out(p.x_bits),
         "centroid_leds": Out(8),
-        "count": Out(p.count_bits),
-        "bins": Out(data.ArrayLayout(p.count_bits, 8)),
-        "sum_x": Out(p.sum_x_bits),
     }
+    if inspect:
+        members.update({
+            "count": Out(p.count_bits),
+            "bins": Out(data.ArrayLayout(p.count_bits, 8)),
+            "sum_x": Out(p.sum_x_bits),
+        })
+    return members
 
 
 class TrackerResults(wiring.Component):
-    """Per-frame results from a frame's counts: snapshot, divider, LED code, proximity.
+    """Per-frame results from a frame's counts: divider, LED code, proximity.
 
-    The snapshot loads on ``counts.end`` together with the divider's start, so the next frame
-    may start counting on the very next cycle. When the divider is done, every output loads at
-    once with the one-cycle ``frame_done``.
+    Everything is decided at ``counts.end``, so the next frame may start counting on the very
+    next cycle: the divider starts from the counts, and ``found``, ``proximity`` and the LED
+    code go into one pending register. When the divider is done (one register stage later),
+    every output loads at once with the one-cycle ``frame_done``.
+
+    Built for simulation speed: the per-frame arithmetic is written under the ``end``
+    condition, each use its own expression (``N``, the sum of the bins, too), so the
+    compiled simulators evaluate it in that cycle only; between frames each register costs
+    them one test.
 
     Parameters
     ----------
     params : FollowTargetParams
+    inspect : bool, optional
+        As in ``FrameTracker``.
 
     Members
     -------
@@ -115,77 +136,88 @@ class TrackerResults(wiring.Component):
         As in ``FrameTracker``.
     """
 
-    def __init__(self, params):
+    def __init__(self, params, *, inspect=True):
         if not isinstance(params, FollowTargetParams):
             raise TypeError(f"params must be a FollowTargetParams, not {params!r}")
         self.params = params
+        self.inspect = bool(inspect)
         super().__init__({
             "counts": In(FrameCounts(params)),
-            **_result_members(params),
+            **_result_members(params, self.inspect),
         })
 
     @property
     def latency(self):
         """``counts.end`` shows right after edge E: ``frame_done`` right after edge
-        E + ``latency``: the snapshot and divider start at E + 1, the divider's
-        ``divider_cycles`` steps, the output register."""
-        return 2 + self.params.divider_cycles
+        E + ``latency``: the divider's start at E + 1, its ``divider_cycles`` steps, one
+        register stage after ``done``, the output register."""
+        return 3 + self.params.divider_cycles
 
     def elaborate(self, platform):
         m = Module()
         p = self.params
         counts = self.counts
+        bins = [counts.bins[k] for k in range(8)]
 
-        # --- Snapshot and divide -----------------------------------------------------------
-        # N is the sum of the bins, added up only when a frame ends: written out twice, so
-        # that each use is its own expression under its `end` condition and the compiled
-        # simulators compute it in that cycle only (a shared net would be computed every clock).
-        def frame_count():
-            return sum(counts.bins[k] for k in range(8))
+        def frame_count():  # N
+            return sum(bins)
 
+        # --- Divide ------------------------------------------------------------------------
         m.submodules.divider = div = SequentialDivider(p.sum_x_bits, p.count_bits, p.x_bits)
         m.d.comb += [
             div.start.eq(counts.end),
             div.dividend.eq(counts.sum_x),
             div.divisor.eq(frame_count()),
         ]
+
+        # --- Everything else of the frame, at its end ----------------------------------------
+        pending = Signal(data.StructLayout({"found": 1, "proximity": 3, "leds": 8}),
+                         reset_less=True)  # only read after an `end` loaded it
         with m.If(counts.end):
             m.d.sync += [
-                self.count.eq(frame_count()),
-                self.sum_x.eq(counts.sum_x),
-                self.bins.eq(counts.bins),
+                pending.found.eq(frame_count() >= p.min_pixels),
+                pending.proximity.eq(sum(
+                    (frame_count() >= t if t > 0 else Const(1, 1))
+                    for t in p.proximity_thresholds)),
+                pending.leds.eq(_led_code(m, bins, frame_count(), p.min_pixels)),
             ]
+            if self.inspect:
+                m.d.sync += [
+                    self.count.eq(frame_count()),
+                    self.sum_x.eq(counts.sum_x),
+                    self.bins.eq(counts.bins),
+                ]
 
-        # --- Results from the snapshot, loaded when the divider is done ---------------------
-        count = self.count
-        bins = [self.bins[k] for k in range(8)]
-        found = count >= p.min_pixels
-        proximity = sum(
-            (count >= t if t > 0 else Const(1, 1)) for t in p.proximity_thresholds
-        )
-        left = bins[0] + bins[1] + bins[2] + bins[3]
-        right = bins[4] + bins[5] + bins[6] + bins[7]
-        half = count >> 1
-        centred = Mux(left > right, left - right, right - left) < (count >> 4)
-        leds = Signal(8)
-        with m.If(~found):
-            m.d.comb += leds.eq(0)
-        with m.Elif(centred):
-            m.d.comb += leds.eq(LEDS_CENTRED)
-        with m.Elif(left > right):
-            m.d.comb += leds.eq(_edge_led(bins[0:3], half, leds_from_edge=(0, 1, 2, 3)))
-        with m.Else():
-            m.d.comb += leds.eq(_edge_led(bins[7:4:-1], half, leds_from_edge=(7, 6, 5, 4)))
-
-        m.d.sync += self.frame_done.eq(div.done)
-        with m.If(div.done):
+        # --- Outputs, loaded together -------------------------------------------------------
+        done = Signal()  # the divider's `done`, one stage later
+        m.d.sync += [done.eq(div.done), self.frame_done.eq(done)]
+        with m.If(done):
             m.d.sync += [
-                self.found.eq(found),
-                self.proximity.eq(proximity),
-                self.centroid_x.eq(Mux(found, div.quotient, 0)),
-                self.centroid_leds.eq(leds),
+                self.found.eq(pending.found),
+                self.proximity.eq(pending.proximity),
+                self.centroid_x.eq(Mux(pending.found, div.quotient, 0)),
+                self.centroid_leds.eq(pending.leds),
             ]
         return m
+
+
+def _led_code(m, bins, count, min_pixels):
+    """The contract's LED code (a comb signal) from the eight bins and their sum ``N``."""
+    found = count >= min_pixels
+    left = bins[0] + bins[1] + bins[2] + bins[3]
+    right = bins[4] + bins[5] + bins[6] + bins[7]
+    half = count >> 1
+    centred = Mux(left > right, left - right, right - left) < (count >> 4)
+    leds = Signal(8)
+    with m.If(~found):
+        m.d.comb += leds.eq(0)
+    with m.Elif(centred):
+        m.d.comb += leds.eq(LEDS_CENTRED)
+    with m.Elif(left > right):
+        m.d.comb += leds.eq(_edge_led(bins[0:3], half, leds_from_edge=(0, 1, 2, 3)))
+    with m.Else():
+        m.d.comb += leds.eq(_edge_led(bins[7:4:-1], half, leds_from_edge=(7, 6, 5, 4)))
+    return leds
 
 
 def _edge_led(bins_from_edge, half, leds_from_edge):

@@ -24,20 +24,18 @@ def FrameCounts(params):
 class WindowCounter(wiring.Component):
     """Counts the matching pixels of each frame inside the window, per bin, and their columns.
 
-    Two register stages, one pixel per cycle at most, never stalls:
+    One register stage, one pixel per cycle at most, never stalls: the position of each
+    pixel from its ``first``/``last`` flags, the geometry checks, and the counts ``h0..h7``
+    and ``SX``; a ``first`` reloads the counts instead of adding, so nothing of an earlier
+    (complete, abandoned or cut short) frame leaks into a frame.
 
-    1. framing: the position of each pixel from its ``first``/``last`` flags, the geometry
-       checks, window membership and the bin boundaries;
-    2. accumulate ``h0..h7`` and ``SX``; a ``first`` reloads them instead of adding,
-       so nothing of an earlier (complete, abandoned or cut short) frame leaks into a frame.
-
-    Built for simulation speed (the compiled simulators evaluate all of it every clock):
-    per pixel there is one comparison of the column with the next bin boundary (a register,
-    not eight pairs of constants), one add into a per-bin accumulator and one masked add
-    into ``SX``. The accumulator is added into a bin only at the bin's last column; the
-    bins then rotate by one place, so the bin being filled is always the first and after
-    the eight bins of a line they are back in order. The row's window membership is a
-    register updated at line ends.
+    Built for simulation speed (the compiled simulators evaluate all of it every clock and
+    pay for every register): per pixel there is one comparison of the column with the next
+    bin boundary (a register, not eight pairs of constants), one add into a per-bin
+    accumulator and one masked add into ``SX``. The accumulator is added into a bin only at
+    the bin's last column; the bins then rotate by one place, so the bin being filled is
+    always the first and after the eight bins of a line they are back in order. Whether the
+    row is inside the window is a register updated at line ends.
 
     Malformed framing: a frame is abandoned (no ``end``) as soon as a line ends early
     (``last`` before column ``width - 1``) or runs long (no ``last`` at column
@@ -56,7 +54,7 @@ class WindowCounter(wiring.Component):
         The counts. ``counts.end`` shows right after edge P + ``latency`` when the frame's
         last pixel was sampled at edge P; the counts are only meaningful while ``end`` is high
         (in between, the bins are rotated and the current bin's count is still in the
-        accumulator).
+        accumulator), and may change from the next edge on (a next frame's ``first``).
     """
 
     def __init__(self, params):
@@ -70,9 +68,9 @@ class WindowCounter(wiring.Component):
 
     @property
     def latency(self):
-        """The frame's last pixel sampled on ``matches`` at edge P (by the first stage):
-        ``counts.end`` and the final counts show right after edge P + 1 (the second)."""
-        return 1
+        """The frame's last pixel sampled on ``matches`` at edge P: ``counts.end`` and the
+        final counts show right after edge P + 0 (the same edge)."""
+        return 0
 
     def elaborate(self, platform):
         m = Module()
@@ -91,74 +89,75 @@ class WindowCounter(wiring.Component):
         def rows_window(y):  # is row y inside margin_y (only at line starts)
             return at_least(y, my) & (y < H - my)
 
-        # --- Stage 1: framing and window -------------------------------------------------
         valid = self.matches.valid
         first = self.matches.payload.first
         last = self.matches.payload.last
 
-        x = Signal(p.x_bits)  # position of the next pixel of the frame in progress
-        y = Signal(p.y_bits)
-        row_in = Signal()  # row y is inside margin_y
-        boundary = Signal(p.x_bits, init=first_boundary)  # next bin's last column in row y
+        # Registers without a reset where the value does not matter until the next `first`
+        # reloads it (the compiled simulators then skip a reset test per register per cycle).
+        # Framing state for the next pixel of the frame in progress:
         active = Signal()  # a well-formed frame is in progress
+        x = Signal(p.x_bits, reset_less=True)
+        y = Signal(p.y_bits, reset_less=True)
+        row_in = Signal(reset_less=True)  # row y is inside margin_y
+        boundary = Signal(p.x_bits, reset_less=True)  # next bin's last column in row y
+        # Counts: bins (rotated during a line), the current bin's accumulator, SX.
+        bins = Signal(8 * p.count_bits, reset_less=True)
+        acc = Signal(range(bw + 1), reset_less=True)  # matches so far in this bin and line
+        sx = Signal(p.sum_x_bits, reset_less=True)
+        end = Signal()  # the last pixel of a well-formed frame was just counted
+        m.d.comb += [
+            self.counts.bins.eq(bins), self.counts.sum_x.eq(sx), self.counts.end.eq(end),
+        ]
+
+        # Named signals, not expressions: the compiled simulators compute each once.
         px = Signal(p.x_bits)  # position of the pixel on the input now
         py = Signal(p.y_bits)
-        m.d.comb += [px.eq(Mux(first, 0, x)), py.eq(Mux(first, 0, y))]
-        row = Mux(first, int(my == 0), row_in)
-        in_frame = valid & (first | active)
-        shape_ok = (px == W - 1) == last  # neither a short nor a long line
-        at_boundary = px == boundary  # never at a `first` (column 0)
+        row = Signal()  # row py is inside margin_y
+        in_frame = Signal()  # the pixel belongs to a frame in progress
+        shape_ok = Signal()  # neither a short nor a long line
+        reload = Signal()  # a `first`: reload the counts
+        advance = Signal()  # any other pixel of a frame in progress, line shape fine
+        count = Signal()  # the pixel matches and is inside the window
+        m.d.comb += [
+            px.eq(Mux(first, 0, x)),
+            py.eq(Mux(first, 0, y)),
+            row.eq(Mux(first, int(my == 0), row_in)),
+            in_frame.eq(valid & (first | active)),
+            shape_ok.eq((px == W - 1) == last),
+            reload.eq(valid & first),
+            advance.eq(valid & active & ~first & shape_ok),
+            count.eq(self.matches.payload.match & row & at_least(px, mx) & (px <= last_boundary)),
+        ]
 
+        m.d.sync += end.eq(0)
         with m.If(in_frame):
             with m.If(~shape_ok):
                 m.d.sync += active.eq(0)  # abandon the frame until the next `first`
             with m.Elif(last):
                 m.d.sync += [
                     x.eq(0), y.eq(py + 1), active.eq(py != H - 1),
-                    row_in.eq(rows_window(py + 1)),
+                    row_in.eq(rows_window(py + 1)), end.eq(py == H - 1),
                 ]
             with m.Else():
                 m.d.sync += [x.eq(px + 1), y.eq(py), active.eq(1), row_in.eq(row)]
-            with m.If(first):
-                m.d.sync += boundary.eq(first_boundary)
-            with m.Elif(at_boundary):
-                # After bin 7 the next boundary is bin 0's of the next line.
-                m.d.sync += boundary.eq(
-                    Mux(boundary == last_boundary, first_boundary, boundary + bw))
 
-        a_restart = Signal()  # this pixel starts a frame: reload the counts
-        a_count = Signal()  # this pixel counts
-        a_flush = Signal()  # this pixel is the last column of a bin
-        a_x = Signal(p.x_bits)
-        a_end = Signal()  # last pixel of a well-formed frame
-        m.d.sync += [a_restart.eq(0), a_count.eq(0), a_flush.eq(0), a_end.eq(0)]
-        with m.If(valid):
-            counted = in_frame & shape_ok
-            in_cols = at_least(px, mx) & (px <= last_boundary)
-            m.d.sync += [
-                a_restart.eq(first),
-                a_count.eq(counted & self.matches.payload.match & row & in_cols),
-                a_flush.eq(counted & at_boundary),
-                a_end.eq(counted & last & (py == H - 1)),
-                a_x.eq(px),
-            ]
-
-        # --- Stage 2: accumulate ---------------------------------------------------------
-        counts = self.counts
         cb = p.count_bits
-        bins, sx = counts.bins.as_value(), counts.sum_x
-        acc = Signal(range(bw + 1))  # matching pixels so far in the current bin and line
-        m.d.sync += counts.end.eq(a_end)
-        with m.If(a_restart):
-            m.d.sync += [bins.eq(0), acc.eq(a_count), sx.eq(0)]  # a `first` is at column 0
-        with m.Else():
+        with m.If(reload):
+            # A `first` is column 0: never a bin's last column, and adds 0 to SX.
+            m.d.sync += [
+                boundary.eq(first_boundary), bins.eq(0), acc.eq(count & shape_ok), sx.eq(0),
+            ]
+        with m.Elif(advance):
             # A masked add rather than a conditional one: no branch on the pixel data.
-            m.d.sync += sx.eq(sx + (a_x & a_count.replicate(p.x_bits)))
-            with m.If(a_flush):
+            m.d.sync += sx.eq(sx + (px & count.replicate(p.x_bits)))
+            with m.If(px == boundary):
                 m.d.sync += [
-                    bins.eq(Cat(bins[cb:], (bins[:cb] + acc + a_count)[:cb])),
+                    # After bin 7 the next boundary is bin 0's of the next line.
+                    boundary.eq(Mux(boundary == last_boundary, first_boundary, boundary + bw)),
+                    bins.eq(Cat(bins[cb:], (bins[:cb] + acc + count)[:cb])),
                     acc.eq(0),
                 ]
             with m.Else():
-                m.d.sync += acc.eq(acc + a_count)
+                m.d.sync += acc.eq(acc + count)
         return m
