@@ -1,6 +1,6 @@
 """Per-pixel colour filter: keeps the pixels of the selected colour, blacks out the others."""
 
-from amaranth import Const, Module, Signal
+from amaranth import Cat, Const, Module, Mux, Signal
 from amaranth.lib import data, stream, wiring
 from amaranth.lib.wiring import In, Out
 
@@ -42,25 +42,25 @@ def color_match_value(m, pixel, color_sel, params):
     def bright(a):  # a >= white_min (no constant-true comparison in the Verilog: lint)
         return a >= wm if wm > 0 else Const(1, 1)
 
+    by_code = {
+        0b000: Const(1, 1),  # none: every pixel
+        0b100: dominates(r, g) & dominates(r, b),  # red: r - max(g, b) >= D
+        0b010: dominates(g, r) & dominates(g, b),  # green
+        0b001: dominates(b, r) & dominates(b, g),  # blue
+        0b110: similar(r, g) & dominates(r, b) & dominates(g, b),  # yellow: min(r, g) - b >= D
+        0b101: similar(r, b) & dominates(r, g) & dominates(b, g),  # magenta
+        0b011: similar(g, b) & dominates(g, r) & dominates(b, r),  # cyan
+        # white: max - min <= S and min >= white_min
+        0b111: similar(r, g) & similar(r, b) & similar(g, b) & bright(r) & bright(g) & bright(b),
+    }
+    # A tree of multiplexers on the bits of color_sel rather than a case statement: any
+    # colour is three bit tests away in the compiled simulators (a case became a chain of
+    # up to seven comparisons of color_sel).
+    choices = [by_code[code] for code in range(8)]
+    for bit in range(3):
+        choices = [Mux(color_sel[bit], hi, lo) for lo, hi in zip(choices[0::2], choices[1::2])]
     match = Signal()
-    with m.Switch(color_sel):
-        with m.Case(0b000):  # none: every pixel
-            m.d.comb += match.eq(1)
-        with m.Case(0b100):  # red: r - max(g, b) >= D
-            m.d.comb += match.eq(dominates(r, g) & dominates(r, b))
-        with m.Case(0b010):  # green
-            m.d.comb += match.eq(dominates(g, r) & dominates(g, b))
-        with m.Case(0b001):  # blue
-            m.d.comb += match.eq(dominates(b, r) & dominates(b, g))
-        with m.Case(0b110):  # yellow: |r - g| <= S and min(r, g) - b >= D
-            m.d.comb += match.eq(similar(r, g) & dominates(r, b) & dominates(g, b))
-        with m.Case(0b101):  # magenta
-            m.d.comb += match.eq(similar(r, b) & dominates(r, g) & dominates(b, g))
-        with m.Case(0b011):  # cyan
-            m.d.comb += match.eq(similar(g, b) & dominates(g, r) & dominates(b, r))
-        with m.Case(0b111):  # white: max - min <= S and min >= white_min
-            m.d.comb += match.eq(similar(r, g) & similar(r, b) & similar(g, b)
-                                 & bright(r) & bright(g) & bright(b))
+    m.d.comb += match.eq(choices[0])
     return match
 
 
@@ -112,7 +112,7 @@ class ColorFilter(wiring.Component):
         # One register for the pixel and its flags, one for the match bit: `matches` shares
         # the valid bit and flags of `filtered` (fewer registers for the compiled simulators
         # to commit every cycle).
-        match_q = Signal()
+        match_q = Signal(reset_less=True)  # only read with `matches.valid`, which resets
         m.d.sync += self.filtered.valid.eq(self.pixels.valid)
         m.d.comb += [
             self.matches.valid.eq(self.filtered.valid),
@@ -124,10 +124,10 @@ class ColorFilter(wiring.Component):
         # Blacking out is an AND with the replicated match bit rather than a multiplexer, so
         # the generated C++ has no branch that depends on the pixel data.
         with m.If(self.pixels.valid):
+            # One assignment of the whole payload (pixel bits masked, flags kept), not three.
+            keep = Cat(match.replicate(len(pix.pixel.as_value())), Const(0b11, 2))
             m.d.sync += [
-                self.filtered.payload.pixel.eq(pix.pixel.as_value() & match.replicate(12)),
-                self.filtered.payload.first.eq(pix.first),
-                self.filtered.payload.last.eq(pix.last),
+                self.filtered.payload.eq(pix.as_value() & keep),
                 match_q.eq(match),
             ]
         return m
