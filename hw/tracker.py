@@ -60,7 +60,7 @@ class FrameTracker(wiring.Component):
     bins : ``Out(data.ArrayLayout(params.count_bits, 8))``
     sum_x : ``Out(params.sum_x_bits)``
         ``N``, ``h0..h7`` and ``SX`` of the last complete frame, for inspection (only with
-        ``inspect``). They load ``params.divider_cycles + 2`` cycles before ``frame_done``
+        ``inspect``). They load ``params.x_bits + 2`` cycles before ``frame_done``
         and hold until the next frame's end.
     """
 
@@ -115,8 +115,8 @@ class TrackerResults(wiring.Component):
 
     Everything is decided at ``counts.end``, so the next frame may start counting on the very
     next cycle: the divider starts from the counts, and ``found``, ``proximity`` and the LED
-    code go into one pending register. When the divider is done (one register stage later),
-    every output loads at once with the one-cycle ``frame_done``.
+    code go into one pending register. When the divider is done, every output loads at once
+    with the one-cycle ``frame_done``.
 
     Built for simulation speed: the per-frame arithmetic is written under the ``end``
     condition, each use its own expression (``N``, the sum of the bins, too), so the
@@ -149,9 +149,9 @@ class TrackerResults(wiring.Component):
     @property
     def latency(self):
         """``counts.end`` shows right after edge E: ``frame_done`` right after edge
-        E + ``latency``: the divider's start at E + 1, its ``divider_cycles`` steps, one
-        register stage after ``done``, the output register."""
-        return 3 + self.params.divider_cycles
+        E + ``latency``: the divider's start at E + 1, its ``x_bits + 1`` steps, the output
+        register."""
+        return 3 + self.params.x_bits
 
     def elaborate(self, platform):
         m = Module()
@@ -163,7 +163,10 @@ class TrackerResults(wiring.Component):
             return sum(bins)
 
         # --- Divide ------------------------------------------------------------------------
-        m.submodules.divider = div = SequentialDivider(p.sum_x_bits, p.count_bits, p.x_bits)
+        # One quotient bit more than SX // N needs (it is always 0): the extra step is the one
+        # cycle the outputs wait for, without a delay register of its own.
+        m.submodules.divider = div = SequentialDivider(
+            p.sum_x_bits, p.count_bits, p.x_bits + 1)
         m.d.comb += [
             div.start.eq(counts.end),
             div.dividend.eq(counts.sum_x),
@@ -189,13 +192,12 @@ class TrackerResults(wiring.Component):
                 ]
 
         # --- Outputs, loaded together -------------------------------------------------------
-        done = Signal()  # the divider's `done`, one stage later
-        m.d.sync += [done.eq(div.done), self.frame_done.eq(done)]
-        with m.If(done):
+        m.d.sync += self.frame_done.eq(div.done)
+        with m.If(div.done):
             m.d.sync += [
                 self.found.eq(pending.found),
                 self.proximity.eq(pending.proximity),
-                self.centroid_x.eq(Mux(pending.found, div.quotient, 0)),
+                self.centroid_x.eq(Mux(pending.found, div.quotient[:p.x_bits], 0)),
                 self.centroid_leds.eq(pending.leds),
             ]
         return m
