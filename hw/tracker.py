@@ -159,8 +159,8 @@ class TrackerResults(wiring.Component):
         counts = self.counts
         bins = [counts.bins[k] for k in range(8)]
 
-        def frame_count():  # N
-            return sum(bins)
+        def frame_count():  # N, as a balanced tree: this is all computed in one clock cycle
+            return _tree_sum(bins)
 
         # --- Divide ------------------------------------------------------------------------
         # One quotient bit more than SX // N needs (it is always 0): the extra step is the one
@@ -203,11 +203,20 @@ class TrackerResults(wiring.Component):
         return m
 
 
+def _tree_sum(values):
+    """Sum as a balanced tree of adders (a short logic path; same work in simulation)."""
+    values = list(values)
+    while len(values) > 1:
+        pairs = [a + b for a, b in zip(values[0::2], values[1::2])]
+        values = pairs + values[len(pairs) * 2:]
+    return values[0]
+
+
 def _led_code(m, bins, count, min_pixels):
     """The contract's LED code (a comb signal) from the eight bins and their sum ``N``."""
     found = count >= min_pixels
-    left = bins[0] + bins[1] + bins[2] + bins[3]
-    right = bins[4] + bins[5] + bins[6] + bins[7]
+    left = _tree_sum(bins[0:4])
+    right = _tree_sum(bins[4:8])
     half = count >> 1
     centred = Mux(left > right, left - right, right - left) < (count >> 4)
     leds = Signal(8)
