@@ -30,7 +30,7 @@ __all__ = [
 #: Every backend name (the names the CLI and scenarios accept).
 BACKEND_NAMES = ("model", "pysim", "cxxrtl", "verilator")
 #: Compiled backends, fastest first as measured on the reference machine (docs/backends.md).
-COMPILED_BACKENDS = ("verilator", "cxxrtl")
+COMPILED_BACKENDS = ("cxxrtl", "verilator")
 
 _CLASSES = {
     "model": ("model", "ModelBackend"),
