@@ -178,19 +178,21 @@ class FollowTargetParams:
 
     @property
     def divider_cycles(self):
-        """Steps of the sequential divider computing ``centroid_x``: one per quotient bit."""
-        return self.x_bits
+        """Steps of the sequential divider computing ``centroid_x``: one per quotient bit,
+        ``x_bits + 1`` (one bit more than ``width - 1`` needs, always 0: it stands in for a
+        delay register before the outputs)."""
+        return self.x_bits + 1
 
     @property
     def result_latency(self):
         """The frame's last pixel sampled at edge P: ``frame_done`` and the per-frame outputs
         show the new values right after edge P + result_latency.
 
-        Stages: colour filter (1), tracker position/window stage (1), accumulate (1),
-        snapshot and divider load (1), divider (``divider_cycles``), output register (1)
-        minus the shared edge: ``x_bits + 4``.
+        The colour filter loads the last pixel at edge P itself; then the window counter (1),
+        the divider start (1), the divider steps (``divider_cycles``) and the output load (1):
+        ``x_bits + 4`` (the edge-by-edge table is in docs/hardware.md).
         """
-        return self.divider_cycles + 4
+        return self.x_bits + 4
 
     @property
     def motor_latency(self):
