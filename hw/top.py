@@ -10,7 +10,24 @@ from .params import FollowTargetParams
 from .pixel import PixelStream
 from .tracker import FrameTracker
 
-__all__ = ["FollowTarget"]
+__all__ = ["FollowTarget", "follow_target_signature"]
+
+
+def follow_target_signature(params):
+    """The ports of ``follow_target`` (hw-spec table) for ``params``; shared with the
+    simulation flows' trivial stand-in design, so both drive the same harness."""
+    return wiring.Signature({
+        "pixels": In(PixelStream()),
+        "color_sel": In(3),
+        "filtered": Out(PixelStream()),
+        "frame_done": Out(1),
+        "found": Out(1),
+        "proximity": Out(3),
+        "centroid_x": Out(params.x_bits),
+        "centroid_leds": Out(8),
+        "motor_left": Out(signed(DPS_BITS)),
+        "motor_right": Out(signed(DPS_BITS)),
+    })
 
 
 class FollowTarget(wiring.Component):
@@ -48,18 +65,7 @@ class FollowTarget(wiring.Component):
         # Without the tracker's inspection outputs, which nothing here reads (simulation speed).
         self.tracker = FrameTracker(params, inspect=False)
         self.motor = MotorController(params)
-        super().__init__({
-            "pixels": In(PixelStream()),
-            "color_sel": In(3),
-            "filtered": Out(PixelStream()),
-            "frame_done": Out(1),
-            "found": Out(1),
-            "proximity": Out(3),
-            "centroid_x": Out(params.x_bits),
-            "centroid_leds": Out(8),
-            "motor_left": Out(signed(DPS_BITS)),
-            "motor_right": Out(signed(DPS_BITS)),
-        })
+        super().__init__(follow_target_signature(params))
 
     def elaborate(self, platform):
         m = Module()

@@ -9,9 +9,8 @@ It is gateware: it imports nothing from the host side.
 
 from amaranth import Module, Mux, ResetSignal, Signal, unsigned
 from amaranth.lib import wiring
-from amaranth.lib.wiring import In, Out
 
-from ...hw.pixel import PixelStream
+from ...hw.top import follow_target_signature
 
 __all__ = ["PassThrough"]
 
@@ -47,20 +46,7 @@ class PassThrough(wiring.Component):
     def __init__(self, params, *, registered_outputs=True):
         self.params = params
         self.registered_outputs = registered_outputs
-        super().__init__(
-            {
-                "pixels": In(PixelStream()),
-                "color_sel": In(3),
-                "filtered": Out(PixelStream()),
-                "frame_done": Out(1),
-                "found": Out(1),
-                "proximity": Out(3),
-                "centroid_x": Out(params.x_bits),
-                "centroid_leds": Out(8),
-                "motor_left": Out(16),
-                "motor_right": Out(16),
-            }
-        )
+        super().__init__(follow_target_signature(params))
 
     def elaborate(self, platform):
         m = Module()
