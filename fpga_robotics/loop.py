@@ -156,6 +156,7 @@ def run_scenario(scenario, *, seed=None, backend="auto", recorder=None, progress
         recorder.log_world_map(world.world_map())
 
     color = scenario.color_at(0.0)
+    color_code = color_select_value(color)
     step = 0
     wall_start = time.perf_counter()
     cpu_start = time.process_time()
@@ -177,8 +178,8 @@ def run_scenario(scenario, *, seed=None, backend="auto", recorder=None, progress
             new_color = scenario.color_at(t)
             if new_color != color:
                 events.append(f"colour select changed to {new_color}")
-                color = new_color
-            result = design.process_frame(rgb, color)
+                color, color_code = new_color, color_select_value(new_color)
+            result = design.process_frame(rgb, color_code)
             events += design_events.update(bool(result.found))
             apply_step = round((k * period + sim.actuation_delay) / dt)
             motors.schedule(apply_step, result.motor_left, result.motor_right)
@@ -202,14 +203,14 @@ def run_scenario(scenario, *, seed=None, backend="auto", recorder=None, progress
             row["found"][k], row["proximity"][k] = result.found, result.proximity
             row["centroid_x"][k], row["centroid_leds"][k] = result.centroid_x, result.centroid_leds
             row["motor_left"][k], row["motor_right"][k] = result.motor_left, result.motor_right
-            row["color_sel"][k] = color_select_value(color)
+            row["color_sel"][k] = color_code
             row["target_x"][k], row["target_y"][k] = tx, ty
             row["target_distance"][k], row["target_in_view"][k] = dist, visible
             events_all += [(k, round(t, 6), e) for e in events]
 
             if want_records:
                 record = FrameRecord(
-                    frame=k, sim_time=t, camera_rgb=rgb, color_sel=color_select_value(color),
+                    frame=k, sim_time=t, camera_rgb=rgb, color_sel=color_code,
                     result=result, robot_x=rx, robot_y=ry, robot_heading=heading,
                     robot_v=v, robot_w=w, cmd_v=cmd_v, cmd_w=cmd_w, camera_hfov=cam.hfov,
                     people=people, target_distance=None if target is None else dist,
