@@ -4,6 +4,8 @@ from amaranth import Cat, Module, Mux, Signal
 from amaranth.lib import data, wiring
 from amaranth.lib.wiring import In, Out
 
+from .fit import fit
+
 __all__ = ["SequentialDivider"]
 
 
@@ -81,19 +83,20 @@ class SequentialDivider(wiring.Component):
             self.busy.eq(steps > 1),
             self.done.eq(steps == 1),
         ]
+        # Each branch loads the whole register in one assignment: a field-by-field load makes
+        # the compiled simulators compute every field's next value on every clock.
+        def load(rem_value, low_value, steps_value):
+            fields = zip((rem_value, low_value, steps_value), (rem, low, steps))
+            return state.eq(Cat(fit(v, len(f)) for v, f in fields))
+
         with m.If(self.start):
             m.d.sync += [
-                rem.eq(self.dividend >> q_bits),
-                low.eq(self.dividend[:q_bits]),
+                load(self.dividend >> q_bits, self.dividend[:q_bits], q_bits + 1),
                 divisor.eq(self.divisor),
-                steps.eq(q_bits + 1),
             ]
         with m.Elif(steps > 1):
-            m.d.sync += [
-                rem.eq(Mux(fits, trial - divisor, trial)),
-                low.eq(Cat(fits, low[:-1])),
-                steps.eq(steps - 1),
-            ]
+            m.d.sync += load(Mux(fits, trial - divisor, trial), Cat(fits, low[:-1]), steps - 1)
         with m.Elif(steps == 1):
-            m.d.sync += steps.eq(0)
+            m.d.sync += load(rem, low, 0)
         return m
+

@@ -1,9 +1,10 @@
 """Motor controller: per-frame wheel speeds (DPS) from the tracker's results."""
 
-from amaranth import Const, Module, Mux, Signal, signed
+from amaranth import Cat, Const, Module, Mux, Signal, signed
 from amaranth.lib import data, wiring
 from amaranth.lib.wiring import In, Out
 
+from .fit import fit
 from .params import FollowTargetParams
 
 __all__ = ["MotorController"]
@@ -104,27 +105,31 @@ class MotorController(wiring.Component):
         search = Const(_wrap16(p.search_dps), signed(DPS_BITS))
         neg_search = Const(_wrap16(-p.search_dps), signed(DPS_BITS))
 
-        # The two state fields in one register (one register fewer to commit every cycle).
-        lost = Signal(data.StructLayout({
+        # All of the controller's state in one register, loaded whole in each branch: the
+        # compiled simulators then spend one test and one copy on it per clock (see `fit`).
+        state = Signal(data.StructLayout({
+            "left": signed(DPS_BITS), "right": signed(DPS_BITS),
             "count": range(p.lost_frames + 1), "right_side": 1,
         }))
-        m.d.comb += [self.lost_count.eq(lost.count), self.last_side.eq(lost.right_side)]
+        m.d.comb += [
+            self.left.eq(state.left), self.right.eq(state.right),
+            self.lost_count.eq(state.count), self.last_side.eq(state.right_side),
+        ]
+
+        def load(left, right, count, right_side):
+            fields = zip((left, right, count, right_side),
+                         (state.left, state.right, state.count, state.right_side))
+            return state.eq(Cat(fit(v, len(f)) for v, f in fields))
 
         with m.If(self.update):
             with m.If(self.found):
-                m.d.sync += [
-                    self.left.eq(saturate(base() + turn())),
-                    self.right.eq(saturate(base() - turn())),
-                    lost.right_side.eq(e() >= 0),
-                    lost.count.eq(0),
-                ]
+                m.d.sync += load(saturate(base() + turn()), saturate(base() - turn()), 0, e() >= 0)
             # This frame reaches the limit (no constant-true comparison when it is 1: lint).
-            with m.Elif(lost.count >= p.lost_frames - 1 if p.lost_frames > 1 else 1):
-                m.d.sync += [
-                    lost.count.eq(p.lost_frames),
-                    self.left.eq(Mux(lost.right_side, search, neg_search)),
-                    self.right.eq(Mux(lost.right_side, neg_search, search)),
-                ]
+            with m.Elif(state.count >= p.lost_frames - 1 if p.lost_frames > 1 else 1):
+                m.d.sync += load(Mux(state.right_side, search, neg_search),
+                                 Mux(state.right_side, neg_search, search),
+                                 p.lost_frames, state.right_side)
             with m.Else():
-                m.d.sync += lost.count.eq(lost.count + 1)
+                m.d.sync += load(state.left, state.right, state.count + 1, state.right_side)
         return m
+

@@ -18,12 +18,13 @@ re-evaluates a module's combinational logic when any of its inputs changes, so t
 logic (LED code, proximity) is not recomputed for every pixel.
 """
 
-from amaranth import Const, Module, Mux, Signal
+from amaranth import Cat, Const, Module, Mux, Signal
 from amaranth.lib import data, wiring
 from amaranth.lib.wiring import In, Out
 
 from .color_filter import MatchStream
 from .divider import SequentialDivider
+from .fit import fit
 from .params import FollowTargetParams
 from .window_counter import FrameCounts, WindowCounter
 
@@ -177,13 +178,13 @@ class TrackerResults(wiring.Component):
         pending = Signal(data.StructLayout({"found": 1, "proximity": 3, "leds": 8}),
                          reset_less=True)  # only read after an `end` loaded it
         with m.If(counts.end):
-            m.d.sync += [
-                pending.found.eq(frame_count() >= p.min_pixels),
-                pending.proximity.eq(sum(
-                    (frame_count() >= t if t > 0 else Const(1, 1))
-                    for t in p.proximity_thresholds)),
-                pending.leds.eq(_led_code(m, bins, frame_count(), p.min_pixels)),
-            ]
+            # One assignment of the whole register (see `fit`).
+            m.d.sync += pending.eq(Cat(
+                frame_count() >= p.min_pixels,
+                fit(sum((frame_count() >= t if t > 0 else Const(1, 1))
+                        for t in p.proximity_thresholds), 3),
+                _led_code(m, bins, frame_count(), p.min_pixels),
+            ))
             if self.inspect:
                 m.d.sync += [
                     self.count.eq(frame_count()),

@@ -183,7 +183,7 @@ def test_both_harness_loops_agree_with_hand_computed_pass_through(name):
     (combinational outputs) give the same, hand-computable results for the pass-through
     design: filtered = the frame, motor_left = the pixel count, cycles = pixels + blanking
     (its result latency is 1, motor latency 0)."""
-    from fpga_robotics.sim.backends.cxxrtl import output_sources
+    from fpga_robotics.sim.backends.cxxrtl_netlist import output_sources
     from fpga_robotics.sim.backends.designs import DesignSource
 
     p = FollowTargetParams(width=40, height=16)

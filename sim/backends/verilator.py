@@ -10,7 +10,7 @@ import subprocess
 from . import build_cache
 from .base import BackendError
 from .compiled import ABI_VERSION, HARNESS_DIR, LIBRARY_NAME, BuildPlan, CompiledBackend
-from .cxxrtl import output_sources
+from .cxxrtl_netlist import output_sources
 from .toolchain import find_compiler, find_make, run_tool, verilator_root, verilator_version
 
 __all__ = ["CXX_FLAGS", "MAKE_FLAGS", "VERILATOR_FLAGS", "VerilatorBackend", "verilator_build_plan"]

@@ -1,0 +1,155 @@
+"""What the compiled harnesses need to know about a generated CXXRTL model, read from its
+C++ text: how to read each output port right after a clock edge, and how to commit it.
+
+Both answers let the harness evaluate the model once per clock cycle instead of twice
+(docs/backends.md, "How the compiled backends work"). When the text does not have the
+expected shape, each function returns ``None`` and the harness uses CXXRTL's general
+``step()`` loop, which is always correct.
+"""
+
+import re
+
+__all__ = ["OUTPUTS", "commit_wires", "model_header", "output_sources"]
+
+#: The output ports of the hw-spec port list that the frame driver reads.
+OUTPUTS = (
+    "filtered__valid",
+    "filtered__payload",
+    "frame_done",
+    "found",
+    "proximity",
+    "centroid_x",
+    "centroid_leds",
+    "motor_left",
+    "motor_right",
+)
+
+_IDENT = re.compile(r"\b([pi]_\w+)\b(\.curr\b|\.next\b)?")
+
+
+def _mangle(name):
+    """CXXRTL's C++ name of a simple identifier: ``p_`` and every ``_`` doubled."""
+    return "p_" + name.replace("_", "__")
+
+
+def _eval_body(source):
+    body = source[source.index("::eval(performer *performer) {") :]
+    return body[: body.index("\n}\n")]
+
+
+def _edge_only_wires(source):
+    """C++ names of the wires whose ``.next`` is assigned only inside ``if (posedge_p_clk)``
+    blocks of eval(), i.e. the flip-flops of the one clock domain."""
+    wires = set(re.findall(r"^\t(?:/\*\w+\*/ )?wire<\d+> (\w+);$", source, re.MULTILINE))
+    depth, posedge_depth = 0, None
+    assigned = re.compile(r"\b(\w+)\.next\b")
+    for line in _eval_body(source).splitlines()[1:]:
+        stripped = line.strip()
+        if posedge_depth is None:
+            for name in assigned.findall(stripped):
+                wires.discard(name)
+        if stripped == "if (posedge_p_clk) {" and posedge_depth is None:
+            posedge_depth = depth
+        depth += stripped.count("{") - stripped.count("}")
+        if posedge_depth is not None and depth <= posedge_depth:
+            posedge_depth = None
+    return wires
+
+
+def output_sources(source):
+    """``{port: C++ expression}`` computing each output port from flip-flops only (members
+    prefixed with ``t.``), or ``None`` when some output depends on an input or on anything
+    this reader does not follow.
+
+    CXXRTL computes an output port during eval(), i.e. from the state before the clock edge;
+    the expression gives the state after the edge, read right after the edge's commit,
+    without a second evaluation. An output that is a flip-flop, a copy of one (``p_out =
+    p_ff.curr;``) or any expression of flip-flops and single-assignment temporaries (slices
+    of a packed register) qualifies.
+    """
+    if re.search(r"\bnegedge_|bool posedge_(?!p_clk\b)", source):
+        return None  # another clock or edge: not the one-domain design this reads
+    body = _eval_body(source)
+    flops = _edge_only_wires(source)
+    # Whole-value assignments at the top level of eval(); a name assigned more than once, or
+    # in part (`x.slice<..>() = ...`), is not followed.
+    assigned = {}
+    for name, expr in re.findall(r"^\t(\w+) = (.+);$", body, re.MULTILINE):
+        assigned[name] = None if name in assigned else expr
+    for name in re.findall(r"^\t(\w+)\.slice<", body, re.MULTILINE):
+        assigned[name] = None
+
+    def resolve(expr, depth=0):
+        if depth > 32:
+            return None
+        parts, pos = [], 0
+        for match in _IDENT.finditer(expr):
+            name, member = match.groups()
+            parts.append(expr[pos : match.start()])
+            pos = match.end()
+            if member == ".curr" and name in flops:
+                parts.append(f"t.{name}.curr")
+                continue
+            if member is not None or assigned.get(name) is None:
+                return None
+            inner = resolve(assigned[name], depth + 1)
+            if inner is None:
+                return None
+            parts.append(f"({inner})")
+        parts.append(expr[pos:])
+        return "".join(parts)
+
+    sources = {}
+    for port in OUTPUTS:
+        mangled = _mangle(port)
+        if re.search(rf"/\*output\*/ wire<\d+> {mangled};", source):
+            expr = f"{mangled}.curr" if mangled in flops else None
+        else:
+            expr = assigned.get(mangled)
+        resolved = resolve(expr) if expr is not None else None
+        if resolved is None:
+            return None
+        sources[port] = resolved
+    return sources
+
+
+def commit_wires(source):
+    """C++ names of every wire the model's ``commit()`` commits, or ``None`` when it also
+    commits something else (memories, submodules): then only CXXRTL's own ``commit()``
+    will do."""
+    start = source.find("bool commit(ObserverT &observer) {")
+    if start < 0:
+        return None
+    body = source[start : source.index("return changed;", start)]
+    statements = [s.strip() for s in body.splitlines()[1:] if s.strip()]
+    wires = []
+    for statement in statements:
+        match = re.fullmatch(r"if \((\w+)\.commit\(observer\)\) changed = true;", statement)
+        if match:
+            wires.append(match.group(1))
+        elif statement not in ("bool changed = false;", "prev_p_clk = p_clk;"):
+            return None
+    return wires
+
+
+def model_header(source):
+    """The ``fr_model.h`` the CXXRTL harness includes.
+
+    ``FR_OUT_<PORT>(t)`` reads an output of model ``t``. With ``FR_REGISTERED_OUTPUTS`` every
+    output is read from flip-flops right after an edge (see ``output_sources``), and with
+    ``FR_COMMIT(t)`` the harness commits by copying each wire's next value, which is all that
+    CXXRTL's ``commit()`` does besides telling whether anything changed (the one-evaluation
+    loop never asks: a flattened design without feedback settles in one evaluation)."""
+    sources = output_sources(source)
+    wires = commit_wires(source) if sources is not None else None
+    converged = "bool converged = true;" in _eval_body(source) and "converged = false" not in source
+    lines = ["// Generated by fpga_robotics.sim.backends.cxxrtl_netlist from the model's source."]
+    if sources is not None:
+        lines.append("#define FR_REGISTERED_OUTPUTS 1")
+    if wires is not None and converged:
+        copies = " ".join(f"t.{w}.curr = t.{w}.next;" for w in wires)
+        lines.append(f"#define FR_COMMIT(t) do {{ {copies} }} while (0)")
+    for port in OUTPUTS:
+        expr = sources[port] if sources is not None else f"t.{_mangle(port)}"
+        lines.append(f"#define FR_OUT_{port.upper()}(t) ({expr})")
+    return "\n".join(lines) + "\n"
