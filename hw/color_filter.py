@@ -9,8 +9,9 @@ from .pixel import PixelStream
 
 __all__ = ["ColorFilter", "MatchFlags", "MatchStream", "color_match_value"]
 
-#: What the tracker needs of each filtered pixel: the match bit and the framing flags.
-MatchFlags = data.StructLayout({"match": 1, "first": 1, "last": 1})
+#: What the tracker needs of each filtered pixel: the framing flags and the match bit (in the
+#: order they sit in the filter's output register, right after the pixel).
+MatchFlags = data.StructLayout({"first": 1, "last": 1, "match": 1})
 
 
 def MatchStream():
@@ -113,25 +114,26 @@ class ColorFilter(wiring.Component):
         pix = self.pixels.payload
         match = color_match_value(m, pix.pixel, self.color_sel, self.params)
 
-        # One register for the pixel and its flags, one for the match bit: `matches` shares
-        # the valid bit and flags of `filtered` (fewer registers for the compiled simulators
-        # to commit every cycle).
-        match_q = Signal(reset_less=True)  # only read with `matches.valid`, which resets
-        m.d.sync += self.filtered.valid.eq(self.pixels.valid)
+        # The whole output stage is one register, laid out so that both streams are plain
+        # slices of it: `filtered.payload` = bits 0-13 (pixel, first, last), `matches.payload`
+        # = bits 12-14 (first, last, match), then the valid bit (one register for the compiled
+        # simulators to test and copy per cycle, and no bit-by-bit assembly of the outputs).
+        flags_at = len(pix.pixel.as_value())
+        stage = Signal(data.StructLayout({
+            "payload": len(pix.as_value()), "match": 1, "valid": 1,
+        }))
         m.d.comb += [
-            self.matches.valid.eq(self.filtered.valid),
-            self.matches.payload.match.eq(match_q),
-            self.matches.payload.first.eq(self.filtered.payload.first),
-            self.matches.payload.last.eq(self.filtered.payload.last),
+            self.filtered.valid.eq(stage.valid),
+            self.filtered.payload.eq(stage.payload),
+            self.matches.valid.eq(stage.valid),
+            self.matches.payload.eq(stage.as_value()[flags_at:flags_at + 3]),
         ]
         # Payloads only load on a transfer: fewer toggles (and a quieter waveform) in blanking.
         # Blacking out is an AND with the replicated match bit rather than a multiplexer, so
         # the generated C++ has no branch that depends on the pixel data.
         with m.If(self.pixels.valid):
-            # One assignment of the whole payload (pixel bits masked, flags kept), not three.
-            keep = Cat(match.replicate(len(pix.pixel.as_value())), Const(0b11, 2))
-            m.d.sync += [
-                self.filtered.payload.eq(pix.as_value() & keep),
-                match_q.eq(match),
-            ]
+            keep = Cat(match.replicate(flags_at), Const(0b11, 2))
+            m.d.sync += stage.eq(Cat(pix.as_value() & keep, match, Const(1, 1)))
+        with m.Else():
+            m.d.sync += stage.eq(Cat(stage.as_value()[:-1], Const(0, 1)))
         return m

@@ -68,12 +68,12 @@ class SequentialDivider(wiring.Component):
         # `steps` is q_bits + 1 at the start, a step is taken while it is above 1, and 1 is
         # the `done` cycle, so `done` needs no register of its own.
         state = Signal(data.StructLayout({
+            "steps": range(q_bits + 2),
             "rem": self.divisor_bits,  # partial remainder, always < divisor
             "low": q_bits,  # dividend bits still to bring down; quotient bits shift in
-            "steps": range(q_bits + 2),
+            "divisor": self.divisor_bits,  # held: the inputs may change once started
         }))
-        rem, low, steps = state.rem, state.low, state.steps
-        divisor = Signal(self.divisor_bits)  # held: the inputs may change once started
+        steps, rem, low, divisor = state.steps, state.rem, state.low, state.divisor
 
         trial = Cat(low[-1], rem)  # rem * 2 + next dividend bit
         fits = trial >= divisor
@@ -85,18 +85,17 @@ class SequentialDivider(wiring.Component):
         ]
         # Each branch loads the whole register in one assignment: a field-by-field load makes
         # the compiled simulators compute every field's next value on every clock.
-        def load(rem_value, low_value, steps_value):
-            fields = zip((rem_value, low_value, steps_value), (rem, low, steps))
+        def load(steps_value, rem_value, low_value, divisor_value=divisor):
+            fields = zip((steps_value, rem_value, low_value, divisor_value),
+                         (steps, rem, low, divisor))
             return state.eq(Cat(fit(v, len(f)) for v, f in fields))
 
         with m.If(self.start):
-            m.d.sync += [
-                load(self.dividend >> q_bits, self.dividend[:q_bits], q_bits + 1),
-                divisor.eq(self.divisor),
-            ]
+            m.d.sync += load(q_bits + 1, self.dividend >> q_bits, self.dividend[:q_bits],
+                             self.divisor)
         with m.Elif(steps > 1):
-            m.d.sync += load(Mux(fits, trial - divisor, trial), Cat(fits, low[:-1]), steps - 1)
+            m.d.sync += load(steps - 1, Mux(fits, trial - divisor, trial), Cat(fits, low[:-1]))
         with m.Elif(steps == 1):
-            m.d.sync += load(rem, low, 0)
+            m.d.sync += load(0, rem, low)
         return m
 

@@ -192,15 +192,22 @@ class TrackerResults(wiring.Component):
                     self.bins.eq(counts.bins),
                 ]
 
-        # --- Outputs, loaded together -------------------------------------------------------
-        m.d.sync += self.frame_done.eq(div.done)
+        # --- Outputs, loaded together ----------------------------------------------------------
+        # One register, loaded whole (see `fit`): `frame_done` drops after one cycle, the
+        # results hold until the next frame's.
+        outputs = Signal(data.StructLayout({
+            "frame_done": 1, "found": 1, "proximity": 3, "centroid_x": p.x_bits,
+            "centroid_leds": 8,
+        }))
+        m.d.comb += [getattr(self, name).eq(getattr(outputs, name))
+                     for name in ("frame_done", "found", "proximity", "centroid_x",
+                                  "centroid_leds")]
         with m.If(div.done):
-            m.d.sync += [
-                self.found.eq(pending.found),
-                self.proximity.eq(pending.proximity),
-                self.centroid_x.eq(Mux(pending.found, div.quotient[:p.x_bits], 0)),
-                self.centroid_leds.eq(pending.leds),
-            ]
+            m.d.sync += outputs.eq(Cat(
+                Const(1, 1), pending.found, pending.proximity,
+                Mux(pending.found, div.quotient[:p.x_bits], 0), pending.leds))
+        with m.Else():
+            m.d.sync += outputs.eq(Cat(Const(0, 1), outputs.as_value()[1:]))
         return m
 
 

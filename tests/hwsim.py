@@ -270,9 +270,17 @@ def small_params(**changes):
     return FollowTargetParams(**values)
 
 
+def match_flag_offset(name):
+    """Bit offset of field ``name`` ("match", "first", "last") in a ``MatchFlags`` payload."""
+    from fpga_robotics.hw.color_filter import MatchFlags
+
+    return MatchFlags[name].offset
+
+
 def match_transfer(match, first=False, last=False):
-    """The ``MatchFlags`` payload: ``match`` bit 0, ``first`` bit 1, ``last`` bit 2."""
-    return int(bool(match)) | (int(first) << 1) | (int(last) << 2)
+    """The ``MatchFlags`` payload with these field values."""
+    return sum(int(bool(v)) << match_flag_offset(name)
+               for name, v in (("match", match), ("first", first), ("last", last)))
 
 
 def match_lines_schedule(lines, *, line_blank=0, first=True, gaps=None):

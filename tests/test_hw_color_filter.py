@@ -8,6 +8,7 @@ from hwsim import (
     LAST_BIT,
     Step,
     edges_where,
+    match_flag_offset,
     pack_transfer,
     run_schedule,
     run_testbench,
@@ -52,7 +53,7 @@ def test_every_pixel_value_for_every_colour(color):
     expected_match = match_table(sel, p)
     assert len(payload) == 4096
     assert np.array_equal(payload & 0xFFF, np.where(expected_match, ALL_PIXELS, 0))
-    assert np.array_equal((matches & 1).astype(bool), expected_match)
+    assert np.array_equal((matches >> match_flag_offset("match")) & 1, expected_match)
     # The numpy model and the plain formulas agree too (spot check of the reference itself).
     assert [scalar_match(int(v), sel) for v in ALL_PIXELS[::97]] == list(expected_match[::97])
 
@@ -97,8 +98,9 @@ def test_latency_flags_and_blanking_pass_through():
     assert outputs == [i + latency - 1 for i in inputs]
     assert list(trace["payload"][outputs]) == [schedule[i] for i in inputs]
     m = trace["m_payload"][edges_where(trace, "m_valid")]
-    assert list((m >> 1) & 1) == [(schedule[i] >> FIRST_BIT) & 1 for i in inputs]
-    assert list((m >> 2) & 1) == [(schedule[i] >> LAST_BIT) & 1 for i in inputs]
+    first_at, last_at = match_flag_offset("first"), match_flag_offset("last")
+    assert list((m >> first_at) & 1) == [(schedule[i] >> FIRST_BIT) & 1 for i in inputs]
+    assert list((m >> last_at) & 1) == [(schedule[i] >> LAST_BIT) & 1 for i in inputs]
 
 
 def test_non_matching_pixels_keep_their_flags():
