@@ -36,7 +36,8 @@ def color_match_value(m, pixel, color_sel, params):
     d, s, wm = params.diff_min, params.similar_max, params.white_min
 
     def at_least(a, c, k):  # a - c >= k: the sign bit of the signed difference a - c - k
-        return ~(a - c - k)[-1]
+        # One subtraction of zero-extended sums: no sign extension in the compiled simulators.
+        return ~(a - (c + k))[-1] if k >= 0 else ~((a + -k) - c)[-1]
 
     def dominates(a, c):  # a - c >= D
         return at_least(a, c, d)

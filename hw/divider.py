@@ -78,9 +78,12 @@ class SequentialDivider(wiring.Component):
         trial = Cat(low[-1], rem)  # rem * 2 + next dividend bit
         fits = trial >= divisor
 
+        # `steps > 1` as "any bit above bit 0": the compiled simulators compute an ordered
+        # comparison with a full carry chain, and this one is evaluated every clock.
+        stepping = steps[1:].any()
         m.d.comb += [
             self.quotient.eq(low),
-            self.busy.eq(steps > 1),
+            self.busy.eq(stepping),
             self.done.eq(steps == 1),
         ]
         # Each branch loads the whole register in one assignment: a field-by-field load makes
@@ -93,7 +96,7 @@ class SequentialDivider(wiring.Component):
         with m.If(self.start):
             m.d.sync += load(q_bits + 1, self.dividend >> q_bits, self.dividend[:q_bits],
                              self.divisor)
-        with m.Elif(steps > 1):
+        with m.Elif(stepping):
             m.d.sync += load(steps - 1, Mux(fits, trial - divisor, trial), Cat(fits, low[:-1]))
         with m.Elif(steps == 1):
             m.d.sync += load(0, rem, low)

@@ -87,6 +87,12 @@ class WindowCounter(wiring.Component):
         def at_least(v, low):  # no constant-true comparison in the Verilog (lint)
             return v >= low if low > 0 else Const(1, 1)
 
+        def in_window_columns(x):
+            # mx <= x <= last_boundary as the borrow bits of two subtractions: the compiled
+            # simulators compute an ordered comparison with a full carry chain, every pixel.
+            below = (x - mx)[-1] if mx > 0 else Const(0, 1)
+            return ~below & ~(last_boundary - x)[-1]
+
         def rows_window(y):  # is row y inside margin_y (only at line starts)
             return at_least(y, my) & (y < H - my)
 
@@ -133,7 +139,7 @@ class WindowCounter(wiring.Component):
             shape_ok.eq((px == W - 1) == last),
             reload.eq(valid & first),
             advance.eq(valid & active & ~first & shape_ok),
-            count.eq(self.matches.payload.match & row & at_least(px, mx) & (px <= last_boundary)),
+            count.eq(self.matches.payload.match & row & in_window_columns(px)),
         ]
 
         m.d.sync += end.eq(0)

@@ -8,7 +8,7 @@ import hashlib
 from . import build_cache
 from .base import BackendError
 from .compiled import ABI_VERSION, HARNESS_DIR, LIBRARY_NAME, BuildPlan, CompiledBackend
-from .cxxrtl_netlist import model_header
+from .cxxrtl_netlist import model_header, without_port_copies
 from .toolchain import cxxrtl_include_dir, find_compiler, run_tool
 
 __all__ = ["CXX_FLAGS", "CxxrtlBackend", "cxxrtl_build_plan"]
@@ -32,7 +32,10 @@ def cxxrtl_build_plan(design, variant, flags=None):
         raise BackendError("the CXXRTL output has no p_follow__target module")
     header = model_header(source)
     flags = list(CXX_FLAGS if flags is None else flags)
-    if variant != "plain":
+    if variant == "plain":
+        # The one-evaluation loop reads every output from its flip-flops (fr_model.h).
+        source = without_port_copies(source)
+    else:
         flags.append("-DFR_TRACE")
     harness = {f: (HARNESS_DIR / f).read_text() for f in _HARNESS_FILES}
     key = build_cache.build_key(

@@ -9,7 +9,7 @@ expected shape, each function returns ``None`` and the harness uses CXXRTL's gen
 
 import re
 
-__all__ = ["OUTPUTS", "commit_wires", "model_header", "output_sources"]
+__all__ = ["OUTPUTS", "commit_wires", "model_header", "output_sources", "without_port_copies"]
 
 #: The output ports of the hw-spec port list that the frame driver reads.
 OUTPUTS = (
@@ -111,6 +111,31 @@ def output_sources(source):
             return None
         sources[port] = resolved
     return sources
+
+
+def without_port_copies(source):
+    """The model's source without the statements of eval() that copy a register (or a slice
+    of a packed one) into an output port, for a harness that reads every output from its
+    flip-flops (``output_sources``), which then never reads the port itself.
+
+    Each such copy is a store per port on every clock that nothing reads (9 ports of a
+    packed design cost about 10% of a cycle). Only top-level statements ``p_port = ...;``
+    of a port that eval() reads nowhere else are removed; the waveform build keeps them.
+    Returns ``source`` unchanged when ``output_sources`` does not apply.
+    """
+    if output_sources(source) is None:
+        return source
+    start = source.index("::eval(performer *performer) {")
+    end = source.index("\n}\n", start)
+    body = source[start:end]
+    for port in OUTPUTS:
+        name = _mangle(port)
+        if not re.search(rf"/\*output\*/ value<\d+> {name};", source):
+            continue  # the port is the flip-flop itself: nothing is copied
+        copies = re.findall(rf"^\t{name} = .*;\n", body, re.MULTILINE)
+        if len(copies) == 1 and len(re.findall(rf"\b{name}\b", body)) == 1:
+            body = body.replace(copies[0], "")
+    return source[:start] + body + source[end:]
 
 
 def commit_wires(source):
