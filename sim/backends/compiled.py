@@ -163,6 +163,12 @@ class CompiledBackend(DesignBackend):
 
     # Running -----------------------------------------------------------------------------------
 
+    @property
+    def evals_per_cycle(self):
+        """Simulator evaluations per clock cycle: 1 when every output is read from
+        flip-flops, else 2 (docs/backends.md)."""
+        return self._library.evals_per_cycle
+
     def _reset(self):
         self._library.lib.fr_reset(self._handle)
 

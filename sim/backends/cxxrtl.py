@@ -8,7 +8,7 @@ import hashlib
 from . import build_cache
 from .base import BackendError
 from .compiled import ABI_VERSION, HARNESS_DIR, LIBRARY_NAME, BuildPlan, CompiledBackend
-from .cxxrtl_netlist import model_header, without_port_copies
+from .cxxrtl_netlist import model_header, with_wire_copies_inlined, without_port_copies
 from .toolchain import cxxrtl_include_dir, find_compiler, run_tool
 
 __all__ = ["CXX_FLAGS", "CxxrtlBackend", "cxxrtl_build_plan"]
@@ -33,8 +33,9 @@ def cxxrtl_build_plan(design, variant, flags=None):
     header = model_header(source)
     flags = list(CXX_FLAGS if flags is None else flags)
     if variant == "plain":
-        # The one-evaluation loop reads every output from its flip-flops (fr_model.h).
-        source = without_port_copies(source)
+        # The one-evaluation loop reads every output from its flip-flops (fr_model.h); the
+        # same computation with fewer copies (see cxxrtl_netlist).
+        source = with_wire_copies_inlined(without_port_copies(source))
     else:
         flags.append("-DFR_TRACE")
     harness = {f: (HARNESS_DIR / f).read_text() for f in _HARNESS_FILES}

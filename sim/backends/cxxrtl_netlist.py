@@ -9,7 +9,14 @@ expected shape, each function returns ``None`` and the harness uses CXXRTL's gen
 
 import re
 
-__all__ = ["OUTPUTS", "commit_wires", "model_header", "output_sources", "without_port_copies"]
+__all__ = [
+    "OUTPUTS",
+    "commit_wires",
+    "model_header",
+    "output_sources",
+    "with_wire_copies_inlined",
+    "without_port_copies",
+]
 
 #: The output ports of the hw-spec port list that the frame driver reads.
 OUTPUTS = (
@@ -138,6 +145,32 @@ def without_port_copies(source):
     return source[:start] + body + source[end:]
 
 
+def with_wire_copies_inlined(source):
+    """The model's source with eval()'s whole-wire copies into locals replaced by the wire.
+
+    CXXRTL copies a flip-flop into a local value when a submodule port it drives has several
+    readers (``value<112> x; x = p_ff.curr;``): a copy of every word of a wide register on
+    every clock. A flip-flop's ``.curr`` only changes in commit(), so reading it directly
+    wherever the local is read is the same computation. Only locals of eval() assigned once,
+    at its top level, from a wire of the same width are replaced."""
+    start = source.index("::eval(performer *performer) {")
+    end = source.index("\n}\n", start)
+    body = source[start:end]
+    wires = re.findall(r"^\t(?:/\*\w+\*/ )?wire<(\d+)> (\w+);$", source, re.MULTILINE)
+    wire_width = {name: width for width, name in wires}
+    for name, wire in re.findall(r"^\t(\w+) = (\w+)\.curr;$", body, re.MULTILINE):
+        declaration = re.search(rf"^\tvalue<(\d+)> {name};\n", body, re.MULTILINE)
+        assignments = re.findall(rf"^\s*{name}(?:\.slice<[^>]*>\(\))? = ", body, re.MULTILINE)
+        if declaration is None or wire_width.get(wire) != declaration.group(1):
+            continue
+        if len(assignments) != 1:
+            continue
+        body = body.replace(declaration.group(0), "")
+        body = body.replace(f"\t{name} = {wire}.curr;\n", "")
+        body = re.sub(rf"\b{name}\b", f"{wire}.curr", body)
+    return source[:start] + body + source[end:]
+
+
 def commit_wires(source):
     """C++ names of every wire the model's ``commit()`` commits, or ``None`` when it also
     commits something else (memories, submodules): then only CXXRTL's own ``commit()``
@@ -147,10 +180,11 @@ def commit_wires(source):
         return None
     body = source[start : source.index("return changed;", start)]
     statements = [s.strip() for s in body.splitlines()[1:] if s.strip()]
+    declared = set(re.findall(r"^\t(?:/\*\w+\*/ )?wire<\d+> (\w+);$", source, re.MULTILINE))
     wires = []
     for statement in statements:
         match = re.fullmatch(r"if \((\w+)\.commit\(observer\)\) changed = true;", statement)
-        if match:
+        if match and match.group(1) in declared:
             wires.append(match.group(1))
         elif statement not in ("bool changed = false;", "prev_p_clk = p_clk;"):
             return None
