@@ -96,9 +96,11 @@ class SequentialDivider(wiring.Component):
         with m.If(self.start):
             m.d.sync += load(q_bits + 1, self.dividend >> q_bits, self.dividend[:q_bits],
                              self.divisor)
-        with m.Elif(stepping):
-            m.d.sync += load(steps - 1, Mux(fits, trial - divisor, trial), Cat(fits, low[:-1]))
-        with m.Elif(steps == 1):
-            m.d.sync += load(0, rem, low)
+        with m.Elif(steps.any()):  # idle (0) in one test: the usual case, every clock
+            with m.If(stepping):
+                m.d.sync += load(steps - 1, Mux(fits, trial - divisor, trial),
+                                 Cat(fits, low[:-1]))
+            with m.Else():
+                m.d.sync += load(0, rem, low)  # the `done` cycle
         return m
 

@@ -109,14 +109,17 @@ class WindowCounter(wiring.Component):
         position = Signal(p.x_bits + p.y_bits + 1, reset_less=True)
         x, y = position[:p.x_bits], position[p.x_bits:-1]
         row_in = position[-1]
-        # Counts: the bins (rotated during a line), the next bin boundary (the last column of a
-        # bin), the current bin's accumulator and SX. (Packing them measured no faster.)
+        # Counts: the bins (rotated during a line) and SX; the current bin's accumulator (the
+        # matches so far in this bin and line) and the next bin boundary (the last column of a
+        # bin) in one register, the accumulator in the low bits: counting a pixel is one add
+        # to the whole register (it never carries into the boundary: at most bw pixels).
         cb = p.count_bits
         bins = Signal(8 * cb, reset_less=True)
-        boundary = Signal(p.x_bits, reset_less=True)
-        acc_bits = Shape.cast(range(bw + 1)).width
-        acc = Signal(acc_bits, reset_less=True)  # matches so far in this bin and line
         sx = Signal(p.sum_x_bits, reset_less=True)
+        acc_bits = Shape.cast(range(bw + 1)).width
+        bin_state = Signal(data.StructLayout({"acc": acc_bits, "boundary": p.x_bits}),
+                           reset_less=True)
+        acc, boundary = bin_state.acc, bin_state.boundary
         end = Signal()  # the last pixel of a well-formed frame was just counted
         m.d.comb += [
             self.counts.bins.eq(bins), self.counts.sum_x.eq(sx), self.counts.end.eq(end),
@@ -158,8 +161,8 @@ class WindowCounter(wiring.Component):
         with m.If(reload):
             # A `first` is column 0: never a bin's last column, and adds 0 to SX.
             m.d.sync += [
-                bins.eq(0), boundary.eq(first_boundary),
-                acc.eq(count & shape_ok), sx.eq(0),
+                bins.eq(0), sx.eq(0),
+                bin_state.eq(Cat(fit(count & shape_ok, acc_bits), Const(first_boundary, p.x_bits))),
             ]
         with m.Elif(advance):
             # A masked add rather than a conditional one: no branch on the pixel data.
@@ -169,9 +172,8 @@ class WindowCounter(wiring.Component):
                 next_boundary = Mux(boundary == last_boundary, first_boundary, boundary + bw)
                 m.d.sync += [
                     bins.eq(Cat(bins[cb:], fit(bins[:cb] + acc + count, cb))),
-                    boundary.eq(next_boundary),
-                    acc.eq(0),
+                    bin_state.eq(Cat(Const(0, acc_bits), fit(next_boundary, p.x_bits))),
                 ]
             with m.Else():
-                m.d.sync += acc.eq(acc + count)
+                m.d.sync += bin_state.eq(bin_state.as_value() + count)
         return m
