@@ -46,6 +46,48 @@ def test_bench_prints_and_writes_figures(tmp_path, capsys):
     # The cycle count of a 40x16 frame is the pixel count plus the documented latency.
     assert rows[("cxxrtl", "passthrough", 40)]["cycles_per_frame"] == 40 * 16 + 1
     assert data["machine"]["cpus"] >= 1
+    # FollowTarget against the trivial design in alternating batches, per size.
+    assert {(r["backend"], r["width"]) for r in data["paired"]} == {("cxxrtl", 40), ("cxxrtl", 48)}
+    for r in data["paired"]:
+        assert r["frames"] == 3 and 0 < r["fraction"] < 10
+    assert "of the trivial design's cycle rate (alternating batches, 3 frames each)" in out
+
+
+class _FakeBackend:
+    """A backend that takes a known time per frame (the sleep) for a known cycle count."""
+
+    def __init__(self, cycles, seconds):
+        self.cycles, self.seconds = cycles, seconds
+
+    def process_frame(self, frame):
+        import time
+        from types import SimpleNamespace
+
+        time.sleep(self.seconds)
+        return SimpleNamespace(cycles=self.cycles)
+
+
+def test_summary_takes_the_fraction_from_the_paired_measurement():
+    def row(design, ms, rate):
+        return {"backend": "cxxrtl", "design": design, "width": 160, "height": 120,
+                "ms_per_frame": ms, "cycles_per_second": rate}
+
+    results = [row("follow_target", 0.3, 60e6), row("passthrough", 0.1, 180e6)]
+    separate = bench.summary(results)
+    assert any("0.33 of the trivial" in line and "MISSED" in line for line in separate)
+    paired = [{"backend": "cxxrtl", "width": 160, "height": 120, "fraction": 0.55, "frames": 9}]
+    lines = bench.summary(results, paired)
+    assert any("0.55 of the trivial" in line and "alternating" in line and line.endswith("met")
+               for line in lines)
+    assert any("0.3" in line and "<= 0.4 ms: met" in line for line in lines)
+
+
+def test_paired_measurement_gives_the_ratio_of_cycle_rates():
+    # 1000 cycles in 4 ms against 1000 cycles in 2 ms: half the rate.
+    design, trivial = _FakeBackend(1000, 0.004), _FakeBackend(1000, 0.002)
+    figures = bench.measure_paired(design, trivial, frames=[None] * 5, min_seconds=0.0)
+    assert figures["frames"] == 5
+    assert figures["fraction"] == pytest.approx(0.5, rel=0.25)
 
 
 def test_pysim_is_skipped_above_its_size_limit_with_a_note(capsys):
