@@ -79,6 +79,10 @@ class World:
         self.space = space = pymunk.Space()
         space.gravity = (0.0, 0.0)
         space.iterations = 10
+        # Pymunk lets shapes overlap by `collision_slop` before it pushes them apart; its
+        # default (0.1) is meant for pixel units and would let the robot sink 10 cm into a
+        # wall here. 1 mm: walls and furniture stay solid.
+        space.collision_slop = 0.001
 
         # The robot and its control body (pymunk's tank example idiom).
         self.robot_body = body = pymunk.Body(spec.mass, spec.moment)
