@@ -88,8 +88,13 @@ class WindowCounter(wiring.Component):
             return v >= low if low > 0 else Const(1, 1)
 
         def in_window_columns(x):
-            # mx <= x <= last_boundary as the borrow bits of two subtractions: the compiled
-            # simulators compute an ordered comparison with a full carry chain, every pixel.
+            # mx <= x <= last_boundary without an ordered comparison (the compiled simulators
+            # compute one with a full carry chain, and this is evaluated every pixel): with a
+            # power-of-two window width ww, x - mx (wrapping below 0) has no bit at or above
+            # log2(ww) set; otherwise the borrow bits of two subtractions.
+            ww = last_boundary - mx + 1
+            if ww & (ww - 1) == 0:
+                return ~(x - mx)[ww.bit_length() - 1:].any()
             below = (x - mx)[-1] if mx > 0 else Const(0, 1)
             return ~below & ~(last_boundary - x)[-1]
 
