@@ -132,7 +132,7 @@ class WindowCounter(wiring.Component):
 
         # Named signals, not expressions: the compiled simulators compute each once.
         px = Signal(p.x_bits)  # position of the pixel on the input now
-        py = Signal(p.y_bits)
+        py = Mux(first, 0, y)  # an expression: only the rare line-end branch reads it
         row = Signal()  # row py is inside margin_y
         in_frame = Signal()  # the pixel belongs to a frame in progress
         shape_ok = Signal()  # neither a short nor a long line
@@ -141,7 +141,6 @@ class WindowCounter(wiring.Component):
         count = Signal()  # the pixel matches and is inside the window
         m.d.comb += [
             px.eq(Mux(first, 0, x)),
-            py.eq(Mux(first, 0, y)),
             row.eq(Mux(first, int(my == 0), row_in)),
             in_frame.eq(valid & (first | active)),
             shape_ok.eq((px == W - 1) == last),
@@ -161,7 +160,13 @@ class WindowCounter(wiring.Component):
                     active.eq(py != H - 1), end.eq(py == H - 1),
                 ]
             with m.Else():
-                m.d.sync += [position.eq(Cat(fit(px + 1, p.x_bits), py, row)), active.eq(1)]
+                # The next column: one add (the column never carries into the row here), or
+                # column 1 of row 0 after a `first`.
+                first_position = Cat(Const(1, p.x_bits), Const(0, p.y_bits), Const(int(my == 0), 1))
+                m.d.sync += [
+                    position.eq(Mux(first, first_position, position + 1)),
+                    active.eq(1),
+                ]
 
         with m.If(reload):
             # A `first` is column 0: never a bin's last column, and adds 0 to SX.
