@@ -22,6 +22,10 @@ class SequentialDivider(wiring.Component):
     ----------
     dividend_bits, divisor_bits, quotient_bits : int
         Operand and result widths (each at least 1).
+    tag_bits : int, optional
+        Width of a tag that travels with the division (default 0: none). A caller with
+        results of its own to deliver with the quotient keeps them here rather than in a
+        register of its own (one register fewer for the compiled simulators every clock).
 
     Members
     -------
@@ -36,24 +40,34 @@ class SequentialDivider(wiring.Component):
         High while steps remain.
     done : ``Out(1)``
         One-cycle strobe: right after edge S + ``latency`` when ``start`` was sampled at edge S.
+    tag_in : ``In(tag_bits)``
+        Sampled with ``start`` (only with ``tag_bits``).
+    tag : ``Out(tag_bits)``
+        The ``tag_in`` of the last ``start``, from the next edge until the next ``start``.
     """
 
-    def __init__(self, dividend_bits, divisor_bits, quotient_bits):
+    def __init__(self, dividend_bits, divisor_bits, quotient_bits, *, tag_bits=0):
         for name, value in (("dividend_bits", dividend_bits), ("divisor_bits", divisor_bits),
                             ("quotient_bits", quotient_bits)):
             if isinstance(value, bool) or not isinstance(value, int) or value < 1:
                 raise ValueError(f"{name} must be an int >= 1, got {value!r}")
+        if isinstance(tag_bits, bool) or not isinstance(tag_bits, int) or tag_bits < 0:
+            raise ValueError(f"tag_bits must be an int >= 0, got {tag_bits!r}")
         self.dividend_bits = dividend_bits
         self.divisor_bits = divisor_bits
         self.quotient_bits = quotient_bits
-        super().__init__({
+        self.tag_bits = tag_bits
+        members = {
             "start": In(1),
             "dividend": In(dividend_bits),
             "divisor": In(divisor_bits),
             "quotient": Out(quotient_bits),
             "busy": Out(1),
             "done": Out(1),
-        })
+        }
+        if tag_bits:
+            members.update(tag_in=In(tag_bits), tag=Out(tag_bits))
+        super().__init__(members)
 
     @property
     def latency(self):
@@ -72,8 +86,12 @@ class SequentialDivider(wiring.Component):
             "rem": self.divisor_bits,  # partial remainder, always < divisor
             "low": q_bits,  # dividend bits still to bring down; quotient bits shift in
             "divisor": self.divisor_bits,  # held: the inputs may change once started
+            "tag": self.tag_bits,
         }))
         steps, rem, low, divisor = state.steps, state.rem, state.low, state.divisor
+        tag = state.tag
+        if self.tag_bits:
+            m.d.comb += self.tag.eq(tag)
 
         trial = Cat(low[-1], rem)  # rem * 2 + next dividend bit
         fits = trial >= divisor
@@ -88,14 +106,14 @@ class SequentialDivider(wiring.Component):
         ]
         # Each branch loads the whole register in one assignment: a field-by-field load makes
         # the compiled simulators compute every field's next value on every clock.
-        def load(steps_value, rem_value, low_value, divisor_value=divisor):
-            fields = zip((steps_value, rem_value, low_value, divisor_value),
-                         (steps, rem, low, divisor))
+        def load(steps_value, rem_value, low_value, divisor_value=divisor, tag_value=tag):
+            fields = zip((steps_value, rem_value, low_value, divisor_value, tag_value),
+                         (steps, rem, low, divisor, tag))
             return state.eq(Cat(fit(v, len(f)) for v, f in fields))
 
         with m.If(self.start):
             m.d.sync += load(q_bits + 1, self.dividend >> q_bits, self.dividend[:q_bits],
-                             self.divisor)
+                             self.divisor, self.tag_in if self.tag_bits else tag)
         with m.Elif(steps.any()):  # idle (0) in one test: the usual case, every clock
             with m.If(stepping):
                 m.d.sync += load(steps - 1, Mux(fits, trial - divisor, trial),

@@ -163,28 +163,27 @@ class TrackerResults(wiring.Component):
         def frame_count():  # N, as a balanced tree: this is all computed in one clock cycle
             return _tree_sum(bins)
 
-        # --- Divide ------------------------------------------------------------------------
+        # --- Divide, and everything else of the frame at its end -----------------------------
         # One quotient bit more than SX // N needs (it is always 0): the extra step is the one
-        # cycle the outputs wait for, without a delay register of its own.
+        # cycle the outputs wait for, without a delay register of its own. The other results
+        # (found, proximity, LED code) travel with the division as its tag: no register of
+        # their own, and the next frame may start counting on the very next cycle.
+        pending_layout = data.StructLayout({"found": 1, "proximity": 3, "leds": 8})
         m.submodules.divider = div = SequentialDivider(
-            p.sum_x_bits, p.count_bits, p.x_bits + 1)
+            p.sum_x_bits, p.count_bits, p.x_bits + 1, tag_bits=pending_layout.size)
         m.d.comb += [
             div.start.eq(counts.end),
             div.dividend.eq(counts.sum_x),
             div.divisor.eq(frame_count()),
-        ]
-
-        # --- Everything else of the frame, at its end ----------------------------------------
-        pending = Signal(data.StructLayout({"found": 1, "proximity": 3, "leds": 8}),
-                         reset_less=True)  # only read after an `end` loaded it
-        with m.If(counts.end):
-            # One assignment of the whole register (see `fit`).
-            m.d.sync += pending.eq(Cat(
+            div.tag_in.eq(Cat(
                 frame_count() >= p.min_pixels,
                 fit(sum((frame_count() >= t if t > 0 else Const(1, 1))
                         for t in p.proximity_thresholds), 3),
                 _led_code(m, bins, frame_count(), p.min_pixels),
-            ))
+            )),
+        ]
+        pending = data.View(pending_layout, div.tag)
+        with m.If(counts.end):
             if self.inspect:
                 m.d.sync += [
                     self.count.eq(frame_count()),

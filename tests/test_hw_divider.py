@@ -91,3 +91,34 @@ def test_zero_divisor_still_finishes_on_time():
 def test_widths_are_validated(bad):
     with pytest.raises(ValueError, match="quotient_bits"):
         SequentialDivider(8, 8, bad)
+
+
+def test_tag_travels_with_the_division_and_holds_until_the_next_start():
+    dut = SequentialDivider(22, 14, 9, tag_bits=12)
+    seen = []
+
+    async def bench(ctx):
+        for dividend, divisor, tag in [(1000, 7, 0xABC), (90, 9, 0x123), (5, 1, 0)]:
+            ctx.set(dut.dividend, dividend)
+            ctx.set(dut.divisor, divisor)
+            ctx.set(dut.tag_in, tag)
+            ctx.set(dut.start, 1)
+            await ctx.tick()
+            ctx.set(dut.start, 0)
+            ctx.set(dut.tag_in, 0xFFF)  # sampled at start only
+            tags = [ctx.get(dut.tag)]
+            while not ctx.get(dut.done):
+                await ctx.tick()
+                tags.append(ctx.get(dut.tag))
+            await ctx.tick()
+            tags.append(ctx.get(dut.tag))
+            seen.append((ctx.get(dut.quotient), set(tags)))
+
+    run_testbench(dut, bench, watchdog=100)
+    assert seen == [(1000 // 7, {0xABC}), (90 // 9, {0x123}), (5, {0})]
+
+
+def test_tag_width_is_validated():
+    with pytest.raises(ValueError, match="tag_bits"):
+        SequentialDivider(8, 8, 4, tag_bits=-1)
+    assert "tag" not in SequentialDivider(8, 8, 4).signature.members
