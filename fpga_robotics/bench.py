@@ -92,11 +92,11 @@ def measure(backend, frames, min_seconds=0.0):
 
 
 def measure_paired(design_backend, trivial_backend, frames, min_seconds=0.0):
-    """Cycle rate of ``design_backend`` as a fraction of ``trivial_backend``'s, measured in
-    alternating batches (one pass over ``frames`` each) so that both see the same machine:
-    on a shared machine whose speed drifts, two cases timed one after the other can differ by
-    more than the designs do. Returns the fraction of the two medians of per-frame cycle
-    rates, and the number of frames each ran."""
+    """Cycle rate of ``design_backend`` as a fraction of ``trivial_backend``'s, measured frame
+    by frame in alternation (each frame through one, then through the other) so that both see
+    the same machine: on a shared machine whose speed drifts within seconds, two cases timed
+    one after the other can differ by more than the designs do. Returns the fraction of the
+    two medians of per-frame cycle rates, and the number of frames each ran."""
     backends = (design_backend, trivial_backend)
     rates = ([], [])
     for backend in backends:
@@ -106,8 +106,8 @@ def measure_paired(design_backend, trivial_backend, frames, min_seconds=0.0):
     begin = time.perf_counter()
     try:
         while not rates[0] or time.perf_counter() - begin < min_seconds:
-            for backend, samples in zip(backends, rates, strict=True):
-                for frame in frames:
+            for frame in frames:
+                for backend, samples in zip(backends, rates, strict=True):
                     start = time.perf_counter()
                     result = backend.process_frame(frame)
                     samples.append(result.cycles / (time.perf_counter() - start))
@@ -226,7 +226,7 @@ def summary(results, paired=()):
             pair = pairs.get((best["backend"], w, h))
             if pair or trivial:
                 if pair:
-                    frac, how = pair["fraction"], "measured in alternating batches"
+                    frac, how = pair["fraction"], "measured in alternation"
                 else:
                     frac = best["cycles_per_second"] / trivial["cycles_per_second"]
                     how = "from the two rows above"
@@ -300,7 +300,7 @@ def main(argv=None):
                     paired.append(pair)
                     print(
                         f"{name} {w}x{h}: FollowTarget at {pair['fraction']:.2f} of the trivial "
-                        f"design's cycle rate (alternating batches, {pair['frames']} frames each)",
+                        f"design's cycle rate (alternating frames, {pair['frames']} each)",
                         flush=True,
                     )
     for line in notes + summary(results, paired):

@@ -46,11 +46,11 @@ def test_bench_prints_and_writes_figures(tmp_path, capsys):
     # The cycle count of a 40x16 frame is the pixel count plus the documented latency.
     assert rows[("cxxrtl", "passthrough", 40)]["cycles_per_frame"] == 40 * 16 + 1
     assert data["machine"]["cpus"] >= 1
-    # FollowTarget against the trivial design in alternating batches, per size.
+    # FollowTarget against the trivial design, frames in alternation, per size.
     assert {(r["backend"], r["width"]) for r in data["paired"]} == {("cxxrtl", 40), ("cxxrtl", 48)}
     for r in data["paired"]:
         assert r["frames"] == 3 and 0 < r["fraction"] < 10
-    assert "of the trivial design's cycle rate (alternating batches, 3 frames each)" in out
+    assert "of the trivial design's cycle rate (alternating frames, 3 each)" in out
 
 
 class _FakeBackend:
@@ -77,7 +77,7 @@ def test_summary_takes_the_fraction_from_the_paired_measurement():
     assert any("0.33 of the trivial" in line and "MISSED" in line for line in separate)
     paired = [{"backend": "cxxrtl", "width": 160, "height": 120, "fraction": 0.55, "frames": 9}]
     lines = bench.summary(results, paired)
-    assert any("0.55 of the trivial" in line and "alternating" in line and line.endswith("met")
+    assert any("0.55 of the trivial" in line and "alternation" in line and line.endswith("met")
                for line in lines)
     assert any("0.3" in line and "<= 0.4 ms: met" in line for line in lines)
 
