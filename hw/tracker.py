@@ -5,9 +5,9 @@ Pipeline (one pixel per cycle at most, never stalls):
 1. ``WindowCounter``: framing, window, bins and the counts ``h0..h7`` and ``SX`` in one
    register stage (see there for malformed framing: such a frame never ends, so it
    produces no ``frame_done`` and its counts are reloaded at the next ``first``);
-2. at the end of a well-formed frame the divider (``SX // N``) starts and every other
-   result is computed into a pending register, so the next frame can start accumulating on
-   the very next cycle;
+2. at the end of a well-formed frame the divider (``SX // N``) starts, and every other
+   result is computed into the divider's tag, which travels with the division, so the next
+   frame can start accumulating on the very next cycle;
 3. after the divider, all per-frame outputs load together with the one-cycle ``frame_done``.
 
 Every stage is kept small and registered for simulation speed: the compiled simulators
@@ -116,8 +116,8 @@ class TrackerResults(wiring.Component):
 
     Everything is decided at ``counts.end``, so the next frame may start counting on the very
     next cycle: the divider starts from the counts, and ``found``, ``proximity`` and the LED
-    code go into one pending register. When the divider is done, every output loads at once
-    with the one-cycle ``frame_done``.
+    code go into its tag (loaded with the start, held through the division). When the
+    divider is done, every output loads at once with the one-cycle ``frame_done``.
 
     Built for simulation speed: the per-frame arithmetic is written under the ``end``
     condition, each use its own expression (``N``, the sum of the bins, too), so the
