@@ -39,9 +39,19 @@ def _mangle(name):
     return "p_" + name.replace("_", "__")
 
 
+def _eval_span(source):
+    start = source.index("::eval(performer *performer) {")
+    return start, source.index("\n}\n", start)
+
+
 def _eval_body(source):
-    body = source[source.index("::eval(performer *performer) {") :]
-    return body[: body.index("\n}\n")]
+    start, end = _eval_span(source)
+    return source[start:end]
+
+
+def _with_eval_body(source, body):
+    start, end = _eval_span(source)
+    return source[:start] + body + source[end:]
 
 
 def _edge_only_wires(source):
@@ -132,9 +142,7 @@ def without_port_copies(source):
     """
     if output_sources(source) is None:
         return source
-    start = source.index("::eval(performer *performer) {")
-    end = source.index("\n}\n", start)
-    body = source[start:end]
+    body = _eval_body(source)
     for port in OUTPUTS:
         name = _mangle(port)
         if not re.search(rf"/\*output\*/ value<\d+> {name};", source):
@@ -142,7 +150,7 @@ def without_port_copies(source):
         copies = re.findall(rf"^\t{name} = .*;\n", body, re.MULTILINE)
         if len(copies) == 1 and len(re.findall(rf"\b{name}\b", body)) == 1:
             body = body.replace(copies[0], "")
-    return source[:start] + body + source[end:]
+    return _with_eval_body(source, body)
 
 
 def with_wire_copies_inlined(source):
@@ -153,9 +161,7 @@ def with_wire_copies_inlined(source):
     every clock. A flip-flop's ``.curr`` only changes in commit(), so reading it directly
     wherever the local is read is the same computation. Only locals of eval() assigned once,
     at its top level, from a wire of the same width are replaced."""
-    start = source.index("::eval(performer *performer) {")
-    end = source.index("\n}\n", start)
-    body = source[start:end]
+    body = _eval_body(source)
     wires = re.findall(r"^\t(?:/\*\w+\*/ )?wire<(\d+)> (\w+);$", source, re.MULTILINE)
     wire_width = {name: width for width, name in wires}
     for name, wire in re.findall(r"^\t(\w+) = (\w+)\.curr;$", body, re.MULTILINE):
@@ -168,7 +174,7 @@ def with_wire_copies_inlined(source):
         body = body.replace(declaration.group(0), "")
         body = body.replace(f"\t{name} = {wire}.curr;\n", "")
         body = re.sub(rf"\b{name}\b", f"{wire}.curr", body)
-    return source[:start] + body + source[end:]
+    return _with_eval_body(source, body)
 
 
 def commit_wires(source):
