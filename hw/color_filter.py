@@ -4,6 +4,7 @@ from amaranth import Cat, Const, Module, Mux, Signal
 from amaranth.lib import data, stream, wiring
 from amaranth.lib.wiring import In, Out
 
+from .fit import load
 from .params import FollowTargetParams
 from .pixel import PixelStream
 
@@ -134,7 +135,7 @@ class ColorFilter(wiring.Component):
         # the generated C++ has no branch that depends on the pixel data.
         with m.If(self.pixels.valid):
             keep = Cat(match.replicate(flags_at), Const(0b11, 2))
-            m.d.sync += stage.eq(Cat(pix.as_value() & keep, match, Const(1, 1)))
+            m.d.sync += load(stage, payload=pix.as_value() & keep, match=match, valid=1)
         with m.Else():
-            m.d.sync += stage.eq(Cat(stage.as_value()[:-1], Const(0, 1)))
+            m.d.sync += load(stage, valid=0)
         return m

@@ -4,7 +4,7 @@ from amaranth import Cat, Module, Mux, Signal
 from amaranth.lib import data, wiring
 from amaranth.lib.wiring import In, Out
 
-from .fit import fit
+from .fit import load
 
 __all__ = ["SequentialDivider"]
 
@@ -89,9 +89,8 @@ class SequentialDivider(wiring.Component):
             "tag": self.tag_bits,
         }))
         steps, rem, low, divisor = state.steps, state.rem, state.low, state.divisor
-        tag = state.tag
         if self.tag_bits:
-            m.d.comb += self.tag.eq(tag)
+            m.d.comb += self.tag.eq(state.tag)
 
         trial = Cat(low[-1], rem)  # rem * 2 + next dividend bit
         fits = trial >= divisor
@@ -104,21 +103,16 @@ class SequentialDivider(wiring.Component):
             self.busy.eq(stepping),
             self.done.eq(steps == 1),
         ]
-        # Each branch loads the whole register in one assignment: a field-by-field load makes
-        # the compiled simulators compute every field's next value on every clock.
-        def load(steps_value, rem_value, low_value, divisor_value=divisor, tag_value=tag):
-            fields = zip((steps_value, rem_value, low_value, divisor_value, tag_value),
-                         (steps, rem, low, divisor, tag))
-            return state.eq(Cat(fit(v, len(f)) for v, f in fields))
-
+        # Each branch loads the whole register in one assignment (see `load`).
         with m.If(self.start):
-            m.d.sync += load(q_bits + 1, self.dividend >> q_bits, self.dividend[:q_bits],
-                             self.divisor, self.tag_in if self.tag_bits else tag)
+            tag_value = {"tag": self.tag_in} if self.tag_bits else {}
+            m.d.sync += load(state, steps=q_bits + 1, rem=self.dividend >> q_bits,
+                             low=self.dividend[:q_bits], divisor=self.divisor, **tag_value)
         with m.Elif(steps.any()):  # idle (0) in one test: the usual case, every clock
             with m.If(stepping):
-                m.d.sync += load(steps - 1, Mux(fits, trial - divisor, trial),
-                                 Cat(fits, low[:-1]))
+                m.d.sync += load(state, steps=steps - 1, rem=Mux(fits, trial - divisor, trial),
+                                 low=Cat(fits, low[:-1]))
             with m.Else():
-                m.d.sync += load(0, rem, low)  # the `done` cycle
+                m.d.sync += load(state, steps=0)  # the `done` cycle
         return m
 

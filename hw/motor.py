@@ -1,10 +1,10 @@
 """Motor controller: per-frame wheel speeds (DPS) from the tracker's results."""
 
-from amaranth import Cat, Const, Module, Mux, Signal, signed
+from amaranth import Const, Module, Mux, Signal, signed
 from amaranth.lib import data, wiring
 from amaranth.lib.wiring import In, Out
 
-from .fit import fit
+from .fit import load
 from .params import FollowTargetParams
 
 __all__ = ["MotorController"]
@@ -116,20 +116,15 @@ class MotorController(wiring.Component):
             self.lost_count.eq(state.count), self.last_side.eq(state.right_side),
         ]
 
-        def load(left, right, count, right_side):
-            fields = zip((left, right, count, right_side),
-                         (state.left, state.right, state.count, state.right_side))
-            return state.eq(Cat(fit(v, len(f)) for v, f in fields))
-
         with m.If(self.update):
             with m.If(self.found):
-                m.d.sync += load(saturate(base() + turn()), saturate(base() - turn()), 0, e() >= 0)
+                m.d.sync += load(state, left=saturate(base() + turn()),
+                                 right=saturate(base() - turn()), count=0, right_side=e() >= 0)
             # This frame reaches the limit (no constant-true comparison when it is 1: lint).
             with m.Elif(state.count >= p.lost_frames - 1 if p.lost_frames > 1 else 1):
-                m.d.sync += load(Mux(state.right_side, search, neg_search),
-                                 Mux(state.right_side, neg_search, search),
-                                 p.lost_frames, state.right_side)
+                m.d.sync += load(state, left=Mux(state.right_side, search, neg_search),
+                                 right=Mux(state.right_side, neg_search, search),
+                                 count=p.lost_frames)
             with m.Else():
-                m.d.sync += load(state.left, state.right, state.count + 1, state.right_side)
+                m.d.sync += load(state, count=state.count + 1)
         return m
-

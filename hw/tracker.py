@@ -18,13 +18,13 @@ re-evaluates a module's combinational logic when any of its inputs changes, so t
 logic (LED code, proximity) is not recomputed for every pixel.
 """
 
-from amaranth import Cat, Const, Module, Mux, Signal
+from amaranth import Const, Module, Mux, Signal
 from amaranth.lib import data, wiring
 from amaranth.lib.wiring import In, Out
 
 from .color_filter import MatchStream
 from .divider import SequentialDivider
-from .fit import fit
+from .fit import load
 from .params import FollowTargetParams
 from .window_counter import FrameCounts, WindowCounter
 
@@ -175,12 +175,11 @@ class TrackerResults(wiring.Component):
             div.start.eq(counts.end),
             div.dividend.eq(counts.sum_x),
             div.divisor.eq(frame_count()),
-            div.tag_in.eq(Cat(
-                frame_count() >= p.min_pixels,
-                fit(sum((frame_count() >= t if t > 0 else Const(1, 1))
-                        for t in p.proximity_thresholds), 3),
-                _led_code(m, bins, frame_count(), p.min_pixels),
-            )),
+            load(data.View(pending_layout, div.tag_in),
+                 found=frame_count() >= p.min_pixels,
+                 proximity=sum((frame_count() >= t if t > 0 else Const(1, 1))
+                               for t in p.proximity_thresholds),
+                 leds=_led_code(m, bins, frame_count(), p.min_pixels)),
         ]
         pending = data.View(pending_layout, div.tag)
         with m.If(counts.end):
@@ -202,11 +201,12 @@ class TrackerResults(wiring.Component):
                      for name in ("frame_done", "found", "proximity", "centroid_x",
                                   "centroid_leds")]
         with m.If(div.done):
-            m.d.sync += outputs.eq(Cat(
-                Const(1, 1), pending.found, pending.proximity,
-                Mux(pending.found, div.quotient[:p.x_bits], 0), pending.leds))
+            m.d.sync += load(outputs, frame_done=1, found=pending.found,
+                             proximity=pending.proximity,
+                             centroid_x=Mux(pending.found, div.quotient[:p.x_bits], 0),
+                             centroid_leds=pending.leds)
         with m.Else():
-            m.d.sync += outputs.eq(Cat(Const(0, 1), outputs.as_value()[1:]))
+            m.d.sync += load(outputs, frame_done=0)
         return m
 
 

@@ -5,7 +5,7 @@ from amaranth.lib import data, wiring
 from amaranth.lib.wiring import In, Out
 
 from .color_filter import MatchStream
-from .fit import fit
+from .fit import fit, load
 from .params import FollowTargetParams
 
 __all__ = ["FrameCounts", "WindowCounter"]
@@ -172,7 +172,7 @@ class WindowCounter(wiring.Component):
             # A `first` is column 0: never a bin's last column, and adds 0 to SX.
             m.d.sync += [
                 bins.eq(0), sx.eq(0),
-                bin_state.eq(Cat(fit(count & shape_ok, acc_bits), Const(first_boundary, p.x_bits))),
+                load(bin_state, acc=count & shape_ok, boundary=first_boundary),
             ]
         with m.Elif(advance):
             # A masked add rather than a conditional one: no branch on the pixel data.
@@ -182,7 +182,7 @@ class WindowCounter(wiring.Component):
                 next_boundary = Mux(boundary == last_boundary, first_boundary, boundary + bw)
                 m.d.sync += [
                     bins.eq(Cat(bins[cb:], fit(bins[:cb] + acc + count, cb))),
-                    bin_state.eq(Cat(Const(0, acc_bits), fit(next_boundary, p.x_bits))),
+                    load(bin_state, acc=0, boundary=next_boundary),
                 ]
             with m.Else():
                 m.d.sync += bin_state.eq(bin_state.as_value() + count)
