@@ -11,6 +11,7 @@ Builds (or cache loads) happen before timing and are reported separately.
 """
 
 import argparse
+import contextlib
 import gc
 import json
 import os
@@ -58,16 +59,26 @@ def bench_frames(width, height, count, seed):
     return [synthetic.as_rgb444(f) for f in synthetic.sequence(width, height, states, rng=rng)]
 
 
+@contextlib.contextmanager
+def _gc_paused():
+    """No garbage collection while timing: a collection would land in one frame's time."""
+    was_enabled = gc.isenabled()
+    gc.disable()
+    try:
+        yield
+    finally:
+        if was_enabled:
+            gc.enable()
+
+
 def measure(backend, frames, min_seconds=0.0):
     """Median ms per frame (wall clock and CPU time) and cycles per second (wall clock) over
     ``frames``, after one warm-up frame; the frames repeat until ``min_seconds`` have passed,
     so that a short burst of other work on a shared machine cannot decide the median."""
     backend.process_frame(frames[0])
     times, cpu_times, cycles = [], [], []
-    gc_was_enabled = gc.isenabled()
-    gc.disable()
-    begin = time.perf_counter()
-    try:
+    with _gc_paused():
+        begin = time.perf_counter()
         n = 0
         while n < len(frames) or time.perf_counter() - begin < min_seconds:
             frame = frames[n % len(frames)]
@@ -77,9 +88,6 @@ def measure(backend, frames, min_seconds=0.0):
             times.append(time.perf_counter() - start)
             cpu_times.append(time.thread_time() - cpu_start)
             cycles.append(result.cycles)
-    finally:
-        if gc_was_enabled:
-            gc.enable()
     median = statistics.median(times)
     return {
         "frames": len(times),
@@ -101,10 +109,8 @@ def measure_paired(design_backend, trivial_backend, frames, min_seconds=0.0):
     rates = ([], [])
     for backend in backends:
         backend.process_frame(frames[0])
-    gc_was_enabled = gc.isenabled()
-    gc.disable()
-    begin = time.perf_counter()
-    try:
+    with _gc_paused():
+        begin = time.perf_counter()
         n = 0
         while not rates[0] or time.perf_counter() - begin < min_seconds:
             for frame in frames:
@@ -114,9 +120,6 @@ def measure_paired(design_backend, trivial_backend, frames, min_seconds=0.0):
                     result = backends[i].process_frame(frame)
                     rates[i].append(result.cycles / (time.perf_counter() - start))
                 n += 1
-    finally:
-        if gc_was_enabled:
-            gc.enable()
     return {
         "fraction": statistics.median(rates[0]) / statistics.median(rates[1]),
         "frames": len(rates[0]),
@@ -299,7 +302,10 @@ def main(argv=None):
         if not args.no_trivial:
             for name in names:
                 if name in COMPILED_BACKENDS:
-                    pair = run_paired(name, params, frames, args.min_seconds)
+                    try:
+                        pair = run_paired(name, params, frames, args.min_seconds)
+                    except BackendError as exc:
+                        raise UsageError(f"the {name} backend cannot run here: {exc}") from None
                     paired.append(pair)
                     print(
                         f"{name} {w}x{h}: FollowTarget at {pair['fraction']:.2f} of the trivial "

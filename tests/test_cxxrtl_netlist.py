@@ -73,7 +73,10 @@ def test_port_copies_are_removed_and_nothing_else(follow_target_source):
     for port in OUTPUTS:
         name = "p_" + port.replace("_", "__")
         assert not re.search(rf"^\t{name} = ", body, re.MULTILINE)
-    assert stripped.replace(before, body) == stripped  # only eval() changed
+    # Only eval() changed: what comes before and after it is the generated text as it was.
+    start = follow_target_source.index(before)
+    assert stripped[:start] == follow_target_source[:start]
+    assert stripped[start + len(body) :] == follow_target_source[start + len(before) :]
 
 
 HAND_MODEL = """

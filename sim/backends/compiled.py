@@ -81,7 +81,7 @@ class _Library:
             raise BackendError(f"the compiled model {path} has an unexpected harness ABI")
         self.lib = lib
         self.path = path
-        #: Simulator evaluations per clock cycle (1 when every output is a flip-flop).
+        #: Simulator evaluations per clock cycle (1 when every output is read from flip-flops).
         self.evals_per_cycle = lib.fr_evals_per_cycle()
 
 

@@ -54,10 +54,16 @@ def _with_eval_body(source, body):
     return source[:start] + body + source[end:]
 
 
+def _wire_widths(source):
+    """``{C++ name: width}`` of the model's wires (its flip-flops)."""
+    found = re.findall(r"^\t(?:/\*\w+\*/ )?wire<(\d+)> (\w+);$", source, re.MULTILINE)
+    return {name: width for width, name in found}
+
+
 def _edge_only_wires(source):
     """C++ names of the wires whose ``.next`` is assigned only inside ``if (posedge_p_clk)``
     blocks of eval(), i.e. the flip-flops of the one clock domain."""
-    wires = set(re.findall(r"^\t(?:/\*\w+\*/ )?wire<\d+> (\w+);$", source, re.MULTILINE))
+    wires = set(_wire_widths(source))
     depth, posedge_depth = 0, None
     assigned = re.compile(r"\b(\w+)\.next\b")
     for line in _eval_body(source).splitlines()[1:]:
@@ -162,8 +168,7 @@ def with_wire_copies_inlined(source):
     wherever the local is read is the same computation. Only locals of eval() assigned once,
     at its top level, from a wire of the same width are replaced."""
     body = _eval_body(source)
-    wires = re.findall(r"^\t(?:/\*\w+\*/ )?wire<(\d+)> (\w+);$", source, re.MULTILINE)
-    wire_width = {name: width for width, name in wires}
+    wire_width = _wire_widths(source)
     for name, wire in re.findall(r"^\t(\w+) = (\w+)\.curr;$", body, re.MULTILINE):
         declaration = re.search(rf"^\tvalue<(\d+)> {name};\n", body, re.MULTILINE)
         assignments = re.findall(rf"^\s*{name}(?:\.slice<[^>]*>\(\))? = ", body, re.MULTILINE)
@@ -186,7 +191,7 @@ def commit_wires(source):
         return None
     body = source[start : source.index("return changed;", start)]
     statements = [s.strip() for s in body.splitlines()[1:] if s.strip()]
-    declared = set(re.findall(r"^\t(?:/\*\w+\*/ )?wire<\d+> (\w+);$", source, re.MULTILINE))
+    declared = _wire_widths(source)
     wires = []
     for statement in statements:
         match = re.fullmatch(r"if \((\w+)\.commit\(observer\)\) changed = true;", statement)
