@@ -1,0 +1,142 @@
+"""Files the project writes: checked before the work starts, written whole or not at all.
+
+Every output (summaries, Verilog, waveforms, recordings, benchmark tables) goes through here:
+
+- ``check_output_path`` is called before a long job, so a bad path fails in a second, not
+  after the run.
+- ``atomic_output`` writes through a hidden temporary file in the same folder and renames it
+  over the target at the end; on any error (or Ctrl-C) the temporary file is removed and the
+  target is untouched. A rename goes only over a regular file or a new path: a device node, a
+  folder or a link to one is never replaced.
+"""
+
+import json
+import os
+import stat
+import tempfile
+from contextlib import contextmanager
+from pathlib import Path
+
+__all__ = [
+    "OutputPathError", "atomic_output", "atomic_path", "check_output_dir", "check_output_path",
+    "default_file_mode", "write_atomic", "write_json_atomic",
+]
+
+
+class OutputPathError(ValueError):
+    """An output path that cannot be written; the message names the path and the fix."""
+
+
+def default_file_mode():
+    """The mode ``open()`` would give a new file under the current umask (``mkstemp`` files
+    are private, 0600; outputs should not be)."""
+    umask = os.umask(0)
+    os.umask(umask)
+    return 0o666 & ~umask
+
+
+def _existing_ancestor(path):
+    for parent in path.parents:
+        if parent.exists() or parent.is_symlink():
+            return parent
+    return Path(".")
+
+
+def _check_folder(folder, path, what):
+    """``folder`` (the nearest existing ancestor of ``path``) must be a writable folder."""
+    if not folder.is_dir():
+        raise OutputPathError(f"{what} {str(path)!r}: {str(folder)!r} is not a folder")
+    try:  # os.access says yes to root even on a read-only file system: try for real
+        fd, probe = tempfile.mkstemp(prefix=".write-test-", dir=folder)
+        os.close(fd)
+        os.unlink(probe)
+    except OSError as exc:
+        raise OutputPathError(
+            f"{what} {str(path)!r}: cannot write in {str(folder)!r} ({exc.strerror}); "
+            "choose another place") from None
+
+
+def check_output_path(path, *, what="output file"):
+    """Check that ``path`` can be written as a regular file; return it as a ``Path``.
+
+    Missing parent folders are fine (``atomic_output`` creates them). Raises
+    ``OutputPathError`` for an empty path, an existing folder or non-regular file (a device,
+    a FIFO), a parent that is a file, or a folder that cannot be written.
+    """
+    if path is None or str(path).strip() == "":
+        raise OutputPathError(f"{what}: the path is empty; give a file name")
+    path = Path(path)
+    if path.exists():
+        mode = path.stat().st_mode
+        if stat.S_ISDIR(mode):
+            raise OutputPathError(f"{what} {str(path)!r} is a folder; give a file name in it")
+        if not stat.S_ISREG(mode):
+            raise OutputPathError(
+                f"{what} {str(path)!r} exists and is not a regular file (a device or pipe); "
+                "give a file name")
+    folder = path.parent if path.parent.exists() else _existing_ancestor(path)
+    _check_folder(folder, path, what)
+    return path
+
+
+def check_output_dir(path, *, what="output folder"):
+    """Check that ``path`` is a writable folder or can be created as one; return a ``Path``."""
+    if path is None or str(path).strip() == "":
+        raise OutputPathError(f"{what}: the path is empty; give a folder")
+    path = Path(path)
+    if path.exists():
+        if not path.is_dir():
+            raise OutputPathError(f"{what} {str(path)!r} exists and is not a folder")
+        _check_folder(path, path, what)
+    else:
+        _check_folder(_existing_ancestor(path), path, what)
+    return path
+
+
+@contextmanager
+def atomic_path(path, *, what="output file", suffix=None):
+    """Yield a hidden temporary path next to ``path`` for a writer that opens files itself
+    (a simulator writing a waveform); on success it becomes ``path``, on error it is removed."""
+    path = check_output_path(path, what=what)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    suffix = path.suffix if suffix is None else suffix
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=f".partial{suffix}",
+                               dir=path.parent)
+    os.close(fd)
+    tmp = Path(tmp)
+    try:
+        yield tmp
+        _replace(tmp, path, what)
+    finally:
+        tmp.unlink(missing_ok=True)
+
+
+def _replace(tmp, path, what):
+    # Checked again at the end: the target may have changed while the work ran.
+    if path.exists() and not path.is_file():
+        raise OutputPathError(f"{what} {str(path)!r} is no longer a regular file; not replaced")
+    os.chmod(tmp, default_file_mode())
+    os.replace(tmp, path)
+
+
+@contextmanager
+def atomic_output(path, mode="w", *, what="output file"):
+    """``with atomic_output(path) as f: f.write(...)``: ``path`` gets all of it or nothing."""
+    if mode not in ("w", "wb"):
+        raise ValueError(f"mode must be 'w' or 'wb', got {mode!r}")
+    with atomic_path(path, what=what) as tmp:
+        with open(tmp, mode) as f:
+            yield f
+
+
+def write_atomic(path, data, *, what="output file"):
+    """Write ``data`` (str or bytes) to ``path`` atomically."""
+    with atomic_output(path, "wb" if isinstance(data, bytes) else "w", what=what) as f:
+        f.write(data)
+
+
+def write_json_atomic(path, obj, *, what="JSON file"):
+    """Write ``obj`` as indented JSON (with a final newline) to ``path`` atomically."""
+    with atomic_output(path, what=what) as f:
+        json.dump(obj, f, indent=2)
+        f.write("\n")
