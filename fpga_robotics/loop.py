@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .hw.pixel import color_select_value
-from .records import FrameRecord
+from .sim.records import FrameRecord
 from .sim_camera import SimCamera, in_view
 from .sim_motors import SimMotors
 from .summary import compute_metrics, evaluate_checks, verdict

@@ -12,7 +12,7 @@ import numpy as np
 
 from .errors import UsageError
 from .hw.pixel import color_select_value
-from .records import FrameRecord
+from .sim.records import FrameRecord
 
 __all__ = ["IMAGE_SUFFIXES", "FrameSource", "open_source", "run_source"]
 

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from fpga_robotics.errors import UsageError
-from fpga_robotics.records import FrameRecord
+from fpga_robotics.sim.records import FrameRecord
 from fpga_robotics.sim.backends.base import FrameResult
 from fpga_robotics.viz import open_recorder, parse_mode, sinks
 from fpga_robotics.viz import paths as P

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from fpga_robotics.errors import UsageError
-from fpga_robotics.records import FrameRecord, PersonState, WorldMap
+from fpga_robotics.sim.records import FrameRecord, PersonState, WorldMap
 from fpga_robotics.sim.backends.base import FrameResult
 from fpga_robotics.sim.frames import rgb444_to_rgb888
 from fpga_robotics.viz import open_recorder

@@ -22,7 +22,7 @@ import numpy as np
 from ..errors import UsageError, run_cli
 from ..hw.params import FollowTargetParams
 from ..hw.pixel import COLOR_SELECT
-from ..records import FrameRecord, PersonState, WorldMap
+from ..sim.records import FrameRecord, PersonState, WorldMap
 from ..sim import synthetic
 from ..sim.backends.base import FrameResult
 from ..sim.frames import to_rgb444

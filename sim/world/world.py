@@ -14,7 +14,7 @@ import math
 import numpy as np
 import pymunk
 
-from ...records import PersonState, WorldMap
+from ..records import PersonState, WorldMap
 from ..scene import CameraPose, Cylinder, Scene
 from .config import WorldConfigError, parse_world_config
 from .lighting import LightingSchedule

@@ -1,6 +1,6 @@
 """What the closed loop produces, frame by frame: the data the viewer and the summary read.
 
-The loop (``fpga_robotics.loop``) fills these; ``fpga_robotics.viz`` logs them to rerun.
+The closed loop (``fpga_robotics.loop``) fills these; ``fpga_robotics.viz`` logs them to rerun.
 Positions are in metres in the world frame (x right, y up, top-down view), headings in radians
 counter-clockwise from +x, times in seconds of simulated time.
 """
@@ -9,7 +9,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .sim.backends.base import FrameResult
+from .backends.base import FrameResult
 
 __all__ = ["FrameRecord", "PersonState", "WorldMap"]
 
