@@ -23,6 +23,8 @@ import time
 from dataclasses import dataclass, field
 
 from .errors import UsageError, run_cli
+from .param_options import add_param_arguments, params_from_args
+from .sim.files import check_output_dir, write_atomic
 
 __all__ = [
     "BOARDS",
@@ -94,24 +96,6 @@ def _plan(board, params, nextpnr_opts=(), *, verilog=False):
         raise UsageError(str(exc)) from None
 
 
-def _write_atomically(path, content):
-    """Write via a temporary file and a rename: an interrupted run leaves no half file."""
-    directory = os.path.dirname(os.path.abspath(path))
-    os.makedirs(directory, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=".tmp-", dir=directory)
-    try:
-        with os.fdopen(fd, "w") as f:
-            f.write(content)
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp, 0o666 & ~umask)  # mkstemp makes it private; give it normal permissions
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
-
-
 def _write_plan(plan, out_dir, *, rename_verilog=True):
     """Write every file of the build plan into ``out_dir`` (each via a temporary + rename)."""
     written = []
@@ -122,7 +106,7 @@ def _write_plan(plan, out_dir, *, rename_verilog=True):
         path = os.path.join(out_dir, target)
         if isinstance(content, bytes):
             content = content.decode()
-        _write_atomically(path, content)
+        write_atomic(path, content, what="board build file")
         written.append(path)
     return written
 
@@ -267,13 +251,17 @@ def add_board_arguments(parser):
                         help=f"export a board top instead: one of {', '.join(board_names())}")
     parser.add_argument("--bitstream", action="store_true",
                         help="with --board: also run synthesis, place and route and packing")
-    parser.add_argument("--seed", type=int, default=1,
-                        help="with --bitstream: nextpnr placement seed (default: %(default)s)")
+    parser.add_argument("--seed", type=int, default=None,
+                        help="with --bitstream: nextpnr placement seed (default: 1)")
 
 
 def run_board(args, params, out_dir):
     """Export (and optionally build) ``args.board`` into ``out_dir``; returns an exit code."""
     _board(args.board)
+    if args.seed is not None and not args.bitstream:
+        raise UsageError("--seed is nextpnr's placement seed: it needs --bitstream")
+    seed = 1 if args.seed is None else args.seed
+    check_output_dir(out_dir, what="board output folder")
     if not args.bitstream:
         written = export_board(args.board, out_dir, params)
         for path in written:
@@ -282,7 +270,7 @@ def run_board(args, params, out_dir):
         print(f"wrote {len(written)} files for board {args.board} in {out_dir}")
         return 0
     try:
-        report = build_bitstream(args.board, out_dir, params, seed=args.seed)
+        report = build_bitstream(args.board, out_dir, params, seed=seed)
     except RuntimeError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 1
@@ -295,8 +283,6 @@ def run_board(args, params, out_dir):
 
 
 def main(argv=None):
-    from .export import add_param_arguments, params_from_args
-
     parser = argparse.ArgumentParser(
         prog="python -m fpga_robotics.board_build",
         description="Export a board top (Verilog + LPF) and optionally build its bitstream.",
@@ -307,7 +293,7 @@ def main(argv=None):
                         help="output directory (default: build/<board>)")
     parser.add_argument("--bitstream", action="store_true",
                         help="run synthesis, place and route and packing too")
-    parser.add_argument("--seed", type=int, default=1, help="nextpnr seed (default: 1)")
+    parser.add_argument("--seed", type=int, default=None, help="nextpnr seed (default: 1)")
     add_param_arguments(parser)
     args = parser.parse_args(argv)
     params = params_from_args(args)

@@ -45,7 +45,8 @@ def _existing_ancestor(path):
 def _check_folder(folder, path, what):
     """``folder`` (the nearest existing ancestor of ``path``) must be a writable folder."""
     if not folder.is_dir():
-        raise OutputPathError(f"{what} {str(path)!r}: {str(folder)!r} is not a folder")
+        raise OutputPathError(
+            f"{what} {str(path)!r}: cannot write there, {str(folder)!r} is not a folder")
     try:  # os.access says yes to root even on a read-only file system: try for real
         fd, probe = tempfile.mkstemp(prefix=".write-test-", dir=folder)
         os.close(fd)

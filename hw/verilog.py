@@ -1,0 +1,61 @@
+"""Verilog and CXXRTL text of a component, without any command-line code.
+
+``generate_verilog(params)`` is what ``fpga-robotics export`` writes and what the Verilator
+backend compiles; ``port_values`` is the port list every back-end conversion uses.
+"""
+
+from amaranth.back import cxxrtl, verilog
+from amaranth.hdl import Const, Value, ValueCastable
+from amaranth.lib import wiring
+
+from .params import FollowTargetParams
+from .top import FollowTarget
+
+__all__ = ["TOP_NAME", "generate_cxxrtl", "generate_verilog", "port_values", "verilog_ports"]
+
+#: Module name of the top in the generated Verilog and C++.
+TOP_NAME = "follow_target"
+
+
+def _port_items(component):
+    for path, member, value in component.signature.flatten(component):
+        if isinstance(value, ValueCastable):
+            value = value.as_value()
+        value = Value.cast(value)
+        # Constant members (``ready`` of a stream that cannot be stalled) are no ports:
+        # the back-ends reject them.
+        if not isinstance(value, Const):
+            yield path, member, value
+
+
+def port_values(component):
+    """``[Value]`` of a component's ports in signature order."""
+    return [value for _path, _member, value in _port_items(component)]
+
+
+def verilog_ports(component):
+    """``{name: (value, "i"|"o")}``: the ports of a component, named ``member__sub`` as
+    Amaranth names them."""
+    return {
+        "__".join(map(str, path)): (value, "i" if member.flow == wiring.In else "o")
+        for path, member, value in _port_items(component)
+    }
+
+
+def generate_verilog(params=None, component=None):
+    """Verilog text of ``FollowTarget(params)`` (or of ``component``), top module
+    ``follow_target``. Ports: ``clk rst pixels__valid pixels__payload color_sel
+    filtered__valid filtered__payload frame_done found proximity centroid_x centroid_leds
+    motor_left motor_right``."""
+    if component is None:
+        component = FollowTarget(FollowTargetParams() if params is None else params)
+        # Direction None: Amaranth infers it (driven inside the design = output).
+        ports = {name: (value, None) for name, (value, _) in verilog_ports(component).items()}
+    else:
+        ports = port_values(component)
+    return verilog.convert(component, name=TOP_NAME, ports=ports, emit_src=False)
+
+
+def generate_cxxrtl(component):
+    """CXXRTL C++ text of ``component``, top class ``p_follow__target``."""
+    return cxxrtl.convert(component, name=TOP_NAME, ports=port_values(component), emit_src=False)
