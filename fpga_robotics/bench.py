@@ -13,7 +13,7 @@ Builds (or cache loads) happen before timing and are reported separately.
 import argparse
 import contextlib
 import gc
-import json
+import math
 import os
 import platform
 import statistics
@@ -26,6 +26,7 @@ from .errors import UsageError, run_cli
 from .hw.params import FollowTargetParams
 from .sim import synthetic
 from .sim.backends import BACKEND_NAMES, COMPILED_BACKENDS, BackendError, get_backend
+from .sim.files import check_output_path, write_json_atomic
 
 __all__ = ["main", "measure", "measure_paired", "parse_resolutions"]
 
@@ -154,9 +155,9 @@ def run_one(name, params, frames, design, min_seconds=0.0):
     return figures
 
 
-def build_parser():
+def build_parser(prog="python -m fpga_robotics.bench"):
     parser = argparse.ArgumentParser(
-        prog="python -m fpga_robotics.bench",
+        prog=prog,
         description="Median ms per frame and simulated cycles per second of every backend.",
     )
     parser.add_argument(
@@ -251,8 +252,8 @@ def summary(results, paired=()):
     return lines
 
 
-def main(argv=None):
-    args = build_parser().parse_args(argv)
+def main(argv=None, prog="python -m fpga_robotics.bench"):
+    args = build_parser(prog).parse_args(argv)
     names = [n.strip() for n in args.backends.split(",") if n.strip()]
     for n in names:
         if n not in BACKEND_NAMES:
@@ -260,10 +261,10 @@ def main(argv=None):
     sizes = parse_resolutions(args.resolutions)
     if args.frames < 1 or args.pysim_frames < 1:
         raise UsageError("--frames and --pysim-frames must be at least 1")
-    if args.json:
-        directory = os.path.dirname(os.path.abspath(args.json))
-        if not os.path.isdir(directory):
-            raise UsageError(f"cannot write {args.json}: no directory {directory}")
+    if not (math.isfinite(args.min_seconds) and args.min_seconds >= 0):
+        raise UsageError(f"--min-seconds must be a finite number >= 0, got {args.min_seconds}")
+    if args.json is not None:  # checked now, not after minutes of measuring
+        check_output_path(args.json, what="--json")
 
     results, paired, notes = [], [], []
     header = (
@@ -339,11 +340,12 @@ def _write_json(path, results, paired, notes):
         "notes": notes,
         "summary": summary(results, paired),
     }
-    tmp = f"{path}.partial"
-    with open(tmp, "w") as f:
-        json.dump(data, f, indent=1)
-    os.replace(tmp, path)
+    write_json_atomic(path, data, what="--json")
+
+
+def cli():
+    run_cli(main, sys.argv[1:], prog="python -m fpga_robotics.bench")
 
 
 if __name__ == "__main__":
-    run_cli(main, sys.argv[1:], prog="python -m fpga_robotics.bench")
+    cli()

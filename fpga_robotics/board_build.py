@@ -282,9 +282,9 @@ def run_board(args, params, out_dir):
     return 0
 
 
-def main(argv=None):
+def main(argv=None, prog="python -m fpga_robotics.board_build"):
     parser = argparse.ArgumentParser(
-        prog="python -m fpga_robotics.board_build",
+        prog=prog,
         description="Export a board top (Verilog + LPF) and optionally build its bitstream.",
     )
     parser.add_argument("--board", metavar="NAME", required=True,

@@ -19,9 +19,9 @@ from .sim.files import check_output_path, write_atomic
 __all__ = ["build_parser", "main"]
 
 
-def build_parser():
+def build_parser(prog="python -m fpga_robotics.export"):
     parser = argparse.ArgumentParser(
-        prog="python -m fpga_robotics.export",
+        prog=prog,
         description="Write the FollowTarget design as one self-contained Verilog file "
                     f"(top module {TOP_NAME}).",
     )
@@ -34,8 +34,8 @@ def build_parser():
     return parser
 
 
-def main(argv=None):
-    parser = build_parser()
+def main(argv=None, prog="python -m fpga_robotics.export"):
+    parser = build_parser(prog)
     args = parser.parse_args(argv)  # a bad option: argparse's message and exit code 2
     params = params_from_args(args)
     if args.board is not None:  # a board top instead (fpga_robotics.board_build)

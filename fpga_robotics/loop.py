@@ -1,4 +1,4 @@
-"""The closed loop: SimCamera → design → SimMotors, stepped on a fixed clock.
+"""The closed loop: CameraConnector → design → MotorConnector, stepped on a fixed clock.
 
 Timing. Physics advances in fixed steps of ``sim.physics_dt``. Frame ``k`` is captured at
 ``k / fps`` (rounded to the nearest physics step): the world's scene at that instant is
@@ -14,13 +14,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .connectors import CameraConnector, MotorConnector, in_view
 from .hw.pixel import color_select_value
 from .sim.records import FrameRecord
-from .sim_camera import SimCamera, in_view
-from .sim_motors import SimMotors
 from .summary import compute_metrics, evaluate_checks, verdict
 
-__all__ = ["TRAJECTORY_FIELDS", "RunResult", "make_backend", "run_scenario"]
+__all__ = ["TRAJECTORY_FIELDS", "ClosedLoop", "RunResult", "frame_count", "make_backend",
+           "run_scenario"]
 
 #: Per-frame arrays of ``RunResult.trajectory`` (one entry per camera frame, at capture time).
 TRAJECTORY_FIELDS = (
@@ -52,13 +52,25 @@ class RunResult:
         return self.summary["verdict"] == "pass"
 
 
-def make_backend(name, params):
-    """A ``DesignBackend`` by name ("auto" = the fastest available compiled one)."""
+def make_backend(name, params, *, on_build=None):
+    """A ``DesignBackend`` by name ("auto" = the fastest available compiled one);
+    ``on_build(text)`` is told before a compiled model is built (not found in the cache)."""
     from .sim.backends import fastest_backend_name, get_backend
 
     if name == "auto":
         name = fastest_backend_name()
-    return get_backend(name, params)
+    return get_backend(name, params, on_build=on_build)
+
+
+def frame_count(duration_steps, frame_period, physics_dt):
+    """How many camera frames a run of ``duration_steps`` physics steps captures: frame ``k``
+    is captured at step ``round(k * frame_period / physics_dt)``, which must fall inside the
+    run. Computed directly (a run may be long), starting just below the answer."""
+    ratio = frame_period / physics_dt
+    n = max(0, math.ceil((duration_steps - 0.5) / ratio) - 1)
+    while round(n * frame_period / physics_dt) < duration_steps:  # the capture step's formula
+        n += 1
+    return n
 
 
 class _DesignEvents:
@@ -87,6 +99,201 @@ class _DesignEvents:
         return events
 
 
+class ClosedLoop:
+    """One closed-loop run, as the steps a reader can follow: ``build`` the world, the camera
+    and the motor connector; for each frame ``advance_physics`` to its capture instant,
+    ``capture`` the camera image, ``process`` it in the design and schedule the command,
+    ``measure`` the robot and the target, ``record`` the frame; then ``finish_physics`` and
+    ``summarise``. ``run()`` does all of it. Built by ``run_scenario``; see its parameters."""
+
+    def __init__(self, scenario, *, seed=None, design, recorder=None, on_frame=None):
+        from .sim.world import World
+
+        self.scenario = scenario
+        self.seed = scenario.seed if seed is None else int(seed)
+        self.design = design
+        self.recorder = recorder
+        self.on_frame = on_frame
+        self.want_records = recorder is not None or on_frame is not None
+
+        cam, sim = scenario.camera, scenario.sim
+        self.world = World.from_config(scenario.world, self.seed)
+        self.camera = self._build_camera(cam, self.world.robot_spec)
+        self.motors = MotorConnector(self.world)
+        self.dt = sim.physics_dt
+        self.period = cam.frame_period
+        self.total_steps = max(1, round(sim.duration / self.dt))
+        self.n_frames = frame_count(self.total_steps, self.period, self.dt)
+        self.step = 0  # physics steps done
+        self.traj = _empty_trajectory(self.n_frames)
+        self.events = []  # (frame, time_s, text)
+        self.design_events = _DesignEvents(scenario.params.lost_frames)
+        self.target_radius = next(
+            (p.radius for p in self.world.people_states() if p.is_target), 0.0)
+        self.color = scenario.color_at(0.0)
+        self.color_code = color_select_value(self.color)
+
+    def _build_camera(self, cam, spec):
+        """The camera on the robot; mount values the scenario leaves unset are the robot's."""
+        return CameraConnector(
+            cam.width, cam.height, cam.hfov,
+            mount_height=cam.mount_height if cam.mount_height is not None else spec.camera_height,
+            mount_forward=(cam.mount_forward if cam.mount_forward is not None
+                           else spec.camera_forward),
+            tilt=cam.tilt if cam.tilt is not None else spec.camera_tilt,
+            noise_std=cam.noise_std,
+            # A stream of its own, so that camera noise never shifts the world's randomness.
+            rng=np.random.default_rng([self.seed, 0xCA3E]),
+        )
+
+    # The steps of one frame ----------------------------------------------------------------
+
+    def advance_physics(self, to_step):
+        """Step the world up to ``to_step``, applying each motor command when it is due."""
+        while self.step < to_step:
+            self.motors.apply_due(self.step)
+            self.world.step(self.dt)
+            self.step += 1
+        self.motors.apply_due(self.step)  # commands that take effect at this very instant
+
+    def capture(self, t):
+        """The camera image at time ``t``, with the events since the last frame."""
+        pose = self.camera.pose(self.world.robot_pose())
+        rgb = self.camera.capture(self.world.scene(), pose)
+        events = list(self.world.drain_events())
+        new_color = self.scenario.color_at(t)
+        if new_color != self.color:
+            events.append(f"colour select changed to {new_color}")
+            self.color, self.color_code = new_color, color_select_value(new_color)
+        return pose, rgb, events
+
+    def process(self, k, rgb):
+        """Frame ``k`` through the design; its wheel command acts after the actuation delay."""
+        result = self.design.process_frame(rgb, self.color_code)
+        apply_step = round((k * self.period + self.scenario.sim.actuation_delay) / self.dt)
+        self.motors.schedule(apply_step, result.motor_left, result.motor_right)
+        self.motors.apply_due(self.step)  # a zero delay acts now
+        return result
+
+    def measure(self, k, t, pose, result):
+        """Fill trajectory row ``k``; return the target's distance and visibility."""
+        rx, ry, heading = self.world.robot_pose()
+        v, w = self.world.robot_velocity()
+        cmd_v, cmd_w = self.world.commanded_twist()
+        target = self.world.target_position()
+        if target is not None:
+            tx, ty = target
+            dist = math.hypot(tx - rx, ty - ry)
+            visible = in_view(pose, self.scenario.camera.hfov, tx, ty, self.target_radius)
+        else:
+            tx = ty = dist = math.nan
+            visible = False
+        row = self.traj
+        row["t"][k], row["x"][k], row["y"][k], row["heading"][k] = t, rx, ry, heading
+        row["v"][k], row["w"][k], row["cmd_v"][k], row["cmd_w"][k] = v, w, cmd_v, cmd_w
+        row["found"][k], row["proximity"][k] = result.found, result.proximity
+        row["centroid_x"][k], row["centroid_leds"][k] = result.centroid_x, result.centroid_leds
+        row["motor_left"][k], row["motor_right"][k] = result.motor_left, result.motor_right
+        row["color_sel"][k] = self.color_code
+        row["target_x"][k], row["target_y"][k] = tx, ty
+        row["target_distance"][k], row["target_in_view"][k] = dist, visible
+        return (None if target is None else dist), visible
+
+    def record(self, k, t, rgb, result, distance, visible, events):
+        """Hand the frame to the viewer and the ``on_frame`` callback."""
+        row = self.traj
+        record = FrameRecord(
+            frame=k, sim_time=t, camera_rgb=rgb, color_sel=self.color_code, result=result,
+            robot_x=row["x"][k], robot_y=row["y"][k], robot_heading=row["heading"][k],
+            robot_v=row["v"][k], robot_w=row["w"][k], cmd_v=row["cmd_v"][k],
+            cmd_w=row["cmd_w"][k], camera_hfov=self.scenario.camera.hfov,
+            people=self.world.people_states(), target_distance=distance,
+            target_in_view=visible, events=events,
+        )
+        if self.recorder is not None:
+            self.recorder.log_frame(record)
+        if self.on_frame is not None:
+            self.on_frame(record)
+
+    def run_frame(self, k):
+        self.advance_physics(round(k * self.period / self.dt))
+        t = self.step * self.dt
+        pose, rgb, events = self.capture(t)
+        result = self.process(k, rgb)
+        events += self.design_events.update(bool(result.found))
+        distance, visible = self.measure(k, t, pose, result)
+        self.events += [(k, round(t, 6), e) for e in events]
+        if self.want_records:
+            self.record(k, t, rgb, result, distance, visible, events)
+
+    def finish_physics(self):
+        """Physics after the last frame, to the end of the run."""
+        self.advance_physics(self.total_steps)
+        tail = list(self.world.drain_events())
+        self.events += [(self.n_frames, round(self.step * self.dt, 6), e) for e in tail]
+
+    # The whole run -------------------------------------------------------------------------
+
+    def run(self, *, progress=None, realtime=False):
+        if self.recorder is not None:
+            self.recorder.log_world_map(self.world.world_map())
+        wall_start = time.perf_counter()
+        cpu_start = time.process_time()
+        for k in range(self.n_frames):
+            self.run_frame(k)
+            if progress is not None:
+                progress(k + 1, self.n_frames)
+            if realtime:
+                ahead = (self.step * self.dt + self.period) - (time.perf_counter() - wall_start)
+                if ahead > 0:
+                    time.sleep(ahead)
+        self.finish_physics()
+        wall = time.perf_counter() - wall_start
+        cpu = time.process_time() - cpu_start
+        return RunResult(summary=self.summarise(wall, cpu), trajectory=self.traj,
+                         events=self.events)
+
+    def summarise(self, wall, cpu):
+        scenario, cam, sim = self.scenario, self.scenario.camera, self.scenario.sim
+        n_frames, dt = self.n_frames, self.dt
+        sim_time = self.total_steps * dt
+        metrics = compute_metrics(self.traj, self.events, self.world.collision_counts(),
+                                  self.period)
+        checks = evaluate_checks(scenario.checks, metrics)
+        return {
+            "scenario": scenario.name,
+            "backend": self.design.name,
+            "resolution": f"{cam.width}x{cam.height}",
+            "seed": self.seed,
+            "color": scenario.color_initial,
+            "overrides": list(scenario.overrides),
+            "fps": cam.fps,
+            "physics_dt_s": dt,
+            "actuation_delay_s": sim.actuation_delay,
+            "sim_time_s": round(sim_time, 6),
+            "frames": n_frames,
+            "wall_time_s": round(wall, 4),
+            "ms_per_frame": round(1000.0 * wall / max(1, n_frames), 4),
+            "realtime_factor": round(sim_time / wall, 3) if wall > 0 else None,
+            # CPU time of this process: the cost per frame on a machine busy with other work.
+            "cpu_ms_per_frame": round(1000.0 * cpu / max(1, n_frames), 4),
+            **metrics,
+            "events": len(self.events),
+            "verdict": verdict(checks),
+            "checks": checks,
+        }
+
+
+def _empty_trajectory(n_frames):
+    traj = {name: np.zeros(n_frames) for name in TRAJECTORY_FIELDS}
+    for name in ("found", "target_in_view"):
+        traj[name] = np.zeros(n_frames, bool)
+    for name in ("proximity", "centroid_x", "centroid_leds", "motor_left", "motor_right",
+                 "color_sel"):
+        traj[name] = np.zeros(n_frames, np.int64)
+    return traj
+
+
 def run_scenario(scenario, *, seed=None, backend="auto", recorder=None, progress=None,
                  realtime=False, on_frame=None):
     """Run one scenario in closed loop and measure it.
@@ -108,159 +315,15 @@ def run_scenario(scenario, *, seed=None, backend="auto", recorder=None, progress
     on_frame : callable(FrameRecord), optional
         Called for every frame (tests, custom logging).
     """
-    from .sim.world import World
-
-    seed = scenario.seed if seed is None else int(seed)
-    params = scenario.params
-    cam = scenario.camera
-    sim = scenario.sim
-
-    world = World.from_config(scenario.world, seed)
-    spec = world.robot_spec
-    camera = SimCamera(
-        cam.width, cam.height, cam.hfov,
-        mount_height=cam.mount_height if cam.mount_height is not None else spec.camera_height,
-        mount_forward=(cam.mount_forward if cam.mount_forward is not None
-                       else spec.camera_forward),
-        tilt=cam.tilt if cam.tilt is not None else spec.camera_tilt,
-        noise_std=cam.noise_std,
-        # A stream of its own, so that camera noise never shifts the world's randomness.
-        rng=np.random.default_rng([seed, 0xCA3E]),
-    )
-    motors = SimMotors(world)
-
     owns_backend = isinstance(backend, str)
-    design = make_backend(backend, params) if owns_backend else backend
-    if design.params != params:
-        raise ValueError("the backend was built for other parameters than the scenario's")
-    design.reset()
-
-    dt = sim.physics_dt
-    period = cam.frame_period
-    total_steps = max(1, round(sim.duration / dt))
-    n_frames = 0
-    while round(n_frames * period / dt) < total_steps:
-        n_frames += 1
-
-    traj = {name: np.zeros(n_frames) for name in TRAJECTORY_FIELDS}
-    for name in ("found", "target_in_view"):
-        traj[name] = np.zeros(n_frames, bool)
-    for name in ("proximity", "centroid_x", "centroid_leds", "motor_left", "motor_right",
-                 "color_sel"):
-        traj[name] = np.zeros(n_frames, np.int64)
-    events_all = []
-    design_events = _DesignEvents(params.lost_frames)
-    want_records = recorder is not None or on_frame is not None
-    target_radius = next((p.radius for p in world.people_states() if p.is_target), 0.0)
-    if recorder is not None:
-        recorder.log_world_map(world.world_map())
-
-    color = scenario.color_at(0.0)
-    color_code = color_select_value(color)
-    step = 0
-    wall_start = time.perf_counter()
-    cpu_start = time.process_time()
+    design = make_backend(backend, scenario.params) if owns_backend else backend
     try:
-        for k in range(n_frames):
-            capture_step = round(k * period / dt)
-            while step < capture_step:
-                motors.apply_due(step)
-                world.step(dt)
-                step += 1
-            t = step * dt
-            motors.apply_due(step)  # commands that take effect at this very instant
-
-            # Capture and process.
-            rx, ry, heading = world.robot_pose()
-            pose = camera.pose((rx, ry, heading))
-            rgb = camera.capture(world.scene(), pose)
-            events = list(world.drain_events())
-            new_color = scenario.color_at(t)
-            if new_color != color:
-                events.append(f"colour select changed to {new_color}")
-                color, color_code = new_color, color_select_value(new_color)
-            result = design.process_frame(rgb, color_code)
-            events += design_events.update(bool(result.found))
-            apply_step = round((k * period + sim.actuation_delay) / dt)
-            motors.schedule(apply_step, result.motor_left, result.motor_right)
-            motors.apply_due(step)  # a zero delay acts now
-
-            # Measure.
-            v, w = world.robot_velocity()
-            cmd_v, cmd_w = world.commanded_twist()
-            target = world.target_position()
-            people = world.people_states() if want_records else []
-            if target is not None:
-                tx, ty = target
-                dist = math.hypot(tx - rx, ty - ry)
-                visible = in_view(pose, cam.hfov, tx, ty, target_radius)
-            else:
-                tx = ty = dist = math.nan
-                visible = False
-            row = traj
-            row["t"][k], row["x"][k], row["y"][k], row["heading"][k] = t, rx, ry, heading
-            row["v"][k], row["w"][k], row["cmd_v"][k], row["cmd_w"][k] = v, w, cmd_v, cmd_w
-            row["found"][k], row["proximity"][k] = result.found, result.proximity
-            row["centroid_x"][k], row["centroid_leds"][k] = result.centroid_x, result.centroid_leds
-            row["motor_left"][k], row["motor_right"][k] = result.motor_left, result.motor_right
-            row["color_sel"][k] = color_code
-            row["target_x"][k], row["target_y"][k] = tx, ty
-            row["target_distance"][k], row["target_in_view"][k] = dist, visible
-            events_all += [(k, round(t, 6), e) for e in events]
-
-            if want_records:
-                record = FrameRecord(
-                    frame=k, sim_time=t, camera_rgb=rgb, color_sel=color_code,
-                    result=result, robot_x=rx, robot_y=ry, robot_heading=heading,
-                    robot_v=v, robot_w=w, cmd_v=cmd_v, cmd_w=cmd_w, camera_hfov=cam.hfov,
-                    people=people, target_distance=None if target is None else dist,
-                    target_in_view=visible, events=events,
-                )
-                if recorder is not None:
-                    recorder.log_frame(record)
-                if on_frame is not None:
-                    on_frame(record)
-            if progress is not None:
-                progress(k + 1, n_frames)
-            if realtime:
-                ahead = (t + period) - (time.perf_counter() - wall_start)
-                if ahead > 0:
-                    time.sleep(ahead)
-        while step < total_steps:
-            motors.apply_due(step)
-            world.step(dt)
-            step += 1
-        tail = list(world.drain_events())
-        events_all += [(n_frames, round(step * dt, 6), e) for e in tail]
+        if design.params != scenario.params:
+            raise ValueError("the backend was built for other parameters than the scenario's")
+        design.reset()
+        loop = ClosedLoop(scenario, seed=seed, design=design, recorder=recorder,
+                          on_frame=on_frame)
+        return loop.run(progress=progress, realtime=realtime)
     finally:
         if owns_backend:
             design.close()
-    wall = time.perf_counter() - wall_start
-    cpu = time.process_time() - cpu_start
-
-    sim_time = total_steps * dt
-    metrics = compute_metrics(traj, events_all, world.collision_counts(), period)
-    checks = evaluate_checks(scenario.checks, metrics)
-    summary = {
-        "scenario": scenario.name,
-        "backend": design.name,
-        "resolution": f"{cam.width}x{cam.height}",
-        "seed": seed,
-        "color": scenario.color_initial,
-        "overrides": list(scenario.overrides),
-        "fps": cam.fps,
-        "physics_dt_s": dt,
-        "actuation_delay_s": sim.actuation_delay,
-        "sim_time_s": round(sim_time, 6),
-        "frames": n_frames,
-        "wall_time_s": round(wall, 4),
-        "ms_per_frame": round(1000.0 * wall / max(1, n_frames), 4),
-        "realtime_factor": round(sim_time / wall, 3) if wall > 0 else None,
-        # CPU time of this process: the cost per frame on a machine busy with other work.
-        "cpu_ms_per_frame": round(1000.0 * cpu / max(1, n_frames), 4),
-        **metrics,
-        "events": len(events_all),
-        "verdict": verdict(checks),
-        "checks": checks,
-    }
-    return RunResult(summary=summary, trajectory=traj, events=events_all)

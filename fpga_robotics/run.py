@@ -7,24 +7,21 @@ or key, malformed file, unopenable source, missing simulator).
 """
 
 import argparse
-import json
-import os
 import sys
-import tempfile
 import time
 from pathlib import Path
 
 from .errors import UsageError, run_cli
 from .hw.pixel import COLOR_SELECT
+from .sim.backends import BACKEND_NAMES
+from .sim.files import check_output_path, write_json_atomic
 
-__all__ = ["Progress", "build_parser", "main", "write_json_atomic"]
-
-BACKEND_CHOICES = ("auto", "model", "pysim", "cxxrtl", "verilator")
+__all__ = ["Progress", "build_parser", "main"]
 
 
-def build_parser():
+def build_parser(prog="python -m fpga_robotics.run"):
     p = argparse.ArgumentParser(
-        prog="python -m fpga_robotics.run",
+        prog=prog,
         description="Run the FollowTarget design in closed loop with a simulated robot, camera "
                     "and people, and check the scenario's pass criteria.",
     )
@@ -32,7 +29,7 @@ def build_parser():
                    help="a shipped scenario (see --list-scenarios) or a .toml file "
                         "(default: follow_person)")
     p.add_argument("--list-scenarios", action="store_true", help="list the shipped scenarios")
-    p.add_argument("--backend", default="auto", choices=BACKEND_CHOICES,
+    p.add_argument("--backend", default="auto", choices=("auto", *BACKEND_NAMES),
                    help="design simulator (default auto: the fastest compiled one available)")
     p.add_argument("--resolution", metavar="WxH", help="camera and design resolution")
     p.add_argument("--color", choices=tuple(COLOR_SELECT), help="initial colour select")
@@ -96,21 +93,6 @@ class Progress:
             self.stream.flush()
 
 
-def write_json_atomic(path, data):
-    """Write ``data`` as JSON to ``path`` through a temporary file and a rename."""
-    path = Path(path)
-    directory = path.parent if str(path.parent) else Path(".")
-    directory.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=directory)
-    try:
-        with os.fdopen(fd, "w") as f:
-            json.dump(data, f, indent=2)
-            f.write("\n")
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-
 
 def _overrides(args):
     from .scenario import parse_resolution
@@ -128,12 +110,16 @@ def _overrides(args):
     return items
 
 
-def _open_backend(name, params):
+def _open_backend(name, params, quiet=False):
     from .loop import make_backend
     from .sim.backends.base import BackendError
 
+    def tell(text):  # a first run compiles the model for seconds: say so
+        if not quiet:
+            print(f"{text} ...", file=sys.stderr, flush=True)
+
     try:
-        return make_backend(name, params)
+        return make_backend(name, params, on_build=tell)
     except (BackendError, ValueError, ImportError) as exc:
         raise UsageError(f"backend {name!r} cannot run here: {exc}") from None
 
@@ -165,7 +151,7 @@ def _run_source(args, scenario):
     params = scenario.params
     source = open_source(args.source, params.width, params.height)
     try:
-        design = _open_backend(args.backend, params)
+        design = _open_backend(args.backend, params, args.quiet)
         recorder = None
         try:
             recorder = _open_recorder(args, Path(str(args.source).replace(":", "_")).stem)
@@ -192,12 +178,12 @@ def _run_source(args, scenario):
     if where:
         print(where)
     if args.summary:
-        write_json_atomic(args.summary, out)
+        write_json_atomic(args.summary, out, what="--summary")
     return 0
 
 
-def main(argv=None):
-    args = build_parser().parse_args(argv)
+def main(argv=None, prog="python -m fpga_robotics.run"):
+    args = build_parser(prog).parse_args(argv)
     if args.list_scenarios:
         return _list_scenarios()
 
@@ -207,14 +193,18 @@ def main(argv=None):
 
     if args.seed is not None and args.seed < 0:
         raise UsageError(f"--seed must be >= 0, got {args.seed}")
+    if args.summary is not None:  # checked now, not after a long run
+        check_output_path(args.summary, what="--summary")
     scenario = load_scenario(args.scenario, _overrides(args))
     if args.source is not None:
+        if args.max_frames is not None and args.max_frames < 1:
+            raise UsageError(f"--max-frames must be >= 1, got {args.max_frames}")
         return _run_source(args, scenario)
     if args.max_frames is not None:
         raise UsageError("--max-frames only applies with --source (use --duration)")
 
     t0 = time.perf_counter()
-    design = _open_backend(args.backend, scenario.params)
+    design = _open_backend(args.backend, scenario.params, args.quiet)
     setup = time.perf_counter() - t0
     recorder = None
     try:
@@ -233,9 +223,13 @@ def main(argv=None):
     if where:
         print(where)
     if args.summary:
-        write_json_atomic(args.summary, summary)
+        write_json_atomic(args.summary, summary, what="--summary")
     return 0 if summary["verdict"] == "pass" else 1
 
 
-if __name__ == "__main__":
+def cli():
     run_cli(main, sys.argv[1:], prog="fpga_robotics.run")
+
+
+if __name__ == "__main__":
+    cli()

@@ -125,9 +125,8 @@ def atomic_output(path, mode="w", *, what="output file"):
     """``with atomic_output(path) as f: f.write(...)``: ``path`` gets all of it or nothing."""
     if mode not in ("w", "wb"):
         raise ValueError(f"mode must be 'w' or 'wb', got {mode!r}")
-    with atomic_path(path, what=what) as tmp:
-        with open(tmp, mode) as f:
-            yield f
+    with atomic_path(path, what=what) as tmp, open(tmp, mode) as f:
+        yield f
 
 
 def write_atomic(path, data, *, what="output file"):

@@ -218,7 +218,7 @@ def test_a_compiled_backend_drives_the_robot_exactly_as_the_model_does():
 
 
 def test_camera_pose_and_field_of_view_geometry():
-    from fpga_robotics.sim_camera import camera_pose, in_view
+    from fpga_robotics.connectors import camera_pose, in_view
 
     pose = camera_pose((1.0, 2.0, math.pi / 2), height=0.3, forward=0.1, tilt=0.05)
     assert (pose.x, pose.y, pose.height, pose.tilt) == pytest.approx((1.0, 2.1, 0.3, 0.05))

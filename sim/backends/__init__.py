@@ -53,8 +53,11 @@ def get_backend(name, params=None, **kwargs):
 
     Keyword arguments go to the backend (``line_blank``, ``frame_blank``, ``waveform``).
     Compiled backends build (or load from the cache) on creation and raise ``BackendError``
-    when a tool is missing.
+    when a tool is missing; ``on_build(text)``, if given, is told before such a build.
     """
+    on_build = kwargs.pop("on_build", None)
+    if name in COMPILED_BACKENDS:
+        kwargs["on_build"] = on_build
     return backend_class(name)(params, **kwargs)
 
 

@@ -95,7 +95,7 @@ def _locked(lock_path):
             fcntl.flock(lock.fileno(), fcntl.LOCK_UN)
 
 
-def get_or_build(name, key, files, build, *, root=None):
+def get_or_build(name, key, files, build, *, root=None, on_build=None):
     """Return the verified ``CacheEntry`` ``name-key``, building it when needed.
 
     Parameters
@@ -109,6 +109,8 @@ def get_or_build(name, key, files, build, *, root=None):
     build : callable
         ``build(directory)`` writes those files into the fresh ``directory`` (raising
         ``BackendError`` on failure). Other files it leaves there (objects) are removed.
+    on_build : callable(), optional
+        Called once before an actual build (not for a cache hit).
     """
     root = Path(root) if root is not None else cache_root()
     entry_dir = root / f"{name}-{key[:32]}"
@@ -118,6 +120,8 @@ def get_or_build(name, key, files, build, *, root=None):
         # Someone else may have built it while we waited for the lock.
         if _valid(entry_dir, key, files):
             return CacheEntry(entry_dir, built=False)
+        if on_build is not None:
+            on_build()
         work = Path(tempfile.mkdtemp(prefix=f".build-{name}-", dir=root))
         final = None
         try:

@@ -103,9 +103,13 @@ class CompiledBackend(DesignBackend):
     waveform_formats = (".vcd",)
 
     def __init__(
-        self, params=None, *, line_blank=0, frame_blank=0, waveform=None, design="follow_target"
+        self, params=None, *, line_blank=0, frame_blank=0, waveform=None, design="follow_target",
+        on_build=None,
     ):
         super().__init__(params, line_blank=line_blank, frame_blank=frame_blank, waveform=waveform)
+        # Told (with a one-line text) before a build that is not in the cache: the first run
+        # spends seconds compiling, and the user should know why nothing moves.
+        self._on_build = on_build
         self.source = DesignSource(self.params, design)
         variant = "plain"
         if waveform is not None:
@@ -145,7 +149,8 @@ class CompiledBackend(DesignBackend):
         """Build (or find in the cache) and load the library; a damaged entry that passes the
         manifest check but does not load is rebuilt once."""
         for attempt in range(2):
-            entry = build_cache.get_or_build(*self.build_plan(self.source, variant))
+            entry = build_cache.get_or_build(*self.build_plan(self.source, variant),
+                                             on_build=self._build_notice)
             #: The cache entry in use (``built`` tells whether this construction built it).
             self.cache_entry = entry
             try:
@@ -155,6 +160,12 @@ class CompiledBackend(DesignBackend):
                     raise
                 build_cache.invalidate(entry)
         raise AssertionError("unreachable")
+
+    def _build_notice(self):
+        if self._on_build is not None:
+            p = self.params
+            self._on_build(f"compiling the {self.name} model of {self.source.design} at "
+                           f"{p.width}x{p.height} (once; later runs load it from the cache)")
 
     @staticmethod
     def build_plan(source, variant):

@@ -1,4 +1,5 @@
-"""SimCamera: the robot's camera in the simulated world, producing the frames the design sees.
+"""CameraConnector: world to design. The robot's camera renders the world into the frames the
+design sees.
 
 The camera sits on the robot: its pose is the robot's pose moved ``mount_forward`` metres
 along the heading, at ``mount_height`` above the floor, pitched by ``tilt``. Each capture
@@ -7,9 +8,9 @@ renders the world's current scene to an RGB888 image of the camera's resolution.
 
 import math
 
-from .sim.scene import CameraPose
+from ..sim.scene import CameraPose
 
-__all__ = ["SimCamera", "camera_pose", "in_view"]
+__all__ = ["CameraConnector", "camera_pose", "in_view"]
 
 
 def camera_pose(robot_pose, *, height, forward=0.0, tilt=0.0):
@@ -38,7 +39,7 @@ def in_view(pose, hfov, px, py, radius):
     return abs(bearing) - math.asin(radius / dist) < hfov / 2
 
 
-class SimCamera:
+class CameraConnector:
     """Renders what the robot's camera sees.
 
     Parameters
@@ -57,7 +58,7 @@ class SimCamera:
 
     def __init__(self, width, height, hfov, *, mount_height, mount_forward=0.0, tilt=0.0,
                  noise_std=0.0, rng=None):
-        from .sim.camera import CameraRenderer
+        from ..sim.camera import CameraRenderer
 
         self.width, self.height, self.hfov = width, height, hfov
         self.mount_height, self.mount_forward, self.tilt = mount_height, mount_forward, tilt

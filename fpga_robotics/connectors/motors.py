@@ -1,4 +1,5 @@
-"""SimMotors: the design's wheel commands reach the simulated motors after a delay.
+"""MotorConnector: design to world. The design's wheel commands reach the simulated motors
+after a delay.
 
 On the robot, a frame's DPS command leaves the FPGA over SPI some time after the frame was
 captured (exposure, readout, processing, the bus). Here each command is scheduled on the
@@ -8,10 +9,10 @@ simulation reaches that step; until then the previous command stays in force.
 
 from collections import deque
 
-__all__ = ["SimMotors"]
+__all__ = ["MotorConnector"]
 
 
-class SimMotors:
+class MotorConnector:
     """Delayed delivery of wheel commands (DPS) to the world.
 
     Parameters

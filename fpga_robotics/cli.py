@@ -1,0 +1,92 @@
+"""``fpga-robotics``: one command, with a subcommand for each job.
+
+    fpga-robotics run [options]           closed loop (python -m fpga_robotics.run)
+    fpga-robotics export [options]        Verilog of the design (python -m fpga_robotics.export)
+    fpga-robotics board [options]         board top, LPF and bitstream
+    fpga-robotics bench [WHAT] [options]  benchmarks: design (default), pysim, camera, world,
+                                          viewer
+
+Each subcommand is the ``main(argv, prog)`` of its module, so ``fpga-robotics run --help`` and
+``python -m fpga_robotics.run --help`` are the same command. New subcommands are one row of
+``COMMANDS`` (or ``BENCHMARKS``).
+"""
+
+import importlib
+import inspect
+import sys
+
+from .errors import USAGE_EXIT, run_cli
+
+__all__ = ["BENCHMARKS", "COMMANDS", "main"]
+
+#: Subcommand -> (module with ``main(argv, prog)``, one-line help).
+COMMANDS = {
+    "run": ("fpga_robotics.run", "run a scenario in closed loop (or the design on real frames)"),
+    "export": ("fpga_robotics.export", "write the design as one Verilog file"),
+    "board": ("fpga_robotics.board_build", "export a board top (Verilog + LPF) and build its "
+                                           "bitstream"),
+    "bench": (None, "print speed figures (see `fpga-robotics bench --list`)"),
+}
+
+#: ``fpga-robotics bench WHAT`` -> (module, one-line help); the first is the default.
+BENCHMARKS = {
+    "design": ("fpga_robotics.bench", "every simulation backend, and the paired fraction"),
+    "pysim": ("fpga_robotics.pysim_bench", "Amaranth's simulator, checked against the model"),
+    "camera": ("fpga_robotics.camera_bench", "the camera renderer"),
+    "world": ("fpga_robotics.world_bench", "the physics of the robot world"),
+    "viewer": ("fpga_robotics.viewer_bench", "the cost of logging to the rerun viewer"),
+}
+
+PROG = "fpga-robotics"
+
+
+def _usage():
+    width = max(map(len, COMMANDS))
+    lines = [f"usage: {PROG} COMMAND [options]   ({PROG} COMMAND --help for its options)", "",
+             "commands:"]
+    lines += [f"  {name:<{width}}  {text}" for name, (_m, text) in COMMANDS.items()]
+    return "\n".join(lines)
+
+
+def _bench_list():
+    width = max(map(len, BENCHMARKS))
+    lines = [f"usage: {PROG} bench [WHAT] [options]   (WHAT defaults to design)", "",
+             "benchmarks:"]
+    lines += [f"  {name:<{width}}  {text}" for name, (_m, text) in BENCHMARKS.items()]
+    return "\n".join(lines)
+
+
+def _call(module_name, argv, prog):
+    main = importlib.import_module(module_name).main
+    if "prog" in inspect.signature(main).parameters:
+        return run_cli(lambda a: main(a, prog=prog), argv, prog=prog)
+    return run_cli(main, argv, prog=prog)
+
+
+def main(argv=None):
+    argv = list(sys.argv[1:] if argv is None else argv)
+    if not argv or argv[0] in ("-h", "--help"):
+        print(_usage())
+        sys.exit(0 if argv else USAGE_EXIT)
+    command, rest = argv[0], argv[1:]
+    if command not in COMMANDS:
+        print(f"{PROG}: error: unknown command {command!r}; choose one of: "
+              f"{', '.join(COMMANDS)}", file=sys.stderr)
+        sys.exit(USAGE_EXIT)
+    if command == "bench":
+        if rest[:1] == ["--list"]:
+            print(_bench_list())
+            sys.exit(0)
+        what = rest[0] if rest and not rest[0].startswith("-") else "design"
+        if what not in BENCHMARKS:
+            print(f"{PROG}: error: unknown benchmark {what!r}; choose one of: "
+                  f"{', '.join(BENCHMARKS)}", file=sys.stderr)
+            sys.exit(USAGE_EXIT)
+        if rest and rest[0] == what:
+            rest = rest[1:]
+        _call(BENCHMARKS[what][0], rest, f"{PROG} bench {what}")
+    _call(COMMANDS[command][0], rest, f"{PROG} {command}")
+
+
+if __name__ == "__main__":
+    main()
