@@ -264,6 +264,9 @@ def main(argv=None, prog="python -m fpga_robotics.bench"):
     if not (math.isfinite(args.min_seconds) and args.min_seconds >= 0):
         raise UsageError(f"--min-seconds must be a finite number >= 0, got {args.min_seconds}")
     if args.json is not None:  # checked now, not after minutes of measuring
+        directory = os.path.dirname(os.path.abspath(args.json))
+        if not os.path.isdir(directory):
+            raise UsageError(f"cannot write {args.json}: no directory {directory}")
         check_output_path(args.json, what="--json")
 
     results, paired, notes = [], [], []
