@@ -65,9 +65,13 @@ def _call(module_name, argv, prog):
 
 def main(argv=None):
     argv = list(sys.argv[1:] if argv is None else argv)
-    if not argv or argv[0] in ("-h", "--help"):
+    if argv[:1] in (["-h"], ["--help"]):
         print(_usage())
-        sys.exit(0 if argv else USAGE_EXIT)
+        sys.exit(0)
+    if not argv:
+        print(_usage(), file=sys.stderr)
+        print(f"{PROG}: error: a command is needed", file=sys.stderr)
+        sys.exit(USAGE_EXIT)
     command, rest = argv[0], argv[1:]
     if command not in COMMANDS:
         print(f"{PROG}: error: unknown command {command!r}; choose one of: "

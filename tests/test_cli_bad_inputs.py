@@ -1,0 +1,93 @@
+"""Bad command-line input to every subcommand: exit code 2, one line on stderr naming the
+problem, no traceback, and nothing written or replaced (issue: reliability).
+
+Each case runs ``fpga-robotics ...`` in-process in an empty working folder that holds only
+what the case prepares; afterwards the folder must hold exactly that again, and a device
+given as an output must still be a device.
+"""
+
+import os
+import stat
+
+import numpy as np
+import pytest
+
+from fpga_robotics import cli
+
+#: (case id, argv, a word the message must contain). ``{dir}``, ``{file}``, ``{frames}`` are
+#: an existing folder, an existing regular file and a folder of two PNG frames.
+CASES = [
+    ("no command", [], "command"),
+    ("unknown command", ["fly"], "unknown command"),
+    ("unknown benchmark", ["bench", "gpu"], "unknown benchmark"),
+    # run: outputs checked before the run, never replaced when not a regular file
+    ("summary to a device", ["run", "--summary", "/dev/full"], "not a regular file"),
+    ("summary to a folder", ["run", "--summary", "{dir}"], "is a folder"),
+    ("summary below a file", ["run", "--summary", "{file}/s.json"], "not a folder"),
+    ("empty summary path", ["run", "--summary", ""], "empty"),
+    ("negative seed", ["run", "--seed", "-1"], "--seed"),
+    ("zero duration", ["run", "--duration", "0"], "--duration"),
+    ("nan duration", ["run", "--duration", "nan"], "--duration"),
+    ("max-frames without source", ["run", "--max-frames", "5"], "--source"),
+    ("negative max-frames", ["run", "--source", "{frames}", "--max-frames", "-1"],
+     "--max-frames"),
+    ("log-every zero", ["run", "--log-every", "0", "--rerun", "save:x.rrd"], "--log-every"),
+    ("unknown backend", ["run", "--backend", "iverilog"], "invalid choice"),
+    # export
+    ("export seed without board", ["export", "--seed", "3"], "--seed"),
+    ("export bitstream without board", ["export", "--bitstream"], "--board"),
+    ("export to a device", ["export", "-o", "/dev/full"], "not a regular file"),
+    ("export to a folder", ["export", "-o", "{dir}"], "is a directory"),
+    ("export below a file", ["export", "-o", "{file}/x.v"], "cannot write"),
+    ("export bad width", ["export", "--width", "17", "-o", "x.v"], "width"),
+    ("board into a file", ["export", "--board", "ulx3s-85f", "-o", "{file}"], "not a folder"),
+    ("board seed without bitstream", ["board", "--board", "ulx3s-85f", "--seed", "2",
+                                      "-o", "out"], "--bitstream"),
+    ("unknown board", ["board", "--board", "nexys", "-o", "out"], "unknown board"),
+    # bench
+    ("bench negative min-seconds", ["bench", "--min-seconds", "-5"], "--min-seconds"),
+    ("bench nan min-seconds", ["bench", "design", "--min-seconds", "nan"], "--min-seconds"),
+    ("bench json to a device", ["bench", "--backends", "model", "--json", "/dev/full"],
+     "not a regular file"),
+    ("bench json to a folder", ["bench", "--backends", "model", "--json", "{dir}"],
+     "is a folder"),
+    ("pysim bench zero frames", ["bench", "pysim", "--frames", "0"], "--frames"),
+]
+
+
+def _snapshot(folder):
+    return sorted(
+        (str(p.relative_to(folder)), p.stat().st_size if p.is_file() else -1)
+        for p in folder.rglob("*")
+    )
+
+
+@pytest.mark.parametrize("case, argv, word", CASES, ids=[c[0] for c in CASES])
+def test_bad_input_is_one_line_and_exit_2(case, argv, word, tmp_path, monkeypatch, capsys):
+    import cv2
+
+    (tmp_path / "folder").mkdir()
+    (tmp_path / "file").write_text("keep me\n")
+    frames = tmp_path / "frames"
+    frames.mkdir()
+    for i in range(2):
+        cv2.imwrite(str(frames / f"{i}.png"), np.full((12, 16, 3), 40 * i, np.uint8))
+    names = {"dir": str(tmp_path / "folder"), "file": str(tmp_path / "file"),
+             "frames": str(frames)}
+    argv = [a.format(**names) for a in argv]
+    monkeypatch.chdir(tmp_path)
+    before = _snapshot(tmp_path)
+
+    with pytest.raises(SystemExit) as exit_info:
+        cli.main(argv)
+
+    err = capsys.readouterr().err
+    assert exit_info.value.code == 2, err
+    assert "Traceback" not in err
+    lines = [line for line in err.splitlines() if line.strip()]
+    assert "error:" in lines[-1] and word in lines[-1], err
+    # One line, or argparse's usage block first and the one error line last.
+    assert len(lines) == 1 or (lines[0].startswith("usage:") and
+                               sum("error:" in line for line in lines) == 1), err
+    assert _snapshot(tmp_path) == before
+    assert stat.S_ISCHR(os.stat("/dev/full").st_mode)
