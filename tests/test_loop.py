@@ -256,3 +256,52 @@ def test_the_steering_gain_grows_with_the_resolution():
     assert low.summary["searches"] == 1 and high.summary["searches"] == 0
     assert high.trajectory["found"].all()
     assert np.abs(high.trajectory["w"]).max() > 1.5 * np.abs(low.trajectory["w"][:100]).max()
+
+
+@pytest.mark.parametrize("robot", ["turtlebot2", "gopigo3"])
+def test_camera_mount_defaults_to_the_robots_own(robot):
+    # A scenario that leaves the mount unset gets the robot's mount: forward offset, height
+    # and tilt each from the robot's spec (three different numbers, so a mix-up shows).
+    from fpga_robotics.loop import ClosedLoop
+    from fpga_robotics.sim.world.robots import ROBOT_MODELS
+
+    spec = ROBOT_MODELS[robot]
+    s = load_scenario("follow_person", [f'robot.model="{robot}"', "sim.duration=0.1"])
+    assert s.camera.mount_forward is None and s.camera.mount_height is None
+    loop = ClosedLoop(s, design=ModelBackend(s.params))
+    x, y, heading = 1.0, 2.0, math.radians(30)
+    pose = loop.camera.pose((x, y, heading))
+    assert pose.x == pytest.approx(x + spec.camera_forward * math.cos(heading))
+    assert pose.y == pytest.approx(y + spec.camera_forward * math.sin(heading))
+    assert pose.height == pytest.approx(spec.camera_height)
+    assert pose.tilt == pytest.approx(spec.camera_tilt)
+    assert spec.camera_forward != spec.camera_height
+
+
+def test_camera_mount_from_the_scenario_wins():
+    from fpga_robotics.loop import ClosedLoop
+
+    s = load_scenario("follow_person", ["camera.mount_forward=0.25", "camera.mount_height=0.2",
+                                        "sim.duration=0.1"])
+    pose = ClosedLoop(s, design=ModelBackend(s.params)).camera.pose((0.0, 0.0, 0.0))
+    assert (pose.x, pose.height) == pytest.approx((0.25, 0.2))
+
+
+def test_frame_count_is_the_capture_rule_counted_directly():
+    # Frame k is captured at step round(k * period / dt) and must fall inside the run: the
+    # closed form agrees with counting frame by frame, on awkward ratios too.
+    from fpga_robotics.loop import frame_count
+
+    def counted(steps, period, dt):
+        n = 0
+        while round(n * period / dt) < steps:
+            n += 1
+        return n
+
+    rng = np.random.default_rng(7)
+    for _ in range(500):
+        steps = int(rng.integers(1, 5000))
+        period = float(rng.choice([1 / 30, 1 / 15, 1 / 7, 0.001, 0.5, rng.uniform(1e-3, 1)]))
+        dt = float(rng.choice([1 / 240, 1 / 200, 0.01, 0.3, rng.uniform(1e-4, 0.1)]))
+        assert frame_count(steps, period, dt) == counted(steps, period, dt)
+    assert frame_count(240 * 10**6, 1 / 30, 1 / 240) == 30 * 10**6  # long runs: no loop
