@@ -16,7 +16,18 @@ from .hw.pixel import COLOR_SELECT
 from .sim.backends import BACKEND_NAMES
 from .sim.files import check_output_path, write_json_atomic
 
-__all__ = ["Progress", "build_parser", "main"]
+__all__ = ["TARGET_CLOTHING", "Progress", "build_parser", "main"]
+
+#: Clothing (shirt and trousers, linear RGB 0..1) that each colour select picks out clearly
+#: under the shipped scenarios' lighting: one channel group well above the others.
+TARGET_CLOTHING = {
+    "red": (0.85, 0.1, 0.1),
+    "green": (0.1, 0.75, 0.12),
+    "blue": (0.1, 0.15, 0.85),
+    "yellow": (0.85, 0.8, 0.1),
+    "magenta": (0.8, 0.1, 0.8),
+    "cyan": (0.1, 0.75, 0.8),
+}
 
 
 def build_parser(prog="python -m fpga_robotics.run"):
@@ -33,6 +44,9 @@ def build_parser(prog="python -m fpga_robotics.run"):
                    help="design simulator (default auto: the fastest compiled one available)")
     p.add_argument("--resolution", metavar="WxH", help="camera and design resolution")
     p.add_argument("--color", choices=tuple(COLOR_SELECT), help="initial colour select")
+    p.add_argument("--target-color", choices=tuple(TARGET_CLOTHING), metavar="C",
+                   help="dress the target person in C and follow C (colour select); one of "
+                        + ", ".join(TARGET_CLOTHING))
     p.add_argument("--duration", type=float, metavar="S", help="simulated seconds")
     p.add_argument("--seed", type=int, metavar="N", help="random seed (default: the scenario's)")
     p.add_argument("--realtime", action="store_true", help="pace the simulation to the clock")
@@ -108,6 +122,19 @@ def _overrides(args):
     if args.color is not None:
         items.append(f'color.initial="{args.color}"')
     return items
+
+
+def _dress_target(scenario, color):
+    """The scenario with its target person dressed in ``color`` and the design's colour
+    select set to it (later colour changes of the scenario are kept)."""
+    people = scenario.data.get("people", [])
+    index = next((i for i, p in enumerate(people) if p.get("target")), None)
+    if index is None:
+        raise UsageError(f"--target-color: scenario {scenario.name!r} has no target person")
+    rgb = "[" + ", ".join(str(c) for c in TARGET_CLOTHING[color]) + "]"
+    return scenario.with_overrides([f"people.{index}.shirt_color={rgb}",
+                                    f"people.{index}.trousers_color={rgb}",
+                                    f'color.initial="{color}"'])
 
 
 def _open_backend(name, params, quiet=False):
@@ -196,6 +223,8 @@ def main(argv=None, prog="python -m fpga_robotics.run"):
     if args.summary is not None:  # checked now, not after a long run
         check_output_path(args.summary, what="--summary")
     scenario = load_scenario(args.scenario, _overrides(args))
+    if args.target_color is not None:
+        scenario = _dress_target(scenario, args.target_color)
     if args.source is not None:
         if args.max_frames is not None and args.max_frames < 1:
             raise UsageError(f"--max-frames must be >= 1, got {args.max_frames}")

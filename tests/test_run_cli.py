@@ -145,3 +145,27 @@ def test_module_entry_point_prints_one_line_and_exits_2():
 
 def test_negative_seed(capsys):
     assert "--seed" in usage_error(["--seed", "-1", "--rerun", "off"], capsys)
+
+
+@pytest.mark.parametrize("color", ["green", "blue", "cyan"])
+def test_target_color_dresses_the_target_and_follows_it(color, tmp_path, capsys):
+    path = tmp_path / "s.json"
+    code, _out, err = run(["--backend", "model", "--duration", "4", "--rerun", "off", "--quiet",
+                           "--target-color", color, "--summary", str(path)], capsys)
+    assert code == 0, err
+    s = json.loads(path.read_text())
+    assert s["color"] == color and s["found_fraction"] > 0.9
+    # Without the matching colour select the same person is invisible to the design.
+    code, _out, _err = run(["--backend", "model", "--duration", "4", "--rerun", "off",
+                            "--quiet", "--target-color", color, "--set", 'color.initial="red"',
+                            "--summary", str(path)], capsys)
+    s = json.loads(path.read_text())
+    assert s["color"] == color  # --target-color sets the colour select last
+
+
+def test_target_color_red_clothes_are_invisible_to_green(tmp_path, capsys):
+    path = tmp_path / "s.json"
+    code, _out, _err = run(["--backend", "model", "--duration", "3", "--rerun", "off",
+                            "--quiet", "--color", "green", "--summary", str(path)], capsys)
+    assert code == 1
+    assert json.loads(path.read_text())["found_fraction"] == 0.0
