@@ -126,6 +126,133 @@ def test_waveform_covers_only_the_requested_frames(tmp_path):
     assert max(changes) >= (c0 + c1 + c2 - 0.5) * fs
 
 
+def vcd_changes(path):
+    """``(id code by name, [(time, id code, value)])`` of a VCD (the first id of a name)."""
+    ids, changes, time = {}, [], None
+    with open(path, "rb") as f:
+        for token in tokenize(f):
+            if token.kind is TokenKind.VAR:
+                ids.setdefault(token.var.reference, token.var.id_code)
+            elif token.kind is TokenKind.CHANGE_TIME:
+                time = token.time_change
+            elif token.kind is TokenKind.CHANGE_SCALAR:
+                changes.append((time, token.scalar_change.id_code, token.scalar_change.value))
+            elif token.kind is TokenKind.CHANGE_VECTOR:
+                changes.append((time, token.vector_change.id_code, token.vector_change.value))
+    return ids, changes
+
+
+def test_waveform_starts_with_the_state_at_the_window_start_and_holds_its_edges(tmp_path):
+    p = small_params()
+    frames = sequence(p, seed=6)[:3]
+    path = tmp_path / "frame_1.vcd"
+    with PysimBackend(p, line_blank=2, waveform=WaveformRequest(str(path), 1, 1)) as sim:
+        results = [sim.process_frame(frame, colour) for frame, colour in frames]
+    fs = round(PERIOD * 1e15)
+    c0, c1 = results[0].cycles, results[1].cycles
+    ids, changes = vcd_changes(path)
+    dump = {code: value for time, code, value in changes if time == 0}
+    # The initial dump holds the state right after frame 0's last edge.
+    assert dump[ids["clk"]] == "1"
+    assert dump[ids["frame_done"]] == "0"
+    assert dump[ids["centroid_x"]] == results[0].centroid_x
+    assert dump[ids["proximity"]] == results[0].proximity
+    assert dump[ids["found"]] == str(int(results[0].found))
+    # Frame 1 starts a quarter period after that edge; every one of its edges is in the file,
+    # the last is frame 1's last; the file ends when frame 2 would start.
+    times = sorted({time for time, _, _ in changes if time > 0})
+    assert times[0] == (c0 - 0.25) * fs
+    rising = [time for time, code, value in changes
+              if time > 0 and code == ids["clk"] and value == "1"]
+    assert rising == [(c0 + k - 0.5) * fs for k in range(1, c1 + 1)]
+    with open(path) as f:
+        assert f.read().rstrip().endswith(f"#{round((c0 + c1 - 0.25) * fs)}")
+
+
+def test_a_reset_before_the_window_is_counted_and_one_inside_ends_it(tmp_path):
+    p = small_params()
+    frames = sequence(p, seed=7)[:3]
+    fs = round(PERIOD * 1e15)
+    before, inside = tmp_path / "before.vcd", tmp_path / "inside.vcd"
+    with PysimBackend(p, waveform=WaveformRequest(str(before), 1, 1)) as sim:
+        c0 = sim.process_frame(*frames[0]).cycles
+        sim.reset()  # one edge; the frames count from 0 again
+        c0b = sim.process_frame(*frames[1]).cycles
+        assert not before.exists()
+        sim.process_frame(*frames[2])
+        assert before.exists()
+    _, changes = vcd_changes(before)
+    first = min(time for time, _, _ in changes if time > 0)
+    assert first == (c0 + 1 + c0b - 0.25) * fs
+    with PysimBackend(p, waveform=WaveformRequest(str(inside), 0, 5)) as sim:
+        c0 = sim.process_frame(*frames[0]).cycles
+        sim.reset()
+        assert inside.exists()  # the window ended with the frame before the reset
+        size = inside.stat().st_size
+        sim.process_frame(*frames[1])
+    assert inside.stat().st_size == size
+    _, changes = vcd_changes(inside)
+    assert max(time for time, _, _ in changes) <= (c0 - 0.5) * fs
+    assert sorted(os.listdir(tmp_path)) == ["before.vcd", "inside.vcd"]
+
+
+def _interrupt_the_third_frame(p, path):
+    """Frames 0 and 1 and part of 2 of a backend tracing 1..3, then Ctrl-C (as
+    ``KeyboardInterrupt`` from inside the simulation)."""
+    frame, colour = sequence(p, seed=8)[0]
+    with pytest.raises(KeyboardInterrupt), \
+            PysimBackend(p, waveform=WaveformRequest(str(path), 1, 3)) as sim:
+        sim.process_frame(frame, colour)
+        sim.process_frame(frame, colour)
+        calls = iter(range(50))
+        advance = sim._sim.advance
+
+        def interrupted():
+            if next(calls, None) is None:
+                raise KeyboardInterrupt
+            return advance()
+
+        sim._sim.advance = interrupted
+        sim.process_frame(frame, colour)
+
+
+# Amaranth cannot close a testbench stopped inside ``tick().repeat()`` without an error,
+# reported as unraisable when the dropped simulator is collected.
+@pytest.mark.filterwarnings("ignore::pytest.PytestUnraisableExceptionWarning")
+def test_an_interrupted_simulation_leaves_no_temporary_file(tmp_path):
+    path = tmp_path / "w.vcd"
+    _interrupt_the_third_frame(small_params(), path)
+    gc.collect()  # here, not in a later test
+    # close() wrote the window as far as it got; nothing else is left.
+    assert os.listdir(tmp_path) == ["w.vcd"]
+    assert "frame_done" in vcd_times_and_names(path)[1]
+
+
+def test_an_interrupted_trim_leaves_no_file_at_all(tmp_path, monkeypatch):
+    from fpga_robotics.sim.backends import pysim
+
+    def interrupted_trim(src, dst, *args, **kwargs):
+        dst.write(src.read(100))
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(pysim, "trim_vcd", interrupted_trim)
+    p = small_params()
+    frame, colour = sequence(p, seed=8)[0]
+    with pytest.raises(KeyboardInterrupt), \
+            PysimBackend(p, waveform=WaveformRequest(str(tmp_path / "w.vcd"), 0, 0)) as sim:
+        sim.process_frame(frame, colour)
+    assert os.listdir(tmp_path) == []
+
+
+def test_a_window_never_reached_leaves_no_file(tmp_path):
+    p = small_params()
+    frame, colour = sequence(p, seed=8)[0]
+    with PysimBackend(p, waveform=WaveformRequest(str(tmp_path / "w.vcd"), 2, 3)) as sim:
+        sim.process_frame(frame, colour)
+        assert len(os.listdir(tmp_path)) == 1  # the recording, from time 0
+    assert os.listdir(tmp_path) == []
+
+
 @pytest.mark.parametrize("path,message", [("wave.fst", ".vcd"), ("missing/wave.vcd", "directory")])
 def test_bad_waveform_requests_are_clear_errors(tmp_path, path, message):
     with pytest.raises(BackendError, match=message):

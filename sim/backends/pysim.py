@@ -15,26 +15,45 @@ per line. Only the few cycles after the frame's last pixel are stepped one by on
 A ``WaveformRequest`` gets a VCD of every signal of the design from the start of frame
 ``first_frame`` to the end of frame ``last_frame``. The harness's signals have private (empty)
 names, which Amaranth leaves out of waveforms, so the wide line signals do not swamp the file.
-Amaranth only starts waveforms at time 0 through its public API; this backend starts them later
-through the simulation engine's own ``write_vcd`` (Amaranth 0.5), which dumps the current
-values first.
+Amaranth's public ``Simulator.write_vcd`` starts only at time 0, so a backend with a waveform
+request records from its first job into a hidden temporary file next to the target. The
+testbench counts the clock edges it awaits, which gives the exact time of every frame's start
+and end (rising edge n is at (n - 1/2) ``PERIOD``; a job starts a quarter period after the
+previous job's last edge). When the last requested frame is done (or at ``close()``, or at a
+``reset()`` inside the window) the recording stops and ``vcd_trim.trim_vcd`` cuts the window
+out of it into the requested path: the header, the values at the window's start as the initial
+dump at time 0, then only the changes inside the window, at their simulation times. The
+recording is removed in every case, also on an error or Ctrl-C, or when the backend is dropped.
+
+Cost: the frames before ``first_frame`` are traced too (and then cut), so they run at the
+traced speed, not the untraced one. At 160x120 a frame takes about 1.8 s traced instead of
+0.6 s (3 times as long), the recording grows by about 4 MB a frame, and cutting the window out
+reads the recording at about 0.1 s a frame. A late ``first_frame`` is therefore costly;
+once the window is written, tracing stops and the frames run at the untraced speed again.
 """
 
 import os
 import tempfile
 import weakref
+from pathlib import Path
 
 import numpy as np
 from amaranth import Cat, ClockDomain, Const, Elaboratable, Module, Mux, Signal, Value
 from amaranth.sim import Simulator
 
 from ...hw.top import FollowTarget
+from ..files import atomic_output
 from .base import BackendError, DesignBackend, FrameResult
+from .vcd_trim import trim_vcd
 
 __all__ = ["PysimBackend"]
 
 #: Simulated clock period. Only the number of edges matters; 1 us keeps VCD times readable.
 PERIOD = 1e-6
+#: The same in femtoseconds, the unit of Amaranth's VCD times (a whole number of them,
+#: divisible by 4). Rising edge n (from 1) is at (n - 1/2) periods (``add_clock`` with phase
+#: PERIOD / 2); a job starts a quarter period after the previous job's last edge.
+PERIOD_FS = round(PERIOD * 10**15)
 
 #: Bits per pixel lane in the harness's line signals (a 14-bit payload, rounded up so that
 #: numpy can pack and unpack lines as little-endian uint16).
@@ -106,7 +125,8 @@ class PysimBackend(DesignBackend):
         Idle cycles after every line / at least after the frame (see ``base.py``).
     waveform : WaveformRequest, optional
         Write a ``.vcd`` of the frames ``first_frame`` .. ``last_frame``. The file is complete
-        when the last requested frame is done (or at ``close()``/``reset()``).
+        when the last requested frame is done (or at ``close()``/``reset()``). The frames
+        before ``first_frame`` are traced too, and run slower for it (see the module's notes).
     """
 
     name = "pysim"
@@ -118,13 +138,14 @@ class PysimBackend(DesignBackend):
         self.dut = FollowTarget(self.params)
         self._harness = _Harness(self.dut)
         self._sim = Simulator(self._harness)
-        self._sim.add_clock(PERIOD)
-        self._started = False  # the testbench is added with the first job (see _submit)
+        self._sim.add_clock(PERIOD, phase=PERIOD / 2)
+        self._started = False  # the testbench is added with the first job (see _start)
         self._job = None
         self._outcome = None
         self._broken = None
-        self._vcd = None  # open waveform writer (a context manager)
-        self._traced = False  # the requested waveform has been written
+        self._edges = 0  # rising clock edges the testbench has awaited
+        self._recording = None  # the whole-run VCD the requested window is cut from
+        self._traced = False  # the requested waveform has been written (or given up)
         p = self.params
         self._color_sel = None
         self._lane_flags = np.zeros((p.height, p.width), dtype=np.uint16)
@@ -134,23 +155,37 @@ class PysimBackend(DesignBackend):
     # --- host side ------------------------------------------------------------------------
 
     def _reset(self):
-        self._finish_trace()
+        if self._recording is not None and self._recording.start is not None:
+            self._finish_trace()  # the window ends with the last frame before the reset
         self._submit(("reset",))
 
     def _run_frame(self, packed, color_sel):
         index = self.frames_processed
-        if (self.waveform is not None and not self._traced and self._vcd is None
-                and self.waveform.covers(index)):
-            self._start_trace()
+        if not self._started:
+            self._start()
+        recording = self._recording
+        if recording is not None and recording.start is None and self.waveform.covers(index):
+            recording.start = self._edges
         try:
             result = self._submit(("frame", packed, color_sel))
         finally:
-            if self._vcd is not None and index >= self.waveform.last_frame:
+            if (recording is not None and recording.start is not None
+                    and index >= self.waveform.last_frame):
                 self._finish_trace()
         return result
 
     def close(self):
         self._finish_trace()
+
+    def _start(self):
+        """Start the simulation: the waveform recording (only possible at time 0), then the
+        testbench."""
+        if self.waveform is not None and not self._traced:
+            self._recording = _Recording(self._sim, self.waveform.path)
+        # Added lazily: Amaranth creates the coroutine right away, and a backend that never
+        # ran would otherwise warn about a coroutine never awaited.
+        self._sim.add_testbench(self._testbench)
+        self._started = True
 
     def _submit(self, job):
         if self._broken is not None:
@@ -158,10 +193,7 @@ class PysimBackend(DesignBackend):
                 f"the pysim simulation failed earlier ({self._broken}); create a new backend"
             )
         if not self._started:
-            # Added lazily: Amaranth creates the coroutine right away, and a backend that
-            # never ran would otherwise warn about a coroutine never awaited.
-            self._sim.add_testbench(self._testbench)
-            self._started = True
+            self._start()
         self._job = job
         self._outcome = None
         advance = self._sim.advance
@@ -179,34 +211,12 @@ class PysimBackend(DesignBackend):
             raise outcome
         return outcome
 
-    def _start_trace(self):
-        engine = getattr(self._sim, "_engine", None)
-        if engine is None or not hasattr(engine, "write_vcd"):
-            raise BackendError(
-                "this Amaranth version cannot start a waveform in mid-simulation; "
-                "use the model, cxxrtl or verilator backend for waveforms"
-            )
-        # Written under a temporary name and renamed when complete, so that an interrupted
-        # run never leaves a half-written file at the requested path.
-        path = os.path.abspath(os.fspath(self.waveform.path))
-        fd, self._vcd_tmp = tempfile.mkstemp(
-            prefix=".tmp-", suffix=os.path.basename(path), dir=os.path.dirname(path)
-        )
-        os.close(fd)
-        self._vcd_cleanup = weakref.finalize(self, _remove_if_exists, self._vcd_tmp)
-        self._vcd = engine.write_vcd(
-            vcd_file=self._vcd_tmp, gtkw_file=None, traces=(), fs_per_delta=0
-        )
-        self._vcd.__enter__()
-
     def _finish_trace(self):
-        if self._vcd is not None:
-            vcd, self._vcd = self._vcd, None
+        """Stop recording; write the window to the requested path if it has begun."""
+        if self._recording is not None:
+            recording, self._recording = self._recording, None
             self._traced = True
-            vcd.__exit__(None, None, None)
-            os.chmod(self._vcd_tmp, _default_file_mode())  # mkstemp made it private
-            os.replace(self._vcd_tmp, os.fspath(self.waveform.path))
-            self._vcd_cleanup.detach()
+            recording.finish(self.waveform.path, self._edges)
 
     # --- simulation side (runs inside the simulator) -----------------------------------------
 
@@ -216,7 +226,7 @@ class PysimBackend(DesignBackend):
             try:
                 if job[0] == "reset":
                     ctx.set(self._harness.rst, 1)
-                    await ctx.tick()
+                    await self._ticks(ctx, 1)
                     ctx.set(self._harness.rst, 0)
                     self._color_sel = None
                     outcome = None
@@ -262,7 +272,7 @@ class PysimBackend(DesignBackend):
         end = max(height * (width + lb) + self.frame_blank, done_edge + p.motor_latency)
         while edge < end:
             if len(lines) >= height:
-                await ctx.tick().repeat(end - edge)
+                await self._ticks(ctx, end - edge)
                 edge = end
             else:
                 await self._tick_collect(ctx, lines)
@@ -297,11 +307,11 @@ class PysimBackend(DesignBackend):
         for row in lanes.astype("<u2", copy=False):
             ctx.set(harness.line, int.from_bytes(row.tobytes(), "little"))
             ctx.set(harness.line_valid, 1)
-            await ctx.tick().repeat(width)
+            await self._ticks(ctx, width)
             ctx.set(harness.line_valid, 0)
             self._collect_line(ctx, lines)
             if lb:
-                await ctx.tick().repeat(lb)
+                await self._ticks(ctx, lb)
         return lines
 
     def _collect_line(self, ctx, lines):
@@ -318,21 +328,57 @@ class PysimBackend(DesignBackend):
 
     async def _tick_collect(self, ctx, lines):
         """One edge, then collect a filtered line if one has completed."""
-        await ctx.tick()
+        await self._ticks(ctx, 1)
         self._collect_line(ctx, lines)
 
+    async def _ticks(self, ctx, count):
+        """Wait for ``count`` rising edges and count them: the waveform's window is found
+        from the edge count (every wait for the clock goes through here)."""
+        if count == 1:
+            await ctx.tick()
+        else:
+            await ctx.tick().repeat(count)
+        self._edges += count
 
-def _default_file_mode():
-    umask = os.umask(0)
-    os.umask(umask)
-    return 0o666 & ~umask
+
+def _edge_time(edges):
+    """Simulation time (fs) of rising edge ``edges`` (from 1); 0 before the first."""
+    return 0 if edges == 0 else PERIOD_FS // 2 + (edges - 1) * PERIOD_FS
 
 
-def _remove_if_exists(path):
-    try:
-        os.unlink(path)
-    except FileNotFoundError:
-        pass
+class _Recording:
+    """The VCD of the whole simulation from time 0, in a hidden temporary file next to the
+    requested path, that the requested window is cut from. The file goes away at ``finish``,
+    or when the recording is dropped unfinished."""
+
+    def __init__(self, sim, path):
+        path = Path(os.path.abspath(os.fspath(path)))
+        fd, raw = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=".untrimmed.vcd",
+                                   dir=path.parent)
+        os.close(fd)
+        self.raw = Path(raw)
+        self._cleanup = weakref.finalize(self, self.raw.unlink, missing_ok=True)
+        self.start = None  # edges before the first requested frame, once it has begun
+        try:
+            self._writer = sim.write_vcd(str(self.raw))
+            self._writer.__enter__()
+        except BaseException:
+            self._cleanup()
+            raise
+
+    def finish(self, path, edges):
+        """Stop recording after ``edges`` edges; if the window has begun, write it to
+        ``path`` (atomically). The recording is removed in any case."""
+        try:
+            self._writer.__exit__(None, None, None)
+            if self.start is not None:
+                start = _edge_time(self.start)
+                # Up to the time the next job would start: a quarter period after the edge.
+                end = _edge_time(edges) + PERIOD_FS // 4
+                with open(self.raw) as src, atomic_output(path, what="waveform") as dst:
+                    trim_vcd(src, dst, start, end, timescale="1 fs")
+        finally:
+            self._cleanup()
 
 
 if __name__ == "__main__":  # the CLI lives in the application layer
