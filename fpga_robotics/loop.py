@@ -16,6 +16,7 @@ import numpy as np
 
 from .connectors import CameraConnector, MotorConnector, in_view
 from .hw.pixel import color_select_value
+from .shadow import ShadowComparison, divergence_event
 from .sim.records import FrameRecord
 from .summary import compute_metrics, evaluate_checks, verdict
 
@@ -106,7 +107,8 @@ class ClosedLoop:
     ``measure`` the robot and the target, ``record`` the frame; then ``finish_physics`` and
     ``summarise``. ``run()`` does all of it. Built by ``run_scenario``; see its parameters."""
 
-    def __init__(self, scenario, *, seed=None, design, recorder=None, on_frame=None):
+    def __init__(self, scenario, *, seed=None, design, recorder=None, on_frame=None,
+                 shadow=None, shadow_label="shadow"):
         from .sim.world import World
 
         self.scenario = scenario
@@ -132,6 +134,9 @@ class ClosedLoop:
             (p.radius for p in self.world.people_states() if p.is_target), 0.0)
         self.color = scenario.color_at(0.0)
         self.color_code = color_select_value(self.color)
+        # A second design on the same frames, never driving the robot (fpga_robotics.shadow).
+        self.shadow = shadow
+        self.comparison = ShadowComparison(shadow_label) if shadow is not None else None
 
     def _build_camera(self, cam, spec):
         """The camera on the robot; mount values the scenario leaves unset are the robot's."""
@@ -175,6 +180,19 @@ class ClosedLoop:
         self.motors.apply_due(self.step)  # a zero delay acts now
         return result
 
+    def process_shadow(self, k, t, rgb, result):
+        """Frame ``k`` through the shadow design; returns its result and events."""
+        if self.shadow is None:
+            return None, []
+        shadow_result = self.shadow.process_frame(rgb, self.color_code)
+        first = self.comparison.first_divergence is None
+        differ = self.comparison.compare(k, t, result, shadow_result)
+        events = []
+        if differ and first:
+            events.append(divergence_event(self.comparison.label, differ, result,
+                                           shadow_result))
+        return shadow_result, events
+
     def measure(self, k, t, pose, result):
         """Fill trajectory row ``k``; return the target's distance and visibility."""
         rx, ry, heading = self.world.robot_pose()
@@ -199,7 +217,7 @@ class ClosedLoop:
         row["target_distance"][k], row["target_in_view"][k] = dist, visible
         return (None if target is None else dist), visible
 
-    def record(self, k, t, rgb, result, distance, visible, events):
+    def record(self, k, t, rgb, result, distance, visible, events, shadow_result=None):
         """Hand the frame to the viewer and the ``on_frame`` callback."""
         row = self.traj
         record = FrameRecord(
@@ -208,7 +226,7 @@ class ClosedLoop:
             robot_v=row["v"][k], robot_w=row["w"][k], cmd_v=row["cmd_v"][k],
             cmd_w=row["cmd_w"][k], camera_hfov=self.scenario.camera.hfov,
             people=self.world.people_states(), target_distance=distance,
-            target_in_view=visible, events=events,
+            target_in_view=visible, events=events, shadow_result=shadow_result,
         )
         if self.recorder is not None:
             self.recorder.log_frame(record)
@@ -220,11 +238,12 @@ class ClosedLoop:
         t = self.step * self.dt
         pose, rgb, events = self.capture(t)
         result = self.process(k, rgb)
-        events += self.design_events.update(bool(result.found))
+        shadow_result, shadow_events = self.process_shadow(k, t, rgb, result)
+        events += self.design_events.update(bool(result.found)) + shadow_events
         distance, visible = self.measure(k, t, pose, result)
         self.events += [(k, round(t, 6), e) for e in events]
         if self.want_records:
-            self.record(k, t, rgb, result, distance, visible, events)
+            self.record(k, t, rgb, result, distance, visible, events, shadow_result)
 
     def finish_physics(self):
         """Physics after the last frame, to the end of the run."""
@@ -260,6 +279,7 @@ class ClosedLoop:
         metrics = compute_metrics(self.traj, self.events, self.world.collision_counts(),
                                   self.period)
         checks = evaluate_checks(scenario.checks, metrics)
+        shadow = {"shadow": self.comparison.summary()} if self.comparison is not None else {}
         return {
             "scenario": scenario.name,
             "backend": self.design.name,
@@ -281,6 +301,7 @@ class ClosedLoop:
             "events": len(self.events),
             "verdict": verdict(checks),
             "checks": checks,
+            **shadow,
         }
 
 
@@ -295,7 +316,7 @@ def _empty_trajectory(n_frames):
 
 
 def run_scenario(scenario, *, seed=None, backend="auto", recorder=None, progress=None,
-                 realtime=False, on_frame=None):
+                 realtime=False, on_frame=None, shadow=None, shadow_label="shadow"):
     """Run one scenario in closed loop and measure it.
 
     Parameters
@@ -314,6 +335,12 @@ def run_scenario(scenario, *, seed=None, backend="auto", recorder=None, progress
         Pace the simulation to the wall clock.
     on_frame : callable(FrameRecord), optional
         Called for every frame (tests, custom logging).
+    shadow : DesignBackend, optional
+        A second design run on the same frames in lockstep, never driving the robot; the
+        summary gains ``shadow`` (first divergence, differing frames per output). Reset
+        first; the caller keeps ownership.
+    shadow_label : str
+        How the summary and the events name the shadow design.
     """
     owns_backend = isinstance(backend, str)
     design = make_backend(backend, scenario.params) if owns_backend else backend
@@ -321,8 +348,10 @@ def run_scenario(scenario, *, seed=None, backend="auto", recorder=None, progress
         if design.params != scenario.params:
             raise ValueError("the backend was built for other parameters than the scenario's")
         design.reset()
+        if shadow is not None:
+            shadow.reset()
         loop = ClosedLoop(scenario, seed=seed, design=design, recorder=recorder,
-                          on_frame=on_frame)
+                          on_frame=on_frame, shadow=shadow, shadow_label=shadow_label)
         return loop.run(progress=progress, realtime=realtime)
     finally:
         if owns_backend:

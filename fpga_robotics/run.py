@@ -61,6 +61,12 @@ def build_parser(prog="python -m fpga_robotics.run"):
     p.add_argument("--source", metavar="camera:N|VIDEO|FOLDER",
                    help="run the design on real frames instead of the simulation (no physics)")
     p.add_argument("--max-frames", type=int, metavar="N", help="with --source: stop after N")
+    p.add_argument("--shadow", metavar="SPEC",
+                   help="run a second design on the same frames without letting it drive: a "
+                        "preset name (published) and/or design KEY=VALUE items separated by ';' "
+                        "(e.g. 'diff_min=5;kp_num=2'); the summary reports where they differ")
+    p.add_argument("--shadow-backend", choices=("auto", *BACKEND_NAMES), default=None,
+                   help="simulator of the shadow design (default: the same as --backend)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     return p
 
@@ -122,6 +128,19 @@ def _overrides(args):
     if args.color is not None:
         items.append(f'color.initial="{args.color}"')
     return items
+
+
+def _shadow_params(scenario, spec):
+    """The shadow design's parameters: the scenario's design with ``--shadow`` applied."""
+    if spec is None:
+        return None
+    from .shadow import shadow_overrides
+
+    try:
+        items = shadow_overrides(spec)
+    except ValueError as exc:
+        raise UsageError(str(exc)) from None
+    return scenario.with_overrides(items).params
 
 
 def _dress_target(scenario, color):
@@ -226,29 +245,42 @@ def main(argv=None, prog="python -m fpga_robotics.run"):
     if args.target_color is not None:
         scenario = _dress_target(scenario, args.target_color)
     if args.source is not None:
+        if args.shadow is not None:
+            raise UsageError("--shadow runs in the closed loop only (not with --source)")
         if args.max_frames is not None and args.max_frames < 1:
             raise UsageError(f"--max-frames must be >= 1, got {args.max_frames}")
         return _run_source(args, scenario)
     if args.max_frames is not None:
         raise UsageError("--max-frames only applies with --source (use --duration)")
+    shadow_params = _shadow_params(scenario, args.shadow)
 
     t0 = time.perf_counter()
     design = _open_backend(args.backend, scenario.params, args.quiet)
-    setup = time.perf_counter() - t0
-    recorder = None
+    shadow = recorder = None
     try:
+        if shadow_params is not None:
+            shadow = _open_backend(args.shadow_backend or args.backend, shadow_params,
+                                   args.quiet)
+        setup = time.perf_counter() - t0
         recorder = _open_recorder(args, scenario.name)
         progress = None if args.quiet else Progress(scenario.name)
         result = run_scenario(scenario, seed=args.seed, backend=design, recorder=recorder,
-                              progress=progress, realtime=args.realtime)
+                              progress=progress, realtime=args.realtime, shadow=shadow,
+                              shadow_label=args.shadow or "shadow")
         if progress is not None:
             progress.finish()
     finally:
         design.close()
+        if shadow is not None:
+            shadow.close()
         where = recorder.close() if recorder is not None else None
     summary = dict(result.summary)
     summary["backend_setup_s"] = round(setup, 3)
     print(format_summary(summary))
+    if "shadow" in summary:
+        from .shadow import format_shadow
+
+        print("\n".join(format_shadow(summary["shadow"])))
     if where:
         print(where)
     if args.summary:

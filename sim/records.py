@@ -54,3 +54,4 @@ class FrameRecord:
     target_distance: float | None = None  # robot centre to target person centre, m
     target_in_view: bool = False  # the target person is geometrically in the camera's view
     events: list = field(default_factory=list)  # ["target found", "collision with wall", ...]
+    shadow_result: FrameResult | None = None  # a shadow design's outputs on the same frame

@@ -1,0 +1,104 @@
+"""Shadow runs: a second design sees exactly the frames the first one sees, in lockstep, without
+driving the robot; where their outputs part is reported frame by frame.
+
+This is how a refactored design is checked against the reference in closed loop: the robot
+moves as the primary design decides, so both designs get the same inputs, and the first frame
+at which they decide differently is the place to look.
+"""
+
+from dataclasses import dataclass, field
+
+__all__ = ["COMPARED_OUTPUTS", "ShadowComparison", "divergence_event", "format_shadow",
+           "shadow_overrides"]
+
+#: The outputs compared frame by frame (the filtered image is compared as a pixel count).
+COMPARED_OUTPUTS = ("found", "proximity", "centroid_x", "centroid_leds", "motor_left",
+                    "motor_right", "filtered")
+
+
+def shadow_overrides(spec):
+    """``--shadow SPEC`` as scenario overrides of the ``[design]`` section.
+
+    ``SPEC`` is a preset name (``published``), ``KEY=VALUE`` items separated by ``;``
+    (``diff_min=5;kp_num=2``; ``design.`` may be written or left out), or both
+    (``published;max_dps=400``: the preset first, the items on top).
+    """
+    items = [part.strip() for part in str(spec).split(";") if part.strip()]
+    if not items:
+        raise ValueError("--shadow needs a preset name or KEY=VALUE items, e.g. "
+                         "--shadow published or --shadow 'diff_min=5;kp_num=2'")
+    out = []
+    for item in items:
+        if "=" not in item:
+            out.append(f'design.preset="{item}"')
+            continue
+        key, value = item.split("=", 1)
+        key = key.strip()
+        out.append(f"{key if key.startswith('design.') else 'design.' + key}={value.strip()}")
+    return out
+
+
+def _value(result, name):
+    if name == "filtered":
+        return int((result.filtered != 0).sum())  # matching pixels; compared as images
+    value = getattr(result, name)
+    return bool(value) if name == "found" else int(value)
+
+
+@dataclass
+class ShadowComparison:
+    """Collects where a shadow design's outputs differ from the primary design's."""
+
+    label: str
+    differing_frames: dict = field(default_factory=lambda: dict.fromkeys(COMPARED_OUTPUTS, 0))
+    first_divergence: dict | None = None
+    frames: int = 0
+
+    def compare(self, frame, time_s, primary, shadow):
+        """Compare one frame's results; return the names of the outputs that differ."""
+        self.frames += 1
+        differ = []
+        for name in COMPARED_OUTPUTS:
+            if name == "filtered":
+                same = (primary.filtered == shadow.filtered).all()
+            else:
+                same = getattr(primary, name) == getattr(shadow, name)
+            if not same:
+                differ.append(name)
+                self.differing_frames[name] += 1
+        if differ and self.first_divergence is None:
+            self.first_divergence = {
+                "frame": frame,
+                "time_s": round(time_s, 6),
+                "outputs": {n: {"primary": _value(primary, n), "shadow": _value(shadow, n)}
+                            for n in differ},
+            }
+        return differ
+
+    def summary(self):
+        """JSON-ready: what was compared, the first divergence and the counts."""
+        return {
+            "design": self.label,
+            "frames": self.frames,
+            "first_divergence": self.first_divergence,
+            "differing_frames": dict(self.differing_frames),
+        }
+
+
+def divergence_event(label, differ, primary, shadow):
+    """The event text for the first frame where the designs part."""
+    parts = ", ".join(f"{n} {_value(primary, n)} vs {_value(shadow, n)}" for n in differ)
+    return f"shadow design {label} diverges: {parts}"
+
+
+def format_shadow(summary):
+    """Lines for the human summary."""
+    first = summary["first_divergence"]
+    if first is None:
+        return [f"  shadow {summary['design']}: identical outputs on all "
+                f"{summary['frames']} frames"]
+    counts = ", ".join(f"{n} {c}" for n, c in summary["differing_frames"].items() if c)
+    what = ", ".join(f"{n} {v['primary']} vs {v['shadow']}" for n, v in first["outputs"].items())
+    return [f"  shadow {summary['design']}: first differs at frame {first['frame']} "
+            f"({first['time_s']:.2f} s): {what}",
+            f"  shadow frames that differ: {counts} (of {summary['frames']})"]

@@ -1,0 +1,67 @@
+"""Shadow runs: a second design on the same frames, in lockstep, never driving the robot."""
+
+import numpy as np
+import pytest
+
+from fpga_robotics.loop import run_scenario
+from fpga_robotics.scenario import load_scenario
+from fpga_robotics.shadow import COMPARED_OUTPUTS, shadow_overrides
+from fpga_robotics.sim.backends.model import ModelBackend
+
+
+def test_shadow_spec_becomes_design_overrides():
+    assert shadow_overrides("published") == ['design.preset="published"']
+    assert shadow_overrides("diff_min=5; design.kp_num=2") == ["design.diff_min=5",
+                                                               "design.kp_num=2"]
+    assert shadow_overrides("published;max_dps=400") == ['design.preset="published"',
+                                                         "design.max_dps=400"]
+    with pytest.raises(ValueError, match="preset name"):
+        shadow_overrides(" ; ")
+
+
+def test_the_design_shadowed_by_itself_never_differs():
+    s = load_scenario("lost_target", ["sim.duration=8"])
+    with ModelBackend(s.params) as shadow:
+        r = run_scenario(s, backend="model", shadow=shadow, shadow_label="same")
+    sh = r.summary["shadow"]
+    assert sh["frames"] == r.summary["frames"]
+    assert sh["first_divergence"] is None
+    assert sh["differing_frames"] == dict.fromkeys(COMPARED_OUTPUTS, 0)
+
+
+def test_shadow_does_not_drive_the_robot():
+    s = load_scenario("lost_target", ["sim.duration=8"])
+    alone = run_scenario(s, backend="model")
+    other = s.with_overrides(["design.lost_frames=5", "design.search_dps=-300"]).params
+    with ModelBackend(other) as shadow:
+        shadowed = run_scenario(s, backend="model", shadow=shadow)
+    for name in ("x", "y", "heading", "motor_left", "motor_right"):
+        assert np.array_equal(alone.trajectory[name], shadowed.trajectory[name]), name
+
+
+def test_first_divergence_is_where_the_shorter_lost_count_starts_searching():
+    # Primary searches after 15 lost frames, the shadow after 5: the designs see the same
+    # frames, so they part exactly at the 5th consecutive frame without the target (found
+    # there and before agree; the motors differ: search versus hold).
+    s = load_scenario("lost_target", ["sim.duration=12"])
+    other = s.with_overrides(["design.lost_frames=5"]).params
+    with ModelBackend(other) as shadow:
+        r = run_scenario(s, backend="model", shadow=shadow, shadow_label="lost_frames=5")
+    found = r.trajectory["found"]
+    seen = False
+    misses = 0
+    expected = None
+    for k, f in enumerate(found):
+        seen |= bool(f)
+        misses = 0 if f else misses + 1
+        if seen and misses == 5:
+            expected = k
+            break
+    assert expected is not None, "the scenario never loses the target"
+    first = r.summary["shadow"]["first_divergence"]
+    assert first["frame"] == expected
+    assert set(first["outputs"]) <= {"motor_left", "motor_right"}
+    assert first["outputs"]["motor_left"]["primary"] == r.trajectory["motor_left"][expected]
+    events = [e for k, _t, e in r.events if k == expected]
+    assert any(e.startswith("shadow design lost_frames=5 diverges") for e in events)
+    assert r.summary["shadow"]["differing_frames"]["found"] == 0
