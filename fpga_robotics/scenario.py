@@ -27,6 +27,7 @@ from pathlib import Path
 from .errors import UsageError
 from .hw.params import FollowTargetParams
 from .hw.pixel import COLOR_SELECT
+from .sim.world.config import WORLD_SECTIONS
 from .summary import CHECKS
 
 __all__ = [
@@ -39,9 +40,6 @@ __all__ = [
     "parse_resolution",
     "shipped_scenarios",
 ]
-
-#: Sections owned and validated by the world (``fpga_robotics.sim.world``).
-WORLD_SECTIONS = ("room", "robot", "people", "lighting")
 
 _TOP_KEYS = ("name", "description", "seed")
 _DESIGN_KEYS = tuple(f.name for f in fields(FollowTargetParams) if f.init and f.name not in

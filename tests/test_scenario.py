@@ -29,6 +29,13 @@ def write(tmp_path, text, name="s.toml"):
     return path
 
 
+def test_the_world_sections_are_defined_once_by_the_world():
+    from fpga_robotics import scenario
+    from fpga_robotics.sim.world import config
+
+    assert scenario.WORLD_SECTIONS is config.WORLD_SECTIONS
+
+
 def test_the_five_scenarios_are_shipped_and_load():
     names = set(shipped_scenarios())
     assert set(SHIPPED) <= names
