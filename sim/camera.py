@@ -38,6 +38,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
+from ..hw.validate import check_int
 from .scene import CameraPose, Scene
 
 __all__ = ["DEFAULT_HFOV", "DEFAULT_MAX_LAYERS", "CameraRenderer", "render"]
@@ -129,13 +130,6 @@ def _cylinder_arrays(cylinders):
     )
 
 
-def _check_int(name, value, lo):
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
-        raise TypeError(f"{name} must be an int, not {type(value).__name__} {value!r}")
-    if value < lo:
-        raise ValueError(f"{name} must be >= {lo}, got {value}")
-
-
 class CameraRenderer:
     """Pinhole camera renderer for one image size, with its per-resolution tables cached.
 
@@ -165,9 +159,9 @@ class CameraRenderer:
     """
 
     def __init__(self, width, height, hfov=DEFAULT_HFOV, *, max_layers=DEFAULT_MAX_LAYERS):
-        _check_int("width", width, 1)
-        _check_int("height", height, 1)
-        _check_int("max_layers", max_layers, 1)
+        check_int("width", width, 1)
+        check_int("height", height, 1)
+        check_int("max_layers", max_layers, 1)
         if isinstance(hfov, bool) or not isinstance(hfov, numbers.Real) or not 0 < hfov < math.pi:
             raise ValueError(f"hfov must be an angle in radians between 0 and pi, got {hfov!r}")
         self.width = int(width)

@@ -474,6 +474,15 @@ def test_bad_renderer_arguments(args, match):
         CameraRenderer(*args)
 
 
+@pytest.mark.parametrize("args,match", [
+    ((10.0, 10), "width must be an int"), ((10, True), "height must be an int"),
+])
+def test_renderer_sizes_must_be_integers(args, match):
+    with pytest.raises(TypeError, match=match):
+        CameraRenderer(*args)
+    assert CameraRenderer(np.int64(16), np.int32(12)).width == 16  # numpy integers are fine
+
+
 def test_bad_pose_and_scene():
     r = CameraRenderer(32, 24)
     with pytest.raises(ValueError, match="height"):
