@@ -8,7 +8,7 @@ from hypothesis import strategies as st
 
 from fpga_robotics.sim.world import GOPIGO3, TURTLEBOT2, dps_to_twist, twist_to_wheels
 from fpga_robotics.sim.world.kinematics import wheels_to_twist
-from fpga_robotics.sim.world.motors import SimMotors, WheelMotor
+from fpga_robotics.sim.world.motors import DriveMotors, WheelMotor
 
 
 def test_robot_geometry_is_the_real_one():
@@ -71,7 +71,7 @@ def test_wheel_motor_ramps_at_its_acceleration_and_clamps():
 
 
 def test_sim_motors_commanded_twist_is_the_raw_command():
-    motors = SimMotors(TURTLEBOT2)
+    motors = DriveMotors(TURTLEBOT2)
     motors.set_wheel_dps(360, 360)
     assert motors.commanded_twist() == pytest.approx((0.035 * 2 * math.pi, 0.0))
     assert motors.motor_twist() == (0.0, 0.0)  # nothing ramped yet

@@ -1,4 +1,4 @@
-"""Motor model and SimMotors: the design's DPS commands to wheel speeds and robot twist.
+"""DriveMotors: the robot's wheel motors, from DPS commands to wheel speeds and robot twist.
 
 Each wheel's speed follows its target with a limited acceleration (the motor controller's
 ramp) and is clamped to the motor's maximum speed. Together these are the robot's "motor
@@ -7,7 +7,7 @@ power"; traction (how hard the wheels can push the body) is applied in the physi
 
 from .kinematics import DEG, dps_to_twist, wheels_to_twist
 
-__all__ = ["SimMotors", "WheelMotor"]
+__all__ = ["DriveMotors", "WheelMotor"]
 
 
 class WheelMotor:
@@ -37,7 +37,7 @@ class WheelMotor:
         return self.speed
 
 
-class SimMotors:
+class DriveMotors:
     """The robot's two wheel motors, commanded in degrees per second like the GoPiGo3.
 
     Parameters

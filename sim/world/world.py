@@ -18,7 +18,7 @@ from ..records import PersonState, WorldMap
 from ..scene import CameraPose, Cylinder, Scene
 from .config import WorldConfigError, parse_world_config
 from .lighting import LightingSchedule
-from .motors import SimMotors
+from .motors import DriveMotors
 from .people import PersonPath, person_bands
 from .room import add_static_shapes, map_data, scene_walls
 
@@ -61,7 +61,7 @@ class World:
         Simulated time, s.
     robot_spec : RobotSpec
         The robot's geometry, mass and motor power.
-    motors : SimMotors
+    motors : DriveMotors
         The wheel motors (``set_wheel_dps`` is forwarded to them).
     """
 
@@ -73,7 +73,7 @@ class World:
         self.time = 0.0
         self._time_error = 0.0  # Kahan compensation: many small steps add up exactly
         self.robot_spec = spec = config.robot.spec
-        self.motors = SimMotors(spec)
+        self.motors = DriveMotors(spec)
         self.lighting = LightingSchedule(config.lighting)
 
         self.space = space = pymunk.Space()
