@@ -1,7 +1,8 @@
 """Benchmark of the camera renderer: median milliseconds per frame at several resolutions.
 
-    python -m fpga_robotics.sim.camera_bench [--frames 60] [--repeats 5] [--noise 2.0]
-                                             [--sizes 160x120,320x240,640x480]
+The command line is ``python -m fpga_robotics.camera_bench`` (the application layer, which
+reports bad arguments as usage errors); ``python -m fpga_robotics.sim.camera_bench`` runs the
+same command.
 
 The scene is a typical room: 8 m x 6 m walls (2.5 m), four pieces of furniture made of four
 walls each (a 1.2 m wooden divider among them) and three people. The camera drives a loop
@@ -11,18 +12,15 @@ clock, and CPU time of the process (which a busy machine does not inflate). With
 (default 2.0) the same again with sensor noise.
 """
 
-import argparse
 import math
-import statistics
 import time
 
 import numpy as np
 
-from ..errors import UsageError, run_cli
 from .camera import DEFAULT_HFOV, CameraRenderer
 from .scene import Band, CameraPose, Cylinder, Lighting, Scene, Wall
 
-__all__ = ["benchmark", "camera_loop", "main", "typical_scene"]
+__all__ = ["DEFAULT_SIZES", "benchmark", "camera_loop", "typical_scene"]
 
 DEFAULT_SIZES = ((160, 120), (320, 240), (640, 480))
 
@@ -84,48 +82,7 @@ def benchmark(width, height, *, frames=60, repeats=5, noise_std=0.0, hfov=DEFAUL
     return wall, cpu
 
 
-def _size(text):
-    try:
-        w, h = (int(v) for v in text.lower().split("x"))
-    except ValueError:
-        raise UsageError(f"a size is WIDTHxHEIGHT, e.g. 160x120; got {text!r}") from None
-    if w < 1 or h < 1:
-        raise UsageError(f"a size needs a positive width and height, got {text!r}")
-    return w, h
+if __name__ == "__main__":  # the command line lives in the application layer
+    from ..camera_bench import cli
 
-
-def main(argv=None):
-    ap = argparse.ArgumentParser(prog="python -m fpga_robotics.sim.camera_bench",
-                                 description=__doc__.split("\n\n")[0])
-    ap.add_argument("--frames", type=int, default=60, help="poses per loop (default 60)")
-    ap.add_argument("--repeats", type=int, default=5, help="loops per size (default 5)")
-    ap.add_argument("--noise", type=float, default=2.0,
-                    help="also time with sensor noise of this std, 8-bit units (0: skip)")
-    ap.add_argument("--sizes", default=",".join(f"{w}x{h}" for w, h in DEFAULT_SIZES),
-                    help="comma-separated WIDTHxHEIGHT list")
-    args = ap.parse_args(argv)
-    if args.frames < 1 or args.repeats < 1:
-        raise UsageError("--frames and --repeats must be >= 1")
-    if not (math.isfinite(args.noise) and args.noise >= 0):
-        raise UsageError(f"--noise must be a number >= 0, got {args.noise}")
-    sizes = [_size(s) for s in args.sizes.split(",") if s.strip()]
-    print(f"camera renderer, typical room ({len(typical_scene().walls)} walls, 3 people), "
-          f"{args.frames} poses x {args.repeats} repeats; median milliseconds per frame "
-          f"(wall clock / CPU time of this process)")
-    header = f"{'size':>9}  {'wall':>7}  {'cpu':>7}"
-    if args.noise:
-        header += f"  {'noise wall':>10}  {'noise cpu':>9}"
-    print(header)
-    for w, h in sizes:
-        wall, cpu = benchmark(w, h, frames=args.frames, repeats=args.repeats)
-        line = f"{w:>4}x{h:<4}  {statistics.median(wall):7.3f}  {statistics.median(cpu):7.3f}"
-        if args.noise:
-            wall, cpu = benchmark(w, h, frames=args.frames, repeats=args.repeats,
-                                  noise_std=args.noise)
-            line += f"  {statistics.median(wall):10.3f}  {statistics.median(cpu):9.3f}"
-        print(line, flush=True)
-    return 0
-
-
-if __name__ == "__main__":
-    run_cli(main, prog="camera_bench")
+    cli()

@@ -503,8 +503,8 @@ def test_bad_pose_and_scene():
 
 
 def test_benchmark_cli_prints_a_line_per_size(capsys):
+    from fpga_robotics.camera_bench import main
     from fpga_robotics.errors import UsageError
-    from fpga_robotics.sim.camera_bench import main
 
     assert main(["--frames", "2", "--repeats", "1", "--sizes", "32x24,40x30"]) == 0
     lines = capsys.readouterr().out.strip().splitlines()
@@ -512,6 +512,8 @@ def test_benchmark_cli_prints_a_line_per_size(capsys):
     assert all(float(v) > 0 for v in lines[-1].split()[1:])
     with pytest.raises(UsageError, match="WIDTHxHEIGHT"):
         main(["--sizes", "160by120"])
+    with pytest.raises(UsageError, match="1..4096"):
+        main(["--sizes", "100000x100000"])
 
 
 def test_non_finite_pose_is_refused():

@@ -1,14 +1,12 @@
 """Benchmark: physics cost per camera frame.
 
-Run ``python -m fpga_robotics.sim.world.bench``. For each world it runs the physics for
-many 30 fps frame periods (7 steps of 1/200 s each, plus ``scene()`` and the state queries
-the closed loop makes per frame) with a changing wheel command, and prints the median
-over several repeats of the time per frame and per step.
+For each world it runs the physics for many 30 fps frame periods (7 steps of 1/200 s each,
+plus ``scene()`` and the state queries the closed loop makes per frame) with a changing wheel
+command; the command line (``python -m fpga_robotics.world_bench``, or this module with
+``-m``) prints the median over several repeats of the time per frame and per step.
 """
 
-import argparse
 import math
-import statistics
 import time
 
 from .world import World
@@ -30,6 +28,8 @@ _BUSY = {
 }
 WORLDS = {"default": {}, "busy (6 furniture, 5 people)": _BUSY}
 
+__all__ = ["WORLDS", "time_frames"]
+
 
 def time_frames(cfg, frames, steps_per_frame, dt):
     world = World.from_config(cfg, seed=0)
@@ -48,25 +48,7 @@ def time_frames(cfg, frames, steps_per_frame, dt):
     return (time.perf_counter() - start) / frames
 
 
-def main(argv=None):
-    parser = argparse.ArgumentParser(prog="python -m fpga_robotics.sim.world.bench",
-                                     description=__doc__.splitlines()[0])
-    parser.add_argument("--frames", type=int, default=900, help="frames per run (default 900)")
-    parser.add_argument("--repeats", type=int, default=5, help="runs per world (default 5)")
-    parser.add_argument("--physics-hz", type=float, default=200.0)
-    parser.add_argument("--fps", type=float, default=30.0)
-    args = parser.parse_args(argv)
-    steps = math.ceil(args.physics_hz / args.fps)
-    dt = 1.0 / args.physics_hz
-    print(f"{steps} steps of {dt * 1e3:.2f} ms per frame, {args.frames} frames, "
-          f"median of {args.repeats} runs")
-    for name, cfg in WORLDS.items():
-        per_frame = statistics.median(time_frames(cfg, args.frames, steps, dt)
-                                      for _ in range(args.repeats))
-        print(f"  {name:32s} {per_frame * 1e3:7.3f} ms/frame  "
-              f"{per_frame / steps * 1e6:6.1f} us/step (incl. scene and queries)")
-    return 0
+if __name__ == "__main__":  # the command line lives in the application layer
+    from ...world_bench import cli
 
-
-if __name__ == "__main__":
-    raise SystemExit(main())
+    cli()

@@ -1,0 +1,75 @@
+"""``python -m fpga_robotics.camera_bench``: time the camera renderer at several resolutions.
+
+    python -m fpga_robotics.camera_bench [--frames 60] [--repeats 5] [--noise 2.0]
+                                         [--sizes 160x120,320x240,640x480]
+
+The benchmark itself (scene, camera loop, timing) is ``fpga_robotics.sim.camera_bench``; this
+is its command line, which reports bad arguments as one-line usage errors.
+"""
+
+import argparse
+import math
+import statistics
+import sys
+
+from .errors import UsageError, run_cli
+from .sim import camera_bench as _bench
+from .sim.camera_bench import DEFAULT_SIZES, benchmark, typical_scene
+
+__all__ = ["MAX_SIDE", "cli", "main"]
+
+#: Largest width or height timed (the design's own limit).
+MAX_SIDE = 4096
+
+
+def _size(text):
+    try:
+        w, h = (int(v) for v in text.lower().split("x"))
+    except ValueError:
+        raise UsageError(f"a size is WIDTHxHEIGHT, e.g. 160x120; got {text!r}") from None
+    if not (1 <= w <= MAX_SIDE and 1 <= h <= MAX_SIDE):
+        raise UsageError(f"a size needs a width and height of 1..{MAX_SIDE}, got {text!r}")
+    return w, h
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(prog="python -m fpga_robotics.camera_bench",
+                                 description=_bench.__doc__.split("\n\n")[0])
+    ap.add_argument("--frames", type=int, default=60, help="poses per loop (default 60)")
+    ap.add_argument("--repeats", type=int, default=5, help="loops per size (default 5)")
+    ap.add_argument("--noise", type=float, default=2.0,
+                    help="also time with sensor noise of this std, 8-bit units (0: skip)")
+    ap.add_argument("--sizes", default=",".join(f"{w}x{h}" for w, h in DEFAULT_SIZES),
+                    help="comma-separated WIDTHxHEIGHT list")
+    args = ap.parse_args(argv)
+    if not (1 <= args.frames <= 10**5 and 1 <= args.repeats <= 1000):
+        raise UsageError(f"--frames must be 1..100000 and --repeats 1..1000, got "
+                         f"{args.frames} and {args.repeats}")
+    if not (math.isfinite(args.noise) and 0 <= args.noise <= 64):
+        raise UsageError(f"--noise must be a number of 8-bit levels in 0..64, got {args.noise}")
+    sizes = [_size(s) for s in args.sizes.split(",") if s.strip()]
+    print(f"camera renderer, typical room ({len(typical_scene().walls)} walls, 3 people), "
+          f"{args.frames} poses x {args.repeats} repeats; median milliseconds per frame "
+          f"(wall clock / CPU time of this process)")
+    header = f"{'size':>9}  {'wall':>7}  {'cpu':>7}"
+    if args.noise:
+        header += f"  {'noise wall':>10}  {'noise cpu':>9}"
+    print(header)
+    for w, h in sizes:
+        wall, cpu = benchmark(w, h, frames=args.frames, repeats=args.repeats)
+        line = f"{w:>4}x{h:<4}  {statistics.median(wall):7.3f}  {statistics.median(cpu):7.3f}"
+        if args.noise:
+            wall, cpu = benchmark(w, h, frames=args.frames, repeats=args.repeats,
+                                  noise_std=args.noise)
+            line += f"  {statistics.median(wall):10.3f}  {statistics.median(cpu):9.3f}"
+        print(line, flush=True)
+    return 0
+
+
+def cli():
+    """The console entry point: usage errors as one line and exit status 2."""
+    run_cli(main, sys.argv[1:], prog="camera_bench")
+
+
+if __name__ == "__main__":
+    cli()
