@@ -41,7 +41,16 @@ import numpy as np
 from ..hw.validate import check_int
 from .scene import CameraPose, Scene
 
-__all__ = ["DEFAULT_HFOV", "DEFAULT_MAX_LAYERS", "CameraRenderer", "render"]
+__all__ = [
+    "DEFAULT_HFOV",
+    "DEFAULT_MAX_LAYERS",
+    "VERTICAL_MARGIN",
+    "CameraRenderer",
+    "max_hfov",
+    "max_tilt",
+    "render",
+    "vertical_fov",
+]
 
 #: Horizontal field of view of the published system's camera, radians.
 DEFAULT_HFOV = 1.047
@@ -51,8 +60,8 @@ DEFAULT_MAX_LAYERS = 6
 NEAR = 1e-3
 # Sensor noise is drawn in blocks of about this many values (cache-sized).
 _NOISE_BLOCK = 32768
-# Keep every ray at least this far (radians) from looking straight up or down.
-_VERTICAL_MARGIN = 0.02
+#: Every ray stays at least this far (radians) from looking straight up or down.
+VERTICAL_MARGIN = 0.02
 
 
 @dataclass(frozen=True)
@@ -79,6 +88,27 @@ class _Cylinders:
     band_z0: np.ndarray
     band_z1: np.ndarray
     band_albedo: np.ndarray  # (B, 3)
+
+
+def vertical_fov(width, height, hfov):
+    """The vertical field of view (rad) of a ``width`` x ``height`` image whose horizontal
+    field of view is ``hfov`` (square pixels: ``2 atan((height/2) / f)``)."""
+    focal = (width / 2) / math.tan(hfov / 2)
+    return 2 * math.atan((height / 2) / focal)
+
+
+def max_tilt(width, height, hfov):
+    """The largest ``|tilt|`` (rad) the renderer draws for this image size and ``hfov``: the
+    top and bottom rows stay ``VERTICAL_MARGIN`` away from looking straight up or down.
+    Negative when even a level camera's rows would (``hfov`` too wide for the image's
+    aspect ratio; see ``max_hfov``)."""
+    return math.pi / 2 - VERTICAL_MARGIN - vertical_fov(width, height, hfov) / 2
+
+
+def max_hfov(width, height, tilt=0.0):
+    """The widest ``hfov`` (rad) the renderer draws at this image size with this tilt."""
+    half_vfov = math.pi / 2 - VERTICAL_MARGIN - abs(tilt)
+    return 2 * math.atan((width / height) * math.tan(half_vfov))
 
 
 def _albedo(color, what):
@@ -176,6 +206,15 @@ class CameraRenderer:
         # Continuous row of the optical axis, and the vertical half field of view.
         self._row_axis = self.height / 2 - 0.5
         self._half_vfov = math.atan((self.height / 2) / self.focal)
+        #: The largest ``|pose.tilt|`` this renderer draws (``max_tilt``).
+        self.max_tilt = max_tilt(self.width, self.height, self.hfov)
+        if self.max_tilt < 0:
+            raise ValueError(
+                f"hfov {self.hfov!r} rad at {self.width}x{self.height} gives a vertical field of "
+                f"view of {2 * self._half_vfov:.4f} rad: the top and bottom rows would look "
+                f"straight up or down; at this size hfov must be at most "
+                f"{max_hfov(self.width, self.height):.4f} rad"
+            )
         # Scratch: run starts are counted into a (H+1, W) grid, then summed down the columns.
         # Run ids go up to width * runs per column; int16 sums faster when they fit.
         runs = 2 * self.max_layers + 2
@@ -297,11 +336,11 @@ class CameraRenderer:
                 f"camera height {h} m must be between the floor (0) and the ceiling "
                 f"({ceiling} m)"
             )
-        if abs(tilt) + self._half_vfov > math.pi / 2 - _VERTICAL_MARGIN:
+        if abs(tilt) > self.max_tilt:
             raise ValueError(
-                f"camera tilt {tilt:.3f} rad with a vertical field of view of "
-                f"{2 * self._half_vfov:.3f} rad would look straight up or down; keep "
-                f"|tilt| below {math.pi / 2 - _VERTICAL_MARGIN - self._half_vfov:.3f} rad"
+                f"camera tilt {tilt:.4f} rad with a vertical field of view of "
+                f"{2 * self._half_vfov:.4f} rad would look straight up or down; keep "
+                f"|tilt| <= {self.max_tilt:.4f} rad"
             )
         ambient, intensity, light = _light(scene.lighting)
         walls, cyls = self._geometry(scene)

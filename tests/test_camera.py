@@ -483,6 +483,49 @@ def test_renderer_sizes_must_be_integers(args, match):
     assert CameraRenderer(np.int64(16), np.int32(12)).width == 16  # numpy integers are fine
 
 
+def test_tilt_and_field_of_view_limits_by_hand():
+    from fpga_robotics.sim.camera import VERTICAL_MARGIN, max_hfov, max_tilt, vertical_fov
+
+    # A square image sees as far vertically as horizontally.
+    assert vertical_fov(100, 100, math.pi / 2) == pytest.approx(math.pi / 2)
+    assert max_tilt(100, 100, math.pi / 2) == pytest.approx(math.pi / 4 - VERTICAL_MARGIN)
+    assert max_hfov(100, 100) == pytest.approx(math.pi - 2 * VERTICAL_MARGIN)
+    # 160x120 at the published hfov: f = 80 / tan(0.5235) = 138.6 px, vfov = 2 atan(60 / f).
+    f = 80 / math.tan(1.047 / 2)
+    assert vertical_fov(160, 120, 1.047) == pytest.approx(2 * math.atan(60 / f))
+    assert max_tilt(160, 120, 1.047) == pytest.approx(1.1422, abs=1e-4)
+    # A tilt uses up the vertical room: the widest hfov shrinks accordingly.
+    assert max_tilt(160, 120, max_hfov(160, 120, 0.5)) == pytest.approx(0.5)
+
+
+@pytest.mark.parametrize("w,h,hfov", [(160, 120, 1.047), (32, 24, 2.0), (20, 40, 1.0)])
+def test_the_renderer_draws_exactly_up_to_max_tilt(w, h, hfov):
+    r = CameraRenderer(w, h, hfov)
+    assert r.max_tilt == max_tilt_of(w, h, hfov)
+    for tilt in (r.max_tilt, -r.max_tilt):
+        assert r.render(scene_of(), CameraPose(0, 0, 0, tilt=tilt)).shape == (h, w, 3)
+    beyond = math.nextafter(r.max_tilt, math.inf)
+    with pytest.raises(ValueError, match=r"keep \|tilt\| <= "):
+        r.render(scene_of(), CameraPose(0, 0, 0, tilt=beyond))
+
+
+def max_tilt_of(w, h, hfov):
+    from fpga_robotics.sim.camera import max_tilt
+
+    return max_tilt(w, h, hfov)
+
+
+def test_an_hfov_too_wide_for_the_aspect_ratio_is_refused_at_construction():
+    # A tall image: the vertical field of view is wider than the horizontal one. The old
+    # message asked for |tilt| < -0.019 rad at the first frame.
+    with pytest.raises(ValueError, match=r"at 40x160 gives a vertical field of view of .* "
+                                         r"hfov must be at most 2\.98"):
+        CameraRenderer(40, 160, 3.0)
+    assert CameraRenderer(40, 160, 2.97).max_tilt > 0
+    with pytest.raises(ValueError, match="hfov must be at most 3.11"):
+        CameraRenderer(160, 120, 3.1405)
+
+
 def test_bad_pose_and_scene():
     r = CameraRenderer(32, 24)
     with pytest.raises(ValueError, match="height"):
