@@ -19,6 +19,7 @@ __all__ = [
     "DEFAULT_SKIN",
     "DEFAULT_TROUSERS",
     "DIVIDER_WOOD",
+    "MAX_TIME",
     "WORLD_SECTIONS",
     "FurnitureConfig",
     "LightingConfig",
@@ -32,6 +33,9 @@ __all__ = [
 
 #: The scenario sections that describe the world.
 WORLD_SECTIONS = ("room", "robot", "people", "lighting")
+
+#: The latest time (s) a world description may name (keyframes, start delays): one day.
+MAX_TIME = 86400.0
 
 DEFAULT_SHIRT = (0.85, 0.1, 0.1)
 DEFAULT_TROUSERS = (0.15, 0.15, 0.22)
@@ -236,7 +240,7 @@ def _parse_furniture(item, path, index):
     center = t.point("center", None)
     divider = kind == "divider"
     size = t.raw("size", (1.5, 0.03) if divider else (1.0, 0.6))
-    size = _check_vector(size, t.key("size"), 2, "[length, width] in m", gt=0, le=100)
+    size = _check_vector(size, t.key("size"), 2, "[length, width] in m", ge=0.01, le=100)
     angle = t.number("angle_deg", 0.0, ge=-360, le=360) * DEG
     height = t.number("height", 1.6 if divider else 0.75, gt=0, le=10, unit="m")
     color = t.color("color", DIVIDER_WOOD if divider else _BOX_COLOR)
@@ -284,10 +288,10 @@ def _parse_robot(section, room):
     heading = t.number("heading_deg", 0.0, ge=-360, le=360) * DEG
     fields = {}
     for key, bounds in (
-        ("mass", {"gt": 0, "le": 1000, "unit": "kg"}),
-        ("body_radius", {"gt": 0, "le": 2, "unit": "m"}),
-        ("wheel_radius", {"gt": 0, "le": 1, "unit": "m"}),
-        ("wheel_separation", {"gt": 0, "le": 3, "unit": "m"}),
+        ("mass", {"ge": 0.05, "le": 1000, "unit": "kg"}),
+        ("body_radius", {"ge": 0.02, "le": 2, "unit": "m"}),
+        ("wheel_radius", {"ge": 0.005, "le": 1, "unit": "m"}),
+        ("wheel_separation", {"ge": 0.02, "le": 3, "unit": "m"}),
         ("max_wheel_dps", {"gt": 0, "le": 100000, "unit": "deg/s"}),
         ("wheel_accel_dps2", {"gt": 0, "le": 1e6, "unit": "deg/s^2"}),
         ("traction_force", {"gt": 0, "le": 1e5, "unit": "N"}),
@@ -299,8 +303,13 @@ def _parse_robot(section, room):
         "traction_torque", fields["traction_force"] * fields["wheel_separation"] / 2,
         gt=0, le=1e5, unit="N m")
     fields["camera_tilt"] = t.number("camera_tilt_deg", base.camera_tilt / DEG,
-                                     ge=-90, le=90) * DEG
+                                     ge=-85, le=85) * DEG
     t.finish()
+    if not fields["camera_height"] < room.height:
+        # The renderer draws from between the floor and the ceiling only.
+        raise WorldConfigError(
+            f"robot.camera_height must be below the ceiling (room.height = {room.height:g} m), "
+            f"got {fields['camera_height']:g}")
     spec = base.with_overrides(**fields)
     if not _inside(start, spec.body_radius, room):
         raise WorldConfigError(
@@ -348,8 +357,8 @@ def _parse_person(item, path, index, room):
         pauses = (_check_number(pause, f"{path}.pause", ge=0, le=3600, unit="s"),) * len(
             waypoints)
     loop = t.boolean("loop", True)
-    start_delay = t.number("start_delay", 0.0, ge=0, le=1e5, unit="s")
-    radius = t.number("radius", 0.2, gt=0, le=1, unit="m")
+    start_delay = t.number("start_delay", 0.0, ge=0, le=MAX_TIME, unit="s")
+    radius = t.number("radius", 0.2, ge=0.05, le=1, unit="m")
     height = t.number("height", 1.75, ge=0.5, le=2.5, unit="m")
     shirt = t.color("shirt_color", DEFAULT_SHIRT)
     trousers = t.color("trousers_color", DEFAULT_TROUSERS)
@@ -388,9 +397,11 @@ def _parse_lighting(section):
     ambient = t.number("ambient", 0.6, ge=0, le=2)
     intensity = t.number("intensity", 0.5, ge=0, le=2)
     direction = t.raw("direction", [1.0, 0.5, -1.0])
-    direction = _check_vector(direction, "lighting.direction", 3, "a vector [dx, dy, dz]")
-    if not any(direction):
-        raise WorldConfigError("lighting.direction must not be [0, 0, 0]")
+    direction = _check_vector(direction, "lighting.direction", 3,
+                              "a vector [dx, dy, dz], each -1000..1000", ge=-1000, le=1000)
+    if math.hypot(*direction) < 1e-3:
+        raise WorldConfigError(
+            f"lighting.direction must have a length of at least 0.001, got {_fmt(direction)}")
     raw = t.raw("keyframes", [])
     if not isinstance(raw, list):
         raise WorldConfigError(
@@ -400,7 +411,7 @@ def _parse_lighting(section):
         p = f"lighting.keyframes[{i}]"
         if not isinstance(k, (list, tuple)) or len(k) != 3:
             raise WorldConfigError(f"{p} must be [t, ambient, intensity], got {_show(k)}")
-        frame = (_check_number(k[0], f"{p}[0] (t)", ge=0, unit="s"),
+        frame = (_check_number(k[0], f"{p}[0] (t)", ge=0, le=MAX_TIME, unit="s"),
                  _check_number(k[1], f"{p}[1] (ambient)", ge=0, le=2),
                  _check_number(k[2], f"{p}[2] (intensity)", ge=0, le=2))
         if keyframes and frame[0] < keyframes[-1][0]:
