@@ -40,6 +40,9 @@ TIMING_FIELDS = (
 )
 
 
+_NO_TARGET = "no target person: no distance to compare"
+
+
 def _round(x, digits=4):
     return None if x is None else round(float(x), digits)
 
@@ -115,11 +118,13 @@ def evaluate_checks(checks, m):
         elif name == "mean_distance_max_m":
             v = m["mean_distance_m"]
             ok = v is not None and v <= limit
-            text = f"mean distance {v} m (limit <= {limit} m)"
+            text = (f"mean distance {v} m (limit <= {limit} m)" if v is not None
+                    else f"{_NO_TARGET} (limit <= {limit} m)")
         elif name == "min_distance_min_m":
             v = m["min_distance_m"]
             ok = v is not None and v >= limit
-            text = f"min distance {v} m (limit >= {limit} m)"
+            text = (f"min distance {v} m (limit >= {limit} m)" if v is not None
+                    else f"{_NO_TARGET} (limit >= {limit} m)")
         elif name.startswith("max_") and name.endswith("_collisions"):
             kind = name[len("max_"): -len("_collisions")]
             v = int(m["collisions"].get(kind, 0))
@@ -159,19 +164,27 @@ def verdict(check_results):
 
 def format_summary(s):
     """The human summary printed at the end of a run (several lines)."""
+    rtf = s["realtime_factor"]
     lines = [
         f"scenario {s['scenario']}  backend {s['backend']}  {s['resolution']}  seed {s['seed']}",
         (f"  {s['frames']} frames, {s['sim_time_s']:.1f} s simulated in {s['wall_time_s']:.2f} s"
-        f" ({s['ms_per_frame']:.2f} ms/frame, {s['realtime_factor']:.1f}x real time)"),
+        f" ({s['ms_per_frame']:.2f} ms/frame, "
+        f"{f'{rtf:.1f}x' if rtf is not None else 'n/a'} real time)"),
     ]
     acq = s["acquired_at_s"]
-    lines.append(
-        "  target: "
-        + (f"first found at {acq:.2f} s" if acq is not None else "never found")
-        + f", in view {s['target_in_view_fraction']:.0%}, found {s['found_fraction']:.0%}"
-        + f", {s['searches']} search(es)"
-    )
-    if s["min_distance_m"] is not None:
+    # Without a target person every distance is missing (the trajectory holds NaN).
+    if s["min_distance_m"] is None:
+        lines.append(
+            f"  target: none in the scenario (the design reported found in "
+            f"{s['found_fraction']:.0%} of frames, {s['searches']} search(es))")
+        lines.append(f"  distance: n/a (no target person); path {s['path_length_m']:.1f} m")
+    else:
+        lines.append(
+            "  target: "
+            + (f"first found at {acq:.2f} s" if acq is not None else "never found")
+            + f", in view {s['target_in_view_fraction']:.0%}, found {s['found_fraction']:.0%}"
+            + f", {s['searches']} search(es)"
+        )
         lines.append(
             f"  distance: min {s['min_distance_m']:.2f} m, mean {s['mean_distance_m']:.2f} m; "
             f"path {s['path_length_m']:.1f} m"

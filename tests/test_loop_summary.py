@@ -43,6 +43,35 @@ def test_no_target_at_all():
     assert "never found" in checks[0]["text"]
 
 
+def summary_of(m, checks, **extra):
+    return {"scenario": "x", "backend": "model", "resolution": "160x120", "seed": 0,
+            "frames": 2, "sim_time_s": 0.2, "wall_time_s": 0.01, "ms_per_frame": 5.0,
+            "realtime_factor": 20.0, **m, "checks": checks, "verdict": verdict(checks),
+            **extra}
+
+
+def test_a_run_without_a_target_person_says_so():
+    m = compute_metrics(trajectory([0, 0], [np.nan, np.nan]), [], {"person": 0}, PERIOD)
+    checks = evaluate_checks({"mean_distance_max_m": 3.5, "min_distance_min_m": 0.6}, m)
+    assert [c["passed"] for c in checks] == [False, False]
+    assert [c["value"] for c in checks] == [None, None]
+    for c in checks:
+        assert "None" not in c["text"]
+        assert c["text"].startswith("no target person: no distance to compare")
+    text = format_summary(summary_of(m, checks))
+    assert "None" not in text
+    assert "  target: none in the scenario (the design reported found in 0% of frames" in text
+    assert "  distance: n/a (no target person)" in text
+    assert "[FAIL] mean_distance_max_m: no target person: no distance to compare (limit <= " \
+           "3.5 m)" in text
+
+
+def test_a_run_too_fast_to_time_still_prints():
+    m = compute_metrics(trajectory([1, 1], [1.0, 1.0]), [], {}, PERIOD)
+    text = format_summary(summary_of(m, [], wall_time_s=0.0, realtime_factor=None))
+    assert "0.2 s simulated in 0.00 s (5.00 ms/frame, n/a real time)" in text
+
+
 def events(*items):
     return [(round(t / PERIOD), t, text) for t, text in items]
 
