@@ -14,36 +14,54 @@ A scenario file has two kinds of sections. The world's sections (``room``, ``rob
 - ``[checks]``: the pass criteria of the scenario (see ``fpga_robotics.summary.CHECKS``).
 
 Top-level keys: ``name``, ``description``, ``seed`` (default seed of a run).
+
+Everything is checked when the scenario is loaded, before a run starts: types, the range of
+every number (``LIMITS`` below and docs/scenarios.md), the size of the run (physics steps and
+camera frames) and the camera's geometry as the renderer will draw it.
 """
 
 import copy
 import difflib
 import math
+import re
 import tomllib
 from dataclasses import dataclass, fields
 from importlib import resources
 from pathlib import Path
 
 from .errors import UsageError
-from .hw.params import FollowTargetParams
+from .hw.params import DEFAULT_BASE_DPS, DEFAULT_PROXIMITY_THRESHOLDS, FollowTargetParams
 from .hw.pixel import COLOR_SELECT
-from .sim.world.config import WORLD_SECTIONS
+from .sim.camera import max_hfov, max_tilt, vertical_fov
+from .sim.world.config import MAX_TIME, WORLD_SECTIONS
 from .summary import CHECKS
 
 __all__ = [
+    "LIMITS",
+    "MAX_FILE_BYTES",
+    "MAX_FRAMES",
+    "MAX_NAME_LENGTH",
+    "MAX_PHYSICS_STEPS",
     "WORLD_SECTIONS",
     "CameraConfig",
     "Scenario",
     "ScenarioError",
     "SimConfig",
+    "frame_count",
     "load_scenario",
     "parse_resolution",
     "shipped_scenarios",
 ]
 
 _TOP_KEYS = ("name", "description", "seed")
+_APP_SECTIONS = ("sim", "camera", "color", "design", "checks")
 _DESIGN_KEYS = tuple(f.name for f in fields(FollowTargetParams) if f.init and f.name not in
                      ("width", "height"))
+#: Design parameters that are arrays: their length and what the values are.
+_DESIGN_ARRAYS = {
+    "base_dps": (len(DEFAULT_BASE_DPS), "wheel DPS per proximity level 0..7"),
+    "proximity_thresholds": (len(DEFAULT_PROXIMITY_THRESHOLDS), "pixel counts of levels 1..7"),
+}
 
 #: Defaults of the application's sections (a key absent here is unknown).
 DEFAULTS = {
@@ -59,6 +77,38 @@ DEFAULTS = {
     },
     "color": {"initial": "red", "changes": []},
 }
+
+#: The range of every number of the application's sections: key → (lo, hi, unit). Chosen so
+#: that no sensible run comes near them, while an absurd one fails at once with the limit
+#: instead of computing for hours (docs/scenarios.md, "Limits").
+LIMITS = {
+    "sim.duration": (0.0, MAX_TIME, "s"),  # lo excluded; one day
+    "sim.physics_dt": (1e-5, None, "s"),  # at most one frame period (1 / camera.fps)
+    "sim.actuation_delay": (0.0, 10.0, "s"),
+    "camera.fps": (0.1, 1000.0, "frames/s"),
+    "camera.hfov": (0.01, 3.1, "rad"),  # and narrow enough for the image's aspect ratio
+    "camera.mount_height": (0.0, None, "m"),  # lo excluded; below the ceiling (room.height)
+    "camera.mount_forward": (-2.0, 2.0, "m"),
+    "camera.tilt": (-math.pi / 2, math.pi / 2, "rad"),  # and what the field of view allows
+    "camera.noise_std": (0.0, 64.0, "8-bit levels"),
+    "color.changes.at": (0.0, MAX_TIME, "s"),
+}
+#: Camera and design resolution: the design's limits (``FollowTargetParams``).
+WIDTH_RANGE = (16, 4096)
+HEIGHT_RANGE = (2, 4096)
+#: A run is at most this many physics steps (``sim.duration / sim.physics_dt``) ...
+MAX_PHYSICS_STEPS = 10**8
+#: ... and this many camera frames (``sim.duration * camera.fps``; about 150 bytes each of
+#: trajectory in memory).
+MAX_FRAMES = 10**7
+#: Seeds are integers 0..2**63-1.
+MAX_SEED = 2**63 - 1
+#: A scenario's name is a file name (``runs/<name>.rrd``): ASCII letters, digits, ``_ - .``,
+#: not starting with ``.`` or ``-``, at most this long.
+MAX_NAME_LENGTH = 64
+_NAME = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.-]*")
+#: A scenario file is at most this large (a few kB is usual).
+MAX_FILE_BYTES = 1 << 20
 
 
 class ScenarioError(UsageError):
@@ -77,12 +127,28 @@ def parse_resolution(text):
             w = h = None
     else:
         w = h = None
+    if isinstance(w, bool) or isinstance(h, bool):
+        w = h = None
     if not (isinstance(w, int) and isinstance(h, int) and w > 0 and h > 0):
         raise ScenarioError(
             f"resolution must look like WIDTHxHEIGHT, e.g. 160x120, 320x240 or 640x480; "
             f"got {text!r}"
         )
     return w, h
+
+
+def frame_count(duration, physics_dt, fps):
+    """Camera frames of a run, as the closed loop takes them: physics runs
+    ``max(1, round(duration / physics_dt))`` steps and frame ``k`` is captured at step
+    ``round(k / fps / physics_dt)``, for every ``k`` whose step comes before the end.
+    (``physics_dt`` is at most a frame period.)"""
+    total = max(1, round(duration / physics_dt))
+    ratio = (1.0 / fps) / physics_dt
+    # Every k below (total - 0.5) / ratio is captured; start just under that and count on.
+    n = max(0, math.floor((total - 1) / ratio) - 1)
+    while round(n * (1.0 / fps) / physics_dt) < total:
+        n += 1
+    return n
 
 
 @dataclass(frozen=True)
@@ -106,6 +172,11 @@ class SimConfig:
     duration: float
     physics_dt: float
     actuation_delay: float
+
+    @property
+    def physics_steps(self):
+        """Physics steps of the run, ``max(1, round(duration / physics_dt))``."""
+        return max(1, round(self.duration / self.physics_dt))
 
 
 @dataclass(frozen=True, eq=False)
@@ -147,6 +218,11 @@ class Scenario:
     checks: dict
     overrides: tuple = ()
 
+    @property
+    def frames(self):
+        """Camera frames of a run (``frame_count``)."""
+        return frame_count(self.sim.duration, self.sim.physics_dt, self.camera.fps)
+
     def color_at(self, t):
         """The colour select in force at simulated time ``t``."""
         color = self.color_initial
@@ -158,8 +234,9 @@ class Scenario:
     def with_overrides(self, overrides):
         """A new scenario: this one's data with more ``KEY=VALUE`` overrides applied."""
         data = copy.deepcopy(self.data)
+        overrides = tuple(overrides)
         _apply_overrides(data, overrides)
-        return _build(data, self.source, tuple(self.overrides) + tuple(overrides))
+        return _finish(data, self.source, tuple(self.overrides) + overrides)
 
 
 # Loading ------------------------------------------------------------------------------------
@@ -184,10 +261,21 @@ def shipped_scenarios():
 
 def _resolve(name_or_path):
     text = str(name_or_path)
+    path = Path(text)
     looks_like_path = text.endswith(".toml") or "/" in text or "\\" in text
-    if looks_like_path or Path(text).is_file():
-        path = Path(text)
-        if not path.is_file():
+    if looks_like_path or path.exists():
+        if path.is_dir():
+            raise ScenarioError(f"scenario {text!r} is a folder; give a .toml file in it or the "
+                                f"name of a shipped scenario")
+        if path.exists() and not path.is_file():
+            raise ScenarioError(f"scenario file {text!r} is not a regular file (a device or "
+                                f"pipe); give a .toml file")
+        if not path.exists():
+            shipped = shipped_scenarios()
+            if path.suffix == ".toml" and path.name == text and path.stem in shipped:
+                raise ScenarioError(
+                    f"scenario file {text!r} does not exist here; for the shipped scenario "
+                    f"give its name: --scenario {path.stem}")
             raise ScenarioError(f"scenario file {text!r} does not exist")
         return path
     shipped = shipped_scenarios()
@@ -201,6 +289,12 @@ def _resolve(name_or_path):
     )
 
 
+def _default_name(path):
+    """The file's stem, made a safe file name (other characters become ``_``)."""
+    name = re.sub(r"[^A-Za-z0-9_.-]", "_", path.stem).lstrip(".-")[:MAX_NAME_LENGTH]
+    return name or "scenario"
+
+
 def load_scenario(name_or_path, overrides=()):
     """Load a shipped scenario by name, or a TOML file by path, and apply overrides.
 
@@ -210,46 +304,64 @@ def load_scenario(name_or_path, overrides=()):
         A shipped scenario's name (``follow_person``) or a ``.toml`` path.
     overrides : list of str
         ``"dotted.key=value"`` items; the value is parsed as TOML (bare words are strings).
+        Array items are chosen by index, ``people.0.speed`` or ``people[0].speed``.
 
     Raises
     ------
     ScenarioError
         With one line that says what is wrong (unknown name, malformed TOML with its line,
-        unknown key with close matches, invalid value).
+        unknown key with close matches, invalid value, a run too large).
     """
     path = _resolve(name_or_path)
     try:
+        size = path.stat().st_size
+        if size > MAX_FILE_BYTES:
+            raise ScenarioError(f"scenario file {str(path)!r} is {size} bytes; a scenario is at "
+                                f"most {MAX_FILE_BYTES} bytes")
         data = tomllib.loads(path.read_text())
     except tomllib.TOMLDecodeError as exc:
         raise ScenarioError(f"{path}: malformed TOML: {exc}") from None
     except (OSError, UnicodeDecodeError) as exc:
         raise ScenarioError(f"cannot read scenario file {path}: {exc}") from None
-    data.setdefault("name", path.stem)
-    _check_known_keys(data, path)
+    _check_sections(data, path)
+    if "name" not in data:
+        data["name"] = _default_name(path)
     _fill_defaults(data)
     overrides = tuple(overrides or ())
     _apply_overrides(data, overrides)
-    return _build(data, str(path), overrides)
+    return _finish(data, str(path), overrides)
 
 
-def _check_known_keys(data, path):
-    known = set(_TOP_KEYS) | set(WORLD_SECTIONS) | set(DEFAULTS) | {"design", "checks"}
+def _finish(data, source, overrides):
+    # An override may have replaced a whole table: check the sections again, then fill in
+    # the keys it left out with their defaults (as a file that gives the table would).
+    _check_sections(data, None)
+    _fill_defaults(data)
+    return _build(data, source, overrides)
+
+
+def _check_sections(data, path):
+    where = f"{path}: " if path is not None else ""
+    known = set(_TOP_KEYS) | set(WORLD_SECTIONS) | set(_APP_SECTIONS)
     for key in data:
         if key not in known:
-            raise ScenarioError(f"{path}: unknown top-level key {key!r}{_close(key, known)}")
-    for section, allowed in (*((s, DEFAULTS[s]) for s in DEFAULTS), ("design", _DESIGN_KEYS),
-                             ("checks", CHECKS)):
+            raise ScenarioError(f"{where}unknown top-level key {key!r}{_close(key, known)}")
+    allowed_keys = {**DEFAULTS, "design": _DESIGN_KEYS, "checks": CHECKS}
+    for section in _APP_SECTIONS:
         value = data.get(section, {})
         if not isinstance(value, dict):
-            raise ScenarioError(f"{path}: [{section}] must be a table")
+            raise ScenarioError(
+                f"{where}{section} must be a table ([{section}] in a file, --set "
+                f"{section}.KEY=VALUE on the command line), got {value!r}")
+        allowed = allowed_keys[section]
         for key in value:
             if key not in allowed:
                 if section == "design" and key in ("width", "height"):
                     raise ScenarioError(
-                        f"{path}: design.{key} comes from camera.resolution; set that instead"
+                        f"{where}design.{key} comes from camera.resolution; set that instead"
                     )
                 raise ScenarioError(
-                    f"{path}: unknown key {section}.{key}{_close(key, allowed, section)}"
+                    f"{where}unknown key {section}.{key}{_close(key, allowed, section)}"
                 )
 
 
@@ -313,10 +425,11 @@ def _apply_overrides(data, overrides):
         key, text = item.split("=", 1)
         key = key.strip()
         value = _parse_value(text)
-        _set_path(data, key, value)
+        # people[0].speed, as the world's messages write it, is people.0.speed.
+        _set_path(data, re.sub(r"\[(\d+)\]", r".\1", key), value, key)
 
 
-def _set_path(data, key, value):
+def _set_path(data, key, value, shown):
     parts = key.split(".")
     node = data
     for i, part in enumerate(parts):
@@ -325,30 +438,30 @@ def _set_path(data, key, value):
         if isinstance(node, list):
             if not part.isdigit() or int(part) >= len(node):
                 raise ScenarioError(
-                    f"unknown key {key!r}: {'.'.join(parts[:i])} is a list of {len(node)} "
+                    f"unknown key {shown!r}: {'.'.join(parts[:i])} is a list of {len(node)} "
                     f"item(s), index it with 0..{len(node) - 1}"
                 )
             part = int(part)
             if last:
-                node[part] = _coerce(node[part], value, key)
+                node[part] = _coerce(node[part], value)
                 return
             node = node[part]
             continue
         if not isinstance(node, dict):
-            raise ScenarioError(f"unknown key {key!r}: {'.'.join(parts[:i])} is not a table")
+            raise ScenarioError(f"unknown key {shown!r}: {'.'.join(parts[:i])} is not a table")
         # Inside the world's sections any key may be set: the world validates the result
         # (with close matches) when the scenario is built.
         in_world = parts[0] in WORLD_SECTIONS
-        if i == 0 and in_world and part not in data and parts[0] != "people":
+        if i == 0 and in_world and part not in data and parts[0] != "people" and not last:
             node[part] = {}
         optional = _optional_keys(parts[:i])
         if part not in node and part not in optional and not (in_world and last):
             if parts[:i] == ["design"] and part in ("width", "height"):
                 raise ScenarioError(f"design.{part} comes from camera.resolution; "
                                     f"set camera.resolution=WxH (or --resolution) instead")
-            raise ScenarioError(_unknown_key_message(data, key, here))
+            raise ScenarioError(_unknown_key_message(data, key, here, shown))
         if last:
-            node[part] = _coerce(node.get(part), value, key)
+            node[part] = _coerce(node.get(part), value)
             return
         node = node[part]
 
@@ -365,7 +478,7 @@ def _optional_keys(parents):
     return tuple(DEFAULTS.get(section, ()))
 
 
-def _unknown_key_message(data, key, here):
+def _unknown_key_message(data, key, here, shown):
     depth = key.count(".")
     paths = [p for p in _known_paths(data) if p.count(".") == depth]
     close = difflib.get_close_matches(key, paths, n=4, cutoff=0.6)
@@ -374,10 +487,10 @@ def _unknown_key_message(data, key, here):
         parent = here.rsplit(".", 1)[0] if "." in here else ""
         close = [p for p in paths if parent and p.startswith(parent + ".")][:10]
     hint = f"; close matches: {', '.join(close)}" if close else ""
-    return f"unknown scenario key {key!r}{hint}"
+    return f"unknown scenario key {shown!r}{hint}"
 
 
-def _coerce(old, value, key):
+def _coerce(old, value):
     # An int where the scenario had a float is a float (``--set sim.duration=10``).
     if isinstance(old, float) and isinstance(value, int) and not isinstance(value, bool):
         return float(value)
@@ -387,26 +500,41 @@ def _coerce(old, value, key):
 # Validation ---------------------------------------------------------------------------------
 
 
-def _number(data, section, key, *, lo=None, hi=None, lo_open=False, integer=False):
-    value = data[section][key]
-    name = f"{section}.{key}"
-    ok_type = int if integer else (int, float)
-    if isinstance(value, bool) or not isinstance(value, ok_type):
-        kind = "an integer" if integer else "a number"
-        raise ScenarioError(f"{name} must be {kind}, got {value!r}")
-    if isinstance(value, float) and not math.isfinite(value):
-        raise ScenarioError(f"{name} must be finite, got {value!r}")
+def _is_int(value):
+    return isinstance(value, int) and not isinstance(value, bool)
+
+
+def _is_number(value):
+    return isinstance(value, (int, float)) and not isinstance(value, bool)
+
+
+def _in_range(value, name, lo, hi, unit, *, lo_open=False, note=""):
+    """``value`` as a float if it is a finite number in ``lo..hi`` (``None``: no bound)."""
+    unit = f" {unit}" if unit else ""
+    if not (_is_number(value) and math.isfinite(value)):
+        bounds = [f"{'>' if lo_open else '>='} {lo:g}"] if lo is not None else []
+        bounds += [f"<= {hi:g}"] if hi is not None else []
+        raise ScenarioError(f"{name} must be a finite number{unit}"
+                            f"{' ' + ' and '.join(bounds) if bounds else ''}, got {value!r}")
     if lo is not None and (value <= lo if lo_open else value < lo):
-        raise ScenarioError(f"{name} must be {'>' if lo_open else '>='} {lo}, got {value!r}")
+        raise ScenarioError(f"{name} must be {'>' if lo_open else '>='} {lo:g}{unit}{note}, "
+                            f"got {value!r}")
     if hi is not None and value > hi:
-        raise ScenarioError(f"{name} must be <= {hi}, got {value!r}")
-    return value
+        raise ScenarioError(f"{name} must be <= {hi:g}{unit}{note}, got {value!r}")
+    return float(value)
 
 
-def _optional(data, section, key, **limits):
-    if data[section].get(key) is None:
+def _limited(data, name, *, optional=False, hi=None, note=""):
+    """The value of ``section.key`` checked against ``LIMITS`` (``hi`` overrides its upper
+    bound); ``None`` for an optional key that is not given."""
+    section, key = name.split(".")
+    value = data[section].get(key)
+    if optional and value is None:
         return None
-    return float(_number(data, section, key, **limits))
+    lo, limit_hi, unit = LIMITS[name]
+    lo_open = name in ("sim.duration", "camera.mount_height")
+    return _in_range(value, name, lo, limit_hi if hi is None else hi, unit, lo_open=lo_open,
+                     note=note)
 
 
 def _color(value, where):
@@ -415,89 +543,189 @@ def _color(value, where):
     return value.lower()
 
 
+def _floor(x, digits):
+    """``x`` rounded down to ``digits`` decimals: a printed limit a user can type."""
+    scale = 10**digits
+    return math.floor(x * scale) / scale
+
+
 def _check_world(world):
-    """Validate the world's sections now, so that a bad value is reported at load time."""
+    """Validate the world's sections now, so that a bad value is reported at load time;
+    returns the parsed ``WorldConfig``."""
     from .sim.world import World, WorldConfigError
 
     try:
         # Building it also finds placement errors (a robot starting inside a person).
-        World.from_config(copy.deepcopy(world), 0)
+        return World.from_config(copy.deepcopy(world), 0).config
     except WorldConfigError as exc:
         raise ScenarioError(str(exc)) from None
 
 
-def _build(data, source, overrides):
-    name = data.get("name")
-    if not isinstance(name, str) or not name:
-        raise ScenarioError("name must be a non-empty string")
-    seed = data.get("seed", 0)
-    if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
-        raise ScenarioError(f"seed must be an integer >= 0, got {seed!r}")
-    for section in WORLD_SECTIONS:
-        if section in data and not isinstance(data[section], (dict, list)):
-            raise ScenarioError(f"[{section}] must be a table")
+def _check_name(name):
+    if not isinstance(name, str):
+        raise ScenarioError(f"name must be a string, got {name!r}")
+    if not (len(name) <= MAX_NAME_LENGTH and _NAME.fullmatch(name)):
+        raise ScenarioError(
+            f"name {name!r} cannot be a file name (a recording is saved as runs/<name>.rrd): "
+            f"use at most {MAX_NAME_LENGTH} ASCII letters, digits, '_', '-' and '.', "
+            f"starting with a letter, a digit or '_'")
+    return name
 
-    width, height = parse_resolution(data["camera"]["resolution"])
-    camera = CameraConfig(
+
+def _camera(data):
+    cam = data["camera"]
+    width, height = parse_resolution(cam["resolution"])
+    if not (WIDTH_RANGE[0] <= width <= WIDTH_RANGE[1]
+            and HEIGHT_RANGE[0] <= height <= HEIGHT_RANGE[1]):
+        raise ScenarioError(
+            f"camera.resolution {width}x{height}: the width must be {WIDTH_RANGE[0]}.."
+            f"{WIDTH_RANGE[1]} and the height {HEIGHT_RANGE[0]}..{HEIGHT_RANGE[1]} pixels "
+            f"(the design's limits)")
+    return CameraConfig(
         width=width,
         height=height,
-        fps=float(_number(data, "camera", "fps", lo=0, lo_open=True, hi=1000)),
-        hfov=float(_number(data, "camera", "hfov", lo=0, lo_open=True, hi=math.pi - 1e-3)),
-        mount_height=_optional(data, "camera", "mount_height", lo=0, lo_open=True),
-        mount_forward=_optional(data, "camera", "mount_forward"),
-        tilt=_optional(data, "camera", "tilt", lo=-math.pi / 2, hi=math.pi / 2),
-        noise_std=float(_number(data, "camera", "noise_std", lo=0)),
+        fps=_limited(data, "camera.fps"),
+        hfov=_limited(data, "camera.hfov"),
+        mount_height=_limited(data, "camera.mount_height", optional=True),
+        mount_forward=_limited(data, "camera.mount_forward", optional=True),
+        tilt=_limited(data, "camera.tilt", optional=True),
+        noise_std=_limited(data, "camera.noise_std"),
     )
-    duration = float(_number(data, "sim", "duration", lo=0, lo_open=True))
-    dt = float(_number(data, "sim", "physics_dt", lo=0, lo_open=True, hi=camera.frame_period))
-    if "actuation_delay" in data["sim"]:
-        delay = float(_number(data, "sim", "actuation_delay", lo=0, hi=10.0))
-    else:
-        delay = camera.frame_period
-    sim = SimConfig(duration=duration, physics_dt=dt, actuation_delay=delay)
 
+
+def _check_camera_geometry(camera, world):
+    """The mount and the field of view the renderer will be asked to draw: between floor and
+    ceiling, and no ray looking straight up or down (``sim.camera.max_tilt``)."""
+    ceiling = world.room.height
+    if camera.mount_height is not None and not camera.mount_height < ceiling:
+        raise ScenarioError(f"camera.mount_height must be below the ceiling (room.height = "
+                            f"{ceiling:g} m), got {camera.mount_height:g}")
+    w, h, hfov = camera.width, camera.height, camera.hfov
+    vfov = vertical_fov(w, h, hfov)
+    limit = max_tilt(w, h, hfov)
+    if limit < 0:
+        raise ScenarioError(
+            f"camera.hfov must be at most {_floor(max_hfov(w, h), 4)} rad at camera.resolution "
+            f"{w}x{h}, got {hfov:g} (a vertical field of view of {vfov:.3f} rad: the top and "
+            f"bottom rows would look straight up or down)")
+    if camera.tilt is not None:
+        tilt, key, shown, unit = camera.tilt, "camera.tilt", _floor(limit, 4), "rad"
+    else:
+        tilt, key, unit = world.robot.spec.camera_tilt, "robot.camera_tilt_deg", "deg"
+        shown = _floor(math.degrees(limit), 2)
+    if abs(tilt) > limit:
+        got = tilt if unit == "rad" else math.degrees(tilt)
+        raise ScenarioError(
+            f"|{key}| must be at most {shown} {unit} with camera.hfov {hfov:g} rad at "
+            f"{w}x{h} (vertical field of view {vfov:.3f} rad; beyond it rows would look "
+            f"straight up or down), got {got:g}")
+
+
+def _sim(data, camera):
+    sim = data["sim"]
+    duration = _limited(data, "sim.duration", note=" (one day)")
+    period = camera.frame_period
+    dt = _limited(data, "sim.physics_dt", hi=period,
+                  note=" (one camera frame period, 1 / camera.fps)")
+    if sim.get("actuation_delay") is not None:
+        delay = _limited(data, "sim.actuation_delay")
+    else:
+        delay = period
+    config = SimConfig(duration=duration, physics_dt=dt, actuation_delay=delay)
+    steps = config.physics_steps
+    if steps > MAX_PHYSICS_STEPS:
+        raise ScenarioError(
+            f"sim.duration {duration:g} s / sim.physics_dt {dt:g} s = {steps} physics steps; "
+            f"the limit is {MAX_PHYSICS_STEPS}: shorten sim.duration or lengthen "
+            f"sim.physics_dt")
+    frames = frame_count(duration, dt, camera.fps)
+    if frames > MAX_FRAMES:
+        raise ScenarioError(
+            f"sim.duration {duration:g} s at camera.fps {camera.fps:g} = {frames} camera "
+            f"frames; the limit is {MAX_FRAMES}: shorten sim.duration or lower camera.fps")
+    return config
+
+
+def _color_changes(data):
     color = data["color"]
     initial = _color(color["initial"], "color.initial")
     changes = color["changes"]
     if not isinstance(changes, list):
         raise ScenarioError("color.changes must be a list of {at = seconds, color = \"...\"}")
+    lo, hi, unit = LIMITS["color.changes.at"]
     parsed = []
     for i, change in enumerate(changes):
-        where = f"color.changes.{i}"
+        where = f"color.changes[{i}]"
         if not isinstance(change, dict) or set(change) != {"at", "color"}:
             raise ScenarioError(f"{where} must be {{at = seconds, color = \"name\"}}, got "
                                 f"{change!r}")
         at = change["at"]
-        if isinstance(at, bool) or not isinstance(at, (int, float)) or at < 0:
-            raise ScenarioError(f"{where}.at must be a time >= 0 in seconds, got {at!r}")
+        if not (_is_number(at) and math.isfinite(at) and lo <= at <= hi):
+            raise ScenarioError(f"{where}.at must be a time in {lo:g}..{hi:g} {unit}, got {at!r}")
         parsed.append((float(at), _color(change["color"], f"{where}.color")))
     if [a for a, _ in parsed] != sorted(a for a, _ in parsed):
         raise ScenarioError("color.changes must be in time order")
+    return initial, tuple(parsed)
 
+
+def _design(data, width, height):
+    design = data["design"]
+    for key, value in design.items():
+        if key in _DESIGN_ARRAYS:
+            n, what = _DESIGN_ARRAYS[key]
+            if not (isinstance(value, list) and len(value) == n and all(map(_is_int, value))):
+                raise ScenarioError(
+                    f"design.{key} must be an array of {n} integers ({what}), got {value!r}")
+        elif not _is_int(value):
+            raise ScenarioError(f"design.{key} must be an integer, got {value!r}")
     try:
-        params = FollowTargetParams(width=width, height=height, **data["design"])
+        return FollowTargetParams(width=width, height=height, **design)
     except (TypeError, ValueError) as exc:
-        raise ScenarioError(f"invalid design parameters (with resolution {width}x{height}): "
-                            f"{exc}") from None
+        message = str(exc)
+        field = re.match(r"\w+", message)
+        if field and field.group() in design:  # "kp_shift must be <= 15, got 99"
+            raise ScenarioError(f"design.{message}") from None
+        raise ScenarioError(f"invalid design parameters with camera.resolution "
+                            f"{width}x{height}: {message}") from None
 
+
+def _checks(data):
     checks = dict(data["checks"])
     for key, limit in checks.items():
-        kind = CHECKS[key][0]
-        if kind is bool:
-            ok = isinstance(limit, bool)
-        else:
-            ok = not isinstance(limit, bool) and isinstance(limit, (int, float)) and limit >= 0
-        if not ok:
-            raise ScenarioError(
-                f"checks.{key} must be {'true or false' if kind is bool else 'a number >= 0'}, "
-                f"got {limit!r}"
-            )
+        kind, (lo, hi, unit), _meaning = CHECKS[key]
+        name = f"checks.{key}"
+        if kind is int:
+            if not (_is_int(limit) and lo <= limit <= hi):
+                raise ScenarioError(f"{name} must be an integer in {lo}..{hi}, got {limit!r}")
+        elif not (_is_number(limit) and math.isfinite(limit) and lo <= limit <= hi):
+            unit = f" {unit}" if unit else ""
+            raise ScenarioError(f"{name} must be a number in {lo:g}..{hi:g}{unit}, "
+                                f"got {limit!r}")
+    return checks
 
+
+def _build(data, source, overrides):
+    name = _check_name(data.get("name"))
+    description = data.get("description", "")
+    if not isinstance(description, str):
+        raise ScenarioError(f"description must be a string, got {description!r}")
+    seed = data.get("seed", 0)
+    if not (_is_int(seed) and 0 <= seed <= MAX_SEED):
+        raise ScenarioError(f"seed must be an integer in 0..{MAX_SEED}, got {seed!r}")
+    for section in WORLD_SECTIONS:
+        if section in data and not isinstance(data[section], (dict, list)):
+            raise ScenarioError(f"[{section}] must be a table")
+
+    camera = _camera(data)
+    sim = _sim(data, camera)
+    initial, changes = _color_changes(data)
+    params = _design(data, camera.width, camera.height)
+    checks = _checks(data)
     world = {s: copy.deepcopy(data[s]) for s in WORLD_SECTIONS if s in data}
-    _check_world(world)
+    _check_camera_geometry(camera, _check_world(world))
     return Scenario(
         name=name,
-        description=str(data.get("description", "")),
+        description=description,
         source=source,
         seed=seed,
         data=data,
@@ -505,7 +733,7 @@ def _build(data, source, overrides):
         camera=camera,
         sim=sim,
         color_initial=initial,
-        color_changes=tuple(parsed),
+        color_changes=changes,
         params=params,
         checks=checks,
         overrides=tuple(overrides),

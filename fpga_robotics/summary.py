@@ -8,6 +8,8 @@ itself. ``format_summary`` is the human version printed by the runner.
 
 import numpy as np
 
+from .sim.world.config import MAX_TIME
+
 __all__ = [
     "CHECKS",
     "TIMING_FIELDS",
@@ -17,18 +19,27 @@ __all__ = [
     "verdict",
 ]
 
-#: Pass criteria a scenario may state in its ``[checks]`` table: name → (type, meaning).
+_DAY = MAX_TIME  # s
+#: Pass criteria a scenario may state in its ``[checks]`` table:
+#: name → (type, (lowest, highest, unit) limit allowed, meaning).
 CHECKS = {
-    "acquired_within_s": (float, "the design reports the target found within this time"),
-    "mean_distance_max_m": (float, "mean robot-to-target distance (centres) at most this"),
-    "min_distance_min_m": (float, "closest robot-to-target distance (centres) at least this"),
-    "max_person_collisions": (int, "at most this many collisions with a person"),
-    "max_wall_collisions": (int, "at most this many collisions with a wall"),
-    "max_furniture_collisions": (int, "at most this many collisions with furniture"),
-    "target_in_view_min_fraction": (float, "the target is in the camera's view this often"),
-    "found_min_fraction": (float, "after first acquisition, the design reports found this often"),
+    "acquired_within_s": (float, (0, _DAY, "s"),
+                          "the design reports the target found within this time"),
+    "mean_distance_max_m": (float, (0, 1000, "m"),
+                            "mean robot-to-target distance (centres) at most this"),
+    "min_distance_min_m": (float, (0, 1000, "m"),
+                           "closest robot-to-target distance (centres) at least this"),
+    "max_person_collisions": (int, (0, 10**6, ""), "at most this many collisions with a person"),
+    "max_wall_collisions": (int, (0, 10**6, ""), "at most this many collisions with a wall"),
+    "max_furniture_collisions": (int, (0, 10**6, ""),
+                                 "at most this many collisions with furniture"),
+    "target_in_view_min_fraction": (float, (0, 1, ""),
+                                    "the target is in the camera's view this often"),
+    "found_min_fraction": (float, (0, 1, ""),
+                           "after first acquisition, the design reports found this often"),
     "reacquired_within_s": (
         float,
+        (0, _DAY, "s"),
         ("the design lost the target and searched at least once, and every loss ended with the "
         "target found again within this time"),
     ),

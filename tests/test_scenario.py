@@ -134,7 +134,8 @@ def test_unknown_keys_are_errors_with_close_matches(item, expect):
     ("camera.resolution=abc", "WIDTHxHEIGHT"),
     ("color.initial=purple", "color.initial must be one of"),
     ("design.kp_num=1.5", "kp_num must be an int"),
-    ("checks.max_person_collisions=-1", ">= 0"),
+    ("checks.max_person_collisions=-1",
+     "checks.max_person_collisions must be an integer in 0..1000000, got -1"),
     ("robot.mass=-1", "robot.mass"),
 ])
 def test_bad_values_are_clear_errors(item, fragment):
@@ -199,3 +200,188 @@ def test_a_world_section_the_file_lacks_can_be_set():
     assert s.world["lighting"] == {"ambient": 0.3}
     with pytest.raises(ScenarioError, match="did you mean 'ambient'"):
         load_scenario("follow_person", ["lighting.ambiant=0.3"])
+
+
+# -- limits, names, types and the camera's geometry (issue 11) --------------------------------
+
+
+def loop_frame_count(duration, dt, fps):
+    """The closed loop's own count (fpga_robotics.loop): one frame at a time."""
+    total_steps = max(1, round(duration / dt))
+    period = 1.0 / fps
+    n = 0
+    while round(n * period / dt) < total_steps:
+        n += 1
+    return n
+
+
+@pytest.mark.parametrize("duration,dt,fps", [
+    (30.0, 1 / 240, 30.0), (3.0, 1 / 240, 30.0), (1e-3, 1 / 240, 30.0), (10.0, 0.01, 30.0),
+    (10.0, 0.004, 25.0), (7.3, 0.001, 1000.0), (5.0, 0.02, 7.0), (2.0, 0.3, 3.0),
+    (1.0, 1e-5, 0.1), (100.0, 1 / 240, 29.97), (0.05, 0.01, 100.0),
+])
+def test_frame_count_is_the_loops_count_without_counting(duration, dt, fps):
+    from fpga_robotics.scenario import frame_count
+
+    assert frame_count(duration, dt, fps) == loop_frame_count(duration, dt, fps)
+
+
+def test_a_scenario_knows_its_steps_and_frames():
+    s = load_scenario("follow_person", ["sim.duration=10"])
+    assert s.sim.physics_steps == 2400 and s.frames == 300
+
+
+def test_the_largest_runs_allowed_load():
+    # A day at the default rates (20.7 million steps, 2.6 million frames).
+    s = load_scenario("follow_person", ["sim.duration=86400"])
+    assert s.sim.physics_steps == 86400 * 240 and s.frames == 86400 * 30
+    # The finest physics step for a second; 1000 fps with a step per frame.
+    assert load_scenario("follow_person", ["sim.duration=1", "sim.physics_dt=1e-5"])
+    s = load_scenario("follow_person", ["sim.duration=10000", "camera.fps=1000",
+                                        "sim.physics_dt=0.001"])
+    assert s.frames == 10**7
+    # The design's largest and smallest resolutions (width - 2 * margin_x divisible by 8).
+    assert load_scenario("follow_person", ['camera.resolution="4000x4096"']).params.width == 4000
+    s = load_scenario("follow_person", ['camera.resolution="16x2"', "design.margin_x=0"])
+    assert (s.params.width, s.params.height) == (16, 2)
+
+
+@pytest.mark.parametrize("width,height", [(15, 120), (4097, 120), (160, 1), (160, 4097)])
+def test_resolution_limits_are_the_designs(width, height):
+    from fpga_robotics.hw.params import FollowTargetParams
+
+    with pytest.raises(ScenarioError, match=r"width must be 16\.\.4096 and the height 2\.\.4096"):
+        load_scenario("follow_person", [f'camera.resolution="{width}x{height}"'])
+    with pytest.raises(ValueError):
+        FollowTargetParams(width=width, height=height)
+
+
+def test_a_file_name_that_is_no_scenario_name_is_made_one(tmp_path):
+    assert load_scenario(write(tmp_path, "", "my room (v2).toml")).name == "my_room__v2_"
+    assert load_scenario(write(tmp_path, "", ".hidden.toml")).name == "hidden"
+    assert load_scenario(write(tmp_path, "", "a" * 80 + ".toml")).name == "a" * 64
+
+
+def test_names_that_are_safe_file_names_are_accepted():
+    for name in ("x", "a" * 64, "run-2.v1", "_tmp"):
+        assert load_scenario("follow_person", [f'name="{name}"']).name == name
+    for name in ("a/b", "..", ".x", "-x", "a b", "a" * 65, "caf\u00e9", "a\\b", ""):
+        with pytest.raises(ScenarioError, match="cannot be a file name"):
+            load_scenario("follow_person", [f'name="{name}"'])
+
+
+def test_array_items_can_be_set_as_the_world_names_them():
+    s = load_scenario("follow_person", ["people[0].shirt_color=[0.1, 0.8, 0.1]",
+                                        "people[0].waypoints[1]=[5.0, 4.0]"])
+    person = s.world["people"][0]
+    assert person["shirt_color"] == [0.1, 0.8, 0.1]
+    assert person["waypoints"][1] == [5.0, 4.0]
+    assert s.overrides[0] == "people[0].shirt_color=[0.1, 0.8, 0.1]"
+    with pytest.raises(ScenarioError, match=r"unknown key 'people\[2\].speed': people is a list"):
+        load_scenario("follow_person", ["people[2].speed=1"])
+
+
+def test_a_whole_table_can_be_set_and_its_other_keys_take_their_defaults():
+    s = load_scenario("follow_person", ["camera={fps = 15.0}"])
+    assert s.camera.fps == 15.0
+    assert s.camera.noise_std == 0.0  # the default, not the file's 2.0
+    assert (s.camera.width, s.camera.height, s.camera.hfov) == (160, 120, 1.047)
+    with pytest.raises(ScenarioError, match=r"unknown key camera\.fsp"):
+        load_scenario("follow_person", ["camera={fsp = 15.0}"])
+
+
+@pytest.mark.parametrize("item,message", [
+    ("design.base_dps=fast", ("design.base_dps must be an array of 8 integers (wheel DPS per "
+                             "proximity level 0..7), got 'fast'")),
+    ("design.base_dps=[0, 1, 2, 3, 4, 5, 6, 7.5]", "design.base_dps must be an array of 8"),
+    ("design.proximity_thresholds=5", ("design.proximity_thresholds must be an array of 7 "
+                                      "integers (pixel counts of levels 1..7), got 5")),
+    ("design.proximity_thresholds=[7, 6, 5, 4, 3, 2, 1]",
+     "design.proximity_thresholds must be non-decreasing"),
+    ("design.lost_frames=0", "design.lost_frames must be >= 1, got 0"),
+    ("design.margin_x=100", "design.margin_x=100 leaves no window in a frame 160 wide"),
+    ('camera.resolution="4096x4096"', ("invalid design parameters with camera.resolution "
+                                      "4096x4096: the window width")),
+    ("design=1", "design must be a table"),
+])
+def test_design_values_are_checked_with_their_key(item, message):
+    with pytest.raises(ScenarioError) as info:
+        load_scenario("follow_person", [item])
+    assert message in str(info.value)
+
+
+def renderer_accepts(width, height, hfov, tilt):
+    from fpga_robotics.sim.camera import CameraRenderer
+    from fpga_robotics.sim.scene import CameraPose, Scene
+
+    try:
+        CameraRenderer(width, height, hfov).render(Scene(), CameraPose(0, 0, 0, tilt=tilt))
+    except ValueError:
+        return False
+    return True
+
+
+def scenario_accepts(width, height, hfov, tilt):
+    try:
+        load_scenario("follow_person", [f'camera.resolution="{width}x{height}"',
+                                        f"camera.hfov={hfov!r}", f"camera.tilt={tilt!r}"])
+    except ScenarioError:
+        return False
+    return True
+
+
+@pytest.mark.parametrize("width,height,hfov", [(160, 120, 1.047), (320, 240, 2.0),
+                                               (40, 160, 1.0), (160, 120, 3.1)])
+def test_the_scenario_accepts_the_tilts_the_renderer_draws(width, height, hfov):
+    from fpga_robotics.sim.camera import max_tilt
+
+    limit = max_tilt(width, height, hfov)
+    for tilt in (0.0, limit * 0.999, -limit * 0.999, limit + 1e-4, -limit - 1e-4, 1.5707963):
+        assert scenario_accepts(width, height, hfov, tilt) == renderer_accepts(
+            width, height, hfov, tilt), tilt
+
+
+def test_the_printed_tilt_limit_can_be_used():
+    with pytest.raises(ScenarioError) as info:
+        load_scenario("follow_person", ["camera.tilt=1.5"])
+    limit = float(str(info.value).split("at most ")[1].split()[0])
+    assert load_scenario("follow_person", [f"camera.tilt={limit!r}"]).camera.tilt == limit
+    with pytest.raises(ScenarioError) as info:
+        load_scenario("follow_person", ["robot.camera_tilt_deg=80"])
+    limit = float(str(info.value).split("at most ")[1].split()[0])
+    assert 65 < limit < 66
+    load_scenario("follow_person", [f"robot.camera_tilt_deg={limit!r}"])
+
+
+def test_the_camera_must_be_below_the_ceiling():
+    s = load_scenario("follow_person", ["camera.mount_height=2.4"])
+    assert s.camera.mount_height == 2.4
+    for item in ("camera.mount_height=2.5", "camera.mount_height=0"):
+        with pytest.raises(ScenarioError, match="camera.mount_height must be"):
+            load_scenario("follow_person", [item])
+    s = load_scenario("follow_person", ["room.height=3.5", "camera.mount_height=3"])
+    assert s.camera.mount_height == 3.0
+
+
+def test_scenario_paths_that_are_not_files(tmp_path, monkeypatch):
+    with pytest.raises(ScenarioError, match="is a folder"):
+        load_scenario(tmp_path)
+    with pytest.raises(ScenarioError, match="is not a regular file"):
+        load_scenario("/dev/null")
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(ScenarioError, match="for the shipped scenario give its name: "
+                                            "--scenario lost_target"):
+        load_scenario("lost_target.toml")
+    (tmp_path / "lost_target.toml").write_text('description = "mine"\n')
+    assert load_scenario("lost_target.toml").description == "mine"  # a local file wins
+    big = write(tmp_path, "# " + "x" * (1 << 20) + "\n", "big.toml")
+    with pytest.raises(ScenarioError, match="a scenario is at most 1048576 bytes"):
+        load_scenario(big)
+
+
+def test_with_overrides_checks_the_same():
+    s = load_scenario("follow_person")
+    with pytest.raises(ScenarioError, match="camera must be a table"):
+        s.with_overrides(["camera=5"])
+    with pytest.raises(ScenarioError, match="one day"):
+        s.with_overrides(["sim.duration=1e9"])

@@ -1,0 +1,159 @@
+"""Bad scenario inputs through the real command line: each one stops before the run with exit
+status 2 and exactly one line on stderr that names the key (no traceback), and leaves no
+file behind.
+
+Every case runs ``fpga_robotics.run.main`` in-process through ``run_cli`` (what ``python -m
+fpga_robotics.run`` does), from an empty working folder; an input that is wrongly accepted
+runs a short simulation and fails its case.
+"""
+
+import pytest
+
+from fpga_robotics.errors import run_cli
+from fpga_robotics.run import main
+
+#: Every case runs with these; ``--rerun save`` would write ``runs/<scenario name>.rrd``.
+BASE = ["--backend", "model", "--quiet"]
+OFF = ["--rerun", "off"]
+
+#: Scenario files the cases refer to as ``{in}/NAME.toml``.
+FILES = {
+    "escape": 'name = "../../escape/x"\n[sim]\nduration = 0.5\n',
+    "absolute": 'name = "/tmp/x"\n[sim]\nduration = 0.5\n',
+    "hidden": 'name = ".x"\n[sim]\nduration = 0.5\n',
+    "long": f'name = "{"a" * 65}"\n[sim]\nduration = 0.5\n',
+    "nan_change": '[sim]\nduration = 0.5\n[color]\nchanges = [{at = nan, color = "green"}]\n',
+    "camera_int": "camera = 5\n[sim]\nduration = 0.5\n",
+}
+
+# (id, arguments, text the one line must contain)
+CASES = [
+    # 5. absurd sizes: refused at load with the limit, instead of a silent hang
+    ("duration-1e9", ["--duration", "1e9"], "sim.duration must be <= 86400 s (one day)"),
+    ("physics-dt-1e-9", ["--set", "sim.physics_dt=1e-9"], "sim.physics_dt must be >= 1e-05"),
+    ("too-many-steps", ["--set", "sim.duration=86400", "--set", "sim.physics_dt=1e-4"],
+     "864000000 physics steps; the limit is 100000000"),
+    ("too-many-frames", ["--set", "camera.fps=1000", "--set", "sim.physics_dt=0.001",
+                         "--duration", "20000"], "20000000 camera frames; the limit is 10000000"),
+    ("fps-tiny", ["--set", "camera.fps=1e-9"], "camera.fps must be >= 0.1"),
+    ("fps-huge", ["--set", "camera.fps=1e9"], "camera.fps must be <= 1000"),
+    ("resolution-huge", ["--resolution", "8192x6144"], "camera.resolution 8192x6144"),
+    ("resolution-narrow", ["--resolution", "8x6"], "camera.resolution 8x6"),
+    ("delay-huge", ["--set", "sim.actuation_delay=1e9"], "sim.actuation_delay must be <= 10"),
+    # 6. a scenario name becomes a file name (runs/<name>.rrd)
+    ("name-escape", ["--scenario", "{in}/escape.toml", "--rerun", "save"], "name '../../escape/x'"),
+    ("name-absolute", ["--scenario", "{in}/absolute.toml", "--rerun", "save"], "name '/tmp/x'"),
+    ("name-hidden", ["--scenario", "{in}/hidden.toml", "--rerun", "save"], "name '.x'"),
+    ("name-long", ["--scenario", "{in}/long.toml", "--rerun", "save"], "at most 64"),
+    ("name-set", ["--set", "name=a/b", "--rerun", "save"], "name 'a/b'"),
+    ("name-not-a-string", ["--set", "name=1"], "name must be a string"),
+    # 8. wrong types, camera geometry the renderer cannot draw
+    ("camera-int", ["--set", "camera=5"], "camera must be a table"),
+    ("camera-int-in-file", ["--scenario", "{in}/camera_int.toml"], "camera must be a table"),
+    ("color-int", ["--set", "color=1"], "color must be a table"),
+    ("checks-int", ["--set", "checks=1"], "checks must be a table"),
+    ("sim-int", ["--set", "sim=1"], "sim must be a table"),
+    ("mount-height-above-ceiling", ["--set", "camera.mount_height=3"],
+     "camera.mount_height must be below the ceiling (room.height = 2.5 m), got 3"),
+    ("robot-camera-above-ceiling", ["--set", "robot.camera_height=3"],
+     "robot.camera_height must be below the ceiling (room.height = 2.5 m), got 3"),
+    ("room-below-camera", ["--set", "room.height=0.25"],
+     "robot.camera_height must be below the ceiling (room.height = 0.25 m), got 0.3"),
+    ("robot-tilt-90", ["--set", "robot.camera_tilt_deg=90"],
+     "robot.camera_tilt_deg must be <= 85, got 90"),
+    ("robot-tilt-70", ["--set", "robot.camera_tilt_deg=70"],
+     "|robot.camera_tilt_deg| must be at most 65.4"),
+    ("camera-tilt-pi/2", ["--set", "camera.tilt=1.5707963"], "|camera.tilt| must be at most 1.142"),
+    ("camera-tilt-1.2", ["--set", "camera.tilt=-1.2"], "|camera.tilt| must be at most 1.142"),
+    ("hfov-3.1405", ["--set", "camera.hfov=3.1405"], "camera.hfov must be <= 3.1"),
+    ("hfov-tall-image", ["--set", "camera.hfov=3.0", "--resolution", "40x160"],
+     "camera.hfov must be at most 2.98"),
+    ("hfov-with-tilt", ["--set", "camera.hfov=2.5", "--set", "camera.tilt=0.8"],
+     "|camera.tilt| must be at most"),
+    # 9. misleading messages
+    ("scenario-folder", ["--scenario", "{in}"], "is a folder"),
+    ("scenario-device", ["--scenario", "/dev/null"], "is not a regular file"),
+    ("scenario-shipped-with-suffix", ["--scenario", "lost_target.toml"],
+     "--scenario lost_target"),
+    ("scenario-missing", ["--scenario", "nothere.toml"], "'nothere.toml' does not exist"),
+    ("base-dps-word", ["--set", "design.base_dps=fast"],
+     "design.base_dps must be an array of 8 integers"),
+    ("base-dps-short", ["--set", "design.base_dps=[1, 2]"],
+     "design.base_dps must be an array of 8 integers"),
+    ("thresholds-int", ["--set", "design.proximity_thresholds=5"],
+     "design.proximity_thresholds must be an array of 7 integers"),
+    ("design-int", ["--set", "design=1"], "design must be a table"),
+    ("design-float", ["--set", "design.kp_num=1.5"], "design.kp_num must be an integer"),
+    ("design-range", ["--set", "design.kp_shift=99"], "design.kp_shift must be <= 15, got 99"),
+    ("people-index-out-of-range", ["--set", "people[3].speed=1"], "people is a list of 1"),
+    # 10. nonsense values
+    ("change-at-nan", ["--scenario", "{in}/nan_change.toml"], "color.changes[0].at"),
+    ("change-at-nan-set", ["--set", 'color.changes=[{at = nan, color = "green"}]'],
+     "color.changes[0].at must be a time in 0..86400 s, got nan"),
+    ("change-at-huge", ["--set", 'color.changes=[{at = 1e300, color = "green"}]'],
+     "color.changes[0].at must be a time in 0..86400 s"),
+    ("noise-huge", ["--set", "camera.noise_std=1e300"], "camera.noise_std must be <= 64"),
+    ("mount-forward-huge", ["--set", "camera.mount_forward=1e300"],
+     "camera.mount_forward must be <= 2"),
+    ("check-inf", ["--set", "checks.acquired_within_s=inf"],
+     "checks.acquired_within_s must be a number in 0..86400"),
+    ("check-fraction", ["--set", "checks.found_min_fraction=5"],
+     "checks.found_min_fraction must be a number in 0..1"),
+    ("check-count-float", ["--set", "checks.max_person_collisions=1.5"],
+     "checks.max_person_collisions must be an integer"),
+    ("check-bool", ["--set", "checks.acquired_within_s=true"],
+     "checks.acquired_within_s must be a number"),
+    ("description-int", ["--set", "description=5"], "description must be a string"),
+    ("seed-huge", ["--set", f"seed={2**64}"], "seed must be an integer in 0.."),
+    ("light-direction-huge", ["--set", "lighting.direction=[1e300, 1e300, 1]"],
+     "lighting.direction[0] must be"),
+    ("light-direction-tiny", ["--set", "lighting.direction=[1e-300, 0, 0]"],
+     "lighting.direction must have a length of at least"),
+    ("keyframe-time-huge", ["--set", "lighting.keyframes=[[1e300, 1, 1]]"],
+     "lighting.keyframes[0][0] (t) must be"),
+    ("robot-radius-tiny", ["--set", "robot.body_radius=1e-300"], "robot.body_radius must be"),
+    ("robot-mass-tiny", ["--set", "robot.mass=1e-300"], "robot.mass must be"),
+    ("person-radius-tiny", ["--set", "people.0.radius=1e-300"], "people[0].radius must be"),
+    ("furniture-tiny", ["--set", "room.furniture=[{center = [3, 2], size = [1e-300, 1e-300]}]"],
+     "room.furniture[0].size[0] must be"),
+]
+
+
+def run(argv, capsys):
+    with pytest.raises(SystemExit) as exc:
+        run_cli(main, argv, prog="fpga_robotics.run")
+    out, err = capsys.readouterr()
+    return exc.value.code, out, err
+
+
+def files_under(folder):
+    return sorted(str(p.relative_to(folder)) for p in folder.rglob("*"))
+
+
+@pytest.mark.parametrize("args,expect", [c[1:] for c in CASES], ids=[c[0] for c in CASES])
+def test_bad_input_is_one_line_exit_2_and_leaves_nothing(args, expect, tmp_path, monkeypatch,
+                                                         capsys):
+    inputs = tmp_path / "in"
+    inputs.mkdir()
+    for name, text in FILES.items():
+        (inputs / f"{name}.toml").write_text(text)
+    cwd = tmp_path / "work" / "here"  # runs/../../escape would land in tmp_path
+    cwd.mkdir(parents=True)
+    monkeypatch.chdir(cwd)
+    before = files_under(tmp_path)
+    argv = [a.replace("{in}", str(inputs)) for a in args]
+    if "--rerun" not in argv:
+        argv += OFF
+    code, out, err = run(BASE + argv, capsys)
+    assert (code, out) == (2, ""), err
+    lines = err.splitlines()
+    assert len(lines) == 1, err
+    assert lines[0].startswith("fpga_robotics.run: error: "), lines[0]
+    assert expect in lines[0]
+    assert "Traceback" not in err
+    assert files_under(tmp_path) == before
+
+
+def test_the_table_has_no_duplicate_ids():
+    ids = [c[0] for c in CASES]
+    assert len(ids) == len(set(ids))
