@@ -93,6 +93,8 @@ BAD = [
     ({"people": [{"waypoints": [[1, 1]], "pause": [-1]}]}, "people[0].pause[0] must be >= 0"),
     ({"people": [{"waypoints": [[1, 1]], "radius": 1e-300}]},
      "people[0].radius must be >= 0.05, got 1e-300"),
+    ({"people": [{"waypoints": [[1, 1]], "yield_gap": -1}]},
+     "people[0].yield_gap must be >= 0, got -1"),
     ({"people": [{"waypoints": [[1, 1]], "start_delay": 1e300}]},
      "people[0].start_delay must be <= 86400, got 1e+300"),
     ({"people": [{"waypoints": [[1, 1]], "loop": "yes"}]}, "people[0].loop must be true or false"),

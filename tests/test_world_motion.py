@@ -177,6 +177,47 @@ def test_a_walking_person_pushes_the_robot_and_keeps_to_their_script():
     assert world.robot_pose()[0] == pytest.approx(3.0 - 0.2 - TURTLEBOT2.body_radius, abs=0.01)
 
 
+CONTACT = 0.2 + TURTLEBOT2.body_radius  # centres of a person and the robot when they touch
+
+
+def test_a_yielding_person_waits_for_the_robot_and_then_keeps_to_their_script():
+    person = {"name": "walker", "waypoints": [[6.0, 3.0], [1.0, 3.0]], "speed": 0.5,
+              "loop": False, "yield_gap": 0.3}
+    world = empty_world({"start": [3.5, 3.0]}, people=[person])
+    run(world, 6.0)  # they would reach the robot after (6 - 3.5 - 0.377) / 0.5 = 4.2 s
+    (state,) = world.people_states()
+    # Waiting where one more step (0.5 m/s for 5 ms) would come closer than the gap.
+    assert 3.5 + CONTACT + 0.3 <= state.x < 3.5 + CONTACT + 0.3 + 0.5 * DT
+    assert world.collision_counts()["person"] == 0
+    # The robot backs away at 0.2 m/s: they follow at the gap, never closer.
+    world.set_wheel_dps(-0.2 / 0.035 / (math.pi / 180), -0.2 / 0.035 / (math.pi / 180))
+    for _ in range(round(4.0 / DT)):
+        world.step(DT)
+        (state,) = world.people_states()
+        gap = math.hypot(state.x - world.robot_pose()[0], state.y - 3.0) - CONTACT
+        assert gap > 0.3 - 0.5 * DT
+    assert world.collision_counts()["person"] == 0
+    # The robot leaves the path: they walk on, their script delayed by the wait.
+    world.set_wheel_dps(0, 0)
+    world.robot_body.position = (3.0, 1.0)
+    run(world, 8.0)
+    (state,) = world.people_states()
+    assert (state.x, state.y) == pytest.approx((1.0, 3.0))
+
+
+def test_a_yielding_person_still_walks_past_the_robot():
+    # Their path passes 0.75 m from the robot's centre, 0.37 m between the bodies: never
+    # closer than the gap (0.3 m), so they never wait.
+    person = {"waypoints": [[6.0, 3.5], [1.0, 3.5]], "speed": 0.5, "loop": False,
+              "yield_gap": 0.3}
+    world = empty_world({"start": [3.5, 2.75]}, people=[person])
+    for _ in range(round(10.0 / DT)):
+        world.step(DT)
+        (state,) = world.people_states()
+        assert state.x == pytest.approx(max(1.0, 6.0 - 0.5 * world.time), abs=1e-6)
+    assert world.collision_counts()["person"] == 0
+
+
 def test_same_seed_same_trajectory_different_seed_different_people():
     people = [{"waypoints": [[3, 3], [6, 4], [6, 2]], "speed": 0.6, "speed_jitter": 0.3,
                "pause": [0.5, 1.0, 0.2]}]

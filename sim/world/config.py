@@ -99,6 +99,7 @@ class PersonConfig:
     pauses: tuple  # s, one per waypoint
     loop: bool
     start_delay: float  # s
+    yield_gap: float  # m: waits rather than walk closer than this to the robot (0: never)
     radius: float
     height: float
     shirt_color: tuple
@@ -358,6 +359,7 @@ def _parse_person(item, path, index, room):
             waypoints)
     loop = t.boolean("loop", True)
     start_delay = t.number("start_delay", 0.0, ge=0, le=MAX_TIME, unit="s")
+    yield_gap = t.number("yield_gap", 0.0, ge=0, le=5, unit="m")
     radius = t.number("radius", 0.2, ge=0.05, le=1, unit="m")
     height = t.number("height", 1.75, ge=0.5, le=2.5, unit="m")
     shirt = t.color("shirt_color", DEFAULT_SHIRT)
@@ -370,7 +372,7 @@ def _parse_person(item, path, index, room):
                 f"{path}.waypoints[{i}] {_fmt(p)} puts the person (radius {radius:g} m) outside "
                 f"the room (0..{room.width:g} x 0..{room.depth:g} m)")
     return PersonConfig(name, target, waypoints, speed, jitter, pauses, loop, start_delay,
-                        radius, height, shirt, trousers, skin)
+                        yield_gap, radius, height, shirt, trousers, skin)
 
 
 def _parse_people(section, room):

@@ -5,7 +5,9 @@ their speed, pauses there for that waypoint's pause, and so on; with ``loop`` th
 to the first waypoint and go round again, otherwise they stay at the last one. The path is a
 pure function of time (legs are generated lazily, in order, so a per-leg speed jitter drawn
 from the world's generator is deterministic for a seed). In the physics a person is a
-kinematic body: the robot bumps into them, but they are never pushed off their script.
+kinematic body: the robot bumps into them, but they are never pushed off their script. (A
+person with a ``yield_gap`` may wait for the robot: the world then asks for the position at a
+script time that runs behind the clock by the time waited.)
 """
 
 import math

@@ -4,7 +4,8 @@ The robot is a dynamic disc driven by pymunk's control-body idiom: a kinematic c
 moves at the twist the wheels ask for, and a ``PivotJoint`` and a ``GearJoint`` (no position
 correction, ``max_bias = 0``) pull the robot towards that velocity with at most the
 robot's traction force and torque. The robot's velocity is never written directly, so walls,
-furniture and people stop it. People are kinematic bodies on scripted paths; walls and
+furniture and people stop it. People are kinematic bodies on scripted paths (a person with a
+``yield_gap`` pauses their script rather than step closer than that to the robot); walls and
 furniture are static shapes. Collisions of the robot are counted per kind from pymunk
 collision handlers.
 """
@@ -33,7 +34,7 @@ _FRICTION = 0.5
 
 
 class _Person:
-    __slots__ = ("bands", "body", "config", "path", "shape")
+    __slots__ = ("bands", "body", "config", "path", "shape", "waited")
 
     def __init__(self, config, path, body, shape):
         self.config = config
@@ -41,6 +42,8 @@ class _Person:
         self.body = body
         self.shape = shape
         self.bands = person_bands(config)
+        #: Time spent waiting for the robot, s: the script runs this much behind the clock.
+        self.waited = 0.0
 
 
 class World:
@@ -171,10 +174,19 @@ class World:
         control.velocity = (v * math.cos(a), v * math.sin(a))
         control.angular_velocity = w
         t1 = self._advance_time(h)
+        rx, ry = body.position
         for person in self.people:
-            x, y = person.path.position(t1)
+            x, y = person.path.position(t1 - person.waited)
             px, py = person.body.position
-            # Arrive exactly on the script at t1; the velocity lets contacts push the robot.
+            gap = person.config.yield_gap
+            if gap > 0.0:
+                # Wait (the script pauses) rather than step closer to the robot than the gap.
+                ahead = math.hypot(x - rx, y - ry)
+                if (ahead < math.hypot(px - rx, py - ry)
+                        and ahead - person.config.radius - spec.body_radius < gap):
+                    person.waited += h
+                    x, y = px, py
+            # Arrive exactly on the script; the velocity lets contacts push the robot.
             person.body.velocity = ((x - px) / h, (y - py) / h)
         self.space.step(h)
         self.time = t1
