@@ -116,6 +116,7 @@ CASES = [
     ("person-radius-tiny", ["--set", "people.0.radius=1e-300"], "people[0].radius must be"),
     ("furniture-tiny", ["--set", "room.furniture=[{center = [3, 2], size = [1e-300, 1e-300]}]"],
      "room.furniture[0].size[0] must be"),
+    ("yield-gap-negative", ["--set", "people.0.yield_gap=-1"], "people[0].yield_gap must be"),
 ]
 
 
