@@ -511,12 +511,12 @@ def _is_number(value):
 def _in_range(value, name, lo, hi, unit, *, lo_open=False, note=""):
     """``value`` as a float if it is a finite number in ``lo..hi`` (``None``: no bound);
     ``note`` explains the upper bound."""
-    unit = f" ({unit})" if " " in unit else f" {unit}" if unit else ""
     if not (_is_number(value) and math.isfinite(value)):
         bounds = [f"{'>' if lo_open else '>='} {lo:g}"] if lo is not None else []
         bounds += [f"<= {hi:g}"] if hi is not None else []
-        raise ScenarioError(f"{name} must be a finite number{unit}"
-                            f"{' ' + ' and '.join(bounds) if bounds else ''}, got {value!r}")
+        raise ScenarioError(f"{name} must be a finite number{' in ' + unit if unit else ''}"
+                            f"{', ' + ' and '.join(bounds) if bounds else ''}, got {value!r}")
+    unit = f" ({unit})" if " " in unit else f" {unit}" if unit else ""
     if lo is not None and (value <= lo if lo_open else value < lo):
         raise ScenarioError(f"{name} must be {'>' if lo_open else '>='} {lo:g}{unit}, "
                             f"got {value!r}")

@@ -379,6 +379,24 @@ def test_scenario_paths_that_are_not_files(tmp_path, monkeypatch):
         load_scenario(big)
 
 
+@pytest.mark.parametrize("item,message", [
+    ("sim.duration=1979-05-27", ("sim.duration must be a finite number in s, > 0 and <= 86400, "
+                                "got datetime.date(1979, 5, 27)")),
+    ("camera.noise_std=nan", ("camera.noise_std must be a finite number in 8-bit levels, >= 0 "
+                             "and <= 64, got nan")),
+    ("camera.fps=inf", ("camera.fps must be a finite number in frames/s, >= 0.1 and <= 1000, "
+                      "got inf")),
+    ("camera.noise_std=65", "camera.noise_std must be <= 64 (8-bit levels), got 65.0"),
+    ("sim.physics_dt=0.1", ("sim.physics_dt must be <= 0.0333333 s (one camera frame period, "
+                           "1 / camera.fps), got 0.1")),
+    ("sim.physics_dt=1e-6", "sim.physics_dt must be >= 1e-05 s, got 1e-06"),
+])
+def test_number_messages_give_the_unit_and_the_range(item, message):
+    with pytest.raises(ScenarioError) as info:
+        load_scenario("follow_person", [item])
+    assert str(info.value) == message
+
+
 def test_with_overrides_checks_the_same():
     s = load_scenario("follow_person")
     with pytest.raises(ScenarioError, match="camera must be a table"):
