@@ -262,31 +262,33 @@ def shipped_scenarios():
 def _resolve(name_or_path):
     text = str(name_or_path)
     path = Path(text)
-    looks_like_path = text.endswith(".toml") or "/" in text or "\\" in text
-    if looks_like_path or path.exists():
-        if path.is_dir():
-            raise ScenarioError(f"scenario {text!r} is a folder; give a .toml file in it or the "
-                                f"name of a shipped scenario")
-        if path.exists() and not path.is_file():
-            raise ScenarioError(f"scenario file {text!r} is not a regular file (a device or "
-                                f"pipe); give a .toml file")
+    if not (text.endswith(".toml") or "/" in text or "\\" in text):
+        # A bare word: a file of that name here, else a shipped scenario.
+        if path.is_file():
+            return path
+        shipped = shipped_scenarios()
+        if text in shipped:
+            return Path(shipped[text][0])
         if not path.exists():
-            shipped = shipped_scenarios()
-            if path.suffix == ".toml" and path.name == text and path.stem in shipped:
-                raise ScenarioError(
-                    f"scenario file {text!r} does not exist here; for the shipped scenario "
-                    f"give its name: --scenario {path.stem}")
-            raise ScenarioError(f"scenario file {text!r} does not exist")
-        return path
-    shipped = shipped_scenarios()
-    if text in shipped:
-        return Path(shipped[text][0])
-    close = difflib.get_close_matches(text, shipped, n=3)
-    hint = f" (did you mean {', '.join(close)}?)" if close else ""
-    raise ScenarioError(
-        f"unknown scenario {text!r}{hint}; shipped scenarios: {', '.join(shipped)} "
-        f"(or give the path of a .toml file)"
-    )
+            close = difflib.get_close_matches(text, shipped, n=3)
+            hint = f" (did you mean {', '.join(close)}?)" if close else ""
+            raise ScenarioError(
+                f"unknown scenario {text!r}{hint}; shipped scenarios: {', '.join(shipped)} "
+                f"(or give the path of a .toml file)"
+            )
+    if path.is_dir():
+        raise ScenarioError(f"scenario {text!r} is a folder; give a .toml file in it or the "
+                            f"name of a shipped scenario")
+    if path.exists() and not path.is_file():
+        raise ScenarioError(f"scenario file {text!r} is not a regular file (a device or "
+                            f"pipe); give a .toml file")
+    if not path.exists():
+        if path.suffix == ".toml" and path.name == text and path.stem in shipped_scenarios():
+            raise ScenarioError(
+                f"scenario file {text!r} does not exist here; for the shipped scenario "
+                f"give its name: --scenario {path.stem}")
+        raise ScenarioError(f"scenario file {text!r} does not exist")
+    return path
 
 
 def _default_name(path):

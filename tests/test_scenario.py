@@ -374,6 +374,11 @@ def test_scenario_paths_that_are_not_files(tmp_path, monkeypatch):
         load_scenario("lost_target.toml")
     (tmp_path / "lost_target.toml").write_text('description = "mine"\n')
     assert load_scenario("lost_target.toml").description == "mine"  # a local file wins
+    (tmp_path / "divider").mkdir()  # a folder named like a shipped scenario does not hide it
+    assert load_scenario("divider").name == "divider"
+    (tmp_path / "mine").mkdir()
+    with pytest.raises(ScenarioError, match="'mine' is a folder"):
+        load_scenario("mine")
     big = write(tmp_path, "# " + "x" * (1 << 20) + "\n", "big.toml")
     with pytest.raises(ScenarioError, match="a scenario is at most 1048576 bytes"):
         load_scenario(big)
