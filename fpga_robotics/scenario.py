@@ -17,7 +17,8 @@ Top-level keys: ``name``, ``description``, ``seed`` (default seed of a run).
 
 Everything is checked when the scenario is loaded, before a run starts: types, the range of
 every number (``LIMITS`` below and docs/scenarios.md), the size of the run (physics steps and
-camera frames) and the camera's geometry as the renderer will draw it.
+camera frames, counted as ``fpga_robotics.loop`` counts them) and the camera's geometry as
+the renderer will draw it.
 """
 
 import copy
@@ -47,7 +48,6 @@ __all__ = [
     "Scenario",
     "ScenarioError",
     "SimConfig",
-    "frame_count",
     "load_scenario",
     "parse_resolution",
     "shipped_scenarios",
@@ -137,20 +137,6 @@ def parse_resolution(text):
     return w, h
 
 
-def frame_count(duration, physics_dt, fps):
-    """Camera frames of a run, as the closed loop takes them: physics runs
-    ``max(1, round(duration / physics_dt))`` steps and frame ``k`` is captured at step
-    ``round(k / fps / physics_dt)``, for every ``k`` whose step comes before the end.
-    (``physics_dt`` is at most a frame period.)"""
-    total = max(1, round(duration / physics_dt))
-    ratio = (1.0 / fps) / physics_dt
-    # Every k below (total - 0.5) / ratio is captured; start just under that and count on.
-    n = max(0, math.floor((total - 1) / ratio) - 1)
-    while round(n * (1.0 / fps) / physics_dt) < total:
-        n += 1
-    return n
-
-
 @dataclass(frozen=True)
 class CameraConfig:
     width: int
@@ -172,11 +158,6 @@ class SimConfig:
     duration: float
     physics_dt: float
     actuation_delay: float
-
-    @property
-    def physics_steps(self):
-        """Physics steps of the run, ``max(1, round(duration / physics_dt))``."""
-        return max(1, round(self.duration / self.physics_dt))
 
 
 @dataclass(frozen=True, eq=False)
@@ -217,11 +198,6 @@ class Scenario:
     params: FollowTargetParams
     checks: dict
     overrides: tuple = ()
-
-    @property
-    def frames(self):
-        """Camera frames of a run (``frame_count``)."""
-        return frame_count(self.sim.duration, self.sim.physics_dt, self.camera.fps)
 
     def color_at(self, t):
         """The colour select in force at simulated time ``t``."""
@@ -625,6 +601,8 @@ def _check_camera_geometry(camera, world):
 
 
 def _sim(data, camera):
+    from .loop import frame_count
+
     sim = data["sim"]
     duration = _limited(data, "sim.duration", note=" (one day)")
     period = camera.frame_period
@@ -635,13 +613,13 @@ def _sim(data, camera):
     else:
         delay = period
     config = SimConfig(duration=duration, physics_dt=dt, actuation_delay=delay)
-    steps = config.physics_steps
+    steps = max(1, round(duration / dt))  # as the closed loop counts them
     if steps > MAX_PHYSICS_STEPS:
         raise ScenarioError(
             f"sim.duration {duration:g} s / sim.physics_dt {dt:g} s = {steps} physics steps; "
             f"the limit is {MAX_PHYSICS_STEPS}: shorten sim.duration or lengthen "
             f"sim.physics_dt")
-    frames = frame_count(duration, dt, camera.fps)
+    frames = frame_count(steps, period, dt)
     if frames > MAX_FRAMES:
         raise ScenarioError(
             f"sim.duration {duration:g} s at camera.fps {camera.fps:g} = {frames} camera "

@@ -205,41 +205,20 @@ def test_a_world_section_the_file_lacks_can_be_set():
 # -- limits, names, types and the camera's geometry (issue 11) --------------------------------
 
 
-def loop_frame_count(duration, dt, fps):
-    """The closed loop's own count (fpga_robotics.loop): one frame at a time."""
-    total_steps = max(1, round(duration / dt))
-    period = 1.0 / fps
-    n = 0
-    while round(n * period / dt) < total_steps:
-        n += 1
-    return n
-
-
-@pytest.mark.parametrize("duration,dt,fps", [
-    (30.0, 1 / 240, 30.0), (3.0, 1 / 240, 30.0), (1e-3, 1 / 240, 30.0), (10.0, 0.01, 30.0),
-    (10.0, 0.004, 25.0), (7.3, 0.001, 1000.0), (5.0, 0.02, 7.0), (2.0, 0.3, 3.0),
-    (1.0, 1e-5, 0.1), (100.0, 1 / 240, 29.97), (0.05, 0.01, 100.0),
-])
-def test_frame_count_is_the_loops_count_without_counting(duration, dt, fps):
-    from fpga_robotics.scenario import frame_count
-
-    assert frame_count(duration, dt, fps) == loop_frame_count(duration, dt, fps)
-
-
-def test_a_scenario_knows_its_steps_and_frames():
-    s = load_scenario("follow_person", ["sim.duration=10"])
-    assert s.sim.physics_steps == 2400 and s.frames == 300
-
-
 def test_the_largest_runs_allowed_load():
     # A day at the default rates (20.7 million steps, 2.6 million frames).
-    s = load_scenario("follow_person", ["sim.duration=86400"])
-    assert s.sim.physics_steps == 86400 * 240 and s.frames == 86400 * 30
-    # The finest physics step for a second; 1000 fps with a step per frame.
+    assert load_scenario("follow_person", ["sim.duration=86400"]).sim.duration == 86400
+    # The finest physics step for a second (100,000 steps); 1000 fps with a step per frame
+    # for 10,000 s: exactly the frame limit, and exactly the step limit.
     assert load_scenario("follow_person", ["sim.duration=1", "sim.physics_dt=1e-5"])
-    s = load_scenario("follow_person", ["sim.duration=10000", "camera.fps=1000",
+    assert load_scenario("follow_person", ["sim.duration=10000", "camera.fps=1000",
+                                           "sim.physics_dt=0.001"])
+    assert load_scenario("follow_person", ["sim.duration=1000", "sim.physics_dt=1e-5"])
+    with pytest.raises(ScenarioError, match="100000001 physics steps; the limit is 100000000"):
+        load_scenario("follow_person", ["sim.duration=1000.00001", "sim.physics_dt=1e-5"])
+    with pytest.raises(ScenarioError, match="10000001 camera frames; the limit is 10000000"):
+        load_scenario("follow_person", ["sim.duration=10000.001", "camera.fps=1000",
                                         "sim.physics_dt=0.001"])
-    assert s.frames == 10**7
     # The design's largest and smallest resolutions (width - 2 * margin_x divisible by 8).
     assert load_scenario("follow_person", ['camera.resolution="4000x4096"']).params.width == 4000
     s = load_scenario("follow_person", ['camera.resolution="16x2"', "design.margin_x=0"])
