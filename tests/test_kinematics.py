@@ -70,7 +70,7 @@ def test_wheel_motor_ramps_at_its_acceleration_and_clamps():
     assert down[-1] == pytest.approx(-10.0)
 
 
-def test_sim_motors_commanded_twist_is_the_raw_command():
+def test_drive_motors_commanded_twist_is_the_raw_command():
     motors = DriveMotors(TURTLEBOT2)
     motors.set_wheel_dps(360, 360)
     assert motors.commanded_twist() == pytest.approx((0.035 * 2 * math.pi, 0.0))
