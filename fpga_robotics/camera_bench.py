@@ -1,4 +1,5 @@
-"""``python -m fpga_robotics.camera_bench``: time the camera renderer at several resolutions.
+"""``python -m fpga_robotics.camera_bench`` (or ``fpga-robotics bench camera``): time the camera
+renderer at several resolutions.
 
     python -m fpga_robotics.camera_bench [--frames 60] [--repeats 5] [--noise 2.0]
                                          [--sizes 160x120,320x240,640x480]
@@ -16,7 +17,10 @@ from .errors import UsageError, run_cli
 from .sim import camera_bench as _bench
 from .sim.camera_bench import DEFAULT_SIZES, benchmark, typical_scene
 
-__all__ = ["MAX_SIDE", "cli", "main"]
+__all__ = ["MAX_SIDE", "PROG", "cli", "main"]
+
+#: The command (also ``fpga-robotics bench camera``).
+PROG = "python -m fpga_robotics.camera_bench"
 
 #: Largest width or height timed (the design's own limit).
 MAX_SIDE = 4096
@@ -32,8 +36,8 @@ def _size(text):
     return w, h
 
 
-def main(argv=None):
-    ap = argparse.ArgumentParser(prog="python -m fpga_robotics.camera_bench",
+def main(argv=None, prog=PROG):
+    ap = argparse.ArgumentParser(prog=prog,
                                  description=_bench.__doc__.split("\n\n")[0])
     ap.add_argument("--frames", type=int, default=60, help="poses per loop (default 60)")
     ap.add_argument("--repeats", type=int, default=5, help="loops per size (default 5)")
@@ -68,7 +72,7 @@ def main(argv=None):
 
 def cli():
     """The console entry point: usage errors as one line and exit status 2."""
-    run_cli(main, sys.argv[1:], prog="camera_bench")
+    run_cli(main, sys.argv[1:], prog=PROG)
 
 
 if __name__ == "__main__":

@@ -1,4 +1,5 @@
-"""``python -m fpga_robotics.world_bench``: the physics cost per camera frame.
+"""``python -m fpga_robotics.world_bench`` (or ``fpga-robotics bench world``): the physics cost
+per camera frame.
 
     python -m fpga_robotics.world_bench [--frames 900] [--repeats 5] [--physics-hz 200]
                                         [--fps 30]
@@ -15,7 +16,10 @@ import sys
 from .errors import UsageError, run_cli
 from .sim.world.bench import WORLDS, time_frames
 
-__all__ = ["cli", "main"]
+__all__ = ["PROG", "cli", "main"]
+
+#: The command (also ``fpga-robotics bench world``).
+PROG = "python -m fpga_robotics.world_bench"
 
 
 def _count(name, value, hi):
@@ -30,8 +34,8 @@ def _rate(name, value, hi):
     return value
 
 
-def main(argv=None):
-    parser = argparse.ArgumentParser(prog="python -m fpga_robotics.world_bench",
+def main(argv=None, prog=PROG):
+    parser = argparse.ArgumentParser(prog=prog,
                                      description="Physics cost per camera frame.")
     parser.add_argument("--frames", type=int, default=900, help="frames per run (default 900)")
     parser.add_argument("--repeats", type=int, default=5, help="runs per world (default 5)")
@@ -57,7 +61,7 @@ def main(argv=None):
 
 def cli():
     """The console entry point: usage errors as one line and exit status 2."""
-    run_cli(main, sys.argv[1:], prog="world_bench")
+    run_cli(main, sys.argv[1:], prog=PROG)
 
 
 if __name__ == "__main__":

@@ -563,11 +563,11 @@ def test_benchmark_cli_prints_a_line_per_size(capsys):
 
 @pytest.mark.parametrize("module,args,message", [
     ("fpga_robotics.sim.camera_bench", ["--sizes", "160by120"],
-     "camera_bench: error: a size is WIDTHxHEIGHT, e.g. 160x120; got '160by120'"),
+     "python -m fpga_robotics.camera_bench: error: a size is WIDTHxHEIGHT, e.g. 160x120; got '160by120'"),
     ("fpga_robotics.camera_bench", ["--frames", "0"],
-     "camera_bench: error: --frames must be 1..100000 and --repeats 1..1000, got 0 and 5"),
+     "python -m fpga_robotics.camera_bench: error: --frames must be 1..100000 and --repeats 1..1000, got 0 and 5"),
     ("fpga_robotics.camera_bench", ["--noise", "1e300"],
-     "camera_bench: error: --noise must be a number of 8-bit levels in 0..64, got 1e+300"),
+     "python -m fpga_robotics.camera_bench: error: --noise must be a number of 8-bit levels in 0..64, got 1e+300"),
 ])
 def test_benchmark_command_line_reports_bad_arguments_in_one_line(module, args, message):
     # The library module is an alias of the command line in the application layer.

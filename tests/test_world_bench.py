@@ -21,16 +21,31 @@ def test_prints_a_line_per_world(capsys):
 
 @pytest.mark.parametrize("module,args,message", [
     ("fpga_robotics.sim.world.bench", ["--fps", "0"],
-     "world_bench: error: --fps must be a number of hertz in (0, 200], got 0.0"),
+     "python -m fpga_robotics.world_bench: error: --fps must be a number of hertz in (0, 200], got 0.0"),
     ("fpga_robotics.world_bench", ["--frames", "0"],
-     "world_bench: error: --frames must be 1..1000000, got 0"),
+     "python -m fpga_robotics.world_bench: error: --frames must be 1..1000000, got 0"),
     ("fpga_robotics.world_bench", ["--physics-hz", "nan"],
-     "world_bench: error: --physics-hz must be a number of hertz in (0, 100000], got nan"),
+     "python -m fpga_robotics.world_bench: error: --physics-hz must be a number of hertz in (0, 100000], got nan"),
     ("fpga_robotics.world_bench", ["--fps", "300"],
-     "world_bench: error: --fps must be a number of hertz in (0, 200], got 300.0"),
+     "python -m fpga_robotics.world_bench: error: --fps must be a number of hertz in (0, 200], got 300.0"),
 ])
 def test_bad_arguments_are_one_line(module, args, message):
     proc = subprocess.run([sys.executable, "-m", module, *args], capture_output=True,
                           check=False, text=True)
     assert (proc.returncode, proc.stdout) == (2, "")
     assert proc.stderr.splitlines() == [message]
+
+
+@pytest.mark.parametrize("what,args,message", [
+    ("world", ["--repeats", "0"],
+     "fpga-robotics bench world: error: --repeats must be 1..1000, got 0"),
+    ("camera", ["--sizes", "0x0"],
+     "fpga-robotics bench camera: error: a size needs a width and height of 1..4096, got '0x0'"),
+])
+def test_the_benchmarks_are_fpga_robotics_bench_subcommands(what, args, message, capsys):
+    from fpga_robotics.cli import main as fpga_robotics
+
+    with pytest.raises(SystemExit) as exc:
+        fpga_robotics(["bench", what, *args])
+    assert exc.value.code == 2
+    assert capsys.readouterr().err.splitlines() == [message]
