@@ -82,17 +82,19 @@ DEFAULTS = {
 #: that no sensible run comes near them, while an absurd one fails at once with the limit
 #: instead of computing for hours (docs/scenarios.md, "Limits").
 LIMITS = {
-    "sim.duration": (0.0, MAX_TIME, "s"),  # lo excluded; one day
+    "sim.duration": (0.0, MAX_TIME, "s"),  # one day
     "sim.physics_dt": (1e-5, None, "s"),  # at most one frame period (1 / camera.fps)
     "sim.actuation_delay": (0.0, 10.0, "s"),
     "camera.fps": (0.1, 1000.0, "frames/s"),
     "camera.hfov": (0.01, 3.1, "rad"),  # and narrow enough for the image's aspect ratio
-    "camera.mount_height": (0.0, None, "m"),  # lo excluded; below the ceiling (room.height)
+    "camera.mount_height": (0.0, None, "m"),  # and below the ceiling (room.height)
     "camera.mount_forward": (-2.0, 2.0, "m"),
     "camera.tilt": (-math.pi / 2, math.pi / 2, "rad"),  # and what the field of view allows
     "camera.noise_std": (0.0, 64.0, "8-bit levels"),
     "color.changes.at": (0.0, MAX_TIME, "s"),
 }
+#: Keys whose lower bound is excluded.
+_LO_EXCLUDED = ("sim.duration", "camera.mount_height")
 #: Camera and design resolution: the design's limits (``FollowTargetParams``).
 WIDTH_RANGE = (16, 4096)
 HEIGHT_RANGE = (2, 4096)
@@ -511,9 +513,8 @@ def _limited(data, name, *, optional=False, hi=None, note=""):
     if optional and value is None:
         return None
     lo, limit_hi, unit = LIMITS[name]
-    lo_open = name in ("sim.duration", "camera.mount_height")
-    return _in_range(value, name, lo, limit_hi if hi is None else hi, unit, lo_open=lo_open,
-                     note=note)
+    return _in_range(value, name, lo, limit_hi if hi is None else hi, unit,
+                     lo_open=name in _LO_EXCLUDED, note=note)
 
 
 def _color(value, where):
