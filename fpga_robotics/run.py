@@ -234,11 +234,11 @@ def main(argv=None, prog="python -m fpga_robotics.run"):
         return _list_scenarios()
 
     from .loop import run_scenario
-    from .scenario import load_scenario
+    from .scenario import MAX_SEED, load_scenario
     from .summary import format_summary
 
-    if args.seed is not None and args.seed < 0:
-        raise UsageError(f"--seed must be >= 0, got {args.seed}")
+    if args.seed is not None and not 0 <= args.seed <= MAX_SEED:
+        raise UsageError(f"--seed must be in 0..{MAX_SEED}, got {args.seed}")
     if args.summary is not None:  # checked now, not after a long run
         check_output_path(args.summary, what="--summary")
     scenario = load_scenario(args.scenario, _overrides(args))
