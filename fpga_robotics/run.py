@@ -67,6 +67,8 @@ def build_parser(prog="python -m fpga_robotics.run"):
                         "(e.g. 'diff_min=5;kp_num=2'); the summary reports where they differ")
     p.add_argument("--shadow-backend", choices=("auto", *BACKEND_NAMES), default=None,
                    help="simulator of the shadow design (default: the same as --backend)")
+    p.add_argument("--save-video", metavar="PATH.mp4|PATH.avi",
+                   help="also write the camera frames as a video (try it with --source)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     return p
 
@@ -128,6 +130,17 @@ def _overrides(args):
     if args.color is not None:
         items.append(f'color.initial="{args.color}"')
     return items
+
+
+def _video(path, fps):
+    """A ``CameraVideo`` context for ``--save-video``, or a context that yields None."""
+    import contextlib
+
+    if path is None:
+        return contextlib.nullcontext()
+    from .video_out import CameraVideo
+
+    return CameraVideo(path, fps)
 
 
 def _shadow_params(scenario, spec):
@@ -253,6 +266,13 @@ def main(argv=None, prog="python -m fpga_robotics.run"):
     if args.max_frames is not None:
         raise UsageError("--max-frames only applies with --source (use --duration)")
     shadow_params = _shadow_params(scenario, args.shadow)
+    if args.save_video is not None:
+        from .video_out import VideoPathError, check_video_path
+
+        try:
+            check_video_path(args.save_video)
+        except VideoPathError as exc:
+            raise UsageError(str(exc)) from None
 
     t0 = time.perf_counter()
     design = _open_backend(args.backend, scenario.params, args.quiet)
@@ -264,9 +284,12 @@ def main(argv=None, prog="python -m fpga_robotics.run"):
         setup = time.perf_counter() - t0
         recorder = _open_recorder(args, scenario.name)
         progress = None if args.quiet else Progress(scenario.name)
-        result = run_scenario(scenario, seed=args.seed, backend=design, recorder=recorder,
-                              progress=progress, realtime=args.realtime, shadow=shadow,
-                              shadow_label=args.shadow or "shadow")
+        with _video(args.save_video, scenario.camera.fps) as video:
+            result = run_scenario(scenario, seed=args.seed, backend=design, recorder=recorder,
+                                  progress=progress, realtime=args.realtime, shadow=shadow,
+                                  shadow_label=args.shadow or "shadow",
+                                  on_frame=None if video is None else
+                                  (lambda record: video.write(record.camera_rgb)))
         if progress is not None:
             progress.finish()
     finally:
@@ -283,6 +306,8 @@ def main(argv=None, prog="python -m fpga_robotics.run"):
         print("\n".join(format_shadow(summary["shadow"])))
     if where:
         print(where)
+    if args.save_video is not None:
+        print(f"camera frames written to {args.save_video} (try: --source {args.save_video})")
     if args.summary:
         write_json_atomic(args.summary, summary, what="--summary")
     return 0 if summary["verdict"] == "pass" else 1

@@ -1,0 +1,56 @@
+"""run --save-video: the camera frames of a run as a video that --source plays back."""
+
+import json
+
+import numpy as np
+import pytest
+
+from fpga_robotics.errors import run_cli
+from fpga_robotics.loop import run_scenario
+from fpga_robotics.run import main
+from fpga_robotics.scenario import load_scenario
+
+
+def cli(argv, capsys):
+    with pytest.raises(SystemExit) as info:
+        run_cli(main, argv, prog="fpga_robotics.run")
+    out, err = capsys.readouterr()
+    return info.value.code, out, err
+
+
+@pytest.mark.parametrize("suffix", [".mp4", ".avi"])
+def test_saved_video_holds_the_camera_frames(suffix, tmp_path, monkeypatch, capsys):
+    import cv2
+
+    monkeypatch.chdir(tmp_path)
+    code, out, err = cli(["--backend", "model", "--duration", "2", "--rerun", "off", "--quiet",
+                          "--save-video", f"clip{suffix}"], capsys)
+    assert code == 0, err
+    assert sorted(p.name for p in tmp_path.iterdir()) == [f"clip{suffix}"]  # no temp file
+
+    frames = []
+    run_scenario(load_scenario("follow_person", ["sim.duration=2"]), backend="model",
+                 on_frame=lambda r: frames.append(r.camera_rgb))
+    cap = cv2.VideoCapture(str(tmp_path / f"clip{suffix}"))
+    decoded = []
+    while True:
+        ok, bgr = cap.read()
+        if not ok:
+            break
+        decoded.append(bgr[:, :, ::-1])
+    cap.release()
+    assert len(decoded) == len(frames) == 60
+    # Lossy codecs: close to the rendered frames, not equal (8-bit levels).
+    errors = [np.abs(d.astype(int) - f.astype(int)).mean() for d, f in zip(decoded, frames)]
+    assert max(errors) < 8
+
+
+def test_source_runs_the_design_on_the_saved_clip(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    assert cli(["--backend", "model", "--duration", "2", "--rerun", "off", "--quiet",
+                "--save-video", "clip.mp4"], capsys)[0] == 0
+    code, _out, err = cli(["--backend", "model", "--rerun", "off", "--quiet",
+                           "--source", "clip.mp4", "--summary", "s.json"], capsys)
+    assert code == 0, err
+    s = json.loads((tmp_path / "s.json").read_text())
+    assert s["frames"] == 60 and s["found_frames"] >= 57
