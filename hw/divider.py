@@ -5,11 +5,12 @@ from amaranth.lib import data, wiring
 from amaranth.lib.wiring import In, Out
 
 from .fit import load
+from .validate import CheckedArguments, check_int
 
 __all__ = ["SequentialDivider"]
 
 
-class SequentialDivider(wiring.Component):
+class SequentialDivider(CheckedArguments, wiring.Component):
     """Unsigned ``dividend // divisor`` for a quotient known to fit ``quotient_bits`` bits.
 
     Only ``quotient_bits`` steps are needed, not ``dividend_bits``: the partial remainder starts
@@ -46,17 +47,19 @@ class SequentialDivider(wiring.Component):
         The ``tag_in`` of the last ``start``, from the next edge until the next ``start``.
     """
 
+    @staticmethod
+    def check_arguments(dividend_bits, divisor_bits, quotient_bits, *, tag_bits=0):
+        """Raise ``TypeError``/``ValueError`` unless the constructor accepts the arguments."""
+        check_int("dividend_bits", dividend_bits, 1)
+        check_int("divisor_bits", divisor_bits, 1)
+        check_int("quotient_bits", quotient_bits, 1)
+        check_int("tag_bits", tag_bits, 0)
+
     def __init__(self, dividend_bits, divisor_bits, quotient_bits, *, tag_bits=0):
-        for name, value in (("dividend_bits", dividend_bits), ("divisor_bits", divisor_bits),
-                            ("quotient_bits", quotient_bits)):
-            if isinstance(value, bool) or not isinstance(value, int) or value < 1:
-                raise ValueError(f"{name} must be an int >= 1, got {value!r}")
-        if isinstance(tag_bits, bool) or not isinstance(tag_bits, int) or tag_bits < 0:
-            raise ValueError(f"tag_bits must be an int >= 0, got {tag_bits!r}")
-        self.dividend_bits = dividend_bits
-        self.divisor_bits = divisor_bits
-        self.quotient_bits = quotient_bits
-        self.tag_bits = tag_bits
+        self.dividend_bits = int(dividend_bits)
+        self.divisor_bits = int(divisor_bits)
+        self.quotient_bits = int(quotient_bits)
+        self.tag_bits = int(tag_bits)
         members = {
             "start": In(1),
             "dividend": In(dividend_bits),

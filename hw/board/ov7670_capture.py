@@ -27,12 +27,12 @@ from amaranth.lib.fifo import AsyncFIFO
 from amaranth.lib.wiring import In, Out
 
 from ..pixel import FramedPixel, PixelStream
-from ._checks import check_int
+from ..validate import CheckedArguments, check_int
 
 __all__ = ["OV7670Capture"]
 
 
-class OV7670Capture(wiring.Component):
+class OV7670Capture(CheckedArguments, wiring.Component):
     """Camera bytes in the ``pclk_domain`` to a framed RGB444 stream in ``sync``.
 
     Parameters
@@ -54,10 +54,14 @@ class OV7670Capture(wiring.Component):
         Sticky (until reset), in ``sync``: a pixel was dropped because the FIFO was full.
     """
 
+    @staticmethod
+    def check_arguments(*, pclk_domain="pclk", fifo_depth=16):
+        """Raise ``TypeError``/``ValueError`` unless ``OV7670Capture`` accepts the arguments."""
+        check_int("fifo_depth", fifo_depth, 4)
+
     def __init__(self, *, pclk_domain="pclk", fifo_depth=16):
-        check_int(self, "fifo_depth", fifo_depth, 4)
         self.pclk_domain = pclk_domain
-        self.fifo_depth = fifo_depth
+        self.fifo_depth = int(fifo_depth)
         super().__init__({
             "data": In(8),
             "href": In(1),
