@@ -1,5 +1,6 @@
 """FollowTargetParams: the contract's defaults, scaling, and clear validation errors."""
 
+import numpy as np
 import pytest
 
 from fpga_robotics.hw.params import FollowTargetParams
@@ -67,3 +68,11 @@ def test_wrong_types_raise_type_error():
         FollowTargetParams(width=160.0)
     with pytest.raises(TypeError, match="kp_num must be an int"):
         FollowTargetParams(kp_num=True)
+
+
+def test_numpy_integers_are_accepted_and_stored_as_int():
+    p = FollowTargetParams(width=np.int64(320), height=np.uint16(240), kp_num=np.int32(2),
+                           base_dps=tuple(np.arange(8, dtype=np.int16)))
+    assert (p.width, p.height, p.kp_num) == (320, 240, 2)
+    assert all(type(v) is int for v in (p.width, p.height, p.kp_num, *p.base_dps))
+    assert p == FollowTargetParams(width=320, height=240, kp_num=2, base_dps=tuple(range(8)))
