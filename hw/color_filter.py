@@ -6,16 +6,16 @@ from amaranth.lib.wiring import In, Out
 
 from .fit import load
 from .params import FollowTargetParams
-from .pixel import PixelStream
+from .pixel import pixel_stream_signature
 
-__all__ = ["ColorFilter", "MatchFlags", "MatchStream", "color_match_value"]
+__all__ = ["ColorFilter", "MatchFlags", "color_match_value", "match_stream_signature"]
 
 #: What the tracker needs of each filtered pixel: the framing flags and the match bit (in the
 #: order they sit in the filter's output register, right after the pixel).
 MatchFlags = data.StructLayout({"first": 1, "last": 1, "match": 1})
 
 
-def MatchStream():
+def match_stream_signature():
     """Signature of the per-pixel match stream from the filter to the tracker."""
     return stream.Signature(MatchFlags, always_ready=True)
 
@@ -85,13 +85,13 @@ class ColorFilter(wiring.Component):
 
     Members
     -------
-    pixels : ``In(PixelStream())``
+    pixels : ``In(pixel_stream_signature())``
         Camera pixels (cannot be stalled).
     color_sel : ``In(3)``
         Colour select, sampled with each pixel: bit 2 red, bit 1 green, bit 0 blue.
-    filtered : ``Out(PixelStream())``
+    filtered : ``Out(pixel_stream_signature())``
         Filtered pixels, ``latency`` cycles after the input.
-    matches : ``Out(MatchStream())``
+    matches : ``Out(match_stream_signature())``
         Match bit and framing flags, aligned with ``filtered``.
     """
 
@@ -100,10 +100,10 @@ class ColorFilter(wiring.Component):
             raise TypeError(f"params must be a FollowTargetParams, not {params!r}")
         self.params = params
         super().__init__({
-            "pixels": In(PixelStream()),
+            "pixels": In(pixel_stream_signature()),
             "color_sel": In(3),
-            "filtered": Out(PixelStream()),
-            "matches": Out(MatchStream()),
+            "filtered": Out(pixel_stream_signature()),
+            "matches": Out(match_stream_signature()),
         })
 
     @property

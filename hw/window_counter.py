@@ -4,14 +4,14 @@ from amaranth import Cat, Const, Module, Mux, Shape, Signal
 from amaranth.lib import data, wiring
 from amaranth.lib.wiring import In, Out
 
-from .color_filter import MatchStream
+from .color_filter import match_stream_signature
 from .fit import fit, load
 from .params import FollowTargetParams
 
-__all__ = ["FrameCounts", "WindowCounter"]
+__all__ = ["WindowCounter", "frame_counts_signature"]
 
 
-def FrameCounts(params):
+def frame_counts_signature(params):
     """Signature of a frame's counts (source side): ``end`` is a one-cycle strobe when
     ``bins`` (``h0..h7``) and ``sum_x`` (``SX``) are those of a complete, well-formed frame.
     ``N`` is the sum of the bins (every window column is in exactly one bin)."""
@@ -50,8 +50,8 @@ class WindowCounter(wiring.Component):
 
     Members
     -------
-    matches : ``In(MatchStream())``
-    counts : ``Out(FrameCounts(params))``
+    matches : ``In(match_stream_signature())``
+    counts : ``Out(frame_counts_signature(params))``
         The counts. ``counts.end`` shows right after edge P + ``latency`` when the frame's
         last pixel was sampled at edge P; the counts are only meaningful while ``end`` is high
         (in between, the bins are rotated and the current bin's count is still in the
@@ -63,8 +63,8 @@ class WindowCounter(wiring.Component):
             raise TypeError(f"params must be a FollowTargetParams, not {params!r}")
         self.params = params
         super().__init__({
-            "matches": In(MatchStream()),
-            "counts": Out(FrameCounts(params)),
+            "matches": In(match_stream_signature()),
+            "counts": Out(frame_counts_signature(params)),
         })
 
     @property

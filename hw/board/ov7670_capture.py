@@ -26,7 +26,7 @@ from amaranth.lib.cdc import FFSynchronizer
 from amaranth.lib.fifo import AsyncFIFO
 from amaranth.lib.wiring import In, Out
 
-from ..pixel import FramedPixel, PixelStream
+from ..pixel import FramedPixel, pixel_stream_signature
 from ..validate import CheckedArguments, check_int
 
 __all__ = ["OV7670Capture"]
@@ -48,7 +48,7 @@ class OV7670Capture(CheckedArguments, wiring.Component):
         Camera data D[7:0] (PCLK domain).
     href, vsync : In(1)
         Camera line and frame syncs (PCLK domain).
-    pixels : Out(PixelStream())
+    pixels : Out(pixel_stream_signature())
         Framed pixels in ``sync``, always ready.
     overflow : Out(1)
         Sticky (until reset), in ``sync``: a pixel was dropped because the FIFO was full.
@@ -66,7 +66,7 @@ class OV7670Capture(CheckedArguments, wiring.Component):
             "data": In(8),
             "href": In(1),
             "vsync": In(1),
-            "pixels": Out(PixelStream()),
+            "pixels": Out(pixel_stream_signature()),
             "overflow": Out(1),
         })
 
