@@ -1,6 +1,6 @@
 """Per-pixel colour filter: keeps the pixels of the selected colour, blacks out the others."""
 
-from amaranth import Cat, Const, Module, Mux, Signal
+from amaranth import Cat, Const, Module, Signal
 from amaranth.lib import data, stream, wiring
 from amaranth.lib.wiring import In, Out
 
@@ -31,7 +31,8 @@ def color_match_value(m, pixel, color_sel, params):
     exactly. No multiplexer depends on the pixel data and only the selected colour's
     comparisons are evaluated, so the compiled simulators do a few branch-free operations per
     pixel (simulation speed; measured faster than max/min multiplexers, than ``>=``
-    comparisons, which CXXRTL calls out of line, and than a lane-packed single subtraction).
+    comparisons, which CXXRTL calls out of line, and than a lane-packed single subtraction;
+    docs/hardware.md).
     """
     r, g, b = pixel.r, pixel.g, pixel.b
     d, s, wm = params.diff_min, params.similar_max, params.white_min
@@ -60,14 +61,13 @@ def color_match_value(m, pixel, color_sel, params):
         # white: max - min <= S and min >= white_min
         0b111: similar(r, g) & similar(r, b) & similar(g, b) & bright(r) & bright(g) & bright(b),
     }
-    # A tree of multiplexers on the bits of color_sel rather than a case statement: any
-    # colour is three bit tests away in the compiled simulators (a case became a chain of
-    # up to seven comparisons of color_sel).
-    choices = [by_code[code] for code in range(8)]
-    for bit in range(3):
-        choices = [Mux(color_sel[bit], hi, lo) for lo, hi in zip(choices[0::2], choices[1::2])]
+    # A plain case statement: the multiplexer tree on the bits of color_sel that it replaced
+    # was about 1% faster in CXXRTL (docs/hardware.md), not worth the odd form.
     match = Signal()
-    m.d.comb += match.eq(choices[0])
+    with m.Switch(color_sel):
+        for code, test in by_code.items():
+            with m.Case(code):
+                m.d.comb += match.eq(test)
     return match
 
 
