@@ -98,9 +98,7 @@ class SequentialDivider(CheckedArguments, wiring.Component):
         trial = Cat(low[-1], rem)  # rem * 2 + next dividend bit
         fits = trial >= divisor
 
-        # `steps > 1` as "any bit above bit 0": the compiled simulators compute an ordered
-        # comparison with a full carry chain, and this one is evaluated every clock.
-        stepping = steps[1:].any()
+        stepping = steps > 1  # as fast as testing the bits above bit 0 (docs/hardware.md)
         m.d.comb += [
             self.quotient.eq(low),
             self.busy.eq(stepping),
@@ -111,7 +109,7 @@ class SequentialDivider(CheckedArguments, wiring.Component):
             tag_value = {"tag": self.tag_in} if self.tag_bits else {}
             m.d.sync += load(state, steps=q_bits + 1, rem=self.dividend >> q_bits,
                              low=self.dividend[:q_bits], divisor=self.divisor, **tag_value)
-        with m.Elif(steps.any()):  # idle (0) in one test: the usual case, every clock
+        with m.Elif(steps != 0):  # idle (most clocks) costs this one test
             with m.If(stepping):
                 m.d.sync += load(state, steps=steps - 1, rem=Mux(fits, trial - divisor, trial),
                                  low=Cat(fits, low[:-1]))
