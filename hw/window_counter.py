@@ -33,7 +33,7 @@ class WindowCounter(wiring.Component):
     Built for simulation speed (the compiled simulators evaluate all of it every clock and
     pay for every register): per pixel there is one comparison of the column with the next
     bin boundary (a register, not eight pairs of constants), one add into a per-bin
-    accumulator and one masked add into ``SX``. The accumulator is added into a bin only at
+    accumulator and one add into ``SX``. The accumulator is added into a bin only at
     the bin's last column; the bins then rotate by one place, so the bin being filled is
     always the first and after the eight bins of a line they are back in order. Whether the
     row is inside the window is a register updated at line ends.
@@ -173,8 +173,8 @@ class WindowCounter(wiring.Component):
                 acc.eq(count & shape_ok), boundary.eq(first_boundary),
             ]
         with m.Elif(advance):
-            # A masked add rather than a conditional one: no branch on the pixel data.
-            m.d.sync += sx.eq(sx + (px & count.replicate(p.x_bits)))
+            with m.If(count):  # a masked add, which avoided this branch, was slower
+                m.d.sync += sx.eq(sx + px)
             with m.If(px == boundary):
                 # After bin 7 the next boundary is bin 0's of the next line.
                 next_boundary = Mux(boundary == last_boundary, first_boundary, boundary + bw)
