@@ -21,7 +21,8 @@ def match_stream_signature():
 
 
 def color_match_value(m, pixel, color_sel, params):
-    """Return a 1-bit signal: does RGB444 ``pixel`` match ``color_sel`` (hw-spec colour table)?
+    """Return a 1-bit signal: does RGB444 ``pixel`` match ``color_sel`` (the colour table of
+    docs/contract.md)?
 
     Every row of the table is written as an AND of differences compared with constants:
     ``a - max(b, c) >= D`` is ``a - b >= D and a - c >= D``; ``abs(a - b) <= S`` is

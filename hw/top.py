@@ -14,7 +14,7 @@ __all__ = ["FollowTarget", "follow_target_signature"]
 
 
 def follow_target_signature(params):
-    """The ports of ``follow_target`` (hw-spec table) for ``params``; shared with the
+    """The ports of ``follow_target`` (docs/contract.md, Ports) for ``params``; shared with the
     simulation flows' trivial stand-in design, so both drive the same harness."""
     return wiring.Signature({
         "pixels": In(pixel_stream_signature()),
@@ -31,7 +31,7 @@ def follow_target_signature(params):
 
 
 class FollowTarget(wiring.Component):
-    """The follow-target design of docs/hw-spec.md (Verilog module ``follow_target``).
+    """The follow-target design of docs/contract.md (Verilog module ``follow_target``).
 
     Parameters
     ----------

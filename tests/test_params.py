@@ -15,7 +15,7 @@ def test_defaults_are_the_published_values_at_160x120():
     assert p.proximity_thresholds == (128, 256, 512, 1024, 2048, 4096, 6144)
     assert p.base_dps == (0, 400, 300, 200, 150, 100, -100, -150)
     assert (p.kp_num, p.kp_shift, p.max_dps, p.lost_frames, p.search_dps) == (3, 0, 512, 15, 250)
-    assert p.x_bits == 8  # centroid_x is 8 bits at 160x120 (hw-spec port table)
+    assert p.x_bits == 8  # centroid_x is 8 bits at 160x120 (docs/contract.md, Ports)
 
 
 @pytest.mark.parametrize("w,h,scale,mx,my", [(320, 240, 4, 32, 16), (640, 480, 16, 64, 32)])
