@@ -1,27 +1,28 @@
 """Per-pixel colour filter: keeps the pixels of the selected colour, blacks out the others."""
 
-from amaranth import Cat, Const, Module, Mux, Signal
+from amaranth import Cat, Const, Module, Signal
 from amaranth.lib import data, stream, wiring
 from amaranth.lib.wiring import In, Out
 
 from .fit import load
 from .params import FollowTargetParams
-from .pixel import PixelStream
+from .pixel import pixel_stream_signature
 
-__all__ = ["ColorFilter", "MatchFlags", "MatchStream", "color_match_value"]
+__all__ = ["ColorFilter", "MatchFlags", "color_match_value", "match_stream_signature"]
 
 #: What the tracker needs of each filtered pixel: the framing flags and the match bit (in the
 #: order they sit in the filter's output register, right after the pixel).
 MatchFlags = data.StructLayout({"first": 1, "last": 1, "match": 1})
 
 
-def MatchStream():
+def match_stream_signature():
     """Signature of the per-pixel match stream from the filter to the tracker."""
     return stream.Signature(MatchFlags, always_ready=True)
 
 
 def color_match_value(m, pixel, color_sel, params):
-    """Return a 1-bit signal: does RGB444 ``pixel`` match ``color_sel`` (hw-spec colour table)?
+    """Return a 1-bit signal: does RGB444 ``pixel`` match ``color_sel`` (the colour table of
+    docs/contract.md)?
 
     Every row of the table is written as an AND of differences compared with constants:
     ``a - max(b, c) >= D`` is ``a - b >= D and a - c >= D``; ``abs(a - b) <= S`` is
@@ -31,7 +32,8 @@ def color_match_value(m, pixel, color_sel, params):
     exactly. No multiplexer depends on the pixel data and only the selected colour's
     comparisons are evaluated, so the compiled simulators do a few branch-free operations per
     pixel (simulation speed; measured faster than max/min multiplexers, than ``>=``
-    comparisons, which CXXRTL calls out of line, and than a lane-packed single subtraction).
+    comparisons, which CXXRTL calls out of line, and than a lane-packed single subtraction;
+    docs/hardware.md).
     """
     r, g, b = pixel.r, pixel.g, pixel.b
     d, s, wm = params.diff_min, params.similar_max, params.white_min
@@ -60,14 +62,13 @@ def color_match_value(m, pixel, color_sel, params):
         # white: max - min <= S and min >= white_min
         0b111: similar(r, g) & similar(r, b) & similar(g, b) & bright(r) & bright(g) & bright(b),
     }
-    # A tree of multiplexers on the bits of color_sel rather than a case statement: any
-    # colour is three bit tests away in the compiled simulators (a case became a chain of
-    # up to seven comparisons of color_sel).
-    choices = [by_code[code] for code in range(8)]
-    for bit in range(3):
-        choices = [Mux(color_sel[bit], hi, lo) for lo, hi in zip(choices[0::2], choices[1::2])]
+    # A plain case statement: the multiplexer tree on the bits of color_sel that it replaced
+    # was about 1% faster in CXXRTL (docs/hardware.md), not worth the odd form.
     match = Signal()
-    m.d.comb += match.eq(choices[0])
+    with m.Switch(color_sel):
+        for code, test in by_code.items():
+            with m.Case(code):
+                m.d.comb += match.eq(test)
     return match
 
 
@@ -85,13 +86,13 @@ class ColorFilter(wiring.Component):
 
     Members
     -------
-    pixels : ``In(PixelStream())``
+    pixels : ``In(pixel_stream_signature())``
         Camera pixels (cannot be stalled).
     color_sel : ``In(3)``
         Colour select, sampled with each pixel: bit 2 red, bit 1 green, bit 0 blue.
-    filtered : ``Out(PixelStream())``
+    filtered : ``Out(pixel_stream_signature())``
         Filtered pixels, ``latency`` cycles after the input.
-    matches : ``Out(MatchStream())``
+    matches : ``Out(match_stream_signature())``
         Match bit and framing flags, aligned with ``filtered``.
     """
 
@@ -100,10 +101,10 @@ class ColorFilter(wiring.Component):
             raise TypeError(f"params must be a FollowTargetParams, not {params!r}")
         self.params = params
         super().__init__({
-            "pixels": In(PixelStream()),
+            "pixels": In(pixel_stream_signature()),
             "color_sel": In(3),
-            "filtered": Out(PixelStream()),
-            "matches": Out(MatchStream()),
+            "filtered": Out(pixel_stream_signature()),
+            "matches": Out(match_stream_signature()),
         })
 
     @property

@@ -5,11 +5,12 @@ from amaranth.lib import data, wiring
 from amaranth.lib.wiring import In, Out
 
 from .fit import load
+from .validate import CheckedArguments, check_int
 
 __all__ = ["SequentialDivider"]
 
 
-class SequentialDivider(wiring.Component):
+class SequentialDivider(CheckedArguments, wiring.Component):
     """Unsigned ``dividend // divisor`` for a quotient known to fit ``quotient_bits`` bits.
 
     Only ``quotient_bits`` steps are needed, not ``dividend_bits``: the partial remainder starts
@@ -46,17 +47,19 @@ class SequentialDivider(wiring.Component):
         The ``tag_in`` of the last ``start``, from the next edge until the next ``start``.
     """
 
+    @staticmethod
+    def check_arguments(dividend_bits, divisor_bits, quotient_bits, *, tag_bits=0):
+        """Raise ``TypeError``/``ValueError`` unless the constructor accepts the arguments."""
+        check_int("dividend_bits", dividend_bits, 1)
+        check_int("divisor_bits", divisor_bits, 1)
+        check_int("quotient_bits", quotient_bits, 1)
+        check_int("tag_bits", tag_bits, 0)
+
     def __init__(self, dividend_bits, divisor_bits, quotient_bits, *, tag_bits=0):
-        for name, value in (("dividend_bits", dividend_bits), ("divisor_bits", divisor_bits),
-                            ("quotient_bits", quotient_bits)):
-            if isinstance(value, bool) or not isinstance(value, int) or value < 1:
-                raise ValueError(f"{name} must be an int >= 1, got {value!r}")
-        if isinstance(tag_bits, bool) or not isinstance(tag_bits, int) or tag_bits < 0:
-            raise ValueError(f"tag_bits must be an int >= 0, got {tag_bits!r}")
-        self.dividend_bits = dividend_bits
-        self.divisor_bits = divisor_bits
-        self.quotient_bits = quotient_bits
-        self.tag_bits = tag_bits
+        self.dividend_bits = int(dividend_bits)
+        self.divisor_bits = int(divisor_bits)
+        self.quotient_bits = int(quotient_bits)
+        self.tag_bits = int(tag_bits)
         members = {
             "start": In(1),
             "dividend": In(dividend_bits),
@@ -95,9 +98,7 @@ class SequentialDivider(wiring.Component):
         trial = Cat(low[-1], rem)  # rem * 2 + next dividend bit
         fits = trial >= divisor
 
-        # `steps > 1` as "any bit above bit 0": the compiled simulators compute an ordered
-        # comparison with a full carry chain, and this one is evaluated every clock.
-        stepping = steps[1:].any()
+        stepping = steps > 1  # as fast as testing the bits above bit 0 (docs/hardware.md)
         m.d.comb += [
             self.quotient.eq(low),
             self.busy.eq(stepping),
@@ -108,7 +109,7 @@ class SequentialDivider(wiring.Component):
             tag_value = {"tag": self.tag_in} if self.tag_bits else {}
             m.d.sync += load(state, steps=q_bits + 1, rem=self.dividend >> q_bits,
                              low=self.dividend[:q_bits], divisor=self.divisor, **tag_value)
-        with m.Elif(steps.any()):  # idle (0) in one test: the usual case, every clock
+        with m.Elif(steps != 0):  # idle (most clocks) costs this one test
             with m.If(stepping):
                 m.d.sync += load(state, steps=steps - 1, rem=Mux(fits, trial - divisor, trial),
                                  low=Cat(fits, low[:-1]))

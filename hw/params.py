@@ -8,6 +8,8 @@ Every value is validated on construction with an error that says what is wrong.
 
 from dataclasses import dataclass, field, fields
 
+from .validate import check_int
+
 __all__ = ["DEFAULT_BASE_DPS", "DEFAULT_PROXIMITY_THRESHOLDS", "FollowTargetParams"]
 
 #: Proximity thresholds at 160x120 (pixels in the window); scaled by ``area_scale``.
@@ -18,15 +20,6 @@ DEFAULT_BASE_DPS = (0, 400, 300, 200, 150, 100, -100, -150)
 DEFAULT_MIN_PIXELS = 128
 
 _INT16_MIN, _INT16_MAX = -(1 << 15), (1 << 15) - 1
-
-
-def _check_int(name, value, lo=None, hi=None):
-    if isinstance(value, bool) or not isinstance(value, int):
-        raise TypeError(f"{name} must be an int, not {type(value).__name__} {value!r}")
-    if lo is not None and value < lo:
-        raise ValueError(f"{name} must be >= {lo}, got {value}")
-    if hi is not None and value > hi:
-        raise ValueError(f"{name} must be <= {hi}, got {value}")
 
 
 @dataclass(frozen=True)
@@ -62,8 +55,8 @@ class FollowTargetParams:
     area_scale: int = field(init=False)
 
     def __post_init__(self):
-        _check_int("width", self.width, 16, 4096)
-        _check_int("height", self.height, 2, 4096)
+        self._check("width", 16, 4096)
+        self._check("height", 2, 4096)
         scale = max(1, (self.width * self.height) // (160 * 120))
         object.__setattr__(self, "area_scale", scale)
         if self.margin_x is None:
@@ -80,11 +73,21 @@ class FollowTargetParams:
         object.__setattr__(self, "base_dps", tuple(self.base_dps))
         self._validate()
 
+    def _check(self, name, lo=None, hi=None):
+        """``check_int`` of one field; the field keeps the plain ``int`` it returns."""
+        object.__setattr__(self, name, check_int(name, getattr(self, name), lo, hi))
+
+    def _check_each(self, name, lo, hi):
+        values = getattr(self, name)
+        object.__setattr__(self, name, tuple(
+            check_int(f"{name}[{i}]", v, lo, hi) for i, v in enumerate(values)
+        ))
+
     def _validate(self):
         for name in ("diff_min", "similar_max", "white_min"):
-            _check_int(name, getattr(self, name), 0, 15)
-        _check_int("margin_x", self.margin_x, 0)
-        _check_int("margin_y", self.margin_y, 0)
+            self._check(name, 0, 15)
+        self._check("margin_x", 0)
+        self._check("margin_y", 0)
         if self.window_width <= 0:
             raise ValueError(
                 f"margin_x={self.margin_x} leaves no window in a frame {self.width} wide"
@@ -100,14 +103,13 @@ class FollowTargetParams:
             )
         # A threshold above the window's pixel count is allowed: that level never occurs.
         max_count = (1 << 32) - 1
-        _check_int("min_pixels", self.min_pixels, 1, max_count)
+        self._check("min_pixels", 1, max_count)
         if len(self.proximity_thresholds) != 7:
             raise ValueError(
                 f"proximity_thresholds needs 7 values (levels 1..7), got "
                 f"{len(self.proximity_thresholds)}"
             )
-        for i, t in enumerate(self.proximity_thresholds):
-            _check_int(f"proximity_thresholds[{i}]", t, 0, max_count)
+        self._check_each("proximity_thresholds", 0, max_count)
         if list(self.proximity_thresholds) != sorted(self.proximity_thresholds):
             raise ValueError(
                 f"proximity_thresholds must be non-decreasing, got {self.proximity_thresholds}"
@@ -116,14 +118,13 @@ class FollowTargetParams:
             raise ValueError(
                 f"base_dps needs 8 values (one per proximity level 0..7), got {len(self.base_dps)}"
             )
-        for i, v in enumerate(self.base_dps):
-            _check_int(f"base_dps[{i}]", v, _INT16_MIN, _INT16_MAX)
-        _check_int("kp_num", self.kp_num, _INT16_MIN, _INT16_MAX)
-        _check_int("kp_shift", self.kp_shift, 0, 15)
-        _check_int("max_dps", self.max_dps, 0, _INT16_MAX)
-        _check_int("lost_frames", self.lost_frames, 1, (1 << 16) - 1)
+        self._check_each("base_dps", _INT16_MIN, _INT16_MAX)
+        self._check("kp_num", _INT16_MIN, _INT16_MAX)
+        self._check("kp_shift", 0, 15)
+        self._check("max_dps", 0, _INT16_MAX)
+        self._check("lost_frames", 1, (1 << 16) - 1)
         # -32768 is excluded: searching the other way negates it, which would wrap in 16 bits.
-        _check_int("search_dps", self.search_dps, -_INT16_MAX, _INT16_MAX)
+        self._check("search_dps", -_INT16_MAX, _INT16_MAX)
 
     # Window geometry -------------------------------------------------------------------------
 

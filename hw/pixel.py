@@ -8,7 +8,9 @@ The stream cannot be stalled (``always_ready``): a camera does not wait.
 
 from amaranth.lib import data, stream
 
-__all__ = ["COLOR_SELECT", "RGB444", "FramedPixel", "PixelStream", "color_select_value"]
+__all__ = [
+    "COLOR_SELECT", "RGB444", "FramedPixel", "color_select_value", "pixel_stream_signature",
+]
 
 
 #: One RGB444 pixel, 12 bits. Struct fields are laid out LSB first.
@@ -18,7 +20,7 @@ RGB444 = data.StructLayout({"b": 4, "g": 4, "r": 4})
 FramedPixel = data.StructLayout({"pixel": RGB444, "first": 1, "last": 1})
 
 
-def PixelStream():
+def pixel_stream_signature():
     """Signature of a framed, non-stallable pixel stream (source side)."""
     return stream.Signature(FramedPixel, always_ready=True)
 

@@ -7,19 +7,19 @@ from amaranth.lib.wiring import In, Out
 from .color_filter import ColorFilter
 from .motor import DPS_BITS, MotorController
 from .params import FollowTargetParams
-from .pixel import PixelStream
+from .pixel import pixel_stream_signature
 from .tracker import FrameTracker
 
 __all__ = ["FollowTarget", "follow_target_signature"]
 
 
 def follow_target_signature(params):
-    """The ports of ``follow_target`` (hw-spec table) for ``params``; shared with the
+    """The ports of ``follow_target`` (docs/contract.md, Ports) for ``params``; shared with the
     simulation flows' trivial stand-in design, so both drive the same harness."""
     return wiring.Signature({
-        "pixels": In(PixelStream()),
+        "pixels": In(pixel_stream_signature()),
         "color_sel": In(3),
-        "filtered": Out(PixelStream()),
+        "filtered": Out(pixel_stream_signature()),
         "frame_done": Out(1),
         "found": Out(1),
         "proximity": Out(3),
@@ -31,7 +31,7 @@ def follow_target_signature(params):
 
 
 class FollowTarget(wiring.Component):
-    """The follow-target design of docs/hw-spec.md (Verilog module ``follow_target``).
+    """The follow-target design of docs/contract.md (Verilog module ``follow_target``).
 
     Parameters
     ----------
@@ -40,11 +40,11 @@ class FollowTarget(wiring.Component):
 
     Members
     -------
-    pixels : ``In(PixelStream())``
+    pixels : ``In(pixel_stream_signature())``
         Camera pixels: RGB444 plus ``first`` (start of frame) and ``last`` (end of line).
     color_sel : ``In(3)``
         Colour to follow: bit 2 red, bit 1 green, bit 0 blue.
-    filtered : ``Out(PixelStream())``
+    filtered : ``Out(pixel_stream_signature())``
         Every pixel, black where it does not match; ``params.filter_latency`` cycles later.
     frame_done : ``Out(1)``
         One-cycle strobe: the per-frame outputs below show a new frame's values.

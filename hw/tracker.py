@@ -22,11 +22,11 @@ from amaranth import Const, Module, Mux, Signal
 from amaranth.lib import data, wiring
 from amaranth.lib.wiring import In, Out
 
-from .color_filter import MatchStream
+from .color_filter import match_stream_signature
 from .divider import SequentialDivider
 from .fit import load
 from .params import FollowTargetParams
-from .window_counter import FrameCounts, WindowCounter
+from .window_counter import WindowCounter, frame_counts_signature
 
 __all__ = ["LEDS_CENTRED", "FrameTracker", "TrackerResults"]
 
@@ -48,7 +48,7 @@ class FrameTracker(wiring.Component):
 
     Members
     -------
-    matches : ``In(MatchStream())``
+    matches : ``In(match_stream_signature())``
         Match bit and framing flags of every pixel (from ``ColorFilter``).
     frame_done : ``Out(1)``
         High for one cycle, the first cycle in which a frame's results show.
@@ -73,7 +73,7 @@ class FrameTracker(wiring.Component):
         self.counter = WindowCounter(params)
         self.results = TrackerResults(params, inspect=inspect)
         super().__init__({
-            "matches": In(MatchStream()),
+            "matches": In(match_stream_signature()),
             **_result_members(params, self.inspect),
         })
 
@@ -132,7 +132,7 @@ class TrackerResults(wiring.Component):
 
     Members
     -------
-    counts : ``In(FrameCounts(params))``
+    counts : ``In(frame_counts_signature(params))``
     frame_done, found, proximity, centroid_x, centroid_leds, count, bins, sum_x : ``Out``
         As in ``FrameTracker``.
     """
@@ -143,7 +143,7 @@ class TrackerResults(wiring.Component):
         self.params = params
         self.inspect = bool(inspect)
         super().__init__({
-            "counts": In(FrameCounts(params)),
+            "counts": In(frame_counts_signature(params)),
             **_result_members(params, self.inspect),
         })
 

@@ -1,17 +1,17 @@
 """Per-pixel half of the target tracker: framing, window, and the running counts of a frame."""
 
-from amaranth import Cat, Const, Module, Mux, Shape, Signal
+from amaranth import Cat, Const, Module, Mux, Signal
 from amaranth.lib import data, wiring
 from amaranth.lib.wiring import In, Out
 
-from .color_filter import MatchStream
-from .fit import fit, load
+from .color_filter import match_stream_signature
+from .fit import fit
 from .params import FollowTargetParams
 
-__all__ = ["FrameCounts", "WindowCounter"]
+__all__ = ["WindowCounter", "frame_counts_signature"]
 
 
-def FrameCounts(params):
+def frame_counts_signature(params):
     """Signature of a frame's counts (source side): ``end`` is a one-cycle strobe when
     ``bins`` (``h0..h7``) and ``sum_x`` (``SX``) are those of a complete, well-formed frame.
     ``N`` is the sum of the bins (every window column is in exactly one bin)."""
@@ -33,7 +33,7 @@ class WindowCounter(wiring.Component):
     Built for simulation speed (the compiled simulators evaluate all of it every clock and
     pay for every register): per pixel there is one comparison of the column with the next
     bin boundary (a register, not eight pairs of constants), one add into a per-bin
-    accumulator and one masked add into ``SX``. The accumulator is added into a bin only at
+    accumulator and one add into ``SX``. The accumulator is added into a bin only at
     the bin's last column; the bins then rotate by one place, so the bin being filled is
     always the first and after the eight bins of a line they are back in order. Whether the
     row is inside the window is a register updated at line ends.
@@ -50,8 +50,8 @@ class WindowCounter(wiring.Component):
 
     Members
     -------
-    matches : ``In(MatchStream())``
-    counts : ``Out(FrameCounts(params))``
+    matches : ``In(match_stream_signature())``
+    counts : ``Out(frame_counts_signature(params))``
         The counts. ``counts.end`` shows right after edge P + ``latency`` when the frame's
         last pixel was sampled at edge P; the counts are only meaningful while ``end`` is high
         (in between, the bins are rotated and the current bin's count is still in the
@@ -63,8 +63,8 @@ class WindowCounter(wiring.Component):
             raise TypeError(f"params must be a FollowTargetParams, not {params!r}")
         self.params = params
         super().__init__({
-            "matches": In(MatchStream()),
-            "counts": Out(FrameCounts(params)),
+            "matches": In(match_stream_signature()),
+            "counts": Out(frame_counts_signature(params)),
         })
 
     @property
@@ -116,15 +116,13 @@ class WindowCounter(wiring.Component):
         row_in = position[-1]
         # Counts: the bins (rotated during a line) and SX; the current bin's accumulator (the
         # matches so far in this bin and line) and the next bin boundary (the last column of a
-        # bin) in one register, the accumulator in the low bits: counting a pixel is one add
-        # to the whole register (it never carries into the boundary: at most bw pixels).
+        # bin). Two plain registers: packed into one (a single add counted a pixel) they were
+        # no faster (docs/hardware.md).
         cb = p.count_bits
         bins = Signal(8 * cb, reset_less=True)
         sx = Signal(p.sum_x_bits, reset_less=True)
-        acc_bits = Shape.cast(range(bw + 1)).width
-        bin_state = Signal(data.StructLayout({"acc": acc_bits, "boundary": p.x_bits}),
-                           reset_less=True)
-        acc, boundary = bin_state.acc, bin_state.boundary
+        acc = Signal(range(bw + 1), reset_less=True)
+        boundary = Signal(p.x_bits, reset_less=True)
         end = Signal()  # the last pixel of a well-formed frame was just counted
         m.d.comb += [
             self.counts.bins.eq(bins), self.counts.sum_x.eq(sx), self.counts.end.eq(end),
@@ -172,18 +170,18 @@ class WindowCounter(wiring.Component):
             # A `first` is column 0: never a bin's last column, and adds 0 to SX.
             m.d.sync += [
                 bins.eq(0), sx.eq(0),
-                load(bin_state, acc=count & shape_ok, boundary=first_boundary),
+                acc.eq(count & shape_ok), boundary.eq(first_boundary),
             ]
         with m.Elif(advance):
-            # A masked add rather than a conditional one: no branch on the pixel data.
-            m.d.sync += sx.eq(sx + (px & count.replicate(p.x_bits)))
+            with m.If(count):  # a masked add, which avoided this branch, was slower
+                m.d.sync += sx.eq(sx + px)
             with m.If(px == boundary):
                 # After bin 7 the next boundary is bin 0's of the next line.
                 next_boundary = Mux(boundary == last_boundary, first_boundary, boundary + bw)
                 m.d.sync += [
                     bins.eq(Cat(bins[cb:], fit(bins[:cb] + acc + count, cb))),
-                    load(bin_state, acc=0, boundary=next_boundary),
+                    acc.eq(0), boundary.eq(next_boundary),
                 ]
             with m.Else():
-                m.d.sync += bin_state.eq(bin_state.as_value() + count)
+                m.d.sync += acc.eq(acc + count)
         return m

@@ -108,8 +108,9 @@ def test_custom_limits():
     assert messages == [limits_message(1, 300, 50), limits_message(2, 300, 50)]
 
 
-@pytest.mark.parametrize("kwargs", [{"dps_limit": -1}, {"power_limit": 101},
-                                    {"startup_wait": 1.5}])
-def test_bad_arguments(kwargs):
-    with pytest.raises(ValueError):
+@pytest.mark.parametrize("kwargs,error", [({"dps_limit": -1}, ValueError),
+                                          ({"power_limit": 101}, ValueError),
+                                          ({"startup_wait": 1.5}, TypeError)])
+def test_bad_arguments(kwargs, error):
+    with pytest.raises(error):
         GoPiGo3Motors(half_period=HALF, **kwargs)

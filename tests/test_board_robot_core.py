@@ -2,13 +2,21 @@
 frames byte by byte; the GoPiGo3 messages decoded from the SPI wires and the LEDs must match
 the golden model of ``FollowTarget`` (speeds x 2 in ticks), so the board path adds no error."""
 
+import gc
+import warnings
+
 import numpy as np
 import pytest
-from amaranth.hdl import ClockDomain, Module
+from amaranth.hdl import ClockDomain, Fragment, Module, UnusedElaboratable
 from amaranth.sim import Simulator
 
+from fpga_robotics.hw.board.color_select import SwitchColorSelect
+from fpga_robotics.hw.board.gopigo3_spi import GoPiGo3Motors, SPIByteMaster
+from fpga_robotics.hw.board.ov7670_capture import OV7670Capture
 from fpga_robotics.hw.board.robot_core import RobotCore, RobotTiming
-from fpga_robotics.hw.board.sccb import RegisterWrite
+from fpga_robotics.hw.board.sccb import RegisterWrite, SCCBInit
+from fpga_robotics.hw.board.ulx3s_top import ULX3SFollowTarget
+from fpga_robotics.hw.divider import SequentialDivider
 from fpga_robotics.hw.params import FollowTargetParams
 from fpga_robotics.sim.model import FollowTargetModel
 
@@ -131,3 +139,28 @@ def test_robot_timing_from_clock():
     assert t.reset_wait == 500_000
     with pytest.raises(ValueError, match="even multiple"):
         RobotTiming(60e6)
+
+
+@pytest.mark.parametrize("make", [
+    lambda: ULX3SFollowTarget(FollowTargetParams(width=320, height=240)),
+    lambda: ULX3SFollowTarget(sys_clk_freq=60e6),
+    # Rejected by a part (the GoPiGo3's speed limit) before FollowTarget is built.
+    lambda: RobotCore(FollowTargetParams(max_dps=20000)),
+    lambda: RobotCore(PARAMS, RobotTiming.from_cycles(
+        xclk_half=0, sccb_quarter=2, spi_half=2, camera_wait=5, reset_wait=8, motor_wait=3)),
+    lambda: RobotCore(PARAMS, TIMING, sccb_table=[]),
+    lambda: SCCBInit(iter(TABLE), quarter_period=2, reset_wait=0),
+    lambda: GoPiGo3Motors(half_period=0),
+    lambda: SPIByteMaster(half_period=1.5),
+    lambda: OV7670Capture(fifo_depth=2),
+    lambda: SequentialDivider(8, 8, 0),
+])
+def test_a_rejected_constructor_leaves_no_unused_elaboratable(make):
+    # Amaranth reports unused elaboratables only once something has been elaborated.
+    Fragment.get(SwitchColorSelect(), None)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        with pytest.raises((TypeError, ValueError)):
+            make()
+        gc.collect()
+    assert [w for w in caught if issubclass(w.category, UnusedElaboratable)] == []

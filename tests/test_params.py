@@ -1,5 +1,6 @@
 """FollowTargetParams: the contract's defaults, scaling, and clear validation errors."""
 
+import numpy as np
 import pytest
 
 from fpga_robotics.hw.params import FollowTargetParams
@@ -14,7 +15,7 @@ def test_defaults_are_the_published_values_at_160x120():
     assert p.proximity_thresholds == (128, 256, 512, 1024, 2048, 4096, 6144)
     assert p.base_dps == (0, 400, 300, 200, 150, 100, -100, -150)
     assert (p.kp_num, p.kp_shift, p.max_dps, p.lost_frames, p.search_dps) == (3, 0, 512, 15, 250)
-    assert p.x_bits == 8  # centroid_x is 8 bits at 160x120 (hw-spec port table)
+    assert p.x_bits == 8  # centroid_x is 8 bits at 160x120 (docs/contract.md, Ports)
 
 
 @pytest.mark.parametrize("w,h,scale,mx,my", [(320, 240, 4, 32, 16), (640, 480, 16, 64, 32)])
@@ -67,3 +68,11 @@ def test_wrong_types_raise_type_error():
         FollowTargetParams(width=160.0)
     with pytest.raises(TypeError, match="kp_num must be an int"):
         FollowTargetParams(kp_num=True)
+
+
+def test_numpy_integers_are_accepted_and_stored_as_int():
+    p = FollowTargetParams(width=np.int64(320), height=np.uint16(240), kp_num=np.int32(2),
+                           base_dps=tuple(np.arange(8, dtype=np.int16)))
+    assert (p.width, p.height, p.kp_num) == (320, 240, 2)
+    assert all(type(v) is int for v in (p.width, p.height, p.kp_num, *p.base_dps))
+    assert p == FollowTargetParams(width=320, height=240, kp_num=2, base_dps=tuple(range(8)))

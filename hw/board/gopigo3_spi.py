@@ -27,7 +27,7 @@ from amaranth.hdl import Const, Module, Mux, Signal, signed
 from amaranth.lib import data, stream, wiring
 from amaranth.lib.wiring import In, Out
 
-from ._checks import check_int
+from ..validate import CheckedArguments, check_int
 
 __all__ = [
     "GOPIGO3_ADDRESS",
@@ -64,7 +64,7 @@ def dps_to_ticks(dps):
 SPIByte = data.StructLayout({"data": 8, "end": 1})
 
 
-class SPIByteMaster(wiring.Component):
+class SPIByteMaster(CheckedArguments, wiring.Component):
     """SPI mode 0 master, write-only, MSB first, one chip select.
 
     Chip select is asserted for the first byte and released after a byte marked ``end``; then
@@ -86,9 +86,13 @@ class SPIByteMaster(wiring.Component):
         Chip select, active high here (the board pin is inverted).
     """
 
+    @staticmethod
+    def check_arguments(*, half_period):
+        """Raise ``TypeError``/``ValueError`` unless ``SPIByteMaster`` accepts the arguments."""
+        check_int("half_period", half_period, 1)
+
     def __init__(self, *, half_period):
-        check_int(self, "half_period", half_period, 1)
-        self.half_period = half_period
+        self.half_period = int(half_period)
         super().__init__({
             "bytes": In(stream.Signature(SPIByte)),
             "sclk": Out(1),
@@ -148,7 +152,7 @@ class SPIByteMaster(wiring.Component):
         return m
 
 
-class GoPiGo3Motors(wiring.Component):
+class GoPiGo3Motors(CheckedArguments, wiring.Component):
     """Sends the GoPiGo3 its motor limits after reset, then the wheel speeds on every update.
 
     Parameters
@@ -174,15 +178,19 @@ class GoPiGo3Motors(wiring.Component):
         A message is being sent or waits to be sent.
     """
 
+    @staticmethod
+    def check_arguments(*, half_period, startup_wait=0, dps_limit=512, power_limit=0):
+        """Raise ``TypeError``/``ValueError`` unless ``GoPiGo3Motors`` accepts the arguments."""
+        SPIByteMaster.check_arguments(half_period=half_period)
+        check_int("startup_wait", startup_wait, 0)
+        check_int("dps_limit", dps_limit, 0, (1 << 14) - 1)
+        check_int("power_limit", power_limit, 0, 100)
+
     def __init__(self, *, half_period, startup_wait=0, dps_limit=512, power_limit=0):
-        check_int(self, "half_period", half_period, 1)
-        check_int(self, "startup_wait", startup_wait, 0)
-        check_int(self, "dps_limit", dps_limit, 0, (1 << 14) - 1)
-        check_int(self, "power_limit", power_limit, 0, 100)
-        self.half_period = half_period
-        self.startup_wait = startup_wait
-        self.dps_limit = dps_limit
-        self.power_limit = power_limit
+        self.half_period = int(half_period)
+        self.startup_wait = int(startup_wait)
+        self.dps_limit = int(dps_limit)
+        self.power_limit = int(power_limit)
         self.spi = SPIByteMaster(half_period=half_period)
         super().__init__({
             "update": In(1),

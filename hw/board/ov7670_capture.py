@@ -26,13 +26,13 @@ from amaranth.lib.cdc import FFSynchronizer
 from amaranth.lib.fifo import AsyncFIFO
 from amaranth.lib.wiring import In, Out
 
-from ..pixel import FramedPixel, PixelStream
-from ._checks import check_int
+from ..pixel import FramedPixel, pixel_stream_signature
+from ..validate import CheckedArguments, check_int
 
 __all__ = ["OV7670Capture"]
 
 
-class OV7670Capture(wiring.Component):
+class OV7670Capture(CheckedArguments, wiring.Component):
     """Camera bytes in the ``pclk_domain`` to a framed RGB444 stream in ``sync``.
 
     Parameters
@@ -48,21 +48,25 @@ class OV7670Capture(wiring.Component):
         Camera data D[7:0] (PCLK domain).
     href, vsync : In(1)
         Camera line and frame syncs (PCLK domain).
-    pixels : Out(PixelStream())
+    pixels : Out(pixel_stream_signature())
         Framed pixels in ``sync``, always ready.
     overflow : Out(1)
         Sticky (until reset), in ``sync``: a pixel was dropped because the FIFO was full.
     """
 
+    @staticmethod
+    def check_arguments(*, pclk_domain="pclk", fifo_depth=16):
+        """Raise ``TypeError``/``ValueError`` unless ``OV7670Capture`` accepts the arguments."""
+        check_int("fifo_depth", fifo_depth, 4)
+
     def __init__(self, *, pclk_domain="pclk", fifo_depth=16):
-        check_int(self, "fifo_depth", fifo_depth, 4)
         self.pclk_domain = pclk_domain
-        self.fifo_depth = fifo_depth
+        self.fifo_depth = int(fifo_depth)
         super().__init__({
             "data": In(8),
             "href": In(1),
             "vsync": In(1),
-            "pixels": Out(PixelStream()),
+            "pixels": Out(pixel_stream_signature()),
             "overflow": Out(1),
         })
 

@@ -14,7 +14,7 @@ from amaranth.lib.wiring import In, Out
 
 from ..params import FollowTargetParams
 from ..top import FollowTarget
-from ._checks import check_int
+from ..validate import CheckedArguments, check_int
 from .color_select import SwitchColorSelect
 from .gopigo3_spi import GoPiGo3Motors
 from .ov7670_capture import OV7670Capture
@@ -64,7 +64,7 @@ class RobotTiming:
         return t
 
 
-class RobotCore(wiring.Component):
+class RobotCore(CheckedArguments, wiring.Component):
     """The robot's logic between the board pins (see module docstring).
 
     Parameters
@@ -94,12 +94,25 @@ class RobotCore(wiring.Component):
         SCCB table written; a pixel was lost in the clock crossing (sticky).
     """
 
+    @staticmethod
+    def check_arguments(params=None, timing=None, *, sccb_table=OV7670_INIT):
+        """Raise ``TypeError``/``ValueError`` unless ``RobotCore`` accepts the arguments,
+        its parts' included (so that none of them is built when one would be rejected)."""
+        params = FollowTargetParams() if params is None else params
+        t = RobotTiming() if timing is None else timing
+        if not isinstance(params, FollowTargetParams):
+            raise TypeError(f"params must be a FollowTargetParams, not {params!r}")
+        for name in ("xclk_half", "sccb_quarter", "spi_half"):
+            check_int(name, getattr(t, name), 1)
+        SCCBInit.check_arguments(sccb_table, quarter_period=t.sccb_quarter,
+                                 reset_wait=t.reset_wait, startup_wait=t.camera_wait)
+        GoPiGo3Motors.check_arguments(half_period=t.spi_half, startup_wait=t.motor_wait,
+                                      dps_limit=params.max_dps)
+
     def __init__(self, params=None, timing=None, *, sccb_table=OV7670_INIT):
         self.params = FollowTargetParams() if params is None else params
         self.timing = RobotTiming() if timing is None else timing
         t = self.timing
-        for name in ("xclk_half", "sccb_quarter", "spi_half"):
-            check_int(self, name, getattr(t, name), 1)
         self.design = FollowTarget(self.params)
         self.sccb = SCCBInit(sccb_table, quarter_period=t.sccb_quarter,
                              reset_wait=t.reset_wait, startup_wait=t.camera_wait)

@@ -21,7 +21,7 @@ from amaranth.hdl import Cat, Const, Module, Signal
 from amaranth.lib import wiring
 from amaranth.lib.wiring import Out
 
-from ._checks import check_int
+from ..validate import CheckedArguments, check_int
 
 __all__ = ["OV7670_INIT", "OV7670_SCCB_ID", "RegisterWrite", "SCCBInit"]
 
@@ -66,7 +66,7 @@ OV7670_INIT = (
 _BITS = 27
 
 
-class SCCBInit(wiring.Component):
+class SCCBInit(CheckedArguments, wiring.Component):
     """Writes a register table over SCCB once after reset, then holds the bus idle.
 
     Parameters
@@ -93,24 +93,30 @@ class SCCBInit(wiring.Component):
         High once the whole table has been written.
     """
 
-    def __init__(self, table=OV7670_INIT, *, quarter_period, reset_wait, startup_wait=0,
-                 device_id=OV7670_SCCB_ID):
-        table = tuple(table)
+    @staticmethod
+    def check_arguments(table=OV7670_INIT, *, quarter_period, reset_wait, startup_wait=0,
+                        device_id=OV7670_SCCB_ID):
+        """Raise ``TypeError``/``ValueError`` unless ``SCCBInit`` accepts these arguments."""
+        if iter(table) is table:  # read once here and once by the constructor
+            raise TypeError("the SCCB register table must be a sequence, not an iterator")
         if not table:
-            self._MustUse__silence = True
             raise ValueError("the SCCB register table is empty")
         for i, w in enumerate(table):
-            check_int(self, f"table[{i}].reg (a byte)", w.reg, 0, 0xFF)
-            check_int(self, f"table[{i}].value (a byte)", w.value, 0, 0xFF)
-        check_int(self, "quarter_period", quarter_period, 1)
-        check_int(self, "reset_wait", reset_wait, 0)
-        check_int(self, "startup_wait", startup_wait, 0)
-        check_int(self, "device_id", device_id, 0, 0xFF)
+            check_int(f"table[{i}].reg (a byte)", w.reg, 0, 0xFF)
+            check_int(f"table[{i}].value (a byte)", w.value, 0, 0xFF)
+        check_int("quarter_period", quarter_period, 1)
+        check_int("reset_wait", reset_wait, 0)
+        check_int("startup_wait", startup_wait, 0)
+        check_int("device_id", device_id, 0, 0xFF)
+
+    def __init__(self, table=OV7670_INIT, *, quarter_period, reset_wait, startup_wait=0,
+                 device_id=OV7670_SCCB_ID):
+        table = tuple(table)  # checked in check_arguments, before the component existed
         self.table = table
-        self.quarter_period = quarter_period
-        self.reset_wait = reset_wait
-        self.startup_wait = startup_wait
-        self.device_id = device_id
+        self.quarter_period = int(quarter_period)
+        self.reset_wait = int(reset_wait)
+        self.startup_wait = int(startup_wait)
+        self.device_id = int(device_id)
         super().__init__({
             "sioc": Out(1, init=1),
             "siod_o": Out(1, init=1),

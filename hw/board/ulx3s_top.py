@@ -18,6 +18,7 @@ from amaranth.lib.cdc import ResetSynchronizer
 from amaranth_boards.ulx3s import ULX3S_85F_Platform
 
 from ..params import FollowTargetParams
+from ..validate import CheckedArguments
 from .clocking import BoardClocking
 from .pins import camera_resources, gopigo3_spi_resources
 from .robot_core import RobotCore, RobotTiming
@@ -35,7 +36,7 @@ def ulx3s_platform():
     return platform
 
 
-class ULX3SFollowTarget(Elaboratable):
+class ULX3SFollowTarget(CheckedArguments, Elaboratable):
     """Board top: ``RobotCore`` (with ``FollowTarget``) wired to the ULX3S.
 
     Parameters
@@ -47,14 +48,22 @@ class ULX3SFollowTarget(Elaboratable):
         Design clock in Hz (an even multiple of the 12.5 MHz XCLK).
     """
 
-    def __init__(self, params=None, *, sys_clk_freq=SYS_CLK_FREQ):
+    @staticmethod
+    def check_arguments(params=None, *, sys_clk_freq=SYS_CLK_FREQ):
+        """Raise ``TypeError``/``ValueError`` unless ``ULX3SFollowTarget`` accepts the
+        arguments (``RobotCore``'s included)."""
         params = FollowTargetParams() if params is None else params
+        if not isinstance(params, FollowTargetParams):
+            raise TypeError(f"params must be a FollowTargetParams, not {params!r}")
         if (params.width, params.height) != (160, 120):
-            self._MustUse__silence = True  # rejected: nothing to elaborate
             raise ValueError(
                 f"the OV7670 is set up for QQVGA (160x120) but the design is "
                 f"{params.width}x{params.height}; build the board with the default geometry"
             )
+        RobotCore.check_arguments(params, RobotTiming(sys_clk_freq))
+
+    def __init__(self, params=None, *, sys_clk_freq=SYS_CLK_FREQ):
+        params = FollowTargetParams() if params is None else params
         self.params = params
         self.sys_clk_freq = sys_clk_freq
         self.core = RobotCore(params, RobotTiming(sys_clk_freq))
