@@ -28,9 +28,9 @@ class PassThrough(wiring.Component):
 
     Members
     -------
-    pixels : In(PixelStream)
+    pixels : In(pixel_stream_signature())
     color_sel : In(3)
-    filtered : Out(PixelStream)
+    filtered : Out(pixel_stream_signature())
         ``pixels`` one cycle later, unchanged.
     frame_done, found, proximity, centroid_x, centroid_leds, motor_left, motor_right : Out
         ``frame_done`` pulses two cycles after the frame's last pixel (so that the last
