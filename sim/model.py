@@ -1,4 +1,4 @@
-"""Golden model of ``FollowTarget`` in numpy, written from docs/hw-spec.md (not from the RTL).
+"""Golden model of ``FollowTarget`` in numpy, written from docs/contract.md (not from the RTL).
 
 Reading of the contract where it leaves room (the gateware must agree):
 

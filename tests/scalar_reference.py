@@ -1,6 +1,6 @@
 """Plain-Python reference formulas of the hardware contract, one pixel / one loop at a time.
 
-Written straight from the tables of docs/hw-spec.md with Python ints, independently of the
+Written straight from the tables of docs/contract.md with Python ints, independently of the
 vectorised numpy model, so that tests can compare the two.
 """
 

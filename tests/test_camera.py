@@ -394,7 +394,7 @@ def test_red_shirt_of_the_default_person_passes_the_red_filter():
                           angle + math.pi, height=0.3)
         noise = {"noise_std": 2.0, "rng": np.random.default_rng(k)} if k % 2 else {}
         r, g, b = unpack_rgb444(to_rgb444(renderer.render(scene, pose, **noise), w, h))
-        red = (r - np.maximum(g, b)) >= 6  # hw-spec colour filter, color_sel red, D = 6
+        red = (r - np.maximum(g, b)) >= 6  # docs/contract.md colour filter, color_sel red, D = 6
         near = dist - person.radius
         rows = slice(math.ceil(h / 2 - f * (shirt.z1 - 0.3) / near) + 1,
                      math.ceil(h / 2 - f * (shirt.z0 - 0.3) / near) - 1)

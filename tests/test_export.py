@@ -1,4 +1,4 @@
-"""Verilog export: the port table of docs/hw-spec.md, Verilator lint, the CLI and its errors."""
+"""Verilog export: the port table of docs/contract.md, Verilator lint, the CLI and its errors."""
 
 import hashlib
 import os
@@ -14,7 +14,7 @@ from fpga_robotics.hw.verilog import generate_verilog
 from fpga_robotics.sim.files import default_file_mode
 from fpga_robotics.sim.backends.toolchain import verilator_root
 
-#: hw-spec's interface table: port -> (direction, width) at 160x120.
+#: The port table of docs/contract.md: port -> (direction, width) at 160x120.
 SPEC_PORTS = {
     "clk": ("input", 1),
     "rst": ("input", 1),

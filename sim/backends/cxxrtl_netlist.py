@@ -18,7 +18,7 @@ __all__ = [
     "without_port_copies",
 ]
 
-#: The output ports of the hw-spec port list that the frame driver reads.
+#: The output ports of the port list in docs/contract.md that the frame driver reads.
 OUTPUTS = (
     "filtered__valid",
     "filtered__payload",

@@ -1,6 +1,6 @@
 """The designs the compiled backends can build: ``FollowTarget`` (what every backend
 simulates) and ``PassThrough`` (the benchmark's one-pixel-per-clock reference). Both have the
-port list of hw-spec.md, so one harness drives either.
+port list of docs/contract.md, so one harness drives either.
 """
 
 import functools
