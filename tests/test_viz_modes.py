@@ -9,10 +9,9 @@ from urllib.parse import parse_qs, urlsplit
 import numpy as np
 import pytest
 
-from fpga_robotics.errors import UsageError
-from fpga_robotics.sim.records import FrameRecord
 from fpga_robotics.sim.backends.base import FrameResult
-from fpga_robotics.viz import open_recorder, parse_mode, sinks
+from fpga_robotics.sim.records import FrameRecord
+from fpga_robotics.viz import ViewerError, open_recorder, parse_mode, sinks
 from fpga_robotics.viz import paths as P
 from fpga_robotics.viz.modes import DEFAULT_CONNECT_URL, display_available, port_is_listening
 from fpga_robotics.viz.readback import read_rrd
@@ -90,7 +89,7 @@ def test_parse_valid_modes(text, kind, path, url):
     ],
 )
 def test_bad_modes_are_usage_errors(text, hint):
-    with pytest.raises(UsageError, match=hint):
+    with pytest.raises(ViewerError, match=hint):
         parse_mode(text, "d.rrd")
 
 
@@ -106,7 +105,7 @@ def test_bad_modes_are_usage_errors(text, hint):
     ],
 )
 def test_bad_options_are_usage_errors(kwargs, tmp_path):
-    with pytest.raises(UsageError):
+    with pytest.raises(ViewerError):
         open_recorder("off", default_path=str(tmp_path / "x.rrd"), **kwargs)
 
 
@@ -133,7 +132,8 @@ def test_spawn_without_display_saves_to_the_default_file(tmp_path, monkeypatch, 
     path = tmp_path / "fallback.rrd"
     rec = open_recorder("spawn", default_path=str(path))
     assert rec.mode == "save"
-    assert "no display" in capsys.readouterr().err
+    assert "no display" in " ".join(rec.pop_notices())
+    assert capsys.readouterr().err == ""  # told through notices, never printed
     for i in range(3):
         rec.log_frame(frame(i))
     msg = rec.close()
@@ -159,7 +159,7 @@ def test_spawn_without_any_file_to_fall_back_on_is_a_usage_error(monkeypatch):
     monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
     monkeypatch.setattr(sys, "platform", "linux")
     no_viewer_running(monkeypatch)
-    with pytest.raises(UsageError, match="save:PATH.rrd"):
+    with pytest.raises(ViewerError, match="save:PATH.rrd"):
         open_recorder("spawn", default_path=None)
 
 
@@ -218,7 +218,7 @@ def test_serve_hosts_grpc_and_web_viewer(tmp_path, capsys):
         web = urlsplit(rec.web_url)
         assert port_is_listening("127.0.0.1", web.port)
         assert parse_qs(web.query)["url"] == [rec.live_url]
-        assert rec.live_url in capsys.readouterr().err  # said when it starts
+        assert rec.live_url in " ".join(rec.pop_notices())  # told when it starts
         rec.log_frame(frame(0))
     finally:
         msg = rec.close()

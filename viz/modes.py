@@ -16,7 +16,7 @@ import sys
 from dataclasses import dataclass
 from urllib.parse import urlsplit
 
-from ..errors import UsageError
+from .errors import ViewerError
 
 __all__ = [
     "DEFAULT_CONNECT_URL",
@@ -80,47 +80,47 @@ def port_is_listening(host, port, timeout=0.3):
 
 def _check_rrd_path(path, where):
     if not path:
-        raise UsageError(f"{where}: the file name is empty; use save:PATH.rrd, e.g. save:run.rrd")
+        raise ViewerError(f"{where}: the file name is empty; use save:PATH.rrd, e.g. save:run.rrd")
     if not path.endswith(".rrd"):
-        raise UsageError(
+        raise ViewerError(
             f"{where}: {path!r} does not end in .rrd; rerun opens .rrd files, e.g. save:run.rrd"
         )
     if os.path.isdir(path):
-        raise UsageError(f"{where}: {path!r} is a directory; give a file name ending in .rrd")
+        raise ViewerError(f"{where}: {path!r} is a directory; give a file name ending in .rrd")
     return path
 
 
 def _check_url(url):
     parts = urlsplit(url)
     if parts.scheme not in _URL_SCHEMES or not parts.hostname:
-        raise UsageError(
+        raise ViewerError(
             f"connect:{url}: not a rerun viewer URL; use e.g. connect:{DEFAULT_CONNECT_URL} "
             f"(scheme rerun+http, rerun+https or rerun)"
         )
     try:
         parts.port  # noqa: B018 - raises on a malformed port
     except ValueError:
-        raise UsageError(f"connect:{url}: the port is not a number 0..65535") from None
+        raise ViewerError(f"connect:{url}: the port is not a number 0..65535") from None
     return url
 
 
 def parse_mode(mode, default_path, *, environ=None, platform=None):
     """Parse a mode string into a ``Mode``; ``auto``/``None`` picks ``spawn`` or ``save``.
 
-    Raises ``UsageError`` naming the valid modes when ``mode`` is not one of them.
+    Raises ``ViewerError`` naming the valid modes when ``mode`` is not one of them.
     """
     if mode is None:
         mode = "auto"
     if not isinstance(mode, str):
-        raise UsageError(f"the viewer mode must be a string, not {type(mode).__name__}")
+        raise ViewerError(f"the viewer mode must be a string, not {type(mode).__name__}")
     default = _check_rrd_path(default_path, "the default recording path") if default_path else None
     kind, sep, arg = mode.strip().partition(":")
     kind = kind.lower()
     valid = "save:PATH.rrd, spawn, connect[:URL], serve, off, auto"
     if kind not in MODE_KINDS:
-        raise UsageError(f"unknown viewer mode {mode!r}; choose one of: {valid}")
+        raise ViewerError(f"unknown viewer mode {mode!r}; choose one of: {valid}")
     if kind in ("spawn", "serve", "off", "auto") and sep:
-        raise UsageError(
+        raise ViewerError(
             f"viewer mode {kind!r} takes no argument (got {mode!r}); choose one of: {valid}"
         )
     if kind == "auto":
@@ -128,7 +128,7 @@ def parse_mode(mode, default_path, *, environ=None, platform=None):
     if kind == "save":
         path = arg if sep else default
         if not sep and path is None:
-            raise UsageError("viewer mode 'save' needs a file: use save:PATH.rrd")
+            raise ViewerError("viewer mode 'save' needs a file: use save:PATH.rrd")
         return Mode("save", path=_check_rrd_path(path, f"save:{arg}"))
     if kind == "connect":
         url = _check_url(arg) if sep else DEFAULT_CONNECT_URL

@@ -16,12 +16,10 @@ What is logged per frame (entity paths in ``viz.paths``):
 
 import math
 import os
-import sys
 import uuid
 
 import rerun as rr
 
-from ..errors import UsageError
 from . import paths as P
 from .blueprint import default_blueprint
 from .columns import (
@@ -35,6 +33,7 @@ from .columns import (
     strips,
     time_ns,
 )
+from .errors import ViewerError
 from .images import check_jpeg_quality, encode_frame, filtered_rgb
 from .leds import centroid_image, proximity_image
 from .modes import parse_mode
@@ -88,7 +87,7 @@ _DEFAULT_RAY = 1.0  # length of the field-of-view rays when no world map gave a 
 
 def _check_log_every(n):
     if isinstance(n, bool) or not isinstance(n, int) or n < 1:
-        raise UsageError(f"log_every must be an integer >= 1, got {n!r}")
+        raise ViewerError(f"log_every must be an integer >= 1, got {n!r}")
     return n
 
 
@@ -144,6 +143,8 @@ class Recorder:
         self.images_logged = 0
         self.viewer_pid = None
         self.live_url = self.web_url = None
+        self.notices = []
+        self._told = 0
         self._closed = False
         self._message = None
         self._ray = _DEFAULT_RAY
@@ -153,6 +154,13 @@ class Recorder:
         if stream is not None:
             self._columns = ColumnBuffer(stream, _COLUMN_BUILDERS)
             self._log_static_styles()
+
+    def pop_notices(self):
+        """The lines for the user not taken yet (e.g. where a live run can be watched, or why
+        the recording goes to a file instead): the caller prints them, the library never does."""
+        new = self.notices[self._told :]
+        self._told = len(self.notices)
+        return new
 
     def _check_open(self):
         if self._closed:
@@ -357,7 +365,7 @@ def open_recorder(mode, *, default_path, app_id="fpga_robotics", log_every=1, jp
 
     Raises
     ------
-    UsageError
+    ViewerError
         A malformed mode, ``log_every`` or ``jpeg_quality``.
     """
     parsed = parse_mode(mode, default_path)
@@ -373,6 +381,7 @@ def open_recorder(mode, *, default_path, app_id="fpga_robotics", log_every=1, jp
         tmp = attach_save(stream, parsed.path)
         return Recorder(stream, "save", path=parsed.path, temp_path=tmp, **options)
     viewer_pid = grpc_url = web_url = None
+    opening = []
     try:
         if parsed.kind == "spawn":
             description, viewer_pid = attach_spawn(stream)
@@ -380,18 +389,20 @@ def open_recorder(mode, *, default_path, app_id="fpga_robotics", log_every=1, jp
             description = attach_connect(stream, parsed.url)
         else:
             grpc_url, web_url, how = attach_serve(stream)
-            # Said now, not at the end: the point of serving is to watch while it runs.
-            print(f"fpga_robotics.viz: serving live: {how}", file=sys.stderr)
+            # Told now, not at the end: the point of serving is to watch while it runs.
+            opening.append(f"serving live: {how}")
             description = f"served live at {grpc_url} (closed at the end of the run)"
     except SinkUnavailable as exc:
         if parsed.path is None:
-            raise UsageError(
+            raise ViewerError(
                 f"viewer mode {parsed.kind!r} cannot work here ({exc}); use save:PATH.rrd"
             ) from None
         notice = f"{parsed.kind}: {exc}, so the recording was saved to a file instead"
-        print(f"fpga_robotics.viz: {notice} ({parsed.path})", file=sys.stderr)
         tmp = attach_save(stream, parsed.path)
-        return Recorder(stream, "save", path=parsed.path, temp_path=tmp, notice=notice, **options)
+        rec = Recorder(stream, "save", path=parsed.path, temp_path=tmp, notice=notice, **options)
+        rec.notices.append(f"{notice} ({parsed.path})")
+        return rec
     rec = Recorder(stream, parsed.kind, description=description, **options)
+    rec.notices.extend(opening)
     rec.viewer_pid, rec.live_url, rec.web_url = viewer_pid, grpc_url, web_url
     return rec

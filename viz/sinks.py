@@ -16,7 +16,7 @@ from urllib.parse import quote, urlsplit
 
 import rerun as rr
 
-from ..errors import UsageError
+from .errors import ViewerError
 from .modes import DEFAULT_VIEWER_PORT, DEFAULT_WEB_PORT, display_available, port_is_listening
 
 __all__ = ["SinkUnavailable", "attach_connect", "attach_save", "attach_serve", "attach_spawn"]
@@ -48,7 +48,7 @@ def attach_save(stream, path):
             pass
         stream.save(tmp)
     except OSError as exc:
-        raise UsageError(f"cannot write the recording {path}: {exc.strerror or exc}") from None
+        raise ViewerError(f"cannot write the recording {path}: {exc.strerror or exc}") from None
     return tmp
 
 
