@@ -313,10 +313,10 @@ def test_file_appears_only_when_closed(tmp_path):
         rec.log_frame(make_frames(1)[0])
 
 
-def test_unwritable_folder_is_a_usage_error(tmp_path):
+def test_a_path_below_a_file_is_a_viewer_error(tmp_path):
     blocker = tmp_path / "file"
     blocker.write_text("not a folder")
-    with pytest.raises(ViewerError, match="cannot write the recording"):
+    with pytest.raises(ViewerError, match="is not a folder"):
         open_recorder(f"save:{blocker}/run.rrd", default_path=str(tmp_path / "d.rrd"))
 
 
