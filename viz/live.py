@@ -45,9 +45,10 @@ class BoundedCall:
 class LiveLink:
     """The network side of a stream: its rerun sockets (``viz.sockets.Connections``)."""
 
-    def __init__(self, connections, what):
+    def __init__(self, connections, what, *, check_delivery=True):
         self.connections = connections
         self.what = what  # e.g. "the rerun viewer at rerun+http://..."
+        self.check_delivery = check_delivery  # a client: its connection must last to the end
         self.closed = False
         _OPEN.add(self)
 
@@ -66,12 +67,28 @@ class LiveLink:
                     problem = f"{self.what} failed ({flush.error})"
                 # Otherwise rerun's disconnect would wait for that peer forever.
                 self.connections.sever()
+            elif self.check_delivery and not self.connections.alive():
+                # rerun only logs a lost connection when it also writes a file: look ourselves.
+                problem = f"the connection to {self.what} was lost during the run"
             disconnect = BoundedCall(stream.disconnect, "viz-disconnect")
             if not disconnect.wait(DISCONNECT_TIMEOUT_S):
                 self.connections.sever()
                 if not disconnect.wait(DISCONNECT_TIMEOUT_S):
                     problem = problem or f"the connection to {self.what} did not close"
+            if not self.check_delivery:
+                # A stopped rerun server keeps the connections it accepted: end them too.
+                self.connections.sever()
             return problem is None, problem
+        finally:
+            self.closed = True
+            _OPEN.discard(self)
+
+    def abort(self, stream):
+        """After an interrupt: cut the network side, then let rerun write out the rest (the
+        file copy) within ``DISCONNECT_TIMEOUT_S``."""
+        try:
+            self.connections.sever()
+            BoundedCall(stream.disconnect, "viz-disconnect").wait(DISCONNECT_TIMEOUT_S)
         finally:
             self.closed = True
             _OPEN.discard(self)

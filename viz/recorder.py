@@ -298,7 +298,13 @@ class Recorder:
             try:
                 self._columns.flush()
                 confirmed, problem = self._output.finish(self._stream)
-            finally:  # even on a second Ctrl-C: the file gets its name or is removed
+            except BaseException:  # Ctrl-C while closing: still hand over every logged row
+                try:
+                    self._columns.flush()  # the rows not sent yet are still buffered
+                finally:
+                    self._output.abort(self._stream)
+                raise
+            finally:  # even on a second Ctrl-C: the file gets its real name
                 self.notices.append(self._settle(confirmed, problem))
         self._message = "\n".join(self.pop_notices())
         return self._message
@@ -397,7 +403,7 @@ def open_recorder(mode, *, default_path, app_id="fpga_robotics", log_every=1, jp
         return Recorder(stream, output, **options)
     except BaseException:  # e.g. Ctrl-C right now: no recorder to close, so no file either
         try:
-            output.finish(stream)
+            output.abort(stream)
         finally:
             if output.file is not None:
                 output.file.discard()

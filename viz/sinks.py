@@ -81,6 +81,21 @@ class Output:
             for proc in self.processes:
                 stop_process(proc)
 
+    def abort(self, stream):
+        """End the stream at once after an interrupt, writing out what it holds (bounded)."""
+        try:
+            if self.link is not None:
+                self.link.abort(stream)
+            else:
+                _abort_file_only(stream)
+        finally:
+            for proc in self.processes:
+                stop_process(proc)
+
+
+def _abort_file_only(stream):
+    BoundedCall(stream.disconnect, "viz-disconnect").wait(DISCONNECT_TIMEOUT_S)
+
 
 def _finish_file_only(stream):
     flush = BoundedCall(lambda: stream.flush(timeout_sec=FLUSH_TIMEOUT_S), "viz-flush")
@@ -171,7 +186,7 @@ def _serve(stream, mode, file):
     connections = Connections(grpc_port)  # the server's own sockets
     # rerun's GrpcServerSink reports a port it cannot bind only in its log: check it listens.
     stream.set_sinks(rr.GrpcServerSink(bind_ip=bind, port=grpc_port), *_file_sink(file))
-    link = LiveLink(connections, f"the gRPC server on {bind}:{grpc_port}")
+    link = LiveLink(connections, f"the gRPC server on {bind}:{grpc_port}", check_delivery=False)
     if not _wait_listening(host, grpc_port):
         link.finish(stream)
         raise SinkUnavailable(f"could not serve gRPC on {bind}:{grpc_port}")

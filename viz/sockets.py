@@ -6,6 +6,10 @@ to abort it; shutting its socket down does: the client sees the connection fail,
 returns at once. The sockets are found among this process's file descriptors (``/proc/self/fd``
 on Linux, ``/dev/fd`` elsewhere): the TCP ones opened after ``Connections`` was created that
 lead to the given port (and host). Where descriptors cannot be listed, nothing is cut.
+
+They also tell whether the connection lasted: rerun's client opens one connection and never
+reconnects, and a rerun sink that tees to a file only *logs* a failed gRPC flush, so a
+connection still open at the end is the sign that the viewer got everything.
 """
 
 import os
@@ -97,11 +101,30 @@ class Connections:
             return False
         return self._peers is None or peer[0] in self._peers
 
+    def alive(self):
+        """How many such sockets are still connected, with no end of stream from the peer."""
+        count = 0
+        for (fd, ino), (local, peer) in _tcp_sockets().items():
+            if (fd, ino) in self._before or peer is None or not self._ours(local, peer):
+                continue
+            dup = _duplicate(fd)
+            if dup is None:
+                continue
+            with dup:
+                try:  # a peek at the stream: b"" is the peer's end; nothing to read is fine
+                    ended = dup.recv(1, socket.MSG_PEEK | socket.MSG_DONTWAIT) == b""
+                except BlockingIOError:
+                    ended = False
+                except OSError:
+                    ended = True
+            count += not ended
+        return count
+
     def sever(self):
         """Shut down every such socket opened since; returns how many were cut."""
         cut = 0
-        for (fd, _ino), (local, peer) in _tcp_sockets().items():
-            if (fd, _ino) in self._before or not self._ours(local, peer):
+        for (fd, ino), (local, peer) in _tcp_sockets().items():
+            if (fd, ino) in self._before or not self._ours(local, peer):
                 continue
             dup = _duplicate(fd)
             if dup is None:
