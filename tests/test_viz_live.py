@@ -244,6 +244,46 @@ def test_a_viewer_that_goes_away_mid_run_leaves_a_full_copy(viewer_process, tmp_
     assert frames_in(default) == list(range(20))
 
 
+def test_a_call_blocked_on_a_stalled_viewer_gets_it_cut_off(silent_port, monkeypatch):
+    from fpga_robotics.viz.sockets import Connections
+
+    monkeypatch.setattr(live, "STALL_TIMEOUT_S", 0.5)
+    connections = Connections(silent_port.port, "127.0.0.1")
+    client = socket.create_connection(("127.0.0.1", silent_port.port), timeout=60)
+    watch = live.StallWatch(connections.sever)
+    try:
+        with watch:
+            pass  # a quick call: nothing happens
+        assert not watch.stalled and connections.alive() == 1
+        with watch:  # stands for a logging call stuck in rerun's native code
+            got = client.recv(1)  # returns only when the watch cuts the connection
+        assert watch.stalled and got == b"" and connections.alive() == 0
+    finally:
+        watch.stop()
+        client.close()
+
+
+@pytest.mark.slow  # fills rerun's queues: a few hundred MB through memory and the disk
+def test_a_viewer_that_stalls_mid_run_does_not_stop_the_run(stalled_viewer, tmp_path, monkeypatch):
+    import dataclasses
+
+    monkeypatch.setattr(live, "STALL_TIMEOUT_S", 1.0)
+    monkeypatch.setattr(live, "FLUSH_TIMEOUT_S", 1.0)
+    default = tmp_path / "run.rrd"
+    rec = open_recorder(f"connect:{stalled_viewer.url}", default_path=str(default), jpeg_quality=0)
+    frames = [frame(i, 640, 480) for i in range(4)]  # raw noise: ~0.9 MB a frame
+    n = 0
+    while n < 600 and not rec._output.link.watch.stalled:
+        rec.log_frame(dataclasses.replace(frames[n % 4], frame=n))
+        n += 1
+    for i in range(n, n + 10):  # the run goes on after the viewer was cut off
+        rec.log_frame(dataclasses.replace(frames[i % 4], frame=i))
+    msg = rec.close()
+    assert "stopped taking data for 1 s during the run and was cut off" in msg
+    assert frames_in(default) == list(range(n + 10))
+    default.unlink()  # hundreds of MB: not left for pytest's kept temporary folders
+
+
 STALLED_CLOSE = textwrap.dedent(
     """
     import sys

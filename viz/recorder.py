@@ -141,8 +141,10 @@ class Recorder:
         self._last_robot = None
         self._last_target = None
         if stream is not None:
-            self._columns = ColumnBuffer(stream, _COLUMN_BUILDERS)
-            self._log_static_styles()
+            self._guard = output.guard()
+            self._columns = ColumnBuffer(stream, _COLUMN_BUILDERS, self._guard)
+            with self._guard:
+                self._log_static_styles()
 
     def pop_notices(self):
         """The lines for the user not taken yet; the caller prints them, the library never does."""
@@ -177,7 +179,8 @@ class Recorder:
             log(path, rr.LineStrips2D.from_fields(colors=color, radii=0.01), static=True)
 
     def _send_blueprint(self, bounds=None):
-        self._stream.send_blueprint(default_blueprint(bounds))
+        with self._guard:
+            self._stream.send_blueprint(default_blueprint(bounds))
         self._blueprint_sent = True
 
     def log_world_map(self, world_map):
@@ -185,6 +188,13 @@ class Recorder:
         self._check_open()
         if self._stream is None:
             return
+        with self._guard:
+            self._log_map_geometry(world_map)
+        xmin, ymin, xmax, ymax = world_map.bounds
+        self._ray = 0.25 * max(xmax - xmin, ymax - ymin)
+        self._send_blueprint(world_map.bounds)
+
+    def _log_map_geometry(self, world_map):
         log = self._stream.log
         walls = [[_xy(*a), _xy(*b)] for a, b in world_map.walls]
         if walls:
@@ -199,9 +209,6 @@ class Recorder:
                 rr.LineStrips2D(polygons, colors=colors or None, radii=0.015),
                 static=True,
             )
-        xmin, ymin, xmax, ymax = world_map.bounds
-        self._ray = 0.25 * max(xmax - xmin, ymax - ymin)
-        self._send_blueprint(world_map.bounds)
 
     # Per frame ---------------------------------------------------------------------------------
 
@@ -230,8 +237,9 @@ class Recorder:
             s = self._stream
             s.set_time("frame", sequence=frame)
             s.set_time("sim_time", duration=t)
-            for text in record.events:
-                s.log(P.EVENTS, rr.TextLog(str(text), level=_event_level(str(text))))
+            with self._guard:
+                for text in record.events:
+                    s.log(P.EVENTS, rr.TextLog(str(text), level=_event_level(str(text))))
 
         add(P.LEDS_PROXIMITY, proximity_image(res.proximity))
         add(P.LEDS_CENTROID, centroid_image(res.centroid_leds))

@@ -14,6 +14,7 @@ served) is not an error when there is a default path: the recording goes to that
 instead, and the first notice says why. Without a default path it is a ``ViewerError``.
 """
 
+import contextlib
 import ipaddress
 import time
 import uuid
@@ -70,6 +71,10 @@ class Output:
         self.opening = []
         self.viewer_pid = self.live_url = self.web_url = None
         self.processes = []  # started here, stopped at the end
+
+    def guard(self):
+        """The context to enter around every logging call (a stall watch for live sinks)."""
+        return self.link.watch if self.link is not None else contextlib.nullcontext()
 
     def finish(self, stream):
         """End the stream in bounded time; returns ``(confirmed, problem)``."""
