@@ -253,3 +253,35 @@ def test_an_interrupt_while_opening_leaves_no_file(tmp_path, monkeypatch):
         with pytest.raises(KeyboardInterrupt):
             open_recorder(mode, default_path=str(tmp_path / "run.rrd"))
     assert os.listdir(tmp_path) == []
+
+
+def test_a_recorder_never_closed_still_leaves_its_file_under_the_real_name(tmp_path):
+    import gc
+
+    path = tmp_path / "forgotten.rrd"
+    rec = open_recorder(f"save:{path}", default_path=str(path))
+    for i in range(3):
+        rec.log_frame(frame(i))
+    del rec
+    gc.collect()
+    assert os.listdir(tmp_path) == ["forgotten.rrd"] and frames_in(path) == [0, 1, 2]
+
+
+def test_a_process_that_exits_without_closing_leaves_no_partial_file(tmp_path):
+    script = textwrap.dedent(
+        f"""
+        import sys
+        sys.path.insert(0, {os.path.join(ROOT, "tests")!r})
+        from test_viz_files import frame
+        from fpga_robotics.viz import open_recorder
+
+        rec = open_recorder("save", default_path={str(tmp_path / "run.rrd")!r})
+        for i in range(40):
+            rec.log_frame(frame(i))
+        """
+    )
+    proc = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+                          timeout=120, check=False)
+    assert proc.returncode == 0, proc.stderr
+    assert os.listdir(tmp_path) == ["run.rrd"]
+    assert frames_in(tmp_path / "run.rrd") == list(range(40))

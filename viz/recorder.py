@@ -16,6 +16,7 @@ What is logged per frame (entity paths in ``viz.paths``):
 
 import math
 import os
+import weakref
 
 import rerun as rr
 
@@ -75,6 +76,13 @@ _COLUMN_BUILDERS = {
     P.TRAIL_TARGET: strips,
 }
 _DEFAULT_RAY = 1.0  # length of the field-of-view rays when no world map gave a scale, m
+
+
+def _close_abandoned(columns, output, stream):
+    try:
+        columns.flush()
+    finally:
+        output.close_abandoned(stream)
 
 
 def _check_log_every(n):
@@ -143,6 +151,10 @@ class Recorder:
         if stream is not None:
             self._guard = output.guard()
             self._columns = ColumnBuffer(stream, _COLUMN_BUILDERS, self._guard)
+            # Never closed (dropped, or open at exit): the file still gets its real name.
+            self._abandoned = weakref.finalize(
+                self, _close_abandoned, self._columns, output, stream
+            )
             with self._guard:
                 self._log_static_styles()
 
@@ -299,6 +311,8 @@ class Recorder:
         if self._closed:
             return self._message
         self._closed = True
+        if self._stream is not None:
+            self._abandoned.detach()
         if self._stream is None:
             self.notices.append("viewer off: nothing was recorded")
         else:

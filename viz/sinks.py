@@ -86,6 +86,19 @@ class Output:
             for proc in self.processes:
                 stop_process(proc)
 
+    def close_abandoned(self, stream):
+        """For a recorder dropped (or still open at exit) without ``close()``: end the stream
+        and give the file its real name all the same; nobody is left to tell."""
+        confirmed = False
+        try:
+            confirmed, _problem = self.finish(stream)
+        finally:
+            if self.file is not None:
+                if confirmed and self.kind != "save" and not self.keep_copy:
+                    self.file.discard()
+                else:
+                    self.file.keep()
+
     def abort(self, stream):
         """End the stream at once after an interrupt, writing out what it holds (bounded)."""
         try:
