@@ -15,7 +15,6 @@ What is logged per frame (entity paths in ``viz.paths``):
 """
 
 import math
-import os
 import weakref
 
 import rerun as rr
@@ -37,6 +36,7 @@ from .errors import ViewerError
 from .images import check_jpeg_quality, encode_frame, filtered_rgb
 from .leds import centroid_image, proximity_image
 from .modes import parse_mode
+from .outcome import settle
 from .sinks import open_output
 
 __all__ = ["Recorder", "open_recorder"]
@@ -303,10 +303,10 @@ class Recorder:
     def close(self):
         """Finish the recording; returns the lines the user has not been told yet, joined.
 
-        Every wait is bounded (a viewer that stopped reading costs at most about 15 s). A file
-        appears under its final name only now; when this runs after Ctrl-C (or anything else
-        raised), what was logged so far is kept all the same. Calling ``close`` again returns
-        the same text.
+        Every wait is bounded (a viewer that stopped reading costs about 10 s more; the limits
+        are in ``viz.live``). A file appears under its final name only now; when this runs
+        after Ctrl-C (or anything else raised), what was logged so far is kept all the same.
+        Calling ``close`` again returns the same text.
         """
         if self._closed:
             return self._message
@@ -331,47 +331,13 @@ class Recorder:
         self._message = "\n".join(self.pop_notices())
         return self._message
 
-    def _frames(self):
-        return f"{self.frames_logged} frames ({self.images_logged} with images)"
-
-    def _saved(self, file):
-        size = os.path.getsize(file.path)
-        per = size / self.frames_logged if self.frames_logged else 0
-        text = f"{file.path} ({size / 1e6:.1f} MB, {per / 1e3:.1f} kB/frame)"
-        if file.replaced:
-            text += ", replacing an earlier recording there"
-        return f"{text}; open it with: rerun {file.path}"
-
-    def _keep(self, file):
-        failed = file.keep()
-        if failed:
-            return f"the recording could not be saved: {failed}"
-        self.path = str(file.path)
-        return None
-
     def _settle(self, confirmed, problem):
-        """Keep or drop the file, and say where the recording is."""
-        out, file = self._output, self._output.file
-        if out.kind == "save":
-            failed = self._keep(file)
-            text = failed or f"saved {self._frames()} to {self._saved(file)}"
-            if problem:
-                text = f"{text} ({problem})"
-            return f"{out.reason}; {text}" if out.reason else text
+        out = self._output
+        line, kept = settle(out, confirmed, problem, self.frames_logged, self.images_logged)
+        self.path = str(kept) if kept is not None else None
         if out.kind in ("spawn", "connect"):
             self.delivered = confirmed
-        if file is None:
-            text = f"{out.description}: {self._frames()}"
-            return text if confirmed else f"{text}; {problem}, and no file was kept"
-        if confirmed and not out.keep_copy:
-            file.discard()
-            return f"streamed {self._frames()} to {out.description}"
-        failed = self._keep(file)
-        if out.kind == "serve":
-            head = f"{out.description} (stopped with the run): {self._frames()}"
-        else:
-            head = f"{problem}, so not every frame may have reached it"
-        return f"{head}; {failed}" if failed else f"{head}; all of it is saved to {self._saved(file)}"
+        return line
 
     def __enter__(self):
         return self
