@@ -9,12 +9,12 @@ from urllib.parse import parse_qs, urlsplit
 import numpy as np
 import pytest
 
-from fpga_robotics.errors import UsageError
-from fpga_robotics.sim.records import FrameRecord
 from fpga_robotics.sim.backends.base import FrameResult
-from fpga_robotics.viz import open_recorder, parse_mode, sinks
+from fpga_robotics.sim.records import FrameRecord
+from fpga_robotics.viz import ViewerError, open_recorder, parse_mode, sinks, viewers
 from fpga_robotics.viz import paths as P
-from fpga_robotics.viz.modes import DEFAULT_CONNECT_URL, display_available, port_is_listening
+from fpga_robotics.viz.modes import DEFAULT_CONNECT_URL, display_available
+from fpga_robotics.viz.net import port_is_listening
 from fpga_robotics.viz.readback import read_rrd
 
 
@@ -50,6 +50,13 @@ def free_port():
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
         return s.getsockname()[1]
+
+
+@pytest.fixture(autouse=True)
+def private_ports(monkeypatch):
+    # Never rerun's default ports: a developer's viewer or another run may be using them.
+    monkeypatch.setattr(sinks, "SERVE_GRPC_PORT", free_port())
+    monkeypatch.setattr(sinks, "SERVE_WEB_PORT", free_port())
 
 
 @pytest.mark.parametrize(
@@ -90,7 +97,7 @@ def test_parse_valid_modes(text, kind, path, url):
     ],
 )
 def test_bad_modes_are_usage_errors(text, hint):
-    with pytest.raises(UsageError, match=hint):
+    with pytest.raises(ViewerError, match=hint):
         parse_mode(text, "d.rrd")
 
 
@@ -106,7 +113,7 @@ def test_bad_modes_are_usage_errors(text, hint):
     ],
 )
 def test_bad_options_are_usage_errors(kwargs, tmp_path):
-    with pytest.raises(UsageError):
+    with pytest.raises(ViewerError):
         open_recorder("off", default_path=str(tmp_path / "x.rrd"), **kwargs)
 
 
@@ -133,7 +140,8 @@ def test_spawn_without_display_saves_to_the_default_file(tmp_path, monkeypatch, 
     path = tmp_path / "fallback.rrd"
     rec = open_recorder("spawn", default_path=str(path))
     assert rec.mode == "save"
-    assert "no display" in capsys.readouterr().err
+    assert "no display" in " ".join(rec.pop_notices())
+    assert capsys.readouterr().err == ""  # told through notices, never printed
     for i in range(3):
         rec.log_frame(frame(i))
     msg = rec.close()
@@ -145,7 +153,7 @@ def test_spawn_whose_viewer_fails_saves_to_the_default_file(tmp_path, monkeypatc
     monkeypatch.setenv("DISPLAY", ":99")
     no_viewer_running(monkeypatch)
     failing = [sys.executable, "-c", "import sys; sys.exit('Error: Failed to open X server')"]
-    monkeypatch.setattr(sinks, "viewer_command", lambda port: failing)
+    monkeypatch.setattr(viewers, "viewer_command", lambda port: failing)
     path = tmp_path / "fallback.rrd"
     rec = open_recorder("spawn", default_path=str(path))
     rec.log_frame(frame(0))
@@ -159,7 +167,7 @@ def test_spawn_without_any_file_to_fall_back_on_is_a_usage_error(monkeypatch):
     monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
     monkeypatch.setattr(sys, "platform", "linux")
     no_viewer_running(monkeypatch)
-    with pytest.raises(UsageError, match="save:PATH.rrd"):
+    with pytest.raises(ViewerError, match="save:PATH.rrd"):
         open_recorder("spawn", default_path=None)
 
 
@@ -168,8 +176,8 @@ def test_spawn_starts_a_viewer_and_streams_to_it(tmp_path, monkeypatch):
     monkeypatch.setenv("DISPLAY", ":99")
     port = free_port()
     monkeypatch.setattr(sinks, "VIEWER_PORT", port)
-    real_command = sinks.viewer_command
-    monkeypatch.setattr(sinks, "viewer_command", lambda p: [*real_command(p), "--serve-grpc"])
+    real_command = viewers.viewer_command
+    monkeypatch.setattr(viewers, "viewer_command", lambda p: [*real_command(p), "--serve-grpc"])
     rec = open_recorder("spawn", default_path=str(tmp_path / "unused.rrd"))
     try:
         assert rec.mode == "spawn" and rec.viewer_pid is not None
@@ -192,10 +200,11 @@ def test_connect_streams_to_a_listening_viewer(tmp_path):
         rec = open_recorder(f"connect:{url}", default_path=str(tmp_path / "b.rrd"))
         assert rec.mode == "connect"
         rec.log_frame(frame(0))
-        assert f"streamed to the rerun viewer at {url}" in rec.close()
+        assert f"to the rerun viewer at {url}" in rec.close()
+        assert rec.delivered
     finally:
         server.close()
-    assert not (tmp_path / "b.rrd").exists()
+    assert not (tmp_path / "b.rrd").exists()  # delivered: the copy is not kept
 
 
 def test_connect_with_nobody_listening_saves_to_the_default_file(tmp_path):
@@ -205,11 +214,12 @@ def test_connect_with_nobody_listening_saves_to_the_default_file(tmp_path):
     assert rec.mode == "save"
     rec.log_frame(frame(0))
     msg = rec.close()
-    assert f"no rerun viewer is listening at {url}" in msg and path.exists()
+    assert "no rerun viewer is listening at 127.0.0.1:" in msg and path.exists()
 
 
-def test_serve_hosts_grpc_and_web_viewer(tmp_path, capsys):
-    rec = open_recorder("serve", default_path=str(tmp_path / "unused.rrd"))
+def test_serve_hosts_grpc_and_web_viewer_and_keeps_a_copy(tmp_path, capsys):
+    copy = tmp_path / "copy.rrd"
+    rec = open_recorder("serve", default_path=str(copy))
     try:
         assert rec.mode == "serve"
         grpc = urlsplit(rec.live_url)
@@ -218,9 +228,13 @@ def test_serve_hosts_grpc_and_web_viewer(tmp_path, capsys):
         web = urlsplit(rec.web_url)
         assert port_is_listening("127.0.0.1", web.port)
         assert parse_qs(web.query)["url"] == [rec.live_url]
-        assert rec.live_url in capsys.readouterr().err  # said when it starts
+        told = " ".join(rec.pop_notices())  # told when it starts, not printed
+        assert rec.live_url in told and "this machine only" in told
+        assert capsys.readouterr().err == ""
         rec.log_frame(frame(0))
     finally:
         msg = rec.close()
-    assert "1 frames" in msg
-    assert not (tmp_path / "unused.rrd").exists()
+    assert "1 frames" in msg and f"saved to {copy}" in msg and f"rerun {copy}" in msg
+    assert read_rrd(str(copy)).entities[P.MOTORS_DPS].frames == [0]
+    assert not port_is_listening("127.0.0.1", grpc.port)  # stopped with the run
+    assert not port_is_listening("127.0.0.1", web.port)

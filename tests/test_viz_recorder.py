@@ -12,13 +12,13 @@ import numpy as np
 import pytest
 
 from fpga_robotics.errors import UsageError
-from fpga_robotics.sim.records import FrameRecord, PersonState, WorldMap
+from fpga_robotics.readback_cli import main as readback_main
 from fpga_robotics.sim.backends.base import FrameResult
 from fpga_robotics.sim.frames import rgb444_to_rgb888
-from fpga_robotics.viz import open_recorder
+from fpga_robotics.sim.records import FrameRecord, PersonState, WorldMap
+from fpga_robotics.viz import ViewerError, open_recorder
 from fpga_robotics.viz import paths as P
 from fpga_robotics.viz.leds import CELL, GAP, cell_centre
-from fpga_robotics.viz.readback import main as readback_main
 from fpga_robotics.viz.readback import read_rrd
 
 PER_FRAME = [
@@ -313,10 +313,10 @@ def test_file_appears_only_when_closed(tmp_path):
         rec.log_frame(make_frames(1)[0])
 
 
-def test_unwritable_folder_is_a_usage_error(tmp_path):
+def test_a_path_below_a_file_is_a_viewer_error(tmp_path):
     blocker = tmp_path / "file"
     blocker.write_text("not a folder")
-    with pytest.raises(UsageError, match="cannot write the recording"):
+    with pytest.raises(ViewerError, match="is not a folder"):
         open_recorder(f"save:{blocker}/run.rrd", default_path=str(tmp_path / "d.rrd"))
 
 

@@ -7,6 +7,7 @@ below a millisecond per frame. Each row keeps its own ``frame`` and ``sim_time``
 recording is the same as with one ``rr.log`` per row.
 """
 
+import contextlib
 import time
 
 import numpy as np
@@ -94,12 +95,14 @@ class ColumnBuffer:
     """Buffer rows per key; ``builders[key](rows)`` turns them into columns.
 
     A key is an entity path, or ``(path, variant)`` when one entity takes rows of different
-    kinds (raw or JPEG images): each variant is sent as its own columns.
+    kinds (raw or JPEG images): each variant is sent as its own columns. ``guard`` is entered
+    around each send (``viz.live.StallWatch``: a viewer that blocks it for long is cut off).
     """
 
-    def __init__(self, stream, builders):
+    def __init__(self, stream, builders, guard=None):
         self._stream = stream
         self._builders = builders
+        self._guard = guard if guard is not None else contextlib.nullcontext()
         self._rows = {path: _Rows() for path in builders}
         self._frames = 0
         self._last_send = time.monotonic()
@@ -120,14 +123,18 @@ class ColumnBuffer:
         for key, r in self._rows.items():
             if not r.frames:
                 continue
-            self._stream.send_columns(
-                key if isinstance(key, str) else key[0],
-                indexes=[
-                    rr.TimeColumn("frame", sequence=r.frames),
-                    rr.TimeColumn("sim_time", duration=np.array(r.times, dtype="timedelta64[ns]")),
-                ],
-                columns=self._builders[key](r.data),
-            )
+            columns = self._builders[key](r.data)
+            with self._guard:
+                self._stream.send_columns(
+                    key if isinstance(key, str) else key[0],
+                    indexes=[
+                        rr.TimeColumn("frame", sequence=r.frames),
+                        rr.TimeColumn(
+                            "sim_time", duration=np.array(r.times, dtype="timedelta64[ns]")
+                        ),
+                    ],
+                    columns=columns,
+                )
             self._rows[key] = _Rows()
         self._frames = 0
         self._last_send = time.monotonic()

@@ -3,8 +3,8 @@
 import cv2
 import numpy as np
 
-from ..errors import UsageError
 from ..sim.frames import rgb444_to_rgb888
+from .errors import ViewerError
 
 __all__ = [
     "AUTO_JPEG_QUALITY",
@@ -28,7 +28,7 @@ def check_jpeg_quality(quality):
     if quality is None:
         return None
     if isinstance(quality, bool) or not isinstance(quality, int) or not 0 <= quality <= 100:
-        raise UsageError(
+        raise ViewerError(
             f"jpeg_quality must be empty (auto), 0 (raw images) or 1..100, got {quality!r}"
         )
     return quality

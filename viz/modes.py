@@ -1,32 +1,38 @@
-"""Where a recording goes: parse the ``--rerun`` mode string and check that the sink can work.
+"""Where a recording goes: parse the ``--rerun`` mode string.
 
 Modes (the string a user types):
 
-- ``save:PATH.rrd`` write a file (``save`` alone: the caller's default path);
+- ``save:PATH.rrd`` write a file, replacing an earlier one at PATH (and saying so); ``save``
+  alone: the caller's default path, under a new name (``NAME-2.rrd``, ...) if that file exists;
 - ``spawn`` open a native viewer (or use the one already listening on the default port);
 - ``connect`` / ``connect:URL`` stream to a running viewer (default ``rerun+http://127.0.0.1:9876/proxy``);
-- ``serve`` host a gRPC server and the web viewer on localhost;
+- ``serve`` / ``serve:ADDRESS`` host a gRPC server and the web viewer, listening on 127.0.0.1
+  unless an IP address is given (``serve:0.0.0.0``: every network interface);
 - ``off`` record nothing;
 - ``auto`` (or ``None``) ``spawn`` where a display exists, else ``save`` to the default path.
+
+Parsing only looks at the string; the file system and the network are checked when the
+recorder opens.
 """
 
+import ipaddress
 import os
-import socket
 import sys
 from dataclasses import dataclass
 from urllib.parse import urlsplit
 
-from ..errors import UsageError
+from .errors import ViewerError
+from .outfile import check_rrd_name
 
 __all__ = [
     "DEFAULT_CONNECT_URL",
+    "DEFAULT_SERVE_BIND",
     "DEFAULT_VIEWER_PORT",
     "DEFAULT_WEB_PORT",
     "MODE_KINDS",
     "Mode",
     "display_available",
     "parse_mode",
-    "port_is_listening",
 ]
 
 MODE_KINDS = ("save", "spawn", "connect", "serve", "off", "auto")
@@ -34,7 +40,10 @@ MODE_KINDS = ("save", "spawn", "connect", "serve", "off", "auto")
 DEFAULT_VIEWER_PORT = 9876
 DEFAULT_WEB_PORT = 9090
 DEFAULT_CONNECT_URL = f"rerun+http://127.0.0.1:{DEFAULT_VIEWER_PORT}/proxy"
+#: ``serve`` is reachable from this machine only unless told otherwise.
+DEFAULT_SERVE_BIND = "127.0.0.1"
 _URL_SCHEMES = ("rerun", "rerun+http", "rerun+https")
+_VALID = "save:PATH.rrd, spawn, connect[:URL], serve[:ADDRESS], off, auto"
 
 
 @dataclass(frozen=True)
@@ -46,14 +55,22 @@ class Mode:
     kind : str
         One of ``save``, ``spawn``, ``connect``, ``serve``, ``off`` (``auto`` is resolved).
     path : str or None
-        The ``.rrd`` file for ``save`` (and the fallback file for the other kinds).
+        The ``.rrd`` file for ``save``; for the live kinds the caller's default path, where
+        the recording is kept when a viewer cannot be used or delivery is not confirmed.
     url : str or None
         The viewer URL for ``connect``.
+    fresh : bool
+        ``path`` is the caller's default, so a new name is taken when it exists; an explicit
+        ``save:PATH`` replaces the file.
+    bind : str or None
+        The IP address ``serve`` listens on.
     """
 
     kind: str
     path: str | None = None
     url: str | None = None
+    fresh: bool = True
+    bind: str | None = None
 
 
 def display_available(environ=None, platform=None):
@@ -69,68 +86,68 @@ def display_available(environ=None, platform=None):
     return bool(env.get("DISPLAY") or env.get("WAYLAND_DISPLAY"))
 
 
-def port_is_listening(host, port, timeout=0.3):
-    """True when a TCP server accepts connections on ``host:port``."""
-    try:
-        with socket.create_connection((host, port), timeout=timeout):
-            return True
-    except OSError:
-        return False
-
-
-def _check_rrd_path(path, where):
-    if not path:
-        raise UsageError(f"{where}: the file name is empty; use save:PATH.rrd, e.g. save:run.rrd")
-    if not path.endswith(".rrd"):
-        raise UsageError(
-            f"{where}: {path!r} does not end in .rrd; rerun opens .rrd files, e.g. save:run.rrd"
-        )
-    if os.path.isdir(path):
-        raise UsageError(f"{where}: {path!r} is a directory; give a file name ending in .rrd")
-    return path
-
-
 def _check_url(url):
     parts = urlsplit(url)
     if parts.scheme not in _URL_SCHEMES or not parts.hostname:
-        raise UsageError(
+        raise ViewerError(
             f"connect:{url}: not a rerun viewer URL; use e.g. connect:{DEFAULT_CONNECT_URL} "
             f"(scheme rerun+http, rerun+https or rerun)"
         )
     try:
-        parts.port  # noqa: B018 - raises on a malformed port
+        port = parts.port
     except ValueError:
-        raise UsageError(f"connect:{url}: the port is not a number 0..65535") from None
+        raise ViewerError(f"connect:{url}: the port is not a number 0..65535") from None
+    if port is None:  # rerun's own default here is not the viewer's port: ask
+        raise ViewerError(
+            f"connect:{url}: give the port, e.g. "
+            f"connect:{parts.scheme}://{parts.hostname}:{DEFAULT_VIEWER_PORT}/proxy"
+        )
+    if parts.path != "/proxy":
+        raise ViewerError(
+            f"connect:{url}: a rerun viewer URL ends in /proxy, e.g. {DEFAULT_CONNECT_URL}"
+        )
     return url
+
+
+def _check_bind(address):
+    try:
+        return str(ipaddress.ip_address(address))
+    except ValueError:
+        raise ViewerError(
+            f"serve:{address}: not an IP address to listen on; use serve (this machine only) "
+            "or serve:0.0.0.0 (every network interface)"
+        ) from None
 
 
 def parse_mode(mode, default_path, *, environ=None, platform=None):
     """Parse a mode string into a ``Mode``; ``auto``/``None`` picks ``spawn`` or ``save``.
 
-    Raises ``UsageError`` naming the valid modes when ``mode`` is not one of them.
+    Raises ``ViewerError`` saying what to type instead when ``mode`` is malformed.
     """
     if mode is None:
         mode = "auto"
     if not isinstance(mode, str):
-        raise UsageError(f"the viewer mode must be a string, not {type(mode).__name__}")
-    default = _check_rrd_path(default_path, "the default recording path") if default_path else None
+        raise ViewerError(f"the viewer mode must be a string, not {type(mode).__name__}")
+    default = check_rrd_name(default_path, "the default recording path") if default_path else None
     kind, sep, arg = mode.strip().partition(":")
     kind = kind.lower()
-    valid = "save:PATH.rrd, spawn, connect[:URL], serve, off, auto"
     if kind not in MODE_KINDS:
-        raise UsageError(f"unknown viewer mode {mode!r}; choose one of: {valid}")
-    if kind in ("spawn", "serve", "off", "auto") and sep:
-        raise UsageError(
-            f"viewer mode {kind!r} takes no argument (got {mode!r}); choose one of: {valid}"
+        raise ViewerError(f"unknown viewer mode {mode!r}; choose one of: {_VALID}")
+    if kind in ("spawn", "off", "auto") and sep:
+        raise ViewerError(
+            f"viewer mode {kind!r} takes no argument (got {mode!r}); choose one of: {_VALID}"
         )
     if kind == "auto":
         kind = "spawn" if display_available(environ, platform) else "save"
     if kind == "save":
-        path = arg if sep else default
-        if not sep and path is None:
-            raise UsageError("viewer mode 'save' needs a file: use save:PATH.rrd")
-        return Mode("save", path=_check_rrd_path(path, f"save:{arg}"))
+        if not sep and default is None:
+            raise ViewerError("viewer mode 'save' needs a file: use save:PATH.rrd")
+        path = check_rrd_name(arg, f"save:{arg}") if sep else default
+        return Mode("save", path=path, fresh=not sep)
     if kind == "connect":
         url = _check_url(arg) if sep else DEFAULT_CONNECT_URL
         return Mode("connect", path=default, url=url)
+    if kind == "serve":
+        bind = _check_bind(arg) if sep else DEFAULT_SERVE_BIND
+        return Mode("serve", path=default, bind=bind)
     return Mode(kind, path=default)

@@ -1,4 +1,7 @@
-"""Read a saved recording back (tests, checks) and summarise it: ``python -m fpga_robotics.viz.readback FILE.rrd``.
+"""Read a saved recording back (tests, checks) and summarise it.
+
+``python -m fpga_robotics.viz.readback FILE.rrd`` prints the summary (the command itself is
+``fpga_robotics.readback_cli``, the application layer).
 
 Built on ``rerun.chunk.RrdReader``. Every temporal row of an entity is returned with its
 ``frame`` and ``sim_time`` (ns), sorted by frame; each component value is the list of its
@@ -7,16 +10,13 @@ back as uint8 numpy arrays.
 """
 
 import os
-import sys
 from dataclasses import dataclass, field
 
 import numpy as np
 import pyarrow as pa
 from rerun.chunk import RrdReader
 
-from ..errors import UsageError, run_cli
-
-__all__ = ["EntityRows", "Recording", "main", "read_rrd"]
+__all__ = ["EntityRows", "Recording", "read_rrd", "summary_lines"]
 
 _INDEX_COLUMNS = ("frame", "sim_time", "log_time", "log_tick")
 
@@ -104,20 +104,24 @@ def read_rrd(path):
     return Recording(entities, static, len(reader.blueprints()), os.path.getsize(path))
 
 
-def main(argv=None):
-    if not argv or len(argv) != 1:
-        raise UsageError("usage: python -m fpga_robotics.viz.readback FILE.rrd")
-    rec = read_rrd(argv[0])
+def summary_lines(rec, name):
+    """Lines describing a ``Recording`` read from ``name``: size, frames, rows per entity."""
     frames = max((len(r) for p, r in rec.entities.items() if p.startswith("design/")), default=0)
-    print(f"{argv[0]}: {rec.size_bytes / 1e6:.2f} MB, {frames} frames", end="")
-    print(f", {rec.size_bytes / frames / 1e3:.1f} kB/frame" if frames else "")
-    print(f"blueprints: {rec.blueprints}")
-    for path in sorted(rec.entities):
-        print(f"  {path:22s} {len(rec.entities[path]):6d} rows")
-    for path in sorted(rec.static):
-        print(f"  {path:22s} static: {', '.join(sorted(rec.static[path]))}")
-    return 0
+    head = f"{name}: {rec.size_bytes / 1e6:.2f} MB, {frames} frames"
+    if frames:
+        head += f", {rec.size_bytes / frames / 1e3:.1f} kB/frame"
+    lines = [head, f"blueprints: {rec.blueprints}"]
+    lines += [f"  {path:22s} {len(rec.entities[path]):6d} rows" for path in sorted(rec.entities)]
+    lines += [
+        f"  {path:22s} static: {', '.join(sorted(rec.static[path]))}" for path in sorted(rec.static)
+    ]
+    return lines
 
 
 if __name__ == "__main__":
+    import sys
+
+    from fpga_robotics.errors import run_cli
+    from fpga_robotics.readback_cli import main
+
     run_cli(main, sys.argv[1:], prog="fpga_robotics.viz.readback")

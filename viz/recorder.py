@@ -15,13 +15,10 @@ What is logged per frame (entity paths in ``viz.paths``):
 """
 
 import math
-import os
-import sys
-import uuid
+import weakref
 
 import rerun as rr
 
-from ..errors import UsageError
 from . import paths as P
 from .blueprint import default_blueprint
 from .columns import (
@@ -35,16 +32,12 @@ from .columns import (
     strips,
     time_ns,
 )
+from .errors import ViewerError
 from .images import check_jpeg_quality, encode_frame, filtered_rgb
 from .leds import centroid_image, proximity_image
 from .modes import parse_mode
-from .sinks import (
-    SinkUnavailable,
-    attach_connect,
-    attach_save,
-    attach_serve,
-    attach_spawn,
-)
+from .outcome import settle
+from .sinks import open_output
 
 __all__ = ["Recorder", "open_recorder"]
 
@@ -82,13 +75,19 @@ _COLUMN_BUILDERS = {
     P.TRAIL_ROBOT: strips,
     P.TRAIL_TARGET: strips,
 }
-_FLUSH_TIMEOUT_S = 15.0  # at close: a viewer that went away must not hang the run for long
 _DEFAULT_RAY = 1.0  # length of the field-of-view rays when no world map gave a scale, m
+
+
+def _close_abandoned(columns, output, stream):
+    try:
+        columns.flush()
+    finally:
+        output.close_abandoned(stream)
 
 
 def _check_log_every(n):
     if isinstance(n, bool) or not isinstance(n, int) or n < 1:
-        raise UsageError(f"log_every must be an integer >= 1, got {n!r}")
+        raise ViewerError(f"log_every must be an integer >= 1, got {n!r}")
     return n
 
 
@@ -109,41 +108,40 @@ class Recorder:
     mode : str
         The sink actually in use: ``save``, ``spawn``, ``connect``, ``serve`` or ``off``.
     path : str or None
-        The ``.rrd`` file written (``save``), else ``None``.
-    notice : str or None
-        Why the requested sink was replaced by a file, if it was.
+        The ``.rrd`` file: for ``save`` from the start; for the live modes after ``close()``,
+        when a copy was kept.
+    notices : list of str
+        Every line the user must be told, in order: when opening (where a served run can be
+        watched, why a file is used instead of a viewer) and when closing (where the
+        recording is). ``pop_notices()`` returns those not taken yet. Nothing is printed.
+    delivered : bool or None
+        After ``close()`` of ``spawn``/``connect``: whether rerun confirmed every message sent.
     frames_logged, images_logged : int
         ``log_frame`` calls, and how many of them logged the camera images.
     viewer_pid : int or None
         The viewer process ``spawn`` started (it outlives the run), if any.
     live_url, web_url : str or None
-        For ``serve``: the gRPC URL (``rerun URL`` opens it) and the web viewer's address.
+        The gRPC URL streamed to or served (``rerun URL`` opens it) and, for ``serve``, the
+        web viewer's address.
     """
 
-    def __init__(
-        self,
-        stream,
-        mode,
-        *,
-        path=None,
-        temp_path=None,
-        description="",
-        notice=None,
-        log_every=1,
-        jpeg_quality=None,
-    ):
+    def __init__(self, stream, output, *, log_every=1, jpeg_quality=None):
         self._stream = stream
-        self.mode = mode
-        self.path = path
-        self._temp_path = temp_path
-        self._description = description
-        self.notice = notice
+        self._output = output
+        self.mode = output.kind if output is not None else "off"
+        file = output.file if output is not None else None
+        self.path = str(file.path) if file is not None and self.mode == "save" else None
+        self.notice = output.reason if output is not None else None
         self.log_every = log_every
         self.jpeg_quality = jpeg_quality
         self.frames_logged = 0
         self.images_logged = 0
-        self.viewer_pid = None
-        self.live_url = self.web_url = None
+        self.delivered = None
+        self.viewer_pid = output.viewer_pid if output is not None else None
+        self.live_url = output.live_url if output is not None else None
+        self.web_url = output.web_url if output is not None else None
+        self.notices = list(output.opening) if output is not None else []
+        self._told = 0
         self._closed = False
         self._message = None
         self._ray = _DEFAULT_RAY
@@ -151,8 +149,20 @@ class Recorder:
         self._last_robot = None
         self._last_target = None
         if stream is not None:
-            self._columns = ColumnBuffer(stream, _COLUMN_BUILDERS)
-            self._log_static_styles()
+            self._guard = output.guard()
+            self._columns = ColumnBuffer(stream, _COLUMN_BUILDERS, self._guard)
+            # Never closed (dropped, or open at exit): the file still gets its real name.
+            self._abandoned = weakref.finalize(
+                self, _close_abandoned, self._columns, output, stream
+            )
+            with self._guard:
+                self._log_static_styles()
+
+    def pop_notices(self):
+        """The lines for the user not taken yet; the caller prints them, the library never does."""
+        new = self.notices[self._told :]
+        self._told = len(self.notices)
+        return new
 
     def _check_open(self):
         if self._closed:
@@ -181,7 +191,8 @@ class Recorder:
             log(path, rr.LineStrips2D.from_fields(colors=color, radii=0.01), static=True)
 
     def _send_blueprint(self, bounds=None):
-        self._stream.send_blueprint(default_blueprint(bounds))
+        with self._guard:
+            self._stream.send_blueprint(default_blueprint(bounds))
         self._blueprint_sent = True
 
     def log_world_map(self, world_map):
@@ -189,6 +200,13 @@ class Recorder:
         self._check_open()
         if self._stream is None:
             return
+        with self._guard:
+            self._log_map_geometry(world_map)
+        xmin, ymin, xmax, ymax = world_map.bounds
+        self._ray = 0.25 * max(xmax - xmin, ymax - ymin)
+        self._send_blueprint(world_map.bounds)
+
+    def _log_map_geometry(self, world_map):
         log = self._stream.log
         walls = [[_xy(*a), _xy(*b)] for a, b in world_map.walls]
         if walls:
@@ -203,9 +221,6 @@ class Recorder:
                 rr.LineStrips2D(polygons, colors=colors or None, radii=0.015),
                 static=True,
             )
-        xmin, ymin, xmax, ymax = world_map.bounds
-        self._ray = 0.25 * max(xmax - xmin, ymax - ymin)
-        self._send_blueprint(world_map.bounds)
 
     # Per frame ---------------------------------------------------------------------------------
 
@@ -234,8 +249,9 @@ class Recorder:
             s = self._stream
             s.set_time("frame", sequence=frame)
             s.set_time("sim_time", duration=t)
-            for text in record.events:
-                s.log(P.EVENTS, rr.TextLog(str(text), level=_event_level(str(text))))
+            with self._guard:
+                for text in record.events:
+                    s.log(P.EVENTS, rr.TextLog(str(text), level=_event_level(str(text))))
 
         add(P.LEDS_PROXIMITY, proximity_image(res.proximity))
         add(P.LEDS_CENTROID, centroid_image(res.centroid_leds))
@@ -285,43 +301,43 @@ class Recorder:
     # End ---------------------------------------------------------------------------------------
 
     def close(self):
-        """Finish the recording and return one line saying where it went and how to open it.
+        """Finish the recording; returns the lines the user has not been told yet, joined.
 
-        A saved file appears under its final name only now (it was written to a temporary
-        file beside it). Calling ``close`` again returns the same line.
+        Every wait is bounded (a viewer that stopped reading costs about 10 s more; the limits
+        are in ``viz.live``). A file appears under its final name only now; when this runs
+        after Ctrl-C (or anything else raised), what was logged so far is kept all the same.
+        Calling ``close`` again returns the same text.
         """
         if self._closed:
             return self._message
         self._closed = True
+        if self._stream is not None:
+            self._abandoned.detach()
         if self._stream is None:
-            self._message = "viewer off: nothing was recorded"
-            return self._message
-        s = self._stream
-        problem = None
-        try:
-            self._columns.flush()
-            s.flush(timeout_sec=_FLUSH_TIMEOUT_S)
-        except Exception as exc:  # noqa: BLE001 - e.g. a viewer closed mid-run: say so
-            problem = f"not everything may have arrived ({type(exc).__name__}: {exc})"
-        finally:
-            s.disconnect()
-        frames = f"{self.frames_logged} frames ({self.images_logged} with images)"
-        if self.mode == "save":
-            os.replace(self._temp_path, self.path)
-            size = os.path.getsize(self.path)
-            per = size / self.frames_logged if self.frames_logged else 0
-            msg = (
-                f"saved {frames} to {self.path} ({size / 1e6:.1f} MB, {per / 1e3:.1f} kB/frame); "
-                f"open it with: rerun {self.path}"
-            )
+            self.notices.append("viewer off: nothing was recorded")
         else:
-            msg = f"{self._description}: {frames}"
-        if self.notice:
-            msg = f"{self.notice}; {msg}"
-        if problem:
-            msg = f"{msg}; {problem}"
-        self._message = msg
-        return msg
+            confirmed, problem = False, "closing was interrupted"
+            try:
+                self._columns.flush()
+                confirmed, problem = self._output.finish(self._stream)
+            except BaseException:  # Ctrl-C while closing: still hand over every logged row
+                try:
+                    self._columns.flush()  # the rows not sent yet are still buffered
+                finally:
+                    self._output.abort(self._stream)
+                raise
+            finally:  # even on a second Ctrl-C: the file gets its real name
+                self.notices.append(self._settle(confirmed, problem))
+        self._message = "\n".join(self.pop_notices())
+        return self._message
+
+    def _settle(self, confirmed, problem):
+        out = self._output
+        line, kept = settle(out, confirmed, problem, self.frames_logged, self.images_logged)
+        self.path = str(kept) if kept is not None else None
+        if out.kind in ("spawn", "connect"):
+            self.delivered = confirmed
+        return line
 
     def __enter__(self):
         return self
@@ -332,7 +348,7 @@ class Recorder:
         return False
 
     def __repr__(self):
-        where = self.path if self.mode == "save" else self._description
+        where = self.path or (self._output.description if self._output else "")
         return f"Recorder(mode={self.mode!r}, {where!r}, frames_logged={self.frames_logged})"
 
 
@@ -342,11 +358,13 @@ def open_recorder(mode, *, default_path, app_id="fpga_robotics", log_every=1, jp
     Parameters
     ----------
     mode : str or None
-        ``save:PATH.rrd``, ``save``, ``spawn``, ``connect``, ``connect:URL``, ``serve``, ``off``
-        or ``auto``/``None`` (``spawn`` with a display, else ``save`` to ``default_path``).
-    default_path : str
-        The ``.rrd`` file for ``save`` without a path, and for any sink that cannot work
-        here (the recorder then saves there and says so in ``notice`` and on stderr).
+        ``save:PATH.rrd``, ``save``, ``spawn``, ``connect``, ``connect:URL``, ``serve``,
+        ``serve:ADDRESS``, ``off`` or ``auto``/``None`` (``spawn`` with a display, else
+        ``save`` to ``default_path``).
+    default_path : str or None
+        The ``.rrd`` file for ``save`` without a path, for a live sink that cannot work here,
+        and for the copy kept beside a live sink; a new name (``NAME-2.rrd``, ...) is taken
+        when it exists. ``None``: no fallback (a live sink that cannot work is an error).
     app_id : str
         rerun application id (the viewer groups recordings and layouts by it).
     log_every : int
@@ -357,41 +375,24 @@ def open_recorder(mode, *, default_path, app_id="fpga_robotics", log_every=1, jp
 
     Raises
     ------
-    UsageError
-        A malformed mode, ``log_every`` or ``jpeg_quality``.
+    ViewerError
+        A malformed mode, ``log_every`` or ``jpeg_quality``; a file that cannot be written
+        (checked now, before any frame); a live sink that cannot work with no default path.
     """
     parsed = parse_mode(mode, default_path)
-    log_every = _check_log_every(log_every)
-    jpeg_quality = check_jpeg_quality(jpeg_quality)
-    options = {"log_every": log_every, "jpeg_quality": jpeg_quality}
+    options = {
+        "log_every": _check_log_every(log_every),
+        "jpeg_quality": check_jpeg_quality(jpeg_quality),
+    }
     if parsed.kind == "off":
-        return Recorder(None, "off", description="viewer off", **options)
-
-    stream = rr.RecordingStream(app_id, recording_id=uuid.uuid4())
-    stream.set_log_time_enabled(False)
-    if parsed.kind == "save":
-        tmp = attach_save(stream, parsed.path)
-        return Recorder(stream, "save", path=parsed.path, temp_path=tmp, **options)
-    viewer_pid = grpc_url = web_url = None
+        return Recorder(None, None, **options)
+    stream, output = open_output(parsed, app_id)
     try:
-        if parsed.kind == "spawn":
-            description, viewer_pid = attach_spawn(stream)
-        elif parsed.kind == "connect":
-            description = attach_connect(stream, parsed.url)
-        else:
-            grpc_url, web_url, how = attach_serve(stream)
-            # Said now, not at the end: the point of serving is to watch while it runs.
-            print(f"fpga_robotics.viz: serving live: {how}", file=sys.stderr)
-            description = f"served live at {grpc_url} (closed at the end of the run)"
-    except SinkUnavailable as exc:
-        if parsed.path is None:
-            raise UsageError(
-                f"viewer mode {parsed.kind!r} cannot work here ({exc}); use save:PATH.rrd"
-            ) from None
-        notice = f"{parsed.kind}: {exc}, so the recording was saved to a file instead"
-        print(f"fpga_robotics.viz: {notice} ({parsed.path})", file=sys.stderr)
-        tmp = attach_save(stream, parsed.path)
-        return Recorder(stream, "save", path=parsed.path, temp_path=tmp, notice=notice, **options)
-    rec = Recorder(stream, parsed.kind, description=description, **options)
-    rec.viewer_pid, rec.live_url, rec.web_url = viewer_pid, grpc_url, web_url
-    return rec
+        return Recorder(stream, output, **options)
+    except BaseException:  # e.g. Ctrl-C right now: no recorder to close, so no file either
+        try:
+            output.abort(stream)
+        finally:
+            if output.file is not None:
+                output.file.discard()
+        raise

@@ -1,185 +1,276 @@
-"""Attach a ``rerun.RecordingStream`` to the sink a ``Mode`` asks for, or say why it cannot.
+"""Open the ``rerun.RecordingStream`` a ``Mode`` asks for, and end it in bounded time.
 
-Every sink that cannot work here (no display, a viewer that fails to start, nobody listening
-at a URL, a busy port) raises ``SinkUnavailable`` with the reason; the recorder then saves to
-its default file instead and tells the user, so data is never lost silently.
+- ``save``: the stream goes to a ``RecordingFile``.
+- ``spawn`` / ``connect``: the viewer is first asked to answer (``net.probe_viewer``); the
+  stream then goes to it *and* to a copy on the default path. The copy is deleted at the end
+  only when rerun confirms that every message was sent; otherwise it is kept and the user is
+  told where.
+- ``serve``: a gRPC server on ``mode.bind`` (127.0.0.1 unless told), the web viewer on the
+  same address (a ``rerun --serve-web`` child), and a copy on the default path, always kept
+  (nobody confirms receiving a served stream).
+
+A live sink that cannot work here (no display, no viewer answering, a port that cannot be
+served) is not an error when there is a default path: the recording goes to that file
+instead, and the first notice says why. Without a default path it is a ``ViewerError``.
 """
 
-import os
-import shutil
-import socket
-import subprocess
-import tempfile
+import contextlib
+import ipaddress
 import time
 import uuid
-from urllib.parse import quote, urlsplit
+from urllib.parse import quote
 
 import rerun as rr
 
-from ..errors import UsageError
-from .modes import DEFAULT_VIEWER_PORT, DEFAULT_WEB_PORT, display_available, port_is_listening
+from .errors import ViewerError
+from .live import DISCONNECT_TIMEOUT_S, FLUSH_TIMEOUT_S, BoundedCall, LiveLink
+from .modes import DEFAULT_VIEWER_PORT, DEFAULT_WEB_PORT, display_available
+from .net import free_port, port_is_free, port_is_listening, probe_viewer, url_address
+from .outfile import RecordingFile
+from .sockets import Connections
+from .viewers import ViewerUnavailable, start_viewer, start_web_viewer, stop_process
 
-__all__ = ["SinkUnavailable", "attach_connect", "attach_save", "attach_serve", "attach_spawn"]
+__all__ = ["Output", "open_output"]
 
-#: How long a spawned viewer may take to listen, and how long it must then stay alive.
-SPAWN_TIMEOUT_S = 20.0
-SPAWN_SETTLE_S = 1.0
 _LOCALHOST = "127.0.0.1"
+#: The port ``spawn`` uses (rerun's default); tests point it elsewhere.
+VIEWER_PORT = DEFAULT_VIEWER_PORT
+#: The ports ``serve`` prefers (rerun's defaults); taken ones are replaced by free ports.
+SERVE_GRPC_PORT = DEFAULT_VIEWER_PORT
+SERVE_WEB_PORT = DEFAULT_WEB_PORT
+#: How long a gRPC server we start may take to listen.
+SERVE_LISTEN_TIMEOUT_S = 5.0
+
+
+class Output:
+    """Where an open stream goes, and how to end it.
+
+    Attributes
+    ----------
+    kind : str
+        ``save``, ``spawn``, ``connect`` or ``serve``: the sink in use.
+    file : RecordingFile or None
+        The file written (``save``), or the copy beside a live sink.
+    description : str
+        The live sink, for messages ("the rerun viewer at URL").
+    reason : str or None
+        Why the requested live sink was replaced by the file, if it was.
+    opening : list of str
+        What the user must be told now (where to watch, why a file is used instead).
+    keep_copy : bool
+        Keep ``file`` even when delivery is confirmed (``serve``).
+    """
+
+    def __init__(self, kind, file, *, description="", reason=None, link=None, keep_copy=False):
+        self.kind = kind
+        self.file = file
+        self.description = description
+        self.reason = reason
+        self.link = link
+        self.keep_copy = keep_copy
+        self.opening = []
+        self.viewer_pid = self.live_url = self.web_url = None
+        self.processes = []  # started here, stopped at the end
+
+    def guard(self):
+        """The context to enter around every logging call (a stall watch for live sinks)."""
+        return self.link.watch if self.link is not None else contextlib.nullcontext()
+
+    def finish(self, stream):
+        """End the stream in bounded time; returns ``(confirmed, problem)``."""
+        try:
+            if self.link is not None:
+                return self.link.finish(stream)
+            return _finish_file_only(stream)
+        finally:
+            for proc in self.processes:
+                stop_process(proc)
+
+    def close_abandoned(self, stream):
+        """For a recorder dropped (or still open at exit) without ``close()``: end the stream
+        and give the file its real name all the same; nobody is left to tell."""
+        confirmed = False
+        try:
+            confirmed, _problem = self.finish(stream)
+        finally:
+            if self.file is not None:
+                if confirmed and self.kind != "save" and not self.keep_copy:
+                    self.file.discard()
+                else:
+                    self.file.keep()
+
+    def abort(self, stream):
+        """End the stream at once after an interrupt, writing out what it holds (bounded)."""
+        try:
+            if self.link is not None:
+                self.link.abort(stream)
+            else:
+                _abort_file_only(stream)
+        finally:
+            for proc in self.processes:
+                stop_process(proc)
+
+
+def _abort_file_only(stream):
+    BoundedCall(stream.disconnect, "viz-disconnect").wait(DISCONNECT_TIMEOUT_S)
+
+
+def _finish_file_only(stream):
+    flush = BoundedCall(lambda: stream.flush(timeout_sec=FLUSH_TIMEOUT_S), "viz-flush")
+    if not flush.wait(FLUSH_TIMEOUT_S + 1.0) or flush.error is not None:
+        return False, f"the file was not fully written ({flush.error or 'timed out'})"
+    if not BoundedCall(stream.disconnect, "viz-disconnect").wait(DISCONNECT_TIMEOUT_S):
+        return False, "the file was not closed in time"
+    return True, None
 
 
 class SinkUnavailable(RuntimeError):
-    """The requested sink cannot work here; the message says why."""
+    """The requested live sink cannot work here; the message says why."""
 
 
-def temp_path_for(path):
-    """A hidden temporary file next to ``path`` (same file system, so the final rename is atomic)."""
-    folder, name = os.path.split(os.path.abspath(path))
-    # Hidden, and still ending in .rrd: ignored by git like any recording, openable if salvaged.
-    return os.path.join(folder, f".{name}.{uuid.uuid4().hex[:8]}.partial.rrd")
+def new_stream(app_id):
+    # One stream per recorder, never the global one; no wall-clock timeline, so a recording
+    # depends only on the run.
+    stream = rr.RecordingStream(app_id, recording_id=uuid.uuid4())
+    stream.set_log_time_enabled(False)
+    return stream
 
 
-def attach_save(stream, path):
-    """Stream to a temporary file beside ``path``; returns the temporary path (rename on close)."""
-    folder = os.path.dirname(os.path.abspath(path))
-    tmp = temp_path_for(path)
-    try:
-        os.makedirs(folder, exist_ok=True)
-        with open(tmp, "wb"):  # fail here, with a clear message, if the folder is not writable
-            pass
-        stream.save(tmp)
-    except OSError as exc:
-        raise UsageError(f"cannot write the recording {path}: {exc.strerror or exc}") from None
-    return tmp
+def _file_sink(file):
+    return [rr.FileSink(str(file.temp))] if file is not None else []
 
 
-def _viewer_binary():
-    # The binary itself rather than the `rerun` console script, which would run it as a child:
-    # then the pid we know is the viewer's own.
-    try:
-        import rerun_cli
-
-        exe = os.path.join(os.path.dirname(rerun_cli.__file__), "rerun")
-        if os.path.isfile(exe) and os.access(exe, os.X_OK):
-            return exe
-    except ImportError:
-        pass
-    exe = shutil.which("rerun")
-    if exe is None:
-        raise SinkUnavailable("the rerun viewer is not installed (pip install rerun-sdk)")
-    return exe
+def _attach_live(stream, url, file, description):
+    host, port, _tls = url_address(url)
+    connections = Connections(port, host)  # before the client exists: its sockets are new
+    stream.set_sinks(rr.GrpcSink(url), *_file_sink(file))
+    return LiveLink(connections, description)
 
 
-def viewer_command(port):
-    """The command that starts a native rerun viewer listening on ``port``."""
-    base = [_viewer_binary()]
-    return base + ["--port", str(port), "--memory-limit", "75%", "--expect-data-soon"]
-
-
-def _last_line(fileobj):
-    fileobj.seek(0)
-    lines = [
-        ln.strip() for ln in fileobj.read().decode(errors="replace").splitlines() if ln.strip()
-    ]
-    errors = [ln for ln in lines if "error" in ln.lower()]
-    return (errors or lines or ["(no output)"])[-1][:300]
-
-
-def _start_viewer(port):
-    cmd = viewer_command(port)
-    env = dict(os.environ, RERUN_APP_ONLY="true")
-    with tempfile.TemporaryFile() as errlog:
-        try:
-            proc = subprocess.Popen(
-                cmd,
-                stdin=subprocess.DEVNULL,
-                stdout=subprocess.DEVNULL,
-                stderr=errlog,
-                env=env,
-                start_new_session=True,  # the viewer outlives the run
-            )
-        except OSError as exc:
-            raise SinkUnavailable(f"cannot start the rerun viewer ({cmd[0]}): {exc}") from None
-        deadline = time.monotonic() + SPAWN_TIMEOUT_S
-        listening_since = None
-        while True:
-            code = proc.poll()
-            if code is not None:
-                raise SinkUnavailable(
-                    f"the rerun viewer exited with code {code}: {_last_line(errlog)}"
-                )
-            now = time.monotonic()
-            if listening_since is None and port_is_listening(_LOCALHOST, port):
-                listening_since = now
-            # A viewer can bind its port and only then fail to open a window: wait a moment.
-            if listening_since is not None and now - listening_since >= SPAWN_SETTLE_S:
-                return proc
-            if now > deadline:
-                proc.terminate()
-                raise SinkUnavailable(
-                    f"the rerun viewer did not listen on port {port} within {SPAWN_TIMEOUT_S:.0f} s"
-                )
-            time.sleep(0.05)
-
-
-#: The port a spawned viewer listens on (rerun's default).
-VIEWER_PORT = DEFAULT_VIEWER_PORT
-
-
-def attach_spawn(stream, port=None):
-    """Open a native viewer (or reuse one already listening on ``port``) and stream to it.
-
-    Returns a description of what happened and the pid of the viewer started (or ``None``).
-    """
-    port = VIEWER_PORT if port is None else port
+def _spawn(stream, mode, file):
+    port = VIEWER_PORT
     url = f"rerun+http://{_LOCALHOST}:{port}/proxy"
+    pid = None
     if port_is_listening(_LOCALHOST, port):
-        stream.connect_grpc(url)
-        return f"streamed to the rerun viewer already running on port {port}", None
-    if not display_available():
-        raise SinkUnavailable(
-            "no display to open a viewer window (DISPLAY and WAYLAND_DISPLAY unset)"
-        )
-    proc = _start_viewer(port)
-    stream.connect_grpc(url)
-    return f"streamed to a new rerun viewer (pid {proc.pid}, port {port})", proc.pid
+        reason = probe_viewer(url)
+        if reason:
+            raise SinkUnavailable(f"port {port} is taken by something else: {reason}")
+        description = f"the rerun viewer already running on port {port}"
+    else:
+        if not display_available():
+            raise SinkUnavailable(
+                "no display to open a viewer window (DISPLAY and WAYLAND_DISPLAY unset)"
+            )
+        try:
+            proc = start_viewer(port)
+        except ViewerUnavailable as exc:
+            raise SinkUnavailable(str(exc)) from None
+        reason = probe_viewer(url)
+        if reason:
+            stop_process(proc)
+            raise SinkUnavailable(f"the rerun viewer started, but {reason}")
+        pid = proc.pid
+        description = f"a new rerun viewer (pid {pid}, port {port})"
+    out = Output("spawn", file, description=description)
+    out.link = _attach_live(stream, url, file, description)
+    out.viewer_pid, out.live_url = pid, url
+    return out
 
 
-def attach_connect(stream, url):
-    """Stream to the viewer at ``url`` after checking that something listens there."""
-    parts = urlsplit(url)
-    default_port = 443 if parts.scheme == "rerun+https" else DEFAULT_VIEWER_PORT
-    port = parts.port or default_port
-    if not port_is_listening(parts.hostname, port, timeout=1.0):
-        raise SinkUnavailable(f"no rerun viewer is listening at {url} (start one with `rerun`)")
-    stream.connect_grpc(url)
-    return f"streamed to the rerun viewer at {url}"
+def _connect(stream, mode, file):
+    reason = probe_viewer(mode.url)
+    if reason:
+        raise SinkUnavailable(reason)
+    description = f"the rerun viewer at {mode.url}"
+    out = Output("connect", file, description=description)
+    out.link = _attach_live(stream, mode.url, file, description)
+    out.live_url = mode.url
+    return out
 
 
-def _free_port():
-    with socket.socket() as s:
-        s.bind((_LOCALHOST, 0))
-        return s.getsockname()[1]
-
-
-def attach_serve(stream, grpc_port=DEFAULT_VIEWER_PORT, web_port=DEFAULT_WEB_PORT):
-    """Host a gRPC server and the web viewer on localhost.
-
-    Returns ``(grpc_url, web_url or None, how_to_open)``.
-    """
+def _serve_port(bind, preferred):
     # rerun's default ports may be taken by another run or viewer: then any free port.
-    if port_is_listening(_LOCALHOST, grpc_port):
-        grpc_port = _free_port()
-    if port_is_listening(_LOCALHOST, web_port):
-        web_port = _free_port()
+    return preferred if port_is_free(bind, preferred) else free_port(bind)
+
+
+def _local_host(bind):
+    # Where this machine reaches a server bound to ``bind`` (any-address binds: loopback).
+    return {"0.0.0.0": _LOCALHOST, "::": "::1"}.get(bind, bind)
+
+
+def _serve(stream, mode, file):
+    bind, host = mode.bind, _local_host(mode.bind)
+    grpc_port = _serve_port(bind, SERVE_GRPC_PORT)
+    connections = Connections(grpc_port)  # the server's own sockets
+    # rerun's GrpcServerSink reports a port it cannot bind only in its log: check it listens.
+    stream.set_sinks(rr.GrpcServerSink(bind_ip=bind, port=grpc_port), *_file_sink(file))
+    link = LiveLink(connections, f"the gRPC server on {bind}:{grpc_port}", check_delivery=False)
+    if not _wait_listening(host, grpc_port):
+        link.finish(stream)
+        raise SinkUnavailable(f"could not serve gRPC on {bind}:{grpc_port}")
+    url_host = f"[{host}]" if ":" in host else host
+    url = f"rerun+http://{url_host}:{grpc_port}/proxy"
+    out = Output("serve", file, description=f"served live at {url}", link=link, keep_copy=True)
+    out.live_url = url
+    web_port = _serve_port(bind, SERVE_WEB_PORT)
     try:
-        url = stream.serve_grpc(grpc_port=grpc_port)
-    except Exception as exc:  # noqa: BLE001 - reported, and the recorder saves instead
-        raise SinkUnavailable(f"cannot serve gRPC on port {grpc_port}: {exc}") from None
-    try:
-        rr.serve_web_viewer(web_port=web_port, open_browser=False, connect_to=url)
-        web = f"http://localhost:{web_port}/?url={quote(url, safe='')}"
-        how = f"open {web} in a browser, or run `rerun {url}`"
-    except Exception as exc:  # noqa: BLE001 - the gRPC server still works without it
-        web = None
+        out.processes.append(start_web_viewer(bind, web_port, url, host))
+        out.web_url = f"http://{url_host}:{web_port}/?url={quote(url, safe='')}"
+        how = f"open {out.web_url} in a browser, or run `rerun {url}`"
+    except ViewerUnavailable as exc:  # the gRPC server still works without it
         how = f"run `rerun {url}` (the web viewer could not start: {exc})"
-    return url, web, how
+    if ipaddress.ip_address(bind).is_loopback:
+        where = f"{bind}, this machine only (serve:0.0.0.0 lets other machines connect)"
+    else:
+        where = f"{bind}; from another machine, use this machine's address instead of {host}"
+    out.opening.append(f"serving live on {where}: {how}")
+    return out
+
+
+def _wait_listening(host, port):
+    deadline = time.monotonic() + SERVE_LISTEN_TIMEOUT_S
+    while time.monotonic() < deadline:
+        if port_is_listening(host, port):
+            return True
+        time.sleep(0.05)
+    return False
+
+
+_LIVE = {"spawn": _spawn, "connect": _connect, "serve": _serve}
+
+
+def open_output(mode, app_id):
+    """A stream attached to what ``mode`` asks for; returns ``(stream, Output)``.
+
+    Raises ``ViewerError`` for an unusable path, or a live sink that cannot work with no
+    default path to fall back on.
+    """
+    if mode.kind == "save":
+        file = RecordingFile(mode.path, fresh=mode.fresh)
+        try:
+            stream = new_stream(app_id)
+            stream.set_sinks(*_file_sink(file))
+        except BaseException:
+            file.discard()
+            raise
+        return stream, Output("save", file)
+    # The copy is reserved first: an unusable default path is said before any viewer starts.
+    file = RecordingFile(mode.path, fresh=True) if mode.path else None
+    try:
+        stream = new_stream(app_id)
+        try:
+            return stream, _LIVE[mode.kind](stream, mode, file)
+        except SinkUnavailable as exc:
+            if file is None:
+                raise ViewerError(
+                    f"viewer mode {mode.kind!r} cannot work here ({exc}); use save:PATH.rrd"
+                ) from None
+            stream = new_stream(app_id)  # the first one may have had sinks: start clean
+            stream.set_sinks(*_file_sink(file))
+            out = Output("save", file, reason=f"{mode.kind}: {exc}")
+            out.opening.append(f"{out.reason}; the recording goes to {file.path} instead")
+            return stream, out
+    except BaseException:
+        if file is not None:
+            file.discard()
+        raise

@@ -1,0 +1,21 @@
+"""``python -m fpga_robotics.readback_cli FILE.rrd`` (or ``python -m fpga_robotics.viz.readback``):
+what a saved recording holds, entity by entity, and its size per frame."""
+
+import sys
+
+from .errors import UsageError, run_cli
+from .viz.readback import read_rrd, summary_lines
+
+__all__ = ["main"]
+
+
+def main(argv=None):
+    if not argv or len(argv) != 1:
+        raise UsageError("usage: python -m fpga_robotics.viz.readback FILE.rrd")
+    for line in summary_lines(read_rrd(argv[0]), argv[0]):
+        print(line)
+    return 0
+
+
+if __name__ == "__main__":
+    run_cli(main, sys.argv[1:], prog="fpga_robotics.readback_cli")
