@@ -54,8 +54,9 @@ def build_parser(prog="python -m fpga_robotics.run"):
     p.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
                    help="override a scenario value, e.g. robot.mass=12 (repeatable; TOML values)")
     p.add_argument("--rerun", default="auto", metavar="MODE",
-                   help="viewer: save:PATH.rrd, spawn, connect[:URL], serve, off; default auto = "
-                        "spawn with a display, else save:runs/<scenario>.rrd")
+                   help="viewer: save[:PATH.rrd] (plain save: a new name under runs/), spawn, "
+                        "connect[:URL], serve[:ADDRESS], off; default auto = spawn with a "
+                        "display, else save")
     p.add_argument("--log-every", type=int, default=1, metavar="N",
                    help="log every Nth frame's images to the viewer (default 1)")
     p.add_argument("--source", metavar="camera:N|VIDEO|FOLDER",
@@ -190,8 +191,25 @@ def _open_recorder(args, name):
         raise UsageError(f"--log-every must be >= 1, got {args.log_every}")
     from .viz import open_recorder
 
-    return open_recorder(args.rerun, default_path=f"runs/{name}.rrd", app_id="fpga_robotics",
+    recorder = open_recorder(args.rerun, default_path=f"runs/{name}.rrd", app_id="fpga_robotics",
                          log_every=args.log_every)
+    for line in recorder.pop_notices():  # where a live viewer is, or why it fell back
+        print(line, file=sys.stderr)
+    return recorder
+
+
+def _close_recorder(recorder, completed):
+    """Close the recording; after an interrupt, say at once where the data is (the summary
+    that would say it is not printed)."""
+    if recorder is None:
+        return []
+    text = recorder.close()  # the notices not yet taken, one a line
+    notices = text.splitlines() if text else []
+    if not completed:
+        for line in notices:
+            print(line, file=sys.stderr)
+        return []
+    return notices
 
 
 def _list_scenarios():
@@ -212,6 +230,7 @@ def _run_source(args, scenario):
     try:
         design = _open_backend(args.backend, params, args.quiet)
         recorder = None
+        completed = False
         try:
             recorder = _open_recorder(args, Path(str(args.source).replace(":", "_")).stem)
             progress = None if args.quiet else Progress("frames")
@@ -220,9 +239,10 @@ def _run_source(args, scenario):
                              hfov=scenario.camera.hfov)
             if progress is not None:
                 progress.finish()
+            completed = True
         finally:
             design.close()
-            where = recorder.close() if recorder is not None else None
+            notices = _close_recorder(recorder, completed)
     finally:
         source.close()
     print(f"source {out['source']} ({out['source_kind']})  backend {out['backend']}  "
@@ -234,8 +254,8 @@ def _run_source(args, scenario):
               f"mean proximity {out['mean_proximity']:.2f}")
     else:
         print("  no frames")
-    if where:
-        print(where)
+    for line in notices:
+        print(line)
     if args.summary:
         write_json_atomic(args.summary, out, what="--summary")
     return 0
@@ -277,6 +297,7 @@ def main(argv=None, prog="python -m fpga_robotics.run"):
     t0 = time.perf_counter()
     design = _open_backend(args.backend, scenario.params, args.quiet)
     shadow = recorder = None
+    completed = False
     try:
         if shadow_params is not None:
             shadow = _open_backend(args.shadow_backend or args.backend, shadow_params,
@@ -292,11 +313,12 @@ def main(argv=None, prog="python -m fpga_robotics.run"):
                                   (lambda record: video.write(record.camera_rgb)))
         if progress is not None:
             progress.finish()
+        completed = True
     finally:
         design.close()
         if shadow is not None:
             shadow.close()
-        where = recorder.close() if recorder is not None else None
+        notices = _close_recorder(recorder, completed)
     summary = dict(result.summary)
     summary["backend_setup_s"] = round(setup, 3)
     print(format_summary(summary))
@@ -304,8 +326,8 @@ def main(argv=None, prog="python -m fpga_robotics.run"):
         from .shadow import format_shadow
 
         print("\n".join(format_shadow(summary["shadow"])))
-    if where:
-        print(where)
+    for line in notices:
+        print(line)
     if args.save_video is not None:
         print(f"camera frames written to {args.save_video} (try: --source {args.save_video})")
     if args.summary:
