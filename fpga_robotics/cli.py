@@ -23,8 +23,8 @@ __all__ = ["BENCHMARKS", "COMMANDS", "main"]
 COMMANDS = {
     "run": ("fpga_robotics.run", "run a scenario in closed loop (or the design on real frames)"),
     "export": ("fpga_robotics.export", "write the design as one Verilog file"),
-    "board": ("fpga_robotics.board_build", "export a board top (Verilog + LPF) and build its "
-                                           "bitstream"),
+    "board": ("fpga_robotics.board_build",
+              "export a board top (Verilog + LPF) and build its bitstream"),
     "bench": (None, "print speed figures (see `fpga-robotics bench --list`)"),
 }
 

@@ -95,10 +95,10 @@ def format_shadow(summary):
     """Lines for the human summary."""
     first = summary["first_divergence"]
     if first is None:
-        return [f"  shadow {summary['design']}: identical outputs on all "
-                f"{summary['frames']} frames"]
+        return [(f"  shadow {summary['design']}: identical outputs on all "
+                 f"{summary['frames']} frames")]
     counts = ", ".join(f"{n} {c}" for n, c in summary["differing_frames"].items() if c)
     what = ", ".join(f"{n} {v['primary']} vs {v['shadow']}" for n, v in first["outputs"].items())
-    return [f"  shadow {summary['design']}: first differs at frame {first['frame']} "
-            f"({first['time_s']:.2f} s): {what}",
+    return [(f"  shadow {summary['design']}: first differs at frame {first['frame']} "
+             f"({first['time_s']:.2f} s): {what}"),
             f"  shadow frames that differ: {counts} (of {summary['frames']})"]

@@ -11,8 +11,8 @@ import pytest
 from fpga_robotics.export import main
 from fpga_robotics.hw.params import FollowTargetParams
 from fpga_robotics.hw.verilog import generate_verilog
-from fpga_robotics.sim.files import default_file_mode
 from fpga_robotics.sim.backends.toolchain import verilator_root
+from fpga_robotics.sim.files import default_file_mode
 
 #: The port table of docs/contract.md: port -> (direction, width) at 160x120.
 SPEC_PORTS = {

@@ -23,8 +23,8 @@ def test_saved_video_holds_the_camera_frames(suffix, tmp_path, monkeypatch, caps
     import cv2
 
     monkeypatch.chdir(tmp_path)
-    code, out, err = cli(["--backend", "model", "--duration", "2", "--rerun", "off", "--quiet",
-                          "--save-video", f"clip{suffix}"], capsys)
+    code, _out, err = cli(["--backend", "model", "--duration", "2", "--rerun", "off",
+                           "--quiet", "--save-video", f"clip{suffix}"], capsys)
     assert code == 0, err
     assert sorted(p.name for p in tmp_path.iterdir()) == [f"clip{suffix}"]  # no temp file
 
