@@ -5,6 +5,7 @@
     fpga-robotics board [options]         board top, LPF and bitstream
     fpga-robotics bench [WHAT] [options]  benchmarks: design (default), pysim, camera, world,
                                           viewer
+    fpga-robotics readback FILE.rrd       what a saved recording holds
 
 Each subcommand is the ``main(argv, prog)`` of its module, so ``fpga-robotics run --help`` and
 ``python -m fpga_robotics.run --help`` are the same command. New subcommands are one row of
@@ -26,6 +27,8 @@ COMMANDS = {
     "board": ("fpga_robotics.board_build",
               "export a board top (Verilog + LPF) and build its bitstream"),
     "bench": (None, "print speed figures (see `fpga-robotics bench --list`)"),
+    "readback": ("fpga_robotics.readback_cli",
+                 "what a saved .rrd recording holds, entity by entity"),
 }
 
 #: ``fpga-robotics bench WHAT`` -> (module, one-line help); the first is the default.

@@ -9,9 +9,9 @@ from .viz.readback import read_rrd, summary_lines
 __all__ = ["main"]
 
 
-def main(argv=None):
-    if not argv or len(argv) != 1:
-        raise UsageError("usage: python -m fpga_robotics.viz.readback FILE.rrd")
+def main(argv=None, prog="python -m fpga_robotics.viz.readback"):
+    if not argv or len(argv) != 1 or argv[0].startswith("-"):
+        raise UsageError(f"usage: {prog} FILE.rrd")
     for line in summary_lines(read_rrd(argv[0]), argv[0]):
         print(line)
     return 0

@@ -121,8 +121,8 @@ def _positive(text):
     return value
 
 
-def main(argv=None):
-    p = argparse.ArgumentParser(prog="python -m fpga_robotics.viewer_bench", description=__doc__)
+def main(argv=None, prog="python -m fpga_robotics.viz.bench"):
+    p = argparse.ArgumentParser(prog=prog, description=__doc__)
     p.add_argument("--frames", type=_positive, default=300, help="frames per run (default 300)")
     p.add_argument("--repeats", type=_positive, default=5, help="runs per setting (default 5)")
     p.add_argument("--log-every", type=_positive, default=1, help="image decimation (default 1)")
