@@ -39,8 +39,8 @@ def main(argv=None, prog=PROG):
                                      description="Physics cost per camera frame.")
     parser.add_argument("--frames", type=int, default=900, help="frames per run (default 900)")
     parser.add_argument("--repeats", type=int, default=5, help="runs per world (default 5)")
-    parser.add_argument("--physics-hz", type=float, default=200.0,
-                        help="physics steps per second (default 200)")
+    parser.add_argument("--physics-hz", type=float, default=240.0,
+                        help="physics steps per second (default 240, the closed loop's)")
     parser.add_argument("--fps", type=float, default=30.0, help="camera frames per second")
     args = parser.parse_args(argv)
     frames = _count("--frames", args.frames, 10**6)
