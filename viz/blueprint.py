@@ -29,8 +29,9 @@ def _trail_range():
     )
 
 
-def default_blueprint(bounds=None):
-    """The layout sent to the viewer; ``bounds`` ``(xmin, ymin, xmax, ymax)`` frame the map."""
+def default_blueprint(bounds=None, shadow=False):
+    """The layout sent to the viewer; ``bounds`` ``(xmin, ymin, xmax, ymax)`` frame the map;
+    ``shadow`` adds a second LED row and the shadow design's wheel speeds."""
     map_kwargs = {}
     if bounds is not None:
         xmin, ymin, xmax, ymax = (float(v) for v in bounds)
@@ -49,12 +50,19 @@ def default_blueprint(bounds=None):
             rrb.Spatial2DView(origin=P.LEDS_CENTROID, name="Centroid LEDs"),
             column_shares=[7, 8],
         ),
+        *([rrb.Horizontal(
+            rrb.Spatial2DView(origin=P.SHADOW_LEDS_PROXIMITY, name="Shadow design: proximity"),
+            rrb.Spatial2DView(origin=P.SHADOW_LEDS_CENTROID, name="Shadow design: centroid"),
+            column_shares=[7, 8],
+        )] if shadow else []),
         rrb.Horizontal(
-            rrb.TimeSeriesView(origin=P.MOTORS_DPS, name="Wheel DPS (left, right)"),
+            rrb.TimeSeriesView(origin=P.MOTORS if shadow else P.MOTORS_DPS,
+                               name="Wheel DPS (left, right" + (", shadow" if shadow else "")
+                               + ")"),
             rrb.TimeSeriesView(origin=P.TWIST_V, name="V m/s (commanded, measured)"),
             rrb.TimeSeriesView(origin=P.TWIST_W, name="W rad/s (commanded, measured)"),
         ),
-        row_shares=[4, 1, 3],
+        row_shares=[4, 1, 1, 3] if shadow else [4, 1, 3],
         name="Board",
     )
     world = rrb.Vertical(

@@ -16,6 +16,12 @@ TWIST_W = "twist/w"  # [commanded, measured]
 TARGET_DISTANCE = "target/distance"
 EVENTS = "events"
 
+# A shadow design's outputs (``run --shadow``), beside the primary design's.
+SHADOW_LEDS_PROXIMITY = "shadow/leds/proximity"
+SHADOW_LEDS_CENTROID = "shadow/leds/centroid"
+SHADOW_MOTORS_DPS = "motors/shadow_dps"  # [left, right]; under "motors" to share the plot
+MOTORS = "motors"
+
 MAP = "map"
 MAP_WALLS = "map/walls"
 MAP_FURNITURE = "map/furniture"
@@ -29,6 +35,7 @@ TRAIL_TARGET = "map/trails/target"
 SERIES = {
     DESIGN_TRACKING: ("found", "proximity"),
     MOTORS_DPS: ("left", "right"),
+    SHADOW_MOTORS_DPS: ("shadow left", "shadow right"),
     TWIST_V: ("commanded", "measured"),
     TWIST_W: ("commanded", "measured"),
     DESIGN_CENTROID_X: ("centroid_x",),

@@ -51,6 +51,7 @@ _TRAIL_TARGET_COLOR = (255, 110, 110)
 _SERIES_COLORS = {
     P.DESIGN_TRACKING: [(80, 220, 80), (255, 170, 30)],
     P.MOTORS_DPS: [(80, 170, 255), (255, 120, 80)],
+    P.SHADOW_MOTORS_DPS: [(40, 90, 150), (150, 70, 40)],
     P.TWIST_V: [(160, 160, 160), (80, 200, 255)],
     P.TWIST_W: [(160, 160, 160), (80, 200, 255)],
     P.DESIGN_CENTROID_X: [(255, 220, 60)],
@@ -66,6 +67,9 @@ _COLUMN_BUILDERS = {
     P.DESIGN_TRACKING: scalars,
     P.DESIGN_CENTROID_X: scalars,
     P.MOTORS_DPS: scalars,
+    P.SHADOW_LEDS_PROXIMITY: images,
+    P.SHADOW_LEDS_CENTROID: images,
+    P.SHADOW_MOTORS_DPS: scalars,
     P.TWIST_V: scalars,
     P.TWIST_W: scalars,
     P.TARGET_DISTANCE: scalars,
@@ -146,6 +150,8 @@ class Recorder:
         self._message = None
         self._ray = _DEFAULT_RAY
         self._blueprint_sent = False
+        self._bounds = None  # the map's, kept for a blueprint sent again
+        self._shadow_seen = False  # a shadow design's first frame re-lays out the board
         self._last_robot = None
         self._last_target = None
         if stream is not None:
@@ -170,18 +176,27 @@ class Recorder:
 
     # Setup -------------------------------------------------------------------------------------
 
-    def _log_static_styles(self):
+    def _log_static_styles(self, shadow=False):
+        """Series names and colours, LED image formats: of the primary design's entities, or
+        (``shadow``) of a shadow design's, logged when its first frame comes."""
         log = self._stream.log
+        shadow_paths = (P.SHADOW_MOTORS_DPS, P.SHADOW_LEDS_PROXIMITY, P.SHADOW_LEDS_CENTROID)
         for path, names in P.SERIES.items():
-            log(path, rr.SeriesLines(names=list(names), colors=_SERIES_COLORS[path]), static=True)
+            if (path in shadow_paths) == shadow:
+                log(path, rr.SeriesLines(names=list(names), colors=_SERIES_COLORS[path]),
+                    static=True)
+        leds = ((P.SHADOW_LEDS_PROXIMITY, P.SHADOW_LEDS_CENTROID) if shadow
+                else (P.LEDS_PROXIMITY, P.LEDS_CENTROID))
         for path, img in (
-            (P.LEDS_PROXIMITY, proximity_image(0)),
-            (P.LEDS_CENTROID, centroid_image(0)),
+            (leds[0], proximity_image(0)),
+            (leds[1], centroid_image(0)),
         ):
             fmt = rr.components.ImageFormat(
                 width=img.shape[1], height=img.shape[0], color_model="RGB", channel_datatype="U8"
             )
             log(path, rr.Image.from_fields(format=fmt), static=True)
+        if shadow:
+            return
         log(P.MAP_ROBOT, rr.Arrows2D.from_fields(colors=_ROBOT_COLOR, radii=0.03), static=True)
         log(P.MAP_FOV, rr.LineStrips2D.from_fields(colors=_FOV_COLOR, radii=0.01), static=True)
         for path, color in (
@@ -190,9 +205,11 @@ class Recorder:
         ):
             log(path, rr.LineStrips2D.from_fields(colors=color, radii=0.01), static=True)
 
-    def _send_blueprint(self, bounds=None):
+    def _send_blueprint(self, bounds=None, shadow=False):
+        if bounds is not None:
+            self._bounds = bounds
         with self._guard:
-            self._stream.send_blueprint(default_blueprint(bounds))
+            self._stream.send_blueprint(default_blueprint(self._bounds, shadow=shadow))
         self._blueprint_sent = True
 
     def log_world_map(self, world_map):
@@ -258,6 +275,8 @@ class Recorder:
         add(P.DESIGN_TRACKING, (float(bool(res.found)), float(res.proximity)))
         add(P.DESIGN_CENTROID_X, (float(res.centroid_x),))
         add(P.MOTORS_DPS, (float(res.motor_left), float(res.motor_right)))
+        if record.shadow_result is not None:
+            self._add_shadow(record.shadow_result, add)
         add(P.TWIST_V, (float(record.cmd_v), float(record.robot_v)))
         add(P.TWIST_W, (float(record.cmd_w), float(record.robot_w)))
         if record.target_distance is not None:
@@ -265,6 +284,16 @@ class Recorder:
         self._add_map(record, add)
         self.frames_logged += 1
         self._columns.end_frame()
+
+    def _add_shadow(self, res, add):
+        if not self._shadow_seen:
+            self._shadow_seen = True
+            with self._guard:
+                self._log_static_styles(shadow=True)
+            self._send_blueprint(shadow=True)
+        add(P.SHADOW_LEDS_PROXIMITY, proximity_image(res.proximity))
+        add(P.SHADOW_LEDS_CENTROID, centroid_image(res.centroid_leds))
+        add(P.SHADOW_MOTORS_DPS, (float(res.motor_left), float(res.motor_right)))
 
     def _add_map(self, record, add):
         x, y = _xy(record.robot_x, record.robot_y)
