@@ -4,7 +4,7 @@
     fpga-robotics export [options]        Verilog of the design (python -m fpga_robotics.export)
     fpga-robotics board [options]         board top, LPF and bitstream
     fpga-robotics bench [WHAT] [options]  benchmarks: design (default), pysim, camera, world,
-                                          viewer
+                                          viewer, shadow
     fpga-robotics readback FILE.rrd       what a saved recording holds
 
 Each subcommand is the ``main(argv, prog)`` of its module, so ``fpga-robotics run --help`` and
@@ -38,6 +38,7 @@ BENCHMARKS = {
     "camera": ("fpga_robotics.camera_bench", "the camera renderer"),
     "world": ("fpga_robotics.world_bench", "the physics of the robot world"),
     "viewer": ("fpga_robotics.viewer_bench", "the cost of logging to the rerun viewer"),
+    "shadow": ("fpga_robotics.shadow_bench", "a shadow design's cost in the closed loop"),
 }
 
 PROG = "fpga-robotics"

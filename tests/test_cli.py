@@ -18,6 +18,7 @@ from fpga_robotics import cli
     (["bench", "camera", "--help"], "fpga-robotics bench camera"),
     (["bench", "world", "--help"], "fpga-robotics bench world"),
     (["bench", "viewer", "--help"], "fpga-robotics bench viewer"),
+    (["bench", "shadow", "--help"], "fpga-robotics bench shadow"),
 ])
 def test_each_subcommand_shows_its_own_help(argv, prog, capsys):
     with pytest.raises(SystemExit) as info:
