@@ -26,11 +26,11 @@ def measure(scenario, backend, shadow_params, repeats):
     frames = []
     alone, shadowed, own = [], [], []
     try:
+        def keep(record):  # the frames of the first run, for the shadow design alone
+            frames.append((record.camera_rgb, record.color_sel))
+
         for turn in range(repeats):
-            keep = frames.append if turn == 0 else None
-            r = run_scenario(scenario, backend=design,
-                             on_frame=None if keep is None else
-                             (lambda rec: keep((rec.camera_rgb, rec.color_sel))))
+            r = run_scenario(scenario, backend=design, on_frame=keep if turn == 0 else None)
             alone.append(r.summary["ms_per_frame"])
             r = run_scenario(scenario, backend=design, shadow=shadow)
             shadowed.append(r.summary["ms_per_frame"])
