@@ -44,20 +44,21 @@ BENCHMARKS = {
 PROG = "fpga-robotics"
 
 
+def _listing(usage, heading, table):
+    """A usage line and an aligned ``name  help`` row per entry of ``table``."""
+    width = max(map(len, table))
+    rows = [f"  {name:<{width}}  {text}" for name, (_module, text) in table.items()]
+    return "\n".join([usage, "", f"{heading}:", *rows])
+
+
 def _usage():
-    width = max(map(len, COMMANDS))
-    lines = [f"usage: {PROG} COMMAND [options]   ({PROG} COMMAND --help for its options)", "",
-             "commands:"]
-    lines += [f"  {name:<{width}}  {text}" for name, (_m, text) in COMMANDS.items()]
-    return "\n".join(lines)
+    return _listing(f"usage: {PROG} COMMAND [options]   ({PROG} COMMAND --help for its options)",
+                    "commands", COMMANDS)
 
 
 def _bench_list():
-    width = max(map(len, BENCHMARKS))
-    lines = [f"usage: {PROG} bench [WHAT] [options]   (WHAT defaults to design)", "",
-             "benchmarks:"]
-    lines += [f"  {name:<{width}}  {text}" for name, (_m, text) in BENCHMARKS.items()]
-    return "\n".join(lines)
+    return _listing(f"usage: {PROG} bench [WHAT] [options]   (WHAT defaults to design)",
+                    "benchmarks", BENCHMARKS)
 
 
 def _call(module_name, argv, prog):
