@@ -18,7 +18,7 @@ from contextlib import contextmanager
 from pathlib import Path
 
 __all__ = [
-    "OutputPathError", "atomic_output", "atomic_path", "check_output_dir", "check_output_path",
+    "OutputPathError", "PendingOutput", "atomic_output", "atomic_path", "check_output_dir", "check_output_path",
     "default_file_mode", "write_atomic", "write_json_atomic",
 ]
 
@@ -94,22 +94,38 @@ def check_output_dir(path, *, what="output folder"):
     return path
 
 
+class PendingOutput:
+    """A hidden temporary file next to ``path`` (``.tmp``), for output written over a while
+    by a writer that opens files itself (a simulator tracing frames): ``commit()`` makes it
+    ``path``, ``discard()`` removes it. The path is checked on construction."""
+
+    def __init__(self, path, *, what="output file", suffix=None):
+        self.path = check_output_path(path, what=what)
+        self.what = what
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        suffix = self.path.suffix if suffix is None else suffix
+        fd, tmp = tempfile.mkstemp(prefix=f".{self.path.stem}.", suffix=f".partial{suffix}",
+                                   dir=self.path.parent)
+        os.close(fd)
+        self.tmp = Path(tmp)
+
+    def commit(self):
+        _replace(self.tmp, self.path, self.what)
+
+    def discard(self):
+        self.tmp.unlink(missing_ok=True)
+
+
 @contextmanager
 def atomic_path(path, *, what="output file", suffix=None):
     """Yield a hidden temporary path next to ``path`` for a writer that opens files itself
     (a simulator writing a waveform); on success it becomes ``path``, on error it is removed."""
-    path = check_output_path(path, what=what)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    suffix = path.suffix if suffix is None else suffix
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=f".partial{suffix}",
-                               dir=path.parent)
-    os.close(fd)
-    tmp = Path(tmp)
+    pending = PendingOutput(path, what=what, suffix=suffix)
     try:
-        yield tmp
-        _replace(tmp, path, what)
+        yield pending.tmp
+        pending.commit()
     finally:
-        tmp.unlink(missing_ok=True)
+        pending.discard()
 
 
 def _replace(tmp, path, what):

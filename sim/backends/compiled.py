@@ -8,13 +8,13 @@ with a waveform writer, made only when a ``WaveformRequest`` asks for it).
 
 import contextlib
 import ctypes
-import os
 from collections.abc import Callable
 from pathlib import Path
 from typing import NamedTuple
 
 import numpy as np
 
+from ..files import PendingOutput
 from . import build_cache
 from .base import BackendError, DesignBackend, FrameResult
 from .designs import DesignSource
@@ -222,18 +222,18 @@ class CompiledBackend(DesignBackend):
     # Waveforms ---------------------------------------------------------------------------------
 
     def _open_trace(self):
-        path = Path(self.waveform.path)
         # Written under a temporary name and renamed when complete.
-        self._trace_tmp = path.with_name(f".{path.name}.partial{path.suffix}")
-        if self._library.lib.fr_trace_open(self._handle, str(self._trace_tmp).encode()) != 0:
-            raise BackendError(f"cannot write the waveform {path}")
+        self._trace_tmp = PendingOutput(self.waveform.path, what="waveform")
+        if self._library.lib.fr_trace_open(self._handle, str(self._trace_tmp.tmp).encode()) != 0:
+            self._trace_tmp.discard()
+            raise BackendError(f"cannot write the waveform {self.waveform.path}")
         self._trace_state = "open"
 
     def _finish_trace(self):
         if self._trace_state != "open":
             return
         self._library.lib.fr_trace_close(self._handle)
-        os.replace(self._trace_tmp, self.waveform.path)
+        self._trace_tmp.commit()
         self._trace_state = "done"
 
     def close(self):

@@ -17,10 +17,11 @@ value after edge ``k`` is written at edge ``k``'s time, as Amaranth's simulator 
 """
 
 import os
-import tempfile
 
 import numpy as np
 from vcd import VCDWriter
+
+from ..files import PendingOutput
 
 __all__ = ["CLOCK_PERIOD_NS", "ModelWaveformWriter"]
 
@@ -55,9 +56,8 @@ class ModelWaveformWriter:
         self.path = os.fspath(path)
         self.params = params
         self.line_blank = line_blank
-        directory = os.path.dirname(os.path.abspath(self.path))
-        fd, self._tmp = tempfile.mkstemp(suffix=".vcd.part", dir=directory)
-        self._file = os.fdopen(fd, "w")
+        self._output = PendingOutput(self.path, what="waveform")
+        self._file = open(self._output.tmp, "w")  # noqa: SIM115 (closed by finish/abort)
         self._writer = VCDWriter(
             self._file, timescale="1 ns", date="", comment="fpga_robotics model backend"
         )
@@ -148,15 +148,11 @@ class ModelWaveformWriter:
         self._emit([], end)
         self._writer.close(end * CLOCK_PERIOD_NS)
         self._file.close()
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(self._tmp, 0o666 & ~umask)  # mkstemp makes it private; a trace is not
-        os.replace(self._tmp, self.path)
+        self._output.commit()
 
     def abort(self):
         """Drop the unfinished trace."""
         try:
             self._file.close()
         finally:
-            if os.path.exists(self._tmp):
-                os.remove(self._tmp)
+            self._output.discard()
