@@ -17,6 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..hw.validate import check_int
 from .frames import to_rgb444
 
 __all__ = [
@@ -98,9 +99,8 @@ def _rgb(color):
 
 
 def _check_size(width, height):
-    for label, v in (("width", width), ("height", height)):
-        if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < 1:
-            raise ValueError(f"{label} must be an int >= 1, got {v!r}")
+    check_int("width", width, 1)
+    check_int("height", height, 1)
 
 
 def background_frame(width, height, background="noise", rng=None, *, speckle=0.0):

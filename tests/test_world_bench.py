@@ -14,20 +14,20 @@ from fpga_robotics.world_bench import main
 def test_prints_a_line_per_world(capsys):
     assert main(["--frames", "3", "--repeats", "1"]) == 0
     lines = capsys.readouterr().out.strip().splitlines()
-    assert lines[0].startswith("7 steps of 5.00 ms per frame, 3 frames, median of 1 runs")
+    assert lines[0].startswith("8 steps of 4.17 ms per frame, 3 frames, median of 1 runs")
     assert [ln[2:34].strip() for ln in lines[1:]] == list(WORLDS)
     assert all(float(ln.split()[-8]) > 0 for ln in lines[1:])  # ms/frame
 
 
 @pytest.mark.parametrize("module,args,message", [
     ("fpga_robotics.sim.world.bench", ["--fps", "0"],
-     "python -m fpga_robotics.world_bench: error: --fps must be a number of hertz in (0, 200], got 0.0"),
+     "python -m fpga_robotics.world_bench: error: --fps must be a number of hertz in (0, 240], got 0.0"),
     ("fpga_robotics.world_bench", ["--frames", "0"],
      "python -m fpga_robotics.world_bench: error: --frames must be 1..1000000, got 0"),
     ("fpga_robotics.world_bench", ["--physics-hz", "nan"],
      "python -m fpga_robotics.world_bench: error: --physics-hz must be a number of hertz in (0, 100000], got nan"),
     ("fpga_robotics.world_bench", ["--fps", "300"],
-     "python -m fpga_robotics.world_bench: error: --fps must be a number of hertz in (0, 200], got 300.0"),
+     "python -m fpga_robotics.world_bench: error: --fps must be a number of hertz in (0, 240], got 300.0"),
 ])
 def test_bad_arguments_are_one_line(module, args, message):
     proc = subprocess.run([sys.executable, "-m", module, *args], capture_output=True,

@@ -21,6 +21,7 @@ import numpy as np
 
 from ...hw.params import FollowTargetParams
 from ...hw.pixel import color_select_value
+from ...hw.validate import check_int
 from ..frames import to_rgb444
 
 __all__ = ["BackendError", "DesignBackend", "FrameResult", "WaveformRequest"]
@@ -105,9 +106,8 @@ class DesignBackend(ABC):
         self.params = params if params is not None else FollowTargetParams()
         if not isinstance(self.params, FollowTargetParams):
             raise TypeError("params must be a FollowTargetParams")
-        for label, value in (("line_blank", line_blank), ("frame_blank", frame_blank)):
-            if isinstance(value, bool) or not isinstance(value, int) or value < 0:
-                raise ValueError(f"{label} must be an int >= 0, got {value!r}")
+        check_int("line_blank", line_blank, 0)
+        check_int("frame_blank", frame_blank, 0)
         if waveform is not None and not isinstance(waveform, WaveformRequest):
             raise TypeError("waveform must be a WaveformRequest or None")
         self.line_blank = line_blank
