@@ -187,8 +187,9 @@ def _table_command(p, speed, code, saturate):
         speed, slow = saturate(speed), saturate(slow)
     # Forwards the wheel on the target's side is the slow one, backwards the other one.
     slow_left = target_left ^ backwards
-    left = Mux(code == 0, 0, Mux(centred | ~slow_left, speed, slow))
-    right = Mux(code == 0, 0, Mux(centred | slow_left, speed, slow))
+    seen = code.any()  # not `code == 0`: Yosys writes `!code`, which the lint flags
+    left = Mux(seen, Mux(centred | ~slow_left, speed, slow), 0)
+    right = Mux(seen, Mux(centred | slow_left, speed, slow), 0)
     return left, right
 
 
