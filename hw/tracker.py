@@ -171,7 +171,8 @@ class TrackerResults(wiring.Component):
         pending_layout = data.StructLayout({"found": 1, "proximity": 3, "leds": 8})
         m.submodules.divider = div = SequentialDivider(
             p.sum_x_bits, p.count_bits, p.x_bits + 1, tag_bits=pending_layout.size)
-        def found():
+
+        def found():  # N >= min_pixels, or N > min_pixels (the published rule)
             if p.found_rule == "gt":
                 return frame_count() > p.min_pixels
             return frame_count() >= p.min_pixels
