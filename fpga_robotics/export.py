@@ -1,10 +1,12 @@
 """Export ``FollowTarget`` as one self-contained Verilog file.
 
     python -m fpga_robotics.export -o build/follow_target.v [--width 320 --height 240 ...]
+    python -m fpga_robotics.export --preset published -o build/published.v   (docs/published.md)
     python -m fpga_robotics.export --board ulx3s-85f -o DIR [--bitstream]   (board top + LPF)
 
 Every ``FollowTargetParams`` field is an option (``--diff-min 5``, ``--base-dps 0,400,...``);
-a bad value prints what is wrong and exits with code 2.
+``--preset NAME`` starts from a preset, the other options on top. A bad value or an unknown
+preset prints what is wrong and exits with code 2.
 """
 
 import argparse
@@ -54,7 +56,8 @@ def main(argv=None, prog="python -m fpga_robotics.export"):
         )
     check_output_path(args.output, what="Verilog file")
     write_atomic(args.output, generate_verilog(params), what="Verilog file")
-    print(f"wrote {args.output} ({params.width}x{params.height}, module {TOP_NAME})")
+    preset = f", preset {args.preset}" if args.preset is not None else ""
+    print(f"wrote {args.output} ({params.width}x{params.height}{preset}, module {TOP_NAME})")
     return 0
 
 

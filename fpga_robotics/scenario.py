@@ -10,7 +10,8 @@ A scenario file has two kinds of sections. The world's sections (``room``, ``rob
   ``mount_forward`` (m ahead of the robot's centre), ``tilt`` (rad, up positive), ``noise_std``;
 - ``[color]``: ``initial`` colour and ``changes = [{at = seconds, color = "..."}, ...]``;
 - ``[design]``: any ``FollowTargetParams`` field except ``width``/``height`` (those come from
-  the camera resolution);
+  the camera resolution), and ``preset`` (``"published"``: ``FollowTargetParams.published()``
+  at the camera's resolution, applied first, the other ``design`` keys on top);
 - ``[checks]``: the pass criteria of the scenario (see ``fpga_robotics.summary.CHECKS``).
 
 Top-level keys: ``name``, ``description``, ``seed`` (default seed of a run).
@@ -31,7 +32,15 @@ from importlib import resources
 from pathlib import Path
 
 from .errors import UsageError
-from .hw.params import DEFAULT_BASE_DPS, DEFAULT_PROXIMITY_THRESHOLDS, FollowTargetParams
+from .hw.params import (
+    CHOICES,
+    DEFAULT_BASE_DPS,
+    DEFAULT_PROXIMITY_THRESHOLDS,
+    DEFAULT_STEER_DPS,
+    PRESETS,
+    FollowTargetParams,
+    preset_values,
+)
 from .hw.pixel import COLOR_SELECT
 from .sim.camera import max_hfov, max_tilt, vertical_fov
 from .sim.world.config import MAX_TIME, WORLD_SECTIONS
@@ -55,12 +64,13 @@ __all__ = [
 
 _TOP_KEYS = ("name", "description", "seed")
 _APP_SECTIONS = ("sim", "camera", "color", "design", "checks")
-_DESIGN_KEYS = tuple(f.name for f in fields(FollowTargetParams) if f.init and f.name not in
-                     ("width", "height"))
+_DESIGN_KEYS = ("preset",) + tuple(f.name for f in fields(FollowTargetParams) if f.init and
+                                   f.name not in ("width", "height"))
 #: Design parameters that are arrays: their length and what the values are.
 _DESIGN_ARRAYS = {
     "base_dps": (len(DEFAULT_BASE_DPS), "wheel DPS per proximity level 0..7"),
     "proximity_thresholds": (len(DEFAULT_PROXIMITY_THRESHOLDS), "pixel counts of levels 1..7"),
+    "steer_dps": (len(DEFAULT_STEER_DPS), "DPS by LED distance 0..3 from the centre"),
 }
 
 #: Defaults of the application's sections (a key absent here is unknown).
@@ -651,17 +661,30 @@ def _color_changes(data):
 
 
 def _design(data, width, height):
-    design = data["design"]
+    design = dict(data["design"])
+    preset = design.pop("preset", None)
     for key, value in design.items():
-        if key in _DESIGN_ARRAYS:
+        if key in CHOICES:
+            if not isinstance(value, str):
+                raise ScenarioError(f"design.{key} must be a string, one of "
+                                    f"{', '.join(CHOICES[key])}; got {value!r}")
+        elif key in _DESIGN_ARRAYS:
             n, what = _DESIGN_ARRAYS[key]
             if not (isinstance(value, list) and len(value) == n and all(map(_is_int, value))):
                 raise ScenarioError(
                     f"design.{key} must be an array of {n} integers ({what}), got {value!r}")
         elif not _is_int(value):
             raise ScenarioError(f"design.{key} must be an integer, got {value!r}")
+    values = {}
+    if preset is not None:
+        if preset not in PRESETS:
+            raise ScenarioError(f"design.preset must be one of {', '.join(map(repr, PRESETS))}, "
+                                f"got {preset!r}")
+        # The preset first, the scenario's other design keys on top.
+        values = preset_values(preset, width, height)
+    values.update(design)
     try:
-        return FollowTargetParams(width=width, height=height, **design)
+        return FollowTargetParams(width=width, height=height, **values)
     except (TypeError, ValueError) as exc:
         message = str(exc)
         field = re.match(r"\w+", message)

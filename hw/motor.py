@@ -1,6 +1,6 @@
 """Motor controller: per-frame wheel speeds (DPS) from the tracker's results."""
 
-from amaranth import Const, Module, Mux, Signal, signed
+from amaranth import Const, Module, Mux, Signal, signed, unsigned
 from amaranth.lib import data, wiring
 from amaranth.lib.wiring import In, Out
 
@@ -19,7 +19,8 @@ def _wrap16(value):
 
 
 class MotorController(wiring.Component):
-    """Proportional steering with a lost-target search, updated once per frame.
+    """Proportional steering (or the published speed table) with a lost-target search,
+    updated once per frame.
 
     On ``update`` (the tracker's ``frame_done``):
 
@@ -34,6 +35,13 @@ class MotorController(wiring.Component):
 
     After reset the outputs are 0, the lost count 0 and ``last_side`` left.
 
+    The parameters that express the published design change this (``sim.model.MotorModel``
+    and ``table_command`` are the reference): ``motor_law = "table"`` steers by the LED code
+    with the ``steer_dps`` table instead of ``turn``; ``lost_motion = "drive"`` drives on below
+    ``lost_frames`` at the frame's ``base_dps[proximity]``, steered by the last found frame's
+    LED code; ``search_side_from = "leds"`` takes ``last_side`` from the LED code. None of it
+    is elaborated at the defaults.
+
     Parameters
     ----------
     params : FollowTargetParams
@@ -45,7 +53,9 @@ class MotorController(wiring.Component):
     found : ``In(1)``
     proximity : ``In(3)``
     centroid_x : ``In(params.x_bits)``
-        The tracker's results, valid while ``update`` is high.
+    leds : ``In(8)``
+        The tracker's results, valid while ``update`` is high (``leds``, the LED code, only
+        when ``params.motor_uses_leds``).
     left, right : ``Out(signed(16))``
         Wheel speeds in DPS; they load at the edge that samples ``update``.
     last_side : ``Out(1)``
@@ -58,11 +68,13 @@ class MotorController(wiring.Component):
         if not isinstance(params, FollowTargetParams):
             raise TypeError(f"params must be a FollowTargetParams, not {params!r}")
         self.params = params
+        leds = {"leds": In(8)} if params.motor_uses_leds else {}
         super().__init__({
             "update": In(1),
             "found": In(1),
             "proximity": In(3),
             "centroid_x": In(params.x_bits),
+            **leds,
             "left": Out(signed(DPS_BITS)),
             "right": Out(signed(DPS_BITS)),
             "last_side": Out(1),
@@ -77,15 +89,19 @@ class MotorController(wiring.Component):
     def elaborate(self, platform):
         m = Module()
         p = self.params
+        table = p.motor_law == "table"
 
         # e, turn and base +- turn are wide enough never to overflow before the saturation
         # (the published design lost bits here). e and turn are plain signals: rebuilt for each
         # use inside the `update` branch they were 3-4% faster, not enough to pay for the form.
-        e_value = self.centroid_x - (p.width // 2)  # signed(x_bits + 1)
-        e = Signal(e_value.shape())
-        turn_value = (e * p.kp_num) >> p.kp_shift
-        turn = Signal(turn_value.shape())
-        m.d.comb += [e.eq(e_value), turn.eq(turn_value)]
+        if not table or p.search_side_from == "centroid":
+            e_value = self.centroid_x - (p.width // 2)  # signed(x_bits + 1)
+            e = Signal(e_value.shape())
+            m.d.comb += e.eq(e_value)
+        if not table:
+            turn_value = (e * p.kp_num) >> p.kp_shift
+            turn = Signal(turn_value.shape())
+            m.d.comb += turn.eq(turn_value)
 
         # The base speed is a multiplexer tree rebuilt for each use, not a case statement or
         # an `Array` (a ROM read port): the compiled simulators then compute it inside the
@@ -107,24 +123,78 @@ class MotorController(wiring.Component):
 
         # All of the controller's state in one register, loaded whole in each branch: the
         # compiled simulators then spend one test and one copy on it per clock (see `fit`).
-        state = Signal(data.StructLayout({
+        fields = {
             "left": signed(DPS_BITS), "right": signed(DPS_BITS),
             "count": range(p.lost_frames + 1), "right_side": 1,
-        }))
+        }
+        if p.lost_motion == "drive":
+            fields["last_leds"] = 8  # the last found frame's LED code, 0 after reset
+        state = Signal(data.StructLayout(fields))
         m.d.comb += [
             self.left.eq(state.left), self.right.eq(state.right),
             self.lost_count.eq(state.count), self.last_side.eq(state.right_side),
         ]
 
+        if table:
+            def command(code):
+                return _table_command(p, base(), code, saturate)
+        else:
+            def command(code):
+                return saturate(base() + turn), saturate(base() - turn)
+
+        if p.search_side_from == "centroid":
+            right_side = e >= 0
+        else:
+            code = self.leds
+            centred = code[3] & code[4]
+            right_side = Mux(centred, int(p.centred_search_side == "right"), code[4:8].any())
+
         with m.If(self.update):
             with m.If(self.found):
-                m.d.sync += load(state, left=saturate(base() + turn),
-                                 right=saturate(base() - turn), count=0, right_side=e >= 0)
+                left, right = command(self.leds if table else None)
+                kept = {"last_leds": self.leds} if p.lost_motion == "drive" else {}
+                m.d.sync += load(state, left=left, right=right, count=0,
+                                 right_side=right_side, **kept)
             # This frame reaches the limit (no constant-true comparison when it is 1: lint).
             with m.Elif(state.count >= p.lost_frames - 1 if p.lost_frames > 1 else 1):
                 m.d.sync += load(state, left=Mux(state.right_side, search, neg_search),
                                  right=Mux(state.right_side, neg_search, search),
                                  count=p.lost_frames)
             with m.Else():
-                m.d.sync += load(state, count=state.count + 1)
+                if p.lost_motion == "drive":
+                    # On at this frame's speed, steered by the last found frame's LED code.
+                    left, right = command(state.last_leds)
+                    m.d.sync += load(state, left=left, right=right, count=state.count + 1)
+                else:
+                    m.d.sync += load(state, count=state.count + 1)
         return m
+
+
+def _table_command(p, speed, code, saturate):
+    """``(left, right)`` of the table law (``sim.model.table_command``) for a signed 16-bit
+    ``speed`` and an LED ``code``, saturated to ``max_dps`` only where a value of the tables can
+    exceed it."""
+    centred = code[3] & code[4]
+    target_left = code[0:4].any()
+    # The outermost lit LED's distance from the centre picks the steering speed.
+    near = [code[3 - d] | code[4 + d] for d in range(4)]
+    steer = Const(p.steer_dps[0], unsigned(DPS_BITS - 1))
+    for d in (1, 2, 3):
+        steer = Mux(near[d], p.steer_dps[d], steer)
+    backwards = speed[-1]
+    slow = Mux(backwards, speed + steer, speed - steer)  # towards 0: no overflow
+    if _table_can_exceed(p):
+        speed, slow = saturate(speed), saturate(slow)
+    # Forwards the wheel on the target's side is the slow one, backwards the other one.
+    slow_left = target_left ^ backwards
+    seen = code.any()  # not `code == 0`: Yosys writes `!code`, which the lint flags
+    left = Mux(seen, Mux(centred | ~slow_left, speed, slow), 0)
+    right = Mux(seen, Mux(centred | slow_left, speed, slow), 0)
+    return left, right
+
+
+def _table_can_exceed(p):
+    """Whether a command of the table law can lie outside ``[-max_dps, max_dps]``."""
+    values = set(p.base_dps)
+    values |= {v + d if v < 0 else v - d for v in p.base_dps for d in p.steer_dps}
+    return max(abs(v) for v in values) > p.max_dps

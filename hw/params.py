@@ -1,8 +1,11 @@
 """Elaboration parameters of ``FollowTarget``, with the hardware contract's defaults.
 
 One frozen dataclass is shared by the gateware, the numpy golden model and every simulation
-backend, so that "the same parameters" means the same object everywhere. Defaults are the
-published values at 160x120; count thresholds scale with the frame area (see ``area_scale``).
+backend, so that "the same parameters" means the same object everywhere. The defaults are this
+project's own design at 160x120 (docs/contract.md); count thresholds scale with the frame area
+(see ``area_scale``). The published FPGA-Robotics design differs in its found rule, proximity
+thresholds, bin groups, motor law and saturation: it is the preset
+``FollowTargetParams.published()`` (docs/published.md compares the two, value by value).
 Every value is validated on construction with an error that says what is wrong.
 """
 
@@ -10,7 +13,8 @@ from dataclasses import dataclass, field, fields
 
 from .validate import check_int
 
-__all__ = ["DEFAULT_BASE_DPS", "DEFAULT_PROXIMITY_THRESHOLDS", "FollowTargetParams"]
+__all__ = ["DEFAULT_BASE_DPS", "DEFAULT_PROXIMITY_THRESHOLDS", "DEFAULT_STEER_DPS", "PRESETS",
+           "FollowTargetParams", "preset_values"]
 
 #: Proximity thresholds at 160x120 (pixels in the window); scaled by ``area_scale``.
 DEFAULT_PROXIMITY_THRESHOLDS = (128, 256, 512, 1024, 2048, 4096, 6144)
@@ -18,6 +22,59 @@ DEFAULT_PROXIMITY_THRESHOLDS = (128, 256, 512, 1024, 2048, 4096, 6144)
 DEFAULT_BASE_DPS = (0, 400, 300, 200, 150, 100, -100, -150)
 #: ``min_pixels`` at 160x120; scaled by ``area_scale``.
 DEFAULT_MIN_PIXELS = 128
+#: Table motor law: how much slower the slow wheel turns, by the distance of the LED from the
+#: centre (LEDs 3/4, 2/5, 1/6, 0/7). Only read when ``motor_law = "table"``.
+DEFAULT_STEER_DPS = (125, 175, 225, 275)
+
+#: The choices of the parameters that are words; the first is the default.
+CHOICES = {
+    "found_rule": ("ge", "gt"),
+    "motor_law": ("p_control", "table"),
+    "lost_motion": ("hold", "drive"),
+    "search_side_from": ("centroid", "leds"),
+    "centred_search_side": ("right", "left"),
+}
+
+#: The published FPGA-Robotics design at 160x120, as values of this design's parameters
+#: (docs/published.md: what each one is and why the defaults differ). Its colour filter,
+#: margins, ``lost_frames`` and ``search_dps`` are the defaults already.
+_PUBLISHED = {
+    "min_pixels": 128,
+    "found_rule": "gt",
+    # Levels 1 and 2 never occur: the published 128 / 768 / 1792 branches all give 3.
+    "proximity_thresholds": (128, 128, 128, 3072, 3840, 4096, 6144),
+    "group_column_offset": 1,
+    "motor_law": "table",
+    "base_dps": (600, 550, 450, 350, 250, 150, -250, -450),
+    "steer_dps": (125, 175, 225, 275),
+    "lost_motion": "drive",
+    "search_side_from": "leds",
+    "centred_search_side": "right",
+    # No saturation: no value of the table reaches it.
+    "max_dps": (1 << 15) - 1,
+    "lost_frames": 15,
+    "search_dps": 250,
+}
+#: Counts of ``_PUBLISHED`` given at 160x120, scaled by ``area_scale`` at other sizes.
+_SCALED = ("min_pixels", "proximity_thresholds")
+
+#: Known presets: name → what it is.
+PRESETS = {
+    "published": "the published FPGA-Robotics design (docs/published.md)",
+}
+
+
+def preset_values(name, width=160, height=120):
+    """The parameter values of preset ``name`` for a ``width`` x ``height`` design: a dict of
+    ``FollowTargetParams`` fields (counts scaled by ``area_scale``). An unknown name raises
+    ``ValueError`` listing the known ones."""
+    if name not in PRESETS:
+        raise ValueError(f"unknown design preset {name!r}; known presets: {', '.join(PRESETS)}")
+    scale = max(1, (width * height) // (160 * 120))
+    values = dict(_PUBLISHED)
+    values["min_pixels"] *= scale
+    values["proximity_thresholds"] = tuple(t * scale for t in values["proximity_thresholds"])
+    return values
 
 _INT16_MIN, _INT16_MAX = -(1 << 15), (1 << 15) - 1
 
@@ -50,6 +107,26 @@ class FollowTargetParams:
     max_dps: int = 512
     lost_frames: int = 15
     search_dps: int = 250
+    #: ``found`` is ``N >= min_pixels`` ("ge") or ``N > min_pixels`` ("gt", published).
+    found_rule: str = "ge"
+    #: 0: the left/right halves and the 2- and 3-bin sums of the LED code use the bins as they
+    #: are; 1: each column counts in the group of the column after it, the window's last column
+    #: in the first group (the published one-column lag; ``h0``, ``h7`` and ``N`` unchanged).
+    group_column_offset: int = 0
+    #: "p_control": ``base_dps[proximity] +- turn``, ``turn`` from the centroid (the defaults);
+    #: "table": ``base_dps[proximity]`` on the fast wheel, the slow wheel ``steer_dps`` slower
+    #: by the LED's distance from the centre, turning to the LED's side (published).
+    motor_law: str = "p_control"
+    steer_dps: tuple = DEFAULT_STEER_DPS
+    #: Lost frames before the search: "hold" the last command, or "drive" on at
+    #: ``base_dps[proximity]`` of the frame, steered by the last LED code (published; "drive"
+    #: needs ``motor_law = "table"``).
+    lost_motion: str = "hold"
+    #: Side of the last sighting, which the search turns to: the sign of ``centroid_x -
+    #: width // 2`` ("centroid"), or the LED code's half ("leds", published), where the centred
+    #: code counts as ``centred_search_side``.
+    search_side_from: str = "centroid"
+    centred_search_side: str = "right"
 
     # Derived, filled in by __post_init__.
     area_scale: int = field(init=False)
@@ -71,11 +148,35 @@ class FollowTargetParams:
             )
         object.__setattr__(self, "proximity_thresholds", tuple(self.proximity_thresholds))
         object.__setattr__(self, "base_dps", tuple(self.base_dps))
+        object.__setattr__(self, "steer_dps", tuple(self.steer_dps))
         self._validate()
+
+    @classmethod
+    def published(cls, **changes):
+        """The published FPGA-Robotics design as this design's parameters (160x120 unless
+        ``width``/``height`` are given; its pixel counts then scale by ``area_scale``), with
+        ``changes`` on top. See docs/published.md."""
+        return cls.preset("published", **changes)
+
+    @classmethod
+    def preset(cls, name, **changes):
+        """Preset ``name`` (``PRESETS``) with ``changes`` on top; an unknown name is a
+        ``ValueError`` listing the known presets."""
+        values = preset_values(name, changes.get("width", 160), changes.get("height", 120))
+        values.update(changes)
+        return cls(**values)
 
     def _check(self, name, lo=None, hi=None):
         """``check_int`` of one field; the field keeps the plain ``int`` it returns."""
         object.__setattr__(self, name, check_int(name, getattr(self, name), lo, hi))
+
+    def _check_choice(self, name):
+        value, choices = getattr(self, name), CHOICES[name]
+        if not isinstance(value, str):
+            raise TypeError(f"{name} must be a string, one of {', '.join(choices)}; "
+                            f"got {type(value).__name__} {value!r}")
+        if value not in choices:
+            raise ValueError(f"{name} must be one of {', '.join(choices)}; got {value!r}")
 
     def _check_each(self, name, lo, hi):
         values = getattr(self, name)
@@ -125,6 +226,27 @@ class FollowTargetParams:
         self._check("lost_frames", 1, (1 << 16) - 1)
         # -32768 is excluded: searching the other way negates it, which would wrap in 16 bits.
         self._check("search_dps", -_INT16_MAX, _INT16_MAX)
+        for name in CHOICES:
+            self._check_choice(name)
+        self._check("group_column_offset", 0, 1)
+        if len(self.steer_dps) != 4:
+            raise ValueError(
+                f"steer_dps needs 4 values (LED distance 0..3 from the centre), got "
+                f"{len(self.steer_dps)}"
+            )
+        # Non-negative: the slow wheel moves towards 0 and the result fits 16 bits.
+        self._check_each("steer_dps", 0, _INT16_MAX)
+        if self.lost_motion == "drive" and self.motor_law != "table":
+            raise ValueError(
+                "lost_motion='drive' needs motor_law='table' (it drives on with the table's "
+                f"speed and the last LED code), got motor_law={self.motor_law!r}"
+            )
+
+    @property
+    def motor_uses_leds(self):
+        """Whether the motor controller reads the LED code (the table law, or the search side
+        from the LEDs)."""
+        return self.motor_law == "table" or self.search_side_from == "leds"
 
     # Window geometry -------------------------------------------------------------------------
 

@@ -95,4 +95,6 @@ class FollowTarget(wiring.Component):
             self.motor_left.eq(motor.left),
             self.motor_right.eq(motor.right),
         ]
+        if p.motor_uses_leds:  # the table law and the search side from the LEDs only
+            m.d.comb += motor.leds.eq(tracker.centroid_leds)
         return m

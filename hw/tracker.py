@@ -171,15 +171,24 @@ class TrackerResults(wiring.Component):
         pending_layout = data.StructLayout({"found": 1, "proximity": 3, "leds": 8})
         m.submodules.divider = div = SequentialDivider(
             p.sum_x_bits, p.count_bits, p.x_bits + 1, tag_bits=pending_layout.size)
+
+        def found():  # N >= min_pixels, or N > min_pixels (the published rule)
+            if p.found_rule == "gt":
+                return frame_count() > p.min_pixels
+            return frame_count() >= p.min_pixels
+
+        # The counts the halves and the 2- and 3-bin sums are taken from.
+        groups = _Groups(bins, [counts.edges[k] for k in range(8)]
+                         if p.group_column_offset else None)
         m.d.comb += [
             div.start.eq(counts.end),
             div.dividend.eq(counts.sum_x),
             div.divisor.eq(frame_count()),
             load(data.View(pending_layout, div.tag_in),
-                 found=frame_count() >= p.min_pixels,
+                 found=found(),
                  proximity=sum((frame_count() >= t if t > 0 else Const(1, 1))
                                for t in p.proximity_thresholds),
-                 leds=_led_code(m, bins, frame_count(), p.min_pixels)),
+                 leds=_led_code(m, groups, frame_count(), found())),
         ]
         pending = data.View(pending_layout, div.tag)
         with m.If(counts.end):
@@ -219,11 +228,43 @@ def _tree_sum(values):
     return values[0]
 
 
-def _led_code(m, bins, count, min_pixels):
-    """The contract's LED code (a comb signal) from the eight bins and their sum ``N``."""
-    found = count >= min_pixels
-    left = _tree_sum(bins[0:4])
-    right = _tree_sum(bins[4:8])
+class _Groups:
+    """Sums of the counts the LED code compares: the halves and the 2- and 3-bin sums from
+    the left and right edges.
+
+    Without ``edges`` they are sums of the bins. With them (``group_column_offset = 1``) each
+    bin's last column belongs to the next group and bin 7's to group 0: group k is
+    ``h[k] - e[k] + e[k-1]``, so the groups of a run of bins ``a..b`` add up to the bins
+    minus ``e[b]`` plus ``e[a-1]`` (``e[7]`` for ``a = 0``).
+    """
+
+    def __init__(self, bins, edges=None):
+        self.bins, self.edges = bins, edges
+
+    def _shifted(self, total, a, b):
+        if self.edges is None:
+            return total
+        return total + self.edges[(a - 1) % 8] - self.edges[b]
+
+    def half(self, a):
+        """Groups ``a..a+3``: a balanced tree of the bins."""
+        return self._shifted(_tree_sum(self.bins[a:a + 4]), a, a + 3)
+
+    def from_edge(self, order):
+        """Groups ``order[0]``, ``order[0..1]``, ``order[0..2]`` (bins from an edge inwards);
+        the single outermost bin is a bin, not a group."""
+        sums, acc = [self.bins[order[0]]], self.bins[order[0]]
+        for n in (2, 3):
+            acc = acc + self.bins[order[n - 1]]
+            run = order[:n]
+            sums.append(self._shifted(acc, min(run), max(run)))
+        return sums
+
+
+def _led_code(m, groups, count, found):
+    """The contract's LED code (a comb signal) from the eight bins, the groups and ``N``."""
+    left = groups.half(0)
+    right = groups.half(4)
     half = count >> 1
     centred = Mux(left > right, left - right, right - left) < (count >> 4)
     leds = Signal(8)
@@ -232,22 +273,19 @@ def _led_code(m, bins, count, min_pixels):
     with m.Elif(centred):
         m.d.comb += leds.eq(LEDS_CENTRED)
     with m.Elif(left > right):
-        m.d.comb += leds.eq(_edge_led(bins[0:3], half, leds_from_edge=(0, 1, 2, 3)))
+        sums = groups.from_edge((0, 1, 2))
+        m.d.comb += leds.eq(_edge_led(sums, half, leds_from_edge=(0, 1, 2, 3)))
     with m.Else():
-        m.d.comb += leds.eq(_edge_led(bins[7:4:-1], half, leds_from_edge=(7, 6, 5, 4)))
+        sums = groups.from_edge((7, 6, 5))
+        m.d.comb += leds.eq(_edge_led(sums, half, leds_from_edge=(7, 6, 5, 4)))
     return leds
 
 
-def _edge_led(bins_from_edge, half, leds_from_edge):
-    """One-hot LED: the first of the three bins from the edge whose running sum reaches
-    ``half``, else the fourth LED (the one next to the centre)."""
+def _edge_led(sums_from_edge, half, leds_from_edge):
+    """One-hot LED: the first of the three sums from the edge (one, two, three bins) that
+    reaches ``half``, else the fourth LED (the one next to the centre)."""
     value = Const(1 << leds_from_edge[3], 8)
-    acc = None
-    sums = []
-    for b in bins_from_edge:
-        acc = b if acc is None else acc + b
-        sums.append(acc)
     # Build from the innermost choice outwards so the outermost bin has priority.
-    for led, s in reversed(list(zip(leds_from_edge[:3], sums))):
+    for led, s in reversed(list(zip(leds_from_edge[:3], sums_from_edge))):
         value = Mux(s >= half, 1 << led, value)
     return value

@@ -11,15 +11,26 @@ from .params import FollowTargetParams
 __all__ = ["WindowCounter", "frame_counts_signature"]
 
 
+def edge_bits(params):
+    """Bits of a bin's last-column count: at most one pixel a window row."""
+    return max(1, params.window_height.bit_length())
+
+
 def frame_counts_signature(params):
     """Signature of a frame's counts (source side): ``end`` is a one-cycle strobe when
     ``bins`` (``h0..h7``) and ``sum_x`` (``SX``) are those of a complete, well-formed frame.
-    ``N`` is the sum of the bins (every window column is in exactly one bin)."""
-    return wiring.Signature({
+    ``N`` is the sum of the bins (every window column is in exactly one bin).
+
+    With ``group_column_offset = 1`` also ``edges``: the matches in the last column of each
+    bin, from which the tracker moves each bin's last column into the next group."""
+    members = {
         "end": Out(1),
         "bins": Out(data.ArrayLayout(params.count_bits, 8)),
         "sum_x": Out(params.sum_x_bits),
-    })
+    }
+    if params.group_column_offset:
+        members["edges"] = Out(data.ArrayLayout(edge_bits(params), 8))
+    return wiring.Signature(members)
 
 
 class WindowCounter(wiring.Component):
@@ -36,7 +47,9 @@ class WindowCounter(wiring.Component):
     accumulator and one add into ``SX``. The accumulator is added into a bin only at
     the bin's last column; the bins then rotate by one place, so the bin being filled is
     always the first and after the eight bins of a line they are back in order. Whether the
-    row is inside the window is a register updated at line ends.
+    row is inside the window is a register updated at line ends. With
+    ``group_column_offset = 1`` the last column of each bin is also counted on its own
+    (``edges``, rotating with the bins).
 
     Malformed framing: a frame is abandoned (no ``end``) as soon as a line ends early
     (``last`` before column ``width - 1``) or runs long (no ``last`` at column
@@ -127,6 +140,11 @@ class WindowCounter(wiring.Component):
         m.d.comb += [
             self.counts.bins.eq(bins), self.counts.sum_x.eq(sx), self.counts.end.eq(end),
         ]
+        edges = None
+        if p.group_column_offset:  # nothing of this at the default
+            eb = edge_bits(p)
+            edges = Signal(8 * eb, reset_less=True)
+            m.d.comb += self.counts.edges.eq(edges)
 
         # Named signals, not expressions: the compiled simulators compute each once.
         px = Signal(p.x_bits)  # position of the pixel on the input now
@@ -172,6 +190,8 @@ class WindowCounter(wiring.Component):
                 bins.eq(0), sx.eq(0),
                 acc.eq(count & shape_ok), boundary.eq(first_boundary),
             ]
+            if edges is not None:
+                m.d.sync += edges.eq(0)
         with m.Elif(advance):
             with m.If(count):  # a masked add, which avoided this branch, was slower
                 m.d.sync += sx.eq(sx + px)
@@ -182,6 +202,8 @@ class WindowCounter(wiring.Component):
                     bins.eq(Cat(bins[cb:], fit(bins[:cb] + acc + count, cb))),
                     acc.eq(0), boundary.eq(next_boundary),
                 ]
+                if edges is not None:
+                    m.d.sync += edges.eq(Cat(edges[eb:], fit(edges[:eb] + count, eb)))
             with m.Else():
                 m.d.sync += acc.eq(acc + count)
         return m

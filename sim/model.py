@@ -22,6 +22,12 @@ Reading of the contract where it leaves room (the gateware must agree):
 - ``turn = (kp_num * e) >> kp_shift`` is a floor division by ``2**kp_shift`` (rounds towards
   minus infinity for negative ``e``), then ``base +- turn`` saturate to ``[-max_dps, max_dps]``.
 
+The knobs that express the published design (``FollowTargetParams.published()``,
+docs/published.md) are written here from their definitions: ``found_rule``,
+``group_column_offset`` (each window column grouped with the column after it, the last with
+the first), ``motor_law = "table"`` (``table_command``), ``lost_motion = "drive"`` and the
+search side from the LED code.
+
 Everything is vectorised per frame: the colour filter is one lookup in a 4096-entry table per
 colour (built from the contract's formulas), the tracker a few numpy reductions.
 """
@@ -43,8 +49,10 @@ __all__ = [
     "centroid_leds",
     "color_match",
     "filter_frame",
+    "is_found",
     "match_table",
     "proximity_level",
+    "table_command",
     "track_frame",
 ]
 
@@ -154,27 +162,37 @@ def proximity_level(count, thresholds):
     return sum(1 for t in thresholds if count >= t)
 
 
-def centroid_leds(bins, count, found):
-    """The published LED code (bit 0 = leftmost LED) from the bins and ``N``."""
+def is_found(count, params):
+    """``found`` for ``N = count`` under ``params.found_rule``."""
+    if params.found_rule == "gt":
+        return count > params.min_pixels
+    return count >= params.min_pixels
+
+
+def centroid_leds(bins, count, found, groups=None):
+    """The LED code (bit 0 = leftmost LED) from the bins and ``N``.
+
+    ``groups`` (default: ``bins``) are the eight counts the halves ``L``, ``R`` and the 2-
+    and 3-bin sums are taken from; the single outermost bins are always ``bins[0]`` and
+    ``bins[7]`` (with ``group_column_offset = 1`` the groups are the bins shifted by a column).
+    """
     if not found:
         return 0
-    left, right = sum(bins[:4]), sum(bins[4:])
+    groups = bins if groups is None else groups
+    left, right = sum(groups[:4]), sum(groups[4:])
     half = count >> 1
     if abs(left - right) < (count >> 4):
         return LEDS_CENTRED
     if left > right:
-        acc = 0
-        for led in range(3):
-            acc += bins[led]
-            if acc >= half:
-                return 1 << led
-        return 1 << 3
-    acc = 0
-    for led in (7, 6, 5):
-        acc += bins[led]
-        if acc >= half:
+        sums = (bins[0], sum(groups[0:2]), sum(groups[0:3]))
+        leds = (0, 1, 2, 3)
+    else:
+        sums = (bins[7], sum(groups[6:8]), sum(groups[5:8]))
+        leds = (7, 6, 5, 4)
+    for led, s in zip(leds, sums):
+        if s >= half:
             return 1 << led
-    return 1 << 4
+    return 1 << leds[3]
 
 
 def track_frame(match, params):
@@ -187,14 +205,19 @@ def track_frame(match, params):
     window = match[my : params.height - my, mx : params.width - mx]
     columns = np.count_nonzero(window, axis=0)
     bins = tuple(int(v) for v in columns.reshape(8, params.bin_width).sum(axis=1))
+    groups = None
+    if params.group_column_offset:
+        # Each column in the group of the column after it; the last column in the first.
+        shifted = np.roll(columns, params.group_column_offset)
+        groups = tuple(int(v) for v in shifted.reshape(8, params.bin_width).sum(axis=1))
     count = sum(bins)
     sum_x = int(columns @ np.arange(mx, params.width - mx))
-    found = count >= params.min_pixels
+    found = is_found(count, params)
     return TrackerResult(
         found=found,
         proximity=proximity_level(count, params.proximity_thresholds),
         centroid_x=sum_x // count if found else 0,
-        centroid_leds=centroid_leds(bins, count, found),
+        centroid_leds=centroid_leds(bins, count, found, groups),
         count=count,
         bins=bins,
         sum_x=sum_x,
@@ -204,6 +227,36 @@ def track_frame(match, params):
 def _wrap16(v):
     """``v`` as a signed 16-bit register holds it."""
     return ((v + (1 << 15)) & 0xFFFF) - (1 << 15)
+
+
+def _led_distance(code):
+    """Distance from the centre (0..3) of the outermost LED lit in ``code``."""
+    for distance in (3, 2, 1):
+        if code & ((1 << (3 - distance)) | (1 << (4 + distance))):
+            return distance
+    return 0
+
+
+def table_command(speed, code, params):
+    """The table motor law's ``(left, right)`` for a speed (``base_dps[proximity]``) and an LED
+    code, before saturation.
+
+    No LED code (0: the target never seen): both 0. Centred (LEDs 3 and 4): both ``speed``.
+    Otherwise the robot turns to the code's side (left when any of LEDs 0..3 is lit): one wheel
+    keeps ``speed`` and the other moves ``steer_dps[d]`` towards 0 (``d``: the outermost lit
+    LED's distance from the centre). Forwards (``speed >= 0``) that is the wheel on the
+    target's side; backwards, the other one.
+    """
+    if code == 0:
+        return 0, 0
+    if code & LEDS_CENTRED == LEDS_CENTRED:
+        return speed, speed
+    d = params.steer_dps[_led_distance(code)]
+    slow = speed + d if speed < 0 else speed - d
+    target_left = bool(code & 0x0F)
+    if target_left == (speed >= 0):
+        return slow, speed
+    return speed, slow
 
 
 class MotorModel:
@@ -221,6 +274,9 @@ class MotorModel:
         Consecutive frames without the target (saturates at ``lost_frames``).
     last_side : str
         ``"left"`` or ``"right"``: side of the last seen target; ``"left"`` after reset.
+    last_leds : int
+        LED code of the last frame with the target (0 after reset); the table law steers by it
+        while the target is lost.
     """
 
     def __init__(self, params):
@@ -234,6 +290,7 @@ class MotorModel:
         self.right = 0
         self.lost_count = 0
         self.last_side = "left"
+        self.last_leds = 0
 
     def _saturate(self, v):
         m = self.params.max_dps
@@ -247,21 +304,38 @@ class MotorModel:
     def step(self, tracker):
         """Update on one frame's ``TrackerResult``; return ``(left, right)``."""
         p = self.params
+        base = p.base_dps[tracker.proximity]
         if tracker.found:
             self.lost_count = 0
-            base = p.base_dps[tracker.proximity]
             e = tracker.centroid_x - p.width // 2
-            turn = (p.kp_num * e) >> p.kp_shift  # Python's >> on ints is arithmetic
-            self.left = self._saturate(base + turn)
-            self.right = self._saturate(base - turn)
-            self.last_side = "right" if e >= 0 else "left"
+            if p.motor_law == "table":
+                left, right = table_command(base, tracker.centroid_leds, p)
+            else:
+                turn = (p.kp_num * e) >> p.kp_shift  # Python's >> on ints is arithmetic
+                left, right = base + turn, base - turn
+            self.left, self.right = self._saturate(left), self._saturate(right)
+            self.last_side = self._side(e, tracker.centroid_leds)
+            self.last_leds = tracker.centroid_leds
         else:
             self.lost_count = min(self.lost_count + 1, p.lost_frames)
             if self.searching:
                 s = p.search_dps if self.last_side == "right" else -p.search_dps
                 self.left, self.right = _wrap16(s), _wrap16(-s)
+            elif p.lost_motion == "drive":
+                # On at this frame's speed, steered by the last sighting.
+                left, right = table_command(base, self.last_leds, p)
+                self.left, self.right = self._saturate(left), self._saturate(right)
             # else: hold the last command
         return self.left, self.right
+
+    def _side(self, e, code):
+        """Side of a sighting: the sign of ``e``, or the LED code's half."""
+        p = self.params
+        if p.search_side_from == "centroid":
+            return "right" if e >= 0 else "left"
+        if code & LEDS_CENTRED == LEDS_CENTRED:
+            return p.centred_search_side
+        return "right" if code & 0xF0 else "left"
 
 
 @dataclass(frozen=True, eq=False)

@@ -216,3 +216,49 @@ def test_random_parameter_sets_match_the_model(seed):
     dut = FollowTarget(p)
     trace, last = run_follow_target(dut, frames, sels, line_blank=int(rng.integers(0, 3)))
     check_against_model(p, frames, sels, trace, last)
+
+
+def published_small(**changes):
+    """The published preset at the small test geometry (counts scaled down by hand)."""
+    return FollowTargetParams.published(**{
+        "width": 48, "height": 12, "margin_x": 4, "margin_y": 1, "min_pixels": 8,
+        "proximity_thresholds": (8, 8, 8, 30, 60, 100, 200), "lost_frames": 3, **changes})
+
+
+def test_published_preset_scenes_match_the_model():
+    # The LED code reaches the motor controller (table law, lost motion, search side).
+    p = published_small()
+    frames, sels = scene_frames(p, 21)
+    dut = FollowTarget(p)
+    trace, last = run_follow_target(dut, frames, sels, line_blank=1)
+    expected = check_against_model(p, frames, sels, trace, last)
+    assert {e.tracker.centroid_leds for e in expected} >= {0, 0x18}
+    assert len({(e.motor_left, e.motor_right) for e in expected}) >= 5
+
+
+@pytest.mark.parametrize("seed,law,motion", [(0, "table", "drive"), (1, "table", "hold"),
+                                              (2, "p_control", "hold"), (3, "table", "drive")])
+def test_random_published_knobs_match_the_model(seed, law, motion):
+    rng = np.random.default_rng(300 + seed)
+    base = random_params(rng)
+    p = base.replace(
+        found_rule=str(rng.choice(["ge", "gt"])),
+        group_column_offset=int(rng.integers(0, 2)),
+        motor_law=law,
+        steer_dps=tuple(int(v) for v in rng.integers(0, 400, 4)),
+        lost_motion=motion,
+        search_side_from=str(rng.choice(["centroid", "leds"])),
+        centred_search_side=str(rng.choice(["right", "left"])),
+    )
+    frames, sels = [], []
+    for i in range(7):
+        if i in (2, 3, 4):
+            rgb = synthetic.empty_frame(p.width, p.height, rng=rng)
+        else:
+            rgb = synthetic.blob_frame(p.width, p.height, "red", cx=rng.random() * p.width,
+                                       cy=p.height / 2, radius=p.height / 2, rng=rng)
+        frames.append(packed(rgb, p))
+        sels.append(COLOR_SELECT["red"] if i != 6 else int(rng.integers(0, 8)))
+    dut = FollowTarget(p)
+    trace, last = run_follow_target(dut, frames, sels, line_blank=int(rng.integers(0, 3)))
+    check_against_model(p, frames, sels, trace, last)

@@ -297,3 +297,85 @@ def test_first_restarts_the_frame_at_any_point():
     for cut in (1, 17, len(garbage)):
         _, results = run_tracker(p, garbage[:cut] + good)
         assert [r for _, r in results] == [expected]
+
+
+# --- The published design's tracker knobs ----------------------------------------------------
+
+def window_count_mask(p, n, rng):
+    """``n`` matching pixels at random places of the window."""
+    window = [(y, x) for y in range(p.margin_y, p.height - p.margin_y)
+              for x in range(p.margin_x, p.width - p.margin_x)]
+    mask = np.zeros((p.height, p.width), bool)
+    for i in rng.permutation(len(window))[:n]:
+        mask[window[i]] = True
+    return mask
+
+
+@pytest.mark.parametrize("rule,found", [("ge", [False, True, True]), ("gt", [False, False, True])])
+def test_found_rule(rule, found):
+    p = small_params(found_rule=rule)
+    rng = np.random.default_rng(2)
+    masks = [window_count_mask(p, n, rng) for n in (p.min_pixels - 1, p.min_pixels,
+                                                     p.min_pixels + 1)]
+    _, results = run_tracker(p, frames_schedule(masks))
+    assert [r.found for _, r in results] == found
+    # Not found: no LED and no centroid; the proximity is counted all the same.
+    assert [r.centroid_leds != 0 for _, r in results] == found
+    assert [r.proximity for _, r in results] == [0, 1, 1]
+    assert [r for _, r in results] == [track_frame(m, p) for m in masks]
+
+
+def test_repeated_proximity_thresholds_skip_levels():
+    # The published thresholds: levels 1 and 2 never occur, 128 pixels is level 3.
+    p = small_params(proximity_thresholds=(8, 8, 8, 30, 60, 100, 200))
+    rng = np.random.default_rng(3)
+    counts = (7, 8, 29, 30, 59, 60, 99, 100, 199, 200)
+    masks = [window_count_mask(p, n, rng) for n in counts]
+    _, results = run_tracker(p, frames_schedule(masks))
+    assert [r.proximity for _, r in results] == [0, 3, 3, 4, 4, 5, 5, 6, 6, 7]
+    assert [r for _, r in results] == [track_frame(m, p) for m in masks]
+
+
+def boundary_bars(p):
+    """Two-column bars on every bin boundary: (last of bin k, first of bin k+1) and (the two
+    last columns of bin k), full window height; the window's last column wraps."""
+    lasts = [p.margin_x + (k + 1) * p.bin_width - 1 for k in range(8)]
+    return [(c, c + 1) for c in lasts[:7]] + [(c - 1, c) for c in lasts]
+
+
+def test_group_column_offset_moves_each_bins_last_column_to_the_next_group():
+    # With bins 5 columns wide: bar (8, 9) is bins 0/1 at offset 0, both group 1 at offset 1.
+    offsets = {}
+    for offset in (0, 1):
+        p = small_params(group_column_offset=offset)
+        masks = [window_columns_mask(p, bar) for bar in boundary_bars(p)]
+        _, results = run_tracker(p, frames_schedule(masks))
+        assert [r for _, r in results] == [track_frame(m, p) for m in masks]
+        offsets[offset] = [r.centroid_leds for _, r in results]
+    # The same bars as the 160x120 hand-derived table (tests/test_published_frames.py):
+    # A_k = (last of bin k, next) for k = 0..6, B_k = (two last of bin k) for k = 0..7.
+    a0, b0 = offsets[0][:7], offsets[0][7:]
+    a1, b1 = offsets[1][:7], offsets[1][7:]
+    assert a0 == [0x01, 0x02, 0x04, 0x18, 0x20, 0x40, 0x80]
+    assert b0 == [0x01, 0x02, 0x04, 0x08, 0x10, 0x20, 0x40, 0x80]
+    assert a1 == [0x01, 0x04, 0x08, 0x10, 0x20, 0x40, 0x80]
+    assert b1 == [0x01, 0x02, 0x04, 0x18, 0x20, 0x40, 0x40, 0x18]
+
+
+@pytest.mark.parametrize("changes", [
+    {"group_column_offset": 1},
+    {"group_column_offset": 1, "found_rule": "gt"},
+    {"group_column_offset": 1, "margin_x": 0, "margin_y": 0},  # the last column is the frame's
+    {"group_column_offset": 1, "margin_x": 8, "width": 32, "height": 6, "margin_y": 2},
+])
+def test_group_column_offset_random_masks_match_the_model(changes):
+    p = small_params(**changes)
+    rng = np.random.default_rng(len(changes))
+    masks = [random_mask(p, rng, d) for d in (0.05, 0.3, 0.7, 1.0)]
+    # Bars on bin edges and the window's right edge, in the window's last rows (found).
+    last_rows = range(p.height - p.margin_y - 5, p.height - p.margin_y)
+    for bar in (*boundary_bars(p)[5:7], *boundary_bars(p)[-2:]):
+        masks.append(window_columns_mask(p, bar, rows=last_rows))
+    schedule = frames_schedule(masks)
+    _, results = run_tracker(p, schedule)
+    assert [r for _, r in results] == [track_frame(m, p) for m in masks]

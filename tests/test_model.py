@@ -17,6 +17,8 @@ from fpga_robotics.sim.model import (
     centroid_leds,
     color_match,
     filter_frame,
+    is_found,
+    table_command,
     track_frame,
 )
 
@@ -446,3 +448,63 @@ def test_model_rejects_bad_frames():
         model.process(np.zeros((120, 160), np.uint16), "red")
     with pytest.raises(ValueError, match="unknown colour"):
         model.process(np.zeros((16, 48), np.uint16), "purple")
+
+
+# The published design's knobs (FollowTargetParams.published(), docs/published.md) -------------
+
+PUBLISHED = FollowTargetParams.published()
+
+
+@pytest.mark.parametrize("count,ge,gt", [(127, False, False), (128, True, False),
+                                         (129, True, True)])
+def test_found_rule_by_hand(count, ge, gt):
+    assert is_found(count, FollowTargetParams()) is ge
+    assert is_found(count, PUBLISHED) is gt
+
+
+def test_groups_shifted_by_one_column_by_hand():
+    # 160x120: one full column (104 pixels) at each of 79 (last of bin 3) and 143 (last of
+    # bin 7). Bins: h3 = h7 = 104. Groups: 79 joins group 4, 143 wraps to group 0.
+    match = np.zeros((120, 160), bool)
+    match[8:112, [79, 143]] = True
+    r0 = track_frame(match, FollowTargetParams())
+    r1 = track_frame(match, FollowTargetParams(group_column_offset=1))
+    assert r0.bins == r1.bins == (0, 0, 0, 104, 0, 0, 0, 104)
+    assert r0.centroid_leds == 0x18  # L = R
+    assert r1.centroid_leds == 0x18  # L = G0 = 104, R = G4 = 104: still centred
+    # Add a column at 80 (bin 4): exact L = 104 < R = 208, shifted L = 104 < R = 208 too,
+    # but from the right edge: h7 = 104 >= half (156)? no; groups 6..7 = 0; 5..7 = 0: LED 4.
+    match[8:112, 80] = True
+    assert centroid_leds((0, 0, 0, 104, 104, 0, 0, 104), 312, True) == 0x10
+    assert track_frame(match, FollowTargetParams(group_column_offset=1)).centroid_leds == 0x10
+    # The outermost single bins are exact: 104 pixels in column 31 (last of bin 0) still
+    # make h0 reach half although column 31 counts in group 1.
+    groups = (0, 104, 0, 0, 0, 0, 0, 0)
+    assert centroid_leds((104, 0, 0, 0, 0, 0, 0, 0), 104, True, groups) == 0x01
+
+
+@pytest.mark.parametrize("speed,code,expected", [
+    (600, 0x01, (325, 600)), (600, 0x02, (375, 600)), (600, 0x04, (425, 600)),
+    (600, 0x08, (475, 600)), (600, 0x10, (600, 475)), (600, 0x80, (600, 325)),
+    (350, 0x18, (350, 350)), (150, 0x40, (150, -75)),
+    (-250, 0x01, (-250, 25)), (-450, 0x80, (-175, -450)), (-450, 0x18, (-450, -450)),
+    (600, 0x00, (0, 0)),  # never seen
+])
+def test_table_command_by_hand(speed, code, expected):
+    assert table_command(speed, code, PUBLISHED) == expected
+
+
+def test_table_law_drives_on_while_lost_and_remembers_the_leds():
+    m = MotorModel(PUBLISHED)
+    seen = TrackerResult(True, 4, 10, 0x04, 3100, (0,) * 8, 0)
+    lost = TrackerResult(False, 0, 0, 0, 0, (0,) * 8, 0)
+    lost_128 = TrackerResult(False, 3, 0, 0, 128, (0,) * 8, 0)
+    assert m.step(seen) == (250 - 175, 250)
+    assert m.step(lost) == (600 - 175, 600) and m.last_leds == 0x04
+    assert m.step(lost_128) == (350 - 175, 350)
+    for _ in range(12):  # lost frames 3..14
+        m.step(lost)
+    assert m.lost_count == 14 and (m.left, m.right) == (425, 600)
+    assert m.step(lost) == (-250, 250)  # the 15th: search left (the LEDs' side)
+    m.reset()
+    assert (m.left, m.right, m.last_leds, m.last_side) == (0, 0, 0, "left")

@@ -6,7 +6,7 @@ import pytest
 from fpga_robotics.hw.params import FollowTargetParams
 
 
-def test_defaults_are_the_published_values_at_160x120():
+def test_defaults_at_160x120():
     p = FollowTargetParams()
     assert (p.width, p.height) == (160, 120)
     assert (p.margin_x, p.margin_y) == (16, 8)
@@ -16,6 +16,11 @@ def test_defaults_are_the_published_values_at_160x120():
     assert p.base_dps == (0, 400, 300, 200, 150, 100, -100, -150)
     assert (p.kp_num, p.kp_shift, p.max_dps, p.lost_frames, p.search_dps) == (3, 0, 512, 15, 250)
     assert p.x_bits == 8  # centroid_x is 8 bits at 160x120 (docs/contract.md, Ports)
+    # The knobs of the published design, at this design's choices.
+    assert (p.found_rule, p.group_column_offset, p.motor_law, p.lost_motion,
+            p.search_side_from, p.centred_search_side) == ("ge", 0, "p_control", "hold",
+                                                           "centroid", "right")
+    assert p.steer_dps == (125, 175, 225, 275)
 
 
 @pytest.mark.parametrize("w,h,scale,mx,my", [(320, 240, 4, 32, 16), (640, 480, 16, 64, 32)])
@@ -55,6 +60,17 @@ def test_replace_recomputes_geometry_defaults_but_keeps_explicit_values():
         ({"kp_shift": 16}, "kp_shift must be <= 15"),
         ({"lost_frames": 0}, "lost_frames must be >= 1"),
         ({"search_dps": -(1 << 15)}, "search_dps must be >= -32767"),
+        ({"found_rule": "gte"}, "found_rule must be one of ge, gt; got 'gte'"),
+        ({"group_column_offset": 2}, "group_column_offset must be <= 1"),
+        ({"group_column_offset": -1}, "group_column_offset must be >= 0"),
+        ({"motor_law": "P"}, "motor_law must be one of p_control, table"),
+        ({"steer_dps": (1, 2, 3)}, "steer_dps needs 4 values"),
+        ({"steer_dps": (1, 2, 3, -4)}, "steer_dps[3] must be >= 0"),
+        ({"steer_dps": (1, 2, 1 << 15, 4)}, "steer_dps[2] must be <= 32767"),
+        ({"lost_motion": "coast"}, "lost_motion must be one of hold, drive"),
+        ({"lost_motion": "drive"}, "lost_motion='drive' needs motor_law='table'"),
+        ({"search_side_from": "led"}, "search_side_from must be one of centroid, leds"),
+        ({"centred_search_side": "centre"}, "centred_search_side must be one of right, left"),
     ],
 )
 def test_bad_values_raise_clear_errors(kwargs, message):
@@ -68,6 +84,12 @@ def test_wrong_types_raise_type_error():
         FollowTargetParams(width=160.0)
     with pytest.raises(TypeError, match="kp_num must be an int"):
         FollowTargetParams(kp_num=True)
+    with pytest.raises(TypeError, match="group_column_offset must be an int"):
+        FollowTargetParams(group_column_offset=True)
+    with pytest.raises(TypeError, match="found_rule must be a string, one of ge, gt"):
+        FollowTargetParams(found_rule=1)
+    with pytest.raises(TypeError, match=r"steer_dps\[0\] must be an int"):
+        FollowTargetParams(steer_dps=(1.5, 2, 3, 4))
 
 
 def test_numpy_integers_are_accepted_and_stored_as_int():
@@ -76,3 +98,19 @@ def test_numpy_integers_are_accepted_and_stored_as_int():
     assert (p.width, p.height, p.kp_num) == (320, 240, 2)
     assert all(type(v) is int for v in (p.width, p.height, p.kp_num, *p.base_dps))
     assert p == FollowTargetParams(width=320, height=240, kp_num=2, base_dps=tuple(range(8)))
+
+
+def test_the_knobs_are_independent_of_the_motor_law_where_they_can_be():
+    # The search side from the LEDs and the table law without "drive" are valid with the
+    # other law; "drive" needs the table (it steers by the last LED code).
+    FollowTargetParams(search_side_from="leds", centred_search_side="left")
+    FollowTargetParams(motor_law="table")
+    FollowTargetParams(motor_law="table", lost_motion="drive", steer_dps=(0, 0, 0, 0))
+    assert FollowTargetParams(motor_law="table").motor_uses_leds
+    assert FollowTargetParams(search_side_from="leds").motor_uses_leds
+    assert not FollowTargetParams().motor_uses_leds
+
+
+def test_replace_keeps_the_knobs():
+    p = FollowTargetParams.published().replace(kp_num=2)
+    assert p == FollowTargetParams.published(kp_num=2)
