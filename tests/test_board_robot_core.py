@@ -144,8 +144,9 @@ def test_robot_timing_from_clock():
 @pytest.mark.parametrize("make", [
     lambda: ULX3SFollowTarget(FollowTargetParams(width=320, height=240)),
     lambda: ULX3SFollowTarget(sys_clk_freq=60e6),
-    # Rejected by a part (the GoPiGo3's speed limit) before FollowTarget is built.
-    lambda: RobotCore(FollowTargetParams(max_dps=20000)),
+    # Rejected (the GoPiGo3 SPI clock) before FollowTarget is built.
+    lambda: RobotCore(PARAMS, RobotTiming.from_cycles(
+        xclk_half=2, sccb_quarter=2, spi_half=0, camera_wait=5, reset_wait=8, motor_wait=3)),
     lambda: RobotCore(PARAMS, RobotTiming.from_cycles(
         xclk_half=0, sccb_quarter=2, spi_half=2, camera_wait=5, reset_wait=8, motor_wait=3)),
     lambda: RobotCore(PARAMS, TIMING, sccb_table=[]),
@@ -164,3 +165,13 @@ def test_a_rejected_constructor_leaves_no_unused_elaboratable(make):
             make()
         gc.collect()
     assert [w for w in caught if issubclass(w.category, UnusedElaboratable)] == []
+
+
+def test_gopigo3_speed_limit_is_the_designs_capped_at_what_the_message_carries():
+    from fpga_robotics.hw.board.gopigo3_spi import GOPIGO3_MAX_DPS_LIMIT
+    from fpga_robotics.hw.board.robot_core import gopigo3_dps_limit
+
+    assert gopigo3_dps_limit(FollowTargetParams()) == 512
+    assert gopigo3_dps_limit(FollowTargetParams(max_dps=600)) == 600
+    # The published preset does not saturate (max_dps 32767): the controller's maximum.
+    assert gopigo3_dps_limit(FollowTargetParams.published()) == GOPIGO3_MAX_DPS_LIMIT == 16383

@@ -42,6 +42,8 @@ __all__ = [
 ]
 
 GOPIGO3_ADDRESS = 0x08
+#: The largest speed limit SET_MOTOR_LIMITS carries: DPS x 2 ticks in a signed 16-bit field.
+GOPIGO3_MAX_DPS_LIMIT = (1 << 14) - 1
 MOTOR_LEFT = 0x01
 MOTOR_RIGHT = 0x02
 TICKS_PER_DEGREE = 2
@@ -183,7 +185,7 @@ class GoPiGo3Motors(CheckedArguments, wiring.Component):
         """Raise ``TypeError``/``ValueError`` unless ``GoPiGo3Motors`` accepts the arguments."""
         SPIByteMaster.check_arguments(half_period=half_period)
         check_int("startup_wait", startup_wait, 0)
-        check_int("dps_limit", dps_limit, 0, (1 << 14) - 1)
+        check_int("dps_limit", dps_limit, 0, GOPIGO3_MAX_DPS_LIMIT)
         check_int("power_limit", power_limit, 0, 100)
 
     def __init__(self, *, half_period, startup_wait=0, dps_limit=512, power_limit=0):

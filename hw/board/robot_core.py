@@ -16,7 +16,7 @@ from ..params import FollowTargetParams
 from ..top import FollowTarget
 from ..validate import CheckedArguments, check_int
 from .color_select import SwitchColorSelect
-from .gopigo3_spi import GoPiGo3Motors
+from .gopigo3_spi import GOPIGO3_MAX_DPS_LIMIT, GoPiGo3Motors
 from .ov7670_capture import OV7670Capture
 from .sccb import OV7670_INIT, SCCBInit
 
@@ -64,6 +64,13 @@ class RobotTiming:
         return t
 
 
+def gopigo3_dps_limit(params):
+    """The speed limit sent to the GoPiGo3: the design's ``max_dps``, capped at the largest
+    SET_MOTOR_LIMITS carries (16383 DPS). A design without saturation (the published preset,
+    ``max_dps = 32767``) so leaves the limit to the motor controller's own maximum."""
+    return min(params.max_dps, GOPIGO3_MAX_DPS_LIMIT)
+
+
 class RobotCore(CheckedArguments, wiring.Component):
     """The robot's logic between the board pins (see module docstring).
 
@@ -107,7 +114,7 @@ class RobotCore(CheckedArguments, wiring.Component):
         SCCBInit.check_arguments(sccb_table, quarter_period=t.sccb_quarter,
                                  reset_wait=t.reset_wait, startup_wait=t.camera_wait)
         GoPiGo3Motors.check_arguments(half_period=t.spi_half, startup_wait=t.motor_wait,
-                                      dps_limit=params.max_dps)
+                                      dps_limit=gopigo3_dps_limit(params))
 
     def __init__(self, params=None, timing=None, *, sccb_table=OV7670_INIT):
         self.params = FollowTargetParams() if params is None else params
@@ -117,7 +124,7 @@ class RobotCore(CheckedArguments, wiring.Component):
         self.sccb = SCCBInit(sccb_table, quarter_period=t.sccb_quarter,
                              reset_wait=t.reset_wait, startup_wait=t.camera_wait)
         self.motors = GoPiGo3Motors(half_period=t.spi_half, startup_wait=t.motor_wait,
-                                    dps_limit=self.params.max_dps)
+                                    dps_limit=gopigo3_dps_limit(self.params))
         super().__init__({
             "cam_data": In(8),
             "cam_href": In(1),
