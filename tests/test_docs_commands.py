@@ -1,0 +1,919 @@
+"""Every command in the documentation's code blocks runs, and does what the page says.
+
+The commands are read from the fenced code blocks of README.md and docs/*.md: in shell blocks
+(```` ```sh ````, ```` ```bash ````, or no language), the lines that start with
+``python -m fpga_robotics``, ``python3 -m``, ``fpga-robotics``, ``rerun``, ``openFPGALoader``
+or ``python -m pytest`` (with ``\\`` continuations joined, a usage synopsis's indented
+``[...]`` lines too, and a trailing ``# comment`` split off); and every ```` ```python ````
+block.
+
+Each command has an entry in ``PLANS`` (keyed by its text as the page writes it): how it is
+run, and what is checked besides its exit code; or why it is not run here. A command that
+is not in the table fails ``test_every_documented_command_is_classified``, so a page cannot
+gain a command that nobody runs or excuses. The exit code expected is the page's: 0, or 1
+where the command's comment says ``FAIL``.
+
+The commands of one code block run in order, each as a subprocess of ``bash -c`` with a
+timeout, in one fresh temporary folder (so ``--save-video clip.mp4`` and then
+``--source clip.mp4`` work), with no display in the environment (so the viewer's ``auto``
+mode saves a file, as on CI). They are made short: ``run`` gets ``--duration 1`` unless the
+plan says why the page's run needs longer, and ``--rerun off --quiet`` unless it is about the
+viewer; ``bench`` gets ``--frames 2 --min-seconds 0``; the other benchmarks their own small
+counts; optional ``[...]`` parts are dropped. pytest commands are collected
+(``--collect-only``), not run: running the tests is CI's own ``python -m pytest``. A server
+that runs until Ctrl-C (``rerun --serve-web``) is started on free loopback ports, must answer
+HTTP 200 within a bounded time, and is stopped with SIGINT. Place and route (``--bitstream``)
+runs only under ``-m slow``. ``python tests/test_docs_commands.py`` prints what is not run
+and why, and which runs keep the page's duration and why.
+
+Python blocks are executed with ``exec`` in a namespace holding the names they assume (a
+real frame, a world, frame records), and what they show is asserted. A bare expression of a
+snippet (``result.found, ...``) is captured so that the test can check its value.
+"""
+
+import ast
+import json
+import os
+import re
+import shlex
+import signal
+import socket
+import subprocess
+import sys
+import time
+import urllib.request
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+ROOT = Path(__file__).resolve().parent.parent
+
+#: The pages whose code blocks are checked.
+PAGES = ["README.md", *sorted(p.relative_to(ROOT).as_posix() for p in (ROOT / "docs").glob("*.md"))]
+
+#: What starts a command line in a shell block.
+COMMAND_PREFIXES = (
+    "python -m fpga_robotics", "python3 -m", "fpga-robotics", "rerun", "openFPGALoader",
+    "python -m pytest",
+)
+
+#: A line of a shell block that looks like a command (a program name first). In a block
+#: marked as shell every line is a command or a comment; in a block without a language (which
+#: may hold output) only such lines are taken for commands. Either way, one that is not a
+#: documented command (``pip install ...``, ``python -m something_else``) fails the
+#: classification test instead of being skipped silently.
+LOOKS_LIKE_COMMAND = re.compile(
+    r"^(\$\s+)?(sudo\s+)?(python[\d.]*|pip[\d.]*|pytest|fpga-robotics|fpga_robotics|rerun|"
+    r"openFPGALoader|apt-get|apt|ssh|yowasp-[\w-]+|verilator|make|git|curl|cd|source|\.)(\s|$)")
+
+SHELL_LANGS = {"", "sh", "bash", "shell", "console"}
+
+#: Seconds one command may take (a cold compiled-model build included) before it counts as hung.
+TIMEOUT = 300
+
+FAIL_MARK = re.compile(r"\bFAIL\b")
+
+
+# --- Extraction -----------------------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class Block:
+    page: str
+    line: int  # the opening fence's line
+    lang: str
+    lines: tuple  # (line number, text) of the block's content
+
+
+@dataclass(frozen=True)
+class DocCommand:
+    page: str
+    line: int
+    text: str  # the command as written (continuations joined, whitespace collapsed)
+    comment: str  # its trailing comment, without the '#'
+
+    @property
+    def expected_rc(self):
+        """The exit code the page gives the command: 1 where its comment says FAIL."""
+        return 1 if FAIL_MARK.search(self.comment) else 0
+
+
+_FENCE = re.compile(r"^ {0,3}(`{3,}|~{3,})\s*([\w+-]*)")
+
+
+def fenced_blocks(page, text):
+    """The fenced code blocks of a Markdown text."""
+    blocks, fence, start, lang, body = [], None, 0, "", []
+    for n, line in enumerate(text.split("\n"), 1):
+        m = _FENCE.match(line)
+        if fence is None:
+            if m:
+                fence, start, lang, body = m.group(1), n, m.group(2).lower(), []
+        elif line.strip().startswith(fence) and set(line.strip()) == {fence[0]}:
+            blocks.append(Block(page, start, lang, tuple(body)))
+            fence = None
+        else:
+            body.append((n, line))
+    return blocks
+
+
+def split_comment(line):
+    """``(command, comment)``: a ``#`` after a blank, outside quotes, starts a comment."""
+    quote = None
+    for i, ch in enumerate(line):
+        if quote:
+            if ch == quote:
+                quote = None
+        elif ch in "'\"":
+            quote = ch
+        elif ch == "#" and (i == 0 or line[i - 1].isspace()):
+            return line[:i].rstrip(), line[i + 1:].strip()
+    return line.rstrip(), ""
+
+
+def logical_lines(block):
+    """``(line number, code, comment)`` of a shell block: ``\\`` continuations joined, and the
+    indented ``[...]`` lines of a usage synopsis joined to the command above them."""
+    out = []
+    pending = None  # [line, code, comment] still open for a continuation
+    for n, raw in block.lines:
+        code, comment = split_comment(raw)
+        if pending is not None and pending[1].endswith("\\"):
+            pending[1] = pending[1][:-1].rstrip() + " " + code.strip()
+            pending[2] = comment or pending[2]
+            continue
+        if pending is not None and re.match(r"^\s+\[", raw) and pending[1].strip():
+            pending[1] += " " + code.strip()
+            pending[2] = comment or pending[2]
+            continue
+        if pending is not None:
+            out.append(tuple(pending))
+        pending = [n, code, comment]
+    if pending is not None:
+        out.append(tuple(pending))
+    return out
+
+
+def collapse(text):
+    return " ".join(text.split())
+
+
+def scan_page(page):
+    """``(commands, python blocks, unclassified lines)`` of one page."""
+    text = (ROOT / page).read_text(encoding="utf-8")
+    commands, snippets, strays = [], [], []
+    for block in fenced_blocks(page, text):
+        if block.lang == "python":
+            snippets.append(block)
+            continue
+        if block.lang not in SHELL_LANGS:
+            continue
+        for n, code, comment in logical_lines(block):
+            stripped = code.strip()
+            if stripped.startswith("$ "):
+                stripped = stripped[2:].lstrip()
+            if not stripped:
+                continue
+            if stripped.startswith(COMMAND_PREFIXES):
+                commands.append(DocCommand(page, n, collapse(stripped), comment))
+            elif block.lang or LOOKS_LIKE_COMMAND.match(stripped):
+                strays.append(f"{page}:{n}: {stripped}")
+    return commands, snippets, strays
+
+
+def command_blocks():
+    """Every shell block with commands, as ``(page, fence line, [DocCommand])``."""
+    found = []
+    for page in PAGES:
+        text = (ROOT / page).read_text(encoding="utf-8")
+        for block in fenced_blocks(page, text):
+            if block.lang not in SHELL_LANGS:
+                continue
+            lines = {n for n, _ in block.lines}
+            cmds = [c for c in scan_page(page)[0] if c.line in lines]
+            if cmds:
+                found.append((page, block.line, cmds))
+    return found
+
+
+def python_blocks():
+    return [b for page in PAGES for b in scan_page(page)[1]]
+
+
+def snippet_key(block):
+    """``(page, first line)``: how ``SNIPPETS`` names a Python block."""
+    first = next(text for _, text in block.lines if text.strip())
+    return block.page, first.strip()
+
+
+# --- How each command is run ----------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class Plan:
+    """How a documented command is run here, or why it is not."""
+
+    #: Why it is not run at all (None: it is run).
+    excused: str = None
+    #: Only this part of a ``&&`` chain is run; ``part_why`` says why the rest is not.
+    part: str = None
+    part_why: str = None
+    #: ``run``: keep the page's duration, or use this one, and say why (else ``--duration 1``).
+    duration: str = None
+    duration_why: str = None
+    #: ``run``: about the viewer, so no ``--rerun off`` is added.
+    viewer: bool = False
+    #: ``(option, value)`` pairs set to keep it short (benchmarks other than ``bench``).
+    shorter: tuple = ()
+    #: Commands run first in the folder, to make what the command's placeholders name.
+    setup: tuple = ()
+    #: Files (relative to the folder) that must exist afterwards.
+    files: tuple = ()
+    #: Regular expressions that must match the output (stdout and stderr).
+    out: tuple = ()
+    #: Regular expressions that must not match the output.
+    not_out: tuple = ()
+    #: A regular expression the last line of stdout must match.
+    last_line: str = None
+    #: Items the ``--summary s.json`` file must hold (``...``: the key is there).
+    summary: tuple = ()
+    #: A pytest command: collected in the repository (``--collect-only``), not run.
+    collect: bool = False
+    #: A server that runs until Ctrl-C: started on free ports, asked for its page, stopped.
+    serve: bool = False
+    #: Marked slow (place and route): run only by ``test_documented_slow_command``.
+    slow: bool = False
+
+
+#: A run whose recording is the placeholder ``runs/follow_person.rrd`` of a page.
+MAKE_RECORDING = "python -m fpga_robotics.run --duration 1 --quiet"
+#: A run whose camera frames are the placeholder ``clip.mp4`` of a page.
+MAKE_CLIP = "python -m fpga_robotics.run --duration 1 --rerun off --quiet --save-video clip.mp4"
+
+SCENARIO_NAMES = ("follow_person", "divider", "lighting", "heavy_robot", "lost_target")
+PASS = r"(?m)^verdict: PASS$"
+SAVED_DEFAULT = r"saved \d+ frames .* to runs/follow_person\.rrd .*open it with: rerun runs/follow_person\.rrd"
+
+_DIVIDER_WHY = (
+    "the scenario's own 25 s (about 1 s of wall time): the loose filter's robot turns to the "
+    "wood and loses the person from view between 10 and 15 s, which is the failure the page "
+    "means; a run of 10 s or less fails only the mean-distance check, as the default design does")
+
+PLANS = {
+    # README: two commands on a fresh machine ------------------------------------------------
+    "python3 -m venv .venv && . .venv/bin/activate && pip install -e . && python -m fpga_robotics.run":
+        Plan(part="python -m fpga_robotics.run",
+             part_why="the virtual environment and the install are the ones this test runs in; "
+                      ".ci/run makes them in a fresh clone on every submission",
+             viewer=True, files=("runs/follow_person.rrd",),
+             out=(PASS, SAVED_DEFAULT), last_line=r"runs/follow_person\.rrd$"),
+    'python3 -m venv .venv && . .venv/bin/activate && pip install -e ".[dev,board]" && python -m pytest':
+        Plan(part="python -m pytest", collect=True,
+             part_why="the set-up and the whole test run are CI's own command (.ci/run, checked "
+                      "by test_ci_runs_the_readme_test_command); here the suite is collected",
+             out=(r"\d{3,} tests collected",)),
+    # Viewing a recording ---------------------------------------------------------------------
+    "rerun --serve-web --bind 127.0.0.1 runs/follow_person.rrd":
+        Plan(serve=True, setup=(MAKE_RECORDING,)),
+    "rerun out/run.rrd":
+        Plan(excused="opens rerun's native viewer window: needs a display (the web viewer of "
+                     "the same file is checked through `rerun --serve-web`)"),
+    # README: the first ten minutes -----------------------------------------------------------
+    "python -m fpga_robotics.run --target-color green":
+        # Found in every frame: the person is dressed in green and the design selects green.
+        Plan(out=(PASS, r"target: first found at 0\.00 s, in view 100%, found 100%")),
+    "python -m fpga_robotics.run --scenario divider --set design.diff_min=5 --rerun off":
+        Plan(duration="keep", duration_why=_DIVIDER_WHY,
+             out=(r"\[FAIL\] target_in_view_min_fraction",)),
+    "python -m fpga_robotics.run --scenario divider --shadow diff_min=5 --rerun off":
+        Plan(duration="keep",
+             duration_why="the page says the default design passes: over the whole scenario "
+                           "(25 s); a run under 15 s fails its mean-distance check",
+             out=(PASS, r"shadow diff_min=5: first differs at frame \d+")),
+    "python -m fpga_robotics.run --duration 5 --rerun off --save-video clip.mp4":
+        Plan(files=("clip.mp4",), out=(PASS,)),
+    "python -m fpga_robotics.run --source clip.mp4 --rerun off":
+        Plan(out=(r"source clip\.mp4 \(video\)", r"target found in 30 frames")),
+    "python -m fpga_robotics.export -o build/follow_target.v [--width 320 --height 240 --kp-num 2 ...]":
+        Plan(files=("build/follow_target.v",), out=(r"160x120, module follow_target",)),
+    # README and docs/running.md: the closed loop ---------------------------------------------
+    "python -m fpga_robotics.run --list-scenarios":
+        Plan(out=tuple(rf"(?m)^{name}\s" for name in SCENARIO_NAMES)),
+    "python -m fpga_robotics.run --scenario lost_target --rerun off --summary s.json":
+        Plan(duration="keep",
+             duration_why="lost_target's reacquired_within_s needs the person to leave the view "
+                          "and be found again (after about 4 s); a 1 s run fails it (15 s "
+                          "simulated, under a second of wall time)",
+             files=("s.json",), out=(PASS,),
+             summary=(("scenario", "lost_target"), ("verdict", "pass"))),
+    "python -m fpga_robotics.run --resolution 640x480 --backend verilator --duration 5 --rerun off":
+        Plan(out=(r"backend verilator\s+640x480", PASS)),
+    "python -m fpga_robotics.run":
+        # The page's "typical ending", line by line.
+        Plan(out=(r"(?m)^scenario follow_person\s+backend {fastest}\s+160x120\s+seed 0$",
+                  (r"(?m)^  30 frames, 1\.0 s simulated in [\d.]+ s \([\d.]+ ms/frame, "
+                   r"[\d.]+x real time\)$"),
+                  (r"(?m)^  target: first found at [\d.]+ s, in view \d+%, found \d+%, "
+                   r"\d+ search\(es\)$"),
+                  r"(?m)^  distance: min [\d.]+ m, mean [\d.]+ m; path [\d.]+ m$",
+                  r"(?m)^  collisions: person 0, wall 0, furniture 0$",
+                  r"(?m)^  \[ok\] acquired_within_s: ", PASS)),
+    "python -m fpga_robotics.run --scenario lost_target --rerun off":
+        Plan(duration="keep", duration_why="as for the same command with --summary",
+             out=(PASS,)),
+    "python -m fpga_robotics.run --scenario divider --set design.diff_min=5":
+        Plan(duration="keep", duration_why=_DIVIDER_WHY,
+             out=(r"\[FAIL\] target_in_view_min_fraction",)),
+    "python -m fpga_robotics.run --resolution 320x240 --backend verilator --summary s.json":
+        Plan(files=("s.json",), out=(r"backend verilator\s+320x240", PASS),
+             summary=(("backend", "verilator"), ("resolution", "320x240"))),
+    "python -m fpga_robotics.run --source clip.mp4 --color red":
+        Plan(setup=(MAKE_CLIP,),
+             out=(r"source clip\.mp4 \(video\)\s+backend \w+\s+160x120\s+colour red",
+                  r"target found in 30 frames")),
+    "python -m fpga_robotics.run --scenario follow_person --rerun off --summary s.json "
+    "[--backend B]":
+        # README quotes the summary's realtime_factor of this command.
+        Plan(files=("s.json",), out=(PASS,), summary=(("realtime_factor", ...),)),
+    "python -m fpga_robotics.run --scenario follow_person --rerun off --summary s.json "
+    "--resolution 640x480 --duration 10 [--backend B]":
+        Plan(files=("s.json",), out=(PASS,),
+             summary=(("resolution", "640x480"), ("realtime_factor", ...))),
+    "python -m fpga_robotics.run --backend model --rerun off --quiet --duration 20 "
+    "--scenario lost_target --shadow 'lost_frames=5'":
+        Plan(duration="keep",
+             duration_why="the page shows this run's last lines, frame numbers and counts "
+                           "'of 600' included (model backend: under a second of wall time)",
+             out=(re.escape("  shadow lost_frames=5: first differs at frame 119 (3.97 s): "
+                            "motor_left 208 vs -250, motor_right 512 vs 250"),
+                  re.escape("  shadow frames that differ: motor_left 10, motor_right 10 "
+                            "(of 600)"))),
+    # docs/viewer.md --------------------------------------------------------------------------
+    "python -m fpga_robotics.run --scenario follow_person":
+        Plan(viewer=True, files=("runs/follow_person.rrd",), out=(SAVED_DEFAULT,)),
+    "python -m fpga_robotics.run --scenario follow_person --rerun save:out/run.rrd":
+        Plan(viewer=True, files=("out/run.rrd",),
+             out=(r"saved \d+ frames .* to out/run\.rrd",)),
+    "python -m fpga_robotics.viz.bench":
+        Plan(shorter=(("--frames", "2"), ("--repeats", "1")),
+             out=(r"160x120: wall median", r"640x480: wall median")),
+    # Verilog export and the board ------------------------------------------------------------
+    "python -m fpga_robotics.export -o build/follow_target.v":
+        Plan(files=("build/follow_target.v",), out=(r"160x120, module follow_target",)),
+    "python -m fpga_robotics.export -o build/ft320.v --width 320 --height 240 --diff-min 5 "
+    "--kp-num 2 --base-dps 0,400,300,200,150,100,-100,-150 "
+    "--proximity-thresholds 512,1024,2048,4096,8192,16384,24576":
+        Plan(files=("build/ft320.v",), out=(r"320x240, module follow_target",)),
+    "python -m fpga_robotics.export --board ulx3s-85f -o build/ulx3s":
+        # docs/board.md: the board top, its LPF and the rest of Amaranth's build plan.
+        Plan(files=tuple(f"build/ulx3s/{name}" for name in (
+            "ulx3s_follow_target.v", "ulx3s_follow_target.lpf", "ulx3s_follow_target.il",
+            "ulx3s_follow_target.ys", "build_ulx3s_follow_target.sh"))),
+    "python -m fpga_robotics.export --board ulx3s-85f -o build/ulx3s --bitstream":
+        Plan(slow=True, files=("build/ulx3s/ulx3s_follow_target.bit",),
+             out=(r"(?i)sync.*MHz",)),
+    "openFPGALoader -b ulx3s build/ulx3s/ulx3s_follow_target.bit":
+        Plan(excused="programs a ULX3S over USB: needs the board (and openFPGALoader, which is "
+                     "not a Python package)"),
+    # "includes the slow full build", and without it:
+    "python -m pytest -q tests/test_board_*.py":
+        Plan(collect=True, out=(r"test_bitstream_build_meets_timing",)),
+    'python -m pytest -q tests/test_board_*.py -m "not slow"':
+        Plan(collect=True, out=(r"\(\d+ deselected\)",),
+             not_out=(r"test_bitstream_build_meets_timing",)),
+    "python -m pytest -q tests/test_hw_color_filter.py tests/test_hw_divider.py "
+    "tests/test_hw_tracker.py tests/test_hw_motor.py tests/test_hw_top.py "
+    "tests/test_hw_pysim_backend.py tests/test_export.py":
+        Plan(collect=True, out=(r"\d+ tests collected",)),
+    # Benchmarks ------------------------------------------------------------------------------
+    "python -m fpga_robotics.bench [--backends model,pysim,cxxrtl,verilator] "
+    "[--resolutions 160x120,320x240,640x480] [--frames 30] [--pysim-frames 3] "
+    "[--pysim-max-pixels 19200] [--min-seconds 1.0] [--no-trivial] [--json bench.json]":
+        Plan(out=tuple(rf"(?m)^{b}\s+{s}\s" for b in ("model", "cxxrtl", "verilator")
+                       for s in ("160x120", "320x240", "640x480"))
+             + (r"(?m)^pysim\s+160x120\s",
+                r"cxxrtl 160x120: FollowTarget at [\d.]+ of the trivial design's cycle rate")),
+    "python -m fpga_robotics.camera_bench":
+        Plan(shorter=(("--frames", "2"), ("--repeats", "1")),
+             out=(r"(?m)^\s*160x120\s+[\d.]+", r"(?m)^\s*640x480\s+[\d.]+")),
+    "python -m fpga_robotics.sim.backends.pysim --frames 7":
+        Plan(shorter=(("--frames", "2"),),
+             out=(r"every frame equal to the golden model", r"median [\d.]+ s wall")),
+}
+
+
+def _is(cmd, module, sub):
+    return cmd.startswith((f"python -m fpga_robotics.{module} ", f"fpga-robotics {sub} ")) \
+        or cmd in (f"python -m fpga_robotics.{module}", f"fpga-robotics {sub}")
+
+
+def _set_option(args, name, value):
+    """``args`` with ``name value`` replacing the option's value, or added."""
+    args = list(args)
+    for i, a in enumerate(args):
+        if a == name:
+            args[i + 1] = value
+            return args
+        if a.startswith(name + "="):
+            args[i] = f"{name}={value}"
+            return args
+    return [*args, name, value]
+
+
+def effective(doc_text, plan):
+    """The command line this test runs for a documented command (a string for ``bash -c``)."""
+    text = plan.part or doc_text
+    text = re.sub(r"(?<=\s)\[[^\]]*\]", "", text)  # optional parts dropped
+    text = collapse(text)
+    args = shlex.split(text)
+    if _is(text, "run", "run") and "--list-scenarios" not in args:
+        if "--source" not in args:
+            if plan.duration is None:
+                args = _set_option(args, "--duration", "1")
+            elif plan.duration != "keep":
+                args = _set_option(args, "--duration", plan.duration)
+        if not plan.viewer and not any(a == "--rerun" or a.startswith("--rerun=") for a in args):
+            args += ["--rerun", "off"]
+        if "--quiet" not in args:
+            args.append("--quiet")
+    elif _is(text, "bench", "bench"):
+        args = _set_option(_set_option(args, "--frames", "2"), "--min-seconds", "0")
+    if plan.collect:
+        args += ["--collect-only", "-p", "no:cacheprovider"]
+    for name, value in plan.shorter:
+        args = _set_option(args, name, value)
+    # Keep the page's glob (tests/test_board_*.py) for the shell to expand.
+    return " ".join(a if re.fullmatch(r"[\w@%+=:,./*-]+", a) else shlex.quote(a) for a in args)
+
+
+# --- Running ----------------------------------------------------------------------------------
+
+def command_env():
+    """The environment of a documented command: this interpreter's scripts first on PATH,
+    and no display (so ``--rerun auto`` saves a file, as on CI)."""
+    env = dict(os.environ)
+    env["PATH"] = str(Path(sys.executable).parent) + os.pathsep + env.get("PATH", "")
+    for name in ("DISPLAY", "WAYLAND_DISPLAY"):
+        env.pop(name, None)
+    return env
+
+
+@dataclass
+class Ran:
+    command: str
+    returncode: int
+    output: str
+    stdout: str = ""
+
+
+def run_shell(command, cwd, timeout=TIMEOUT):
+    try:
+        proc = subprocess.run(["bash", "-c", command], check=False, cwd=cwd, env=command_env(),
+                              stdin=subprocess.DEVNULL, capture_output=True, text=True,
+                              timeout=timeout)
+    except subprocess.TimeoutExpired as exc:
+        pytest.fail(f"{command!r} did not end within {timeout} s:\n{exc.stdout}\n{exc.stderr}")
+    return Ran(command, proc.returncode, proc.stdout + proc.stderr, proc.stdout)
+
+
+def free_port():
+    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def http_status(url, timeout=2.0):
+    try:
+        with urllib.request.urlopen(url, timeout=timeout) as response:
+            return response.status
+    except OSError:
+        return None
+
+
+def run_server(command, cwd, *, within=60.0):
+    """Start a server that runs until Ctrl-C on free loopback ports, wait (bounded) until its
+    web page answers HTTP 200 on 127.0.0.1, then stop it as Ctrl-C does (SIGINT to its
+    process group). Returns a ``Ran`` whose output is what it printed and whose return code
+    is 0 when it served the page."""
+    web, grpc = free_port(), free_port()
+    while grpc == web:
+        grpc = free_port()
+    command = f"{command} --web-viewer-port {web} --port {grpc}"
+    log = Path(cwd) / "server.log"
+    start = time.monotonic()
+    with open(log, "wb") as out:
+        proc = subprocess.Popen(["bash", "-c", command], cwd=cwd, env=command_env(),
+                                stdin=subprocess.DEVNULL, stdout=out, stderr=subprocess.STDOUT,
+                                start_new_session=True)
+    try:
+        status = None
+        while time.monotonic() - start < within and proc.poll() is None:
+            status = http_status(f"http://127.0.0.1:{web}/")
+            if status == 200:
+                break
+            time.sleep(0.5)
+        os.killpg(proc.pid, signal.SIGINT)  # Ctrl-C
+        try:
+            proc.wait(timeout=15)
+            stopped = True
+        except subprocess.TimeoutExpired:
+            stopped = False
+    finally:
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGKILL)
+            proc.wait(timeout=10)
+    printed = log.read_text(errors="replace")
+    ran = Ran(command, 0 if status == 200 else 1, printed, printed)
+    assert status == 200, f"{command!r}: no HTTP 200 on 127.0.0.1:{web} within {within} s:\n" \
+                          f"{ran.output}"
+    assert stopped, f"{command!r} did not stop within 15 s of Ctrl-C"
+    # The page says it prints the address to open, with the gRPC port in the URL.
+    assert f"http://127.0.0.1:{web}?url=rerun%2Bhttp%3A%2F%2Flocalhost%3A{grpc}%2Fproxy" \
+        in ran.output, ran.output
+    return ran
+
+
+def check(doc, plan, ran, folder):
+    where = f"{doc.page}:{doc.line}: {ran.command!r}"
+    assert ran.returncode == doc.expected_rc, (
+        f"{where}: exit code {ran.returncode}, the page says "
+        f"{doc.expected_rc}{' (# FAIL)' if doc.expected_rc else ''}:\n{ran.output[-3000:]}")
+    for name in plan.files:
+        assert (folder / name).is_file(), f"{where}: wrote no {name}:\n{ran.output[-2000:]}"
+    for pattern in plan.out:
+        pattern = pattern.replace("{fastest}", _fastest())
+        assert re.search(pattern, ran.output), (
+            f"{where}: no match for {pattern!r} in the output:\n{ran.output[-3000:]}")
+    for pattern in plan.not_out:
+        assert not re.search(pattern, ran.output), f"{where}: {pattern!r} in the output"
+    if plan.last_line:
+        last = (ran.stdout.strip().splitlines() or [""])[-1]
+        assert re.search(plan.last_line, last), f"{where}: last line {last!r}"
+    if plan.summary:
+        summary = json.loads((folder / "s.json").read_text())
+        for key, value in plan.summary:
+            assert key in summary, f"{where}: s.json has no {key!r}"
+            if value is not ...:
+                assert summary[key] == value, f"{where}: s.json {key} = {summary[key]!r}"
+
+
+def _fastest():
+    from fpga_robotics.sim.backends import fastest_backend_name
+
+    return fastest_backend_name()
+
+
+def run_documented(doc, plan, folder):
+    """Run one documented command in ``folder`` as its plan says, and check it."""
+    for setup in plan.setup:
+        ran = run_shell(setup, folder)
+        assert ran.returncode == 0, f"set-up {setup!r} failed:\n{ran.output[-3000:]}"
+    command = effective(doc.text, plan)
+    if plan.serve:
+        ran = run_server(command, folder)
+    else:
+        ran = run_shell(command, ROOT if plan.collect else folder)
+    check(doc, plan, ran, folder)
+    return ran
+
+
+# --- The extraction itself ------------------------------------------------------------------------
+
+SAMPLE = """\
+Text.
+
+```sh
+python -m fpga_robotics.run --scenario divider --rerun off   # FAIL
+python -m fpga_robotics.export -o a.v \\
+    --width 320 --height 240     # wide
+fpga-robotics run --set 'x=a # b' --quiet
+```
+
+```
+python -m fpga_robotics.bench [--frames 30]
+                              [--json b.json]
+output line
+pip install something
+```
+
+```python
+print(1)
+```
+
+```toml
+key = 1
+```
+"""
+
+
+def test_extraction_of_a_sample_page(tmp_path, monkeypatch):
+    monkeypatch.setattr(sys.modules[__name__], "ROOT", tmp_path)
+    (tmp_path / "page.md").write_text(SAMPLE)
+    commands, snippets, strays = scan_page("page.md")
+    assert [(c.line, c.text, c.comment, c.expected_rc) for c in commands] == [
+        (4, "python -m fpga_robotics.run --scenario divider --rerun off", "FAIL", 1),
+        (5, "python -m fpga_robotics.export -o a.v --width 320 --height 240", "wide", 0),
+        (7, "fpga-robotics run --set 'x=a # b' --quiet", "", 0),
+        (11, "python -m fpga_robotics.bench [--frames 30] [--json b.json]", "", 0),
+    ]
+    assert strays == ["page.md:14: pip install something"]
+    assert [snippet_key(b) for b in snippets] == [("page.md", "print(1)")]
+
+
+def test_shortening_rules():
+    plan = Plan()
+    assert effective("python -m fpga_robotics.run --duration 5 --save-video c.mp4", plan) == \
+        "python -m fpga_robotics.run --duration 1 --save-video c.mp4 --rerun off --quiet"
+    assert effective("fpga-robotics run --source c.mp4", plan) == \
+        "fpga-robotics run --source c.mp4 --rerun off --quiet"
+    assert effective("python -m fpga_robotics.run --scenario x", Plan(viewer=True)) == \
+        "python -m fpga_robotics.run --scenario x --duration 1 --quiet"
+    assert effective("python -m fpga_robotics.run --duration 20 --quiet",
+                     Plan(duration="keep")) == \
+        "python -m fpga_robotics.run --duration 20 --quiet --rerun off"
+    assert effective("python -m fpga_robotics.bench [--frames 30] [--json b.json]", plan) == \
+        "python -m fpga_robotics.bench --frames 2 --min-seconds 0"
+    assert effective("python -m fpga_robotics.run --shadow 'a=1;b=2'", plan).startswith(
+        "python -m fpga_robotics.run --shadow 'a=1;b=2' --duration 1")
+    assert effective("python -m pytest -q tests/test_board_*.py -m \"not slow\"",
+                     Plan(collect=True)) == \
+        "python -m pytest -q tests/test_board_*.py -m 'not slow' --collect-only -p no:cacheprovider"
+
+
+# --- Every command is run or excused --------------------------------------------------------------
+
+def test_every_documented_command_is_classified():
+    problems = []
+    for page in PAGES:
+        commands, _, strays = scan_page(page)
+        problems += [f"{s}  (a command line the extractor does not take: make it one of "
+                     f"{COMMAND_PREFIXES} or move it out of the code block)" for s in strays]
+        problems += [f"{c.page}:{c.line}: {c.text}  (not in PLANS: run it or excuse it)"
+                     for c in commands if c.text not in PLANS]
+    used = {c.text for page in PAGES for c in scan_page(page)[0]}
+    problems += [f"PLANS entry no page has any more: {key}" for key in PLANS if key not in used]
+    problems += [f"PLANS[{key!r}].part is not a part of the command" for key, plan in PLANS.items()
+                 if plan.part and plan.part not in key.split(" && ")]
+    blocks = {snippet_key(b) for b in python_blocks()}
+    problems += [f"{p}: python block starting {first!r} has no entry in SNIPPETS"
+                 for p, first in sorted(blocks - set(SNIPPETS))]
+    problems += [f"SNIPPETS entry no page has any more: {key}" for key in SNIPPETS
+                 if key not in blocks]
+    assert not problems, "\n".join(problems)
+
+
+def test_ci_runs_the_readme_test_command():
+    """README: ``.ci/run`` does exactly the README's test command in a fresh clone."""
+    ci = (ROOT / ".ci" / "run").read_text()
+    for step in ("python3 -m venv .venv", ". .venv/bin/activate",
+                 'pip install -q -e ".[dev,board]"', "python -m pytest"):
+        assert step in ci, f".ci/run does not do {step!r}"
+
+
+def _block_id(item):
+    page, line, _ = item
+    return f"{page}:{line}"
+
+
+@pytest.mark.parametrize("block", command_blocks(), ids=_block_id)
+def test_documented_commands(block, tmp_path):
+    """The commands of one code block, in order, in one fresh folder."""
+    _, _, commands = block
+    ran_any = False
+    for doc in commands:
+        plan = PLANS.get(doc.text)
+        if plan is None:
+            pytest.fail(f"{doc.page}:{doc.line}: {doc.text}: not in PLANS")
+        if plan.excused or plan.slow:
+            continue
+        run_documented(doc, plan, tmp_path)
+        ran_any = True
+    if not ran_any:
+        pytest.skip("every command of this block is excused or slow: " + "; ".join(
+            PLANS[d.text].excused or "slow" for d in commands))
+
+
+def _slow_commands():
+    """Each slow command once (the same build is documented on two pages)."""
+    seen = {}
+    for page in PAGES:
+        for d in scan_page(page)[0]:
+            if d.text in PLANS and PLANS[d.text].slow:
+                seen.setdefault(d.text, d)
+    return [pytest.param(d, id=f"{d.page}:{d.line}") for d in seen.values()]
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("doc", _slow_commands())
+def test_documented_slow_command(doc, tmp_path):
+    """Place and route (about 40 s, more on a cold YoWASP cache): the page's full flow."""
+    run_documented(doc, PLANS[doc.text], tmp_path)
+
+
+# --- Python blocks ----------------------------------------------------------------------------
+
+class _ShowExpressions(ast.NodeTransformer):
+    """Every bare expression statement ``e`` becomes ``_shown.append(e)``, so that what a
+    snippet shows (``result.found, result.proximity``) can be checked."""
+
+    def visit_Expr(self, node):
+        call = ast.Call(func=ast.Attribute(value=ast.Name("_shown", ast.Load()), attr="append",
+                                           ctx=ast.Load()), args=[node.value], keywords=[])
+        return ast.copy_location(ast.Expr(call), node)
+
+
+def exec_snippet(block, namespace):
+    """Execute a Python block in ``namespace``; returns the values of its bare expressions."""
+    source = "\n".join(text for _, text in block.lines)
+    tree = _ShowExpressions().visit(ast.parse(source))
+    ast.fix_missing_locations(tree)
+    shown = []
+    namespace["_shown"] = shown
+    exec(compile(tree, f"{block.page}:{block.line}", "exec"), namespace)  # noqa: S102
+    return shown
+
+
+def _model_result(frame, params, **kwargs):
+    from fpga_robotics.sim.backends import get_backend
+
+    with get_backend("model", params, **kwargs) as model:
+        return model.process_frame(frame, "red")
+
+
+def snippet_readme_backends(tmp_path, capsys):
+    """README: the frame API on Verilator; what it shows equals the golden model's result."""
+    from fpga_robotics.hw.params import FollowTargetParams
+    from fpga_robotics.sim.synthetic import blob_frame
+
+    frame = blob_frame(160, 120, "red", rng=1)
+    ns = {"rgb888_image": frame}
+    shown = yield ns
+    expected = _model_result(frame, FollowTargetParams(), line_blank=0, frame_blank=0)
+    filtered, found, proximity, centroid_x, motor_left = shown[-1]
+    assert found is True or found == 1
+    assert filtered.shape == (120, 160) and filtered.dtype == np.uint16
+    assert np.array_equal(filtered, expected.filtered)
+    assert (found, proximity, centroid_x, motor_left) == (
+        expected.found, expected.proximity, expected.centroid_x, expected.motor_left)
+    assert ns["result"] == expected  # cycles included
+
+
+def snippet_backends_api(tmp_path, capsys):
+    """docs/backends.md: the fastest backend at 320x240 with blanking equals the model."""
+    from fpga_robotics.hw.params import FollowTargetParams
+    from fpga_robotics.sim.synthetic import blob_frame
+
+    frame = blob_frame(320, 240, "red", rng=2)
+    ns = {"rgb_frame": frame}
+    yield ns
+    expected = _model_result(frame, FollowTargetParams(width=320, height=240),
+                             line_blank=4, frame_blank=100)
+    assert ns["result"].found
+    assert ns["result"] == expected
+
+
+def snippet_backends_waveform(tmp_path, capsys):
+    """docs/backends.md: a waveform of frames 10..12, renamed into place when frame 12 is done.
+    The snippet continues the page's first block (its imports) and assumes ``params`` and an
+    existing ``out/`` (a missing directory is an error, as the page says)."""
+    from fpga_robotics.hw.params import FollowTargetParams
+    from fpga_robotics.sim.backends import WaveformRequest, get_backend
+    from fpga_robotics.sim.synthetic import blob_frame
+
+    (tmp_path / "out").mkdir()
+    ns = {"get_backend": get_backend, "WaveformRequest": WaveformRequest,
+          "params": FollowTargetParams()}
+    shown = yield ns
+    design = shown[-1]
+    try:
+        frame = blob_frame(160, 120, "red", rng=3)
+        for _ in range(12):  # frames 0..11
+            design.process_frame(frame, "red")
+        assert not (tmp_path / "out" / "run.fst").exists()
+        design.process_frame(frame, "red")  # frame 12, the last requested
+        fst = tmp_path / "out" / "run.fst"
+        assert fst.is_file() and fst.stat().st_size > 0
+    finally:
+        design.close()
+
+
+def snippet_camera(tmp_path, capsys):
+    """docs/camera.md: the renderer on a real scene and camera pose; the cached ``render`` gives
+    the same image as the renderer without noise."""
+    from fpga_robotics.scenario import load_scenario
+    from fpga_robotics.sim.camera import CameraRenderer
+    from fpga_robotics.sim.world import World
+
+    world = World.from_config(load_scenario("follow_person").world, 0)
+    scene, pose = world.scene(), world.camera_pose()
+    ns = {"np": np, "scene": scene, "pose": pose, "seed": 0}
+    yield ns
+    img = ns["img"]
+    assert img.shape == (120, 160, 3) and img.dtype == np.uint8
+    plain = CameraRenderer(160, 120, hfov=1.047).render(scene, pose)
+    assert np.array_equal(img, plain)
+    assert np.array_equal(ns["renderer"].render(scene, pose), plain)
+
+
+def snippet_running(tmp_path, capsys):
+    """docs/running.md: a run from Python (model backend, the snippet's 10 s: 300 frames in
+    about a second)."""
+    ns = {}
+    shown = yield ns
+    (verdict, mean_distance), (x, found), events = shown
+    assert verdict in ("pass", "fail") and ns["result"].passed == (verdict == "pass")
+    assert isinstance(mean_distance, float) and mean_distance > 0
+    assert isinstance(x, np.ndarray) and isinstance(found, np.ndarray)
+    assert len(x) == len(found) == 300  # one value per frame: 10 s at 30 frames/s
+    assert isinstance(events, list)
+    for frame, time_s, text in events:
+        assert isinstance(frame, int) and isinstance(time_s, float) and isinstance(text, str)
+
+
+def snippet_viewer(tmp_path, capsys):
+    """docs/viewer.md: a recorder fed a world's map and a run's frame records; the file gets
+    its real name and the last notice says how to open it."""
+    from fpga_robotics.loop import run_scenario
+    from fpga_robotics.scenario import load_scenario
+    from fpga_robotics.sim.world import World
+
+    scenario = load_scenario("follow_person", ["sim.duration=1"])
+    records = []
+    run_scenario(scenario, backend="model", on_frame=records.append)
+    assert len(records) == 30
+    ns = {"world": World.from_config(scenario.world, scenario.seed), "records": records}
+    yield ns
+    printed = capsys.readouterr().out
+    assert (tmp_path / "run.rrd").is_file()
+    assert not (tmp_path / "runs").exists()  # save:PATH writes exactly PATH
+    assert re.search(r"saved 30 frames .*open it with: rerun run\.rrd", printed), printed
+
+    from fpga_robotics.viz.readback import read_rrd
+
+    assert read_rrd(str(tmp_path / "run.rrd"))  # a recording rerun can read
+
+
+#: Python blocks, by (page, first line): a generator that yields the namespace the snippet
+#: assumes, is sent the values of its bare expressions, and checks them.
+SNIPPETS = {
+    ("README.md", "from fpga_robotics.hw.params import FollowTargetParams"):
+        snippet_readme_backends,
+    ("docs/backends.md", "from fpga_robotics.hw.params import FollowTargetParams"):
+        snippet_backends_api,
+    ("docs/backends.md", ('get_backend("verilator", params, waveform=WaveformRequest('
+                          '"out/run.fst", first_frame=10,')):
+        snippet_backends_waveform,
+    ("docs/camera.md", "from fpga_robotics.sim.camera import CameraRenderer, render"):
+        snippet_camera,
+    ("docs/running.md", "from fpga_robotics.scenario import load_scenario"):
+        snippet_running,
+    ("docs/viewer.md", "from fpga_robotics.viz import ViewerError, open_recorder"):
+        snippet_viewer,
+}
+
+
+@pytest.mark.parametrize("block", python_blocks(), ids=lambda b: f"{b.page}:{b.line}")
+def test_documented_python(block, tmp_path, monkeypatch, capsys):
+    handler = SNIPPETS.get(snippet_key(block))
+    if handler is None:
+        pytest.fail(f"{block.page}:{block.line}: no entry in SNIPPETS")
+    monkeypatch.chdir(tmp_path)
+    steps = handler(tmp_path, capsys)
+    namespace = next(steps)
+    shown = exec_snippet(block, namespace)
+    with pytest.raises(StopIteration):
+        steps.send(shown)
+
+
+# --- What is not run, for the report -------------------------------------------------------------
+
+def excused_commands():
+    """``(where, command, reason)`` of every documented command (or part) not run here."""
+    rows = []
+    for page in PAGES:
+        for doc in scan_page(page)[0]:
+            plan = PLANS.get(doc.text)
+            if plan is None:
+                continue
+            where = f"{doc.page}:{doc.line}"
+            if plan.excused:
+                rows.append((where, doc.text, plan.excused))
+            if plan.part_why:
+                rows.append((where, doc.text.replace(plan.part, "").rstrip(" &"), plan.part_why))
+            if plan.slow:
+                rows.append((where, doc.text, "place and route: only under -m slow"))
+    return rows
+
+
+def test_every_excuse_gives_a_reason():
+    rows = excused_commands()
+    assert rows and all(reason.strip() for _, _, reason in rows)
+    assert all(PLANS[k].duration_why for k in PLANS if PLANS[k].duration)
+
+
+if __name__ == "__main__":  # python tests/test_docs_commands.py: the table of what is not run
+    for where, command, reason in excused_commands():
+        print(f"{where}\t{command}\t{reason}")
+    for key, plan in PLANS.items():
+        if plan.duration_why:
+            print(f"duration kept\t{key}\t{plan.duration_why}")
