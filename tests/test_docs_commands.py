@@ -40,6 +40,7 @@ import signal
 import socket
 import subprocess
 import sys
+import textwrap
 import time
 import urllib.request
 from dataclasses import dataclass
@@ -383,8 +384,38 @@ PLANS = {
              not_out=(r"test_bitstream_build_meets_timing",)),
     "python -m pytest -q tests/test_hw_color_filter.py tests/test_hw_divider.py "
     "tests/test_hw_tracker.py tests/test_hw_motor.py tests/test_hw_top.py "
-    "tests/test_hw_pysim_backend.py tests/test_export.py":
+    "tests/test_hw_pysim_backend.py tests/test_export.py tests/test_published_frames.py":
         Plan(collect=True, out=(r"\d+ tests collected",)),
+    # docs/published.md: the published design as a preset -----------------------------------
+    "python -m fpga_robotics.run --set design.preset=published --rerun off":
+        Plan(out=(PASS,)),
+    "python -m fpga_robotics.run --shadow published --rerun off":
+        Plan(duration="keep",
+             duration_why="the page shows this run's last lines, with counts 'of 900': the "
+                          "whole 30 s of follow_person (a second or two of wall time)",
+             out=(PASS,
+                  re.escape("  shadow published: first differs at frame 0 (0.00 s): proximity 4 "
+                            "vs 3, centroid_leds 24 vs 16, motor_left 147 vs 350, motor_right "
+                            "153 vs 225"),
+                  re.escape("  shadow frames that differ: proximity 750, centroid_leds 118, "
+                            "motor_left 900, motor_right 900 (of 900)"))),
+    "python -m fpga_robotics.export --preset published -o build/published.v":
+        Plan(files=("build/published.v",),
+             out=(r"160x120, preset published, module follow_target",)),
+    "python -m fpga_robotics.run --set design.preset=published":
+        Plan(viewer=True, files=("runs/follow_person.rrd",), out=(PASS, SAVED_DEFAULT)),
+    "python -m fpga_robotics.run --set design.preset=published --rerun off --summary "
+    "published.json":
+        Plan(files=("published.json",), out=(PASS,)),
+    "python -m fpga_robotics.run --rerun off --summary ours.json":
+        Plan(files=("ours.json",), out=(PASS,)),
+    "python -m fpga_robotics.run --shadow published --set robot.heading_deg=180 --duration 6 "
+    "--rerun off":
+        Plan(duration="keep", duration_why="the page shows this 6 s run's last lines",
+             out=(re.escape("  shadow published: first differs at frame 79 (2.63 s): proximity "
+                            "2 vs 3, motor_left 111 vs 75, motor_right 489 vs 350"),
+                  re.escape("  shadow frames that differ: proximity 96, centroid_leds 1, "
+                            "motor_left 101, motor_right 101 (of 180)"))),
     # Benchmarks ------------------------------------------------------------------------------
     "python -m fpga_robotics.bench [--backends model,pysim,cxxrtl,verilator] "
     "[--resolutions 160x120,320x240,640x480] [--frames 30] [--pysim-frames 3] "
@@ -724,7 +755,8 @@ class _ShowExpressions(ast.NodeTransformer):
 
 def exec_snippet(block, namespace):
     """Execute a Python block in ``namespace``; returns the values of its bare expressions."""
-    source = "\n".join(text for _, text in block.lines)
+    # A block inside a list item is indented as a whole.
+    source = textwrap.dedent("\n".join(text for _, text in block.lines))
     tree = _ShowExpressions().visit(ast.parse(source))
     ast.fix_missing_locations(tree)
     shown = []
@@ -853,6 +885,49 @@ def snippet_viewer(tmp_path, capsys):
     assert read_rrd(str(tmp_path / "run.rrd"))  # a recording rerun can read
 
 
+def snippet_published_scenarios(tmp_path, capsys):
+    """docs/published.md: the preset passes every shipped scenario, five ways (25 runs)."""
+    yield {}
+    lines = capsys.readouterr().out.splitlines()
+    assert len(lines) == 25
+    assert all(line.split()[-1] == "pass" for line in lines), lines
+
+
+def snippet_published_driving(tmp_path, capsys):
+    """docs/published.md: the table of how each design drives on follow_person."""
+    yield {}
+    out = capsys.readouterr().out
+    assert re.search(r"(?m)^ours +mean 3\.05 m, min 1\.73 m, path 2\.8 m, steering reversals "
+                     r"10, turn-rate sign changes 1, rms turn rate 0\.06 rad/s, frames backing "
+                     r"0$", out), out
+    assert re.search(r"(?m)^published mean 2\.09 m, min 1\.27 m, path 5\.0 m, steering "
+                     r"reversals 276, turn-rate sign changes 132, rms turn rate 0\.26 rad/s, "
+                     r"frames backing 80$", out), out
+
+
+def snippet_published_lost(tmp_path, capsys):
+    """docs/published.md: on losing the person the preset speeds up, ours holds."""
+    yield {}
+    out = capsys.readouterr().out
+    # The page rounds the re-acquisition times to 1.87 s and 2.03 s.
+    assert re.search(r"(?m)^ours lost at frame 115 found again after \[1\.866\d*\] s$", out), out
+    assert re.search(r"(?m)^published lost at frame 113 found again after \[2\.033\d*\] s$",
+                     out), out
+    assert re.search(r"(?m)^ +115 False 208 512$", out), out
+    assert re.search(r"(?m)^ +113 False 325 600$", out), out
+
+
+def snippet_published_first_frame(tmp_path, capsys):
+    """docs/published.md: the first frame's counts, levels and LED codes in both designs."""
+    yield {}
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[0] == "column 79: 71"
+    ours, published = lines[1].split(), lines[2].split()
+    assert ours[0] == published[0] == "1696"
+    assert (ours[-2], ours[-1]) == ("4", "00011000")  # level 4, LEDs 3 and 4
+    assert (published[-2], published[-1]) == ("3", "00010000")  # level 3, LED 4
+
+
 #: Python blocks, by (page, first line): a generator that yields the namespace the snippet
 #: assumes, is sent the values of its bare expressions, and checks them.
 SNIPPETS = {
@@ -869,6 +944,16 @@ SNIPPETS = {
         snippet_running,
     ("docs/viewer.md", "from fpga_robotics.viz import ViewerError, open_recorder"):
         snippet_viewer,
+    ("docs/published.md",
+     "# Every shipped scenario with the preset, five ways (25 runs on the model backend)"):
+        snippet_published_scenarios,
+    ("docs/published.md", "# How each design drives on follow_person"):
+        snippet_published_driving,
+    ("docs/published.md", "# What each design does when it loses the person (lost_target)"):
+        snippet_published_lost,
+    ("docs/published.md",
+     "# The first camera frame of follow_person through both designs' trackers"):
+        snippet_published_first_frame,
 }
 
 
