@@ -1,0 +1,258 @@
+"""Foreign Verilog designs on Verilator through a port map (issue 14, stream style): the
+exported follow_target bit for bit against the model, a renamed-ports wrapper written here,
+and bad port maps as one-line errors."""
+
+
+import numpy as np
+import pytest
+
+from fpga_robotics.hw.params import FollowTargetParams
+from fpga_robotics.hw.verilog import generate_verilog
+from fpga_robotics.sim import synthetic
+from fpga_robotics.sim.backends import BackendError, get_backend
+from fpga_robotics.sim.backends.port_map import PortMapError
+
+foreign = pytest.importorskip("fpga_robotics.sim.backends.foreign")
+
+try:
+    from fpga_robotics.sim.backends.toolchain import find_compiler, find_make, verilator_root
+
+    find_compiler(), find_make(), verilator_root()
+except (BackendError, ImportError) as exc:  # pragma: no cover - depends on the machine
+    pytest.skip(f"no Verilator toolchain: {exc}", allow_module_level=True)
+
+PARAMS = FollowTargetParams(width=80, height=60)
+
+STREAM_MAP = """\
+style = "stream"
+top = "follow_target"
+clock = { port = "clk" }
+reset = { port = "rst" }
+pixels = { valid = "pixels__valid", payload = "pixels__payload" }
+color = { port = "color_sel" }
+result = { strobe = "frame_done", latency = %(latency)d }
+filtered = { valid = "filtered__valid", payload = "filtered__payload" }
+
+[outputs]
+found = "found"
+proximity = "proximity"
+centroid_x = "centroid_x"
+centroid_leds = "centroid_leds"
+motor_left = "motor_left"
+motor_right = "motor_right"
+"""
+
+# A wrapper with other names, an active-low reset, separate first/last flags, a 2-bit colour
+# code of its own and only three outputs.
+RENAMED = """\
+module robot_top (
+  input clock, input reset_n,
+  input px_valid, input [11:0] px_rgb, input px_sof, input px_eol,
+  input [1:0] colour,
+  output result_ready, output [7:0] leds,
+  output signed [15:0] left_dps, output signed [15:0] right_dps
+);
+  wire [2:0] sel = colour == 2'd0 ? 3'b100 : colour == 2'd1 ? 3'b010 : 3'b001;
+  wire fv; wire [13:0] fp; wire found; wire [2:0] prox; wire [%(xmsb)d:0] cx;
+  follow_target core (
+    .clk(clock), .rst(~reset_n), .pixels__valid(px_valid),
+    .pixels__payload({px_eol, px_sof, px_rgb}), .color_sel(sel),
+    .filtered__valid(fv), .filtered__payload(fp), .frame_done(result_ready),
+    .found(found), .proximity(prox), .centroid_x(cx), .centroid_leds(leds),
+    .motor_left(left_dps), .motor_right(right_dps)
+  );
+endmodule
+"""
+
+RENAMED_MAP = """\
+style = "stream"
+top = "robot_top"
+clock = { port = "clock" }
+reset = { port = "reset_n", active_low = true }
+pixels = { valid = "px_valid", data = "px_rgb", first = "px_sof", last = "px_eol" }
+color = { port = "colour", codes = { red = 0, green = 1, blue = 2 } }
+result = { strobe = "result_ready", latency = %(latency)d }
+
+[outputs]
+centroid_leds = "leds"
+motor_left = { port = "left_dps", width = 16, signed = true }
+motor_right = { port = "right_dps", width = 16, signed = true }
+"""
+
+NEVER_DONE = """\
+module never_done (input clk, input rst, input v, input [13:0] p, output done,
+                   output [15:0] ml, output [15:0] mr);
+  assign done = 1'b0; assign ml = 16'd0; assign mr = 16'd0;
+endmodule
+"""
+NEVER_DONE_MAP = """\
+top = "never_done"
+clock = { port = "clk" }
+reset = { port = "rst" }
+pixels = { valid = "v", payload = "p" }
+result = { strobe = "done", timeout = 500 }
+outputs = { motor_left = "ml", motor_right = "mr" }
+"""
+
+
+def _frames(params):
+    """Synthetic frames: a sweep and a lost target (every output changes), random noise."""
+    w, h = params.width, params.height
+    frames = list(synthetic.scenario("sweep", w, h, n_frames=5, rng=1).frames)
+    frames += synthetic.scenario("lost", w, h, n_frames=2, lost_frames=2, rng=2).frames
+    frames.append(synthetic.random_frame(w, h, synthetic.make_rng(3)))
+    return frames
+
+
+@pytest.fixture(scope="module")
+def files(tmp_path_factory):
+    d = tmp_path_factory.mktemp("foreign")
+    (d / "follow_target.v").write_text(generate_verilog(PARAMS))
+    (d / "ft.toml").write_text(STREAM_MAP % {"latency": PARAMS.motor_latency})
+    (d / "robot_top.v").write_text(RENAMED % {"xmsb": PARAMS.x_bits - 1})
+    (d / "robot.toml").write_text(RENAMED_MAP % {"latency": PARAMS.motor_latency})
+    (d / "never.v").write_text(NEVER_DONE)
+    (d / "never.toml").write_text(NEVER_DONE_MAP)
+    return d
+
+
+def test_exported_follow_target_matches_the_model_bit_for_bit(files):
+    design = foreign.ForeignVerilatorBackend(PARAMS, files=[files / "follow_target.v"],
+                                             port_map=files / "ft.toml")
+    model = get_backend("model", PARAMS)
+    try:
+        for color in ("red", "green"):
+            for i, frame in enumerate(_frames(PARAMS)):
+                got, want = design.process_frame(frame, color), model.process_frame(frame, color)
+                assert got.outputs() == want.outputs(), (color, i)
+                assert np.array_equal(got.filtered, want.filtered), (color, i)
+        design.reset(), model.reset()
+        frame = _frames(PARAMS)[0]
+        assert design.process_frame(frame) == model.process_frame(frame)
+    finally:
+        design.close()
+
+
+def test_renamed_ports_active_low_reset_and_own_colour_codes(files):
+    design = foreign.ForeignVerilatorBackend(PARAMS, files=[files / "robot_top.v",
+                                                            files / "follow_target.v"],
+                                             port_map=files / "robot.toml")
+    model = get_backend("model", PARAMS)
+    try:
+        design.reset(), model.reset()  # rst is held low (reset_n high) only if inverted
+        for color in ("red", "blue"):
+            for i, frame in enumerate(_frames(PARAMS)):
+                got, want = design.process_frame(frame, color), model.process_frame(frame, color)
+                assert (got.centroid_leds, got.motor_left, got.motor_right, got.cycles) == (
+                    want.centroid_leds, want.motor_left, want.motor_right, want.cycles
+                ), (color, i)
+                # Outputs the design does not map are absent, not zero.
+                assert got.found is None and got.proximity is None and got.centroid_x is None
+                assert got.filtered is None
+        with pytest.raises(BackendError, match="no code for colour 'yellow'"):
+            design.process_frame(_frames(PARAMS)[0], "yellow")
+    finally:
+        design.close()
+
+
+def test_fill_absent_gives_zeros(files):
+    design = foreign.ForeignVerilatorBackend(PARAMS, files=[files / "robot_top.v",
+                                                            files / "follow_target.v"],
+                                             port_map=files / "robot.toml", fill_absent=True)
+    try:
+        got = design.process_frame(_frames(PARAMS)[0])
+        assert (got.found, got.proximity, got.centroid_x) == (0, 0, 0)
+        assert got.filtered.shape == (PARAMS.height, PARAMS.width)
+    finally:
+        design.close()
+
+
+def test_a_design_that_never_raises_its_strobe_is_a_named_timeout(files):
+    design = foreign.ForeignVerilatorBackend(PARAMS, files=[files / "never.v"],
+                                             port_map=files / "never.toml")
+    try:
+        with pytest.raises(BackendError, match=r"timeout: the result strobe 'done' never rose "
+                                               r"within 500 cycles"):
+            design.process_frame(_frames(PARAMS)[0])
+    finally:
+        design.close()
+
+
+def _map_with(files, text, name="bad.toml"):
+    (files / name).write_text(text)
+    return files / name
+
+
+BASE = STREAM_MAP % {"latency": 1}
+
+
+@pytest.mark.parametrize(
+    "text, message",
+    [
+        (BASE.replace('"centroid_leds"\n', '"leds"\n', 1).replace(
+            'centroid_leds = "leds"', 'centroid_leds = "led_code"'),
+         "has no port 'led_code'"),
+        (BASE.replace('clock = { port = "clk" }\n', ""), r"missing \[clock\]"),
+        (BASE.replace('motor_left = "motor_left"',
+                      'motor_left = { port = "motor_left", width = 8 }'),
+         "'motor_left' of follow_target is 16 bits wide, the map expects 8"),
+        (BASE.replace('centroid_leds = "centroid_leds"', 'centroid_leds = "proximity"'),
+         "'proximity' of follow_target is 3 bits wide, the map expects 8"),
+        (BASE.replace('color = { port = "color_sel" }\n', ""), "input 'color_sel' .* not mapped"),
+        (BASE.replace('found = "found"\n', "").replace('valid = "pixels__valid"', 'valid = "found"'),
+         "port 'found' of follow_target is an output, the map uses it as an input"),
+        (BASE.replace('top = "follow_target"', 'top = "nope"'), "Verilator cannot read"),
+        (BASE.replace('style = "stream"', 'style = "fifo"'), "style must be one of"),
+        (BASE.replace('style = "stream"', 'style = "framebuffer"'), "not supported yet"),
+        ("speed = 3\n" + BASE, "unknown key 'speed'"),
+        (BASE.replace("[outputs]", "[outputs]\nwheels = \"x\""), "unknown key 'outputs.wheels'"),
+        (BASE.replace('color = { port = "color_sel" }',
+                      'color = { port = "color_sel", codes = { red = 9 } }'),
+         "codes.red does not fit"),
+        ("top = [", "not valid TOML"),
+    ],
+)
+def test_bad_port_maps_are_one_line_errors(files, text, message):
+    with pytest.raises(PortMapError, match=message) as info:
+        foreign.ForeignDesign([files / "follow_target.v"], _map_with(files, text))
+    assert "\n" not in str(info.value)
+
+
+def test_cli_runs_a_foreign_design_in_closed_loop(files, capsys):
+    from fpga_robotics import run
+
+    code = run.main(["--design", f"verilog:{files / 'robot_top.v'},{files / 'follow_target.v'}",
+                     "--ports", str(files / "robot.toml"), "--resolution", "80x60",
+                     "--duration", "1", "--rerun", "off", "--quiet"])
+    assert code in (0, 1)
+    assert "verdict" in capsys.readouterr().out.lower()
+
+
+@pytest.mark.parametrize(
+    "argv, message",
+    [
+        (["--ports", "x.toml"], "--ports goes with --design"),
+        (["--design", "verilog:a.v"], "--design needs --ports"),
+        (["--design", "vhdl:a.vhd", "--ports", "x.toml"], "--design must be verilog:"),
+        (["--design", "verilog:a.v", "--ports", "x.toml", "--backend", "cxxrtl"],
+         "runs on the verilator backend"),
+        (["--design", "verilog:{dir}/never.v", "--ports", "{dir}/ft.toml"],
+         ("--design: Verilator cannot read the design (top follow_target): %Error: Specified "
+          "--top-module 'follow_target' was not found")),
+        (["--design", "verilog:{dir}/never.v", "--ports", "{dir}/never.toml"],
+         "timeout: the result strobe 'done' never rose"),
+        (["--design", "verilog:{dir}/missing.v", "--ports", "{dir}/never.toml"],
+         "cannot read the Verilog file"),
+    ],
+)
+def test_cli_bad_designs_exit_2_with_one_line(files, capsys, argv, message):
+    from fpga_robotics import run
+    from fpga_robotics.errors import run_cli
+
+    argv = [a.replace("{dir}", str(files)) for a in argv]
+    with pytest.raises(SystemExit) as info:
+        run_cli(run.main, [*argv, "--resolution", "80x60", "--duration", "0.5", "--rerun",
+                           "off", "--quiet"], prog="fpga_robotics.run")
+    assert info.value.code == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and message in err, err
