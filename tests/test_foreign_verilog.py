@@ -95,6 +95,49 @@ outputs = { motor_left = "ml", motor_right = "mr" }
 """
 
 
+# Framebuffer style: a write enable, a linear address, RGB444 data and a new-frame pulse. The
+# design rebuilds the stream flags from the address, and shows all-on LEDs if the new-frame
+# pulse ever comes other than the cycle after the frame's last pixel.
+FB_TOP = """\
+module fb_top #(parameter W = %(w)d, H = %(h)d) (
+  input clk, input rst,
+  input we, input [12:0] waddr, input [11:0] wdata, input frame_start, input [2:0] sel,
+  output done, output [7:0] leds, output signed [15:0] ml, output signed [15:0] mr
+);
+  wire first = waddr == 13'd0;
+  wire last = (waddr %% W) == W - 1;
+  reg prev_last, err;
+  always @(posedge clk)
+    if (rst) begin prev_last <= 1'b0; err <= 1'b0; end
+    else begin
+      prev_last <= we && waddr == W * H - 1;
+      err <= err | (frame_start != prev_last);
+    end
+  wire [7:0] core_leds;
+  follow_target core (
+    .clk(clk), .rst(rst), .pixels__valid(we), .pixels__payload({last, first, wdata}),
+    .color_sel(sel), .frame_done(done), .centroid_leds(core_leds), .motor_left(ml),
+    .motor_right(mr)
+  );
+  assign leds = err ? 8'hff : core_leds;
+endmodule
+"""
+FB_MAP = """\
+style = "framebuffer"
+top = "fb_top"
+clock = { port = "clk" }
+reset = { port = "rst" }
+pixels = { write_enable = "we", address = "waddr", data = "wdata", new_frame = "frame_start" }
+color = { port = "sel" }
+%(result)s
+
+[outputs]
+centroid_leds = "leds"
+motor_left = "ml"
+motor_right = "mr"
+"""
+
+
 def _frames(params):
     """Synthetic frames: a sweep and a lost target (every output changes), random noise."""
     w, h = params.width, params.height
@@ -113,6 +156,10 @@ def files(tmp_path_factory):
     (d / "robot.toml").write_text(RENAMED_MAP % {"latency": PARAMS.motor_latency})
     (d / "never.v").write_text(NEVER_DONE)
     (d / "never.toml").write_text(NEVER_DONE_MAP)
+    (d / "fb_top.v").write_text(FB_TOP % {"w": PARAMS.width, "h": PARAMS.height})
+    (d / "fb.toml").write_text(FB_MAP % {
+        "result": f'result = {{ strobe = "done", latency = {PARAMS.motor_latency} }}'})
+    (d / "fb_after.toml").write_text(FB_MAP % {"result": "result = { after_cycles = 200 }"})
     return d
 
 
@@ -196,14 +243,14 @@ BASE = STREAM_MAP % {"latency": 1}
         (BASE.replace('motor_left = "motor_left"',
                       'motor_left = { port = "motor_left", width = 8 }'),
          "'motor_left' of follow_target is 16 bits wide, the map expects 8"),
-        (BASE.replace('centroid_leds = "centroid_leds"', 'centroid_leds = "proximity"'),
+        (BASE.replace('proximity = "proximity"\n', "").replace(
+            'centroid_leds = "centroid_leds"', 'centroid_leds = "proximity"'),
          "'proximity' of follow_target is 3 bits wide, the map expects 8"),
         (BASE.replace('color = { port = "color_sel" }\n', ""), "input 'color_sel' .* not mapped"),
         (BASE.replace('found = "found"\n', "").replace('valid = "pixels__valid"', 'valid = "found"'),
          "port 'found' of follow_target is an output, the map uses it as an input"),
         (BASE.replace('top = "follow_target"', 'top = "nope"'), "Verilator cannot read"),
         (BASE.replace('style = "stream"', 'style = "fifo"'), "style must be one of"),
-        (BASE.replace('style = "stream"', 'style = "framebuffer"'), "not supported yet"),
         ("speed = 3\n" + BASE, "unknown key 'speed'"),
         (BASE.replace("[outputs]", "[outputs]\nwheels = \"x\""), "unknown key 'outputs.wheels'"),
         (BASE.replace('color = { port = "color_sel" }',
@@ -256,3 +303,81 @@ def test_cli_bad_designs_exit_2_with_one_line(files, capsys, argv, message):
     assert info.value.code == 2
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and message in err, err
+
+
+def _scalars(r):
+    return r.centroid_leds, r.motor_left, r.motor_right
+
+
+@pytest.mark.parametrize("line_blank", [0, 3])
+def test_framebuffer_style_matches_the_model(files, line_blank):
+    design = foreign.ForeignVerilatorBackend(PARAMS, files=[files / "fb_top.v",
+                                                            files / "follow_target.v"],
+                                             port_map=files / "fb.toml", line_blank=line_blank)
+    model = get_backend("model", PARAMS, line_blank=line_blank)
+    try:
+        for i, frame in enumerate(_frames(PARAMS)):
+            got, want = design.process_frame(frame), model.process_frame(frame)
+            assert (*_scalars(got), got.cycles) == (*_scalars(want), want.cycles), i
+            assert got.found is None and got.filtered is None
+    finally:
+        design.close()
+
+
+def test_framebuffer_outputs_read_a_number_of_cycles_after_the_frame(files):
+    design = foreign.ForeignVerilatorBackend(PARAMS, files=[files / "fb_top.v",
+                                                            files / "follow_target.v"],
+                                             port_map=files / "fb_after.toml")
+    model = get_backend("model", PARAMS)
+    try:
+        for i, frame in enumerate(_frames(PARAMS)):
+            got, want = design.process_frame(frame), model.process_frame(frame)
+            assert _scalars(got) == _scalars(want), i
+            assert got.cycles == PARAMS.width * PARAMS.height + 200
+    finally:
+        design.close()
+
+
+FB_BASE = FB_MAP % {"result": 'result = { strobe = "done" }'}
+
+
+@pytest.mark.parametrize(
+    "text, message",
+    [
+        (FB_BASE.replace('color = { port = "sel" }\n', "").replace('address = "waddr"',
+                                                                     'address = "sel"'),
+         "the 3-bit address port 'sel' cannot address 4800 pixels"),
+        (FB_BASE.replace('write_enable = "we", ', ""), "missing pixels.write_enable"),
+        (FB_BASE.replace('data = "wdata", ', ""), "missing pixels.data"),
+        (FB_BASE.replace('strobe = "done"', 'strobe = "done", after_cycles = 5'),
+         "not both"),
+        (FB_BASE.replace('new_frame = "frame_start"', 'valid = "we"'),
+         "unknown key 'pixels.valid'"),
+        (FB_BASE.replace('new_frame = "frame_start"', 'new_frame = "wdata"'),
+         "'wdata' is mapped more than once"),
+        (BASE.replace('centroid_leds = "centroid_leds"', 'centroid_leds = "proximity"'),
+         "port 'proximity' is mapped more than once"),
+    ],
+)
+def test_bad_framebuffer_port_maps(files, text, message):
+    with pytest.raises(PortMapError, match=message):
+        foreign.ForeignDesign([files / "fb_top.v", files / "follow_target.v"],
+                              _map_with(files, text), PARAMS)
+
+
+def test_stream_outputs_read_a_number_of_cycles_after_the_frame(files):
+    text = (files / "ft.toml").read_text().replace(
+        f"result = {{ strobe = \"frame_done\", latency = {PARAMS.motor_latency} }}",
+        "result = { after_cycles = 40 }")
+    assert "after_cycles" in text
+    design = foreign.ForeignVerilatorBackend(PARAMS, files=[files / "follow_target.v"],
+                                             port_map=_map_with(files, text, "after.toml"))
+    model = get_backend("model", PARAMS)
+    try:
+        for i, frame in enumerate(_frames(PARAMS)):
+            got, want = design.process_frame(frame), model.process_frame(frame)
+            assert got.outputs()[:-1] == want.outputs()[:-1], i
+            assert np.array_equal(got.filtered, want.filtered)
+            assert got.cycles == PARAMS.width * PARAMS.height + 40
+    finally:
+        design.close()

@@ -36,9 +36,13 @@ _LINT_FLAGS = ("-Wno-fatal", "-Wno-lint", "-Wno-style")
 
 
 class ForeignDesign:
-    """Verilog files and their port map (a path or a ``PortMap``)."""
+    """Verilog files and their port map (a path or a ``PortMap``), for frames of ``params``
+    (``FollowTargetParams``, default 160x120)."""
 
-    def __init__(self, files, port_map):
+    def __init__(self, files, port_map, params=None):
+        from ...hw.params import FollowTargetParams
+
+        self.params = params if params is not None else FollowTargetParams()
         if isinstance(files, (str, os.PathLike)):
             files = [files]
         self.files = [Path(f) for f in files]
@@ -56,7 +60,7 @@ class ForeignDesign:
         self.port_map = port_map if not isinstance(port_map, (str, os.PathLike)) \
             else load_port_map(port_map)
         self.ports = design_ports(self.sources, self.port_map.top)
-        check_widths(self.port_map, self.ports)
+        check_widths(self.port_map, self.ports, self.params.width * self.params.height)
         for key in ("motor_left", "motor_right"):
             out = self.port_map.outputs.get(key)
             if out is not None and self.ports[out.port][1] > 16:
@@ -64,7 +68,8 @@ class ForeignDesign:
         if "found" in self.port_map.outputs and self.ports[
                 self.port_map.outputs["found"].port][1] != 1:
             raise PortMapError("port map: outputs.found must be a 1-bit port")
-        self.wrapper = wrapper_verilog(self.port_map, self.ports)
+        self.wrapper = wrapper_verilog(self.port_map, self.ports, self.params.width,
+                                       self.params.height)
 
     def digest(self):
         h = hashlib.sha256()
@@ -136,11 +141,31 @@ def design_ports(sources, top):
     return ports
 
 
-def wrapper_verilog(pm, ports):
-    """A module ``fr_foreign_top`` with the ports of docs/contract.md around ``pm.top``."""
+def wrapper_verilog(pm, ports, width, height):
+    """A module ``fr_foreign_top`` with the ports of docs/contract.md around ``pm.top``, for
+    frames of ``width`` x ``height``."""
     conns = [f".{pm.clock}(clk)", f".{pm.reset}({'~rst' if pm.reset_active_low else 'rst'})",
              f".{pm.valid}(pixels__valid)"]
-    if pm.payload:
+    body = []
+    last = width * height - 1
+    if pm.style == "framebuffer" or pm.after_cycles:
+        # The pixel's linear address, counted from the frame's first pixel (flag bit 12).
+        aw = max(1, last.bit_length())
+        body.append(
+            f"  reg [{aw - 1}:0] fr_next;\n"
+            f"  wire [{aw - 1}:0] fr_addr = pixels__payload[12] ? {aw}'d0 : fr_next;\n"
+            f"  wire fr_end = pixels__valid && fr_addr == {aw}'d{last};\n"
+            "  always @(posedge clk)\n"
+            f"    if (rst) fr_next <= {aw}'d0;\n"
+            f"    else if (pixels__valid) fr_next <= fr_addr + {aw}'d1;")
+    if pm.style == "framebuffer":
+        conns.append(f".{pm.data}(pixels__payload[11:0])")
+        conns.append(f".{pm.address}(fr_addr)")
+        if pm.new_frame:
+            body.append("  reg fr_new_frame;\n"
+                        "  always @(posedge clk) fr_new_frame <= !rst && fr_end;")
+            conns.append(f".{pm.new_frame}(fr_new_frame)")
+    elif pm.payload:
         conns.append(f".{pm.payload}(pixels__payload)")
     else:
         conns.append(f".{pm.data}(pixels__payload[11:0])")
@@ -148,7 +173,6 @@ def wrapper_verilog(pm, ports):
             conns.append(f".{pm.first}(pixels__payload[12])")
         if pm.last:
             conns.append(f".{pm.last}(pixels__payload[13])")
-    body = []
     if pm.color_port:
         width = ports[pm.color_port][1]
         cases = "\n".join(
@@ -158,7 +182,18 @@ def wrapper_verilog(pm, ports):
         body.append(f"  reg [{width - 1}:0] fr_sel;\n  always @* begin\n    case (color_sel)\n"
                     f"{cases}\n      default: fr_sel = {width}'d0;\n    endcase\n  end")
         conns.append(f".{pm.color_port}(fr_sel)")
-    conns.append(f".{pm.strobe}(frame_done)")
+    if pm.strobe:
+        conns.append(f".{pm.strobe}(frame_done)")
+    else:
+        # frame_done one cycle before the outputs are read (the harness reads them one edge
+        # later: the backend's latency is 1), after_cycles edges after the last pixel's.
+        body.append(
+            "  reg [31:0] fr_wait;\n"
+            "  always @(posedge clk)\n"
+            "    if (rst) fr_wait <= 32'd0;\n"
+            f"    else if (fr_end) fr_wait <= 32'd{pm.after_cycles};\n"
+            "    else if (fr_wait != 32'd0) fr_wait <= fr_wait - 32'd1;\n"
+            "  assign frame_done = fr_wait == 32'd1;")
     decls = []
     for key, (out_width, _) in (("found", (1, 0)), ("proximity", (16, 0)),
                                 ("centroid_x", (16, 0)), ("centroid_leds", (16, 0)),
@@ -253,7 +288,11 @@ class ForeignVerilatorBackend(DesignBackend):
         super().__init__(params, line_blank=line_blank, frame_blank=frame_blank)
         if waveform is not None:
             raise BackendError("the foreign Verilog backend writes no waveforms yet")
-        self.design = design if design is not None else ForeignDesign(files, port_map)
+        self.design = (design if design is not None
+                       else ForeignDesign(files, port_map, self.params))
+        if (self.design.params.width, self.design.params.height) != (self.params.width,
+                                                                    self.params.height):
+            raise BackendError("the ForeignDesign was made for another frame size")
         self.fill_absent = fill_absent
         self._handle = None
         name, key, outputs, build = foreign_build_plan(self.design)
@@ -268,8 +307,10 @@ class ForeignVerilatorBackend(DesignBackend):
         pixel_edges = p.height * (p.width + line_blank)
         self._out = np.zeros(_N_OUT, np.int64)
         self._args = np.array(
-            [p.width, p.height, 0, line_blank, frame_blank, pm.latency,
-             pixel_edges + frame_blank + pm.latency + pm.timeout], np.int64)
+            [p.width, p.height, 0, line_blank, frame_blank,
+             1 if pm.after_cycles else pm.latency,
+             pixel_edges + frame_blank + (pm.after_cycles or pm.latency) + pm.timeout],
+            np.int64)
         assert len(self._args) == _N_ARGS
 
     @property

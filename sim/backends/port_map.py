@@ -2,7 +2,9 @@
 the per-frame outputs (docs/foreign.md). ``load_port_map(path)`` reads and checks a TOML file;
 ``check_widths(port_map, ports)`` checks it against the widths Verilator reports.
 
-Only the ``stream`` interface style (this project's ``follow_target`` ports) is supported.
+Interface styles: ``stream`` (this project's ``follow_target`` ports) and ``framebuffer``
+(per pixel a write enable, a linear write address and a 12-bit RGB444 datum; a one-cycle
+new-frame pulse the cycle after the frame's last pixel).
 """
 
 import argparse
@@ -57,17 +59,26 @@ class PortMap:
     color_port: str | None
     color_codes: dict  # colour name -> code on color_port
     color_width: int | None
-    strobe: str
+    strobe: str | None  # None: the result is read after_cycles after the frame
     latency: int
     timeout: int
     outputs: dict = field(default_factory=dict)  # FrameResult field -> Output
     filtered_valid: str | None = None
     filtered_payload: str | None = None
+    style: str = "stream"
+    address: str | None = None  # framebuffer: linear write address y * width + x
+    new_frame: str | None = None  # framebuffer: the one-cycle pulse after the last pixel
+    after_cycles: int | None = None  # read the outputs this many cycles after the frame
 
     def inputs(self):
         """Input port name -> expected width (None: checked elsewhere)."""
         ports = {self.clock: 1, self.reset: 1, self.valid: 1}
-        if self.payload:
+        if self.style == "framebuffer":
+            ports[self.address] = None  # wide enough for the frame: checked with its size
+            ports[self.data] = 12
+            if self.new_frame:
+                ports[self.new_frame] = 1
+        elif self.payload:
             ports[self.payload] = 14
         else:
             ports[self.data] = 12
@@ -79,7 +90,7 @@ class PortMap:
         return ports
 
     def output_ports(self):
-        ports = {self.strobe: 1}
+        ports = {self.strobe: 1} if self.strobe else {}
         for out in self.outputs.values():
             ports[out.port] = out.width
         if self.filtered_valid:
@@ -132,8 +143,6 @@ def parse_port_map(data):
     style = data.get("style", "stream")
     if style not in _STYLES:
         raise PortMapError(f"port map: style must be one of {', '.join(_STYLES)}, got {style!r}")
-    if style != "stream":
-        raise PortMapError(f"port map: style {style!r} is not supported yet (only 'stream')")
     top = data.get("top")
     if not isinstance(top, str) or not top.isidentifier():
         raise PortMapError(f"port map: top must be the top module's name, got {top!r}")
@@ -147,9 +156,23 @@ def parse_port_map(data):
         raise PortMapError("port map: reset.active_low must be true or false")
 
     pixels = _table(data, "pixels", "")
-    _unknown(pixels, {"valid", "payload", "data", "first", "last"}, "pixels.")
+    address = new_frame = None
+    if style == "framebuffer":
+        _unknown(pixels, {"write_enable", "address", "data", "new_frame"}, "pixels.")
+        pixels = dict(pixels, valid=pixels.get("write_enable", ""))
+        if "write_enable" not in pixels or pixels["valid"] == "":
+            raise PortMapError("port map: missing pixels.write_enable (a port name)")
+        address = _name(pixels, "address", "pixels")
+        new_frame = _name(pixels, "new_frame", "pixels", required=False)
+        pixels.pop("write_enable")
+        pixels.pop("address")
+        pixels.pop("new_frame", None)
+    else:
+        _unknown(pixels, {"valid", "payload", "data", "first", "last"}, "pixels.")
     payload = _name(pixels, "payload", "pixels", required=False)
     data_port = _name(pixels, "data", "pixels", required=False)
+    if style == "framebuffer" and data_port is None:
+        raise PortMapError("port map: missing pixels.data (a port name)")
     if (payload is None) == (data_port is None):
         raise PortMapError("port map: give pixels.payload (14 bits with the first/last flags) "
                            "or pixels.data (12-bit RGB444), not both or neither")
@@ -177,8 +200,14 @@ def parse_port_map(data):
         color_width = _int(color, "width", "color", None, 1, 32)
 
     result = _table(data, "result", "")
-    _unknown(result, {"strobe", "latency", "timeout"}, "result.")
-    strobe = _name(result, "strobe", "result")
+    _unknown(result, {"strobe", "latency", "timeout", "after_cycles"}, "result.")
+    strobe = _name(result, "strobe", "result", required="after_cycles" not in result)
+    after_cycles = None
+    if "after_cycles" in result:
+        if strobe is not None or "latency" in result:
+            raise PortMapError("port map: give result.strobe (and latency) or "
+                               "result.after_cycles, not both")
+        after_cycles = _int(result, "after_cycles", "result", None, 1, 1 << 20)
     latency = _int(result, "latency", "result", 0, 0, 1 << 20)
     timeout = _int(result, "timeout", "result", 100_000, 1, 1 << 30)
 
@@ -213,9 +242,14 @@ def parse_port_map(data):
         reset_active_low=active_low, valid=_name(pixels, "valid", "pixels"), payload=payload,
         data=data_port, first=first, last=last, color_port=color_port, color_codes=codes,
         color_width=color_width, strobe=strobe, latency=latency, timeout=timeout,
-        outputs=outputs, filtered_valid=f_valid, filtered_payload=f_payload,
+        outputs=outputs, filtered_valid=f_valid, filtered_payload=f_payload, style=style,
+        address=address, new_frame=new_frame, after_cycles=after_cycles,
     )
-    names = [*port_map.inputs(), *port_map.output_ports()]
+    pm = port_map
+    names = [n for n in (pm.clock, pm.reset, pm.valid, pm.payload, pm.data, pm.first, pm.last,
+                         pm.address, pm.new_frame, pm.color_port, pm.strobe,
+                         *(o.port for o in pm.outputs.values()), pm.filtered_valid,
+                         pm.filtered_payload) if n]
     dup = sorted({n for n in names if names.count(n) > 1})
     if dup:
         raise PortMapError(f"port map: port {dup[0]!r} is mapped more than once")
@@ -236,9 +270,10 @@ def load_port_map(path):
     return parse_port_map(data)
 
 
-def check_widths(port_map, ports):
+def check_widths(port_map, ports, pixels=None):
     """Check ``port_map`` against the design's ``ports`` (name -> (direction, width, signed)
-    as Verilator reports them); ``PortMapError`` names the first problem."""
+    as Verilator reports them) for frames of ``pixels`` pixels; ``PortMapError`` names the
+    first problem."""
     for direction, wanted in (("input", port_map.inputs()), ("output", port_map.output_ports())):
         for name, width in wanted.items():
             if name not in ports:
@@ -254,6 +289,11 @@ def check_widths(port_map, ports):
             if actual_width > 32:
                 raise PortMapError(f"port map: port {name!r} is {actual_width} bits wide "
                                    "(at most 32)")
+    if port_map.address and pixels is not None:
+        width = ports[port_map.address][1]
+        if (pixels - 1) >> width:
+            raise PortMapError(f"port map: the {width}-bit address port {port_map.address!r} "
+                               f"cannot address {pixels} pixels")
     if port_map.color_port:
         width = ports[port_map.color_port][1]
         too_big = [n for n, c in port_map.color_codes.items() if c >= 1 << width]
