@@ -265,14 +265,27 @@ def test_bad_port_maps_are_one_line_errors(files, text, message):
     assert "\n" not in str(info.value)
 
 
-def test_cli_runs_a_foreign_design_in_closed_loop(files, capsys):
+@pytest.mark.parametrize("top, ports", [("robot_top", "robot"), ("fb_top", "fb")])
+def test_cli_runs_a_foreign_design_in_closed_loop(files, capsys, top, ports):
     from fpga_robotics import run
 
-    code = run.main(["--design", f"verilog:{files / 'robot_top.v'},{files / 'follow_target.v'}",
-                     "--ports", str(files / "robot.toml"), "--resolution", "80x60",
-                     "--duration", "1", "--rerun", "off", "--quiet"])
-    assert code in (0, 1)
-    assert "verdict" in capsys.readouterr().out.lower()
+    argv = ["--resolution", "80x60", "--duration", "1", "--rerun", "off", "--quiet",
+            "--summary", str(files / f"{top}.json")]
+    code = run.main(["--design", f"verilog:{files / (top + '.v')},{files / 'follow_target.v'}",
+                     "--ports", str(files / f"{ports}.toml"), *argv])
+    out = capsys.readouterr().out
+    # These maps leave out found: filled with 0, so the found checks fail (exit 1).
+    assert code == 1 and "verdict: FAIL" in out
+    # The same wheels as FollowTarget on the built-in backend, so the same trajectory.
+    run.main(["--backend", "verilator", *argv[:-1], str(files / "builtin.json")])
+    import json
+
+    got, want = (json.loads((files / n).read_text()) for n in (f"{top}.json", "builtin.json"))
+    assert got["backend"] == "verilator-foreign"
+    assert got["found_fraction"] == 0
+    for key in ("min_distance_m", "mean_distance_m", "target_in_view_fraction",
+                "path_length_m", "collisions", "frames"):
+        assert got[key] == want[key], key
 
 
 @pytest.mark.parametrize(
