@@ -394,3 +394,41 @@ def test_stream_outputs_read_a_number_of_cycles_after_the_frame(files):
             assert got.cycles == PARAMS.width * PARAMS.height + 40
     finally:
         design.close()
+
+
+INC_TOP = """\
+`include "sub/consts.vh"
+module inc_top (input clk, input rst, input v, input [13:0] p, input [2:0] sel,
+                output done, output [7:0] leds, output [15:0] ml, output [15:0] mr);
+  wire [7:0] l;
+  follow_target core (.clk(clk), .rst(rst), .pixels__valid(v), .pixels__payload(p),
+    .color_sel(sel), .frame_done(done), .centroid_leds(l), .motor_left(ml), .motor_right(mr));
+  assign leds = l ^ `LED_XOR;
+endmodule
+"""
+INC_MAP = """\
+top = "inc_top"
+clock = { port = "clk" }
+reset = { port = "rst" }
+pixels = { valid = "v", payload = "p" }
+color = { port = "sel" }
+result = { strobe = "done", latency = %d }
+outputs = { centroid_leds = "leds", motor_left = "ml", motor_right = "mr" }
+"""
+
+
+def test_included_files_are_found_and_part_of_the_build(files, tmp_path):
+    (tmp_path / "sub").mkdir()
+    (tmp_path / "inc_top.v").write_text(INC_TOP)
+    (tmp_path / "ports.toml").write_text(INC_MAP % PARAMS.motor_latency)
+    frame = _frames(PARAMS)[2]
+    want = get_backend("model", PARAMS).process_frame(frame)
+    for xor in (0, 1):
+        (tmp_path / "sub" / "consts.vh").write_text(f"`define LED_XOR 8'h{xor:02x}\n")
+        with foreign.ForeignVerilatorBackend(
+            PARAMS, files=[tmp_path / "inc_top.v", files / "follow_target.v"],
+            port_map=tmp_path / "ports.toml",
+        ) as design:
+            got = design.process_frame(frame)
+        assert got.centroid_leds == want.centroid_leds ^ xor, xor
+        assert (got.motor_left, got.motor_right) == (want.motor_left, want.motor_right)
