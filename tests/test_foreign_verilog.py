@@ -432,3 +432,41 @@ def test_included_files_are_found_and_part_of_the_build(files, tmp_path):
             got = design.process_frame(frame)
         assert got.centroid_leds == want.centroid_leds ^ xor, xor
         assert (got.motor_left, got.motor_right) == (want.motor_left, want.motor_right)
+
+
+STOPPER = """\
+module stopper (input clk, input rst, input v, input [13:0] p, output reg done,
+                output [15:0] ml, output [15:0] mr);
+  reg [15:0] n;
+  always @(posedge clk) begin
+    if (rst) n <= 16'd0; else n <= n + 16'd1;
+    done <= n == 16'd6000;
+    if (n == 16'd50) %s;
+  end
+  assign ml = 16'd0; assign mr = 16'd0;
+endmodule
+"""
+STOPPER_MAP = """\
+top = "stopper"
+clock = { port = "clk" }
+reset = { port = "rst" }
+pixels = { valid = "v", payload = "p" }
+result = { strobe = "done" }
+outputs = { motor_left = "ml", motor_right = "mr" }
+"""
+
+
+@pytest.mark.parametrize("task, what", [("$stop", r"\$stop or \$fatal"),
+                                        ('$fatal(1, "bad")', r"\$stop or \$fatal"),
+                                        ("$finish", r"\$finish")])
+def test_stop_fatal_and_finish_are_errors_not_a_dead_process(tmp_path, task, what):
+    (tmp_path / "stopper.v").write_text(STOPPER % task)
+    (tmp_path / "stopper.toml").write_text(STOPPER_MAP)
+    frame = _frames(PARAMS)[0]
+    with (
+        foreign.ForeignVerilatorBackend(PARAMS, files=[tmp_path / "stopper.v"],
+                                        port_map=tmp_path / "stopper.toml") as design,
+        pytest.raises(BackendError,
+                      match=rf"frame 0: the design called {what} at stopper\.v:\d+$"),
+    ):
+        design.process_frame(frame)
