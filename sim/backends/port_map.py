@@ -156,30 +156,26 @@ def parse_port_map(data):
         raise PortMapError("port map: reset.active_low must be true or false")
 
     pixels = _table(data, "pixels", "")
-    address = new_frame = None
+    address = new_frame = payload = first = last = None
     if style == "framebuffer":
         _unknown(pixels, {"write_enable", "address", "data", "new_frame"}, "pixels.")
-        pixels = dict(pixels, valid=pixels.get("write_enable", ""))
-        if "write_enable" not in pixels or pixels["valid"] == "":
-            raise PortMapError("port map: missing pixels.write_enable (a port name)")
+        valid = _name(pixels, "write_enable", "pixels")
         address = _name(pixels, "address", "pixels")
+        data_port = _name(pixels, "data", "pixels")
         new_frame = _name(pixels, "new_frame", "pixels", required=False)
-        pixels.pop("write_enable")
-        pixels.pop("address")
-        pixels.pop("new_frame", None)
     else:
         _unknown(pixels, {"valid", "payload", "data", "first", "last"}, "pixels.")
-    payload = _name(pixels, "payload", "pixels", required=False)
-    data_port = _name(pixels, "data", "pixels", required=False)
-    if style == "framebuffer" and data_port is None:
-        raise PortMapError("port map: missing pixels.data (a port name)")
-    if (payload is None) == (data_port is None):
-        raise PortMapError("port map: give pixels.payload (14 bits with the first/last flags) "
-                           "or pixels.data (12-bit RGB444), not both or neither")
-    first = _name(pixels, "first", "pixels", required=False)
-    last = _name(pixels, "last", "pixels", required=False)
-    if payload is not None and (first or last):
-        raise PortMapError("port map: pixels.first/last go with pixels.data, not with payload")
+        valid = _name(pixels, "valid", "pixels")
+        payload = _name(pixels, "payload", "pixels", required=False)
+        data_port = _name(pixels, "data", "pixels", required=False)
+        if (payload is None) == (data_port is None):
+            raise PortMapError("port map: give pixels.payload (14 bits with the first/last "
+                               "flags) or pixels.data (12-bit RGB444), not both or neither")
+        first = _name(pixels, "first", "pixels", required=False)
+        last = _name(pixels, "last", "pixels", required=False)
+        if payload is not None and (first or last):
+            raise PortMapError("port map: pixels.first/last go with pixels.data, not with "
+                               "payload")
 
     color = _table(data, "color", "", required=False)
     _unknown(color, {"port", "width", "codes"}, "color.")
@@ -239,7 +235,7 @@ def parse_port_map(data):
 
     port_map = PortMap(
         top=top, clock=_name(clock, "port", "clock"), reset=_name(reset, "port", "reset"),
-        reset_active_low=active_low, valid=_name(pixels, "valid", "pixels"), payload=payload,
+        reset_active_low=active_low, valid=valid, payload=payload,
         data=data_port, first=first, last=last, color_port=color_port, color_codes=codes,
         color_width=color_width, strobe=strobe, latency=latency, timeout=timeout,
         outputs=outputs, filtered_valid=f_valid, filtered_payload=f_payload, style=style,
