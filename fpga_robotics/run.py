@@ -68,6 +68,11 @@ def build_parser(prog="python -m fpga_robotics.run"):
                         "(e.g. 'diff_min=5;kp_num=2'); the summary reports where they differ")
     p.add_argument("--shadow-backend", choices=("auto", *BACKEND_NAMES), default=None,
                    help="simulator of the shadow design (default: the same as --backend)")
+    p.add_argument("--design", metavar="verilog:TOP.v[,MORE.v...]",
+                   help="run your own Verilog design (on Verilator) instead of FollowTarget; "
+                        "needs --ports (docs/foreign.md)")
+    p.add_argument("--ports", metavar="PORTS.toml",
+                   help="with --design: the port map of the Verilog design")
     p.add_argument("--save-video", metavar="PATH.mp4|PATH.avi",
                    help="also write the camera frames as a video (try it with --source)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
@@ -184,6 +189,65 @@ def _open_backend(name, params, quiet=False):
         raise UsageError(f"backend {name!r} cannot run here: {exc}") from None
 
 
+def _design_files(args):
+    """The Verilog files of ``--design`` (None without it); checks --design/--ports."""
+    if args.design is None:
+        if args.ports is not None:
+            raise UsageError("--ports goes with --design verilog:FILE.v")
+        return None
+    if not args.design.startswith("verilog:") or not args.design[len("verilog:"):].strip(","):
+        raise UsageError(f"--design must be verilog:FILE.v[,MORE.v...], got {args.design!r}")
+    if args.ports is None:
+        raise UsageError("--design needs --ports PORTS.toml (the design's port map)")
+    if args.backend not in ("auto", "verilator"):
+        raise UsageError(f"--design runs on the verilator backend, not {args.backend!r}")
+    return [f for f in args.design[len("verilog:"):].split(",") if f]
+
+
+def _open_design(args, params):
+    """The main design: ``--design`` on Verilator, else FollowTarget on ``--backend``."""
+    files = _design_files(args)
+    if files is None:
+        return _open_backend(args.backend, params, args.quiet)
+    from .sim.backends.base import BackendError
+    from .sim.backends.foreign import ForeignVerilatorBackend
+
+    def tell(text):
+        if not args.quiet:
+            print(f"{text} ...", file=sys.stderr, flush=True)
+
+    try:
+        backend = ForeignVerilatorBackend(params, files=files, port_map=args.ports,
+                                          on_build=tell, fill_absent=True)
+    except BackendError as exc:
+        raise UsageError(f"--design: {exc}".splitlines()[0]) from None
+    missing = [k for k in ("motor_left", "motor_right") if k not in
+               backend.design.port_map.outputs]
+    if missing:
+        backend.close()
+        raise UsageError(f"--design: the closed loop needs outputs.{missing[0]} in the port map")
+    return _UserDesign(backend)
+
+
+class _UserDesign:
+    """A foreign design whose per-frame errors (a named timeout, a broken stream) are the
+    user's to fix: reported as one line and exit 2, like a bad port map."""
+
+    def __init__(self, backend):
+        self._backend = backend
+
+    def process_frame(self, frame, color_sel="red"):
+        from .sim.backends.base import BackendError
+
+        try:
+            return self._backend.process_frame(frame, color_sel)
+        except BackendError as exc:
+            raise UsageError(f"--design: {exc}") from None
+
+    def __getattr__(self, name):
+        return getattr(self._backend, name)
+
+
 def _open_recorder(args, name):
     if args.rerun == "off":
         return None
@@ -228,7 +292,7 @@ def _run_source(args, scenario):
     params = scenario.params
     source = open_source(args.source, params.width, params.height)
     try:
-        design = _open_backend(args.backend, params, args.quiet)
+        design = _open_design(args, params)
         recorder = None
         completed = False
         try:
@@ -294,8 +358,9 @@ def main(argv=None, prog="python -m fpga_robotics.run"):
         except VideoPathError as exc:
             raise UsageError(str(exc)) from None
 
+    _design_files(args)
     t0 = time.perf_counter()
-    design = _open_backend(args.backend, scenario.params, args.quiet)
+    design = _open_design(args, scenario.params)
     shadow = recorder = None
     completed = False
     try:

@@ -358,6 +358,20 @@ PLANS = {
     "python -m fpga_robotics.viz.bench":
         Plan(shorter=(("--frames", "2"), ("--repeats", "1")),
              out=(r"160x120: wall median", r"640x480: wall median")),
+    # docs/foreign.md: your own Verilog design -----------------------------------------------
+    "python -m fpga_robotics.export -o follow_target.v":
+        Plan(files=("follow_target.v",), out=(r"160x120, module follow_target",)),
+    "python -m fpga_robotics.sim.backends.port_map --example ports.toml":
+        Plan(files=("ports.toml",), out=(r"wrote ports\.toml",)),
+    "python -m fpga_robotics.run --design verilog:follow_target.v --ports ports.toml":
+        Plan(out=(PASS, r"(?m)^backend:? .*verilator-foreign|verilator-foreign")),
+    "python -m fpga_robotics.sim.backends.port_map ports.toml":
+        Plan(setup=("python -m fpga_robotics.sim.backends.port_map --example ports.toml",),
+             out=(r"ports\.toml: follow_target, outputs found, proximity",)),
+    "python -m fpga_robotics.sim.backends.foreign_bench":
+        Plan(shorter=(("--frames", "2"), ("--repeats", "1")),
+             out=(r"verilator \(built-in\) +[\d.]+ ms/frame",
+                  r"foreign follow_target \(stream\) +[\d.]+ ms/frame +\([\d.]+x the built-in\)")),
     # Verilog export and the board ------------------------------------------------------------
     "python -m fpga_robotics.export -o build/follow_target.v":
         Plan(files=("build/follow_target.v",), out=(r"160x120, module follow_target",)),

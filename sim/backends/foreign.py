@@ -1,0 +1,454 @@
+"""Foreign Verilog designs on Verilator: any Verilog top with a port map (port_map.py,
+docs/foreign.md) runs behind the frame API of every backend.
+
+The design's ports are read from Verilator's JSON tree and checked against the map; then a
+generated wrapper module gives the design the port list of docs/contract.md (renaming ports,
+inverting an active-low reset, encoding the colour select, splitting the pixel payload,
+extending the outputs) so that the Verilator backend's own harness drives it unchanged.
+Outputs the map does not name are ``None`` in the ``FrameResult`` (``filtered`` too when the
+design has no filtered stream); ``ForeignVerilatorBackend(fill_absent=True)`` gives 0 instead,
+which the closed loop needs.
+"""
+
+import contextlib
+import ctypes
+import hashlib
+import json
+import os
+import re
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+from ...hw.pixel import COLOR_SELECT
+from ..processes import run_captured
+from . import build_cache
+from .base import BackendError, DesignBackend, FrameResult
+from .compiled import _N_ARGS, _N_OUT, _STATUS, ABI_VERSION, HARNESS_DIR, LIBRARY_NAME, _Library
+from .port_map import OUTPUTS, PortMapError, check_widths, load_port_map
+from .toolchain import find_compiler, find_make, run_tool, verilator_root, verilator_version
+from .verilator import CXX_FLAGS, MAKE_FLAGS, VERILATOR_FLAGS
+
+__all__ = ["ForeignDesign", "ForeignVerilatorBackend", "design_ports", "wrapper_verilog"]
+
+WRAPPER = "fr_foreign_top"
+_HARNESS_FILES = ("verilator_harness.cpp", "frame_driver.h")
+_LINT_FLAGS = ("-Wno-fatal", "-Wno-lint", "-Wno-style")
+
+
+class ForeignDesign:
+    """Verilog files and their port map (a path or a ``PortMap``), for frames of ``params``
+    (``FollowTargetParams``, default 160x120)."""
+
+    def __init__(self, files, port_map, params=None):
+        from ...hw.params import FollowTargetParams
+
+        self.params = params if params is not None else FollowTargetParams()
+        if isinstance(files, (str, os.PathLike)):
+            files = [files]
+        self.files = [Path(f) for f in files]
+        if not self.files:
+            raise PortMapError("no Verilog file given")
+        self.sources = {}
+        for f in self.files:
+            try:
+                self.sources[f.name] = f.read_text()
+            except (OSError, UnicodeDecodeError) as exc:
+                raise PortMapError(f"cannot read the Verilog file {f}: "
+                                   f"{getattr(exc, 'strerror', None) or exc}") from None
+        if len(self.sources) != len(self.files):
+            raise PortMapError("two Verilog files have the same name")
+        #: Files named by `include, found next to the including file or a listed one: copied
+        #: next to the sources and part of the build's cache key.
+        self.includes = _includes(self.files)
+        self.port_map = port_map if not isinstance(port_map, (str, os.PathLike)) \
+            else load_port_map(port_map)
+        self.ports = design_ports(self.sources, self.port_map.top, self.includes)
+        check_widths(self.port_map, self.ports, self.params.width * self.params.height)
+        for key in ("motor_left", "motor_right"):
+            out = self.port_map.outputs.get(key)
+            if out is not None and self.ports[out.port][1] > 16:
+                raise PortMapError(f"port map: outputs.{key} is wider than 16 bits")
+        if "found" in self.port_map.outputs and self.ports[
+                self.port_map.outputs["found"].port][1] != 1:
+            raise PortMapError("port map: outputs.found must be a 1-bit port")
+        self.wrapper = wrapper_verilog(self.port_map, self.ports, self.params.width,
+                                       self.params.height)
+
+    def digest(self):
+        h = hashlib.sha256()
+        for name in sorted(self.sources):
+            h.update(name.encode() + b"\0" + self.sources[name].encode() + b"\0")
+        for name in sorted(self.includes):
+            h.update(b"include\0" + name.encode() + b"\0" + self.includes[name].encode() + b"\0")
+        h.update(self.wrapper.encode())
+        return h.hexdigest()
+
+
+_INCLUDE = re.compile(r'`include\s+"([^"]+)"')
+
+
+def _includes(files):
+    """``include name -> text`` of every file the sources `include (recursively) that is
+    found relative to the including file's folder or a listed file's folder; one that is not
+    found is left to Verilator to report."""
+    folders = [f.parent for f in files]
+    found, todo = {}, [(f, f.parent) for f in files]
+    while todo:
+        path, folder = todo.pop()
+        try:
+            text = path.read_text()
+        except (OSError, UnicodeDecodeError):
+            continue
+        for name in _INCLUDE.findall(text):
+            if name in found or Path(name).is_absolute() or ".." in Path(name).parts:
+                continue
+            for base in (folder, *folders):
+                candidate = base / name
+                if candidate.is_file():
+                    try:
+                        found[name] = candidate.read_text()
+                    except (OSError, UnicodeDecodeError) as exc:
+                        raise PortMapError(f"cannot read the included file {candidate}: "
+                                           f"{getattr(exc, 'strerror', None) or exc}") from None
+                    todo.append((candidate, candidate.parent))
+                    break
+    return found
+
+
+def _write_sources(directory, sources, includes=None):
+    for name, text in (includes or {}).items():
+        path = Path(directory) / "src" / name
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(text)
+    paths = []
+    for name, text in sources.items():
+        path = Path(directory) / "src" / name
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(text)
+        paths.append(path)
+    return paths
+
+
+def _dtypes(node, acc):
+    if isinstance(node, dict):
+        if "DTYPE" in node.get("type", "") and "addr" in node:
+            acc[node["addr"]] = node
+        for value in node.values():
+            _dtypes(value, acc)
+    elif isinstance(node, list):
+        for value in node:
+            _dtypes(value, acc)
+    return acc
+
+
+def design_ports(sources, top, includes=None):
+    """Ports of module ``top`` as Verilator elaborates it: name -> (direction, width, signed)."""
+    root = verilator_root()
+    with tempfile.TemporaryDirectory(prefix="fr-foreign-") as tmp:
+        paths = _write_sources(tmp, sources, includes)
+        code, output = run_captured(
+            [root / "bin" / "verilator", "--json-only", *_LINT_FLAGS, "--top-module", top,
+             f"-I{Path(tmp) / 'src'}",
+             "--Mdir", Path(tmp) / "obj", *paths],
+            cwd=tmp, env=dict(os.environ, VERILATOR_ROOT=str(root)),
+        )
+        if code != 0:
+            errors = [line for line in output.splitlines() if line.startswith("%Error")]
+            first = (errors or output.strip().splitlines() or ["(no output)"])[0]
+            raise PortMapError(f"Verilator cannot read the design (top {top}): "
+                               f"{first.replace(str(Path(tmp) / 'src') + '/', '')}")
+        tree = json.loads(next((Path(tmp) / "obj").glob("*.tree.json")).read_text())
+    dtypes = _dtypes(tree, {})
+    module = next((m for m in tree["modulesp"] if m.get("origName", m["name"]) == top
+                   or m["name"] == top), None)
+    if module is None:
+        raise PortMapError(f"Verilator found no module {top}")
+    ports = {}
+    for var in module.get("stmtsp", []):
+        if var.get("type") != "VAR" or not var.get("isPrimaryIO"):
+            continue
+        direction = {"INPUT": "input", "OUTPUT": "output"}.get(var.get("direction"))
+        if direction is None:
+            raise PortMapError(f"port {var['name']!r} of {top} is {var.get('direction')}: only "
+                               "inputs and outputs are supported")
+        dtype = dtypes.get(var.get("dtypep"), {})
+        rng = dtype.get("range")
+        width = 1
+        if rng:
+            left, right = (int(x) for x in rng.split(":"))
+            width = abs(left - right) + 1
+        name = var.get("verilogName", var["name"])
+        ports[name] = (direction, width, bool(dtype.get("signed")))
+    return ports
+
+
+def wrapper_verilog(pm, ports, width, height):
+    """A module ``fr_foreign_top`` with the ports of docs/contract.md around ``pm.top``, for
+    frames of ``width`` x ``height``."""
+    conns = [f".{pm.clock}(clk)", f".{pm.reset}({'~rst' if pm.reset_active_low else 'rst'})",
+             f".{pm.valid}(pixels__valid)"]
+    body = []
+    last = width * height - 1
+    if pm.style == "framebuffer" or pm.after_cycles:
+        # The pixel's linear address, counted from the frame's first pixel (flag bit 12).
+        aw = max(1, last.bit_length())
+        body.append(
+            f"  reg [{aw - 1}:0] fr_next;\n"
+            f"  wire [{aw - 1}:0] fr_addr = pixels__payload[12] ? {aw}'d0 : fr_next;\n"
+            f"  wire fr_end = pixels__valid && fr_addr == {aw}'d{last};\n"
+            "  always @(posedge clk)\n"
+            f"    if (rst) fr_next <= {aw}'d0;\n"
+            f"    else if (pixels__valid) fr_next <= fr_addr + {aw}'d1;")
+    if pm.style == "framebuffer":
+        conns.append(f".{pm.data}(pixels__payload[11:0])")
+        conns.append(f".{pm.address}(fr_addr)")
+        if pm.new_frame:
+            body.append("  reg fr_new_frame;\n"
+                        "  always @(posedge clk) fr_new_frame <= !rst && fr_end;")
+            conns.append(f".{pm.new_frame}(fr_new_frame)")
+    elif pm.payload:
+        conns.append(f".{pm.payload}(pixels__payload)")
+    else:
+        conns.append(f".{pm.data}(pixels__payload[11:0])")
+        if pm.first:
+            conns.append(f".{pm.first}(pixels__payload[12])")
+        if pm.last:
+            conns.append(f".{pm.last}(pixels__payload[13])")
+    if pm.color_port:
+        width = ports[pm.color_port][1]
+        cases = "\n".join(
+            f"      3'd{code_of}: fr_sel = {width}'d{code};"
+            for code_of, code in sorted(
+(COLOR_SELECT[n], c) for n, c in pm.color_codes.items()))
+        body.append(f"  reg [{width - 1}:0] fr_sel;\n  always @* begin\n    case (color_sel)\n"
+                    f"{cases}\n      default: fr_sel = {width}'d0;\n    endcase\n  end")
+        conns.append(f".{pm.color_port}(fr_sel)")
+    if pm.strobe:
+        conns.append(f".{pm.strobe}(frame_done)")
+    else:
+        # frame_done one cycle before the outputs are read (the harness reads them one edge
+        # later: the backend's latency is 1), after_cycles edges after the last pixel's.
+        body.append(
+            "  reg [31:0] fr_wait;\n"
+            "  always @(posedge clk)\n"
+            "    if (rst) fr_wait <= 32'd0;\n"
+            f"    else if (fr_end) fr_wait <= 32'd{pm.after_cycles};\n"
+            "    else if (fr_wait != 32'd0) fr_wait <= fr_wait - 32'd1;\n"
+            "  assign frame_done = fr_wait == 32'd1;")
+    decls = []
+    for key, (out_width, _) in (("found", (1, 0)), ("proximity", (16, 0)),
+                                ("centroid_x", (16, 0)), ("centroid_leds", (16, 0)),
+                                ("motor_left", (16, 0)), ("motor_right", (16, 0))):
+        out = pm.outputs.get(key)
+        if out is None:
+            body.append(f"  assign {key} = {out_width}'d0;")
+            continue
+        width = ports[out.port][1]
+        decls.append(f"  wire [{width - 1}:0] fr_{key};")
+        conns.append(f".{out.port}(fr_{key})")
+        if width == out_width:
+            body.append(f"  assign {key} = fr_{key};")
+        else:
+            fill = (f"{{{out_width - width}{{fr_{key}[{width - 1}]}}}}" if out.signed
+                    else f"{out_width - width}'d0")
+            body.append(f"  assign {key} = {{{fill}, fr_{key}}};")
+    if pm.filtered_valid:
+        conns += [f".{pm.filtered_valid}(filtered__valid)",
+                  f".{pm.filtered_payload}(filtered__payload)"]
+    else:
+        body.append("  assign filtered__valid = 1'b0;\n  assign filtered__payload = 14'd0;")
+    conn_text = ",\n    ".join(conns)
+    return f"""// Generated by fpga_robotics.sim.backends.foreign: {pm.top} with the ports of
+// docs/contract.md, for the Verilator harness.
+module {WRAPPER} (
+  input clk, input rst,
+  input pixels__valid, input [13:0] pixels__payload, input [2:0] color_sel,
+  output filtered__valid, output [13:0] filtered__payload, output frame_done,
+  output found, output [15:0] proximity, output [15:0] centroid_x,
+  output [15:0] centroid_leds, output [15:0] motor_left, output [15:0] motor_right
+);
+{chr(10).join(decls)}
+{chr(10).join(body)}
+  {pm.top} fr_design (
+    {conn_text}
+  );
+endmodule
+"""
+
+
+#: Compiled with the design: $stop, $fatal and $finish record where they were called instead
+#: of aborting the process (Verilator's default for $stop and $fatal); the backend raises
+#: ``BackendError`` after the frame.
+_HOOKS = """\
+// Generated by fpga_robotics.sim.backends.foreign (VL_USER_STOP, VL_USER_FINISH).
+#include <cstdio>
+#include "verilated.h"
+
+static char fr_stop_message[600];
+static int fr_stopped = 0;
+
+static void fr_record(const char *what, const char *filename, int linenum) {
+    if (!fr_stopped)
+        std::snprintf(fr_stop_message, sizeof fr_stop_message, "%s at %s:%d", what, filename,
+                      linenum);
+    fr_stopped = 1;
+    Verilated::threadContextp()->gotFinish(true);
+}
+void vl_stop(const char *filename, int linenum, const char *) {
+    fr_record("$stop or $fatal", filename, linenum);
+}
+void vl_finish(const char *filename, int linenum, const char *) {
+    fr_record("$finish", filename, linenum);
+}
+extern "C" __attribute__((visibility("default"))) const char *fr_foreign_stop() {
+    return fr_stopped ? fr_stop_message : nullptr;
+}
+extern "C" __attribute__((visibility("default"))) void fr_foreign_clear() { fr_stopped = 0; }
+"""
+
+
+def foreign_build_plan(design):
+    compiler = find_compiler()
+    find_make()
+    root = verilator_root()
+    harness = {f: (HARNESS_DIR / f).read_text() for f in _HARNESS_FILES}
+    cflags = " ".join([*CXX_FLAGS, "-DVL_USER_STOP", "-DVL_USER_FINISH"])
+    key = build_cache.build_key({
+        "flow": "verilator-foreign",
+        "abi": ABI_VERSION,
+        "source": design.digest(),
+        "hooks": hashlib.sha256(_HOOKS.encode()).hexdigest(),
+        "harness": {f: hashlib.sha256(t.encode()).hexdigest() for f, t in harness.items()},
+        "flags": [*VERILATOR_FLAGS, cflags, *MAKE_FLAGS],
+        "compiler": compiler.version,
+        "verilator": verilator_version(),
+    })
+
+    def build(directory):
+        paths = _write_sources(directory, design.sources, design.includes)
+        (directory / "fr_wrapper.v").write_text(design.wrapper)
+        (directory / "fr_foreign_hooks.cpp").write_text(_HOOKS)
+        (directory / "fr_ports.h").write_text("// Generated by the foreign backend.\n")
+        for name, text in harness.items():
+            (directory / name).write_text(text)
+        env = dict(os.environ, VERILATOR_ROOT=str(root))
+        make_flags = [*MAKE_FLAGS, f"CXX={compiler.path}", f"LINK={compiler.path}"]
+        run_tool(
+            [root / "bin" / "verilator", *VERILATOR_FLAGS, "-j", "2", f"-I{directory / 'src'}",
+             "--top-module", WRAPPER, "--prefix", "Vfollow_target",
+             "--Mdir", directory / "obj", "-CFLAGS", f"{cflags} -I{directory}",
+             "-LDFLAGS", "-shared", "-MAKEFLAGS", " ".join(make_flags),
+             "-o", directory / LIBRARY_NAME, directory / "fr_wrapper.v", *paths,
+             directory / "verilator_harness.cpp", directory / "fr_foreign_hooks.cpp"],
+            cwd=directory, env=env,
+            what=f"building the Verilator model of {design.port_map.top}",
+        )
+
+    return (f"verilator-foreign-{design.port_map.top}", key, [LIBRARY_NAME], build)
+
+
+class ForeignVerilatorBackend(DesignBackend):
+    """A foreign Verilog design (``ForeignDesign``, or ``files`` and ``port_map``) on
+    Verilator. ``params`` gives the frame size; the design is the user's.
+
+    Raises ``BackendError`` (``PortMapError``) for a bad map, and per frame when the design
+    does not raise its result strobe within ``result.timeout`` cycles after the frame.
+    """
+
+    name = "verilator-foreign"
+
+    def __init__(self, params=None, *, design=None, files=None, port_map=None, line_blank=0,
+                 frame_blank=0, waveform=None, on_build=None, fill_absent=False):
+        super().__init__(params, line_blank=line_blank, frame_blank=frame_blank)
+        if waveform is not None:
+            raise BackendError("the foreign Verilog backend writes no waveforms yet")
+        self.design = (design if design is not None
+                       else ForeignDesign(files, port_map, self.params))
+        if (self.design.params.width, self.design.params.height) != (self.params.width,
+                                                                    self.params.height):
+            raise BackendError("the ForeignDesign was made for another frame size")
+        self.fill_absent = fill_absent
+        self._handle = None
+        name, key, outputs, build = foreign_build_plan(self.design)
+        notice = None if on_build is None else (
+            lambda: on_build(f"compiling the Verilator model of {self.design.port_map.top} "
+                             "(once; later runs load it from the cache)"))
+        entry = build_cache.get_or_build(name, key, outputs, build, on_build=notice)
+        self.cache_entry = entry
+        self._library = _Library(entry.file(LIBRARY_NAME))
+        lib = self._library.lib
+        self._stop = lib.fr_foreign_stop
+        self._stop.restype = ctypes.c_char_p
+        self._stop.argtypes = []
+        lib.fr_foreign_clear.restype = None
+        lib.fr_foreign_clear()
+        self._handle = self._library.lib.fr_create()
+        p, pm = self.params, self.design.port_map
+        pixel_edges = p.height * (p.width + line_blank)
+        self._out = np.zeros(_N_OUT, np.int64)
+        self._args = np.array(
+            [p.width, p.height, 0, line_blank, frame_blank,
+             1 if pm.after_cycles else pm.latency,
+             pixel_edges + frame_blank + (pm.after_cycles or pm.latency) + pm.timeout],
+            np.int64)
+        assert len(self._args) == _N_ARGS
+
+    @property
+    def evals_per_cycle(self):
+        return self._library.evals_per_cycle
+
+    def _reset(self):
+        self._library.lib.fr_reset(self._handle)
+
+    def _run_frame(self, packed, color_sel):
+        pm = self.design.port_map
+        names = [n for n, c in COLOR_SELECT.items() if c == color_sel]
+        if pm.color_port and names[0] not in pm.color_codes:
+            raise BackendError(f"{pm.top} has no code for colour {names[0]!r} "
+                               f"(color.codes: {', '.join(pm.color_codes)})")
+        self._args[2] = color_sel
+        filtered = np.zeros((self.params.height, self.params.width), np.uint16)
+        out = self._out
+        status = self._library.lib.fr_run_frame(
+            self._handle, packed.ctypes.data, self._args.ctypes.data, filtered.ctypes.data,
+            out.ctypes.data)
+        index = self.frames_processed
+        stopped = self._stop()
+        if stopped:
+            self._library.lib.fr_foreign_clear()
+            # The file as the user named it, not its copy in the build folder.
+            where = re.sub(r" at .*/src/", " at ", stopped.decode(errors="replace"))
+            raise BackendError(f"{pm.top}: frame {index}: the design called {where}")
+        if status == 1:
+            raise BackendError(
+                f"{pm.top}: frame {index}: timeout: the result strobe {pm.strobe!r} never "
+                f"rose within {pm.timeout} cycles (result.timeout) after the frame")
+        if status == 3 and pm.filtered_valid is None:
+            status = 0
+        if status != 0:
+            message = _STATUS.get(status, f"harness status {status}").format(
+                cycles=int(out[0]), filtered=int(out[7]), pixels=packed.size, bad=int(out[9]))
+            raise BackendError(f"{pm.top}: frame {index}: {message}")
+        absent = 0 if self.fill_absent else None
+        values = {}
+        for i, key in enumerate(OUTPUTS, start=1):
+            if key in pm.outputs:
+                value = int(out[i])
+                values[key] = bool(value) if key == "found" else value
+            else:
+                values[key] = absent
+        if pm.filtered_valid is None and not self.fill_absent:
+            filtered = None
+        return FrameResult(filtered=filtered, cycles=int(out[0]), **values)
+
+    def close(self):
+        if self._handle is not None:
+            self._library.lib.fr_destroy(self._handle)
+            self._handle = None
+
+    def __del__(self):
+        # Interpreter shutdown may have torn down ctypes already: nothing to save then.
+        with contextlib.suppress(AttributeError, TypeError, OSError):
+            self.close()

@@ -1,0 +1,364 @@
+"""Port maps of foreign Verilog designs: how a design's ports take the world's frames and give
+the per-frame outputs (docs/foreign.md). ``load_port_map(path)`` reads and checks a TOML file;
+``check_widths(port_map, ports)`` checks it against the widths Verilator reports.
+
+Interface styles: ``stream`` (this project's ``follow_target`` ports) and ``framebuffer``
+(per pixel a write enable, a linear write address and a 12-bit RGB444 datum; a one-cycle
+new-frame pulse the cycle after the frame's last pixel).
+"""
+
+import argparse
+import sys
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from ...hw.pixel import COLOR_SELECT
+from .base import BackendError
+
+__all__ = [
+    "OUTPUTS", "Output", "PortMap", "PortMapError", "check_widths", "follow_target_port_map",
+    "load_port_map", "parse_port_map",
+]
+
+#: Per-frame outputs a port map may name: FrameResult field -> (default width, signed).
+OUTPUTS = {
+    "found": (1, False),
+    "proximity": (3, False),
+    "centroid_x": (None, False),
+    "centroid_leds": (8, False),
+    "motor_left": (16, True),
+    "motor_right": (16, True),
+}
+_STYLES = ("stream", "framebuffer")
+_TOP_KEYS = {"style", "top", "clock", "reset", "pixels", "color", "result", "outputs", "filtered"}
+
+
+class PortMapError(BackendError):
+    """A port map that is malformed or does not fit the design."""
+
+
+@dataclass(frozen=True)
+class Output:
+    port: str
+    width: int | None  # expected width (None: any up to 32)
+    signed: bool
+
+
+@dataclass(frozen=True)
+class PortMap:
+    top: str
+    clock: str
+    reset: str
+    reset_active_low: bool
+    valid: str
+    payload: str | None  # 14 bits: data[11:0], first[12], last[13]
+    data: str | None  # 12-bit RGB444 (with first/last as separate ports)
+    first: str | None
+    last: str | None
+    color_port: str | None
+    color_codes: dict  # colour name -> code on color_port
+    color_width: int | None
+    strobe: str | None  # None: the result is read after_cycles after the frame
+    latency: int
+    timeout: int
+    outputs: dict = field(default_factory=dict)  # FrameResult field -> Output
+    filtered_valid: str | None = None
+    filtered_payload: str | None = None
+    style: str = "stream"
+    address: str | None = None  # framebuffer: linear write address y * width + x
+    new_frame: str | None = None  # framebuffer: the one-cycle pulse after the last pixel
+    after_cycles: int | None = None  # read the outputs this many cycles after the frame
+
+    def inputs(self):
+        """Input port name -> expected width (None: checked elsewhere)."""
+        ports = {self.clock: 1, self.reset: 1, self.valid: 1}
+        if self.style == "framebuffer":
+            ports[self.address] = None  # wide enough for the frame: checked with its size
+            ports[self.data] = 12
+            if self.new_frame:
+                ports[self.new_frame] = 1
+        elif self.payload:
+            ports[self.payload] = 14
+        else:
+            ports[self.data] = 12
+            for flag in (self.first, self.last):
+                if flag:
+                    ports[flag] = 1
+        if self.color_port:
+            ports[self.color_port] = self.color_width
+        return ports
+
+    def output_ports(self):
+        ports = {self.strobe: 1} if self.strobe else {}
+        for out in self.outputs.values():
+            ports[out.port] = out.width
+        if self.filtered_valid:
+            ports[self.filtered_valid] = 1
+            ports[self.filtered_payload] = 14
+        return ports
+
+
+def _table(data, key, where, required=True):
+    value = data.get(key)
+    if value is None:
+        if required:
+            raise PortMapError(f"port map: missing [{key}]{where}")
+        return {}
+    if not isinstance(value, dict):
+        raise PortMapError(f"port map: {key} must be a table")
+    return value
+
+
+def _name(table, key, where, required=True):
+    value = table.get(key)
+    if value is None:
+        if required:
+            raise PortMapError(f"port map: missing {where}.{key} (a port name)")
+        return None
+    if not isinstance(value, str) or not value.isidentifier():
+        raise PortMapError(f"port map: {where}.{key} must be a Verilog port name, got {value!r}")
+    return value
+
+
+def _unknown(table, allowed, where):
+    extra = sorted(set(table) - set(allowed))
+    if extra:
+        raise PortMapError(
+            f"port map: unknown key '{where}{extra[0]}'; allowed: {', '.join(sorted(allowed))}"
+        )
+
+
+def _int(table, key, where, default, low, high):
+    value = table.get(key, default)
+    if isinstance(value, bool) or not isinstance(value, int) or not low <= value <= high:
+        raise PortMapError(f"port map: {where}.{key} must be an integer in {low}..{high}, "
+                           f"got {value!r}")
+    return value
+
+
+def parse_port_map(data):
+    """A ``PortMap`` from the TOML document ``data`` (a dict); ``PortMapError`` if invalid."""
+    _unknown(data, _TOP_KEYS, "")
+    style = data.get("style", "stream")
+    if style not in _STYLES:
+        raise PortMapError(f"port map: style must be one of {', '.join(_STYLES)}, got {style!r}")
+    top = data.get("top")
+    if not isinstance(top, str) or not top.isidentifier():
+        raise PortMapError(f"port map: top must be the top module's name, got {top!r}")
+
+    clock = _table(data, "clock", "")
+    _unknown(clock, {"port"}, "clock.")
+    reset = _table(data, "reset", "")
+    _unknown(reset, {"port", "active_low"}, "reset.")
+    active_low = reset.get("active_low", False)
+    if not isinstance(active_low, bool):
+        raise PortMapError("port map: reset.active_low must be true or false")
+
+    pixels = _table(data, "pixels", "")
+    address = new_frame = payload = first = last = None
+    if style == "framebuffer":
+        _unknown(pixels, {"write_enable", "address", "data", "new_frame"}, "pixels.")
+        valid = _name(pixels, "write_enable", "pixels")
+        address = _name(pixels, "address", "pixels")
+        data_port = _name(pixels, "data", "pixels")
+        new_frame = _name(pixels, "new_frame", "pixels", required=False)
+    else:
+        _unknown(pixels, {"valid", "payload", "data", "first", "last"}, "pixels.")
+        valid = _name(pixels, "valid", "pixels")
+        payload = _name(pixels, "payload", "pixels", required=False)
+        data_port = _name(pixels, "data", "pixels", required=False)
+        if (payload is None) == (data_port is None):
+            raise PortMapError("port map: give pixels.payload (14 bits with the first/last "
+                               "flags) or pixels.data (12-bit RGB444), not both or neither")
+        first = _name(pixels, "first", "pixels", required=False)
+        last = _name(pixels, "last", "pixels", required=False)
+        if payload is not None and (first or last):
+            raise PortMapError("port map: pixels.first/last go with pixels.data, not with "
+                               "payload")
+
+    color = _table(data, "color", "", required=False)
+    _unknown(color, {"port", "width", "codes"}, "color.")
+    color_port = _name(color, "port", "color", required=False)
+    codes = color.get("codes")
+    if codes is None:
+        codes = dict(COLOR_SELECT)
+    if not isinstance(codes, dict) or not codes:
+        raise PortMapError("port map: color.codes must be a table of colour = code")
+    for name, code in codes.items():
+        if name not in COLOR_SELECT:
+            raise PortMapError(f"port map: color.codes: unknown colour {name!r}; "
+                               f"known: {', '.join(COLOR_SELECT)}")
+        if isinstance(code, bool) or not isinstance(code, int) or code < 0:
+            raise PortMapError(f"port map: color.codes.{name} must be an integer >= 0")
+    color_width = color.get("width")
+    if color_width is not None:
+        color_width = _int(color, "width", "color", None, 1, 32)
+
+    result = _table(data, "result", "")
+    _unknown(result, {"strobe", "latency", "timeout", "after_cycles"}, "result.")
+    strobe = _name(result, "strobe", "result", required="after_cycles" not in result)
+    after_cycles = None
+    if "after_cycles" in result:
+        if strobe is not None or "latency" in result:
+            raise PortMapError("port map: give result.strobe (and latency) or "
+                               "result.after_cycles, not both")
+        after_cycles = _int(result, "after_cycles", "result", None, 1, 1 << 20)
+    latency = _int(result, "latency", "result", 0, 0, 1 << 20)
+    timeout = _int(result, "timeout", "result", 100_000, 1, 1 << 30)
+
+    out_table = _table(data, "outputs", "")
+    _unknown(out_table, set(OUTPUTS), "outputs.")
+    outputs = {}
+    for key, value in out_table.items():
+        default_width, default_signed = OUTPUTS[key]
+        if isinstance(value, str):
+            value = {"port": value}
+        if not isinstance(value, dict):
+            raise PortMapError(f"port map: outputs.{key} must be a port name or a table")
+        _unknown(value, {"port", "width", "signed"}, f"outputs.{key}.")
+        port = _name(value, "port", f"outputs.{key}")
+        width = value.get("width", default_width)
+        if width is not None:
+            width = _int({"width": width}, "width", f"outputs.{key}", None, 1, 32)
+        signed = value.get("signed", default_signed)
+        if not isinstance(signed, bool):
+            raise PortMapError(f"port map: outputs.{key}.signed must be true or false")
+        outputs[key] = Output(port, width, signed)
+    if not outputs:
+        raise PortMapError("port map: [outputs] names no output")
+
+    filtered = _table(data, "filtered", "", required=False)
+    _unknown(filtered, {"valid", "payload"}, "filtered.")
+    f_valid = _name(filtered, "valid", "filtered", required=bool(filtered))
+    f_payload = _name(filtered, "payload", "filtered", required=bool(filtered))
+
+    port_map = PortMap(
+        top=top, clock=_name(clock, "port", "clock"), reset=_name(reset, "port", "reset"),
+        reset_active_low=active_low, valid=valid, payload=payload,
+        data=data_port, first=first, last=last, color_port=color_port, color_codes=codes,
+        color_width=color_width, strobe=strobe, latency=latency, timeout=timeout,
+        outputs=outputs, filtered_valid=f_valid, filtered_payload=f_payload, style=style,
+        address=address, new_frame=new_frame, after_cycles=after_cycles,
+    )
+    pm = port_map
+    names = [n for n in (pm.clock, pm.reset, pm.valid, pm.payload, pm.data, pm.first, pm.last,
+                         pm.address, pm.new_frame, pm.color_port, pm.strobe,
+                         *(o.port for o in pm.outputs.values()), pm.filtered_valid,
+                         pm.filtered_payload) if n]
+    dup = sorted({n for n in names if names.count(n) > 1})
+    if dup:
+        raise PortMapError(f"port map: port {dup[0]!r} is mapped more than once")
+    return port_map
+
+
+def load_port_map(path):
+    """Read and check the TOML port map at ``path``."""
+    path = Path(path)
+    try:
+        text = path.read_text()
+    except OSError as exc:
+        raise PortMapError(f"cannot read the port map {path}: {exc.strerror or exc}") from None
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise PortMapError(f"port map {path}: not valid TOML: {exc}") from None
+    return parse_port_map(data)
+
+
+def check_widths(port_map, ports, pixels=None):
+    """Check ``port_map`` against the design's ``ports`` (name -> (direction, width, signed)
+    as Verilator reports them) for frames of ``pixels`` pixels; ``PortMapError`` names the
+    first problem."""
+    for direction, wanted in (("input", port_map.inputs()), ("output", port_map.output_ports())):
+        for name, width in wanted.items():
+            if name not in ports:
+                raise PortMapError(f"port map: the design {port_map.top} has no port {name!r} "
+                                   f"(its ports: {', '.join(ports)})")
+            actual_dir, actual_width, _ = ports[name]
+            if actual_dir != direction:
+                raise PortMapError(f"port map: port {name!r} of {port_map.top} is an "
+                                   f"{actual_dir}, the map uses it as an {direction}")
+            if width is not None and actual_width != width:
+                raise PortMapError(f"port map: port {name!r} of {port_map.top} is "
+                                   f"{actual_width} bits wide, the map expects {width}")
+            if actual_width > 32:
+                raise PortMapError(f"port map: port {name!r} is {actual_width} bits wide "
+                                   "(at most 32)")
+    if port_map.address and pixels is not None:
+        width = ports[port_map.address][1]
+        if (pixels - 1) >> width:
+            raise PortMapError(f"port map: the {width}-bit address port {port_map.address!r} "
+                               f"cannot address {pixels} pixels")
+    if port_map.color_port:
+        width = ports[port_map.color_port][1]
+        too_big = [n for n, c in port_map.color_codes.items() if c >= 1 << width]
+        if too_big:
+            raise PortMapError(f"port map: color.codes.{too_big[0]} does not fit the "
+                               f"{width}-bit port {port_map.color_port!r}")
+    unconnected = [n for n, (d, _, _) in ports.items()
+                   if d == "input" and n not in port_map.inputs()]
+    if unconnected:
+        raise PortMapError(f"port map: input {unconnected[0]!r} of {port_map.top} is not "
+                           "mapped (every input must be driven)")
+
+
+#: The port map of the exported ``follow_target`` (docs/foreign.md).
+_FOLLOW_TARGET_MAP = """\
+# Port map of the exported follow_target (python -m fpga_robotics.export), stream style.
+style = "stream"
+top = "follow_target"
+clock = {{ port = "clk" }}
+reset = {{ port = "rst", active_low = false }}
+pixels = {{ valid = "pixels__valid", payload = "pixels__payload" }}
+color = {{ port = "color_sel" }}  # this project's 3-bit codes (docs/contract.md)
+result = {{ strobe = "frame_done", latency = {latency}, timeout = 100000 }}
+filtered = {{ valid = "filtered__valid", payload = "filtered__payload" }}
+
+[outputs]
+found = "found"
+proximity = "proximity"
+centroid_x = "centroid_x"
+centroid_leds = "centroid_leds"
+motor_left = {{ port = "motor_left", width = 16, signed = true }}
+motor_right = {{ port = "motor_right", width = 16, signed = true }}
+"""
+
+
+def follow_target_port_map(params=None):
+    """TOML text: the port map of the exported ``follow_target`` at ``params``."""
+    from ...hw.params import FollowTargetParams
+
+    params = params if params is not None else FollowTargetParams()
+    return _FOLLOW_TARGET_MAP.format(latency=params.motor_latency)
+
+
+def main(argv=None):
+    """``python -m fpga_robotics.sim.backends.port_map``: write the example port map or check
+    one."""
+    parser = argparse.ArgumentParser(prog="python -m fpga_robotics.sim.backends.port_map",
+                                     description="Write the port map of the exported "
+                                     "follow_target (--example) or check a port map file.")
+    parser.add_argument("path", help="the port map (TOML)")
+    parser.add_argument("--example", action="store_true",
+                        help="write the follow_target example to PATH (not replacing a file)")
+    args = parser.parse_args(argv)
+    try:
+        if args.example:
+            try:
+                with open(args.path, "x") as f:
+                    f.write(follow_target_port_map())
+            except OSError as exc:
+                raise PortMapError(f"cannot write {args.path}: {exc.strerror or exc}") from None
+            print(f"wrote {args.path}")
+            return 0
+        port_map = load_port_map(args.path)
+    except PortMapError as exc:
+        print(f"port_map: error: {exc}", file=sys.stderr)
+        return 2
+    print(f"{args.path}: {port_map.top}, outputs {', '.join(port_map.outputs)}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
