@@ -27,6 +27,8 @@ COMMANDS = {
     "board": ("fpga_robotics.board_build",
               "export a board top (Verilog + LPF) and build its bitstream"),
     "bench": (None, "print speed figures (see `fpga-robotics bench --list`)"),
+    "ports": ("fpga_robotics.sim.backends.port_map",
+              "write (--example) or check a port map for run --design verilog:..."),
     "readback": ("fpga_robotics.readback_cli",
                  "what a saved .rrd recording holds, entity by entity"),
 }
@@ -39,6 +41,8 @@ BENCHMARKS = {
     "world": ("fpga_robotics.world_bench", "the physics of the robot world"),
     "viewer": ("fpga_robotics.viewer_bench", "the cost of logging to the rerun viewer"),
     "shadow": ("fpga_robotics.shadow_bench", "a shadow design's cost in the closed loop"),
+    "foreign": ("fpga_robotics.sim.backends.foreign_bench",
+                "a Verilog design through a port map against the built-in Verilator backend"),
 }
 
 PROG = "fpga-robotics"
