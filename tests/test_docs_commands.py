@@ -387,6 +387,12 @@ PLANS = {
     "python -m fpga_robotics.export --board ulx3s-85f -o build/ulx3s --bitstream":
         Plan(slow=True, files=("build/ulx3s/ulx3s_follow_target.bit",),
              out=(r"(?i)sync.*MHz",)),
+    ("python -m fpga_robotics.run --design verilog:design_top.v,centroid.v,color_proc.v,"
+     "frame_buffer.v,motor_ctrl_spi.v --ports \"$(python -c 'import fpga_robotics, pathlib; "
+     "print(pathlib.Path(fpga_robotics.__file__).parent / \"port_maps/published_design_top.toml"
+     "\")')\" --rerun off --shadow published --shadow-backend model"):
+        Plan(excused="runs the published RTL, which this project does not ship (third-party "
+                     "files); the shipped port map is read by test_foreign_verilog.py"),
     "openFPGALoader -b ulx3s build/ulx3s/ulx3s_follow_target.bit":
         Plan(excused="programs a ULX3S over USB: needs the board (and openFPGALoader, which is "
                      "not a Python package)"),

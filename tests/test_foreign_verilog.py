@@ -470,3 +470,88 @@ def test_stop_fatal_and_finish_are_errors_not_a_dead_process(tmp_path, task, wha
                       match=rf"frame 0: the design called {what} at stopper\.v:\d+$"),
     ):
         design.process_frame(frame)
+
+
+# A wrapper with inputs the world does not drive: a debug read address and a mode pin whose
+# value 5 is the only one under which the design passes its outputs on.
+MODED = """\
+module moded_top (
+  input clk, input rst, input pixels__valid, input [13:0] pixels__payload,
+  input [2:0] color_sel, input [14:0] dbg_addr, input [3:0] mode,
+  output frame_done, output signed [15:0] motor_left, output signed [15:0] motor_right,
+  output [7:0] centroid_leds
+);
+  wire fv; wire [13:0] fp; wire found; wire [2:0] prox; wire [%(xmsb)d:0] cx;
+  wire signed [15:0] ml, mr;
+  follow_target core (
+    .clk(clk), .rst(rst), .pixels__valid(pixels__valid), .pixels__payload(pixels__payload),
+    .color_sel(color_sel), .filtered__valid(fv), .filtered__payload(fp),
+    .frame_done(frame_done), .found(found), .proximity(prox), .centroid_x(cx),
+    .centroid_leds(centroid_leds), .motor_left(ml), .motor_right(mr));
+  assign motor_left = mode == 4'd5 ? ml : 16'sd0;
+  assign motor_right = mode == 4'd5 ? mr : 16'sd0;
+endmodule
+"""
+
+MODED_MAP = """\
+style = "stream"
+top = "moded_top"
+clock = { port = "clk" }
+reset = { port = "rst" }
+pixels = { valid = "pixels__valid", payload = "pixels__payload" }
+color = { port = "color_sel" }
+result = { strobe = "frame_done", latency = %(latency)d }
+
+[outputs]
+centroid_leds = "centroid_leds"
+motor_left = "motor_left"
+motor_right = "motor_right"
+%(constants)s
+"""
+
+
+def test_constants_tie_inputs_the_world_does_not_drive(tmp_path):
+    (tmp_path / "moded.v").write_text(MODED % {"xmsb": PARAMS.x_bits - 1})
+    (tmp_path / "follow_target.v").write_text(generate_verilog(PARAMS))
+    files = [tmp_path / "moded.v", tmp_path / "follow_target.v"]
+
+    def port_map(constants):
+        path = tmp_path / f"m{abs(hash(constants))}.toml"
+        path.write_text(MODED_MAP % {"latency": PARAMS.motor_latency, "constants": constants})
+        return path
+
+    design = foreign.ForeignVerilatorBackend(
+        PARAMS, files=files, port_map=port_map("[constants]\nmode = 5\ndbg_addr = 0"))
+    model = get_backend("model", PARAMS)
+    try:
+        frames = _frames(PARAMS)
+        moved = 0
+        for frame in frames:
+            got, want = design.process_frame(frame), model.process_frame(frame)
+            assert (got.motor_left, got.motor_right, got.centroid_leds) == (
+                want.motor_left, want.motor_right, want.centroid_leds)
+            moved += want.motor_left != 0
+        assert moved  # the tie matters: under any other mode the motors would read 0
+    finally:
+        design.close()
+    with pytest.raises(PortMapError, match="'dbg_addr'.*not mapped"):
+        foreign.ForeignVerilatorBackend(PARAMS, files=files,
+                                        port_map=port_map("[constants]\nmode = 5"))
+    with pytest.raises(PortMapError, match="constants.mode = 16 does not fit the 4-bit port"):
+        foreign.ForeignVerilatorBackend(
+            PARAMS, files=files, port_map=port_map("[constants]\nmode = 16\ndbg_addr = 0"))
+    with pytest.raises(PortMapError, match="constants.mode must be an integer >= 0"):
+        foreign.ForeignVerilatorBackend(
+            PARAMS, files=files, port_map=port_map('[constants]\nmode = "5"\ndbg_addr = 0'))
+
+
+def test_the_shipped_map_of_the_published_design_reads():
+    from importlib import resources
+
+    from fpga_robotics.sim.backends.port_map import load_port_map
+
+    path = resources.files("fpga_robotics") / "port_maps" / "published_design_top.toml"
+    pm = load_port_map(str(path))
+    assert (pm.style, pm.top, pm.strobe, pm.constants) == (
+        "framebuffer", "design_top", "new_centroid", {"addrout": 0})
+    assert set(pm.outputs) == {"centroid_leds", "proximity", "motor_left", "motor_right"}

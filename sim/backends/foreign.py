@@ -254,6 +254,8 @@ def wrapper_verilog(pm, ports, width, height):
             fill = (f"{{{out_width - width}{{fr_{key}[{width - 1}]}}}}" if out.signed
                     else f"{out_width - width}'d0")
             body.append(f"  assign {key} = {{{fill}, fr_{key}}};")
+    for name, value in pm.constants.items():
+        conns.append(f".{name}({ports[name][1]}'d{value})")
     if pm.filtered_valid:
         conns += [f".{pm.filtered_valid}(filtered__valid)",
                   f".{pm.filtered_payload}(filtered__payload)"]

@@ -31,7 +31,8 @@ OUTPUTS = {
     "motor_right": (16, True),
 }
 _STYLES = ("stream", "framebuffer")
-_TOP_KEYS = {"style", "top", "clock", "reset", "pixels", "color", "result", "outputs", "filtered"}
+_TOP_KEYS = {"style", "top", "clock", "reset", "pixels", "color", "result", "outputs", "filtered",
+             "constants"}
 
 
 class PortMapError(BackendError):
@@ -69,6 +70,7 @@ class PortMap:
     address: str | None = None  # framebuffer: linear write address y * width + x
     new_frame: str | None = None  # framebuffer: the one-cycle pulse after the last pixel
     after_cycles: int | None = None  # read the outputs this many cycles after the frame
+    constants: dict = field(default_factory=dict)  # input port -> value it is tied to
 
     def inputs(self):
         """Input port name -> expected width (None: checked elsewhere)."""
@@ -87,6 +89,8 @@ class PortMap:
                     ports[flag] = 1
         if self.color_port:
             ports[self.color_port] = self.color_width
+        for name in self.constants:
+            ports[name] = None  # any width the value fits: checked with the design's ports
         return ports
 
     def output_ports(self):
@@ -233,6 +237,15 @@ def parse_port_map(data):
     f_valid = _name(filtered, "valid", "filtered", required=bool(filtered))
     f_payload = _name(filtered, "payload", "filtered", required=bool(filtered))
 
+    # Inputs the world does not drive (a read address of a debug port, a mode pin) tied to a
+    # value: [constants] port = value.
+    constants = _table(data, "constants", "", required=False)
+    for name, value in constants.items():
+        if not name.isidentifier():
+            raise PortMapError(f"port map: constants.{name}: not a port name")
+        if isinstance(value, bool) or not isinstance(value, int) or value < 0:
+            raise PortMapError(f"port map: constants.{name} must be an integer >= 0, got "
+                               f"{value!r}")
     port_map = PortMap(
         top=top, clock=_name(clock, "port", "clock"), reset=_name(reset, "port", "reset"),
         reset_active_low=active_low, valid=valid, payload=payload,
@@ -240,12 +253,13 @@ def parse_port_map(data):
         color_width=color_width, strobe=strobe, latency=latency, timeout=timeout,
         outputs=outputs, filtered_valid=f_valid, filtered_payload=f_payload, style=style,
         address=address, new_frame=new_frame, after_cycles=after_cycles,
+        constants=dict(constants),
     )
     pm = port_map
     names = [n for n in (pm.clock, pm.reset, pm.valid, pm.payload, pm.data, pm.first, pm.last,
                          pm.address, pm.new_frame, pm.color_port, pm.strobe,
                          *(o.port for o in pm.outputs.values()), pm.filtered_valid,
-                         pm.filtered_payload) if n]
+                         pm.filtered_payload, *pm.constants) if n]
     dup = sorted({n for n in names if names.count(n) > 1})
     if dup:
         raise PortMapError(f"port map: port {dup[0]!r} is mapped more than once")
@@ -296,6 +310,10 @@ def check_widths(port_map, ports, pixels=None):
         if too_big:
             raise PortMapError(f"port map: color.codes.{too_big[0]} does not fit the "
                                f"{width}-bit port {port_map.color_port!r}")
+    for name, value in port_map.constants.items():
+        if value >> ports[name][1]:
+            raise PortMapError(f"port map: constants.{name} = {value} does not fit the "
+                               f"{ports[name][1]}-bit port")
     unconnected = [n for n, (d, _, _) in ports.items()
                    if d == "input" and n not in port_map.inputs()]
     if unconnected:
