@@ -277,7 +277,8 @@ class ClosedLoop:
         n_frames, dt = self.n_frames, self.dt
         sim_time = self.total_steps * dt
         metrics = compute_metrics(self.traj, self.events, self.world.collision_counts(),
-                                  self.period)
+                                  self.period,
+                                  at_fault_collisions=self.world.at_fault_collisions())
         checks = evaluate_checks(scenario.checks, metrics)
         shadow = {"shadow": self.comparison.summary()} if self.comparison is not None else {}
         return {

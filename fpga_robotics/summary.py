@@ -30,6 +30,11 @@ CHECKS = {
     "min_distance_min_m": (float, (0, 1000, "m"),
                            "closest robot-to-target distance (centres) at least this"),
     "max_person_collisions": (int, (0, 10**6, ""), "at most this many collisions with a person"),
+    "max_robot_at_fault_collisions": (
+        int, (0, 10**6, ""),
+        ("at most this many times the robot drove into a person (moving towards them faster "
+         "than sim.world.AT_FAULT_SPEED at the touch)"),
+    ),
     "max_wall_collisions": (int, (0, 10**6, ""), "at most this many collisions with a wall"),
     "max_furniture_collisions": (int, (0, 10**6, ""),
                                  "at most this many collisions with furniture"),
@@ -58,7 +63,7 @@ def _round(x, digits=4):
     return None if x is None else round(float(x), digits)
 
 
-def compute_metrics(traj, events, collisions, frame_period):
+def compute_metrics(traj, events, collisions, frame_period, *, at_fault_collisions=0):
     """Reduce a run to numbers.
 
     Parameters
@@ -69,6 +74,8 @@ def compute_metrics(traj, events, collisions, frame_period):
     events : list of (frame, time, text)
     collisions : dict kind → count
     frame_period : float
+    at_fault_collisions : int
+        Collisions with a person the robot drove into (``World.at_fault_collisions``).
     """
     t = traj["t"]
     n = len(t)
@@ -103,6 +110,7 @@ def compute_metrics(traj, events, collisions, frame_period):
         "found_after_acquisition_fraction": _round(found_after),
         "acquired_at_s": _round(acquired_at),
         "collisions": dict(collisions),
+        "robot_at_fault_collisions": int(at_fault_collisions),
         "losses": len(episodes),
         "searches": sum(1 for _, _, text in events if text == "search started"),
         "searched_losses": sum(1 for ep in episodes if ep[2]),
@@ -136,6 +144,10 @@ def evaluate_checks(checks, m):
             ok = v is not None and v >= limit
             text = (f"min distance {v} m (limit >= {limit} m)" if v is not None
                     else f"{_NO_TARGET} (limit >= {limit} m)")
+        elif name == "max_robot_at_fault_collisions":
+            v = m["robot_at_fault_collisions"]
+            ok = v <= limit
+            text = f"the robot drove into a person {v} time(s) (limit {limit})"
         elif name.startswith("max_") and name.endswith("_collisions"):
             kind = name[len("max_"): -len("_collisions")]
             v = int(m["collisions"].get(kind, 0))

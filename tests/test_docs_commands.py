@@ -260,6 +260,11 @@ _DIVIDER_WHY = (
     "wood and loses the person from view between 10 and 15 s, which is the failure the page "
     "means; a run of 10 s or less fails only the mean-distance check, as the default design does")
 
+_APPROACH_WHY = (
+    "the scenario's own 30 s (about a second of wall time): with the early thresholds the "
+    "robot reaches the standing person at 26.7 s; the page's default run must stop short over "
+    "the same time")
+
 PLANS = {
     # README: two commands on a fresh machine ------------------------------------------------
     "python3 -m venv .venv && . .venv/bin/activate && pip install -e . && python -m fpga_robotics.run":
@@ -322,6 +327,14 @@ PLANS = {
     "python -m fpga_robotics.run --scenario lost_target --rerun off":
         Plan(duration="keep", duration_why="as for the same command with --summary",
              out=(PASS,)),
+    # docs/stories.md -------------------------------------------------------------------------
+    "python -m fpga_robotics.run --scenario approach --rerun off":
+        Plan(duration="keep", duration_why=_APPROACH_WHY,
+             out=(PASS, r"\[ok\] max_robot_at_fault_collisions")),
+    'python -m fpga_robotics.run --scenario approach --rerun off --set '
+    '"design.proximity_thresholds=[128,256,512,1024,2048,19000,19100]"':
+        Plan(duration="keep", duration_why=_APPROACH_WHY,
+             out=(r"\[FAIL\] max_person_collisions", r"\[FAIL\] max_robot_at_fault_collisions")),
     "python -m fpga_robotics.run --scenario divider --set design.diff_min=5":
         Plan(duration="keep", duration_why=_DIVIDER_WHY,
              out=(r"\[FAIL\] target_in_view_min_fraction",)),

@@ -23,10 +23,15 @@ from .motors import DriveMotors
 from .people import PersonPath, person_bands
 from .room import add_static_shapes, map_data, scene_walls
 
-__all__ = ["MAX_SUBSTEP", "World"]
+__all__ = ["AT_FAULT_SPEED", "MAX_SUBSTEP", "World"]
 
 #: ``step(dt)`` splits longer steps into equal sub-steps no longer than this, s.
 MAX_SUBSTEP = 0.01
+
+#: A contact with a person is the robot's fault when, at the first touch, the robot moves
+#: towards the person faster than this (m/s): its velocity projected on the direction from
+#: its centre to the person's. A person walking into a standing or retreating robot is not.
+AT_FAULT_SPEED = 0.02
 
 _ROBOT, _WALL, _FURNITURE, _PERSON = 1, 2, 3, 4
 _KINDS = ("person", "wall", "furniture")
@@ -132,6 +137,7 @@ class World:
             raise WorldConfigError(f"robot.start [{x:g}, {y:g}] overlaps the {what}")
 
         self._counts = dict.fromkeys(_KINDS, 0)
+        self._at_fault = 0
         self._events = []
         for ctype in (_WALL, _FURNITURE, _PERSON):
             space.on_collision(_ROBOT, ctype, begin=self._on_begin)
@@ -148,9 +154,24 @@ class World:
     # -- physics ------------------------------------------------------------------------
 
     def _on_begin(self, arbiter, space, data):
-        kind, name = self._names[arbiter.shapes[1]]
+        other = arbiter.shapes[1]
+        kind, name = self._names[other]
         self._counts[kind] += 1
         self._events.append(f"collision with {kind} {name!r}" if name else f"collision with {kind}")
+        if kind == "person":
+            if self._closing_speed(other.body) > AT_FAULT_SPEED:
+                self._at_fault += 1
+
+    def _closing_speed(self, person_body):
+        """The robot's speed towards the person (m/s): its velocity (before the contact
+        resolves) projected on the unit vector from its centre to the person's."""
+        rx, ry = self.robot_body.position
+        px, py = person_body.position
+        d = math.hypot(px - rx, py - ry)
+        if d == 0.0:
+            return 0.0
+        vx, vy = self.robot_body.velocity
+        return (vx * (px - rx) + vy * (py - ry)) / d
 
     def step(self, dt):
         """Advance the world by ``dt`` seconds (split into sub-steps of at most
@@ -280,3 +301,7 @@ class World:
     def collision_counts(self):
         """Robot collisions since the start, per kind: ``{"person", "wall", "furniture"}``."""
         return dict(self._counts)
+
+    def at_fault_collisions(self):
+        """Collisions with a person that were the robot's fault (``AT_FAULT_SPEED``)."""
+        return self._at_fault
