@@ -278,7 +278,8 @@ class ClosedLoop:
         sim_time = self.total_steps * dt
         metrics = compute_metrics(self.traj, self.events, self.world.collision_counts(),
                                   self.period,
-                                  at_fault_collisions=self.world.at_fault_collisions())
+                                  at_fault_collisions=self.world.at_fault_collisions(),
+                                  width=cam.width)
         checks = evaluate_checks(scenario.checks, metrics)
         shadow = {"shadow": self.comparison.summary()} if self.comparison is not None else {}
         return {

@@ -35,6 +35,12 @@ CHECKS = {
         ("at most this many times the robot drove into a person (moving towards them faster "
          "than sim.world.AT_FAULT_SPEED at the touch)"),
     ),
+    "max_tip_overs": (int, (0, 1, ""),
+                      ("the robot tipped over at most this often (0: never; sim.world tip-over "
+                       "model)")),
+    "max_oscillation_hz": (float, (0, 1000, "Hz"),
+                           ("the commanded turn rate W changes sign at most this often per "
+                            "second while the target is centred")),
     "max_wall_collisions": (int, (0, 10**6, ""), "at most this many collisions with a wall"),
     "max_furniture_collisions": (int, (0, 10**6, ""),
                                  "at most this many collisions with furniture"),
@@ -63,7 +69,13 @@ def _round(x, digits=4):
     return None if x is None else round(float(x), digits)
 
 
-def compute_metrics(traj, events, collisions, frame_period, *, at_fault_collisions=0):
+#: The target is centred when the design's centroid is within this fraction of the image
+#: width from the centre (for the oscillation metric).
+CENTRED_FRACTION = 0.125
+
+
+def compute_metrics(traj, events, collisions, frame_period, *, at_fault_collisions=0,
+                    width=None):
     """Reduce a run to numbers.
 
     Parameters
@@ -76,6 +88,9 @@ def compute_metrics(traj, events, collisions, frame_period, *, at_fault_collisio
     frame_period : float
     at_fault_collisions : int
         Collisions with a person the robot drove into (``World.at_fault_collisions``).
+    width : int, optional
+        The image width, pixels: the oscillation metric needs the centre of the image
+        (without it, or without ``cmd_w``/``centroid_x``, the metric is None).
     """
     t = traj["t"]
     n = len(t)
@@ -102,6 +117,7 @@ def compute_metrics(traj, events, collisions, frame_period, *, at_fault_collisio
     end_time = float(t[-1]) + frame_period if n else 0.0
     reacq = [round(f - lost, 4) for lost, f, _ in episodes if f is not None]
     unrecovered = [round(end_time - lost, 4) for lost, f, _ in episodes if f is None]
+    tipped = [(time, text) for _f, time, text in events if text.startswith("tipped over")]
     return {
         "min_distance_m": _round(dist[valid].min()) if valid.any() else None,
         "mean_distance_m": _round(dist[valid].mean()) if valid.any() else None,
@@ -118,7 +134,44 @@ def compute_metrics(traj, events, collisions, frame_period, *, at_fault_collisio
         "reacquire_times_s": reacq,
         "unrecovered_losses_s": unrecovered,
         "path_length_m": _round(path),
+        "tipped_over_at_s": _round(tipped[0][0]) if tipped else None,
+        "tip_overs": len(tipped),
+        "max_wheel_command_step_dps": _max_command_step(traj),
+        "oscillation_hz": _oscillation(traj, width, n * frame_period),
     }
+
+
+def _max_command_step(traj):
+    """The largest change of a wheel's command from one frame to the next, DPS."""
+    if "motor_left" not in traj or len(traj["motor_left"]) < 2:
+        return None
+    steps = [np.abs(np.diff(np.asarray(traj[k], dtype=float))).max()
+             for k in ("motor_left", "motor_right")]
+    return int(max(steps))
+
+
+def _oscillation(traj, width, seconds):
+    """Sign changes of the commanded turn rate W per second while the design reports the
+    target found within ``CENTRED_FRACTION`` of the image width from the centre: a steering
+    that swings left-right-left around a centred target. Frames with W = 0 (straight ahead)
+    keep the last sign, so left-straight-right counts once; a frame off-centre starts the
+    count afresh. Per second of centred time; None if the target was never centred, or
+    without the fields."""
+    if width is None or "cmd_w" not in traj or "centroid_x" not in traj or seconds <= 0:
+        return None
+    w = np.asarray(traj["cmd_w"], dtype=float)
+    centred = traj["found"] & (np.abs(np.asarray(traj["centroid_x"]) - width / 2)
+                               <= CENTRED_FRACTION * width)
+    if not centred.any():
+        return None
+    flips, last = 0, 0.0
+    for wk, ck in zip(np.sign(w), centred):
+        if not ck:
+            last = 0.0
+        elif wk != 0:
+            flips += bool(last * wk < 0)
+            last = wk
+    return _round(flips / (seconds * centred.mean()))
 
 
 def _check(name, passed, value, limit, text):
@@ -148,6 +201,17 @@ def evaluate_checks(checks, m):
             v = m["robot_at_fault_collisions"]
             ok = v <= limit
             text = f"the robot drove into a person {v} time(s) (limit {limit})"
+        elif name == "max_tip_overs":
+            v = m["tip_overs"]
+            ok = v <= limit
+            text = ("the robot never tipped over" if v == 0
+                    else f"the robot tipped over at {m['tipped_over_at_s']:.2f} s (limit {limit})")
+        elif name == "max_oscillation_hz":
+            v = m["oscillation_hz"]
+            ok = v is None or v <= limit
+            text = ("the target was never centred" if v is None
+                    else f"W changes sign {v:.2f} times per second with the target centred "
+                         f"(limit {limit})")
         elif name.startswith("max_") and name.endswith("_collisions"):
             kind = name[len("max_"): -len("_collisions")]
             v = int(m["collisions"].get(kind, 0))

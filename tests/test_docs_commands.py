@@ -265,6 +265,11 @@ _APPROACH_WHY = (
     "robot reaches the standing person at 26.7 s; the page's default run must stop short over "
     "the same time")
 
+_ERRATIC_WHY = (
+    "the scenario's own 30 s (about a second of wall time): the robot tips at 1.47 s and the "
+    "oscillation the page quotes is over the whole run; a 1 s run of the default design fails "
+    "its mean-distance check")
+
 PLANS = {
     # README: two commands on a fresh machine ------------------------------------------------
     "python3 -m venv .venv && . .venv/bin/activate && pip install -e . && python -m fpga_robotics.run":
@@ -335,6 +340,13 @@ PLANS = {
     '"design.proximity_thresholds=[128,256,512,1024,2048,19000,19100]"':
         Plan(duration="keep", duration_why=_APPROACH_WHY,
              out=(r"\[FAIL\] max_person_collisions", r"\[FAIL\] max_robot_at_fault_collisions")),
+    "python -m fpga_robotics.run --scenario erratic --rerun off":
+        Plan(duration="keep", duration_why=_ERRATIC_WHY, out=(PASS, r"\[ok\] max_tip_overs")),
+    "python -m fpga_robotics.run --scenario erratic --rerun off --set design.kp_num=32":
+        Plan(duration="keep", duration_why=_ERRATIC_WHY, out=(r"\[FAIL\] max_tip_overs: the robot tipped over at 1\.47 s",)),
+    "python -m fpga_robotics.run --scenario erratic --rerun off --set design.preset=published":
+        Plan(duration="keep", duration_why=_ERRATIC_WHY,
+             out=(r"\[FAIL\] max_oscillation_hz: W changes sign 4\.87 times",)),
     "python -m fpga_robotics.run --scenario divider --set design.diff_min=5":
         Plan(duration="keep", duration_why=_DIVIDER_WHY,
              out=(r"\[FAIL\] target_in_view_min_fraction",)),

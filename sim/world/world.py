@@ -138,6 +138,9 @@ class World:
 
         self._counts = dict.fromkeys(_KINDS, 0)
         self._at_fault = 0
+        #: ``(time_s, reason)`` once the robot has tipped over, else None.
+        self.tipped = None
+        self._motor_v = 0.0  # the wheels' forward speed at the last sub-step, m/s
         self._events = []
         for ctype in (_WALL, _FURNITURE, _PERSON):
             space.on_collision(_ROBOT, ctype, begin=self._on_begin)
@@ -188,6 +191,13 @@ class World:
         wl, wr = self.motors.step(h)
         r = spec.wheel_radius
         v = r * (wl + wr) * 0.5
+        if self.tipped is None:
+            # The body follows the wheels at most at traction_force / mass.
+            accel = min(abs(v - self._motor_v) / h, spec.traction_force / spec.mass)
+            if accel > spec.tip_accel:
+                self._tip(f"longitudinal acceleration {accel:.2f} m/s^2 > "
+                          f"{spec.tip_accel:.2f} m/s^2")
+        self._motor_v = v
         w = r * (wr - wl) / spec.wheel_separation
         body = self.robot_body
         a = body.angle
@@ -221,8 +231,26 @@ class World:
     # -- motors -------------------------------------------------------------------------
 
     def set_wheel_dps(self, left_dps, right_dps):
-        """Wheel speed targets in degrees per second (the design's SET_MOTOR_DPS values)."""
+        """Wheel speed targets in degrees per second (the design's SET_MOTOR_DPS values).
+        A jump of either wheel's command beyond ``robot_spec.tip_step_dps`` (when the spec
+        has a ``motor_step_response``) tips the robot over; a tipped robot's wheels stay
+        still."""
+        if self.tipped is not None:
+            return
+        old_l, old_r = self.motors.command_dps
+        jump = max(abs(left_dps - old_l), abs(right_dps - old_r))
+        limit = self.robot_spec.tip_step_dps
+        if limit is not None and jump > limit:
+            self._tip(f"wheel command jumped {jump:g} DPS > {limit:.0f} DPS")
+            return
         self.motors.set_wheel_dps(left_dps, right_dps)
+
+    def _tip(self, reason):
+        """The robot falls: its wheels stop (the body is braked by the drive's traction)."""
+        self.tipped = (self.time, reason)
+        self._events.append(f"tipped over: {reason}")
+        self.motors.set_wheel_dps(0.0, 0.0)
+        self.motors.left.speed = self.motors.right.speed = 0.0
 
     def commanded_twist(self):
         """``(v, w)`` of the current DPS command by the real kinematics."""
