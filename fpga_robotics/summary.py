@@ -41,6 +41,11 @@ CHECKS = {
     "max_oscillation_hz": (float, (0, 1000, "Hz"),
                            ("the commanded turn rate W changes sign at most this often per "
                             "second while the target is centred")),
+    "max_off_target_fraction": (
+        float, (0, 1, ""),
+        ("the design's centroid is more than an eighth of the image width from the target's "
+         "image column in at most this fraction of the frames in which it reports found with "
+         "the target's centre in view (a non-target object taken for the target)")),
     "max_wall_collisions": (int, (0, 10**6, ""), "at most this many collisions with a wall"),
     "max_furniture_collisions": (int, (0, 10**6, ""),
                                  "at most this many collisions with furniture"),
@@ -69,6 +74,9 @@ def _round(x, digits=4):
     return None if x is None else round(float(x), digits)
 
 
+#: The design's centroid points away from the target when it is further than this fraction of
+#: the image width from the target's column.
+OFF_TARGET_FRACTION = 0.125
 #: The target is centred when the design's centroid is within this fraction of the image
 #: width from the centre (for the oscillation metric).
 CENTRED_FRACTION = 0.125
@@ -138,7 +146,25 @@ def compute_metrics(traj, events, collisions, frame_period, *, at_fault_collisio
         "tip_overs": len(tipped),
         "max_wheel_command_step_dps": _max_command_step(traj),
         "oscillation_hz": _oscillation(traj, width, n * frame_period),
+        **_off_target(traj, width),
     }
+
+
+def _off_target(traj, width):
+    """How far the design's centroid is from the target's image column (``target_column``),
+    over the frames in which it reports found and the target's centre is in view: the
+    fraction of them with an error above ``OFF_TARGET_FRACTION * width``, and the mean error
+    (pixels). None without such frames or fields."""
+    none = {"off_target_fraction": None, "mean_centroid_error_px": None}
+    if width is None or "target_column" not in traj or "centroid_x" not in traj:
+        return none
+    column = np.asarray(traj["target_column"], dtype=float)
+    ok = traj["found"] & ~np.isnan(column)
+    if not ok.any():
+        return none
+    err = np.abs(np.asarray(traj["centroid_x"], dtype=float)[ok] - column[ok])
+    return {"off_target_fraction": _round((err > OFF_TARGET_FRACTION * width).mean()),
+            "mean_centroid_error_px": _round(err.mean(), 2)}
 
 
 def _max_command_step(traj):
@@ -212,6 +238,12 @@ def evaluate_checks(checks, m):
             text = ("the target was never centred" if v is None
                     else f"W changes sign {v:.2f} times per second with the target centred "
                          f"(limit {limit})")
+        elif name == "max_off_target_fraction":
+            v = m["off_target_fraction"]
+            ok = v is None or v <= limit
+            text = ("the design never reported the target found with it in view" if v is None
+                    else f"centroid away from the target in {v:.0%} of the frames with the "
+                         f"target found and in view (limit <= {limit:.0%})")
         elif name.startswith("max_") and name.endswith("_collisions"):
             kind = name[len("max_"): -len("_collisions")]
             v = int(m["collisions"].get(kind, 0))
