@@ -46,6 +46,11 @@ CHECKS = {
         ("the design's centroid is more than an eighth of the image width from the target's "
          "image column in at most this fraction of the frames in which it reports found with "
          "the target's centre in view (a non-target object taken for the target)")),
+    "mean_centroid_error_max_px": (
+        float, (0, 10000, "px"),
+        ("mean distance of the design's centroid from the target's image column (frames found "
+         "with the target's centre in view) at most this; with the target straight ahead, the "
+         "centroid's distance from the image centre")),
     "max_wall_collisions": (int, (0, 10**6, ""), "at most this many collisions with a wall"),
     "max_furniture_collisions": (int, (0, 10**6, ""),
                                  "at most this many collisions with furniture"),
@@ -244,6 +249,12 @@ def evaluate_checks(checks, m):
             text = ("the design never reported the target found with it in view" if v is None
                     else f"centroid away from the target in {v:.0%} of the frames with the "
                          f"target found and in view (limit <= {limit:.0%})")
+        elif name == "mean_centroid_error_max_px":
+            v = m["mean_centroid_error_px"]
+            ok = v is not None and v <= limit
+            text = ("the design never reported the target found with it in view" if v is None
+                    else f"centroid {v:.2f} px from the target's image column on average "
+                         f"(limit <= {limit} px)")
         elif name.startswith("max_") and name.endswith("_collisions"):
             kind = name[len("max_"): -len("_collisions")]
             v = int(m["collisions"].get(kind, 0))

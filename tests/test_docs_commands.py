@@ -334,6 +334,11 @@ PLANS = {
         Plan(duration="keep", duration_why="as for the same command with --summary",
              out=(PASS,)),
     # docs/stories.md -------------------------------------------------------------------------
+    "python -m pytest -q -m stories tests/test_story_*.py":
+        Plan(collect=True, out=(r"test_story_b_early_thresholds_drive_into_the_person",
+                                r"test_story_c_an_unstable_gain_tips_the_gopigo3",
+                                r"\(\d+ deselected\)"),
+             not_out=(r"test_the_check_reads_the_at_fault_count",)),
     "python -m fpga_robotics.run --scenario divider --rerun off":
         Plan(duration="keep",
              duration_why="the page says the default design passes: over the whole scenario "
