@@ -51,6 +51,9 @@ CHECKS = {
         ("mean distance of the design's centroid from the target's image column (frames found "
          "with the target's centre in view) at most this; with the target straight ahead, the "
          "centroid's distance from the image centre")),
+    "max_heading_overshoot_deg": (
+        float, (0, 180, "deg"),
+        "the robot turns at most this far past the target (heading_overshoot_deg)"),
     "max_wall_collisions": (int, (0, 10**6, ""), "at most this many collisions with a wall"),
     "max_furniture_collisions": (int, (0, 10**6, ""),
                                  "at most this many collisions with furniture"),
@@ -152,7 +155,35 @@ def compute_metrics(traj, events, collisions, frame_period, *, at_fault_collisio
         "max_wheel_command_step_dps": _max_command_step(traj),
         "oscillation_hz": _oscillation(traj, width, n * frame_period),
         **_off_target(traj, width),
+        "heading_overshoot_deg": _heading_overshoot(traj),
     }
+
+
+def _heading_overshoot(traj):
+    """How far the robot turns past the target, degrees: the largest bearing error (the
+    target's bearing from the robot's centre, relative to its heading) on the far side once
+    the error has changed sign, over frames with the target's centre in view (a frame out of
+    view starts afresh). Meaningful with a standing target (a step response, e.g. ``approach``
+    with ``robot.heading_deg=20``); a walking target crossing the robot's axis counts too.
+    None without the fields."""
+    need = ("x", "y", "heading", "target_x", "target_y", "target_column")
+    if any(k not in traj for k in need) or len(traj["x"]) == 0:
+        return None
+    b = np.arctan2(traj["target_y"] - traj["y"], traj["target_x"] - traj["x"]) - traj["heading"]
+    b = np.degrees((b + np.pi) % (2 * np.pi) - np.pi)
+    best, last, crossed = 0.0, 0.0, False
+    for bk, seen in zip(b, ~np.isnan(np.asarray(traj["target_column"], dtype=float))):
+        if not seen:
+            last, crossed = 0.0, False
+            continue
+        sign = np.sign(bk)
+        if sign == 0:
+            continue
+        crossed = crossed or (last != 0 and sign != last)
+        if crossed:
+            best = max(best, abs(float(bk)))
+        last = sign
+    return _round(best, 2)
 
 
 def _off_target(traj, width):
@@ -255,6 +286,11 @@ def evaluate_checks(checks, m):
             text = ("the design never reported the target found with it in view" if v is None
                     else f"centroid {v:.2f} px from the target's image column on average "
                          f"(limit <= {limit} px)")
+        elif name == "max_heading_overshoot_deg":
+            v = m["heading_overshoot_deg"]
+            ok = v is not None and v <= limit
+            text = ("no heading to compare" if v is None
+                    else f"turned {v:.1f} deg past the target (limit <= {limit} deg)")
         elif name.startswith("max_") and name.endswith("_collisions"):
             kind = name[len("max_"): -len("_collisions")]
             v = int(m["collisions"].get(kind, 0))

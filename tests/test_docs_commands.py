@@ -339,6 +339,16 @@ PLANS = {
                                 r"test_story_c_an_unstable_gain_tips_the_gopigo3",
                                 r"\(\d+ deselected\)"),
              not_out=(r"test_the_check_reads_the_at_fault_count",)),
+    "python -m fpga_robotics.run --scenario approach --rerun off --set robot.heading_deg=20 "
+    "--set checks.max_heading_overshoot_deg=5":
+        Plan(duration="keep",
+             duration_why="the page says the default gain never turns past the person: over the "
+                           "whole 30 s run (about a second of wall time); in 1 s the robot has "
+                           "not finished its turn, so 0 degrees there would prove nothing",
+             out=(PASS, r"\[ok\] max_heading_overshoot_deg: turned 0\.0 deg")),
+    "python -m fpga_robotics.run --scenario approach --rerun off --set robot.heading_deg=20 "
+    "--set checks.max_heading_overshoot_deg=5 --set design.kp_num=16":
+        Plan(out=(r"\[FAIL\] max_heading_overshoot_deg: turned 11\.0 deg past the target",)),
     "python -m fpga_robotics.run --scenario divider --rerun off":
         Plan(duration="keep",
              duration_why="the page says the default design passes: over the whole scenario "

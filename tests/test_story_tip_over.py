@@ -153,3 +153,30 @@ def test_story_c_the_default_design_stays_upright_and_steady():
     r = run_scenario(load_scenario("erratic"), backend="cxxrtl")
     assert r.summary["verdict"] == "pass", _failed(r)
     assert r.summary["tipped_over_at_s"] is None and r.summary["oscillation_hz"] < 1.0
+
+
+def test_heading_overshoot_is_the_far_side_error_after_the_first_crossing():
+    # Robot at the origin, target at (1, 0): bearing error = -heading. Headings (deg):
+    # -20, -5, 4 (crossed: 4), 7 (7), 2, -1 (crossed back: 1), out of view, 3 (afresh: 0).
+    headings = np.radians([-20, -5, 4, 7, 2, -1, 30, 3])
+    n = len(headings)
+    column = np.where(np.arange(n) == 6, np.nan, 80.0)
+    traj = {"t": np.arange(n) / 30, "x": np.zeros(n), "y": np.zeros(n), "heading": headings,
+            "found": np.ones(n, bool), "target_x": np.ones(n), "target_y": np.zeros(n),
+            "target_distance": np.ones(n), "target_in_view": np.ones(n, bool),
+            "target_column": column}
+    m = compute_metrics(traj, [], {}, 1 / 30)
+    assert m["heading_overshoot_deg"] == pytest.approx(7.0)
+    (c,) = evaluate_checks({"max_heading_overshoot_deg": 5.0}, m)
+    assert not c["passed"] and c["text"] == "turned 7.0 deg past the target (limit <= 5.0 deg)"
+
+
+@pytest.mark.parametrize("overrides, overshoot", [
+    ([], (0.0, 0.0)),                       # the default gain turns onto the person
+    (["design.kp_num=16"], (8.0, 14.0)),    # a high gain swings past them
+])
+def test_turning_onto_a_standing_person(overrides, overshoot):
+    s = load_scenario("approach", ["robot.heading_deg=20", "sim.duration=10"] + overrides)
+    r = run_scenario(s, backend="model")
+    lo, hi = overshoot
+    assert lo <= r.summary["heading_overshoot_deg"] <= hi
