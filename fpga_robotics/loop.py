@@ -27,7 +27,7 @@ __all__ = ["TRAJECTORY_FIELDS", "ClosedLoop", "RunResult", "frame_count", "make_
 TRAJECTORY_FIELDS = (
     "t", "x", "y", "heading", "v", "w", "cmd_v", "cmd_w",
     "found", "proximity", "centroid_x", "centroid_leds", "motor_left", "motor_right",
-    "color_sel", "target_x", "target_y", "target_distance", "target_in_view",
+    "color_sel", "target_x", "target_y", "target_distance", "target_in_view", "target_column",
 )
 
 
@@ -203,8 +203,9 @@ class ClosedLoop:
             tx, ty = target
             dist = math.hypot(tx - rx, ty - ry)
             visible = in_view(pose, self.scenario.camera.hfov, tx, ty, self.target_radius)
+            column = target_column(pose, self.scenario.camera, tx, ty)
         else:
-            tx = ty = dist = math.nan
+            tx = ty = dist = column = math.nan
             visible = False
         row = self.traj
         row["t"][k], row["x"][k], row["y"][k], row["heading"][k] = t, rx, ry, heading
@@ -215,6 +216,7 @@ class ClosedLoop:
         row["color_sel"][k] = self.color_code
         row["target_x"][k], row["target_y"][k] = tx, ty
         row["target_distance"][k], row["target_in_view"][k] = dist, visible
+        row["target_column"][k] = column
         return (None if target is None else dist), visible
 
     def record(self, k, t, rgb, result, distance, visible, events, shadow_result=None):
@@ -277,7 +279,9 @@ class ClosedLoop:
         n_frames, dt = self.n_frames, self.dt
         sim_time = self.total_steps * dt
         metrics = compute_metrics(self.traj, self.events, self.world.collision_counts(),
-                                  self.period)
+                                  self.period,
+                                  at_fault_collisions=self.world.at_fault_collisions(),
+                                  width=cam.width)
         checks = evaluate_checks(scenario.checks, metrics)
         shadow = {"shadow": self.comparison.summary()} if self.comparison is not None else {}
         return {
@@ -303,6 +307,19 @@ class ClosedLoop:
             "checks": checks,
             **shadow,
         }
+
+
+def target_column(pose, cam, x, y):
+    """The image column (pixels, 0 = left edge) of the centre of a person at ``(x, y)`` seen
+    by a camera at ``pose``: ``W/2 - f tan(bearing)``, ``f = (W/2) / tan(hfov/2)`` (image
+    right is the camera's right; sim/camera.py). NaN when the centre is outside the field of
+    view."""
+    bearing = math.atan2(y - pose.y, x - pose.x) - pose.heading
+    bearing = (bearing + math.pi) % (2 * math.pi) - math.pi
+    if abs(bearing) >= cam.hfov / 2:
+        return math.nan
+    focal = (cam.width / 2) / math.tan(cam.hfov / 2)
+    return cam.width / 2 - focal * math.tan(bearing)
 
 
 def _empty_trajectory(n_frames):

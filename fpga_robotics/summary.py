@@ -30,6 +30,30 @@ CHECKS = {
     "min_distance_min_m": (float, (0, 1000, "m"),
                            "closest robot-to-target distance (centres) at least this"),
     "max_person_collisions": (int, (0, 10**6, ""), "at most this many collisions with a person"),
+    "max_robot_at_fault_collisions": (
+        int, (0, 10**6, ""),
+        ("at most this many times the robot drove into a person (moving towards them faster "
+         "than sim.world.AT_FAULT_SPEED at the touch)"),
+    ),
+    "max_tip_overs": (int, (0, 1, ""),
+                      ("the robot tipped over at most this often (0: never; sim.world tip-over "
+                       "model)")),
+    "max_oscillation_hz": (float, (0, 1000, "Hz"),
+                           ("the commanded turn rate W changes sign at most this often per "
+                            "second while the target is centred")),
+    "max_off_target_fraction": (
+        float, (0, 1, ""),
+        ("the design's centroid is more than an eighth of the image width from the target's "
+         "image column in at most this fraction of the frames in which it reports found with "
+         "the target's centre in view (a non-target object taken for the target)")),
+    "mean_centroid_error_max_px": (
+        float, (0, 10000, "px"),
+        ("mean distance of the design's centroid from the target's image column (frames found "
+         "with the target's centre in view) at most this; with the target straight ahead, the "
+         "centroid's distance from the image centre")),
+    "max_heading_overshoot_deg": (
+        float, (0, 180, "deg"),
+        "the robot turns at most this far past the target (heading_overshoot_deg)"),
     "max_wall_collisions": (int, (0, 10**6, ""), "at most this many collisions with a wall"),
     "max_furniture_collisions": (int, (0, 10**6, ""),
                                  "at most this many collisions with furniture"),
@@ -58,7 +82,16 @@ def _round(x, digits=4):
     return None if x is None else round(float(x), digits)
 
 
-def compute_metrics(traj, events, collisions, frame_period):
+#: The design's centroid points away from the target when it is further than this fraction of
+#: the image width from the target's column.
+OFF_TARGET_FRACTION = 0.125
+#: The target is centred when the design's centroid is within this fraction of the image
+#: width from the centre (for the oscillation metric).
+CENTRED_FRACTION = 0.125
+
+
+def compute_metrics(traj, events, collisions, frame_period, *, at_fault_collisions=0,
+                    width=None):
     """Reduce a run to numbers.
 
     Parameters
@@ -69,6 +102,11 @@ def compute_metrics(traj, events, collisions, frame_period):
     events : list of (frame, time, text)
     collisions : dict kind → count
     frame_period : float
+    at_fault_collisions : int
+        Collisions with a person the robot drove into (``World.at_fault_collisions``).
+    width : int, optional
+        The image width, pixels: the oscillation metric needs the centre of the image
+        (without it, or without ``cmd_w``/``centroid_x``, the metric is None).
     """
     t = traj["t"]
     n = len(t)
@@ -95,6 +133,7 @@ def compute_metrics(traj, events, collisions, frame_period):
     end_time = float(t[-1]) + frame_period if n else 0.0
     reacq = [round(f - lost, 4) for lost, f, _ in episodes if f is not None]
     unrecovered = [round(end_time - lost, 4) for lost, f, _ in episodes if f is None]
+    tipped = [(time, text) for _f, time, text in events if text.startswith("tipped over")]
     return {
         "min_distance_m": _round(dist[valid].min()) if valid.any() else None,
         "mean_distance_m": _round(dist[valid].mean()) if valid.any() else None,
@@ -103,6 +142,7 @@ def compute_metrics(traj, events, collisions, frame_period):
         "found_after_acquisition_fraction": _round(found_after),
         "acquired_at_s": _round(acquired_at),
         "collisions": dict(collisions),
+        "robot_at_fault_collisions": int(at_fault_collisions),
         "losses": len(episodes),
         "searches": sum(1 for _, _, text in events if text == "search started"),
         "searched_losses": sum(1 for ep in episodes if ep[2]),
@@ -110,7 +150,90 @@ def compute_metrics(traj, events, collisions, frame_period):
         "reacquire_times_s": reacq,
         "unrecovered_losses_s": unrecovered,
         "path_length_m": _round(path),
+        "tipped_over_at_s": _round(tipped[0][0]) if tipped else None,
+        "tip_overs": len(tipped),
+        "max_wheel_command_step_dps": _max_command_step(traj),
+        "oscillation_hz": _oscillation(traj, width, n * frame_period),
+        **_off_target(traj, width),
+        "heading_overshoot_deg": _heading_overshoot(traj),
     }
+
+
+def _heading_overshoot(traj):
+    """How far the robot turns past the target, degrees: the largest bearing error (the
+    target's bearing from the robot's centre, relative to its heading) on the far side once
+    the error has changed sign, over frames with the target's centre in view (a frame out of
+    view starts afresh). Meaningful with a standing target (a step response, e.g. ``approach``
+    with ``robot.heading_deg=20``); a walking target crossing the robot's axis counts too.
+    None without the fields."""
+    need = ("x", "y", "heading", "target_x", "target_y", "target_column")
+    if any(k not in traj for k in need) or len(traj["x"]) == 0:
+        return None
+    b = np.arctan2(traj["target_y"] - traj["y"], traj["target_x"] - traj["x"]) - traj["heading"]
+    b = np.degrees((b + np.pi) % (2 * np.pi) - np.pi)
+    best, last, crossed = 0.0, 0.0, False
+    for bk, seen in zip(b, ~np.isnan(np.asarray(traj["target_column"], dtype=float))):
+        if not seen:
+            last, crossed = 0.0, False
+            continue
+        sign = np.sign(bk)
+        if sign == 0:
+            continue
+        crossed = crossed or (last != 0 and sign != last)
+        if crossed:
+            best = max(best, abs(float(bk)))
+        last = sign
+    return _round(best, 2)
+
+
+def _off_target(traj, width):
+    """How far the design's centroid is from the target's image column (``target_column``),
+    over the frames in which it reports found and the target's centre is in view: the
+    fraction of them with an error above ``OFF_TARGET_FRACTION * width``, and the mean error
+    (pixels). None without such frames or fields."""
+    none = {"off_target_fraction": None, "mean_centroid_error_px": None}
+    if width is None or "target_column" not in traj or "centroid_x" not in traj:
+        return none
+    column = np.asarray(traj["target_column"], dtype=float)
+    ok = traj["found"] & ~np.isnan(column)
+    if not ok.any():
+        return none
+    err = np.abs(np.asarray(traj["centroid_x"], dtype=float)[ok] - column[ok])
+    return {"off_target_fraction": _round((err > OFF_TARGET_FRACTION * width).mean()),
+            "mean_centroid_error_px": _round(err.mean(), 2)}
+
+
+def _max_command_step(traj):
+    """The largest change of a wheel's command from one frame to the next, DPS."""
+    if "motor_left" not in traj or len(traj["motor_left"]) < 2:
+        return None
+    steps = [np.abs(np.diff(np.asarray(traj[k], dtype=float))).max()
+             for k in ("motor_left", "motor_right")]
+    return int(max(steps))
+
+
+def _oscillation(traj, width, seconds):
+    """Sign changes of the commanded turn rate W per second while the design reports the
+    target found within ``CENTRED_FRACTION`` of the image width from the centre: a steering
+    that swings left-right-left around a centred target. Frames with W = 0 (straight ahead)
+    keep the last sign, so left-straight-right counts once; a frame off-centre starts the
+    count afresh. Per second of centred time; None if the target was never centred, or
+    without the fields."""
+    if width is None or "cmd_w" not in traj or "centroid_x" not in traj or seconds <= 0:
+        return None
+    w = np.asarray(traj["cmd_w"], dtype=float)
+    centred = traj["found"] & (np.abs(np.asarray(traj["centroid_x"]) - width / 2)
+                               <= CENTRED_FRACTION * width)
+    if not centred.any():
+        return None
+    flips, last = 0, 0.0
+    for wk, ck in zip(np.sign(w), centred):
+        if not ck:
+            last = 0.0
+        elif wk != 0:
+            flips += bool(last * wk < 0)
+            last = wk
+    return _round(flips / (seconds * centred.mean()))
 
 
 def _check(name, passed, value, limit, text):
@@ -136,6 +259,38 @@ def evaluate_checks(checks, m):
             ok = v is not None and v >= limit
             text = (f"min distance {v} m (limit >= {limit} m)" if v is not None
                     else f"{_NO_TARGET} (limit >= {limit} m)")
+        elif name == "max_robot_at_fault_collisions":
+            v = m["robot_at_fault_collisions"]
+            ok = v <= limit
+            text = f"the robot drove into a person {v} time(s) (limit {limit})"
+        elif name == "max_tip_overs":
+            v = m["tip_overs"]
+            ok = v <= limit
+            text = ("the robot never tipped over" if v == 0
+                    else f"the robot tipped over at {m['tipped_over_at_s']:.2f} s (limit {limit})")
+        elif name == "max_oscillation_hz":
+            v = m["oscillation_hz"]
+            ok = v is None or v <= limit
+            text = ("the target was never centred" if v is None
+                    else f"W changes sign {v:.2f} times per second with the target centred "
+                         f"(limit {limit})")
+        elif name == "max_off_target_fraction":
+            v = m["off_target_fraction"]
+            ok = v is None or v <= limit
+            text = ("the design never reported the target found with it in view" if v is None
+                    else f"centroid away from the target in {v:.0%} of the frames with the "
+                         f"target found and in view (limit <= {limit:.0%})")
+        elif name == "mean_centroid_error_max_px":
+            v = m["mean_centroid_error_px"]
+            ok = v is not None and v <= limit
+            text = ("the design never reported the target found with it in view" if v is None
+                    else f"centroid {v:.2f} px from the target's image column on average "
+                         f"(limit <= {limit} px)")
+        elif name == "max_heading_overshoot_deg":
+            v = m["heading_overshoot_deg"]
+            ok = v is not None and v <= limit
+            text = ("no heading to compare" if v is None
+                    else f"turned {v:.1f} deg past the target (limit <= {limit} deg)")
         elif name.startswith("max_") and name.endswith("_collisions"):
             kind = name[len("max_"): -len("_collisions")]
             v = int(m["collisions"].get(kind, 0))

@@ -260,6 +260,16 @@ _DIVIDER_WHY = (
     "wood and loses the person from view between 10 and 15 s, which is the failure the page "
     "means; a run of 10 s or less fails only the mean-distance check, as the default design does")
 
+_APPROACH_WHY = (
+    "the scenario's own 30 s (about a second of wall time): with the early thresholds the "
+    "robot reaches the standing person at 26.7 s; the page's default run must stop short over "
+    "the same time")
+
+_ERRATIC_WHY = (
+    "the scenario's own 30 s (about a second of wall time): the robot tips at 1.47 s and the "
+    "oscillation the page quotes is over the whole run; a 1 s run of the default design fails "
+    "its mean-distance check")
+
 PLANS = {
     # README: two commands on a fresh machine ------------------------------------------------
     "python3 -m venv .venv && . .venv/bin/activate && pip install -e . && python -m fpga_robotics.run":
@@ -285,7 +295,8 @@ PLANS = {
         Plan(out=(PASS, r"target: first found at 0\.00 s, in view 100%, found 100%")),
     "python -m fpga_robotics.run --scenario divider --set design.diff_min=5 --rerun off":
         Plan(duration="keep", duration_why=_DIVIDER_WHY,
-             out=(r"\[FAIL\] target_in_view_min_fraction",)),
+             out=(r"\[FAIL\] target_in_view_min_fraction",
+                  r"\[FAIL\] max_off_target_fraction: centroid away from the target in 67%")),
     "python -m fpga_robotics.run --scenario divider --shadow diff_min=5 --rerun off":
         Plan(duration="keep",
              duration_why="the page says the default design passes: over the whole scenario "
@@ -322,6 +333,41 @@ PLANS = {
     "python -m fpga_robotics.run --scenario lost_target --rerun off":
         Plan(duration="keep", duration_why="as for the same command with --summary",
              out=(PASS,)),
+    # docs/stories.md -------------------------------------------------------------------------
+    "python -m pytest -q -m stories tests/test_story_*.py":
+        Plan(collect=True, out=(r"test_story_b_early_thresholds_drive_into_the_person",
+                                r"test_story_c_an_unstable_gain_tips_the_gopigo3",
+                                r"\(\d+ deselected\)"),
+             not_out=(r"test_the_check_reads_the_at_fault_count",)),
+    "python -m fpga_robotics.run --scenario approach --rerun off --set robot.heading_deg=20 "
+    "--set checks.max_heading_overshoot_deg=5":
+        Plan(duration="keep",
+             duration_why="the page says the default gain never turns past the person: over the "
+                           "whole 30 s run (about a second of wall time); in 1 s the robot has "
+                           "not finished its turn, so 0 degrees there would prove nothing",
+             out=(PASS, r"\[ok\] max_heading_overshoot_deg: turned 0\.0 deg")),
+    "python -m fpga_robotics.run --scenario approach --rerun off --set robot.heading_deg=20 "
+    "--set checks.max_heading_overshoot_deg=5 --set design.kp_num=16":
+        Plan(out=(r"\[FAIL\] max_heading_overshoot_deg: turned 11\.0 deg past the target",)),
+    "python -m fpga_robotics.run --scenario divider --rerun off":
+        Plan(duration="keep",
+             duration_why="the page says the default design passes: over the whole scenario "
+                           "(25 s); a run under 15 s fails its mean-distance check",
+             out=(PASS, r"\[ok\] max_off_target_fraction: centroid away from the target in 0%")),
+    "python -m fpga_robotics.run --scenario approach --rerun off":
+        Plan(duration="keep", duration_why=_APPROACH_WHY,
+             out=(PASS, r"\[ok\] max_robot_at_fault_collisions")),
+    'python -m fpga_robotics.run --scenario approach --rerun off --set '
+    '"design.proximity_thresholds=[128,256,512,1024,2048,19000,19100]"':
+        Plan(duration="keep", duration_why=_APPROACH_WHY,
+             out=(r"\[FAIL\] max_person_collisions", r"\[FAIL\] max_robot_at_fault_collisions")),
+    "python -m fpga_robotics.run --scenario erratic --rerun off":
+        Plan(duration="keep", duration_why=_ERRATIC_WHY, out=(PASS, r"\[ok\] max_tip_overs")),
+    "python -m fpga_robotics.run --scenario erratic --rerun off --set design.kp_num=32":
+        Plan(duration="keep", duration_why=_ERRATIC_WHY, out=(r"\[FAIL\] max_tip_overs: the robot tipped over at 1\.47 s",)),
+    "python -m fpga_robotics.run --scenario erratic --rerun off --set design.preset=published":
+        Plan(duration="keep", duration_why=_ERRATIC_WHY,
+             out=(r"\[FAIL\] max_oscillation_hz: W changes sign 4\.87 times",)),
     "python -m fpga_robotics.run --scenario divider --set design.diff_min=5":
         Plan(duration="keep", duration_why=_DIVIDER_WHY,
              out=(r"\[FAIL\] target_in_view_min_fraction",)),

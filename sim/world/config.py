@@ -305,6 +305,14 @@ def _parse_robot(section, room):
         gt=0, le=1e5, unit="N m")
     fields["camera_tilt"] = t.number("camera_tilt_deg", base.camera_tilt / DEG,
                                      ge=-85, le=85) * DEG
+    for key, bounds in (
+        ("com_height", {"gt": 0, "le": 5, "unit": "m"}),
+        ("support_half_length", {"gt": 0, "le": 5, "unit": "m"}),
+    ):
+        fields[key] = t.number(key, getattr(base, key), **bounds)
+    # None (the presets' value): commands are ramped, a jump never tips the robot.
+    fields["motor_step_response"] = t.number("motor_step_response", base.motor_step_response,
+                                             gt=0, le=10, unit="s")
     t.finish()
     if not fields["camera_height"] < room.height:
         # The renderer draws from between the floor and the ceiling only.

@@ -10,7 +10,10 @@ from dataclasses import dataclass, replace
 
 from .kinematics import DEG
 
-__all__ = ["GOPIGO3", "ROBOT_MODELS", "TURTLEBOT2", "RobotSpec", "robot_model"]
+#: Standard gravity, m/s^2.
+G = 9.80665
+
+__all__ = ["G", "GOPIGO3", "ROBOT_MODELS", "TURTLEBOT2", "RobotSpec", "robot_model"]
 
 
 @dataclass(frozen=True)
@@ -45,6 +48,20 @@ class RobotSpec:
         Camera position ahead of the robot's centre, m.
     camera_tilt : float
         Camera pitch, rad, positive looks up.
+    com_height : float
+        Height of the centre of mass above the floor, m (tip-over model).
+    support_half_length : float
+        Horizontal distance from the centre of mass to the nearest edge of the support
+        polygon along the direction of travel (the wheel axle or a caster's contact), m.
+    motor_step_response : float or None
+        None (the presets): the motor controller ramps every command at ``wheel_accel_dps2``,
+        so a jump of the command never tips the robot. A number: the motors follow a jump of
+        the command within this time, s (a controller without a ramp): a jump of D DPS asks
+        the body for ``wheel_radius * D * DEG / motor_step_response`` m/s^2.
+
+    The robot tips over (quasi-statically) when its longitudinal acceleration exceeds
+    ``tip_accel = g * support_half_length / com_height``: the inertial force at the centre of
+    mass then has a larger moment about the support edge than the weight.
     """
 
     name: str
@@ -59,6 +76,22 @@ class RobotSpec:
     camera_height: float
     camera_forward: float
     camera_tilt: float = 0.0
+    com_height: float = 0.2
+    support_half_length: float = 0.1
+    motor_step_response: float | None = None
+
+    @property
+    def tip_accel(self):
+        """Longitudinal acceleration that tips the robot over, m/s^2 (quasi-static)."""
+        return G * self.support_half_length / self.com_height
+
+    @property
+    def tip_step_dps(self):
+        """The largest jump of a wheel's command (DPS) the robot survives: the jump whose
+        step response asks for ``tip_accel``; None without ``motor_step_response``."""
+        if self.motor_step_response is None:
+            return None
+        return self.tip_accel * self.motor_step_response / (self.wheel_radius * DEG)
 
     @property
     def max_speed(self):
@@ -101,6 +134,12 @@ TURTLEBOT2 = RobotSpec(
     traction_torque=_turning_torque(12.6, 0.230),
     camera_height=0.30,
     camera_forward=0.10,
+    # Tip-over: the Kobuki base (Kobuki user guide: 351.5 mm diameter, 124 mm high, 2.35 kg)
+    # rests on its two wheels on the centre line and two casters about 0.12 m ahead and
+    # behind; the TurtleBot2's plates and sensor (to 420 mm) raise the centre of mass to an
+    # estimated 0.20 m. tip_accel = 9.81 * 0.12 / 0.20 = 5.9 m/s^2.
+    com_height=0.20,
+    support_half_length=0.12,
 )
 
 # GoPiGo3: wheel diameter 66.5 mm, wheel base 117 mm, about 0.8 kg with batteries. The
@@ -118,6 +157,15 @@ GOPIGO3 = RobotSpec(
     traction_torque=round(_turning_torque(2 * 0.8 * _GPG3_ACCEL, 0.117), 4),
     camera_height=0.12,
     camera_forward=0.08,
+    # Tip-over: the GoPiGo3 (Dexter Industries: about 200 x 150 x 110 mm without sensors) rests
+    # on its two wheels at the front and one ball caster at the back; its battery pack puts the
+    # centre of mass just behind the axle, an estimated 0.04 m, at an estimated 0.07 m above the
+    # floor: braking (or reversing hard) pitches it forward over the axle at
+    # tip_accel = 9.81 * 0.04 / 0.07 = 5.6 m/s^2. The same forward edge is used in both
+    # directions (the model is symmetric). These are estimates from the published size, not
+    # measurements. A scenario may set robot.motor_step_response (docs/stories.md, story c).
+    com_height=0.07,
+    support_half_length=0.04,
 )
 
 ROBOT_MODELS = {spec.name: spec for spec in (TURTLEBOT2, GOPIGO3)}

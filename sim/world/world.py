@@ -23,10 +23,15 @@ from .motors import DriveMotors
 from .people import PersonPath, person_bands
 from .room import add_static_shapes, map_data, scene_walls
 
-__all__ = ["MAX_SUBSTEP", "World"]
+__all__ = ["AT_FAULT_SPEED", "MAX_SUBSTEP", "World"]
 
 #: ``step(dt)`` splits longer steps into equal sub-steps no longer than this, s.
 MAX_SUBSTEP = 0.01
+
+#: A contact with a person is the robot's fault when, at the first touch, the robot moves
+#: towards the person faster than this (m/s): its velocity projected on the direction from
+#: its centre to the person's. A person walking into a standing or retreating robot is not.
+AT_FAULT_SPEED = 0.02
 
 _ROBOT, _WALL, _FURNITURE, _PERSON = 1, 2, 3, 4
 _KINDS = ("person", "wall", "furniture")
@@ -132,6 +137,10 @@ class World:
             raise WorldConfigError(f"robot.start [{x:g}, {y:g}] overlaps the {what}")
 
         self._counts = dict.fromkeys(_KINDS, 0)
+        self._at_fault = 0
+        #: ``(time_s, reason)`` once the robot has tipped over, else None.
+        self.tipped = None
+        self._motor_v = 0.0  # the wheels' forward speed at the last sub-step, m/s
         self._events = []
         for ctype in (_WALL, _FURNITURE, _PERSON):
             space.on_collision(_ROBOT, ctype, begin=self._on_begin)
@@ -148,9 +157,24 @@ class World:
     # -- physics ------------------------------------------------------------------------
 
     def _on_begin(self, arbiter, space, data):
-        kind, name = self._names[arbiter.shapes[1]]
+        other = arbiter.shapes[1]
+        kind, name = self._names[other]
         self._counts[kind] += 1
         self._events.append(f"collision with {kind} {name!r}" if name else f"collision with {kind}")
+        if kind == "person":
+            if self._closing_speed(other.body) > AT_FAULT_SPEED:
+                self._at_fault += 1
+
+    def _closing_speed(self, person_body):
+        """The robot's speed towards the person (m/s): its velocity (before the contact
+        resolves) projected on the unit vector from its centre to the person's."""
+        rx, ry = self.robot_body.position
+        px, py = person_body.position
+        d = math.hypot(px - rx, py - ry)
+        if d == 0.0:
+            return 0.0
+        vx, vy = self.robot_body.velocity
+        return (vx * (px - rx) + vy * (py - ry)) / d
 
     def step(self, dt):
         """Advance the world by ``dt`` seconds (split into sub-steps of at most
@@ -167,6 +191,13 @@ class World:
         wl, wr = self.motors.step(h)
         r = spec.wheel_radius
         v = r * (wl + wr) * 0.5
+        if self.tipped is None:
+            # The body follows the wheels at most at traction_force / mass.
+            accel = min(abs(v - self._motor_v) / h, spec.traction_force / spec.mass)
+            if accel > spec.tip_accel:
+                self._tip(f"longitudinal acceleration {accel:.2f} m/s^2 > "
+                          f"{spec.tip_accel:.2f} m/s^2")
+        self._motor_v = v
         w = r * (wr - wl) / spec.wheel_separation
         body = self.robot_body
         a = body.angle
@@ -200,8 +231,26 @@ class World:
     # -- motors -------------------------------------------------------------------------
 
     def set_wheel_dps(self, left_dps, right_dps):
-        """Wheel speed targets in degrees per second (the design's SET_MOTOR_DPS values)."""
+        """Wheel speed targets in degrees per second (the design's SET_MOTOR_DPS values).
+        A jump of either wheel's command beyond ``robot_spec.tip_step_dps`` (when the spec
+        has a ``motor_step_response``) tips the robot over; a tipped robot's wheels stay
+        still."""
+        if self.tipped is not None:
+            return
+        old_l, old_r = self.motors.command_dps
+        jump = max(abs(left_dps - old_l), abs(right_dps - old_r))
+        limit = self.robot_spec.tip_step_dps
+        if limit is not None and jump > limit:
+            self._tip(f"wheel command jumped {jump:g} DPS > {limit:.0f} DPS")
+            return
         self.motors.set_wheel_dps(left_dps, right_dps)
+
+    def _tip(self, reason):
+        """The robot falls: its wheels stop (the body is braked by the drive's traction)."""
+        self.tipped = (self.time, reason)
+        self._events.append(f"tipped over: {reason}")
+        self.motors.set_wheel_dps(0.0, 0.0)
+        self.motors.left.speed = self.motors.right.speed = 0.0
 
     def commanded_twist(self):
         """``(v, w)`` of the current DPS command by the real kinematics."""
@@ -280,3 +329,7 @@ class World:
     def collision_counts(self):
         """Robot collisions since the start, per kind: ``{"person", "wall", "furniture"}``."""
         return dict(self._counts)
+
+    def at_fault_collisions(self):
+        """Collisions with a person that were the robot's fault (``AT_FAULT_SPEED``)."""
+        return self._at_fault

@@ -1,0 +1,182 @@
+"""Story (c) of the paper (docs/stories.md): an unstable controller's erratic motor commands
+make the robot fall. The world's tip-over model (quasi-static: the robot tips when its
+longitudinal acceleration exceeds ``g * support_half_length / com_height``), the metrics
+(oscillation, largest wheel-command step) and the ``erratic`` scenario."""
+
+import math
+
+import numpy as np
+import pytest
+
+from fpga_robotics.loop import run_scenario
+from fpga_robotics.scenario import load_scenario
+from fpga_robotics.sim.backends import available_backends
+from fpga_robotics.sim.world import GOPIGO3, TURTLEBOT2, World
+from fpga_robotics.summary import compute_metrics, evaluate_checks
+
+DT = 1 / 240
+DEG = math.pi / 180
+
+
+def _run(world, seconds):
+    for _ in range(round(seconds / DT)):
+        world.step(DT)
+
+
+def test_tip_accelerations_of_the_presets():
+    assert TURTLEBOT2.tip_accel == pytest.approx(9.80665 * 0.12 / 0.20)  # 5.88 m/s^2
+    assert GOPIGO3.tip_accel == pytest.approx(9.80665 * 0.04 / 0.07)  # 5.60 m/s^2
+    # The presets ramp their commands: no jump tips them.
+    assert TURTLEBOT2.tip_step_dps is None and GOPIGO3.tip_step_dps is None
+
+
+@pytest.mark.parametrize("accel_dps2, tips", [
+    (9000, False),   # 0.035 m * 9000 deg/s^2 = 5.50 m/s^2 < 5.88
+    (12000, True),   # 7.33 m/s^2 > 5.88
+])
+def test_a_steep_motor_ramp_tips_the_turtlebot(accel_dps2, tips):
+    assert (0.035 * accel_dps2 * DEG > TURTLEBOT2.tip_accel) == tips
+    # Traction (100 N / 6.3 kg = 15.9 m/s^2) does not limit the ramp.
+    world = World.from_config({"robot": {"start": [1.0, 3.0], "wheel_accel_dps2": accel_dps2,
+                                         "traction_force": 100.0}, "people": []}, 0)
+    world.set_wheel_dps(600, 600)
+    _run(world, 0.5)
+    events = world.drain_events()
+    if tips:
+        assert world.tipped is not None and world.tipped[0] == pytest.approx(0.0)
+        assert events == ["tipped over: longitudinal acceleration 7.33 m/s^2 > 5.88 m/s^2"]
+        assert world.robot_velocity()[0] == pytest.approx(0.0, abs=1e-6)  # it lies still
+    else:
+        assert world.tipped is None and events == []
+        assert world.robot_velocity()[0] == pytest.approx(0.035 * 600 * DEG)
+
+
+def test_traction_limits_the_acceleration_that_tips():
+    # The ramp asks 7.33 m/s^2, but 30 N / 6.3 kg = 4.76 m/s^2 is all the wheels can push.
+    world = World.from_config({"robot": {"start": [1.0, 3.0], "wheel_accel_dps2": 12000,
+                                         "traction_force": 30.0}, "people": []}, 0)
+    world.set_wheel_dps(600, 600)
+    _run(world, 0.5)
+    assert world.tipped is None
+
+
+def _gopigo(step_response=0.05):
+    return World.from_config({"robot": {"model": "gopigo3", "start": [1.0, 3.0],
+                                        "motor_step_response": step_response},
+                              "people": []}, 0)
+
+
+def test_a_jump_of_the_command_beyond_the_step_limit_tips_the_gopigo3():
+    # 5.6038 m/s^2 * 0.05 s / 0.03325 m = 8.43 rad/s = 482.8 DPS.
+    world = _gopigo()
+    limit = world.robot_spec.tip_step_dps
+    assert limit == pytest.approx(GOPIGO3.tip_accel * 0.05 / (0.03325 * DEG))
+    assert 482 < limit < 483
+    world.set_wheel_dps(300, 300)
+    _run(world, 1.0)
+    world.set_wheel_dps(-180, -180)  # a jump of 480 DPS: survives
+    _run(world, 1.0)
+    assert world.tipped is None
+    world.set_wheel_dps(300, 310)  # 490 DPS on the right wheel: falls
+    assert world.tipped is not None
+    assert world.drain_events() == ["tipped over: wheel command jumped 490 DPS > 483 DPS"]
+    world.set_wheel_dps(300, 300)  # ignored: it lies on its side
+    _run(world, 1.0)
+    assert world.wheel_speeds() == (0.0, 0.0)
+    assert world.robot_velocity()[0] == pytest.approx(0.0, abs=1e-6)
+
+
+def _traj(cmd_w, centroid_x, found=None):
+    n = len(cmd_w)
+    return {"t": np.arange(n) / 30, "x": np.zeros(n), "y": np.zeros(n),
+            "found": np.ones(n, bool) if found is None else np.asarray(found),
+            "target_distance": np.ones(n), "target_in_view": np.ones(n, bool),
+            "cmd_w": np.asarray(cmd_w, float), "centroid_x": np.asarray(centroid_x),
+            "motor_left": np.array([0, 100, -50, -50] + [0] * (n - 4)),
+            "motor_right": np.array([0, 120, 0, 0] + [0] * (n - 4))}
+
+
+def test_oscillation_counts_sign_changes_of_w_while_centred():
+    # 30 frames (1 s) at 30 fps, all centred (80 +- 20 of 160 px): W flips at 6 places
+    # (-1, 0, 0, 1 is one flip: straight ahead keeps the last sign).
+    w = [1, -1, 1, -1, 0, 0, 1, 1, -1, -1, 1] + [1] * 19
+    m = compute_metrics(_traj(w, [80] * 30), [], {}, 1 / 30, width=160)
+    assert m["oscillation_hz"] == pytest.approx(6.0)
+    # Frames off-centre (centroid 10 px, the first 4) neither count nor add time: from frame
+    # 4 on the signs are 0, 0, 1, 1, -1, -1, 1, ...: 2 flips in 26 frames (26/30 s).
+    m = compute_metrics(_traj(w, [10] * 4 + [80] * 26), [], {}, 1 / 30, width=160)
+    assert m["oscillation_hz"] == pytest.approx(round(2 / (26 / 30), 4))
+    assert m["max_wheel_command_step_dps"] == 150  # left 100 -> -50
+    (c,) = evaluate_checks({"max_oscillation_hz": 1.0}, m)
+    assert not c["passed"] and "2.31 times per second" in c["text"]
+    # Never centred: no value, and the check passes.
+    m = compute_metrics(_traj(w, [10] * 30), [], {}, 1 / 30, width=160)
+    assert m["oscillation_hz"] is None
+    assert evaluate_checks({"max_oscillation_hz": 1.0}, m)[0]["passed"]
+
+
+def test_tip_over_check_reads_the_event():
+    events = [(44, 1.466667, "tipped over: wheel command jumped 502 DPS > 483 DPS")]
+    m = compute_metrics(_traj([0] * 30, [80] * 30), events, {}, 1 / 30, width=160)
+    assert m["tip_overs"] == 1 and m["tipped_over_at_s"] == pytest.approx(1.4667)
+    (c,) = evaluate_checks({"max_tip_overs": 0}, m)
+    assert not c["passed"] and c["text"] == "the robot tipped over at 1.47 s (limit 0)"
+
+
+def _failed(r):
+    return {c["name"] for c in r.summary["checks"] if not c["passed"]}
+
+
+CXXRTL = pytest.mark.skipif("cxxrtl" not in available_backends(), reason="no C++ compiler")
+
+
+@pytest.mark.stories
+@CXXRTL
+def test_story_c_an_unstable_gain_tips_the_gopigo3():
+    r = run_scenario(load_scenario("erratic", ["design.kp_num=32"]), backend="cxxrtl")
+    assert "max_tip_overs" in _failed(r)
+    assert r.summary["tipped_over_at_s"] == pytest.approx(1.4667)
+    assert r.summary["max_wheel_command_step_dps"] > GOPIGO3.tip_accel * 0.05 / (0.03325 * DEG)
+
+
+@pytest.mark.stories
+@CXXRTL
+def test_story_c_the_published_table_oscillates():
+    r = run_scenario(load_scenario("erratic", ["design.preset=published"]), backend="cxxrtl")
+    assert _failed(r) == {"max_oscillation_hz"}
+    assert r.summary["oscillation_hz"] > 4.0
+
+
+@pytest.mark.stories
+@CXXRTL
+def test_story_c_the_default_design_stays_upright_and_steady():
+    r = run_scenario(load_scenario("erratic"), backend="cxxrtl")
+    assert r.summary["verdict"] == "pass", _failed(r)
+    assert r.summary["tipped_over_at_s"] is None and r.summary["oscillation_hz"] < 1.0
+
+
+def test_heading_overshoot_is_the_far_side_error_after_the_first_crossing():
+    # Robot at the origin, target at (1, 0): bearing error = -heading. Headings (deg):
+    # -20, -5, 4 (crossed: 4), 7 (7), 2, -1 (crossed back: 1), out of view, 3 (afresh: 0).
+    headings = np.radians([-20, -5, 4, 7, 2, -1, 30, 3])
+    n = len(headings)
+    column = np.where(np.arange(n) == 6, np.nan, 80.0)
+    traj = {"t": np.arange(n) / 30, "x": np.zeros(n), "y": np.zeros(n), "heading": headings,
+            "found": np.ones(n, bool), "target_x": np.ones(n), "target_y": np.zeros(n),
+            "target_distance": np.ones(n), "target_in_view": np.ones(n, bool),
+            "target_column": column}
+    m = compute_metrics(traj, [], {}, 1 / 30)
+    assert m["heading_overshoot_deg"] == pytest.approx(7.0)
+    (c,) = evaluate_checks({"max_heading_overshoot_deg": 5.0}, m)
+    assert not c["passed"] and c["text"] == "turned 7.0 deg past the target (limit <= 5.0 deg)"
+
+
+@pytest.mark.parametrize("overrides, overshoot", [
+    ([], (0.0, 0.0)),                       # the default gain turns onto the person
+    (["design.kp_num=16"], (8.0, 14.0)),    # a high gain swings past them
+])
+def test_turning_onto_a_standing_person(overrides, overshoot):
+    s = load_scenario("approach", ["robot.heading_deg=20", "sim.duration=10"] + overrides)
+    r = run_scenario(s, backend="model")
+    lo, hi = overshoot
+    assert lo <= r.summary["heading_overshoot_deg"] <= hi
