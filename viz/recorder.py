@@ -101,7 +101,10 @@ def _xy(x, y):
 
 
 def _event_level(text):
-    return rr.TextLogLevel.WARN if "collision" in text.lower() else rr.TextLogLevel.INFO
+    """Collisions and a tipped robot stand out in the event log (WARN); the rest is INFO."""
+    text = text.lower()
+    return (rr.TextLogLevel.WARN if "collision" in text or text.startswith("tipped over")
+            else rr.TextLogLevel.INFO)
 
 
 class Recorder:
