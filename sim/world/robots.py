@@ -13,7 +13,7 @@ from .kinematics import DEG
 #: Standard gravity, m/s^2.
 G = 9.80665
 
-__all__ = ["G", "GOPIGO3", "ROBOT_MODELS", "TURTLEBOT2", "RobotSpec", "robot_model"]
+__all__ = ["GOPIGO3", "ROBOT_MODELS", "TURTLEBOT2", "G", "RobotSpec", "robot_model"]
 
 
 @dataclass(frozen=True)
