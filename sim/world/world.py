@@ -161,9 +161,8 @@ class World:
         kind, name = self._names[other]
         self._counts[kind] += 1
         self._events.append(f"collision with {kind} {name!r}" if name else f"collision with {kind}")
-        if kind == "person":
-            if self._closing_speed(other.body) > AT_FAULT_SPEED:
-                self._at_fault += 1
+        if kind == "person" and self._closing_speed(other.body) > AT_FAULT_SPEED:
+            self._at_fault += 1
 
     def _closing_speed(self, person_body):
         """The robot's speed towards the person (m/s): its velocity (before the contact
