@@ -49,6 +49,8 @@ def add_param_arguments(parser):
 
 
 def _default_text(f):
+    if f.name == "sx_bits":
+        return "the full width, wide enough for any frame"
     if f.default is None:
         return "derived from the geometry"
     return str(f.default)

@@ -127,6 +127,11 @@ class FollowTargetParams:
     #: code counts as ``centred_search_side``.
     search_side_from: str = "centroid"
     centred_search_side: str = "right"
+    #: Width of the column-sum register ``SX`` (``None``: ``full_sum_x_bits``, wide enough for
+    #: any frame). A narrower ``SX`` wraps (``SX mod 2**sx_bits``) in the gateware and the
+    #: model alike, and the centroid ``SX // N`` comes out off-centre: the paper's story (d),
+    #: a signal with too narrow a bit range (docs/stories.md). Only for showing that bug.
+    sx_bits: int | None = None
 
     # Derived, filled in by __post_init__.
     area_scale: int = field(init=False)
@@ -229,6 +234,8 @@ class FollowTargetParams:
         for name in CHOICES:
             self._check_choice(name)
         self._check("group_column_offset", 0, 1)
+        if self.sx_bits is not None:
+            self._check("sx_bits", 1, self.full_sum_x_bits)
         if len(self.steer_dps) != 4:
             raise ValueError(
                 f"steer_dps needs 4 values (LED distance 0..3 from the centre), got "
@@ -287,9 +294,17 @@ class FollowTargetParams:
         return max(1, self.window_pixels.bit_length())
 
     @property
-    def sum_x_bits(self):
-        """Bits of ``SX``, the sum of the column index of every counted pixel."""
+    def full_sum_x_bits(self):
+        """Bits ``SX`` needs to hold the sum of the column index of every pixel of a window
+        that matches everywhere: its width unless ``sx_bits`` narrows it."""
         return max(1, (self.window_pixels * (self.width - 1)).bit_length())
+
+    @property
+    def sum_x_bits(self):
+        """Bits of ``SX``, the sum of the column index of every counted pixel:
+        ``full_sum_x_bits``, or ``sx_bits`` when given (then ``SX`` wraps modulo
+        ``2**sx_bits``)."""
+        return self.full_sum_x_bits if self.sx_bits is None else self.sx_bits
 
     # Latencies of the gateware, in clock cycles (see docs/hardware.md) ------------------------
 

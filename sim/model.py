@@ -135,7 +135,8 @@ class TrackerResult:
     bins
         ``(h0, ..., h7)``: matching pixels per bin of window columns, left to right.
     sum_x
-        ``SX``: sum of the frame column index of every counted pixel.
+        ``SX``: sum of the frame column index of every counted pixel, modulo
+        ``2**params.sx_bits`` when ``sx_bits`` narrows it.
     """
 
     found: bool
@@ -212,6 +213,8 @@ def track_frame(match, params):
         groups = tuple(int(v) for v in shifted.reshape(8, params.bin_width).sum(axis=1))
     count = sum(bins)
     sum_x = int(columns @ np.arange(mx, params.width - mx))
+    if params.sx_bits is not None:  # a too-narrow SX register wraps (docs/stories.md, (d))
+        sum_x %= 1 << params.sx_bits
     found = is_found(count, params)
     return TrackerResult(
         found=found,

@@ -379,3 +379,24 @@ def test_group_column_offset_random_masks_match_the_model(changes):
     schedule = frames_schedule(masks)
     _, results = run_tracker(p, schedule)
     assert [r for _, r in results] == [track_frame(m, p) for m in masks]
+
+
+@pytest.mark.parametrize("sx_bits", [3, 9, 12])
+def test_a_narrow_sx_wraps_as_in_the_model(sx_bits):
+    # small_params: SX needs 15 bits at most (400 window pixels, columns up to 47). A narrower
+    # register wraps SX modulo 2**sx_bits, the centroid is the wrapped SX // N, as in the model
+    # (3 bits: narrower than the divider's quotient).
+    p = small_params(sx_bits=sx_bits)
+    assert p.full_sum_x_bits == 15 and p.sum_x_bits == sx_bits
+    rng = np.random.default_rng(sx_bits)
+    masks = [random_mask(p, rng, d) for d in (0.05, 0.3, 1.0)]
+    masks.append(window_columns_mask(p, range(30, 36)))  # a blob right of the centre
+    _, results = run_tracker(p, frames_schedule(masks))
+    full = small_params()
+    expected = [track_frame(m, p) for m in masks]
+    assert [r for _, r in results] == expected
+    for m, r in zip(masks, expected, strict=True):
+        assert r.sum_x == track_frame(m, full).sum_x % (1 << sx_bits)
+    # The stimulus makes SX wrap, and the centroid move, in some frames.
+    assert any(r.centroid_x != track_frame(m, full).centroid_x
+               for m, r in zip(masks, expected, strict=True))

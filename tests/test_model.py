@@ -1,5 +1,7 @@
 """Golden model against independent expectations: scalar formulas, loops, hand-computed values."""
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -508,3 +510,23 @@ def test_table_law_drives_on_while_lost_and_remembers_the_leds():
     assert m.step(lost) == (-250, 250)  # the 15th: search left (the LEDs' side)
     m.reset()
     assert (m.left, m.right, m.last_leds, m.last_side) == (0, 0, 0, "left")
+
+
+def test_a_narrow_sx_wraps_and_moves_the_centroid_off_centre():
+    # Story (d) (docs/stories.md): a person centred on column 80, columns 60..99 over rows
+    # 30..79, at 160x120. N = 40 * 50 = 2000; SX = 50 * (60 + ... + 99) = 50 * 3180 = 159000,
+    # the centroid 159000 // 2000 = 79. In 17 bits SX wraps at 131072: 159000 - 131072 = 27928,
+    # the centroid 27928 // 2000 = 13.
+    match = np.zeros((120, 160), bool)
+    match[30:80, 60:100] = True
+    full = track_frame(match, FollowTargetParams())
+    assert (full.count, full.sum_x, full.centroid_x) == (2000, 159000, 79)
+    narrow = track_frame(match, FollowTargetParams(sx_bits=17))
+    assert (narrow.count, narrow.sum_x, narrow.centroid_x) == (2000, 27928, 13)
+    # Only SX and the centroid change: N, the bins, found, proximity and the LEDs do not.
+    assert narrow == replace(full, sum_x=27928, centroid_x=13)
+    # 18 bits hold 159000 (< 262144): no wrap; 16 bits wrap it twice: 159000 - 2 * 65536 = 27928.
+    assert track_frame(match, FollowTargetParams(sx_bits=18)) == full
+    assert track_frame(match, FollowTargetParams(sx_bits=16)).sum_x == 27928
+    # 12 bits: 159000 = 38 * 4096 + 3352; 3352 // 2000 = 1.
+    assert track_frame(match, FollowTargetParams(sx_bits=12)).centroid_x == 1

@@ -71,6 +71,8 @@ def test_replace_recomputes_geometry_defaults_but_keeps_explicit_values():
         ({"lost_motion": "drive"}, "lost_motion='drive' needs motor_law='table'"),
         ({"search_side_from": "led"}, "search_side_from must be one of centroid, leds"),
         ({"centred_search_side": "centre"}, "centred_search_side must be one of right, left"),
+        ({"sx_bits": 0}, "sx_bits must be >= 1"),
+        ({"sx_bits": 23}, "sx_bits must be <= 22"),  # the full width at 160x120
     ],
 )
 def test_bad_values_raise_clear_errors(kwargs, message):
@@ -90,6 +92,8 @@ def test_wrong_types_raise_type_error():
         FollowTargetParams(found_rule=1)
     with pytest.raises(TypeError, match=r"steer_dps\[0\] must be an int"):
         FollowTargetParams(steer_dps=(1.5, 2, 3, 4))
+    with pytest.raises(TypeError, match="sx_bits must be an int"):
+        FollowTargetParams(sx_bits=17.0)
 
 
 def test_numpy_integers_are_accepted_and_stored_as_int():
@@ -114,3 +118,14 @@ def test_the_knobs_are_independent_of_the_motor_law_where_they_can_be():
 def test_replace_keeps_the_knobs():
     p = FollowTargetParams.published().replace(kp_num=2)
     assert p == FollowTargetParams.published(kp_num=2)
+
+
+def test_sx_bits_narrows_the_column_sum_and_defaults_to_the_full_width():
+    # SX of a window that matches everywhere: 128 * 104 pixels, columns up to 159 at 160x120.
+    p = FollowTargetParams()
+    assert p.sx_bits is None
+    assert p.sum_x_bits == p.full_sum_x_bits == (128 * 104 * 159).bit_length() == 22
+    assert FollowTargetParams(sx_bits=17).sum_x_bits == 17
+    assert FollowTargetParams(sx_bits=22) != p  # the same width, but an explicit value
+    assert FollowTargetParams(width=640, height=480).full_sum_x_bits == 28
+    assert FollowTargetParams(sx_bits=17).replace(kp_num=2).sx_bits == 17

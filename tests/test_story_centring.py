@@ -1,8 +1,8 @@
 """Story (d) of the paper (docs/stories.md): a centroid off-centre because a signal had too
 narrow a bit range. The centring check ``mean_centroid_error_max_px``: in ``approach`` the
 person stands on the robot's axis, so the design's centroid must be at the image centre.
-(The gateware knob that narrows the range is not there yet: the buggy side is shown on a
-hand-computed centroid.)"""
+Here the check on a hand-computed centroid; the gateware knob that narrows the range
+(``design.sx_bits``) and its run are in tests/test_story_narrow_centroid.py."""
 
 import numpy as np
 import pytest
