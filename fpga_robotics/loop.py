@@ -5,8 +5,9 @@ Timing. Physics advances in fixed steps of ``sim.physics_dt``. Frame ``k`` is ca
 rendered, the design processes it with the colour select in force, and its wheel command
 (DPS) takes effect ``sim.actuation_delay`` seconds later (rounded to a step), the previous
 command staying in force until then. A robot that tips over ends the run at the frame that
-reports it (``RunResult``, summary ``ended_early``). Everything is a function of the scenario and the seed:
-``run_scenario`` keeps no global state and can be called many times in one process.
+reports it (``RunResult``, summary ``ended_early``). Everything is a function of the scenario
+and the seed: ``run_scenario`` keeps no global state and can be called many times in one
+process.
 """
 
 import math
