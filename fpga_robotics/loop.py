@@ -4,8 +4,10 @@ Timing. Physics advances in fixed steps of ``sim.physics_dt``. Frame ``k`` is ca
 ``k / fps`` (rounded to the nearest physics step): the world's scene at that instant is
 rendered, the design processes it with the colour select in force, and its wheel command
 (DPS) takes effect ``sim.actuation_delay`` seconds later (rounded to a step), the previous
-command staying in force until then. Everything is a function of the scenario and the seed:
-``run_scenario`` keeps no global state and can be called many times in one process.
+command staying in force until then. A robot that tips over ends the run at the frame that
+reports it (``RunResult``, summary ``ended_early``). Everything is a function of the scenario
+and the seed: ``run_scenario`` keeps no global state and can be called many times in one
+process.
 """
 
 import math
@@ -42,6 +44,11 @@ class RunResult:
     trajectory : dict of numpy arrays
         ``TRAJECTORY_FIELDS``, one value per camera frame (NaN where there is no target).
     events : list of (frame, time_s, text)
+
+    A robot that tips over ends the run at the frame that reports it (``World.tipped``):
+    the trajectory holds the frames done, ``summary["frames"]`` counts them,
+    ``summary["sim_time_s"]`` is the time reached and ``summary["ended_early"]`` says why
+    (None for a run to its end).
     """
 
     summary: dict
@@ -127,6 +134,8 @@ class ClosedLoop:
         self.total_steps = max(1, round(sim.duration / self.dt))
         self.n_frames = frame_count(self.total_steps, self.period, self.dt)
         self.step = 0  # physics steps done
+        self.frames_done = 0
+        self.ended_early = None  # why the run stopped before its end (a tip-over), else None
         self.traj = _empty_trajectory(self.n_frames)
         self.events = []  # (frame, time_s, text)
         self.design_events = _DesignEvents(scenario.params.lost_frames)
@@ -242,16 +251,29 @@ class ClosedLoop:
         result = self.process(k, rgb)
         shadow_result, shadow_events = self.process_shadow(k, t, rgb, result)
         events += self.design_events.update(bool(result.found)) + shadow_events
+        # A command that acts at once (no actuation delay) may tip the robot: this frame's.
+        events += self.world.drain_events()
         distance, visible = self.measure(k, t, pose, result)
         self.events += [(k, round(t, 6), e) for e in events]
+        self.frames_done = k + 1
         if self.want_records:
             self.record(k, t, rgb, result, distance, visible, events, shadow_result)
 
+    def tipped_over(self):
+        """Whether the robot has tipped over; if so the run ends (``ended_early``)."""
+        if self.world.tipped is None:
+            return False
+        if self.ended_early is None:
+            self.ended_early = f"tipped over at {self.step * self.dt:.2f} s"
+        return True
+
     def finish_physics(self):
-        """Physics after the last frame, to the end of the run."""
-        self.advance_physics(self.total_steps)
+        """Physics after the last frame, to the end of the run or until the robot tips over
+        (then the time reached is the tip's step)."""
+        while self.step < self.total_steps and not self.tipped_over():
+            self.advance_physics(self.step + 1)
         tail = list(self.world.drain_events())
-        self.events += [(self.n_frames, round(self.step * self.dt, 6), e) for e in tail]
+        self.events += [(self.frames_done, round(self.step * self.dt, 6), e) for e in tail]
 
     # The whole run -------------------------------------------------------------------------
 
@@ -264,11 +286,16 @@ class ClosedLoop:
             self.run_frame(k)
             if progress is not None:
                 progress(k + 1, self.n_frames)
+            if self.tipped_over():  # the frame that reported it is the last
+                break
             if realtime:
                 ahead = (self.step * self.dt + self.period) - (time.perf_counter() - wall_start)
                 if ahead > 0:
                     time.sleep(ahead)
-        self.finish_physics()
+        if self.ended_early is None:
+            self.finish_physics()
+        else:  # the trajectory holds the frames done, every field alike
+            self.traj = {name: a[:self.frames_done] for name, a in self.traj.items()}
         wall = time.perf_counter() - wall_start
         cpu = time.process_time() - cpu_start
         return RunResult(summary=self.summarise(wall, cpu), trajectory=self.traj,
@@ -276,8 +303,8 @@ class ClosedLoop:
 
     def summarise(self, wall, cpu):
         scenario, cam, sim = self.scenario, self.scenario.camera, self.scenario.sim
-        n_frames, dt = self.n_frames, self.dt
-        sim_time = self.total_steps * dt
+        n_frames, dt = self.frames_done, self.dt
+        sim_time = self.step * dt  # the end of the run, or the tip-over that ended it
         metrics = compute_metrics(self.traj, self.events, self.world.collision_counts(),
                                   self.period,
                                   at_fault_collisions=self.world.at_fault_collisions(),
@@ -296,6 +323,7 @@ class ClosedLoop:
             "actuation_delay_s": sim.actuation_delay,
             "sim_time_s": round(sim_time, 6),
             "frames": n_frames,
+            "ended_early": self.ended_early,
             "wall_time_s": round(wall, 4),
             "ms_per_frame": round(1000.0 * wall / max(1, n_frames), 4),
             "realtime_factor": round(sim_time / wall, 3) if wall > 0 else None,

@@ -189,26 +189,39 @@ def _open_backend(name, params, quiet=False):
         raise UsageError(f"backend {name!r} cannot run here: {exc}") from None
 
 
-def _design_files(args):
-    """The Verilog files of ``--design`` (None without it); checks --design/--ports."""
-    if args.design is None:
+def _design_files(args, foreign=None):
+    """The Verilog files and port map of the foreign design (None without one): ``--design``
+    and ``--ports``, each overriding the scenario's ``[design] verilog`` / ``ports``
+    (``foreign``, a ``ForeignDesignFiles``); checks they go together."""
+    if args.design is None and foreign is None:
         if args.ports is not None:
             raise UsageError("--ports goes with --design verilog:FILE.v")
         return None
-    if not args.design.startswith("verilog:") or not args.design[len("verilog:"):].strip(","):
-        raise UsageError(f"--design must be verilog:FILE.v[,MORE.v...], got {args.design!r}")
-    if args.ports is None:
+    if args.design is not None:
+        if (not args.design.startswith("verilog:")
+                or not args.design[len("verilog:"):].strip(",")):
+            raise UsageError(
+                f"--design must be verilog:FILE.v[,MORE.v...], got {args.design!r}")
+        files = [f for f in args.design[len("verilog:"):].split(",") if f]
+    else:
+        files = list(foreign.verilog)
+    ports = args.ports if args.ports is not None else (
+        foreign.ports if foreign is not None else None)
+    if ports is None:
         raise UsageError("--design needs --ports PORTS.toml (the design's port map)")
     if args.backend not in ("auto", "verilator"):
-        raise UsageError(f"--design runs on the verilator backend, not {args.backend!r}")
-    return [f for f in args.design[len("verilog:"):].split(",") if f]
+        what = "--design" if args.design is not None else "the scenario's design.verilog"
+        raise UsageError(f"{what} runs on the verilator backend, not {args.backend!r}")
+    return files, ports
 
 
-def _open_design(args, params):
-    """The main design: ``--design`` on Verilator, else FollowTarget on ``--backend``."""
-    files = _design_files(args)
-    if files is None:
+def _open_design(args, params, foreign=None):
+    """The main design: ``--design`` (or the scenario's ``foreign`` design) on Verilator,
+    else FollowTarget on ``--backend``."""
+    design_files = _design_files(args, foreign)
+    if design_files is None:
         return _open_backend(args.backend, params, args.quiet)
+    files, ports = design_files
     from .sim.backends.base import BackendError
     from .sim.backends.foreign import ForeignVerilatorBackend
 
@@ -217,7 +230,7 @@ def _open_design(args, params):
             print(f"{text} ...", file=sys.stderr, flush=True)
 
     try:
-        backend = ForeignVerilatorBackend(params, files=files, port_map=args.ports,
+        backend = ForeignVerilatorBackend(params, files=files, port_map=ports,
                                           on_build=tell, fill_absent=True)
     except BackendError as exc:
         raise UsageError(f"--design: {exc}".splitlines()[0]) from None
@@ -292,7 +305,7 @@ def _run_source(args, scenario):
     params = scenario.params
     source = open_source(args.source, params.width, params.height)
     try:
-        design = _open_design(args, params)
+        design = _open_design(args, params, scenario.foreign)
         recorder = None
         completed = False
         try:
@@ -358,9 +371,9 @@ def main(argv=None, prog="python -m fpga_robotics.run"):
         except VideoPathError as exc:
             raise UsageError(str(exc)) from None
 
-    _design_files(args)
+    _design_files(args, scenario.foreign)
     t0 = time.perf_counter()
-    design = _open_design(args, scenario.params)
+    design = _open_design(args, scenario.params, scenario.foreign)
     shadow = recorder = None
     completed = False
     try:

@@ -54,6 +54,7 @@ __all__ = [
     "MAX_PHYSICS_STEPS",
     "WORLD_SECTIONS",
     "CameraConfig",
+    "ForeignDesignFiles",
     "Scenario",
     "ScenarioError",
     "SimConfig",
@@ -64,7 +65,9 @@ __all__ = [
 
 _TOP_KEYS = ("name", "description", "seed")
 _APP_SECTIONS = ("sim", "camera", "color", "design", "checks")
-_DESIGN_KEYS = ("preset",) + tuple(f.name for f in fields(FollowTargetParams) if f.init and
+#: A foreign Verilog design instead of FollowTarget (docs/foreign.md): its files and port map.
+_FOREIGN_KEYS = ("verilog", "ports")
+_DESIGN_KEYS = ("preset",) + _FOREIGN_KEYS + tuple(f.name for f in fields(FollowTargetParams) if f.init and
                                    f.name not in ("width", "height"))
 #: Design parameters that are arrays: their length and what the values are.
 _DESIGN_ARRAYS = {
@@ -172,6 +175,15 @@ class SimConfig:
     actuation_delay: float
 
 
+@dataclass(frozen=True)
+class ForeignDesignFiles:
+    """A scenario's foreign Verilog design: its files and port map, as paths that exist
+    (relative ones resolved against the scenario file's folder)."""
+
+    verilog: tuple
+    ports: str
+
+
 @dataclass(frozen=True, eq=False)
 class Scenario:
     """A validated scenario.
@@ -195,6 +207,9 @@ class Scenario:
         Pass criteria, name → limit.
     overrides : tuple of str
         The ``--set`` overrides applied, as given.
+    foreign : ForeignDesignFiles or None
+        ``[design] verilog = [...]`` and ``ports = "..."``: a foreign Verilog design to run
+        instead of FollowTarget (docs/foreign.md), paths resolved; None without them.
     """
 
     name: str
@@ -210,6 +225,7 @@ class Scenario:
     params: FollowTargetParams
     checks: dict
     overrides: tuple = ()
+    foreign: "ForeignDesignFiles | None" = None
 
     def color_at(self, t):
         """The colour select in force at simulated time ``t``."""
@@ -660,8 +676,43 @@ def _color_changes(data):
     return initial, tuple(parsed)
 
 
+def _foreign(design, source):
+    """``design.verilog`` and ``design.ports`` (popped from ``design``): a
+    ``ForeignDesignFiles`` or None; relative paths from the scenario file's folder."""
+    verilog, ports = design.pop("verilog", None), design.pop("ports", None)
+    if verilog is None and ports is None:
+        return None
+    if verilog is None:
+        raise ScenarioError("design.ports goes with design.verilog = [\"top.v\", ...]")
+    if ports is None:
+        raise ScenarioError("design.verilog needs design.ports = \"ports.toml\" (the design's "
+                            "port map, docs/foreign.md)")
+    if isinstance(verilog, str):
+        verilog = [verilog]
+    if not (isinstance(verilog, list) and verilog
+            and all(isinstance(f, str) and f.strip() for f in verilog)):
+        raise ScenarioError(f"design.verilog must be an array of Verilog file paths, "
+                            f"got {verilog!r}")
+    if not (isinstance(ports, str) and ports.strip()):
+        raise ScenarioError(f"design.ports must be the path of a port map (.toml), "
+                            f"got {ports!r}")
+    base = Path(source).parent if source else Path(".")
+
+    def existing(key, text):
+        path = Path(text).expanduser()
+        path = path if path.is_absolute() else base / path
+        if not path.is_file():
+            raise ScenarioError(f"design.{key}: no file {text!r} (looked for {str(path)!r})")
+        return str(path)
+
+    return ForeignDesignFiles(tuple(existing("verilog", f) for f in verilog),
+                              existing("ports", ports))
+
+
 def _design(data, width, height):
     design = dict(data["design"])
+    for key in _FOREIGN_KEYS:
+        design.pop(key, None)
     preset = design.pop("preset", None)
     for key, value in design.items():
         if key in CHOICES:
@@ -725,6 +776,7 @@ def _build(data, source, overrides):
     sim = _sim(data, camera)
     initial, changes = _color_changes(data)
     params = _design(data, camera.width, camera.height)
+    foreign = _foreign(dict(data["design"]), source)
     checks = _checks(data)
     world = {s: copy.deepcopy(data[s]) for s in WORLD_SECTIONS if s in data}
     _check_camera_geometry(camera, _check_world(world))
@@ -742,4 +794,5 @@ def _build(data, source, overrides):
         params=params,
         checks=checks,
         overrides=tuple(overrides),
+        foreign=foreign,
     )

@@ -337,6 +337,8 @@ def format_summary(s):
         f" ({s['ms_per_frame']:.2f} ms/frame, "
         f"{f'{rtf:.1f}x' if rtf is not None else 'n/a'} real time)"),
     ]
+    if s.get("ended_early"):
+        lines.append(f"  run ended early: {s['ended_early']}")
     acq = s["acquired_at_s"]
     # Without a target person every distance is missing (the trajectory holds NaN).
     if s["min_distance_m"] is None:

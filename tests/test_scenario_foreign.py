@@ -1,0 +1,148 @@
+"""A foreign Verilog design as a scenario's ``[design]`` entry: ``verilog = [...]`` and
+``ports = "..."`` (paths from the scenario file's folder), checked at load with one-line
+errors; ``--design`` and ``--ports`` override them (docs/foreign.md)."""
+
+import argparse
+import json
+
+import pytest
+
+from fpga_robotics.errors import UsageError
+from fpga_robotics.hw.params import FollowTargetParams
+from fpga_robotics.run import _design_files
+from fpga_robotics.scenario import ScenarioError, load_scenario
+
+PARAMS = FollowTargetParams(width=80, height=60)
+
+# The exported follow_target's own port map (as tests/test_foreign_verilog.py writes it).
+STREAM_MAP = """\
+style = "stream"
+top = "follow_target"
+clock = { port = "clk" }
+reset = { port = "rst" }
+pixels = { valid = "pixels__valid", payload = "pixels__payload" }
+color = { port = "color_sel" }
+result = { strobe = "frame_done", latency = %(latency)d }
+filtered = { valid = "filtered__valid", payload = "filtered__payload" }
+
+[outputs]
+found = "found"
+proximity = "proximity"
+centroid_x = "centroid_x"
+centroid_leds = "centroid_leds"
+motor_left = "motor_left"
+motor_right = "motor_right"
+"""
+
+SCENARIO = """\
+[camera]
+resolution = "80x60"
+
+[design]
+verilog = ["rtl/follow_target.v"]
+ports = "rtl/ft.toml"
+"""
+
+
+@pytest.fixture(scope="module")
+def files(tmp_path_factory):
+    from fpga_robotics.hw.verilog import generate_verilog
+
+    d = tmp_path_factory.mktemp("scenario_foreign")
+    (d / "rtl").mkdir()
+    (d / "rtl" / "follow_target.v").write_text(generate_verilog(PARAMS))
+    (d / "rtl" / "ft.toml").write_text(STREAM_MAP % {"latency": PARAMS.motor_latency})
+    (d / "foreign.toml").write_text(SCENARIO)
+    (d / "plain.toml").write_text(SCENARIO.split("[design]")[0])
+    return d
+
+
+def test_paths_are_relative_to_the_scenario_file(files, monkeypatch):
+    monkeypatch.chdir(files / "rtl")  # not where the paths start from
+    s = load_scenario(str(files / "foreign.toml"))
+    assert s.foreign.verilog == (str(files / "rtl" / "follow_target.v"),)
+    assert s.foreign.ports == str(files / "rtl" / "ft.toml")
+    assert s.params == PARAMS  # the design keys are not FollowTarget's parameters
+    assert load_scenario(str(files / "plain.toml")).foreign is None
+    assert load_scenario("follow_person").foreign is None
+    # A single file may be a string; an override keeps the design.
+    s = load_scenario(str(files / "foreign.toml"), ["design.verilog=rtl/follow_target.v"])
+    assert s.foreign.verilog == (str(files / "rtl" / "follow_target.v"),)
+    assert s.with_overrides(["design.kp_num=5"]).foreign == s.foreign
+
+
+@pytest.mark.parametrize("text, message", [
+    ('[design]\nverilog = ["rtl/missing.v"]\nports = "rtl/ft.toml"\n',
+     "design.verilog: no file 'rtl/missing.v' (looked for "),
+    ('[design]\nverilog = ["rtl/follow_target.v"]\nports = "nope.toml"\n',
+     "design.ports: no file 'nope.toml'"),
+    ('[design]\nverilog = ["rtl/follow_target.v"]\n', "design.verilog needs design.ports"),
+    ('[design]\nports = "rtl/ft.toml"\n', "design.ports goes with design.verilog"),
+    ('[design]\nverilog = []\nports = "rtl/ft.toml"\n',
+     "design.verilog must be an array of Verilog file paths, got []"),
+    ('[design]\nverilog = [3]\nports = "rtl/ft.toml"\n',
+     "design.verilog must be an array of Verilog file paths"),
+    ('[design]\nverilog = ["rtl/follow_target.v"]\nports = 7\n',
+     "design.ports must be the path of a port map (.toml), got 7"),
+    ('[design]\nverilogg = ["a.v"]\n', "unknown key design.verilogg"),
+])
+def test_bad_entries_are_one_line_errors_at_load(files, text, message):
+    path = files / "bad.toml"
+    path.write_text(text)
+    with pytest.raises(ScenarioError, match=message.replace("(", r"\(").replace(")", r"\)")
+                       .replace("[", r"\[").replace("]", r"\]")) as info:
+        load_scenario(str(path))
+    assert "\n" not in str(info.value)
+
+
+def _args(**kw):
+    base = {"design": None, "ports": None, "backend": "auto"}
+    return argparse.Namespace(**{**base, **kw})
+
+
+def test_the_command_line_overrides_the_scenario(files):
+    foreign = load_scenario(str(files / "foreign.toml")).foreign
+    v, p = list(foreign.verilog), foreign.ports
+    assert _design_files(_args(), foreign) == (v, p)
+    assert _design_files(_args(design="verilog:x.v,y.v"), foreign) == (["x.v", "y.v"], p)
+    assert _design_files(_args(ports="other.toml"), foreign) == (v, "other.toml")
+    assert _design_files(_args(design="verilog:x.v", ports="o.toml"), foreign) == (
+        ["x.v"], "o.toml")
+    assert _design_files(_args(), None) is None
+    with pytest.raises(UsageError, match="the scenario's design.verilog runs on the verilator "
+                                         "backend, not 'model'"):
+        _design_files(_args(backend="model"), foreign)
+    with pytest.raises(UsageError, match="--ports goes with --design"):
+        _design_files(_args(ports="o.toml"), None)
+
+
+def _toolchain():
+    """Why the foreign backend cannot build here, or None."""
+    from fpga_robotics.sim.backends import BackendError
+
+    try:
+        from fpga_robotics.sim.backends import foreign  # noqa: F401
+        from fpga_robotics.sim.backends import toolchain as tc
+
+        tc.find_compiler(), tc.find_make(), tc.verilator_root()
+    except (BackendError, ImportError) as exc:  # pragma: no cover - depends on the machine
+        return str(exc)
+    return None
+
+
+@pytest.mark.skipif(_toolchain() is not None, reason="no Verilator toolchain")
+def test_a_scenario_runs_its_foreign_design_in_closed_loop(files, capsys):
+    from fpga_robotics import run
+
+    argv = ["--duration", "1", "--rerun", "off", "--quiet"]
+    code = run.main(["--scenario", str(files / "foreign.toml"), *argv,
+                     "--summary", str(files / "foreign.json")])
+    assert code == 0, capsys.readouterr().out
+    run.main(["--scenario", str(files / "plain.toml"), "--backend", "model", *argv,
+              "--summary", str(files / "plain.json")])
+    got, want = (json.loads((files / n).read_text()) for n in ("foreign.json", "plain.json"))
+    assert got["backend"] == "verilator-foreign" and want["backend"] == "model"
+    # The exported FollowTarget with its full port map: the same run, figure for figure.
+    for key in ("frames", "min_distance_m", "mean_distance_m", "found_fraction",
+                "target_in_view_fraction", "path_length_m", "collisions", "verdict"):
+        assert got[key] == want[key], key
