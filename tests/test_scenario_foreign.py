@@ -11,28 +11,9 @@ from fpga_robotics.errors import UsageError
 from fpga_robotics.hw.params import FollowTargetParams
 from fpga_robotics.run import _design_files
 from fpga_robotics.scenario import ScenarioError, load_scenario
+from fpga_robotics.sim.backends.port_map import follow_target_port_map
 
 PARAMS = FollowTargetParams(width=80, height=60)
-
-# The exported follow_target's own port map (as tests/test_foreign_verilog.py writes it).
-STREAM_MAP = """\
-style = "stream"
-top = "follow_target"
-clock = { port = "clk" }
-reset = { port = "rst" }
-pixels = { valid = "pixels__valid", payload = "pixels__payload" }
-color = { port = "color_sel" }
-result = { strobe = "frame_done", latency = %(latency)d }
-filtered = { valid = "filtered__valid", payload = "filtered__payload" }
-
-[outputs]
-found = "found"
-proximity = "proximity"
-centroid_x = "centroid_x"
-centroid_leds = "centroid_leds"
-motor_left = "motor_left"
-motor_right = "motor_right"
-"""
 
 SCENARIO = """\
 [camera]
@@ -51,7 +32,7 @@ def files(tmp_path_factory):
     d = tmp_path_factory.mktemp("scenario_foreign")
     (d / "rtl").mkdir()
     (d / "rtl" / "follow_target.v").write_text(generate_verilog(PARAMS))
-    (d / "rtl" / "ft.toml").write_text(STREAM_MAP % {"latency": PARAMS.motor_latency})
+    (d / "rtl" / "ft.toml").write_text(follow_target_port_map(PARAMS))
     (d / "foreign.toml").write_text(SCENARIO)
     (d / "plain.toml").write_text(SCENARIO.split("[design]")[0])
     return d
