@@ -19,6 +19,7 @@ import numpy as np
 from .connectors import CameraConnector, MotorConnector, in_view
 from .hw.pixel import color_select_value
 from .shadow import ShadowComparison, divergence_event
+from .sim.camera import focal_length
 from .sim.records import FrameRecord
 from .summary import compute_metrics, evaluate_checks, verdict
 
@@ -346,8 +347,7 @@ def target_column(pose, cam, x, y):
     bearing = (bearing + math.pi) % (2 * math.pi) - math.pi
     if abs(bearing) >= cam.hfov / 2:
         return math.nan
-    focal = (cam.width / 2) / math.tan(cam.hfov / 2)
-    return cam.width / 2 - focal * math.tan(bearing)
+    return cam.width / 2 - focal_length(cam.width, cam.hfov) * math.tan(bearing)
 
 
 def _empty_trajectory(n_frames):

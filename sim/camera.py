@@ -46,6 +46,7 @@ __all__ = [
     "DEFAULT_MAX_LAYERS",
     "VERTICAL_MARGIN",
     "CameraRenderer",
+    "focal_length",
     "max_hfov",
     "max_tilt",
     "render",
@@ -90,11 +91,15 @@ class _Cylinders:
     band_albedo: np.ndarray  # (B, 3)
 
 
+def focal_length(width, hfov):
+    """The pinhole focal length in pixels, ``(width/2) / tan(hfov/2)`` (square pixels)."""
+    return (width / 2) / math.tan(hfov / 2)
+
+
 def vertical_fov(width, height, hfov):
     """The vertical field of view (rad) of a ``width`` x ``height`` image whose horizontal
     field of view is ``hfov`` (square pixels: ``2 atan((height/2) / f)``)."""
-    focal = (width / 2) / math.tan(hfov / 2)
-    return 2 * math.atan((height / 2) / focal)
+    return 2 * math.atan((height / 2) / focal_length(width, hfov))
 
 
 def max_tilt(width, height, hfov):
@@ -198,7 +203,7 @@ class CameraRenderer:
         self.height = int(height)
         self.hfov = float(hfov)
         self.max_layers = int(max_layers)
-        self.focal = (self.width / 2) / math.tan(self.hfov / 2)
+        self.focal = focal_length(self.width, self.hfov)
         # Lateral offset (to the right) of each column's ray per metre forward.
         self._slope = (np.arange(self.width) + 0.5 - self.width / 2) / self.focal
         self._slope_sq1 = 1.0 + self._slope**2
