@@ -21,7 +21,7 @@ from .hw.pixel import color_select_value
 from .shadow import ShadowComparison, divergence_event
 from .sim.camera import focal_length
 from .sim.records import FrameRecord
-from .summary import compute_metrics, evaluate_checks, verdict
+from .summary import DESIGN_OUTPUTS, compute_metrics, evaluate_checks, verdict
 
 __all__ = ["TRAJECTORY_FIELDS", "ClosedLoop", "RunResult", "frame_count", "make_backend",
            "run_scenario"]
@@ -43,7 +43,8 @@ class RunResult:
     summary : dict
         JSON-ready: run identity, timing, metrics, ``checks`` and ``verdict``.
     trajectory : dict of numpy arrays
-        ``TRAJECTORY_FIELDS``, one value per camera frame (NaN where there is no target).
+        ``TRAJECTORY_FIELDS``, one value per camera frame (NaN where there is no target, and
+        in every frame of a design output the design lacks: ``summary["absent_outputs"]``).
     events : list of (frame, time_s, text)
 
     A robot that tips over ends the run at the frame that reports it (``World.tipped``):
@@ -138,6 +139,7 @@ class ClosedLoop:
         self.frames_done = 0
         self.ended_early = None  # why the run stopped before its end (a tip-over), else None
         self.traj = _empty_trajectory(self.n_frames)
+        self.absent = set()  # DESIGN_OUTPUTS the design does not produce
         self.events = []  # (frame, time_s, text)
         self.design_events = _DesignEvents(scenario.params.lost_frames)
         self.target_radius = next(
@@ -186,7 +188,7 @@ class ClosedLoop:
         """Frame ``k`` through the design; its wheel command acts after the actuation delay."""
         result = self.design.process_frame(rgb, self.color_code)
         apply_step = round((k * self.period + self.scenario.sim.actuation_delay) / self.dt)
-        self.motors.schedule(apply_step, result.motor_left, result.motor_right)
+        self.motors.schedule(apply_step, _dps(result.motor_left), _dps(result.motor_right))
         self.motors.apply_due(self.step)  # a zero delay acts now
         return result
 
@@ -220,9 +222,12 @@ class ClosedLoop:
         row = self.traj
         row["t"][k], row["x"][k], row["y"][k], row["heading"][k] = t, rx, ry, heading
         row["v"][k], row["w"][k], row["cmd_v"][k], row["cmd_w"][k] = v, w, cmd_v, cmd_w
-        row["found"][k], row["proximity"][k] = result.found, result.proximity
-        row["centroid_x"][k], row["centroid_leds"][k] = result.centroid_x, result.centroid_leds
-        row["motor_left"][k], row["motor_right"][k] = result.motor_left, result.motor_right
+        for name in DESIGN_OUTPUTS:  # an absent one (None) drives its wheel at 0 DPS
+            value = getattr(result, name)
+            if value is None:
+                self.absent.add(name)  # stored as 0 here, NaN once the run is done (summary.py)
+            else:
+                row[name][k] = value
         row["color_sel"][k] = self.color_code
         row["target_x"][k], row["target_y"][k] = tx, ty
         row["target_distance"][k], row["target_in_view"][k] = dist, visible
@@ -251,7 +256,9 @@ class ClosedLoop:
         pose, rgb, events = self.capture(t)
         result = self.process(k, rgb)
         shadow_result, shadow_events = self.process_shadow(k, t, rgb, result)
-        events += self.design_events.update(bool(result.found)) + shadow_events
+        if result.found is not None:  # a design without `found` has no found/lost events
+            events += self.design_events.update(bool(result.found))
+        events += shadow_events
         # A command that acts at once (no actuation delay) may tip the robot: this frame's.
         events += self.world.drain_events()
         distance, visible = self.measure(k, t, pose, result)
@@ -297,6 +304,8 @@ class ClosedLoop:
             self.finish_physics()
         else:  # the trajectory holds the frames done, every field alike
             self.traj = {name: a[:self.frames_done] for name, a in self.traj.items()}
+        for name in self.absent:
+            self.traj[name] = np.full(len(self.traj[name]), np.nan)
         wall = time.perf_counter() - wall_start
         cpu = time.process_time() - cpu_start
         return RunResult(summary=self.summarise(wall, cpu), trajectory=self.traj,
@@ -309,7 +318,7 @@ class ClosedLoop:
         metrics = compute_metrics(self.traj, self.events, self.world.collision_counts(),
                                   self.period,
                                   at_fault_collisions=self.world.at_fault_collisions(),
-                                  width=cam.width)
+                                  width=cam.width, absent=self.absent)
         checks = evaluate_checks(scenario.checks, metrics)
         shadow = {"shadow": self.comparison.summary()} if self.comparison is not None else {}
         return {
@@ -348,6 +357,11 @@ def target_column(pose, cam, x, y):
     if abs(bearing) >= cam.hfov / 2:
         return math.nan
     return cam.width / 2 - focal_length(cam.width, cam.hfov) * math.tan(bearing)
+
+
+def _dps(command):
+    """A wheel command as the motors take it: an absent one (None) is 0 DPS."""
+    return 0 if command is None else command
 
 
 def _empty_trajectory(n_frames):

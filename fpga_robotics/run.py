@@ -230,8 +230,8 @@ def _open_design(args, params, foreign=None):
             print(f"{text} ...", file=sys.stderr, flush=True)
 
     try:
-        backend = ForeignVerilatorBackend(params, files=files, port_map=ports,
-                                          on_build=tell, fill_absent=True)
+        # Outputs the map does not name stay None: absent in the summary and the viewer.
+        backend = ForeignVerilatorBackend(params, files=files, port_map=ports, on_build=tell)
     except BackendError as exc:
         raise UsageError(f"--design: {exc}".splitlines()[0]) from None
     missing = [k for k in ("motor_left", "motor_right") if k not in

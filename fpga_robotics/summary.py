@@ -12,6 +12,8 @@ from .sim.world.config import MAX_TIME
 
 __all__ = [
     "CHECKS",
+    "CHECK_OUTPUTS",
+    "DESIGN_OUTPUTS",
     "TIMING_FIELDS",
     "compute_metrics",
     "evaluate_checks",
@@ -69,6 +71,39 @@ CHECKS = {
     ),
 }
 
+#: The design's per-frame scalar outputs. A design may lack some (a foreign Verilog design whose
+#: port map names no such port: its ``FrameResult`` holds None); those are *absent*, never 0:
+#: NaN in the trajectory, listed in ``absent_outputs``, the metrics made of them None, the
+#: checks that need them "n/a" (left out of the verdict), nothing drawn for them in the viewer.
+DESIGN_OUTPUTS = ("found", "proximity", "centroid_x", "centroid_leds", "motor_left",
+                  "motor_right")
+
+#: The design outputs a check is measured from (checks not named here need none).
+CHECK_OUTPUTS = {
+    "acquired_within_s": ("found",),
+    "found_min_fraction": ("found",),
+    "reacquired_within_s": ("found",),
+    "max_off_target_fraction": ("found", "centroid_x"),
+    "mean_centroid_error_max_px": ("found", "centroid_x"),
+    "max_oscillation_hz": ("found", "centroid_x"),
+}
+
+#: Metrics made of design outputs: name -> the outputs they need (None when one is absent).
+_METRIC_OUTPUTS = {
+    "found_fraction": ("found",),
+    "found_after_acquisition_fraction": ("found",),
+    "acquired_at_s": ("found",),
+    "losses": ("found",),
+    "searches": ("found",),
+    "searched_losses": ("found",),
+    "searched_reacquisitions": ("found",),
+    "reacquire_times_s": ("found",),
+    "unrecovered_losses_s": ("found",),
+    "oscillation_hz": ("found", "centroid_x"),
+    "off_target_fraction": ("found", "centroid_x"),
+    "mean_centroid_error_px": ("found", "centroid_x"),
+}
+
 #: Summary fields that depend on the machine, not on the simulation.
 TIMING_FIELDS = (
     "wall_time_s", "ms_per_frame", "realtime_factor", "cpu_ms_per_frame", "backend_setup_s",
@@ -91,7 +126,7 @@ CENTRED_FRACTION = 0.125
 
 
 def compute_metrics(traj, events, collisions, frame_period, *, at_fault_collisions=0,
-                    width=None):
+                    width=None, absent=()):
     """Reduce a run to numbers.
 
     Parameters
@@ -107,7 +142,22 @@ def compute_metrics(traj, events, collisions, frame_period, *, at_fault_collisio
     width : int, optional
         The image width, pixels: the oscillation metric needs the centre of the image
         (without it, or without ``cmd_w``/``centroid_x``, the metric is None).
+    absent : collection of str
+        ``DESIGN_OUTPUTS`` the design does not produce (their trajectory entries are NaN): the
+        metrics made of them are None, and ``absent_outputs`` lists them.
     """
+    absent = [name for name in DESIGN_OUTPUTS if name in set(absent)]
+    if absent:
+        present = {k: v for k, v in traj.items() if k not in absent}
+        if "found" in absent:  # the metrics below read it; theirs are replaced by None
+            present["found"] = np.zeros(len(traj["t"]), bool)
+        m = compute_metrics(present, events, collisions, frame_period,
+                            at_fault_collisions=at_fault_collisions, width=width)
+        for name, needs in _METRIC_OUTPUTS.items():
+            if any(o in absent for o in needs):
+                m[name] = None
+        m["absent_outputs"] = absent
+        return m
     t = traj["t"]
     n = len(t)
     dist = traj["target_distance"]
@@ -156,6 +206,7 @@ def compute_metrics(traj, events, collisions, frame_period, *, at_fault_collisio
         "oscillation_hz": _oscillation(traj, width, n * frame_period),
         **_off_target(traj, width),
         "heading_overshoot_deg": _heading_overshoot(traj),
+        "absent_outputs": [],
     }
 
 
@@ -204,11 +255,12 @@ def _off_target(traj, width):
 
 
 def _max_command_step(traj):
-    """The largest change of a wheel's command from one frame to the next, DPS."""
-    if "motor_left" not in traj or len(traj["motor_left"]) < 2:
+    """The largest change of a wheel's command from one frame to the next, DPS (of the wheels
+    whose command the design produces; None with neither)."""
+    wheels = [k for k in ("motor_left", "motor_right") if k in traj]
+    if not wheels or len(traj[wheels[0]]) < 2:
         return None
-    steps = [np.abs(np.diff(np.asarray(traj[k], dtype=float))).max()
-             for k in ("motor_left", "motor_right")]
+    steps = [np.abs(np.diff(np.asarray(traj[k], dtype=float))).max() for k in wheels]
     return int(max(steps))
 
 
@@ -240,10 +292,24 @@ def _check(name, passed, value, limit, text):
     return {"name": name, "passed": bool(passed), "value": value, "limit": limit, "text": text}
 
 
+def _not_measured(name, limit, missing):
+    """A check the design's outputs cannot measure: ``passed`` None, left out of the verdict."""
+    names = " or ".join(f"`{o}`" for o in missing)
+    return {"name": name, "passed": None, "value": None, "limit": limit,
+            "text": f"not measured: the design has no {names} output"}
+
+
 def evaluate_checks(checks, m):
-    """The scenario's checks against the metrics ``m``: a list of result dicts, in order."""
+    """The scenario's checks against the metrics ``m``: a list of result dicts, in order.
+    ``passed`` is True or False, or None for a check that needs a design output the design
+    lacks (``m["absent_outputs"]``)."""
     out = []
+    absent = m.get("absent_outputs") or ()
     for name, limit in checks.items():
+        missing = [o for o in CHECK_OUTPUTS.get(name, ()) if o in absent]
+        if missing:
+            out.append(_not_measured(name, limit, missing))
+            continue
         if name == "acquired_within_s":
             v = m["acquired_at_s"]
             ok = v is not None and v <= limit
@@ -325,7 +391,8 @@ def evaluate_checks(checks, m):
 
 
 def verdict(check_results):
-    return "pass" if all(c["passed"] for c in check_results) else "fail"
+    """"pass" when no check failed (checks that could not be measured do not count)."""
+    return "fail" if any(c["passed"] is False for c in check_results) else "pass"
 
 
 def format_summary(s):
@@ -339,19 +406,26 @@ def format_summary(s):
     ]
     if s.get("ended_early"):
         lines.append(f"  run ended early: {s['ended_early']}")
+    if s.get("absent_outputs"):
+        lines.append("  design outputs absent (not produced by the design): "
+                     + ", ".join(s["absent_outputs"]))
     acq = s["acquired_at_s"]
+    found = (f"{s['found_fraction']:.0%}" if s["found_fraction"] is not None
+             else "n/a (no `found` output)")
+    searches = s["searches"] if s["searches"] is not None else "n/a"
     # Without a target person every distance is missing (the trajectory holds NaN).
     if s["min_distance_m"] is None:
         lines.append(
             f"  target: none in the scenario (the design reported found in "
-            f"{s['found_fraction']:.0%} of frames, {s['searches']} search(es))")
+            f"{found} of frames, {searches} search(es))")
         lines.append(f"  distance: n/a (no target person); path {s['path_length_m']:.1f} m")
     else:
         lines.append(
             "  target: "
-            + (f"first found at {acq:.2f} s" if acq is not None else "never found")
-            + f", in view {s['target_in_view_fraction']:.0%}, found {s['found_fraction']:.0%}"
-            + f", {s['searches']} search(es)"
+            + (f"first found at {acq:.2f} s" if acq is not None
+               else "never found" if s["found_fraction"] is not None else "acquisition n/a")
+            + f", in view {s['target_in_view_fraction']:.0%}, found {found}"
+            + f", {searches} search(es)"
         )
         lines.append(
             f"  distance: min {s['min_distance_m']:.2f} m, mean {s['mean_distance_m']:.2f} m; "
@@ -360,6 +434,7 @@ def format_summary(s):
     coll = ", ".join(f"{k} {v}" for k, v in s["collisions"].items()) or "none"
     lines.append(f"  collisions: {coll}")
     for c in s["checks"]:
-        lines.append(f"  [{'ok' if c['passed'] else 'FAIL'}] {c['name']}: {c['text']}")
+        mark = {True: "ok", False: "FAIL", None: "n/a"}[c["passed"]]
+        lines.append(f"  [{mark}] {c['name']}: {c['text']}")
     lines.append(f"verdict: {s['verdict'].upper()}")
     return "\n".join(lines)

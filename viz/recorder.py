@@ -12,6 +12,10 @@ What is logged per frame (entity paths in ``viz.paths``):
 - every frame: the LEDs (small images), the scalar series (found, proximity, centroid_x,
   DPS, V, W, target distance), the robot, field of view, people and trails on the map, and
   the frame's events. They are small, and decimating them would hide short events.
+
+An output the design lacks (None in its ``FrameResult``: a foreign design whose port map does
+not name it) is absent in the viewer, never drawn as 0: no LEDs or filtered image for it, a gap
+in its series.
 """
 
 import math
@@ -98,6 +102,11 @@ def _check_log_every(n):
 def _xy(x, y):
     # World (y up) to the viewer's 2D coordinates (y down).
     return (float(x), -float(y))
+
+
+def _series(value):
+    """A design output as a series value: NaN (a gap in the plot) when the design lacks it."""
+    return float("nan") if value is None else float(value)
 
 
 def _event_level(text):
@@ -262,8 +271,9 @@ class Recorder:
             q = self.jpeg_quality
             kind, data = encode_frame(record.camera_rgb, q)
             add((P.CAMERA_RAW, kind), data)
-            kind, data = encode_frame(filtered_rgb(res.filtered), q)
-            add((P.CAMERA_FILTERED, kind), data)
+            if res.filtered is not None:  # a design without a filtered stream: no image
+                kind, data = encode_frame(filtered_rgb(res.filtered), q)
+                add((P.CAMERA_FILTERED, kind), data)
             self.images_logged += 1
         if record.events:
             s = self._stream
@@ -273,11 +283,11 @@ class Recorder:
                 for text in record.events:
                     s.log(P.EVENTS, rr.TextLog(str(text), level=_event_level(str(text))))
 
-        add(P.LEDS_PROXIMITY, proximity_image(res.proximity))
-        add(P.LEDS_CENTROID, centroid_image(res.centroid_leds))
-        add(P.DESIGN_TRACKING, (float(bool(res.found)), float(res.proximity)))
-        add(P.DESIGN_CENTROID_X, (float(res.centroid_x),))
-        add(P.MOTORS_DPS, (float(res.motor_left), float(res.motor_right)))
+        self._add_outputs(res, add, P.LEDS_PROXIMITY, P.LEDS_CENTROID, P.MOTORS_DPS)
+        if res.found is not None or res.proximity is not None:
+            add(P.DESIGN_TRACKING, (_series(res.found), _series(res.proximity)))
+        if res.centroid_x is not None:
+            add(P.DESIGN_CENTROID_X, (float(res.centroid_x),))
         if record.shadow_result is not None:
             self._add_shadow(record.shadow_result, add)
         add(P.TWIST_V, (float(record.cmd_v), float(record.robot_v)))
@@ -294,9 +304,19 @@ class Recorder:
             with self._guard:
                 self._log_static_styles(shadow=True)
             self._send_blueprint(shadow=True)
-        add(P.SHADOW_LEDS_PROXIMITY, proximity_image(res.proximity))
-        add(P.SHADOW_LEDS_CENTROID, centroid_image(res.centroid_leds))
-        add(P.SHADOW_MOTORS_DPS, (float(res.motor_left), float(res.motor_right)))
+        self._add_outputs(res, add, P.SHADOW_LEDS_PROXIMITY, P.SHADOW_LEDS_CENTROID,
+                          P.SHADOW_MOTORS_DPS)
+
+    @staticmethod
+    def _add_outputs(res, add, proximity_path, centroid_path, motors_path):
+        """The LEDs and wheel commands; an output the design lacks (None) is drawn as absent:
+        its LEDs not at all, its series with a gap (NaN), never as 0."""
+        if res.proximity is not None:
+            add(proximity_path, proximity_image(res.proximity))
+        if res.centroid_leds is not None:
+            add(centroid_path, centroid_image(res.centroid_leds))
+        if res.motor_left is not None or res.motor_right is not None:
+            add(motors_path, (_series(res.motor_left), _series(res.motor_right)))
 
     def _add_map(self, record, add):
         x, y = _xy(record.robot_x, record.robot_y)
