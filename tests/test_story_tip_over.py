@@ -24,15 +24,15 @@ def _run(world, seconds):
 
 
 def test_tip_accelerations_of_the_presets():
-    assert TURTLEBOT2.tip_accel == pytest.approx(9.80665 * 0.12 / 0.20)  # 5.88 m/s^2
-    assert GOPIGO3.tip_accel == pytest.approx(9.80665 * 0.04 / 0.07)  # 5.60 m/s^2
+    assert TURTLEBOT2.tip_accel == pytest.approx(9.80665 * 0.115 / 0.20)  # 5.64 m/s^2
+    assert GOPIGO3.tip_accel == pytest.approx(9.80665 * 0.06 / 0.075)  # 7.85 m/s^2
     # The presets ramp their commands: no jump tips them.
     assert TURTLEBOT2.tip_step_dps is None and GOPIGO3.tip_step_dps is None
 
 
 @pytest.mark.parametrize("accel_dps2, tips", [
-    (9000, False),   # 0.035 m * 9000 deg/s^2 = 5.50 m/s^2 < 5.88
-    (12000, True),   # 7.33 m/s^2 > 5.88
+    (9000, False),   # 0.035 m * 9000 deg/s^2 = 5.50 m/s^2 < 5.64
+    (12000, True),   # 7.33 m/s^2 > 5.64
 ])
 def test_a_steep_motor_ramp_tips_the_turtlebot(accel_dps2, tips):
     assert (0.035 * accel_dps2 * DEG > TURTLEBOT2.tip_accel) == tips
@@ -44,7 +44,7 @@ def test_a_steep_motor_ramp_tips_the_turtlebot(accel_dps2, tips):
     events = world.drain_events()
     if tips:
         assert world.tipped is not None and world.tipped[0] == pytest.approx(0.0)
-        assert events == ["tipped over: longitudinal acceleration 7.33 m/s^2 > 5.88 m/s^2"]
+        assert events == ["tipped over: longitudinal acceleration 7.33 m/s^2 > 5.64 m/s^2"]
         assert world.robot_velocity()[0] == pytest.approx(0.0, abs=1e-6)  # it lies still
     else:
         assert world.tipped is None and events == []
@@ -67,19 +67,19 @@ def _gopigo(step_response=0.05):
 
 
 def test_a_jump_of_the_command_beyond_the_step_limit_tips_the_gopigo3():
-    # 5.6038 m/s^2 * 0.05 s / 0.03325 m = 8.43 rad/s = 482.8 DPS.
+    # 7.8453 m/s^2 * 0.05 s / 0.03325 m = 11.80 rad/s = 675.9 DPS.
     world = _gopigo()
     limit = world.robot_spec.tip_step_dps
     assert limit == pytest.approx(GOPIGO3.tip_accel * 0.05 / (0.03325 * DEG))
-    assert 482 < limit < 483
+    assert 675 < limit < 676
     world.set_wheel_dps(300, 300)
     _run(world, 1.0)
-    world.set_wheel_dps(-180, -180)  # a jump of 480 DPS: survives
+    world.set_wheel_dps(-370, -370)  # a jump of 670 DPS: survives
     _run(world, 1.0)
     assert world.tipped is None
-    world.set_wheel_dps(300, 310)  # 490 DPS on the right wheel: falls
+    world.set_wheel_dps(300, 310)  # 680 DPS on the right wheel: falls
     assert world.tipped is not None
-    assert world.drain_events() == ["tipped over: wheel command jumped 490 DPS > 483 DPS"]
+    assert world.drain_events() == ["tipped over: wheel command jumped 680 DPS > 676 DPS"]
     world.set_wheel_dps(300, 300)  # ignored: it lies on its side
     _run(world, 1.0)
     assert world.wheel_speeds() == (0.0, 0.0)
@@ -116,7 +116,7 @@ def test_oscillation_counts_sign_changes_of_w_while_centred():
 
 
 def test_tip_over_check_reads_the_event():
-    events = [(44, 1.466667, "tipped over: wheel command jumped 502 DPS > 483 DPS")]
+    events = [(44, 1.466667, "tipped over: wheel command jumped 736 DPS > 676 DPS")]
     m = compute_metrics(_traj([0] * 30, [80] * 30), events, {}, 1 / 30, width=160)
     assert m["tip_overs"] == 1 and m["tipped_over_at_s"] == pytest.approx(1.4667)
     (c,) = evaluate_checks({"max_tip_overs": 0}, m)
@@ -135,7 +135,7 @@ CXXRTL = pytest.mark.skipif("cxxrtl" not in available_backends(), reason="no C++
 def test_story_c_an_unstable_gain_tips_the_gopigo3():
     r = run_scenario(load_scenario("erratic", ["design.kp_num=32"]), backend="cxxrtl")
     assert "max_tip_overs" in _failed(r)
-    assert r.summary["tipped_over_at_s"] == pytest.approx(1.4667)
+    assert r.summary["tipped_over_at_s"] == pytest.approx(3.1667)
     assert r.summary["max_wheel_command_step_dps"] > GOPIGO3.tip_accel * 0.05 / (0.03325 * DEG)
 
 

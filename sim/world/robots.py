@@ -135,11 +135,13 @@ TURTLEBOT2 = RobotSpec(
     camera_height=0.30,
     camera_forward=0.10,
     # Tip-over: the Kobuki base (Kobuki user guide: 351.5 mm diameter, 124 mm high, 2.35 kg)
-    # rests on its two wheels on the centre line and two casters about 0.12 m ahead and
-    # behind; the TurtleBot2's plates and sensor (to 420 mm) raise the centre of mass to an
-    # estimated 0.20 m. tip_accel = 9.81 * 0.12 / 0.20 = 5.9 m/s^2.
+    # rests on its two wheels on the centre line and two casters, 0.115 m ahead and 0.135 m
+    # behind the axle (yujinrobot/kobuki, kobuki_description/urdf/kobuki.urdf.xacro: the
+    # caster joints); the nearer, front one is the edge. The TurtleBot2's plates and sensor
+    # (to 420 mm) raise the centre of mass to an estimated 0.20 m (no published figure; the
+    # URDF's masses are placeholders). tip_accel = 9.81 * 0.115 / 0.20 = 5.6 m/s^2.
     com_height=0.20,
-    support_half_length=0.12,
+    support_half_length=0.115,
 )
 
 # GoPiGo3: wheel diameter 66.5 mm, wheel base 117 mm, about 0.8 kg with batteries. The
@@ -157,15 +159,16 @@ GOPIGO3 = RobotSpec(
     traction_torque=round(_turning_torque(2 * 0.8 * _GPG3_ACCEL, 0.117), 4),
     camera_height=0.12,
     camera_forward=0.08,
-    # Tip-over: the GoPiGo3 (Dexter Industries: about 200 x 150 x 110 mm without sensors) rests
-    # on its two wheels at the front and one ball caster at the back; its battery pack puts the
-    # centre of mass just behind the axle, an estimated 0.04 m, at an estimated 0.07 m above the
-    # floor: braking (or reversing hard) pitches it forward over the axle at
-    # tip_accel = 9.81 * 0.04 / 0.07 = 5.6 m/s^2. The same forward edge is used in both
-    # directions (the model is symmetric). These are estimates from the published size, not
-    # measurements. A scenario may set robot.motor_step_response (docs/stories.md, story c).
-    com_height=0.07,
-    support_half_length=0.04,
+    # Tip-over: the GoPiGo3 rests on its two wheels at the front and one ball caster at the
+    # back. Its ROS description (gpg_description/urdf/gpg.urdf.xacro of the book "Hands-On ROS
+    # for Robotics Programming", B. Japon, 2020: base_link "at the center of gravity of GoPiGo3
+    # body") puts the centre of mass 0.075 m above the floor and 0.06 m behind the wheel axle,
+    # the caster 0.132 m behind it: the axle, 0.06 m away, is the nearer edge, so braking (or
+    # reversing hard) pitches it forward at tip_accel = 9.81 * 0.06 / 0.075 = 7.8 m/s^2. The
+    # same edge is used in both directions (the model is symmetric). A scenario may set
+    # robot.motor_step_response (docs/stories.md, story c).
+    com_height=0.075,
+    support_half_length=0.06,
 )
 
 ROBOT_MODELS = {spec.name: spec for spec in (TURTLEBOT2, GOPIGO3)}
