@@ -546,6 +546,55 @@ def test_constants_tie_inputs_the_world_does_not_drive(tmp_path):
             PARAMS, files=files, port_map=port_map('[constants]\nmode = "5"\ndbg_addr = 0'))
 
 
+def test_runtime_inputs_are_set_between_frames_in_one_build(tmp_path):
+    """``[runtime] mode = 0``: the same compiled model under mode 0 (motors held at 0) and
+    mode 5 (the design's motors), switched from Python between frames."""
+    (tmp_path / "moded.v").write_text(MODED % {"xmsb": PARAMS.x_bits - 1})
+    (tmp_path / "follow_target.v").write_text(generate_verilog(PARAMS))
+    files = [tmp_path / "moded.v", tmp_path / "follow_target.v"]
+    path = tmp_path / "runtime.toml"
+    path.write_text(MODED_MAP % {"latency": PARAMS.motor_latency,
+                                 "constants": "[constants]\ndbg_addr = 0\n[runtime]\nmode = 0"})
+    design = foreign.ForeignVerilatorBackend(PARAMS, files=files, port_map=path)
+    model = get_backend("model", PARAMS)
+    try:
+        frames = _frames(PARAMS)
+        want = [model.process_frame(f) for f in frames]
+        assert any(w.motor_left != 0 for w in want)
+        held = [design.process_frame(f) for f in frames]
+        assert all((g.motor_left, g.motor_right) == (0, 0) for g in held)
+        design.set_runtime("mode", 5)
+        design.reset()
+        got = [design.process_frame(f) for f in frames]
+        assert [(g.motor_left, g.motor_right, g.centroid_leds) for g in got] == [
+            (w.motor_left, w.motor_right, w.centroid_leds) for w in want]
+        with pytest.raises(BackendError, match="'mode' is 4 bits wide: the value must be 0..15"):
+            design.set_runtime("mode", 16)
+    finally:
+        design.close()
+
+
+@pytest.mark.parametrize("table, message", [
+    ("[runtime]\nmode = -1", "runtime.mode must be an integer >= 0"),
+    ("[runtime]\nmode = true", "runtime.mode must be an integer >= 0"),
+    ("[runtime]\nmode = 16", "runtime.mode = 16 does not fit the 4-bit port"),
+    ("[runtime]\nmode = 1\nclk = 0", "port 'clk' is mapped more than once"),
+    ("[constants]\nmode = 5\n[runtime]\nmode = 1", "port 'mode' is mapped more than once"),
+    ("[runtime]\n" + "\n".join(f"p{i} = 0" for i in range(9)), "at most 8"),
+])
+def test_bad_runtime_tables_are_one_line_errors(tmp_path, table, message):
+    (tmp_path / "moded.v").write_text(MODED % {"xmsb": PARAMS.x_bits - 1})
+    (tmp_path / "follow_target.v").write_text(generate_verilog(PARAMS))
+    path = tmp_path / "bad.toml"
+    path.write_text(MODED_MAP % {"latency": PARAMS.motor_latency,
+                                 "constants": table.replace("[runtime]",
+                                                            "[constants]\ndbg_addr = 0\n[runtime]", 1)
+                                 if "[constants]" not in table else table + "\n"})
+    with pytest.raises(PortMapError, match=message) as info:
+        foreign.ForeignDesign([tmp_path / "moded.v", tmp_path / "follow_target.v"], path)
+    assert "\n" not in str(info.value)
+
+
 def test_the_shipped_map_of_the_published_design_reads():
     from importlib import resources
 

@@ -86,17 +86,22 @@ def _toolchain():
 
 
 @pytest.mark.skipif(_toolchain() is not None, reason="no Verilator toolchain")
-def test_select_zero_is_the_design_and_a_stuck_output_bit_is_not(tmp_path):
+def test_one_build_runs_the_design_and_each_mutant(tmp_path):
+    """``mutsel`` as a ``[runtime]`` input of the port map: one compiled model, the mutant
+    chosen between runs. Select 0 is the design bit for bit; a stuck-at-1 on the filtered
+    payload shows exactly as computed by hand; back at 0 it is the design again."""
+    from fpga_robotics.sim.backends import BackendError
     from fpga_robotics.sim.backends.foreign import ForeignVerilatorBackend
     from fpga_robotics.sim.backends.port_map import follow_target_port_map
 
-    # Two mutants: the filtered stream's payload bit 0 stuck at 1 is seen on every frame.
-    chosen = [m for m in mutation.list_mutants(PARAMS, 400, seed=1)
-              if m.signal == "filtered__payload" and m.mode == "const1"][:1]
-    assert chosen, "no stuck-at-1 on the filtered payload among 400 mutants"
-    stuck = chosen[0]
-    stuck = mutation.Mutant(**{**stuck.__dict__, "index": 1})
-    (tmp_path / "m.v").write_text(mutation.mutant_netlist(PARAMS, [stuck]))
+    listed = mutation.list_mutants(PARAMS, 400, seed=1)
+    stuck = next((m for m in listed if m.signal == "filtered__payload" and m.mode == "const1"),
+                 None)
+    assert stuck is not None, "no stuck-at-1 on the filtered payload among 400 mutants"
+    others = [m for m in listed if m is not stuck][:5]
+    (tmp_path / "m.v").write_text(mutation.mutant_netlist(PARAMS, [stuck, *others]))
+    (tmp_path / "pm.toml").write_text(follow_target_port_map(PARAMS)
+                                      + "\n[runtime]\nmutsel = 0\n")
     rng = np.random.default_rng(3)
     frames = [rng.integers(0, 256, (60, 80, 3), dtype=np.uint8) for _ in range(2)]
     red = np.zeros((60, 80, 3), np.uint8)
@@ -104,20 +109,26 @@ def test_select_zero_is_the_design_and_a_stuck_output_bit_is_not(tmp_path):
     frames.append(red)
     model = get_backend("model", PARAMS)
     want = [model.process_frame(f) for f in frames]
-    got = {}
-    for select in (0, 1):
-        (tmp_path / "pm.toml").write_text(follow_target_port_map(PARAMS)
-                                          + f"\n[constants]\nmutsel = {select}\n")
-        design = ForeignVerilatorBackend(PARAMS, files=[tmp_path / "m.v"],
-                                         port_map=tmp_path / "pm.toml")
-        try:
-            got[select] = [design.process_frame(f) for f in frames]
-        finally:
-            design.close()
-    assert got[0] == want
-    # The mutant, by hand: every pixel of the filtered stream (the pixel where it matched,
-    # 0 elsewhere) has its payload bit forced to 1; the tracker's outputs are untouched.
-    assert (want[2].filtered != 0).any()
-    for g, w in zip(got[1], want):
-        np.testing.assert_array_equal(g.filtered, w.filtered | (1 << stuck.bit))
-        assert g.outputs() == w.outputs()
+    design = ForeignVerilatorBackend(PARAMS, files=[tmp_path / "m.v"],
+                                     port_map=tmp_path / "pm.toml")
+
+    def run(select):
+        design.set_runtime("mutsel", select)
+        design.reset()
+        return [design.process_frame(f) for f in frames]
+
+    try:
+        assert run(0) == want
+        # The mutant, by hand: every pixel of the filtered stream (the pixel where it matched,
+        # 0 elsewhere) has its payload bit forced to 1; the tracker's outputs are untouched.
+        assert (want[2].filtered != 0).any()
+        for g, w in zip(run(stuck.index), want):
+            np.testing.assert_array_equal(g.filtered, w.filtered | (1 << stuck.bit))
+            assert g.outputs() == w.outputs()
+        assert run(0) == want
+        with pytest.raises(BackendError, match="the value must be 0..7"):
+            design.set_runtime("mutsel", 8)
+        with pytest.raises(BackendError, match="no \\[runtime\\] input 'mode'"):
+            design.set_runtime("mode", 1)
+    finally:
+        design.close()

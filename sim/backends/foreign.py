@@ -256,6 +256,15 @@ def wrapper_verilog(pm, ports, width, height):
             body.append(f"  assign {key} = {{{fill}, fr_{key}}};")
     for name, value in pm.constants.items():
         conns.append(f".{name}({ports[name][1]}'d{value})")
+    if pm.runtime:
+        # Held in registers loaded every clock from the host's values (fr_foreign_set_runtime,
+        # in the hooks compiled with the design), so a new value acts from the next edge.
+        body.append('  import "DPI-C" function int fr_runtime_value(input int index);')
+    for index, name in enumerate(pm.runtime):
+        width = ports[name][1]
+        body.append(f"  reg [{width - 1}:0] fr_rt_{index};\n"
+                    f"  always @(posedge clk) fr_rt_{index} <= fr_runtime_value({index});")
+        conns.append(f".{name}(fr_rt_{index})")
     if pm.filtered_valid:
         conns += [f".{pm.filtered_valid}(filtered__valid)",
                   f".{pm.filtered_payload}(filtered__payload)"]
@@ -308,6 +317,17 @@ extern "C" __attribute__((visibility("default"))) const char *fr_foreign_stop() 
     return fr_stopped ? fr_stop_message : nullptr;
 }
 extern "C" __attribute__((visibility("default"))) void fr_foreign_clear() { fr_stopped = 0; }
+
+// [runtime] inputs: the wrapper reads these through DPI at every clock edge.
+static int fr_runtime[8];
+extern "C" int fr_runtime_value(int index) {
+    return index >= 0 && index < 8 ? fr_runtime[index] : 0;
+}
+extern "C" __attribute__((visibility("default"))) void fr_foreign_set_runtime(int index,
+                                                                              int value) {
+    if (index >= 0 && index < 8)
+        fr_runtime[index] = value;
+}
 """
 
 
@@ -386,6 +406,10 @@ class ForeignVerilatorBackend(DesignBackend):
         self._stop.argtypes = []
         lib.fr_foreign_clear.restype = None
         lib.fr_foreign_clear()
+        lib.fr_foreign_set_runtime.restype = None
+        lib.fr_foreign_set_runtime.argtypes = [ctypes.c_int, ctypes.c_int]
+        self._runtime = dict(self.design.port_map.runtime)
+        self._apply_runtime()
         self._handle = self._library.lib.fr_create()
         p, pm = self.params, self.design.port_map
         pixel_edges = p.height * (p.width + line_blank)
@@ -401,7 +425,30 @@ class ForeignVerilatorBackend(DesignBackend):
     def evals_per_cycle(self):
         return self._library.evals_per_cycle
 
+    def set_runtime(self, name, value):
+        """Hold the ``[runtime]`` input ``name`` at ``value`` from the next clock edge (the
+        next frame, or the next ``reset()``). The values belong to the loaded model: two
+        backends of the same design in one process share them, so each sets its own before
+        its frames (``process_frame`` does)."""
+        pm = self.design.port_map
+        if name not in pm.runtime:
+            known = ", ".join(pm.runtime) or "none"
+            raise BackendError(f"{pm.top} has no [runtime] input {name!r} (its runtime "
+                               f"inputs: {known})")
+        width = self.design.ports[name][1]
+        if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or not (
+                0 <= value < 1 << width):
+            raise BackendError(f"runtime input {name!r} is {width} bits wide: the value must "
+                               f"be 0..{(1 << width) - 1}, got {value!r}")
+        self._runtime[name] = int(value)
+        self._apply_runtime()
+
+    def _apply_runtime(self):
+        for index, value in enumerate(self._runtime.values()):
+            self._library.lib.fr_foreign_set_runtime(index, value)
+
     def _reset(self):
+        self._apply_runtime()
         self._library.lib.fr_reset(self._handle)
 
     def _run_frame(self, packed, color_sel):
@@ -411,6 +458,8 @@ class ForeignVerilatorBackend(DesignBackend):
             raise BackendError(f"{pm.top} has no code for colour {names[0]!r} "
                                f"(color.codes: {', '.join(pm.color_codes)})")
         self._args[2] = color_sel
+        if self._runtime:
+            self._apply_runtime()
         filtered = np.zeros((self.params.height, self.params.width), np.uint16)
         out = self._out
         status = self._library.lib.fr_run_frame(

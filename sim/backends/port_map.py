@@ -32,7 +32,9 @@ OUTPUTS = {
 }
 _STYLES = ("stream", "framebuffer")
 _TOP_KEYS = {"style", "top", "clock", "reset", "pixels", "color", "result", "outputs", "filtered",
-             "constants"}
+             "constants", "runtime"}
+#: At most this many ``[runtime]`` inputs.
+MAX_RUNTIME = 8
 
 
 class PortMapError(BackendError):
@@ -71,6 +73,8 @@ class PortMap:
     new_frame: str | None = None  # framebuffer: the one-cycle pulse after the last pixel
     after_cycles: int | None = None  # read the outputs this many cycles after the frame
     constants: dict = field(default_factory=dict)  # input port -> value it is tied to
+    # input port -> its value until ``ForeignVerilatorBackend.set_runtime`` changes it
+    runtime: dict = field(default_factory=dict)
 
     def inputs(self):
         """Input port name -> expected width (None: checked elsewhere)."""
@@ -89,7 +93,7 @@ class PortMap:
                     ports[flag] = 1
         if self.color_port:
             ports[self.color_port] = self.color_width
-        for name in self.constants:
+        for name in (*self.constants, *self.runtime):
             ports[name] = None  # any width the value fits: checked with the design's ports
         return ports
 
@@ -246,6 +250,18 @@ def parse_port_map(data):
         if isinstance(value, bool) or not isinstance(value, int) or value < 0:
             raise PortMapError(f"port map: constants.{name} must be an integer >= 0, got "
                                f"{value!r}")
+    # Inputs held at a value the host sets between frames (a mutant select, a mode):
+    # [runtime] port = initial value.
+    runtime = _table(data, "runtime", "", required=False)
+    if len(runtime) > MAX_RUNTIME:
+        raise PortMapError(f"port map: [runtime] names {len(runtime)} inputs (at most "
+                           f"{MAX_RUNTIME})")
+    for name, value in runtime.items():
+        if not name.isidentifier():
+            raise PortMapError(f"port map: runtime.{name}: not a port name")
+        if isinstance(value, bool) or not isinstance(value, int) or value < 0:
+            raise PortMapError(f"port map: runtime.{name} must be an integer >= 0 (its "
+                               f"initial value), got {value!r}")
     port_map = PortMap(
         top=top, clock=_name(clock, "port", "clock"), reset=_name(reset, "port", "reset"),
         reset_active_low=active_low, valid=valid, payload=payload,
@@ -253,13 +269,13 @@ def parse_port_map(data):
         color_width=color_width, strobe=strobe, latency=latency, timeout=timeout,
         outputs=outputs, filtered_valid=f_valid, filtered_payload=f_payload, style=style,
         address=address, new_frame=new_frame, after_cycles=after_cycles,
-        constants=dict(constants),
+        constants=dict(constants), runtime=dict(runtime),
     )
     pm = port_map
     names = [n for n in (pm.clock, pm.reset, pm.valid, pm.payload, pm.data, pm.first, pm.last,
                          pm.address, pm.new_frame, pm.color_port, pm.strobe,
                          *(o.port for o in pm.outputs.values()), pm.filtered_valid,
-                         pm.filtered_payload, *pm.constants) if n]
+                         pm.filtered_payload, *pm.constants, *pm.runtime) if n]
     dup = sorted({n for n in names if names.count(n) > 1})
     if dup:
         raise PortMapError(f"port map: port {dup[0]!r} is mapped more than once")
@@ -310,10 +326,11 @@ def check_widths(port_map, ports, pixels=None):
         if too_big:
             raise PortMapError(f"port map: color.codes.{too_big[0]} does not fit the "
                                f"{width}-bit port {port_map.color_port!r}")
-    for name, value in port_map.constants.items():
-        if value >> ports[name][1]:
-            raise PortMapError(f"port map: constants.{name} = {value} does not fit the "
-                               f"{ports[name][1]}-bit port")
+    for table, values in (("constants", port_map.constants), ("runtime", port_map.runtime)):
+        for name, value in values.items():
+            if value >> ports[name][1]:
+                raise PortMapError(f"port map: {table}.{name} = {value} does not fit the "
+                                   f"{ports[name][1]}-bit port")
     unconnected = [n for n, (d, _, _) in ports.items()
                    if d == "input" and n not in port_map.inputs()]
     if unconnected:
