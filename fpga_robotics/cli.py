@@ -5,6 +5,7 @@
     fpga-robotics board [options]         board top, LPF and bitstream
     fpga-robotics bench [WHAT] [options]  benchmarks: design (default), pysim, camera, world,
                                           viewer, shadow
+    fpga-robotics mutate [options]        mutation coverage (python -m fpga_robotics.mutation)
     fpga-robotics readback FILE.rrd       what a saved recording holds
 
 Each subcommand is the ``main(argv, prog)`` of its module, so ``fpga-robotics run --help`` and
@@ -29,6 +30,8 @@ COMMANDS = {
     "bench": (None, "print speed figures (see `fpga-robotics bench --list`)"),
     "ports": ("fpga_robotics.sim.backends.port_map",
               "write (--example) or check a port map for run --design verilog:..."),
+    "mutate": ("fpga_robotics.mutation.cli",
+               "mutation coverage: Yosys mutants of the design against the golden model"),
     "readback": ("fpga_robotics.readback_cli",
                  "what a saved .rrd recording holds, entity by entity"),
 }

@@ -68,8 +68,9 @@ class Mutant:
         """One line: what the mutant does and where."""
         what = {"inv": "inverted", "const0": "stuck at 0", "const1": "stuck at 1",
                 "cnot0": f"XOR bit {self.ctrlbit}", "cnot1": f"XNOR bit {self.ctrlbit}"}
+        cell = self.cell.rpartition(".")[2] if self.cell.startswith("$flatten") else self.cell
         where = (f"{self.signal}[{self.bit}]" if self.signal is not None
-                 else f"cell {self.cell} port {self.port}[{self.portbit}]")
+                 else f"cell {cell} port {self.port}[{self.portbit}]")
         module = self.module or "top"
         src = f" ({', '.join(self.sources)})" if self.sources else ""
         return f"#{self.index} {module}: {where} {what.get(self.mode, self.mode)}{src}"

@@ -126,9 +126,64 @@ def test_one_build_runs_the_design_and_each_mutant(tmp_path):
             np.testing.assert_array_equal(g.filtered, w.filtered | (1 << stuck.bit))
             assert g.outputs() == w.outputs()
         assert run(0) == want
+        # The unit judge on the same build: the design itself is not "caught", the stuck
+        # payload bit is, on the first frame (every filtered pixel changes).
+        from fpga_robotics.mutation.unit_judge import golden_results, judge_frames, judge_mutant
+
+        unit_frames = judge_frames(PARAMS)
+        golden = golden_results(PARAMS, unit_frames)
+        assert not judge_mutant(design, 0, unit_frames, golden).caught
+        v = judge_mutant(design, stuck.index, unit_frames, golden)
+        assert v.caught and v.first_frame == 0 and v.differing["filtered"] == len(unit_frames)
+        assert v.differing["found"] == 0 and "filtered" in v.effect()
         with pytest.raises(BackendError, match="the value must be 0..7"):
             design.set_runtime("mutsel", 8)
         with pytest.raises(BackendError, match="no \\[runtime\\] input 'mode'"):
             design.set_runtime("mode", 1)
     finally:
         design.close()
+
+
+# The judges and the scores --------------------------------------------------------------------
+
+
+def test_scores_by_hand():
+    from fpga_robotics.mutation.scores import blind_spots, by_module, robot_score, unit_score
+
+    # Six mutants: the unit judge catches 1, 2, 3, 5; the robot judge ran 1, 2, 3, 4 and
+    # caught 1 and 4 (4 is not unit-caught: it does not count in the robot score).
+    unit = {1: True, 2: True, 3: True, 4: False, 5: True, 6: False}
+    robot = {1: True, 2: False, 3: False, 4: True}
+    assert unit_score(unit) == {"total": 6, "caught": 4, "equivalent": 2, "score": 4 / 6}
+    assert robot_score(unit, robot) == {"judged": 3, "caught": 1, "score": 1 / 3}
+    assert blind_spots(unit, robot) == [2, 3]
+    assert unit_score({}) == {"total": 0, "caught": 0, "equivalent": 0, "score": None}
+
+    def m(i, module):
+        return mutation.Mutant(i, "inv", module, "$1", "Y", 0, None, None, None, (), "")
+
+    mods = by_module([m(1, "motor"), m(2, "motor"), m(3, ""), m(5, "motor")], unit, robot)
+    assert mods == {"motor": {"total": 3, "unit_caught": 3, "robot_caught": 1},
+                    "top": {"total": 1, "unit_caught": 1, "robot_caught": 0}}
+
+
+def test_bad_arguments_are_one_line_errors(tmp_path, monkeypatch):
+    import subprocess
+    import sys
+
+    def run(*argv, env=None):
+        return subprocess.run([sys.executable, "-m", "fpga_robotics.mutation", *argv],
+                              capture_output=True, text=True, timeout=120, env=env)
+
+    for argv, message in ((["--mutants", "0"], "--mutants must be 1..4000, got 0"),
+                          (["--seed", "-1"], "--seed must be >= 0"),
+                          (["--width", "33"], "bad design parameter")):
+        r = run(*argv, "--out", str(tmp_path / "o"))
+        assert r.returncode == 2 and message in r.stderr and "Traceback" not in r.stderr
+        assert len(r.stderr.strip().splitlines()) == 1
+    import os
+
+    r = run("--mutants", "3", "--out", str(tmp_path / "o"),
+            env={**os.environ, "YOSYS": "no-such-yosys"})
+    assert r.returncode == 2 and "YOSYS='no-such-yosys' is not an executable" in r.stderr
+    assert not (tmp_path / "o" / "mutants.json").exists()

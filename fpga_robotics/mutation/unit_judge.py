@@ -1,0 +1,110 @@
+"""The unit judge: each mutant against the golden model, frame by frame, on a fixed set of
+frames.
+
+The frames are seeded synthetic sequences that move every output: a still target at the
+centre, left and right; a sweep across the image; an approach through every proximity level;
+a target lost long enough for the search and found again on the other side; the same sweep
+in green (the colour select); a wooden distractor; noise frames that may match anywhere. They
+run in one order from a reset, so state (the motor's lost-frame count, the divider) matters.
+
+A mutant is *caught* when any output of any frame differs from the model's (the filtered
+image included) or the design breaks the frame protocol (no result strobe within the time-out,
+a filtered stream of the wrong length); otherwise it is *equivalent on these frames* (reported apart: it may be a
+real equivalent mutant, or a bug these frames cannot show).
+"""
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..sim import synthetic
+from ..sim.backends import BackendError, get_backend
+from ..sim.mutation import MUTATION_SELECT
+
+__all__ = ["COMPARED", "UnitVerdict", "judge_frames", "judge_mutant", "golden_results"]
+
+#: The outputs compared, in the order they are reported.
+COMPARED = ("found", "proximity", "centroid_x", "centroid_leds", "motor_left", "motor_right",
+            "filtered")
+
+
+@dataclass
+class UnitVerdict:
+    """What the unit judge found for one mutant."""
+
+    index: int
+    caught: bool
+    first_frame: int | None = None  # the first frame with a difference
+    # output -> frames in which it differs
+    differing: dict = field(default_factory=lambda: dict.fromkeys(COMPARED, 0))
+    first_difference: dict = field(default_factory=dict)  # output -> (model, mutant) there
+    failure: str | None = None  # the design broke the frame protocol (a timeout, a bad stream)
+
+    def effect(self):
+        """One line: what the mutant does to the outputs."""
+        if not self.caught:
+            return "no output differs on the unit frames"
+        if self.failure is not None:
+            return f"frame {self.first_frame}: {self.failure}"
+        parts = [f"{name} in {n} frame(s)" for name, n in self.differing.items() if n]
+        first = ", ".join(f"{k} {v[0]} -> {v[1]}" for k, v in self.first_difference.items())
+        return f"differs from frame {self.first_frame}: {first}; " + ", ".join(parts)
+
+
+def judge_frames(params, seed=0):
+    """``[(frame, colour)]``: the unit judge's frames for ``params``'s resolution."""
+    w, h, lost = params.width, params.height, params.lost_frames
+    rng = synthetic.make_rng(seed)
+    frames = []
+
+    def add(name, color="red", **kw):
+        s = synthetic.scenario(name, w, h, color=color, lost_frames=lost, rng=rng, **kw)
+        frames.extend((f, color) for f in s.frames)
+
+    for name in ("centre", "left", "right", "sweep", "approach", "lost"):
+        add(name)
+    add("sweep", color="green")
+    wood = synthetic.Blob("wood", w * 0.3, h * 0.5, radius=h * 0.15)
+    add("sweep", n_frames=6, distractors=(wood,))
+    frames.extend((synthetic.random_frame(w, h, rng), "red") for _ in range(4))
+    return frames
+
+
+def golden_results(params, frames):
+    """The model's results for ``frames`` from a reset."""
+    model = get_backend("model", params)
+    return [model.process_frame(f, color) for f, color in frames]
+
+
+def _value(result, name):
+    if name == "filtered":
+        return int(np.count_nonzero(result.filtered))  # matching pixels, for the report
+    value = getattr(result, name)
+    return bool(value) if name == "found" else int(value)
+
+
+def judge_mutant(design, index, frames, golden):
+    """Run mutant ``index`` of ``design`` (a backend of the mutant netlist with ``mutsel`` as a
+    ``[runtime]`` input; 0 is the unmutated design) on ``frames`` from a reset and compare
+    with ``golden``; a ``UnitVerdict``."""
+    design.set_runtime(MUTATION_SELECT, index)
+    design.reset()
+    verdict = UnitVerdict(index=index, caught=False)
+    for k, ((frame, color), want) in enumerate(zip(frames, golden)):
+        try:
+            got = design.process_frame(frame, color)
+        except BackendError as exc:  # a hang (no result strobe) or a broken stream: caught
+            if not verdict.caught:
+                verdict.caught, verdict.first_frame = True, k
+                verdict.failure = str(exc).split(": ", 2)[-1]
+            break
+        differ = [n for n in COMPARED
+                  if (not np.array_equal(got.filtered, want.filtered) if n == "filtered"
+                      else getattr(got, n) != getattr(want, n))]
+        for name in differ:
+            verdict.differing[name] += 1
+        if differ and not verdict.caught:
+            verdict.caught = True
+            verdict.first_frame = k
+            verdict.first_difference = {n: (_value(want, n), _value(got, n)) for n in differ}
+    return verdict
