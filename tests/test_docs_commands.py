@@ -421,6 +421,14 @@ PLANS = {
     "python -m fpga_robotics.sim.backends.port_map ports.toml":
         Plan(setup=("python -m fpga_robotics.sim.backends.port_map --example ports.toml",),
              out=(r"ports\.toml: follow_target, outputs found, proximity",)),
+    "python -m fpga_robotics.mutation --mutants 200":
+        Plan(shorter=(("--mutants", "12"), ("--width", "80"), ("--height", "60")),
+             out=(r"unit judge: \d+ caught, \d+ equivalent on these frames: score",),
+             files=("runs/mutation/n12-s1/mutants.json", "runs/mutation/n12-s1/mutants.v")),
+    "fpga-robotics mutate --mutants 40 --width 80 --height 60 --out runs/mutation/small":
+        Plan(shorter=(("--mutants", "12"),),
+             out=(r"12 mutants of follow_target 80x60",),
+             files=("runs/mutation/small/mutants.json",)),
     "python -m fpga_robotics.sim.backends.foreign_bench":
         Plan(shorter=(("--frames", "2"), ("--repeats", "1")),
              out=(r"verilator \(built-in\) +[\d.]+ ms/frame",
