@@ -73,6 +73,9 @@ def build_parser(prog="python -m fpga_robotics.run"):
                         "needs --ports (docs/foreign.md)")
     p.add_argument("--ports", metavar="PORTS.toml",
                    help="with --design: the port map of the Verilog design")
+    p.add_argument("--runtime", action="append", default=[], metavar="NAME=VALUE",
+                   help="with a Verilog design: hold its [runtime] input NAME at VALUE for the "
+                        "run (repeatable; e.g. mutsel=3 selects a mutant, docs/mutation.md)")
     p.add_argument("--save-video", metavar="PATH.mp4|PATH.avi",
                    help="also write the camera frames as a video (try it with --source)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
@@ -196,7 +199,11 @@ def _design_files(args, foreign=None):
     if args.design is None and foreign is None:
         if args.ports is not None:
             raise UsageError("--ports goes with --design verilog:FILE.v")
+        if getattr(args, "runtime", None):
+            raise UsageError("--runtime sets [runtime] inputs of a Verilog design: it goes with "
+                             "--design verilog:FILE.v (or a scenario's design.verilog)")
         return None
+    runtime_values(args)  # a malformed item is an error before any build
     if args.design is not None:
         if (not args.design.startswith("verilog:")
                 or not args.design[len("verilog:"):].strip(",")):
@@ -239,7 +246,40 @@ def _open_design(args, params, foreign=None):
     if missing:
         backend.close()
         raise UsageError(f"--design: the closed loop needs outputs.{missing[0]} in the port map")
-    return _UserDesign(backend)
+    design = _UserDesign(backend)
+    try:
+        apply_runtime(design, args)
+    except UsageError:
+        backend.close()
+        raise
+    return design
+
+
+def runtime_values(args):
+    """``--runtime NAME=VALUE`` items as ``{name: int}`` (``UsageError`` for a bad item)."""
+    values = {}
+    for item in getattr(args, "runtime", None) or ():
+        name, sep, value = item.partition("=")
+        try:
+            if not sep or not name.strip():
+                raise ValueError
+            values[name.strip()] = int(value.strip(), 0)
+        except ValueError:
+            raise UsageError(f"--runtime needs NAME=VALUE with an integer VALUE, got "
+                             f"{item!r}") from None
+    return values
+
+
+def apply_runtime(design, args):
+    """Hold the design's ``[runtime]`` inputs at the ``--runtime`` values (a design opened
+    once and reused for several runs gets its values again before each)."""
+    from .sim.backends.base import BackendError
+
+    for name, value in runtime_values(args).items():
+        try:
+            design.set_runtime(name, value)
+        except BackendError as exc:
+            raise UsageError(f"--runtime: {exc}") from None
 
 
 class _UserDesign:

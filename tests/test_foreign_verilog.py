@@ -304,6 +304,14 @@ def test_cli_runs_a_foreign_design_in_closed_loop(files, capsys, top, ports):
          "timeout: the result strobe 'done' never rose"),
         (["--design", "verilog:{dir}/missing.v", "--ports", "{dir}/never.toml"],
          "cannot read the Verilog file"),
+        (["--runtime", "mutsel=1"], "--runtime sets [runtime] inputs of a Verilog design"),
+        (["--design", "verilog:{dir}/follow_target.v", "--ports", "{dir}/ft.toml", "--runtime",
+          "mutsel"], "--runtime needs NAME=VALUE with an integer VALUE, got 'mutsel'"),
+        (["--design", "verilog:{dir}/follow_target.v", "--ports", "{dir}/ft.toml", "--runtime",
+          "mutsel=x"], "--runtime needs NAME=VALUE"),
+        (["--design", "verilog:{dir}/follow_target.v", "--ports", "{dir}/ft.toml", "--runtime",
+          "mutsel=1"], "--runtime: follow_target has no [runtime] input 'mutsel' (its runtime "
+                       "inputs: none)"),
     ],
 )
 def test_cli_bad_designs_exit_2_with_one_line(files, capsys, argv, message):
