@@ -122,7 +122,7 @@ def _relative_source(src):
     if norm.startswith(_HW_DIR + os.sep):
         rel = os.path.relpath(norm, _HW_DIR)
         # Installed, the gateware lives in fpga_robotics/hw; in the repository in hw/.
-        rel = rel[len("fpga_robotics" + os.sep):] if rel.startswith("fpga_robotics" + os.sep) else rel
+        rel = rel.removeprefix("fpga_robotics" + os.sep)
         return f"{rel}:{line}"
     parts = norm.split(os.sep)
     if "amaranth" in parts:

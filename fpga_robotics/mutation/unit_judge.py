@@ -21,7 +21,7 @@ from ..sim import synthetic
 from ..sim.backends import BackendError, get_backend
 from ..sim.mutation import MUTATION_SELECT
 
-__all__ = ["COMPARED", "UnitVerdict", "judge_frames", "judge_mutant", "golden_results"]
+__all__ = ["COMPARED", "UnitVerdict", "golden_results", "judge_frames", "judge_mutant"]
 
 #: The outputs compared, in the order they are reported.
 COMPARED = ("found", "proximity", "centroid_x", "centroid_leds", "motor_left", "motor_right",
