@@ -2,7 +2,9 @@
 renderer at several resolutions.
 
     python -m fpga_robotics.camera_bench [--frames 60] [--repeats 5] [--noise 2.0]
-                                         [--sizes 160x120,320x240,640x480]
+                                         [--sizes 160x120,320x240,640x480] [--sensor]
+
+``--sensor`` times the OV7670 sensor model's stages instead (``fpga_robotics.sim.sensor.bench``).
 
 The benchmark itself (scene, camera loop, timing) is ``fpga_robotics.sim.camera_bench``; this
 is its command line, which reports bad arguments as one-line usage errors.
@@ -45,6 +47,8 @@ def main(argv=None, prog=PROG):
                     help="also time with sensor noise of this std, 8-bit units (0: skip)")
     ap.add_argument("--sizes", default=",".join(f"{w}x{h}" for w, h in DEFAULT_SIZES),
                     help="comma-separated WIDTHxHEIGHT list")
+    ap.add_argument("--sensor", action="store_true",
+                    help="time each stage of the OV7670 sensor model instead of the renderer")
     args = ap.parse_args(argv)
     if not (1 <= args.frames <= 10**5 and 1 <= args.repeats <= 1000):
         raise UsageError(f"--frames must be 1..100000 and --repeats 1..1000, got "
@@ -52,6 +56,8 @@ def main(argv=None, prog=PROG):
     if not (math.isfinite(args.noise) and 0 <= args.noise <= 64):
         raise UsageError(f"--noise must be a number of 8-bit levels in 0..64, got {args.noise}")
     sizes = [_size(s) for s in args.sizes.split(",") if s.strip()]
+    if args.sensor:
+        return _sensor_table(sizes, args.frames, args.repeats)
     print(f"camera renderer, typical room ({len(typical_scene().walls)} walls, 3 people), "
           f"{args.frames} poses x {args.repeats} repeats; median milliseconds per frame "
           f"(wall clock / CPU time of this process)")
@@ -67,6 +73,21 @@ def main(argv=None, prog=PROG):
                                   noise_std=args.noise)
             line += f"  {statistics.median(wall):10.3f}  {statistics.median(cpu):9.3f}"
         print(line, flush=True)
+    return 0
+
+
+def _sensor_table(sizes, frames, repeats):
+    from .sim.sensor.bench import STAGES, stage_times
+
+    print(f"OV7670 sensor model on the renderer's frames of the typical room, turning at "
+          f"0.5 rad/s, {frames} frames x {repeats} repeats; median milliseconds per frame "
+          f"(stages: wall clock; frame: wall / CPU time of this process)")
+    print(f"{'size':>9}  " + "  ".join(f"{n:>8}" for n in STAGES) + f"  {'frame':>7}  {'cpu':>7}")
+    for w, h in sizes:
+        t = stage_times(w, h, frames=frames, repeats=repeats)
+        cells = "  ".join(f"{statistics.median(t[n]):8.3f}" for n in STAGES)
+        print(f"{w:>4}x{h:<4}  {cells}  {statistics.median(t['frame']):7.3f}  "
+              f"{statistics.median(t['frame_cpu']):7.3f}", flush=True)
     return 0
 
 
