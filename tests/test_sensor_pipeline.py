@@ -36,6 +36,17 @@ def test_same_seed_same_frames_other_seed_other_noise(room_frame):
         assert not np.any(f & 0x0F)  # RGB444 levels
 
 
+@pytest.mark.parametrize("bayer", ["BGGR", "off"])
+def test_a_black_frame_with_read_noise_stays_in_the_adc_range(bayer):
+    # Read noise takes dark pixels below zero; the ADC clips them to code 0, at full gain too.
+    cam = OV7670Sensor(160, 120, OV7670Params(bayer=bayer), rng=np.random.default_rng(2))
+    for _ in range(3):
+        out = cam.process(np.zeros((120, 160, 3), np.uint8))
+    assert cam.aec.gain == cam.params.max_gain
+    # At 32x the read noise (1/398 of full scale before the gain) shows; the mean stays dark.
+    assert out.max() > 0 and out.mean() < 48
+
+
 def test_other_resolutions_and_odd_sizes(room_frame):
     for w, h in ((640, 480), (161, 121), (16, 2)):
         img = np.ascontiguousarray(np.resize(room_frame, (h, w, 3)))

@@ -158,14 +158,14 @@ class OV7670Sensor:
         gains = self.aec.gain * self.awb.gains
         if self._channels is None:
             q *= gains.astype(np.float32)
-            np.minimum(q, np.float32(1.0), out=q)
+            np.clip(q, np.float32(0.0), np.float32(1.0), out=q)  # the ADC's range
             means = q.reshape(-1, 3).mean(axis=0)
         else:
             sums, counts = np.zeros(3), np.zeros(3)
             for i, j, c in self._tile:
                 site = q[i::2, j::2]
                 site *= np.float32(gains[c])
-                np.minimum(site, np.float32(1.0), out=site)
+                np.clip(site, np.float32(0.0), np.float32(1.0), out=site)  # the ADC's range
                 sums[c] += site.sum(dtype=np.float64)
                 counts[c] += site.size
             means = sums / np.maximum(counts, 1)
