@@ -117,6 +117,8 @@ def _stage_images(folder):
     for i, (title, img) in enumerate(stages):
         big = cv2.resize(img, None, fx=2, fy=2, interpolation=cv2.INTER_NEAREST)
         ok, png = cv2.imencode(".png", cv2.cvtColor(big, cv2.COLOR_RGB2BGR))
+        if not ok:
+            raise UsageError("OpenCV could not encode a PNG (is its image codec installed?)")
         path = folder / f"sensor_stage_{i}.png"
         write_atomic(path, png.tobytes(), what="stage image")
         print(f"{path}: {title}")

@@ -29,7 +29,7 @@ import difflib
 import math
 import re
 import tomllib
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, field, fields
 from importlib import resources
 from pathlib import Path
 
@@ -170,7 +170,7 @@ class CameraConfig:
     tilt: float | None
     noise_std: float
     sensor: str = "plain"  # "plain" or "ov7670" (sim.sensor, with the parameters below)
-    ov7670: OV7670Params = OV7670Params()
+    ov7670: OV7670Params = field(default_factory=OV7670Params)
 
     @property
     def frame_period(self):

@@ -1,6 +1,7 @@
 """Auto-exposure (AEC/AGC) and auto white balance (AWB) of the OV7670 sensor model: their
 convergence over frames, hand-computed from the chip's documented rules."""
 
+import itertools
 import math
 
 import numpy as np
@@ -12,8 +13,8 @@ from fpga_robotics.sim.sensor.white_balance import grey_world_gains
 
 # A linear camera (no noise, mosaic or gamma) so that the frame's mean luminance is
 # 255.75 * clip(radiance * sensitivity * exposure * gain, 0, 1), rounded to 10-bit codes.
-LINEAR = dict(noise=False, bayer="off", gamma="off", awb=False, settle_frames=0,
-              sensitivity=1.2)
+LINEAR = {"noise": False, "bayer": "off", "gamma": "off", "awb": False, "settle_frames": 0,
+          "sensitivity": 1.2}
 
 
 def flat(value):
@@ -69,7 +70,7 @@ def test_in_the_control_zone_the_exposure_moves_a_sixteenth_a_frame():
     n = math.ceil(math.log(117 / lumas[0]) / math.log(15 / 16))
     assert n == 4
     # The output (RGB444 levels) follows the exposure: each frame darker until frame 4.
-    assert all(a >= b for a, b in zip(means[:5], means[1:5]))
+    assert all(a >= b for a, b in itertools.pairwise(means[:5]))
     assert means[4] == means[7]
 
 

@@ -16,8 +16,8 @@ __all__ = ["PARAMS", "OV7670Params"]
 PARAMS = {
     "sensitivity": (
         1.2, "float", (0.01, 1000.0), "full scales",
-        "model choice: signal of a white (radiance 1) surface exposed a whole frame at gain 1; "
-        "puts the shipped rooms at about half a frame of exposure, as an indoor scene at 30 fps"),
+        ("model choice: signal of a white (radiance 1) surface exposed a whole frame at gain 1; "
+         "puts the shipped rooms at about half a frame of exposure, as an indoor scene at 30 fps")),
     "aec": (True, "bool", None, "", "COM8[0] and COM8[2] (AEC, AGC) on at power-on"),
     "aec_window": ((0x63, 0x75), "pair", (0, 255), "8-bit luminance",
                    "AEB 0x25 = 0x63, AEW 0x24 = 0x75 (stable operating region)"),
@@ -42,8 +42,8 @@ PARAMS = {
               "the raw output's first lines B G B G ..., G R G R ..."),
     "motion_blur": (True, "bool", None, "", "smear from the robot's turn rate over the exposure"),
     "input_gamma": (1.0, "float", (0.1, 5.0), "",
-                    "the renderer's 8-bit values are linear in light (1.0); 2.2 for an sRGB "
-                    "renderer"),
+                    ("the renderer's 8-bit values are linear in light (1.0); 2.2 for an sRGB "
+                     "renderer")),
 }
 
 
