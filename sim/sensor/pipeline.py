@@ -15,8 +15,9 @@ Stages, in the order light meets them (each a small module of this package, docs
 8. **Gamma** (``gamma``) and **RGB444** (``rgb444``): one table from code to output byte.
 
 After each frame the AEC/AGC (``exposure``) and AWB (``white_balance``) update from that frame's
-statistics, so the next frame shows the change, as on the robot. All per-frame work is on
-preallocated arrays.
+statistics, so the next frame shows the change, as on the robot. The tables (radiance, gamma
+and RGB444) and the larger buffers are built once per sensor; a frame costs a few dozen
+whole-array numpy and OpenCV calls.
 """
 
 import cv2
