@@ -152,6 +152,8 @@ class ClosedLoop:
 
     def _build_camera(self, cam, spec):
         """The camera on the robot; mount values the scenario leaves unset are the robot's."""
+        from .connectors.camera import make_sensor
+
         return CameraConnector(
             cam.width, cam.height, cam.hfov,
             mount_height=cam.mount_height if cam.mount_height is not None else spec.camera_height,
@@ -161,6 +163,9 @@ class ClosedLoop:
             noise_std=cam.noise_std,
             # A stream of its own, so that camera noise never shifts the world's randomness.
             rng=np.random.default_rng([self.seed, 0xCA3E]),
+            # camera.sensor = "ov7670": the sensor model, blurred by the robot's turn rate.
+            sensor=make_sensor(cam, self.seed),
+            turn_rate=lambda: self.world.robot_velocity()[1],
         )
 
     # The steps of one frame ----------------------------------------------------------------

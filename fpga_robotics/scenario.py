@@ -8,6 +8,8 @@ A scenario file has two kinds of sections. The world's sections (``room``, ``rob
   period);
 - ``[camera]``: ``resolution`` ("WxH"), ``fps``, ``hfov`` (rad), ``mount_height`` (m),
   ``mount_forward`` (m ahead of the robot's centre), ``tilt`` (rad, up positive), ``noise_std``;
+  ``sensor`` (``"plain"``: the rendered frame plus ``noise_std``; ``"ov7670"``: the sensor model
+  ``fpga_robotics.sim.sensor`` with its ``[camera.ov7670]`` table, docs/camera.md);
 - ``[color]``: ``initial`` colour and ``changes = [{at = seconds, color = "..."}, ...]``;
 - ``[design]``: any ``FollowTargetParams`` field except ``width``/``height`` (those come from
   the camera resolution), and ``preset`` (``"published"``: ``FollowTargetParams.published()``
@@ -27,7 +29,7 @@ import difflib
 import math
 import re
 import tomllib
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, field, fields
 from importlib import resources
 from pathlib import Path
 
@@ -43,6 +45,8 @@ from .hw.params import (
 )
 from .hw.pixel import COLOR_SELECT
 from .sim.camera import max_hfov, max_tilt, vertical_fov
+from .sim.sensor import PARAMS as SENSOR_PARAMS
+from .sim.sensor import OV7670Params
 from .sim.world.config import MAX_TIME, WORLD_SECTIONS
 from .summary import CHECKS
 
@@ -87,6 +91,9 @@ DEFAULTS = {
         "mount_forward": None,
         "tilt": None,
         "noise_std": 0.0,
+        # The sensor model after the renderer (camera.sensor, camera.ov7670.*).
+        "sensor": "plain",
+        "ov7670": {k: list(v[0]) if v[1] == "pair" else v[0] for k, v in SENSOR_PARAMS.items()},
     },
     "color": {"initial": "red", "changes": []},
 }
@@ -162,6 +169,8 @@ class CameraConfig:
     mount_forward: float | None
     tilt: float | None
     noise_std: float
+    sensor: str = "plain"  # "plain" or "ov7670" (sim.sensor, with the parameters below)
+    ov7670: OV7670Params = field(default_factory=OV7670Params)
 
     @property
     def frame_period(self):
@@ -360,6 +369,7 @@ def _check_sections(data, path):
                 f"{where}{section} must be a table ([{section}] in a file, --set "
                 f"{section}.KEY=VALUE on the command line), got {value!r}")
         allowed = allowed_keys[section]
+        _check_subtables(value, DEFAULTS.get(section, {}), section, where)
         for key in value:
             if key not in allowed:
                 if section == "design" and key in ("width", "height"):
@@ -371,12 +381,29 @@ def _check_sections(data, path):
                 )
 
 
+def _check_subtables(table, defaults, section, where):
+    """A section's sub-tables (``camera.ov7670``) are tables of known keys."""
+    for key, default in defaults.items():
+        if isinstance(default, dict) and key in table:
+            sub = table[key]
+            if not isinstance(sub, dict):
+                raise ScenarioError(f"{where}{section}.{key} must be a table ([{section}.{key}] "
+                                    f"in a file), got {sub!r}")
+            for k in sub:
+                if k not in default:
+                    raise ScenarioError(f"{where}unknown key {section}.{key}.{k}"
+                                        f"{_close(k, default, f'{section}.{key}')}")
+
+
 def _fill_defaults(data):
     for section, defaults in DEFAULTS.items():
         table = data.setdefault(section, {})
         for key, value in defaults.items():
             if key not in table and value is not None:
                 table[key] = copy.deepcopy(value)
+            elif isinstance(value, dict) and isinstance(table[key], dict):
+                for k, v in value.items():  # a sub-table's keys the file leaves out
+                    table[key].setdefault(k, copy.deepcopy(v))
     data.setdefault("design", {})
     data.setdefault("checks", {})
     data.setdefault("description", "")
@@ -596,7 +623,43 @@ def _camera(data):
         mount_forward=_limited(data, "camera.mount_forward", optional=True),
         tilt=_limited(data, "camera.tilt", optional=True),
         noise_std=_limited(data, "camera.noise_std"),
+        sensor=_choice(cam["sensor"], "camera.sensor", ("plain", "ov7670")),
+        ov7670=_sensor_params(cam["ov7670"]),
     )
+
+
+def _choice(value, name, choices):
+    if value not in choices:
+        raise ScenarioError(f"{name} must be one of {', '.join(map(repr, choices))}, "
+                            f"got {value!r}")
+    return value
+
+
+def _sensor_params(table):
+    """``[camera.ov7670]`` checked against ``sim.sensor.PARAMS``."""
+    values = {}
+    for key, (_, kind, limits, unit, _) in SENSOR_PARAMS.items():
+        name, value = f"camera.ov7670.{key}", table[key]
+        if kind == "bool" and not isinstance(value, bool):
+            raise ScenarioError(f"{name} must be true or false, got {value!r}")
+        if kind == "choice":
+            _choice(value, name, limits)
+        if kind == "float":
+            value = _in_range(value, name, *limits, unit)
+        if kind == "int" and not (_is_int(value) and limits[0] <= value <= limits[1]):
+            raise ScenarioError(f"{name} must be an integer {limits[0]}..{limits[1]} ({unit}), "
+                                f"got {value!r}")
+        if kind == "pair" and not (isinstance(value, list) and len(value) == 2
+                                   and all(_is_int(v) and limits[0] <= v <= limits[1]
+                                           for v in value) and value[0] < value[1]):
+            raise ScenarioError(f"{name} must be [low, high], integers {limits[0]}..{limits[1]} "
+                                f"with low < high ({unit}), got {value!r}")
+        values[key] = tuple(value) if kind == "pair" else value
+    (lo, hi), (fast_lo, fast_hi) = values["aec_window"], values["aec_fast_zone"]
+    if not fast_lo <= lo < hi <= fast_hi:
+        raise ScenarioError(f"camera.ov7670.aec_window {[lo, hi]} must lie inside "
+                            f"camera.ov7670.aec_fast_zone {[fast_lo, fast_hi]}")
+    return OV7670Params.from_dict(values)
 
 
 def _check_camera_geometry(camera, world):

@@ -253,6 +253,9 @@ MAKE_CLIP = "python -m fpga_robotics.run --duration 1 --rerun off --quiet --save
 
 SCENARIO_NAMES = ("follow_person", "divider", "lighting", "heavy_robot", "lost_target")
 PASS = r"(?m)^verdict: PASS$"
+#: Why docs/camera.md's sensor-model runs keep their scenario's duration.
+_SENSOR_WHY = ("the page gives the verdict of the whole scenario (the divider's mean-distance "
+               "check fails in runs under 15 s; the dimming of lighting lasts from 8 s to 24 s)")
 SAVED_DEFAULT = r"saved \d+ frames .* to runs/follow_person\.rrd .*open it with: rerun runs/follow_person\.rrd"
 
 _DIVIDER_WHY = (
@@ -508,6 +511,30 @@ PLANS = {
     "python -m fpga_robotics.camera_bench":
         Plan(shorter=(("--frames", "2"), ("--repeats", "1")),
              out=(r"(?m)^\s*160x120\s+[\d.]+", r"(?m)^\s*640x480\s+[\d.]+")),
+    # docs/camera.md: the sensor model ---------------------------------------------------------
+    "python -m fpga_robotics.camera_bench --sensor --sizes 160x120,640x480":
+        Plan(shorter=(("--frames", "2"), ("--repeats", "1")),
+             out=(r"(?m)^\s*160x120(\s+[\d.]+){9}$", r"(?m)^\s*640x480(\s+[\d.]+){9}$")),
+    "python -m fpga_robotics.camera_bench --stage-images docs/images":
+        Plan(files=tuple(f"docs/images/sensor_stage_{i}.png" for i in range(7)),
+             out=(r"sensor_stage_6\.png: RGB444",)),
+    "python -m fpga_robotics.run --scenario divider --backend cxxrtl --set camera.sensor=ov7670":
+        Plan(duration="keep", duration_why=_SENSOR_WHY, out=(PASS,)),
+    "python -m fpga_robotics.run --scenario divider --backend cxxrtl --rerun off "
+    "--set camera.sensor=ov7670":
+        Plan(duration="keep", duration_why=_SENSOR_WHY, out=(PASS,)),
+    "python -m fpga_robotics.run --scenario lighting --backend cxxrtl --rerun off "
+    "--set camera.sensor=ov7670":
+        Plan(duration="keep", duration_why=_SENSOR_WHY, out=(PASS,)),
+    "python -m fpga_robotics.run --scenario divider --backend cxxrtl --rerun off "
+    "--set design.diff_min=5 --set camera.sensor=ov7670":
+        Plan(duration="keep", duration_why=_SENSOR_WHY,
+             out=(PASS, r"target: first found at 0\.00 s, in view 100%, found 100%")),
+    "python -m fpga_robotics.run --scenario lighting --backend cxxrtl --rerun off "
+    "--set camera.sensor=ov7670 "
+    "--set 'lighting.keyframes=[[0,0.6,0.4],[8,0.28,0.2],[18,0.28,0.2],[24,0.8,0.5]]'":
+        Plan(duration="keep", duration_why=_SENSOR_WHY,
+             out=(PASS, r"target: first found at 0\.00 s, in view 100%, found 100%")),
     "python -m fpga_robotics.sim.backends.pysim --frames 7":
         Plan(shorter=(("--frames", "2"),),
              out=(r"every frame equal to the golden model", r"median [\d.]+ s wall")),

@@ -24,6 +24,8 @@ FILES = {
     "long": f'name = "{"a" * 65}"\n[sim]\nduration = 0.5\n',
     "nan_change": '[sim]\nduration = 0.5\n[color]\nchanges = [{at = nan, color = "green"}]\n',
     "camera_int": "camera = 5\n[sim]\nduration = 0.5\n",
+    "ov7670_unknown": '[sim]\nduration = 0.5\n[camera]\nsensor = "ov7670"\n'
+                      '[camera.ov7670]\nmax_gian = 8\n',
 }
 
 # (id, arguments, text the one line must contain)
@@ -117,6 +119,34 @@ CASES = [
     ("furniture-tiny", ["--set", "room.furniture=[{center = [3, 2], size = [1e-300, 1e-300]}]"],
      "room.furniture[0].size[0] must be"),
     ("yield-gap-negative", ["--set", "people.0.yield_gap=-1"], "people[0].yield_gap must be"),
+    # the sensor model (camera.sensor, [camera.ov7670])
+    ("sensor-unknown", ["--set", "camera.sensor=ov7725"],
+     "camera.sensor must be one of 'plain', 'ov7670', got 'ov7725'"),
+    ("sensor-table-int", ["--set", "camera.ov7670=3"], "camera.ov7670 must be a table"),
+    ("sensor-key-unknown", ["--set", "camera.ov7670.gian=2"],
+     "unknown scenario key 'camera.ov7670.gian'"),
+    ("sensor-key-unknown-in-file", ["--scenario", "{in}/ov7670_unknown.toml"],
+     "unknown key camera.ov7670.max_gian (did you mean camera.ov7670.max_gain"),
+    ("sensor-gain-below-1", ["--set", "camera.ov7670.max_gain=0.5"],
+     "camera.ov7670.max_gain must be >= 1, got 0.5"),
+    ("sensor-sensitivity-nan", ["--set", "camera.ov7670.sensitivity=nan"],
+     "camera.ov7670.sensitivity must be a finite number"),
+    ("sensor-exposure-huge", ["--set", "camera.ov7670.exposure=2"],
+     "camera.ov7670.exposure must be <= 1"),
+    ("sensor-bool-int", ["--set", "camera.ov7670.awb=1"],
+     "camera.ov7670.awb must be true or false, got 1"),
+    ("sensor-gamma-unknown", ["--set", "camera.ov7670.gamma=srgb"],
+     "camera.ov7670.gamma must be one of 'default', 'driver', 'off', got 'srgb'"),
+    ("sensor-bayer-unknown", ["--set", "camera.ov7670.bayer=BBGG"],
+     "camera.ov7670.bayer must be one of"),
+    ("sensor-settle-float", ["--set", "camera.ov7670.settle_frames=2.5"],
+     "camera.ov7670.settle_frames must be an integer 0..1000"),
+    ("sensor-window-reversed", ["--set", "camera.ov7670.aec_window=[117, 99]"],
+     "camera.ov7670.aec_window must be [low, high]"),
+    ("sensor-window-outside-zone", ["--set", "camera.ov7670.aec_window=[30, 117]"],
+     "camera.ov7670.aec_window [30, 117] must lie inside camera.ov7670.aec_fast_zone [64, 208]"),
+    ("sensor-snr-huge", ["--set", "camera.ov7670.snr_db=1e300"],
+     "camera.ov7670.snr_db must be <= 80"),
 ]
 
 
