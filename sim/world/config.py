@@ -13,6 +13,7 @@ from dataclasses import dataclass
 
 from .kinematics import DEG
 from .robots import ROBOT_MODELS
+from .terrain import TerrainPatch
 
 __all__ = [
     "DEFAULT_SHIRT",
@@ -80,6 +81,21 @@ class RoomConfig:
     floor_color: tuple
     ceiling_color: tuple
     furniture: tuple  # of FurnitureConfig
+    terrain: tuple = ()  # of terrain.TerrainPatch, in file order (the last listed wins)
+
+
+@dataclass(frozen=True)
+class Uncertainty:
+    """Seeded imperfections of the robot (all zero: the ideal robot, today's runs)."""
+
+    motor_gain_error: float = 0.0  # each wheel's gain is 1 + U(-e, e), drawn once per run
+    motor_noise_dps: float = 0.0  # white noise on each wheel's speed, std, deg/s (per 10 ms)
+    slip_rate_hz: float = 0.0  # wheel slip events per second (Poisson)
+    slip_duration_s: float = 0.2  # each slip's length
+    slip_traction: float = 0.2  # traction factor during a slip
+
+    def __bool__(self):
+        return bool(self.motor_gain_error or self.motor_noise_dps or self.slip_rate_hz)
 
 
 @dataclass(frozen=True)
@@ -87,6 +103,7 @@ class RobotConfig:
     spec: object  # RobotSpec
     start: tuple  # (x, y), m
     heading: float  # rad
+    uncertainty: Uncertainty = Uncertainty()
 
 
 @dataclass(frozen=True)
@@ -249,6 +266,46 @@ def _parse_furniture(item, path, index):
     return FurnitureConfig(name, kind, center, size, angle, height, color)
 
 
+def _parse_terrain(item, path, index, room):
+    t = _Table(item, path)
+    name = t.string("name", f"terrain{index}")
+    has_points, has_center = t.has("points"), t.has("center")
+    if has_points == has_center:
+        raise WorldConfigError(f"{path} needs either points = [[x, y], ...] (a polygon) or "
+                               f"center = [x, y] with size = [length, width] (a rectangle)")
+    if has_points:
+        points = t.raw("points")
+        if not isinstance(points, list) or len(points) < 3:
+            raise WorldConfigError(f"{t.key('points')} must be an array of at least 3 points "
+                                   f"[x, y], got {_show(points)}")
+        polygon = tuple(_check_vector(p, f"{t.key('points')}[{i}]", 2, "a point [x, y] in m")
+                        for i, p in enumerate(points))
+        area = 0.5 * abs(sum(x0 * y1 - x1 * y0 for (x0, y0), (x1, y1)
+                             in zip(polygon, polygon[1:] + polygon[:1])))
+        if area < 1e-4:
+            raise WorldConfigError(f"{t.key('points')} encloses no area (the points are on "
+                                   f"a line)")
+    else:
+        center = t.point("center", None)
+        size = _check_vector(t.raw("size", (1.0, 1.0)), t.key("size"), 2,
+                             "[length, width] in m", ge=0.01, le=100)
+        angle = t.number("angle_deg", 0.0, ge=-360, le=360) * DEG
+        shape = FurnitureConfig(name, "box", center, size, angle, 0.0, (0, 0, 0))
+        polygon = tuple(tuple(c) for c in shape.corners())
+    friction = t.number("friction", 1.0, ge=0.01, le=10)
+    slope = t.number("slope_deg", 0.0, ge=0, le=45) * DEG
+    slope_dir = t.number("slope_dir_deg", 0.0, ge=-360, le=360) * DEG
+    # No colour: the patch is not drawn (a wet floor looks like the floor).
+    color = t.color("color", (0.0, 0.0, 0.0)) if t.has("color") else t.raw("color")
+    t.finish()
+    inside = [(x, y) for x, y in polygon if -1e-9 <= x <= room[0] + 1e-9
+              and -1e-9 <= y <= room[1] + 1e-9]
+    if not inside:
+        raise WorldConfigError(f"{path} lies outside the room (0..{room[0]:g} x "
+                               f"0..{room[1]:g} m)")
+    return TerrainPatch(name, polygon, friction, slope, slope_dir, color)
+
+
 def _parse_room(section):
     t = _Table(section, "room")
     width = t.number("width", 8.0, gt=0.5, le=100, unit="m")
@@ -263,6 +320,12 @@ def _parse_room(section):
             f"room.furniture must be an array of tables ([[room.furniture]]), got {_show(items)}")
     furniture = tuple(_parse_furniture(item, f"room.furniture[{i}]", i)
                       for i, item in enumerate(items))
+    patches = t.raw("terrain", [])
+    if not isinstance(patches, list):
+        raise WorldConfigError(
+            f"room.terrain must be an array of tables ([[room.terrain]]), got {_show(patches)}")
+    terrain = tuple(_parse_terrain(item, f"room.terrain[{i}]", i, (width, depth))
+                    for i, item in enumerate(patches))
     names = [f.name for f in furniture]
     for i, name in enumerate(names):
         if name in names[:i]:
@@ -273,7 +336,8 @@ def _parse_room(section):
             raise WorldConfigError(f"room.furniture[{i}].center {_fmt(f.center)} is outside "
                                    f"the room (0..{width:g} x 0..{depth:g} m)")
     t.finish()
-    return RoomConfig(width, depth, height, wall_color, floor_color, ceiling_color, furniture)
+    return RoomConfig(width, depth, height, wall_color, floor_color, ceiling_color, furniture,
+                      terrain)
 
 
 def _inside(point, radius, room):
@@ -313,6 +377,13 @@ def _parse_robot(section, room):
     # None (the presets' value): commands are ramped, a jump never tips the robot.
     fields["motor_step_response"] = t.number("motor_step_response", base.motor_step_response,
                                              gt=0, le=10, unit="s")
+    uncertainty = Uncertainty(
+        motor_gain_error=t.number("motor_gain_error", 0.0, ge=0, le=0.9),
+        motor_noise_dps=t.number("motor_noise_dps", 0.0, ge=0, le=10000, unit="deg/s"),
+        slip_rate_hz=t.number("slip_rate_hz", 0.0, ge=0, le=100, unit="1/s"),
+        slip_duration_s=t.number("slip_duration_s", 0.2, gt=0, le=60, unit="s"),
+        slip_traction=t.number("slip_traction", 0.2, ge=0.01, le=1),
+    )
     t.finish()
     if not fields["camera_height"] < room.height:
         # The renderer draws from between the floor and the ceiling only.
@@ -324,7 +395,7 @@ def _parse_robot(section, room):
         raise WorldConfigError(
             f"robot.start {_fmt(start)} puts the robot (radius {spec.body_radius:g} m) outside "
             f"the room (0..{room.width:g} x 0..{room.depth:g} m)")
-    return RobotConfig(spec, tuple(start), heading)
+    return RobotConfig(spec, tuple(start), heading, uncertainty)
 
 
 def _default_people(room):

@@ -21,7 +21,10 @@ from .config import WorldConfigError, parse_world_config
 from .lighting import LightingSchedule
 from .motors import DriveMotors
 from .people import PersonPath, person_bands
+from .robots import G
 from .room import add_static_shapes, map_data, scene_walls
+from .terrain import TerrainMap, slope_pitch
+from .uncertainty import MotorUncertainty
 
 __all__ = ["AT_FAULT_SPEED", "MAX_SUBSTEP", "World"]
 
@@ -84,6 +87,14 @@ class World:
         self.motors = DriveMotors(spec)
         self.lighting = LightingSchedule(config.lighting)
 
+        self.terrain = TerrainMap(config.room.terrain)
+        self._patch = None  # the terrain patch under the robot's centre
+        self._traction = 1.0  # the factor the joints' forces are set to
+        # Motor gain, noise and slips: a stream of their own (None for the ideal robot), so
+        # that they never shift the people's randomness.
+        self.uncertainty = (MotorUncertainty(config.robot.uncertainty, self.seed)
+                            if config.robot.uncertainty else None)
+
         self.space = space = pymunk.Space()
         space.gravity = (0.0, 0.0)
         space.iterations = 10
@@ -109,7 +120,9 @@ class World:
         gear = pymunk.GearJoint(control, body, 0.0, 1.0)
         gear.max_bias = 0.0
         gear.max_force = spec.traction_torque
+        self._pivot, self._gear = pivot, gear
         space.add(body, shape, control, pivot, gear)
+        self._patch = self.terrain.at(*config.robot.start) if self.terrain else None
 
         self._names = add_static_shapes(space, config.room, wall_type=_WALL,
                                         furniture_type=_FURNITURE, friction=_FRICTION)
@@ -188,6 +201,12 @@ class World:
     def _substep(self, h):
         spec = self.robot_spec
         wl, wr = self.motors.step(h)
+        slip = 1.0
+        if self.uncertainty is not None:
+            wl, wr, slip = self.uncertainty.step(h, wl, wr, self.time)
+            self._events += self.uncertainty.drain_events()
+        if self.terrain or self.uncertainty is not None:
+            self._apply_terrain(slip)
         r = spec.wheel_radius
         v = r * (wl + wr) * 0.5
         if self.tipped is None:
@@ -220,6 +239,31 @@ class World:
             person.body.velocity = ((x - px) / h, (y - py) / h)
         self.space.step(h)
         self.time = t1
+
+    def _apply_terrain(self, slip):
+        """The patch under the robot: its traction factor (times a slip's) on the drive's
+        joints, and gravity's downhill component on the body (pymunk clears it each step)."""
+        x, y = self.robot_body.position
+        patch = self.terrain.at(x, y) if self.terrain else None
+        if patch is not self._patch:
+            self._patch = patch
+            self._events.append(f"terrain: on {patch.name!r}" if patch is not None
+                                else "terrain: off the patches")
+        factor = slip * (patch.friction if patch is not None else 1.0)
+        if factor != self._traction:
+            self._traction = factor
+            self._pivot.max_force = self.robot_spec.traction_force * factor
+            self._gear.max_force = self.robot_spec.traction_torque * factor
+        if patch is not None and patch.slope > 0.0:
+            self.robot_body.force = patch.downhill_force(self.robot_spec.mass, G)
+
+    def terrain_under_robot(self):
+        """The terrain patch under the robot's centre (``terrain.TerrainPatch``), or None."""
+        return self._patch
+
+    def camera_pitch(self):
+        """The camera's extra pitch from the slope under the robot, rad (positive looks up)."""
+        return slope_pitch(self._patch, self.robot_body.angle)
 
     def _advance_time(self, h):
         y = h - self._time_error
@@ -281,7 +325,7 @@ class World:
         x, y, heading = self.robot_pose()
         return CameraPose(x=x + spec.camera_forward * math.cos(heading),
                           y=y + spec.camera_forward * math.sin(heading), heading=heading,
-                          height=spec.camera_height, tilt=spec.camera_tilt)
+                          height=spec.camera_height, tilt=spec.camera_tilt + self.camera_pitch())
 
     def people_states(self):
         """Every person's position, as ``records.PersonState``."""
