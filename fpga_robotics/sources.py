@@ -124,11 +124,13 @@ def open_source(spec, width, height):
 
 
 def run_source(source, design, *, color="red", recorder=None, progress=None, max_frames=None,
-               duration=None, hfov=1.047):
+               duration=None, hfov=1.047, on_frame=None):
     """Run the design on every frame of ``source`` and summarise its outputs.
 
     Returns a JSON-ready dict: the source, frame count, timing, how often the target was
-    found, and the per-frame outputs (``results``).
+    found, and the per-frame outputs (``results``). ``on_frame(FrameRecord)`` is called for
+    every frame; a source with recorded times (a bag: ``frame_time(k)``) stamps the frames
+    with them, others with the wall time since the start.
     """
     sel = color_select_value(color)
     design.reset()
@@ -158,13 +160,19 @@ def run_source(source, design, *, color="red", recorder=None, progress=None, max
                 "motor_left": int(result.motor_left),
                 "motor_right": int(result.motor_right),
             })
-            if recorder is not None:
-                recorder.log_frame(FrameRecord(
-                    frame=k, sim_time=time.perf_counter() - start, camera_rgb=rgb,
+            if recorder is not None or on_frame is not None:
+                stamp = (source.frame_time(k) if hasattr(source, "frame_time")
+                         else time.perf_counter() - start)
+                record = FrameRecord(
+                    frame=k, sim_time=stamp, camera_rgb=rgb,
                     color_sel=sel, result=result, robot_x=0.0, robot_y=0.0, robot_heading=0.0,
                     robot_v=0.0, robot_w=0.0, cmd_v=0.0, cmd_w=0.0, camera_hfov=hfov,
                     events=events,
-                ))
+                )
+                if recorder is not None:
+                    recorder.log_frame(record)
+                if on_frame is not None:
+                    on_frame(record)
             if progress is not None:
                 progress(k + 1, None)
     except KeyboardInterrupt:
