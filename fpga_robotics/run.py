@@ -60,7 +60,7 @@ def build_parser(prog="python -m fpga_robotics.run"):
                         "display, else save")
     p.add_argument("--log-every", type=int, default=1, metavar="N",
                    help="log every Nth frame's images to the viewer (default 1)")
-    p.add_argument("--source", metavar="camera:N|VIDEO|FOLDER",
+    p.add_argument("--source", metavar="camera:N|VIDEO|FOLDER|bag:PATH[:TOPIC]",
                    help="run the design on real frames instead of the simulation (no physics)")
     p.add_argument("--max-frames", type=int, metavar="N", help="with --source: stop after N")
     p.add_argument("--shadow", metavar="SPEC",

@@ -1,4 +1,5 @@
-"""Frames from outside the simulation: a camera, a video file or a folder of images.
+"""Frames from outside the simulation: a camera, a video file, a folder of images or the
+images of a ROS bag (``fpga_robotics.ros.bag_source``).
 
 ``open_source(spec, width, height)`` yields RGB888 frames at the design's resolution, resized
 with ``cv2.resize`` (``INTER_LINEAR``) and converted from OpenCV's BGR order. ``run_source``
@@ -14,7 +15,7 @@ from .errors import UsageError
 from .hw.pixel import color_select_value
 from .sim.records import FrameRecord
 
-__all__ = ["IMAGE_SUFFIXES", "FrameSource", "open_source", "run_source"]
+__all__ = ["IMAGE_SUFFIXES", "FrameSource", "open_source", "run_source", "to_design_rgb"]
 
 #: Files of a folder source that are read as frames (in sorted name order).
 IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff", ".ppm", ".pgm")
@@ -80,17 +81,7 @@ class FrameSource:
         self._first = first
 
     def _convert(self, bgr):
-        import cv2
-
-        if bgr.ndim == 2:
-            bgr = cv2.cvtColor(bgr, cv2.COLOR_GRAY2BGR)
-        elif bgr.shape[2] == 4:
-            bgr = cv2.cvtColor(bgr, cv2.COLOR_BGRA2BGR)
-        if bgr.dtype != np.uint8:  # 16-bit images: keep the top 8 bits
-            bgr = (bgr >> 8).astype(np.uint8) if bgr.dtype == np.uint16 else bgr.astype(np.uint8)
-        if bgr.shape[:2] != (self.height, self.width):
-            bgr = cv2.resize(bgr, (self.width, self.height), interpolation=cv2.INTER_LINEAR)
-        return np.ascontiguousarray(cv2.cvtColor(bgr, cv2.COLOR_BGR2RGB))
+        return to_design_rgb(bgr, self.width, self.height)
 
     def __iter__(self):
         import cv2
@@ -117,9 +108,28 @@ class FrameSource:
             self._cap = None
 
 
+def to_design_rgb(bgr, width, height):
+    """An OpenCV image (BGR, grey or BGRA; 8 or 16 bits) as RGB888 at ``width`` x ``height``."""
+    import cv2
+
+    if bgr.ndim == 2:
+        bgr = cv2.cvtColor(bgr, cv2.COLOR_GRAY2BGR)
+    elif bgr.shape[2] == 4:
+        bgr = cv2.cvtColor(bgr, cv2.COLOR_BGRA2BGR)
+    if bgr.dtype != np.uint8:  # 16-bit images: keep the top 8 bits
+        bgr = (bgr >> 8).astype(np.uint8) if bgr.dtype == np.uint16 else bgr.astype(np.uint8)
+    if bgr.shape[:2] != (height, width):
+        bgr = cv2.resize(bgr, (width, height), interpolation=cv2.INTER_LINEAR)
+    return np.ascontiguousarray(cv2.cvtColor(bgr, cv2.COLOR_BGR2RGB))
+
+
 def open_source(spec, width, height):
-    """Open ``spec`` (``camera:N``, a video file, a folder of images) at ``width`` x ``height``;
-    ``UsageError`` when it cannot be opened."""
+    """Open ``spec`` (``camera:N``, a video file, a folder of images, ``bag:PATH[:TOPIC]``) at
+    ``width`` x ``height``; ``UsageError`` when it cannot be opened."""
+    if str(spec).startswith("bag:"):  # a ROS bag (fpga_robotics.ros.bag_source)
+        from .ros.bag_source import BagSource
+
+        return BagSource(spec, width, height)
     return FrameSource(spec, width, height)
 
 
