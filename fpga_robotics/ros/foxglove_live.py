@@ -146,7 +146,7 @@ class LivePublisher:
     def log_frame(self, record):
         channels = self._channels
         for topic, ns, data in self._messages.encode(record):
-            channels[topic].log(data, log_time=ns)
+            channels[topic].log(bytes(data), log_time=ns)
         self.frames_logged += 1
 
     def close(self):
