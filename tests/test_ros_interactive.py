@@ -18,7 +18,7 @@ import pytest
 from rosbags.highlevel import AnyReader
 from rosbags.typesys import Stores, get_typestore
 
-from fpga_robotics.ros.interactive import TELEOP_SPEED
+from fpga_robotics.ros.controls import TELEOP_SPEED
 
 DEADLINE_S = 90  # includes the child's start-up (imports)
 

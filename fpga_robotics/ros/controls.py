@@ -18,8 +18,11 @@ import time
 from ..errors import UsageError
 from ..hw.pixel import COLOR_SELECT, color_select_value
 
-__all__ = ["INPUT_KINDS", "LiveControls", "ReplayControls", "apply_inputs", "check_input",
+__all__ = ["INPUT_KINDS", "TELEOP_SPEED", "LiveControls", "ReplayControls", "apply_inputs", "check_input",
            "load_inputs"]
+
+#: Speed of the target person driven by the terminal's arrows and the layout's teleop pad, m/s.
+TELEOP_SPEED = 0.5
 
 #: What an input can be: kind -> what its value is.
 INPUT_KINDS = {

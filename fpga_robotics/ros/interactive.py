@@ -12,11 +12,9 @@ import threading
 import tty
 
 from ..errors import UsageError
+from .controls import TELEOP_SPEED
 
-__all__ = ["KEYS", "TELEOP_SPEED", "TerminalControls", "key_input"]
-
-#: Speed of the target person driven with the arrow keys, m/s.
-TELEOP_SPEED = 0.5
+__all__ = ["KEYS", "TerminalControls", "key_input"]
 
 _COLORS = {"r": "red", "g": "green", "b": "blue", "y": "yellow", "m": "magenta",
            "c": "cyan", "w": "white", "n": "none"}
