@@ -204,3 +204,61 @@ def test_replayed_inputs_give_the_same_run(tmp_path):
     assert run_main(base + ["--summary", str(tmp_path / "plain.json")]) in (0, 1)
     plain = json.loads((tmp_path / "plain.json").read_text())
     assert "inputs" not in plain
+
+
+@pytest.mark.parametrize("topic, schema, fields, expected", [
+    ("/fpga/color_select", "std_msgs/String", {"data": "cyan"}, ("color", "cyan")),
+    ("/fpga/color_select", "std_msgs/UInt8", {"data": 0b010}, ("color", "green")),
+    ("/sim/pause", "std_msgs/Bool", {"data": True}, ("pause", None)),
+    ("/sim/pause", "std_msgs/Bool", {"data": False}, ("resume", None)),
+    ("/sim/step", "std_msgs/Empty", {}, ("step", None)),
+])
+def test_control_messages_in_cdr_and_json(topic, schema, fields, expected):
+    """What Foxglove publishes (CDR with a ROS 2 schema, or JSON) becomes the same input."""
+    from fpga_robotics.ros.controls import check_input
+    from fpga_robotics.ros.foxglove_live import _decode, control_input
+
+    msgtype = schema.replace("/", "/msg/")
+    cdr = bytes(STORE.serialize_cdr(STORE.types[msgtype](**fields), msgtype))
+    for encoding, data in (("cdr", cdr), ("json", json.dumps(fields).encode())):
+        assert check_input(*control_input(topic, _decode(encoding, schema, data))) == expected
+
+
+def test_teleop_twist_in_cdr():
+    from fpga_robotics.ros.foxglove_live import _decode, control_input
+
+    T = STORE.types
+    twist = T["geometry_msgs/msg/Twist"](linear=T["geometry_msgs/msg/Vector3"](x=0.25, y=-0.5,
+                                                                              z=0.0),
+                                         angular=T["geometry_msgs/msg/Vector3"](x=0.0, y=0.0,
+                                                                               z=1.0))
+    cdr = bytes(STORE.serialize_cdr(twist, "geometry_msgs/msg/Twist"))
+    assert control_input("/target/cmd_vel", _decode("cdr", "geometry_msgs/Twist", cdr)) == (
+        "target_velocity", [0.25, -0.5])
+
+
+def test_inputs_are_events_of_the_run_and_of_its_frames():
+    """Each applied input is an event of the run (the summary's count, the rerun event log
+    through the frame records) at its frame; a teleop without a target is an event too."""
+    from fpga_robotics.loop import run_scenario
+    from fpga_robotics.ros.controls import ReplayControls
+    from fpga_robotics.scenario import load_scenario
+
+    inputs = [{"frame": 2, "kind": "color", "value": "green"},
+              {"frame": 4, "kind": "target_velocity", "value": [0.1, 0.0]}]
+    for people, teleop_event in ((None, "control: target velocity (+0.10, +0.00) m/s"),
+                                 ("people=[]", "control: no target person to drive")):
+        overrides = ['camera.resolution="80x60"', "sim.duration=0.3"]
+        scenario = load_scenario("follow_person", overrides + ([people] if people else []))
+        records = []
+        result = run_scenario(scenario, backend="model", controls=ReplayControls(inputs),
+                              on_frame=records.append)
+        controls = [(k, e) for k, _, e in result.events if e.startswith("control:")]
+        assert controls == [(2, "control: colour select green"), (4, teleop_event)]
+        assert [(r.frame, [e for e in r.events if e.startswith("control:")])
+                for r in records if any(e.startswith("control:") for e in r.events)] == [
+            (2, ["control: colour select green"]), (4, [teleop_event])]
+        if people is None:  # the red target is lost on the very frame green is selected
+            assert "target lost" in records[2].events
+        assert [r.color_sel for r in records] == [4, 4] + [2] * (len(records) - 2)
+        assert result.summary["events"] == len(result.events)

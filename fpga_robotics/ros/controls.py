@@ -80,6 +80,9 @@ def apply_inputs(loop, inputs):
             loop.set_color(value)
             events.append(f"control: colour select {value}")
         elif kind == "target_velocity":
+            if loop.world.target_position() is None:  # a scenario without a target
+                events.append("control: no target person to drive")
+                continue
             loop.world.set_target_velocity(value)
             events.append("control: target back on its script" if value is None else
                           f"control: target velocity ({value[0]:+.2f}, {value[1]:+.2f}) m/s")
