@@ -516,15 +516,15 @@ PLANS = {
                      "(the replay below gets its steered.json from a set-up)"),
     "python -m fpga_robotics.run --replay-inputs steered.json --bag runs/replayed":
         # Inputs as a steered run records them: the target stopped for ten frames.
-        Plan(setup=("""echo '{"inputs": [{"frame": 12, "kind": "target_velocity", """
-                    """"value": [0, 0]}, {"frame": 22, "kind": "target_velocity", """
-                    """"value": null}]}' > steered.json""",),
+        Plan(setup=(("""echo '{"inputs": [{"frame": 12, "kind": "target_velocity", """
+                     """"value": [0, 0]}, {"frame": 22, "kind": "target_velocity", """
+                     """"value": null}]}' > steered.json"""),),
              files=("runs/replayed/metadata.yaml",),
              out=(PASS, r"ROS 2 bag \(30 frames\) written to runs/replayed")),
     "python -m fpga_robotics.run --source bag:robot_bag:/camera/image_raw --bag runs/robot_outputs":
         # A run's own bag stands in for a real robot's.
-        Plan(setup=("python -m fpga_robotics.run --duration 1 --rerun off --quiet "
-                    "--bag robot_bag",),
+        Plan(setup=(("python -m fpga_robotics.run --duration 1 --rerun off --quiet "
+                     "--bag robot_bag"),),
              files=("runs/robot_outputs/metadata.yaml",),
              out=(r"source bag:robot_bag:/camera/image_raw \(bag\)",
                   r"target found in 30 frames",
@@ -532,8 +532,8 @@ PLANS = {
     "python -m fpga_robotics.ros.bench":
         Plan(shorter=(("--frames", "2"), ("--repeats", "1")),
              out=(r"bag  \(--bag\): log_frame median [\d.]+ ms",
-                  r"live \(--live foxglove, one client\): log_frame median [\d.]+ ms; "
-                  r"client received 26/26 messages")),
+                  (r"live \(--live foxglove, one client\): log_frame median [\d.]+ ms; "
+                   r"client received 26/26 messages"))),
     "python -m fpga_robotics.sim.backends.pysim --frames 7":
         Plan(shorter=(("--frames", "2"),),
              out=(r"every frame equal to the golden model", r"median [\d.]+ s wall")),

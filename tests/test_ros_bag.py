@@ -1,6 +1,7 @@
 """``--bag``: a closed-loop run written as a ROS 2 bag (MCAP), read back with rosbags and with
 mcap's own reader, and compared with the frames the design saw (issue 16)."""
 
+import itertools
 import json
 import math
 from pathlib import Path
@@ -84,7 +85,7 @@ def test_topics_types_and_counts(recorded):
 def test_stamps_are_sim_time_and_monotonic(recorded):
     _, _, records, messages, _ = recorded
     expected = [round(r.sim_time * 1e9) for r in records]
-    assert all(b > a for a, b in zip(expected, expected[1:]))
+    assert all(b > a for a, b in itertools.pairwise(expected))
     for topic, items in messages.items():
         assert [stamp for stamp, _ in items] == expected, topic
     for _, msg in messages["/camera/image_raw"]:

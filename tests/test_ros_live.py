@@ -98,7 +98,7 @@ def test_live_topics_and_client_controls(tmp_path):
     def run():
         try:
             outcome["code"] = run_main(argv)
-        except BaseException as exc:  # reported by the test thread
+        except Exception as exc:  # noqa: BLE001 - re-raised by the test thread
             outcome["error"] = exc
 
     runner = threading.Thread(target=run, daemon=True)
@@ -123,7 +123,7 @@ def test_live_topics_and_client_controls(tmp_path):
         time.sleep(0.3)  # let the server take the subscription and the advertisement
         for k in range(PAUSED_FRAMES):  # one frame a step, each seen before the next
             client.publish(1, {})
-            client.wait_for(lambda: client.count("/camera/image_raw") >= k + 1)
+            client.wait_for(lambda k=k: client.count("/camera/image_raw") >= k + 1)
         time.sleep(0.3)
         assert client.count("/camera/image_raw") == PAUSED_FRAMES  # still paused
         client.publish(2, {"data": "blue"})

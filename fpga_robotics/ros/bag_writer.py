@@ -7,12 +7,13 @@ that fails or is interrupted leaves nothing behind (``abandon()``). The topics a
 are ``messages.TOPICS``; ``ros2 bag info PATH`` and Foxglove open the result.
 """
 
+import contextlib
 import os
 import shutil
 import tempfile
 from pathlib import Path
 
-from rosbags.rosbag2 import StoragePlugin, Writer
+from rosbags.rosbag2 import StoragePlugin, Writer, WriterError
 
 from ..errors import UsageError
 from .messages import TOPICS, TYPESTORE, FrameMessages, camera_geometry
@@ -102,10 +103,8 @@ class BagWriter:
         """Stop without a bag: the partial one is removed."""
         if self._writer is not None:
             writer, self._writer = self._writer, None
-            try:
+            with contextlib.suppress(OSError, WriterError):  # discarded either way
                 writer.close()
-            except Exception:  # a half-written bag is discarded either way
-                pass
         shutil.rmtree(self._staging, ignore_errors=True)
 
 

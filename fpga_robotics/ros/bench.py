@@ -93,7 +93,7 @@ class _Client(threading.Thread):
                     with contextlib.suppress(TimeoutError):
                         if isinstance(ws.recv(timeout=0.2), bytes):
                             self.received += 1
-        except Exception as exc:  # reported by the benchmark
+        except Exception as exc:  # noqa: BLE001 - reported by the benchmark
             self.error = exc
             self.subscribed.set()
 

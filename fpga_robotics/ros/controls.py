@@ -65,7 +65,7 @@ def check_input(kind, value):
 
 def _color_name(code):
     if isinstance(code, bool) or not isinstance(code, int):
-        raise ValueError(f"colour must be a name or a code 0..7, got {code!r}")
+        raise TypeError(f"colour must be a name or a code 0..7, got {code!r}")
     for name, value in COLOR_SELECT.items():
         if value == code:
             return name
@@ -215,7 +215,7 @@ def load_inputs(path):
     for i, item in enumerate(data):
         try:
             if not isinstance(item, dict):
-                raise ValueError("not an object")
+                raise TypeError("not an object")
             frame = item.get("frame")
             if isinstance(frame, bool) or not isinstance(frame, int) or frame < 0:
                 raise ValueError(f"frame must be an integer >= 0, got {frame!r}")

@@ -91,7 +91,7 @@ class _Listener(foxglove.websocket.ServerListener):
         try:
             kind, value = control_input(topic, _decode(encoding, schema_name, data))
             self.publisher.controls.submit(kind, value)
-        except Exception as exc:  # a malformed message from a client never stops the run
+        except Exception as exc:  # noqa: BLE001 - a client's bad message never stops the run
             self.publisher.rejected.append(f"{topic}: {exc}")
 
 
@@ -126,7 +126,7 @@ class LivePublisher:
                 capabilities=[Capability.ClientPublish] if controls is not None else [],
                 supported_encodings=["json", "cdr"],
                 server_listener=_Listener(self) if controls is not None else None)
-        except Exception as exc:  # port taken, no permission
+        except RuntimeError as exc:  # FoxgloveError: the port is taken, no permission
             raise UsageError(f"--live: cannot serve on 127.0.0.1:{port} ({exc}); "
                              f"give another port with --live foxglove:PORT") from None
         self.port = self._server.port
@@ -137,8 +137,8 @@ class LivePublisher:
         return f"ws://127.0.0.1:{self.port}"
 
     def pop_notices(self):
-        return [f"Foxglove live: open a WebSocket connection to {self.url} "
-                f"(layout: {layout_path()})"]
+        return [(f"Foxglove live: open a WebSocket connection to {self.url} "
+                 f"(layout: {layout_path()})")]
 
     def log_world_map(self, world_map):
         """Nothing: Foxglove draws the people and the robot from their topics."""

@@ -120,13 +120,14 @@ class FrameMessages:
         self.geometry = g = geometry
         f = focal_length(g.width, g.hfov)
         cx, cy = g.width / 2, g.height / 2
-        self._camera_info = dict(
-            height=g.height, width=g.width, distortion_model="plumb_bob",
-            d=np.zeros(5), k=np.array([f, 0, cx, 0, f, cy, 0, 0, 1], float),
-            r=np.eye(3).ravel(), p=np.array([f, 0, cx, 0, 0, f, cy, 0, 0, 0, 1, 0], float),
-            binning_x=0, binning_y=0,
-            roi=_T["sensor_msgs/msg/RegionOfInterest"](x_offset=0, y_offset=0, height=0,
-                                                       width=0, do_rectify=False))
+        self._camera_info = {
+            "height": g.height, "width": g.width, "distortion_model": "plumb_bob",
+            "d": np.zeros(5), "k": np.array([f, 0, cx, 0, f, cy, 0, 0, 1], float),
+            "r": np.eye(3).ravel(),
+            "p": np.array([f, 0, cx, 0, 0, f, cy, 0, 0, 0, 1, 0], float),
+            "binning_x": 0, "binning_y": 0,
+            "roi": _T["sensor_msgs/msg/RegionOfInterest"](x_offset=0, y_offset=0, height=0,
+                                                          width=0, do_rectify=False)}
         self._mount = _T["geometry_msgs/msg/Transform"](
             translation=_Vector3(x=g.mount_forward, y=0.0, z=g.mount_height),
             rotation=_pitch(g.tilt))
