@@ -291,6 +291,16 @@ def _close_recorder(recorder, completed):
     return notices
 
 
+def _close_outputs(recorder, ros, completed):
+    """Close the ROS outputs (the terminal's modes restored first) and the recording;
+    returns their notices, the recording's first."""
+    try:
+        ros_notices = ros.close(completed)
+    finally:
+        notices = _close_recorder(recorder, completed)
+    return notices + ros_notices
+
+
 def _frame_callback(video, ros):
     """The ``on_frame`` of a run: the video and the ROS outputs, each when asked for."""
     calls = ([lambda record: video.write(record.camera_rgb)] if video is not None else []) + (
@@ -336,7 +346,7 @@ def _run_source(args, scenario, ros):
             completed = True
         finally:
             design.close()
-            notices = _close_recorder(recorder, completed) + ros.close(completed)
+            notices = _close_outputs(recorder, ros, completed)
     finally:
         source.close()
     print(f"source {out['source']} ({out['source_kind']})  backend {out['backend']}  "
@@ -415,7 +425,7 @@ def main(argv=None, prog="python -m fpga_robotics.run"):
         design.close()
         if shadow is not None:
             shadow.close()
-        notices = _close_recorder(recorder, completed) + ros.close(completed)
+        notices = _close_outputs(recorder, ros, completed)
     summary = dict(result.summary)
     summary["backend_setup_s"] = round(setup, 3)
     summary.update(ros.summary_items())  # the live inputs, for --replay-inputs
