@@ -189,3 +189,24 @@ def test_cli_writes_the_bag_and_replaces_an_old_one(tmp_path, monkeypatch):
     second, _ = _read_bag(tmp_path / "out")
     assert len(second["/camera/image_raw"]) == 6
     assert sorted(p.name for p in tmp_path.iterdir()) == ["out", "s.json"]
+
+
+def test_camera_link_is_tilted_as_the_camera():
+    """The sim's tilt is positive looking up; in ROS (x forward, y left, z up) the camera's
+    x axis then points up: rotated by the tf's quaternion it gains +z."""
+    from fpga_robotics.ros.messages import TYPESTORE, CameraGeometry, FrameMessages
+
+    tilt = 0.2
+    geometry = CameraGeometry(width=80, height=60, hfov=1.0, mount_forward=0.1,
+                              mount_height=0.3, tilt=tilt, wheel_radius=0.03,
+                              wheel_separation=0.2)
+    scenario = load_scenario("follow_person", OVERRIDES)
+    records = []
+    run_scenario(scenario, backend="model", on_frame=records.append)
+    encoded = {t: d for t, _, d in FrameMessages(geometry).encode(records[0])}
+    tf = TYPESTORE.deserialize_cdr(encoded["/tf"], "tf2_msgs/msg/TFMessage").transforms[1]
+    q = tf.transform.rotation
+    # x axis rotated by q = (x, y, z, w): first column of the rotation matrix.
+    forward = (1 - 2 * (q.y ** 2 + q.z ** 2), 2 * (q.x * q.y + q.w * q.z),
+               2 * (q.x * q.z - q.w * q.y))
+    assert forward == pytest.approx((math.cos(tilt), 0.0, math.sin(tilt)))

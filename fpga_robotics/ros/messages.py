@@ -5,7 +5,7 @@ triples: the same bytes go into a bag (``bag_writer``) and out on the live Foxgl
 (``foxglove_live``). Everything is stamped in simulated time (nanoseconds from the run's
 start). Frames: ``odom`` (the world: x, y on the floor, z up, headings counter-clockwise
 from +x, as in ROS REP 103), ``base_link`` (the robot), ``camera_link`` (the camera on its
-mount, x forward, pitched down by the tilt). An output the design lacks (None) is not
+mount, x forward, pitched by the camera's tilt). An output the design lacks (None) is not
 published for that frame.
 """
 
@@ -81,7 +81,7 @@ class CameraGeometry:
     hfov: float  # rad
     mount_forward: float  # camera ahead of the robot's centre, m
     mount_height: float  # above the floor, m
-    tilt: float  # pitch down, rad
+    tilt: float  # rad, positive looks up (as sim.scene.CameraPose)
     wheel_radius: float  # m
     wheel_separation: float  # m
 
@@ -130,7 +130,7 @@ class FrameMessages:
                                                           width=0, do_rectify=False)}
         self._mount = _T["geometry_msgs/msg/Transform"](
             translation=_Vector3(x=g.mount_forward, y=0.0, z=g.mount_height),
-            rotation=_pitch(g.tilt))
+            rotation=_pitch(-g.tilt))  # about +y (left): a positive pitch looks down
         self._dps_layout = _MultiArrayLayout(
             dim=[_MultiArrayDimension(label="left,right", size=2, stride=2)], data_offset=0)
         self._zero = _Vector3(x=0.0, y=0.0, z=0.0)
