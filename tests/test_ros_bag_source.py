@@ -143,6 +143,10 @@ def test_bag_frames_are_resized_and_keep_the_bags_times(tmp_path):
     src.close()
     expected = [cv2.resize(f, (W, H), interpolation=cv2.INTER_LINEAR) for f in big]
     assert all(np.array_equal(a, b) for a, b in zip(seen, expected))
+    # The bag's .mcap file names the same bag.
+    src = open_source(f"bag:{bag}/{bag.name}.mcap:/camera/image_raw", W, H)
+    assert sum(1 for _ in src) == 6
+    src.close()
 
 
 def test_bag_in_and_bag_out(tmp_path):

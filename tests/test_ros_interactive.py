@@ -64,6 +64,7 @@ def test_keys_in_a_terminal_control_the_run(tmp_path):
             proc.wait()
         os.close(master)
     assert proc.returncode in (0, 1), bytes(output)
+    assert b"5 live input(s) applied" in output
     assert attrs[3] & termios.ICANON and attrs[3] & termios.ECHO  # the terminal restored
 
     inputs = json.loads((tmp_path / "s.json").read_text())["inputs"]

@@ -123,6 +123,10 @@ class RosOutputs:
             self._terminal = None
         if self.controls is not None:
             self.controls.close()
+            if completed and self.replay is None and self.controls.log:
+                notices.append(f"{len(self.controls.log)} live input(s) applied; the "
+                               f"summary's 'inputs' replay them (--summary PATH, then "
+                               f"--replay-inputs PATH)")
         for sink in self._sinks:
             if sink is self._bag and not completed:
                 sink.abandon()
