@@ -46,6 +46,7 @@ BENCHMARKS = {
     "shadow": ("fpga_robotics.shadow_bench", "a shadow design's cost in the closed loop"),
     "foreign": ("fpga_robotics.sim.backends.foreign_bench",
                 "a Verilog design through a port map against the built-in Verilator backend"),
+    "ros": ("fpga_robotics.ros.bench", "writing a ROS 2 bag and publishing live to Foxglove"),
 }
 
 PROG = "fpga-robotics"

@@ -117,7 +117,7 @@ class ClosedLoop:
     ``summarise``. ``run()`` does all of it. Built by ``run_scenario``; see its parameters."""
 
     def __init__(self, scenario, *, seed=None, design, recorder=None, on_frame=None,
-                 shadow=None, shadow_label="shadow"):
+                 shadow=None, shadow_label="shadow", controls=None):
         from .sim.world import World
 
         self.scenario = scenario
@@ -144,8 +144,10 @@ class ClosedLoop:
         self.design_events = _DesignEvents(scenario.params.lost_frames)
         self.target_radius = next(
             (p.radius for p in self.world.people_states() if p.is_target), 0.0)
-        self.color = scenario.color_at(0.0)
+        self.color = self.scheduled_color = scenario.color_at(0.0)
         self.color_code = color_select_value(self.color)
+        # Live control inputs (fpga_robotics.ros.controls), asked once per frame.
+        self.controls = controls
         # A second design on the same frames, never driving the robot (fpga_robotics.shadow).
         self.shadow = shadow
         self.comparison = ShadowComparison(shadow_label) if shadow is not None else None
@@ -184,10 +186,22 @@ class ClosedLoop:
         rgb = self.camera.capture(self.world.scene(), pose)
         events = list(self.world.drain_events())
         new_color = self.scenario.color_at(t)
-        if new_color != self.color:
+        if new_color != self.scheduled_color:  # a live colour holds until the next change
             events.append(f"colour select changed to {new_color}")
-            self.color, self.color_code = new_color, color_select_value(new_color)
+            self.scheduled_color = new_color
+            self.set_color(new_color)
         return pose, rgb, events
+
+    def set_color(self, color):
+        self.color, self.color_code = color, color_select_value(color)
+
+    def apply_controls(self, k, t):
+        """The live control inputs due at frame ``k``, applied; returns their events."""
+        if self.controls is None:
+            return []
+        from .ros.controls import apply_inputs
+
+        return apply_inputs(self, self.controls.inputs_for(k, t))
 
     def process(self, k, rgb):
         """Frame ``k`` through the design; its wheel command acts after the actuation delay."""
@@ -259,6 +273,7 @@ class ClosedLoop:
         self.advance_physics(round(k * self.period / self.dt))
         t = self.step * self.dt
         pose, rgb, events = self.capture(t)
+        events += self.apply_controls(k, t)
         result = self.process(k, rgb)
         shadow_result, shadow_events = self.process_shadow(k, t, rgb, result)
         if result.found is not None:  # a design without `found` has no found/lost events
@@ -380,7 +395,8 @@ def _empty_trajectory(n_frames):
 
 
 def run_scenario(scenario, *, seed=None, backend="auto", recorder=None, progress=None,
-                 realtime=False, on_frame=None, shadow=None, shadow_label="shadow"):
+                 realtime=False, on_frame=None, shadow=None, shadow_label="shadow",
+                 controls=None):
     """Run one scenario in closed loop and measure it.
 
     Parameters
@@ -405,6 +421,9 @@ def run_scenario(scenario, *, seed=None, backend="auto", recorder=None, progress
         first; the caller keeps ownership.
     shadow_label : str
         How the summary and the events name the shadow design.
+    controls : object with inputs_for(frame, t), optional
+        Live control inputs (``fpga_robotics.ros.controls``): colour select, the target
+        driven by hand, pause and step; applied just after each frame's capture.
     """
     owns_backend = isinstance(backend, str)
     design = make_backend(backend, scenario.params) if owns_backend else backend
@@ -415,7 +434,8 @@ def run_scenario(scenario, *, seed=None, backend="auto", recorder=None, progress
         if shadow is not None:
             shadow.reset()
         loop = ClosedLoop(scenario, seed=seed, design=design, recorder=recorder,
-                          on_frame=on_frame, shadow=shadow, shadow_label=shadow_label)
+                          on_frame=on_frame, shadow=shadow, shadow_label=shadow_label,
+                          controls=controls)
         return loop.run(progress=progress, realtime=realtime)
     finally:
         if owns_backend:

@@ -13,6 +13,7 @@ from pathlib import Path
 
 from .errors import UsageError, run_cli
 from .hw.pixel import COLOR_SELECT
+from .ros.run_options import RosOutputs, add_ros_arguments
 from .sim.backends import BACKEND_NAMES
 from .sim.files import check_output_path, write_json_atomic
 
@@ -59,7 +60,7 @@ def build_parser(prog="python -m fpga_robotics.run"):
                         "display, else save")
     p.add_argument("--log-every", type=int, default=1, metavar="N",
                    help="log every Nth frame's images to the viewer (default 1)")
-    p.add_argument("--source", metavar="camera:N|VIDEO|FOLDER",
+    p.add_argument("--source", metavar="camera:N|VIDEO|FOLDER|bag:PATH[:TOPIC]",
                    help="run the design on real frames instead of the simulation (no physics)")
     p.add_argument("--max-frames", type=int, metavar="N", help="with --source: stop after N")
     p.add_argument("--shadow", metavar="SPEC",
@@ -79,6 +80,7 @@ def build_parser(prog="python -m fpga_robotics.run"):
     p.add_argument("--save-video", metavar="PATH.mp4|PATH.avi",
                    help="also write the camera frames as a video (try it with --source)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
+    add_ros_arguments(p)  # --bag, --live, --interactive, --paused, --replay-inputs
     return p
 
 
@@ -329,6 +331,27 @@ def _close_recorder(recorder, completed):
     return notices
 
 
+def _close_outputs(recorder, ros, completed):
+    """Close the ROS outputs (the terminal's modes restored first) and the recording;
+    returns their notices, the recording's first."""
+    try:
+        ros_notices = ros.close(completed)
+    finally:
+        notices = _close_recorder(recorder, completed)
+    return notices + ros_notices
+
+
+def _frame_callback(video, ros):
+    """The ``on_frame`` of a run: the video and the ROS outputs, each when asked for."""
+    calls = ([lambda record: video.write(record.camera_rgb)] if video is not None else []) + (
+        [ros.on_frame] if ros.active else [])
+    if not calls:
+        return None
+    if len(calls) == 1:
+        return calls[0]
+    return lambda record: [call(record) for call in calls]
+
+
 def _list_scenarios():
     from .scenario import shipped_scenarios
 
@@ -339,9 +362,10 @@ def _list_scenarios():
     return 0
 
 
-def _run_source(args, scenario):
+def _run_source(args, scenario, ros):
     from .sources import open_source, run_source
 
+    ros.check_closed_loop_only()
     params = scenario.params
     source = open_source(args.source, params.width, params.height)
     try:
@@ -350,16 +374,19 @@ def _run_source(args, scenario):
         completed = False
         try:
             recorder = _open_recorder(args, Path(str(args.source).replace(":", "_")).stem)
+            for line in ros.open(scenario, closed_loop=False):
+                print(line, file=sys.stderr)
             progress = None if args.quiet else Progress("frames")
             out = run_source(source, design, color=scenario.color_initial, recorder=recorder,
                              progress=progress, max_frames=args.max_frames,
-                             hfov=scenario.camera.hfov)
+                             hfov=scenario.camera.hfov,
+                             on_frame=ros.on_frame if ros.active else None)
             if progress is not None:
                 progress.finish()
             completed = True
         finally:
             design.close()
-            notices = _close_recorder(recorder, completed)
+            notices = _close_outputs(recorder, ros, completed)
     finally:
         source.close()
     print(f"source {out['source']} ({out['source_kind']})  backend {out['backend']}  "
@@ -391,6 +418,7 @@ def main(argv=None, prog="python -m fpga_robotics.run"):
         raise UsageError(f"--seed must be in 0..{MAX_SEED}, got {args.seed}")
     if args.summary is not None:  # checked now, not after a long run
         check_output_path(args.summary, what="--summary")
+    ros = RosOutputs(args)  # --bag, --live ...: checked now, not after a long run
     scenario = load_scenario(args.scenario, _overrides(args))
     if args.target_color is not None:
         scenario = _dress_target(scenario, args.target_color)
@@ -399,7 +427,7 @@ def main(argv=None, prog="python -m fpga_robotics.run"):
             raise UsageError("--shadow runs in the closed loop only (not with --source)")
         if args.max_frames is not None and args.max_frames < 1:
             raise UsageError(f"--max-frames must be >= 1, got {args.max_frames}")
-        return _run_source(args, scenario)
+        return _run_source(args, scenario, ros)
     if args.max_frames is not None:
         raise UsageError("--max-frames only applies with --source (use --duration)")
     shadow_params = _shadow_params(scenario, args.shadow)
@@ -422,13 +450,14 @@ def main(argv=None, prog="python -m fpga_robotics.run"):
                                    args.quiet)
         setup = time.perf_counter() - t0
         recorder = _open_recorder(args, scenario.name)
+        for line in ros.open(scenario):
+            print(line, file=sys.stderr)
         progress = None if args.quiet else Progress(scenario.name)
         with _video(args.save_video, scenario.camera.fps) as video:
             result = run_scenario(scenario, seed=args.seed, backend=design, recorder=recorder,
                                   progress=progress, realtime=args.realtime, shadow=shadow,
                                   shadow_label=args.shadow or "shadow",
-                                  on_frame=None if video is None else
-                                  (lambda record: video.write(record.camera_rgb)))
+                                  on_frame=_frame_callback(video, ros), controls=ros.controls)
         if progress is not None:
             progress.finish()
         completed = True
@@ -436,9 +465,10 @@ def main(argv=None, prog="python -m fpga_robotics.run"):
         design.close()
         if shadow is not None:
             shadow.close()
-        notices = _close_recorder(recorder, completed)
+        notices = _close_outputs(recorder, ros, completed)
     summary = dict(result.summary)
     summary["backend_setup_s"] = round(setup, 3)
+    summary.update(ros.summary_items())  # the live inputs, for --replay-inputs
     print(format_summary(summary))
     if "shadow" in summary:
         from .shadow import format_shadow

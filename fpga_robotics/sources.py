@@ -1,4 +1,5 @@
-"""Frames from outside the simulation: a camera, a video file or a folder of images.
+"""Frames from outside the simulation: a camera, a video file, a folder of images or the
+images of a ROS bag (``fpga_robotics.ros.bag_source``).
 
 ``open_source(spec, width, height)`` yields RGB888 frames at the design's resolution, resized
 with ``cv2.resize`` (``INTER_LINEAR``) and converted from OpenCV's BGR order. ``run_source``
@@ -14,7 +15,7 @@ from .errors import UsageError
 from .hw.pixel import color_select_value
 from .sim.records import FrameRecord
 
-__all__ = ["IMAGE_SUFFIXES", "FrameSource", "open_source", "run_source"]
+__all__ = ["IMAGE_SUFFIXES", "FrameSource", "open_source", "run_source", "to_design_rgb"]
 
 #: Files of a folder source that are read as frames (in sorted name order).
 IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff", ".ppm", ".pgm")
@@ -80,17 +81,7 @@ class FrameSource:
         self._first = first
 
     def _convert(self, bgr):
-        import cv2
-
-        if bgr.ndim == 2:
-            bgr = cv2.cvtColor(bgr, cv2.COLOR_GRAY2BGR)
-        elif bgr.shape[2] == 4:
-            bgr = cv2.cvtColor(bgr, cv2.COLOR_BGRA2BGR)
-        if bgr.dtype != np.uint8:  # 16-bit images: keep the top 8 bits
-            bgr = (bgr >> 8).astype(np.uint8) if bgr.dtype == np.uint16 else bgr.astype(np.uint8)
-        if bgr.shape[:2] != (self.height, self.width):
-            bgr = cv2.resize(bgr, (self.width, self.height), interpolation=cv2.INTER_LINEAR)
-        return np.ascontiguousarray(cv2.cvtColor(bgr, cv2.COLOR_BGR2RGB))
+        return to_design_rgb(bgr, self.width, self.height)
 
     def __iter__(self):
         import cv2
@@ -117,18 +108,39 @@ class FrameSource:
             self._cap = None
 
 
+def to_design_rgb(bgr, width, height):
+    """An OpenCV image (BGR, grey or BGRA; 8 or 16 bits) as RGB888 at ``width`` x ``height``."""
+    import cv2
+
+    if bgr.ndim == 2:
+        bgr = cv2.cvtColor(bgr, cv2.COLOR_GRAY2BGR)
+    elif bgr.shape[2] == 4:
+        bgr = cv2.cvtColor(bgr, cv2.COLOR_BGRA2BGR)
+    if bgr.dtype != np.uint8:  # 16-bit images: keep the top 8 bits
+        bgr = (bgr >> 8).astype(np.uint8) if bgr.dtype == np.uint16 else bgr.astype(np.uint8)
+    if bgr.shape[:2] != (height, width):
+        bgr = cv2.resize(bgr, (width, height), interpolation=cv2.INTER_LINEAR)
+    return np.ascontiguousarray(cv2.cvtColor(bgr, cv2.COLOR_BGR2RGB))
+
+
 def open_source(spec, width, height):
-    """Open ``spec`` (``camera:N``, a video file, a folder of images) at ``width`` x ``height``;
-    ``UsageError`` when it cannot be opened."""
+    """Open ``spec`` (``camera:N``, a video file, a folder of images, ``bag:PATH[:TOPIC]``) at
+    ``width`` x ``height``; ``UsageError`` when it cannot be opened."""
+    if str(spec).startswith("bag:"):  # a ROS bag (fpga_robotics.ros.bag_source)
+        from .ros.bag_source import BagSource
+
+        return BagSource(spec, width, height)
     return FrameSource(spec, width, height)
 
 
 def run_source(source, design, *, color="red", recorder=None, progress=None, max_frames=None,
-               duration=None, hfov=1.047):
+               duration=None, hfov=1.047, on_frame=None):
     """Run the design on every frame of ``source`` and summarise its outputs.
 
     Returns a JSON-ready dict: the source, frame count, timing, how often the target was
-    found, and the per-frame outputs (``results``).
+    found, and the per-frame outputs (``results``). ``on_frame(FrameRecord)`` is called for
+    every frame; a source with recorded times (a bag: ``frame_time(k)``) stamps the frames
+    with them, others with the wall time since the start.
     """
     sel = color_select_value(color)
     design.reset()
@@ -158,13 +170,19 @@ def run_source(source, design, *, color="red", recorder=None, progress=None, max
                 "motor_left": int(result.motor_left),
                 "motor_right": int(result.motor_right),
             })
-            if recorder is not None:
-                recorder.log_frame(FrameRecord(
-                    frame=k, sim_time=time.perf_counter() - start, camera_rgb=rgb,
+            if recorder is not None or on_frame is not None:
+                stamp = (source.frame_time(k) if hasattr(source, "frame_time")
+                         else time.perf_counter() - start)
+                record = FrameRecord(
+                    frame=k, sim_time=stamp, camera_rgb=rgb,
                     color_sel=sel, result=result, robot_x=0.0, robot_y=0.0, robot_heading=0.0,
                     robot_v=0.0, robot_w=0.0, cmd_v=0.0, cmd_w=0.0, camera_hfov=hfov,
                     events=events,
-                ))
+                )
+                if recorder is not None:
+                    recorder.log_frame(record)
+                if on_frame is not None:
+                    on_frame(record)
             if progress is not None:
                 progress(k + 1, None)
     except KeyboardInterrupt:

@@ -41,6 +41,24 @@ CASES = [
      "--shadow"),
     ("target colour without a target", ["run", "--set", "people=[]", "--target-color", "green"],
      "no target"),
+    # run: ROS bags in and out, live control (issue 16); {bag} is a ROS 2 bag of two
+    # 32FC1 images on /cam, {emptybag} one whose only image topic has no messages
+    ("bag source with a missing topic", ["run", "--source", "bag:{bag}:/nope"], "no topic"),
+    ("bag source with a bad encoding", ["run", "--source", "bag:{bag}", "--backend", "model"],
+     "32FC1"),
+    ("empty bag source", ["run", "--source", "bag:{emptybag}"], "no messages"),
+    ("missing bag source", ["run", "--source", "bag:nothing_here"], "no such bag"),
+    ("bag out over a file", ["run", "--bag", "{file}"], "--bag"),
+    ("bag out over a folder", ["run", "--bag", "{dir}"], "not a ROS 2 bag"),
+    ("live with a bad kind", ["run", "--live", "rviz"], "--live"),
+    ("live with a bad port", ["run", "--live", "foxglove:99999"], "port"),
+    ("replay of a missing file", ["run", "--replay-inputs", "nope.json"], "no such file"),
+    ("replay of a bad input", ["run", "--replay-inputs", "{file}"], "JSON"),
+    ("replay with live", ["run", "--replay-inputs", "{file}", "--live", "foxglove"],
+     "does not go with"),
+    ("interactive with source", ["run", "--source", "{frames}", "--interactive"],
+     "--interactive"),
+    ("paused alone", ["run", "--paused"], "--paused"),
     # export
     ("export seed without board", ["export", "--seed", "3"], "--seed"),
     ("export bitstream without board", ["export", "--bitstream"], "--board"),
@@ -70,6 +88,25 @@ def _snapshot(folder):
     )
 
 
+def _float_image_bag(path, n):
+    """A ROS 2 bag of ``n`` 32FC1 images on /cam (an encoding the design cannot take)."""
+    from rosbags.rosbag2 import StoragePlugin, Writer
+    from rosbags.typesys import Stores, get_typestore
+
+    store = get_typestore(Stores.ROS2_HUMBLE)
+    T = store.types
+    with Writer(path, version=9, storage_plugin=StoragePlugin.MCAP) as writer:
+        conn = writer.add_connection("/cam", "sensor_msgs/msg/Image", typestore=store)
+        for k in range(n):
+            msg = T["sensor_msgs/msg/Image"](
+                header=T["std_msgs/msg/Header"](
+                    stamp=T["builtin_interfaces/msg/Time"](sec=k, nanosec=0), frame_id=""),
+                height=2, width=2, encoding="32FC1", is_bigendian=0, step=8,
+                data=np.zeros(16, np.uint8))
+            writer.write(conn, k + 1, store.serialize_cdr(msg, "sensor_msgs/msg/Image"))
+    return path
+
+
 @pytest.mark.parametrize("case, argv, word", CASES, ids=[c[0] for c in CASES])
 def test_bad_input_is_one_line_and_exit_2(case, argv, word, tmp_path, monkeypatch, capsys):
     import cv2
@@ -81,7 +118,8 @@ def test_bad_input_is_one_line_and_exit_2(case, argv, word, tmp_path, monkeypatc
     for i in range(2):
         cv2.imwrite(str(frames / f"{i}.png"), np.full((12, 16, 3), 40 * i, np.uint8))
     names = {"dir": str(tmp_path / "folder"), "file": str(tmp_path / "file"),
-             "frames": str(frames)}
+             "frames": str(frames), "bag": str(_float_image_bag(tmp_path / "bag", 2)),
+             "emptybag": str(_float_image_bag(tmp_path / "emptybag", 0))}
     argv = [a.format(**names) for a in argv]
     monkeypatch.chdir(tmp_path)
     before = _snapshot(tmp_path)

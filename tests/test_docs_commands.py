@@ -535,6 +535,40 @@ PLANS = {
     "--set 'lighting.keyframes=[[0,0.6,0.4],[8,0.28,0.2],[18,0.28,0.2],[24,0.8,0.5]]'":
         Plan(duration="keep", duration_why=_SENSOR_WHY,
              out=(PASS, r"target: first found at 0\.00 s, in view 100%, found 100%")),
+    # docs/ros.md: ROS 2 bags and Foxglove -------------------------------------------------------
+    "python -m fpga_robotics.run --bag runs/follow_bag":
+        Plan(files=("runs/follow_bag/metadata.yaml", "runs/follow_bag/follow_bag.mcap"),
+             out=(PASS, r"ROS 2 bag \(30 frames\) written to runs/follow_bag")),
+    "python -m fpga_robotics.run --live foxglove":
+        Plan(out=(PASS, r"Foxglove live: open a WebSocket connection to ws://127\.0\.0\.1:8765",
+                  r"foxglove_layout\.json")),
+    "python -m fpga_robotics.run --interactive":
+        Plan(excused="reads keys from a terminal, and this test gives commands none; "
+                     "tests/test_ros_interactive.py drives it through a pseudo-terminal"),
+    "python -m fpga_robotics.run --interactive --summary steered.json":
+        Plan(excused="reads keys from a terminal, and this test gives commands none; "
+                     "tests/test_ros_interactive.py drives it through a pseudo-terminal "
+                     "(the replay below gets its steered.json from a set-up)"),
+    "python -m fpga_robotics.run --replay-inputs steered.json --bag runs/replayed":
+        # Inputs as a steered run records them: the target stopped for ten frames.
+        Plan(setup=(("""echo '{"inputs": [{"frame": 12, "kind": "target_velocity", """
+                     """"value": [0, 0]}, {"frame": 22, "kind": "target_velocity", """
+                     """"value": null}]}' > steered.json"""),),
+             files=("runs/replayed/metadata.yaml",),
+             out=(PASS, r"ROS 2 bag \(30 frames\) written to runs/replayed")),
+    "python -m fpga_robotics.run --source bag:robot_bag:/camera/image_raw --bag runs/robot_outputs":
+        # A run's own bag stands in for a real robot's.
+        Plan(setup=(("python -m fpga_robotics.run --duration 1 --rerun off --quiet "
+                     "--bag robot_bag"),),
+             files=("runs/robot_outputs/metadata.yaml",),
+             out=(r"source bag:robot_bag:/camera/image_raw \(bag\)",
+                  r"target found in 30 frames",
+                  r"ROS 2 bag \(30 frames\) written to runs/robot_outputs")),
+    "python -m fpga_robotics.ros.bench":
+        Plan(shorter=(("--frames", "2"), ("--repeats", "1")),
+             out=(r"bag  \(--bag\): log_frame median [\d.]+ ms",
+                  (r"live \(--live foxglove, one client\): log_frame median [\d.]+ ms; "
+                   r"client received 26/26 messages"))),
     "python -m fpga_robotics.sim.backends.pysim --frames 7":
         Plan(shorter=(("--frames", "2"),),
              out=(r"every frame equal to the golden model", r"median [\d.]+ s wall")),

@@ -42,7 +42,7 @@ _FRICTION = 0.5
 
 
 class _Person:
-    __slots__ = ("bands", "body", "config", "path", "shape", "waited")
+    __slots__ = ("bands", "body", "config", "offset", "path", "shape", "teleop", "waited")
 
     def __init__(self, config, path, body, shape):
         self.config = config
@@ -52,6 +52,11 @@ class _Person:
         self.bands = person_bands(config)
         #: Time spent waiting for the robot, s: the script runs this much behind the clock.
         self.waited = 0.0
+        #: Where a hand-driven person (``World.set_target_velocity``) was moved off the
+        #: script, m: added to the script's position from then on.
+        self.offset = (0.0, 0.0)
+        #: ``(vx, vy)`` m/s while the person is driven by hand, else None.
+        self.teleop = None
 
 
 class World:
@@ -225,10 +230,15 @@ class World:
         t1 = self._advance_time(h)
         rx, ry = body.position
         for person in self.people:
-            x, y = person.path.position(t1 - person.waited)
+            if person.teleop is not None:  # driven by hand: the script waits, the offset grows
+                person.waited += h
+                ox, oy = person.offset
+                person.offset = (ox + person.teleop[0] * h, oy + person.teleop[1] * h)
+            sx, sy = person.path.position(t1 - person.waited)
+            x, y = sx + person.offset[0], sy + person.offset[1]
             px, py = person.body.position
             gap = person.config.yield_gap
-            if gap > 0.0:
+            if gap > 0.0 and person.teleop is None:
                 # Wait (the script pauses) rather than step closer to the robot than the gap.
                 ahead = math.hypot(x - rx, y - ry)
                 if (ahead < math.hypot(px - rx, py - ry)
@@ -270,6 +280,20 @@ class World:
         t = self.time + y
         self._time_error = (t - self.time) - y
         return t
+
+    def set_target_velocity(self, velocity):
+        """Drive the target person by hand (as one drags a person in Gazebo): ``(vx, vy)``
+        in m/s in the world frame from the next step on, its script paused; None hands it
+        back to its script, which goes on from where the person was left. Raises
+        ``ValueError`` when there is no target or a value is not finite."""
+        if self._target is None:
+            raise ValueError("the world has no target person to drive")
+        if velocity is not None:
+            vx, vy = (float(v) for v in velocity)
+            if not (math.isfinite(vx) and math.isfinite(vy)):
+                raise ValueError(f"target velocity must be finite, got {velocity!r}")
+            velocity = (vx, vy)
+        self._target.teleop = velocity
 
     # -- motors -------------------------------------------------------------------------
 

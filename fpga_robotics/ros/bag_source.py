@@ -1,0 +1,148 @@
+"""``--source bag:PATH[:TOPIC]``: the images of a ROS 2 or ROS 1 bag (a real robot's
+recording) as frames for the design.
+
+``sensor_msgs/Image`` in rgb8, bgr8, rgba8, bgra8, mono8, yuv422 (UYVY) or yuv422_yuy2
+(YUYV), or ``sensor_msgs/CompressedImage`` (JPEG, PNG): decoded to BGR and resized to the
+design's resolution like every other source (``sources.to_design_rgb``). Without ``TOPIC``
+the bag's only image topic is used (``/camera/image_raw`` when there are several). The
+frames keep the bag's times: ``frame_time(k)`` is seconds since the first frame.
+"""
+
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import UsageError
+
+__all__ = ["ENCODINGS", "IMAGE_TYPES", "BagSource", "parse_bag_spec"]
+
+IMAGE_TYPES = ("sensor_msgs/msg/Image", "sensor_msgs/msg/CompressedImage")
+
+#: Raw image encodings read, with the OpenCV conversion to BGR (None: already BGR).
+ENCODINGS = {
+    "rgb8": "COLOR_RGB2BGR", "bgr8": None, "rgba8": "COLOR_RGBA2BGR",
+    "bgra8": "COLOR_BGRA2BGR", "mono8": "COLOR_GRAY2BGR",
+    "yuv422": "COLOR_YUV2BGR_UYVY", "uyvy": "COLOR_YUV2BGR_UYVY",
+    "yuv422_yuy2": "COLOR_YUV2BGR_YUY2", "yuyv": "COLOR_YUV2BGR_YUY2",
+}
+_CHANNELS = {"rgb8": 3, "bgr8": 3, "rgba8": 4, "bgra8": 4, "mono8": 1}
+
+_DEFAULT_TOPIC = "/camera/image_raw"
+
+
+def parse_bag_spec(spec):
+    """``bag:PATH[:TOPIC]`` (a topic starts with ``/``) to ``(path, topic or None)``."""
+    rest = str(spec)[len("bag:"):]
+    path, sep, topic = rest.rpartition(":/")
+    if not sep:
+        path, topic = rest, None
+    else:
+        topic = "/" + topic
+    if not path:
+        raise UsageError(f"--source bag:PATH[:TOPIC] needs the bag's path, got {spec!r}")
+    return Path(path), topic
+
+
+def decode_image(msg, msgtype):
+    """A bag image message as a BGR uint8 array; ``UsageError`` for an encoding not read."""
+    import cv2
+
+    data = np.frombuffer(memoryview(msg.data), np.uint8)
+    if msgtype.endswith("CompressedImage"):
+        bgr = cv2.imdecode(data, cv2.IMREAD_COLOR)
+        if bgr is None:
+            raise UsageError(f"cannot decode a CompressedImage in format {msg.format!r} "
+                             f"(OpenCV reads JPEG and PNG)")
+        return bgr
+    enc = msg.encoding.lower()
+    if enc not in ENCODINGS:
+        raise UsageError(f"image encoding {msg.encoding!r} is not read; use one of "
+                         + ", ".join(ENCODINGS))
+    h, w = msg.height, msg.width
+    if msg.step < w * _CHANNELS.get(enc, 2) or data.size != h * msg.step:
+        raise UsageError(f"a {w}x{h} {enc} image with step {msg.step} cannot hold "
+                         f"{data.size} bytes: the bag's image is malformed")
+    if enc in _CHANNELS:
+        c = _CHANNELS[enc]
+        rows = data.reshape(h, msg.step)[:, :w * c]  # rows may be padded to `step`
+        img = rows.reshape(h, w, c) if c > 1 else rows.reshape(h, w)
+    else:  # 4:2:2, two bytes a pixel
+        img = data.reshape(h, msg.step)[:, :w * 2].reshape(h, w, 2)
+    conversion = ENCODINGS[enc]
+    return np.ascontiguousarray(img) if conversion is None else cv2.cvtColor(
+        np.ascontiguousarray(img), getattr(cv2, conversion))
+
+
+class BagSource:
+    """The images of one topic of a bag, as RGB888 frames at ``width`` x ``height``."""
+
+    def __init__(self, spec, width, height):
+        from rosbags.highlevel import AnyReader, AnyReaderError
+        from rosbags.typesys import Stores, get_typestore
+
+        self.spec = str(spec)
+        self.kind = "bag"
+        self.width, self.height = width, height
+        path, topic = parse_bag_spec(spec)
+        if not path.exists():
+            raise UsageError(f"--source {self.spec!r}: no such bag (give a ROS 2 bag folder, "
+                             f"its .mcap/.db3 file, or a ROS 1 .bag file)")
+        if path.is_file() and path.suffix in (".mcap", ".db3"):
+            path = path.parent  # a ROS 2 bag is its folder
+        try:
+            self._reader = AnyReader([path],
+                                     default_typestore=get_typestore(Stores.ROS2_HUMBLE))
+            self._reader.open()
+        except (AnyReaderError, OSError, ValueError, KeyError) as exc:
+            raise UsageError(f"--source {self.spec!r}: cannot read the bag ({exc})") from None
+        images = {c.topic: c for c in self._reader.connections if c.msgtype in IMAGE_TYPES}
+        if topic is None:
+            if not images:
+                self.close()
+                raise UsageError(f"bag {str(path)!r} has no sensor_msgs/Image or "
+                                 f"CompressedImage topic")
+            if len(images) > 1 and _DEFAULT_TOPIC not in images:
+                self.close()
+                raise UsageError(f"bag {str(path)!r} has several image topics ("
+                                 + ", ".join(sorted(images)) + f"); pick one with "
+                                 f"bag:{path}:TOPIC")
+            topic = next(iter(images)) if len(images) == 1 else _DEFAULT_TOPIC
+        if topic not in images:
+            known = {c.topic: c.msgtype for c in self._reader.connections}
+            self.close()
+            if topic in known:
+                raise UsageError(f"topic {topic} of bag {str(path)!r} holds {known[topic]}, "
+                                 f"not images")
+            raise UsageError(f"bag {str(path)!r} has no topic {topic}; image topics: "
+                             + (", ".join(sorted(images)) or "none"))
+        self.topic = topic
+        self._connections = [c for c in self._reader.connections if c.topic == topic]
+        if sum(c.msgcount for c in self._connections) == 0:
+            self.close()
+            raise UsageError(f"topic {topic} of bag {str(path)!r} has no messages")
+        self._stamps = []
+        # The first image is decoded now: a bad encoding is reported before the run starts.
+        conn, _, raw = next(self._reader.messages(connections=self._connections))
+        try:
+            decode_image(self._reader.deserialize(raw, conn.msgtype), conn.msgtype)
+        except UsageError as exc:
+            self.close()
+            raise UsageError(f"bag {str(path)!r} topic {topic}: {exc}") from None
+
+    def frame_time(self, k):
+        """Seconds from the first frame to frame ``k`` (by the bag's times)."""
+        return (self._stamps[k] - self._stamps[0]) / 1e9
+
+    def __iter__(self):
+        from ..sources import to_design_rgb
+
+        reader = self._reader
+        for conn, stamp, raw in reader.messages(connections=self._connections):
+            msg = reader.deserialize(raw, conn.msgtype)
+            self._stamps.append(stamp)
+            yield to_design_rgb(decode_image(msg, conn.msgtype), self.width, self.height)
+
+    def close(self):
+        if self._reader is not None:
+            self._reader.close()
+            self._reader = None

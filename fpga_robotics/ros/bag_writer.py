@@ -1,0 +1,113 @@
+"""``--bag PATH``: a run's frames as a ROS 2 bag (MCAP storage), written with ``rosbags``.
+
+A display connector like the rerun recorder (``viz.recorder``): ``log_frame(record)`` for
+every ``FrameRecord``, ``close()`` at the end. The bag is written into a hidden folder next to
+``PATH`` and renamed to ``PATH`` only when complete (an existing bag there is replaced); a run
+that fails or is interrupted leaves nothing behind (``abandon()``). The topics and their types
+are ``messages.TOPICS``; ``ros2 bag info PATH`` and Foxglove open the result.
+"""
+
+import contextlib
+import os
+import shutil
+import tempfile
+from pathlib import Path
+
+from rosbags.rosbag2 import StoragePlugin, Writer, WriterError
+
+from ..errors import UsageError
+from .messages import TOPICS, TYPESTORE, FrameMessages, camera_geometry
+
+__all__ = ["BagWriter", "check_bag_path", "open_bag_writer"]
+
+
+def check_bag_path(path):
+    """``PATH`` must be new, or a bag (a folder with ``metadata.yaml``) to replace, in a
+    folder we can write; returns it as a ``Path``."""
+    if path is None or str(path).strip() == "":
+        raise UsageError("--bag: the path is empty; give a folder name for the bag")
+    path = Path(path)
+    if path.exists() and not (path.is_dir() and (path / "metadata.yaml").is_file()):
+        what = "a folder that is not a ROS 2 bag" if path.is_dir() else "a file"
+        raise UsageError(f"--bag {str(path)!r} exists and is {what}; give a new name")
+    parent = path.parent
+    while not parent.exists():
+        parent = parent.parent
+    if not os.access(parent, os.W_OK):
+        raise UsageError(f"--bag {str(path)!r}: cannot write in {str(parent)!r}; "
+                         f"choose another place")
+    return path
+
+
+class BagWriter:
+    """Writes ``FrameRecord`` s to a ROS 2 bag at ``path`` (see the module docstring).
+
+    Parameters
+    ----------
+    path : str or Path
+        The bag folder to create.
+    geometry : messages.CameraGeometry
+        Camera and robot geometry (``messages.camera_geometry(scenario)``).
+
+    Attributes
+    ----------
+    frames_logged : int
+    path : Path
+    """
+
+    def __init__(self, path, geometry):
+        self.path = check_bag_path(path)
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        self._staging = Path(tempfile.mkdtemp(prefix=f".{self.path.name}.", suffix=".partial",
+                                              dir=self.path.parent))
+        self._tmp = self._staging / self.path.name  # the .mcap inside is named after it
+        self._messages = FrameMessages(geometry)
+        self._writer = Writer(self._tmp, version=9, storage_plugin=StoragePlugin.MCAP)
+        self._writer.open()
+        self._connections = {topic: self._writer.add_connection(topic, msgtype,
+                                                                 typestore=TYPESTORE)
+                             for topic, msgtype in TOPICS.items()}
+        self.frames_logged = 0
+        self._notices = []
+
+    def log_world_map(self, world_map):
+        """Nothing: the bag carries the people and the robot, the room stays in the map."""
+
+    def log_frame(self, record):
+        write, conns = self._writer.write, self._connections
+        for topic, ns, data in self._messages.encode(record):
+            write(conns[topic], ns, data)
+        self.frames_logged += 1
+
+    def pop_notices(self):
+        notices, self._notices = self._notices, []
+        return notices
+
+    def close(self):
+        """Finish the bag and move it to ``path``; returns the line that says where it is."""
+        if self._writer is None:
+            return ""
+        writer, self._writer = self._writer, None
+        try:
+            writer.close()
+            old = None
+            if self.path.exists():  # a bag from an earlier run: replaced only now
+                old = self._staging / "old"
+                os.replace(self.path, old)
+            os.replace(self._tmp, self.path)
+        finally:
+            shutil.rmtree(self._staging, ignore_errors=True)
+        return f"ROS 2 bag ({self.frames_logged} frames) written to {self.path}"
+
+    def abandon(self):
+        """Stop without a bag: the partial one is removed."""
+        if self._writer is not None:
+            writer, self._writer = self._writer, None
+            with contextlib.suppress(OSError, WriterError):  # discarded either way
+                writer.close()
+        shutil.rmtree(self._staging, ignore_errors=True)
+
+
+def open_bag_writer(path, scenario):
+    """A ``BagWriter`` for the run of ``scenario`` (its camera and robot geometry)."""
+    return BagWriter(path, camera_geometry(scenario))

@@ -1,0 +1,163 @@
+"""``--live foxglove[:PORT]``: the run's topics on a Foxglove WebSocket server (foxglove-sdk),
+and live control from the client.
+
+The server listens on localhost only and publishes the same ROS 2 messages as the bag
+(``messages.TOPICS``, CDR with their ``ros2msg`` schemas) as each frame is done. Clients may
+publish (client-publish capability) on the control topics ``CONTROL_TOPICS``, in JSON or CDR;
+each message becomes a ``LiveControls`` input, applied at the next frame boundary.
+"""
+
+import json
+import threading
+
+import foxglove
+from foxglove.websocket import Capability
+
+from ..errors import UsageError
+from .messages import TOPICS, TYPESTORE, FrameMessages, msgdef
+
+__all__ = ["CONTROL_TOPICS", "DEFAULT_PORT", "LivePublisher", "control_input",
+           "parse_live_spec"]
+
+DEFAULT_PORT = 8765
+
+#: Topics a client may publish on, with the types they accept: what each one controls.
+CONTROL_TOPICS = {
+    "/fpga/color_select": ("std_msgs/msg/String", "std_msgs/msg/UInt8"),
+    "/target/cmd_vel": ("geometry_msgs/msg/Twist",),
+    "/sim/pause": ("std_msgs/msg/Bool", "std_msgs/msg/Empty"),
+    "/sim/step": ("std_msgs/msg/Empty", "std_msgs/msg/Bool"),
+}
+
+
+def parse_live_spec(spec):
+    """``foxglove`` or ``foxglove:PORT`` (0 = any free port) to the port number."""
+    kind, _, port = str(spec).partition(":")
+    if kind != "foxglove":
+        raise UsageError(f"--live must be foxglove or foxglove:PORT, got {spec!r}")
+    if not port:
+        return DEFAULT_PORT
+    if not port.isdigit() or not 0 <= int(port) <= 65535:
+        raise UsageError(f"--live foxglove:PORT needs a port number 0..65535, got {port!r}")
+    return int(port)
+
+
+def _decode(encoding, schema_name, data):
+    """A client message as a dict (JSON) or a message object (CDR)."""
+    if encoding == "json":
+        return json.loads(bytes(data).decode())
+    name = schema_name.replace("/", "/msg/", 1) if "/msg/" not in schema_name else schema_name
+    msg = TYPESTORE.deserialize_cdr(bytes(data), name)
+    return {f: getattr(msg, f) for f in msg.__dataclass_fields__}
+
+
+def control_input(topic, message):
+    """The ``(kind, value)`` input of a message on a control topic (a dict of its fields)."""
+    if topic == "/fpga/color_select":
+        return "color", message["data"]
+    if topic == "/target/cmd_vel":
+        lin = message["linear"]
+        lin = lin if isinstance(lin, dict) else {"x": lin.x, "y": lin.y}
+        return "target_velocity", [float(lin.get("x", 0.0)), float(lin.get("y", 0.0))]
+    if topic == "/sim/pause":
+        paused = message.get("data", True)
+        return ("pause" if paused else "resume"), None
+    if topic == "/sim/step":
+        return "step", None
+    raise ValueError(f"{topic} is not a control topic")
+
+
+class _Listener(foxglove.websocket.ServerListener):
+    def __init__(self, publisher):
+        self.publisher = publisher
+        self.channels = {}  # (client id, client channel id) -> (topic, encoding, schema name)
+
+    def on_subscribe(self, client, channel):
+        with self.publisher.lock:
+            self.publisher.subscribed.add(channel.topic)
+
+    def on_client_advertise(self, client, channel):
+        self.channels[(client.id, channel.id)] = (channel.topic, channel.encoding,
+                                                  channel.schema_name)
+
+    def on_client_unadvertise(self, client, client_channel_id):
+        self.channels.pop((client.id, client_channel_id), None)
+
+    def on_message_data(self, client, client_channel_id, data):
+        topic, encoding, schema_name = self.channels.get((client.id, client_channel_id),
+                                                         (None, None, None))
+        if topic not in CONTROL_TOPICS:
+            return
+        try:
+            kind, value = control_input(topic, _decode(encoding, schema_name, data))
+            self.publisher.controls.submit(kind, value)
+        except Exception as exc:  # noqa: BLE001 - a client's bad message never stops the run
+            self.publisher.rejected.append(f"{topic}: {exc}")
+
+
+class LivePublisher:
+    """A display connector that publishes each ``FrameRecord`` to a Foxglove server.
+
+    Parameters
+    ----------
+    port : int
+        TCP port on 127.0.0.1 (0: any free port; ``port`` then tells which).
+    geometry : messages.CameraGeometry
+    controls : controls.LiveControls or None
+        Where client-published control messages go (None: no client publishing).
+    """
+
+    def __init__(self, port, geometry, controls=None):
+        self.controls = controls
+        self.lock = threading.Lock()
+        self.subscribed = set()
+        self.rejected = []  # client messages that could not be used, with why
+        self._messages = FrameMessages(geometry)
+        self._context = foxglove.Context()
+        self._channels = {
+            topic: foxglove.Channel(topic, message_encoding="cdr", context=self._context,
+                                    schema=foxglove.Schema(name=msgtype.replace("/msg/", "/"),
+                                                           encoding="ros2msg",
+                                                           data=msgdef(msgtype).encode()))
+            for topic, msgtype in TOPICS.items()}
+        try:
+            self._server = foxglove.start_server(
+                name="fpga_robotics", host="127.0.0.1", port=port, context=self._context,
+                capabilities=[Capability.ClientPublish] if controls is not None else [],
+                supported_encodings=["json", "cdr"],
+                server_listener=_Listener(self) if controls is not None else None)
+        except RuntimeError as exc:  # FoxgloveError: the port is taken, no permission
+            raise UsageError(f"--live: cannot serve on 127.0.0.1:{port} ({exc}); "
+                             f"give another port with --live foxglove:PORT") from None
+        self.port = self._server.port
+        self.frames_logged = 0
+
+    @property
+    def url(self):
+        return f"ws://127.0.0.1:{self.port}"
+
+    def pop_notices(self):
+        return [(f"Foxglove live: open a WebSocket connection to {self.url} "
+                 f"(layout: {layout_path()})")]
+
+    def log_world_map(self, world_map):
+        """Nothing: Foxglove draws the people and the robot from their topics."""
+
+    def log_frame(self, record):
+        channels = self._channels
+        for topic, ns, data in self._messages.encode(record):
+            channels[topic].log(bytes(data), log_time=ns)
+        self.frames_logged += 1
+
+    def close(self):
+        if self._server is not None:
+            self._server.stop()
+            self._server = None
+        return ""
+
+
+def layout_path():
+    """The Foxglove layout shipped with the package."""
+    from pathlib import Path
+
+    return Path(__file__).with_name("foxglove_layout.json")

@@ -1,0 +1,191 @@
+"""``--source bag:PATH[:TOPIC]``: frames written by the test into ROS 2 and ROS 1 bags (raw
+rgb8 / bgr8 / yuv422, CompressedImage PNG) give the design the same outputs as the same
+frames given straight to the model (issue 16)."""
+
+import json
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pytest
+from rosbags.highlevel import AnyReader
+from rosbags.rosbag1 import Writer as Writer1
+from rosbags.rosbag2 import StoragePlugin
+from rosbags.rosbag2 import Writer as Writer2
+from rosbags.typesys import Stores, get_typestore
+
+from fpga_robotics.errors import UsageError
+from fpga_robotics.hw.params import FollowTargetParams
+from fpga_robotics.run import main as run_main
+from fpga_robotics.sim.model import FollowTargetModel
+from fpga_robotics.sim.synthetic import scenario as synthetic_scenario
+from fpga_robotics.sources import open_source
+
+W, H = 80, 60
+PERIOD_NS = 50_000_000  # 20 fps, as a camera driver would stamp them
+T0_NS = 1_700_000_000_000_000_000  # a real robot's bag starts at its wall-clock time
+ROS2 = get_typestore(Stores.ROS2_HUMBLE)
+ROS1 = get_typestore(Stores.ROS1_NOETIC)
+
+
+def frames():
+    """A red target sweeping across a noisy background, then an empty-ish frame."""
+    return synthetic_scenario("sweep", W, H, n_frames=6, rng=5).frames
+
+
+def to_uyvy(rgb):
+    """RGB to UYVY 4:2:2 by BT.601 (video range), chroma averaged over each pixel pair."""
+    f = rgb.astype(float)
+    r, g, b = f[..., 0], f[..., 1], f[..., 2]
+    y = 16 + 0.257 * r + 0.504 * g + 0.098 * b
+    u = 128 - 0.148 * r - 0.291 * g + 0.439 * b
+    v = 128 + 0.439 * r - 0.368 * g - 0.071 * b
+    u2 = (u[:, 0::2] + u[:, 1::2]) / 2
+    v2 = (v[:, 0::2] + v[:, 1::2]) / 2
+    out = np.empty((rgb.shape[0], rgb.shape[1], 2))
+    out[:, 0::2, 0], out[:, 1::2, 0] = u2, v2
+    out[..., 1] = y
+    return np.clip(np.round(out), 0, 255).astype(np.uint8)
+
+
+def image_msg(store, rgb, k, encoding, ros1=False):
+    T = store.types
+    stamp = T["builtin_interfaces/msg/Time"](sec=(T0_NS + k * PERIOD_NS) // 10**9,
+                                             nanosec=(T0_NS + k * PERIOD_NS) % 10**9)
+    header = (T["std_msgs/msg/Header"](seq=k, stamp=stamp, frame_id="cam") if ros1 else
+              T["std_msgs/msg/Header"](stamp=stamp, frame_id="cam"))
+    if encoding == "png":
+        ok, png = cv2.imencode(".png", cv2.cvtColor(rgb, cv2.COLOR_RGB2BGR))
+        assert ok
+        return "sensor_msgs/msg/CompressedImage", T["sensor_msgs/msg/CompressedImage"](
+            header=header, format="png", data=png.reshape(-1))
+    pixels = {"rgb8": rgb, "bgr8": rgb[..., ::-1], "yuv422": to_uyvy(rgb)}[encoding]
+    step = pixels.shape[1] * pixels.shape[2]
+    return "sensor_msgs/msg/Image", T["sensor_msgs/msg/Image"](
+        header=header, height=rgb.shape[0], width=rgb.shape[1], encoding=encoding, is_bigendian=0, step=step,
+        data=np.ascontiguousarray(pixels).reshape(-1))
+
+
+def write_bag(path, images, encoding, *, ros1=False, topic="/camera/image_raw", extra=()):
+    """A bag of ``images`` on ``topic`` (and ``extra`` empty image topics)."""
+    store = ROS1 if ros1 else ROS2
+    writer = Writer1(path) if ros1 else Writer2(path, version=9,
+                                               storage_plugin=StoragePlugin.MCAP)
+    with writer:
+        msgtype = image_msg(store, images[0], 0, encoding, ros1)[0]
+        conn = writer.add_connection(topic, msgtype, typestore=store)
+        for name in extra:
+            writer.add_connection(name, msgtype, typestore=store)
+        for k, rgb in enumerate(images):
+            _, msg = image_msg(store, rgb, k, encoding, ros1)
+            data = store.serialize_ros1(msg, msgtype) if ros1 else store.serialize_cdr(msg,
+                                                                                      msgtype)
+            writer.write(conn, T0_NS + k * PERIOD_NS, data)
+    return path
+
+
+def model_outputs(images):
+    model = FollowTargetModel(FollowTargetParams(width=W, height=H))
+    out = []
+    for rgb in images:
+        m = model.process(rgb, 0b100)  # red
+        out.append([m.tracker.found, m.tracker.proximity, m.tracker.centroid_x,
+                    m.motor_left, m.motor_right])
+    return out
+
+
+def run_bag(spec, tmp_path, *extra):
+    summary = tmp_path / "s.json"
+    code = run_main(["--source", spec, "--backend", "model", "--resolution", f"{W}x{H}",
+                     "--rerun", "off", "--quiet", "--summary", str(summary), *extra])
+    assert code == 0
+    out = json.loads(summary.read_text())
+    return [[r["found"], r["proximity"], r["centroid_x"], r["motor_left"], r["motor_right"]]
+            for r in out["results"]]
+
+
+@pytest.mark.parametrize("encoding, ros1", [("rgb8", False), ("bgr8", False),
+                                            ("png", False), ("rgb8", True), ("bgr8", True)])
+def test_lossless_bags_give_the_models_outputs(encoding, ros1, tmp_path):
+    images = frames()
+    bag = write_bag(tmp_path / ("b.bag" if ros1 else "b"), images, encoding, ros1=ros1)
+    src = open_source(f"bag:{bag}", W, H)
+    seen = list(src)
+    src.close()
+    assert all(np.array_equal(a, b) for a, b in zip(seen, images)) and len(seen) == 6
+    expected = model_outputs(images)
+    assert run_bag(f"bag:{bag}", tmp_path) == expected
+    assert any(e[0] for e in expected) and len({e[2] for e in expected}) > 1  # it tracks
+
+
+def test_yuv422_is_decoded_as_uyvy(tmp_path):
+    images = frames()
+    # Pixel pairs of one colour lose nothing to 4:2:2: only rounding is left.
+    paired = [np.repeat(f[:, 0::2], 2, axis=1) for f in images]
+    bag = write_bag(tmp_path / "p", paired, "yuv422")
+    src = open_source(f"bag:{bag}:/camera/image_raw", W, H)
+    seen = list(src)
+    src.close()
+    for a, b in zip(seen, paired):
+        assert np.abs(a.astype(int) - b.astype(int)).max() <= 3
+    bag = write_bag(tmp_path / "b", images, "yuv422")
+    # The design sees exactly what OpenCV's UYVY decoder makes of the bytes.
+    decoded = [cv2.cvtColor(to_uyvy(rgb), cv2.COLOR_YUV2RGB_UYVY) for rgb in images]
+    assert run_bag(f"bag:{bag}", tmp_path) == model_outputs(decoded)
+
+
+def test_bag_frames_are_resized_and_keep_the_bags_times(tmp_path):
+    big = [cv2.resize(f, (2 * W, 2 * H), interpolation=cv2.INTER_NEAREST) for f in frames()]
+    bag = write_bag(tmp_path / "b", big, "rgb8")
+    src = open_source(f"bag:{bag}", W, H)
+    seen = list(src)
+    assert [src.frame_time(k) for k in range(6)] == pytest.approx([0.05 * k for k in range(6)])
+    src.close()
+    expected = [cv2.resize(f, (W, H), interpolation=cv2.INTER_LINEAR) for f in big]
+    assert all(np.array_equal(a, b) for a, b in zip(seen, expected))
+    # The bag's .mcap file names the same bag.
+    src = open_source(f"bag:{bag}/{bag.name}.mcap:/camera/image_raw", W, H)
+    assert sum(1 for _ in src) == 6
+    src.close()
+
+
+def test_bag_in_and_bag_out(tmp_path):
+    images = frames()
+    bag = write_bag(tmp_path / "in", images, "bgr8")
+    run_bag(f"bag:{bag}", tmp_path, "--bag", str(tmp_path / "out"))
+    with AnyReader([tmp_path / "out"], default_typestore=ROS2) as reader:
+        conns = {c.topic: c for c in reader.connections}
+        got = [reader.deserialize(raw, c.msgtype) for c, _, raw in
+               reader.messages(connections=[conns["/camera/image_raw"]])]
+        stamps = [t for _, t, _ in reader.messages(connections=[conns["/fpga/found"]])]
+        found = [reader.deserialize(raw, c.msgtype).data for c, _, raw in
+                 reader.messages(connections=[conns["/fpga/found"]])]
+    assert [g.data.tobytes() for g in got] == [f.tobytes() for f in images]
+    assert stamps == [k * PERIOD_NS for k in range(6)]  # the input's times, from its start
+    assert found == [e[0] for e in model_outputs(images)]
+
+
+def test_bad_bags_are_usage_errors(tmp_path):
+    images = frames()
+    bag = write_bag(tmp_path / "b", images, "rgb8", extra=("/other/image",))
+    with pytest.raises(UsageError, match="no topic /nope"):
+        open_source(f"bag:{bag}:/nope", W, H)
+    empty = write_bag(tmp_path / "e", images[:0] or [images[0]], "rgb8",
+                      topic="/unused", extra=("/camera/image_raw",))
+    with pytest.raises(UsageError, match="has no messages"):
+        open_source(f"bag:{empty}", W, H)
+    mono16 = tmp_path / "m"
+    with Writer2(mono16, version=9, storage_plugin=StoragePlugin.MCAP) as writer:
+        conn = writer.add_connection("/cam", "sensor_msgs/msg/Image", typestore=ROS2)
+        msg = ROS2.types["sensor_msgs/msg/Image"](
+            header=ROS2.types["std_msgs/msg/Header"](
+                stamp=ROS2.types["builtin_interfaces/msg/Time"](sec=0, nanosec=0),
+                frame_id=""),
+            height=2, width=2, encoding="32FC1", is_bigendian=0, step=8,
+            data=np.zeros(16, np.uint8))
+        writer.write(conn, 1, ROS2.serialize_cdr(msg, "sensor_msgs/msg/Image"))
+    with pytest.raises(UsageError, match="encoding '32FC1' is not read"):
+        open_source(f"bag:{mono16}", W, H)
+    with pytest.raises(UsageError, match="no such bag"):
+        open_source(f"bag:{tmp_path / 'missing'}", W, H)
+    assert Path(bag).is_dir()
