@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .connectors import CameraConnector, MotorConnector, in_view
+from .connectors.camera import ExposureDrift
 from .hw.pixel import color_select_value
 from .shadow import ShadowComparison, divergence_event
 from .sim.camera import focal_length
@@ -165,6 +166,11 @@ class ClosedLoop:
             noise_std=cam.noise_std,
             # A stream of its own, so that camera noise never shifts the world's randomness.
             rng=np.random.default_rng([self.seed, 0xCA3E]),
+            yaw_offset=cam.yaw_offset,
+            # camera.exposure_drift: a stream of its own too, one step per frame.
+            drift=(ExposureDrift(cam.exposure_drift, cam.frame_period,
+                                 np.random.default_rng([self.seed, 0xD41F]))
+                   if cam.exposure_drift > 0 else None),
             # camera.sensor = "ov7670": the sensor model, blurred by the robot's turn rate.
             sensor=make_sensor(cam, self.seed),
             turn_rate=lambda: self.world.robot_velocity()[1],
@@ -182,7 +188,8 @@ class ClosedLoop:
 
     def capture(self, t):
         """The camera image at time ``t``, with the events since the last frame."""
-        pose = self.camera.pose(self.world.robot_pose())
+        # On a ramp the camera pitches with the robot (sim/world/terrain.py).
+        pose = self.camera.pose(self.world.robot_pose(), pitch=self.world.camera_pitch())
         rgb = self.camera.capture(self.world.scene(), pose)
         events = list(self.world.drain_events())
         new_color = self.scenario.color_at(t)

@@ -91,6 +91,8 @@ DEFAULTS = {
         "mount_forward": None,
         "tilt": None,
         "noise_std": 0.0,
+        "yaw_offset_deg": 0.0,  # the mount knocked off its pose (positive: turned left)
+        "exposure_drift": 0.0,  # std of the log brightness gain's slow drift (10 s correlation)
         # The sensor model after the renderer (camera.sensor, camera.ov7670.*).
         "sensor": "plain",
         "ov7670": {k: list(v[0]) if v[1] == "pair" else v[0] for k, v in SENSOR_PARAMS.items()},
@@ -111,6 +113,8 @@ LIMITS = {
     "camera.mount_forward": (-2.0, 2.0, "m"),
     "camera.tilt": (-math.pi / 2, math.pi / 2, "rad"),  # and what the field of view allows
     "camera.noise_std": (0.0, 64.0, "8-bit levels"),
+    "camera.yaw_offset_deg": (-45.0, 45.0, "deg"),
+    "camera.exposure_drift": (0.0, 2.0, ""),
     "color.changes.at": (0.0, MAX_TIME, "s"),
 }
 #: Keys whose lower bound is excluded.
@@ -169,6 +173,8 @@ class CameraConfig:
     mount_forward: float | None
     tilt: float | None
     noise_std: float
+    yaw_offset: float = 0.0  # rad: the mount's yaw off the robot's heading (left positive)
+    exposure_drift: float = 0.0  # std of the log brightness gain (CameraConnector)
     sensor: str = "plain"  # "plain" or "ov7670" (sim.sensor, with the parameters below)
     ov7670: OV7670Params = field(default_factory=OV7670Params)
 
@@ -623,6 +629,8 @@ def _camera(data):
         mount_forward=_limited(data, "camera.mount_forward", optional=True),
         tilt=_limited(data, "camera.tilt", optional=True),
         noise_std=_limited(data, "camera.noise_std"),
+        yaw_offset=math.radians(_limited(data, "camera.yaw_offset_deg")),
+        exposure_drift=_limited(data, "camera.exposure_drift"),
         sensor=_choice(cam["sensor"], "camera.sensor", ("plain", "ov7670")),
         ov7670=_sensor_params(cam["ov7670"]),
     )

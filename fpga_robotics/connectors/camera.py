@@ -9,12 +9,44 @@ sensor, and the capture is what the OV7670 makes of it.
 """
 
 import math
+from dataclasses import replace
 
 import numpy as np
 
 from ..sim.scene import CameraPose
 
-__all__ = ["SENSOR_STREAM", "CameraConnector", "camera_pose", "in_view", "make_sensor"]
+__all__ = ["SENSOR_STREAM", "CameraConnector", "ExposureDrift", "camera_pose", "in_view",
+           "make_sensor"]
+
+#: Correlation time of the exposure drift, s: a slow change (clouds, a lamp warming up).
+DRIFT_TAU = 10.0
+
+
+class ExposureDrift:
+    """A slow random drift of the frames' brightness (``camera.exposure_drift = s``): the log
+    of the gain is an Ornstein-Uhlenbeck process with standard deviation ``s`` and a
+    correlation time of ``DRIFT_TAU``, stepped once a frame (exactly, whatever the frame
+    rate) and starting at 1 (no change at frame 0)."""
+
+    def __init__(self, std, frame_period, rng):
+        self.std, self.rng = float(std), rng
+        self.a = math.exp(-frame_period / DRIFT_TAU)
+        self.b = self.std * math.sqrt(1.0 - self.a * self.a)
+        self.log_gain = 0.0
+        self.frames = 0
+
+    def gain(self):
+        """The gain of the next frame (advancing the process after the first frame)."""
+        if self.frames:
+            self.log_gain = self.a * self.log_gain + self.b * self.rng.standard_normal()
+        self.frames += 1
+        return math.exp(self.log_gain)
+
+    def apply(self, rgb):
+        """``rgb`` (uint8) times the next gain, rounded and clipped to 0..255."""
+        g = self.gain()
+        return np.clip(rgb.astype(np.float32) * np.float32(g) + np.float32(0.5), 0,
+                       255).astype(np.uint8)
 
 #: The sensor model's random stream is ``default_rng([seed, SENSOR_STREAM])``: its own, so that
 #: it shifts neither the world's randomness nor the plain path's noise.
@@ -80,10 +112,15 @@ class CameraConnector:
         ``sensor_state()``.
     turn_rate : callable or None
         Returns the robot's turn rate (rad/s) at the capture, for the sensor's motion blur.
+    yaw_offset : float
+        The mount's yaw off the robot's heading, rad (a camera knocked off its pose).
+    drift : ExposureDrift or None
+        A slow random drift of the frames' brightness (``camera.exposure_drift``).
     """
 
     def __init__(self, width, height, hfov, *, mount_height, mount_forward=0.0, tilt=0.0,
-                 noise_std=0.0, rng=None, sensor=None, turn_rate=None):
+                 noise_std=0.0, rng=None, sensor=None, turn_rate=None, yaw_offset=0.0,
+                 drift=None):
         from ..sim.camera import CameraRenderer
 
         self.width, self.height, self.hfov = width, height, hfov
@@ -92,16 +129,24 @@ class CameraConnector:
         self.rng = rng
         self.renderer = CameraRenderer(width, height, hfov)
         self.sensor, self.turn_rate = sensor, turn_rate
+        self.yaw_offset, self.drift = yaw_offset, drift
 
-    def pose(self, robot_pose):
-        return camera_pose(robot_pose, height=self.mount_height, forward=self.mount_forward,
-                           tilt=self.tilt)
+    def pose(self, robot_pose, pitch=0.0):
+        """The camera's pose on a robot at ``robot_pose``; ``pitch`` (rad) adds to the
+        mount's tilt (the slope under the robot)."""
+        pose = camera_pose(robot_pose, height=self.mount_height, forward=self.mount_forward,
+                           tilt=self.tilt + pitch)
+        if self.yaw_offset:
+            pose = replace(pose, heading=pose.heading + self.yaw_offset)
+        return pose
 
     def capture(self, scene, pose):
         """The RGB888 frame (height, width, 3) of ``scene`` seen from ``pose``."""
-        if self.sensor is not None:
-            return self._sense(self.renderer.render(scene, pose))
-        return self.renderer.render(scene, pose, noise_std=self.noise_std, rng=self.rng)
+        if self.sensor is not None:  # the drift is in the light that reaches the sensor
+            rendered = self.renderer.render(scene, pose)
+            return self._sense(rendered if self.drift is None else self.drift.apply(rendered))
+        rgb = self.renderer.render(scene, pose, noise_std=self.noise_std, rng=self.rng)
+        return rgb if self.drift is None else self.drift.apply(rgb)
 
     def _sense(self, rgb):
         """The sensor model's frame of the rendered (noise-free) ``rgb``."""
