@@ -14,7 +14,9 @@ column instead of one per pixel:
    ``row = H/2 - 0.5 - f * (z - h) / p`` (tilt aside). Each column therefore splits into a few
    runs of rows, each showing the nearest hit that covers it, or the floor / ceiling.
 4. The runs are painted with a cumulative sum down the columns and one palette lookup, so the
-   per-pixel work is a handful of whole-image operations whatever the scene.
+   per-pixel work is a handful of whole-image operations whatever the scene. Where a C++
+   compiler is present, a compiled pass (``camera_pixels``) paints the runs and adds the
+   sensor noise straight into the RGB888 image instead, with the same bytes.
 
 Lighting is Lambertian with ambient (``Scene.lighting``); sensor noise is optional, seeded by
 the caller's generator. docs/camera.md has the details and the measured speed.
@@ -39,6 +41,7 @@ import cv2
 import numpy as np
 
 from ..hw.validate import check_int
+from .camera_pixels import pixel_kernel
 from .scene import CameraPose, Scene
 
 __all__ = [
@@ -237,6 +240,8 @@ class CameraRenderer:
         self._col_index = self._cols[:, None]  # row selector for per-column gathers
         self._walls_key = self._walls = None
         self._cyls_key = self._cyls = None
+        #: The compiled per-pixel stage, or None (numpy); the image is the same either way.
+        self._kernel = pixel_kernel()
 
     def __repr__(self):
         return (
@@ -292,23 +297,51 @@ class CameraRenderer:
             raise TypeError(f"scene must be a fpga_robotics.sim.scene.Scene, not {type(scene)}")
         if not isinstance(pose, CameraPose):
             raise TypeError(f"pose must be a fpga_robotics.sim.scene.CameraPose, not {type(pose)}")
-        ids, palette = self._runs(scene, pose)
+        starts, palette = self._runs(scene, pose)
+        if noise_std:
+            _check_noise(noise_std, rng)
+        if self._kernel is not None:
+            return self._paint_compiled(starts, palette, noise_std, rng)
         # One 4-byte palette lookup per pixel, then RGBA -> RGB: ~3x faster than taking
         # 3-byte rows; cvtColor returns a fresh image for the caller.
-        palette.take(ids, out=self._rgba)
+        palette.take(self._paint_runs(starts), out=self._rgba)
         image = cv2.cvtColor(self._rgba_bytes, cv2.COLOR_RGBA2RGB)
         if noise_std:
             self._add_noise(image, noise_std, rng)
         return image
 
+    def _paint_compiled(self, starts, palette, noise_std, rng):
+        """The image from the runs in one compiled pass, noise included (same bytes as the
+        numpy path: the same random bits, in the same order, index the same table)."""
+        image = np.empty((self.height, self.width, 3), dtype=np.uint8)
+        starts = np.ascontiguousarray(starts, dtype=np.int32)
+        palette = np.ascontiguousarray(palette, dtype=np.uint32)
+        noise = table = None
+        if noise_std:
+            table = self._noise_table(float(noise_std))
+            noise = self._noise_indices(rng)
+        self._kernel.paint(
+            starts.ctypes.data, starts.shape[1], palette.ctypes.data, self.width, self.height,
+            image.ctypes.data, None if noise is None else noise.ctypes.data,
+            None if table is None else table.ctypes.data)
+        return image
+
+    def _noise_indices(self, rng):
+        """The 16-bit table index of every byte of the image, row-major: the values
+        ``_add_noise`` draws block by block, in one array."""
+        bits = rng.bit_generator.random_raw
+        size = self.height * self.width * 3
+        if (3 * self.width) % 4 == 0:  # every block a whole number of 64-bit draws
+            return bits(size // 4).view(np.uint16)
+        indices = np.empty(size, dtype=np.uint16)
+        block = self._noise_rows * self.width * 3
+        for start in range(0, size, block):
+            n = min(block, size - start)
+            indices[start : start + n] = bits(-(-n // 4)).view(np.uint16)[:n]
+        return indices
+
     def _add_noise(self, image, noise_std, rng):
-        if not (math.isfinite(noise_std) and noise_std > 0):
-            raise ValueError(f"noise_std must be a finite number >= 0, got {noise_std!r}")
-        if not isinstance(rng, np.random.Generator):
-            raise TypeError(
-                "noise_std > 0 needs rng=numpy.random.Generator (e.g. np.random.default_rng(seed))"
-                " so that the noise is reproducible"
-            )
+        _check_noise(noise_std, rng)
         # Inverse-CDF sampling: 16 random bits of the caller's generator per value pick one of
         # 65536 equally likely quantiles of N(0, std), rounded to 8-bit levels. The raw bits
         # come 8 bytes at a time (several times faster than drawing normals). Blocks of rows
@@ -330,7 +363,8 @@ class CameraRenderer:
         return self._noise_levels
 
     def _runs(self, scene, pose):
-        """Per-pixel run ids (H, W) and the flat palette of packed RGBA uint32 they index."""
+        """Each column's run start rows (W, R), ascending from 0, and the flat palette
+        (W * R) of packed RGBA uint32: column c's run j has colour ``palette[c * R + j]``."""
         W, H = self.width, self.height
         cx, cy, h, tilt = float(pose.x), float(pose.y), float(pose.height), float(pose.tilt)
         if not all(map(math.isfinite, (cx, cy, h, tilt, pose.heading))):
@@ -460,7 +494,7 @@ class CameraRenderer:
         s = starts[:, :, None]
         layer = ((rs[:, None, :] <= s) & (s < re[:, None, :])).argmax(axis=2)  # (W, runs)
         layer += (layer == k) & (starts >= horizon)  # no surface: ceiling or floor
-        return self._paint_runs(starts), colors[ci, layer].ravel()
+        return starts, colors[ci, layer].ravel()
 
     def _rows_covered(self, depth, z0, z1, h, tilt):
         """Rows ``row_start <= row < row_end`` where surfaces at ``depth`` spanning heights
@@ -493,7 +527,17 @@ class CameraRenderer:
         palette = np.empty((self.width, 2, 3))
         palette[:, 0] = ceil_rgb if horizon > 0 else floor_rgb
         palette[:, 1] = floor_rgb
-        return self._paint_runs(starts), _packed_colors(palette).ravel()
+        return starts, _packed_colors(palette).ravel()
+
+
+def _check_noise(noise_std, rng):
+    if not (math.isfinite(noise_std) and noise_std > 0):
+        raise ValueError(f"noise_std must be a finite number >= 0, got {noise_std!r}")
+    if not isinstance(rng, np.random.Generator):
+        raise TypeError(
+            "noise_std > 0 needs rng=numpy.random.Generator (e.g. np.random.default_rng(seed))"
+            " so that the noise is reproducible"
+        )
 
 
 @functools.lru_cache(maxsize=1)
