@@ -15,7 +15,7 @@ column instead of one per pixel:
    runs of rows, each showing the nearest hit that covers it, or the floor / ceiling.
 4. The runs are painted with a cumulative sum down the columns and one palette lookup, so the
    per-pixel work is a handful of whole-image operations whatever the scene. Where a C++
-   compiler is present, a compiled pass (``camera_pixels``) paints the runs and adds the
+   compiler is present, a compiled pass (``camera_kernel``) paints the runs and adds the
    sensor noise straight into the RGB888 image instead, with the same bytes.
 
 Lighting is Lambertian with ambient (``Scene.lighting``); sensor noise is optional, seeded by
@@ -41,7 +41,7 @@ import cv2
 import numpy as np
 
 from ..hw.validate import check_int
-from .camera_pixels import pixel_kernel
+from .camera_kernel import camera_kernel
 from .scene import CameraPose, Scene
 
 __all__ = [
@@ -92,6 +92,7 @@ class _Cylinders:
     band_z0: np.ndarray
     band_z1: np.ndarray
     band_albedo: np.ndarray  # (B, 3)
+    bands: tuple = ()  # the Band tuples they were made of (reused while these stay)
 
 
 def focal_length(width, hfov):
@@ -142,29 +143,43 @@ def _walls_arrays(walls):
     if np.any(a[:, 4] <= 0.0):
         i = int(np.argmin(a[:, 4]))
         raise ValueError(f"wall {i} has zero length ({walls[i]}); give it two distinct ends")
-    return _Walls(a[:, 0], a[:, 1], a[:, 2], a[:, 3], a[:, 4], a[:, 5], albedo)
+    # Contiguous columns: the compiled stage reads them as plain arrays.
+    a = np.ascontiguousarray(a.T)
+    return _Walls(a[0], a[1], a[2], a[3], a[4], a[5], albedo)
 
 
-def _cylinder_arrays(cylinders):
+def _cylinder_arrays(cylinders, previous=None):
+    """The cylinders as arrays; ``previous`` (the arrays of an earlier tuple) lends its band
+    arrays when every cylinder wears the very same bands (people move, their looks stay)."""
     centres = np.empty((len(cylinders), 3))
-    owner, z, albedo = [], [], []
     for i, c in enumerate(cylinders):
         centres[i] = (c.x, c.y, c.radius)
-        for band in c.bands:
-            owner.append(i)
-            z.append((band.z0, band.z1))
-            albedo.append(_albedo(band.color, f"cylinder {i} band"))
+    bands = tuple(c.bands for c in cylinders)
+    same_bands = previous is not None and len(previous.bands) == len(bands) and all(
+        a is b for a, b in zip(bands, previous.bands))
+    if not same_bands:
+        owner, z, albedo = [], [], []
+        for i, c in enumerate(cylinders):
+            for band in c.bands:
+                owner.append(i)
+                z.append((band.z0, band.z1))
+                albedo.append(_albedo(band.color, f"cylinder {i} band"))
     if not np.all(np.isfinite(centres)) or np.any(centres[:, 2] <= 0.0):
         raise ValueError("cylinders need finite centres and a radius > 0")
-    z = np.asarray(z, dtype=float).reshape(-1, 2)
+    centres = np.ascontiguousarray(centres.T)
+    if same_bands:
+        return _Cylinders(centres[0], centres[1], centres[2], previous.band_owner,
+                          previous.band_z0, previous.band_z1, previous.band_albedo, bands)
+    z = np.ascontiguousarray(np.asarray(z, dtype=float).reshape(-1, 2).T)
     return _Cylinders(
-        centres[:, 0],
-        centres[:, 1],
-        centres[:, 2],
+        centres[0],
+        centres[1],
+        centres[2],
         np.asarray(owner, dtype=np.intp),
-        z[:, 0],
-        z[:, 1],
+        z[0],
+        z[1],
         np.asarray(albedo, dtype=float).reshape(-1, 3),
+        bands,
     )
 
 
@@ -240,8 +255,12 @@ class CameraRenderer:
         self._col_index = self._cols[:, None]  # row selector for per-column gathers
         self._walls_key = self._walls = None
         self._cyls_key = self._cyls = None
-        #: The compiled per-pixel stage, or None (numpy); the image is the same either way.
-        self._kernel = pixel_kernel()
+        #: The compiled stages, or None (numpy); the image is the same either way.
+        self._kernel = camera_kernel()
+        self._surfaces_key = self._surfaces_value = None
+        self._no_walls = np.empty(0)
+        self._cyl_scratch = np.empty(0)
+        self._layer_starts = self._layer_palette = None
 
     def __repr__(self):
         return (
@@ -261,7 +280,7 @@ class CameraRenderer:
             self._walls = _walls_arrays(scene.walls)
             self._walls_key = scene.walls
         if scene.cylinders is not self._cyls_key:
-            self._cyls = _cylinder_arrays(scene.cylinders)
+            self._cyls = _cylinder_arrays(scene.cylinders, self._cyls)
             self._cyls_key = scene.cylinders
         return self._walls, self._cyls
 
@@ -388,71 +407,43 @@ class CameraRenderer:
         dx = (ch + self._slope * sh)[:, None]
         dy = (sh - self._slope * ch)[:, None]
 
-        depths, shades = [], []
-        z0s, z1s, albedos = [], [], []
-        with np.errstate(divide="ignore", invalid="ignore"):
-            if len(walls.x0):
-                qx, qy = walls.x0 - cx, walls.y0 - cy
-                denom = dx * walls.ey - dy * walls.ex
-                t = (qx * walls.ey - qy * walls.ex) / denom
-                s = (qx * dy - qy * dx) / denom
-                depths.append(np.where((s >= 0.0) & (s <= 1.0) & (t > NEAR), t, np.inf))
-                # Unit normal turned towards the camera (the camera's side of the wall line).
-                side = np.where(walls.ey * qx - walls.ex * qy > 0.0, -1.0, 1.0) / walls.length
-                ndotl = side * (walls.ey * light[0] - walls.ex * light[1])
-                shade = ambient + intensity * np.maximum(0.0, -ndotl)
-                shades.append(np.broadcast_to(shade, (W, len(shade))))
-                z0s.append(np.zeros(len(shade)))
-                z1s.append(walls.height)
-                albedos.append(walls.albedo)
-            if len(cyls.band_owner):
-                qx, qy, r = cx - cyls.x, cy - cyls.y, cyls.radius
-                b = dx * qx + dy * qy
-                c = qx * qx + qy * qy - r * r  # > 0: camera outside the cylinder
-                disc = b * b - self._slope_sq1[:, None] * c
-                t = (-b - np.sqrt(disc)) / self._slope_sq1[:, None]
-                t = np.where((disc >= 0.0) & (t > NEAR) & (c > 0.0), t, np.inf)
-                # Outward normal at the hit point, (q + t d) / r (horizontal).
-                th = np.where(t < np.inf, t, 0.0)  # keeps misses finite (they are not drawn)
-                ndotl = ((qx + th * dx) * light[0] + (qy + th * dy) * light[1]) / r
-                shade = ambient + intensity * np.maximum(0.0, -ndotl)
-                own = cyls.band_owner
-                depths.append(t[:, own])
-                shades.append(shade[:, own])
-                z0s.append(cyls.band_z0)
-                z1s.append(cyls.band_z1)
-                albedos.append(cyls.band_albedo)
+        wall_shade = None
+        if len(walls.x0):
+            # Unit normal turned towards the camera (the camera's side of the wall line).
+            qx, qy = walls.x0 - cx, walls.y0 - cy
+            side = np.where(walls.ey * qx - walls.ex * qy > 0.0, -1.0, 1.0) / walls.length
+            ndotl = side * (walls.ey * light[0] - walls.ex * light[1])
+            wall_shade = ambient + intensity * np.maximum(0.0, -ndotl)
 
         floor_rgb = _lit(scene.floor_color, ambient + intensity * max(0.0, -light[2]), "floor")
         ceil_rgb = _lit(scene.ceiling_color, ambient + intensity * max(0.0, light[2]), "ceiling")
         horizon = min(H, max(0, math.ceil(self._rows_of(0.0, tilt))))  # first floor row
 
-        if not depths:  # an empty scene: floor and ceiling only
+        z0, z1, albedo = self._surfaces(walls, cyls, ceiling)
+        if not len(z0):  # an empty scene: floor and ceiling only
             return self._paint_background(horizon, floor_rgb, ceil_rgb)
-
-        depth = np.concatenate(depths, axis=1) if len(depths) > 1 else depths[0]
-        shade = np.concatenate(shades, axis=1) if len(shades) > 1 else shades[0]
-        z0 = np.concatenate(z0s) if len(z0s) > 1 else z0s[0]
-        z1 = np.concatenate(z1s) if len(z1s) > 1 else z1s[0]
-        albedo = np.concatenate(albedos) if len(albedos) > 1 else albedos[0]
-        # The floor and ceiling hide anything below 0 or above the ceiling.
-        z0 = np.maximum(z0, 0.0)
-        z1 = np.minimum(z1, ceiling)
+        hits = self._hits_compiled if self._kernel is not None else self._hits
+        depth, shade = hits(walls, cyls, wall_shade, dx, dy, cx, cy, ambient, intensity, light)
         n = depth.shape[1]
 
+        if self._kernel is not None and tilt == 0.0:
+            layers = self._layers_compiled(depth, shade, z0, z1, albedo, h, horizon, floor_rgb,
+                                           ceil_rgb)
+            if layers is not None:
+                return layers
+            return self._paint_background(horizon, floor_rgb, ceil_rgb)
         # Usually every hit of a column fits in the layer budget: then draw them all. Else
-        # take the 2k nearest as candidates and drop the hidden ones first (below).
+        # take the 2k nearest as candidates and drop the hidden ones first (below). Equal
+        # depths (the bands of one person) keep the surfaces' order: a stable sort.
         most = int(np.count_nonzero(depth < np.inf, axis=1).max())
         if most == 0:
             return self._paint_background(horizon, floor_rgb, ceil_rgb)
         k = min(self.max_layers, most)
         m = min(2 * k, most)
         ci = self._col_index
+        cand = np.argsort(depth, axis=1, kind="stable")
         if n > m:
-            cand = np.argpartition(depth, m - 1, axis=1)[:, :m]
-            cand = cand[ci, np.argsort(depth[ci, cand], axis=1)]
-        else:
-            cand = np.argsort(depth, axis=1)
+            cand = cand[:, :m]
         row_start, row_end = self._rows_covered(depth[ci, cand], z0[cand], z1[cand], h, tilt)
         if m == k:
             sel = cand  # (W, k) surface of each layer, nearest first
@@ -496,6 +487,89 @@ class CameraRenderer:
         layer += (layer == k) & (starts >= horizon)  # no surface: ceiling or floor
         return starts, colors[ci, layer].ravel()
 
+    def _layers_compiled(self, depth, shade, z0, z1, albedo, h, horizon, floor_rgb, ceil_rgb):
+        """The rest of ``_runs`` for a level camera in one compiled pass: run starts
+        (W, 2k + 2) and palette, or None when no column sees a surface."""
+        W, n = depth.shape
+        if self._layer_starts is None:
+            runs = 2 * self.max_layers + 2
+            self._layer_starts = np.empty(W * runs, dtype=np.int32)
+            self._layer_palette = np.empty(W * runs, dtype=np.uint32)
+        a = _address
+        k = self._kernel.layers(
+            W, self.height, n, a(depth), a(shade), a(z0), a(z1), a(albedo), h, self._row_axis,
+            self.focal, self.max_layers, horizon, int(_packed_colors(np.asarray(ceil_rgb))),
+            int(_packed_colors(np.asarray(floor_rgb))), self._layer_starts.ctypes.data,
+            self._layer_palette.ctypes.data)
+        if k == 0:
+            return None
+        runs = 2 * k + 2
+        return self._layer_starts[: W * runs].reshape(W, runs), self._layer_palette[: W * runs]
+
+    def _surfaces(self, walls, cyls, ceiling):
+        """Bottom and top height (clipped to the floor and the ceiling) and albedo of every
+        surface, walls first, then bands; kept while the geometry arrays are the same."""
+        key = (walls, cyls.band_z0, ceiling)
+        if self._surfaces_key is None or any(a is not b for a, b in zip(key, self._surfaces_key)):
+            z0 = np.concatenate([np.zeros(len(walls.x0)), cyls.band_z0])
+            z1 = np.concatenate([walls.height, cyls.band_z1])
+            albedo = np.concatenate([walls.albedo, cyls.band_albedo])
+            # The floor and ceiling hide anything below 0 or above the ceiling.
+            self._surfaces_value = (np.maximum(z0, 0.0), np.minimum(z1, ceiling), albedo)
+            self._surfaces_key = key
+        return self._surfaces_value
+
+    def _hits(self, walls, cyls, wall_shade, dx, dy, cx, cy, ambient, intensity, light):
+        """Depth (inf: no hit) and shade of every surface in every column, (W, surfaces)."""
+        W = self.width
+        depths, shades = [], []
+        with np.errstate(divide="ignore", invalid="ignore"):
+            if len(walls.x0):
+                qx, qy = walls.x0 - cx, walls.y0 - cy
+                denom = dx * walls.ey - dy * walls.ex
+                t = (qx * walls.ey - qy * walls.ex) / denom
+                s = (qx * dy - qy * dx) / denom
+                depths.append(np.where((s >= 0.0) & (s <= 1.0) & (t > NEAR), t, np.inf))
+                shades.append(np.broadcast_to(wall_shade, (W, len(wall_shade))))
+            if len(cyls.band_owner):
+                qx, qy, r = cx - cyls.x, cy - cyls.y, cyls.radius
+                b = dx * qx + dy * qy
+                c = qx * qx + qy * qy - r * r  # > 0: camera outside the cylinder
+                disc = b * b - self._slope_sq1[:, None] * c
+                t = (-b - np.sqrt(disc)) / self._slope_sq1[:, None]
+                t = np.where((disc >= 0.0) & (t > NEAR) & (c > 0.0), t, np.inf)
+                # Outward normal at the hit point, (q + t d) / r (horizontal).
+                th = np.where(t < np.inf, t, 0.0)  # keeps misses finite (they are not drawn)
+                ndotl = ((qx + th * dx) * light[0] + (qy + th * dy) * light[1]) / r
+                shade = ambient + intensity * np.maximum(0.0, -ndotl)
+                own = cyls.band_owner
+                depths.append(t[:, own])
+                shades.append(shade[:, own])
+        depth = np.concatenate(depths, axis=1) if len(depths) > 1 else depths[0]
+        shade = np.concatenate(shades, axis=1) if len(shades) > 1 else shades[0]
+        return depth, shade
+
+    def _hits_compiled(self, walls, cyls, wall_shade, dx, dy, cx, cy, ambient, intensity, light):
+        """``_hits`` in one compiled pass (the same values to the bit)."""
+        n_walls, n_cyls, n_bands = len(walls.x0), len(cyls.x), len(cyls.band_owner)
+        n = n_walls + n_bands
+        depth = np.empty((self.width, n))
+        shade = np.empty((self.width, n))
+        if wall_shade is None:
+            wall_shade = self._no_walls
+        scratch = self._cyl_scratch
+        if len(scratch) < 2 * n_cyls:
+            scratch = self._cyl_scratch = np.empty(2 * n_cyls)
+        cyl_t, cyl_shade = scratch.ctypes.data, scratch.ctypes.data + 8 * n_cyls
+        a = _address
+        self._kernel.hits(
+            self.width, a(dx), a(dy), a(self._slope_sq1), cx, cy, n_walls,
+            a(walls.x0), a(walls.y0), a(walls.ex), a(walls.ey), a(wall_shade), n_cyls,
+            a(cyls.x), a(cyls.y), a(cyls.radius), n_bands, a(cyls.band_owner), NEAR,
+            ambient, intensity, float(light[0]), float(light[1]), cyl_t, cyl_shade,
+            a(depth), a(shade))
+        return depth, shade
+
     def _rows_covered(self, depth, z0, z1, h, tilt):
         """Rows ``row_start <= row < row_end`` where surfaces at ``depth`` spanning heights
         ``z0..z1`` are seen (pixel centres inside the span); (H, H) for no hit."""
@@ -538,6 +612,13 @@ def _check_noise(noise_std, rng):
             "noise_std > 0 needs rng=numpy.random.Generator (e.g. np.random.default_rng(seed))"
             " so that the noise is reproducible"
         )
+
+
+def _address(array):
+    """The data address of a C-contiguous float64 or int64 array (checked: the compiled
+    stage reads it as such)."""
+    assert array.flags.c_contiguous and array.dtype.itemsize == 8, array.dtype
+    return array.__array_interface__["data"][0]
 
 
 @functools.lru_cache(maxsize=1)
