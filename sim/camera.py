@@ -41,7 +41,7 @@ import cv2
 import numpy as np
 
 from ..hw.validate import check_int
-from .camera_kernel import camera_kernel
+from .camera_kernel import NoiseTable, camera_kernel
 from .scene import CameraPose, Scene
 
 __all__ = [
@@ -79,6 +79,7 @@ class _Walls:
     length: np.ndarray
     height: np.ndarray
     albedo: np.ndarray  # (N, 3)
+    block: np.ndarray = None  # (6, N): the six arrays above in one (the compiled stage's)
 
 
 @dataclass(frozen=True)
@@ -93,6 +94,7 @@ class _Cylinders:
     band_z1: np.ndarray
     band_albedo: np.ndarray  # (B, 3)
     bands: tuple = ()  # the Band tuples they were made of (reused while these stay)
+    centres: np.ndarray = None  # (3, C): x, y, radius in one (the compiled stage's)
 
 
 def focal_length(width, hfov):
@@ -145,7 +147,7 @@ def _walls_arrays(walls):
         raise ValueError(f"wall {i} has zero length ({walls[i]}); give it two distinct ends")
     # Contiguous columns: the compiled stage reads them as plain arrays.
     a = np.ascontiguousarray(a.T)
-    return _Walls(a[0], a[1], a[2], a[3], a[4], a[5], albedo)
+    return _Walls(a[0], a[1], a[2], a[3], a[4], a[5], albedo, a)
 
 
 def _cylinder_arrays(cylinders, previous=None):
@@ -169,7 +171,8 @@ def _cylinder_arrays(cylinders, previous=None):
     centres = np.ascontiguousarray(centres.T)
     if same_bands:
         return _Cylinders(centres[0], centres[1], centres[2], previous.band_owner,
-                          previous.band_z0, previous.band_z1, previous.band_albedo, bands)
+                          previous.band_z0, previous.band_z1, previous.band_albedo, bands,
+                          centres)
     z = np.ascontiguousarray(np.asarray(z, dtype=float).reshape(-1, 2).T)
     return _Cylinders(
         centres[0],
@@ -180,6 +183,7 @@ def _cylinder_arrays(cylinders, previous=None):
         z[1],
         np.asarray(albedo, dtype=float).reshape(-1, 3),
         bands,
+        centres,
     )
 
 
@@ -250,7 +254,7 @@ class CameraRenderer:
         self._rgba_bytes = self._rgba.view(np.uint8).reshape(self.height, self.width, 4)
         self._noise_rows = max(1, _NOISE_BLOCK // (3 * self.width))
         self._noise = np.empty((self._noise_rows, self.width, 3), dtype=np.int8)
-        self._noise_std = self._noise_levels = None
+        self._noise_std = self._noise_levels = self._noise_compiled = None
         self._cols = np.arange(self.width)
         self._col_index = self._cols[:, None]  # row selector for per-column gathers
         self._walls_key = self._walls = None
@@ -258,8 +262,10 @@ class CameraRenderer:
         #: The compiled stages, or None (numpy); the image is the same either way.
         self._kernel = camera_kernel()
         self._surfaces_key = self._surfaces_value = None
-        self._no_walls = np.empty(0)
-        self._cyl_scratch = np.empty(0)
+        self._scratch = np.empty(0)
+        self._hit_scratch = None
+        self._slope_address = _address(self._slope)
+        self._slope_sq1_address = _address(self._slope_sq1)
         self._layer_starts = self._layer_palette = None
 
     def __repr__(self):
@@ -335,14 +341,16 @@ class CameraRenderer:
         image = np.empty((self.height, self.width, 3), dtype=np.uint8)
         starts = np.ascontiguousarray(starts, dtype=np.int32)
         palette = np.ascontiguousarray(palette, dtype=np.uint32)
-        noise = table = None
+        noise, table = None, (None, None, 0, None, 0)
         if noise_std:
-            table = self._noise_table(float(noise_std))
-            noise = self._noise_indices(rng)
-        self._kernel.paint(
-            starts.ctypes.data, starts.shape[1], palette.ctypes.data, self.width, self.height,
-            image.ctypes.data, None if noise is None else noise.ctypes.data,
-            None if table is None else table.ctypes.data)
+            self._noise_table(float(noise_std))
+            if self._noise_compiled is None:
+                self._noise_compiled = NoiseTable(self._noise_levels)
+            table = self._noise_compiled.arguments()
+            indices = self._noise_indices(rng)  # held until the call returns
+            noise = indices.ctypes.data
+        self._kernel.paint(starts.ctypes.data, starts.shape[1], palette.ctypes.data, self.width,
+                           self.height, image.ctypes.data, noise, *table)
         return image
 
     def _noise_indices(self, rng):
@@ -378,6 +386,7 @@ class CameraRenderer:
         if self._noise_std != noise_std:
             levels = np.clip(np.rint(noise_std * _normal_quantiles()), -127, 127)
             self._noise_levels = levels.astype(np.int8)
+            self._noise_compiled = None  # the compiled stage's forms, made when needed
             self._noise_std = noise_std
         return self._noise_levels
 
@@ -402,19 +411,6 @@ class CameraRenderer:
             )
         ambient, intensity, light = _light(scene.lighting)
         walls, cyls = self._geometry(scene)
-        ch, sh = math.cos(pose.heading), math.sin(pose.heading)
-        # Column ray directions with a forward component of 1: the ray parameter is the depth.
-        dx = (ch + self._slope * sh)[:, None]
-        dy = (sh - self._slope * ch)[:, None]
-
-        wall_shade = None
-        if len(walls.x0):
-            # Unit normal turned towards the camera (the camera's side of the wall line).
-            qx, qy = walls.x0 - cx, walls.y0 - cy
-            side = np.where(walls.ey * qx - walls.ex * qy > 0.0, -1.0, 1.0) / walls.length
-            ndotl = side * (walls.ey * light[0] - walls.ex * light[1])
-            wall_shade = ambient + intensity * np.maximum(0.0, -ndotl)
-
         floor_rgb = _lit(scene.floor_color, ambient + intensity * max(0.0, -light[2]), "floor")
         ceil_rgb = _lit(scene.ceiling_color, ambient + intensity * max(0.0, light[2]), "ceiling")
         horizon = min(H, max(0, math.ceil(self._rows_of(0.0, tilt))))  # first floor row
@@ -423,15 +419,15 @@ class CameraRenderer:
         if not len(z0):  # an empty scene: floor and ceiling only
             return self._paint_background(horizon, floor_rgb, ceil_rgb)
         hits = self._hits_compiled if self._kernel is not None else self._hits
-        depth, shade = hits(walls, cyls, wall_shade, dx, dy, cx, cy, ambient, intensity, light)
-        n = depth.shape[1]
-
+        depth, shade = hits(walls, cyls, cx, cy, pose.heading, ambient, intensity, light)
         if self._kernel is not None and tilt == 0.0:
             layers = self._layers_compiled(depth, shade, z0, z1, albedo, h, horizon, floor_rgb,
                                            ceil_rgb)
             if layers is not None:
                 return layers
             return self._paint_background(horizon, floor_rgb, ceil_rgb)
+        n = depth.shape[1]
+
         # Usually every hit of a column fits in the layer budget: then draw them all. Else
         # take the 2k nearest as candidates and drop the hidden ones first (below). Equal
         # depths (the bands of one person) keep the surfaces' order: a stable sort.
@@ -498,9 +494,8 @@ class CameraRenderer:
         a = _address
         k = self._kernel.layers(
             W, self.height, n, a(depth), a(shade), a(z0), a(z1), a(albedo), h, self._row_axis,
-            self.focal, self.max_layers, horizon, int(_packed_colors(np.asarray(ceil_rgb))),
-            int(_packed_colors(np.asarray(floor_rgb))), self._layer_starts.ctypes.data,
-            self._layer_palette.ctypes.data)
+            self.focal, self.max_layers, horizon, a(ceil_rgb), a(floor_rgb),
+            self._layer_starts.ctypes.data, self._layer_palette.ctypes.data)
         if k == 0:
             return None
         runs = 2 * k + 2
@@ -519,13 +514,22 @@ class CameraRenderer:
             self._surfaces_key = key
         return self._surfaces_value
 
-    def _hits(self, walls, cyls, wall_shade, dx, dy, cx, cy, ambient, intensity, light):
-        """Depth (inf: no hit) and shade of every surface in every column, (W, surfaces)."""
+    def _hits(self, walls, cyls, cx, cy, heading, ambient, intensity, light):
+        """Depth (inf: no hit) and shade of every surface in every column, (W, surfaces),
+        for a camera at ``(cx, cy)`` looking along ``heading``."""
         W = self.width
+        ch, sh = math.cos(heading), math.sin(heading)
+        # Column ray directions with a forward component of 1: the ray parameter is the depth.
+        dx = (ch + self._slope * sh)[:, None]
+        dy = (sh - self._slope * ch)[:, None]
         depths, shades = [], []
         with np.errstate(divide="ignore", invalid="ignore"):
             if len(walls.x0):
                 qx, qy = walls.x0 - cx, walls.y0 - cy
+                # Unit normal turned towards the camera (the camera's side of the wall line).
+                side = np.where(walls.ey * qx - walls.ex * qy > 0.0, -1.0, 1.0) / walls.length
+                ndotl = side * (walls.ey * light[0] - walls.ex * light[1])
+                wall_shade = ambient + intensity * np.maximum(0.0, -ndotl)
                 denom = dx * walls.ey - dy * walls.ex
                 t = (qx * walls.ey - qy * walls.ex) / denom
                 s = (qx * dy - qy * dx) / denom
@@ -549,25 +553,22 @@ class CameraRenderer:
         shade = np.concatenate(shades, axis=1) if len(shades) > 1 else shades[0]
         return depth, shade
 
-    def _hits_compiled(self, walls, cyls, wall_shade, dx, dy, cx, cy, ambient, intensity, light):
-        """``_hits`` in one compiled pass (the same values to the bit)."""
+    def _hits_compiled(self, walls, cyls, cx, cy, heading, ambient, intensity, light):
+        """``_hits`` in one compiled pass (the same values to the bit); the arrays are
+        scratch, valid until the next frame."""
         n_walls, n_cyls, n_bands = len(walls.x0), len(cyls.x), len(cyls.band_owner)
         n = n_walls + n_bands
-        depth = np.empty((self.width, n))
-        shade = np.empty((self.width, n))
-        if wall_shade is None:
-            wall_shade = self._no_walls
-        scratch = self._cyl_scratch
-        if len(scratch) < 2 * n_cyls:
-            scratch = self._cyl_scratch = np.empty(2 * n_cyls)
-        cyl_t, cyl_shade = scratch.ctypes.data, scratch.ctypes.data + 8 * n_cyls
+        if self._hit_scratch is None or self._hit_scratch[0].shape[1] != n:
+            self._hit_scratch = (np.empty((self.width, n)), np.empty((self.width, n)))
+        if len(self._scratch) < n_walls + 2 * n_cyls:
+            self._scratch = np.empty(n_walls + 2 * n_cyls)
+        depth, shade = self._hit_scratch
         a = _address
         self._kernel.hits(
-            self.width, a(dx), a(dy), a(self._slope_sq1), cx, cy, n_walls,
-            a(walls.x0), a(walls.y0), a(walls.ex), a(walls.ey), a(wall_shade), n_cyls,
-            a(cyls.x), a(cyls.y), a(cyls.radius), n_bands, a(cyls.band_owner), NEAR,
-            ambient, intensity, float(light[0]), float(light[1]), cyl_t, cyl_shade,
-            a(depth), a(shade))
+            self.width, self._slope_address, self._slope_sq1_address, math.cos(heading),
+            math.sin(heading), cx, cy, n_walls, a(walls.block), n_cyls, a(cyls.centres),
+            n_bands, a(cyls.band_owner), NEAR, ambient, intensity, float(light[0]),
+            float(light[1]), a(self._scratch), a(depth), a(shade))
         return depth, shade
 
     def _rows_covered(self, depth, z0, z1, h, tilt):

@@ -12,31 +12,44 @@
 #include <cmath>
 #include <cstdint>
 #include <algorithm>
+#include <immintrin.h>
 #include <cstring>
 #include <vector>
 
 #define FR_EXPORT extern "C" __attribute__((visibility("default")))
 
-FR_EXPORT int fr_camera_kernel_version() { return 3; }
+constexpr int64_t MAX_STEPS = 64;  // sim/camera_kernel.py MAX_STEPS
+
+FR_EXPORT int fr_camera_kernel_version() { return 7; }
 
 static inline double positive_part(double x) { return x > 0.0 ? x : 0.0; }  // np.maximum(0, x)
 
-// Column c's ray has direction (dx[c], dy[c]) with a forward component of 1, so the ray
-// parameter is the depth. Walls: start (wx0, wy0), vector (wex, wey), shade per wall (wshade).
-// Cylinders: centre (cx_, cy_), radius; bands: owner cylinder. Output (width, walls + bands)
-// row-major: depth (inf for no hit) and shade.
-FR_EXPORT void fr_camera_hits(int64_t width, const double *dx, const double *dy,
-                              const double *slope_sq1, double px, double py, int64_t n_walls,
-                              const double *wx0, const double *wy0, const double *wex,
-                              const double *wey, const double *wshade, int64_t n_cyls,
-                              const double *cx_, const double *cy_, const double *radius,
+// Column c's ray has direction (ch + slope[c] sh, sh - slope[c] ch) with a forward component
+// of 1, so the ray parameter is the depth. walls: (6, n_walls) rows x0, y0, ex, ey, length,
+// height; centres: (3, n_cyls) rows x, y, radius; owner: the cylinder of each band. scratch:
+// n_walls + 2 n_cyls doubles. Output (width, walls + bands) row-major: depth (inf for no
+// hit) and shade.
+FR_EXPORT void fr_camera_hits(int64_t width, const double *slope, const double *slope_sq1,
+                              double ch, double sh, double px, double py, int64_t n_walls,
+                              const double *walls, int64_t n_cyls, const double *centres,
                               int64_t n_bands, const int64_t *owner, double near,
                               double ambient, double intensity, double lx, double ly,
-                              double *cyl_t, double *cyl_shade, double *depth, double *shade) {
+                              double *scratch, double *depth, double *shade) {
     const double inf = INFINITY;
     const int64_t n = n_walls + n_bands;
+    const double *wx0 = walls, *wy0 = walls + n_walls, *wex = walls + 2 * n_walls,
+                 *wey = walls + 3 * n_walls, *wlen = walls + 4 * n_walls;
+    const double *cx_ = centres, *cy_ = centres + n_cyls, *radius = centres + 2 * n_cyls;
+    double *wshade = scratch, *cyl_t = scratch + n_walls, *cyl_shade = cyl_t + n_cyls;
+    for (int64_t i = 0; i < n_walls; ++i) {
+        // Unit normal turned towards the camera (the camera's side of the wall line).
+        const double qx = wx0[i] - px, qy = wy0[i] - py;
+        const double side = (wey[i] * qx - wex[i] * qy > 0.0 ? -1.0 : 1.0) / wlen[i];
+        const double ndotl = side * (wey[i] * lx - wex[i] * ly);
+        wshade[i] = ambient + intensity * positive_part(-ndotl);
+    }
     for (int64_t c = 0; c < width; ++c) {
-        const double ddx = dx[c], ddy = dy[c], a = slope_sq1[c];
+        const double ddx = ch + slope[c] * sh, ddy = sh - slope[c] * ch, a = slope_sq1[c];
         double *d = depth + c * n, *s = shade + c * n;
         for (int64_t i = 0; i < n_walls; ++i) {
             const double qx = wx0[i] - px, qy = wy0[i] - py;
@@ -65,36 +78,169 @@ FR_EXPORT void fr_camera_hits(int64_t width, const double *dx, const double *dy,
     }
 }
 
+// The noise table is monotone (quantiles of a normal distribution, rounded): table[i] is
+// table[0] plus the number of steps at[j] <= i (a step of two levels listed twice). With few
+// steps, counting them for 8 or 16 indices at a time (SIMD compares) is faster than looking
+// each index up, and gives the same value. out[i] = clean[i] + table[idx[i]], saturated to
+// 0..255 (as cv2.add into uint8; packus saturates the same way).
+struct Noise {
+    const uint16_t *idx;      // one per byte of the image
+    const int32_t *block;     // table[i] == sub[block[i >> 8] + (i & 255)]
+    const int8_t *sub;
+    int64_t steps;            // 0: look every index up
+    const uint16_t *at;       // the steps' first indices (>= 1), ascending
+    int16_t base;             // table[0]
+};
+
+static inline uint8_t saturated(int v) {
+    return static_cast<uint8_t>(v < 0 ? 0 : (v > 255 ? 255 : v));
+}
+
+// Restrict: the byte stores may otherwise alias every pointer, reloaded after each one.
+static void noise_lookup(uint8_t *__restrict out, const uint8_t *__restrict clean,
+                         const uint16_t *__restrict idx, int64_t from, int64_t n,
+                         const int32_t *__restrict block, const int8_t *__restrict sub) {
+    for (int64_t i = from; i < n; ++i)
+        out[i] = saturated(clean[i] + sub[block[idx[i] >> 8] + (idx[i] & 255)]);
+}
+
+// idx >= at as a signed 16-bit compare: both with the top bit flipped, and at - 1 (at >= 1).
+static inline int16_t flipped_step(uint16_t at) {
+    return static_cast<int16_t>(static_cast<uint16_t>(at - 1) ^ 0x8000u);
+}
+
+// SSE2 (every x86-64): 16 bytes an iteration; returns where the rest starts.
+static int64_t noise_count_sse2(uint8_t *out, const uint8_t *clean, const uint16_t *idx,
+                                int64_t n, const Noise &z) {
+    const __m128i flip = _mm_set1_epi16(static_cast<int16_t>(0x8000)), zero = _mm_setzero_si128();
+    const __m128i base = _mm_set1_epi16(z.base);
+    __m128i at[MAX_STEPS];
+    const int64_t steps = z.steps;
+    for (int64_t j = 0; j < steps; ++j)
+        at[j] = _mm_set1_epi16(flipped_step(z.at[j]));
+    const int64_t whole = n - n % 16;
+    for (int64_t i = 0; i < whole; i += 16) {
+        const __m128i x0 = _mm_xor_si128(_mm_loadu_si128((const __m128i *)(idx + i)), flip);
+        const __m128i x1 = _mm_xor_si128(_mm_loadu_si128((const __m128i *)(idx + i + 8)), flip);
+        const __m128i c = _mm_loadu_si128((const __m128i *)(clean + i));
+        __m128i v0 = _mm_add_epi16(_mm_unpacklo_epi8(c, zero), base);
+        __m128i v1 = _mm_add_epi16(_mm_unpackhi_epi8(c, zero), base);
+        for (int64_t j = 0; j < steps; ++j) {  // a true compare is -1: subtract it
+            v0 = _mm_sub_epi16(v0, _mm_cmpgt_epi16(x0, at[j]));
+            v1 = _mm_sub_epi16(v1, _mm_cmpgt_epi16(x1, at[j]));
+        }
+        _mm_storeu_si128((__m128i *)(out + i), _mm_packus_epi16(v0, v1));
+    }
+    return whole;
+}
+
+// AVX2 where the CPU has it: 32 bytes an iteration.
+__attribute__((target("avx2"))) static int64_t noise_count_avx2(uint8_t *out,
+                                                                const uint8_t *clean,
+                                                                const uint16_t *idx, int64_t n,
+                                                                const Noise &z) {
+    const __m256i flip = _mm256_set1_epi16(static_cast<int16_t>(0x8000));
+    const __m256i base = _mm256_set1_epi16(z.base);
+    __m256i at[MAX_STEPS];
+    const int64_t steps = z.steps;
+    for (int64_t j = 0; j < steps; ++j)
+        at[j] = _mm256_set1_epi16(flipped_step(z.at[j]));
+    const int64_t whole = n - n % 32;
+    for (int64_t i = 0; i < whole; i += 32) {
+        const __m256i x0 = _mm256_xor_si256(_mm256_loadu_si256((const __m256i *)(idx + i)), flip);
+        const __m256i x1 =
+            _mm256_xor_si256(_mm256_loadu_si256((const __m256i *)(idx + i + 16)), flip);
+        __m256i v0 = _mm256_add_epi16(
+            _mm256_cvtepu8_epi16(_mm_loadu_si128((const __m128i *)(clean + i))), base);
+        __m256i v1 = _mm256_add_epi16(
+            _mm256_cvtepu8_epi16(_mm_loadu_si128((const __m128i *)(clean + i + 16))), base);
+        for (int64_t j = 0; j < steps; ++j) {
+            v0 = _mm256_sub_epi16(v0, _mm256_cmpgt_epi16(x0, at[j]));
+            v1 = _mm256_sub_epi16(v1, _mm256_cmpgt_epi16(x1, at[j]));
+        }
+        // packus works within 128-bit lanes: put the four 8-byte quarters back in order.
+        const __m256i packed = _mm256_packus_epi16(v0, v1);
+        _mm256_storeu_si256((__m256i *)(out + i), _mm256_permute4x64_epi64(packed, 0xD8));
+    }
+    return whole;
+}
+
+static void add_noise(uint8_t *out, const uint8_t *clean, int64_t offset, int64_t n,
+                      const Noise &z) {
+    static const bool avx2 = __builtin_cpu_supports("avx2");
+    const uint16_t *idx = z.idx + offset;
+    int64_t done = 0;
+    if (z.steps > 0)
+        done = avx2 ? noise_count_avx2(out, clean, idx, n, z)
+                    : noise_count_sse2(out, clean, idx, n, z);
+    noise_lookup(out, clean, idx, done, n, z.block, z.sub);
+}
+
 // starts: (width, runs) int32, each column's run start rows ascending, the first 0 (a start
 // equal to height begins no run). palette: (width * runs) packed RGBA, bytes r, g, b, a.
-// noise: nullptr, or (height * width * 3) uint16 indices into the int8 table, one per byte
-// of the image in row-major order.
+// noise: nullptr, or (height * width * 3) uint16 indices, one per byte of the image in
+// row-major order, into the noise table, given in two levels that stay in the L1 cache:
+// table[i] == sub[block[i >> 8] + (i & 255)], and as its steps (struct Noise; steps 0 when
+// there are too many to count).
+//
+// A row differs from the one above only in the columns where a run starts, so the clean row
+// is kept in `line` and patched at those columns (found through per-row buckets), then copied
+// (or noised) into the image.
 FR_EXPORT void fr_camera_paint(const int32_t *starts, int64_t runs, const uint32_t *palette,
                                int64_t width, int64_t height, uint8_t *rgb,
-                               const uint16_t *noise, const int8_t *table) {
+                               const uint16_t *noise, const int32_t *block, const int8_t *sub,
+                               int64_t steps, const uint16_t *at, int64_t base) {
+    const Noise z{noise, block, sub, steps <= MAX_STEPS ? steps : 0, at,
+                  static_cast<int16_t>(base)};
     std::vector<int64_t> run(width, 0);  // each column's current run
-    for (int64_t y = 0; y < height; ++y) {
-        uint8_t *out = rgb + 3 * y * width;
-        const uint16_t *idx = noise ? noise + 3 * y * width : nullptr;
+    std::vector<uint8_t> line(3 * width);
+    // Columns by the rows where one of their runs starts (row 0 is painted whole).
+    std::vector<int32_t> first(height + 1, 0), column;
+    for (int64_t c = 0; c < width; ++c) {
+        int32_t last = -1;  // a column is listed once per row (equal starts)
+        for (int64_t j = 1; j < runs; ++j) {
+            const int32_t s = starts[c * runs + j];
+            if (s > 0 && s < height && s != last)
+                ++first[s + 1];
+            last = s;
+        }
+    }
+    for (int64_t y = 0; y < height; ++y)
+        first[y + 1] += first[y];
+    column.resize(first[height]);
+    {
+        std::vector<int32_t> fill(first.begin(), first.end() - 1);
         for (int64_t c = 0; c < width; ++c) {
-            const int32_t *s = starts + c * runs;
-            int64_t j = run[c];
-            while (j + 1 < runs && s[j + 1] <= y)
-                ++j;
-            run[c] = j;
-            uint8_t px[4];
-            std::memcpy(px, palette + c * runs + j, 4);
-            if (idx) {
-                for (int k = 0; k < 3; ++k) {
-                    int v = px[k] + table[idx[3 * c + k]];
-                    out[3 * c + k] = static_cast<uint8_t>(v < 0 ? 0 : (v > 255 ? 255 : v));
-                }
-            } else {
-                out[3 * c] = px[0];
-                out[3 * c + 1] = px[1];
-                out[3 * c + 2] = px[2];
+            int32_t last = -1;
+            for (int64_t j = 1; j < runs; ++j) {
+                const int32_t s = starts[c * runs + j];
+                if (s > 0 && s < height && s != last)
+                    column[fill[s]++] = static_cast<int32_t>(c);
+                last = s;
             }
         }
+    }
+    auto paint = [&](int64_t c, int64_t y) {
+        const int32_t *s = starts + c * runs;
+        int64_t j = run[c];
+        while (j + 1 < runs && s[j + 1] <= y)
+            ++j;
+        run[c] = j;
+        std::memcpy(&line[3 * c], palette + c * runs + j, 3);  // r, g, b of r, g, b, a
+    };
+    for (int64_t y = 0; y < height; ++y) {
+        if (y == 0) {
+            for (int64_t c = 0; c < width; ++c)
+                paint(c, 0);
+        } else {
+            for (int32_t i = first[y]; i < first[y + 1]; ++i)
+                paint(column[i], y);
+        }
+        uint8_t *out = rgb + 3 * y * width;
+        if (noise)
+            add_noise(out, line.data(), 3 * y * width, 3 * width, z);
+        else
+            std::memcpy(out, line.data(), 3 * width);
     }
 }
 
@@ -114,8 +260,11 @@ FR_EXPORT int64_t fr_camera_layers(int64_t width, int64_t height, int64_t n,
                                    const double *depth, const double *shade, const double *z0,
                                    const double *z1, const double *albedo, double cam_h,
                                    double row_axis, double focal, int64_t max_layers,
-                                   int64_t horizon, uint32_t ceil_rgba, uint32_t floor_rgba,
-                                   int32_t *starts, uint32_t *palette) {
+                                   int64_t horizon, const double *ceil_rgb,
+                                   const double *floor_rgb, int32_t *starts,
+                                   uint32_t *palette) {
+    const uint32_t ceil_rgba = packed(ceil_rgb[0], ceil_rgb[1], ceil_rgb[2]);
+    const uint32_t floor_rgba = packed(floor_rgb[0], floor_rgb[1], floor_rgb[2]);
     int64_t most = 0;
     for (int64_t c = 0; c < width; ++c) {
         int64_t hits = 0;

@@ -12,6 +12,8 @@ import functools
 import hashlib
 from pathlib import Path
 
+import numpy as np
+
 __all__ = ["camera_kernel"]
 
 _SOURCE = Path(__file__).resolve().parent / "camera_kernel.cpp"
@@ -24,30 +26,59 @@ _I64 = ctypes.c_int64
 
 
 class CameraKernel:
-    """The loaded library: ``paint(starts, runs, palette, width, height, rgb, noise, table)``
-    (addresses; ``noise`` and ``table`` None for no noise), ``hits(...)`` and ``layers(...)``
+    """The loaded library: ``paint(starts, runs, palette, width, height, rgb, noise,
+    *NoiseTable.arguments())`` (addresses; noise None and the rest None or 0 for no noise), ``hits(...)`` and ``layers(...)``
     (camera.py's ``_hits_compiled`` and ``_layers_compiled`` give their arguments)."""
 
     def __init__(self, path):
         lib = ctypes.CDLL(str(path))
-        if lib.fr_camera_kernel_version() != 3:
+        if lib.fr_camera_kernel_version() != 7:
             raise OSError("unexpected camera_kernel library version")
         paint = lib.fr_camera_paint
         paint.restype = None
-        paint.argtypes = [_VP, _I64, _VP, _I64, _I64, _VP, _VP, _VP]
+        paint.argtypes = [_VP, _I64, _VP, _I64, _I64, _VP, _VP, _VP, _VP, _I64, _VP, _I64]
         self.paint = paint
         hits = lib.fr_camera_hits
         hits.restype = None
         _D = ctypes.c_double
-        hits.argtypes = [_I64, _VP, _VP, _VP, _D, _D, _I64, _VP, _VP, _VP, _VP, _VP, _I64,
-                         _VP, _VP, _VP, _I64, _VP, _D, _D, _D, _D, _D, _VP, _VP, _VP, _VP]
+        hits.argtypes = [_I64, _VP, _VP, _D, _D, _D, _D, _I64, _VP, _I64, _VP, _I64, _VP, _D,
+                         _D, _D, _D, _D, _VP, _VP, _VP]
         self.hits = hits
         layers = lib.fr_camera_layers
         layers.restype = _I64
         layers.argtypes = [_I64, _I64, _I64, _VP, _VP, _VP, _VP, _VP, _D, _D, _D, _I64, _I64,
-                           ctypes.c_uint32, ctypes.c_uint32, _VP, _VP]
+                           _VP, _VP, _VP, _VP]
         self.layers = layers
         self.path = path
+
+
+#: Most steps of the noise table the compiled stage counts (beyond, it looks indices up;
+#: MAX_STEPS in camera_kernel.cpp).
+MAX_STEPS = 64
+
+
+class NoiseTable:
+    """The 65536-entry int8 noise table in the compiled stage's two forms.
+
+    ``block, sub``: ``table[i] == sub[block[i >> 8] + (i & 255)]``, equal 256-entry blocks
+    stored once so that lookups stay in the L1 cache. ``at, base``: the steps of a monotone
+    table, ``table[i] == base + count(at[j] <= i)``, a step of two levels listed twice
+    (``steps`` 0 when the table is not monotone or has more than ``MAX_STEPS`` steps)."""
+
+    def __init__(self, table):
+        blocks, inverse = np.unique(table.reshape(256, 256), axis=0, return_inverse=True)
+        self.block = (inverse.reshape(256) * 256).astype(np.int32)
+        self.sub = np.ascontiguousarray(blocks.ravel())
+        diff = np.diff(table.astype(np.int16))
+        monotone = bool(np.all(diff >= 0))
+        self.at = np.repeat(np.arange(1, 65536), np.maximum(diff, 0)).astype(np.uint16)
+        self.base = int(table[0])
+        self.steps = len(self.at) if monotone and len(self.at) <= MAX_STEPS else 0
+
+    def arguments(self):
+        """The paint call's last five arguments, after the noise indices."""
+        return (self.block.ctypes.data, self.sub.ctypes.data, self.steps,
+                self.at.ctypes.data if len(self.at) else None, self.base)
 
 
 @functools.cache
