@@ -45,6 +45,7 @@ STEPS = {
     "measure": "measure + events (trajectory row, design events)",
     "record": "recording (FrameRecord; the viewer's cost: bench viewer)",
     "other": "other (the loop's own bookkeeping)",
+    "finish": "after the frames (physics to the end, the summary), per frame",
 }
 
 
@@ -56,7 +57,7 @@ def _timed_loop_class():
 
         def __init__(self, *args, **kwargs):
             super().__init__(*args, **kwargs)
-            self.spent = dict.fromkeys(STEPS, 0.0)
+            self.spent = dict.fromkeys((k for k in STEPS if k != "finish"), 0.0)
             self.want_records = True  # the record is built (and dropped) every frame
             design = self.design
             self._harness = hasattr(design, "_run_harness")
@@ -127,6 +128,8 @@ def measure(scenario, design, repeats):
         loop.run()
         wall = time.perf_counter() - start
         n = max(1, loop.frames_done)
+        # The rest of the run's wall time: what comes after the last frame.
+        loop.spent["finish"] = wall - sum(loop.spent.values())
         runs.append(({k: 1e3 * v / n for k, v in loop.spent.items()}, 1e3 * wall / n,
                       loop.step * loop.dt / wall, n))
     steps = {k: statistics.median(r[0][k] for r in runs) for k in STEPS}

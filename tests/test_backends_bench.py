@@ -43,6 +43,15 @@ def test_bench_prints_and_writes_figures(tmp_path, capsys):
         assert r["cycles_per_second"] == pytest.approx(
             r["cycles_per_frame"] / (r["ms_per_frame"] / 1e3), rel=0.5
         )
+    # Compiled rows split the call: the C++ loop (timed in the harness) and the rest. Each
+    # frame's loop is inside its call, so the medians keep that order.
+    for key, r in rows.items():
+        if key[0] == "cxxrtl":
+            assert 0 < r["loop_ms_per_frame"] <= r["ms_per_frame"]
+            assert r["python_us_per_frame"] > 0
+        else:
+            assert "loop_ms_per_frame" not in r
+    assert "process_frame(RGB888 frame) as users call it" in out and "C++ loop" in out
     # The cycle count of a 40x16 frame is the pixel count plus the documented latency.
     assert rows[("cxxrtl", "passthrough", 40)]["cycles_per_frame"] == 40 * 16 + 1
     assert data["machine"]["cpus"] >= 1
@@ -141,3 +150,10 @@ def test_pysim_is_skipped_above_its_size_limit_with_a_note(capsys):
 def test_bad_options_are_usage_errors(argv, message):
     with pytest.raises(UsageError, match=message):
         bench.main(argv)
+
+
+def test_published_needs_its_five_files(tmp_path):
+    (tmp_path / "design_top.v").write_text("module design_top; endmodule\n")
+    with pytest.raises(UsageError, match=r"no centroid.v, color_proc.v, frame_buffer.v, "
+                                         r"motor_ctrl_spi.v there"):
+        bench.main(["--published", str(tmp_path), "--backends", "model"])
