@@ -43,6 +43,11 @@ TARGET_MS = {(160, 120): 0.4, (640, 480): 6.0}
 TARGET_TRIVIAL_FRACTION = 0.5
 #: The Python side of ``process_frame`` at most this fraction of the C++ loop (issue 12).
 TARGET_PYTHON_FRACTION = 0.05
+#: A call whose wall time exceeds its thread's CPU time by more than this fraction (and
+#: ``PREEMPTED_S``, above the clocks' own jitter) waited for a core while another job ran:
+#: the paired measurement leaves its pair out.
+PREEMPTED = 0.05
+PREEMPTED_S = 20e-6
 TARGET_PYSIM_MS_160 = 1000.0
 
 
@@ -128,29 +133,39 @@ def measure_paired(design_backend, trivial_backend, frames, min_seconds=0.0):
     the same machine: on a shared machine whose speed drifts within seconds, two cases timed
     one after the other can differ by more than the designs do. The design is timed as users
     call it (the whole ``process_frame``); the trivial design by its C++ loop alone where the
-    backend reports it (``last_loop_seconds``), the stricter reference. Returns the fraction
-    of the two medians of per-frame cycle rates, and the number of frames each ran."""
+    backend reports it (``last_loop_seconds``), the stricter reference. A pair in which
+    either call was preempted (its wall time more than ``PREEMPTED`` above the thread's CPU
+    time, plus ``PREEMPTED_S``: on a loaded machine a long frame often waits for a core) is
+    left out, unless all are. Returns the fraction of the two medians of per-frame cycle rates, the number of
+    pairs used and the number left out."""
     backends = (design_backend, trivial_backend)
-    rates = ([], [])
+    rates, preempted = ([], []), ([], [])
     for backend in backends:
         backend.process_frame(frames[0])
     with _gc_paused():
         begin = time.perf_counter()
         n = 0
-        while not rates[0] or time.perf_counter() - begin < min_seconds:
+        while not (rates[0] or preempted[0]) or time.perf_counter() - begin < min_seconds:
             for frame in frames:
                 # Which one goes first alternates too: the second finds the frame in the cache.
+                pair, waited = [0.0, 0.0], False
                 for i in (0, 1) if n % 2 == 0 else (1, 0):
-                    start = time.perf_counter()
+                    start, cpu_start = time.perf_counter(), time.thread_time()
                     result = backends[i].process_frame(frame)
                     seconds = time.perf_counter() - start
+                    waited |= (seconds - (time.thread_time() - cpu_start)
+                               > PREEMPTED * seconds + PREEMPTED_S)
                     if i == 1:
                         seconds = _loop_seconds(backends[i]) or seconds
-                    rates[i].append(result.cycles / seconds)
+                    pair[i] = result.cycles / seconds
+                for i in (0, 1):
+                    (preempted if waited else rates)[i].append(pair[i])
                 n += 1
+    used = rates if rates[0] else preempted
     return {
-        "fraction": statistics.median(rates[0]) / statistics.median(rates[1]),
-        "frames": len(rates[0]),
+        "fraction": statistics.median(used[0]) / statistics.median(used[1]),
+        "frames": len(used[0]),
+        "preempted": len(preempted[0]) if rates[0] else 0,
     }
 
 
@@ -416,9 +431,12 @@ def main(argv=None, prog="python -m fpga_robotics.bench"):
                     except BackendError as exc:
                         raise UsageError(f"the {name} backend cannot run here: {exc}") from None
                     paired.append(pair)
+                    left_out = (f", {pair['preempted']} preempted pairs left out"
+                                if pair["preempted"] else "")
                     print(
                         f"{name} {w}x{h}: FollowTarget at {pair['fraction']:.2f} of the trivial "
-                        f"design's cycle rate (alternating frames, {pair['frames']} each)",
+                        f"design's cycle rate (alternating frames, {pair['frames']} each"
+                        f"{left_out})",
                         flush=True,
                     )
     published_row = None

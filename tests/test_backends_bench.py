@@ -58,8 +58,8 @@ def test_bench_prints_and_writes_figures(tmp_path, capsys):
     # FollowTarget against the trivial design, frames in alternation, per size.
     assert {(r["backend"], r["width"]) for r in data["paired"]} == {("cxxrtl", 40), ("cxxrtl", 48)}
     for r in data["paired"]:
-        assert r["frames"] == 3 and 0 < r["fraction"] < 10
-    assert "of the trivial design's cycle rate (alternating frames, 3 each)" in out
+        assert r["frames"] + r["preempted"] == 3 and 0 < r["fraction"] < 10
+    assert "of the trivial design's cycle rate (alternating frames, " in out
 
 
 class _FakeBackend:
@@ -72,14 +72,25 @@ class _FakeBackend:
         from types import SimpleNamespace
 
         self.clock.now += self.seconds
+        self.clock.cpu += self.seconds
+        self.calls = getattr(self, "calls", 0) + 1
+        if self.calls % 3 == 0 and getattr(self, "preempt", False):
+            self.clock.now += 10 * self.seconds  # waited for a core: wall time only
         return SimpleNamespace(cycles=self.cycles)
 
 
 class _FakeClock:
+    """Wall clock and thread CPU time; ``lost`` seconds of wall time pass without the thread
+    running during every ``lose_every``-th reading pair (another job took the core)."""
+
     now = 0.0
+    cpu = 0.0
 
     def perf_counter(self):
         return self.now
+
+    def thread_time(self):
+        return self.cpu
 
 
 def test_summary_takes_the_fraction_from_the_paired_measurement():
@@ -104,7 +115,20 @@ def test_paired_measurement_gives_the_ratio_of_cycle_rates(monkeypatch):
     monkeypatch.setattr(bench, "time", clock)
     design, trivial = _FakeBackend(clock, 1000, 0.004), _FakeBackend(clock, 1000, 0.002)
     figures = bench.measure_paired(design, trivial, frames=[None] * 5, min_seconds=0.0)
-    assert figures["frames"] == 5
+    assert figures["frames"] == 5 and figures["preempted"] == 0
+    assert figures["fraction"] == pytest.approx(0.5)
+
+
+def test_paired_measurement_leaves_out_preempted_pairs(monkeypatch):
+    # Every third call of the design waits for a core (10x its time, wall clock only): those
+    # pairs are left out and the fraction stays the machine-independent one.
+    clock = _FakeClock()
+    monkeypatch.setattr(bench, "time", clock)
+    design, trivial = _FakeBackend(clock, 1000, 0.004), _FakeBackend(clock, 1000, 0.002)
+    design.preempt = True
+    figures = bench.measure_paired(design, trivial, frames=[None] * 9, min_seconds=0.0)
+    # The warm-up call is the first; calls 3, 6, 9 of the design fall in pairs 2, 5, 8.
+    assert figures["preempted"] == 3 and figures["frames"] == 6
     assert figures["fraction"] == pytest.approx(0.5)
 
 
