@@ -116,7 +116,7 @@ def test_paired_measurement_gives_the_ratio_of_cycle_rates(monkeypatch):
     design, trivial = _FakeBackend(clock, 1000, 0.004), _FakeBackend(clock, 1000, 0.002)
     figures = bench.measure_paired(design, trivial, frames=[None] * 5, min_seconds=0.0)
     assert figures["frames"] == 5 and figures["preempted"] == 0
-    assert figures["fraction"] == pytest.approx(0.5)
+    assert figures["fraction"] == pytest.approx(0.5) and figures["clock"] == "wall"
 
 
 def test_paired_measurement_leaves_out_preempted_pairs(monkeypatch):
@@ -129,7 +129,25 @@ def test_paired_measurement_leaves_out_preempted_pairs(monkeypatch):
     figures = bench.measure_paired(design, trivial, frames=[None] * 9, min_seconds=0.0)
     # The warm-up call is the first; calls 3, 6, 9 of the design fall in pairs 2, 5, 8.
     assert figures["preempted"] == 3 and figures["frames"] == 6
+    assert figures["fraction"] == pytest.approx(0.5) and figures["clock"] == "wall"
+    # When every call waits, both sides are timed by CPU time, still the same fraction.
+    design.calls = trivial.calls = 0
+    design.preempt = trivial.preempt = True
+    monkeypatch.setattr(design, "process_frame", _always_preempted(design))
+    figures = bench.measure_paired(design, trivial, frames=[None] * 4, min_seconds=0.0)
+    assert figures["clock"] == "cpu" and figures["frames"] == 4
     assert figures["fraction"] == pytest.approx(0.5)
+
+
+def _always_preempted(backend):
+    inner = backend.process_frame
+
+    def process_frame(frame):
+        result = inner(frame)
+        backend.clock.now += 5 * backend.seconds
+        return result
+
+    return process_frame
 
 
 def test_pysim_is_skipped_above_its_size_limit_with_a_note(capsys):
