@@ -263,7 +263,8 @@ class CameraRenderer:
         self._kernel = camera_kernel()
         self._surfaces_key = self._surfaces_value = None
         self._scratch = np.empty(0)
-        self._hit_scratch = None
+        self._scratch_address = _address(self._scratch)
+        self._hit_scratch = self._hit_walls = self._hit_owner = None
         self._slope_address = _address(self._slope)
         self._slope_sq1_address = _address(self._slope_sq1)
         self._layer_starts = self._layer_palette = None
@@ -339,18 +340,22 @@ class CameraRenderer:
         """The image from the runs in one compiled pass, noise included (same bytes as the
         numpy path: the same random bits, in the same order, index the same table)."""
         image = np.empty((self.height, self.width, 3), dtype=np.uint8)
-        starts = np.ascontiguousarray(starts, dtype=np.int32)
-        palette = np.ascontiguousarray(palette, dtype=np.uint32)
+        if starts.base is self._layer_starts is not None:  # the compiled layers' buffers
+            starts_at, palette_at = self._layer_addresses
+        else:
+            starts = np.ascontiguousarray(starts, dtype=np.int32)
+            palette = np.ascontiguousarray(palette, dtype=np.uint32)
+            starts_at, palette_at = starts.ctypes.data, palette.ctypes.data
         noise, table = None, (None, None, 0, None, 0)
         if noise_std:
             self._noise_table(float(noise_std))
             if self._noise_compiled is None:
                 self._noise_compiled = NoiseTable(self._noise_levels)
-            table = self._noise_compiled.arguments()
+            table = self._noise_compiled.arguments
             indices = self._noise_indices(rng)  # held until the call returns
-            noise = indices.ctypes.data
-        self._kernel.paint(starts.ctypes.data, starts.shape[1], palette.ctypes.data, self.width,
-                           self.height, image.ctypes.data, noise, *table)
+            noise = indices.__array_interface__["data"][0]
+        self._kernel.paint(starts_at, starts.shape[1], palette_at, self.width, self.height,
+                           image.__array_interface__["data"][0], noise, *table)
         return image
 
     def _noise_indices(self, rng):
@@ -491,11 +496,14 @@ class CameraRenderer:
             runs = 2 * self.max_layers + 2
             self._layer_starts = np.empty(W * runs, dtype=np.int32)
             self._layer_palette = np.empty(W * runs, dtype=np.uint32)
-        a = _address
+            self._layer_addresses = (self._layer_starts.ctypes.data,
+                                     self._layer_palette.ctypes.data)
+        depth_at, shade_at = self._hit_addresses
+        z0_at, z1_at, albedo_at = self._surfaces_addresses
         k = self._kernel.layers(
-            W, self.height, n, a(depth), a(shade), a(z0), a(z1), a(albedo), h, self._row_axis,
-            self.focal, self.max_layers, horizon, a(ceil_rgb), a(floor_rgb),
-            self._layer_starts.ctypes.data, self._layer_palette.ctypes.data)
+            W, self.height, n, depth_at, shade_at, z0_at, z1_at, albedo_at, h, self._row_axis,
+            self.focal, self.max_layers, horizon, *map(float, ceil_rgb), *map(float, floor_rgb),
+            *self._layer_addresses)
         if k == 0:
             return None
         runs = 2 * k + 2
@@ -511,6 +519,7 @@ class CameraRenderer:
             albedo = np.concatenate([walls.albedo, cyls.band_albedo])
             # The floor and ceiling hide anything below 0 or above the ceiling.
             self._surfaces_value = (np.maximum(z0, 0.0), np.minimum(z1, ceiling), albedo)
+            self._surfaces_addresses = tuple(map(_address, self._surfaces_value))
             self._surfaces_key = key
         return self._surfaces_value
 
@@ -560,16 +569,20 @@ class CameraRenderer:
         n = n_walls + n_bands
         if self._hit_scratch is None or self._hit_scratch[0].shape[1] != n:
             self._hit_scratch = (np.empty((self.width, n)), np.empty((self.width, n)))
+            self._hit_addresses = tuple(map(_address, self._hit_scratch))
         if len(self._scratch) < n_walls + 2 * n_cyls:
             self._scratch = np.empty(n_walls + 2 * n_cyls)
-        depth, shade = self._hit_scratch
-        a = _address
+            self._scratch_address = _address(self._scratch)
+        if walls is not self._hit_walls:  # addresses kept with the arrays they point into
+            self._hit_walls, self._walls_address = walls, _address(walls.block)
+        if cyls.band_owner is not self._hit_owner:
+            self._hit_owner, self._owner_address = cyls.band_owner, _address(cyls.band_owner)
         self._kernel.hits(
             self.width, self._slope_address, self._slope_sq1_address, math.cos(heading),
-            math.sin(heading), cx, cy, n_walls, a(walls.block), n_cyls, a(cyls.centres),
-            n_bands, a(cyls.band_owner), NEAR, ambient, intensity, float(light[0]),
-            float(light[1]), a(self._scratch), a(depth), a(shade))
-        return depth, shade
+            math.sin(heading), cx, cy, n_walls, self._walls_address, n_cyls,
+            _address(cyls.centres), n_bands, self._owner_address, NEAR, ambient, intensity,
+            float(light[0]), float(light[1]), self._scratch_address, *self._hit_addresses)
+        return self._hit_scratch
 
     def _rows_covered(self, depth, z0, z1, h, tilt):
         """Rows ``row_start <= row < row_end`` where surfaces at ``depth`` spanning heights

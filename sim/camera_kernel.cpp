@@ -20,7 +20,7 @@
 
 constexpr int64_t MAX_STEPS = 64;  // sim/camera_kernel.py MAX_STEPS
 
-FR_EXPORT int fr_camera_kernel_version() { return 7; }
+FR_EXPORT int fr_camera_kernel_version() { return 8; }
 
 static inline double positive_part(double x) { return x > 0.0 ? x : 0.0; }  // np.maximum(0, x)
 
@@ -260,11 +260,11 @@ FR_EXPORT int64_t fr_camera_layers(int64_t width, int64_t height, int64_t n,
                                    const double *depth, const double *shade, const double *z0,
                                    const double *z1, const double *albedo, double cam_h,
                                    double row_axis, double focal, int64_t max_layers,
-                                   int64_t horizon, const double *ceil_rgb,
-                                   const double *floor_rgb, int32_t *starts,
-                                   uint32_t *palette) {
-    const uint32_t ceil_rgba = packed(ceil_rgb[0], ceil_rgb[1], ceil_rgb[2]);
-    const uint32_t floor_rgba = packed(floor_rgb[0], floor_rgb[1], floor_rgb[2]);
+                                   int64_t horizon, double ceil_r, double ceil_g,
+                                   double ceil_b, double floor_r, double floor_g,
+                                   double floor_b, int32_t *starts, uint32_t *palette) {
+    const uint32_t ceil_rgba = packed(ceil_r, ceil_g, ceil_b);
+    const uint32_t floor_rgba = packed(floor_r, floor_g, floor_b);
     int64_t most = 0;
     for (int64_t c = 0; c < width; ++c) {
         int64_t hits = 0;

@@ -27,12 +27,12 @@ _I64 = ctypes.c_int64
 
 class CameraKernel:
     """The loaded library: ``paint(starts, runs, palette, width, height, rgb, noise,
-    *NoiseTable.arguments())`` (addresses; noise None and the rest None or 0 for no noise), ``hits(...)`` and ``layers(...)``
+    *NoiseTable.arguments)`` (addresses; noise None and the rest None or 0 for no noise), ``hits(...)`` and ``layers(...)``
     (camera.py's ``_hits_compiled`` and ``_layers_compiled`` give their arguments)."""
 
     def __init__(self, path):
         lib = ctypes.CDLL(str(path))
-        if lib.fr_camera_kernel_version() != 7:
+        if lib.fr_camera_kernel_version() != 8:
             raise OSError("unexpected camera_kernel library version")
         paint = lib.fr_camera_paint
         paint.restype = None
@@ -47,7 +47,7 @@ class CameraKernel:
         layers = lib.fr_camera_layers
         layers.restype = _I64
         layers.argtypes = [_I64, _I64, _I64, _VP, _VP, _VP, _VP, _VP, _D, _D, _D, _I64, _I64,
-                           _VP, _VP, _VP, _VP]
+                           _D, _D, _D, _D, _D, _D, _VP, _VP]
         self.layers = layers
         self.path = path
 
@@ -74,11 +74,9 @@ class NoiseTable:
         self.at = np.repeat(np.arange(1, 65536), np.maximum(diff, 0)).astype(np.uint16)
         self.base = int(table[0])
         self.steps = len(self.at) if monotone and len(self.at) <= MAX_STEPS else 0
-
-    def arguments(self):
-        """The paint call's last five arguments, after the noise indices."""
-        return (self.block.ctypes.data, self.sub.ctypes.data, self.steps,
-                self.at.ctypes.data if len(self.at) else None, self.base)
+        #: The paint call's last five arguments, after the noise indices.
+        self.arguments = (self.block.ctypes.data, self.sub.ctypes.data, self.steps,
+                          self.at.ctypes.data if len(self.at) else None, self.base)
 
 
 @functools.cache
