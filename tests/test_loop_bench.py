@@ -25,6 +25,8 @@ def test_the_steps_add_up_to_the_whole_loop(backend):
     split = steps["handover"] > 0 and steps["results"] > 0
     assert split == (backend == "cxxrtl")
     assert m["realtime"] == pytest.approx(1.0 / (m["loop_ms"] * 30 / 1e3), rel=0.05)
+    assert 0 < m["cpu_ms"] <= m["loop_ms"] * 1.05
+    assert m["cpu_realtime"] == pytest.approx(1.0 / (m["cpu_ms"] * 30 / 1e3), rel=0.05)
 
 
 def test_the_command_prints_the_breakdown_and_a_profile(capsys):
