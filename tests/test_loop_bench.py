@@ -26,6 +26,8 @@ def test_the_steps_add_up_to_the_whole_loop(backend):
     assert split == (backend == "cxxrtl")
     assert m["realtime"] == pytest.approx(1.0 / (m["loop_ms"] * 30 / 1e3), rel=0.05)
     assert 0 < m["cpu_ms"] <= m["loop_ms"] * 1.05
+    assert 0 < m["design_alone_ms"] < m["loop_ms"]
+    assert 0 < m["design_alone_cpu_ms"] < m["cpu_ms"]
     assert m["cpu_realtime"] == pytest.approx(1.0 / (m["cpu_ms"] * 30 / 1e3), rel=0.05)
 
 
@@ -35,7 +37,9 @@ def test_the_command_prints_the_breakdown_and_a_profile(capsys):
     out = capsys.readouterr().out
     for label in loop_bench.STEPS.values():
         assert label in out
-    assert "whole loop" in out and "target 160x120" in out
+    assert "whole loop" in out and "target 160x120, the design's time in the loop" in out
+    assert "target 160x120, the design's time alone" in out and "alone on the run's frames" in out
+    assert "target 160x120, the design's time alone, CPU time" in out
     assert "function calls" in out and "tottime" in out
 
 
