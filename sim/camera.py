@@ -31,6 +31,8 @@ tilt``): exact at the centre column and with the camera level (tilt 0, the usual
 tilt, vertical edges stay vertical instead of converging (no keystone).
 """
 
+import contextlib
+import ctypes
 import functools
 import math
 import numbers
@@ -268,6 +270,7 @@ class CameraRenderer:
         self._slope_address = _address(self._slope)
         self._slope_sq1_address = _address(self._slope_sq1)
         self._layer_starts = self._layer_palette = None
+        self._draw_for = None  # (bit generator, its next_uint64, its state): see _direct_draw
 
     def __repr__(self):
         return (
@@ -346,17 +349,33 @@ class CameraRenderer:
             starts = np.ascontiguousarray(starts, dtype=np.int32)
             palette = np.ascontiguousarray(palette, dtype=np.uint32)
             starts_at, palette_at = starts.ctypes.data, palette.ctypes.data
-        noise, table = None, (None, None, 0, None, 0)
+        noise, table, draw = None, (None, None, 0, None, 0), (None, None)
         if noise_std:
             self._noise_table(float(noise_std))
             if self._noise_compiled is None:
                 self._noise_compiled = NoiseTable(self._noise_levels)
             table = self._noise_compiled.arguments
-            indices = self._noise_indices(rng)  # held until the call returns
-            noise = indices.__array_interface__["data"][0]
-        self._kernel.paint(starts_at, starts.shape[1], palette_at, self.width, self.height,
-                           image.__array_interface__["data"][0], noise, *table)
+            draw = self._direct_draw(rng)
+            if draw[0] is None:
+                indices = self._noise_indices(rng)  # held until the call returns
+                noise = indices.__array_interface__["data"][0]
+        with rng.bit_generator.lock if noise_std else contextlib.nullcontext():
+            self._kernel.paint(starts_at, starts.shape[1], palette_at, self.width, self.height,
+                               image.__array_interface__["data"][0], noise, *table, *draw)
         return image
+
+    def _direct_draw(self, rng):
+        """``(next_uint64, state)`` addresses of ``rng``'s bit generator when the compiled
+        stage may draw the noise bits itself: a PCG64 (whose ``random_raw`` is its
+        ``next_uint64``) and rows of whole 64-bit draws; else ``(None, None)``."""
+        bits = rng.bit_generator
+        if type(bits) is not np.random.PCG64 or (3 * self.width) % 4:
+            return None, None
+        if self._draw_for is None or self._draw_for[0] is not bits:
+            c = bits.ctypes
+            self._draw_for = (bits, ctypes.cast(c.next_uint64, ctypes.c_void_p).value,
+                              c.state_address)
+        return self._draw_for[1:]
 
     def _noise_indices(self, rng):
         """The 16-bit table index of every byte of the image, row-major: the values

@@ -20,7 +20,7 @@
 
 constexpr int64_t MAX_STEPS = 64;  // sim/camera_kernel.py MAX_STEPS
 
-FR_EXPORT int fr_camera_kernel_version() { return 8; }
+FR_EXPORT int fr_camera_kernel_version() { return 9; }
 
 static inline double positive_part(double x) { return x > 0.0 ? x : 0.0; }  // np.maximum(0, x)
 
@@ -165,10 +165,9 @@ __attribute__((target("avx2"))) static int64_t noise_count_avx2(uint8_t *out,
     return whole;
 }
 
-static void add_noise(uint8_t *out, const uint8_t *clean, int64_t offset, int64_t n,
+static void add_noise(uint8_t *out, const uint8_t *clean, const uint16_t *idx, int64_t n,
                       const Noise &z) {
     static const bool avx2 = __builtin_cpu_supports("avx2");
-    const uint16_t *idx = z.idx + offset;
     int64_t done = 0;
     if (z.steps > 0)
         done = avx2 ? noise_count_avx2(out, clean, idx, n, z)
@@ -189,11 +188,16 @@ static void add_noise(uint8_t *out, const uint8_t *clean, int64_t offset, int64_
 FR_EXPORT void fr_camera_paint(const int32_t *starts, int64_t runs, const uint32_t *palette,
                                int64_t width, int64_t height, uint8_t *rgb,
                                const uint16_t *noise, const int32_t *block, const int8_t *sub,
-                               int64_t steps, const uint16_t *at, int64_t base) {
+                               int64_t steps, const uint16_t *at, int64_t base,
+                               uint64_t (*draw)(void *), void *draw_state) {
     const Noise z{noise, block, sub, steps <= MAX_STEPS ? steps : 0, at,
                   static_cast<int16_t>(base)};
     std::vector<int64_t> run(width, 0);  // each column's current run
     std::vector<uint8_t> line(3 * width);
+    // draw: numpy's PCG64 itself (its next_raw), drawn here row by row, 3 * width / 4 raw
+    // values a row (the caller makes sure that is whole), four indices each, low bits first:
+    // random_raw(...).view(uint16) on this little-endian machine, without the array.
+    std::vector<uint16_t> drawn(draw ? 3 * width : 0);
     // Columns by the rows where one of their runs starts (row 0 is painted whole).
     std::vector<int32_t> first(height + 1, 0), column;
     for (int64_t c = 0; c < width; ++c) {
@@ -237,10 +241,17 @@ FR_EXPORT void fr_camera_paint(const int32_t *starts, int64_t runs, const uint32
                 paint(column[i], y);
         }
         uint8_t *out = rgb + 3 * y * width;
-        if (noise)
-            add_noise(out, line.data(), 3 * y * width, 3 * width, z);
-        else
+        if (draw) {
+            for (int64_t k = 0; k < 3 * width / 4; ++k) {
+                const uint64_t bits = draw(draw_state);
+                std::memcpy(&drawn[4 * k], &bits, 8);
+            }
+            add_noise(out, line.data(), drawn.data(), 3 * width, z);
+        } else if (noise) {
+            add_noise(out, line.data(), noise + 3 * y * width, 3 * width, z);
+        } else {
             std::memcpy(out, line.data(), 3 * width);
+        }
     }
 }
 

@@ -27,16 +27,19 @@ _I64 = ctypes.c_int64
 
 class CameraKernel:
     """The loaded library: ``paint(starts, runs, palette, width, height, rgb, noise,
-    *NoiseTable.arguments)`` (addresses; noise None and the rest None or 0 for no noise), ``hits(...)`` and ``layers(...)``
+    *NoiseTable.arguments, draw, state)`` (addresses; noise None and the rest None or 0 for no
+    noise; ``draw, state``: a PCG64's ``next_uint64`` and state to draw the indices with
+    instead of ``noise``, else None), ``hits(...)`` and ``layers(...)``
     (camera.py's ``_hits_compiled`` and ``_layers_compiled`` give their arguments)."""
 
     def __init__(self, path):
         lib = ctypes.CDLL(str(path))
-        if lib.fr_camera_kernel_version() != 8:
+        if lib.fr_camera_kernel_version() != 9:
             raise OSError("unexpected camera_kernel library version")
         paint = lib.fr_camera_paint
         paint.restype = None
-        paint.argtypes = [_VP, _I64, _VP, _I64, _I64, _VP, _VP, _VP, _VP, _I64, _VP, _I64]
+        paint.argtypes = [_VP, _I64, _VP, _I64, _I64, _VP, _VP, _VP, _VP, _I64, _VP, _I64, _VP,
+                              _VP]
         self.paint = paint
         hits = lib.fr_camera_hits
         hits.restype = None

@@ -145,3 +145,18 @@ def test_compiled_stages_equal_numpy_to_the_bit_on_random_rooms(seed, max_layers
         for got, want in zip(compiled._hits_compiled(*args), numpy_path._hits(*args),
                              strict=True):
             np.testing.assert_array_equal(got, want)
+
+
+@pytest.mark.parametrize("bits", [np.random.PCG64, np.random.MT19937, np.random.Philox])
+def test_noise_bits_drawn_in_the_kernel_or_by_numpy_are_the_same(bits):
+    # A PCG64 is drawn from in the compiled stage (its next_uint64 is its random_raw); other
+    # generators' bits come from random_raw. The image and the generator's state agree.
+    compiled, numpy_path = pair(64, 48)
+    assert (compiled._direct_draw(np.random.Generator(bits(1)))[0] is not None) == (
+        bits is np.random.PCG64)
+    rng_a, rng_b = np.random.Generator(bits(9)), np.random.Generator(bits(9))
+    for pose in camera_loop(3):
+        a = compiled.render(typical_scene(), pose, noise_std=2.5, rng=rng_a)
+        b = numpy_path.render(typical_scene(), pose, noise_std=2.5, rng=rng_b)
+        np.testing.assert_array_equal(a, b)
+    assert rng_a.bit_generator.state == rng_b.bit_generator.state
