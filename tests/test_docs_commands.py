@@ -507,7 +507,7 @@ PLANS = {
         Plan(shorter=(("--duration", "1"), ("--repeats", "1")),
              out=(r"closed loop 160x120: follow_person, cxxrtl",
                   r"closed loop 640x480: follow_person, cxxrtl",
-                  r"target 160x120, the design's time alone, CPU time: whole loop [\d.]+x",
+                  r"the loop against the design alone, CPU time: whole [\d.]+x",
                   r"target 640x480: [\d.]+x real time by CPU time")),
     "python -m fpga_robotics.loop_bench --backend cxxrtl --resolutions 160x120 --profile 12":
         Plan(shorter=(("--duration", "1"), ("--repeats", "1")),
