@@ -1,7 +1,7 @@
 """Benchmark of the simulation backends.
 
     python -m fpga_robotics.bench [--backends model,cxxrtl] [--resolutions 160x120]
-                                  [--frames 30] [--json bench.json]
+                                  [--frames 30] [--published DIR] [--json bench.json]
 
 For every backend and resolution it runs seeded synthetic RGB888 frames through
 ``FollowTarget`` with ``process_frame`` as users call it, and prints the median milliseconds
