@@ -44,6 +44,7 @@ BENCHMARKS = {
     "world": ("fpga_robotics.world_bench", "the physics of the robot world"),
     "viewer": ("fpga_robotics.viewer_bench", "the cost of logging to the rerun viewer"),
     "shadow": ("fpga_robotics.shadow_bench", "a shadow design's cost in the closed loop"),
+    "loop": ("fpga_robotics.loop_bench", "where the closed loop's time goes, per frame"),
     "foreign": ("fpga_robotics.sim.backends.foreign_bench",
                 "a Verilog design through a port map against the built-in Verilator backend"),
     "ros": ("fpga_robotics.ros.bench", "writing a ROS 2 bag and publishing live to Foxglove"),

@@ -14,7 +14,9 @@ column instead of one per pixel:
    ``row = H/2 - 0.5 - f * (z - h) / p`` (tilt aside). Each column therefore splits into a few
    runs of rows, each showing the nearest hit that covers it, or the floor / ceiling.
 4. The runs are painted with a cumulative sum down the columns and one palette lookup, so the
-   per-pixel work is a handful of whole-image operations whatever the scene.
+   per-pixel work is a handful of whole-image operations whatever the scene. Where a C++
+   compiler is present, a compiled pass (``camera_kernel``) paints the runs and adds the
+   sensor noise straight into the RGB888 image instead, with the same bytes.
 
 Lighting is Lambertian with ambient (``Scene.lighting``); sensor noise is optional, seeded by
 the caller's generator. docs/camera.md has the details and the measured speed.
@@ -29,6 +31,8 @@ tilt``): exact at the centre column and with the camera level (tilt 0, the usual
 tilt, vertical edges stay vertical instead of converging (no keystone).
 """
 
+import contextlib
+import ctypes
 import functools
 import math
 import numbers
@@ -39,6 +43,7 @@ import cv2
 import numpy as np
 
 from ..hw.validate import check_int
+from .camera_kernel import NoiseTable, camera_kernel
 from .scene import CameraPose, Scene
 
 __all__ = [
@@ -76,6 +81,7 @@ class _Walls:
     length: np.ndarray
     height: np.ndarray
     albedo: np.ndarray  # (N, 3)
+    block: np.ndarray = None  # (6, N): the six arrays above in one (the compiled stage's)
 
 
 @dataclass(frozen=True)
@@ -89,6 +95,8 @@ class _Cylinders:
     band_z0: np.ndarray
     band_z1: np.ndarray
     band_albedo: np.ndarray  # (B, 3)
+    bands: tuple = ()  # the Band tuples they were made of (reused while these stay)
+    centres: np.ndarray = None  # (3, C): x, y, radius in one (the compiled stage's)
 
 
 def focal_length(width, hfov):
@@ -139,29 +147,45 @@ def _walls_arrays(walls):
     if np.any(a[:, 4] <= 0.0):
         i = int(np.argmin(a[:, 4]))
         raise ValueError(f"wall {i} has zero length ({walls[i]}); give it two distinct ends")
-    return _Walls(a[:, 0], a[:, 1], a[:, 2], a[:, 3], a[:, 4], a[:, 5], albedo)
+    # Contiguous columns: the compiled stage reads them as plain arrays.
+    a = np.ascontiguousarray(a.T)
+    return _Walls(a[0], a[1], a[2], a[3], a[4], a[5], albedo, a)
 
 
-def _cylinder_arrays(cylinders):
+def _cylinder_arrays(cylinders, previous=None):
+    """The cylinders as arrays; ``previous`` (the arrays of an earlier tuple) lends its band
+    arrays when every cylinder wears the very same bands (people move, their looks stay)."""
     centres = np.empty((len(cylinders), 3))
-    owner, z, albedo = [], [], []
     for i, c in enumerate(cylinders):
         centres[i] = (c.x, c.y, c.radius)
-        for band in c.bands:
-            owner.append(i)
-            z.append((band.z0, band.z1))
-            albedo.append(_albedo(band.color, f"cylinder {i} band"))
+    bands = tuple(c.bands for c in cylinders)
+    same_bands = previous is not None and len(previous.bands) == len(bands) and all(
+        a is b for a, b in zip(bands, previous.bands))
+    if not same_bands:
+        owner, z, albedo = [], [], []
+        for i, c in enumerate(cylinders):
+            for band in c.bands:
+                owner.append(i)
+                z.append((band.z0, band.z1))
+                albedo.append(_albedo(band.color, f"cylinder {i} band"))
     if not np.all(np.isfinite(centres)) or np.any(centres[:, 2] <= 0.0):
         raise ValueError("cylinders need finite centres and a radius > 0")
-    z = np.asarray(z, dtype=float).reshape(-1, 2)
+    centres = np.ascontiguousarray(centres.T)
+    if same_bands:
+        return _Cylinders(centres[0], centres[1], centres[2], previous.band_owner,
+                          previous.band_z0, previous.band_z1, previous.band_albedo, bands,
+                          centres)
+    z = np.ascontiguousarray(np.asarray(z, dtype=float).reshape(-1, 2).T)
     return _Cylinders(
-        centres[:, 0],
-        centres[:, 1],
-        centres[:, 2],
+        centres[0],
+        centres[1],
+        centres[2],
         np.asarray(owner, dtype=np.intp),
-        z[:, 0],
-        z[:, 1],
+        z[0],
+        z[1],
         np.asarray(albedo, dtype=float).reshape(-1, 3),
+        bands,
+        centres,
     )
 
 
@@ -232,11 +256,21 @@ class CameraRenderer:
         self._rgba_bytes = self._rgba.view(np.uint8).reshape(self.height, self.width, 4)
         self._noise_rows = max(1, _NOISE_BLOCK // (3 * self.width))
         self._noise = np.empty((self._noise_rows, self.width, 3), dtype=np.int8)
-        self._noise_std = self._noise_levels = None
+        self._noise_std = self._noise_levels = self._noise_compiled = None
         self._cols = np.arange(self.width)
         self._col_index = self._cols[:, None]  # row selector for per-column gathers
         self._walls_key = self._walls = None
         self._cyls_key = self._cyls = None
+        #: The compiled stages, or None (numpy); the image is the same either way.
+        self._kernel = camera_kernel()
+        self._surfaces_key = self._surfaces_value = None
+        self._scratch = np.empty(0)
+        self._scratch_address = _address(self._scratch)
+        self._hit_scratch = self._hit_walls = self._hit_owner = None
+        self._slope_address = _address(self._slope)
+        self._slope_sq1_address = _address(self._slope_sq1)
+        self._layer_starts = self._layer_palette = None
+        self._draw_for = None  # (bit generator, its next_uint64, its state): see _direct_draw
 
     def __repr__(self):
         return (
@@ -256,7 +290,7 @@ class CameraRenderer:
             self._walls = _walls_arrays(scene.walls)
             self._walls_key = scene.walls
         if scene.cylinders is not self._cyls_key:
-            self._cyls = _cylinder_arrays(scene.cylinders)
+            self._cyls = _cylinder_arrays(scene.cylinders, self._cyls)
             self._cyls_key = scene.cylinders
         return self._walls, self._cyls
 
@@ -292,23 +326,73 @@ class CameraRenderer:
             raise TypeError(f"scene must be a fpga_robotics.sim.scene.Scene, not {type(scene)}")
         if not isinstance(pose, CameraPose):
             raise TypeError(f"pose must be a fpga_robotics.sim.scene.CameraPose, not {type(pose)}")
-        ids, palette = self._runs(scene, pose)
+        starts, palette = self._runs(scene, pose)
+        if noise_std:
+            _check_noise(noise_std, rng)
+        if self._kernel is not None:
+            return self._paint_compiled(starts, palette, noise_std, rng)
         # One 4-byte palette lookup per pixel, then RGBA -> RGB: ~3x faster than taking
         # 3-byte rows; cvtColor returns a fresh image for the caller.
-        palette.take(ids, out=self._rgba)
+        palette.take(self._paint_runs(starts), out=self._rgba)
         image = cv2.cvtColor(self._rgba_bytes, cv2.COLOR_RGBA2RGB)
         if noise_std:
             self._add_noise(image, noise_std, rng)
         return image
 
+    def _paint_compiled(self, starts, palette, noise_std, rng):
+        """The image from the runs in one compiled pass, noise included (same bytes as the
+        numpy path: the same random bits, in the same order, index the same table)."""
+        image = np.empty((self.height, self.width, 3), dtype=np.uint8)
+        if starts.base is self._layer_starts is not None:  # the compiled layers' buffers
+            starts_at, palette_at = self._layer_addresses
+        else:
+            starts = np.ascontiguousarray(starts, dtype=np.int32)
+            palette = np.ascontiguousarray(palette, dtype=np.uint32)
+            starts_at, palette_at = starts.ctypes.data, palette.ctypes.data
+        noise, table, draw = None, (None, None, 0, None, 0), (None, None)
+        if noise_std:
+            self._noise_table(float(noise_std))
+            if self._noise_compiled is None:
+                self._noise_compiled = NoiseTable(self._noise_levels)
+            table = self._noise_compiled.arguments
+            draw = self._direct_draw(rng)
+            if draw[0] is None:
+                indices = self._noise_indices(rng)  # held until the call returns
+                noise = indices.__array_interface__["data"][0]
+        with rng.bit_generator.lock if noise_std else contextlib.nullcontext():
+            self._kernel.paint(starts_at, starts.shape[1], palette_at, self.width, self.height,
+                               image.__array_interface__["data"][0], noise, *table, *draw)
+        return image
+
+    def _direct_draw(self, rng):
+        """``(next_uint64, state)`` addresses of ``rng``'s bit generator when the compiled
+        stage may draw the noise bits itself: a PCG64 (whose ``random_raw`` is its
+        ``next_uint64``) and rows of whole 64-bit draws; else ``(None, None)``."""
+        bits = rng.bit_generator
+        if type(bits) is not np.random.PCG64 or (3 * self.width) % 4:
+            return None, None
+        if self._draw_for is None or self._draw_for[0] is not bits:
+            c = bits.ctypes
+            self._draw_for = (bits, ctypes.cast(c.next_uint64, ctypes.c_void_p).value,
+                              c.state_address)
+        return self._draw_for[1:]
+
+    def _noise_indices(self, rng):
+        """The 16-bit table index of every byte of the image, row-major: the values
+        ``_add_noise`` draws block by block, in one array."""
+        bits = rng.bit_generator.random_raw
+        size = self.height * self.width * 3
+        if (3 * self.width) % 4 == 0:  # every block a whole number of 64-bit draws
+            return bits(size // 4).view(np.uint16)
+        indices = np.empty(size, dtype=np.uint16)
+        block = self._noise_rows * self.width * 3
+        for start in range(0, size, block):
+            n = min(block, size - start)
+            indices[start : start + n] = bits(-(-n // 4)).view(np.uint16)[:n]
+        return indices
+
     def _add_noise(self, image, noise_std, rng):
-        if not (math.isfinite(noise_std) and noise_std > 0):
-            raise ValueError(f"noise_std must be a finite number >= 0, got {noise_std!r}")
-        if not isinstance(rng, np.random.Generator):
-            raise TypeError(
-                "noise_std > 0 needs rng=numpy.random.Generator (e.g. np.random.default_rng(seed))"
-                " so that the noise is reproducible"
-            )
+        _check_noise(noise_std, rng)
         # Inverse-CDF sampling: 16 random bits of the caller's generator per value pick one of
         # 65536 equally likely quantiles of N(0, std), rounded to 8-bit levels. The raw bits
         # come 8 bytes at a time (several times faster than drawing normals). Blocks of rows
@@ -326,11 +410,13 @@ class CameraRenderer:
         if self._noise_std != noise_std:
             levels = np.clip(np.rint(noise_std * _normal_quantiles()), -127, 127)
             self._noise_levels = levels.astype(np.int8)
+            self._noise_compiled = None  # the compiled stage's forms, made when needed
             self._noise_std = noise_std
         return self._noise_levels
 
     def _runs(self, scene, pose):
-        """Per-pixel run ids (H, W) and the flat palette of packed RGBA uint32 they index."""
+        """Each column's run start rows (W, R), ascending from 0, and the flat palette
+        (W * R) of packed RGBA uint32: column c's run j has colour ``palette[c * R + j]``."""
         W, H = self.width, self.height
         cx, cy, h, tilt = float(pose.x), float(pose.y), float(pose.height), float(pose.tilt)
         if not all(map(math.isfinite, (cx, cy, h, tilt, pose.heading))):
@@ -349,76 +435,35 @@ class CameraRenderer:
             )
         ambient, intensity, light = _light(scene.lighting)
         walls, cyls = self._geometry(scene)
-        ch, sh = math.cos(pose.heading), math.sin(pose.heading)
-        # Column ray directions with a forward component of 1: the ray parameter is the depth.
-        dx = (ch + self._slope * sh)[:, None]
-        dy = (sh - self._slope * ch)[:, None]
-
-        depths, shades = [], []
-        z0s, z1s, albedos = [], [], []
-        with np.errstate(divide="ignore", invalid="ignore"):
-            if len(walls.x0):
-                qx, qy = walls.x0 - cx, walls.y0 - cy
-                denom = dx * walls.ey - dy * walls.ex
-                t = (qx * walls.ey - qy * walls.ex) / denom
-                s = (qx * dy - qy * dx) / denom
-                depths.append(np.where((s >= 0.0) & (s <= 1.0) & (t > NEAR), t, np.inf))
-                # Unit normal turned towards the camera (the camera's side of the wall line).
-                side = np.where(walls.ey * qx - walls.ex * qy > 0.0, -1.0, 1.0) / walls.length
-                ndotl = side * (walls.ey * light[0] - walls.ex * light[1])
-                shade = ambient + intensity * np.maximum(0.0, -ndotl)
-                shades.append(np.broadcast_to(shade, (W, len(shade))))
-                z0s.append(np.zeros(len(shade)))
-                z1s.append(walls.height)
-                albedos.append(walls.albedo)
-            if len(cyls.band_owner):
-                qx, qy, r = cx - cyls.x, cy - cyls.y, cyls.radius
-                b = dx * qx + dy * qy
-                c = qx * qx + qy * qy - r * r  # > 0: camera outside the cylinder
-                disc = b * b - self._slope_sq1[:, None] * c
-                t = (-b - np.sqrt(disc)) / self._slope_sq1[:, None]
-                t = np.where((disc >= 0.0) & (t > NEAR) & (c > 0.0), t, np.inf)
-                # Outward normal at the hit point, (q + t d) / r (horizontal).
-                th = np.where(t < np.inf, t, 0.0)  # keeps misses finite (they are not drawn)
-                ndotl = ((qx + th * dx) * light[0] + (qy + th * dy) * light[1]) / r
-                shade = ambient + intensity * np.maximum(0.0, -ndotl)
-                own = cyls.band_owner
-                depths.append(t[:, own])
-                shades.append(shade[:, own])
-                z0s.append(cyls.band_z0)
-                z1s.append(cyls.band_z1)
-                albedos.append(cyls.band_albedo)
-
         floor_rgb = _lit(scene.floor_color, ambient + intensity * max(0.0, -light[2]), "floor")
         ceil_rgb = _lit(scene.ceiling_color, ambient + intensity * max(0.0, light[2]), "ceiling")
         horizon = min(H, max(0, math.ceil(self._rows_of(0.0, tilt))))  # first floor row
 
-        if not depths:  # an empty scene: floor and ceiling only
+        z0, z1, albedo = self._surfaces(walls, cyls, ceiling)
+        if not len(z0):  # an empty scene: floor and ceiling only
             return self._paint_background(horizon, floor_rgb, ceil_rgb)
-
-        depth = np.concatenate(depths, axis=1) if len(depths) > 1 else depths[0]
-        shade = np.concatenate(shades, axis=1) if len(shades) > 1 else shades[0]
-        z0 = np.concatenate(z0s) if len(z0s) > 1 else z0s[0]
-        z1 = np.concatenate(z1s) if len(z1s) > 1 else z1s[0]
-        albedo = np.concatenate(albedos) if len(albedos) > 1 else albedos[0]
-        # The floor and ceiling hide anything below 0 or above the ceiling.
-        z0 = np.maximum(z0, 0.0)
-        z1 = np.minimum(z1, ceiling)
+        hits = self._hits_compiled if self._kernel is not None else self._hits
+        depth, shade = hits(walls, cyls, cx, cy, pose.heading, ambient, intensity, light)
+        if self._kernel is not None and tilt == 0.0:
+            layers = self._layers_compiled(depth, shade, z0, z1, albedo, h, horizon, floor_rgb,
+                                           ceil_rgb)
+            if layers is not None:
+                return layers
+            return self._paint_background(horizon, floor_rgb, ceil_rgb)
         n = depth.shape[1]
 
         # Usually every hit of a column fits in the layer budget: then draw them all. Else
-        # take the 2k nearest as candidates and drop the hidden ones first (below).
+        # take the 2k nearest as candidates and drop the hidden ones first (below). Equal
+        # depths (the bands of one person) keep the surfaces' order: a stable sort.
         most = int(np.count_nonzero(depth < np.inf, axis=1).max())
         if most == 0:
             return self._paint_background(horizon, floor_rgb, ceil_rgb)
         k = min(self.max_layers, most)
         m = min(2 * k, most)
         ci = self._col_index
+        cand = np.argsort(depth, axis=1, kind="stable")
         if n > m:
-            cand = np.argpartition(depth, m - 1, axis=1)[:, :m]
-            cand = cand[ci, np.argsort(depth[ci, cand], axis=1)]
-        else:
-            cand = np.argsort(depth, axis=1)
+            cand = cand[:, :m]
         row_start, row_end = self._rows_covered(depth[ci, cand], z0[cand], z1[cand], h, tilt)
         if m == k:
             sel = cand  # (W, k) surface of each layer, nearest first
@@ -460,7 +505,103 @@ class CameraRenderer:
         s = starts[:, :, None]
         layer = ((rs[:, None, :] <= s) & (s < re[:, None, :])).argmax(axis=2)  # (W, runs)
         layer += (layer == k) & (starts >= horizon)  # no surface: ceiling or floor
-        return self._paint_runs(starts), colors[ci, layer].ravel()
+        return starts, colors[ci, layer].ravel()
+
+    def _layers_compiled(self, depth, shade, z0, z1, albedo, h, horizon, floor_rgb, ceil_rgb):
+        """The rest of ``_runs`` for a level camera in one compiled pass: run starts
+        (W, 2k + 2) and palette, or None when no column sees a surface."""
+        W, n = depth.shape
+        if self._layer_starts is None:
+            runs = 2 * self.max_layers + 2
+            self._layer_starts = np.empty(W * runs, dtype=np.int32)
+            self._layer_palette = np.empty(W * runs, dtype=np.uint32)
+            self._layer_addresses = (self._layer_starts.ctypes.data,
+                                     self._layer_palette.ctypes.data)
+        depth_at, shade_at = self._hit_addresses
+        z0_at, z1_at, albedo_at = self._surfaces_addresses
+        k = self._kernel.layers(
+            W, self.height, n, depth_at, shade_at, z0_at, z1_at, albedo_at, h, self._row_axis,
+            self.focal, self.max_layers, horizon, *map(float, ceil_rgb), *map(float, floor_rgb),
+            *self._layer_addresses)
+        if k == 0:
+            return None
+        runs = 2 * k + 2
+        return self._layer_starts[: W * runs].reshape(W, runs), self._layer_palette[: W * runs]
+
+    def _surfaces(self, walls, cyls, ceiling):
+        """Bottom and top height (clipped to the floor and the ceiling) and albedo of every
+        surface, walls first, then bands; kept while the geometry arrays are the same."""
+        key = (walls, cyls.band_z0, ceiling)
+        if self._surfaces_key is None or any(a is not b for a, b in zip(key, self._surfaces_key)):
+            z0 = np.concatenate([np.zeros(len(walls.x0)), cyls.band_z0])
+            z1 = np.concatenate([walls.height, cyls.band_z1])
+            albedo = np.concatenate([walls.albedo, cyls.band_albedo])
+            # The floor and ceiling hide anything below 0 or above the ceiling.
+            self._surfaces_value = (np.maximum(z0, 0.0), np.minimum(z1, ceiling), albedo)
+            self._surfaces_addresses = tuple(map(_address, self._surfaces_value))
+            self._surfaces_key = key
+        return self._surfaces_value
+
+    def _hits(self, walls, cyls, cx, cy, heading, ambient, intensity, light):
+        """Depth (inf: no hit) and shade of every surface in every column, (W, surfaces),
+        for a camera at ``(cx, cy)`` looking along ``heading``."""
+        W = self.width
+        ch, sh = math.cos(heading), math.sin(heading)
+        # Column ray directions with a forward component of 1: the ray parameter is the depth.
+        dx = (ch + self._slope * sh)[:, None]
+        dy = (sh - self._slope * ch)[:, None]
+        depths, shades = [], []
+        with np.errstate(divide="ignore", invalid="ignore"):
+            if len(walls.x0):
+                qx, qy = walls.x0 - cx, walls.y0 - cy
+                # Unit normal turned towards the camera (the camera's side of the wall line).
+                side = np.where(walls.ey * qx - walls.ex * qy > 0.0, -1.0, 1.0) / walls.length
+                ndotl = side * (walls.ey * light[0] - walls.ex * light[1])
+                wall_shade = ambient + intensity * np.maximum(0.0, -ndotl)
+                denom = dx * walls.ey - dy * walls.ex
+                t = (qx * walls.ey - qy * walls.ex) / denom
+                s = (qx * dy - qy * dx) / denom
+                depths.append(np.where((s >= 0.0) & (s <= 1.0) & (t > NEAR), t, np.inf))
+                shades.append(np.broadcast_to(wall_shade, (W, len(wall_shade))))
+            if len(cyls.band_owner):
+                qx, qy, r = cx - cyls.x, cy - cyls.y, cyls.radius
+                b = dx * qx + dy * qy
+                c = qx * qx + qy * qy - r * r  # > 0: camera outside the cylinder
+                disc = b * b - self._slope_sq1[:, None] * c
+                t = (-b - np.sqrt(disc)) / self._slope_sq1[:, None]
+                t = np.where((disc >= 0.0) & (t > NEAR) & (c > 0.0), t, np.inf)
+                # Outward normal at the hit point, (q + t d) / r (horizontal).
+                th = np.where(t < np.inf, t, 0.0)  # keeps misses finite (they are not drawn)
+                ndotl = ((qx + th * dx) * light[0] + (qy + th * dy) * light[1]) / r
+                shade = ambient + intensity * np.maximum(0.0, -ndotl)
+                own = cyls.band_owner
+                depths.append(t[:, own])
+                shades.append(shade[:, own])
+        depth = np.concatenate(depths, axis=1) if len(depths) > 1 else depths[0]
+        shade = np.concatenate(shades, axis=1) if len(shades) > 1 else shades[0]
+        return depth, shade
+
+    def _hits_compiled(self, walls, cyls, cx, cy, heading, ambient, intensity, light):
+        """``_hits`` in one compiled pass (the same values to the bit); the arrays are
+        scratch, valid until the next frame."""
+        n_walls, n_cyls, n_bands = len(walls.x0), len(cyls.x), len(cyls.band_owner)
+        n = n_walls + n_bands
+        if self._hit_scratch is None or self._hit_scratch[0].shape[1] != n:
+            self._hit_scratch = (np.empty((self.width, n)), np.empty((self.width, n)))
+            self._hit_addresses = tuple(map(_address, self._hit_scratch))
+        if len(self._scratch) < n_walls + 2 * n_cyls:
+            self._scratch = np.empty(n_walls + 2 * n_cyls)
+            self._scratch_address = _address(self._scratch)
+        if walls is not self._hit_walls:  # addresses kept with the arrays they point into
+            self._hit_walls, self._walls_address = walls, _address(walls.block)
+        if cyls.band_owner is not self._hit_owner:
+            self._hit_owner, self._owner_address = cyls.band_owner, _address(cyls.band_owner)
+        self._kernel.hits(
+            self.width, self._slope_address, self._slope_sq1_address, math.cos(heading),
+            math.sin(heading), cx, cy, n_walls, self._walls_address, n_cyls,
+            _address(cyls.centres), n_bands, self._owner_address, NEAR, ambient, intensity,
+            float(light[0]), float(light[1]), self._scratch_address, *self._hit_addresses)
+        return self._hit_scratch
 
     def _rows_covered(self, depth, z0, z1, h, tilt):
         """Rows ``row_start <= row < row_end`` where surfaces at ``depth`` spanning heights
@@ -493,7 +634,24 @@ class CameraRenderer:
         palette = np.empty((self.width, 2, 3))
         palette[:, 0] = ceil_rgb if horizon > 0 else floor_rgb
         palette[:, 1] = floor_rgb
-        return self._paint_runs(starts), _packed_colors(palette).ravel()
+        return starts, _packed_colors(palette).ravel()
+
+
+def _check_noise(noise_std, rng):
+    if not (math.isfinite(noise_std) and noise_std > 0):
+        raise ValueError(f"noise_std must be a finite number >= 0, got {noise_std!r}")
+    if not isinstance(rng, np.random.Generator):
+        raise TypeError(
+            "noise_std > 0 needs rng=numpy.random.Generator (e.g. np.random.default_rng(seed))"
+            " so that the noise is reproducible"
+        )
+
+
+def _address(array):
+    """The data address of a C-contiguous float64 or int64 array (checked: the compiled
+    stage reads it as such)."""
+    assert array.flags.c_contiguous and array.dtype.itemsize == 8, array.dtype
+    return array.__array_interface__["data"][0]
 
 
 @functools.lru_cache(maxsize=1)

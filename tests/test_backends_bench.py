@@ -43,14 +43,23 @@ def test_bench_prints_and_writes_figures(tmp_path, capsys):
         assert r["cycles_per_second"] == pytest.approx(
             r["cycles_per_frame"] / (r["ms_per_frame"] / 1e3), rel=0.5
         )
+    # Compiled rows split the call: the C++ loop (timed in the harness) and the rest. Each
+    # frame's loop is inside its call, so the medians keep that order.
+    for key, r in rows.items():
+        if key[0] == "cxxrtl":
+            assert 0 < r["loop_ms_per_frame"] <= r["ms_per_frame"]
+            assert r["python_us_per_frame"] > 0
+        else:
+            assert "loop_ms_per_frame" not in r
+    assert "process_frame(RGB888 frame) as users call it" in out and "C++ loop" in out
     # The cycle count of a 40x16 frame is the pixel count plus the documented latency.
     assert rows[("cxxrtl", "passthrough", 40)]["cycles_per_frame"] == 40 * 16 + 1
     assert data["machine"]["cpus"] >= 1
     # FollowTarget against the trivial design, frames in alternation, per size.
     assert {(r["backend"], r["width"]) for r in data["paired"]} == {("cxxrtl", 40), ("cxxrtl", 48)}
     for r in data["paired"]:
-        assert r["frames"] == 3 and 0 < r["fraction"] < 10
-    assert "of the trivial design's cycle rate (alternating frames, 3 each)" in out
+        assert r["frames"] + r["preempted"] == 3 and 0 < r["fraction"] < 10
+    assert "of the trivial design's cycle rate (alternating frames, " in out
 
 
 class _FakeBackend:
@@ -63,14 +72,25 @@ class _FakeBackend:
         from types import SimpleNamespace
 
         self.clock.now += self.seconds
+        self.clock.cpu += self.seconds
+        self.calls = getattr(self, "calls", 0) + 1
+        if self.calls % 3 == 0 and getattr(self, "preempt", False):
+            self.clock.now += 10 * self.seconds  # waited for a core: wall time only
         return SimpleNamespace(cycles=self.cycles)
 
 
 class _FakeClock:
+    """Wall clock and thread CPU time; ``lost`` seconds of wall time pass without the thread
+    running during every ``lose_every``-th reading pair (another job took the core)."""
+
     now = 0.0
+    cpu = 0.0
 
     def perf_counter(self):
         return self.now
+
+    def thread_time(self):
+        return self.cpu
 
 
 def test_summary_takes_the_fraction_from_the_paired_measurement():
@@ -95,8 +115,39 @@ def test_paired_measurement_gives_the_ratio_of_cycle_rates(monkeypatch):
     monkeypatch.setattr(bench, "time", clock)
     design, trivial = _FakeBackend(clock, 1000, 0.004), _FakeBackend(clock, 1000, 0.002)
     figures = bench.measure_paired(design, trivial, frames=[None] * 5, min_seconds=0.0)
-    assert figures["frames"] == 5
+    assert figures["frames"] == 5 and figures["preempted"] == 0
+    assert figures["fraction"] == pytest.approx(0.5) and figures["clock"] == "wall"
+
+
+def test_paired_measurement_leaves_out_preempted_pairs(monkeypatch):
+    # Every third call of the design waits for a core (10x its time, wall clock only): those
+    # pairs are left out and the fraction stays the machine-independent one.
+    clock = _FakeClock()
+    monkeypatch.setattr(bench, "time", clock)
+    design, trivial = _FakeBackend(clock, 1000, 0.004), _FakeBackend(clock, 1000, 0.002)
+    design.preempt = True
+    figures = bench.measure_paired(design, trivial, frames=[None] * 9, min_seconds=0.0)
+    # The warm-up call is the first; calls 3, 6, 9 of the design fall in pairs 2, 5, 8.
+    assert figures["preempted"] == 3 and figures["frames"] == 6
+    assert figures["fraction"] == pytest.approx(0.5) and figures["clock"] == "wall"
+    # When every call waits, both sides are timed by CPU time, still the same fraction.
+    design.calls = trivial.calls = 0
+    design.preempt = trivial.preempt = True
+    monkeypatch.setattr(design, "process_frame", _always_preempted(design))
+    figures = bench.measure_paired(design, trivial, frames=[None] * 4, min_seconds=0.0)
+    assert figures["clock"] == "cpu" and figures["frames"] == 4
     assert figures["fraction"] == pytest.approx(0.5)
+
+
+def _always_preempted(backend):
+    inner = backend.process_frame
+
+    def process_frame(frame):
+        result = inner(frame)
+        backend.clock.now += 5 * backend.seconds
+        return result
+
+    return process_frame
 
 
 def test_pysim_is_skipped_above_its_size_limit_with_a_note(capsys):
@@ -141,3 +192,10 @@ def test_pysim_is_skipped_above_its_size_limit_with_a_note(capsys):
 def test_bad_options_are_usage_errors(argv, message):
     with pytest.raises(UsageError, match=message):
         bench.main(argv)
+
+
+def test_published_needs_its_five_files(tmp_path):
+    (tmp_path / "design_top.v").write_text("module design_top; endmodule\n")
+    with pytest.raises(UsageError, match=r"no centroid.v, color_proc.v, frame_buffer.v, "
+                                         r"motor_ctrl_spi.v there"):
+        bench.main(["--published", str(tmp_path), "--backends", "model"])

@@ -503,11 +503,27 @@ PLANS = {
     # Benchmarks ------------------------------------------------------------------------------
     "python -m fpga_robotics.bench [--backends model,pysim,cxxrtl,verilator] "
     "[--resolutions 160x120,320x240,640x480] [--frames 30] [--pysim-frames 3] "
-    "[--pysim-max-pixels 19200] [--min-seconds 1.0] [--no-trivial] [--json bench.json]":
+    "[--pysim-max-pixels 19200] [--min-seconds 1.0] [--no-trivial] [--published DIR] "
+    "[--json bench.json]":
         Plan(out=tuple(rf"(?m)^{b}\s+{s}\s" for b in ("model", "cxxrtl", "verilator")
                        for s in ("160x120", "320x240", "640x480"))
              + (r"(?m)^pysim\s+160x120\s",
                 r"cxxrtl 160x120: FollowTarget at [\d.]+ of the trivial design's cycle rate")),
+    "python -m fpga_robotics.bench --backends cxxrtl,verilator --resolutions 160x120,640x480 "
+    "--frames 30 --min-seconds 2 --published /tmp/published":
+        Plan(excused="needs the published FPGA-Robotics RTL in /tmp/published, which is not part "
+                     "of the project (docs/foreign.md says where it is); "
+                     "tests/test_backends_bench.py runs the option's checks"),
+    "python -m fpga_robotics.loop_bench --backend cxxrtl --duration 10 --repeats 3":
+        Plan(shorter=(("--duration", "1"), ("--repeats", "1")),
+             out=(r"closed loop 160x120: follow_person, cxxrtl",
+                  r"closed loop 640x480: follow_person, cxxrtl",
+                  r"the loop against the design alone, CPU time: whole [\d.]+x",
+                  r"target 640x480: [\d.]+x real time by CPU time")),
+    "python -m fpga_robotics.loop_bench --backend cxxrtl --resolutions 160x120 --profile 12":
+        Plan(shorter=(("--duration", "1"), ("--repeats", "1")),
+             out=(r"cProfile of one run, 12 functions of largest own time",
+                  r"tottime")),
     "python -m fpga_robotics.camera_bench":
         Plan(shorter=(("--frames", "2"), ("--repeats", "1")),
              out=(r"(?m)^\s*160x120\s+[\d.]+", r"(?m)^\s*640x480\s+[\d.]+")),

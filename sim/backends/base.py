@@ -15,16 +15,16 @@ followed by ``line_blank`` idle cycles). The driver then runs idle cycles until 
 
 import os
 from abc import ABC, abstractmethod
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from ...hw.params import FollowTargetParams
 from ...hw.pixel import color_select_value
 from ...hw.validate import check_int
-from ..frames import to_rgb444
+from ..frames import FrameError, to_rgb444
 
-__all__ = ["BackendError", "DesignBackend", "FrameResult", "WaveformRequest"]
+__all__ = ["BackendError", "DesignBackend", "FrameResult", "WaveformRequest", "check_out"]
 
 
 class BackendError(RuntimeError):
@@ -120,15 +120,23 @@ class DesignBackend(ABC):
         self._reset()
         self.frames_processed = 0
 
-    def process_frame(self, frame, color_sel="red"):
+    def process_frame(self, frame, color_sel="red", *, out=None):
         """Run one frame through the design and return its ``FrameResult``.
 
         ``frame`` is RGB888 (H, W, 3) uint8 or packed RGB444 (H, W); ``color_sel`` a colour
-        name or its 3-bit code.
+        name or its 3-bit code. ``out``, a C-contiguous writable (H, W) uint16 array, receives
+        the filtered frame and is the result's ``filtered`` (no new array per frame; the
+        next call with the same ``out`` overwrites it). A wrong ``out`` is a ``FrameError``.
         """
-        packed = to_rgb444(frame, self.params.width, self.params.height)
+        p = self.params
+        if out is not None:
+            check_out(out, p.width, p.height)
+        packed = to_rgb444(frame, p.width, p.height)
         result = self._run_frame(packed, color_select_value(color_sel))
         self.frames_processed += 1
+        if out is not None and result.filtered is not None:
+            np.copyto(out, result.filtered)
+            result = replace(result, filtered=out)
         return result
 
     def close(self):
@@ -146,3 +154,18 @@ class DesignBackend(ABC):
     @abstractmethod
     def _run_frame(self, packed, color_sel):
         """Process a validated (H, W) uint16 frame; return a ``FrameResult``."""
+
+
+def check_out(out, width, height):
+    """Raise ``FrameError`` unless ``out`` can receive a ``width`` x ``height`` filtered frame:
+    a C-contiguous, writable (height, width) uint16 numpy array."""
+    if not isinstance(out, np.ndarray):
+        raise FrameError(f"out= must be a numpy array, not {type(out).__name__}; make one with "
+                         f"numpy.empty(({height}, {width}), numpy.uint16)")
+    if out.shape != (height, width) or out.dtype != np.uint16:
+        raise FrameError(f"out= must be a ({height}, {width}) uint16 array for a {width}x{height} "
+                         f"design, got {out.shape} {out.dtype}; make one with "
+                         f"numpy.empty(({height}, {width}), numpy.uint16)")
+    if not (out.flags.c_contiguous and out.flags.writeable):
+        raise FrameError("out= must be a C-contiguous, writable array (not a view with strides "
+                         "or a read-only array)")

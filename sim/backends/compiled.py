@@ -1,6 +1,10 @@
 """Shared Python side of the compiled backends: loading a harness library through ctypes and
 running whole frames in it (one call per frame, the frame passed as a pointer).
 
+An RGB888 frame goes to the harness as it is (``fr_run_frame_rgb888``: the C++ loop packs
+each pixel to RGB444 as it streams it in), so ``process_frame`` on the host does little more
+than the call: check the shape, pick the entry point, read the results.
+
 Subclasses say how to build the library (``_build``) for a ``DesignSource`` and variant:
 ``"plain"`` (no tracing code at all, the fast one) or ``"vcd"``/``"fst"`` (a separate build
 with a waveform writer, made only when a ``WaveformRequest`` asks for it).
@@ -14,22 +18,26 @@ from typing import NamedTuple
 
 import numpy as np
 
+from ...hw.pixel import color_select_value
 from ..files import PendingOutput
+from ..frames import to_rgb444
 from . import build_cache
-from .base import BackendError, DesignBackend, FrameResult
+from .base import BackendError, DesignBackend, FrameResult, check_out
 from .designs import DesignSource
 
-__all__ = ["ABI_VERSION", "HARNESS_DIR", "LIBRARY_NAME", "BuildPlan", "CompiledBackend"]
+__all__ = ["ABI_VERSION", "HARNESS_DIR", "LIBRARY_NAME", "BuildPlan", "CompiledBackend",
+           "HarnessFrames"]
 
 #: Directory of the C++ harness sources (package data).
 HARNESS_DIR = Path(__file__).resolve().parent
 #: File name of the harness library in a cache entry.
 LIBRARY_NAME = "libfollow_target.so"
 #: Must match ``fr::ABI_VERSION`` in frame_driver.h.
-ABI_VERSION = 1
+ABI_VERSION = 2
 
 # Layout of the argument and result arrays (enums Arg and Out in frame_driver.h).
-_N_ARGS, _N_OUT = 7, 10
+_N_ARGS, _N_OUT = 7, 11
+_O_LOOP_NS = 10
 _STATUS = {
     1: "the design never raised frame_done (watchdog after {cycles} cycles): it hung or "
     "its result latency is far from the documented one",
@@ -70,6 +78,7 @@ class _Library:
             ("fr_trace_enable", None, [_VP, ctypes.c_int]),
             ("fr_trace_close", None, [_VP]),
             ("fr_run_frame", ctypes.c_int, [_VP, _VP, _VP, _VP, _VP]),
+            ("fr_run_frame_rgb888", ctypes.c_int, [_VP, _VP, _VP, _VP, _VP]),
         ):
             try:
                 fn = getattr(lib, name)
@@ -85,7 +94,58 @@ class _Library:
         self.evals_per_cycle = lib.fr_evals_per_cycle()
 
 
-class CompiledBackend(DesignBackend):
+_U8 = np.dtype(np.uint8)
+
+
+def _address(array):
+    return array.__array_interface__["data"][0]  # faster than array.ctypes.data
+
+
+class HarnessFrames:
+    """``process_frame`` through a harness library (``_Library``) whose results land in the
+    int64 array ``self._out``: an RGB888 frame, C-contiguous (H, W, 3) uint8, is passed to
+    ``fr_run_frame_rgb888`` unconverted; anything else is checked and packed by ``to_rgb444``
+    and passed to ``fr_run_frame``. Subclasses implement ``_run_harness(entry, frame,
+    color_sel, filtered)``: one call of ``entry`` and the ``FrameResult``."""
+
+    def _init_harness(self):
+        p = self.params
+        self._shape = (p.height, p.width)
+        self._rgb_shape = (p.height, p.width, 3)
+        lib = self._library.lib
+        self._entry_rgb888, self._entry_packed = lib.fr_run_frame_rgb888, lib.fr_run_frame
+        self._out_address = _address(self._out)
+        self._args_address = _address(self._args)
+
+    def process_frame(self, frame, color_sel="red", *, out=None):
+        # The common case first, in as few steps as possible: this runs once per frame.
+        code = (color_sel if type(color_sel) is int and 0 <= color_sel <= 7
+                else color_select_value(color_sel))
+        if out is None:
+            filtered = np.empty(self._shape, np.uint16)
+        else:
+            check_out(out, self._shape[1], self._shape[0])
+            filtered = out
+        if (type(frame) is np.ndarray and frame.dtype is _U8 and frame.shape == self._rgb_shape
+                and frame.flags.c_contiguous):
+            result = self._run_harness(self._entry_rgb888, frame, code, filtered)
+        else:
+            packed = to_rgb444(frame, self._shape[1], self._shape[0])
+            result = self._run_harness(self._entry_packed, packed, code, filtered)
+        self.frames_processed += 1
+        return result
+
+    def _run_frame(self, packed, color_sel):
+        return self._run_harness(self._entry_packed, packed, color_sel,
+                                 np.empty(self._shape, np.uint16))
+
+    @property
+    def last_loop_seconds(self):
+        """Time of the last frame's C++ loop alone (measured in the harness), seconds."""
+        return int(self._out[_O_LOOP_NS]) * 1e-9
+
+
+class CompiledBackend(HarnessFrames, DesignBackend):
     """A backend whose clock loop runs in a compiled C++ harness.
 
     Parameters
@@ -127,7 +187,6 @@ class CompiledBackend(DesignBackend):
         if not self._handle:
             raise BackendError(f"the {self.name} model could not be created")
         p = self.params
-        self._filtered = np.zeros((p.height, p.width), np.uint16)
         self._out = np.zeros(_N_OUT, np.int64)
         self._args = np.array(
             [
@@ -142,6 +201,7 @@ class CompiledBackend(DesignBackend):
             np.int64,
         )
         assert len(self._args) == _N_ARGS
+        self._init_harness()
 
     # Building ----------------------------------------------------------------------------------
 
@@ -183,41 +243,28 @@ class CompiledBackend(DesignBackend):
     def _reset(self):
         self._library.lib.fr_reset(self._handle)
 
-    def _run_frame(self, packed, color_sel):
-        lib = self._library.lib
+    def _run_harness(self, entry, frame, color_sel, filtered):
         index = self.frames_processed
-        tracing = self.waveform is not None and self.waveform.covers(index)
-        if tracing and self._trace_state == "idle":
-            self._open_trace()
-        if self._trace_state == "open":
-            lib.fr_trace_enable(self._handle, int(tracing))
+        if self.waveform is not None:
+            tracing = self.waveform.covers(index)
+            if tracing and self._trace_state == "idle":
+                self._open_trace()
+            if self._trace_state == "open":
+                self._library.lib.fr_trace_enable(self._handle, int(tracing))
         self._args[2] = color_sel
-        filtered = np.empty_like(self._filtered)
-        status = lib.fr_run_frame(
-            self._handle,
-            packed.ctypes.data,
-            self._args.ctypes.data,
-            filtered.ctypes.data,
-            self._out.ctypes.data,
-        )
-        out = self._out
-        if tracing and index >= self.waveform.last_frame:
+        status = entry(self._handle, _address(frame), self._args_address, _address(filtered),
+                       self._out_address)
+        if self.waveform is not None and tracing and index >= self.waveform.last_frame:
             self._finish_trace()
+        cycles, found, proximity, centroid_x, leds, left, right, n_filtered, _, bad, _ = (
+            self._out.tolist())
         if status != 0:
             message = _STATUS.get(status, f"harness status {status}").format(
-                cycles=int(out[0]), filtered=int(out[7]), pixels=packed.size, bad=int(out[9])
+                cycles=cycles, filtered=n_filtered, pixels=filtered.size, bad=bad
             )
             raise BackendError(f"{self.name}: frame {index}: {message}")
-        return FrameResult(
-            filtered=filtered,
-            found=bool(out[1]),
-            proximity=int(out[2]),
-            centroid_x=int(out[3]),
-            centroid_leds=int(out[4]),
-            motor_left=int(out[5]),
-            motor_right=int(out[6]),
-            cycles=int(out[0]),
-        )
+        return FrameResult(filtered, bool(found), proximity, centroid_x, leds, left, right,
+                           cycles)
 
     # Waveforms ---------------------------------------------------------------------------------
 

@@ -25,7 +25,17 @@ from ...hw.pixel import COLOR_SELECT
 from ..processes import run_captured
 from . import build_cache
 from .base import BackendError, DesignBackend, FrameResult
-from .compiled import _N_ARGS, _N_OUT, _STATUS, ABI_VERSION, HARNESS_DIR, LIBRARY_NAME, _Library
+from .compiled import (
+    _N_ARGS,
+    _N_OUT,
+    _STATUS,
+    ABI_VERSION,
+    HARNESS_DIR,
+    LIBRARY_NAME,
+    HarnessFrames,
+    _address,
+    _Library,
+)
 from .port_map import OUTPUTS, PortMapError, check_widths, load_port_map
 from .toolchain import find_compiler, find_make, run_tool, verilator_root, verilator_version
 from .verilator import CXX_FLAGS, MAKE_FLAGS, VERILATOR_FLAGS
@@ -371,7 +381,7 @@ def foreign_build_plan(design):
     return (f"verilator-foreign-{design.port_map.top}", key, [LIBRARY_NAME], build)
 
 
-class ForeignVerilatorBackend(DesignBackend):
+class ForeignVerilatorBackend(HarnessFrames, DesignBackend):
     """A foreign Verilog design (``ForeignDesign``, or ``files`` and ``port_map``) on
     Verilator. ``params`` gives the frame size; the design is the user's.
 
@@ -420,6 +430,7 @@ class ForeignVerilatorBackend(DesignBackend):
              pixel_edges + frame_blank + (pm.after_cycles or pm.latency) + pm.timeout],
             np.int64)
         assert len(self._args) == _N_ARGS
+        self._init_harness()
 
     @property
     def evals_per_cycle(self):
@@ -451,7 +462,7 @@ class ForeignVerilatorBackend(DesignBackend):
         self._apply_runtime()
         self._library.lib.fr_reset(self._handle)
 
-    def _run_frame(self, packed, color_sel):
+    def _run_harness(self, entry, frame, color_sel, filtered):
         pm = self.design.port_map
         names = [n for n, c in COLOR_SELECT.items() if c == color_sel]
         if pm.color_port and names[0] not in pm.color_codes:
@@ -460,11 +471,9 @@ class ForeignVerilatorBackend(DesignBackend):
         self._args[2] = color_sel
         if self._runtime:
             self._apply_runtime()
-        filtered = np.zeros((self.params.height, self.params.width), np.uint16)
         out = self._out
-        status = self._library.lib.fr_run_frame(
-            self._handle, packed.ctypes.data, self._args.ctypes.data, filtered.ctypes.data,
-            out.ctypes.data)
+        status = entry(self._handle, _address(frame), self._args_address, _address(filtered),
+                       self._out_address)
         index = self.frames_processed
         stopped = self._stop()
         if stopped:
@@ -480,7 +489,7 @@ class ForeignVerilatorBackend(DesignBackend):
             status = 0
         if status != 0:
             message = _STATUS.get(status, f"harness status {status}").format(
-                cycles=int(out[0]), filtered=int(out[7]), pixels=packed.size, bad=int(out[9]))
+                cycles=int(out[0]), filtered=int(out[7]), pixels=filtered.size, bad=int(out[9]))
             raise BackendError(f"{pm.top}: frame {index}: {message}")
         absent = 0 if self.fill_absent else None
         values = {}
@@ -490,8 +499,11 @@ class ForeignVerilatorBackend(DesignBackend):
                 values[key] = bool(value) if key == "found" else value
             else:
                 values[key] = absent
-        if pm.filtered_valid is None and not self.fill_absent:
-            filtered = None
+        if pm.filtered_valid is None:
+            if not self.fill_absent:
+                filtered = None
+            else:
+                filtered.fill(0)  # the harness wrote none of it
         return FrameResult(filtered=filtered, cycles=int(out[0]), **values)
 
     def close(self):

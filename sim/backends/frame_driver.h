@@ -12,9 +12,15 @@
 //              combinational response to the inputs that the next edge samples
 //   edge()     clock high, evaluate: one rising edge
 //   filtered_valid(), filtered_payload(), frame_done(), and the result outputs.
+//
+// Frames come packed (RGB444 in uint16, fr_run_frame) or as the host's RGB888 image
+// (H x W x 3 uint8, row-major, fr_run_frame_rgb888): the loop packs each pixel as it streams
+// it in (a channel keeps its top 4 bits, sim/frames.py), so the host makes no copy. The
+// loop's own time is returned in out[O_LOOP_NS], for the benchmark's Python-side figure.
 #ifndef FPGA_ROBOTICS_FRAME_DRIVER_H
 #define FPGA_ROBOTICS_FRAME_DRIVER_H
 
+#include <chrono>
 #include <cstdint>
 
 #define FR_EXPORT extern "C" __attribute__((visibility("default")))
@@ -22,16 +28,31 @@
 namespace fr {
 
 // Bump when the argument or result layout changes (checked by the Python side).
-constexpr int ABI_VERSION = 1;
+constexpr int ABI_VERSION = 2;
 
 enum Arg { A_WIDTH, A_HEIGHT, A_COLOR_SEL, A_LINE_BLANK, A_FRAME_BLANK, A_MOTOR_LATENCY,
            A_WATCHDOG, A_COUNT };
 enum Out { O_CYCLES, O_FOUND, O_PROXIMITY, O_CENTROID_X, O_CENTROID_LEDS, O_MOTOR_LEFT,
-           O_MOTOR_RIGHT, O_FILTERED, O_DONE_EDGE, O_BAD_INDEX, O_COUNT };
+           O_MOTOR_RIGHT, O_FILTERED, O_DONE_EDGE, O_BAD_INDEX, O_LOOP_NS, O_COUNT };
 enum Status { OK = 0, NO_FRAME_DONE = 1, TOO_MANY_FILTERED = 2, TOO_FEW_FILTERED = 3,
               BAD_FILTERED_FLAGS = 4, BAD_ARGUMENTS = 5 };
 
 constexpr uint16_t FIRST = 1u << 12, LAST = 1u << 13, PIXEL = 0x0FFF;
+
+// Pixel sources: the 12-bit pixel x of row y.
+struct Packed {
+    const uint16_t *frame;
+    int64_t width;
+    inline uint16_t operator()(int64_t y, int64_t x) const { return frame[y * width + x] & PIXEL; }
+};
+struct Rgb888 {
+    const uint8_t *rgb;
+    int64_t width;
+    inline uint16_t operator()(int64_t y, int64_t x) const {
+        const uint8_t *p = rgb + 3 * (y * width + x);
+        return static_cast<uint16_t>(((p[0] & 0xF0u) << 4) | (p[1] & 0xF0u) | (p[2] >> 4));
+    }
+};
 
 template <class S>
 class FrameRun {
@@ -69,19 +90,19 @@ public:
         }
     }
 
-    int run(const uint16_t *frame, int64_t line_blank, int64_t frame_blank,
+    template <class Source>
+    int run(const Source &pixel, int64_t line_blank, int64_t frame_blank,
             int64_t motor_latency, int64_t watchdog, int64_t *out) {
         const int64_t pixel_edges = height * (width + line_blank);
         const int64_t min_edges = pixel_edges + frame_blank;
         last_pixel_edge = pixel_edges - line_blank;
         for (int64_t y = 0; y < height; ++y) {
-            const uint16_t *row = frame + y * width;
             uint16_t first = y == 0 ? FIRST : 0;
-            cycle(true, (row[0] & PIXEL) | first | (width == 1 ? LAST : 0));
+            cycle(true, pixel(y, 0) | first | (width == 1 ? LAST : 0));
             for (int64_t x = 1; x < width - 1; ++x)
-                cycle(true, row[x] & PIXEL);
+                cycle(true, pixel(y, x));
             if (width > 1)
-                cycle(true, (row[width - 1] & PIXEL) | LAST);
+                cycle(true, pixel(y, width - 1) | LAST);
             for (int64_t i = 0; i < line_blank; ++i)
                 cycle(false, 0);
         }
@@ -126,15 +147,19 @@ private:
     int status = OK;
 };
 
-template <class S>
-int run_frame(S &sim, const uint16_t *frame, const int64_t *args, uint16_t *filtered,
+template <class S, class Source>
+int run_frame(S &sim, const Source &pixel, const int64_t *args, uint16_t *filtered,
               int64_t *out) {
     if (args[A_WIDTH] < 1 || args[A_HEIGHT] < 1 || args[A_LINE_BLANK] < 0 ||
         args[A_FRAME_BLANK] < 0 || args[A_MOTOR_LATENCY] < 0)
         return BAD_ARGUMENTS;
+    const auto start = std::chrono::steady_clock::now();
     FrameRun<S> run(sim, args, filtered);
-    return run.run(frame, args[A_LINE_BLANK], args[A_FRAME_BLANK], args[A_MOTOR_LATENCY],
-                   args[A_WATCHDOG], out);
+    int status = run.run(pixel, args[A_LINE_BLANK], args[A_FRAME_BLANK],
+                         args[A_MOTOR_LATENCY], args[A_WATCHDOG], out);
+    out[O_LOOP_NS] = std::chrono::duration_cast<std::chrono::nanoseconds>(
+                         std::chrono::steady_clock::now() - start).count();
+    return status;
 }
 
 // Synchronous reset: rst high for one rising edge, not counted in any frame.
@@ -164,7 +189,13 @@ void reset(S &sim) {
     FR_EXPORT void fr_trace_close(void *h) { static_cast<SIM *>(h)->trace_close(); }          \
     FR_EXPORT int fr_run_frame(void *h, const uint16_t *frame, const int64_t *args,           \
                                uint16_t *filtered, int64_t *out) {                            \
-        return fr::run_frame(*static_cast<SIM *>(h), frame, args, filtered, out);             \
+        return fr::run_frame(*static_cast<SIM *>(h), fr::Packed{frame, args[fr::A_WIDTH]},   \
+                             args, filtered, out);                                            \
+    }                                                                                         \
+    FR_EXPORT int fr_run_frame_rgb888(void *h, const uint8_t *rgb, const int64_t *args,       \
+                                      uint16_t *filtered, int64_t *out) {                     \
+        return fr::run_frame(*static_cast<SIM *>(h), fr::Rgb888{rgb, args[fr::A_WIDTH]},      \
+                             args, filtered, out);                                            \
     }
 
 #endif
