@@ -156,7 +156,7 @@ class ClosedLoop:
             mount_forward=(cam.mount_forward if cam.mount_forward is not None
                            else spec.camera_forward),
             tilt=cam.tilt if cam.tilt is not None else spec.camera_tilt,
-            noise_std=cam.noise_std,
+            noise_std=cam.noise_std, renderer=cam.renderer, render3d=cam.render3d,
             # A stream of its own, so that camera noise never shifts the world's randomness.
             rng=np.random.default_rng([self.seed, 0xCA3E]),
         )

@@ -42,6 +42,7 @@ from .hw.params import (
     preset_values,
 )
 from .hw.pixel import COLOR_SELECT
+from .render3d_keys import RENDER_DEFAULTS, parse_render_keys
 from .sim.camera import max_hfov, max_tilt, vertical_fov
 from .sim.world.config import MAX_TIME, WORLD_SECTIONS
 from .summary import CHECKS
@@ -87,6 +88,7 @@ DEFAULTS = {
         "mount_forward": None,
         "tilt": None,
         "noise_std": 0.0,
+        **RENDER_DEFAULTS,  # renderer, shadows, ... (fpga_robotics.render3d_keys)
     },
     "color": {"initial": "red", "changes": []},
 }
@@ -162,6 +164,8 @@ class CameraConfig:
     mount_forward: float | None
     tilt: float | None
     noise_std: float
+    renderer: str = "raster"  # "raster" or "mujoco" (fpga_robotics.render3d_keys)
+    render3d: object = None  # sim.render3d.Render3DOptions
 
     @property
     def frame_period(self):
@@ -587,6 +591,7 @@ def _camera(data):
             f"camera.resolution {width}x{height}: the width must be {WIDTH_RANGE[0]}.."
             f"{WIDTH_RANGE[1]} and the height {HEIGHT_RANGE[0]}..{HEIGHT_RANGE[1]} pixels "
             f"(the design's limits)")
+    renderer, render3d = parse_render_keys(cam, data.get("seed", 0))
     return CameraConfig(
         width=width,
         height=height,
@@ -596,6 +601,8 @@ def _camera(data):
         mount_forward=_limited(data, "camera.mount_forward", optional=True),
         tilt=_limited(data, "camera.tilt", optional=True),
         noise_std=_limited(data, "camera.noise_std"),
+        renderer=renderer,
+        render3d=render3d,
     )
 
 

@@ -8,9 +8,29 @@ renders the world's current scene to an RGB888 image of the camera's resolution.
 
 import math
 
+from ..errors import UsageError
 from ..sim.scene import CameraPose
 
-__all__ = ["CameraConnector", "camera_pose", "in_view"]
+__all__ = ["CameraConnector", "camera_pose", "in_view", "make_renderer"]
+
+
+def make_renderer(name, width, height, hfov, render3d=None):
+    """The renderer ``camera.renderer`` names; a missing MuJoCo or OpenGL is a
+    ``UsageError`` that says how to install them."""
+    if name == "raster":
+        from ..sim.camera import CameraRenderer
+
+        return CameraRenderer(width, height, hfov)
+    if name != "mujoco":
+        raise ValueError(f"renderer must be 'raster' or 'mujoco', got {name!r}")
+    from ..sim.render3d import MujocoRenderer, Render3DUnavailable
+
+    try:
+        renderer = MujocoRenderer(width, height, hfov, render3d)
+        renderer.prepare()
+    except Render3DUnavailable as exc:
+        raise UsageError(f"camera.renderer = \"mujoco\": {exc}") from None
+    return renderer
 
 
 def camera_pose(robot_pose, *, height, forward=0.0, tilt=0.0):
@@ -54,17 +74,19 @@ class CameraConnector:
         Standard deviation of the sensor noise added by the renderer (8-bit levels).
     rng : numpy.random.Generator
         The noise's random stream (one per run, for determinism).
+    renderer : str
+        ``"raster"`` (``sim.camera.CameraRenderer``) or ``"mujoco"`` (``sim.render3d``).
+    render3d : sim.render3d.Render3DOptions or None
+        The 3D renderer's options (shadows, textures, lamps); None: its defaults.
     """
 
     def __init__(self, width, height, hfov, *, mount_height, mount_forward=0.0, tilt=0.0,
-                 noise_std=0.0, rng=None):
-        from ..sim.camera import CameraRenderer
-
+                 noise_std=0.0, rng=None, renderer="raster", render3d=None):
         self.width, self.height, self.hfov = width, height, hfov
         self.mount_height, self.mount_forward, self.tilt = mount_height, mount_forward, tilt
         self.noise_std = noise_std
         self.rng = rng
-        self.renderer = CameraRenderer(width, height, hfov)
+        self.renderer = make_renderer(renderer, width, height, hfov, render3d)
 
     def pose(self, robot_pose):
         return camera_pose(robot_pose, height=self.mount_height, forward=self.mount_forward,

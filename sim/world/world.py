@@ -39,7 +39,7 @@ _FRICTION = 0.5
 
 
 class _Person:
-    __slots__ = ("bands", "body", "config", "path", "shape", "waited")
+    __slots__ = ("bands", "body", "config", "facing", "path", "shape", "waited", "walked")
 
     def __init__(self, config, path, body, shape):
         self.config = config
@@ -49,6 +49,18 @@ class _Person:
         self.bands = person_bands(config)
         #: Time spent waiting for the robot, s: the script runs this much behind the clock.
         self.waited = 0.0
+        #: Distance walked (m) and the direction of the last step (rad): a 3D renderer's gait.
+        self.walked = 0.0
+        self.facing = _first_facing(config.waypoints)
+
+
+def _first_facing(waypoints):
+    """The direction from the first waypoint to the next different one (0 if none)."""
+    x0, y0 = waypoints[0]
+    for x, y in waypoints[1:]:
+        if (x, y) != (x0, y0):
+            return math.atan2(y - y0, x - x0)
+    return 0.0
 
 
 class World:
@@ -218,6 +230,10 @@ class World:
                     x, y = px, py
             # Arrive exactly on the script; the velocity lets contacts push the robot.
             person.body.velocity = ((x - px) / h, (y - py) / h)
+            step = math.hypot(x - px, y - py)
+            if step > 0.0:
+                person.walked += step
+                person.facing = math.atan2(y - py, x - px)
         self.space.step(h)
         self.time = t1
 
@@ -309,8 +325,10 @@ class World:
         cylinders = []
         for p in self.people:
             x, y = p.body.position
+            vx, vy = p.body.velocity
             cylinders.append(Cylinder(x=float(x), y=float(y), radius=p.config.radius,
-                                      bands=p.bands))
+                                      bands=p.bands, facing=p.facing,
+                                      speed=math.hypot(vx, vy), walked=p.walked))
         return Scene(walls=self._static_walls, cylinders=tuple(cylinders),
                      floor_color=tuple(room.floor_color),
                      ceiling_color=tuple(room.ceiling_color), ceiling_height=room.height,
