@@ -164,48 +164,48 @@ def _person(i, cyl, mats, shine):
     upper_arm, forearm = 0.29 * s, 0.27 * s
     thigh, shin = 0.40 * s, 0.40 * s
     lines = [f'<body name="{name}" mocap="true" pos="{_f((cyl.x, cyl.y, 0))}">',
-             f'<geom type="box" pos="{_f((0, 0, (0.85 + 1.40) / 2 * s))}" size="{_f(torso)}" '
-             f'material="{shirt}"/>',
+             (f'<geom type="box" pos="{_f((0, 0, (0.85 + 1.40) / 2 * s))}" size="{_f(torso)}" '
+             f'material="{shirt}"/>'),
              # Hips in the trousers' colour: they hide the torso's underside from a camera
              # below it, as the raster's bands do.
-             f'<geom type="box" pos="{_f((0, 0, 0.785 * s))}" '
-             f'size="{_f((0.128 * k, 0.118 * k, 0.075 * s))}" material="{trousers}"/>',
+             (f'<geom type="box" pos="{_f((0, 0, 0.785 * s))}" '
+             f'size="{_f((0.128 * k, 0.118 * k, 0.075 * s))}" material="{trousers}"/>'),
              # Shoulders: a bar across the top of the torso.
-             f'<geom type="capsule" fromto="{_f((0, -0.115 * k, 1.40 * s, 0, 0.115 * k, 1.40 * s))}"'
-             f' size="{0.05 * k:.6g}" material="{shirt}"/>',
-             f'<geom type="cylinder" pos="{_f((0, 0, 1.47 * s))}" '
-             f'size="{_f((0.045 * k, 0.05 * s))}" material="{skin}"/>',
-             f'<geom type="ellipsoid" pos="{_f((0, 0, 1.625 * s))}" '
-             f'size="{_f((0.1 * k, 0.085 * k, 0.115 * s))}" material="{skin}"/>',
-             f'<geom type="ellipsoid" pos="{_f((-0.015 * k, 0, 1.68 * s))}" '
-             f'size="{_f((0.1 * k, 0.09 * k, 0.075 * s))}" material="{hair}"/>']
+             (f'<geom type="capsule" fromto="{_f((0, -0.115 * k, 1.40 * s, 0, 0.115 * k, 1.40 * s))}"'
+             f' size="{0.05 * k:.6g}" material="{shirt}"/>'),
+             (f'<geom type="cylinder" pos="{_f((0, 0, 1.47 * s))}" '
+             f'size="{_f((0.045 * k, 0.05 * s))}" material="{skin}"/>'),
+             (f'<geom type="ellipsoid" pos="{_f((0, 0, 1.625 * s))}" '
+             f'size="{_f((0.1 * k, 0.085 * k, 0.115 * s))}" material="{skin}"/>'),
+             (f'<geom type="ellipsoid" pos="{_f((-0.015 * k, 0, 1.68 * s))}" '
+             f'size="{_f((0.1 * k, 0.09 * k, 0.075 * s))}" material="{hair}"/>')]
     for side, y in (("l", sh_y), ("r", -sh_y)):
         lines += [
             f'<body pos="{_f((0, y, 1.40 * s))}">',
             f'<joint name="{joints["shoulder_" + side]}" type="hinge" axis="0 -1 0"/>',
-            f'<geom type="capsule" fromto="{_f((0, 0, 0, 0, 0, -upper_arm))}" '
-            f'size="{arm_r:.6g}" material="{shirt}"/>',
+            (f'<geom type="capsule" fromto="{_f((0, 0, 0, 0, 0, -upper_arm))}" '
+            f'size="{arm_r:.6g}" material="{shirt}"/>'),
             f'<body pos="{_f((0, 0, -upper_arm))}">',
             f'<joint name="{joints["elbow_" + side]}" type="hinge" axis="0 -1 0"/>',
-            f'<geom type="capsule" fromto="{_f((0, 0, 0, 0, 0, -forearm))}" '
-            f'size="{arm_r * 0.9:.6g}" material="{shirt}"/>',
-            f'<geom type="sphere" pos="{_f((0, 0, -forearm - 0.05 * s))}" '
-            f'size="{0.045 * k:.6g}" material="{skin}"/>',
+            (f'<geom type="capsule" fromto="{_f((0, 0, 0, 0, 0, -forearm))}" '
+            f'size="{arm_r * 0.9:.6g}" material="{shirt}"/>'),
+            (f'<geom type="sphere" pos="{_f((0, 0, -forearm - 0.05 * s))}" '
+            f'size="{0.045 * k:.6g}" material="{skin}"/>'),
             "</body></body>",
         ]
     for side, y in (("l", hip_y), ("r", -hip_y)):
         lines += [
             f'<body pos="{_f((0, y, hip_z))}">',
             f'<joint name="{joints["hip_" + side]}" type="hinge" axis="0 -1 0"/>',
-            f'<geom type="capsule" fromto="{_f((0, 0, 0, 0, 0, -thigh))}" '
-            f'size="{leg_r:.6g}" material="{trousers}"/>',
+            (f'<geom type="capsule" fromto="{_f((0, 0, 0, 0, 0, -thigh))}" '
+            f'size="{leg_r:.6g}" material="{trousers}"/>'),
             f'<body pos="{_f((0, 0, -thigh))}">',
             # A knee bends the shin backwards.
             f'<joint name="{joints["knee_" + side]}" type="hinge" axis="0 1 0"/>',
-            f'<geom type="capsule" fromto="{_f((0, 0, 0, 0, 0, -shin))}" '
-            f'size="{leg_r * 0.85:.6g}" material="{trousers}"/>',
-            f'<geom type="box" pos="{_f((0.04 * k, 0, -shin - 0.01 * s))}" '
-            f'size="{_f((0.12 * k, 0.05 * k, 0.045 * s))}" material="{shoes}"/>',
+            (f'<geom type="capsule" fromto="{_f((0, 0, 0, 0, 0, -shin))}" '
+            f'size="{leg_r * 0.85:.6g}" material="{trousers}"/>'),
+            (f'<geom type="box" pos="{_f((0.04 * k, 0, -shin - 0.01 * s))}" '
+            f'size="{_f((0.12 * k, 0.05 * k, 0.045 * s))}" material="{shoes}"/>'),
             "</body></body>",
         ]
     lines.append("</body>")
@@ -239,8 +239,8 @@ def build_model_xml(scene, options, width, height, fovy_deg):
     # Light 0: the scene's directional light, above the room (its shadow map covers it).
     # Its strengths are set every frame from Scene.lighting.
     shadow = "true" if options.shadows else "false"
-    lights = [f'<light name="sun" directional="true" pos="{_f((cx, cy, ceiling + 4 * half))}" '
-              f'dir="1 0.5 -1" castshadow="{shadow}" ambient="0 0 0" specular="0.3 0.3 0.3"/>']
+    lights = [(f'<light name="sun" directional="true" pos="{_f((cx, cy, ceiling + 4 * half))}" '
+              f'dir="1 0.5 -1" castshadow="{shadow}" ambient="0 0 0" specular="0.3 0.3 0.3"/>')]
     for j, lamp in enumerate(options.lamps):
         d = [a - p for a, p in zip(lamp.aim, lamp.pos)]
         cast = "true" if options.shadows and lamp.shadows else "false"
@@ -256,14 +256,14 @@ def build_model_xml(scene, options, width, height, fovy_deg):
         f'<global offwidth="{max(width, 1)}" offheight="{max(height, 1)}"/>',
         f'<quality shadowsize="{options.shadow_size}" offsamples="0"/>',
         '<headlight active="1" ambient="0 0 0" diffuse="0 0 0" specular="0 0 0"/>',
-        f'<map znear="0.005" zfar="{8 * half + 2 * ceiling:.6g}" shadowclip="1.2" '
-        f'shadowscale="0.6" haze="0"/>',
+        (f'<map znear="0.005" zfar="{8 * half + 2 * ceiling:.6g}" shadowclip="1.2" '
+        f'shadowscale="0.6" haze="0"/>'),
         '<rgba haze="0 0 0 1"/>',
         "</visual>",
         f'<statistic center="{_f((cx, cy, ceiling / 2))}" extent="{half * 1.2:.6g}"/>',
         "<asset>",
-        '<texture name="ceiling" type="skybox" builtin="flat" width="8" height="8" '
-        'rgb1="1 1 1" rgb2="1 1 1"/>',
+        ('<texture name="ceiling" type="skybox" builtin="flat" width="8" height="8" '
+        'rgb1="1 1 1" rgb2="1 1 1"/>'),
         *mats.assets,
         "</asset>",
         "<worldbody>",

@@ -111,7 +111,7 @@ class MujocoRenderer:
             context = self._mj.GLContext(self.width, self.height)
             context.make_current()
             context.free()
-        except Exception as exc:  # the GL platform's own error types vary
+        except Exception as exc:  # noqa: BLE001 (each GL platform raises its own types)
             raise _no_context(exc) from None
 
     def close(self):
@@ -142,7 +142,7 @@ class MujocoRenderer:
         self.model, self.data = model, mj.MjData(model)
         try:
             self._renderer = mj.Renderer(model, self.height, self.width)
-        except Exception as exc:  # the GL platform's own error types vary
+        except Exception as exc:  # noqa: BLE001 (each GL platform raises its own types)
             raise _no_context(exc) from None
         self._eye = model.body("eye").mocapid[0]
         self._people = []
@@ -219,7 +219,5 @@ class MujocoRenderer:
         return image
 
     def __del__(self):
-        try:
+        if getattr(self, "_renderer", None) is not None:
             self.close()
-        except Exception:
-            pass
