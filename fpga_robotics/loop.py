@@ -174,7 +174,8 @@ class ClosedLoop:
     def capture(self, t):
         """The camera image at time ``t``, with the events since the last frame."""
         pose = self.camera.pose(self.world.robot_pose())
-        rgb = self.camera.capture(self.world.scene(), pose)
+        self.scene, self.pose = self.world.scene(), pose  # kept for the viewer's 3D world
+        rgb = self.camera.capture(self.scene, pose)
         events = list(self.world.drain_events())
         new_color = self.scenario.color_at(t)
         if new_color != self.color:
@@ -239,6 +240,8 @@ class ClosedLoop:
             cmd_w=row["cmd_w"][k], camera_hfov=self.scenario.camera.hfov,
             people=self.world.people_states(), target_distance=distance,
             target_in_view=visible, events=events, shadow_result=shadow_result,
+            scene=self.scene, camera_pose=self.pose,
+            robot_radius=self.world.robot_spec.body_radius,
         )
         if self.recorder is not None:
             self.recorder.log_frame(record)

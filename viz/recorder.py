@@ -38,6 +38,7 @@ from .leds import centroid_image, proximity_image
 from .modes import parse_mode
 from .outcome import settle
 from .sinks import open_output
+from .world3d import World3D
 
 __all__ = ["Recorder", "open_recorder"]
 
@@ -155,6 +156,7 @@ class Recorder:
         self._blueprint_sent = False
         self._bounds = None  # the map's, kept for a blueprint sent again
         self._shadow_seen = False  # a shadow design's first frame re-lays out the board
+        self._world3d = None  # viz.world3d.World3D, made at the first record with a scene
         self._last_robot = None
         self._last_target = None
         if stream is not None:
@@ -208,11 +210,13 @@ class Recorder:
         ):
             log(path, rr.LineStrips2D.from_fields(colors=color, radii=0.01), static=True)
 
-    def _send_blueprint(self, bounds=None, shadow=False):
+    def _send_blueprint(self, bounds=None, shadow=False, world3d=None):
         if bounds is not None:
             self._bounds = bounds
+        world3d = self._world3d is not None if world3d is None else world3d
         with self._guard:
-            self._stream.send_blueprint(default_blueprint(self._bounds, shadow=shadow))
+            self._stream.send_blueprint(default_blueprint(self._bounds, shadow=shadow,
+                                                          world3d=world3d))
         self._blueprint_sent = True
 
     def log_world_map(self, world_map):
@@ -285,8 +289,19 @@ class Recorder:
         if record.target_distance is not None:
             add(P.TARGET_DISTANCE, (float(record.target_distance),))
         self._add_map(record, add)
+        self._add_world3d(record, frame, t)
         self.frames_logged += 1
         self._columns.end_frame()
+
+    def _add_world3d(self, record, frame, t):
+        """The world in 3D (``viz.world3d``), for records that carry their scene."""
+        if record.scene is None:
+            return
+        if self._world3d is None:
+            self._world3d = World3D(self._stream)
+            self._send_blueprint(shadow=self._shadow_seen, world3d=True)
+        with self._guard:
+            self._world3d.log_frame(record, frame, t)
 
     def _add_shadow(self, res, add):
         if not self._shadow_seen:
