@@ -19,7 +19,7 @@ RENDERERS = ("raster", "mujoco")
 RENDER_DEFAULTS = {
     "renderer": "raster",
     "shadows": True,
-    "shadow_size": 1024,
+    "shadow_size": 256,
     "textures": True,
     "floor": "planks",
     "shine": 0.0,

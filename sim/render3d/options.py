@@ -49,7 +49,7 @@ class Render3DOptions:
     """
 
     shadows: bool = True
-    shadow_size: int = 1024
+    shadow_size: int = 256
     textures: bool = True
     floor: str = "planks"
     shine: float = 0.0
