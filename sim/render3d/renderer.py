@@ -124,9 +124,9 @@ class MujocoRenderer:
     # -- the model, rebuilt when the layout changes -------------------------------------------
 
     def _layout_key(self, scene):
-        return (id(scene.walls), tuple(id(c.bands) for c in scene.cylinders),
-                tuple(c.radius for c in scene.cylinders), scene.floor_color,
-                scene.ceiling_color, scene.ceiling_height)
+        # Compared by value (a tuple compares its items by identity first: cheap per frame).
+        return (scene.walls, tuple((c.bands, c.radius) for c in scene.cylinders),
+                scene.floor_color, scene.ceiling_color, scene.ceiling_height)
 
     def _build(self, scene):
         mj = self._mj
