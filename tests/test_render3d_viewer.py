@@ -68,6 +68,8 @@ def test_people_and_robot_are_drawn_each_frame(recorded):
     heads = data.entities["world3d/people/heads"]
     robot = data.entities["world3d/robot"]
     assert len(heads) == len(robot) == n
+    # The map's layout, then the one with the 3D view beside the map, sent once.
+    assert data.blueprints == 2
     (head,) = heads.values["Points3D:positions"][-1]
     assert head[2] == pytest.approx(1.63)  # a 1.75 m person's head centre
     (centre,) = robot.values["Cylinders3D:centers"][-1]

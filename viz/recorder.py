@@ -157,6 +157,7 @@ class Recorder:
         self._bounds = None  # the map's, kept for a blueprint sent again
         self._shadow_seen = False  # a shadow design's first frame re-lays out the board
         self._world3d = None  # viz.world3d.World3D, made at the first record with a scene
+        self._layout_stale = False  # the layout sent lacks a view that is now needed
         self._last_robot = None
         self._last_target = None
         if stream is not None:
@@ -210,13 +211,13 @@ class Recorder:
         ):
             log(path, rr.LineStrips2D.from_fields(colors=color, radii=0.01), static=True)
 
-    def _send_blueprint(self, bounds=None, shadow=False, world3d=None):
+    def _send_blueprint(self, bounds=None, shadow=False):
         if bounds is not None:
             self._bounds = bounds
-        world3d = self._world3d is not None if world3d is None else world3d
         with self._guard:
-            self._stream.send_blueprint(default_blueprint(self._bounds, shadow=shadow,
-                                                          world3d=world3d))
+            self._stream.send_blueprint(default_blueprint(
+                self._bounds, shadow=shadow, world3d=self._world3d is not None))
+        self._layout_stale = False
         self._blueprint_sent = True
 
     def log_world_map(self, world_map):
@@ -253,6 +254,10 @@ class Recorder:
         self._check_open()
         if self._stream is None:
             return
+        if record.scene is not None and self._world3d is None:
+            # The world in 3D (viz.world3d) joins the layout: sent once this frame is logged.
+            self._world3d = World3D(self._stream)
+            self._layout_stale = True
         if not self._blueprint_sent:
             self._send_blueprint()
         frame = int(record.frame)
@@ -289,19 +294,13 @@ class Recorder:
         if record.target_distance is not None:
             add(P.TARGET_DISTANCE, (float(record.target_distance),))
         self._add_map(record, add)
-        self._add_world3d(record, frame, t)
+        if self._world3d is not None and record.scene is not None:
+            with self._guard:
+                self._world3d.log_frame(record, frame, t)
+        if self._layout_stale:
+            self._send_blueprint(shadow=self._shadow_seen)
         self.frames_logged += 1
         self._columns.end_frame()
-
-    def _add_world3d(self, record, frame, t):
-        """The world in 3D (``viz.world3d``), for records that carry their scene."""
-        if record.scene is None:
-            return
-        if self._world3d is None:
-            self._world3d = World3D(self._stream)
-            self._send_blueprint(shadow=self._shadow_seen, world3d=True)
-        with self._guard:
-            self._world3d.log_frame(record, frame, t)
 
     def _add_shadow(self, res, add):
         if not self._shadow_seen:
