@@ -16,8 +16,9 @@ pytestmark = mujoco_missing
 
 @pytest.fixture(scope="module")
 def divider():
-    import mujoco
+    from fpga_robotics.sim.render3d import load_mujoco
 
+    mujoco = load_mujoco()  # off-screen (EGL), as the renderer imports it
     scenario = load_scenario("divider_3d")
     scene = World.from_config(scenario.world, 0).scene()
     spec = build_model_xml(scene, scenario.camera.render3d, 160, 120, 45.0)

@@ -4,7 +4,7 @@ optional install ``pip install -e ".[realistic]"`` (docs/render3d.md)."""
 
 from .body import cycle_length, gait_angles
 from .options import FLOORS, Lamp, Render3DOptions
-from .renderer import INSTALL_HINT, MujocoRenderer, Render3DUnavailable
+from .renderer import INSTALL_HINT, MujocoRenderer, Render3DUnavailable, load_mujoco
 
 __all__ = [
     "FLOORS",
@@ -15,4 +15,5 @@ __all__ = [
     "Render3DUnavailable",
     "cycle_length",
     "gait_angles",
+    "load_mujoco",
 ]

@@ -23,7 +23,7 @@ from .body import gait_angles, person_height
 from .mjcf import build_model_xml
 from .options import Render3DOptions
 
-__all__ = ["INSTALL_HINT", "MujocoRenderer", "Render3DUnavailable"]
+__all__ = ["INSTALL_HINT", "MujocoRenderer", "Render3DUnavailable", "load_mujoco"]
 
 INSTALL_HINT = ('install it with: pip install -e ".[realistic]" and, on Debian/Ubuntu, '
                 "apt-get install libegl1 libgl1-mesa-dri")
@@ -33,7 +33,9 @@ class Render3DUnavailable(RuntimeError):
     """MuJoCo or an off-screen OpenGL context is missing; the message says how to install."""
 
 
-def _mujoco():
+def load_mujoco():
+    """The ``mujoco`` module, imported for off-screen drawing; ``Render3DUnavailable`` when
+    it is missing."""
     # MuJoCo picks its OpenGL platform when first imported: off-screen EGL unless the user
     # chose another (MUJOCO_GL=osmesa).
     os.environ.setdefault("MUJOCO_GL", "egl")
@@ -89,7 +91,7 @@ class MujocoRenderer:
     def __init__(self, width, height, hfov=DEFAULT_HFOV, options=None):
         check_int("width", width, 1)
         check_int("height", height, 1)
-        self._mj = _mujoco()
+        self._mj = load_mujoco()
         # The raster renderer checks the geometry (field of view, tilt) and adds the noise.
         self._raster = CameraRenderer(width, height, hfov)
         self.width, self.height, self.hfov = int(width), int(height), float(hfov)
