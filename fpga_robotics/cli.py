@@ -42,6 +42,8 @@ BENCHMARKS = {
     "pysim": ("fpga_robotics.pysim_bench", "Amaranth's simulator, checked against the model"),
     "camera": ("fpga_robotics.camera_bench", "the camera renderer"),
     "world": ("fpga_robotics.world_bench", "the physics of the robot world"),
+    "render3d": ("fpga_robotics.render3d_bench",
+                 "the raster and the 3D renderer, per frame and in the closed loop"),
     "viewer": ("fpga_robotics.viewer_bench", "the cost of logging to the rerun viewer"),
     "shadow": ("fpga_robotics.shadow_bench", "a shadow design's cost in the closed loop"),
     "loop": ("fpga_robotics.loop_bench", "where the closed loop's time goes, per frame"),

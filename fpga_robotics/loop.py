@@ -163,7 +163,7 @@ class ClosedLoop:
             mount_forward=(cam.mount_forward if cam.mount_forward is not None
                            else spec.camera_forward),
             tilt=cam.tilt if cam.tilt is not None else spec.camera_tilt,
-            noise_std=cam.noise_std,
+            noise_std=cam.noise_std, renderer=cam.renderer, render3d=cam.render3d,
             # A stream of its own, so that camera noise never shifts the world's randomness.
             rng=np.random.default_rng([self.seed, 0xCA3E]),
             yaw_offset=cam.yaw_offset,
@@ -190,7 +190,8 @@ class ClosedLoop:
         """The camera image at time ``t``, with the events since the last frame."""
         # On a ramp the camera pitches with the robot (sim/world/terrain.py).
         pose = self.camera.pose(self.world.robot_pose(), pitch=self.world.camera_pitch())
-        rgb = self.camera.capture(self.world.scene(), pose)
+        self.scene, self.pose = self.world.scene(), pose  # kept for the viewer's 3D world
+        rgb = self.camera.capture(self.scene, pose)
         events = list(self.world.drain_events())
         new_color = self.scenario.color_at(t)
         if new_color != self.scheduled_color:  # a live colour holds until the next change
@@ -270,6 +271,8 @@ class ClosedLoop:
             cmd_w=row["cmd_w"][k], camera_hfov=self.scenario.camera.hfov,
             people=self.world.people_states(), target_distance=distance,
             target_in_view=visible, events=events, shadow_result=shadow_result,
+            scene=self.scene, camera_pose=self.pose,
+            robot_radius=self.world.robot_spec.body_radius,
         )
         if self.recorder is not None:
             self.recorder.log_frame(record)

@@ -44,6 +44,7 @@ from .hw.params import (
     preset_values,
 )
 from .hw.pixel import COLOR_SELECT
+from .render3d_keys import RENDER_DEFAULTS, parse_render_keys
 from .sim.camera import max_hfov, max_tilt, vertical_fov
 from .sim.sensor import PARAMS as SENSOR_PARAMS
 from .sim.sensor import OV7670Params
@@ -96,6 +97,7 @@ DEFAULTS = {
         # The sensor model after the renderer (camera.sensor, camera.ov7670.*).
         "sensor": "plain",
         "ov7670": {k: list(v[0]) if v[1] == "pair" else v[0] for k, v in SENSOR_PARAMS.items()},
+        **RENDER_DEFAULTS,  # renderer, shadows, ... (fpga_robotics.render3d_keys)
     },
     "color": {"initial": "red", "changes": []},
 }
@@ -177,6 +179,8 @@ class CameraConfig:
     exposure_drift: float = 0.0  # std of the log brightness gain (CameraConnector)
     sensor: str = "plain"  # "plain" or "ov7670" (sim.sensor, with the parameters below)
     ov7670: OV7670Params = field(default_factory=OV7670Params)
+    renderer: str = "raster"  # "raster" or "mujoco" (fpga_robotics.render3d_keys)
+    render3d: object = None  # sim.render3d.Render3DOptions
 
     @property
     def frame_period(self):
@@ -620,6 +624,7 @@ def _camera(data):
             f"camera.resolution {width}x{height}: the width must be {WIDTH_RANGE[0]}.."
             f"{WIDTH_RANGE[1]} and the height {HEIGHT_RANGE[0]}..{HEIGHT_RANGE[1]} pixels "
             f"(the design's limits)")
+    renderer, render3d = parse_render_keys(cam, data.get("seed", 0))
     return CameraConfig(
         width=width,
         height=height,
@@ -633,6 +638,8 @@ def _camera(data):
         exposure_drift=_limited(data, "camera.exposure_drift"),
         sensor=_choice(cam["sensor"], "camera.sensor", ("plain", "ov7670")),
         ov7670=_sensor_params(cam["ov7670"]),
+        renderer=renderer,
+        render3d=render3d,
     )
 
 

@@ -55,3 +55,8 @@ class FrameRecord:
     target_in_view: bool = False  # the target person is geometrically in the camera's view
     events: list = field(default_factory=list)  # ["target found", "collision with wall", ...]
     shadow_result: FrameResult | None = None  # a shadow design's outputs on the same frame
+    # The world in 3D for the viewer (viz.world3d): the scene the camera saw, the camera's
+    # pose and the robot's radius (m).
+    scene: object = None  # sim.scene.Scene
+    camera_pose: object = None  # sim.scene.CameraPose
+    robot_radius: float = 0.0

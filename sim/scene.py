@@ -23,6 +23,10 @@ class Wall:
     y1: float
     height: float
     color: tuple  # albedo (r, g, b) in 0..1
+    #: What the face belongs to, for renderers that draw solids (sim.render3d): "room" (the
+    #: room's walls), "box" or "divider" (a piece of furniture named ``part``), "" (a lone wall).
+    kind: str = ""
+    part: str = ""
 
 
 @dataclass(frozen=True)
@@ -42,6 +46,12 @@ class Cylinder:
     y: float
     radius: float
     bands: tuple  # of Band, any order, may leave gaps
+    #: How a person moves, for renderers that draw bodies (sim.render3d): the direction they
+    #: face (rad, counter-clockwise from +x), their speed (m/s) and the distance they have
+    #: walked since the start (m), which sets the phase of their gait.
+    facing: float = 0.0
+    speed: float = 0.0
+    walked: float = 0.0
 
 
 @dataclass(frozen=True)

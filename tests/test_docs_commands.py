@@ -585,6 +585,39 @@ PLANS = {
              out=(r"bag  \(--bag\): log_frame median [\d.]+ ms",
                   (r"live \(--live foxglove, one client\): log_frame median [\d.]+ ms; "
                    r"client received 26/26 messages"))),
+    # docs/render3d.md: the 3D renderer ----------------------------------------------------
+    "python -m fpga_robotics.run --scenario follow_person --set camera.renderer=mujoco --rerun off":
+        Plan(out=(PASS,)),
+    "python -m pytest -q tests/test_render3d_agreement.py tests/test_render3d_people.py":
+        Plan(collect=True, out=(r"\d+ tests collected",)),
+    "python -m fpga_robotics.render3d_figures docs/figures":
+        Plan(files=("docs/figures/divider_3d.png", "docs/figures/lighting_3d.png"),
+             out=(r"wrote docs/figures/divider_3d\.png",)),
+    "python -m fpga_robotics.run --scenario divider_3d --rerun off":
+        Plan(duration="keep",
+             duration_why="the page says the scenario passes: over its own 25 s; a run under "
+                          "15 s fails its mean-distance check, as divider's does",
+             out=(PASS,)),
+    "python -m fpga_robotics.run --scenario divider_3d --set design.diff_min=6 --rerun off":
+        Plan(duration="10",
+             duration_why="the centroid is on the lit wood well within 10 s (the person leaves "
+                          "the view later, failing target_in_view_min_fraction over 25 s)",
+             out=(r"\[FAIL\] max_off_target_fraction",)),
+    "python -m fpga_robotics.run --scenario lighting_3d --rerun off":
+        Plan(duration="keep",
+             duration_why="the page says the scenario passes, dusk and the light's return "
+                          "included (30 s)",
+             out=(PASS,)),
+    "python -m fpga_robotics.run --scenario lighting_3d --set design.diff_min=6 --rerun off":
+        Plan(duration="16",
+             duration_why="dusk falls by 8 s; by 16 s the person has been lost long enough to "
+                          "fail found_min_fraction",
+             out=(r"\[FAIL\] found_min_fraction",)),
+    "python -m fpga_robotics.render3d_bench":
+        Plan(shorter=(("--frames", "2"), ("--repeats", "1"), ("--seconds", "0.5"),
+                      ("--backend", "model")),
+             out=(r"(?m)^\s*raster\s+[\d.]+\s+[\d.]+\s+[\d.]+",
+                  r"(?m)^\s*3d, shadows 256\s+[\d.]+ ms/frame\s+[\d.]+x real time")),
     "python -m fpga_robotics.sim.backends.pysim --frames 7":
         Plan(shorter=(("--frames", "2"),),
              out=(r"every frame equal to the golden model", r"median [\d.]+ s wall")),

@@ -9,6 +9,7 @@ outputs and the event log.
 import rerun.blueprint as rrb
 
 from . import paths as P
+from .world3d import world3d_view
 
 __all__ = ["default_blueprint"]
 
@@ -29,9 +30,10 @@ def _trail_range():
     )
 
 
-def default_blueprint(bounds=None, shadow=False):
+def default_blueprint(bounds=None, shadow=False, world3d=False):
     """The layout sent to the viewer; ``bounds`` ``(xmin, ymin, xmax, ymax)`` frame the map;
-    ``shadow`` adds a second LED row and the shadow design's wheel speeds."""
+    ``shadow`` adds a second LED row and the shadow design's wheel speeds; ``world3d`` puts
+    the world in 3D (``viz.world3d``) beside the map."""
     map_kwargs = {}
     if bounds is not None:
         xmin, ymin, xmax, ymax = (float(v) for v in bounds)
@@ -65,13 +67,14 @@ def default_blueprint(bounds=None, shadow=False):
         row_shares=[4, 1, 1, 3] if shadow else [4, 1, 3],
         name="Board",
     )
+    top_down = rrb.Spatial2DView(
+        origin=P.MAP,
+        name="World (top-down)",
+        overrides={P.TRAIL_ROBOT: _trail_range(), P.TRAIL_TARGET: _trail_range()},
+        **map_kwargs,
+    )
     world = rrb.Vertical(
-        rrb.Spatial2DView(
-            origin=P.MAP,
-            name="World (top-down)",
-            overrides={P.TRAIL_ROBOT: _trail_range(), P.TRAIL_TARGET: _trail_range()},
-            **map_kwargs,
-        ),
+        rrb.Horizontal(top_down, world3d_view(bounds)) if world3d else top_down,
         rrb.Horizontal(
             rrb.Tabs(
                 rrb.TimeSeriesView(origin=P.DESIGN_TRACKING, name="found, proximity"),

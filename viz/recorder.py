@@ -42,6 +42,7 @@ from .leds import centroid_image, proximity_image
 from .modes import parse_mode
 from .outcome import settle
 from .sinks import open_output
+from .world3d import World3D
 
 __all__ = ["Recorder", "open_recorder"]
 
@@ -164,6 +165,8 @@ class Recorder:
         self._blueprint_sent = False
         self._bounds = None  # the map's, kept for a blueprint sent again
         self._shadow_seen = False  # a shadow design's first frame re-lays out the board
+        self._world3d = None  # viz.world3d.World3D, made at the first record with a scene
+        self._layout_stale = False  # the layout sent lacks a view that is now needed
         self._last_robot = None
         self._last_target = None
         if stream is not None:
@@ -221,7 +224,9 @@ class Recorder:
         if bounds is not None:
             self._bounds = bounds
         with self._guard:
-            self._stream.send_blueprint(default_blueprint(self._bounds, shadow=shadow))
+            self._stream.send_blueprint(default_blueprint(
+                self._bounds, shadow=shadow, world3d=self._world3d is not None))
+        self._layout_stale = False
         self._blueprint_sent = True
 
     def log_world_map(self, world_map):
@@ -258,6 +263,10 @@ class Recorder:
         self._check_open()
         if self._stream is None:
             return
+        if record.scene is not None and self._world3d is None:
+            # The world in 3D (viz.world3d) joins the layout: sent once this frame is logged.
+            self._world3d = World3D(self._stream)
+            self._layout_stale = True
         if not self._blueprint_sent:
             self._send_blueprint()
         frame = int(record.frame)
@@ -295,6 +304,11 @@ class Recorder:
         if record.target_distance is not None:
             add(P.TARGET_DISTANCE, (float(record.target_distance),))
         self._add_map(record, add)
+        if self._world3d is not None and record.scene is not None:
+            with self._guard:
+                self._world3d.log_frame(record, frame, t)
+        if self._layout_stale:
+            self._send_blueprint(shadow=self._shadow_seen)
         self.frames_logged += 1
         self._columns.end_frame()
 

@@ -13,10 +13,11 @@ from dataclasses import replace
 
 import numpy as np
 
+from ..errors import UsageError
 from ..sim.scene import CameraPose
 
 __all__ = ["SENSOR_STREAM", "CameraConnector", "ExposureDrift", "camera_pose", "in_view",
-           "make_sensor"]
+           "make_renderer", "make_sensor"]
 
 #: Correlation time of the exposure drift, s: a slow change (clouds, a lamp warming up).
 DRIFT_TAU = 10.0
@@ -63,6 +64,25 @@ def make_sensor(cam, seed):
     return OV7670Sensor(cam.width, cam.height, cam.ov7670,
                         rng=np.random.default_rng([seed, SENSOR_STREAM]),
                         frame_period=cam.frame_period, focal_px=focal_length(cam.width, cam.hfov))
+
+def make_renderer(name, width, height, hfov, render3d=None):
+    """The renderer ``camera.renderer`` names; a missing MuJoCo or OpenGL is a
+    ``UsageError`` that says how to install them."""
+    if name == "raster":
+        from ..sim.camera import CameraRenderer
+
+        return CameraRenderer(width, height, hfov)
+    if name != "mujoco":
+        raise ValueError(f"renderer must be 'raster' or 'mujoco', got {name!r}")
+    from ..sim.render3d import MujocoRenderer, Render3DUnavailable
+
+    try:
+        renderer = MujocoRenderer(width, height, hfov, render3d)
+        renderer.prepare()
+    except Render3DUnavailable as exc:
+        raise UsageError(f"camera.renderer = \"mujoco\": {exc}") from None
+    return renderer
+
 
 
 def camera_pose(robot_pose, *, height, forward=0.0, tilt=0.0):
@@ -116,18 +136,20 @@ class CameraConnector:
         The mount's yaw off the robot's heading, rad (a camera knocked off its pose).
     drift : ExposureDrift or None
         A slow random drift of the frames' brightness (``camera.exposure_drift``).
+    renderer : str
+        ``"raster"`` (``sim.camera.CameraRenderer``) or ``"mujoco"`` (``sim.render3d``).
+    render3d : sim.render3d.Render3DOptions or None
+        The 3D renderer's options (shadows, textures, lamps); None: its defaults.
     """
 
     def __init__(self, width, height, hfov, *, mount_height, mount_forward=0.0, tilt=0.0,
                  noise_std=0.0, rng=None, sensor=None, turn_rate=None, yaw_offset=0.0,
-                 drift=None):
-        from ..sim.camera import CameraRenderer
-
+                 drift=None, renderer="raster", render3d=None):
         self.width, self.height, self.hfov = width, height, hfov
         self.mount_height, self.mount_forward, self.tilt = mount_height, mount_forward, tilt
         self.noise_std = noise_std
         self.rng = rng
-        self.renderer = CameraRenderer(width, height, hfov)
+        self.renderer = make_renderer(renderer, width, height, hfov, render3d)
         self.sensor, self.turn_rate = sensor, turn_rate
         self.yaw_offset, self.drift = yaw_offset, drift
 

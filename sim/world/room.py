@@ -37,10 +37,11 @@ def furniture_faces(item):
 
 def scene_walls(room):
     """Every static vertical surface as ``sim.scene.Wall`` (room walls then furniture)."""
-    walls = [Wall(a[0], a[1], b[0], b[1], room.height, tuple(room.wall_color))
+    walls = [Wall(a[0], a[1], b[0], b[1], room.height, tuple(room.wall_color), "room")
              for a, b in room_segments(room)]
     for item in room.furniture:
-        walls += [Wall(a[0], a[1], b[0], b[1], item.height, tuple(item.color))
+        walls += [Wall(a[0], a[1], b[0], b[1], item.height, tuple(item.color), item.kind,
+                       item.name)
                   for a, b in furniture_faces(item)]
     return tuple(walls)
 

@@ -42,7 +42,8 @@ _FRICTION = 0.5
 
 
 class _Person:
-    __slots__ = ("bands", "body", "config", "offset", "path", "shape", "teleop", "waited")
+    __slots__ = ("bands", "body", "config", "facing", "offset", "path", "shape", "teleop",
+                 "waited", "walked")
 
     def __init__(self, config, path, body, shape):
         self.config = config
@@ -57,6 +58,18 @@ class _Person:
         self.offset = (0.0, 0.0)
         #: ``(vx, vy)`` m/s while the person is driven by hand, else None.
         self.teleop = None
+        #: Distance walked (m) and the direction of the last step (rad): a 3D renderer's gait.
+        self.walked = 0.0
+        self.facing = _first_facing(config.waypoints)
+
+
+def _first_facing(waypoints):
+    """The direction from the first waypoint to the next different one (0 if none)."""
+    x0, y0 = waypoints[0]
+    for x, y in waypoints[1:]:
+        if (x, y) != (x0, y0):
+            return math.atan2(y - y0, x - x0)
+    return 0.0
 
 
 class World:
@@ -247,6 +260,10 @@ class World:
                     x, y = px, py
             # Arrive exactly on the script; the velocity lets contacts push the robot.
             person.body.velocity = ((x - px) / h, (y - py) / h)
+            step = math.hypot(x - px, y - py)
+            if step > 0.0:
+                person.walked += step
+                person.facing = math.atan2(y - py, x - px)
         self.space.step(h)
         self.time = t1
 
@@ -377,8 +394,10 @@ class World:
         cylinders = []
         for p in self.people:
             x, y = p.body.position
+            vx, vy = p.body.velocity
             cylinders.append(Cylinder(x=float(x), y=float(y), radius=p.config.radius,
-                                      bands=p.bands))
+                                      bands=p.bands, facing=p.facing,
+                                      speed=math.hypot(vx, vy), walked=p.walked))
         return Scene(walls=self._static_walls, cylinders=tuple(cylinders),
                      floor_color=tuple(room.floor_color),
                      ceiling_color=tuple(room.ceiling_color), ceiling_height=room.height,

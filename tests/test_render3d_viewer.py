@@ -1,0 +1,85 @@
+"""The world in 3D in the recording (viz.world3d): a short closed-loop run saved and read back;
+the room, the furniture, the robot, the people and the camera's pinhole and pose are where
+the run put them."""
+
+import math
+
+import numpy as np
+import pytest
+
+from fpga_robotics.loop import run_scenario
+from fpga_robotics.scenario import load_scenario
+from fpga_robotics.sim.world.robots import ROBOT_MODELS
+from fpga_robotics.viz import open_recorder
+from fpga_robotics.viz.readback import read_rrd
+from fpga_robotics.viz.world3d import CAMERA, camera_rotation
+
+
+@pytest.fixture(scope="module")
+def recorded(tmp_path_factory):
+    path = tmp_path_factory.mktemp("w3d") / "divider.rrd"
+    scenario = load_scenario("divider", ["sim.duration=0.5"])
+    with open_recorder(f"save:{path}", default_path=str(path)) as rec:
+        result = run_scenario(scenario, backend="model", recorder=rec)
+    return scenario, result, read_rrd(str(path))
+
+
+def test_the_room_and_the_divider_are_boxes_of_their_size(recorded):
+    _scenario, _, data = recorded
+    room = data.static["world3d/room"]
+    halves = sorted(tuple(round(v, 4) for v in h) for h in room["Boxes3D:half_sizes"])
+    # 8 x 6 m room, 2.5 m high: two walls 4 m and two 3 m half long, 1.25 m half high.
+    assert halves == [(3.0, 0.025, 1.25)] * 2 + [(4.0, 0.025, 1.25)] * 2
+    furniture = data.static["world3d/furniture"]
+    centers = furniture["Boxes3D:centers"]
+    assert len(centers) == 2  # the divider's two faces
+    for c in centers:
+        assert c[2] == pytest.approx(1.8 / 2)  # its height, 1.8 m
+        assert abs(c[0] - 7.3) < 0.03 and c[1] == pytest.approx(3.0)
+
+
+def test_the_camera_pinhole_and_pose_follow_the_robot(recorded):
+    scenario, result, data = recorded
+    pinhole = data.static[CAMERA]
+    f = 80 / math.tan(scenario.camera.hfov / 2)
+    # image_from_camera, column-major: [f, 0, 0, 0, f, 0, cx, cy, 1].
+    k = pinhole["Pinhole:image_from_camera"][0]
+    assert k[0] == pytest.approx(f, rel=1e-5) and k[4] == pytest.approx(f, rel=1e-5)
+    assert (k[6], k[7]) == pytest.approx((80.0, 60.0))
+    rows = data.entities[CAMERA]
+    traj = result.trajectory
+    n = len(traj["t"])
+    assert rows.frames == list(range(n))
+    spec = ROBOT_MODELS["turtlebot2"]  # the divider's robot: its camera mount
+    forward = spec.camera_forward
+    for i in (0, n - 1):
+        x, y, h = traj["x"][i], traj["y"][i], traj["heading"][i]
+        tx, ty, tz = rows.values["Transform3D:translation"][i][0]
+        assert (tx, ty, tz) == pytest.approx(
+            (x + forward * math.cos(h), y + forward * math.sin(h), spec.camera_height), abs=1e-5)
+        m = np.array(rows.values["Transform3D:mat3x3"][i][0]).reshape(3, 3).T  # column-major
+        # The camera's forward axis (its third column) is the robot's heading.
+        assert m[:, 2] == pytest.approx([math.cos(h), math.sin(h), 0.0], abs=1e-5)
+
+
+def test_people_and_robot_are_drawn_each_frame(recorded):
+    _, result, data = recorded
+    n = len(result.trajectory["t"])
+    heads = data.entities["world3d/people/heads"]
+    robot = data.entities["world3d/robot"]
+    assert len(heads) == len(robot) == n
+    # The map's layout, then the one with the 3D view beside the map, sent once.
+    assert data.blueprints == 2
+    (head,) = heads.values["Points3D:positions"][-1]
+    assert head[2] == pytest.approx(1.63)  # a 1.75 m person's head centre
+    (centre,) = robot.values["Cylinders3D:centers"][-1]
+    assert centre[:2] == pytest.approx((result.trajectory["x"][-1], result.trajectory["y"][-1]),
+                                       abs=1e-5)
+
+
+def test_camera_rotation_maps_the_camera_axes():
+    m = camera_rotation(math.pi / 2, 0.1)  # looking along +y, tilted up
+    assert m[:, 0] == pytest.approx([1.0, 0.0, 0.0])  # right: +x
+    assert m[:, 2] == pytest.approx([0.0, math.cos(0.1), math.sin(0.1)])
+    assert m[:, 1] == pytest.approx([0.0, math.sin(0.1), -math.cos(0.1)])  # down
+    assert np.linalg.det(m) == pytest.approx(1.0)
