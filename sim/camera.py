@@ -44,6 +44,7 @@ import numpy as np
 
 from ..hw.validate import check_int
 from .camera_kernel import NoiseTable, camera_kernel
+from .floor_patches import paint_floor_patches
 from .scene import CameraPose, Scene
 
 __all__ = [
@@ -326,9 +327,14 @@ class CameraRenderer:
             raise TypeError(f"scene must be a fpga_robotics.sim.scene.Scene, not {type(scene)}")
         if not isinstance(pose, CameraPose):
             raise TypeError(f"pose must be a fpga_robotics.sim.scene.CameraPose, not {type(pose)}")
-        starts, palette = self._runs(scene, pose)
         if noise_std:
             _check_noise(noise_std, rng)
+        if scene.floor_patches:
+            image = paint_floor_patches(self, scene, pose)
+            if noise_std:
+                self._add_noise(image, noise_std, rng)
+            return image
+        starts, palette = self._runs(scene, pose)
         if self._kernel is not None:
             return self._paint_compiled(starts, palette, noise_std, rng)
         # One 4-byte palette lookup per pixel, then RGBA -> RGB: ~3x faster than taking

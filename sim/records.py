@@ -22,6 +22,8 @@ class WorldMap:
     obstacles: list  # [[(x, y), ...], ...] furniture polygons (closed, counter-clockwise)
     obstacle_colors: list  # [(r, g, b), ...] one uint8 colour per obstacle
     bounds: tuple  # (xmin, ymin, xmax, ymax)
+    terrain: list = field(default_factory=list)  # [[(x, y), ...], ...] floor patch outlines
+    terrain_colors: list = field(default_factory=list)  # [(r, g, b), ...] uint8, one each
 
 
 @dataclass(frozen=True)

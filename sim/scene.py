@@ -75,6 +75,9 @@ class Scene:
     ceiling_color: tuple = (0.9, 0.9, 0.9)
     ceiling_height: float = 2.5
     lighting: Lighting = field(default_factory=Lighting)
+    #: Coloured floor patches drawn on the floor: ``((polygon, albedo), ...)``, the last one
+    #: drawn over the others (``[[room.terrain]]`` with a ``color``).
+    floor_patches: tuple = ()
 
 
 @dataclass(frozen=True)

@@ -220,3 +220,23 @@ def test_bad_terrain_names_the_key(room, message):
 def test_bad_uncertainty_names_the_key(key, value, message):
     with pytest.raises(WorldConfigError, match=message):
         World.from_config({"robot": {key: value}, "people": []}, seed=0)
+
+
+def test_the_map_shows_the_terrain(tmp_path):
+    from fpga_robotics.loop import run_scenario
+    from fpga_robotics.scenario import load_scenario
+    from fpga_robotics.viz import open_recorder
+    from fpga_robotics.viz import paths as P
+    from fpga_robotics.viz.readback import read_rrd
+
+    path = tmp_path / "slippery.rrd"
+    rec = open_recorder(f"save:{path}", default_path=None)
+    run_scenario(load_scenario("slippery", ['camera.resolution="80x60"', "sim.duration=0.2"]),
+                 backend="model", recorder=rec)
+    rec.close()
+    recording = read_rrd(str(path))
+    static = recording.static[P.MAP_TERRAIN]
+    (strip,) = static["LineStrips2D:strips"]
+    # The wet strip's outline, closed (5 points), in the viewer's coordinates (y down).
+    assert sorted({round(p[0], 4) for p in strip}) == [2.6, 4.6]
+    assert sorted({round(abs(p[1]), 4) for p in strip}) == [0.0, 6.0] and len(strip) == 5

@@ -245,6 +245,12 @@ class Recorder:
         walls = [[_xy(*a), _xy(*b)] for a, b in world_map.walls]
         if walls:
             log(P.MAP_WALLS, rr.LineStrips2D(walls, colors=_WALL_COLOR, radii=0.02), static=True)
+        terrain = [[_xy(*p) for p in poly] + [_xy(*poly[0])]
+                   for poly in getattr(world_map, "terrain", ()) if poly]
+        if terrain:  # floor patches (ramps, wet floor), under the furniture
+            log(P.MAP_TERRAIN, rr.LineStrips2D(
+                terrain, colors=[tuple(c) for c in world_map.terrain_colors], radii=0.01),
+                static=True)
         polygons = [
             [_xy(*p) for p in poly] + [_xy(*poly[0])] for poly in world_map.obstacles if poly
         ]

@@ -106,6 +106,8 @@ class World:
         self.lighting = LightingSchedule(config.lighting)
 
         self.terrain = TerrainMap(config.room.terrain)
+        self._floor_patches = tuple((t.polygon, t.color) for t in config.room.terrain
+                                    if t.color is not None)
         self._patch = None  # the terrain patch under the robot's centre
         self._traction = 1.0  # the factor the joints' forces are set to
         # Motor gain, noise and slips: a stream of their own (None for the ideal robot), so
@@ -177,7 +179,12 @@ class World:
             space.on_collision(_ROBOT, ctype, begin=self._on_begin)
 
         self._static_walls = scene_walls(config.room)
-        self._world_map = WorldMap(*map_data(config.room))
+        # Terrain on the map: a patch's colour, or a pale blue for one not drawn on the floor.
+        self._world_map = WorldMap(
+            *map_data(config.room),
+            terrain=[list(t.polygon) for t in config.room.terrain],
+            terrain_colors=[tuple(round(c * 255) for c in (t.color or (0.55, 0.7, 0.9)))
+                            for t in config.room.terrain])
 
     @classmethod
     def from_config(cls, cfg=None, seed=0):
@@ -401,7 +408,7 @@ class World:
         return Scene(walls=self._static_walls, cylinders=tuple(cylinders),
                      floor_color=tuple(room.floor_color),
                      ceiling_color=tuple(room.ceiling_color), ceiling_height=room.height,
-                     lighting=self.lighting.at(self.time))
+                     lighting=self.lighting.at(self.time), floor_patches=self._floor_patches)
 
     def world_map(self):
         """Static geometry for the viewer's top-down map (``records.WorldMap``)."""

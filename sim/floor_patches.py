@@ -1,0 +1,76 @@
+"""Coloured floor patches (``Scene.floor_patches``) in the raster camera's image.
+
+The ray caster draws the floor as one colour behind everything else. To colour patches of
+it, the scene is drawn twice, with two different floor colours: the pixels that change are
+the floor's. Each such pixel is taken back to the floor point its ray meets, by the
+renderer's own pinhole model (``row = H/2 - 0.5 - f (z - h) / p`` with the tilt added to each
+row's elevation, ``p`` the depth along the optical axis; the column's offset from the centre
+is ``p (col + 0.5 - W/2) / f`` to the right), and given the albedo of the last patch that
+holds that point, lit as the floor is lit.
+"""
+
+import dataclasses
+import math
+
+import numpy as np
+
+__all__ = ["floor_points", "paint_floor_patches", "patch_index"]
+
+
+def floor_points(renderer, pose, rows, cols):
+    """World ``(x, y)`` of the floor seen at pixels ``(rows, cols)`` (arrays)."""
+    f, w, h = renderer.focal, renderer.width, renderer.height
+    v = h / 2 - (rows + 0.5)
+    elevation = np.arctan(v / f) + pose.tilt
+    with np.errstate(divide="ignore"):
+        depth = pose.height / np.tan(-elevation)  # along the optical axis
+    right = depth * (cols + 0.5 - w / 2) / f
+    c, s = math.cos(pose.heading), math.sin(pose.heading)
+    # Forward (c, s); the camera's right is (s, -c).
+    return pose.x + depth * c + right * s, pose.y + depth * s - right * c
+
+
+def patch_index(polygons, x, y):
+    """For each point, the index of the last polygon that holds it, or -1 (even-odd rule)."""
+    found = np.full(x.shape, -1, dtype=np.int64)
+    for k, poly in enumerate(polygons):
+        inside = np.zeros(x.shape, dtype=bool)
+        px = np.array([p[0] for p in poly], dtype=float)
+        py = np.array([p[1] for p in poly], dtype=float)
+        for i in range(len(poly)):
+            x0, y0, x1, y1 = px[i - 1], py[i - 1], px[i], py[i]
+            if y0 == y1:
+                continue
+            crosses = (y1 > y) != (y0 > y)
+            xs = (x0 - x1) * (y - y1) / (y0 - y1) + x1
+            inside ^= crosses & (x < xs)
+        found[inside] = k
+    return found
+
+
+def _other_floor(color):
+    """A floor colour that differs from ``color`` in every channel by at least 0.4."""
+    return tuple(0.0 if c > 0.5 else 1.0 for c in color)
+
+
+def paint_floor_patches(renderer, scene, pose):
+    """The noise-free image of ``scene`` with its floor patches painted in."""
+    plain = dataclasses.replace(scene, floor_patches=())
+    image = renderer.render(plain, pose)
+    other = renderer.render(dataclasses.replace(plain, floor_color=_other_floor(scene.floor_color)),
+                            pose)
+    rows, cols = np.nonzero((image != other).any(axis=2))
+    if rows.size == 0:
+        return image
+    x, y = floor_points(renderer, pose, rows, cols)
+    index = patch_index([poly for poly, _ in scene.floor_patches], x, y)
+    hit = index >= 0
+    if not hit.any():
+        return image
+    light = scene.lighting
+    d = np.asarray(light.direction, dtype=float)
+    shade = light.ambient + light.intensity * max(0.0, -d[2] / np.linalg.norm(d))
+    albedo = np.array([color for _, color in scene.floor_patches], dtype=float)
+    rgb = np.clip(albedo * shade * 255.0 + 0.5, 0.0, 255.0).astype(np.uint8)
+    image[rows[hit], cols[hit]] = rgb[index[hit]]
+    return image
