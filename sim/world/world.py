@@ -105,11 +105,12 @@ class World:
         self.motors = DriveMotors(spec)
         self.lighting = LightingSchedule(config.lighting)
 
-        self.terrain = TerrainMap(config.room.terrain)
+        self.terrain = TerrainMap(config.room.terrain, config.room.width, config.room.depth)
         self._floor_patches = tuple((t.polygon, t.color) for t in config.room.terrain
                                     if t.color is not None)
         self._patch = None  # the terrain patch under the robot's centre
         self._traction = 1.0  # the factor the joints' forces are set to
+        self._downhill_cache = {}  # id(patch) -> gravity's downhill force on the robot
         # Motor gain, noise and slips: a stream of their own (None for the ideal robot), so
         # that they never shift the people's randomness.
         self.uncertainty = (MotorUncertainty(config.robot.uncertainty, self.seed)
@@ -225,13 +226,17 @@ class World:
 
     def _substep(self, h):
         spec = self.robot_spec
+        body = self.robot_body
+        rx, ry = body.position  # unchanged until space.step (one read: pymunk's are slow)
         wl, wr = self.motors.step(h)
-        slip = 1.0
         if self.uncertainty is not None:
             wl, wr, slip = self.uncertainty.step(h, wl, wr, self.time)
-            self._events += self.uncertainty.drain_events()
-        if self.terrain or self.uncertainty is not None:
-            self._apply_terrain(slip)
+            if self.uncertainty._events:
+                self._events += self.uncertainty.drain_events()
+            if self.terrain or slip != self._traction:
+                self._apply_terrain(slip, rx, ry)
+        elif self.terrain:
+            self._apply_terrain(1.0, rx, ry)
         r = spec.wheel_radius
         v = r * (wl + wr) * 0.5
         if self.tipped is None:
@@ -242,13 +247,11 @@ class World:
                           f"{spec.tip_accel:.2f} m/s^2")
         self._motor_v = v
         w = r * (wr - wl) / spec.wheel_separation
-        body = self.robot_body
         a = body.angle
         control = self.control_body
         control.velocity = (v * math.cos(a), v * math.sin(a))
         control.angular_velocity = w
         t1 = self._advance_time(h)
-        rx, ry = body.position
         for person in self.people:
             if person.teleop is not None:  # driven by hand: the script waits, the offset grows
                 person.waited += h
@@ -274,10 +277,10 @@ class World:
         self.space.step(h)
         self.time = t1
 
-    def _apply_terrain(self, slip):
-        """The patch under the robot: its traction factor (times a slip's) on the drive's
-        joints, and gravity's downhill component on the body (pymunk clears it each step)."""
-        x, y = self.robot_body.position
+    def _apply_terrain(self, slip, x, y):
+        """The patch under the robot at ``(x, y)``: its traction factor (times a slip's) on
+        the drive's joints, and gravity's downhill component on the body (pymunk clears it
+        each step)."""
         patch = self.terrain.at(x, y) if self.terrain else None
         if patch is not self._patch:
             self._patch = patch
@@ -289,7 +292,14 @@ class World:
             self._pivot.max_force = self.robot_spec.traction_force * factor
             self._gear.max_force = self.robot_spec.traction_torque * factor
         if patch is not None and patch.slope > 0.0:
-            self.robot_body.force = patch.downhill_force(self.robot_spec.mass, G)
+            self.robot_body.force = self._downhill(patch)
+
+    def _downhill(self, patch):
+        force = self._downhill_cache.get(id(patch))
+        if force is None:
+            force = self._downhill_cache[id(patch)] = patch.downhill_force(
+                self.robot_spec.mass, G)
+        return force
 
     def terrain_under_robot(self):
         """The terrain patch under the robot's centre (``terrain.TerrainPatch``), or None."""
