@@ -163,12 +163,13 @@ def test_a_foreign_design_without_found_runs_from_the_command_line(tmp_path, cap
     pytest.importorskip("fpga_robotics.sim.backends.foreign")
     from fpga_robotics import run
     from fpga_robotics.hw.verilog import generate_verilog
+    from fpga_robotics.sim.backends import BackendError
     from fpga_robotics.sim.backends import toolchain as tc
     from fpga_robotics.sim.backends.port_map import follow_target_port_map
 
     try:
         tc.find_compiler(), tc.find_make(), tc.verilator_root()
-    except Exception as exc:  # pragma: no cover - depends on the machine
+    except BackendError as exc:  # pragma: no cover - depends on the machine
         pytest.skip(f"no Verilator toolchain: {exc}")
     s = load_scenario("follow_person", [f'camera.resolution="{RES}"'])
     (tmp_path / "ft.v").write_text(generate_verilog(s.params))

@@ -11,7 +11,6 @@ from fpga_robotics.sim.camera_kernel import camera_kernel
 from fpga_robotics.sim.scene import CameraPose, Scene
 
 
-
 def _have_compiler():
     from fpga_robotics.sim.backends.base import BackendError
     from fpga_robotics.sim.backends.toolchain import find_compiler

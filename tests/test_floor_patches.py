@@ -85,3 +85,37 @@ def test_the_world_draws_its_coloured_terrain():
     (poly, color), = scene.floor_patches
     assert color == (0.8, 0.1, 0.1) and len(poly) == 4
     assert math.isclose(min(p[0] for p in poly), 2.5) and math.isclose(max(p[1] for p in poly), 3.5)
+
+
+def test_triangulation_covers_any_simple_polygon():
+    from fpga_robotics.sim.render3d.floor_patches import triangulate
+
+    def area(poly):
+        return abs(sum(x0 * y1 - x1 * y0 for (x0, y0), (x1, y1)
+                       in zip(poly, list(poly[1:]) + [poly[0]]))) / 2
+
+    square = ((0, 0), (2, 0), (2, 2), (0, 2))
+    l_shape = ((0, 0), (3, 0), (3, 1), (1, 1), (1, 3), (0, 3))  # not convex, area 5
+    for poly, n in ((square, 2), (l_shape, 4), (tuple(reversed(l_shape)), 4)):
+        tris = triangulate(poly)
+        assert len(tris) == n
+        assert sum(area(t) for t in tris) == pytest.approx(area(poly))
+        # Every triangle lies inside the polygon (its centroid does).
+        from fpga_robotics.sim.world.terrain import polygon_contains
+
+        for t in tris:
+            cx, cy = sum(p[0] for p in t) / 3, sum(p[1] for p in t) / 3
+            assert polygon_contains(poly, cx, cy)
+
+
+def test_the_3d_model_has_one_flat_mesh_per_triangle():
+    from fpga_robotics.sim.render3d.floor_patches import LIFT, patch_assets_and_geoms
+
+    scene = _scene(floor_patches=(PATCH, (((0, 0), (3, 0), (3, 1), (1, 1), (1, 3), (0, 3)),
+                                          (0.2, 0.3, 0.9))))
+    assets, geoms = patch_assets_and_geoms(scene)
+    assert len(assets) == len(geoms) == 2 + 4
+    assert 'rgba="0.8 0.1 0.1 1"' in geoms[0] and 'contype="0"' in geoms[0]
+    # Six vertices a triangle, at LIFT / 2 and LIFT: above the floor, below anything on it.
+    zs = {float(v) for a in assets for v in a.split('vertex="')[1].rstrip('"/>').split()[2::3]}
+    assert zs == {LIFT / 2, LIFT}

@@ -310,8 +310,8 @@ def test_cli_runs_a_foreign_design_in_closed_loop(files, capsys, top, ports):
         (["--design", "verilog:{dir}/follow_target.v", "--ports", "{dir}/ft.toml", "--runtime",
           "mutsel=x"], "--runtime needs NAME=VALUE"),
         (["--design", "verilog:{dir}/follow_target.v", "--ports", "{dir}/ft.toml", "--runtime",
-          "mutsel=1"], "--runtime: follow_target has no [runtime] input 'mutsel' (its runtime "
-                       "inputs: none)"),
+          "mutsel=1"], ("--runtime: follow_target has no [runtime] input 'mutsel' (its runtime "
+                       "inputs: none)")),
     ],
 )
 def test_cli_bad_designs_exit_2_with_one_line(files, capsys, argv, message):

@@ -14,7 +14,7 @@ import pytest
 from fpga_robotics.sim.camera import CameraRenderer, focal_length
 from fpga_robotics.sim.world import World
 from fpga_robotics.sim.world.config import Uncertainty, WorldConfigError
-from fpga_robotics.sim.world.robots import G, TURTLEBOT2
+from fpga_robotics.sim.world.robots import TURTLEBOT2, G
 from fpga_robotics.sim.world.terrain import TerrainPatch, polygon_contains, slope_pitch
 from fpga_robotics.sim.world.uncertainty import NOISE_TAU, MotorUncertainty
 
@@ -197,13 +197,13 @@ def test_the_same_seed_gives_the_same_run_and_the_ideal_robot_is_unchanged():
     ({"terrain": [{"friction": 0.5}]}, "room.terrain[0] needs either points"),
     ({"terrain": [{"center": [1, 1], "points": [[0, 0], [1, 0], [1, 1]]}]},
      "room.terrain[0] needs either points"),
-    ({"terrain": [{"points": [[0, 0], [1, 0]]}]}, "room.terrain[0].points must be an array of "
-                                                  "at least 3 points"),
+    ({"terrain": [{"points": [[0, 0], [1, 0]]}]}, ("room.terrain[0].points must be an array of "
+                                                  "at least 3 points")),
     ({"terrain": [{"points": [[0, 0], [1, 1], [2, 2]]}]}, "encloses no area"),
     ({"terrain": [{"center": [1, 1], "slope_deg": 60}]}, "room.terrain[0].slope_deg must be <= 45"),
     ({"terrain": [{"center": [1, 1], "friction": 0}]}, "room.terrain[0].friction must be >= 0.01"),
-    ({"terrain": [{"center": [1, 1], "colour": [1, 0, 0]}]}, "room.terrain[0].colour is not a "
-                                                             "known key (did you mean 'color'?)"),
+    ({"terrain": [{"center": [1, 1], "colour": [1, 0, 0]}]}, ("room.terrain[0].colour is not a "
+                                                             "known key (did you mean 'color'?)")),
     ({"terrain": [{"center": [50, 50]}]}, "room.terrain[0] lies outside the room"),
 ])
 def test_bad_terrain_names_the_key(room, message):

@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .body import JOINTS, REFERENCE_HEIGHT, REFERENCE_RADIUS, body_colors, person_height
+from .floor_patches import patch_assets_and_geoms
 from .textures import texture_rgb
 
 __all__ = ["ModelSpec", "build_model_xml"]
@@ -229,6 +230,8 @@ def build_model_xml(scene, options, width, height, fovy_deg):
     body.append(f'<geom type="plane" pos="{_f((cx, cy, 0))}" '
                 f'size="{_f((half + SLAB, half + SLAB, 0.1))}" material="{floor_mat}"/>')
     body += _static_geoms(scene, mats)
+    patch_assets, patch_geoms = patch_assets_and_geoms(scene)  # terrain drawn on the floor
+    body += patch_geoms
     people = []
     for i, cyl in enumerate(scene.cylinders):
         name, joints, lines = _person(i, cyl, mats, options.shine)
@@ -265,6 +268,7 @@ def build_model_xml(scene, options, width, height, fovy_deg):
         ('<texture name="ceiling" type="skybox" builtin="flat" width="8" height="8" '
         'rgb1="1 1 1" rgb2="1 1 1"/>'),
         *mats.assets,
+        *patch_assets,
         "</asset>",
         "<worldbody>",
         *lights,

@@ -128,7 +128,8 @@ class MujocoRenderer:
     def _layout_key(self, scene):
         # Compared by value (a tuple compares its items by identity first: cheap per frame).
         return (scene.walls, tuple((c.bands, c.radius) for c in scene.cylinders),
-                scene.floor_color, scene.ceiling_color, scene.ceiling_height)
+                scene.floor_color, scene.ceiling_color, scene.ceiling_height,
+                getattr(scene, "floor_patches", ()))
 
     def _build(self, scene):
         mj = self._mj
