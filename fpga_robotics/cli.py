@@ -6,6 +6,7 @@
     fpga-robotics bench [WHAT] [options]  benchmarks: design (default), pysim, camera, world,
                                           viewer, shadow
     fpga-robotics readback FILE.rrd       what a saved recording holds
+    fpga-robotics sweep CAMPAIGN [options]  a verification campaign on Dask
 
 Each subcommand is the ``main(argv, prog)`` of its module, so ``fpga-robotics run --help`` and
 ``python -m fpga_robotics.run --help`` are the same command. New subcommands are one row of
@@ -31,6 +32,8 @@ COMMANDS = {
               "write (--example) or check a port map for run --design verilog:..."),
     "readback": ("fpga_robotics.readback_cli",
                  "what a saved .rrd recording holds, entity by entity"),
+    "sweep": ("fpga_robotics.sweep.cli",
+              "a verification campaign: many runs on Dask, results table and report"),
 }
 
 #: ``fpga-robotics bench WHAT`` -> (module, one-line help); the first is the default.
