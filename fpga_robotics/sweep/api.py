@@ -42,6 +42,11 @@ def run_campaign(campaign, out_dir, *, workers=None, scheduler=None, resume=Fals
             meta["build_s"] = round(time.perf_counter() - t_build, 3)
             meta["build_s_each"] = [round(b, 3) for b in builds]
             say(f"built or loaded {len(builds)} design(s) in {meta['build_s']:.1f} s")
+            done = store.done_ids()
+            already = len({plan.ids[s] for s in plan.runs} & done)
+            if already:
+                say(f"{already} of {len(plan.runs)} runs already in {out_dir} (--resume): "
+                    f"running the other {len(plan.runs) - already}")
             t_runs = time.perf_counter()
             meta["ran"] = run_plan(c, plan, store, record=record, timeout=timeout,
                                    quiet=quiet)
