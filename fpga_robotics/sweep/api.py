@@ -36,7 +36,7 @@ def run_campaign(campaign, out_dir, *, workers=None, scheduler=None, resume=Fals
     try:
         with (_given(client) if client is not None else
               open_client(scheduler=scheduler, workers=workers)) as c:
-            meta["workers"] = len(c.scheduler_info()["workers"])
+            _wait_for_a_worker(c, scheduler)
             t_build = time.perf_counter()
             builds = build_all(c, plan)
             meta["build_s"] = round(time.perf_counter() - t_build, 3)
@@ -51,6 +51,7 @@ def run_campaign(campaign, out_dir, *, workers=None, scheduler=None, resume=Fals
             meta["ran"] = run_plan(c, plan, store, record=record, timeout=timeout,
                                    quiet=quiet)
             meta["runs_wall_s"] = round(time.perf_counter() - t_runs, 3)
+            meta["workers"] = len(c.scheduler_info()["workers"])
     finally:
         store.close()
         meta["wall_s"] = round(time.perf_counter() - t0, 3)
@@ -59,6 +60,21 @@ def run_campaign(campaign, out_dir, *, workers=None, scheduler=None, resume=Fals
         if rows:
             write_html(out_dir / "report.html", rows, campaign.axes, meta)
     return rows
+
+
+#: How long a campaign waits for a first worker to join an existing scheduler.
+WORKER_WAIT_S = 60
+
+
+def _wait_for_a_worker(client, scheduler):
+    from ..errors import UsageError
+
+    try:
+        client.wait_for_workers(1, timeout=WORKER_WAIT_S)
+    except TimeoutError:
+        raise UsageError(f"no Dask worker joined the scheduler {scheduler} within "
+                         f"{WORKER_WAIT_S} s; start workers with `dask worker {scheduler}`") \
+            from None
 
 
 class _given:
