@@ -10,6 +10,7 @@ queued, closes the client and stops an embedded cluster's workers; the rows so f
 import contextlib
 import logging
 import os
+import signal
 import statistics
 import sys
 import time
@@ -52,20 +53,54 @@ def open_client(scheduler=None, workers=None):
             client.close()
         return
     n = workers or os.cpu_count() or 1
+    # Ctrl-C in a terminal reaches the whole process group: the workers ignore it (started
+    # with SIGINT ignored, and told again when a nanny restarts one) and this process stops
+    # them in order.
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        cluster_cm = _local_cluster(dask, LocalCluster, n)
+        cluster = cluster_cm.__enter__()
+    finally:
+        signal.signal(signal.SIGINT, previous)
+    try:
+        client = Client(cluster)
+        try:
+            client.register_plugin(_ignore_interrupts_plugin(), name="fpga-robotics-ignore-sigint")
+            yield client
+        finally:
+            client.close()
+    finally:
+        cluster_cm.__exit__(None, None, None)
+
+
+@contextlib.contextmanager
+def _local_cluster(dask, LocalCluster, n):
     with dask.config.set({"distributed.scheduler.allowed-failures": 0,
                           "distributed.scheduler.worker-saturation": 1.0,
                           "distributed.worker.daemon": False,
                           "distributed.admin.system-monitor.gil.enabled": False}):
         cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
                                dashboard_address=None, silence_logs=logging.CRITICAL)
-        try:
-            client = Client(cluster)
-            try:
-                yield client
-            finally:
-                client.close()
-        finally:
-            cluster.close()
+    try:
+        yield cluster
+    finally:
+        cluster.close()
+
+
+def _ignore_interrupts_plugin():
+    from distributed import WorkerPlugin
+
+    class IgnoreInterrupts(WorkerPlugin):
+        """Worker plugin of the embedded cluster: the worker process ignores SIGINT (its
+        campaign's process ends it)."""
+
+        def setup(self, worker):
+            import threading
+
+            if threading.current_thread() is threading.main_thread():
+                signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+    return IgnoreInterrupts()
 
 
 class _Timeouts:
