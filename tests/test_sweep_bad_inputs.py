@@ -36,7 +36,7 @@ def test_bad_campaign_file_is_one_line_and_exit_2(case, tmp_path):
     text, message = CASES[case]
     (tmp_path / "c.toml").write_text(text)
     proc = subprocess.run(SWEEP + ["c.toml", "--out", "out", "--quiet"], cwd=tmp_path,
-                          capture_output=True, text=True, timeout=60)
+                          check=False, capture_output=True, text=True, timeout=60)
     assert proc.returncode == 2, proc.stderr
     lines = proc.stderr.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("fpga_robotics.sweep: error: "), lines
@@ -55,7 +55,7 @@ def test_bad_options_are_one_line_and_exit_2(argv, message, tmp_path):
     (tmp_path / "c.toml").write_text(GOOD)
     if argv[0] != "nonexistent_campaign":
         argv = ["c.toml", *argv]
-    proc = subprocess.run(SWEEP + argv + ["--quiet"], cwd=tmp_path, capture_output=True,
+    proc = subprocess.run(SWEEP + argv + ["--quiet"], cwd=tmp_path, check=False, capture_output=True,
                           text=True, timeout=60)
     assert proc.returncode == 2, proc.stderr
     lines = proc.stderr.strip().splitlines()
@@ -64,7 +64,7 @@ def test_bad_options_are_one_line_and_exit_2(argv, message, tmp_path):
 
 def test_dry_run_counts_and_shows_commands(tmp_path):
     (tmp_path / "c.toml").write_text(GOOD + '[grid]\n"design.diff_min" = [4, 5, 6]\n')
-    proc = subprocess.run(SWEEP + ["c.toml", "--dry-run"], cwd=tmp_path, capture_output=True,
+    proc = subprocess.run(SWEEP + ["c.toml", "--dry-run"], cwd=tmp_path, check=False, capture_output=True,
                           text=True, timeout=60)
     assert proc.returncode == 0, proc.stderr
     lines = proc.stdout.splitlines()

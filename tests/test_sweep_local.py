@@ -50,7 +50,7 @@ def _assert_row_matches(row, summary):
 @pytest.fixture(scope="module")
 def small_campaign(tmp_path_factory):
     out = tmp_path_factory.mktemp("small")
-    rows = run_campaign(load_campaign(dict(SMALL)), out, workers=2, record="none")
+    rows = run_campaign(load_campaign(dict(SMALL)), out, workers=2, record="failing")
     return out, rows
 
 
@@ -71,6 +71,20 @@ def test_two_workers_give_the_summaries_of_runs_made_one_by_one(small_campaign):
     assert "data:image/png;base64," in html and "<script" not in html
 
 
+def test_failing_runs_have_their_recording(small_campaign):
+    out, rows = small_campaign
+    failing = [r for r in rows if r["status"] == "fail"]
+    assert failing and len(failing) < len(rows)
+    for row in rows:
+        if row["status"] == "fail":
+            rrd = out / row["recording"]
+            assert rrd.name == f"{row['run_id']}.rrd" and rrd.stat().st_size > 1000
+        else:
+            assert row["recording"] == ""
+    assert sorted(p.name for p in (out / "recordings").iterdir()) == sorted(
+        f"{r['run_id']}.rrd" for r in failing)
+
+
 def test_replay_command_reproduces_the_summary(small_campaign, tmp_path):
     _out, rows = small_campaign
     for row in (rows[0], next(r for r in rows if r["status"] == "fail")):
@@ -79,7 +93,7 @@ def test_replay_command_reproduces_the_summary(small_campaign, tmp_path):
         summary_path = tmp_path / f"{row['run_id']}.json"
         proc = subprocess.run([sys.executable, *argv[1:], "--rerun", "off", "--quiet",
                                "--summary", str(summary_path)],
-                              capture_output=True, text=True, timeout=120)
+                              check=False, capture_output=True, text=True, timeout=120)
         assert proc.returncode == (0 if row["status"] == "pass" else 1), proc.stderr
         _assert_row_matches(row, json.loads(summary_path.read_text()))
 

@@ -65,7 +65,7 @@ def test_campaign_on_a_real_scheduler_matches_the_embedded_cluster(tmp_path):
         proc = subprocess.run([sys.executable, "-m", "fpga_robotics.sweep", "c.toml",
                                "--scheduler", address, "--out", "remote", "--quiet",
                                "--record", "none"],
-                              cwd=tmp_path, capture_output=True, text=True, timeout=180)
+                              cwd=tmp_path, check=False, capture_output=True, text=True, timeout=180)
         assert proc.returncode in (0, 1), proc.stderr
         assert "4 runs:" in proc.stdout
         meta = json.loads((tmp_path / "remote" / "campaign.json").read_text())

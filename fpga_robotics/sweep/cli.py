@@ -90,22 +90,17 @@ def _merge_options(data, args):
 
 
 def _campaign(args):
-    from .campaign import CampaignError
-
     if args.campaign is None:
         if args.scenarios is None:
             raise UsageError("give a campaign (a shipped name: "
                              f"{', '.join(shipped_campaigns())}; or a .toml file), or "
                              "--scenarios")
-        data, source, base = {"name": "campaign"}, "", Path.cwd()
+        data, source = {"name": "campaign"}, ""
     else:
         data, path = read_campaign_file(args.campaign)
-        source, base = str(path), path.parent
+        source = str(path)
     _merge_options(data, args)
-    try:
-        return load_campaign(data, source=source)
-    except CampaignError:
-        raise
+    return load_campaign(data, source=source)
 
 
 def _check_counts(args):

@@ -19,9 +19,9 @@ from pathlib import Path
 from ..errors import UsageError
 from ..sim.files import write_atomic
 from . import runner
-from .results import ResultStore, make_row
+from .results import make_row
 
-__all__ = ["DEFAULT_TIMEOUT_FACTOR", "MIN_TIMEOUT_S", "open_client", "run_plan"]
+__all__ = ["DEFAULT_TIMEOUT_FACTOR", "MIN_TIMEOUT_S", "build_all", "open_client", "run_plan"]
 
 #: A run's default timeout is this many times its expected time ...
 DEFAULT_TIMEOUT_FACTOR = 10.0
@@ -80,7 +80,7 @@ def _local_cluster(dask, LocalCluster, n):
                           "distributed.worker.daemon": False,
                           "distributed.admin.system-monitor.gil.enabled": False}):
         cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                               dashboard_address=None, silence_logs=logging.CRITICAL)
+                               dashboard_address=":0", silence_logs=logging.CRITICAL)
     try:
         yield cluster
     finally:
@@ -149,9 +149,6 @@ def build_all(client, plan):
             times.append(fut.result())
         except UsageError as exc:
             raise UsageError(f"building the design of `{' '.join(argv)}`: {exc}") from None
-        except Exception as exc:
-            raise UsageError(f"building the design of `{' '.join(argv)}`: "
-                             f"{type(exc).__name__}: {exc}".splitlines()[0]) from None
     return times
 
 
@@ -180,8 +177,9 @@ def run_plan(client, plan, store, *, record="failing", timeout=None, quiet=False
     def submit(spec, recording=False):
         frames, pixels = plan.frames[spec]
         limit = timeouts(spec, frames, pixels)
+        key = f"run-{plan.ids[spec]}-{time.monotonic_ns()}"
         fut = client.submit(runner.execute, spec.argv(), limit, recording or record == "all",
-                            pure=False, key=f"run-{plan.ids[spec]}-{time.monotonic_ns()}")
+                            key, pure=False, key=key)
         running[fut] = (spec, time.monotonic(), limit, recording)
         completed.add(fut)
 
@@ -192,8 +190,8 @@ def run_plan(client, plan, store, *, record="failing", timeout=None, quiet=False
     try:
         top_up()
         for fut in completed:
-            spec, submitted, limit, recording = running.pop(fut)
-            outcome = _outcome(fut, time.monotonic() - submitted, limit)
+            spec, _submitted, limit, recording = running.pop(fut)
+            outcome = _outcome(client, fut, limit)
             if recording:  # the recording pass of a failing run: attach its .rrd
                 row = done_rows.pop(plan.ids[spec], None)
                 if row is not None and outcome.get("recording"):
@@ -228,18 +226,30 @@ def run_plan(client, plan, store, *, record="failing", timeout=None, quiet=False
     return len(todo)
 
 
-def _outcome(fut, elapsed, limit):
+def _timed_out(client, key):
+    """Whether a worker said it ended itself because run ``key`` was stuck."""
+    end = time.monotonic() + 3.0  # the event may arrive just after the worker's death
+    while True:
+        events = client.get_events(runner.TIMEOUT_TOPIC)
+        if any(msg.get("tag") == key for _t, msg in events):
+            return True
+        if time.monotonic() > end:
+            return False
+        time.sleep(0.1)
+
+
+def _outcome(client, fut, limit):
     from distributed import KilledWorker
 
     try:
         return fut.result()
     except KilledWorker:
-        if elapsed >= limit:
+        if _timed_out(client, fut.key):
             return {"status": "timeout",
                     "message": f"no result within the per-run timeout of {limit:.3g} s: the "
                                f"run stopped making progress and its worker was ended"}
         return {"status": "error", "message": "the worker running it died (a crash or a kill)"}
-    except Exception as exc:
+    except Exception as exc:  # noqa: BLE001 (a lost connection, a cancelled task: recorded)
         return {"status": "error", "message": f"{type(exc).__name__}: {exc}".splitlines()[0]}
 
 
@@ -249,5 +259,3 @@ def _save_recording(out_dir, run_id, data):
     write_atomic(path, data, what="recording")
     return str(path.relative_to(out_dir))
 
-
-__all__ += ["build_all", "ResultStore"]

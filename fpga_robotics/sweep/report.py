@@ -59,7 +59,7 @@ def format_report(rows, axes):
     for axis in axes:
         lines.append(f"pass rate per {axis}:")
         for value, group in _by(rows, axis).items():
-            lines.append(f"  {str(value):<20} {_rate(group):6.0%}  ({len(group)} runs)")
+            lines.append(f"  {value!s:<20} {_rate(group):6.0%}  ({len(group)} runs)")
     groups = failures_by_check(rows)
     if groups:
         lines.append("failures by check (replay one with its command):")
@@ -162,9 +162,9 @@ def write_html(path, rows, axes, meta):
     esc = html.escape
     title = f"Campaign {meta.get('name', '')}"
     parts = [f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>{esc(title)}</title>",
-             "<style>body{font-family:sans-serif;margin:2em;max-width:70em}"
-             "code{background:#eee;padding:0 .2em;word-break:break-all}"
-             "td,th{padding:.2em .6em;text-align:left}img{margin:.5em}</style></head><body>",
+             ("<style>body{font-family:sans-serif;margin:2em;max-width:70em}"
+              "code{background:#eee;padding:0 .2em;word-break:break-all}"
+              "td,th{padding:.2em .6em;text-align:left}img{margin:.5em}</style></head><body>"),
              f"<h1>{esc(title)}</h1>"]
     if meta.get("description"):
         parts.append(f"<p>{esc(meta['description'])}</p>")

@@ -15,7 +15,7 @@ from pathlib import Path
 
 from ..sim.files import atomic_path, write_atomic, write_json_atomic
 
-__all__ = ["ResultStore", "STATUSES", "load_rows", "make_row", "read_meta"]
+__all__ = ["STATUSES", "ResultStore", "load_rows", "make_row", "read_meta"]
 
 STATUSES = ("pass", "fail", "error", "timeout")
 #: Statuses of finished runs that ``--resume`` does not run again (an error or a timeout may
@@ -133,7 +133,7 @@ class ResultStore:
         # Runs to do again (errors, timeouts) are dropped from the journal too.
         self._rows = {r["run_id"]: r for r in rows if r.get("status") in DONE}
         self._rewrite_journal()
-        self._journal = open(self.dir / JOURNAL, "a")
+        self._journal = open(self.dir / JOURNAL, "a")  # noqa: SIM115 (open for the campaign)
         self._last_flush = time.monotonic()
         self._dirty = True
 

@@ -17,7 +17,11 @@ import os
 import threading
 import time
 
-__all__ = ["RunTimeout", "build_designs", "execute", "load_run"]
+__all__ = ["TIMEOUT_TOPIC", "RunTimeout", "build_designs", "execute", "load_run"]
+
+#: The Dask event topic under which a worker says it ends itself for a stuck run (the client
+#: then records that run as ``timeout``, not as a crash).
+TIMEOUT_TOPIC = "fpga-robotics-sweep-timeouts"
 
 #: Designs a worker keeps open (a campaign has few parameter sets per worker at a time).
 _KEEP = 4
@@ -101,14 +105,16 @@ class _Deadline:
     """The progress callback: raises ``RunTimeout`` once the run is over its time; a
     watchdog ends the worker process if a single frame hangs past a hard limit."""
 
-    def __init__(self, timeout, fault):
+    def __init__(self, timeout, fault, tag=None):
         self.timeout = timeout
         self.fault = fault
+        self.tag = tag
         self.start = time.perf_counter()
         self.watchdog = None
+        self.worker = _current_worker()
         if timeout is not None:
             grace = min(HARD_GRACE_S, max(1.0, timeout))
-            self.watchdog = threading.Timer(timeout + grace, os._exit, (75,))
+            self.watchdog = threading.Timer(timeout + grace, self._expire)
             self.watchdog.daemon = True
             self.watchdog.start()
 
@@ -124,13 +130,29 @@ class _Deadline:
             raise RunTimeout(f"no result within the per-run timeout of {self.timeout:.3g} s "
                              f"(frame {done} of {total})")
 
+    def _expire(self):
+        """End this worker process (its nanny starts a new one), telling the scheduler why."""
+        if self.worker is not None and self.tag is not None:
+            self.worker.log_event(TIMEOUT_TOPIC, {"tag": self.tag})
+            time.sleep(1.0)  # the event is sent in the background
+        os._exit(75)
+
     def cancel(self):
         if self.watchdog is not None:
             self.watchdog.cancel()
 
 
-def execute(argv, timeout=None, record=False):
-    """Run one campaign run; returns ``{"status", "message", "summary", "wall_s", "cpu_s",
+def _current_worker():
+    try:
+        from distributed import get_worker
+
+        return get_worker()
+    except (ImportError, ValueError):  # called outside a Dask worker
+        return None
+
+
+def execute(argv, timeout=None, record=False, tag=None):
+    """Run one campaign run (``tag``: its name, for the timeout event); returns ``{"status", "message", "summary", "wall_s", "cpu_s",
     "run_s", "recording"}`` (``recording``: the ``.rrd`` bytes when ``record``)."""
     from .. import run
     from ..loop import run_scenario
@@ -141,7 +163,7 @@ def execute(argv, timeout=None, record=False):
     try:
         args, scenario, shadow_params = load_run(argv)
         design, shadow = _designs_for(args, scenario, shadow_params)
-        deadline = _Deadline(timeout, _fault(args.seed))
+        deadline = _Deadline(timeout, _fault(args.seed), tag)
         recorder, rrd = (None, None)
         if record:
             recorder, rrd = _recorder(args, scenario.name)
@@ -161,7 +183,7 @@ def execute(argv, timeout=None, record=False):
         out.update(status=summary["verdict"], summary=summary)
     except RunTimeout as exc:
         out.update(status="timeout", message=str(exc))
-    except Exception as exc:  # the campaign records it and goes on
+    except Exception as exc:  # noqa: BLE001 (the campaign records it and goes on)
         out.update(status="error", message=f"{type(exc).__name__}: {exc}".splitlines()[0])
     finally:
         if deadline is not None:
