@@ -129,12 +129,16 @@ def _heatmap(rows, x_axis, y_axis):
 def _histogram(rows, column, label):
     import matplotlib.pyplot as plt
 
+    import numpy as np
+
     fig, ax = plt.subplots(figsize=(4.5, 3))
+    every = [r[column] for r in rows if isinstance(r.get(column), (int, float))]
+    bins = np.histogram_bin_edges(every, bins=20)  # the same bins for passes and failures
     for status, color in (("pass", "#4a7"), ("fail", "#c44")):
         values = [r[column] for r in rows if r["status"] == status
                   and isinstance(r.get(column), (int, float))]
         if values:
-            ax.hist(values, bins=20, alpha=0.6, color=color, label=f"{status} ({len(values)})")
+            ax.hist(values, bins=bins, alpha=0.6, color=color, label=f"{status} ({len(values)})")
     ax.set_xlabel(label)
     ax.set_ylabel("runs")
     ax.legend()
