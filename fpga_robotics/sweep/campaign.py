@@ -32,6 +32,7 @@ import itertools
 import json
 import math
 import os
+import re
 import tomllib
 from dataclasses import dataclass, field, replace
 from importlib import resources
@@ -290,6 +291,8 @@ def load_campaign(data, *, source=""):
     where = f"{source}: " if source else ""
     try:
         name = _typed(data, "name", str, "a string") or "campaign"
+        # The name makes the default results folder: a plain file name.
+        name = re.sub(r"[^A-Za-z0-9_.-]", "_", name).lstrip(".-")[:64] or "campaign"
         scenarios = data.get("scenarios")
         if isinstance(scenarios, str):
             scenarios = [scenarios]

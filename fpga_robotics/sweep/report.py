@@ -99,12 +99,12 @@ def _bar_figure(groups, title, xlabel):
     return _png(fig)
 
 
-def _heatmap(rows, x_axis, y_axis):
+def _heatmap(rows, x_axis, y_axis, label):
     import matplotlib.pyplot as plt
     import numpy as np
 
-    xs = list(_by(rows, x_axis))
-    ys = list(_by(rows, y_axis))
+    xs = [x for x in _by(rows, x_axis) if x is not None]
+    ys = [y for y in _by(rows, y_axis) if y is not None]
     grid = np.full((len(ys), len(xs)), np.nan)
     for j, y in enumerate(ys):
         for i, x in enumerate(xs):
@@ -122,13 +122,12 @@ def _heatmap(rows, x_axis, y_axis):
             if not np.isnan(grid[j, i]):
                 ax.text(i, j, f"{grid[j, i]:.0f}", ha="center", va="center", fontsize=8)
     fig.colorbar(im, ax=ax, label="pass rate (%)")
-    ax.set_title(f"pass rate: {y_axis} x {x_axis}")
+    ax.set_title(f"{label}: pass rate (%)")
     return _png(fig)
 
 
 def _histogram(rows, column, label):
     import matplotlib.pyplot as plt
-
     import numpy as np
 
     fig, ax = plt.subplots(figsize=(4.5, 3))
@@ -184,9 +183,10 @@ def write_html(path, rows, axes, meta):
         parts.append(f"<img src='{_bar_figure(_by(rows, 'scenario'), 'per scenario', 'scenario')}'>")
         for axis in axes:
             parts.append(f"<img src='{_bar_figure(_by(rows, axis), f'per {axis}', axis)}'>")
-        if len(axes) >= 2:
+        if len(axes) >= 2:  # one map per scenario: each has its own conditions
             parts.append(f"<h2>{esc(axes[0])} x {esc(axes[1])}</h2>")
-            parts.append(f"<img src='{_heatmap(rows, axes[0], axes[1])}'>")
+            for name, group in _by(rows, "scenario").items():
+                parts.append(f"<img src='{_heatmap(group, axes[0], axes[1], name)}'>")
         parts.append("<h2>Metric distributions</h2>")
         for column, label in METRICS:
             if any(isinstance(r.get(column), (int, float)) for r in rows):

@@ -37,6 +37,34 @@ class RunTimeout(Exception):
     """The run took longer than its timeout."""
 
 
+def _loaded(argv):
+    """``load_run`` of the runs of a worker, remembered by their arguments other than the
+    seed (the scenario does not depend on it): a campaign's runs differ mostly by seed."""
+    import argparse
+
+    argv = list(argv)
+    i = argv.index("--seed") if "--seed" in argv else None
+    seed = argv[i + 1] if i is not None else None
+    shape = tuple(argv[:i] + argv[i + 2:]) if i is not None else tuple(argv)
+    if shape not in _loads:
+        if len(_loads) >= 64:
+            _loads.clear()
+        _loads[shape] = load_run(list(shape))
+    args, scenario, shadow_params = _loads[shape]
+    args = argparse.Namespace(**vars(args))
+    if seed is not None:
+        args.seed = int(seed)
+        from ..errors import UsageError
+        from ..scenario import MAX_SEED
+
+        if not 0 <= args.seed <= MAX_SEED:
+            raise UsageError(f"--seed must be in 0..{MAX_SEED}, got {args.seed}")
+    return args, scenario, shadow_params
+
+
+_loads = {}
+
+
 def load_run(argv):
     """``(args, scenario, shadow_params)`` of a run, checked as ``run`` checks them
     (``UsageError`` with one line when something is wrong)."""
@@ -161,7 +189,7 @@ def execute(argv, timeout=None, record=False, tag=None):
     out = {"status": "error", "message": "", "summary": None, "recording": None, "run_s": 0.0}
     deadline = None
     try:
-        args, scenario, shadow_params = load_run(argv)
+        args, scenario, shadow_params = _loaded(argv)
         design, shadow = _designs_for(args, scenario, shadow_params)
         deadline = _Deadline(timeout, _fault(args.seed), tag)
         recorder, rrd = (None, None)
