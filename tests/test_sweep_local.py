@@ -113,3 +113,22 @@ def test_raising_hanging_and_dying_runs_are_recorded_and_the_rest_complete(tmp_p
     assert by_seed[3]["status"] == "error" and "worker" in by_seed[3]["message"]
     for seed in (0, 4, 5):
         _assert_row_matches(by_seed[seed], _direct("approach", 4, seed))
+
+
+def test_a_campaign_with_a_shadow_design_reports_where_it_differs(tmp_path):
+    from fpga_robotics.loop import make_backend
+    from fpga_robotics.run import _shadow_params
+
+    campaign = load_campaign({"scenarios": ["approach"], "seeds": [3], "backend": "model",
+                              "duration": 1.0, "shadow": "published"})
+    [row] = run_campaign(campaign, tmp_path, workers=1, record="none")
+    assert "--shadow published" in row["replay"]
+    scenario = load_scenario("approach", ["sim.duration=1.0"])
+    shadow = make_backend("model", _shadow_params(scenario, "published"))
+    try:
+        direct = run_scenario(scenario, seed=3, backend="model", shadow=shadow,
+                              shadow_label="published").summary
+    finally:
+        shadow.close()
+    assert direct["shadow"]["differing_frames"]["motor_left"] > 0  # the designs differ
+    _assert_row_matches(row, direct)
