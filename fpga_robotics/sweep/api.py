@@ -5,7 +5,7 @@ import time
 from pathlib import Path
 
 from .. import __version__
-from .engine import build_all, open_client, run_plan
+from .engine import RECORD_LOG_EVERY, build_all, open_client, run_plan
 from .plan import make_plan
 from .report import format_report, write_html
 from .results import ResultStore, load_rows, read_meta, write_meta
@@ -15,7 +15,7 @@ __all__ = ["report_dir", "run_campaign"]
 
 def run_campaign(campaign, out_dir, *, workers=None, scheduler=None, resume=False,
                  record="failing", timeout=None, max_runs=None, quiet=True, client=None,
-                 echo=None):
+                 echo=None, log_every=RECORD_LOG_EVERY):
     """Run ``campaign`` (a ``Campaign``) and return its results rows (list of dicts, one per
     run, in the order they finished; with ``resume`` the rows already in ``out_dir`` too).
 
@@ -49,7 +49,7 @@ def run_campaign(campaign, out_dir, *, workers=None, scheduler=None, resume=Fals
                     f"running the other {len(plan.runs) - already}")
             t_runs = time.perf_counter()
             meta["ran"] = run_plan(c, plan, store, record=record, timeout=timeout,
-                                   quiet=quiet)
+                                   quiet=quiet, log_every=log_every)
             meta["runs_wall_s"] = round(time.perf_counter() - t_runs, 3)
             meta["workers"] = len(c.scheduler_info()["workers"])
     finally:

@@ -11,6 +11,7 @@ from pathlib import Path
 from ..errors import UsageError, run_cli
 from ..sim.files import check_output_dir
 from .campaign import load_campaign, read_campaign_file, shipped_campaigns
+from .engine import RECORD_LOG_EVERY
 
 __all__ = ["build_parser", "main"]
 
@@ -54,6 +55,9 @@ def build_parser(prog=PROG):
                    help="keep the runs already in --out and run only the others")
     e.add_argument("--record", choices=RECORD, default="failing",
                    help="save the .rrd recording of failing runs (default), all or none")
+    e.add_argument("--log-every", type=int, default=None, metavar="N",
+                   help="recordings log every Nth frame's images (default "
+                        f"{RECORD_LOG_EVERY}; the replay command records every frame)")
     e.add_argument("--dry-run", action="store_true",
                    help="print the run count and three example commands, run nothing")
     e.add_argument("--quiet", action="store_true", help="no progress bar")
@@ -104,7 +108,7 @@ def _campaign(args):
 
 
 def _check_counts(args):
-    for name in ("workers", "max_runs", "bench_runs"):
+    for name in ("workers", "max_runs", "bench_runs", "log_every"):
         value = getattr(args, name)
         if value is not None and value < 1:
             raise UsageError(f"--{name.replace('_', '-')} must be >= 1, got {value}")
@@ -168,7 +172,8 @@ def main(argv=None, prog=PROG):
     try:
         rows = run_campaign(campaign, out, workers=args.workers, scheduler=args.scheduler,
                             resume=args.resume, record=args.record, timeout=args.timeout,
-                            max_runs=args.max_runs, quiet=args.quiet, echo=echo)
+                            max_runs=args.max_runs, quiet=args.quiet, echo=echo,
+                            log_every=args.log_every or RECORD_LOG_EVERY)
     except KeyboardInterrupt:
         kept = len(load_rows(out))
         print(f"interrupted: {kept} finished run(s) kept in {out}; continue with --resume",

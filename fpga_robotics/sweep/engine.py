@@ -21,8 +21,11 @@ from ..sim.files import write_atomic
 from . import runner
 from .results import make_row
 
-__all__ = ["DEFAULT_TIMEOUT_FACTOR", "MIN_TIMEOUT_S", "build_all", "open_client", "run_plan"]
+__all__ = ["DEFAULT_TIMEOUT_FACTOR", "MIN_TIMEOUT_S", "RECORD_LOG_EVERY", "build_all", "open_client", "run_plan"]
 
+#: A campaign's recordings log the images of every this many frames (a run's recording at
+#: 160x120 is about 45 MB with every frame; the replay command records every frame).
+RECORD_LOG_EVERY = 10
 #: A run's default timeout is this many times its expected time ...
 DEFAULT_TIMEOUT_FACTOR = 10.0
 #: ... and never less than this (a loaded machine, a first model load).
@@ -153,8 +156,9 @@ def build_all(client, plan):
 
 
 def run_plan(client, plan, store, *, record="failing", timeout=None, quiet=False,
-             on_row=None):
-    """Run every planned run not already in ``store``; returns the number run."""
+             on_row=None, log_every=RECORD_LOG_EVERY):
+    """Run every planned run not already in ``store``; returns the number run.
+    Recordings log every ``log_every``-th frame's images (every frame's numbers)."""
     from distributed import as_completed
 
     todo, seen = [], store.done_ids()
@@ -178,8 +182,8 @@ def run_plan(client, plan, store, *, record="failing", timeout=None, quiet=False
         frames, pixels = plan.frames[spec]
         limit = timeouts(spec, frames, pixels)
         key = f"run-{plan.ids[spec]}-{time.monotonic_ns()}"
-        fut = client.submit(runner.execute, spec.argv(), limit, recording or record == "all",
-                            key, pure=False, key=key)
+        rec = log_every if (recording or record == "all") else False
+        fut = client.submit(runner.execute, spec.argv(), limit, rec, key, pure=False, key=key)
         running[fut] = (spec, time.monotonic(), limit, recording)
         completed.add(fut)
 

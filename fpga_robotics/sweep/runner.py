@@ -180,7 +180,8 @@ def _current_worker():
 
 
 def execute(argv, timeout=None, record=False, tag=None):
-    """Run one campaign run (``tag``: its name, for the timeout event); returns ``{"status", "message", "summary", "wall_s", "cpu_s",
+    """Run one campaign run (``tag``: its name, for the timeout event; ``record``: False, or
+    log every how many frames' images to the recording); returns ``{"status", "message", "summary", "wall_s", "cpu_s",
     "run_s", "recording"}`` (``recording``: the ``.rrd`` bytes when ``record``)."""
     from .. import run
     from ..loop import run_scenario
@@ -194,7 +195,7 @@ def execute(argv, timeout=None, record=False, tag=None):
         deadline = _Deadline(timeout, _fault(args.seed), tag)
         recorder, rrd = (None, None)
         if record:
-            recorder, rrd = _recorder(args, scenario.name)
+            recorder, rrd = _recorder(args, scenario.name, int(record))
         t_run = time.perf_counter()
         try:
             result = run_scenario(scenario, seed=args.seed, backend=design, recorder=recorder,
@@ -221,7 +222,7 @@ def execute(argv, timeout=None, record=False, tag=None):
     return out
 
 
-def _recorder(args, name):
+def _recorder(args, name, log_every):
     import tempfile
     from pathlib import Path
 
@@ -230,4 +231,5 @@ def _recorder(args, name):
     fd, path = tempfile.mkstemp(prefix=f"sweep-{name}-", suffix=".rrd")
     os.close(fd)
     args.rerun = f"save:{path}"
+    args.log_every = log_every
     return run._open_recorder(args, name), Path(path)
