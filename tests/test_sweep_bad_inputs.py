@@ -72,3 +72,14 @@ def test_dry_run_counts_and_shows_commands(tmp_path):
     assert len(lines) == 4
     assert all(line.strip().startswith("python -m fpga_robotics.run --scenario approach")
                for line in lines[1:])
+
+
+def test_report_of_a_folder_without_results_is_one_line_and_exit_2(tmp_path):
+    (tmp_path / "empty").mkdir()
+    for folder, message in (("empty", "holds no campaign results"),
+                            ("missing", "is not a folder of campaign results")):
+        proc = subprocess.run(SWEEP + ["report", folder], cwd=tmp_path, check=False,
+                              capture_output=True, text=True, timeout=60)
+        assert proc.returncode == 2
+        lines = proc.stderr.strip().splitlines()
+        assert len(lines) == 1 and message in lines[0], lines
