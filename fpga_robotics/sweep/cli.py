@@ -65,6 +65,8 @@ def build_parser(prog=PROG):
                    help="benchmark: the same runs on 1 worker and on N (--workers) workers")
     e.add_argument("--bench-runs", type=int, default=40, metavar="N",
                    help="with --bench: runs per measurement (default 40)")
+    e.add_argument("--bench-repeats", type=int, default=3, metavar="N",
+                   help="with --bench: measurements each way (default 3; medians)")
     return p
 
 
@@ -108,7 +110,7 @@ def _campaign(args):
 
 
 def _check_counts(args):
-    for name in ("workers", "max_runs", "bench_runs", "log_every"):
+    for name in ("workers", "max_runs", "bench_runs", "bench_repeats", "log_every"):
         value = getattr(args, name)
         if value is not None and value < 1:
             raise UsageError(f"--{name.replace('_', '-')} must be >= 1, got {value}")

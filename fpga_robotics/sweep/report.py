@@ -120,7 +120,9 @@ def _heatmap(rows, x_axis, y_axis, label):
     for j in range(len(ys)):
         for i in range(len(xs)):
             if not np.isnan(grid[j, i]):
-                ax.text(i, j, f"{grid[j, i]:.0f}", ha="center", va="center", fontsize=8)
+                v = grid[j, i]  # white on the dark ends of the colour map
+                ax.text(i, j, f"{v:.0f}", ha="center", va="center", fontsize=9,
+                        color="white" if v < 25 or v > 75 else "black")
     fig.colorbar(im, ax=ax, label="pass rate (%)")
     ax.set_title(f"{label}: pass rate (%)")
     return _png(fig)
