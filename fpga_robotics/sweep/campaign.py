@@ -121,13 +121,18 @@ def toml_value(v):
             return "inf" if v > 0 else "-inf"
         return repr(v)
     if isinstance(v, str):
-        return json.dumps(v)
+        return _toml_string(v)
     if isinstance(v, (list, tuple)):
         return "[" + ", ".join(toml_value(x) for x in v) + "]"
     if isinstance(v, dict):
-        return "{" + ", ".join(f"{json.dumps(str(k))} = {toml_value(x)}"
+        return "{" + ", ".join(f"{_toml_string(str(k))} = {toml_value(x)}"
                                for k, x in v.items()) + "}"
     raise CampaignError(f"cannot write {v!r} as a --set value")
+
+
+def _toml_string(text):
+    """A TOML basic string: JSON's escapes (not of non-ASCII characters), DEL escaped too."""
+    return json.dumps(text, ensure_ascii=False).replace("\x7f", "\\u007f")
 
 
 def parse_seeds(value, where="seeds"):
