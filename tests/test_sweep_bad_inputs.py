@@ -6,6 +6,9 @@ import sys
 
 import pytest
 
+from fpga_robotics.errors import run_cli
+from fpga_robotics.sweep.cli import main
+
 SWEEP = [sys.executable, "-m", "fpga_robotics.sweep"]
 
 GOOD = """scenarios = ["approach"]
@@ -32,15 +35,19 @@ CASES = {
 
 
 @pytest.mark.parametrize("case", sorted(CASES))
-def test_bad_campaign_file_is_one_line_and_exit_2(case, tmp_path):
+def test_bad_campaign_file_is_one_line_and_exit_2(case, tmp_path, monkeypatch, capsys):
+    # In this process, through the command's own wrapper (the options below go through a
+    # fresh interpreter).
     text, message = CASES[case]
     (tmp_path / "c.toml").write_text(text)
-    proc = subprocess.run(SWEEP + ["c.toml", "--out", "out", "--quiet"], cwd=tmp_path,
-                          check=False, capture_output=True, text=True, timeout=60)
-    assert proc.returncode == 2, proc.stderr
-    lines = proc.stderr.strip().splitlines()
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(SystemExit) as exit_info:
+        run_cli(main, ["c.toml", "--out", "out", "--quiet"], prog="fpga_robotics.sweep")
+    assert exit_info.value.code == 2
+    captured = capsys.readouterr()
+    lines = captured.err.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("fpga_robotics.sweep: error: "), lines
-    assert message in lines[0]
+    assert message in lines[0] and captured.out == ""
     assert not (tmp_path / "out").exists()
 
 
