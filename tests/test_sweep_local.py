@@ -12,7 +12,7 @@ import pytest
 from fpga_robotics.loop import run_scenario
 from fpga_robotics.scenario import load_scenario
 from fpga_robotics.summary import TIMING_FIELDS
-from fpga_robotics.sweep import load_campaign, run_campaign
+from fpga_robotics.sweep import load_campaign, report_dir, run_campaign
 
 #: Small and fast: the model backend, tiny frames, short runs.
 SMALL = {
@@ -23,15 +23,20 @@ SMALL = {
     "resolution": "40x24",
     "duration": 2.0,
     "grid": {"design.diff_min": [4, 8]},
+    "sets": [{"robot.mass": 8.0}],
 }
 
 #: Summary fields that are not simulation results (the machine's timing, the run's label).
 NOT_COMPARED = {*TIMING_FIELDS, "scenario", "seed", "collisions", "checks", "overrides"}
 
 
-def _direct(scenario, diff_min, seed):
-    sc = load_scenario(scenario, ['camera.resolution="40x24"', "sim.duration=2.0",
-                                  f"design.diff_min={diff_min}"])
+def _direct(scenario, seed, diff_min=None, mass=None):
+    overrides = ['camera.resolution="40x24"', "sim.duration=2.0"]
+    if diff_min is not None:
+        overrides.append(f"design.diff_min={diff_min}")
+    if mass is not None:
+        overrides.append(f"robot.mass={mass}")
+    sc = load_scenario(scenario, overrides)
     return run_scenario(sc, seed=seed, backend="model").summary
 
 
@@ -56,11 +61,14 @@ def small_campaign(tmp_path_factory):
 
 def test_two_workers_give_the_summaries_of_runs_made_one_by_one(small_campaign):
     out, rows = small_campaign
-    assert len(rows) == 2 * 2 * 2
-    assert {(r["scenario"], r["design.diff_min"], r["seed"]) for r in rows} == {
-        (s, d, seed) for s in ("approach", "follow_person") for d in (4, 8) for seed in (0, 1)}
+    assert len(rows) == 2 * (2 + 1) * 2  # scenarios x (grid + the set) x seeds
+    assert {(r["scenario"], r.get("design.diff_min"), r.get("robot.mass"), r["seed"])
+            for r in rows} == {
+        (s, d, m, seed) for s in ("approach", "follow_person")
+        for d, m in ((4, None), (8, None), (None, 8.0)) for seed in (0, 1)}
     for row in rows:
-        _assert_row_matches(row, _direct(row["scenario"], row["design.diff_min"], row["seed"]))
+        _assert_row_matches(row, _direct(row["scenario"], row["seed"], row.get("design.diff_min"),
+                                         row.get("robot.mass")))
     # The tables hold the same rows as the run returned.
     import pyarrow.parquet as pq
 
@@ -69,6 +77,10 @@ def test_two_workers_give_the_summaries_of_runs_made_one_by_one(small_campaign):
     assert len((out / "results.csv").read_text().splitlines()) == len(rows) + 1
     html = (out / "report.html").read_text()
     assert "data:image/png;base64," in html and "<script" not in html
+    # The report names every axis, with the runs of the other kind as "(not set)".
+    summary = report_dir(out)
+    assert "pass rate per design.diff_min:" in summary and "pass rate per robot.mass:" in summary
+    assert "(not set)" in summary
 
 
 def test_failing_runs_have_their_recording(small_campaign):
@@ -103,7 +115,8 @@ def test_raising_hanging_and_dying_runs_are_recorded_and_the_rest_complete(tmp_p
     # Worker processes inherit the environment: seed 1 raises, seed 2 hangs inside a frame
     # (its worker is ended after the timeout), seed 3 ends its worker process.
     monkeypatch.setenv("FPGA_ROBOTICS_SWEEP_FAULT", "raise@1,hang@2,exit@3")
-    campaign = load_campaign({**SMALL, "scenarios": ["approach"], "seeds": "0-5",
+    grid_only = {k: v for k, v in SMALL.items() if k != "sets"}
+    campaign = load_campaign({**grid_only, "scenarios": ["approach"], "seeds": "0-5",
                               "grid": {"design.diff_min": [4]}})
     rows = run_campaign(campaign, tmp_path, workers=2, record="none", timeout=3.0)
     by_seed = {r["seed"]: r for r in rows}
@@ -112,7 +125,7 @@ def test_raising_hanging_and_dying_runs_are_recorded_and_the_rest_complete(tmp_p
     assert by_seed[2]["status"] == "timeout" and "timeout" in by_seed[2]["message"]
     assert by_seed[3]["status"] == "error" and "worker" in by_seed[3]["message"]
     for seed in (0, 4, 5):
-        _assert_row_matches(by_seed[seed], _direct("approach", 4, seed))
+        _assert_row_matches(by_seed[seed], _direct("approach", seed, 4))
 
 
 def test_a_campaign_with_a_shadow_design_reports_where_it_differs(tmp_path):

@@ -25,7 +25,17 @@ def _rate(rows):
 
 
 def _value_key(v):
-    return (isinstance(v, str), v if not isinstance(v, str) else str(v))
+    """Numbers in order, then text, then runs without the key (an explicit set's rows on
+    another set's axis)."""
+    if v is None:
+        return (2, 0, "")
+    if isinstance(v, (int, float)) and not isinstance(v, bool):
+        return (0, v, "")
+    return (1, 0, str(v))
+
+
+def _shown(v):
+    return "(not set)" if v is None else str(v)
 
 
 def _by(rows, column):
@@ -59,7 +69,7 @@ def format_report(rows, axes):
     for axis in axes:
         lines.append(f"pass rate per {axis}:")
         for value, group in _by(rows, axis).items():
-            lines.append(f"  {value!s:<20} {_rate(group):6.0%}  ({len(group)} runs)")
+            lines.append(f"  {_shown(value):<20} {_rate(group):6.0%}  ({len(group)} runs)")
     groups = failures_by_check(rows)
     if groups:
         lines.append("failures by check (replay one with its command):")
@@ -87,7 +97,7 @@ def _png(fig):
 def _bar_figure(groups, title, xlabel):
     import matplotlib.pyplot as plt
 
-    labels = [str(k) for k in groups]
+    labels = [_shown(k) for k in groups]
     fig, ax = plt.subplots(figsize=(max(4, 0.6 * len(labels) + 2), 3))
     ax.bar(labels, [100 * _rate(g) for g in groups.values()], color="#4a7")
     ax.set_ylim(0, 100)
