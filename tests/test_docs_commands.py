@@ -405,8 +405,8 @@ PLANS = {
     # docs/campaigns.md: verification campaigns on Dask -------------------------------------
     "python -m fpga_robotics.sweep regression --dry-run":
         Plan(out=(r"campaign regression: 140 runs",
-                  r"(?m)^  python -m fpga_robotics\.run --scenario approach --backend \w+ "
-                  r"--seed 0$")),
+                  (r"(?m)^  python -m fpga_robotics\.run --scenario approach --backend \w+ "
+                   r"--seed 0$"))),
     "python -m fpga_robotics.sweep regression":
         # Two short runs on the model backend: the whole campaign takes minutes (the page
         # gives its measured time); the next command reads the same folder.
