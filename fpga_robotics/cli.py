@@ -7,6 +7,7 @@
                                           viewer, shadow
     fpga-robotics mutate [options]        mutation coverage (python -m fpga_robotics.mutation)
     fpga-robotics readback FILE.rrd       what a saved recording holds
+    fpga-robotics sweep CAMPAIGN [options]  a verification campaign on Dask
 
 Each subcommand is the ``main(argv, prog)`` of its module, so ``fpga-robotics run --help`` and
 ``python -m fpga_robotics.run --help`` are the same command. New subcommands are one row of
@@ -34,6 +35,8 @@ COMMANDS = {
                "mutation coverage: Yosys mutants of the design against the golden model"),
     "readback": ("fpga_robotics.readback_cli",
                  "what a saved .rrd recording holds, entity by entity"),
+    "sweep": ("fpga_robotics.sweep.cli",
+              "a verification campaign: many runs on Dask, results table and report"),
 }
 
 #: ``fpga-robotics bench WHAT`` -> (module, one-line help); the first is the default.

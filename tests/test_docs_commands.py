@@ -405,6 +405,39 @@ PLANS = {
                             "motor_left 208 vs -250, motor_right 512 vs 250"),
                   re.escape("  shadow frames that differ: motor_left 10, motor_right 10 "
                             "(of 600)"))),
+    # docs/campaigns.md: verification campaigns on Dask -------------------------------------
+    "python -m fpga_robotics.sweep regression --dry-run":
+        Plan(out=(r"campaign regression: 140 runs",
+                  (r"(?m)^  python -m fpga_robotics\.run --scenario approach --backend \w+ "
+                   r"--seed 0$"))),
+    "python -m fpga_robotics.sweep regression":
+        # Two short runs on the model backend: the whole campaign takes minutes (the page
+        # gives its measured time); the next command reads the same folder.
+        Plan(shorter=(("--max-runs", "2"), ("--backend", "model"), ("--duration", "2")),
+             files=("runs/sweeps/regression/results.parquet",
+                    "runs/sweeps/regression/results.csv", "runs/sweeps/regression/report.html"),
+             out=(r"2 runs: 2 pass", r"pass rate per scenario:")),
+    "python -m fpga_robotics.sweep report runs/sweeps/regression":
+        Plan(files=("runs/sweeps/regression/report.html",),
+             out=(r"2 runs: 2 pass",), last_line=r"report: runs/sweeps/regression/report\.html$"),
+    "python -m fpga_robotics.sweep filter_tuning":
+        # Two short runs: the page quotes the whole campaign's measured figures.
+        Plan(shorter=(("--max-runs", "2"), ("--backend", "model"), ("--duration", "2")),
+             files=("runs/sweeps/filter_tuning/report.html",),
+             out=(r"2 runs: ", r"pass rate per design\.diff_min:",
+                  r"pass rate per lighting\.ambient:")),
+    "python -m fpga_robotics.sweep robot_variants":
+        Plan(shorter=(("--max-runs", "2"), ("--backend", "model"), ("--duration", "2")),
+             files=("runs/sweeps/robot_variants/report.html",),
+             out=(r"2 runs: ", r"pass rate per robot\.mass:")),
+    "python -m fpga_robotics.sweep regression --scheduler tcp://HOST:8786":
+        Plan(excused="needs a Dask cluster (HOST is the page's placeholder); "
+                     "tests/test_sweep_scheduler.py runs a campaign through a real `dask "
+                     "scheduler` and `dask worker` on 127.0.0.1"),
+    "python -m fpga_robotics.sweep --bench":
+        Plan(shorter=(("--bench-runs", "2"), ("--bench-repeats", "1"), ("--duration", "1")),
+             out=(r"1 worker\(s\): [\d.]+ runs/s",
+                  r"outside run_scenario with 1 worker: [\d.-]+ ms per run")),
     # docs/viewer.md --------------------------------------------------------------------------
     "python -m fpga_robotics.run --scenario follow_person":
         Plan(viewer=True, files=("runs/follow_person.rrd",), out=(SAVED_DEFAULT,)),

@@ -1,0 +1,104 @@
+"""``run_campaign``: plan, build, run and report a campaign (the command's and the API's
+one code path)."""
+
+import time
+from pathlib import Path
+
+from .. import __version__
+from .engine import RECORD_LOG_EVERY, build_all, open_client, run_plan
+from .plan import make_plan
+from .report import format_report, write_html
+from .results import ResultStore, load_rows, read_meta, write_meta
+
+__all__ = ["report_dir", "run_campaign"]
+
+
+def run_campaign(campaign, out_dir, *, workers=None, scheduler=None, resume=False,
+                 record="failing", timeout=None, max_runs=None, quiet=True, client=None,
+                 echo=None, log_every=RECORD_LOG_EVERY):
+    """Run ``campaign`` (a ``Campaign``) and return its results rows (list of dicts, one per
+    run, in the order they finished; with ``resume`` the rows already in ``out_dir`` too).
+
+    ``client``: an open ``distributed.Client`` to use (else one is opened: ``scheduler`` or
+    an embedded cluster of ``workers`` processes). ``echo(text)``: where progress notes go.
+    """
+    say = echo or (lambda text: None)
+    plan = make_plan(campaign)
+    if max_runs is not None:
+        plan.runs = plan.runs[:max_runs]
+    out_dir = Path(out_dir)
+    store = ResultStore(out_dir, resume=resume)
+    meta = {"name": campaign.name, "description": campaign.description,
+            "source": campaign.source, "axes": campaign.axes, "runs": len(plan.runs),
+            "backend": sorted({s.backend for s in plan.runs}), "version": __version__,
+            "scheduler": scheduler, "workers": workers}
+    t0 = time.perf_counter()
+    try:
+        with (_given(client) if client is not None else
+              open_client(scheduler=scheduler, workers=workers)) as c:
+            _wait_for_a_worker(c, scheduler)
+            t_build = time.perf_counter()
+            builds = build_all(c, plan)
+            meta["build_s"] = round(time.perf_counter() - t_build, 3)
+            meta["build_s_each"] = [round(b, 3) for b in builds]
+            say(f"built or loaded {len(builds)} design(s) in {meta['build_s']:.1f} s")
+            done = store.done_ids()
+            already = len({plan.ids[s] for s in plan.runs} & done)
+            if already:
+                say(f"{already} of {len(plan.runs)} runs already in {out_dir} (--resume): "
+                    f"running the other {len(plan.runs) - already}")
+            t_runs = time.perf_counter()
+            meta["ran"] = run_plan(c, plan, store, record=record, timeout=timeout,
+                                   quiet=quiet, log_every=log_every)
+            meta["runs_wall_s"] = round(time.perf_counter() - t_runs, 3)
+            meta["workers"] = len(c.scheduler_info()["workers"])
+    finally:
+        store.close()
+        meta["wall_s"] = round(time.perf_counter() - t0, 3)
+        write_meta(out_dir, meta)
+        rows = store.rows
+        if rows:
+            write_html(out_dir / "report.html", rows, campaign.axes, meta)
+    return rows
+
+
+#: How long a campaign waits for a first worker to join an existing scheduler.
+WORKER_WAIT_S = 60
+
+
+def _wait_for_a_worker(client, scheduler):
+    from ..errors import UsageError
+
+    try:
+        client.wait_for_workers(1, timeout=WORKER_WAIT_S)
+    except TimeoutError:
+        raise UsageError(f"no Dask worker joined the scheduler {scheduler} within "
+                         f"{WORKER_WAIT_S} s; start workers with `dask worker {scheduler}`") \
+            from None
+
+
+class _given:
+    def __init__(self, client):
+        self.client = client
+
+    def __enter__(self):
+        return self.client
+
+    def __exit__(self, *exc):
+        return False
+
+
+def report_dir(out_dir):
+    """Rebuild ``report.html`` in ``out_dir`` from its results; returns the terminal summary."""
+    from ..errors import UsageError
+
+    out_dir = Path(out_dir)
+    rows = load_rows(out_dir)
+    if not rows:
+        raise UsageError(f"{out_dir} holds no campaign results (results.jsonl or "
+                         f"results.parquet); run a campaign with --out {out_dir} first")
+    meta = read_meta(out_dir)
+    axes = meta.get("axes") or sorted({k for r in rows for k in r if "." in k and
+                                       not k.startswith(("check_", "collisions_"))})
+    write_html(out_dir / "report.html", rows, axes, meta)
+    return format_report(rows, axes)

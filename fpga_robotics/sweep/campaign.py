@@ -1,0 +1,378 @@
+"""Campaign files: which runs a campaign makes, each as the ``run`` command that replays it.
+
+A campaign is a TOML file (docs/campaigns.md)::
+
+    name = "filter_tuning"                  # default: the file's stem
+    description = "..."
+    scenarios = ["divider", "lighting"]     # shipped names or .toml paths
+    seeds = "0-19"                          # "A-B" (inclusive) or a list of integers
+    backend = "model"                       # as run --backend (default auto)
+    resolution = "160x120"                  # optional, as run --resolution
+    duration = 10.0                         # optional, as run --duration
+    shadow = "published"                    # optional, as run --shadow
+    design = "verilog:top.v"                # optional, as run --design (with ports)
+    ports = "top_ports.toml"
+    set = ["robot.mass=12"]                 # optional fixed overrides, as run --set
+    timeout = 120.0                         # optional per-run limit (s)
+
+    [grid]                                  # every key run --set accepts, a list of values
+    "design.diff_min" = [4, 6, 8]
+    "lighting.ambient" = [0.25, 0.7]
+
+    [[sets]]                                # optional explicit override sets
+    "robot.mass" = 12
+
+The runs are, for every scenario and seed, the cartesian product of the grid plus each
+explicit set. A run *is* its ``python -m fpga_robotics.run`` argument list: the workers parse
+it with ``run``'s own parser, so the replay command of a row is the run itself.
+"""
+
+import hashlib
+import itertools
+import json
+import math
+import os
+import re
+import tomllib
+from dataclasses import dataclass, field, replace
+from importlib import resources
+from pathlib import Path
+
+from .. import __version__
+from ..errors import UsageError
+
+__all__ = ["Campaign", "CampaignError", "RunSpec", "load_campaign", "parse_seeds",
+           "shipped_campaigns", "toml_value"]
+
+#: Keys a campaign file may hold.
+KEYS = ("name", "description", "scenarios", "seeds", "backend", "resolution", "duration",
+        "shadow", "design", "ports", "set", "timeout", "grid", "sets")
+
+#: At most this many runs in one campaign (a typo in a seed range must not plan 10**12).
+MAX_RUNS = 1_000_000
+
+
+class CampaignError(UsageError):
+    """A malformed campaign file or option: one line saying what and how to fix it."""
+
+
+@dataclass(frozen=True)
+class RunSpec:
+    """One run of a campaign."""
+
+    scenario: str          # as the campaign names it (shipped name or path)
+    seed: int
+    overrides: tuple       # ((key, value), ...) from the grid or a set, in file order
+    backend: str
+    resolution: str | None = None
+    duration: float | None = None
+    shadow: str | None = None
+    design: str | None = None
+    ports: str | None = None
+    fixed: tuple = ()      # the campaign's fixed ``set`` items (KEY=VALUE text)
+
+    def set_items(self):
+        return [*self.fixed, *(f"{k}={toml_value(v)}" for k, v in self.overrides)]
+
+    def argv(self):
+        """The ``python -m fpga_robotics.run`` arguments of this run."""
+        out = ["--scenario", self.scenario, "--backend", self.backend, "--seed", str(self.seed)]
+        if self.resolution is not None:
+            out += ["--resolution", self.resolution]
+        if self.duration is not None:
+            out += ["--duration", repr(float(self.duration))]
+        for item in self.set_items():
+            out += ["--set", item]
+        if self.shadow is not None:
+            out += ["--shadow", self.shadow]
+        if self.design is not None:
+            out += ["--design", self.design]
+        if self.ports is not None:
+            out += ["--ports", self.ports]
+        return out
+
+    def replay(self):
+        import shlex
+
+        return shlex.join(["python", "-m", "fpga_robotics.run", *self.argv()])
+
+
+@dataclass
+class Campaign:
+    name: str
+    description: str
+    runs: list
+    axes: list                 # grid/set keys, the override columns of the results
+    timeout: float | None = None
+    source: str = ""
+    identities: dict = field(default_factory=dict)   # filled by plan.identify
+
+
+def toml_value(v):
+    """``v`` as a TOML value, so that ``--set key=<text>`` reads it back as ``v``."""
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, int):
+        return str(v)
+    if isinstance(v, float):
+        if math.isnan(v):
+            return "nan"
+        if math.isinf(v):
+            return "inf" if v > 0 else "-inf"
+        return repr(v)
+    if isinstance(v, str):
+        return _toml_string(v)
+    if isinstance(v, (list, tuple)):
+        return "[" + ", ".join(toml_value(x) for x in v) + "]"
+    if isinstance(v, dict):
+        return "{" + ", ".join(f"{_toml_string(str(k))} = {toml_value(x)}"
+                               for k, x in v.items()) + "}"
+    raise CampaignError(f"cannot write {v!r} as a --set value")
+
+
+def _toml_string(text):
+    """A TOML basic string: JSON's escapes (not of non-ASCII characters), DEL escaped too."""
+    return json.dumps(text, ensure_ascii=False).replace("\x7f", "\\u007f")
+
+
+def parse_seeds(value, where="seeds"):
+    """``"0-19"``, ``"7"``, an integer or a list of integers → a list of seeds."""
+    from ..scenario import MAX_SEED
+
+    if isinstance(value, bool):
+        raise CampaignError(f"{where} must be \"A-B\" or a list of integers, got {value!r}")
+    if isinstance(value, int):
+        seeds = [value]
+    elif isinstance(value, str):
+        text = value.strip()
+        lo, sep, hi = text.partition("-")
+        try:
+            a = int(lo)
+            b = int(hi) if sep else a
+        except ValueError:
+            raise CampaignError(f"{where} must be \"A-B\" (e.g. \"0-19\") or a list of "
+                                f"integers, got {value!r}") from None
+        if b < a:
+            raise CampaignError(f"{where} range {value!r} is empty: write the lower seed first "
+                                f"(e.g. \"{b}-{a}\")")
+        if b - a + 1 > MAX_RUNS:
+            raise CampaignError(f"{where} range {value!r} has {b - a + 1} seeds; at most "
+                                f"{MAX_RUNS}")
+        seeds = list(range(a, b + 1))
+    elif isinstance(value, list):
+        if not all(isinstance(s, int) and not isinstance(s, bool) for s in value):
+            raise CampaignError(f"{where} list must hold integers only, got {value!r}")
+        seeds = list(dict.fromkeys(value))
+    else:
+        raise CampaignError(f"{where} must be \"A-B\" or a list of integers, got {value!r}")
+    if not seeds:
+        raise CampaignError(f"{where} is empty: give at least one seed (e.g. \"0-4\")")
+    bad = [s for s in seeds if not 0 <= s <= MAX_SEED]
+    if bad:
+        raise CampaignError(f"{where}: seed {bad[0]} is out of range 0..{MAX_SEED}")
+    return seeds
+
+
+def _flatten(table, prefix, where):
+    """``{"design": {"diff_min": [4, 5]}}`` or ``{"design.diff_min": [4, 5]}`` → pairs."""
+    out = []
+    for key, value in table.items():
+        path = f"{prefix}{key}"
+        if isinstance(value, dict):
+            out += _flatten(value, f"{path}.", where)
+        elif isinstance(value, list):
+            if not value:
+                raise CampaignError(f"{where} {path!r} has no values: give a list of at "
+                                    f"least one value (e.g. {path} = [4, 6])")
+            out.append((path, value))
+        else:
+            raise CampaignError(f"{where} {path!r} must be a list of values, got {value!r} "
+                                f"(write {path} = [{toml_value(value)}])")
+    return out
+
+
+def _set_items(items, where):
+    if isinstance(items, str):
+        items = [items]
+    if not isinstance(items, list) or not all(isinstance(i, str) and "=" in i for i in items):
+        raise CampaignError(f"{where} must be a list of \"KEY=VALUE\" strings, got {items!r}")
+    return tuple(items)
+
+
+def _combos(data):
+    """The override sets: the grid's cartesian product, then the explicit sets."""
+    combos = []
+    axes = []
+    if "grid" in data:
+        grid = data["grid"]
+        if not isinstance(grid, dict) or not grid:
+            raise CampaignError("grid is empty: give at least one key with a list of values "
+                                "(e.g. [grid] \"design.diff_min\" = [4, 6, 8]), or leave it out")
+        pairs = _flatten(grid, "", "grid key")
+        axes = [k for k, _ in pairs]
+        combos = [tuple(zip(axes, values)) for values in
+                  itertools.product(*(v for _, v in pairs))]
+    if "sets" in data:
+        sets = data["sets"]
+        if not isinstance(sets, list) or not sets or not all(isinstance(s, dict) for s in sets):
+            raise CampaignError("sets must be a non-empty list of tables ([[sets]] with "
+                                "KEY = VALUE lines)")
+        for i, s in enumerate(sets):
+            if not s:
+                raise CampaignError(f"sets[{i}] is empty: give at least one KEY = VALUE")
+            items = tuple(_flatten_values(s, ""))
+            for k, _ in items:
+                if k not in axes:
+                    axes.append(k)
+            combos.append(items)
+    return combos or [()], axes
+
+
+def _flatten_values(table, prefix):
+    out = []
+    for key, value in table.items():
+        if isinstance(value, dict):
+            out += _flatten_values(value, f"{prefix}{key}.")
+        else:
+            out.append((f"{prefix}{key}", value))
+    return out
+
+
+def _typed(data, key, types, what):
+    value = data.get(key)
+    if value is None:
+        return None
+    if isinstance(value, bool) or not isinstance(value, types):
+        raise CampaignError(f"{key} must be {what}, got {value!r}")
+    return value
+
+
+def shipped_campaigns():
+    """Names → paths of the campaigns shipped with the package."""
+    folder = resources.files("fpga_robotics") / "campaigns"
+    return {e.name[:-5]: str(e) for e in sorted(folder.iterdir(), key=lambda e: e.name)
+            if e.name.endswith(".toml")}
+
+
+def _resolve(name_or_path):
+    text = str(name_or_path)
+    path = Path(text)
+    if path.is_file():
+        return path
+    shipped = shipped_campaigns()
+    if text in shipped:
+        return Path(shipped[text])
+    if path.is_dir():
+        raise CampaignError(f"campaign {text!r} is a folder; give a .toml file")
+    raise CampaignError(f"unknown campaign {text!r}: no such file, and the shipped campaigns "
+                        f"are {', '.join(shipped)}")
+
+
+def read_campaign_file(name_or_path):
+    """The campaign file's table (checked for unknown keys) and its path."""
+    path = _resolve(name_or_path)
+    try:
+        data = tomllib.loads(path.read_text())
+    except tomllib.TOMLDecodeError as exc:
+        raise CampaignError(f"{path}: malformed TOML: {exc}") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise CampaignError(f"cannot read campaign file {path}: {exc}") from None
+    unknown = [k for k in data if k not in KEYS]
+    if unknown:
+        import difflib
+
+        close = difflib.get_close_matches(unknown[0], KEYS, n=1)
+        hint = f" (did you mean {close[0]!r}?)" if close else ""
+        raise CampaignError(f"{path}: unknown key {unknown[0]!r}{hint}; a campaign holds "
+                            f"{', '.join(KEYS)}")
+    data.setdefault("name", path.stem)
+    _file_paths(data, path.parent)
+    return data, path
+
+
+def load_campaign(data, *, source=""):
+    """The ``Campaign`` of a checked table (``read_campaign_file`` plus command-line
+    options merged in). Scenarios and overrides are checked by ``plan.validate``."""
+    where = f"{source}: " if source else ""
+    try:
+        name = _typed(data, "name", str, "a string") or "campaign"
+        # The name makes the default results folder: a plain file name.
+        name = re.sub(r"[^A-Za-z0-9_.-]", "_", name).lstrip(".-")[:64] or "campaign"
+        scenarios = data.get("scenarios")
+        if isinstance(scenarios, str):
+            scenarios = [scenarios]
+        if not scenarios or not isinstance(scenarios, list) or not all(
+                isinstance(s, str) and s for s in scenarios):
+            raise CampaignError("scenarios must be a non-empty list of shipped scenario names "
+                                "or .toml paths")
+        seeds = parse_seeds(data.get("seeds", "0"))
+        backend = _typed(data, "backend", str, "a backend name") or "auto"
+        resolution = _typed(data, "resolution", str, "\"WxH\"")
+        duration = _typed(data, "duration", (int, float), "a number of seconds")
+        if duration is not None and not 0 < duration < math.inf:
+            raise CampaignError(f"duration must be > 0 seconds, got {duration}")
+        timeout = _typed(data, "timeout", (int, float), "a number of seconds")
+        if timeout is not None and not 0 < timeout < math.inf:
+            raise CampaignError(f"timeout must be > 0 seconds, got {timeout}")
+        fixed = _set_items(data.get("set", []), "set")
+        combos, axes = _combos(data)
+        base = RunSpec(scenario="", seed=0, overrides=(), backend=backend,
+                       resolution=resolution, duration=duration,
+                       shadow=_typed(data, "shadow", str, "a shadow spec (e.g. \"published\")"),
+                       design=_typed(data, "design", str, "\"verilog:FILE.v\""),
+                       ports=_typed(data, "ports", str, "a port map path"), fixed=fixed)
+        count = len(scenarios) * len(seeds) * len(combos)
+        if count > MAX_RUNS:
+            raise CampaignError(f"the campaign has {count} runs; at most {MAX_RUNS}")
+        runs = [replace(base, scenario=sc, seed=seed, overrides=combo)
+                for sc in scenarios for combo in combos for seed in seeds]
+    except CampaignError as exc:
+        raise CampaignError(f"{where}{exc}") from None
+    return Campaign(name=name, description=data.get("description", ""), runs=runs, axes=axes,
+                    timeout=timeout, source=source)
+
+
+def run_identity(spec, scenario_source, extra_files=()):
+    """The hash that names a run: scenario content, overrides, seed, backend, resolution,
+    duration, design files and the package version (the same run in another folder or
+    campaign has the same identity)."""
+    h = hashlib.sha256()
+    argv = spec.argv()
+    argv[1] = "<scenario>"  # the content counts, not the path
+    blob = {"argv": argv, "version": __version__}
+    h.update(json.dumps(blob, sort_keys=True).encode())
+    for path in (scenario_source, *extra_files):
+        try:
+            h.update(Path(path).read_bytes())
+        except OSError:
+            h.update(str(path).encode())
+    return h.hexdigest()[:16]
+
+
+def _near(value, base):
+    """A path given in a campaign file, relative to the file's folder, as a path from here
+    (so that replay commands work where the campaign was started)."""
+    if not isinstance(value, str) or "/" not in value and not value.endswith((".toml", ".v",
+                                                                               ".sv")):
+        return value
+    path = Path(value)
+    if not path.is_absolute():
+        candidate = base / path
+        if candidate.exists() or not path.exists():
+            path = candidate
+    try:
+        return os.path.relpath(path)
+    except ValueError:
+        return str(path)
+
+
+def _file_paths(data, base):
+    if isinstance(data.get("scenarios"), list):
+        data["scenarios"] = [_near(s, base) for s in data["scenarios"]]
+    elif isinstance(data.get("scenarios"), str):
+        data["scenarios"] = [_near(data["scenarios"], base)]
+    if isinstance(data.get("ports"), str):
+        data["ports"] = _near(data["ports"], base)
+    if isinstance(data.get("design"), str) and data["design"].startswith("verilog:"):
+        files = data["design"][len("verilog:"):].split(",")
+        data["design"] = "verilog:" + ",".join(_near(f, base) for f in files if f)

@@ -1,0 +1,265 @@
+"""Running a planned campaign on Dask: an embedded ``LocalCluster`` of worker processes (one
+thread each) or an existing scheduler; builds first, then the runs, results as they arrive.
+
+A run's outcome comes back as a row; a run whose worker died (a crash, or the watchdog that
+ends a worker stuck inside one frame) comes back as Dask's ``KilledWorker`` and is recorded as
+``timeout`` (when it was out for longer than its timeout) or ``error``. Ctrl-C cancels what is
+queued, closes the client and stops an embedded cluster's workers; the rows so far are kept.
+"""
+
+import contextlib
+import logging
+import os
+import signal
+import statistics
+import sys
+import time
+from pathlib import Path
+
+from ..errors import UsageError
+from ..sim.files import write_atomic
+from . import runner
+from .results import make_row
+
+__all__ = ["DEFAULT_TIMEOUT_FACTOR", "MIN_TIMEOUT_S", "RECORD_LOG_EVERY", "build_all", "open_client", "run_plan"]
+
+#: A campaign's recordings log the images of every this many frames (a run's recording at
+#: 160x120 is about 45 MB with every frame; the replay command records every frame).
+RECORD_LOG_EVERY = 10
+#: A run's default timeout is this many times its expected time ...
+DEFAULT_TIMEOUT_FACTOR = 10.0
+#: ... and never less than this (a loaded machine, a first model load).
+MIN_TIMEOUT_S = 30.0
+#: Expected seconds per frame and pixel before any run has finished (generous guesses).
+_GUESS_S_PER_PIXEL_FRAME = {"pysim": 2e-5}
+_GUESS_DEFAULT = 2e-7
+_GUESS_PER_FRAME_S = 2e-3
+
+
+@contextlib.contextmanager
+def open_client(scheduler=None, workers=None):
+    """A ``distributed.Client``: to ``scheduler`` (an address), or to a new ``LocalCluster``
+    of ``workers`` processes (default: the machine's cores), each with one thread. The
+    embedded cluster's scheduler gives up on a run whose worker dies at once (no retry)."""
+    import dask
+    from distributed import Client, LocalCluster
+
+    if scheduler is not None:
+        try:
+            client = Client(scheduler, timeout="10s")
+        except (OSError, TimeoutError, ValueError) as exc:
+            raise UsageError(f"cannot reach the Dask scheduler at {scheduler!r} ({exc}); start "
+                             f"one with `dask scheduler` and give its tcp://HOST:PORT") from None
+        try:
+            yield client
+        finally:
+            client.close()
+        return
+    n = workers or os.cpu_count() or 1
+    # Ctrl-C in a terminal reaches the whole process group: the workers ignore it (started
+    # with SIGINT ignored, and told again when a nanny restarts one) and this process stops
+    # them in order.
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        cluster_cm = _local_cluster(dask, LocalCluster, n)
+        cluster = cluster_cm.__enter__()
+    finally:
+        signal.signal(signal.SIGINT, previous)
+    try:
+        client = Client(cluster)
+        try:
+            client.register_plugin(_ignore_interrupts_plugin(), name="fpga-robotics-ignore-sigint")
+            yield client
+        finally:
+            client.close()
+    finally:
+        cluster_cm.__exit__(None, None, None)
+
+
+@contextlib.contextmanager
+def _local_cluster(dask, LocalCluster, n):
+    with dask.config.set({"distributed.scheduler.allowed-failures": 0,
+                          "distributed.scheduler.worker-saturation": 1.0,
+                          "distributed.worker.daemon": False,
+                          "distributed.admin.system-monitor.gil.enabled": False}):
+        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
+                               dashboard_address=":0", silence_logs=logging.CRITICAL)
+    try:
+        yield cluster
+    finally:
+        cluster.close()
+
+
+def _ignore_interrupts_plugin():
+    from distributed import WorkerPlugin
+
+    class IgnoreInterrupts(WorkerPlugin):
+        """Worker plugin of the embedded cluster: the worker process ignores SIGINT (its
+        campaign's process ends it)."""
+
+        def setup(self, worker):
+            import threading
+
+            if threading.current_thread() is threading.main_thread():
+                signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+    return IgnoreInterrupts()
+
+
+class _Timeouts:
+    """Per-run timeouts: fixed, or 10x the expected time from the runs finished so far."""
+
+    def __init__(self, fixed):
+        self.fixed = fixed
+        self.samples = {}
+
+    def learn(self, backend, frames, pixels, run_s):
+        if frames > 0 and run_s > 0:
+            self.samples.setdefault(backend, []).append(run_s / frames)
+
+    def __call__(self, spec, frames, pixels):
+        if self.fixed is not None:
+            return self.fixed
+        samples = self.samples.get(spec.backend)
+        if samples:
+            per_frame = statistics.median(samples[-50:])
+        else:
+            per_frame = (_GUESS_PER_FRAME_S
+                         + pixels * _GUESS_S_PER_PIXEL_FRAME.get(spec.backend, _GUESS_DEFAULT))
+        return max(MIN_TIMEOUT_S, DEFAULT_TIMEOUT_FACTOR * frames * per_frame)
+
+
+def _progress(total, quiet):
+    from tqdm import tqdm
+
+    disable = quiet or bool(os.environ.get("CI")) or not sys.stderr.isatty()
+    return tqdm(total=total, unit="run", disable=disable, file=sys.stderr, smoothing=0.1,
+                dynamic_ncols=True)
+
+
+def build_all(client, plan):
+    """Build (or load from the build cache) every design the plan needs, one task per
+    parameter set; returns the seconds each took. A design that cannot be built is the
+    user's to fix (``UsageError``)."""
+    from distributed import wait
+
+    futures = {client.submit(runner.build_designs, argv, pure=False): argv
+               for argv in plan.builds.values()}
+    wait(list(futures))
+    times = []
+    for fut, argv in futures.items():
+        try:
+            times.append(fut.result())
+        except UsageError as exc:
+            raise UsageError(f"building the design of `{' '.join(argv)}`: {exc}") from None
+    return times
+
+
+def run_plan(client, plan, store, *, record="failing", timeout=None, quiet=False,
+             on_row=None, log_every=RECORD_LOG_EVERY):
+    """Run every planned run not already in ``store``; returns the number run.
+    Recordings log every ``log_every``-th frame's images (every frame's numbers)."""
+    from distributed import as_completed
+
+    todo, seen = [], store.done_ids()
+    for spec in plan.runs:
+        rid = plan.ids[spec]
+        if rid not in seen:
+            seen.add(rid)
+            todo.append(spec)
+    if not todo:
+        return 0
+    timeouts = _Timeouts(timeout)
+    window = max(2, 2 * sum(client.nthreads().values()) or 2)
+    pending = list(reversed(todo))
+    running = {}   # future -> (spec, submitted at, timeout, recording pass)
+    done_rows = {}
+    failures = 0
+    bar = _progress(len(todo), quiet)
+    completed = as_completed()
+
+    def submit(spec, recording=False):
+        frames, pixels = plan.frames[spec]
+        limit = timeouts(spec, frames, pixels)
+        key = f"run-{plan.ids[spec]}-{time.monotonic_ns()}"
+        rec = log_every if (recording or record == "all") else False
+        fut = client.submit(runner.execute, spec.argv(), limit, rec, key, pure=False, key=key)
+        running[fut] = (spec, time.monotonic(), limit, recording)
+        completed.add(fut)
+
+    def top_up():
+        while pending and len(running) < window:
+            submit(pending.pop())
+
+    try:
+        top_up()
+        for fut in completed:
+            spec, _submitted, limit, recording = running.pop(fut)
+            outcome = _outcome(client, fut, limit)
+            if recording:  # the recording pass of a failing run: attach its .rrd
+                row = done_rows.pop(plan.ids[spec], None)
+                if row is not None and outcome.get("recording"):
+                    row["recording"] = _save_recording(store.dir, plan.ids[spec],
+                                                       outcome["recording"])
+                    store.add(row)
+                top_up()
+                continue
+            row = make_row(spec, plan.ids[spec], plan.names[spec], outcome)
+            if outcome.get("recording"):
+                row["recording"] = _save_recording(store.dir, row["run_id"],
+                                                   outcome["recording"])
+            store.add(row)
+            if on_row is not None:
+                on_row(row)
+            frames, pixels = plan.frames[spec]
+            if outcome["status"] in ("pass", "fail"):
+                timeouts.learn(spec.backend, frames, pixels, outcome.get("run_s", 0.0))
+            if outcome["status"] != "pass":
+                failures += 1
+            if outcome["status"] == "fail" and record == "failing":
+                done_rows[row["run_id"]] = row
+                submit(spec, recording=True)
+            bar.update(1)
+            bar.set_postfix_str(f"{failures} not passed", refresh=False)
+            top_up()
+    finally:
+        if running:
+            client.cancel(list(running))
+        bar.close()
+        store.flush()
+    return len(todo)
+
+
+def _timed_out(client, key):
+    """Whether a worker said it ended itself because run ``key`` was stuck."""
+    end = time.monotonic() + 3.0  # the event may arrive just after the worker's death
+    while True:
+        events = client.get_events(runner.TIMEOUT_TOPIC)
+        if any(msg.get("tag") == key for _t, msg in events):
+            return True
+        if time.monotonic() > end:
+            return False
+        time.sleep(0.1)
+
+
+def _outcome(client, fut, limit):
+    from distributed import KilledWorker
+
+    try:
+        return fut.result()
+    except KilledWorker:
+        if _timed_out(client, fut.key):
+            return {"status": "timeout",
+                    "message": f"no result within the per-run timeout of {limit:.3g} s: the "
+                               f"run stopped making progress and its worker was ended"}
+        return {"status": "error", "message": "the worker running it died (a crash or a kill)"}
+    except Exception as exc:  # noqa: BLE001 (a lost connection, a cancelled task: recorded)
+        return {"status": "error", "message": f"{type(exc).__name__}: {exc}".splitlines()[0]}
+
+
+def _save_recording(out_dir, run_id, data):
+    path = Path(out_dir) / "recordings" / f"{run_id}.rrd"
+    path.parent.mkdir(parents=True, exist_ok=True)
+    write_atomic(path, data, what="recording")
+    return str(path.relative_to(out_dir))
+

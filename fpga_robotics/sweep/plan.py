@@ -1,0 +1,67 @@
+"""Before a campaign runs: every run checked as ``run`` would check it, named by its identity,
+and grouped by the design it needs (each parameter set is built once)."""
+
+from dataclasses import dataclass, field, replace
+
+from ..errors import UsageError
+from .campaign import run_identity
+from .runner import _design_key, load_run
+
+__all__ = ["Plan", "make_plan"]
+
+
+@dataclass
+class Plan:
+    runs: list                                       # RunSpec, in campaign order
+    ids: dict = field(default_factory=dict)          # RunSpec -> identity
+    names: dict = field(default_factory=dict)        # RunSpec -> scenario name
+    frames: dict = field(default_factory=dict)       # RunSpec -> (frames, pixels)
+    builds: dict = field(default_factory=dict)       # design key -> argv of one run
+
+
+def _concrete_backend(spec):
+    if spec.backend != "auto":
+        return spec
+    if spec.design is not None:
+        return replace(spec, backend="verilator")
+    from ..sim.backends import fastest_backend_name
+
+    return replace(spec, backend=fastest_backend_name())
+
+
+def make_plan(campaign):
+    """Check every run (``UsageError`` naming the run's scenario and overrides) and name it.
+    Runs differing only by seed share one check."""
+    from ..sim.backends import BACKEND_NAMES
+
+    plan = Plan(runs=[])
+    checked = {}
+    for spec in campaign.runs:
+        if spec.backend not in ("auto", *BACKEND_NAMES):
+            raise UsageError(f"backend must be one of auto, {', '.join(BACKEND_NAMES)}; got "
+                             f"{spec.backend!r}")
+        spec = _concrete_backend(spec)
+        shape = replace(spec, seed=0)
+        if shape not in checked:
+            try:
+                args, scenario, shadow_params = load_run(spec.argv())
+            except UsageError as exc:
+                what = " ".join(spec.set_items())
+                raise UsageError(f"run of {spec.scenario}{' with ' + what if what else ''}: "
+                                 f"{exc}") from None
+            files = []
+            if scenario.foreign is not None:
+                files = [*scenario.foreign.verilog, scenario.foreign.ports]
+            if args.design is not None:
+                files = [*args.design[len("verilog:"):].split(","), args.ports]
+            key = (_design_key(args, scenario), repr(shadow_params))
+            frames = round(scenario.sim.duration * scenario.camera.fps)
+            checked[shape] = (scenario, files, key, frames,
+                              scenario.camera.width * scenario.camera.height)
+            plan.builds.setdefault(key, spec.argv())
+        scenario, files, _key, frames, pixels = checked[shape]
+        plan.runs.append(spec)
+        plan.ids[spec] = run_identity(spec, scenario.source, files)
+        plan.names[spec] = scenario.name
+        plan.frames[spec] = (frames, pixels)
+    return plan

@@ -1,0 +1,222 @@
+"""What a campaign found: a terminal summary and ``report.html`` (one self-contained file,
+matplotlib figures embedded as PNG), both from the results rows alone."""
+
+import base64
+import html
+import io
+from collections import defaultdict
+from pathlib import Path
+
+from ..sim.files import write_atomic
+
+__all__ = ["format_report", "write_html"]
+
+#: Metric distributions shown: column, label.
+METRICS = (("min_distance_m", "closest distance to the target (m)"),
+           ("found_fraction", "fraction of frames with the target found"),
+           ("collisions_total", "collisions (person + wall + furniture)"))
+#: Replay commands listed per failed check in the terminal summary.
+SHOWN_PER_CHECK = 3
+
+
+def _rate(rows):
+    n = len(rows)
+    return sum(r["status"] == "pass" for r in rows) / n if n else 0.0
+
+
+def _value_key(v):
+    """Numbers in order, then text, then runs without the key (an explicit set's rows on
+    another set's axis)."""
+    if v is None:
+        return (2, 0, "")
+    if isinstance(v, (int, float)) and not isinstance(v, bool):
+        return (0, v, "")
+    return (1, 0, str(v))
+
+
+def _shown(v):
+    return "(not set)" if v is None else str(v)
+
+
+def _by(rows, column):
+    groups = defaultdict(list)
+    for r in rows:
+        groups[r.get(column)].append(r)
+    return dict(sorted(groups.items(), key=lambda kv: _value_key(kv[0])))
+
+
+def failures_by_check(rows):
+    """Failed check (or ``error``/``timeout``) → the rows, most frequent first."""
+    groups = defaultdict(list)
+    for r in rows:
+        if r["status"] == "fail":
+            for name in filter(None, (r.get("failed_checks") or "").split(";")):
+                groups[name].append(r)
+        elif r["status"] in ("error", "timeout"):
+            groups[r["status"]].append(r)
+    return dict(sorted(groups.items(), key=lambda kv: -len(kv[1])))
+
+
+def format_report(rows, axes):
+    """The terminal summary (several lines)."""
+    counts = {s: sum(r["status"] == s for r in rows) for s in ("pass", "fail", "error",
+                                                               "timeout")}
+    lines = [f"{len(rows)} runs: " + ", ".join(f"{n} {s}" for s, n in counts.items())
+             + f" (pass rate {_rate(rows):.0%})"]
+    lines.append("pass rate per scenario:")
+    for name, group in _by(rows, "scenario").items():
+        lines.append(f"  {name:<20} {_rate(group):6.0%}  ({len(group)} runs)")
+    for axis in axes:
+        lines.append(f"pass rate per {axis}:")
+        for value, group in _by(rows, axis).items():
+            lines.append(f"  {_shown(value):<20} {_rate(group):6.0%}  ({len(group)} runs)")
+    groups = failures_by_check(rows)
+    if groups:
+        lines.append("failures by check (replay one with its command):")
+        for name, group in groups.items():
+            lines.append(f"  {name}: {len(group)} run(s)")
+            for r in group[:SHOWN_PER_CHECK]:
+                lines.append(f"    {r['replay']}")
+                if r["status"] in ("error", "timeout") and r.get("message"):
+                    lines.append(f"      {r['message']}")
+            if len(group) > SHOWN_PER_CHECK:
+                lines.append(f"    ... and {len(group) - SHOWN_PER_CHECK} more "
+                             f"(report.html, results.csv)")
+    return "\n".join(lines)
+
+
+def _png(fig):
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=90, bbox_inches="tight")
+    import matplotlib.pyplot as plt
+
+    plt.close(fig)
+    return "data:image/png;base64," + base64.b64encode(buf.getvalue()).decode()
+
+
+def _bar_figure(groups, title, xlabel):
+    import matplotlib.pyplot as plt
+
+    labels = [_shown(k) for k in groups]
+    fig, ax = plt.subplots(figsize=(max(4, 0.6 * len(labels) + 2), 3))
+    ax.bar(labels, [100 * _rate(g) for g in groups.values()], color="#4a7")
+    ax.set_ylim(0, 100)
+    ax.set_ylabel("pass rate (%)")
+    ax.set_xlabel(xlabel)
+    ax.set_title(title)
+    if len(labels) > 4:
+        ax.tick_params(axis="x", rotation=45)
+    return _png(fig)
+
+
+def _heatmap(rows, x_axis, y_axis, label):
+    import matplotlib.pyplot as plt
+    import numpy as np
+
+    xs = [x for x in _by(rows, x_axis) if x is not None]
+    ys = [y for y in _by(rows, y_axis) if y is not None]
+    grid = np.full((len(ys), len(xs)), np.nan)
+    for j, y in enumerate(ys):
+        for i, x in enumerate(xs):
+            group = [r for r in rows if r.get(x_axis) == x and r.get(y_axis) == y]
+            if group:
+                grid[j, i] = 100 * _rate(group)
+    fig, ax = plt.subplots(figsize=(1 + 0.8 * len(xs) + 1.5, 1 + 0.5 * len(ys)))
+    im = ax.imshow(grid, origin="lower", cmap="RdYlGn", vmin=0, vmax=100, aspect="auto")
+    ax.set_xticks(range(len(xs)), [str(x) for x in xs])
+    ax.set_yticks(range(len(ys)), [str(y) for y in ys])
+    ax.set_xlabel(x_axis)
+    ax.set_ylabel(y_axis)
+    for j in range(len(ys)):
+        for i in range(len(xs)):
+            if not np.isnan(grid[j, i]):
+                v = grid[j, i]  # white on the dark ends of the colour map
+                ax.text(i, j, f"{v:.0f}", ha="center", va="center", fontsize=9,
+                        color="white" if v < 25 or v > 75 else "black")
+    fig.colorbar(im, ax=ax, label="pass rate (%)")
+    ax.set_title(f"{label}: pass rate (%)")
+    return _png(fig)
+
+
+def _histogram(rows, column, label):
+    import matplotlib.pyplot as plt
+    import numpy as np
+
+    fig, ax = plt.subplots(figsize=(4.5, 3))
+    every = [r[column] for r in rows if isinstance(r.get(column), (int, float))]
+    bins = np.histogram_bin_edges(every, bins=20)  # the same bins for passes and failures
+    for status, color in (("pass", "#4a7"), ("fail", "#c44")):
+        values = [r[column] for r in rows if r["status"] == status
+                  and isinstance(r.get(column), (int, float))]
+        if values:
+            ax.hist(values, bins=bins, alpha=0.6, color=color, label=f"{status} ({len(values)})")
+    ax.set_xlabel(label)
+    ax.set_ylabel("runs")
+    ax.legend()
+    return _png(fig)
+
+
+def _with_totals(rows):
+    out = []
+    for r in rows:
+        r = dict(r)
+        kinds = [k for k in r if k.startswith("collisions_") and k != "collisions_total"]
+        if kinds:
+            r["collisions_total"] = sum(r[k] or 0 for k in kinds)
+        out.append(r)
+    return out
+
+
+def write_html(path, rows, axes, meta):
+    """``report.html``: pass rates, the heatmap of the first two grid axes, metric
+    distributions and the failing runs grouped by check, each with its replay command."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    rows = _with_totals(rows)
+    esc = html.escape
+    title = f"Campaign {meta.get('name', '')}"
+    parts = [f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>{esc(title)}</title>",
+             ("<style>body{font-family:sans-serif;margin:2em;max-width:70em}"
+              "code{background:#eee;padding:0 .2em;word-break:break-all}"
+              "td,th{padding:.2em .6em;text-align:left}img{margin:.5em}</style></head><body>"),
+             f"<h1>{esc(title)}</h1>"]
+    if meta.get("description"):
+        parts.append(f"<p>{esc(meta['description'])}</p>")
+    summary = format_report(rows, axes).splitlines()[0]
+    parts.append(f"<p><b>{esc(summary)}</b></p>")
+    facts = [(k, meta[k]) for k in ("backend", "workers", "scheduler", "wall_s", "build_s",
+                                     "version") if meta.get(k) is not None]
+    if facts:
+        parts.append("<table>" + "".join(f"<tr><th>{esc(k)}</th><td>{esc(str(v))}</td></tr>"
+                                         for k, v in facts) + "</table>")
+    if rows:
+        parts.append("<h2>Pass rate</h2>")
+        parts.append(f"<img src='{_bar_figure(_by(rows, 'scenario'), 'per scenario', 'scenario')}'>")
+        for axis in axes:
+            parts.append(f"<img src='{_bar_figure(_by(rows, axis), f'per {axis}', axis)}'>")
+        if len(axes) >= 2:  # one map per scenario: each has its own conditions
+            parts.append(f"<h2>{esc(axes[0])} x {esc(axes[1])}</h2>")
+            for name, group in _by(rows, "scenario").items():
+                parts.append(f"<img src='{_heatmap(group, axes[0], axes[1], name)}'>")
+        parts.append("<h2>Metric distributions</h2>")
+        for column, label in METRICS:
+            if any(isinstance(r.get(column), (int, float)) for r in rows):
+                parts.append(f"<img src='{_histogram(rows, column, label)}'>")
+    groups = failures_by_check(rows)
+    parts.append("<h2>Failing runs by check</h2>")
+    if not groups:
+        parts.append("<p>None: every run passed.</p>")
+    for name, group in groups.items():
+        parts.append(f"<h3>{esc(name)} ({len(group)} run(s))</h3><table>")
+        parts.append("<tr><th>scenario</th><th>seed</th><th>what</th><th>replay</th>"
+                     "<th>recording</th></tr>")
+        for r in group:
+            rec = r.get("recording") or ""
+            link = f"<a href='{esc(rec)}'>{esc(Path(rec).name)}</a>" if rec else ""
+            parts.append(f"<tr><td>{esc(str(r['scenario']))}</td><td>{r['seed']}</td>"
+                         f"<td>{esc(r.get('message') or '')}</td>"
+                         f"<td><code>{esc(r['replay'])}</code></td><td>{link}</td></tr>")
+        parts.append("</table>")
+    parts.append("</body></html>")
+    write_atomic(path, "\n".join(parts), what="report")

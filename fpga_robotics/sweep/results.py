@@ -1,0 +1,226 @@
+"""The results of a campaign: one row per run, written as the runs arrive.
+
+Every row is appended to ``results.jsonl`` at once (one line, flushed: an interrupted campaign
+keeps every finished run; a torn last line is ignored on reading). ``results.parquet`` and
+``results.csv`` are rewritten from all rows every few seconds and at the end, each atomically
+(a reader sees the previous complete table or the new one, never half of one).
+``campaign.json`` says what the campaign was (name, grid axes, build times).
+"""
+
+import csv
+import io
+import json
+import time
+from pathlib import Path
+
+from ..sim.files import atomic_path, write_atomic, write_json_atomic
+
+__all__ = ["STATUSES", "ResultStore", "load_rows", "make_row", "read_meta"]
+
+STATUSES = ("pass", "fail", "error", "timeout")
+#: Statuses of finished runs that ``--resume`` does not run again (an error or a timeout may
+#: have been the machine's: those are run again).
+DONE = ("pass", "fail")
+
+JOURNAL = "results.jsonl"
+PARQUET = "results.parquet"
+CSV = "results.csv"
+META = "campaign.json"
+
+#: Columns every row has, first in the tables.
+LEAD = ("run_id", "scenario", "seed", "status", "message", "failed_checks", "wall_s", "cpu_s",
+        "run_s", "replay", "recording")
+
+
+def _cell(value):
+    """A table cell: scalars as they are, lists and tables as JSON text."""
+    if value is None or isinstance(value, (bool, int, float, str)):
+        return value
+    return json.dumps(value, sort_keys=True)
+
+
+def make_row(spec, run_id, scenario_name, outcome):
+    """The results row of a run: identity, overrides (one column each), status, times, the
+    replay command, and every summary field (collisions and checks one column each)."""
+    row = {
+        "run_id": run_id,
+        "scenario": scenario_name,
+        "seed": spec.seed,
+        "status": outcome["status"],
+        "message": outcome.get("message", ""),
+        "failed_checks": "",
+        "wall_s": round(outcome.get("wall_s", 0.0), 4),
+        "cpu_s": round(outcome.get("cpu_s", 0.0), 4),
+        "run_s": round(outcome.get("run_s", 0.0), 4),
+        "replay": spec.replay(),
+        "recording": "",
+        "scenario_arg": spec.scenario,
+    }
+    for key, value in spec.overrides:
+        row[key] = _cell(value)
+    summary = outcome.get("summary")
+    if summary:
+        for key, value in summary.items():
+            if key in ("scenario", "seed"):
+                continue
+            if key == "collisions":
+                for kind, n in value.items():
+                    row[f"collisions_{kind}"] = n
+            elif key == "checks":
+                for check in value:
+                    row[f"check_{check['name']}"] = check["passed"]
+                failed = [c for c in value if not c["passed"]]
+                row["failed_checks"] = ";".join(c["name"] for c in failed)
+                if failed and not row["message"]:
+                    row["message"] = "; ".join(f"{c['name']}: {c['text']}" for c in failed)
+                row["checks_json"] = json.dumps(value)
+            elif key == "overrides":
+                row["overrides"] = " ".join(value)
+            else:
+                row[key] = _cell(value)
+    return row
+
+
+def _column_type(values):
+    import pyarrow as pa
+
+    present = [v for v in values if v is not None]
+    if present and all(isinstance(v, bool) for v in present):
+        return pa.bool_()
+    if present and all(isinstance(v, int) and not isinstance(v, bool) for v in present):
+        return pa.int64()
+    if present and all(isinstance(v, (int, float)) and not isinstance(v, bool)
+                       for v in present):
+        return pa.float64()
+    return pa.string()
+
+
+def _columns(rows):
+    names = list(LEAD)
+    for row in rows:
+        for key in row:
+            if key not in names:
+                names.append(key)
+    return names
+
+
+def _table(rows):
+    import pyarrow as pa
+
+    names = _columns(rows)
+    arrays = {}
+    for name in names:
+        values = [row.get(name) for row in rows]
+        kind = _column_type(values)
+        if kind == pa.string():
+            values = [None if v is None else (v if isinstance(v, str) else json.dumps(v))
+                      for v in values]
+        elif kind == pa.float64():
+            values = [None if v is None else float(v) for v in values]
+        arrays[name] = pa.array(values, type=kind)
+    return pa.table(arrays)
+
+
+class ResultStore:
+    """The results folder of a campaign. ``resume``: keep the rows already there."""
+
+    FLUSH_EVERY_S = 2.0
+
+    def __init__(self, out_dir, *, resume=False):
+        self.dir = Path(out_dir)
+        self.dir.mkdir(parents=True, exist_ok=True)
+        rows = load_rows(self.dir) if resume else []
+        # Runs to do again (errors, timeouts) are dropped from the journal too.
+        self._rows = {r["run_id"]: r for r in rows if r.get("status") in DONE}
+        self._rewrite_journal()
+        self._journal = open(self.dir / JOURNAL, "a")  # noqa: SIM115 (open for the campaign)
+        self._last_flush = time.monotonic()
+        self._dirty = True
+
+    def _rewrite_journal(self):
+        text = "".join(json.dumps(r) + "\n" for r in self.rows)
+        write_atomic(self.dir / JOURNAL, text, what="results journal")
+
+    @property
+    def rows(self):
+        return list(self._rows.values())
+
+    def done_ids(self):
+        return set(self._rows)
+
+    def add(self, row):
+        """Record a finished run (again: a later row of the same run replaces it)."""
+        self._rows[row["run_id"]] = row
+        self._journal.write(json.dumps(row) + "\n")
+        self._journal.flush()
+        self._dirty = True
+        if time.monotonic() - self._last_flush >= self.FLUSH_EVERY_S:
+            self.flush()
+
+    def flush(self):
+        """Rewrite the Parquet and CSV tables from every row, each atomically."""
+        if not self._dirty:
+            return
+        write_tables(self.dir, self.rows)
+        self._dirty = False
+        self._last_flush = time.monotonic()
+
+    def close(self):
+        self.flush()
+        self._journal.close()
+
+
+def write_tables(out_dir, rows):
+    import pyarrow.parquet as pq
+
+    out_dir = Path(out_dir)
+    table = _table(rows)
+    with atomic_path(out_dir / PARQUET, what="results table") as tmp:
+        pq.write_table(table, tmp)
+    names = table.column_names
+    buf = io.StringIO()
+    writer = csv.DictWriter(buf, fieldnames=names, extrasaction="ignore")
+    writer.writeheader()
+    for row in rows:
+        writer.writerow({k: _csv_cell(row.get(k)) for k in names})
+    write_atomic(out_dir / CSV, buf.getvalue(), what="results table")
+
+
+def _csv_cell(v):
+    if v is None:
+        return ""
+    return v if isinstance(v, str) else json.dumps(v)
+
+
+def load_rows(out_dir):
+    """The rows in ``out_dir``: the journal (every finished run), else the Parquet table."""
+    out_dir = Path(out_dir)
+    journal = out_dir / JOURNAL
+    rows = []
+    if journal.is_file():
+        for line in journal.read_text().splitlines():
+            try:
+                row = json.loads(line)
+            except ValueError:  # a line torn by a crash: that run is not finished
+                continue
+            if isinstance(row, dict) and "run_id" in row:
+                rows.append(row)
+        # A run finished twice (a resumed error run): the last row counts.
+        return list({r["run_id"]: r for r in rows}.values())
+    parquet = out_dir / PARQUET
+    if parquet.is_file():
+        import pyarrow.parquet as pq
+
+        return pq.read_table(parquet).to_pylist()
+    return []
+
+
+def write_meta(out_dir, meta):
+    write_json_atomic(Path(out_dir) / META, meta, what="campaign description")
+
+
+def read_meta(out_dir):
+    try:
+        return json.loads((Path(out_dir) / META).read_text())
+    except (OSError, ValueError):
+        return {}

@@ -1,0 +1,235 @@
+"""One run of a campaign, from its ``run`` argument list to its result row.
+
+The argument list is parsed by ``fpga_robotics.run``'s own parser and turned into a scenario,
+a design and a shadow by ``run``'s own helpers, then ``loop.run_scenario`` runs it: a row's
+replay command (``python -m fpga_robotics.run`` + the same arguments) is the same run.
+
+These functions are the Dask tasks (importable, never defined in ``__main__``). A worker
+process keeps the designs it opened (a compiled model is loaded once, reset before each run).
+
+Test hook (not a user option): ``FPGA_ROBOTICS_SWEEP_FAULT="raise@SEED,exit@SEED,hang@SEED"``
+in a worker's environment makes the run of that seed raise, end its worker process, or stop
+making progress, at its first frame; the test suite uses it to check that a campaign records
+such runs and goes on.
+"""
+
+import os
+import threading
+import time
+
+__all__ = ["TIMEOUT_TOPIC", "RunTimeout", "build_designs", "execute", "load_run"]
+
+#: The Dask event topic under which a worker says it ends itself for a stuck run (the client
+#: then records that run as ``timeout``, not as a crash).
+TIMEOUT_TOPIC = "fpga-robotics-sweep-timeouts"
+
+#: Designs a worker keeps open (a campaign has few parameter sets per worker at a time).
+_KEEP = 4
+_designs = {}
+
+#: How much longer than the per-run timeout (at most, and at most the timeout again) a run
+#: stuck inside one frame may take before its worker process is ended (a run stuck in
+#: compiled code cannot be interrupted otherwise).
+HARD_GRACE_S = 10.0
+
+
+class RunTimeout(Exception):
+    """The run took longer than its timeout."""
+
+
+def _loaded(argv):
+    """``load_run`` of the runs of a worker, remembered by their arguments other than the
+    seed (the scenario does not depend on it): a campaign's runs differ mostly by seed."""
+    import argparse
+
+    argv = list(argv)
+    i = argv.index("--seed") if "--seed" in argv else None
+    seed = argv[i + 1] if i is not None else None
+    shape = tuple(argv[:i] + argv[i + 2:]) if i is not None else tuple(argv)
+    if shape not in _loads:
+        if len(_loads) >= 64:
+            _loads.clear()
+        _loads[shape] = load_run(list(shape))
+    args, scenario, shadow_params = _loads[shape]
+    args = argparse.Namespace(**vars(args))
+    if seed is not None:
+        args.seed = int(seed)
+        from ..errors import UsageError
+        from ..scenario import MAX_SEED
+
+        if not 0 <= args.seed <= MAX_SEED:
+            raise UsageError(f"--seed must be in 0..{MAX_SEED}, got {args.seed}")
+    return args, scenario, shadow_params
+
+
+_loads = {}
+
+
+def load_run(argv):
+    """``(args, scenario, shadow_params)`` of a run, checked as ``run`` checks them
+    (``UsageError`` with one line when something is wrong)."""
+    from .. import run
+    from ..errors import UsageError
+    from ..scenario import MAX_SEED, load_scenario
+
+    args = run.build_parser().parse_args(argv)
+    args.quiet = True
+    if args.seed is not None and not 0 <= args.seed <= MAX_SEED:
+        raise UsageError(f"--seed must be in 0..{MAX_SEED}, got {args.seed}")
+    scenario = load_scenario(args.scenario, run._overrides(args))
+    shadow_params = run._shadow_params(scenario, args.shadow)
+    run._design_files(args, scenario.foreign)
+    return args, scenario, shadow_params
+
+
+def _design_key(args, scenario):
+    return ("design", args.backend, args.design, args.ports, repr(scenario.foreign),
+            repr(scenario.params))
+
+
+def _open(key, opener):
+    design = _designs.pop(key, None)
+    if design is None:
+        design = opener()
+    _designs[key] = design  # most recently used last
+    while len(_designs) > _KEEP:
+        old = _designs.pop(next(iter(_designs)))
+        old.close()
+    return design
+
+
+def _designs_for(args, scenario, shadow_params):
+    from .. import run
+
+    design = _open(_design_key(args, scenario),
+                   lambda: run._open_design(args, scenario.params, scenario.foreign))
+    shadow = None
+    if shadow_params is not None:
+        name = args.shadow_backend or args.backend
+        shadow = _open(("shadow", name, repr(shadow_params)),
+                       lambda: run._open_backend(name, shadow_params, True))
+    return design, shadow
+
+
+def build_designs(argv):
+    """Build (or find in the build cache) the design and shadow of a run; returns seconds.
+    Called once per parameter set before the runs are dispatched."""
+    t0 = time.perf_counter()
+    args, scenario, shadow_params = load_run(argv)
+    _designs_for(args, scenario, shadow_params)
+    return time.perf_counter() - t0
+
+
+def _fault(seed):
+    spec = os.environ.get("FPGA_ROBOTICS_SWEEP_FAULT", "")
+    for item in filter(None, (s.strip() for s in spec.split(","))):
+        kind, _, at = item.partition("@")
+        if at.strip() == str(seed):
+            return kind.strip()
+    return None
+
+
+class _Deadline:
+    """The progress callback: raises ``RunTimeout`` once the run is over its time; a
+    watchdog ends the worker process if a single frame hangs past a hard limit."""
+
+    def __init__(self, timeout, fault, tag=None):
+        self.timeout = timeout
+        self.fault = fault
+        self.tag = tag
+        self.start = time.perf_counter()
+        self.watchdog = None
+        self.worker = _current_worker()
+        if timeout is not None:
+            grace = min(HARD_GRACE_S, max(1.0, timeout))
+            self.watchdog = threading.Timer(timeout + grace, self._expire)
+            self.watchdog.daemon = True
+            self.watchdog.start()
+
+    def __call__(self, done, total):
+        if self.fault is not None and done == 1:
+            if self.fault == "raise":
+                raise RuntimeError("injected fault (FPGA_ROBOTICS_SWEEP_FAULT)")
+            if self.fault == "exit":
+                os._exit(70)
+            if self.fault == "hang":
+                time.sleep(10**6)
+        if self.timeout is not None and time.perf_counter() - self.start > self.timeout:
+            raise RunTimeout(f"no result within the per-run timeout of {self.timeout:.3g} s "
+                             f"(frame {done} of {total})")
+
+    def _expire(self):
+        """End this worker process (its nanny starts a new one), telling the scheduler why."""
+        if self.worker is not None and self.tag is not None:
+            self.worker.log_event(TIMEOUT_TOPIC, {"tag": self.tag})
+            time.sleep(1.0)  # the event is sent in the background
+        os._exit(75)
+
+    def cancel(self):
+        if self.watchdog is not None:
+            self.watchdog.cancel()
+
+
+def _current_worker():
+    try:
+        from distributed import get_worker
+
+        return get_worker()
+    except (ImportError, ValueError):  # called outside a Dask worker
+        return None
+
+
+def execute(argv, timeout=None, record=False, tag=None):
+    """Run one campaign run (``tag``: its name, for the timeout event; ``record``: False, or
+    log every how many frames' images to the recording); returns ``{"status", "message", "summary", "wall_s", "cpu_s",
+    "run_s", "recording"}`` (``recording``: the ``.rrd`` bytes when ``record``)."""
+    from .. import run
+    from ..loop import run_scenario
+
+    wall0, cpu0 = time.perf_counter(), time.process_time()
+    out = {"status": "error", "message": "", "summary": None, "recording": None, "run_s": 0.0}
+    deadline = None
+    try:
+        args, scenario, shadow_params = _loaded(argv)
+        design, shadow = _designs_for(args, scenario, shadow_params)
+        deadline = _Deadline(timeout, _fault(args.seed), tag)
+        recorder, rrd = (None, None)
+        if record:
+            recorder, rrd = _recorder(args, scenario.name, int(record))
+        t_run = time.perf_counter()
+        try:
+            result = run_scenario(scenario, seed=args.seed, backend=design, recorder=recorder,
+                                  progress=deadline, realtime=False, shadow=shadow,
+                                  shadow_label=args.shadow or "shadow")
+        finally:
+            out["run_s"] = time.perf_counter() - t_run
+            if recorder is not None:
+                run._close_recorder(recorder, True)
+        if rrd is not None:
+            out["recording"] = rrd.read_bytes()
+            rrd.unlink(missing_ok=True)
+        summary = dict(result.summary)
+        out.update(status=summary["verdict"], summary=summary)
+    except RunTimeout as exc:
+        out.update(status="timeout", message=str(exc))
+    except Exception as exc:  # noqa: BLE001 (the campaign records it and goes on)
+        out.update(status="error", message=f"{type(exc).__name__}: {exc}".splitlines()[0])
+    finally:
+        if deadline is not None:
+            deadline.cancel()
+    out["wall_s"] = time.perf_counter() - wall0
+    out["cpu_s"] = time.process_time() - cpu0
+    return out
+
+
+def _recorder(args, name, log_every):
+    import tempfile
+    from pathlib import Path
+
+    from .. import run
+
+    fd, path = tempfile.mkstemp(prefix=f"sweep-{name}-", suffix=".rrd")
+    os.close(fd)
+    args.rerun = f"save:{path}"
+    args.log_every = log_every
+    return run._open_recorder(args, name), Path(path)

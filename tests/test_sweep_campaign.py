@@ -1,0 +1,50 @@
+"""Campaign files to runs: seeds, the grid's cartesian product plus explicit sets, and the
+``--set`` text of every value read back as the value itself."""
+
+import itertools
+import tomllib
+
+from hypothesis import given
+from hypothesis import strategies as st
+
+from fpga_robotics.scenario import _parse_value
+from fpga_robotics.sweep import load_campaign
+from fpga_robotics.sweep.campaign import parse_seeds, toml_value
+
+SCALARS = (st.booleans() | st.integers(-2**63, 2**63 - 1)
+           | st.floats(allow_nan=False) | st.text(max_size=20))
+VALUES = st.recursive(SCALARS, lambda inner: st.lists(inner, max_size=4), max_leaves=10)
+
+
+@given(VALUES)
+def test_set_text_reads_back_as_the_value(value):
+    assert _parse_value(toml_value(value)) == value
+
+
+def test_seed_ranges_and_lists():
+    assert parse_seeds("0-19") == list(range(20))
+    assert parse_seeds("7") == [7] and parse_seeds(7) == [7]
+    assert parse_seeds([5, 1, 5]) == [5, 1]
+
+
+def test_runs_are_the_grid_product_plus_the_sets_for_every_scenario_and_seed():
+    data = tomllib.loads("""
+scenarios = ["approach", "divider"]
+seeds = "0-2"
+[grid]
+"design.diff_min" = [4, 6]
+lighting = {ambient = [0.3, 0.5, 0.7]}
+[[sets]]
+robot.mass = 12.0
+""")
+    campaign = load_campaign(data)
+    assert campaign.axes == ["design.diff_min", "lighting.ambient", "robot.mass"]
+    expected = [(sc, combo, seed) for sc in ("approach", "divider")
+                for combo in [*(((("design.diff_min", d), ("lighting.ambient", a)))
+                                for d, a in itertools.product((4, 6), (0.3, 0.5, 0.7))),
+                              (("robot.mass", 12.0),)]
+                for seed in range(3)]
+    assert [(r.scenario, r.overrides, r.seed) for r in campaign.runs] == expected
+    run = campaign.runs[0]
+    assert run.argv() == ["--scenario", "approach", "--backend", "auto", "--seed", "0",
+                          "--set", "design.diff_min=4", "--set", "lighting.ambient=0.3"]
