@@ -222,3 +222,43 @@ def test_a_mutant_runs_in_closed_loop_from_the_command_line(tmp_path, capsys):
     for name in ("select0", "stuck"):
         assert summaries[name]["backend"] == "verilator-foreign"
         assert {k: summaries[name][k] for k in keys} == {k: summaries["builtin"][k] for k in keys}
+
+
+@pytest.mark.skipif(_toolchain() is not None, reason="no Verilator toolchain")
+def test_the_robot_judge_catches_a_wheel_bug_and_not_a_filtered_image_bug(tmp_path):
+    """Two mutants judged by hand: the filtered stream's bit stuck at 1 changes nothing the
+    robot acts on (a blind spot: the unit judge alone sees it); bit 12 of the left wheel's
+    command inverted adds 4096 DPS to it (clamped to the motor's top speed): the robot spins
+    and the runs fail. One Dask worker; resumed, nothing runs again."""
+    import json
+
+    from fpga_robotics.mutation.design import write_mutant_design
+    from fpga_robotics.mutation.robot_judge import robot_judge
+    from fpga_robotics.mutation.scores import blind_spots, robot_score
+    from fpga_robotics.sweep import load_campaign
+
+    listed = mutation.list_mutants(PARAMS, 3000, seed=1)
+    stuck = next(m for m in listed if m.signal == "filtered__payload" and m.mode == "const1")
+    wheel = next(m for m in listed if (m.signal, m.bit, m.mode) == ("motor_left", 12, "inv"))
+    chosen = [mutation.Mutant(**{**m.__dict__, "index": i}) for i, m in ((1, stuck), (2, wheel))]
+    netlist, ports = write_mutant_design(PARAMS, chosen, tmp_path)
+    campaign = load_campaign({"name": "tiny", "scenarios": ["follow_person"], "seeds": "0-1",
+                              "duration": 4.0})
+    baseline, verdicts = robot_judge(campaign, netlist, ports, "80x60", [1, 2], str(tmp_path),
+                                     workers=1, say=lambda text: None)
+    assert baseline["passing"] == [0, 1] and len(baseline["runs"]) == 2
+    assert "--runtime mutsel=0" in " ".join(baseline["runs"][0])
+    assert verdicts[1]["caught"] is False and verdicts[1]["runs"] == 2
+    assert verdicts[2]["caught"] is True and verdicts[2]["run"] == 0
+    assert verdicts[2]["status"] == "fail" and verdicts[2]["failed_checks"]
+    assert verdicts[2]["replay"].endswith("--runtime mutsel=2")
+    unit = {1: True, 2: True}
+    robot = {k: v["caught"] for k, v in verdicts.items()}
+    assert robot_score(unit, robot) == {"judged": 2, "caught": 1, "score": 0.5}
+    assert blind_spots(unit, robot) == [1]
+    lines = (tmp_path / "robot.jsonl").read_text().splitlines()
+    assert sorted(json.loads(line)["index"] for line in lines) == [1, 2]
+    again, resumed = robot_judge(campaign, netlist, ports, "80x60", [1, 2], str(tmp_path),
+                                 workers=1, resume=True, say=lambda text: None)
+    assert {k: v["caught"] for k, v in resumed.items()} == robot
+    assert (tmp_path / "robot.jsonl").read_text().splitlines() == lines

@@ -192,6 +192,8 @@ def execute(argv, timeout=None, record=False, tag=None):
     try:
         args, scenario, shadow_params = _loaded(argv)
         design, shadow = _designs_for(args, scenario, shadow_params)
+        if getattr(args, "runtime", None):  # a kept design gets this run's [runtime] values
+            run.apply_runtime(design, args)
         deadline = _Deadline(timeout, _fault(args.seed), tag)
         recorder, rrd = (None, None)
         if record:

@@ -1,0 +1,181 @@
+"""The robot judge: each mutant against a campaign's closed-loop verdicts.
+
+First the campaign's runs go with the unmutated design (the mutant netlist at ``mutsel = 0``):
+the runs that pass are the judging runs. A mutant is *caught* when any judging run does not
+pass with it (fails, errs or times out). A mutant's runs go in the campaign's order and stop
+at the first that does not pass (most caught mutants fail their first run), one Dask task per
+mutant on the campaign engine's workers (``fpga_robotics.sweep``): each worker keeps the
+compiled model loaded and switches ``mutsel`` between runs.
+
+Every run is a ``python -m fpga_robotics.run`` argument list (the campaign's, with
+``--design verilog:mutants.v --ports mutants_ports.toml --runtime mutsel=K`` and the mutant
+design's resolution), so each verdict comes with the command that replays it.
+"""
+
+import json
+import os
+import shlex
+import time
+
+__all__ = ["closest_to_failing", "judge_runs", "mutant_argv", "replay", "robot_judge",
+           "run_margin"]
+
+#: Checks whose limit is a lower bound (the value must be at least the limit).
+_LOWER = ("min_distance_min_m", "target_in_view_min_fraction", "found_min_fraction")
+
+
+def mutant_argv(argv, netlist, ports, index, resolution):
+    """A campaign run's arguments with mutant ``index`` of the netlist as the design."""
+    out, skip = [], False
+    for a in argv:
+        if skip:
+            skip = False
+            continue
+        if a in ("--backend", "--design", "--ports", "--runtime", "--resolution"):
+            skip = True
+            continue
+        out.append(a)
+    return [*out, "--backend", "verilator", "--resolution", resolution, "--design",
+            f"verilog:{netlist}", "--ports", str(ports), "--runtime", f"mutsel={index}"]
+
+
+def replay(argv):
+    """The shell command that replays a run."""
+    return shlex.join(["python", "-m", "fpga_robotics.run", *argv])
+
+
+def run_margin(summary):
+    """How far a passing run is from failing: the smallest relative margin of its measured
+    checks (value against limit, 0 = on the limit; None when no check has a number)."""
+    margins = []
+    for c in summary.get("checks", ()):
+        v, limit = c.get("value"), c.get("limit")
+        if c.get("passed") is None or isinstance(v, bool) or not isinstance(
+                v, (int, float)) or not isinstance(limit, (int, float)):
+            continue
+        scale = max(abs(float(limit)), 1e-9)
+        if c["name"] in _LOWER:
+            margins.append((float(v) - float(limit)) / scale)
+        else:
+            margins.append((float(limit) - float(v)) / scale)
+    return min(margins) if margins else None
+
+
+def closest_to_failing(outcomes):
+    """The index of the passing outcome with the smallest ``run_margin`` (None if none)."""
+    best, best_margin = None, None
+    for i, o in enumerate(outcomes):
+        if o.get("status") != "pass" or not o.get("summary"):
+            continue
+        m = run_margin(o["summary"])
+        if m is not None and (best_margin is None or m < best_margin):
+            best, best_margin = i, m
+    return best
+
+
+def judge_runs(argvs, timeouts=None):
+    """The Dask task of one mutant: its runs in order until one does not pass. Returns
+    ``{"caught", "run", "status", "message", "failed_checks", "closest", "runs", "wall_s"}``
+    (``run``: the index of the first run that did not pass; ``closest``: of a mutant not
+    caught, the run nearest to failing)."""
+    from ..sweep import runner
+
+    t0 = time.perf_counter()
+    outcomes = []
+    for i, argv in enumerate(argvs):
+        o = runner.execute(argv, timeout=None if timeouts is None else timeouts[i])
+        o.pop("recording", None)
+        outcomes.append(o)
+        if o["status"] != "pass":
+            failed = [c["name"] for c in (o["summary"] or {}).get("checks", ())
+                      if c.get("passed") is False]
+            return {"caught": True, "run": i, "status": o["status"], "message": o["message"],
+                    "failed_checks": failed, "closest": None, "runs": i + 1,
+                    "wall_s": time.perf_counter() - t0}
+    return {"caught": False, "run": None, "status": "pass", "message": "", "failed_checks": [],
+            "closest": closest_to_failing(outcomes), "runs": len(argvs),
+            "wall_s": time.perf_counter() - t0}
+
+
+def _baseline(client, argvs, progress):
+    """The campaign with the unmutated design: ``[outcome]`` in order."""
+    from distributed import as_completed
+
+    from ..sweep import runner
+
+    futures = {client.submit(runner.execute, a, None, pure=False): i
+               for i, a in enumerate(argvs)}
+    out = [None] * len(argvs)
+    for fut in as_completed(futures):
+        out[futures[fut]] = fut.result()
+        progress(1)
+    return out
+
+
+def robot_judge(campaign, netlist, ports, resolution, indices, out_dir, *, workers=None,
+                scheduler=None, resume=False, progress=None, say=print):
+    """Judge the mutants ``indices`` by ``campaign``'s closed-loop runs.
+
+    Returns ``(baseline, verdicts)``: ``baseline`` is ``{"runs": [argv at mutsel 0, ...],
+    "passing": [their indices], "statuses": [...]}``; ``verdicts`` is ``{index: judge_runs
+    result}`` (with the replay command of the run that caught it, or of the closest run).
+    Verdicts are appended to ``out_dir/robot.jsonl`` as they come (``resume`` keeps the
+    ones there)."""
+    from distributed import as_completed
+
+    from ..sweep.engine import open_client
+    from ..sweep.plan import make_plan
+
+    tick = progress or (lambda n: None)
+    plan = make_plan(campaign)
+    if any(k.startswith("design.") for spec in plan.runs for k, _ in spec.overrides) or any(
+            item.startswith("design.") for spec in plan.runs for item in spec.fixed):
+        from ..errors import UsageError
+
+        raise UsageError("the mutation campaign may not override design.* values: the "
+                         "mutants are of one design (give its parameters to mutate instead)")
+    base = [mutant_argv(spec.argv(), netlist, ports, 0, resolution) for spec in plan.runs]
+    journal = os.path.join(out_dir, "robot.jsonl")
+    verdicts = {}
+    if resume and os.path.exists(journal):
+        with open(journal) as f:
+            for line in f:
+                if line.strip():
+                    row = json.loads(line)
+                    verdicts[int(row["index"])] = row
+    elif os.path.exists(journal):
+        os.remove(journal)
+    with open_client(scheduler=scheduler, workers=workers) as client:
+        client.wait_for_workers(1, timeout=60)
+        say(f"robot judge: {len(base)} campaign runs with the unmutated design first")
+        outcomes = _baseline(client, base, tick)
+        passing = [i for i, o in enumerate(outcomes) if o["status"] == "pass"]
+        statuses = [o["status"] for o in outcomes]
+        # Each mutant's run may take ten times as long as the design's (at least 30 s).
+        limits = [max(30.0, 10.0 * outcomes[i].get("wall_s", 3.0)) for i in passing]
+        todo = [k for k in indices if k not in verdicts]
+        say(f"robot judge: {len(passing)} of {len(base)} runs pass unmutated; judging "
+            f"{len(todo)} mutants ({len(indices) - len(todo)} already in {journal})")
+        futures = {}
+        for k in todo:
+            argvs = [mutant_argv(spec.argv(), netlist, ports, k, resolution)
+                     for spec in (plan.runs[i] for i in passing)]
+            futures[client.submit(judge_runs, argvs, limits, pure=False,
+                                  key=f"mutant-{k}-{time.monotonic_ns()}")] = (k, argvs)
+        with open(journal, "a") as f:
+            for fut in as_completed(futures):
+                k, argvs = futures[fut]
+                try:
+                    v = fut.result()
+                except Exception as exc:  # noqa: BLE001 (a worker died: the mutant is caught)
+                    v = {"caught": True, "run": None, "status": "error",
+                         "message": f"{type(exc).__name__}: {exc}".splitlines()[0],
+                         "failed_checks": [], "closest": None, "runs": 0, "wall_s": 0.0}
+                at = v["run"] if v["caught"] else v["closest"]
+                v["replay"] = replay(argvs[at]) if at is not None else None
+                v["index"] = k
+                verdicts[k] = v
+                f.write(json.dumps(v) + "\n")
+                f.flush()
+                tick(1)
+    return {"runs": base, "passing": passing, "statuses": statuses}, verdicts
