@@ -258,7 +258,7 @@ def test_the_robot_judge_catches_a_wheel_bug_and_not_a_filtered_image_bug(tmp_pa
     assert blind_spots(unit, robot) == [1]
     lines = (tmp_path / "robot.jsonl").read_text().splitlines()
     assert sorted(json.loads(line)["index"] for line in lines) == [1, 2]
-    again, resumed = robot_judge(campaign, netlist, ports, "80x60", [1, 2], str(tmp_path),
+    _again, resumed = robot_judge(campaign, netlist, ports, "80x60", [1, 2], str(tmp_path),
                                  workers=1, resume=True, say=lambda text: None)
     assert {k: v["caught"] for k, v in resumed.items()} == robot
     assert (tmp_path / "robot.jsonl").read_text().splitlines() == lines

@@ -33,13 +33,13 @@ def write_report(out, campaign, mutants, unit_verdicts, robot_verdicts, baseline
     effects = {v.index: v.effect() for v in unit_verdicts}
     by_index = {m.index: m for m in mutants}
     e = html.escape
-    parts = [f"<!doctype html><meta charset=utf-8><title>Mutation coverage</title>"
-             f"<style>{_STYLE}</style><h1>Mutation coverage of follow_target</h1>",
-             f"<p>{us['total']} mutants. Unit judge: {us['caught']} caught, {us['equivalent']} "
+    parts = [(f"<!doctype html><meta charset=utf-8><title>Mutation coverage</title>"
+             f"<style>{_STYLE}</style><h1>Mutation coverage of follow_target</h1>"),
+             (f"<p>{us['total']} mutants. Unit judge: {us['caught']} caught, {us['equivalent']} "
              f"equivalent on the unit frames (score {_pct(us['score'])}). Robot judge "
              f"(campaign <code>{e(campaign)}</code>, {len(baseline['passing'])} of "
              f"{len(baseline['runs'])} runs pass unmutated): {rs['caught']} of {rs['judged']} "
-             f"unit-caught mutants caught (score {_pct(rs['score'])}).</p>",
+             f"unit-caught mutants caught (score {_pct(rs['score'])}).</p>"),
              "<h2>By component</h2>",
              _table(["component", "mutants", "unit judge caught", "robot judge caught"],
                     [[e(name), r["total"], r["unit_caught"], r["robot_caught"]]
