@@ -407,7 +407,7 @@ PLANS = {
                             "(of 600)"))),
     # docs/campaigns.md: verification campaigns on Dask -------------------------------------
     "python -m fpga_robotics.sweep regression --dry-run":
-        Plan(out=(r"campaign regression: 140 runs",
+        Plan(out=(r"campaign regression: 180 runs",
                   (r"(?m)^  python -m fpga_robotics\.run --scenario approach --backend \w+ "
                    r"--seed 0$"))),
     "python -m fpga_robotics.sweep regression":
