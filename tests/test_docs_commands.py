@@ -465,6 +465,14 @@ PLANS = {
         Plan(shorter=(("--mutants", "12"),),
              out=(r"12 mutants of follow_target 80x60",),
              files=("runs/mutation/small/mutants.json",)),
+    "python -m fpga_robotics.mutation --mutants 100 --campaign mutation":
+        # Four mutants at 80x60 on one worker, the campaign's runs made short: the whole
+        # command takes minutes (the page gives its measured time).
+        Plan(shorter=(("--mutants", "4"), ("--width", "80"), ("--height", "60"),
+                      ("--workers", "1"), ("--recordings", "1")),
+             out=(r"robot judge \(campaign mutation: \d+ of 7 runs pass unmutated\)",),
+             files=("runs/mutation/n4-s1/report.html", "runs/mutation/n4-s1/robot.jsonl",
+                    "runs/mutation/n4-s1/mutants.json")),
     "python -m fpga_robotics.sim.backends.foreign_bench":
         Plan(shorter=(("--frames", "2"), ("--repeats", "1")),
              out=(r"verilator \(built-in\) +[\d.]+ ms/frame",
