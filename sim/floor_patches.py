@@ -59,7 +59,11 @@ def paint_floor_patches(renderer, scene, pose):
     image = renderer.render(plain, pose)
     other = renderer.render(dataclasses.replace(plain, floor_color=_other_floor(scene.floor_color)),
                             pose)
-    rows, cols = np.nonzero((image != other).any(axis=2))
+    # Channel by channel: several times faster than .any(axis=2) on a (H, W, 3) array.
+    changed = image[..., 0] != other[..., 0]
+    changed |= image[..., 1] != other[..., 1]
+    changed |= image[..., 2] != other[..., 2]
+    rows, cols = np.nonzero(changed)
     if rows.size == 0:
         return image
     x, y = floor_points(renderer, pose, rows, cols)

@@ -15,12 +15,14 @@ __all__ = ["report_dir", "run_campaign"]
 
 def run_campaign(campaign, out_dir, *, workers=None, scheduler=None, resume=False,
                  record="failing", timeout=None, max_runs=None, quiet=True, client=None,
-                 echo=None, log_every=RECORD_LOG_EVERY):
+                 echo=None, log_every=RECORD_LOG_EVERY, bag=False):
     """Run ``campaign`` (a ``Campaign``) and return its results rows (list of dicts, one per
     run, in the order they finished; with ``resume`` the rows already in ``out_dir`` too).
 
     ``client``: an open ``distributed.Client`` to use (else one is opened: ``scheduler`` or
     an embedded cluster of ``workers`` processes). ``echo(text)``: where progress notes go.
+    ``bag``: the recorded runs (``record``) are also written as ROS 2 bags, ``bags/<run_id>/``
+    (docs/ros.md).
     """
     say = echo or (lambda text: None)
     plan = make_plan(campaign)
@@ -49,7 +51,7 @@ def run_campaign(campaign, out_dir, *, workers=None, scheduler=None, resume=Fals
                     f"running the other {len(plan.runs) - already}")
             t_runs = time.perf_counter()
             meta["ran"] = run_plan(c, plan, store, record=record, timeout=timeout,
-                                   quiet=quiet, log_every=log_every)
+                                   quiet=quiet, log_every=log_every, bag=bag)
             meta["runs_wall_s"] = round(time.perf_counter() - t_runs, 3)
             meta["workers"] = len(c.scheduler_info()["workers"])
     finally:

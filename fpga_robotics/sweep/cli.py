@@ -55,6 +55,9 @@ def build_parser(prog=PROG):
                    help="keep the runs already in --out and run only the others")
     e.add_argument("--record", choices=RECORD, default="failing",
                    help="save the .rrd recording of failing runs (default), all or none")
+    e.add_argument("--bag", action="store_true",
+                   help="also write each recorded run as a ROS 2 bag, OUT/bags/RUN_ID/ "
+                        "(docs/ros.md)")
     e.add_argument("--log-every", type=int, default=None, metavar="N",
                    help="recordings log every Nth frame's images (default "
                         f"{RECORD_LOG_EVERY}; the replay command records every frame)")
@@ -171,11 +174,14 @@ def main(argv=None, prog=PROG):
         if not args.quiet:
             print(text, file=sys.stderr, flush=True)
 
+    if args.bag and args.record == "none":
+        raise UsageError("--bag writes the recorded runs as ROS 2 bags: it needs --record "
+                         "failing (the default) or all")
     try:
         rows = run_campaign(campaign, out, workers=args.workers, scheduler=args.scheduler,
                             resume=args.resume, record=args.record, timeout=args.timeout,
                             max_runs=args.max_runs, quiet=args.quiet, echo=echo,
-                            log_every=args.log_every or RECORD_LOG_EVERY)
+                            log_every=args.log_every or RECORD_LOG_EVERY, bag=args.bag)
     except KeyboardInterrupt:
         kept = len(load_rows(out))
         print(f"interrupted: {kept} finished run(s) kept in {out}; continue with --resume",

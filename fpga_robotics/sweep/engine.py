@@ -156,7 +156,7 @@ def build_all(client, plan):
 
 
 def run_plan(client, plan, store, *, record="failing", timeout=None, quiet=False,
-             on_row=None, log_every=RECORD_LOG_EVERY):
+             on_row=None, log_every=RECORD_LOG_EVERY, bag=False):
     """Run every planned run not already in ``store``; returns the number run.
     Recordings log every ``log_every``-th frame's images (every frame's numbers)."""
     from distributed import as_completed
@@ -183,7 +183,8 @@ def run_plan(client, plan, store, *, record="failing", timeout=None, quiet=False
         limit = timeouts(spec, frames, pixels)
         key = f"run-{plan.ids[spec]}-{time.monotonic_ns()}"
         rec = log_every if (recording or record == "all") else False
-        fut = client.submit(runner.execute, spec.argv(), limit, rec, key, pure=False, key=key)
+        fut = client.submit(runner.execute, spec.argv(), limit, rec, key, pure=False, key=key,
+                            bag=bool(bag and rec))
         running[fut] = (spec, time.monotonic(), limit, recording)
         completed.add(fut)
 
@@ -201,6 +202,8 @@ def run_plan(client, plan, store, *, record="failing", timeout=None, quiet=False
                 if row is not None and outcome.get("recording"):
                     row["recording"] = _save_recording(store.dir, plan.ids[spec],
                                                        outcome["recording"])
+                    if outcome.get("bag"):
+                        row["bag"] = _save_bag(store.dir, plan.ids[spec], outcome["bag"])
                     store.add(row)
                 top_up()
                 continue
@@ -208,6 +211,8 @@ def run_plan(client, plan, store, *, record="failing", timeout=None, quiet=False
             if outcome.get("recording"):
                 row["recording"] = _save_recording(store.dir, row["run_id"],
                                                    outcome["recording"])
+            if outcome.get("bag"):
+                row["bag"] = _save_bag(store.dir, row["run_id"], outcome["bag"])
             store.add(row)
             if on_row is not None:
                 on_row(row)
@@ -255,6 +260,23 @@ def _outcome(client, fut, limit):
         return {"status": "error", "message": "the worker running it died (a crash or a kill)"}
     except Exception as exc:  # noqa: BLE001 (a lost connection, a cancelled task: recorded)
         return {"status": "error", "message": f"{type(exc).__name__}: {exc}".splitlines()[0]}
+
+
+def _save_bag(out_dir, run_id, files):
+    """Write a run's ROS 2 bag (its files) to ``bags/<run_id>/``, whole or not at all."""
+    import shutil
+    import tempfile
+
+    bags = Path(out_dir) / "bags"
+    bags.mkdir(parents=True, exist_ok=True)
+    staging = Path(tempfile.mkdtemp(prefix=f".{run_id}.", dir=bags))
+    for name, data in files.items():
+        (staging / name).write_bytes(data)
+    final = bags / run_id
+    if final.exists():
+        shutil.rmtree(final)
+    os.replace(staging, final)
+    return str(final.relative_to(out_dir))
 
 
 def _save_recording(out_dir, run_id, data):

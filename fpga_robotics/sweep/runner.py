@@ -179,10 +179,11 @@ def _current_worker():
         return None
 
 
-def execute(argv, timeout=None, record=False, tag=None):
+def execute(argv, timeout=None, record=False, tag=None, bag=False):
     """Run one campaign run (``tag``: its name, for the timeout event; ``record``: False, or
     log every how many frames' images to the recording); returns ``{"status", "message", "summary", "wall_s", "cpu_s",
-    "run_s", "recording"}`` (``recording``: the ``.rrd`` bytes when ``record``)."""
+    "run_s", "recording", "bag"}`` (``recording``: the ``.rrd`` bytes when ``record``;
+    ``bag``: with ``bag`` and ``record``, the ROS 2 bag's files as ``{name: bytes}``)."""
     from .. import run
     from ..loop import run_scenario
 
@@ -198,15 +199,25 @@ def execute(argv, timeout=None, record=False, tag=None):
         recorder, rrd = (None, None)
         if record:
             recorder, rrd = _recorder(args, scenario.name, int(record))
+        bag_writer, bag_dir = (_bag_writer(scenario) if record and bag else (None, None))
         t_run = time.perf_counter()
         try:
             result = run_scenario(scenario, seed=args.seed, backend=design, recorder=recorder,
                                   progress=deadline, realtime=False, shadow=shadow,
-                                  shadow_label=args.shadow or "shadow")
+                                  shadow_label=args.shadow or "shadow",
+                                  on_frame=bag_writer.log_frame if bag_writer else None)
+            if bag_writer is not None:
+                bag_writer.close()
+                out["bag"] = _read_bag(bag_dir)
         finally:
             out["run_s"] = time.perf_counter() - t_run
             if recorder is not None:
                 run._close_recorder(recorder, True)
+            if bag_writer is not None:
+                bag_writer.abandon()  # nothing left once closed; a partial bag otherwise
+                import shutil
+
+                shutil.rmtree(bag_dir, ignore_errors=True)
         if rrd is not None:
             out["recording"] = rrd.read_bytes()
             rrd.unlink(missing_ok=True)
@@ -222,6 +233,23 @@ def execute(argv, timeout=None, record=False, tag=None):
     out["wall_s"] = time.perf_counter() - wall0
     out["cpu_s"] = time.process_time() - cpu0
     return out
+
+
+def _bag_writer(scenario):
+    """A ROS 2 bag writer into a temporary folder (``fpga_robotics.ros``), and the folder."""
+    import tempfile
+    from pathlib import Path
+
+    from ..ros.bag_writer import open_bag_writer
+
+    folder = Path(tempfile.mkdtemp(prefix="sweep-bag-"))
+    return open_bag_writer(folder / "bag", scenario), folder
+
+
+def _read_bag(folder):
+    """The files of the bag written into ``folder`` as ``{name: bytes}``."""
+    bag = folder / "bag"
+    return {p.name: p.read_bytes() for p in sorted(bag.iterdir()) if p.is_file()}
 
 
 def _recorder(args, name, log_every):
