@@ -6,6 +6,7 @@
     fpga-robotics bench [WHAT] [options]  benchmarks: design (default), pysim, camera, world,
                                           viewer, shadow
     fpga-robotics readback FILE.rrd       what a saved recording holds
+    fpga-robotics formal [options]        formal proofs of the gateware's promises
 
 Each subcommand is the ``main(argv, prog)`` of its module, so ``fpga-robotics run --help`` and
 ``python -m fpga_robotics.run --help`` are the same command. New subcommands are one row of
@@ -31,6 +32,7 @@ COMMANDS = {
               "write (--example) or check a port map for run --design verilog:..."),
     "readback": ("fpga_robotics.readback_cli",
                  "what a saved .rrd recording holds, entity by entity"),
+    "formal": ("fpga_robotics.formal", "prove the gateware's promises (SymbiYosys, Yices)"),
 }
 
 #: ``fpga-robotics bench WHAT`` -> (module, one-line help); the first is the default.

@@ -1,0 +1,183 @@
+"""The tracker's promises: nothing of an abandoned frame leaks into the next frame's results
+(a miter of two trackers), and the per-frame results are the contract's formulas of the
+counts, for every count (``found``, ``proximity``, ``centroid_x``, the LED code)."""
+
+from amaranth.asserts import AnyConst, AnySeq
+from amaranth.hdl import Assert, Assume, Const, Cover, Mux, Signal, Value
+
+from ..tracker import FrameTracker, TrackerResults
+from .harness import Harness, delayed
+from .sizes import FULL_SIZES, SMALL
+
+__all__ = ["NoLeakMiter", "ProximityMonotonic", "ResultsFormulas", "contract_leds"]
+
+_RESULTS = ("found", "proximity", "centroid_x", "centroid_leds", "count", "sum_x", "bins")
+
+
+class NoLeakMiter(Harness):
+    """Two trackers fed different free inputs until a cycle the solver picks, in which both
+    get the same ``first``, and the same free inputs from then on. Once the results of
+    frames that ended before that ``first`` have had time to show (``latency`` edges), the
+    two agree on ``frame_done`` and on every result: whatever came before (abandoned,
+    cut-short or complete frames, blanking) does not reach the frames after it."""
+
+    def __init__(self, dut=None, twin=None, params=SMALL):
+        super().__init__()
+        self.dut = FrameTracker(params) if dut is None else dut
+        self.twin = FrameTracker(self.dut.params) if twin is None else twin
+
+    def check(self, m):
+        m.submodules.a = a = self.dut
+        m.submodules.b = b = self.twin
+        width = len(a.matches.payload.as_value())
+        synced = Signal()  # the shared `first` has been sampled
+        sync_now = AnySeq(1)
+        shared_valid, shared = AnySeq(1), AnySeq(width)
+        go = Signal()
+        m.d.comb += go.eq(synced | sync_now)
+        m.d.sync += synced.eq(go)
+        for dut in (a, b):
+            m.d.comb += [
+                dut.matches.valid.eq(Mux(go, shared_valid, AnySeq(1))),
+                dut.matches.payload.eq(Mux(go, shared, AnySeq(width))),
+            ]
+        with m.If(go & ~synced):  # the shared input starts with a `first`
+            m.d.comb += Assume(a.matches.valid & a.matches.payload.first)
+        since = Signal(range(a.latency + 2))  # edges since the shared `first`, saturating
+        with m.If(go & (since <= a.latency)):
+            m.d.sync += since.eq(since + 1)
+        after = Signal()
+        m.d.comb += after.eq(since > a.latency)
+        with m.If(after):
+            m.d.comb += Assert(a.frame_done == b.frame_done, "frame_done differs")
+            with m.If(a.frame_done):
+                for name in _RESULTS:
+                    m.d.comb += Assert(Value.cast(getattr(a, name)) == Value.cast(getattr(b, name)),
+                                       f"{name} differs")
+
+
+def _tree(values):
+    total = values[0]
+    for v in values[1:]:
+        total = total + v
+    return total
+
+
+def contract_leds(p, bins, count, found):
+    """The contract's LED code (docs/contract.md, Per-frame outputs) of ``bins``."""
+    half = count >> 1
+    left, right = _tree(bins[:4]), _tree(bins[4:])
+    centred = Mux(left > right, left - right, right - left) < (count >> 4)
+
+    def from_edge(order, leds):
+        code = Const(1 << leds[3], 8)
+        sums = [_tree([bins[k] for k in order[:n]]) for n in (1, 2, 3)]
+        for led, s in reversed(list(zip(leds[:3], sums))):
+            code = Mux(s >= half, 1 << led, code)
+        return code
+
+    return Mux(~found, 0, Mux(centred, 0b0001_1000,
+               Mux(left > right, from_edge((0, 1, 2), (0, 1, 2, 3)),
+                   from_edge((7, 6, 5), (7, 6, 5, 4)))))
+
+
+class _FreeCounts(Harness):
+    """``TrackerResults`` given free counts of one frame (``AnyConst``: every value at once)
+    and one ``end`` at a free time. The counts are those a frame can have: each bin at most
+    its columns times the window's rows, and ``SX`` at most ``(width - 1) * N``."""
+
+    def __init__(self, dut=None, params=FULL_SIZES["160x120"]):
+        super().__init__()
+        self.dut = TrackerResults(params) if dut is None else dut
+
+    def feed(self, m, dut, end):
+        p = dut.params
+        bins = [AnyConst(p.count_bits) for _ in range(8)]
+        sum_x = AnyConst(p.sum_x_bits)
+        count = _tree(bins)
+        for b in bins:
+            m.d.comb += Assume(b <= p.bin_width * p.window_height)
+        m.d.comb += Assume(sum_x <= count * (p.width - 1))
+        m.d.comb += [dut.counts.end.eq(end), dut.counts.sum_x.eq(sum_x)]
+        m.d.comb += [dut.counts.bins[k].eq(bins[k]) for k in range(8)]
+        return bins, sum_x, count
+
+    def one_end(self, m):
+        """``end`` in the first cycle only: the results of any counts from the reset state
+        (the outputs depend on nothing but the counts sampled with ``end``; a bounded run of
+        ``latency + 2`` cycles is then the whole story)."""
+        end = Signal(init=1)
+        m.d.sync += end.eq(0)
+        return end
+
+
+class ResultsFormulas(_FreeCounts):
+    """Right after ``latency`` edges from ``end``: ``frame_done`` (at no other time) and the
+    contract's ``found``, ``proximity`` and LED code (``which="counts"``), or ``centroid_x``,
+    ``SX // N`` when found, else 0 (``which="centroid"``: a division, which the solver finds
+    far harder, so it is a check of its own, at sizes it can reach)."""
+
+    def __init__(self, which, dut=None, params=FULL_SIZES["160x120"]):
+        super().__init__(dut, params)
+        if which not in ("counts", "centroid"):
+            raise ValueError("which must be 'counts' or 'centroid'")
+        self.which = which
+
+    def check(self, m):
+        dut, p = self.dut, self.dut.params
+        m.submodules.dut = dut
+        end = self.one_end(m)
+        bins, sum_x, count = self.feed(m, dut, end)
+        # `end` on the input now shows right after the coming edge E; frame_done shows
+        # right after edge E + latency: `latency` registers after this cycle.
+        due = delayed(m, end, dut.latency)
+        m.d.comb += Assert(dut.frame_done == due, "frame_done not latency edges after end")
+        found = count >= p.min_pixels if p.found_rule == "ge" else count > p.min_pixels
+        done = dut.frame_done
+        if self.which == "centroid":
+            q = dut.centroid_x
+            with m.If(done):
+                m.d.comb += Assert(
+                    Mux(found, (q * count <= sum_x) & (sum_x < (q + 1) * count), q == 0),
+                    "centroid_x is not SX // N (0 when not found)")
+            m.d.comb += [
+                Cover(done & dut.found & (dut.centroid_x == p.margin_x)),
+                Cover(done & dut.found & (dut.centroid_x == p.width - p.margin_x - 1)),
+            ]
+            return
+        proximity = _tree([(count >= t).as_unsigned() for t in p.proximity_thresholds])
+        with m.If(done):
+            m.d.comb += [
+                Assert(dut.found == found, "found is not N >= min_pixels"),
+                Assert(dut.proximity == proximity, "proximity is not #thresholds <= N"),
+                Assert(dut.centroid_leds == contract_leds(p, bins, count, found),
+                       "centroid_leds is not the contract's LED code"),
+            ]
+        m.d.comb += [
+            Cover(done & (dut.proximity == 7)),
+            Cover(done & (dut.centroid_leds == 0b0001_1000)),
+            *[Cover(done & (dut.centroid_leds == 1 << k)) for k in range(8)],
+        ]
+
+
+class ProximityMonotonic(_FreeCounts):
+    """Two copies given free counts with ``N1 <= N2``, ending together: ``proximity`` of the
+    first is never above the second's, and ``found`` of the first implies the second's."""
+
+    def __init__(self, dut=None, twin=None, params=FULL_SIZES["160x120"]):
+        super().__init__(dut, params)
+        self.twin = TrackerResults(self.dut.params) if twin is None else twin
+
+    def check(self, m):
+        m.submodules.a = a = self.dut
+        m.submodules.b = b = self.twin
+        end = self.one_end(m)
+        _, _, n1 = self.feed(m, a, end)
+        _, _, n2 = self.feed(m, b, end)
+        m.d.comb += Assume(n1 <= n2)
+        with m.If(a.frame_done):
+            m.d.comb += [
+                Assert(a.proximity <= b.proximity, "proximity not monotonic in N"),
+                Assert(~a.found | b.found, "found not monotonic in N"),
+            ]
+        m.d.comb += Cover(a.frame_done & (a.proximity < b.proximity))
