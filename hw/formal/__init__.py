@@ -12,7 +12,8 @@ from ..color_filter import ColorFilter
 from ..motor import MotorController
 from ..params import FollowTargetParams
 from ..top import FollowTarget
-from ..tracker import FrameTracker, TrackerResults
+from ..tracker import TrackerResults
+from ..window_counter import WindowCounter
 from .capture import CaptureHarness
 from .color_filter import ColorFilterHarness
 from .follow_target import FollowTargetCovers, FrameDoneHarness
@@ -23,7 +24,9 @@ from .sizes import FULL_SIZES, SMALL
 from .spi import SPIHarness
 from .tracker import NoLeakMiter, ProximityMonotonic, ResultsFormulas
 
-__all__ = ["CHECKS", "MODES", "FormalCheck", "Harness", "check_named"]
+__all__ = [
+    "CHECKS", "FILTER_SETS", "MODES", "MOTOR_ODD", "FormalCheck", "Harness", "check_named",
+]
 
 P160, P640 = FULL_SIZES["160x120"], FULL_SIZES["640x480"]
 
@@ -63,7 +66,7 @@ CHECKS = [
     FormalCheck("tracker.no_leak@16x2", "bmc", 50,
                 "two trackers with different pasts agree on every frame after a shared first",
                 build=lambda dut=None: NoLeakMiter(dut),
-                make_dut=lambda: FrameTracker(SMALL)),
+                make_dut=lambda: WindowCounter(SMALL)),
     # 4: the motor controller, for ever (k-induction).
     *[FormalCheck(f"motor.limits_hold_search@{size}", "prove", 2,
                   "wheels within +-max_dps; lost frames hold, then search to the last side",

@@ -14,7 +14,7 @@ from .framing import FramingMonitor
 from .harness import Harness, delayed
 from .sizes import SMALL
 
-__all__ = ["FrameDoneHarness", "FollowTargetCovers"]
+__all__ = ["FollowTargetCovers", "FrameDoneHarness"]
 
 
 class _FreeInputs(Harness):

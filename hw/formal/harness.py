@@ -10,8 +10,8 @@ The clock must be a port of the top: without one Yosys ties it to 0, nothing eve
 every assertion would hold vacuously (the covers of each harness catch that).
 """
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Callable
 
 from amaranth.hdl import ClockDomain, Elaboratable, Module, Signal, Value
 

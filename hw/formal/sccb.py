@@ -1,4 +1,4 @@
-"""The SCCB master's promises: SIOD changes while SIOC is high only as a START (falling,
+"""The SCCB master's promises: SIOD changes while SIOC is high (or rising) only as a START (falling,
 with the bus free) or a STOP (rising, after the 27 bits of a write), and each write carries
 the device ID, register and value of its table entry MSB first, with SIOD released on the
 three don't-care bits. The master has no inputs: one bounded run through the whole table
@@ -46,6 +46,8 @@ class SCCBHarness(Harness):
         busy = Signal()  # between a START and its STOP
         edges = Signal(range(29))  # SIOC rising edges since the START
         index = Signal(range(len(dut.table) + 1))  # writes completed
+        m.d.comb += Assert(~dut.sioc | (line == was_line) | start | stop,
+                           "SIOD changed with SIOC high, not as a START or STOP")
         with m.If(start):
             m.d.comb += Assert(~busy, "START inside a write")
             m.d.sync += [busy.eq(1), edges.eq(0)]
