@@ -15,7 +15,7 @@ __all__ = ["NoLeakMiter", "ProximityMonotonic", "ResultsFormulas", "contract_led
 class NoLeakMiter(Harness):
     """Two window counters (the tracker's per-pixel half, which turns pixels into a frame's
     counts): one fed free inputs for ``prefix`` cycles, the other blanking; then both get
-    the same ``first`` and the same free inputs. From the next cycle on their counts
+    the same ``first`` and the same free pixels, one a cycle. From the next cycle on their counts
     registers agree on every cycle, so they agree at every ``end``: whatever the prefix held
     (abandoned, cut-short or complete frames, blanking) does not reach the frames after it.
 
@@ -24,7 +24,7 @@ class NoLeakMiter(Harness):
     shared ``first`` comes at a fixed cycle: with a free one the search grew too slow to
     reach a whole frame after it."""
 
-    def __init__(self, dut=None, twin=None, params=SMALL, prefix=12):
+    def __init__(self, dut=None, twin=None, params=SMALL, prefix=20):
         super().__init__()
         self.dut = WindowCounter(params) if dut is None else dut
         self.twin = WindowCounter(self.dut.params) if twin is None else twin
@@ -47,7 +47,11 @@ class NoLeakMiter(Harness):
             b.matches.payload.eq(shared),
         ]
         with m.If(cycle == self.prefix):  # the shared input starts with a `first`
-            m.d.comb += Assume(shared_valid & a.matches.payload.first)
+            m.d.comb += Assume(a.matches.payload.first)
+        # No blanking after it: blanking is the frame_done checks' business, and without it
+        # the search reaches the end of the frame after the `first` (with it, it did not).
+        with m.If(go):
+            m.d.comb += Assume(shared_valid)
         with m.If(cycle > self.prefix):
             m.d.comb += [
                 Assert(a.counts.end == b.counts.end, "end differs"),
