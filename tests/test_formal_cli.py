@@ -4,6 +4,7 @@ errors (a missing tool, an unknown check, a bad depth) with exit code 2."""
 import sys
 
 import pytest
+from mutants import mutant
 
 import fpga_robotics.hw.formal as formal_checks
 from fpga_robotics import formal
@@ -11,7 +12,6 @@ from fpga_robotics.errors import run_cli
 from fpga_robotics.hw.formal import CHECKS, FormalCheck, check_named
 from fpga_robotics.hw.formal.sizes import FULL_SIZES
 from fpga_robotics.hw.motor import MotorController
-from mutants import mutant
 
 
 def run(argv, capsys):

@@ -8,6 +8,7 @@ missing, a divider comparison off by one, a colour rule with a term left out, a 
 short, a FIFO that is never read."""
 
 import pytest
+from mutants import mutant
 
 from fpga_robotics.formal import run_check
 from fpga_robotics.hw.board.gopigo3_spi import SPIByteMaster
@@ -22,7 +23,6 @@ from fpga_robotics.hw.motor import MotorController
 from fpga_robotics.hw.top import FollowTarget
 from fpga_robotics.hw.tracker import FrameTracker, TrackerResults
 from fpga_robotics.hw.window_counter import WindowCounter
-from mutants import mutant
 
 pytestmark = pytest.mark.formal
 

@@ -27,7 +27,7 @@ class NoLeakMiter(Harness):
     def __init__(self, dut=None, twin=None, params=SMALL, prefix=20):
         super().__init__()
         self.dut = WindowCounter(params) if dut is None else dut
-        self.twin = WindowCounter(self.dut.params) if twin is None else twin
+        self.twin = type(self.dut)(self.dut.params) if twin is None else twin  # a copy
         self.prefix = prefix
 
     def check(self, m):
@@ -174,7 +174,7 @@ class ProximityMonotonic(_FreeCounts):
 
     def __init__(self, dut=None, twin=None, params=FULL_SIZES["160x120"]):
         super().__init__(dut, params)
-        self.twin = TrackerResults(self.dut.params) if twin is None else twin
+        self.twin = type(self.dut)(self.dut.params) if twin is None else twin  # a copy
 
     def check(self, m):
         m.submodules.a = a = self.dut
