@@ -88,7 +88,6 @@ def sby_script(check, depth):
         "[options]",
         f"mode {check.mode}",
         f"depth {depth}",
-        *(["multiclock on"] if check.multiclock else []),
         "",
         "[engines]",
         "smtbmc yices",
@@ -103,7 +102,7 @@ def sby_script(check, depth):
     ])
 
 
-def _summary(output, mode):
+def _summary(output):
     """The lines of SymbiYosys's summary that say what failed, where (``file:line``)."""
     wanted = ("failed assertion", "unreached cover", "failed assumption")
     found = []
@@ -182,7 +181,7 @@ def run_check(check, *, depth=None, dut=None, trace_dir=None, env=None, timeout=
         status_file = work / "check" / "status"
         verdict = status_file.read_text().split()[0] if status_file.exists() else "ERROR"
         status = _VERDICTS.get(verdict, "error")
-        detail = _summary(output, check.mode)
+        detail = _summary(output)
         if status == "error":
             detail = detail or (output.strip().splitlines() or ["no output"])[-1]
         trace = None

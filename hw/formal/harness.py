@@ -1,4 +1,4 @@
-"""What every formal harness shares: the clock, the first cycle, delayed values, the check record.
+"""What every formal harness shares: the clock, delayed values, the record of a check.
 
 A harness is the top of one formal run. It drives the design under test from ``AnySeq`` /
 ``AnyConst`` inputs (free values the solver picks: every input sequence at once), constrains
@@ -38,8 +38,6 @@ class FormalCheck:
     promise: str
     build: Callable = field(repr=False)
     make_dut: Callable = field(repr=False)
-    #: Several clock domains (the capture's camera clock): SymbiYosys ``multiclock on``.
-    multiclock: bool = False
 
     def __post_init__(self):
         if self.mode not in MODES:
