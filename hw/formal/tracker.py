@@ -1,5 +1,5 @@
 """The tracker's promises: nothing of an abandoned frame leaks into the next frame's results
-(a miter of two trackers), and the per-frame results are the contract's formulas of the
+(a miter of two window counters), and the per-frame results are the contract's formulas of the
 counts, for every count (``found``, ``proximity``, ``centroid_x``, the LED code)."""
 
 from amaranth.asserts import AnyConst, AnySeq
@@ -11,6 +11,7 @@ from .harness import Harness, delayed
 from .sizes import FULL_SIZES, SMALL
 
 __all__ = ["NoLeakMiter", "ProximityMonotonic", "ResultsFormulas", "contract_leds"]
+
 
 class NoLeakMiter(Harness):
     """Two window counters (the tracker's per-pixel half, which turns pixels into a frame's
@@ -61,10 +62,10 @@ class NoLeakMiter(Harness):
             if a.params.group_column_offset:
                 m.d.comb += Assert(Value.cast(a.counts.edges) == Value.cast(b.counts.edges),
                                    "edges differ")
-        m.d.comb += Cover((cycle > self.prefix) & a.counts.end & (a.counts.sum_x != 0))
 
 
 def _tree(values):
+    """The sum of ``values`` (Amaranth widens each add: no wrap)."""
     total = values[0]
     for v in values[1:]:
         total = total + v
