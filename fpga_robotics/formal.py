@@ -184,6 +184,9 @@ def run_check(check, *, depth=None, dut=None, trace_dir=None, env=None, timeout=
         detail = _summary(output)
         if status == "error":
             detail = detail or (output.strip().splitlines() or ["no output"])[-1]
+        elif status == "unknown":
+            detail = (f"the induction did not close at depth {depth} (no counterexample from "
+                      "reset): a larger --depth proves it or finds one")
         trace = None
         source = work / "check" / "engine_0" / "trace.vcd"
         if status == "FAIL" and check.mode != "cover" and source.exists() and trace_dir:

@@ -82,3 +82,19 @@ def test_a_failing_check_writes_its_counterexample(capsys, monkeypatch, tmp_path
     assert lines[4].split()[:4] == ["cover.motor@defaults", "cover", "20", "pass"]
     assert lines[-1].startswith("1 of 2 checks passed")
     assert [p.name for p in traces.iterdir()] == ["motor.broken.vcd"]  # no partial files
+
+
+@pytest.mark.formal
+def test_an_induction_that_does_not_close_is_unknown_not_pass(tmp_path):
+    """A search that starts one lost frame early: an induction of 2 cycles cannot close, and
+    no counterexample is 2 cycles from reset (it is 15 frames away), so the answer is
+    ``unknown`` with the advice to go deeper, and no trace; deeper, it is a FAIL."""
+    bad = mutant(MotorController, "state.count >= p.lost_frames - 1 if p.lost_frames > 1",
+                 "state.count >= p.lost_frames - 2 if p.lost_frames > 2")
+    check = check_named("motor.limits_hold_search@defaults")
+    result = formal.run_check(check, dut=bad(FULL_SIZES["160x120"]), trace_dir=tmp_path)
+    assert (result.status, result.trace) == ("unknown", None)
+    assert "did not close at depth 2" in result.detail and "--depth" in result.detail
+    deeper = formal.run_check(check, depth=17, dut=bad(FULL_SIZES["160x120"]),
+                              trace_dir=tmp_path)
+    assert deeper.status == "FAIL" and deeper.trace.exists()
