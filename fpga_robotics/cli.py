@@ -8,6 +8,7 @@
     fpga-robotics mutate [options]        mutation coverage (python -m fpga_robotics.mutation)
     fpga-robotics readback FILE.rrd       what a saved recording holds
     fpga-robotics sweep CAMPAIGN [options]  a verification campaign on Dask
+    fpga-robotics formal [options]        formal proofs of the gateware's promises
 
 Each subcommand is the ``main(argv, prog)`` of its module, so ``fpga-robotics run --help`` and
 ``python -m fpga_robotics.run --help`` are the same command. New subcommands are one row of
@@ -37,6 +38,7 @@ COMMANDS = {
                  "what a saved .rrd recording holds, entity by entity"),
     "sweep": ("fpga_robotics.sweep.cli",
               "a verification campaign: many runs on Dask, results table and report"),
+    "formal": ("fpga_robotics.formal", "prove the gateware's promises (SymbiYosys, Yices)"),
 }
 
 #: ``fpga-robotics bench WHAT`` -> (module, one-line help); the first is the default.

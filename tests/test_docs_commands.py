@@ -286,6 +286,24 @@ PLANS = {
              part_why="the set-up and the whole test run are CI's own command (.ci/run, checked "
                       "by test_ci_runs_the_readme_test_command); here the suite is collected",
              out=(r"\d{3,} tests collected",)),
+    # docs/formal.md ------------------------------------------------------------------------------
+    "python -m fpga_robotics.formal":
+        Plan(excused="every formal check, about a minute of wall time with two solver jobs; "
+                     "the same checks run as tests (`pytest -m formal`, "
+                     "tests/test_formal_checks.py), and the documented --only commands run here"),
+    "python -m fpga_robotics.formal --list":
+        Plan(out=(r"(?m)^frame_done\.latency@16x2\s+bmc\s+60\s",
+                  r"(?m)^capture\.no_overflow@fifo_depth=16\s+bmc\s+40\s")),
+    "python -m fpga_robotics.formal --only frame_done.strobe":
+        Plan(out=(r"(?m)^frame_done\.strobe@16x2\s+prove\s+4\s+pass\s",
+                  r"(?m)^1 of 1 checks passed")),
+    "python -m fpga_robotics.formal --only motor --depth 4":
+        Plan(out=(r"(?m)^motor\.limits_hold_search@defaults\s+prove\s+4\s+pass\s",
+                  r"(?m)^motor\.limits_hold_search@odd\s+prove\s+4\s+pass\s",
+                  r"(?m)^2 of 2 checks passed")),
+    "python -m pytest -m formal":
+        Plan(collect=True, out=(r"test_seeded_bug_fails\[tracker\.no_leak@16x2\]",
+                                r"test_check_passes\[cover\.sccb\]")),
     # Viewing a recording ---------------------------------------------------------------------
     "rerun --serve-web --bind 127.0.0.1 runs/follow_person.rrd":
         Plan(serve=True, setup=(MAKE_RECORDING,)),
