@@ -53,6 +53,12 @@ CHECKS = {
         ("mean distance of the design's centroid from the target's image column (frames found "
          "with the target's centre in view) at most this; with the target straight ahead, the "
          "centroid's distance from the image centre")),
+    "max_led_wrong_side_fraction": (
+        float, (0, 1, ""),
+        ("the design's centroid LEDs point the wrong way (an LED of the other half lit with the "
+         "target an eighth of the width or more to one side, an outermost LED lit with it "
+         "within a sixteenth of the centre) in at most this fraction of the frames found "
+         "with the target in view (led_wrong_side_fraction)")),
     "max_heading_overshoot_deg": (
         float, (0, 180, "deg"),
         "the robot turns at most this far past the target (heading_overshoot_deg)"),
@@ -86,6 +92,7 @@ CHECK_OUTPUTS = {
     "max_off_target_fraction": ("found", "centroid_x"),
     "mean_centroid_error_max_px": ("found", "centroid_x"),
     "max_oscillation_hz": ("found", "centroid_x"),
+    "max_led_wrong_side_fraction": ("found", "centroid_leds"),
 }
 
 #: Metrics made of design outputs: name -> the outputs they need (None when one is absent).
@@ -102,6 +109,7 @@ _METRIC_OUTPUTS = {
     "oscillation_hz": ("found", "centroid_x"),
     "off_target_fraction": ("found", "centroid_x"),
     "mean_centroid_error_px": ("found", "centroid_x"),
+    "led_wrong_side_fraction": ("found", "centroid_leds"),
 }
 
 #: Summary fields that depend on the machine, not on the simulation.
@@ -205,6 +213,7 @@ def compute_metrics(traj, events, collisions, frame_period, *, at_fault_collisio
         "max_wheel_command_step_dps": _max_command_step(traj),
         "oscillation_hz": _oscillation(traj, width, n * frame_period),
         **_off_target(traj, width),
+        "led_wrong_side_fraction": _led_wrong_side(traj, width),
         "heading_overshoot_deg": _heading_overshoot(traj),
         "absent_outputs": [],
     }
@@ -252,6 +261,35 @@ def _off_target(traj, width):
     err = np.abs(np.asarray(traj["centroid_x"], dtype=float)[ok] - column[ok])
     return {"off_target_fraction": _round((err > OFF_TARGET_FRACTION * width).mean()),
             "mean_centroid_error_px": _round(err.mean(), 2)}
+
+
+#: The target is on one side when its image column is at least this fraction of the image
+#: width from the centre (``led_wrong_side_fraction``).
+LED_SIDE_FRACTION = 0.125
+
+
+def _led_wrong_side(traj, width):
+    """How often the centroid LEDs point the wrong way, over the frames found with the
+    target's centre in view: at least ``LED_SIDE_FRACTION`` of the width to one side, an LED of
+    the other half is lit (bits 0-3 are the left half, 4-7 the right); within half that of the
+    centre, one of the two outermost LEDs of a side is lit (bits 0, 1, 6, 7: they light only
+    when half the target's pixels are in the outer quarter of the window). None without such
+    frames or fields."""
+    if width is None or "target_column" not in traj or "centroid_leds" not in traj:
+        return None
+    column = np.asarray(traj["target_column"], dtype=float)
+    offset = column - width / 2
+    seen = traj["found"] & ~np.isnan(column)
+    side = seen & (np.abs(offset) >= LED_SIDE_FRACTION * width)
+    centre = seen & (np.abs(offset) <= LED_SIDE_FRACTION * width / 2)
+    judged = side | centre
+    if not judged.any():
+        return None
+    leds = np.asarray(traj["centroid_leds"], dtype=np.int64)
+    other_half = np.where(offset < 0, leds & 0xF0, leds & 0x0F) != 0
+    outer = (leds & 0b1100_0011) != 0
+    wrong = (side & other_half) | (centre & outer)
+    return _round(wrong[judged].mean())
 
 
 def _max_command_step(traj):
@@ -352,6 +390,12 @@ def evaluate_checks(checks, m):
             text = ("the design never reported the target found with it in view" if v is None
                     else f"centroid {v:.2f} px from the target's image column on average "
                          f"(limit <= {limit} px)")
+        elif name == "max_led_wrong_side_fraction":
+            v = m["led_wrong_side_fraction"]
+            ok = v is None or v <= limit
+            text = ("the target was never found to one side or at the centre" if v is None
+                    else f"centroid LEDs point the wrong way in {v:.0%} of the frames judged "
+                         f"(limit <= {limit:.0%})")
         elif name == "max_heading_overshoot_deg":
             v = m["heading_overshoot_deg"]
             ok = v is not None and v <= limit

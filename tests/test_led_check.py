@@ -1,0 +1,53 @@
+"""``max_led_wrong_side_fraction``: the centroid LEDs on the robot point the right way
+(fpga_robotics/summary.py), checked on hand-made trajectories of a 160-pixel-wide image."""
+
+import numpy as np
+import pytest
+
+from fpga_robotics.summary import compute_metrics, evaluate_checks
+
+W = 160
+
+
+def _traj(columns, leds, found=True):
+    n = len(columns)
+    return {"t": np.arange(n) / 30, "x": np.zeros(n), "y": np.zeros(n),
+            "found": np.full(n, found), "target_distance": np.ones(n),
+            "target_in_view": np.ones(n, bool),
+            "target_column": np.asarray(columns, dtype=float),
+            "centroid_leds": np.asarray(leds), "centroid_x": np.full(n, 80)}
+
+
+def test_leds_on_the_other_half_or_outer_leds_at_the_centre_are_wrong():
+    # Frames: target right (column 120 >= 80 + 20), left (30), centred (82), in between (95,
+    # not judged: 15 px from the centre is neither within 10 nor beyond 20), out of view.
+    columns = [120, 120, 30, 30, 82, 82, 82, 95, np.nan]
+    leds = [0b1000_0000,   # right LED for a right target: fine
+            0b0000_1000,   # bit 3 (left half) for a right target: wrong
+            0b0000_0001,   # left for left: fine
+            0b0001_0000,   # bit 4 (right half) for a left target: wrong
+            0b0001_1000,   # centred: fine
+            0b0000_0100,   # bit 2 at the centre: fine (a wide target)
+            0b1000_0000,   # bit 7 at the centre: wrong
+            0b0000_0001,   # not judged
+            0b0000_0001]   # not judged (no target column)
+    m = compute_metrics(_traj(columns, leds), [], {}, 1 / 30, width=W)
+    assert m["led_wrong_side_fraction"] == pytest.approx(round(3 / 7, 4))
+    (c,) = evaluate_checks({"max_led_wrong_side_fraction": 0.5}, m)
+    assert c["passed"] and "43% of the frames judged" in c["text"]
+    (c,) = evaluate_checks({"max_led_wrong_side_fraction": 0.4}, m)
+    assert not c["passed"]
+
+
+def test_not_judged_without_found_frames_or_without_the_leds():
+    m = compute_metrics(_traj([120, 30], [0b1, 0b1], found=False), [], {}, 1 / 30, width=W)
+    assert m["led_wrong_side_fraction"] is None
+    (c,) = evaluate_checks({"max_led_wrong_side_fraction": 0.0}, m)
+    assert c["passed"] and c["text"] == "the target was never found to one side or at the centre"
+    # A design without the LEDs: not measured (docs/foreign.md).
+    traj = _traj([120], [0])
+    traj["centroid_leds"] = np.full(1, np.nan)
+    m = compute_metrics(traj, [], {}, 1 / 30, width=W, absent={"centroid_leds"})
+    assert m["led_wrong_side_fraction"] is None
+    (c,) = evaluate_checks({"max_led_wrong_side_fraction": 0.0}, m)
+    assert c["passed"] is None
