@@ -8,8 +8,10 @@ at which they decide differently is the place to look.
 
 from dataclasses import dataclass, field
 
-__all__ = ["COMPARED_OUTPUTS", "ShadowComparison", "divergence_event", "format_shadow",
-           "shadow_overrides"]
+import numpy as np
+
+__all__ = ["COMPARED_OUTPUTS", "ShadowComparison", "differing_outputs", "divergence_event",
+           "format_shadow", "output_value", "shadow_overrides"]
 
 #: The outputs compared frame by frame (the filtered image is compared as a pixel count).
 COMPARED_OUTPUTS = ("found", "proximity", "centroid_x", "centroid_leds", "motor_left",
@@ -38,11 +40,26 @@ def shadow_overrides(spec):
     return out
 
 
-def _value(result, name):
+def output_value(result, name):
+    """Output ``name`` of a ``FrameResult`` as a plain value for a report (the filtered image
+    as its count of matching pixels)."""
     if name == "filtered":
         return int((result.filtered != 0).sum())  # matching pixels; compared as images
     value = getattr(result, name)
     return bool(value) if name == "found" else int(value)
+
+
+def differing_outputs(a, b):
+    """The ``COMPARED_OUTPUTS`` in which two ``FrameResult``s differ; an output either of them
+    lacks (None) is not compared."""
+    differ = []
+    for name in COMPARED_OUTPUTS:
+        x, y = getattr(a, name), getattr(b, name)
+        if x is None or y is None:
+            continue
+        if not (np.array_equal(x, y) if name == "filtered" else x == y):
+            differ.append(name)
+    return differ
 
 
 @dataclass
@@ -55,25 +72,17 @@ class ShadowComparison:
     frames: int = 0
 
     def compare(self, frame, time_s, primary, shadow):
-        """Compare one frame's results; return the names of the outputs that differ. An output
-        one of the designs lacks (None) is not compared."""
+        """Compare one frame's results; return the names of the outputs that differ."""
         self.frames += 1
-        differ = []
-        for name in COMPARED_OUTPUTS:
-            if getattr(primary, name) is None or getattr(shadow, name) is None:
-                continue
-            if name == "filtered":
-                same = (primary.filtered == shadow.filtered).all()
-            else:
-                same = getattr(primary, name) == getattr(shadow, name)
-            if not same:
-                differ.append(name)
-                self.differing_frames[name] += 1
+        differ = differing_outputs(primary, shadow)
+        for name in differ:
+            self.differing_frames[name] += 1
         if differ and self.first_divergence is None:
             self.first_divergence = {
                 "frame": frame,
                 "time_s": round(time_s, 6),
-                "outputs": {n: {"primary": _value(primary, n), "shadow": _value(shadow, n)}
+                "outputs": {n: {"primary": output_value(primary, n),
+                                "shadow": output_value(shadow, n)}
                             for n in differ},
             }
         return differ
@@ -90,7 +99,7 @@ class ShadowComparison:
 
 def divergence_event(label, differ, primary, shadow):
     """The event text for the first frame where the designs part."""
-    parts = ", ".join(f"{n} {_value(primary, n)} vs {_value(shadow, n)}" for n in differ)
+    parts = ", ".join(f"{n} {output_value(primary, n)} vs {output_value(shadow, n)}" for n in differ)
     return f"shadow design {label} diverges: {parts}"
 
 

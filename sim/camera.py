@@ -52,6 +52,7 @@ __all__ = [
     "DEFAULT_MAX_LAYERS",
     "VERTICAL_MARGIN",
     "CameraRenderer",
+    "floor_shade",
     "focal_length",
     "max_hfov",
     "max_tilt",
@@ -330,7 +331,7 @@ class CameraRenderer:
         if noise_std:
             _check_noise(noise_std, rng)
         if scene.floor_patches:
-            image = paint_floor_patches(self, scene, pose)
+            image = paint_floor_patches(self, scene, pose, floor_shade(scene.lighting))
             if noise_std:
                 self._add_noise(image, noise_std, rng)
             return image
@@ -441,7 +442,7 @@ class CameraRenderer:
             )
         ambient, intensity, light = _light(scene.lighting)
         walls, cyls = self._geometry(scene)
-        floor_rgb = _lit(scene.floor_color, ambient + intensity * max(0.0, -light[2]), "floor")
+        floor_rgb = _lit(scene.floor_color, floor_shade(scene.lighting), "floor")
         ceil_rgb = _lit(scene.ceiling_color, ambient + intensity * max(0.0, light[2]), "ceiling")
         horizon = min(H, max(0, math.ceil(self._rows_of(0.0, tilt))))  # first floor row
 
@@ -686,6 +687,12 @@ def _light(lighting):
             f"lighting.ambient and lighting.intensity must be >= 0, got {ambient}, {intensity}"
         )
     return ambient, intensity, d / norm
+
+
+def floor_shade(lighting):
+    """How bright the flat floor is lit: ambient plus the light falling on it (Lambert)."""
+    ambient, intensity, light = _light(lighting)
+    return ambient + intensity * max(0.0, -light[2])
 
 
 def _lit(color, shade, what):

@@ -53,8 +53,9 @@ def _other_floor(color):
     return tuple(0.0 if c > 0.5 else 1.0 for c in color)
 
 
-def paint_floor_patches(renderer, scene, pose):
-    """The noise-free image of ``scene`` with its floor patches painted in."""
+def paint_floor_patches(renderer, scene, pose, shade):
+    """The noise-free image of ``scene`` with its floor patches painted in, lit by ``shade``
+    (the floor's, ``camera.floor_shade``)."""
     plain = dataclasses.replace(scene, floor_patches=())
     image = renderer.render(plain, pose)
     other = renderer.render(dataclasses.replace(plain, floor_color=_other_floor(scene.floor_color)),
@@ -71,9 +72,6 @@ def paint_floor_patches(renderer, scene, pose):
     hit = index >= 0
     if not hit.any():
         return image
-    light = scene.lighting
-    d = np.asarray(light.direction, dtype=float)
-    shade = light.ambient + light.intensity * max(0.0, -d[2] / np.linalg.norm(d))
     albedo = np.array([color for _, color in scene.floor_patches], dtype=float)
     rgb = np.clip(albedo * shade * 255.0 + 0.5, 0.0, 255.0).astype(np.uint8)
     image[rows[hit], cols[hit]] = rgb[index[hit]]

@@ -125,7 +125,6 @@ def test_compute_metrics_by_hand():
 
 
 def test_the_viewer_draws_absent_outputs_as_absent(tmp_path):
-    s = scenario()
     s = load_scenario("follow_person", [f'camera.resolution="{RES}"', "sim.duration=0.5"])
     path = tmp_path / "absent.rrd"
     rec = open_recorder(f"save:{path}", default_path=None)

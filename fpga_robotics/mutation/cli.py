@@ -59,17 +59,14 @@ def _report_robot(out, campaign, mutants, verdicts, unit, robot, robot_verdicts,
 
 def _record_closest(out, verdicts, say):
     """Record the closest-to-failing run of each verdict; ``{index: path}``."""
-    import shlex
-
     from ..sim.files import write_atomic
     from ..sweep import runner
 
     paths = {}
     for v in verdicts:
-        if not v.get("replay"):
+        if not v.get("argv"):
             continue
-        argv = shlex.split(v["replay"])[3:]  # after python -m fpga_robotics.run
-        o = runner.execute(argv, record=1)
+        o = runner.execute(v["argv"], record=1)
         if o.get("recording"):
             path = os.path.join(out, "recordings", f"mutant{v['index']}.rrd")
             os.makedirs(os.path.dirname(path), exist_ok=True)

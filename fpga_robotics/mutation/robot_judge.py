@@ -123,6 +123,7 @@ def robot_judge(campaign, netlist, ports, resolution, indices, out_dir, *, worke
     ones there)."""
     from distributed import as_completed
 
+    from ..sweep.api import wait_for_a_worker
     from ..sweep.engine import open_client
     from ..sweep.plan import make_plan
 
@@ -146,7 +147,7 @@ def robot_judge(campaign, netlist, ports, resolution, indices, out_dir, *, worke
     elif os.path.exists(journal):
         os.remove(journal)
     with open_client(scheduler=scheduler, workers=workers) as client:
-        client.wait_for_workers(1, timeout=60)
+        wait_for_a_worker(client, scheduler)
         say(f"robot judge: {len(base)} campaign runs with the unmutated design first")
         outcomes = _baseline(client, base, tick)
         passing = [i for i, o in enumerate(outcomes) if o["status"] == "pass"]
@@ -172,7 +173,8 @@ def robot_judge(campaign, netlist, ports, resolution, indices, out_dir, *, worke
                          "message": f"{type(exc).__name__}: {exc}".splitlines()[0],
                          "failed_checks": [], "closest": None, "runs": 0, "wall_s": 0.0}
                 at = v["run"] if v["caught"] else v["closest"]
-                v["replay"] = replay(argvs[at]) if at is not None else None
+                v["argv"] = argvs[at] if at is not None else None
+                v["replay"] = replay(v["argv"]) if at is not None else None
                 v["index"] = k
                 verdicts[k] = v
                 f.write(json.dumps(v) + "\n")

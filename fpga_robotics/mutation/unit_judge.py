@@ -15,17 +15,12 @@ real equivalent mutant, or a bug these frames cannot show).
 
 from dataclasses import dataclass, field
 
-import numpy as np
-
+from ..shadow import COMPARED_OUTPUTS, differing_outputs, output_value
 from ..sim import synthetic
 from ..sim.backends import BackendError, get_backend
 from ..sim.mutation import MUTATION_SELECT
 
-__all__ = ["COMPARED", "UnitVerdict", "golden_results", "judge_frames", "judge_mutant"]
-
-#: The outputs compared, in the order they are reported.
-COMPARED = ("found", "proximity", "centroid_x", "centroid_leds", "motor_left", "motor_right",
-            "filtered")
+__all__ = ["UnitVerdict", "golden_results", "judge_frames", "judge_mutant"]
 
 
 @dataclass
@@ -36,7 +31,7 @@ class UnitVerdict:
     caught: bool
     first_frame: int | None = None  # the first frame with a difference
     # output -> frames in which it differs
-    differing: dict = field(default_factory=lambda: dict.fromkeys(COMPARED, 0))
+    differing: dict = field(default_factory=lambda: dict.fromkeys(COMPARED_OUTPUTS, 0))
     first_difference: dict = field(default_factory=dict)  # output -> (model, mutant) there
     failure: str | None = None  # the design broke the frame protocol (a timeout, a bad stream)
 
@@ -76,13 +71,6 @@ def golden_results(params, frames):
     return [model.process_frame(f, color) for f, color in frames]
 
 
-def _value(result, name):
-    if name == "filtered":
-        return int(np.count_nonzero(result.filtered))  # matching pixels, for the report
-    value = getattr(result, name)
-    return bool(value) if name == "found" else int(value)
-
-
 def judge_mutant(design, index, frames, golden):
     """Run mutant ``index`` of ``design`` (a backend of the mutant netlist with ``mutsel`` as a
     ``[runtime]`` input; 0 is the unmutated design) on ``frames`` from a reset and compare
@@ -98,13 +86,12 @@ def judge_mutant(design, index, frames, golden):
                 verdict.caught, verdict.first_frame = True, k
                 verdict.failure = str(exc).split(": ", 2)[-1]
             break
-        differ = [n for n in COMPARED
-                  if (not np.array_equal(got.filtered, want.filtered) if n == "filtered"
-                      else getattr(got, n) != getattr(want, n))]
+        differ = differing_outputs(want, got)
         for name in differ:
             verdict.differing[name] += 1
         if differ and not verdict.caught:
             verdict.caught = True
             verdict.first_frame = k
-            verdict.first_difference = {n: (_value(want, n), _value(got, n)) for n in differ}
+            verdict.first_difference = {n: (output_value(want, n), output_value(got, n))
+                                        for n in differ}
     return verdict

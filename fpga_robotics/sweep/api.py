@@ -10,7 +10,7 @@ from .plan import make_plan
 from .report import format_report, write_html
 from .results import ResultStore, load_rows, read_meta, write_meta
 
-__all__ = ["report_dir", "run_campaign"]
+__all__ = ["report_dir", "run_campaign", "wait_for_a_worker"]
 
 
 def run_campaign(campaign, out_dir, *, workers=None, scheduler=None, resume=False,
@@ -38,7 +38,7 @@ def run_campaign(campaign, out_dir, *, workers=None, scheduler=None, resume=Fals
     try:
         with (_given(client) if client is not None else
               open_client(scheduler=scheduler, workers=workers)) as c:
-            _wait_for_a_worker(c, scheduler)
+            wait_for_a_worker(c, scheduler)
             t_build = time.perf_counter()
             builds = build_all(c, plan)
             meta["build_s"] = round(time.perf_counter() - t_build, 3)
@@ -68,7 +68,9 @@ def run_campaign(campaign, out_dir, *, workers=None, scheduler=None, resume=Fals
 WORKER_WAIT_S = 60
 
 
-def _wait_for_a_worker(client, scheduler):
+def wait_for_a_worker(client, scheduler):
+    """Wait (``WORKER_WAIT_S``) for a first worker; a scheduler without one is the user's to
+    fix (``UsageError`` saying how to start workers)."""
     from ..errors import UsageError
 
     try:

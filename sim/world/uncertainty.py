@@ -38,7 +38,7 @@ class MotorUncertainty:
         self.sigma = config.motor_noise_dps * DEG  # rad/s
         self.noise_left = self.noise_right = 0.0  # rad/s
         self.slip_until = -math.inf
-        self._events = []
+        self.events = []  # "wheel slip: ..." since the last drain_events()
         # Draws come in blocks (one generator call per block, not per step): the same
         # numbers in the same order as one at a time would give for each kind of draw.
         self._normals, self._uniforms = [], []
@@ -76,10 +76,10 @@ class MotorUncertainty:
             left, right = left * gl, right * gr
         if c.slip_rate_hz > 0.0 and t >= self.slip_until and self._uniform() < self._p_slip:
             self.slip_until = t + c.slip_duration_s
-            self._events.append(f"wheel slip: traction x{c.slip_traction:g} for "
+            self.events.append(f"wheel slip: traction x{c.slip_traction:g} for "
                                 f"{c.slip_duration_s:g} s")
         return left, right, (c.slip_traction if t < self.slip_until else 1.0)
 
     def drain_events(self):
-        events, self._events = self._events, []
+        events, self.events = self.events, []
         return events

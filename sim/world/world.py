@@ -231,7 +231,7 @@ class World:
         wl, wr = self.motors.step(h)
         if self.uncertainty is not None:
             wl, wr, slip = self.uncertainty.step(h, wl, wr, self.time)
-            if self.uncertainty._events:
+            if self.uncertainty.events:
                 self._events += self.uncertainty.drain_events()
             if self.terrain or slip != self._traction:
                 self._apply_terrain(slip, rx, ry)
