@@ -1,8 +1,11 @@
-"""Connectors between the design and the simulated world: what the design's ports see of the
-world (``CameraConnector``: rendered frames in) and what they do to it (``MotorConnector``:
-wheel commands out, after the actuation delay)."""
+"""Connectors between the design and the simulated world (the API: ``base.py``,
+docs/connectors.md): what the design's pins see of the world and what they do to it.
+Importing this package registers every shipped kind: ``camera`` (rendered frames in),
+``wheels`` (wheel commands out, after the actuation delay)."""
 
+from .base import CONNECTORS, Connector, ConnectorError, Mount, Pin, PinIO, register
 from .camera import CameraConnector, camera_pose, in_view
 from .motors import MotorConnector
 
-__all__ = ["CameraConnector", "MotorConnector", "camera_pose", "in_view"]
+__all__ = ["CONNECTORS", "CameraConnector", "Connector", "ConnectorError", "Mount",
+           "MotorConnector", "Pin", "PinIO", "camera_pose", "in_view", "register"]

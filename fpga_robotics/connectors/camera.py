@@ -14,6 +14,7 @@ from dataclasses import replace
 import numpy as np
 
 from ..errors import UsageError
+from .base import Connector, Mount, Pin, register
 from ..sim.scene import CameraPose
 
 __all__ = ["SENSOR_STREAM", "CameraConnector", "ExposureDrift", "camera_pose", "in_view",
@@ -111,8 +112,13 @@ def in_view(pose, hfov, px, py, radius):
     return abs(bearing) - math.asin(radius / dist) < hfov / 2
 
 
-class CameraConnector:
-    """Renders what the robot's camera sees.
+@register
+class CameraConnector(Connector):
+    """Renders what the robot's camera sees: the connector of kind ``camera``, bound to the
+    design's pixel stream (``pixels``: RGB444 with first/last flags, docs/contract.md) and
+    colour select. Scenarios configure it with the ``[camera]`` table (docs/scenarios.md);
+    the closed loop streams each capture into the design, in frames (compressed timing) or
+    pixel by pixel on the design clock with the sensor's blanking (real-clock timing).
 
     Parameters
     ----------
@@ -145,6 +151,7 @@ class CameraConnector:
     def __init__(self, width, height, hfov, *, mount_height, mount_forward=0.0, tilt=0.0,
                  noise_std=0.0, rng=None, sensor=None, turn_rate=None, yaw_offset=0.0,
                  drift=None, renderer="raster", render3d=None):
+        self.name, self.params, self.world = "camera", None, None
         self.width, self.height, self.hfov = width, height, hfov
         self.mount_height, self.mount_forward, self.tilt = mount_height, mount_forward, tilt
         self.noise_std = noise_std
@@ -152,6 +159,15 @@ class CameraConnector:
         self.renderer = make_renderer(renderer, width, height, hfov, render3d)
         self.sensor, self.turn_rate = sensor, turn_rate
         self.yaw_offset, self.drift = yaw_offset, drift
+
+    kind = "camera"
+    pins = {"pixels": Pin("in", 14), "color_sel": Pin("in", 3)}
+
+    @property
+    def mount(self):
+        """Where the camera sits (``base.Mount``), from the constructor's fields."""
+        return Mount(forward=self.mount_forward, height=self.mount_height,
+                     yaw=self.yaw_offset)
 
     def pose(self, robot_pose, pitch=0.0):
         """The camera's pose on a robot at ``robot_pose``; ``pitch`` (rad) adds to the

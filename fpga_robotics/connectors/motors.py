@@ -7,13 +7,22 @@ physics step at which it takes effect and applied with ``world.set_wheel_dps`` w
 simulation reaches that step; until then the previous command stays in force.
 """
 
+import math
 from collections import deque
+
+from .base import Connector, Pin, register
 
 __all__ = ["MotorConnector"]
 
 
-class MotorConnector:
-    """Delayed delivery of wheel commands (DPS) to the world.
+@register
+class MotorConnector(Connector):
+    """Delayed delivery of wheel commands (DPS) to the world: the connector of kind
+    ``wheels``, bound to the design's ``motor_left`` and ``motor_right`` outputs.
+
+    In frame timing the closed loop schedules each frame's command itself. In real-clock
+    timing the pins are watched: a change at edge ``e`` takes effect at the first physics
+    step at or after ``e / clock_hz + delay`` (``configure_real_clock``).
 
     Parameters
     ----------
@@ -21,10 +30,28 @@ class MotorConnector:
         Receives ``set_wheel_dps(left, right)``.
     """
 
+    kind = "wheels"
+    role = "actuator"
+    pins = {"motor_left": Pin("out", 16, signed=True), "motor_right": Pin("out", 16, signed=True)}
+    watch = ("motor_left", "motor_right")
+
     def __init__(self, world):
-        self.world = world
+        self.name, self.mount, self.params, self.world = "wheels", None, None, world
         self._pending = deque()  # (step, left, right), in step order
         self.applied = (0, 0)
+        self.dt = self.delay = None  # real-clock timing only
+
+    def configure_real_clock(self, dt, delay):
+        """Real-clock timing: physics steps of ``dt`` s, commands acting ``delay`` s after the
+        pins change."""
+        self.dt, self.delay = dt, delay
+
+    def on_change(self, io, pin, value, t):
+        """A wheel pin changed at edge ``io.cycle``: both pins' values act after the delay."""
+        step = math.ceil((io.time_of(io.cycle) + self.delay) / self.dt - 1e-9)
+        if self._pending and step < self._pending[-1][0]:
+            step = self._pending[-1][0]
+        self.schedule(step, io.peek("motor_left"), io.peek("motor_right"))
 
     def schedule(self, step, left_dps, right_dps):
         """Apply ``(left_dps, right_dps)`` at physics step ``step`` (not before)."""
