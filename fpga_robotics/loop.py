@@ -142,6 +142,7 @@ class ClosedLoop:
         self.traj = _empty_trajectory(self.n_frames)
         self.absent = set()  # DESIGN_OUTPUTS the design does not produce
         self.events = []  # (frame, time_s, text)
+        self.cycles = 0  # design clock edges simulated
         self.design_events = _DesignEvents(scenario.params.lost_frames)
         self.target_radius = next(
             (p.radius for p in self.world.people_states() if p.is_target), 0.0)
@@ -234,6 +235,13 @@ class ClosedLoop:
 
     def measure(self, k, t, pose, result):
         """Fill trajectory row ``k``; return the target's distance and visibility."""
+        measured = self.measure_world(k, t, pose)
+        self.store_outputs(k, result)
+        return measured
+
+    def measure_world(self, k, t, pose):
+        """Row ``k``'s robot and target fields at time ``t``; returns the target's distance
+        (None without a target) and whether it is in the camera's view."""
         rx, ry, heading = self.world.robot_pose()
         v, w = self.world.robot_velocity()
         cmd_v, cmd_w = self.world.commanded_twist()
@@ -249,17 +257,22 @@ class ClosedLoop:
         row = self.traj
         row["t"][k], row["x"][k], row["y"][k], row["heading"][k] = t, rx, ry, heading
         row["v"][k], row["w"][k], row["cmd_v"][k], row["cmd_w"][k] = v, w, cmd_v, cmd_w
-        for name in DESIGN_OUTPUTS:  # an absent one (None) drives its wheel at 0 DPS
-            value = getattr(result, name)
-            if value is None:
-                self.absent.add(name)  # stored as 0 here, NaN once the run is done (summary.py)
-            else:
-                row[name][k] = value
         row["color_sel"][k] = self.color_code
         row["target_x"][k], row["target_y"][k] = tx, ty
         row["target_distance"][k], row["target_in_view"][k] = dist, visible
         row["target_column"][k] = column
         return (None if target is None else dist), visible
+
+    def store_outputs(self, k, result):
+        """Row ``k``'s design outputs from ``result`` (a ``FrameResult``)."""
+        if result.cycles is not None:
+            self.cycles += result.cycles
+        for name in DESIGN_OUTPUTS:  # an absent one (None) drives its wheel at 0 DPS
+            value = getattr(result, name)
+            if value is None:
+                self.absent.add(name)  # stored as 0 here, NaN once the run is done (summary.py)
+            else:
+                self.traj[name][k] = value
 
     def record(self, k, t, rgb, result, distance, visible, events, shadow_result=None):
         """Hand the frame to the viewer and the ``on_frame`` callback."""
@@ -332,7 +345,8 @@ class ClosedLoop:
                     time.sleep(ahead)
         if self.ended_early is None:
             self.finish_physics()
-        else:  # the trajectory holds the frames done, every field alike
+        self.after_frames()
+        if self.ended_early is not None:  # the trajectory holds the frames done, every field alike
             self.traj = {name: a[:self.frames_done] for name, a in self.traj.items()}
         for name in self.absent:
             self.traj[name] = np.full(len(self.traj[name]), np.nan)
@@ -340,6 +354,14 @@ class ClosedLoop:
         cpu = time.process_time() - cpu_start
         return RunResult(summary=self.summarise(wall, cpu), trajectory=self.traj,
                          events=self.events)
+
+    def after_frames(self):
+        """Called once the frames (and the physics after them) are done."""
+
+    def timing_summary(self, wall):
+        """How the design's clock related to world time, and how fast it was simulated."""
+        return {"timing": "compressed", "clock_hz": None, "sim_cycles": self.cycles,
+                "cycles_per_wall_s": round(self.cycles / wall) if wall > 0 else None}
 
     def summarise(self, wall, cpu):
         scenario, cam, sim = self.scenario, self.scenario.camera, self.scenario.sim
@@ -369,6 +391,7 @@ class ClosedLoop:
             "realtime_factor": round(sim_time / wall, 3) if wall > 0 else None,
             # CPU time of this process: the cost per frame on a machine busy with other work.
             "cpu_ms_per_frame": round(1000.0 * cpu / max(1, n_frames), 4),
+            **self.timing_summary(wall),
             **metrics,
             "events": len(self.events),
             "verdict": verdict(checks),

@@ -72,7 +72,9 @@ _TOP_KEYS = ("name", "description", "seed")
 _APP_SECTIONS = ("sim", "camera", "color", "design", "checks")
 #: A foreign Verilog design instead of FollowTarget (docs/foreign.md): its files and port map.
 _FOREIGN_KEYS = ("verilog", "ports")
-_DESIGN_KEYS = ("preset",) + _FOREIGN_KEYS + tuple(f.name for f in fields(FollowTargetParams) if f.init and
+#: ``design.top`` (fpga_robotics.tops), a buggy ``variant``, and the tops' parameter tables.
+_TOP_DESIGN_KEYS = ("top", "variant", "ultrasound", "interlock", "line")
+_DESIGN_KEYS = ("preset",) + _TOP_DESIGN_KEYS + _FOREIGN_KEYS + tuple(f.name for f in fields(FollowTargetParams) if f.init and
                                    f.name not in ("width", "height"))
 #: Design parameters that are arrays: their length and what the values are.
 _DESIGN_ARRAYS = {
@@ -83,7 +85,9 @@ _DESIGN_ARRAYS = {
 
 #: Defaults of the application's sections (a key absent here is unknown).
 DEFAULTS = {
-    "sim": {"duration": 20.0, "physics_dt": 1.0 / 240.0, "actuation_delay": None},
+    # timing: "auto" (compressed for camera-only designs), "compressed" or "real_clock".
+    "sim": {"duration": 20.0, "physics_dt": 1.0 / 240.0, "actuation_delay": None,
+            "timing": "auto", "clock_hz": 50e6},
     "camera": {
         "resolution": "160x120",
         "fps": 30.0,
@@ -109,6 +113,7 @@ LIMITS = {
     "sim.duration": (0.0, MAX_TIME, "s"),  # one day
     "sim.physics_dt": (1e-5, None, "s"),  # at most one frame period (1 / camera.fps)
     "sim.actuation_delay": (0.0, 10.0, "s"),
+    "sim.clock_hz": (1e3, 1e9, "Hz"),
     "camera.fps": (0.1, 1000.0, "frames/s"),
     "camera.hfov": (0.01, 3.1, "rad"),  # and narrow enough for the image's aspect ratio
     "camera.mount_height": (0.0, None, "m"),  # and below the ceiling (room.height)
@@ -187,11 +192,20 @@ class CameraConfig:
         return 1.0 / self.fps
 
 
+#: ``sim.timing`` values.
+TIMINGS = ("auto", "compressed", "real_clock")
+#: In real-clock timing the readout and the processing are simulated, so the default
+#: actuation delay is only the command's trip to the motor controller (one SPI message), s.
+REAL_CLOCK_ACTUATION_DELAY = 0.001
+
+
 @dataclass(frozen=True)
 class SimConfig:
     duration: float
     physics_dt: float
     actuation_delay: float
+    timing: str = "compressed"  # "compressed" or "real_clock" (never "auto" once loaded)
+    clock_hz: float = 50e6
 
 
 @dataclass(frozen=True)
@@ -229,6 +243,13 @@ class Scenario:
     foreign : ForeignDesignFiles or None
         ``[design] verilog = [...]`` and ``ports = "..."``: a foreign Verilog design to run
         instead of FollowTarget (docs/foreign.md), paths resolved; None without them.
+    top : str
+        ``design.top``: the design to run (``fpga_robotics.tops``).
+    design_tables : dict
+        The top's parameter objects by sub-table (``[design.ultrasound]`` ...), a variant's
+        changes applied.
+    connectors : tuple of ConnectorSpec
+        ``[[robot.sensors]]`` and ``[[robot.actuators]]`` (fpga_robotics.connector_specs).
     """
 
     name: str
@@ -245,6 +266,9 @@ class Scenario:
     checks: dict
     overrides: tuple = ()
     foreign: "ForeignDesignFiles | None" = None
+    top: str = "follow_target"
+    design_tables: dict = field(default_factory=dict)
+    connectors: tuple = ()
 
     def color_at(self, t):
         """The colour select in force at simulated time ``t``."""
@@ -713,11 +737,14 @@ def _sim(data, camera):
     period = camera.frame_period
     dt = _limited(data, "sim.physics_dt", hi=period,
                   note=" (one camera frame period, 1 / camera.fps)")
+    timing = _choice(sim.get("timing", "auto"), "sim.timing", TIMINGS)
+    clock_hz = _limited(data, "sim.clock_hz")
     if sim.get("actuation_delay") is not None:
         delay = _limited(data, "sim.actuation_delay")
     else:
-        delay = period
-    config = SimConfig(duration=duration, physics_dt=dt, actuation_delay=delay)
+        delay = None  # one frame period, or REAL_CLOCK_ACTUATION_DELAY (_resolve_timing)
+    config = SimConfig(duration=duration, physics_dt=dt, actuation_delay=delay, timing=timing,
+                       clock_hz=clock_hz)
     steps = max(1, round(duration / dt))  # as the closed loop counts them
     if steps > MAX_PHYSICS_STEPS:
         raise ScenarioError(
@@ -789,7 +816,7 @@ def _foreign(design, source):
 
 def _design(data, width, height):
     design = dict(data["design"])
-    for key in _FOREIGN_KEYS:
+    for key in _FOREIGN_KEYS + _TOP_DESIGN_KEYS:
         design.pop(key, None)
     preset = design.pop("preset", None)
     for key, value in design.items():
@@ -821,6 +848,88 @@ def _design(data, width, height):
             raise ScenarioError(f"design.{message}") from None
         raise ScenarioError(f"invalid design parameters with camera.resolution "
                             f"{width}x{height}: {message}") from None
+
+
+def _top(design):
+    """``design.top`` and its parameter tables (a ``design.variant`` applied first)."""
+    from .tops import TOPS, design_tables
+
+    top = design.get("top", "follow_target")
+    if top not in TOPS:
+        raise ScenarioError(f"design.top must be one of {', '.join(map(repr, TOPS))}, "
+                            f"got {top!r}")
+    spec = TOPS[top]
+    tables = {}
+    for key in ("ultrasound", "interlock", "line"):
+        value = design.get(key)
+        if value is None:
+            continue
+        if key not in spec.tables:
+            raise ScenarioError(f"design.{key} is a table of another design; design.top = "
+                                f"{top!r} takes: {', '.join(spec.tables) or 'none'}")
+        if not isinstance(value, dict):
+            raise ScenarioError(f"design.{key} must be a table ([design.{key}] in a file), "
+                                f"got {value!r}")
+        tables[key] = dict(value)
+    variant = design.get("variant")
+    if variant is not None:
+        tables = _apply_variant(top, variant, tables)
+    try:
+        return top, design_tables(spec, tables)
+    except ValueError as exc:
+        raise ScenarioError(str(exc)) from None
+
+
+def _apply_variant(top, variant, tables):
+    """``design.variant``: a named buggy variant (fpga_robotics.hw.variants) of ``top``."""
+    from .hw.variants import VARIANTS
+
+    names = [n for n, v in VARIANTS.items() if v.top == top]
+    if variant not in names:
+        raise ScenarioError(f"design.variant must be one of {', '.join(map(repr, names)) or '(none for this top)'} "
+                            f"for design.top = {top!r}, got {variant!r}")
+    out = {k: dict(v) for k, v in tables.items()}
+    for key, changes in VARIANTS[variant].tables.items():
+        out.setdefault(key, {}).update(changes)
+    return out
+
+
+def _connectors(world):
+    """``robot.sensors`` / ``robot.actuators``, taken out of the world's ``robot`` table."""
+    from .connector_specs import parse_connectors
+    from .connectors import ConnectorError
+
+    robot = world.get("robot")
+    if not isinstance(robot, dict):
+        return ()
+    try:
+        return parse_connectors(robot)
+    except ConnectorError as exc:
+        raise ScenarioError(str(exc)) from None
+
+
+def _resolve_timing(sim, camera, top, connectors, foreign):
+    """``sim.timing = "auto"`` made definite; a design or connector with pins of its own
+    needs real-clock timing."""
+    from dataclasses import replace
+
+    # Every design but the camera-only follow_target has pins of its own.
+    pins = [f"the {c.kind} connector" for c in connectors]
+    if top != "follow_target":
+        pins.insert(0, f"design.top = {top!r}")
+    timing = sim.timing
+    if timing == "auto":
+        timing = "real_clock" if pins else "compressed"
+    elif timing == "compressed" and pins:
+        raise ScenarioError(f"sim.timing = \"compressed\" runs the design only while pixels "
+                            f"flow; {pins[0]} needs sim.timing = \"real_clock\" (or \"auto\")")
+    if timing == "real_clock" and foreign is not None:
+        raise ScenarioError("sim.timing = \"real_clock\" runs this project's designs "
+                            "(design.top); a foreign Verilog design runs in compressed timing")
+    delay = sim.actuation_delay
+    if delay is None:
+        delay = REAL_CLOCK_ACTUATION_DELAY if timing == "real_clock" else camera.frame_period
+    return replace(sim, timing=timing, actuation_delay=delay)
 
 
 def _checks(data):
@@ -855,8 +964,11 @@ def _build(data, source, overrides):
     initial, changes = _color_changes(data)
     params = _design(data, camera.width, camera.height)
     foreign = _foreign(dict(data["design"]), source)
+    top, tables = _top(data["design"])
     checks = _checks(data)
     world = {s: copy.deepcopy(data[s]) for s in WORLD_SECTIONS if s in data}
+    connectors = _connectors(world)
+    sim = _resolve_timing(sim, camera, top, connectors, foreign)
     _check_camera_geometry(camera, _check_world(world))
     return Scenario(
         name=name,
@@ -873,4 +985,7 @@ def _build(data, source, overrides):
         checks=checks,
         overrides=tuple(overrides),
         foreign=foreign,
+        top=top,
+        design_tables=tables,
+        connectors=connectors,
     )

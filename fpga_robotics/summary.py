@@ -115,6 +115,7 @@ _METRIC_OUTPUTS = {
 #: Summary fields that depend on the machine, not on the simulation.
 TIMING_FIELDS = (
     "wall_time_s", "ms_per_frame", "realtime_factor", "cpu_ms_per_frame", "backend_setup_s",
+    "cycles_per_wall_s",
 )
 
 

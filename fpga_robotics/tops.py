@@ -1,0 +1,104 @@
+"""The designs a scenario can run (``[design] top = "..."``): for each, how to build it, its
+parameter tables, which connector pins bind to which of its ports, and which of the run's
+per-frame outputs it has.
+
+``follow_target`` is the camera-only design of docs/contract.md (frames in, wheel speeds
+out). ``follow_target_safe`` adds an HC-SR04 ultrasound driver and an interlock that stops
+the wheels near an obstacle; ``follow_line`` steers by KY-033 line sensors
+(docs/sensor_designs.md). A design with pins other than the camera's and the wheels' runs
+in real-clock timing (``[sim] timing``).
+"""
+
+import dataclasses
+import importlib
+from dataclasses import dataclass, field
+
+__all__ = ["TOPS", "Top", "build_component", "design_tables", "get_top"]
+
+
+@dataclass(frozen=True)
+class Top:
+    name: str
+    description: str
+    #: The design takes the camera's pixel stream (and has FollowTarget's frame outputs).
+    camera: bool
+    #: Scenario sub-table ``[design.<key>]`` -> (module, params class) of its parameters.
+    tables: dict = field(default_factory=dict)
+    #: connector kind -> {connector pin: design port}.
+    bindings: dict = field(default_factory=dict)
+    #: More outputs the run records each frame: trajectory field -> design port.
+    extra_outputs: dict = field(default_factory=dict)
+    #: (module, class) of the component; built as ``cls(ft_params, *table params)``.
+    component: tuple = ("fpga_robotics.hw.top", "FollowTarget")
+    #: Whether the FollowTarget params (``[design]`` keys) are the first argument.
+    takes_follow_target_params: bool = True
+
+
+_CAMERA = {"camera": {"pixels": "pixels", "color_sel": "color_sel"}}
+_WHEELS = {"wheels": {"motor_left": "motor_left", "motor_right": "motor_right"}}
+
+TOPS = {
+    "follow_target": Top(
+        "follow_target", "FollowTarget: colour filter, tracker and motor controller",
+        camera=True, bindings={**_CAMERA, **_WHEELS}),
+    "follow_target_safe": Top(
+        "follow_target_safe",
+        "FollowTarget with an HC-SR04 ultrasound driver and an obstacle interlock",
+        camera=True,
+        tables={"ultrasound": ("fpga_robotics.hw.ultrasound", "UltrasoundParams"),
+                "interlock": ("fpga_robotics.hw.safe_follow", "InterlockParams")},
+        bindings={**_CAMERA, **_WHEELS, "ultrasound": {"trig": "us_trig", "echo": "us_echo"}},
+        extra_outputs={"distance_mm": "distance_mm", "obstacle": "obstacle"},
+        component=("fpga_robotics.hw.safe_follow", "FollowTargetSafe")),
+    "follow_line": Top(
+        "follow_line", "FollowLine: KY-033 line sensors to wheel speeds",
+        camera=False,
+        tables={"line": ("fpga_robotics.hw.follow_line", "FollowLineParams")},
+        bindings={**_WHEELS, "line_sensors": {"line": "line"}},
+        extra_outputs={"line_seen": "line_seen"},
+        component=("fpga_robotics.hw.follow_line", "FollowLine"),
+        takes_follow_target_params=False),
+}
+
+
+def get_top(name):
+    try:
+        return TOPS[name]
+    except KeyError:
+        raise ValueError(f"design.top must be one of {', '.join(map(repr, TOPS))}, "
+                         f"got {name!r}") from None
+
+
+def _load(module_and_name):
+    module, name = module_and_name
+    return getattr(importlib.import_module(module), name)
+
+
+def design_tables(top, tables):
+    """The params objects of ``top``'s sub-tables from ``{key: {field: value}}`` (missing
+    tables: the defaults). Raises ``ValueError`` naming ``design.<key>.<field>``."""
+    out = {}
+    for key, where in top.tables.items():
+        cls = _load(where)
+        values = dict(tables.get(key) or {})
+        known = {f.name: f for f in dataclasses.fields(cls) if f.init}
+        for name, value in values.items():
+            if name not in known:
+                raise ValueError(f"unknown key design.{key}.{name}; known: "
+                                 f"{', '.join(sorted(known))}")
+            if isinstance(value, list):
+                values[name] = tuple(value)
+        try:
+            out[key] = cls(**values)
+        except (TypeError, ValueError) as exc:
+            raise ValueError(f"design.{key}: {exc}") from None
+    return out
+
+
+def build_component(top, ft_params, table_params):
+    """The Amaranth component of ``top`` (``table_params`` from ``design_tables``)."""
+    cls = _load(top.component)
+    args = [table_params[k] for k in top.tables]
+    if top.takes_follow_target_params:
+        args.insert(0, ft_params)
+    return cls(*args)
