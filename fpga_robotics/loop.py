@@ -458,6 +458,10 @@ def run_scenario(scenario, *, seed=None, backend="auto", recorder=None, progress
         Live control inputs (``fpga_robotics.ros.controls``): colour select, the target
         driven by hand, pause and step; applied just after each frame's capture.
     """
+    if scenario.sim.timing == "real_clock":
+        return _run_real_clock(scenario, seed=seed, backend=backend, recorder=recorder,
+                               progress=progress, realtime=realtime, on_frame=on_frame,
+                               shadow=shadow, controls=controls)
     owns_backend = isinstance(backend, str)
     design = make_backend(backend, scenario.params) if owns_backend else backend
     try:
@@ -469,6 +473,26 @@ def run_scenario(scenario, *, seed=None, backend="auto", recorder=None, progress
         loop = ClosedLoop(scenario, seed=seed, design=design, recorder=recorder,
                           on_frame=on_frame, shadow=shadow, shadow_label=shadow_label,
                           controls=controls)
+        return loop.run(progress=progress, realtime=realtime)
+    finally:
+        if owns_backend:
+            design.close()
+
+
+def _run_real_clock(scenario, *, seed, backend, recorder, progress, realtime, on_frame, shadow,
+                    controls):
+    """``run_scenario`` in real-clock timing (fpga_robotics.clocked_loop)."""
+    from .clocked_loop import RealClockLoop, make_pin_backend
+    from .errors import UsageError
+
+    if shadow is not None:
+        raise UsageError("shadow runs compare frames; they need sim.timing = \"compressed\"")
+    owns_backend = isinstance(backend, str)
+    design = make_pin_backend(backend, scenario) if owns_backend else backend
+    try:
+        design.reset()
+        loop = RealClockLoop(scenario, seed=seed, design=design, recorder=recorder,
+                             on_frame=on_frame, controls=controls)
         return loop.run(progress=progress, realtime=realtime)
     finally:
         if owns_backend:
