@@ -258,6 +258,16 @@ class RealClockLoop(ClosedLoop):
         self.traj.update({f"design.{k}": v for k, v in self.extra.items()})
         self.traj.update(self.measurements)
 
+    def extra_metrics(self):
+        """Also the line metrics, over the world's floor lines, from the line sensors' mounts."""
+        from .sensor_metrics import line_metrics
+
+        mounts = [m for c in self.sensors if c.kind == "line_sensors"
+                  for m in c.sensor_mounts()]
+        return {**super().extra_metrics(),
+                **line_metrics(self.traj, getattr(self.world, "floor_lines", ()), mounts,
+                               self.period)}
+
     def timing_summary(self, wall):
         cycles = self.pins.cycle
         return {"timing": "real_clock", "clock_hz": self.clock_hz, "sim_cycles": cycles,

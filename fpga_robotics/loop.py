@@ -358,6 +358,13 @@ class ClosedLoop:
     def after_frames(self):
         """Called once the frames (and the physics after them) are done."""
 
+    def extra_metrics(self):
+        """Metrics beyond ``compute_metrics``: whether following resumed after an obstacle
+        left (fpga_robotics.sensor_metrics)."""
+        from .sensor_metrics import obstacle_metrics
+
+        return obstacle_metrics(self.traj, self.events)
+
     def timing_summary(self, wall):
         """How the design's clock related to world time, and how fast it was simulated."""
         return {"timing": "compressed", "clock_hz": None, "sim_cycles": self.cycles,
@@ -371,6 +378,7 @@ class ClosedLoop:
                                   self.period,
                                   at_fault_collisions=self.world.at_fault_collisions(),
                                   width=cam.width, absent=self.absent)
+        metrics.update(self.extra_metrics())
         checks = evaluate_checks(scenario.checks, metrics)
         shadow = {"shadow": self.comparison.summary()} if self.comparison is not None else {}
         return {

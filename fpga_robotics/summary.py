@@ -8,6 +8,7 @@ itself. ``format_summary`` is the human version printed by the runner.
 
 import numpy as np
 
+from .sensor_metrics import SENSOR_CHECKS, sensor_check
 from .sim.world.config import MAX_TIME
 
 __all__ = [
@@ -85,6 +86,8 @@ DESIGN_OUTPUTS = ("found", "proximity", "centroid_x", "centroid_leds", "motor_le
                   "motor_right")
 
 #: The design outputs a check is measured from (checks not named here need none).
+#: The sensor designs' checks (fpga_robotics.sensor_metrics).
+CHECKS.update(SENSOR_CHECKS)
 CHECK_OUTPUTS = {
     "acquired_within_s": ("found",),
     "found_min_fraction": ("found",),
@@ -402,6 +405,11 @@ def evaluate_checks(checks, m):
             ok = v is not None and v <= limit
             text = ("no heading to compare" if v is None
                     else f"turned {v:.1f} deg past the target (limit <= {limit} deg)")
+        elif name in SENSOR_CHECKS:
+            ok, text = sensor_check(name, limit, m)
+            v = m.get({"min_laps": "laps", "max_off_line_s": "off_line_s",
+                       "max_lateral_error_m": "lateral_error_max_m"}.get(name,
+                                                                         "resumed_after_s"))
         elif name.startswith("max_") and name.endswith("_collisions"):
             kind = name[len("max_"): -len("_collisions")]
             v = int(m["collisions"].get(kind, 0))
