@@ -20,7 +20,7 @@ that frame (at its ``frame_done``) and the wheel pins at the next capture. A des
 camera (``follow_line``) has its rows sampled at the camera's frame rate all the same.
 """
 
-import math
+import hashlib
 
 import numpy as np
 
@@ -46,7 +46,8 @@ def pin_design_source(scenario):
 
     top = TOPS[scenario.top]
     params, tables = scenario.params, scenario.design_tables
-    key = f"{top.name}:{params!r}:{sorted(tables.items())!r}"
+    described = f"{params!r}:{sorted(tables.items())!r}"
+    key = f"{top.name}-{hashlib.sha256(described.encode()).hexdigest()[:16]}"
     extra = {}
     if top.camera:
         extra = dict(pixels=("pixels__valid", "pixels__payload"),
