@@ -50,9 +50,9 @@ def pin_design_source(scenario):
     key = f"{top.name}-{hashlib.sha256(described.encode()).hexdigest()[:16]}"
     extra = {}
     if top.camera:
-        extra = dict(pixels=("pixels__valid", "pixels__payload"),
-                     filtered=("filtered__valid", "filtered__payload"),
-                     frame_size=(params.width, params.height))
+        extra = {"pixels": ("pixels__valid", "pixels__payload"),
+                     "filtered": ("filtered__valid", "filtered__payload"),
+                     "frame_size": (params.width, params.height)}
     return PinDesignSource(lambda: build_component(top, params, tables), key, **extra)
 
 

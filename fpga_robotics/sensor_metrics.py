@@ -19,14 +19,14 @@ _REMOVED = re.compile(r"furniture '(.*)' removed")
 
 SENSOR_CHECKS = {
     "max_lateral_error_m": (float, (0, 100, "m"),
-                            "the line sensors' centre stays within this distance of the nearest "
-                            "floor line's centreline"),
+                            ("the line sensors' centre stays within this distance of the nearest "
+                            "floor line's centreline")),
     "min_laps": (int, (0, 10**6, ""), "at least this many whole laps of the closed floor line"),
     "max_off_line_s": (float, (0, _DAY, "s"),
                        "at most this long in all with no line sensor over a floor line"),
     "resumes_within_s": (float, (0, _DAY, "s"),
-                         f"after the last piece of furniture is removed, the robot closes "
-                         f"{RESUME_CLOSING_M} m on the target within this time"),
+                         (f"after the last piece of furniture is removed, the robot closes "
+                         f"{RESUME_CLOSING_M} m on the target within this time")),
 }
 
 

@@ -8,5 +8,17 @@ from .bumper import BumperConnector
 from .camera import CameraConnector, camera_pose, in_view
 from .motors import MotorConnector
 
-__all__ = ["CONNECTORS", "BumperConnector", "CameraConnector", "Connector", "ConnectorError", "Mount",
-           "MotorConnector", "Pin", "PinIO", "camera_pose", "in_view", "register"]
+__all__ = [
+           "CONNECTORS",
+           "BumperConnector",
+           "CameraConnector",
+           "Connector",
+           "ConnectorError",
+           "MotorConnector",
+           "Mount",
+           "Pin",
+           "PinIO",
+           "camera_pose",
+           "in_view",
+           "register",
+]

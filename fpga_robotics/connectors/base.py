@@ -116,9 +116,8 @@ class Connector:
         ``name`` and the mount keys); return the params object. Raise ``ConnectorError``
         naming ``where`` (e.g. ``robot.sensors[0]``) and the key."""
         if table:
-            raise ConnectorError(f"{where}: unknown key {sorted(table)[0]!r} for a "
+            raise ConnectorError(f"{where}: unknown key {min(table)!r} for a "
                                  f"{cls.kind!r} connector")
-        return None
 
     def start(self, io):
         """Called once, after the design's reset, before the first physics step."""

@@ -7,6 +7,7 @@ inside the bumper's arc (``arc_deg`` wide, centred on the mount's yaw).
 """
 
 import math
+from typing import ClassVar
 
 import pymunk
 
@@ -28,7 +29,7 @@ class BumperParams:
 @register
 class BumperConnector(Connector):
     kind = "bumper"
-    pins = {"pressed": Pin("in", 1)}
+    pins: ClassVar[dict] = {"pressed": Pin("in", 1)}
 
     @classmethod
     def parse(cls, table, where):

@@ -10,12 +10,13 @@ sensor, and the capture is what the OV7670 makes of it.
 
 import math
 from dataclasses import replace
+from typing import ClassVar
 
 import numpy as np
 
 from ..errors import UsageError
-from .base import Connector, Mount, Pin, register
 from ..sim.scene import CameraPose
+from .base import Connector, Mount, Pin, register
 
 __all__ = ["SENSOR_STREAM", "CameraConnector", "ExposureDrift", "camera_pose", "in_view",
            "make_renderer", "make_sensor"]
@@ -161,7 +162,7 @@ class CameraConnector(Connector):
         self.yaw_offset, self.drift = yaw_offset, drift
 
     kind = "camera"
-    pins = {"pixels": Pin("in", 14), "color_sel": Pin("in", 3)}
+    pins: ClassVar[dict] = {"pixels": Pin("in", 14), "color_sel": Pin("in", 3)}
 
     @property
     def mount(self):

@@ -8,6 +8,7 @@ simulation reaches that step; until then the previous command stays in force.
 """
 
 import math
+from typing import ClassVar
 from collections import deque
 
 from .base import Connector, Pin, register
@@ -32,7 +33,7 @@ class MotorConnector(Connector):
 
     kind = "wheels"
     role = "actuator"
-    pins = {"motor_left": Pin("out", 16, signed=True), "motor_right": Pin("out", 16, signed=True)}
+    pins: ClassVar[dict] = {"motor_left": Pin("out", 16, signed=True), "motor_right": Pin("out", 16, signed=True)}
     watch = ("motor_left", "motor_right")
 
     def __init__(self, world):
