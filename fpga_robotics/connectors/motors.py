@@ -8,8 +8,8 @@ simulation reaches that step; until then the previous command stays in force.
 """
 
 import math
-from typing import ClassVar
 from collections import deque
+from typing import ClassVar
 
 from .base import Connector, Pin, register
 
