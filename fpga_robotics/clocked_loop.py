@@ -29,6 +29,7 @@ from .errors import UsageError
 from .loop import ClosedLoop
 from .sim.backends.base import FrameResult
 from .sim.frames import to_rgb444
+from .sim.records import SensorReading
 from .tops import TOPS, build_component
 
 __all__ = ["RealClockLoop", "make_pin_backend", "pin_design_source"]
@@ -66,6 +67,20 @@ def make_pin_backend(name, scenario, *, on_build=None):
                          "cxxrtl, verilator or pysim")
     kwargs = {"on_build": on_build} if on_build is not None else {}
     return get_pin_backend(name, pin_design_source(scenario), **kwargs)
+
+
+class _PendingRow:
+    """Trajectory row ``k`` between its capture and the end of its frame's processing."""
+
+    __slots__ = ("distance", "edge", "events", "filtered", "k", "outputs", "readings", "rgb",
+                 "t", "visible")
+
+    def __init__(self, k, t, rgb, events, distance, visible, edge, readings):
+        self.k, self.t, self.rgb, self.events = k, t, rgb, events
+        self.distance, self.visible, self.edge = distance, visible, edge
+        self.readings = readings  # {connector name: SensorReading} at the capture
+        self.outputs = None  # the per-frame outputs, at the frame strobe
+        self.filtered = None
 
 
 class RealClockLoop(ClosedLoop):
@@ -173,11 +188,11 @@ class RealClockLoop(ClosedLoop):
 
     def design_output_changed(self, port, value, t):
         if port == _FRAME_STROBE:
-            if value and self.pending is not None and self.pending[4] is None:
-                self.pending[4] = {name: self.pins.peek(name) for name in _FRAME_OUTPUTS}
-                self.pending[5] = self.pins.filtered_frame()
+            if value and self.pending is not None and self.pending.outputs is None:
+                self.pending.outputs = {name: self.pins.peek(name) for name in _FRAME_OUTPUTS}
+                self.pending.filtered = self.pins.filtered_frame()
         elif port == "obstacle":
-            k = self.pending[0] if self.pending is not None else 0
+            k = self.pending.k if self.pending is not None else 0
             self.events.append((k, round(t, 6), "interlock: obstacle, wheels stopped" if value
                                 else "interlock: clear, wheels released"))
 
@@ -212,8 +227,25 @@ class RealClockLoop(ClosedLoop):
         if self.top.camera:
             self._stream(rgb)
         distance, visible = self.measure_world(k, t, pose)
-        self.pending = [k, t, rgb, events, None, None, distance, visible, self.pins.cycle]
+        self.pending = _PendingRow(k, t, rgb, events, distance, visible, self.pins.cycle,
+                                   self.read_sensors(k))
         self.frames_done = k + 1
+
+    def read_sensors(self, k):
+        """The connectors' measurements into row ``k``; their readings for the viewer."""
+        readings = {}
+        for conn in self.sensors:
+            values = conn.measurement()
+            for key, value in values.items():
+                column = self.measurements.setdefault(
+                    f"{conn.name}.{key}", np.full(self.n_frames, np.nan))
+                column[k] = np.nan if value is None else float(value)
+            if self.want_records:
+                overlay = conn.map_overlay()
+                readings[conn.name] = SensorReading(
+                    conn.kind, dict(values), tuple(overlay.get("points", ())),
+                    tuple(overlay.get("states", ())), tuple(overlay.get("rays", ())))
+        return readings
 
     def _stream(self, rgb):
         from .sim.pins.timing import real_clock_timing
@@ -229,29 +261,28 @@ class RealClockLoop(ClosedLoop):
 
     def finish_row(self):
         """Complete the pending row: its outputs, the wheel pins now, events, the record."""
-        if self.pending is None:
+        row, self.pending = self.pending, None
+        if row is None:
             return
-        k, t, rgb, events, outputs, filtered, distance, visible, edge = self.pending
-        self.pending = None
-        outputs = outputs or {}
+        outputs = row.outputs or {}
         values = {name: (outputs.get(name) if self.top.camera else None)
                   for name in _FRAME_OUTPUTS}
-        values["motor_left"] = self.pins.peek(self.io[self.motors].binding["motor_left"])
-        values["motor_right"] = self.pins.peek(self.io[self.motors].binding["motor_right"])
-        result = FrameResult(filtered=filtered, cycles=self.pins.cycle - edge, **values)
-        self.store_outputs(k, result)
+        wheels = self.io[self.motors].binding
+        values["motor_left"] = self.pins.peek(wheels["motor_left"])
+        values["motor_right"] = self.pins.peek(wheels["motor_right"])
+        result = FrameResult(filtered=row.filtered, cycles=self.pins.cycle - row.edge, **values)
+        self.store_outputs(row.k, result)
+        events = row.events
         if result.found is not None:
             events += self.design_events.update(bool(result.found))
+        extra = {}
         for name, port in self.top.extra_outputs.items():
-            self.extra[name][k] = float(self.pins.peek(port))
-        for conn in self.sensors:
-            for key, value in conn.measurement().items():
-                column = self.measurements.setdefault(
-                    f"{conn.name}.{key}", np.full(self.n_frames, np.nan))
-                column[k] = np.nan if value is None else float(value)
-        self.events += [(k, round(t, 6), e) for e in events]
+            extra[name] = self.pins.peek(port)
+            self.extra[name][row.k] = float(extra[name])
+        self.events += [(row.k, round(row.t, 6), e) for e in events]
         if self.want_records:
-            self.record(k, t, rgb, result, distance, visible, events)
+            self.record(row.k, row.t, row.rgb, result, row.distance, row.visible, events,
+                        sensors=row.readings, design_extra=extra)
 
     def after_frames(self):
         self.finish_row()

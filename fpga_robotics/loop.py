@@ -274,8 +274,10 @@ class ClosedLoop:
             else:
                 self.traj[name][k] = value
 
-    def record(self, k, t, rgb, result, distance, visible, events, shadow_result=None):
-        """Hand the frame to the viewer and the ``on_frame`` callback."""
+    def record(self, k, t, rgb, result, distance, visible, events, shadow_result=None,
+               **extra):
+        """Hand the frame to the viewer and the ``on_frame`` callback; ``extra`` are more
+        ``FrameRecord`` fields (``sensors``, ``design_extra``)."""
         row = self.traj
         record = FrameRecord(
             frame=k, sim_time=t, camera_rgb=rgb, color_sel=self.color_code, result=result,
@@ -285,7 +287,7 @@ class ClosedLoop:
             people=self.world.people_states(), target_distance=distance,
             target_in_view=visible, events=events, shadow_result=shadow_result,
             scene=self.scene, camera_pose=self.pose,
-            robot_radius=self.world.robot_spec.body_radius,
+            robot_radius=self.world.robot_spec.body_radius, **extra,
         )
         if self.recorder is not None:
             self.recorder.log_frame(record)

@@ -11,7 +11,7 @@ import numpy as np
 
 from .backends.base import FrameResult
 
-__all__ = ["FrameRecord", "PersonState", "WorldMap"]
+__all__ = ["FrameRecord", "PersonState", "SensorReading", "WorldMap"]
 
 
 @dataclass(frozen=True)
@@ -62,3 +62,22 @@ class FrameRecord:
     scene: object = None  # sim.scene.Scene
     camera_pose: object = None  # sim.scene.CameraPose
     robot_radius: float = 0.0
+    # Real-clock timing: what each connector measured and what the design saw at its pins,
+    # {name: SensorReading}, and the design's outputs beyond FollowTarget's ({name: value}:
+    # distance_mm, obstacle, line_seen).
+    sensors: dict = field(default_factory=dict)
+    design_extra: dict = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class SensorReading:
+    """One connector's reading for the viewer: its ``kind``, its measurement values
+    (``Connector.measurement``), and what to draw on the map: ``points`` (x, y) with a
+    0/1 ``state`` each (line sensors: over the line or not) and ``rays`` ((x0, y0), (x1, y1))
+    (an ultrasound's measured range)."""
+
+    kind: str
+    values: dict
+    points: tuple = ()
+    states: tuple = ()
+    rays: tuple = ()

@@ -135,6 +135,11 @@ class Connector:
         """The latest values for the trajectory and the viewer: ``{name: float}``."""
         return {}
 
+    def map_overlay(self):
+        """What the viewer draws on the map now: ``{"points": ((x, y), ...), "states":
+        (0/1 per point), "rays": (((x0, y0), (x1, y1)), ...)}`` (any key may be left out)."""
+        return {}
+
 
 def register(cls):
     """Class decorator: make ``cls`` available as ``kind = cls.kind`` in scenarios."""

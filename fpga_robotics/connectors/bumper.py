@@ -75,3 +75,7 @@ class BumperConnector(Connector):
 
     def measurement(self):
         return {"pressed": self.pressed}
+
+    def map_overlay(self):
+        x, y, heading = self.mount.world_pose(*self.world.robot_pose())
+        return {"points": ((x, y),), "states": (self.pressed,)}
