@@ -77,5 +77,5 @@ class BumperConnector(Connector):
         return {"pressed": self.pressed}
 
     def map_overlay(self):
-        x, y, heading = self.mount.world_pose(*self.world.robot_pose())
+        x, y, _ = self.mount.world_pose(*self.world.robot_pose())
         return {"points": ((x, y),), "states": (self.pressed,)}
