@@ -30,10 +30,11 @@ def _trail_range():
     )
 
 
-def default_blueprint(bounds=None, shadow=False, world3d=False):
+def default_blueprint(bounds=None, shadow=False, world3d=False, sensors=()):
     """The layout sent to the viewer; ``bounds`` ``(xmin, ymin, xmax, ymax)`` frame the map;
     ``shadow`` adds a second LED row and the shadow design's wheel speeds; ``world3d`` puts
-    the world in 3D (``viz.world3d``) beside the map."""
+    the world in 3D (``viz.world3d``) beside the map; ``sensors`` (series entity paths,
+    ``viz.sensors``) come first among the plots under the map, one tab each."""
     map_kwargs = {}
     if bounds is not None:
         xmin, ymin, xmax, ymax = (float(v) for v in bounds)
@@ -77,6 +78,8 @@ def default_blueprint(bounds=None, shadow=False, world3d=False):
         rrb.Horizontal(top_down, world3d_view(bounds)) if world3d else top_down,
         rrb.Horizontal(
             rrb.Tabs(
+                *(rrb.TimeSeriesView(origin=path, name=path.split("/", 1)[1])
+                  for path in sensors),
                 rrb.TimeSeriesView(origin=P.DESIGN_TRACKING, name="found, proximity"),
                 rrb.TimeSeriesView(origin=P.DESIGN_CENTROID_X, name="centroid_x"),
                 rrb.TimeSeriesView(origin=P.TARGET_DISTANCE, name="target distance m"),

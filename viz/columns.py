@@ -107,6 +107,15 @@ class ColumnBuffer:
         self._frames = 0
         self._last_send = time.monotonic()
 
+    def register(self, key, builder):
+        """Take rows for ``key`` from now on (an entity that appears during a run); returns
+        whether it is new."""
+        if key in self._builders:
+            return False
+        self._builders = {**self._builders, key: builder}
+        self._rows[key] = _Rows()
+        return True
+
     def add(self, path, frame, t_ns, row):
         r = self._rows[path]
         r.frames.append(frame)

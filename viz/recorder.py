@@ -42,6 +42,7 @@ from .leds import centroid_image, proximity_image
 from .modes import parse_mode
 from .outcome import settle
 from .sinks import open_output
+from .sensors import MAP_LINES, SensorViews, line_strips
 from .world3d import World3D
 
 __all__ = ["Recorder", "open_recorder"]
@@ -167,11 +168,13 @@ class Recorder:
         self._shadow_seen = False  # a shadow design's first frame re-lays out the board
         self._world3d = None  # viz.world3d.World3D, made at the first record with a scene
         self._layout_stale = False  # the layout sent lacks a view that is now needed
+        self._sensor_series = 0  # sensor series in the layout sent (viz.sensors)
         self._last_robot = None
         self._last_target = None
         if stream is not None:
             self._guard = output.guard()
             self._columns = ColumnBuffer(stream, _COLUMN_BUILDERS, self._guard)
+            self._sensors = SensorViews(stream, self._columns)
             # Never closed (dropped, or open at exit): the file still gets its real name.
             self._abandoned = weakref.finalize(
                 self, _close_abandoned, self._columns, output, stream
@@ -225,7 +228,9 @@ class Recorder:
             self._bounds = bounds
         with self._guard:
             self._stream.send_blueprint(default_blueprint(
-                self._bounds, shadow=shadow, world3d=self._world3d is not None))
+                self._bounds, shadow=shadow, world3d=self._world3d is not None,
+                sensors=tuple(self._sensors.series)))
+        self._sensor_series = len(self._sensors.series)
         self._layout_stale = False
         self._blueprint_sent = True
 
@@ -245,6 +250,9 @@ class Recorder:
         walls = [[_xy(*a), _xy(*b)] for a, b in world_map.walls]
         if walls:
             log(P.MAP_WALLS, rr.LineStrips2D(walls, colors=_WALL_COLOR, radii=0.02), static=True)
+        strips_, radii, colors = line_strips(world_map)
+        if strips_:  # floor markings (line-following tracks)
+            log(MAP_LINES, rr.LineStrips2D(strips_, radii=radii, colors=colors), static=True)
         terrain = [[_xy(*p) for p in poly] + [_xy(*poly[0])]
                    for poly in getattr(world_map, "terrain", ()) if poly]
         if terrain:  # floor patches (ramps, wet floor), under the furniture
@@ -310,6 +318,10 @@ class Recorder:
         if record.target_distance is not None:
             add(P.TARGET_DISTANCE, (float(record.target_distance),))
         self._add_map(record, add)
+        with self._guard:
+            self._sensors.log(record, add)
+        if len(self._sensors.series) != self._sensor_series:
+            self._layout_stale = True
         if self._world3d is not None and record.scene is not None:
             with self._guard:
                 self._world3d.log_frame(record, frame, t)
