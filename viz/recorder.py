@@ -41,8 +41,8 @@ from .images import check_jpeg_quality, encode_frame, filtered_rgb
 from .leds import centroid_image, proximity_image
 from .modes import parse_mode
 from .outcome import settle
-from .sinks import open_output
 from .sensors import MAP_LINES, SensorViews, line_strips
+from .sinks import open_output
 from .world3d import World3D
 
 __all__ = ["Recorder", "open_recorder"]
