@@ -3,11 +3,12 @@ Amaranth's simulator (``pysim``, the reference) or a compiled model (``cxxrtl``,
 ``verilator``); docs/pins.md."""
 
 from .base import PinBackend, PinError, PixelTiming, Port, Stop
-from .design import FILTERED_PORTS, PIXEL_PORTS, PinDesignSource
+from .design import FILTERED_PORTS, PIXEL_PORTS, PinDesignSource, follow_target_source
 from .timing import real_clock_timing
 
 __all__ = ["FILTERED_PORTS", "PIN_BACKENDS", "PIXEL_PORTS", "PinBackend", "PinDesignSource",
-           "PinError", "PixelTiming", "Port", "Stop", "get_pin_backend", "real_clock_timing"]
+           "PinError", "PixelTiming", "Port", "Stop", "follow_target_source", "get_pin_backend",
+           "real_clock_timing"]
 
 #: Backend names ``get_pin_backend`` accepts; ``auto`` tries the compiled ones fastest first.
 PIN_BACKENDS = ("auto", "pysim", "cxxrtl", "verilator")

@@ -12,7 +12,7 @@ from amaranth.lib import wiring
 from ...hw.verilog import generate_cxxrtl, generate_verilog, verilog_ports
 from .base import PinError, Port
 
-__all__ = ["FILTERED_PORTS", "PIXEL_PORTS", "PinDesignSource"]
+__all__ = ["FILTERED_PORTS", "PIXEL_PORTS", "PinDesignSource", "follow_target_source"]
 
 #: The default stream bindings: (valid, payload) of the pixel input and the filtered output.
 PIXEL_PORTS = ("pixels__valid", "pixels__payload")
@@ -48,6 +48,9 @@ class PinDesignSource:
         self.factory = factory
         self.key = key
         component = factory()
+        # Handed out by the first component() call: an Amaranth elaboratable that is created
+        # and never elaborated warns when it is collected.
+        self._unused = component
         if not isinstance(component, wiring.Component):
             raise TypeError(f"the factory returned {component!r}, not a wiring.Component")
         ports = {}
@@ -87,7 +90,9 @@ class PinDesignSource:
         return (valid, payload)
 
     def component(self):
-        return self.factory()
+        """A component to elaborate (the one the ports were read from, the first time)."""
+        component, self._unused = self._unused, None
+        return self.factory() if component is None else component
 
     @functools.cached_property
     def verilog(self):
@@ -101,3 +106,15 @@ class PinDesignSource:
 
     def __repr__(self):
         return f"PinDesignSource({self.key!r}, {len(self.ports)} ports)"
+
+
+def follow_target_source(params=None):
+    """``FollowTarget(params)`` (hw/top.py) as a ``PinDesignSource``, its pixel and filtered
+    streams bound."""
+    from ...hw.params import FollowTargetParams
+    from ...hw.top import FollowTarget
+
+    params = FollowTargetParams() if params is None else params
+    return PinDesignSource(lambda: FollowTarget(params), f"follow_target_{params.width}x"
+                           f"{params.height}", pixels=PIXEL_PORTS, filtered=FILTERED_PORTS,
+                           frame_size=(params.width, params.height))
