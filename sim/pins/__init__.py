@@ -1,5 +1,45 @@
-"""Pin-level simulation: every port of a design by name, clock by clock (base.py)."""
+"""Pin-level simulation: every port of a design by name, clock by clock (base.py), on
+Amaranth's simulator (``pysim``, the reference) or a compiled model (``cxxrtl``,
+``verilator``); docs/pins.md."""
 
 from .base import PinBackend, PinError, PixelTiming, Port, Stop
+from .design import FILTERED_PORTS, PIXEL_PORTS, PinDesignSource, follow_target_source
+from .timing import real_clock_timing
 
-__all__ = ["PinBackend", "PinError", "PixelTiming", "Port", "Stop"]
+__all__ = ["FILTERED_PORTS", "PIN_BACKENDS", "PIXEL_PORTS", "PinBackend", "PinDesignSource",
+           "PinError", "PixelTiming", "Port", "Stop", "follow_target_source", "get_pin_backend",
+           "real_clock_timing"]
+
+#: Backend names ``get_pin_backend`` accepts; ``auto`` tries the compiled ones fastest first.
+PIN_BACKENDS = ("auto", "pysim", "cxxrtl", "verilator")
+_AUTO_ORDER = ("cxxrtl", "verilator")
+
+
+def _backend_class(name):
+    if name == "pysim":
+        from .pysim import PysimPins
+
+        return PysimPins
+    from .compiled import CxxrtlPins, VerilatorPins
+
+    return CxxrtlPins if name == "cxxrtl" else VerilatorPins
+
+
+def get_pin_backend(name, source, **kwargs):
+    """A ``PinBackend`` ``name`` (see ``PIN_BACKENDS``) for ``source`` (a ``PinDesignSource``),
+    reset (cycle 0). ``on_build=`` (compiled backends) is told before a build."""
+    if name not in PIN_BACKENDS:
+        raise PinError(f"unknown pin backend {name!r}; choose one of: {', '.join(PIN_BACKENDS)}")
+    if not isinstance(source, PinDesignSource):
+        raise TypeError(f"source must be a PinDesignSource, not {source!r}")
+    if name != "auto":
+        if name == "pysim":
+            kwargs.pop("on_build", None)
+        return _backend_class(name)(source, **kwargs)
+    errors = []
+    for candidate in _AUTO_ORDER:
+        try:
+            return _backend_class(candidate)(source, **kwargs)
+        except PinError as exc:
+            errors.append(str(exc))
+    raise PinError("no compiled pin backend works here: " + "; ".join(errors))

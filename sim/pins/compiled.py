@@ -1,0 +1,279 @@
+"""The compiled pin backends: a design's CXXRTL or Verilator model with the pin driver
+(pin_driver.h) and its generated port accessors (codegen.py) built into a shared library
+(through the frame backends' build cache and toolchain), driven through ctypes: one call
+per ``run``, ``poke``, ``peek``, ``schedule``, ``watch`` and ``stream_frame``.
+"""
+
+import contextlib
+import ctypes
+import hashlib
+import os
+from pathlib import Path
+
+import numpy as np
+
+from ..backends import build_cache
+from ..backends.base import BackendError
+from ..backends.compiled import BuildPlan
+from ..backends.cxxrtl import CXX_FLAGS as CXXRTL_FLAGS
+from ..backends.cxxrtl_netlist import (
+    fast_commit,
+    output_sources,
+    with_wire_copies_inlined,
+    without_port_copies,
+)
+from ..backends.toolchain import (
+    cxxrtl_include_dir,
+    find_compiler,
+    find_make,
+    run_tool,
+    verilator_root,
+    verilator_version,
+)
+from ..backends.verilator import CXX_FLAGS as VERILATOR_CXX_FLAGS
+from ..backends.verilator import MAKE_FLAGS, VERILATOR_FLAGS
+from .base import PinError
+from .codegen import cxxrtl_accessors, verilator_accessors
+from .host import HostPins, capture_error
+
+__all__ = ["CompiledPins", "CxxrtlPins", "VerilatorPins"]
+
+#: Directory of the C++ sources (package data).
+SOURCE_DIR = Path(__file__).resolve().parent
+LIBRARY_NAME = "libpins.so"
+#: Must match ``pin::ABI_VERSION`` in pin_driver.h.
+ABI_VERSION = 1
+_DRIVER = "pin_driver.h"
+# Layout of run()'s result array (enum Out in pin_driver.h) and its status codes.
+_N_OUT = 6
+_O_CYCLE, _O_PORT, _O_VALUE, _O_CAPTURED, _O_PENDING, _O_BAD_INDEX = range(_N_OUT)
+_TOO_MANY_FILTERED, _BAD_FILTERED_FLAGS = 1, 2
+
+_VP = ctypes.c_void_p
+_I64 = ctypes.c_int64
+_U64 = ctypes.c_uint64
+_ENTRIES = (
+    ("pin_abi_version", ctypes.c_int, []),
+    ("pin_evals_per_cycle", ctypes.c_int, []),
+    ("pin_create", _VP, []),
+    ("pin_destroy", None, [_VP]),
+    ("pin_reset", None, [_VP]),
+    ("pin_cycle", _I64, [_VP]),
+    ("pin_poke", None, [_VP, ctypes.c_int, _U64]),
+    ("pin_peek", _U64, [_VP, ctypes.c_int]),
+    ("pin_schedule", None, [_VP, _I64, ctypes.c_int, _U64]),
+    ("pin_watch", None, [_VP, _VP, _I64]),
+    ("pin_stream", ctypes.c_int, [_VP, _VP, _VP, _VP]),
+    ("pin_run", ctypes.c_int, [_VP, _I64, _VP]),
+)
+
+
+def _sources(*names):
+    return {name: (SOURCE_DIR / name).read_text() for name in names}
+
+
+def _digest(text):
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
+def cxxrtl_plan(source):
+    """The ``BuildPlan`` of a ``PinDesignSource`` with CXXRTL."""
+    compiler = find_compiler()
+    include = cxxrtl_include_dir()
+    model = source.cxxrtl
+    outputs = [p.name for p in source.ports.values() if p.direction == "out"]
+    exprs = output_sources(model, outputs)
+    commit = fast_commit(model) if exprs is not None else None
+    if exprs is not None:
+        model = with_wire_copies_inlined(without_port_copies(model, outputs))
+    accessors = cxxrtl_accessors(source, exprs, commit)
+    harness = _sources("pin_cxxrtl.cpp", _DRIVER)
+    flags = list(CXXRTL_FLAGS)
+    key = build_cache.build_key({
+        "flow": "pins-cxxrtl",
+        "abi": ABI_VERSION,
+        "design": source.key,
+        "source": _digest(model + accessors),
+        "harness": {name: _digest(text) for name, text in harness.items()},
+        "flags": flags,
+        "compiler": compiler.version,
+        "runtime": str(include),
+    })
+
+    def build(directory):
+        (directory / "design.cc").write_text(model)
+        (directory / "pin_design.h").write_text(accessors)
+        for name, text in harness.items():
+            (directory / name).write_text(text)
+        run_tool([compiler.path, *flags, f"-I{directory}", f"-I{include}",
+                  directory / "pin_cxxrtl.cpp", "-o", directory / LIBRARY_NAME],
+                 cwd=directory, what=f"compiling the CXXRTL pin model ({compiler.path})")
+
+    return BuildPlan(f"pins-cxxrtl-{source.key}", key, [LIBRARY_NAME], build)
+
+
+def verilator_plan(source):
+    """The ``BuildPlan`` of a ``PinDesignSource`` with Verilator."""
+    compiler = find_compiler()
+    find_make()
+    root = verilator_root()
+    verilog = source.verilog
+    outputs = [p.name for p in source.ports.values() if p.direction == "out"]
+    registered = output_sources(source.cxxrtl, outputs) is not None
+    accessors = verilator_accessors(source, registered)
+    harness = _sources("pin_verilator.cpp", _DRIVER)
+    cflags = " ".join(VERILATOR_CXX_FLAGS)
+    jobs = str(max(1, min(os.cpu_count() or 1, 4)))
+    key = build_cache.build_key({
+        "flow": "pins-verilator",
+        "abi": ABI_VERSION,
+        "design": source.key,
+        "source": _digest(verilog + accessors),
+        "harness": {name: _digest(text) for name, text in harness.items()},
+        "flags": [*VERILATOR_FLAGS, cflags, *MAKE_FLAGS],
+        "compiler": compiler.version,
+        "verilator": verilator_version(),
+    })
+
+    def build(directory):
+        (directory / "follow_target.v").write_text(verilog)
+        (directory / "pin_design.h").write_text(accessors)
+        for name, text in harness.items():
+            (directory / name).write_text(text)
+        env = dict(os.environ, VERILATOR_ROOT=str(root))
+        make_flags = [*MAKE_FLAGS, f"CXX={compiler.path}", f"LINK={compiler.path}"]
+        run_tool([root / "bin" / "verilator", *VERILATOR_FLAGS, "-j", jobs,
+                  "--top-module", "follow_target", "--Mdir", directory / "obj",
+                  "-CFLAGS", f"{cflags} -I{directory}", "-LDFLAGS", "-shared",
+                  "-MAKEFLAGS", " ".join(make_flags), "-o", directory / LIBRARY_NAME,
+                  directory / "follow_target.v", directory / "pin_verilator.cpp"],
+                 cwd=directory, env=env,
+                 what=f"building the Verilator pin model (make, {compiler.path})")
+
+    return BuildPlan(f"pins-verilator-{source.key}", key, [LIBRARY_NAME], build)
+
+
+def _load(path):
+    try:
+        lib = ctypes.CDLL(str(path))
+    except OSError as exc:
+        raise PinError(f"cannot load the compiled pin model {path}: {exc}") from None
+    for name, restype, argtypes in _ENTRIES:
+        fn = getattr(lib, name, None)
+        if fn is None:
+            raise PinError(f"the compiled pin model {path} lacks {name}()")
+        fn.restype, fn.argtypes = restype, argtypes
+    if lib.pin_abi_version() != ABI_VERSION:
+        raise PinError(f"the compiled pin model {path} has an unexpected ABI")
+    return lib
+
+
+def _address(array):
+    return array.__array_interface__["data"][0]
+
+
+class CompiledPins(HostPins):
+    """A design's compiled model behind the pin interface (see ``HostPins``).
+
+    Parameters
+    ----------
+    source : PinDesignSource
+    on_build : callable(str), optional
+        Told (one line) before a build that is not in the cache.
+    """
+
+    #: ``plan(source)`` -> ``BuildPlan``.
+    plan = None
+
+    def __init__(self, source, *, on_build=None):
+        super().__init__(source)
+        self._handle = None
+        self._on_build = on_build
+        try:
+            self._lib = self._build_and_load()
+        except BackendError as exc:
+            raise PinError(f"{self.name}: {exc}") from None
+        self._handle = self._lib.pin_create()
+        if not self._handle:
+            raise PinError(f"the {self.name} pin model could not be created")
+        self._out = np.zeros(_N_OUT, np.int64)
+        self._out_address = _address(self._out)
+        self._run_entry = self._lib.pin_run
+        self._geometry = np.zeros(5, np.int64)
+        #: Simulator evaluations per clock cycle (1 when every output is a flip-flop).
+        self.evals_per_cycle = self._lib.pin_evals_per_cycle()
+
+    def _build_and_load(self):
+        for attempt in range(2):
+            entry = build_cache.get_or_build(*type(self).plan(self.source),
+                                             on_build=self._notice)
+            self.cache_entry = entry
+            try:
+                return _load(entry.file(LIBRARY_NAME))
+            except PinError:
+                if attempt or entry.built:
+                    raise
+                build_cache.invalidate(entry)
+        raise AssertionError("unreachable")
+
+    def _notice(self):
+        if self._on_build is not None:
+            self._on_build(f"compiling the {self.name} pin model of {self.source.key} (once; "
+                           f"later runs load it from the cache)")
+
+    def _raw_reset(self):
+        self._lib.pin_reset(self._handle)
+
+    def _raw_poke(self, index, raw):
+        self._lib.pin_poke(self._handle, index, raw)
+
+    def _raw_peek(self, index):
+        return self._lib.pin_peek(self._handle, index)
+
+    def _raw_schedule(self, edge, index, raw):
+        self._lib.pin_schedule(self._handle, edge, index, raw)
+
+    def _raw_watch(self, indices):
+        order = np.array(indices, np.int32)
+        self._lib.pin_watch(self._handle, _address(order), len(order))
+
+    def _raw_stream(self, frame, timing, capture):
+        height, width = frame.shape
+        self._geometry[:] = (width, height, timing.start, timing.line_period,
+                             timing.pixel_period)
+        status = self._lib.pin_stream(self._handle, _address(frame), _address(self._geometry),
+                                      None if capture is None else _address(capture))
+        if status != 0:
+            raise PinError(f"{self.name}: the pin model rejected the frame (status {status})")
+
+    def _raw_run(self, cycles):
+        out = self._out
+        status = self._run_entry(self._handle, cycles, self._out_address)
+        cycle, port, value, captured, _pending, bad = out.tolist()
+        if status:
+            self._cycle = cycle
+            raise capture_error(status == _TOO_MANY_FILTERED, bad)
+        return cycle, port, value & 0xFFFF_FFFF_FFFF_FFFF, captured
+
+    def close(self):
+        if self._handle is not None:
+            self._lib.pin_destroy(self._handle)
+            self._handle = None
+
+    def __del__(self):
+        with contextlib.suppress(AttributeError, TypeError, OSError):
+            self.close()
+
+
+class CxxrtlPins(CompiledPins):
+    """The design compiled with CXXRTL."""
+
+    name = "cxxrtl"
+    plan = staticmethod(cxxrtl_plan)
+
+
+class VerilatorPins(CompiledPins):
+    """The design built with Verilator."""
+
+    name = "verilator"
+    plan = staticmethod(verilator_plan)

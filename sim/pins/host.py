@@ -1,0 +1,202 @@
+"""The host side every pin backend shares: argument checks with one-line ``PinError``s, port
+values as the user sees them (signed ports negative) and as the simulators hold them (raw
+unsigned bits), the pixel stream's bookkeeping and the filtered frames' buffers.
+
+A backend implements the ``_raw_*`` methods on port indices (signature order) and raw values.
+"""
+
+from collections import deque
+
+import numpy as np
+
+from .base import PinBackend, PinError, PixelTiming, Stop
+
+__all__ = ["HostPins", "capture_error"]
+
+
+def capture_error(too_many, bad_index):
+    """The ``PinError`` of a filtered stream that does not frame the frames streamed."""
+    if too_many:
+        return PinError("the design put out more filtered pixels than the frames streamed")
+    return PinError(f"filtered pixel {bad_index} of a frame carries wrong first/last framing "
+                    f"flags")
+
+
+class HostPins(PinBackend):
+    """Checks and bookkeeping around a simulator reached by port index (see module doc)."""
+
+    def __init__(self, source):
+        self.source = source
+        self.ports = dict(source.ports)
+        self._index = {name: i for i, name in enumerate(self.ports)}
+        self._port_list = list(self.ports.values())
+        stream = set(source.pixels or ())
+        self._stream_ports = stream
+        self._cycle = 0
+        self._last_pixel_edge = 0
+        self._captures = deque()  # buffers of frames whose filtered stream is still coming
+        self._filtered = None
+        self._captured = 0  # frames the simulator has completed (its counter)
+
+    # --- values ---------------------------------------------------------------------------
+
+    def _port(self, name):
+        index = self._index.get(name)
+        if index is None:
+            raise PinError(f"unknown port {name!r}; the design's ports: {', '.join(self.ports)}")
+        return index, self._port_list[index]
+
+    def _input(self, name):
+        index, port = self._port(name)
+        if port.direction != "in":
+            raise PinError(f"port {name!r} is an output of the design; only inputs can be "
+                           f"driven (inputs: {', '.join(self._inputs())})")
+        if name in self._stream_ports:
+            raise PinError(f"port {name!r} is driven by the pixel stream; use stream_frame")
+        return index, port
+
+    def _inputs(self):
+        return [p.name for p in self._port_list if p.direction == "in"]
+
+    @staticmethod
+    def _raw(port, value):
+        if isinstance(value, (bool, np.bool_)):
+            value = int(value)
+        if not isinstance(value, (int, np.integer)):
+            raise PinError(f"the value for {port.name!r} must be an int, not {value!r}")
+        value = int(value)
+        lo, hi = ((-(1 << (port.width - 1)), (1 << (port.width - 1)) - 1) if port.signed
+                  else (0, (1 << port.width) - 1))
+        if not lo <= value <= hi:
+            kind = "signed" if port.signed else "unsigned"
+            raise PinError(f"{value} does not fit port {port.name!r} ({port.width}-bit "
+                           f"{kind}: {lo}..{hi})")
+        return value & ((1 << port.width) - 1)
+
+    @staticmethod
+    def _cooked(port, raw):
+        if port.signed and raw >> (port.width - 1):
+            return raw - (1 << port.width)
+        return raw
+
+    # --- the interface ----------------------------------------------------------------------
+
+    @property
+    def cycle(self):
+        return self._cycle
+
+    def reset(self):
+        self._raw_reset()
+        self._cycle = 0
+        self._last_pixel_edge = 0
+        self._captures.clear()
+        self._filtered = None
+        self._captured = 0
+
+    def poke(self, name, value):
+        index, port = self._input(name)
+        self._raw_poke(index, self._raw(port, value))
+
+    def peek(self, name):
+        index, port = self._port(name)
+        return self._cooked(port, self._raw_peek(index))
+
+    def schedule(self, edge, name, value):
+        index, port = self._input(name)
+        raw = self._raw(port, value)
+        if isinstance(edge, bool) or not isinstance(edge, (int, np.integer)):
+            raise PinError(f"the edge must be an int, not {edge!r}")
+        if edge <= self._cycle:
+            raise PinError(f"edge {edge} is in the past (cycle is {self._cycle}); schedule "
+                           f"changes for edge {self._cycle + 1} or later")
+        self._raw_schedule(int(edge), index, raw)
+
+    def watch(self, names):
+        if isinstance(names, str):
+            names = [names]
+        indices = []
+        for name in names:
+            index, port = self._port(name)
+            if port.direction != "out":
+                raise PinError(f"port {name!r} is an input; only outputs can be watched")
+            if index not in indices:
+                indices.append(index)
+        self._raw_watch(indices)
+
+    @property
+    def frame_pending(self):
+        return self._last_pixel_edge > self._cycle
+
+    def stream_frame(self, packed, timing):
+        source = self.source
+        if source.pixels is None:
+            raise PinError("this design has no pixel stream binding (PinDesignSource "
+                           "pixels=...)")
+        width, height = source.frame_size
+        packed = np.asarray(packed)
+        if packed.shape != (height, width) or packed.dtype.kind not in "ui":
+            raise PinError(f"a frame must be a ({height}, {width}) uint16 array of RGB444 "
+                           f"pixels, not {packed.dtype} {packed.shape}")
+        if self.frame_pending:
+            raise PinError(f"a frame is still streaming (its last pixel is at edge "
+                           f"{self._last_pixel_edge}, cycle is {self._cycle}); run until "
+                           f"frame_pending is False first")
+        if not isinstance(timing, PixelTiming):
+            raise PinError(f"timing must be a PixelTiming, not {timing!r}")
+        if timing.start <= self._cycle:
+            raise PinError(f"the frame starts at edge {timing.start}, in the past (cycle is "
+                           f"{self._cycle}); start it at edge {self._cycle + 1} or later")
+        if timing.pixel_period < 1 or timing.line_period < (width - 1) * timing.pixel_period + 1:
+            raise PinError(f"pixel_period must be >= 1 and line_period >= (width - 1) * "
+                           f"pixel_period + 1 = {(width - 1) * max(1, timing.pixel_period) + 1} "
+                           f"so that lines do not overlap (got {timing})")
+        capture = None
+        if source.filtered is not None:
+            if len(self._captures) >= 2:
+                raise PinError("two frames' filtered streams are still incomplete; the "
+                               "design's filtered output lags by more than a frame")
+            capture = np.zeros((height, width), np.uint16)
+            self._captures.append(capture)
+        frame = np.ascontiguousarray(packed & 0xFFF, dtype=np.uint16)
+        self._raw_stream(frame, timing, capture)
+        self._last_pixel_edge = timing.last_edge(width, height)
+
+    def filtered_frame(self):
+        return self._filtered
+
+    def run(self, cycles):
+        if isinstance(cycles, bool) or not isinstance(cycles, (int, np.integer)) or cycles < 0:
+            raise PinError(f"run needs a number of cycles >= 0, not {cycles!r}")
+        cycle, index, raw, captured = self._raw_run(int(cycles))
+        self._cycle = cycle
+        while self._captured < captured:
+            self._filtered = self._captures.popleft()
+            self._captured += 1
+        if index < 0:
+            return Stop(cycle)
+        port = self._port_list[index]
+        return Stop(cycle, port.name, self._cooked(port, raw))
+
+    # --- what a backend implements -----------------------------------------------------------
+
+    def _raw_reset(self):
+        raise NotImplementedError
+
+    def _raw_poke(self, index, raw):
+        raise NotImplementedError
+
+    def _raw_peek(self, index):
+        raise NotImplementedError
+
+    def _raw_schedule(self, edge, index, raw):
+        raise NotImplementedError
+
+    def _raw_watch(self, indices):
+        raise NotImplementedError
+
+    def _raw_stream(self, frame, timing, capture):
+        raise NotImplementedError
+
+    def _raw_run(self, cycles):
+        """Returns ``(cycle, stop port index or -1, raw value, frames captured so far)``."""
+        raise NotImplementedError
