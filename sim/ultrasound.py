@@ -9,11 +9,11 @@ The speed of sound in air is ``c = 331.3 + 0.606 T`` m/s (T in degrees C).
 
 The world (``range_to``): the distance to the nearest surface inside the beam, a cone of
 ``cone_deg`` full angle around the sensor's heading, in the horizontal plane: the room's
-walls, the faces of the furniture still in the room and people (upright circles). A surface
-lower than the beam reaches only counts from the distance where the cone's lower edge comes
-down to its top (``height - r tan(cone/2) < top``): a low box close by is under the beam.
-Nearest points are found exactly (no sampled rays): a face is clipped to the cone's wedge
-and its distance taken; a person outside the cone's axis is met on the cone's edges.
+walls, the furniture still in the room (solid footprints) and people (upright circles). An
+object lower than the sensor only counts from the distance where the cone's lower edge comes
+down to its top (``height - r tan(cone/2) <= top``): a low box close by is under the beam
+until the beam spreads down onto it. Nearest points are found exactly (no sampled rays): a
+footprint is clipped to the cone's wedge; a person off the cone's axis is met on its edges.
 """
 
 import math
@@ -67,6 +67,37 @@ def _clip_to_wedge(p0, p1, planes):
     return ((p0[0] + t0 * dx, p0[1] + t0 * dy), (p0[0] + t1 * dx, p0[1] + t1 * dy))
 
 
+def _clip_polygon(points, planes):
+    """The convex polygon ``points`` (relative to the sensor) cut to the side ``n . p >= 0``
+    of every plane (Sutherland-Hodgman); an empty list when nothing is left."""
+    for nx, ny in planes:
+        out = []
+        for i, q in enumerate(points):
+            p = points[i - 1]
+            dp, dq = nx * p[0] + ny * p[1], nx * q[0] + ny * q[1]
+            if (dp >= 0.0) != (dq >= 0.0):
+                t = dp / (dp - dq)
+                out.append((p[0] + t * (q[0] - p[0]), p[1] + t * (q[1] - p[1])))
+            if dq >= 0.0:
+                out.append(q)
+        points = out
+        if not points:
+            break
+    return points
+
+
+def _polygon_near_far(points):
+    """``(nearest, farthest)`` distance of a convex polygon's area from the origin."""
+    far = max(math.hypot(*p) for p in points)
+    inside = len(points) >= 3 and all(
+        (q[0] - p[0]) * -p[1] - (q[1] - p[1]) * -p[0] >= 0.0
+        for p, q in zip(points, points[1:] + points[:1]))
+    if inside:
+        return 0.0, far
+    near = min(_segment_near_far(points[i - 1], points[i])[0] for i in range(len(points)))
+    return near, far
+
+
 def _segment_near_far(q0, q1):
     """``(nearest, farthest)`` distance of segment q0-q1 from the origin."""
     dx, dy = q1[0] - q0[0], q1[1] - q0[1]
@@ -116,16 +147,16 @@ def range_to(world, x, y, heading, height, params=HCSR04Params()):
 
     best = math.inf
     room = world.config.room
-    faces = [(a, b, room.height) for a, b in _room_walls(room)]
-    for item in world.present_furniture():
-        corners = item.corners()
-        faces += [(corners[i], corners[(i + 1) % 4], item.height) for i in range(4)]
-    for a, b, top in faces:
+    for a, b in _room_walls(room):
         clipped = _clip_to_wedge((a[0] - x, a[1] - y), (b[0] - x, b[1] - y), planes)
-        if clipped is None:
+        if clipped is not None:
+            best = min(best, _segment_near_far(*clipped)[0])
+    for item in world.present_furniture():
+        # corners() is counter-clockwise: the inside test of _polygon_near_far relies on it.
+        inside = _clip_polygon([(px - x, py - y) for px, py in item.corners()], planes)
+        if not inside:
             continue
-        near, far = _segment_near_far(*clipped)
-        d = _visible_from(near, far, reach(top))
+        d = _visible_from(*_polygon_near_far(inside), reach(item.height))
         if d is not None and d < best:
             best = d
     for person in world.people:
