@@ -32,19 +32,30 @@ def floor_points(renderer, pose, rows, cols):
 
 def patch_index(polygons, x, y):
     """For each point, the index of the last polygon that holds it, or -1 (even-odd rule)."""
+    x = np.asarray(x, dtype=float)
+    y = np.asarray(y, dtype=float)
     found = np.full(x.shape, -1, dtype=np.int64)
+    flat_x, flat_y, flat_found = x.ravel(), y.ravel(), found.reshape(-1)
     for k, poly in enumerate(polygons):
-        inside = np.zeros(x.shape, dtype=bool)
         px = np.array([p[0] for p in poly], dtype=float)
         py = np.array([p[1] for p in poly], dtype=float)
+        # Only the points in the polygon's bounding box are tested edge by edge: a marking's
+        # narrow strips cover a small part of the floor.
+        box = ((flat_x >= px.min()) & (flat_x <= px.max()) & (flat_y >= py.min())
+               & (flat_y <= py.max()))
+        idx = np.flatnonzero(box)
+        if idx.size == 0:
+            continue
+        sx, sy = flat_x[idx], flat_y[idx]
+        inside = np.zeros(idx.shape, dtype=bool)
         for i in range(len(poly)):
             x0, y0, x1, y1 = px[i - 1], py[i - 1], px[i], py[i]
             if y0 == y1:
                 continue
-            crosses = (y1 > y) != (y0 > y)
-            xs = (x0 - x1) * (y - y1) / (y0 - y1) + x1
-            inside ^= crosses & (x < xs)
-        found[inside] = k
+            crosses = (y1 > sy) != (y0 > sy)
+            xs = (x0 - x1) * (sy - y1) / (y0 - y1) + x1
+            inside ^= crosses & (sx < xs)
+        flat_found[idx[inside]] = k
     return found
 
 

@@ -24,6 +24,11 @@ class WorldMap:
     bounds: tuple  # (xmin, ymin, xmax, ymax)
     terrain: list = field(default_factory=list)  # [[(x, y), ...], ...] floor patch outlines
     terrain_colors: list = field(default_factory=list)  # [(r, g, b), ...] uint8, one each
+    #: Floor markings (``[[room.lines]]``): centrelines ``[[(x, y), ...], ...]`` (a closed
+    #: line repeats its first point at the end), their widths (m) and uint8 colours.
+    lines: list = field(default_factory=list)
+    line_widths: list = field(default_factory=list)
+    line_colors: list = field(default_factory=list)
 
 
 @dataclass(frozen=True)

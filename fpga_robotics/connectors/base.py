@@ -19,8 +19,8 @@ import math
 from dataclasses import dataclass
 from typing import ClassVar
 
-__all__ = ["CONNECTORS", "Connector", "ConnectorError", "Mount", "Pin", "PinIO",
-           "connector_class", "register"]
+__all__ = ["CONNECTORS", "MOUNT_KEYS", "Connector", "ConnectorError", "Mount", "Pin", "PinIO",
+           "check_number", "connector_class", "parse_mount", "register"]
 
 #: kind -> Connector subclass.
 CONNECTORS = {}
@@ -139,6 +139,35 @@ class Connector:
         """What the viewer draws on the map now: ``{"points": ((x, y), ...), "states":
         (0/1 per point), "rays": (((x0, y0), (x1, y1)), ...)}`` (any key may be left out)."""
         return {}
+
+
+#: The scenario keys of a connector's mount (``yaw_deg`` in degrees, as every angle in a file).
+MOUNT_KEYS = ("forward", "left", "height", "yaw_deg")
+
+
+def check_number(table, key, default, where, *, lo, hi, unit="", lo_open=False):
+    """``table[key]`` (or ``default``) as a float within ``lo..hi`` (``lo`` excluded with
+    ``lo_open``); a ``ConnectorError`` naming ``where.key`` otherwise."""
+    value = table.get(key, default)
+    ok = (isinstance(value, (int, float)) and not isinstance(value, bool)
+          and math.isfinite(value) and (value > lo if lo_open else value >= lo) and value <= hi)
+    if not ok:
+        span = f"{'>' if lo_open else '>='} {lo:g} and <= {hi:g}"
+        raise ConnectorError(f"{where}.{key} must be a number{' in ' + unit if unit else ''} "
+                             f"{span}, got {value!r}")
+    return float(value)
+
+
+def parse_mount(table, where):
+    """Split a connector table into its ``Mount`` (keys ``MOUNT_KEYS``: m, m, m, degrees)
+    and the rest (a new dict); a ``ConnectorError`` naming ``where`` for a bad value."""
+    rest = {k: v for k, v in table.items() if k not in MOUNT_KEYS}
+    mount = Mount(forward=check_number(table, "forward", 0.0, where, lo=-2, hi=2, unit="m"),
+                  left=check_number(table, "left", 0.0, where, lo=-2, hi=2, unit="m"),
+                  height=check_number(table, "height", 0.0, where, lo=0, hi=3, unit="m"),
+                  yaw=math.radians(check_number(table, "yaw_deg", 0.0, where, lo=-360,
+                                                hi=360)))
+    return mount, rest
 
 
 def register(cls):

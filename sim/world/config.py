@@ -12,6 +12,7 @@ import math
 from dataclasses import dataclass
 
 from .kinematics import DEG
+from .markings import FloorLine
 from .robots import ROBOT_MODELS
 from .terrain import TerrainPatch
 
@@ -62,6 +63,8 @@ class FurnitureConfig:
     angle: float  # rad, counter-clockwise from +x
     height: float  # m
     color: tuple  # albedo
+    #: World time (s) at which the item leaves the room (physics, camera, map); None: never.
+    present_until: float | None = None
 
     def corners(self):
         """The footprint's four corners, counter-clockwise."""
@@ -82,6 +85,7 @@ class RoomConfig:
     ceiling_color: tuple
     furniture: tuple  # of FurnitureConfig
     terrain: tuple = ()  # of terrain.TerrainPatch, in file order (the last listed wins)
+    lines: tuple = ()  # of markings.FloorLine, in file order (drawn over the terrain)
 
 
 @dataclass(frozen=True)
@@ -262,8 +266,40 @@ def _parse_furniture(item, path, index):
     angle = t.number("angle_deg", 0.0, ge=-360, le=360) * DEG
     height = t.number("height", 1.6 if divider else 0.75, gt=0, le=10, unit="m")
     color = t.color("color", DIVIDER_WOOD if divider else _BOX_COLOR)
+    present_until = t.number("present_until", None, gt=0, le=MAX_TIME, unit="s")
     t.finish()
-    return FurnitureConfig(name, kind, center, size, angle, height, color)
+    return FurnitureConfig(name, kind, center, size, angle, height, color, present_until)
+
+
+#: Floor markings' default colour: black electrical tape.
+_LINE_COLOR = (0.0, 0.0, 0.0)
+
+
+def _parse_line(item, path, index, room):
+    t = _Table(item, path)
+    name = t.string("name", f"line{index}")
+    points = t.raw("points")
+    closed = t.boolean("closed", False)
+    least = 3 if closed else 2
+    if not isinstance(points, list) or len(points) < least:
+        raise WorldConfigError(
+            f"{t.key('points')} must be an array of at least {least} points [x, y] "
+            f"({'a closed' if closed else 'an open'} line), got "
+            f"{_show(points) if points is not None else 'nothing'}")
+    centreline = tuple(_check_vector(p, f"{t.key('points')}[{i}]", 2, "a point [x, y] in m")
+                       for i, p in enumerate(points))
+    width = t.number("width", 0.019, gt=0, le=1, unit="m")
+    color = t.color("color", _LINE_COLOR)
+    t.finish()
+    w, d = room
+    for i, (x, y) in enumerate(centreline):
+        if not (0 <= x <= w and 0 <= y <= d):
+            raise WorldConfigError(f"{t.key('points')}[{i}] {_fmt((x, y))} is outside the room "
+                                   f"(0..{w:g} x 0..{d:g} m)")
+    line = FloorLine(name, centreline, width, color, closed)
+    if line.length < 1e-6:
+        raise WorldConfigError(f"{t.key('points')} has no length (all the points are the same)")
+    return line
 
 
 def _parse_terrain(item, path, index, room):
@@ -326,6 +362,16 @@ def _parse_room(section):
             f"room.terrain must be an array of tables ([[room.terrain]]), got {_show(patches)}")
     terrain = tuple(_parse_terrain(item, f"room.terrain[{i}]", i, (width, depth))
                     for i, item in enumerate(patches))
+    raw_lines = t.raw("lines", [])
+    if not isinstance(raw_lines, list):
+        raise WorldConfigError(
+            f"room.lines must be an array of tables ([[room.lines]]), got {_show(raw_lines)}")
+    lines = tuple(_parse_line(item, f"room.lines[{i}]", i, (width, depth))
+                  for i, item in enumerate(raw_lines))
+    line_names = [line.name for line in lines]
+    for i, name in enumerate(line_names):
+        if name in line_names[:i]:
+            raise WorldConfigError(f"room.lines[{i}].name {name!r} is used twice")
     names = [f.name for f in furniture]
     for i, name in enumerate(names):
         if name in names[:i]:
@@ -337,7 +383,7 @@ def _parse_room(section):
                                    f"the room (0..{width:g} x 0..{depth:g} m)")
     t.finish()
     return RoomConfig(width, depth, height, wall_color, floor_color, ceiling_color, furniture,
-                      terrain)
+                      terrain, lines)
 
 
 def _inside(point, radius, room):

@@ -35,11 +35,14 @@ def furniture_faces(item):
     return [(c[i], c[(i + 1) % 4]) for i in range(4)]
 
 
-def scene_walls(room):
-    """Every static vertical surface as ``sim.scene.Wall`` (room walls then furniture)."""
+def scene_walls(room, removed=frozenset()):
+    """Every static vertical surface as ``sim.scene.Wall`` (room walls then furniture, but
+    the items named in ``removed``)."""
     walls = [Wall(a[0], a[1], b[0], b[1], room.height, tuple(room.wall_color), "room")
              for a, b in room_segments(room)]
     for item in room.furniture:
+        if item.name in removed:
+            continue
         walls += [Wall(a[0], a[1], b[0], b[1], item.height, tuple(item.color), item.kind,
                        item.name)
                   for a, b in furniture_faces(item)]
@@ -68,9 +71,11 @@ def add_static_shapes(space, room, *, wall_type, furniture_type, friction):
     return shapes
 
 
-def map_data(room):
-    """``(walls, obstacles, obstacle_colors, bounds)`` for ``records.WorldMap``."""
+def map_data(room, removed=frozenset()):
+    """``(walls, obstacles, obstacle_colors, bounds)`` for ``records.WorldMap`` (without the
+    furniture named in ``removed``)."""
     walls = room_segments(room)
-    obstacles = [item.corners() for item in room.furniture]
-    colors = [tuple(round(c * 255) for c in item.color) for item in room.furniture]
+    present = [item for item in room.furniture if item.name not in removed]
+    obstacles = [item.corners() for item in present]
+    colors = [tuple(round(c * 255) for c in item.color) for item in present]
     return walls, obstacles, colors, (0.0, 0.0, room.width, room.depth)

@@ -106,8 +106,13 @@ class World:
         self.lighting = LightingSchedule(config.lighting)
 
         self.terrain = TerrainMap(config.room.terrain, config.room.width, config.room.depth)
-        self._floor_patches = tuple((t.polygon, t.color) for t in config.room.terrain
-                                    if t.color is not None)
+        #: The floor markings (``markings.FloorLine``), in file order.
+        self.floor_lines = tuple(config.room.lines)
+        painted = [t for t in config.room.terrain if t.color is not None]
+        self._painted = TerrainMap(painted, config.room.width, config.room.depth)
+        # The camera draws the painted patches, then the markings over them.
+        self._floor_patches = tuple((t.polygon, t.color) for t in painted) + tuple(
+            (tuple(poly), line.color) for line in self.floor_lines for poly in line.polygons())
         self._patch = None  # the terrain patch under the robot's centre
         self._traction = 1.0  # the factor the joints' forces are set to
         self._downhill_cache = {}  # id(patch) -> gravity's downhill force on the robot
@@ -147,6 +152,13 @@ class World:
 
         self._names = add_static_shapes(space, config.room, wall_type=_WALL,
                                         furniture_type=_FURNITURE, friction=_FRICTION)
+        self._furniture_shapes = {name: shape for shape, (kind, name) in self._names.items()
+                                  if kind == "furniture"}
+        self._removed = set()
+        # (time, name) of the furniture that leaves the room, earliest first.
+        self._removals = sorted((f.present_until, f.name) for f in config.room.furniture
+                                if f.present_until is not None)
+        self._furniture_contacts = {f.name: 0 for f in config.room.furniture}
         self.people = []
         # One generator per person, so a person's jitter does not depend on the others or on
         # the order in which their paths are queried.
@@ -180,12 +192,21 @@ class World:
             space.on_collision(_ROBOT, ctype, begin=self._on_begin)
 
         self._static_walls = scene_walls(config.room)
+        self._world_map = self._build_map()
+
+    def _build_map(self):
+        room = self.config.room
         # Terrain on the map: a patch's colour, or a pale blue for one not drawn on the floor.
-        self._world_map = WorldMap(
-            *map_data(config.room),
-            terrain=[list(t.polygon) for t in config.room.terrain],
+        return WorldMap(
+            *map_data(room, self._removed),
+            terrain=[list(t.polygon) for t in room.terrain],
             terrain_colors=[tuple(round(c * 255) for c in (t.color or (0.55, 0.7, 0.9)))
-                            for t in config.room.terrain])
+                            for t in room.terrain],
+            lines=[[tuple(p) for p in line.points] + ([tuple(line.points[0])] if line.closed
+                                                       else [])
+                   for line in self.floor_lines],
+            line_widths=[line.width for line in self.floor_lines],
+            line_colors=[tuple(round(c * 255) for c in line.color) for line in self.floor_lines])
 
     @classmethod
     def from_config(cls, cfg=None, seed=0):
@@ -199,6 +220,8 @@ class World:
         other = arbiter.shapes[1]
         kind, name = self._names[other]
         self._counts[kind] += 1
+        if kind == "furniture":
+            self._furniture_contacts[name] += 1
         self._events.append(f"collision with {kind} {name!r}" if name else f"collision with {kind}")
         if kind == "person" and self._closing_speed(other.body) > AT_FAULT_SPEED:
             self._at_fault += 1
@@ -276,6 +299,19 @@ class World:
                 person.facing = math.atan2(y - py, x - px)
         self.space.step(h)
         self.time = t1
+        if self._removals and self._removals[0][0] <= t1:
+            self._remove_due()
+
+    def _remove_due(self):
+        """Take the furniture whose ``present_until`` has come out of the physics, the
+        camera's scene and the map."""
+        while self._removals and self._removals[0][0] <= self.time:
+            _, name = self._removals.pop(0)
+            self.space.remove(self._furniture_shapes[name])
+            self._removed.add(name)
+            self._events.append(f"furniture {name!r} removed")
+        self._static_walls = scene_walls(self.config.room, self._removed)
+        self._world_map = self._build_map()
 
     def _apply_terrain(self, slip, x, y):
         """The patch under the robot at ``(x, y)``: its traction factor (times a slip's) on
@@ -421,11 +457,34 @@ class World:
                      lighting=self.lighting.at(self.time), floor_patches=self._floor_patches)
 
     def world_map(self):
-        """Static geometry for the viewer's top-down map (``records.WorldMap``)."""
+        """Geometry for the viewer's top-down map (``records.WorldMap``); a new map after
+        furniture has left (``present_until``)."""
         return self._world_map
 
+    def present_furniture(self):
+        """The furniture still in the room (``config.FurnitureConfig``), in file order."""
+        return [f for f in self.config.room.furniture if f.name not in self._removed]
+
+    def furniture_contacts(self, name):
+        """Collisions of the robot with the furniture item ``name`` since the start."""
+        try:
+            return self._furniture_contacts[name]
+        except KeyError:
+            raise ValueError(f"no furniture named {name!r}") from None
+
+    def floor_color_at(self, x, y):
+        """The albedo ``(r, g, b)`` of the floor at ``(x, y)``: the last marking that covers
+        the point, else the last painted terrain patch that holds it, else the floor's."""
+        for line in reversed(self.floor_lines):
+            x0, y0, x1, y1 = line.bounds
+            if x0 <= x <= x1 and y0 <= y <= y1 and line.covers(x, y):
+                return line.color
+        patch = self._painted.at(x, y) if self._painted else None
+        return tuple(patch.color) if patch is not None else tuple(self.config.room.floor_color)
+
     def drain_events(self):
-        """Collision events since the last call, e.g. ``"collision with wall"``."""
+        """Events since the last call, e.g. ``"collision with wall"``, ``"furniture 'box'
+        removed"``."""
         events, self._events = self._events, []
         return events
 
