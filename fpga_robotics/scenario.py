@@ -871,27 +871,10 @@ def _top(design):
             raise ScenarioError(f"design.{key} must be a table ([design.{key}] in a file), "
                                 f"got {value!r}")
         tables[key] = dict(value)
-    variant = design.get("variant")
-    if variant is not None:
-        tables = _apply_variant(top, variant, tables)
     try:
-        return top, design_tables(spec, tables)
+        return top, design_tables(spec, tables, design.get("variant"))
     except ValueError as exc:
         raise ScenarioError(str(exc)) from None
-
-
-def _apply_variant(top, variant, tables):
-    """``design.variant``: a named buggy variant (fpga_robotics.hw.variants) of ``top``."""
-    from .hw.variants import VARIANTS
-
-    names = [n for n, v in VARIANTS.items() if v.top == top]
-    if variant not in names:
-        raise ScenarioError(f"design.variant must be one of {', '.join(map(repr, names)) or '(none for this top)'} "
-                            f"for design.top = {top!r}, got {variant!r}")
-    out = {k: dict(v) for k, v in tables.items()}
-    for key, changes in VARIANTS[variant].tables.items():
-        out.setdefault(key, {}).update(changes)
-    return out
 
 
 def _connectors(world):

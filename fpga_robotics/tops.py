@@ -45,15 +45,15 @@ TOPS = {
         "follow_target_safe",
         "FollowTarget with an HC-SR04 ultrasound driver and an obstacle interlock",
         camera=True,
-        tables={"ultrasound": ("fpga_robotics.hw.ultrasound", "UltrasoundParams"),
-                "interlock": ("fpga_robotics.hw.safe_follow", "InterlockParams")},
+        tables={"ultrasound": ("fpga_robotics.hw.sensor_params", "UltrasoundParams"),
+                "interlock": ("fpga_robotics.hw.sensor_params", "InterlockParams")},
         bindings={**_CAMERA, **_WHEELS, "ultrasound": {"trig": "us_trig", "echo": "us_echo"}},
         extra_outputs={"distance_mm": "distance_mm", "obstacle": "obstacle"},
         component=("fpga_robotics.hw.safe_follow", "FollowTargetSafe")),
     "follow_line": Top(
         "follow_line", "FollowLine: KY-033 line sensors to wheel speeds",
         camera=False,
-        tables={"line": ("fpga_robotics.hw.follow_line", "FollowLineParams")},
+        tables={"line": ("fpga_robotics.hw.sensor_params", "FollowLineParams")},
         bindings={**_WHEELS, "line_sensors": {"line": "line"}},
         extra_outputs={"line_seen": "line_seen"},
         component=("fpga_robotics.hw.follow_line", "FollowLine"),
@@ -74,9 +74,10 @@ def _load(module_and_name):
     return getattr(importlib.import_module(module), name)
 
 
-def design_tables(top, tables):
+def design_tables(top, tables, variant=None):
     """The params objects of ``top``'s sub-tables from ``{key: {field: value}}`` (missing
-    tables: the defaults). Raises ``ValueError`` naming ``design.<key>.<field>``."""
+    tables: the defaults), the buggy ``variant`` (``hw.variants``) applied on top. Raises
+    ``ValueError`` naming ``design.<key>.<field>`` or the variant."""
     out = {}
     for key, where in top.tables.items():
         cls = _load(where)
@@ -92,7 +93,25 @@ def design_tables(top, tables):
             out[key] = cls(**values)
         except (TypeError, ValueError) as exc:
             raise ValueError(f"design.{key}: {exc}") from None
+    if variant is not None:
+        out = _with_variant(top, out, variant)
     return out
+
+
+def _with_variant(top, tables, name):
+    from .hw.variants import VARIANTS, variant_params
+
+    names = [n for n, v in VARIANTS.items() if v.design == top.name]
+    if name not in names:
+        raise ValueError(f"design.variant must be one of {', '.join(map(repr, names))} for "
+                         f"design.top = {top.name!r}, got {name!r}" if names else
+                         f"design.top = {top.name!r} has no variants (design.variant)")
+    params_type = VARIANTS[name].params_type
+    key = next(k for k, v in tables.items() if isinstance(v, params_type))
+    try:
+        return {**tables, key: variant_params(name, tables[key])}
+    except ValueError as exc:
+        raise ValueError(f"design.variant {name!r}: {exc}") from None
 
 
 def build_component(top, ft_params, table_params):
