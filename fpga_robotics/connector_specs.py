@@ -3,21 +3,18 @@
 
 Each table has ``kind`` (a registered connector kind), an optional ``name`` (default: the
 kind, numbered when a kind appears twice), the mount keys ``forward``, ``left``, ``height``
-(m) and ``yaw`` (rad), an optional ``ports = {pin = "design_port"}`` overriding the design's
+(m) and ``yaw_deg`` (degrees, left positive), an optional ``ports = {pin = "design_port"}`` overriding the design's
 binding, and the kind's own parameters (checked by its ``parse``).
 """
 
-import math
 import re
 from dataclasses import dataclass, field
 
-from .connectors import CONNECTORS, ConnectorError, Mount
+from .connectors import CONNECTORS, ConnectorError
+from .connectors.base import Mount, parse_mount
 
-__all__ = ["MOUNT_LIMITS", "ConnectorSpec", "parse_connectors"]
+__all__ = ["ConnectorSpec", "parse_connectors"]
 
-#: Mount keys: (lowest, highest) allowed.
-MOUNT_LIMITS = {"forward": (-2.0, 2.0), "left": (-2.0, 2.0), "height": (0.0, 3.0),
-                "yaw": (-math.pi, math.pi)}
 _NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]{0,31}")
 
 
@@ -29,10 +26,6 @@ class ConnectorSpec:
     mount: Mount
     params: object
     ports: dict = field(default_factory=dict)  # pin -> design port (overrides the design's)
-
-
-def _number(value):
-    return not isinstance(value, bool) and isinstance(value, (int, float)) and math.isfinite(value)
 
 
 def parse_connectors(robot):
@@ -69,14 +62,7 @@ def parse_connectors(robot):
             if name in names:
                 raise ConnectorError(f"{where}.name {name!r} is used twice")
             names.add(name)
-            mount = {}
-            for k, (lo, hi) in MOUNT_LIMITS.items():
-                if k in table:
-                    v = table.pop(k)
-                    if not (_number(v) and lo <= v <= hi):
-                        raise ConnectorError(f"{where}.{k} must be a number in {lo:g}..{hi:g}, "
-                                             f"got {v!r}")
-                    mount[k] = float(v)
+            mount, table = parse_mount(table, where)
             ports = table.pop("ports", {})
             if not (isinstance(ports, dict) and all(
                     isinstance(p, str) and p for p in ports.values())):
@@ -87,5 +73,5 @@ def parse_connectors(robot):
                     raise ConnectorError(f"{where}.ports: a {kind!r} connector has no pin "
                                          f"{pin!r}; its pins: {', '.join(cls.pins)}")
             params = cls.parse(table, where)
-            specs.append(ConnectorSpec(kind, name, role, Mount(**mount), params, dict(ports)))
+            specs.append(ConnectorSpec(kind, name, role, mount, params, dict(ports)))
     return tuple(specs)

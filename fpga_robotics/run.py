@@ -194,6 +194,22 @@ def _open_backend(name, params, quiet=False):
         raise UsageError(f"backend {name!r} cannot run here: {exc}") from None
 
 
+def _open_pin_design(args, scenario):
+    """The scenario's design on a pin-level backend (real-clock timing)."""
+    from .clocked_loop import make_pin_backend
+    from .sim.backends.base import BackendError
+    from .sim.pins import PinError
+
+    def tell(text):
+        if not args.quiet:
+            print(f"{text} ...", file=sys.stderr, flush=True)
+
+    try:
+        return make_pin_backend(args.backend, scenario, on_build=tell)
+    except (BackendError, PinError, ValueError, ImportError) as exc:
+        raise UsageError(f"backend {args.backend!r} cannot run here: {exc}") from None
+
+
 def _design_files(args, foreign=None):
     """The Verilog files and port map of the foreign design (None without one): ``--design``
     and ``--ports``, each overriding the scenario's ``[design] verilog`` / ``ports``
@@ -366,6 +382,10 @@ def _run_source(args, scenario, ros):
     from .sources import open_source, run_source
 
     ros.check_closed_loop_only()
+    if scenario.sim.timing == "real_clock":
+        raise UsageError(f"--source feeds camera frames to the design; scenario "
+                         f"{scenario.name!r} runs in real-clock timing (design.top = "
+                         f"{scenario.top!r}, sensors on pins): run it without --source")
     params = scenario.params
     source = open_source(args.source, params.width, params.height)
     try:
@@ -441,7 +461,13 @@ def main(argv=None, prog="python -m fpga_robotics.run"):
 
     _design_files(args, scenario.foreign)
     t0 = time.perf_counter()
-    design = _open_design(args, scenario.params, scenario.foreign)
+    if scenario.sim.timing == "real_clock":
+        if shadow_params is not None:
+            raise UsageError("--shadow compares frames; it needs a scenario in compressed "
+                             "timing (sim.timing), not real_clock")
+        design = _open_pin_design(args, scenario)
+    else:
+        design = _open_design(args, scenario.params, scenario.foreign)
     shadow = recorder = None
     completed = False
     try:

@@ -57,7 +57,7 @@ def test_the_pin_is_poked_only_when_it_changes():
     ({"kind": "bumper", "colour": 1}, "unknown key 'colour' for a bumper"),
     ({"kind": "bumpr"}, "unknown connector kind 'bumpr'"),
     ({"kind": "wheels"}, "declare it in [[robot.actuators]]"),
-    ({"kind": "bumper", "yaw": 9}, "robot.sensors[0].yaw must be a number in -3.14159..3.14159"),
+    ({"kind": "bumper", "yaw_deg": 999}, "robot.sensors[0].yaw_deg must be a number"),
     ({"kind": "bumper", "ports": {"pushed": "x"}}, "has no pin 'pushed'"),
 ])
 def test_bad_tables_name_the_key(table, message):

@@ -7,8 +7,14 @@ import math
 import numpy as np
 import pytest
 
-from fpga_robotics.connectors.base import (CONNECTORS, ConnectorError, Mount, PinIO,
-                                           connector_class, parse_mount)
+from fpga_robotics.connectors.base import (
+    CONNECTORS,
+    ConnectorError,
+    Mount,
+    PinIO,
+    connector_class,
+    parse_mount,
+)
 from fpga_robotics.connectors.line_sensors import LineSensorsConnector
 from fpga_robotics.connectors.ultrasound import UltrasoundConnector
 from fpga_robotics.sim.world import World
