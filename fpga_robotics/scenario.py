@@ -73,7 +73,8 @@ _APP_SECTIONS = ("sim", "camera", "color", "design", "checks")
 #: A foreign Verilog design instead of FollowTarget (docs/foreign.md): its files and port map.
 _FOREIGN_KEYS = ("verilog", "ports")
 #: ``design.top`` (fpga_robotics.tops), a buggy ``variant``, and the tops' parameter tables.
-_TOP_DESIGN_KEYS = ("top", "variant", "ultrasound", "interlock", "line")
+_TOP_TABLES = ("ultrasound", "interlock", "line")
+_TOP_DESIGN_KEYS = ("top", "variant", *_TOP_TABLES)
 _DESIGN_KEYS = ("preset",) + _TOP_DESIGN_KEYS + _FOREIGN_KEYS + tuple(f.name for f in fields(FollowTargetParams) if f.init and
                                    f.name not in ("width", "height"))
 #: Design parameters that are arrays: their length and what the values are.
@@ -530,11 +531,15 @@ def _set_path(data, key, value, shown):
         if last:
             node[part] = _coerce(node.get(part), value)
             return
+        if part not in node and parts[:i] == ["design"] and part in _TOP_TABLES:
+            node[part] = {}  # a design parameter table the file does not give
         node = node[part]
 
 
 def _optional_keys(parents):
     """Keys that may be set although the file does not give them."""
+    if len(parents) == 2 and parents[0] == "design" and parents[1] in _TOP_TABLES:
+        return _top_table_fields(parents[1])
     if len(parents) != 1:
         return ()
     section = parents[0]
@@ -875,6 +880,13 @@ def _top(design):
         return top, design_tables(spec, tables, design.get("variant"))
     except ValueError as exc:
         raise ScenarioError(str(exc)) from None
+
+
+def _top_table_fields(key):
+    """The fields of a design parameter table (``design.line`` ...), for ``--set``."""
+    from .tops import table_fields
+
+    return table_fields(key)
 
 
 def _connectors(world):

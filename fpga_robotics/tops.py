@@ -13,7 +13,7 @@ import dataclasses
 import importlib
 from dataclasses import dataclass, field
 
-__all__ = ["TOPS", "Top", "build_component", "design_tables", "get_top"]
+__all__ = ["TOPS", "Top", "build_component", "design_tables", "get_top", "table_fields"]
 
 
 @dataclass(frozen=True)
@@ -72,6 +72,14 @@ def get_top(name):
 def _load(module_and_name):
     module, name = module_and_name
     return getattr(importlib.import_module(module), name)
+
+
+def table_fields(key):
+    """The parameter names of design sub-table ``key`` (any top's)."""
+    for top in TOPS.values():
+        if key in top.tables:
+            return tuple(f.name for f in dataclasses.fields(_load(top.tables[key])) if f.init)
+    return ()
 
 
 def design_tables(top, tables, variant=None):
