@@ -167,6 +167,8 @@ class RealClockLoop(ClosedLoop):
     def start_design(self):
         self.pins.watch(list(self.watched))
         self.last = {port: self.pins.peek(port) for port in self.watched}
+        # The wheel pins' values out of reset are a command too (a design may start moving).
+        self.motors.on_change(self.io[self.motors], "motor_left", None, 0.0)
         for conn in self.sensors:
             conn.start(self.io[conn])
 

@@ -13,7 +13,8 @@ import dataclasses
 import importlib
 from dataclasses import dataclass, field
 
-__all__ = ["TOPS", "Top", "build_component", "design_tables", "get_top", "table_fields"]
+__all__ = ["TOPS", "Top", "build_component", "design_tables", "get_top", "register_top",
+           "table_fields"]
 
 
 @dataclass(frozen=True)
@@ -28,8 +29,9 @@ class Top:
     bindings: dict = field(default_factory=dict)
     #: More outputs the run records each frame: trajectory field -> design port.
     extra_outputs: dict = field(default_factory=dict)
-    #: (module, class) of the component; built as ``cls(ft_params, *table params)``.
-    component: tuple = ("fpga_robotics.hw.top", "FollowTarget")
+    #: (module, class) of the component, or the class itself (a design of your own); built as
+    #: ``cls(ft_params, *table params)``.
+    component: object = ("fpga_robotics.hw.top", "FollowTarget")
     #: Whether the FollowTarget params (``[design]`` keys) are the first argument.
     takes_follow_target_params: bool = True
 
@@ -61,6 +63,14 @@ TOPS = {
 }
 
 
+def register_top(top):
+    """Make ``top`` (a ``Top``) available as ``design.top = top.name`` in scenarios."""
+    if not isinstance(top, Top):
+        raise TypeError(f"register_top takes a Top, not {top!r}")
+    TOPS[top.name] = top
+    return top
+
+
 def get_top(name):
     try:
         return TOPS[name]
@@ -69,8 +79,10 @@ def get_top(name):
                          f"got {name!r}") from None
 
 
-def _load(module_and_name):
-    module, name = module_and_name
+def _load(where):
+    if callable(where):
+        return where
+    module, name = where
     return getattr(importlib.import_module(module), name)
 
 

@@ -1180,7 +1180,27 @@ def snippet_published_first_frame(tmp_path, capsys):
 
 #: Python blocks, by (page, first line): a generator that yields the namespace the snippet
 #: assumes, is sent the values of its bare expressions, and checks them.
+def snippet_connectors_own_design(tmp_path, capsys):
+    """docs/connectors.md: a design of one's own with the bumper stops short of the wall."""
+    from fpga_robotics.tops import TOPS
+
+    shown = yield {}
+    try:
+        verdict, pressed, x = shown[-1]
+        assert verdict == "pass" and pressed == 1
+        # Pressed at 3 cm, minus the braking distance (300 DPS at 1500 DPS/s on 66.5 mm
+        # wheels: v^2 / 2a = 17.4 mm): about 1.26 cm short of the wall's 1.89 m.
+        v = 300 / 360 * np.pi * 0.0665
+        braking = v * v / (2 * 1500 / 360 * np.pi * 0.0665)
+        assert 2.0 - 0.11 - 0.03 <= x <= 2.0 - 0.11 - 0.03 + braking + 0.005
+        assert str(x).startswith("1.87")
+    finally:
+        TOPS.pop("bump_stop", None)
+
+
 SNIPPETS = {
+    ("docs/connectors.md", "from amaranth import Module, Mux, Signal, signed"):
+        snippet_connectors_own_design,
     ("README.md", "from fpga_robotics.hw.params import FollowTargetParams"):
         snippet_readme_backends,
     ("docs/backends.md", "from fpga_robotics.hw.params import FollowTargetParams"):
