@@ -84,7 +84,8 @@ def load_run(argv):
 
 def _design_key(args, scenario):
     return ("design", args.backend, args.design, args.ports, repr(scenario.foreign),
-            repr(scenario.params))
+            repr(scenario.params), scenario.sim.timing, scenario.top,
+            repr(sorted(scenario.design_tables.items())))
 
 
 def _open(key, opener):
@@ -101,8 +102,11 @@ def _open(key, opener):
 def _designs_for(args, scenario, shadow_params):
     from .. import run
 
-    design = _open(_design_key(args, scenario),
-                   lambda: run._open_design(args, scenario.params, scenario.foreign))
+    if scenario.sim.timing == "real_clock":  # a pin-level backend (fpga_robotics.clocked_loop)
+        design = _open(_design_key(args, scenario), lambda: run._open_pin_design(args, scenario))
+    else:
+        design = _open(_design_key(args, scenario),
+                       lambda: run._open_design(args, scenario.params, scenario.foreign))
     shadow = None
     if shadow_params is not None:
         name = args.shadow_backend or args.backend
