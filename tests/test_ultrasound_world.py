@@ -125,3 +125,17 @@ def test_noise_is_seeded_and_of_the_given_spread():
     metres = a / F * params.speed_of_sound / 2
     assert abs(metres.mean() - 1.0) < 4 * 0.01 / math.sqrt(len(a))
     assert metres.std() == pytest.approx(0.01, rel=0.1)
+
+
+@pytest.mark.parametrize("margin_deg, seen", [(-0.2, True), (0.2, False)])
+def test_a_box_corner_at_the_cone_edge(margin_deg, seen):
+    # A tall box whose nearest corner is 1 m away at bearing 7.5 - margin degrees, the box
+    # lying away from the beam's axis: only that corner can be in the beam.
+    b = math.radians(7.5 + margin_deg)
+    cx, cy = 1.0 + math.cos(b), 3.0 + math.sin(b)
+    box = {"name": "box", "center": [cx + 0.25, cy + 0.25], "size": [0.5, 0.5], "height": 1.0}
+    d = range_to(_world(furniture=[box]), 1.0, 3.0, 0.0, 0.1, QUIET)
+    if seen:
+        assert d == pytest.approx(1.0, abs=1e-12)  # the corner itself
+    else:
+        assert d == pytest.approx(3.0, abs=1e-12)
