@@ -12,15 +12,17 @@ the photodiode sees, plus seeded Gaussian noise; the output is 1 when that is be
 import math
 from dataclasses import dataclass
 
+import numpy as np
+
 __all__ = ["KY033", "KY033Params", "luminance", "spot_offsets"]
 
 #: Rec. 709 luma weights.
-_LUMA = (0.2126, 0.7152, 0.0722)
+_LUMA = np.array([0.2126, 0.7152, 0.0722])
 
 
 def luminance(color):
     """The luminance of an albedo ``(r, g, b)``, 0..1."""
-    return sum(w * c for w, c in zip(_LUMA, color))
+    return float(np.dot(_LUMA, color))
 
 
 def spot_offsets(radius):
@@ -55,19 +57,28 @@ class KY033:
             raise ValueError("a KY-033 with noise_std > 0 needs an rng")
         self.params = params
         self.rng = rng
-        self._offsets = spot_offsets(params.spot_radius)
+        offsets = np.array(spot_offsets(params.spot_radius))
+        self._dx, self._dy = offsets[:, 0], offsets[:, 1]
 
     def reflectance(self, world, x, y):
         """The mean luminance of the floor over the spot centred on ``(x, y)`` (no noise)."""
-        total = sum(luminance(world.floor_color_at(x + dx, y + dy)) for dx, dy in self._offsets)
-        return total / len(self._offsets)
+        colors = world.floor_colors_at(x + self._dx, y + self._dy)
+        return float(np.mean(colors @ _LUMA))
 
     def output(self, world, x, y):
         """The module's output (0 or 1) over the floor at ``(x, y)``: 1 over a dark surface."""
+        return self.outputs(world, [(x, y)])[0]
+
+    def outputs(self, world, points):
+        """The outputs of identical modules over each of ``points`` ((x, y), ...), read in
+        one pass (the noise drawn in the points' order)."""
         p = self.params
         if p.height > p.max_height:
-            return 1
-        value = self.reflectance(world, x, y)
+            return [1] * len(points)
+        centres = np.asarray(points, dtype=float).reshape(-1, 2)
+        colors = world.floor_colors_at((centres[:, :1] + self._dx).ravel(),
+                                       (centres[:, 1:] + self._dy).ravel())
+        values = (colors @ _LUMA).reshape(len(centres), -1).mean(axis=1)
         if p.noise_std > 0:
-            value += p.noise_std * float(self.rng.standard_normal())
-        return int(value < p.threshold)
+            values = values + p.noise_std * self.rng.standard_normal(len(centres))
+        return [int(v < p.threshold) for v in values]

@@ -3,6 +3,9 @@ what they poke and schedule: the ECHO edges a TRIG pulse gets, ignored triggers,
 bits' order, the measurements, and clear errors for bad scenario tables."""
 
 import math
+import pathlib
+import re
+import tomllib
 
 import numpy as np
 import pytest
@@ -151,3 +154,17 @@ def test_parse_mount_splits_the_mount_keys():
     assert mount == Mount(0.1, -0.02, 0.15, math.pi / 2) and rest == {"cone_deg": 20}
     with pytest.raises(ConnectorError, match=r"robot\.sensors\[0\]\.height must be a number"):
         parse_mount({"height": -1}, "robot.sensors[0]")
+
+
+def test_the_documented_sensor_tables_parse():
+    doc = pathlib.Path(__file__).parents[1] / "docs" / "scenarios.md"
+    (block,) = re.findall(r"```toml sensors\n(.*?)```", doc.read_text(), re.DOTALL)
+    tables = tomllib.loads(block)["robot"]["sensors"]
+    assert [t["kind"] for t in tables] == ["ultrasound", "line_sensors"]
+    for i, table in enumerate(tables):
+        rest = {k: v for k, v in table.items() if k not in ("kind", "name")}
+        mount, rest = parse_mount(rest, f"robot.sensors[{i}]")
+        params = connector_class(table["kind"]).parse(rest, f"robot.sensors[{i}]")
+        conn = connector_class(table["kind"])(table["name"], mount, params, world=_world(),
+                                              rng=np.random.default_rng(0))
+        assert conn.mount.height == table["height"]

@@ -89,6 +89,10 @@ def test_the_world_floor_colour_map_and_scene():
     assert world.floor_color_at(1.2, 2.011) == (0.6, 0.6, 0.6)  # the floor
     assert world.floor_color_at(2.3, 2.2) == (0.2, 0.8, 0.2)  # the patch
     assert world.floor_color_at(2.0, 2.0) == (1.0, 1.0, 1.0)  # the later line on top
+    rng = np.random.default_rng(0)
+    x, y = rng.uniform(1.4, 2.6, 3000), rng.uniform(1.4, 2.6, 3000)
+    np.testing.assert_array_equal(world.floor_colors_at(x, y),
+                                  [world.floor_color_at(a, b) for a, b in zip(x, y)])
     world_map = world.world_map()
     assert world_map.lines == [[(1.0, 2.0), (3.0, 2.0)], [(2.0, 1.0), (2.0, 3.0)]]
     assert world_map.line_widths == [0.02, 0.04]

@@ -125,3 +125,20 @@ def test_noise_is_seeded_and_of_the_given_spread():
     metres = a / F * params.speed_of_sound / 2
     assert abs(metres.mean() - 1.0) < 4 * 0.01 / math.sqrt(len(a))
     assert metres.std() == pytest.approx(0.01, rel=0.1)
+
+
+@pytest.mark.parametrize("margin_deg, seen", [(-0.2, True), (0.2, False)])
+def test_a_box_corner_at_the_cone_edge(margin_deg, seen):
+    # A tall box whose nearest corner is 1 m away at bearing b = 7.5 + margin degrees, turned
+    # by b so that one edge runs radially out from the corner and the box lies at bearings
+    # >= b: inside the cone's edge the corner is seen, outside nothing of the box is.
+    b = math.radians(7.5 + margin_deg)
+    cx, cy = 1.0 + math.cos(b), 3.0 + math.sin(b)
+    centre = [cx + 0.25 * (math.cos(b) - math.sin(b)), cy + 0.25 * (math.sin(b) + math.cos(b))]
+    box = {"name": "box", "center": centre, "size": [0.5, 0.5], "height": 1.0,
+           "angle_deg": math.degrees(b)}
+    d = range_to(_world(furniture=[box]), 1.0, 3.0, 0.0, 0.1, QUIET)
+    if seen:
+        assert d == pytest.approx(1.0, abs=1e-12)  # the corner itself
+    else:
+        assert d == pytest.approx(3.0, abs=1e-12)

@@ -48,7 +48,7 @@ class LineSensorsConnector(Connector):
         module = params.module
         if mount.height > 0:  # the mount's height is the module's
             module = replace(module, height=mount.height)
-        self.modules = [KY033(module, rng) for _ in params.sensors]
+        self.module = KY033(module, rng)  # one model reads every sensor (same settings)
         self.bits = 0
         self.positions = []
 
@@ -98,8 +98,8 @@ class LineSensorsConnector(Connector):
         """The bits (bit i = sensor i) over the floor under the sensors now."""
         self.positions = self.sensor_positions()
         bits = 0
-        for i, (module, (x, y)) in enumerate(zip(self.modules, self.positions)):
-            bits |= module.output(self.world, x, y) << i
+        for i, bit in enumerate(self.module.outputs(self.world, self.positions)):
+            bits |= bit << i
         return bits
 
     def before_step(self, io, t, dt):

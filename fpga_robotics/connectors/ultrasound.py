@@ -58,6 +58,10 @@ class UltrasoundConnector(Connector):
                                  f"({values['min_range']:g} m), got {values['max_range']:g}")
         return HCSR04Params(**values)
 
+    def start(self, io):
+        self._rise, self._last = None, None
+        self.module.busy_until = -1
+
     def sensor_pose(self):
         """``(x, y, heading)`` of the sensor in the world now."""
         return self.mount.world_pose(*self.world.robot_pose())

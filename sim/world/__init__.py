@@ -7,11 +7,13 @@ lighting; ``world.scene()`` describes it for the camera renderer. See docs/scena
 
 from .config import WORLD_SECTIONS, WorldConfigError, parse_world_config
 from .kinematics import dps_to_twist, twist_to_wheels, wheels_to_twist
+from .markings import FloorLine
 from .robots import GOPIGO3, ROBOT_MODELS, TURTLEBOT2, RobotSpec
 from .world import World
 
 __all__ = [
     "GOPIGO3",
+    "FloorLine",
     "ROBOT_MODELS",
     "TURTLEBOT2",
     "WORLD_SECTIONS",

@@ -16,7 +16,7 @@ import numpy as np
 __all__ = ["DISC_SIDES", "MITRE_TURN", "FloorLine"]
 
 #: The sharpest bend (rad) joined by a mitre; a mitre sticks out past the round band by at
-#: most ``w/2 (1/cos(MITRE_TURN/2) - 1)`` (7 % of the half width at 45°).
+#: most ``w/2 (1/cos(MITRE_TURN/2) - 1)`` (8.2 % of the half width at 45°).
 MITRE_TURN = math.radians(45.0)
 #: Sides of the polygon that stands for a disc (a round corner or end).
 DISC_SIDES = 16

@@ -482,6 +482,22 @@ class World:
         patch = self._painted.at(x, y) if self._painted else None
         return tuple(patch.color) if patch is not None else tuple(self.config.room.floor_color)
 
+    def floor_colors_at(self, x, y):
+        """``floor_color_at`` for arrays of points: an ``(n, 3)`` float array."""
+        x = np.asarray(x, dtype=float).ravel()
+        y = np.asarray(y, dtype=float).ravel()
+        out = np.empty((x.size, 3))
+        for i in range(x.size):
+            patch = self._painted.at(x[i], y[i]) if self._painted else None
+            out[i] = patch.color if patch is not None else self.config.room.floor_color
+        for line in self.floor_lines:  # in file order: a later line paints over
+            x0, y0, x1, y1 = line.bounds
+            near = (x >= x0) & (x <= x1) & (y >= y0) & (y <= y1)
+            if near.any():
+                idx = np.flatnonzero(near)
+                out[idx[line.covers(x[idx], y[idx])]] = line.color
+        return out
+
     def drain_events(self):
         """Events since the last call, e.g. ``"collision with wall"``, ``"furniture 'box'
         removed"``."""
