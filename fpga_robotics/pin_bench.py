@@ -195,7 +195,7 @@ def main(argv=None, prog="fpga-robotics bench pins"):
                 f"{stops} stops a run)")
         if name != "pysim":
             try:
-                frame_rate = frame_path_rate(name, params, bench_frames(params, 8),
+                frame_rate = frame_path_rate(name, params, bench_frames(params, 30),
                                              args.repeats) / 1e6
             except BackendError as exc:
                 frame_rate = None
