@@ -57,7 +57,10 @@ def pins(request):
                                             r"changes for edge 6 or later")),
     (lambda p: p.run(-1), r"run needs a number of cycles >= 0"),
     (lambda p: p.stream_frame(np.zeros((3, 2), np.uint16), PixelTiming(9, 4)),
-     r"a frame must be a \(2, 3\) uint16 array of RGB444 pixels, not uint16 \(3, 2\)"),
+     (r"a frame must be a \(2, 3\) uint16 array of RGB444 pixels \(or \(2, 3, 3\) uint8 "
+     r"RGB888\), not uint16 \(3, 2\)")),
+    (lambda p: p.stream_frame(np.full((2, 3), 0x1000, np.uint16), PixelTiming(9, 4)),
+     r"a packed RGB444 frame holds 12-bit values; found one above 0xFFF"),
     (lambda p: p.stream_frame(np.zeros((2, 3), np.uint16), PixelTiming(5, 4)),
      r"the frame starts at edge 5, in the past \(cycle is 5\)"),
     (lambda p: p.stream_frame(np.zeros((2, 3), np.uint16), PixelTiming(9, 2)),

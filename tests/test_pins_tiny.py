@@ -200,10 +200,20 @@ def test_combinational_stream_from_the_next_edge(probe):
     pins = probe
     pins.reset()
     pins.poke("mode", 1)
-    pins.stream_frame(FRAME | 0xF000, PixelTiming(start=1, line_period=4))  # flags ignored
+    pins.stream_frame(FRAME, PixelTiming(start=1, line_period=4))
     assert pins.filtered_frame() is None
     pins.run(12)
     np.testing.assert_array_equal(pins.filtered_frame(), FRAME)
+
+
+def test_rgb888_frames_are_packed_as_the_camera_does(probe):
+    pins = probe
+    pins.reset()
+    rgb = np.zeros((3, 4, 3), np.uint8)
+    rgb[..., 0], rgb[..., 1], rgb[..., 2] = 0xAF, 0x5C, 0x17  # each channel's top 4 bits
+    pins.stream_frame(rgb, PixelTiming(start=1, line_period=4))
+    pins.run(14)
+    np.testing.assert_array_equal(pins.filtered_frame(), np.full((3, 4), 0xA51))
 
 
 def test_back_to_back_frames_keep_their_filtered_streams_apart(probe):
