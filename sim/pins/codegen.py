@@ -41,7 +41,7 @@ def _header(source, getters, setters, registered, extra=()):
         f"#define PIN_HAS_FILTERED {int(source.filtered is not None)}",
     ]
     if registered:
-        lines.append("#define PIN_REGISTERED_OUTPUTS 1")
+        lines.append("#define FR_REGISTERED_OUTPUTS 1")
     lines += list(extra)
     lines.append("static inline void pin_set_input(PinTop &t, int port, uint64_t v) {")
     lines.append("    switch (port) {")
@@ -103,7 +103,7 @@ def cxxrtl_accessors(source, output_exprs, commit):
         setters[port.name] = f"{member}.set<uint64_t>(v)"
     extra = []
     if output_exprs is not None and commit is not None:
-        extra.append(f"#define PIN_COMMIT(t) do {{ {commit} }} while (0)")
+        extra.append(f"#define FR_COMMIT(t) do {{ {commit} }} while (0)")
     return _header(source, getters, setters, output_exprs is not None, extra)
 
 
