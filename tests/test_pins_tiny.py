@@ -240,3 +240,22 @@ def test_a_badly_framed_filtered_stream_is_an_error(probe, mode, message):
         pins.stream_frame(FRAME, PixelTiming(start=2, line_period=5))
     with pytest.raises(PinError, match=message):
         pins.run(100)
+
+
+def test_many_changes_scheduled_ahead(burst):
+    """A queue that never empties (changes scheduled far ahead) keeps its order: bursts of
+    1, 2, 3, ... edges, each latched into ``last`` by the edge that samples ``a`` low."""
+    pins = burst
+    pins.reset()
+    starts = [10 * k + 5 for k in range(150)]
+    for k, start in enumerate(starts):
+        pins.schedule(start, "a", 1)
+        pins.schedule(start + 1 + k % 7, "a", 0)
+    pins.schedule(100_000, "b", 1)  # stays queued throughout
+    pins.watch(["last"])
+    latched = []
+    while pins.cycle < 1600:
+        stop = pins.run(1600 - pins.cycle)
+        if stop.port:
+            latched.append(stop.value)
+    assert latched == [k % 7 + 1 for k in range(150)]  # neighbours differ: each one stops

@@ -103,6 +103,10 @@ struct Driver {
         if (head == queue.size()) {
             queue.clear();
             head = 0;
+        } else if (head >= 64 && 2 * head >= queue.size()) {
+            // Changes scheduled far ahead keep the queue from emptying: drop the used part.
+            queue.erase(queue.begin(), queue.begin() + head);
+            head = 0;
         }
 #if PIN_HAS_PIXELS
         if (next_pixel == e) {
