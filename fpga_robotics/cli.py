@@ -55,6 +55,7 @@ BENCHMARKS = {
     "foreign": ("fpga_robotics.sim.backends.foreign_bench",
                 "a Verilog design through a port map against the built-in Verilator backend"),
     "ros": ("fpga_robotics.ros.bench", "writing a ROS 2 bag and publishing live to Foxglove"),
+    "pins": ("fpga_robotics.pin_bench", "the pin backends in real-clock time (Mcycles/s)"),
 }
 
 PROG = "fpga-robotics"

@@ -586,6 +586,13 @@ PLANS = {
     "python -m fpga_robotics.camera_bench":
         Plan(shorter=(("--frames", "2"), ("--repeats", "1")),
              out=(r"(?m)^\s*160x120\s+[\d.]+", r"(?m)^\s*640x480\s+[\d.]+")),
+    # docs/pins.md -------------------------------------------------------------------------------
+    "python -m fpga_robotics.pin_bench":
+        Plan(shorter=(("--seconds", "0.02"), ("--pysim-seconds", "0.0002"), ("--repeats", "1")),
+             out=((r"(?m)^cxxrtl +pins: +[\d.]+ Mcycles/s \(1,000,000 cycles, 1 frames, \d+ stops "
+                  r"a run\); frame path [\d.]+ Mcycles/s, pins/frame [\d.]+$"),
+                  r"(?m)^verilator +pins: +[\d.]+ Mcycles/s",
+                  r"(?m)^pysim +pins: +[\d.]+ Mcycles/s \(10,000 cycles")),
     # docs/camera.md: the sensor model ---------------------------------------------------------
     "python -m fpga_robotics.camera_bench --sensor --sizes 160x120,640x480":
         Plan(shorter=(("--frames", "2"), ("--repeats", "1")),
@@ -1178,6 +1185,25 @@ def snippet_published_first_frame(tmp_path, capsys):
     assert (published[-2], published[-1]) == ("3", "00010000")  # level 3, LED 4
 
 
+def snippet_pins(tmp_path, capsys):
+    """docs/pins.md: a frame streamed in real-clock time on a pin backend; frame_done comes
+    result_latency edges after the last pixel, the outputs are the golden model's."""
+    from fpga_robotics.hw.params import FollowTargetParams
+    from fpga_robotics.sim.pins import Stop, real_clock_timing
+    from fpga_robotics.sim.synthetic import blob_frame
+
+    frame = blob_frame(160, 120, "red", rng=1)
+    shown = yield {"rgb888_image": frame}
+    stop, found, centroid_x = shown[-1]
+    params = FollowTargetParams()
+    last = real_clock_timing(160, 120, 30, 50e6, 1).last_edge(160, 120)
+    assert stop == Stop(last + params.result_latency, "frame_done", 1) == Stop(1559887,
+                                                                               "frame_done", 1)
+    expected = _model_result(frame, params)
+    assert (found, centroid_x) == (int(expected.found), expected.centroid_x)
+    assert found == 1
+
+
 #: Python blocks, by (page, first line): a generator that yields the namespace the snippet
 #: assumes, is sent the values of its bare expressions, and checks them.
 def snippet_connectors_own_design(tmp_path, capsys):
@@ -1201,6 +1227,9 @@ def snippet_connectors_own_design(tmp_path, capsys):
 SNIPPETS = {
     ("docs/connectors.md", "from amaranth import Module, Mux, Signal, signed"):
         snippet_connectors_own_design,
+    ("docs/pins.md", ("from fpga_robotics.sim.pins import follow_target_source, get_pin_backend, "
+                     "real_clock_timing")):
+        snippet_pins,
     ("README.md", "from fpga_robotics.hw.params import FollowTargetParams"):
         snippet_readme_backends,
     ("docs/backends.md", "from fpga_robotics.hw.params import FollowTargetParams"):

@@ -19,7 +19,7 @@ __all__ = ["CXX_FLAGS", "CxxrtlBackend", "cxxrtl_build_plan"]
 #: -fvisibility=hidden lets the compiler treat the model as private to the library.
 CXX_FLAGS = ("-std=c++17", "-O3", "-fno-tree-vectorize", "-fPIC", "-fvisibility=hidden", "-shared")
 
-_HARNESS_FILES = ("cxxrtl_harness.cpp", "frame_driver.h")
+_HARNESS_FILES = ("cxxrtl_harness.cpp", "frame_driver.h", "cxxrtl_clock.h")
 
 
 def cxxrtl_build_plan(design, variant, flags=None):

@@ -16,6 +16,7 @@
 
 #include "design.cc"
 #include "fr_model.h"
+#include "cxxrtl_clock.h"
 #include "frame_driver.h"
 
 #ifdef FR_TRACE
@@ -39,8 +40,7 @@ struct Sim {
 
     Sim() {
 #ifdef FR_ONE_EVAL
-        top.p_clk.set<bool>(true);
-        top.prev_p_clk.set<bool>(false);
+        fr_cxxrtl::one_eval_init(top);
 #endif
     }
     inline void set_inputs(bool valid, uint16_t payload, uint8_t color_sel) {
@@ -51,23 +51,15 @@ struct Sim {
     inline void set_rst(bool on) { top.p_rst.set<bool>(on); }
     inline void settle() {
 #ifndef FR_ONE_EVAL
-        top.p_clk.set<bool>(false);
-        top.step();
+        fr_cxxrtl::step_settle(top);
 #endif
         sample();
     }
     inline void edge() {
 #ifdef FR_ONE_EVAL
-        top.eval();
-#ifdef FR_COMMIT
-        FR_COMMIT(top);
+        fr_cxxrtl::one_eval_edge(top);
 #else
-        top.commit();
-        top.prev_p_clk.set<bool>(false);  // commit() recorded the high clock: the next edge
-#endif
-#else
-        top.p_clk.set<bool>(true);
-        top.step();
+        fr_cxxrtl::step_edge(top);
 #endif
         sample();
     }

@@ -43,7 +43,7 @@ from .verilator import CXX_FLAGS, MAKE_FLAGS, VERILATOR_FLAGS
 __all__ = ["ForeignDesign", "ForeignVerilatorBackend", "design_ports", "wrapper_verilog"]
 
 WRAPPER = "fr_foreign_top"
-_HARNESS_FILES = ("verilator_harness.cpp", "frame_driver.h")
+_HARNESS_FILES = ("verilator_harness.cpp", "frame_driver.h", "verilator_clock.h")
 _LINT_FLAGS = ("-Wno-fatal", "-Wno-lint", "-Wno-style")
 
 

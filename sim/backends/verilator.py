@@ -35,7 +35,7 @@ MAKE_FLAGS = ("OPT_FAST=-O2", "OPT_SLOW=-O1", "OPT_GLOBAL=-O2")
 #: A shared library must hide its symbols to run as fast as a program.
 CXX_FLAGS = ("-fPIC", "-fvisibility=hidden")
 
-_HARNESS_FILES = ("verilator_harness.cpp", "frame_driver.h")
+_HARNESS_FILES = ("verilator_harness.cpp", "frame_driver.h", "verilator_clock.h")
 
 
 def _check_fst_headers(compiler):

@@ -10,22 +10,17 @@
 // high and clears the remembered value instead, so each eval() is one rising edge. Traced
 // builds keep the real clock so that the waveform shows it.
 #include <memory>
-#include <type_traits>
-#include <utility>
 
 #include "Vfollow_target.h"
 #include "Vfollow_target___024root.h"
 #include "fr_ports.h"
 #include "frame_driver.h"
 #include "verilated.h"
+#include "verilator_clock.h"
 
-// Verilator's eval() wraps the scheduler in per-call housekeeping (a mutex-guarded deleter,
-// the message queue of $display and DPI) that costs more than this design's whole cycle.
-// The design has neither, so after the first eval() (which runs the initial blocks) the
-// harness calls the scheduler directly (not in traced builds: the trace needs that
+// The design has no $display or DPI, so after the first eval() the harness calls the
+// scheduler directly (verilator_clock.h; not in traced builds: the trace needs eval()'s
 // bookkeeping). Define FR_VERILATOR_PUBLIC_EVAL to always use eval().
-class Vfollow_target___024root;
-void Vfollow_target___024root___eval(Vfollow_target___024root *vlSelf);
 
 #ifdef FR_TRACE
 #ifdef FR_TRACE_FST
@@ -39,19 +34,10 @@ using TraceFile = VerilatedVcdC;
 
 namespace {
 
-template <class R, class = void>
-struct remembers_clk : std::false_type {};
-template <class R>
-struct remembers_clk<R, decltype(void(std::declval<R &>().__Vtrigprevexpr___TOP__clk__0))>
-    : std::true_type {};
-
-template <class R>
-inline void forget_clk(R *root, std::true_type) { root->__Vtrigprevexpr___TOP__clk__0 = 0; }
-template <class R>
-inline void forget_clk(R *, std::false_type) {}
+using fr_verilator::forget_clk;
 
 #if defined(FR_REGISTERED_OUTPUTS) && !defined(FR_TRACE)
-constexpr bool ONE_EVAL = remembers_clk<Vfollow_target___024root>::value;
+constexpr bool ONE_EVAL = fr_verilator::remembers_clk<Vfollow_target___024root>::value;
 #else
 constexpr bool ONE_EVAL = false;
 #endif

@@ -14,7 +14,7 @@ import numpy as np
 
 from ..backends import build_cache
 from ..backends.base import BackendError
-from ..backends.compiled import BuildPlan
+from ..backends.compiled import HARNESS_DIR, BuildPlan
 from ..backends.cxxrtl import CXX_FLAGS as CXXRTL_FLAGS
 from ..backends.cxxrtl_netlist import (
     fast_commit,
@@ -69,7 +69,10 @@ _ENTRIES = (
 
 
 def _sources(*names):
-    return {name: (SOURCE_DIR / name).read_text() for name in names}
+    """``{name: text}`` of harness files of this package or, shared with the frame
+    harnesses, of sim/backends."""
+    return {name: ((SOURCE_DIR if (SOURCE_DIR / name).exists() else HARNESS_DIR) / name)
+            .read_text() for name in names}
 
 
 def _digest(text):
@@ -87,7 +90,7 @@ def cxxrtl_plan(source):
     if exprs is not None:
         model = with_wire_copies_inlined(without_port_copies(model, outputs))
     accessors = cxxrtl_accessors(source, exprs, commit)
-    harness = _sources("pin_cxxrtl.cpp", _DRIVER)
+    harness = _sources("pin_cxxrtl.cpp", _DRIVER, "cxxrtl_clock.h")
     flags = list(CXXRTL_FLAGS)
     key = build_cache.build_key({
         "flow": "pins-cxxrtl",
@@ -121,7 +124,7 @@ def verilator_plan(source):
     outputs = [p.name for p in source.ports.values() if p.direction == "out"]
     registered = output_sources(source.cxxrtl, outputs) is not None
     accessors = verilator_accessors(source, registered)
-    harness = _sources("pin_verilator.cpp", _DRIVER)
+    harness = _sources("pin_verilator.cpp", _DRIVER, "verilator_clock.h")
     cflags = " ".join(VERILATOR_CXX_FLAGS)
     jobs = str(max(1, min(os.cpu_count() or 1, 4)))
     key = build_cache.build_key({

@@ -5,8 +5,10 @@ CXXRTL name them: a member path joined with ``__`` (``pixels.valid`` is ``pixels
 The clock ``clk`` and the reset ``rst`` are Amaranth's defaults and not ports here.
 """
 
+import contextlib
 import functools
 
+from amaranth.hdl import Fragment
 from amaranth.lib import wiring
 
 from ...hw.verilog import generate_cxxrtl, generate_verilog, verilog_ports
@@ -48,11 +50,25 @@ class PinDesignSource:
         self.factory = factory
         self.key = key
         component = factory()
+        if not isinstance(component, wiring.Component):
+            raise TypeError(f"the factory returned {component!r}, not a wiring.Component")
         # Handed out by the first component() call: an Amaranth elaboratable that is created
         # and never elaborated warns when it is collected.
         self._unused = component
-        if not isinstance(component, wiring.Component):
-            raise TypeError(f"the factory returned {component!r}, not a wiring.Component")
+        try:
+            self._read_ports(component, pixels, filtered, frame_size)
+        except PinError:
+            self._discard()
+            raise
+
+    def _discard(self):
+        """Elaborate the unused component, so that dropping it does not warn."""
+        component, self._unused = self._unused, None
+        with contextlib.suppress(Exception):
+            Fragment.get(component, None)
+
+    def _read_ports(self, component, pixels, filtered, frame_size):
+        key = self.key
         ports = {}
         for name, (value, direction) in verilog_ports(component).items():
             shape = value.shape()

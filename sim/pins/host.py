@@ -9,6 +9,7 @@ from collections import deque
 
 import numpy as np
 
+from ..frames import FrameError, to_rgb444
 from .base import PinBackend, PinError, PixelTiming, Stop
 
 __all__ = ["HostPins", "capture_error"]
@@ -133,10 +134,15 @@ class HostPins(PinBackend):
             raise PinError("this design has no pixel stream binding (PinDesignSource "
                            "pixels=...)")
         width, height = source.frame_size
-        packed = np.asarray(packed)
-        if packed.shape != (height, width) or packed.dtype.kind not in "ui":
+        shape = getattr(packed, "shape", None)
+        if shape not in ((height, width), (height, width, 3)):
             raise PinError(f"a frame must be a ({height}, {width}) uint16 array of RGB444 "
-                           f"pixels, not {packed.dtype} {packed.shape}")
+                           f"pixels (or ({height}, {width}, 3) uint8 RGB888), not "
+                           f"{getattr(packed, 'dtype', type(packed).__name__)} {shape}")
+        try:
+            frame = to_rgb444(packed, width, height)
+        except FrameError as exc:
+            raise PinError(str(exc)) from None
         if self.frame_pending:
             raise PinError(f"a frame is still streaming (its last pixel is at edge "
                            f"{self._last_pixel_edge}, cycle is {self._cycle}); run until "
@@ -157,7 +163,6 @@ class HostPins(PinBackend):
                                "design's filtered output lags by more than a frame")
             capture = np.zeros((height, width), np.uint16)
             self._captures.append(capture)
-        frame = np.ascontiguousarray(packed & 0xFFF, dtype=np.uint16)
         self._raw_stream(frame, timing, capture)
         self._last_pixel_edge = timing.last_edge(width, height)
 

@@ -1,9 +1,9 @@
 // Pin driver shared by the compiled pin backends: the clock loop of `run()` runs here, so
 // Python makes one call per run. The cycle numbering is sim/pins/base.py's:
 //   state c = after rising edge c, with the inputs of edge c + 1 applied and settled.
-//   run(n): for each edge e = c + 1 .. c + n: the edge; then the inputs due at e + 1
-//   (scheduled changes, the pixel slot); settle; capture a filtered beat; compare the
-//   watched outputs with the values last reported; stop at a difference.
+//   run(n): for each edge e = c + 1 .. c + n: capture the filtered beat that edge samples;
+//   the edge; then the inputs due at e + 1 (scheduled changes, the pixel slot); settle;
+//   compare the watched outputs with the values last reported; stop at a difference.
 //
 // The idle edge costs the model's evaluation, one compare against the next event edge (the
 // earlier of the next scheduled change and the next pixel-stream change), one read of the
@@ -102,6 +102,10 @@ struct Driver {
         }
         if (head == queue.size()) {
             queue.clear();
+            head = 0;
+        } else if (head >= 64 && 2 * head >= queue.size()) {
+            // Changes scheduled far ahead keep the queue from emptying: drop the used part.
+            queue.erase(queue.begin(), queue.begin() + head);
             head = 0;
         }
 #if PIN_HAS_PIXELS
@@ -210,17 +214,18 @@ struct Driver {
         int status = OK;
         uint64_t diff = pin_diff(sim.top, mask, prev);
         while (!diff && cycle < end) {
-            sim.edge();
-            const int64_t next = ++cycle + 1;
-            if (__builtin_expect(next_event == next, 0))
-                apply_events(next);
-            sim.settle();
 #if PIN_HAS_FILTERED
+            // The beat the coming edge samples, as a consumer of the stream sees it.
             if (__builtin_expect(pin_filtered_valid(sim.top), 0) && !capture()) {
                 status = n_captures == 0 ? TOO_MANY_FILTERED : BAD_FILTERED_FLAGS;
                 break;
             }
 #endif
+            sim.edge();
+            const int64_t next = ++cycle + 1;
+            if (__builtin_expect(next_event == next, 0))
+                apply_events(next);
+            sim.settle();
             diff = pin_diff(sim.top, mask, prev);
         }
         out[O_PORT] = -1;

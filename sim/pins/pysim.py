@@ -238,11 +238,11 @@ class PysimPins(HostPins):
         changed = self._changed(ctx)
         try:
             while changed is None and self._sim_cycle < end:
+                if self._filtered_sigs is not None:
+                    self._capture(ctx)  # the beat the coming edge samples
                 self._edge(ctx)
                 self._sim_cycle += 1
                 self._events(ctx, self._sim_cycle + 1)
-                if self._filtered_sigs is not None:
-                    self._capture(ctx)
                 changed = self._changed(ctx)
         except PinError:
             self._cycle = self._sim_cycle
