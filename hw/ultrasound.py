@@ -117,7 +117,7 @@ class UltrasoundDriver(CheckedArguments, wiring.Component):
                     m.d.sync += [state.eq(_State.COUNT), count.eq(1)]
                 with m.Elif(phase == T + W):
                     no_echo()
-            with m.Case(_State.COUNT):
+            with m.Default():  # COUNT (Default: no uncovered state value in the Verilog)
                 with m.If(~sync2):
                     m.d.sync += [
                         state.eq(_State.IDLE),
