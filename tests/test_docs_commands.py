@@ -563,7 +563,8 @@ PLANS = {
         Plan(files=("build/safe_narrow.v",),
              out=(r"variant us_echo_counter_narrow, module follow_target_safe",)),
     "python -m pytest -q tests/test_hw_ultrasound.py tests/test_hw_safe_follow.py "
-    "tests/test_hw_follow_line.py tests/test_export_sensor_designs.py":
+    "tests/test_hw_follow_line.py tests/test_hw_follow_line_track.py "
+    "tests/test_export_sensor_designs.py":
         Plan(collect=True, out=(r"\d+ tests collected",)),
     "python -m fpga_robotics.run --set design.preset=published":
         Plan(viewer=True, files=("runs/follow_person.rrd",), out=(PASS, SAVED_DEFAULT)),
