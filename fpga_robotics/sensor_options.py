@@ -64,7 +64,7 @@ def given_options(args, key):
 def sensor_params_from_args(args, key, top):
     """The params of group ``key`` from the options (with ``--variant`` applied when it
     changes this class); a bad value, or a variant of another top, raises ``UsageError``."""
-    cls, prefix, heading, _ = SENSOR_GROUPS[key]
+    cls, _, heading, _ = SENSOR_GROUPS[key]
     values = {f.name: getattr(args, _dest(key, f.name)) for f in _option_fields(cls)
               if getattr(args, _dest(key, f.name)) is not None}
     try:

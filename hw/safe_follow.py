@@ -37,6 +37,8 @@ class FollowTargetSafe(CheckedArguments, wiring.Component):
     - ``no_echo``, or ``distance_mm >= resume_mm``, clears it;
     - a distance in ``stop_mm .. resume_mm - 1`` keeps it (hysteresis).
 
+    (With ``release_on_far`` False, the seeded bug, only ``no_echo`` clears it.)
+
     While ``obstacle`` is high ``motor_left`` and ``motor_right`` are 0 (from the cycle it
     rises in); otherwise they are ``FollowTarget``'s, which keeps tracking and steering
     throughout. ``obstacle`` is 0 after reset. Every other port is ``follow_target``'s,
@@ -100,10 +102,12 @@ class FollowTargetSafe(CheckedArguments, wiring.Component):
             self.distance_mm.eq(us.distance_mm),
         ]
 
+        far = us.distance_mm >= ip.resume_mm
+        release = (us.no_echo | far) if ip.release_on_far else (us.no_echo & far)
         with m.If(us.measured):
             with m.If(~us.no_echo & (us.distance_mm < ip.stop_mm)):
                 m.d.sync += self.obstacle.eq(1)
-            with m.Elif(us.no_echo | (us.distance_mm >= ip.resume_mm)):
+            with m.Elif(release):
                 m.d.sync += self.obstacle.eq(0)
         m.d.comb += [
             self.motor_left.eq(Mux(self.obstacle, 0, ft.motor_left)),

@@ -109,9 +109,8 @@ class UltrasoundDriver(CheckedArguments, wiring.Component):
                          self.distance_mm.eq(DISTANCE_NONE), self.measured.eq(1)]
 
         with m.Switch(state):
-            with m.Case(_State.IDLE):
-                with m.If(phase == T):  # the edge at which TRIG falls
-                    m.d.sync += state.eq(_State.WAIT)
+            with m.Case(_State.IDLE), m.If(phase == T):  # the edge at which TRIG falls
+                m.d.sync += state.eq(_State.WAIT)
             with m.Case(_State.WAIT):
                 with m.If(rising):
                     m.d.sync += [state.eq(_State.COUNT), count.eq(1)]

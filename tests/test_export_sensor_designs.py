@@ -122,8 +122,8 @@ def test_options_reach_the_design(tmp_path):
     (["--line-base-dps", "3"], "--line-base-dps applies to --top follow_line"),
     (["--top", "follow_line", "--stop-mm", "3"], "--stop-mm applies to --top follow_target_safe"),
     (["--variant", "us_echo_inverted"], "--variant names a seeded bug of a sensor design"),
-    (["--top", "follow_line", "--variant", "us_echo_inverted"], "is a variant of --top "
-                                                                  "follow_target_safe"),
+    (["--top", "follow_line", "--variant", "us_echo_inverted"],
+     "is a variant of --top follow_target_safe"),
     (["--top", "follow_line", "--variant", "nope"], "known variants: line_inverted_polarity"),
     (["--top", "follow_target_safe", "--stop-mm", "500"], "resume_mm=400 must be >= stop_mm=500"),
     (["--top", "follow_target_safe", "--us-trigger-us", "5"], "trigger_us must be >= 10"),

@@ -4,12 +4,13 @@ ultrasound driver inside it (against its model) and the interlock's hysteresis a
 
 import numpy as np
 import pytest
-from hwsim import PERIOD, WatchdogTimeout, frame_schedule, small_params
 from amaranth.sim import Simulator
+from hwsim import PERIOD, WatchdogTimeout, frame_schedule, small_params
 
 from fpga_robotics.hw.pixel import COLOR_SELECT
 from fpga_robotics.hw.safe_follow import FollowTargetSafe
 from fpga_robotics.hw.sensor_params import DISTANCE_NONE, InterlockParams, UltrasoundParams
+from fpga_robotics.hw.variants import variant_params
 from fpga_robotics.sim import synthetic
 from fpga_robotics.sim.frames import to_rgb444
 from fpga_robotics.sim.model import FollowTargetModel
@@ -136,6 +137,28 @@ def test_interlock_stops_and_releases_with_hysteresis():
     assert np.all(left[~stopped] == held.motor_left)
     assert np.all(right[~stopped] == held.motor_right)
     assert np.array_equal(trace["ft_left"][after_frame:], np.full(len(left), held.motor_left))
+
+
+def test_latching_variant_releases_only_on_no_echo():
+    p = small_params()
+    periods = 5
+    fall = [k * US.period_cycles + US.trigger_cycles + 1 for k in range(periods)]
+    # Period 0: nothing; then near (102 mm), far (257 mm) twice, nothing.
+    pulses = [(fall[k] + 40, fall[k] + 40 + w)
+              for k, w in ((1, MM["stop"]), (2, MM["far"]), (3, MM["far"]))]
+    lock = variant_params("interlock_latches", LOCK)
+    dut = FollowTargetSafe(p, US, lock)
+    trace = run_safe(dut, [], pulses, edges=periods * US.period_cycles)
+    measured = measurements_of(trace)
+    assert [m.distance_mm for m in measured] == [DISTANCE_NONE, 102, 257, 257, DISTANCE_NONE]
+    got = [bool(trace["obstacle"][m.edge]) for m in measured]
+    model = InterlockModel(lock)
+    assert got == [model.step(m) for m in measured]
+    # The correct interlock lets go at the first far reading; the variant holds on until
+    # the view is empty.
+    assert got == [False, True, True, True, False]
+    correct = InterlockModel(LOCK)
+    assert [correct.step(m) for m in measured] == [False, True, False, False, False]
 
 
 @pytest.mark.parametrize("stop,resume,message", [

@@ -11,7 +11,7 @@ from fpga_robotics.hw.variants import variant_params
 from fpga_robotics.sim.ultrasound_model import Measurement, UltrasoundModel, echo_cycles_of
 
 #: A 1 MHz clock and a 2.4 ms period keep pysim fast: T = 12, W = 500, M = 1749 cycles.
-SMALL = dict(clock_hz=1_000_000, period_us=2400, wait_us=500, max_range_mm=300)
+SMALL = {"clock_hz": 1_000_000, "period_us": 2400, "wait_us": 500, "max_range_mm": 300}
 
 
 def run_driver(params, pulses, periods):
@@ -108,6 +108,8 @@ def test_boundaries_and_random_echoes_match_the_model():
     trig, measured = run_driver(p, pulses, periods=12)
     model = UltrasoundModel(p)
     assert measured == model.measurements(12, pulses)
+    # ECHO never disturbs TRIG.
+    assert list(zip(*edges_of(trig))) == [model.trigger(k) for k in range(12)]
     # The hand-known ones.
     assert measured[0] == Measurement(fall[0] + 42, (41 * p.distance_k) >> 18, False)
     assert measured[1].distance_mm == p.distance_of(M) == 299  # 300 mm, floored
