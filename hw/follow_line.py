@@ -6,6 +6,7 @@ from amaranth.lib.wiring import In, Out
 
 from .motor import DPS_BITS
 from .sensor_params import FollowLineParams
+from .validate import CheckedArguments
 
 __all__ = ["FollowLine", "FollowLineParams", "line_command"]
 
@@ -60,7 +61,7 @@ def line_command(params, bits, side):
     return (*turn(LEFT if left else RIGHT, amount), side)
 
 
-class FollowLine(wiring.Component):
+class FollowLine(CheckedArguments, wiring.Component):
     """Line follower (Verilog module ``follow_line``).
 
     **Synchroniser.** Each bit of ``line`` passes two flops (inverted first when
@@ -104,11 +105,13 @@ class FollowLine(wiring.Component):
         The synchronised bits the controller acts on (1 = line under the sensor).
     """
 
-    def __init__(self, params=None):
-        params = FollowLineParams() if params is None else params
-        if not isinstance(params, FollowLineParams):
+    @staticmethod
+    def check_arguments(params=None):
+        if params is not None and not isinstance(params, FollowLineParams):
             raise TypeError(f"params must be a FollowLineParams, not {params!r}")
-        self.params = params
+
+    def __init__(self, params=None):
+        self.params = params = FollowLineParams() if params is None else params
         n = params.n_sensors
         super().__init__({
             "line": In(n),

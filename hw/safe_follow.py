@@ -8,6 +8,7 @@ from .params import FollowTargetParams
 from .sensor_params import DISTANCE_BITS, InterlockParams, UltrasoundParams
 from .top import FollowTarget, follow_target_signature
 from .ultrasound import UltrasoundDriver
+from .validate import CheckedArguments
 
 __all__ = ["FollowTargetSafe", "InterlockParams", "follow_target_safe_signature"]
 
@@ -24,7 +25,7 @@ def follow_target_safe_signature(ft_params):
     return wiring.Signature(members)
 
 
-class FollowTargetSafe(wiring.Component):
+class FollowTargetSafe(CheckedArguments, wiring.Component):
     """``FollowTarget`` (unchanged, as a submodule) whose wheels an obstacle interlock stops
     (Verilog module ``follow_target_safe``).
 
@@ -35,6 +36,8 @@ class FollowTargetSafe(wiring.Component):
     - a measurement (not ``no_echo``) with ``distance_mm < stop_mm`` sets ``obstacle``;
     - ``no_echo``, or ``distance_mm >= resume_mm``, clears it;
     - a distance in ``stop_mm .. resume_mm - 1`` keeps it (hysteresis).
+
+    (With ``release_on_far`` False, the seeded bug, only ``no_echo`` clears it.)
 
     While ``obstacle`` is high ``motor_left`` and ``motor_right`` are 0 (from the cycle it
     rises in); otherwise they are ``FollowTarget``'s, which keeps tracking and steering
@@ -60,14 +63,18 @@ class FollowTargetSafe(wiring.Component):
         The interlock holds the wheels at 0.
     """
 
+    @staticmethod
+    def check_arguments(ft_params=None, us_params=None, interlock_params=None):
+        for name, value, cls in (("ft_params", ft_params, FollowTargetParams),
+                                 ("us_params", us_params, UltrasoundParams),
+                                 ("interlock_params", interlock_params, InterlockParams)):
+            if value is not None and not isinstance(value, cls):
+                raise TypeError(f"{name} must be a {cls.__name__}, not {value!r}")
+
     def __init__(self, ft_params=None, us_params=None, interlock_params=None):
         ft_params = FollowTargetParams() if ft_params is None else ft_params
         us_params = UltrasoundParams() if us_params is None else us_params
         interlock_params = InterlockParams() if interlock_params is None else interlock_params
-        for value, cls in ((ft_params, FollowTargetParams), (us_params, UltrasoundParams),
-                           (interlock_params, InterlockParams)):
-            if not isinstance(value, cls):
-                raise TypeError(f"expected a {cls.__name__}, not {value!r}")
         self.params = ft_params
         self.us_params = us_params
         self.interlock_params = interlock_params
@@ -95,10 +102,12 @@ class FollowTargetSafe(wiring.Component):
             self.distance_mm.eq(us.distance_mm),
         ]
 
+        far = us.distance_mm >= ip.resume_mm
+        release = (us.no_echo | far) if ip.release_on_far else (us.no_echo & far)
         with m.If(us.measured):
             with m.If(~us.no_echo & (us.distance_mm < ip.stop_mm)):
                 m.d.sync += self.obstacle.eq(1)
-            with m.Elif(us.no_echo | (us.distance_mm >= ip.resume_mm)):
+            with m.Elif(release):
                 m.d.sync += self.obstacle.eq(0)
         m.d.comb += [
             self.motor_left.eq(Mux(self.obstacle, 0, ft.motor_left)),

@@ -166,10 +166,15 @@ class InterlockParams(_Params):
 
     stop_mm: int = 300
     resume_mm: int = 400
+    #: A measurement at ``resume_mm`` or farther releases the interlock, as does no echo.
+    #: False: only a no-echo measurement that is also far does, which every no echo is and
+    #: no real distance is (an AND where an OR belongs: a seeded bug, ``hw/variants.py``).
+    release_on_far: bool = True
 
     def __post_init__(self):
         self._check("stop_mm", 1, DISTANCE_NONE - 1)
         self._check("resume_mm", 1, DISTANCE_NONE - 1)
+        _check_bool("release_on_far", self.release_on_far)
         if self.resume_mm < self.stop_mm:
             raise ValueError(f"resume_mm={self.resume_mm} must be >= stop_mm={self.stop_mm} "
                              "(no overlap of 'stop' and 'resume')")

@@ -6,10 +6,10 @@ variant's wrong output exactly (the unit tests show it on hand-built inputs).
 ``variant_params(name, base)`` applies a variant to the parameters it changes.
 """
 
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Callable
 
-from .sensor_params import FollowLineParams, UltrasoundParams
+from .sensor_params import FollowLineParams, InterlockParams, UltrasoundParams
 
 __all__ = ["VARIANTS", "Variant", "variant_params"]
 
@@ -61,6 +61,16 @@ VARIANTS = {v.name: v for v in (
             "reads 2920 mm instead of no echo",
         fails="obstacle_between: following resumes when the box is gone: with the box gone, a "
               "wall 3.60-3.89 m ahead reads below stop_mm (300 mm) and holds the wheels at 0",
+    ),
+    Variant(
+        name="interlock_latches",
+        design="follow_target_safe",
+        params_type=InterlockParams,
+        changes=lambda p: {"release_on_far": False},
+        bug="the interlock's release is 'no echo AND far' instead of 'no echo OR far': once "
+            "stopped, only an empty view (no echo at all) releases the wheels",
+        fails="obstacle_between: following resumes when the box is gone: the person (or any "
+              "surface within 4 m) keeps answering, so the robot never moves again",
     ),
 )}
 

@@ -92,6 +92,7 @@ class InterlockModel:
         p = self.params
         if not measurement.no_echo and measurement.distance_mm < p.stop_mm:
             self.obstacle = True
-        elif measurement.no_echo or measurement.distance_mm >= p.resume_mm:
+        elif measurement.no_echo or (p.release_on_far and measurement.distance_mm >= p.resume_mm):
+            # (Without release_on_far, the seeded bug, a far measurement does not release.)
             self.obstacle = False
         return self.obstacle

@@ -545,6 +545,27 @@ PLANS = {
     "python -m fpga_robotics.export --preset published -o build/published.v":
         Plan(files=("build/published.v",),
              out=(r"160x120, preset published, module follow_target",)),
+    # docs/sensor_designs.md: the sensor designs' exports -------------------------------------
+    "python -m fpga_robotics.export --top follow_target_safe -o build/follow_target_safe.v":
+        Plan(files=("build/follow_target_safe.v",),
+             out=(r"160x120, 50000000 Hz, stop 300 mm, resume 400 mm, module follow_target_safe",)),
+    "python -m fpga_robotics.export --top follow_target_safe --stop-mm 250 --resume-mm 350 "
+    "-o build/safe250.v":
+        Plan(files=("build/safe250.v",), out=(r"stop 250 mm, resume 350 mm",)),
+    "python -m fpga_robotics.export --top follow_line --line-n-sensors 2 -o build/follow_line2.v":
+        Plan(files=("build/follow_line2.v",), out=(r"2 sensors, module follow_line",)),
+    "python -m fpga_robotics.export --top follow_line --variant line_inverted_polarity "
+    "-o build/line_inverted.v":
+        Plan(files=("build/line_inverted.v",),
+             out=(r"3 sensors, variant line_inverted_polarity, module follow_line",)),
+    "python -m fpga_robotics.export --top follow_target_safe --variant us_echo_counter_narrow "
+    "-o build/safe_narrow.v":
+        Plan(files=("build/safe_narrow.v",),
+             out=(r"variant us_echo_counter_narrow, module follow_target_safe",)),
+    "python -m pytest -q tests/test_hw_ultrasound.py tests/test_hw_safe_follow.py "
+    "tests/test_hw_follow_line.py tests/test_hw_follow_line_track.py "
+    "tests/test_export_sensor_designs.py":
+        Plan(collect=True, out=(r"\d+ tests collected",)),
     "python -m fpga_robotics.run --set design.preset=published":
         Plan(viewer=True, files=("runs/follow_person.rrd",), out=(PASS, SAVED_DEFAULT)),
     "python -m fpga_robotics.run --set design.preset=published --rerun off --summary "

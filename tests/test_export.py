@@ -66,11 +66,11 @@ def test_widths_follow_the_geometry():
     }
 
 
-def verilator_lint(path):
+def verilator_lint(path, top="follow_target"):
     root = verilator_root()
     env = dict(os.environ, VERILATOR_ROOT=str(root))
     argv = [str(root / "bin" / "verilator"), "--lint-only", "-Wall",
-            *(f"-Wno-{w}" for w in LINT_WAIVERS), "--top-module", "follow_target", str(path)]
+            *(f"-Wno-{w}" for w in LINT_WAIVERS), "--top-module", top, str(path)]
     return subprocess.run(argv, capture_output=True, text=True, env=env, timeout=120,
                           check=False)
 
