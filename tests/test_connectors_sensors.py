@@ -126,8 +126,10 @@ def test_line_bits_are_ordered_from_the_left():
     assert backend.pokes == [(0, "line", 0b001)]
     m = conn.measurement()
     assert (m["line"], m["line0"], m["line1"], m["line2"]) == (1.0, 1.0, 0.0, 0.0)
-    assert (m["line0_x"], m["line0_y"]) == pytest.approx((1.1, 3.05))
-    assert (m["line2_x"], m["line2_y"]) == pytest.approx((1.1, 2.95))
+    overlay = conn.map_overlay()
+    assert overlay["points"][0] == pytest.approx((1.1, 3.05))
+    assert overlay["points"][2] == pytest.approx((1.1, 2.95))
+    assert overlay["states"] == (1, 0, 0)
 
 
 @pytest.mark.parametrize("kind, table, match", [

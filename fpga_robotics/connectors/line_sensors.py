@@ -10,6 +10,7 @@ step (the world moves only between steps, so the pose inside a step is not known
 
 import math
 from dataclasses import dataclass, replace
+from typing import ClassVar
 
 from ..sim.line_sensor import KY033, KY033Params
 from .base import Connector, ConnectorError, Pin, check_number, register
@@ -40,7 +41,7 @@ class LineSensorsConnector(Connector):
     kind = "line_sensors"
     role = "sensor"
     #: The width of ``line`` is the number of sensors (set per connector).
-    pins = {"line": Pin("in", MAX_SENSORS)}
+    pins: ClassVar[dict] = {"line": Pin("in", MAX_SENSORS)}
 
     def __init__(self, name, mount, params, *, world, rng):
         super().__init__(name, mount, params, world=world, rng=rng)
@@ -107,10 +108,13 @@ class LineSensorsConnector(Connector):
         io.poke("line", self.bits)
 
     def measurement(self):
-        """``line`` (the bits as a number), and per sensor i ``line<i>`` (its bit) and
-        ``line<i>_x``, ``line<i>_y`` (its position, m)."""
+        """``line`` (the bits as a number) and per sensor i ``line<i>`` (its bit)."""
         out = {"line": float(self.bits)}
-        for i, (x, y) in enumerate(self.positions):
+        for i in range(len(self.positions)):
             out[f"line{i}"] = float(self.bits >> i & 1)
-            out[f"line{i}_x"], out[f"line{i}_y"] = float(x), float(y)
         return out
+
+    def map_overlay(self):
+        """Each sensor where it read the floor, lit when its bit is 1 (over the line)."""
+        return {"points": tuple((float(x), float(y)) for x, y in self.positions),
+                "states": tuple(self.bits >> i & 1 for i in range(len(self.positions)))}

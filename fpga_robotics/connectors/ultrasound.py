@@ -8,6 +8,7 @@ trigger the module ignores (too short, or while it is busy) schedules nothing.
 """
 
 import math
+from typing import ClassVar
 
 from ..sim.ultrasound import HCSR04Module, HCSR04Params, range_to
 from .base import Connector, ConnectorError, Pin, check_number, register
@@ -32,7 +33,7 @@ class UltrasoundConnector(Connector):
     """An HC-SR04: ``trig`` out of the design (1 bit), ``echo`` into it (1 bit)."""
 
     kind = "ultrasound"
-    pins = {"trig": Pin("out"), "echo": Pin("in")}
+    pins: ClassVar[dict] = {"trig": Pin("out"), "echo": Pin("in")}
     watch = ("trig",)
 
     def __init__(self, name, mount, params, *, world, rng):
@@ -99,3 +100,15 @@ class UltrasoundConnector(Connector):
             "range_m": math.nan if distance is None else float(distance),
             "timeout": float(distance is None),
         }
+
+    def map_overlay(self):
+        """The sensor, and a ray along its axis as long as the last echo says (none after a
+        time-out)."""
+        x, y, heading = self.sensor_pose()
+        out = {"points": ((x, y),), "states": (1,)}
+        m = self.measurement()
+        if m and not m["timeout"]:
+            reach = m["echo_m"]
+            out["rays"] = (((x, y), (x + reach * math.cos(heading),
+                                     y + reach * math.sin(heading))),)
+        return out
