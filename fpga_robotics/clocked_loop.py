@@ -74,7 +74,7 @@ class _PendingRow:
     """Trajectory row ``k`` between its capture and the end of its frame's processing."""
 
     __slots__ = ("distance", "edge", "events", "filtered", "k", "outputs", "readings", "rgb",
-                 "t", "visible")
+                 "t", "viewer_events", "visible")
 
     def __init__(self, k, t, rgb, events, distance, visible, edge, readings):
         self.k, self.t, self.rgb, self.events = k, t, rgb, events
@@ -82,6 +82,7 @@ class _PendingRow:
         self.readings = readings  # {connector name: SensorReading} at the capture
         self.outputs = None  # the per-frame outputs, at the frame strobe
         self.filtered = None
+        self.viewer_events = []  # events already in the run's list at their exact time
 
 
 class RealClockLoop(ClosedLoop):
@@ -195,9 +196,12 @@ class RealClockLoop(ClosedLoop):
                 self.pending.outputs = {name: self.pins.peek(name) for name in _FRAME_OUTPUTS}
                 self.pending.filtered = self.pins.filtered_frame()
         elif port == "obstacle":
-            k = self.pending.k if self.pending is not None else 0
-            self.events.append((k, round(t, 6), "interlock: obstacle, wheels stopped" if value
-                                else "interlock: clear, wheels released"))
+            text = ("interlock: obstacle, wheels stopped" if value
+                    else "interlock: clear, wheels released")
+            row = self.pending
+            self.events.append((row.k if row is not None else 0, round(t, 6), text))
+            if row is not None:  # shown in the viewer with the row it happened in
+                row.viewer_events.append(text)
 
     def advance_physics(self, to_step):
         while self.step < to_step:
@@ -284,8 +288,8 @@ class RealClockLoop(ClosedLoop):
             self.extra[name][row.k] = float(extra[name])
         self.events += [(row.k, round(row.t, 6), e) for e in events]
         if self.want_records:
-            self.record(row.k, row.t, row.rgb, result, row.distance, row.visible, events,
-                        sensors=row.readings, design_extra=extra)
+            self.record(row.k, row.t, row.rgb, result, row.distance, row.visible,
+                        events + row.viewer_events, sensors=row.readings, design_extra=extra)
 
     def after_frames(self):
         self.finish_row()

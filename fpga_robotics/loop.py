@@ -290,8 +290,10 @@ class ClosedLoop:
             robot_radius=self.world.robot_spec.body_radius, **extra,
         )
         if self.recorder is not None:
-            if any(e.startswith("furniture '") and e.endswith("' removed") for e in events):
-                self.recorder.log_world_map(self.world.world_map())  # without it from now on
+            update = getattr(self.recorder, "update_furniture", None)
+            if update is not None and any(e.startswith("furniture '") and e.endswith("' removed")
+                                          for e in events):
+                update(self.world.world_map(), k, t)  # drawn without it from now on
             self.recorder.log_frame(record)
         if self.on_frame is not None:
             self.on_frame(record)

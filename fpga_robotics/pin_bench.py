@@ -17,7 +17,6 @@ import argparse
 import statistics
 import time
 
-import numpy as np
 from amaranth import Module
 from amaranth.lib import wiring
 from amaranth.lib.wiring import In, Out

@@ -259,16 +259,30 @@ class Recorder:
             log(P.MAP_TERRAIN, rr.LineStrips2D(
                 terrain, colors=[tuple(c) for c in world_map.terrain_colors], radii=0.01),
                 static=True)
+        self._log_furniture(world_map, 0, 0.0)
+
+    def _log_furniture(self, world_map, frame, sim_time):
+        """The furniture from ``frame`` on: on the timeline, since a piece may leave the room
+        during the run (``update_furniture``)."""
         polygons = [
             [_xy(*p) for p in poly] + [_xy(*poly[0])] for poly in world_map.obstacles if poly
         ]
+        self._stream.set_time("frame", sequence=frame)
+        self._stream.set_time("sim_time", duration=time_ns(sim_time))
         if polygons:
             colors = [tuple(int(c) for c in col) for col in world_map.obstacle_colors]
-            log(
-                P.MAP_FURNITURE,
-                rr.LineStrips2D(polygons, colors=colors or None, radii=0.015),
-                static=True,
-            )
+            self._stream.log(P.MAP_FURNITURE,
+                             rr.LineStrips2D(polygons, colors=colors or None, radii=0.015))
+        else:
+            self._stream.log(P.MAP_FURNITURE, rr.Clear(recursive=False))
+
+    def update_furniture(self, world_map, frame, sim_time):
+        """The furniture changed (a piece left the room) at ``frame``: draw it anew from then."""
+        self._check_open()
+        if self._stream is None:
+            return
+        with self._guard:
+            self._log_furniture(world_map, frame, sim_time)
 
     # Per frame ---------------------------------------------------------------------------------
 
