@@ -64,4 +64,4 @@ def test_floor_lines_are_drawn_once(tmp_path):
     points = data.entities[f"{MAP_SENSORS}/line/points"]
     assert len(points.values["Points2D:positions"][-1]) == 3
     bits = data.entities[f"{SENSORS}/line/line1"]
-    assert [v[0] for v in bits.values["Scalars:scalars"]][0] == 1.0  # the middle one on the tape
+    assert bits.values["Scalars:scalars"][0][0] == 1.0  # the middle one on the tape

@@ -13,10 +13,10 @@ from .world import World
 
 __all__ = [
     "GOPIGO3",
-    "FloorLine",
     "ROBOT_MODELS",
     "TURTLEBOT2",
     "WORLD_SECTIONS",
+    "FloorLine",
     "RobotSpec",
     "World",
     "WorldConfigError",
