@@ -30,7 +30,7 @@ def _trail_range():
     )
 
 
-def default_blueprint(bounds=None, shadow=False, world3d=False, sensors=()):
+def default_blueprint(bounds=None, shadow=False, world3d=False, sensors=(), frame_outputs=True):
     """The layout sent to the viewer; ``bounds`` ``(xmin, ymin, xmax, ymax)`` frame the map;
     ``shadow`` adds a second LED row and the shadow design's wheel speeds; ``world3d`` puts
     the world in 3D (``viz.world3d``) beside the map; ``sensors`` (series entity paths,
@@ -43,6 +43,17 @@ def default_blueprint(bounds=None, shadow=False, world3d=False, sensors=()):
         map_kwargs["visual_bounds"] = rrb.VisualBounds2D(
             x_range=[xmin - pad, xmax + pad], y_range=[-ymax - pad, -ymin + pad]
         )
+    plots = rrb.Horizontal(
+        rrb.TimeSeriesView(origin=P.MOTORS if shadow else P.MOTORS_DPS,
+                           name="Wheel DPS (left, right" + (", shadow" if shadow else "")
+                           + ")"),
+        rrb.TimeSeriesView(origin=P.TWIST_V, name="V m/s (commanded, measured)"),
+        rrb.TimeSeriesView(origin=P.TWIST_W, name="W rad/s (commanded, measured)"),
+    )
+    if not frame_outputs:
+        board = rrb.Vertical(rrb.Spatial2DView(origin=P.CAMERA_RAW, name="Camera"), plots,
+                             row_shares=[4, 3], name="Board")
+        return _blueprint(board, bounds, map_kwargs, world3d, sensors)
     board = rrb.Vertical(
         rrb.Horizontal(
             rrb.Spatial2DView(origin=P.CAMERA_RAW, name="Camera"),
@@ -58,16 +69,15 @@ def default_blueprint(bounds=None, shadow=False, world3d=False, sensors=()):
             rrb.Spatial2DView(origin=P.SHADOW_LEDS_CENTROID, name="Shadow design: centroid"),
             column_shares=[7, 8],
         )] if shadow else []),
-        rrb.Horizontal(
-            rrb.TimeSeriesView(origin=P.MOTORS if shadow else P.MOTORS_DPS,
-                               name="Wheel DPS (left, right" + (", shadow" if shadow else "")
-                               + ")"),
-            rrb.TimeSeriesView(origin=P.TWIST_V, name="V m/s (commanded, measured)"),
-            rrb.TimeSeriesView(origin=P.TWIST_W, name="W rad/s (commanded, measured)"),
-        ),
+        plots,
         row_shares=[4, 1, 1, 3] if shadow else [4, 1, 3],
         name="Board",
     )
+    return _blueprint(board, bounds, map_kwargs, world3d, sensors)
+
+
+def _blueprint(board, bounds, map_kwargs, world3d, sensors):
+    """The whole layout: ``board`` on the left, the world on the right."""
     top_down = rrb.Spatial2DView(
         origin=P.MAP,
         name="World (top-down)",

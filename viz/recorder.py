@@ -169,6 +169,10 @@ class Recorder:
         self._world3d = None  # viz.world3d.World3D, made at the first record with a scene
         self._layout_stale = False  # the layout sent lacks a view that is now needed
         self._sensor_series = 0  # sensor series in the layout sent (viz.sensors)
+        # Whether the design has a filtered image or LEDs (follow_line has neither): the
+        # first frame tells.
+        self._frame_outputs = True
+        self._first_frame_seen = False
         self._last_robot = None
         self._last_target = None
         if stream is not None:
@@ -229,7 +233,7 @@ class Recorder:
         with self._guard:
             self._stream.send_blueprint(default_blueprint(
                 self._bounds, shadow=shadow, world3d=self._world3d is not None,
-                sensors=tuple(self._sensors.series)))
+                sensors=tuple(self._sensors.series), frame_outputs=self._frame_outputs))
         self._sensor_series = len(self._sensors.series)
         self._layout_stale = False
         self._blueprint_sent = True
@@ -300,6 +304,11 @@ class Recorder:
         frame = int(record.frame)
         t = time_ns(record.sim_time)
         res = record.result
+        if not self._first_frame_seen:
+            self._first_frame_seen = True
+            if res.filtered is None and res.proximity is None and res.centroid_leds is None:
+                self._frame_outputs = False
+                self._layout_stale = True
 
         def add(path, row):
             self._columns.add(path, frame, t, row)
