@@ -42,11 +42,16 @@ _FRAME_STROBE = "frame_done"
 _CONNECTOR_STREAM = 0xC011
 
 
+def scenario_top(scenario):
+    """The ``Top`` (fpga_robotics.tops) the scenario runs: ``design.top``."""
+    return TOPS[scenario.top]
+
+
 def pin_design_source(scenario):
     """The ``PinDesignSource`` of the scenario's design (``design.top`` and its tables)."""
     from .sim.pins import PinDesignSource
 
-    top = TOPS[scenario.top]
+    top = scenario_top(scenario)
     params, tables = scenario.params, scenario.design_tables
     described = f"{params!r}:{sorted(tables.items())!r}"
     key = f"{top.name}-{hashlib.sha256(described.encode()).hexdigest()[:16]}"
@@ -92,7 +97,7 @@ class RealClockLoop(ClosedLoop):
                  controls=None):
         super().__init__(scenario, seed=seed, design=design, recorder=recorder,
                          on_frame=on_frame, controls=controls)
-        self.top = TOPS[scenario.top]
+        self.top = scenario_top(scenario)
         self.clock_hz = scenario.sim.clock_hz
         self.pins = design
         self.motors.configure_real_clock(self.dt, scenario.sim.actuation_delay)
