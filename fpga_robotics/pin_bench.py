@@ -185,7 +185,10 @@ def main(argv=None, prog="fpga-robotics bench pins"):
         params = FollowTargetParams(width=width, height=height)
     except ValueError as exc:
         raise UsageError(f"--resolution: {exc}") from None
-    timing = real_clock_timing(width, height, args.fps, args.clock_hz, 1)
+    try:
+        timing = real_clock_timing(width, height, args.fps, args.clock_hz, 1)
+    except PinError as exc:
+        raise UsageError(str(exc)) from None
     print(f"FollowTarget {width}x{height} + echoed pin, {args.clock_hz / 1e6:g} MHz, "
           f"{args.fps:g} fps: line_period {timing.line_period}, pixel_period "
           f"{timing.pixel_period}, ping toggled every {args.toggle_every} cycles, "
