@@ -10,10 +10,11 @@ closed loop's pattern: per physics step, ``run`` up to the step's last edge, han
 and ``pong``, ``motor_left`` and ``motor_right`` are watched (a ``Stop`` per toggle and per
 wheel change). Each backend's figure is the median of ``--repeats`` runs; in the same run the
 frame backend of the same simulator processes the same frames back to back (no blanking),
-for the ratio of the pin path to the frame path.
+over as many cycles after each run, for the ratio of the pin path to the frame path.
 """
 
 import argparse
+import contextlib
 import statistics
 import time
 
@@ -113,27 +114,36 @@ def run_once(pins, frames, *, seconds, clock_hz, fps, step_s, toggle_every):
     return wall, pins.cycle, stops, streamed
 
 
-def frame_path_rate(name, params, frames, repeats):
-    """Median simulated cycles per second of the frame backend ``name`` on ``frames``."""
-    rates = []
-    with get_backend(name, params) as backend:
-        for _ in range(repeats):
-            backend.reset()
-            start, cycles = time.perf_counter(), 0
-            for packed in frames:
-                cycles += backend.process_frame(packed, "red").cycles
-            rates.append(cycles / (time.perf_counter() - start))
-    return statistics.median(rates)
+def frame_path_once(backend, frames, cycles):
+    """The frame backend on ``frames`` back to back (cycling) until ``cycles`` have run:
+    simulated cycles per wall second."""
+    backend.reset()
+    done, i = 0, 0
+    start = time.perf_counter()
+    while done < cycles:
+        done += backend.process_frame(frames[i % len(frames)], "red").cycles
+        i += 1
+    return done / (time.perf_counter() - start)
 
 
-def benchmark(name, params, *, seconds, repeats, clock_hz, fps, step_s, toggle_every, seed=0):
-    """Median Mcycles per wall second of pin backend ``name`` (and its runs' details)."""
+def benchmark(name, params, *, seconds, repeats, clock_hz, fps, step_s, toggle_every, seed=0,
+              frame_path=True):
+    """Pin backend ``name``'s runs and, with ``frame_path``, the frame backend of the same
+    simulator over as many cycles after each run (so that the machine's load of the moment
+    weighs on both alike). Returns ``(pin rates, frame rates, runs)``, rates in cycles/s."""
     frames = bench_frames(params, 8, seed)
-    with get_pin_backend(name, bench_source(params)) as pins:
-        runs = [run_once(pins, frames, seconds=seconds, clock_hz=clock_hz, fps=fps,
-                         step_s=step_s, toggle_every=toggle_every) for _ in range(repeats)]
-    rates = [cycles / wall / 1e6 for wall, cycles, _, _ in runs]
-    return statistics.median(rates), runs
+    pin_rates, frame_rates, runs = [], [], []
+    with contextlib.ExitStack() as stack:
+        pins = stack.enter_context(get_pin_backend(name, bench_source(params)))
+        backend = stack.enter_context(get_backend(name, params)) if frame_path else None
+        for _ in range(repeats):
+            run = run_once(pins, frames, seconds=seconds, clock_hz=clock_hz, fps=fps,
+                           step_s=step_s, toggle_every=toggle_every)
+            runs.append(run)
+            pin_rates.append(run[1] / run[0])
+            if backend is not None:
+                frame_rates.append(frame_path_once(backend, frames, run[1]))
+    return pin_rates, frame_rates, runs
 
 
 def _size(text):
@@ -175,7 +185,10 @@ def main(argv=None, prog="fpga-robotics bench pins"):
         params = FollowTargetParams(width=width, height=height)
     except ValueError as exc:
         raise UsageError(f"--resolution: {exc}") from None
-    timing = real_clock_timing(width, height, args.fps, args.clock_hz, 1)
+    try:
+        timing = real_clock_timing(width, height, args.fps, args.clock_hz, 1)
+    except PinError as exc:
+        raise UsageError(str(exc)) from None
     print(f"FollowTarget {width}x{height} + echoed pin, {args.clock_hz / 1e6:g} MHz, "
           f"{args.fps:g} fps: line_period {timing.line_period}, pixel_period "
           f"{timing.pixel_period}, ping toggled every {args.toggle_every} cycles, "
@@ -183,25 +196,20 @@ def main(argv=None, prog="fpga-robotics bench pins"):
     for name in names:
         seconds = args.pysim_seconds if name == "pysim" else args.seconds
         try:
-            rate, runs = benchmark(name, params, seconds=seconds, repeats=args.repeats,
-                                   clock_hz=args.clock_hz, fps=args.fps, step_s=args.step,
-                                   toggle_every=args.toggle_every)
-        except PinError as exc:
+            pin_rates, frame_rates, runs = benchmark(
+                name, params, seconds=seconds, repeats=args.repeats, clock_hz=args.clock_hz,
+                fps=args.fps, step_s=args.step, toggle_every=args.toggle_every,
+                frame_path=name != "pysim")
+        except (PinError, BackendError) as exc:
             print(f"{name}: not available ({exc})")
             continue
         _, cycles, stops, streamed = runs[0]
-        line = (f"{name:9s} pins: {rate:8.2f} Mcycles/s ({cycles:,} cycles, {streamed} frames, "
-                f"{stops} stops a run)")
-        if name != "pysim":
-            try:
-                frame_rate = frame_path_rate(name, params, bench_frames(params, 30),
-                                             args.repeats) / 1e6
-            except BackendError as exc:
-                frame_rate = None
-                line += f"; frame path not available ({exc})"
-            if frame_rate:
-                line += (f"; frame path {frame_rate:.2f} Mcycles/s, pins/frame "
-                         f"{rate / frame_rate:.2f}")
+        line = (f"{name:9s} pins: {statistics.median(pin_rates) / 1e6:8.2f} Mcycles/s "
+                f"({cycles:,} cycles, {streamed} frames, {stops} stops a run)")
+        if frame_rates:
+            ratios = [p / f for p, f in zip(pin_rates, frame_rates, strict=True)]
+            line += (f"; frame path {statistics.median(frame_rates) / 1e6:.2f} Mcycles/s, "
+                     f"pins/frame {statistics.median(ratios):.2f} (median of the runs' ratios)")
         print(line)
     return 0
 

@@ -611,7 +611,8 @@ PLANS = {
     "python -m fpga_robotics.pin_bench":
         Plan(shorter=(("--seconds", "0.02"), ("--pysim-seconds", "0.0002"), ("--repeats", "1")),
              out=((r"(?m)^cxxrtl +pins: +[\d.]+ Mcycles/s \(1,000,000 cycles, 1 frames, \d+ stops "
-                  r"a run\); frame path [\d.]+ Mcycles/s, pins/frame [\d.]+$"),
+                  r"a run\); frame path [\d.]+ Mcycles/s, pins/frame [\d.]+ \(median of the runs' "
+                   r"ratios\)$"),
                   r"(?m)^verilator +pins: +[\d.]+ Mcycles/s",
                   r"(?m)^pysim +pins: +[\d.]+ Mcycles/s \(10,000 cycles")),
     # docs/camera.md: the sensor model ---------------------------------------------------------

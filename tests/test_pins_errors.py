@@ -143,3 +143,18 @@ def test_real_clock_timing():
     assert real_clock_timing(160, 120, 30, 691200, 1) == PixelTiming(1, 180, 1)
     with pytest.raises(PinError, match="3267 cycles per line at 30 fps, too few for 4000 pixels"):
         real_clock_timing(4000, 480, 30, 50e6, 1)
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["--backends", "cxxrtl,fast"], "unknown backend"),
+    (["--resolution", "160"], "--resolution must be WxH"),
+    (["--resolution", "16x12"], "--resolution: the window width"),
+    (["--clock-hz", "1e5"], "too few for 160 pixels; lower the resolution or fps"),
+    (["--repeats", "0"], "must be positive"),
+])
+def test_pin_bench_bad_arguments(argv, message):
+    from fpga_robotics.errors import UsageError
+    from fpga_robotics.pin_bench import main
+
+    with pytest.raises(UsageError, match=message):
+        main(argv)

@@ -46,8 +46,7 @@ ABI_VERSION = 1
 _DRIVER = "pin_driver.h"
 # Layout of run()'s result array (enum Out in pin_driver.h) and its status codes.
 _N_OUT = 6
-_O_CYCLE, _O_PORT, _O_VALUE, _O_CAPTURED, _O_PENDING, _O_BAD_INDEX = range(_N_OUT)
-_TOO_MANY_FILTERED, _BAD_FILTERED_FLAGS = 1, 2
+_TOO_MANY_FILTERED = 1  # the other failure of a run: 2, wrong framing flags
 
 _VP = ctypes.c_void_p
 _I64 = ctypes.c_int64
@@ -252,7 +251,7 @@ class CompiledPins(HostPins):
     def _raw_run(self, cycles):
         out = self._out
         status = self._run_entry(self._handle, cycles, self._out_address)
-        cycle, port, value, captured, _pending, bad = out.tolist()
+        cycle, port, value, captured, _pending, bad = out.tolist()  # enum Out
         if status:
             self._cycle = cycle
             raise capture_error(status == _TOO_MANY_FILTERED, bad)

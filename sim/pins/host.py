@@ -31,8 +31,7 @@ class HostPins(PinBackend):
         self.ports = dict(source.ports)
         self._index = {name: i for i, name in enumerate(self.ports)}
         self._port_list = list(self.ports.values())
-        stream = set(source.pixels or ())
-        self._stream_ports = stream
+        self._stream_ports = set(source.pixels or ())
         self._cycle = 0
         self._last_pixel_edge = 0
         self._captures = deque()  # buffers of frames whose filtered stream is still coming
