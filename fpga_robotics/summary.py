@@ -457,6 +457,12 @@ def format_summary(s):
         f" ({s['ms_per_frame']:.2f} ms/frame, "
         f"{f'{rtf:.1f}x' if rtf is not None else 'n/a'} real time)"),
     ]
+    if s.get("timing") is not None:
+        rate = s.get("cycles_per_wall_s")
+        rate = f", {rate / 1e6:.1f} M/s of wall time" if rate else ""
+        clock = (f"real clock at {s['clock_hz'] / 1e6:g} MHz" if s["timing"] == "real_clock"
+                 else "compressed (clocked while pixels flow)")
+        lines.append(f"  timing: {clock}; {s['sim_cycles']:,} design cycles{rate}")
     if s.get("ended_early"):
         lines.append(f"  run ended early: {s['ended_early']}")
     if s.get("absent_outputs"):
