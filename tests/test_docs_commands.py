@@ -448,6 +448,11 @@ PLANS = {
         Plan(shorter=(("--max-runs", "2"), ("--backend", "model"), ("--duration", "2")),
              files=("runs/sweeps/robot_variants/report.html",),
              out=(r"2 runs: ", r"pass rate per robot\.mass:")),
+    "python -m fpga_robotics.sweep sensor_designs":
+        # Two one-second runs in real-clock timing (the campaign's first two: line_track).
+        Plan(shorter=(("--max-runs", "2"), ("--duration", "1")),
+             files=("runs/sweeps/sensor_designs/report.html",),
+             out=(r"2 runs: ", r"pass rate per scenario:")),
     "python -m fpga_robotics.sweep regression --scheduler tcp://HOST:8786":
         Plan(excused="needs a Dask cluster (HOST is the page's placeholder); "
                      "tests/test_sweep_scheduler.py runs a campaign through a real `dask "
