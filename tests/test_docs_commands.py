@@ -488,7 +488,7 @@ PLANS = {
         # command takes minutes (the page gives its measured time).
         Plan(shorter=(("--mutants", "4"), ("--width", "80"), ("--height", "60"),
                       ("--workers", "1"), ("--recordings", "1")),
-             out=(r"robot judge \(campaign mutation: \d+ of 7 runs pass unmutated\)",),
+             out=(r"robot judge \(campaign mutation: \d+ of 9 runs pass unmutated\)",),
              files=("runs/mutation/n4-s1/report.html", "runs/mutation/n4-s1/robot.jsonl",
                     "runs/mutation/n4-s1/mutants.json")),
     "python -m fpga_robotics.sim.backends.foreign_bench":

@@ -39,8 +39,7 @@ def _report_robot(out, campaign, mutants, verdicts, unit, robot, robot_verdicts,
     n_runs, n_pass = len(baseline["runs"]), len(baseline["passing"])
     print(f"robot judge (campaign {campaign.name}: {n_pass} of {n_runs} runs pass unmutated): "
           f"{rs['caught']} of {rs['judged']} unit-caught mutants caught: score "
-          f"{_percent(rs['score'])}; {60 * max(1, rs['judged']) / max(robot_s, 1e-9):.0f} "
-          f"mutants/min")
+          f"{_percent(rs['score'])}; {_robot_rate(baseline['judged_here'], robot_s)}")
     blind = blind_spots(unit, robot)
     by_index = {m.index: m for m in mutants}
     recorded = _record_closest(out, [robot_verdicts[k] for k in blind[:recordings]], say)
@@ -58,6 +57,14 @@ def _report_robot(out, campaign, mutants, verdicts, unit, robot, robot_verdicts,
     path = write_report(out, campaign.name, mutants, verdicts, robot_verdicts, baseline,
                         recorded, width)
     print(f"report: {path}")
+
+
+def _robot_rate(judged_here, seconds):
+    """The robot judge's rate: the mutants it judged in this run (not those ``--resume``
+    kept) per minute of its wall time, the baseline runs included."""
+    if not judged_here:
+        return "no mutant judged in this run (all kept by --resume)"
+    return f"{60 * judged_here / max(seconds, 1e-9):.0f} mutants/min"
 
 
 def _record_closest(out, verdicts, say):
