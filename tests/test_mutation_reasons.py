@@ -112,3 +112,36 @@ def test_the_unit_judge_keeps_the_frames_and_the_largest_differences():
     assert v.differing["filtered"] == 1 and v.differing["centroid_x"] == 1
     # The filtered image differs too (not a steering error alone); 2 of 104 frames: rare.
     assert reason_class(v, 80) == "rare state"
+
+
+def test_the_report_gives_each_blind_spot_its_reason(tmp_path):
+    """report.html: mutant 1 (only the filtered image differs) and 2 (a 1 px centroid error)
+    are blind spots, each with its reason; mutant 3, caught by a run, has none."""
+    from fpga_robotics.mutation.report import write_report
+    from fpga_robotics.sim.mutation import Mutant
+
+    def mutant(i, module, signal):
+        return Mutant(i, "inv", module, "$1", "Y", 0, None, signal, 0, ("hw/x.py:1",), "")
+
+    mutants = [mutant(1, "color_filter", "filtered__payload"),
+               mutant(2, "tracker.counter", "px"), mutant(3, "motor", "motor_left")]
+    filtered = _verdict(differing_frames=70, filtered=70)
+    small = _verdict(differing_frames=21, centroid_x=21,
+                     max_difference={"centroid_x": 1, "motor_left": 3})
+    wheel = _verdict(differing_frames=90, motor_left=90, max_difference={"motor_left": 4096})
+    for k, v in enumerate((filtered, small, wheel), start=1):
+        v.index = k
+    robot = {1: {"caught": False, "replay": "python -m fpga_robotics.run --runtime mutsel=1"},
+             2: {"caught": False, "replay": None},
+             3: {"caught": True, "status": "fail", "failed_checks": ["max_wheel_command_dps"]}}
+    baseline = {"runs": [["--scenario", "approach"]], "passing": [0]}
+    path = write_report(str(tmp_path), "mutation", mutants, [filtered, small, wheel], robot,
+                        baseline, {}, 160)
+    with open(path) as f:
+        text = f.read()
+    assert "why no run shows it" in text
+    assert "filtered only: differs in 70 of 104 unit frames" in text
+    assert ("small steering error: differs in 21 of 104 unit frames (centroid_x); centroid "
+            "off by up to 1 px; wheels off by up to 3 DPS") in text
+    assert "Blind spots: caught by the unit judge, missed by every run (2)" in text
+    assert "other: differs in 90" not in text and "max_wheel_command_dps" in text
