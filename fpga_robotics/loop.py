@@ -383,7 +383,8 @@ class ClosedLoop:
         metrics = compute_metrics(self.traj, self.events, self.world.collision_counts(),
                                   self.period,
                                   at_fault_collisions=self.world.at_fault_collisions(),
-                                  width=cam.width, absent=self.absent)
+                                  width=cam.width, absent=self.absent,
+                                  margin_x=scenario.params.margin_x)
         metrics.update(self.extra_metrics())
         checks = evaluate_checks(scenario.checks, metrics)
         shadow = {"shadow": self.comparison.summary()} if self.comparison is not None else {}

@@ -60,6 +60,21 @@ CHECKS = {
          "target an eighth of the width or more to one side, an outermost LED lit with it "
          "within a sixteenth of the centre) in at most this fraction of the frames found "
          "with the target in view (led_wrong_side_fraction)")),
+    "max_led_misplaced_fraction": (
+        float, (0, 1, ""),
+        ("the lit centroid LEDs are not the one above the target (the LED of the window's "
+         "eighth that holds the target's image column; near a border between eighths either "
+         "neighbour, near the image centre also the middle pair) in at most this fraction of "
+         "the frames found with the target's centre inside the window (led_misplaced_fraction)"
+         )),
+    "max_wheel_command_dps": (
+        float, (0, 32768, "DPS"),
+        ("the design never commands a wheel faster than this, either way "
+         "(peak_wheel_command_dps): the speed the motors are rated for")),
+    "max_search_travel_m": (
+        float, (0, 1000, "m"),
+        ("while the design searches (from a search started to the target found again) the "
+         "robot's centre travels at most this far: it turns in place (search_travel_m)")),
     "max_heading_overshoot_deg": (
         float, (0, 180, "deg"),
         "the robot turns at most this far past the target (heading_overshoot_deg)"),
@@ -96,6 +111,9 @@ CHECK_OUTPUTS = {
     "mean_centroid_error_max_px": ("found", "centroid_x"),
     "max_oscillation_hz": ("found", "centroid_x"),
     "max_led_wrong_side_fraction": ("found", "centroid_leds"),
+    "max_led_misplaced_fraction": ("found", "centroid_leds"),
+    "max_wheel_command_dps": ("motor_left", "motor_right"),
+    "max_search_travel_m": ("found",),
 }
 
 #: Metrics made of design outputs: name -> the outputs they need (None when one is absent).
@@ -113,6 +131,9 @@ _METRIC_OUTPUTS = {
     "off_target_fraction": ("found", "centroid_x"),
     "mean_centroid_error_px": ("found", "centroid_x"),
     "led_wrong_side_fraction": ("found", "centroid_leds"),
+    "led_misplaced_fraction": ("found", "centroid_leds"),
+    "peak_wheel_command_dps": ("motor_left", "motor_right"),
+    "search_travel_m": ("found",),
 }
 
 #: Summary fields that depend on the machine, not on the simulation.
@@ -138,7 +159,7 @@ CENTRED_FRACTION = 0.125
 
 
 def compute_metrics(traj, events, collisions, frame_period, *, at_fault_collisions=0,
-                    width=None, absent=()):
+                    width=None, absent=(), margin_x=None):
     """Reduce a run to numbers.
 
     Parameters
@@ -157,6 +178,9 @@ def compute_metrics(traj, events, collisions, frame_period, *, at_fault_collisio
     absent : collection of str
         ``DESIGN_OUTPUTS`` the design does not produce (their trajectory entries are NaN): the
         metrics made of them are None, and ``absent_outputs`` lists them.
+    margin_x : int, optional
+        The columns the design's tracking window leaves on each side (the LEDs sit above its
+        eighths); default ``width // 10``, the design's default.
     """
     absent = [name for name in DESIGN_OUTPUTS if name in set(absent)]
     if absent:
@@ -164,7 +188,8 @@ def compute_metrics(traj, events, collisions, frame_period, *, at_fault_collisio
         if "found" in absent:  # the metrics below read it; theirs are replaced by None
             present["found"] = np.zeros(len(traj["t"]), bool)
         m = compute_metrics(present, events, collisions, frame_period,
-                            at_fault_collisions=at_fault_collisions, width=width)
+                            at_fault_collisions=at_fault_collisions, width=width,
+                            margin_x=margin_x)
         for name, needs in _METRIC_OUTPUTS.items():
             if any(o in absent for o in needs):
                 m[name] = None
@@ -218,6 +243,9 @@ def compute_metrics(traj, events, collisions, frame_period, *, at_fault_collisio
         "oscillation_hz": _oscillation(traj, width, n * frame_period),
         **_off_target(traj, width),
         "led_wrong_side_fraction": _led_wrong_side(traj, width),
+        "led_misplaced_fraction": _led_misplaced(traj, width, margin_x),
+        "peak_wheel_command_dps": _peak_command(traj),
+        "search_travel_m": _search_travel(traj, events),
         "heading_overshoot_deg": _heading_overshoot(traj),
         "absent_outputs": [],
     }
@@ -294,6 +322,76 @@ def _led_wrong_side(traj, width):
     outer = (leds & 0b1100_0011) != 0
     wrong = (side & other_half) | (centre & outer)
     return _round(wrong[judged].mean())
+
+
+#: Near a border between two of the window's eighths, or near the image centre, the LED
+#: above the target is ambiguous within this fraction of the image width
+#: (``led_misplaced_fraction``): a body a few pixels across straddles the border.
+LED_BORDER_FRACTION = 1 / 32
+#: The middle pair of LEDs (the design's "centred" code).
+LED_CENTRED = 0b0001_1000
+
+
+def _led_misplaced(traj, width, margin_x=None):
+    """How often the lit LEDs are not the one above the target, over the frames found with
+    the target's centre inside the tracking window's columns (``margin_x`` from each side;
+    default ``width // 10``): LED k sits above the window's k-th eighth (from the left); the
+    right code is that LED alone, or, with the column within ``LED_BORDER_FRACTION`` of the
+    width from a border between eighths, the LED on either side of it, or, that close to the
+    image centre, the middle pair too. Any other code (no LED, two LEDs, the wrong one) is
+    misplaced. None without such frames or fields."""
+    if width is None or "target_column" not in traj or "centroid_leds" not in traj:
+        return None
+    margin = width // 10 if margin_x is None else margin_x
+    bin_width = (width - 2 * margin) / 8
+    if bin_width <= 0:
+        return None
+    column = np.asarray(traj["target_column"], dtype=float)
+    judged = traj["found"] & ~np.isnan(column)
+    judged &= (column >= margin) & (column < width - margin)
+    if not judged.any():
+        return None
+    col = column[judged]
+    leds = np.asarray(traj["centroid_leds"], dtype=np.int64)[judged]
+    tol = LED_BORDER_FRACTION * width
+    bins = np.clip(((col - margin) // bin_width).astype(np.int64), 0, 7)
+    allowed = np.left_shift(1, bins)
+    left = np.clip(((col - tol - margin) // bin_width).astype(np.int64), 0, 7)
+    right = np.clip(((col + tol - margin) // bin_width).astype(np.int64), 0, 7)
+    ok = (leds == allowed) | (leds == np.left_shift(1, left)) | (leds == np.left_shift(1, right))
+    ok |= (np.abs(col - width / 2) <= tol) & (leds == LED_CENTRED)
+    return _round((~ok).mean())
+
+
+def _peak_command(traj):
+    """The largest wheel command either way, DPS (of the wheels whose command the design
+    produces; None with neither)."""
+    wheels = [k for k in ("motor_left", "motor_right") if k in traj]
+    if not wheels or len(traj[wheels[0]]) == 0:
+        return None
+    return int(max(np.abs(np.asarray(traj[k], dtype=float)).max() for k in wheels))
+
+
+def _search_travel(traj, events):
+    """The longest distance the robot's centre travelled during one search: from a "search
+    started" event's frame to the next "target found" (or the last frame), metres. None
+    without a search."""
+    starts, longest = None, None
+    x, y = np.asarray(traj["x"], dtype=float), np.asarray(traj["y"], dtype=float)
+    episodes = []
+    for frame, _time, text in events:
+        if text == "search started" and starts is None:
+            starts = frame
+        elif text == "target found" and starts is not None:
+            episodes.append((starts, frame))
+            starts = None
+    if starts is not None:
+        episodes.append((starts, len(x) - 1))
+    for a, b in episodes:
+        seg = slice(a, min(b, len(x) - 1) + 1)
+        travel = float(np.hypot(np.diff(x[seg]), np.diff(y[seg])).sum())
+        longest = travel if longest is None else max(longest, travel)
+    return _round(longest)
 
 
 def _max_command_step(traj):
@@ -400,6 +498,22 @@ def evaluate_checks(checks, m):
             text = ("the target was never found to one side or at the centre" if v is None
                     else f"centroid LEDs point the wrong way in {v:.0%} of the frames judged "
                          f"(limit <= {limit:.0%})")
+        elif name == "max_led_misplaced_fraction":
+            v = m["led_misplaced_fraction"]
+            ok = v is None or v <= limit
+            text = ("the target was never found inside the window" if v is None
+                    else f"the lit LEDs are not the one above the target in {v:.1%} of the "
+                         f"frames judged (limit <= {limit:.1%})")
+        elif name == "max_wheel_command_dps":
+            v = m["peak_wheel_command_dps"]
+            ok = v is None or v <= limit
+            text = ("no wheel command" if v is None
+                    else f"largest wheel command {v} DPS (limit <= {limit:g} DPS)")
+        elif name == "max_search_travel_m":
+            v = m["search_travel_m"]
+            ok = v is None or v <= limit
+            text = ("the design never searched" if v is None
+                    else f"the robot travelled {v:.2f} m during a search (limit <= {limit} m)")
         elif name == "max_heading_overshoot_deg":
             v = m["heading_overshoot_deg"]
             ok = v is not None and v <= limit

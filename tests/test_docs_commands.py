@@ -493,9 +493,30 @@ PLANS = {
         # command takes minutes (the page gives its measured time).
         Plan(shorter=(("--mutants", "4"), ("--width", "80"), ("--height", "60"),
                       ("--workers", "1"), ("--recordings", "1")),
-             out=(r"robot judge \(campaign mutation: \d+ of 7 runs pass unmutated\)",),
+             out=(r"robot judge \(campaign mutation: \d+ of 9 runs pass unmutated\)",),
              files=("runs/mutation/n4-s1/report.html", "runs/mutation/n4-s1/robot.jsonl",
                     "runs/mutation/n4-s1/mutants.json")),
+    # The robot judge's scaling with workers: the same four mutants at 80x60 as above.
+    ("python -m fpga_robotics.mutation --mutants 30 --campaign mutation --workers 1 "
+     "--recordings 0 --out runs/mutation/scale-w1"):
+        Plan(shorter=(("--mutants", "4"), ("--width", "80"), ("--height", "60")),
+             out=(r"robot judge \(campaign mutation: \d+ of 9 runs pass unmutated\).*"
+                  r"mutants/min",),
+             files=("runs/mutation/scale-w1/mutants.json",)),
+    ("python -m fpga_robotics.mutation --mutants 30 --campaign mutation --workers 2 "
+     "--recordings 0 --out runs/mutation/scale-w2"):
+        Plan(shorter=(("--mutants", "4"), ("--width", "80"), ("--height", "60")),
+             out=(r"robot judge \(campaign mutation: \d+ of 9 runs pass unmutated\).*"
+                  r"mutants/min",),
+             files=("runs/mutation/scale-w2/mutants.json",)),
+    # The mutation campaign with the unmutated design: two short runs on the model backend
+    # (the page gives the whole campaign's results).
+    "python -m fpga_robotics.sweep mutation":
+        Plan(shorter=(("--max-runs", "2"), ("--backend", "model"), ("--duration", "2")),
+             out=(r"2 runs: 2 pass",)),
+    "python -m fpga_robotics.sweep mutation --seeds 0-19 --out runs/sweeps/mutation-20":
+        Plan(shorter=(("--max-runs", "2"), ("--backend", "model"), ("--duration", "2")),
+             files=("runs/sweeps/mutation-20/report.html",), out=(r"2 runs: 2 pass",)),
     "python -m fpga_robotics.sim.backends.foreign_bench":
         Plan(shorter=(("--frames", "2"), ("--repeats", "1")),
              out=(r"verilator \(built-in\) +[\d.]+ ms/frame",

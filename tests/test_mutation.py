@@ -247,6 +247,7 @@ def test_the_robot_judge_catches_a_wheel_bug_and_not_a_filtered_image_bug(tmp_pa
     baseline, verdicts = robot_judge(campaign, netlist, ports, "80x60", [1, 2], str(tmp_path),
                                      workers=1, say=lambda text: None)
     assert baseline["passing"] == [0, 1] and len(baseline["runs"]) == 2
+    assert baseline["judged_here"] == 2
     assert "--runtime mutsel=0" in " ".join(baseline["runs"][0])
     assert verdicts[1]["caught"] is False and verdicts[1]["runs"] == 2
     assert verdicts[2]["caught"] is True and verdicts[2]["run"] == 0
@@ -261,4 +262,5 @@ def test_the_robot_judge_catches_a_wheel_bug_and_not_a_filtered_image_bug(tmp_pa
     _again, resumed = robot_judge(campaign, netlist, ports, "80x60", [1, 2], str(tmp_path),
                                  workers=1, resume=True, say=lambda text: None)
     assert {k: v["caught"] for k, v in resumed.items()} == robot
+    assert _again["judged_here"] == 0
     assert (tmp_path / "robot.jsonl").read_text().splitlines() == lines

@@ -17,6 +17,7 @@ from ..param_options import add_param_arguments, params_from_args
 from ..sim.files import check_output_dir, write_json_atomic
 from ..sim.mutation import MutationError, list_mutants
 from .design import open_mutant_design, write_mutant_design
+from .reasons import blind_spot_reason
 from .scores import blind_spots, by_module, robot_score, unit_score
 from .unit_judge import golden_results, judge_frames, judge_mutant
 
@@ -30,7 +31,7 @@ def _campaign(name):
 
 
 def _report_robot(out, campaign, mutants, verdicts, unit, robot, robot_verdicts, baseline,
-                  robot_s, recordings, say):
+                  robot_s, recordings, say, width):
     """The robot judge's lines, the recordings of the closest runs, and report.html."""
     from .report import write_report
 
@@ -38,23 +39,32 @@ def _report_robot(out, campaign, mutants, verdicts, unit, robot, robot_verdicts,
     n_runs, n_pass = len(baseline["runs"]), len(baseline["passing"])
     print(f"robot judge (campaign {campaign.name}: {n_pass} of {n_runs} runs pass unmutated): "
           f"{rs['caught']} of {rs['judged']} unit-caught mutants caught: score "
-          f"{_percent(rs['score'])}; {60 * max(1, rs['judged']) / max(robot_s, 1e-9):.0f} "
-          f"mutants/min")
+          f"{_percent(rs['score'])}; {_robot_rate(baseline['judged_here'], robot_s)}")
     blind = blind_spots(unit, robot)
     by_index = {m.index: m for m in mutants}
     recorded = _record_closest(out, [robot_verdicts[k] for k in blind[:recordings]], say)
     if blind:
         print(f"blind spots: caught by the unit judge, missed by every run ({len(blind)}):")
         effects = {v.index: v.effect() for v in verdicts}
+        reasons = {v.index: blind_spot_reason(v, width) for v in verdicts if v.index in blind}
         for k in blind:
             print(f"  {by_index[k].describe()}")
             print(f"    unit: {effects[k]}")
+            print(f"    why: {reasons[k]}")
             if robot_verdicts[k].get("replay"):
                 print(f"    closest run: {robot_verdicts[k]['replay']}"
                       + (f"  (recording {recorded[k]})" if k in recorded else ""))
     path = write_report(out, campaign.name, mutants, verdicts, robot_verdicts, baseline,
-                        recorded)
+                        recorded, width)
     print(f"report: {path}")
+
+
+def _robot_rate(judged_here, seconds):
+    """The robot judge's rate: the mutants it judged in this run (not those ``--resume``
+    kept) per minute of its wall time, the baseline runs included."""
+    if not judged_here:
+        return "no mutant judged in this run (all kept by --resume)"
+    return f"{60 * judged_here / max(seconds, 1e-9):.0f} mutants/min"
 
 
 def _record_closest(out, verdicts, say):
@@ -172,6 +182,7 @@ def main(argv=None, prog="python -m fpga_robotics.mutation"):
             workers=args.workers, scheduler=args.scheduler, resume=args.resume, say=say)
         robot_s = time.perf_counter() - t2
     robot = {k: v["caught"] for k, v in robot_verdicts.items()}
+    blind = set(blind_spots(unit, robot))
     score = unit_score(unit)
     modules = by_module(mutants, unit, robot)
     write_json_atomic(os.path.join(out, "mutants.json"), {
@@ -190,8 +201,11 @@ def main(argv=None, prog="python -m fpga_robotics.mutation"):
         "mutants": [{**{k: v for k, v in m.__dict__.items()}, "sources": list(m.sources),
                      "describe": m.describe(),
                      "unit": {"caught": v.caught, "first_frame": v.first_frame,
-                              "differing": v.differing, "effect": v.effect()},
-                     "robot": robot_verdicts.get(m.index)}
+                              "differing": v.differing, "frames_differing": v.frames_differing,
+                              "max_difference": v.max_difference, "effect": v.effect()},
+                     "robot": robot_verdicts.get(m.index),
+                     "blind_spot_reason": (blind_spot_reason(v, params.width)
+                                           if m.index in blind else None)}
                     for m, v in zip(mutants, verdicts)],
     }, what="mutation results")
 
@@ -207,7 +221,7 @@ def main(argv=None, prog="python -m fpga_robotics.mutation"):
         print(f"  {name:<{width}}  {row['unit_caught']:>4}/{row['total']:<4} caught{robot_part}")
     if campaign is not None:
         _report_robot(out, campaign, mutants, verdicts, unit, robot, robot_verdicts, baseline,
-                      robot_s, args.recordings, say)
+                      robot_s, args.recordings, say, params.width)
     missed = [m for m, v in zip(mutants, verdicts) if not v.caught]
     if missed:
         print("equivalent on the unit frames (first 10):")

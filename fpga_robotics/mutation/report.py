@@ -1,11 +1,13 @@
 """``report.html`` of a mutation run: the scores, the components, the robot-level blind spots
-(module, signal, source line, what the mutant does, the replay command and recording of the
-closest-to-failing run) and the mutants no unit frame shows. One self-contained file."""
+(module, signal, source line, what the mutant does, why no run shows it, the replay command
+and recording of the closest-to-failing run) and the mutants no unit frame shows. One
+self-contained file."""
 
 import html
 import os
 
 from ..sim.files import write_atomic
+from .reasons import blind_spot_reason
 from .scores import blind_spots, by_module, robot_score, unit_score
 
 __all__ = ["write_report"]
@@ -25,12 +27,16 @@ def _table(header, rows):
     return f"<table><tr>{head}</tr>{body}</table>"
 
 
-def write_report(out, campaign, mutants, unit_verdicts, robot_verdicts, baseline, recordings):
-    """Write ``out/report.html``; returns its path."""
+def write_report(out, campaign, mutants, unit_verdicts, robot_verdicts, baseline, recordings,
+                 width):
+    """Write ``out/report.html`` (``width``: the design's image width, for the blind spots'
+    reasons); returns its path."""
     unit = {v.index: v.caught for v in unit_verdicts}
     robot = {k: v["caught"] for k, v in robot_verdicts.items()}
     us, rs = unit_score(unit), robot_score(unit, robot)
     effects = {v.index: v.effect() for v in unit_verdicts}
+    blind = blind_spots(unit, robot)
+    reasons = {v.index: blind_spot_reason(v, width) for v in unit_verdicts if v.index in blind}
     by_index = {m.index: m for m in mutants}
     e = html.escape
     parts = [(f"<!doctype html><meta charset=utf-8><title>Mutation coverage</title>"
@@ -44,17 +50,16 @@ def write_report(out, campaign, mutants, unit_verdicts, robot_verdicts, baseline
              _table(["component", "mutants", "unit judge caught", "robot judge caught"],
                     [[e(name), r["total"], r["unit_caught"], r["robot_caught"]]
                      for name, r in by_module(mutants, unit, robot).items()])]
-    blind = blind_spots(unit, robot)
     rows = []
     for k in sorted(blind, key=lambda i: (by_index[i].module, i)):
         m, v = by_index[k], robot_verdicts[k]
         rec = recordings.get(k)
         rows.append([e(m.module or "top"), e(m.describe()), e(", ".join(m.sources)),
-                     e(effects[k]), f"<code>{e(v.get('replay') or '')}</code>",
+                     e(effects[k]), e(reasons[k]), f"<code>{e(v.get('replay') or '')}</code>",
                      f'<a href="{e(rec)}">{e(rec)}</a>' if rec else ""])
     parts += [f"<h2>Blind spots: caught by the unit judge, missed by every run ({len(blind)})</h2>",
               _table(["component", "mutant", "source", "what it does to the outputs",
-                      "closest-to-failing run", "recording"], rows)]
+                      "why no run shows it", "closest-to-failing run", "recording"], rows)]
     caught_rows = []
     for k, v in sorted(robot_verdicts.items()):
         if v["caught"]:

@@ -117,7 +117,8 @@ def robot_judge(campaign, netlist, ports, resolution, indices, out_dir, *, worke
     """Judge the mutants ``indices`` by ``campaign``'s closed-loop runs.
 
     Returns ``(baseline, verdicts)``: ``baseline`` is ``{"runs": [argv at mutsel 0, ...],
-    "passing": [their indices], "statuses": [...]}``; ``verdicts`` is ``{index: judge_runs
+    "passing": [their indices], "statuses": [...], "judged_here": how many mutants this call
+    judged (the others were kept from the journal)}``; ``verdicts`` is ``{index: judge_runs
     result}`` (with the replay command of the run that caught it, or of the closest run).
     Verdicts are appended to ``out_dir/robot.jsonl`` as they come (``resume`` keeps the
     ones there)."""
@@ -180,4 +181,5 @@ def robot_judge(campaign, netlist, ports, resolution, indices, out_dir, *, worke
                 f.write(json.dumps(v) + "\n")
                 f.flush()
                 tick(1)
-    return {"runs": base, "passing": passing, "statuses": statuses}, verdicts
+    return ({"runs": base, "passing": passing, "statuses": statuses, "judged_here": len(todo)},
+            verdicts)

@@ -34,6 +34,10 @@ class UnitVerdict:
     differing: dict = field(default_factory=lambda: dict.fromkeys(COMPARED_OUTPUTS, 0))
     first_difference: dict = field(default_factory=dict)  # output -> (model, mutant) there
     failure: str | None = None  # the design broke the frame protocol (a timeout, a bad stream)
+    frames: int = 0  # the frames judged
+    frames_differing: int = 0  # frames in which any output differs
+    # scalar output -> the largest |model - mutant| over the frames (found counts 0/1)
+    max_difference: dict = field(default_factory=dict)
 
     def effect(self):
         """One line: what the mutant does to the outputs."""
@@ -86,9 +90,14 @@ def judge_mutant(design, index, frames, golden):
                 verdict.caught, verdict.first_frame = True, k
                 verdict.failure = str(exc).split(": ", 2)[-1]
             break
+        verdict.frames += 1
         differ = differing_outputs(want, got)
+        verdict.frames_differing += bool(differ)
         for name in differ:
             verdict.differing[name] += 1
+            if name != "filtered":
+                gap = abs(int(output_value(want, name)) - int(output_value(got, name)))
+                verdict.max_difference[name] = max(verdict.max_difference.get(name, 0), gap)
         if differ and not verdict.caught:
             verdict.caught = True
             verdict.first_frame = k
