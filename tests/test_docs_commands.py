@@ -500,14 +500,14 @@ PLANS = {
     ("python -m fpga_robotics.mutation --mutants 30 --campaign mutation --workers 1 "
      "--recordings 0 --out runs/mutation/scale-w1"):
         Plan(shorter=(("--mutants", "4"), ("--width", "80"), ("--height", "60")),
-             out=(r"robot judge \(campaign mutation: \d+ of 9 runs pass unmutated\).*"
-                  r"mutants/min",),
+             out=((r"robot judge \(campaign mutation: \d+ of 9 runs pass unmutated\).*"
+                   r"mutants/min"),),
              files=("runs/mutation/scale-w1/mutants.json",)),
     ("python -m fpga_robotics.mutation --mutants 30 --campaign mutation --workers 2 "
      "--recordings 0 --out runs/mutation/scale-w2"):
         Plan(shorter=(("--mutants", "4"), ("--width", "80"), ("--height", "60")),
-             out=(r"robot judge \(campaign mutation: \d+ of 9 runs pass unmutated\).*"
-                  r"mutants/min",),
+             out=((r"robot judge \(campaign mutation: \d+ of 9 runs pass unmutated\).*"
+                   r"mutants/min"),),
              files=("runs/mutation/scale-w2/mutants.json",)),
     # The mutation campaign with the unmutated design: two short runs on the model backend
     # (the page gives the whole campaign's results).
