@@ -43,14 +43,32 @@ _CONNECTOR_STREAM = 0xC011
 
 
 def scenario_top(scenario):
-    """The ``Top`` (fpga_robotics.tops) the scenario runs: ``design.top``."""
+    """The ``Top`` (fpga_robotics.tops) the scenario runs: ``design.top``, or for a foreign
+    Verilog design (``design.verilog``) the one its port map describes."""
+    if scenario.foreign is not None:
+        from .sim.backends.port_map import load_port_map
+        from .tops import foreign_top
+
+        return foreign_top(load_port_map(scenario.foreign.ports))
     return TOPS[scenario.top]
 
 
 def pin_design_source(scenario):
-    """The ``PinDesignSource`` of the scenario's design (``design.top`` and its tables)."""
+    """The pin design of the scenario: a ``PinDesignSource`` of ``design.top`` and its
+    tables, or a ``VerilogPinSource`` of its foreign Verilog design."""
     from .sim.pins import PinDesignSource
 
+    if scenario.foreign is not None:
+        from .sim.backends.foreign import ForeignDesign
+        from .sim.pins import VerilogPinSource
+        from .tops import connector_kinds
+
+        design = ForeignDesign(scenario.foreign.verilog, scenario.foreign.ports,
+                               scenario.params, pins=True, connector_kinds=connector_kinds())
+        missing = [k for k in ("motor_left", "motor_right") if k not in design.port_map.outputs]
+        if missing:
+            raise UsageError(f"the closed loop needs outputs.{missing[0]} in the port map")
+        return VerilogPinSource(design)
     top = scenario_top(scenario)
     params, tables = scenario.params, scenario.design_tables
     described = f"{params!r}:{sorted(tables.items())!r}"
@@ -198,7 +216,9 @@ class RealClockLoop(ClosedLoop):
     def design_output_changed(self, port, value, t):
         if port == _FRAME_STROBE:
             if value and self.pending is not None and self.pending.outputs is None:
-                self.pending.outputs = {name: self.pins.peek(name) for name in _FRAME_OUTPUTS}
+                # A foreign design's absent outputs are no ports: None in the row.
+                self.pending.outputs = {name: self.pins.peek(name) for name in _FRAME_OUTPUTS
+                                        if name in self.pins.ports}
                 self.pending.filtered = self.pins.filtered_frame()
         elif port == "obstacle":
             text = ("interlock: obstacle, wheels stopped" if value

@@ -204,10 +204,29 @@ def _open_pin_design(args, scenario):
         if not args.quiet:
             print(f"{text} ...", file=sys.stderr, flush=True)
 
+    if scenario.foreign is not None:  # a Verilog design on pins: on Verilator
+        try:
+            return make_pin_backend(args.backend, scenario, on_build=tell)
+        except (BackendError, PinError) as exc:
+            raise UsageError(f"--design: {exc}".splitlines()[0]) from None
     try:
         return make_pin_backend(args.backend, scenario, on_build=tell)
     except (BackendError, PinError, ValueError, ImportError) as exc:
         raise UsageError(f"backend {args.backend!r} cannot run here: {exc}") from None
+
+
+def _with_design_files(args, scenario):
+    """The scenario with ``--design``/``--ports`` as its foreign design (real-clock timing
+    runs the design the scenario names)."""
+    design_files = _design_files(args, scenario.foreign)
+    if design_files is None:
+        return scenario
+    import dataclasses
+
+    from .scenario import ForeignDesignFiles
+
+    files, ports = design_files
+    return dataclasses.replace(scenario, foreign=ForeignDesignFiles(tuple(files), str(ports)))
 
 
 def _design_files(args, foreign=None):
@@ -465,6 +484,7 @@ def main(argv=None, prog="python -m fpga_robotics.run"):
         if shadow_params is not None:
             raise UsageError("--shadow compares frames; it needs a scenario in compressed "
                              "timing (sim.timing), not real_clock")
+        scenario = _with_design_files(args, scenario)
         design = _open_pin_design(args, scenario)
     else:
         design = _open_design(args, scenario.params, scenario.foreign)

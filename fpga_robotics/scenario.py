@@ -912,15 +912,24 @@ def _resolve_timing(sim, camera, top, connectors, foreign):
     pins = [f"the {c.kind} connector" for c in connectors]
     if top != "follow_target":
         pins.insert(0, f"design.top = {top!r}")
+    if foreign is not None:
+        # A port map that binds connectors (or has no camera) is a design with pins.
+        from .sim.backends.port_map import PortMapError, load_port_map
+
+        try:
+            port_map = load_port_map(foreign.ports)
+        except PortMapError as exc:
+            raise ScenarioError(f"design.ports: {exc}") from None
+        if port_map.connectors:
+            pins.insert(0, f"the port map's [connectors.{next(iter(port_map.connectors))}]")
+        elif not port_map.has_pixels:
+            pins.insert(0, "a port map without pixels")
     timing = sim.timing
     if timing == "auto":
         timing = "real_clock" if pins else "compressed"
     elif timing == "compressed" and pins:
         raise ScenarioError(f"sim.timing = \"compressed\" runs the design only while pixels "
                             f"flow; {pins[0]} needs sim.timing = \"real_clock\" (or \"auto\")")
-    if timing == "real_clock" and foreign is not None:
-        raise ScenarioError("sim.timing = \"real_clock\" runs this project's designs "
-                            "(design.top); a foreign Verilog design runs in compressed timing")
     delay = sim.actuation_delay
     if delay is None:
         delay = REAL_CLOCK_ACTUATION_DELAY if timing == "real_clock" else camera.frame_period

@@ -13,8 +13,8 @@ import dataclasses
 import importlib
 from dataclasses import dataclass, field
 
-__all__ = ["TOPS", "Top", "build_component", "design_tables", "get_top", "register_top",
-           "table_fields"]
+__all__ = ["TOPS", "Top", "build_component", "connector_kinds", "design_tables", "foreign_top",
+           "get_top", "register_top", "table_fields"]
 
 
 @dataclass(frozen=True)
@@ -77,6 +77,28 @@ def get_top(name):
     except KeyError:
         raise ValueError(f"design.top must be one of {', '.join(map(repr, TOPS))}, "
                          f"got {name!r}") from None
+
+
+def foreign_top(port_map):
+    """The ``Top`` of a foreign Verilog design (docs/foreign.md) from its ``PortMap``: a
+    camera iff the map has a pixel stream, the wheels on the wrapper's ``motor_left``/
+    ``motor_right`` (the map's ``outputs``), each ``[connectors.<kind>]`` table as it binds.
+    Not registered: built from the scenario's map each time."""
+    bindings = {**_WHEELS, **{kind: dict(pins) for kind, pins in port_map.connectors.items()}}
+    if port_map.has_pixels:
+        bindings.update(_CAMERA)
+    return Top(f"verilog:{port_map.top}", f"the Verilog design {port_map.top} (port map)",
+               camera=port_map.has_pixels, bindings=bindings, component=None,
+               takes_follow_target_params=False)
+
+
+def connector_kinds():
+    """Every registered connector kind with pins bound by a port map's ``[connectors]``:
+    kind -> {pin: (direction, at most this many bits)} (``port_map.check_connectors``)."""
+    from .connectors import CONNECTORS
+
+    return {kind: {pin: (spec.direction, spec.width) for pin, spec in cls.pins.items()}
+            for kind, cls in CONNECTORS.items() if kind not in ("camera", "wheels")}
 
 
 def _load(where):

@@ -8,6 +8,11 @@ extending the outputs) so that the Verilator backend's own harness drives it unc
 Outputs the map does not name are ``None`` in the ``FrameResult`` (``filtered`` too when the
 design has no filtered stream); ``ForeignVerilatorBackend(fill_absent=True)`` gives 0 instead,
 which the closed loop needs.
+
+For real-clock timing (``ForeignDesign(..., pins=True)``, the Verilator pin backend) the
+wrapper has the same ports where the map gives them (the pixel stream, colour select, result
+strobe, the outputs it names) and passes the ports of ``[connectors.<kind>]`` through under
+their own names.
 """
 
 import contextlib
@@ -36,22 +41,31 @@ from .compiled import (
     _address,
     _Library,
 )
-from .port_map import OUTPUTS, PortMapError, check_widths, load_port_map
+from .port_map import OUTPUTS, PortMapError, check_connectors, check_widths, load_port_map
 from .toolchain import find_compiler, find_make, run_tool, verilator_root, verilator_version
 from .verilator import CXX_FLAGS, MAKE_FLAGS, VERILATOR_FLAGS
 
-__all__ = ["ForeignDesign", "ForeignVerilatorBackend", "design_ports", "wrapper_verilog"]
+__all__ = ["ForeignDesign", "ForeignVerilatorBackend", "design_ports", "pin_ports", "wrapper_verilog"]
 
 WRAPPER = "fr_foreign_top"
+#: The wrapper's own port names (docs/contract.md): no connector port may take one.
+_WRAPPER_PORTS = ("clk", "rst", "pixels__valid", "pixels__payload", "color_sel",
+                  "filtered__valid", "filtered__payload", "frame_done", *OUTPUTS)
 _HARNESS_FILES = ("verilator_harness.cpp", "frame_driver.h", "verilator_clock.h")
 _LINT_FLAGS = ("-Wno-fatal", "-Wno-lint", "-Wno-style")
 
 
 class ForeignDesign:
     """Verilog files and their port map (a path or a ``PortMap``), for frames of ``params``
-    (``FollowTargetParams``, default 160x120)."""
+    (``FollowTargetParams``, default 160x120).
 
-    def __init__(self, files, port_map, params=None):
+    ``pins=True``: for the pin backend (real-clock timing), with the map's connectors;
+    ``connector_kinds`` (kind -> {pin: (direction, max width)}) checks them
+    (``port_map.check_connectors``). Without ``pins`` a map with connectors is refused: the
+    frame backend drives no connector.
+    """
+
+    def __init__(self, files, port_map, params=None, *, pins=False, connector_kinds=None):
         from ...hw.params import FollowTargetParams
 
         self.params = params if params is not None else FollowTargetParams()
@@ -74,8 +88,23 @@ class ForeignDesign:
         self.includes = _includes(self.files)
         self.port_map = port_map if not isinstance(port_map, (str, os.PathLike)) \
             else load_port_map(port_map)
+        pm = self.port_map
+        if not pins and (pm.connectors or not pm.has_pixels):
+            what = (f"binds connectors ([connectors.{next(iter(pm.connectors))}])"
+                    if pm.connectors else "has no pixel stream")
+            raise PortMapError(f"port map: {pm.top}'s map {what}: the design runs in real-clock "
+                               "timing (sim.timing = \"real_clock\", on the verilator backend) "
+                               "with the scenario's [[robot.sensors]]")
+        clash = sorted(set(pm.connector_ports()) & set(_WRAPPER_PORTS))
+        if clash:
+            raise PortMapError(f"port map: {pm.connector_ports()[clash[0]]}: the port name "
+                               f"{clash[0]!r} is reserved for the wrapper's own ports; rename "
+                               "it in the design")
+        self.pins = pins
         self.ports = design_ports(self.sources, self.port_map.top, self.includes)
         check_widths(self.port_map, self.ports, self.params.width * self.params.height)
+        if connector_kinds is not None:
+            check_connectors(self.port_map, self.ports, connector_kinds)
         for key in ("motor_left", "motor_right"):
             out = self.port_map.outputs.get(key)
             if out is not None and self.ports[out.port][1] > 16:
@@ -84,7 +113,7 @@ class ForeignDesign:
                 self.port_map.outputs["found"].port][1] != 1:
             raise PortMapError("port map: outputs.found must be a 1-bit port")
         self.wrapper = wrapper_verilog(self.port_map, self.ports, self.params.width,
-                                       self.params.height)
+                                       self.params.height, pins=pins)
 
     def digest(self):
         h = hashlib.sha256()
@@ -194,14 +223,19 @@ def design_ports(sources, top, includes=None):
     return ports
 
 
-def wrapper_verilog(pm, ports, width, height):
+def wrapper_verilog(pm, ports, width, height, pins=False):
     """A module ``fr_foreign_top`` with the ports of docs/contract.md around ``pm.top``, for
-    frames of ``width`` x ``height``."""
-    conns = [f".{pm.clock}(clk)", f".{pm.reset}({'~rst' if pm.reset_active_low else 'rst'})",
-             f".{pm.valid}(pixels__valid)"]
+    frames of ``width`` x ``height``.
+
+    ``pins=True`` (the pin backend): only the ports the map gives (no pixel stream, strobe
+    or colour select without ``pixels``, no absent outputs), the connector ports passed
+    through under their own names, ``[runtime]`` inputs held at their initial values."""
+    conns = [f".{pm.clock}(clk)", f".{pm.reset}({'~rst' if pm.reset_active_low else 'rst'})"]
+    if pm.has_pixels:
+        conns.append(f".{pm.valid}(pixels__valid)")
     body = []
     last = width * height - 1
-    if pm.style == "framebuffer" or pm.after_cycles:
+    if pm.has_pixels and (pm.style == "framebuffer" or pm.after_cycles):
         # The pixel's linear address, counted from the frame's first pixel (flag bit 12).
         aw = max(1, last.bit_length())
         body.append(
@@ -211,7 +245,9 @@ def wrapper_verilog(pm, ports, width, height):
             "  always @(posedge clk)\n"
             f"    if (rst) fr_next <= {aw}'d0;\n"
             f"    else if (pixels__valid) fr_next <= fr_addr + {aw}'d1;")
-    if pm.style == "framebuffer":
+    if not pm.has_pixels:
+        pass
+    elif pm.style == "framebuffer":
         conns.append(f".{pm.data}(pixels__payload[11:0])")
         conns.append(f".{pm.address}(fr_addr)")
         if pm.new_frame:
@@ -237,7 +273,7 @@ def wrapper_verilog(pm, ports, width, height):
         conns.append(f".{pm.color_port}(fr_sel)")
     if pm.strobe:
         conns.append(f".{pm.strobe}(frame_done)")
-    else:
+    elif pm.has_pixels:
         # frame_done one cycle before the outputs are read (the harness reads them one edge
         # later: the backend's latency is 1), after_cycles edges after the last pixel's.
         body.append(
@@ -247,14 +283,16 @@ def wrapper_verilog(pm, ports, width, height):
             f"    else if (fr_end) fr_wait <= 32'd{pm.after_cycles};\n"
             "    else if (fr_wait != 32'd0) fr_wait <= fr_wait - 32'd1;\n"
             "  assign frame_done = fr_wait == 32'd1;")
-    decls = []
+    decls, header = [], []
     for key, (out_width, _) in (("found", (1, 0)), ("proximity", (16, 0)),
                                 ("centroid_x", (16, 0)), ("centroid_leds", (16, 0)),
                                 ("motor_left", (16, 0)), ("motor_right", (16, 0))):
         out = pm.outputs.get(key)
         if out is None:
-            body.append(f"  assign {key} = {out_width}'d0;")
+            if not pins:
+                body.append(f"  assign {key} = {out_width}'d0;")
             continue
+        header.append(f"output [{out_width - 1}:0] {key}")
         width = ports[out.port][1]
         decls.append(f"  wire [{width - 1}:0] fr_{key};")
         conns.append(f".{out.port}(fr_{key})")
@@ -266,11 +304,15 @@ def wrapper_verilog(pm, ports, width, height):
             body.append(f"  assign {key} = {{{fill}, fr_{key}}};")
     for name, value in pm.constants.items():
         conns.append(f".{name}({ports[name][1]}'d{value})")
-    if pm.runtime:
+    if pins:
+        # No host hooks in the pin model: each [runtime] input keeps its initial value.
+        for name, value in pm.runtime.items():
+            conns.append(f".{name}({ports[name][1]}'d{value})")
+    elif pm.runtime:
         # Held in registers loaded every clock from the host's values (fr_foreign_set_runtime,
         # in the hooks compiled with the design), so a new value acts from the next edge.
         body.append('  import "DPI-C" function int fr_runtime_value(input int index);')
-    for index, name in enumerate(pm.runtime):
+    for index, name in enumerate(() if pins else pm.runtime):
         width = ports[name][1]
         body.append(f"  reg [{width - 1}:0] fr_rt_{index};\n"
                     f"  always @(posedge clk) fr_rt_{index} <= fr_runtime_value({index});")
@@ -278,9 +320,11 @@ def wrapper_verilog(pm, ports, width, height):
     if pm.filtered_valid:
         conns += [f".{pm.filtered_valid}(filtered__valid)",
                   f".{pm.filtered_payload}(filtered__payload)"]
-    else:
+    elif not pins:
         body.append("  assign filtered__valid = 1'b0;\n  assign filtered__payload = 14'd0;")
     conn_text = ",\n    ".join(conns)
+    if pins:
+        return _pin_wrapper(pm, ports, header, decls, body, conns)
     return f"""// Generated by fpga_robotics.sim.backends.foreign: {pm.top} with the ports of
 // docs/contract.md, for the Verilator harness.
 module {WRAPPER} (
@@ -297,6 +341,53 @@ module {WRAPPER} (
   );
 endmodule
 """
+
+
+def _pin_wrapper(pm, ports, outputs, decls, body, conns):
+    header = ["input clk", "input rst"]
+    if pm.has_pixels:
+        header += ["input pixels__valid", "input [13:0] pixels__payload", "input [2:0] color_sel",
+                   "output frame_done"]
+    if pm.filtered_valid:
+        header += ["output filtered__valid", "output [13:0] filtered__payload"]
+    header += outputs
+    for port in pm.connector_ports():
+        direction, width, signed = ports[port]
+        header.append(f"{direction} {'signed ' if signed else ''}[{width - 1}:0] {port}")
+        conns.append(f".{port}({port})")
+    ports_text = ",\n  ".join(header)
+    conn_text = ",\n    ".join(conns)
+    return f"""// Generated by fpga_robotics.sim.backends.foreign: {pm.top} with the ports of
+// docs/contract.md and its connector ports, for the Verilator pin harness.
+module {WRAPPER} (
+  {ports_text}
+);
+{chr(10).join(decls)}
+{chr(10).join(body)}
+  {pm.top} fr_design (
+    {conn_text}
+  );
+endmodule
+"""
+
+
+def pin_ports(design):
+    """The pin wrapper's ports of a ``ForeignDesign(pins=True)``: name -> (direction ``in`` or
+    ``out``, width, signed), clock and reset left out (the pin driver's own)."""
+    pm, ports = design.port_map, {}
+    if pm.has_pixels:
+        ports.update(pixels__valid=("in", 1, False), pixels__payload=("in", 14, False),
+                     color_sel=("in", 3, False), frame_done=("out", 1, False))
+    if pm.filtered_valid:
+        ports.update(filtered__valid=("out", 1, False), filtered__payload=("out", 14, False))
+    for key in OUTPUTS:
+        if key in pm.outputs:
+            # The contract's wheel speeds are signed 16 bits; the other outputs unsigned.
+            ports[key] = ("out", 1 if key == "found" else 16, key.startswith("motor_"))
+    for port in pm.connector_ports():
+        direction, width, signed = design.ports[port]
+        ports[port] = ("in" if direction == "input" else "out", width, signed)
+    return ports
 
 
 #: Compiled with the design: $stop, $fatal and $finish record where they were called instead

@@ -5,6 +5,12 @@ the per-frame outputs (docs/foreign.md). ``load_port_map(path)`` reads and check
 Interface styles: ``stream`` (this project's ``follow_target`` ports) and ``framebuffer``
 (per pixel a write enable, a linear write address and a 12-bit RGB444 datum; a one-cycle
 new-frame pulse the cycle after the frame's last pixel).
+
+``[connectors.<kind>]`` tables bind the pins of sensor and actuator connectors (an
+ultrasound's ``trig``/``echo``, a bumper's ``pressed``) to ports of the design: such a design
+runs in real-clock timing on the Verilator pin backend; ``check_connectors`` checks the
+bindings against the connector kinds the application knows. A map with connectors may leave
+out the pixel stream (a design without a camera).
 """
 
 import argparse
@@ -17,8 +23,8 @@ from ...hw.pixel import COLOR_SELECT
 from .base import BackendError
 
 __all__ = [
-    "OUTPUTS", "Output", "PortMap", "PortMapError", "check_widths", "follow_target_port_map",
-    "load_port_map", "parse_port_map",
+    "OUTPUTS", "Output", "PortMap", "PortMapError", "check_connectors", "check_widths",
+    "follow_target_port_map", "load_port_map", "parse_port_map",
 ]
 
 #: Per-frame outputs a port map may name: FrameResult field -> (default width, signed).
@@ -32,7 +38,13 @@ OUTPUTS = {
 }
 _STYLES = ("stream", "framebuffer")
 _TOP_KEYS = {"style", "top", "clock", "reset", "pixels", "color", "result", "outputs", "filtered",
-             "constants", "runtime"}
+             "constants", "runtime", "connectors"}
+#: Connector kinds the map binds elsewhere: the camera by ``pixels``/``color``, the wheels by
+#: ``outputs.motor_left``/``motor_right``.
+_BOUND_ELSEWHERE = {"camera": "pixels and color", "wheels": "outputs.motor_left and "
+                    "outputs.motor_right"}
+#: Outputs read when the frame's result is ready: they need a pixel stream.
+_FRAME_ONLY = ("found", "proximity", "centroid_x", "centroid_leds")
 #: At most this many ``[runtime]`` inputs.
 MAX_RUNTIME = 8
 
@@ -54,7 +66,7 @@ class PortMap:
     clock: str
     reset: str
     reset_active_low: bool
-    valid: str
+    valid: str | None  # None: no pixel stream (a design without a camera)
     payload: str | None  # 14 bits: data[11:0], first[12], last[13]
     data: str | None  # 12-bit RGB444 (with first/last as separate ports)
     first: str | None
@@ -75,18 +87,35 @@ class PortMap:
     constants: dict = field(default_factory=dict)  # input port -> value it is tied to
     # input port -> its value until ``ForeignVerilatorBackend.set_runtime`` changes it
     runtime: dict = field(default_factory=dict)
+    #: connector kind -> {connector pin: design port} (``[connectors.<kind>]``).
+    connectors: dict = field(default_factory=dict)
+
+    @property
+    def has_pixels(self):
+        return self.valid is not None
+
+    def connector_ports(self):
+        """Design port -> its key ``connectors.<kind>.<pin>``."""
+        return {port: f"connectors.{kind}.{pin}" for kind, pins in self.connectors.items()
+                for pin, port in pins.items()}
 
     def inputs(self):
-        """Input port name -> expected width (None: checked elsewhere)."""
-        ports = {self.clock: 1, self.reset: 1, self.valid: 1}
-        if self.style == "framebuffer":
+        """Input port name -> expected width (None: checked elsewhere). Connector ports are
+        not listed: their direction is the connector's (``check_connectors``)."""
+        ports = {self.clock: 1, self.reset: 1}
+        if not self.has_pixels:
+            pass
+        elif self.style == "framebuffer":
+            ports[self.valid] = 1
             ports[self.address] = None  # wide enough for the frame: checked with its size
             ports[self.data] = 12
             if self.new_frame:
                 ports[self.new_frame] = 1
         elif self.payload:
+            ports[self.valid] = 1
             ports[self.payload] = 14
         else:
+            ports[self.valid] = 1
             ports[self.data] = 12
             for flag in (self.first, self.last):
                 if flag:
@@ -163,9 +192,16 @@ def parse_port_map(data):
     if not isinstance(active_low, bool):
         raise PortMapError("port map: reset.active_low must be true or false")
 
-    pixels = _table(data, "pixels", "")
-    address = new_frame = payload = first = last = None
-    if style == "framebuffer":
+    connectors = _connectors(data)
+    # A design without a camera (only connectors and wheels) has no pixel stream.
+    pixels = _table(data, "pixels", "", required=not connectors)
+    address = new_frame = payload = first = last = valid = data_port = None
+    if not pixels:
+        for key in ("color", "result", "filtered"):
+            if key in data:
+                raise PortMapError(f"port map: [{key}] goes with a pixel stream; this map has "
+                                   "no pixels (a design without a camera)")
+    elif style == "framebuffer":
         _unknown(pixels, {"write_enable", "address", "data", "new_frame"}, "pixels.")
         valid = _name(pixels, "write_enable", "pixels")
         address = _name(pixels, "address", "pixels")
@@ -203,9 +239,10 @@ def parse_port_map(data):
     if color_width is not None:
         color_width = _int(color, "width", "color", None, 1, 32)
 
-    result = _table(data, "result", "")
+    result = _table(data, "result", "", required=bool(pixels))
     _unknown(result, {"strobe", "latency", "timeout", "after_cycles"}, "result.")
-    strobe = _name(result, "strobe", "result", required="after_cycles" not in result)
+    strobe = _name(result, "strobe", "result",
+                   required=bool(pixels) and "after_cycles" not in result)
     after_cycles = None
     if "after_cycles" in result:
         if strobe is not None or "latency" in result:
@@ -235,6 +272,11 @@ def parse_port_map(data):
         outputs[key] = Output(port, width, signed)
     if not outputs:
         raise PortMapError("port map: [outputs] names no output")
+    if not pixels:
+        frame_only = [k for k in _FRAME_ONLY if k in outputs]
+        if frame_only:
+            raise PortMapError(f"port map: outputs.{frame_only[0]} is read when a frame's "
+                               "result is ready: it needs a pixel stream (pixels)")
 
     filtered = _table(data, "filtered", "", required=False)
     _unknown(filtered, {"valid", "payload"}, "filtered.")
@@ -269,17 +311,38 @@ def parse_port_map(data):
         color_width=color_width, strobe=strobe, latency=latency, timeout=timeout,
         outputs=outputs, filtered_valid=f_valid, filtered_payload=f_payload, style=style,
         address=address, new_frame=new_frame, after_cycles=after_cycles,
-        constants=dict(constants), runtime=dict(runtime),
+        constants=dict(constants), runtime=dict(runtime), connectors=connectors,
     )
     pm = port_map
     names = [n for n in (pm.clock, pm.reset, pm.valid, pm.payload, pm.data, pm.first, pm.last,
                          pm.address, pm.new_frame, pm.color_port, pm.strobe,
                          *(o.port for o in pm.outputs.values()), pm.filtered_valid,
-                         pm.filtered_payload, *pm.constants, *pm.runtime) if n]
+                         pm.filtered_payload, *pm.constants, *pm.runtime,
+                         *(p for pins in pm.connectors.values() for p in pins.values())) if n]
     dup = sorted({n for n in names if names.count(n) > 1})
     if dup:
         raise PortMapError(f"port map: port {dup[0]!r} is mapped more than once")
     return port_map
+
+
+def _connectors(data):
+    """``[connectors.<kind>]`` tables: kind -> {pin: port}; names only (the kinds and their
+    pins are checked by ``check_connectors``)."""
+    table = _table(data, "connectors", "", required=False)
+    out = {}
+    for kind, pins in table.items():
+        where = f"connectors.{kind}"
+        if not kind.isidentifier():
+            raise PortMapError(f"port map: {where}: not a connector kind")
+        if kind in _BOUND_ELSEWHERE:
+            raise PortMapError(f"port map: {where}: the {kind} is bound by "
+                               f"{_BOUND_ELSEWHERE[kind]}, not a [connectors] table")
+        if not isinstance(pins, dict) or not pins:
+            raise PortMapError(f"port map: {where} must be a table of pin = \"port\"")
+        for pin in pins:
+            _name(pins, pin, where)
+        out[kind] = dict(pins)
+    return out
 
 
 def load_port_map(path):
@@ -331,11 +394,48 @@ def check_widths(port_map, ports, pixels=None):
             if value >> ports[name][1]:
                 raise PortMapError(f"port map: {table}.{name} = {value} does not fit the "
                                    f"{ports[name][1]}-bit port")
-    unconnected = [n for n, (d, _, _) in ports.items()
-                   if d == "input" and n not in port_map.inputs()]
+    for port, key in port_map.connector_ports().items():
+        if port not in ports:
+            raise PortMapError(f"port map: {key}: the design {port_map.top} has no port "
+                               f"{port!r} (its ports: {', '.join(ports)})")
+        if ports[port][1] > 32:
+            raise PortMapError(f"port map: {key}: port {port!r} is {ports[port][1]} bits wide "
+                               "(at most 32)")
+    mapped = {**port_map.inputs(), **port_map.connector_ports()}
+    unconnected = [n for n, (d, _, _) in ports.items() if d == "input" and n not in mapped]
     if unconnected:
         raise PortMapError(f"port map: input {unconnected[0]!r} of {port_map.top} is not "
                            "mapped (every input must be driven)")
+
+
+def check_connectors(port_map, ports, kinds):
+    """Check ``port_map``'s ``[connectors]`` against the design's ``ports`` (as for
+    ``check_widths``) and the connector ``kinds`` the application knows: kind -> {pin: (direction
+    seen from the design, "in" or "out"; at most this many bits)}. ``PortMapError`` names the
+    key of the first problem."""
+    for kind, pins in port_map.connectors.items():
+        if kind not in kinds:
+            raise PortMapError(f"port map: connectors.{kind}: unknown connector kind; known: "
+                               f"{', '.join(sorted(kinds))}")
+        known = kinds[kind]
+        for pin, port in pins.items():
+            key = f"connectors.{kind}.{pin}"
+            if pin not in known:
+                raise PortMapError(f"port map: {key}: the {kind} connector has no pin {pin!r}; "
+                                   f"its pins: {', '.join(known)}")
+            if port not in ports:
+                raise PortMapError(f"port map: {key}: the design {port_map.top} has no port "
+                                   f"{port!r} (its ports: {', '.join(ports)})")
+            direction, width = known[pin]
+            wanted = {"in": "input", "out": "output"}[direction]
+            actual_dir, actual_width, _ = ports[port]
+            if actual_dir != wanted:
+                raise PortMapError(f"port map: {key}: port {port!r} of {port_map.top} is an "
+                                   f"{actual_dir}; the {kind} pin {pin!r} needs an {wanted}")
+            if actual_width > width:
+                raise PortMapError(f"port map: {key}: port {port!r} of {port_map.top} is "
+                                   f"{actual_width} bits wide; the {kind} pin {pin!r} takes "
+                                   + (f"{width} bit" if width == 1 else f"at most {width} bits"))
 
 
 #: The port map of the exported ``follow_target`` (docs/foreign.md).

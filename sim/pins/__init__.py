@@ -5,10 +5,11 @@ Amaranth's simulator (``pysim``, the reference) or a compiled model (``cxxrtl``,
 from .base import PinBackend, PinError, PixelTiming, Port, Stop
 from .design import FILTERED_PORTS, PIXEL_PORTS, PinDesignSource, follow_target_source
 from .timing import real_clock_timing
+from .verilog import VerilogPinSource
 
 __all__ = ["FILTERED_PORTS", "PIN_BACKENDS", "PIXEL_PORTS", "PinBackend", "PinDesignSource",
            "PinError", "PixelTiming", "Port", "Stop", "follow_target_source", "get_pin_backend",
-           "real_clock_timing"]
+           "real_clock_timing", "VerilogPinSource"]
 
 #: Backend names ``get_pin_backend`` accepts; ``auto`` tries the compiled ones fastest first.
 PIN_BACKENDS = ("auto", "pysim", "cxxrtl", "verilator")
@@ -30,6 +31,12 @@ def get_pin_backend(name, source, **kwargs):
     reset (cycle 0). ``on_build=`` (compiled backends) is told before a build."""
     if name not in PIN_BACKENDS:
         raise PinError(f"unknown pin backend {name!r}; choose one of: {', '.join(PIN_BACKENDS)}")
+    if isinstance(source, VerilogPinSource):
+        # Only Verilator reads Verilog: Amaranth's simulator and CXXRTL take Amaranth designs.
+        if name not in ("auto", "verilator"):
+            raise PinError(f"the {name} pin backend cannot run a Verilog design "
+                           f"({source.design.port_map.top}); use the verilator backend")
+        return _backend_class("verilator")(source, **kwargs)
     if not isinstance(source, PinDesignSource):
         raise TypeError(f"source must be a PinDesignSource, not {source!r}")
     if name != "auto":

@@ -115,13 +115,21 @@ def cxxrtl_plan(source):
 
 
 def verilator_plan(source):
-    """The ``BuildPlan`` of a ``PinDesignSource`` with Verilator."""
+    """The ``BuildPlan`` of a ``PinDesignSource`` (its exported Verilog) or a
+    ``VerilogPinSource`` (a foreign design's files and wrapper) with Verilator."""
     compiler = find_compiler()
     find_make()
     root = verilator_root()
-    verilog = source.verilog
     outputs = [p.name for p in source.ports.values() if p.direction == "out"]
-    registered = output_sources(source.cxxrtl, outputs) is not None
+    if hasattr(source, "verilog_files"):  # a foreign Verilog design
+        files, compiled = source.verilog_files()
+        top, registered = source.verilog_top, source.registered_outputs
+        text = "".join(f"{name}\0{body}\0" for name, body in files.items())
+    else:
+        text = source.verilog
+        files, compiled = {"follow_target.v": text}, ["follow_target.v"]
+        top = "follow_target"
+        registered = output_sources(source.cxxrtl, outputs) is not None
     accessors = verilator_accessors(source, registered)
     harness = _sources("pin_verilator.cpp", _DRIVER, "verilator_clock.h")
     cflags = " ".join(VERILATOR_CXX_FLAGS)
@@ -130,7 +138,7 @@ def verilator_plan(source):
         "flow": "pins-verilator",
         "abi": ABI_VERSION,
         "design": source.key,
-        "source": _digest(verilog + accessors),
+        "source": _digest(text + accessors),
         "harness": {name: _digest(text) for name, text in harness.items()},
         "flags": [*VERILATOR_FLAGS, cflags, *MAKE_FLAGS],
         "compiler": compiler.version,
@@ -138,17 +146,21 @@ def verilator_plan(source):
     })
 
     def build(directory):
-        (directory / "follow_target.v").write_text(verilog)
+        for name, body in files.items():
+            path = directory / name
+            path.parent.mkdir(parents=True, exist_ok=True)
+            path.write_text(body)
         (directory / "pin_design.h").write_text(accessors)
-        for name, text in harness.items():
-            (directory / name).write_text(text)
+        for name, body in harness.items():
+            (directory / name).write_text(body)
         env = dict(os.environ, VERILATOR_ROOT=str(root))
         make_flags = [*MAKE_FLAGS, f"CXX={compiler.path}", f"LINK={compiler.path}"]
         run_tool([root / "bin" / "verilator", *VERILATOR_FLAGS, "-j", jobs,
-                  "--top-module", "follow_target", "--Mdir", directory / "obj",
+                  "--top-module", top, "--prefix", "Vfollow_target", f"-I{directory / 'src'}",
+                  "--Mdir", directory / "obj",
                   "-CFLAGS", f"{cflags} -I{directory}", "-LDFLAGS", "-shared",
                   "-MAKEFLAGS", " ".join(make_flags), "-o", directory / LIBRARY_NAME,
-                  directory / "follow_target.v", directory / "pin_verilator.cpp"],
+                  *(directory / name for name in compiled), directory / "pin_verilator.cpp"],
                  cwd=directory, env=env,
                  what=f"building the Verilator pin model (make, {compiler.path})")
 

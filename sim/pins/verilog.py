@@ -1,0 +1,69 @@
+"""``VerilogPinSource``: a foreign Verilog design (files and a port map, docs/foreign.md) for
+the Verilator pin backend, in real-clock timing.
+
+The design is wrapped by the foreign backend's generated module (``ForeignDesign(pins=True)``):
+the pixel stream, colour codes, reset polarity and output extension work as in compressed
+timing, and the ports of the map's ``[connectors.<kind>]`` tables pass through under their own
+names. Amaranth's simulator and CXXRTL cannot take Verilog: only ``verilator`` runs it.
+"""
+
+import hashlib
+
+from .base import PinError, Port
+from .design import FILTERED_PORTS, MAX_PORTS, PIXEL_PORTS
+
+__all__ = ["VerilogPinSource"]
+
+
+class VerilogPinSource:
+    """A ``ForeignDesign`` made with ``pins=True`` (sim.backends.foreign) as a pin design.
+
+    Its ports are the wrapper's: ``pixels__valid``/``pixels__payload``, ``color_sel`` and
+    ``frame_done`` when the map has a pixel stream, the outputs the map names (``found``,
+    ``motor_left``, ...; absent ones are not ports), ``filtered__*`` with ``[filtered]``, and
+    every connector port under the design's own name.
+    """
+
+    #: The wrapper's module: the pin harness's model (``--prefix Vfollow_target``).
+    verilog_top = "fr_foreign_top"
+
+    def __init__(self, design):
+        from ..backends.foreign import WRAPPER, pin_ports
+
+        if not design.pins:
+            raise PinError("a VerilogPinSource needs a ForeignDesign made with pins=True")
+        assert WRAPPER == self.verilog_top
+        self.design = design
+        pm = design.port_map
+        self.key = f"verilog-{pm.top}-{design.digest()[:16]}"
+        self.ports = {name: Port(name, width, direction, signed)
+                      for name, (direction, width, signed) in pin_ports(design).items()}
+        if len(self.ports) > MAX_PORTS:
+            raise PinError(f"design {pm.top!r} has {len(self.ports)} ports; the pin backends "
+                           f"take at most {MAX_PORTS}")
+        self.pixels = PIXEL_PORTS if pm.has_pixels else None
+        self.filtered = FILTERED_PORTS if pm.filtered_valid else None
+        params = design.params
+        self.frame_size = (params.width, params.height) if pm.has_pixels else None
+
+    def verilog_files(self):
+        """``(files, compiled)``: every file to write (relative path -> text, the design's
+        `include files too) and the ones Verilator compiles, in order; the includes are
+        found under ``src``."""
+        d = self.design
+        files = {"fr_wrapper.v": d.wrapper}
+        files.update({f"src/{name}": text for name, text in d.includes.items()})
+        files.update({f"src/{name}": text for name, text in d.sources.items()})
+        compiled = ["fr_wrapper.v", *(f"src/{name}" for name in d.sources)]
+        return files, compiled
+
+    #: Whether every output is a flip-flop is not known for a foreign design: the harness
+    #: evaluates twice per edge (the edge, then the settling on the next edge's inputs).
+    registered_outputs = False
+
+    @property
+    def digest(self):
+        return hashlib.sha256(self.design.digest().encode()).hexdigest()
+
+    def __repr__(self):
+        return f"VerilogPinSource({self.key!r}, {len(self.ports)} ports)"
