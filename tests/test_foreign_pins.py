@@ -1,0 +1,217 @@
+"""Foreign Verilog designs in real-clock timing (docs/foreign.md, "Sensors on pins"): a port
+map's ``[connectors.<kind>]`` binds a connector's pins to the design's ports, and the design
+runs on the Verilator pin backend in the closed loop.
+
+The design is tests/data/bump_stop.v: on at 300 DPS until the bumper closes, then stopped for
+good (an active-low reset, 12-bit wheel speeds sign-extended by the map). It must stop short
+of the wall by the bumper's margin less the braking distance, and drive exactly as the same
+logic written in Amaranth and registered with ``register_top``.
+"""
+
+import math
+from pathlib import Path
+
+import pytest
+from amaranth import Module, Mux, Signal, signed
+from amaranth.lib import wiring
+from amaranth.lib.wiring import In, Out
+
+from fpga_robotics.errors import run_cli
+from fpga_robotics.loop import run_scenario
+from fpga_robotics.run import main as run_main
+from fpga_robotics.scenario import load_scenario
+from fpga_robotics.sim.backends.port_map import PortMapError, parse_port_map
+from fpga_robotics.tops import TOPS, Top, register_top
+
+DATA = Path(__file__).parent / "data"
+VERILOG = DATA / "bump_stop.v"
+PORTS = DATA / "bump_stop_ports.toml"
+MARGIN = 0.03  # the bumper closes 3 cm from the wall
+ROOM_WIDTH, START_X = 2.0, 0.5
+
+#: A scenario: the robot drives at a wall 2 m away (x = 2) until its bumper closes.
+SCENARIO = """
+people = []
+[sim]
+duration = {duration}
+clock_hz = 10000.0
+{design}
+[room]
+width = 2.0
+depth = 1.0
+[robot]
+model = "gopigo3"
+start = [0.5, 0.5]
+[[robot.sensors]]
+kind = "bumper"
+margin = 0.03
+[checks]
+max_wall_collisions = 0
+"""
+VERILOG_DESIGN = f'[design]\nverilog = "{VERILOG}"\nports = "{PORTS}"'
+
+
+class BumpStop(wiring.Component):
+    """tests/data/bump_stop.v in Amaranth (docs/connectors.md's example)."""
+
+    bump: In(1)
+    motor_left: Out(signed(16))
+    motor_right: Out(signed(16))
+
+    def elaborate(self, platform):
+        m = Module()
+        hit = Signal()
+        with m.If(self.bump):
+            m.d.sync += hit.eq(1)
+        speed = Signal(signed(16))
+        m.d.comb += speed.eq(Mux(hit, 0, 300))
+        m.d.comb += [self.motor_left.eq(speed), self.motor_right.eq(speed)]
+        return m
+
+
+def _scenario(tmp_path, design, duration=12.0, name="bump.toml"):
+    path = tmp_path / name
+    path.write_text(SCENARIO.format(duration=duration, design=design))
+    return load_scenario(str(path))
+
+
+@pytest.fixture(scope="module")
+def verilog_run(tmp_path_factory):
+    scenario = _scenario(tmp_path_factory.mktemp("vlog"), VERILOG_DESIGN)
+    assert scenario.sim.timing == "real_clock"  # "auto": the port map binds a connector
+    return run_scenario(scenario, backend="auto")
+
+
+def test_the_verilog_design_stops_short_of_the_wall_by_margin_less_braking(verilog_run):
+    from fpga_robotics.sim.world import World
+
+    spec = World.from_config({"room": {"width": 2.0, "depth": 1.0}, "people": [],
+                              "robot": {"model": "gopigo3", "start": [0.5, 0.5]}}).robot_spec
+    traj = verilog_run.trajectory
+    assert verilog_run.summary["verdict"] == "pass"
+    assert verilog_run.summary["timing"] == "real_clock"
+    assert traj["bumper.pressed"][-1] == 1.0
+    assert traj["motor_left"][0] == 300 and traj["motor_left"][-1] == 0
+    # From 300 DPS at the wheels' ramp: v0^2 / (2 a) of wheel angle, times the wheel radius.
+    braking = math.radians(300.0 ** 2 / (2 * spec.wheel_accel_dps2)) * spec.wheel_radius
+    gap = ROOM_WIDTH - spec.body_radius - traj["x"][-1]
+    # Discrete time moves it by up to a physics step (1/240 s) of travel at 0.17 m/s each:
+    # the bumper is sampled at a step's start, the 1 ms actuation delay ends at a step, the
+    # wheels ramp step by step.
+    step = math.radians(300.0) * spec.wheel_radius / 240
+    assert MARGIN - braking - 3 * step <= gap <= MARGIN - braking + step
+    # Absent outputs stay absent (the map names no found/proximity/centroid).
+    assert set(verilog_run.summary["absent_outputs"]) == {"found", "proximity", "centroid_x",
+                                                          "centroid_leds"}
+
+
+def test_the_verilog_design_drives_exactly_as_its_amaranth_twin(verilog_run, tmp_path):
+    register_top(Top("bump_stop_twin", "BumpStop in Amaranth", camera=False,
+                     component=BumpStop, takes_follow_target_params=False,
+                     bindings={"wheels": {"motor_left": "motor_left",
+                                          "motor_right": "motor_right"},
+                               "bumper": {"pressed": "bump"}}))
+    try:
+        twin = run_scenario(_scenario(tmp_path, '[design]\ntop = "bump_stop_twin"'),
+                            backend="pysim")
+    finally:
+        TOPS.pop("bump_stop_twin", None)
+    for key in ("x", "y", "heading", "motor_left", "motor_right", "bumper.pressed"):
+        assert (twin.trajectory[key] == verilog_run.trajectory[key]).all(), key
+    assert twin.summary["sim_cycles"] == verilog_run.summary["sim_cycles"]
+
+
+def test_a_verilog_design_runs_on_verilator_only(tmp_path):
+    from fpga_robotics.clocked_loop import pin_design_source
+    from fpga_robotics.sim.pins import PinError, get_pin_backend
+
+    source = pin_design_source(_scenario(tmp_path, VERILOG_DESIGN, duration=0.1))
+    assert set(source.ports) == {"motor_left", "motor_right", "bump_i"}
+    for name in ("pysim", "cxxrtl"):
+        with pytest.raises(PinError, match=f"the {name} pin backend cannot run a Verilog "
+                                           "design.*use the verilator backend"):
+            get_pin_backend(name, source)
+
+
+def _map(**extra):
+    text = PORTS.read_text()
+    for key, value in extra.items():
+        text = text.replace(key, value)
+    return text
+
+
+#: (case, port map text or a change to the scenario, words of the one-line error).
+BAD_MAPS = [
+    ("unknown connector kind", _map(**{"[connectors.bumper]": "[connectors.sonar]"}),
+     "connectors.sonar: unknown connector kind; known: bumper, line_sensors, ultrasound"),
+    ("unknown pin", _map(pressed="pushed"), "connectors.bumper.pushed: the bumper connector "
+     "has no pin 'pushed'"),
+    ("missing port", _map(**{'pressed = "bump_i"': 'pressed = "bump"'}),
+     "connectors.bumper.pressed: the design bump_stop has no port 'bump'"),
+    ("wrong direction", _map(**{'pressed = "bump_i"': 'pressed = "hit_o"\n[constants]\n'
+                                                      'bump_i = 0'}),
+     "connectors.bumper.pressed: port 'hit_o' of bump_stop is an output; the bumper pin "
+     "'pressed' needs an input"),
+    ("camera as a connector", _map(**{"[connectors.bumper]": "[connectors.camera]"}),
+     "connectors.camera: the camera is bound by pixels and color"),
+]
+
+
+def _run_cli(argv, capsys):
+    with pytest.raises(SystemExit) as exit_info:
+        run_cli(run_main, argv, prog="fpga_robotics.run")
+    err = capsys.readouterr().err
+    return exit_info.value.code, err
+
+
+@pytest.mark.parametrize("case, text, message", BAD_MAPS, ids=[c[0] for c in BAD_MAPS])
+def test_bad_connector_maps_are_one_line_errors(case, text, message, tmp_path, capsys):
+    ports = tmp_path / "ports.toml"
+    ports.write_text(text)
+    scenario = tmp_path / "bump.toml"
+    scenario.write_text(SCENARIO.format(duration=0.1, design=""))
+    code, err = _run_cli(["--scenario", str(scenario), "--design", f"verilog:{VERILOG}",
+                          "--ports", str(ports), "--rerun", "off", "--quiet"], capsys)
+    assert code == 2
+    assert len(err.strip().splitlines()) == 1, err
+    assert message in err
+
+
+def test_a_too_wide_port_is_refused(tmp_path, capsys):
+    wide = tmp_path / "wide.v"
+    wide.write_text(VERILOG.read_text().replace("input bump_i", "input [3:0] bump_i"))
+    scenario = tmp_path / "bump.toml"
+    scenario.write_text(SCENARIO.format(duration=0.1, design=""))
+    code, err = _run_cli(["--scenario", str(scenario), "--design", f"verilog:{wide}",
+                          "--ports", str(PORTS), "--rerun", "off", "--quiet"], capsys)
+    assert code == 2 and len(err.strip().splitlines()) == 1
+    assert ("connectors.bumper.pressed: port 'bump_i' of bump_stop is 4 bits wide; the "
+            "bumper pin 'pressed' takes 1 bit") in err
+
+
+def test_other_backends_and_compressed_timing_are_usage_errors(tmp_path, capsys):
+    scenario = tmp_path / "bump.toml"
+    scenario.write_text(SCENARIO.format(duration=0.1, design=VERILOG_DESIGN))
+    code, err = _run_cli(["--scenario", str(scenario), "--backend", "pysim", "--rerun", "off"],
+                         capsys)
+    assert code == 2 and "runs on the verilator backend, not 'pysim'" in err
+    code, err = _run_cli(["--scenario", str(scenario), "--set", 'sim.timing="compressed"',
+                          "--rerun", "off"], capsys)
+    assert code == 2 and len(err.strip().splitlines()) == 1
+    assert "needs sim.timing = \"real_clock\"" in err
+
+
+def test_parse_errors_name_the_key():
+    base = {"top": "t", "clock": {"port": "clk"}, "reset": {"port": "rst"},
+            "outputs": {"motor_left": "l", "motor_right": "r"}}
+    with pytest.raises(PortMapError, match="missing \\[pixels\\]"):
+        parse_port_map(base)  # neither a camera nor a connector
+    pm = parse_port_map({**base, "connectors": {"bumper": {"pressed": "b"}}})
+    assert not pm.has_pixels and pm.connector_ports() == {"b": "connectors.bumper.pressed"}
+    with pytest.raises(PortMapError, match="connectors.bumper.pressed must be a Verilog port"):
+        parse_port_map({**base, "connectors": {"bumper": {"pressed": 3}}})
+    with pytest.raises(PortMapError, match="port 'l' is mapped more than once"):
+        parse_port_map({**base, "connectors": {"bumper": {"pressed": "l"}}})
+    with pytest.raises(PortMapError, match="outputs.found is read when a frame's result"):
+        parse_port_map({**base, "outputs": {**base["outputs"], "found": "f"},
+                        "connectors": {"bumper": {"pressed": "b"}}})
