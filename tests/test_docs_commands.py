@@ -477,6 +477,13 @@ PLANS = {
         Plan(files=("ports.toml",), out=(r"wrote ports\.toml",)),
     "python -m fpga_robotics.run --design verilog:follow_target.v --ports ports.toml":
         Plan(out=(PASS, r"(?m)^backend:? .*verilator-foreign|verilator-foreign")),
+    ("python -m fpga_robotics.run --scenario bump_wall.toml --design verilog:bump_stop.v "
+     "--ports bump_stop_ports.toml --rerun off"):
+        Plan(setup=(f"cp {ROOT}/tests/data/bump_stop.v {ROOT}/tests/data/bump_stop_ports.toml "
+                    f"{ROOT}/tests/data/bump_wall.toml .",),
+             duration="keep", duration_why="the page quotes the whole run's 120 000 cycles "
+                                           "(12 s at 10 kHz, a twentieth of a second's wall time)",
+             out=(PASS, r"\[ok\] max_wall_collisions")),
     "python -m fpga_robotics.sim.backends.port_map ports.toml":
         Plan(setup=("python -m fpga_robotics.sim.backends.port_map --example ports.toml",),
              out=(r"ports\.toml: follow_target, outputs found, proximity",)),
