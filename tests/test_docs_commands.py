@@ -479,8 +479,8 @@ PLANS = {
         Plan(out=(PASS, r"(?m)^backend:? .*verilator-foreign|verilator-foreign")),
     ("python -m fpga_robotics.run --scenario bump_wall.toml --design verilog:bump_stop.v "
      "--ports bump_stop_ports.toml --rerun off"):
-        Plan(setup=(f"cp {ROOT}/tests/data/bump_stop.v {ROOT}/tests/data/bump_stop_ports.toml "
-                    f"{ROOT}/tests/data/bump_wall.toml .",),
+        Plan(setup=(" ".join(["cp", *(str(ROOT / "tests/data" / name) for name in (
+                         "bump_stop.v", "bump_stop_ports.toml", "bump_wall.toml")), "."]),),
              duration="keep", duration_why="the page quotes the whole run's 120 000 cycles "
                                            "(12 s at 10 kHz, a twentieth of a second's wall time)",
              out=(PASS, r"\[ok\] max_wall_collisions")),

@@ -144,14 +144,14 @@ def _map(**extra):
 BAD_MAPS = [
     ("unknown connector kind", _map(**{"[connectors.bumper]": "[connectors.sonar]"}),
      "connectors.sonar: unknown connector kind; known: bumper, line_sensors, ultrasound"),
-    ("unknown pin", _map(pressed="pushed"), "connectors.bumper.pushed: the bumper connector "
-     "has no pin 'pushed'"),
+    ("unknown pin", _map(pressed="pushed"),
+     "connectors.bumper.pushed: the bumper connector has no pin 'pushed'"),
     ("missing port", _map(**{'pressed = "bump_i"': 'pressed = "bump"'}),
      "connectors.bumper.pressed: the design bump_stop has no port 'bump'"),
     ("wrong direction", _map(**{'pressed = "bump_i"': 'pressed = "hit_o"\n[constants]\n'
                                                       'bump_i = 0'}),
-     "connectors.bumper.pressed: port 'hit_o' of bump_stop is an output; the bumper pin "
-     "'pressed' needs an input"),
+     ("connectors.bumper.pressed: port 'hit_o' of bump_stop is an output; the bumper pin "
+      "'pressed' needs an input")),
     ("camera as a connector", _map(**{"[connectors.bumper]": "[connectors.camera]"}),
      "connectors.camera: the camera is bound by pixels and color"),
 ]

@@ -8,8 +8,8 @@ from .timing import real_clock_timing
 from .verilog import VerilogPinSource
 
 __all__ = ["FILTERED_PORTS", "PIN_BACKENDS", "PIXEL_PORTS", "PinBackend", "PinDesignSource",
-           "PinError", "PixelTiming", "Port", "Stop", "follow_target_source", "get_pin_backend",
-           "real_clock_timing", "VerilogPinSource"]
+           "PinError", "PixelTiming", "Port", "Stop", "VerilogPinSource", "follow_target_source",
+           "get_pin_backend", "real_clock_timing"]
 
 #: Backend names ``get_pin_backend`` accepts; ``auto`` tries the compiled ones fastest first.
 PIN_BACKENDS = ("auto", "pysim", "cxxrtl", "verilator")
