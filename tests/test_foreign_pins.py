@@ -11,6 +11,7 @@ logic written in Amaranth and registered with ``register_top``.
 import math
 from pathlib import Path
 
+import numpy as np
 import pytest
 from amaranth import Module, Mux, Signal, signed
 from amaranth.lib import wiring
@@ -276,3 +277,51 @@ def test_a_camera_design_in_verilog_follows_as_follow_target_does(tmp_path):
     for key in ("x", "y", "heading", "motor_left", "motor_right", "centroid_leds"):
         assert (theirs.trajectory[key] == ours.trajectory[key]).all(), key
     assert "found" in theirs.summary["absent_outputs"]
+
+
+SAFE_MAP = """\
+style = "stream"
+top = "follow_target"
+clock = { port = "clk" }
+reset = { port = "rst" }
+pixels = { valid = "pixels__valid", payload = "pixels__payload" }
+color = { port = "color_sel" }
+result = { strobe = "frame_done", latency = %(latency)d }
+
+[outputs]
+found = "found"
+motor_left = "motor_left"
+motor_right = "motor_right"
+
+[connectors.ultrasound]
+trig = "us_trig"
+echo = "us_echo"
+"""
+
+
+def test_a_camera_and_ultrasound_design_in_verilog_stops_as_follow_target_safe(tmp_path):
+    """FollowTargetSafe exported to Verilog, its HC-SR04 pins bound by the port map, 0.3 m
+    from a box: its interlock stops the wheels at the same cycles as the Amaranth design's."""
+    from fpga_robotics.hw.safe_follow import FollowTargetSafe
+    from fpga_robotics.hw.verilog import generate_verilog
+    from fpga_robotics.tops import build_component, get_top
+
+    scene = ['camera.resolution="40x30"', "sim.clock_hz=2e5", "sim.duration=0.5",
+             "robot.start=[2.05, 2.0]"]
+    builtin = load_scenario("obstacle_between", [*scene, "design.ultrasound.clock_hz=200000"])
+    component = build_component(get_top("follow_target_safe"), builtin.params,
+                                builtin.design_tables)
+    assert isinstance(component, FollowTargetSafe)
+    (tmp_path / "safe.v").write_text(generate_verilog(component=component))
+    (tmp_path / "safe.toml").write_text(SAFE_MAP % {"latency": builtin.params.motor_latency})
+    verilog = load_scenario("obstacle_between", [
+        *scene, 'design.top="follow_target"', f'design.verilog="{tmp_path}/safe.v"',
+        f'design.ports="{tmp_path}/safe.toml"'])
+    assert verilog.sim.timing == "real_clock"
+    theirs = run_scenario(verilog, backend="auto")
+    ours = run_scenario(builtin, backend="pysim")
+    # The interlock held the wheels: the box's face is 0.25 m ahead of the sensor.
+    assert ours.trajectory["design.obstacle"][-1] == 1
+    assert ours.trajectory["motor_left"][-1] == 0 == ours.trajectory["motor_right"][-1]
+    for key in ("x", "y", "heading", "motor_left", "motor_right", "found", "front.echo_edges"):
+        assert np.array_equal(theirs.trajectory[key], ours.trajectory[key], equal_nan=True), key
