@@ -205,6 +205,9 @@ def _open_pin_design(args, scenario):
             print(f"{text} ...", file=sys.stderr, flush=True)
 
     if scenario.foreign is not None:  # a Verilog design on pins: on Verilator
+        if args.runtime:
+            raise UsageError("--runtime changes [runtime] inputs between frames in compressed "
+                             "timing; in real-clock timing they keep the port map's values")
         try:
             return make_pin_backend(args.backend, scenario, on_build=tell)
         except (BackendError, PinError) as exc:

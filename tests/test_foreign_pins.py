@@ -200,6 +200,9 @@ def test_other_backends_and_compressed_timing_are_usage_errors(tmp_path, capsys)
                           "--rerun", "off"], capsys)
     assert code == 2 and len(err.strip().splitlines()) == 1
     assert "needs sim.timing = \"real_clock\"" in err
+    code, err = _run_cli(["--scenario", str(scenario), "--runtime", "mode=1", "--rerun", "off"],
+                         capsys)
+    assert code == 2 and "in real-clock timing they keep the port map's values" in err
 
 
 def test_parse_errors_name_the_key():

@@ -491,7 +491,8 @@ def main(argv=None):
     except PortMapError as exc:
         print(f"port_map: error: {exc}", file=sys.stderr)
         return 2
-    print(f"{args.path}: {port_map.top}, outputs {', '.join(port_map.outputs)}")
+    connectors = "".join(f", connectors.{kind}" for kind in port_map.connectors)
+    print(f"{args.path}: {port_map.top}, outputs {', '.join(port_map.outputs)}{connectors}")
     return 0
 
 
