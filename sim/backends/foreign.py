@@ -271,8 +271,21 @@ def wrapper_verilog(pm, ports, width, height, pins=False):
         body.append(f"  reg [{width - 1}:0] fr_sel;\n  always @* begin\n    case (color_sel)\n"
                     f"{cases}\n      default: fr_sel = {width}'d0;\n    endcase\n  end")
         conns.append(f".{pm.color_port}(fr_sel)")
+    # The pin loop reads the per-frame outputs when frame_done rises; the frame harness reads
+    # them `latency` edges after it (1 with after_cycles): on pins frame_done is delayed by
+    # as much, so that both read the same cycle's values.
+    delay = (pm.latency if pm.strobe else 1) if pins and pm.has_pixels else 0
+    done = "fr_result" if delay else "frame_done"
+    if delay:
+        body.append(
+            "  wire fr_result;\n  reg [31:0] fr_read;\n"
+            "  always @(posedge clk)\n"
+            "    if (rst) fr_read <= 32'd0;\n"
+            f"    else if (fr_result) fr_read <= 32'd{delay};\n"
+            "    else if (fr_read != 32'd0) fr_read <= fr_read - 32'd1;\n"
+            "  assign frame_done = fr_read == 32'd1;")
     if pm.strobe:
-        conns.append(f".{pm.strobe}(frame_done)")
+        conns.append(f".{pm.strobe}({done})")
     elif pm.has_pixels:
         # frame_done one cycle before the outputs are read (the harness reads them one edge
         # later: the backend's latency is 1), after_cycles edges after the last pixel's.
@@ -282,7 +295,7 @@ def wrapper_verilog(pm, ports, width, height, pins=False):
             "    if (rst) fr_wait <= 32'd0;\n"
             f"    else if (fr_end) fr_wait <= 32'd{pm.after_cycles};\n"
             "    else if (fr_wait != 32'd0) fr_wait <= fr_wait - 32'd1;\n"
-            "  assign frame_done = fr_wait == 32'd1;")
+            f"  assign {done} = fr_wait == 32'd1;")
     decls, header = [], []
     for key, (out_width, _) in (("found", (1, 0)), ("proximity", (16, 0)),
                                 ("centroid_x", (16, 0)), ("centroid_leds", (16, 0)),
