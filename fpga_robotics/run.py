@@ -458,6 +458,8 @@ def main(argv=None, prog="python -m fpga_robotics.run"):
 
     if args.seed is not None and not 0 <= args.seed <= MAX_SEED:
         raise UsageError(f"--seed must be in 0..{MAX_SEED}, got {args.seed}")
+    if args.log_every < 1:  # checked now, before a model is built
+        raise UsageError(f"--log-every must be >= 1, got {args.log_every}")
     if args.summary is not None:  # checked now, not after a long run
         check_output_path(args.summary, what="--summary")
     ros = RosOutputs(args)  # --bag, --live ...: checked now, not after a long run
