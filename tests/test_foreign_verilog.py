@@ -5,6 +5,7 @@ and bad port maps as one-line errors."""
 
 import numpy as np
 import pytest
+from renamed_design import RENAMED, RENAMED_MAP
 
 from fpga_robotics.hw.params import FollowTargetParams
 from fpga_robotics.hw.verilog import generate_verilog
@@ -40,43 +41,6 @@ centroid_x = "centroid_x"
 centroid_leds = "centroid_leds"
 motor_left = "motor_left"
 motor_right = "motor_right"
-"""
-
-# A wrapper with other names, an active-low reset, separate first/last flags, a 2-bit colour
-# code of its own and only three outputs.
-RENAMED = """\
-module robot_top (
-  input clock, input reset_n,
-  input px_valid, input [11:0] px_rgb, input px_sof, input px_eol,
-  input [1:0] colour,
-  output result_ready, output [7:0] leds,
-  output signed [15:0] left_dps, output signed [15:0] right_dps
-);
-  wire [2:0] sel = colour == 2'd0 ? 3'b100 : colour == 2'd1 ? 3'b010 : 3'b001;
-  wire fv; wire [13:0] fp; wire found; wire [2:0] prox; wire [%(xmsb)d:0] cx;
-  follow_target core (
-    .clk(clock), .rst(~reset_n), .pixels__valid(px_valid),
-    .pixels__payload({px_eol, px_sof, px_rgb}), .color_sel(sel),
-    .filtered__valid(fv), .filtered__payload(fp), .frame_done(result_ready),
-    .found(found), .proximity(prox), .centroid_x(cx), .centroid_leds(leds),
-    .motor_left(left_dps), .motor_right(right_dps)
-  );
-endmodule
-"""
-
-RENAMED_MAP = """\
-style = "stream"
-top = "robot_top"
-clock = { port = "clock" }
-reset = { port = "reset_n", active_low = true }
-pixels = { valid = "px_valid", data = "px_rgb", first = "px_sof", last = "px_eol" }
-color = { port = "colour", codes = { red = 0, green = 1, blue = 2 } }
-result = { strobe = "result_ready", latency = %(latency)d }
-
-[outputs]
-centroid_leds = "leds"
-motor_left = { port = "left_dps", width = 16, signed = true }
-motor_right = { port = "right_dps", width = 16, signed = true }
 """
 
 NEVER_DONE = """\
