@@ -8,8 +8,8 @@ import re
 
 import numpy as np
 
-__all__ = ["RESUME_CLOSING_M", "SENSOR_CHECKS", "line_metrics", "obstacle_metrics",
-           "sensor_check"]
+__all__ = ["CHECK_METRIC", "RESUME_CLOSING_M", "SENSOR_CHECKS", "line_metrics",
+           "obstacle_metrics", "sensor_check"]
 
 _DAY = 86400.0
 #: Following has resumed once the robot is this much closer to the target than when the last
@@ -28,6 +28,11 @@ SENSOR_CHECKS = {
                          (f"after the last piece of furniture is removed, the robot closes "
                          f"{RESUME_CLOSING_M} m on the target within this time")),
 }
+
+
+#: The metric each of ``SENSOR_CHECKS`` judges.
+CHECK_METRIC = {"max_lateral_error_m": "lateral_error_max_m", "min_laps": "laps",
+                "max_off_line_s": "off_line_s", "resumes_within_s": "resumed_after_s"}
 
 
 def line_metrics(traj, lines, mounts, period):
@@ -92,9 +97,7 @@ def sensor_check(name, limit, m):
                            f"the obstacle left at {t_r:.2f} s (limit {limit} s)")
         return v <= limit, (f"closed {RESUME_CLOSING_M} m on the target {v:.2f} s after the "
                             f"obstacle left (limit {limit} s)")
-    key = {"max_lateral_error_m": "lateral_error_max_m", "min_laps": "laps",
-           "max_off_line_s": "off_line_s"}[name]
-    v = m.get(key)
+    v = m.get(CHECK_METRIC[name])
     if v is None:
         return False, "not measured: the run has no floor line or no line sensors"
     if name == "max_lateral_error_m":

@@ -8,7 +8,7 @@ itself. ``format_summary`` is the human version printed by the runner.
 
 import numpy as np
 
-from .sensor_metrics import SENSOR_CHECKS, sensor_check
+from .sensor_metrics import CHECK_METRIC, SENSOR_CHECKS, sensor_check
 from .sim.world.config import MAX_TIME
 
 __all__ = [
@@ -521,9 +521,7 @@ def evaluate_checks(checks, m):
                     else f"turned {v:.1f} deg past the target (limit <= {limit} deg)")
         elif name in SENSOR_CHECKS:
             ok, text = sensor_check(name, limit, m)
-            v = m.get({"min_laps": "laps", "max_off_line_s": "off_line_s",
-                       "max_lateral_error_m": "lateral_error_max_m"}.get(name,
-                                                                         "resumed_after_s"))
+            v = m.get(CHECK_METRIC[name])
         elif name.startswith("max_") and name.endswith("_collisions"):
             kind = name[len("max_"): -len("_collisions")]
             v = int(m["collisions"].get(kind, 0))
