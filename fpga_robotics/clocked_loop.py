@@ -21,11 +21,10 @@ camera (``follow_line``) has its rows sampled at the camera's frame rate all the
 """
 
 import hashlib
-import math
 
 import numpy as np
 
-from .connectors import CONNECTORS, Mount, PinIO
+from .connectors import CONNECTORS, PinIO
 from .errors import UsageError
 from .loop import ClosedLoop
 from .sim.backends.base import FrameResult
@@ -327,7 +326,7 @@ class RealClockLoop(ClosedLoop):
         from .sensor_metrics import line_metrics
 
         mounts = [m for c in self.sensors if c.kind == "line_sensors"
-                  for m in _line_sensor_mounts(c)]
+                  for m in c.sensor_mounts]
         return {**super().extra_metrics(),
                 **line_metrics(self.traj, getattr(self.world, "floor_lines", ()), mounts,
                                self.period)}
@@ -337,11 +336,3 @@ class RealClockLoop(ClosedLoop):
         return {"timing": "real_clock", "clock_hz": self.clock_hz, "sim_cycles": cycles,
                 "cycles_per_wall_s": round(cycles / wall) if wall > 0 else None}
 
-
-def _line_sensor_mounts(conn):
-    """Each sensor of a line_sensors connector as a ``Mount`` on the robot (its offset
-    turned by the connector's yaw and added to the connector's mount)."""
-    m = conn.mount
-    c, s = math.cos(m.yaw), math.sin(m.yaw)
-    return [Mount(forward=m.forward + f * c - left * s, left=m.left + f * s + left * c,
-                  height=m.height, yaw=m.yaw) for f, left in conn.params.sensors]

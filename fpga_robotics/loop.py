@@ -22,6 +22,7 @@ from .hw.pixel import color_select_value
 from .shadow import ShadowComparison, divergence_event
 from .sim.camera import focal_length
 from .sim.records import FrameRecord
+from .sim.world import is_removal_event
 from .summary import DESIGN_OUTPUTS, compute_metrics, evaluate_checks, verdict
 
 __all__ = ["TRAJECTORY_FIELDS", "ClosedLoop", "RunResult", "frame_count", "make_backend",
@@ -291,8 +292,7 @@ class ClosedLoop:
         )
         if self.recorder is not None:
             update = getattr(self.recorder, "update_furniture", None)
-            if update is not None and any(e.startswith("furniture '") and e.endswith("' removed")
-                                          for e in events):
+            if update is not None and any(map(is_removal_event, events)):
                 update(self.world.world_map(), k, t)  # drawn without it from now on
             self.recorder.log_frame(record)
         if self.on_frame is not None:

@@ -539,7 +539,9 @@ def _set_path(data, key, value, shown):
 def _optional_keys(parents):
     """Keys that may be set although the file does not give them."""
     if len(parents) == 2 and parents[0] == "design" and parents[1] in _TOP_TABLES:
-        return _top_table_fields(parents[1])
+        from .tops import table_fields
+
+        return table_fields(parents[1])
     if len(parents) != 1:
         return ()
     section = parents[0]
@@ -880,13 +882,6 @@ def _top(design):
         return top, design_tables(spec, tables, design.get("variant"))
     except ValueError as exc:
         raise ScenarioError(str(exc)) from None
-
-
-def _top_table_fields(key):
-    """The fields of a design parameter table (``design.line`` ...), for ``--set``."""
-    from .tops import table_fields
-
-    return table_fields(key)
 
 
 def _connectors(world):

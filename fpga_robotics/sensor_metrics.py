@@ -4,9 +4,10 @@ gone. ``SENSOR_CHECKS`` joins ``summary.CHECKS``; ``sensor_check`` evaluates one
 """
 
 import math
-import re
 
 import numpy as np
+
+from .sim.world import is_removal_event
 
 __all__ = ["CHECK_METRIC", "RESUME_CLOSING_M", "SENSOR_CHECKS", "line_metrics",
            "obstacle_metrics", "sensor_check"]
@@ -15,7 +16,6 @@ _DAY = 86400.0
 #: Following has resumed once the robot is this much closer to the target than when the last
 #: obstacle left, m.
 RESUME_CLOSING_M = 0.2
-_REMOVED = re.compile(r"furniture '(.*)' removed")
 
 SENSOR_CHECKS = {
     "max_lateral_error_m": (float, (0, 100, "m"),
@@ -45,21 +45,20 @@ def line_metrics(traj, lines, mounts, period):
     n = len(traj["t"])
     if not lines or not mounts or n == 0:
         return none
-    errors, off, arcs = np.empty(n), 0, []
+    x, y, h = (np.asarray(traj[k], dtype=float) for k in ("x", "y", "heading"))
+    c, s = np.cos(h), np.sin(h)
+    # Every sensor's world position in every row (the geometry of ``Mount.world_pose``).
+    px = np.array([x + m.forward * c - m.left * s for m in mounts])
+    py = np.array([y + m.forward * s + m.left * c for m in mounts])
+    cx, cy = px.mean(axis=0), py.mean(axis=0)
+    errors = np.min([line.distance(cx, cy) for line in lines], axis=0)
+    on_line = np.any([line.covers(px.ravel(), py.ravel()).reshape(px.shape)
+                      for line in lines], axis=(0, 1))
+    off = int(np.count_nonzero(~on_line))
     track = next((line for line in lines if line.closed), None)
-    for k in range(n):
-        x, y, h = traj["x"][k], traj["y"][k], traj["heading"][k]
-        points = [m.world_pose(x, y, h)[:2] for m in mounts]
-        cx = sum(p[0] for p in points) / len(points)
-        cy = sum(p[1] for p in points) / len(points)
-        errors[k] = min(line.distance(cx, cy) for line in lines)
-        if not any(line.covers(px, py) for px, py in points for line in lines):
-            off += 1
-        if track is not None:
-            arcs.append(track.arc_position(cx, cy))
     laps = None
     if track is not None:
-        steps = np.diff(np.asarray(arcs))
+        steps = np.diff(track.arc_position(cx, cy))
         length = track.length
         steps = (steps + length / 2) % length - length / 2  # across the start: the short way
         laps = int(abs(float(steps.sum())) // length)
@@ -71,7 +70,7 @@ def line_metrics(traj, lines, mounts, period):
 def obstacle_metrics(traj, events):
     """``obstacle_removed_at_s`` (the last furniture removal) and ``resumed_after_s`` (from
     then until the robot is ``RESUME_CLOSING_M`` closer to the target; None if never)."""
-    removed = [t for _, t, text in events if _REMOVED.fullmatch(text)]
+    removed = [t for _, t, text in events if is_removal_event(text)]
     if not removed:
         return {"obstacle_removed_at_s": None, "resumed_after_s": None}
     t_r = max(removed)

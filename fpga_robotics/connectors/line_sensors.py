@@ -13,7 +13,7 @@ from dataclasses import dataclass, replace
 from typing import ClassVar
 
 from ..sim.line_sensor import KY033, KY033Params
-from .base import Connector, ConnectorError, Pin, check_number, register
+from .base import Connector, ConnectorError, Mount, Pin, check_number, register
 
 __all__ = ["LineSensorsConnector", "LineSensorsParams"]
 
@@ -50,6 +50,12 @@ class LineSensorsConnector(Connector):
         if mount.height > 0:  # the mount's height is the module's
             module = replace(module, height=mount.height)
         self.module = KY033(module, rng)  # one model reads every sensor (same settings)
+        #: Each sensor as a ``Mount`` on the robot: its offset turned by the connector's yaw
+        #: and added to the connector's mount (also what the line metrics follow).
+        c, s = math.cos(mount.yaw), math.sin(mount.yaw)
+        self.sensor_mounts = tuple(
+            Mount(forward=mount.forward + f * c - left * s, left=mount.left + f * s + left * c,
+                  height=mount.height, yaw=mount.yaw) for f, left in params.sensors)
         self.bits = 0
         self.positions = []
 
@@ -90,10 +96,8 @@ class LineSensorsConnector(Connector):
 
     def sensor_positions(self):
         """Each sensor's ``(x, y)`` in the world now."""
-        x, y, heading = self.mount.world_pose(*self.world.robot_pose())
-        c, s = math.cos(heading), math.sin(heading)
-        return [(x + f * c - left * s, y + f * s + left * c)
-                for f, left in self.params.sensors]
+        pose = self.world.robot_pose()
+        return [m.world_pose(*pose)[:2] for m in self.sensor_mounts]
 
     def read(self):
         """The bits (bit i = sensor i) over the floor under the sensors now."""

@@ -9,7 +9,7 @@ from .config import WORLD_SECTIONS, WorldConfigError, parse_world_config
 from .kinematics import dps_to_twist, twist_to_wheels, wheels_to_twist
 from .markings import FloorLine
 from .robots import GOPIGO3, ROBOT_MODELS, TURTLEBOT2, RobotSpec
-from .world import World
+from .world import World, is_removal_event, removal_event
 
 __all__ = [
     "GOPIGO3",
@@ -21,7 +21,9 @@ __all__ = [
     "World",
     "WorldConfigError",
     "dps_to_twist",
+    "is_removal_event",
     "parse_world_config",
+    "removal_event",
     "twist_to_wheels",
     "wheels_to_twist",
 ]

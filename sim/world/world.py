@@ -26,7 +26,17 @@ from .room import add_static_shapes, map_data, scene_walls
 from .terrain import TerrainMap, slope_pitch
 from .uncertainty import MotorUncertainty
 
-__all__ = ["AT_FAULT_SPEED", "MAX_SUBSTEP", "World"]
+__all__ = ["AT_FAULT_SPEED", "MAX_SUBSTEP", "World", "is_removal_event", "removal_event"]
+
+def removal_event(name):
+    """The event a piece of furniture leaving the room (``present_until``) gives."""
+    return f"furniture {name!r} removed"
+
+
+def is_removal_event(text):
+    """Whether an event text is a ``removal_event``."""
+    return text.startswith("furniture ") and text.endswith(" removed")
+
 
 #: ``step(dt)`` splits longer steps into equal sub-steps no longer than this, s.
 MAX_SUBSTEP = 0.01
@@ -309,7 +319,7 @@ class World:
             _, name = self._removals.pop(0)
             self.space.remove(self._furniture_shapes[name])
             self._removed.add(name)
-            self._events.append(f"furniture {name!r} removed")
+            self._events.append(removal_event(name))
         self._static_walls = scene_walls(self.config.room, self._removed)
         self._world_map = self._build_map()
 
