@@ -10,11 +10,11 @@ import math
 import numpy as np
 import pytest
 
-from fpga_robotics.loop import run_scenario
-from fpga_robotics.scenario import load_scenario
-from fpga_robotics.shadow import ShadowComparison
+from fpga_robotics.loop.compressed import run_scenario
+from fpga_robotics.scenario.load import load_scenario
+from fpga_robotics.loop.shadow import ShadowComparison
 from fpga_robotics.sim.backends import get_backend
-from fpga_robotics.summary import (
+from fpga_robotics.checks.summary import (
     DESIGN_OUTPUTS,
     compute_metrics,
     evaluate_checks,
@@ -160,7 +160,7 @@ def test_a_foreign_design_without_found_runs_from_the_command_line(tmp_path, cap
     """The user's path: `run --design verilog:... --ports` with a map that names no `found`,
     no centroid and no filtered stream; the JSON summary says absent, the text says n/a."""
     pytest.importorskip("fpga_robotics.sim.backends.foreign")
-    from fpga_robotics import run
+    from fpga_robotics.cli import run
     from fpga_robotics.hw.verilog import generate_verilog
     from fpga_robotics.sim.backends import BackendError
     from fpga_robotics.sim.backends import toolchain as tc

@@ -4,8 +4,8 @@ import json
 
 import pytest
 
-from fpga_robotics import bench
-from fpga_robotics.errors import UsageError
+from fpga_robotics.bench import design as bench
+from fpga_robotics.cli.errors import UsageError
 
 
 def test_bench_prints_and_writes_figures(tmp_path, capsys):

@@ -15,7 +15,7 @@ import pytest
 
 from fpga_robotics.hw.params import FollowTargetParams
 from fpga_robotics.hw.pixel import COLOR_SELECT
-from fpga_robotics.sim import synthetic
+from fpga_robotics.sim.camera import synthetic
 from fpga_robotics.sim.backends import BackendError, get_backend
 
 # Small geometries with thresholds low enough that their blobs reach every proximity level.
@@ -150,7 +150,7 @@ def test_compiled_backend_matches_model_at_160x120(name):
 
 @pytest.mark.parametrize("name", ["cxxrtl", "verilator"])
 def test_wrong_frames_give_clear_errors_and_change_nothing(name):
-    from fpga_robotics.sim.frames import FrameError
+    from fpga_robotics.sim.camera.frames import FrameError
 
     p = SMALL_A
     seq = frame_sequence(p, 2)[:3]

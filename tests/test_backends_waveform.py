@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from fpga_robotics.hw.params import FollowTargetParams
-from fpga_robotics.sim import synthetic
+from fpga_robotics.sim.camera import synthetic
 from fpga_robotics.sim.backends import BackendError, WaveformRequest, get_backend
 
 PARAMS = FollowTargetParams(

@@ -18,7 +18,7 @@ from fpga_robotics.hw.board.sccb import RegisterWrite, SCCBInit
 from fpga_robotics.hw.board.ulx3s_top import ULX3SFollowTarget
 from fpga_robotics.hw.divider import SequentialDivider
 from fpga_robotics.hw.params import FollowTargetParams
-from fpga_robotics.sim.model import FollowTargetModel
+from fpga_robotics.sim.models.follow_target import FollowTargetModel
 
 PARAMS = FollowTargetParams(width=48, height=16)
 TIMING = RobotTiming.from_cycles(xclk_half=2, sccb_quarter=2, spi_half=2, camera_wait=5,

@@ -10,14 +10,14 @@ import sys
 import pytest
 from amaranth.sim import Simulator
 
-from fpga_robotics.board_build import (
+from fpga_robotics.flow.board import (
     BuildReport,
     ClockTiming,
     export_board,
     main,
     parse_nextpnr_report,
 )
-from fpga_robotics.errors import UsageError
+from fpga_robotics.cli.errors import UsageError
 from fpga_robotics.hw.board.clocking import ecp5_pll_params
 from fpga_robotics.hw.board.color_select import SwitchColorSelect
 from fpga_robotics.hw.pixel import COLOR_SELECT
@@ -96,7 +96,7 @@ def test_switches_select_colour(switches, colour):
 
 
 def test_unknown_board_lists_supported_ones():
-    proc = subprocess.run([sys.executable, "-m", "fpga_robotics.board_build", "--board", "nope"],
+    proc = subprocess.run([sys.executable, "-m", "fpga_robotics.flow.board", "--board", "nope"],
                           capture_output=True, text=True, timeout=120, check=False)
     assert proc.returncode == 2
     assert "ulx3s-85f" in proc.stderr and "unknown board 'nope'" in proc.stderr
@@ -122,7 +122,7 @@ def test_report_parsing_and_timing_verdict():
 
 
 def test_export_cli_board_option(tmp_path):
-    from fpga_robotics.export import main as export_main
+    from fpga_robotics.flow.export import main as export_main
 
     assert export_main(["--board", "ulx3s-85f", "-o", str(tmp_path)]) == 0
     assert (tmp_path / "ulx3s_follow_target.v").stat().st_size > 10_000

@@ -8,9 +8,9 @@ import sys
 import numpy as np
 import pytest
 
-from fpga_robotics.sim.camera import CameraRenderer, render
-from fpga_robotics.sim.frames import to_rgb444, unpack_rgb444
-from fpga_robotics.sim.scene import Band, CameraPose, Cylinder, Lighting, Scene, Wall
+from fpga_robotics.sim.camera.raster import CameraRenderer, render
+from fpga_robotics.sim.camera.frames import to_rgb444, unpack_rgb444
+from fpga_robotics.sim.camera.scene import Band, CameraPose, Cylinder, Lighting, Scene, Wall
 
 HFOV = 1.047
 FLAT = Lighting(ambient=1.0, intensity=0.0)  # colours come out as 255 * albedo
@@ -408,7 +408,7 @@ def test_red_shirt_of_the_default_person_passes_the_red_filter():
 
 
 def test_red_filter_of_the_golden_model_agrees():
-    model = pytest.importorskip("fpga_robotics.sim.model")
+    model = pytest.importorskip("fpga_robotics.sim.models.follow_target")
     from fpga_robotics.hw.params import FollowTargetParams
     from fpga_robotics.hw.pixel import COLOR_SELECT
     from fpga_robotics.sim.world import World
@@ -486,7 +486,7 @@ def test_renderer_sizes_must_be_integers(args, match):
 
 
 def test_tilt_and_field_of_view_limits_by_hand():
-    from fpga_robotics.sim.camera import VERTICAL_MARGIN, max_hfov, max_tilt, vertical_fov
+    from fpga_robotics.sim.camera.raster import VERTICAL_MARGIN, max_hfov, max_tilt, vertical_fov
 
     # A square image sees as far vertically as horizontally.
     assert vertical_fov(100, 100, math.pi / 2) == pytest.approx(math.pi / 2)
@@ -512,7 +512,7 @@ def test_the_renderer_draws_exactly_up_to_max_tilt(w, h, hfov):
 
 
 def max_tilt_of(w, h, hfov):
-    from fpga_robotics.sim.camera import max_tilt
+    from fpga_robotics.sim.camera.raster import max_tilt
 
     return max_tilt(w, h, hfov)
 
@@ -548,8 +548,8 @@ def test_bad_pose_and_scene():
 
 
 def test_benchmark_cli_prints_a_line_per_size(capsys):
-    from fpga_robotics.camera_bench import main
-    from fpga_robotics.errors import UsageError
+    from fpga_robotics.bench.camera import main
+    from fpga_robotics.cli.errors import UsageError
 
     assert main(["--frames", "2", "--repeats", "1", "--sizes", "32x24,40x30"]) == 0
     lines = capsys.readouterr().out.strip().splitlines()
@@ -562,12 +562,12 @@ def test_benchmark_cli_prints_a_line_per_size(capsys):
 
 
 @pytest.mark.parametrize("module,args,message", [
-    ("fpga_robotics.sim.camera_bench", ["--sizes", "160by120"],
-     "python -m fpga_robotics.camera_bench: error: a size is WIDTHxHEIGHT, e.g. 160x120; got '160by120'"),
-    ("fpga_robotics.camera_bench", ["--frames", "0"],
-     "python -m fpga_robotics.camera_bench: error: --frames must be 1..100000 and --repeats 1..1000, got 0 and 5"),
-    ("fpga_robotics.camera_bench", ["--noise", "1e300"],
-     "python -m fpga_robotics.camera_bench: error: --noise must be a number of 8-bit levels in 0..64, got 1e+300"),
+    ("fpga_robotics.bench.camera", ["--sizes", "160by120"],
+     "python -m fpga_robotics.bench.camera: error: a size is WIDTHxHEIGHT, e.g. 160x120; got '160by120'"),
+    ("fpga_robotics.bench.camera", ["--frames", "0"],
+     "python -m fpga_robotics.bench.camera: error: --frames must be 1..100000 and --repeats 1..1000, got 0 and 5"),
+    ("fpga_robotics.bench.camera", ["--noise", "1e300"],
+     "python -m fpga_robotics.bench.camera: error: --noise must be a number of 8-bit levels in 0..64, got 1e+300"),
 ])
 def test_benchmark_command_line_reports_bad_arguments_in_one_line(module, args, message):
     # The library module is an alias of the command line in the application layer.

@@ -5,10 +5,10 @@ import math
 import numpy as np
 import pytest
 
-from fpga_robotics.sim.camera import CameraRenderer
-from fpga_robotics.sim.camera_bench import camera_loop, typical_scene
-from fpga_robotics.sim.camera_kernel import camera_kernel
-from fpga_robotics.sim.scene import CameraPose, Scene
+from fpga_robotics.sim.camera.raster import CameraRenderer
+from fpga_robotics.bench.camera_frames import camera_loop, typical_scene
+from fpga_robotics.sim.camera.kernel import camera_kernel
+from fpga_robotics.sim.camera.scene import CameraPose, Scene
 
 
 def _have_compiler():
@@ -98,7 +98,7 @@ def test_bad_noise_arguments_are_the_same_errors():
 def random_room(rng):
     """Walls in every direction (some parallel to columns' rays), people with bands, one of
     them around the camera now and then."""
-    from fpga_robotics.sim.scene import Band, Cylinder, Lighting, Wall
+    from fpga_robotics.sim.camera.scene import Band, Cylinder, Lighting, Wall
 
     walls = []
     for _ in range(int(rng.integers(0, 12))):

@@ -7,10 +7,10 @@ import math
 import numpy as np
 import pytest
 
-from fpga_robotics.connectors.camera import DRIFT_TAU, CameraConnector, ExposureDrift
-from fpga_robotics.loop import run_scenario
-from fpga_robotics.scenario import ScenarioError, load_scenario
-from fpga_robotics.sim.camera import focal_length
+from fpga_robotics.loop.connectors.camera import DRIFT_TAU, CameraConnector, ExposureDrift
+from fpga_robotics.loop.compressed import run_scenario
+from fpga_robotics.scenario.load import ScenarioError, load_scenario
+from fpga_robotics.sim.camera.raster import focal_length
 
 
 def test_the_yaw_offset_turns_the_camera_and_the_pitch_adds_to_the_tilt():

@@ -3,7 +3,7 @@ as docs/running.md states, so a metric equal to it passes and the next value out
 
 import pytest
 
-from fpga_robotics.summary import evaluate_checks
+from fpga_robotics.checks.summary import evaluate_checks
 
 #: Metrics of a run that passes everything comfortably.
 GOOD = {

@@ -10,7 +10,7 @@ import tomllib
 import numpy as np
 import pytest
 
-from fpga_robotics.connectors.base import (
+from fpga_robotics.loop.connectors.base import (
     CONNECTORS,
     ConnectorError,
     Mount,
@@ -18,8 +18,8 @@ from fpga_robotics.connectors.base import (
     connector_class,
     parse_mount,
 )
-from fpga_robotics.connectors.line_sensors import LineSensorsConnector
-from fpga_robotics.connectors.ultrasound import UltrasoundConnector
+from fpga_robotics.loop.connectors.line_sensors import LineSensorsConnector
+from fpga_robotics.loop.connectors.ultrasound import UltrasoundConnector
 from fpga_robotics.sim.world import World
 
 F = 50e6

@@ -468,7 +468,7 @@ PLANS = {
     "python -m fpga_robotics.run --scenario follow_person --rerun save:out/run.rrd":
         Plan(viewer=True, files=("out/run.rrd",),
              out=(r"saved \d+ frames .* to out/run\.rrd",)),
-    "python -m fpga_robotics.viz.bench":
+    "python -m fpga_robotics.bench.viewer":
         Plan(shorter=(("--frames", "2"), ("--repeats", "1")),
              out=(r"160x120: wall median", r"640x480: wall median")),
     # docs/foreign.md: your own Verilog design -----------------------------------------------
@@ -525,7 +525,7 @@ PLANS = {
     "python -m fpga_robotics.sweep mutation --seeds 0-19 --out runs/sweeps/mutation-20":
         Plan(shorter=(("--max-runs", "2"), ("--backend", "model"), ("--duration", "2")),
              files=("runs/sweeps/mutation-20/report.html",), out=(r"2 runs: 2 pass",)),
-    "python -m fpga_robotics.sim.backends.foreign_bench":
+    "python -m fpga_robotics.bench.foreign":
         Plan(shorter=(("--frames", "2"), ("--repeats", "1")),
              out=(r"verilator \(built-in\) +[\d.]+ ms/frame",
                   r"foreign follow_target \(stream\) +[\d.]+ ms/frame +\([\d.]+x the built-in\)")),
@@ -546,7 +546,7 @@ PLANS = {
              out=(r"(?i)sync.*MHz",)),
     ("python -m fpga_robotics.run --design verilog:design_top.v,centroid.v,color_proc.v,"
      "frame_buffer.v,motor_ctrl_spi.v --ports \"$(python -c 'import fpga_robotics, pathlib; "
-     "print(pathlib.Path(fpga_robotics.__file__).parent / \"port_maps/published_design_top.toml"
+     "print(pathlib.Path(fpga_robotics.__file__).parent / \"designs/port_maps/published_design_top.toml"
      "\")')\" --rerun off --shadow published --shadow-backend model"):
         Plan(excused="runs the published RTL, which this project does not ship (third-party "
                      "files); the shipped port map is read by test_foreign_verilog.py"),
@@ -628,21 +628,21 @@ PLANS = {
         Plan(excused="needs the published FPGA-Robotics RTL in /tmp/published, which is not part "
                      "of the project (docs/foreign.md says where it is); "
                      "tests/test_backends_bench.py runs the option's checks"),
-    "python -m fpga_robotics.loop_bench --backend cxxrtl --duration 10 --repeats 3":
+    "python -m fpga_robotics.bench.loop --backend cxxrtl --duration 10 --repeats 3":
         Plan(shorter=(("--duration", "1"), ("--repeats", "1")),
              out=(r"closed loop 160x120: follow_person, cxxrtl",
                   r"closed loop 640x480: follow_person, cxxrtl",
                   r"the loop against the design alone, CPU time: whole [\d.]+x",
                   r"target 640x480: [\d.]+x real time by CPU time")),
-    "python -m fpga_robotics.loop_bench --backend cxxrtl --resolutions 160x120 --profile 12":
+    "python -m fpga_robotics.bench.loop --backend cxxrtl --resolutions 160x120 --profile 12":
         Plan(shorter=(("--duration", "1"), ("--repeats", "1")),
              out=(r"cProfile of one run, 12 functions of largest own time",
                   r"tottime")),
-    "python -m fpga_robotics.camera_bench":
+    "python -m fpga_robotics.bench.camera":
         Plan(shorter=(("--frames", "2"), ("--repeats", "1")),
              out=(r"(?m)^\s*160x120\s+[\d.]+", r"(?m)^\s*640x480\s+[\d.]+")),
     # docs/pins.md -------------------------------------------------------------------------------
-    "python -m fpga_robotics.pin_bench":
+    "python -m fpga_robotics.bench.pins":
         Plan(shorter=(("--seconds", "0.02"), ("--pysim-seconds", "0.0002"), ("--repeats", "1")),
              out=((r"(?m)^cxxrtl +pins: +[\d.]+ Mcycles/s \(1,000,000 cycles, 1 frames, \d+ stops "
                   r"a run\); frame path [\d.]+ Mcycles/s, pins/frame [\d.]+ \(median of the runs' "
@@ -650,10 +650,10 @@ PLANS = {
                   r"(?m)^verilator +pins: +[\d.]+ Mcycles/s",
                   r"(?m)^pysim +pins: +[\d.]+ Mcycles/s \(10,000 cycles")),
     # docs/camera.md: the sensor model ---------------------------------------------------------
-    "python -m fpga_robotics.camera_bench --sensor --sizes 160x120,640x480":
+    "python -m fpga_robotics.bench.camera --sensor --sizes 160x120,640x480":
         Plan(shorter=(("--frames", "2"), ("--repeats", "1")),
              out=(r"(?m)^\s*160x120(\s+[\d.]+){9}$", r"(?m)^\s*640x480(\s+[\d.]+){9}$")),
-    "python -m fpga_robotics.camera_bench --stage-images docs/images":
+    "python -m fpga_robotics.bench.camera --stage-images docs/images":
         Plan(files=tuple(f"docs/images/sensor_stage_{i}.png" for i in range(7)),
              out=(r"sensor_stage_6\.png: RGB444",)),
     "python -m fpga_robotics.run --scenario divider --backend cxxrtl --set camera.sensor=ov7670":
@@ -702,7 +702,7 @@ PLANS = {
              out=(r"source bag:robot_bag:/camera/image_raw \(bag\)",
                   r"target found in 30 frames",
                   r"ROS 2 bag \(30 frames\) written to runs/robot_outputs")),
-    "python -m fpga_robotics.ros.bench":
+    "python -m fpga_robotics.bench.ros":
         Plan(shorter=(("--frames", "2"), ("--repeats", "1")),
              out=(r"bag  \(--bag\): log_frame median [\d.]+ ms",
                   (r"live \(--live foxglove, one client\): log_frame median [\d.]+ ms; "
@@ -712,7 +712,7 @@ PLANS = {
         Plan(out=(PASS,)),
     "python -m pytest -q tests/test_render3d_agreement.py tests/test_render3d_people.py":
         Plan(collect=True, out=(r"\d+ tests collected",)),
-    "python -m fpga_robotics.render3d_figures docs/figures":
+    "python -m fpga_robotics.bench.render3d_figures docs/figures":
         Plan(files=("docs/figures/divider_3d.png", "docs/figures/lighting_3d.png"),
              out=(r"wrote docs/figures/divider_3d\.png",)),
     "python -m fpga_robotics.run --scenario divider_3d --rerun off":
@@ -735,7 +735,7 @@ PLANS = {
              duration_why="dusk falls by 8 s; by 16 s the person has been lost long enough to "
                           "fail found_min_fraction",
              out=(r"\[FAIL\] found_min_fraction",)),
-    "python -m fpga_robotics.render3d_bench":
+    "python -m fpga_robotics.bench.render3d":
         Plan(shorter=(("--frames", "2"), ("--repeats", "1"), ("--seconds", "0.5"),
                       ("--backend", "model")),
              out=(r"(?m)^\s*raster\s+[\d.]+\s+[\d.]+\s+[\d.]+",
@@ -1088,7 +1088,7 @@ def _model_result(frame, params, **kwargs):
 def snippet_readme_backends(tmp_path, capsys):
     """README: the frame API on Verilator; what it shows equals the golden model's result."""
     from fpga_robotics.hw.params import FollowTargetParams
-    from fpga_robotics.sim.synthetic import blob_frame
+    from fpga_robotics.sim.camera.synthetic import blob_frame
 
     frame = blob_frame(160, 120, "red", rng=1)
     ns = {"rgb888_image": frame}
@@ -1106,7 +1106,7 @@ def snippet_readme_backends(tmp_path, capsys):
 def snippet_backends_api(tmp_path, capsys):
     """docs/backends.md: the fastest backend at 320x240 with blanking equals the model."""
     from fpga_robotics.hw.params import FollowTargetParams
-    from fpga_robotics.sim.synthetic import blob_frame
+    from fpga_robotics.sim.camera.synthetic import blob_frame
 
     frame = blob_frame(320, 240, "red", rng=2)
     ns = {"rgb_frame": frame}
@@ -1123,7 +1123,7 @@ def snippet_backends_waveform(tmp_path, capsys):
     existing ``out/`` (a missing directory is an error, as the page says)."""
     from fpga_robotics.hw.params import FollowTargetParams
     from fpga_robotics.sim.backends import WaveformRequest, get_backend
-    from fpga_robotics.sim.synthetic import blob_frame
+    from fpga_robotics.sim.camera.synthetic import blob_frame
 
     (tmp_path / "out").mkdir()
     ns = {"get_backend": get_backend, "WaveformRequest": WaveformRequest,
@@ -1145,8 +1145,8 @@ def snippet_backends_waveform(tmp_path, capsys):
 def snippet_camera(tmp_path, capsys):
     """docs/camera.md: the renderer on a real scene and camera pose; the cached ``render`` gives
     the same image as the renderer without noise."""
-    from fpga_robotics.scenario import load_scenario
-    from fpga_robotics.sim.camera import CameraRenderer
+    from fpga_robotics.scenario.load import load_scenario
+    from fpga_robotics.sim.camera.raster import CameraRenderer
     from fpga_robotics.sim.world import World
 
     world = World.from_config(load_scenario("follow_person").world, 0)
@@ -1178,8 +1178,8 @@ def snippet_running(tmp_path, capsys):
 def snippet_viewer(tmp_path, capsys):
     """docs/viewer.md: a recorder fed a world's map and a run's frame records; the file gets
     its real name and the last notice says how to open it."""
-    from fpga_robotics.loop import run_scenario
-    from fpga_robotics.scenario import load_scenario
+    from fpga_robotics.loop.compressed import run_scenario
+    from fpga_robotics.scenario.load import load_scenario
     from fpga_robotics.sim.world import World
 
     scenario = load_scenario("follow_person", ["sim.duration=1"])
@@ -1246,7 +1246,7 @@ def snippet_pins(tmp_path, capsys):
     result_latency edges after the last pixel, the outputs are the golden model's."""
     from fpga_robotics.hw.params import FollowTargetParams
     from fpga_robotics.sim.pins import Stop, real_clock_timing
-    from fpga_robotics.sim.synthetic import blob_frame
+    from fpga_robotics.sim.camera.synthetic import blob_frame
 
     frame = blob_frame(160, 120, "red", rng=1)
     shown = yield {"rgb888_image": frame}
@@ -1264,7 +1264,7 @@ def snippet_pins(tmp_path, capsys):
 #: assumes, is sent the values of its bare expressions, and checks them.
 def snippet_connectors_own_design(tmp_path, capsys):
     """docs/connectors.md: a design of one's own with the bumper stops short of the wall."""
-    from fpga_robotics.tops import TOPS
+    from fpga_robotics.designs.builtin import TOPS
 
     shown = yield {}
     try:

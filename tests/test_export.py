@@ -8,7 +8,7 @@ import sys
 
 import pytest
 
-from fpga_robotics.export import main
+from fpga_robotics.flow.export import main
 from fpga_robotics.hw.params import FollowTargetParams
 from fpga_robotics.hw.verilog import generate_verilog
 from fpga_robotics.sim.backends.toolchain import verilator_root
@@ -93,7 +93,7 @@ def test_verilator_lints_the_export_cleanly(tmp_path, params):
 def test_cli_writes_one_file_and_creates_the_directory(tmp_path, capsys):
     out = tmp_path / "new" / "dir" / "ft.v"
     with pytest.raises(SystemExit) as exit_info:
-        from fpga_robotics.errors import run_cli
+        from fpga_robotics.cli.errors import run_cli
 
         run_cli(main, ["-o", str(out), "--width", "320", "--height", "240", "--kp-num", "2",
                        "--base-dps", "0,100,90,80,70,60,-10,-20"])

@@ -6,8 +6,8 @@ import math
 import numpy as np
 import pytest
 
-from fpga_robotics.sim.camera import CameraRenderer, focal_length
-from fpga_robotics.sim.scene import Band, CameraPose, Cylinder, Lighting, Scene, Wall
+from fpga_robotics.sim.camera.raster import CameraRenderer, focal_length
+from fpga_robotics.sim.camera.scene import Band, CameraPose, Cylinder, Lighting, Scene, Wall
 
 W, H, HFOV = 160, 120, 1.047
 LIGHT = Lighting(ambient=0.6, intensity=0.5, direction=(1.0, 0.5, -1.0))
@@ -88,7 +88,7 @@ def test_the_world_draws_its_coloured_terrain():
 
 
 def test_triangulation_covers_any_simple_polygon():
-    from fpga_robotics.sim.render3d.floor_patches import triangulate
+    from fpga_robotics.sim.camera.render3d.floor_patches import triangulate
 
     def area(poly):
         return abs(sum(x0 * y1 - x1 * y0 for (x0, y0), (x1, y1)
@@ -109,7 +109,7 @@ def test_triangulation_covers_any_simple_polygon():
 
 
 def test_the_3d_model_has_one_flat_mesh_per_triangle():
-    from fpga_robotics.sim.render3d.floor_patches import LIFT, patch_assets_and_geoms
+    from fpga_robotics.sim.camera.render3d.floor_patches import LIFT, patch_assets_and_geoms
 
     scene = _scene(floor_patches=(PATCH, (((0, 0), (3, 0), (3, 1), (1, 1), (1, 3), (0, 3)),
                                           (0.2, 0.3, 0.9))))

@@ -18,12 +18,12 @@ from amaranth.lib import wiring
 from amaranth.lib.wiring import In, Out
 from renamed_design import RENAMED, RENAMED_MAP
 
-from fpga_robotics.errors import run_cli
-from fpga_robotics.loop import run_scenario
-from fpga_robotics.run import main as run_main
-from fpga_robotics.scenario import load_scenario
+from fpga_robotics.cli.errors import run_cli
+from fpga_robotics.loop.compressed import run_scenario
+from fpga_robotics.cli.run import main as run_main
+from fpga_robotics.scenario.load import load_scenario
 from fpga_robotics.sim.backends.port_map import PortMapError, parse_port_map
-from fpga_robotics.tops import TOPS, Top, register_top
+from fpga_robotics.designs.builtin import TOPS, Top, register_top
 
 DATA = Path(__file__).parent / "data"
 VERILOG = DATA / "bump_stop.v"
@@ -124,7 +124,7 @@ def test_the_verilog_design_drives_exactly_as_its_amaranth_twin(verilog_run, tmp
 
 
 def test_a_verilog_design_runs_on_verilator_only(tmp_path):
-    from fpga_robotics.clocked_loop import pin_design_source
+    from fpga_robotics.loop.real_clock import pin_design_source
     from fpga_robotics.sim.pins import PinError, get_pin_backend
 
     source = pin_design_source(_scenario(tmp_path, VERILOG_DESIGN, duration=0.1))
@@ -270,7 +270,7 @@ def test_a_camera_and_ultrasound_design_in_verilog_stops_as_follow_target_safe(t
     from a box: its interlock stops the wheels at the same cycles as the Amaranth design's."""
     from fpga_robotics.hw.safe_follow import FollowTargetSafe
     from fpga_robotics.hw.verilog import generate_verilog
-    from fpga_robotics.tops import build_component, get_top
+    from fpga_robotics.designs.builtin import build_component, get_top
 
     scene = ['camera.resolution="40x30"', "sim.clock_hz=2e5", "sim.duration=0.5",
              "robot.start=[2.05, 2.0]"]

@@ -9,7 +9,7 @@ from renamed_design import RENAMED, RENAMED_MAP
 
 from fpga_robotics.hw.params import FollowTargetParams
 from fpga_robotics.hw.verilog import generate_verilog
-from fpga_robotics.sim import synthetic
+from fpga_robotics.sim.camera import synthetic
 from fpga_robotics.sim.backends import BackendError, get_backend
 from fpga_robotics.sim.backends.port_map import PortMapError
 
@@ -231,7 +231,7 @@ def test_bad_port_maps_are_one_line_errors(files, text, message):
 
 @pytest.mark.parametrize("top, ports", [("robot_top", "robot"), ("fb_top", "fb")])
 def test_cli_runs_a_foreign_design_in_closed_loop(files, capsys, top, ports):
-    from fpga_robotics import run
+    from fpga_robotics.cli import run
 
     argv = ["--resolution", "80x60", "--duration", "1", "--rerun", "off", "--quiet",
             "--summary", str(files / f"{top}.json")]
@@ -279,8 +279,8 @@ def test_cli_runs_a_foreign_design_in_closed_loop(files, capsys, top, ports):
     ],
 )
 def test_cli_bad_designs_exit_2_with_one_line(files, capsys, argv, message):
-    from fpga_robotics import run
-    from fpga_robotics.errors import run_cli
+    from fpga_robotics.cli import run
+    from fpga_robotics.cli.errors import run_cli
 
     argv = [a.replace("{dir}", str(files)) for a in argv]
     with pytest.raises(SystemExit) as info:
@@ -572,7 +572,7 @@ def test_the_shipped_map_of_the_published_design_reads():
 
     from fpga_robotics.sim.backends.port_map import load_port_map
 
-    path = resources.files("fpga_robotics") / "port_maps" / "published_design_top.toml"
+    path = resources.files("fpga_robotics.designs") / "port_maps" / "published_design_top.toml"
     pm = load_port_map(str(path))
     assert (pm.style, pm.top, pm.strobe, pm.constants) == (
         "framebuffer", "design_top", "new_centroid", {"addrout": 0})

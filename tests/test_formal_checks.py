@@ -4,7 +4,7 @@ of docs/formal.md are proved (prove), hold to the depth searched (bmc), or are r
 
 import pytest
 
-from fpga_robotics.formal import run_check
+from fpga_robotics.flow.formal import run_check
 from fpga_robotics.hw.formal import CHECKS
 
 pytestmark = pytest.mark.formal

@@ -7,8 +7,8 @@ import pytest
 from mutants import mutant
 
 import fpga_robotics.hw.formal as formal_checks
-from fpga_robotics import formal
-from fpga_robotics.errors import run_cli
+from fpga_robotics.flow import formal
+from fpga_robotics.cli.errors import run_cli
 from fpga_robotics.hw.formal import CHECKS, FormalCheck, check_named
 from fpga_robotics.hw.formal.sizes import FULL_SIZES
 from fpga_robotics.hw.motor import MotorController

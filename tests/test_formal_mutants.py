@@ -10,7 +10,7 @@ short, a FIFO that is never read."""
 import pytest
 from mutants import mutant
 
-from fpga_robotics.formal import run_check
+from fpga_robotics.flow.formal import run_check
 from fpga_robotics.hw.board.gopigo3_spi import SPIByteMaster
 from fpga_robotics.hw.board.ov7670_capture import OV7670Capture
 from fpga_robotics.hw.board.sccb import SCCBInit

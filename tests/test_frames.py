@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from fpga_robotics.sim.frames import FrameError, rgb444_to_rgb888, to_rgb444, unpack_rgb444
+from fpga_robotics.sim.camera.frames import FrameError, rgb444_to_rgb888, to_rgb444, unpack_rgb444
 
 
 def test_rgb888_keeps_the_top_four_bits_of_each_channel():

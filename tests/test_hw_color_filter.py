@@ -21,7 +21,7 @@ from scalar_reference import scalar_match
 from fpga_robotics.hw.color_filter import ColorFilter
 from fpga_robotics.hw.params import FollowTargetParams
 from fpga_robotics.hw.pixel import COLOR_SELECT
-from fpga_robotics.sim.model import match_table
+from fpga_robotics.sim.models.follow_target import match_table
 
 ALL_PIXELS = np.arange(4096, dtype=np.uint16)
 

@@ -11,7 +11,7 @@ from hwsim import WithReset, run_testbench
 from fpga_robotics.hw.follow_line import FollowLine
 from fpga_robotics.hw.sensor_params import FollowLineParams
 from fpga_robotics.hw.variants import variant_params
-from fpga_robotics.sim.follow_line_model import FollowLineModel, action, wheel_command
+from fpga_robotics.sim.models.follow_line import FollowLineModel, action, wheel_command
 from fpga_robotics.sim.world.robots import GOPIGO3
 
 

@@ -10,7 +10,7 @@ import pytest
 
 from fpga_robotics.hw.sensor_params import FollowLineParams
 from fpga_robotics.hw.variants import variant_params
-from fpga_robotics.sim.follow_line_model import action, wheel_command
+from fpga_robotics.sim.models.follow_line import action, wheel_command
 from fpga_robotics.sim.world.robots import GOPIGO3
 
 #: Track: a 3 m x 2 m rounded rectangle, corner radii in driving order (counter-clockwise).

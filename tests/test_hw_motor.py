@@ -8,7 +8,7 @@ from hwsim import WithReset, run_testbench, small_params
 
 from fpga_robotics.hw.motor import MotorController
 from fpga_robotics.hw.params import FollowTargetParams
-from fpga_robotics.sim.model import MotorModel, TrackerResult
+from fpga_robotics.sim.models.follow_target import MotorModel, TrackerResult
 
 
 def tracker_result(found, proximity, centroid_x, leds=0):

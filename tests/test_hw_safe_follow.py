@@ -11,10 +11,10 @@ from fpga_robotics.hw.pixel import COLOR_SELECT
 from fpga_robotics.hw.safe_follow import FollowTargetSafe
 from fpga_robotics.hw.sensor_params import DISTANCE_NONE, InterlockParams, UltrasoundParams
 from fpga_robotics.hw.variants import variant_params
-from fpga_robotics.sim import synthetic
-from fpga_robotics.sim.frames import to_rgb444
-from fpga_robotics.sim.model import FollowTargetModel
-from fpga_robotics.sim.ultrasound_model import InterlockModel, Measurement, UltrasoundModel
+from fpga_robotics.sim.camera import synthetic
+from fpga_robotics.sim.camera.frames import to_rgb444
+from fpga_robotics.sim.models.follow_target import FollowTargetModel
+from fpga_robotics.sim.models.ultrasound_driver import InterlockModel, Measurement, UltrasoundModel
 
 US = UltrasoundParams(clock_hz=1_000_000, period_us=2400, wait_us=500, max_range_mm=300)
 LOCK = InterlockParams(stop_mm=120, resume_mm=200)

@@ -17,9 +17,9 @@ from hwsim import (
 from fpga_robotics.hw.params import FollowTargetParams
 from fpga_robotics.hw.pixel import COLOR_SELECT
 from fpga_robotics.hw.top import FollowTarget
-from fpga_robotics.sim import synthetic
-from fpga_robotics.sim.frames import to_rgb444
-from fpga_robotics.sim.model import FollowTargetModel
+from fpga_robotics.sim.camera import synthetic
+from fpga_robotics.sim.camera.frames import to_rgb444
+from fpga_robotics.sim.models.follow_target import FollowTargetModel
 
 COLOURS = [c for c in COLOR_SELECT if c != "none"]
 

@@ -14,7 +14,7 @@ from hwsim import (
 
 from fpga_robotics.hw.params import FollowTargetParams
 from fpga_robotics.hw.tracker import FrameTracker
-from fpga_robotics.sim.model import TrackerResult, track_frame
+from fpga_robotics.sim.models.follow_target import TrackerResult, track_frame
 
 RESULTS = ("found", "proximity", "centroid_x", "centroid_leds")
 

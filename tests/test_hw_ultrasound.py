@@ -8,7 +8,7 @@ from hwsim import run_testbench
 from fpga_robotics.hw.sensor_params import DISTANCE_NONE, UltrasoundParams
 from fpga_robotics.hw.ultrasound import UltrasoundDriver
 from fpga_robotics.hw.variants import variant_params
-from fpga_robotics.sim.ultrasound_model import Measurement, UltrasoundModel, echo_cycles_of
+from fpga_robotics.sim.models.ultrasound_driver import Measurement, UltrasoundModel, echo_cycles_of
 
 #: A 1 MHz clock and a 2.4 ms period keep pysim fast: T = 12, W = 500, M = 1749 cycles.
 SMALL = {"clock_hz": 1_000_000, "period_us": 2400, "wait_us": 500, "max_range_mm": 300}

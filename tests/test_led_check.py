@@ -4,7 +4,7 @@
 import numpy as np
 import pytest
 
-from fpga_robotics.summary import compute_metrics, evaluate_checks
+from fpga_robotics.checks.summary import compute_metrics, evaluate_checks
 
 W = 160
 

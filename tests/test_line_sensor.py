@@ -7,9 +7,9 @@ import math
 import numpy as np
 import pytest
 
-from fpga_robotics.connectors.base import Mount
-from fpga_robotics.connectors.line_sensors import LineSensorsConnector
-from fpga_robotics.sim.line_sensor import KY033, KY033Params, luminance, spot_offsets
+from fpga_robotics.loop.connectors.base import Mount
+from fpga_robotics.loop.connectors.line_sensors import LineSensorsConnector
+from fpga_robotics.sim.world.line_sensor import KY033, KY033Params, luminance, spot_offsets
 from fpga_robotics.sim.world import World
 from fpga_robotics.sim.world.kinematics import DEG
 

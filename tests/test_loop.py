@@ -5,11 +5,11 @@ import math
 import numpy as np
 import pytest
 
-from fpga_robotics.loop import TRAJECTORY_FIELDS, run_scenario
-from fpga_robotics.scenario import load_scenario
+from fpga_robotics.loop.compressed import TRAJECTORY_FIELDS, run_scenario
+from fpga_robotics.scenario.load import load_scenario
 from fpga_robotics.sim.backends.model import ModelBackend
 from fpga_robotics.sim.world.kinematics import dps_to_twist
-from fpga_robotics.summary import TIMING_FIELDS
+from fpga_robotics.checks.summary import TIMING_FIELDS
 
 CONTACT = 0.177 + 0.2  # TurtleBot2 body radius + person radius, m
 
@@ -218,7 +218,7 @@ def test_a_compiled_backend_drives_the_robot_exactly_as_the_model_does():
 
 
 def test_camera_pose_and_field_of_view_geometry():
-    from fpga_robotics.connectors import camera_pose, in_view
+    from fpga_robotics.loop.connectors import camera_pose, in_view
 
     pose = camera_pose((1.0, 2.0, math.pi / 2), height=0.3, forward=0.1, tilt=0.05)
     assert (pose.x, pose.y, pose.height, pose.tilt) == pytest.approx((1.0, 2.1, 0.3, 0.05))
@@ -262,7 +262,7 @@ def test_the_steering_gain_grows_with_the_resolution():
 def test_camera_mount_defaults_to_the_robots_own(robot):
     # A scenario that leaves the mount unset gets the robot's mount: forward offset, height
     # and tilt each from the robot's spec (three different numbers, so a mix-up shows).
-    from fpga_robotics.loop import ClosedLoop
+    from fpga_robotics.loop.compressed import ClosedLoop
     from fpga_robotics.sim.world.robots import ROBOT_MODELS
 
     spec = ROBOT_MODELS[robot]
@@ -279,7 +279,7 @@ def test_camera_mount_defaults_to_the_robots_own(robot):
 
 
 def test_camera_mount_from_the_scenario_wins():
-    from fpga_robotics.loop import ClosedLoop
+    from fpga_robotics.loop.compressed import ClosedLoop
 
     s = load_scenario("follow_person", ["camera.mount_forward=0.25", "camera.mount_height=0.2",
                                         "sim.duration=0.1"])
@@ -290,7 +290,7 @@ def test_camera_mount_from_the_scenario_wins():
 def test_frame_count_is_the_capture_rule_counted_directly():
     # Frame k is captured at step round(k * period / dt) and must fall inside the run: the
     # closed form agrees with counting frame by frame, on awkward ratios too.
-    from fpga_robotics.loop import frame_count
+    from fpga_robotics.loop.compressed import frame_count
 
     def counted(steps, period, dt):
         n = 0

@@ -2,10 +2,10 @@
 
 import pytest
 
-from fpga_robotics import loop_bench
-from fpga_robotics.errors import UsageError
-from fpga_robotics.loop import make_backend
-from fpga_robotics.scenario import load_scenario
+from fpga_robotics.bench import loop as loop_bench
+from fpga_robotics.cli.errors import UsageError
+from fpga_robotics.loop.compressed import make_backend
+from fpga_robotics.scenario.load import load_scenario
 
 
 @pytest.mark.parametrize("backend", ["model", "cxxrtl"])

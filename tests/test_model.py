@@ -10,9 +10,9 @@ from scalar_reference import loop_track, scalar_match
 
 from fpga_robotics.hw.params import FollowTargetParams
 from fpga_robotics.hw.pixel import COLOR_SELECT
-from fpga_robotics.sim import synthetic
-from fpga_robotics.sim.frames import FrameError
-from fpga_robotics.sim.model import (
+from fpga_robotics.sim.camera import synthetic
+from fpga_robotics.sim.camera.frames import FrameError
+from fpga_robotics.sim.models.follow_target import (
     FollowTargetModel,
     MotorModel,
     TrackerResult,

@@ -198,7 +198,7 @@ def test_a_mutant_runs_in_closed_loop_from_the_command_line(tmp_path, capsys):
     only the unit judge sees."""
     import json
 
-    from fpga_robotics import run
+    from fpga_robotics.cli import run
     from fpga_robotics.mutation.design import write_mutant_design
 
     listed = mutation.list_mutants(PARAMS, 400, seed=1)

@@ -153,8 +153,8 @@ def test_real_clock_timing():
     (["--repeats", "0"], "must be positive"),
 ])
 def test_pin_bench_bad_arguments(argv, message):
-    from fpga_robotics.errors import UsageError
-    from fpga_robotics.pin_bench import main
+    from fpga_robotics.cli.errors import UsageError
+    from fpga_robotics.bench.pins import main
 
     with pytest.raises(UsageError, match=message):
         main(argv)

@@ -8,7 +8,7 @@ import math
 import pytest
 from render3d_scenes import HFOV, POSE, H, W, mujoco_missing, person_scene, red_pixels
 
-from fpga_robotics.sim.camera import CameraRenderer
+from fpga_robotics.sim.camera.raster import CameraRenderer
 
 pytestmark = mujoco_missing
 
@@ -18,7 +18,7 @@ BEARINGS = (-25.0, -10.0, 0.0, 15.0, 25.0)
 
 @pytest.fixture(scope="module")
 def renderers():
-    from fpga_robotics.sim.render3d import MujocoRenderer, Render3DOptions
+    from fpga_robotics.sim.camera.render3d import MujocoRenderer, Render3DOptions
 
     return CameraRenderer(W, H, HFOV), MujocoRenderer(W, H, HFOV, Render3DOptions(shadows=False))
 
@@ -41,7 +41,7 @@ def test_the_person_is_at_the_same_column_and_size_in_both_renderers(renderers, 
 
 
 def test_shadows_change_the_frame_but_not_where_the_person_is():
-    from fpga_robotics.sim.render3d import MujocoRenderer, Render3DOptions
+    from fpga_robotics.sim.camera.render3d import MujocoRenderer, Render3DOptions
 
     scene = person_scene(3.0, 10.0)
     plain = MujocoRenderer(W, H, HFOV, Render3DOptions(shadows=False)).render(scene, POSE)

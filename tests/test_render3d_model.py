@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 from render3d_scenes import mujoco_missing
 
-from fpga_robotics.scenario import load_scenario
-from fpga_robotics.sim.render3d import Render3DOptions
-from fpga_robotics.sim.render3d.mjcf import build_model_xml
+from fpga_robotics.scenario.load import load_scenario
+from fpga_robotics.sim.camera.render3d import Render3DOptions
+from fpga_robotics.sim.camera.render3d.mjcf import build_model_xml
 from fpga_robotics.sim.world import World
 
 pytestmark = mujoco_missing
@@ -16,7 +16,7 @@ pytestmark = mujoco_missing
 
 @pytest.fixture(scope="module")
 def divider():
-    from fpga_robotics.sim.render3d import load_mujoco
+    from fpga_robotics.sim.camera.render3d import load_mujoco
 
     mujoco = load_mujoco()  # off-screen (EGL), as the renderer imports it
     scenario = load_scenario("divider_3d")

@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 from render3d_scenes import HFOV, POSE, H, W, mujoco_missing, person_scene
 
-from fpga_robotics.sim.render3d import cycle_length, gait_angles
-from fpga_robotics.sim.render3d.body import JOINTS, SWING
-from fpga_robotics.sim.render3d.textures import KINDS, modulation
+from fpga_robotics.sim.camera.render3d import cycle_length, gait_angles
+from fpga_robotics.sim.camera.render3d.body import JOINTS, SWING
+from fpga_robotics.sim.camera.render3d.textures import KINDS, modulation
 from fpga_robotics.sim.world import World
 
 
@@ -82,7 +82,7 @@ def test_textures_come_from_the_seed():
 def test_rendered_limbs_move_only_when_walking_and_frames_repeat():
     import dataclasses
 
-    from fpga_robotics.sim.render3d import MujocoRenderer
+    from fpga_robotics.sim.camera.render3d import MujocoRenderer
 
     renderer = MujocoRenderer(W, H, HFOV)
     base = person_scene(2.5, 0.0)

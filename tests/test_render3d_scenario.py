@@ -10,11 +10,11 @@ import numpy as np
 import pytest
 from render3d_scenes import mujoco_missing
 
-from fpga_robotics.connectors.camera import CameraConnector
-from fpga_robotics.loop import run_scenario
-from fpga_robotics.scenario import ScenarioError, load_scenario
-from fpga_robotics.sim.camera import CameraRenderer
-from fpga_robotics.sim.render3d import Lamp
+from fpga_robotics.loop.connectors.camera import CameraConnector
+from fpga_robotics.loop.compressed import run_scenario
+from fpga_robotics.scenario.load import ScenarioError, load_scenario
+from fpga_robotics.sim.camera.raster import CameraRenderer
+from fpga_robotics.sim.camera.render3d import Lamp
 
 
 def test_the_raster_is_the_default_and_the_keys_have_defaults():

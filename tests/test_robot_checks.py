@@ -6,7 +6,7 @@ limit) and ``max_search_travel_m`` (the robot turns in place while it searches).
 import numpy as np
 import pytest
 
-from fpga_robotics.summary import CHECK_OUTPUTS, CHECKS, compute_metrics, evaluate_checks
+from fpga_robotics.checks.summary import CHECK_OUTPUTS, CHECKS, compute_metrics, evaluate_checks
 
 # 160 pixels wide, the default window (margin 16): LED k above columns 16 + 16k .. 31 + 16k;
 # the border tolerance is 160 / 32 = 5 px.

@@ -6,8 +6,8 @@ import json
 import pytest
 from rosbags.highlevel import AnyReader
 
-from fpga_robotics.errors import run_cli
-from fpga_robotics.sweep.cli import main
+from fpga_robotics.cli.errors import run_cli
+from fpga_robotics.cli.sweep import main
 
 
 def test_recorded_runs_are_written_as_bags(tmp_path, capsys):

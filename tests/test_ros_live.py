@@ -17,7 +17,7 @@ from rosbags.typesys import Stores, get_typestore
 from websockets.exceptions import ConnectionClosed
 from websockets.sync.client import connect
 
-from fpga_robotics.run import main as run_main
+from fpga_robotics.cli.run import main as run_main
 
 STORE = get_typestore(Stores.ROS2_HUMBLE)
 DEADLINE_S = 30  # the whole exchange; the run itself takes about 2 s
@@ -240,9 +240,9 @@ def test_teleop_twist_in_cdr():
 def test_inputs_are_events_of_the_run_and_of_its_frames():
     """Each applied input is an event of the run (the summary's count, the rerun event log
     through the frame records) at its frame; a teleop without a target is an event too."""
-    from fpga_robotics.loop import run_scenario
+    from fpga_robotics.loop.compressed import run_scenario
     from fpga_robotics.ros.controls import ReplayControls
-    from fpga_robotics.scenario import load_scenario
+    from fpga_robotics.scenario.load import load_scenario
 
     inputs = [{"frame": 2, "kind": "color", "value": "green"},
               {"frame": 4, "kind": "target_velocity", "value": [0.1, 0.0]}]

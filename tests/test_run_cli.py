@@ -6,8 +6,8 @@ import sys
 
 import pytest
 
-from fpga_robotics.errors import run_cli
-from fpga_robotics.run import main
+from fpga_robotics.cli.errors import run_cli
+from fpga_robotics.cli.run import main
 
 SHIPPED = ("follow_person", "divider", "lighting", "heavy_robot", "lost_target")
 REQUIRED = (

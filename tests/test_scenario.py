@@ -4,8 +4,8 @@ import math
 
 import pytest
 
-from fpga_robotics.errors import UsageError
-from fpga_robotics.scenario import (
+from fpga_robotics.cli.errors import UsageError
+from fpga_robotics.scenario.load import (
     ScenarioError,
     load_scenario,
     parse_resolution,
@@ -30,7 +30,7 @@ def write(tmp_path, text, name="s.toml"):
 
 
 def test_the_world_sections_are_defined_once_by_the_world():
-    from fpga_robotics import scenario
+    from fpga_robotics.scenario import load as scenario
     from fpga_robotics.sim.world import config
 
     assert scenario.WORLD_SECTIONS is config.WORLD_SECTIONS
@@ -290,8 +290,8 @@ def test_design_values_are_checked_with_their_key(item, message):
 
 
 def renderer_accepts(width, height, hfov, tilt):
-    from fpga_robotics.sim.camera import CameraRenderer
-    from fpga_robotics.sim.scene import CameraPose, Scene
+    from fpga_robotics.sim.camera.raster import CameraRenderer
+    from fpga_robotics.sim.camera.scene import CameraPose, Scene
 
     try:
         CameraRenderer(width, height, hfov).render(Scene(), CameraPose(0, 0, 0, tilt=tilt))
@@ -312,7 +312,7 @@ def scenario_accepts(width, height, hfov, tilt):
 @pytest.mark.parametrize("width,height,hfov", [(160, 120, 1.047), (320, 240, 2.0),
                                                (40, 160, 1.0), (160, 120, 3.1)])
 def test_the_scenario_accepts_the_tilts_the_renderer_draws(width, height, hfov):
-    from fpga_robotics.sim.camera import max_tilt
+    from fpga_robotics.sim.camera.raster import max_tilt
 
     limit = max_tilt(width, height, hfov)
     for tilt in (0.0, limit * 0.999, -limit * 0.999, limit + 1e-4, -limit - 1e-4, 1.5707963):

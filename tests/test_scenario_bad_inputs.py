@@ -9,8 +9,8 @@ runs a short simulation and fails its case.
 
 import pytest
 
-from fpga_robotics.errors import run_cli
-from fpga_robotics.run import main
+from fpga_robotics.cli.errors import run_cli
+from fpga_robotics.cli.run import main
 
 #: Every case runs with these; ``--rerun save`` would write ``runs/<scenario name>.rrd``.
 BASE = ["--backend", "model", "--quiet"]

@@ -7,10 +7,10 @@ import json
 
 import pytest
 
-from fpga_robotics.errors import UsageError
+from fpga_robotics.cli.errors import UsageError
 from fpga_robotics.hw.params import FollowTargetParams
-from fpga_robotics.run import _design_files
-from fpga_robotics.scenario import ScenarioError, load_scenario
+from fpga_robotics.cli.run import _design_files
+from fpga_robotics.scenario.load import ScenarioError, load_scenario
 from fpga_robotics.sim.backends.port_map import follow_target_port_map
 
 PARAMS = FollowTargetParams(width=80, height=60)
@@ -113,7 +113,7 @@ def _toolchain():
 
 @pytest.mark.skipif(_toolchain() is not None, reason="no Verilator toolchain")
 def test_a_scenario_runs_its_foreign_design_in_closed_loop(files, capsys):
-    from fpga_robotics import run
+    from fpga_robotics.cli import run
 
     argv = ["--duration", "1", "--rerun", "off", "--quiet"]
     code = run.main(["--scenario", str(files / "foreign.toml"), *argv,

@@ -7,8 +7,8 @@ import math
 import numpy as np
 import pytest
 
-from fpga_robotics.loop import run_scenario
-from fpga_robotics.scenario import load_scenario, shipped_scenarios
+from fpga_robotics.loop.compressed import run_scenario
+from fpga_robotics.scenario.load import load_scenario, shipped_scenarios
 from fpga_robotics.sim.world import TURTLEBOT2
 
 SHIPPED = sorted(shipped_scenarios())

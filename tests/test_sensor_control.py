@@ -7,9 +7,9 @@ import math
 import numpy as np
 import pytest
 
-from fpga_robotics.sim.sensor import OV7670Params, OV7670Sensor
-from fpga_robotics.sim.sensor.exposure import AutoExposure
-from fpga_robotics.sim.sensor.white_balance import grey_world_gains
+from fpga_robotics.sim.camera.sensor import OV7670Params, OV7670Sensor
+from fpga_robotics.sim.camera.sensor.exposure import AutoExposure
+from fpga_robotics.sim.camera.sensor.white_balance import grey_world_gains
 
 # A linear camera (no noise, mosaic or gamma) so that the frame's mean luminance is
 # 255.75 * clip(radiance * sensitivity * exposure * gain, 0, 1), rounded to 10-bit codes.

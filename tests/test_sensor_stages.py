@@ -1,16 +1,16 @@
-"""Each stage of the OV7670 sensor model (fpga_robotics.sim.sensor) against its formula."""
+"""Each stage of the OV7670 sensor model (fpga_robotics.sim.camera.sensor) against its formula."""
 
 import math
 
 import numpy as np
 import pytest
 
-from fpga_robotics.sim.frames import rgb444_to_rgb888, to_rgb444
-from fpga_robotics.sim.sensor.bayer import bayer_channels, demosaic, mosaic
-from fpga_robotics.sim.sensor.blur import blur_length, box_kernel, motion_blur
-from fpga_robotics.sim.sensor.gamma import GAMMA_CURVES, GAMMA_X, gamma_curve, gamma_lut
-from fpga_robotics.sim.sensor.noise import PixelNoise, noise_sigma, well_and_read_noise
-from fpga_robotics.sim.sensor.rgb444 import rgb444_levels, truncate_rgb444
+from fpga_robotics.sim.camera.frames import rgb444_to_rgb888, to_rgb444
+from fpga_robotics.sim.camera.sensor.bayer import bayer_channels, demosaic, mosaic
+from fpga_robotics.sim.camera.sensor.blur import blur_length, box_kernel, motion_blur
+from fpga_robotics.sim.camera.sensor.gamma import GAMMA_CURVES, GAMMA_X, gamma_curve, gamma_lut
+from fpga_robotics.sim.camera.sensor.noise import PixelNoise, noise_sigma, well_and_read_noise
+from fpga_robotics.sim.camera.sensor.rgb444 import rgb444_levels, truncate_rgb444
 
 # Gamma -------------------------------------------------------------------------------------
 

@@ -10,9 +10,9 @@ import numpy as np
 import pytest
 
 from fpga_robotics.hw.params import FollowTargetParams
-from fpga_robotics.loop import run_scenario
-from fpga_robotics.scenario import load_scenario
-from fpga_robotics.sim import synthetic
+from fpga_robotics.loop.compressed import run_scenario
+from fpga_robotics.scenario.load import load_scenario
+from fpga_robotics.sim.camera import synthetic
 from fpga_robotics.sim.backends import available_backends, get_backend
 
 NARROW = "design.sx_bits=17"

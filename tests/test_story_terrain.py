@@ -6,8 +6,8 @@ import math
 
 import pytest
 
-from fpga_robotics.loop import run_scenario
-from fpga_robotics.scenario import load_scenario
+from fpga_robotics.loop.compressed import run_scenario
+from fpga_robotics.scenario.load import load_scenario
 from fpga_robotics.sim.backends import available_backends
 from fpga_robotics.sim.world.robots import G
 

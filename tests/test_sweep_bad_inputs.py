@@ -6,8 +6,8 @@ import sys
 
 import pytest
 
-from fpga_robotics.errors import run_cli
-from fpga_robotics.sweep.cli import main
+from fpga_robotics.cli.errors import run_cli
+from fpga_robotics.cli.sweep import main
 
 SWEEP = [sys.executable, "-m", "fpga_robotics.sweep"]
 

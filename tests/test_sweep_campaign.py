@@ -7,7 +7,7 @@ import tomllib
 from hypothesis import given
 from hypothesis import strategies as st
 
-from fpga_robotics.scenario import _parse_value
+from fpga_robotics.scenario.load import _parse_value
 from fpga_robotics.sweep import load_campaign
 from fpga_robotics.sweep.campaign import parse_seeds, toml_value
 

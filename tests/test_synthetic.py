@@ -5,8 +5,8 @@ import pytest
 from scalar_reference import scalar_match
 
 from fpga_robotics.hw.pixel import COLOR_SELECT
-from fpga_robotics.sim import synthetic
-from fpga_robotics.sim.frames import to_rgb444
+from fpga_robotics.sim.camera import synthetic
+from fpga_robotics.sim.camera.frames import to_rgb444
 
 COLOURS = [c for c in COLOR_SELECT if c != "none"]
 

@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from fpga_robotics.sim.ultrasound import HCSR04Module, HCSR04Params, range_to, speed_of_sound
+from fpga_robotics.sim.world.ultrasound import HCSR04Module, HCSR04Params, range_to, speed_of_sound
 from fpga_robotics.sim.world import World
 
 F = 50e6  # the design's clock

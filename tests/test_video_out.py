@@ -5,10 +5,10 @@ import json
 import numpy as np
 import pytest
 
-from fpga_robotics.errors import run_cli
-from fpga_robotics.loop import run_scenario
-from fpga_robotics.run import main
-from fpga_robotics.scenario import load_scenario
+from fpga_robotics.cli.errors import run_cli
+from fpga_robotics.loop.compressed import run_scenario
+from fpga_robotics.cli.run import main
+from fpga_robotics.scenario.load import load_scenario
 
 
 def cli(argv, capsys):

@@ -11,10 +11,10 @@ import cv2
 import numpy as np
 import pytest
 
-from fpga_robotics.errors import UsageError
-from fpga_robotics.readback_cli import main as readback_main
+from fpga_robotics.cli.errors import UsageError
+from fpga_robotics.cli.readback import main as readback_main
 from fpga_robotics.sim.backends.base import FrameResult
-from fpga_robotics.sim.frames import rgb444_to_rgb888
+from fpga_robotics.sim.camera.frames import rgb444_to_rgb888
 from fpga_robotics.sim.records import FrameRecord, PersonState, WorldMap
 from fpga_robotics.viz import ViewerError, open_recorder
 from fpga_robotics.viz import paths as P

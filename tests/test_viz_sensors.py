@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from fpga_robotics.loop import run_scenario
-from fpga_robotics.scenario import load_scenario
+from fpga_robotics.loop.compressed import run_scenario
+from fpga_robotics.scenario.load import load_scenario
 from fpga_robotics.viz import open_recorder
 from fpga_robotics.viz import paths as P
 from fpga_robotics.viz.readback import read_rrd

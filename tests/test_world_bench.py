@@ -1,5 +1,5 @@
-"""The physics benchmark: its command line (``python -m fpga_robotics.world_bench``, or the
-library module ``fpga_robotics.sim.world.bench`` as an alias) prints a line per world and
+"""The physics benchmark: its command line (``python -m fpga_robotics.bench.world``, or the
+library module ``fpga_robotics.bench.world_physics`` as an alias) prints a line per world and
 reports bad arguments as one line with exit status 2."""
 
 import subprocess
@@ -7,8 +7,8 @@ import sys
 
 import pytest
 
-from fpga_robotics.sim.world.bench import WORLDS
-from fpga_robotics.world_bench import main
+from fpga_robotics.bench.world_physics import WORLDS
+from fpga_robotics.bench.world import main
 
 
 def test_prints_a_line_per_world(capsys):
@@ -23,14 +23,14 @@ def test_prints_a_line_per_world(capsys):
 
 
 @pytest.mark.parametrize("module,args,message", [
-    ("fpga_robotics.sim.world.bench", ["--fps", "0"],
-     "python -m fpga_robotics.world_bench: error: --fps must be a number of hertz in (0, 240], got 0.0"),
-    ("fpga_robotics.world_bench", ["--frames", "0"],
-     "python -m fpga_robotics.world_bench: error: --frames must be 1..1000000, got 0"),
-    ("fpga_robotics.world_bench", ["--physics-hz", "nan"],
-     "python -m fpga_robotics.world_bench: error: --physics-hz must be a number of hertz in (0, 100000], got nan"),
-    ("fpga_robotics.world_bench", ["--fps", "300"],
-     "python -m fpga_robotics.world_bench: error: --fps must be a number of hertz in (0, 240], got 300.0"),
+    ("fpga_robotics.bench.world_physics", ["--fps", "0"],
+     "python -m fpga_robotics.bench.world: error: --fps must be a number of hertz in (0, 240], got 0.0"),
+    ("fpga_robotics.bench.world", ["--frames", "0"],
+     "python -m fpga_robotics.bench.world: error: --frames must be 1..1000000, got 0"),
+    ("fpga_robotics.bench.world", ["--physics-hz", "nan"],
+     "python -m fpga_robotics.bench.world: error: --physics-hz must be a number of hertz in (0, 100000], got nan"),
+    ("fpga_robotics.bench.world", ["--fps", "300"],
+     "python -m fpga_robotics.bench.world: error: --fps must be a number of hertz in (0, 240], got 300.0"),
 ])
 def test_bad_arguments_are_one_line(module, args, message):
     proc = subprocess.run([sys.executable, "-m", module, *args], capture_output=True,

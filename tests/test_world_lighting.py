@@ -2,7 +2,7 @@
 
 import pytest
 
-from fpga_robotics.sim.scene import Lighting
+from fpga_robotics.sim.camera.scene import Lighting
 from fpga_robotics.sim.world import World, parse_world_config
 from fpga_robotics.sim.world.lighting import LightingSchedule
 

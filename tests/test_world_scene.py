@@ -4,7 +4,7 @@ import math
 
 import pytest
 
-from fpga_robotics.sim.scene import Band, Scene, Wall
+from fpga_robotics.sim.camera.scene import Band, Scene, Wall
 from fpga_robotics.sim.world import World
 
 

@@ -11,7 +11,7 @@ import re
 import numpy as np
 import pytest
 
-from fpga_robotics.sim.camera import CameraRenderer, focal_length
+from fpga_robotics.sim.camera.raster import CameraRenderer, focal_length
 from fpga_robotics.sim.world import World
 from fpga_robotics.sim.world.config import Uncertainty, WorldConfigError
 from fpga_robotics.sim.world.robots import TURTLEBOT2, G
@@ -223,8 +223,8 @@ def test_bad_uncertainty_names_the_key(key, value, message):
 
 
 def test_the_map_shows_the_terrain(tmp_path):
-    from fpga_robotics.loop import run_scenario
-    from fpga_robotics.scenario import load_scenario
+    from fpga_robotics.loop.compressed import run_scenario
+    from fpga_robotics.scenario.load import load_scenario
     from fpga_robotics.viz import open_recorder
     from fpga_robotics.viz import paths as P
     from fpga_robotics.viz.readback import read_rrd

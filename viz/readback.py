@@ -1,7 +1,7 @@
 """Read a saved recording back (tests, checks) and summarise it.
 
 ``python -m fpga_robotics.viz.readback FILE.rrd`` prints the summary (the command itself is
-``fpga_robotics.readback_cli``, the application layer).
+``fpga_robotics.cli.readback``, the application layer).
 
 Built on ``rerun.chunk.RrdReader``. Every temporal row of an entity is returned with its
 ``frame`` and ``sim_time`` (ns), sorted by frame; each component value is the list of its
@@ -116,12 +116,3 @@ def summary_lines(rec, name):
         f"  {path:22s} static: {', '.join(sorted(rec.static[path]))}" for path in sorted(rec.static)
     ]
     return lines
-
-
-if __name__ == "__main__":
-    import sys
-
-    from fpga_robotics.errors import run_cli
-    from fpga_robotics.readback_cli import main
-
-    run_cli(main, sys.argv[1:], prog="fpga_robotics.viz.readback")

@@ -15,7 +15,7 @@ import numpy as np
 import rerun as rr
 import rerun.blueprint as rrb
 
-from ..sim.render3d.body import (
+from fpga_robotics.sim.camera.render3d.body import (
     REFERENCE_HEIGHT,
     REFERENCE_RADIUS,
     body_colors,

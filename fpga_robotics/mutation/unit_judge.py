@@ -15,8 +15,8 @@ real equivalent mutant, or a bug these frames cannot show).
 
 from dataclasses import dataclass, field
 
-from ..shadow import COMPARED_OUTPUTS, differing_outputs, output_value
-from ..sim import synthetic
+from fpga_robotics.loop.shadow import COMPARED_OUTPUTS, differing_outputs, output_value
+from fpga_robotics.sim.camera import synthetic
 from ..sim.backends import BackendError, get_backend
 from ..sim.mutation import MUTATION_SELECT
 

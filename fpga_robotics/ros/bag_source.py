@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import UsageError
+from fpga_robotics.cli.errors import UsageError
 
 __all__ = ["ENCODINGS", "IMAGE_TYPES", "BagSource", "parse_bag_spec"]
 
@@ -134,7 +134,7 @@ class BagSource:
         return (self._stamps[k] - self._stamps[0]) / 1e9
 
     def __iter__(self):
-        from ..sources import to_design_rgb
+        from fpga_robotics.loop.sources import to_design_rgb
 
         reader = self._reader
         for conn, stamp, raw in reader.messages(connections=self._connections):

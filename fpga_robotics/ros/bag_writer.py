@@ -15,7 +15,7 @@ from pathlib import Path
 
 from rosbags.rosbag2 import StoragePlugin, Writer, WriterError
 
-from ..errors import UsageError
+from fpga_robotics.cli.errors import UsageError
 from .messages import TOPICS, TYPESTORE, FrameMessages, camera_geometry
 
 __all__ = ["BagWriter", "check_bag_path", "open_bag_writer"]

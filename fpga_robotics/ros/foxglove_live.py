@@ -13,7 +13,7 @@ import threading
 import foxglove
 from foxglove.websocket import Capability
 
-from ..errors import UsageError
+from fpga_robotics.cli.errors import UsageError
 from .messages import TOPICS, TYPESTORE, FrameMessages, msgdef
 
 __all__ = ["CONTROL_TOPICS", "DEFAULT_PORT", "LivePublisher", "control_input",

@@ -11,7 +11,7 @@ import termios
 import threading
 import tty
 
-from ..errors import UsageError
+from fpga_robotics.cli.errors import UsageError
 from .controls import TELEOP_SPEED
 
 __all__ = ["KEYS", "TerminalControls", "key_input"]

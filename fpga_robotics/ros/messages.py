@@ -15,7 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 from rosbags.typesys import Stores, get_typestore
 
-from ..sim.camera import focal_length
+from fpga_robotics.sim.camera.raster import focal_length
 from ..sim.world.kinematics import dps_to_twist
 
 __all__ = ["TOPICS", "TYPESTORE", "CameraGeometry", "FrameMessages", "camera_geometry",

@@ -1,6 +1,6 @@
-"""``python -m fpga_robotics.sweep``: see ``fpga_robotics.sweep.cli``."""
+"""``python -m fpga_robotics.sweep``: see ``fpga_robotics.cli.sweep``."""
 
 if __name__ == "__main__":  # worker processes import this module again: do nothing there
-    from .cli import cli
+    from fpga_robotics.cli.sweep import cli
 
     cli()

@@ -39,7 +39,7 @@ from importlib import resources
 from pathlib import Path
 
 from .. import __version__
-from ..errors import UsageError
+from fpga_robotics.cli.errors import UsageError
 
 __all__ = ["Campaign", "CampaignError", "RunSpec", "load_campaign", "parse_seeds",
            "shipped_campaigns", "toml_value"]
@@ -137,7 +137,7 @@ def _toml_string(text):
 
 def parse_seeds(value, where="seeds"):
     """``"0-19"``, ``"7"``, an integer or a list of integers → a list of seeds."""
-    from ..scenario import MAX_SEED
+    from fpga_robotics.scenario.load import MAX_SEED
 
     if isinstance(value, bool):
         raise CampaignError(f"{where} must be \"A-B\" or a list of integers, got {value!r}")
@@ -249,7 +249,7 @@ def _typed(data, key, types, what):
 
 def shipped_campaigns():
     """Names → paths of the campaigns shipped with the package."""
-    folder = resources.files("fpga_robotics") / "campaigns"
+    folder = resources.files("fpga_robotics.sweep") / "campaigns"
     return {e.name[:-5]: str(e) for e in sorted(folder.iterdir(), key=lambda e: e.name)
             if e.name.endswith(".toml")}
 

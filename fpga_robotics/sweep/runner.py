@@ -54,8 +54,8 @@ def _loaded(argv):
     args = argparse.Namespace(**vars(args))
     if seed is not None:
         args.seed = int(seed)
-        from ..errors import UsageError
-        from ..scenario import MAX_SEED
+        from fpga_robotics.cli.errors import UsageError
+        from fpga_robotics.scenario.load import MAX_SEED
 
         if not 0 <= args.seed <= MAX_SEED:
             raise UsageError(f"--seed must be in 0..{MAX_SEED}, got {args.seed}")
@@ -68,9 +68,9 @@ _loads = {}
 def load_run(argv):
     """``(args, scenario, shadow_params)`` of a run, checked as ``run`` checks them
     (``UsageError`` with one line when something is wrong)."""
-    from .. import run
-    from ..errors import UsageError
-    from ..scenario import MAX_SEED, load_scenario
+    from fpga_robotics.cli import run
+    from fpga_robotics.cli.errors import UsageError
+    from fpga_robotics.scenario.load import MAX_SEED, load_scenario
 
     args = run.build_parser().parse_args(argv)
     args.quiet = True
@@ -100,9 +100,9 @@ def _open(key, opener):
 
 
 def _designs_for(args, scenario, shadow_params):
-    from .. import run
+    from fpga_robotics.cli import run
 
-    if scenario.sim.timing == "real_clock":  # a pin-level backend (fpga_robotics.clocked_loop)
+    if scenario.sim.timing == "real_clock":  # a pin-level backend (fpga_robotics.loop.real_clock)
         design = _open(_design_key(args, scenario), lambda: run._open_pin_design(args, scenario))
     else:
         design = _open(_design_key(args, scenario),
@@ -188,8 +188,8 @@ def execute(argv, timeout=None, record=False, tag=None, bag=False):
     log every how many frames' images to the recording); returns ``{"status", "message", "summary", "wall_s", "cpu_s",
     "run_s", "recording", "bag"}`` (``recording``: the ``.rrd`` bytes when ``record``;
     ``bag``: with ``bag`` and ``record``, the ROS 2 bag's files as ``{name: bytes}``)."""
-    from .. import run
-    from ..loop import run_scenario
+    from fpga_robotics.cli import run
+    from fpga_robotics.loop.compressed import run_scenario
 
     wall0, cpu0 = time.perf_counter(), time.process_time()
     out = {"status": "error", "message": "", "summary": None, "recording": None, "run_s": 0.0}
@@ -260,7 +260,7 @@ def _recorder(args, name, log_every):
     import tempfile
     from pathlib import Path
 
-    from .. import run
+    from fpga_robotics.cli import run
 
     fd, path = tempfile.mkstemp(prefix=f"sweep-{name}-", suffix=".rrd")
     os.close(fd)

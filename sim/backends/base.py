@@ -22,7 +22,7 @@ import numpy as np
 from ...hw.params import FollowTargetParams
 from ...hw.pixel import color_select_value
 from ...hw.validate import check_int
-from ..frames import FrameError, to_rgb444
+from ..camera.frames import FrameError, to_rgb444
 
 __all__ = ["BackendError", "DesignBackend", "FrameResult", "WaveformRequest", "check_out"]
 

@@ -20,7 +20,7 @@ import numpy as np
 
 from ...hw.pixel import color_select_value
 from ..files import PendingOutput
-from ..frames import to_rgb444
+from ..camera.frames import to_rgb444
 from . import build_cache
 from .base import BackendError, DesignBackend, FrameResult, check_out
 from .designs import DesignSource

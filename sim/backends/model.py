@@ -10,7 +10,7 @@ signals: use the ``pysim``, ``cxxrtl`` or ``verilator`` backend for those.
 """
 
 
-from ..model import FollowTargetModel
+from ..models.follow_target import FollowTargetModel
 from .base import DesignBackend, FrameResult
 from .model_waveform import ModelWaveformWriter
 

@@ -379,9 +379,3 @@ class _Recording:
                     trim_vcd(src, dst, start, end, timescale="1 fs")
         finally:
             self._cleanup()
-
-
-if __name__ == "__main__":  # the CLI lives in the application layer
-    from ...pysim_bench import cli
-
-    cli()

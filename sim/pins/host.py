@@ -9,7 +9,7 @@ from collections import deque
 
 import numpy as np
 
-from ..frames import FrameError, to_rgb444
+from ..camera.frames import FrameError, to_rgb444
 from .base import PinBackend, PinError, PixelTiming, Stop
 
 __all__ = ["HostPins", "capture_error"]

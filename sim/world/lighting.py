@@ -8,7 +8,7 @@ keyframes the constant ``ambient`` and ``intensity`` apply.
 
 import bisect
 
-from ..scene import Lighting
+from ..camera.scene import Lighting
 
 __all__ = ["LightingSchedule"]
 

@@ -12,7 +12,7 @@ script time that runs behind the clock by the time waited.)
 
 import math
 
-from ..scene import Band
+from ..camera.scene import Band
 
 __all__ = ["REFERENCE_HEIGHT", "PersonPath", "person_bands"]
 

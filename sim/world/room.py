@@ -3,7 +3,7 @@ renderer walls and as the viewer's map."""
 
 import pymunk
 
-from ..scene import Wall
+from ..camera.scene import Wall
 
 __all__ = [
     "WALL_THICKNESS",

@@ -84,7 +84,7 @@ class TerrainMap:
             self._grid = self._build_grid(width, depth)
 
     def _build_grid(self, width, depth):
-        from ..floor_patches import patch_index
+        from ..camera.floor_patches import patch_index
 
         cell = max(MIN_CELL, math.sqrt(width * depth / MAX_CELLS))
         nx, ny = math.ceil(width / cell), math.ceil(depth / cell)

@@ -16,7 +16,7 @@ import numpy as np
 import pymunk
 
 from ..records import PersonState, WorldMap
-from ..scene import CameraPose, Cylinder, Scene
+from ..camera.scene import CameraPose, Cylinder, Scene
 from .config import WorldConfigError, parse_world_config
 from .lighting import LightingSchedule
 from .motors import DriveMotors

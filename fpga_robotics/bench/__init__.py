@@ -1,0 +1,2 @@
+"""Benchmarks: a module per subject, each a ``main(argv)`` that prints figures
+(``fpga-robotics bench --list``)."""

@@ -1,0 +1,71 @@
+"""``fpga-robotics bench pysim``: time Amaranth's own simulator on ``FollowTarget``, one frame
+at a time, every frame checked against the golden model (also
+``python -m fpga_robotics.sim.backends.pysim``)."""
+
+import argparse
+import statistics
+import sys
+import time
+
+from fpga_robotics.cli.errors import UsageError, run_cli
+from fpga_robotics.cli.param_options import add_param_arguments, params_from_args
+from fpga_robotics.sim.backends.base import BackendError
+from fpga_robotics.sim.backends.model import ModelBackend
+from fpga_robotics.sim.backends.pysim import PysimBackend
+from fpga_robotics.sim.camera.synthetic import blob_frame
+
+__all__ = ["benchmark", "cli", "main"]
+
+
+def benchmark(params=None, *, frames=7, line_blank=0, frame_blank=0, seed=0):
+    """Time ``frames`` synthetic frames (a red target moving across) on one backend and check
+    each against the golden model. Returns ``(wall_seconds, cpu_seconds, cycles)`` lists."""
+
+    params = params if params is not None else PysimBackend().params
+    w, h = params.width, params.height
+    wall, cpu, cycles = [], [], []
+    with PysimBackend(params, line_blank=line_blank, frame_blank=frame_blank) as sim, \
+            ModelBackend(params, line_blank=line_blank, frame_blank=frame_blank) as model:
+        for i in range(frames):
+            frame = blob_frame(w, h, "red", cx=w * (0.2 + 0.6 * i / max(1, frames - 1)),
+                               cy=h / 2, radius=h / 5, rng=seed + i)
+            t0, c0 = time.perf_counter(), time.process_time()
+            got = sim.process_frame(frame, "red")
+            wall.append(time.perf_counter() - t0)
+            cpu.append(time.process_time() - c0)
+            cycles.append(got.cycles)
+            if got != model.process_frame(frame, "red"):
+                raise BackendError(f"frame {i}: pysim differs from the golden model")
+    return wall, cpu, cycles
+
+
+def main(argv=None, prog="fpga-robotics bench pysim"):
+    parser = argparse.ArgumentParser(
+        prog=prog,
+        description="Time the pysim backend, one frame at a time, checked against the model.",
+    )
+    parser.add_argument("--frames", type=int, default=7, help="frames to time (default 7)")
+    parser.add_argument("--line-blank", type=int, default=0)
+    parser.add_argument("--frame-blank", type=int, default=0)
+    add_param_arguments(parser)
+    args = parser.parse_args(argv)
+    params = params_from_args(args)
+    if args.frames < 1:
+        raise UsageError("--frames must be >= 1")
+    wall, cpu, cycles = benchmark(params, frames=args.frames, line_blank=args.line_blank,
+                                  frame_blank=args.frame_blank)
+    print(f"pysim {params.width}x{params.height}, {args.frames} frames, "
+          f"{cycles[0]} cycles per frame, every frame equal to the golden model")
+    print("wall s per frame: " + " ".join(f"{t:.3f}" for t in wall))
+    med = statistics.median(wall)
+    print(f"median {med:.3f} s wall ({cycles[0] / med:,.0f} cycles/s), "
+          f"{statistics.median(cpu):.3f} s CPU")
+    return 0
+
+
+def cli():
+    run_cli(main, sys.argv[1:], prog="python -m fpga_robotics.sim.backends.pysim")
+
+
+if __name__ == "__main__":
+    cli()

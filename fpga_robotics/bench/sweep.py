@@ -1,0 +1,73 @@
+"""``python -m fpga_robotics.sweep --bench``: campaign throughput on 1 worker and on N.
+
+The same runs (``--bench-runs``, default 40: follow_person, 160x120, 10 s simulated, model
+backend, seeds 0..) go through the whole campaign path on an embedded cluster of 1 worker and
+of N (``--workers``, default the machine's cores), alternately, ``--bench-repeats`` times
+(default 3; medians printed). Printed: runs/s each way and the speed-up against N; a run's wall
+and CPU time (a run slower for the same CPU time waited for a core: other work on the
+machine); the share of the workers' time spent inside ``run_scenario``; and the time outside it per run
+(planning, scheduling, result writing) with 1 worker, as a share of the run. The machine's
+load average is printed too: other work on the machine shows as slower runs, not overhead.
+"""
+
+import os
+import statistics
+import tempfile
+import time
+
+from fpga_robotics.sweep.api import run_campaign
+from fpga_robotics.sweep.campaign import load_campaign
+from fpga_robotics.sweep.results import read_meta
+
+__all__ = ["bench"]
+
+
+def _campaign(runs, args):
+    return load_campaign({
+        "name": "bench", "scenarios": [args.scenarios or "follow_person"],
+        "seeds": [*range(runs)], "backend": args.backend or "model",
+        "resolution": args.resolution or "160x120", "duration": args.duration or 10.0})
+
+
+def _once(runs, workers, args):
+    with tempfile.TemporaryDirectory(prefix="sweep-bench-") as out:
+        rows = run_campaign(_campaign(runs, args), out, workers=workers, record="none")
+        meta = read_meta(out)
+    wall = meta["runs_wall_s"]
+    run_s = [r["run_s"] for r in rows]
+    return {"rps": runs / wall, "inside": sum(run_s) / (workers * wall),
+            "outside_s": wall * workers / runs - statistics.mean(run_s),
+            "run_s": statistics.median(run_s),
+            "cpu_s": statistics.median(r["cpu_s"] for r in rows)}
+
+
+def bench(args):
+    n = args.workers or os.cpu_count() or 1
+    runs, repeats = args.bench_runs, args.bench_repeats
+    print(f"campaign benchmark: {runs} runs of {args.scenarios or 'follow_person'}, "
+          f"{args.resolution or '160x120'}, {args.duration or 10.0} s simulated, backend "
+          f"{args.backend or 'model'}; 1 and {n} workers alternately, {repeats} times; "
+          f"load average {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
+    counts = sorted({1, n})
+    samples = {w: [] for w in counts}
+    t0 = time.perf_counter()
+    for _ in range(repeats):
+        for workers in counts:
+            samples[workers].append(_once(runs, workers, args))
+    med = {w: {k: statistics.median(s[k] for s in samples[w]) for k in samples[w][0]}
+           for w in counts}
+    for workers in counts:
+        m = med[workers]
+        print(f"  {workers} worker(s): {m['rps']:.2f} runs/s, median run_scenario "
+              f"{m['run_s'] * 1000:.0f} ms (CPU {m['cpu_s'] * 1000:.0f} ms), {m['inside']:.0%} "
+              f"of the workers' time inside run_scenario")
+    one = med[1]
+    print(f"  outside run_scenario with 1 worker: {one['outside_s'] * 1000:.1f} ms per run "
+          f"({100 * one['outside_s'] / one['run_s']:.1f}% of a run)")
+    if n > 1:
+        speedup = med[n]["rps"] / med[1]["rps"]
+        print(f"  speed-up with {n} workers: {speedup:.2f}x ({speedup / n:.2f} x N); a run "
+              f"takes {med[n]['run_s'] / med[1]['run_s']:.2f}x as long as with 1 worker")
+    print(f"  ({time.perf_counter() - t0:.0f} s; load average now "
+          f"{os.getloadavg()[0]:.1f})")
+    return 0

@@ -1,0 +1,83 @@
+"""Benchmark: physics cost per camera frame.
+
+For each world it runs the physics for many 30 fps frame periods (7 steps of 1/200 s each,
+plus ``scene()`` and the state queries the closed loop makes per frame) with a changing wheel
+command; the command line (``python -m fpga_robotics.bench.world``, or this module with
+``-m``) prints the median over several repeats of the time per frame and per step.
+"""
+
+import math
+import time
+
+from fpga_robotics.sim.world.world import World
+
+_BUSY = {
+    "room": {"furniture": [
+        {"center": [2.0, 1.0]}, {"center": [6.0, 1.0], "angle_deg": 20},
+        {"center": [2.0, 5.0], "size": [1.5, 0.5]}, {"center": [7.0, 5.0]},
+        {"type": "divider", "center": [5.0, 5.2], "name": "divider"},
+        {"center": [0.8, 0.8], "size": [0.5, 0.5]},
+    ]},
+    "people": [
+        {"waypoints": [[4, 3], [6, 4.5], [6.5, 1.5]], "pause": 1.0, "speed_jitter": 0.2},
+        {"waypoints": [[1, 3], [7, 3]], "speed": 1.0},
+        {"waypoints": [[3, 1.8], [3, 4.2]], "speed": 0.7},
+        {"waypoints": [[5, 2], [7, 2], [7, 4], [5, 4]], "speed": 0.5, "pause": 0.5},
+        {"waypoints": [[4, 4.5]]},
+    ],
+}
+# The default world with terrain under the whole drive (four patches, a ramp among them) and
+# every drive imperfection on: against "default", the cost of terrain lookup and noise.
+_TERRAIN = {
+    "room": {"terrain": [
+        {"center": [2.0, 3.0], "size": [4.0, 6.0], "friction": 0.8},
+        {"points": [[4, 0], [8, 0], [8, 3], [4, 3]], "friction": 0.5, "color": [0.4, 0.4, 0.5]},
+        {"center": [6.0, 4.5], "size": [4.0, 3.0], "slope_deg": 3.0, "slope_dir_deg": 90},
+        {"center": [4.0, 3.0], "size": [1.0, 1.0], "friction": 0.3},
+    ]},
+    "robot": {"motor_gain_error": 0.05, "motor_noise_dps": 10.0, "slip_rate_hz": 0.2},
+}
+WORLDS = {"default": {}, "busy (6 furniture, 5 people)": _BUSY,
+          "terrain, drive noise": _TERRAIN}
+
+__all__ = ["TERRAIN_WORLD", "WORLDS", "time_frames", "time_terrain_and_noise"]
+
+TERRAIN_WORLD = "terrain, drive noise"
+
+
+def time_frames(cfg, frames, steps_per_frame, dt):
+    world = World.from_config(cfg, seed=0)
+    start = time.perf_counter()
+    for k in range(frames):
+        world.set_wheel_dps(300 + 200 * math.sin(k / 20), 300 + 200 * math.cos(k / 30))
+        for _ in range(steps_per_frame):
+            world.step(dt)
+        world.scene()
+        world.robot_pose()
+        world.robot_velocity()
+        world.commanded_twist()
+        world.target_position()
+        world.people_states()
+        world.drain_events()
+    return (time.perf_counter() - start) / frames
+
+
+def time_terrain_and_noise(frames, steps_per_frame, dt):
+    """Seconds per frame of the terrain lookup and the drive noise alone (what the terrain
+    world adds to every physics step), timed on the robot positions of a drive through the
+    terrain world. The physics of the two worlds differ with the path taken, so comparing
+    their whole frames would not isolate this."""
+    world = World.from_config(_TERRAIN, seed=0)
+    positions = []
+    for k in range(frames):
+        world.set_wheel_dps(300 + 200 * math.sin(k / 20), 300 + 200 * math.cos(k / 30))
+        for _ in range(steps_per_frame):
+            world.step(dt)
+        positions.append(tuple(world.robot_body.position))
+    unc = world.uncertainty
+    start = time.perf_counter()
+    for k, position in enumerate(positions):
+        for i in range(steps_per_frame):
+            _, _, slip = unc.step(dt, 1.0, 1.0, (k * steps_per_frame + i) * dt)
+            world._apply_terrain(slip, *position)
+    return (time.perf_counter() - start) / frames

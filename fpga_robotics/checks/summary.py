@@ -1,0 +1,611 @@
+"""What a closed-loop run measured, the scenario's checks against it, and the verdict.
+
+``metrics(traj, events, ...)`` reduces the per-frame trajectory to numbers;
+``evaluate_checks(checks, metrics)`` compares them with the scenario's limits. Each check
+says what it measured, its limit and whether it passed, so that a failing verdict explains
+itself. ``format_summary`` is the human version printed by the runner.
+"""
+
+import numpy as np
+
+from fpga_robotics.checks.sensor_metrics import CHECK_METRIC, SENSOR_CHECKS, sensor_check
+from fpga_robotics.sim.world.config import MAX_TIME
+
+__all__ = [
+    "CHECKS",
+    "CHECK_OUTPUTS",
+    "DESIGN_OUTPUTS",
+    "TIMING_FIELDS",
+    "compute_metrics",
+    "evaluate_checks",
+    "format_summary",
+    "verdict",
+]
+
+_DAY = MAX_TIME  # s
+#: Pass criteria a scenario may state in its ``[checks]`` table:
+#: name → (type, (lowest, highest, unit) limit allowed, meaning).
+CHECKS = {
+    "acquired_within_s": (float, (0, _DAY, "s"),
+                          "the design reports the target found within this time"),
+    "mean_distance_max_m": (float, (0, 1000, "m"),
+                            "mean robot-to-target distance (centres) at most this"),
+    "min_distance_min_m": (float, (0, 1000, "m"),
+                           "closest robot-to-target distance (centres) at least this"),
+    "max_person_collisions": (int, (0, 10**6, ""), "at most this many collisions with a person"),
+    "max_robot_at_fault_collisions": (
+        int, (0, 10**6, ""),
+        ("at most this many times the robot drove into a person (moving towards them faster "
+         "than sim.world.AT_FAULT_SPEED at the touch)"),
+    ),
+    "max_tip_overs": (int, (0, 1, ""),
+                      ("the robot tipped over at most this often (0: never; sim.world tip-over "
+                       "model)")),
+    "max_oscillation_hz": (float, (0, 1000, "Hz"),
+                           ("the commanded turn rate W changes sign at most this often per "
+                            "second while the target is centred")),
+    "max_off_target_fraction": (
+        float, (0, 1, ""),
+        ("the design's centroid is more than an eighth of the image width from the target's "
+         "image column in at most this fraction of the frames in which it reports found with "
+         "the target's centre in view (a non-target object taken for the target)")),
+    "mean_centroid_error_max_px": (
+        float, (0, 10000, "px"),
+        ("mean distance of the design's centroid from the target's image column (frames found "
+         "with the target's centre in view) at most this; with the target straight ahead, the "
+         "centroid's distance from the image centre")),
+    "max_led_wrong_side_fraction": (
+        float, (0, 1, ""),
+        ("the design's centroid LEDs point the wrong way (an LED of the other half lit with the "
+         "target an eighth of the width or more to one side, an outermost LED lit with it "
+         "within a sixteenth of the centre) in at most this fraction of the frames found "
+         "with the target in view (led_wrong_side_fraction)")),
+    "max_led_misplaced_fraction": (
+        float, (0, 1, ""),
+        ("the lit centroid LEDs are not the one above the target (the LED of the window's "
+         "eighth that holds the target's image column; near a border between eighths either "
+         "neighbour, near the image centre also the middle pair) in at most this fraction of "
+         "the frames found with the target's centre inside the window (led_misplaced_fraction)"
+         )),
+    "max_wheel_command_dps": (
+        float, (0, 32768, "DPS"),
+        ("the design never commands a wheel faster than this, either way "
+         "(peak_wheel_command_dps): the speed the motors are rated for")),
+    "max_search_travel_m": (
+        float, (0, 1000, "m"),
+        ("while the design searches (from a search started to the target found again) the "
+         "robot's centre travels at most this far: it turns in place (search_travel_m)")),
+    "max_heading_overshoot_deg": (
+        float, (0, 180, "deg"),
+        "the robot turns at most this far past the target (heading_overshoot_deg)"),
+    "max_wall_collisions": (int, (0, 10**6, ""), "at most this many collisions with a wall"),
+    "max_furniture_collisions": (int, (0, 10**6, ""),
+                                 "at most this many collisions with furniture"),
+    "target_in_view_min_fraction": (float, (0, 1, ""),
+                                    "the target is in the camera's view this often"),
+    "found_min_fraction": (float, (0, 1, ""),
+                           "after first acquisition, the design reports found this often"),
+    "reacquired_within_s": (
+        float,
+        (0, _DAY, "s"),
+        ("the design lost the target and searched at least once, and every loss ended with the "
+        "target found again within this time"),
+    ),
+}
+
+#: The design's per-frame scalar outputs. A design may lack some (a foreign Verilog design whose
+#: port map names no such port: its ``FrameResult`` holds None); those are *absent*, never 0:
+#: NaN in the trajectory, listed in ``absent_outputs``, the metrics made of them None, the
+#: checks that need them "n/a" (left out of the verdict), nothing drawn for them in the viewer.
+DESIGN_OUTPUTS = ("found", "proximity", "centroid_x", "centroid_leds", "motor_left",
+                  "motor_right")
+
+#: The design outputs a check is measured from (checks not named here need none).
+#: The sensor designs' checks (fpga_robotics.checks.sensor_metrics).
+CHECKS.update(SENSOR_CHECKS)
+CHECK_OUTPUTS = {
+    "acquired_within_s": ("found",),
+    "found_min_fraction": ("found",),
+    "reacquired_within_s": ("found",),
+    "max_off_target_fraction": ("found", "centroid_x"),
+    "mean_centroid_error_max_px": ("found", "centroid_x"),
+    "max_oscillation_hz": ("found", "centroid_x"),
+    "max_led_wrong_side_fraction": ("found", "centroid_leds"),
+    "max_led_misplaced_fraction": ("found", "centroid_leds"),
+    "max_wheel_command_dps": ("motor_left", "motor_right"),
+    "max_search_travel_m": ("found",),
+}
+
+#: Metrics made of design outputs: name -> the outputs they need (None when one is absent).
+_METRIC_OUTPUTS = {
+    "found_fraction": ("found",),
+    "found_after_acquisition_fraction": ("found",),
+    "acquired_at_s": ("found",),
+    "losses": ("found",),
+    "searches": ("found",),
+    "searched_losses": ("found",),
+    "searched_reacquisitions": ("found",),
+    "reacquire_times_s": ("found",),
+    "unrecovered_losses_s": ("found",),
+    "oscillation_hz": ("found", "centroid_x"),
+    "off_target_fraction": ("found", "centroid_x"),
+    "mean_centroid_error_px": ("found", "centroid_x"),
+    "led_wrong_side_fraction": ("found", "centroid_leds"),
+    "led_misplaced_fraction": ("found", "centroid_leds"),
+    "peak_wheel_command_dps": ("motor_left", "motor_right"),
+    "search_travel_m": ("found",),
+}
+
+#: Summary fields that depend on the machine, not on the simulation.
+TIMING_FIELDS = (
+    "wall_time_s", "ms_per_frame", "realtime_factor", "cpu_ms_per_frame", "backend_setup_s",
+    "cycles_per_wall_s",
+)
+
+
+_NO_TARGET = "no target person: no distance to compare"
+
+
+def _round(x, digits=4):
+    return None if x is None else round(float(x), digits)
+
+
+#: The design's centroid points away from the target when it is further than this fraction of
+#: the image width from the target's column.
+OFF_TARGET_FRACTION = 0.125
+#: The target is centred when the design's centroid is within this fraction of the image
+#: width from the centre (for the oscillation metric).
+CENTRED_FRACTION = 0.125
+
+
+def compute_metrics(traj, events, collisions, frame_period, *, at_fault_collisions=0,
+                    width=None, absent=(), margin_x=None):
+    """Reduce a run to numbers.
+
+    Parameters
+    ----------
+    traj : dict of numpy arrays, one entry per camera frame
+        ``t``, ``x``, ``y``, ``found``, ``target_distance`` (NaN without target),
+        ``target_in_view``.
+    events : list of (frame, time, text)
+    collisions : dict kind → count
+    frame_period : float
+    at_fault_collisions : int
+        Collisions with a person the robot drove into (``World.at_fault_collisions``).
+    width : int, optional
+        The image width, pixels: the oscillation metric needs the centre of the image
+        (without it, or without ``cmd_w``/``centroid_x``, the metric is None).
+    absent : collection of str
+        ``DESIGN_OUTPUTS`` the design does not produce (their trajectory entries are NaN): the
+        metrics made of them are None, and ``absent_outputs`` lists them.
+    margin_x : int, optional
+        The columns the design's tracking window leaves on each side (the LEDs sit above its
+        eighths); default ``width // 10``, the design's default.
+    """
+    absent = [name for name in DESIGN_OUTPUTS if name in set(absent)]
+    if absent:
+        present = {k: v for k, v in traj.items() if k not in absent}
+        if "found" in absent:  # the metrics below read it; theirs are replaced by None
+            present["found"] = np.zeros(len(traj["t"]), bool)
+        m = compute_metrics(present, events, collisions, frame_period,
+                            at_fault_collisions=at_fault_collisions, width=width,
+                            margin_x=margin_x)
+        for name, needs in _METRIC_OUTPUTS.items():
+            if any(o in absent for o in needs):
+                m[name] = None
+        m["absent_outputs"] = absent
+        return m
+    t = traj["t"]
+    n = len(t)
+    dist = traj["target_distance"]
+    valid = ~np.isnan(dist)
+    found = traj["found"]
+    first = int(np.argmax(found)) if found.any() else None
+    acquired_at = float(t[first]) if first is not None else None
+    found_after = float(found[first:].mean()) if first is not None else 0.0
+    path = float(np.hypot(np.diff(traj["x"]), np.diff(traj["y"])).sum()) if n > 1 else 0.0
+
+    # Loss episodes: from a "target lost" to the next "target found".
+    episodes = []  # (lost_time, found_time or None, searched)
+    open_ep = None
+    for _frame, time, text in events:
+        if text == "target lost":
+            open_ep = [time, None, False]
+            episodes.append(open_ep)
+        elif text == "search started" and open_ep is not None:
+            open_ep[2] = True
+        elif text == "target found" and open_ep is not None:
+            open_ep[1] = time
+            open_ep = None
+    end_time = float(t[-1]) + frame_period if n else 0.0
+    reacq = [round(f - lost, 4) for lost, f, _ in episodes if f is not None]
+    unrecovered = [round(end_time - lost, 4) for lost, f, _ in episodes if f is None]
+    tipped = [(time, text) for _f, time, text in events if text.startswith("tipped over")]
+    return {
+        "min_distance_m": _round(dist[valid].min()) if valid.any() else None,
+        "mean_distance_m": _round(dist[valid].mean()) if valid.any() else None,
+        "target_in_view_fraction": _round(traj["target_in_view"].mean()) if n else 0.0,
+        "found_fraction": _round(found.mean()) if n else 0.0,
+        "found_after_acquisition_fraction": _round(found_after),
+        "acquired_at_s": _round(acquired_at),
+        "collisions": dict(collisions),
+        "robot_at_fault_collisions": int(at_fault_collisions),
+        "losses": len(episodes),
+        "searches": sum(1 for _, _, text in events if text == "search started"),
+        "searched_losses": sum(1 for ep in episodes if ep[2]),
+        "searched_reacquisitions": sum(1 for ep in episodes if ep[2] and ep[1] is not None),
+        "reacquire_times_s": reacq,
+        "unrecovered_losses_s": unrecovered,
+        "path_length_m": _round(path),
+        "tipped_over_at_s": _round(tipped[0][0]) if tipped else None,
+        "tip_overs": len(tipped),
+        "max_wheel_command_step_dps": _max_command_step(traj),
+        "oscillation_hz": _oscillation(traj, width, n * frame_period),
+        **_off_target(traj, width),
+        "led_wrong_side_fraction": _led_wrong_side(traj, width),
+        "led_misplaced_fraction": _led_misplaced(traj, width, margin_x),
+        "peak_wheel_command_dps": _peak_command(traj),
+        "search_travel_m": _search_travel(traj, events),
+        "heading_overshoot_deg": _heading_overshoot(traj),
+        "absent_outputs": [],
+    }
+
+
+def _heading_overshoot(traj):
+    """How far the robot turns past the target, degrees: the largest bearing error (the
+    target's bearing from the robot's centre, relative to its heading) on the far side once
+    the error has changed sign, over frames with the target's centre in view (a frame out of
+    view starts afresh). Meaningful with a standing target (a step response, e.g. ``approach``
+    with ``robot.heading_deg=20``); a walking target crossing the robot's axis counts too.
+    None without the fields."""
+    need = ("x", "y", "heading", "target_x", "target_y", "target_column")
+    if any(k not in traj for k in need) or len(traj["x"]) == 0:
+        return None
+    b = np.arctan2(traj["target_y"] - traj["y"], traj["target_x"] - traj["x"]) - traj["heading"]
+    b = np.degrees((b + np.pi) % (2 * np.pi) - np.pi)
+    best, last, crossed = 0.0, 0.0, False
+    for bk, seen in zip(b, ~np.isnan(np.asarray(traj["target_column"], dtype=float))):
+        if not seen:
+            last, crossed = 0.0, False
+            continue
+        sign = np.sign(bk)
+        if sign == 0:
+            continue
+        crossed = crossed or (last != 0 and sign != last)
+        if crossed:
+            best = max(best, abs(float(bk)))
+        last = sign
+    return _round(best, 2)
+
+
+def _off_target(traj, width):
+    """How far the design's centroid is from the target's image column (``target_column``),
+    over the frames in which it reports found and the target's centre is in view: the
+    fraction of them with an error above ``OFF_TARGET_FRACTION * width``, and the mean error
+    (pixels). None without such frames or fields."""
+    none = {"off_target_fraction": None, "mean_centroid_error_px": None}
+    if width is None or "target_column" not in traj or "centroid_x" not in traj:
+        return none
+    column = np.asarray(traj["target_column"], dtype=float)
+    ok = traj["found"] & ~np.isnan(column)
+    if not ok.any():
+        return none
+    err = np.abs(np.asarray(traj["centroid_x"], dtype=float)[ok] - column[ok])
+    return {"off_target_fraction": _round((err > OFF_TARGET_FRACTION * width).mean()),
+            "mean_centroid_error_px": _round(err.mean(), 2)}
+
+
+#: The target is on one side when its image column is at least this fraction of the image
+#: width from the centre (``led_wrong_side_fraction``).
+LED_SIDE_FRACTION = 0.125
+
+
+def _led_wrong_side(traj, width):
+    """How often the centroid LEDs point the wrong way, over the frames found with the
+    target's centre in view: at least ``LED_SIDE_FRACTION`` of the width to one side, an LED of
+    the other half is lit (bits 0-3 are the left half, 4-7 the right); within half that of the
+    centre, one of the two outermost LEDs of a side is lit (bits 0, 1, 6, 7: they light only
+    when half the target's pixels are in the outer quarter of the window). None without such
+    frames or fields."""
+    if width is None or "target_column" not in traj or "centroid_leds" not in traj:
+        return None
+    column = np.asarray(traj["target_column"], dtype=float)
+    offset = column - width / 2
+    seen = traj["found"] & ~np.isnan(column)
+    side = seen & (np.abs(offset) >= LED_SIDE_FRACTION * width)
+    centre = seen & (np.abs(offset) <= LED_SIDE_FRACTION * width / 2)
+    judged = side | centre
+    if not judged.any():
+        return None
+    leds = np.asarray(traj["centroid_leds"], dtype=np.int64)
+    other_half = np.where(offset < 0, leds & 0xF0, leds & 0x0F) != 0
+    outer = (leds & 0b1100_0011) != 0
+    wrong = (side & other_half) | (centre & outer)
+    return _round(wrong[judged].mean())
+
+
+#: Near a border between two of the window's eighths, or near the image centre, the LED
+#: above the target is ambiguous within this fraction of the image width
+#: (``led_misplaced_fraction``): a body a few pixels across straddles the border.
+LED_BORDER_FRACTION = 1 / 32
+#: The middle pair of LEDs (the design's "centred" code).
+LED_CENTRED = 0b0001_1000
+
+
+def _led_misplaced(traj, width, margin_x=None):
+    """How often the lit LEDs are not the one above the target, over the frames found with
+    the target's centre inside the tracking window's columns (``margin_x`` from each side;
+    default ``width // 10``): LED k sits above the window's k-th eighth (from the left); the
+    right code is that LED alone, or, with the column within ``LED_BORDER_FRACTION`` of the
+    width from a border between eighths, the LED on either side of it, or, that close to the
+    image centre, the middle pair too. Any other code (no LED, two LEDs, the wrong one) is
+    misplaced. None without such frames or fields."""
+    if width is None or "target_column" not in traj or "centroid_leds" not in traj:
+        return None
+    margin = width // 10 if margin_x is None else margin_x
+    bin_width = (width - 2 * margin) / 8
+    if bin_width <= 0:
+        return None
+    column = np.asarray(traj["target_column"], dtype=float)
+    judged = traj["found"] & ~np.isnan(column)
+    judged &= (column >= margin) & (column < width - margin)
+    if not judged.any():
+        return None
+    col = column[judged]
+    leds = np.asarray(traj["centroid_leds"], dtype=np.int64)[judged]
+    tol = LED_BORDER_FRACTION * width
+    bins = np.clip(((col - margin) // bin_width).astype(np.int64), 0, 7)
+    allowed = np.left_shift(1, bins)
+    left = np.clip(((col - tol - margin) // bin_width).astype(np.int64), 0, 7)
+    right = np.clip(((col + tol - margin) // bin_width).astype(np.int64), 0, 7)
+    ok = (leds == allowed) | (leds == np.left_shift(1, left)) | (leds == np.left_shift(1, right))
+    ok |= (np.abs(col - width / 2) <= tol) & (leds == LED_CENTRED)
+    return _round((~ok).mean())
+
+
+def _peak_command(traj):
+    """The largest wheel command either way, DPS (of the wheels whose command the design
+    produces; None with neither)."""
+    wheels = [k for k in ("motor_left", "motor_right") if k in traj]
+    if not wheels or len(traj[wheels[0]]) == 0:
+        return None
+    return int(max(np.abs(np.asarray(traj[k], dtype=float)).max() for k in wheels))
+
+
+def _search_travel(traj, events):
+    """The longest distance the robot's centre travelled during one search: from a "search
+    started" event's frame to the next "target found" (or the last frame), metres. None
+    without a search."""
+    starts, longest = None, None
+    x, y = np.asarray(traj["x"], dtype=float), np.asarray(traj["y"], dtype=float)
+    episodes = []
+    for frame, _time, text in events:
+        if text == "search started" and starts is None:
+            starts = frame
+        elif text == "target found" and starts is not None:
+            episodes.append((starts, frame))
+            starts = None
+    if starts is not None:
+        episodes.append((starts, len(x) - 1))
+    for a, b in episodes:
+        seg = slice(a, min(b, len(x) - 1) + 1)
+        travel = float(np.hypot(np.diff(x[seg]), np.diff(y[seg])).sum())
+        longest = travel if longest is None else max(longest, travel)
+    return _round(longest)
+
+
+def _max_command_step(traj):
+    """The largest change of a wheel's command from one frame to the next, DPS (of the wheels
+    whose command the design produces; None with neither)."""
+    wheels = [k for k in ("motor_left", "motor_right") if k in traj]
+    if not wheels or len(traj[wheels[0]]) < 2:
+        return None
+    steps = [np.abs(np.diff(np.asarray(traj[k], dtype=float))).max() for k in wheels]
+    return int(max(steps))
+
+
+def _oscillation(traj, width, seconds):
+    """Sign changes of the commanded turn rate W per second while the design reports the
+    target found within ``CENTRED_FRACTION`` of the image width from the centre: a steering
+    that swings left-right-left around a centred target. Frames with W = 0 (straight ahead)
+    keep the last sign, so left-straight-right counts once; a frame off-centre starts the
+    count afresh. Per second of centred time; None if the target was never centred, or
+    without the fields."""
+    if width is None or "cmd_w" not in traj or "centroid_x" not in traj or seconds <= 0:
+        return None
+    w = np.asarray(traj["cmd_w"], dtype=float)
+    centred = traj["found"] & (np.abs(np.asarray(traj["centroid_x"]) - width / 2)
+                               <= CENTRED_FRACTION * width)
+    if not centred.any():
+        return None
+    flips, last = 0, 0.0
+    for wk, ck in zip(np.sign(w), centred):
+        if not ck:
+            last = 0.0
+        elif wk != 0:
+            flips += bool(last * wk < 0)
+            last = wk
+    return _round(flips / (seconds * centred.mean()))
+
+
+def _check(name, passed, value, limit, text):
+    return {"name": name, "passed": bool(passed), "value": value, "limit": limit, "text": text}
+
+
+def _not_measured(name, limit, missing):
+    """A check the design's outputs cannot measure: ``passed`` None, left out of the verdict."""
+    names = " or ".join(f"`{o}`" for o in missing)
+    return {"name": name, "passed": None, "value": None, "limit": limit,
+            "text": f"not measured: the design has no {names} output"}
+
+
+def evaluate_checks(checks, m):
+    """The scenario's checks against the metrics ``m``: a list of result dicts, in order.
+    ``passed`` is True or False, or None for a check that needs a design output the design
+    lacks (``m["absent_outputs"]``)."""
+    out = []
+    absent = m.get("absent_outputs") or ()
+    for name, limit in checks.items():
+        missing = [o for o in CHECK_OUTPUTS.get(name, ()) if o in absent]
+        if missing:
+            out.append(_not_measured(name, limit, missing))
+            continue
+        if name == "acquired_within_s":
+            v = m["acquired_at_s"]
+            ok = v is not None and v <= limit
+            text = (f"target first found at {v:.2f} s (limit {limit} s)" if v is not None
+                    else "the target was never found")
+        elif name == "mean_distance_max_m":
+            v = m["mean_distance_m"]
+            ok = v is not None and v <= limit
+            text = (f"mean distance {v} m (limit <= {limit} m)" if v is not None
+                    else f"{_NO_TARGET} (limit <= {limit} m)")
+        elif name == "min_distance_min_m":
+            v = m["min_distance_m"]
+            ok = v is not None and v >= limit
+            text = (f"min distance {v} m (limit >= {limit} m)" if v is not None
+                    else f"{_NO_TARGET} (limit >= {limit} m)")
+        elif name == "max_robot_at_fault_collisions":
+            v = m["robot_at_fault_collisions"]
+            ok = v <= limit
+            text = f"the robot drove into a person {v} time(s) (limit {limit})"
+        elif name == "max_tip_overs":
+            v = m["tip_overs"]
+            ok = v <= limit
+            text = ("the robot never tipped over" if v == 0
+                    else f"the robot tipped over at {m['tipped_over_at_s']:.2f} s (limit {limit})")
+        elif name == "max_oscillation_hz":
+            v = m["oscillation_hz"]
+            ok = v is None or v <= limit
+            text = ("the target was never centred" if v is None
+                    else f"W changes sign {v:.2f} times per second with the target centred "
+                         f"(limit {limit})")
+        elif name == "max_off_target_fraction":
+            v = m["off_target_fraction"]
+            ok = v is None or v <= limit
+            text = ("the design never reported the target found with it in view" if v is None
+                    else f"centroid away from the target in {v:.0%} of the frames with the "
+                         f"target found and in view (limit <= {limit:.0%})")
+        elif name == "mean_centroid_error_max_px":
+            v = m["mean_centroid_error_px"]
+            ok = v is not None and v <= limit
+            text = ("the design never reported the target found with it in view" if v is None
+                    else f"centroid {v:.2f} px from the target's image column on average "
+                         f"(limit <= {limit} px)")
+        elif name == "max_led_wrong_side_fraction":
+            v = m["led_wrong_side_fraction"]
+            ok = v is None or v <= limit
+            text = ("the target was never found to one side or at the centre" if v is None
+                    else f"centroid LEDs point the wrong way in {v:.0%} of the frames judged "
+                         f"(limit <= {limit:.0%})")
+        elif name == "max_led_misplaced_fraction":
+            v = m["led_misplaced_fraction"]
+            ok = v is None or v <= limit
+            text = ("the target was never found inside the window" if v is None
+                    else f"the lit LEDs are not the one above the target in {v:.1%} of the "
+                         f"frames judged (limit <= {limit:.1%})")
+        elif name == "max_wheel_command_dps":
+            v = m["peak_wheel_command_dps"]
+            ok = v is None or v <= limit
+            text = ("no wheel command" if v is None
+                    else f"largest wheel command {v} DPS (limit <= {limit:g} DPS)")
+        elif name == "max_search_travel_m":
+            v = m["search_travel_m"]
+            ok = v is None or v <= limit
+            text = ("the design never searched" if v is None
+                    else f"the robot travelled {v:.2f} m during a search (limit <= {limit} m)")
+        elif name == "max_heading_overshoot_deg":
+            v = m["heading_overshoot_deg"]
+            ok = v is not None and v <= limit
+            text = ("no heading to compare" if v is None
+                    else f"turned {v:.1f} deg past the target (limit <= {limit} deg)")
+        elif name in SENSOR_CHECKS:
+            ok, text = sensor_check(name, limit, m)
+            v = m.get(CHECK_METRIC[name])
+        elif name.startswith("max_") and name.endswith("_collisions"):
+            kind = name[len("max_"): -len("_collisions")]
+            v = int(m["collisions"].get(kind, 0))
+            ok = v <= limit
+            text = f"{v} collision(s) with {kind} (limit {limit})"
+        elif name == "target_in_view_min_fraction":
+            v = m["target_in_view_fraction"]
+            ok = v >= limit
+            text = f"target in view {v:.0%} of frames (limit >= {limit:.0%})"
+        elif name == "found_min_fraction":
+            v = m["found_after_acquisition_fraction"]
+            ok = m["acquired_at_s"] is not None and v >= limit
+            text = f"found in {v:.0%} of frames after acquisition (limit >= {limit:.0%})"
+        elif name == "reacquired_within_s":
+            times = m["reacquire_times_s"]
+            late = [u for u in m["unrecovered_losses_s"] if u > limit]
+            v = max(times) if times else None
+            ok = m["searched_reacquisitions"] >= 1 and all(x <= limit for x in times) and not late
+            if m["searched_losses"] == 0:
+                text = "the target was never lost long enough for the design to search"
+            elif late:
+                text = f"target lost and not found again for {max(late):.2f} s (limit {limit} s)"
+            elif m["searched_reacquisitions"] == 0:
+                text = "the design searched but the run ended before it found the target again"
+            else:
+                text = (f"{len(times)} re-acquisition(s), slowest {v:.2f} s after the loss "
+                        f"(limit {limit} s)")
+        else:  # validated by the scenario loader; keep a clear message anyway
+            raise ValueError(f"unknown check {name!r}")
+        out.append(_check(name, ok, v, limit, text))
+    return out
+
+
+def verdict(check_results):
+    """"pass" when no check failed (checks that could not be measured do not count)."""
+    return "fail" if any(c["passed"] is False for c in check_results) else "pass"
+
+
+def format_summary(s):
+    """The human summary printed at the end of a run (several lines)."""
+    rtf = s["realtime_factor"]
+    lines = [
+        f"scenario {s['scenario']}  backend {s['backend']}  {s['resolution']}  seed {s['seed']}",
+        (f"  {s['frames']} frames, {s['sim_time_s']:.1f} s simulated in {s['wall_time_s']:.2f} s"
+        f" ({s['ms_per_frame']:.2f} ms/frame, "
+        f"{f'{rtf:.1f}x' if rtf is not None else 'n/a'} real time)"),
+    ]
+    if s.get("timing") is not None:
+        rate = s.get("cycles_per_wall_s")
+        rate = f", {rate / 1e6:.1f} M/s of wall time" if rate else ""
+        clock = (f"real clock at {s['clock_hz'] / 1e6:g} MHz" if s["timing"] == "real_clock"
+                 else "compressed (clocked while pixels flow)")
+        lines.append(f"  timing: {clock}; {s['sim_cycles']:,} design cycles{rate}")
+    if s.get("ended_early"):
+        lines.append(f"  run ended early: {s['ended_early']}")
+    if s.get("absent_outputs"):
+        lines.append("  design outputs absent (not produced by the design): "
+                     + ", ".join(s["absent_outputs"]))
+    acq = s["acquired_at_s"]
+    found = (f"{s['found_fraction']:.0%}" if s["found_fraction"] is not None
+             else "n/a (no `found` output)")
+    searches = s["searches"] if s["searches"] is not None else "n/a"
+    # Without a target person every distance is missing (the trajectory holds NaN).
+    if s["min_distance_m"] is None:
+        lines.append(
+            f"  target: none in the scenario (the design reported found in "
+            f"{found} of frames, {searches} search(es))")
+        lines.append(f"  distance: n/a (no target person); path {s['path_length_m']:.1f} m")
+    else:
+        lines.append(
+            "  target: "
+            + (f"first found at {acq:.2f} s" if acq is not None
+               else "never found" if s["found_fraction"] is not None else "acquisition n/a")
+            + f", in view {s['target_in_view_fraction']:.0%}, found {found}"
+            + f", {searches} search(es)"
+        )
+        lines.append(
+            f"  distance: min {s['min_distance_m']:.2f} m, mean {s['mean_distance_m']:.2f} m; "
+            f"path {s['path_length_m']:.1f} m"
+        )
+    coll = ", ".join(f"{k} {v}" for k, v in s["collisions"].items()) or "none"
+    lines.append(f"  collisions: {coll}")
+    for c in s["checks"]:
+        mark = {True: "ok", False: "FAIL", None: "n/a"}[c["passed"]]
+        lines.append(f"  [{mark}] {c['name']}: {c['text']}")
+    lines.append(f"verdict: {s['verdict'].upper()}")
+    return "\n".join(lines)

@@ -1,0 +1,118 @@
+"""``fpga-robotics``: one command, with a subcommand for each job.
+
+    fpga-robotics run [options]           closed loop (python -m fpga_robotics.run)
+    fpga-robotics export [options]        Verilog of the design (python -m fpga_robotics.export)
+    fpga-robotics board [options]         board top, LPF and bitstream
+    fpga-robotics bench [WHAT] [options]  benchmarks: design (default), pysim, camera, world,
+                                          viewer, shadow
+    fpga-robotics mutate [options]        mutation coverage (python -m fpga_robotics.mutation)
+    fpga-robotics readback FILE.rrd       what a saved recording holds
+    fpga-robotics sweep CAMPAIGN [options]  a verification campaign on Dask
+    fpga-robotics formal [options]        formal proofs of the gateware's promises
+
+Each subcommand is the ``main(argv, prog)`` of its module, so ``fpga-robotics run --help`` and
+``python -m fpga_robotics.run --help`` are the same command. New subcommands are one row of
+``COMMANDS`` (or ``BENCHMARKS``).
+"""
+
+import importlib
+import inspect
+import sys
+
+from fpga_robotics.cli.errors import USAGE_EXIT, run_cli
+
+__all__ = ["BENCHMARKS", "COMMANDS", "main"]
+
+#: Subcommand -> (module with ``main(argv, prog)``, one-line help).
+COMMANDS = {
+    "run": ("fpga_robotics.cli.run", "run a scenario in closed loop (or the design on real frames)"),
+    "export": ("fpga_robotics.flow.export", "write the design as one Verilog file"),
+    "board": ("fpga_robotics.flow.board",
+              "export a board top (Verilog + LPF) and build its bitstream"),
+    "bench": (None, "print speed figures (see `fpga-robotics bench --list`)"),
+    "ports": ("fpga_robotics.sim.backends.port_map",
+              "write (--example) or check a port map for run --design verilog:..."),
+    "mutate": ("fpga_robotics.cli.mutate",
+               "mutation coverage: Yosys mutants of the design against the golden model"),
+    "readback": ("fpga_robotics.cli.readback",
+                 "what a saved .rrd recording holds, entity by entity"),
+    "sweep": ("fpga_robotics.cli.sweep",
+              "a verification campaign: many runs on Dask, results table and report"),
+    "formal": ("fpga_robotics.flow.formal", "prove the gateware's promises (SymbiYosys, Yices)"),
+}
+
+#: ``fpga-robotics bench WHAT`` -> (module, one-line help); the first is the default.
+BENCHMARKS = {
+    "design": ("fpga_robotics.bench.design", "every simulation backend, and the paired fraction"),
+    "pysim": ("fpga_robotics.bench.pysim", "Amaranth's simulator, checked against the model"),
+    "camera": ("fpga_robotics.bench.camera", "the camera renderer"),
+    "world": ("fpga_robotics.bench.world", "the physics of the robot world"),
+    "render3d": ("fpga_robotics.bench.render3d",
+                 "the raster and the 3D renderer, per frame and in the closed loop"),
+    "viewer": ("fpga_robotics.bench.viewer", "the cost of logging to the rerun viewer"),
+    "shadow": ("fpga_robotics.bench.shadow", "a shadow design's cost in the closed loop"),
+    "loop": ("fpga_robotics.bench.loop", "where the closed loop's time goes, per frame"),
+    "foreign": ("fpga_robotics.bench.foreign",
+                "a Verilog design through a port map against the built-in Verilator backend"),
+    "ros": ("fpga_robotics.bench.ros", "writing a ROS 2 bag and publishing live to Foxglove"),
+    "pins": ("fpga_robotics.bench.pins", "the pin backends in real-clock time (Mcycles/s)"),
+}
+
+PROG = "fpga-robotics"
+
+
+def _listing(usage, heading, table):
+    """A usage line and an aligned ``name  help`` row per entry of ``table``."""
+    width = max(map(len, table))
+    rows = [f"  {name:<{width}}  {text}" for name, (_module, text) in table.items()]
+    return "\n".join([usage, "", f"{heading}:", *rows])
+
+
+def _usage():
+    return _listing(f"usage: {PROG} COMMAND [options]   ({PROG} COMMAND --help for its options)",
+                    "commands", COMMANDS)
+
+
+def _bench_list():
+    return _listing(f"usage: {PROG} bench [WHAT] [options]   (WHAT defaults to design)",
+                    "benchmarks", BENCHMARKS)
+
+
+def _call(module_name, argv, prog):
+    main = importlib.import_module(module_name).main
+    if "prog" in inspect.signature(main).parameters:
+        return run_cli(lambda a: main(a, prog=prog), argv, prog=prog)
+    return run_cli(main, argv, prog=prog)
+
+
+def main(argv=None):
+    argv = list(sys.argv[1:] if argv is None else argv)
+    if argv[:1] in (["-h"], ["--help"]):
+        print(_usage())
+        sys.exit(0)
+    if not argv:
+        print(_usage(), file=sys.stderr)
+        print(f"{PROG}: error: a command is needed", file=sys.stderr)
+        sys.exit(USAGE_EXIT)
+    command, rest = argv[0], argv[1:]
+    if command not in COMMANDS:
+        print(f"{PROG}: error: unknown command {command!r}; choose one of: "
+              f"{', '.join(COMMANDS)}", file=sys.stderr)
+        sys.exit(USAGE_EXIT)
+    if command == "bench":
+        if rest[:1] == ["--list"]:
+            print(_bench_list())
+            sys.exit(0)
+        what = rest[0] if rest and not rest[0].startswith("-") else "design"
+        if what not in BENCHMARKS:
+            print(f"{PROG}: error: unknown benchmark {what!r}; choose one of: "
+                  f"{', '.join(BENCHMARKS)}", file=sys.stderr)
+            sys.exit(USAGE_EXIT)
+        if rest and rest[0] == what:
+            rest = rest[1:]
+        _call(BENCHMARKS[what][0], rest, f"{PROG} bench {what}")
+    _call(COMMANDS[command][0], rest, f"{PROG} {command}")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,231 @@
+"""``fpga-robotics mutate``: how many gateware bugs do the unit frames catch?
+
+Generates N mutants of ``FollowTarget`` with Yosys's ``mutate`` pass (seeded), builds one
+Verilator model holding all of them (``mutsel`` picks one), runs each through the unit judge
+(every output against the golden model on fixed frames), and writes ``mutants.json`` into
+the output folder; the terminal gets the score, the score per component and the mutants no
+frame shows.
+"""
+
+import argparse
+import os
+import sys
+import time
+
+from fpga_robotics.cli.errors import UsageError
+from fpga_robotics.cli.param_options import add_param_arguments, params_from_args
+from fpga_robotics.sim.files import check_output_dir, write_json_atomic
+from fpga_robotics.sim.mutation import MutationError, list_mutants
+from fpga_robotics.mutation.design import open_mutant_design, write_mutant_design
+from fpga_robotics.mutation.reasons import blind_spot_reason
+from fpga_robotics.mutation.scores import blind_spots, by_module, robot_score, unit_score
+from fpga_robotics.mutation.unit_judge import golden_results, judge_frames, judge_mutant
+
+__all__ = ["main"]
+
+
+def _campaign(name):
+    from fpga_robotics.sweep import load_campaign_file
+
+    return load_campaign_file(name)
+
+
+def _report_robot(out, campaign, mutants, verdicts, unit, robot, robot_verdicts, baseline,
+                  robot_s, recordings, say, width):
+    """The robot judge's lines, the recordings of the closest runs, and report.html."""
+    from fpga_robotics.mutation.report import write_report
+
+    rs = robot_score(unit, robot)
+    n_runs, n_pass = len(baseline["runs"]), len(baseline["passing"])
+    print(f"robot judge (campaign {campaign.name}: {n_pass} of {n_runs} runs pass unmutated): "
+          f"{rs['caught']} of {rs['judged']} unit-caught mutants caught: score "
+          f"{_percent(rs['score'])}; {_robot_rate(baseline['judged_here'], robot_s)}")
+    blind = blind_spots(unit, robot)
+    by_index = {m.index: m for m in mutants}
+    recorded = _record_closest(out, [robot_verdicts[k] for k in blind[:recordings]], say)
+    if blind:
+        print(f"blind spots: caught by the unit judge, missed by every run ({len(blind)}):")
+        effects = {v.index: v.effect() for v in verdicts}
+        reasons = {v.index: blind_spot_reason(v, width) for v in verdicts if v.index in blind}
+        for k in blind:
+            print(f"  {by_index[k].describe()}")
+            print(f"    unit: {effects[k]}")
+            print(f"    why: {reasons[k]}")
+            if robot_verdicts[k].get("replay"):
+                print(f"    closest run: {robot_verdicts[k]['replay']}"
+                      + (f"  (recording {recorded[k]})" if k in recorded else ""))
+    path = write_report(out, campaign.name, mutants, verdicts, robot_verdicts, baseline,
+                        recorded, width)
+    print(f"report: {path}")
+
+
+def _robot_rate(judged_here, seconds):
+    """The robot judge's rate: the mutants it judged in this run (not those ``--resume``
+    kept) per minute of its wall time, the baseline runs included."""
+    if not judged_here:
+        return "no mutant judged in this run (all kept by --resume)"
+    return f"{60 * judged_here / max(seconds, 1e-9):.0f} mutants/min"
+
+
+def _record_closest(out, verdicts, say):
+    """Record the closest-to-failing run of each verdict; ``{index: path}``."""
+    from fpga_robotics.sim.files import write_atomic
+    from fpga_robotics.sweep import runner
+
+    paths = {}
+    for v in verdicts:
+        if not v.get("argv"):
+            continue
+        o = runner.execute(v["argv"], record=1)
+        if o.get("recording"):
+            path = os.path.join(out, "recordings", f"mutant{v['index']}.rrd")
+            os.makedirs(os.path.dirname(path), exist_ok=True)
+            write_atomic(path, o["recording"], what="recording")
+            paths[v["index"]] = os.path.relpath(path, out)
+            say(f"recorded the closest run of mutant {v['index']}: {path}")
+    return paths
+
+DEFAULT_MUTANTS = 100
+MAX_MUTANTS = 4000
+
+
+def build_parser(prog):
+    p = argparse.ArgumentParser(
+        prog=prog,
+        description="Mutation coverage: Yosys mutants of the design, one build for all of "
+                    "them, each judged against the golden model on fixed frames "
+                    "(docs/mutation.md).")
+    p.add_argument("--mutants", type=int, default=DEFAULT_MUTANTS, metavar="N",
+                   help=f"how many mutants (default {DEFAULT_MUTANTS}, at most {MAX_MUTANTS})")
+    p.add_argument("--seed", type=int, default=1, metavar="S",
+                   help="Yosys's choice of mutants (default 1); the same seed, the same list")
+    p.add_argument("--out", default=None, metavar="DIR",
+                   help="output folder (default runs/mutation/n<N>-s<S>/)")
+    p.add_argument("--campaign", metavar="NAME|PATH",
+                   help="also judge the mutants the unit judge catches by this campaign's "
+                        "closed-loop verdicts (the robot judge; e.g. mutation, regression)")
+    p.add_argument("--workers", type=int, default=None, metavar="N",
+                   help="robot judge: Dask worker processes (default: the machine's cores)")
+    p.add_argument("--scheduler", metavar="ADDRESS",
+                   help="robot judge: an existing Dask scheduler (tcp://HOST:8786)")
+    p.add_argument("--resume", action="store_true",
+                   help="robot judge: keep the mutants already judged in the output folder")
+    p.add_argument("--recordings", type=int, default=5, metavar="N",
+                   help="robot judge: record the closest-to-failing run of the first N blind "
+                        "spots (default 5)")
+    p.add_argument("--quiet", action="store_true", help="no progress lines")
+    add_param_arguments(p)
+    return p
+
+
+def _check(args):
+    if not 1 <= args.mutants <= MAX_MUTANTS:
+        raise UsageError(f"--mutants must be 1..{MAX_MUTANTS}, got {args.mutants}")
+    if args.seed < 0:
+        raise UsageError(f"--seed must be >= 0, got {args.seed}")
+    if args.workers is not None and not 1 <= args.workers <= 256:
+        raise UsageError(f"--workers must be 1..256, got {args.workers}")
+    if args.recordings < 0:
+        raise UsageError(f"--recordings must be >= 0, got {args.recordings}")
+    if args.campaign is None and (args.workers or args.scheduler or args.resume):
+        raise UsageError("--workers, --scheduler and --resume go with --campaign (the robot "
+                         "judge)")
+
+
+def _percent(x):
+    return "n/a" if x is None else f"{100 * x:.1f}%"
+
+
+def main(argv=None, prog="python -m fpga_robotics.mutation"):
+    args = build_parser(prog).parse_args(argv)
+    _check(args)
+    params = params_from_args(args)
+    campaign = _campaign(args.campaign) if args.campaign is not None else None
+    out = args.out or os.path.join("runs", "mutation", f"n{args.mutants}-s{args.seed}")
+    check_output_dir(out, what="output folder")
+
+    def say(text):
+        if not args.quiet:
+            print(text, file=sys.stderr, flush=True)
+
+    t0 = time.perf_counter()
+    try:
+        mutants = list_mutants(params, args.mutants, args.seed)
+    except MutationError as exc:
+        raise UsageError(str(exc).splitlines()[0]) from None
+    netlist, ports = write_mutant_design(params, mutants, out)
+    design = open_mutant_design(params, netlist, ports, on_build=lambda t: say(f"{t} ..."))
+    build_s = time.perf_counter() - t0
+    try:
+        frames = judge_frames(params)
+        golden = golden_results(params, frames)
+        t1 = time.perf_counter()
+        verdicts = []
+        for k, m in enumerate(mutants, start=1):
+            verdicts.append(judge_mutant(design, m.index, frames, golden))
+            if k == len(mutants) or k * 10 // len(mutants) != (k - 1) * 10 // len(mutants):
+                say(f"unit judge: {k}/{len(mutants)} mutants, "
+                    f"{sum(v.caught for v in verdicts)} caught")
+        unit_s = time.perf_counter() - t1
+    finally:
+        design.close()
+
+    unit = {v.index: v.caught for v in verdicts}
+    robot_verdicts, baseline = {}, None
+    if campaign is not None:
+        from fpga_robotics.mutation.robot_judge import robot_judge
+
+        caught = [v.index for v in verdicts if v.caught]
+        t2 = time.perf_counter()
+        baseline, robot_verdicts = robot_judge(
+            campaign, netlist, ports, f"{params.width}x{params.height}", caught, out,
+            workers=args.workers, scheduler=args.scheduler, resume=args.resume, say=say)
+        robot_s = time.perf_counter() - t2
+    robot = {k: v["caught"] for k, v in robot_verdicts.items()}
+    blind = set(blind_spots(unit, robot))
+    score = unit_score(unit)
+    modules = by_module(mutants, unit, robot)
+    write_json_atomic(os.path.join(out, "mutants.json"), {
+        "design": {"width": params.width, "height": params.height},
+        "seed": args.seed,
+        "frames": len(frames),
+        "build_and_list_s": round(build_s, 2),
+        "unit_judge_s": round(unit_s, 2),
+        "unit_mutants_per_minute": round(60 * len(mutants) / unit_s, 1) if unit_s else None,
+        "unit": score,
+        "robot": robot_score(unit, robot) if campaign is not None else None,
+        "campaign": campaign.name if campaign is not None else None,
+        "robot_judge_s": round(robot_s, 2) if campaign is not None else None,
+        "baseline": baseline,
+        "modules": modules,
+        "mutants": [{**{k: v for k, v in m.__dict__.items()}, "sources": list(m.sources),
+                     "describe": m.describe(),
+                     "unit": {"caught": v.caught, "first_frame": v.first_frame,
+                              "differing": v.differing, "frames_differing": v.frames_differing,
+                              "max_difference": v.max_difference, "effect": v.effect()},
+                     "robot": robot_verdicts.get(m.index),
+                     "blind_spot_reason": (blind_spot_reason(v, params.width)
+                                           if m.index in blind else None)}
+                    for m, v in zip(mutants, verdicts)],
+    }, what="mutation results")
+
+    print(f"{len(mutants)} mutants of follow_target {params.width}x{params.height} "
+          f"(seed {args.seed}), {len(frames)} unit frames; build {build_s:.1f} s, "
+          f"unit judge {60 * len(mutants) / unit_s:.0f} mutants/min")
+    print(f"unit judge: {score['caught']} caught, {score['equivalent']} equivalent on these "
+          f"frames: score {_percent(score['score'])}")
+    width = max(len(name) for name in modules)
+    for name, row in modules.items():
+        robot_part = (f", robot judge {row['robot_caught']:>4}/{row['unit_caught']}"
+                      if campaign is not None else "")
+        print(f"  {name:<{width}}  {row['unit_caught']:>4}/{row['total']:<4} caught{robot_part}")
+    if campaign is not None:
+        _report_robot(out, campaign, mutants, verdicts, unit, robot, robot_verdicts, baseline,
+                      robot_s, args.recordings, say, params.width)
+    missed = [m for m, v in zip(mutants, verdicts) if not v.caught]
+    if missed:
+        print("equivalent on the unit frames (first 10):")
+        for m in missed[:10]:
+            print(f"  {m.describe()}")
+    print(f"wrote {os.path.join(out, 'mutants.json')}")
+    return 0

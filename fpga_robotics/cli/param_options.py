@@ -1,0 +1,74 @@
+"""The design's parameters as command-line options, shared by ``export``, ``board`` and the
+benchmarks: ``--preset NAME`` and one option per ``FollowTargetParams`` field
+(``--diff-min 5``, ``--base-dps 0,400,...``, ``--found-rule gt``)."""
+
+import argparse
+from dataclasses import fields
+
+from fpga_robotics.cli.errors import UsageError
+from fpga_robotics.hw.params import CHOICES, PRESETS, FollowTargetParams
+
+__all__ = ["add_param_arguments", "params_from_args"]
+
+#: Parameters given as a comma-separated list of ints on the command line.
+_TUPLE_PARAMS = ("proximity_thresholds", "base_dps", "steer_dps")
+
+
+def _int_list(text):
+    try:
+        return tuple(int(v, 0) for v in text.split(","))
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"expected comma-separated integers such as 0,400,300, got {text!r}"
+        ) from None
+
+
+def add_param_arguments(parser):
+    """Add ``--preset`` and one option per ``FollowTargetParams`` field (default: the
+    contract's default, or the preset's value)."""
+    group = parser.add_argument_group(
+        "design parameters (defaults: the contract's, docs/contract.md; with --preset the "
+        "preset's, the other options on top)")
+    # Checked in params_from_args, not by argparse: an unknown name is one line, exit 2.
+    group.add_argument("--preset", default=None, metavar="NAME",
+                       help=f"start from a preset: {', '.join(PRESETS)} "
+                            f"({'; '.join(PRESETS.values())})")
+    for f in fields(FollowTargetParams):
+        if not f.init:
+            continue
+        option = "--" + f.name.replace("_", "-")
+        if f.name in _TUPLE_PARAMS:
+            group.add_argument(option, type=_int_list, default=None, metavar="A,B,...",
+                               help=f"{f.name} as comma-separated ints")
+        elif f.name in CHOICES:
+            group.add_argument(option, default=None, metavar="{" + ",".join(CHOICES[f.name]) + "}",
+                               help=f"{f.name} (default {f.default})")
+        else:
+            group.add_argument(option, type=int, default=None, metavar="N",
+                               help=f"{f.name} (default {_default_text(f)})")
+
+
+def _default_text(f):
+    if f.name == "sx_bits":
+        return "the full width, wide enough for any frame"
+    if f.default is None:
+        return "derived from the geometry"
+    return str(f.default)
+
+
+def params_from_args(args):
+    """``FollowTargetParams`` from parsed options (the preset first, the other options on
+    top); a bad value or an unknown preset raises ``UsageError``."""
+    given = {}
+    for f in fields(FollowTargetParams):
+        if f.init and getattr(args, f.name, None) is not None:
+            given[f.name] = getattr(args, f.name)
+    preset = getattr(args, "preset", None)
+    if preset is not None and preset not in PRESETS:
+        raise UsageError(f"unknown --preset {preset!r}; known presets: {', '.join(PRESETS)}")
+    try:
+        if preset is not None:
+            return FollowTargetParams.preset(preset, **given)
+        return FollowTargetParams(**given)
+    except (ValueError, TypeError) as exc:
+        raise UsageError(f"bad design parameter: {exc}") from None

@@ -1,0 +1,542 @@
+"""``python -m fpga_robotics.run``: run a scenario in closed loop (or the design on real frames).
+
+Headless and faster than real time by default; prints a progress bar on stderr and a human
+summary at the end; ``--summary PATH`` writes the same as JSON. Exit status: 0 when the
+scenario's checks pass, 1 when they fail, 2 for a usage error (bad argument, unknown scenario
+or key, malformed file, unopenable source, missing simulator).
+"""
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+from fpga_robotics.cli.errors import UsageError, run_cli
+from fpga_robotics.hw.pixel import COLOR_SELECT
+from fpga_robotics.ros.run_options import RosOutputs, add_ros_arguments
+from fpga_robotics.sim.backends import BACKEND_NAMES
+from fpga_robotics.sim.files import check_output_path, write_json_atomic
+
+__all__ = ["TARGET_CLOTHING", "Progress", "build_parser", "main"]
+
+#: Clothing (shirt and trousers, linear RGB 0..1) that each colour select picks out clearly
+#: under the shipped scenarios' lighting: one channel group well above the others.
+TARGET_CLOTHING = {
+    "red": (0.85, 0.1, 0.1),
+    "green": (0.1, 0.75, 0.12),
+    "blue": (0.1, 0.15, 0.85),
+    "yellow": (0.85, 0.8, 0.1),
+    "magenta": (0.8, 0.1, 0.8),
+    "cyan": (0.1, 0.75, 0.8),
+}
+
+
+def build_parser(prog="python -m fpga_robotics.run"):
+    p = argparse.ArgumentParser(
+        prog=prog,
+        description="Run the FollowTarget design in closed loop with a simulated robot, camera "
+                    "and people, and check the scenario's pass criteria.",
+    )
+    p.add_argument("--scenario", default="follow_person", metavar="NAME|PATH",
+                   help="a shipped scenario (see --list-scenarios) or a .toml file "
+                        "(default: follow_person)")
+    p.add_argument("--list-scenarios", action="store_true", help="list the shipped scenarios")
+    p.add_argument("--backend", default="auto", choices=("auto", *BACKEND_NAMES),
+                   help="design simulator (default auto: the fastest compiled one available)")
+    p.add_argument("--resolution", metavar="WxH", help="camera and design resolution")
+    p.add_argument("--color", choices=tuple(COLOR_SELECT), help="initial colour select")
+    p.add_argument("--target-color", choices=tuple(TARGET_CLOTHING), metavar="C",
+                   help="dress the target person in C and follow C (colour select); one of "
+                        + ", ".join(TARGET_CLOTHING))
+    p.add_argument("--duration", type=float, metavar="S", help="simulated seconds")
+    p.add_argument("--seed", type=int, metavar="N", help="random seed (default: the scenario's)")
+    p.add_argument("--realtime", action="store_true", help="pace the simulation to the clock")
+    p.add_argument("--summary", metavar="PATH", help="write the summary as JSON")
+    p.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
+                   help="override a scenario value, e.g. robot.mass=12 (repeatable; TOML values)")
+    p.add_argument("--rerun", default="auto", metavar="MODE",
+                   help="viewer: save[:PATH.rrd] (plain save: a new name under runs/), spawn, "
+                        "connect[:URL], serve[:ADDRESS], off; default auto = spawn with a "
+                        "display, else save")
+    p.add_argument("--log-every", type=int, default=1, metavar="N",
+                   help="log every Nth frame's images to the viewer (default 1)")
+    p.add_argument("--source", metavar="camera:N|VIDEO|FOLDER|bag:PATH[:TOPIC]",
+                   help="run the design on real frames instead of the simulation (no physics)")
+    p.add_argument("--max-frames", type=int, metavar="N", help="with --source: stop after N")
+    p.add_argument("--shadow", metavar="SPEC",
+                   help="run a second design on the same frames without letting it drive: a "
+                        "preset name (published) and/or design KEY=VALUE items separated by ';' "
+                        "(e.g. 'diff_min=5;kp_num=2'); the summary reports where they differ")
+    p.add_argument("--shadow-backend", choices=("auto", *BACKEND_NAMES), default=None,
+                   help="simulator of the shadow design (default: the same as --backend)")
+    p.add_argument("--design", metavar="verilog:TOP.v[,MORE.v...]",
+                   help="run your own Verilog design (on Verilator) instead of FollowTarget; "
+                        "needs --ports (docs/foreign.md)")
+    p.add_argument("--ports", metavar="PORTS.toml",
+                   help="with --design: the port map of the Verilog design")
+    p.add_argument("--runtime", action="append", default=[], metavar="NAME=VALUE",
+                   help="with a Verilog design: hold its [runtime] input NAME at VALUE for the "
+                        "run (repeatable; e.g. mutsel=3 selects a mutant, docs/mutation.md)")
+    p.add_argument("--save-video", metavar="PATH.mp4|PATH.avi",
+                   help="also write the camera frames as a video (try it with --source)")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    add_ros_arguments(p)  # --bag, --live, --interactive, --paused, --replay-inputs
+    return p
+
+
+class Progress:
+    """A progress bar on stderr: redrawn in place on a terminal, a few plain lines otherwise."""
+
+    def __init__(self, label, stream=None):
+        self.stream = stream if stream is not None else sys.stderr
+        self.tty = bool(getattr(self.stream, "isatty", lambda: False)())
+        self.label = label
+        self.start = time.perf_counter()
+        self._last_draw = 0.0
+        self._last_decile = -1
+
+    def __call__(self, done, total):
+        now = time.perf_counter()
+        if total is None:  # open-ended source
+            if self.tty and (now - self._last_draw > 0.1):
+                self.stream.write(f"\r{self.label}: {done} frames")
+                self.stream.flush()
+                self._last_draw = now
+            return
+        if self.tty:
+            if now - self._last_draw < 0.1 and done < total:
+                return
+            self._last_draw = now
+            width = 30
+            filled = int(width * done / total)
+            rate = done / max(now - self.start, 1e-9)
+            self.stream.write(f"\r{self.label} [{'#' * filled}{'.' * (width - filled)}] "
+                              f"{done}/{total} frames, {rate:.0f} fps")
+            self.stream.flush()
+        else:
+            decile = 10 * done // total
+            if decile != self._last_decile and decile % 2 == 0:
+                self._last_decile = decile
+                self.stream.write(f"{self.label}: {10 * decile}% ({done}/{total} frames)\n")
+                self.stream.flush()
+
+    def finish(self):
+        if self.tty:
+            self.stream.write("\n")
+            self.stream.flush()
+
+
+
+def _overrides(args):
+    from fpga_robotics.scenario.load import parse_resolution
+
+    items = list(args.overrides)
+    if args.resolution is not None:
+        w, h = parse_resolution(args.resolution)
+        items.append(f'camera.resolution="{w}x{h}"')
+    if args.duration is not None:
+        if not args.duration > 0:
+            raise UsageError(f"--duration must be > 0 seconds, got {args.duration}")
+        items.append(f"sim.duration={float(args.duration)!r}")
+    if args.color is not None:
+        items.append(f'color.initial="{args.color}"')
+    return items
+
+
+def _video(path, fps):
+    """A ``CameraVideo`` context for ``--save-video``, or a context that yields None."""
+    import contextlib
+
+    if path is None:
+        return contextlib.nullcontext()
+    from fpga_robotics.loop.video_out import CameraVideo
+
+    return CameraVideo(path, fps)
+
+
+def _shadow_params(scenario, spec):
+    """The shadow design's parameters: the scenario's design with ``--shadow`` applied."""
+    if spec is None:
+        return None
+    from fpga_robotics.loop.shadow import shadow_overrides
+
+    try:
+        items = shadow_overrides(spec)
+    except ValueError as exc:
+        raise UsageError(str(exc)) from None
+    return scenario.with_overrides(items).params
+
+
+def _dress_target(scenario, color):
+    """The scenario with its target person dressed in ``color`` and the design's colour
+    select set to it (later colour changes of the scenario are kept)."""
+    people = scenario.data.get("people", [])
+    index = next((i for i, p in enumerate(people) if p.get("target")), None)
+    if index is None:
+        raise UsageError(f"--target-color: scenario {scenario.name!r} has no target person")
+    rgb = "[" + ", ".join(str(c) for c in TARGET_CLOTHING[color]) + "]"
+    return scenario.with_overrides([f"people.{index}.shirt_color={rgb}",
+                                    f"people.{index}.trousers_color={rgb}",
+                                    f'color.initial="{color}"'])
+
+
+def _open_backend(name, params, quiet=False):
+    from fpga_robotics.loop.compressed import make_backend
+    from fpga_robotics.sim.backends.base import BackendError
+
+    def tell(text):  # a first run compiles the model for seconds: say so
+        if not quiet:
+            print(f"{text} ...", file=sys.stderr, flush=True)
+
+    try:
+        return make_backend(name, params, on_build=tell)
+    except (BackendError, ValueError, ImportError) as exc:
+        raise UsageError(f"backend {name!r} cannot run here: {exc}") from None
+
+
+def _open_pin_design(args, scenario):
+    """The scenario's design on a pin-level backend (real-clock timing)."""
+    from fpga_robotics.loop.real_clock import make_pin_backend
+    from fpga_robotics.sim.backends.base import BackendError
+    from fpga_robotics.sim.pins import PinError
+
+    def tell(text):
+        if not args.quiet:
+            print(f"{text} ...", file=sys.stderr, flush=True)
+
+    if scenario.foreign is not None:  # a Verilog design on pins: on Verilator
+        if args.runtime:
+            raise UsageError("--runtime changes [runtime] inputs between frames in compressed "
+                             "timing; in real-clock timing they keep the port map's values")
+        try:
+            return make_pin_backend(args.backend, scenario, on_build=tell)
+        except (BackendError, PinError) as exc:
+            raise UsageError(f"--design: {exc}".splitlines()[0]) from None
+    try:
+        return make_pin_backend(args.backend, scenario, on_build=tell)
+    except (BackendError, PinError, ValueError, ImportError) as exc:
+        raise UsageError(f"backend {args.backend!r} cannot run here: {exc}") from None
+
+
+def _with_design_files(args, scenario):
+    """The scenario with ``--design``/``--ports`` as its foreign design (real-clock timing
+    runs the design the scenario names)."""
+    design_files = _design_files(args, scenario.foreign)
+    if design_files is None:
+        return scenario
+    import dataclasses
+
+    from fpga_robotics.scenario.load import ForeignDesignFiles
+
+    files, ports = design_files
+    return dataclasses.replace(scenario, foreign=ForeignDesignFiles(tuple(files), str(ports)))
+
+
+def _design_files(args, foreign=None):
+    """The Verilog files and port map of the foreign design (None without one): ``--design``
+    and ``--ports``, each overriding the scenario's ``[design] verilog`` / ``ports``
+    (``foreign``, a ``ForeignDesignFiles``); checks they go together."""
+    if args.design is None and foreign is None:
+        if args.ports is not None:
+            raise UsageError("--ports goes with --design verilog:FILE.v")
+        if getattr(args, "runtime", None):
+            raise UsageError("--runtime sets [runtime] inputs of a Verilog design: it goes with "
+                             "--design verilog:FILE.v (or a scenario's design.verilog)")
+        return None
+    runtime_values(args)  # a malformed item is an error before any build
+    if args.design is not None:
+        if (not args.design.startswith("verilog:")
+                or not args.design[len("verilog:"):].strip(",")):
+            raise UsageError(
+                f"--design must be verilog:FILE.v[,MORE.v...], got {args.design!r}")
+        files = [f for f in args.design[len("verilog:"):].split(",") if f]
+    else:
+        files = list(foreign.verilog)
+    ports = args.ports if args.ports is not None else (
+        foreign.ports if foreign is not None else None)
+    if ports is None:
+        raise UsageError("--design needs --ports PORTS.toml (the design's port map)")
+    if args.backend not in ("auto", "verilator"):
+        what = "--design" if args.design is not None else "the scenario's design.verilog"
+        raise UsageError(f"{what} runs on the verilator backend, not {args.backend!r}")
+    return files, ports
+
+
+def _open_design(args, params, foreign=None):
+    """The main design: ``--design`` (or the scenario's ``foreign`` design) on Verilator,
+    else FollowTarget on ``--backend``."""
+    design_files = _design_files(args, foreign)
+    if design_files is None:
+        return _open_backend(args.backend, params, args.quiet)
+    files, ports = design_files
+    from fpga_robotics.sim.backends.base import BackendError
+    from fpga_robotics.sim.backends.foreign import ForeignVerilatorBackend
+
+    def tell(text):
+        if not args.quiet:
+            print(f"{text} ...", file=sys.stderr, flush=True)
+
+    try:
+        # Outputs the map does not name stay None: absent in the summary and the viewer.
+        backend = ForeignVerilatorBackend(params, files=files, port_map=ports, on_build=tell)
+    except BackendError as exc:
+        raise UsageError(f"--design: {exc}".splitlines()[0]) from None
+    missing = [k for k in ("motor_left", "motor_right") if k not in
+               backend.design.port_map.outputs]
+    if missing:
+        backend.close()
+        raise UsageError(f"--design: the closed loop needs outputs.{missing[0]} in the port map")
+    design = _UserDesign(backend)
+    try:
+        apply_runtime(design, args)
+    except UsageError:
+        backend.close()
+        raise
+    return design
+
+
+def runtime_values(args):
+    """``--runtime NAME=VALUE`` items as ``{name: int}`` (``UsageError`` for a bad item)."""
+    values = {}
+    for item in getattr(args, "runtime", None) or ():
+        name, sep, value = item.partition("=")
+        try:
+            if not sep or not name.strip():
+                raise ValueError
+            values[name.strip()] = int(value.strip(), 0)
+        except ValueError:
+            raise UsageError(f"--runtime needs NAME=VALUE with an integer VALUE, got "
+                             f"{item!r}") from None
+    return values
+
+
+def apply_runtime(design, args):
+    """Hold the design's ``[runtime]`` inputs at the ``--runtime`` values (a design opened
+    once and reused for several runs gets its values again before each)."""
+    from fpga_robotics.sim.backends.base import BackendError
+
+    for name, value in runtime_values(args).items():
+        try:
+            design.set_runtime(name, value)
+        except BackendError as exc:
+            raise UsageError(f"--runtime: {exc}") from None
+
+
+class _UserDesign:
+    """A foreign design whose per-frame errors (a named timeout, a broken stream) are the
+    user's to fix: reported as one line and exit 2, like a bad port map."""
+
+    def __init__(self, backend):
+        self._backend = backend
+
+    def process_frame(self, frame, color_sel="red"):
+        from fpga_robotics.sim.backends.base import BackendError
+
+        try:
+            return self._backend.process_frame(frame, color_sel)
+        except BackendError as exc:
+            raise UsageError(f"--design: {exc}") from None
+
+    def __getattr__(self, name):
+        return getattr(self._backend, name)
+
+
+def _open_recorder(args, name):
+    if args.rerun == "off":
+        return None
+    if args.log_every < 1:
+        raise UsageError(f"--log-every must be >= 1, got {args.log_every}")
+    from fpga_robotics.viz import open_recorder
+
+    recorder = open_recorder(args.rerun, default_path=f"runs/{name}.rrd", app_id="fpga_robotics",
+                         log_every=args.log_every)
+    for line in recorder.pop_notices():  # where a live viewer is, or why it fell back
+        print(line, file=sys.stderr)
+    return recorder
+
+
+def _close_recorder(recorder, completed):
+    """Close the recording; after an interrupt, say at once where the data is (the summary
+    that would say it is not printed)."""
+    if recorder is None:
+        return []
+    text = recorder.close()  # the notices not yet taken, one a line
+    notices = text.splitlines() if text else []
+    if not completed:
+        for line in notices:
+            print(line, file=sys.stderr)
+        return []
+    return notices
+
+
+def _close_outputs(recorder, ros, completed):
+    """Close the ROS outputs (the terminal's modes restored first) and the recording;
+    returns their notices, the recording's first."""
+    try:
+        ros_notices = ros.close(completed)
+    finally:
+        notices = _close_recorder(recorder, completed)
+    return notices + ros_notices
+
+
+def _frame_callback(video, ros):
+    """The ``on_frame`` of a run: the video and the ROS outputs, each when asked for."""
+    calls = ([lambda record: video.write(record.camera_rgb)] if video is not None else []) + (
+        [ros.on_frame] if ros.active else [])
+    if not calls:
+        return None
+    if len(calls) == 1:
+        return calls[0]
+    return lambda record: [call(record) for call in calls]
+
+
+def _list_scenarios():
+    from fpga_robotics.scenario.load import shipped_scenarios
+
+    shipped = shipped_scenarios()
+    width = max(len(n) for n in shipped)
+    for name, (_path, desc) in shipped.items():
+        print(f"{name:<{width}}  {desc}")
+    return 0
+
+
+def _run_source(args, scenario, ros):
+    from fpga_robotics.loop.sources import open_source, run_source
+
+    ros.check_closed_loop_only()
+    if scenario.sim.timing == "real_clock":
+        raise UsageError(f"--source feeds camera frames to the design; scenario "
+                         f"{scenario.name!r} runs in real-clock timing (design.top = "
+                         f"{scenario.top!r}, sensors on pins): run it without --source")
+    params = scenario.params
+    source = open_source(args.source, params.width, params.height)
+    try:
+        design = _open_design(args, params, scenario.foreign)
+        recorder = None
+        completed = False
+        try:
+            recorder = _open_recorder(args, Path(str(args.source).replace(":", "_")).stem)
+            for line in ros.open(scenario, closed_loop=False):
+                print(line, file=sys.stderr)
+            progress = None if args.quiet else Progress("frames")
+            out = run_source(source, design, color=scenario.color_initial, recorder=recorder,
+                             progress=progress, max_frames=args.max_frames,
+                             hfov=scenario.camera.hfov,
+                             on_frame=ros.on_frame if ros.active else None)
+            if progress is not None:
+                progress.finish()
+            completed = True
+        finally:
+            design.close()
+            notices = _close_outputs(recorder, ros, completed)
+    finally:
+        source.close()
+    print(f"source {out['source']} ({out['source_kind']})  backend {out['backend']}  "
+          f"{out['resolution']}  colour {out['color']}")
+    if out["frames"]:
+        print(f"  {out['frames']} frames, {out['ms_per_frame']:.2f} ms/frame "
+              f"(design {out['design_ms_per_frame']:.2f} ms)")
+        print(f"  target found in {out['found_frames']} frames ({out['found_fraction']:.0%}), "
+              f"mean proximity {out['mean_proximity']:.2f}")
+    else:
+        print("  no frames")
+    for line in notices:
+        print(line)
+    if args.summary:
+        write_json_atomic(args.summary, out, what="--summary")
+    return 0
+
+
+def main(argv=None, prog="python -m fpga_robotics.run"):
+    args = build_parser(prog).parse_args(argv)
+    if args.list_scenarios:
+        return _list_scenarios()
+
+    from fpga_robotics.loop.compressed import run_scenario
+    from fpga_robotics.scenario.load import MAX_SEED, load_scenario
+    from fpga_robotics.checks.summary import format_summary
+
+    if args.seed is not None and not 0 <= args.seed <= MAX_SEED:
+        raise UsageError(f"--seed must be in 0..{MAX_SEED}, got {args.seed}")
+    if args.log_every < 1:  # checked now, before a model is built
+        raise UsageError(f"--log-every must be >= 1, got {args.log_every}")
+    if args.summary is not None:  # checked now, not after a long run
+        check_output_path(args.summary, what="--summary")
+    ros = RosOutputs(args)  # --bag, --live ...: checked now, not after a long run
+    scenario = load_scenario(args.scenario, _overrides(args))
+    if args.target_color is not None:
+        scenario = _dress_target(scenario, args.target_color)
+    if args.source is not None:
+        if args.shadow is not None:
+            raise UsageError("--shadow runs in the closed loop only (not with --source)")
+        if args.max_frames is not None and args.max_frames < 1:
+            raise UsageError(f"--max-frames must be >= 1, got {args.max_frames}")
+        return _run_source(args, scenario, ros)
+    if args.max_frames is not None:
+        raise UsageError("--max-frames only applies with --source (use --duration)")
+    shadow_params = _shadow_params(scenario, args.shadow)
+    if args.save_video is not None:
+        from fpga_robotics.loop.video_out import VideoPathError, check_video_path
+
+        try:
+            check_video_path(args.save_video)
+        except VideoPathError as exc:
+            raise UsageError(str(exc)) from None
+
+    _design_files(args, scenario.foreign)
+    t0 = time.perf_counter()
+    if scenario.sim.timing == "real_clock":
+        if shadow_params is not None:
+            raise UsageError("--shadow compares frames; it needs a scenario in compressed "
+                             "timing (sim.timing), not real_clock")
+        scenario = _with_design_files(args, scenario)
+        design = _open_pin_design(args, scenario)
+    else:
+        design = _open_design(args, scenario.params, scenario.foreign)
+    shadow = recorder = None
+    completed = False
+    try:
+        if shadow_params is not None:
+            shadow = _open_backend(args.shadow_backend or args.backend, shadow_params,
+                                   args.quiet)
+        setup = time.perf_counter() - t0
+        recorder = _open_recorder(args, scenario.name)
+        for line in ros.open(scenario):
+            print(line, file=sys.stderr)
+        progress = None if args.quiet else Progress(scenario.name)
+        with _video(args.save_video, scenario.camera.fps) as video:
+            result = run_scenario(scenario, seed=args.seed, backend=design, recorder=recorder,
+                                  progress=progress, realtime=args.realtime, shadow=shadow,
+                                  shadow_label=args.shadow or "shadow",
+                                  on_frame=_frame_callback(video, ros), controls=ros.controls)
+        if progress is not None:
+            progress.finish()
+        completed = True
+    finally:
+        design.close()
+        if shadow is not None:
+            shadow.close()
+        notices = _close_outputs(recorder, ros, completed)
+    summary = dict(result.summary)
+    summary["backend_setup_s"] = round(setup, 3)
+    summary.update(ros.summary_items())  # the live inputs, for --replay-inputs
+    print(format_summary(summary))
+    if "shadow" in summary:
+        from fpga_robotics.loop.shadow import format_shadow
+
+        print("\n".join(format_shadow(summary["shadow"])))
+    for line in notices:
+        print(line)
+    if args.save_video is not None:
+        print(f"camera frames written to {args.save_video} (try: --source {args.save_video})")
+    if args.summary:
+        write_json_atomic(args.summary, summary, what="--summary")
+    return 0 if summary["verdict"] == "pass" else 1
+
+
+def cli():
+    run_cli(main, sys.argv[1:], prog="fpga_robotics.run")
+
+
+if __name__ == "__main__":
+    cli()

@@ -1,0 +1,198 @@
+"""``python -m fpga_robotics.sweep CAMPAIGN [options]``, ``... report DIR`` and ``... --bench``.
+
+Exit status: 0 when every run passed, 1 when some did not, 2 for a usage error (bad option,
+malformed campaign file, unknown scenario or key, bad override value, unreachable scheduler).
+"""
+
+import argparse
+import sys
+from pathlib import Path
+
+from fpga_robotics.cli.errors import UsageError, run_cli
+from fpga_robotics.sim.files import check_output_dir
+from fpga_robotics.sweep.campaign import load_campaign, read_campaign_file, shipped_campaigns
+from fpga_robotics.sweep.engine import RECORD_LOG_EVERY
+
+__all__ = ["build_parser", "main"]
+
+PROG = "python -m fpga_robotics.sweep"
+RECORD = ("failing", "all", "none")
+
+
+def build_parser(prog=PROG):
+    p = argparse.ArgumentParser(
+        prog=prog,
+        description="Run a verification campaign (scenarios x seeds x a grid of overrides) on "
+                    "Dask and report where the design fails. `report DIR` rebuilds a report.",
+        epilog=f"shipped campaigns: {', '.join(shipped_campaigns())}")
+    p.add_argument("campaign", nargs="?", metavar="CAMPAIGN",
+                   help="a shipped campaign name or a .toml file (docs/campaigns.md)")
+    g = p.add_argument_group("what runs (each overrides the campaign file)")
+    g.add_argument("--scenarios", metavar="A,B", help="scenarios, comma-separated")
+    g.add_argument("--seeds", metavar="A-B|A,B,C", help="seeds: a range or a list")
+    g.add_argument("--backend", metavar="NAME", help="design simulator, as run --backend")
+    g.add_argument("--resolution", metavar="WxH", help="as run --resolution")
+    g.add_argument("--duration", type=float, metavar="S", help="as run --duration")
+    g.add_argument("--set", dest="fixed", action="append", default=None, metavar="KEY=VALUE",
+                   help="an override for every run, as run --set (repeatable)")
+    g.add_argument("--grid", action="append", default=[], metavar="KEY=[V1,V2]",
+                   help="a grid axis: a TOML list of values (repeatable; replaces the file's "
+                        "axis of that key)")
+    g.add_argument("--shadow", metavar="SPEC", help="as run --shadow (e.g. published)")
+    g.add_argument("--design", metavar="verilog:TOP.v", help="as run --design")
+    g.add_argument("--ports", metavar="PORTS.toml", help="as run --ports")
+    g.add_argument("--timeout", type=float, metavar="S",
+                   help="per-run timeout (default 10x the run's expected time, at least 30 s)")
+    g.add_argument("--max-runs", type=int, metavar="N", help="only the first N runs")
+    e = p.add_argument_group("where and how")
+    e.add_argument("--workers", type=int, metavar="N",
+                   help="embedded cluster: N worker processes, one thread each (default: "
+                        "the machine's cores)")
+    e.add_argument("--scheduler", metavar="ADDRESS",
+                   help="use an existing Dask scheduler (tcp://HOST:8786) instead")
+    e.add_argument("--out", metavar="DIR", help="results folder (default runs/sweeps/NAME)")
+    e.add_argument("--resume", action="store_true",
+                   help="keep the runs already in --out and run only the others")
+    e.add_argument("--record", choices=RECORD, default="failing",
+                   help="save the .rrd recording of failing runs (default), all or none")
+    e.add_argument("--bag", action="store_true",
+                   help="also write each recorded run as a ROS 2 bag, OUT/bags/RUN_ID/ "
+                        "(docs/ros.md)")
+    e.add_argument("--log-every", type=int, default=None, metavar="N",
+                   help="recordings log every Nth frame's images (default "
+                        f"{RECORD_LOG_EVERY}; the replay command records every frame)")
+    e.add_argument("--dry-run", action="store_true",
+                   help="print the run count and three example commands, run nothing")
+    e.add_argument("--quiet", action="store_true", help="no progress bar")
+    e.add_argument("--bench", action="store_true",
+                   help="benchmark: the same runs on 1 worker and on N (--workers) workers")
+    e.add_argument("--bench-runs", type=int, default=40, metavar="N",
+                   help="with --bench: runs per measurement (default 40)")
+    e.add_argument("--bench-repeats", type=int, default=3, metavar="N",
+                   help="with --bench: measurements each way (default 3; medians)")
+    return p
+
+
+def _merge_options(data, args):
+    from fpga_robotics.scenario.load import _parse_value
+
+    if args.scenarios is not None:
+        data["scenarios"] = [s for s in args.scenarios.split(",") if s]
+    if args.seeds is not None:
+        text = args.seeds.strip()
+        data["seeds"] = ([int(s) for s in text.split(",") if s.strip()]
+                         if "," in text and all(s.strip().isdigit() for s in text.split(","))
+                         else text)
+    for key in ("backend", "resolution", "duration", "shadow", "design", "ports", "timeout"):
+        value = getattr(args, key)
+        if value is not None:
+            data[key] = value
+    if args.fixed is not None:
+        data["set"] = list(data.get("set", [])) + args.fixed
+    for item in args.grid:
+        key, sep, text = item.partition("=")
+        values = _parse_value(text) if sep else None
+        if not key.strip() or not isinstance(values, list):
+            raise UsageError(f"--grid needs KEY=[V1, V2, ...] (a TOML list), got {item!r}")
+        grid = data.get("grid") if isinstance(data.get("grid"), dict) else {}
+        data["grid"] = {**grid, key.strip(): values}
+
+
+def _campaign(args):
+    if args.campaign is None:
+        if args.scenarios is None:
+            raise UsageError("give a campaign (a shipped name: "
+                             f"{', '.join(shipped_campaigns())}; or a .toml file), or "
+                             "--scenarios")
+        data, source = {"name": "campaign"}, ""
+    else:
+        data, path = read_campaign_file(args.campaign)
+        source = str(path)
+    _merge_options(data, args)
+    return load_campaign(data, source=source)
+
+
+def _check_counts(args):
+    for name in ("workers", "max_runs", "bench_runs", "bench_repeats", "log_every"):
+        value = getattr(args, name)
+        if value is not None and value < 1:
+            raise UsageError(f"--{name.replace('_', '-')} must be >= 1, got {value}")
+    if args.timeout is not None and not args.timeout > 0:
+        raise UsageError(f"--timeout must be > 0 seconds, got {args.timeout}")
+    if args.workers is not None and args.scheduler is not None:
+        raise UsageError("--workers sizes the embedded cluster; with --scheduler the cluster "
+                         "has the workers you started (`dask worker ADDRESS`)")
+
+
+def _dry_run(campaign, args):
+    from fpga_robotics.sweep.plan import make_plan
+
+    plan = make_plan(campaign)
+    runs = plan.runs[:args.max_runs] if args.max_runs else plan.runs
+    print(f"campaign {campaign.name}: {len(runs)} runs "
+          f"({len(plan.builds)} design parameter set(s) to build)")
+    step = max(1, len(runs) // 3)
+    for spec in runs[::step][:3]:
+        print(f"  {spec.replay()}")
+    return 0
+
+
+def _report(argv, prog):
+    p = argparse.ArgumentParser(prog=f"{prog} report",
+                                description="Rebuild report.html from a campaign's results.")
+    p.add_argument("dir", metavar="DIR", help="the campaign's results folder")
+    args = p.parse_args(argv)
+    from fpga_robotics.sweep.api import report_dir
+
+    if not Path(args.dir).is_dir():
+        raise UsageError(f"{args.dir} is not a folder of campaign results")
+    print(report_dir(args.dir))
+    print(f"report: {Path(args.dir) / 'report.html'}")
+    return 0
+
+
+def main(argv=None, prog=PROG):
+    argv = list(sys.argv[1:] if argv is None else argv)
+    if argv[:1] == ["report"]:
+        return _report(argv[1:], prog)
+    args = build_parser(prog).parse_args(argv)
+    _check_counts(args)
+    if args.bench:
+        from fpga_robotics.bench.sweep import bench
+
+        return bench(args)
+    campaign = _campaign(args)
+    if args.dry_run:
+        return _dry_run(campaign, args)
+    out = Path(args.out) if args.out else Path("runs") / "sweeps" / campaign.name
+    check_output_dir(out, what="--out")
+    from fpga_robotics.sweep.api import run_campaign
+    from fpga_robotics.sweep.report import format_report
+    from fpga_robotics.sweep.results import load_rows
+
+    def echo(text):
+        if not args.quiet:
+            print(text, file=sys.stderr, flush=True)
+
+    if args.bag and args.record == "none":
+        raise UsageError("--bag writes the recorded runs as ROS 2 bags: it needs --record "
+                         "failing (the default) or all")
+    try:
+        rows = run_campaign(campaign, out, workers=args.workers, scheduler=args.scheduler,
+                            resume=args.resume, record=args.record, timeout=args.timeout,
+                            max_runs=args.max_runs, quiet=args.quiet, echo=echo,
+                            log_every=args.log_every or RECORD_LOG_EVERY, bag=args.bag)
+    except KeyboardInterrupt:
+        kept = len(load_rows(out))
+        print(f"interrupted: {kept} finished run(s) kept in {out}; continue with --resume",
+              file=sys.stderr)
+        raise
+    axes = campaign.axes
+    print(format_report(rows, axes))
+    print(f"results: {out / 'results.parquet'}, {out / 'results.csv'}; "
+          f"report: {out / 'report.html'}")
+    return 0 if rows and all(r["status"] == "pass" for r in rows) else 1
+
+
+def cli():
+    run_cli(main, sys.argv[1:], prog="fpga_robotics.sweep")

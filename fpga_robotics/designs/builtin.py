@@ -1,0 +1,165 @@
+"""The designs a scenario can run (``[design] top = "..."``): for each, how to build it, its
+parameter tables, which connector pins bind to which of its ports, and which of the run's
+per-frame outputs it has.
+
+``follow_target`` is the camera-only design of docs/contract.md (frames in, wheel speeds
+out). ``follow_target_safe`` adds an HC-SR04 ultrasound driver and an interlock that stops
+the wheels near an obstacle; ``follow_line`` steers by KY-033 line sensors
+(docs/sensor_designs.md). A design with pins other than the camera's and the wheels' runs
+in real-clock timing (``[sim] timing``).
+"""
+
+import dataclasses
+import importlib
+from dataclasses import dataclass, field
+
+__all__ = ["TOPS", "Top", "build_component", "connector_kinds", "design_tables", "foreign_top",
+           "get_top", "register_top", "table_fields"]
+
+
+@dataclass(frozen=True)
+class Top:
+    name: str
+    description: str
+    #: The design takes the camera's pixel stream (and has FollowTarget's frame outputs).
+    camera: bool
+    #: Scenario sub-table ``[design.<key>]`` -> (module, params class) of its parameters.
+    tables: dict = field(default_factory=dict)
+    #: connector kind -> {connector pin: design port}.
+    bindings: dict = field(default_factory=dict)
+    #: More outputs the run records each frame: trajectory field -> design port.
+    extra_outputs: dict = field(default_factory=dict)
+    #: (module, class) of the component, or the class itself (a design of your own); built as
+    #: ``cls(ft_params, *table params)``.
+    component: object = ("fpga_robotics.hw.top", "FollowTarget")
+    #: Whether the FollowTarget params (``[design]`` keys) are the first argument.
+    takes_follow_target_params: bool = True
+
+
+_CAMERA = {"camera": {"pixels": "pixels", "color_sel": "color_sel"}}
+_WHEELS = {"wheels": {"motor_left": "motor_left", "motor_right": "motor_right"}}
+
+TOPS = {
+    "follow_target": Top(
+        "follow_target", "FollowTarget: colour filter, tracker and motor controller",
+        camera=True, bindings={**_CAMERA, **_WHEELS}),
+    "follow_target_safe": Top(
+        "follow_target_safe",
+        "FollowTarget with an HC-SR04 ultrasound driver and an obstacle interlock",
+        camera=True,
+        tables={"ultrasound": ("fpga_robotics.hw.sensor_params", "UltrasoundParams"),
+                "interlock": ("fpga_robotics.hw.sensor_params", "InterlockParams")},
+        bindings={**_CAMERA, **_WHEELS, "ultrasound": {"trig": "us_trig", "echo": "us_echo"}},
+        extra_outputs={"distance_mm": "distance_mm", "obstacle": "obstacle"},
+        component=("fpga_robotics.hw.safe_follow", "FollowTargetSafe")),
+    "follow_line": Top(
+        "follow_line", "FollowLine: KY-033 line sensors to wheel speeds",
+        camera=False,
+        tables={"line": ("fpga_robotics.hw.sensor_params", "FollowLineParams")},
+        bindings={**_WHEELS, "line_sensors": {"line": "line"}},
+        extra_outputs={"line_seen": "line_seen"},
+        component=("fpga_robotics.hw.follow_line", "FollowLine"),
+        takes_follow_target_params=False),
+}
+
+
+def register_top(top):
+    """Make ``top`` (a ``Top``) available as ``design.top = top.name`` in scenarios."""
+    if not isinstance(top, Top):
+        raise TypeError(f"register_top takes a Top, not {top!r}")
+    TOPS[top.name] = top
+    return top
+
+
+def get_top(name):
+    try:
+        return TOPS[name]
+    except KeyError:
+        raise ValueError(f"design.top must be one of {', '.join(map(repr, TOPS))}, "
+                         f"got {name!r}") from None
+
+
+def foreign_top(port_map):
+    """The ``Top`` of a foreign Verilog design (docs/foreign.md) from its ``PortMap``: a
+    camera iff the map has a pixel stream, the wheels on the wrapper's ``motor_left``/
+    ``motor_right`` (the map's ``outputs``), each ``[connectors.<kind>]`` table as it binds.
+    Not registered: built from the scenario's map each time."""
+    bindings = {**_WHEELS, **{kind: dict(pins) for kind, pins in port_map.connectors.items()}}
+    if port_map.has_pixels:
+        bindings.update(_CAMERA)
+    return Top(f"verilog:{port_map.top}", f"the Verilog design {port_map.top} (port map)",
+               camera=port_map.has_pixels, bindings=bindings, component=None,
+               takes_follow_target_params=False)
+
+
+def connector_kinds():
+    """Every registered connector kind with pins bound by a port map's ``[connectors]``:
+    kind -> {pin: (direction, at most this many bits)} (``port_map.check_connectors``)."""
+    from fpga_robotics.loop.connectors import CONNECTORS
+
+    return {kind: {pin: (spec.direction, spec.width) for pin, spec in cls.pins.items()}
+            for kind, cls in CONNECTORS.items() if kind not in ("camera", "wheels")}
+
+
+def _load(where):
+    if callable(where):
+        return where
+    module, name = where
+    return getattr(importlib.import_module(module), name)
+
+
+def table_fields(key):
+    """The parameter names of design sub-table ``key`` (any top's)."""
+    for top in TOPS.values():
+        if key in top.tables:
+            return tuple(f.name for f in dataclasses.fields(_load(top.tables[key])) if f.init)
+    return ()
+
+
+def design_tables(top, tables, variant=None):
+    """The params objects of ``top``'s sub-tables from ``{key: {field: value}}`` (missing
+    tables: the defaults), the buggy ``variant`` (``hw.variants``) applied on top. Raises
+    ``ValueError`` naming ``design.<key>.<field>`` or the variant."""
+    out = {}
+    for key, where in top.tables.items():
+        cls = _load(where)
+        values = dict(tables.get(key) or {})
+        known = {f.name: f for f in dataclasses.fields(cls) if f.init}
+        for name, value in values.items():
+            if name not in known:
+                raise ValueError(f"unknown key design.{key}.{name}; known: "
+                                 f"{', '.join(sorted(known))}")
+            if isinstance(value, list):
+                values[name] = tuple(value)
+        try:
+            out[key] = cls(**values)
+        except (TypeError, ValueError) as exc:
+            raise ValueError(f"design.{key}: {exc}") from None
+    if variant is not None:
+        out = _with_variant(top, out, variant)
+    return out
+
+
+def _with_variant(top, tables, name):
+    from fpga_robotics.hw.variants import VARIANTS, variant_params
+
+    names = [n for n, v in VARIANTS.items() if v.design == top.name]
+    if name not in names:
+        raise ValueError(f"design.variant must be one of {', '.join(map(repr, names))} for "
+                         f"design.top = {top.name!r}, got {name!r}" if names else
+                         f"design.top = {top.name!r} has no variants (design.variant)")
+    params_type = VARIANTS[name].params_type
+    key = next(k for k, v in tables.items() if isinstance(v, params_type))
+    try:
+        return {**tables, key: variant_params(name, tables[key])}
+    except ValueError as exc:
+        raise ValueError(f"design.variant {name!r}: {exc}") from None
+
+
+def build_component(top, ft_params, table_params):
+    """The Amaranth component of ``top`` (``table_params`` from ``design_tables``)."""
+    cls = _load(top.component)
+    args = [table_params[k] for k in top.tables]
+    if top.takes_follow_target_params:
+        args.insert(0, ft_params)
+    return cls(*args)

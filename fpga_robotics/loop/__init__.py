@@ -1,0 +1,19 @@
+"""The closed loop: the design, its connectors and the world stepped together.
+
+``compressed.py`` runs a camera frame's pixels back to back (the default for FollowTarget);
+``real_clock.py`` runs every design cycle at its instant of world time; ``connectors/`` are
+what the design's pins see of the world and do to it; ``shadow.py`` runs a second design on
+the same frames; ``sources.py`` feeds frames from outside the simulation.
+"""
+
+from fpga_robotics.loop.compressed import (
+    TRAJECTORY_FIELDS,
+    ClosedLoop,
+    RunResult,
+    frame_count,
+    make_backend,
+    run_scenario,
+)
+
+__all__ = ["TRAJECTORY_FIELDS", "ClosedLoop", "RunResult", "frame_count", "make_backend",
+           "run_scenario"]

@@ -1,0 +1,196 @@
+"""CameraConnector: world to design. The robot's camera renders the world into the frames the
+design sees.
+
+The camera sits on the robot: its pose is the robot's pose moved ``mount_forward`` metres
+along the heading, at ``mount_height`` above the floor, pitched by ``tilt``. Each capture
+renders the world's current scene to an RGB888 image of the camera's resolution; with a sensor
+model (``camera.sensor = "ov7670"``, ``make_sensor``) that image is the light reaching the
+sensor, and the capture is what the OV7670 makes of it.
+"""
+
+import math
+from dataclasses import replace
+from typing import ClassVar
+
+import numpy as np
+
+from fpga_robotics.cli.errors import UsageError
+from fpga_robotics.sim.camera.scene import CameraPose
+from fpga_robotics.loop.connectors.base import Connector, Mount, Pin, register
+
+__all__ = ["SENSOR_STREAM", "CameraConnector", "ExposureDrift", "camera_pose", "in_view",
+           "make_renderer", "make_sensor"]
+
+#: Correlation time of the exposure drift, s: a slow change (clouds, a lamp warming up).
+DRIFT_TAU = 10.0
+
+
+class ExposureDrift:
+    """A slow random drift of the frames' brightness (``camera.exposure_drift = s``): the log
+    of the gain is an Ornstein-Uhlenbeck process with standard deviation ``s`` and a
+    correlation time of ``DRIFT_TAU``, stepped once a frame (exactly, whatever the frame
+    rate) and starting at 1 (no change at frame 0)."""
+
+    def __init__(self, std, frame_period, rng):
+        self.std, self.rng = float(std), rng
+        self.a = math.exp(-frame_period / DRIFT_TAU)
+        self.b = self.std * math.sqrt(1.0 - self.a * self.a)
+        self.log_gain = 0.0
+        self.frames = 0
+
+    def gain(self):
+        """The gain of the next frame (advancing the process after the first frame)."""
+        if self.frames:
+            self.log_gain = self.a * self.log_gain + self.b * self.rng.standard_normal()
+        self.frames += 1
+        return math.exp(self.log_gain)
+
+    def apply(self, rgb):
+        """``rgb`` (uint8) times the next gain, rounded and clipped to 0..255."""
+        g = self.gain()
+        return np.clip(rgb.astype(np.float32) * np.float32(g) + np.float32(0.5), 0,
+                       255).astype(np.uint8)
+
+#: The sensor model's random stream is ``default_rng([seed, SENSOR_STREAM])``: its own, so that
+#: it shifts neither the world's randomness nor the plain path's noise.
+SENSOR_STREAM = 0x5E45
+
+
+def make_sensor(cam, seed):
+    """The sensor model a scenario's ``CameraConfig`` asks for (``None``: the plain path)."""
+    if cam.sensor == "plain":
+        return None
+    from fpga_robotics.sim.camera.raster import focal_length
+    from fpga_robotics.sim.camera.sensor import OV7670Sensor
+
+    return OV7670Sensor(cam.width, cam.height, cam.ov7670,
+                        rng=np.random.default_rng([seed, SENSOR_STREAM]),
+                        frame_period=cam.frame_period, focal_px=focal_length(cam.width, cam.hfov))
+
+def make_renderer(name, width, height, hfov, render3d=None):
+    """The renderer ``camera.renderer`` names; a missing MuJoCo or OpenGL is a
+    ``UsageError`` that says how to install them."""
+    if name == "raster":
+        from fpga_robotics.sim.camera.raster import CameraRenderer
+
+        return CameraRenderer(width, height, hfov)
+    if name != "mujoco":
+        raise ValueError(f"renderer must be 'raster' or 'mujoco', got {name!r}")
+    from fpga_robotics.sim.camera.render3d import MujocoRenderer, Render3DUnavailable
+
+    try:
+        renderer = MujocoRenderer(width, height, hfov, render3d)
+        renderer.prepare()
+    except Render3DUnavailable as exc:
+        raise UsageError(f"camera.renderer = \"mujoco\": {exc}") from None
+    return renderer
+
+
+
+def camera_pose(robot_pose, *, height, forward=0.0, tilt=0.0):
+    """The ``CameraPose`` of a camera mounted on a robot at ``robot_pose = (x, y, heading)``."""
+    x, y, heading = robot_pose
+    return CameraPose(
+        x=x + forward * math.cos(heading),
+        y=y + forward * math.sin(heading),
+        heading=heading,
+        height=height,
+        tilt=tilt,
+    )
+
+
+def in_view(pose, hfov, px, py, radius):
+    """Whether an upright cylinder at ``(px, py)`` is (at least partly) inside the horizontal
+    field of view of a camera at ``pose``. Occlusion is not considered."""
+    dx, dy = px - pose.x, py - pose.y
+    dist = math.hypot(dx, dy)
+    if dist <= radius:
+        return True
+    bearing = math.atan2(dy, dx) - pose.heading
+    bearing = (bearing + math.pi) % (2 * math.pi) - math.pi
+    if abs(bearing) >= math.pi / 2:
+        return False  # behind the camera
+    return abs(bearing) - math.asin(radius / dist) < hfov / 2
+
+
+@register
+class CameraConnector(Connector):
+    """Renders what the robot's camera sees: the connector of kind ``camera``, bound to the
+    design's pixel stream (``pixels``: RGB444 with first/last flags, docs/contract.md) and
+    colour select. Scenarios configure it with the ``[camera]`` table (docs/scenarios.md);
+    the closed loop streams each capture into the design, in frames (compressed timing) or
+    pixel by pixel on the design clock with the sensor's blanking (real-clock timing).
+
+    Parameters
+    ----------
+    width, height : int
+        Resolution of the captured frames.
+    hfov : float
+        Horizontal field of view, rad.
+    mount_height, mount_forward, tilt : float
+        The camera's mount on the robot (m, m, rad).
+    noise_std : float
+        Standard deviation of the sensor noise added by the renderer (8-bit levels).
+    rng : numpy.random.Generator
+        The noise's random stream (one per run, for determinism).
+    sensor : fpga_robotics.sim.camera.sensor.OV7670Sensor or None
+        The sensor model the rendered frames go through (``make_sensor``); ``None``: the
+        plain path (the rendered frame plus ``noise_std``). Its state (exposure, gains) is
+        ``sensor_state()``.
+    turn_rate : callable or None
+        Returns the robot's turn rate (rad/s) at the capture, for the sensor's motion blur.
+    yaw_offset : float
+        The mount's yaw off the robot's heading, rad (a camera knocked off its pose).
+    drift : ExposureDrift or None
+        A slow random drift of the frames' brightness (``camera.exposure_drift``).
+    renderer : str
+        ``"raster"`` (``sim.camera.CameraRenderer``) or ``"mujoco"`` (``sim.render3d``).
+    render3d : sim.render3d.Render3DOptions or None
+        The 3D renderer's options (shadows, textures, lamps); None: its defaults.
+    """
+
+    def __init__(self, width, height, hfov, *, mount_height, mount_forward=0.0, tilt=0.0,
+                 noise_std=0.0, rng=None, sensor=None, turn_rate=None, yaw_offset=0.0,
+                 drift=None, renderer="raster", render3d=None):
+        self.name, self.params, self.world = "camera", None, None
+        self.width, self.height, self.hfov = width, height, hfov
+        self.mount_height, self.mount_forward, self.tilt = mount_height, mount_forward, tilt
+        self.noise_std = noise_std
+        self.rng = rng
+        self.renderer = make_renderer(renderer, width, height, hfov, render3d)
+        self.sensor, self.turn_rate = sensor, turn_rate
+        self.yaw_offset, self.drift = yaw_offset, drift
+
+    kind = "camera"
+    pins: ClassVar[dict] = {"pixels": Pin("in", 14), "color_sel": Pin("in", 3)}
+
+    @property
+    def mount(self):
+        """Where the camera sits (``base.Mount``), from the constructor's fields."""
+        return Mount(forward=self.mount_forward, height=self.mount_height,
+                     yaw=self.yaw_offset)
+
+    def pose(self, robot_pose, pitch=0.0):
+        """The camera's pose on a robot at ``robot_pose``; ``pitch`` (rad) adds to the
+        mount's tilt (the slope under the robot)."""
+        pose = camera_pose(robot_pose, height=self.mount_height, forward=self.mount_forward,
+                           tilt=self.tilt + pitch)
+        if self.yaw_offset:
+            pose = replace(pose, heading=pose.heading + self.yaw_offset)
+        return pose
+
+    def capture(self, scene, pose):
+        """The RGB888 frame (height, width, 3) of ``scene`` seen from ``pose``."""
+        if self.sensor is not None:  # the drift is in the light that reaches the sensor
+            rendered = self.renderer.render(scene, pose)
+            return self._sense(rendered if self.drift is None else self.drift.apply(rendered))
+        rgb = self.renderer.render(scene, pose, noise_std=self.noise_std, rng=self.rng)
+        return rgb if self.drift is None else self.drift.apply(rgb)
+
+    def _sense(self, rgb):
+        """The sensor model's frame of the rendered (noise-free) ``rgb``."""
+        return self.sensor.process(rgb, self.turn_rate() if self.turn_rate is not None else 0.0)
+
+    def sensor_state(self):
+        """The sensor model's exposure, gain and white-balance gains; None on the plain path."""
+        return self.sensor.state() if self.sensor is not None else None

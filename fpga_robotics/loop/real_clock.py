@@ -1,0 +1,338 @@
+"""Real-clock timing: every design cycle simulated, each at its instant of world time.
+
+Edge ``e`` of the design clock happens at ``e / sim.clock_hz`` seconds (50 MHz by default, as
+on the board). The world advances in physics steps of ``sim.physics_dt``; within each step the
+design runs the step's edges, stopping wherever a watched output changes (a wheel pin, an
+ultrasound TRIG, the frame strobe) so that the connector concerned acts at that very edge
+(``fpga_robotics.loop.connectors.base``). Per step:
+
+1. every sensor connector's ``before_step`` drives its inputs for the step (values now or at
+   exact future edges);
+2. the design runs to the step's last edge, stop by stop;
+3. every connector's ``after_step``; due wheel commands go to the motors; the world steps.
+
+The camera captures frame ``k`` at ``k / fps`` as in compressed timing; its pixels then reach
+the design spread over the frame period like an OV7670's (line and frame blanking,
+``sim.pins.timing.real_clock_timing``), so a frame's results come out about a frame period
+after the capture and the command acts ``sim.actuation_delay`` after the wheel pins change.
+Trajectory row ``k`` holds the world at the capture of frame ``k``, the per-frame outputs of
+that frame (at its ``frame_done``) and the wheel pins at the next capture. A design without a
+camera (``follow_line``) has its rows sampled at the camera's frame rate all the same.
+"""
+
+import hashlib
+
+import numpy as np
+
+from fpga_robotics.loop.connectors import CONNECTORS, PinIO
+from fpga_robotics.cli.errors import UsageError
+from fpga_robotics.loop.compressed import ClosedLoop
+from fpga_robotics.sim.backends.base import FrameResult
+from fpga_robotics.sim.camera.frames import to_rgb444
+from fpga_robotics.sim.records import SensorReading
+from fpga_robotics.designs.builtin import TOPS, build_component
+
+__all__ = ["RealClockLoop", "make_pin_backend", "pin_design_source"]
+
+#: Per-frame outputs read when the frame strobe rises (the wheels are read at the next capture).
+_FRAME_OUTPUTS = ("found", "proximity", "centroid_x", "centroid_leds")
+_FRAME_STROBE = "frame_done"
+#: Each connector's random stream: ``default_rng([seed, _CONNECTOR_STREAM, index])``.
+_CONNECTOR_STREAM = 0xC011
+
+
+def scenario_top(scenario):
+    """The ``Top`` (fpga_robotics.designs) the scenario runs: ``design.top``, or for a foreign
+    Verilog design (``design.verilog``) the one its port map describes."""
+    if scenario.foreign is not None:
+        from fpga_robotics.sim.backends.port_map import load_port_map
+        from fpga_robotics.designs.builtin import foreign_top
+
+        return foreign_top(load_port_map(scenario.foreign.ports))
+    return TOPS[scenario.top]
+
+
+def pin_design_source(scenario):
+    """The pin design of the scenario: a ``PinDesignSource`` of ``design.top`` and its
+    tables, or a ``VerilogPinSource`` of its foreign Verilog design."""
+    from fpga_robotics.sim.pins import PinDesignSource
+
+    if scenario.foreign is not None:
+        from fpga_robotics.sim.backends.foreign import ForeignDesign
+        from fpga_robotics.sim.pins import VerilogPinSource
+        from fpga_robotics.designs.builtin import connector_kinds
+
+        design = ForeignDesign(scenario.foreign.verilog, scenario.foreign.ports,
+                               scenario.params, pins=True, connector_kinds=connector_kinds())
+        missing = [k for k in ("motor_left", "motor_right") if k not in design.port_map.outputs]
+        if missing:
+            raise UsageError(f"the closed loop needs outputs.{missing[0]} in the port map")
+        return VerilogPinSource(design)
+    top = scenario_top(scenario)
+    params, tables = scenario.params, scenario.design_tables
+    described = f"{params!r}:{sorted(tables.items())!r}"
+    key = f"{top.name}-{hashlib.sha256(described.encode()).hexdigest()[:16]}"
+    extra = {}
+    if top.camera:
+        extra = {"pixels": ("pixels__valid", "pixels__payload"),
+                     "filtered": ("filtered__valid", "filtered__payload"),
+                     "frame_size": (params.width, params.height)}
+    return PinDesignSource(lambda: build_component(top, params, tables), key, **extra)
+
+
+def make_pin_backend(name, scenario, *, on_build=None):
+    """A pin-level backend by name ("auto": the fastest compiled one) for the scenario."""
+    from fpga_robotics.sim.pins import get_pin_backend
+
+    if name == "model":
+        raise UsageError("the model backend runs whole frames; sim.timing = \"real_clock\" "
+                         "needs a backend that simulates every clock: --backend auto, "
+                         "cxxrtl, verilator or pysim")
+    kwargs = {"on_build": on_build} if on_build is not None else {}
+    return get_pin_backend(name, pin_design_source(scenario), **kwargs)
+
+
+class _PendingRow:
+    """Trajectory row ``k`` between its capture and the end of its frame's processing."""
+
+    __slots__ = ("distance", "edge", "events", "filtered", "k", "outputs", "readings", "rgb",
+                 "t", "viewer_events", "visible")
+
+    def __init__(self, k, t, rgb, events, distance, visible, edge, readings):
+        self.k, self.t, self.rgb, self.events = k, t, rgb, events
+        self.distance, self.visible, self.edge = distance, visible, edge
+        self.readings = readings  # {connector name: SensorReading} at the capture
+        self.outputs = None  # the per-frame outputs, at the frame strobe
+        self.filtered = None
+        self.viewer_events = []  # events already in the run's list at their exact time
+
+
+class RealClockLoop(ClosedLoop):
+    """``ClosedLoop`` in real-clock timing, on a ``PinBackend`` (``design``)."""
+
+    def __init__(self, scenario, *, design, seed=None, recorder=None, on_frame=None,
+                 controls=None):
+        super().__init__(scenario, seed=seed, design=design, recorder=recorder,
+                         on_frame=on_frame, controls=controls)
+        self.top = scenario_top(scenario)
+        self.clock_hz = scenario.sim.clock_hz
+        self.pins = design
+        self.motors.configure_real_clock(self.dt, scenario.sim.actuation_delay)
+        self.sensors = [
+            CONNECTORS[spec.kind](spec.name, spec.mount, spec.params, world=self.world,
+                                  rng=np.random.default_rng([self.seed, _CONNECTOR_STREAM, i]))
+            for i, spec in enumerate(scenario.connectors)]
+        specs = {c.name: s for c, s in zip(self.sensors, scenario.connectors)}
+        self.io = {}  # connector -> PinIO
+        self.watched = {}  # design port -> (connector or None, pin)
+        for conn in [self.motors, *self.sensors]:
+            binding = dict(self.top.bindings.get(conn.kind, {}))
+            if conn in self.sensors:
+                binding.update(specs[conn.name].ports)
+            self.io[conn] = PinIO(design, self._checked(conn, binding), self.clock_hz)
+            for pin in conn.watch:
+                self.watched[self.io[conn].binding[pin]] = (conn, pin)
+        self._check_inputs_driven()
+        if self.top.camera:
+            self.watched[_FRAME_STROBE] = (None, _FRAME_STROBE)
+        for port in self.top.extra_outputs.values():
+            self.watched.setdefault(port, (None, port))
+        self.last = {}  # watched port -> last value seen
+        self.pending = None  # the frame whose outputs are awaited: [k, t, rgb, events, result]
+        self.frame_outputs = {}
+        self.extra = {name: np.full(self.n_frames, np.nan) for name in self.top.extra_outputs}
+        self.measurements = {}  # "<connector>.<key>" -> array per row
+
+    # Binding ----------------------------------------------------------------------------
+
+    def _checked(self, conn, binding):
+        ports = self.pins.ports
+        for pin, spec in conn.pins.items():
+            port = binding.get(pin)
+            if port is None:
+                raise UsageError(
+                    f"the {conn.kind} connector {conn.name!r}: design {self.top.name!r} has "
+                    f"no port for its pin {pin!r}; bind one with ports = {{{pin} = "
+                    f"\"PORT\"}} in its [[robot.sensors]] table")
+            if port not in ports:
+                raise UsageError(
+                    f"the {conn.kind} connector {conn.name!r}: design {self.top.name!r} has "
+                    f"no port {port!r} (for pin {pin!r}); its ports: {', '.join(sorted(ports))}")
+            p = ports[port]
+            if p.direction != spec.direction or p.width != spec.width:
+                raise UsageError(
+                    f"the {conn.kind} connector {conn.name!r}: pin {pin!r} is {spec.direction} "
+                    f"{spec.width} bit(s) but port {port!r} of design {self.top.name!r} is "
+                    f"{p.direction} {p.width} bit(s)" + (
+                        "; the line_sensors table must list as many sensors as the design's "
+                        "line input has bits (design.line.n_sensors)"
+                        if conn.kind == "line_sensors" else ""))
+        return binding
+
+    def _check_inputs_driven(self):
+        """Every design input is driven: by the camera's stream or a connector's pin."""
+        driven = {port for io in self.io.values() for pin, port in io.binding.items()}
+        if self.top.camera:
+            driven |= {"pixels__valid", "pixels__payload", "color_sel"}
+        for name, port in sorted(self.pins.ports.items()):
+            if port.direction == "in" and name not in driven:
+                kinds = [k for k, b in self.top.bindings.items() if name in b.values()]
+                hint = (f"declare a [[robot.sensors]] table with kind = \"{kinds[0]}\""
+                        if kinds else "bind a connector pin to it with ports = {...}")
+                raise UsageError(f"design {self.top.name!r}: nothing drives its input "
+                                 f"{name!r}; {hint}")
+
+    # The design clock --------------------------------------------------------------------
+
+    def edge_of_step(self, step):
+        return round(step * self.dt * self.clock_hz)
+
+    def start_design(self):
+        self.pins.watch(list(self.watched))
+        self.last = {port: self.pins.peek(port) for port in self.watched}
+        # The wheel pins' values out of reset are a command too (a design may start moving).
+        self.motors.on_change(self.io[self.motors], "motor_left", None, 0.0)
+        for conn in self.sensors:
+            conn.start(self.io[conn])
+
+    def run_design_to(self, edge):
+        """Run the design up to ``edge``, handling every watched change where it happens."""
+        while self.pins.cycle < edge:
+            stop = self.pins.run(edge - self.pins.cycle)
+            if stop.port is None:
+                continue
+            t = stop.cycle / self.clock_hz
+            for port, (conn, pin) in self.watched.items():  # several may change on one edge
+                value = self.pins.peek(port)
+                if value == self.last[port]:
+                    continue
+                self.last[port] = value
+                if conn is not None:
+                    conn.on_change(self.io[conn], pin, value, t)
+                else:
+                    self.design_output_changed(port, value, t)
+
+    def design_output_changed(self, port, value, t):
+        if port == _FRAME_STROBE:
+            if value and self.pending is not None and self.pending.outputs is None:
+                # A foreign design's absent outputs are no ports: None in the row.
+                self.pending.outputs = {name: self.pins.peek(name) for name in _FRAME_OUTPUTS
+                                        if name in self.pins.ports}
+                self.pending.filtered = self.pins.filtered_frame()
+        elif port == "obstacle":
+            text = ("interlock: obstacle, wheels stopped" if value
+                    else "interlock: clear, wheels released")
+            row = self.pending
+            self.events.append((row.k if row is not None else 0, round(t, 6), text))
+            if row is not None:  # shown in the viewer with the row it happened in
+                row.viewer_events.append(text)
+
+    def advance_physics(self, to_step):
+        while self.step < to_step:
+            t = self.step * self.dt
+            for conn in self.sensors:
+                conn.before_step(self.io[conn], t, self.dt)
+            self.run_design_to(self.edge_of_step(self.step + 1))
+            for conn in self.sensors:
+                conn.after_step(self.io[conn], t + self.dt)
+            self.motors.apply_due(self.step)
+            self.world.step(self.dt)
+            self.step += 1
+        self.motors.apply_due(self.step)
+
+    # Frames --------------------------------------------------------------------------------
+
+    def run_frame(self, k):
+        if k == 0:
+            self.start_design()
+        self.advance_physics(round(k * self.period / self.dt))
+        t = self.step * self.dt
+        self.finish_row()
+        rgb, events = None, []
+        if self.top.camera or self.want_records:
+            pose, rgb, events = self.capture(t)
+        else:
+            pose = self.camera.pose(self.world.robot_pose(), pitch=self.world.camera_pitch())
+            events = list(self.world.drain_events())
+        events += self.apply_controls(k, t)
+        if self.top.camera:
+            self._stream(rgb)
+        distance, visible = self.measure_world(k, t, pose)
+        self.pending = _PendingRow(k, t, rgb, events, distance, visible, self.pins.cycle,
+                                   self.read_sensors(k))
+        self.frames_done = k + 1
+
+    def read_sensors(self, k):
+        """The connectors' measurements into row ``k``; their readings for the viewer."""
+        readings = {}
+        for conn in self.sensors:
+            values = conn.measurement()
+            for key, value in values.items():
+                column = self.measurements.setdefault(
+                    f"{conn.name}.{key}", np.full(self.n_frames, np.nan))
+                column[k] = np.nan if value is None else float(value)
+            if self.want_records:
+                overlay = conn.map_overlay()
+                readings[conn.name] = SensorReading(
+                    conn.kind, dict(values), tuple(overlay.get("points", ())),
+                    tuple(overlay.get("states", ())), tuple(overlay.get("rays", ())))
+        return readings
+
+    def _stream(self, rgb):
+        from fpga_robotics.sim.pins.timing import real_clock_timing
+
+        p = self.scenario.params
+        self.pins.poke("color_sel", self.color_code)
+        timing = real_clock_timing(p.width, p.height, self.scenario.camera.fps, self.clock_hz,
+                                   self.pins.cycle + 1)
+        if self.pins.frame_pending:
+            raise UsageError("a camera frame is still streaming when the next is captured; "
+                             "lower camera.fps or raise sim.clock_hz")
+        self.pins.stream_frame(to_rgb444(rgb, p.width, p.height), timing)
+
+    def finish_row(self):
+        """Complete the pending row: its outputs, the wheel pins now, events, the record."""
+        row, self.pending = self.pending, None
+        if row is None:
+            return
+        outputs = row.outputs or {}
+        values = {name: (outputs.get(name) if self.top.camera else None)
+                  for name in _FRAME_OUTPUTS}
+        wheels = self.io[self.motors].binding
+        values["motor_left"] = self.pins.peek(wheels["motor_left"])
+        values["motor_right"] = self.pins.peek(wheels["motor_right"])
+        result = FrameResult(filtered=row.filtered, cycles=self.pins.cycle - row.edge, **values)
+        self.store_outputs(row.k, result)
+        events = row.events
+        if result.found is not None:
+            events += self.design_events.update(bool(result.found))
+        extra = {}
+        for name, port in self.top.extra_outputs.items():
+            extra[name] = self.pins.peek(port)
+            self.extra[name][row.k] = float(extra[name])
+        self.events += [(row.k, round(row.t, 6), e) for e in events]
+        if self.want_records:
+            self.record(row.k, row.t, row.rgb, result, row.distance, row.visible,
+                        events + row.viewer_events, sensors=row.readings, design_extra=extra)
+
+    def after_frames(self):
+        self.finish_row()
+        # Extra columns: "design.<output>" and "<connector>.<measurement>".
+        self.traj.update({f"design.{k}": v for k, v in self.extra.items()})
+        self.traj.update(self.measurements)
+
+    def extra_metrics(self):
+        """Also the line metrics, over the world's floor lines, from the line sensors' mounts."""
+        from fpga_robotics.checks.sensor_metrics import line_metrics
+
+        mounts = [m for c in self.sensors if c.kind == "line_sensors"
+                  for m in c.sensor_mounts]
+        return {**super().extra_metrics(),
+                **line_metrics(self.traj, getattr(self.world, "floor_lines", ()), mounts,
+                               self.period)}
+
+    def timing_summary(self, wall):
+        cycles = self.pins.cycle
+        return {"timing": "real_clock", "clock_hz": self.clock_hz, "sim_cycles": cycles,
+                "cycles_per_wall_s": round(cycles / wall) if wall > 0 else None}
+

@@ -1,0 +1,990 @@
+"""Scenarios as data: load a TOML file, fill defaults, apply ``--set`` overrides, validate.
+
+A scenario file has two kinds of sections. The world's sections (``room``, ``robot``,
+``people``, ``lighting``) are passed unchanged to ``World.from_config``, which validates them
+(see docs/scenarios.md). The application's sections are validated here:
+
+- ``[sim]``: ``duration`` (s), ``physics_dt`` (s), ``actuation_delay`` (s, default one frame
+  period);
+- ``[camera]``: ``resolution`` ("WxH"), ``fps``, ``hfov`` (rad), ``mount_height`` (m),
+  ``mount_forward`` (m ahead of the robot's centre), ``tilt`` (rad, up positive), ``noise_std``;
+  ``sensor`` (``"plain"``: the rendered frame plus ``noise_std``; ``"ov7670"``: the sensor model
+  ``fpga_robotics.sim.camera.sensor`` with its ``[camera.ov7670]`` table, docs/camera.md);
+- ``[color]``: ``initial`` colour and ``changes = [{at = seconds, color = "..."}, ...]``;
+- ``[design]``: any ``FollowTargetParams`` field except ``width``/``height`` (those come from
+  the camera resolution), and ``preset`` (``"published"``: ``FollowTargetParams.published()``
+  at the camera's resolution, applied first, the other ``design`` keys on top);
+- ``[checks]``: the pass criteria of the scenario (see ``fpga_robotics.checks.summary.CHECKS``).
+
+Top-level keys: ``name``, ``description``, ``seed`` (default seed of a run).
+
+Everything is checked when the scenario is loaded, before a run starts: types, the range of
+every number (``LIMITS`` below and docs/scenarios.md), the size of the run (physics steps and
+camera frames, counted as ``fpga_robotics.loop`` counts them) and the camera's geometry as
+the renderer will draw it.
+"""
+
+import copy
+import difflib
+import math
+import re
+import tomllib
+from dataclasses import dataclass, field, fields
+from importlib import resources
+from pathlib import Path
+
+from fpga_robotics.cli.errors import UsageError
+from fpga_robotics.hw.params import (
+    CHOICES,
+    DEFAULT_BASE_DPS,
+    DEFAULT_PROXIMITY_THRESHOLDS,
+    DEFAULT_STEER_DPS,
+    PRESETS,
+    FollowTargetParams,
+    preset_values,
+)
+from fpga_robotics.hw.pixel import COLOR_SELECT
+from fpga_robotics.scenario.render3d_keys import RENDER_DEFAULTS, parse_render_keys
+from fpga_robotics.sim.camera.raster import max_hfov, max_tilt, vertical_fov
+from fpga_robotics.sim.camera.sensor import PARAMS as SENSOR_PARAMS
+from fpga_robotics.sim.camera.sensor import OV7670Params
+from fpga_robotics.sim.world.config import MAX_TIME, WORLD_SECTIONS
+from fpga_robotics.checks.summary import CHECKS
+
+__all__ = [
+    "LIMITS",
+    "MAX_FILE_BYTES",
+    "MAX_FRAMES",
+    "MAX_NAME_LENGTH",
+    "MAX_PHYSICS_STEPS",
+    "WORLD_SECTIONS",
+    "CameraConfig",
+    "ForeignDesignFiles",
+    "Scenario",
+    "ScenarioError",
+    "SimConfig",
+    "load_scenario",
+    "parse_resolution",
+    "shipped_scenarios",
+]
+
+_TOP_KEYS = ("name", "description", "seed")
+_APP_SECTIONS = ("sim", "camera", "color", "design", "checks")
+#: A foreign Verilog design instead of FollowTarget (docs/foreign.md): its files and port map.
+_FOREIGN_KEYS = ("verilog", "ports")
+#: ``design.top`` (fpga_robotics.designs), a buggy ``variant``, and the tops' parameter tables.
+_TOP_TABLES = ("ultrasound", "interlock", "line")
+_TOP_DESIGN_KEYS = ("top", "variant", *_TOP_TABLES)
+_DESIGN_KEYS = ("preset",) + _TOP_DESIGN_KEYS + _FOREIGN_KEYS + tuple(f.name for f in fields(FollowTargetParams) if f.init and
+                                   f.name not in ("width", "height"))
+#: Design parameters that are arrays: their length and what the values are.
+_DESIGN_ARRAYS = {
+    "base_dps": (len(DEFAULT_BASE_DPS), "wheel DPS per proximity level 0..7"),
+    "proximity_thresholds": (len(DEFAULT_PROXIMITY_THRESHOLDS), "pixel counts of levels 1..7"),
+    "steer_dps": (len(DEFAULT_STEER_DPS), "DPS by LED distance 0..3 from the centre"),
+}
+
+#: Defaults of the application's sections (a key absent here is unknown).
+DEFAULTS = {
+    # timing: "auto" (compressed for camera-only designs), "compressed" or "real_clock".
+    "sim": {"duration": 20.0, "physics_dt": 1.0 / 240.0, "actuation_delay": None,
+            "timing": "auto", "clock_hz": 50e6},
+    "camera": {
+        "resolution": "160x120",
+        "fps": 30.0,
+        "hfov": 1.047,
+        "mount_height": None,  # None: the robot model's camera mount
+        "mount_forward": None,
+        "tilt": None,
+        "noise_std": 0.0,
+        "yaw_offset_deg": 0.0,  # the mount knocked off its pose (positive: turned left)
+        "exposure_drift": 0.0,  # std of the log brightness gain's slow drift (10 s correlation)
+        # The sensor model after the renderer (camera.sensor, camera.ov7670.*).
+        "sensor": "plain",
+        "ov7670": {k: list(v[0]) if v[1] == "pair" else v[0] for k, v in SENSOR_PARAMS.items()},
+        **RENDER_DEFAULTS,  # renderer, shadows, ... (fpga_robotics.scenario.render3d_keys)
+    },
+    "color": {"initial": "red", "changes": []},
+}
+
+#: The range of every number of the application's sections: key → (lo, hi, unit). Chosen so
+#: that no sensible run comes near them, while an absurd one fails at once with the limit
+#: instead of computing for hours (docs/scenarios.md, "Limits").
+LIMITS = {
+    "sim.duration": (0.0, MAX_TIME, "s"),  # one day
+    "sim.physics_dt": (1e-5, None, "s"),  # at most one frame period (1 / camera.fps)
+    "sim.actuation_delay": (0.0, 10.0, "s"),
+    "sim.clock_hz": (1e3, 1e9, "Hz"),
+    "camera.fps": (0.1, 1000.0, "frames/s"),
+    "camera.hfov": (0.01, 3.1, "rad"),  # and narrow enough for the image's aspect ratio
+    "camera.mount_height": (0.0, None, "m"),  # and below the ceiling (room.height)
+    "camera.mount_forward": (-2.0, 2.0, "m"),
+    "camera.tilt": (-math.pi / 2, math.pi / 2, "rad"),  # and what the field of view allows
+    "camera.noise_std": (0.0, 64.0, "8-bit levels"),
+    "camera.yaw_offset_deg": (-45.0, 45.0, "deg"),
+    "camera.exposure_drift": (0.0, 2.0, ""),
+    "color.changes.at": (0.0, MAX_TIME, "s"),
+}
+#: Keys whose lower bound is excluded.
+_LO_EXCLUDED = ("sim.duration", "camera.mount_height")
+#: Camera and design resolution: the design's limits (``FollowTargetParams``).
+WIDTH_RANGE = (16, 4096)
+HEIGHT_RANGE = (2, 4096)
+#: A run is at most this many physics steps (``sim.duration / sim.physics_dt``) ...
+MAX_PHYSICS_STEPS = 10**8
+#: ... and this many camera frames (``sim.duration * camera.fps``; about 150 bytes each of
+#: trajectory in memory).
+MAX_FRAMES = 10**7
+#: Seeds are integers 0..2**63-1.
+MAX_SEED = 2**63 - 1
+#: A scenario's name is a file name (``runs/<name>.rrd``): ASCII letters, digits, ``_ - .``,
+#: not starting with ``.`` or ``-``, at most this long.
+MAX_NAME_LENGTH = 64
+_NAME = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.-]*")
+#: A scenario file is at most this large (a few kB is usual).
+MAX_FILE_BYTES = 1 << 20
+
+
+class ScenarioError(UsageError):
+    """A scenario that cannot be loaded: unknown name, malformed file, bad value or key."""
+
+
+def parse_resolution(text):
+    """``"160x120"`` (or ``[160, 120]``) → ``(160, 120)``; ``ScenarioError`` when malformed."""
+    if isinstance(text, (list, tuple)) and len(text) == 2:
+        w, h = text
+    elif isinstance(text, str) and text.lower().count("x") == 1:
+        w, h = text.lower().split("x")
+        try:
+            w, h = int(w), int(h)
+        except ValueError:
+            w = h = None
+    else:
+        w = h = None
+    if isinstance(w, bool) or isinstance(h, bool):
+        w = h = None
+    if not (isinstance(w, int) and isinstance(h, int) and w > 0 and h > 0):
+        raise ScenarioError(
+            f"resolution must look like WIDTHxHEIGHT, e.g. 160x120, 320x240 or 640x480; "
+            f"got {text!r}"
+        )
+    return w, h
+
+
+@dataclass(frozen=True)
+class CameraConfig:
+    width: int
+    height: int
+    fps: float
+    hfov: float
+    mount_height: float | None  # None: the robot model's own mount
+    mount_forward: float | None
+    tilt: float | None
+    noise_std: float
+    yaw_offset: float = 0.0  # rad: the mount's yaw off the robot's heading (left positive)
+    exposure_drift: float = 0.0  # std of the log brightness gain (CameraConnector)
+    sensor: str = "plain"  # "plain" or "ov7670" (sim.sensor, with the parameters below)
+    ov7670: OV7670Params = field(default_factory=OV7670Params)
+    renderer: str = "raster"  # "raster" or "mujoco" (fpga_robotics.scenario.render3d_keys)
+    render3d: object = None  # sim.render3d.Render3DOptions
+
+    @property
+    def frame_period(self):
+        return 1.0 / self.fps
+
+
+#: ``sim.timing`` values.
+TIMINGS = ("auto", "compressed", "real_clock")
+#: In real-clock timing the readout and the processing are simulated, so the default
+#: actuation delay is only the command's trip to the motor controller (one SPI message), s.
+REAL_CLOCK_ACTUATION_DELAY = 0.001
+
+
+@dataclass(frozen=True)
+class SimConfig:
+    duration: float
+    physics_dt: float
+    actuation_delay: float
+    timing: str = "compressed"  # "compressed" or "real_clock" (never "auto" once loaded)
+    clock_hz: float = 50e6
+
+
+@dataclass(frozen=True)
+class ForeignDesignFiles:
+    """A scenario's foreign Verilog design: its files and port map, as paths that exist
+    (relative ones resolved against the scenario file's folder)."""
+
+    verilog: tuple
+    ports: str
+
+
+@dataclass(frozen=True, eq=False)
+class Scenario:
+    """A validated scenario.
+
+    Attributes
+    ----------
+    name : str
+        Its name (file stem unless the file says otherwise).
+    source : str
+        Where it was loaded from (a path).
+    data : dict
+        The whole scenario with defaults filled and overrides applied (plain TOML types).
+    world : dict
+        The world's sections, for ``World.from_config``.
+    camera, sim : CameraConfig, SimConfig
+    color_initial : str
+    color_changes : tuple of (time_s, colour)
+    params : FollowTargetParams
+        The design's parameters (resolution from ``camera``, the rest from ``[design]``).
+    checks : dict
+        Pass criteria, name → limit.
+    overrides : tuple of str
+        The ``--set`` overrides applied, as given.
+    foreign : ForeignDesignFiles or None
+        ``[design] verilog = [...]`` and ``ports = "..."``: a foreign Verilog design to run
+        instead of FollowTarget (docs/foreign.md), paths resolved; None without them.
+    top : str
+        ``design.top``: the design to run (``fpga_robotics.designs``).
+    design_tables : dict
+        The top's parameter objects by sub-table (``[design.ultrasound]`` ...), a variant's
+        changes applied.
+    connectors : tuple of ConnectorSpec
+        ``[[robot.sensors]]`` and ``[[robot.actuators]]`` (fpga_robotics.scenario.connectors).
+    """
+
+    name: str
+    description: str
+    source: str
+    seed: int
+    data: dict
+    world: dict
+    camera: CameraConfig
+    sim: SimConfig
+    color_initial: str
+    color_changes: tuple
+    params: FollowTargetParams
+    checks: dict
+    overrides: tuple = ()
+    foreign: "ForeignDesignFiles | None" = None
+    top: str = "follow_target"
+    design_tables: dict = field(default_factory=dict)
+    connectors: tuple = ()
+
+    def color_at(self, t):
+        """The colour select in force at simulated time ``t``."""
+        color = self.color_initial
+        for at, c in self.color_changes:
+            if at <= t + 1e-12:
+                color = c
+        return color
+
+    def with_overrides(self, overrides):
+        """A new scenario: this one's data with more ``KEY=VALUE`` overrides applied."""
+        data = copy.deepcopy(self.data)
+        overrides = tuple(overrides)
+        _apply_overrides(data, overrides)
+        return _finish(data, self.source, tuple(self.overrides) + overrides)
+
+
+# Loading ------------------------------------------------------------------------------------
+
+
+def _scenario_dir():
+    return resources.files("fpga_robotics.scenario") / "shipped"
+
+
+def shipped_scenarios():
+    """Names → (path, description) of the scenarios shipped with the package, sorted."""
+    out = {}
+    for entry in sorted(_scenario_dir().iterdir(), key=lambda e: e.name):
+        if entry.name.endswith(".toml"):
+            try:
+                desc = tomllib.loads(entry.read_text()).get("description", "")
+            except tomllib.TOMLDecodeError:
+                desc = "(malformed)"
+            out[entry.name[: -len(".toml")]] = (str(entry), desc)
+    return out
+
+
+def _resolve(name_or_path):
+    text = str(name_or_path)
+    path = Path(text)
+    if not (text.endswith(".toml") or "/" in text or "\\" in text):
+        # A bare word: a file of that name here, else a shipped scenario.
+        if path.is_file():
+            return path
+        shipped = shipped_scenarios()
+        if text in shipped:
+            return Path(shipped[text][0])
+        if not path.exists():
+            close = difflib.get_close_matches(text, shipped, n=3)
+            hint = f" (did you mean {', '.join(close)}?)" if close else ""
+            raise ScenarioError(
+                f"unknown scenario {text!r}{hint}; shipped scenarios: {', '.join(shipped)} "
+                f"(or give the path of a .toml file)"
+            )
+    if path.is_dir():
+        raise ScenarioError(f"scenario {text!r} is a folder; give a .toml file in it or the "
+                            f"name of a shipped scenario")
+    if path.exists() and not path.is_file():
+        raise ScenarioError(f"scenario file {text!r} is not a regular file (a device or "
+                            f"pipe); give a .toml file")
+    if not path.exists():
+        if path.suffix == ".toml" and path.name == text and path.stem in shipped_scenarios():
+            raise ScenarioError(
+                f"scenario file {text!r} does not exist here; for the shipped scenario "
+                f"give its name: --scenario {path.stem}")
+        raise ScenarioError(f"scenario file {text!r} does not exist")
+    return path
+
+
+def _default_name(path):
+    """The file's stem, made a safe file name (other characters become ``_``)."""
+    name = re.sub(r"[^A-Za-z0-9_.-]", "_", path.stem).lstrip(".-")[:MAX_NAME_LENGTH]
+    return name or "scenario"
+
+
+def load_scenario(name_or_path, overrides=()):
+    """Load a shipped scenario by name, or a TOML file by path, and apply overrides.
+
+    Parameters
+    ----------
+    name_or_path : str or Path
+        A shipped scenario's name (``follow_person``) or a ``.toml`` path.
+    overrides : list of str
+        ``"dotted.key=value"`` items; the value is parsed as TOML (bare words are strings).
+        Array items are chosen by index, ``people.0.speed`` or ``people[0].speed``.
+
+    Raises
+    ------
+    ScenarioError
+        With one line that says what is wrong (unknown name, malformed TOML with its line,
+        unknown key with close matches, invalid value, a run too large).
+    """
+    path = _resolve(name_or_path)
+    try:
+        size = path.stat().st_size
+        if size > MAX_FILE_BYTES:
+            raise ScenarioError(f"scenario file {str(path)!r} is {size} bytes; a scenario is at "
+                                f"most {MAX_FILE_BYTES} bytes")
+        data = tomllib.loads(path.read_text())
+    except tomllib.TOMLDecodeError as exc:
+        raise ScenarioError(f"{path}: malformed TOML: {exc}") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ScenarioError(f"cannot read scenario file {path}: {exc}") from None
+    _check_sections(data, path)
+    if "name" not in data:
+        data["name"] = _default_name(path)
+    _fill_defaults(data)
+    overrides = tuple(overrides or ())
+    _apply_overrides(data, overrides)
+    return _finish(data, str(path), overrides)
+
+
+def _finish(data, source, overrides):
+    # An override may have replaced a whole table: check the sections again, then fill in
+    # the keys it left out with their defaults (as a file that gives the table would).
+    _check_sections(data, None)
+    _fill_defaults(data)
+    return _build(data, source, overrides)
+
+
+def _check_sections(data, path):
+    where = f"{path}: " if path is not None else ""
+    known = set(_TOP_KEYS) | set(WORLD_SECTIONS) | set(_APP_SECTIONS)
+    for key in data:
+        if key not in known:
+            raise ScenarioError(f"{where}unknown top-level key {key!r}{_close(key, known)}")
+    allowed_keys = {**DEFAULTS, "design": _DESIGN_KEYS, "checks": CHECKS}
+    for section in _APP_SECTIONS:
+        value = data.get(section, {})
+        if not isinstance(value, dict):
+            raise ScenarioError(
+                f"{where}{section} must be a table ([{section}] in a file, --set "
+                f"{section}.KEY=VALUE on the command line), got {value!r}")
+        allowed = allowed_keys[section]
+        _check_subtables(value, DEFAULTS.get(section, {}), section, where)
+        for key in value:
+            if key not in allowed:
+                if section == "design" and key in ("width", "height"):
+                    raise ScenarioError(
+                        f"{where}design.{key} comes from camera.resolution; set that instead"
+                    )
+                raise ScenarioError(
+                    f"{where}unknown key {section}.{key}{_close(key, allowed, section)}"
+                )
+
+
+def _check_subtables(table, defaults, section, where):
+    """A section's sub-tables (``camera.ov7670``) are tables of known keys."""
+    for key, default in defaults.items():
+        if isinstance(default, dict) and key in table:
+            sub = table[key]
+            if not isinstance(sub, dict):
+                raise ScenarioError(f"{where}{section}.{key} must be a table ([{section}.{key}] "
+                                    f"in a file), got {sub!r}")
+            for k in sub:
+                if k not in default:
+                    raise ScenarioError(f"{where}unknown key {section}.{key}.{k}"
+                                        f"{_close(k, default, f'{section}.{key}')}")
+
+
+def _fill_defaults(data):
+    for section, defaults in DEFAULTS.items():
+        table = data.setdefault(section, {})
+        for key, value in defaults.items():
+            if key not in table and value is not None:
+                table[key] = copy.deepcopy(value)
+            elif isinstance(value, dict) and isinstance(table[key], dict):
+                for k, v in value.items():  # a sub-table's keys the file leaves out
+                    table[key].setdefault(k, copy.deepcopy(v))
+    data.setdefault("design", {})
+    data.setdefault("checks", {})
+    data.setdefault("description", "")
+    data.setdefault("seed", 0)
+
+
+def _close(key, candidates, prefix=None):
+    close = difflib.get_close_matches(key, list(candidates), n=3, cutoff=0.5)
+    if not close:
+        return ""
+    names = [f"{prefix}.{c}" if prefix else c for c in close]
+    return f" (did you mean {', '.join(names)}?)"
+
+
+# Overrides ----------------------------------------------------------------------------------
+
+
+def _parse_value(text):
+    """A TOML value (``12``, ``0.5``, ``true``, ``"red"``, ``[1, 2]``); bare words are strings."""
+    try:
+        return tomllib.loads(f"v = {text}")["v"]
+    except tomllib.TOMLDecodeError:
+        return text.strip()
+
+
+def _known_paths(data):
+    """Every dotted key the data has, plus the application's optional keys."""
+    out = []
+
+    def walk(prefix, value):
+        if isinstance(value, dict):
+            for k, v in value.items():
+                walk(f"{prefix}.{k}" if prefix else k, v)
+        elif isinstance(value, list) and value and all(isinstance(v, dict) for v in value):
+            for i, v in enumerate(value):
+                walk(f"{prefix}.{i}", v)
+        if prefix:
+            out.append(prefix)
+
+    walk("", data)
+    out += list(WORLD_SECTIONS)
+    out += [f"design.{k}" for k in _DESIGN_KEYS]
+    out += [f"checks.{k}" for k in CHECKS]
+    out += [f"{s}.{k}" for s, d in DEFAULTS.items() for k in d]
+    return sorted(set(out))
+
+
+def _apply_overrides(data, overrides):
+    for item in overrides:
+        if not isinstance(item, str) or "=" not in item:
+            raise ScenarioError(f"--set needs KEY=VALUE (e.g. robot.mass=12), got {item!r}")
+        key, text = item.split("=", 1)
+        key = key.strip()
+        value = _parse_value(text)
+        # people[0].speed, as the world's messages write it, is people.0.speed.
+        _set_path(data, re.sub(r"\[(\d+)\]", r".\1", key), value, key)
+
+
+def _set_path(data, key, value, shown):
+    parts = key.split(".")
+    node = data
+    for i, part in enumerate(parts):
+        last = i == len(parts) - 1
+        here = ".".join(parts[: i + 1])
+        if isinstance(node, list):
+            if not part.isdigit() or int(part) >= len(node):
+                raise ScenarioError(
+                    f"unknown key {shown!r}: {'.'.join(parts[:i])} is a list of {len(node)} "
+                    f"item(s), index it with 0..{len(node) - 1}"
+                )
+            part = int(part)
+            if last:
+                node[part] = _coerce(node[part], value)
+                return
+            node = node[part]
+            continue
+        if not isinstance(node, dict):
+            raise ScenarioError(f"unknown key {shown!r}: {'.'.join(parts[:i])} is not a table")
+        # Inside the world's sections any key may be set: the world validates the result
+        # (with close matches) when the scenario is built.
+        in_world = parts[0] in WORLD_SECTIONS
+        if i == 0 and in_world and part not in data and parts[0] != "people" and not last:
+            node[part] = {}
+        optional = _optional_keys(parts[:i])
+        if part not in node and part not in optional and not (in_world and last):
+            if parts[:i] == ["design"] and part in ("width", "height"):
+                raise ScenarioError(f"design.{part} comes from camera.resolution; "
+                                    f"set camera.resolution=WxH (or --resolution) instead")
+            raise ScenarioError(_unknown_key_message(data, key, here, shown))
+        if last:
+            node[part] = _coerce(node.get(part), value)
+            return
+        if part not in node and parts[:i] == ["design"] and part in _TOP_TABLES:
+            node[part] = {}  # a design parameter table the file does not give
+        node = node[part]
+
+
+def _optional_keys(parents):
+    """Keys that may be set although the file does not give them."""
+    if len(parents) == 2 and parents[0] == "design" and parents[1] in _TOP_TABLES:
+        from fpga_robotics.designs.builtin import table_fields
+
+        return table_fields(parents[1])
+    if len(parents) != 1:
+        return ()
+    section = parents[0]
+    if section == "design":
+        return _DESIGN_KEYS
+    if section == "checks":
+        return CHECKS
+    return tuple(DEFAULTS.get(section, ()))
+
+
+def _unknown_key_message(data, key, here, shown):
+    depth = key.count(".")
+    paths = [p for p in _known_paths(data) if p.count(".") == depth]
+    close = difflib.get_close_matches(key, paths, n=4, cutoff=0.6)
+    if not close:
+        # Suggest the siblings of the deepest known parent.
+        parent = here.rsplit(".", 1)[0] if "." in here else ""
+        close = [p for p in paths if parent and p.startswith(parent + ".")][:10]
+    hint = f"; close matches: {', '.join(close)}" if close else ""
+    return f"unknown scenario key {shown!r}{hint}"
+
+
+def _coerce(old, value):
+    # An int where the scenario had a float is a float (``--set sim.duration=10``).
+    if isinstance(old, float) and isinstance(value, int) and not isinstance(value, bool):
+        return float(value)
+    return value
+
+
+# Validation ---------------------------------------------------------------------------------
+
+
+def _is_int(value):
+    return isinstance(value, int) and not isinstance(value, bool)
+
+
+def _is_number(value):
+    return isinstance(value, (int, float)) and not isinstance(value, bool)
+
+
+def _in_range(value, name, lo, hi, unit, *, lo_open=False, note=""):
+    """``value`` as a float if it is a finite number in ``lo..hi`` (``None``: no bound);
+    ``note`` explains the upper bound."""
+    if not (_is_number(value) and math.isfinite(value)):
+        bounds = [f"{'>' if lo_open else '>='} {lo:g}"] if lo is not None else []
+        bounds += [f"<= {hi:g}"] if hi is not None else []
+        raise ScenarioError(f"{name} must be a finite number{' in ' + unit if unit else ''}"
+                            f"{', ' + ' and '.join(bounds) if bounds else ''}, got {value!r}")
+    unit = f" ({unit})" if " " in unit else f" {unit}" if unit else ""
+    if lo is not None and (value <= lo if lo_open else value < lo):
+        raise ScenarioError(f"{name} must be {'>' if lo_open else '>='} {lo:g}{unit}, "
+                            f"got {value!r}")
+    if hi is not None and value > hi:
+        raise ScenarioError(f"{name} must be <= {hi:g}{unit}{note}, got {value!r}")
+    return float(value)
+
+
+def _limited(data, name, *, optional=False, hi=None, note=""):
+    """The value of ``section.key`` checked against ``LIMITS`` (``hi`` overrides its upper
+    bound); ``None`` for an optional key that is not given."""
+    section, key = name.split(".")
+    value = data[section].get(key)
+    if optional and value is None:
+        return None
+    lo, limit_hi, unit = LIMITS[name]
+    return _in_range(value, name, lo, limit_hi if hi is None else hi, unit,
+                     lo_open=name in _LO_EXCLUDED, note=note)
+
+
+def _color(value, where):
+    if not isinstance(value, str) or value.lower() not in COLOR_SELECT:
+        raise ScenarioError(f"{where} must be one of {', '.join(COLOR_SELECT)}; got {value!r}")
+    return value.lower()
+
+
+def _floor(x, digits):
+    """``x`` rounded down to ``digits`` decimals: a printed limit a user can type."""
+    scale = 10**digits
+    return math.floor(x * scale) / scale
+
+
+def _check_world(world):
+    """Validate the world's sections now, so that a bad value is reported at load time;
+    returns the parsed ``WorldConfig``."""
+    from fpga_robotics.sim.world import World, WorldConfigError
+
+    try:
+        # Building it also finds placement errors (a robot starting inside a person).
+        return World.from_config(copy.deepcopy(world), 0).config
+    except WorldConfigError as exc:
+        raise ScenarioError(str(exc)) from None
+
+
+def _check_name(name):
+    if not isinstance(name, str):
+        raise ScenarioError(f"name must be a string, got {name!r}")
+    if not (len(name) <= MAX_NAME_LENGTH and _NAME.fullmatch(name)):
+        raise ScenarioError(
+            f"name {name!r} cannot be a file name (a recording is saved as runs/<name>.rrd): "
+            f"use at most {MAX_NAME_LENGTH} ASCII letters, digits, '_', '-' and '.', "
+            f"starting with a letter, a digit or '_'")
+    return name
+
+
+def _camera(data):
+    cam = data["camera"]
+    width, height = parse_resolution(cam["resolution"])
+    if not (WIDTH_RANGE[0] <= width <= WIDTH_RANGE[1]
+            and HEIGHT_RANGE[0] <= height <= HEIGHT_RANGE[1]):
+        raise ScenarioError(
+            f"camera.resolution {width}x{height}: the width must be {WIDTH_RANGE[0]}.."
+            f"{WIDTH_RANGE[1]} and the height {HEIGHT_RANGE[0]}..{HEIGHT_RANGE[1]} pixels "
+            f"(the design's limits)")
+    renderer, render3d = parse_render_keys(cam, data.get("seed", 0))
+    return CameraConfig(
+        width=width,
+        height=height,
+        fps=_limited(data, "camera.fps"),
+        hfov=_limited(data, "camera.hfov"),
+        mount_height=_limited(data, "camera.mount_height", optional=True),
+        mount_forward=_limited(data, "camera.mount_forward", optional=True),
+        tilt=_limited(data, "camera.tilt", optional=True),
+        noise_std=_limited(data, "camera.noise_std"),
+        yaw_offset=math.radians(_limited(data, "camera.yaw_offset_deg")),
+        exposure_drift=_limited(data, "camera.exposure_drift"),
+        sensor=_choice(cam["sensor"], "camera.sensor", ("plain", "ov7670")),
+        ov7670=_sensor_params(cam["ov7670"]),
+        renderer=renderer,
+        render3d=render3d,
+    )
+
+
+def _choice(value, name, choices):
+    if value not in choices:
+        raise ScenarioError(f"{name} must be one of {', '.join(map(repr, choices))}, "
+                            f"got {value!r}")
+    return value
+
+
+def _sensor_params(table):
+    """``[camera.ov7670]`` checked against ``sim.sensor.PARAMS``."""
+    values = {}
+    for key, (_, kind, limits, unit, _) in SENSOR_PARAMS.items():
+        name, value = f"camera.ov7670.{key}", table[key]
+        if kind == "bool" and not isinstance(value, bool):
+            raise ScenarioError(f"{name} must be true or false, got {value!r}")
+        if kind == "choice":
+            _choice(value, name, limits)
+        if kind == "float":
+            value = _in_range(value, name, *limits, unit)
+        if kind == "int" and not (_is_int(value) and limits[0] <= value <= limits[1]):
+            raise ScenarioError(f"{name} must be an integer {limits[0]}..{limits[1]} ({unit}), "
+                                f"got {value!r}")
+        if kind == "pair" and not (isinstance(value, list) and len(value) == 2
+                                   and all(_is_int(v) and limits[0] <= v <= limits[1]
+                                           for v in value) and value[0] < value[1]):
+            raise ScenarioError(f"{name} must be [low, high], integers {limits[0]}..{limits[1]} "
+                                f"with low < high ({unit}), got {value!r}")
+        values[key] = tuple(value) if kind == "pair" else value
+    (lo, hi), (fast_lo, fast_hi) = values["aec_window"], values["aec_fast_zone"]
+    if not fast_lo <= lo < hi <= fast_hi:
+        raise ScenarioError(f"camera.ov7670.aec_window {[lo, hi]} must lie inside "
+                            f"camera.ov7670.aec_fast_zone {[fast_lo, fast_hi]}")
+    return OV7670Params.from_dict(values)
+
+
+def _check_camera_geometry(camera, world):
+    """The mount and the field of view the renderer will be asked to draw: between floor and
+    ceiling, and no ray looking straight up or down (``sim.camera.max_tilt``)."""
+    ceiling = world.room.height
+    if camera.mount_height is not None and not camera.mount_height < ceiling:
+        raise ScenarioError(f"camera.mount_height must be below the ceiling (room.height = "
+                            f"{ceiling:g} m), got {camera.mount_height:g}")
+    w, h, hfov = camera.width, camera.height, camera.hfov
+    vfov = vertical_fov(w, h, hfov)
+    limit = max_tilt(w, h, hfov)
+    if limit < 0:
+        raise ScenarioError(
+            f"camera.hfov must be at most {_floor(max_hfov(w, h), 4)} rad at camera.resolution "
+            f"{w}x{h}, got {hfov:g} (a vertical field of view of {vfov:.3f} rad: the top and "
+            f"bottom rows would look straight up or down)")
+    if camera.tilt is not None:
+        tilt, key, shown, unit = camera.tilt, "camera.tilt", _floor(limit, 4), "rad"
+    else:
+        tilt, key, unit = world.robot.spec.camera_tilt, "robot.camera_tilt_deg", "deg"
+        shown = _floor(math.degrees(limit), 2)
+    if abs(tilt) > limit:
+        got = tilt if unit == "rad" else math.degrees(tilt)
+        raise ScenarioError(
+            f"|{key}| must be at most {shown} {unit} with camera.hfov {hfov:g} rad at "
+            f"{w}x{h} (vertical field of view {vfov:.3f} rad; beyond it rows would look "
+            f"straight up or down), got {got:g}")
+
+
+def _sim(data, camera):
+    from fpga_robotics.loop.compressed import frame_count
+
+    sim = data["sim"]
+    duration = _limited(data, "sim.duration", note=" (one day)")
+    period = camera.frame_period
+    dt = _limited(data, "sim.physics_dt", hi=period,
+                  note=" (one camera frame period, 1 / camera.fps)")
+    timing = _choice(sim.get("timing", "auto"), "sim.timing", TIMINGS)
+    clock_hz = _limited(data, "sim.clock_hz")
+    if sim.get("actuation_delay") is not None:
+        delay = _limited(data, "sim.actuation_delay")
+    else:
+        delay = None  # one frame period, or REAL_CLOCK_ACTUATION_DELAY (_resolve_timing)
+    config = SimConfig(duration=duration, physics_dt=dt, actuation_delay=delay, timing=timing,
+                       clock_hz=clock_hz)
+    steps = max(1, round(duration / dt))  # as the closed loop counts them
+    if steps > MAX_PHYSICS_STEPS:
+        raise ScenarioError(
+            f"sim.duration {duration:g} s / sim.physics_dt {dt:g} s = {steps} physics steps; "
+            f"the limit is {MAX_PHYSICS_STEPS}: shorten sim.duration or lengthen "
+            f"sim.physics_dt")
+    frames = frame_count(steps, period, dt)
+    if frames > MAX_FRAMES:
+        raise ScenarioError(
+            f"sim.duration {duration:g} s at camera.fps {camera.fps:g} = {frames} camera "
+            f"frames; the limit is {MAX_FRAMES}: shorten sim.duration or lower camera.fps")
+    return config
+
+
+def _color_changes(data):
+    color = data["color"]
+    initial = _color(color["initial"], "color.initial")
+    changes = color["changes"]
+    if not isinstance(changes, list):
+        raise ScenarioError("color.changes must be a list of {at = seconds, color = \"...\"}")
+    lo, hi, unit = LIMITS["color.changes.at"]
+    parsed = []
+    for i, change in enumerate(changes):
+        where = f"color.changes[{i}]"
+        if not isinstance(change, dict) or set(change) != {"at", "color"}:
+            raise ScenarioError(f"{where} must be {{at = seconds, color = \"name\"}}, got "
+                                f"{change!r}")
+        at = change["at"]
+        if not (_is_number(at) and math.isfinite(at) and lo <= at <= hi):
+            raise ScenarioError(f"{where}.at must be a time in {lo:g}..{hi:g} {unit}, got {at!r}")
+        parsed.append((float(at), _color(change["color"], f"{where}.color")))
+    if [a for a, _ in parsed] != sorted(a for a, _ in parsed):
+        raise ScenarioError("color.changes must be in time order")
+    return initial, tuple(parsed)
+
+
+def _foreign(design, source):
+    """``design.verilog`` and ``design.ports`` (popped from ``design``): a
+    ``ForeignDesignFiles`` or None; relative paths from the scenario file's folder."""
+    verilog, ports = design.pop("verilog", None), design.pop("ports", None)
+    if verilog is None and ports is None:
+        return None
+    if verilog is None:
+        raise ScenarioError("design.ports goes with design.verilog = [\"top.v\", ...]")
+    if ports is None:
+        raise ScenarioError("design.verilog needs design.ports = \"ports.toml\" (the design's "
+                            "port map, docs/foreign.md)")
+    if isinstance(verilog, str):
+        verilog = [verilog]
+    if not (isinstance(verilog, list) and verilog
+            and all(isinstance(f, str) and f.strip() for f in verilog)):
+        raise ScenarioError(f"design.verilog must be an array of Verilog file paths, "
+                            f"got {verilog!r}")
+    if not (isinstance(ports, str) and ports.strip()):
+        raise ScenarioError(f"design.ports must be the path of a port map (.toml), "
+                            f"got {ports!r}")
+    base = Path(source).parent if source else Path(".")
+
+    def existing(key, text):
+        path = Path(text).expanduser()
+        path = path if path.is_absolute() else base / path
+        if not path.is_file():
+            raise ScenarioError(f"design.{key}: no file {text!r} (looked for {str(path)!r})")
+        return str(path)
+
+    return ForeignDesignFiles(tuple(existing("verilog", f) for f in verilog),
+                              existing("ports", ports))
+
+
+def _design(data, width, height):
+    design = dict(data["design"])
+    for key in _FOREIGN_KEYS + _TOP_DESIGN_KEYS:
+        design.pop(key, None)
+    preset = design.pop("preset", None)
+    for key, value in design.items():
+        if key in CHOICES:
+            if not isinstance(value, str):
+                raise ScenarioError(f"design.{key} must be a string, one of "
+                                    f"{', '.join(CHOICES[key])}; got {value!r}")
+        elif key in _DESIGN_ARRAYS:
+            n, what = _DESIGN_ARRAYS[key]
+            if not (isinstance(value, list) and len(value) == n and all(map(_is_int, value))):
+                raise ScenarioError(
+                    f"design.{key} must be an array of {n} integers ({what}), got {value!r}")
+        elif not _is_int(value):
+            raise ScenarioError(f"design.{key} must be an integer, got {value!r}")
+    values = {}
+    if preset is not None:
+        if preset not in PRESETS:
+            raise ScenarioError(f"design.preset must be one of {', '.join(map(repr, PRESETS))}, "
+                                f"got {preset!r}")
+        # The preset first, the scenario's other design keys on top.
+        values = preset_values(preset, width, height)
+    values.update(design)
+    try:
+        return FollowTargetParams(width=width, height=height, **values)
+    except (TypeError, ValueError) as exc:
+        message = str(exc)
+        field = re.match(r"\w+", message)
+        if field and field.group() in design:  # "kp_shift must be <= 15, got 99"
+            raise ScenarioError(f"design.{message}") from None
+        raise ScenarioError(f"invalid design parameters with camera.resolution "
+                            f"{width}x{height}: {message}") from None
+
+
+def _top(design):
+    """``design.top`` and its parameter tables (a ``design.variant`` applied first)."""
+    from fpga_robotics.designs.builtin import TOPS, design_tables
+
+    top = design.get("top", "follow_target")
+    if top not in TOPS:
+        raise ScenarioError(f"design.top must be one of {', '.join(map(repr, TOPS))}, "
+                            f"got {top!r}")
+    spec = TOPS[top]
+    tables = {}
+    for key in ("ultrasound", "interlock", "line"):
+        value = design.get(key)
+        if value is None:
+            continue
+        if key not in spec.tables:
+            raise ScenarioError(f"design.{key} is a table of another design; design.top = "
+                                f"{top!r} takes: {', '.join(spec.tables) or 'none'}")
+        if not isinstance(value, dict):
+            raise ScenarioError(f"design.{key} must be a table ([design.{key}] in a file), "
+                                f"got {value!r}")
+        tables[key] = dict(value)
+    try:
+        return top, design_tables(spec, tables, design.get("variant"))
+    except ValueError as exc:
+        raise ScenarioError(str(exc)) from None
+
+
+def _connectors(world):
+    """``robot.sensors`` / ``robot.actuators``, taken out of the world's ``robot`` table."""
+    from fpga_robotics.scenario.connectors import parse_connectors
+    from fpga_robotics.loop.connectors import ConnectorError
+
+    robot = world.get("robot")
+    if not isinstance(robot, dict):
+        return ()
+    try:
+        return parse_connectors(robot)
+    except ConnectorError as exc:
+        raise ScenarioError(str(exc)) from None
+
+
+def _resolve_timing(sim, camera, top, connectors, foreign):
+    """``sim.timing = "auto"`` made definite; a design or connector with pins of its own
+    needs real-clock timing."""
+    from dataclasses import replace
+
+    # Every design but the camera-only follow_target has pins of its own.
+    pins = [f"the {c.kind} connector" for c in connectors]
+    if top != "follow_target":
+        pins.insert(0, f"design.top = {top!r}")
+    if foreign is not None:
+        # A port map that binds connectors (or has no camera) is a design with pins.
+        from fpga_robotics.sim.backends.port_map import PortMapError, load_port_map
+
+        try:
+            port_map = load_port_map(foreign.ports)
+        except PortMapError as exc:
+            raise ScenarioError(f"design.ports: {exc}") from None
+        if port_map.connectors:
+            pins.insert(0, f"the port map's [connectors.{next(iter(port_map.connectors))}]")
+        elif not port_map.has_pixels:
+            pins.insert(0, "a port map without pixels")
+    timing = sim.timing
+    if timing == "auto":
+        timing = "real_clock" if pins else "compressed"
+    elif timing == "compressed" and pins:
+        raise ScenarioError(f"sim.timing = \"compressed\" runs the design only while pixels "
+                            f"flow; {pins[0]} needs sim.timing = \"real_clock\" (or \"auto\")")
+    delay = sim.actuation_delay
+    if delay is None:
+        delay = REAL_CLOCK_ACTUATION_DELAY if timing == "real_clock" else camera.frame_period
+    return replace(sim, timing=timing, actuation_delay=delay)
+
+
+def _checks(data):
+    checks = dict(data["checks"])
+    for key, limit in checks.items():
+        kind, (lo, hi, unit), _meaning = CHECKS[key]
+        name = f"checks.{key}"
+        if kind is int:
+            if not (_is_int(limit) and lo <= limit <= hi):
+                raise ScenarioError(f"{name} must be an integer in {lo}..{hi}, got {limit!r}")
+        elif not (_is_number(limit) and math.isfinite(limit) and lo <= limit <= hi):
+            unit = f" {unit}" if unit else ""
+            raise ScenarioError(f"{name} must be a number in {lo:g}..{hi:g}{unit}, "
+                                f"got {limit!r}")
+    return checks
+
+
+def _build(data, source, overrides):
+    name = _check_name(data.get("name"))
+    description = data.get("description", "")
+    if not isinstance(description, str):
+        raise ScenarioError(f"description must be a string, got {description!r}")
+    seed = data.get("seed", 0)
+    if not (_is_int(seed) and 0 <= seed <= MAX_SEED):
+        raise ScenarioError(f"seed must be an integer in 0..{MAX_SEED}, got {seed!r}")
+    for section in WORLD_SECTIONS:
+        if section in data and not isinstance(data[section], (dict, list)):
+            raise ScenarioError(f"[{section}] must be a table")
+
+    camera = _camera(data)
+    sim = _sim(data, camera)
+    initial, changes = _color_changes(data)
+    params = _design(data, camera.width, camera.height)
+    foreign = _foreign(dict(data["design"]), source)
+    top, tables = _top(data["design"])
+    checks = _checks(data)
+    world = {s: copy.deepcopy(data[s]) for s in WORLD_SECTIONS if s in data}
+    connectors = _connectors(world)
+    sim = _resolve_timing(sim, camera, top, connectors, foreign)
+    _check_camera_geometry(camera, _check_world(world))
+    return Scenario(
+        name=name,
+        description=description,
+        source=source,
+        seed=seed,
+        data=data,
+        world=world,
+        camera=camera,
+        sim=sim,
+        color_initial=initial,
+        color_changes=changes,
+        params=params,
+        checks=checks,
+        overrides=tuple(overrides),
+        foreign=foreign,
+        top=top,
+        design_tables=tables,
+        connectors=connectors,
+    )
