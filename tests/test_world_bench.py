@@ -23,7 +23,7 @@ def test_prints_a_line_per_world(capsys):
 
 
 @pytest.mark.parametrize("module,args,message", [
-    ("fpga_robotics.bench.world_physics", ["--fps", "0"],
+    ("fpga_robotics.bench.world", ["--fps", "0"],
      "python -m fpga_robotics.bench.world: error: --fps must be a number of hertz in (0, 240], got 0.0"),
     ("fpga_robotics.bench.world", ["--frames", "0"],
      "python -m fpga_robotics.bench.world: error: --frames must be 1..1000000, got 0"),

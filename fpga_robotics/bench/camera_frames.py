@@ -1,7 +1,7 @@
 """Benchmark of the camera renderer: median milliseconds per frame at several resolutions.
 
 The command line is ``python -m fpga_robotics.bench.camera`` (the application layer, which
-reports bad arguments as usage errors); ``python -m fpga_robotics.bench.camera_frames`` runs the
+reports bad arguments as usage errors); ``fpga-robotics bench camera`` runs the
 same command.
 
 The scene is a typical room: 8 m x 6 m walls (2.5 m), four pieces of furniture made of four

@@ -1,6 +1,6 @@
 """``fpga-robotics bench pysim``: time Amaranth's own simulator on ``FollowTarget``, one frame
 at a time, every frame checked against the golden model (also
-``python -m fpga_robotics.sim.backends.pysim``)."""
+``fpga-robotics bench pysim``)."""
 
 import argparse
 import statistics
@@ -64,7 +64,7 @@ def main(argv=None, prog="fpga-robotics bench pysim"):
 
 
 def cli():
-    run_cli(main, sys.argv[1:], prog="python -m fpga_robotics.sim.backends.pysim")
+    run_cli(main, sys.argv[1:], prog="fpga-robotics bench pysim")
 
 
 if __name__ == "__main__":
