@@ -151,3 +151,12 @@ def summary_lines(rec, name):
         f"  {path:22s} static: {', '.join(sorted(rec.static[path]))}" for path in sorted(rec.static)
     ]
     return lines
+
+
+if __name__ == "__main__":
+    import sys
+
+    from fpga_robotics.cli.errors import run_cli
+    from fpga_robotics.cli.readback import main
+
+    run_cli(main, sys.argv[1:], prog="fpga_robotics.viz.readback")
