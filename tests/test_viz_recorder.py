@@ -381,6 +381,12 @@ def test_readback_summary(saved, capsys):
     assert readback_main([str(path)]) == 0
     out = capsys.readouterr().out
     assert "12 frames" in out and "blueprints: 1" in out
-    assert f"{P.MOTORS_DPS:22s}     12 rows" in out
+    assert f"{P.MOTORS_DPS:22s}     12 rows\n" in out
+    assert f"{P.CAMERA_RAW:22s}     12 rows, PNG " in out
+    # Raw 32x24 RGB frames: 2304 bytes each.
+    raw = record(saved[0].with_name("raw.rrd"), make_frames(3), jpeg_quality=0).path
+    assert readback_main([str(raw)]) == 0
+    out = capsys.readouterr().out
+    assert f"{P.CAMERA_RAW:22s}      3 rows, raw 2.3 kB each\n" in out
     with pytest.raises(UsageError):
         readback_main([])

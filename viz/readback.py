@@ -139,6 +139,19 @@ def images(rec, path):
     return out
 
 
+def _image_bytes(rows):
+    """``", PNG 26.4 kB each"``: how the rows' images are stored and their mean size, or ``""``."""
+    for column, kind in (("EncodedImage:blob", None), ("Image:buffer", "raw")):
+        blobs = [row[0] for row in rows.values.get(column, ()) if row]
+        if blobs:
+            if kind is None:
+                types = {t for row in rows.values.get("EncodedImage:media_type", ()) if row
+                         for t in row}
+                kind = "/".join(sorted(t.removeprefix("image/").upper() for t in types)) or "?"
+            return f", {kind} {sum(len(b) for b in blobs) / len(blobs) / 1e3:.1f} kB each"
+    return ""
+
+
 def summary_lines(rec, name):
     """Lines describing a ``Recording`` read from ``name``: size, frames, rows per entity."""
     frames = max((len(r) for p, r in rec.entities.items() if p.startswith("design/")), default=0)
@@ -146,7 +159,8 @@ def summary_lines(rec, name):
     if frames:
         head += f", {rec.size_bytes / frames / 1e3:.1f} kB/frame"
     lines = [head, f"blueprints: {rec.blueprints}"]
-    lines += [f"  {path:22s} {len(rec.entities[path]):6d} rows" for path in sorted(rec.entities)]
+    lines += [f"  {path:22s} {len(rec.entities[path]):6d} rows{_image_bytes(rec.entities[path])}"
+              for path in sorted(rec.entities)]
     lines += [
         f"  {path:22s} static: {', '.join(sorted(rec.static[path]))}" for path in sorted(rec.static)
     ]
