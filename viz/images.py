@@ -12,6 +12,7 @@ import cv2
 import numpy as np
 
 from fpga_robotics.sim.camera.frames import rgb444_to_rgb888
+
 from .errors import ViewerError
 
 __all__ = [
