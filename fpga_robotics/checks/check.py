@@ -4,8 +4,8 @@ it could not judge.
 """
 
 import math
-from dataclasses import dataclass
 from collections.abc import Callable
+from dataclasses import dataclass
 from typing import Any
 
 __all__ = ["COMPARISONS", "DESIGN_OUTPUTS", "STATUSES", "Check", "judge", "measured"]
