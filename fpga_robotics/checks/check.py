@@ -36,6 +36,8 @@ class Check:
     kind, limits : the type of the limit (``int`` or ``float``) and ``(lowest, highest, unit)``
         a scenario may set.
     outputs : the design outputs it is measured from; a design lacking one makes it n/a.
+    sensors : the kinds of robot sensor (``[[robot.sensors]]`` ``kind``) whose measurements
+        it reads; a run in which no sensor of a kind measured anything makes it n/a.
     precondition : ``precondition(metrics)`` -> None when the run can be judged, else the
         reason it cannot (the check is n/a, e.g. "the design never searched").
     passes : ``passes(value, limit, metrics)`` for a criterion more than one comparison
@@ -50,6 +52,7 @@ class Check:
     kind: type = float
     limits: tuple = (0, math.inf, "")
     outputs: tuple = ()
+    sensors: tuple = ()
     precondition: Callable | None = None
     passes: Callable | None = None
 
@@ -87,6 +90,19 @@ def _result(check, status, value, limit, text, reason=None):
             "limit": limit, "text": text, "reason": reason}
 
 
+def _silent(kinds, m):
+    """Why the sensors of ``kinds`` cannot be judged (none, or none measured), else None."""
+    sensor_kinds = m.get("sensor_kinds") or {}
+    counts = m.get("measured_frames") or {}
+    for kind in kinds:
+        names = [n for n, k in sensor_kinds.items() if k == kind]
+        if not names:
+            return f"the robot has no {kind} sensor"
+        if not any(counts.get(n, 0) for n in names):
+            return f"no {kind} measurement arrived"
+    return None
+
+
 def judge(check, limit, m):
     """The outcome of ``check`` with ``limit`` on the metrics ``m``: a result dict with
     ``status`` ("pass", "fail" or "n/a"), ``passed`` (True, False or None), ``value``,
@@ -97,7 +113,9 @@ def judge(check, limit, m):
         names = " or ".join(f"`{o}`" for o in missing)
         reason = f"not measured: the design has no {names} output"
         return _result(check, "n/a", None, limit, reason, reason)
-    reason = check.precondition(m) if check.precondition is not None else None
+    reason = _silent(check.sensors, m)
+    if reason is None and check.precondition is not None:
+        reason = check.precondition(m)
     if reason is not None:
         return _result(check, "n/a", None, limit, reason, reason)
     v = check.value(m)

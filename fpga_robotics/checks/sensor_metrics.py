@@ -69,19 +69,20 @@ def obstacle_metrics(traj, events):
 
 
 def measurement_metrics(columns, sensors, frames):
-    """How often each measuring sensor gave a measurement: ``measured_frames`` (sensor name ->
-    frames with one), ``measured_frames_min`` (the fewest; None without sensors) and
-    ``silent_sensors`` (those with none at all). ``columns`` are the trajectory's
-    ``"<sensor>.<measurement>"`` columns (NaN where it had none), ``sensors`` the names of the
-    robot's sensors, ``frames`` the rows done."""
+    """How often each sensor gave a measurement: ``measured_frames`` (sensor name -> frames
+    with one), ``measured_frames_min`` (the fewest; None without sensors), ``silent_sensors``
+    (those with none at all) and ``sensor_kinds`` (name -> kind). ``columns`` are the
+    trajectory's ``"<sensor>.<measurement>"`` columns (NaN where it had none), ``sensors`` the
+    robot's sensors as ``(name, kind)``, ``frames`` the rows done."""
     counts = {}
-    for name in sensors:
+    for name, _kind in sensors:
         mine = [np.asarray(v[:frames], dtype=float) for k, v in columns.items()
                 if k.startswith(f"{name}.")]
         counts[name] = int(np.any(~np.isnan(mine), axis=0).sum()) if mine else 0
     return {"measured_frames": counts,
             "measured_frames_min": min(counts.values()) if counts else None,
-            "silent_sensors": [name for name, n in counts.items() if n == 0]}
+            "silent_sensors": [name for name, n in counts.items() if n == 0],
+            "sensor_kinds": dict(sensors)}
 
 
 def sensor_check(name, limit, m):

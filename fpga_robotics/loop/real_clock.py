@@ -331,8 +331,8 @@ class RealClockLoop(ClosedLoop):
         return {**super().extra_metrics(),
                 **line_metrics(self.traj, getattr(self.world, "floor_lines", ()), mounts,
                                self.period),
-                **measurement_metrics(self.measurements, [c.name for c in self.sensors],
-                                      self.frames_done)}
+                **measurement_metrics(self.measurements,
+                                      [(c.name, c.kind) for c in self.sensors], self.frames_done)}
 
     def timing_summary(self, wall):
         cycles = self.pins.cycle
