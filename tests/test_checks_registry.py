@@ -77,8 +77,8 @@ JUDGED_IF = {
     "min_laps": (2, 3, {"laps": None}, _NO_LINE),
     "max_off_line_s": (0.5, 0.4, {"off_line_s": None}, _NO_LINE),
     "resumes_within_s": (2.4, 2.3, {"obstacle_removed_at_s": None, "resumed_after_s": None},
-                         "no furniture was removed during the run "
-                         "(room.furniture.present_until)"),
+                         ("no furniture was removed during the run "
+                          "(room.furniture.present_until)")),
     "min_measured_frames": (30, 31, {"measured_frames": {}, "measured_frames_min": None,
                                      "silent_sensors": [], "sensor_kinds": {}},
                             "the robot has no sensor that measures ([[robot.sensors]])"),
