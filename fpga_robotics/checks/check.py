@@ -40,7 +40,7 @@ class Check:
         it reads; a run in which no sensor of a kind measured anything makes it n/a.
     precondition : ``precondition(metrics)`` -> None when the run can be judged, else the
         reason it cannot (the check is n/a, e.g. "the design never searched").
-    passes : ``passes(value, limit, metrics)`` for a criterion more than one comparison
+    passes : ``passes(value, limit, metrics)`` for a criterion that is more than one comparison
         (None: ``compare`` decides).
     """
 
