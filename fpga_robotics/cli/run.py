@@ -2,8 +2,9 @@
 
 Headless and faster than real time by default; prints a progress bar on stderr and a human
 summary at the end; ``--summary PATH`` writes the same as JSON. Exit status: 0 when the
-scenario's checks pass, 1 when they fail, 2 for a usage error (bad argument, unknown scenario
-or key, malformed file, unopenable source, missing simulator).
+scenario's checks pass, 1 when one fails or none could judge the run (verdict n/a), 2 for a
+usage error (bad argument, unknown scenario or key, malformed file, unopenable source, missing
+simulator).
 """
 
 import argparse

@@ -322,14 +322,17 @@ class RealClockLoop(ClosedLoop):
         self.traj.update(self.measurements)
 
     def extra_metrics(self):
-        """Also the line metrics, over the world's floor lines, from the line sensors' mounts."""
-        from fpga_robotics.checks.sensor_metrics import line_metrics
+        """Also the line metrics, over the world's floor lines, from the line sensors' mounts,
+        and how often each sensor measured."""
+        from fpga_robotics.checks.sensor_metrics import line_metrics, measurement_metrics
 
         mounts = [m for c in self.sensors if c.kind == "line_sensors"
                   for m in c.sensor_mounts]
         return {**super().extra_metrics(),
                 **line_metrics(self.traj, getattr(self.world, "floor_lines", ()), mounts,
-                               self.period)}
+                               self.period),
+                **measurement_metrics(self.measurements,
+                                      [(c.name, c.kind) for c in self.sensors], self.frames_done)}
 
     def timing_summary(self, wall):
         cycles = self.pins.cycle
