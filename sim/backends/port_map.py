@@ -19,6 +19,8 @@ import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from fpga_robotics.hw.errors import UserError
+
 from ...hw.pixel import COLOR_SELECT
 from .base import BackendError
 
@@ -49,7 +51,7 @@ _FRAME_ONLY = ("found", "proximity", "centroid_x", "centroid_leds")
 MAX_RUNTIME = 8
 
 
-class PortMapError(BackendError):
+class PortMapError(UserError, BackendError):
     """A port map that is malformed or does not fit the design."""
 
 
