@@ -1,7 +1,7 @@
 """Read a saved recording back (tests, checks) and summarise it.
 
-``python -m fpga_robotics.viz.readback FILE.rrd`` prints the summary (the command itself is
-``fpga_robotics.cli.readback``, the application layer).
+``python -m fpga_robotics.viz.readback FILE.rrd`` prints the summary (the command itself,
+``fpga-robotics readback``, is ``fpga_robotics.cli.readback`` in the application layer).
 
 Built on ``rerun.chunk.RrdReader``. Every temporal row of an entity is returned with its
 ``frame`` and ``sim_time`` (ns), sorted by frame; each component value is the list of its
@@ -105,8 +105,11 @@ def read_rrd(path):
 
 
 def summary_lines(rec, name):
-    """Lines describing a ``Recording`` read from ``name``: size, frames, rows per entity."""
-    frames = max((len(r) for p, r in rec.entities.items() if p.startswith("design/")), default=0)
+    """Lines describing a ``Recording`` read from ``name``: size, frames, rows per entity.
+
+    The frames are the distinct steps of the ``frame`` timeline over every entity, so any
+    design's recording counts them, whatever entities it logs."""
+    frames = len({f for rows in rec.entities.values() for f in rows.frames if f is not None})
     head = f"{name}: {rec.size_bytes / 1e6:.2f} MB, {frames} frames"
     if frames:
         head += f", {rec.size_bytes / frames / 1e3:.1f} kB/frame"
@@ -116,3 +119,9 @@ def summary_lines(rec, name):
         f"  {path:22s} static: {', '.join(sorted(rec.static[path]))}" for path in sorted(rec.static)
     ]
     return lines
+
+
+if __name__ == "__main__":  # the documented alias of `fpga-robotics readback`
+    from fpga_robotics.cli import run_command
+
+    run_command("readback")

@@ -13,8 +13,6 @@ bindings against the connector kinds the application knows. A map with connector
 out the pixel stream (a design without a camera).
 """
 
-import argparse
-import sys
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -26,7 +24,7 @@ from .base import BackendError
 
 __all__ = [
     "OUTPUTS", "Output", "PortMap", "PortMapError", "check_connectors", "check_widths",
-    "follow_target_port_map", "load_port_map", "parse_port_map",
+    "follow_target_port_map", "load_port_map", "parse_port_map", "write_follow_target_port_map",
 ]
 
 #: Per-frame outputs a port map may name: FrameResult field -> (default width, signed).
@@ -470,33 +468,17 @@ def follow_target_port_map(params=None):
     return _FOLLOW_TARGET_MAP.format(latency=params.motor_latency)
 
 
-def main(argv=None):
-    """``python -m fpga_robotics.sim.backends.port_map``: write the example port map or check
-    one."""
-    parser = argparse.ArgumentParser(prog="python -m fpga_robotics.sim.backends.port_map",
-                                     description="Write the port map of the exported "
-                                     "follow_target (--example) or check a port map file.")
-    parser.add_argument("path", help="the port map (TOML)")
-    parser.add_argument("--example", action="store_true",
-                        help="write the follow_target example to PATH (not replacing a file)")
-    args = parser.parse_args(argv)
+def write_follow_target_port_map(path, params=None):
+    """Write ``follow_target_port_map(params)`` to ``path``, never replacing a file;
+    ``PortMapError`` when it cannot be written."""
     try:
-        if args.example:
-            try:
-                with open(args.path, "x") as f:
-                    f.write(follow_target_port_map())
-            except OSError as exc:
-                raise PortMapError(f"cannot write {args.path}: {exc.strerror or exc}") from None
-            print(f"wrote {args.path}")
-            return 0
-        port_map = load_port_map(args.path)
-    except PortMapError as exc:
-        print(f"port_map: error: {exc}", file=sys.stderr)
-        return 2
-    connectors = "".join(f", connectors.{kind}" for kind in port_map.connectors)
-    print(f"{args.path}: {port_map.top}, outputs {', '.join(port_map.outputs)}{connectors}")
-    return 0
+        with open(path, "x") as f:
+            f.write(follow_target_port_map(params))
+    except OSError as exc:
+        raise PortMapError(f"cannot write {path}: {exc.strerror or exc}") from None
 
 
-if __name__ == "__main__":
-    sys.exit(main())
+if __name__ == "__main__":  # the documented alias of `fpga-robotics ports`
+    from fpga_robotics.cli import run_command
+
+    run_command("ports")
