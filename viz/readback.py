@@ -16,6 +16,8 @@ import numpy as np
 import pyarrow as pa
 from rerun.chunk import RrdReader
 
+from .errors import ViewerError
+
 __all__ = ["EntityRows", "Recording", "read_rrd", "summary_lines"]
 
 _INDEX_COLUMNS = ("frame", "sim_time", "log_time", "log_tick")
@@ -65,9 +67,14 @@ def read_rrd(path):
     """Read the first recording in ``path``; returns a ``Recording``."""
     if not os.path.isfile(path):
         raise FileNotFoundError(f"no recording at {path}")
-    reader = RrdReader(path)
+    try:
+        reader = RrdReader(path)
+        chunks = list(reader.stream())
+    except RuntimeError as exc:  # rerun's word for a file that is not a recording
+        raise ViewerError(f"{path} is not a rerun recording (.rrd): "
+                          f"{str(exc).splitlines()[0]}") from None
     entities, static = {}, {}
-    for chunk in reader.stream():
+    for chunk in chunks:
         name = chunk.entity_path.lstrip("/")
         batch = chunk.to_record_batch()
         comps = [
