@@ -359,6 +359,38 @@ class _UserDesign:
         return getattr(self._backend, name)
 
 
+def _recording_name(args, scenario):
+    """The stem of the default recording: the scenario's name, or the source's."""
+    if args.source is not None:
+        return Path(str(args.source).replace(":", "_")).stem
+    return scenario.name
+
+
+def _check_recording(args, name):
+    """The ``--rerun`` mode and the file it would write, checked before any build: a run
+    never fails on its recording after the work."""
+    if args.rerun == "off":
+        return
+    from fpga_robotics.viz.modes import parse_mode
+
+    mode = parse_mode(args.rerun, default_path=f"runs/{name}.rrd")
+    if mode.path is not None:
+        check_output_path(mode.path, what="recording")
+
+
+def _check_renderer(scenario):
+    """A 3D scenario needs the ``realistic`` extra (MuJoCo): said before the design is built,
+    not when the first frame is drawn."""
+    if scenario.camera.renderer != "mujoco":
+        return
+    from fpga_robotics.sim.camera.render3d.renderer import Render3DUnavailable, load_mujoco
+
+    try:
+        load_mujoco()
+    except Render3DUnavailable as exc:
+        raise UsageError(f'camera.renderer = "mujoco": {exc}') from None
+
+
 def _open_recorder(args, name):
     if args.rerun == "off":
         return None
@@ -433,7 +465,7 @@ def _run_source(args, scenario, ros):
         recorder = None
         completed = False
         try:
-            recorder = _open_recorder(args, Path(str(args.source).replace(":", "_")).stem)
+            recorder = _open_recorder(args, _recording_name(args, scenario))
             for line in ros.open(scenario, closed_loop=False):
                 print(line, file=sys.stderr)
             progress = None if args.quiet else Progress("frames")
@@ -484,6 +516,7 @@ def main(argv=None, prog="fpga-robotics run"):
     scenario = load_scenario(args.scenario, _overrides(args))
     if args.target_color is not None:
         scenario = _dress_target(scenario, args.target_color)
+    _check_recording(args, _recording_name(args, scenario))
     if args.source is not None:
         if args.shadow is not None:
             raise UsageError("--shadow runs in the closed loop only (not with --source)")
@@ -502,6 +535,7 @@ def main(argv=None, prog="fpga-robotics run"):
             raise UsageError(str(exc)) from None
 
     _design_files(args, scenario.foreign)
+    _check_renderer(scenario)
     t0 = time.perf_counter()
     if scenario.sim.timing == "real_clock":
         if shadow_params is not None:

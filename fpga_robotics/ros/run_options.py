@@ -52,6 +52,10 @@ class RosOutputs:
             from .controls import load_inputs
 
             self.replay = load_inputs(args.replay_inputs)
+        if self.interactive:
+            from .interactive import check_terminal
+
+            check_terminal()
         self.live_control = self.port is not None or self.interactive
         if args.paused and not self.live_control:
             raise UsageError("--paused goes with --live or --interactive")
