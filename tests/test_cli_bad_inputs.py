@@ -10,6 +10,7 @@ the numpy model) fails the case.
 
 import io
 import os
+import socket
 import stat
 import sys
 
@@ -43,6 +44,8 @@ CASES = [
     ("shadow with an unknown key", ["run", "--shadow", "frob=1"], "design.frob"),
     ("shadow with --source", ["run", "--source", "{frames}", "--shadow", "diff_min=5"],
      "--shadow"),
+    ("video with --source", ["run", "--source", "{frames}", "--save-video", "clip.mp4"],
+     "--save-video"),
     ("target colour without a target", ["run", "--set", "people=[]", "--target-color", "green"],
      "no target"),
     # run: ROS bags in and out, live control (issue 16); {bag} is a ROS 2 bag of two
@@ -56,6 +59,7 @@ CASES = [
     ("bag out over a folder", ["run", "--bag", "{dir}"], "not a ROS 2 bag"),
     ("live with a bad kind", ["run", "--live", "rviz"], "--live"),
     ("live with a bad port", ["run", "--live", "foxglove:99999"], "port"),
+    ("live on a port in use", ["run", "--live", "foxglove:{busyport}"], "cannot serve"),
     ("replay of a missing file", ["run", "--replay-inputs", "nope.json"], "no such file"),
     ("replay of a bad input", ["run", "--replay-inputs", "{file}"], "JSON"),
     ("replay with live", ["run", "--replay-inputs", "{file}", "--live", "foxglove"],
@@ -127,8 +131,18 @@ def _float_image_bag(path, n):
     return path
 
 
+@pytest.fixture
+def busy_port():
+    """A port on 127.0.0.1 that something listens on."""
+    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:
+        s.bind(("127.0.0.1", 0))
+        s.listen()
+        yield s.getsockname()[1]
+
+
 @pytest.mark.parametrize("case, argv, word", CASES, ids=[c[0] for c in CASES])
-def test_bad_input_is_one_line_and_exit_2(case, argv, word, tmp_path, monkeypatch, capsys):
+def test_bad_input_is_one_line_and_exit_2(case, argv, word, tmp_path, monkeypatch, capsys,
+                                          busy_port):
     import cv2
 
     (tmp_path / "folder").mkdir()
@@ -139,7 +153,8 @@ def test_bad_input_is_one_line_and_exit_2(case, argv, word, tmp_path, monkeypatc
         cv2.imwrite(str(frames / f"{i}.png"), np.full((12, 16, 3), 40 * i, np.uint8))
     names = {"dir": str(tmp_path / "folder"), "file": str(tmp_path / "file"),
              "frames": str(frames), "bag": str(_float_image_bag(tmp_path / "bag", 2)),
-             "emptybag": str(_float_image_bag(tmp_path / "emptybag", 0))}
+             "emptybag": str(_float_image_bag(tmp_path / "emptybag", 0)),
+             "busyport": str(busy_port)}
     argv = [a.format(**names) for a in argv]
     monkeypatch.chdir(tmp_path)
     (tmp_path / "folder.rrd").mkdir()

@@ -520,6 +520,9 @@ def main(argv=None, prog="fpga-robotics run"):
     if args.source is not None:
         if args.shadow is not None:
             raise UsageError("--shadow runs in the closed loop only (not with --source)")
+        if args.save_video is not None:
+            raise UsageError("--save-video writes the simulated camera's frames: it goes with "
+                             "the closed loop, not with --source")
         if args.max_frames is not None and args.max_frames < 1:
             raise UsageError(f"--max-frames must be >= 1, got {args.max_frames}")
         return _run_source(args, scenario, ros)

@@ -42,9 +42,10 @@ class RosOutputs:
 
             check_bag_path(args.bag)
         if args.live is not None:
-            from .foxglove_live import parse_live_spec
+            from .foxglove_live import check_live_port, parse_live_spec
 
             self.port = parse_live_spec(args.live)
+            check_live_port(self.port)
         if args.replay_inputs is not None:
             if self.port is not None or self.interactive:
                 raise UsageError("--replay-inputs replays a run's inputs; it does not go with "
