@@ -6,8 +6,13 @@ keeps its traceback. It lives in the lowest layer so that the gateware, the simu
 viewer can all raise it without importing the application.
 """
 
-__all__ = ["UserError"]
+__all__ = ["ParamError", "UserError"]
 
 
 class UserError(Exception):
     """Something the user can fix; the message says what is wrong and how to fix it."""
+
+
+class ParamError(UserError, ValueError):
+    """A design parameter out of its range, or an unknown preset, variant or choice (still a
+    ``ValueError``, as callers that check values catch)."""

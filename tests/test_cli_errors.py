@@ -52,6 +52,21 @@ def test_every_library_error_derives_from_user_error(name):
     assert issubclass(getattr(importlib.import_module(module), cls), UserError), name
 
 
+def test_a_design_parameter_out_of_range_is_a_user_error():
+    from fpga_robotics.hw.errors import ParamError
+    from fpga_robotics.hw.params import FollowTargetParams
+    from fpga_robotics.hw.sensor_params import InterlockParams
+
+    # diff_min is a 4-bit channel difference (0..15); resume must not be below stop.
+    with pytest.raises(ParamError, match="diff_min"):
+        FollowTargetParams(diff_min=16)
+    with pytest.raises(ParamError, match="resume_mm"):
+        InterlockParams(stop_mm=300, resume_mm=200)
+    with pytest.raises(ParamError, match="unknown design preset"):
+        FollowTargetParams.preset("nope")
+    assert issubclass(ParamError, UserError) and issubclass(ParamError, ValueError)
+
+
 def test_bases_callers_catch_are_kept():
     from fpga_robotics.sim.backends.base import BackendError
     from fpga_robotics.sim.backends.port_map import PortMapError
