@@ -11,7 +11,6 @@ import cv2
 import numpy as np
 import pytest
 
-from fpga_robotics.cli.errors import UsageError
 from fpga_robotics.cli.readback import main as readback_main
 from fpga_robotics.sim.backends.base import FrameResult
 from fpga_robotics.sim.camera.frames import rgb444_to_rgb888
@@ -368,5 +367,7 @@ def test_readback_summary(saved, capsys):
     out = capsys.readouterr().out
     assert "12 frames" in out and "blueprints: 1" in out
     assert f"{P.MOTORS_DPS:22s}     12 rows" in out
-    with pytest.raises(UsageError):
+    with pytest.raises(SystemExit) as info:  # no file named: one line, exit 2
         readback_main([])
+    assert info.value.code == 2
+    assert capsys.readouterr().err.startswith("fpga-robotics readback: error: ")
