@@ -184,9 +184,8 @@ def test_bad_input_is_one_line_and_exit_2(case, argv, word, tmp_path, monkeypatc
 
 def _forbid_builds(monkeypatch):
     """Record (and refuse) every start of a design simulator but the numpy model's."""
-    import fpga_robotics.loop.compressed as compressed
-    import fpga_robotics.loop.real_clock as real_clock
-    import fpga_robotics.sim.backends.foreign as foreign
+    from fpga_robotics.loop import compressed, real_clock
+    from fpga_robotics.sim.backends import foreign
 
     builds = []
     real_make_backend = compressed.make_backend

@@ -6,10 +6,10 @@ import ast
 import importlib
 
 import pytest
+from test_layering import source_modules
 
 from fpga_robotics.cli.errors import USAGE_EXIT, UsageError, run_cli
 from fpga_robotics.hw.errors import UserError
-from test_layering import source_modules
 
 #: Exception classes that are not the user's to fix, and why.
 NOT_USER_ERRORS = {

@@ -12,8 +12,8 @@ import sys
 import time
 
 from fpga_robotics.cli.errors import UsageError
-from fpga_robotics.cli.parser import CommandParser
 from fpga_robotics.cli.param_options import add_param_arguments, params_from_args
+from fpga_robotics.cli.parser import CommandParser
 from fpga_robotics.mutation.design import open_mutant_design, write_mutant_design
 from fpga_robotics.mutation.reasons import blind_spot_reason
 from fpga_robotics.mutation.scores import blind_spots, by_module, robot_score, unit_score
