@@ -15,8 +15,8 @@
 
 Each subcommand is the ``main(argv, prog)`` of its module, and the ``python -m`` aliases call
 ``run_command``, so ``fpga-robotics run --help`` and ``python -m fpga_robotics.run --help`` are
-the same command under the same name. New subcommands are one row of
-``COMMANDS`` (or ``BENCHMARKS``).
+the same command under the same name. New subcommands are one row of ``COMMANDS`` (or
+``BENCHMARKS``).
 """
 
 import importlib

@@ -140,7 +140,7 @@ def _dry_run(campaign, args):
 
 def _report(argv, prog):
     p = CommandParser(prog=f"{prog} report",
-                                description="Rebuild report.html from a campaign's results.")
+                      description="Rebuild report.html from a campaign's results.")
     p.add_argument("dir", metavar="DIR", help="the campaign's results folder")
     args = p.parse_args(argv)
     from fpga_robotics.sweep.api import report_dir
