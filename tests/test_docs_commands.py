@@ -474,7 +474,7 @@ PLANS = {
     # docs/foreign.md: your own Verilog design -----------------------------------------------
     "python -m fpga_robotics.export -o follow_target.v":
         Plan(files=("follow_target.v",), out=(r"160x120, module follow_target",)),
-    "python -m fpga_robotics.sim.backends.port_map --example ports.toml":
+    "fpga-robotics ports --example ports.toml":
         Plan(files=("ports.toml",), out=(r"wrote ports\.toml",)),
     "python -m fpga_robotics.run --design verilog:follow_target.v --ports ports.toml":
         Plan(out=(PASS, r"(?m)^backend:? .*verilator-foreign|verilator-foreign")),
@@ -485,8 +485,8 @@ PLANS = {
              duration="keep", duration_why="the page quotes the whole run's 120 000 cycles "
                                            "(12 s at 10 kHz, a twentieth of a second's wall time)",
              out=(PASS, r"\[ok\] max_wall_collisions")),
-    "python -m fpga_robotics.sim.backends.port_map ports.toml":
-        Plan(setup=("python -m fpga_robotics.sim.backends.port_map --example ports.toml",),
+    "fpga-robotics ports ports.toml":
+        Plan(setup=("fpga-robotics ports --example ports.toml",),
              out=(r"ports\.toml: follow_target, outputs found, proximity",)),
     "python -m fpga_robotics.mutation --mutants 200":
         Plan(shorter=(("--mutants", "12"), ("--width", "80"), ("--height", "60")),

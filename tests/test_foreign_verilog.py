@@ -285,7 +285,7 @@ def test_cli_bad_designs_exit_2_with_one_line(files, capsys, argv, message):
     argv = [a.replace("{dir}", str(files)) for a in argv]
     with pytest.raises(SystemExit) as info:
         run_cli(run.main, [*argv, "--resolution", "80x60", "--duration", "0.5", "--rerun",
-                           "off", "--quiet"], prog="fpga_robotics.run")
+                           "off", "--quiet"], prog="fpga-robotics run")
     assert info.value.code == 2
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and message in err, err

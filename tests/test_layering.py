@@ -124,7 +124,7 @@ def test_dependencies_point_one_way():
 
 def test_the_checker_sees_an_upward_import(tmp_path):
     path = tmp_path / "x.py"
-    path.write_text("import os\nfrom ...errors import UsageError\n"
+    path.write_text("import os\nfrom ...cli.errors import UsageError\n"
                     "def f():\n    from ..world import World\n"
                     "if __name__ == '__main__':\n    from ...run import main\n")
     found = imports_of("fpga_robotics.sim.backends.x", path)

@@ -11,7 +11,6 @@ import cv2
 import numpy as np
 import pytest
 
-from fpga_robotics.cli.errors import UsageError
 from fpga_robotics.cli.readback import main as readback_main
 from fpga_robotics.sim.backends.base import FrameResult
 from fpga_robotics.sim.camera.frames import rgb444_to_rgb888
@@ -388,5 +387,7 @@ def test_readback_summary(saved, capsys):
     assert readback_main([str(raw)]) == 0
     out = capsys.readouterr().out
     assert f"{P.CAMERA_RAW:22s}      3 rows, raw 2.3 kB each\n" in out
-    with pytest.raises(UsageError):
+    with pytest.raises(SystemExit) as info:  # no file named: one line, exit 2
         readback_main([])
+    assert info.value.code == 2
+    assert capsys.readouterr().err.startswith("fpga-robotics readback: error: ")

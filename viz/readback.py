@@ -17,6 +17,7 @@ import numpy as np
 import pyarrow as pa
 from rerun.chunk import RrdReader
 
+from .errors import ViewerError
 from .images import decode_image
 
 __all__ = ["EntityRows", "Recording", "images", "read_rrd", "summary_lines"]
@@ -68,9 +69,14 @@ def read_rrd(path):
     """Read the first recording in ``path``; returns a ``Recording``."""
     if not os.path.isfile(path):
         raise FileNotFoundError(f"no recording at {path}")
-    reader = RrdReader(path)
+    try:
+        reader = RrdReader(path)
+        chunks = list(reader.stream())
+    except RuntimeError as exc:  # rerun's word for a file that is not a recording
+        raise ViewerError(f"{path} is not a rerun recording (.rrd): "
+                          f"{str(exc).splitlines()[0]}") from None
     entities, static = {}, {}
-    for chunk in reader.stream():
+    for chunk in chunks:
         name = chunk.entity_path.lstrip("/")
         batch = chunk.to_record_batch()
         comps = [
@@ -153,8 +159,11 @@ def _image_bytes(rows):
 
 
 def summary_lines(rec, name):
-    """Lines describing a ``Recording`` read from ``name``: size, frames, rows per entity."""
-    frames = max((len(r) for p, r in rec.entities.items() if p.startswith("design/")), default=0)
+    """Lines describing a ``Recording`` read from ``name``: size, frames, rows per entity.
+
+    The frames are the distinct steps of the ``frame`` timeline over every entity, so any
+    design's recording counts them, whatever entities it logs."""
+    frames = len({f for rows in rec.entities.values() for f in rows.frames if f is not None})
     head = f"{name}: {rec.size_bytes / 1e6:.2f} MB, {frames} frames"
     if frames:
         head += f", {rec.size_bytes / frames / 1e3:.1f} kB/frame"

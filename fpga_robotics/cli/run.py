@@ -1,4 +1,4 @@
-"""``python -m fpga_robotics.run``: run a scenario in closed loop (or the design on real frames).
+"""``fpga-robotics run`` (or ``python -m fpga_robotics.run``): run a scenario in closed loop (or the design on real frames).
 
 Headless and faster than real time by default; prints a progress bar on stderr and a human
 summary at the end; ``--summary PATH`` writes the same as JSON. Exit status: 0 when the
@@ -7,12 +7,12 @@ usage error (bad argument, unknown scenario or key, malformed file, unopenable s
 simulator).
 """
 
-import argparse
 import sys
 import time
 from pathlib import Path
 
-from fpga_robotics.cli.errors import UsageError, run_cli
+from fpga_robotics.cli.errors import UsageError
+from fpga_robotics.cli.parser import CommandParser
 from fpga_robotics.hw.pixel import COLOR_SELECT
 from fpga_robotics.ros.run_options import RosOutputs, add_ros_arguments
 from fpga_robotics.sim.backends import BACKEND_NAMES
@@ -32,24 +32,42 @@ TARGET_CLOTHING = {
 }
 
 
-def build_parser(prog="python -m fpga_robotics.run"):
-    p = argparse.ArgumentParser(
+#: The scenario ``run`` runs without ``--scenario``.
+DEFAULT_SCENARIO = "follow_person"
+
+
+def _scenario_default(section, key):
+    """The default scenario's ``[section] key`` as ``--help`` shows it (read from its TOML
+    file, not loaded: ``--help`` stays quick)."""
+    import tomllib
+    from importlib import resources
+
+    path = resources.files("fpga_robotics.scenario") / "shipped" / f"{DEFAULT_SCENARIO}.toml"
+    value = tomllib.loads(path.read_text()).get(section, {}).get(key)
+    return "the scenario's" if value is None else f"the scenario's; {DEFAULT_SCENARIO}: {value}"
+
+
+def build_parser(prog="fpga-robotics run"):
+    p = CommandParser(
         prog=prog,
         description="Run the FollowTarget design in closed loop with a simulated robot, camera "
                     "and people, and check the scenario's pass criteria.",
     )
-    p.add_argument("--scenario", default="follow_person", metavar="NAME|PATH",
-                   help="a shipped scenario (see --list-scenarios) or a .toml file "
-                        "(default: follow_person)")
+    p.add_argument("--scenario", default=DEFAULT_SCENARIO, metavar="NAME|PATH",
+                   help="a shipped scenario (see --list-scenarios) or a .toml file")
     p.add_argument("--list-scenarios", action="store_true", help="list the shipped scenarios")
     p.add_argument("--backend", default="auto", choices=("auto", *BACKEND_NAMES),
                    help="design simulator (default auto: the fastest compiled one available)")
-    p.add_argument("--resolution", metavar="WxH", help="camera and design resolution")
-    p.add_argument("--color", choices=tuple(COLOR_SELECT), help="initial colour select")
+    p.add_argument("--resolution", metavar="WxH",
+                   help="camera and design resolution (default: "
+                        f"{_scenario_default('camera', 'resolution')})")
+    p.add_argument("--color", choices=tuple(COLOR_SELECT),
+                   help=f"initial colour select (default: {_scenario_default('color', 'initial')})")
     p.add_argument("--target-color", choices=tuple(TARGET_CLOTHING), metavar="C",
                    help="dress the target person in C and follow C (colour select); one of "
                         + ", ".join(TARGET_CLOTHING))
-    p.add_argument("--duration", type=float, metavar="S", help="simulated seconds")
+    p.add_argument("--duration", type=float, metavar="S",
+                   help=f"simulated seconds (default: {_scenario_default('sim', 'duration')})")
     p.add_argument("--seed", type=int, metavar="N", help="random seed (default: the scenario's)")
     p.add_argument("--realtime", action="store_true", help="pace the simulation to the clock")
     p.add_argument("--summary", metavar="PATH", help="write the summary as JSON")
@@ -60,7 +78,7 @@ def build_parser(prog="python -m fpga_robotics.run"):
                         "connect[:URL], serve[:ADDRESS], off; default auto = spawn with a "
                         "display, else save")
     p.add_argument("--log-every", type=int, default=1, metavar="N",
-                   help="log every Nth frame's images to the viewer (default 1)")
+                   help="log every Nth frame's images to the viewer")
     p.add_argument("--source", metavar="camera:N|VIDEO|FOLDER|bag:PATH[:TOPIC]",
                    help="run the design on real frames instead of the simulation (no physics)")
     p.add_argument("--max-frames", type=int, metavar="N", help="with --source: stop after N")
@@ -342,6 +360,38 @@ class _UserDesign:
         return getattr(self._backend, name)
 
 
+def _recording_name(args, scenario):
+    """The stem of the default recording: the scenario's name, or the source's."""
+    if args.source is not None:
+        return Path(str(args.source).replace(":", "_")).stem
+    return scenario.name
+
+
+def _check_recording(args, name):
+    """The ``--rerun`` mode and the file it would write, checked before any build: a run
+    never fails on its recording after the work."""
+    if args.rerun == "off":
+        return
+    from fpga_robotics.viz.modes import parse_mode
+
+    mode = parse_mode(args.rerun, default_path=f"runs/{name}.rrd")
+    if mode.path is not None:
+        check_output_path(mode.path, what="recording")
+
+
+def _check_renderer(scenario):
+    """A 3D scenario needs the ``realistic`` extra (MuJoCo): said before the design is built,
+    not when the first frame is drawn."""
+    if scenario.camera.renderer != "mujoco":
+        return
+    from fpga_robotics.sim.camera.render3d.renderer import Render3DUnavailable, load_mujoco
+
+    try:
+        load_mujoco()
+    except Render3DUnavailable as exc:
+        raise UsageError(f'camera.renderer = "mujoco": {exc}') from None
+
+
 def _open_recorder(args, name):
     if args.rerun == "off":
         return None
@@ -416,7 +466,7 @@ def _run_source(args, scenario, ros):
         recorder = None
         completed = False
         try:
-            recorder = _open_recorder(args, Path(str(args.source).replace(":", "_")).stem)
+            recorder = _open_recorder(args, _recording_name(args, scenario))
             for line in ros.open(scenario, closed_loop=False):
                 print(line, file=sys.stderr)
             progress = None if args.quiet else Progress("frames")
@@ -448,14 +498,14 @@ def _run_source(args, scenario, ros):
     return 0
 
 
-def main(argv=None, prog="python -m fpga_robotics.run"):
+def main(argv=None, prog="fpga-robotics run"):
     args = build_parser(prog).parse_args(argv)
     if args.list_scenarios:
         return _list_scenarios()
 
+    from fpga_robotics.checks.summary import format_summary
     from fpga_robotics.loop.compressed import run_scenario
     from fpga_robotics.scenario.load import MAX_SEED, load_scenario
-    from fpga_robotics.checks.summary import format_summary
 
     if args.seed is not None and not 0 <= args.seed <= MAX_SEED:
         raise UsageError(f"--seed must be in 0..{MAX_SEED}, got {args.seed}")
@@ -467,9 +517,13 @@ def main(argv=None, prog="python -m fpga_robotics.run"):
     scenario = load_scenario(args.scenario, _overrides(args))
     if args.target_color is not None:
         scenario = _dress_target(scenario, args.target_color)
+    _check_recording(args, _recording_name(args, scenario))
     if args.source is not None:
         if args.shadow is not None:
             raise UsageError("--shadow runs in the closed loop only (not with --source)")
+        if args.save_video is not None:
+            raise UsageError("--save-video writes the simulated camera's frames: it goes with "
+                             "the closed loop, not with --source")
         if args.max_frames is not None and args.max_frames < 1:
             raise UsageError(f"--max-frames must be >= 1, got {args.max_frames}")
         return _run_source(args, scenario, ros)
@@ -485,6 +539,7 @@ def main(argv=None, prog="python -m fpga_robotics.run"):
             raise UsageError(str(exc)) from None
 
     _design_files(args, scenario.foreign)
+    _check_renderer(scenario)
     t0 = time.perf_counter()
     if scenario.sim.timing == "real_clock":
         if shadow_params is not None:
@@ -533,11 +588,3 @@ def main(argv=None, prog="python -m fpga_robotics.run"):
     if args.summary:
         write_json_atomic(args.summary, summary, what="--summary")
     return 0 if summary["verdict"] == "pass" else 1
-
-
-def cli():
-    run_cli(main, sys.argv[1:], prog="fpga_robotics.run")
-
-
-if __name__ == "__main__":
-    cli()

@@ -13,18 +13,18 @@ bindings against the connector kinds the application knows. A map with connector
 out the pixel stream (a design without a camera).
 """
 
-import argparse
-import sys
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
+
+from fpga_robotics.hw.errors import UserError
 
 from ...hw.pixel import COLOR_SELECT
 from .base import BackendError
 
 __all__ = [
     "OUTPUTS", "Output", "PortMap", "PortMapError", "check_connectors", "check_widths",
-    "follow_target_port_map", "load_port_map", "parse_port_map",
+    "follow_target_port_map", "load_port_map", "parse_port_map", "write_follow_target_port_map",
 ]
 
 #: Per-frame outputs a port map may name: FrameResult field -> (default width, signed).
@@ -49,7 +49,7 @@ _FRAME_ONLY = ("found", "proximity", "centroid_x", "centroid_leds")
 MAX_RUNTIME = 8
 
 
-class PortMapError(BackendError):
+class PortMapError(UserError, BackendError):
     """A port map that is malformed or does not fit the design."""
 
 
@@ -468,33 +468,11 @@ def follow_target_port_map(params=None):
     return _FOLLOW_TARGET_MAP.format(latency=params.motor_latency)
 
 
-def main(argv=None):
-    """``python -m fpga_robotics.sim.backends.port_map``: write the example port map or check
-    one."""
-    parser = argparse.ArgumentParser(prog="python -m fpga_robotics.sim.backends.port_map",
-                                     description="Write the port map of the exported "
-                                     "follow_target (--example) or check a port map file.")
-    parser.add_argument("path", help="the port map (TOML)")
-    parser.add_argument("--example", action="store_true",
-                        help="write the follow_target example to PATH (not replacing a file)")
-    args = parser.parse_args(argv)
+def write_follow_target_port_map(path, params=None):
+    """Write ``follow_target_port_map(params)`` to ``path``, never replacing a file;
+    ``PortMapError`` when it cannot be written."""
     try:
-        if args.example:
-            try:
-                with open(args.path, "x") as f:
-                    f.write(follow_target_port_map())
-            except OSError as exc:
-                raise PortMapError(f"cannot write {args.path}: {exc.strerror or exc}") from None
-            print(f"wrote {args.path}")
-            return 0
-        port_map = load_port_map(args.path)
-    except PortMapError as exc:
-        print(f"port_map: error: {exc}", file=sys.stderr)
-        return 2
-    connectors = "".join(f", connectors.{kind}" for kind in port_map.connectors)
-    print(f"{args.path}: {port_map.top}, outputs {', '.join(port_map.outputs)}{connectors}")
-    return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main())
+        with open(path, "x") as f:
+            f.write(follow_target_port_map(params))
+    except OSError as exc:
+        raise PortMapError(f"cannot write {path}: {exc.strerror or exc}") from None
