@@ -80,6 +80,9 @@ def build_parser(prog="python -m fpga_robotics.run"):
     p.add_argument("--save-video", metavar="PATH.mp4|PATH.avi",
                    help="also write the camera frames as a video (try it with --source)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.add_argument("--strict", action="store_true",
+                   help="refuse a scenario that loads with warnings (a waypoint inside "
+                        "furniture, a check no run can meet...) instead of printing them")
     add_ros_arguments(p)  # --bag, --live, --interactive, --paused, --replay-inputs
     return p
 
@@ -455,6 +458,7 @@ def main(argv=None, prog="python -m fpga_robotics.run"):
     from fpga_robotics.loop.compressed import run_scenario
     from fpga_robotics.scenario.load import MAX_SEED, load_scenario
     from fpga_robotics.checks.summary import format_summary
+    from fpga_robotics.scenario.sanity import report_warnings
 
     if args.seed is not None and not 0 <= args.seed <= MAX_SEED:
         raise UsageError(f"--seed must be in 0..{MAX_SEED}, got {args.seed}")
@@ -466,6 +470,7 @@ def main(argv=None, prog="python -m fpga_robotics.run"):
     scenario = load_scenario(args.scenario, _overrides(args))
     if args.target_color is not None:
         scenario = _dress_target(scenario, args.target_color)
+    report_warnings(scenario, args.strict, sys.stderr, UsageError)
     if args.source is not None:
         if args.shadow is not None:
             raise UsageError("--shadow runs in the closed loop only (not with --source)")
