@@ -1,6 +1,8 @@
 """A campaign's scenario warnings (``fpga_robotics.scenario.sanity``), before any run starts:
 each scenario is loaded once per distinct set of overrides the campaign gives it."""
 
+from argparse import Namespace
+
 from fpga_robotics.scenario.sanity import report_warnings
 
 __all__ = ["report_campaign_warnings"]
@@ -19,10 +21,12 @@ def report_campaign_warnings(campaign, strict, stream, error):
         if key in seen:
             continue
         seen.add(key)
+        # The run's own overrides, as ``run`` makes them of its options.
+        args = Namespace(overrides=list(spec.set_items()), resolution=spec.resolution,
+                         duration=spec.duration, color=None)
         try:
-            args = run.build_parser().parse_args(spec.argv())
-            scenario = load_scenario(args.scenario, run._overrides(args))
-        except (UsageError, SystemExit):  # the run reports it as its own failure
+            scenario = load_scenario(spec.scenario, run._overrides(args))
+        except UsageError:  # the run reports it as its own failure
             continue
         fresh = tuple(w for w in scenario.warnings if (scenario.name, w) not in seen)
         seen.update((scenario.name, w) for w in fresh)
