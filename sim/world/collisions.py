@@ -14,7 +14,8 @@ fault when it closed faster than the other body and faster than ``AT_FAULT_SPEED
 import math
 from collections import deque
 
-__all__ = ["AT_FAULT_SPEED", "EPISODE_GAP", "FAULT_WINDOW", "CollisionLog", "closing_speeds"]
+__all__ = ["AT_FAULT_SPEED", "EPISODE_GAP", "FAULT_WINDOW", "CollisionLog", "MotionHistory",
+           "closing_speeds"]
 
 #: A contact that resumes within this time (s) of its end is the same collision.
 EPISODE_GAP = 0.5
@@ -133,8 +134,8 @@ class CollisionLog:
 
 
 class MotionHistory:
-    """The robot's and the people's positions at the last sub-steps, for averaged
-    velocities."""
+    """The robot's and the people's positions at the start of the last sub-steps (the world
+    records one before each physics step), for averaged velocities."""
 
     def __init__(self, window=FAULT_WINDOW, size=64):
         self.window = window
@@ -145,14 +146,13 @@ class MotionHistory:
 
     def mean_velocities(self, t, robot_xy, people_xy):
         """``(robot_v, [person_v, ...])`` averaged from the oldest row within the window
-        before ``t`` up to the positions now; None when nothing was recorded before ``t``."""
-        start = None
+        before ``t`` (at least the last one: the sub-step under way) up to the positions
+        now."""
+        start = self._rows[-1]
         for row in self._rows:
-            if row[0] < t and t - row[0] <= self.window + 1e-12:
+            if t - row[0] <= self.window + 1e-12:
                 start = row
                 break
-        if start is None:
-            return None
         t0, r0, p0 = start
         span = t - t0
 

@@ -233,38 +233,27 @@ class World:
         kind, name = self._names[other]
         if not self._collisions.begin(kind, name, other, self._now):
             return  # still touching, or touching again within the episode gap
-        robot_c, other_c = self._closing_speeds(kind, other, arbiter)
-        fault = robot_c > AT_FAULT_SPEED and robot_c > other_c
-        if fault and kind == "person":
-            self._collisions.record_fault(kind)
-        if kind == "person":
-            verdict = "the robot's fault" if fault else "not the robot's fault"
-            self._events.append(f"collision with person {name!r} (robot closing "
-                                f"{_speed(robot_c)} m/s, person {_speed(other_c)} m/s: "
-                                f"{verdict})")
-        else:
+        if kind != "person":
             self._events.append(f"collision with {kind} {name!r}" if name
                                 else f"collision with {kind}")
+            return
+        robot_c, person_c = self._closing_speeds(other)
+        fault = robot_c > AT_FAULT_SPEED and robot_c > person_c
+        if fault:
+            self._collisions.record_fault(kind)
+        verdict = "the robot's fault" if fault else "not the robot's fault"
+        self._events.append(f"collision with person {name!r} (robot closing {_speed(robot_c)} "
+                            f"m/s, person {_speed(person_c)} m/s: {verdict})")
 
-    def _closing_speeds(self, kind, other, arbiter):
-        """The robot's and the other body's speeds towards each other at a first touch, m/s,
-        averaged over ``collisions.FAULT_WINDOW`` (the current velocities at the very first
-        step)."""
+    def _closing_speeds(self, person_shape):
+        """The robot's and the person's speeds towards each other at a first touch, m/s,
+        averaged over ``collisions.FAULT_WINDOW``."""
         robot_xy = tuple(self.robot_body.position)
         people_xy = [tuple(p.body.position) for p in self.people]
-        mean = self._history.mean_velocities(self._now, robot_xy, people_xy)
-        if kind == "person":
-            i = next(i for i, p in enumerate(self.people) if p.shape is other)
-            ox, oy = people_xy[i]
-            towards = (ox - robot_xy[0], oy - robot_xy[1])
-            if mean is None:
-                return closing_speeds(tuple(self.robot_body.velocity),
-                                      tuple(other.body.velocity), towards)
-            return closing_speeds(mean[0], mean[1][i], towards)
-        # Walls and furniture stand still; the contact normal points from the robot to them.
-        towards = tuple(arbiter.normal)
-        robot_v = mean[0] if mean is not None else tuple(self.robot_body.velocity)
-        return closing_speeds(robot_v, (0.0, 0.0), towards)
+        i = next(i for i, p in enumerate(self.people) if p.shape is person_shape)
+        towards = (people_xy[i][0] - robot_xy[0], people_xy[i][1] - robot_xy[1])
+        robot_v, people_v = self._history.mean_velocities(self._now, robot_xy, people_xy)
+        return closing_speeds(robot_v, people_v[i], towards)
 
     def _on_post_solve(self, arbiter, space, data):
         kind, _ = self._names[arbiter.shapes[1]]
