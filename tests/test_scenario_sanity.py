@@ -45,8 +45,8 @@ def test_a_waypoint_that_puts_the_person_into_furniture(tmp_path):
     # 0.15 m above the desk's far edge (y 1.2): closer than the person's radius.
     body = DESK + _person([(5.0, 2.0), (3.1, 1.35)])
     assert _warnings(tmp_path, body) == [
-        "people[0].waypoints[1] [3.1, 1.35] puts the person (radius 0.2 m) into furniture "
-        "'desk'"]
+        ("people[0].waypoints[1] [3.1, 1.35] puts the person (radius 0.2 m) into furniture "
+        "'desk'")]
     # 0.25 m away: clear.
     assert _warnings(tmp_path, DESK + _person([(5.0, 2.0), (3.1, 1.45)])) == []
 
@@ -77,8 +77,8 @@ def test_a_path_across_the_robots_start(tmp_path):
     robot = "[robot]\nstart = [1.5, 3.0]\n"
     # 0.3 m from the start: less than 0.2 + 0.177 m, the bodies would touch.
     assert _warnings(tmp_path, robot + _person([(0.5, 3.3), (4.0, 3.3)])) == [
-        "people[0].waypoints[0] -> [1] passes 0.30 m from robot.start [1.5, 3]: the person "
-        "(radius 0.2 m) walks into the robot (radius 0.177 m) where it starts"]
+        ("people[0].waypoints[0] -> [1] passes 0.30 m from robot.start [1.5, 3]: the person "
+        "(radius 0.2 m) walks into the robot (radius 0.177 m) where it starts")]
     # 0.4 m: they pass clear of it.
     assert _warnings(tmp_path, robot + _person([(0.5, 3.4), (4.0, 3.4)])) == []
 
@@ -87,10 +87,10 @@ def test_distance_checks_without_a_target(tmp_path):
     body = _person([(5.0, 3.0)], target=False) + (
         "[checks]\nmean_distance_max_m = 2.0\ntarget_in_view_min_fraction = 0.5\n")
     assert _warnings(tmp_path, body) == [
-        "checks.mean_distance_max_m = 2 needs a target person (people[].target = true); the "
-        "scenario has none: it always fails",
-        "checks.target_in_view_min_fraction = 0.5 needs a target person (people[].target = "
-        "true); the scenario has none: it always fails"]
+        ("checks.mean_distance_max_m = 2 needs a target person (people[].target = true); the "
+        "scenario has none: it always fails"),
+        ("checks.target_in_view_min_fraction = 0.5 needs a target person (people[].target = "
+        "true); the scenario has none: it always fails")]
 
 
 def test_distance_checks_decided_by_the_bodies_and_the_room(tmp_path):
@@ -98,14 +98,14 @@ def test_distance_checks_decided_by_the_bodies_and_the_room(tmp_path):
     # The centres touch at 0.2 + 0.177 = 0.377 m and are at most
     # hypot(8 - 0.377, 6 - 0.377) = 9.47 m apart in the default 8 m x 6 m room.
     assert _warnings(tmp_path, person + "[checks]\nmean_distance_max_m = 0.3\n") == [
-        "checks.mean_distance_max_m = 0.3 m is below 0.377 m, the robot's and the target's "
-        "centres when they touch: it always fails"]
+        ("checks.mean_distance_max_m = 0.3 m is below 0.377 m, the robot's and the target's "
+        "centres when they touch: it always fails")]
     assert _warnings(tmp_path, person + "[checks]\nmin_distance_min_m = 0.2\n") == [
-        "checks.min_distance_min_m = 0.2 m is below 0.377 m, the robot's and the target's "
-        "centres when they touch: it always passes (use max_person_collisions for contact)"]
+        ("checks.min_distance_min_m = 0.2 m is below 0.377 m, the robot's and the target's "
+        "centres when they touch: it always passes (use max_person_collisions for contact)")]
     assert _warnings(tmp_path, person + "[checks]\nmin_distance_min_m = 9.5\n") == [
-        "checks.min_distance_min_m = 9.5 m is beyond 9.47 m, the farthest the centres can be "
-        "apart in the room: it always fails"]
+        ("checks.min_distance_min_m = 9.5 m is beyond 9.47 m, the farthest the centres can be "
+        "apart in the room: it always fails")]
     assert _warnings(tmp_path, person + "[checks]\nmin_distance_min_m = 9.4\n"
                      "mean_distance_max_m = 0.4\n") == []
 

@@ -66,8 +66,8 @@ def test_a_person_walking_steadily_into_a_parked_robot_is_one_episode_not_its_fa
     touch = (2.0 - CONTACT) / 0.6
     stop = 4.0 / 0.6
     assert [e for _, e in events] == [
-        "collision with person 'p1' (robot closing 0.00 m/s, person 0.60 m/s: "
-        "not the robot's fault)"]
+        ("collision with person 'p1' (robot closing 0.00 m/s, person 0.60 m/s: "
+        "not the robot's fault)")]
     assert events[0][0] == pytest.approx(touch, abs=DT)
     summary = world.collision_summary()
     assert summary["person"]["episodes"] == world.collision_counts()["person"] == 1
@@ -85,8 +85,8 @@ def test_a_creeping_robot_hit_by_a_walking_person_is_not_at_fault():
     events = []
     _run(world, 3.0, events)
     assert [e for _, e in events] == [
-        "collision with person 'p1' (robot closing 0.06 m/s, person 0.60 m/s: "
-        "not the robot's fault)"]
+        ("collision with person 'p1' (robot closing 0.06 m/s, person 0.60 m/s: "
+        "not the robot's fault)")]
     assert world.at_fault_collisions() == 0
 
 
@@ -105,8 +105,8 @@ def test_the_robot_driving_into_a_standing_person_is_one_episode_and_its_fault()
     _run(world, 6.0, events)  # it keeps pushing against the person to the end
     touch = _touch_time(300, 1.0 - CONTACT)
     assert [e for _, e in events] == [
-        "collision with person 'bob' (robot closing 0.18 m/s, person 0.00 m/s: "
-        "the robot's fault)"]
+        ("collision with person 'bob' (robot closing 0.18 m/s, person 0.00 m/s: "
+        "the robot's fault)")]
     assert events[0][0] == pytest.approx(touch, abs=DT)
     summary = world.collision_summary()["person"]
     assert summary["episodes"] == 1 and world.at_fault_collisions() == 1

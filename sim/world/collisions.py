@@ -41,7 +41,7 @@ def closing_speeds(robot_velocity, other_velocity, towards):
 
 
 class _Episode:
-    __slots__ = ("kind", "name", "shapes", "since", "ended")
+    __slots__ = ("ended", "kind", "name", "shapes", "since")
 
     def __init__(self, kind, name):
         self.kind = kind
@@ -101,8 +101,7 @@ class CollisionLog:
     def impulse(self, kind, impulse):
         """A physics step's contact impulse with a body of ``kind``, N s."""
         stats = self._stats[kind]
-        if impulse > stats["max_impulse_ns"]:
-            stats["max_impulse_ns"] = impulse
+        stats["max_impulse_ns"] = max(stats["max_impulse_ns"], impulse)
 
     def record_fault(self, kind):
         """The episode just begun with a body of ``kind`` was the robot's fault."""
