@@ -63,7 +63,7 @@ CENTRED_FRACTION = 0.125
 
 
 def compute_metrics(traj, events, collisions, frame_period, *, at_fault_collisions=0,
-                    width=None, absent=(), margin_x=None):
+                    width=None, absent=(), margin_x=None, collision_summary=None):
     """Reduce a run to numbers.
 
     Parameters
@@ -85,6 +85,8 @@ def compute_metrics(traj, events, collisions, frame_period, *, at_fault_collisio
     margin_x : int, optional
         The columns the design's tracking window leaves on each side (the LEDs sit above its
         eighths); default ``width // 10``, the design's default.
+    collision_summary : dict, optional
+        ``World.collision_summary()``: per kind, episodes, contact time and largest impulse.
     """
     absent = [name for name in DESIGN_OUTPUTS if name in set(absent)]
     if absent:
@@ -93,7 +95,7 @@ def compute_metrics(traj, events, collisions, frame_period, *, at_fault_collisio
             present["found"] = np.zeros(len(traj["t"]), bool)
         m = compute_metrics(present, events, collisions, frame_period,
                             at_fault_collisions=at_fault_collisions, width=width,
-                            margin_x=margin_x)
+                            margin_x=margin_x, collision_summary=collision_summary)
         for name, needs in _METRIC_OUTPUTS.items():
             if any(o in absent for o in needs):
                 m[name] = None
@@ -134,6 +136,7 @@ def compute_metrics(traj, events, collisions, frame_period, *, at_fault_collisio
         "acquired_at_s": _round(acquired_at),
         "collisions": dict(collisions),
         "robot_at_fault_collisions": int(at_fault_collisions),
+        "collision_summary": dict(collision_summary or {}),
         "losses": len(episodes),
         "searches": sum(1 for _, _, text in events if text == "search started"),
         "searched_losses": sum(1 for ep in episodes if ep[2]),

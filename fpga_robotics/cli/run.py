@@ -99,6 +99,9 @@ def build_parser(prog="fpga-robotics run"):
     p.add_argument("--save-video", metavar="PATH.mp4|PATH.avi",
                    help="also write the camera frames as a video (try it with --source)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.add_argument("--strict", action="store_true",
+                   help="refuse a scenario that loads with warnings (a waypoint inside "
+                        "furniture, a check no run can meet...) instead of printing them")
     add_ros_arguments(p)  # --bag, --live, --interactive, --paused, --replay-inputs
     return p
 
@@ -506,6 +509,7 @@ def main(argv=None, prog="fpga-robotics run"):
     from fpga_robotics.checks.summary import format_summary
     from fpga_robotics.loop.compressed import run_scenario
     from fpga_robotics.scenario.load import MAX_SEED, load_scenario
+    from fpga_robotics.scenario.sanity import report_warnings
 
     if args.seed is not None and not 0 <= args.seed <= MAX_SEED:
         raise UsageError(f"--seed must be in 0..{MAX_SEED}, got {args.seed}")
@@ -517,6 +521,7 @@ def main(argv=None, prog="fpga-robotics run"):
     scenario = load_scenario(args.scenario, _overrides(args))
     if args.target_color is not None:
         scenario = _dress_target(scenario, args.target_color)
+    report_warnings(scenario, args.strict, sys.stderr, UsageError)
     _check_recording(args, _recording_name(args, scenario))
     if args.source is not None:
         if args.shadow is not None:

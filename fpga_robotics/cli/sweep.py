@@ -65,6 +65,10 @@ def build_parser(prog=PROG):
     e.add_argument("--dry-run", action="store_true",
                    help="print the run count and three example commands, run nothing")
     e.add_argument("--quiet", action="store_true", help="no progress bar")
+    e.add_argument("--strict", action="store_true",
+                   help="refuse a campaign whose scenarios load with warnings (a waypoint "
+                        "inside furniture, a check no run can meet...) instead of printing "
+                        "them")
     e.add_argument("--bench", action="store_true",
                    help="benchmark: the same runs on 1 worker and on N (--workers) workers")
     e.add_argument("--bench-runs", type=int, default=40, metavar="N",
@@ -163,6 +167,9 @@ def main(argv=None, prog=PROG):
 
         return bench(args)
     campaign = _campaign(args)
+    from fpga_robotics.sweep.sanity import report_campaign_warnings
+
+    report_campaign_warnings(campaign, args.strict, sys.stderr, UsageError)
     if args.dry_run:
         return _dry_run(campaign, args)
     out = Path(args.out) if args.out else Path("runs") / "sweeps" / campaign.name

@@ -383,6 +383,7 @@ class ClosedLoop:
         metrics = compute_metrics(self.traj, self.events, self.world.collision_counts(),
                                   self.period,
                                   at_fault_collisions=self.world.at_fault_collisions(),
+                                  collision_summary=self.world.collision_summary(),
                                   width=cam.width, absent=self.absent,
                                   margin_x=scenario.params.margin_x)
         metrics.update(self.extra_metrics())

@@ -45,6 +45,7 @@ from fpga_robotics.hw.params import (
 )
 from fpga_robotics.hw.pixel import COLOR_SELECT
 from fpga_robotics.scenario.render3d_keys import RENDER_DEFAULTS, parse_render_keys
+from fpga_robotics.scenario.sanity import scenario_warnings
 from fpga_robotics.sim.camera.raster import max_hfov, max_tilt, vertical_fov
 from fpga_robotics.sim.camera.sensor import PARAMS as SENSOR_PARAMS
 from fpga_robotics.sim.camera.sensor import OV7670Params
@@ -251,6 +252,9 @@ class Scenario:
         changes applied.
     connectors : tuple of ConnectorSpec
         ``[[robot.sensors]]`` and ``[[robot.actuators]]`` (fpga_robotics.scenario.connectors).
+    warnings : tuple of str
+        Legal values that make a run meaningless, one line each naming the key path
+        (fpga_robotics.scenario.sanity): printed before a run, errors with ``--strict``.
     """
 
     name: str
@@ -270,6 +274,7 @@ class Scenario:
     top: str = "follow_target"
     design_tables: dict = field(default_factory=dict)
     connectors: tuple = ()
+    warnings: tuple = ()
 
     def color_at(self, t):
         """The colour select in force at simulated time ``t``."""
@@ -968,7 +973,8 @@ def _build(data, source, overrides):
     world = {s: copy.deepcopy(data[s]) for s in WORLD_SECTIONS if s in data}
     connectors = _connectors(world)
     sim = _resolve_timing(sim, camera, top, connectors, foreign)
-    _check_camera_geometry(camera, _check_world(world))
+    world_config = _check_world(world)
+    _check_camera_geometry(camera, world_config)
     return Scenario(
         name=name,
         description=description,
@@ -987,4 +993,5 @@ def _build(data, source, overrides):
         top=top,
         design_tables=tables,
         connectors=connectors,
+        warnings=tuple(scenario_warnings(world_config, checks)),
     )
