@@ -97,8 +97,8 @@ SHIPPED_CHECKS = (
           limits=(0, 1000, "m")),
     _collisions("person", "at most this many collisions with a person"),
     Check("max_robot_at_fault_collisions", "robot_at_fault_collisions", "max",
-          ("at most this many times the robot drove into a person (moving towards them faster "
-           "than sim.world.AT_FAULT_SPEED at the touch)"),
+          ("at most this many times the robot drove into a person (at the first touch it closed "
+           "the gap faster than the person and than sim.world.AT_FAULT_SPEED)"),
           lambda v, limit, m: f"the robot drove into a person {v} time(s) (limit {limit})",
           kind=int, limits=_COUNT),
     Check("max_tip_overs", "tip_overs", "max",
