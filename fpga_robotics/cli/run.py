@@ -69,9 +69,11 @@ def build_parser(prog="python -m fpga_robotics.run"):
                         "(e.g. 'diff_min=5;kp_num=2'); the summary reports where they differ")
     p.add_argument("--shadow-backend", choices=("auto", *BACKEND_NAMES), default=None,
                    help="simulator of the shadow design (default: the same as --backend)")
-    p.add_argument("--design", metavar="verilog:TOP.v[,MORE.v...]",
-                   help="run your own Verilog design (on Verilator) instead of FollowTarget; "
-                        "needs --ports (docs/foreign.md)")
+    p.add_argument("--design", metavar="REF",
+                   help="the design to run instead of the scenario's design.top: a built-in "
+                        "name, FILE.py:Name or package.module:Name (an Amaranth component, "
+                        "docs/your_design.md), or verilog:TOP.v[,MORE.v...] with --ports "
+                        "(docs/foreign.md)")
     p.add_argument("--ports", metavar="PORTS.toml",
                    help="with --design: the port map of the Verilog design")
     p.add_argument("--runtime", action="append", default=[], metavar="NAME=VALUE",
@@ -127,10 +129,26 @@ class Progress:
 
 
 
+def design_override(reference):
+    """``--design REF`` (not ``verilog:``) as the override ``design.top="REF"``, a file path
+    made absolute (a scenario file's relative paths are from its own folder)."""
+    import json
+
+    where, sep, name = reference.rpartition(":")
+    if sep and where.endswith(".py"):
+        reference = f"{Path(where).expanduser().resolve()}:{name}"
+    return f"design.top={json.dumps(reference)}"
+
+
 def _overrides(args):
     from fpga_robotics.scenario.load import parse_resolution
 
     items = list(args.overrides)
+    if args.design is not None and not args.design.startswith("verilog:"):
+        if args.ports is not None:
+            raise UsageError("--ports is the port map of a Verilog design: it goes with "
+                             "--design verilog:FILE.v")
+        items.append(design_override(args.design))
     if args.resolution is not None:
         w, h = parse_resolution(args.resolution)
         items.append(f'camera.resolution="{w}x{h}"')
@@ -464,6 +482,12 @@ def main(argv=None, prog="python -m fpga_robotics.run"):
         check_output_path(args.summary, what="--summary")
     ros = RosOutputs(args)  # --bag, --live ...: checked now, not after a long run
     scenario = load_scenario(args.scenario, _overrides(args))
+    if args.design is not None and not args.design.startswith("verilog:"):
+        if scenario.foreign is not None:
+            raise UsageError(f"--design {args.design}: scenario {scenario.name!r} names a "
+                             f"Verilog design (design.verilog); remove it there to run "
+                             f"another design")
+        args.design = None  # now the scenario's design.top
     if args.target_color is not None:
         scenario = _dress_target(scenario, args.target_color)
     if args.source is not None:
@@ -521,6 +545,10 @@ def main(argv=None, prog="python -m fpga_robotics.run"):
     summary["backend_setup_s"] = round(setup, 3)
     summary.update(ros.summary_items())  # the live inputs, for --replay-inputs
     print(format_summary(summary))
+    from fpga_robotics.loop.real_clock import format_extra_outputs
+
+    for line in format_extra_outputs(summary):
+        print(line)
     if "shadow" in summary:
         from fpga_robotics.loop.shadow import format_shadow
 

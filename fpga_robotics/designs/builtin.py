@@ -25,9 +25,11 @@ class Top:
     camera: bool
     #: Scenario sub-table ``[design.<key>]`` -> (module, params class) of its parameters.
     tables: dict = field(default_factory=dict)
-    #: connector kind -> {connector pin: design port}.
+    #: connector kind -> {connector pin: design port}, beyond what the component declares
+    #: (its ``connectors`` attribute) and what binds by name (designs/reference.py).
     bindings: dict = field(default_factory=dict)
-    #: More outputs the run records each frame: trajectory field -> design port.
+    #: More outputs the run records each frame: trajectory field -> design port (resolving
+    #: the design fills in every output no connector reads).
     extra_outputs: dict = field(default_factory=dict)
     #: (module, class) of the component, or the class itself (a design of your own); built as
     #: ``cls(ft_params, *table params)``.
@@ -42,22 +44,18 @@ _WHEELS = {"wheels": {"motor_left": "motor_left", "motor_right": "motor_right"}}
 TOPS = {
     "follow_target": Top(
         "follow_target", "FollowTarget: colour filter, tracker and motor controller",
-        camera=True, bindings={**_CAMERA, **_WHEELS}),
+        camera=True),
     "follow_target_safe": Top(
         "follow_target_safe",
         "FollowTarget with an HC-SR04 ultrasound driver and an obstacle interlock",
         camera=True,
         tables={"ultrasound": ("fpga_robotics.hw.sensor_params", "UltrasoundParams"),
                 "interlock": ("fpga_robotics.hw.sensor_params", "InterlockParams")},
-        bindings={**_CAMERA, **_WHEELS, "ultrasound": {"trig": "us_trig", "echo": "us_echo"}},
-        extra_outputs={"distance_mm": "distance_mm", "obstacle": "obstacle"},
         component=("fpga_robotics.hw.safe_follow", "FollowTargetSafe")),
     "follow_line": Top(
         "follow_line", "FollowLine: KY-033 line sensors to wheel speeds",
         camera=False,
         tables={"line": ("fpga_robotics.hw.sensor_params", "FollowLineParams")},
-        bindings={**_WHEELS, "line_sensors": {"line": "line"}},
-        extra_outputs={"line_seen": "line_seen"},
         component=("fpga_robotics.hw.follow_line", "FollowLine"),
         takes_follow_target_params=False),
 }

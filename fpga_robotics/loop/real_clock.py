@@ -21,6 +21,7 @@ camera (``follow_line``) has its rows sampled at the camera's frame rate all the
 """
 
 import hashlib
+import re
 
 import numpy as np
 
@@ -30,9 +31,10 @@ from fpga_robotics.loop.compressed import ClosedLoop
 from fpga_robotics.sim.backends.base import FrameResult
 from fpga_robotics.sim.camera.frames import to_rgb444
 from fpga_robotics.sim.records import SensorReading
-from fpga_robotics.designs.builtin import TOPS, build_component
+from fpga_robotics.designs.builtin import build_component
 
-__all__ = ["RealClockLoop", "make_pin_backend", "pin_design_source"]
+__all__ = ["RealClockLoop", "extra_output_stats", "format_extra_outputs", "make_pin_backend",
+           "pin_design_source"]
 
 #: Per-frame outputs read when the frame strobe rises (the wheels are read at the next capture).
 _FRAME_OUTPUTS = ("found", "proximity", "centroid_x", "centroid_leds")
@@ -42,14 +44,17 @@ _CONNECTOR_STREAM = 0xC011
 
 
 def scenario_top(scenario):
-    """The ``Top`` (fpga_robotics.designs) the scenario runs: ``design.top``, or for a foreign
-    Verilog design (``design.verilog``) the one its port map describes."""
+    """The ``Top`` (fpga_robotics.designs) the scenario runs: ``design.top`` resolved
+    (designs/reference.py: its bindings and extra outputs), or for a foreign Verilog design
+    (``design.verilog``) the one its port map describes."""
     if scenario.foreign is not None:
         from fpga_robotics.sim.backends.port_map import load_port_map
         from fpga_robotics.designs.builtin import foreign_top
 
         return foreign_top(load_port_map(scenario.foreign.ports))
-    return TOPS[scenario.top]
+    from fpga_robotics.designs.reference import resolve_design
+
+    return resolve_design(scenario.top, scenario.design_params).top
 
 
 def pin_design_source(scenario):
@@ -70,13 +75,19 @@ def pin_design_source(scenario):
         return VerilogPinSource(design)
     top = scenario_top(scenario)
     params, tables = scenario.params, scenario.design_tables
-    described = f"{params!r}:{sorted(tables.items())!r}"
-    key = f"{top.name}-{hashlib.sha256(described.encode()).hexdigest()[:16]}"
+    described = (f"{scenario.top}:{params!r}:{sorted(tables.items())!r}:"
+                 f"{sorted(scenario.design_params.items())!r}")
+    name = re.sub(r"[^A-Za-z0-9_]", "_", top.name)[:40]
+    key = f"{name}-{hashlib.sha256(described.encode()).hexdigest()[:16]}"
     extra = {}
     if top.camera:
         extra = {"pixels": ("pixels__valid", "pixels__payload"),
-                     "filtered": ("filtered__valid", "filtered__payload"),
-                     "frame_size": (params.width, params.height)}
+                 "frame_size": (params.width, params.height)}
+        from fpga_robotics.designs.reference import resolve_design
+
+        ports = resolve_design(scenario.top, scenario.design_params).ports
+        if ports.get("filtered__valid", ("",))[0] == "out" and "filtered__payload" in ports:
+            extra["filtered"] = ("filtered__valid", "filtered__payload")
     return PinDesignSource(lambda: build_component(top, params, tables), key, **extra)
 
 
@@ -90,6 +101,23 @@ def make_pin_backend(name, scenario, *, on_build=None):
                          "cxxrtl, verilator or pysim")
     kwargs = {"on_build": on_build} if on_build is not None else {}
     return get_pin_backend(name, pin_design_source(scenario), **kwargs)
+
+
+def extra_output_stats(column):
+    """``{"last", "min", "max"}`` of an extra output's trajectory column (None where no row
+    holds a value)."""
+    values = np.asarray(column, float)
+    values = values[np.isfinite(values)]
+    if not len(values):
+        return {"last": None, "min": None, "max": None}
+    return {"last": int(values[-1]), "min": int(values.min()), "max": int(values.max())}
+
+
+def format_extra_outputs(summary):
+    """The summary's ``extra_outputs`` as lines for the terminal (none without any)."""
+    extra = summary.get("extra_outputs") or {}
+    return [f"  design output {name}: last {v['last']}, min {v['min']}, max {v['max']}"
+            for name, v in extra.items()]
 
 
 class _PendingRow:
@@ -125,7 +153,9 @@ class RealClockLoop(ClosedLoop):
         specs = {c.name: s for c, s in zip(self.sensors, scenario.connectors)}
         self.io = {}  # connector -> PinIO
         self.watched = {}  # design port -> (connector or None, pin)
-        for conn in [self.motors, *self.sensors]:
+        # A design without wheel outputs leaves the robot standing: the motors get no pins.
+        self.wheels = "wheels" in self.top.bindings
+        for conn in [self.motors, *self.sensors] if self.wheels else self.sensors:
             binding = dict(self.top.bindings.get(conn.kind, {}))
             if conn in self.sensors:
                 binding.update(specs[conn.name].ports)
@@ -135,8 +165,8 @@ class RealClockLoop(ClosedLoop):
         self._check_inputs_driven()
         if self.top.camera:
             self.watched[_FRAME_STROBE] = (None, _FRAME_STROBE)
-        for port in self.top.extra_outputs.values():
-            self.watched.setdefault(port, (None, port))
+        if "obstacle" in self.top.extra_outputs.values():  # the interlock's events
+            self.watched.setdefault("obstacle", (None, "obstacle"))
         self.last = {}  # watched port -> last value seen
         self.pending = None  # the frame whose outputs are awaited: [k, t, rgb, events, result]
         self.frame_outputs = {}
@@ -191,7 +221,8 @@ class RealClockLoop(ClosedLoop):
         self.pins.watch(list(self.watched))
         self.last = {port: self.pins.peek(port) for port in self.watched}
         # The wheel pins' values out of reset are a command too (a design may start moving).
-        self.motors.on_change(self.io[self.motors], "motor_left", None, 0.0)
+        if self.wheels:
+            self.motors.on_change(self.io[self.motors], "motor_left", None, 0.0)
         for conn in self.sensors:
             conn.start(self.io[conn])
 
@@ -282,7 +313,9 @@ class RealClockLoop(ClosedLoop):
         from fpga_robotics.sim.pins.timing import real_clock_timing
 
         p = self.scenario.params
-        self.pins.poke("color_sel", self.color_code)
+        color_port = self.top.bindings["camera"].get("color_sel")
+        if color_port is not None:  # a camera design may have no colour select
+            self.pins.poke(color_port, self.color_code)
         timing = real_clock_timing(p.width, p.height, self.scenario.camera.fps, self.clock_hz,
                                    self.pins.cycle + 1)
         if self.pins.frame_pending:
@@ -298,9 +331,9 @@ class RealClockLoop(ClosedLoop):
         outputs = row.outputs or {}
         values = {name: (outputs.get(name) if self.top.camera else None)
                   for name in _FRAME_OUTPUTS}
-        wheels = self.io[self.motors].binding
-        values["motor_left"] = self.pins.peek(wheels["motor_left"])
-        values["motor_right"] = self.pins.peek(wheels["motor_right"])
+        wheels = self.io[self.motors].binding if self.wheels else {}
+        for pin in ("motor_left", "motor_right"):  # absent without wheels
+            values[pin] = self.pins.peek(wheels[pin]) if pin in wheels else None
         result = FrameResult(filtered=row.filtered, cycles=self.pins.cycle - row.edge, **values)
         self.store_outputs(row.k, result)
         events = row.events
@@ -330,6 +363,15 @@ class RealClockLoop(ClosedLoop):
         return {**super().extra_metrics(),
                 **line_metrics(self.traj, getattr(self.world, "floor_lines", ()), mounts,
                                self.period)}
+
+    def summarise(self, wall, cpu):
+        """Also ``extra_outputs``: the last, smallest and largest value of each output no
+        connector reads (its trajectory column ``design.<name>``)."""
+        summary = super().summarise(wall, cpu)
+        if self.extra:
+            summary["extra_outputs"] = {
+                name: extra_output_stats(self.traj[f"design.{name}"]) for name in self.extra}
+        return summary
 
     def timing_summary(self, wall):
         cycles = self.pins.cycle
