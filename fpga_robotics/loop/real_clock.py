@@ -163,7 +163,7 @@ class RealClockLoop(ClosedLoop):
             for pin in conn.watch:
                 self.watched[self.io[conn].binding[pin]] = (conn, pin)
         self._check_inputs_driven()
-        if self.top.camera:
+        if self.top.camera and _FRAME_STROBE in design.ports:  # FollowTarget's frame outputs
             self.watched[_FRAME_STROBE] = (None, _FRAME_STROBE)
         if "obstacle" in self.top.extra_outputs.values():  # the interlock's events
             self.watched.setdefault("obstacle", (None, "obstacle"))
