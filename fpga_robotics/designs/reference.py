@@ -20,6 +20,7 @@ bumper, ``line`` line sensors). Every output no connector reads, other than Foll
 per-frame outputs, is an extra output: recorded under its own name.
 """
 
+import contextlib
 import functools
 import hashlib
 import importlib
@@ -360,11 +361,16 @@ def _call(target, params, reference):
 def component_ports(component):
     """Port name (as the generated Verilog names it) -> (direction, width). The component
     was only looked at: it is marked so that Amaranth does not warn it was never used."""
+    from amaranth.hdl import Fragment
+
     from fpga_robotics.hw.verilog import verilog_ports
 
     ports = {name: ("in" if direction == "i" else "out", value.shape().width)
              for name, (value, direction) in verilog_ports(component).items()}
-    component._MustUse__silence = True
+    # Elaborated once, so that neither it nor the submodules its constructor made warn
+    # when collected unused (a design that cannot elaborate fails when built for a run).
+    with contextlib.suppress(Exception):
+        Fragment.get(component, None)
     return ports
 
 
