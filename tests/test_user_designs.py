@@ -195,3 +195,64 @@ def test_a_scenario_names_its_design_relative_to_its_folder(tmp_path):
         load_scenario(str(tmp_path / "s.toml"), ['design.params.stop_mm="near"'])
     with pytest.raises(ScenarioError, match="design.ultrasound is a table of a built-in"):
         load_scenario(str(tmp_path / "s.toml"), ["design.ultrasound.trigger_us=12"])
+
+
+# Verilog designs: an active-low reset, no reset, an output no connector reads ------------
+
+DATA = Path(__file__).parent / "data"
+BUMP_WALL = DATA / "bump_wall.toml"
+
+
+def _verilog_run(capsys, tmp_path, design, ports, *more):
+    summary = tmp_path / f"{Path(ports).stem}.json"
+    code, out, err = _cli(["run", "--scenario", str(BUMP_WALL), "--design", design, "--ports",
+                           str(ports), "--rerun", "off", "--quiet", "--summary", str(summary),
+                           *more], capsys)
+    assert code == 0, err
+    return json.loads(summary.read_text()), out
+
+
+def test_verilog_designs_with_and_without_reset_record_an_unread_output(tmp_path, capsys):
+    # tests/data/bump_stop.v (active-low reset) with its hit_o recorded as an extra output.
+    ports = tmp_path / "ports.toml"
+    ports.write_text((DATA / "bump_stop_ports.toml").read_text()
+                     + '\n[extra_outputs]\nhit = "hit_o"\n')
+    with_reset, out = _verilog_run(capsys, tmp_path, f"verilog:{DATA / 'bump_stop.v'}", ports)
+    without, _ = _verilog_run(capsys, tmp_path,
+                              f"verilog:{DESIGNS / 'bump_stop_noreset.v'}",
+                              DESIGNS / "bump_stop_noreset_ports.toml")
+    for summary in (with_reset, without):
+        assert summary["verdict"] == "pass"
+        # Driving until the bumper closed, then stopped: hit went 0 -> 1 once.
+        assert summary["extra_outputs"] == {"hit": {"last": 1, "min": 0, "max": 1}}
+    assert "design output hit: last 1, min 0, max 1" in out
+    # A register's initial value is what the reset gave: the same run, to the millimetre.
+    assert with_reset["path_length_m"] == without["path_length_m"]
+    assert with_reset["sim_cycles"] == without["sim_cycles"]
+
+
+def test_a_verilog_design_by_reference_in_the_scenario(tmp_path):
+    ports = DESIGNS / "bump_stop_noreset_ports.toml"
+    text = BUMP_WALL.read_text() + (
+        f'[design]\ntop = "verilog:{DESIGNS / "bump_stop_noreset.v"}"\nports = "{ports}"\n')
+    (tmp_path / "s.toml").write_text(text)
+    result = run_scenario(load_scenario(str(tmp_path / "s.toml")), backend="auto")
+    traj = result.trajectory
+    assert ((traj["design.hit"] == 1) == (traj["motor_left"] == 0)).all()
+    assert ((traj["design.hit"] == 1) == (traj["bumper.pressed"] == 1)
+            ).sum() >= len(traj["t"]) - 1  # the latch follows the bumper within a row
+
+
+def test_a_design_without_wheels_runs_and_the_robot_stands(tmp_path):
+    text = BUMP_WALL.read_text().replace("start = [0.5, 0.5]", "start = [1.88, 0.5]") + (
+        f'[design]\ntop = "{DESIGNS / "bump_watch.py"}:BumpWatch"\n')
+    (tmp_path / "s.toml").write_text(text)
+    scenario = load_scenario(str(tmp_path / "s.toml"), ["sim.duration=0.5"])
+    result = run_scenario(scenario, backend="pysim")
+    traj = result.trajectory
+    assert "motor_left" in result.summary["absent_outputs"]
+    assert np.isnan(traj["motor_left"]).all() and result.summary["path_length_m"] == 0
+    # Placed 1 cm from the wall (x = 2 less the 0.11 m body): the 3 cm bumper is closed
+    # from the first step on (row 0 is read before it), one closing counted.
+    assert (traj["bumper.pressed"][1:] == 1).all()
+    assert traj["design.presses"][-1] == 1

@@ -82,11 +82,14 @@ def foreign_top(port_map):
     camera iff the map has a pixel stream, the wheels on the wrapper's ``motor_left``/
     ``motor_right`` (the map's ``outputs``), each ``[connectors.<kind>]`` table as it binds.
     Not registered: built from the scenario's map each time."""
-    bindings = {**_WHEELS, **{kind: dict(pins) for kind, pins in port_map.connectors.items()}}
+    wheels = all(k in port_map.outputs for k in _WHEELS["wheels"])
+    bindings = {**(_WHEELS if wheels else {}),
+                **{kind: dict(pins) for kind, pins in port_map.connectors.items()}}
     if port_map.has_pixels:
         bindings.update(_CAMERA)
     return Top(f"verilog:{port_map.top}", f"the Verilog design {port_map.top} (port map)",
-               camera=port_map.has_pixels, bindings=bindings, component=None,
+               camera=port_map.has_pixels, bindings=bindings,
+               extra_outputs=dict(port_map.extra_outputs), component=None,
                takes_follow_target_params=False)
 
 

@@ -969,6 +969,8 @@ def _resolve_timing(sim, camera, top, connectors, foreign):
             raise ScenarioError(f"design.ports: {exc}") from None
         if port_map.connectors:
             pins.insert(0, f"the port map's [connectors.{next(iter(port_map.connectors))}]")
+        elif port_map.extra_outputs:
+            pins.insert(0, "the port map's [extra_outputs]")
         elif not port_map.has_pixels:
             pins.insert(0, "a port map without pixels")
     timing = sim.timing
