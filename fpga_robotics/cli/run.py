@@ -140,6 +140,18 @@ def design_override(reference):
     return f"design.top={json.dumps(reference)}"
 
 
+def take_design_reference(args, scenario):
+    """After loading: a ``--design`` reference other than ``verilog:`` is the scenario's
+    ``design.top`` now (``_overrides``); ``args.design`` keeps only Verilog files."""
+    if args.design is None or args.design.startswith("verilog:"):
+        return
+    if scenario.foreign is not None:
+        raise UsageError(f"--design {args.design}: scenario {scenario.name!r} names a "
+                         f"Verilog design (design.verilog); remove it there to run "
+                         f"another design")
+    args.design = None
+
+
 def _overrides(args):
     from fpga_robotics.scenario.load import parse_resolution
 
@@ -482,12 +494,7 @@ def main(argv=None, prog="python -m fpga_robotics.run"):
         check_output_path(args.summary, what="--summary")
     ros = RosOutputs(args)  # --bag, --live ...: checked now, not after a long run
     scenario = load_scenario(args.scenario, _overrides(args))
-    if args.design is not None and not args.design.startswith("verilog:"):
-        if scenario.foreign is not None:
-            raise UsageError(f"--design {args.design}: scenario {scenario.name!r} names a "
-                             f"Verilog design (design.verilog); remove it there to run "
-                             f"another design")
-        args.design = None  # now the scenario's design.top
+    take_design_reference(args, scenario)
     if args.target_color is not None:
         scenario = _dress_target(scenario, args.target_color)
     if args.source is not None:

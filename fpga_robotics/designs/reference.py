@@ -227,7 +227,8 @@ def _load_target(reference):
                               f"{type(exc).__name__}: {_first_line(exc)}") from None
     target = getattr(module, name, None)
     if target is None:
-        found = sorted(n for n, v in vars(module).items() if _is_component_class(v))
+        found = sorted(n for n, v in vars(module).items() if _is_component_class(v)
+                       and v.__module__ == module.__name__)
         raise DesignError(f"design {reference!r}: {where} has no {name!r}"
                           + (f"; its components: {', '.join(found)}" if found else ""))
     if not callable(target):

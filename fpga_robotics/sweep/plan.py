@@ -54,6 +54,9 @@ def make_plan(campaign):
                 files = [*scenario.foreign.verilog, scenario.foreign.ports]
             if args.design is not None:
                 files = [*args.design[len("verilog:"):].split(","), args.ports]
+            where = scenario.top.rpartition(":")[0]
+            if where.endswith(".py"):  # a design of one's own: its file names the run too
+                files.append(where)
             key = (_design_key(args, scenario), repr(shadow_params))
             frames = round(scenario.sim.duration * scenario.camera.fps)
             checked[shape] = (scenario, files, key, frames,

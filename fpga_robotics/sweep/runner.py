@@ -77,6 +77,7 @@ def load_run(argv):
     if args.seed is not None and not 0 <= args.seed <= MAX_SEED:
         raise UsageError(f"--seed must be in 0..{MAX_SEED}, got {args.seed}")
     scenario = load_scenario(args.scenario, run._overrides(args))
+    run.take_design_reference(args, scenario)
     shadow_params = run._shadow_params(scenario, args.shadow)
     run._design_files(args, scenario.foreign)
     return args, scenario, shadow_params
@@ -85,7 +86,8 @@ def load_run(argv):
 def _design_key(args, scenario):
     return ("design", args.backend, args.design, args.ports, repr(scenario.foreign),
             repr(scenario.params), scenario.sim.timing, scenario.top,
-            repr(sorted(scenario.design_tables.items())))
+            repr(sorted(scenario.design_tables.items())),
+            repr(sorted(scenario.design_params.items())))
 
 
 def _open(key, opener):
