@@ -256,3 +256,34 @@ def test_a_design_without_wheels_runs_and_the_robot_stands(tmp_path):
     # from the first step on (row 0 is read before it), one closing counted.
     assert (traj["bumper.pressed"][1:] == 1).all()
     assert traj["design.presses"][-1] == 1
+
+
+def test_the_page_shows_the_files_the_tests_run():
+    """docs/your_design.md's design, scenario and port map are these files, word for word."""
+    page = (Path(__file__).parent.parent / "docs" / "your_design.md").read_text()
+    for name in ("wall_stop.py", "wall_stop.toml", "bump_stop_noreset_ports.toml"):
+        assert (DESIGNS / name).read_text().rstrip("\n") + "\n```" in page, name
+
+
+def test_installed_packages_offer_designs_by_entry_point(tmp_path, monkeypatch, capsys):
+    """A distribution on the path with an ``fpga_robotics.designs`` entry point: its name is
+    a reference, listed by ``fpga-robotics designs``."""
+    package = tmp_path / "my_robot"
+    package.mkdir()
+    (package / "__init__.py").write_text("")
+    shutil.copy(DESIGNS / "wall_stop.py", package / "designs.py")
+    info = tmp_path / "my_robot-1.0.dist-info"
+    info.mkdir()
+    (info / "METADATA").write_text("Metadata-Version: 2.1\nName: my-robot\nVersion: 1.0\n")
+    (info / "entry_points.txt").write_text(
+        "[fpga_robotics.designs]\nwall_stopper = my_robot.designs:WallStop\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    spec = resolve_design("wall_stopper", {"stop_mm": 100})
+    assert spec.reference == "my_robot.designs:WallStop"
+    assert spec.extra_outputs == ("distance_mm", "stopped")
+    from fpga_robotics.cli.designs import main
+
+    assert main([]) == 0
+    out = capsys.readouterr().out
+    assert "my_robot.designs:WallStop  (installed: my_robot.designs:WallStop)" in out
+    assert "follow_line  (built-in)" in out

@@ -138,6 +138,8 @@ def resolve_design(reference, params=None, *, ports=None, base=None):
         if not path.is_absolute() and base is not None:
             path = Path(base) / path
         reference = f"{path.resolve()}:{name}"
+    else:
+        reference = target  # an installed design's name stands for its module:Name
     frozen = tuple(sorted((k, _freeze(v)) for k, v in params.items()))
     return _amaranth_spec(reference, frozen, _stamp(reference))
 
