@@ -287,3 +287,29 @@ def test_installed_packages_offer_designs_by_entry_point(tmp_path, monkeypatch, 
     out = capsys.readouterr().out
     assert "my_robot.designs:WallStop  (installed: my_robot.designs:WallStop)" in out
     assert "follow_line  (built-in)" in out
+
+
+def test_shadow_runs_a_previous_version_of_the_design_on_the_same_pins(tmp_path, capsys):
+    """--shadow REF in real-clock timing: the shadow gets every input the primary gets; its
+    wheels differ exactly while neither has stopped, its measurements never."""
+    old = (DESIGNS / "wall_stop.py").read_text().replace(
+        "Mux(self.stopped, 0, self.speed)", "Mux(self.stopped, 0, self.speed - 50)")
+    (tmp_path / "wall_stop_v1.py").write_text(old)
+    summary = tmp_path / "s.json"
+    code, out, err = _cli(["run", "--scenario", str(WALL_STOP), "--shadow",
+                           f"{tmp_path}/wall_stop_v1.py:WallStop", "--backend", "cxxrtl",
+                           "--rerun", "off", "--quiet", "--summary", str(summary)], capsys)
+    assert code == 0, err
+    shadow = json.loads(summary.read_text())["shadow"]
+    frames = shadow["frames"]
+    moving = shadow["differing_frames"]["motor_left"]
+    assert shadow["first_divergence"] == {
+        "frame": 0, "time_s": 0.0,
+        "outputs": {"motor_left": {"primary": 300, "shadow": 250},
+                    "motor_right": {"primary": 300, "shadow": 250}}}
+    assert shadow["differing_frames"]["motor_right"] == moving
+    assert shadow["differing_frames"]["distance_mm"] == 0
+    assert shadow["differing_frames"]["stopped"] == 0
+    assert shadow["differing_frames"]["trig"] == 0
+    assert 0 < moving < frames == 360
+    assert f"first differs at frame 0 (0.00 s): motor_left 300 vs 250" in out

@@ -66,7 +66,9 @@ def build_parser(prog="python -m fpga_robotics.run"):
     p.add_argument("--shadow", metavar="SPEC",
                    help="run a second design on the same frames without letting it drive: a "
                         "preset name (published) and/or design KEY=VALUE items separated by ';' "
-                        "(e.g. 'diff_min=5;kp_num=2'); the summary reports where they differ")
+                        "(e.g. 'diff_min=5;kp_num=2'), or in real-clock timing a design "
+                        "reference (e.g. wall_stop_v1.py:WallStop); the summary reports where "
+                        "they differ")
     p.add_argument("--shadow-backend", choices=("auto", *BACKEND_NAMES), default=None,
                    help="simulator of the shadow design (default: the same as --backend)")
     p.add_argument("--design", metavar="REF",
@@ -195,6 +197,23 @@ def _shadow_params(scenario, spec):
     except ValueError as exc:
         raise UsageError(str(exc)) from None
     return scenario.with_overrides(items).params
+
+
+def _shadow_scenario(scenario, spec):
+    """With ``--shadow REF`` (a design reference): the scenario running that design instead
+    (its ``[design.params]`` kept); None for a FollowTarget parameter shadow."""
+    from fpga_robotics.loop.pin_shadow import is_design_reference
+
+    if spec is None or not is_design_reference(spec):
+        return None
+    if scenario.sim.timing != "real_clock":
+        raise UsageError(f"--shadow {spec}: a second design runs on pins, in real-clock "
+                         f"timing; scenario {scenario.name!r} runs in compressed timing "
+                         f"(compare FollowTarget parameters there: --shadow KEY=VALUE)")
+    if scenario.foreign is not None:
+        raise UsageError(f"--shadow {spec}: scenario {scenario.name!r} runs a Verilog design "
+                         f"(design.verilog); a shadow design goes with an Amaranth one")
+    return scenario.with_overrides([design_override(spec)])
 
 
 def _dress_target(scenario, color):
@@ -505,7 +524,9 @@ def main(argv=None, prog="python -m fpga_robotics.run"):
         return _run_source(args, scenario, ros)
     if args.max_frames is not None:
         raise UsageError("--max-frames only applies with --source (use --duration)")
-    shadow_params = _shadow_params(scenario, args.shadow)
+    shadow_scenario = _shadow_scenario(scenario, args.shadow)
+    shadow_params = None if shadow_scenario is not None else _shadow_params(scenario,
+                                                                            args.shadow)
     if args.save_video is not None:
         from fpga_robotics.loop.video_out import VideoPathError, check_video_path
 
@@ -527,6 +548,12 @@ def main(argv=None, prog="python -m fpga_robotics.run"):
     shadow = recorder = None
     completed = False
     try:
+        if shadow_scenario is not None:
+            import copy
+
+            shadow_args = copy.copy(args)
+            shadow_args.backend = args.shadow_backend or args.backend
+            shadow = _open_pin_design(shadow_args, shadow_scenario)
         if shadow_params is not None:
             shadow = _open_backend(args.shadow_backend or args.backend, shadow_params,
                                    args.quiet)

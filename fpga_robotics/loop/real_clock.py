@@ -137,7 +137,11 @@ class RealClockLoop(ClosedLoop):
     """``ClosedLoop`` in real-clock timing, on a ``PinBackend`` (``design``)."""
 
     def __init__(self, scenario, *, design, seed=None, recorder=None, on_frame=None,
-                 controls=None):
+                 controls=None, shadow=None, shadow_label="shadow"):
+        from fpga_robotics.loop.pin_shadow import MirroredPins, PinComparison
+
+        if shadow is not None:  # a second design, given every input the primary gets
+            design = MirroredPins(design, shadow)
         super().__init__(scenario, seed=seed, design=design, recorder=recorder,
                          on_frame=on_frame, controls=controls)
         self.top = scenario_top(scenario)
@@ -169,6 +173,12 @@ class RealClockLoop(ClosedLoop):
         self.pending = None  # the frame whose outputs are awaited: [k, t, rgb, events, result]
         self.frame_outputs = {}
         self.extra = {name: np.full(self.n_frames, np.nan) for name in self.top.extra_outputs}
+        self.shadow_pins = shadow
+        if shadow is not None:
+            outputs = tuple(n for n, p in design.ports.items() if p.direction == "out"
+                            and n in shadow.ports and shadow.ports[n].direction == "out"
+                            and not n.startswith("filtered__"))
+            self.comparison = PinComparison(shadow_label, outputs)
         self.measurements = {}  # "<connector>.<key>" -> array per row
 
     # Binding ----------------------------------------------------------------------------
@@ -341,10 +351,25 @@ class RealClockLoop(ClosedLoop):
         for name, port in self.top.extra_outputs.items():
             extra[name] = self.pins.peek(port)
             self.extra[name][row.k] = float(extra[name])
+        if self.shadow_pins is not None:
+            events += self.compare_shadow(row)
         self.events += [(row.k, round(row.t, 6), e) for e in events]
         if self.want_records:
             self.record(row.k, row.t, row.rgb, result, row.distance, row.visible,
                         events + row.viewer_events, sensors=row.readings, design_extra=extra)
+
+    def compare_shadow(self, row):
+        """Row ``row.k``'s outputs of both designs compared; the event of the first
+        divergence."""
+        c = self.comparison
+        first = c.first_divergence is None
+        primary = {n: self.pins.primary.peek(n) for n in c.outputs}
+        shadow = {n: self.shadow_pins.peek(n) for n in c.outputs}
+        differ = c.compare(row.k, row.t, primary, shadow)
+        if not (differ and first):
+            return []
+        parts = ", ".join(f"{n} {primary[n]} vs {shadow[n]}" for n in differ)
+        return [f"shadow design {c.label} diverges: {parts}"]
 
     def after_frames(self):
         self.finish_row()
