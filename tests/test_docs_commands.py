@@ -493,6 +493,13 @@ PLANS = {
                                            "(12 s; about a second of wall time on CXXRTL)",
              out=(PASS, r"design output distance_mm: last 227, min 218, max 1898",
                   r"design output stopped: last 1, min 0, max 1")),
+    "fpga-robotics run --scenario wall_stop.toml --shadow wall_stop_v1.py:WallStop --rerun off":
+        Plan(setup=(" ".join(["cp", *(str(ROOT / "tests/data/user_designs" / name) for name in (
+                         "wall_stop.py", "wall_stop.toml")), "."]),
+                    "cp wall_stop.py wall_stop_v1.py"),
+             duration="keep", duration_why="the page quotes the whole run's 360 frames",
+             out=(PASS, r"shadow wall_stop_v1\.py:WallStop: identical outputs on all 360 "
+                        r"frames")),
     "fpga-robotics designs":
         Plan(out=(r"follow_target_safe  \(built-in\)",
                   r"connectors: ultrasound \(trig=us_trig, echo=us_echo\)")),

@@ -1,6 +1,6 @@
-"""The designs a scenario can run (``[design] top = "..."``): for each, how to build it, its
-parameter tables, which connector pins bind to which of its ports, and which of the run's
-per-frame outputs it has.
+"""The built-in designs a scenario can run by name (``[design] top = "..."``): for each, how
+to build it and its parameter tables. Which ports the connectors bind, and which outputs are
+recorded, the designs themselves state (``designs/reference.py`` reads them).
 
 ``follow_target`` is the camera-only design of docs/contract.md (frames in, wheel speeds
 out). ``follow_target_safe`` adds an HC-SR04 ultrasound driver and an interlock that stops
