@@ -313,3 +313,23 @@ def test_shadow_runs_a_previous_version_of_the_design_on_the_same_pins(tmp_path,
     assert shadow["differing_frames"]["trig"] == 0
     assert 0 < moving < frames == 360
     assert f"first differs at frame 0 (0.00 s): motor_left 300 vs 250" in out
+
+
+def test_designs_checks_a_verilog_port_map_against_the_design(tmp_path, capsys):
+    verilog = f"verilog:{DESIGNS / 'bump_stop_noreset.v'}"
+    ports = DESIGNS / "bump_stop_noreset_ports.toml"
+    code, out, _ = _cli(["designs", verilog, "--ports", str(ports)], capsys)
+    assert code == 0
+    assert "ports: in clk[1], in bump_i[1], out left_dps[12], out right_dps[12], out hit_o[1]" \
+        in out
+    assert "recorded outputs: hit" in out
+    for change, message in ((("bump_i", "bump"), "the design bump_stop_noreset has no port "
+                                                 "'bump'"),
+                            (('hit = "hit_o"', 'hit = "hit"'), "has no port 'hit'"),
+                            (('top = "bump_stop_noreset"', 'top = "bump_stop"'),
+                             "Verilator cannot read")):
+        bad = tmp_path / "bad.toml"
+        bad.write_text(ports.read_text().replace(*change))
+        code, _, err = _cli(["designs", verilog, "--ports", str(bad)], capsys)
+        assert code == 2 and len(err.strip().splitlines()) == 1, err
+        assert message in err, err

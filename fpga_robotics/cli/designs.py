@@ -54,6 +54,31 @@ def describe(spec, origin):
     return lines
 
 
+def checked_verilog(spec, ports):
+    """A Verilog design's spec with its ports as Verilator reads them, the port map checked
+    against them (names, directions, widths, every input driven, the connectors' pins):
+    ``DesignError`` for the first mismatch."""
+    import dataclasses
+
+    from fpga_robotics.designs.builtin import connector_kinds
+    from fpga_robotics.designs.reference import DesignError
+    from fpga_robotics.sim.backends.base import BackendError
+    from fpga_robotics.sim.backends.foreign import ForeignDesign
+    from fpga_robotics.sim.backends.port_map import load_port_map
+
+    files = spec.reference[len("verilog:"):].split(",")
+    port_map = load_port_map(ports)
+    pins = bool(port_map.connectors or port_map.extra_outputs or not port_map.has_pixels)
+    try:
+        design = ForeignDesign(files, port_map, pins=pins, connector_kinds=connector_kinds())
+    except BackendError as exc:
+        raise DesignError(f"{ports}: {exc}".splitlines()[0]) from None
+    found = {name: ("in" if d == "input" else "out", width)
+             for name, (d, width, _signed) in design.ports.items()}
+    return dataclasses.replace(spec, ports=found,
+                               extra_outputs=tuple(port_map.extra_outputs))
+
+
 def main(argv=None, prog="fpga-robotics designs"):
     from fpga_robotics.designs.builtin import TOPS
     from fpga_robotics.designs.reference import entry_point_designs, resolve_design
@@ -69,6 +94,8 @@ def main(argv=None, prog="fpga-robotics designs"):
             print("\n".join(describe(resolve_design(name), f"installed: {target}")))
         return 0
     spec = resolve_design(args.reference, params, ports=args.ports)
+    if spec.kind == "verilog":
+        spec = checked_verilog(spec, args.ports)
     origin = {"builtin": "built-in", "amaranth": "Amaranth", "verilog": "Verilog"}[spec.kind]
     print("\n".join(describe(spec, origin)))
     return 0
