@@ -333,3 +333,27 @@ def test_designs_checks_a_verilog_port_map_against_the_design(tmp_path, capsys):
         code, _, err = _cli(["designs", verilog, "--ports", str(bad)], capsys)
         assert code == 2 and len(err.strip().splitlines()) == 1, err
         assert message in err, err
+
+
+def test_a_campaign_takes_design_references_and_their_params_as_axes(tmp_path, monkeypatch):
+    from fpga_robotics.sweep.campaign import load_campaign, read_campaign_file
+    from fpga_robotics.sweep.plan import make_plan
+
+    for name in ("wall_stop.py", "wall_stop.toml"):
+        shutil.copy(DESIGNS / name, tmp_path / name)
+    (tmp_path / "c.toml").write_text(
+        'scenarios = ["wall_stop.toml"]\ndesign = "wall_stop.py:wall_stop"\n'
+        'backend = "cxxrtl"\nset = ["design.params={}"]\n'
+        '[grid]\n"design.params.speed" = [100, 200]\n')
+    monkeypatch.chdir(tmp_path.parent)  # file paths are from the campaign's folder
+    data, path = read_campaign_file(str(tmp_path / "c.toml"))
+    plan = make_plan(load_campaign(data, source=str(path)))
+    assert [r.argv()[r.argv().index("--design") + 1] for r in plan.runs] == [
+        f"{tmp_path.name}/wall_stop.py:wall_stop"] * 2
+    # The design's file names the run: another version of it is another run.
+    first = plan.ids[plan.runs[0]]
+    (tmp_path / "wall_stop.py").write_text((DESIGNS / "wall_stop.py").read_text() + "\n# v2\n")
+    again = make_plan(load_campaign(read_campaign_file(str(tmp_path / "c.toml"))[0],
+                                    source=str(path)))
+    assert again.ids[again.runs[0]] != first
+    assert len(set(plan.ids.values())) == 2

@@ -89,10 +89,16 @@ class DesignSpec:
         return "camera" in self.bindings
 
     def build(self):
-        """A new Amaranth component of the design (not for Verilog designs)."""
+        """A new Amaranth component of the design (a built-in one at its default
+        parameters); not for Verilog designs, which Verilator builds."""
         if self.kind == "verilog":
             raise DesignError(f"design {self.reference!r} is Verilog: Verilator builds it")
-        return _call(self.top.component, {}, self.reference)
+        if self.kind == "builtin":
+            from fpga_robotics.designs.builtin import build_component, design_tables
+            from fpga_robotics.hw.params import FollowTargetParams
+
+            return build_component(self.top, FollowTargetParams(), design_tables(self.top, {}))
+        return self.top.component()
 
 
 def is_builtin(reference):
