@@ -165,8 +165,8 @@ BAD = [
 @pytest.mark.parametrize("case, reference, params, message", BAD, ids=[c[0] for c in BAD])
 def test_bad_references_are_one_line_errors(case, reference, params, message, tmp_path,
                                             capsys, monkeypatch):
-    for name in ("broken.py", "syntax_error.py"):
-        shutil.copy(DESIGNS / name, tmp_path / name)
+    shutil.copy(DESIGNS / "broken.py", tmp_path / "broken.py")
+    (tmp_path / "syntax_error.py").write_text("class Broken(\n")  # never closed
     with pytest.raises(DesignError, match=message.replace("(", r"\(").replace(")", r"\)")):
         resolve_design(reference, params, base=tmp_path)
     # The same through the command line: exit 2, one line, nothing written.
@@ -312,7 +312,7 @@ def test_shadow_runs_a_previous_version_of_the_design_on_the_same_pins(tmp_path,
     assert shadow["differing_frames"]["stopped"] == 0
     assert shadow["differing_frames"]["trig"] == 0
     assert 0 < moving < frames == 360
-    assert f"first differs at frame 0 (0.00 s): motor_left 300 vs 250" in out
+    assert "first differs at frame 0 (0.00 s): motor_left 300 vs 250" in out
 
 
 def test_designs_checks_a_verilog_port_map_against_the_design(tmp_path, capsys):
@@ -323,8 +323,8 @@ def test_designs_checks_a_verilog_port_map_against_the_design(tmp_path, capsys):
     assert "ports: in clk[1], in bump_i[1], out left_dps[12], out right_dps[12], out hit_o[1]" \
         in out
     assert "recorded outputs: hit" in out
-    for change, message in ((("bump_i", "bump"), "the design bump_stop_noreset has no port "
-                                                 "'bump'"),
+    for change, message in ((("bump_i", "bump"),
+                             "the design bump_stop_noreset has no port 'bump'"),
                             (('hit = "hit_o"', 'hit = "hit"'), "has no port 'hit'"),
                             (('top = "bump_stop_noreset"', 'top = "bump_stop"'),
                              "Verilator cannot read")):

@@ -230,7 +230,7 @@ def _load_target(reference):
         except ModuleNotFoundError as exc:
             raise DesignError(f"design {reference!r}: no module {exc.name!r}; install the "
                               f"package or give the file as path/to/file.py:{name}") from None
-        except Exception as exc:
+        except Exception as exc:  # noqa: BLE001 - the user's module may raise anything
             raise DesignError(f"design {reference!r}: importing {where} raised "
                               f"{type(exc).__name__}: {_first_line(exc)}") from None
     target = getattr(module, name, None)
@@ -260,7 +260,7 @@ def _load_file(path, reference):
     sys.modules[name] = module
     try:
         spec.loader.exec_module(module)
-    except Exception as exc:
+    except Exception as exc:  # noqa: BLE001 - the user's file may raise anything
         sys.modules.pop(name, None)
         line = _error_line(exc, path)
         raise DesignError(f"design {reference!r}: loading {path.name}{line} raised "
@@ -358,7 +358,7 @@ def _call(target, params, reference):
     values = {k: tuple(v) if isinstance(v, list) else v for k, v in params.items()}
     try:
         component = target(**values)
-    except Exception as exc:
+    except Exception as exc:  # noqa: BLE001 - the user's constructor may raise anything
         raise DesignError(f"design {reference!r}: building it raised "
                           f"{type(exc).__name__}: {_first_line(exc)}") from None
     if not isinstance(component, wiring.Component):
