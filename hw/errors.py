@@ -6,7 +6,7 @@ keeps its traceback. It lives in the lowest layer so that the gateware, the simu
 viewer can all raise it without importing the application.
 """
 
-__all__ = ["ParamError", "UserError"]
+__all__ = ["ParamError", "UsageError", "UserError"]
 
 
 class UserError(Exception):
@@ -16,3 +16,8 @@ class UserError(Exception):
 class ParamError(UserError, ValueError):
     """A design parameter out of its range, or an unknown preset, variant or choice (still a
     ``ValueError``, as callers that check values catch)."""
+
+
+class UsageError(UserError):
+    """A bad argument or input the user gave (a command-line option, a scenario or campaign
+    value, a design reference): the message says what is wrong and how to fix it."""

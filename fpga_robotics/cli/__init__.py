@@ -6,6 +6,7 @@
     fpga-robotics ports PORTS.toml        check (or --example: write) a port map
     fpga-robotics bench [WHAT] [options]  benchmarks: design (default), pysim, camera, world,
                                           viewer, shadow
+    fpga-robotics designs [REF]           the designs a run can name, ports and connectors
     fpga-robotics mutate [options]        mutation coverage (python -m fpga_robotics.mutation)
     fpga-robotics readback FILE.rrd       what a saved recording holds
     fpga-robotics sweep CAMPAIGN [options]  a verification campaign on Dask
@@ -34,6 +35,8 @@ COMMANDS = {
     "board": ("fpga_robotics.cli.board",
               "export a board top (Verilog + LPF) and build its bitstream"),
     "bench": (None, "print speed figures (see `fpga-robotics bench --list`)"),
+    "designs": ("fpga_robotics.cli.designs",
+                "the designs a run can name: their ports and the connectors they bind"),
     "ports": ("fpga_robotics.cli.ports",
               "write (--example) or check a port map for run --design verilog:..."),
     "mutate": ("fpga_robotics.cli.mutate",

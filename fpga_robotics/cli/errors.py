@@ -9,16 +9,12 @@ still shows its traceback.
 import signal
 import sys
 
-from fpga_robotics.hw.errors import UserError
+from fpga_robotics.hw.errors import UsageError, UserError
 
 __all__ = ["USAGE_EXIT", "Terminated", "UsageError", "UserError", "run_cli"]
 
 #: Exit code for a bad argument, a malformed input file or a missing tool.
 USAGE_EXIT = 2
-
-
-class UsageError(UserError):
-    """A bad command-line argument: the message says what is wrong and how to fix it."""
 
 
 class Terminated(KeyboardInterrupt):

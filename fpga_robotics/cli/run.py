@@ -85,12 +85,16 @@ def build_parser(prog="fpga-robotics run"):
     p.add_argument("--shadow", metavar="SPEC",
                    help="run a second design on the same frames without letting it drive: a "
                         "preset name (published) and/or design KEY=VALUE items separated by ';' "
-                        "(e.g. 'diff_min=5;kp_num=2'); the summary reports where they differ")
+                        "(e.g. 'diff_min=5;kp_num=2'), or in real-clock timing a design "
+                        "reference (e.g. wall_stop_v1.py:WallStop); the summary reports where "
+                        "they differ")
     p.add_argument("--shadow-backend", choices=("auto", *BACKEND_NAMES), default=None,
                    help="simulator of the shadow design (default: the same as --backend)")
-    p.add_argument("--design", metavar="verilog:TOP.v[,MORE.v...]",
-                   help="run your own Verilog design (on Verilator) instead of FollowTarget; "
-                        "needs --ports (docs/foreign.md)")
+    p.add_argument("--design", metavar="REF",
+                   help="the design to run instead of the scenario's design.top: a built-in "
+                        "name, FILE.py:Name or package.module:Name (an Amaranth component, "
+                        "docs/your_design.md), or verilog:TOP.v[,MORE.v...] with --ports "
+                        "(docs/foreign.md)")
     p.add_argument("--ports", metavar="PORTS.toml",
                    help="with --design: the port map of the Verilog design")
     p.add_argument("--runtime", action="append", default=[], metavar="NAME=VALUE",
@@ -149,10 +153,38 @@ class Progress:
 
 
 
+def design_override(reference):
+    """``--design REF`` (not ``verilog:``) as the override ``design.top="REF"``, a file path
+    made absolute (a scenario file's relative paths are from its own folder)."""
+    import json
+
+    where, sep, name = reference.rpartition(":")
+    if sep and where.endswith(".py"):
+        reference = f"{Path(where).expanduser().resolve()}:{name}"
+    return f"design.top={json.dumps(reference)}"
+
+
+def take_design_reference(args, scenario):
+    """After loading: a ``--design`` reference other than ``verilog:`` is the scenario's
+    ``design.top`` now (``_overrides``); ``args.design`` keeps only Verilog files."""
+    if args.design is None or args.design.startswith("verilog:"):
+        return
+    if scenario.foreign is not None:
+        raise UsageError(f"--design {args.design}: scenario {scenario.name!r} names a "
+                         f"Verilog design (design.verilog); remove it there to run "
+                         f"another design")
+    args.design = None
+
+
 def _overrides(args):
     from fpga_robotics.scenario.load import parse_resolution
 
     items = list(args.overrides)
+    if args.design is not None and not args.design.startswith("verilog:"):
+        if args.ports is not None:
+            raise UsageError("--ports is the port map of a Verilog design: it goes with "
+                             "--design verilog:FILE.v")
+        items.append(design_override(args.design))
     if args.resolution is not None:
         w, h = parse_resolution(args.resolution)
         items.append(f'camera.resolution="{w}x{h}"')
@@ -187,6 +219,23 @@ def _shadow_params(scenario, spec):
     except ValueError as exc:
         raise UsageError(str(exc)) from None
     return scenario.with_overrides(items).params
+
+
+def _shadow_scenario(scenario, spec):
+    """With ``--shadow REF`` (a design reference): the scenario running that design instead
+    (its ``[design.params]`` kept); None for a FollowTarget parameter shadow."""
+    from fpga_robotics.loop.pin_shadow import is_design_reference
+
+    if spec is None or not is_design_reference(spec):
+        return None
+    if scenario.sim.timing != "real_clock":
+        raise UsageError(f"--shadow {spec}: a second design runs on pins, in real-clock "
+                         f"timing; scenario {scenario.name!r} runs in compressed timing "
+                         f"(compare FollowTarget parameters there: --shadow KEY=VALUE)")
+    if scenario.foreign is not None:
+        raise UsageError(f"--shadow {spec}: scenario {scenario.name!r} runs a Verilog design "
+                         f"(design.verilog); a shadow design goes with an Amaranth one")
+    return scenario.with_overrides([design_override(spec)])
 
 
 def _dress_target(scenario, color):
@@ -519,6 +568,7 @@ def main(argv=None, prog="fpga-robotics run"):
         check_output_path(args.summary, what="--summary")
     ros = RosOutputs(args)  # --bag, --live ...: checked now, not after a long run
     scenario = load_scenario(args.scenario, _overrides(args))
+    take_design_reference(args, scenario)
     if args.target_color is not None:
         scenario = _dress_target(scenario, args.target_color)
     report_warnings(scenario, args.strict, sys.stderr, UsageError)
@@ -534,7 +584,9 @@ def main(argv=None, prog="fpga-robotics run"):
         return _run_source(args, scenario, ros)
     if args.max_frames is not None:
         raise UsageError("--max-frames only applies with --source (use --duration)")
-    shadow_params = _shadow_params(scenario, args.shadow)
+    shadow_scenario = _shadow_scenario(scenario, args.shadow)
+    shadow_params = None if shadow_scenario is not None else _shadow_params(scenario,
+                                                                            args.shadow)
     if args.save_video is not None:
         from fpga_robotics.loop.video_out import VideoPathError, check_video_path
 
@@ -557,6 +609,12 @@ def main(argv=None, prog="fpga-robotics run"):
     shadow = recorder = None
     completed = False
     try:
+        if shadow_scenario is not None:
+            import copy
+
+            shadow_args = copy.copy(args)
+            shadow_args.backend = args.shadow_backend or args.backend
+            shadow = _open_pin_design(shadow_args, shadow_scenario)
         if shadow_params is not None:
             shadow = _open_backend(args.shadow_backend or args.backend, shadow_params,
                                    args.quiet)
@@ -582,6 +640,10 @@ def main(argv=None, prog="fpga-robotics run"):
     summary["backend_setup_s"] = round(setup, 3)
     summary.update(ros.summary_items())  # the live inputs, for --replay-inputs
     print(format_summary(summary))
+    from fpga_robotics.loop.real_clock import format_extra_outputs
+
+    for line in format_extra_outputs(summary):
+        print(line)
     if "shadow" in summary:
         from fpga_robotics.loop.shadow import format_shadow
 

@@ -15,7 +15,7 @@ from pathlib import Path
 
 from rosbags.rosbag2 import StoragePlugin, Writer, WriterError
 
-from fpga_robotics.cli.errors import UsageError
+from fpga_robotics.hw.errors import UsageError
 from fpga_robotics.sim.files import check_output_dir
 from .messages import TOPICS, TYPESTORE, FrameMessages, camera_geometry
 

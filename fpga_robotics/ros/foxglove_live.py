@@ -14,7 +14,7 @@ import threading
 import foxglove
 from foxglove.websocket import Capability
 
-from fpga_robotics.cli.errors import UsageError
+from fpga_robotics.hw.errors import UsageError
 from .messages import TOPICS, TYPESTORE, FrameMessages, msgdef
 
 __all__ = ["CONTROL_TOPICS", "DEFAULT_PORT", "LivePublisher", "check_live_port", "control_input",

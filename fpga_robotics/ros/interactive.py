@@ -11,7 +11,7 @@ import termios
 import threading
 import tty
 
-from fpga_robotics.cli.errors import UsageError
+from fpga_robotics.hw.errors import UsageError
 from .controls import TELEOP_SPEED
 
 __all__ = ["KEYS", "TerminalControls", "check_terminal", "key_input"]

@@ -31,7 +31,7 @@ class RosOutputs:
     """The ROS/Foxglove side of one run; see the module docstring."""
 
     def __init__(self, args):
-        from fpga_robotics.cli.errors import UsageError
+        from fpga_robotics.hw.errors import UsageError
 
         self.bag_path = args.bag
         self.port = None
@@ -67,7 +67,7 @@ class RosOutputs:
 
     def check_closed_loop_only(self):
         """With ``--source`` (no simulation) there is nothing to control."""
-        from fpga_robotics.cli.errors import UsageError
+        from fpga_robotics.hw.errors import UsageError
 
         if self.interactive:
             raise UsageError("--interactive controls the closed loop (not with --source)")

@@ -16,7 +16,7 @@ import sys
 import time
 from pathlib import Path
 
-from fpga_robotics.cli.errors import UsageError
+from fpga_robotics.hw.errors import UsageError
 from ..sim.files import write_atomic
 from . import runner
 from .results import make_row

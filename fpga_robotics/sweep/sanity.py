@@ -12,7 +12,7 @@ def report_campaign_warnings(campaign, strict, stream, error):
     """Print the warnings of every scenario the campaign runs (each line once); with
     ``strict`` raise ``error`` with the first instead."""
     from fpga_robotics.cli import run
-    from fpga_robotics.cli.errors import UsageError
+    from fpga_robotics.hw.errors import UsageError
     from fpga_robotics.scenario.load import load_scenario
 
     seen = set()
