@@ -10,6 +10,7 @@
     fpga-robotics readback FILE.rrd       what a saved recording holds
     fpga-robotics sweep CAMPAIGN [options]  a verification campaign on Dask
     fpga-robotics formal [options]        formal proofs of the gateware's promises
+    fpga-robotics new NAME                a project skeleton: design, scenario, test, README
 
 Each subcommand is the ``main(argv, prog)`` of its module, so ``fpga-robotics run --help`` and
 ``python -m fpga_robotics.run --help`` are the same command. New subcommands are one row of
@@ -42,6 +43,8 @@ COMMANDS = {
     "sweep": ("fpga_robotics.cli.sweep",
               "a verification campaign: many runs on Dask, results table and report"),
     "formal": ("fpga_robotics.flow.formal", "prove the gateware's promises (SymbiYosys, Yices)"),
+    "new": ("fpga_robotics.cli.new",
+            "write a project skeleton: a design, a scenario and a test that runs it"),
 }
 
 #: ``fpga-robotics bench WHAT`` -> (module, one-line help); the first is the default.
