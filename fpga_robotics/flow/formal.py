@@ -25,7 +25,8 @@ from fpga_robotics.cli.errors import UsageError, run_cli
 from fpga_robotics.sim.files import atomic_path, check_output_dir
 
 __all__ = [
-    "CheckResult", "default_trace_dir", "end_running", "formal_env", "main", "run_check", "select",
+    "CheckResult", "default_trace_dir", "design_checks", "end_running", "formal_env", "main",
+    "run_check", "select",
 ]
 
 #: The programs a check needs, and the pip package that ships each.
@@ -197,6 +198,31 @@ def run_check(check, *, depth=None, dut=None, trace_dir=None, env=None, timeout=
     return CheckResult(check.name, check.mode, depth, status, seconds, detail, trace)
 
 
+def design_checks(reference=None, params=None):
+    """The formal checks of a design reference (docs/your_design.md): ``follow_target`` (or
+    None) has the project's own list, ``hw.formal.CHECKS``; a design of one's own the
+    properties it declares (``formal_properties``/``formal_covers``, docs/formal.md). A design
+    that declares none, or a Verilog one, is a ``UsageError``."""
+    from fpga_robotics.hw.formal import CHECKS
+    from fpga_robotics.hw.formal.declared import PROPERTY_HOOK, declared_checks
+
+    if reference is None or reference == "follow_target":
+        return list(CHECKS)
+    from fpga_robotics.designs.reference import resolve_design
+
+    if reference.startswith("verilog:"):
+        raise UsageError(f"--design {reference}: a Verilog design's properties are not "
+                         f"checked here; give an Amaranth design (FILE.py:Name)")
+    spec = resolve_design(reference, params)
+    name = reference if spec.kind == "builtin" else spec.reference.rpartition(":")[2]
+    checks = declared_checks(name, spec.build)
+    if not checks:
+        raise UsageError(f"design {reference!r} declares no formal properties: give its class "
+                         f"a method {PROPERTY_HOOK}(self, m) adding Assert statements "
+                         f"(docs/formal.md)")
+    return checks
+
+
 def select(checks, only):
     """The checks named by ``only`` (each a whole name or its part before ``.``/``@``, as
     ``frame_done`` or ``motor.limits_hold_search``); all of them for none."""
@@ -233,6 +259,10 @@ def build_parser(prog):
                         "$FPGA_ROBOTICS_CACHE/formal-traces, else "
                         "~/.cache/fpga_robotics/formal-traces)")
     parser.add_argument("--list", action="store_true", help="list the checks and exit")
+    parser.add_argument("--design", metavar="REF",
+                        help="check the properties this design declares (FILE.py:Name or "
+                        "package.module:Name with formal_properties, docs/formal.md) instead "
+                        "of FollowTarget's")
     return parser
 
 
@@ -242,9 +272,7 @@ def main(argv=None, prog="python -m fpga_robotics.formal"):
         raise UsageError(f"--depth must be at least 1, got {args.depth}")
     if args.jobs < 1:
         raise UsageError(f"--jobs must be at least 1, got {args.jobs}")
-    from fpga_robotics.hw.formal import CHECKS
-
-    checks = select(CHECKS, args.only)
+    checks = select(design_checks(args.design), args.only)
     if args.list:
         width = max(len(c.name) for c in checks)
         for c in checks:
