@@ -188,9 +188,9 @@ def list_mutants(params=None, n=100, seed=1, *, rtlil_text=None):
 _MUTATE = re.compile(r"^mutate\s")
 
 
-def mutant_netlist(params, mutants, *, rtlil_text=None, cxxrtl=False):
-    """Verilog (or, with ``cxxrtl``, CXXRTL C++) of ``FollowTarget(params)`` (or of the
-    design ``rtlil_text``) with every mutant behind ``mutsel`` (``select_width(len(mutants))``
+def mutant_netlist(params, mutants, *, rtlil_text=None):
+    """Verilog of ``FollowTarget(params)`` (or of the design ``rtlil_text``, from
+    ``component_rtlil``) with every mutant behind ``mutsel`` (``select_width(len(mutants))``
     bits; ``mutsel = m.index`` selects ``m``). Top module ``follow_target``, the design's own
     ports plus ``mutsel``."""
     params = params if params is not None else FollowTargetParams()
@@ -202,8 +202,7 @@ def mutant_netlist(params, mutants, *, rtlil_text=None, cxxrtl=False):
         for m in mutants:
             lines.append(_MUTATE.sub(f"mutate -ctrl {MUTATION_SELECT} {width} {m.index} ",
                                      m.command))
-        out = "mutants.cc" if cxxrtl else "mutants.v"
-        lines += ["opt_clean", f"write_cxxrtl -g0 {out}" if cxxrtl else f"write_verilog -noattr {out}"]
+        lines += ["opt_clean", "write_verilog -noattr mutants.v"]
         _yosys(lines, work)
-        with open(os.path.join(work, out)) as f:
+        with open(os.path.join(work, "mutants.v")) as f:
             return f.read()

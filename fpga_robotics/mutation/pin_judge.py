@@ -5,7 +5,7 @@ The stimulus is seeded random: every input port (``mutsel`` aside) changes, at e
 edge with probability ``CHANGE_PROBABILITY``, to a new random value of its width, so a bit
 holds for a few cycles on average and long enough now and then for counters and pulse
 measurements to see it. The mutant netlist (every mutant behind ``mutsel``) is compiled once
-as a CXXRTL pin model (sim/pins); each run starts from a reset with ``mutsel`` held, applies
+as a Verilator pin model (sim/pins); each run starts from a reset with ``mutsel`` held, applies
 the same stimulus, and records every change of every output (the model stops at each one).
 ``mutsel = 0`` gives the reference. A mutant is *caught* when any output's changes differ
 from the reference's (a value, or the cycle it came at).
@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..hw.verilog import TOP_NAME
 from ..sim.mutation import MUTATION_SELECT, mutant_netlist, select_width
 from ..sim.pins.base import Port
 
@@ -28,11 +29,13 @@ CHANGE_PROBABILITY = 1 / 8
 
 
 class MutantPinSource:
-    """The mutant netlist of a design as a source for the CXXRTL pin backend: the design's
-    ports (``ports``: name -> ``Port``) plus the ``mutsel`` input."""
+    """The mutant netlist of a design as a Verilog source for the Verilator pin backend: the
+    design's ports (``ports``: name -> ``Port``) plus the ``mutsel`` input. Its outputs are
+    read after the design settles (two evaluations an edge), as for any Verilog design."""
 
     pixels = filtered = frame_size = None
     registered_outputs = False
+    verilog_top = TOP_NAME
 
     def __init__(self, rtlil_text, ports, mutants, name):
         self._rtlil, self._mutants = rtlil_text, list(mutants)
@@ -42,8 +45,12 @@ class MutantPinSource:
         self.key = f"mutants-{name}-{digest.hexdigest()[:12]}"
 
     @functools.cached_property
-    def cxxrtl(self):
-        return mutant_netlist(None, self._mutants, rtlil_text=self._rtlil, cxxrtl=True)
+    def verilog(self):
+        return mutant_netlist(None, self._mutants, rtlil_text=self._rtlil)
+
+    def verilog_files(self):
+        """``(files, compiled)``, as ``VerilogPinSource`` gives them."""
+        return {"mutants.v": self.verilog}, ["mutants.v"]
 
 
 def pin_stimulus(ports, cycles, seed):
@@ -141,7 +148,7 @@ def judge_pin_mutant(backend, index, stimulus, cycles, reference):
 
 
 def open_pin_mutants(source, *, on_build=None):
-    """The CXXRTL pin model of a ``MutantPinSource`` (built once, then from the cache)."""
-    from ..sim.pins.compiled import CxxrtlPins
+    """The Verilator pin model of a ``MutantPinSource`` (built once, then from the cache)."""
+    from ..sim.pins.compiled import VerilatorPins
 
-    return CxxrtlPins(source, on_build=on_build)
+    return VerilatorPins(source, on_build=on_build)
