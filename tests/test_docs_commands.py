@@ -537,6 +537,13 @@ PLANS = {
         Plan(shorter=(("--mutants", "12"),),
              out=(r"12 mutants of follow_target 80x60",),
              files=("runs/mutation/small/mutants.json",)),
+    "fpga-robotics mutate --design wall_stop.py:WallStop --mutants 40 --param clock_hz=100000":
+        Plan(setup=(f"cp {ROOT / 'tests/data/user_designs/wall_stop.py'} .",),
+             shorter=(("--mutants", "12"),),
+             out=(r"12 mutants of WallStop \(seed 1\), 100000 cycles of random inputs",
+                  r"unit judge \(against the unmutated design\): \d+ caught, \d+ equivalent "
+                  r"on these inputs: score"),
+             files=("runs/mutation/WallStop-n12-s1/mutants.json",)),
     "python -m fpga_robotics.mutation --mutants 100 --campaign mutation":
         # Four mutants at 80x60 on one worker, the campaign's runs made short: the whole
         # command takes minutes (the page gives its measured time).
