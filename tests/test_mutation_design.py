@@ -12,9 +12,14 @@ import pytest
 
 from fpga_robotics import cli
 from fpga_robotics.designs.reference import resolve_design
-from fpga_robotics.mutation.design_run import _ports
-from fpga_robotics.mutation.pin_judge import (MutantPinSource, judge_pin_mutant,
-                                              open_pin_mutants, pin_stimulus, pin_trace)
+from fpga_robotics.mutation.design_run import design_ports
+from fpga_robotics.mutation.pin_judge import (
+    MutantPinSource,
+    judge_pin_mutant,
+    open_pin_mutants,
+    pin_stimulus,
+    pin_trace,
+)
 from fpga_robotics.sim.mutation import component_rtlil, list_mutants
 
 DESIGNS = Path(__file__).parent / "data" / "user_designs"
@@ -44,7 +49,7 @@ def model_trace(stimulus, cycles, limit=LIMIT):
 @pytest.fixture(scope="module")
 def saturating():
     spec = resolve_design(f"{DESIGNS}/counters.py:Saturating")
-    ports, _ = _ports(spec)
+    ports = design_ports(spec)
     rtlil_text = component_rtlil(spec.build())
     mutants = list_mutants(None, 40, 3, rtlil_text=rtlil_text)
     backend = open_pin_mutants(MutantPinSource(rtlil_text, ports, mutants, "Saturating"))
@@ -76,7 +81,7 @@ def test_a_mutant_is_caught_exactly_when_it_departs_from_the_model(saturating):
         assert verdict.caught == departs, m.describe()
         caught += verdict.caught
         if verdict.caught:  # the first difference is where the mutant's values part
-            for name, (was, now) in verdict.first_difference.items():
+            for was, now in verdict.first_difference.values():
                 assert was != now
     assert caught > 0
 

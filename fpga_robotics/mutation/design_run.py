@@ -11,30 +11,31 @@ from ..sim.pins.base import Port
 from .pin_judge import MutantPinSource, judge_pin_mutant, open_pin_mutants, pin_stimulus, pin_trace
 from .scores import by_module, unit_score
 
-__all__ = ["DEFAULT_CYCLES", "mutate_design"]
+__all__ = ["DEFAULT_CYCLES", "design_ports", "mutate_design"]
 
 #: Cycles of random stimulus per mutant by default (five 20 ms ultrasound periods at 1 MHz).
 DEFAULT_CYCLES = 100_000
 
 
-def _ports(spec):
-    """The design's ports as pin ``Port``s (signedness from the component's signature)."""
+def design_ports(spec):
+    """The ports of the design ``spec`` (a ``DesignSpec``) as pin ``Port``s, named as the
+    generated Verilog names them."""
+    from amaranth.hdl import Fragment
+
     from ..hw.verilog import verilog_ports
 
     component = spec.build()
-    from amaranth.hdl import Fragment
-
     Fragment.get(component, None)  # read for its signature only: elaborated, so no warning
     return {name: Port(name, value.shape().width, "in" if d == "i" else "out",
                        value.shape().signed)
-            for name, (value, d) in verilog_ports(component).items()}, component
+            for name, (value, d) in verilog_ports(component).items()}
 
 
 def mutate_design(spec, n, seed, cycles, out, *, stimulus_seed=0, say=print):
     """Mutants of ``spec`` (a resolved Amaranth ``DesignSpec``) judged on ``cycles`` cycles;
     writes ``out/mutants.json`` and returns its content."""
     t0 = time.perf_counter()
-    ports, _ = _ports(spec)
+    ports = design_ports(spec)
     rtlil_text = component_rtlil(spec.build())
     mutants = list_mutants(None, n, seed, rtlil_text=rtlil_text)
     name = spec.reference.rpartition(":")[2] or spec.reference
