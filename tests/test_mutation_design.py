@@ -124,3 +124,21 @@ def test_bad_design_arguments_are_one_line(argv, message, capsys, monkeypatch):
     monkeypatch.chdir(DESIGNS)
     code, _, err = _cli(["mutate", *argv], capsys)
     assert code == 2 and message in err and err.count("\n") == 1
+
+
+@pytest.mark.slow  # a Verilator build of FollowTarget's mutant netlist
+def test_follow_target_against_itself_scores_as_against_the_model(tmp_path, capsys):
+    # The unmutated design gives the golden model's results on the unit frames, so each
+    # mutant's verdict is the same whichever it is compared with.
+    runs = {}
+    for against in ("model", "design"):
+        out = tmp_path / against
+        code, text, _ = _cli(["mutate", "--mutants", "12", "--width", "80", "--height", "60",
+                              "--quiet", "--against", against, "--out", str(out)], capsys)
+        assert code == 0
+        runs[against] = json.loads((out / "mutants.json").read_text())
+        assert runs[against]["against"] == against
+    assert "unit judge (against the unmutated design): " in text
+    assert [m["unit"] for m in runs["model"]["mutants"]] == \
+        [m["unit"] for m in runs["design"]["mutants"]]
+    assert runs["model"]["unit"] == runs["design"]["unit"]

@@ -19,7 +19,8 @@ from fpga_robotics.sim.mutation import MutationError, list_mutants
 from fpga_robotics.mutation.design import open_mutant_design, write_mutant_design
 from fpga_robotics.mutation.reasons import blind_spot_reason
 from fpga_robotics.mutation.scores import blind_spots, by_module, robot_score, unit_score
-from fpga_robotics.mutation.unit_judge import golden_results, judge_frames, judge_mutant
+from fpga_robotics.mutation.unit_judge import (golden_results, judge_frames, judge_mutant,
+                                               reference_results)
 
 __all__ = ["main"]
 
@@ -114,6 +115,9 @@ def build_parser(prog):
                    help="robot judge: record the closest-to-failing run of the first N blind "
                         "spots (default 5)")
     p.add_argument("--quiet", action="store_true", help="no progress lines")
+    p.add_argument("--against", choices=("model", "design"), default="model",
+                   help="FollowTarget's unit judge compares each mutant with the golden model "
+                        "(default) or with the unmutated design on the same frames")
     p.add_argument("--design", metavar="REF",
                    help="mutants of this Amaranth design (FILE.py:Name, package.module:Name; "
                         "docs/your_design.md) instead of FollowTarget, each judged against "
@@ -233,7 +237,8 @@ def main(argv=None, prog="python -m fpga_robotics.mutation"):
     build_s = time.perf_counter() - t0
     try:
         frames = judge_frames(params)
-        golden = golden_results(params, frames)
+        golden = (golden_results(params, frames) if args.against == "model"
+                  else reference_results(design, frames))
         t1 = time.perf_counter()
         verdicts = []
         for k, m in enumerate(mutants, start=1):
@@ -263,6 +268,7 @@ def main(argv=None, prog="python -m fpga_robotics.mutation"):
     write_json_atomic(os.path.join(out, "mutants.json"), {
         "design": {"width": params.width, "height": params.height},
         "seed": args.seed,
+        "against": args.against,
         "frames": len(frames),
         "build_and_list_s": round(build_s, 2),
         "unit_judge_s": round(unit_s, 2),
@@ -287,8 +293,9 @@ def main(argv=None, prog="python -m fpga_robotics.mutation"):
     print(f"{len(mutants)} mutants of follow_target {params.width}x{params.height} "
           f"(seed {args.seed}), {len(frames)} unit frames; build {build_s:.1f} s, "
           f"unit judge {60 * len(mutants) / unit_s:.0f} mutants/min")
-    print(f"unit judge: {score['caught']} caught, {score['equivalent']} equivalent on these "
-          f"frames: score {_percent(score['score'])}")
+    against = "" if args.against == "model" else " (against the unmutated design)"
+    print(f"unit judge{against}: {score['caught']} caught, {score['equivalent']} equivalent "
+          f"on these frames: score {_percent(score['score'])}")
     width = max(len(name) for name in modules)
     for name, row in modules.items():
         robot_part = (f", robot judge {row['robot_caught']:>4}/{row['unit_caught']}"
