@@ -28,8 +28,8 @@ from ..hw.top import FollowTarget
 from ..hw.verilog import TOP_NAME, verilog_ports
 from .processes import run_captured
 
-__all__ = ["MUTATION_SELECT", "Mutant", "MutationError", "find_yosys", "list_mutants",
-           "mutant_netlist", "select_width"]
+__all__ = ["MUTATION_SELECT", "Mutant", "MutationError", "component_rtlil", "find_yosys",
+           "list_mutants", "mutant_netlist", "select_width"]
 
 #: The input of the mutant netlist that selects the mutant (0: none).
 MUTATION_SELECT = "mutsel"
@@ -163,15 +163,23 @@ def _parse(index, line):
         sources=tuple(dict.fromkeys(sources)), command=line.strip())
 
 
-def list_mutants(params=None, n=100, seed=1):
-    """``n`` mutants of ``FollowTarget(params)`` chosen by Yosys with ``seed`` (the same
-    arguments give the same list). Yosys may return fewer when the design has fewer places."""
+def component_rtlil(component):
+    """RTLIL of any Amaranth component, top module ``follow_target`` (the name the mutant
+    netlists and the pin models use), its ports named as the generated Verilog names them."""
+    ports = {name: (value, None) for name, (value, _) in verilog_ports(component).items()}
+    return rtlil.convert(component, name=TOP_NAME, ports=ports)
+
+
+def list_mutants(params=None, n=100, seed=1, *, rtlil_text=None):
+    """``n`` mutants of ``FollowTarget(params)`` (or of the design ``rtlil_text``, from
+    ``component_rtlil``) chosen by Yosys with ``seed`` (the same arguments give the same
+    list). Yosys may return fewer when the design has fewer places."""
     params = params if params is not None else FollowTargetParams()
     if not 1 <= int(n) <= 100_000:
         raise ValueError(f"the number of mutants must be 1..100000, got {n}")
     with tempfile.TemporaryDirectory(prefix="fr-mutate-") as work:
         with open(os.path.join(work, "design.il"), "w") as f:
-            f.write(_rtlil(params))
+            f.write(_rtlil(params) if rtlil_text is None else rtlil_text)
         _yosys(["read_rtlil design.il", *(s.format(top=TOP_NAME) for s in _PREPARE),
                 f"mutate -list {int(n)} -seed {int(seed)} -o mutants.ys"], work)
         with open(os.path.join(work, "mutants.ys")) as f:
@@ -182,15 +190,16 @@ def list_mutants(params=None, n=100, seed=1):
 _MUTATE = re.compile(r"^mutate\s")
 
 
-def mutant_netlist(params, mutants):
-    """Verilog of ``FollowTarget(params)`` with every mutant behind ``mutsel``
-    (``select_width(len(mutants))`` bits; ``mutsel = m.index`` selects ``m``). Top module
-    ``follow_target``, the design's own ports plus ``mutsel``."""
+def mutant_netlist(params, mutants, *, rtlil_text=None):
+    """Verilog of ``FollowTarget(params)`` (or of the design ``rtlil_text``, from
+    ``component_rtlil``) with every mutant behind ``mutsel`` (``select_width(len(mutants))``
+    bits; ``mutsel = m.index`` selects ``m``). Top module ``follow_target``, the design's own
+    ports plus ``mutsel``."""
     params = params if params is not None else FollowTargetParams()
     width = select_width(max((m.index for m in mutants), default=0))
     with tempfile.TemporaryDirectory(prefix="fr-mutate-") as work:
         with open(os.path.join(work, "design.il"), "w") as f:
-            f.write(_rtlil(params))
+            f.write(_rtlil(params) if rtlil_text is None else rtlil_text)
         lines = ["read_rtlil design.il", *(s.format(top=TOP_NAME) for s in _PREPARE)]
         for m in mutants:
             lines.append(_MUTATE.sub(f"mutate -ctrl {MUTATION_SELECT} {width} {m.index} ",

@@ -301,6 +301,16 @@ PLANS = {
         Plan(out=(r"(?m)^motor\.limits_hold_search@defaults\s+prove\s+4\s+pass\s",
                   r"(?m)^motor\.limits_hold_search@odd\s+prove\s+4\s+pass\s",
                   r"(?m)^2 of 2 checks passed")),
+    "fpga-robotics formal --design counters.py:Saturating":
+        Plan(setup=(f"cp {ROOT / 'tests/data/user_designs/counters.py'} .",),
+             out=(r"(?m)^Saturating\.properties\s+prove\s+3\s+pass\s",
+                  r"(?m)^Saturating\.covers\s+cover\s+12\s+pass\s",
+                  r"(?m)^2 of 2 checks passed")),
+    "fpga-robotics formal --design counters.py:OffByOne":
+        Plan(setup=(f"cp {ROOT / 'tests/data/user_designs/counters.py'} .",),
+             out=(r"(?m)^OffByOne\.properties\s+bmc\s+15\s+FAIL\s",
+                  r"failed assertion \S*counters\.py:40 step 11",
+                  r"counterexample: \S*OffByOne\.properties\.vcd")),
     "python -m pytest -m formal":
         Plan(collect=True, out=(r"test_seeded_bug_fails\[tracker\.no_leak@16x2\]",
                                 r"test_check_passes\[cover\.sccb\]")),
@@ -532,6 +542,13 @@ PLANS = {
         Plan(shorter=(("--mutants", "12"),),
              out=(r"12 mutants of follow_target 80x60",),
              files=("runs/mutation/small/mutants.json",)),
+    "fpga-robotics mutate --design wall_stop.py:WallStop --mutants 40 --param clock_hz=100000":
+        Plan(setup=(f"cp {ROOT / 'tests/data/user_designs/wall_stop.py'} .",),
+             shorter=(("--mutants", "12"),),
+             out=(r"12 mutants of WallStop \(seed 1\), 100000 cycles of random inputs",
+                  r"unit judge \(against the unmutated design\): \d+ caught, \d+ equivalent "
+                  r"on these inputs: score"),
+             files=("runs/mutation/WallStop-n12-s1/mutants.json",)),
     "python -m fpga_robotics.mutation --mutants 100 --campaign mutation":
         # Four mutants at 80x60 on one worker, the campaign's runs made short: the whole
         # command takes minutes (the page gives its measured time).

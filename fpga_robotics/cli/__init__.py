@@ -12,6 +12,7 @@
     fpga-robotics sweep CAMPAIGN [options]  a verification campaign on Dask
     fpga-robotics sweep report DIR        the report of a finished campaign
     fpga-robotics formal [options]        formal proofs of the gateware's promises
+    fpga-robotics new NAME                a project skeleton: design, scenario, test, README
     fpga-robotics --version               the installed version
 
 Each subcommand is the ``main(argv, prog)`` of its module, and the ``python -m`` aliases call
@@ -46,6 +47,8 @@ COMMANDS = {
     "sweep": ("fpga_robotics.cli.sweep",
               "a verification campaign: many runs on Dask, results table and report"),
     "formal": ("fpga_robotics.cli.formal", "prove the gateware's promises (SymbiYosys, Yices)"),
+    "new": ("fpga_robotics.cli.new",
+            "write a project skeleton: a design, a scenario and a test that runs it"),
 }
 
 #: ``fpga-robotics bench WHAT`` -> (module, one-line help); the first is the default.

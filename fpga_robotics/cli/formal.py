@@ -13,6 +13,7 @@ from fpga_robotics.cli.errors import UsageError
 from fpga_robotics.cli.parser import CommandParser
 from fpga_robotics.flow.formal import (
     default_trace_dir,
+    design_checks,
     end_running,
     formal_env,
     run_check,
@@ -44,6 +45,10 @@ def build_parser(prog="fpga-robotics formal"):
                         "$FPGA_ROBOTICS_CACHE/formal-traces, else "
                         "~/.cache/fpga_robotics/formal-traces)")
     parser.add_argument("--list", action="store_true", help="list the checks and exit")
+    parser.add_argument("--design", metavar="REF",
+                        help="check the properties this design declares (FILE.py:Name or "
+                        "package.module:Name with formal_properties, docs/formal.md) instead "
+                        "of FollowTarget's")
     return parser
 
 
@@ -53,9 +58,8 @@ def main(argv=None, prog="fpga-robotics formal"):
         raise UsageError(f"--depth must be at least 1, got {args.depth}")
     if args.jobs < 1:
         raise UsageError(f"--jobs must be at least 1, got {args.jobs}")
-    from fpga_robotics.hw.formal import CHECKS
 
-    checks = select(CHECKS, args.only)
+    checks = select(design_checks(args.design), args.only)
     if args.list:
         width = max(len(c.name) for c in checks)
         for c in checks:

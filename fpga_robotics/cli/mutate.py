@@ -17,7 +17,8 @@ from fpga_robotics.cli.parser import CommandParser
 from fpga_robotics.mutation.design import open_mutant_design, write_mutant_design
 from fpga_robotics.mutation.reasons import blind_spot_reason
 from fpga_robotics.mutation.scores import blind_spots, by_module, robot_score, unit_score
-from fpga_robotics.mutation.unit_judge import golden_results, judge_frames, judge_mutant
+from fpga_robotics.mutation.unit_judge import (golden_results, judge_frames, judge_mutant,
+                                               reference_results)
 from fpga_robotics.sim.files import check_output_dir, write_json_atomic
 from fpga_robotics.sim.mutation import MutationError, list_mutants
 
@@ -114,8 +115,82 @@ def build_parser(prog="fpga-robotics mutate"):
                    help="robot judge: record the closest-to-failing run of the first N blind "
                         "spots (default 5)")
     p.add_argument("--quiet", action="store_true", help="no progress lines")
+    p.add_argument("--against", choices=("model", "design"), default="model",
+                   help="FollowTarget's unit judge compares each mutant with the golden model "
+                        "(default) or with the unmutated design on the same frames")
+    p.add_argument("--design", metavar="REF",
+                   help="mutants of this Amaranth design (FILE.py:Name, package.module:Name; "
+                        "docs/your_design.md) instead of FollowTarget, each judged against "
+                        "the unmutated design on seeded random inputs, cycle by cycle")
+    p.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
+                   help="with --design: one of its parameters (a TOML value; repeatable)")
+    p.add_argument("--cycles", type=int, default=None, metavar="N",
+                   help="with --design: cycles of random inputs per mutant (default "
+                        "100000)")
     add_param_arguments(p)
     return p
+
+
+def _design_params(items):
+    """``--param NAME=VALUE`` items as a dict (values parsed as TOML, else text)."""
+    import tomllib
+
+    params = {}
+    for item in items:
+        name, sep, text = item.partition("=")
+        if not sep or not name.strip().isidentifier():
+            raise UsageError(f"--param must be NAME=VALUE, got {item!r}")
+        try:
+            params[name.strip()] = tomllib.loads(f"v = {text}")["v"]
+        except tomllib.TOMLDecodeError:
+            params[name.strip()] = text
+    return params
+
+
+def _main_design(args):
+    """``--design REF``: the mutants of a design of one's own against itself."""
+    from fpga_robotics.designs.reference import resolve_design
+    from fpga_robotics.mutation.design_run import DEFAULT_CYCLES, mutate_design
+
+    if args.design.startswith("verilog:"):
+        raise UsageError(f"--design {args.design}: mutants are made of Amaranth designs "
+                         f"(FILE.py:Name); a Verilog design is not mutated here")
+    if args.campaign is not None:
+        raise UsageError("--campaign (the robot judge) runs FollowTarget's mutants; with "
+                         "--design only the unit judge runs")
+    cycles = DEFAULT_CYCLES if args.cycles is None else args.cycles
+    if not 1 <= cycles <= 100_000_000:
+        raise UsageError(f"--cycles must be 1..100000000, got {cycles}")
+    spec = resolve_design(args.design, _design_params(args.param))
+    name = spec.reference.rpartition(":")[2]
+    out = args.out or os.path.join("runs", "mutation", f"{name}-n{args.mutants}-s{args.seed}")
+    check_output_dir(out, what="output folder")
+
+    def say(text):
+        if not args.quiet:
+            print(text, file=sys.stderr, flush=True)
+
+    try:
+        result = mutate_design(spec, args.mutants, args.seed, cycles, out, say=say)
+    except MutationError as exc:
+        raise UsageError(str(exc).splitlines()[0]) from None
+    score, modules = result["unit"], result["modules"]
+    rate = (60 * score["total"] / result["unit_judge_s"]) if result["unit_judge_s"] else 0
+    print(f"{score['total']} mutants of {name} (seed {args.seed}), {cycles} cycles of random "
+          f"inputs each; build {result['build_and_list_s']:.1f} s, unit judge {rate:.0f} "
+          f"mutants/min")
+    print(f"unit judge (against the unmutated design): {score['caught']} caught, "
+          f"{score['equivalent']} equivalent on these inputs: score {_percent(score['score'])}")
+    width = max(len(m) for m in modules)
+    for module, row in modules.items():
+        print(f"  {module:<{width}}  {row['unit_caught']:>4}/{row['total']:<4} caught")
+    missed = [m for m in result["mutants"] if not m["unit"]["caught"]]
+    if missed:
+        print("equivalent on these inputs (first 10):")
+        for m in missed[:10]:
+            print(f"  {m['describe']}")
+    print(f"wrote {os.path.join(out, 'mutants.json')}")
+    return 0
 
 
 def _check(args):
@@ -139,6 +214,10 @@ def _percent(x):
 def main(argv=None, prog="fpga-robotics mutate"):
     args = build_parser(prog).parse_args(argv)
     _check(args)
+    if args.design is not None and args.design != "follow_target":
+        return _main_design(args)
+    if args.param or args.cycles is not None:
+        raise UsageError("--param and --cycles go with --design REF (a design of your own)")
     params = params_from_args(args)
     campaign = _campaign(args.campaign) if args.campaign is not None else None
     out = args.out or os.path.join("runs", "mutation", f"n{args.mutants}-s{args.seed}")
@@ -158,7 +237,8 @@ def main(argv=None, prog="fpga-robotics mutate"):
     build_s = time.perf_counter() - t0
     try:
         frames = judge_frames(params)
-        golden = golden_results(params, frames)
+        golden = (golden_results(params, frames) if args.against == "model"
+                  else reference_results(design, frames))
         t1 = time.perf_counter()
         verdicts = []
         for k, m in enumerate(mutants, start=1):
@@ -188,6 +268,7 @@ def main(argv=None, prog="fpga-robotics mutate"):
     write_json_atomic(os.path.join(out, "mutants.json"), {
         "design": {"width": params.width, "height": params.height},
         "seed": args.seed,
+        "against": args.against,
         "frames": len(frames),
         "build_and_list_s": round(build_s, 2),
         "unit_judge_s": round(unit_s, 2),
@@ -212,8 +293,9 @@ def main(argv=None, prog="fpga-robotics mutate"):
     print(f"{len(mutants)} mutants of follow_target {params.width}x{params.height} "
           f"(seed {args.seed}), {len(frames)} unit frames; build {build_s:.1f} s, "
           f"unit judge {60 * len(mutants) / unit_s:.0f} mutants/min")
-    print(f"unit judge: {score['caught']} caught, {score['equivalent']} equivalent on these "
-          f"frames: score {_percent(score['score'])}")
+    against = "" if args.against == "model" else " (against the unmutated design)"
+    print(f"unit judge{against}: {score['caught']} caught, {score['equivalent']} equivalent "
+          f"on these frames: score {_percent(score['score'])}")
     width = max(len(name) for name in modules)
     for name, row in modules.items():
         robot_part = (f", robot judge {row['robot_caught']:>4}/{row['unit_caught']}"

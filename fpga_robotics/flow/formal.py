@@ -24,7 +24,8 @@ from fpga_robotics.hw.errors import UserError
 from fpga_robotics.sim.files import atomic_path
 
 __all__ = [
-    "CheckResult", "default_trace_dir", "end_running", "formal_env", "run_check", "select",
+    "CheckResult", "default_trace_dir", "design_checks", "end_running", "formal_env",
+    "run_check", "select",
 ]
 
 #: The programs a check needs, and the pip package that ships each.
@@ -194,6 +195,31 @@ def run_check(check, *, depth=None, dut=None, trace_dir=None, env=None, timeout=
             with atomic_path(trace, what="counterexample trace") as tmp:
                 shutil.copyfile(source, tmp)
     return CheckResult(check.name, check.mode, depth, status, seconds, detail, trace)
+
+
+def design_checks(reference=None, params=None):
+    """The formal checks of a design reference (docs/your_design.md): ``follow_target`` (or
+    None) has the project's own list, ``hw.formal.CHECKS``; a design of one's own the
+    properties it declares (``formal_properties``/``formal_covers``, docs/formal.md). A design
+    that declares none, or a Verilog one, is a ``UserError``."""
+    from fpga_robotics.hw.formal import CHECKS
+    from fpga_robotics.hw.formal.declared import PROPERTY_HOOK, declared_checks
+
+    if reference is None or reference == "follow_target":
+        return list(CHECKS)
+    from fpga_robotics.designs.reference import resolve_design
+
+    if reference.startswith("verilog:"):
+        raise UserError(f"--design {reference}: a Verilog design's properties are not "
+                         f"checked here; give an Amaranth design (FILE.py:Name)")
+    spec = resolve_design(reference, params)
+    name = reference if spec.kind == "builtin" else spec.reference.rpartition(":")[2]
+    checks = declared_checks(name, spec.build)
+    if not checks:
+        raise UserError(f"design {reference!r} declares no formal properties: give its class "
+                         f"a method {PROPERTY_HOOK}(self, m) adding Assert statements "
+                         f"(docs/formal.md)")
+    return checks
 
 
 def select(checks, only):

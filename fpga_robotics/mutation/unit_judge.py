@@ -20,7 +20,8 @@ from fpga_robotics.sim.camera import synthetic
 from ..sim.backends import BackendError, get_backend
 from ..sim.mutation import MUTATION_SELECT
 
-__all__ = ["UnitVerdict", "golden_results", "judge_frames", "judge_mutant"]
+__all__ = ["UnitVerdict", "golden_results", "judge_frames", "judge_mutant",
+           "reference_results"]
 
 
 @dataclass
@@ -73,6 +74,15 @@ def golden_results(params, frames):
     """The model's results for ``frames`` from a reset."""
     model = get_backend("model", params)
     return [model.process_frame(f, color) for f, color in frames]
+
+
+def reference_results(design, frames):
+    """The unmutated design's results for ``frames`` from a reset (``mutsel = 0`` of the
+    mutant netlist): what each mutant is compared with when no golden model is used, as in
+    MCY. ``BackendError`` if the design itself breaks the frame protocol."""
+    design.set_runtime(MUTATION_SELECT, 0)
+    design.reset()
+    return [design.process_frame(f, color) for f, color in frames]
 
 
 def judge_mutant(design, index, frames, golden):

@@ -1,0 +1,78 @@
+"""``fpga-robotics new NAME``: a project skeleton in folder NAME — an Amaranth design, a
+scenario it passes, a pytest test of that scenario (``fpga_robotics.testing``) and a README.
+
+The files come from the package's ``templates/new/`` (``${name}`` becomes the folder's name).
+They are written into a hidden folder next to NAME first and moved into place at the end, so
+a failure leaves nothing behind; an existing folder that is not empty is refused.
+"""
+
+import argparse
+import os
+import re
+import shutil
+import string
+import tempfile
+from importlib import resources
+from pathlib import Path
+
+from fpga_robotics.cli.errors import UsageError
+
+__all__ = ["main", "write_project"]
+
+_TEMPLATES = ("design.py", "scenario.toml", "README.md", "pyproject.toml",
+              "tests/test_scenario.py")
+#: A scenario name (it names the run's recording): letters, digits, '_', '-', '.'.
+_NAME = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.-]{0,63}")
+
+
+def _template(relative):
+    return (resources.files("fpga_robotics.cli") / "templates" / "new"
+            / f"{relative}.tmpl").read_text(encoding="utf-8")
+
+
+def write_project(folder):
+    """Write the skeleton into ``folder`` (absent or empty); return the files written."""
+    folder = Path(folder)
+    name = folder.resolve().name
+    if not _NAME.fullmatch(name):
+        raise UsageError(f"{str(folder)!r}: the project's name {name!r} must be ASCII letters, "
+                         f"digits, '_', '-' and '.' (at most 64), starting with a letter, a "
+                         f"digit or '_'")
+    if folder.exists():
+        if not folder.is_dir():
+            raise UsageError(f"{str(folder)!r} exists and is not a folder; give a new name")
+        if any(folder.iterdir()):
+            raise UsageError(f"folder {str(folder)!r} exists and is not empty; give a new "
+                             f"name or empty it")
+    parent = folder.resolve().parent
+    if not parent.is_dir():
+        raise UsageError(f"no folder {str(parent)!r} to create {name!r} in; create it first")
+    if not os.access(parent, os.W_OK):
+        raise UsageError(f"folder {str(parent)!r} is not writable")
+    staging = Path(tempfile.mkdtemp(prefix=f".{name}.", dir=parent))
+    try:
+        for relative in _TEMPLATES:
+            text = string.Template(_template(relative)).safe_substitute(name=name)
+            target = staging / relative
+            target.parent.mkdir(parents=True, exist_ok=True)
+            target.write_text(text, encoding="utf-8")
+        if folder.exists():
+            folder.rmdir()  # empty: checked above
+        staging.rename(folder)
+    except BaseException:
+        shutil.rmtree(staging, ignore_errors=True)
+        raise
+    return [folder / r for r in _TEMPLATES]
+
+
+def main(argv=None, prog="fpga-robotics new"):
+    p = argparse.ArgumentParser(
+        prog=prog, description="Write a project skeleton: an Amaranth design (design.py), a "
+        "scenario it passes (scenario.toml), a pytest test of it and a README. "
+        "Then: cd NAME && python -m pytest")
+    p.add_argument("name", metavar="NAME", help="the project's folder (new or empty)")
+    args = p.parse_args(argv)
+    for path in write_project(args.name):
+        print(f"wrote {path}")
+    print(f"next: cd {args.name} && python -m pytest")
+    return 0

@@ -1,0 +1,154 @@
+"""The unit judge of a design without a camera: each mutant against the unmutated design on
+the same pin stimulus, cycle by cycle.
+
+The stimulus is seeded random: every input port (``mutsel`` aside) changes, at each clock
+edge with probability ``CHANGE_PROBABILITY``, to a new random value of its width, so a bit
+holds for a few cycles on average and long enough now and then for counters and pulse
+measurements to see it. The mutant netlist (every mutant behind ``mutsel``) is compiled once
+as a Verilator pin model (sim/pins); each run starts from a reset with ``mutsel`` held, applies
+the same stimulus, and records every change of every output (the model stops at each one).
+``mutsel = 0`` gives the reference. A mutant is *caught* when any output's changes differ
+from the reference's (a value, or the cycle it came at).
+"""
+
+import functools
+import hashlib
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..hw.verilog import TOP_NAME
+from ..sim.mutation import MUTATION_SELECT, mutant_netlist, select_width
+from ..sim.pins.base import Port
+
+__all__ = ["CHANGE_PROBABILITY", "MutantPinSource", "PinVerdict", "judge_pin_mutant",
+           "open_pin_mutants", "pin_stimulus", "pin_trace"]
+
+#: The chance that an input takes a new random value at a clock edge.
+CHANGE_PROBABILITY = 1 / 8
+
+
+class MutantPinSource:
+    """The mutant netlist of a design as a Verilog source for the Verilator pin backend: the
+    design's ports (``ports``: name -> ``Port``) plus the ``mutsel`` input. Its outputs are
+    read after the design settles (two evaluations an edge), as for any Verilog design."""
+
+    pixels = filtered = frame_size = None
+    registered_outputs = False
+    verilog_top = TOP_NAME
+
+    def __init__(self, rtlil_text, ports, mutants, name):
+        self._rtlil, self._mutants = rtlil_text, list(mutants)
+        width = select_width(max((m.index for m in mutants), default=0))
+        self.ports = {**ports, MUTATION_SELECT: Port(MUTATION_SELECT, width, "in", False)}
+        digest = hashlib.sha256((rtlil_text + "".join(m.command for m in mutants)).encode())
+        self.key = f"mutants-{name}-{digest.hexdigest()[:12]}"
+
+    @functools.cached_property
+    def verilog(self):
+        return mutant_netlist(None, self._mutants, rtlil_text=self._rtlil)
+
+    def verilog_files(self):
+        """``(files, compiled)``, as ``VerilogPinSource`` gives them."""
+        return {"mutants.v": self.verilog}, ["mutants.v"]
+
+
+def pin_stimulus(ports, cycles, seed):
+    """``[(edge, input, value)]``: the seeded random changes of every input (``ports``:
+    name -> ``Port``; ``mutsel`` left out) over ``cycles`` edges, in edge order."""
+    rng = np.random.default_rng(seed)
+    changes = []
+    for port in ports.values():
+        if port.direction != "in" or port.name == MUTATION_SELECT:
+            continue
+        edges = np.flatnonzero(rng.random(cycles) < CHANGE_PROBABILITY) + 1
+        lo, hi = ((-(1 << (port.width - 1)), 1 << (port.width - 1)) if port.signed
+                  else (0, 1 << port.width))
+        values = rng.integers(lo, hi, size=len(edges), dtype=np.int64)
+        changes += [(int(e), port.name, int(v)) for e, v in zip(edges, values)]
+    return sorted(changes)
+
+
+def pin_trace(backend, index, stimulus, cycles, outputs):
+    """Mutant ``index`` (0: the design) on ``stimulus`` from a reset: ``{output: [(cycle,
+    value), ...]}``, its value at cycle 0 and every change after."""
+    backend.reset()
+    backend.poke(MUTATION_SELECT, index)
+    for edge, name, value in stimulus:
+        backend.schedule(edge, name, value)
+    trace = {name: [(0, backend.peek(name))] for name in outputs}
+    backend.watch(list(outputs))
+    while backend.cycle < cycles:
+        stop = backend.run(cycles - backend.cycle)
+        for name in outputs:
+            value = backend.peek(name)
+            if trace[name][-1][1] != value:
+                trace[name].append((backend.cycle, value))
+        if stop.port is None:
+            break
+    return trace
+
+
+@dataclass
+class PinVerdict:
+    """What the unit judge found for one mutant on the pin stimulus."""
+
+    index: int
+    caught: bool
+    first_cycle: int | None = None  # the first cycle at which an output differs
+    differing: dict = field(default_factory=dict)  # output -> True if its changes differ
+    first_difference: dict = field(default_factory=dict)  # output -> (design, mutant) there
+    cycles: int = 0
+
+    def effect(self):
+        if not self.caught:
+            return f"no output differs in {self.cycles} cycles of random inputs"
+        first = ", ".join(f"{k} {v[0]} -> {v[1]}" for k, v in self.first_difference.items())
+        return f"differs from cycle {self.first_cycle}: {first}"
+
+
+def _value_at(changes, cycle):
+    value = changes[0][1]
+    for at, v in changes:
+        if at > cycle:
+            break
+        value = v
+    return value
+
+
+def _first_divergence(want, got):
+    """The first cycle at which two change lists of one output give different values."""
+    for (ca, va), (cb, vb) in zip(want, got):
+        if (ca, va) != (cb, vb):
+            return min(ca, cb)
+    if len(want) != len(got):
+        longer = want if len(want) > len(got) else got
+        return longer[min(len(want), len(got))][0]
+    return None
+
+
+def judge_pin_mutant(backend, index, stimulus, cycles, reference):
+    """Mutant ``index`` against ``reference`` (``pin_trace`` of index 0): a ``PinVerdict``."""
+    got = pin_trace(backend, index, stimulus, cycles, reference)
+    verdict = PinVerdict(index=index, caught=False, cycles=cycles)
+    firsts = {}
+    for name, want in reference.items():
+        at = _first_divergence(want, got[name])
+        verdict.differing[name] = at is not None
+        if at is not None:
+            firsts[name] = at
+    if firsts:
+        verdict.caught = True
+        verdict.first_cycle = min(firsts.values())
+        verdict.first_difference = {
+            name: (_value_at(reference[name], verdict.first_cycle),
+                   _value_at(got[name], verdict.first_cycle))
+            for name, at in firsts.items() if at == verdict.first_cycle}
+    return verdict
+
+
+def open_pin_mutants(source, *, on_build=None):
+    """The Verilator pin model of a ``MutantPinSource`` (built once, then from the cache)."""
+    from ..sim.pins.compiled import VerilatorPins
+
+    return VerilatorPins(source, on_build=on_build)

@@ -1,0 +1,144 @@
+"""Mutation coverage of a design of one's own (``fpga-robotics mutate --design REF``): each
+Yosys mutant against the unmutated design on seeded random pin stimulus, cycle by cycle.
+
+The independent expectation is a Python model of ``Saturating`` (tests/data/user_designs/
+counters.py): the unmutated netlist's trace must be the model's, and a mutant is caught
+exactly when its trace differs from the model's."""
+
+import json
+from pathlib import Path
+
+import pytest
+
+from fpga_robotics import cli
+from fpga_robotics.designs.reference import resolve_design
+from fpga_robotics.mutation.design_run import design_ports
+from fpga_robotics.mutation.pin_judge import (
+    MutantPinSource,
+    judge_pin_mutant,
+    open_pin_mutants,
+    pin_stimulus,
+    pin_trace,
+)
+from fpga_robotics.sim.mutation import component_rtlil, list_mutants
+
+DESIGNS = Path(__file__).parent / "data" / "user_designs"
+LIMIT, CYCLES = 10, 3000
+
+
+def model_trace(stimulus, cycles, limit=LIMIT):
+    """Saturating by hand: ``{output: [(cycle, value), ...]}`` as ``pin_trace`` records it.
+    An input scheduled for edge e is what the design samples at edge e."""
+    by_edge = {}
+    for edge, name, value in stimulus:
+        by_edge.setdefault(edge, {})[name] = value
+    inputs, count = {"up": 0, "clear": 0}, 0
+    trace = {"count": [(0, 0)], "full": [(0, 0)]}
+    for edge in range(1, cycles + 1):
+        inputs.update(by_edge.get(edge, {}))
+        if inputs["clear"]:
+            count = 0
+        elif inputs["up"] and count < limit:
+            count += 1
+        for name, value in (("count", count), ("full", int(count == limit))):
+            if trace[name][-1][1] != value:
+                trace[name].append((edge, value))
+    return trace
+
+
+@pytest.fixture(scope="module")
+def saturating():
+    spec = resolve_design(f"{DESIGNS}/counters.py:Saturating")
+    ports = design_ports(spec)
+    rtlil_text = component_rtlil(spec.build())
+    mutants = list_mutants(None, 40, 3, rtlil_text=rtlil_text)
+    backend = open_pin_mutants(MutantPinSource(rtlil_text, ports, mutants, "Saturating"))
+    yield ports, mutants, backend
+    backend.close()
+
+
+@pytest.mark.slow  # a Verilator build of the mutant netlist
+def test_the_unmutated_netlist_runs_as_the_model(saturating):
+    ports, _, backend = saturating
+    stimulus = pin_stimulus(ports, CYCLES, seed=0)
+    assert {name for _, name, _ in stimulus} == {"up", "clear"}
+    assert stimulus == pin_stimulus(ports, CYCLES, seed=0)  # seeded
+    want = model_trace(stimulus, CYCLES)
+    assert len(want["full"]) > 4  # the stimulus fills the counter and clears it, repeatedly
+    assert pin_trace(backend, 0, stimulus, CYCLES, ["count", "full"]) == want
+
+
+@pytest.mark.slow  # a Verilator build of the mutant netlist
+def test_a_mutant_is_caught_exactly_when_it_departs_from_the_model(saturating):
+    ports, mutants, backend = saturating
+    stimulus = pin_stimulus(ports, CYCLES, seed=1)
+    model = model_trace(stimulus, CYCLES)
+    reference = pin_trace(backend, 0, stimulus, CYCLES, ["count", "full"])
+    caught = 0
+    for m in mutants:
+        verdict = judge_pin_mutant(backend, m.index, stimulus, CYCLES, reference)
+        departs = pin_trace(backend, m.index, stimulus, CYCLES, ["count", "full"]) != model
+        assert verdict.caught == departs, m.describe()
+        caught += verdict.caught
+        if verdict.caught:  # the first difference is where the mutant's values part
+            for was, now in verdict.first_difference.values():
+                assert was != now
+    assert caught > 0
+
+
+def _cli(argv, capsys):
+    with pytest.raises(SystemExit) as info:
+        cli.main(argv)
+    out = capsys.readouterr()
+    return info.value.code, out.out, out.err
+
+
+@pytest.mark.slow  # a Verilator build of the mutant netlist
+def test_mutate_design_prints_the_scores_of_a_users_design(tmp_path, capsys):
+    out = tmp_path / "m"
+    code, text, _ = _cli(["mutate", "--design", f"{DESIGNS}/wall_stop.py:WallStop",
+                          "--param", "clock_hz=100000", "--mutants", "20", "--cycles",
+                          "20000", "--out", str(out), "--quiet"], capsys)
+    assert code == 0
+    result = json.loads((out / "mutants.json").read_text())
+    caught = sum(m["unit"]["caught"] for m in result["mutants"])
+    assert result["unit"] == {"total": 20, "caught": caught, "equivalent": 20 - caught,
+                              "score": caught / 20}
+    assert result["design"]["params"] == {"clock_hz": 100000}
+    lines = text.splitlines()
+    assert lines[0].startswith("20 mutants of WallStop (seed 1), 20000 cycles of random inputs")
+    assert lines[1] == (f"unit judge (against the unmutated design): {caught} caught, "
+                        f"{20 - caught} equivalent on these inputs: score "
+                        f"{100 * caught / 20:.1f}%")
+    assert {m["module"] or "top" for m in result["mutants"]} <= {"top", "us"}
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["--design", "verilog:x.v"], "a Verilog design is not mutated here"),
+    (["--design", "wall_stop.py:WallStop", "--campaign", "mutation"],
+     "with --design only the unit judge runs"),
+    (["--design", "wall_stop.py:WallStop", "--param", "nope"], "--param must be NAME=VALUE"),
+    (["--cycles", "5"], "--param and --cycles go with --design REF"),
+])
+def test_bad_design_arguments_are_one_line(argv, message, capsys, monkeypatch):
+    monkeypatch.chdir(DESIGNS)
+    code, _, err = _cli(["mutate", *argv], capsys)
+    assert code == 2 and message in err and err.count("\n") == 1
+
+
+@pytest.mark.slow  # a Verilator build of FollowTarget's mutant netlist
+def test_follow_target_against_itself_scores_as_against_the_model(tmp_path, capsys):
+    # The unmutated design gives the golden model's results on the unit frames, so each
+    # mutant's verdict is the same whichever it is compared with.
+    runs = {}
+    for against in ("model", "design"):
+        out = tmp_path / against
+        code, text, _ = _cli(["mutate", "--mutants", "12", "--width", "80", "--height", "60",
+                              "--quiet", "--against", against, "--out", str(out)], capsys)
+        assert code == 0
+        runs[against] = json.loads((out / "mutants.json").read_text())
+        assert runs[against]["against"] == against
+    assert "unit judge (against the unmutated design): " in text
+    assert [m["unit"] for m in runs["model"]["mutants"]] == \
+        [m["unit"] for m in runs["design"]["mutants"]]
+    assert runs["model"]["unit"] == runs["design"]["unit"]

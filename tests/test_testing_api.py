@@ -1,0 +1,53 @@
+"""The public test API (fpga_robotics.testing): a scenario run for a design reference, its
+checks by name, a readable assertion message."""
+
+from pathlib import Path
+
+import pytest
+
+from fpga_robotics.cli.errors import UsageError
+from fpga_robotics.testing import run
+
+DESIGNS = Path(__file__).parent / "data" / "user_designs"
+#: The wall of wall_stop.toml (x = room width), the sensor's mount ahead of the centre.
+WALL_X, SENSOR_FORWARD = 2.5, 0.1
+
+
+@pytest.fixture(scope="module")
+def slow_run():
+    """wall_stop.toml at 450 DPS (its file says 300): the design's params from ``run``."""
+    return run(DESIGNS / "wall_stop.toml", params={"speed": 450}, backend="cxxrtl")
+
+
+def test_params_reach_the_design_and_the_checks_are_named(slow_run):
+    traj = slow_run.trajectory
+    assert traj["motor_left"][0] == 450 and traj["motor_left"][-1] == 0
+    c = slow_run.check("max_wall_collisions")
+    assert (c.status, c.value, c.limit) == ("pass", 0, 0)
+    slow_run.assert_passes()
+    # It stopped by its own rule: less than stop_mm (250) from the wall.
+    assert 150 < 1000 * (WALL_X - traj["x"][-1] - SENSOR_FORWARD) < 250
+    with pytest.raises(KeyError, match="its checks: max_wall_collisions"):
+        slow_run.check("min_distance_min_m")
+
+
+def test_a_failing_check_is_listed_in_the_assertion(tmp_path, monkeypatch):
+    # A design reference relative to the current folder, a stop distance too short for the
+    # braking: the robot hits the wall (0.5 m from it at 300 DPS; stop at 10 mm).
+    monkeypatch.chdir(DESIGNS)
+    result = run("wall_stop.toml", design="wall_stop.py:WallStop",
+                 params={"stop_mm": 10, "speed": 600}, overrides=["sim.duration=6",
+                                                                  "robot.start=[1.8, 0.5]"])
+    assert result.check("max_wall_collisions").status == "fail"
+    assert not result.passed
+    with pytest.raises(AssertionError) as info:
+        result.assert_passes()
+    text = str(info.value)
+    assert "1 of 1 checks not passed" in text and "[fail] max_wall_collisions" in text
+
+
+def test_bad_arguments_are_one_line_errors():
+    with pytest.raises(UsageError, match="takes no parameter 'nope'"):
+        run(DESIGNS / "wall_stop.toml", params={"nope": 1})
+    with pytest.raises(UsageError, match="needs ports="):
+        run(DESIGNS / "wall_stop.toml", design="verilog:x.v")
