@@ -357,3 +357,47 @@ def test_a_campaign_takes_design_references_and_their_params_as_axes(tmp_path, m
                                     source=str(path)))
     assert again.ids[again.runs[0]] != first
     assert len(set(plan.ids.values())) == 2
+
+
+def test_export_writes_a_design_of_ones_own_and_refuses_bad_params(tmp_path, capsys):
+    out_v = tmp_path / "ws.v"
+    code, out, err = _cli(["export", "--design", f"{DESIGNS}/wall_stop.py:WallStop",
+                           "--param", "speed=200", "-o", str(out_v)], capsys)
+    assert code == 0, err
+    assert out == f"wrote {out_v} (module WallStop, 6 ports)\n"
+    text = out_v.read_text()
+    assert "module WallStop(" in text
+    # Every port of the design, at its width, as the resolver reads it.
+    for port, width in (("trig", 1), ("echo", 1), ("motor_left", 16), ("distance_mm", 16)):
+        decl = f"[{width - 1}:0] {port};" if width > 1 else f" {port};"
+        assert decl in text, port
+    bad = tmp_path / "bad.v"
+    code, out, err = _cli(["export", "--design", f"{DESIGNS}/wall_stop.py:WallStop",
+                           "--param", "speed=fast", "-o", str(bad)], capsys)
+    assert (code, out) == (2, "") and err.count("\n") == 1 and "design.params.speed" in err
+    assert not bad.exists()
+
+
+@pytest.mark.slow
+def test_the_exported_verilog_drives_as_its_amaranth_design(tmp_path, capsys):
+    """Round trip: wall_stop.py exported, run as Verilog through a port map, gives the
+    Amaranth design's trajectory (same stop, same recorded distance) in the same scenario."""
+    out_v = tmp_path / "WallStop.v"
+    code, _out, err = _cli(["export", "--design", f"{DESIGNS}/wall_stop.py:WallStop",
+                            "-o", str(out_v)], capsys)
+    assert code == 0, err
+    ports = tmp_path / "ports.toml"
+    ports.write_text('top = "WallStop"\nclock = { port = "clk" }\nreset = { port = "rst" }\n'
+                     '[outputs]\nmotor_left = { port = "motor_left", width = 16, signed = true }\n'
+                     'motor_right = { port = "motor_right", width = 16, signed = true }\n'
+                     '[connectors.ultrasound]\ntrig = "trig"\necho = "echo"\n'
+                     '[extra_outputs]\ndistance_mm = "distance_mm"\nstopped = "stopped"\n')
+    amaranth = run_scenario(load_scenario(str(WALL_STOP), ["sim.duration=4"]),
+                            backend="cxxrtl")
+    scenario = load_scenario(str(WALL_STOP), [
+        "sim.duration=4", f'design.top="verilog:{out_v}"', f'design.ports="{ports}"',
+        "design.params={}"])
+    verilog = run_scenario(scenario, backend="verilator")
+    for column in ("x", "y", "heading", "motor_left", "design.distance_mm", "design.stopped"):
+        np.testing.assert_array_equal(amaranth.trajectory[column], verilog.trajectory[column],
+                                      err_msg=column)

@@ -5,6 +5,7 @@
     fpga-robotics export --board ulx3s-85f -o DIR [--bitstream]   (board top + LPF)
     fpga-robotics export --top follow_target_safe [--stop-mm 250 --us-period-us ...]
     fpga-robotics export --top follow_line [--line-n-sensors 2 --variant ...]
+    fpga-robotics export --design my_design.py:MyDesign [--param NAME=VALUE ...] -o x.v
 
 ``--top`` picks the design (default ``follow_target``; docs/sensor_designs.md describes the
 other two), and the Verilog module is named after it. Every ``FollowTargetParams`` field is an
@@ -51,6 +52,12 @@ def build_parser(prog="fpga-robotics export"):
                         help="output Verilog file (default: build/<top>.v); its directory is "
                              "created if missing; with --board: the output directory "
                              "(default build/<board>)")
+    parser.add_argument("--design", metavar="REF",
+                        help="a design of your own instead of --top: FILE.py:Name or "
+                             "package.module:Name (docs/your_design.md); the module is named "
+                             "after Name")
+    parser.add_argument("--param", dest="design_params", action="append", default=[],
+                        metavar="NAME=VALUE", help="a parameter of the --design (repeatable)")
     add_board_arguments(parser)
     add_param_arguments(parser)
     add_sensor_arguments(parser)
@@ -60,6 +67,10 @@ def build_parser(prog="fpga-robotics export"):
 def main(argv=None, prog="fpga-robotics export"):
     parser = build_parser(prog)
     args = parser.parse_args(argv)  # a bad option: one line, exit 2
+    if args.design is not None:
+        return _export_design(args)
+    if args.design_params:
+        raise UsageError("--param sets a parameter of a --design REF (a design of your own)")
     _check_options_fit_the_top(args)
     params = params_from_args(args) if args.top != "follow_line" else None
     if args.board is not None:  # a board top instead (fpga_robotics.flow.board)
@@ -131,3 +142,27 @@ def _check_options_fit_the_top(args):
 
 def _is_follow_target_option(dest):
     return dest == "preset" or dest in {f.name for f in fields(FollowTargetParams) if f.init}
+
+
+def _export_design(args):
+    """``--design REF``: any Amaranth design of one's own as Verilog, its module named after
+    the class or function the reference names; its other options must not be given."""
+    from fpga_robotics.cli.designs import _params
+    from fpga_robotics.designs.reference import resolve_design
+
+    if args.top != TOP_NAME or args.board is not None or args.bitstream:
+        raise UsageError("--design exports a design of your own: --top, --board and "
+                         "--bitstream go without it")
+    spec = resolve_design(args.design, _params(args.design_params))
+    if spec.kind == "verilog":
+        raise UsageError(f"--design {args.design} is Verilog already: nothing to export")
+    name = spec.reference.rpartition(":")[2] if spec.kind != "builtin" else spec.reference
+    output = args.output if args.output is not None else os.path.join("build", f"{name}.v")
+    if os.path.isdir(output):
+        raise UsageError(f"{output} is a directory; give the Verilog file's path, e.g. "
+                         f"{os.path.join(output, name + '.v')}")
+    check_output_path(output, what="Verilog file")
+    text = generate_top_verilog(spec.build(), name)
+    write_atomic(output, text, what="Verilog file")
+    print(f"wrote {output} (module {name}, {len(spec.ports)} ports)")
+    return 0
