@@ -41,6 +41,7 @@ from .compiled import (
     _address,
     _Library,
 )
+from .lifecycle import BuildPlan, digest, load_built, read_sources
 from .port_map import OUTPUTS, PortMapError, check_connectors, check_widths, load_port_map
 from .toolchain import find_compiler, find_make, run_tool, verilator_root, verilator_version
 from .verilator import CXX_FLAGS, MAKE_FLAGS, VERILATOR_FLAGS
@@ -449,14 +450,14 @@ def foreign_build_plan(design):
     compiler = find_compiler()
     find_make()
     root = verilator_root()
-    harness = {f: (HARNESS_DIR / f).read_text() for f in _HARNESS_FILES}
+    harness = read_sources(_HARNESS_FILES, HARNESS_DIR)
     cflags = " ".join([*CXX_FLAGS, "-DVL_USER_STOP", "-DVL_USER_FINISH"])
     key = build_cache.build_key({
         "flow": "verilator-foreign",
         "abi": ABI_VERSION,
         "source": design.digest(),
-        "hooks": hashlib.sha256(_HOOKS.encode()).hexdigest(),
-        "harness": {f: hashlib.sha256(t.encode()).hexdigest() for f, t in harness.items()},
+        "hooks": digest(_HOOKS),
+        "harness": {f: digest(t) for f, t in harness.items()},
         "flags": [*VERILATOR_FLAGS, cflags, *MAKE_FLAGS],
         "compiler": compiler.version,
         "verilator": verilator_version(),
@@ -482,7 +483,7 @@ def foreign_build_plan(design):
             what=f"building the Verilator model of {design.port_map.top}",
         )
 
-    return (f"verilator-foreign-{design.port_map.top}", key, [LIBRARY_NAME], build)
+    return BuildPlan(f"verilator-foreign-{design.port_map.top}", key, [LIBRARY_NAME], build)
 
 
 class ForeignVerilatorBackend(HarnessFrames, DesignBackend):
@@ -507,13 +508,11 @@ class ForeignVerilatorBackend(HarnessFrames, DesignBackend):
             raise BackendError("the ForeignDesign was made for another frame size")
         self.fill_absent = fill_absent
         self._handle = None
-        name, key, outputs, build = foreign_build_plan(self.design)
         notice = None if on_build is None else (
             lambda: on_build(f"compiling the Verilator model of {self.design.port_map.top} "
                              "(once; later runs load it from the cache)"))
-        entry = build_cache.get_or_build(name, key, outputs, build, on_build=notice)
-        self.cache_entry = entry
-        self._library = _Library(entry.file(LIBRARY_NAME))
+        self.cache_entry, self._library = load_built(foreign_build_plan(self.design),
+                                                     LIBRARY_NAME, _Library, on_build=notice)
         lib = self._library.lib
         self._stop = lib.fr_foreign_stop
         self._stop.restype = ctypes.c_char_p

@@ -6,7 +6,6 @@ per ``run``, ``poke``, ``peek``, ``schedule``, ``watch`` and ``stream_frame``.
 
 import contextlib
 import ctypes
-import hashlib
 import os
 from pathlib import Path
 
@@ -14,7 +13,7 @@ import numpy as np
 
 from ..backends import build_cache
 from ..backends.base import BackendError
-from ..backends.compiled import HARNESS_DIR, BuildPlan
+from ..backends.compiled import HARNESS_DIR
 from ..backends.cxxrtl import CXX_FLAGS as CXXRTL_FLAGS
 from ..backends.cxxrtl_netlist import (
     fast_commit,
@@ -22,6 +21,7 @@ from ..backends.cxxrtl_netlist import (
     with_wire_copies_inlined,
     without_port_copies,
 )
+from ..backends.lifecycle import BuildPlan, bind_library, digest, load_built, read_sources
 from ..backends.toolchain import (
     cxxrtl_include_dir,
     find_compiler,
@@ -70,12 +70,7 @@ _ENTRIES = (
 def _sources(*names):
     """``{name: text}`` of harness files of this package or, shared with the frame
     harnesses, of sim/backends."""
-    return {name: ((SOURCE_DIR if (SOURCE_DIR / name).exists() else HARNESS_DIR) / name)
-            .read_text() for name in names}
-
-
-def _digest(text):
-    return hashlib.sha256(text.encode()).hexdigest()
+    return read_sources(names, SOURCE_DIR, HARNESS_DIR)
 
 
 def cxxrtl_plan(source):
@@ -95,8 +90,8 @@ def cxxrtl_plan(source):
         "flow": "pins-cxxrtl",
         "abi": ABI_VERSION,
         "design": source.key,
-        "source": _digest(model + accessors),
-        "harness": {name: _digest(text) for name, text in harness.items()},
+        "source": digest(model + accessors),
+        "harness": {name: digest(text) for name, text in harness.items()},
         "flags": flags,
         "compiler": compiler.version,
         "runtime": str(include),
@@ -138,8 +133,8 @@ def verilator_plan(source):
         "flow": "pins-verilator",
         "abi": ABI_VERSION,
         "design": source.key,
-        "source": _digest(text + accessors),
-        "harness": {name: _digest(text) for name, text in harness.items()},
+        "source": digest(text + accessors),
+        "harness": {name: digest(text) for name, text in harness.items()},
         "flags": [*VERILATOR_FLAGS, cflags, *MAKE_FLAGS],
         "compiler": compiler.version,
         "verilator": verilator_version(),
@@ -168,18 +163,8 @@ def verilator_plan(source):
 
 
 def _load(path):
-    try:
-        lib = ctypes.CDLL(str(path))
-    except OSError as exc:
-        raise PinError(f"cannot load the compiled pin model {path}: {exc}") from None
-    for name, restype, argtypes in _ENTRIES:
-        fn = getattr(lib, name, None)
-        if fn is None:
-            raise PinError(f"the compiled pin model {path} lacks {name}()")
-        fn.restype, fn.argtypes = restype, argtypes
-    if lib.pin_abi_version() != ABI_VERSION:
-        raise PinError(f"the compiled pin model {path} has an unexpected ABI")
-    return lib
+    return bind_library(path, _ENTRIES, what="compiled pin model", abi_entry="pin_abi_version",
+                        abi=ABI_VERSION, error=PinError)
 
 
 def _address(array):
@@ -218,17 +203,9 @@ class CompiledPins(HostPins):
         self.evals_per_cycle = self._lib.pin_evals_per_cycle()
 
     def _build_and_load(self):
-        for attempt in range(2):
-            entry = build_cache.get_or_build(*type(self).plan(self.source),
-                                             on_build=self._notice)
-            self.cache_entry = entry
-            try:
-                return _load(entry.file(LIBRARY_NAME))
-            except PinError:
-                if attempt or entry.built:
-                    raise
-                build_cache.invalidate(entry)
-        raise AssertionError("unreachable")
+        self.cache_entry, lib = load_built(type(self).plan(self.source), LIBRARY_NAME, _load,
+                                           on_build=self._notice, error=PinError)
+        return lib
 
     def _notice(self):
         if self._on_build is not None:
