@@ -33,7 +33,7 @@ from ..backends.toolchain import (
 from ..backends.verilator import CXX_FLAGS as VERILATOR_CXX_FLAGS
 from ..backends.verilator import MAKE_FLAGS, VERILATOR_FLAGS
 from .base import PinError
-from .codegen import cxxrtl_accessors, verilator_accessors
+from .codegen import PIN_WRAPPER, cxxrtl_accessors, verilator_accessors, verilator_wrapper
 from .host import HostPins, capture_error
 
 __all__ = ["CompiledPins", "CxxrtlPins", "VerilatorPins"]
@@ -119,12 +119,14 @@ def verilator_plan(source):
     if hasattr(source, "verilog_files"):  # a foreign Verilog design
         files, compiled = source.verilog_files()
         top, registered = source.verilog_top, source.registered_outputs
-        text = "".join(f"{name}\0{body}\0" for name, body in files.items())
     else:
-        text = source.verilog
-        files, compiled = {"follow_target.v": text}, ["follow_target.v"]
+        files, compiled = {"follow_target.v": source.verilog}, ["follow_target.v"]
         top = "follow_target"
         registered = output_sources(source.cxxrtl, outputs) is not None
+    # The model's top is a wrapper whose ports are numbered: any port name builds.
+    files = {**files, "fr_pin_top.v": verilator_wrapper(source, top)}
+    compiled = [*compiled, "fr_pin_top.v"]
+    text = "".join(f"{name}\0{body}\0" for name, body in files.items())
     accessors = verilator_accessors(source, registered)
     harness = _sources("pin_verilator.cpp", _DRIVER, "verilator_clock.h")
     cflags = " ".join(VERILATOR_CXX_FLAGS)
@@ -151,7 +153,7 @@ def verilator_plan(source):
         env = dict(os.environ, VERILATOR_ROOT=str(root))
         make_flags = [*MAKE_FLAGS, f"CXX={compiler.path}", f"LINK={compiler.path}"]
         run_tool([root / "bin" / "verilator", *VERILATOR_FLAGS, "-j", jobs,
-                  "--top-module", top, "--prefix", "Vfollow_target", f"-I{directory / 'src'}",
+                  "--top-module", PIN_WRAPPER, "--prefix", "Vfollow_target", f"-I{directory / 'src'}",
                   "--Mdir", directory / "obj",
                   "-CFLAGS", f"{cflags} -I{directory}", "-LDFLAGS", "-shared",
                   "-MAKEFLAGS", " ".join(make_flags), "-o", directory / LIBRARY_NAME,
