@@ -14,6 +14,8 @@ __all__ = ["FILTERED_PORTS", "PIN_BACKENDS", "PIXEL_PORTS", "PinBackend", "PinDe
 #: Backend names ``get_pin_backend`` accepts; ``auto`` tries the compiled ones fastest first.
 PIN_BACKENDS = ("auto", "pysim", "cxxrtl", "verilator")
 _AUTO_ORDER = ("cxxrtl", "verilator")
+#: ``auto`` for a Verilog design: the faster of the two on it (docs/pins.md).
+_VERILOG_AUTO = "verilator"
 
 
 def _backend_class(name):
@@ -32,11 +34,14 @@ def get_pin_backend(name, source, **kwargs):
     if name not in PIN_BACKENDS:
         raise PinError(f"unknown pin backend {name!r}; choose one of: {', '.join(PIN_BACKENDS)}")
     if isinstance(source, VerilogPinSource):
-        # Only Verilator reads Verilog: Amaranth's simulator and CXXRTL take Amaranth designs.
-        if name not in ("auto", "verilator"):
-            raise PinError(f"the {name} pin backend cannot run a Verilog design "
-                           f"({source.design.port_map.top}); use the verilator backend")
-        return _backend_class("verilator")(source, **kwargs)
+        # Amaranth's simulator takes Amaranth designs only.
+        if name == "pysim":
+            raise PinError(f"the pysim pin backend cannot run a Verilog design "
+                           f"({source.design.port_map.top}); use the cxxrtl or verilator "
+                           "backend")
+        if name != "auto":
+            return _backend_class(name)(source, **kwargs)
+        return _backend_class(_VERILOG_AUTO)(source, **kwargs)
     if not isinstance(source, PinDesignSource):
         raise TypeError(f"source must be a PinDesignSource, not {source!r}")
     if name != "auto":

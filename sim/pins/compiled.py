@@ -31,6 +31,7 @@ from ..backends.toolchain import (
     verilator_version,
 )
 from ..backends.verilator import CXX_FLAGS as VERILATOR_CXX_FLAGS
+from ..backends.verilog_cxxrtl import runtime_include_dir
 from ..backends.verilator import MAKE_FLAGS, VERILATOR_FLAGS
 from .base import PinError
 from .codegen import PIN_WRAPPER, cxxrtl_accessors, verilator_accessors, verilator_wrapper
@@ -74,9 +75,12 @@ def _sources(*names):
 
 
 def cxxrtl_plan(source):
-    """The ``BuildPlan`` of a ``PinDesignSource`` with CXXRTL."""
+    """The ``BuildPlan`` of a ``PinDesignSource`` (Amaranth's CXXRTL output) or a
+    ``VerilogPinSource`` (its files read by Yosys) with CXXRTL."""
     compiler = find_compiler()
-    include = cxxrtl_include_dir()
+    foreign = hasattr(source, "verilog_files")
+    # Each model compiles against the runtime headers of the Yosys that wrote it.
+    include = runtime_include_dir() if foreign else cxxrtl_include_dir()
     model = source.cxxrtl
     outputs = [p.name for p in source.ports.values() if p.direction == "out"]
     exprs = output_sources(model, outputs)
