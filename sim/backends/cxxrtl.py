@@ -22,11 +22,12 @@ CXX_FLAGS = ("-std=c++17", "-O3", "-fno-tree-vectorize", "-fPIC", "-fvisibility=
 _HARNESS_FILES = ("cxxrtl_harness.cpp", "frame_driver.h", "cxxrtl_clock.h")
 
 
-def cxxrtl_build_plan(design, variant, flags=None):
+def cxxrtl_build_plan(design, variant, flags=None, include=None):
     """The ``BuildPlan`` of a ``DesignSource`` in variant ``"plain"`` or ``"vcd"``;
-    ``flags`` replaces ``CXX_FLAGS``."""
+    ``flags`` replaces ``CXX_FLAGS``, ``include`` the runtime headers of Amaranth's Yosys
+    (for a model another Yosys wrote)."""
     compiler = find_compiler()
-    include = cxxrtl_include_dir()
+    include = cxxrtl_include_dir() if include is None else include
     source = design.cxxrtl()
     if "struct p_follow__target" not in source:
         raise BackendError("the CXXRTL output has no p_follow__target module")

@@ -496,6 +496,8 @@ class ForeignVerilatorBackend(HarnessFrames, DesignBackend):
     """
 
     name = "verilator-foreign"
+    #: The simulator, as the build notice names it.
+    flow = "Verilator"
 
     def __init__(self, params=None, *, design=None, files=None, port_map=None, line_blank=0,
                  frame_blank=0, waveform=None, on_build=None, fill_absent=False):
@@ -510,19 +512,12 @@ class ForeignVerilatorBackend(HarnessFrames, DesignBackend):
         self.fill_absent = fill_absent
         self._handle = None
         notice = None if on_build is None else (
-            lambda: on_build(f"compiling the Verilator model of {self.design.port_map.top} "
+            lambda: on_build(f"compiling the {self.flow} model of {self.design.port_map.top} "
                              "(once; later runs load it from the cache)"))
-        self.cache_entry, self._library = load_built(foreign_build_plan(self.design),
-                                                     LIBRARY_NAME, _Library, on_build=notice)
-        lib = self._library.lib
-        self._stop = lib.fr_foreign_stop
-        self._stop.restype = ctypes.c_char_p
-        self._stop.argtypes = []
-        lib.fr_foreign_clear.restype = None
-        lib.fr_foreign_clear()
-        lib.fr_foreign_set_runtime.restype = None
-        lib.fr_foreign_set_runtime.argtypes = [ctypes.c_int, ctypes.c_int]
         self._runtime = dict(self.design.port_map.runtime)
+        self.cache_entry, self._library = load_built(self._build_plan(self.design),
+                                                     LIBRARY_NAME, _Library, on_build=notice)
+        self._bind_hooks(self._library.lib)
         self._apply_runtime()
         self._handle = self._library.lib.fr_create()
         p, pm = self.params, self.design.port_map
@@ -535,6 +530,20 @@ class ForeignVerilatorBackend(HarnessFrames, DesignBackend):
             np.int64)
         assert len(self._args) == _N_ARGS
         self._init_harness()
+
+    @staticmethod
+    def _build_plan(design):
+        return foreign_build_plan(design)
+
+    def _bind_hooks(self, lib):
+        """The C entry points compiled with the design (``_HOOKS``)."""
+        self._stop = lib.fr_foreign_stop
+        self._stop.restype = ctypes.c_char_p
+        self._stop.argtypes = []
+        lib.fr_foreign_clear.restype = None
+        lib.fr_foreign_clear()
+        lib.fr_foreign_set_runtime.restype = None
+        lib.fr_foreign_set_runtime.argtypes = [ctypes.c_int, ctypes.c_int]
 
     @property
     def evals_per_cycle(self):
