@@ -15,6 +15,7 @@ from fpga_robotics.cli.errors import UsageError, run_cli
 from fpga_robotics.hw.pixel import COLOR_SELECT
 from fpga_robotics.ros.run_options import RosOutputs, add_ros_arguments
 from fpga_robotics.sim.backends import BACKEND_NAMES
+from fpga_robotics.sim.backends.foreign_choice import FOREIGN_BACKENDS
 from fpga_robotics.sim.files import check_output_path, write_json_atomic
 
 __all__ = ["TARGET_CLOTHING", "Progress", "build_parser", "main"]
@@ -70,8 +71,8 @@ def build_parser(prog="python -m fpga_robotics.run"):
     p.add_argument("--shadow-backend", choices=("auto", *BACKEND_NAMES), default=None,
                    help="simulator of the shadow design (default: the same as --backend)")
     p.add_argument("--design", metavar="verilog:TOP.v[,MORE.v...]",
-                   help="run your own Verilog design (on Verilator) instead of FollowTarget; "
-                        "needs --ports (docs/foreign.md)")
+                   help="run your own Verilog design (on CXXRTL or Verilator) instead of "
+                        "FollowTarget; needs --ports (docs/foreign.md)")
     p.add_argument("--ports", metavar="PORTS.toml",
                    help="with --design: the port map of the Verilog design")
     p.add_argument("--runtime", action="append", default=[], metavar="NAME=VALUE",
@@ -204,7 +205,7 @@ def _open_pin_design(args, scenario):
         if not args.quiet:
             print(f"{text} ...", file=sys.stderr, flush=True)
 
-    if scenario.foreign is not None:  # a Verilog design on pins: on Verilator
+    if scenario.foreign is not None:  # a Verilog design on pins: on CXXRTL or Verilator
         if args.runtime:
             raise UsageError("--runtime changes [runtime] inputs between frames in compressed "
                              "timing; in real-clock timing they keep the port map's values")
@@ -256,21 +257,22 @@ def _design_files(args, foreign=None):
         foreign.ports if foreign is not None else None)
     if ports is None:
         raise UsageError("--design needs --ports PORTS.toml (the design's port map)")
-    if args.backend not in ("auto", "verilator"):
+    if args.backend not in FOREIGN_BACKENDS:
         what = "--design" if args.design is not None else "the scenario's design.verilog"
-        raise UsageError(f"{what} runs on the verilator backend, not {args.backend!r}")
+        raise UsageError(f"{what} runs on the cxxrtl or verilator backend, not "
+                         f"{args.backend!r}")
     return files, ports
 
 
 def _open_design(args, params, foreign=None):
-    """The main design: ``--design`` (or the scenario's ``foreign`` design) on Verilator,
-    else FollowTarget on ``--backend``."""
+    """The main design: ``--design`` (or the scenario's ``foreign`` design), else
+    FollowTarget, on ``--backend``."""
     design_files = _design_files(args, foreign)
     if design_files is None:
         return _open_backend(args.backend, params, args.quiet)
     files, ports = design_files
     from fpga_robotics.sim.backends.base import BackendError
-    from fpga_robotics.sim.backends.foreign import ForeignVerilatorBackend
+    from fpga_robotics.sim.backends.foreign_choice import open_foreign_frames
 
     def tell(text):
         if not args.quiet:
@@ -278,7 +280,8 @@ def _open_design(args, params, foreign=None):
 
     try:
         # Outputs the map does not name stay None: absent in the summary and the viewer.
-        backend = ForeignVerilatorBackend(params, files=files, port_map=ports, on_build=tell)
+        backend = open_foreign_frames(args.backend, params, files=files, port_map=ports,
+                                      on_build=tell)
     except BackendError as exc:
         raise UsageError(f"--design: {exc}".splitlines()[0]) from None
     missing = [k for k in ("motor_left", "motor_right") if k not in
