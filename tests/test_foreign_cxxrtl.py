@@ -9,8 +9,15 @@ import numpy as np
 import pytest
 from renamed_design import RENAMED, RENAMED_MAP
 from test_foreign_pins import SCENARIO, VERILOG_DESIGN
-from test_foreign_verilog import FB_MAP, FB_TOP, NEVER_DONE, NEVER_DONE_MAP, PARAMS, STREAM_MAP
-from test_foreign_verilog import _frames
+from test_foreign_verilog import (
+    FB_MAP,
+    FB_TOP,
+    NEVER_DONE,
+    NEVER_DONE_MAP,
+    PARAMS,
+    STREAM_MAP,
+    _frames,
+)
 
 from fpga_robotics.hw.verilog import generate_verilog
 from fpga_robotics.loop.compressed import run_scenario
@@ -97,11 +104,11 @@ def test_cxxrtl_gives_verilators_results_cycle_for_cycle(files, names, ports, li
 
 
 def test_a_named_timeout_on_cxxrtl_too(files):
-    with ForeignCxxrtlBackend(PARAMS, files=[files / "never.v"],
-                              port_map=files / "never.toml") as design:
-        with pytest.raises(BackendError, match="frame 0: timeout: the result strobe 'done' "
-                                               "never rose within 500 cycles"):
-            design.process_frame(_frames(PARAMS)[0])
+    design = ForeignCxxrtlBackend(PARAMS, files=[files / "never.v"],
+                                  port_map=files / "never.toml")
+    with design, pytest.raises(BackendError, match="frame 0: timeout: the result strobe "
+                                                   "'done' never rose within 500 cycles"):
+        design.process_frame(_frames(PARAMS)[0])
 
 
 def test_what_yosys_cannot_read_runs_on_verilator(files):

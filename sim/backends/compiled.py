@@ -17,8 +17,8 @@ from pathlib import Path
 import numpy as np
 
 from ...hw.pixel import color_select_value
-from ..files import PendingOutput
 from ..camera.frames import to_rgb444
+from ..files import PendingOutput
 from .base import BackendError, DesignBackend, FrameResult, check_out
 from .designs import DesignSource
 from .lifecycle import BuildPlan, bind_library, load_built

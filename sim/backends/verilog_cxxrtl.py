@@ -9,7 +9,6 @@ What Yosys cannot read (most of SystemVerilog beyond synthesis, DPI) is a one-li
 """
 
 import functools
-import hashlib
 import os
 import shutil
 import subprocess
@@ -20,8 +19,7 @@ from pathlib import Path
 from ..processes import run_captured
 from .base import BackendError
 
-__all__ = ["YOSYS_SCRIPT", "runtime_include_dir", "script_digest", "verilog_to_cxxrtl",
-           "yosys_version"]
+__all__ = ["YOSYS_SCRIPT", "runtime_include_dir", "verilog_to_cxxrtl", "yosys_version"]
 
 #: The Yosys commands after reading the files (``{top}``: the design's top module). The
 #: hierarchy is flattened so that the harness's one-evaluation analysis (cxxrtl_netlist) sees
@@ -95,7 +93,3 @@ def _convert(sources, top, includes):
                                "run it on the Verilator backend (--backend verilator)")
         return (Path(tmp) / "design.cc").read_text()
 
-
-def script_digest():
-    """Digest of the conversion (the script and the Yosys), for build keys."""
-    return hashlib.sha256((YOSYS_SCRIPT + yosys_version()).encode()).hexdigest()

@@ -31,8 +31,8 @@ from ..backends.toolchain import (
     verilator_version,
 )
 from ..backends.verilator import CXX_FLAGS as VERILATOR_CXX_FLAGS
-from ..backends.verilog_cxxrtl import runtime_include_dir
 from ..backends.verilator import MAKE_FLAGS, VERILATOR_FLAGS
+from ..backends.verilog_cxxrtl import runtime_include_dir
 from .base import PinError
 from .codegen import PIN_WRAPPER, cxxrtl_accessors, verilator_accessors, verilator_wrapper
 from .host import HostPins, capture_error
