@@ -1,6 +1,7 @@
 """Foreign Verilog designs in real-clock timing (docs/foreign.md, "Sensors on pins"): a port
 map's ``[connectors.<kind>]`` binds a connector's pins to the design's ports, and the design
-runs on the Verilator pin backend in the closed loop.
+runs on a compiled pin backend in the closed loop (``auto``: CXXRTL; tests/test_foreign_cxxrtl.py
+compares it with Verilator).
 
 The design is tests/data/bump_stop.v: on at 300 DPS until the bumper closes, then stopped for
 good (an active-low reset, 12-bit wheel speeds sign-extended by the map). It must stop short
