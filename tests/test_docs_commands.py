@@ -487,7 +487,7 @@ PLANS = {
     "fpga-robotics ports --example ports.toml":
         Plan(files=("ports.toml",), out=(r"wrote ports\.toml",)),
     "python -m fpga_robotics.run --design verilog:follow_target.v --ports ports.toml":
-        Plan(out=(PASS, r"(?m)^backend:? .*verilator-foreign|verilator-foreign")),
+        Plan(out=(PASS, r"(?m)^backend:? .*cxxrtl-foreign|cxxrtl-foreign")),
     ("python -m fpga_robotics.run --scenario bump_wall.toml --design verilog:bump_stop.v "
      "--ports bump_stop_ports.toml --rerun off"):
         Plan(setup=(" ".join(["cp", *(str(ROOT / "tests/data" / name) for name in (

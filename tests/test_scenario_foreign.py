@@ -90,8 +90,8 @@ def test_the_command_line_overrides_the_scenario(files):
     assert _design_files(_args(design="verilog:x.v", ports="o.toml"), foreign) == (
         ["x.v"], "o.toml")
     assert _design_files(_args(), None) is None
-    with pytest.raises(UsageError, match="the scenario's design.verilog runs on the verilator "
-                                         "backend, not 'model'"):
+    with pytest.raises(UsageError, match="the scenario's design.verilog runs on the cxxrtl or "
+                                         "verilator backend, not 'model'"):
         _design_files(_args(backend="model"), foreign)
     with pytest.raises(UsageError, match="--ports goes with --design"):
         _design_files(_args(ports="o.toml"), None)
@@ -122,7 +122,7 @@ def test_a_scenario_runs_its_foreign_design_in_closed_loop(files, capsys):
     run.main(["--scenario", str(files / "plain.toml"), "--backend", "model", *argv,
               "--summary", str(files / "plain.json")])
     got, want = (json.loads((files / n).read_text()) for n in ("foreign.json", "plain.json"))
-    assert got["backend"] == "verilator-foreign" and want["backend"] == "model"
+    assert got["backend"] == "cxxrtl-foreign" and want["backend"] == "model"
     # The exported FollowTarget with its full port map: the same run, figure for figure.
     for key in ("frames", "min_distance_m", "mean_distance_m", "found_fraction",
                 "target_in_view_fraction", "path_length_m", "collisions", "verdict"):

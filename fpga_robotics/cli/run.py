@@ -16,6 +16,7 @@ from fpga_robotics.cli.parser import CommandParser
 from fpga_robotics.hw.pixel import COLOR_SELECT
 from fpga_robotics.ros.run_options import RosOutputs, add_ros_arguments
 from fpga_robotics.sim.backends import BACKEND_NAMES
+from fpga_robotics.sim.backends.foreign_choice import FOREIGN_BACKENDS
 from fpga_robotics.sim.files import check_output_path, write_json_atomic
 
 __all__ = ["TARGET_CLOTHING", "Progress", "build_parser", "main"]
@@ -94,7 +95,7 @@ def build_parser(prog="fpga-robotics run"):
                    help="the design to run instead of the scenario's design.top: a built-in "
                         "name, FILE.py:Name or package.module:Name (an Amaranth component, "
                         "docs/your_design.md), or verilog:TOP.v[,MORE.v...] with --ports "
-                        "(docs/foreign.md)")
+                        "(on CXXRTL or Verilator, docs/foreign.md)")
     p.add_argument("--ports", metavar="PORTS.toml",
                    help="with --design: the port map of the Verilog design")
     p.add_argument("--runtime", action="append", default=[], metavar="NAME=VALUE",
@@ -275,7 +276,7 @@ def _open_pin_design(args, scenario):
         if not args.quiet:
             print(f"{text} ...", file=sys.stderr, flush=True)
 
-    if scenario.foreign is not None:  # a Verilog design on pins: on Verilator
+    if scenario.foreign is not None:  # a Verilog design on pins: on CXXRTL or Verilator
         if args.runtime:
             raise UsageError("--runtime changes [runtime] inputs between frames in compressed "
                              "timing; in real-clock timing they keep the port map's values")
@@ -327,21 +328,22 @@ def _design_files(args, foreign=None):
         foreign.ports if foreign is not None else None)
     if ports is None:
         raise UsageError("--design needs --ports PORTS.toml (the design's port map)")
-    if args.backend not in ("auto", "verilator"):
+    if args.backend not in FOREIGN_BACKENDS:
         what = "--design" if args.design is not None else "the scenario's design.verilog"
-        raise UsageError(f"{what} runs on the verilator backend, not {args.backend!r}")
+        raise UsageError(f"{what} runs on the cxxrtl or verilator backend, not "
+                         f"{args.backend!r}")
     return files, ports
 
 
 def _open_design(args, params, foreign=None):
-    """The main design: ``--design`` (or the scenario's ``foreign`` design) on Verilator,
-    else FollowTarget on ``--backend``."""
+    """The main design: ``--design`` (or the scenario's ``foreign`` design), else
+    FollowTarget, on ``--backend``."""
     design_files = _design_files(args, foreign)
     if design_files is None:
         return _open_backend(args.backend, params, args.quiet)
     files, ports = design_files
     from fpga_robotics.sim.backends.base import BackendError
-    from fpga_robotics.sim.backends.foreign import ForeignVerilatorBackend
+    from fpga_robotics.sim.backends.foreign_choice import open_foreign_frames
 
     def tell(text):
         if not args.quiet:
@@ -349,7 +351,8 @@ def _open_design(args, params, foreign=None):
 
     try:
         # Outputs the map does not name stay None: absent in the summary and the viewer.
-        backend = ForeignVerilatorBackend(params, files=files, port_map=ports, on_build=tell)
+        backend = open_foreign_frames(args.backend, params, files=files, port_map=ports,
+                                      on_build=tell)
     except BackendError as exc:
         raise UsageError(f"--design: {exc}".splitlines()[0]) from None
     missing = [k for k in ("motor_left", "motor_right") if k not in

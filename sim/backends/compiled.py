@@ -12,18 +12,16 @@ with a waveform writer, made only when a ``WaveformRequest`` asks for it).
 
 import contextlib
 import ctypes
-from collections.abc import Callable
 from pathlib import Path
-from typing import NamedTuple
 
 import numpy as np
 
 from ...hw.pixel import color_select_value
-from ..files import PendingOutput
 from ..camera.frames import to_rgb444
-from . import build_cache
+from ..files import PendingOutput
 from .base import BackendError, DesignBackend, FrameResult, check_out
 from .designs import DesignSource
+from .lifecycle import BuildPlan, bind_library, load_built
 
 __all__ = ["ABI_VERSION", "HARNESS_DIR", "LIBRARY_NAME", "BuildPlan", "CompiledBackend",
            "HarnessFrames"]
@@ -50,48 +48,29 @@ _STATUS = {
 _VP = ctypes.c_void_p
 
 
-class BuildPlan(NamedTuple):
-    """Arguments of ``build_cache.get_or_build``: entry name, key, files and build function."""
-
-    name: str
-    key: str
-    files: list
-    build: Callable
-
-
 class _Library:
     """A loaded harness library and its C entry points."""
 
+    _ENTRIES = (
+        ("fr_abi_version", ctypes.c_int, []),
+        ("fr_traced", ctypes.c_int, []),
+        ("fr_evals_per_cycle", ctypes.c_int, []),
+        ("fr_create", _VP, []),
+        ("fr_destroy", None, [_VP]),
+        ("fr_reset", None, [_VP]),
+        ("fr_trace_open", ctypes.c_int, [_VP, ctypes.c_char_p]),
+        ("fr_trace_enable", None, [_VP, ctypes.c_int]),
+        ("fr_trace_close", None, [_VP]),
+        ("fr_run_frame", ctypes.c_int, [_VP, _VP, _VP, _VP, _VP]),
+        ("fr_run_frame_rgb888", ctypes.c_int, [_VP, _VP, _VP, _VP, _VP]),
+    )
+
     def __init__(self, path):
-        try:
-            lib = ctypes.CDLL(str(path))
-        except OSError as exc:
-            raise BackendError(f"cannot load the compiled model {path}: {exc}") from None
-        for name, restype, argtypes in (
-            ("fr_abi_version", ctypes.c_int, []),
-            ("fr_traced", ctypes.c_int, []),
-            ("fr_evals_per_cycle", ctypes.c_int, []),
-            ("fr_create", _VP, []),
-            ("fr_destroy", None, [_VP]),
-            ("fr_reset", None, [_VP]),
-            ("fr_trace_open", ctypes.c_int, [_VP, ctypes.c_char_p]),
-            ("fr_trace_enable", None, [_VP, ctypes.c_int]),
-            ("fr_trace_close", None, [_VP]),
-            ("fr_run_frame", ctypes.c_int, [_VP, _VP, _VP, _VP, _VP]),
-            ("fr_run_frame_rgb888", ctypes.c_int, [_VP, _VP, _VP, _VP, _VP]),
-        ):
-            try:
-                fn = getattr(lib, name)
-            except AttributeError:
-                raise BackendError(f"the compiled model {path} lacks {name}()") from None
-            fn.restype = restype
-            fn.argtypes = argtypes
-        if lib.fr_abi_version() != ABI_VERSION:
-            raise BackendError(f"the compiled model {path} has an unexpected harness ABI")
-        self.lib = lib
+        self.lib = bind_library(path, self._ENTRIES, what="compiled model",
+                                abi_entry="fr_abi_version", abi=ABI_VERSION)
         self.path = path
         #: Simulator evaluations per clock cycle (1 when every output is read from flip-flops).
-        self.evals_per_cycle = lib.fr_evals_per_cycle()
+        self.evals_per_cycle = self.lib.fr_evals_per_cycle()
 
 
 _U8 = np.dtype(np.uint8)
@@ -206,20 +185,12 @@ class CompiledBackend(HarnessFrames, DesignBackend):
     # Building ----------------------------------------------------------------------------------
 
     def _load(self, variant):
-        """Build (or find in the cache) and load the library; a damaged entry that passes the
-        manifest check but does not load is rebuilt once."""
-        for attempt in range(2):
-            entry = build_cache.get_or_build(*self.build_plan(self.source, variant),
-                                             on_build=self._build_notice)
-            #: The cache entry in use (``built`` tells whether this construction built it).
-            self.cache_entry = entry
-            try:
-                return _Library(entry.file(LIBRARY_NAME))
-            except BackendError:
-                if attempt or entry.built:
-                    raise
-                build_cache.invalidate(entry)
-        raise AssertionError("unreachable")
+        """Build (or find in the cache) and load the library (``lifecycle.load_built``)."""
+        #: The cache entry in use (``built`` tells whether this construction built it).
+        self.cache_entry, library = load_built(self.build_plan(self.source, variant),
+                                               LIBRARY_NAME, _Library,
+                                               on_build=self._build_notice)
+        return library
 
     def _build_notice(self):
         if self._on_build is not None:

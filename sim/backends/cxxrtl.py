@@ -3,12 +3,12 @@ against the CXXRTL runtime headers of Amaranth's builtin Yosys, driven frame by 
 C++ harness (cxxrtl_harness.cpp + frame_driver.h) through ctypes.
 """
 
-import hashlib
 
 from . import build_cache
 from .base import BackendError
-from .compiled import ABI_VERSION, HARNESS_DIR, LIBRARY_NAME, BuildPlan, CompiledBackend
+from .compiled import ABI_VERSION, HARNESS_DIR, LIBRARY_NAME, CompiledBackend
 from .cxxrtl_netlist import model_header, with_wire_copies_inlined, without_port_copies
+from .lifecycle import BuildPlan, digest, read_sources
 from .toolchain import cxxrtl_include_dir, find_compiler, run_tool
 
 __all__ = ["CXX_FLAGS", "CxxrtlBackend", "cxxrtl_build_plan"]
@@ -22,11 +22,12 @@ CXX_FLAGS = ("-std=c++17", "-O3", "-fno-tree-vectorize", "-fPIC", "-fvisibility=
 _HARNESS_FILES = ("cxxrtl_harness.cpp", "frame_driver.h", "cxxrtl_clock.h")
 
 
-def cxxrtl_build_plan(design, variant, flags=None):
+def cxxrtl_build_plan(design, variant, flags=None, include=None):
     """The ``BuildPlan`` of a ``DesignSource`` in variant ``"plain"`` or ``"vcd"``;
-    ``flags`` replaces ``CXX_FLAGS``."""
+    ``flags`` replaces ``CXX_FLAGS``, ``include`` the runtime headers of Amaranth's Yosys
+    (for a model another Yosys wrote)."""
     compiler = find_compiler()
-    include = cxxrtl_include_dir()
+    include = cxxrtl_include_dir() if include is None else include
     source = design.cxxrtl()
     if "struct p_follow__target" not in source:
         raise BackendError("the CXXRTL output has no p_follow__target module")
@@ -38,13 +39,13 @@ def cxxrtl_build_plan(design, variant, flags=None):
         source = with_wire_copies_inlined(without_port_copies(source))
     else:
         flags.append("-DFR_TRACE")
-    harness = {f: (HARNESS_DIR / f).read_text() for f in _HARNESS_FILES}
+    harness = read_sources(_HARNESS_FILES, HARNESS_DIR)
     key = build_cache.build_key(
         {
             "flow": "cxxrtl",
             "abi": ABI_VERSION,
-            "source": hashlib.sha256((source + header).encode()).hexdigest(),
-            "harness": {f: hashlib.sha256(t.encode()).hexdigest() for f, t in harness.items()},
+            "source": digest(source + header),
+            "harness": {f: digest(t) for f, t in harness.items()},
             "params": design.params.as_dict(),
             "design": design.design,
             "flags": flags,

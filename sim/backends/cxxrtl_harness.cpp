@@ -34,7 +34,13 @@ constexpr int EVALS_PER_CYCLE = 1;
 constexpr int EVALS_PER_CYCLE = 2;
 #endif
 
-struct Sim {
+#ifdef FR_TRACE
+struct TraceBase {};  // the tracing members are Sim's own
+#else
+using TraceBase = fr::Untraced;
+#endif
+
+struct Sim : TraceBase {
     static constexpr int evals_per_cycle = EVALS_PER_CYCLE;
     Top top;
 
@@ -66,10 +72,10 @@ struct Sim {
     inline bool filtered_valid() const { return FR_OUT_FILTERED__VALID(top).get<bool>(); }
     inline uint16_t filtered_payload() const { return FR_OUT_FILTERED__PAYLOAD(top).get<uint16_t>(); }
     inline bool frame_done() const { return FR_OUT_FRAME_DONE(top).get<bool>(); }
-    int64_t found() const { return FR_OUT_FOUND(top).get<uint8_t>(); }
-    int64_t proximity() const { return FR_OUT_PROXIMITY(top).get<uint8_t>(); }
+    int64_t found() const { return FR_OUT_FOUND(top).get<uint32_t>(); }
+    int64_t proximity() const { return FR_OUT_PROXIMITY(top).get<uint32_t>(); }
     int64_t centroid_x() const { return FR_OUT_CENTROID_X(top).get<uint32_t>(); }
-    int64_t centroid_leds() const { return FR_OUT_CENTROID_LEDS(top).get<uint8_t>(); }
+    int64_t centroid_leds() const { return FR_OUT_CENTROID_LEDS(top).get<uint32_t>(); }
     uint16_t motor_left() const { return FR_OUT_MOTOR_LEFT(top).get<uint16_t>(); }
     uint16_t motor_right() const { return FR_OUT_MOTOR_RIGHT(top).get<uint16_t>(); }
 
@@ -113,12 +119,6 @@ struct Sim {
                 flush();
         }
     }
-#else
-    static constexpr int traced = 0;
-    int trace_open(const char *) { return 2; }
-    void trace_enable(int) {}
-    void trace_close() {}
-    inline void sample() {}
 #endif
 };
 

@@ -94,6 +94,8 @@ def output_sources(source, outputs=OUTPUTS):
     """
     if re.search(r"\bnegedge_|bool posedge_(?!p_clk\b)", source):
         return None  # another clock or edge: not the one-domain design this reads
+    if "prev_p_clk" not in source:
+        return None  # no flip-flop on clk (a combinational design): no edge to hold the clock for
     body = _eval_body(source)
     flops = _edge_only_wires(source)
     # Whole-value assignments at the top level of eval(); a name assigned more than once, or

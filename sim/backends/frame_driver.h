@@ -172,6 +172,16 @@ void reset(S &sim) {
     sim.set_rst(false);
 }
 
+// The tracing members of an adapter built without FR_TRACE (its base then): no waveform
+// writer; trace_open() answers 2, "this build does not trace".
+struct Untraced {
+    static constexpr int traced = 0;
+    int trace_open(const char *) { return 2; }
+    void trace_enable(int) {}
+    void trace_close() {}
+    inline void sample() {}
+};
+
 }  // namespace fr
 
 // The C entry points every harness exports, given its adapter type `SIM`.

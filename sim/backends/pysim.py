@@ -44,6 +44,7 @@ from amaranth.sim import Simulator
 from ...hw.top import FollowTarget
 from ..files import atomic_output
 from .base import BackendError, DesignBackend, FrameResult
+from .pysim_jobs import JobLoop
 from .vcd_trim import trim_vcd
 
 __all__ = ["PysimBackend"]
@@ -139,10 +140,7 @@ class PysimBackend(DesignBackend):
         self._harness = _Harness(self.dut)
         self._sim = Simulator(self._harness)
         self._sim.add_clock(PERIOD, phase=PERIOD / 2)
-        self._started = False  # the testbench is added with the first job (see _start)
-        self._job = None
-        self._outcome = None
-        self._broken = None
+        self._jobs = JobLoop(self._sim, self._run_job, park=PERIOD / 4, error=BackendError)
         self._edges = 0  # rising clock edges the testbench has awaited
         self._recording = None  # the whole-run VCD the requested window is cut from
         self._traced = False  # the requested waveform has been written (or given up)
@@ -161,7 +159,7 @@ class PysimBackend(DesignBackend):
 
     def _run_frame(self, packed, color_sel):
         index = self.frames_processed
-        if not self._started:
+        if not self._jobs.started:
             self._start()
         recording = self._recording
         if recording is not None and recording.start is None and self.waveform.covers(index):
@@ -182,34 +180,12 @@ class PysimBackend(DesignBackend):
         testbench."""
         if self.waveform is not None and not self._traced:
             self._recording = _Recording(self._sim, self.waveform.path)
-        # Added lazily: Amaranth creates the coroutine right away, and a backend that never
-        # ran would otherwise warn about a coroutine never awaited.
-        self._sim.add_testbench(self._testbench)
-        self._started = True
+        self._jobs.start()
 
     def _submit(self, job):
-        if self._broken is not None:
-            raise BackendError(
-                f"the pysim simulation failed earlier ({self._broken}); create a new backend"
-            )
-        if not self._started:
+        if not self._jobs.started:
             self._start()
-        self._job = job
-        self._outcome = None
-        advance = self._sim.advance
-        try:
-            while self._job is not None:
-                advance()
-        except BackendError:
-            raise
-        except Exception as exc:  # a failure inside the simulator leaves it unusable
-            self._broken = f"{type(exc).__name__}: {exc}"
-            self._job = None
-            raise BackendError(f"pysim simulation failed: {self._broken}") from exc
-        outcome, self._outcome = self._outcome, None
-        if isinstance(outcome, BaseException):
-            raise outcome
-        return outcome
+        return self._jobs.submit(job)
 
     def _finish_trace(self):
         """Stop recording; write the window to the requested path if it has begun."""
@@ -220,24 +196,14 @@ class PysimBackend(DesignBackend):
 
     # --- simulation side (runs inside the simulator) -----------------------------------------
 
-    async def _testbench(self, ctx):
-        while True:
-            job = self._job
-            try:
-                if job[0] == "reset":
-                    ctx.set(self._harness.rst, 1)
-                    await self._ticks(ctx, 1)
-                    ctx.set(self._harness.rst, 0)
-                    self._color_sel = None
-                    outcome = None
-                else:
-                    outcome = await self._frame(ctx, job[1], job[2])
-            except BackendError as exc:
-                outcome = exc
-            self._outcome = outcome
-            self._job = None
-            # Park between two edges until the host hands over the next job.
-            await ctx.delay(PERIOD / 4)
+    async def _run_job(self, ctx, job):
+        if job[0] == "reset":
+            ctx.set(self._harness.rst, 1)
+            await self._ticks(ctx, 1)
+            ctx.set(self._harness.rst, 0)
+            self._color_sel = None
+            return None
+        return await self._frame(ctx, job[1], job[2])
 
     async def _frame(self, ctx, packed, color_sel):
         p = self.params

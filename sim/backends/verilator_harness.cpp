@@ -42,7 +42,13 @@ constexpr bool ONE_EVAL = fr_verilator::remembers_clk<Vfollow_target___024root>:
 constexpr bool ONE_EVAL = false;
 #endif
 
-struct Sim {
+#ifdef FR_TRACE
+struct TraceBase {};  // the tracing members are Sim's own
+#else
+using TraceBase = fr::Untraced;
+#endif
+
+struct Sim : TraceBase {
     static constexpr int evals_per_cycle = ONE_EVAL ? 1 : 2;
     std::unique_ptr<VerilatedContext> context;
     std::unique_ptr<Vfollow_target> top;
@@ -124,12 +130,6 @@ struct Sim {
         if (enabled)
             trace->dump(time);
     }
-#else
-    static constexpr int traced = 0;
-    int trace_open(const char *) { return 2; }
-    void trace_enable(int) {}
-    void trace_close() {}
-    inline void sample() {}
 #endif
 };
 

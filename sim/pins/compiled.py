@@ -6,7 +6,6 @@ per ``run``, ``poke``, ``peek``, ``schedule``, ``watch`` and ``stream_frame``.
 
 import contextlib
 import ctypes
-import hashlib
 import os
 from pathlib import Path
 
@@ -14,7 +13,7 @@ import numpy as np
 
 from ..backends import build_cache
 from ..backends.base import BackendError
-from ..backends.compiled import HARNESS_DIR, BuildPlan
+from ..backends.compiled import HARNESS_DIR
 from ..backends.cxxrtl import CXX_FLAGS as CXXRTL_FLAGS
 from ..backends.cxxrtl_netlist import (
     fast_commit,
@@ -22,6 +21,7 @@ from ..backends.cxxrtl_netlist import (
     with_wire_copies_inlined,
     without_port_copies,
 )
+from ..backends.lifecycle import BuildPlan, bind_library, digest, load_built, read_sources
 from ..backends.toolchain import (
     cxxrtl_include_dir,
     find_compiler,
@@ -32,8 +32,9 @@ from ..backends.toolchain import (
 )
 from ..backends.verilator import CXX_FLAGS as VERILATOR_CXX_FLAGS
 from ..backends.verilator import MAKE_FLAGS, VERILATOR_FLAGS
+from ..backends.verilog_cxxrtl import runtime_include_dir
 from .base import PinError
-from .codegen import cxxrtl_accessors, verilator_accessors
+from .codegen import PIN_WRAPPER, cxxrtl_accessors, verilator_accessors, verilator_wrapper
 from .host import HostPins, capture_error
 
 __all__ = ["CompiledPins", "CxxrtlPins", "VerilatorPins"]
@@ -70,18 +71,16 @@ _ENTRIES = (
 def _sources(*names):
     """``{name: text}`` of harness files of this package or, shared with the frame
     harnesses, of sim/backends."""
-    return {name: ((SOURCE_DIR if (SOURCE_DIR / name).exists() else HARNESS_DIR) / name)
-            .read_text() for name in names}
-
-
-def _digest(text):
-    return hashlib.sha256(text.encode()).hexdigest()
+    return read_sources(names, SOURCE_DIR, HARNESS_DIR)
 
 
 def cxxrtl_plan(source):
-    """The ``BuildPlan`` of a ``PinDesignSource`` with CXXRTL."""
+    """The ``BuildPlan`` of a ``PinDesignSource`` (Amaranth's CXXRTL output) or a
+    ``VerilogPinSource`` (its files read by Yosys) with CXXRTL."""
     compiler = find_compiler()
-    include = cxxrtl_include_dir()
+    foreign = hasattr(source, "verilog_files")
+    # Each model compiles against the runtime headers of the Yosys that wrote it.
+    include = runtime_include_dir() if foreign else cxxrtl_include_dir()
     model = source.cxxrtl
     outputs = [p.name for p in source.ports.values() if p.direction == "out"]
     exprs = output_sources(model, outputs)
@@ -95,8 +94,8 @@ def cxxrtl_plan(source):
         "flow": "pins-cxxrtl",
         "abi": ABI_VERSION,
         "design": source.key,
-        "source": _digest(model + accessors),
-        "harness": {name: _digest(text) for name, text in harness.items()},
+        "source": digest(model + accessors),
+        "harness": {name: digest(text) for name, text in harness.items()},
         "flags": flags,
         "compiler": compiler.version,
         "runtime": str(include),
@@ -124,12 +123,14 @@ def verilator_plan(source):
     if hasattr(source, "verilog_files"):  # a foreign Verilog design
         files, compiled = source.verilog_files()
         top, registered = source.verilog_top, source.registered_outputs
-        text = "".join(f"{name}\0{body}\0" for name, body in files.items())
     else:
-        text = source.verilog
-        files, compiled = {"follow_target.v": text}, ["follow_target.v"]
+        files, compiled = {"follow_target.v": source.verilog}, ["follow_target.v"]
         top = "follow_target"
         registered = output_sources(source.cxxrtl, outputs) is not None
+    # The model's top is a wrapper whose ports are numbered: any port name builds.
+    files = {**files, "fr_pin_top.v": verilator_wrapper(source, top)}
+    compiled = [*compiled, "fr_pin_top.v"]
+    text = "".join(f"{name}\0{body}\0" for name, body in files.items())
     accessors = verilator_accessors(source, registered)
     harness = _sources("pin_verilator.cpp", _DRIVER, "verilator_clock.h")
     cflags = " ".join(VERILATOR_CXX_FLAGS)
@@ -138,8 +139,8 @@ def verilator_plan(source):
         "flow": "pins-verilator",
         "abi": ABI_VERSION,
         "design": source.key,
-        "source": _digest(text + accessors),
-        "harness": {name: _digest(text) for name, text in harness.items()},
+        "source": digest(text + accessors),
+        "harness": {name: digest(text) for name, text in harness.items()},
         "flags": [*VERILATOR_FLAGS, cflags, *MAKE_FLAGS],
         "compiler": compiler.version,
         "verilator": verilator_version(),
@@ -156,7 +157,7 @@ def verilator_plan(source):
         env = dict(os.environ, VERILATOR_ROOT=str(root))
         make_flags = [*MAKE_FLAGS, f"CXX={compiler.path}", f"LINK={compiler.path}"]
         run_tool([root / "bin" / "verilator", *VERILATOR_FLAGS, "-j", jobs,
-                  "--top-module", top, "--prefix", "Vfollow_target", f"-I{directory / 'src'}",
+                  "--top-module", PIN_WRAPPER, "--prefix", "Vfollow_target", f"-I{directory / 'src'}",
                   "--Mdir", directory / "obj",
                   "-CFLAGS", f"{cflags} -I{directory}", "-LDFLAGS", "-shared",
                   "-MAKEFLAGS", " ".join(make_flags), "-o", directory / LIBRARY_NAME,
@@ -168,18 +169,8 @@ def verilator_plan(source):
 
 
 def _load(path):
-    try:
-        lib = ctypes.CDLL(str(path))
-    except OSError as exc:
-        raise PinError(f"cannot load the compiled pin model {path}: {exc}") from None
-    for name, restype, argtypes in _ENTRIES:
-        fn = getattr(lib, name, None)
-        if fn is None:
-            raise PinError(f"the compiled pin model {path} lacks {name}()")
-        fn.restype, fn.argtypes = restype, argtypes
-    if lib.pin_abi_version() != ABI_VERSION:
-        raise PinError(f"the compiled pin model {path} has an unexpected ABI")
-    return lib
+    return bind_library(path, _ENTRIES, what="compiled pin model", abi_entry="pin_abi_version",
+                        abi=ABI_VERSION, error=PinError)
 
 
 def _address(array):
@@ -218,17 +209,9 @@ class CompiledPins(HostPins):
         self.evals_per_cycle = self._lib.pin_evals_per_cycle()
 
     def _build_and_load(self):
-        for attempt in range(2):
-            entry = build_cache.get_or_build(*type(self).plan(self.source),
-                                             on_build=self._notice)
-            self.cache_entry = entry
-            try:
-                return _load(entry.file(LIBRARY_NAME))
-            except PinError:
-                if attempt or entry.built:
-                    raise
-                build_cache.invalidate(entry)
-        raise AssertionError("unreachable")
+        self.cache_entry, lib = load_built(type(self).plan(self.source), LIBRARY_NAME, _load,
+                                           on_build=self._notice, error=PinError)
+        return lib
 
     def _notice(self):
         if self._on_build is not None:

