@@ -194,8 +194,8 @@ def _stage_images(folder):
     import numpy as np
 
     from fpga_robotics.sim.camera.sensor import OV7670Params
-    from fpga_robotics.sim.files import check_output_dir, write_atomic
     from fpga_robotics.sim.camera.sensor.figure import stage_images
+    from fpga_robotics.sim.files import check_output_dir, write_atomic
 
     folder = check_output_dir(folder, what="--stage-images folder")
     rgb = CameraRenderer(160, 120, 1.047).render(typical_scene(),

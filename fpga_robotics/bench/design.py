@@ -19,8 +19,8 @@ import numpy as np
 from fpga_robotics.bench import scaffold
 from fpga_robotics.cli.errors import UsageError
 from fpga_robotics.hw.params import FollowTargetParams
-from fpga_robotics.sim.camera import synthetic
 from fpga_robotics.sim.backends import BACKEND_NAMES, COMPILED_BACKENDS, BackendError, get_backend
+from fpga_robotics.sim.camera import synthetic
 
 __all__ = ["main", "measure", "measure_paired", "parse_resolutions"]
 

@@ -1,23 +1,24 @@
-"""``python -m fpga_robotics.bench.foreign``: the exported ``follow_target`` run as a
+"""``fpga-robotics bench foreign``: the exported ``follow_target`` run as a
 foreign Verilog design (through a stream port map) against the built-in verilator backend,
 milliseconds per frame on the same frames. Both build once into the cache; the first run
 compiles for a minute or so.
 """
 
-import argparse
 import sys
 import tempfile
 import time
 from pathlib import Path
 
+from fpga_robotics.bench import scaffold
 from fpga_robotics.hw.params import FollowTargetParams
 from fpga_robotics.hw.verilog import generate_verilog
-from fpga_robotics.sim.camera import synthetic
 from fpga_robotics.sim.backends import get_backend
 from fpga_robotics.sim.backends.foreign import ForeignVerilatorBackend
 from fpga_robotics.sim.backends.port_map import follow_target_port_map
+from fpga_robotics.sim.camera import synthetic
 
 __all__ = ["main"]
+
 
 def _ms_per_frame(backend, frames, repeats):
     backend.process_frame(frames[0])  # warm-up
@@ -30,14 +31,7 @@ def _ms_per_frame(backend, frames, repeats):
     return best * 1e3
 
 
-def main(argv=None):
-    parser = argparse.ArgumentParser(prog="python -m fpga_robotics.bench.foreign",
-                                     description=__doc__.split("\n\n")[0])
-    parser.add_argument("--frames", type=int, default=20, help="frames per repeat (default 20)")
-    parser.add_argument("--repeats", type=int, default=3, help="best of N (default 3)")
-    args = parser.parse_args(argv)
-    if args.frames < 1 or args.repeats < 1:
-        parser.error("--frames and --repeats must be >= 1")
+def run(args):
     params = FollowTargetParams(width=160, height=120)
     frames = synthetic.scenario("sweep", 160, 120, n_frames=args.frames, rng=1).frames
 
@@ -60,8 +54,8 @@ def main(argv=None):
     print(f"  verilator (built-in)          {ms_builtin:7.3f} ms/frame")
     print(f"  foreign follow_target (stream) {ms_foreign:6.3f} ms/frame  "
           f"({ms_foreign / ms_builtin:.2f}x the built-in)")
-    return 0
+    return {"builtin_ms": ms_builtin, "foreign_ms": ms_foreign,
+            "foreign_over_builtin": ms_foreign / ms_builtin}
 
 
-if __name__ == "__main__":
-    sys.exit(main())
+main = scaffold.command(run, __doc__, name="foreign", repeats=3, frames=20)

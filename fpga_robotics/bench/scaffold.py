@@ -193,17 +193,19 @@ def _label(item, index):
     return " ".join(parts) or str(index)
 
 
-def absolute_times(figures, prefix=""):
+def absolute_times(figures, prefix="", in_ms=False):
     """``(name, ms)`` of every entry whose key says milliseconds (``frame_ms``,
-    ``ms_per_frame``); nested dicts and lists walked, a ``Spread`` by its median."""
+    ``ms_per_frame``, or every number under a ``steps_ms`` dict); nested dicts and lists
+    walked, a ``Spread`` by its median."""
     out = []
     items = (figures.items() if isinstance(figures, dict)
              else ((_label(v, i), v) for i, v in enumerate(figures)))
     for key, value in items:
         name = f"{prefix}{key}"
+        is_ms = in_ms or bool(_MS_KEY.search(str(key)))
         if isinstance(value, (dict, list, tuple)):
-            out += absolute_times(value, f"{name}.")
-        elif _MS_KEY.search(str(key)) and isinstance(value, (int, float, Spread)) \
+            out += absolute_times(value, f"{name}.", is_ms and isinstance(value, dict))
+        elif is_ms and isinstance(value, (int, float, Spread)) \
                 and not isinstance(value, bool):
             out.append((name, value.median if isinstance(value, Spread) else float(value)))
     return out

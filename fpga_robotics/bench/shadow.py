@@ -7,12 +7,11 @@ of the run on its own. The figure is the loop's extra time per frame over the sh
 own time per frame (the target: at most 1.1).
 """
 
-import argparse
 import statistics
-import sys
 import time
 
-from fpga_robotics.cli.errors import UsageError, run_cli
+from fpga_robotics.bench import scaffold
+from fpga_robotics.cli.errors import UsageError
 
 __all__ = ["main", "measure"]
 
@@ -45,23 +44,27 @@ def measure(scenario, backend, shadow_params, repeats):
     return statistics.median(alone), statistics.median(shadowed), statistics.median(own)
 
 
-def main(argv=None, prog="fpga-robotics bench shadow"):
-    from fpga_robotics.cli.run import _shadow_params
-    from fpga_robotics.scenario.load import load_scenario
+def _options(p):
     from fpga_robotics.sim.backends import BACKEND_NAMES
 
-    p = argparse.ArgumentParser(prog=prog, description=__doc__)
     p.add_argument("--scenario", default="follow_person")
     p.add_argument("--shadow", default="diff_min=5", metavar="SPEC",
                    help="the shadow design, as run --shadow takes it (default diff_min=5)")
     p.add_argument("--backend", default="auto", choices=("auto", *BACKEND_NAMES))
     p.add_argument("--duration", type=float, default=10.0, help="simulated seconds a run")
-    p.add_argument("--repeats", type=int, default=3, help="turns of each (default 3)")
-    args = p.parse_args(argv)
-    if not 1 <= args.repeats <= 100:
-        raise UsageError(f"--repeats must be in 1..100, got {args.repeats}")
+
+
+def _check(args):
+    if not args.repeats <= 100:
+        raise UsageError(f"--repeats must be 1..100, got {args.repeats}")
     if not 0 < args.duration <= 600:
         raise UsageError(f"--duration must be in (0, 600] s, got {args.duration}")
+
+
+def run(args):
+    from fpga_robotics.cli.run import _shadow_params
+    from fpga_robotics.scenario.load import load_scenario
+
     scenario = load_scenario(args.scenario, [f"sim.duration={args.duration!r}"])
     shadow_params = _shadow_params(scenario, args.shadow)
     alone, shadowed, own = measure(scenario, args.backend, shadow_params, args.repeats)
@@ -72,8 +75,8 @@ def main(argv=None, prog="fpga-robotics bench shadow"):
     print(f"  closed loop with the shadow {shadowed:8.3f}")
     print(f"  shadow design on its own    {own:8.3f}")
     print(f"  extra per frame / own time  {extra / own:8.2f}  (target <= 1.10)")
-    return 0
+    return {"alone_ms": alone, "shadowed_ms": shadowed, "own_ms": own,
+            "extra_over_own": extra / own}
 
 
-if __name__ == "__main__":
-    run_cli(main, sys.argv[1:], prog="fpga-robotics bench shadow")
+main = scaffold.command(run, __doc__, name="shadow", options=_options, check=_check, repeats=3)
