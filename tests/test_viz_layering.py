@@ -71,7 +71,8 @@ def test_the_moved_commands_still_run_under_their_old_names(tmp_path):
     import subprocess
     import sys
 
-    for module, args in (("fpga_robotics.bench.viewer", ["--help"]), ("fpga_robotics.viz.readback", [])):
+    for module, args in (("fpga_robotics.bench", ["viewer", "--help"]),
+                         ("fpga_robotics.viz.readback", [])):
         proc = subprocess.run(
             [sys.executable, "-m", module, *args],
             capture_output=True, text=True, timeout=120, check=False, cwd=tmp_path,
