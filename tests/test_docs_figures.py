@@ -1,0 +1,192 @@
+"""The speed ratios the documentation quotes, re-measured.
+
+Absolute speeds do not travel between machines; a ratio of two times measured in one run
+does. The pages write such a figure as ``N.NNx (ratio ±S)``: the ratio and how far a run may
+stray from it. ``FIGURES`` has one entry per quoted ratio: the page, the ratio, its spread,
+the benchmark command that measures it (as the page names it) and what to take from the
+figures that command writes with ``--json``. The fast tests check that every quoted ratio has
+its entry and every entry its quote; the slow one runs the commands and fails when a
+measurement is off by more than the stated spread.
+
+``python tests/test_docs_figures.py`` measures every entry and prints the figures.
+"""
+
+import json
+import re
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parent.parent
+PAGES = ["README.md", *sorted(p.relative_to(ROOT).as_posix() for p in (ROOT / "docs").glob("*.md"))]
+
+#: A quoted ratio: ``1.8x (ratio ±0.4)``.
+QUOTE = re.compile(r"(\d+(?:\.\d+)?)x \(ratio ±(\d+(?:\.\d+)?)\)")
+#: Anything that looks like the start of a quote, to catch a malformed one.
+LOOSE = re.compile(r"\(ratio\b")
+
+
+@dataclass(frozen=True)
+class Figure:
+    page: str
+    ratio: str  # as the page writes it
+    spread: str
+    command: str  # the benchmark command (after ``fpga-robotics bench``)
+    take: object  # figures dict of the command's --json -> the measured ratio
+    what: str
+
+
+def _rows(figures, key):
+    return {(r.get("backend"), r.get("design"), r["width"], r["height"]): r
+            for r in figures[key]}
+
+
+def _verilator_over_cxxrtl(data):
+    rows = _rows(data["figures"], "results")
+    return (rows[("verilator", "follow_target", 160, 120)]["cpu_ms_per_frame"]
+            / rows[("cxxrtl", "follow_target", 160, 120)]["cpu_ms_per_frame"])
+
+
+def _vga_over_qqvga(data):
+    rows = _rows(data["figures"], "results")
+    return (rows[("cxxrtl", "follow_target", 640, 480)]["cpu_ms_per_frame"]
+            / rows[("cxxrtl", "follow_target", 160, 120)]["cpu_ms_per_frame"])
+
+
+def _paired_fraction(data):
+    return data["figures"]["paired"][0]["fraction"]
+
+
+def _pins_over_frames(data):
+    return data["figures"]["backends"][0]["pins_over_frame"]
+
+
+def _pins_real_time(data):
+    return data["figures"]["backends"][0]["pins_mcycles_per_s"] / 50.0
+
+
+def _loop_over_design(data):
+    run = data["figures"]["runs"][0]
+    return run["plain_cpu_ms"] / run["design_alone_cpu_ms"]
+
+
+def _foreign_over_builtin(data):
+    return data["figures"]["foreign_over_builtin"]
+
+
+def _camera_in_calibrations(data):
+    row = data["figures"]["renderer"][0]
+    return row["cpu_ms"] / data["calibration"]["cpu_ms"]["median"]
+
+
+def _camera_vga_over_qqvga(data):
+    small, large = data["figures"]["renderer"]
+    return large["cpu_ms"] / small["cpu_ms"]
+
+
+FIGURES = (
+    Figure("docs/backends.md", "1.9", "0.6",
+           "design --backends cxxrtl,verilator --resolutions 160x120 --no-trivial "
+           "--frames 30 --min-seconds 2",
+           _verilator_over_cxxrtl, "Verilator's CPU time a 160x120 frame over CXXRTL's"),
+    Figure("docs/backends.md", "15", "4",
+           "design --backends cxxrtl --resolutions 160x120,640x480 --no-trivial "
+           "--frames 30 --min-seconds 2",
+           _vga_over_qqvga, "CXXRTL's CPU time a 640x480 frame over a 160x120 one"),
+    Figure("docs/hardware.md", "0.51", "0.1",
+           "design --backends cxxrtl --resolutions 160x120 --frames 30 --min-seconds 2",
+           _paired_fraction, "FollowTarget's cycle rate over the trivial design's, CXXRTL"),
+    Figure("docs/pins.md", "0.9", "0.35",
+           "pins --backends cxxrtl --seconds 0.25 --repeats 3",
+           _pins_over_frames, "CXXRTL: the pin path's cycle rate over the frame path's"),
+    Figure("docs/pins.md", "1.8", "0.9",
+           "pins --backends cxxrtl --seconds 0.25 --repeats 3",
+           _pins_real_time, "CXXRTL's pin path against real time at 50 MHz"),
+    Figure("docs/backends.md", "2.0", "0.6",
+           "loop --backend cxxrtl --resolutions 160x120 --duration 3 --repeats 3",
+           _loop_over_design, "the closed loop's CPU time a frame over the design's alone"),
+    Figure("docs/foreign.md", "1.4", "0.3",
+           "foreign --frames 20 --repeats 3",
+           _foreign_over_builtin, "the exported design as a foreign design over built-in"),
+    Figure("docs/camera.md", "1.2", "0.6",
+           "camera --sizes 160x120 --noise 0 --frames 60 --repeats 3 --calibrate",
+           _camera_in_calibrations, "the renderer's CPU time a 160x120 frame, in calibrations"),
+    Figure("docs/camera.md", "6", "3",
+           "camera --sizes 160x120,640x480 --noise 0 --frames 60 --repeats 3",
+           _camera_vga_over_qqvga, "the renderer's CPU time a 640x480 frame over a 160x120 one"),
+)
+
+
+def quoted(pages=PAGES, root=ROOT):
+    """``(page, line, ratio, spread)`` of every quoted ratio; a malformed quote raises."""
+    found = []
+    for page in pages:
+        for n, line in enumerate((root / page).read_text().split("\n"), 1):
+            quotes = QUOTE.findall(line)
+            if len(LOOSE.findall(line)) != len(quotes):
+                raise AssertionError(f"{page}:{n}: a '(ratio' that is not 'N.Nx (ratio ±S)': "
+                                     f"{line.strip()}")
+            found += [(page, n, ratio, spread) for ratio, spread in quotes]
+    return found
+
+
+def test_every_quoted_ratio_has_an_entry_and_every_entry_a_quote():
+    quotes = quoted()
+    assert quotes, "no quoted ratio in the documentation"
+    in_docs = sorted((page, ratio, spread) for page, _, ratio, spread in quotes)
+    in_table = sorted((f.page, f.ratio, f.spread) for f in FIGURES)
+    missing = [q for q in quotes if (q[0], q[2], q[3]) not in in_table]
+    assert not missing, f"quoted ratios without an entry in FIGURES: {missing}"
+    assert in_docs == in_table, "FIGURES has entries that no page quotes (or quotes twice)"
+
+
+def test_the_quote_pattern(tmp_path):
+    (tmp_path / "a.md").write_text("runs at 1.8x (ratio ±0.4) real time; 0.51x (ratio ±0.1).\n"
+                                   "took 3 ms.\n")
+    assert quoted(["a.md"], tmp_path) == [("a.md", 1, "1.8", "0.4"), ("a.md", 1, "0.51", "0.1")]
+    (tmp_path / "b.md").write_text("runs at 1.8 times (ratio 0.4) real time\n")
+    with pytest.raises(AssertionError, match="b.md:1"):
+        quoted(["b.md"], tmp_path)
+
+
+def test_every_command_is_a_benchmark_with_its_options():
+    from fpga_robotics.cli import BENCHMARKS
+
+    for f in FIGURES:
+        assert f.command.split()[0] in BENCHMARKS, f.command
+
+
+def measure(figure, folder):
+    """Run ``fpga-robotics bench COMMAND --json`` in this process; the ratio it gives."""
+    from fpga_robotics.cli import BENCHMARKS, _call
+
+    what, *argv = figure.command.split()
+    path = Path(folder) / f"{what}.json"
+    with pytest.raises(SystemExit) as exit_:
+        _call(BENCHMARKS[what][0], [*argv, "--json", str(path)], f"fpga-robotics bench {what}")
+    assert exit_.value.code == 0, figure.command
+    return figure.take(json.loads(path.read_text()))
+
+
+@pytest.mark.slow
+@pytest.mark.timeout(900)
+@pytest.mark.parametrize("figure", FIGURES, ids=lambda f: f"{f.page}:{f.ratio}x")
+def test_quoted_ratio_measures_within_its_spread(figure, tmp_path):
+    measured = measure(figure, tmp_path)
+    assert abs(measured - float(figure.ratio)) <= float(figure.spread), (
+        f"{figure.page}: {figure.what}: quoted {figure.ratio}x ±{figure.spread}, "
+        f"measured {measured:.3f}x (fpga-robotics bench {figure.command})")
+
+
+if __name__ == "__main__":
+    import tempfile
+
+    with tempfile.TemporaryDirectory() as tmp:
+        for f in FIGURES:
+            if len(sys.argv) > 1 and not any(a in f.command or a in f.page for a in sys.argv[1:]):
+                continue
+            value = measure(f, tmp)
+            print(f"RESULT {f.page}: {f.what}: quoted {f.ratio} ±{f.spread}, measured "
+                  f"{value:.3f}", file=sys.stderr, flush=True)
