@@ -746,15 +746,16 @@ PLANS = {
 }
 
 
+def _is_design_bench(cmd):
+    """``bench`` of the design backends (the default benchmark), not another subject's."""
+    words = cmd.split()
+    subject = words[2] if words[0] == "fpga-robotics" and len(words) > 2 else ""
+    return not subject or subject.startswith("-") or subject == "design"
+
+
 def _is(cmd, module, sub):
     return cmd.startswith((f"python -m fpga_robotics.{module} ", f"fpga-robotics {sub} ")) \
         or cmd in (f"python -m fpga_robotics.{module}", f"fpga-robotics {sub}")
-
-
-def _bench_subject(args):
-    """The benchmark a ``bench`` command runs: its first word after ``bench``, else design."""
-    rest = args[2:] if args[0] == "fpga-robotics" else args[3:]
-    return rest[0] if rest and not rest[0].startswith("-") else "design"
 
 
 def _set_option(args, name, value):
@@ -786,7 +787,7 @@ def effective(doc_text, plan):
             args += ["--rerun", "off"]
         if "--quiet" not in args:
             args.append("--quiet")
-    elif _is(text, "bench", "bench") and _bench_subject(args) == "design":
+    elif _is(text, "bench", "bench") and _is_design_bench(text):
         args = _set_option(_set_option(args, "--frames", "2"), "--min-seconds", "0")
     if plan.collect:
         args += ["--collect-only", "-p", "no:cacheprovider"]

@@ -1,4 +1,4 @@
-"""Coloured floor patches in the raster camera (sim/floor_patches.py): drawn where the
+"""Coloured floor patches in the raster camera (sim/camera/floor_patches.py): drawn where the
 pinhole model puts them, lit as the floor, under the walls and people, noise after them."""
 
 import math

@@ -1,4 +1,4 @@
-"""FollowLine against the Python model (sim/follow_line_model.py) cycle for cycle, the control
+"""FollowLine against the Python model (sim/models/follow_line.py) cycle for cycle, the control
 law's table by hand, its timing, the GoPiGo3's turn radii, and the inverted-polarity
 variant's wrong commands."""
 

@@ -1,4 +1,4 @@
-"""UltrasoundDriver against the Python model (sim/ultrasound_model.py) edge for edge, against
+"""UltrasoundDriver against the Python model (sim/models/ultrasound_driver.py) edge for edge, against
 distances computed by hand, and its seeded variants' wrong readings."""
 
 import numpy as np

@@ -128,10 +128,10 @@ def test_the_checker_sees_an_upward_import(tmp_path):
                     "def f():\n    from ..world import World\n"
                     "if __name__ == '__main__':\n    from ...run import main\n")
     found = imports_of("fpga_robotics.sim.backends.x", path)
-    assert (2, "fpga_robotics.cli.errors") in found
+    assert (2, "fpga_robotics.errors") in found
     assert (4, "fpga_robotics.sim.world") in found
     assert all(t != "fpga_robotics.run" for _, t in found)  # the __main__ alias is exempt
-    assert layer_of("fpga_robotics.cli.errors") > layer_of("fpga_robotics.sim.backends.x")
+    assert layer_of("fpga_robotics.errors") > layer_of("fpga_robotics.sim.backends.x")
 
 
 @pytest.mark.parametrize("needle", ["amaranth._", "_MustUse__", "._engine"])

@@ -1,5 +1,5 @@
 """``max_led_wrong_side_fraction``: the centroid LEDs on the robot point the right way
-(fpga_robotics/summary.py), checked on hand-made trajectories of a 160-pixel-wide image."""
+(fpga_robotics/checks/summary.py), checked on hand-made trajectories of a 160-pixel-wide image."""
 
 import numpy as np
 import pytest

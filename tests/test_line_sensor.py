@@ -1,4 +1,4 @@
-"""KY-033 physics (sim/line_sensor.py): HIGH over a dark line, LOW over the floor, the
+"""KY-033 physics (sim/world/line_sensor.py): HIGH over a dark line, LOW over the floor, the
 threshold, seeded noise, and a robot driven straight across a line of known width: the bit
 is high for width / speed seconds, to within one physics step."""
 

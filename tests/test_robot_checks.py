@@ -1,4 +1,4 @@
-"""The robot-level checks the mutation campaign adds (fpga_robotics/summary.py), each on a
+"""The robot-level checks the mutation campaign adds (fpga_robotics/checks/summary.py), each on a
 hand-made trajectory with the answer computed by hand: ``max_led_misplaced_fraction`` (the
 lit LED is the one above the target), ``max_wheel_command_dps`` (no wheel command beyond a
 limit) and ``max_search_travel_m`` (the robot turns in place while it searches)."""

@@ -1,6 +1,6 @@
 """Story (a) of the paper (docs/stories.md): a wooden divider taken for the red target. The
 check ``max_off_target_fraction`` compares the design's centroid with the target's image
-column, ``W/2 - f tan(bearing)`` with ``f = (W/2) / tan(hfov/2)`` (sim/camera.py)."""
+column, ``W/2 - f tan(bearing)`` with ``f = (W/2) / tan(hfov/2)`` (sim/camera/raster.py)."""
 
 import math
 from types import SimpleNamespace

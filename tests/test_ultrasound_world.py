@@ -1,4 +1,4 @@
-"""HC-SR04 physics (sim/ultrasound.py) against distances and echo widths computed by hand:
+"""HC-SR04 physics (sim/world/ultrasound.py) against distances and echo widths computed by hand:
 the cone, the beam's height, the range limits, the module's timing (time-out, short and busy
 triggers) and the speed of sound's temperature."""
 

@@ -67,17 +67,16 @@ def test_viz_never_prints(source):
             assert getattr(node.value, "id", None) != "sys", f"{source.name}:{node.lineno}"
 
 
-def test_the_moved_commands_still_run_under_their_old_names(tmp_path):
+def test_the_viewer_commands_run_from_the_application(tmp_path):
     import subprocess
     import sys
 
-    for module, args in (("fpga_robotics.bench", ["viewer", "--help"]),
-                         ("fpga_robotics.viz.readback", [])):
+    for args in (["bench", "viewer", "--help"], ["readback"]):
         proc = subprocess.run(
-            [sys.executable, "-m", module, *args],
+            [sys.executable, "-m", "fpga_robotics", *args],
             capture_output=True, text=True, timeout=120, check=False, cwd=tmp_path,
         )
-        if module.endswith("bench"):
+        if args[0] == "bench":
             assert proc.returncode == 0 and "--frames" in proc.stdout, proc.stderr
         else:  # a usage error: one line, exit 2
             assert proc.returncode == 2 and "usage:" in proc.stderr, proc.stderr

@@ -1,6 +1,6 @@
 """Read a saved recording back (tests, checks) and summarise it.
 
-``python -m fpga_robotics.viz.readback FILE.rrd`` prints the summary (the command itself is
+``fpga-robotics readback FILE.rrd`` prints the summary (the command itself is
 ``fpga_robotics.cli.readback``, the application layer).
 
 Built on ``rerun.chunk.RrdReader``. Every temporal row of an entity is returned with its

@@ -1,4 +1,4 @@
-"""``python -m fpga_robotics.cli.readback FILE.rrd`` (or ``python -m fpga_robotics.viz.readback``):
+"""``python -m fpga_robotics.cli.readback FILE.rrd`` (or ``fpga-robotics readback``):
 what a saved recording holds, entity by entity, and its size per frame."""
 
 import sys
@@ -9,7 +9,7 @@ from fpga_robotics.viz.readback import read_rrd, summary_lines
 __all__ = ["main"]
 
 
-def main(argv=None, prog="python -m fpga_robotics.viz.readback"):
+def main(argv=None, prog="fpga-robotics readback"):
     if not argv or len(argv) != 1 or argv[0].startswith("-"):
         raise UsageError(f"usage: {prog} FILE.rrd")
     for line in summary_lines(read_rrd(argv[0]), argv[0]):

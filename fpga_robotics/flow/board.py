@@ -1,6 +1,6 @@
 """Board exports and bitstreams: Verilog + LPF for a board, and the open ECP5 flow.
 
-    python -m fpga_robotics.flow.board --board ulx3s-85f -o build/ulx3s [--bitstream]
+    fpga-robotics board --board ulx3s-85f -o build/ulx3s [--bitstream]
 
 (also reachable as ``python -m fpga_robotics.export --board ulx3s-85f -o DIR [--bitstream]``).
 
@@ -282,7 +282,7 @@ def run_board(args, params, out_dir):
     return 0
 
 
-def main(argv=None, prog="python -m fpga_robotics.flow.board"):
+def main(argv=None, prog="fpga-robotics board"):
     parser = argparse.ArgumentParser(
         prog=prog,
         description="Export a board top (Verilog + LPF) and optionally build its bitstream.",
@@ -301,4 +301,4 @@ def main(argv=None, prog="python -m fpga_robotics.flow.board"):
 
 
 if __name__ == "__main__":
-    run_cli(main, prog="python -m fpga_robotics.flow.board")
+    run_cli(main, prog="fpga-robotics board")

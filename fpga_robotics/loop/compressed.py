@@ -418,7 +418,7 @@ class ClosedLoop:
 def target_column(pose, cam, x, y):
     """The image column (pixels, 0 = left edge) of the centre of a person at ``(x, y)`` seen
     by a camera at ``pose``: ``W/2 - f tan(bearing)``, ``f = (W/2) / tan(hfov/2)`` (image
-    right is the camera's right; sim/camera.py). NaN when the centre is outside the field of
+    right is the camera's right; sim/camera/raster.py). NaN when the centre is outside the field of
     view."""
     bearing = math.atan2(y - pose.y, x - pose.x) - pose.heading
     bearing = (bearing + math.pi) % (2 * math.pi) - math.pi

@@ -16,7 +16,7 @@ import numpy as np
 
 __all__ = ["camera_kernel"]
 
-_SOURCE = Path(__file__).resolve().parent / "camera_kernel.cpp"
+_SOURCE = Path(__file__).resolve().parent / "kernel.cpp"
 _LIBRARY = "libcamera_kernel.so"
 #: No fused multiply-adds and no fast-math: the hits must be numpy's to the last bit.
 _FLAGS = ("-std=c++17", "-O2", "-ffp-contract=off", "-fno-fast-math", "-fPIC",
