@@ -628,6 +628,10 @@ PLANS = {
         Plan(excused="needs the published FPGA-Robotics RTL in /tmp/published, which is not part "
                      "of the project (docs/foreign.md says where it is); "
                      "tests/test_backends_bench.py runs the option's checks"),
+    "fpga-robotics bench calibrate":
+        Plan(shorter=(("--frames", "2"), ("--repeats", "1")),
+             out=(r"calibration: published preset, (cxxrtl|verilator|model), 160x120",
+                  r"(?m)^wall +[\d.]+ +[\d.]+ +[\d.]+$")),
     "fpga-robotics bench loop --backend cxxrtl --duration 10 --repeats 3":
         Plan(shorter=(("--duration", "1"), ("--repeats", "1")),
              out=(r"closed loop 160x120: follow_person, cxxrtl",

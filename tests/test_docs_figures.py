@@ -63,10 +63,6 @@ def _pins_over_frames(data):
     return data["figures"]["backends"][0]["pins_over_frame"]
 
 
-def _pins_real_time(data):
-    return data["figures"]["backends"][0]["pins_mcycles_per_s"] / 50.0
-
-
 def _loop_over_design(data):
     run = data["figures"]["runs"][0]
     return run["plain_cpu_ms"] / run["design_alone_cpu_ms"]
@@ -101,9 +97,6 @@ FIGURES = (
     Figure("docs/pins.md", "0.9", "0.35",
            "pins --backends cxxrtl --seconds 0.25 --repeats 3",
            _pins_over_frames, "CXXRTL: the pin path's cycle rate over the frame path's"),
-    Figure("docs/pins.md", "1.8", "0.9",
-           "pins --backends cxxrtl --seconds 0.25 --repeats 3",
-           _pins_real_time, "CXXRTL's pin path against real time at 50 MHz"),
     Figure("docs/backends.md", "2.0", "0.6",
            "loop --backend cxxrtl --resolutions 160x120 --duration 3 --repeats 3",
            _loop_over_design, "the closed loop's CPU time a frame over the design's alone"),
