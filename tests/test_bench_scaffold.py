@@ -44,6 +44,8 @@ def test_absolute_times_and_their_ratios():
         ("frame_ms", 2.0),
     ]
     assert [r for _, _, r in scaffold.ratios_to(figures, 0.25)] == [2.0, 1.0, 0.5, 8.0]
+    cpu = {"wall_ms": 1.0, "cpu_ms": 1.0}
+    assert [r for _, _, r in scaffold.ratios_to(cpu, 0.5, 0.25)] == [2.0, 4.0]
 
 
 def _command(runs, **kwargs):
@@ -86,12 +88,13 @@ def test_json_holds_the_figures_and_the_machine(tmp_path, capsys):
 def test_calibrate_option_prints_each_time_in_calibration_frames(monkeypatch, tmp_path, capsys):
     reference = {"what": "published preset, test, 160x120", "backend": "test",
                  "frame_ms": scaffold.Spread.of([0.25, 0.2, 0.3]),
-                 "cpu_ms": scaffold.Spread.of([0.25])}
+                 "cpu_ms": scaffold.Spread.of([0.125])}
     monkeypatch.setattr(calibrate, "measure_calibration", lambda **_: reference)
     path = tmp_path / "f.json"
     assert _command([])(["--calibrate", "--json", str(path)]) == 0
     out = capsys.readouterr().out
-    assert "calibration (published preset, test, 160x120): 0.2500 (0.2000-0.3000) ms/frame" in out
+    assert ("calibration (published preset, test, 160x120): 0.2500 (0.2000-0.3000) ms/frame, "
+            "CPU 0.1250 (0.1250-0.1250)") in out
     lines = out.splitlines()
     assert lines[-3].split() == ["figure", "time", "x", "calibration"]
     assert lines[-2].split() == ["frame_ms", "0.5", "ms", "2x"]  # 0.5 ms / 0.25 ms

@@ -211,9 +211,12 @@ def absolute_times(figures, prefix="", in_ms=False):
     return out
 
 
-def ratios_to(figures, reference_ms):
-    """Every absolute time of ``figures`` as a multiple of ``reference_ms``."""
-    return [(name, ms, ms / reference_ms) for name, ms in absolute_times(figures)]
+def ratios_to(figures, reference_ms, cpu_reference_ms=None):
+    """Every absolute time of ``figures`` as a multiple of ``reference_ms``; a CPU time (its
+    name says ``cpu``) of ``cpu_reference_ms`` where given, so that like meets like."""
+    cpu_ref = cpu_reference_ms or reference_ms
+    return [(name, ms, ms / (cpu_ref if "cpu" in name else reference_ms))
+            for name, ms in absolute_times(figures)]
 
 
 def _add_common(parser, repeats, frames, min_seconds):
@@ -283,10 +286,11 @@ def command(run, doc, *, name, options=None, repeats=None, frames=None, min_seco
 
 def print_calibrated(figures, calibration):
     """Each absolute time of ``figures`` next to the same run's calibration frame time."""
-    ref = calibration["frame_ms"].median
-    print(f"calibration ({calibration['what']}): {calibration['frame_ms']:.4f} ms/frame "
-          f"(median, min-max of {calibration['frame_ms'].n}); the times above in calibration "
-          f"frames:")
-    rows = [(name, f"{ms:.4g} ms", f"{ratio:.3g}x") for name, ms, ratio in ratios_to(figures, ref)]
+    ref, cpu_ref = calibration["frame_ms"].median, calibration["cpu_ms"].median
+    print(f"calibration ({calibration['what']}): {calibration['frame_ms']:.4f} ms/frame, "
+          f"CPU {calibration['cpu_ms']:.4f} (median, min-max of {calibration['frame_ms'].n}); "
+          f"the times above in calibration frames (CPU times in its CPU time):")
+    rows = [(name, f"{ms:.4g} ms", f"{ratio:.3g}x")
+            for name, ms, ratio in ratios_to(figures, ref, cpu_ref)]
     if rows:
         print_table(("figure", "time", "x calibration"), rows)
