@@ -83,6 +83,24 @@ def _camera_vga_over_qqvga(data):
     return large["cpu_ms"] / small["cpu_ms"]
 
 
+def _shadow_extra_over_own(data):
+    return data["figures"]["extra_over_own"]
+
+
+def _viewer_in_calibrations(data):
+    row = data["figures"]["sizes"][0]
+    return row["caller_cpu_ms"] / data["calibration"]["cpu_ms"]["median"]
+
+
+def _viewer_vga_over_qqvga(data):
+    small, large = data["figures"]["sizes"]
+    return large["caller_cpu_ms"] / small["caller_cpu_ms"]
+
+
+def _bag_in_calibrations(data):
+    return data["figures"]["bag"]["cpu_ms"] / data["calibration"]["cpu_ms"]["median"]
+
+
 FIGURES = (
     Figure("docs/backends.md", "2.7", "0.6",
            "design --backends cxxrtl,verilator --resolutions 160x120 --no-trivial "
@@ -113,6 +131,24 @@ FIGURES = (
     Figure("docs/camera.md", "3.8", "1.5",
            "camera --sizes 160x120,640x480 --noise 0 --frames 60 --repeats 3",
            _camera_vga_over_qqvga, "the renderer's CPU time a 640x480 frame over a 160x120 one"),
+    Figure("docs/running.md", "2.2", "0.8",
+           "loop --backend cxxrtl --resolutions 160x120 --duration 3 --repeats 3",
+           _loop_over_design, "the closed loop's CPU time a frame over the design's alone"),
+    Figure("docs/running.md", "1.35", "0.4",
+           "loop --backend cxxrtl --resolutions 640x480 --duration 3 --repeats 3",
+           _loop_over_design, "the same at 640x480"),
+    Figure("docs/running.md", "1.4", "0.5",
+           "shadow --backend cxxrtl --duration 3 --repeats 3",
+           _shadow_extra_over_own, "what a shadow design adds to a frame over its own time"),
+    Figure("docs/viewer.md", "1.6", "0.5",
+           "viewer --frames 100 --repeats 3 --calibrate",
+           _viewer_in_calibrations, "log_frame's CPU time at 160x120, in calibrations"),
+    Figure("docs/viewer.md", "8", "3",
+           "viewer --frames 100 --repeats 3 --calibrate",
+           _viewer_vga_over_qqvga, "log_frame's CPU time at 640x480 over 160x120"),
+    Figure("docs/ros.md", "1.7", "0.5",
+           "ros --only bag --repeats 3 --calibrate",
+           _bag_in_calibrations, "a bag's CPU time a frame, in calibrations"),
 )
 
 
