@@ -97,6 +97,11 @@ def _viewer_vga_over_qqvga(data):
     return large["caller_cpu_ms"] / small["caller_cpu_ms"]
 
 
+def _model_in_calibrations(data):
+    row = data["figures"]["results"][0]
+    return row["cpu_ms_per_frame"] / data["calibration"]["cpu_ms"]["median"]
+
+
 def _bag_in_calibrations(data):
     return data["figures"]["bag"]["cpu_ms"] / data["calibration"]["cpu_ms"]["median"]
 
@@ -149,6 +154,10 @@ FIGURES = (
     Figure("docs/ros.md", "1.7", "0.5",
            "ros --only bag --repeats 3 --calibrate",
            _bag_in_calibrations, "a bag's CPU time a frame, in calibrations"),
+    Figure("docs/model.md", "0.35", "0.2",
+           "design --backends model --resolutions 160x120 --no-trivial --frames 30 "
+           "--min-seconds 1 --calibrate",
+           _model_in_calibrations, "the model backend's CPU time a 160x120 frame, in calibrations"),
 )
 
 
