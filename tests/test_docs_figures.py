@@ -102,6 +102,10 @@ def _model_in_calibrations(data):
     return row["cpu_ms_per_frame"] / data["calibration"]["cpu_ms"]["median"]
 
 
+def _pysim_in_calibrations(data):
+    return data["figures"]["cpu_ms"] / data["calibration"]["cpu_ms"]["median"]
+
+
 def _bag_in_calibrations(data):
     return data["figures"]["bag"]["cpu_ms"] / data["calibration"]["cpu_ms"]["median"]
 
@@ -158,6 +162,8 @@ FIGURES = (
            "design --backends model --resolutions 160x120 --no-trivial --frames 30 "
            "--min-seconds 1 --calibrate",
            _model_in_calibrations, "the model backend's CPU time a 160x120 frame, in calibrations"),
+    Figure("docs/hardware.md", "2400", "600", "pysim --frames 3 --calibrate",
+           _pysim_in_calibrations, "a pysim frame's CPU time, in calibrations"),
 )
 
 
