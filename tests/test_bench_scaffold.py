@@ -115,3 +115,23 @@ def test_calibration_on_the_model_backend(tmp_path, capsys):
         calibrate.main(["--calibrate"])
     with pytest.raises(UsageError, match="unknown backend 'gpu'"):
         calibrate.main(["--backend", "gpu"])
+
+
+def test_every_benchmark_is_a_subcommand_on_the_scaffold(capsys):
+    import importlib
+    from pathlib import Path
+
+    from fpga_robotics.cli import BENCHMARKS
+
+    for what, (module_name, _help) in BENCHMARKS.items():
+        module = importlib.import_module(module_name)
+        with pytest.raises(SystemExit) as exit_:
+            module.main(["--help"], prog=f"fpga-robotics bench {what}")
+        out = capsys.readouterr().out
+        assert exit_.value.code == 0 and f"usage: fpga-robotics bench {what}" in out
+        assert "--json PATH" in out and "--calibrate" in out, what
+    # The ways in are fpga-robotics bench and python -m fpga_robotics.bench, nothing else.
+    folder = Path(scaffold.__file__).parent
+    own = [p.name for p in folder.glob("*.py")
+           if p.name != "__main__.py" and "if __name__ ==" in p.read_text()]
+    assert not own, f"benchmark modules with a command line of their own: {own}"
