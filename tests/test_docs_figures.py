@@ -22,11 +22,24 @@ import pytest
 ROOT = Path(__file__).resolve().parent.parent
 PAGES = ["README.md", *sorted(p.relative_to(ROOT).as_posix() for p in (ROOT / "docs").glob("*.md"))]
 
-#: A quoted ratio: ``1.8x (ratio ±0.4)``.
-QUOTE = re.compile(r"(\d+(?:\.\d+)?)x \(ratio ±(\d+(?:\.\d+)?)\)")
+#: A quoted ratio: ``1.8x (ratio ±0.4)`` (it may wrap at its spaces).
+QUOTE = re.compile(r"(\d+(?:\.\d+)?)x\s+\(ratio\s+±(\d+(?:\.\d+)?)\)")
 #: Anything that looks like the start of a quote, to catch a malformed one.
 LOOSE = re.compile(r"\(ratio\b")
 CODE = re.compile(r"`[^`]*`")
+FENCE = re.compile(r"^ {0,3}(```|~~~)")
+
+
+def prose(text):
+    """``text`` without its code blocks and code spans (program output and the pattern
+    shown as code quote nothing), line breaks kept so that line numbers stay."""
+    lines, fenced = [], False
+    for line in text.split("\n"):
+        if FENCE.match(line):
+            fenced = not fenced
+            line = ""
+        lines.append("" if fenced else line)
+    return CODE.sub(lambda m: "\n" * m.group().count("\n"), "\n".join(lines))
 
 
 @dataclass(frozen=True)
@@ -106,6 +119,14 @@ def _pysim_in_calibrations(data):
     return data["figures"]["cpu_ms"] / data["calibration"]["cpu_ms"]["median"]
 
 
+def _terrain_in_calibrations(data):
+    return data["figures"]["worlds"][-1]["frame_ms"] / data["calibration"]["frame_ms"]["median"]
+
+
+def _physics_in_calibrations(data):
+    return data["figures"]["worlds"][0]["frame_ms"] / data["calibration"]["frame_ms"]["median"]
+
+
 def _bag_in_calibrations(data):
     return data["figures"]["bag"]["cpu_ms"] / data["calibration"]["cpu_ms"]["median"]
 
@@ -162,6 +183,12 @@ FIGURES = (
            "design --backends model --resolutions 160x120 --no-trivial --frames 30 "
            "--min-seconds 1 --calibrate",
            _model_in_calibrations, "the model backend's CPU time a 160x120 frame, in calibrations"),
+    Figure("docs/scenarios.md", "0.22", "0.1",
+           "world --frames 300 --repeats 3 --calibrate",
+           _terrain_in_calibrations, "terrain lookups and drive noise a frame, in calibrations"),
+    Figure("docs/scenarios.md", "1.2", "0.4",
+           "world --frames 300 --repeats 3 --calibrate",
+           _physics_in_calibrations, "the default world's physics a frame, in calibrations"),
     Figure("docs/hardware.md", "2400", "600", "pysim --frames 3 --calibrate",
            _pysim_in_calibrations, "a pysim frame's CPU time, in calibrations"),
 )
@@ -171,13 +198,15 @@ def quoted(pages=PAGES, root=ROOT):
     """``(page, line, ratio, spread)`` of every quoted ratio; a malformed quote raises."""
     found = []
     for page in pages:
-        for n, line in enumerate((root / page).read_text().split("\n"), 1):
-            line = CODE.sub("", line)  # the pattern shown as code is no quote
-            quotes = QUOTE.findall(line)
-            if len(LOOSE.findall(line)) != len(quotes):
-                raise AssertionError(f"{page}:{n}: a '(ratio' that is not 'N.Nx (ratio ±S)': "
-                                     f"{line.strip()}")
-            found += [(page, n, ratio, spread) for ratio, spread in quotes]
+        text = prose((root / page).read_text())
+        quotes = list(QUOTE.finditer(text))
+        starts = {m.start() for m in quotes}
+        for m in LOOSE.finditer(text):
+            if not any(start < m.start() < start + 12 for start in starts):
+                n = text.count("\n", 0, m.start()) + 1
+                raise AssertionError(f"{page}:{n}: a '(ratio' that is not 'N.Nx (ratio ±S)'")
+        found += [(page, text.count("\n", 0, m.start()) + 1, m.group(1), m.group(2))
+                  for m in quotes]
     return found
 
 
@@ -193,8 +222,11 @@ def test_every_quoted_ratio_has_an_entry_and_every_entry_a_quote():
 
 def test_the_quote_pattern(tmp_path):
     (tmp_path / "a.md").write_text("runs at 1.8x (ratio ±0.4) real time; 0.51x (ratio ±0.1).\n"
-                                   "took 3 ms; written `N.Nx (ratio ±S)`.\n")
-    assert quoted(["a.md"], tmp_path) == [("a.md", 1, "1.8", "0.4"), ("a.md", 1, "0.51", "0.1")]
+                                   "took 3 ms; written `N.Nx (ratio ±S)`; then 2.5x\n"
+                                   "(ratio ±1) over a line break.\n"
+                                   "```\noutput 9.9x (ratio ±1)\n```\n")
+    assert quoted(["a.md"], tmp_path) == [("a.md", 1, "1.8", "0.4"), ("a.md", 1, "0.51", "0.1"),
+                                          ("a.md", 2, "2.5", "1")]
     (tmp_path / "b.md").write_text("runs at 1.8 times (ratio 0.4) real time\n")
     with pytest.raises(AssertionError, match="b.md:1"):
         quoted(["b.md"], tmp_path)
