@@ -167,7 +167,7 @@ FIGURES = (
     Figure("docs/running.md", "1.35", "0.4",
            "loop --backend cxxrtl --resolutions 640x480 --duration 3 --repeats 3",
            _loop_over_design, "the same at 640x480"),
-    Figure("docs/running.md", "1.6", "0.6",
+    Figure("docs/running.md", "1.5", "0.6",
            "shadow --backend cxxrtl --duration 3 --repeats 3",
            _shadow_extra_over_own, "what a shadow design adds to a frame over its own time"),
     Figure("docs/viewer.md", "1.35", "0.5",
@@ -176,7 +176,7 @@ FIGURES = (
     Figure("docs/viewer.md", "9", "3",
            "viewer --frames 100 --repeats 3 --calibrate",
            _viewer_vga_over_qqvga, "log_frame's CPU time at 640x480 over 160x120"),
-    Figure("docs/ros.md", "1.45", "0.5",
+    Figure("docs/ros.md", "1.3", "0.55",
            "ros --only bag --repeats 3 --calibrate",
            _bag_in_calibrations, "a bag's CPU time a frame, in calibrations"),
     Figure("docs/model.md", "0.35", "0.2",
@@ -189,7 +189,7 @@ FIGURES = (
     Figure("docs/scenarios.md", "1.2", "0.4",
            "world --frames 300 --repeats 3 --calibrate",
            _physics_in_calibrations, "the default world's physics a frame, in calibrations"),
-    Figure("docs/hardware.md", "2400", "600", "pysim --frames 3 --calibrate",
+    Figure("docs/hardware.md", "2300", "700", "pysim --frames 3 --calibrate",
            _pysim_in_calibrations, "a pysim frame's CPU time, in calibrations"),
 )
 
