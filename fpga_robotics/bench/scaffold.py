@@ -2,7 +2,7 @@
 
 A subject module declares its own options and its measurement, and gets the rest here::
 
-    main = command(run, __doc__, options=add_options, repeats=5, frames=60)
+    main = command(run, __doc__, name="camera", options=add_options, repeats=5, frames=60)
 
 ``command`` builds ``main(argv, prog)``: the common options (``--repeats``, ``--frames``,
 ``--min-seconds`` where the subject takes them, ``--json PATH`` and ``--calibrate`` always),
@@ -10,7 +10,8 @@ their checks, and bad arguments as ``UsageError`` (one line ``prog: error: ...``
 ``run_cli``). ``run(args)`` prints its figures as it measures and returns them as a dict;
 ``--json`` writes that dict atomically with the machine's description, and ``--calibrate``
 times the calibration design in the same run and prints every absolute time of the dict
-(a key ending in ``_ms``) as a multiple of it: the figure that travels between machines.
+(a key that names milliseconds: ``frame_ms``, ``ms_per_frame``) as a multiple of it: the
+figure that travels between machines.
 """
 
 import argparse
@@ -248,10 +249,6 @@ def _check_common(args):
         check_json_path(args.json)
 
 
-def default_prog(module_name):
-    return f"fpga-robotics bench {module_name.rsplit('.', 1)[-1]}"
-
-
 def command(run, doc, *, name, options=None, repeats=None, frames=None, min_seconds=None,
             check=None):
     """``main(argv=None, prog=...)`` of a benchmark: parse (common options, then the
@@ -273,7 +270,8 @@ def command(run, doc, *, name, options=None, repeats=None, frames=None, min_seco
         if args.calibrate and figures:
             from fpga_robotics.bench.calibrate import measure_calibration
 
-            calibration = measure_calibration(repeats=getattr(args, "repeats", 5) or 5)
+            # At least 3 passes, so that its range means something.
+            calibration = measure_calibration(repeats=max(3, getattr(args, "repeats", 5) or 5))
             print_calibrated(figures, calibration)
         if args.json is not None:
             write_json(args.json, prog, figures or {}, calibration)
