@@ -1,11 +1,11 @@
-"""``python -m fpga_robotics.export``: the same as ``fpga-robotics export``; from Python,
-``generate_verilog(params)`` (``flow/export.py``)."""
+"""``python -m fpga_robotics.export``: the same as ``fpga-robotics export``
+(``cli/export.py``); from Python, ``generate_verilog(params)`` (``flow/export.py``)."""
 
-from fpga_robotics.flow.export import generate_verilog, main
+from fpga_robotics.flow.export import generate_verilog
 
-__all__ = ["generate_verilog", "main"]
+__all__ = ["generate_verilog"]
 
 if __name__ == "__main__":
-    from fpga_robotics.cli.errors import run_cli
+    from fpga_robotics.cli import run_command
 
-    run_cli(main, prog="fpga-robotics export")
+    run_command("export")

@@ -1,10 +1,6 @@
-"""``python -m fpga_robotics.formal``: the same as ``fpga-robotics formal`` (``flow/formal.py``)."""
-
-import sys
-
-from fpga_robotics.flow.formal import main
+"""``python -m fpga_robotics.formal``: the same as ``fpga-robotics formal`` (``cli/formal.py``)."""
 
 if __name__ == "__main__":
-    from fpga_robotics.cli.errors import run_cli
+    from fpga_robotics.cli import run_command
 
-    run_cli(main, sys.argv[1:], prog="fpga-robotics formal")
+    run_command("formal")

@@ -11,6 +11,7 @@ Every value is validated on construction with an error that says what is wrong.
 
 from dataclasses import dataclass, field, fields
 
+from .errors import ParamError
 from .validate import check_int
 
 __all__ = ["DEFAULT_BASE_DPS", "DEFAULT_PROXIMITY_THRESHOLDS", "DEFAULT_STEER_DPS", "PRESETS",
@@ -69,7 +70,7 @@ def preset_values(name, width=160, height=120):
     ``FollowTargetParams`` fields (counts scaled by ``area_scale``). An unknown name raises
     ``ValueError`` listing the known ones."""
     if name not in PRESETS:
-        raise ValueError(f"unknown design preset {name!r}; known presets: {', '.join(PRESETS)}")
+        raise ParamError(f"unknown design preset {name!r}; known presets: {', '.join(PRESETS)}")
     scale = max(1, (width * height) // (160 * 120))
     values = dict(_PUBLISHED)
     values["min_pixels"] *= scale
@@ -181,7 +182,7 @@ class FollowTargetParams:
             raise TypeError(f"{name} must be a string, one of {', '.join(choices)}; "
                             f"got {type(value).__name__} {value!r}")
         if value not in choices:
-            raise ValueError(f"{name} must be one of {', '.join(choices)}; got {value!r}")
+            raise ParamError(f"{name} must be one of {', '.join(choices)}; got {value!r}")
 
     def _check_each(self, name, lo, hi):
         values = getattr(self, name)
@@ -195,15 +196,15 @@ class FollowTargetParams:
         self._check("margin_x", 0)
         self._check("margin_y", 0)
         if self.window_width <= 0:
-            raise ValueError(
+            raise ParamError(
                 f"margin_x={self.margin_x} leaves no window in a frame {self.width} wide"
             )
         if self.window_height <= 0:
-            raise ValueError(
+            raise ParamError(
                 f"margin_y={self.margin_y} leaves no window in a frame {self.height} high"
             )
         if self.window_width % 8:
-            raise ValueError(
+            raise ParamError(
                 f"the window width (width - 2*margin_x = {self.window_width}) must be divisible "
                 f"by 8 so that the 8 bins are equal; adjust width or margin_x"
             )
@@ -211,17 +212,17 @@ class FollowTargetParams:
         max_count = (1 << 32) - 1
         self._check("min_pixels", 1, max_count)
         if len(self.proximity_thresholds) != 7:
-            raise ValueError(
+            raise ParamError(
                 f"proximity_thresholds needs 7 values (levels 1..7), got "
                 f"{len(self.proximity_thresholds)}"
             )
         self._check_each("proximity_thresholds", 0, max_count)
         if list(self.proximity_thresholds) != sorted(self.proximity_thresholds):
-            raise ValueError(
+            raise ParamError(
                 f"proximity_thresholds must be non-decreasing, got {self.proximity_thresholds}"
             )
         if len(self.base_dps) != 8:
-            raise ValueError(
+            raise ParamError(
                 f"base_dps needs 8 values (one per proximity level 0..7), got {len(self.base_dps)}"
             )
         self._check_each("base_dps", _INT16_MIN, _INT16_MAX)
@@ -237,14 +238,14 @@ class FollowTargetParams:
         if self.sx_bits is not None:
             self._check("sx_bits", 1, self.full_sum_x_bits)
         if len(self.steer_dps) != 4:
-            raise ValueError(
+            raise ParamError(
                 f"steer_dps needs 4 values (LED distance 0..3 from the centre), got "
                 f"{len(self.steer_dps)}"
             )
         # Non-negative: the slow wheel moves towards 0 and the result fits 16 bits.
         self._check_each("steer_dps", 0, _INT16_MAX)
         if self.lost_motion == "drive" and self.motor_law != "table":
-            raise ValueError(
+            raise ParamError(
                 "lost_motion='drive' needs motor_law='table' (it drives on with the table's "
                 f"speed and the last LED code), got motor_law={self.motor_law!r}"
             )

@@ -8,6 +8,8 @@ The stream cannot be stalled (``always_ready``): a camera does not wait.
 
 from amaranth.lib import data, stream
 
+from .errors import ParamError
+
 __all__ = [
     "COLOR_SELECT", "RGB444", "FramedPixel", "color_select_value", "pixel_stream_signature",
 ]
@@ -44,9 +46,9 @@ def color_select_value(color):
         try:
             return COLOR_SELECT[color.lower()]
         except KeyError:
-            raise ValueError(
+            raise ParamError(
                 f"unknown colour {color!r}; choose one of: {', '.join(COLOR_SELECT)}"
             ) from None
     if isinstance(color, bool) or not isinstance(color, int) or not 0 <= color <= 7:
-        raise ValueError(f"color_sel must be a colour name or an int 0..7, not {color!r}")
+        raise ParamError(f"color_sel must be a colour name or an int 0..7, not {color!r}")
     return color

@@ -63,6 +63,9 @@ class FollowTargetSafe(CheckedArguments, wiring.Component):
         The interlock holds the wheels at 0.
     """
 
+    #: Which ports the HC-SR04 connector's pins are (the camera and the wheels bind by name).
+    connectors = {"ultrasound": {"trig": "us_trig", "echo": "us_echo"}}
+
     @staticmethod
     def check_arguments(ft_params=None, us_params=None, interlock_params=None):
         for name, value, cls in (("ft_params", ft_params, FollowTargetParams),

@@ -11,6 +11,7 @@ with integer arithmetic so that the models and the gateware agree exactly.
 
 from dataclasses import dataclass, fields, replace
 
+from .errors import ParamError
 from .validate import check_int
 
 __all__ = ["FOLLOW_LINE_PRESETS", "FollowLineParams", "InterlockParams", "UltrasoundParams"]
@@ -79,11 +80,11 @@ class UltrasoundParams(_Params):
         self._check("sound_mm_per_s", 1000, 10_000_000)
         _check_bool("echo_active_high", self.echo_active_high)
         if self.trigger_cycles < 1 or self.wait_cycles < 2:
-            raise ValueError(
+            raise ParamError(
                 f"clock_hz={self.clock_hz} is too slow for trigger_us={self.trigger_us} and "
                 f"wait_us={self.wait_us}: they must last at least 1 and 2 cycles")
         if self.max_echo_cycles < 1:
-            raise ValueError(f"max_range_mm={self.max_range_mm} is shorter than one clock "
+            raise ParamError(f"max_range_mm={self.max_range_mm} is shorter than one clock "
                              f"cycle of echo at clock_hz={self.clock_hz}")
         if self.echo_bits is not None:
             self._check("echo_bits", 1, 64)
@@ -91,12 +92,12 @@ class UltrasoundParams(_Params):
         # echo) ends before the next trigger starts.
         needed = self.trigger_cycles + self.wait_cycles + self.max_echo_cycles + 2
         if self.period_cycles < needed:
-            raise ValueError(
+            raise ParamError(
                 f"period_us={self.period_us} is too short: a measurement takes up to "
                 f"trigger_us + wait_us + the longest echo = {needed} cycles of "
                 f"{self.period_cycles} (lengthen period_us or shorten wait_us/max_range_mm)")
         if self.distance_k < 1:
-            raise ValueError(f"clock_hz={self.clock_hz} is too fast for a distance constant")
+            raise ParamError(f"clock_hz={self.clock_hz} is too fast for a distance constant")
 
     def _cycles(self, us):
         return us * self.clock_hz // 1_000_000
@@ -176,7 +177,7 @@ class InterlockParams(_Params):
         self._check("resume_mm", 1, DISTANCE_NONE - 1)
         _check_bool("release_on_far", self.release_on_far)
         if self.resume_mm < self.stop_mm:
-            raise ValueError(f"resume_mm={self.resume_mm} must be >= stop_mm={self.stop_mm} "
+            raise ParamError(f"resume_mm={self.resume_mm} must be >= stop_mm={self.stop_mm} "
                              "(no overlap of 'stop' and 'resume')")
 
 
@@ -217,19 +218,19 @@ class FollowLineParams(_Params):
         self._check("search_dps", -_INT16_MAX, _INT16_MAX)
         _check_bool("active_high", self.active_high)
         if not isinstance(self.edge_side, str) or self.edge_side not in EDGE_SIDES:
-            raise ValueError(f"edge_side must be one of {', '.join(EDGE_SIDES)}; "
+            raise ParamError(f"edge_side must be one of {', '.join(EDGE_SIDES)}; "
                              f"got {self.edge_side!r}")
         for name in ("gentle_turn_dps", "sharp_turn_dps"):
             turn = getattr(self, name)
             if abs(self.base_dps) + turn > _INT16_MAX:
-                raise ValueError(f"base_dps +- {name} = {abs(self.base_dps) + turn} does not "
+                raise ParamError(f"base_dps +- {name} = {abs(self.base_dps) + turn} does not "
                                  f"fit a signed 16-bit wheel command (max {_INT16_MAX})")
 
     @classmethod
     def preset(cls, name, **changes):
         """Preset ``name`` (``FOLLOW_LINE_PRESETS``) with ``changes`` on top."""
         if name not in FOLLOW_LINE_PRESETS:
-            raise ValueError(f"unknown follow_line preset {name!r}; known presets: "
+            raise ParamError(f"unknown follow_line preset {name!r}; known presets: "
                              f"{', '.join(FOLLOW_LINE_PRESETS)}")
         return cls(**{**FOLLOW_LINE_PRESETS[name][1], **changes})
 

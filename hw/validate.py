@@ -7,20 +7,22 @@ importing gateware.
 
 import numbers
 
+from .errors import ParamError
+
 __all__ = ["CheckedArguments", "check_int"]
 
 
 def check_int(name, value, lo=None, hi=None):
     """Return ``value`` as an ``int`` if it is an integer in ``lo..hi`` (either bound may be
     ``None``); otherwise raise ``TypeError`` (not an integer: bool and float are refused) or
-    ``ValueError`` (out of range), naming ``name`` and the allowed range."""
+    ``ParamError`` (a ``ValueError``: out of range), naming ``name`` and the allowed range."""
     if isinstance(value, bool) or not isinstance(value, numbers.Integral):
         raise TypeError(f"{name} must be an int, not {type(value).__name__} {value!r}")
     value = int(value)
     if lo is not None and value < lo:
-        raise ValueError(f"{name} must be >= {lo}, got {value}")
+        raise ParamError(f"{name} must be >= {lo}, got {value}")
     if hi is not None and value > hi:
-        raise ValueError(f"{name} must be <= {hi}, got {value}")
+        raise ParamError(f"{name} must be <= {hi}, got {value}")
     return value
 
 

@@ -9,6 +9,7 @@ variant's wrong output exactly (the unit tests show it on hand-built inputs).
 from collections.abc import Callable
 from dataclasses import dataclass
 
+from .errors import ParamError
 from .sensor_params import FollowLineParams, InterlockParams, UltrasoundParams
 
 __all__ = ["VARIANTS", "Variant", "variant_params"]
@@ -79,7 +80,7 @@ def variant_params(name, base=None):
     """``base`` (default: the class's defaults) with variant ``name`` applied; an unknown
     name is a ``ValueError`` listing the known ones."""
     if name not in VARIANTS:
-        raise ValueError(f"unknown variant {name!r}; known variants: {', '.join(VARIANTS)}")
+        raise ParamError(f"unknown variant {name!r}; known variants: {', '.join(VARIANTS)}")
     variant = VARIANTS[name]
     base = variant.params_type() if base is None else base
     if not isinstance(base, variant.params_type):

@@ -17,13 +17,15 @@ import tempfile
 from contextlib import contextmanager
 from pathlib import Path
 
+from fpga_robotics.hw.errors import UserError
+
 __all__ = [
     "OutputPathError", "PendingOutput", "atomic_output", "atomic_path", "check_output_dir", "check_output_path",
     "default_file_mode", "write_atomic", "write_json_atomic",
 ]
 
 
-class OutputPathError(ValueError):
+class OutputPathError(UserError, ValueError):
     """An output path that cannot be written; the message names the path and the fix."""
 
 

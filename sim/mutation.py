@@ -21,6 +21,8 @@ from dataclasses import dataclass
 
 from amaranth.back import rtlil
 
+from fpga_robotics.hw.errors import UserError
+
 from ..hw.params import FollowTargetParams
 from ..hw.top import FollowTarget
 from ..hw.verilog import TOP_NAME, verilog_ports
@@ -36,7 +38,7 @@ _PREPARE = ("hierarchy -top {top}", "proc", "flatten", "opt_clean")
 _HW_DIR = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))  # the package root
 
 
-class MutationError(RuntimeError):
+class MutationError(UserError, RuntimeError):
     """Yosys is missing or failed."""
 
 

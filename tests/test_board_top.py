@@ -10,16 +10,16 @@ import sys
 import pytest
 from amaranth.sim import Simulator
 
+from fpga_robotics.cli.board import main
 from fpga_robotics.flow.board import (
     BuildReport,
     ClockTiming,
     export_board,
-    main,
     parse_nextpnr_report,
 )
-from fpga_robotics.cli.errors import UsageError
 from fpga_robotics.hw.board.clocking import ecp5_pll_params
 from fpga_robotics.hw.board.color_select import SwitchColorSelect
+from fpga_robotics.hw.errors import UserError
 from fpga_robotics.hw.pixel import COLOR_SELECT
 
 # The published pin assignment (ulx3s_v20.lpf of the published robot), transcribed here
@@ -104,7 +104,7 @@ def test_unknown_board_lists_supported_ones():
 
 
 def test_board_rejects_other_geometries(tmp_path):
-    with pytest.raises(UsageError, match="160x120"):
+    with pytest.raises(UserError, match="160x120"):
         main(["--board", "ulx3s-85f", "-o", str(tmp_path), "--width", "320", "--height", "240"])
     assert list(tmp_path.iterdir()) == []
 
@@ -122,14 +122,14 @@ def test_report_parsing_and_timing_verdict():
 
 
 def test_export_cli_board_option(tmp_path):
-    from fpga_robotics.flow.export import main as export_main
+    from fpga_robotics.cli.export import main as export_main
 
     assert export_main(["--board", "ulx3s-85f", "-o", str(tmp_path)]) == 0
     assert (tmp_path / "ulx3s_follow_target.v").stat().st_size > 10_000
     assert "LOCATE COMP" in (tmp_path / "ulx3s_follow_target.lpf").read_text()
-    with pytest.raises(UsageError, match="supported boards: ulx3s-85f"):
+    with pytest.raises(UserError, match="supported boards: ulx3s-85f"):
         export_main(["--board", "ulx3s-12f", "-o", str(tmp_path / "x")])
-    with pytest.raises(UsageError, match="--bitstream needs --board"):
+    with pytest.raises(UserError, match="--bitstream needs --board"):
         export_main(["--bitstream"])
 
 

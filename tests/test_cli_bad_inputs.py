@@ -1,13 +1,18 @@
 """Bad command-line input to every subcommand: exit code 2, one line on stderr naming the
-problem, no traceback, and nothing written or replaced (issue: reliability).
+problem, no traceback, nothing written or replaced, and no design model built first.
 
 Each case runs ``fpga-robotics ...`` in-process in an empty working folder that holds only
-what the case prepares; afterwards the folder must hold exactly that again, and a device
-given as an output must still be a device.
+what the case prepares, with no terminal on standard input; afterwards the folder must hold
+exactly that again, and a device given as an output must still be a device. Every output and
+optional dependency is checked before the work: building a model (or any simulator other than
+the numpy model) fails the case.
 """
 
+import io
 import os
+import socket
 import stat
+import sys
 
 import numpy as np
 import pytest
@@ -39,6 +44,8 @@ CASES = [
     ("shadow with an unknown key", ["run", "--shadow", "frob=1"], "design.frob"),
     ("shadow with --source", ["run", "--source", "{frames}", "--shadow", "diff_min=5"],
      "--shadow"),
+    ("video with --source", ["run", "--source", "{frames}", "--save-video", "clip.mp4"],
+     "--save-video"),
     ("target colour without a target", ["run", "--set", "people=[]", "--target-color", "green"],
      "no target"),
     # run: ROS bags in and out, live control (issue 16); {bag} is a ROS 2 bag of two
@@ -52,6 +59,7 @@ CASES = [
     ("bag out over a folder", ["run", "--bag", "{dir}"], "not a ROS 2 bag"),
     ("live with a bad kind", ["run", "--live", "rviz"], "--live"),
     ("live with a bad port", ["run", "--live", "foxglove:99999"], "port"),
+    ("live on a port in use", ["run", "--live", "foxglove:{busyport}"], "cannot serve"),
     ("replay of a missing file", ["run", "--replay-inputs", "nope.json"], "no such file"),
     ("replay of a bad input", ["run", "--replay-inputs", "{file}"], "JSON"),
     ("replay with live", ["run", "--replay-inputs", "{file}", "--live", "foxglove"],
@@ -59,6 +67,16 @@ CASES = [
     ("interactive with source", ["run", "--source", "{frames}", "--interactive"],
      "--interactive"),
     ("paused alone", ["run", "--paused"], "--paused"),
+    ("bag out where nothing can be written", ["run", "--bag", "/proc/bag"], "cannot write"),
+    ("interactive without a terminal", ["run", "--interactive"], "needs a terminal"),
+    # the recording: checked before the design is built
+    ("recording where nothing can be written", ["run", "--rerun", "save:/proc/r.rrd"],
+     "cannot write"),
+    ("recording below a file", ["run", "--rerun", "save:{file}/r.rrd"], "not a folder"),
+    ("recording to a folder", ["run", "--rerun", "save:folder.rrd"], "is a folder"),
+    ("default recording below a file", ["run", "--rerun", "save"], "not a folder"),
+    # a 3D scenario without the realistic extra (MuJoCo not importable)
+    ("3D scenario without the realistic extra", ["run", "--scenario", "divider_3d"], "MuJoCo"),
     # export
     ("export seed without board", ["export", "--seed", "3"], "--seed"),
     ("export bitstream without board", ["export", "--bitstream"], "--board"),
@@ -79,6 +97,12 @@ CASES = [
      "is a folder"),
     ("pysim bench zero frames", ["bench", "pysim", "--frames", "0"], "--frames"),
 ]
+
+
+#: Cases run as if the ``realistic`` extra were not installed.
+WITHOUT_MUJOCO = {"3D scenario without the realistic extra"}
+#: Cases run where ``runs`` (the default recordings' folder) is a file.
+RUNS_IS_A_FILE = {"default recording below a file"}
 
 
 def _snapshot(folder):
@@ -107,8 +131,18 @@ def _float_image_bag(path, n):
     return path
 
 
+@pytest.fixture
+def busy_port():
+    """A port on 127.0.0.1 that something listens on."""
+    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:
+        s.bind(("127.0.0.1", 0))
+        s.listen()
+        yield s.getsockname()[1]
+
+
 @pytest.mark.parametrize("case, argv, word", CASES, ids=[c[0] for c in CASES])
-def test_bad_input_is_one_line_and_exit_2(case, argv, word, tmp_path, monkeypatch, capsys):
+def test_bad_input_is_one_line_and_exit_2(case, argv, word, tmp_path, monkeypatch, capsys,
+                                          busy_port):
     import cv2
 
     (tmp_path / "folder").mkdir()
@@ -119,9 +153,17 @@ def test_bad_input_is_one_line_and_exit_2(case, argv, word, tmp_path, monkeypatc
         cv2.imwrite(str(frames / f"{i}.png"), np.full((12, 16, 3), 40 * i, np.uint8))
     names = {"dir": str(tmp_path / "folder"), "file": str(tmp_path / "file"),
              "frames": str(frames), "bag": str(_float_image_bag(tmp_path / "bag", 2)),
-             "emptybag": str(_float_image_bag(tmp_path / "emptybag", 0))}
+             "emptybag": str(_float_image_bag(tmp_path / "emptybag", 0)),
+             "busyport": str(busy_port)}
     argv = [a.format(**names) for a in argv]
     monkeypatch.chdir(tmp_path)
+    (tmp_path / "folder.rrd").mkdir()
+    if case in RUNS_IS_A_FILE:
+        (tmp_path / "runs").write_text("keep me\n")
+    monkeypatch.setattr(sys, "stdin", io.StringIO())  # no terminal
+    if case in WITHOUT_MUJOCO:
+        monkeypatch.setitem(sys.modules, "mujoco", None)  # `import mujoco` fails
+    builds = _forbid_builds(monkeypatch)
     before = _snapshot(tmp_path)
 
     with pytest.raises(SystemExit) as exit_info:
@@ -137,3 +179,30 @@ def test_bad_input_is_one_line_and_exit_2(case, argv, word, tmp_path, monkeypatc
                                sum("error:" in line for line in lines) == 1), err
     assert _snapshot(tmp_path) == before
     assert stat.S_ISCHR(os.stat("/dev/full").st_mode)
+    assert builds == [], f"a simulator was started before the error: {builds}"
+
+
+def _forbid_builds(monkeypatch):
+    """Record (and refuse) every start of a design simulator but the numpy model's."""
+    from fpga_robotics.loop import compressed, real_clock
+    from fpga_robotics.sim.backends import foreign
+
+    builds = []
+    real_make_backend = compressed.make_backend
+
+    def make_backend(name, *args, **kwargs):
+        if name == "model":
+            return real_make_backend(name, *args, **kwargs)
+        builds.append(("make_backend", name))
+        raise RuntimeError("no simulator may start in a bad-input case")
+
+    def refuse(what):
+        def start(*args, **kwargs):
+            builds.append((what,))
+            raise RuntimeError("no simulator may start in a bad-input case")
+        return start
+
+    monkeypatch.setattr(compressed, "make_backend", make_backend)
+    monkeypatch.setattr(real_clock, "make_pin_backend", refuse("make_pin_backend"))
+    monkeypatch.setattr(foreign, "ForeignVerilatorBackend", refuse("ForeignVerilatorBackend"))
+    return builds

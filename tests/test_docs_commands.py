@@ -474,7 +474,7 @@ PLANS = {
     # docs/foreign.md: your own Verilog design -----------------------------------------------
     "python -m fpga_robotics.export -o follow_target.v":
         Plan(files=("follow_target.v",), out=(r"160x120, module follow_target",)),
-    "python -m fpga_robotics.sim.backends.port_map --example ports.toml":
+    "fpga-robotics ports --example ports.toml":
         Plan(files=("ports.toml",), out=(r"wrote ports\.toml",)),
     "python -m fpga_robotics.run --design verilog:follow_target.v --ports ports.toml":
         Plan(out=(PASS, r"(?m)^backend:? .*verilator-foreign|verilator-foreign")),
@@ -485,8 +485,40 @@ PLANS = {
              duration="keep", duration_why="the page quotes the whole run's 120 000 cycles "
                                            "(12 s at 10 kHz, a twentieth of a second's wall time)",
              out=(PASS, r"\[ok\] max_wall_collisions")),
-    "python -m fpga_robotics.sim.backends.port_map ports.toml":
-        Plan(setup=("python -m fpga_robotics.sim.backends.port_map --example ports.toml",),
+    # docs/your_design.md: your own design, by reference ------------------------------------
+    "fpga-robotics run --scenario wall_stop.toml --rerun off":
+        Plan(setup=(" ".join(["cp", *(str(ROOT / "tests/data/user_designs" / name) for name in (
+                         "wall_stop.py", "wall_stop.toml")), "."]),),
+             duration="keep", duration_why="the page quotes the whole run's stop at the wall "
+                                           "(12 s; about a second of wall time on CXXRTL)",
+             out=(PASS, r"design output distance_mm: last 227, min 218, max 1898",
+                  r"design output stopped: last 1, min 0, max 1")),
+    "fpga-robotics run --scenario wall_stop.toml --shadow wall_stop_v1.py:WallStop --rerun off":
+        Plan(setup=(" ".join(["cp", *(str(ROOT / "tests/data/user_designs" / name) for name in (
+                         "wall_stop.py", "wall_stop.toml")), "."]),
+                    "cp wall_stop.py wall_stop_v1.py"),
+             duration="keep", duration_why="the page quotes the whole run's 360 frames",
+             out=(PASS, r"shadow wall_stop_v1\.py:WallStop: identical outputs on all 360 "
+                        r"frames")),
+    "fpga-robotics designs":
+        Plan(out=(r"follow_target_safe  \(built-in\)",
+                  r"connectors: ultrasound \(trig=us_trig, echo=us_echo\)")),
+    "fpga-robotics designs wall_stop.py:WallStop":
+        Plan(setup=(f"cp {ROOT / 'tests/data/user_designs/wall_stop.py'} .",),
+             out=(r"wall_stop\.py:WallStop  \(Amaranth\)",
+                  r"connectors: wheels \(motor_left=motor_left, motor_right=motor_right\); "
+                  r"ultrasound \(trig=trig, echo=echo\)",
+                  r"recorded outputs: distance_mm, stopped")),
+    ("fpga-robotics run --scenario bump_wall.toml --design verilog:bump_stop_noreset.v --ports "
+     "bump_stop_noreset_ports.toml --rerun off"):
+        Plan(setup=(" ".join(["cp", str(ROOT / "tests/data/bump_wall.toml"), *(
+                         str(ROOT / "tests/data/user_designs" / name) for name in (
+                             "bump_stop_noreset.v", "bump_stop_noreset_ports.toml")), "."]),),
+             duration="keep", duration_why="the bumper closes after about 8 s of the 12 s",
+             out=(PASS, r"design output hit: last 1, min 0, max 1")),
+
+    "fpga-robotics ports ports.toml":
+        Plan(setup=("fpga-robotics ports --example ports.toml",),
              out=(r"ports\.toml: follow_target, outputs found, proximity",)),
     "python -m fpga_robotics.mutation --mutants 200":
         Plan(shorter=(("--mutants", "12"), ("--width", "80"), ("--height", "60")),
@@ -1295,7 +1327,22 @@ def snippet_connectors_own_design(tmp_path, capsys):
         TOPS.pop("bump_stop", None)
 
 
+def snippet_your_design(tmp_path, capsys):
+    """docs/your_design.md: the design file, word for word the one the tests run
+    (tests/data/user_designs/wall_stop.py); defining it builds nothing."""
+    namespace = {"__name__": "wall_stop"}
+    shown = yield namespace
+    assert all(isinstance(text, str) for text in shown)  # only its docstrings
+    from fpga_robotics.designs.reference import component_ports
+
+    component = namespace["WallStop"](stop_mm=100)
+    assert component_ports(component)["distance_mm"] == ("out", 16)
+
+
 SNIPPETS = {
+    ("docs/your_design.md", '"""A design of one\'s own with pin sensors and no camera: drives '
+                            'straight on at ``speed`` DPS'):
+        snippet_your_design,
     ("docs/connectors.md", "from amaranth import Module, Mux, Signal, signed"):
         snippet_connectors_own_design,
     ("docs/pins.md", ("from fpga_robotics.sim.pins import follow_target_source, get_pin_backend, "

@@ -8,7 +8,7 @@ import sys
 
 import pytest
 
-from fpga_robotics.flow.export import main
+from fpga_robotics.cli.export import main
 from fpga_robotics.hw.params import FollowTargetParams
 from fpga_robotics.hw.verilog import generate_verilog
 from fpga_robotics.sim.backends.toolchain import verilator_root

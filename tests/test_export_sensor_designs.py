@@ -11,7 +11,8 @@ import pytest
 from test_export import SPEC_PORTS, verilator_lint
 
 from fpga_robotics.cli.errors import run_cli
-from fpga_robotics.flow.export import generate_top_verilog, main
+from fpga_robotics.cli.export import main
+from fpga_robotics.flow.export import generate_top_verilog
 from fpga_robotics.hw.follow_line import FollowLine
 from fpga_robotics.hw.safe_follow import FollowTargetSafe
 from fpga_robotics.hw.sensor_params import FollowLineParams, UltrasoundParams

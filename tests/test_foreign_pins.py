@@ -161,7 +161,7 @@ BAD_MAPS = [
 
 def _run_cli(argv, capsys):
     with pytest.raises(SystemExit) as exit_info:
-        run_cli(run_main, argv, prog="fpga_robotics.run")
+        run_cli(run_main, argv, prog="fpga-robotics run")
     err = capsys.readouterr().err
     return exit_info.value.code, err
 

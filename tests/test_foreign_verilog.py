@@ -258,7 +258,9 @@ def test_cli_runs_a_foreign_design_in_closed_loop(files, capsys, top, ports):
     [
         (["--ports", "x.toml"], "--ports goes with --design"),
         (["--design", "verilog:a.v"], "--design needs --ports"),
-        (["--design", "vhdl:a.vhd", "--ports", "x.toml"], "--design must be verilog:"),
+        (["--design", "vhdl:a.vhd", "--ports", "x.toml"],
+         "--ports is the port map of a Verilog design: it goes with --design verilog:FILE.v"),
+        (["--design", "vhdl:a.vhd"], "'a.vhd' is not a Python name; write FILE.py:ClassName"),
         (["--design", "verilog:a.v", "--ports", "x.toml", "--backend", "cxxrtl"],
          "runs on the verilator backend"),
         (["--design", "verilog:{dir}/never.v", "--ports", "{dir}/ft.toml"],
@@ -285,7 +287,7 @@ def test_cli_bad_designs_exit_2_with_one_line(files, capsys, argv, message):
     argv = [a.replace("{dir}", str(files)) for a in argv]
     with pytest.raises(SystemExit) as info:
         run_cli(run.main, [*argv, "--resolution", "80x60", "--duration", "0.5", "--rerun",
-                           "off", "--quiet"], prog="fpga_robotics.run")
+                           "off", "--quiet"], prog="fpga-robotics run")
     assert info.value.code == 2
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and message in err, err

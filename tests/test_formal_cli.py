@@ -1,4 +1,4 @@
-"""``python -m fpga_robotics.formal``: its table, its counterexample file, and its one-line
+"""``fpga-robotics formal``: its table, its counterexample file, and its one-line
 errors (a missing tool, an unknown check, a bad depth) with exit code 2."""
 
 import sys
@@ -7,8 +7,9 @@ import pytest
 from mutants import mutant
 
 import fpga_robotics.hw.formal as formal_checks
-from fpga_robotics.flow import formal
+from fpga_robotics.cli import formal as formal_cli
 from fpga_robotics.cli.errors import run_cli
+from fpga_robotics.flow import formal
 from fpga_robotics.hw.formal import CHECKS, FormalCheck, check_named
 from fpga_robotics.hw.formal.sizes import FULL_SIZES
 from fpga_robotics.hw.motor import MotorController
@@ -16,7 +17,7 @@ from fpga_robotics.hw.motor import MotorController
 
 def run(argv, capsys):
     with pytest.raises(SystemExit) as exit_info:
-        run_cli(formal.main, argv, prog="fpga_robotics.formal")
+        run_cli(formal_cli.main, argv, prog="fpga-robotics formal")
     out, err = capsys.readouterr()
     return exit_info.value.code, out, err
 

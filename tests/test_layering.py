@@ -124,14 +124,14 @@ def test_dependencies_point_one_way():
 
 def test_the_checker_sees_an_upward_import(tmp_path):
     path = tmp_path / "x.py"
-    path.write_text("import os\nfrom ...errors import UsageError\n"
+    path.write_text("import os\nfrom ...cli.errors import UsageError\n"
                     "def f():\n    from ..world import World\n"
                     "if __name__ == '__main__':\n    from ...run import main\n")
     found = imports_of("fpga_robotics.sim.backends.x", path)
-    assert (2, "fpga_robotics.errors") in found
+    assert (2, "fpga_robotics.cli.errors") in found
     assert (4, "fpga_robotics.sim.world") in found
     assert all(t != "fpga_robotics.run" for _, t in found)  # the __main__ alias is exempt
-    assert layer_of("fpga_robotics.errors") > layer_of("fpga_robotics.sim.backends.x")
+    assert layer_of("fpga_robotics.cli.errors") > layer_of("fpga_robotics.sim.backends.x")
 
 
 @pytest.mark.parametrize("needle", ["amaranth._", "_MustUse__", "._engine"])

@@ -43,7 +43,8 @@ def test_not_judged_without_found_frames_or_without_the_leds():
     m = compute_metrics(_traj([120, 30], [0b1, 0b1], found=False), [], {}, 1 / 30, width=W)
     assert m["led_wrong_side_fraction"] is None
     (c,) = evaluate_checks({"max_led_wrong_side_fraction": 0.0}, m)
-    assert c["passed"] and c["text"] == "the target was never found to one side or at the centre"
+    assert c["passed"] is None and c["status"] == "n/a"  # nothing to judge: neither way
+    assert c["text"] == "the target was never found to one side or at the centre"
     # A design without the LEDs: not measured (docs/foreign.md).
     traj = _traj([120], [0])
     traj["centroid_leds"] = np.full(1, np.nan)

@@ -248,7 +248,7 @@ def test_every_shipped_scenario_passes_with_the_default_design(name):
 def test_the_steering_gain_grows_with_the_resolution():
     """``kp_num`` is DPS per pixel of centroid error: at 320x240 a radian of error is twice
     the pixels, so the robot turns twice as hard and keeps up with the person who escapes
-    it at 160x120 (lost_target then fails: the loss it is meant to test never happens)."""
+    it at 160x120 (lost_target then judges its search n/a: the loss it is meant to test never happens)."""
     low = run_scenario(load_scenario("lost_target", ["sim.duration=6"]), backend="model")
     high = run_scenario(load_scenario("lost_target", ["sim.duration=6",
                                                       'camera.resolution="320x240"']),

@@ -6,11 +6,11 @@ import pytest
 from test_export import verilator_lint
 
 from fpga_robotics.cli.errors import run_cli
-from fpga_robotics.flow.export import main as export_main
+from fpga_robotics.cli.export import main as export_main
+from fpga_robotics.cli.run import main as run_main
 from fpga_robotics.hw.params import PRESETS, FollowTargetParams
 from fpga_robotics.hw.verilog import generate_verilog
 from fpga_robotics.loop.compressed import run_scenario
-from fpga_robotics.cli.run import main as run_main
 from fpga_robotics.scenario.load import ScenarioError, load_scenario
 from fpga_robotics.sim.backends import get_backend
 

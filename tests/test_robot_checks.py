@@ -1,5 +1,5 @@
-"""The robot-level checks the mutation campaign adds (fpga_robotics/checks/summary.py), each on a
-hand-made trajectory with the answer computed by hand: ``max_led_misplaced_fraction`` (the
+"""The robot-level checks the mutation campaign adds (fpga_robotics/checks/shipped.py), each
+on a hand-made trajectory with the answer computed by hand: ``max_led_misplaced_fraction`` (the
 lit LED is the one above the target), ``max_wheel_command_dps`` (no wheel command beyond a
 limit) and ``max_search_travel_m`` (the robot turns in place while it searches)."""
 
@@ -76,7 +76,9 @@ def test_leds_not_judged_without_found_frames_or_leds():
     m = compute_metrics(_traj([24, 40], [0, 0], found=False), [], {}, 1 / 30, width=W)
     assert m["led_misplaced_fraction"] is None
     c = _check("max_led_misplaced_fraction", 0.0, m)
-    assert c["passed"] and c["text"] == "the target was never found inside the window"
+    # Nothing to judge: n/a with the reason, neither a pass nor a failure.
+    assert c["status"] == "n/a" and c["passed"] is None
+    assert c["text"] == c["reason"] == "the target was never found inside the window"
     traj = _traj([24], [1])
     traj["centroid_leds"] = np.full(1, np.nan)
     m = compute_metrics(traj, [], {}, 1 / 30, width=W, absent={"centroid_leds"})
@@ -114,10 +116,11 @@ def test_the_robot_travels_little_while_it_searches():
     c = _check("max_search_travel_m", 0.1, m)
     assert not c["passed"] and "travelled 0.15 m during a search" in c["text"]
     assert _check("max_search_travel_m", 0.2, m)["passed"]
-    # Never searched: nothing to judge, the check passes.
+    # Never searched: nothing to judge, the check is n/a.
     m = compute_metrics(traj, events[:1], {}, 1 / 30, width=W)
     assert m["search_travel_m"] is None
-    assert _check("max_search_travel_m", 0.1, m)["text"] == "the design never searched"
+    c = _check("max_search_travel_m", 0.1, m)
+    assert c["text"] == "the design never searched" and c["status"] == "n/a"
 
 
 def test_the_new_checks_are_declared_with_their_outputs():

@@ -17,7 +17,7 @@ def test_recorded_runs_are_written_as_bags(tmp_path, capsys):
     out = tmp_path / "out"
     with pytest.raises(SystemExit) as info:
         run_cli(main, [str(campaign), "--out", str(out), "--workers", "1", "--record", "all",
-                       "--bag", "--quiet"], prog="fpga_robotics.sweep")
+                       "--bag", "--quiet"], prog="fpga-robotics sweep")
     assert info.value.code in (0, 1), capsys.readouterr().err  # 1: a run failed its checks
     rows = [json.loads(line) for line in (out / "results.jsonl").read_text().splitlines()]
     assert len(rows) == 2 and {r["status"] for r in rows} <= {"pass", "fail"}
@@ -33,6 +33,6 @@ def test_bag_needs_recorded_runs(tmp_path, capsys):
     campaign = tmp_path / "tiny.toml"
     campaign.write_text('scenarios = ["follow_person"]\n')
     with pytest.raises(SystemExit) as info:
-        run_cli(main, [str(campaign), "--record", "none", "--bag"], prog="fpga_robotics.sweep")
+        run_cli(main, [str(campaign), "--record", "none", "--bag"], prog="fpga-robotics sweep")
     assert info.value.code == 2
     assert "--bag writes the recorded runs as ROS 2 bags" in capsys.readouterr().err

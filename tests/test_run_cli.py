@@ -20,7 +20,7 @@ REQUIRED = (
 def run(argv, capsys):
     """Call the CLI as ``python -m`` does; return (exit code, stdout, stderr)."""
     with pytest.raises(SystemExit) as info:
-        run_cli(main, argv, prog="fpga_robotics.run")
+        run_cli(main, argv, prog="fpga-robotics run")
     out, err = capsys.readouterr()
     return info.value.code, out, err
 
@@ -139,7 +139,7 @@ def test_module_entry_point_prints_one_line_and_exits_2():
         capture_output=True, text=True, timeout=120, check=False,
     )
     assert proc.returncode == 2
-    assert proc.stderr.startswith("fpga_robotics.run: error: unknown scenario 'nope'")
+    assert proc.stderr.startswith("fpga-robotics run: error: unknown scenario 'nope'")
     assert "Traceback" not in proc.stderr
 
 

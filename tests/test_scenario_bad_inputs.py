@@ -152,7 +152,7 @@ CASES = [
 
 def run(argv, capsys):
     with pytest.raises(SystemExit) as exc:
-        run_cli(main, argv, prog="fpga_robotics.run")
+        run_cli(main, argv, prog="fpga-robotics run")
     out, err = capsys.readouterr()
     return exc.value.code, out, err
 
@@ -179,7 +179,7 @@ def test_bad_input_is_one_line_exit_2_and_leaves_nothing(args, expect, tmp_path,
     assert (code, out) == (2, ""), err
     lines = err.splitlines()
     assert len(lines) == 1, err
-    assert lines[0].startswith("fpga_robotics.run: error: "), lines[0]
+    assert lines[0].startswith("fpga-robotics run: error: "), lines[0]
     assert expect in lines[0]
     assert "Traceback" not in err
     assert files_under(tmp_path) == before

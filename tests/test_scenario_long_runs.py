@@ -34,7 +34,11 @@ def test_without_yielding_the_person_walks_into_the_reversing_robot():
     s = load_scenario("follow_person", ["sim.duration=60", "people.0.yield_gap=0"])
     r = run_scenario(s, backend="model")
     assert r.summary["collisions"]["person"] >= 1
-    (frame, _t, _text) = next(e for e in r.events if e[2] == "collision with person 'target'")
+    person = r.summary["collision_summary"]["person"]
+    assert person["episodes"] == r.summary["collisions"]["person"]
+    assert person["contact_s"] > 0 and person["max_impulse_ns"] > 0
+    assert r.summary["robot_at_fault_collisions"] == 0  # it was reversing away
+    (frame, _t, _text) = next(e for e in r.events if e[2].startswith("collision with person 'target'"))
     t = r.trajectory
     reverse = 150 * math.pi / 180 * TURTLEBOT2.wheel_radius  # m/s
     before = slice(frame - 30, frame)  # the second before the contact

@@ -109,10 +109,11 @@ def test_oscillation_counts_sign_changes_of_w_while_centred():
     assert m["max_wheel_command_step_dps"] == 150  # left 100 -> -50
     (c,) = evaluate_checks({"max_oscillation_hz": 1.0}, m)
     assert not c["passed"] and "2.31 times per second" in c["text"]
-    # Never centred: no value, and the check passes.
+    # Never centred: no value, nothing to judge: the check is n/a.
     m = compute_metrics(_traj(w, [10] * 30), [], {}, 1 / 30, width=160)
     assert m["oscillation_hz"] is None
-    assert evaluate_checks({"max_oscillation_hz": 1.0}, m)[0]["passed"]
+    (c,) = evaluate_checks({"max_oscillation_hz": 1.0}, m)
+    assert c["status"] == "n/a" and c["text"] == "the target was never centred"
 
 
 def test_tip_over_check_reads_the_event():

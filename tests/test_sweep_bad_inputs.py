@@ -42,11 +42,11 @@ def test_bad_campaign_file_is_one_line_and_exit_2(case, tmp_path, monkeypatch, c
     (tmp_path / "c.toml").write_text(text)
     monkeypatch.chdir(tmp_path)
     with pytest.raises(SystemExit) as exit_info:
-        run_cli(main, ["c.toml", "--out", "out", "--quiet"], prog="fpga_robotics.sweep")
+        run_cli(main, ["c.toml", "--out", "out", "--quiet"], prog="fpga-robotics sweep")
     assert exit_info.value.code == 2
     captured = capsys.readouterr()
     lines = captured.err.strip().splitlines()
-    assert len(lines) == 1 and lines[0].startswith("fpga_robotics.sweep: error: "), lines
+    assert len(lines) == 1 and lines[0].startswith("fpga-robotics sweep: error: "), lines
     assert message in lines[0] and captured.out == ""
     assert not (tmp_path / "out").exists()
 

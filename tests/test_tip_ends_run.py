@@ -77,7 +77,7 @@ def test_the_cli_reports_the_early_end_and_fails(tmp_path, capsys):
     with pytest.raises(SystemExit) as info:
         run_cli(main, ["--scenario", "erratic", "--backend", "model", "--rerun", "off",
                        "--quiet", "--set", TIPS[0], "--summary", str(path)],
-                prog="fpga_robotics.run")
+                prog="fpga-robotics run")
     out, _ = capsys.readouterr()
     assert info.value.code == 1
     s = json.loads(path.read_text())

@@ -13,7 +13,7 @@ from fpga_robotics.scenario.load import load_scenario
 
 def cli(argv, capsys):
     with pytest.raises(SystemExit) as info:
-        run_cli(main, argv, prog="fpga_robotics.run")
+        run_cli(main, argv, prog="fpga-robotics run")
     out, err = capsys.readouterr()
     return info.value.code, out, err
 

@@ -141,6 +141,29 @@ def test_an_explicit_path_is_replaced_and_the_notice_says_so(tmp_path):
     assert sorted(os.listdir(tmp_path)) == ["mine.rrd"]
 
 
+def test_the_closing_line_names_a_folder_full_of_recordings(tmp_path, monkeypatch):
+    from fpga_robotics.viz import outcome
+
+    monkeypatch.setattr(outcome, "LARGE_FOLDER_BYTES", 3_000_000)
+    runs = tmp_path / "runs"
+    runs.mkdir()
+    (runs / "old.rrd").write_bytes(bytes(2_000_000))
+    (runs / "notes.txt").write_bytes(bytes(5_000_000))  # not a recording: not counted
+    (runs / "sub").mkdir()
+    (runs / "sub" / "deep.rrd").write_bytes(bytes(5_000_000))  # below the folder: not counted
+    rec, msg = record("save", runs / "run.rrd", 3)
+    size = os.path.getsize(rec.path)
+    assert f"({size / 1e6:.1f} MB, " in msg  # the recording's own size
+    assert "holds" not in msg and "--rerun off" not in msg  # 2 MB and a little: not large
+    (runs / ".old.1a2b3c4d.partial.rrd").write_bytes(bytes(1_500_000))  # a killed run's
+    rec, msg = record("save", runs / "run.rrd", 3)
+    assert os.path.basename(rec.path) == "run-2.rrd"
+    held = 2_000_000 + 1_500_000 + size + os.path.getsize(rec.path)
+    assert msg.endswith(f"open it with: rerun {rec.path} "
+                        f"({runs.as_posix()}/ holds {held / 1e6:.0f} MB; "
+                        "--rerun off skips the recording)"), msg
+
+
 def test_a_fallback_file_does_not_replace_either(tmp_path, monkeypatch):
     monkeypatch.delenv("DISPLAY", raising=False)
     monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)

@@ -79,4 +79,6 @@ def test_the_viewer_commands_run_from_the_application(tmp_path):
         if args[0] == "bench":
             assert proc.returncode == 0 and "--frames" in proc.stdout, proc.stderr
         else:  # a usage error: one line, exit 2
-            assert proc.returncode == 2 and "usage:" in proc.stderr, proc.stderr
+            assert proc.returncode == 2, proc.stderr
+            assert proc.stderr.startswith("fpga-robotics readback: error: "), proc.stderr
+            assert proc.stderr.count("\n") == 1, proc.stderr

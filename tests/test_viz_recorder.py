@@ -11,7 +11,6 @@ import cv2
 import numpy as np
 import pytest
 
-from fpga_robotics.cli.errors import UsageError
 from fpga_robotics.cli.readback import main as readback_main
 from fpga_robotics.sim.backends.base import FrameResult
 from fpga_robotics.sim.camera.frames import rgb444_to_rgb888
@@ -19,7 +18,7 @@ from fpga_robotics.sim.records import FrameRecord, PersonState, WorldMap
 from fpga_robotics.viz import ViewerError, open_recorder
 from fpga_robotics.viz import paths as P
 from fpga_robotics.viz.leds import CELL, GAP, cell_centre
-from fpga_robotics.viz.readback import read_rrd
+from fpga_robotics.viz.readback import images, read_rrd
 
 PER_FRAME = [
     P.LEDS_PROXIMITY,
@@ -146,18 +145,32 @@ def test_every_entity_is_there_once_per_frame(saved):
     assert data.entities[P.MAP_FURNITURE].frames == [0]
 
 
-def test_small_frames_are_logged_raw_and_exact(saved):
+def test_small_frames_are_logged_as_png_and_exact(saved):
     _, frames, _, data = saved
-    raw = data.entities[P.CAMERA_RAW]
-    filt = data.entities[P.CAMERA_FILTERED]
+    for path in (P.CAMERA_RAW, P.CAMERA_FILTERED):
+        values = data.entities[path].values
+        assert "Image:buffer" not in values
+        assert single(values["EncodedImage:media_type"]) == ["image/png"] * len(frames)
+        for blob in single(values["EncodedImage:blob"]):
+            assert bytes(blob[:8]) == b"\x89PNG\r\n\x1a\n"  # the PNG signature
+    raw, filt = images(data, P.CAMERA_RAW), images(data, P.CAMERA_FILTERED)
+    assert sorted(raw) == sorted(filt) == list(range(len(frames)))
     for i, f in enumerate(frames):
-        h, w = f.camera_rgb.shape[:2]
-        fmt = single(raw.values["Image:format"])[i]
-        assert (fmt["width"], fmt["height"]) == (w, h)
-        got = single(raw.values["Image:buffer"])[i].reshape(h, w, 3)
-        np.testing.assert_array_equal(got, f.camera_rgb)
-        got_f = single(filt.values["Image:buffer"])[i].reshape(h, w, 3)
-        np.testing.assert_array_equal(got_f, rgb444_to_rgb888(f.result.filtered))
+        np.testing.assert_array_equal(raw[i], f.camera_rgb)
+        np.testing.assert_array_equal(filt[i], rgb444_to_rgb888(f.result.filtered))
+
+
+def test_jpeg_quality_0_logs_raw_images(tmp_path):
+    frames = make_frames(3)
+    data = read_rrd(str(record(tmp_path / "raw.rrd", frames, jpeg_quality=0).path))
+    values = data.entities[P.CAMERA_RAW].values
+    assert "EncodedImage:blob" not in values
+    fmt = single(values["Image:format"])[2]
+    assert (fmt["width"], fmt["height"]) == (32, 24)
+    np.testing.assert_array_equal(single(values["Image:buffer"])[2].reshape(24, 32, 3),
+                                  frames[2].camera_rgb)
+    np.testing.assert_array_equal(images(data, P.CAMERA_FILTERED)[1],
+                                  rgb444_to_rgb888(frames[1].result.filtered))
 
 
 def led_states(buffer, fmt, n):
@@ -348,8 +361,8 @@ def test_two_recorders_in_one_process_do_not_mix(tmp_path):
     da, db = read_rrd(str(a)), read_rrd(str(b))
     assert da.entities[P.CAMERA_RAW].frames == list(range(5))
     assert db.entities[P.CAMERA_RAW].frames == list(range(7))
-    got = da.entities[P.CAMERA_RAW].values["Image:buffer"][4][0].reshape(24, 32, 3)
-    np.testing.assert_array_equal(got, fa[4].camera_rgb)
+    np.testing.assert_array_equal(images(da, P.CAMERA_RAW)[4], fa[4].camera_rgb)
+    np.testing.assert_array_equal(images(db, P.CAMERA_RAW)[6], fb[6].camera_rgb)
 
 
 def test_off_records_nothing(tmp_path):
@@ -367,6 +380,14 @@ def test_readback_summary(saved, capsys):
     assert readback_main([str(path)]) == 0
     out = capsys.readouterr().out
     assert "12 frames" in out and "blueprints: 1" in out
-    assert f"{P.MOTORS_DPS:22s}     12 rows" in out
-    with pytest.raises(UsageError):
+    assert f"{P.MOTORS_DPS:22s}     12 rows\n" in out
+    assert f"{P.CAMERA_RAW:22s}     12 rows, PNG " in out
+    # Raw 32x24 RGB frames: 2304 bytes each.
+    raw = record(saved[0].with_name("raw.rrd"), make_frames(3), jpeg_quality=0).path
+    assert readback_main([str(raw)]) == 0
+    out = capsys.readouterr().out
+    assert f"{P.CAMERA_RAW:22s}      3 rows, raw 2.3 kB each\n" in out
+    with pytest.raises(SystemExit) as info:  # no file named: one line, exit 2
         readback_main([])
+    assert info.value.code == 2
+    assert capsys.readouterr().err.startswith("fpga-robotics readback: error: ")

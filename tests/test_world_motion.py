@@ -157,7 +157,9 @@ def test_driving_into_a_standing_person_is_a_collision_and_does_not_move_them():
     (state,) = world.people_states()
     assert (state.x, state.y) == pytest.approx((4.0, 3.0), abs=1e-9)
     assert world.collision_counts() == {"person": 1, "wall": 0, "furniture": 0}
-    assert world.drain_events() == ["collision with person 'bob'"]
+    # 1000 DPS: 0.035 m * 1000 * pi / 180 = 0.61 m/s towards a person standing still.
+    assert world.drain_events() == [("collision with person 'bob' (robot closing 0.61 m/s, "
+                                    "person 0.00 m/s: the robot's fault)")]
 
 
 def test_a_walking_person_pushes_the_robot_and_keeps_to_their_script():

@@ -18,6 +18,7 @@ __all__ = [
     "arrows",
     "images",
     "jpegs",
+    "pngs",
     "points",
     "rgb_images",
     "scalars",
@@ -61,6 +62,11 @@ def jpegs(rows):
     return rr.EncodedImage.columns(blob=rows, media_type=["image/jpeg"] * len(rows))
 
 
+def pngs(rows):
+    """Rows of PNG bytes -> ``EncodedImage`` columns."""
+    return rr.EncodedImage.columns(blob=rows, media_type=["image/png"] * len(rows))
+
+
 def arrows(rows):
     """Rows ``(ox, oy, vx, vy)`` -> one arrow per row."""
     a = np.asarray(rows, dtype=np.float32)
@@ -95,7 +101,7 @@ class ColumnBuffer:
     """Buffer rows per key; ``builders[key](rows)`` turns them into columns.
 
     A key is an entity path, or ``(path, variant)`` when one entity takes rows of different
-    kinds (raw or JPEG images): each variant is sent as its own columns. ``guard`` is entered
+    kinds (raw, PNG or JPEG images): each variant is sent as its own columns. ``guard`` is entered
     around each send (``viz.live.StallWatch``: a viewer that blocks it for long is cut off).
     """
 

@@ -1,8 +1,39 @@
-"""The end of a recording: keep or drop its file, and the line that says where it went."""
+"""The end of a recording: keep or drop its file, and the line that says where it went.
+
+The line names the file's size; when the folder it is in holds more than
+``LARGE_FOLDER_BYTES`` of recordings, it says so and how to record nothing, so that a folder
+of default-named runs (``runs/``) does not fill the disk unnoticed.
+"""
 
 import os
+from pathlib import Path
 
-__all__ = ["settle"]
+__all__ = ["LARGE_FOLDER_BYTES", "recordings_bytes", "settle"]
+
+#: A recording's folder holding more ``.rrd`` bytes than this is named in the closing line.
+LARGE_FOLDER_BYTES = 500 * 10**6
+
+
+def recordings_bytes(folder):
+    """The bytes of the ``.rrd`` files in ``folder`` (not below it), hidden partial files of
+    runs that were killed included."""
+    total = 0
+    for path in Path(folder).glob("*.rrd"):
+        try:
+            if path.is_file():
+                total += path.stat().st_size
+        except OSError:  # removed meanwhile, or unreadable: not ours to count
+            continue
+    return total
+
+
+def _folder_hint(path):
+    folder = Path(path).parent
+    held = recordings_bytes(folder)
+    if held <= LARGE_FOLDER_BYTES:
+        return ""
+    where = folder.as_posix().rstrip("/")
+    return f" ({where}/ holds {held / 1e6:.0f} MB; --rerun off skips the recording)"
 
 
 def _saved(file, frames):
@@ -11,7 +42,7 @@ def _saved(file, frames):
     text = f"{file.path} ({size / 1e6:.1f} MB, {per / 1e3:.1f} kB/frame)"
     if file.replaced:
         text += ", replacing an earlier recording there"
-    return f"{text}; open it with: rerun {file.path}"
+    return f"{text}; open it with: rerun {file.path}{_folder_hint(file.path)}"
 
 
 def _keep(file):

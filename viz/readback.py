@@ -5,8 +5,9 @@
 
 Built on ``rerun.chunk.RrdReader``. Every temporal row of an entity is returned with its
 ``frame`` and ``sim_time`` (ns), sorted by frame; each component value is the list of its
-instances (plain Python values), except byte blobs (image buffers, JPEG data), which come
-back as uint8 numpy arrays.
+instances (plain Python values), except byte blobs (image buffers, PNG and JPEG data), which
+come back as uint8 numpy arrays. ``images(rec, path)`` turns an image entity's rows back into
+pixels, whichever way they were logged (``viz.images``).
 """
 
 import os
@@ -16,7 +17,10 @@ import numpy as np
 import pyarrow as pa
 from rerun.chunk import RrdReader
 
-__all__ = ["EntityRows", "Recording", "read_rrd", "summary_lines"]
+from .errors import ViewerError
+from .images import decode_image
+
+__all__ = ["EntityRows", "Recording", "images", "read_rrd", "summary_lines"]
 
 _INDEX_COLUMNS = ("frame", "sim_time", "log_time", "log_tick")
 
@@ -65,9 +69,14 @@ def read_rrd(path):
     """Read the first recording in ``path``; returns a ``Recording``."""
     if not os.path.isfile(path):
         raise FileNotFoundError(f"no recording at {path}")
-    reader = RrdReader(path)
+    try:
+        reader = RrdReader(path)
+        chunks = list(reader.stream())
+    except RuntimeError as exc:  # rerun's word for a file that is not a recording
+        raise ViewerError(f"{path} is not a rerun recording (.rrd): "
+                          f"{str(exc).splitlines()[0]}") from None
     entities, static = {}, {}
-    for chunk in reader.stream():
+    for chunk in chunks:
         name = chunk.entity_path.lstrip("/")
         batch = chunk.to_record_batch()
         comps = [
@@ -104,14 +113,63 @@ def read_rrd(path):
     return Recording(entities, static, len(reader.blueprints()), os.path.getsize(path))
 
 
+# rerun's ColorModel values -> channels per pixel, and the ChannelDatatype of uint8.
+_CHANNELS = {1: 1, 2: 3, 3: 4}  # L, RGB, RGBA
+_U8 = 6
+
+
+def _pixels(buffer, fmt):
+    if fmt is None or fmt.get("color_model") not in _CHANNELS or fmt.get("channel_datatype") != _U8:
+        raise ValueError(f"an image format this reader does not know: {fmt!r}")
+    shape = (fmt["height"], fmt["width"], _CHANNELS[fmt["color_model"]])
+    return np.asarray(buffer, dtype=np.uint8).reshape(shape)
+
+
+def images(rec, path):
+    """``{frame: (H, W, C) uint8}``: every image row of entity ``path`` as pixels, from raw
+    ``Image`` rows (their format per row, or the static one) and from PNG or JPEG
+    ``EncodedImage`` rows alike."""
+    rows = rec.entities.get(path)
+    if rows is None:
+        raise KeyError(f"no entity {path!r} in the recording")
+    static_fmt = (rec.static.get(path, {}).get("Image:format") or [None])[0]
+    buffers = rows.values.get("Image:buffer", [None] * len(rows))
+    formats = rows.values.get("Image:format", [None] * len(rows))
+    blobs = rows.values.get("EncodedImage:blob", [None] * len(rows))
+    out = {}
+    for frame, buf, fmt, blob in zip(rows.frames, buffers, formats, blobs):
+        if blob:
+            out[frame] = decode_image(blob[0])
+        elif buf:
+            out[frame] = _pixels(buf[0], fmt[0] if fmt else static_fmt)
+    return out
+
+
+def _image_bytes(rows):
+    """``", PNG 26.4 kB each"``: how the rows' images are stored and their mean size, or ``""``."""
+    for column, kind in (("EncodedImage:blob", None), ("Image:buffer", "raw")):
+        blobs = [row[0] for row in rows.values.get(column, ()) if row]
+        if blobs:
+            if kind is None:
+                types = {t for row in rows.values.get("EncodedImage:media_type", ()) if row
+                         for t in row}
+                kind = "/".join(sorted(t.removeprefix("image/").upper() for t in types)) or "?"
+            return f", {kind} {sum(len(b) for b in blobs) / len(blobs) / 1e3:.1f} kB each"
+    return ""
+
+
 def summary_lines(rec, name):
-    """Lines describing a ``Recording`` read from ``name``: size, frames, rows per entity."""
-    frames = max((len(r) for p, r in rec.entities.items() if p.startswith("design/")), default=0)
+    """Lines describing a ``Recording`` read from ``name``: size, frames, rows per entity.
+
+    The frames are the distinct steps of the ``frame`` timeline over every entity, so any
+    design's recording counts them, whatever entities it logs."""
+    frames = len({f for rows in rec.entities.values() for f in rows.frames if f is not None})
     head = f"{name}: {rec.size_bytes / 1e6:.2f} MB, {frames} frames"
     if frames:
         head += f", {rec.size_bytes / frames / 1e3:.1f} kB/frame"
     lines = [head, f"blueprints: {rec.blueprints}"]
-    lines += [f"  {path:22s} {len(rec.entities[path]):6d} rows" for path in sorted(rec.entities)]
+    lines += [f"  {path:22s} {len(rec.entities[path]):6d} rows{_image_bytes(rec.entities[path])}"
+              for path in sorted(rec.entities)]
     lines += [
         f"  {path:22s} static: {', '.join(sorted(rec.static[path]))}" for path in sorted(rec.static)
     ]

@@ -8,7 +8,7 @@ depends only on the run.
 What is logged per frame (entity paths in ``viz.paths``):
 
 - every ``log_every``-th frame (``frame % log_every == 0``): the camera frame and the design's
-  filtered frame, raw up to 160x120 and JPEG above (``jpeg_quality``);
+  filtered frame, PNG (lossless) up to 160x120 and JPEG above (``jpeg_quality``);
 - every frame: the LEDs (small images), the scalar series (found, proximity, centroid_x,
   DPS, V, W, target distance), the robot, field of view, people and trails on the map, and
   the frame's events. They are small, and decimating them would hide short events.
@@ -30,6 +30,7 @@ from .columns import (
     arrows,
     images,
     jpegs,
+    pngs,
     points,
     rgb_images,
     scalars,
@@ -65,8 +66,10 @@ _SERIES_COLORS = {
 }
 _COLUMN_BUILDERS = {
     (P.CAMERA_RAW, "raw"): rgb_images,
+    (P.CAMERA_RAW, "png"): pngs,
     (P.CAMERA_RAW, "jpeg"): jpegs,
     (P.CAMERA_FILTERED, "raw"): rgb_images,
+    (P.CAMERA_FILTERED, "png"): pngs,
     (P.CAMERA_FILTERED, "jpeg"): jpegs,
     P.LEDS_PROXIMITY: images,
     P.LEDS_CENTROID: images,
@@ -477,8 +480,8 @@ def open_recorder(mode, *, default_path, app_id="fpga_robotics", log_every=1, jp
     log_every : int
         Log the camera images of every ``log_every``-th frame; everything else every frame.
     jpeg_quality : int or None
-        ``None`` raw up to 160x120 and JPEG quality 85 above; ``0`` always raw; 1..100 always
-        JPEG at that quality.
+        ``None`` PNG (lossless) up to 160x120 and JPEG quality 85 above; ``0`` always raw
+        (uncompressed, exact); 1..100 always JPEG at that quality.
 
     Raises
     ------

@@ -22,6 +22,8 @@ from urllib.parse import quote
 
 import rerun as rr
 
+from fpga_robotics.hw.errors import UserError
+
 from .errors import ViewerError
 from .live import DISCONNECT_TIMEOUT_S, FLUSH_TIMEOUT_S, BoundedCall, LiveLink
 from .modes import DEFAULT_VIEWER_PORT, DEFAULT_WEB_PORT, display_available
@@ -124,7 +126,7 @@ def _finish_file_only(stream):
     return True, None
 
 
-class SinkUnavailable(RuntimeError):
+class SinkUnavailable(UserError, RuntimeError):
     """The requested live sink cannot work here; the message says why."""
 
 

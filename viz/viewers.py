@@ -7,6 +7,8 @@ import subprocess
 import tempfile
 import time
 
+from fpga_robotics.hw.errors import UserError
+
 from .net import port_is_listening
 
 __all__ = [
@@ -29,7 +31,7 @@ STOP_TIMEOUT_S = 3.0
 _LOCALHOST = "127.0.0.1"
 
 
-class ViewerUnavailable(RuntimeError):
+class ViewerUnavailable(UserError, RuntimeError):
     """A viewer process cannot run here; the message says why."""
 
 

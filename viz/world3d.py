@@ -22,6 +22,7 @@ from fpga_robotics.sim.camera.render3d.body import (
     gait_angles,
     person_height,
 )
+
 from . import paths as P
 
 __all__ = ["CAMERA", "ROBOT", "ROOM", "WORLD3D", "World3D", "camera_rotation", "world3d_view"]

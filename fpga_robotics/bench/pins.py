@@ -22,7 +22,7 @@ from amaranth.lib import wiring
 from amaranth.lib.wiring import In, Out
 
 from fpga_robotics.bench import scaffold
-from fpga_robotics.cli.errors import UsageError
+from fpga_robotics.hw.errors import UsageError
 from fpga_robotics.hw.params import FollowTargetParams
 from fpga_robotics.hw.top import FollowTarget, follow_target_signature
 from fpga_robotics.sim.backends import BackendError, get_backend

@@ -1,6 +1,7 @@
 """Metrics and checks of the sensor designs' runs: how well a line follower holds its line
 (lateral error, laps, time off the line) and whether following resumes once an obstacle is
-gone. ``SENSOR_CHECKS`` joins ``summary.CHECKS``; ``sensor_check`` evaluates one.
+gone, and how often each sensor measured (``fpga_robotics.checks.shipped`` declares their
+checks).
 """
 
 import math
@@ -9,30 +10,12 @@ import numpy as np
 
 from fpga_robotics.sim.world import is_removal_event
 
-__all__ = ["CHECK_METRIC", "RESUME_CLOSING_M", "SENSOR_CHECKS", "line_metrics",
-           "obstacle_metrics", "sensor_check"]
+__all__ = ["RESUME_CLOSING_M", "line_metrics", "measurement_metrics", "obstacle_metrics",
+           "sensor_check"]
 
-_DAY = 86400.0
 #: Following has resumed once the robot is this much closer to the target than when the last
 #: obstacle left, m.
 RESUME_CLOSING_M = 0.2
-
-SENSOR_CHECKS = {
-    "max_lateral_error_m": (float, (0, 100, "m"),
-                            ("the line sensors' centre stays within this distance of the nearest "
-                            "floor line's centreline")),
-    "min_laps": (int, (0, 10**6, ""), "at least this many whole laps of the closed floor line"),
-    "max_off_line_s": (float, (0, _DAY, "s"),
-                       "at most this long in all with no line sensor over a floor line"),
-    "resumes_within_s": (float, (0, _DAY, "s"),
-                         (f"after the last piece of furniture is removed, the robot closes "
-                         f"{RESUME_CLOSING_M} m on the target within this time")),
-}
-
-
-#: The metric each of ``SENSOR_CHECKS`` judges.
-CHECK_METRIC = {"max_lateral_error_m": "lateral_error_max_m", "min_laps": "laps",
-                "max_off_line_s": "off_line_s", "resumes_within_s": "resumed_after_s"}
 
 
 def line_metrics(traj, lines, mounts, period):
@@ -85,23 +68,27 @@ def obstacle_metrics(traj, events):
     return {"obstacle_removed_at_s": round(t_r, 6), "resumed_after_s": resumed}
 
 
+def measurement_metrics(columns, sensors, frames):
+    """How often each sensor gave a measurement: ``measured_frames`` (sensor name -> frames
+    with one), ``measured_frames_min`` (the fewest; None without sensors), ``silent_sensors``
+    (those with none at all) and ``sensor_kinds`` (name -> kind). ``columns`` are the
+    trajectory's ``"<sensor>.<measurement>"`` columns (NaN where it had none), ``sensors`` the
+    robot's sensors as ``(name, kind)``, ``frames`` the rows done."""
+    counts = {}
+    for name, _kind in sensors:
+        mine = [np.asarray(v[:frames], dtype=float) for k, v in columns.items()
+                if k.startswith(f"{name}.")]
+        counts[name] = int(np.any(~np.isnan(mine), axis=0).sum()) if mine else 0
+    return {"measured_frames": counts,
+            "measured_frames_min": min(counts.values()) if counts else None,
+            "silent_sensors": [name for name, n in counts.items() if n == 0],
+            "sensor_kinds": dict(sensors)}
+
+
 def sensor_check(name, limit, m):
-    """``(passed, text)`` of one of ``SENSOR_CHECKS`` against the metrics ``m``."""
-    if name == "resumes_within_s":
-        t_r, v = m.get("obstacle_removed_at_s"), m.get("resumed_after_s")
-        if t_r is None:
-            return False, "no furniture was removed during the run (room.furniture.present_until)"
-        if v is None:
-            return False, (f"the robot never closed {RESUME_CLOSING_M} m on the target after "
-                           f"the obstacle left at {t_r:.2f} s (limit {limit} s)")
-        return v <= limit, (f"closed {RESUME_CLOSING_M} m on the target {v:.2f} s after the "
-                            f"obstacle left (limit {limit} s)")
-    v = m.get(CHECK_METRIC[name])
-    if v is None:
-        return False, "not measured: the run has no floor line or no line sensors"
-    if name == "max_lateral_error_m":
-        return v <= limit, (f"line sensors at most {v:.3f} m from the line (mean "
-                            f"{m['lateral_error_mean_m']:.3f} m; limit {limit} m)")
-    if name == "min_laps":
-        return v >= limit, f"{v} whole lap(s) of the track (limit >= {limit})"
-    return v <= limit, f"{v:.2f} s with no line sensor over the line (limit {limit} s)"
+    """``(passed, text)`` of the check ``name`` against the metrics ``m`` (``passed`` None when
+    it cannot judge; ``fpga_robotics.checks.registry``)."""
+    from fpga_robotics.checks.registry import evaluate_checks
+
+    (c,) = evaluate_checks({name: limit}, m)
+    return c["passed"], c["text"]

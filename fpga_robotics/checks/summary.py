@@ -1,15 +1,16 @@
 """What a closed-loop run measured, the scenario's checks against it, and the verdict.
 
 ``metrics(traj, events, ...)`` reduces the per-frame trajectory to numbers;
-``evaluate_checks(checks, metrics)`` compares them with the scenario's limits. Each check
-says what it measured, its limit and whether it passed, so that a failing verdict explains
-itself. ``format_summary`` is the human version printed by the runner.
+``evaluate_checks(checks, metrics)`` (``registry.py``) compares them with the scenario's
+limits. Each check says what it measured, its limit and whether it passed, failed or could
+not judge (n/a, with the reason), so that a verdict explains itself. ``format_summary`` is
+the human version printed by the runner.
 """
 
 import numpy as np
 
-from fpga_robotics.checks.sensor_metrics import CHECK_METRIC, SENSOR_CHECKS, sensor_check
-from fpga_robotics.sim.world.config import MAX_TIME
+from fpga_robotics.checks.check import DESIGN_OUTPUTS
+from fpga_robotics.checks.registry import CHECK_OUTPUTS, CHECKS, evaluate_checks, verdict
 
 __all__ = [
     "CHECKS",
@@ -21,100 +22,6 @@ __all__ = [
     "format_summary",
     "verdict",
 ]
-
-_DAY = MAX_TIME  # s
-#: Pass criteria a scenario may state in its ``[checks]`` table:
-#: name → (type, (lowest, highest, unit) limit allowed, meaning).
-CHECKS = {
-    "acquired_within_s": (float, (0, _DAY, "s"),
-                          "the design reports the target found within this time"),
-    "mean_distance_max_m": (float, (0, 1000, "m"),
-                            "mean robot-to-target distance (centres) at most this"),
-    "min_distance_min_m": (float, (0, 1000, "m"),
-                           "closest robot-to-target distance (centres) at least this"),
-    "max_person_collisions": (int, (0, 10**6, ""), "at most this many collisions with a person"),
-    "max_robot_at_fault_collisions": (
-        int, (0, 10**6, ""),
-        ("at most this many times the robot drove into a person (moving towards them faster "
-         "than sim.world.AT_FAULT_SPEED at the touch)"),
-    ),
-    "max_tip_overs": (int, (0, 1, ""),
-                      ("the robot tipped over at most this often (0: never; sim.world tip-over "
-                       "model)")),
-    "max_oscillation_hz": (float, (0, 1000, "Hz"),
-                           ("the commanded turn rate W changes sign at most this often per "
-                            "second while the target is centred")),
-    "max_off_target_fraction": (
-        float, (0, 1, ""),
-        ("the design's centroid is more than an eighth of the image width from the target's "
-         "image column in at most this fraction of the frames in which it reports found with "
-         "the target's centre in view (a non-target object taken for the target)")),
-    "mean_centroid_error_max_px": (
-        float, (0, 10000, "px"),
-        ("mean distance of the design's centroid from the target's image column (frames found "
-         "with the target's centre in view) at most this; with the target straight ahead, the "
-         "centroid's distance from the image centre")),
-    "max_led_wrong_side_fraction": (
-        float, (0, 1, ""),
-        ("the design's centroid LEDs point the wrong way (an LED of the other half lit with the "
-         "target an eighth of the width or more to one side, an outermost LED lit with it "
-         "within a sixteenth of the centre) in at most this fraction of the frames found "
-         "with the target in view (led_wrong_side_fraction)")),
-    "max_led_misplaced_fraction": (
-        float, (0, 1, ""),
-        ("the lit centroid LEDs are not the one above the target (the LED of the window's "
-         "eighth that holds the target's image column; near a border between eighths either "
-         "neighbour, near the image centre also the middle pair) in at most this fraction of "
-         "the frames found with the target's centre inside the window (led_misplaced_fraction)"
-         )),
-    "max_wheel_command_dps": (
-        float, (0, 32768, "DPS"),
-        ("the design never commands a wheel faster than this, either way "
-         "(peak_wheel_command_dps): the speed the motors are rated for")),
-    "max_search_travel_m": (
-        float, (0, 1000, "m"),
-        ("while the design searches (from a search started to the target found again) the "
-         "robot's centre travels at most this far: it turns in place (search_travel_m)")),
-    "max_heading_overshoot_deg": (
-        float, (0, 180, "deg"),
-        "the robot turns at most this far past the target (heading_overshoot_deg)"),
-    "max_wall_collisions": (int, (0, 10**6, ""), "at most this many collisions with a wall"),
-    "max_furniture_collisions": (int, (0, 10**6, ""),
-                                 "at most this many collisions with furniture"),
-    "target_in_view_min_fraction": (float, (0, 1, ""),
-                                    "the target is in the camera's view this often"),
-    "found_min_fraction": (float, (0, 1, ""),
-                           "after first acquisition, the design reports found this often"),
-    "reacquired_within_s": (
-        float,
-        (0, _DAY, "s"),
-        ("the design lost the target and searched at least once, and every loss ended with the "
-        "target found again within this time"),
-    ),
-}
-
-#: The design's per-frame scalar outputs. A design may lack some (a foreign Verilog design whose
-#: port map names no such port: its ``FrameResult`` holds None); those are *absent*, never 0:
-#: NaN in the trajectory, listed in ``absent_outputs``, the metrics made of them None, the
-#: checks that need them "n/a" (left out of the verdict), nothing drawn for them in the viewer.
-DESIGN_OUTPUTS = ("found", "proximity", "centroid_x", "centroid_leds", "motor_left",
-                  "motor_right")
-
-#: The design outputs a check is measured from (checks not named here need none).
-#: The sensor designs' checks (fpga_robotics.checks.sensor_metrics).
-CHECKS.update(SENSOR_CHECKS)
-CHECK_OUTPUTS = {
-    "acquired_within_s": ("found",),
-    "found_min_fraction": ("found",),
-    "reacquired_within_s": ("found",),
-    "max_off_target_fraction": ("found", "centroid_x"),
-    "mean_centroid_error_max_px": ("found", "centroid_x"),
-    "max_oscillation_hz": ("found", "centroid_x"),
-    "max_led_wrong_side_fraction": ("found", "centroid_leds"),
-    "max_led_misplaced_fraction": ("found", "centroid_leds"),
-    "max_wheel_command_dps": ("motor_left", "motor_right"),
-    "max_search_travel_m": ("found",),
-}
 
 #: Metrics made of design outputs: name -> the outputs they need (None when one is absent).
 _METRIC_OUTPUTS = {
@@ -143,9 +50,6 @@ TIMING_FIELDS = (
 )
 
 
-_NO_TARGET = "no target person: no distance to compare"
-
-
 def _round(x, digits=4):
     return None if x is None else round(float(x), digits)
 
@@ -159,7 +63,7 @@ CENTRED_FRACTION = 0.125
 
 
 def compute_metrics(traj, events, collisions, frame_period, *, at_fault_collisions=0,
-                    width=None, absent=(), margin_x=None):
+                    width=None, absent=(), margin_x=None, collision_summary=None):
     """Reduce a run to numbers.
 
     Parameters
@@ -181,6 +85,8 @@ def compute_metrics(traj, events, collisions, frame_period, *, at_fault_collisio
     margin_x : int, optional
         The columns the design's tracking window leaves on each side (the LEDs sit above its
         eighths); default ``width // 10``, the design's default.
+    collision_summary : dict, optional
+        ``World.collision_summary()``: per kind, episodes, contact time and largest impulse.
     """
     absent = [name for name in DESIGN_OUTPUTS if name in set(absent)]
     if absent:
@@ -189,7 +95,7 @@ def compute_metrics(traj, events, collisions, frame_period, *, at_fault_collisio
             present["found"] = np.zeros(len(traj["t"]), bool)
         m = compute_metrics(present, events, collisions, frame_period,
                             at_fault_collisions=at_fault_collisions, width=width,
-                            margin_x=margin_x)
+                            margin_x=margin_x, collision_summary=collision_summary)
         for name, needs in _METRIC_OUTPUTS.items():
             if any(o in absent for o in needs):
                 m[name] = None
@@ -230,6 +136,7 @@ def compute_metrics(traj, events, collisions, frame_period, *, at_fault_collisio
         "acquired_at_s": _round(acquired_at),
         "collisions": dict(collisions),
         "robot_at_fault_collisions": int(at_fault_collisions),
+        "collision_summary": dict(collision_summary or {}),
         "losses": len(episodes),
         "searches": sum(1 for _, _, text in events if text == "search started"),
         "searched_losses": sum(1 for ep in episodes if ep[2]),
@@ -428,138 +335,6 @@ def _oscillation(traj, width, seconds):
     return _round(flips / (seconds * centred.mean()))
 
 
-def _check(name, passed, value, limit, text):
-    return {"name": name, "passed": bool(passed), "value": value, "limit": limit, "text": text}
-
-
-def _not_measured(name, limit, missing):
-    """A check the design's outputs cannot measure: ``passed`` None, left out of the verdict."""
-    names = " or ".join(f"`{o}`" for o in missing)
-    return {"name": name, "passed": None, "value": None, "limit": limit,
-            "text": f"not measured: the design has no {names} output"}
-
-
-def evaluate_checks(checks, m):
-    """The scenario's checks against the metrics ``m``: a list of result dicts, in order.
-    ``passed`` is True or False, or None for a check that needs a design output the design
-    lacks (``m["absent_outputs"]``)."""
-    out = []
-    absent = m.get("absent_outputs") or ()
-    for name, limit in checks.items():
-        missing = [o for o in CHECK_OUTPUTS.get(name, ()) if o in absent]
-        if missing:
-            out.append(_not_measured(name, limit, missing))
-            continue
-        if name == "acquired_within_s":
-            v = m["acquired_at_s"]
-            ok = v is not None and v <= limit
-            text = (f"target first found at {v:.2f} s (limit {limit} s)" if v is not None
-                    else "the target was never found")
-        elif name == "mean_distance_max_m":
-            v = m["mean_distance_m"]
-            ok = v is not None and v <= limit
-            text = (f"mean distance {v} m (limit <= {limit} m)" if v is not None
-                    else f"{_NO_TARGET} (limit <= {limit} m)")
-        elif name == "min_distance_min_m":
-            v = m["min_distance_m"]
-            ok = v is not None and v >= limit
-            text = (f"min distance {v} m (limit >= {limit} m)" if v is not None
-                    else f"{_NO_TARGET} (limit >= {limit} m)")
-        elif name == "max_robot_at_fault_collisions":
-            v = m["robot_at_fault_collisions"]
-            ok = v <= limit
-            text = f"the robot drove into a person {v} time(s) (limit {limit})"
-        elif name == "max_tip_overs":
-            v = m["tip_overs"]
-            ok = v <= limit
-            text = ("the robot never tipped over" if v == 0
-                    else f"the robot tipped over at {m['tipped_over_at_s']:.2f} s (limit {limit})")
-        elif name == "max_oscillation_hz":
-            v = m["oscillation_hz"]
-            ok = v is None or v <= limit
-            text = ("the target was never centred" if v is None
-                    else f"W changes sign {v:.2f} times per second with the target centred "
-                         f"(limit {limit})")
-        elif name == "max_off_target_fraction":
-            v = m["off_target_fraction"]
-            ok = v is None or v <= limit
-            text = ("the design never reported the target found with it in view" if v is None
-                    else f"centroid away from the target in {v:.0%} of the frames with the "
-                         f"target found and in view (limit <= {limit:.0%})")
-        elif name == "mean_centroid_error_max_px":
-            v = m["mean_centroid_error_px"]
-            ok = v is not None and v <= limit
-            text = ("the design never reported the target found with it in view" if v is None
-                    else f"centroid {v:.2f} px from the target's image column on average "
-                         f"(limit <= {limit} px)")
-        elif name == "max_led_wrong_side_fraction":
-            v = m["led_wrong_side_fraction"]
-            ok = v is None or v <= limit
-            text = ("the target was never found to one side or at the centre" if v is None
-                    else f"centroid LEDs point the wrong way in {v:.0%} of the frames judged "
-                         f"(limit <= {limit:.0%})")
-        elif name == "max_led_misplaced_fraction":
-            v = m["led_misplaced_fraction"]
-            ok = v is None or v <= limit
-            text = ("the target was never found inside the window" if v is None
-                    else f"the lit LEDs are not the one above the target in {v:.1%} of the "
-                         f"frames judged (limit <= {limit:.1%})")
-        elif name == "max_wheel_command_dps":
-            v = m["peak_wheel_command_dps"]
-            ok = v is None or v <= limit
-            text = ("no wheel command" if v is None
-                    else f"largest wheel command {v} DPS (limit <= {limit:g} DPS)")
-        elif name == "max_search_travel_m":
-            v = m["search_travel_m"]
-            ok = v is None or v <= limit
-            text = ("the design never searched" if v is None
-                    else f"the robot travelled {v:.2f} m during a search (limit <= {limit} m)")
-        elif name == "max_heading_overshoot_deg":
-            v = m["heading_overshoot_deg"]
-            ok = v is not None and v <= limit
-            text = ("no heading to compare" if v is None
-                    else f"turned {v:.1f} deg past the target (limit <= {limit} deg)")
-        elif name in SENSOR_CHECKS:
-            ok, text = sensor_check(name, limit, m)
-            v = m.get(CHECK_METRIC[name])
-        elif name.startswith("max_") and name.endswith("_collisions"):
-            kind = name[len("max_"): -len("_collisions")]
-            v = int(m["collisions"].get(kind, 0))
-            ok = v <= limit
-            text = f"{v} collision(s) with {kind} (limit {limit})"
-        elif name == "target_in_view_min_fraction":
-            v = m["target_in_view_fraction"]
-            ok = v >= limit
-            text = f"target in view {v:.0%} of frames (limit >= {limit:.0%})"
-        elif name == "found_min_fraction":
-            v = m["found_after_acquisition_fraction"]
-            ok = m["acquired_at_s"] is not None and v >= limit
-            text = f"found in {v:.0%} of frames after acquisition (limit >= {limit:.0%})"
-        elif name == "reacquired_within_s":
-            times = m["reacquire_times_s"]
-            late = [u for u in m["unrecovered_losses_s"] if u > limit]
-            v = max(times) if times else None
-            ok = m["searched_reacquisitions"] >= 1 and all(x <= limit for x in times) and not late
-            if m["searched_losses"] == 0:
-                text = "the target was never lost long enough for the design to search"
-            elif late:
-                text = f"target lost and not found again for {max(late):.2f} s (limit {limit} s)"
-            elif m["searched_reacquisitions"] == 0:
-                text = "the design searched but the run ended before it found the target again"
-            else:
-                text = (f"{len(times)} re-acquisition(s), slowest {v:.2f} s after the loss "
-                        f"(limit {limit} s)")
-        else:  # validated by the scenario loader; keep a clear message anyway
-            raise ValueError(f"unknown check {name!r}")
-        out.append(_check(name, ok, v, limit, text))
-    return out
-
-
-def verdict(check_results):
-    """"pass" when no check failed (checks that could not be measured do not count)."""
-    return "fail" if any(c["passed"] is False for c in check_results) else "pass"
-
-
 def format_summary(s):
     """The human summary printed at the end of a run (several lines)."""
     rtf = s["realtime_factor"]
@@ -604,8 +379,16 @@ def format_summary(s):
         )
     coll = ", ".join(f"{k} {v}" for k, v in s["collisions"].items()) or "none"
     lines.append(f"  collisions: {coll}")
+    if s.get("silent_sensors"):
+        lines.append("  warning: no measurement at all from sensor(s) "
+                     + ", ".join(s["silent_sensors"])
+                     + " (the checks that need them are n/a; checks.min_measured_frames "
+                       "fails such a run)")
     for c in s["checks"]:
         mark = {True: "ok", False: "FAIL", None: "n/a"}[c["passed"]]
         lines.append(f"  [{mark}] {c['name']}: {c['text']}")
-    lines.append(f"verdict: {s['verdict'].upper()}")
+    if s["verdict"] == "n/a":
+        lines.append("verdict: N/A (no check could judge this run)")
+    else:
+        lines.append(f"verdict: {s['verdict'].upper()}")
     return "\n".join(lines)

@@ -3,16 +3,21 @@
     fpga-robotics run [options]           closed loop (python -m fpga_robotics.run)
     fpga-robotics export [options]        Verilog of the design (python -m fpga_robotics.export)
     fpga-robotics board [options]         board top, LPF and bitstream
+    fpga-robotics ports PORTS.toml        check (or --example: write) a port map
     fpga-robotics bench [WHAT] [options]  benchmarks: design (default), pysim, camera, world,
                                           viewer, shadow
+    fpga-robotics designs [REF]           the designs a run can name, ports and connectors
     fpga-robotics mutate [options]        mutation coverage (python -m fpga_robotics.mutation)
     fpga-robotics readback FILE.rrd       what a saved recording holds
     fpga-robotics sweep CAMPAIGN [options]  a verification campaign on Dask
+    fpga-robotics sweep report DIR        the report of a finished campaign
     fpga-robotics formal [options]        formal proofs of the gateware's promises
+    fpga-robotics --version               the installed version
 
-Each subcommand is the ``main(argv, prog)`` of its module, so ``fpga-robotics run --help`` and
-``python -m fpga_robotics.run --help`` are the same command. New subcommands are one row of
-``COMMANDS`` (or ``BENCHMARKS``).
+Each subcommand is the ``main(argv, prog)`` of its module, and the ``python -m`` aliases call
+``run_command``, so ``fpga-robotics run --help`` and ``python -m fpga_robotics.run --help`` are
+the same command under the same name. New subcommands are one row of ``COMMANDS`` (or
+``BENCHMARKS``).
 """
 
 import importlib
@@ -21,16 +26,18 @@ import sys
 
 from fpga_robotics.cli.errors import USAGE_EXIT, run_cli
 
-__all__ = ["BENCHMARKS", "COMMANDS", "main"]
+__all__ = ["BENCHMARKS", "COMMANDS", "main", "run_command", "version"]
 
 #: Subcommand -> (module with ``main(argv, prog)``, one-line help).
 COMMANDS = {
     "run": ("fpga_robotics.cli.run", "run a scenario in closed loop (or the design on real frames)"),
-    "export": ("fpga_robotics.flow.export", "write the design as one Verilog file"),
-    "board": ("fpga_robotics.flow.board",
+    "export": ("fpga_robotics.cli.export", "write the design as one Verilog file"),
+    "board": ("fpga_robotics.cli.board",
               "export a board top (Verilog + LPF) and build its bitstream"),
     "bench": (None, "print speed figures (see `fpga-robotics bench --list`)"),
-    "ports": ("fpga_robotics.sim.backends.port_map",
+    "designs": ("fpga_robotics.cli.designs",
+                "the designs a run can name: their ports and the connectors they bind"),
+    "ports": ("fpga_robotics.cli.ports",
               "write (--example) or check a port map for run --design verilog:..."),
     "mutate": ("fpga_robotics.cli.mutate",
                "mutation coverage: Yosys mutants of the design against the golden model"),
@@ -38,7 +45,7 @@ COMMANDS = {
                  "what a saved .rrd recording holds, entity by entity"),
     "sweep": ("fpga_robotics.cli.sweep",
               "a verification campaign: many runs on Dask, results table and report"),
-    "formal": ("fpga_robotics.flow.formal", "prove the gateware's promises (SymbiYosys, Yices)"),
+    "formal": ("fpga_robotics.cli.formal", "prove the gateware's promises (SymbiYosys, Yices)"),
 }
 
 #: ``fpga-robotics bench WHAT`` -> (module, one-line help); the first is the default.
@@ -72,13 +79,31 @@ def _listing(usage, heading, table):
 
 
 def _usage():
-    return _listing(f"usage: {PROG} COMMAND [options]   ({PROG} COMMAND --help for its options)",
-                    "commands", COMMANDS)
+    return _listing(f"usage: {PROG} COMMAND [options]   ({PROG} COMMAND --help for its options)"
+                    f"\n       {PROG} --version", "commands", COMMANDS)
 
 
 def _bench_list():
     return _listing(f"usage: {PROG} bench [WHAT] [options]   (WHAT defaults to design)",
                     "benchmarks", BENCHMARKS)
+
+
+def version():
+    """The installed package's version (``fpga-robotics --version``)."""
+    from importlib.metadata import PackageNotFoundError
+    from importlib.metadata import version as package_version
+
+    try:
+        return package_version("fpga-robotics")
+    except PackageNotFoundError:  # run from a source tree that was never installed
+        return "unknown (not installed)"
+
+
+def run_command(command, argv=None):
+    """Run subcommand ``command`` as ``fpga-robotics command`` does (the ``python -m``
+    aliases): the same name in its usage and errors."""
+    argv = list(sys.argv[1:] if argv is None else argv)
+    _call(COMMANDS[command][0], argv, f"{PROG} {command}")
 
 
 def _call(module_name, argv, prog):
@@ -92,6 +117,9 @@ def main(argv=None):
     argv = list(sys.argv[1:] if argv is None else argv)
     if argv[:1] in (["-h"], ["--help"]):
         print(_usage())
+        sys.exit(0)
+    if argv[:1] == ["--version"]:
+        print(f"{PROG} {version()}")
         sys.exit(0)
     if not argv:
         print(_usage(), file=sys.stderr)

@@ -7,19 +7,19 @@ the output folder; the terminal gets the score, the score per component and the 
 frame shows.
 """
 
-import argparse
 import os
 import sys
 import time
 
 from fpga_robotics.cli.errors import UsageError
 from fpga_robotics.cli.param_options import add_param_arguments, params_from_args
-from fpga_robotics.sim.files import check_output_dir, write_json_atomic
-from fpga_robotics.sim.mutation import MutationError, list_mutants
+from fpga_robotics.cli.parser import CommandParser
 from fpga_robotics.mutation.design import open_mutant_design, write_mutant_design
 from fpga_robotics.mutation.reasons import blind_spot_reason
 from fpga_robotics.mutation.scores import blind_spots, by_module, robot_score, unit_score
 from fpga_robotics.mutation.unit_judge import golden_results, judge_frames, judge_mutant
+from fpga_robotics.sim.files import check_output_dir, write_json_atomic
+from fpga_robotics.sim.mutation import MutationError, list_mutants
 
 __all__ = ["main"]
 
@@ -89,8 +89,8 @@ DEFAULT_MUTANTS = 100
 MAX_MUTANTS = 4000
 
 
-def build_parser(prog):
-    p = argparse.ArgumentParser(
+def build_parser(prog="fpga-robotics mutate"):
+    p = CommandParser(
         prog=prog,
         description="Mutation coverage: Yosys mutants of the design, one build for all of "
                     "them, each judged against the golden model on fixed frames "
@@ -136,7 +136,7 @@ def _percent(x):
     return "n/a" if x is None else f"{100 * x:.1f}%"
 
 
-def main(argv=None, prog="python -m fpga_robotics.mutation"):
+def main(argv=None, prog="fpga-robotics mutate"):
     args = build_parser(prog).parse_args(argv)
     _check(args)
     params = params_from_args(args)

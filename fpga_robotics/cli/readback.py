@@ -1,21 +1,20 @@
-"""``python -m fpga_robotics.cli.readback FILE.rrd`` (or ``fpga-robotics readback``):
-what a saved recording holds, entity by entity, and its size per frame."""
+"""``fpga-robotics readback FILE.rrd``: what a saved recording holds, entity by entity, and its size per frame."""
 
-import sys
-
-from fpga_robotics.cli.errors import UsageError, run_cli
+from fpga_robotics.cli.parser import CommandParser
 from fpga_robotics.viz.readback import read_rrd, summary_lines
 
-__all__ = ["main"]
+__all__ = ["build_parser", "main"]
+
+
+def build_parser(prog="fpga-robotics readback"):
+    parser = CommandParser(prog=prog, description="What a saved .rrd recording holds: its "
+                           "size, its frames and the rows of each entity.")
+    parser.add_argument("path", metavar="FILE.rrd", help="the recording")
+    return parser
 
 
 def main(argv=None, prog="fpga-robotics readback"):
-    if not argv or len(argv) != 1 or argv[0].startswith("-"):
-        raise UsageError(f"usage: {prog} FILE.rrd")
-    for line in summary_lines(read_rrd(argv[0]), argv[0]):
+    args = build_parser(prog).parse_args(argv)
+    for line in summary_lines(read_rrd(args.path), args.path):
         print(line)
     return 0
-
-
-if __name__ == "__main__":
-    run_cli(main, sys.argv[1:], prog="fpga_robotics.cli.readback")

@@ -1,17 +1,18 @@
-"""``python -m fpga_robotics.run``: run a scenario in closed loop (or the design on real frames).
+"""``fpga-robotics run`` (or ``python -m fpga_robotics.run``): run a scenario in closed loop (or the design on real frames).
 
 Headless and faster than real time by default; prints a progress bar on stderr and a human
 summary at the end; ``--summary PATH`` writes the same as JSON. Exit status: 0 when the
-scenario's checks pass, 1 when they fail, 2 for a usage error (bad argument, unknown scenario
-or key, malformed file, unopenable source, missing simulator).
+scenario's checks pass, 1 when one fails or none could judge the run (verdict n/a), 2 for a
+usage error (bad argument, unknown scenario or key, malformed file, unopenable source, missing
+simulator).
 """
 
-import argparse
 import sys
 import time
 from pathlib import Path
 
-from fpga_robotics.cli.errors import UsageError, run_cli
+from fpga_robotics.cli.errors import UsageError
+from fpga_robotics.cli.parser import CommandParser
 from fpga_robotics.hw.pixel import COLOR_SELECT
 from fpga_robotics.ros.run_options import RosOutputs, add_ros_arguments
 from fpga_robotics.sim.backends import BACKEND_NAMES
@@ -31,24 +32,42 @@ TARGET_CLOTHING = {
 }
 
 
-def build_parser(prog="python -m fpga_robotics.run"):
-    p = argparse.ArgumentParser(
+#: The scenario ``run`` runs without ``--scenario``.
+DEFAULT_SCENARIO = "follow_person"
+
+
+def _scenario_default(section, key):
+    """The default scenario's ``[section] key`` as ``--help`` shows it (read from its TOML
+    file, not loaded: ``--help`` stays quick)."""
+    import tomllib
+    from importlib import resources
+
+    path = resources.files("fpga_robotics.scenario") / "shipped" / f"{DEFAULT_SCENARIO}.toml"
+    value = tomllib.loads(path.read_text()).get(section, {}).get(key)
+    return "the scenario's" if value is None else f"the scenario's; {DEFAULT_SCENARIO}: {value}"
+
+
+def build_parser(prog="fpga-robotics run"):
+    p = CommandParser(
         prog=prog,
         description="Run the FollowTarget design in closed loop with a simulated robot, camera "
                     "and people, and check the scenario's pass criteria.",
     )
-    p.add_argument("--scenario", default="follow_person", metavar="NAME|PATH",
-                   help="a shipped scenario (see --list-scenarios) or a .toml file "
-                        "(default: follow_person)")
+    p.add_argument("--scenario", default=DEFAULT_SCENARIO, metavar="NAME|PATH",
+                   help="a shipped scenario (see --list-scenarios) or a .toml file")
     p.add_argument("--list-scenarios", action="store_true", help="list the shipped scenarios")
     p.add_argument("--backend", default="auto", choices=("auto", *BACKEND_NAMES),
                    help="design simulator (default auto: the fastest compiled one available)")
-    p.add_argument("--resolution", metavar="WxH", help="camera and design resolution")
-    p.add_argument("--color", choices=tuple(COLOR_SELECT), help="initial colour select")
+    p.add_argument("--resolution", metavar="WxH",
+                   help="camera and design resolution (default: "
+                        f"{_scenario_default('camera', 'resolution')})")
+    p.add_argument("--color", choices=tuple(COLOR_SELECT),
+                   help=f"initial colour select (default: {_scenario_default('color', 'initial')})")
     p.add_argument("--target-color", choices=tuple(TARGET_CLOTHING), metavar="C",
                    help="dress the target person in C and follow C (colour select); one of "
                         + ", ".join(TARGET_CLOTHING))
-    p.add_argument("--duration", type=float, metavar="S", help="simulated seconds")
+    p.add_argument("--duration", type=float, metavar="S",
+                   help=f"simulated seconds (default: {_scenario_default('sim', 'duration')})")
     p.add_argument("--seed", type=int, metavar="N", help="random seed (default: the scenario's)")
     p.add_argument("--realtime", action="store_true", help="pace the simulation to the clock")
     p.add_argument("--summary", metavar="PATH", help="write the summary as JSON")
@@ -59,19 +78,23 @@ def build_parser(prog="python -m fpga_robotics.run"):
                         "connect[:URL], serve[:ADDRESS], off; default auto = spawn with a "
                         "display, else save")
     p.add_argument("--log-every", type=int, default=1, metavar="N",
-                   help="log every Nth frame's images to the viewer (default 1)")
+                   help="log every Nth frame's images to the viewer")
     p.add_argument("--source", metavar="camera:N|VIDEO|FOLDER|bag:PATH[:TOPIC]",
                    help="run the design on real frames instead of the simulation (no physics)")
     p.add_argument("--max-frames", type=int, metavar="N", help="with --source: stop after N")
     p.add_argument("--shadow", metavar="SPEC",
                    help="run a second design on the same frames without letting it drive: a "
                         "preset name (published) and/or design KEY=VALUE items separated by ';' "
-                        "(e.g. 'diff_min=5;kp_num=2'); the summary reports where they differ")
+                        "(e.g. 'diff_min=5;kp_num=2'), or in real-clock timing a design "
+                        "reference (e.g. wall_stop_v1.py:WallStop); the summary reports where "
+                        "they differ")
     p.add_argument("--shadow-backend", choices=("auto", *BACKEND_NAMES), default=None,
                    help="simulator of the shadow design (default: the same as --backend)")
-    p.add_argument("--design", metavar="verilog:TOP.v[,MORE.v...]",
-                   help="run your own Verilog design (on Verilator) instead of FollowTarget; "
-                        "needs --ports (docs/foreign.md)")
+    p.add_argument("--design", metavar="REF",
+                   help="the design to run instead of the scenario's design.top: a built-in "
+                        "name, FILE.py:Name or package.module:Name (an Amaranth component, "
+                        "docs/your_design.md), or verilog:TOP.v[,MORE.v...] with --ports "
+                        "(docs/foreign.md)")
     p.add_argument("--ports", metavar="PORTS.toml",
                    help="with --design: the port map of the Verilog design")
     p.add_argument("--runtime", action="append", default=[], metavar="NAME=VALUE",
@@ -80,6 +103,9 @@ def build_parser(prog="python -m fpga_robotics.run"):
     p.add_argument("--save-video", metavar="PATH.mp4|PATH.avi",
                    help="also write the camera frames as a video (try it with --source)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.add_argument("--strict", action="store_true",
+                   help="refuse a scenario that loads with warnings (a waypoint inside "
+                        "furniture, a check no run can meet...) instead of printing them")
     add_ros_arguments(p)  # --bag, --live, --interactive, --paused, --replay-inputs
     return p
 
@@ -127,10 +153,38 @@ class Progress:
 
 
 
+def design_override(reference):
+    """``--design REF`` (not ``verilog:``) as the override ``design.top="REF"``, a file path
+    made absolute (a scenario file's relative paths are from its own folder)."""
+    import json
+
+    where, sep, name = reference.rpartition(":")
+    if sep and where.endswith(".py"):
+        reference = f"{Path(where).expanduser().resolve()}:{name}"
+    return f"design.top={json.dumps(reference)}"
+
+
+def take_design_reference(args, scenario):
+    """After loading: a ``--design`` reference other than ``verilog:`` is the scenario's
+    ``design.top`` now (``_overrides``); ``args.design`` keeps only Verilog files."""
+    if args.design is None or args.design.startswith("verilog:"):
+        return
+    if scenario.foreign is not None:
+        raise UsageError(f"--design {args.design}: scenario {scenario.name!r} names a "
+                         f"Verilog design (design.verilog); remove it there to run "
+                         f"another design")
+    args.design = None
+
+
 def _overrides(args):
     from fpga_robotics.scenario.load import parse_resolution
 
     items = list(args.overrides)
+    if args.design is not None and not args.design.startswith("verilog:"):
+        if args.ports is not None:
+            raise UsageError("--ports is the port map of a Verilog design: it goes with "
+                             "--design verilog:FILE.v")
+        items.append(design_override(args.design))
     if args.resolution is not None:
         w, h = parse_resolution(args.resolution)
         items.append(f'camera.resolution="{w}x{h}"')
@@ -165,6 +219,23 @@ def _shadow_params(scenario, spec):
     except ValueError as exc:
         raise UsageError(str(exc)) from None
     return scenario.with_overrides(items).params
+
+
+def _shadow_scenario(scenario, spec):
+    """With ``--shadow REF`` (a design reference): the scenario running that design instead
+    (its ``[design.params]`` kept); None for a FollowTarget parameter shadow."""
+    from fpga_robotics.loop.pin_shadow import is_design_reference
+
+    if spec is None or not is_design_reference(spec):
+        return None
+    if scenario.sim.timing != "real_clock":
+        raise UsageError(f"--shadow {spec}: a second design runs on pins, in real-clock "
+                         f"timing; scenario {scenario.name!r} runs in compressed timing "
+                         f"(compare FollowTarget parameters there: --shadow KEY=VALUE)")
+    if scenario.foreign is not None:
+        raise UsageError(f"--shadow {spec}: scenario {scenario.name!r} runs a Verilog design "
+                         f"(design.verilog); a shadow design goes with an Amaranth one")
+    return scenario.with_overrides([design_override(spec)])
 
 
 def _dress_target(scenario, color):
@@ -341,6 +412,38 @@ class _UserDesign:
         return getattr(self._backend, name)
 
 
+def _recording_name(args, scenario):
+    """The stem of the default recording: the scenario's name, or the source's."""
+    if args.source is not None:
+        return Path(str(args.source).replace(":", "_")).stem
+    return scenario.name
+
+
+def _check_recording(args, name):
+    """The ``--rerun`` mode and the file it would write, checked before any build: a run
+    never fails on its recording after the work."""
+    if args.rerun == "off":
+        return
+    from fpga_robotics.viz.modes import parse_mode
+
+    mode = parse_mode(args.rerun, default_path=f"runs/{name}.rrd")
+    if mode.path is not None:
+        check_output_path(mode.path, what="recording")
+
+
+def _check_renderer(scenario):
+    """A 3D scenario needs the ``realistic`` extra (MuJoCo): said before the design is built,
+    not when the first frame is drawn."""
+    if scenario.camera.renderer != "mujoco":
+        return
+    from fpga_robotics.sim.camera.render3d.renderer import Render3DUnavailable, load_mujoco
+
+    try:
+        load_mujoco()
+    except Render3DUnavailable as exc:
+        raise UsageError(f'camera.renderer = "mujoco": {exc}') from None
+
+
 def _open_recorder(args, name):
     if args.rerun == "off":
         return None
@@ -415,7 +518,7 @@ def _run_source(args, scenario, ros):
         recorder = None
         completed = False
         try:
-            recorder = _open_recorder(args, Path(str(args.source).replace(":", "_")).stem)
+            recorder = _open_recorder(args, _recording_name(args, scenario))
             for line in ros.open(scenario, closed_loop=False):
                 print(line, file=sys.stderr)
             progress = None if args.quiet else Progress("frames")
@@ -447,14 +550,15 @@ def _run_source(args, scenario, ros):
     return 0
 
 
-def main(argv=None, prog="python -m fpga_robotics.run"):
+def main(argv=None, prog="fpga-robotics run"):
     args = build_parser(prog).parse_args(argv)
     if args.list_scenarios:
         return _list_scenarios()
 
+    from fpga_robotics.checks.summary import format_summary
     from fpga_robotics.loop.compressed import run_scenario
     from fpga_robotics.scenario.load import MAX_SEED, load_scenario
-    from fpga_robotics.checks.summary import format_summary
+    from fpga_robotics.scenario.sanity import report_warnings
 
     if args.seed is not None and not 0 <= args.seed <= MAX_SEED:
         raise UsageError(f"--seed must be in 0..{MAX_SEED}, got {args.seed}")
@@ -464,17 +568,25 @@ def main(argv=None, prog="python -m fpga_robotics.run"):
         check_output_path(args.summary, what="--summary")
     ros = RosOutputs(args)  # --bag, --live ...: checked now, not after a long run
     scenario = load_scenario(args.scenario, _overrides(args))
+    take_design_reference(args, scenario)
     if args.target_color is not None:
         scenario = _dress_target(scenario, args.target_color)
+    report_warnings(scenario, args.strict, sys.stderr, UsageError)
+    _check_recording(args, _recording_name(args, scenario))
     if args.source is not None:
         if args.shadow is not None:
             raise UsageError("--shadow runs in the closed loop only (not with --source)")
+        if args.save_video is not None:
+            raise UsageError("--save-video writes the simulated camera's frames: it goes with "
+                             "the closed loop, not with --source")
         if args.max_frames is not None and args.max_frames < 1:
             raise UsageError(f"--max-frames must be >= 1, got {args.max_frames}")
         return _run_source(args, scenario, ros)
     if args.max_frames is not None:
         raise UsageError("--max-frames only applies with --source (use --duration)")
-    shadow_params = _shadow_params(scenario, args.shadow)
+    shadow_scenario = _shadow_scenario(scenario, args.shadow)
+    shadow_params = None if shadow_scenario is not None else _shadow_params(scenario,
+                                                                            args.shadow)
     if args.save_video is not None:
         from fpga_robotics.loop.video_out import VideoPathError, check_video_path
 
@@ -484,6 +596,7 @@ def main(argv=None, prog="python -m fpga_robotics.run"):
             raise UsageError(str(exc)) from None
 
     _design_files(args, scenario.foreign)
+    _check_renderer(scenario)
     t0 = time.perf_counter()
     if scenario.sim.timing == "real_clock":
         if shadow_params is not None:
@@ -496,6 +609,12 @@ def main(argv=None, prog="python -m fpga_robotics.run"):
     shadow = recorder = None
     completed = False
     try:
+        if shadow_scenario is not None:
+            import copy
+
+            shadow_args = copy.copy(args)
+            shadow_args.backend = args.shadow_backend or args.backend
+            shadow = _open_pin_design(shadow_args, shadow_scenario)
         if shadow_params is not None:
             shadow = _open_backend(args.shadow_backend or args.backend, shadow_params,
                                    args.quiet)
@@ -521,6 +640,10 @@ def main(argv=None, prog="python -m fpga_robotics.run"):
     summary["backend_setup_s"] = round(setup, 3)
     summary.update(ros.summary_items())  # the live inputs, for --replay-inputs
     print(format_summary(summary))
+    from fpga_robotics.loop.real_clock import format_extra_outputs
+
+    for line in format_extra_outputs(summary):
+        print(line)
     if "shadow" in summary:
         from fpga_robotics.loop.shadow import format_shadow
 
@@ -532,11 +655,3 @@ def main(argv=None, prog="python -m fpga_robotics.run"):
     if args.summary:
         write_json_atomic(args.summary, summary, what="--summary")
     return 0 if summary["verdict"] == "pass" else 1
-
-
-def cli():
-    run_cli(main, sys.argv[1:], prog="fpga_robotics.run")
-
-
-if __name__ == "__main__":
-    cli()

@@ -6,7 +6,12 @@ for a seeded buggy variant (``hw/variants.py``)."""
 from dataclasses import MISSING, fields
 
 from fpga_robotics.cli.errors import UsageError
-from fpga_robotics.hw.sensor_params import EDGE_SIDES, FollowLineParams, InterlockParams, UltrasoundParams
+from fpga_robotics.hw.sensor_params import (
+    EDGE_SIDES,
+    FollowLineParams,
+    InterlockParams,
+    UltrasoundParams,
+)
 from fpga_robotics.hw.variants import VARIANTS, variant_params
 
 __all__ = ["SENSOR_GROUPS", "add_sensor_arguments", "given_options", "sensor_params_from_args"]

@@ -1,27 +1,28 @@
-"""``python -m fpga_robotics.sweep CAMPAIGN [options]``, ``... report DIR`` and ``... --bench``.
+"""``fpga-robotics sweep CAMPAIGN [options]``, ``... report DIR`` and ``... --bench``.
 
 Exit status: 0 when every run passed, 1 when some did not, 2 for a usage error (bad option,
 malformed campaign file, unknown scenario or key, bad override value, unreachable scheduler).
 """
 
-import argparse
 import sys
 from pathlib import Path
 
-from fpga_robotics.cli.errors import UsageError, run_cli
+from fpga_robotics.cli.errors import UsageError
+from fpga_robotics.cli.parser import CommandParser
 from fpga_robotics.sim.files import check_output_dir
 from fpga_robotics.sweep.campaign import load_campaign, read_campaign_file, shipped_campaigns
 from fpga_robotics.sweep.engine import RECORD_LOG_EVERY
 
 __all__ = ["build_parser", "main"]
 
-PROG = "python -m fpga_robotics.sweep"
+PROG = "fpga-robotics sweep"
 RECORD = ("failing", "all", "none")
 
 
 def build_parser(prog=PROG):
-    p = argparse.ArgumentParser(
+    p = CommandParser(
         prog=prog,
+        usage=f"%(prog)s [CAMPAIGN] [options]\n       {prog} report DIR",
         description="Run a verification campaign (scenarios x seeds x a grid of overrides) on "
                     "Dask and report where the design fails. `report DIR` rebuilds a report.",
         epilog=f"shipped campaigns: {', '.join(shipped_campaigns())}")
@@ -64,6 +65,10 @@ def build_parser(prog=PROG):
     e.add_argument("--dry-run", action="store_true",
                    help="print the run count and three example commands, run nothing")
     e.add_argument("--quiet", action="store_true", help="no progress bar")
+    e.add_argument("--strict", action="store_true",
+                   help="refuse a campaign whose scenarios load with warnings (a waypoint "
+                        "inside furniture, a check no run can meet...) instead of printing "
+                        "them")
     e.add_argument("--bench", action="store_true",
                    help="benchmark: the same runs on 1 worker and on N (--workers) workers")
     e.add_argument("--bench-runs", type=int, default=40, metavar="N",
@@ -138,8 +143,8 @@ def _dry_run(campaign, args):
 
 
 def _report(argv, prog):
-    p = argparse.ArgumentParser(prog=f"{prog} report",
-                                description="Rebuild report.html from a campaign's results.")
+    p = CommandParser(prog=f"{prog} report",
+                      description="Rebuild report.html from a campaign's results.")
     p.add_argument("dir", metavar="DIR", help="the campaign's results folder")
     args = p.parse_args(argv)
     from fpga_robotics.sweep.api import report_dir
@@ -162,6 +167,9 @@ def main(argv=None, prog=PROG):
 
         return bench(args)
     campaign = _campaign(args)
+    from fpga_robotics.sweep.sanity import report_campaign_warnings
+
+    report_campaign_warnings(campaign, args.strict, sys.stderr, UsageError)
     if args.dry_run:
         return _dry_run(campaign, args)
     out = Path(args.out) if args.out else Path("runs") / "sweeps" / campaign.name
@@ -192,7 +200,3 @@ def main(argv=None, prog=PROG):
     print(f"results: {out / 'results.parquet'}, {out / 'results.csv'}; "
           f"report: {out / 'report.html'}")
     return 0 if rows and all(r["status"] == "pass" for r in rows) else 1
-
-
-def cli():
-    run_cli(main, sys.argv[1:], prog="fpga_robotics.sweep")

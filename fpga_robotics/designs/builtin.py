@@ -1,6 +1,6 @@
-"""The designs a scenario can run (``[design] top = "..."``): for each, how to build it, its
-parameter tables, which connector pins bind to which of its ports, and which of the run's
-per-frame outputs it has.
+"""The built-in designs a scenario can run by name (``[design] top = "..."``): for each, how
+to build it and its parameter tables. Which ports the connectors bind, and which outputs are
+recorded, the designs themselves state (``designs/reference.py`` reads them).
 
 ``follow_target`` is the camera-only design of docs/contract.md (frames in, wheel speeds
 out). ``follow_target_safe`` adds an HC-SR04 ultrasound driver and an interlock that stops
@@ -25,9 +25,11 @@ class Top:
     camera: bool
     #: Scenario sub-table ``[design.<key>]`` -> (module, params class) of its parameters.
     tables: dict = field(default_factory=dict)
-    #: connector kind -> {connector pin: design port}.
+    #: connector kind -> {connector pin: design port}, beyond what the component declares
+    #: (its ``connectors`` attribute) and what binds by name (designs/reference.py).
     bindings: dict = field(default_factory=dict)
-    #: More outputs the run records each frame: trajectory field -> design port.
+    #: More outputs the run records each frame: trajectory field -> design port (resolving
+    #: the design fills in every output no connector reads).
     extra_outputs: dict = field(default_factory=dict)
     #: (module, class) of the component, or the class itself (a design of your own); built as
     #: ``cls(ft_params, *table params)``.
@@ -42,22 +44,18 @@ _WHEELS = {"wheels": {"motor_left": "motor_left", "motor_right": "motor_right"}}
 TOPS = {
     "follow_target": Top(
         "follow_target", "FollowTarget: colour filter, tracker and motor controller",
-        camera=True, bindings={**_CAMERA, **_WHEELS}),
+        camera=True),
     "follow_target_safe": Top(
         "follow_target_safe",
         "FollowTarget with an HC-SR04 ultrasound driver and an obstacle interlock",
         camera=True,
         tables={"ultrasound": ("fpga_robotics.hw.sensor_params", "UltrasoundParams"),
                 "interlock": ("fpga_robotics.hw.sensor_params", "InterlockParams")},
-        bindings={**_CAMERA, **_WHEELS, "ultrasound": {"trig": "us_trig", "echo": "us_echo"}},
-        extra_outputs={"distance_mm": "distance_mm", "obstacle": "obstacle"},
         component=("fpga_robotics.hw.safe_follow", "FollowTargetSafe")),
     "follow_line": Top(
         "follow_line", "FollowLine: KY-033 line sensors to wheel speeds",
         camera=False,
         tables={"line": ("fpga_robotics.hw.sensor_params", "FollowLineParams")},
-        bindings={**_WHEELS, "line_sensors": {"line": "line"}},
-        extra_outputs={"line_seen": "line_seen"},
         component=("fpga_robotics.hw.follow_line", "FollowLine"),
         takes_follow_target_params=False),
 }
@@ -84,11 +82,14 @@ def foreign_top(port_map):
     camera iff the map has a pixel stream, the wheels on the wrapper's ``motor_left``/
     ``motor_right`` (the map's ``outputs``), each ``[connectors.<kind>]`` table as it binds.
     Not registered: built from the scenario's map each time."""
-    bindings = {**_WHEELS, **{kind: dict(pins) for kind, pins in port_map.connectors.items()}}
+    wheels = all(k in port_map.outputs for k in _WHEELS["wheels"])
+    bindings = {**(_WHEELS if wheels else {}),
+                **{kind: dict(pins) for kind, pins in port_map.connectors.items()}}
     if port_map.has_pixels:
         bindings.update(_CAMERA)
     return Top(f"verilog:{port_map.top}", f"the Verilog design {port_map.top} (port map)",
-               camera=port_map.has_pixels, bindings=bindings, component=None,
+               camera=port_map.has_pixels, bindings=bindings,
+               extra_outputs=dict(port_map.extra_outputs), component=None,
                takes_follow_target_params=False)
 
 

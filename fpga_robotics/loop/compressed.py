@@ -383,6 +383,7 @@ class ClosedLoop:
         metrics = compute_metrics(self.traj, self.events, self.world.collision_counts(),
                                   self.period,
                                   at_fault_collisions=self.world.at_fault_collisions(),
+                                  collision_summary=self.world.collision_summary(),
                                   width=cam.width, absent=self.absent,
                                   margin_x=scenario.params.margin_x)
         metrics.update(self.extra_metrics())
@@ -476,7 +477,7 @@ def run_scenario(scenario, *, seed=None, backend="auto", recorder=None, progress
     if scenario.sim.timing == "real_clock":
         return _run_real_clock(scenario, seed=seed, backend=backend, recorder=recorder,
                                progress=progress, realtime=realtime, on_frame=on_frame,
-                               shadow=shadow, controls=controls)
+                               shadow=shadow, shadow_label=shadow_label, controls=controls)
     owns_backend = isinstance(backend, str)
     design = make_backend(backend, scenario.params) if owns_backend else backend
     try:
@@ -495,19 +496,24 @@ def run_scenario(scenario, *, seed=None, backend="auto", recorder=None, progress
 
 
 def _run_real_clock(scenario, *, seed, backend, recorder, progress, realtime, on_frame, shadow,
-                    controls):
+                    shadow_label, controls):
     """``run_scenario`` in real-clock timing (fpga_robotics.loop.real_clock)."""
     from fpga_robotics.loop.real_clock import RealClockLoop, make_pin_backend
-    from fpga_robotics.cli.errors import UsageError
+    from fpga_robotics.hw.errors import UsageError
 
-    if shadow is not None:
-        raise UsageError("shadow runs compare frames; they need sim.timing = \"compressed\"")
+    if shadow is not None and not hasattr(shadow, "ports"):
+        raise UsageError("a shadow in real-clock timing is a design on a pin backend "
+                         "(run --shadow REF); FollowTarget parameters compare frames in "
+                         "sim.timing = \"compressed\"")
     owns_backend = isinstance(backend, str)
     design = make_pin_backend(backend, scenario) if owns_backend else backend
     try:
         design.reset()
+        if shadow is not None:
+            shadow.reset()
         loop = RealClockLoop(scenario, seed=seed, design=design, recorder=recorder,
-                             on_frame=on_frame, controls=controls)
+                             on_frame=on_frame, controls=controls, shadow=shadow,
+                             shadow_label=shadow_label)
         return loop.run(progress=progress, realtime=realtime)
     finally:
         if owns_backend:

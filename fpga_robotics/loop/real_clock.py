@@ -21,18 +21,20 @@ camera (``follow_line``) has its rows sampled at the camera's frame rate all the
 """
 
 import hashlib
+import re
 
 import numpy as np
 
 from fpga_robotics.loop.connectors import CONNECTORS, PinIO
-from fpga_robotics.cli.errors import UsageError
+from fpga_robotics.hw.errors import UsageError
 from fpga_robotics.loop.compressed import ClosedLoop
 from fpga_robotics.sim.backends.base import FrameResult
 from fpga_robotics.sim.camera.frames import to_rgb444
 from fpga_robotics.sim.records import SensorReading
-from fpga_robotics.designs.builtin import TOPS, build_component
+from fpga_robotics.designs.builtin import build_component
 
-__all__ = ["RealClockLoop", "make_pin_backend", "pin_design_source"]
+__all__ = ["RealClockLoop", "extra_output_stats", "format_extra_outputs", "make_pin_backend",
+           "pin_design_source"]
 
 #: Per-frame outputs read when the frame strobe rises (the wheels are read at the next capture).
 _FRAME_OUTPUTS = ("found", "proximity", "centroid_x", "centroid_leds")
@@ -42,14 +44,17 @@ _CONNECTOR_STREAM = 0xC011
 
 
 def scenario_top(scenario):
-    """The ``Top`` (fpga_robotics.designs) the scenario runs: ``design.top``, or for a foreign
-    Verilog design (``design.verilog``) the one its port map describes."""
+    """The ``Top`` (fpga_robotics.designs) the scenario runs: ``design.top`` resolved
+    (designs/reference.py: its bindings and extra outputs), or for a foreign Verilog design
+    (``design.verilog``) the one its port map describes."""
     if scenario.foreign is not None:
         from fpga_robotics.sim.backends.port_map import load_port_map
         from fpga_robotics.designs.builtin import foreign_top
 
         return foreign_top(load_port_map(scenario.foreign.ports))
-    return TOPS[scenario.top]
+    from fpga_robotics.designs.reference import resolve_design
+
+    return resolve_design(scenario.top, scenario.design_params).top
 
 
 def pin_design_source(scenario):
@@ -64,19 +69,23 @@ def pin_design_source(scenario):
 
         design = ForeignDesign(scenario.foreign.verilog, scenario.foreign.ports,
                                scenario.params, pins=True, connector_kinds=connector_kinds())
-        missing = [k for k in ("motor_left", "motor_right") if k not in design.port_map.outputs]
-        if missing:
-            raise UsageError(f"the closed loop needs outputs.{missing[0]} in the port map")
+        # Without outputs.motor_left and motor_right the robot stands: the wheels are absent.
         return VerilogPinSource(design)
     top = scenario_top(scenario)
     params, tables = scenario.params, scenario.design_tables
-    described = f"{params!r}:{sorted(tables.items())!r}"
-    key = f"{top.name}-{hashlib.sha256(described.encode()).hexdigest()[:16]}"
+    described = (f"{scenario.top}:{params!r}:{sorted(tables.items())!r}:"
+                 f"{sorted(scenario.design_params.items())!r}")
+    name = re.sub(r"[^A-Za-z0-9_]", "_", top.name)[:40]
+    key = f"{name}-{hashlib.sha256(described.encode()).hexdigest()[:16]}"
     extra = {}
     if top.camera:
         extra = {"pixels": ("pixels__valid", "pixels__payload"),
-                     "filtered": ("filtered__valid", "filtered__payload"),
-                     "frame_size": (params.width, params.height)}
+                 "frame_size": (params.width, params.height)}
+        from fpga_robotics.designs.reference import resolve_design
+
+        ports = resolve_design(scenario.top, scenario.design_params).ports
+        if ports.get("filtered__valid", ("",))[0] == "out" and "filtered__payload" in ports:
+            extra["filtered"] = ("filtered__valid", "filtered__payload")
     return PinDesignSource(lambda: build_component(top, params, tables), key, **extra)
 
 
@@ -90,6 +99,23 @@ def make_pin_backend(name, scenario, *, on_build=None):
                          "cxxrtl, verilator or pysim")
     kwargs = {"on_build": on_build} if on_build is not None else {}
     return get_pin_backend(name, pin_design_source(scenario), **kwargs)
+
+
+def extra_output_stats(column):
+    """``{"last", "min", "max"}`` of an extra output's trajectory column (None where no row
+    holds a value)."""
+    values = np.asarray(column, float)
+    values = values[np.isfinite(values)]
+    if not len(values):
+        return {"last": None, "min": None, "max": None}
+    return {"last": int(values[-1]), "min": int(values.min()), "max": int(values.max())}
+
+
+def format_extra_outputs(summary):
+    """The summary's ``extra_outputs`` as lines for the terminal (none without any)."""
+    extra = summary.get("extra_outputs") or {}
+    return [f"  design output {name}: last {v['last']}, min {v['min']}, max {v['max']}"
+            for name, v in extra.items()]
 
 
 class _PendingRow:
@@ -111,7 +137,11 @@ class RealClockLoop(ClosedLoop):
     """``ClosedLoop`` in real-clock timing, on a ``PinBackend`` (``design``)."""
 
     def __init__(self, scenario, *, design, seed=None, recorder=None, on_frame=None,
-                 controls=None):
+                 controls=None, shadow=None, shadow_label="shadow"):
+        from fpga_robotics.loop.pin_shadow import MirroredPins, PinComparison
+
+        if shadow is not None:  # a second design, given every input the primary gets
+            design = MirroredPins(design, shadow)
         super().__init__(scenario, seed=seed, design=design, recorder=recorder,
                          on_frame=on_frame, controls=controls)
         self.top = scenario_top(scenario)
@@ -125,7 +155,9 @@ class RealClockLoop(ClosedLoop):
         specs = {c.name: s for c, s in zip(self.sensors, scenario.connectors)}
         self.io = {}  # connector -> PinIO
         self.watched = {}  # design port -> (connector or None, pin)
-        for conn in [self.motors, *self.sensors]:
+        # A design without wheel outputs leaves the robot standing: the motors get no pins.
+        self.wheels = "wheels" in self.top.bindings
+        for conn in [self.motors, *self.sensors] if self.wheels else self.sensors:
             binding = dict(self.top.bindings.get(conn.kind, {}))
             if conn in self.sensors:
                 binding.update(specs[conn.name].ports)
@@ -133,14 +165,20 @@ class RealClockLoop(ClosedLoop):
             for pin in conn.watch:
                 self.watched[self.io[conn].binding[pin]] = (conn, pin)
         self._check_inputs_driven()
-        if self.top.camera:
+        if self.top.camera and _FRAME_STROBE in design.ports:  # FollowTarget's frame outputs
             self.watched[_FRAME_STROBE] = (None, _FRAME_STROBE)
-        for port in self.top.extra_outputs.values():
-            self.watched.setdefault(port, (None, port))
+        if "obstacle" in self.top.extra_outputs.values():  # the interlock's events
+            self.watched.setdefault("obstacle", (None, "obstacle"))
         self.last = {}  # watched port -> last value seen
         self.pending = None  # the frame whose outputs are awaited: [k, t, rgb, events, result]
         self.frame_outputs = {}
         self.extra = {name: np.full(self.n_frames, np.nan) for name in self.top.extra_outputs}
+        self.shadow_pins = shadow
+        if shadow is not None:
+            outputs = tuple(n for n, p in design.ports.items() if p.direction == "out"
+                            and n in shadow.ports and shadow.ports[n].direction == "out"
+                            and not n.startswith("filtered__"))
+            self.comparison = PinComparison(shadow_label, outputs)
         self.measurements = {}  # "<connector>.<key>" -> array per row
 
     # Binding ----------------------------------------------------------------------------
@@ -191,7 +229,8 @@ class RealClockLoop(ClosedLoop):
         self.pins.watch(list(self.watched))
         self.last = {port: self.pins.peek(port) for port in self.watched}
         # The wheel pins' values out of reset are a command too (a design may start moving).
-        self.motors.on_change(self.io[self.motors], "motor_left", None, 0.0)
+        if self.wheels:
+            self.motors.on_change(self.io[self.motors], "motor_left", None, 0.0)
         for conn in self.sensors:
             conn.start(self.io[conn])
 
@@ -282,7 +321,9 @@ class RealClockLoop(ClosedLoop):
         from fpga_robotics.sim.pins.timing import real_clock_timing
 
         p = self.scenario.params
-        self.pins.poke("color_sel", self.color_code)
+        color_port = self.top.bindings["camera"].get("color_sel")
+        if color_port is not None:  # a camera design may have no colour select
+            self.pins.poke(color_port, self.color_code)
         timing = real_clock_timing(p.width, p.height, self.scenario.camera.fps, self.clock_hz,
                                    self.pins.cycle + 1)
         if self.pins.frame_pending:
@@ -298,9 +339,9 @@ class RealClockLoop(ClosedLoop):
         outputs = row.outputs or {}
         values = {name: (outputs.get(name) if self.top.camera else None)
                   for name in _FRAME_OUTPUTS}
-        wheels = self.io[self.motors].binding
-        values["motor_left"] = self.pins.peek(wheels["motor_left"])
-        values["motor_right"] = self.pins.peek(wheels["motor_right"])
+        wheels = self.io[self.motors].binding if self.wheels else {}
+        for pin in ("motor_left", "motor_right"):  # absent without wheels
+            values[pin] = self.pins.peek(wheels[pin]) if pin in wheels else None
         result = FrameResult(filtered=row.filtered, cycles=self.pins.cycle - row.edge, **values)
         self.store_outputs(row.k, result)
         events = row.events
@@ -310,10 +351,25 @@ class RealClockLoop(ClosedLoop):
         for name, port in self.top.extra_outputs.items():
             extra[name] = self.pins.peek(port)
             self.extra[name][row.k] = float(extra[name])
+        if self.shadow_pins is not None:
+            events += self.compare_shadow(row)
         self.events += [(row.k, round(row.t, 6), e) for e in events]
         if self.want_records:
             self.record(row.k, row.t, row.rgb, result, row.distance, row.visible,
                         events + row.viewer_events, sensors=row.readings, design_extra=extra)
+
+    def compare_shadow(self, row):
+        """Row ``row.k``'s outputs of both designs compared; the event of the first
+        divergence."""
+        c = self.comparison
+        first = c.first_divergence is None
+        primary = {n: self.pins.primary.peek(n) for n in c.outputs}
+        shadow = {n: self.shadow_pins.peek(n) for n in c.outputs}
+        differ = c.compare(row.k, row.t, primary, shadow)
+        if not (differ and first):
+            return []
+        parts = ", ".join(f"{n} {primary[n]} vs {shadow[n]}" for n in differ)
+        return [f"shadow design {c.label} diverges: {parts}"]
 
     def after_frames(self):
         self.finish_row()
@@ -322,14 +378,26 @@ class RealClockLoop(ClosedLoop):
         self.traj.update(self.measurements)
 
     def extra_metrics(self):
-        """Also the line metrics, over the world's floor lines, from the line sensors' mounts."""
-        from fpga_robotics.checks.sensor_metrics import line_metrics
+        """Also the line metrics, over the world's floor lines, from the line sensors' mounts,
+        and how often each sensor measured."""
+        from fpga_robotics.checks.sensor_metrics import line_metrics, measurement_metrics
 
         mounts = [m for c in self.sensors if c.kind == "line_sensors"
                   for m in c.sensor_mounts]
         return {**super().extra_metrics(),
                 **line_metrics(self.traj, getattr(self.world, "floor_lines", ()), mounts,
-                               self.period)}
+                               self.period),
+                **measurement_metrics(self.measurements,
+                                      [(c.name, c.kind) for c in self.sensors], self.frames_done)}
+
+    def summarise(self, wall, cpu):
+        """Also ``extra_outputs``: the last, smallest and largest value of each output no
+        connector reads (its trajectory column ``design.<name>``)."""
+        summary = super().summarise(wall, cpu)
+        if self.extra:
+            summary["extra_outputs"] = {
+                name: extra_output_stats(self.traj[f"design.{name}"]) for name in self.extra}
+        return summary
 
     def timing_summary(self, wall):
         cycles = self.pins.cycle

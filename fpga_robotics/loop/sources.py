@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from fpga_robotics.cli.errors import UsageError
+from fpga_robotics.hw.errors import UsageError
 from fpga_robotics.hw.pixel import color_select_value
 from fpga_robotics.sim.records import FrameRecord
 

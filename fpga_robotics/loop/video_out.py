@@ -8,6 +8,7 @@ exactly, the frames of the run.
 
 from contextlib import ExitStack
 
+from fpga_robotics.hw.errors import UserError
 from fpga_robotics.sim.files import atomic_path, check_output_path
 
 __all__ = ["VIDEO_CODECS", "CameraVideo", "VideoPathError", "check_video_path"]
@@ -16,7 +17,7 @@ __all__ = ["VIDEO_CODECS", "CameraVideo", "VideoPathError", "check_video_path"]
 VIDEO_CODECS = {".mp4": "mp4v", ".avi": "MJPG"}
 
 
-class VideoPathError(ValueError):
+class VideoPathError(UserError, ValueError):
     """A video path with a suffix no codec is known for."""
 
 

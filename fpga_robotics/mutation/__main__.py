@@ -1,4 +1,6 @@
-from fpga_robotics.cli.errors import run_cli
-from fpga_robotics.cli.mutate import main
+"""``python -m fpga_robotics.mutation``: the same as ``fpga-robotics mutate``
+(``cli/mutate.py``)."""
 
-run_cli(main, prog="python -m fpga_robotics.mutation")
+from fpga_robotics.cli import run_command
+
+run_command("mutate")

@@ -132,7 +132,7 @@ def robot_judge(campaign, netlist, ports, resolution, indices, out_dir, *, worke
     plan = make_plan(campaign)
     if any(k.startswith("design.") for spec in plan.runs for k, _ in spec.overrides) or any(
             item.startswith("design.") for spec in plan.runs for item in spec.fixed):
-        from fpga_robotics.cli.errors import UsageError
+        from fpga_robotics.hw.errors import UsageError
 
         raise UsageError("the mutation campaign may not override design.* values: the "
                          "mutants are of one design (give its parameters to mutate instead)")

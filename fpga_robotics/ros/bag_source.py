@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from fpga_robotics.cli.errors import UsageError
+from fpga_robotics.hw.errors import UsageError
 
 __all__ = ["ENCODINGS", "IMAGE_TYPES", "BagSource", "parse_bag_spec"]
 

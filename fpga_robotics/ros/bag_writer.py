@@ -15,7 +15,8 @@ from pathlib import Path
 
 from rosbags.rosbag2 import StoragePlugin, Writer, WriterError
 
-from fpga_robotics.cli.errors import UsageError
+from fpga_robotics.hw.errors import UsageError
+from fpga_robotics.sim.files import check_output_dir
 from .messages import TOPICS, TYPESTORE, FrameMessages, camera_geometry
 
 __all__ = ["BagWriter", "check_bag_path", "open_bag_writer"]
@@ -30,12 +31,7 @@ def check_bag_path(path):
     if path.exists() and not (path.is_dir() and (path / "metadata.yaml").is_file()):
         what = "a folder that is not a ROS 2 bag" if path.is_dir() else "a file"
         raise UsageError(f"--bag {str(path)!r} exists and is {what}; give a new name")
-    parent = path.parent
-    while not parent.exists():
-        parent = parent.parent
-    if not os.access(parent, os.W_OK):
-        raise UsageError(f"--bag {str(path)!r}: cannot write in {str(parent)!r}; "
-                         f"choose another place")
+    check_output_dir(path, what="--bag")  # a write is tried for real: os.access trusts root
     return path
 
 

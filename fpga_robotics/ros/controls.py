@@ -15,7 +15,7 @@ import math
 import threading
 import time
 
-from fpga_robotics.cli.errors import UsageError
+from fpga_robotics.hw.errors import UsageError
 from ..hw.pixel import COLOR_SELECT, color_select_value
 
 __all__ = ["INPUT_KINDS", "TELEOP_SPEED", "LiveControls", "ReplayControls", "apply_inputs", "check_input",

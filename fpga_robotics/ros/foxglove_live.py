@@ -8,15 +8,16 @@ each message becomes a ``LiveControls`` input, applied at the next frame boundar
 """
 
 import json
+import socket
 import threading
 
 import foxglove
 from foxglove.websocket import Capability
 
-from fpga_robotics.cli.errors import UsageError
+from fpga_robotics.hw.errors import UsageError
 from .messages import TOPICS, TYPESTORE, FrameMessages, msgdef
 
-__all__ = ["CONTROL_TOPICS", "DEFAULT_PORT", "LivePublisher", "control_input",
+__all__ = ["CONTROL_TOPICS", "DEFAULT_PORT", "LivePublisher", "check_live_port", "control_input",
            "parse_live_spec"]
 
 DEFAULT_PORT = 8765
@@ -40,6 +41,21 @@ def parse_live_spec(spec):
     if not port.isdigit() or not 0 <= int(port) <= 65535:
         raise UsageError(f"--live foxglove:PORT needs a port number 0..65535, got {port!r}")
     return int(port)
+
+
+def check_live_port(port):
+    """``UsageError`` when ``port`` on 127.0.0.1 is taken or not ours to listen on: said
+    before the run starts, not when the server opens."""
+    if port == 0:  # any free port
+        return
+    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:
+        # As a server binds: a port left in TIME_WAIT is free, one with a listener is not.
+        s.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        try:
+            s.bind(("127.0.0.1", port))
+        except OSError as exc:
+            raise UsageError(f"--live: cannot serve on 127.0.0.1:{port} ({exc.strerror}); "
+                             f"give another port with --live foxglove:PORT") from None
 
 
 def _decode(encoding, schema_name, data):

@@ -11,10 +11,10 @@ import termios
 import threading
 import tty
 
-from fpga_robotics.cli.errors import UsageError
+from fpga_robotics.hw.errors import UsageError
 from .controls import TELEOP_SPEED
 
-__all__ = ["KEYS", "TerminalControls", "key_input"]
+__all__ = ["KEYS", "TerminalControls", "check_terminal", "key_input"]
 
 _COLORS = {"r": "red", "g": "green", "b": "blue", "y": "yellow", "m": "magenta",
            "c": "cyan", "w": "white", "n": "none"}
@@ -57,15 +57,22 @@ def key_input(key, controls):
     return None
 
 
+def check_terminal(stream=None):
+    """``UsageError`` unless ``stream`` (standard input) is a terminal: checked before a run
+    starts, not when its controls open."""
+    stream = sys.stdin if stream is None else stream
+    if not stream.isatty():
+        raise UsageError("--interactive needs a terminal on standard input "
+                         "(use --live foxglove or --replay-inputs otherwise)")
+
+
 class TerminalControls:
     """Reads keys from ``stream`` (a terminal) into ``controls`` until ``close()``."""
 
     def __init__(self, controls, stream=None):
         self.controls = controls
         stream = sys.stdin if stream is None else stream
-        if not stream.isatty():
-            raise UsageError("--interactive needs a terminal on standard input "
-                             "(use --live foxglove or --replay-inputs otherwise)")
+        check_terminal(stream)
         self._fd = stream.fileno()
         self._saved = termios.tcgetattr(self._fd)
         tty.setcbreak(self._fd)

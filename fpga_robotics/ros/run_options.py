@@ -31,7 +31,7 @@ class RosOutputs:
     """The ROS/Foxglove side of one run; see the module docstring."""
 
     def __init__(self, args):
-        from fpga_robotics.cli.errors import UsageError
+        from fpga_robotics.hw.errors import UsageError
 
         self.bag_path = args.bag
         self.port = None
@@ -42,9 +42,10 @@ class RosOutputs:
 
             check_bag_path(args.bag)
         if args.live is not None:
-            from .foxglove_live import parse_live_spec
+            from .foxglove_live import check_live_port, parse_live_spec
 
             self.port = parse_live_spec(args.live)
+            check_live_port(self.port)
         if args.replay_inputs is not None:
             if self.port is not None or self.interactive:
                 raise UsageError("--replay-inputs replays a run's inputs; it does not go with "
@@ -52,6 +53,10 @@ class RosOutputs:
             from .controls import load_inputs
 
             self.replay = load_inputs(args.replay_inputs)
+        if self.interactive:
+            from .interactive import check_terminal
+
+            check_terminal()
         self.live_control = self.port is not None or self.interactive
         if args.paused and not self.live_control:
             raise UsageError("--paused goes with --live or --interactive")
@@ -62,7 +67,7 @@ class RosOutputs:
 
     def check_closed_loop_only(self):
         """With ``--source`` (no simulation) there is nothing to control."""
-        from fpga_robotics.cli.errors import UsageError
+        from fpga_robotics.hw.errors import UsageError
 
         if self.interactive:
             raise UsageError("--interactive controls the closed loop (not with --source)")

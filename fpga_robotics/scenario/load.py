@@ -33,7 +33,7 @@ from dataclasses import dataclass, field, fields
 from importlib import resources
 from pathlib import Path
 
-from fpga_robotics.cli.errors import UsageError
+from fpga_robotics.hw.errors import UsageError
 from fpga_robotics.hw.params import (
     CHOICES,
     DEFAULT_BASE_DPS,
@@ -45,6 +45,7 @@ from fpga_robotics.hw.params import (
 )
 from fpga_robotics.hw.pixel import COLOR_SELECT
 from fpga_robotics.scenario.render3d_keys import RENDER_DEFAULTS, parse_render_keys
+from fpga_robotics.scenario.sanity import scenario_warnings
 from fpga_robotics.sim.camera.raster import max_hfov, max_tilt, vertical_fov
 from fpga_robotics.sim.camera.sensor import PARAMS as SENSOR_PARAMS
 from fpga_robotics.sim.camera.sensor import OV7670Params
@@ -74,7 +75,8 @@ _APP_SECTIONS = ("sim", "camera", "color", "design", "checks")
 _FOREIGN_KEYS = ("verilog", "ports")
 #: ``design.top`` (fpga_robotics.designs), a buggy ``variant``, and the tops' parameter tables.
 _TOP_TABLES = ("ultrasound", "interlock", "line")
-_TOP_DESIGN_KEYS = ("top", "variant", *_TOP_TABLES)
+#: ``design.params``: the keyword arguments of a design of one's own (designs/reference.py).
+_TOP_DESIGN_KEYS = ("top", "variant", "params", *_TOP_TABLES)
 _DESIGN_KEYS = ("preset",) + _TOP_DESIGN_KEYS + _FOREIGN_KEYS + tuple(f.name for f in fields(FollowTargetParams) if f.init and
                                    f.name not in ("width", "height"))
 #: Design parameters that are arrays: their length and what the values are.
@@ -245,12 +247,18 @@ class Scenario:
         ``[design] verilog = [...]`` and ``ports = "..."``: a foreign Verilog design to run
         instead of FollowTarget (docs/foreign.md), paths resolved; None without them.
     top : str
-        ``design.top``: the design to run (``fpga_robotics.designs``).
+        ``design.top``: the design to run, a built-in name or a design reference
+        (``fpga_robotics.designs.reference``; a file path made absolute).
+    design_params : dict
+        ``[design.params]``: the keyword arguments of a design of one's own.
     design_tables : dict
         The top's parameter objects by sub-table (``[design.ultrasound]`` ...), a variant's
         changes applied.
     connectors : tuple of ConnectorSpec
         ``[[robot.sensors]]`` and ``[[robot.actuators]]`` (fpga_robotics.scenario.connectors).
+    warnings : tuple of str
+        Legal values that make a run meaningless, one line each naming the key path
+        (fpga_robotics.scenario.sanity): printed before a run, errors with ``--strict``.
     """
 
     name: str
@@ -269,7 +277,9 @@ class Scenario:
     foreign: "ForeignDesignFiles | None" = None
     top: str = "follow_target"
     design_tables: dict = field(default_factory=dict)
+    design_params: dict = field(default_factory=dict)
     connectors: tuple = ()
+    warnings: tuple = ()
 
     def color_at(self, t):
         """The colour select in force at simulated time ``t``."""
@@ -531,13 +541,23 @@ def _set_path(data, key, value, shown):
         if last:
             node[part] = _coerce(node.get(part), value)
             return
-        if part not in node and parts[:i] == ["design"] and part in _TOP_TABLES:
+        if part not in node and parts[:i] == ["design"] and part in (*_TOP_TABLES, "params"):
             node[part] = {}  # a design parameter table the file does not give
         node = node[part]
 
 
+class _AnyName:
+    """Every name: the keys of ``design.params`` are the design's own (checked against its
+    signature when it is resolved)."""
+
+    def __contains__(self, name):
+        return True
+
+
 def _optional_keys(parents):
     """Keys that may be set although the file does not give them."""
+    if parents == ["design", "params"]:
+        return _AnyName()
     if len(parents) == 2 and parents[0] == "design" and parents[1] in _TOP_TABLES:
         from fpga_robotics.designs.builtin import table_fields
 
@@ -789,9 +809,19 @@ def _color_changes(data):
 
 
 def _foreign(design, source):
-    """``design.verilog`` and ``design.ports`` (popped from ``design``): a
-    ``ForeignDesignFiles`` or None; relative paths from the scenario file's folder."""
+    """``design.verilog`` and ``design.ports`` (popped from ``design``), or ``design.top =
+    "verilog:FILES"`` with ``ports``: a ``ForeignDesignFiles`` or None; relative paths from
+    the scenario file's folder."""
     verilog, ports = design.pop("verilog", None), design.pop("ports", None)
+    top = design.get("top")
+    if isinstance(top, str) and top.startswith("verilog:"):
+        if verilog is not None:
+            raise ScenarioError("give the Verilog files once: design.top = \"verilog:...\" or "
+                                "design.verilog, not both")
+        verilog = [f for f in top[len("verilog:"):].split(",") if f.strip()]
+        if ports is None:
+            raise ScenarioError(f"design.top = {top!r} needs design.ports = \"ports.toml\" "
+                                f"(the design's port map, docs/foreign.md)")
     if verilog is None and ports is None:
         return None
     if verilog is None:
@@ -857,14 +887,41 @@ def _design(data, width, height):
                             f"{width}x{height}: {message}") from None
 
 
-def _top(design):
-    """``design.top`` and its parameter tables (a ``design.variant`` applied first)."""
+def _top(design, source):
+    """``design.top``, its parameter tables (a ``design.variant`` applied first) and
+    ``design.params``; a design of one's own is resolved here (designs/reference.py), its
+    reference made independent of the current folder."""
     from fpga_robotics.designs.builtin import TOPS, design_tables
+    from fpga_robotics.designs.reference import DesignError, resolve_design
 
     top = design.get("top", "follow_target")
-    if top not in TOPS:
-        raise ScenarioError(f"design.top must be one of {', '.join(map(repr, TOPS))}, "
-                            f"got {top!r}")
+    params = design.get("params", {})
+    if not isinstance(params, dict):
+        raise ScenarioError(f"design.params must be a table ([design.params] in a file, "
+                            f"--set design.params.NAME=VALUE), got {params!r}")
+    if isinstance(top, str) and top.startswith("verilog:"):
+        top = "follow_target"  # the design is the scenario's foreign one (design.ports)
+        if params:
+            raise ScenarioError("design.params: a Verilog design takes no parameters here; "
+                                "set them in the Verilog (or tie inputs in [constants])")
+    if not isinstance(top, str) or top not in TOPS:
+        given = [k for k in _TOP_TABLES if design.get(k) is not None]
+        if given:
+            raise ScenarioError(f"design.{given[0]} is a table of a built-in design; a "
+                                f"design of your own takes design.params")
+        if design.get("variant") is not None:
+            raise ScenarioError("design.variant names a buggy variant of a built-in design; "
+                                f"design.top = {top!r} has none")
+        base = Path(source).parent if source else None
+        try:
+            spec = resolve_design(top, params, base=base)
+        except DesignError as exc:
+            raise ScenarioError(str(exc)) from None
+        return spec.reference, {}, dict(spec.params)
+    if params:
+        raise ScenarioError(f"design.params: the built-in design {top!r} takes its "
+                            f"parameters from [design] and its own tables "
+                            f"({', '.join(TOPS[top].tables) or 'none'}), not design.params")
     spec = TOPS[top]
     tables = {}
     for key in ("ultrasound", "interlock", "line"):
@@ -879,7 +936,7 @@ def _top(design):
                                 f"got {value!r}")
         tables[key] = dict(value)
     try:
-        return top, design_tables(spec, tables, design.get("variant"))
+        return top, design_tables(spec, tables, design.get("variant")), {}
     except ValueError as exc:
         raise ScenarioError(str(exc)) from None
 
@@ -917,6 +974,8 @@ def _resolve_timing(sim, camera, top, connectors, foreign):
             raise ScenarioError(f"design.ports: {exc}") from None
         if port_map.connectors:
             pins.insert(0, f"the port map's [connectors.{next(iter(port_map.connectors))}]")
+        elif port_map.extra_outputs:
+            pins.insert(0, "the port map's [extra_outputs]")
         elif not port_map.has_pixels:
             pins.insert(0, "a port map without pixels")
     timing = sim.timing
@@ -963,12 +1022,13 @@ def _build(data, source, overrides):
     initial, changes = _color_changes(data)
     params = _design(data, camera.width, camera.height)
     foreign = _foreign(dict(data["design"]), source)
-    top, tables = _top(data["design"])
+    top, tables, design_params = _top(data["design"], source)
     checks = _checks(data)
     world = {s: copy.deepcopy(data[s]) for s in WORLD_SECTIONS if s in data}
     connectors = _connectors(world)
     sim = _resolve_timing(sim, camera, top, connectors, foreign)
-    _check_camera_geometry(camera, _check_world(world))
+    world_config = _check_world(world)
+    _check_camera_geometry(camera, world_config)
     return Scenario(
         name=name,
         description=description,
@@ -986,5 +1046,7 @@ def _build(data, source, overrides):
         foreign=foreign,
         top=top,
         design_tables=tables,
+        design_params=design_params,
         connectors=connectors,
+        warnings=tuple(scenario_warnings(world_config, checks)),
     )

@@ -1,6 +1,6 @@
-"""``python -m fpga_robotics.sweep``: see ``fpga_robotics.cli.sweep``."""
+"""``python -m fpga_robotics.sweep``: the same as ``fpga-robotics sweep`` (``cli/sweep.py``)."""
 
 if __name__ == "__main__":  # worker processes import this module again: do nothing there
-    from fpga_robotics.cli.sweep import cli
+    from fpga_robotics.cli import run_command
 
-    cli()
+    run_command("sweep")

@@ -71,7 +71,7 @@ WORKER_WAIT_S = 60
 def wait_for_a_worker(client, scheduler):
     """Wait (``WORKER_WAIT_S``) for a first worker; a scheduler without one is the user's to
     fix (``UsageError`` saying how to start workers)."""
-    from fpga_robotics.cli.errors import UsageError
+    from fpga_robotics.hw.errors import UsageError
 
     try:
         client.wait_for_workers(1, timeout=WORKER_WAIT_S)
@@ -94,7 +94,7 @@ class _given:
 
 def report_dir(out_dir):
     """Rebuild ``report.html`` in ``out_dir`` from its results; returns the terminal summary."""
-    from fpga_robotics.cli.errors import UsageError
+    from fpga_robotics.hw.errors import UsageError
 
     out_dir = Path(out_dir)
     rows = load_rows(out_dir)

@@ -10,7 +10,8 @@ A campaign is a TOML file (docs/campaigns.md)::
     resolution = "160x120"                  # optional, as run --resolution
     duration = 10.0                         # optional, as run --duration
     shadow = "published"                    # optional, as run --shadow
-    design = "verilog:top.v"                # optional, as run --design (with ports)
+    design = "my_design.py:MyDesign"        # optional, as run --design (verilog:top.v with
+                                            # ports)
     ports = "top_ports.toml"
     set = ["robot.mass=12"]                 # optional fixed overrides, as run --set
     timeout = 120.0                         # optional per-run limit (s)
@@ -18,6 +19,8 @@ A campaign is a TOML file (docs/campaigns.md)::
     [grid]                                  # every key run --set accepts, a list of values
     "design.diff_min" = [4, 6, 8]
     "lighting.ambient" = [0.25, 0.7]
+    # "design.top" = ["follow_target", "follow_target_safe"]: designs as an axis (a file
+    # reference there is relative to the scenario file's folder, as in the scenario)
 
     [[sets]]                                # optional explicit override sets
     "robot.mass" = 12
@@ -39,7 +42,7 @@ from importlib import resources
 from pathlib import Path
 
 from .. import __version__
-from fpga_robotics.cli.errors import UsageError
+from fpga_robotics.hw.errors import UsageError
 
 __all__ = ["Campaign", "CampaignError", "RunSpec", "load_campaign", "parse_seeds",
            "shipped_campaigns", "toml_value"]
@@ -319,7 +322,8 @@ def load_campaign(data, *, source=""):
         base = RunSpec(scenario="", seed=0, overrides=(), backend=backend,
                        resolution=resolution, duration=duration,
                        shadow=_typed(data, "shadow", str, "a shadow spec (e.g. \"published\")"),
-                       design=_typed(data, "design", str, "\"verilog:FILE.v\""),
+                       design=_typed(data, "design", str,
+                                     "a design reference (\"FILE.py:Name\", \"verilog:FILE.v\")"),
                        ports=_typed(data, "ports", str, "a port map path"), fixed=fixed)
         count = len(scenarios) * len(seeds) * len(combos)
         if count > MAX_RUNS:
@@ -352,7 +356,7 @@ def run_identity(spec, scenario_source, extra_files=()):
 def _near(value, base):
     """A path given in a campaign file, relative to the file's folder, as a path from here
     (so that replay commands work where the campaign was started)."""
-    if not isinstance(value, str) or "/" not in value and not value.endswith((".toml", ".v",
+    if not isinstance(value, str) or "/" not in value and not value.endswith((".toml", ".v", ".py",
                                                                                ".sv")):
         return value
     path = Path(value)
@@ -376,3 +380,6 @@ def _file_paths(data, base):
     if isinstance(data.get("design"), str) and data["design"].startswith("verilog:"):
         files = data["design"][len("verilog:"):].split(",")
         data["design"] = "verilog:" + ",".join(_near(f, base) for f in files if f)
+    elif isinstance(data.get("design"), str) and ".py:" in data["design"]:
+        where, _, name = data["design"].rpartition(":")
+        data["design"] = f"{_near(where, base)}:{name}"

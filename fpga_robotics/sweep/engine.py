@@ -16,7 +16,7 @@ import sys
 import time
 from pathlib import Path
 
-from fpga_robotics.cli.errors import UsageError
+from fpga_robotics.hw.errors import UsageError
 from ..sim.files import write_atomic
 from . import runner
 from .results import make_row
@@ -217,7 +217,7 @@ def run_plan(client, plan, store, *, record="failing", timeout=None, quiet=False
             if on_row is not None:
                 on_row(row)
             frames, pixels = plan.frames[spec]
-            if outcome["status"] in ("pass", "fail"):
+            if outcome["status"] in ("pass", "fail", "n/a"):  # a finished run, whatever its verdict
                 timeouts.learn(spec.backend, frames, pixels, outcome.get("run_s", 0.0))
             if outcome["status"] != "pass":
                 failures += 1

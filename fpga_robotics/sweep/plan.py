@@ -3,7 +3,7 @@ and grouped by the design it needs (each parameter set is built once)."""
 
 from dataclasses import dataclass, field, replace
 
-from fpga_robotics.cli.errors import UsageError
+from fpga_robotics.hw.errors import UsageError
 from .campaign import run_identity
 from .runner import _design_key, load_run
 
@@ -54,6 +54,9 @@ def make_plan(campaign):
                 files = [*scenario.foreign.verilog, scenario.foreign.ports]
             if args.design is not None:
                 files = [*args.design[len("verilog:"):].split(","), args.ports]
+            where = scenario.top.rpartition(":")[0]
+            if where.endswith(".py"):  # a design of one's own: its file names the run too
+                files.append(where)
             key = (_design_key(args, scenario), repr(shadow_params))
             frames = round(scenario.sim.duration * scenario.camera.fps)
             checked[shape] = (scenario, files, key, frames,

@@ -4,12 +4,13 @@ matplotlib figures embedded as PNG), both from the results rows alone."""
 import base64
 import html
 import io
+import json
 from collections import defaultdict
 from pathlib import Path
 
 from ..sim.files import write_atomic
 
-__all__ = ["format_report", "write_html"]
+__all__ = ["failures_by_check", "format_report", "na_by_check", "write_html"]
 
 #: Metric distributions shown: column, label.
 METRICS = (("min_distance_m", "closest distance to the target (m)"),
@@ -46,20 +47,42 @@ def _by(rows, column):
 
 
 def failures_by_check(rows):
-    """Failed check (or ``error``/``timeout``) → the rows, most frequent first."""
+    """Failed check (or ``error``/``timeout``, or ``n/a`` for a run no check could judge) →
+    the rows, most frequent first."""
     groups = defaultdict(list)
     for r in rows:
         if r["status"] == "fail":
             for name in filter(None, (r.get("failed_checks") or "").split(";")):
                 groups[name].append(r)
-        elif r["status"] in ("error", "timeout"):
+        elif r["status"] in ("n/a", "error", "timeout"):
             groups[r["status"]].append(r)
+    return dict(sorted(groups.items(), key=lambda kv: -len(kv[1])))
+
+
+def _na_reasons(row):
+    """``{check: reason}`` of the row's n/a checks (the reasons from ``checks_json``)."""
+    names = [n for n in (row.get("na_checks") or "").split(";") if n]
+    try:
+        checks = json.loads(row.get("checks_json") or "[]")
+    except ValueError:
+        checks = []
+    reasons = {c["name"]: c.get("reason") or c.get("text") or "" for c in checks
+               if isinstance(c, dict) and c.get("passed") is None}
+    return {n: reasons.get(n, "") for n in names}
+
+
+def na_by_check(rows):
+    """Check → ``[(row, reason), ...]`` of the runs it could not judge, most frequent first."""
+    groups = defaultdict(list)
+    for r in rows:
+        for name, reason in _na_reasons(r).items():
+            groups[name].append((r, reason))
     return dict(sorted(groups.items(), key=lambda kv: -len(kv[1])))
 
 
 def format_report(rows, axes):
     """The terminal summary (several lines)."""
-    counts = {s: sum(r["status"] == s for r in rows) for s in ("pass", "fail", "error",
+    counts = {s: sum(r["status"] == s for r in rows) for s in ("pass", "fail", "n/a", "error",
                                                                "timeout")}
     lines = [f"{len(rows)} runs: " + ", ".join(f"{n} {s}" for s, n in counts.items())
              + f" (pass rate {_rate(rows):.0%})"]
@@ -82,6 +105,14 @@ def format_report(rows, axes):
             if len(group) > SHOWN_PER_CHECK:
                 lines.append(f"    ... and {len(group) - SHOWN_PER_CHECK} more "
                              f"(report.html, results.csv)")
+    na = na_by_check(rows)
+    if na:
+        lines.append("checks that could not judge (n/a; not counted as pass or fail):")
+        for name, group in na.items():
+            reasons = sorted({reason for _, reason in group})
+            lines.append(f"  {name}: {len(group)} run(s): {reasons[0]}"
+                         + (f" (and {len(reasons) - 1} other reason(s))"
+                            if len(reasons) > 1 else ""))
     return "\n".join(lines)
 
 
@@ -169,7 +200,8 @@ def _with_totals(rows):
 
 def write_html(path, rows, axes, meta):
     """``report.html``: pass rates, the heatmap of the first two grid axes, metric
-    distributions and the failing runs grouped by check, each with its replay command."""
+    distributions, the failing runs grouped by check, each with its replay command, and the
+    checks that could not judge some runs (n/a), with their reasons."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -217,6 +249,20 @@ def write_html(path, rows, axes, meta):
             parts.append(f"<tr><td>{esc(str(r['scenario']))}</td><td>{r['seed']}</td>"
                          f"<td>{esc(r.get('message') or '')}</td>"
                          f"<td><code>{esc(r['replay'])}</code></td><td>{link}</td></tr>")
+        parts.append("</table>")
+    na = na_by_check(rows)
+    if na:
+        parts.append("<h2>Checks that could not judge (n/a)</h2>")
+        parts.append("<p>Neither a pass nor a failure: the run gave the check nothing to judge. "
+                     "A run whose every check is n/a has the status n/a.</p>")
+    for name, group in na.items():
+        parts.append(f"<h3>{esc(name)} ({len(group)} run(s))</h3><table>")
+        parts.append("<tr><th>scenario</th><th>seed</th><th>status</th><th>reason</th>"
+                     "<th>replay</th></tr>")
+        for r, reason in group:
+            parts.append(f"<tr><td>{esc(str(r['scenario']))}</td><td>{r['seed']}</td>"
+                         f"<td>{esc(r['status'])}</td><td>{esc(reason)}</td>"
+                         f"<td><code>{esc(r['replay'])}</code></td></tr>")
         parts.append("</table>")
     parts.append("</body></html>")
     write_atomic(path, "\n".join(parts), what="report")

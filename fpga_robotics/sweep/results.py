@@ -17,10 +17,12 @@ from ..sim.files import atomic_path, write_atomic, write_json_atomic
 
 __all__ = ["STATUSES", "ResultStore", "load_rows", "make_row", "read_meta"]
 
-STATUSES = ("pass", "fail", "error", "timeout")
+#: A run's status: its verdict ("n/a": checks were set and none could judge it), or why it has
+#: none.
+STATUSES = ("pass", "fail", "n/a", "error", "timeout")
 #: Statuses of finished runs that ``--resume`` does not run again (an error or a timeout may
 #: have been the machine's: those are run again).
-DONE = ("pass", "fail")
+DONE = ("pass", "fail", "n/a")
 
 JOURNAL = "results.jsonl"
 PARQUET = "results.parquet"
@@ -28,8 +30,8 @@ CSV = "results.csv"
 META = "campaign.json"
 
 #: Columns every row has, first in the tables.
-LEAD = ("run_id", "scenario", "seed", "status", "message", "failed_checks", "wall_s", "cpu_s",
-        "run_s", "replay", "recording")
+LEAD = ("run_id", "scenario", "seed", "status", "message", "failed_checks", "na_checks",
+        "wall_s", "cpu_s", "run_s", "replay", "recording")
 
 
 def _cell(value):
@@ -41,7 +43,10 @@ def _cell(value):
 
 def make_row(spec, run_id, scenario_name, outcome):
     """The results row of a run: identity, overrides (one column each), status, times, the
-    replay command, and every summary field (collisions and checks one column each)."""
+    replay command, and every summary field (collisions and checks one column each:
+    ``check_<name>`` True, False or None for n/a). ``failed_checks`` names the checks that
+    failed, ``na_checks`` those that could not judge the run (their reasons are in
+    ``checks_json``)."""
     row = {
         "run_id": run_id,
         "scenario": scenario_name,
@@ -49,6 +54,7 @@ def make_row(spec, run_id, scenario_name, outcome):
         "status": outcome["status"],
         "message": outcome.get("message", ""),
         "failed_checks": "",
+        "na_checks": "",
         "wall_s": round(outcome.get("wall_s", 0.0), 4),
         "cpu_s": round(outcome.get("cpu_s", 0.0), 4),
         "run_s": round(outcome.get("run_s", 0.0), 4),
@@ -69,10 +75,13 @@ def make_row(spec, run_id, scenario_name, outcome):
             elif key == "checks":
                 for check in value:
                     row[f"check_{check['name']}"] = check["passed"]
-                failed = [c for c in value if not c["passed"]]
+                failed = [c for c in value if c["passed"] is False]
+                na = [c for c in value if c["passed"] is None]
                 row["failed_checks"] = ";".join(c["name"] for c in failed)
-                if failed and not row["message"]:
-                    row["message"] = "; ".join(f"{c['name']}: {c['text']}" for c in failed)
+                row["na_checks"] = ";".join(c["name"] for c in na)
+                shown = failed if failed else na if outcome["status"] == "n/a" else []
+                if shown and not row["message"]:
+                    row["message"] = "; ".join(f"{c['name']}: {c['text']}" for c in shown)
                 row["checks_json"] = json.dumps(value)
             elif key == "overrides":
                 row["overrides"] = " ".join(value)

@@ -54,7 +54,7 @@ def _loaded(argv):
     args = argparse.Namespace(**vars(args))
     if seed is not None:
         args.seed = int(seed)
-        from fpga_robotics.cli.errors import UsageError
+        from fpga_robotics.hw.errors import UsageError
         from fpga_robotics.scenario.load import MAX_SEED
 
         if not 0 <= args.seed <= MAX_SEED:
@@ -69,7 +69,7 @@ def load_run(argv):
     """``(args, scenario, shadow_params)`` of a run, checked as ``run`` checks them
     (``UsageError`` with one line when something is wrong)."""
     from fpga_robotics.cli import run
-    from fpga_robotics.cli.errors import UsageError
+    from fpga_robotics.hw.errors import UsageError
     from fpga_robotics.scenario.load import MAX_SEED, load_scenario
 
     args = run.build_parser().parse_args(argv)
@@ -77,6 +77,7 @@ def load_run(argv):
     if args.seed is not None and not 0 <= args.seed <= MAX_SEED:
         raise UsageError(f"--seed must be in 0..{MAX_SEED}, got {args.seed}")
     scenario = load_scenario(args.scenario, run._overrides(args))
+    run.take_design_reference(args, scenario)
     shadow_params = run._shadow_params(scenario, args.shadow)
     run._design_files(args, scenario.foreign)
     return args, scenario, shadow_params
@@ -85,7 +86,8 @@ def load_run(argv):
 def _design_key(args, scenario):
     return ("design", args.backend, args.design, args.ports, repr(scenario.foreign),
             repr(scenario.params), scenario.sim.timing, scenario.top,
-            repr(sorted(scenario.design_tables.items())))
+            repr(sorted(scenario.design_tables.items())),
+            repr(sorted(scenario.design_params.items())))
 
 
 def _open(key, opener):

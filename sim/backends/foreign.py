@@ -89,15 +89,18 @@ class ForeignDesign:
         self.port_map = port_map if not isinstance(port_map, (str, os.PathLike)) \
             else load_port_map(port_map)
         pm = self.port_map
-        if not pins and (pm.connectors or not pm.has_pixels):
+        if not pins and (pm.connectors or pm.extra_outputs or not pm.has_pixels):
             what = (f"binds connectors ([connectors.{next(iter(pm.connectors))}])"
-                    if pm.connectors else "has no pixel stream")
+                    if pm.connectors else "records [extra_outputs]" if pm.extra_outputs
+                    else "has no pixel stream")
             raise PortMapError(f"port map: {pm.top}'s map {what}: the design runs in real-clock "
                                "timing (sim.timing = \"real_clock\", on the verilator backend) "
                                "with the scenario's [[robot.sensors]]")
-        clash = sorted(set(pm.connector_ports()) & set(_WRAPPER_PORTS))
+        passed = {**pm.connector_ports(),
+                  **{port: f"extra_outputs.{name}" for name, port in pm.extra_outputs.items()}}
+        clash = sorted(set(passed) & set(_WRAPPER_PORTS))
         if clash:
-            raise PortMapError(f"port map: {pm.connector_ports()[clash[0]]}: the port name "
+            raise PortMapError(f"port map: {passed[clash[0]]}: the port name "
                                f"{clash[0]!r} is reserved for the wrapper's own ports; rename "
                                "it in the design")
         self.pins = pins
@@ -230,7 +233,9 @@ def wrapper_verilog(pm, ports, width, height, pins=False):
     ``pins=True`` (the pin backend): only the ports the map gives (no pixel stream, strobe
     or colour select without ``pixels``, no absent outputs), the connector ports passed
     through under their own names, ``[runtime]`` inputs held at their initial values."""
-    conns = [f".{pm.clock}(clk)", f".{pm.reset}({'~rst' if pm.reset_active_low else 'rst'})"]
+    conns = [f".{pm.clock}(clk)"]
+    if pm.reset:
+        conns.append(f".{pm.reset}({'~rst' if pm.reset_active_low else 'rst'})")
     if pm.has_pixels:
         conns.append(f".{pm.valid}(pixels__valid)")
     body = []
@@ -364,7 +369,7 @@ def _pin_wrapper(pm, ports, outputs, decls, body, conns):
     if pm.filtered_valid:
         header += ["output filtered__valid", "output [13:0] filtered__payload"]
     header += outputs
-    for port in pm.connector_ports():
+    for port in (*pm.connector_ports(), *pm.extra_outputs.values()):
         direction, width, signed = ports[port]
         header.append(f"{direction} {'signed ' if signed else ''}[{width - 1}:0] {port}")
         conns.append(f".{port}({port})")
@@ -397,7 +402,7 @@ def pin_ports(design):
         if key in pm.outputs:
             # The contract's wheel speeds are signed 16 bits; the other outputs unsigned.
             ports[key] = ("out", 1 if key == "found" else 16, key.startswith("motor_"))
-    for port in pm.connector_ports():
+    for port in (*pm.connector_ports(), *pm.extra_outputs.values()):
         direction, width, signed = design.ports[port]
         ports[port] = ("in" if direction == "input" else "out", width, signed)
     return ports

@@ -13,18 +13,18 @@ bindings against the connector kinds the application knows. A map with connector
 out the pixel stream (a design without a camera).
 """
 
-import argparse
-import sys
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
+
+from fpga_robotics.hw.errors import UserError
 
 from ...hw.pixel import COLOR_SELECT
 from .base import BackendError
 
 __all__ = [
     "OUTPUTS", "Output", "PortMap", "PortMapError", "check_connectors", "check_widths",
-    "follow_target_port_map", "load_port_map", "parse_port_map",
+    "follow_target_port_map", "load_port_map", "parse_port_map", "write_follow_target_port_map",
 ]
 
 #: Per-frame outputs a port map may name: FrameResult field -> (default width, signed).
@@ -38,7 +38,7 @@ OUTPUTS = {
 }
 _STYLES = ("stream", "framebuffer")
 _TOP_KEYS = {"style", "top", "clock", "reset", "pixels", "color", "result", "outputs", "filtered",
-             "constants", "runtime", "connectors"}
+             "constants", "runtime", "connectors", "extra_outputs"}
 #: Connector kinds the map binds elsewhere: the camera by ``pixels``/``color``, the wheels by
 #: ``outputs.motor_left``/``motor_right``.
 _BOUND_ELSEWHERE = {"camera": "pixels and color", "wheels": "outputs.motor_left and "
@@ -49,7 +49,7 @@ _FRAME_ONLY = ("found", "proximity", "centroid_x", "centroid_leds")
 MAX_RUNTIME = 8
 
 
-class PortMapError(BackendError):
+class PortMapError(UserError, BackendError):
     """A port map that is malformed or does not fit the design."""
 
 
@@ -64,7 +64,7 @@ class Output:
 class PortMap:
     top: str
     clock: str
-    reset: str
+    reset: str | None  # None: the design has no reset (its registers start at their init)
     reset_active_low: bool
     valid: str | None  # None: no pixel stream (a design without a camera)
     payload: str | None  # 14 bits: data[11:0], first[12], last[13]
@@ -89,6 +89,8 @@ class PortMap:
     runtime: dict = field(default_factory=dict)
     #: connector kind -> {connector pin: design port} (``[connectors.<kind>]``).
     connectors: dict = field(default_factory=dict)
+    #: name -> design output recorded under that name (``[extra_outputs]``; real-clock timing).
+    extra_outputs: dict = field(default_factory=dict)
 
     @property
     def has_pixels(self):
@@ -102,7 +104,9 @@ class PortMap:
     def inputs(self):
         """Input port name -> expected width (None: checked elsewhere). Connector ports are
         not listed: their direction is the connector's (``check_connectors``)."""
-        ports = {self.clock: 1, self.reset: 1}
+        ports = {self.clock: 1}
+        if self.reset:
+            ports[self.reset] = 1
         if not self.has_pixels:
             pass
         elif self.style == "framebuffer":
@@ -133,6 +137,8 @@ class PortMap:
         if self.filtered_valid:
             ports[self.filtered_valid] = 1
             ports[self.filtered_payload] = 14
+        for port in self.extra_outputs.values():
+            ports[port] = None  # any width up to 32
         return ports
 
 
@@ -186,7 +192,8 @@ def parse_port_map(data):
 
     clock = _table(data, "clock", "")
     _unknown(clock, {"port"}, "clock.")
-    reset = _table(data, "reset", "")
+    # No [reset]: a design without one (its registers start at their initial values).
+    reset = _table(data, "reset", "", required=False)
     _unknown(reset, {"port", "active_low"}, "reset.")
     active_low = reset.get("active_low", False)
     if not isinstance(active_low, bool):
@@ -252,7 +259,7 @@ def parse_port_map(data):
     latency = _int(result, "latency", "result", 0, 0, 1 << 20)
     timeout = _int(result, "timeout", "result", 100_000, 1, 1 << 30)
 
-    out_table = _table(data, "outputs", "")
+    out_table = _table(data, "outputs", "", required=False)
     _unknown(out_table, set(OUTPUTS), "outputs.")
     outputs = {}
     for key, value in out_table.items():
@@ -270,7 +277,13 @@ def parse_port_map(data):
         if not isinstance(signed, bool):
             raise PortMapError(f"port map: outputs.{key}.signed must be true or false")
         outputs[key] = Output(port, width, signed)
-    if not outputs:
+    extra = _table(data, "extra_outputs", "", required=False)
+    for name, port in extra.items():
+        if not name.isidentifier() or name in OUTPUTS:
+            raise PortMapError(f"port map: extra_outputs.{name}: the name must be a Python "
+                               f"name other than the [outputs] keys")
+        _name(extra, name, "extra_outputs")
+    if not outputs and not extra and not connectors:
         raise PortMapError("port map: [outputs] names no output")
     if not pixels:
         frame_only = [k for k in _FRAME_ONLY if k in outputs]
@@ -305,19 +318,22 @@ def parse_port_map(data):
             raise PortMapError(f"port map: runtime.{name} must be an integer >= 0 (its "
                                f"initial value), got {value!r}")
     port_map = PortMap(
-        top=top, clock=_name(clock, "port", "clock"), reset=_name(reset, "port", "reset"),
+        top=top, clock=_name(clock, "port", "clock"),
+        reset=_name(reset, "port", "reset", required=bool(reset)),
         reset_active_low=active_low, valid=valid, payload=payload,
         data=data_port, first=first, last=last, color_port=color_port, color_codes=codes,
         color_width=color_width, strobe=strobe, latency=latency, timeout=timeout,
         outputs=outputs, filtered_valid=f_valid, filtered_payload=f_payload, style=style,
         address=address, new_frame=new_frame, after_cycles=after_cycles,
         constants=dict(constants), runtime=dict(runtime), connectors=connectors,
+        extra_outputs=dict(extra),
     )
     pm = port_map
     names = [n for n in (pm.clock, pm.reset, pm.valid, pm.payload, pm.data, pm.first, pm.last,
                          pm.address, pm.new_frame, pm.color_port, pm.strobe,
                          *(o.port for o in pm.outputs.values()), pm.filtered_valid,
                          pm.filtered_payload, *pm.constants, *pm.runtime,
+                         *pm.extra_outputs.values(),
                          *(p for pins in pm.connectors.values() for p in pins.values())) if n]
     dup = sorted({n for n in names if names.count(n) > 1})
     if dup:
@@ -468,33 +484,11 @@ def follow_target_port_map(params=None):
     return _FOLLOW_TARGET_MAP.format(latency=params.motor_latency)
 
 
-def main(argv=None):
-    """``python -m fpga_robotics.sim.backends.port_map``: write the example port map or check
-    one."""
-    parser = argparse.ArgumentParser(prog="python -m fpga_robotics.sim.backends.port_map",
-                                     description="Write the port map of the exported "
-                                     "follow_target (--example) or check a port map file.")
-    parser.add_argument("path", help="the port map (TOML)")
-    parser.add_argument("--example", action="store_true",
-                        help="write the follow_target example to PATH (not replacing a file)")
-    args = parser.parse_args(argv)
+def write_follow_target_port_map(path, params=None):
+    """Write ``follow_target_port_map(params)`` to ``path``, never replacing a file;
+    ``PortMapError`` when it cannot be written."""
     try:
-        if args.example:
-            try:
-                with open(args.path, "x") as f:
-                    f.write(follow_target_port_map())
-            except OSError as exc:
-                raise PortMapError(f"cannot write {args.path}: {exc.strerror or exc}") from None
-            print(f"wrote {args.path}")
-            return 0
-        port_map = load_port_map(args.path)
-    except PortMapError as exc:
-        print(f"port_map: error: {exc}", file=sys.stderr)
-        return 2
-    connectors = "".join(f", connectors.{kind}" for kind in port_map.connectors)
-    print(f"{args.path}: {port_map.top}, outputs {', '.join(port_map.outputs)}{connectors}")
-    return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main())
+        with open(path, "x") as f:
+            f.write(follow_target_port_map(params))
+    except OSError as exc:
+        raise PortMapError(f"cannot write {path}: {exc.strerror or exc}") from None

@@ -18,6 +18,8 @@ window are kept.
 
 import re
 
+from fpga_robotics.hw.errors import UserError
+
 __all__ = ["VCDTrimError", "trim_vcd"]
 
 _TOKEN = re.compile(r"\S+")
@@ -26,7 +28,7 @@ _TOKEN = re.compile(r"\S+")
 _NO_UNKNOWN = ("real", "string", "event")
 
 
-class VCDTrimError(ValueError):
+class VCDTrimError(UserError, ValueError):
     """The input is not a VCD this trimmer understands, or not in the expected time unit."""
 
 

@@ -7,10 +7,12 @@ and goes back to 8 bits as ``c << 4``.
 
 import numpy as np
 
+from fpga_robotics.hw.errors import UserError
+
 __all__ = ["FrameError", "rgb444_to_rgb888", "to_rgb444", "unpack_rgb444"]
 
 
-class FrameError(ValueError):
+class FrameError(UserError, ValueError):
     """A frame of the wrong shape, dtype or value range."""
 
 

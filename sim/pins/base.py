@@ -26,10 +26,12 @@ into ``filtered_frame()``.
 from abc import ABC, abstractmethod
 from dataclasses import dataclass
 
+from fpga_robotics.hw.errors import UserError
+
 __all__ = ["PinBackend", "PinError", "PixelTiming", "Port", "Stop"]
 
 
-class PinError(RuntimeError):
+class PinError(UserError, RuntimeError):
     """A pin-level run cannot go on: unknown port, a value out of range, a missing tool."""
 
 

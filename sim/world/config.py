@@ -11,6 +11,8 @@ import difflib
 import math
 from dataclasses import dataclass
 
+from fpga_robotics.hw.errors import UserError
+
 from .kinematics import DEG
 from .markings import FloorLine
 from .robots import ROBOT_MODELS
@@ -50,7 +52,7 @@ _FLOOR_COLOR = (0.55, 0.55, 0.5)
 _CEILING_COLOR = (0.9, 0.9, 0.9)
 
 
-class WorldConfigError(ValueError):
+class WorldConfigError(UserError, ValueError):
     """A scenario's world description is invalid; the message names the key path."""
 
 

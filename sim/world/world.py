@@ -6,8 +6,8 @@ correction, ``max_bias = 0``) pull the robot towards that velocity with at most 
 robot's traction force and torque. The robot's velocity is never written directly, so walls,
 furniture and people stop it. People are kinematic bodies on scripted paths (a person with a
 ``yield_gap`` pauses their script rather than step closer than that to the robot); walls and
-furniture are static shapes. Collisions of the robot are counted per kind from pymunk
-collision handlers.
+furniture are static shapes. The robot's contacts, from pymunk collision handlers, are
+gathered into collision episodes per kind of body, each with its fault (``collisions``).
 """
 
 import math
@@ -17,6 +17,7 @@ import pymunk
 
 from ..records import PersonState, WorldMap
 from ..camera.scene import CameraPose, Cylinder, Scene
+from .collisions import AT_FAULT_SPEED, CollisionLog, MotionHistory, closing_speeds
 from .config import WorldConfigError, parse_world_config
 from .lighting import LightingSchedule
 from .motors import DriveMotors
@@ -41,14 +42,14 @@ def is_removal_event(text):
 #: ``step(dt)`` splits longer steps into equal sub-steps no longer than this, s.
 MAX_SUBSTEP = 0.01
 
-#: A contact with a person is the robot's fault when, at the first touch, the robot moves
-#: towards the person faster than this (m/s): its velocity projected on the direction from
-#: its centre to the person's. A person walking into a standing or retreating robot is not.
-AT_FAULT_SPEED = 0.02
-
 _ROBOT, _WALL, _FURNITURE, _PERSON = 1, 2, 3, 4
 _KINDS = ("person", "wall", "furniture")
 _FRICTION = 0.5
+
+
+def _speed(v):
+    """A speed with two decimals, never "-0.00"."""
+    return f"{round(v, 2) + 0.0:.2f}"
 
 
 class _Person:
@@ -168,7 +169,6 @@ class World:
         # (time, name) of the furniture that leaves the room, earliest first.
         self._removals = sorted((f.present_until, f.name) for f in config.room.furniture
                                 if f.present_until is not None)
-        self._furniture_contacts = {f.name: 0 for f in config.room.furniture}
         self.people = []
         # One generator per person, so a person's jitter does not depend on the others or on
         # the order in which their paths are queried.
@@ -192,14 +192,16 @@ class World:
             x, y = config.robot.start
             raise WorldConfigError(f"robot.start [{x:g}, {y:g}] overlaps the {what}")
 
-        self._counts = dict.fromkeys(_KINDS, 0)
-        self._at_fault = 0
+        self._collisions = CollisionLog(_KINDS)
+        self._history = MotionHistory()
+        self._now = 0.0  # the end of the physics step under way: when its contacts happen
         #: ``(time_s, reason)`` once the robot has tipped over, else None.
         self.tipped = None
         self._motor_v = 0.0  # the wheels' forward speed at the last sub-step, m/s
         self._events = []
         for ctype in (_WALL, _FURNITURE, _PERSON):
-            space.on_collision(_ROBOT, ctype, begin=self._on_begin)
+            space.on_collision(_ROBOT, ctype, begin=self._on_begin,
+                               post_solve=self._on_post_solve, separate=self._on_separate)
 
         self._static_walls = scene_walls(config.room)
         self._world_map = self._build_map()
@@ -229,23 +231,39 @@ class World:
     def _on_begin(self, arbiter, space, data):
         other = arbiter.shapes[1]
         kind, name = self._names[other]
-        self._counts[kind] += 1
-        if kind == "furniture":
-            self._furniture_contacts[name] += 1
-        self._events.append(f"collision with {kind} {name!r}" if name else f"collision with {kind}")
-        if kind == "person" and self._closing_speed(other.body) > AT_FAULT_SPEED:
-            self._at_fault += 1
+        if not self._collisions.begin(kind, name, other, self._now):
+            return  # still touching, or touching again within the episode gap
+        if kind != "person":
+            self._events.append(f"collision with {kind} {name!r}" if name
+                                else f"collision with {kind}")
+            return
+        robot_c, person_c = self._closing_speeds(other)
+        fault = robot_c > AT_FAULT_SPEED and robot_c > person_c
+        if fault:
+            self._collisions.record_fault(kind)
+        verdict = "the robot's fault" if fault else "not the robot's fault"
+        self._events.append(f"collision with person {name!r} (robot closing {_speed(robot_c)} "
+                            f"m/s, person {_speed(person_c)} m/s: {verdict})")
 
-    def _closing_speed(self, person_body):
-        """The robot's speed towards the person (m/s): its velocity (before the contact
-        resolves) projected on the unit vector from its centre to the person's."""
-        rx, ry = self.robot_body.position
-        px, py = person_body.position
-        d = math.hypot(px - rx, py - ry)
-        if d == 0.0:
-            return 0.0
-        vx, vy = self.robot_body.velocity
-        return (vx * (px - rx) + vy * (py - ry)) / d
+    def _closing_speeds(self, person_shape):
+        """The robot's and the person's speeds towards each other at a first touch, m/s,
+        averaged over ``collisions.FAULT_WINDOW``."""
+        robot_xy = tuple(self.robot_body.position)
+        people_xy = [tuple(p.body.position) for p in self.people]
+        i = next(i for i, p in enumerate(self.people) if p.shape is person_shape)
+        towards = (people_xy[i][0] - robot_xy[0], people_xy[i][1] - robot_xy[1])
+        robot_v, people_v = self._history.mean_velocities(self._now, robot_xy, people_xy)
+        return closing_speeds(robot_v, people_v[i], towards)
+
+    def _on_post_solve(self, arbiter, space, data):
+        kind, _ = self._names[arbiter.shapes[1]]
+        self._collisions.impulse(kind, arbiter.total_impulse.length)
+
+    def _on_separate(self, arbiter, space, data):
+        other = arbiter.shapes[1]
+        hit = self._names.get(other)
+        if hit is not None:  # None: the space is being torn down
+            self._collisions.separate(hit[0], hit[1], other, self._now)
 
     def step(self, dt):
         """Advance the world by ``dt`` seconds (split into sub-steps of at most
@@ -285,6 +303,7 @@ class World:
         control.velocity = (v * math.cos(a), v * math.sin(a))
         control.angular_velocity = w
         t1 = self._advance_time(h)
+        before = []  # the people's positions at the start of the sub-step
         for person in self.people:
             if person.teleop is not None:  # driven by hand: the script waits, the offset grows
                 person.waited += h
@@ -293,6 +312,7 @@ class World:
             sx, sy = person.path.position(t1 - person.waited)
             x, y = sx + person.offset[0], sy + person.offset[1]
             px, py = person.body.position
+            before.append((px, py))
             gap = person.config.yield_gap
             if gap > 0.0 and person.teleop is None:
                 # Wait (the script pauses) rather than step closer to the robot than the gap.
@@ -307,6 +327,8 @@ class World:
             if step > 0.0:
                 person.walked += step
                 person.facing = math.atan2(y - py, x - px)
+        self._history.record(self.time, (rx, ry), before)
+        self._now = t1
         self.space.step(h)
         self.time = t1
         if self._removals and self._removals[0][0] <= t1:
@@ -317,7 +339,9 @@ class World:
         camera's scene and the map."""
         while self._removals and self._removals[0][0] <= self.time:
             _, name = self._removals.pop(0)
-            self.space.remove(self._furniture_shapes[name])
+            shape = self._furniture_shapes[name]
+            self._collisions.separate("furniture", name, shape, self.time)
+            self.space.remove(shape)
             self._removed.add(name)
             self._events.append(removal_event(name))
         self._static_walls = scene_walls(self.config.room, self._removed)
@@ -476,11 +500,10 @@ class World:
         return [f for f in self.config.room.furniture if f.name not in self._removed]
 
     def furniture_contacts(self, name):
-        """Collisions of the robot with the furniture item ``name`` since the start."""
-        try:
-            return self._furniture_contacts[name]
-        except KeyError:
-            raise ValueError(f"no furniture named {name!r}") from None
+        """Collision episodes of the robot with the furniture item ``name`` since the start."""
+        if name not in self._furniture_shapes:
+            raise ValueError(f"no furniture named {name!r}")
+        return self._collisions.episodes_with("furniture", name)
 
     def floor_color_at(self, x, y):
         """The albedo ``(r, g, b)`` of the floor at ``(x, y)``: the last marking that covers
@@ -515,9 +538,16 @@ class World:
         return events
 
     def collision_counts(self):
-        """Robot collisions since the start, per kind: ``{"person", "wall", "furniture"}``."""
-        return dict(self._counts)
+        """Robot collision episodes since the start, per kind: ``{"person", "wall",
+        "furniture"}`` (``collisions.EPISODE_GAP`` joins contacts with one body)."""
+        return self._collisions.episodes()
+
+    def collision_summary(self):
+        """Per kind: ``{"episodes", "contact_s", "max_impulse_ns"}``: collision episodes, the
+        time spent touching (s) and the largest contact impulse of one physics step (N s)."""
+        return self._collisions.summary(self.time)
 
     def at_fault_collisions(self):
-        """Collisions with a person that were the robot's fault (``AT_FAULT_SPEED``)."""
-        return self._at_fault
+        """Collision episodes with a person that were the robot's fault: it closed the gap
+        faster than the person, and faster than ``AT_FAULT_SPEED``."""
+        return self._collisions.at_fault("person")

@@ -19,6 +19,8 @@ import math
 from dataclasses import dataclass
 from typing import ClassVar
 
+from fpga_robotics.hw.errors import UserError
+
 __all__ = ["CONNECTORS", "MOUNT_KEYS", "Connector", "ConnectorError", "Mount", "Pin", "PinIO",
            "check_number", "connector_class", "parse_mount", "register"]
 
@@ -26,7 +28,7 @@ __all__ = ["CONNECTORS", "MOUNT_KEYS", "Connector", "ConnectorError", "Mount", "
 CONNECTORS = {}
 
 
-class ConnectorError(ValueError):
+class ConnectorError(UserError, ValueError):
     """A connector table that is malformed (unknown kind, bad parameter): a usage error."""
 
 

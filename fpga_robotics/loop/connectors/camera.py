@@ -14,7 +14,7 @@ from typing import ClassVar
 
 import numpy as np
 
-from fpga_robotics.cli.errors import UsageError
+from fpga_robotics.hw.errors import UsageError
 from fpga_robotics.sim.camera.scene import CameraPose
 from fpga_robotics.loop.connectors.base import Connector, Mount, Pin, register
 

@@ -16,7 +16,9 @@ import os
 
 import numpy as np
 
+from fpga_robotics.hw.errors import UserError
 from fpga_robotics.hw.validate import check_int
+
 from ..raster import DEFAULT_HFOV, CameraRenderer, vertical_fov
 from ..scene import CameraPose, Scene
 from .body import gait_angles, person_height
@@ -29,7 +31,7 @@ INSTALL_HINT = ('install it with: pip install -e ".[realistic]" and, on Debian/U
                 "apt-get install libegl1 libgl1-mesa-dri")
 
 
-class Render3DUnavailable(RuntimeError):
+class Render3DUnavailable(UserError, RuntimeError):
     """MuJoCo or an off-screen OpenGL context is missing; the message says how to install."""
 
 

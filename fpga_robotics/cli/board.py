@@ -1,0 +1,73 @@
+"""``fpga-robotics board``: export a board top (Verilog + LPF) and optionally build its
+bitstream (also ``fpga-robotics export --board NAME``); the flow is ``fpga_robotics.flow.board``.
+A timing failure or a failed tool is exit code 1."""
+
+import os
+import sys
+
+from fpga_robotics.cli.errors import UsageError
+from fpga_robotics.cli.param_options import add_param_arguments, params_from_args
+from fpga_robotics.cli.parser import CommandParser
+from fpga_robotics.flow.board import board_factory, board_names, build_bitstream, export_board
+from fpga_robotics.sim.files import check_output_dir
+
+__all__ = ["add_board_arguments", "main", "run_board"]
+
+
+def add_board_arguments(parser):
+    """The ``--board``/``--bitstream``/``--seed`` options (shared with ``export``)."""
+    parser.add_argument("--board", metavar="NAME",
+                        help=f"export a board top instead: one of {', '.join(board_names())}")
+    parser.add_argument("--bitstream", action="store_true",
+                        help="with --board: also run synthesis, place and route and packing")
+    parser.add_argument("--seed", type=int, default=None,
+                        help="with --bitstream: nextpnr placement seed (default: 1)")
+
+
+def run_board(args, params, out_dir, prog="fpga-robotics board"):
+    """Export (and optionally build) ``args.board`` into ``out_dir``; returns an exit code."""
+    board_factory(args.board)
+    if args.seed is not None and not args.bitstream:
+        raise UsageError("--seed is nextpnr's placement seed: it needs --bitstream")
+    seed = 1 if args.seed is None else args.seed
+    check_output_dir(out_dir, what="board output folder")
+    if not args.bitstream:
+        written = export_board(args.board, out_dir, params)
+        for path in written:
+            if path.endswith((".v", ".lpf")):
+                print(f"wrote {path}")
+        print(f"wrote {len(written)} files for board {args.board} in {out_dir}")
+        return 0
+    try:
+        report = build_bitstream(args.board, out_dir, params, seed=seed)
+    except RuntimeError as exc:
+        print(f"{prog}: error: {exc}", file=sys.stderr)
+        return 1
+    print(report.format())
+    if not report.timing_ok:
+        print(f"{prog}: error: timing failed (a clock is slower than required)",
+              file=sys.stderr)
+        return 1
+    print(f"wrote {report.bitstream}")
+    return 0
+
+
+def main(argv=None, prog="fpga-robotics board"):
+    parser = CommandParser(
+        prog=prog,
+        description="Export a board top (Verilog + LPF) and optionally build its bitstream.",
+    )
+    boards = board_names()
+    # With one board there is nothing to choose: it is the default.
+    parser.add_argument("--board", metavar="NAME", required=len(boards) > 1,
+                        default=boards[0] if len(boards) == 1 else None,
+                        help=f"one of {', '.join(boards)}")
+    parser.add_argument("-o", "--output", metavar="DIR", default=None,
+                        help="output directory (default: build/<board>)")
+    parser.add_argument("--bitstream", action="store_true",
+                        help="run synthesis, place and route and packing too")
+    parser.add_argument("--seed", type=int, default=None, help="nextpnr seed (default: 1)")
+    add_param_arguments(parser)
+    args = parser.parse_args(argv)
+    params = params_from_args(args)
+    return run_board(args, params, args.output or os.path.join("build", args.board), prog)

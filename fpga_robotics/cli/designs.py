@@ -1,0 +1,105 @@
+"""``fpga-robotics designs [REF]``: the designs a run can name (built-in, installed through
+the ``fpga_robotics.designs`` entry points, or the reference given), with their ports, the
+connectors they bind and the outputs recorded under their own names."""
+
+import argparse
+import sys
+
+from fpga_robotics.cli.errors import UsageError, run_cli
+
+__all__ = ["describe", "main"]
+
+
+def build_parser(prog):
+    p = argparse.ArgumentParser(
+        prog=prog, description="List the designs a scenario's design.top (or run --design) can "
+                               "name, with their ports and the connectors they bind.")
+    p.add_argument("reference", nargs="?", metavar="REF",
+                   help="describe only this design: a built-in name, FILE.py:Name, "
+                        "package.module:Name or verilog:TOP.v[,MORE.v] with --ports")
+    p.add_argument("--param", dest="params", action="append", default=[], metavar="NAME=VALUE",
+                   help="a parameter of REF (repeatable; TOML values)")
+    p.add_argument("--ports", metavar="PORTS.toml", help="the port map of a verilog: REF")
+    return p
+
+
+def _params(items):
+    import tomllib
+
+    params = {}
+    for item in items:
+        name, sep, text = item.partition("=")
+        if not sep or not name.strip().isidentifier():
+            raise UsageError(f"--param needs NAME=VALUE, got {item!r}")
+        try:
+            params[name.strip()] = tomllib.loads(f"v = {text}")["v"]
+        except tomllib.TOMLDecodeError:
+            params[name.strip()] = text.strip()
+    return params
+
+
+def describe(spec, origin):
+    """Lines describing a ``DesignSpec``."""
+    lines = [f"{spec.reference}  ({origin})  {spec.description}"]
+    if spec.ports:
+        lines.append("  ports: " + ", ".join(f"{d} {n}[{w}]" for n, (d, w) in
+                                             spec.ports.items()))
+    else:
+        lines.append("  ports: as Verilator reads them from the files (the port map names "
+                     "them)")
+    binds = "; ".join(f"{kind} ({', '.join(f'{pin}={port}' for pin, port in pins.items())})"
+                      for kind, pins in spec.bindings.items())
+    lines.append(f"  connectors: {binds or 'none'}")
+    lines.append(f"  recorded outputs: {', '.join(spec.extra_outputs) or 'none'}")
+    return lines
+
+
+def checked_verilog(spec, ports):
+    """A Verilog design's spec with its ports as Verilator reads them, the port map checked
+    against them (names, directions, widths, every input driven, the connectors' pins):
+    ``DesignError`` for the first mismatch."""
+    import dataclasses
+
+    from fpga_robotics.designs.builtin import connector_kinds
+    from fpga_robotics.designs.reference import DesignError
+    from fpga_robotics.sim.backends.base import BackendError
+    from fpga_robotics.sim.backends.foreign import ForeignDesign
+    from fpga_robotics.sim.backends.port_map import load_port_map
+
+    files = spec.reference[len("verilog:"):].split(",")
+    port_map = load_port_map(ports)
+    pins = bool(port_map.connectors or port_map.extra_outputs or not port_map.has_pixels)
+    try:
+        design = ForeignDesign(files, port_map, pins=pins, connector_kinds=connector_kinds())
+    except BackendError as exc:
+        raise DesignError(f"{ports}: {exc}".splitlines()[0]) from None
+    found = {name: ("in" if d == "input" else "out", width)
+             for name, (d, width, _signed) in design.ports.items()}
+    return dataclasses.replace(spec, ports=found,
+                               extra_outputs=tuple(port_map.extra_outputs))
+
+
+def main(argv=None, prog="fpga-robotics designs"):
+    from fpga_robotics.designs.builtin import TOPS
+    from fpga_robotics.designs.reference import entry_point_designs, resolve_design
+
+    args = build_parser(prog).parse_args(argv)
+    params = _params(args.params)
+    if args.reference is None:
+        if params or args.ports:
+            raise UsageError("--param and --ports describe a design REF: give one")
+        for name in TOPS:
+            print("\n".join(describe(resolve_design(name), "built-in")))
+        for name, target in entry_point_designs().items():
+            print("\n".join(describe(resolve_design(name), f"installed: {target}")))
+        return 0
+    spec = resolve_design(args.reference, params, ports=args.ports)
+    if spec.kind == "verilog":
+        spec = checked_verilog(spec, args.ports)
+    origin = {"builtin": "built-in", "amaranth": "Amaranth", "verilog": "Verilog"}[spec.kind]
+    print("\n".join(describe(spec, origin)))
+    return 0
+
+
+if __name__ == "__main__":
+    run_cli(main, sys.argv[1:], prog="fpga-robotics designs")

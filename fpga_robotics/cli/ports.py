@@ -1,0 +1,46 @@
+"""``fpga-robotics ports``: write the port map of the exported follow_target (``--example``)
+or check a port map file (docs/foreign.md); with ``--design verilog:FILES`` the map is checked
+against the design's real ports as Verilator reads them (names, directions, widths, every input
+driven, the connectors' pins)."""
+
+from fpga_robotics.cli.parser import CommandParser
+from fpga_robotics.sim.backends.port_map import load_port_map, write_follow_target_port_map
+
+__all__ = ["build_parser", "main"]
+
+
+def build_parser(prog="fpga-robotics ports"):
+    parser = CommandParser(prog=prog, description="Write the port map of the exported "
+                           "follow_target (--example) or check a port map file.")
+    parser.add_argument("path", help="the port map (TOML)")
+    parser.add_argument("--example", action="store_true",
+                        help="write the follow_target example to PATH (not replacing a file)")
+    parser.add_argument("--design", metavar="verilog:TOP.v[,MORE.v]",
+                        help="check the map against this design's real ports")
+    return parser
+
+
+def main(argv=None, prog="fpga-robotics ports"):
+    args = build_parser(prog).parse_args(argv)
+    if args.example:
+        write_follow_target_port_map(args.path)
+        print(f"wrote {args.path}")
+        return 0
+    port_map = load_port_map(args.path)
+    if args.design is not None:
+        _check_against_design(args.design, args.path)
+    connectors = "".join(f", connectors.{kind}" for kind in port_map.connectors)
+    print(f"{args.path}: {port_map.top}, outputs {', '.join(port_map.outputs)}{connectors}")
+    return 0
+
+
+def _check_against_design(reference, path):
+    """Raise a one-line ``DesignError`` at the first way the map and the design disagree."""
+    from fpga_robotics.cli.designs import checked_verilog
+    from fpga_robotics.designs.reference import DesignError, resolve_design
+
+    if not reference.startswith("verilog:"):
+        raise DesignError(f"--design must be a Verilog design, verilog:TOP.v[,MORE.v], got "
+                          f"{reference!r} (an Amaranth design needs no port map)")
+    spec = checked_verilog(resolve_design(reference, {}, ports=path), path)
+    print(f"{path}: matches {reference} ({len(spec.ports)} ports)")

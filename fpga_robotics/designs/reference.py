@@ -1,0 +1,481 @@
+"""Design references: one text names the design a run simulates, wherever it is taken
+(``[design] top``, ``run --design``, a campaign's ``design.top`` axis, ``fpga-robotics
+designs``).
+
+A reference is one of
+
+- a built-in name: ``follow_target``, ``follow_target_safe``, ``follow_line``;
+- a name an installed package registers in the entry-point group ``fpga_robotics.designs``
+  (``name = "package.module:Name"``);
+- ``path/to/file.py:Name`` or ``package.module:Name``: an Amaranth ``wiring.Component``
+  class, or a function returning one, called with the ``[design.params]`` values as keyword
+  arguments;
+- ``verilog:TOP.v[,MORE.v...]``: a Verilog design with its port map (docs/foreign.md).
+
+Ports bind by declaration (docs/your_design.md): a component's ``connectors`` attribute,
+``{kind: {connector pin: port}}``, binds the pins it names; a connector kind whose pins are all
+ports of the same names binds by that convention (``motor_left``/``motor_right`` are the
+wheels, ``pixels``/``color_sel`` the camera, ``trig``/``echo`` an ultrasound, ``pressed`` a
+bumper, ``line`` line sensors). Every output no connector reads, other than FollowTarget's
+per-frame outputs, is an extra output: recorded under its own name.
+"""
+
+import contextlib
+import functools
+import hashlib
+import importlib
+import importlib.metadata
+import importlib.util
+import inspect
+import sys
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from fpga_robotics.hw.errors import UsageError
+from fpga_robotics.designs.builtin import TOPS, Top
+
+__all__ = ["ENTRY_POINT_GROUP", "FRAME_OUTPUTS", "DesignError", "DesignSpec", "bindings_of",
+           "entry_point_designs", "extra_outputs_of", "is_builtin", "resolve_design"]
+
+#: The entry-point group through which installed packages offer designs.
+ENTRY_POINT_GROUP = "fpga_robotics.designs"
+#: FollowTarget's per-frame outputs: trajectory columns of their own, not extra outputs.
+FRAME_OUTPUTS = ("found", "proximity", "centroid_x", "centroid_leds")
+#: Outputs the camera's stream machinery reads (the frame strobe, the filtered stream).
+_STREAM_OUTPUTS = ("frame_done", "filtered__valid", "filtered__payload")
+#: The camera's stream input ports, by Amaranth's naming of ``pixels: In(stream)``.
+CAMERA_PORTS = ("pixels__valid", "pixels__payload")
+
+
+class DesignError(UsageError, ValueError):
+    """A design reference that cannot be resolved: the message says what and how to fix it."""
+
+
+@dataclass(frozen=True, eq=False)
+class DesignSpec:
+    """A resolved design reference.
+
+    Attributes
+    ----------
+    reference : str
+        The reference as resolved (a file path made absolute).
+    kind : str
+        ``"builtin"``, ``"amaranth"`` or ``"verilog"``.
+    description : str
+    ports : dict
+        Port name -> (direction ``"in"``/``"out"``, width); empty for a Verilog design (its
+        widths come from Verilator when it is built).
+    bindings : dict
+        Connector kind -> {connector pin: design port}.
+    extra_outputs : tuple
+        The outputs no connector reads, recorded under their own names.
+    params : dict
+        The keyword arguments the component is built with.
+    top : Top
+        What the closed loop runs (``fpga_robotics.designs.builtin.Top``).
+    """
+
+    reference: str
+    kind: str
+    description: str
+    ports: dict
+    bindings: dict
+    extra_outputs: tuple
+    params: dict = field(default_factory=dict)
+    top: Top = None
+
+    @property
+    def camera(self):
+        return "camera" in self.bindings
+
+    def build(self):
+        """A new Amaranth component of the design (a built-in one at its default
+        parameters); not for Verilog designs, which Verilator builds."""
+        if self.kind == "verilog":
+            raise DesignError(f"design {self.reference!r} is Verilog: Verilator builds it")
+        if self.kind == "builtin":
+            from fpga_robotics.designs.builtin import build_component, design_tables
+            from fpga_robotics.hw.params import FollowTargetParams
+
+            return build_component(self.top, FollowTargetParams(), design_tables(self.top, {}))
+        return self.top.component()
+
+
+def is_builtin(reference):
+    return reference in TOPS
+
+
+def entry_point_designs():
+    """Designs installed packages register: name -> ``"module:Name"``."""
+    return {ep.name: ep.value
+            for ep in importlib.metadata.entry_points(group=ENTRY_POINT_GROUP)}
+
+
+def resolve_design(reference, params=None, *, ports=None, base=None):
+    """The ``DesignSpec`` of ``reference`` built with ``params`` (``[design.params]``).
+
+    ``ports`` is the port map of a ``verilog:`` reference; ``base`` the folder relative file
+    paths are taken from (a scenario file's; default the current folder). Raises
+    ``DesignError`` (one line: what is wrong and how to fix it)."""
+    if not isinstance(reference, str) or not reference.strip():
+        raise DesignError(f"design.top must be a design reference (a built-in name, "
+                          f"FILE.py:Name, package.module:Name or verilog:FILE.v), got "
+                          f"{reference!r}")
+    params = dict(params or {})
+    reference = reference.strip()
+    if reference.startswith("verilog:"):
+        return _verilog_spec(reference, ports, base, params)
+    if reference in TOPS:
+        if params:
+            raise DesignError(f"design.params: the built-in design {reference!r} takes its "
+                              f"parameters from [design] and its own tables, not "
+                              f"design.params ({', '.join(sorted(params))})")
+        return _builtin_spec(TOPS[reference])
+    installed = entry_point_designs()
+    target = installed.get(reference, reference)
+    if ":" not in target:
+        raise DesignError(
+            f"unknown design {reference!r}: give a built-in name ({', '.join(TOPS)}"
+            f"{', ' + ', '.join(installed) if installed else ''}), FILE.py:Name, "
+            f"package.module:Name or verilog:FILE.v")
+    where, _, name = target.rpartition(":")
+    if where.endswith(".py"):
+        path = Path(where).expanduser()
+        if not path.is_absolute() and base is not None:
+            path = Path(base) / path
+        reference = f"{path.resolve()}:{name}"
+    else:
+        reference = target  # an installed design's name stands for its module:Name
+    frozen = tuple(sorted((k, _freeze(v)) for k, v in params.items()))
+    return _amaranth_spec(reference, frozen, _stamp(reference))
+
+
+def _freeze(value):
+    return tuple(map(_freeze, value)) if isinstance(value, list) else value
+
+
+def _stamp(reference):
+    """What makes a cached resolution stale: the design file's modification time."""
+    where = reference.rpartition(":")[0]
+    if where.endswith(".py"):
+        try:
+            return Path(where).stat().st_mtime_ns
+        except OSError:
+            return None
+    return None
+
+
+# Built-in designs ------------------------------------------------------------------------
+
+
+#: id of a registered ``Top`` -> (the Top, its spec): ``register_top`` may replace a name.
+_TOP_SPECS = {}
+
+
+def _builtin_spec(registered):
+    cached = _TOP_SPECS.get(id(registered))
+    if cached is not None and cached[0] is registered:
+        return cached[1]
+    from fpga_robotics.designs.builtin import build_component, design_tables
+    from fpga_robotics.hw.params import FollowTargetParams
+
+    component = build_component(registered, FollowTargetParams(),
+                                design_tables(registered, {}))
+    ports = component_ports(component)
+    bindings = bindings_of(component, ports, registered.bindings)
+    extra = {n: n for n in extra_outputs_of(ports, bindings)}
+    extra.update(registered.extra_outputs)
+    top = Top(registered.name, registered.description, camera="camera" in bindings,
+              tables=registered.tables, bindings=bindings, extra_outputs=extra,
+              component=registered.component,
+              takes_follow_target_params=registered.takes_follow_target_params)
+    spec = DesignSpec(registered.name, "builtin", registered.description, ports, bindings,
+                      tuple(extra), {}, top)
+    _TOP_SPECS[id(registered)] = (registered, spec)
+    return spec
+
+
+# Amaranth designs of one's own ------------------------------------------------------------
+
+
+@functools.lru_cache(maxsize=64)
+def _amaranth_spec(reference, frozen_params, _stamp):
+    params = {k: list(v) if isinstance(v, tuple) else v for k, v in frozen_params}
+    target = _load_target(reference)
+    _check_params(target, params, reference)
+    factory = functools.partial(_call, target, params, reference)
+    component = factory()
+    ports = component_ports(component)
+    bindings = bindings_of(component, ports)
+    extra = extra_outputs_of(ports, bindings)
+    doc = (inspect.getdoc(target) or "").strip().splitlines()
+    description = doc[0] if doc else f"the Amaranth design {reference.rpartition(':')[2]}"
+    name = reference.rpartition(":")[2]
+    top = Top(name, description, camera="camera" in bindings, bindings=bindings,
+              extra_outputs={n: n for n in extra}, component=factory,
+              takes_follow_target_params=False)
+    return DesignSpec(reference, "amaranth", description, ports, bindings, extra, params, top)
+
+
+def _load_target(reference):
+    where, _, name = reference.rpartition(":")
+    if not name.isidentifier():
+        raise DesignError(f"design {reference!r}: {name!r} is not a Python name; write "
+                          f"FILE.py:ClassName or package.module:ClassName")
+    if where.endswith(".py"):
+        module = _load_file(Path(where), reference)
+    else:
+        try:
+            module = importlib.import_module(where)
+        except ModuleNotFoundError as exc:
+            raise DesignError(f"design {reference!r}: no module {exc.name!r}; install the "
+                              f"package or give the file as path/to/file.py:{name}") from None
+        except Exception as exc:  # noqa: BLE001 - the user's module may raise anything
+            raise DesignError(f"design {reference!r}: importing {where} raised "
+                              f"{type(exc).__name__}: {_first_line(exc)}") from None
+    target = getattr(module, name, None)
+    if target is None:
+        found = sorted(n for n, v in vars(module).items() if _is_component_class(v)
+                       and v.__module__ == module.__name__)
+        raise DesignError(f"design {reference!r}: {where} has no {name!r}"
+                          + (f"; its components: {', '.join(found)}" if found else ""))
+    if not callable(target):
+        raise DesignError(f"design {reference!r}: {name} is a {type(target).__name__}; it "
+                          f"must be a wiring.Component class or a function returning one")
+    if inspect.isclass(target) and not _is_component_class(target):
+        raise DesignError(f"design {reference!r}: class {name} is not an Amaranth "
+                          f"wiring.Component; derive it from amaranth.lib.wiring.Component")
+    return target
+
+
+def _load_file(path, reference):
+    if not path.is_file():
+        raise DesignError(f"design {reference!r}: no file {str(path)!r}; give the path of "
+                          f"a .py file (relative paths from the scenario file's folder)")
+    # A module name of its own per file, so that two files of one name do not collide.
+    name = "fpga_robotics_user_design_" + hashlib.sha256(
+        str(path).encode()).hexdigest()[:12]
+    spec = importlib.util.spec_from_file_location(name, path)
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[name] = module
+    try:
+        spec.loader.exec_module(module)
+    except Exception as exc:  # noqa: BLE001 - the user's file may raise anything
+        sys.modules.pop(name, None)
+        line = _error_line(exc, path)
+        raise DesignError(f"design {reference!r}: loading {path.name}{line} raised "
+                          f"{type(exc).__name__}: {_first_line(exc)}") from None
+    return module
+
+
+def _error_line(exc, path):
+    if isinstance(exc, SyntaxError) and exc.lineno:
+        return f" (line {exc.lineno})"
+    tb = exc.__traceback__
+    line = None
+    while tb is not None:
+        if Path(tb.tb_frame.f_code.co_filename) == path:
+            line = tb.tb_lineno
+        tb = tb.tb_next
+    return f" (line {line})" if line else ""
+
+
+def _first_line(exc):
+    text = str(exc).strip()
+    return text.splitlines()[0] if text else "(no message)"
+
+
+def _is_component_class(value):
+    from amaranth.lib import wiring
+
+    return inspect.isclass(value) and issubclass(value, wiring.Component)
+
+
+def _check_params(target, params, reference):
+    """``params`` against the signature of ``target``: known names, required ones given,
+    each value of its annotation's (or default's) type."""
+    try:
+        signature = inspect.signature(target)
+    except (TypeError, ValueError):
+        return
+    known = {n: p for n, p in signature.parameters.items()
+             if p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY)}
+    takes_any = any(p.kind == p.VAR_KEYWORD for p in signature.parameters.values())
+    name = reference.rpartition(":")[2]
+    for key, value in params.items():
+        if key not in known:
+            if takes_any:
+                continue
+            raise DesignError(f"design.params.{key}: {name} takes no parameter {key!r}; it "
+                              f"takes: {', '.join(known) or 'none'}")
+        expected = _expected_type(known[key])
+        if expected is not None and not _fits(value, expected):
+            raise DesignError(f"design.params.{key} must be {_type_name(expected)} (a "
+                              f"parameter of {name}), got {value!r}")
+    missing = [n for n, p in known.items() if p.default is p.empty and n not in params]
+    if missing:
+        raise DesignError(f"design {reference!r}: parameter {missing[0]!r} has no default; "
+                          f"give it in [design.params] (or --set design.params."
+                          f"{missing[0]}=VALUE)")
+
+
+def _expected_type(parameter):
+    annotation = parameter.annotation
+    if isinstance(annotation, str):  # from __future__ import annotations
+        annotation = {"int": int, "float": float, "bool": bool, "str": str,
+                      "list": list, "tuple": tuple}.get(annotation)
+    if annotation in (int, float, bool, str, list, tuple):
+        return annotation
+    default = parameter.default
+    if default is not parameter.empty and default is not None:
+        kind = type(default)
+        if kind in (int, float, bool, str, list, tuple):
+            return kind
+    return None
+
+
+def _fits(value, expected):
+    if expected is bool:
+        return isinstance(value, bool)
+    if isinstance(value, bool):
+        return False
+    if expected is float:
+        return isinstance(value, (int, float))
+    if expected in (list, tuple):
+        return isinstance(value, (list, tuple))
+    return isinstance(value, expected)
+
+
+def _type_name(kind):
+    return {int: "an integer", float: "a number", bool: "true or false", str: "a string",
+            list: "an array", tuple: "an array"}[kind]
+
+
+def _call(target, params, reference):
+    """``target(**params)``, the component it returns (an error names what went wrong)."""
+    from amaranth.lib import wiring
+
+    values = {k: tuple(v) if isinstance(v, list) else v for k, v in params.items()}
+    try:
+        component = target(**values)
+    except Exception as exc:  # noqa: BLE001 - the user's constructor may raise anything
+        raise DesignError(f"design {reference!r}: building it raised "
+                          f"{type(exc).__name__}: {_first_line(exc)}") from None
+    if not isinstance(component, wiring.Component):
+        raise DesignError(f"design {reference!r}: it returned {type(component).__name__}, "
+                          f"not an Amaranth wiring.Component")
+    return component
+
+
+def component_ports(component):
+    """Port name (as the generated Verilog names it) -> (direction, width). The component
+    was only looked at: it is marked so that Amaranth does not warn it was never used."""
+    from amaranth.hdl import Fragment
+
+    from fpga_robotics.hw.verilog import verilog_ports
+
+    ports = {name: ("in" if direction == "i" else "out", value.shape().width)
+             for name, (value, direction) in verilog_ports(component).items()}
+    # Elaborated once, so that neither it nor the submodules its constructor made warn
+    # when collected unused (a design that cannot elaborate fails when built for a run).
+    with contextlib.suppress(Exception):
+        Fragment.get(component, None)
+    return ports
+
+
+def _connector_pins():
+    """Connector kind -> its pin names (the camera's stream is its ``pixels`` pin)."""
+    from fpga_robotics.loop.connectors import CONNECTORS
+
+    return {kind: tuple(cls.pins) for kind, cls in CONNECTORS.items()}
+
+
+def bindings_of(component, ports, given=None):
+    """Connector kind -> {pin: port}: ``given`` and the component's declared ``connectors``,
+    then every kind whose pins are all ports of the same names (the camera: ``pixels`` a
+    stream input, ``color_sel`` when it has one)."""
+    declared = getattr(component, "connectors", None) or {}
+    if not isinstance(declared, dict):
+        raise DesignError(f"{type(component).__name__}.connectors must be a dict "
+                          f"{{kind: {{pin: port}}}}, got {declared!r}")
+    declared = {**declared, **(given or {})}
+    kinds = _connector_pins()
+    bindings = {}
+    for kind, pins in declared.items():
+        if kind not in kinds:
+            raise DesignError(f"{type(component).__name__}.connectors: unknown connector kind "
+                              f"{kind!r}; known: {', '.join(sorted(kinds))}")
+        if not isinstance(pins, dict):
+            raise DesignError(f"{type(component).__name__}.connectors[{kind!r}] must be a dict "
+                              f"{{pin: port}}, got {pins!r}")
+        for pin, port in pins.items():
+            if pin not in kinds[kind]:
+                raise DesignError(f"{type(component).__name__}.connectors[{kind!r}]: the "
+                                  f"{kind} connector has no pin {pin!r}; its pins: "
+                                  f"{', '.join(kinds[kind])}")
+            if kind == "camera" and pin == "pixels":
+                continue  # the stream: pixels__valid / pixels__payload
+            if port not in ports:
+                raise DesignError(f"{type(component).__name__}.connectors[{kind!r}][{pin!r}]: "
+                                  f"no port {port!r}; its ports: {', '.join(ports)}")
+        bindings[kind] = dict(pins)
+    for kind, pins in kinds.items():
+        if kind in bindings:
+            continue
+        if kind == "camera":
+            if all(ports.get(p, ("",))[0] == "in" for p in CAMERA_PORTS):
+                bindings[kind] = {"pixels": "pixels", **(
+                    {"color_sel": "color_sel"} if "color_sel" in ports else {})}
+        elif pins and all(p in ports for p in pins):
+            bindings[kind] = {p: p for p in pins}
+    return bindings
+
+
+def extra_outputs_of(ports, bindings):
+    """The outputs no connector reads and that are not FollowTarget's per-frame outputs."""
+    bound = {port for pins in bindings.values() for port in pins.values()}
+    camera = "camera" in bindings
+    return tuple(name for name, (direction, _width) in ports.items()
+                 if direction == "out" and name not in bound
+                 and not (camera and (name in FRAME_OUTPUTS or name in _STREAM_OUTPUTS)))
+
+
+# Verilog designs ------------------------------------------------------------------------
+
+
+def _verilog_spec(reference, ports, base, params):
+    from fpga_robotics.designs.builtin import foreign_top
+    from fpga_robotics.sim.backends.port_map import PortMapError, load_port_map
+
+    files = [f for f in reference[len("verilog:"):].split(",") if f.strip()]
+    if not files:
+        raise DesignError(f"design {reference!r}: name the Verilog files, "
+                          f"verilog:TOP.v[,MORE.v...]")
+    if params:
+        raise DesignError("design.params: a Verilog design takes no parameters here; set "
+                          "its parameters in the Verilog (or tie inputs in the port map's "
+                          "[constants])")
+    resolved = []
+    for text in files:
+        path = Path(text).expanduser()
+        if not path.is_absolute() and base is not None:
+            path = Path(base) / path
+        if not path.is_file():
+            raise DesignError(f"design {reference!r}: no file {text!r} (looked for "
+                              f"{str(path)!r})")
+        resolved.append(str(path))
+    if ports is None:
+        raise DesignError(f"design {reference!r} needs its port map: --ports PORTS.toml "
+                          f"(or design.ports in the scenario; docs/foreign.md)")
+    try:
+        port_map = load_port_map(ports)
+    except PortMapError as exc:
+        raise DesignError(f"design {reference!r}: {ports}: {exc}") from None
+    top = foreign_top(port_map)
+    wheels = {k: port_map.outputs[k].port for k in ("motor_left", "motor_right")
+              if k in port_map.outputs}
+    bindings = {**{k: v for k, v in top.bindings.items() if k != "wheels"},
+                **({"wheels": wheels} if wheels else {})}
+    return DesignSpec("verilog:" + ",".join(resolved), "verilog",
+                      f"the Verilog design {port_map.top} (port map {ports})", {}, bindings,
+                      (), {}, top)

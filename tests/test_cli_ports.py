@@ -1,0 +1,88 @@
+"""``fpga-robotics ports``: writes the exported follow_target's port map (never over a file),
+checks a port map, and reports a bad one as one line with exit code 2."""
+
+import pytest
+
+from fpga_robotics import cli
+
+
+def _ports(argv, capsys):
+    with pytest.raises(SystemExit) as info:
+        cli.main(["ports", *argv])
+    out, err = capsys.readouterr()
+    return info.value.code, out, err
+
+
+def test_example_is_written_and_then_checked(tmp_path, capsys):
+    path = tmp_path / "ports.toml"
+    code, out, err = _ports(["--example", str(path)], capsys)
+    assert (code, out, err) == (0, f"wrote {path}\n", "")
+    code, out, err = _ports([str(path)], capsys)
+    assert code == 0, err
+    # The six per-frame outputs of follow_target, as docs/foreign.md lists them.
+    assert out == (f"{path}: follow_target, outputs found, proximity, centroid_x, "
+                   "centroid_leds, motor_left, motor_right\n")
+
+
+def test_example_never_replaces_a_file(tmp_path, capsys):
+    path = tmp_path / "ports.toml"
+    path.write_text("keep me\n")
+    code, out, err = _ports(["--example", str(path)], capsys)
+    assert code == 2 and out == ""
+    assert err.startswith(f"fpga-robotics ports: error: cannot write {path}") and \
+        err.count("\n") == 1
+    assert path.read_text() == "keep me\n"
+
+
+@pytest.mark.parametrize("text, word", [
+    ("style = \n", "not valid TOML"),
+    ('style = "pixels"\n', "style"),
+])
+def test_a_bad_port_map_is_one_line(text, word, tmp_path, capsys):
+    path = tmp_path / "ports.toml"
+    path.write_text(text)
+    code, out, err = _ports([str(path)], capsys)
+    assert code == 2 and out == ""
+    assert err.startswith("fpga-robotics ports: error: ") and err.count("\n") == 1
+    assert word in err
+
+
+_USER = __import__("pathlib").Path(__file__).parent / "data" / "user_designs"
+
+
+def _noreset(tmp_path, edit=None):
+    """The no-reset bumper design's port map, optionally edited (old -> new)."""
+    text = (_USER / "bump_stop_noreset_ports.toml").read_text()
+    if edit is not None:
+        assert edit[0] in text
+        text = text.replace(*edit)
+    path = tmp_path / "ports.toml"
+    path.write_text(text)
+    return path, f"verilog:{_USER / 'bump_stop_noreset.v'}"
+
+
+def test_a_map_is_checked_against_the_design_it_names(tmp_path, capsys):
+    path, design = _noreset(tmp_path)
+    code, out, err = _ports([str(path), "--design", design], capsys)
+    assert code == 0, err
+    # clk, bump_i, left_dps, right_dps, hit_o: the five ports of bump_stop_noreset.v.
+    assert out.splitlines()[0] == f"{path}: matches {design} (5 ports)"
+
+
+@pytest.mark.parametrize("edit, message", [
+    (('pressed = "bump_i"', 'pressed = "bump_x"'), "has no port 'bump_x'"),
+    (("width = 12, signed = true }\nmotor_right", "width = 16, signed = true }\nmotor_right"),
+     "left_dps"),
+])
+def test_a_map_that_does_not_match_the_design_is_one_line(tmp_path, capsys, edit, message):
+    path, design = _noreset(tmp_path, edit)
+    code, out, err = _ports([str(path), "--design", design], capsys)
+    assert (code, out) == (2, "")
+    assert err.startswith("fpga-robotics ports: error: ") and err.count("\n") == 1, err
+    assert message in err
+
+
+def test_design_must_be_verilog(tmp_path, capsys):
+    path, _design = _noreset(tmp_path)
+    code, out, err = _ports([str(path), "--design", "follow_target"], capsys)
+    assert code == 2 and "must be a Verilog design" in err

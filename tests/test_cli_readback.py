@@ -1,0 +1,57 @@
+"""``fpga-robotics readback``: the frames of any design's recording (whatever entities it
+logs), ``--help``, and a file that is not a recording as one line with exit code 2."""
+
+import pytest
+import rerun as rr
+
+from fpga_robotics import cli
+
+
+def _recording(path, entities):
+    """An .rrd where each ``entities[name]`` lists the frames that entity is logged at."""
+    stream = rr.RecordingStream("readback-test")
+    stream.save(str(path))
+    stream.log("world/room", rr.Scalars(1.0), static=True)
+    for name, frames in entities.items():
+        for f in frames:
+            stream.set_time("frame", sequence=f)
+            stream.log(name, rr.Scalars(float(f)))
+    stream.flush()
+    stream.disconnect()
+    return path
+
+
+def _readback(argv, capsys):
+    with pytest.raises(SystemExit) as info:
+        cli.main(["readback", *argv])
+    out, err = capsys.readouterr()
+    return info.value.code, out, err
+
+
+@pytest.mark.parametrize("entities, frames", [
+    # a line follower: no design/ entity of FollowTarget's at all
+    ({"sensors/line/left": range(7), "robot/wheels": range(7)}, 7),
+    # entities logged at different frames: the frames are their union
+    ({"design/found": range(0, 10, 2), "sensors/ultrasound": range(1, 10, 2)}, 10),
+])
+def test_readback_counts_the_frames_of_any_recording(entities, frames, tmp_path, capsys):
+    path = _recording(tmp_path / "r.rrd", entities)
+    code, out, err = _readback([str(path)], capsys)
+    assert code == 0, err
+    head = out.splitlines()[0]
+    assert f", {frames} frames, " in head, out
+    for name, logged in entities.items():
+        assert f"  {name:22s} {len(logged):6d} rows" in out
+
+
+def test_readback_answers_help(capsys):
+    code, out, _ = _readback(["--help"], capsys)
+    assert code == 0 and out.startswith("usage: fpga-robotics readback")
+
+
+def test_a_file_that_is_not_a_recording_is_one_line(tmp_path, capsys):
+    junk = tmp_path / "junk.rrd"
+    junk.write_text("not a recording\n")
+    code, _, err = _readback([str(junk)], capsys)
+    assert code == 2
+    assert err.count("\n") == 1 and "is not a rerun recording" in err

@@ -1,0 +1,359 @@
+"""Designs of one's own by reference (docs/your_design.md): ``[design] top = "FILE.py:Name"``,
+``run --design REF``, ``[design.params]``; ports bound by name, every output no connector
+reads recorded under its own name (trajectory, summary, viewer); bad references one line.
+
+The designs live in tests/data/user_designs/, outside the package, as a user's would.
+"""
+
+import json
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+from amaranth.hdl import Fragment
+
+from fpga_robotics import cli
+from fpga_robotics.designs.reference import DesignError, resolve_design
+from fpga_robotics.loop.compressed import run_scenario
+from fpga_robotics.scenario.load import ScenarioError, load_scenario
+from fpga_robotics.sim.camera.frames import to_rgb444
+
+DESIGNS = Path(__file__).parent / "data" / "user_designs"
+WALL_STOP = DESIGNS / "wall_stop.toml"
+NEAR_RED = DESIGNS / "near_red.toml"
+#: The wall of wall_stop.toml (x = room width) and the ultrasound's mount ahead of the centre.
+WALL_X, SENSOR_FORWARD = 2.5, 0.1
+
+
+def _cli(argv, capsys):
+    with pytest.raises(SystemExit) as info:
+        cli.main(argv)
+    out = capsys.readouterr()
+    return info.value.code, out.out, out.err
+
+
+@pytest.fixture(scope="module")
+def wall_stop_run(tmp_path_factory):
+    """wall_stop.toml by reference, recorded to a .rrd."""
+    from fpga_robotics.viz import open_recorder
+
+    path = tmp_path_factory.mktemp("rrd") / "wall.rrd"
+    recorder = open_recorder(f"save:{path}", default_path=None)
+    try:
+        result = run_scenario(load_scenario(str(WALL_STOP)), backend="cxxrtl",
+                              recorder=recorder)
+    finally:
+        recorder.close()
+    return result, path
+
+
+def test_a_design_reference_resolves_its_ports_bindings_and_extra_outputs():
+    spec = resolve_design(f"{DESIGNS}/wall_stop.py:WallStop", {"speed": 100})
+    assert spec.kind == "amaranth" and spec.params == {"speed": 100}
+    assert spec.ports == {"trig": ("out", 1), "echo": ("in", 1), "motor_left": ("out", 16),
+                          "motor_right": ("out", 16), "distance_mm": ("out", 16),
+                          "stopped": ("out", 1)}
+    # By name: trig/echo are the ultrasound's pins, motor_left/right the wheels'.
+    assert spec.bindings == {"ultrasound": {"trig": "trig", "echo": "echo"},
+                             "wheels": {"motor_left": "motor_left",
+                                        "motor_right": "motor_right"}}
+    assert spec.extra_outputs == ("distance_mm", "stopped")
+    component = spec.build()
+    assert component.speed == 100
+    Fragment.get(component, None)  # used: Amaranth warns of a component never elaborated
+    # The built-in follow_target_safe declares its ultrasound pins on its class.
+    safe = resolve_design("follow_target_safe")
+    assert safe.bindings["ultrasound"] == {"trig": "us_trig", "echo": "us_echo"}
+    assert safe.extra_outputs == ("distance_mm", "obstacle")
+    assert resolve_design("follow_target").extra_outputs == ()
+
+
+def test_a_pin_sensor_design_stops_at_the_wall_and_records_its_outputs(wall_stop_run):
+    result, _ = wall_stop_run
+    traj, summary = result.trajectory, result.summary
+    assert summary["verdict"] == "pass" and summary["timing"] == "real_clock"
+    # Stopped by its own rule: the true distance from the sensor to the wall is below
+    # stop_mm (250) by at most the braking from 300 DPS (17 mm at the GoPiGo3's 1500 DPS/s)
+    # plus a measurement period of travel (20 ms at 0.17 m/s) and the echo's rounding.
+    gap_mm = 1000 * (WALL_X - (traj["x"][-1] + SENSOR_FORWARD))
+    assert 250 - 17 - 4 - 3 <= gap_mm < 250
+    assert traj["motor_left"][0] == 300 and traj["motor_left"][-1] == 0
+    # Every output no connector reads: a trajectory column under its own name ...
+    distance, stopped = traj["design.distance_mm"], traj["design.stopped"]
+    assert abs(distance[-1] - gap_mm) <= 3  # the design's own measurement of that gap
+    assert stopped[0] == 0 and stopped[-1] == 1
+    assert ((stopped == 1) == (traj["motor_left"] == 0)).all()
+    # ... a summary field ...
+    assert summary["extra_outputs"]["stopped"] == {"last": 1, "min": 0, "max": 1}
+    assert summary["extra_outputs"]["distance_mm"]["last"] == int(distance[-1])
+    assert summary["extra_outputs"]["distance_mm"]["min"] == int(np.nanmin(distance))
+
+
+def test_the_extra_outputs_are_viewer_series(wall_stop_run):
+    from fpga_robotics.viz.readback import read_rrd
+
+    result, path = wall_stop_run
+    entities = read_rrd(str(path)).entities
+    for name in ("distance_mm", "stopped"):
+        rows = entities[f"design/extra/{name}"]
+        scalars = next(v for k, v in rows.values.items() if "calar" in k)
+        assert [s[0] for s in scalars] == list(result.trajectory[f"design.{name}"])
+
+
+def test_a_camera_design_with_an_output_named_near(tmp_path):
+    frames = []
+    scenario = load_scenario(str(NEAR_RED))
+    result = run_scenario(scenario, backend="cxxrtl",
+                          on_frame=lambda r: frames.append(r.camera_rgb))
+    traj = result.trajectory
+    assert result.summary["verdict"] == "pass"
+    # red_count in row k is frame k-1's (latched at the first pixel of frame k), counted
+    # here from the camera's own frames: strongly red RGB444 pixels.
+    w, h = scenario.camera.width, scenario.camera.height
+    packed = [to_rgb444(f, w, h) for f in frames]
+    counts = [int(((p >> 8 >= 8) & ((p >> 4) & 15 < 5) & (p & 15 < 5)).sum()) for p in packed]
+    assert list(traj["design.red_count"][1:]) == counts[:-1]
+    near = traj["design.near"]
+    assert list(near[1:]) == [float(c > 300) for c in counts[:-1]]
+    assert near[0] == 0 and near[-1] == 1  # drove up to the person, then stopped
+    assert ((traj["motor_left"] == 0) == (near == 1)).all()
+    assert set(result.summary["extra_outputs"]) == {"near", "red_count"}
+
+
+def test_run_design_takes_a_reference_and_params_from_the_command_line(tmp_path, capsys):
+    summary = tmp_path / "s.json"
+    code, out, _ = _cli(["run", "--scenario", str(WALL_STOP), "--design",
+                         f"{DESIGNS}/wall_stop.py:wall_stop", "--set", "design.params={}",
+                         "--set", "design.params.speed=150", "--duration", "1",
+                         "--backend", "cxxrtl", "--rerun", "off", "--quiet",
+                         "--summary", str(summary)], capsys)
+    assert code == 0
+    data = json.loads(summary.read_text())
+    assert data["extra_outputs"]["stopped"] == {"last": 0, "min": 0, "max": 0}
+    assert "design output distance_mm" in out
+    # A function reference at speed 150 (--set): 1 s at 150 DPS after the wheels' ramp
+    # (0.1 s at 1500 DPS/s, half of it lost), the first 1 ms of actuation delay aside.
+    from fpga_robotics.sim.world import World
+
+    spec = World.from_config({"people": [], "robot": {"model": "gopigo3"}}).robot_spec
+    ramp = 150 / spec.wheel_accel_dps2
+    expected = np.radians(150) * spec.wheel_radius * (1 - 0.001 - ramp / 2)
+    assert data["path_length_m"] == pytest.approx(expected, abs=0.01)
+
+
+#: (case, reference, params, words of the one-line error).
+BAD = [
+    ("missing file", "nowhere.py:Design", {}, "no file"),
+    ("missing module", "no_such_package.designs:Design", {}, "no module 'no_such_package'"),
+    ("missing name", "broken.py:Missing", {}, "has no 'Missing'; its components: Sized"),
+    ("not a component", "broken.py:NotAComponent", {}, "is not an Amaranth wiring.Component"),
+    ("a function that raises", "broken.py:raises", {},
+     "building it raised ValueError: width 4 is not supported"),
+    ("a function returning no component", "broken.py:returns_a_number", {},
+     "it returned int, not an Amaranth wiring.Component"),
+    ("a parameter of the wrong type", "broken.py:Sized", {"width": "wide"},
+     "design.params.width must be an integer"),
+    ("an unknown parameter", "broken.py:Sized", {"depth": 2},
+     "Sized takes no parameter 'depth'; it takes: width"),
+    ("a syntax error", "syntax_error.py:Broken", {}, "loading syntax_error.py (line 1)"),
+    ("params of a built-in", "follow_target", {"speed": 1}, "takes its parameters from"),
+    ("an unknown name", "follow_me", {}, "unknown design 'follow_me'"),
+]
+
+
+@pytest.mark.parametrize("case, reference, params, message", BAD, ids=[c[0] for c in BAD])
+def test_bad_references_are_one_line_errors(case, reference, params, message, tmp_path,
+                                            capsys, monkeypatch):
+    shutil.copy(DESIGNS / "broken.py", tmp_path / "broken.py")
+    (tmp_path / "syntax_error.py").write_text("class Broken(\n")  # never closed
+    with pytest.raises(DesignError, match=message.replace("(", r"\(").replace(")", r"\)")):
+        resolve_design(reference, params, base=tmp_path)
+    # The same through the command line: exit 2, one line, nothing written.
+    monkeypatch.chdir(tmp_path)
+    before = sorted(p.name for p in tmp_path.iterdir())
+    argv = ["run", "--scenario", str(WALL_STOP), "--design", reference, "--rerun",
+            "save:out.rrd", "--summary", "out.json", "--quiet", "--set", "design.params={}"]
+    for key, value in params.items():
+        argv += ["--set", f"design.params.{key}={json.dumps(value)}"]
+    code, _, err = _cli(argv, capsys)
+    assert code == 2
+    assert len(err.strip().splitlines()) == 1, err
+    assert message in err
+    assert sorted(p.name for p in tmp_path.iterdir() if p.name != "__pycache__") == before
+
+
+def test_a_scenario_names_its_design_relative_to_its_folder(tmp_path):
+    shutil.copy(DESIGNS / "wall_stop.py", tmp_path / "mine.py")
+    text = WALL_STOP.read_text().replace("wall_stop.py:WallStop", "mine.py:WallStop")
+    (tmp_path / "s.toml").write_text(text)
+    scenario = load_scenario(str(tmp_path / "s.toml"), ["design.params.stop_mm=100"])
+    assert scenario.top == f"{(tmp_path / 'mine.py').resolve()}:WallStop"
+    assert scenario.design_params == {"speed": 300, "stop_mm": 100}
+    assert scenario.sim.timing == "real_clock"
+    with pytest.raises(ScenarioError, match="design.params.stop_mm must be an integer"):
+        load_scenario(str(tmp_path / "s.toml"), ['design.params.stop_mm="near"'])
+    with pytest.raises(ScenarioError, match="design.ultrasound is a table of a built-in"):
+        load_scenario(str(tmp_path / "s.toml"), ["design.ultrasound.trigger_us=12"])
+
+
+# Verilog designs: an active-low reset, no reset, an output no connector reads ------------
+
+DATA = Path(__file__).parent / "data"
+BUMP_WALL = DATA / "bump_wall.toml"
+
+
+def _verilog_run(capsys, tmp_path, design, ports, *more):
+    summary = tmp_path / f"{Path(ports).stem}.json"
+    code, out, err = _cli(["run", "--scenario", str(BUMP_WALL), "--design", design, "--ports",
+                           str(ports), "--rerun", "off", "--quiet", "--summary", str(summary),
+                           *more], capsys)
+    assert code == 0, err
+    return json.loads(summary.read_text()), out
+
+
+def test_verilog_designs_with_and_without_reset_record_an_unread_output(tmp_path, capsys):
+    # tests/data/bump_stop.v (active-low reset) with its hit_o recorded as an extra output.
+    ports = tmp_path / "ports.toml"
+    ports.write_text((DATA / "bump_stop_ports.toml").read_text()
+                     + '\n[extra_outputs]\nhit = "hit_o"\n')
+    with_reset, out = _verilog_run(capsys, tmp_path, f"verilog:{DATA / 'bump_stop.v'}", ports)
+    without, _ = _verilog_run(capsys, tmp_path,
+                              f"verilog:{DESIGNS / 'bump_stop_noreset.v'}",
+                              DESIGNS / "bump_stop_noreset_ports.toml")
+    for summary in (with_reset, without):
+        assert summary["verdict"] == "pass"
+        # Driving until the bumper closed, then stopped: hit went 0 -> 1 once.
+        assert summary["extra_outputs"] == {"hit": {"last": 1, "min": 0, "max": 1}}
+    assert "design output hit: last 1, min 0, max 1" in out
+    # A register's initial value is what the reset gave: the same run, to the millimetre.
+    assert with_reset["path_length_m"] == without["path_length_m"]
+    assert with_reset["sim_cycles"] == without["sim_cycles"]
+
+
+def test_a_verilog_design_by_reference_in_the_scenario(tmp_path):
+    ports = DESIGNS / "bump_stop_noreset_ports.toml"
+    text = BUMP_WALL.read_text() + (
+        f'[design]\ntop = "verilog:{DESIGNS / "bump_stop_noreset.v"}"\nports = "{ports}"\n')
+    (tmp_path / "s.toml").write_text(text)
+    result = run_scenario(load_scenario(str(tmp_path / "s.toml")), backend="auto")
+    traj = result.trajectory
+    assert ((traj["design.hit"] == 1) == (traj["motor_left"] == 0)).all()
+    assert ((traj["design.hit"] == 1) == (traj["bumper.pressed"] == 1)
+            ).sum() >= len(traj["t"]) - 1  # the latch follows the bumper within a row
+
+
+def test_a_design_without_wheels_runs_and_the_robot_stands(tmp_path):
+    text = BUMP_WALL.read_text().replace("start = [0.5, 0.5]", "start = [1.88, 0.5]") + (
+        f'[design]\ntop = "{DESIGNS / "bump_watch.py"}:BumpWatch"\n')
+    (tmp_path / "s.toml").write_text(text)
+    scenario = load_scenario(str(tmp_path / "s.toml"), ["sim.duration=0.5"])
+    result = run_scenario(scenario, backend="pysim")
+    traj = result.trajectory
+    assert "motor_left" in result.summary["absent_outputs"]
+    assert np.isnan(traj["motor_left"]).all() and result.summary["path_length_m"] == 0
+    # Placed 1 cm from the wall (x = 2 less the 0.11 m body): the 3 cm bumper is closed
+    # from the first step on (row 0 is read before it), one closing counted.
+    assert (traj["bumper.pressed"][1:] == 1).all()
+    assert traj["design.presses"][-1] == 1
+
+
+def test_the_page_shows_the_files_the_tests_run():
+    """docs/your_design.md's design, scenario and port map are these files, word for word."""
+    page = (Path(__file__).parent.parent / "docs" / "your_design.md").read_text()
+    for name in ("wall_stop.py", "wall_stop.toml", "bump_stop_noreset_ports.toml"):
+        assert (DESIGNS / name).read_text().rstrip("\n") + "\n```" in page, name
+
+
+def test_installed_packages_offer_designs_by_entry_point(tmp_path, monkeypatch, capsys):
+    """A distribution on the path with an ``fpga_robotics.designs`` entry point: its name is
+    a reference, listed by ``fpga-robotics designs``."""
+    package = tmp_path / "my_robot"
+    package.mkdir()
+    (package / "__init__.py").write_text("")
+    shutil.copy(DESIGNS / "wall_stop.py", package / "designs.py")
+    info = tmp_path / "my_robot-1.0.dist-info"
+    info.mkdir()
+    (info / "METADATA").write_text("Metadata-Version: 2.1\nName: my-robot\nVersion: 1.0\n")
+    (info / "entry_points.txt").write_text(
+        "[fpga_robotics.designs]\nwall_stopper = my_robot.designs:WallStop\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    spec = resolve_design("wall_stopper", {"stop_mm": 100})
+    assert spec.reference == "my_robot.designs:WallStop"
+    assert spec.extra_outputs == ("distance_mm", "stopped")
+    from fpga_robotics.cli.designs import main
+
+    assert main([]) == 0
+    out = capsys.readouterr().out
+    assert "my_robot.designs:WallStop  (installed: my_robot.designs:WallStop)" in out
+    assert "follow_line  (built-in)" in out
+
+
+def test_shadow_runs_a_previous_version_of_the_design_on_the_same_pins(tmp_path, capsys):
+    """--shadow REF in real-clock timing: the shadow gets every input the primary gets; its
+    wheels differ exactly while neither has stopped, its measurements never."""
+    old = (DESIGNS / "wall_stop.py").read_text().replace(
+        "Mux(self.stopped, 0, self.speed)", "Mux(self.stopped, 0, self.speed - 50)")
+    (tmp_path / "wall_stop_v1.py").write_text(old)
+    summary = tmp_path / "s.json"
+    code, out, err = _cli(["run", "--scenario", str(WALL_STOP), "--shadow",
+                           f"{tmp_path}/wall_stop_v1.py:WallStop", "--backend", "cxxrtl",
+                           "--rerun", "off", "--quiet", "--summary", str(summary)], capsys)
+    assert code == 0, err
+    shadow = json.loads(summary.read_text())["shadow"]
+    frames = shadow["frames"]
+    moving = shadow["differing_frames"]["motor_left"]
+    assert shadow["first_divergence"] == {
+        "frame": 0, "time_s": 0.0,
+        "outputs": {"motor_left": {"primary": 300, "shadow": 250},
+                    "motor_right": {"primary": 300, "shadow": 250}}}
+    assert shadow["differing_frames"]["motor_right"] == moving
+    assert shadow["differing_frames"]["distance_mm"] == 0
+    assert shadow["differing_frames"]["stopped"] == 0
+    assert shadow["differing_frames"]["trig"] == 0
+    assert 0 < moving < frames == 360
+    assert "first differs at frame 0 (0.00 s): motor_left 300 vs 250" in out
+
+
+def test_designs_checks_a_verilog_port_map_against_the_design(tmp_path, capsys):
+    verilog = f"verilog:{DESIGNS / 'bump_stop_noreset.v'}"
+    ports = DESIGNS / "bump_stop_noreset_ports.toml"
+    code, out, _ = _cli(["designs", verilog, "--ports", str(ports)], capsys)
+    assert code == 0
+    assert "ports: in clk[1], in bump_i[1], out left_dps[12], out right_dps[12], out hit_o[1]" \
+        in out
+    assert "recorded outputs: hit" in out
+    for change, message in ((("bump_i", "bump"),
+                             "the design bump_stop_noreset has no port 'bump'"),
+                            (('hit = "hit_o"', 'hit = "hit"'), "has no port 'hit'"),
+                            (('top = "bump_stop_noreset"', 'top = "bump_stop"'),
+                             "Verilator cannot read")):
+        bad = tmp_path / "bad.toml"
+        bad.write_text(ports.read_text().replace(*change))
+        code, _, err = _cli(["designs", verilog, "--ports", str(bad)], capsys)
+        assert code == 2 and len(err.strip().splitlines()) == 1, err
+        assert message in err, err
+
+
+def test_a_campaign_takes_design_references_and_their_params_as_axes(tmp_path, monkeypatch):
+    from fpga_robotics.sweep.campaign import load_campaign, read_campaign_file
+    from fpga_robotics.sweep.plan import make_plan
+
+    for name in ("wall_stop.py", "wall_stop.toml"):
+        shutil.copy(DESIGNS / name, tmp_path / name)
+    (tmp_path / "c.toml").write_text(
+        'scenarios = ["wall_stop.toml"]\ndesign = "wall_stop.py:wall_stop"\n'
+        'backend = "cxxrtl"\nset = ["design.params={}"]\n'
+        '[grid]\n"design.params.speed" = [100, 200]\n')
+    monkeypatch.chdir(tmp_path.parent)  # file paths are from the campaign's folder
+    data, path = read_campaign_file(str(tmp_path / "c.toml"))
+    plan = make_plan(load_campaign(data, source=str(path)))
+    assert [r.argv()[r.argv().index("--design") + 1] for r in plan.runs] == [
+        f"{tmp_path.name}/wall_stop.py:wall_stop"] * 2
+    # The design's file names the run: another version of it is another run.
+    first = plan.ids[plan.runs[0]]
+    (tmp_path / "wall_stop.py").write_text((DESIGNS / "wall_stop.py").read_text() + "\n# v2\n")
+    again = make_plan(load_campaign(read_campaign_file(str(tmp_path / "c.toml"))[0],
+                                    source=str(path)))
+    assert again.ids[again.runs[0]] != first
+    assert len(set(plan.ids.values())) == 2

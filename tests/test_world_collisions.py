@@ -1,0 +1,152 @@
+"""Collision episodes, contact time, impulse and fault, on hand-made contacts in a World.
+
+Expected times come from the motor ramp (``wheel_accel_dps2``) and the people's scripted
+speeds; the impulse of a stop from Newton (m v, plus the drive's push during that step).
+"""
+
+import math
+
+import pytest
+
+from fpga_robotics.sim.world import TURTLEBOT2, World
+from fpga_robotics.sim.world.collisions import EPISODE_GAP, CollisionLog
+
+DT = 1 / 200
+CONTACT = 0.2 + TURTLEBOT2.body_radius  # centres of a person and the robot when they touch
+RAMP = TURTLEBOT2.wheel_accel_dps2  # DPS per second
+
+
+def _dps(speed):
+    """Wheel DPS for a forward speed, m/s."""
+    return math.degrees(speed / TURTLEBOT2.wheel_radius)
+
+
+def _world(robot, people=(), room=None):
+    cfg = {"robot": robot, "people": list(people)}
+    if room:
+        cfg["room"] = room
+    return World.from_config(cfg, 0)
+
+
+def _run(world, seconds, events=None):
+    for _ in range(round(seconds / DT)):
+        world.step(DT)
+        if events is not None:
+            events += [(world.time, e) for e in world.drain_events()]
+
+
+def test_contacts_that_resume_within_the_gap_are_one_episode():
+    log = CollisionLog(("person",))
+    shape = object()
+    t = 1.0
+    stretches = 0.0
+    for _ in range(28):  # 28 touches of 10 ms, 3 ms apart: one person leaning in
+        assert log.begin("person", "p1", shape, t) is (t == 1.0)
+        log.separate("person", "p1", shape, t + 0.01)
+        stretches += 0.01
+        t += 0.013
+    assert log.episodes() == {"person": 1}
+    assert log.summary(t)["person"]["contact_s"] == pytest.approx(stretches)
+    # Touching again after more than the gap is a second episode.
+    assert log.begin("person", "p1", shape, t - 0.003 + EPISODE_GAP + 0.01)
+    assert log.episodes() == {"person": 2}
+    # Another body is an episode of its own, even at the same time.
+    assert log.begin("person", "p2", object(), t + EPISODE_GAP + 0.01)
+    assert log.episodes() == {"person": 3}
+
+
+def test_a_person_walking_steadily_into_a_parked_robot_is_one_episode_not_its_fault():
+    person = {"name": "p1", "waypoints": [[5.0, 3.0], [1.0, 3.0]], "speed": 0.6,
+              "loop": False}
+    world = _world({"start": [3.0, 3.0]}, [person])
+    events = []
+    _run(world, 8.0, events)
+    # They touch when the person has walked 2 - CONTACT, and part when the person stops
+    # at the end of the path (the robot, pushed at 0.6 m/s, slides on).
+    touch = (2.0 - CONTACT) / 0.6
+    stop = 4.0 / 0.6
+    assert [e for _, e in events] == [
+        ("collision with person 'p1' (robot closing 0.00 m/s, person 0.60 m/s: "
+        "not the robot's fault)")]
+    assert events[0][0] == pytest.approx(touch, abs=DT)
+    summary = world.collision_summary()
+    assert summary["person"]["episodes"] == world.collision_counts()["person"] == 1
+    assert summary["person"]["contact_s"] == pytest.approx(stop - touch, abs=DT)
+    assert world.at_fault_collisions() == 0
+
+
+def test_a_creeping_robot_hit_by_a_walking_person_is_not_at_fault():
+    # The robot creeps towards the person at 0.06 m/s (above AT_FAULT_SPEED), the person
+    # walks into it at 0.6 m/s: the person closed the gap.
+    person = {"name": "p1", "waypoints": [[5.0, 3.0], [1.0, 3.0]], "speed": 0.6,
+              "loop": False}
+    world = _world({"start": [3.0, 3.0]}, [person])
+    world.set_wheel_dps(_dps(0.06), _dps(0.06))
+    events = []
+    _run(world, 3.0, events)
+    assert [e for _, e in events] == [
+        ("collision with person 'p1' (robot closing 0.06 m/s, person 0.60 m/s: "
+        "not the robot's fault)")]
+    assert world.at_fault_collisions() == 0
+
+
+def _touch_time(dps, distance):
+    """When a robot starting still, commanded ``dps``, has covered ``distance``, s."""
+    v = TURTLEBOT2.wheel_radius * math.radians(dps)
+    ramp = dps / RAMP
+    return ramp + (distance - v * ramp / 2) / v
+
+
+def test_the_robot_driving_into_a_standing_person_is_one_episode_and_its_fault():
+    person = {"name": "bob", "waypoints": [[3.0, 3.0]]}
+    world = _world({"start": [2.0, 3.0]}, [person])
+    world.set_wheel_dps(300, 300)
+    events = []
+    _run(world, 6.0, events)  # it keeps pushing against the person to the end
+    touch = _touch_time(300, 1.0 - CONTACT)
+    assert [e for _, e in events] == [
+        ("collision with person 'bob' (robot closing 0.18 m/s, person 0.00 m/s: "
+        "the robot's fault)")]
+    assert events[0][0] == pytest.approx(touch, abs=DT)
+    summary = world.collision_summary()["person"]
+    assert summary["episodes"] == 1 and world.at_fault_collisions() == 1
+    # Still touching at the end: the contact counts up to now.
+    assert summary["contact_s"] == pytest.approx(6.0 - touch, abs=DT)
+
+
+def test_two_bumps_two_seconds_apart_are_two_episodes_and_a_quick_rebound_is_one():
+    person = {"name": "bob", "waypoints": [[3.0, 3.0]]}
+    world = _world({"start": [2.0, 3.0]}, [person])
+    world.set_wheel_dps(300, 300)
+    events = []
+    _run(world, 4.0, events)  # touches at about 3.5 s
+    world.set_wheel_dps(-300, -300)
+    _run(world, 0.25, events)  # parts after the wheels turn round (0.18 s), backs off
+    assert 3.0 - world.robot_pose()[0] > CONTACT  # the contact has broken
+    world.set_wheel_dps(300, 300)
+    _run(world, 1.0, events)  # back within a few tenths of a second: the same episode
+    assert world.collision_counts()["person"] == 1
+    world.set_wheel_dps(-300, -300)
+    _run(world, 1.5, events)
+    world.set_wheel_dps(300, 300)
+    _run(world, 3.0, events)
+    times = [t for t, e in events]
+    assert len(times) == 2 and times[1] - times[0] > 2.0
+    assert world.collision_counts()["person"] == 2
+    assert world.at_fault_collisions() == 2
+
+
+def test_a_wall_hit_gives_its_contact_time_and_impulse():
+    world = _world({"start": [6.5, 3.0]})
+    world.set_wheel_dps(1000, 1000)
+    _run(world, 5.0)
+    v = TURTLEBOT2.wheel_radius * math.radians(1000)
+    touch = _touch_time(1000, 8.0 - TURTLEBOT2.body_radius - 6.5)
+    wall = world.collision_summary()["wall"]
+    assert wall["episodes"] == 1
+    assert wall["contact_s"] == pytest.approx(5.0 - touch, abs=DT)
+    # Stopping m at v in one step, while the drive pushes with its traction for that step.
+    expected = TURTLEBOT2.mass * v + TURTLEBOT2.traction_force * DT
+    assert wall["max_impulse_ns"] == pytest.approx(expected, rel=0.02)
+    assert world.collision_summary()["person"] == {"episodes": 0, "contact_s": 0.0,
+                                                   "max_impulse_ns": 0.0}
