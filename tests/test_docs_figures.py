@@ -136,7 +136,7 @@ FIGURES = (
            "design --backends cxxrtl,verilator --resolutions 160x120 --no-trivial "
            "--frames 30 --min-seconds 2",
            _verilator_over_cxxrtl, "Verilator's CPU time a 160x120 frame over CXXRTL's"),
-    Figure("docs/backends.md", "16", "6",
+    Figure("docs/backends.md", "17", "8",
            "design --backends cxxrtl --resolutions 160x120,640x480 --no-trivial "
            "--frames 30 --min-seconds 2",
            _vga_over_qqvga, "CXXRTL's CPU time a 640x480 frame over a 160x120 one"),
