@@ -176,7 +176,7 @@ FIGURES = (
     Figure("docs/viewer.md", "2.5", "0.8",
            "viewer --frames 100 --repeats 3 --calibrate",
            _viewer_vga_over_qqvga, "log_frame's CPU time at 640x480 over 160x120"),
-    Figure("docs/ros.md", "1.3", "0.55",
+    Figure("docs/ros.md", "1.4", "0.7",
            "ros --only bag --repeats 3 --calibrate",
            _bag_in_calibrations, "a bag's CPU time a frame, in calibrations"),
     Figure("docs/model.md", "0.35", "0.2",
