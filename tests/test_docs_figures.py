@@ -152,7 +152,7 @@ FIGURES = (
     Figure("README.md", "2.2", "0.8",
            "loop --backend cxxrtl --resolutions 160x120 --duration 3 --repeats 3",
            _loop_over_design, "the closed loop's CPU time a frame over the design's alone"),
-    Figure("docs/foreign.md", "1.6", "0.5",
+    Figure("docs/foreign.md", "1.35", "0.3",
            "foreign --frames 20 --repeats 3",
            _foreign_over_builtin, "the exported design as a foreign design over built-in"),
     Figure("docs/camera.md", "0.24", "0.12",
