@@ -167,7 +167,7 @@ FIGURES = (
     Figure("docs/running.md", "1.35", "0.4",
            "loop --backend cxxrtl --resolutions 640x480 --duration 3 --repeats 3",
            _loop_over_design, "the same at 640x480"),
-    Figure("docs/running.md", "1.05", "0.25",
+    Figure("docs/running.md", "1.25", "0.35",
            "shadow --backend cxxrtl --duration 3 --repeats 3",
            _shadow_extra_over_own, "what a shadow design adds to a frame over its own time"),
     Figure("docs/viewer.md", "4.4", "1.5",
