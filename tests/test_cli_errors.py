@@ -41,7 +41,7 @@ def test_the_scan_finds_the_known_error_classes():
                  "fpga_robotics.sim.backends.port_map.PortMapError",
                  "fpga_robotics.scenario.load.ScenarioError",
                  "fpga_robotics.viz.errors.ViewerError",
-                 "fpga_robotics.cli.errors.UsageError"):
+                 "fpga_robotics.hw.errors.UsageError"):
         assert name in CLASSES
     assert len(CLASSES) >= 17
 

@@ -520,6 +520,10 @@ PLANS = {
     "fpga-robotics ports ports.toml":
         Plan(setup=("fpga-robotics ports --example ports.toml",),
              out=(r"ports\.toml: follow_target, outputs found, proximity",)),
+    "fpga-robotics ports ports.toml --design verilog:follow_target.v":
+        Plan(setup=("fpga-robotics ports --example ports.toml",
+                    "python -m fpga_robotics.export -o follow_target.v"),
+             out=(r"ports\.toml: matches verilog:follow_target\.v \(\d+ ports\)",)),
     "python -m fpga_robotics.mutation --mutants 200":
         Plan(shorter=(("--mutants", "12"), ("--width", "80"), ("--height", "60")),
              out=(r"unit judge: \d+ caught, \d+ equivalent on these frames: score",),
