@@ -129,7 +129,7 @@ def run(args):
         raise UsageError(str(exc)) from None
     print(
         f"viz logging cost per frame, file sink, {args.frames} frames x {args.repeats} runs, "
-        f"log_every={args.log_every}, jpeg_quality={args.jpeg_quality or 'auto'}"
+        f"log_every={args.log_every}, jpeg_quality={'auto' if args.jpeg_quality is None else args.jpeg_quality}"
     )
     figures = []
     with tempfile.TemporaryDirectory(prefix="viz-bench-") as folder:
