@@ -127,9 +127,10 @@ def run(args):
         open_recorder("off", default_path=None, **options).close()
     except ViewerError as exc:
         raise UsageError(str(exc)) from None
+    quality = "auto" if args.jpeg_quality is None else args.jpeg_quality
     print(
         f"viz logging cost per frame, file sink, {args.frames} frames x {args.repeats} runs, "
-        f"log_every={args.log_every}, jpeg_quality={'auto' if args.jpeg_quality is None else args.jpeg_quality}"
+        f"log_every={args.log_every}, jpeg_quality={quality}"
     )
     figures = []
     with tempfile.TemporaryDirectory(prefix="viz-bench-") as folder:
