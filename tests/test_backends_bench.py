@@ -27,7 +27,9 @@ def test_bench_prints_and_writes_figures(tmp_path, capsys):
     assert code == 0
     out = capsys.readouterr().out
     assert "ms/frame" in out and "cxxrtl (trivial)" in out
-    data = json.loads(path.read_text())
+    written = json.loads(path.read_text())
+    assert written["command"] == "fpga-robotics bench design"
+    data = written["figures"]
     rows = {(r["backend"], r["design"], r["width"]): r for r in data["results"]}
     assert set(rows) == {
         ("model", "follow_target", 40),
@@ -54,7 +56,7 @@ def test_bench_prints_and_writes_figures(tmp_path, capsys):
     assert "process_frame(RGB888 frame) as users call it" in out and "C++ loop" in out
     # The cycle count of a 40x16 frame is the pixel count plus the documented latency.
     assert rows[("cxxrtl", "passthrough", 40)]["cycles_per_frame"] == 40 * 16 + 1
-    assert data["machine"]["cpus"] >= 1
+    assert written["machine"]["cpus"] >= 1
     # FollowTarget against the trivial design, frames in alternation, per size.
     assert {(r["backend"], r["width"]) for r in data["paired"]} == {("cxxrtl", 40), ("cxxrtl", 48)}
     for r in data["paired"]:
@@ -172,7 +174,7 @@ def test_pysim_is_skipped_above_its_size_limit_with_a_note(capsys):
     [
         (["--resolutions", "160by120"], "WIDTHxHEIGHT"),
         (["--backends", "iverilog"], "unknown backend"),
-        (["--frames", "0"], "at least 1"),
+        (["--frames", "0"], "--frames must be 1..1000000"),
         (["--backends", "model", "--resolutions", "44x16"], "divisible by 8"),
         (
             [

@@ -478,7 +478,7 @@ PLANS = {
     "python -m fpga_robotics.run --scenario follow_person --rerun save:out/run.rrd":
         Plan(viewer=True, files=("out/run.rrd",),
              out=(r"saved \d+ frames .* to out/run\.rrd",)),
-    "python -m fpga_robotics.bench.viewer":
+    "fpga-robotics bench viewer":
         Plan(shorter=(("--frames", "2"), ("--repeats", "1")),
              out=(r"160x120: wall median", r"640x480: wall median")),
     # docs/foreign.md: your own Verilog design -----------------------------------------------
@@ -578,7 +578,7 @@ PLANS = {
     "python -m fpga_robotics.sweep mutation --seeds 0-19 --out runs/sweeps/mutation-20":
         Plan(shorter=(("--max-runs", "2"), ("--backend", "model"), ("--duration", "2")),
              files=("runs/sweeps/mutation-20/report.html",), out=(r"2 runs: 2 pass",)),
-    "python -m fpga_robotics.bench.foreign":
+    "fpga-robotics bench foreign":
         Plan(shorter=(("--frames", "2"), ("--repeats", "1")),
              out=(r"verilator \(built-in\) +[\d.]+ ms/frame",
                   r"foreign follow_target \(stream\) +[\d.]+ ms/frame +\([\d.]+x the built-in\)")),
@@ -668,34 +668,38 @@ PLANS = {
                   re.escape("  shadow frames that differ: proximity 96, centroid_leds 1, "
                             "motor_left 101, motor_right 101 (of 180)"))),
     # Benchmarks ------------------------------------------------------------------------------
-    "python -m fpga_robotics.bench [--backends model,pysim,cxxrtl,verilator] "
+    "fpga-robotics bench design [--backends model,pysim,cxxrtl,verilator] "
     "[--resolutions 160x120,320x240,640x480] [--frames 30] [--pysim-frames 3] "
     "[--pysim-max-pixels 19200] [--min-seconds 1.0] [--no-trivial] [--published DIR] "
-    "[--json bench.json]":
+    "[--json bench.json] [--calibrate]":
         Plan(out=tuple(rf"(?m)^{b}\s+{s}\s" for b in ("model", "cxxrtl", "verilator")
                        for s in ("160x120", "320x240", "640x480"))
              + (r"(?m)^pysim\s+160x120\s",
                 r"cxxrtl 160x120: FollowTarget at [\d.]+ of the trivial design's cycle rate")),
-    "python -m fpga_robotics.bench --backends cxxrtl,verilator --resolutions 160x120,640x480 "
+    "fpga-robotics bench design --backends cxxrtl,verilator --resolutions 160x120,640x480 "
     "--frames 30 --min-seconds 2 --published /tmp/published":
         Plan(excused="needs the published FPGA-Robotics RTL in /tmp/published, which is not part "
                      "of the project (docs/foreign.md says where it is); "
                      "tests/test_backends_bench.py runs the option's checks"),
-    "python -m fpga_robotics.bench.loop --backend cxxrtl --duration 10 --repeats 3":
+    "fpga-robotics bench calibrate":
+        Plan(shorter=(("--frames", "2"), ("--repeats", "1")),
+             out=(r"calibration: published preset, (cxxrtl|verilator|model), 160x120",
+                  r"(?m)^wall +[\d.]+ +[\d.]+ +[\d.]+$")),
+    "fpga-robotics bench loop --backend cxxrtl --duration 10 --repeats 3":
         Plan(shorter=(("--duration", "1"), ("--repeats", "1")),
              out=(r"closed loop 160x120: follow_person, cxxrtl",
                   r"closed loop 640x480: follow_person, cxxrtl",
                   r"the loop against the design alone, CPU time: whole [\d.]+x",
                   r"target 640x480: [\d.]+x real time by CPU time")),
-    "python -m fpga_robotics.bench.loop --backend cxxrtl --resolutions 160x120 --profile 12":
+    "fpga-robotics bench loop --backend cxxrtl --resolutions 160x120 --profile 12":
         Plan(shorter=(("--duration", "1"), ("--repeats", "1")),
              out=(r"cProfile of one run, 12 functions of largest own time",
                   r"tottime")),
-    "python -m fpga_robotics.bench.camera":
+    "fpga-robotics bench camera":
         Plan(shorter=(("--frames", "2"), ("--repeats", "1")),
              out=(r"(?m)^\s*160x120\s+[\d.]+", r"(?m)^\s*640x480\s+[\d.]+")),
     # docs/pins.md -------------------------------------------------------------------------------
-    "python -m fpga_robotics.bench.pins":
+    "fpga-robotics bench pins":
         Plan(shorter=(("--seconds", "0.02"), ("--pysim-seconds", "0.0002"), ("--repeats", "1")),
              out=((r"(?m)^cxxrtl +pins: +[\d.]+ Mcycles/s \(1,000,000 cycles, 1 frames, \d+ stops "
                   r"a run\); frame path [\d.]+ Mcycles/s, pins/frame [\d.]+ \(median of the runs' "
@@ -703,10 +707,10 @@ PLANS = {
                   r"(?m)^verilator +pins: +[\d.]+ Mcycles/s",
                   r"(?m)^pysim +pins: +[\d.]+ Mcycles/s \(10,000 cycles")),
     # docs/camera.md: the sensor model ---------------------------------------------------------
-    "python -m fpga_robotics.bench.camera --sensor --sizes 160x120,640x480":
+    "fpga-robotics bench camera --sensor --sizes 160x120,640x480":
         Plan(shorter=(("--frames", "2"), ("--repeats", "1")),
              out=(r"(?m)^\s*160x120(\s+[\d.]+){9}$", r"(?m)^\s*640x480(\s+[\d.]+){9}$")),
-    "python -m fpga_robotics.bench.camera --stage-images docs/images":
+    "fpga-robotics bench camera --stage-images docs/images":
         Plan(files=tuple(f"docs/images/sensor_stage_{i}.png" for i in range(7)),
              out=(r"sensor_stage_6\.png: RGB444",)),
     "python -m fpga_robotics.run --scenario divider --backend cxxrtl --set camera.sensor=ov7670":
@@ -755,7 +759,7 @@ PLANS = {
              out=(r"source bag:robot_bag:/camera/image_raw \(bag\)",
                   r"target found in 30 frames",
                   r"ROS 2 bag \(30 frames\) written to runs/robot_outputs")),
-    "python -m fpga_robotics.bench.ros":
+    "fpga-robotics bench ros":
         Plan(shorter=(("--frames", "2"), ("--repeats", "1")),
              out=(r"bag  \(--bag\): log_frame median [\d.]+ ms",
                   (r"live \(--live foxglove, one client\): log_frame median [\d.]+ ms; "
@@ -765,7 +769,7 @@ PLANS = {
         Plan(out=(PASS,)),
     "python -m pytest -q tests/test_render3d_agreement.py tests/test_render3d_people.py":
         Plan(collect=True, out=(r"\d+ tests collected",)),
-    "python -m fpga_robotics.bench.render3d_figures docs/figures":
+    "fpga-robotics bench render3d --figures docs/figures":
         Plan(files=("docs/figures/divider_3d.png", "docs/figures/lighting_3d.png"),
              out=(r"wrote docs/figures/divider_3d\.png",)),
     "python -m fpga_robotics.run --scenario divider_3d --rerun off":
@@ -788,7 +792,7 @@ PLANS = {
              duration_why="dusk falls by 8 s; by 16 s the person has been lost long enough to "
                           "fail found_min_fraction",
              out=(r"\[FAIL\] found_min_fraction",)),
-    "python -m fpga_robotics.bench.render3d":
+    "fpga-robotics bench render3d":
         Plan(shorter=(("--frames", "2"), ("--repeats", "1"), ("--seconds", "0.5"),
                       ("--backend", "model")),
              out=(r"(?m)^\s*raster\s+[\d.]+\s+[\d.]+\s+[\d.]+",
@@ -1037,6 +1041,10 @@ def test_shortening_rules():
         "python -m fpga_robotics.run --duration 20 --quiet --rerun off"
     assert effective("python -m fpga_robotics.bench [--frames 30] [--json b.json]", plan) == \
         "python -m fpga_robotics.bench --frames 2 --min-seconds 0"
+    assert effective("fpga-robotics bench design --json b.json", plan) == \
+        "fpga-robotics bench design --json b.json --frames 2 --min-seconds 0"
+    assert effective("fpga-robotics bench loop --duration 10", plan) == \
+        "fpga-robotics bench loop --duration 10"
     assert effective("python -m fpga_robotics.run --shadow 'a=1;b=2'", plan).startswith(
         "python -m fpga_robotics.run --shadow 'a=1;b=2' --duration 1")
     assert effective("python -m pytest -q tests/test_board_*.py -m \"not slow\"",

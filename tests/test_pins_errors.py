@@ -147,10 +147,11 @@ def test_real_clock_timing():
 
 @pytest.mark.parametrize("argv, message", [
     (["--backends", "cxxrtl,fast"], "unknown backend"),
-    (["--resolution", "160"], "--resolution must be WxH"),
+    (["--resolution", "160"], "--resolution is WIDTHxHEIGHT"),
     (["--resolution", "16x12"], "--resolution: the window width"),
     (["--clock-hz", "1e5"], "too few for 160 pixels; lower the resolution or fps"),
-    (["--repeats", "0"], "must be positive"),
+    (["--repeats", "0"], "--repeats must be 1..1000"),
+    (["--step", "0"], "must be positive"),
 ])
 def test_pin_bench_bad_arguments(argv, message):
     from fpga_robotics.cli.errors import UsageError

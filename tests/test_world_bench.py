@@ -1,14 +1,13 @@
-"""The physics benchmark: its command line (``python -m fpga_robotics.bench.world``, or the
-library module ``fpga_robotics.bench.world_physics`` as an alias) prints a line per world and
-reports bad arguments as one line with exit status 2."""
+"""The physics benchmark: its command line (``fpga-robotics bench world``, or
+``python -m fpga_robotics.bench world``) prints a line per world and reports bad arguments as
+one line with exit status 2."""
 
 import subprocess
 import sys
 
 import pytest
 
-from fpga_robotics.bench.world_physics import WORLDS
-from fpga_robotics.bench.world import main
+from fpga_robotics.bench.world import WORLDS, main
 
 
 def test_prints_a_line_per_world(capsys):
@@ -22,18 +21,19 @@ def test_prints_a_line_per_world(capsys):
     assert float(lines[-1].split()[6]) > 0
 
 
-@pytest.mark.parametrize("module,args,message", [
-    ("fpga_robotics.bench.world", ["--fps", "0"],
-     "python -m fpga_robotics.bench.world: error: --fps must be a number of hertz in (0, 240], got 0.0"),
-    ("fpga_robotics.bench.world", ["--frames", "0"],
-     "python -m fpga_robotics.bench.world: error: --frames must be 1..1000000, got 0"),
-    ("fpga_robotics.bench.world", ["--physics-hz", "nan"],
-     "python -m fpga_robotics.bench.world: error: --physics-hz must be a number of hertz in (0, 100000], got nan"),
-    ("fpga_robotics.bench.world", ["--fps", "300"],
-     "python -m fpga_robotics.bench.world: error: --fps must be a number of hertz in (0, 240], got 300.0"),
+@pytest.mark.parametrize("args,message", [
+    (["--fps", "0"],
+     "fpga-robotics bench world: error: --fps must be a number of hertz in (0, 240], got 0.0"),
+    (["--frames", "0"],
+     "fpga-robotics bench world: error: --frames must be 1..1000000, got 0"),
+    (["--physics-hz", "nan"],
+     "fpga-robotics bench world: error: --physics-hz must be a number of hertz in (0, 100000], got nan"),
+    (["--fps", "300"],
+     "fpga-robotics bench world: error: --fps must be a number of hertz in (0, 240], got 300.0"),
 ])
-def test_bad_arguments_are_one_line(module, args, message):
-    proc = subprocess.run([sys.executable, "-m", module, *args], capture_output=True,
+def test_bad_arguments_are_one_line(args, message):
+    proc = subprocess.run([sys.executable, "-m", "fpga_robotics.bench", "world", *args],
+                          capture_output=True,
                           check=False, text=True)
     assert (proc.returncode, proc.stdout) == (2, "")
     assert proc.stderr.splitlines() == [message]

@@ -1,7 +1,4 @@
-"""Benchmark of the simulation backends.
-
-    python -m fpga_robotics.bench [--backends model,cxxrtl] [--resolutions 160x120]
-                                  [--frames 30] [--published DIR] [--json bench.json]
+"""``fpga-robotics bench design``: every simulation backend, and the paired fraction.
 
 For every backend and resolution it runs seeded synthetic RGB888 frames through
 ``FollowTarget`` with ``process_frame`` as users call it, and prints the median milliseconds
@@ -13,24 +10,17 @@ practical limit of this machine. Builds (or cache loads) happen before timing an
 reported separately.
 """
 
-import argparse
-import contextlib
-import gc
-import math
-import os
-import platform
 import statistics
-import sys
 import time
 from pathlib import Path
 
 import numpy as np
 
-from fpga_robotics.cli.errors import UsageError, run_cli
+from fpga_robotics.bench import scaffold
+from fpga_robotics.cli.errors import UsageError
 from fpga_robotics.hw.params import FollowTargetParams
-from fpga_robotics.sim.camera import synthetic
 from fpga_robotics.sim.backends import BACKEND_NAMES, COMPILED_BACKENDS, BackendError, get_backend
-from fpga_robotics.sim.files import check_output_path, write_json_atomic
+from fpga_robotics.sim.camera import synthetic
 
 __all__ = ["main", "measure", "measure_paired", "parse_resolutions"]
 
@@ -52,16 +42,7 @@ TARGET_PYSIM_MS_160 = 1000.0
 
 
 def parse_resolutions(text):
-    sizes = []
-    for item in text.split(","):
-        try:
-            w, h = (int(v) for v in item.lower().split("x"))
-        except ValueError:
-            raise UsageError(
-                f"bad resolution {item!r}: write WIDTHxHEIGHT, e.g. 160x120,640x480"
-            ) from None
-        sizes.append((w, h))
-    return sizes
+    return scaffold.parse_sizes(text, "a resolution")
 
 
 def bench_frames(width, height, count, seed):
@@ -77,25 +58,13 @@ def _loop_seconds(backend):
     return getattr(backend, "last_loop_seconds", None)
 
 
-@contextlib.contextmanager
-def _gc_paused():
-    """No garbage collection while timing: a collection would land in one frame's time."""
-    was_enabled = gc.isenabled()
-    gc.disable()
-    try:
-        yield
-    finally:
-        if was_enabled:
-            gc.enable()
-
-
 def measure(backend, frames, min_seconds=0.0):
     """Median ms per frame (wall clock and CPU time) and cycles per second (wall clock) over
     ``frames``, after one warm-up frame; the frames repeat until ``min_seconds`` have passed,
     so that a short burst of other work on a shared machine cannot decide the median."""
     backend.process_frame(frames[0])
     times, cpu_times, cycles, loops = [], [], [], []
-    with _gc_paused():
+    with scaffold.gc_paused():
         begin = time.perf_counter()
         n = 0
         while n < len(frames) or time.perf_counter() - begin < min_seconds:
@@ -143,7 +112,7 @@ def measure_paired(design_backend, trivial_backend, frames, min_seconds=0.0):
     rates, preempted, cpu_rates = ([], []), ([], []), ([], [])
     for backend in backends:
         backend.process_frame(frames[0])
-    with _gc_paused():
+    with scaffold.gc_paused():
         begin = time.perf_counter()
         n = 0
         while not (rates[0] or preempted[0]) or time.perf_counter() - begin < min_seconds:
@@ -240,7 +209,7 @@ def run_published(paths, name, frames, min_seconds=0.0):
     ):
         published.process_frame(packed[0])
         ours.process_frame(frames[0])
-        with _gc_paused():
+        with scaffold.gc_paused():
             begin = time.perf_counter()
             n = 0
             while not times[0] or time.perf_counter() - begin < min_seconds:
@@ -258,11 +227,7 @@ def run_published(paths, name, frames, min_seconds=0.0):
             "frames": len(times[0])}
 
 
-def build_parser(prog="python -m fpga_robotics.bench"):
-    parser = argparse.ArgumentParser(
-        prog=prog,
-        description="Median ms per frame and simulated cycles per second of every backend.",
-    )
+def _options(parser):
     parser.add_argument(
         "--backends",
         default=",".join(BACKEND_NAMES),
@@ -270,15 +235,6 @@ def build_parser(prog="python -m fpga_robotics.bench"):
     )
     parser.add_argument(
         "--resolutions", default=DEFAULT_RESOLUTIONS, help=f"default {DEFAULT_RESOLUTIONS}"
-    )
-    parser.add_argument(
-        "--frames", type=int, default=30, help="distinct timed frames per case (30)"
-    )
-    parser.add_argument(
-        "--min-seconds",
-        type=float,
-        default=1.0,
-        help="repeat the frames until each case has run this long (1.0; not for pysim)",
     )
     parser.add_argument(
         "--pysim-frames",
@@ -306,8 +262,6 @@ def build_parser(prog="python -m fpga_robotics.bench"):
         "with the fastest compiled backend",
     )
     parser.add_argument("--seed", type=int, default=0, help="seed of the synthetic frames")
-    parser.add_argument("--json", metavar="PATH", help="also write the figures to PATH")
-    return parser
 
 
 def _format_row(r):
@@ -376,22 +330,14 @@ def summary(results, paired=()):
     return lines
 
 
-def main(argv=None, prog="python -m fpga_robotics.bench"):
-    args = build_parser(prog).parse_args(argv)
+def run(args):
     names = [n.strip() for n in args.backends.split(",") if n.strip()]
     for n in names:
         if n not in BACKEND_NAMES:
             raise UsageError(f"unknown backend {n!r}; choose from {', '.join(BACKEND_NAMES)}")
     sizes = parse_resolutions(args.resolutions)
-    if args.frames < 1 or args.pysim_frames < 1:
-        raise UsageError("--frames and --pysim-frames must be at least 1")
-    if not (math.isfinite(args.min_seconds) and args.min_seconds >= 0):
-        raise UsageError(f"--min-seconds must be a finite number >= 0, got {args.min_seconds}")
-    if args.json is not None:  # checked now, not after minutes of measuring
-        directory = os.path.dirname(os.path.abspath(args.json))
-        if not os.path.isdir(directory):
-            raise UsageError(f"cannot write {args.json}: no directory {directory}")
-        check_output_path(args.json, what="--json")
+    if args.pysim_frames < 1:
+        raise UsageError(f"--pysim-frames must be at least 1, got {args.pysim_frames}")
     published = published_files(args.published) if args.published else None
 
     results, paired, notes = [], [], []
@@ -468,38 +414,9 @@ def main(argv=None, prog="python -m fpga_robotics.bench"):
         )
     for line in notes + summary(results, paired):
         print(line)
-    if args.json:
-        _write_json(args.json, results, paired, notes, published_row)
-        print(f"figures written to {args.json}")
-    return 0
+    return {"results": results, "paired": paired, "notes": notes, "published": published_row,
+            "summary": summary(results, paired)}
 
 
-def _write_json(path, results, paired, notes, published=None):
-    from fpga_robotics.sim.backends.toolchain import find_compiler
-
-    try:
-        compiler = find_compiler().version
-    except BackendError:
-        compiler = None
-    data = {
-        "machine": {
-            "platform": platform.platform(),
-            "python": platform.python_version(),
-            "cpus": os.cpu_count(),
-            "compiler": compiler,
-        },
-        "results": results,
-        "paired": paired,
-        "notes": notes,
-        "published": published,
-        "summary": summary(results, paired),
-    }
-    write_json_atomic(path, data, what="--json")
-
-
-def cli():
-    run_cli(main, sys.argv[1:], prog="python -m fpga_robotics.bench")
-
-
-if __name__ == "__main__":
-    cli()
+main = scaffold.command(run, __doc__, name="design", options=_options, frames=30,
+                        min_seconds=1.0)

@@ -1,43 +1,44 @@
-"""``python -m fpga_robotics.bench.foreign``: the exported ``follow_target`` run as a
+"""``fpga-robotics bench foreign``: the exported ``follow_target`` run as a
 foreign Verilog design (through a stream port map) against the built-in verilator backend,
-milliseconds per frame on the same frames. Both build once into the cache; the first run
-compiles for a minute or so.
+milliseconds per frame on the same frames, taken in alternation (each frame through one, then
+the other, taking turns at going first) and timed by the thread's CPU time, so that both see
+the same machine. Both build once into the cache; the first run compiles for a minute or so.
 """
 
-import argparse
 import sys
 import tempfile
 import time
 from pathlib import Path
 
+from fpga_robotics.bench import scaffold
 from fpga_robotics.hw.params import FollowTargetParams
 from fpga_robotics.hw.verilog import generate_verilog
-from fpga_robotics.sim.camera import synthetic
 from fpga_robotics.sim.backends import get_backend
 from fpga_robotics.sim.backends.foreign import ForeignVerilatorBackend
 from fpga_robotics.sim.backends.port_map import follow_target_port_map
+from fpga_robotics.sim.camera import synthetic
 
 __all__ = ["main"]
 
-def _ms_per_frame(backend, frames, repeats):
-    backend.process_frame(frames[0])  # warm-up
-    best = float("inf")
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        for frame in frames:
-            backend.process_frame(frame)
-        best = min(best, (time.perf_counter() - t0) / len(frames))
-    return best * 1e3
+
+def _alternating_ms(backends, frames, repeats):
+    """Median CPU milliseconds a frame of each backend: ``repeats`` passes over ``frames``,
+    each frame through both in turn."""
+    times = [[] for _ in backends]
+    for backend in backends:
+        backend.process_frame(frames[0])  # warm-up
+    with scaffold.gc_paused():
+        for n in range(repeats * len(frames)):
+            frame = frames[n % len(frames)]
+            order = range(len(backends)) if n % 2 == 0 else reversed(range(len(backends)))
+            for i in order:
+                with scaffold.stopwatch(time.thread_time) as t:
+                    backends[i].process_frame(frame)
+                times[i].append(t.cpu * 1e3)
+    return [scaffold.Spread.of(t).median for t in times]
 
 
-def main(argv=None):
-    parser = argparse.ArgumentParser(prog="python -m fpga_robotics.bench.foreign",
-                                     description=__doc__.split("\n\n")[0])
-    parser.add_argument("--frames", type=int, default=20, help="frames per repeat (default 20)")
-    parser.add_argument("--repeats", type=int, default=3, help="best of N (default 3)")
-    args = parser.parse_args(argv)
-    if args.frames < 1 or args.repeats < 1:
-        parser.error("--frames and --repeats must be >= 1")
+def run(args):
     params = FollowTargetParams(width=160, height=120)
     frames = synthetic.scenario("sweep", 160, 120, n_frames=args.frames, rng=1).frames
 
@@ -51,17 +52,17 @@ def main(argv=None):
         foreign = ForeignVerilatorBackend(params, files=[verilog], port_map=ports, on_build=tell)
     builtin = get_backend("verilator", params, on_build=tell)
     try:
-        ms_builtin = _ms_per_frame(builtin, frames, args.repeats)
-        ms_foreign = _ms_per_frame(foreign, frames, args.repeats)
+        ms_builtin, ms_foreign = _alternating_ms((builtin, foreign), frames, args.repeats)
     finally:
         builtin.close()
         foreign.close()
-    print(f"160x120, {args.frames} frames, best of {args.repeats}:")
+    print(f"160x120, {args.frames} frames x {args.repeats} passes in alternation; median CPU "
+          f"time a frame:")
     print(f"  verilator (built-in)          {ms_builtin:7.3f} ms/frame")
     print(f"  foreign follow_target (stream) {ms_foreign:6.3f} ms/frame  "
           f"({ms_foreign / ms_builtin:.2f}x the built-in)")
-    return 0
+    return {"builtin_cpu_ms": ms_builtin, "foreign_cpu_ms": ms_foreign,
+            "foreign_over_builtin": ms_foreign / ms_builtin}
 
 
-if __name__ == "__main__":
-    sys.exit(main())
+main = scaffold.command(run, __doc__, name="foreign", repeats=3, frames=20)

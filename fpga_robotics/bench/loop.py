@@ -1,9 +1,5 @@
 """``fpga-robotics bench loop``: where the closed loop's time goes, per frame.
 
-    python -m fpga_robotics.bench.loop [--scenario follow_person] [--backend auto]
-                                       [--resolutions 160x120,640x480] [--duration 10]
-                                       [--repeats 3] [--profile 0]
-
 Each size runs the scenario once untimed (it keeps the frames), then ``--repeats`` turns of:
 the loop as users run it (no timers, no frame records), the design alone on the kept frames,
 and the loop with every step of ``ClosedLoop`` timed (one compiled model, built or loaded
@@ -20,20 +16,17 @@ misses, which count as the rest's against the design alone). ``--profile N`` add
 under cProfile.
 """
 
-import argparse
 import cProfile
 import io
 import math
 import pstats
 import statistics
-import sys
 import time
 
-from fpga_robotics.cli.errors import UsageError, run_cli
+from fpga_robotics.bench import scaffold
+from fpga_robotics.cli.errors import UsageError
 
-__all__ = ["PROG", "STEPS", "main", "measure"]
-
-PROG = "python -m fpga_robotics.bench.loop"
+__all__ = ["STEPS", "main", "measure"]
 
 #: Targets of issue 12 at 160x120 and 640x480.
 TARGET_LOOP_RATIO = 2.2
@@ -126,9 +119,9 @@ def _timed_loop_class():
 
 def _timed(fn):
     """``fn()``'s wall and CPU time (this thread), seconds."""
-    start, cpu_start = time.perf_counter(), time.thread_time()
-    fn()
-    return time.perf_counter() - start, time.thread_time() - cpu_start
+    with scaffold.stopwatch(time.thread_time) as t:
+        fn()
+    return t.wall, t.cpu
 
 
 def measure(scenario, design, repeats):
@@ -196,35 +189,35 @@ def _profile(scenario, design, top):
     return lines[next(i for i, ln in enumerate(lines) if "function calls" in ln):]
 
 
-def _resolutions(text):
-    from fpga_robotics.bench.design import parse_resolutions
+def _options(p):
+    from fpga_robotics.sim.backends import BACKEND_NAMES
 
-    return parse_resolutions(text)
-
-
-def main(argv=None, prog=PROG):
-    from fpga_robotics.loop.compressed import make_backend
-    from fpga_robotics.scenario.load import load_scenario
-    from fpga_robotics.sim.backends import BACKEND_NAMES, BackendError
-
-    p = argparse.ArgumentParser(prog=prog, description=__doc__.split("\n\n")[0])
     p.add_argument("--scenario", default="follow_person")
     p.add_argument("--backend", default="auto", choices=("auto", *BACKEND_NAMES))
     p.add_argument("--resolutions", default="160x120,640x480",
                    help="comma-separated WIDTHxHEIGHT list (default 160x120,640x480)")
     p.add_argument("--duration", type=float, default=10.0, help="simulated seconds a run (10)")
-    p.add_argument("--repeats", type=int, default=3, help="runs per size (default 3)")
     p.add_argument("--profile", type=int, default=0, metavar="N",
                    help="also print the N functions of largest own time (cProfile, one run)")
-    args = p.parse_args(argv)
-    if not 1 <= args.repeats <= 100:
+
+
+def _check(args):
+    if not args.repeats <= 100:
         raise UsageError(f"--repeats must be 1..100, got {args.repeats}")
     if not (math.isfinite(args.duration) and 0 < args.duration <= 600):
         raise UsageError(f"--duration must be 0..600 simulated seconds, got {args.duration}")
     if not 0 <= args.profile <= 200:
         raise UsageError(f"--profile must be 0..200 functions, got {args.profile}")
-    sizes = _resolutions(args.resolutions)
-    for w, h in sizes:
+    args.resolutions = scaffold.parse_sizes(args.resolutions, "a resolution")
+
+
+def run(args):
+    from fpga_robotics.loop.compressed import make_backend
+    from fpga_robotics.scenario.load import load_scenario
+    from fpga_robotics.sim.backends import BackendError
+
+    figures = []
+    for w, h in args.resolutions:
         scenario = load_scenario(args.scenario, [f'camera.resolution="{w}x{h}"',
                                                  f"sim.duration={args.duration}"])
         try:
@@ -233,6 +226,7 @@ def main(argv=None, prog=PROG):
             raise UsageError(f"the {args.backend} backend cannot run here: {exc}") from None
         with design:
             m = measure(scenario, design, args.repeats)
+            figures.append({"size": f"{w}x{h}", "backend": design.name, **m})
             steps = m["steps_ms"]
             print(f"closed loop {w}x{h}: {scenario.name}, {design.name}, {m['frames']} frames x "
                   f"{args.repeats} runs; ms per frame (median of the runs)")
@@ -272,12 +266,7 @@ def main(argv=None, prog=PROG):
                 print(f"  cProfile of one run, {args.profile} functions of largest own time:")
                 for line in _profile(scenario, design, args.profile):
                     print(f"    {line}")
-    return 0
+    return {"runs": figures}
 
 
-def cli():
-    run_cli(main, sys.argv[1:], prog=PROG)
-
-
-if __name__ == "__main__":
-    cli()
+main = scaffold.command(run, __doc__, name="loop", options=_options, check=_check, repeats=3)

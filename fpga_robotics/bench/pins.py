@@ -1,5 +1,5 @@
 """``fpga-robotics bench pins``: simulated clock cycles per wall second of the pin backends
-in real-clock time (also ``python -m fpga_robotics.bench.pins``).
+in real-clock time.
 
 The design is ``FollowTarget`` with a one-flip-flop echo beside it (``ping`` in, ``pong``
 out, one cycle later): the stand-in for a peripheral driver's pin traffic. The run is the
@@ -13,7 +13,6 @@ frame backend of the same simulator processes the same frames back to back (no b
 over as many cycles after each run, for the ratio of the pin path to the frame path.
 """
 
-import argparse
 import contextlib
 import statistics
 import time
@@ -22,11 +21,13 @@ from amaranth import Module
 from amaranth.lib import wiring
 from amaranth.lib.wiring import In, Out
 
+from fpga_robotics.bench import scaffold
 from fpga_robotics.hw.errors import UsageError
 from fpga_robotics.hw.params import FollowTargetParams
 from fpga_robotics.hw.top import FollowTarget, follow_target_signature
 from fpga_robotics.sim.backends import BackendError, get_backend
 from fpga_robotics.sim.camera.frames import to_rgb444
+from fpga_robotics.sim.camera.synthetic import blob_frame
 from fpga_robotics.sim.pins import (
     FILTERED_PORTS,
     PIXEL_PORTS,
@@ -35,7 +36,6 @@ from fpga_robotics.sim.pins import (
     get_pin_backend,
     real_clock_timing,
 )
-from fpga_robotics.sim.camera.synthetic import blob_frame
 
 __all__ = ["EchoedFollowTarget", "benchmark", "main"]
 
@@ -146,40 +146,31 @@ def benchmark(name, params, *, seconds, repeats, clock_hz, fps, step_s, toggle_e
     return pin_rates, frame_rates, runs
 
 
-def _size(text):
-    try:
-        w, h = (int(v) for v in text.lower().split("x"))
-    except ValueError:
-        raise UsageError(f"--resolution must be WxH like 160x120, not {text!r}") from None
-    return w, h
-
-
-def main(argv=None, prog="fpga-robotics bench pins"):
-    parser = argparse.ArgumentParser(prog=prog, description=(
-        "Simulated Mcycles per wall second of the pin backends in real-clock time: "
-        "FollowTarget frames at 30 fps on a 50 MHz clock plus a toggling pin."))
+def _options(parser):
     parser.add_argument("--backends", default=",".join(BACKENDS),
                         help=f"comma-separated (default {','.join(BACKENDS)})")
-    parser.add_argument("--resolution", default="160x120", type=_size)
+    parser.add_argument("--resolution", default="160x120",
+                        type=lambda text: scaffold.parse_size(text, "--resolution"))
     parser.add_argument("--seconds", type=float, default=1.0,
                         help="simulated seconds per compiled run (default 1)")
     parser.add_argument("--pysim-seconds", type=float, default=PYSIM_SECONDS,
                         help=f"simulated seconds per pysim run (default {PYSIM_SECONDS})")
-    parser.add_argument("--repeats", type=int, default=5, help="runs per backend (default 5)")
     parser.add_argument("--clock-hz", type=float, default=50e6)
     parser.add_argument("--fps", type=float, default=30.0)
     parser.add_argument("--step", type=float, default=1 / 240,
                         help="physics step in seconds: one run() target (default 1/240)")
     parser.add_argument("--toggle-every", type=int, default=5000,
                         help="cycles between toggles of the echoed pin (default 5000)")
-    args = parser.parse_args(argv)
+
+
+def run(args):
     names = [n for n in args.backends.split(",") if n]
     unknown = sorted(set(names) - set(BACKENDS))
     if unknown:
         raise UsageError(f"unknown backend(s) {', '.join(unknown)}; choose from "
                          f"{', '.join(BACKENDS)}")
-    if args.repeats < 1 or args.toggle_every < 1 or args.seconds <= 0 or args.step <= 0:
-        raise UsageError("--repeats, --toggle-every, --seconds and --step must be positive")
+    if args.toggle_every < 1 or not (args.seconds > 0 and args.step > 0):
+        raise UsageError("--toggle-every, --seconds and --step must be positive")
     width, height = args.resolution
     try:
         params = FollowTargetParams(width=width, height=height)
@@ -193,6 +184,7 @@ def main(argv=None, prog="fpga-robotics bench pins"):
           f"{args.fps:g} fps: line_period {timing.line_period}, pixel_period "
           f"{timing.pixel_period}, ping toggled every {args.toggle_every} cycles, "
           f"physics step {args.step * 1e3:.3g} ms, median of {args.repeats} runs")
+    figures = []
     for name in names:
         seconds = args.pysim_seconds if name == "pysim" else args.seconds
         try:
@@ -204,19 +196,18 @@ def main(argv=None, prog="fpga-robotics bench pins"):
             print(f"{name}: not available ({exc})")
             continue
         _, cycles, stops, streamed = runs[0]
+        row = {"backend": name, "pins_mcycles_per_s": statistics.median(pin_rates) / 1e6}
         line = (f"{name:9s} pins: {statistics.median(pin_rates) / 1e6:8.2f} Mcycles/s "
                 f"({cycles:,} cycles, {streamed} frames, {stops} stops a run)")
         if frame_rates:
             ratios = [p / f for p, f in zip(pin_rates, frame_rates, strict=True)]
+            row.update(frame_mcycles_per_s=statistics.median(frame_rates) / 1e6,
+                       pins_over_frame=statistics.median(ratios))
             line += (f"; frame path {statistics.median(frame_rates) / 1e6:.2f} Mcycles/s, "
                      f"pins/frame {statistics.median(ratios):.2f} (median of the runs' ratios)")
         print(line)
-    return 0
+        figures.append(row)
+    return {"backends": figures}
 
 
-if __name__ == "__main__":
-    import sys
-
-    from fpga_robotics.cli.errors import run_cli
-
-    run_cli(main, sys.argv[1:], prog="python -m fpga_robotics.bench.pins")
+main = scaffold.command(run, __doc__, name="pins", options=_options, repeats=5)

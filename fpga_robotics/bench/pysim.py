@@ -1,20 +1,16 @@
 """``fpga-robotics bench pysim``: time Amaranth's own simulator on ``FollowTarget``, one frame
-at a time, every frame checked against the golden model (also
-``fpga-robotics bench pysim``)."""
+at a time, every frame checked against the golden model."""
 
-import argparse
-import statistics
-import sys
 import time
 
-from fpga_robotics.cli.errors import UsageError, run_cli
+from fpga_robotics.bench import scaffold
 from fpga_robotics.cli.param_options import add_param_arguments, params_from_args
 from fpga_robotics.sim.backends.base import BackendError
 from fpga_robotics.sim.backends.model import ModelBackend
 from fpga_robotics.sim.backends.pysim import PysimBackend
 from fpga_robotics.sim.camera.synthetic import blob_frame
 
-__all__ = ["benchmark", "cli", "main"]
+__all__ = ["benchmark", "main"]
 
 
 def benchmark(params=None, *, frames=7, line_blank=0, frame_blank=0, seed=0):
@@ -39,33 +35,24 @@ def benchmark(params=None, *, frames=7, line_blank=0, frame_blank=0, seed=0):
     return wall, cpu, cycles
 
 
-def main(argv=None, prog="fpga-robotics bench pysim"):
-    parser = argparse.ArgumentParser(
-        prog=prog,
-        description="Time the pysim backend, one frame at a time, checked against the model.",
-    )
-    parser.add_argument("--frames", type=int, default=7, help="frames to time (default 7)")
+def _options(parser):
     parser.add_argument("--line-blank", type=int, default=0)
     parser.add_argument("--frame-blank", type=int, default=0)
     add_param_arguments(parser)
-    args = parser.parse_args(argv)
+
+
+def run(args):
     params = params_from_args(args)
-    if args.frames < 1:
-        raise UsageError("--frames must be >= 1")
     wall, cpu, cycles = benchmark(params, frames=args.frames, line_blank=args.line_blank,
                                   frame_blank=args.frame_blank)
     print(f"pysim {params.width}x{params.height}, {args.frames} frames, "
           f"{cycles[0]} cycles per frame, every frame equal to the golden model")
     print("wall s per frame: " + " ".join(f"{t:.3f}" for t in wall))
-    med = statistics.median(wall)
-    print(f"median {med:.3f} s wall ({cycles[0] / med:,.0f} cycles/s), "
-          f"{statistics.median(cpu):.3f} s CPU")
-    return 0
+    med = scaffold.Spread.of(wall).median
+    cpu_med = scaffold.Spread.of(cpu).median
+    print(f"median {med:.3f} s wall ({cycles[0] / med:,.0f} cycles/s), {cpu_med:.3f} s CPU")
+    return {"size": f"{params.width}x{params.height}", "frame_ms": med * 1e3,
+            "cpu_ms": cpu_med * 1e3, "cycles_per_frame": cycles[0]}
 
 
-def cli():
-    run_cli(main, sys.argv[1:], prog="fpga-robotics bench pysim")
-
-
-if __name__ == "__main__":
-    cli()
+main = scaffold.command(run, __doc__, name="pysim", options=_options, frames=7)

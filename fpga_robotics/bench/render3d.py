@@ -1,8 +1,5 @@
-"""``python -m fpga_robotics.bench.render3d`` (or ``fpga-robotics bench render3d``): the raster
-and the 3D renderer per frame, and the closed loop in each mode.
-
-    python -m fpga_robotics.bench.render3d [--frames 60] [--repeats 3] [--seconds 5]
-                                           [--sizes 160x120,640x480] [--backend auto]
+"""``fpga-robotics bench render3d``: the raster and the 3D renderer per frame, and the closed
+loop in each mode (``--figures DIR``: the figures of docs/render3d.md instead).
 
 Frames: the room of the shipped ``divider_3d`` scenario (its warm lamp, the person in red),
 seen from ``--frames`` poses on a loop through the room; per mode and size the median over
@@ -16,19 +13,14 @@ to the last; the start-up before the first frame (the 3D renderer's OpenGL conte
 model, about 3 s) is printed apart.
 """
 
-import argparse
 import math
 import statistics
-import sys
 import time
 
-from fpga_robotics.bench.camera import MAX_SIDE, _size
-from fpga_robotics.cli.errors import UsageError, run_cli
+from fpga_robotics.bench import scaffold
+from fpga_robotics.cli.errors import UsageError
 
-__all__ = ["MODES", "PROG", "cli", "main"]
-
-#: The command (also ``fpga-robotics bench render3d``).
-PROG = "python -m fpga_robotics.bench.render3d"
+__all__ = ["MODES", "main"]
 
 #: Renderer modes: name -> scenario overrides.
 MODES = {
@@ -109,28 +101,40 @@ def _loop_times(mode, seconds, repeats, backend):
             statistics.median(startup))
 
 
-def main(argv=None, prog=PROG):
-    ap = argparse.ArgumentParser(prog=prog, description=__doc__.split("\n\n")[0].strip("`"))
-    ap.add_argument("--frames", type=int, default=60, help="poses per loop (default 60)")
-    ap.add_argument("--repeats", type=int, default=3, help="repeats of each timing (default 3)")
+def _options(ap):
     ap.add_argument("--seconds", type=float, default=5.0,
                     help="simulated seconds of each closed-loop run (default 5; 0 skips them)")
     ap.add_argument("--sizes", default="160x120,640x480", help="comma-separated WIDTHxHEIGHT")
     ap.add_argument("--backend", default="auto", help="the design's backend in the closed loop")
-    args = ap.parse_args(argv)
-    if not (1 <= args.frames <= 10**5 and 1 <= args.repeats <= 1000):
-        raise UsageError(f"--frames must be 1..100000 and --repeats 1..1000, got "
-                         f"{args.frames} and {args.repeats}")
+    ap.add_argument("--figures", metavar="DIR",
+                    help="write the figures of docs/render3d.md to DIR instead, and exit")
+    ap.add_argument("--viewer", action="store_true",
+                    help="with --figures: also a screenshot of the viewer (needs a Vulkan driver)")
+
+
+def _check(args):
     if not (math.isfinite(args.seconds) and 0 <= args.seconds <= 3600):
         raise UsageError(f"--seconds must be 0..3600, got {args.seconds}")
-    sizes = [_size(s) for s in args.sizes.split(",") if s.strip()]
-    if any(max(s) > MAX_SIDE for s in sizes):
-        raise UsageError(f"a size is at most {MAX_SIDE} pixels a side")
+    if args.viewer and args.figures is None:
+        raise UsageError("--viewer goes with --figures DIR")
+    args.sizes = scaffold.parse_sizes(args.sizes)
+
+
+def run(args):
+    if args.figures is not None:
+        from fpga_robotics.bench.render3d_figures import write_figures
+
+        write_figures(args.figures, viewer=args.viewer)
+        return None
+    sizes = args.sizes
     print(f"renderers on the divider_3d room, {args.frames} poses x {args.repeats} repeats; "
           f"median ms per frame (wall / CPU of this process)")
     print(f"{'mode':>18}" + "".join(f"  {f'{w}x{h} wall':>14} {'cpu':>7}" for w, h in sizes))
+    frames, loops = [], []
     for mode in MODES:
         cells = [_frame_times(mode, size, args.frames, args.repeats) for size in sizes]
+        frames += [{"mode": mode, "size": f"{w}x{h}", "wall_ms": wall, "cpu_ms": cpu}
+                   for (w, h), (wall, cpu) in zip(sizes, cells, strict=True)]
         print(f"{mode:>18}" + "".join(f"  {wall:14.2f} {cpu:7.2f}" for wall, cpu in cells),
               flush=True)
     if args.seconds:
@@ -140,15 +144,12 @@ def main(argv=None, prog=PROG):
         for mode in MODES:
             ms, factor, cpu, startup = _loop_times(mode, args.seconds, args.repeats,
                                                    args.backend)
+            loops.append({"mode": mode, "frame_ms": ms, "realtime": factor,
+                          "cpu_realtime": cpu, "startup_s": startup})
             print(f"{mode:>18}  {ms:8.2f} ms/frame  {factor:6.2f}x real time  "
                   f"{cpu:6.2f}x per CPU second  (start-up {startup:.1f} s)", flush=True)
-    return 0
+    return {"frames": frames, "loop": loops}
 
 
-def cli():
-    """The console entry point: usage errors as one line and exit status 2."""
-    run_cli(main, sys.argv[1:], prog=PROG)
-
-
-if __name__ == "__main__":
-    cli()
+main = scaffold.command(run, __doc__, name="render3d", options=_options, check=_check,
+                        repeats=3, frames=60)

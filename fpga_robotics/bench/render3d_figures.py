@@ -1,4 +1,4 @@
-"""``python -m fpga_robotics.bench.render3d_figures FOLDER``: the figures of docs/render3d.md.
+"""The figures of docs/render3d.md (``fpga-robotics bench render3d --figures FOLDER``).
 
 For each 3D scenario (``divider_3d``, ``lighting_3d``), the same instant drawn by both
 renderers side by side (raster left, 3D right), and under each frame what the design's red
@@ -9,17 +9,11 @@ viewer's window (headless, 1920x1080) after 3 s of ``divider_3d`` in closed loop
 world in 3D beside the map; it needs a Vulkan driver (on Debian ``mesa-vulkan-drivers``).
 """
 
-import argparse
-import sys
 from pathlib import Path
 
 import numpy as np
 
-from fpga_robotics.cli.errors import run_cli
-
-__all__ = ["FIGURES", "PROG", "cli", "figure", "main"]
-
-PROG = "python -m fpga_robotics.bench.render3d_figures"
+__all__ = ["FIGURES", "figure", "write_figures"]
 
 #: Scenario -> (simulated time shown, s; overrides).
 FIGURES = {
@@ -32,8 +26,8 @@ FILTER_DIFF_MIN = 6
 
 def figure(name, t, overrides=()):
     """The (2H, 2W, 3) uint8 figure of scenario ``name`` at time ``t``."""
-    from fpga_robotics.loop.connectors.camera import make_renderer
     from fpga_robotics.hw.params import FollowTargetParams
+    from fpga_robotics.loop.connectors.camera import make_renderer
     from fpga_robotics.scenario.load import load_scenario
     from fpga_robotics.sim.camera.frames import rgb444_to_rgb888, to_rgb444
     from fpga_robotics.sim.models.follow_target import filter_frame
@@ -56,30 +50,28 @@ def figure(name, t, overrides=()):
     return np.hstack(columns)
 
 
-def main(argv=None, prog=PROG):
+def write_figures(folder, viewer=False):
+    """Write ``FOLDER/<scenario>.png`` for each of ``FIGURES`` (and the viewer's screenshot)."""
     import cv2
 
+    from fpga_robotics.cli.errors import UsageError
     from fpga_robotics.sim.files import check_output_dir, write_atomic
 
-    ap = argparse.ArgumentParser(prog=prog, description=__doc__.split("\n\n")[1])
-    ap.add_argument("folder", help="where to write the PNGs")
-    ap.add_argument("--viewer", action="store_true",
-                    help="also a screenshot of the viewer (needs a Vulkan driver)")
-    args = ap.parse_args(argv)
-    folder = Path(args.folder)
+    folder = Path(folder)
     check_output_dir(folder)
     folder.mkdir(parents=True, exist_ok=True)
     for name, (t, overrides) in FIGURES.items():
         image = figure(name, t, overrides)
         path = folder / f"{name}.png"
-        _, data = cv2.imencode(".png", cv2.cvtColor(image, cv2.COLOR_RGB2BGR))
+        ok, data = cv2.imencode(".png", cv2.cvtColor(image, cv2.COLOR_RGB2BGR))
+        if not ok:
+            raise UsageError("OpenCV could not encode a PNG (is its image codec installed?)")
         write_atomic(path, data.tobytes())
         print(f"wrote {path}")
-    if args.viewer:
+    if viewer:
         path = folder / "viewer_3d.png"
         _viewer_screenshot(path)
         print(f"wrote {path}")
-    return 0
 
 
 def _viewer_screenshot(path, port=9877):
@@ -104,11 +96,3 @@ def _viewer_screenshot(path, port=9877):
             viewer.save_screenshot(str(path))
         finally:
             viewer.quit()
-
-
-def cli():
-    run_cli(main, sys.argv[1:], prog=PROG)
-
-
-if __name__ == "__main__":
-    cli()

@@ -1,8 +1,8 @@
-"""``fpga-robotics bench ros`` (or ``python -m fpga_robotics.bench.ros``): what writing a ROS 2
-bag and publishing live to Foxglove cost per frame.
+"""``fpga-robotics bench ros``: what writing a ROS 2 bag and publishing live to Foxglove cost
+per frame.
 
 Synthetic frames (a red target over noise, the design's filtered frame from the golden model;
-``viewer_bench.make_records``) at 160x120 by default. Bag: every frame through
+``fpga_robotics.bench.viewer.make_records``) at 160x120 by default. Bag: every frame through
 ``BagWriter.log_frame`` (all topics, both images) into a temporary bag; printed: the median
 and the mean milliseconds of a ``log_frame`` call after the first (the mean includes the
 chunk writes, and any time the machine gave to other processes), the CPU milliseconds per
@@ -14,18 +14,17 @@ a live run; printed: the median milliseconds of a ``log_frame`` call and how man
 messages sent the client received. Each figure is the median over ``--repeats`` runs.
 """
 
-import argparse
 import contextlib
 import json
 import shutil
 import statistics
-import sys
 import tempfile
 import threading
 import time
 from pathlib import Path
 
-from fpga_robotics.cli.errors import UsageError, run_cli
+from fpga_robotics.bench import scaffold
+from fpga_robotics.cli.errors import UsageError
 
 __all__ = ["bench_bag", "bench_live", "main"]
 
@@ -129,24 +128,16 @@ def bench_live(records, geometry, fps=30.0):
     return times, sent, client.received
 
 
-def _positive(text):
-    value = int(text)
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"must be >= 1, got {value}")
-    return value
+def _options(p):
+    p.add_argument("--resolution", default="160x120", metavar="WxH")
+    p.add_argument("--only", choices=("bag", "live"), help="run one of the two")
 
 
-def main(argv=None, prog="python -m fpga_robotics.bench.ros"):
-    from fpga_robotics.scenario.load import parse_resolution
+def run(args):
     from fpga_robotics.bench.viewer import make_records
 
-    p = argparse.ArgumentParser(prog=prog, description=__doc__.split("\n\n")[0])
-    p.add_argument("--resolution", default="160x120", metavar="WxH")
-    p.add_argument("--frames", type=_positive, default=120, metavar="N")
-    p.add_argument("--repeats", type=_positive, default=3, metavar="N")
-    p.add_argument("--only", choices=("bag", "live"), help="run one of the two")
-    args = p.parse_args(argv)
-    width, height = parse_resolution(args.resolution)
+    width, height = scaffold.parse_size(args.resolution, "--resolution")
+    figures = {}
     records = make_records(width, height, args.frames)
     geometry = _geometry(width, height)
     print(f"ROS outputs per {width}x{height} frame ({args.frames} frames, median of "
@@ -162,6 +153,9 @@ def main(argv=None, prog="python -m fpga_robotics.bench.ros"):
         first = statistics.median(t[0] for t, _, _ in runs)
         fixed = statistics.median(f for _, f, _ in runs)
         cpu = statistics.median(c for _, _, c in runs)
+        figures["bag"] = {"call_median_ms": 1000 * call, "call_mean_ms": 1000 * mean,
+                          "cpu_ms": 1000 * cpu, "first_call_ms": 1000 * first,
+                          "open_close_ms": 1000 * fixed}
         print(f"  bag  (--bag): log_frame median {1000 * call:.3f} ms, mean {1000 * mean:.3f} "
               f"ms after the first, CPU {1000 * cpu:.3f} ms/frame; the first call "
               f"{1000 * first:.1f} ms; opening and closing the bag {1000 * fixed:.1f} ms once")
@@ -170,10 +164,10 @@ def main(argv=None, prog="python -m fpga_robotics.bench.ros"):
         call = statistics.median(statistics.median(t) for t, _, _ in runs)
         sent = sum(s for _, s, _ in runs)
         got = sum(g for _, _, g in runs)
+        figures["live"] = {"call_median_ms": 1000 * call, "sent": sent, "received": got}
         print(f"  live (--live foxglove, one client): log_frame median {1000 * call:.3f} ms; "
               f"client received {got}/{sent} messages")
-    return 0
+    return figures
 
 
-if __name__ == "__main__":
-    run_cli(main, sys.argv[1:], prog="python -m fpga_robotics.bench.ros")
+main = scaffold.command(run, __doc__, name="ros", options=_options, repeats=3, frames=120)

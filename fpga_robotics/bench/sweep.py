@@ -1,4 +1,5 @@
-"""``python -m fpga_robotics.sweep --bench``: campaign throughput on 1 worker and on N.
+"""``fpga-robotics bench sweep`` (also ``python -m fpga_robotics.sweep --bench``): campaign
+throughput on 1 worker and on N.
 
 The same runs (``--bench-runs``, default 40: follow_person, 160x120, 10 s simulated, model
 backend, seeds 0..) go through the whole campaign path on an embedded cluster of 1 worker and
@@ -14,15 +15,17 @@ import os
 import statistics
 import tempfile
 import time
+from types import SimpleNamespace
 
-from fpga_robotics.sweep.api import run_campaign
-from fpga_robotics.sweep.campaign import load_campaign
-from fpga_robotics.sweep.results import read_meta
+from fpga_robotics.bench import scaffold
+from fpga_robotics.cli.errors import UsageError
 
-__all__ = ["bench"]
+__all__ = ["bench", "main", "measure"]
 
 
 def _campaign(runs, args):
+    from fpga_robotics.sweep.campaign import load_campaign
+
     return load_campaign({
         "name": "bench", "scenarios": [args.scenarios or "follow_person"],
         "seeds": [*range(runs)], "backend": args.backend or "model",
@@ -30,6 +33,9 @@ def _campaign(runs, args):
 
 
 def _once(runs, workers, args):
+    from fpga_robotics.sweep.api import run_campaign
+    from fpga_robotics.sweep.results import read_meta
+
     with tempfile.TemporaryDirectory(prefix="sweep-bench-") as out:
         rows = run_campaign(_campaign(runs, args), out, workers=workers, record="none")
         meta = read_meta(out)
@@ -42,6 +48,13 @@ def _once(runs, workers, args):
 
 
 def bench(args):
+    """``python -m fpga_robotics.sweep --bench``: print the figures; exit code 0."""
+    measure(args)
+    return 0
+
+
+def measure(args):
+    """Print the figures and return them: per worker count, the medians."""
     n = args.workers or os.cpu_count() or 1
     runs, repeats = args.bench_runs, args.bench_repeats
     print(f"campaign benchmark: {runs} runs of {args.scenarios or 'follow_person'}, "
@@ -70,4 +83,32 @@ def bench(args):
               f"takes {med[n]['run_s'] / med[1]['run_s']:.2f}x as long as with 1 worker")
     print(f"  ({time.perf_counter() - t0:.0f} s; load average now "
           f"{os.getloadavg()[0]:.1f})")
-    return 0
+    return {str(w): {**m, "run_ms": m["run_s"] * 1e3, "cpu_ms": m["cpu_s"] * 1e3}
+            for w, m in med.items()}
+
+
+def _options(parser):
+    parser.add_argument("--runs", type=int, default=40, help="runs per measurement (default 40)")
+    parser.add_argument("--workers", type=int, help="N (default: the machine's cores)")
+    parser.add_argument("--scenario", help="the scenario (default follow_person)")
+    parser.add_argument("--backend", help="the design's backend (default model)")
+    parser.add_argument("--resolution", help="default 160x120")
+    parser.add_argument("--duration", type=float, help="simulated seconds a run (default 10)")
+
+
+def _check(args):
+    if not 1 <= args.runs <= 10000:
+        raise UsageError(f"--runs must be 1..10000, got {args.runs}")
+    if args.workers is not None and not 1 <= args.workers <= 256:
+        raise UsageError(f"--workers must be 1..256, got {args.workers}")
+
+
+def run(args):
+    figures = measure(SimpleNamespace(
+        workers=args.workers, bench_runs=args.runs, bench_repeats=args.repeats,
+        scenarios=args.scenario, backend=args.backend, resolution=args.resolution,
+        duration=args.duration))
+    return figures
+
+
+main = scaffold.command(run, __doc__, name="sweep", options=_options, check=_check, repeats=3)

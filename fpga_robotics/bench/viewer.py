@@ -1,5 +1,4 @@
-"""``python -m fpga_robotics.bench.viewer`` (or ``python -m fpga_robotics.bench.viewer``): what
-logging to rerun adds per frame, to a file sink.
+"""``fpga-robotics bench viewer``: what logging to rerun adds per frame, to a file sink.
 
 For each resolution, a run of synthetic frames (a moving target over a noisy background, the
 design's filtered frame from the golden model) is logged with ``Recorder.log_frame`` to a
@@ -10,21 +9,20 @@ processes), the CPU milliseconds per frame of the calling thread and of the whol
 (rerun's encoder and writer threads included, through ``close``), and the file size per frame.
 """
 
-import argparse
 import math
 import os
 import statistics
-import sys
 import tempfile
 import time
 
 import numpy as np
 
-from fpga_robotics.cli.errors import UsageError, run_cli
+from fpga_robotics.bench import scaffold
+from fpga_robotics.cli.errors import UsageError
 from fpga_robotics.hw.params import FollowTargetParams
 from fpga_robotics.hw.pixel import COLOR_SELECT
-from fpga_robotics.sim.camera import synthetic
 from fpga_robotics.sim.backends.base import FrameResult
+from fpga_robotics.sim.camera import synthetic
 from fpga_robotics.sim.camera.frames import to_rgb444
 from fpga_robotics.sim.models.follow_target import FollowTargetModel
 from fpga_robotics.sim.records import FrameRecord, PersonState, WorldMap
@@ -114,36 +112,27 @@ def bench_once(records, folder, **options):
     return times, cpu, proc, size
 
 
-def _positive(text):
-    value = int(text)
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"must be >= 1, got {value}")
-    return value
-
-
-def main(argv=None, prog="python -m fpga_robotics.bench.viewer"):
-    p = argparse.ArgumentParser(prog=prog, description=__doc__)
-    p.add_argument("--frames", type=_positive, default=300, help="frames per run (default 300)")
-    p.add_argument("--repeats", type=_positive, default=5, help="runs per setting (default 5)")
-    p.add_argument("--log-every", type=_positive, default=1, help="image decimation (default 1)")
+def _options(p):
+    p.add_argument("--log-every", type=int, default=1, help="image decimation (default 1)")
     p.add_argument(
         "--jpeg-quality", type=int, default=None, help="0 raw, 1..100 JPEG (default: auto)"
     )
-    try:
-        args = p.parse_args(argv)
-    except SystemExit as exc:
-        if exc.code:
-            raise UsageError("bad arguments (see --help)") from None
-        return 0
+
+
+def run(args):
+    if args.log_every < 1:
+        raise UsageError(f"--log-every must be >= 1, got {args.log_every}")
     options = {"log_every": args.log_every, "jpeg_quality": args.jpeg_quality}
     try:  # a bad --jpeg-quality is said before any work
         open_recorder("off", default_path=None, **options).close()
     except ViewerError as exc:
         raise UsageError(str(exc)) from None
+    quality = "auto" if args.jpeg_quality is None else args.jpeg_quality
     print(
         f"viz logging cost per frame, file sink, {args.frames} frames x {args.repeats} runs, "
-        f"log_every={args.log_every}, jpeg_quality={args.jpeg_quality or 'auto'}"
+        f"log_every={args.log_every}, jpeg_quality={quality}"
     )
+    figures = []
     with tempfile.TemporaryDirectory(prefix="viz-bench-") as folder:
         for width, height in RESOLUTIONS:
             records = make_records(width, height, args.frames)
@@ -157,14 +146,16 @@ def main(argv=None, prog="python -m fpga_robotics.bench.viewer"):
                 procs.append(proc * 1e3)
                 sizes.append(size / len(records))
             med = statistics.median
+            figures.append({"size": f"{width}x{height}", "call_median_ms": med(medians),
+                            "call_mean_ms": med(means), "caller_cpu_ms": med(cpus),
+                            "process_cpu_ms": med(procs), "bytes_per_frame": med(sizes)})
             print(
                 f"  {width}x{height}: wall median {med(medians):.3f} ms/frame, "
                 f"mean {med(means):.3f} ms/frame; CPU {med(cpus):.3f} ms/frame in the caller, "
                 f"{med(procs):.3f} ms/frame with rerun's threads; "
                 f"{med(sizes) / 1e3:.1f} kB/frame"
             )
-    return 0
+    return {"sizes": figures}
 
 
-if __name__ == "__main__":
-    run_cli(main, sys.argv[1:], prog="fpga_robotics.bench.viewer")
+main = scaffold.command(run, __doc__, name="viewer", options=_options, repeats=5, frames=300)

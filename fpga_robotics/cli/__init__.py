@@ -66,6 +66,9 @@ BENCHMARKS = {
                 "a Verilog design through a port map against the built-in Verilator backend"),
     "ros": ("fpga_robotics.bench.ros", "writing a ROS 2 bag and publishing live to Foxglove"),
     "pins": ("fpga_robotics.bench.pins", "the pin backends in real-clock time (Mcycles/s)"),
+    "sweep": ("fpga_robotics.bench.sweep", "campaign throughput on 1 worker and on N"),
+    "calibrate": ("fpga_robotics.bench.calibrate",
+                  "this machine's calibration frame time: divide a time by it to compare"),
 }
 
 PROG = "fpga-robotics"

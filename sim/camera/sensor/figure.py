@@ -4,7 +4,7 @@
 the motion blur, the raw mosaic (each pixel shown in its filter's colour), the mosaic after
 exposure, noise and gains (ADC codes / 4), the demosaiced frame (still linear), after gamma, and
 the RGB444 frame the design gets. docs/camera.md shows them (``python -m
-fpga_robotics.bench.camera --stage-images docs/images``).
+fpga-robotics bench camera --stage-images docs/images``).
 """
 
 import numpy as np

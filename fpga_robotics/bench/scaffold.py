@@ -1,0 +1,294 @@
+"""What every benchmark shares: its command line, its clocks and medians, its output.
+
+A subject module declares its own options and its measurement, and gets the rest here::
+
+    main = command(run, __doc__, name="camera", options=add_options, repeats=5, frames=60)
+
+``command`` builds ``main(argv, prog)``: the common options (``--repeats``, ``--frames``,
+``--min-seconds`` where the subject takes them, ``--json PATH`` and ``--calibrate`` always),
+their checks, and bad arguments as ``UsageError`` (one line ``prog: error: ...``, exit 2, from
+``run_cli``). ``run(args)`` prints its figures as it measures and returns them as a dict;
+``--json`` writes that dict atomically with the machine's description, and ``--calibrate``
+times the calibration design in the same run and prints every absolute time of the dict
+(a key that names milliseconds: ``frame_ms``, ``ms_per_frame``) as a multiple of it: the
+figure that travels between machines.
+"""
+
+import argparse
+import contextlib
+import gc
+import math
+import os
+import platform
+import re
+import statistics
+import time
+from dataclasses import asdict, dataclass
+
+from fpga_robotics.cli.errors import UsageError
+
+__all__ = ["BenchParser", "Spread", "check_json_path", "command", "gc_paused", "parse_size",
+           "parse_sizes", "print_table", "ratios_to", "stopwatch", "write_json"]
+
+#: Largest width or height a benchmark takes (the design's own limit).
+MAX_SIDE = 4096
+MAX_REPEATS = 1000
+MAX_FRAMES = 10**6
+
+
+class BenchParser(argparse.ArgumentParser):
+    """An ``ArgumentParser`` whose errors are ``UsageError``: one line, exit code 2."""
+
+    def error(self, message):
+        raise UsageError(message)
+
+
+@dataclass(frozen=True)
+class Spread:
+    """Median, minimum and maximum of repeated measurements."""
+
+    median: float
+    min: float
+    max: float
+    n: int
+
+    @classmethod
+    def of(cls, values):
+        values = list(values)
+        if not values:
+            raise ValueError("no measurements")
+        return cls(statistics.median(values), min(values), max(values), len(values))
+
+    def scaled(self, factor):
+        return Spread(self.median * factor, self.min * factor, self.max * factor, self.n)
+
+    def __format__(self, spec):
+        """``median (min-max)`` in ``spec`` (``f"{s:.3f}"``)."""
+        spec = spec or ".3g"
+        return f"{self.median:{spec}} ({self.min:{spec}}-{self.max:{spec}})"
+
+
+@dataclass
+class Times:
+    """Wall-clock and CPU seconds of a ``stopwatch`` block."""
+
+    wall: float = 0.0
+    cpu: float = 0.0
+
+
+@contextlib.contextmanager
+def stopwatch(cpu_clock=time.process_time):
+    """``with stopwatch() as t: ...``; then ``t.wall`` and ``t.cpu`` in seconds. The CPU clock
+    is the process's by default (threads of a library count); ``time.thread_time`` for the
+    calling thread alone."""
+    times = Times()
+    start, cpu_start = time.perf_counter(), cpu_clock()
+    try:
+        yield times
+    finally:
+        times.wall = time.perf_counter() - start
+        times.cpu = cpu_clock() - cpu_start
+
+
+@contextlib.contextmanager
+def gc_paused():
+    """No garbage collection while timing: a collection would land in one frame's time."""
+    was_enabled = gc.isenabled()
+    gc.disable()
+    try:
+        yield
+    finally:
+        if was_enabled:
+            gc.enable()
+
+
+def parse_size(text, what="a size"):
+    """``"160x120"`` -> ``(160, 120)``; ``UsageError`` for anything else."""
+    try:
+        w, h = (int(v) for v in text.strip().lower().split("x"))
+    except ValueError:
+        raise UsageError(f"{what} is WIDTHxHEIGHT, e.g. 160x120; got {text!r}") from None
+    if not (1 <= w <= MAX_SIDE and 1 <= h <= MAX_SIDE):
+        raise UsageError(f"{what} needs a width and height of 1..{MAX_SIDE}, got {text!r}")
+    return w, h
+
+
+def parse_sizes(text, what="a size"):
+    """``"160x120,640x480"`` -> ``[(160, 120), (640, 480)]``."""
+    sizes = [parse_size(item, what) for item in text.split(",") if item.strip()]
+    if not sizes:
+        raise UsageError(f"{what} list is empty; write WIDTHxHEIGHT[,WIDTHxHEIGHT...]")
+    return sizes
+
+
+def print_table(header, rows, *, first_width=None):
+    """Columns right-aligned to the widest cell, the first left-aligned; cells as given
+    (format numbers before)."""
+    rows = [[str(c) for c in row] for row in rows]
+    widths = [max(len(str(h)), *(len(r[i]) for r in rows)) for i, h in enumerate(header)]
+    if first_width:
+        widths[0] = max(widths[0], first_width)
+
+    def line(cells):
+        return "  ".join(f"{c:<{widths[0]}}" if i == 0 else f"{c:>{widths[i]}}"
+                         for i, c in enumerate(cells)).rstrip()
+
+    print(line(header))
+    for row in rows:
+        print(line(row), flush=True)
+
+
+def check_json_path(path):
+    """Checked before measuring, not after minutes of it."""
+    from fpga_robotics.sim.files import check_output_path
+
+    directory = os.path.dirname(os.path.abspath(path))
+    if not os.path.isdir(directory):
+        raise UsageError(f"cannot write {path}: no directory {directory}")
+    return check_output_path(path, what="--json")
+
+
+def machine():
+    """What the figures were measured on."""
+    from fpga_robotics.sim.backends import BackendError
+    from fpga_robotics.sim.backends.toolchain import find_compiler
+
+    try:
+        compiler = find_compiler().version
+    except BackendError:
+        compiler = None
+    return {"platform": platform.platform(), "python": platform.python_version(),
+            "cpus": os.cpu_count(), "load_average": os.getloadavg()[0], "compiler": compiler}
+
+
+def _plain(value):
+    """JSON-ready: dataclasses (``Spread``) as dicts, tuples as lists, recursively."""
+    if isinstance(value, Spread):
+        return asdict(value)
+    if isinstance(value, dict):
+        return {str(k): _plain(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_plain(v) for v in value]
+    return value
+
+
+def write_json(path, prog, figures, calibration=None):
+    """``figures`` (and the calibration, if measured) with the machine, written atomically."""
+    from fpga_robotics.sim.files import write_json_atomic
+
+    data = {"command": prog, "machine": machine(), "figures": _plain(figures)}
+    if calibration is not None:
+        data["calibration"] = _plain(calibration)
+    write_json_atomic(path, data, what="--json")
+
+
+_MS_KEY = re.compile(r"(^|_)ms(_|$)")
+
+
+def _label(item, index):
+    """A list entry's name: its backend, design, mode and size where it has them."""
+    parts = [str(item[k]) for k in ("backend", "design", "mode", "world", "size")
+             if isinstance(item, dict) and k in item]
+    if isinstance(item, dict) and "width" in item and "height" in item:
+        parts.append(f"{item['width']}x{item['height']}")
+    return " ".join(parts) or str(index)
+
+
+def absolute_times(figures, prefix="", in_ms=False):
+    """``(name, ms)`` of every entry whose key says milliseconds (``frame_ms``,
+    ``ms_per_frame``, or every number under a ``steps_ms`` dict); nested dicts and lists
+    walked, a ``Spread`` by its median."""
+    out = []
+    items = (figures.items() if isinstance(figures, dict)
+             else ((_label(v, i), v) for i, v in enumerate(figures)))
+    for key, value in items:
+        name = f"{prefix}{key}"
+        is_ms = in_ms or bool(_MS_KEY.search(str(key)))
+        if isinstance(value, (dict, list, tuple)):
+            out += absolute_times(value, f"{name}.", is_ms and isinstance(value, dict))
+        elif is_ms and isinstance(value, (int, float, Spread)) \
+                and not isinstance(value, bool):
+            out.append((name, value.median if isinstance(value, Spread) else float(value)))
+    return out
+
+
+def ratios_to(figures, reference_ms, cpu_reference_ms=None):
+    """Every absolute time of ``figures`` as a multiple of ``reference_ms``; a CPU time (its
+    name says ``cpu``) of ``cpu_reference_ms`` where given, so that like meets like."""
+    cpu_ref = cpu_reference_ms or reference_ms
+    return [(name, ms, ms / (cpu_ref if "cpu" in name else reference_ms))
+            for name, ms in absolute_times(figures)]
+
+
+def _add_common(parser, repeats, frames, min_seconds):
+    if repeats is not None:
+        parser.add_argument("--repeats", type=int, default=repeats,
+                            help=f"repeats of each measurement (default {repeats})")
+    if frames is not None:
+        parser.add_argument("--frames", type=int, default=frames,
+                            help=f"frames per measurement (default {frames})")
+    if min_seconds is not None:
+        parser.add_argument("--min-seconds", type=float, default=min_seconds,
+                            help="repeat the frames until each case has run this long "
+                                 f"(default {min_seconds:g})")
+    parser.add_argument("--json", metavar="PATH", help="also write the figures to PATH")
+    parser.add_argument("--calibrate", action="store_true",
+                        help="also time the calibration design (bench calibrate) in this run "
+                             "and print every time as a multiple of it")
+
+
+def _check_common(args):
+    if getattr(args, "repeats", None) is not None and not 1 <= args.repeats <= MAX_REPEATS:
+        raise UsageError(f"--repeats must be 1..{MAX_REPEATS}, got {args.repeats}")
+    if getattr(args, "frames", None) is not None and not 1 <= args.frames <= MAX_FRAMES:
+        raise UsageError(f"--frames must be 1..{MAX_FRAMES}, got {args.frames}")
+    seconds = getattr(args, "min_seconds", None)
+    if seconds is not None and not (math.isfinite(seconds) and 0 <= seconds <= 3600):
+        raise UsageError(f"--min-seconds must be a finite number in 0..3600, got {seconds}")
+    if args.json is not None:
+        check_json_path(args.json)
+
+
+def command(run, doc, *, name, options=None, repeats=None, frames=None, min_seconds=None,
+            check=None):
+    """``main(argv=None, prog=...)`` of a benchmark: parse (common options, then the
+    subject's ``options(parser)``), check (common, then ``check(args)``), ``run(args)`` ->
+    figures, then the calibration and ``--json`` if asked for."""
+    description = doc.strip().split("\n\n")[0]
+
+    def main(argv=None, prog=f"fpga-robotics bench {name}"):
+        parser = BenchParser(prog=prog, description=description)
+        if options is not None:
+            options(parser)
+        _add_common(parser, repeats, frames, min_seconds)
+        args = parser.parse_args(argv)
+        _check_common(args)
+        if check is not None:
+            check(args)
+        figures = run(args)
+        calibration = None
+        if args.calibrate and figures:
+            from fpga_robotics.bench.calibrate import measure_calibration
+
+            # At least 3 passes, so that its range means something.
+            calibration = measure_calibration(repeats=max(3, getattr(args, "repeats", 5) or 5))
+            print_calibrated(figures, calibration)
+        if args.json is not None:
+            write_json(args.json, prog, figures or {}, calibration)
+            print(f"figures written to {args.json}")
+        return 0
+
+    main.__doc__ = doc
+    return main
+
+
+def print_calibrated(figures, calibration):
+    """Each absolute time of ``figures`` next to the same run's calibration frame time."""
+    ref, cpu_ref = calibration["frame_ms"].median, calibration["cpu_ms"].median
+    print(f"calibration ({calibration['what']}): {calibration['frame_ms']:.4f} ms/frame, "
+          f"CPU {calibration['cpu_ms']:.4f} (median, min-max of {calibration['frame_ms'].n}); "
+          f"the times above in calibration frames (CPU times in its CPU time):")
+    rows = [(name, f"{ms:.4g} ms", f"{ratio:.3g}x")
+            for name, ms, ratio in ratios_to(figures, ref, cpu_ref)]
+    if rows:
+        print_table(("figure", "time", "x calibration"), rows)
