@@ -24,15 +24,20 @@ import hashlib
 
 import numpy as np
 
-from fpga_robotics.loop.connectors import CONNECTORS, PinIO
+from fpga_robotics.checks.sensor_metrics import line_metrics
 from fpga_robotics.cli.errors import UsageError
-from fpga_robotics.loop.compressed import ClosedLoop
+from fpga_robotics.designs.builtin import TOPS, build_component, connector_kinds, foreign_top
+from fpga_robotics.loop.compressed import TIMINGS, ClosedLoop
+from fpga_robotics.loop.connectors import CONNECTORS, PinIO
 from fpga_robotics.sim.backends.base import FrameResult
+from fpga_robotics.sim.backends.foreign import ForeignDesign
+from fpga_robotics.sim.backends.port_map import load_port_map
 from fpga_robotics.sim.camera.frames import to_rgb444
+from fpga_robotics.sim.pins import PinDesignSource, VerilogPinSource, get_pin_backend
+from fpga_robotics.sim.pins.timing import real_clock_timing
 from fpga_robotics.sim.records import SensorReading
-from fpga_robotics.designs.builtin import TOPS, build_component
 
-__all__ = ["RealClockLoop", "make_pin_backend", "pin_design_source"]
+__all__ = ["RealClockLoop", "make_pin_backend", "pin_design_source", "run_real_clock"]
 
 #: Per-frame outputs read when the frame strobe rises (the wheels are read at the next capture).
 _FRAME_OUTPUTS = ("found", "proximity", "centroid_x", "centroid_leds")
@@ -45,9 +50,6 @@ def scenario_top(scenario):
     """The ``Top`` (fpga_robotics.designs) the scenario runs: ``design.top``, or for a foreign
     Verilog design (``design.verilog``) the one its port map describes."""
     if scenario.foreign is not None:
-        from fpga_robotics.sim.backends.port_map import load_port_map
-        from fpga_robotics.designs.builtin import foreign_top
-
         return foreign_top(load_port_map(scenario.foreign.ports))
     return TOPS[scenario.top]
 
@@ -55,13 +57,7 @@ def scenario_top(scenario):
 def pin_design_source(scenario):
     """The pin design of the scenario: a ``PinDesignSource`` of ``design.top`` and its
     tables, or a ``VerilogPinSource`` of its foreign Verilog design."""
-    from fpga_robotics.sim.pins import PinDesignSource
-
     if scenario.foreign is not None:
-        from fpga_robotics.sim.backends.foreign import ForeignDesign
-        from fpga_robotics.sim.pins import VerilogPinSource
-        from fpga_robotics.designs.builtin import connector_kinds
-
         design = ForeignDesign(scenario.foreign.verilog, scenario.foreign.ports,
                                scenario.params, pins=True, connector_kinds=connector_kinds())
         missing = [k for k in ("motor_left", "motor_right") if k not in design.port_map.outputs]
@@ -82,8 +78,6 @@ def pin_design_source(scenario):
 
 def make_pin_backend(name, scenario, *, on_build=None):
     """A pin-level backend by name ("auto": the fastest compiled one) for the scenario."""
-    from fpga_robotics.sim.pins import get_pin_backend
-
     if name == "model":
         raise UsageError("the model backend runs whole frames; sim.timing = \"real_clock\" "
                          "needs a backend that simulates every clock: --backend auto, "
@@ -279,8 +273,6 @@ class RealClockLoop(ClosedLoop):
         return readings
 
     def _stream(self, rgb):
-        from fpga_robotics.sim.pins.timing import real_clock_timing
-
         p = self.scenario.params
         self.pins.poke("color_sel", self.color_code)
         timing = real_clock_timing(p.width, p.height, self.scenario.camera.fps, self.clock_hz,
@@ -323,8 +315,6 @@ class RealClockLoop(ClosedLoop):
 
     def extra_metrics(self):
         """Also the line metrics, over the world's floor lines, from the line sensors' mounts."""
-        from fpga_robotics.checks.sensor_metrics import line_metrics
-
         mounts = [m for c in self.sensors if c.kind == "line_sensors"
                   for m in c.sensor_mounts]
         return {**super().extra_metrics(),
@@ -336,3 +326,22 @@ class RealClockLoop(ClosedLoop):
         return {"timing": "real_clock", "clock_hz": self.clock_hz, "sim_cycles": cycles,
                 "cycles_per_wall_s": round(cycles / wall) if wall > 0 else None}
 
+
+def run_real_clock(scenario, *, seed, backend, recorder, progress, realtime, on_frame, shadow,
+                   controls):
+    """``run_scenario`` (fpga_robotics.loop.compressed) in real-clock timing."""
+    if shadow is not None:
+        raise UsageError("shadow runs compare frames; they need sim.timing = \"compressed\"")
+    owns_backend = isinstance(backend, str)
+    design = make_pin_backend(backend, scenario) if owns_backend else backend
+    try:
+        design.reset()
+        loop = RealClockLoop(scenario, seed=seed, design=design, recorder=recorder,
+                             on_frame=on_frame, controls=controls)
+        return loop.run(progress=progress, realtime=realtime)
+    finally:
+        if owns_backend:
+            design.close()
+
+
+TIMINGS["real_clock"] = run_real_clock
