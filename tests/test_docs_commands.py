@@ -311,8 +311,9 @@ PLANS = {
                       ".ci/run makes them in a fresh clone on every submission",
              viewer=True, files=("runs/follow_person.rrd",),
              out=(PASS, SAVED_DEFAULT), last_line=r"runs/follow_person\.rrd$"),
-    'python3 -m venv .venv && . .venv/bin/activate && pip install -e ".[dev,board]" && python -m pytest':
-        Plan(part="python -m pytest", collect=True,
+    'python3 -m venv .venv && . .venv/bin/activate && pip install -e ".[dev,board]" && '
+    'python -m pytest -q -n auto':
+        Plan(part="python -m pytest -q -n auto", collect=True,
              part_why="the set-up and the whole test run are CI's own command (.ci/run, checked "
                       "by test_ci_runs_the_readme_test_command); here the suite is collected",
              out=(r"\d{3,} tests collected",)),
@@ -1047,10 +1048,12 @@ def test_shell_blocks_hold_no_synopsis():
 
 
 def test_ci_runs_the_readme_test_command():
-    """README: ``.ci/run`` does exactly the README's test command in a fresh clone."""
-    ci = (ROOT / ".ci" / "run").read_text()
+    """README: ``.ci/run`` does exactly the README's test command in a fresh clone, and the
+    linter's two checks."""
+    ci = (ROOT / ".ci" / "run").read_text().splitlines()
     for step in ("python3 -m venv .venv", ". .venv/bin/activate",
-                 'pip install -q -e ".[dev,board]"', "python -m pytest"):
+                 'python -m pip install -q -e ".[dev,board]"', "python -m pytest -q -n auto",
+                 "ruff check .", "ruff format --check ."):
         assert step in ci, f".ci/run does not do {step!r}"
 
 
