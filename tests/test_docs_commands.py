@@ -369,7 +369,7 @@ PLANS = {
              files=("s.json",), out=(PASS,),
              summary=(("scenario", "lost_target"), ("verdict", "pass"))),
     "python -m fpga_robotics.run --resolution 640x480 --backend verilator --duration 5 --rerun off":
-        Plan(out=(r"backend verilator\s+640x480", PASS)),
+        Plan(slow=True, out=(r"backend verilator\s+640x480", PASS)),
     "python -m fpga_robotics.run":
         # The page's "typical ending", line by line.
         Plan(out=(r"(?m)^scenario follow_person\s+backend {fastest}\s+160x120\s+seed 0$",
@@ -429,7 +429,7 @@ PLANS = {
         Plan(duration="keep", duration_why=_DIVIDER_WHY,
              out=(r"\[FAIL\] target_in_view_min_fraction",)),
     "python -m fpga_robotics.run --resolution 320x240 --backend verilator --summary s.json":
-        Plan(files=("s.json",), out=(r"backend verilator\s+320x240", PASS),
+        Plan(slow=True, files=("s.json",), out=(r"backend verilator\s+320x240", PASS),
              summary=(("backend", "verilator"), ("resolution", "320x240"))),
     "python -m fpga_robotics.run --source clip.mp4 --color red":
         Plan(setup=(MAKE_CLIP,),
@@ -505,10 +505,12 @@ PLANS = {
     "python -m fpga_robotics.sim.backends.port_map --example ports.toml":
         Plan(files=("ports.toml",), out=(r"wrote ports\.toml",)),
     "python -m fpga_robotics.run --design verilog:follow_target.v --ports ports.toml":
-        Plan(out=(PASS, r"(?m)^backend:? .*verilator-foreign|verilator-foreign")),
+        Plan(slow=True, setup=("python -m fpga_robotics.export -o follow_target.v",
+                               "python -m fpga_robotics.sim.backends.port_map --example ports.toml"),
+             out=(PASS, r"(?m)^backend:? .*verilator-foreign|verilator-foreign")),
     ("python -m fpga_robotics.run --scenario bump_wall.toml --design verilog:bump_stop.v "
      "--ports bump_stop_ports.toml --rerun off"):
-        Plan(setup=(" ".join(["cp", *(str(ROOT / "tests/data" / name) for name in (
+        Plan(slow=True, setup=(" ".join(["cp", *(str(ROOT / "tests/data" / name) for name in (
                          "bump_stop.v", "bump_stop_ports.toml", "bump_wall.toml")), "."]),),
              duration="keep", duration_why="the page quotes the whole run's 120 000 cycles "
                                            "(12 s at 10 kHz, a twentieth of a second's wall time)",
@@ -517,17 +519,17 @@ PLANS = {
         Plan(setup=("python -m fpga_robotics.sim.backends.port_map --example ports.toml",),
              out=(r"ports\.toml: follow_target, outputs found, proximity",)),
     "python -m fpga_robotics.mutation --mutants 200":
-        Plan(shorter=(("--mutants", "12"), ("--width", "80"), ("--height", "60")),
+        Plan(slow=True, shorter=(("--mutants", "12"), ("--width", "80"), ("--height", "60")),
              out=(r"unit judge: \d+ caught, \d+ equivalent on these frames: score",),
              files=("runs/mutation/n12-s1/mutants.json", "runs/mutation/n12-s1/mutants.v")),
     "fpga-robotics mutate --mutants 40 --width 80 --height 60 --out runs/mutation/small":
-        Plan(shorter=(("--mutants", "12"),),
+        Plan(slow=True, shorter=(("--mutants", "12"),),
              out=(r"12 mutants of follow_target 80x60",),
              files=("runs/mutation/small/mutants.json",)),
     "python -m fpga_robotics.mutation --mutants 100 --campaign mutation":
         # Four mutants at 80x60 on one worker, the campaign's runs made short: the whole
         # command takes minutes (the page gives its measured time).
-        Plan(shorter=(("--mutants", "4"), ("--width", "80"), ("--height", "60"),
+        Plan(slow=True, shorter=(("--mutants", "4"), ("--width", "80"), ("--height", "60"),
                       ("--workers", "1"), ("--recordings", "1")),
              out=(r"robot judge \(campaign mutation: \d+ of 9 runs pass unmutated\)",),
              files=("runs/mutation/n4-s1/report.html", "runs/mutation/n4-s1/robot.jsonl",
@@ -535,13 +537,13 @@ PLANS = {
     # The robot judge's scaling with workers: the same four mutants at 80x60 as above.
     ("python -m fpga_robotics.mutation --mutants 30 --campaign mutation --workers 1 "
      "--recordings 0 --out runs/mutation/scale-w1"):
-        Plan(shorter=(("--mutants", "4"), ("--width", "80"), ("--height", "60")),
+        Plan(slow=True, shorter=(("--mutants", "4"), ("--width", "80"), ("--height", "60")),
              out=((r"robot judge \(campaign mutation: \d+ of 9 runs pass unmutated\).*"
                    r"mutants/min"),),
              files=("runs/mutation/scale-w1/mutants.json",)),
     ("python -m fpga_robotics.mutation --mutants 30 --campaign mutation --workers 2 "
      "--recordings 0 --out runs/mutation/scale-w2"):
-        Plan(shorter=(("--mutants", "4"), ("--width", "80"), ("--height", "60")),
+        Plan(slow=True, shorter=(("--mutants", "4"), ("--width", "80"), ("--height", "60")),
              out=((r"robot judge \(campaign mutation: \d+ of 9 runs pass unmutated\).*"
                    r"mutants/min"),),
              files=("runs/mutation/scale-w2/mutants.json",)),
@@ -554,7 +556,7 @@ PLANS = {
         Plan(shorter=(("--max-runs", "2"), ("--backend", "model"), ("--duration", "2")),
              files=("runs/sweeps/mutation-20/report.html",), out=(r"2 runs: 2 pass",)),
     "python -m fpga_robotics.bench.foreign":
-        Plan(shorter=(("--frames", "2"), ("--repeats", "1")),
+        Plan(slow=True, shorter=(("--frames", "2"), ("--repeats", "1")),
              out=(r"verilator \(built-in\) +[\d.]+ ms/frame",
                   r"foreign follow_target \(stream\) +[\d.]+ ms/frame +\([\d.]+x the built-in\)")),
     # Verilog export and the board ------------------------------------------------------------
@@ -668,7 +670,7 @@ PLANS = {
              out=(r"(?m)^\s*160x120\s+[\d.]+", r"(?m)^\s*640x480\s+[\d.]+")),
     # docs/pins.md -------------------------------------------------------------------------------
     "python -m fpga_robotics.bench.pins":
-        Plan(shorter=(("--seconds", "0.02"), ("--pysim-seconds", "0.0002"), ("--repeats", "1")),
+        Plan(slow=True, shorter=(("--seconds", "0.02"), ("--pysim-seconds", "0.0002"), ("--repeats", "1")),
              out=((r"(?m)^cxxrtl +pins: +[\d.]+ Mcycles/s \(1,000,000 cycles, 1 frames, \d+ stops "
                   r"a run\); frame path [\d.]+ Mcycles/s, pins/frame [\d.]+ \(median of the runs' "
                    r"ratios\)$"),
@@ -1356,7 +1358,20 @@ SNIPPETS = {
 }
 
 
-@pytest.mark.parametrize("block", python_blocks(), ids=lambda b: f"{b.page}:{b.line}")
+#: Python blocks that build a Verilator model: run only under ``-m slow``.
+SLOW_SNIPPETS = {
+    ("README.md", "from fpga_robotics.hw.params import FollowTargetParams"),
+    ("docs/backends.md", ('get_backend("verilator", params, waveform=WaveformRequest('
+                          '"out/run.fst", first_frame=10,')),
+}
+
+
+def _python_params():
+    return [pytest.param(b, marks=pytest.mark.slow) if snippet_key(b) in SLOW_SNIPPETS else b
+            for b in python_blocks()]
+
+
+@pytest.mark.parametrize("block", _python_params(), ids=lambda b: f"{b.page}:{b.line}")
 def test_documented_python(block, tmp_path, monkeypatch, capsys):
     handler = SNIPPETS.get(snippet_key(block))
     if handler is None:
