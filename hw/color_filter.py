@@ -6,7 +6,7 @@ from amaranth.lib.wiring import In, Out
 
 from .fit import load
 from .params import FollowTargetParams
-from .pixel import pixel_stream_signature
+from .pixel import TargetColor, pixel_stream_signature
 
 __all__ = ["ColorFilter", "MatchFlags", "color_match_value", "match_stream_signature"]
 
@@ -29,17 +29,15 @@ def color_match_value(m, pixel, color_sel, params):
     ``a - b >= -S and b - a >= -S``; ``max - min <= S`` is every pair within ``S``. Each
     ``a - c >= k`` is the sign bit of the signed ``a - c - k`` (6 bits, cannot overflow for
     4-bit channels and ``|k| <= 15``), which is the contract's signed-difference rule
-    exactly. No multiplexer depends on the pixel data and only the selected colour's
-    comparisons are evaluated, so the compiled simulators do a few branch-free operations per
-    pixel (simulation speed; measured faster than max/min multiplexers, than ``>=``
-    comparisons, which CXXRTL calls out of line, and than a lane-packed single subtraction;
-    docs/hardware.md).
+    exactly. No multiplexer depends on the pixel data: each test is a short carry chain and
+    the colour select picks one AND of them (why this form and not max/min multiplexers or
+    ``>=`` comparisons: docs/hardware.md).
     """
     r, g, b = pixel.r, pixel.g, pixel.b
     d, s, wm = params.diff_min, params.similar_max, params.white_min
 
     def at_least(a, c, k):  # a - c >= k: the sign bit of the signed difference a - c - k
-        # One subtraction of zero-extended sums: no sign extension in the compiled simulators.
+        # One subtraction of zero-extended sums: no sign extension, one carry chain.
         return ~(a - (c + k))[-1] if k >= 0 else ~((a + -k) - c)[-1]
 
     def dominates(a, c):  # a - c >= D
@@ -51,23 +49,23 @@ def color_match_value(m, pixel, color_sel, params):
     def bright(a):  # a >= white_min
         return at_least(a, Const(0, 4), wm)
 
-    by_code = {
-        0b000: Const(1, 1),  # none: every pixel
-        0b100: dominates(r, g) & dominates(r, b),  # red: r - max(g, b) >= D
-        0b010: dominates(g, r) & dominates(g, b),  # green
-        0b001: dominates(b, r) & dominates(b, g),  # blue
-        0b110: similar(r, g) & dominates(r, b) & dominates(g, b),  # yellow: min(r, g) - b >= D
-        0b101: similar(r, b) & dominates(r, g) & dominates(b, g),  # magenta
-        0b011: similar(g, b) & dominates(g, r) & dominates(b, r),  # cyan
-        # white: max - min <= S and min >= white_min
-        0b111: similar(r, g) & similar(r, b) & similar(g, b) & bright(r) & bright(g) & bright(b),
+    by_color = {
+        TargetColor.NONE: Const(1, 1),  # every pixel
+        TargetColor.RED: dominates(r, g) & dominates(r, b),  # r - max(g, b) >= D
+        TargetColor.GREEN: dominates(g, r) & dominates(g, b),
+        TargetColor.BLUE: dominates(b, r) & dominates(b, g),
+        TargetColor.YELLOW: similar(r, g) & dominates(r, b) & dominates(g, b),  # min(r, g) - b >= D
+        TargetColor.MAGENTA: similar(r, b) & dominates(r, g) & dominates(b, g),
+        TargetColor.CYAN: similar(g, b) & dominates(g, r) & dominates(b, r),
+        # max - min <= S and min >= white_min
+        TargetColor.WHITE: (similar(r, g) & similar(r, b) & similar(g, b)
+                            & bright(r) & bright(g) & bright(b)),
     }
-    # A plain case statement: the multiplexer tree on the bits of color_sel that it replaced
-    # was about 1% faster in CXXRTL (docs/hardware.md), not worth the odd form.
+    # A plain case statement on the colour select: one row of the table per colour.
     match = Signal()
     with m.Switch(color_sel):
-        for code, test in by_code.items():
-            with m.Case(code):
+        for color, test in by_color.items():
+            with m.Case(color):
                 m.d.comb += match.eq(test)
     return match
 
@@ -88,7 +86,7 @@ class ColorFilter(wiring.Component):
     -------
     pixels : ``In(pixel_stream_signature())``
         Camera pixels (cannot be stalled).
-    color_sel : ``In(3)``
+    color_sel : ``In(TargetColor)``
         Colour select, sampled with each pixel: bit 2 red, bit 1 green, bit 0 blue.
     filtered : ``Out(pixel_stream_signature())``
         Filtered pixels, ``latency`` cycles after the input.
@@ -102,7 +100,7 @@ class ColorFilter(wiring.Component):
         self.params = params
         super().__init__({
             "pixels": In(pixel_stream_signature()),
-            "color_sel": In(3),
+            "color_sel": In(TargetColor),
             "filtered": Out(pixel_stream_signature()),
             "matches": Out(match_stream_signature()),
         })
@@ -119,8 +117,8 @@ class ColorFilter(wiring.Component):
 
         # The whole output stage is one register, laid out so that both streams are plain
         # slices of it: `filtered.payload` = bits 0-13 (pixel, first, last), `matches.payload`
-        # = bits 12-14 (first, last, match), then the valid bit (one register for the compiled
-        # simulators to test and copy per cycle, and no bit-by-bit assembly of the outputs).
+        # = bits 12-14 (first, last, match), then the valid bit (one register with one enable,
+        # and no bit-by-bit assembly of the outputs).
         flags_at = len(pix.pixel.as_value())
         stage = Signal(data.StructLayout({
             "payload": len(pix.as_value()), "match": 1, "valid": 1,

@@ -26,7 +26,7 @@ class SequentialDivider(CheckedArguments, wiring.Component):
     tag_bits : int, optional
         Width of a tag that travels with the division (default 0: none). A caller with
         results of its own to deliver with the quotient keeps them here rather than in a
-        register of its own (one register fewer for the compiled simulators every clock).
+        register of its own (the tag shares the divider's state register and its enable).
 
     Members
     -------
@@ -81,7 +81,7 @@ class SequentialDivider(CheckedArguments, wiring.Component):
         m = Module()
         q_bits = self.quotient_bits
 
-        # One packed register (fewer registers for the compiled simulators to commit).
+        # One packed register, loaded whole in each branch (see `fit`).
         # `steps` is q_bits + 1 at the start, a step is taken while it is above 1, and 1 is
         # the `done` cycle, so `done` needs no register of its own.
         state = Signal(data.StructLayout({

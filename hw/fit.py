@@ -1,9 +1,10 @@
 """Helpers for packed registers: all fields of a register load together, in one assignment.
 
-Why packed loads: the compiled simulators (CXXRTL, Verilator) compute the next value of
-every register on every clock. A register loaded field by field is split by Yosys into one
-computation per field, done every clock even when nothing loads; loaded whole, it costs
-one test while it holds.
+A packed register is one register with one load condition per branch: every branch
+assigns all of it, so the fields that load together share one enable and the fields a branch
+does not name keep their value through the same assignment. Yosys keeps it as one register
+instead of splitting it into one per field, each with its own enable logic (why this shape
+was chosen: docs/hardware.md).
 """
 
 from amaranth import Cat, Const, Value

@@ -92,8 +92,8 @@ class MotorController(wiring.Component):
         table = p.motor_law == "table"
 
         # e, turn and base +- turn are wide enough never to overflow before the saturation
-        # (the published design lost bits here). e and turn are plain signals: rebuilt for each
-        # use inside the `update` branch they were 3-4% faster, not enough to pay for the form.
+        # (the published design lost bits here). e and turn are plain signals, each one net
+        # for every use.
         if not table or p.search_side_from == "centroid":
             e_value = self.centroid_x - (p.width // 2)  # signed(x_bits + 1)
             e = Signal(e_value.shape())
@@ -103,9 +103,9 @@ class MotorController(wiring.Component):
             turn = Signal(turn_value.shape())
             m.d.comb += turn.eq(turn_value)
 
-        # The base speed is a multiplexer tree rebuilt for each use, not a case statement or
-        # an `Array` (a ROM read port): the compiled simulators then compute it inside the
-        # `update` branch only (7% faster at 160x120, docs/hardware.md).
+        # The base speed is a multiplexer tree on the proximity bits, rebuilt for each use
+        # inside the `update` branch, not a case statement or an `Array` (a ROM read port):
+        # three levels of 2:1 multiplexers over constants (why: docs/hardware.md).
         def base():
             values = [Const(v, signed(DPS_BITS)) for v in p.base_dps]
             for bit in range(3):
@@ -121,8 +121,8 @@ class MotorController(wiring.Component):
         search = Const(_wrap16(p.search_dps), signed(DPS_BITS))
         neg_search = Const(_wrap16(-p.search_dps), signed(DPS_BITS))
 
-        # All of the controller's state in one register, loaded whole in each branch: the
-        # compiled simulators then spend one test and one copy on it per clock (see `fit`).
+        # All of the controller's state in one register, loaded whole in each branch (one
+        # enable for the wheel speeds and the lost-target state; see `fit`).
         fields = {
             "left": signed(DPS_BITS), "right": signed(DPS_BITS),
             "count": range(p.lost_frames + 1), "right_side": 1,

@@ -6,12 +6,15 @@ A stream transfer carries one pixel plus two framing flags, as AXI4-Stream video
 The stream cannot be stalled (``always_ready``): a camera does not wait.
 """
 
-from amaranth.lib import data, stream
+from types import MappingProxyType
+
+from amaranth.lib import data, enum, stream
 
 from .errors import ParamError
 
 __all__ = [
-    "COLOR_SELECT", "RGB444", "FramedPixel", "color_select_value", "pixel_stream_signature",
+    "COLOR_SELECT", "RGB444", "FramedPixel", "TargetColor", "color_select_value",
+    "pixel_stream_signature",
 ]
 
 
@@ -27,24 +30,32 @@ def pixel_stream_signature():
     return stream.Signature(FramedPixel, always_ready=True)
 
 
-#: ``color_sel`` codes of the colour filter: bit 2 red, bit 1 green, bit 0 blue.
-COLOR_SELECT = {
-    "none": 0b000,
-    "blue": 0b001,
-    "green": 0b010,
-    "cyan": 0b011,
-    "red": 0b100,
-    "magenta": 0b101,
-    "yellow": 0b110,
-    "white": 0b111,
-}
+class TargetColor(enum.Enum, shape=3):
+    """The colour filter's ``color_sel`` codes: bit 2 red, bit 1 green, bit 0 blue."""
+
+    NONE = 0b000  # every pixel matches
+    BLUE = 0b001
+    GREEN = 0b010
+    CYAN = 0b011
+    RED = 0b100
+    MAGENTA = 0b101
+    YELLOW = 0b110
+    WHITE = 0b111
+
+
+#: Lower-case colour names to ``TargetColor`` codes (ints), for host code that reads names
+#: from scenarios, command lines and ROS topics.
+COLOR_SELECT = MappingProxyType({color.name.lower(): color.value for color in TargetColor})
 
 
 def color_select_value(color):
-    """Return the 3-bit ``color_sel`` code for a colour name or an int 0..7."""
+    """Return the 3-bit ``color_sel`` code (an int) for a colour name, a ``TargetColor`` or an
+    int 0..7."""
+    if isinstance(color, TargetColor):
+        return color.value
     if isinstance(color, str):
         try:
-            return COLOR_SELECT[color.lower()]
+            return TargetColor[color.upper()].value
         except KeyError:
             raise ParamError(
                 f"unknown colour {color!r}; choose one of: {', '.join(COLOR_SELECT)}"

@@ -7,7 +7,7 @@ from amaranth.lib.wiring import In, Out
 from .color_filter import ColorFilter
 from .motor import DPS_BITS, MotorController
 from .params import FollowTargetParams
-from .pixel import pixel_stream_signature
+from .pixel import TargetColor, pixel_stream_signature
 from .tracker import FrameTracker
 
 __all__ = ["FollowTarget", "follow_target_signature"]
@@ -18,7 +18,7 @@ def follow_target_signature(params):
     simulation flows' trivial stand-in design, so both drive the same harness."""
     return wiring.Signature({
         "pixels": In(pixel_stream_signature()),
-        "color_sel": In(3),
+        "color_sel": In(TargetColor),
         "filtered": Out(pixel_stream_signature()),
         "frame_done": Out(1),
         "found": Out(1),
@@ -42,8 +42,8 @@ class FollowTarget(wiring.Component):
     -------
     pixels : ``In(pixel_stream_signature())``
         Camera pixels: RGB444 plus ``first`` (start of frame) and ``last`` (end of line).
-    color_sel : ``In(3)``
-        Colour to follow: bit 2 red, bit 1 green, bit 0 blue.
+    color_sel : ``In(TargetColor)``
+        Colour to follow, 3 bits: bit 2 red, bit 1 green, bit 0 blue.
     filtered : ``Out(pixel_stream_signature())``
         Every pixel, black where it does not match; ``params.filter_latency`` cycles later.
     frame_done : ``Out(1)``
@@ -62,7 +62,7 @@ class FollowTarget(wiring.Component):
         self.params = params
         # Built here rather than in elaborate() so that tests and waveforms can reach them.
         self.color_filter = ColorFilter(params)
-        # Without the tracker's inspection outputs, which nothing here reads (simulation speed).
+        # Without the tracker's inspection outputs: three wide registers nothing here reads.
         self.tracker = FrameTracker(params, inspect=False)
         self.motor = MotorController(params)
         super().__init__(follow_target_signature(params))

@@ -10,12 +10,12 @@ Pipeline (one pixel per cycle at most, never stalls):
    frame can start accumulating on the very next cycle;
 3. after the divider, all per-frame outputs load together with the one-cycle ``frame_done``.
 
-Every stage is kept small and registered for simulation speed: the compiled simulators
-(CXXRTL, Verilator) evaluate all logic and commit every register on every clock.
+Every stage is small and registered: the per-pixel path is one register stage, and the
+per-frame arithmetic has a whole frame's worth of cycles to finish.
 
-The per-pixel and per-frame halves are separate modules on purpose: Amaranth's simulator
-re-evaluates a module's combinational logic when any of its inputs changes, so the per-frame
-logic (LED code, proximity) is not recomputed for every pixel.
+The per-pixel and per-frame halves are separate modules: they change at different rates (every
+pixel, once a frame), and the per-frame half only reads the counts at a frame's end
+(docs/hardware.md).
 """
 
 from amaranth import Const, Module, Mux, Signal
@@ -43,8 +43,7 @@ class FrameTracker(wiring.Component):
         Geometry, margins, ``min_pixels`` and ``proximity_thresholds``.
     inspect : bool, optional
         Also output ``count``, ``bins`` and ``sum_x`` (default). ``FollowTarget`` leaves
-        them out: three wide registers that nothing reads, which the compiled simulators
-        would still copy and compare on every clock.
+        them out: three wide registers that nothing reads.
 
     Members
     -------
@@ -119,10 +118,9 @@ class TrackerResults(wiring.Component):
     code go into its tag (loaded with the start, held through the division). When the
     divider is done, every output loads at once with the one-cycle ``frame_done``.
 
-    Built for simulation speed: the per-frame arithmetic is written under the ``end``
-    condition, each use its own expression (``N``, the sum of the bins, too), so the
-    compiled simulators evaluate it in that cycle only; between frames each register costs
-    them one test.
+    The per-frame arithmetic is written under the ``end`` condition, each use its own
+    expression (``N``, the sum of the bins, too): it is read in that cycle only, and its
+    results load registers with one enable each (docs/hardware.md).
 
     Parameters
     ----------
@@ -220,7 +218,7 @@ class TrackerResults(wiring.Component):
 
 
 def _tree_sum(values):
-    """Sum as a balanced tree of adders (a short logic path; same work in simulation)."""
+    """Sum as a balanced tree of adders (a short logic path: log2(n) adders deep)."""
     values = list(values)
     while len(values) > 1:
         pairs = [a + b for a, b in zip(values[0::2], values[1::2])]

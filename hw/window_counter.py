@@ -41,9 +41,8 @@ class WindowCounter(wiring.Component):
     and ``SX``; a ``first`` reloads the counts instead of adding, so nothing of an earlier
     (complete, abandoned or cut short) frame leaks into a frame.
 
-    Built for simulation speed (the compiled simulators evaluate all of it every clock and
-    pay for every register): per pixel there is one comparison of the column with the next
-    bin boundary (a register, not eight pairs of constants), one add into a per-bin
+    Little logic per pixel: one equality of the column with the next bin boundary (a
+    register, not eight pairs of constant comparisons), one add into a per-bin
     accumulator and one add into ``SX``. The accumulator is added into a bin only at
     the bin's last column; the bins then rotate by one place, so the bin being filled is
     always the first and after the eight bins of a line they are back in order. Whether the
@@ -101,10 +100,10 @@ class WindowCounter(wiring.Component):
             return v >= low if low > 0 else Const(1, 1)
 
         def in_window_columns(x):
-            # mx <= x <= last_boundary without an ordered comparison (the compiled simulators
-            # compute one with a full carry chain, and this is evaluated every pixel): with a
+            # mx <= x <= last_boundary without an ordered comparison, on every pixel: with a
             # power-of-two window width ww, x - mx (wrapping below 0) has no bit at or above
-            # log2(ww) set; otherwise the borrow bits of two subtractions.
+            # log2(ww) set, an OR of the high bits; otherwise the borrow bits of two
+            # subtractions.
             ww = last_boundary - mx + 1
             if ww & (ww - 1) == 0:
                 return ~(x - mx)[ww.bit_length() - 1:].any()
@@ -119,8 +118,8 @@ class WindowCounter(wiring.Component):
         last = self.matches.payload.last
 
         # Registers without a reset where the value does not matter until the next `first`
-        # reloads it (the compiled simulators test fewer conditions per cycle); the framing
-        # position, which always loads whole, is one register (see `fit`).
+        # reloads it (no reset logic for a value nobody reads); the framing position, which
+        # always loads whole, is one register (see `fit`).
         active = Signal()  # a well-formed frame is in progress
         # Framing state for the next pixel of the frame in progress: column, row, and
         # whether the row is inside margin_y.
@@ -129,8 +128,7 @@ class WindowCounter(wiring.Component):
         row_in = position[-1]
         # Counts: the bins (rotated during a line) and SX; the current bin's accumulator (the
         # matches so far in this bin and line) and the next bin boundary (the last column of a
-        # bin). Two plain registers: packed into one (a single add counted a pixel) they were
-        # no faster (docs/hardware.md).
+        # bin). Two plain registers, each with its own add (docs/hardware.md).
         cb = p.count_bits
         bins = Signal(8 * cb, reset_less=True)
         sx = Signal(p.sum_x_bits, reset_less=True)
@@ -146,7 +144,7 @@ class WindowCounter(wiring.Component):
             edges = Signal(8 * eb, reset_less=True)
             m.d.comb += self.counts.edges.eq(edges)
 
-        # Named signals, not expressions: the compiled simulators compute each once.
+        # Named signals, not expressions: each is one net, shared by every use.
         px = Signal(p.x_bits)  # position of the pixel on the input now
         py = Mux(first, 0, y)  # an expression: only the rare line-end branch reads it
         row = Signal()  # row py is inside margin_y
@@ -193,7 +191,7 @@ class WindowCounter(wiring.Component):
             if edges is not None:
                 m.d.sync += edges.eq(0)
         with m.Elif(advance):
-            with m.If(count):  # a masked add, which avoided this branch, was slower
+            with m.If(count):  # SX grows by the column only for a counted pixel
                 m.d.sync += sx.eq(sx + px)
             with m.If(px == boundary):
                 # After bin 7 the next boundary is bin 0's of the next line.

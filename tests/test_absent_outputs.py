@@ -159,6 +159,7 @@ def test_a_shadow_comparison_skips_outputs_one_design_lacks():
     json.dumps(cmp.summary())
 
 
+@pytest.mark.slow
 def test_a_foreign_design_without_found_runs_from_the_command_line(tmp_path, capsys):
     """The user's path: `run --design verilog:... --ports` with a map that names no `found`,
     no centroid and no filtered stream; the JSON summary says absent, the text says n/a."""

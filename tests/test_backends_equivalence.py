@@ -120,7 +120,7 @@ def test_sequences_exercise_search_every_proximity_and_colour():
 
 @pytest.mark.parametrize("params", [SMALL_A, SMALL_B], ids=["40x16", "48x24"])
 @pytest.mark.parametrize("blanking", BLANKINGS, ids=["no-blank", "blank"])
-@pytest.mark.parametrize("name", ["pysim", "cxxrtl", "verilator"])
+@pytest.mark.parametrize("name", ["pysim", "cxxrtl", pytest.param("verilator", marks=pytest.mark.slow)])
 def test_backend_matches_model_frame_by_frame(name, params, blanking):
     if name == "pysim" and not has_pysim():
         pytest.skip("the pysim backend (gateware helper) is not in this tree yet")
@@ -148,7 +148,7 @@ def test_compiled_backend_matches_model_at_160x120(name):
             assert_same(ref, run(b, seq), name)
 
 
-@pytest.mark.parametrize("name", ["cxxrtl", "verilator"])
+@pytest.mark.parametrize("name", ["cxxrtl", pytest.param("verilator", marks=pytest.mark.slow)])
 def test_wrong_frames_give_clear_errors_and_change_nothing(name):
     from fpga_robotics.sim.camera.frames import FrameError
 

@@ -11,6 +11,7 @@ import pytest
 from amaranth.sim import Simulator
 
 from fpga_robotics.cli.board import main
+from fpga_robotics.cli.errors import UsageError
 from fpga_robotics.flow.board import (
     BuildReport,
     ClockTiming,
@@ -20,7 +21,7 @@ from fpga_robotics.flow.board import (
 from fpga_robotics.hw.board.clocking import ecp5_pll_params
 from fpga_robotics.hw.board.color_select import SwitchColorSelect
 from fpga_robotics.hw.errors import UserError
-from fpga_robotics.hw.pixel import COLOR_SELECT
+from fpga_robotics.hw.pixel import COLOR_SELECT, TargetColor
 
 # The published pin assignment (ulx3s_v20.lpf of the published robot), transcribed here
 # independently of hw/board/pins.py.
@@ -92,7 +93,7 @@ def test_switches_select_colour(switches, colour):
 
     sim.add_testbench(bench)
     sim.run()
-    assert seen == [COLOR_SELECT[colour]]
+    assert seen == [TargetColor[colour.upper()]]
 
 
 def test_unknown_board_lists_supported_ones():

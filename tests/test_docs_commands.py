@@ -3,9 +3,10 @@
 The commands are read from the fenced code blocks of README.md and docs/*.md: in shell blocks
 (```` ```sh ````, ```` ```bash ````, or no language), the lines that start with
 ``python -m fpga_robotics``, ``python3 -m``, ``fpga-robotics``, ``rerun``, ``openFPGALoader``
-or ``python -m pytest`` (with ``\\`` continuations joined, a usage synopsis's indented
-``[...]`` lines too, and a trailing ``# comment`` split off); and every ```` ```python ````
-block.
+or ``python -m pytest`` (with ``\\`` continuations joined and a trailing ``# comment`` split
+off); and every ```` ```python ```` block. A shell block holds runnable commands only: a usage
+synopsis (an optional ``[...]`` part, a ``...``) belongs in a ```` ```text ```` block, and
+``test_shell_blocks_hold_no_synopsis`` fails on one.
 
 Each command has an entry in ``PLANS`` (keyed by its text as the page writes it): how it is
 run, and what is checked besides its exit code; or why it is not run here. A command that
@@ -19,7 +20,7 @@ timeout, in one fresh temporary folder (so ``--save-video clip.mp4`` and then
 mode saves a file, as on CI). They are made short: ``run`` gets ``--duration 1`` unless the
 plan says why the page's run needs longer, and ``--rerun off --quiet`` unless it is about the
 viewer; ``bench`` gets ``--frames 2 --min-seconds 0``; the other benchmarks their own small
-counts; optional ``[...]`` parts are dropped. pytest commands are collected
+counts. pytest commands are collected
 (``--collect-only``), not run: running the tests is CI's own ``python -m pytest``. A server
 that runs until Ctrl-C (``rerun --serve-web``) is started on free loopback ports, must answer
 HTTP 200 within a bounded time, and is stopped with SIGINT. Place and route (``--bitstream``)
@@ -134,18 +135,13 @@ def split_comment(line):
 
 
 def logical_lines(block):
-    """``(line number, code, comment)`` of a shell block: ``\\`` continuations joined, and the
-    indented ``[...]`` lines of a usage synopsis joined to the command above them."""
+    """``(line number, code, comment)`` of a shell block, ``\\`` continuations joined."""
     out = []
     pending = None  # [line, code, comment] still open for a continuation
     for n, raw in block.lines:
         code, comment = split_comment(raw)
         if pending is not None and pending[1].endswith("\\"):
             pending[1] = pending[1][:-1].rstrip() + " " + code.strip()
-            pending[2] = comment or pending[2]
-            continue
-        if pending is not None and re.match(r"^\s+\[", raw) and pending[1].strip():
-            pending[1] += " " + code.strip()
             pending[2] = comment or pending[2]
             continue
         if pending is not None:
@@ -160,6 +156,35 @@ def collapse(text):
     return " ".join(text.split())
 
 
+#: What marks a usage synopsis rather than a command: an optional ``[...]`` part after a blank
+#: (not a quoted TOML list such as ``--set 'x=[1,2]'``, not ``".[dev]"``), or ``...``.
+SYNOPSIS = re.compile(r"(?:^|\s)\[[^\]]*\]|(?:^|\s)\.\.\.(?:\s|\]|$)")
+
+
+def is_synopsis(code, previous_is_synopsis):
+    """Whether a logical line of a shell block is (part of) a usage synopsis: a command with an
+    optional part, or an indented ``[...]`` line under one."""
+    stripped = code.strip()
+    if stripped.startswith("[") and code[:1].isspace():
+        return previous_is_synopsis
+    return stripped.startswith(COMMAND_PREFIXES) and bool(SYNOPSIS.search(stripped))
+
+
+def synopsis_lines(page):
+    """``page:line: text`` of every line of a shell block that is a usage synopsis."""
+    text = (ROOT / page).read_text(encoding="utf-8")
+    found = []
+    for block in fenced_blocks(page, text):
+        if block.lang not in SHELL_LANGS:
+            continue
+        previous = False
+        for n, code, _ in logical_lines(block):
+            previous = is_synopsis(code, previous)
+            if previous:
+                found.append(f"{page}:{n}: {code.strip()}")
+    return found
+
+
 def scan_page(page):
     """``(commands, python blocks, unclassified lines)`` of one page."""
     text = (ROOT / page).read_text(encoding="utf-8")
@@ -170,12 +195,16 @@ def scan_page(page):
             continue
         if block.lang not in SHELL_LANGS:
             continue
+        synopsis = False
         for n, code, comment in logical_lines(block):
             stripped = code.strip()
             if stripped.startswith("$ "):
                 stripped = stripped[2:].lstrip()
             if not stripped:
                 continue
+            synopsis = is_synopsis(code, synopsis)
+            if synopsis:
+                continue  # test_shell_blocks_hold_no_synopsis reports it
             if stripped.startswith(COMMAND_PREFIXES):
                 commands.append(DocCommand(page, n, collapse(stripped), comment))
             elif block.lang or LOOKS_LIKE_COMMAND.match(stripped):
@@ -242,7 +271,8 @@ class Plan:
     collect: bool = False
     #: A server that runs until Ctrl-C: started on free ports, asked for its page, stopped.
     serve: bool = False
-    #: Marked slow (place and route): run only by ``test_documented_slow_command``.
+    #: Marked slow (it builds Verilator models or runs place and route): run only by
+    #: ``test_documented_slow_command``.
     slow: bool = False
 
 
@@ -281,8 +311,9 @@ PLANS = {
                       ".ci/run makes them in a fresh clone on every submission",
              viewer=True, files=("runs/follow_person.rrd",),
              out=(PASS, SAVED_DEFAULT), last_line=r"runs/follow_person\.rrd$"),
-    'python3 -m venv .venv && . .venv/bin/activate && pip install -e ".[dev,board]" && python -m pytest':
-        Plan(part="python -m pytest", collect=True,
+    'python3 -m venv .venv && . .venv/bin/activate && pip install -e ".[dev,board]" && '
+    'python -m pytest -q -n auto':
+        Plan(part="python -m pytest -q -n auto", collect=True,
              part_why="the set-up and the whole test run are CI's own command (.ci/run, checked "
                       "by test_ci_runs_the_readme_test_command); here the suite is collected",
              out=(r"\d{3,} tests collected",)),
@@ -337,8 +368,6 @@ PLANS = {
         Plan(files=("clip.mp4",), out=(PASS,)),
     "python -m fpga_robotics.run --source clip.mp4 --rerun off":
         Plan(out=(r"source clip\.mp4 \(video\)", r"target found in 30 frames")),
-    "python -m fpga_robotics.export -o build/follow_target.v [--width 320 --height 240 --kp-num 2 ...]":
-        Plan(files=("build/follow_target.v",), out=(r"160x120, module follow_target",)),
     # README and docs/running.md: the closed loop ---------------------------------------------
     "python -m fpga_robotics.run --list-scenarios":
         Plan(out=tuple(rf"(?m)^{name}\s" for name in SCENARIO_NAMES)),
@@ -350,7 +379,7 @@ PLANS = {
              files=("s.json",), out=(PASS,),
              summary=(("scenario", "lost_target"), ("verdict", "pass"))),
     "python -m fpga_robotics.run --resolution 640x480 --backend verilator --duration 5 --rerun off":
-        Plan(out=(r"backend verilator\s+640x480", PASS)),
+        Plan(slow=True, out=(r"backend verilator\s+640x480", PASS)),
     "python -m fpga_robotics.run":
         # The page's "typical ending", line by line.
         Plan(out=(r"(?m)^scenario follow_person\s+backend {fastest}\s+160x120\s+seed 0$",
@@ -410,18 +439,17 @@ PLANS = {
         Plan(duration="keep", duration_why=_DIVIDER_WHY,
              out=(r"\[FAIL\] target_in_view_min_fraction",)),
     "python -m fpga_robotics.run --resolution 320x240 --backend verilator --summary s.json":
-        Plan(files=("s.json",), out=(r"backend verilator\s+320x240", PASS),
+        Plan(slow=True, files=("s.json",), out=(r"backend verilator\s+320x240", PASS),
              summary=(("backend", "verilator"), ("resolution", "320x240"))),
     "python -m fpga_robotics.run --source clip.mp4 --color red":
         Plan(setup=(MAKE_CLIP,),
              out=(r"source clip\.mp4 \(video\)\s+backend \w+\s+160x120\s+colour red",
                   r"target found in 30 frames")),
-    "python -m fpga_robotics.run --scenario follow_person --rerun off --summary s.json "
-    "[--backend B]":
+    "python -m fpga_robotics.run --scenario follow_person --rerun off --summary s.json":
         # README quotes the summary's realtime_factor of this command.
         Plan(files=("s.json",), out=(PASS,), summary=(("realtime_factor", ...),)),
     "python -m fpga_robotics.run --scenario follow_person --rerun off --summary s.json "
-    "--resolution 640x480 --duration 10 [--backend B]":
+    "--resolution 640x480 --duration 10":
         Plan(files=("s.json",), out=(PASS,),
              summary=(("resolution", "640x480"), ("realtime_factor", ...))),
     "python -m fpga_robotics.run --backend model --rerun off --quiet --duration 20 "
@@ -487,10 +515,10 @@ PLANS = {
     "fpga-robotics ports --example ports.toml":
         Plan(files=("ports.toml",), out=(r"wrote ports\.toml",)),
     "python -m fpga_robotics.run --design verilog:follow_target.v --ports ports.toml":
-        Plan(out=(PASS, r"(?m)^backend:? .*cxxrtl-foreign|cxxrtl-foreign")),
+        Plan(slow=True, out=(PASS, r"(?m)^backend:? .*cxxrtl-foreign|cxxrtl-foreign")),
     ("python -m fpga_robotics.run --scenario bump_wall.toml --design verilog:bump_stop.v "
      "--ports bump_stop_ports.toml --rerun off"):
-        Plan(setup=(" ".join(["cp", *(str(ROOT / "tests/data" / name) for name in (
+        Plan(slow=True, setup=(" ".join(["cp", *(str(ROOT / "tests/data" / name) for name in (
                          "bump_stop.v", "bump_stop_ports.toml", "bump_wall.toml")), "."]),),
              duration="keep", duration_why="the page quotes the whole run's 120 000 cycles "
                                            "(12 s at 10 kHz, a twentieth of a second's wall time)",
@@ -535,11 +563,11 @@ PLANS = {
                     "python -m fpga_robotics.export -o follow_target.v"),
              out=(r"ports\.toml: matches verilog:follow_target\.v \(\d+ ports\)",)),
     "python -m fpga_robotics.mutation --mutants 200":
-        Plan(shorter=(("--mutants", "12"), ("--width", "80"), ("--height", "60")),
+        Plan(slow=True, shorter=(("--mutants", "12"), ("--width", "80"), ("--height", "60")),
              out=(r"unit judge: \d+ caught, \d+ equivalent on these frames: score",),
              files=("runs/mutation/n12-s1/mutants.json", "runs/mutation/n12-s1/mutants.v")),
     "fpga-robotics mutate --mutants 40 --width 80 --height 60 --out runs/mutation/small":
-        Plan(shorter=(("--mutants", "12"),),
+        Plan(slow=True, shorter=(("--mutants", "12"),),
              out=(r"12 mutants of follow_target 80x60",),
              files=("runs/mutation/small/mutants.json",)),
     "fpga-robotics mutate --design wall_stop.py:WallStop --mutants 40 --param clock_hz=100000":
@@ -552,7 +580,7 @@ PLANS = {
     "python -m fpga_robotics.mutation --mutants 100 --campaign mutation":
         # Four mutants at 80x60 on one worker, the campaign's runs made short: the whole
         # command takes minutes (the page gives its measured time).
-        Plan(shorter=(("--mutants", "4"), ("--width", "80"), ("--height", "60"),
+        Plan(slow=True, shorter=(("--mutants", "4"), ("--width", "80"), ("--height", "60"),
                       ("--workers", "1"), ("--recordings", "1")),
              out=(r"robot judge \(campaign mutation: \d+ of 9 runs pass unmutated\)",),
              files=("runs/mutation/n4-s1/report.html", "runs/mutation/n4-s1/robot.jsonl",
@@ -560,13 +588,13 @@ PLANS = {
     # The robot judge's scaling with workers: the same four mutants at 80x60 as above.
     ("python -m fpga_robotics.mutation --mutants 30 --campaign mutation --workers 1 "
      "--recordings 0 --out runs/mutation/scale-w1"):
-        Plan(shorter=(("--mutants", "4"), ("--width", "80"), ("--height", "60")),
+        Plan(slow=True, shorter=(("--mutants", "4"), ("--width", "80"), ("--height", "60")),
              out=((r"robot judge \(campaign mutation: \d+ of 9 runs pass unmutated\).*"
                    r"mutants/min"),),
              files=("runs/mutation/scale-w1/mutants.json",)),
     ("python -m fpga_robotics.mutation --mutants 30 --campaign mutation --workers 2 "
      "--recordings 0 --out runs/mutation/scale-w2"):
-        Plan(shorter=(("--mutants", "4"), ("--width", "80"), ("--height", "60")),
+        Plan(slow=True, shorter=(("--mutants", "4"), ("--width", "80"), ("--height", "60")),
              out=((r"robot judge \(campaign mutation: \d+ of 9 runs pass unmutated\).*"
                    r"mutants/min"),),
              files=("runs/mutation/scale-w2/mutants.json",)),
@@ -579,7 +607,7 @@ PLANS = {
         Plan(shorter=(("--max-runs", "2"), ("--backend", "model"), ("--duration", "2")),
              files=("runs/sweeps/mutation-20/report.html",), out=(r"2 runs: 2 pass",)),
     "fpga-robotics bench foreign":
-        Plan(shorter=(("--frames", "2"), ("--repeats", "1")),
+        Plan(slow=True, shorter=(("--frames", "2"), ("--repeats", "1")),
              out=(r"verilator \(built-in\) +[\d.]+ ms/frame",
                   r"foreign follow_target \(stream\) +[\d.]+ ms/frame +\([\d.]+x the built-in\)")),
     # Verilog export and the board ------------------------------------------------------------
@@ -668,11 +696,8 @@ PLANS = {
                   re.escape("  shadow frames that differ: proximity 96, centroid_leds 1, "
                             "motor_left 101, motor_right 101 (of 180)"))),
     # Benchmarks ------------------------------------------------------------------------------
-    "fpga-robotics bench design [--backends model,pysim,cxxrtl,verilator] "
-    "[--resolutions 160x120,320x240,640x480] [--frames 30] [--pysim-frames 3] "
-    "[--pysim-max-pixels 19200] [--min-seconds 1.0] [--no-trivial] [--published DIR] "
-    "[--json bench.json] [--calibrate]":
-        Plan(out=tuple(rf"(?m)^{b}\s+{s}\s" for b in ("model", "cxxrtl", "verilator")
+    "fpga-robotics bench":
+        Plan(slow=True, out=tuple(rf"(?m)^{b}\s+{s}\s" for b in ("model", "cxxrtl", "verilator")
                        for s in ("160x120", "320x240", "640x480"))
              + (r"(?m)^pysim\s+160x120\s",
                 r"cxxrtl 160x120: FollowTarget at [\d.]+ of the trivial design's cycle rate")),
@@ -700,7 +725,7 @@ PLANS = {
              out=(r"(?m)^\s*160x120\s+[\d.]+", r"(?m)^\s*640x480\s+[\d.]+")),
     # docs/pins.md -------------------------------------------------------------------------------
     "fpga-robotics bench pins":
-        Plan(shorter=(("--seconds", "0.02"), ("--pysim-seconds", "0.0002"), ("--repeats", "1")),
+        Plan(slow=True, shorter=(("--seconds", "0.02"), ("--pysim-seconds", "0.0002"), ("--repeats", "1")),
              out=((r"(?m)^cxxrtl +pins: +[\d.]+ Mcycles/s \(1,000,000 cycles, 1 frames, \d+ stops "
                   r"a run\); frame path [\d.]+ Mcycles/s, pins/frame [\d.]+ \(median of the runs' "
                    r"ratios\)$"),
@@ -831,7 +856,6 @@ def _set_option(args, name, value):
 def effective(doc_text, plan):
     """The command line this test runs for a documented command (a string for ``bash -c``)."""
     text = plan.part or doc_text
-    text = re.sub(r"(?<=\s)\[[^\]]*\]", "", text)  # optional parts dropped
     text = collapse(text)
     args = shlex.split(text)
     if _is(text, "run", "run") and "--list-scenarios" not in args:
@@ -1000,8 +1024,13 @@ fpga-robotics run --set 'x=a # b' --quiet
 ```
 python -m fpga_robotics.bench [--frames 30]
                               [--json b.json]
-output line
+python -m fpga_robotics.export -o a.v ...
 pip install something
+fpga-robotics run --set 'lighting.keyframes=[[0,0.6,0.4]]' --quiet
+```
+
+```text
+python -m fpga_robotics.bench [--frames 30]
 ```
 
 ```python
@@ -1022,9 +1051,14 @@ def test_extraction_of_a_sample_page(tmp_path, monkeypatch):
         (4, "python -m fpga_robotics.run --scenario divider --rerun off", "FAIL", 1),
         (5, "python -m fpga_robotics.export -o a.v --width 320 --height 240", "wide", 0),
         (7, "fpga-robotics run --set 'x=a # b' --quiet", "", 0),
-        (11, "python -m fpga_robotics.bench [--frames 30] [--json b.json]", "", 0),
+        (15, "fpga-robotics run --set 'lighting.keyframes=[[0,0.6,0.4]]' --quiet", "", 0),
     ]
     assert strays == ["page.md:14: pip install something"]
+    assert synopsis_lines("page.md") == [
+        "page.md:11: python -m fpga_robotics.bench [--frames 30]",
+        "page.md:12: [--json b.json]",
+        "page.md:13: python -m fpga_robotics.export -o a.v ...",
+    ]
     assert [snippet_key(b) for b in snippets] == [("page.md", "print(1)")]
 
 
@@ -1039,8 +1073,8 @@ def test_shortening_rules():
     assert effective("python -m fpga_robotics.run --duration 20 --quiet",
                      Plan(duration="keep")) == \
         "python -m fpga_robotics.run --duration 20 --quiet --rerun off"
-    assert effective("python -m fpga_robotics.bench [--frames 30] [--json b.json]", plan) == \
-        "python -m fpga_robotics.bench --frames 2 --min-seconds 0"
+    assert effective("python -m fpga_robotics.bench --frames 30 --json b.json", plan) == \
+        "python -m fpga_robotics.bench --frames 2 --json b.json --min-seconds 0"
     assert effective("fpga-robotics bench design --json b.json", plan) == \
         "fpga-robotics bench design --json b.json --frames 2 --min-seconds 0"
     assert effective("fpga-robotics bench loop --duration 10", plan) == \
@@ -1074,11 +1108,20 @@ def test_every_documented_command_is_classified():
     assert not problems, "\n".join(problems)
 
 
+def test_shell_blocks_hold_no_synopsis():
+    """A shell block is run line by line: a usage synopsis there is not a command."""
+    found = [line for page in PAGES for line in synopsis_lines(page)]
+    assert not found, "usage synopses in shell blocks (move them into a ```text block):\n" + (
+        "\n".join(found))
+
+
 def test_ci_runs_the_readme_test_command():
-    """README: ``.ci/run`` does exactly the README's test command in a fresh clone."""
-    ci = (ROOT / ".ci" / "run").read_text()
+    """README: ``.ci/run`` does exactly the README's test command in a fresh clone, and the
+    linter's two checks."""
+    ci = (ROOT / ".ci" / "run").read_text().splitlines()
     for step in ("python3 -m venv .venv", ". .venv/bin/activate",
-                 'pip install -q -e ".[dev,board]"', "python -m pytest"):
+                 'python -m pip install -q -e ".[dev,board]"', "python -m pytest -q -n auto",
+                 "ruff check .", "ruff format --check ."):
         assert step in ci, f".ci/run does not do {step!r}"
 
 
@@ -1118,7 +1161,8 @@ def _slow_commands():
 @pytest.mark.slow
 @pytest.mark.parametrize("doc", _slow_commands())
 def test_documented_slow_command(doc, tmp_path):
-    """Place and route (about 40 s, more on a cold YoWASP cache): the page's full flow."""
+    """Verilator builds or place and route (about 40 s, more on a cold YoWASP cache): the
+    page's full command."""
     run_documented(doc, PLANS[doc.text], tmp_path)
 
 
@@ -1395,7 +1439,20 @@ SNIPPETS = {
 }
 
 
-@pytest.mark.parametrize("block", python_blocks(), ids=lambda b: f"{b.page}:{b.line}")
+#: Python blocks that build a Verilator model: run only under ``-m slow``.
+SLOW_SNIPPETS = {
+    ("README.md", "from fpga_robotics.hw.params import FollowTargetParams"),
+    ("docs/backends.md", ('get_backend("verilator", params, waveform=WaveformRequest('
+                          '"out/run.fst", first_frame=10,')),
+}
+
+
+def _python_params():
+    return [pytest.param(b, marks=pytest.mark.slow) if snippet_key(b) in SLOW_SNIPPETS else b
+            for b in python_blocks()]
+
+
+@pytest.mark.parametrize("block", _python_params(), ids=lambda b: f"{b.page}:{b.line}")
 def test_documented_python(block, tmp_path, monkeypatch, capsys):
     handler = SNIPPETS.get(snippet_key(block))
     if handler is None:

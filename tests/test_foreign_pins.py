@@ -222,6 +222,7 @@ def test_parse_errors_name_the_key():
                         "connectors": {"bumper": {"pressed": "b"}}})
 
 
+@pytest.mark.slow
 def test_a_camera_design_in_verilog_follows_as_follow_target_does(tmp_path):
     from fpga_robotics.hw.verilog import generate_verilog
 
@@ -265,6 +266,7 @@ echo = "us_echo"
 """
 
 
+@pytest.mark.slow
 def test_a_camera_and_ultrasound_design_in_verilog_stops_as_follow_target_safe(tmp_path):
     """FollowTargetSafe exported to Verilog, its HC-SR04 pins bound by the port map, 0.3 m
     from a box: its interlock stops the wheels at the same cycles as the Amaranth design's."""

@@ -127,6 +127,7 @@ def files(tmp_path_factory):
     return d
 
 
+@pytest.mark.slow
 def test_exported_follow_target_matches_the_model_bit_for_bit(files):
     design = foreign.ForeignVerilatorBackend(PARAMS, files=[files / "follow_target.v"],
                                              port_map=files / "ft.toml")
@@ -144,6 +145,7 @@ def test_exported_follow_target_matches_the_model_bit_for_bit(files):
         design.close()
 
 
+@pytest.mark.slow
 def test_renamed_ports_active_low_reset_and_own_colour_codes(files):
     design = foreign.ForeignVerilatorBackend(PARAMS, files=[files / "robot_top.v",
                                                             files / "follow_target.v"],
@@ -166,6 +168,7 @@ def test_renamed_ports_active_low_reset_and_own_colour_codes(files):
         design.close()
 
 
+@pytest.mark.slow
 def test_fill_absent_gives_zeros(files):
     design = foreign.ForeignVerilatorBackend(PARAMS, files=[files / "robot_top.v",
                                                             files / "follow_target.v"],
@@ -178,6 +181,7 @@ def test_fill_absent_gives_zeros(files):
         design.close()
 
 
+@pytest.mark.slow
 def test_a_design_that_never_raises_its_strobe_is_a_named_timeout(files):
     design = foreign.ForeignVerilatorBackend(PARAMS, files=[files / "never.v"],
                                              port_map=files / "never.toml")
@@ -230,6 +234,7 @@ def test_bad_port_maps_are_one_line_errors(files, text, message):
 
 
 @pytest.mark.parametrize("top, ports", [("robot_top", "robot"), ("fb_top", "fb")])
+@pytest.mark.slow
 def test_cli_runs_a_foreign_design_in_closed_loop(files, capsys, top, ports):
     from fpga_robotics.cli import run
 
@@ -266,8 +271,8 @@ def test_cli_runs_a_foreign_design_in_closed_loop(files, capsys, top, ports):
         (["--design", "verilog:{dir}/never.v", "--ports", "{dir}/ft.toml"],
          ("--design: Verilator cannot read the design (top follow_target): %Error: Specified "
           "--top-module 'follow_target' was not found")),
-        (["--design", "verilog:{dir}/never.v", "--ports", "{dir}/never.toml"],
-         "timeout: the result strobe 'done' never rose"),
+        pytest.param(["--design", "verilog:{dir}/never.v", "--ports", "{dir}/never.toml"],
+                     "timeout: the result strobe 'done' never rose", marks=pytest.mark.slow),
         (["--design", "verilog:{dir}/missing.v", "--ports", "{dir}/never.toml"],
          "cannot read the Verilog file"),
         (["--runtime", "mutsel=1"], "--runtime sets [runtime] inputs of a Verilog design"),
@@ -275,9 +280,10 @@ def test_cli_runs_a_foreign_design_in_closed_loop(files, capsys, top, ports):
           "mutsel"], "--runtime needs NAME=VALUE with an integer VALUE, got 'mutsel'"),
         (["--design", "verilog:{dir}/follow_target.v", "--ports", "{dir}/ft.toml", "--runtime",
           "mutsel=x"], "--runtime needs NAME=VALUE"),
-        (["--design", "verilog:{dir}/follow_target.v", "--ports", "{dir}/ft.toml", "--runtime",
-          "mutsel=1"], ("--runtime: follow_target has no [runtime] input 'mutsel' (its runtime "
-                       "inputs: none)")),
+        pytest.param(["--design", "verilog:{dir}/follow_target.v", "--ports", "{dir}/ft.toml",
+                      "--runtime", "mutsel=1"],
+                     ("--runtime: follow_target has no [runtime] input 'mutsel' (its runtime "
+                      "inputs: none)"), marks=pytest.mark.slow),
     ],
 )
 def test_cli_bad_designs_exit_2_with_one_line(files, capsys, argv, message):
@@ -298,6 +304,7 @@ def _scalars(r):
 
 
 @pytest.mark.parametrize("line_blank", [0, 3])
+@pytest.mark.slow
 def test_framebuffer_style_matches_the_model(files, line_blank):
     design = foreign.ForeignVerilatorBackend(PARAMS, files=[files / "fb_top.v",
                                                             files / "follow_target.v"],
@@ -312,6 +319,7 @@ def test_framebuffer_style_matches_the_model(files, line_blank):
         design.close()
 
 
+@pytest.mark.slow
 def test_framebuffer_outputs_read_a_number_of_cycles_after_the_frame(files):
     design = foreign.ForeignVerilatorBackend(PARAMS, files=[files / "fb_top.v",
                                                             files / "follow_target.v"],
@@ -353,6 +361,7 @@ def test_bad_framebuffer_port_maps(files, text, message):
                               _map_with(files, text), PARAMS)
 
 
+@pytest.mark.slow
 def test_stream_outputs_read_a_number_of_cycles_after_the_frame(files):
     text = (files / "ft.toml").read_text().replace(
         f"result = {{ strobe = \"frame_done\", latency = {PARAMS.motor_latency} }}",
@@ -392,6 +401,7 @@ outputs = { centroid_leds = "leds", motor_left = "ml", motor_right = "mr" }
 """
 
 
+@pytest.mark.slow
 def test_included_files_are_found_and_part_of_the_build(files, tmp_path):
     (tmp_path / "sub").mkdir()
     (tmp_path / "inc_top.v").write_text(INC_TOP)
@@ -434,6 +444,7 @@ outputs = { motor_left = "ml", motor_right = "mr" }
 @pytest.mark.parametrize("task, what", [("$stop", r"\$stop or \$fatal"),
                                         ('$fatal(1, "bad")', r"\$stop or \$fatal"),
                                         ("$finish", r"\$finish")])
+@pytest.mark.slow
 def test_stop_fatal_and_finish_are_errors_not_a_dead_process(tmp_path, task, what):
     (tmp_path / "stopper.v").write_text(STOPPER % task)
     (tmp_path / "stopper.toml").write_text(STOPPER_MAP)
@@ -485,6 +496,7 @@ motor_right = "motor_right"
 """
 
 
+@pytest.mark.slow
 def test_constants_tie_inputs_the_world_does_not_drive(tmp_path):
     (tmp_path / "moded.v").write_text(MODED % {"xmsb": PARAMS.x_bits - 1})
     (tmp_path / "follow_target.v").write_text(generate_verilog(PARAMS))
@@ -520,6 +532,7 @@ def test_constants_tie_inputs_the_world_does_not_drive(tmp_path):
             PARAMS, files=files, port_map=port_map('[constants]\nmode = "5"\ndbg_addr = 0'))
 
 
+@pytest.mark.slow
 def test_runtime_inputs_are_set_between_frames_in_one_build(tmp_path):
     """``[runtime] mode = 0``: the same compiled model under mode 0 (motors held at 0) and
     mode 5 (the design's motors), switched from Python between frames."""

@@ -88,8 +88,8 @@ BUGS = {
                              "(frame_count()[:8] >= t if t > 0 else Const(1, 1))")),
     "color_filter.table@defaults": (
         "yellow does not ask for r and g to be similar",
-        lambda: mutant(ColorFilter, "0b110: similar(r, g) & dominates(r, b)",
-                       "0b110: dominates(r, b)")(P160)),
+        lambda: mutant(ColorFilter, "TargetColor.YELLOW: similar(r, g) & dominates(r, b)",
+                       "TargetColor.YELLOW: dominates(r, b)")(P160)),
     "color_filter.table@zero": (
         "the filter drops the last flag",
         lambda: mutant(ColorFilter, "Const(0b11, 2)", "Const(0b01, 2)")(

@@ -20,10 +20,33 @@ from scalar_reference import scalar_match
 
 from fpga_robotics.hw.color_filter import ColorFilter
 from fpga_robotics.hw.params import FollowTargetParams
-from fpga_robotics.hw.pixel import COLOR_SELECT
+from fpga_robotics.hw.pixel import COLOR_SELECT, TargetColor, color_select_value
+from fpga_robotics.hw.top import FollowTarget
 from fpga_robotics.sim.models.follow_target import match_table
 
 ALL_PIXELS = np.arange(4096, dtype=np.uint16)
+
+#: docs/contract.md: bit 2 red, bit 1 green, bit 0 blue; a colour is the primaries it mixes.
+PRIMARIES = {
+    "none": "", "blue": "b", "green": "g", "cyan": "gb", "red": "r", "magenta": "rb",
+    "yellow": "rg", "white": "rgb",
+}
+
+
+def test_target_color_codes_are_the_contract_bits():
+    expected = {name: 4 * ("r" in mix) + 2 * ("g" in mix) + ("b" in mix)
+                for name, mix in PRIMARIES.items()}
+    assert {c.name.lower(): c.value for c in TargetColor} == expected
+    assert dict(COLOR_SELECT) == expected
+    assert color_select_value("Yellow") == color_select_value(TargetColor.YELLOW) == 0b110
+    with pytest.raises(ValueError, match="unknown colour 'teal'"):
+        color_select_value("teal")
+
+
+def test_color_sel_port_is_the_enum_on_three_bits():
+    for dut in (ColorFilter(FollowTargetParams()), FollowTarget()):
+        assert dut.color_sel.shape() is TargetColor
+        assert len(dut.color_sel.as_value()) == 3
 
 
 def run_filter(params, schedule, color_sel):

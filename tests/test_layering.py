@@ -1,15 +1,10 @@
-"""The house rules of the code base, read from the source: dependencies point one way, the
-gateware imports no host code, and nothing leans on Amaranth's private internals.
+"""The house rules of the code base, read from the source: imports point downwards through the
+rooms of docs/architecture.md, no two modules import each other (directly or round a circle),
+the gateware imports no host code, and nothing leans on Amaranth's private internals.
 
-The layers, lowest first (a module may import its own layer and the ones below):
-
-    fpga_robotics.hw   gateware (Amaranth only)
-    fpga_robotics.sim  model, backends, world, camera, shared data types, file helpers
-    fpga_robotics.viz  the rerun viewer
-    fpga_robotics.*    the application: CLIs, closed loop, connectors, scenarios
-
-Imports under ``if __name__ == "__main__":`` are exempt: that is how a library module keeps
-its documented ``python -m`` alias while its CLI lives in the application layer.
+Every import counts: at the top of a module, inside a function, under
+``if __name__ == "__main__":``, and the module named by a string literal in
+``importlib.import_module("...")``.
 """
 
 import ast
@@ -23,123 +18,268 @@ ROOT = Path(__file__).resolve().parent.parent
 PACKAGE_DIRS = {"fpga_robotics": "fpga_robotics", "hw": "fpga_robotics.hw",
                 "sim": "fpga_robotics.sim", "viz": "fpga_robotics.viz"}
 
-#: Package prefix -> layer; the longest matching prefix decides.
-LAYERS = {"fpga_robotics.hw": 0, "fpga_robotics.sim": 1, "fpga_robotics.viz": 2,
-          "fpga_robotics": 3}
-LAYER_NAMES = {0: "hw", 1: "sim", 2: "viz", 3: "application"}
+#: The rooms, top first: a module may import its own room and the rooms below it. A module's
+#: room is the one with the longest prefix that matches its name (docs/architecture.md).
+ROOMS = [
+    ("aliases", ("fpga_robotics.__main__", "fpga_robotics.run", "fpga_robotics.export",
+                 "fpga_robotics.formal", "fpga_robotics.bench.__main__",
+                 "fpga_robotics.mutation.__main__", "fpga_robotics.sweep.__main__")),
+    ("cli", ("fpga_robotics.cli",)),
+    ("bench", ("fpga_robotics.bench",)),
+    ("mutation", ("fpga_robotics.mutation",)),
+    ("sweep", ("fpga_robotics.sweep",)),
+    ("run command", ("fpga_robotics.cli.run",)),
+    ("flow", ("fpga_robotics.flow",)),
+    ("scenario", ("fpga_robotics.scenario",)),
+    ("loop", ("fpga_robotics.loop",)),
+    ("designs", ("fpga_robotics.designs",)),
+    ("connectors", ("fpga_robotics.loop.connectors",)),
+    ("ros", ("fpga_robotics.ros",)),
+    ("checks", ("fpga_robotics.checks",)),
+    ("cli support", ("fpga_robotics.cli.errors", "fpga_robotics.cli.param_options",
+                     "fpga_robotics.cli.sensor_options")),
+    ("package", ("fpga_robotics",)),
+    ("viz", ("fpga_robotics.viz",)),
+    ("sim", ("fpga_robotics.sim",)),
+    ("hw", ("fpga_robotics.hw",)),
+]
 
 #: Third-party host packages the gateware must never import.
-HOST_PACKAGES = {"numpy", "pymunk", "cv2", "rerun", "scipy"}
+HOST_PACKAGES = {"numpy", "pymunk", "cv2", "rerun", "scipy", "mujoco", "rosbags", "dask"}
 
 
-def layer_of(module):
-    best = max((p for p in LAYERS if module == p or module.startswith(p + ".")), key=len)
-    return LAYERS[best]
+def room_of(module, rooms=ROOMS):
+    """``(height, room name)`` of ``module``: 0 is the bottom room."""
+    best = None
+    for height, (name, prefixes) in enumerate(reversed(rooms)):
+        for prefix in prefixes:
+            if (module == prefix or module.startswith(prefix + ".")) and (
+                    best is None or len(prefix) > best[0]):
+                best = (len(prefix), height, name)
+    return best[1:] if best else (None, None)
 
 
-def source_modules():
-    """``(module name, path)`` of every Python file of the installed packages."""
-    out = []
-    for folder, package in PACKAGE_DIRS.items():
-        for path in sorted((ROOT / folder).rglob("*.py")):
-            rel = path.relative_to(ROOT / folder).with_suffix("")
+def source_modules(root=ROOT, package_dirs=PACKAGE_DIRS):
+    """``{module name: path}`` of every Python file of the installed packages."""
+    out = {}
+    for folder, package in package_dirs.items():
+        for path in sorted((root / folder).rglob("*.py")):
+            rel = path.relative_to(root / folder).with_suffix("")
             parts = [p for p in rel.parts if p != "__init__"]
             if folder == "fpga_robotics" and parts and parts[0] in ("hw", "sim", "viz"):
-                continue  # not there: the repo keeps them at the top
-            out.append((".".join([package, *parts]), path))
+                continue  # not there: the repository keeps them at the top
+            out[".".join([package, *parts])] = path
     return out
 
 
 def _is_main_guard(node):
     test = node.test
-    return (isinstance(node, ast.If) and isinstance(test, ast.Compare)
-            and isinstance(test.left, ast.Name) and test.left.id == "__name__"
+    return (isinstance(test, ast.Compare) and isinstance(test.left, ast.Name)
+            and test.left.id == "__name__"
             and any(isinstance(c, ast.Constant) and c.value == "__main__"
                     for c in test.comparators))
 
 
-def imports_of(module, path):
-    """``(line, imported module)`` for every import in the file (at any depth), relative
-    imports resolved, those under a ``__main__`` guard left out."""
-    tree = ast.parse(path.read_text(), str(path))
-    is_package = path.name == "__init__.py"
-    base = module.split(".") if is_package else module.split(".")[:-1]
-    found = []
-
-    def visit(node):
+def _main_guard_lines(tree):
+    lines = set()
+    for node in ast.walk(tree):
         if isinstance(node, ast.If) and _is_main_guard(node):
-            for child in node.orelse:
-                visit(child)
-            return
+            lines.update(range(node.lineno, node.end_lineno + 1))
+    return lines
+
+
+def _is_import_module_call(node):
+    func = node.func
+    name = func.attr if isinstance(func, ast.Attribute) else getattr(func, "id", None)
+    return (name in ("import_module", "__import__") and node.args
+            and isinstance(node.args[0], ast.Constant) and isinstance(node.args[0].value, str))
+
+
+def imports_of(module, path, modules):
+    """``(line, imported module, under a __main__ guard)`` for every import in the file:
+    ``from package import name`` is the module ``package.name`` where that is a module of
+    ``modules``, else ``package``; relative imports are resolved."""
+    tree = ast.parse(path.read_text(), str(path))
+    in_main = _main_guard_lines(tree)
+    base = module.split(".") if path.name == "__init__.py" else module.split(".")[:-1]
+    found = []
+    for node in ast.walk(tree):
+        targets = []
         if isinstance(node, ast.Import):
-            found.extend((node.lineno, alias.name) for alias in node.names)
+            targets = [alias.name for alias in node.names]
         elif isinstance(node, ast.ImportFrom):
             if node.level:
                 anchor = base[: len(base) - (node.level - 1)]
-                target = ".".join(anchor + ([node.module] if node.module else []))
+                package = ".".join(anchor + ([node.module] if node.module else []))
             else:
-                target = node.module
-            found.append((node.lineno, target))
-            if node.module is None or node.level == 0:  # "from . import x": x may be a module
-                found.extend((node.lineno, f"{target}.{a.name}") for a in node.names)
-        for child in ast.iter_child_nodes(node):
-            visit(child)
-
-    visit(tree)
+                package = node.module
+            named = [f"{package}.{alias.name}" for alias in node.names]
+            targets = [t for t in named if t in modules]
+            if len(targets) < len(named):
+                targets.append(package)
+        elif isinstance(node, ast.Call) and _is_import_module_call(node):
+            targets = [node.args[0].value]
+        found.extend((node.lineno, t, node.lineno in in_main) for t in targets)
     return found
 
 
-def _is_module(name):
-    """Whether ``name`` (inside fpga_robotics) is a module or package of the source tree."""
-    return any(m == name for m, _ in source_modules())
+def _project_module(name, modules):
+    """The module of ``modules`` that importing ``name`` runs (its longest known prefix)."""
+    while name and name not in modules:
+        name = name.rpartition(".")[0]
+    return name or None
 
 
-def layering_violations():
-    bad = []
-    for module, path in source_modules():
-        mine = layer_of(module)
-        for line, target in imports_of(module, path):
-            root = target.split(".")[0]
-            if mine == 0 and root in HOST_PACKAGES:
-                bad.append(f"{path.relative_to(ROOT)}:{line}: gateware imports host "
-                           f"package {target}")
-            if root != "fpga_robotics" or not _is_module(target):
-                continue
-            theirs = layer_of(target)
-            if theirs > mine:
-                bad.append(f"{path.relative_to(ROOT)}:{line}: {LAYER_NAMES[mine]} module "
-                           f"{module} imports {LAYER_NAMES[theirs]} module {target}")
-    return bad
+def import_graph(modules):
+    """``{module: {imported project module: first line}}`` and the list of every import."""
+    graph, every = {m: {} for m in modules}, []
+    for module, path in modules.items():
+        for line, target, in_main in imports_of(module, path, modules):
+            every.append((module, line, target, in_main))
+            imported = _project_module(target, modules)
+            if imported is not None and imported != module:
+                graph[module].setdefault(imported, line)
+    return graph, every
 
 
-def test_every_source_module_is_found():
-    names = {m for m, _ in source_modules()}
-    assert {"fpga_robotics.hw.top", "fpga_robotics.sim.models.follow_target", "fpga_robotics.viz.recorder",
-            "fpga_robotics.loop", "fpga_robotics.sim.backends.cxxrtl"} <= names
+def circles(graph):
+    """The import circles of ``graph``: Tarjan's strongly connected components of more than
+    one module, each sorted, and a module that imports itself."""
+    index, low, stack, on_stack, found = {}, {}, [], set(), []
+    for start in sorted(graph):
+        if start in index:
+            continue
+        # Iterative depth-first search: (node, iterator over its successors).
+        index[start] = low[start] = len(index)
+        stack.append(start)
+        on_stack.add(start)
+        work = [(start, iter(sorted(graph[start])))]
+        while work:
+            node, successors = work[-1]
+            for nxt in successors:
+                if nxt not in index:
+                    index[nxt] = low[nxt] = len(index)
+                    stack.append(nxt)
+                    on_stack.add(nxt)
+                    work.append((nxt, iter(sorted(graph.get(nxt, ())))))
+                    break
+                if nxt in on_stack:
+                    low[node] = min(low[node], index[nxt])
+            else:
+                work.pop()
+                if work:
+                    parent = work[-1][0]
+                    low[parent] = min(low[parent], low[node])
+                if low[node] == index[node]:
+                    component = []
+                    while True:
+                        member = stack.pop()
+                        on_stack.discard(member)
+                        component.append(member)
+                        if member == node:
+                            break
+                    if len(component) > 1:
+                        found.append(sorted(component))
+    return sorted(found)
 
 
-def test_dependencies_point_one_way():
-    assert layering_violations() == []
+def check(root=ROOT, package_dirs=PACKAGE_DIRS, rooms=ROOMS):
+    """Every broken rule of the tree at ``root``, one line each."""
+    modules = source_modules(root, package_dirs)
+    graph, every = import_graph(modules)
+    problems = []
+    for module, line, target, in_main in every:
+        where = f"{modules[module].relative_to(root)}:{line}"
+        main_note = " (under __main__)" if in_main else ""
+        mine, my_room = room_of(module, rooms)
+        if my_room is None:
+            problems.append(f"{where}: {module} is in no room of the table")
+            continue
+        if my_room == "hw" and target.split(".")[0] in HOST_PACKAGES:
+            problems.append(f"{where}: gateware imports host package {target}{main_note}")
+        imported = _project_module(target, modules)
+        if imported is None or imported == module:
+            continue
+        theirs, their_room = room_of(imported, rooms)
+        if theirs is not None and theirs > mine:
+            problems.append(f"{where}: {my_room} module {module} imports {imported} of the "
+                            f"{their_room} room above it{main_note}")
+    for circle in circles(graph):
+        ring = " -> ".join(circle + circle[:1])
+        problems.append(f"import circle: {ring} (move what they share into a module below "
+                        f"both)")
+    return problems
 
 
-def test_the_checker_sees_an_upward_import(tmp_path):
-    path = tmp_path / "x.py"
-    path.write_text("import os\nfrom ...cli.errors import UsageError\n"
-                    "def f():\n    from ..world import World\n"
-                    "if __name__ == '__main__':\n    from ...run import main\n")
-    found = imports_of("fpga_robotics.sim.backends.x", path)
-    assert (2, "fpga_robotics.cli.errors") in found
-    assert (4, "fpga_robotics.sim.world") in found
-    assert all(t != "fpga_robotics.run" for _, t in found)  # the __main__ alias is exempt
-    assert layer_of("fpga_robotics.cli.errors") > layer_of("fpga_robotics.sim.backends.x")
+def test_every_source_module_is_found_and_has_a_room():
+    modules = source_modules()
+    assert {"fpga_robotics.hw.top", "fpga_robotics.sim.models.follow_target",
+            "fpga_robotics.viz.recorder", "fpga_robotics.loop", "fpga_robotics.cli.errors",
+            "fpga_robotics.sim.backends.cxxrtl", "fpga_robotics.bench.__main__"} <= set(modules)
+    assert [m for m in modules if room_of(m)[1] is None] == []
+    assert room_of("fpga_robotics.loop.connectors.camera")[1] == "connectors"
+    assert room_of("fpga_robotics.cli.errors")[1] == "cli support"
+    assert room_of("fpga_robotics.cli.sweep")[1] == "cli"
+
+
+def test_imports_point_downwards_and_never_round_a_circle():
+    assert check() == []
+
+
+def test_the_checker_reports_upward_imports_circles_and_main_blocks(tmp_path):
+    files = {
+        # an upward import at the top: the gateware imports the simulation
+        "hw/top.py": "from fpga_robotics.sim import world\n",
+        "hw/pure.py": "import numpy as np\n",
+        "sim/__init__.py": "",
+        "sim/world.py": "import math\n",
+        # an upward import under the __main__ guard (a module keeping its own command line)
+        "sim/tool.py": ("def f():\n    return 1\n\n"
+                        "if __name__ == '__main__':\n"
+                        "    from fpga_robotics.cli import main\n    main()\n"),
+        # an upward import by a string literal, inside a function
+        "viz/plugin.py": ("import importlib\n\n"
+                          "def load():\n"
+                          "    return importlib.import_module('fpga_robotics.loop.a')\n"),
+        # a circle inside one room, one side importing inside a function
+        "fpga_robotics/__init__.py": "",
+        "fpga_robotics/cli/__init__.py": "def main():\n    pass\n",
+        "fpga_robotics/loop/__init__.py": "",
+        "fpga_robotics/loop/a.py": "from fpga_robotics.loop.b import g\n\ndef f():\n    g()\n",
+        "fpga_robotics/loop/b.py": ("def g():\n    from . import a\n    return a\n"),
+        # allowed: downwards, and its own room
+        "fpga_robotics/loop/c.py": "from fpga_robotics.sim import world\nfrom . import b\n",
+    }
+    for name, text in files.items():
+        path = tmp_path / name
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(text)
+    problems = check(tmp_path)
+    assert problems == [
+        "hw/pure.py:1: gateware imports host package numpy",
+        ("hw/top.py:1: hw module fpga_robotics.hw.top imports fpga_robotics.sim.world of the "
+         "sim room above it"),
+        ("sim/tool.py:5: sim module fpga_robotics.sim.tool imports fpga_robotics.cli of the "
+         "cli room above it (under __main__)"),
+        ("viz/plugin.py:4: viz module fpga_robotics.viz.plugin imports fpga_robotics.loop.a of "
+         "the loop room above it"),
+        ("import circle: fpga_robotics.loop.a -> fpga_robotics.loop.b -> fpga_robotics.loop.a "
+         "(move what they share into a module below both)"),
+    ]
+
+
+def test_circles_finds_every_ring_and_nothing_else():
+    graph = {"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"a", "e"}, "e": {"d"}, "f": {"a"},
+             "g": set()}
+    assert circles(graph) == [["a", "b", "c"], ["d", "e"]]
+    assert circles({"a": {"b"}, "b": set()}) == []
 
 
 @pytest.mark.parametrize("needle", ["amaranth._", "_MustUse__", "._engine"])
 def test_no_private_amaranth_internals(needle):
     hits = []
-    for _module, path in source_modules():
+    for path in source_modules().values():
         for n, line in enumerate(path.read_text().splitlines(), 1):
-            code = line.split("#", 1)[0]
-            if needle in code and not (needle == "amaranth._" and "amaranth._" not in code):
+            if needle in line.split("#", 1)[0]:
                 hits.append(f"{path.relative_to(ROOT)}:{n}: {line.strip()}")
     assert hits == []

@@ -86,6 +86,7 @@ def _toolchain():
 
 
 @pytest.mark.skipif(_toolchain() is not None, reason="no Verilator toolchain")
+@pytest.mark.slow
 def test_one_build_runs_the_design_and_each_mutant(tmp_path):
     """``mutsel`` as a ``[runtime]`` input of the port map: one compiled model, the mutant
     chosen between runs. Select 0 is the design bit for bit; a stuck-at-1 on the filtered
@@ -191,6 +192,7 @@ def test_bad_arguments_are_one_line_errors(tmp_path, monkeypatch):
 
 
 @pytest.mark.skipif(_toolchain() is not None, reason="no Verilator toolchain")
+@pytest.mark.slow
 def test_a_mutant_runs_in_closed_loop_from_the_command_line(tmp_path, capsys):
     """``run --design verilog:mutants.v --ports mutants_ports.toml --runtime mutsel=K``: the
     select 0 is the design (the same run as the built-in Verilator backend); the stuck filtered
@@ -225,6 +227,7 @@ def test_a_mutant_runs_in_closed_loop_from_the_command_line(tmp_path, capsys):
 
 
 @pytest.mark.skipif(_toolchain() is not None, reason="no Verilator toolchain")
+@pytest.mark.slow
 def test_the_robot_judge_catches_a_wheel_bug_and_not_a_filtered_image_bug(tmp_path):
     """Two mutants judged by hand: the filtered stream's bit stuck at 1 changes nothing the
     robot acts on (a blind spot: the unit judge alone sees it); bit 12 of the left wheel's

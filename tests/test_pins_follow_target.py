@@ -84,7 +84,7 @@ def check_sequence(name, params, frames, timing_of):
         assert searched  # the sequence did reach the motors' search
 
 
-@pytest.mark.parametrize("name", ["pysim", "cxxrtl", "verilator"])
+@pytest.mark.parametrize("name", ["pysim", "cxxrtl", pytest.param("verilator", marks=pytest.mark.slow)])
 def test_small_geometry_with_sparse_pixels(name):
     # Pixels every 3rd edge, 9 idle edges after a line, frames 50 edges apart.
     frames = frames_for(SMALL, 1)
@@ -93,7 +93,7 @@ def test_small_geometry_with_sparse_pixels(name):
                                              pixel_period=3))
 
 
-@pytest.mark.parametrize("name", ["cxxrtl", "verilator"])
+@pytest.mark.parametrize("name", ["cxxrtl", pytest.param("verilator", marks=pytest.mark.slow)])
 def test_160x120_in_real_clock_time(name):
     params = FollowTargetParams(lost_frames=2)
     frames = frames_for(params, 2)

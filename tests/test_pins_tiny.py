@@ -164,6 +164,7 @@ def _script(pins, seed):
     return log
 
 
+@pytest.mark.slow
 def test_a_seeded_script_is_the_same_on_every_backend():
     logs = {}
     for name in BACKENDS:

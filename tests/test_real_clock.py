@@ -92,6 +92,7 @@ def test_modes_agree_while_the_robot_has_not_moved():
     assert b.summary["sim_cycles"] == round(0.1 * CLOCK)
 
 
+@pytest.mark.slow
 def test_real_clock_backends_agree_bit_for_bit():
     s = load_scenario("line_track", ["sim.duration=1.0", "sim.clock_hz=100000"])
     runs = [run_scenario(s, backend=name) for name in ("pysim", "cxxrtl", "verilator")]

@@ -112,6 +112,7 @@ def _toolchain():
 
 
 @pytest.mark.skipif(_toolchain() is not None, reason="no Verilator toolchain")
+@pytest.mark.slow
 def test_a_scenario_runs_its_foreign_design_in_closed_loop(files, capsys):
     from fpga_robotics.cli import run
 

@@ -19,6 +19,7 @@ pytestmark = pytest.mark.skipif("verilator" not in available_backends(),
                                 reason="no Verilator toolchain")
 
 
+@pytest.mark.slow
 def test_a_foreign_design_without_found_in_a_campaign(tmp_path):
     params = FollowTargetParams(width=80, height=60)
     (tmp_path / "ft.v").write_text(generate_verilog(params))

@@ -6,6 +6,8 @@ what the design's pins see of the world and do to it; ``shadow.py`` runs a secon
 the same frames; ``sources.py`` feeds frames from outside the simulation.
 """
 
+# Registers real-clock timing with run_scenario (compressed.TIMINGS).
+from fpga_robotics.loop import real_clock  # noqa: F401
 from fpga_robotics.loop.compressed import (
     TRAJECTORY_FIELDS,
     ClosedLoop,

@@ -16,14 +16,23 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from fpga_robotics.loop.connectors import CameraConnector, MotorConnector, in_view
-from fpga_robotics.loop.connectors.camera import ExposureDrift
+from fpga_robotics.checks.sensor_metrics import obstacle_metrics
+from fpga_robotics.checks.summary import DESIGN_OUTPUTS, compute_metrics, evaluate_checks, verdict
 from fpga_robotics.hw.pixel import color_select_value
+from fpga_robotics.loop.connectors import CameraConnector, MotorConnector, in_view
+from fpga_robotics.loop.connectors.camera import ExposureDrift, make_sensor
 from fpga_robotics.loop.shadow import ShadowComparison, divergence_event
+from fpga_robotics.ros.controls import apply_inputs
+from fpga_robotics.sim.backends import fastest_backend_name, get_backend
 from fpga_robotics.sim.camera.raster import focal_length
 from fpga_robotics.sim.records import FrameRecord
-from fpga_robotics.sim.world import is_removal_event
-from fpga_robotics.checks.summary import DESIGN_OUTPUTS, compute_metrics, evaluate_checks, verdict
+from fpga_robotics.sim.world import World, is_removal_event
+
+#: ``sim.timing`` -> the function ``run_scenario`` hands a scenario in that timing to (with
+#: its own arguments). The real-clock loop registers itself there: it builds on
+#: ``ClosedLoop``, so this module cannot import it; the ``fpga_robotics.loop`` package,
+#: imported before any of its modules, imports both.
+TIMINGS = {}
 
 __all__ = ["TRAJECTORY_FIELDS", "ClosedLoop", "RunResult", "frame_count", "make_backend",
            "run_scenario"]
@@ -67,8 +76,6 @@ class RunResult:
 def make_backend(name, params, *, on_build=None):
     """A ``DesignBackend`` by name ("auto" = the fastest available compiled one);
     ``on_build(text)`` is told before a compiled model is built (not found in the cache)."""
-    from fpga_robotics.sim.backends import fastest_backend_name, get_backend
-
     if name == "auto":
         name = fastest_backend_name()
     return get_backend(name, params, on_build=on_build)
@@ -120,8 +127,6 @@ class ClosedLoop:
 
     def __init__(self, scenario, *, seed=None, design, recorder=None, on_frame=None,
                  shadow=None, shadow_label="shadow", controls=None):
-        from fpga_robotics.sim.world import World
-
         self.scenario = scenario
         self.seed = scenario.seed if seed is None else int(seed)
         self.design = design
@@ -157,8 +162,6 @@ class ClosedLoop:
 
     def _build_camera(self, cam, spec):
         """The camera on the robot; mount values the scenario leaves unset are the robot's."""
-        from fpga_robotics.loop.connectors.camera import make_sensor
-
         return CameraConnector(
             cam.width, cam.height, cam.hfov,
             mount_height=cam.mount_height if cam.mount_height is not None else spec.camera_height,
@@ -209,8 +212,6 @@ class ClosedLoop:
         """The live control inputs due at frame ``k``, applied; returns their events."""
         if self.controls is None:
             return []
-        from fpga_robotics.ros.controls import apply_inputs
-
         return apply_inputs(self, self.controls.inputs_for(k, t))
 
     def process(self, k, rgb):
@@ -367,8 +368,6 @@ class ClosedLoop:
     def extra_metrics(self):
         """Metrics beyond ``compute_metrics``: whether following resumed after an obstacle
         left (fpga_robotics.checks.sensor_metrics)."""
-        from fpga_robotics.checks.sensor_metrics import obstacle_metrics
-
         return obstacle_metrics(self.traj, self.events)
 
     def timing_summary(self, wall):
@@ -474,10 +473,11 @@ def run_scenario(scenario, *, seed=None, backend="auto", recorder=None, progress
         Live control inputs (``fpga_robotics.ros.controls``): colour select, the target
         driven by hand, pause and step; applied just after each frame's capture.
     """
-    if scenario.sim.timing == "real_clock":
-        return _run_real_clock(scenario, seed=seed, backend=backend, recorder=recorder,
-                               progress=progress, realtime=realtime, on_frame=on_frame,
-                               shadow=shadow, shadow_label=shadow_label, controls=controls)
+    if scenario.sim.timing != "compressed":
+        return TIMINGS[scenario.sim.timing](
+            scenario, seed=seed, backend=backend, recorder=recorder, progress=progress,
+            realtime=realtime, on_frame=on_frame, shadow=shadow, shadow_label=shadow_label,
+            controls=controls)
     owns_backend = isinstance(backend, str)
     design = make_backend(backend, scenario.params) if owns_backend else backend
     try:
@@ -489,31 +489,6 @@ def run_scenario(scenario, *, seed=None, backend="auto", recorder=None, progress
         loop = ClosedLoop(scenario, seed=seed, design=design, recorder=recorder,
                           on_frame=on_frame, shadow=shadow, shadow_label=shadow_label,
                           controls=controls)
-        return loop.run(progress=progress, realtime=realtime)
-    finally:
-        if owns_backend:
-            design.close()
-
-
-def _run_real_clock(scenario, *, seed, backend, recorder, progress, realtime, on_frame, shadow,
-                    shadow_label, controls):
-    """``run_scenario`` in real-clock timing (fpga_robotics.loop.real_clock)."""
-    from fpga_robotics.loop.real_clock import RealClockLoop, make_pin_backend
-    from fpga_robotics.hw.errors import UsageError
-
-    if shadow is not None and not hasattr(shadow, "ports"):
-        raise UsageError("a shadow in real-clock timing is a design on a pin backend "
-                         "(run --shadow REF); FollowTarget parameters compare frames in "
-                         "sim.timing = \"compressed\"")
-    owns_backend = isinstance(backend, str)
-    design = make_pin_backend(backend, scenario) if owns_backend else backend
-    try:
-        design.reset()
-        if shadow is not None:
-            shadow.reset()
-        loop = RealClockLoop(scenario, seed=seed, design=design, recorder=recorder,
-                             on_frame=on_frame, controls=controls, shadow=shadow,
-                             shadow_label=shadow_label)
         return loop.run(progress=progress, realtime=realtime)
     finally:
         if owns_backend:

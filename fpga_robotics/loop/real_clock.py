@@ -25,16 +25,21 @@ import re
 
 import numpy as np
 
-from fpga_robotics.loop.connectors import CONNECTORS, PinIO
+from fpga_robotics.checks.sensor_metrics import line_metrics, measurement_metrics
+from fpga_robotics.designs.builtin import build_component, connector_kinds, foreign_top
 from fpga_robotics.hw.errors import UsageError
-from fpga_robotics.loop.compressed import ClosedLoop
+from fpga_robotics.loop.compressed import TIMINGS, ClosedLoop
+from fpga_robotics.loop.connectors import CONNECTORS, PinIO
 from fpga_robotics.sim.backends.base import FrameResult
+from fpga_robotics.sim.backends.foreign import ForeignDesign
+from fpga_robotics.sim.backends.port_map import load_port_map
 from fpga_robotics.sim.camera.frames import to_rgb444
+from fpga_robotics.sim.pins import PinDesignSource, VerilogPinSource, get_pin_backend
+from fpga_robotics.sim.pins.timing import real_clock_timing
 from fpga_robotics.sim.records import SensorReading
-from fpga_robotics.designs.builtin import build_component
 
 __all__ = ["RealClockLoop", "extra_output_stats", "format_extra_outputs", "make_pin_backend",
-           "pin_design_source"]
+           "pin_design_source", "run_real_clock"]
 
 #: Per-frame outputs read when the frame strobe rises (the wheels are read at the next capture).
 _FRAME_OUTPUTS = ("found", "proximity", "centroid_x", "centroid_leds")
@@ -48,9 +53,6 @@ def scenario_top(scenario):
     (designs/reference.py: its bindings and extra outputs), or for a foreign Verilog design
     (``design.verilog``) the one its port map describes."""
     if scenario.foreign is not None:
-        from fpga_robotics.sim.backends.port_map import load_port_map
-        from fpga_robotics.designs.builtin import foreign_top
-
         return foreign_top(load_port_map(scenario.foreign.ports))
     from fpga_robotics.designs.reference import resolve_design
 
@@ -60,13 +62,7 @@ def scenario_top(scenario):
 def pin_design_source(scenario):
     """The pin design of the scenario: a ``PinDesignSource`` of ``design.top`` and its
     tables, or a ``VerilogPinSource`` of its foreign Verilog design."""
-    from fpga_robotics.sim.pins import PinDesignSource
-
     if scenario.foreign is not None:
-        from fpga_robotics.sim.backends.foreign import ForeignDesign
-        from fpga_robotics.sim.pins import VerilogPinSource
-        from fpga_robotics.designs.builtin import connector_kinds
-
         design = ForeignDesign(scenario.foreign.verilog, scenario.foreign.ports,
                                scenario.params, pins=True, connector_kinds=connector_kinds())
         # Without outputs.motor_left and motor_right the robot stands: the wheels are absent.
@@ -91,8 +87,6 @@ def pin_design_source(scenario):
 
 def make_pin_backend(name, scenario, *, on_build=None):
     """A pin-level backend by name ("auto": the fastest compiled one) for the scenario."""
-    from fpga_robotics.sim.pins import get_pin_backend
-
     if name == "model":
         raise UsageError("the model backend runs whole frames; sim.timing = \"real_clock\" "
                          "needs a backend that simulates every clock: --backend auto, "
@@ -318,8 +312,6 @@ class RealClockLoop(ClosedLoop):
         return readings
 
     def _stream(self, rgb):
-        from fpga_robotics.sim.pins.timing import real_clock_timing
-
         p = self.scenario.params
         color_port = self.top.bindings["camera"].get("color_sel")
         if color_port is not None:  # a camera design may have no colour select
@@ -380,8 +372,6 @@ class RealClockLoop(ClosedLoop):
     def extra_metrics(self):
         """Also the line metrics, over the world's floor lines, from the line sensors' mounts,
         and how often each sensor measured."""
-        from fpga_robotics.checks.sensor_metrics import line_metrics, measurement_metrics
-
         mounts = [m for c in self.sensors if c.kind == "line_sensors"
                   for m in c.sensor_mounts]
         return {**super().extra_metrics(),
@@ -404,3 +394,27 @@ class RealClockLoop(ClosedLoop):
         return {"timing": "real_clock", "clock_hz": self.clock_hz, "sim_cycles": cycles,
                 "cycles_per_wall_s": round(cycles / wall) if wall > 0 else None}
 
+
+def run_real_clock(scenario, *, seed, backend, recorder, progress, realtime, on_frame, shadow,
+                   shadow_label, controls):
+    """``run_scenario`` (fpga_robotics.loop.compressed) in real-clock timing."""
+    if shadow is not None and not hasattr(shadow, "ports"):
+        raise UsageError("a shadow in real-clock timing is a design on a pin backend "
+                         "(run --shadow REF); FollowTarget parameters compare frames in "
+                         "sim.timing = \"compressed\"")
+    owns_backend = isinstance(backend, str)
+    design = make_pin_backend(backend, scenario) if owns_backend else backend
+    try:
+        design.reset()
+        if shadow is not None:
+            shadow.reset()
+        loop = RealClockLoop(scenario, seed=seed, design=design, recorder=recorder,
+                             on_frame=on_frame, controls=controls, shadow=shadow,
+                             shadow_label=shadow_label)
+        return loop.run(progress=progress, realtime=realtime)
+    finally:
+        if owns_backend:
+            design.close()
+
+
+TIMINGS["real_clock"] = run_real_clock

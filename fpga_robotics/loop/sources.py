@@ -9,10 +9,12 @@ runs the design on each frame (no physics) and reports what it found.
 import time
 from pathlib import Path
 
-import numpy as np
+import cv2
 
 from fpga_robotics.hw.errors import UsageError
 from fpga_robotics.hw.pixel import color_select_value
+from fpga_robotics.ros.bag_source import BagSource
+from fpga_robotics.sim.camera.opencv_frames import to_design_rgb
 from fpga_robotics.sim.records import FrameRecord
 
 __all__ = ["IMAGE_SUFFIXES", "FrameSource", "open_source", "run_source", "to_design_rgb"]
@@ -33,8 +35,6 @@ class FrameSource:
     """
 
     def __init__(self, spec, width, height):
-        import cv2
-
         self.spec = str(spec)
         self.width, self.height = width, height
         self.kind = None
@@ -84,8 +84,6 @@ class FrameSource:
         return to_design_rgb(bgr, self.width, self.height)
 
     def __iter__(self):
-        import cv2
-
         if self.kind == "folder":
             for p in self._files:
                 img = cv2.imread(str(p), cv2.IMREAD_UNCHANGED)
@@ -108,27 +106,10 @@ class FrameSource:
             self._cap = None
 
 
-def to_design_rgb(bgr, width, height):
-    """An OpenCV image (BGR, grey or BGRA; 8 or 16 bits) as RGB888 at ``width`` x ``height``."""
-    import cv2
-
-    if bgr.ndim == 2:
-        bgr = cv2.cvtColor(bgr, cv2.COLOR_GRAY2BGR)
-    elif bgr.shape[2] == 4:
-        bgr = cv2.cvtColor(bgr, cv2.COLOR_BGRA2BGR)
-    if bgr.dtype != np.uint8:  # 16-bit images: keep the top 8 bits
-        bgr = (bgr >> 8).astype(np.uint8) if bgr.dtype == np.uint16 else bgr.astype(np.uint8)
-    if bgr.shape[:2] != (height, width):
-        bgr = cv2.resize(bgr, (width, height), interpolation=cv2.INTER_LINEAR)
-    return np.ascontiguousarray(cv2.cvtColor(bgr, cv2.COLOR_BGR2RGB))
-
-
 def open_source(spec, width, height):
     """Open ``spec`` (``camera:N``, a video file, a folder of images, ``bag:PATH[:TOPIC]``) at
     ``width`` x ``height``; ``UsageError`` when it cannot be opened."""
     if str(spec).startswith("bag:"):  # a ROS bag (fpga_robotics.ros.bag_source)
-        from fpga_robotics.ros.bag_source import BagSource
-
         return BagSource(spec, width, height)
     return FrameSource(spec, width, height)
 

@@ -3,16 +3,20 @@ recording) as frames for the design.
 
 ``sensor_msgs/Image`` in rgb8, bgr8, rgba8, bgra8, mono8, yuv422 (UYVY) or yuv422_yuy2
 (YUYV), or ``sensor_msgs/CompressedImage`` (JPEG, PNG): decoded to BGR and resized to the
-design's resolution like every other source (``sources.to_design_rgb``). Without ``TOPIC``
+design's resolution like every other source (``sim.camera.opencv_frames.to_design_rgb``). Without ``TOPIC``
 the bag's only image topic is used (``/camera/image_raw`` when there are several). The
 frames keep the bag's times: ``frame_time(k)`` is seconds since the first frame.
 """
 
 from pathlib import Path
 
+import cv2
 import numpy as np
+from rosbags.highlevel import AnyReader, AnyReaderError
+from rosbags.typesys import Stores, get_typestore
 
 from fpga_robotics.hw.errors import UsageError
+from fpga_robotics.sim.camera.opencv_frames import to_design_rgb
 
 __all__ = ["ENCODINGS", "IMAGE_TYPES", "BagSource", "parse_bag_spec"]
 
@@ -45,8 +49,6 @@ def parse_bag_spec(spec):
 
 def decode_image(msg, msgtype):
     """A bag image message as a BGR uint8 array; ``UsageError`` for an encoding not read."""
-    import cv2
-
     data = np.frombuffer(memoryview(msg.data), np.uint8)
     if msgtype.endswith("CompressedImage"):
         bgr = cv2.imdecode(data, cv2.IMREAD_COLOR)
@@ -77,9 +79,6 @@ class BagSource:
     """The images of one topic of a bag, as RGB888 frames at ``width`` x ``height``."""
 
     def __init__(self, spec, width, height):
-        from rosbags.highlevel import AnyReader, AnyReaderError
-        from rosbags.typesys import Stores, get_typestore
-
         self.spec = str(spec)
         self.kind = "bag"
         self.width, self.height = width, height
@@ -134,8 +133,6 @@ class BagSource:
         return (self._stamps[k] - self._stamps[0]) / 1e9
 
     def __iter__(self):
-        from fpga_robotics.loop.sources import to_design_rgb
-
         reader = self._reader
         for conn, stamp, raw in reader.messages(connections=self._connections):
             msg = reader.deserialize(raw, conn.msgtype)

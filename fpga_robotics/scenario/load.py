@@ -29,11 +29,13 @@ import difflib
 import math
 import re
 import tomllib
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, field, fields, replace
 from importlib import resources
 from pathlib import Path
 
 from fpga_robotics.hw.errors import UsageError
+from fpga_robotics.checks.summary import CHECKS
+from fpga_robotics.designs.builtin import TOPS, design_tables, table_fields
 from fpga_robotics.hw.params import (
     CHOICES,
     DEFAULT_BASE_DPS,
@@ -44,13 +46,18 @@ from fpga_robotics.hw.params import (
     preset_values,
 )
 from fpga_robotics.hw.pixel import COLOR_SELECT
+from fpga_robotics.loop.compressed import frame_count
+from fpga_robotics.loop.connectors import ConnectorError
+from fpga_robotics.scenario.connectors import parse_connectors
+from fpga_robotics.scenario.errors import ScenarioError
 from fpga_robotics.scenario.render3d_keys import RENDER_DEFAULTS, parse_render_keys
 from fpga_robotics.scenario.sanity import scenario_warnings
+from fpga_robotics.sim.backends.port_map import PortMapError, load_port_map
 from fpga_robotics.sim.camera.raster import max_hfov, max_tilt, vertical_fov
 from fpga_robotics.sim.camera.sensor import PARAMS as SENSOR_PARAMS
 from fpga_robotics.sim.camera.sensor import OV7670Params
+from fpga_robotics.sim.world import World, WorldConfigError
 from fpga_robotics.sim.world.config import MAX_TIME, WORLD_SECTIONS
-from fpga_robotics.checks.summary import CHECKS
 
 __all__ = [
     "LIMITS",
@@ -145,10 +152,6 @@ MAX_NAME_LENGTH = 64
 _NAME = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.-]*")
 #: A scenario file is at most this large (a few kB is usual).
 MAX_FILE_BYTES = 1 << 20
-
-
-class ScenarioError(UsageError):
-    """A scenario that cannot be loaded: unknown name, malformed file, bad value or key."""
 
 
 def parse_resolution(text):
@@ -559,8 +562,6 @@ def _optional_keys(parents):
     if parents == ["design", "params"]:
         return _AnyName()
     if len(parents) == 2 and parents[0] == "design" and parents[1] in _TOP_TABLES:
-        from fpga_robotics.designs.builtin import table_fields
-
         return table_fields(parents[1])
     if len(parents) != 1:
         return ()
@@ -646,8 +647,6 @@ def _floor(x, digits):
 def _check_world(world):
     """Validate the world's sections now, so that a bad value is reported at load time;
     returns the parsed ``WorldConfig``."""
-    from fpga_robotics.sim.world import World, WorldConfigError
-
     try:
         # Building it also finds placement errors (a robot starting inside a person).
         return World.from_config(copy.deepcopy(world), 0).config
@@ -757,8 +756,6 @@ def _check_camera_geometry(camera, world):
 
 
 def _sim(data, camera):
-    from fpga_robotics.loop.compressed import frame_count
-
     sim = data["sim"]
     duration = _limited(data, "sim.duration", note=" (one day)")
     period = camera.frame_period
@@ -891,7 +888,6 @@ def _top(design, source):
     """``design.top``, its parameter tables (a ``design.variant`` applied first) and
     ``design.params``; a design of one's own is resolved here (designs/reference.py), its
     reference made independent of the current folder."""
-    from fpga_robotics.designs.builtin import TOPS, design_tables
     from fpga_robotics.designs.reference import DesignError, resolve_design
 
     top = design.get("top", "follow_target")
@@ -943,9 +939,6 @@ def _top(design, source):
 
 def _connectors(world):
     """``robot.sensors`` / ``robot.actuators``, taken out of the world's ``robot`` table."""
-    from fpga_robotics.scenario.connectors import parse_connectors
-    from fpga_robotics.loop.connectors import ConnectorError
-
     robot = world.get("robot")
     if not isinstance(robot, dict):
         return ()
@@ -958,16 +951,12 @@ def _connectors(world):
 def _resolve_timing(sim, camera, top, connectors, foreign):
     """``sim.timing = "auto"`` made definite; a design or connector with pins of its own
     needs real-clock timing."""
-    from dataclasses import replace
-
     # Every design but the camera-only follow_target has pins of its own.
     pins = [f"the {c.kind} connector" for c in connectors]
     if top != "follow_target":
         pins.insert(0, f"design.top = {top!r}")
     if foreign is not None:
         # A port map that binds connectors (or has no camera) is a design with pins.
-        from fpga_robotics.sim.backends.port_map import PortMapError, load_port_map
-
         try:
             port_map = load_port_map(foreign.ports)
         except PortMapError as exc:

@@ -8,6 +8,7 @@
 
 import math
 
+from fpga_robotics.scenario.errors import ScenarioError
 from fpga_robotics.sim.camera.render3d.options import FLOORS, Lamp, Render3DOptions
 
 __all__ = ["RENDERERS", "RENDER_DEFAULTS", "parse_render_keys"]
@@ -28,47 +29,40 @@ RENDER_DEFAULTS = {
 _LAMP_KEYS = ("pos", "aim", "color", "cutoff_deg", "shadows")
 
 
-def _error(message):
-    # A ScenarioError (a UsageError) without importing scenario.py, which imports this.
-    from fpga_robotics.scenario.load import ScenarioError
-
-    return ScenarioError(message)
-
-
 def _number(value, name, lo, hi):
     ok = isinstance(value, (int, float)) and not isinstance(value, bool)
     if not (ok and math.isfinite(value) and lo <= value <= hi):
-        raise _error(f"{name} must be a number in {lo:g}..{hi:g}, got {value!r}")
+        raise ScenarioError(f"{name} must be a number in {lo:g}..{hi:g}, got {value!r}")
     return float(value)
 
 
 def _vector(value, name, lo, hi):
     if not (isinstance(value, list) and len(value) == 3):
-        raise _error(f"{name} must be an array of three numbers, got {value!r}")
+        raise ScenarioError(f"{name} must be an array of three numbers, got {value!r}")
     return tuple(_number(v, f"{name}[{i}]", lo, hi) for i, v in enumerate(value))
 
 
 def _boolean(value, name):
     if not isinstance(value, bool):
-        raise _error(f"{name} must be true or false, got {value!r}")
+        raise ScenarioError(f"{name} must be true or false, got {value!r}")
     return value
 
 
 def _lamp(item, i):
     where = f"camera.lamps[{i}]"
     if not isinstance(item, dict):
-        raise _error(f"{where} must be a table {{pos = [x, y, z], aim = [x, y, z], ...}}, "
+        raise ScenarioError(f"{where} must be a table {{pos = [x, y, z], aim = [x, y, z], ...}}, "
                      f"got {item!r}")
     unknown = [k for k in item if k not in _LAMP_KEYS]
     if unknown:
-        raise _error(f"unknown key {where}.{unknown[0]}; known keys: {', '.join(_LAMP_KEYS)}")
+        raise ScenarioError(f"unknown key {where}.{unknown[0]}; known keys: {', '.join(_LAMP_KEYS)}")
     for key in ("pos", "aim"):
         if key not in item:
-            raise _error(f"{where}.{key} is required: a point [x, y, z] in m")
+            raise ScenarioError(f"{where}.{key} is required: a point [x, y, z] in m")
     pos = _vector(item["pos"], f"{where}.pos", -100, 100)
     aim = _vector(item["aim"], f"{where}.aim", -100, 100)
     if pos == aim:
-        raise _error(f"{where}.aim must differ from its pos (the lamp shines from pos to aim)")
+        raise ScenarioError(f"{where}.aim must differ from its pos (the lamp shines from pos to aim)")
     return Lamp(pos=pos, aim=aim,
                 color=_vector(item.get("color", [0.5, 0.5, 0.5]), f"{where}.color", 0, 10),
                 cutoff_deg=_number(item.get("cutoff_deg", 45.0), f"{where}.cutoff_deg", 1, 90),
@@ -80,19 +74,19 @@ def parse_render_keys(cam, seed):
     raises a ``ScenarioError`` naming the key."""
     renderer = cam["renderer"]
     if renderer not in RENDERERS:
-        raise _error(f"camera.renderer must be one of {', '.join(map(repr, RENDERERS))}, "
+        raise ScenarioError(f"camera.renderer must be one of {', '.join(map(repr, RENDERERS))}, "
                      f"got {renderer!r}")
     size = cam["shadow_size"]
     if isinstance(size, bool) or not isinstance(size, int) or not 64 <= size <= 8192:
-        raise _error(f"camera.shadow_size must be an integer in 64..8192 (pixels of a "
+        raise ScenarioError(f"camera.shadow_size must be an integer in 64..8192 (pixels of a "
                      f"light's shadow map), got {size!r}")
     floor = cam["floor"]
     if floor not in FLOORS:
-        raise _error(f"camera.floor must be one of {', '.join(map(repr, FLOORS))}, "
+        raise ScenarioError(f"camera.floor must be one of {', '.join(map(repr, FLOORS))}, "
                      f"got {floor!r}")
     lamps = cam["lamps"]
     if not isinstance(lamps, list):
-        raise _error(f"camera.lamps must be an array of tables ([[camera.lamps]]), "
+        raise ScenarioError(f"camera.lamps must be an array of tables ([[camera.lamps]]), "
                      f"got {lamps!r}")
     options = Render3DOptions(
         shadows=_boolean(cam["shadows"], "camera.shadows"),

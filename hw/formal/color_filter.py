@@ -7,7 +7,7 @@ from amaranth.asserts import AnySeq
 from amaranth.hdl import Assert, Cover, Mux, Signal, signed
 
 from ..color_filter import ColorFilter
-from ..pixel import COLOR_SELECT
+from ..pixel import TargetColor
 from .harness import Harness, delayed
 from .sizes import FULL_SIZES
 
@@ -31,18 +31,19 @@ def contract_match(m, p, r, g, b, color_sel):
 
     d, sim, wm = p.diff_min, p.similar_max, p.white_min
     table = {
-        "none": 1,
-        "red": sr - mx(sg, sb) >= d,
-        "green": sg - mx(sr, sb) >= d,
-        "blue": sb - mx(sr, sg) >= d,
-        "yellow": (absdiff(sr, sg) <= sim) & (mn(sr, sg) - sb >= d),
-        "magenta": (absdiff(sr, sb) <= sim) & (mn(sr, sb) - sg >= d),
-        "cyan": (absdiff(sg, sb) <= sim) & (mn(sg, sb) - sr >= d),
-        "white": (mx(sr, mx(sg, sb)) - mn(sr, mn(sg, sb)) <= sim) & (mn(sr, mn(sg, sb)) >= wm),
+        TargetColor.NONE: 1,
+        TargetColor.RED: sr - mx(sg, sb) >= d,
+        TargetColor.GREEN: sg - mx(sr, sb) >= d,
+        TargetColor.BLUE: sb - mx(sr, sg) >= d,
+        TargetColor.YELLOW: (absdiff(sr, sg) <= sim) & (mn(sr, sg) - sb >= d),
+        TargetColor.MAGENTA: (absdiff(sr, sb) <= sim) & (mn(sr, sb) - sg >= d),
+        TargetColor.CYAN: (absdiff(sg, sb) <= sim) & (mn(sg, sb) - sr >= d),
+        TargetColor.WHITE: ((mx(sr, mx(sg, sb)) - mn(sr, mn(sg, sb)) <= sim)
+                            & (mn(sr, mn(sg, sb)) >= wm)),
     }
     result = 0
-    for name, test in table.items():
-        result = Mux(color_sel == COLOR_SELECT[name], test, result)
+    for color, test in table.items():
+        result = Mux(color_sel == color.value, test, result)
     return result
 
 
@@ -79,5 +80,5 @@ class ColorFilterHarness(Harness):
                        & (dut.matches.payload.last == out.last), "match flags differ"),
             ]
         m.d.comb += [Cover(dut.filtered.valid & dut.matches.payload.match
-                           & (delayed(m, color_sel, 1) == code))
-                     for code in COLOR_SELECT.values()]
+                           & (delayed(m, color_sel, 1) == color.value))
+                     for color in TargetColor]
