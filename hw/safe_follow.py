@@ -64,7 +64,7 @@ class FollowTargetSafe(CheckedArguments, wiring.Component):
     """
 
     #: Which ports the HC-SR04 connector's pins are (the camera and the wheels bind by name).
-    connectors = {"ultrasound": {"trig": "us_trig", "echo": "us_echo"}}
+    connectors = {"ultrasound": {"trig": "us_trig", "echo": "us_echo"}}  # noqa: RUF012
 
     @staticmethod
     def check_arguments(ft_params=None, us_params=None, interlock_params=None):

@@ -9,8 +9,8 @@ import pytest
 
 from fpga_robotics.hw.params import FollowTargetParams
 from fpga_robotics.sim.camera.frames import to_rgb444
-from fpga_robotics.sim.models.follow_target import color_match
 from fpga_robotics.sim.camera.scene import CameraPose
+from fpga_robotics.sim.models.follow_target import color_match
 from fpga_robotics.sim.world import World
 
 mujoco_missing = pytest.mark.skipif(

@@ -10,10 +10,6 @@ import math
 import numpy as np
 import pytest
 
-from fpga_robotics.loop.compressed import run_scenario
-from fpga_robotics.scenario.load import load_scenario
-from fpga_robotics.loop.shadow import ShadowComparison
-from fpga_robotics.sim.backends import get_backend
 from fpga_robotics.checks.summary import (
     DESIGN_OUTPUTS,
     compute_metrics,
@@ -21,6 +17,10 @@ from fpga_robotics.checks.summary import (
     format_summary,
     verdict,
 )
+from fpga_robotics.loop.compressed import run_scenario
+from fpga_robotics.loop.shadow import ShadowComparison
+from fpga_robotics.scenario.load import load_scenario
+from fpga_robotics.sim.backends import get_backend
 from fpga_robotics.viz import open_recorder
 from fpga_robotics.viz import paths as P
 from fpga_robotics.viz.readback import read_rrd

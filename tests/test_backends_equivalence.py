@@ -15,8 +15,8 @@ import pytest
 
 from fpga_robotics.hw.params import FollowTargetParams
 from fpga_robotics.hw.pixel import COLOR_SELECT
-from fpga_robotics.sim.camera import synthetic
 from fpga_robotics.sim.backends import BackendError, get_backend
+from fpga_robotics.sim.camera import synthetic
 
 # Small geometries with thresholds low enough that their blobs reach every proximity level.
 SMALL_A = FollowTargetParams(

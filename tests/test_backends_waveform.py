@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 from fpga_robotics.hw.params import FollowTargetParams
-from fpga_robotics.sim.camera import synthetic
 from fpga_robotics.sim.backends import BackendError, WaveformRequest, get_backend
+from fpga_robotics.sim.camera import synthetic
 
 PARAMS = FollowTargetParams(
     width=40, height=16, min_pixels=4, proximity_thresholds=(4, 8, 16, 32, 64, 96, 128)

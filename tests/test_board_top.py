@@ -11,7 +11,6 @@ import pytest
 from amaranth.sim import Simulator
 
 from fpga_robotics.cli.board import main
-from fpga_robotics.cli.errors import UsageError
 from fpga_robotics.flow.board import (
     BuildReport,
     ClockTiming,
@@ -21,7 +20,7 @@ from fpga_robotics.flow.board import (
 from fpga_robotics.hw.board.clocking import ecp5_pll_params
 from fpga_robotics.hw.board.color_select import SwitchColorSelect
 from fpga_robotics.hw.errors import UserError
-from fpga_robotics.hw.pixel import COLOR_SELECT, TargetColor
+from fpga_robotics.hw.pixel import TargetColor
 
 # The published pin assignment (ulx3s_v20.lpf of the published robot), transcribed here
 # independently of hw/board/pins.py.

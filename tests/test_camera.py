@@ -8,8 +8,8 @@ import sys
 import numpy as np
 import pytest
 
-from fpga_robotics.sim.camera.raster import CameraRenderer, render
 from fpga_robotics.sim.camera.frames import to_rgb444, unpack_rgb444
+from fpga_robotics.sim.camera.raster import CameraRenderer, render
 from fpga_robotics.sim.camera.scene import Band, CameraPose, Cylinder, Lighting, Scene, Wall
 
 HFOV = 1.047

@@ -5,9 +5,9 @@ import math
 import numpy as np
 import pytest
 
-from fpga_robotics.sim.camera.raster import CameraRenderer
 from fpga_robotics.bench.camera import camera_loop, typical_scene
 from fpga_robotics.sim.camera.kernel import camera_kernel
+from fpga_robotics.sim.camera.raster import CameraRenderer
 from fpga_robotics.sim.camera.scene import CameraPose, Scene
 
 

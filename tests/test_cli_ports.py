@@ -84,5 +84,5 @@ def test_a_map_that_does_not_match_the_design_is_one_line(tmp_path, capsys, edit
 
 def test_design_must_be_verilog(tmp_path, capsys):
     path, _design = _noreset(tmp_path)
-    code, out, err = _ports([str(path), "--design", "follow_target"], capsys)
+    code, _out, err = _ports([str(path), "--design", "follow_target"], capsys)
     assert code == 2 and "must be a Verilog design" in err

@@ -5,9 +5,9 @@ import math
 import numpy as np
 import pytest
 
-from fpga_robotics.scenario.connectors import parse_connectors
 from fpga_robotics.loop.connectors import ConnectorError
 from fpga_robotics.loop.connectors.bumper import BumperConnector
+from fpga_robotics.scenario.connectors import parse_connectors
 from fpga_robotics.sim.world import World
 
 

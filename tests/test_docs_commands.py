@@ -536,16 +536,16 @@ PLANS = {
                          "wall_stop.py", "wall_stop.toml")), "."]),
                     "cp wall_stop.py wall_stop_v1.py"),
              duration="keep", duration_why="the page quotes the whole run's 360 frames",
-             out=(PASS, r"shadow wall_stop_v1\.py:WallStop: identical outputs on all 360 "
-                        r"frames")),
+             out=(PASS, (r"shadow wall_stop_v1\.py:WallStop: identical outputs on all 360 "
+                        r"frames"))),
     "fpga-robotics designs":
         Plan(out=(r"follow_target_safe  \(built-in\)",
                   r"connectors: ultrasound \(trig=us_trig, echo=us_echo\)")),
     "fpga-robotics designs wall_stop.py:WallStop":
         Plan(setup=(f"cp {ROOT / 'tests/data/user_designs/wall_stop.py'} .",),
              out=(r"wall_stop\.py:WallStop  \(Amaranth\)",
-                  r"connectors: wheels \(motor_left=motor_left, motor_right=motor_right\); "
-                  r"ultrasound \(trig=trig, echo=echo\)",
+                  (r"connectors: wheels \(motor_left=motor_left, motor_right=motor_right\); "
+                  r"ultrasound \(trig=trig, echo=echo\)"),
                   r"recorded outputs: distance_mm, stopped")),
     ("fpga-robotics run --scenario bump_wall.toml --design verilog:bump_stop_noreset.v --ports "
      "bump_stop_noreset_ports.toml --rerun off"):
@@ -574,8 +574,8 @@ PLANS = {
         Plan(setup=(f"cp {ROOT / 'tests/data/user_designs/wall_stop.py'} .",),
              shorter=(("--mutants", "12"),),
              out=(r"12 mutants of WallStop \(seed 1\), 100000 cycles of random inputs",
-                  r"unit judge \(against the unmutated design\): \d+ caught, \d+ equivalent "
-                  r"on these inputs: score"),
+                  (r"unit judge \(against the unmutated design\): \d+ caught, \d+ equivalent "
+                  r"on these inputs: score")),
              files=("runs/mutation/WallStop-n12-s1/mutants.json",)),
     "python -m fpga_robotics.mutation --mutants 100 --campaign mutation":
         # Four mutants at 80x60 on one worker, the campaign's runs made short: the whole
@@ -1357,8 +1357,8 @@ def snippet_pins(tmp_path, capsys):
     """docs/pins.md: a frame streamed in real-clock time on a pin backend; frame_done comes
     result_latency edges after the last pixel, the outputs are the golden model's."""
     from fpga_robotics.hw.params import FollowTargetParams
-    from fpga_robotics.sim.pins import Stop, real_clock_timing
     from fpga_robotics.sim.camera.synthetic import blob_frame
+    from fpga_robotics.sim.pins import Stop, real_clock_timing
 
     frame = blob_frame(160, 120, "red", rng=1)
     shown = yield {"rgb888_image": frame}
@@ -1405,8 +1405,8 @@ def snippet_your_design(tmp_path, capsys):
 
 
 SNIPPETS = {
-    ("docs/your_design.md", '"""A design of one\'s own with pin sensors and no camera: drives '
-                            'straight on at ``speed`` DPS'):
+    ("docs/your_design.md", ('"""A design of one\'s own with pin sensors and no camera: drives '
+                            'straight on at ``speed`` DPS')):
         snippet_your_design,
     ("docs/connectors.md", "from amaranth import Module, Mux, Signal, signed"):
         snippet_connectors_own_design,

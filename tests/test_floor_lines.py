@@ -7,8 +7,8 @@ import math
 import numpy as np
 import pytest
 
-from fpga_robotics.sim.camera.raster import CameraRenderer, focal_length
 from fpga_robotics.sim.camera.floor_patches import patch_index
+from fpga_robotics.sim.camera.raster import CameraRenderer, focal_length
 from fpga_robotics.sim.world import World, WorldConfigError
 from fpga_robotics.sim.world.markings import MITRE_TURN, FloorLine
 

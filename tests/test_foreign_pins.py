@@ -20,11 +20,11 @@ from amaranth.lib.wiring import In, Out
 from renamed_design import RENAMED, RENAMED_MAP
 
 from fpga_robotics.cli.errors import run_cli
-from fpga_robotics.loop.compressed import run_scenario
 from fpga_robotics.cli.run import main as run_main
+from fpga_robotics.designs.builtin import TOPS, Top, register_top
+from fpga_robotics.loop.compressed import run_scenario
 from fpga_robotics.scenario.load import load_scenario
 from fpga_robotics.sim.backends.port_map import PortMapError, parse_port_map
-from fpga_robotics.designs.builtin import TOPS, Top, register_top
 
 DATA = Path(__file__).parent / "data"
 VERILOG = DATA / "bump_stop.v"
@@ -270,9 +270,9 @@ echo = "us_echo"
 def test_a_camera_and_ultrasound_design_in_verilog_stops_as_follow_target_safe(tmp_path):
     """FollowTargetSafe exported to Verilog, its HC-SR04 pins bound by the port map, 0.3 m
     from a box: its interlock stops the wheels at the same cycles as the Amaranth design's."""
+    from fpga_robotics.designs.builtin import build_component, get_top
     from fpga_robotics.hw.safe_follow import FollowTargetSafe
     from fpga_robotics.hw.verilog import generate_verilog
-    from fpga_robotics.designs.builtin import build_component, get_top
 
     scene = ['camera.resolution="40x30"', "sim.clock_hz=2e5", "sim.duration=0.5",
              "robot.start=[2.05, 2.0]"]

@@ -9,9 +9,9 @@ from renamed_design import RENAMED, RENAMED_MAP
 
 from fpga_robotics.hw.params import FollowTargetParams
 from fpga_robotics.hw.verilog import generate_verilog
-from fpga_robotics.sim.camera import synthetic
 from fpga_robotics.sim.backends import BackendError, get_backend
 from fpga_robotics.sim.backends.port_map import PortMapError
+from fpga_robotics.sim.camera import synthetic
 
 foreign = pytest.importorskip("fpga_robotics.sim.backends.foreign")
 

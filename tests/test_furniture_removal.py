@@ -3,8 +3,8 @@ ultrasound's beam at that time, with one event; collision counts stay as they we
 
 import pytest
 
-from fpga_robotics.sim.world.ultrasound import HCSR04Params, range_to
 from fpga_robotics.sim.world import World, WorldConfigError
+from fpga_robotics.sim.world.ultrasound import HCSR04Params, range_to
 
 BOX = {"name": "crate", "center": [2.0, 3.0], "size": [0.4, 0.4], "height": 0.5,
        "present_until": 1.5}

@@ -13,10 +13,10 @@ from vcd.reader import TokenKind, tokenize
 
 from fpga_robotics.hw.params import FollowTargetParams
 from fpga_robotics.hw.top import FollowTarget
-from fpga_robotics.sim.camera import synthetic
 from fpga_robotics.sim.backends.base import BackendError, WaveformRequest
 from fpga_robotics.sim.backends.model import ModelBackend
 from fpga_robotics.sim.backends.pysim import PERIOD, PysimBackend
+from fpga_robotics.sim.camera import synthetic
 from fpga_robotics.sim.camera.frames import FrameError
 
 

@@ -9,9 +9,9 @@ import pytest
 
 from fpga_robotics.loop.connectors.base import Mount
 from fpga_robotics.loop.connectors.line_sensors import LineSensorsConnector
-from fpga_robotics.sim.world.line_sensor import KY033, KY033Params, luminance, spot_offsets
 from fpga_robotics.sim.world import World
 from fpga_robotics.sim.world.kinematics import DEG
+from fpga_robotics.sim.world.line_sensor import KY033, KY033Params, luminance, spot_offsets
 
 FLOOR = (0.55, 0.55, 0.5)
 QUIET = KY033Params(noise_std=0.0)

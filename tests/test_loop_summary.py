@@ -5,8 +5,8 @@ import io
 import numpy as np
 import pytest
 
-from fpga_robotics.cli.run import Progress, write_json_atomic
 from fpga_robotics.checks.summary import compute_metrics, evaluate_checks, format_summary, verdict
+from fpga_robotics.cli.run import Progress, write_json_atomic
 
 PERIOD = 0.1
 

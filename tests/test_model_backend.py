@@ -7,7 +7,6 @@ import pytest
 from vcd.reader import TokenKind, tokenize
 
 from fpga_robotics.hw.params import FollowTargetParams
-from fpga_robotics.sim.camera import synthetic
 from fpga_robotics.sim.backends.base import (
     BackendError,
     DesignBackend,
@@ -16,6 +15,7 @@ from fpga_robotics.sim.backends.base import (
 )
 from fpga_robotics.sim.backends.model import ModelBackend
 from fpga_robotics.sim.backends.model_waveform import CLOCK_PERIOD_NS
+from fpga_robotics.sim.camera import synthetic
 from fpga_robotics.sim.camera.frames import FrameError
 from fpga_robotics.sim.models.follow_target import FollowTargetModel
 

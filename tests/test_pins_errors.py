@@ -154,8 +154,8 @@ def test_real_clock_timing():
     (["--step", "0"], "must be positive"),
 ])
 def test_pin_bench_bad_arguments(argv, message):
-    from fpga_robotics.cli.errors import UsageError
     from fpga_robotics.bench.pins import main
+    from fpga_robotics.cli.errors import UsageError
 
     with pytest.raises(UsageError, match=message):
         main(argv)

@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 from fpga_robotics.hw.params import FollowTargetParams
-from fpga_robotics.sim.camera import synthetic
 from fpga_robotics.sim.backends.model import ModelBackend
+from fpga_robotics.sim.camera import synthetic
 from fpga_robotics.sim.camera.frames import to_rgb444
 from fpga_robotics.sim.pins import (
     PixelTiming,

@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from fpga_robotics.hw.params import FollowTargetParams
-from fpga_robotics.sim.camera import synthetic
 from fpga_robotics.sim.backends import get_backend
+from fpga_robotics.sim.camera import synthetic
 from fpga_robotics.sim.camera.frames import FrameError, to_rgb444
 
 P = FollowTargetParams(width=40, height=16, diff_min=5, min_pixels=4,

@@ -15,11 +15,11 @@ from rosbags.rosbag2 import Writer as Writer2
 from rosbags.typesys import Stores, get_typestore
 
 from fpga_robotics.cli.errors import UsageError
-from fpga_robotics.hw.params import FollowTargetParams
 from fpga_robotics.cli.run import main as run_main
-from fpga_robotics.sim.models.follow_target import FollowTargetModel
-from fpga_robotics.sim.camera.synthetic import scenario as synthetic_scenario
+from fpga_robotics.hw.params import FollowTargetParams
 from fpga_robotics.loop.sources import open_source
+from fpga_robotics.sim.camera.synthetic import scenario as synthetic_scenario
+from fpga_robotics.sim.models.follow_target import FollowTargetModel
 
 W, H = 80, 60
 PERIOD_NS = 50_000_000  # 20 fps, as a camera driver would stamp them

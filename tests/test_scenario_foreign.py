@@ -8,8 +8,8 @@ import json
 import pytest
 
 from fpga_robotics.cli.errors import UsageError
-from fpga_robotics.hw.params import FollowTargetParams
 from fpga_robotics.cli.run import _design_files
+from fpga_robotics.hw.params import FollowTargetParams
 from fpga_robotics.scenario.load import ScenarioError, load_scenario
 from fpga_robotics.sim.backends.port_map import follow_target_port_map
 

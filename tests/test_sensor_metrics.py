@@ -40,8 +40,8 @@ def _rows(xs, ys, headings):
 
 
 def test_lateral_error_and_time_off_a_straight_line_by_hand():
-    from fpga_robotics.loop.connectors import Mount
     from fpga_robotics.checks.sensor_metrics import line_metrics
+    from fpga_robotics.loop.connectors import Mount
     from fpga_robotics.sim.world.markings import FloorLine
 
     tape = FloorLine("tape", ((0.0, 1.0), (4.0, 1.0)), 0.02)
@@ -62,8 +62,8 @@ def test_lateral_error_and_time_off_a_straight_line_by_hand():
 
 
 def test_laps_count_the_net_progress_around_a_closed_line():
-    from fpga_robotics.loop.connectors import Mount
     from fpga_robotics.checks.sensor_metrics import line_metrics
+    from fpga_robotics.loop.connectors import Mount
     from fpga_robotics.sim.world.markings import FloorLine
 
     square = FloorLine("sq", ((0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)), 0.02, closed=True)

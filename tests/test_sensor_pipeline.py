@@ -6,11 +6,11 @@ import dataclasses
 import numpy as np
 import pytest
 
+from fpga_robotics.bench.camera import typical_scene
 from fpga_robotics.loop.compressed import ClosedLoop
 from fpga_robotics.scenario.load import DEFAULTS, load_scenario
 from fpga_robotics.sim.backends.model import ModelBackend
 from fpga_robotics.sim.camera.raster import CameraRenderer, focal_length
-from fpga_robotics.bench.camera import typical_scene
 from fpga_robotics.sim.camera.scene import CameraPose
 from fpga_robotics.sim.camera.sensor import PARAMS, OV7670Params, OV7670Sensor
 from fpga_robotics.sim.camera.sensor.blur import motion_blur

@@ -7,11 +7,11 @@ import numpy as np
 import pytest
 
 from fpga_robotics.cli.errors import UsageError, run_cli
-from fpga_robotics.hw.params import FollowTargetParams
 from fpga_robotics.cli.run import main
+from fpga_robotics.hw.params import FollowTargetParams
+from fpga_robotics.loop.sources import open_source, run_source
 from fpga_robotics.sim.backends.model import ModelBackend
 from fpga_robotics.sim.models.follow_target import FollowTargetModel
-from fpga_robotics.loop.sources import open_source, run_source
 
 W, H = 160, 120
 

@@ -9,12 +9,12 @@ import math
 
 import pytest
 
+from fpga_robotics.checks.summary import compute_metrics, evaluate_checks
 from fpga_robotics.loop.compressed import run_scenario
 from fpga_robotics.scenario.load import load_scenario
 from fpga_robotics.sim.backends import available_backends
 from fpga_robotics.sim.world import TURTLEBOT2, World
 from fpga_robotics.sim.world.world import AT_FAULT_SPEED
-from fpga_robotics.checks.summary import compute_metrics, evaluate_checks
 
 DT = 1 / 240
 #: Levels 6 and 7 (the reversing ones) need more red pixels than the person fills at touch

@@ -7,10 +7,10 @@ Here the check on a hand-computed centroid; the gateware knob that narrows the r
 import numpy as np
 import pytest
 
+from fpga_robotics.checks.summary import compute_metrics, evaluate_checks
 from fpga_robotics.loop.compressed import run_scenario
 from fpga_robotics.scenario.load import load_scenario
 from fpga_robotics.sim.backends import available_backends
-from fpga_robotics.checks.summary import compute_metrics, evaluate_checks
 
 
 def _metrics(centroid, column=80.0, n=30):

@@ -8,10 +8,10 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
+from fpga_robotics.checks.summary import compute_metrics, evaluate_checks
 from fpga_robotics.loop.compressed import run_scenario, target_column
 from fpga_robotics.scenario.load import load_scenario
 from fpga_robotics.sim.backends import available_backends
-from fpga_robotics.checks.summary import compute_metrics, evaluate_checks
 
 CAM = SimpleNamespace(width=160, hfov=math.radians(60))
 POSE = SimpleNamespace(x=1.0, y=2.0, heading=math.radians(90))  # looking along +y

@@ -12,8 +12,8 @@ import pytest
 from fpga_robotics.hw.params import FollowTargetParams
 from fpga_robotics.loop.compressed import run_scenario
 from fpga_robotics.scenario.load import load_scenario
-from fpga_robotics.sim.camera import synthetic
 from fpga_robotics.sim.backends import available_backends, get_backend
+from fpga_robotics.sim.camera import synthetic
 
 NARROW = "design.sx_bits=17"
 

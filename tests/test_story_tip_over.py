@@ -8,11 +8,11 @@ import math
 import numpy as np
 import pytest
 
+from fpga_robotics.checks.summary import compute_metrics, evaluate_checks
 from fpga_robotics.loop.compressed import run_scenario
 from fpga_robotics.scenario.load import load_scenario
 from fpga_robotics.sim.backends import available_backends
 from fpga_robotics.sim.world import GOPIGO3, TURTLEBOT2, World
-from fpga_robotics.checks.summary import compute_metrics, evaluate_checks
 
 DT = 1 / 240
 DEG = math.pi / 180

@@ -9,9 +9,9 @@ import sys
 
 import pytest
 
+from fpga_robotics.checks.summary import TIMING_FIELDS
 from fpga_robotics.loop.compressed import run_scenario
 from fpga_robotics.scenario.load import load_scenario
-from fpga_robotics.checks.summary import TIMING_FIELDS
 from fpga_robotics.sweep import load_campaign, report_dir, run_campaign
 
 #: Small and fast: the model backend, tiny frames, short runs.
@@ -129,8 +129,8 @@ def test_raising_hanging_and_dying_runs_are_recorded_and_the_rest_complete(tmp_p
 
 
 def test_a_campaign_with_a_shadow_design_reports_where_it_differs(tmp_path):
-    from fpga_robotics.loop.compressed import make_backend
     from fpga_robotics.cli.run import _shadow_params
+    from fpga_robotics.loop.compressed import make_backend
 
     campaign = load_campaign({"scenarios": ["approach"], "seeds": [3], "backend": "model",
                               "duration": 1.0, "shadow": "published"})

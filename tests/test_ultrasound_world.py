@@ -7,8 +7,8 @@ import math
 import numpy as np
 import pytest
 
-from fpga_robotics.sim.world.ultrasound import HCSR04Module, HCSR04Params, range_to, speed_of_sound
 from fpga_robotics.sim.world import World
+from fpga_robotics.sim.world.ultrasound import HCSR04Module, HCSR04Params, range_to, speed_of_sound
 
 F = 50e6  # the design's clock
 QUIET = HCSR04Params(noise_std=0.0)

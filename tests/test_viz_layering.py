@@ -48,8 +48,6 @@ def test_viz_never_prints(source):
 
 
 def test_the_viewer_commands_run_from_the_application(tmp_path):
-    import subprocess
-    import sys
 
     for args in (["bench", "viewer", "--help"], ["readback"]):
         proc = subprocess.run(

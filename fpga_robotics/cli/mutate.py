@@ -17,8 +17,12 @@ from fpga_robotics.cli.parser import CommandParser
 from fpga_robotics.mutation.design import open_mutant_design, write_mutant_design
 from fpga_robotics.mutation.reasons import blind_spot_reason
 from fpga_robotics.mutation.scores import blind_spots, by_module, robot_score, unit_score
-from fpga_robotics.mutation.unit_judge import (golden_results, judge_frames, judge_mutant,
-                                               reference_results)
+from fpga_robotics.mutation.unit_judge import (
+    golden_results,
+    judge_frames,
+    judge_mutant,
+    reference_results,
+)
 from fpga_robotics.sim.files import check_output_dir, write_json_atomic
 from fpga_robotics.sim.mutation import MutationError, list_mutants
 

@@ -31,8 +31,8 @@ import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from fpga_robotics.hw.errors import UsageError
 from fpga_robotics.designs.builtin import TOPS, Top
+from fpga_robotics.hw.errors import UsageError
 
 __all__ = ["ENTRY_POINT_GROUP", "FRAME_OUTPUTS", "DesignError", "DesignSpec", "bindings_of",
            "entry_point_designs", "extra_outputs_of", "is_builtin", "resolve_design"]

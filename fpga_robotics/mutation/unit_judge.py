@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 
 from fpga_robotics.loop.shadow import COMPARED_OUTPUTS, differing_outputs, output_value
 from fpga_robotics.sim.camera import synthetic
+
 from ..sim.backends import BackendError, get_backend
 from ..sim.mutation import MUTATION_SELECT
 

@@ -17,6 +17,7 @@ from rosbags.rosbag2 import StoragePlugin, Writer, WriterError
 
 from fpga_robotics.hw.errors import UsageError
 from fpga_robotics.sim.files import check_output_dir
+
 from .messages import TOPICS, TYPESTORE, FrameMessages, camera_geometry
 
 __all__ = ["BagWriter", "check_bag_path", "open_bag_writer"]

@@ -16,6 +16,7 @@ import threading
 import time
 
 from fpga_robotics.hw.errors import UsageError
+
 from ..hw.pixel import COLOR_SELECT, color_select_value
 
 __all__ = ["INPUT_KINDS", "TELEOP_SPEED", "LiveControls", "ReplayControls", "apply_inputs", "check_input",

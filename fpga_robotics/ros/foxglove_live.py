@@ -15,6 +15,7 @@ import foxglove
 from foxglove.websocket import Capability
 
 from fpga_robotics.hw.errors import UsageError
+
 from .messages import TOPICS, TYPESTORE, FrameMessages, msgdef
 
 __all__ = ["CONTROL_TOPICS", "DEFAULT_PORT", "LivePublisher", "check_live_port", "control_input",

@@ -12,6 +12,7 @@ import threading
 import tty
 
 from fpga_robotics.hw.errors import UsageError
+
 from .controls import TELEOP_SPEED
 
 __all__ = ["KEYS", "TerminalControls", "check_terminal", "key_input"]

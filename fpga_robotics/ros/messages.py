@@ -16,6 +16,7 @@ import numpy as np
 from rosbags.typesys import Stores, get_typestore
 
 from fpga_robotics.sim.camera.raster import focal_length
+
 from ..sim.world.kinematics import dps_to_twist
 
 __all__ = ["TOPICS", "TYPESTORE", "CameraGeometry", "FrameMessages", "camera_geometry",

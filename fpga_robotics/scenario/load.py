@@ -33,7 +33,6 @@ from dataclasses import dataclass, field, fields, replace
 from importlib import resources
 from pathlib import Path
 
-from fpga_robotics.hw.errors import UsageError
 from fpga_robotics.checks.summary import CHECKS
 from fpga_robotics.designs.builtin import TOPS, design_tables, table_fields
 from fpga_robotics.hw.params import (

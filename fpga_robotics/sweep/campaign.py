@@ -41,8 +41,9 @@ from dataclasses import dataclass, field, replace
 from importlib import resources
 from pathlib import Path
 
-from .. import __version__
 from fpga_robotics.hw.errors import UsageError
+
+from .. import __version__
 
 __all__ = ["Campaign", "CampaignError", "RunSpec", "load_campaign", "parse_seeds",
            "shipped_campaigns", "toml_value"]

@@ -17,6 +17,7 @@ import time
 from pathlib import Path
 
 from fpga_robotics.hw.errors import UsageError
+
 from ..sim.files import write_atomic
 from . import runner
 from .results import make_row

@@ -4,6 +4,7 @@ and grouped by the design it needs (each parameter set is built once)."""
 from dataclasses import dataclass, field, replace
 
 from fpga_robotics.hw.errors import UsageError
+
 from .campaign import run_identity
 from .runner import _design_key, load_run
 

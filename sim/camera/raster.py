@@ -43,8 +43,9 @@ import cv2
 import numpy as np
 
 from fpga_robotics.hw.validate import check_int
-from .kernel import NoiseTable, camera_kernel
+
 from .floor_patches import paint_floor_patches
+from .kernel import NoiseTable, camera_kernel
 from .scene import CameraPose, Scene
 
 __all__ = [

@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from fpga_robotics.hw.validate import check_int
+
 from .frames import to_rgb444
 
 __all__ = [

@@ -39,6 +39,7 @@ import numpy as np
 
 from fpga_robotics.hw.params import FollowTargetParams
 from fpga_robotics.hw.pixel import color_select_value
+
 from ..camera.frames import FrameError, to_rgb444, unpack_rgb444
 
 __all__ = [

@@ -15,8 +15,8 @@ import math
 import numpy as np
 import pymunk
 
-from ..records import PersonState, WorldMap
 from ..camera.scene import CameraPose, Cylinder, Scene
+from ..records import PersonState, WorldMap
 from .collisions import AT_FAULT_SPEED, CollisionLog, MotionHistory, closing_speeds
 from .config import WorldConfigError, parse_world_config
 from .lighting import LightingSchedule

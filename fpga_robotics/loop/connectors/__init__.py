@@ -5,7 +5,15 @@ Importing this package registers every shipped kind: ``camera`` (rendered frames
 ``ultrasound`` (an HC-SR04: TRIG out, ECHO in) and ``line_sensors`` (KY-033s under the
 robot)."""
 
-from fpga_robotics.loop.connectors.base import CONNECTORS, Connector, ConnectorError, Mount, Pin, PinIO, register
+from fpga_robotics.loop.connectors.base import (
+           CONNECTORS,
+           Connector,
+           ConnectorError,
+           Mount,
+           Pin,
+           PinIO,
+           register,
+)
 from fpga_robotics.loop.connectors.bumper import BumperConnector
 from fpga_robotics.loop.connectors.camera import CameraConnector, camera_pose, in_view
 from fpga_robotics.loop.connectors.line_sensors import LineSensorsConnector

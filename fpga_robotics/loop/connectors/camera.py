@@ -15,8 +15,8 @@ from typing import ClassVar
 import numpy as np
 
 from fpga_robotics.hw.errors import UsageError
-from fpga_robotics.sim.camera.scene import CameraPose
 from fpga_robotics.loop.connectors.base import Connector, Mount, Pin, register
+from fpga_robotics.sim.camera.scene import CameraPose
 
 __all__ = ["SENSOR_STREAM", "CameraConnector", "ExposureDrift", "camera_pose", "in_view",
            "make_renderer", "make_sensor"]

@@ -12,8 +12,15 @@ import math
 from dataclasses import dataclass, replace
 from typing import ClassVar
 
+from fpga_robotics.loop.connectors.base import (
+    Connector,
+    ConnectorError,
+    Mount,
+    Pin,
+    check_number,
+    register,
+)
 from fpga_robotics.sim.world.line_sensor import KY033, KY033Params
-from fpga_robotics.loop.connectors.base import Connector, ConnectorError, Mount, Pin, check_number, register
 
 __all__ = ["LineSensorsConnector", "LineSensorsParams"]
 

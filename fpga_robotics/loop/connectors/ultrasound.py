@@ -10,8 +10,14 @@ trigger the module ignores (too short, or while it is busy) schedules nothing.
 import math
 from typing import ClassVar
 
+from fpga_robotics.loop.connectors.base import (
+    Connector,
+    ConnectorError,
+    Pin,
+    check_number,
+    register,
+)
 from fpga_robotics.sim.world.ultrasound import HCSR04Module, HCSR04Params, range_to
-from fpga_robotics.loop.connectors.base import Connector, ConnectorError, Pin, check_number, register
 
 __all__ = ["UltrasoundConnector"]
 
