@@ -6,12 +6,15 @@ stray from it. ``FIGURES`` has one entry per quoted ratio: the page, the ratio, 
 the benchmark command that measures it (as the page names it) and what to take from the
 figures that command writes with ``--json``. The fast tests check that every quoted ratio has
 its entry and every entry its quote; the slow one runs the commands and fails when a
-measurement is off by more than the stated spread.
+measurement is off by more than the stated spread. It times things, so it runs only when asked
+(``FPGA_ROBOTICS_FIGURES=1 python -m pytest tests/test_docs_figures.py``, on a machine doing
+nothing else): a timed test in the default run would fail for the machine's load, not the code.
 
 ``python tests/test_docs_figures.py`` measures every entry and prints the figures.
 """
 
 import json
+import os
 import re
 import sys
 from dataclasses import dataclass
@@ -261,6 +264,8 @@ def measure(figure, folder):
 
 @pytest.mark.slow
 @pytest.mark.timeout(900)
+@pytest.mark.skipif(os.environ.get("FPGA_ROBOTICS_FIGURES") != "1",
+                    reason="times benchmarks: FPGA_ROBOTICS_FIGURES=1 on a quiet machine")
 @pytest.mark.parametrize("figure", FIGURES, ids=lambda f: f"{f.page}:{f.ratio}x")
 def test_quoted_ratio_measures_within_its_spread(figure, tmp_path):
     measured = measure(figure, tmp_path)
