@@ -121,12 +121,13 @@ class ReferenceRun:
         """How many frames the reference ran."""
         return len(self._loop.commands)
 
-    def run_variant(self, design, scenario=None):
+    def run_variant(self, design, scenario=None, *, progress=None):
         """The run of ``design`` (reset here, not closed) in the reference's world.
 
         ``scenario`` is the variant's own scenario when its design parameters or checks
         differ (its world, camera, timing and seed must be the reference's); default the
-        reference's."""
+        reference's. ``progress(done, total)`` is called after every frame replayed or run
+        (it may raise to stop the run)."""
         scenario = self.scenario if scenario is None else scenario
         _check_same_world(self.scenario, scenario)
         if design.params != scenario.params:
@@ -137,6 +138,8 @@ class ReferenceRun:
         outputs, diverged = [], None
         for k, (rgb, color) in enumerate(ref.seen):
             outputs.append(_outputs(design.process_frame(rgb, color)))
+            if progress is not None:
+                progress(k + 1, ref.n_frames)
             if (_dps(outputs[k].motor_left), _dps(outputs[k].motor_right)) != ref.commands[k]:
                 diverged = k
                 break
@@ -152,7 +155,7 @@ class ReferenceRun:
         design.reset()
         for rgb, color in ref.seen[:start.frame]:
             design.process_frame(rgb, color)
-        return loop.run(start=start.frame)
+        return loop.run(start=start.frame, progress=progress)
 
 
 def _outputs(result):

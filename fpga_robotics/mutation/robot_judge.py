@@ -73,17 +73,20 @@ def closest_to_failing(outcomes):
     return best
 
 
-def judge_runs(argvs, timeouts=None):
+def judge_runs(argvs, timeouts=None, execute=None):
     """The Dask task of one mutant: its runs in order until one does not pass. Returns
     ``{"caught", "run", "status", "message", "failed_checks", "closest", "runs", "wall_s"}``
     (``run``: the index of the first run that did not pass; ``closest``: of a mutant not
-    caught, the run nearest to failing)."""
+    caught, the run nearest to failing). ``execute(i, argv, timeout)`` runs run ``i``
+    (default ``runner.execute``; forked runs: fpga_robotics.mutation.forked_runs)."""
     from ..sweep import runner
 
+    if execute is None:
+        execute = lambda i, argv, timeout: runner.execute(argv, timeout=timeout)  # noqa: E731
     t0 = time.perf_counter()
     outcomes = []
     for i, argv in enumerate(argvs):
-        o = runner.execute(argv, timeout=None if timeouts is None else timeouts[i])
+        o = execute(i, argv, None if timeouts is None else timeouts[i])
         o.pop("recording", None)
         outcomes.append(o)
         if o["status"] != "pass":
@@ -113,7 +116,7 @@ def _baseline(client, argvs, progress):
 
 
 def robot_judge(campaign, netlist, ports, resolution, indices, out_dir, *, workers=None,
-                scheduler=None, resume=False, progress=None, say=print):
+                scheduler=None, resume=False, progress=None, say=print, fork=True):
     """Judge the mutants ``indices`` by ``campaign``'s closed-loop runs.
 
     Returns ``(baseline, verdicts)``: ``baseline`` is ``{"runs": [argv at mutsel 0, ...],
@@ -121,7 +124,9 @@ def robot_judge(campaign, netlist, ports, resolution, indices, out_dir, *, worke
     judged (the others were kept from the journal)}``; ``verdicts`` is ``{index: judge_runs
     result}`` (with the replay command of the run that caught it, or of the closest run).
     Verdicts are appended to ``out_dir/robot.jsonl`` as they come (``resume`` keeps the
-    ones there)."""
+    ones there). With ``fork`` each mutant's run is forked from the unmutated design's
+    (fpga_robotics.mutation.forked_runs): the same verdicts, most of the world not
+    re-simulated."""
     from distributed import as_completed
 
     from ..sweep.api import wait_for_a_worker
@@ -162,7 +167,13 @@ def robot_judge(campaign, netlist, ports, resolution, indices, out_dir, *, worke
         for k in todo:
             argvs = [mutant_argv(spec.argv(), netlist, ports, k, resolution)
                      for spec in (plan.runs[i] for i in passing)]
-            futures[client.submit(judge_runs, argvs, limits, pure=False,
+            if fork:
+                from .forked_runs import judge_runs_forked
+
+                task = (judge_runs_forked, argvs, [base[i] for i in passing], limits)
+            else:
+                task = (judge_runs, argvs, limits)
+            futures[client.submit(*task, pure=False,
                                   key=f"mutant-{k}-{time.monotonic_ns()}")] = (k, argvs)
         with open(journal, "a") as f:
             for fut in as_completed(futures):
