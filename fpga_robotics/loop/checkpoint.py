@@ -25,23 +25,33 @@ STATE = ("world", "camera", "motors", "step", "frames_done", "ended_early", "tra
 class Checkpoint:
     """The state of a loop before frame ``frame``; restore it as often as needed."""
 
-    def __init__(self, frame, state, renderer):
+    def __init__(self, frame, state, shared):
         self.frame = frame
         self._state = state
-        self._renderer = renderer
+        self._shared = shared
 
     def copy_state(self):
-        """A fresh deep copy of the saved state (the renderer shared)."""
-        return copy.deepcopy(self._state, {id(self._renderer): self._renderer})
+        """A fresh deep copy of the saved state (the objects that never change shared)."""
+        return copy.deepcopy(self._state, {id(x): x for x in self._shared})
+
+
+def _never_changing(loop):
+    """Objects of the state that no step changes, shared rather than copied: the renderer,
+    and the terrain maps with their (frozen) patches, which the world compares by identity."""
+    shared = [loop.camera.renderer]
+    for terrain in (loop.world.terrain, loop.world._painted):
+        shared += [terrain, *terrain.patches]
+    return shared
 
 
 def take(loop):
     """A ``Checkpoint`` of ``loop`` at its current frame boundary (``loop.frames_done``)."""
-    camera = loop.camera
+    shared = _never_changing(loop)
+    memo = {id(x): x for x in shared}
     # The camera's turn-rate callback reads the loop it belongs to: left out, bound on restore.
-    memo = {id(camera.renderer): camera.renderer, id(camera.turn_rate): None}
+    memo[id(loop.camera.turn_rate)] = None
     state = copy.deepcopy({name: getattr(loop, name) for name in STATE}, memo)
-    return Checkpoint(loop.frames_done, state, camera.renderer)
+    return Checkpoint(loop.frames_done, state, shared)
 
 
 def restore(loop, checkpoint):
