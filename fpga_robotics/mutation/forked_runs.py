@@ -9,7 +9,7 @@ design are run in full (``runner.execute``).
 
 import time
 
-__all__ = ["execute_forked", "judge_runs_forked"]
+__all__ = ["execute_forked", "judge_runs_forked", "reference_outcome"]
 
 #: References a worker keeps (one per campaign run: the mutation campaign has nine).
 _KEEP = 16
@@ -39,6 +39,26 @@ def _forkable(argv):
 
     _, scenario, shadow_params = runner.load_run(list(argv))
     return scenario.sim.timing == "compressed" and shadow_params is None
+
+
+def reference_outcome(ref_argv):
+    """``runner.execute(ref_argv)`` of a run with the unmutated design, which the worker keeps
+    as the reference of the mutants' runs (the robot judge's baseline)."""
+    from ..sweep import runner
+
+    if not _forkable(ref_argv):
+        return runner.execute(ref_argv)
+    wall0, cpu0 = time.perf_counter(), time.process_time()
+    out = {"status": "error", "message": "", "summary": None, "recording": None, "run_s": 0.0}
+    try:
+        summary = dict(_reference(ref_argv).result.summary)
+        out.update(status=summary["verdict"], summary=summary,
+                   run_s=time.perf_counter() - wall0)
+    except Exception as exc:  # noqa: BLE001 (recorded as the baseline's error)
+        out.update(status="error", message=f"{type(exc).__name__}: {exc}".splitlines()[0])
+    out["wall_s"] = time.perf_counter() - wall0
+    out["cpu_s"] = time.process_time() - cpu0
+    return out
 
 
 def execute_forked(argv, ref_argv, timeout=None):

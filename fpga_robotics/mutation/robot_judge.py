@@ -100,14 +100,21 @@ def judge_runs(argvs, timeouts=None, execute=None):
             "wall_s": time.perf_counter() - t0}
 
 
-def _baseline(client, argvs, progress):
-    """The campaign with the unmutated design: ``[outcome]`` in order."""
+def _baseline(client, argvs, progress, fork):
+    """The campaign with the unmutated design: ``[outcome]`` in order (with ``fork``, each
+    worker keeps its runs as references for the mutants')."""
     from distributed import as_completed
 
     from ..sweep import runner
 
-    futures = {client.submit(runner.execute, a, None, pure=False): i
-               for i, a in enumerate(argvs)}
+    if fork:
+        from .forked_runs import reference_outcome
+
+        futures = {client.submit(reference_outcome, a, pure=False): i
+                   for i, a in enumerate(argvs)}
+    else:
+        futures = {client.submit(runner.execute, a, None, pure=False): i
+                   for i, a in enumerate(argvs)}
     out = [None] * len(argvs)
     for fut in as_completed(futures):
         out[futures[fut]] = fut.result()
@@ -155,7 +162,7 @@ def robot_judge(campaign, netlist, ports, resolution, indices, out_dir, *, worke
     with open_client(scheduler=scheduler, workers=workers) as client:
         wait_for_a_worker(client, scheduler)
         say(f"robot judge: {len(base)} campaign runs with the unmutated design first")
-        outcomes = _baseline(client, base, tick)
+        outcomes = _baseline(client, base, tick, fork)
         passing = [i for i, o in enumerate(outcomes) if o["status"] == "pass"]
         statuses = [o["status"] for o in outcomes]
         # Each mutant's run may take ten times as long as the design's (at least 30 s).
