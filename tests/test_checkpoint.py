@@ -2,13 +2,12 @@
 uninterrupted run, on every shipped scenario in compressed timing."""
 
 import pytest
+from run_equality import assert_same_run
 
 from fpga_robotics.loop import checkpoint
 from fpga_robotics.loop.compressed import ClosedLoop, run_scenario
 from fpga_robotics.scenario.load import load_scenario, shipped_scenarios
 from fpga_robotics.sim.backends.model import ModelBackend
-
-from run_equality import assert_same_run
 
 COMPRESSED = [n for n in shipped_scenarios()
               if load_scenario(n).sim.timing == "compressed"]

@@ -2,11 +2,10 @@
 summary and verdict of its full run (``runner.execute``), mutant by mutant."""
 
 import pytest
+from run_equality import TIMING_FIELDS
 
 from fpga_robotics.hw.params import FollowTargetParams
 from fpga_robotics.sim import mutation
-
-from run_equality import TIMING_FIELDS
 
 PARAMS = FollowTargetParams(width=80, height=60)
 

@@ -82,7 +82,8 @@ def judge_runs(argvs, timeouts=None, execute=None):
     from ..sweep import runner
 
     if execute is None:
-        execute = lambda i, argv, timeout: runner.execute(argv, timeout=timeout)  # noqa: E731
+        def execute(i, argv, timeout):
+            return runner.execute(argv, timeout=timeout)
     t0 = time.perf_counter()
     outcomes = []
     for i, argv in enumerate(argvs):
