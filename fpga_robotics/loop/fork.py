@@ -14,8 +14,10 @@ reference's. Up to that frame the variant saw exactly the reference's images, so
   with the variant's own design outputs, design events (found, lost, search started) and
   cycle count;
 - if frame ``k``'s command differs, the world is restored from the last checkpoint at or
-  before ``k``, the variant is reset and replayed up to that checkpoint's frame, and the run
-  continues in closed loop from there.
+  before ``k`` and the run continues in closed loop from there: up to frame ``k`` with the
+  variant's outputs as replayed (its images there are the reference's), then with the
+  variant design itself, which has processed frame ``k`` already. The design is simulated
+  once per frame, the world only from the checkpoint on.
 
 Either way the ``RunResult`` equals the variant's full run (``run_scenario``): trajectory,
 events and summary, the wall-clock timing fields excepted.
@@ -152,10 +154,25 @@ class ReferenceRun:
         start = [c for c in ref.checkpoints if c.frame <= diverged][-1]
         checkpoint.restore(loop, start)
         _rewrite_design_part(loop, outputs[:start.frame], ref)
-        design.reset()
-        for rgb, color in ref.seen[:start.frame]:
-            design.process_frame(rgb, color)
+        # The variant has run up to frame `diverged` already: from the checkpoint to there
+        # the loop gets its outputs as replayed (the frames are the same), then the design.
+        loop.design = _Replayed(outputs[start.frame:], design)
         return loop.run(start=start.frame, progress=progress)
+
+
+class _Replayed:
+    """A design that gives recorded outputs for its first frames, then hands over to
+    ``design`` (which has processed those frames already)."""
+
+    def __init__(self, outputs, design):
+        self.outputs = list(outputs)
+        self.design = design
+        self.name = design.name
+
+    def process_frame(self, rgb, color_sel):
+        if self.outputs:
+            return self.outputs.pop(0)
+        return self.design.process_frame(rgb, color_sel)
 
 
 def _outputs(result):
