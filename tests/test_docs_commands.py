@@ -598,6 +598,19 @@ PLANS = {
              out=((r"robot judge \(campaign mutation: \d+ of 9 runs pass unmutated\).*"
                    r"mutants/min"),),
              files=("runs/mutation/scale-w2/mutants.json",)),
+    # Forked against full robot-judge runs: the same four mutants at 80x60 as above.
+    ("python -m fpga_robotics.mutation --mutants 30 --campaign mutation --workers 2 "
+     "--recordings 0 --out runs/mutation/fork"):
+        Plan(shorter=(("--mutants", "4"), ("--width", "80"), ("--height", "60")),
+             out=((r"robot judge \(campaign mutation: \d+ of 9 runs pass unmutated\).*"
+                   r"mutants/min"),),
+             files=("runs/mutation/fork/mutants.json",)),
+    ("python -m fpga_robotics.mutation --mutants 30 --campaign mutation --workers 2 "
+     "--recordings 0 --no-fork --out runs/mutation/no-fork"):
+        Plan(shorter=(("--mutants", "4"), ("--width", "80"), ("--height", "60")),
+             out=((r"robot judge \(campaign mutation: \d+ of 9 runs pass unmutated\).*"
+                   r"mutants/min"),),
+             files=("runs/mutation/no-fork/mutants.json",)),
     # The mutation campaign with the unmutated design: two short runs on the model backend
     # (the page gives the whole campaign's results).
     "python -m fpga_robotics.sweep mutation":

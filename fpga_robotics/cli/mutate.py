@@ -7,6 +7,7 @@ the output folder; the terminal gets the score, the score per component and the 
 frame shows.
 """
 
+import argparse
 import os
 import sys
 import time
@@ -118,6 +119,10 @@ def build_parser(prog="fpga-robotics mutate"):
     p.add_argument("--recordings", type=int, default=5, metavar="N",
                    help="robot judge: record the closest-to-failing run of the first N blind "
                         "spots (default 5)")
+    p.add_argument("--fork", action=argparse.BooleanOptionalAction, default=True,
+                   help="robot judge: fork each mutant's runs from the unmutated design's at "
+                        "the first frame its wheel commands differ (default; the same "
+                        "verdicts, docs/mutation.md) or, with --no-fork, run them in full")
     p.add_argument("--quiet", action="store_true", help="no progress lines")
     p.add_argument("--against", choices=("model", "design"), default="model",
                    help="FollowTarget's unit judge compares each mutant with the golden model "
@@ -263,7 +268,7 @@ def main(argv=None, prog="fpga-robotics mutate"):
         t2 = time.perf_counter()
         baseline, robot_verdicts = robot_judge(
             campaign, netlist, ports, f"{params.width}x{params.height}", caught, out,
-            workers=args.workers, scheduler=args.scheduler, resume=args.resume, say=say)
+            workers=args.workers, scheduler=args.scheduler, resume=args.resume, say=say, fork=args.fork)
         robot_s = time.perf_counter() - t2
     robot = {k: v["caught"] for k, v in robot_verdicts.items()}
     blind = set(blind_spots(unit, robot))

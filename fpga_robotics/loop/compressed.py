@@ -178,8 +178,12 @@ class ClosedLoop:
                    if cam.exposure_drift > 0 else None),
             # camera.sensor = "ov7670": the sensor model, blurred by the robot's turn rate.
             sensor=make_sensor(cam, self.seed),
-            turn_rate=lambda: self.world.robot_velocity()[1],
+            turn_rate=self.camera_turn_rate,
         )
+
+    def camera_turn_rate(self):
+        """The robot's turn rate now, rad/s (the sensor model's motion blur)."""
+        return self.world.robot_velocity()[1]
 
     # The steps of one frame ----------------------------------------------------------------
 
@@ -335,12 +339,14 @@ class ClosedLoop:
 
     # The whole run -------------------------------------------------------------------------
 
-    def run(self, *, progress=None, realtime=False):
+    def run(self, *, progress=None, realtime=False, start=0):
+        """Run the frames from ``start`` on (a loop restored from a checkpoint taken before
+        frame ``start``: fpga_robotics.loop.checkpoint) and finish the run."""
         if self.recorder is not None:
             self.recorder.log_world_map(self.world.world_map())
         wall_start = time.perf_counter()
         cpu_start = time.process_time()
-        for k in range(self.n_frames):
+        for k in range(start, self.n_frames):
             self.run_frame(k)
             if progress is not None:
                 progress(k + 1, self.n_frames)
@@ -352,6 +358,10 @@ class ClosedLoop:
                     time.sleep(ahead)
         if self.ended_early is None:
             self.finish_physics()
+        return self.finish_run(wall_start, cpu_start)
+
+    def finish_run(self, wall_start, cpu_start):
+        """The ``RunResult`` once the frames and the physics after them are done."""
         self.after_frames()
         if self.ended_early is not None:  # the trajectory holds the frames done, every field alike
             self.traj = {name: a[:self.frames_done] for name, a in self.traj.items()}

@@ -73,17 +73,21 @@ def closest_to_failing(outcomes):
     return best
 
 
-def judge_runs(argvs, timeouts=None):
+def judge_runs(argvs, timeouts=None, execute=None):
     """The Dask task of one mutant: its runs in order until one does not pass. Returns
     ``{"caught", "run", "status", "message", "failed_checks", "closest", "runs", "wall_s"}``
     (``run``: the index of the first run that did not pass; ``closest``: of a mutant not
-    caught, the run nearest to failing)."""
+    caught, the run nearest to failing). ``execute(i, argv, timeout)`` runs run ``i``
+    (default ``runner.execute``; forked runs: fpga_robotics.mutation.forked_runs)."""
     from ..sweep import runner
 
+    if execute is None:
+        def execute(i, argv, timeout):
+            return runner.execute(argv, timeout=timeout)
     t0 = time.perf_counter()
     outcomes = []
     for i, argv in enumerate(argvs):
-        o = runner.execute(argv, timeout=None if timeouts is None else timeouts[i])
+        o = execute(i, argv, None if timeouts is None else timeouts[i])
         o.pop("recording", None)
         outcomes.append(o)
         if o["status"] != "pass":
@@ -97,14 +101,21 @@ def judge_runs(argvs, timeouts=None):
             "wall_s": time.perf_counter() - t0}
 
 
-def _baseline(client, argvs, progress):
-    """The campaign with the unmutated design: ``[outcome]`` in order."""
+def _baseline(client, argvs, progress, fork):
+    """The campaign with the unmutated design: ``[outcome]`` in order (with ``fork``, each
+    worker keeps its runs as references for the mutants')."""
     from distributed import as_completed
 
     from ..sweep import runner
 
-    futures = {client.submit(runner.execute, a, None, pure=False): i
-               for i, a in enumerate(argvs)}
+    if fork:
+        from .forked_runs import reference_outcome
+
+        futures = {client.submit(reference_outcome, a, pure=False): i
+                   for i, a in enumerate(argvs)}
+    else:
+        futures = {client.submit(runner.execute, a, None, pure=False): i
+                   for i, a in enumerate(argvs)}
     out = [None] * len(argvs)
     for fut in as_completed(futures):
         out[futures[fut]] = fut.result()
@@ -113,7 +124,7 @@ def _baseline(client, argvs, progress):
 
 
 def robot_judge(campaign, netlist, ports, resolution, indices, out_dir, *, workers=None,
-                scheduler=None, resume=False, progress=None, say=print):
+                scheduler=None, resume=False, progress=None, say=print, fork=True):
     """Judge the mutants ``indices`` by ``campaign``'s closed-loop runs.
 
     Returns ``(baseline, verdicts)``: ``baseline`` is ``{"runs": [argv at mutsel 0, ...],
@@ -121,7 +132,9 @@ def robot_judge(campaign, netlist, ports, resolution, indices, out_dir, *, worke
     judged (the others were kept from the journal)}``; ``verdicts`` is ``{index: judge_runs
     result}`` (with the replay command of the run that caught it, or of the closest run).
     Verdicts are appended to ``out_dir/robot.jsonl`` as they come (``resume`` keeps the
-    ones there)."""
+    ones there). With ``fork`` each mutant's run is forked from the unmutated design's
+    (fpga_robotics.mutation.forked_runs): the same verdicts, most of the world not
+    re-simulated."""
     from distributed import as_completed
 
     from ..sweep.api import wait_for_a_worker
@@ -150,7 +163,7 @@ def robot_judge(campaign, netlist, ports, resolution, indices, out_dir, *, worke
     with open_client(scheduler=scheduler, workers=workers) as client:
         wait_for_a_worker(client, scheduler)
         say(f"robot judge: {len(base)} campaign runs with the unmutated design first")
-        outcomes = _baseline(client, base, tick)
+        outcomes = _baseline(client, base, tick, fork)
         passing = [i for i, o in enumerate(outcomes) if o["status"] == "pass"]
         statuses = [o["status"] for o in outcomes]
         # Each mutant's run may take ten times as long as the design's (at least 30 s).
@@ -162,7 +175,13 @@ def robot_judge(campaign, netlist, ports, resolution, indices, out_dir, *, worke
         for k in todo:
             argvs = [mutant_argv(spec.argv(), netlist, ports, k, resolution)
                      for spec in (plan.runs[i] for i in passing)]
-            futures[client.submit(judge_runs, argvs, limits, pure=False,
+            if fork:
+                from .forked_runs import judge_runs_forked
+
+                task = (judge_runs_forked, argvs, [base[i] for i in passing], limits)
+            else:
+                task = (judge_runs, argvs, limits)
+            futures[client.submit(*task, pure=False,
                                   key=f"mutant-{k}-{time.monotonic_ns()}")] = (k, argvs)
         with open(journal, "a") as f:
             for fut in as_completed(futures):

@@ -1,0 +1,61 @@
+"""World checkpoints: the whole closed-loop state at a frame boundary, saved and restored.
+
+A checkpoint of a ``ClosedLoop`` (compressed timing) taken before frame ``k`` holds
+everything the run's future depends on except the design: the pymunk world (bodies, people's
+scripts, terrain under the robot, collision episodes, the uncertainty streams, lighting),
+the camera's noise, drift and sensor streams, the motor commands still scheduled, the colour
+select, the trajectory, events and metrics so far and the step and frame counters. Restored
+into a loop of the same scenario and seed and run on from frame ``k`` with a design in the
+state it had there, the run is bit-identical to the uninterrupted one.
+
+The design is not part of it (whatever backend drives the loop keeps its own state), nor is
+the renderer (a pure function of the scene: shared, never copied), the viewer or the live
+controls.
+"""
+
+import copy
+
+__all__ = ["STATE", "Checkpoint", "restore", "take"]
+
+#: The ``ClosedLoop`` attributes that make up its state at a frame boundary.
+STATE = ("world", "camera", "motors", "step", "frames_done", "ended_early", "traj", "absent",
+         "events", "cycles", "design_events", "color", "scheduled_color", "color_code")
+
+
+class Checkpoint:
+    """The state of a loop before frame ``frame``; restore it as often as needed."""
+
+    def __init__(self, frame, state, shared):
+        self.frame = frame
+        self._state = state
+        self._shared = shared
+
+    def copy_state(self):
+        """A fresh deep copy of the saved state (the objects that never change shared)."""
+        return copy.deepcopy(self._state, {id(x): x for x in self._shared})
+
+
+def _never_changing(loop):
+    """Objects of the state that no step changes, shared rather than copied: the renderer,
+    and the terrain maps with their (frozen) patches, which the world compares by identity."""
+    shared = [loop.camera.renderer]
+    for terrain in (loop.world.terrain, loop.world._painted):
+        shared += [terrain, *terrain.patches]
+    return shared
+
+
+def take(loop):
+    """A ``Checkpoint`` of ``loop`` at its current frame boundary (``loop.frames_done``)."""
+    shared = _never_changing(loop)
+    memo = {id(x): x for x in shared}
+    # The camera's turn-rate callback reads the loop it belongs to: left out, bound on restore.
+    memo[id(loop.camera.turn_rate)] = None
+    state = copy.deepcopy({name: getattr(loop, name) for name in STATE}, memo)
+    return Checkpoint(loop.frames_done, state, shared)
+
+
+def restore(loop, checkpoint):
+    """Put ``checkpoint``'s state into ``loop`` (a loop of the same scenario and seed)."""
+    for name, value in checkpoint.copy_state().items():
+        setattr(loop, name, value)
+    loop.camera.turn_rate = loop.camera_turn_rate

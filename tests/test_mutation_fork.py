@@ -1,0 +1,54 @@
+"""The robot judge's forked runs: a mutant's run forked from the unmutated design's gives the
+summary and verdict of its full run (``runner.execute``), mutant by mutant."""
+
+import pytest
+from run_equality import TIMING_FIELDS
+
+from fpga_robotics.hw.params import FollowTargetParams
+from fpga_robotics.sim import mutation
+
+PARAMS = FollowTargetParams(width=80, height=60)
+
+
+def _toolchain():
+    from fpga_robotics.sim.backends import BackendError
+    from fpga_robotics.sim.backends import toolchain as tc
+
+    try:
+        mutation.find_yosys()
+        tc.find_compiler(), tc.find_make(), tc.verilator_root()
+    except (mutation.MutationError, BackendError) as exc:  # pragma: no cover - the machine
+        return str(exc)
+    return None
+
+
+@pytest.mark.skipif(_toolchain() is not None, reason="no Yosys or Verilator toolchain")
+def test_forked_mutant_runs_equal_their_full_runs(tmp_path):
+    from fpga_robotics.mutation.design import write_mutant_design
+    from fpga_robotics.mutation.forked_runs import execute_forked
+    from fpga_robotics.mutation.robot_judge import mutant_argv
+    from fpga_robotics.sweep import load_campaign, runner
+    from fpga_robotics.sweep.plan import make_plan
+
+    listed = mutation.list_mutants(PARAMS, 3000, seed=1)
+    # Mutants the robot acts on (wheel commands) and ones it may not (the filtered image,
+    # the centroid, the tracker's counters): forked at many frames, or never.
+    picks = [next(m for m in listed if (m.signal, m.bit, m.mode) == ("motor_left", 12, "inv")),
+             next(m for m in listed if m.signal == "filtered__payload" and m.mode == "const1")]
+    picks += [m for m in listed if m not in picks][::300][:6]
+    chosen = [mutation.Mutant(**{**m.__dict__, "index": i}) for i, m in enumerate(picks, 1)]
+    netlist, ports = write_mutant_design(PARAMS, chosen, tmp_path)
+    campaign = load_campaign({"name": "tiny", "scenarios": ["lost_target"], "seeds": "0",
+                              "duration": 3.0, "set": ["camera.noise_std=4"]})
+    spec = make_plan(campaign).runs[0]
+    ref_argv = mutant_argv(spec.argv(), netlist, ports, 0, "80x60")
+    verdicts = set()
+    for m in chosen:
+        argv = mutant_argv(spec.argv(), netlist, ports, m.index, "80x60")
+        full = runner.execute(argv)
+        forked = execute_forked(argv, ref_argv)
+        assert forked["status"] == full["status"], m.describe()
+        assert {k: v for k, v in forked["summary"].items() if k not in TIMING_FIELDS} == {
+            k: v for k, v in full["summary"].items() if k not in TIMING_FIELDS}, m.describe()
+        verdicts.add(full["status"])
+    assert verdicts == {"pass", "fail"}  # both outcomes compared
