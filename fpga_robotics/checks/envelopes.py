@@ -276,7 +276,7 @@ def _search_judged(found, ml, mr, dist, bearing, geom, params):
     target was last seen on (left after reset). A sighting within ``E_TOLERANCE_PX`` of the
     image centre has no sure side: its search frames are not judged."""
     out = []
-    lost, side = 0, -1  # -1 left, +1 right, 0 unknown
+    lost, side, held = 0, -1, (0.0, 0.0)  # side: -1 left, +1 right, 0 unknown
     for k in range(len(found)):
         if found[k]:
             lost = 0
@@ -287,10 +287,11 @@ def _search_judged(found, ml, mr, dist, bearing, geom, params):
                 if abs(offset) > E_TOLERANCE_PX:
                     side = 1 if offset > 0 else -1
             continue
+        if lost == 0:  # the command shown when the loss began is the one to hold
+            held = (ml[k - 1], mr[k - 1]) if k else (0.0, 0.0)
         lost = min(lost + 1, params.lost_frames)
         if lost < params.lost_frames:
-            previous = (ml[k - 1], mr[k - 1]) if k else (0.0, 0.0)
-            out.append((ml[k], mr[k]) != previous)
+            out.append((ml[k], mr[k]) != held)
         elif side:
             s = params.search_dps * side
             out.append((ml[k], mr[k]) != (s, -s))
