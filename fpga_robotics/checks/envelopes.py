@@ -44,7 +44,8 @@ class EnvelopeGeometry:
     """What the bands need to know of the camera and the target.
 
     width, height, hfov : the image and its horizontal field of view (rad).
-    mount_height, mount_forward, tilt : the camera on the robot (m, m, rad).
+    mount_height, mount_forward, tilt : the camera on the robot (m, m, rad); ``yaw``: its
+        yaw off the heading (rad, left positive).
     radius : the target's radius (m).
     bands_sure, bands_maybe : per colour code, the ``(z0, z1)`` of the target's bands that
         match in every light (lower bound) and in some light (upper bound).
@@ -59,6 +60,8 @@ class EnvelopeGeometry:
     radius: float
     bands_sure: dict
     bands_maybe: dict
+    #: The mount's yaw off the robot's heading (rad, left positive).
+    yaw: float = 0.0
 
     @property
     def focal(self):
@@ -99,7 +102,8 @@ def envelope_geometry(scenario, world_config, camera):
                 maybe[code].append((band.z0, band.z1))
     cam = scenario.camera
     return EnvelopeGeometry(cam.width, cam.height, cam.hfov, camera.mount_height,
-                            camera.mount_forward, camera.tilt, target.radius, sure, maybe)
+                            camera.mount_forward, camera.tilt, target.radius, sure, maybe,
+                            yaw=getattr(camera, "yaw_offset", 0.0))
 
 
 def _rows(z0, z1, depth, geom, params):
@@ -203,7 +207,7 @@ def _camera_view(traj, geom):
     cy = np.asarray(traj["y"], float) + geom.mount_forward * np.sin(h)
     dx = np.asarray(traj["target_x"], float) - cx
     dy = np.asarray(traj["target_y"], float) - cy
-    bearing = (np.arctan2(dy, dx) - h + np.pi) % (2 * np.pi) - np.pi
+    bearing = (np.arctan2(dy, dx) - h - geom.yaw + np.pi) % (2 * np.pi) - np.pi
     return np.hypot(dx, dy), bearing
 
 

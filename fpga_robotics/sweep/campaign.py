@@ -243,8 +243,8 @@ def _flatten_values(table, prefix):
     for key, value in table.items():
         if isinstance(value, dict):
             out += _flatten_values(value, f"{prefix}{key}.")
-        else:
-            out.append((f"{prefix}{key}", value))
+        else:  # a list value (a colour) as a tuple: a run's overrides are hashable
+            out.append((f"{prefix}{key}", tuple(value) if isinstance(value, list) else value))
     return out
 
 
