@@ -16,6 +16,9 @@ those bands. Stated tolerances (nothing tuned to a run):
 - centroid error ``e``: +-2 pixels (the centroid's floor and the half-pixel of the column),
   plus a quarter of the silhouette's width when a band that may count does not match in
   ambient light alone (its shaded side then drops out and the centroid moves to the lit side);
+- with the camera's sensor model (``camera.sensor``) no band matches surely (exposure and
+  white balance move its colour) and the turn's smear over a frame's exposure adds half its
+  length to the centroid's tolerance;
 - only frames with the whole silhouette inside the window's columns are judged, with the
   target the only person of its colour in view assumed (a second one adds pixels).
 
@@ -62,6 +65,9 @@ class EnvelopeGeometry:
     bands_maybe: dict
     #: The mount's yaw off the robot's heading (rad, left positive).
     yaw: float = 0.0
+    #: The longest exposure (s) over which a turning robot smears the image sideways (the
+    #: sensor model's motion blur; 0 for the plain camera, which has none).
+    exposure_s: float = 0.0
 
     @property
     def focal(self):
@@ -101,9 +107,15 @@ def envelope_geometry(scenario, world_config, camera):
             if any(ok):
                 maybe[code].append((band.z0, band.z1))
     cam = scenario.camera
+    exposure = 0.0
+    if cam.sensor != "plain":
+        # The sensor model's exposure and white balance change the colour a band takes: no
+        # band matches surely, and an exposure may last up to a whole frame.
+        sure = {code: [] for code in sure}
+        exposure = cam.frame_period
     return EnvelopeGeometry(cam.width, cam.height, cam.hfov, camera.mount_height,
                             camera.mount_forward, camera.tilt, target.radius, sure, maybe,
-                            yaw=getattr(camera, "yaw_offset", 0.0))
+                            yaw=getattr(camera, "yaw_offset", 0.0), exposure_s=exposure)
 
 
 def _rows(z0, z1, depth, geom, params):
@@ -254,6 +266,8 @@ def envelope_metrics(traj, params, geom):
         tol = E_TOLERANCE_PX
         if geom.bands_maybe[code] != geom.bands_sure[code]:
             tol += (right - left) / 4
+        if geom.exposure_s and "w" in traj:  # half the smear of a turn during the exposure
+            tol += abs(float(traj["w"][k])) * geom.exposure_s * geom.focal / 2
         e = column - w // 2
         f_lo, f_hi, t_lo, t_hi = law_band(levels, e - tol, e + tol, params)
         if abs(column + 0.5 - w / 2) <= centred_px:
