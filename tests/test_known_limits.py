@@ -18,15 +18,19 @@ def test_known_limits_are_parsed_with_their_scope():
     c = load_campaign({**BASE, "known_limits": [LIMIT, {**LIMIT, "scenarios": "divider",
                                                         "when": {}}]})
     assert c.known_limits == [
-        {"check": "found_min_fraction", "when": {"camera.resolution": "80x60"},
+        {"check": ["found_min_fraction"], "when": {"camera.resolution": "80x60"},
          "scenarios": [], "reason": LIMIT["reason"]},
-        {"check": "found_min_fraction", "when": {}, "scenarios": ["divider"],
+        {"check": ["found_min_fraction"], "when": {}, "scenarios": ["divider"],
          "reason": LIMIT["reason"]}]
+    both = load_campaign({**BASE, "known_limits": [
+        {**LIMIT, "check": ["found_min_fraction", "max_person_collisions"]}]}).known_limits
+    assert both[0]["check"] == ["found_min_fraction", "max_person_collisions"]
     assert load_campaign(dict(BASE)).known_limits == []
 
 
 @pytest.mark.parametrize("entry, says", [
     ({**LIMIT, "check": "found_min"}, "registered check"),
+    ({**LIMIT, "check": []}, "registered check"),
     ({**LIMIT, "reason": " "}, "give a reason"),
     ({**LIMIT, "when": {"camera.noise_std": 0.0}}, "no grid axis or set"),
     ({**LIMIT, "why": "x"}, "unknown key 'why'"),
@@ -56,6 +60,10 @@ def test_a_failure_is_explained_only_where_the_limit_applies():
     groups = failures_by_check([at_limit, elsewhere, also_other], limits)
     assert [r["replay"] for r in groups["found_min_fraction"]] == [elsewhere["replay"]]
     assert groups["max_person_collisions"] == [also_other]
+    # A limit naming both checks explains the run that failed both.
+    both = load_campaign({**BASE, "known_limits": [
+        {**LIMIT, "check": ["found_min_fraction", "max_person_collisions"]}]}).known_limits
+    assert explained(also_other, both) and not explained(elsewhere, both)
 
 
 def test_the_report_shows_each_known_limit_with_its_reason(tmp_path):

@@ -23,7 +23,7 @@ A campaign is a TOML file (docs/campaigns.md)::
     "robot.mass" = 12
 
     [[known_limits]]                        # optional: a failure that is a limit of the design
-    check = "found_min_fraction"            # the check that fails
+    check = "found_min_fraction"            # the check that fails (or a list of checks)
     when = {"camera.resolution" = "80x60"}  # optional: the runs' overrides it applies to
     scenarios = ["divider"]                 # optional: the scenarios it applies to
     reason = "at 80x60 the target is ..."   # why: shown in the report
@@ -265,11 +265,15 @@ def _known_limits(data, axes):
         if unknown:
             raise CampaignError(f"{where}: unknown key {unknown[0]!r}; an entry holds "
                                 f"{', '.join(LIMIT_KEYS)}")
-        check, reason = entry.get("check"), entry.get("reason")
-        if check not in check_names():
-            raise CampaignError(f"{where}: check must name a registered check, got {check!r}")
+        checks, reason = entry.get("check"), entry.get("reason")
+        checks = [checks] if isinstance(checks, str) else checks
+        if (not isinstance(checks, list) or not checks
+                or any(c not in check_names() for c in checks)):
+            raise CampaignError(f"{where}: check must name a registered check (or a list of "
+                                f"them), got {entry.get('check')!r}")
         if not isinstance(reason, str) or not reason.strip():
-            raise CampaignError(f"{where}: give a reason (why the design fails {check} there)")
+            raise CampaignError(f"{where}: give a reason (why the design fails "
+                                f"{', '.join(checks)} there)")
         when = dict(_flatten_values(entry.get("when", {}), "")) if isinstance(
             entry.get("when", {}), dict) else None
         if when is None:
@@ -283,7 +287,7 @@ def _known_limits(data, axes):
             scenarios = [scenarios]
         if not isinstance(scenarios, list) or not all(isinstance(x, str) for x in scenarios):
             raise CampaignError(f"{where}: scenarios must be a list of scenario names")
-        out.append({"check": check, "reason": reason.strip(), "when": when,
+        out.append({"check": checks, "reason": reason.strip(), "when": when,
                     "scenarios": list(scenarios)})
     return out
 

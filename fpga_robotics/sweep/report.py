@@ -50,11 +50,16 @@ def _failed(row):
     return [n for n in (row.get("failed_checks") or "").split(";") if n]
 
 
+def _names(entry):
+    """The checks a known limit names (one, or a list)."""
+    return [entry["check"]] if isinstance(entry["check"], str) else list(entry["check"])
+
+
 def known_limit(row, name, known_limits):
     """The ``[[known_limits]]`` entry that explains the run's failed check ``name`` (its
     scenario and overrides match), else None."""
     for entry in known_limits:
-        if entry["check"] != name:
+        if name not in _names(entry):
             continue
         if entry.get("scenarios") and row.get("scenario") not in entry["scenarios"]:
             continue
@@ -80,8 +85,8 @@ def known_limits_met(rows, known_limits):
     """``[(entry, rows), ...]``: each known limit with the failing runs it explains."""
     out = []
     for entry in known_limits:
-        met = [r for r in rows if r["status"] == "fail" and entry["check"] in _failed(r)
-               and known_limit(r, entry["check"], [entry]) is entry]
+        met = [r for r in rows if r["status"] == "fail"
+               and any(known_limit(r, n, [entry]) is entry for n in _failed(r))]
         out.append((entry, met))
     return out
 
@@ -125,7 +130,7 @@ def _limit_text(entry):
     cond = ", ".join(f"{k}={_shown(v)}" for k, v in (entry.get("when") or {}).items())
     where = ", ".join(entry.get("scenarios") or [])
     scope = "; ".join(x for x in (cond, where) if x) or "every run"
-    return f"{entry['check']} ({scope})"
+    return f"{', '.join(_names(entry))} ({scope})"
 
 
 def format_report(rows, axes, known_limits=()):
