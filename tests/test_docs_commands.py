@@ -454,6 +454,14 @@ PLANS = {
         Plan(shorter=(("--max-runs", "2"), ("--duration", "1"), ("--set", "checks.min_laps=0")),
              files=("runs/sweeps/sensor_designs/report.html",),
              out=(r"2 runs: ", r"pass rate per scenario:")),
+    "python -m fpga_robotics.sweep robustness":
+        # Two short runs: the page gives the whole campaign's results and known limits.
+        Plan(shorter=(("--max-runs", "2"), ("--duration", "2")),
+             files=("runs/sweeps/robustness/report.html",),
+             out=(r"2 runs: ", r"pass rate per robot\.model:")),
+    "python -m fpga_robotics.sweep robustness_small":
+        Plan(shorter=(("--max-runs", "2"), ("--duration", "2")),
+             files=("runs/sweeps/robustness_small/report.html",), out=(r"2 runs: 2 pass",)),
     "python -m fpga_robotics.sweep regression --scheduler tcp://HOST:8786":
         Plan(excused="needs a Dask cluster (HOST is the page's placeholder); "
                      "tests/test_sweep_scheduler.py runs a campaign through a real `dask "
@@ -525,6 +533,9 @@ PLANS = {
     "python -m fpga_robotics.sweep mutation --seeds 0-19 --out runs/sweeps/mutation-20":
         Plan(shorter=(("--max-runs", "2"), ("--backend", "model"), ("--duration", "2")),
              files=("runs/sweeps/mutation-20/report.html",), out=(r"2 runs: 2 pass",)),
+    "python -m fpga_robotics.sweep mutation --seeds 0-4 --out runs/sweeps/mutation-5":
+        Plan(shorter=(("--max-runs", "2"), ("--backend", "model"), ("--duration", "2")),
+             files=("runs/sweeps/mutation-5/report.html",), out=(r"2 runs: 2 pass",)),
     "python -m fpga_robotics.bench.foreign":
         Plan(shorter=(("--frames", "2"), ("--repeats", "1")),
              out=(r"verilator \(built-in\) +[\d.]+ ms/frame",
