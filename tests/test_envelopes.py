@@ -7,8 +7,12 @@ import math
 import numpy as np
 import pytest
 
-from fpga_robotics.checks.envelopes import (EnvelopeGeometry, count_bounds, envelope_metrics,
-                                            stop_distance_m)
+from fpga_robotics.checks.envelopes import (
+    EnvelopeGeometry,
+    count_bounds,
+    envelope_metrics,
+    stop_distance_m,
+)
 from fpga_robotics.checks.registry import evaluate_checks
 from fpga_robotics.hw.params import FollowTargetParams
 

@@ -5,8 +5,13 @@ campaign's small version runs (slow)."""
 import pytest
 
 from fpga_robotics.sweep.campaign import CampaignError, load_campaign, read_campaign_file
-from fpga_robotics.sweep.report import (campaign_passed, explained, failures_by_check,
-                                        format_report, write_html)
+from fpga_robotics.sweep.report import (
+    campaign_passed,
+    explained,
+    failures_by_check,
+    format_report,
+    write_html,
+)
 
 BASE = {"name": "t", "scenarios": ["follow_person"], "seeds": "0",
         "sets": [{"camera.resolution": "80x60"}, {"camera.fps": 15.0}]}

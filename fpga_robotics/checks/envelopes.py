@@ -153,7 +153,7 @@ def count_bounds(distance, bearing, code, geom, params):
              for z0, z1 in geom.bands_sure[code])
     hi = sum((cols + 2) * (_rows(z0, z1, near, geom, params) + 2)
              for z0, z1 in geom.bands_maybe[code])
-    return int(math.floor(lo)), int(math.ceil(hi))
+    return math.floor(lo), math.ceil(hi)
 
 
 def _saturate(v, params):
