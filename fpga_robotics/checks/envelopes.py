@@ -1,5 +1,6 @@
 """Behaviour envelopes: what the design promises at robot level, as bands computed from its
-parameters (``FollowTargetParams``) and the camera's geometry, never from its own outputs.
+parameters (``FollowTargetParams``) and the camera's geometry, not from what the design
+reports (its ``found`` only picks the frames each law applies to).
 
 Per frame, the target's pixel count in the tracking window is bounded from where the target
 stands (pinhole camera, the person an upright cylinder of coloured bands): ``count_bounds``.
@@ -12,7 +13,7 @@ those bands. Stated tolerances (nothing tuned to a run):
 - count: the silhouette's width and each band's rows +-1 pixel (edge quantisation), rows at
   the nearest depth of the body for the upper bound and at its centre for the lower one; a
   band counts towards the lower bound only if its colour matches in the darkest light of the
-  scenario (ambient alone), towards the upper one if it matches in any light;
+  scenario (ambient alone) and in its brightest, towards the upper one if in either;
 - centroid error ``e``: +-2 pixels (the centroid's floor and the half-pixel of the column),
   plus a quarter of the silhouette's width when a band that may count does not match in
   ambient light alone (its shaded side then drops out and the centroid moves to the lit side);
@@ -20,7 +21,8 @@ those bands. Stated tolerances (nothing tuned to a run):
   white balance move its colour) and the turn's smear over a frame's exposure adds half its
   length to the centroid's tolerance;
 - only frames with the whole silhouette inside the window's columns are judged, with the
-  target the only person of its colour in view assumed (a second one adds pixels).
+  target assumed the only thing of its colour in view and not hidden (another adds pixels,
+  an occluder removes them: the robustness campaign's known limits show where that fails).
 
 The envelopes read the default laws (``motor_law = "p_control"``, ``lost_motion = "hold"``,
 ``search_side_from = "centroid"``); a design with another law has them n/a.
