@@ -525,6 +525,15 @@ PLANS = {
              out=((r"robot judge \(campaign mutation: \d+ of 9 runs pass unmutated\).*"
                    r"mutants/min"),),
              files=("runs/mutation/scale-w2/mutants.json",)),
+    # The robot judge with the envelopes on three seeds: four mutants at 80x60 each (the page
+    # gives the measured scores; the whole commands take tens of minutes).
+    **{f"python -m fpga_robotics.mutation --mutants {n} --campaign mutation --seed {seed} "
+       "--workers 1":
+       Plan(shorter=(("--mutants", "4"), ("--width", "80"), ("--height", "60"),
+                     ("--recordings", "0")),
+            out=(rf"4 mutants of follow_target 80x60 \(seed {seed}\)",
+                 r"robot judge \(campaign mutation: \d+ of 9 runs pass unmutated\)"))
+       for n, seed in ((60, 1), (20, 2), (20, 3))},
     # The mutation campaign with the unmutated design: two short runs on the model backend
     # (the page gives the whole campaign's results).
     "python -m fpga_robotics.sweep mutation":
