@@ -150,3 +150,11 @@ def test_other_laws_leave_the_envelopes_na():
     m = envelope_metrics(traj, DEFAULT, GEOM)
     (c,) = evaluate_checks({"max_approach_speed_violation_fraction": 0.0}, m)
     assert c["status"] == "pass"
+
+
+def test_no_geometry_leaves_the_envelopes_na_with_its_reason():
+    m = envelope_metrics(_traj([(True, 0.0, 200, 200)]), DEFAULT, "no target person")
+    assert m["envelope_reason"] == "no target person"
+    assert m["approach_speed_violation_fraction"] is None
+    (c,) = evaluate_checks({"max_turn_law_violation_fraction": 0.0}, m)
+    assert c["status"] == "n/a" and c["reason"] == "no envelope: no target person"

@@ -25,7 +25,8 @@ those bands. Stated tolerances (nothing tuned to a run):
   an occluder removes them: the robustness campaign's known limits show where that fails).
 
 The envelopes read the default laws (``motor_law = "p_control"``, ``lost_motion = "hold"``,
-``search_side_from = "centroid"``); a design with another law has them n/a.
+``search_side_from = "centroid"``); a design with another law has them n/a, and so has a run
+with the 3D renderer (its people are bodies, not cylinders of bands).
 """
 
 import math
@@ -88,12 +89,16 @@ def _band_matches(color, shades, code, params):
 
 def envelope_geometry(scenario, world_config, camera):
     """The ``EnvelopeGeometry`` of a run (``scenario``, its ``WorldConfig``, its
-    ``CameraConnector``); None without a target person."""
+    ``CameraConnector``), or why there is none (a string): no target person, or a renderer
+    that draws bodies rather than the cylinders the bounds are computed for."""
     from fpga_robotics.sim.world.people import person_bands
 
     target = next((p for p in world_config.people if p.target), None)
     if target is None:
-        return None
+        return "no target person"
+    if scenario.camera.renderer != "raster":
+        return (f"the bands are computed for the 2D renderer's cylinders; camera.renderer = "
+                f"{scenario.camera.renderer!r} draws bodies")
     light = world_config.lighting
     ambients = [light.ambient] + [k[1] for k in light.keyframes]
     brights = [light.ambient + light.intensity] + [k[1] + k[2] for k in light.keyframes]
@@ -231,11 +236,11 @@ _NAMES = ("approach_speed_violation_fraction", "reverse_when_far_fraction",
 
 
 def envelope_metrics(traj, params, geom):
-    """The envelope metrics of a run: fractions of the judged frames outside each band (None
-    when no frame could be judged), the stop overshoot (m) and ``envelope_reason`` (why
-    nothing could be judged at all, else None)."""
+    """The envelope metrics of a run (``geom``: ``envelope_geometry``'s answer): fractions of
+    the judged frames outside each band (None when no frame could be judged), the stop
+    overshoot (m) and ``envelope_reason`` (why nothing could be judged at all, else None)."""
     out = dict.fromkeys(_NAMES)
-    why = _supported(params) if geom is not None else "no target person"
+    why = geom if isinstance(geom, str) else _supported(params)
     need = ("found", "motor_left", "motor_right", "target_x", "color_sel", "heading")
     if why is None and any(k not in traj for k in need):
         why = "the trajectory lacks the design's found/motor outputs"
