@@ -46,6 +46,9 @@ JUDGEABLE = {
     "lateral_error_mean_m": 0.01, "laps": 2, "off_line_s": 0.5, "obstacle_removed_at_s": 12.0,
     "resumed_after_s": 2.4, "measured_frames": {"front": 30}, "measured_frames_min": 30,
     "silent_sensors": [], "sensor_kinds": {"front": "ultrasound"}, "absent_outputs": [],
+    "approach_speed_violation_fraction": 0.1, "reverse_when_far_fraction": 0.1,
+    "stop_overshoot_m": 0.05, "turn_law_violation_fraction": 0.1,
+    "search_law_violation_fraction": 0.1, "envelope_reason": None,
 }
 
 _IN_VIEW = "the target was never found"
@@ -82,6 +85,18 @@ JUDGED_IF = {
     "min_measured_frames": (30, 31, {"measured_frames": {}, "measured_frames_min": None,
                                      "silent_sensors": [], "sensor_kinds": {}},
                             "the robot has no sensor that measures ([[robot.sensors]])"),
+    "max_approach_speed_violation_fraction": (
+        0.1, 0.09, {"approach_speed_violation_fraction": None},
+        "the target was never found centred and wholly in the window"),
+    "max_reverse_when_far_fraction": (
+        0.1, 0.09, {"reverse_when_far_fraction": None},
+        "the target was never found beyond the reversing distance"),
+    "max_stop_overshoot_m": (0.05, 0.04, {"stop_overshoot_m": None},
+                             "the robot never came near the stop distance"),
+    "max_turn_law_violation_fraction": (0.1, 0.09, {"turn_law_violation_fraction": None},
+                                        "the target was never found wholly in the window"),
+    "max_search_law_violation_fraction": (0.1, 0.09, {"search_law_violation_fraction": None},
+                                          "the target was never lost"),
 }
 #: Checks that always judge: name -> (a limit the JUDGEABLE run passes, one it fails).
 ALWAYS_JUDGED = {

@@ -492,6 +492,14 @@ PLANS = {
         Plan(shorter=(("--max-runs", "2"), ("--duration", "1"), ("--set", "checks.min_laps=0")),
              files=("runs/sweeps/sensor_designs/report.html",),
              out=(r"2 runs: ", r"pass rate per scenario:")),
+    "python -m fpga_robotics.sweep robustness":
+        # Two short runs: the page gives the whole campaign's results and known limits.
+        Plan(shorter=(("--max-runs", "2"), ("--duration", "2")),
+             files=("runs/sweeps/robustness/report.html",),
+             out=(r"2 runs: ", r"pass rate per robot\.model:")),
+    "python -m fpga_robotics.sweep robustness_small":
+        Plan(shorter=(("--max-runs", "2"), ("--duration", "2")),
+             files=("runs/sweeps/robustness_small/report.html",), out=(r"2 runs: 2 pass",)),
     "python -m fpga_robotics.sweep regression --scheduler tcp://HOST:8786":
         Plan(excused="needs a Dask cluster (HOST is the page's placeholder); "
                      "tests/test_sweep_scheduler.py runs a campaign through a real `dask "
@@ -601,16 +609,25 @@ PLANS = {
     # Forked against full robot-judge runs: the same four mutants at 80x60 as above.
     ("python -m fpga_robotics.mutation --mutants 30 --campaign mutation --workers 2 "
      "--recordings 0 --out runs/mutation/fork"):
-        Plan(shorter=(("--mutants", "4"), ("--width", "80"), ("--height", "60")),
+        Plan(slow=True, shorter=(("--mutants", "4"), ("--width", "80"), ("--height", "60")),
              out=((r"robot judge \(campaign mutation: \d+ of 9 runs pass unmutated\).*"
                    r"mutants/min"),),
              files=("runs/mutation/fork/mutants.json",)),
     ("python -m fpga_robotics.mutation --mutants 30 --campaign mutation --workers 2 "
      "--recordings 0 --no-fork --out runs/mutation/no-fork"):
-        Plan(shorter=(("--mutants", "4"), ("--width", "80"), ("--height", "60")),
+        Plan(slow=True, shorter=(("--mutants", "4"), ("--width", "80"), ("--height", "60")),
              out=((r"robot judge \(campaign mutation: \d+ of 9 runs pass unmutated\).*"
                    r"mutants/min"),),
              files=("runs/mutation/no-fork/mutants.json",)),
+    # The robot judge with the envelopes on three seeds: four mutants at 80x60 each (the page
+    # gives the measured scores; the whole commands take tens of minutes).
+    **{f"python -m fpga_robotics.mutation --mutants {n} --campaign mutation --seed {seed} "
+       "--workers 1":
+       Plan(shorter=(("--mutants", "4"), ("--width", "80"), ("--height", "60"),
+                     ("--recordings", "0")),
+            out=(rf"4 mutants of follow_target 80x60 \(seed {seed}\)",
+                 r"robot judge \(campaign mutation: \d+ of 9 runs pass unmutated\)"))
+       for n, seed in ((60, 1), (20, 2), (20, 3))},
     # The mutation campaign with the unmutated design: two short runs on the model backend
     # (the page gives the whole campaign's results).
     "python -m fpga_robotics.sweep mutation":
@@ -619,6 +636,9 @@ PLANS = {
     "python -m fpga_robotics.sweep mutation --seeds 0-19 --out runs/sweeps/mutation-20":
         Plan(shorter=(("--max-runs", "2"), ("--backend", "model"), ("--duration", "2")),
              files=("runs/sweeps/mutation-20/report.html",), out=(r"2 runs: 2 pass",)),
+    "python -m fpga_robotics.sweep mutation --seeds 0-4 --out runs/sweeps/mutation-5":
+        Plan(shorter=(("--max-runs", "2"), ("--backend", "model"), ("--duration", "2")),
+             files=("runs/sweeps/mutation-5/report.html",), out=(r"2 runs: 2 pass",)),
     "fpga-robotics bench foreign":
         Plan(slow=True, shorter=(("--frames", "2"), ("--repeats", "1")),
              out=(r"verilator \(built-in\) +[\d.]+ ms/frame",

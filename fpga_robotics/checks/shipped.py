@@ -77,6 +77,19 @@ def _measured_text(v, limit, m):
     return f"every sensor measured in at least {v} frame(s) (limit >= {limit})"
 
 
+def _envelope(metric, no_frames):
+    """A precondition: the envelopes read this design's laws and the run judged a frame."""
+    def precondition(m):
+        if m.get("envelope_reason"):
+            return f"no envelope: {m['envelope_reason']}"
+        return no_frames if m.get(metric) is None else None
+    return precondition
+
+
+_WHEELS = ("found", "motor_left", "motor_right")
+_BAND = ("(bands from the design's parameters and the camera's geometry: "
+         "fpga_robotics.checks.envelopes)")
+
 _NO_LINE = "not measured: the run has no floor line or no line sensors"
 
 SHIPPED_CHECKS = (
@@ -214,4 +227,50 @@ SHIPPED_CHECKS = (
           _measured_text, kind=int, limits=(0, 10**7, ""),
           precondition=measured("measured_frames_min",
                                 "the robot has no sensor that measures ([[robot.sensors]])")),
+    # Behaviour envelopes (fpga_robotics.checks.envelopes).
+    Check("max_approach_speed_violation_fraction", "approach_speed_violation_fraction", "max",
+          ("with the target found and centred, the commanded forward speed (L + R) / 2 is "
+           "outside the law's speed for the target's distance (base_dps of the proximity "
+           f"levels its pixel count can reach there) in at most this fraction of the frames {_BAND}"),
+          lambda v, limit, m: (f"forward speed outside the approach law in {v:.1%} of the "
+                               f"centred frames (limit <= {limit:.1%})"),
+          limits=_FRACTION, outputs=_WHEELS,
+          precondition=_envelope("approach_speed_violation_fraction",
+                                 "the target was never found centred and wholly in the window")),
+    Check("max_reverse_when_far_fraction", "reverse_when_far_fraction", "max",
+          ("the robot is commanded backwards while the target is farther than the distance at "
+           "which the law reverses, in at most this fraction of the frames found there "
+           f"{_BAND}"),
+          lambda v, limit, m: (f"reversing with the target beyond the reversing distance in "
+                               f"{v:.1%} of those frames (limit <= {limit:.1%})"),
+          limits=_FRACTION, outputs=_WHEELS,
+          precondition=_envelope("reverse_when_far_fraction",
+                                 "the target was never found beyond the reversing distance")),
+    Check("max_stop_overshoot_m", "stop_overshoot_m", "max",
+          ("the robot comes at most this much closer to the target than the distance within "
+           "which the law surely says stop or reverse (the stop distance) "
+           f"{_BAND}"),
+          lambda v, limit, m: (f"came {v:.3f} m inside the stop distance "
+                               f"(limit <= {limit} m)"),
+          limits=(0, 100, "m"), outputs=_WHEELS,
+          precondition=_envelope("stop_overshoot_m",
+                                 "the robot never came near the stop distance")),
+    Check("max_turn_law_violation_fraction", "turn_law_violation_fraction", "max",
+          ("with the target found wholly in the window, the commanded turn (L - R) / 2 is "
+           "outside kp * (the target's column - the image centre), saturating at max_dps, "
+           f"in at most this fraction of the frames {_BAND}"),
+          lambda v, limit, m: (f"turn outside the steering law in {v:.1%} of the frames "
+                               f"judged (limit <= {limit:.1%})"),
+          limits=_FRACTION, outputs=_WHEELS,
+          precondition=_envelope("turn_law_violation_fraction",
+                                 "the target was never found wholly in the window")),
+    Check("max_search_law_violation_fraction", "search_law_violation_fraction", "max",
+          ("with the target lost, the design holds its last command for lost_frames - 1 "
+           "frames, then turns in place at search_dps towards the side the target was last "
+           f"seen on, in all but at most this fraction of the lost frames {_BAND}"),
+          lambda v, limit, m: (f"lost/search command off the law in {v:.1%} of the lost "
+                               f"frames judged (limit <= {limit:.1%})"),
+          limits=_FRACTION, outputs=_WHEELS,
+          precondition=_envelope("search_law_violation_fraction",
+                                 "the target was never lost")),
 )

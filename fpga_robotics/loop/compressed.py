@@ -377,8 +377,13 @@ class ClosedLoop:
 
     def extra_metrics(self):
         """Metrics beyond ``compute_metrics``: whether following resumed after an obstacle
-        left (fpga_robotics.checks.sensor_metrics)."""
-        return obstacle_metrics(self.traj, self.events)
+        left (fpga_robotics.checks.sensor_metrics), and the behaviour envelopes
+        (fpga_robotics.checks.envelopes)."""
+        from fpga_robotics.checks.envelopes import envelope_geometry, envelope_metrics
+
+        geometry = envelope_geometry(self.scenario, self.world.config, self.camera)
+        return {**obstacle_metrics(self.traj, self.events),
+                **envelope_metrics(self.traj, self.scenario.params, geometry)}
 
     def timing_summary(self, wall):
         """How the design's clock related to world time, and how fast it was simulated."""

@@ -33,7 +33,7 @@ def run_campaign(campaign, out_dir, *, workers=None, scheduler=None, resume=Fals
     meta = {"name": campaign.name, "description": campaign.description,
             "source": campaign.source, "axes": campaign.axes, "runs": len(plan.runs),
             "backend": sorted({s.backend for s in plan.runs}), "version": __version__,
-            "scheduler": scheduler, "workers": workers}
+            "scheduler": scheduler, "workers": workers, "known_limits": campaign.known_limits}
     t0 = time.perf_counter()
     try:
         with (_given(client) if client is not None else
@@ -105,4 +105,4 @@ def report_dir(out_dir):
     axes = meta.get("axes") or sorted({k for r in rows for k in r if "." in k and
                                        not k.startswith(("check_", "collisions_"))})
     write_html(out_dir / "report.html", rows, axes, meta)
-    return format_report(rows, axes)
+    return format_report(rows, axes, meta.get("known_limits") or ())

@@ -25,6 +25,12 @@ A campaign is a TOML file (docs/campaigns.md)::
     [[sets]]                                # optional explicit override sets
     "robot.mass" = 12
 
+    [[known_limits]]                        # optional: a failure that is a limit of the design
+    check = "found_min_fraction"            # the check that fails (or a list of checks)
+    when = {"camera.resolution" = "80x60"}  # optional: the runs' overrides it applies to
+    scenarios = ["divider"]                 # optional: the scenarios it applies to
+    reason = "at 80x60 the target is ..."   # why: shown in the report
+
 The runs are, for every scenario and seed, the cartesian product of the grid plus each
 explicit set. A run *is* its ``python -m fpga_robotics.run`` argument list: the workers parse
 it with ``run``'s own parser, so the replay command of a row is the run itself.
@@ -50,7 +56,9 @@ __all__ = ["Campaign", "CampaignError", "RunSpec", "load_campaign", "parse_seeds
 
 #: Keys a campaign file may hold.
 KEYS = ("name", "description", "scenarios", "seeds", "backend", "resolution", "duration",
-        "shadow", "design", "ports", "set", "timeout", "grid", "sets")
+        "shadow", "design", "ports", "set", "timeout", "grid", "sets", "known_limits")
+#: Keys of a ``[[known_limits]]`` entry.
+LIMIT_KEYS = ("check", "reason", "when", "scenarios")
 
 #: At most this many runs in one campaign (a typo in a seed range must not plan 10**12).
 MAX_RUNS = 1_000_000
@@ -110,6 +118,8 @@ class Campaign:
     timeout: float | None = None
     source: str = ""
     identities: dict = field(default_factory=dict)   # filled by plan.identify
+    #: ``[[known_limits]]``: failures that are limits of the design, each with its reason.
+    known_limits: list = field(default_factory=list)
 
 
 def toml_value(v):
@@ -237,8 +247,52 @@ def _flatten_values(table, prefix):
     for key, value in table.items():
         if isinstance(value, dict):
             out += _flatten_values(value, f"{prefix}{key}.")
-        else:
-            out.append((f"{prefix}{key}", value))
+        else:  # a list value (a colour) as a tuple: a run's overrides are hashable
+            out.append((f"{prefix}{key}", tuple(value) if isinstance(value, list) else value))
+    return out
+
+
+def _known_limits(data, axes):
+    """The ``[[known_limits]]`` entries, checked: each names a registered check and a reason,
+    optionally ``when`` (override key -> value, keys among the grid/sets axes) and
+    ``scenarios``."""
+    from fpga_robotics.checks.registry import check_names
+
+    limits = data.get("known_limits", [])
+    if not isinstance(limits, list) or not all(isinstance(x, dict) for x in limits):
+        raise CampaignError("known_limits must be a list of tables ([[known_limits]] with "
+                            "check = NAME and reason = TEXT)")
+    out = []
+    for i, entry in enumerate(limits):
+        where = f"known_limits[{i}]"
+        unknown = [k for k in entry if k not in LIMIT_KEYS]
+        if unknown:
+            raise CampaignError(f"{where}: unknown key {unknown[0]!r}; an entry holds "
+                                f"{', '.join(LIMIT_KEYS)}")
+        checks, reason = entry.get("check"), entry.get("reason")
+        checks = [checks] if isinstance(checks, str) else checks
+        if (not isinstance(checks, list) or not checks
+                or any(c not in check_names() for c in checks)):
+            raise CampaignError(f"{where}: check must name a registered check (or a list of "
+                                f"them), got {entry.get('check')!r}")
+        if not isinstance(reason, str) or not reason.strip():
+            raise CampaignError(f"{where}: give a reason (why the design fails "
+                                f"{', '.join(checks)} there)")
+        when = dict(_flatten_values(entry.get("when", {}), "")) if isinstance(
+            entry.get("when", {}), dict) else None
+        if when is None:
+            raise CampaignError(f"{where}: when must be a table of override KEY = VALUE")
+        stray = [k for k in when if k not in axes]
+        if stray:
+            raise CampaignError(f"{where}: when names {stray[0]!r}, which no grid axis or set "
+                                f"of the campaign varies")
+        scenarios = entry.get("scenarios", [])
+        if isinstance(scenarios, str):
+            scenarios = [scenarios]
+        if not isinstance(scenarios, list) or not all(isinstance(x, str) for x in scenarios):
+            raise CampaignError(f"{where}: scenarios must be a list of scenario names")
+        out.append({"check": checks, "reason": reason.strip(), "when": when,
+                    "scenarios": list(scenarios)})
     return out
 
 
@@ -320,6 +374,7 @@ def load_campaign(data, *, source=""):
             raise CampaignError(f"timeout must be > 0 seconds, got {timeout}")
         fixed = _set_items(data.get("set", []), "set")
         combos, axes = _combos(data)
+        known_limits = _known_limits(data, axes)
         base = RunSpec(scenario="", seed=0, overrides=(), backend=backend,
                        resolution=resolution, duration=duration,
                        shadow=_typed(data, "shadow", str, "a shadow spec (e.g. \"published\")"),
@@ -334,7 +389,7 @@ def load_campaign(data, *, source=""):
     except CampaignError as exc:
         raise CampaignError(f"{where}{exc}") from None
     return Campaign(name=name, description=data.get("description", ""), runs=runs, axes=axes,
-                    timeout=timeout, source=source)
+                    timeout=timeout, source=source, known_limits=known_limits)
 
 
 def run_identity(spec, scenario_source, extra_files=()):

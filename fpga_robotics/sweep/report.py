@@ -46,14 +46,60 @@ def _by(rows, column):
     return dict(sorted(groups.items(), key=lambda kv: _value_key(kv[0])))
 
 
-def failures_by_check(rows):
+def _failed(row):
+    return [n for n in (row.get("failed_checks") or "").split(";") if n]
+
+
+def _names(entry):
+    """The checks a known limit names (one, or a list)."""
+    return [entry["check"]] if isinstance(entry["check"], str) else list(entry["check"])
+
+
+def known_limit(row, name, known_limits):
+    """The ``[[known_limits]]`` entry that explains the run's failed check ``name`` (its
+    scenario and overrides match), else None."""
+    for entry in known_limits:
+        if name not in _names(entry):
+            continue
+        if entry.get("scenarios") and row.get("scenario") not in entry["scenarios"]:
+            continue
+        if all(row.get(k) == v for k, v in (entry.get("when") or {}).items()):
+            return entry
+    return None
+
+
+def explained(row, known_limits):
+    """Whether the run failed and every check it failed is a known limit of the design."""
+    failed = _failed(row)
+    return (row["status"] == "fail" and bool(failed)
+            and all(known_limit(row, n, known_limits) for n in failed))
+
+
+def campaign_passed(rows, known_limits=()):
+    """Every run passed, or failed only where a known limit of the design explains it."""
+    return bool(rows) and all(r["status"] == "pass" or explained(r, known_limits)
+                              for r in rows)
+
+
+def known_limits_met(rows, known_limits):
+    """``[(entry, rows), ...]``: each known limit with the failing runs it explains."""
+    out = []
+    for entry in known_limits:
+        met = [r for r in rows if r["status"] == "fail"
+               and any(known_limit(r, n, [entry]) is entry for n in _failed(r))]
+        out.append((entry, met))
+    return out
+
+
+def failures_by_check(rows, known_limits=()):
     """Failed check (or ``error``/``timeout``, or ``n/a`` for a run no check could judge) →
-    the rows, most frequent first."""
+    the rows, most frequent first; a check a known limit explains for that run is left out."""
     groups = defaultdict(list)
     for r in rows:
         if r["status"] == "fail":
-            for name in filter(None, (r.get("failed_checks") or "").split(";")):
-                groups[name].append(r)
+            for name in _failed(r):
+                if known_limit(r, name, known_limits) is None:
+                    groups[name].append(r)
         elif r["status"] in ("n/a", "error", "timeout"):
             groups[r["status"]].append(r)
     return dict(sorted(groups.items(), key=lambda kv: -len(kv[1])))
@@ -80,7 +126,14 @@ def na_by_check(rows):
     return dict(sorted(groups.items(), key=lambda kv: -len(kv[1])))
 
 
-def format_report(rows, axes):
+def _limit_text(entry):
+    cond = ", ".join(f"{k}={_shown(v)}" for k, v in (entry.get("when") or {}).items())
+    where = ", ".join(entry.get("scenarios") or [])
+    scope = "; ".join(x for x in (cond, where) if x) or "every run"
+    return f"{', '.join(_names(entry))} ({scope})"
+
+
+def format_report(rows, axes, known_limits=()):
     """The terminal summary (several lines)."""
     counts = {s: sum(r["status"] == s for r in rows) for s in ("pass", "fail", "n/a", "error",
                                                                "timeout")}
@@ -93,7 +146,12 @@ def format_report(rows, axes):
         lines.append(f"pass rate per {axis}:")
         for value, group in _by(rows, axis).items():
             lines.append(f"  {_shown(value):<20} {_rate(group):6.0%}  ({len(group)} runs)")
-    groups = failures_by_check(rows)
+    met = [(e, g) for e, g in known_limits_met(rows, known_limits) if g]
+    if met:
+        lines.append("known limits of the design (failures the campaign explains):")
+        for entry, group in met:
+            lines.append(f"  {_limit_text(entry)}: {len(group)} run(s): {entry['reason']}")
+    groups = failures_by_check(rows, known_limits)
     if groups:
         lines.append("failures by check (replay one with its command):")
         for name, group in groups.items():
@@ -215,7 +273,8 @@ def write_html(path, rows, axes, meta):
              f"<h1>{esc(title)}</h1>"]
     if meta.get("description"):
         parts.append(f"<p>{esc(meta['description'])}</p>")
-    summary = format_report(rows, axes).splitlines()[0]
+    known_limits = meta.get("known_limits") or ()
+    summary = format_report(rows, axes, known_limits).splitlines()[0]
     parts.append(f"<p><b>{esc(summary)}</b></p>")
     facts = [(k, meta[k]) for k in ("backend", "workers", "scheduler", "wall_s", "build_s",
                                      "version") if meta.get(k) is not None]
@@ -235,10 +294,24 @@ def write_html(path, rows, axes, meta):
         for column, label in METRICS:
             if any(isinstance(r.get(column), (int, float)) for r in rows):
                 parts.append(f"<img src='{_histogram(rows, column, label)}'>")
-    groups = failures_by_check(rows)
+    if known_limits:
+        parts.append("<h2>Known limits of the design</h2>")
+        parts.append("<p>Failures the campaign expects: a limit of the design under that "
+                     "variation, with the reason. They are not counted against it.</p>")
+        for entry, group in known_limits_met(rows, known_limits):
+            parts.append(f"<h3>{esc(_limit_text(entry))}: {len(group)} run(s)</h3>"
+                         f"<p>{esc(entry['reason'])}</p>")
+            if group:
+                parts.append("<table><tr><th>scenario</th><th>seed</th><th>replay</th></tr>")
+                for r in group:
+                    parts.append(f"<tr><td>{esc(str(r['scenario']))}</td><td>{r['seed']}</td>"
+                                 f"<td><code>{esc(r['replay'])}</code></td></tr>")
+                parts.append("</table>")
+    groups = failures_by_check(rows, known_limits)
     parts.append("<h2>Failing runs by check</h2>")
     if not groups:
-        parts.append("<p>None: every run passed.</p>")
+        parts.append("<p>None: every run passed"
+                     + (" or failed only by a known limit.</p>" if known_limits else ".</p>"))
     for name, group in groups.items():
         parts.append(f"<h3>{esc(name)} ({len(group)} run(s))</h3><table>")
         parts.append("<tr><th>scenario</th><th>seed</th><th>what</th><th>replay</th>"

@@ -1,0 +1,327 @@
+"""Behaviour envelopes: what the design promises at robot level, as bands computed from its
+parameters (``FollowTargetParams``) and the camera's geometry, not from what the design
+reports (its ``found`` only picks the frames each law applies to).
+
+Per frame, the target's pixel count in the tracking window is bounded from where the target
+stands (pinhole camera, the person an upright cylinder of coloured bands): ``count_bounds``.
+The proximity levels those counts allow give the law's forward speed (``base_dps``), and the
+target's image column gives the centroid error ``e`` and so the law's turn
+(``(kp_num * e) >> kp_shift``, wheels saturating at ``max_dps``). The design's wheel commands
+(``motor_left``, ``motor_right``: forward ``(L + R) / 2``, turn ``(L - R) / 2``) must fall in
+those bands. Stated tolerances (nothing tuned to a run):
+
+- count: the silhouette's width and each band's rows +-1 pixel (edge quantisation), rows at
+  the nearest depth of the body for the upper bound and at its centre for the lower one; a
+  band counts towards the lower bound only if its colour matches in the darkest light of the
+  scenario (ambient alone) and in its brightest, towards the upper one if in either;
+- centroid error ``e``: +-2 pixels (the centroid's floor and the half-pixel of the column),
+  plus a quarter of the silhouette's width when a band that may count does not match in
+  ambient light alone (its shaded side then drops out and the centroid moves to the lit side);
+- with the camera's sensor model (``camera.sensor``) no band matches surely (exposure and
+  white balance move its colour) and the turn's smear over a frame's exposure adds half its
+  length to the centroid's tolerance;
+- only frames with the whole silhouette inside the window's columns are judged, with the
+  target assumed the only thing of its colour in view and not hidden (another adds pixels,
+  an occluder removes them: the robustness campaign's known limits show where that fails).
+
+The envelopes read the default laws (``motor_law = "p_control"``, ``lost_motion = "hold"``,
+``search_side_from = "centroid"``); a design with another law has them n/a, and so has a run
+with the 3D renderer (its people are bodies, not cylinders of bands).
+"""
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from fpga_robotics.sim.models.follow_target import match_table, proximity_level
+
+__all__ = ["EnvelopeGeometry", "count_bounds", "envelope_geometry", "envelope_metrics",
+           "law_band", "stop_distance_m"]
+
+#: Tolerance of the centroid error against the target's image column, pixels.
+E_TOLERANCE_PX = 2.0
+#: A target within this many pixels of the image centre is "centred" (speed envelope).
+CENTRED_PX_FRACTION = 1 / 16
+
+
+@dataclass(frozen=True)
+class EnvelopeGeometry:
+    """What the bands need to know of the camera and the target.
+
+    width, height, hfov : the image and its horizontal field of view (rad).
+    mount_height, mount_forward, tilt : the camera on the robot (m, m, rad); ``yaw``: its
+        yaw off the heading (rad, left positive).
+    radius : the target's radius (m).
+    bands_sure, bands_maybe : per colour code, the ``(z0, z1)`` of the target's bands that
+        match in every light (lower bound) and in some light (upper bound).
+    """
+
+    width: int
+    height: int
+    hfov: float
+    mount_height: float
+    mount_forward: float
+    tilt: float
+    radius: float
+    bands_sure: dict
+    bands_maybe: dict
+    #: The mount's yaw off the robot's heading (rad, left positive).
+    yaw: float = 0.0
+    #: The longest exposure (s) over which a turning robot smears the image sideways (the
+    #: sensor model's motion blur; 0 for the plain camera, which has none).
+    exposure_s: float = 0.0
+
+    @property
+    def focal(self):
+        return (self.width / 2) / math.tan(self.hfov / 2)
+
+
+def _band_matches(color, shades, code, params):
+    """Whether a band of albedo ``color`` matches colour ``code`` lit by each of ``shades``."""
+    table = match_table(code, params)
+    out = []
+    for s in shades:
+        r, g, b = (min(255, int(c * s * 255.0 + 0.5)) >> 4 for c in color)
+        out.append(bool(table[(r << 8) | (g << 4) | b]))
+    return out
+
+
+def envelope_geometry(scenario, world_config, camera):
+    """The ``EnvelopeGeometry`` of a run (``scenario``, its ``WorldConfig``, its
+    ``CameraConnector``), or why there is none (a string): no target person, or a renderer
+    that draws bodies rather than the cylinders the bounds are computed for."""
+    from fpga_robotics.sim.world.people import person_bands
+
+    target = next((p for p in world_config.people if p.target), None)
+    if target is None:
+        return "no target person"
+    if scenario.camera.renderer != "raster":
+        return (f"the bands are computed for the 2D renderer's cylinders; camera.renderer = "
+                f"{scenario.camera.renderer!r} draws bodies")
+    light = world_config.lighting
+    ambients = [light.ambient] + [k[1] for k in light.keyframes]
+    brights = [light.ambient + light.intensity] + [k[1] + k[2] for k in light.keyframes]
+    darkest, brightest = min(ambients), max(brights)
+    shades = (darkest, brightest)
+    sure, maybe = {}, {}
+    for code in range(8):
+        sure[code], maybe[code] = [], []
+        for band in person_bands(target):
+            ok = _band_matches(band.color, shades, code, scenario.params)
+            if all(ok):
+                sure[code].append((band.z0, band.z1))
+            if any(ok):
+                maybe[code].append((band.z0, band.z1))
+    cam = scenario.camera
+    exposure = 0.0
+    if cam.sensor != "plain":
+        # The sensor model's exposure and white balance change the colour a band takes: no
+        # band matches surely, and an exposure may last up to a whole frame.
+        sure = {code: [] for code in sure}
+        exposure = cam.frame_period
+    return EnvelopeGeometry(cam.width, cam.height, cam.hfov, camera.mount_height,
+                            camera.mount_forward, camera.tilt, target.radius, sure, maybe,
+                            yaw=getattr(camera, "yaw_offset", 0.0), exposure_s=exposure)
+
+
+def _rows(z0, z1, depth, geom, params):
+    """Rows of the window (continuous) a band from ``z0`` to ``z1`` covers at ``depth``."""
+    f, h = geom.focal, geom.mount_height
+    axis = geom.height / 2
+
+    def row(z):
+        return axis - f * math.tan(math.atan2(z - h, depth) - geom.tilt)
+
+    top, bottom = row(z1), row(z0)
+    lo, hi = params.margin_y, geom.height - params.margin_y
+    return max(0.0, min(bottom, hi) - max(top, lo))
+
+
+def silhouette(distance, bearing, geom):
+    """``(left, right)`` image columns of the target's silhouette (continuous pixels)."""
+    a = math.asin(min(1.0, geom.radius / distance))
+    f, c = geom.focal, geom.width / 2
+    return c - f * math.tan(bearing + a), c - f * math.tan(bearing - a)
+
+
+def count_bounds(distance, bearing, code, geom, params):
+    """``(lo, hi)``: the target's pixel count in the window for a camera ``distance`` (m) from
+    its centre, at ``bearing`` (rad, left positive), colour code ``code``; None when the
+    silhouette is not wholly inside the window's columns."""
+    if distance <= geom.radius or abs(bearing) >= geom.hfov / 2:
+        return None
+    left, right = silhouette(distance, bearing, geom)
+    if left < params.margin_x or right > geom.width - params.margin_x:
+        return None
+    cols = right - left
+    near, far = distance - geom.radius, distance
+    lo = sum(max(0.0, cols - 2) * max(0.0, _rows(z0, z1, far, geom, params) - 2)
+             for z0, z1 in geom.bands_sure[code])
+    hi = sum((cols + 2) * (_rows(z0, z1, near, geom, params) + 2)
+             for z0, z1 in geom.bands_maybe[code])
+    return math.floor(lo), math.ceil(hi)
+
+
+def _saturate(v, params):
+    return max(-params.max_dps, min(params.max_dps, v))
+
+
+def law_band(levels, e_lo, e_hi, params):
+    """The law's ``(forward_min, forward_max, turn_min, turn_max)`` for proximity levels in
+    ``levels`` and a centroid error in ``[e_lo, e_hi]`` (pixels): forward ``(L + R) / 2``,
+    turn ``(L - R) / 2`` of ``L, R = sat(base +- (kp_num * e) >> kp_shift)``."""
+    es = {math.floor(e_lo), math.ceil(e_hi), min(max(0, math.floor(e_lo)), math.ceil(e_hi))}
+    fwd, turn = [], []
+    for level in levels:
+        b = params.base_dps[level]
+        for e in es:
+            t = (params.kp_num * e) >> params.kp_shift
+            left, right = _saturate(b + t, params), _saturate(b - t, params)
+            fwd.append((left + right) / 2)
+            turn.append((left - right) / 2)
+    return min(fwd), max(fwd), min(turn), max(turn)
+
+
+def _supported(params):
+    """None when the envelopes read this design's laws, else why not."""
+    if params.motor_law != "p_control":
+        return f"the design steers by its LED table (motor_law={params.motor_law!r})"
+    if params.lost_motion != "hold" or params.search_side_from != "centroid":
+        return "the design's lost/search law is not the default one"
+    return None
+
+
+def _stop_level(params):
+    """The lowest proximity level whose law speed is not forward (None: the law never stops)."""
+    return next((lvl for lvl in range(1, 8) if params.base_dps[lvl] <= 0), None)
+
+
+def stop_distance_m(geom, params, code):
+    """``(near, far)``: within ``near`` m (camera to the target's centre, target straight
+    ahead) the law surely says stop or reverse; beyond ``far`` it surely drives forward.
+    None when the law never stops or the bounds never reach its level."""
+    level = _stop_level(params)
+    if level is None:
+        return None
+    threshold = params.proximity_thresholds[level - 1]
+    near = far = None
+    for d in np.arange(0.3, 20.0, 0.005):
+        b = count_bounds(float(d), 0.0, code, geom, params)
+        if b is None:
+            continue
+        if b[0] >= threshold:
+            near = float(d)
+        if b[1] >= threshold:
+            far = float(d)
+    if near is None or far is None:
+        return None
+    return round(near, 3), round(far, 3)
+
+
+def _camera_view(traj, geom):
+    """Per frame: the camera's distance to the target's centre (m) and its bearing (rad)."""
+    h = np.asarray(traj["heading"], float)
+    cx = np.asarray(traj["x"], float) + geom.mount_forward * np.cos(h)
+    cy = np.asarray(traj["y"], float) + geom.mount_forward * np.sin(h)
+    dx = np.asarray(traj["target_x"], float) - cx
+    dy = np.asarray(traj["target_y"], float) - cy
+    bearing = (np.arctan2(dy, dx) - h - geom.yaw + np.pi) % (2 * np.pi) - np.pi
+    return np.hypot(dx, dy), bearing
+
+
+_NAMES = ("approach_speed_violation_fraction", "reverse_when_far_fraction",
+          "turn_law_violation_fraction", "search_law_violation_fraction", "stop_overshoot_m",
+          "envelope_reason")
+
+
+def envelope_metrics(traj, params, geom):
+    """The envelope metrics of a run (``geom``: ``envelope_geometry``'s answer): fractions of
+    the judged frames outside each band (None when no frame could be judged), the stop
+    overshoot (m) and ``envelope_reason`` (why nothing could be judged at all, else None)."""
+    out = dict.fromkeys(_NAMES)
+    why = geom if isinstance(geom, str) else _supported(params)
+    need = ("found", "motor_left", "motor_right", "target_x", "color_sel", "heading")
+    if why is None and any(k not in traj for k in need):
+        why = "the trajectory lacks the design's found/motor outputs"
+    if why is not None:
+        out["envelope_reason"] = why
+        return out
+    found = np.asarray(traj["found"], bool)
+    ml = np.asarray(traj["motor_left"], float)
+    mr = np.asarray(traj["motor_right"], float)
+    if np.isnan(ml).any() or np.isnan(mr).any():
+        out["envelope_reason"] = "the design has no wheel command outputs"
+        return out
+    fwd, turn = (ml + mr) / 2, (ml - mr) / 2
+    dist, bearing = _camera_view(traj, geom)
+    codes = np.asarray(traj["color_sel"], np.int64)
+    w, centred_px = geom.width, geom.width * CENTRED_PX_FRACTION
+    speed, reverse, steer = [], [], []
+    closest = None
+    for k in np.flatnonzero(found):
+        if not math.isfinite(dist[k]):
+            continue
+        code = int(codes[k])
+        bounds = count_bounds(float(dist[k]), float(bearing[k]), code, geom, params)
+        if bounds is None:
+            continue
+        levels = range(proximity_level(bounds[0], params.proximity_thresholds),
+                       proximity_level(bounds[1], params.proximity_thresholds) + 1)
+        left, right = silhouette(float(dist[k]), float(bearing[k]), geom)
+        column = (left + right) / 2 - 0.5  # the pixel index the centre falls on
+        tol = E_TOLERANCE_PX
+        if geom.bands_maybe[code] != geom.bands_sure[code]:
+            tol += (right - left) / 4
+        if geom.exposure_s and "w" in traj:  # half the smear of a turn during the exposure
+            tol += abs(float(traj["w"][k])) * geom.exposure_s * geom.focal / 2
+        e = column - w // 2
+        f_lo, f_hi, t_lo, t_hi = law_band(levels, e - tol, e + tol, params)
+        if abs(column + 0.5 - w / 2) <= centred_px:
+            speed.append(not f_lo <= fwd[k] <= f_hi)
+        if f_lo >= 0:
+            reverse.append(fwd[k] < 0)
+        steer.append(not t_lo <= turn[k] <= t_hi)
+        if abs(bearing[k]) < geom.hfov / 2:
+            closest = dist[k] if closest is None else min(closest, dist[k])
+    out["approach_speed_violation_fraction"] = _fraction(speed)
+    out["reverse_when_far_fraction"] = _fraction(reverse)
+    out["turn_law_violation_fraction"] = _fraction(steer)
+    out["search_law_violation_fraction"] = _fraction(_search_judged(found, ml, mr, dist,
+                                                                    bearing, geom, params))
+    stop = stop_distance_m(geom, params, int(codes[0])) if len(codes) else None
+    if stop is not None and closest is not None and closest <= stop[1]:
+        out["stop_overshoot_m"] = round(max(0.0, stop[0] - float(closest)), 4)
+    return out
+
+
+def _search_judged(found, ml, mr, dist, bearing, geom, params):
+    """Per judged lost frame, whether the design broke the lost law: hold the last command
+    for lost frames 1..lost_frames-1, then turn in place at ``search_dps`` towards the side the
+    target was last seen on (left after reset). A sighting within ``E_TOLERANCE_PX`` of the
+    image centre has no sure side: its search frames are not judged."""
+    out = []
+    lost, side, held = 0, -1, (0.0, 0.0)  # side: -1 left, +1 right, 0 unknown
+    for k in range(len(found)):
+        if found[k]:
+            lost = 0
+            side = 0
+            if math.isfinite(dist[k]) and abs(bearing[k]) < geom.hfov / 2:
+                left, right = silhouette(float(dist[k]), float(bearing[k]), geom)
+                offset = (left + right) / 2 - geom.width / 2
+                if abs(offset) > E_TOLERANCE_PX:
+                    side = 1 if offset > 0 else -1
+            continue
+        if lost == 0:  # the command shown when the loss began is the one to hold
+            held = (ml[k - 1], mr[k - 1]) if k else (0.0, 0.0)
+        lost = min(lost + 1, params.lost_frames)
+        if lost < params.lost_frames:
+            out.append((ml[k], mr[k]) != held)
+        elif side:
+            s = params.search_dps * side
+            out.append((ml[k], mr[k]) != (s, -s))
+    return out
+
+
+def _fraction(flags):
+    return round(float(np.mean(flags)), 4) if flags else None

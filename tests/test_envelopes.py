@@ -1,0 +1,160 @@
+"""Behaviour envelopes on hand-made trajectories, with bands worked out by hand from the
+camera's geometry and the design's parameters: the defaults, and changed parameters that move
+each band."""
+
+import math
+
+import numpy as np
+import pytest
+
+from fpga_robotics.checks.envelopes import (
+    EnvelopeGeometry,
+    count_bounds,
+    envelope_metrics,
+    stop_distance_m,
+)
+from fpga_robotics.checks.registry import evaluate_checks
+from fpga_robotics.hw.params import FollowTargetParams
+
+RED = 0b100
+#: f = 80 / tan(hfov / 2) = 160 px; the camera 0.5 m up, level; a target 0.2 m in radius,
+#: one red band from the floor to 1 m.
+GEOM = EnvelopeGeometry(width=160, height=120, hfov=2 * math.atan(0.5), mount_height=0.5,
+                        mount_forward=0.0, tilt=0.0, radius=0.2,
+                        bands_sure={c: ([(0.0, 1.0)] if c == RED else []) for c in range(8)},
+                        bands_maybe={c: ([(0.0, 1.0)] if c == RED else []) for c in range(8)})
+DEFAULT = FollowTargetParams()
+
+
+def test_count_bounds_at_4_m_by_hand():
+    # Half-width f tan(asin(0.2 / 4)) = 8.01 px: 16.02 columns. Rows at 4 m: 60 -+ 160 * 0.5 / 4
+    # = 40..80 (40 rows); at the near side (3.8 m) 38.95..81.05 (42.1 rows); window rows 8..112.
+    # lo = (16.02 - 2) * (40 - 2) = 532.8, hi = (16.02 + 2) * (42.1 + 2) = 794.7.
+    assert count_bounds(4.0, 0.0, RED, GEOM, DEFAULT) == (532, 795)
+    assert count_bounds(4.0, 0.0, 0b010, GEOM, DEFAULT) == (0, 0)  # no green band
+    # The silhouette leaves the window (columns 16..144) past a bearing of ~0.4 rad.
+    assert count_bounds(4.0, 0.45, RED, GEOM, DEFAULT) is None
+
+
+def _traj(frames):
+    """A trajectory from ``(found, target_y, motor_left, motor_right)`` per frame: the robot at
+    the origin facing +x, the target 4 m ahead at ``target_y`` (left positive)."""
+    n = len(frames)
+    return {
+        "t": np.arange(n) / 30, "x": np.zeros(n), "y": np.zeros(n), "heading": np.zeros(n),
+        "found": np.array([f[0] for f in frames], bool),
+        "target_x": np.full(n, 4.0), "target_y": np.array([f[1] for f in frames], float),
+        "motor_left": np.array([f[2] for f in frames], float),
+        "motor_right": np.array([f[3] for f in frames], float),
+        "color_sel": np.full(n, RED),
+    }
+
+
+def test_approach_speed_and_reversing_default_and_changed_speed_table():
+    # At 4 m every count the geometry allows (532..795) is level 3: base_dps[3] = 200 forward.
+    traj = _traj([(True, 0.0, 200, 200), (True, 0.0, 300, 300), (True, 0.0, -100, -100),
+                  (True, 0.0, 200, 200)])
+    m = envelope_metrics(traj, DEFAULT, GEOM)
+    assert m["approach_speed_violation_fraction"] == 0.5  # 300 and -100
+    assert m["reverse_when_far_fraction"] == 0.25
+    # Level 3 at 300 DPS: the band moves, the 300 DPS frame now keeps the law.
+    faster = DEFAULT.replace(base_dps=(0, 400, 300, 300, 150, 100, -100, -150))
+    m = envelope_metrics(traj, faster, GEOM)
+    assert m["approach_speed_violation_fraction"] == 0.75
+    assert envelope_metrics(_traj([(True, 0.0, 300, 300)]), faster,
+                            GEOM)["approach_speed_violation_fraction"] == 0.0
+    # Thresholds halved (64, 128, 256, 512, ...): 532..795 is level 4, 150 DPS.
+    halved = DEFAULT.replace(proximity_thresholds=(64, 128, 256, 512, 1024, 2048, 3072))
+    m = envelope_metrics(_traj([(True, 0.0, 150, 150), (True, 0.0, 200, 200)]), halved, GEOM)
+    assert m["approach_speed_violation_fraction"] == 0.5
+
+
+def test_turn_law_default_and_changed_gain():
+    # Target 0.4 m to the left at 4 m: bearing atan(0.1); silhouette columns
+    # 80 - 160 tan(bearing +- asin(0.2 / 4.02)): centre column 63.97, e = 63.97 - 0.5 - 80
+    # = -16.53 +- 2: turn 3e in [3 * -19, 3 * -14] = [-57, -42]; the robot turns left (L < R).
+    y = 0.4
+    good = (True, y, 200 - 48, 200 + 48)
+    wrong_sign = (True, y, 200 + 48, 200 - 48)
+    too_much = (True, y, 200 - 70, 200 + 70)
+    m = envelope_metrics(_traj([good, wrong_sign, too_much, good]), DEFAULT, GEOM)
+    assert m["turn_law_violation_fraction"] == 0.5
+    # kp_num = 4: the band is [-76, -56]; 70 keeps it, 48 breaks it.
+    m = envelope_metrics(_traj([good, too_much]), DEFAULT.replace(kp_num=4), GEOM)
+    assert m["turn_law_violation_fraction"] == 0.5
+    assert envelope_metrics(_traj([too_much]), DEFAULT.replace(kp_num=4),
+                            GEOM)["turn_law_violation_fraction"] == 0.0
+
+
+def test_search_law_default_and_changed_search():
+    # Seen on the right (y < 0), then lost: lost frames 1..14 hold (152, 248 here), frame 15
+    # on turns right in place at 250 DPS: left +250, right -250.
+    seen = (True, -0.4, 248, 152)
+    hold = (False, -0.4, 248, 152)
+    search = (False, -0.4, 250, -250)
+    left_search = (False, -0.4, -250, 250)
+    frames = [seen] + [hold] * 14 + [search] * 5
+    assert envelope_metrics(_traj(frames), DEFAULT, GEOM)["search_law_violation_fraction"] == 0
+    wrong = [seen] + [hold] * 14 + [left_search] * 5
+    assert envelope_metrics(_traj(wrong), DEFAULT,
+                            GEOM)["search_law_violation_fraction"] == round(5 / 19, 4)
+    early = [seen] + [hold] * 10 + [search] * 9
+    assert envelope_metrics(_traj(early), DEFAULT,
+                            GEOM)["search_law_violation_fraction"] == round(4 / 19, 4)
+    # lost_frames = 11 and search_dps = 100: the search starts at the 11th lost frame.
+    changed = DEFAULT.replace(lost_frames=11, search_dps=100)
+    early_slow = [seen] + [hold] * 10 + [(False, -0.4, 100, -100)] * 9
+    assert envelope_metrics(_traj(early_slow), changed,
+                            GEOM)["search_law_violation_fraction"] == 0
+    assert envelope_metrics(_traj(early), changed,
+                            GEOM)["search_law_violation_fraction"] == round(9 / 19, 4)  # 250
+    # After reset, never seen: the search turns left.
+    never = [(False, 0.0, 0, 0)] * 14 + [(False, 0.0, -250, 250)] * 3
+    assert envelope_metrics(_traj(never), DEFAULT, GEOM)["search_law_violation_fraction"] == 0
+
+
+def _lo(d):
+    """The lower count bound straight ahead, from the geometry by hand (rows unclipped)."""
+    cols = 2 * 160 * math.tan(math.asin(0.2 / d))
+    return (cols - 2) * (160 * 0.5 / d + 160 * 0.5 / d - 2)
+
+
+def _solve(f, threshold, a=0.5, b=20.0):
+    for _ in range(60):  # bisection: f decreases with the distance
+        mid = (a + b) / 2
+        a, b = (mid, b) if f(mid) >= threshold else (a, mid)
+    return a
+
+
+def test_stop_distance_moves_with_the_reversing_threshold():
+    # Level 6 (base -100) at 1000 px: lo(d) = 1000 at d = 3.09 m (rows unclipped there).
+    params = DEFAULT.replace(proximity_thresholds=(128, 256, 400, 600, 800, 1000, 1200))
+    near, far = stop_distance_m(GEOM, params, RED)
+    assert near == pytest.approx(_solve(_lo, 1000), abs=0.006)
+    # The law reversing one level later (level 7 at 1200 px) stops the robot closer.
+    later = params.replace(base_dps=(0, 400, 300, 200, 150, 100, 50, -150))
+    near7, _ = stop_distance_m(GEOM, later, RED)
+    assert near7 == pytest.approx(_solve(_lo, 1200), abs=0.006)
+    assert near7 < near < far
+    # Never stopping: no stop distance.
+    assert stop_distance_m(GEOM, DEFAULT.replace(base_dps=(1, 400, 300, 200, 150, 100, 50, 40)),
+                           RED) is None
+
+
+def test_other_laws_leave_the_envelopes_na():
+    traj = _traj([(True, 0.0, 200, 200)])
+    m = envelope_metrics(traj, FollowTargetParams.published(), GEOM)
+    assert "table" in m["envelope_reason"]
+    (c,) = evaluate_checks({"max_approach_speed_violation_fraction": 0.0}, m)
+    assert c["status"] == "n/a" and "no envelope" in c["reason"]
+    m = envelope_metrics(traj, DEFAULT, GEOM)
+    (c,) = evaluate_checks({"max_approach_speed_violation_fraction": 0.0}, m)
+    assert c["status"] == "pass"
+
+
+def test_no_geometry_leaves_the_envelopes_na_with_its_reason():
+    m = envelope_metrics(_traj([(True, 0.0, 200, 200)]), DEFAULT, "no target person")
+    assert m["envelope_reason"] == "no target person"
+    assert m["approach_speed_violation_fraction"] is None
+    (c,) = evaluate_checks({"max_turn_law_violation_fraction": 0.0}, m)
+    assert c["status"] == "n/a" and c["reason"] == "no envelope: no target person"
