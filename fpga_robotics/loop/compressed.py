@@ -16,6 +16,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from fpga_robotics.checks.envelopes import envelope_geometry, envelope_metrics
 from fpga_robotics.checks.sensor_metrics import obstacle_metrics
 from fpga_robotics.checks.summary import DESIGN_OUTPUTS, compute_metrics, evaluate_checks, verdict
 from fpga_robotics.hw.pixel import color_select_value
@@ -379,8 +380,6 @@ class ClosedLoop:
         """Metrics beyond ``compute_metrics``: whether following resumed after an obstacle
         left (fpga_robotics.checks.sensor_metrics), and the behaviour envelopes
         (fpga_robotics.checks.envelopes)."""
-        from fpga_robotics.checks.envelopes import envelope_geometry, envelope_metrics
-
         geometry = envelope_geometry(self.scenario, self.world.config, self.camera)
         return {**obstacle_metrics(self.traj, self.events),
                 **envelope_metrics(self.traj, self.scenario.params, geometry)}
