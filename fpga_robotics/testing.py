@@ -52,8 +52,12 @@ class Result:
     @property
     def checks(self):
         """Every check, in the scenario's order."""
-        return [Check(c["name"], _STATUS[c["passed"]], c.get("value"), c.get("limit"),
-                      c.get("text", "")) for c in self.summary.get("checks", ())]
+        return [
+            Check(
+                c["name"], _STATUS[c["passed"]], c.get("value"), c.get("limit"), c.get("text", "")
+            )
+            for c in self.summary.get("checks", ())
+        ]
 
     @property
     def passed(self):
@@ -64,26 +68,35 @@ class Result:
         for c in self.checks:
             if c.name == name:
                 return c
-        raise KeyError(f"scenario {self.scenario.name!r} has no check {name!r}; its checks: "
-                       f"{', '.join(c.name for c in self.checks) or 'none'}")
+        raise KeyError(
+            f"scenario {self.scenario.name!r} has no check {name!r}; its checks: "
+            f"{', '.join(c.name for c in self.checks) or 'none'}"
+        )
 
     def assert_passes(self, *, allow_not_measured=False):
         """Raise ``AssertionError`` listing every failing check (and every check the design
         could not measure, unless ``allow_not_measured``)."""
-        bad = [c for c in self.checks
-               if c.status == "fail" or (c.status == "n/a" and not allow_not_measured)]
+        bad = [
+            c
+            for c in self.checks
+            if c.status == "fail" or (c.status == "n/a" and not allow_not_measured)
+        ]
         if not self.checks:
-            raise AssertionError(f"scenario {self.scenario.name!r} has no checks: give it a "
-                                 f"[checks] table")
+            raise AssertionError(
+                f"scenario {self.scenario.name!r} has no checks: give it a [checks] table"
+            )
         if bad:
             lines = [f"  [{c.status}] {c.name}: {c.text}" for c in bad]
-            raise AssertionError(f"scenario {self.scenario.name!r} ({self.summary['verdict']}):"
-                                 f" {len(bad)} of {len(self.checks)} checks not passed\n"
-                                 + "\n".join(lines))
+            raise AssertionError(
+                f"scenario {self.scenario.name!r} ({self.summary['verdict']}):"
+                f" {len(bad)} of {len(self.checks)} checks not passed\n" + "\n".join(lines)
+            )
 
     def __repr__(self):
-        return (f"<Result {self.scenario.name} {self.summary['verdict']}: "
-                f"{', '.join(f'{c.name}={c.status}' for c in self.checks)}>")
+        return (
+            f"<Result {self.scenario.name} {self.summary['verdict']}: "
+            f"{', '.join(f'{c.name}={c.status}' for c in self.checks)}>"
+        )
 
 
 def _absolute(reference):
@@ -102,23 +115,34 @@ def _design_overrides(design, params, ports):
             raise UsageError(f"design must be a design reference (text), got {design!r}")
         if design.startswith("verilog:"):
             if ports is None:
-                raise UsageError(f"design {design!r} needs ports= (its port map, "
-                                 f"docs/foreign.md)")
-            files = [str(Path(f).resolve()) for f in design[len("verilog:"):].split(",") if f]
-            items += [f"design.top={json.dumps('verilog:' + ','.join(files))}",
-                      f"design.ports={json.dumps(str(Path(ports).resolve()))}"]
+                raise UsageError(f"design {design!r} needs ports= (its port map, docs/foreign.md)")
+            files = [str(Path(f).resolve()) for f in design[len("verilog:") :].split(",") if f]
+            items += [
+                f"design.top={json.dumps('verilog:' + ','.join(files))}",
+                f"design.ports={json.dumps(str(Path(ports).resolve()))}",
+            ]
         else:
             items.append(f"design.top={json.dumps(_absolute(design))}")
     elif ports is not None:
-        raise UsageError("ports= is the port map of a Verilog design: it goes with "
-                         "design='verilog:FILE.v'")
+        raise UsageError(
+            "ports= is the port map of a Verilog design: it goes with design='verilog:FILE.v'"
+        )
     for name, value in (params or {}).items():
         items.append(f"design.params.{name}={json.dumps(value)}")
     return items
 
 
-def run(scenario, *, design=None, params=None, overrides=(), seed=None, backend="auto",
-        ports=None, recorder=None):
+def run(
+    scenario,
+    *,
+    design=None,
+    params=None,
+    overrides=(),
+    seed=None,
+    backend="auto",
+    ports=None,
+    recorder=None,
+):
     """Run ``scenario`` (a .toml path or a shipped scenario's name) in closed loop.
 
     Parameters

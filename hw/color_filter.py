@@ -58,8 +58,9 @@ def color_match_value(m, pixel, color_sel, params):
         TargetColor.MAGENTA: similar(r, b) & dominates(r, g) & dominates(b, g),
         TargetColor.CYAN: similar(g, b) & dominates(g, r) & dominates(b, r),
         # max - min <= S and min >= white_min
-        TargetColor.WHITE: (similar(r, g) & similar(r, b) & similar(g, b)
-                            & bright(r) & bright(g) & bright(b)),
+        TargetColor.WHITE: (
+            similar(r, g) & similar(r, b) & similar(g, b) & bright(r) & bright(g) & bright(b)
+        ),
     }
     # A plain case statement on the colour select: one row of the table per colour.
     match = Signal()
@@ -98,12 +99,14 @@ class ColorFilter(wiring.Component):
         if not isinstance(params, FollowTargetParams):
             raise TypeError(f"params must be a FollowTargetParams, not {params!r}")
         self.params = params
-        super().__init__({
-            "pixels": In(pixel_stream_signature()),
-            "color_sel": In(TargetColor),
-            "filtered": Out(pixel_stream_signature()),
-            "matches": Out(match_stream_signature()),
-        })
+        super().__init__(
+            {
+                "pixels": In(pixel_stream_signature()),
+                "color_sel": In(TargetColor),
+                "filtered": Out(pixel_stream_signature()),
+                "matches": Out(match_stream_signature()),
+            }
+        )
 
     @property
     def latency(self):
@@ -120,14 +123,20 @@ class ColorFilter(wiring.Component):
         # = bits 12-14 (first, last, match), then the valid bit (one register with one enable,
         # and no bit-by-bit assembly of the outputs).
         flags_at = len(pix.pixel.as_value())
-        stage = Signal(data.StructLayout({
-            "payload": len(pix.as_value()), "match": 1, "valid": 1,
-        }))
+        stage = Signal(
+            data.StructLayout(
+                {
+                    "payload": len(pix.as_value()),
+                    "match": 1,
+                    "valid": 1,
+                }
+            )
+        )
         m.d.comb += [
             self.filtered.valid.eq(stage.valid),
             self.filtered.payload.eq(stage.payload),
             self.matches.valid.eq(stage.valid),
-            self.matches.payload.eq(stage.as_value()[flags_at:flags_at + 3]),
+            self.matches.payload.eq(stage.as_value()[flags_at : flags_at + 3]),
         ]
         # Payloads only load on a transfer: fewer toggles (and a quieter waveform) in blanking.
         # Blacking out is an AND with the replicated match bit rather than a multiplexer, so

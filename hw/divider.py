@@ -84,13 +84,17 @@ class SequentialDivider(CheckedArguments, wiring.Component):
         # One packed register, loaded whole in each branch (see `fit`).
         # `steps` is q_bits + 1 at the start, a step is taken while it is above 1, and 1 is
         # the `done` cycle, so `done` needs no register of its own.
-        state = Signal(data.StructLayout({
-            "steps": range(q_bits + 2),
-            "rem": self.divisor_bits,  # partial remainder, always < divisor
-            "low": q_bits,  # dividend bits still to bring down; quotient bits shift in
-            "divisor": self.divisor_bits,  # held: the inputs may change once started
-            "tag": self.tag_bits,
-        }))
+        state = Signal(
+            data.StructLayout(
+                {
+                    "steps": range(q_bits + 2),
+                    "rem": self.divisor_bits,  # partial remainder, always < divisor
+                    "low": q_bits,  # dividend bits still to bring down; quotient bits shift in
+                    "divisor": self.divisor_bits,  # held: the inputs may change once started
+                    "tag": self.tag_bits,
+                }
+            )
+        )
         steps, rem, low, divisor = state.steps, state.rem, state.low, state.divisor
         if self.tag_bits:
             m.d.comb += self.tag.eq(state.tag)
@@ -107,13 +111,22 @@ class SequentialDivider(CheckedArguments, wiring.Component):
         # Each branch loads the whole register in one assignment (see `load`).
         with m.If(self.start):
             tag_value = {"tag": self.tag_in} if self.tag_bits else {}
-            m.d.sync += load(state, steps=q_bits + 1, rem=self.dividend >> q_bits,
-                             low=self.dividend[:q_bits], divisor=self.divisor, **tag_value)
+            m.d.sync += load(
+                state,
+                steps=q_bits + 1,
+                rem=self.dividend >> q_bits,
+                low=self.dividend[:q_bits],
+                divisor=self.divisor,
+                **tag_value,
+            )
         with m.Elif(steps != 0):  # idle (most clocks) costs this one test
             with m.If(stepping):
-                m.d.sync += load(state, steps=steps - 1, rem=Mux(fits, trial - divisor, trial),
-                                 low=Cat(fits, low[:-1]))
+                m.d.sync += load(
+                    state,
+                    steps=steps - 1,
+                    rem=Mux(fits, trial - divisor, trial),
+                    low=Cat(fits, low[:-1]),
+                )
             with m.Else():
                 m.d.sync += load(state, steps=0)  # the `done` cycle
         return m
-

@@ -32,11 +32,11 @@ def load(view, **fields):
     for name, field in sorted(layout, key=lambda item: item[1].offset):
         if name in fields:
             if kept_from is not None:
-                parts.append(whole[kept_from:field.offset])
+                parts.append(whole[kept_from : field.offset])
                 kept_from = None
             parts.append(fit(fields[name], field.width))
         elif kept_from is None:
             kept_from = field.offset
     if kept_from is not None:
-        parts.append(whole[kept_from:layout.size])
+        parts.append(whole[kept_from : layout.size])
     return view.eq(Cat(*parts))

@@ -113,12 +113,14 @@ class FollowLine(CheckedArguments, wiring.Component):
     def __init__(self, params=None):
         self.params = params = FollowLineParams() if params is None else params
         n = params.n_sensors
-        super().__init__({
-            "line": In(n),
-            "motor_left": Out(signed(DPS_BITS)),
-            "motor_right": Out(signed(DPS_BITS)),
-            "line_seen": Out(n),
-        })
+        super().__init__(
+            {
+                "line": In(n),
+                "motor_left": Out(signed(DPS_BITS)),
+                "motor_right": Out(signed(DPS_BITS)),
+                "line_seen": Out(n),
+            }
+        )
 
     def elaborate(self, platform):
         m = Module()
@@ -130,16 +132,26 @@ class FollowLine(CheckedArguments, wiring.Component):
         m.d.sync += [sync1.eq(line_in), self.line_seen.eq(sync1)]
 
         # The whole command in one register, loaded whole from a table of every case.
-        state = Signal(data.StructLayout({
-            "left": signed(DPS_BITS), "right": signed(DPS_BITS), "side": 1,
-        }))
+        state = Signal(
+            data.StructLayout(
+                {
+                    "left": signed(DPS_BITS),
+                    "right": signed(DPS_BITS),
+                    "side": 1,
+                }
+            )
+        )
         m.d.comb += [self.motor_left.eq(state.left), self.motor_right.eq(state.right)]
         with m.Switch(Cat(self.line_seen, state.side)):
             for index in range(1 << (n + 1)):
                 bits, side = index & ((1 << n) - 1), index >> n
                 left, right, new_side = line_command(p, bits, side)
                 with m.Case(index):
-                    m.d.sync += state.eq(Cat(Const(left, signed(DPS_BITS)),
-                                             Const(right, signed(DPS_BITS)),
-                                             Const(new_side, 1)))
+                    m.d.sync += state.eq(
+                        Cat(
+                            Const(left, signed(DPS_BITS)),
+                            Const(right, signed(DPS_BITS)),
+                            Const(new_side, 1),
+                        )
+                    )
         return m

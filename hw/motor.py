@@ -69,17 +69,19 @@ class MotorController(wiring.Component):
             raise TypeError(f"params must be a FollowTargetParams, not {params!r}")
         self.params = params
         leds = {"leds": In(8)} if params.motor_uses_leds else {}
-        super().__init__({
-            "update": In(1),
-            "found": In(1),
-            "proximity": In(3),
-            "centroid_x": In(params.x_bits),
-            **leds,
-            "left": Out(signed(DPS_BITS)),
-            "right": Out(signed(DPS_BITS)),
-            "last_side": Out(1),
-            "lost_count": Out(range(params.lost_frames + 1)),
-        })
+        super().__init__(
+            {
+                "update": In(1),
+                "found": In(1),
+                "proximity": In(3),
+                "centroid_x": In(params.x_bits),
+                **leds,
+                "left": Out(signed(DPS_BITS)),
+                "right": Out(signed(DPS_BITS)),
+                "last_side": Out(1),
+                "lost_count": Out(range(params.lost_frames + 1)),
+            }
+        )
 
     @property
     def latency(self):
@@ -109,8 +111,9 @@ class MotorController(wiring.Component):
         def base():
             values = [Const(v, signed(DPS_BITS)) for v in p.base_dps]
             for bit in range(3):
-                values = [Mux(self.proximity[bit], hi, lo)
-                          for lo, hi in zip(values[0::2], values[1::2])]
+                values = [
+                    Mux(self.proximity[bit], hi, lo) for lo, hi in zip(values[0::2], values[1::2])
+                ]
             return values[0]
 
         def saturate(v):
@@ -124,21 +127,27 @@ class MotorController(wiring.Component):
         # All of the controller's state in one register, loaded whole in each branch (one
         # enable for the wheel speeds and the lost-target state; see `fit`).
         fields = {
-            "left": signed(DPS_BITS), "right": signed(DPS_BITS),
-            "count": range(p.lost_frames + 1), "right_side": 1,
+            "left": signed(DPS_BITS),
+            "right": signed(DPS_BITS),
+            "count": range(p.lost_frames + 1),
+            "right_side": 1,
         }
         if p.lost_motion == "drive":
             fields["last_leds"] = 8  # the last found frame's LED code, 0 after reset
         state = Signal(data.StructLayout(fields))
         m.d.comb += [
-            self.left.eq(state.left), self.right.eq(state.right),
-            self.lost_count.eq(state.count), self.last_side.eq(state.right_side),
+            self.left.eq(state.left),
+            self.right.eq(state.right),
+            self.lost_count.eq(state.count),
+            self.last_side.eq(state.right_side),
         ]
 
         if table:
+
             def command(code):
                 return _table_command(p, base(), code, saturate)
         else:
+
             def command(code):
                 return saturate(base() + turn), saturate(base() - turn)
 
@@ -153,13 +162,17 @@ class MotorController(wiring.Component):
             with m.If(self.found):
                 left, right = command(self.leds if table else None)
                 kept = {"last_leds": self.leds} if p.lost_motion == "drive" else {}
-                m.d.sync += load(state, left=left, right=right, count=0,
-                                 right_side=right_side, **kept)
+                m.d.sync += load(
+                    state, left=left, right=right, count=0, right_side=right_side, **kept
+                )
             # This frame reaches the limit (no constant-true comparison when it is 1: lint).
             with m.Elif(state.count >= p.lost_frames - 1 if p.lost_frames > 1 else 1):
-                m.d.sync += load(state, left=Mux(state.right_side, search, neg_search),
-                                 right=Mux(state.right_side, neg_search, search),
-                                 count=p.lost_frames)
+                m.d.sync += load(
+                    state,
+                    left=Mux(state.right_side, search, neg_search),
+                    right=Mux(state.right_side, neg_search, search),
+                    count=p.lost_frames,
+                )
             with m.Else():
                 if p.lost_motion == "drive":
                     # On at this frame's speed, steered by the last found frame's LED code.

@@ -14,8 +14,14 @@ from dataclasses import dataclass, field, fields
 from .errors import ParamError
 from .validate import check_int
 
-__all__ = ["DEFAULT_BASE_DPS", "DEFAULT_PROXIMITY_THRESHOLDS", "DEFAULT_STEER_DPS", "PRESETS",
-           "FollowTargetParams", "preset_values"]
+__all__ = [
+    "DEFAULT_BASE_DPS",
+    "DEFAULT_PROXIMITY_THRESHOLDS",
+    "DEFAULT_STEER_DPS",
+    "PRESETS",
+    "FollowTargetParams",
+    "preset_values",
+]
 
 #: Proximity thresholds at 160x120 (pixels in the window); scaled by ``area_scale``.
 DEFAULT_PROXIMITY_THRESHOLDS = (128, 256, 512, 1024, 2048, 4096, 6144)
@@ -76,6 +82,7 @@ def preset_values(name, width=160, height=120):
     values["min_pixels"] *= scale
     values["proximity_thresholds"] = tuple(t * scale for t in values["proximity_thresholds"])
     return values
+
 
 _INT16_MIN, _INT16_MAX = -(1 << 15), (1 << 15) - 1
 
@@ -179,16 +186,18 @@ class FollowTargetParams:
     def _check_choice(self, name):
         value, choices = getattr(self, name), CHOICES[name]
         if not isinstance(value, str):
-            raise TypeError(f"{name} must be a string, one of {', '.join(choices)}; "
-                            f"got {type(value).__name__} {value!r}")
+            raise TypeError(
+                f"{name} must be a string, one of {', '.join(choices)}; "
+                f"got {type(value).__name__} {value!r}"
+            )
         if value not in choices:
             raise ParamError(f"{name} must be one of {', '.join(choices)}; got {value!r}")
 
     def _check_each(self, name, lo, hi):
         values = getattr(self, name)
-        object.__setattr__(self, name, tuple(
-            check_int(f"{name}[{i}]", v, lo, hi) for i, v in enumerate(values)
-        ))
+        object.__setattr__(
+            self, name, tuple(check_int(f"{name}[{i}]", v, lo, hi) for i, v in enumerate(values))
+        )
 
     def _validate(self):
         for name in ("diff_min", "similar_max", "white_min"):

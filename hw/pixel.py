@@ -13,7 +13,11 @@ from amaranth.lib import data, enum, stream
 from .errors import ParamError
 
 __all__ = [
-    "COLOR_SELECT", "RGB444", "FramedPixel", "TargetColor", "color_select_value",
+    "COLOR_SELECT",
+    "RGB444",
+    "FramedPixel",
+    "TargetColor",
+    "color_select_value",
     "pixel_stream_signature",
 ]
 

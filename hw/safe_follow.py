@@ -16,12 +16,14 @@ __all__ = ["FollowTargetSafe", "InterlockParams", "follow_target_safe_signature"
 def follow_target_safe_signature(ft_params):
     """``follow_target``'s ports plus the ultrasound pins and the interlock's outputs."""
     members = dict(follow_target_signature(ft_params).members)
-    members.update({
-        "us_trig": Out(1),
-        "us_echo": In(1),
-        "distance_mm": Out(DISTANCE_BITS),
-        "obstacle": Out(1),
-    })
+    members.update(
+        {
+            "us_trig": Out(1),
+            "us_echo": In(1),
+            "distance_mm": Out(DISTANCE_BITS),
+            "obstacle": Out(1),
+        }
+    )
     return wiring.Signature(members)
 
 
@@ -68,9 +70,11 @@ class FollowTargetSafe(CheckedArguments, wiring.Component):
 
     @staticmethod
     def check_arguments(ft_params=None, us_params=None, interlock_params=None):
-        for name, value, cls in (("ft_params", ft_params, FollowTargetParams),
-                                 ("us_params", us_params, UltrasoundParams),
-                                 ("interlock_params", interlock_params, InterlockParams)):
+        for name, value, cls in (
+            ("ft_params", ft_params, FollowTargetParams),
+            ("us_params", us_params, UltrasoundParams),
+            ("interlock_params", interlock_params, InterlockParams),
+        ):
             if value is not None and not isinstance(value, cls):
                 raise TypeError(f"{name} must be a {cls.__name__}, not {value!r}")
 

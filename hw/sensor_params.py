@@ -82,10 +82,13 @@ class UltrasoundParams(_Params):
         if self.trigger_cycles < 1 or self.wait_cycles < 2:
             raise ParamError(
                 f"clock_hz={self.clock_hz} is too slow for trigger_us={self.trigger_us} and "
-                f"wait_us={self.wait_us}: they must last at least 1 and 2 cycles")
+                f"wait_us={self.wait_us}: they must last at least 1 and 2 cycles"
+            )
         if self.max_echo_cycles < 1:
-            raise ParamError(f"max_range_mm={self.max_range_mm} is shorter than one clock "
-                             f"cycle of echo at clock_hz={self.clock_hz}")
+            raise ParamError(
+                f"max_range_mm={self.max_range_mm} is shorter than one clock "
+                f"cycle of echo at clock_hz={self.clock_hz}"
+            )
         if self.echo_bits is not None:
             self._check("echo_bits", 1, 64)
         # A measurement (echo start by the end of the wait, then at most max_echo_cycles of
@@ -95,7 +98,8 @@ class UltrasoundParams(_Params):
             raise ParamError(
                 f"period_us={self.period_us} is too short: a measurement takes up to "
                 f"trigger_us + wait_us + the longest echo = {needed} cycles of "
-                f"{self.period_cycles} (lengthen period_us or shorten wait_us/max_range_mm)")
+                f"{self.period_cycles} (lengthen period_us or shorten wait_us/max_range_mm)"
+            )
         if self.distance_k < 1:
             raise ParamError(f"clock_hz={self.clock_hz} is too fast for a distance constant")
 
@@ -177,8 +181,10 @@ class InterlockParams(_Params):
         self._check("resume_mm", 1, DISTANCE_NONE - 1)
         _check_bool("release_on_far", self.release_on_far)
         if self.resume_mm < self.stop_mm:
-            raise ParamError(f"resume_mm={self.resume_mm} must be >= stop_mm={self.stop_mm} "
-                             "(no overlap of 'stop' and 'resume')")
+            raise ParamError(
+                f"resume_mm={self.resume_mm} must be >= stop_mm={self.stop_mm} "
+                "(no overlap of 'stop' and 'resume')"
+            )
 
 
 #: The choices of ``FollowLineParams.edge_side``.
@@ -218,20 +224,25 @@ class FollowLineParams(_Params):
         self._check("search_dps", -_INT16_MAX, _INT16_MAX)
         _check_bool("active_high", self.active_high)
         if not isinstance(self.edge_side, str) or self.edge_side not in EDGE_SIDES:
-            raise ParamError(f"edge_side must be one of {', '.join(EDGE_SIDES)}; "
-                             f"got {self.edge_side!r}")
+            raise ParamError(
+                f"edge_side must be one of {', '.join(EDGE_SIDES)}; got {self.edge_side!r}"
+            )
         for name in ("gentle_turn_dps", "sharp_turn_dps"):
             turn = getattr(self, name)
             if abs(self.base_dps) + turn > _INT16_MAX:
-                raise ParamError(f"base_dps +- {name} = {abs(self.base_dps) + turn} does not "
-                                 f"fit a signed 16-bit wheel command (max {_INT16_MAX})")
+                raise ParamError(
+                    f"base_dps +- {name} = {abs(self.base_dps) + turn} does not "
+                    f"fit a signed 16-bit wheel command (max {_INT16_MAX})"
+                )
 
     @classmethod
     def preset(cls, name, **changes):
         """Preset ``name`` (``FOLLOW_LINE_PRESETS``) with ``changes`` on top."""
         if name not in FOLLOW_LINE_PRESETS:
-            raise ParamError(f"unknown follow_line preset {name!r}; known presets: "
-                             f"{', '.join(FOLLOW_LINE_PRESETS)}")
+            raise ParamError(
+                f"unknown follow_line preset {name!r}; known presets: "
+                f"{', '.join(FOLLOW_LINE_PRESETS)}"
+            )
         return cls(**{**FOLLOW_LINE_PRESETS[name][1], **changes})
 
     @classmethod
@@ -243,6 +254,8 @@ class FollowLineParams(_Params):
 #: name -> (description, FollowLineParams values).
 FOLLOW_LINE_PRESETS = {
     "default": ("this project's line follower", {}),
-    "inverted_polarity": ("seeded bug: reads the KY-033 output as low over the line",
-                          {"active_high": False}),
+    "inverted_polarity": (
+        "seeded bug: reads the KY-033 output as low over the line",
+        {"active_high": False},
+    ),
 }

@@ -16,18 +16,20 @@ __all__ = ["FollowTarget", "follow_target_signature"]
 def follow_target_signature(params):
     """The ports of ``follow_target`` (docs/contract.md, Ports) for ``params``; shared with the
     simulation flows' trivial stand-in design, so both drive the same harness."""
-    return wiring.Signature({
-        "pixels": In(pixel_stream_signature()),
-        "color_sel": In(TargetColor),
-        "filtered": Out(pixel_stream_signature()),
-        "frame_done": Out(1),
-        "found": Out(1),
-        "proximity": Out(3),
-        "centroid_x": Out(params.x_bits),
-        "centroid_leds": Out(8),
-        "motor_left": Out(signed(DPS_BITS)),
-        "motor_right": Out(signed(DPS_BITS)),
-    })
+    return wiring.Signature(
+        {
+            "pixels": In(pixel_stream_signature()),
+            "color_sel": In(TargetColor),
+            "filtered": Out(pixel_stream_signature()),
+            "frame_done": Out(1),
+            "found": Out(1),
+            "proximity": Out(3),
+            "centroid_x": Out(params.x_bits),
+            "centroid_leds": Out(8),
+            "motor_left": Out(signed(DPS_BITS)),
+            "motor_right": Out(signed(DPS_BITS)),
+        }
+    )
 
 
 class FollowTarget(wiring.Component):

@@ -71,10 +71,12 @@ class FrameTracker(wiring.Component):
         self.inspect = bool(inspect)
         self.counter = WindowCounter(params)
         self.results = TrackerResults(params, inspect=inspect)
-        super().__init__({
-            "matches": In(match_stream_signature()),
-            **_result_members(params, self.inspect),
-        })
+        super().__init__(
+            {
+                "matches": In(match_stream_signature()),
+                **_result_members(params, self.inspect),
+            }
+        )
 
     @property
     def latency(self):
@@ -102,11 +104,13 @@ def _result_members(p, inspect):
         "centroid_leds": Out(8),
     }
     if inspect:
-        members.update({
-            "count": Out(p.count_bits),
-            "bins": Out(data.ArrayLayout(p.count_bits, 8)),
-            "sum_x": Out(p.sum_x_bits),
-        })
+        members.update(
+            {
+                "count": Out(p.count_bits),
+                "bins": Out(data.ArrayLayout(p.count_bits, 8)),
+                "sum_x": Out(p.sum_x_bits),
+            }
+        )
     return members
 
 
@@ -140,10 +144,12 @@ class TrackerResults(wiring.Component):
             raise TypeError(f"params must be a FollowTargetParams, not {params!r}")
         self.params = params
         self.inspect = bool(inspect)
-        super().__init__({
-            "counts": In(frame_counts_signature(params)),
-            **_result_members(params, self.inspect),
-        })
+        super().__init__(
+            {
+                "counts": In(frame_counts_signature(params)),
+                **_result_members(params, self.inspect),
+            }
+        )
 
     @property
     def latency(self):
@@ -168,7 +174,8 @@ class TrackerResults(wiring.Component):
         # their own, and the next frame may start counting on the very next cycle.
         pending_layout = data.StructLayout({"found": 1, "proximity": 3, "leds": 8})
         m.submodules.divider = div = SequentialDivider(
-            p.sum_x_bits, p.count_bits, p.x_bits + 1, tag_bits=pending_layout.size)
+            p.sum_x_bits, p.count_bits, p.x_bits + 1, tag_bits=pending_layout.size
+        )
 
         def found():  # N >= min_pixels, or N > min_pixels (the published rule)
             if p.found_rule == "gt":
@@ -176,17 +183,21 @@ class TrackerResults(wiring.Component):
             return frame_count() >= p.min_pixels
 
         # The counts the halves and the 2- and 3-bin sums are taken from.
-        groups = _Groups(bins, [counts.edges[k] for k in range(8)]
-                         if p.group_column_offset else None)
+        groups = _Groups(
+            bins, [counts.edges[k] for k in range(8)] if p.group_column_offset else None
+        )
         m.d.comb += [
             div.start.eq(counts.end),
             div.dividend.eq(counts.sum_x),
             div.divisor.eq(frame_count()),
-            load(data.View(pending_layout, div.tag_in),
-                 found=found(),
-                 proximity=sum((frame_count() >= t if t > 0 else Const(1, 1))
-                               for t in p.proximity_thresholds),
-                 leds=_led_code(m, groups, frame_count(), found())),
+            load(
+                data.View(pending_layout, div.tag_in),
+                found=found(),
+                proximity=sum(
+                    (frame_count() >= t if t > 0 else Const(1, 1)) for t in p.proximity_thresholds
+                ),
+                leds=_led_code(m, groups, frame_count(), found()),
+            ),
         ]
         pending = data.View(pending_layout, div.tag)
         with m.If(counts.end):
@@ -200,18 +211,30 @@ class TrackerResults(wiring.Component):
         # --- Outputs, loaded together ----------------------------------------------------------
         # One register, loaded whole (see `fit`): `frame_done` drops after one cycle, the
         # results hold until the next frame's.
-        outputs = Signal(data.StructLayout({
-            "frame_done": 1, "found": 1, "proximity": 3, "centroid_x": p.x_bits,
-            "centroid_leds": 8,
-        }))
-        m.d.comb += [getattr(self, name).eq(getattr(outputs, name))
-                     for name in ("frame_done", "found", "proximity", "centroid_x",
-                                  "centroid_leds")]
+        outputs = Signal(
+            data.StructLayout(
+                {
+                    "frame_done": 1,
+                    "found": 1,
+                    "proximity": 3,
+                    "centroid_x": p.x_bits,
+                    "centroid_leds": 8,
+                }
+            )
+        )
+        m.d.comb += [
+            getattr(self, name).eq(getattr(outputs, name))
+            for name in ("frame_done", "found", "proximity", "centroid_x", "centroid_leds")
+        ]
         with m.If(div.done):
-            m.d.sync += load(outputs, frame_done=1, found=pending.found,
-                             proximity=pending.proximity,
-                             centroid_x=Mux(pending.found, div.quotient[:p.x_bits], 0),
-                             centroid_leds=pending.leds)
+            m.d.sync += load(
+                outputs,
+                frame_done=1,
+                found=pending.found,
+                proximity=pending.proximity,
+                centroid_x=Mux(pending.found, div.quotient[: p.x_bits], 0),
+                centroid_leds=pending.leds,
+            )
         with m.Else():
             m.d.sync += load(outputs, frame_done=0)
         return m
@@ -222,7 +245,7 @@ def _tree_sum(values):
     values = list(values)
     while len(values) > 1:
         pairs = [a + b for a, b in zip(values[0::2], values[1::2])]
-        values = pairs + values[len(pairs) * 2:]
+        values = pairs + values[len(pairs) * 2 :]
     return values[0]
 
 
@@ -246,7 +269,7 @@ class _Groups:
 
     def half(self, a):
         """Groups ``a..a+3``: a balanced tree of the bins."""
-        return self._shifted(_tree_sum(self.bins[a:a + 4]), a, a + 3)
+        return self._shifted(_tree_sum(self.bins[a : a + 4]), a, a + 3)
 
     def from_edge(self, order):
         """Groups ``order[0]``, ``order[0..1]``, ``order[0..2]`` (bins from an edge inwards);

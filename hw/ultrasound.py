@@ -73,13 +73,15 @@ class UltrasoundDriver(CheckedArguments, wiring.Component):
 
     def __init__(self, params=None):
         self.params = params = UltrasoundParams() if params is None else params
-        super().__init__({
-            "trig": Out(1),
-            "echo": In(1),
-            "distance_mm": Out(DISTANCE_BITS),
-            "measured": Out(1),
-            "no_echo": Out(1),
-        })
+        super().__init__(
+            {
+                "trig": Out(1),
+                "echo": In(1),
+                "distance_mm": Out(DISTANCE_BITS),
+                "measured": Out(1),
+                "no_echo": Out(1),
+            }
+        )
 
     def elaborate(self, platform):
         m = Module()
@@ -105,8 +107,12 @@ class UltrasoundDriver(CheckedArguments, wiring.Component):
         m.d.sync += self.measured.eq(0)
 
         def no_echo():
-            m.d.sync += [state.eq(_State.IDLE), self.no_echo.eq(1),
-                         self.distance_mm.eq(DISTANCE_NONE), self.measured.eq(1)]
+            m.d.sync += [
+                state.eq(_State.IDLE),
+                self.no_echo.eq(1),
+                self.distance_mm.eq(DISTANCE_NONE),
+                self.measured.eq(1),
+            ]
 
         with m.Switch(state):
             with m.Case(_State.IDLE), m.If(phase == T):  # the edge at which TRIG falls

@@ -30,50 +30,53 @@ class Variant:
     fails: str
 
 
-VARIANTS = {v.name: v for v in (
-    Variant(
-        name="line_inverted_polarity",
-        design="follow_line",
-        params_type=FollowLineParams,
-        changes=lambda p: {"active_high": False},
-        bug="reads the KY-033 output with the wrong polarity (line = low): every sensor over "
+VARIANTS = {
+    v.name: v
+    for v in (
+        Variant(
+            name="line_inverted_polarity",
+            design="follow_line",
+            params_type=FollowLineParams,
+            changes=lambda p: {"active_high": False},
+            bug="reads the KY-033 output with the wrong polarity (line = low): every sensor over "
             "the bright floor counts as on the line",
-        fails="line_track: time off the line (and laps completed): the robot steers away from "
-              "the line as soon as a sensor crosses it",
-    ),
-    Variant(
-        name="us_echo_inverted",
-        design="follow_target_safe",
-        params_type=UltrasoundParams,
-        changes=lambda p: {"echo_active_high": False},
-        bug="ECHO read with the wrong polarity: the driver times the gap after the echo "
+            fails="line_track: time off the line (and laps completed): the robot steers away from "
+            "the line as soon as a sensor crosses it",
+        ),
+        Variant(
+            name="us_echo_inverted",
+            design="follow_target_safe",
+            params_type=UltrasoundParams,
+            changes=lambda p: {"echo_active_high": False},
+            bug="ECHO read with the wrong polarity: the driver times the gap after the echo "
             "instead of the echo, which outlasts the longest range, so every measurement is "
             "no_echo",
-        fails="obstacle_between: no contact with the box (max_furniture_collisions): the "
-              "interlock never sees the box and the robot drives into it",
-    ),
-    Variant(
-        name="us_echo_counter_narrow",
-        design="follow_target_safe",
-        params_type=UltrasoundParams,
-        changes=lambda p: {"echo_bits": p.full_echo_bits - 1},
-        bug="echo counter one bit too narrow: echoes of 2**(bits-1) cycles or more wrap (at "
+            fails="obstacle_between: no contact with the box (max_furniture_collisions): the "
+            "interlock never sees the box and the robot drives into it",
+        ),
+        Variant(
+            name="us_echo_counter_narrow",
+            design="follow_target_safe",
+            params_type=UltrasoundParams,
+            changes=lambda p: {"echo_bits": p.full_echo_bits - 1},
+            bug="echo counter one bit too narrow: echoes of 2**(bits-1) cycles or more wrap (at "
             "50 MHz surfaces 3.60-4.00 m away read 0-404 mm) and the 38 ms time-out pulse "
             "reads 2920 mm instead of no echo",
-        fails="obstacle_between: following resumes when the box is gone: with the box gone, a "
-              "wall 3.60-3.89 m ahead reads below stop_mm (300 mm) and holds the wheels at 0",
-    ),
-    Variant(
-        name="interlock_latches",
-        design="follow_target_safe",
-        params_type=InterlockParams,
-        changes=lambda p: {"release_on_far": False},
-        bug="the interlock's release is 'no echo AND far' instead of 'no echo OR far': once "
+            fails="obstacle_between: following resumes when the box is gone: with the box gone, a "
+            "wall 3.60-3.89 m ahead reads below stop_mm (300 mm) and holds the wheels at 0",
+        ),
+        Variant(
+            name="interlock_latches",
+            design="follow_target_safe",
+            params_type=InterlockParams,
+            changes=lambda p: {"release_on_far": False},
+            bug="the interlock's release is 'no echo AND far' instead of 'no echo OR far': once "
             "stopped, only an empty view (no echo at all) releases the wheels",
-        fails="obstacle_between: following resumes when the box is gone: the person (or any "
-              "surface within 4 m) keeps answering, so the robot never moves again",
-    ),
-)}
+            fails="obstacle_between: following resumes when the box is gone: the person (or any "
+            "surface within 4 m) keeps answering, so the robot never moves again",
+        ),
+    )
+}
 
 
 def variant_params(name, base=None):
@@ -84,6 +87,7 @@ def variant_params(name, base=None):
     variant = VARIANTS[name]
     base = variant.params_type() if base is None else base
     if not isinstance(base, variant.params_type):
-        raise TypeError(f"variant {name} changes a {variant.params_type.__name__}, "
-                        f"not {type(base).__name__}")
+        raise TypeError(
+            f"variant {name} changes a {variant.params_type.__name__}, not {type(base).__name__}"
+        )
     return base.replace(**variant.changes(base))

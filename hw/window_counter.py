@@ -74,10 +74,12 @@ class WindowCounter(wiring.Component):
         if not isinstance(params, FollowTargetParams):
             raise TypeError(f"params must be a FollowTargetParams, not {params!r}")
         self.params = params
-        super().__init__({
-            "matches": In(match_stream_signature()),
-            "counts": Out(frame_counts_signature(params)),
-        })
+        super().__init__(
+            {
+                "matches": In(match_stream_signature()),
+                "counts": Out(frame_counts_signature(params)),
+            }
+        )
 
     @property
     def latency(self):
@@ -106,7 +108,7 @@ class WindowCounter(wiring.Component):
             # subtractions.
             ww = last_boundary - mx + 1
             if ww & (ww - 1) == 0:
-                return ~(x - mx)[ww.bit_length() - 1:].any()
+                return ~(x - mx)[ww.bit_length() - 1 :].any()
             below = (x - mx)[-1] if mx > 0 else Const(0, 1)
             return ~below & ~(last_boundary - x)[-1]
 
@@ -124,7 +126,7 @@ class WindowCounter(wiring.Component):
         # Framing state for the next pixel of the frame in progress: column, row, and
         # whether the row is inside margin_y.
         position = Signal(p.x_bits + p.y_bits + 1, reset_less=True)
-        x, y = position[:p.x_bits], position[p.x_bits:-1]
+        x, y = position[: p.x_bits], position[p.x_bits : -1]
         row_in = position[-1]
         # Counts: the bins (rotated during a line) and SX; the current bin's accumulator (the
         # matches so far in this bin and line) and the next bin boundary (the last column of a
@@ -136,7 +138,9 @@ class WindowCounter(wiring.Component):
         boundary = Signal(p.x_bits, reset_less=True)
         end = Signal()  # the last pixel of a well-formed frame was just counted
         m.d.comb += [
-            self.counts.bins.eq(bins), self.counts.sum_x.eq(sx), self.counts.end.eq(end),
+            self.counts.bins.eq(bins),
+            self.counts.sum_x.eq(sx),
+            self.counts.end.eq(end),
         ]
         edges = None
         if p.group_column_offset:  # nothing of this at the default
@@ -169,9 +173,11 @@ class WindowCounter(wiring.Component):
                 m.d.sync += active.eq(0)  # abandon the frame until the next `first`
             with m.Elif(last):
                 m.d.sync += [
-                    position.eq(Cat(Const(0, p.x_bits), fit(py + 1, p.y_bits),
-                                    rows_window(py + 1))),
-                    active.eq(py != H - 1), end.eq(py == H - 1),
+                    position.eq(
+                        Cat(Const(0, p.x_bits), fit(py + 1, p.y_bits), rows_window(py + 1))
+                    ),
+                    active.eq(py != H - 1),
+                    end.eq(py == H - 1),
                 ]
             with m.Else():
                 # The next column: one add (the column never carries into the row here), or
@@ -185,8 +191,10 @@ class WindowCounter(wiring.Component):
         with m.If(reload):
             # A `first` is column 0: never a bin's last column, and adds 0 to SX.
             m.d.sync += [
-                bins.eq(0), sx.eq(0),
-                acc.eq(count & shape_ok), boundary.eq(first_boundary),
+                bins.eq(0),
+                sx.eq(0),
+                acc.eq(count & shape_ok),
+                boundary.eq(first_boundary),
             ]
             if edges is not None:
                 m.d.sync += edges.eq(0)
@@ -198,7 +206,8 @@ class WindowCounter(wiring.Component):
                 next_boundary = Mux(boundary == last_boundary, first_boundary, boundary + bw)
                 m.d.sync += [
                     bins.eq(Cat(bins[cb:], fit(bins[:cb] + acc + count, cb))),
-                    acc.eq(0), boundary.eq(next_boundary),
+                    acc.eq(0),
+                    boundary.eq(next_boundary),
                 ]
                 if edges is not None:
                     m.d.sync += edges.eq(Cat(edges[eb:], fit(edges[:eb] + count, eb)))

@@ -20,8 +20,15 @@ from pathlib import Path
 from fpga_robotics.hw.errors import UserError
 
 __all__ = [
-    "OutputPathError", "PendingOutput", "atomic_output", "atomic_path", "check_output_dir", "check_output_path",
-    "default_file_mode", "write_atomic", "write_json_atomic",
+    "OutputPathError",
+    "PendingOutput",
+    "atomic_output",
+    "atomic_path",
+    "check_output_dir",
+    "check_output_path",
+    "default_file_mode",
+    "write_atomic",
+    "write_json_atomic",
 ]
 
 
@@ -48,7 +55,8 @@ def _check_folder(folder, path, what):
     """``folder`` (the nearest existing ancestor of ``path``) must be a writable folder."""
     if not folder.is_dir():
         raise OutputPathError(
-            f"{what} {str(path)!r}: cannot write there, {str(folder)!r} is not a folder")
+            f"{what} {str(path)!r}: cannot write there, {str(folder)!r} is not a folder"
+        )
     try:  # os.access says yes to root even on a read-only file system: try for real
         fd, probe = tempfile.mkstemp(prefix=".write-test-", dir=folder)
         os.close(fd)
@@ -56,7 +64,8 @@ def _check_folder(folder, path, what):
     except OSError as exc:
         raise OutputPathError(
             f"{what} {str(path)!r}: cannot write in {str(folder)!r} ({exc.strerror}); "
-            "choose another place") from None
+            "choose another place"
+        ) from None
 
 
 def check_output_path(path, *, what="output file"):
@@ -76,7 +85,8 @@ def check_output_path(path, *, what="output file"):
         if not stat.S_ISREG(mode):
             raise OutputPathError(
                 f"{what} {str(path)!r} exists and is not a regular file (a device or pipe); "
-                "give a file name")
+                "give a file name"
+            )
     folder = path.parent if path.parent.exists() else _existing_ancestor(path)
     _check_folder(folder, path, what)
     return path
@@ -106,8 +116,9 @@ class PendingOutput:
         self.what = what
         self.path.parent.mkdir(parents=True, exist_ok=True)
         suffix = self.path.suffix if suffix is None else suffix
-        fd, tmp = tempfile.mkstemp(prefix=f".{self.path.stem}.", suffix=f".partial{suffix}",
-                                   dir=self.path.parent)
+        fd, tmp = tempfile.mkstemp(
+            prefix=f".{self.path.stem}.", suffix=f".partial{suffix}", dir=self.path.parent
+        )
         os.close(fd)
         self.tmp = Path(tmp)
 

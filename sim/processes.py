@@ -35,8 +35,15 @@ def run_captured(argv, *, cwd=None, env=None, stdout=subprocess.PIPE, timeout=No
     ``None``). On an exception here (KeyboardInterrupt, a timeout) the child's whole process
     group is ended before the exception goes on.
     """
-    proc = subprocess.Popen([str(a) for a in argv], cwd=cwd, env=env, stdout=stdout,
-                            stderr=subprocess.STDOUT, text=True, start_new_session=True)
+    proc = subprocess.Popen(
+        [str(a) for a in argv],
+        cwd=cwd,
+        env=env,
+        stdout=stdout,
+        stderr=subprocess.STDOUT,
+        text=True,
+        start_new_session=True,
+    )
     try:
         out, _ = proc.communicate(timeout=timeout)
     except BaseException:

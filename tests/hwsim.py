@@ -97,8 +97,9 @@ def lines_schedule(lines, *, line_blank=0, first=True, gaps=None):
         line = list(line)
         for x, pixel in enumerate(line):
             schedule.extend([None] * gaps.get(index, 0))
-            schedule.append(pack_transfer(
-                pixel, first=first and y == 0 and x == 0, last=x == len(line) - 1))
+            schedule.append(
+                pack_transfer(pixel, first=first and y == 0 and x == 0, last=x == len(line) - 1)
+            )
             index += 1
         schedule.extend([None] * line_blank)
     return schedule
@@ -223,8 +224,9 @@ def unpack_lanes(value, lane_bits, count):
 TOP_OUTPUTS = ("found", "proximity", "centroid_x", "centroid_leds", "motor_left", "motor_right")
 
 
-def run_follow_target(dut, frames, color_sels, *, line_blank=0, frame_gap=0, tail=None,
-                      gaps=None, extra_schedule=None):
+def run_follow_target(
+    dut, frames, color_sels, *, line_blank=0, frame_gap=0, tail=None, gaps=None, extra_schedule=None
+):
     """Stream whole frames into a ``FollowTarget`` and trace every port.
 
     ``frames`` are packed RGB444 (H, W) arrays, ``color_sels`` one code per frame (changed in
@@ -237,8 +239,7 @@ def run_follow_target(dut, frames, color_sels, *, line_blank=0, frame_gap=0, tai
     schedule = []
     last_index = []
     for frame, sel in zip(frames, color_sels):
-        part = frame_schedule(frame, line_blank=line_blank,
-                              gaps=gaps)
+        part = frame_schedule(frame, line_blank=line_blank, gaps=gaps)
         part[0] = Step(part[0], [(dut.color_sel, sel)])
         schedule.extend(part)
         last_index.append(len(schedule) - 1 - line_blank)
@@ -263,8 +264,13 @@ def small_params(**changes):
     from fpga_robotics.hw.params import FollowTargetParams
 
     values = {
-        "width": 48, "height": 12, "margin_x": 4, "margin_y": 1, "min_pixels": 8,
-        "proximity_thresholds": (8, 16, 32, 64, 128, 200, 300), "lost_frames": 3,
+        "width": 48,
+        "height": 12,
+        "margin_x": 4,
+        "margin_y": 1,
+        "min_pixels": 8,
+        "proximity_thresholds": (8, 16, 32, 64, 128, 200, 300),
+        "lost_frames": 3,
     }
     values.update(changes)
     return FollowTargetParams(**values)
@@ -279,14 +285,21 @@ def match_flag_offset(name):
 
 def match_transfer(match, first=False, last=False):
     """The ``MatchFlags`` payload with these field values."""
-    return sum(int(bool(v)) << match_flag_offset(name)
-               for name, v in (("match", match), ("first", first), ("last", last)))
+    return sum(
+        int(bool(v)) << match_flag_offset(name)
+        for name, v in (("match", match), ("first", first), ("last", last))
+    )
 
 
 def match_lines_schedule(lines, *, line_blank=0, first=True, gaps=None):
     """Like ``lines_schedule`` for the tracker's match stream; ``lines`` hold bools."""
-    schedule = lines_schedule([[int(bool(v)) for v in line] for line in lines],
-                              line_blank=line_blank, first=first, gaps=gaps)
-    return [None if e is None else match_transfer(e & 1, (e >> FIRST_BIT) & 1,
-                                                  (e >> LAST_BIT) & 1)
-            for e in schedule]
+    schedule = lines_schedule(
+        [[int(bool(v)) for v in line] for line in lines],
+        line_blank=line_blank,
+        first=first,
+        gaps=gaps,
+    )
+    return [
+        None if e is None else match_transfer(e & 1, (e >> FIRST_BIT) & 1, (e >> LAST_BIT) & 1)
+        for e in schedule
+    ]

@@ -20,8 +20,11 @@ def mutant(cls, old, new, **names):
     count = source.count(old)
     if count != 1:
         raise AssertionError(f"{old!r} occurs {count} times in {module.__name__}, not once")
-    namespace = {"__name__": f"{module.__name__}_mutant", "__package__": module.__package__,
-                 **names}
+    namespace = {
+        "__name__": f"{module.__name__}_mutant",
+        "__package__": module.__package__,
+        **names,
+    }
     code = compile(source.replace(old, new), f"<{module.__name__} with a seeded bug>", "exec")
     exec(code, namespace)  # noqa: S102 - our own source, one line changed
     return namespace[cls.__name__]

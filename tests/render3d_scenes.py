@@ -15,7 +15,8 @@ from fpga_robotics.sim.world import World
 
 mujoco_missing = pytest.mark.skipif(
     __import__("importlib").util.find_spec("mujoco") is None,
-    reason='needs the optional install: pip install -e ".[realistic]"')
+    reason='needs the optional install: pip install -e ".[realistic]"',
+)
 
 W, H, HFOV = 160, 120, 1.047
 #: The camera: 1 m from the room's left wall, level, 0.3 m high, looking along +x.

@@ -4,8 +4,13 @@ bit for bit, the wall-clock timing fields excepted (they measure the machine, no
 import numpy as np
 
 #: Summary fields that measure how fast the run went.
-TIMING_FIELDS = ("wall_time_s", "ms_per_frame", "realtime_factor", "cpu_ms_per_frame",
-                 "cycles_per_wall_s")
+TIMING_FIELDS = (
+    "wall_time_s",
+    "ms_per_frame",
+    "realtime_factor",
+    "cpu_ms_per_frame",
+    "cycles_per_wall_s",
+)
 
 
 def assert_same_run(a, b):

@@ -26,8 +26,14 @@ from fpga_robotics.viz import paths as P
 from fpga_robotics.viz.readback import read_rrd
 
 RES = "80x60"
-CHECKS = ("acquired_within_s", "found_min_fraction", "max_off_target_fraction",
-          "max_oscillation_hz", "mean_distance_max_m", "max_person_collisions")
+CHECKS = (
+    "acquired_within_s",
+    "found_min_fraction",
+    "max_off_target_fraction",
+    "max_oscillation_hz",
+    "mean_distance_max_m",
+    "max_person_collisions",
+)
 
 
 class WithoutOutputs:
@@ -74,12 +80,25 @@ def test_the_robot_moves_the_same_and_the_lacking_outputs_are_nan(runs):
 
 def test_metrics_of_absent_outputs_are_none_and_the_rest_unchanged(runs):
     full, part = runs
-    for key in ("found_fraction", "acquired_at_s", "searches", "losses", "off_target_fraction",
-                "mean_centroid_error_px", "oscillation_hz"):
+    for key in (
+        "found_fraction",
+        "acquired_at_s",
+        "searches",
+        "losses",
+        "off_target_fraction",
+        "mean_centroid_error_px",
+        "oscillation_hz",
+    ):
         assert part.summary[key] is None, key
     assert full.summary["found_fraction"] > 0.5
-    for key in ("min_distance_m", "mean_distance_m", "path_length_m", "collisions",
-                "target_in_view_fraction", "max_wheel_command_step_dps"):
+    for key in (
+        "min_distance_m",
+        "mean_distance_m",
+        "path_length_m",
+        "collisions",
+        "target_in_view_fraction",
+        "max_wheel_command_step_dps",
+    ):
         assert part.summary[key] == full.summary[key], key
     # No found/lost events come from a design without `found`.
     assert not any(t in ("target found", "target lost") for _, _, t in part.events)
@@ -89,20 +108,28 @@ def test_metrics_of_absent_outputs_are_none_and_the_rest_unchanged(runs):
 def test_checks_that_need_an_absent_output_are_na_and_left_out_of_the_verdict(runs):
     _, part = runs
     m = {k: part.summary[k] for k in part.summary}
-    limits = {"acquired_within_s": 1.0, "found_min_fraction": 0.9,
-              "max_off_target_fraction": 0.1, "mean_distance_max_m": 0.01}
+    limits = {
+        "acquired_within_s": 1.0,
+        "found_min_fraction": 0.9,
+        "max_off_target_fraction": 0.1,
+        "mean_distance_max_m": 0.01,
+    }
     checks = evaluate_checks(limits, m)
     by = {c["name"]: c for c in checks}
     for name in ("acquired_within_s", "found_min_fraction", "max_off_target_fraction"):
-        assert by[name]["passed"] is None and by[name]["text"].startswith("not measured: the design has no")
+        assert by[name]["passed"] is None and by[name]["text"].startswith(
+            "not measured: the design has no"
+        )
     assert "`found`" in by["acquired_within_s"]["text"]
     # The measurable check still decides: 1 cm mean distance is impossible.
     assert by["mean_distance_max_m"]["passed"] is False
     assert verdict(checks) == "fail"
     # Without it every check set is n/a: no check could judge, which is no pass.
     assert verdict([c for c in checks if c["name"] != "mean_distance_max_m"]) == "n/a"
-    assert verdict([c for c in checks if c["name"] in ("mean_distance_max_m", "acquired_within_s")]
-                   ) == "fail"
+    assert (
+        verdict([c for c in checks if c["name"] in ("mean_distance_max_m", "acquired_within_s")])
+        == "fail"
+    )
     text = format_summary({**part.summary, "checks": checks})
     assert "[n/a] acquired_within_s" in text and "found n/a" in text
     assert "design outputs absent (not produced by the design): found, centroid_x" in text
@@ -110,11 +137,17 @@ def test_checks_that_need_an_absent_output_are_na_and_left_out_of_the_verdict(ru
 
 def test_compute_metrics_by_hand():
     # Three frames: found in the last two; with `found` absent the found metrics are None.
-    traj = {"t": np.array([0.0, 0.1, 0.2]), "x": np.zeros(3), "y": np.array([0.0, 0.3, 0.7]),
-            "heading": np.zeros(3), "target_distance": np.array([2.0, 1.5, 1.0]),
-            "target_in_view": np.array([True, True, False]),
-            "found": np.array([False, True, True]), "motor_left": np.array([0, 40, 10]),
-            "motor_right": np.array([0, -20, 10])}
+    traj = {
+        "t": np.array([0.0, 0.1, 0.2]),
+        "x": np.zeros(3),
+        "y": np.array([0.0, 0.3, 0.7]),
+        "heading": np.zeros(3),
+        "target_distance": np.array([2.0, 1.5, 1.0]),
+        "target_in_view": np.array([True, True, False]),
+        "found": np.array([False, True, True]),
+        "motor_left": np.array([0, 40, 10]),
+        "motor_right": np.array([0, -20, 10]),
+    }
     m = compute_metrics(traj, [], {}, 0.1)
     assert m["acquired_at_s"] == 0.1 and m["found_fraction"] == round(2 / 3, 4)
     assert m["max_wheel_command_step_dps"] == 40  # |0 - 40|
@@ -176,13 +209,30 @@ def test_a_foreign_design_without_found_runs_from_the_command_line(tmp_path, cap
         pytest.skip(f"no Verilator toolchain: {exc}")
     s = load_scenario("follow_person", [f'camera.resolution="{RES}"'])
     (tmp_path / "ft.v").write_text(generate_verilog(s.params))
-    keep = [line for line in follow_target_port_map(s.params).splitlines()
-            if not line.startswith(("found", "centroid", "filtered"))]
+    keep = [
+        line
+        for line in follow_target_port_map(s.params).splitlines()
+        if not line.startswith(("found", "centroid", "filtered"))
+    ]
     (tmp_path / "ft.toml").write_text("\n".join(keep) + "\n")
-    code = run.main(["--scenario", "follow_person", "--resolution", RES, "--duration", "1",
-                     "--design", f"verilog:{tmp_path / 'ft.v'}", "--ports",
-                     str(tmp_path / "ft.toml"), "--rerun", "off",
-                     "--summary", str(tmp_path / "s.json")])
+    code = run.main(
+        [
+            "--scenario",
+            "follow_person",
+            "--resolution",
+            RES,
+            "--duration",
+            "1",
+            "--design",
+            f"verilog:{tmp_path / 'ft.v'}",
+            "--ports",
+            str(tmp_path / "ft.toml"),
+            "--rerun",
+            "off",
+            "--summary",
+            str(tmp_path / "s.json"),
+        ]
+    )
     out = capsys.readouterr().out
     summary = json.loads((tmp_path / "s.json").read_text())
     assert summary["backend"] == "cxxrtl-foreign"  # auto: Yosys reads it

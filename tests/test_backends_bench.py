@@ -97,16 +97,24 @@ class _FakeClock:
 
 def test_summary_takes_the_fraction_from_the_paired_measurement():
     def row(design, ms, rate):
-        return {"backend": "cxxrtl", "design": design, "width": 160, "height": 120,
-                "ms_per_frame": ms, "cycles_per_second": rate}
+        return {
+            "backend": "cxxrtl",
+            "design": design,
+            "width": 160,
+            "height": 120,
+            "ms_per_frame": ms,
+            "cycles_per_second": rate,
+        }
 
     results = [row("follow_target", 0.3, 60e6), row("passthrough", 0.1, 180e6)]
     separate = bench.summary(results)
     assert any("0.33 of the trivial" in line and "MISSED" in line for line in separate)
     paired = [{"backend": "cxxrtl", "width": 160, "height": 120, "fraction": 0.55, "frames": 9}]
     lines = bench.summary(results, paired)
-    assert any("0.55 of the trivial" in line and "alternation" in line and line.endswith("met")
-               for line in lines)
+    assert any(
+        "0.55 of the trivial" in line and "alternation" in line and line.endswith("met")
+        for line in lines
+    )
     assert any("0.3" in line and "<= 0.4 ms: met" in line for line in lines)
 
 
@@ -198,6 +206,9 @@ def test_bad_options_are_usage_errors(argv, message):
 
 def test_published_needs_its_five_files(tmp_path):
     (tmp_path / "design_top.v").write_text("module design_top; endmodule\n")
-    with pytest.raises(UsageError, match=r"no centroid.v, color_proc.v, frame_buffer.v, "
-                                         r"motor_ctrl_spi.v there"):
+    with pytest.raises(
+        UsageError,
+        match=r"no centroid.v, color_proc.v, frame_buffer.v, "
+        r"motor_ctrl_spi.v there",
+    ):
         bench.main(["--published", str(tmp_path), "--backends", "model"])

@@ -120,7 +120,9 @@ def test_sequences_exercise_search_every_proximity_and_colour():
 
 @pytest.mark.parametrize("params", [SMALL_A, SMALL_B], ids=["40x16", "48x24"])
 @pytest.mark.parametrize("blanking", BLANKINGS, ids=["no-blank", "blank"])
-@pytest.mark.parametrize("name", ["pysim", "cxxrtl", pytest.param("verilator", marks=pytest.mark.slow)])
+@pytest.mark.parametrize(
+    "name", ["pysim", "cxxrtl", pytest.param("verilator", marks=pytest.mark.slow)]
+)
 def test_backend_matches_model_frame_by_frame(name, params, blanking):
     if name == "pysim" and not has_pysim():
         pytest.skip("the pysim backend (gateware helper) is not in this tree yet")

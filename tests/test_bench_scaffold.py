@@ -17,9 +17,15 @@ def test_spread_is_median_min_max():
         scaffold.Spread.of([])
 
 
-@pytest.mark.parametrize("text, message", [
-    ("160by120", "WIDTHxHEIGHT"), ("0x120", "1..4096"), ("160x5000", "1..4096"), ("", "empty"),
-])
+@pytest.mark.parametrize(
+    "text, message",
+    [
+        ("160by120", "WIDTHxHEIGHT"),
+        ("0x120", "1..4096"),
+        ("160x5000", "1..4096"),
+        ("", "empty"),
+    ],
+)
 def test_bad_sizes_are_usage_errors(text, message):
     with pytest.raises(UsageError, match=message):
         scaffold.parse_sizes(text)
@@ -31,8 +37,16 @@ def test_sizes():
 
 def test_absolute_times_and_their_ratios():
     figures = {
-        "results": [{"backend": "cxxrtl", "width": 160, "height": 120, "ms_per_frame": 0.5,
-                     "cycles_per_second": 4e7, "frames": 30}],
+        "results": [
+            {
+                "backend": "cxxrtl",
+                "width": 160,
+                "height": 120,
+                "ms_per_frame": 0.5,
+                "cycles_per_second": 4e7,
+                "frames": 30,
+            }
+        ],
         "steps_ms": {"render": 0.25, "physics": 0.125},
         "frame_ms": scaffold.Spread.of([1.0, 2.0, 3.0]),
         "startup_s": 3.0,
@@ -40,7 +54,8 @@ def test_absolute_times_and_their_ratios():
     }
     assert scaffold.absolute_times(figures) == [
         ("results.cxxrtl 160x120.ms_per_frame", 0.5),
-        ("steps_ms.render", 0.25), ("steps_ms.physics", 0.125),
+        ("steps_ms.render", 0.25),
+        ("steps_ms.physics", 0.125),
         ("frame_ms", 2.0),
     ]
     assert [r for _, _, r in scaffold.ratios_to(figures, 0.25)] == [2.0, 1.0, 0.5, 8.0]
@@ -62,11 +77,13 @@ def test_common_options_and_their_checks(tmp_path):
     assert main([]) == 0
     args = runs[-1]
     assert (args.repeats, args.frames, args.min_seconds, args.json) == (3, 10, 1.0, None)
-    for argv, message in [(["--repeats", "0"], "--repeats must be 1..1000"),
-                          (["--frames", "0"], "--frames must be 1..1000000"),
-                          (["--min-seconds", "nan"], "--min-seconds"),
-                          (["--bogus"], "unrecognized arguments: --bogus"),
-                          (["--json", str(tmp_path / "no" / "f.json")], "no directory")]:
+    for argv, message in [
+        (["--repeats", "0"], "--repeats must be 1..1000"),
+        (["--frames", "0"], "--frames must be 1..1000000"),
+        (["--min-seconds", "nan"], "--min-seconds"),
+        (["--bogus"], "unrecognized arguments: --bogus"),
+        (["--json", str(tmp_path / "no" / "f.json")], "no directory"),
+    ]:
         with pytest.raises(UsageError, match=message):
             main(argv)
     assert len(runs) == 1  # a bad option is refused before any measuring
@@ -86,15 +103,20 @@ def test_json_holds_the_figures_and_the_machine(tmp_path, capsys):
 
 
 def test_calibrate_option_prints_each_time_in_calibration_frames(monkeypatch, tmp_path, capsys):
-    reference = {"what": "published preset, test, 160x120", "backend": "test",
-                 "frame_ms": scaffold.Spread.of([0.25, 0.2, 0.3]),
-                 "cpu_ms": scaffold.Spread.of([0.125])}
+    reference = {
+        "what": "published preset, test, 160x120",
+        "backend": "test",
+        "frame_ms": scaffold.Spread.of([0.25, 0.2, 0.3]),
+        "cpu_ms": scaffold.Spread.of([0.125]),
+    }
     monkeypatch.setattr(calibrate, "measure_calibration", lambda **_: reference)
     path = tmp_path / "f.json"
     assert _command([])(["--calibrate", "--json", str(path)]) == 0
     out = capsys.readouterr().out
-    assert ("calibration (published preset, test, 160x120): 0.2500 (0.2000-0.3000) ms/frame, "
-            "CPU 0.1250 (0.1250-0.1250)") in out
+    assert (
+        "calibration (published preset, test, 160x120): 0.2500 (0.2000-0.3000) ms/frame, "
+        "CPU 0.1250 (0.1250-0.1250)"
+    ) in out
     lines = out.splitlines()
     assert lines[-3].split() == ["figure", "time", "x", "calibration"]
     assert lines[-2].split() == ["frame_ms", "0.5", "ms", "2x"]  # 0.5 ms / 0.25 ms
@@ -104,8 +126,12 @@ def test_calibrate_option_prints_each_time_in_calibration_frames(monkeypatch, tm
 
 def test_calibration_on_the_model_backend(tmp_path, capsys):
     path = tmp_path / "c.json"
-    assert calibrate.main(["--backend", "model", "--frames", "2", "--repeats", "3",
-                           "--json", str(path)]) == 0
+    assert (
+        calibrate.main(
+            ["--backend", "model", "--frames", "2", "--repeats", "3", "--json", str(path)]
+        )
+        == 0
+    )
     out = capsys.readouterr().out
     assert "calibration: published preset, model, 160x120, 2 frames x 3 repeats" in out
     cal = json.loads(path.read_text())["figures"]["calibration"]
@@ -132,6 +158,9 @@ def test_every_benchmark_is_a_subcommand_on_the_scaffold(capsys):
         assert "--json PATH" in out and "--calibrate" in out, what
     # The ways in are fpga-robotics bench and python -m fpga_robotics.bench, nothing else.
     folder = Path(scaffold.__file__).parent
-    own = [p.name for p in folder.glob("*.py")
-           if p.name != "__main__.py" and "if __name__ ==" in p.read_text()]
+    own = [
+        p.name
+        for p in folder.glob("*.py")
+        if p.name != "__main__.py" and "if __name__ ==" in p.read_text()
+    ]
     assert not own, f"benchmark modules with a command line of their own: {own}"

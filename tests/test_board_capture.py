@@ -11,15 +11,20 @@ from fpga_robotics.hw.board.ov7670_capture import OV7670Capture
 
 # Blanking (in PCLK cycles) of the simulated camera; small but with every phase present.
 VSYNC_CYCLES = 5
-FRONT_PORCH = 4   # after VSYNC falls, before the first line
-HBLANK = 6        # HREF low between lines
-BACK_PORCH = 5    # after the last line, before the next VSYNC
+FRONT_PORCH = 4  # after VSYNC falls, before the first line
+HBLANK = 6  # HREF low between lines
+BACK_PORCH = 5  # after the last line, before the next VSYNC
 
 
 def camera_frames(seed, width, height, frames):
     rng = random.Random(seed)
-    return [[[(rng.randrange(16), rng.randrange(16), rng.randrange(16)) for _ in range(width)]
-             for _ in range(height)] for _ in range(frames)]
+    return [
+        [
+            [(rng.randrange(16), rng.randrange(16), rng.randrange(16)) for _ in range(width)]
+            for _ in range(height)
+        ]
+        for _ in range(frames)
+    ]
 
 
 def expected_stream(frames, lead_in):
@@ -30,8 +35,9 @@ def expected_stream(frames, lead_in):
     for frame in frames:
         for y, line in enumerate(frame):
             for x, (r, g, b) in enumerate(line):
-                out.append(((r << 8) | (g << 4) | b, int(x == 0 and y == 0),
-                            int(x == len(line) - 1)))
+                out.append(
+                    ((r << 8) | (g << 4) | b, int(x == 0 and y == 0), int(x == len(line) - 1))
+                )
     return out
 
 
@@ -85,8 +91,7 @@ def run_capture(frames, lead_in, *, sync_period, pclk_period, fifo_depth=16, see
             dut.pixels.valid, dut.pixels.payload, dut.overflow
         ):
             if valid:
-                got.append((payload.pixel.as_value().value, int(payload.first),
-                            int(payload.last)))
+                got.append((payload.pixel.as_value().value, int(payload.first), int(payload.last)))
             state["overflow"] |= overflow
 
     sim.add_testbench(camera)
@@ -98,16 +103,18 @@ def run_capture(frames, lead_in, *, sync_period, pclk_period, fifo_depth=16, see
     return got, state["overflow"]
 
 
-@pytest.mark.parametrize("sync_period,pclk_period", [
-    (20e-9, 80e-9),    # 50 MHz design, 12.5 MHz PCLK: the board's worst case
-    (20e-9, 320e-9),   # PCLK divided by 4 (the QQVGA register table)
-    (20e-9, 45e-9),    # PCLK faster than half the design clock, unrelated phase
-])
+@pytest.mark.parametrize(
+    "sync_period,pclk_period",
+    [
+        (20e-9, 80e-9),  # 50 MHz design, 12.5 MHz PCLK: the board's worst case
+        (20e-9, 320e-9),  # PCLK divided by 4 (the QQVGA register table)
+        (20e-9, 45e-9),  # PCLK faster than half the design clock, unrelated phase
+    ],
+)
 def test_capture_yields_exact_framed_stream(sync_period, pclk_period):
     frames = camera_frames(seed=7, width=5, height=3, frames=2)
     lead_in = [(1, 2, 3), (4, 5, 6)]
-    got, overflow = run_capture(frames, lead_in, sync_period=sync_period,
-                                pclk_period=pclk_period)
+    got, overflow = run_capture(frames, lead_in, sync_period=sync_period, pclk_period=pclk_period)
     assert got == expected_stream(frames, lead_in)
     assert overflow == 0
 
@@ -123,8 +130,7 @@ def test_fifo_overflow_is_flagged_and_does_not_hang():
     # A design clock far slower than the pixel rate: the FIFO must overflow, be flagged, and
     # what does come out is a subsequence of the real stream.
     frames = camera_frames(seed=3, width=8, height=4, frames=1)
-    got, overflow = run_capture(frames, [], sync_period=400e-9, pclk_period=20e-9,
-                                fifo_depth=4)
+    got, overflow = run_capture(frames, [], sync_period=400e-9, pclk_period=20e-9, fifo_depth=4)
     assert overflow == 1
     expected = expected_stream(frames, [])
     assert 0 < len(got) < len(expected)

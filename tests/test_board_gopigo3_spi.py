@@ -92,8 +92,12 @@ def test_latest_update_wins_while_busy():
     # the second is overwritten by the third, which is sent after the first.
     updates = [(1500, 10, 20), (1520, 30, 40), (1540, 50, 60)]
     messages, _, _ = run_spi(updates)
-    assert messages[2:] == [dps_message(1, 10), dps_message(2, 20),
-                            dps_message(1, 50), dps_message(2, 60)]
+    assert messages[2:] == [
+        dps_message(1, 10),
+        dps_message(2, 20),
+        dps_message(1, 50),
+        dps_message(2, 60),
+    ]
 
 
 def test_saturation_beyond_int16_ticks():
@@ -108,9 +112,14 @@ def test_custom_limits():
     assert messages == [limits_message(1, 300, 50), limits_message(2, 300, 50)]
 
 
-@pytest.mark.parametrize("kwargs,error", [({"dps_limit": -1}, ValueError),
-                                          ({"power_limit": 101}, ValueError),
-                                          ({"startup_wait": 1.5}, TypeError)])
+@pytest.mark.parametrize(
+    "kwargs,error",
+    [
+        ({"dps_limit": -1}, ValueError),
+        ({"power_limit": 101}, ValueError),
+        ({"startup_wait": 1.5}, TypeError),
+    ],
+)
 def test_bad_arguments(kwargs, error):
     with pytest.raises(error):
         GoPiGo3Motors(half_period=HALF, **kwargs)

@@ -21,8 +21,9 @@ from fpga_robotics.hw.params import FollowTargetParams
 from fpga_robotics.sim.models.follow_target import FollowTargetModel
 
 PARAMS = FollowTargetParams(width=48, height=16)
-TIMING = RobotTiming.from_cycles(xclk_half=2, sccb_quarter=2, spi_half=2, camera_wait=5,
-                                 reset_wait=8000, motor_wait=30)
+TIMING = RobotTiming.from_cycles(
+    xclk_half=2, sccb_quarter=2, spi_half=2, camera_wait=5, reset_wait=8000, motor_wait=30
+)
 # A short table with a long reset wait: the SCCB phase outlasts one camera frame.
 TABLE = [RegisterWrite(0x12, 0x80, "reset", True), RegisterWrite(0x8C, 0x02, "rgb444")]
 HBLANK, VSYNC_CYCLES = 4, 6
@@ -44,15 +45,20 @@ def ticks_bytes(dps):
 
 
 def test_camera_to_gopigo3_matches_golden_model():
-    frames = [red_blob_frame(26, 44, 2, 14, seed=1), red_blob_frame(6, 20, 3, 13, seed=2),
-              red_blob_frame(0, 0, 0, 0, seed=3)]
+    frames = [
+        red_blob_frame(26, 44, 2, 14, seed=1),
+        red_blob_frame(6, 20, 3, 13, seed=2),
+        red_blob_frame(0, 0, 0, 0, seed=3),
+    ]
     model = FollowTargetModel(PARAMS)
     expected_msgs = [[0x08, 0x0F, port, 0, 0x04, 0x00] for port in (1, 2)]
     expected_leds = []
     for frame in frames:
         out = model.process(frame, 0b100)
-        expected_msgs += [[0x08, 0x0E, 1, *ticks_bytes(out.motor_left)],
-                          [0x08, 0x0E, 2, *ticks_bytes(out.motor_right)]]
+        expected_msgs += [
+            [0x08, 0x0E, 1, *ticks_bytes(out.motor_left)],
+            [0x08, 0x0E, 2, *ticks_bytes(out.motor_right)],
+        ]
         expected_leds.append(out.tracker.centroid_leds)
     # The scene must exercise the controller: found on one side, then the other, then lost.
     assert expected_leds[0] != 0 and expected_leds[1] != 0 and expected_leds[2] == 0
@@ -74,8 +80,7 @@ def test_camera_to_gopigo3_matches_golden_model():
         # power-on format); here a whole-red frame that would make the robot back off if it
         # reached the design. It must be ignored.
         assert not ctx.get(core.camera_ready)
-        await send_frame(ctx, np.full((PARAMS.height, PARAMS.width), 0xF00, np.uint16),
-                         blank=0)
+        await send_frame(ctx, np.full((PARAMS.height, PARAMS.width), 0xF00, np.uint16), blank=0)
         assert not ctx.get(core.camera_ready), "the junk frame must fit in the SCCB time"
         while not ctx.get(core.camera_ready):
             await ctx.tick("pclk")
@@ -105,7 +110,8 @@ def test_camera_to_gopigo3_matches_golden_model():
         prev_sclk, prev_cs, prev_xclk, cycle = 0, 0, 0, 0
         current, shift, nbits = [], 0, 0
         async for _clk, _rst, sclk, copi, cs, xclk in ctx.tick("sync").sample(
-                core.spi_sclk, core.spi_copi, core.spi_cs, core.xclk):
+            core.spi_sclk, core.spi_copi, core.spi_cs, core.xclk
+        ):
             cycle += 1
             if cs and not prev_cs:
                 current, shift, nbits = [], 0, 0
@@ -124,8 +130,9 @@ def test_camera_to_gopigo3_matches_golden_model():
     sim.add_process(spi_peripheral)
     bytes_per_frame = PARAMS.height * (2 * PARAMS.width + HBLANK) + VSYNC_CYCLES + 400
     sccb_cycles = TIMING.reset_wait + 1000
-    sim.run_until(((len(frames) + 1) * bytes_per_frame + 200) * 80e-9 * 1.2
-                  + sccb_cycles * 20e-9)  # watchdog
+    sim.run_until(
+        ((len(frames) + 1) * bytes_per_frame + 200) * 80e-9 * 1.2 + sccb_cycles * 20e-9
+    )  # watchdog
     assert state["camera_done"], "the simulated camera did not finish in time"
     assert msgs == expected_msgs
     assert leds_after_frame == expected_leds
@@ -141,21 +148,32 @@ def test_robot_timing_from_clock():
         RobotTiming(60e6)
 
 
-@pytest.mark.parametrize("make", [
-    lambda: ULX3SFollowTarget(FollowTargetParams(width=320, height=240)),
-    lambda: ULX3SFollowTarget(sys_clk_freq=60e6),
-    # Rejected (the GoPiGo3 SPI clock) before FollowTarget is built.
-    lambda: RobotCore(PARAMS, RobotTiming.from_cycles(
-        xclk_half=2, sccb_quarter=2, spi_half=0, camera_wait=5, reset_wait=8, motor_wait=3)),
-    lambda: RobotCore(PARAMS, RobotTiming.from_cycles(
-        xclk_half=0, sccb_quarter=2, spi_half=2, camera_wait=5, reset_wait=8, motor_wait=3)),
-    lambda: RobotCore(PARAMS, TIMING, sccb_table=[]),
-    lambda: SCCBInit(iter(TABLE), quarter_period=2, reset_wait=0),
-    lambda: GoPiGo3Motors(half_period=0),
-    lambda: SPIByteMaster(half_period=1.5),
-    lambda: OV7670Capture(fifo_depth=2),
-    lambda: SequentialDivider(8, 8, 0),
-])
+@pytest.mark.parametrize(
+    "make",
+    [
+        lambda: ULX3SFollowTarget(FollowTargetParams(width=320, height=240)),
+        lambda: ULX3SFollowTarget(sys_clk_freq=60e6),
+        # Rejected (the GoPiGo3 SPI clock) before FollowTarget is built.
+        lambda: RobotCore(
+            PARAMS,
+            RobotTiming.from_cycles(
+                xclk_half=2, sccb_quarter=2, spi_half=0, camera_wait=5, reset_wait=8, motor_wait=3
+            ),
+        ),
+        lambda: RobotCore(
+            PARAMS,
+            RobotTiming.from_cycles(
+                xclk_half=0, sccb_quarter=2, spi_half=2, camera_wait=5, reset_wait=8, motor_wait=3
+            ),
+        ),
+        lambda: RobotCore(PARAMS, TIMING, sccb_table=[]),
+        lambda: SCCBInit(iter(TABLE), quarter_period=2, reset_wait=0),
+        lambda: GoPiGo3Motors(half_period=0),
+        lambda: SPIByteMaster(half_period=1.5),
+        lambda: OV7670Capture(fifo_depth=2),
+        lambda: SequentialDivider(8, 8, 0),
+    ],
+)
 def test_a_rejected_constructor_leaves_no_unused_elaboratable(make):
     # Amaranth reports unused elaboratables only once something has been elaborated.
     Fragment.get(SwitchColorSelect(), None)

@@ -28,11 +28,11 @@ def decode_bus(dut, *, max_cycles):
             oe = ctx.get(dut.siod_oe)
             d = ctx.get(dut.siod_o) if oe else 1  # pull-up when released
             if prev_c and c:
-                if prev_d and not d:      # START
+                if prev_d and not d:  # START
                     assert not in_tx, f"repeated START at cycle {cycle}"
                     in_tx, bits, released, last_rise = True, [], [], None
                     result["starts"].append(cycle)
-                elif not prev_d and d:    # STOP
+                elif not prev_d and d:  # STOP
                     assert in_tx, f"STOP without START at cycle {cycle}"
                     in_tx = False
                     result["stops"].append(cycle)
@@ -40,7 +40,7 @@ def decode_bus(dut, *, max_cycles):
                     assert bits and bits[-1] == 0, "STOP must follow SIOC rising with SIOD low"
                     bits, released = bits[:-1], released[:-1]
                     result["tx"].append((bits, released))
-            if not prev_c and c:          # SIOC rising: the target samples SIOD
+            if not prev_c and c:  # SIOC rising: the target samples SIOD
                 assert in_tx, f"SIOC pulse outside a transmission at cycle {cycle}"
                 bits.append(d)
                 released.append(not oe)
@@ -76,9 +76,12 @@ def check_writes(result, table):
 
 
 def test_ov7670_table_is_sent_in_order():
-    dut = SCCBInit(OV7670_INIT, quarter_period=QUARTER, reset_wait=RESET_WAIT,
-                   startup_wait=STARTUP_WAIT)
-    result = decode_bus(dut, max_cycles=len(OV7670_INIT) * 36 * 4 * QUARTER + RESET_WAIT + STARTUP_WAIT + 100)
+    dut = SCCBInit(
+        OV7670_INIT, quarter_period=QUARTER, reset_wait=RESET_WAIT, startup_wait=STARTUP_WAIT
+    )
+    result = decode_bus(
+        dut, max_cycles=len(OV7670_INIT) * 36 * 4 * QUARTER + RESET_WAIT + STARTUP_WAIT + 100
+    )
     check_writes(result, OV7670_INIT)
     # SIOC period is four quarter periods.
     assert result["rise_periods"] == {4 * QUARTER}
@@ -94,9 +97,9 @@ def test_ov7670_table_is_sent_in_order():
 
 def test_published_register_values_are_in_the_table():
     table = {w.reg: w.value for w in OV7670_INIT[1:]}
-    assert table[0x12] == 0x04   # COM7: RGB
-    assert table[0x8C] == 0x02   # RGB444 enable, xR GB
-    assert table[0x40] == 0xF0   # COM15
+    assert table[0x12] == 0x04  # COM7: RGB
+    assert table[0x8C] == 0x02  # RGB444 enable, xR GB
+    assert table[0x40] == 0xF0  # COM15
     assert table[0x72] == 0x22 and table[0x73] == 0xF2  # QQVGA downsampling, PCLK divider
 
 
@@ -107,12 +110,15 @@ def test_custom_table_and_device_id():
     check_writes(result, table)
 
 
-@pytest.mark.parametrize("kwargs,message", [
-    ({"table": [], "quarter_period": 2, "reset_wait": 0}, "empty"),
-    ({"table": [RegisterWrite(0x100, 0, "")], "quarter_period": 2, "reset_wait": 0}, "a byte"),
-    ({"table": OV7670_INIT, "quarter_period": 0, "reset_wait": 0}, "quarter_period"),
-    ({"table": OV7670_INIT, "quarter_period": 2, "reset_wait": -1}, "reset_wait"),
-])
+@pytest.mark.parametrize(
+    "kwargs,message",
+    [
+        ({"table": [], "quarter_period": 2, "reset_wait": 0}, "empty"),
+        ({"table": [RegisterWrite(0x100, 0, "")], "quarter_period": 2, "reset_wait": 0}, "a byte"),
+        ({"table": OV7670_INIT, "quarter_period": 0, "reset_wait": 0}, "quarter_period"),
+        ({"table": OV7670_INIT, "quarter_period": 2, "reset_wait": -1}, "reset_wait"),
+    ],
+)
 def test_bad_arguments(kwargs, message):
     with pytest.raises(ValueError, match=message):
         SCCBInit(**kwargs)

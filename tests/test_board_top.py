@@ -25,14 +25,23 @@ from fpga_robotics.hw.pixel import TargetColor
 # The published pin assignment (ulx3s_v20.lpf of the published robot), transcribed here
 # independently of hw/board/pins.py.
 PUBLISHED_SITES = {
-    **{f"ov7670_0__data__io[{i}]": s
-       for i, s in enumerate(["B11", "C11", "A10", "A11", "A9", "B10", "B9", "C10"])},
-    "ov7670_0__xclk__io": "A7", "ov7670_0__pclk__io": "A8", "ov7670_0__href__io": "C8",
-    "ov7670_0__vsync__io": "B8", "ov7670_0__siod__io": "H4", "ov7670_0__sioc__io": "G5",
+    **{
+        f"ov7670_0__data__io[{i}]": s
+        for i, s in enumerate(["B11", "C11", "A10", "A11", "A9", "B10", "B9", "C10"])
+    },
+    "ov7670_0__xclk__io": "A7",
+    "ov7670_0__pclk__io": "A8",
+    "ov7670_0__href__io": "C8",
+    "ov7670_0__vsync__io": "B8",
+    "ov7670_0__siod__io": "H4",
+    "ov7670_0__sioc__io": "G5",
     "ov7670_0__reset__io": "C18",
-    "gopigo3_spi_0__cs__io": "C6", "gopigo3_spi_0__clk__io": "C7",
-    "gopigo3_spi_0__cipo__io": "D18", "gopigo3_spi_0__copi__io": "E17",
-    "button_fire_0__io": "R1", "clk25_0__io": "G2",
+    "gopigo3_spi_0__cs__io": "C6",
+    "gopigo3_spi_0__clk__io": "C7",
+    "gopigo3_spi_0__cipo__io": "D18",
+    "gopigo3_spi_0__copi__io": "E17",
+    "button_fire_0__io": "R1",
+    "clk25_0__io": "G2",
     **{f"led_{i}__io": s for i, s in enumerate(["B2", "C2", "C1", "D2", "D1", "E2", "E1", "H3"])},
 }
 
@@ -49,8 +58,12 @@ def test_export_writes_verilog_with_unchanged_follow_target(exported):
     assert re.search(r"^module ulx3s_follow_target\(", text, re.MULTILINE)
     assert "EHXPLLL" in text
     # FollowTarget is inside, as its own module with its filter, tracker and motor blocks.
-    for sub in ("core.design ", "core.design.color_filter ", "core.design.tracker ",
-                "core.design.motor "):
+    for sub in (
+        "core.design ",
+        "core.design.color_filter ",
+        "core.design.tracker ",
+        "core.design.motor ",
+    ):
         assert f"module \\ulx3s_follow_target.{sub}" in text
 
 
@@ -74,10 +87,19 @@ def test_pll_divider_search():
         ecp5_pll_params(25e6, 1e9)
 
 
-@pytest.mark.parametrize("switches,colour", [
-    (0b000, "red"), (0b001, "red"), (0b010, "green"), (0b100, "blue"),
-    (0b011, "yellow"), (0b101, "magenta"), (0b110, "cyan"), (0b111, "white"),
-])
+@pytest.mark.parametrize(
+    "switches,colour",
+    [
+        (0b000, "red"),
+        (0b001, "red"),
+        (0b010, "green"),
+        (0b100, "blue"),
+        (0b011, "yellow"),
+        (0b101, "magenta"),
+        (0b110, "cyan"),
+        (0b111, "white"),
+    ],
+)
 def test_switches_select_colour(switches, colour):
     dut = SwitchColorSelect()
     sim = Simulator(dut)
@@ -96,8 +118,13 @@ def test_switches_select_colour(switches, colour):
 
 
 def test_unknown_board_lists_supported_ones():
-    proc = subprocess.run([sys.executable, "-m", "fpga_robotics.flow.board", "--board", "nope"],
-                          capture_output=True, text=True, timeout=120, check=False)
+    proc = subprocess.run(
+        [sys.executable, "-m", "fpga_robotics.flow.board", "--board", "nope"],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        check=False,
+    )
     assert proc.returncode == 2
     assert "ulx3s-85f" in proc.stderr and "unknown board 'nope'" in proc.stderr
     assert "Traceback" not in proc.stderr
@@ -110,10 +137,15 @@ def test_board_rejects_other_geometries(tmp_path):
 
 
 def test_report_parsing_and_timing_verdict():
-    report = parse_nextpnr_report({
-        "utilization": {"TRELLIS_COMB": {"used": 10, "available": 100}},
-        "fmax": {"a": {"achieved": 49.9, "constraint": 50}, "b": {"achieved": 80, "constraint": 12.5}},
-    })
+    report = parse_nextpnr_report(
+        {
+            "utilization": {"TRELLIS_COMB": {"used": 10, "available": 100}},
+            "fmax": {
+                "a": {"achieved": 49.9, "constraint": 50},
+                "b": {"achieved": 80, "constraint": 12.5},
+            },
+        }
+    )
     assert report.resource("TRELLIS_COMB") == (10, 100)
     assert [c.ok for c in report.clocks] == [False, True]
     assert not report.timing_ok
@@ -138,14 +170,29 @@ def test_bitstream_build_meets_timing(tmp_path):
     """The full open flow on the real board top, through the documented command (about
     2-3 minutes on 2 cores); nothing is cached, the build directory is fresh."""
     proc = subprocess.run(
-        [sys.executable, "-m", "fpga_robotics.export", "--board", "ulx3s-85f", "-o",
-         str(tmp_path), "--bitstream", "--seed", "1"],
-        capture_output=True, text=True, timeout=1200, check=False)
+        [
+            sys.executable,
+            "-m",
+            "fpga_robotics.export",
+            "--board",
+            "ulx3s-85f",
+            "-o",
+            str(tmp_path),
+            "--bitstream",
+            "--seed",
+            "1",
+        ],
+        capture_output=True,
+        text=True,
+        timeout=1200,
+        check=False,
+    )
     print(proc.stdout, proc.stderr)
     assert proc.returncode == 0, proc.stdout + proc.stderr
     assert "PASS" in proc.stdout and "FAIL" not in proc.stdout
     report = parse_nextpnr_report(
-        json.loads((tmp_path / "ulx3s_follow_target.report.json").read_text()))
+        json.loads((tmp_path / "ulx3s_follow_target.report.json").read_text())
+    )
     assert report.timing_ok, report.format()
     assert sorted(c.required_mhz for c in report.clocks) == [12.5, 50.0]
     assert report.resource("TRELLIS_COMB")[0] > 500

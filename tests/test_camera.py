@@ -88,7 +88,13 @@ def reference_render(scene, pose, width, height, hfov=HFOV):
             t = (qx * ey - qy * ex) / den
             sp = (qx * dy - qy * dx) / den
             z = h + t * dz
-            ok = (t > 0) & (sp >= 0) & (sp <= 1) & (z >= 0) & (z <= min(w.height, scene.ceiling_height))
+            ok = (
+                (t > 0)
+                & (sp >= 0)
+                & (sp <= 1)
+                & (z >= 0)
+                & (z <= min(w.height, scene.ceiling_height))
+            )
             n = np.array([ey, -ex]) / math.hypot(ex, ey)
             if n @ np.array([pose.x - w.x0, pose.y - w.y0]) < 0:
                 n = -n
@@ -213,8 +219,12 @@ def test_cylinder_to_the_left_appears_left_where_the_pinhole_puts_it():
     w, h = 160, 120
     f = focal(w)
     angle = 0.3  # left of the heading (counter-clockwise)
-    img = render(scene_of(cylinders=[pillar(3 * math.cos(angle), 3 * math.sin(angle), 0.1)]),
-                 CameraPose(0, 0, 0), w, h)
+    img = render(
+        scene_of(cylinders=[pillar(3 * math.cos(angle), 3 * math.sin(angle), 0.1)]),
+        CameraPose(0, 0, 0),
+        w,
+        h,
+    )
     cols = np.nonzero(is_color(img, RED)[h // 2])[0]
     assert cols.mean() + 0.5 == pytest.approx(w / 2 - f * math.tan(angle), abs=1.0)
     assert cols.max() < w / 2
@@ -260,8 +270,9 @@ def test_tilt_moves_horizon_and_edges(tilt):
     # The horizon (elevation 0) sits at y = H/2 + f * tan(tilt).
     assert np.nonzero(floor)[0].min() == math.ceil(h / 2 + f * math.tan(tilt) - 0.5)
     dist, wall_h, cam_h = 4.0, 1.0, 0.3
-    img = render(scene_of([Wall(dist, -9, dist, 9, wall_h, GREEN)]),
-                 CameraPose(0, 0, 0, cam_h, tilt), w, h)
+    img = render(
+        scene_of([Wall(dist, -9, dist, 9, wall_h, GREEN)]), CameraPose(0, 0, 0, cam_h, tilt), w, h
+    )
     y_top = h / 2 - f * math.tan(math.atan((wall_h - cam_h) / dist) - tilt)
     y_bottom = h / 2 - f * math.tan(math.atan(-cam_h / dist) - tilt)
     top, bottom = first_row(is_color(img[:, w // 2], GREEN))
@@ -275,11 +286,16 @@ def test_person_hides_the_wall_and_the_wall_shows_above_the_head():
     w, h = 160, 120
     f = focal(w)
     cam_h, d_person, d_wall = 0.3, 3.0, 6.0
-    person = Cylinder(d_person, 0.0, 0.2, (
-        Band(0.0, 0.5, BLUE),
-        Band(0.55, 0.9, RED),  # a gap 0.5..0.55 shows what is behind
-        Band(0.9, 1.0, (1.0, 1.0, 0.0)),
-    ))
+    person = Cylinder(
+        d_person,
+        0.0,
+        0.2,
+        (
+            Band(0.0, 0.5, BLUE),
+            Band(0.55, 0.9, RED),  # a gap 0.5..0.55 shows what is behind
+            Band(0.9, 1.0, (1.0, 1.0, 0.0)),
+        ),
+    )
     scene = scene_of([Wall(d_wall, -9, d_wall, 9, 2.5, GREEN)], [person], ceiling_height=2.5)
     img = render(scene, CameraPose(0, 0, 0, cam_h), w, h)
     col = img[:, w // 2]
@@ -290,14 +306,16 @@ def test_person_hides_the_wall_and_the_wall_shows_above_the_head():
     # Above the head: the wall, from its top edge down to the head.
     assert set(range(max(wall_top, 0), head_top)) <= set(green_rows)
     # In front of the person the wall is hidden, except through the gap between the bands.
-    gap = range(math.ceil(h / 2 - f * (0.55 - cam_h) / near - 0.5),
-                math.ceil(h / 2 - f * (0.5 - cam_h) / near - 0.5))
+    gap = range(
+        math.ceil(h / 2 - f * (0.55 - cam_h) / near - 0.5),
+        math.ceil(h / 2 - f * (0.5 - cam_h) / near - 0.5),
+    )
     assert len(gap) >= 1
     assert set(green_rows) - set(range(max(wall_top, 0), head_top)) == set(gap)
     assert is_color(col[head_top], (1.0, 1.0, 0.0))
     # Beside the person the wall is seen all the way down to the floor.
     side = is_color(img[:, 5], GREEN)
-    assert side[head_top:h // 2 + 1].all()
+    assert side[head_top : h // 2 + 1].all()
 
 
 def test_low_divider_in_front_of_the_back_wall():
@@ -313,14 +331,18 @@ def test_low_divider_in_front_of_the_back_wall():
     wall_top = math.ceil(h / 2 - f * (2.5 - cam_h) / d_wall - 0.5)
     assert first_row(is_color(col, wood)) == (div_top, div_bottom)
     assert first_row(is_color(col, GREEN)) == (wall_top, div_top - 1)
-    assert is_color(col[div_bottom + 1:], GREY).all()  # then the floor
+    assert is_color(col[div_bottom + 1 :], GREY).all()  # then the floor
     assert is_color(col[:wall_top], (0.6, 0.6, 0.6)).all()  # and the ceiling above
 
 
 def test_walls_taller_than_the_ceiling_are_cut_by_it():
     w, h = 80, 60
-    img = render(scene_of([Wall(2.0, -9, 2.0, 9, 5.0, GREEN)], ceiling_height=1.0),
-                 CameraPose(0, 0, 0, 0.3), w, h)
+    img = render(
+        scene_of([Wall(2.0, -9, 2.0, 9, 5.0, GREEN)], ceiling_height=1.0),
+        CameraPose(0, 0, 0, 0.3),
+        w,
+        h,
+    )
     top = math.ceil(h / 2 - focal(w) * (1.0 - 0.3) / 2.0 - 0.5)
     assert first_row(is_color(img[:, w // 2], GREEN))[0] == top
     assert is_color(img[:top, w // 2], (0.6, 0.6, 0.6)).all()
@@ -336,10 +358,22 @@ def test_objects_behind_the_camera_are_not_drawn():
 
 def test_doubling_ambient_without_direct_light_doubles_every_pixel():
     scene, pose = random_scene(3)
-    dim = Scene(scene.walls, scene.cylinders, (0.5, 0.4, 0.3), (0.7, 0.6, 0.5), 2.5,
-                Lighting(ambient=0.5, intensity=0.0))
-    bright = Scene(dim.walls, dim.cylinders, dim.floor_color, dim.ceiling_color, 2.5,
-                   Lighting(ambient=1.0, intensity=0.0))
+    dim = Scene(
+        scene.walls,
+        scene.cylinders,
+        (0.5, 0.4, 0.3),
+        (0.7, 0.6, 0.5),
+        2.5,
+        Lighting(ambient=0.5, intensity=0.0),
+    )
+    bright = Scene(
+        dim.walls,
+        dim.cylinders,
+        dim.floor_color,
+        dim.ceiling_color,
+        2.5,
+        Lighting(ambient=1.0, intensity=0.0),
+    )
     a = render(dim, pose, 80, 60).astype(int)
     b = render(bright, pose, 80, 60).astype(int)
     assert np.abs(b - 2 * a).max() <= 1  # rounding of each image only
@@ -362,8 +396,12 @@ def test_surface_facing_the_light_is_brighter_by_the_lambert_term():
 def test_cylinder_shading_follows_its_normal():
     light = Lighting(ambient=0.3, intensity=0.6, direction=(0.0, -1.0, 0.0))  # travels -y
     w, h = 160, 120
-    img = render(scene_of(cylinders=[pillar(2.0, 0.0, 0.4, (1.0, 1.0, 1.0))], lighting=light),
-                 CameraPose(0, 0, 0), w, h).astype(int)
+    img = render(
+        scene_of(cylinders=[pillar(2.0, 0.0, 0.4, (1.0, 1.0, 1.0))], lighting=light),
+        CameraPose(0, 0, 0),
+        w,
+        h,
+    ).astype(int)
     row = img[h // 2 + 5]
     cols = np.nonzero(row[:, 1] > 0.25 * 255)[0]
     cols = cols[(cols > 20) & (cols < 140)]  # the cylinder's silhouette
@@ -390,20 +428,26 @@ def test_red_shirt_of_the_default_person_passes_the_red_filter():
     renderer = CameraRenderer(w, h)
     for k, angle in enumerate(np.linspace(0, 2 * math.pi, 8, endpoint=False)):
         dist = 3.0
-        pose = CameraPose(person.x + dist * math.cos(angle), person.y + dist * math.sin(angle),
-                          angle + math.pi, height=0.3)
+        pose = CameraPose(
+            person.x + dist * math.cos(angle),
+            person.y + dist * math.sin(angle),
+            angle + math.pi,
+            height=0.3,
+        )
         noise = {"noise_std": 2.0, "rng": np.random.default_rng(k)} if k % 2 else {}
         r, g, b = unpack_rgb444(to_rgb444(renderer.render(scene, pose, **noise), w, h))
         red = (r - np.maximum(g, b)) >= 6  # docs/contract.md colour filter, color_sel red, D = 6
         near = dist - person.radius
-        rows = slice(math.ceil(h / 2 - f * (shirt.z1 - 0.3) / near) + 1,
-                     math.ceil(h / 2 - f * (shirt.z0 - 0.3) / near) - 1)
+        rows = slice(
+            math.ceil(h / 2 - f * (shirt.z1 - 0.3) / near) + 1,
+            math.ceil(h / 2 - f * (shirt.z0 - 0.3) / near) - 1,
+        )
         half = f * math.tan(math.asin(person.radius / dist))
         cols = slice(math.ceil(w / 2 - 0.9 * half), math.floor(w / 2 + 0.9 * half))
         assert red[rows, cols].all(), f"shirt not red seen from angle {angle:.2f}"
         # Nothing else in the default room (walls, floor, trousers, skin) passes.
         outside = np.ones_like(red)
-        outside[rows.start - 2:rows.stop + 2, cols.start - 2:cols.stop + 2] = False
+        outside[rows.start - 2 : rows.stop + 2, cols.start - 2 : cols.stop + 2] = False
         assert not red[outside].any()
 
 
@@ -419,8 +463,9 @@ def test_red_filter_of_the_golden_model_agrees():
     # Look at the target from 2.4 m, from the robot's side of it.
     rx, ry, _ = world.robot_pose()
     away = math.atan2(ry - person.y, rx - person.x)
-    pose = CameraPose(person.x + 2.4 * math.cos(away), person.y + 2.4 * math.sin(away),
-                      away + math.pi)
+    pose = CameraPose(
+        person.x + 2.4 * math.cos(away), person.y + 2.4 * math.sin(away), away + math.pi
+    )
     img = render(scene, pose, 160, 120)
     match = model.color_match(to_rgb444(img, 160, 120), COLOR_SELECT["red"], FollowTargetParams())
     r, g, b = unpack_rgb444(to_rgb444(img, 160, 120))
@@ -468,17 +513,27 @@ def test_noise_without_a_generator_is_refused():
         render(scene_of(), CameraPose(0, 0, 0), 16, 12, noise_std=1.0)
 
 
-@pytest.mark.parametrize("args,match", [
-    ((0, 10), "width"), ((10, -1), "height"), ((10, 10, 0.0), "hfov"), ((10, 10, 3.2), "hfov"),
-])
+@pytest.mark.parametrize(
+    "args,match",
+    [
+        ((0, 10), "width"),
+        ((10, -1), "height"),
+        ((10, 10, 0.0), "hfov"),
+        ((10, 10, 3.2), "hfov"),
+    ],
+)
 def test_bad_renderer_arguments(args, match):
     with pytest.raises(ValueError, match=match):
         CameraRenderer(*args)
 
 
-@pytest.mark.parametrize("args,match", [
-    ((10.0, 10), "width must be an int"), ((10, True), "height must be an int"),
-])
+@pytest.mark.parametrize(
+    "args,match",
+    [
+        ((10.0, 10), "width must be an int"),
+        ((10, True), "height must be an int"),
+    ],
+)
 def test_renderer_sizes_must_be_integers(args, match):
     with pytest.raises(TypeError, match=match):
         CameraRenderer(*args)
@@ -520,8 +575,11 @@ def max_tilt_of(w, h, hfov):
 def test_an_hfov_too_wide_for_the_aspect_ratio_is_refused_at_construction():
     # A tall image: the vertical field of view is wider than the horizontal one. The old
     # message asked for |tilt| < -0.019 rad at the first frame.
-    with pytest.raises(ValueError, match=r"at 40x160 gives a vertical field of view of .* "
-                                         r"hfov must be at most 2\.98"):
+    with pytest.raises(
+        ValueError,
+        match=r"at 40x160 gives a vertical field of view of .* "
+        r"hfov must be at most 2\.98",
+    ):
         CameraRenderer(40, 160, 3.0)
     assert CameraRenderer(40, 160, 2.97).max_tilt > 0
     with pytest.raises(ValueError, match="hfov must be at most 3.11"):
@@ -561,17 +619,30 @@ def test_benchmark_cli_prints_a_line_per_size(capsys):
         main(["--sizes", "100000x100000"])
 
 
-@pytest.mark.parametrize("args,message", [
-    (["--sizes", "160by120"],
-     "fpga-robotics bench camera: error: a size is WIDTHxHEIGHT, e.g. 160x120; got '160by120'"),
-    (["--frames", "0"],
-     "fpga-robotics bench camera: error: --frames must be 1..1000000, got 0"),
-    (["--noise", "1e300"],
-     "fpga-robotics bench camera: error: --noise must be a number of 8-bit levels in 0..64, got 1e+300"),
-])
+@pytest.mark.parametrize(
+    "args,message",
+    [
+        (
+            ["--sizes", "160by120"],
+            "fpga-robotics bench camera: error: a size is WIDTHxHEIGHT, e.g. 160x120; got '160by120'",
+        ),
+        (
+            ["--frames", "0"],
+            "fpga-robotics bench camera: error: --frames must be 1..1000000, got 0",
+        ),
+        (
+            ["--noise", "1e300"],
+            "fpga-robotics bench camera: error: --noise must be a number of 8-bit levels in 0..64, got 1e+300",
+        ),
+    ],
+)
 def test_benchmark_command_line_reports_bad_arguments_in_one_line(args, message):
-    proc = subprocess.run([sys.executable, "-m", "fpga_robotics.bench", "camera", *args],
-                          capture_output=True, check=False, text=True)
+    proc = subprocess.run(
+        [sys.executable, "-m", "fpga_robotics.bench", "camera", *args],
+        capture_output=True,
+        check=False,
+        text=True,
+    )
     assert (proc.returncode, proc.stdout) == (2, "")
     assert proc.stderr.splitlines() == [message]
 

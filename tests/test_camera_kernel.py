@@ -58,8 +58,12 @@ def test_compiled_pixels_equal_numpy_in_a_room(size, noise):
 def test_noise_saturates_at_both_ends_like_the_numpy_path():
     # A white wall and a black floor under heavy noise: clipping at 255 and 0 both happen.
     compiled, numpy_path = pair(64, 48)
-    scene = Scene(walls=typical_scene().walls, cylinders=(), floor_color=(0.0, 0.0, 0.0),
-                  ceiling_color=(1.0, 1.0, 1.0))
+    scene = Scene(
+        walls=typical_scene().walls,
+        cylinders=(),
+        floor_color=(0.0, 0.0, 0.0),
+        ceiling_color=(1.0, 1.0, 1.0),
+    )
     pose = CameraPose(4.0, 3.0, 0.3)
     a = compiled.render(scene, pose, noise_std=60.0, rng=np.random.default_rng(1))
     b = numpy_path.render(scene, pose, noise_std=60.0, rng=np.random.default_rng(1))
@@ -69,8 +73,11 @@ def test_noise_saturates_at_both_ends_like_the_numpy_path():
 
 def test_empty_scene_and_tilt_equal_numpy():
     compiled, numpy_path = pair(48, 40)
-    for scene, tilt in ((Scene(walls=(), cylinders=()), 0.0), (typical_scene(), 0.2),
-                        (typical_scene(), -0.3)):
+    for scene, tilt in (
+        (Scene(walls=(), cylinders=()), 0.0),
+        (typical_scene(), 0.2),
+        (typical_scene(), -0.3),
+    ):
         pose = CameraPose(3.0, 2.0, math.pi / 5, height=0.4, tilt=tilt)
         np.testing.assert_array_equal(compiled.render(scene, pose), numpy_path.render(scene, pose))
 
@@ -91,8 +98,7 @@ def test_bad_noise_arguments_are_the_same_errors():
     with pytest.raises(TypeError, match="rng=numpy.random.Generator"):
         compiled.render(typical_scene(), pose, noise_std=2.0)
     with pytest.raises(ValueError, match="finite number"):
-        compiled.render(typical_scene(), pose, noise_std=float("nan"),
-                        rng=np.random.default_rng(0))
+        compiled.render(typical_scene(), pose, noise_std=float("nan"), rng=np.random.default_rng(0))
 
 
 def random_room(rng):
@@ -104,22 +110,31 @@ def random_room(rng):
     for _ in range(int(rng.integers(0, 12))):
         x0, y0 = rng.uniform(-1, 9, 2)
         if rng.random() < 0.2:  # axis-aligned, like most rooms
-            x1, y1 = (x0 + rng.uniform(0.1, 4), y0) if rng.random() < 0.5 else \
-                (x0, y0 + rng.uniform(0.1, 4))
+            x1, y1 = (
+                (x0 + rng.uniform(0.1, 4), y0)
+                if rng.random() < 0.5
+                else (x0, y0 + rng.uniform(0.1, 4))
+            )
         else:
             x1, y1 = rng.uniform(-1, 9, 2)
         walls.append(Wall(x0, y0, x1, y1, rng.uniform(0.2, 3.0), tuple(rng.uniform(0, 1, 3))))
     people = []
     for _ in range(int(rng.integers(0, 5))):
-        bands = tuple(Band(z, z + rng.uniform(0.1, 0.9), tuple(rng.uniform(0, 1, 3)))
-                      for z in np.sort(rng.uniform(0, 1.8, int(rng.integers(0, 4)))))
-        people.append(Cylinder(rng.uniform(0, 8), rng.uniform(0, 6), rng.uniform(0.05, 0.6),
-                               bands))
+        bands = tuple(
+            Band(z, z + rng.uniform(0.1, 0.9), tuple(rng.uniform(0, 1, 3)))
+            for z in np.sort(rng.uniform(0, 1.8, int(rng.integers(0, 4))))
+        )
+        people.append(Cylinder(rng.uniform(0, 8), rng.uniform(0, 6), rng.uniform(0.05, 0.6), bands))
     lighting = Lighting(rng.uniform(0, 1), rng.uniform(0, 1), tuple(rng.uniform(-1, 1, 3)))
     # Mostly level (the compiled layer stage), sometimes tilted (numpy's, after compiled hits).
     tilt = 0.0 if rng.random() < 0.7 else rng.uniform(-0.3, 0.3)
-    pose = CameraPose(rng.uniform(0, 8), rng.uniform(0, 6), rng.uniform(-math.pi, math.pi),
-                      height=rng.uniform(0.1, 2.0), tilt=tilt)
+    pose = CameraPose(
+        rng.uniform(0, 8),
+        rng.uniform(0, 6),
+        rng.uniform(-math.pi, math.pi),
+        height=rng.uniform(0.1, 2.0),
+        tilt=tilt,
+    )
     if people and rng.random() < 0.2:
         pose = CameraPose(people[0].x, people[0].y, pose.heading, height=pose.height)
     return Scene(walls=tuple(walls), cylinders=tuple(people), lighting=lighting), pose
@@ -141,8 +156,7 @@ def test_compiled_stages_equal_numpy_to_the_bit_on_random_rooms(seed, max_layers
         if not len(walls.x0) + len(cyls.band_owner):
             continue
         args = (walls, cyls, pose.x, pose.y, pose.heading, 0.4, 0.7, np.array([0.3, -0.8, -0.5]))
-        for got, want in zip(compiled._hits_compiled(*args), numpy_path._hits(*args),
-                             strict=True):
+        for got, want in zip(compiled._hits_compiled(*args), numpy_path._hits(*args), strict=True):
             np.testing.assert_array_equal(got, want)
 
 
@@ -152,7 +166,8 @@ def test_noise_bits_drawn_in_the_kernel_or_by_numpy_are_the_same(bits):
     # generators' bits come from random_raw. The image and the generator's state agree.
     compiled, numpy_path = pair(64, 48)
     assert (compiled._direct_draw(np.random.Generator(bits(1)))[0] is not None) == (
-        bits is np.random.PCG64)
+        bits is np.random.PCG64
+    )
     rng_a, rng_b = np.random.Generator(bits(9)), np.random.Generator(bits(9))
     for pose in camera_loop(3):
         a = compiled.render(typical_scene(), pose, noise_std=2.5, rng=rng_a)

@@ -21,15 +21,17 @@ def verdict_of(check, limit, **metrics):
     return result["passed"]
 
 
-@pytest.mark.parametrize("check, limit, key, at_limit, beyond", [
-    ("acquired_within_s", 1.0, "acquired_at_s", 1.0, 1.0 + 1e-9),
-    ("mean_distance_max_m", 3.5, "mean_distance_m", 3.5, 3.5 + 1e-9),
-    ("min_distance_min_m", 0.6, "min_distance_m", 0.6, 0.6 - 1e-9),
-    ("target_in_view_min_fraction", 0.9, "target_in_view_fraction", 0.9, 0.9 - 1e-9),
-    ("found_min_fraction", 0.9, "found_after_acquisition_fraction", 0.9, 0.9 - 1e-9),
-])
-def test_a_metric_on_the_limit_passes_and_just_beyond_fails(check, limit, key, at_limit,
-                                                            beyond):
+@pytest.mark.parametrize(
+    "check, limit, key, at_limit, beyond",
+    [
+        ("acquired_within_s", 1.0, "acquired_at_s", 1.0, 1.0 + 1e-9),
+        ("mean_distance_max_m", 3.5, "mean_distance_m", 3.5, 3.5 + 1e-9),
+        ("min_distance_min_m", 0.6, "min_distance_m", 0.6, 0.6 - 1e-9),
+        ("target_in_view_min_fraction", 0.9, "target_in_view_fraction", 0.9, 0.9 - 1e-9),
+        ("found_min_fraction", 0.9, "found_after_acquisition_fraction", 0.9, 0.9 - 1e-9),
+    ],
+)
+def test_a_metric_on_the_limit_passes_and_just_beyond_fails(check, limit, key, at_limit, beyond):
     assert verdict_of(check, limit, **{key: at_limit})
     assert not verdict_of(check, limit, **{key: beyond})
 

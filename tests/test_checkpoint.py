@@ -9,8 +9,7 @@ from fpga_robotics.loop.compressed import ClosedLoop, run_scenario
 from fpga_robotics.scenario.load import load_scenario, shipped_scenarios
 from fpga_robotics.sim.backends.model import ModelBackend
 
-COMPRESSED = [n for n in shipped_scenarios()
-              if load_scenario(n).sim.timing == "compressed"]
+COMPRESSED = [n for n in shipped_scenarios() if load_scenario(n).sim.timing == "compressed"]
 
 
 @pytest.mark.parametrize("name", COMPRESSED)
@@ -22,8 +21,9 @@ def test_restored_run_is_the_uninterrupted_run(name):
     seen = []  # the images the design saw, with the colour select
     with ModelBackend(s.params) as design:
         design.reset()
-        loop = ClosedLoop(s, design=design,
-                          on_frame=lambda r: seen.append((r.camera_rgb, r.color_sel)))
+        loop = ClosedLoop(
+            s, design=design, on_frame=lambda r: seen.append((r.camera_rgb, r.color_sel))
+        )
         middle = loop.n_frames // 2
         for k in range(middle):
             loop.run_frame(k)

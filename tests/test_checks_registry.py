@@ -35,20 +35,44 @@ SMALL = ['camera.resolution="80x60"', "sim.duration=1"]
 
 #: A run every shipped check can judge: the metrics each reads, made up by hand.
 JUDGEABLE = {
-    "acquired_at_s": 0.5, "target_in_view_fraction": 0.95,
-    "found_after_acquisition_fraction": 0.92, "mean_distance_m": 2.0, "min_distance_m": 1.0,
-    "collisions": {"person": 1, "wall": 2, "furniture": 3}, "robot_at_fault_collisions": 1,
-    "tip_overs": 1, "tipped_over_at_s": 3.17, "oscillation_hz": 0.5,
-    "off_target_fraction": 0.05, "mean_centroid_error_px": 1.5, "led_wrong_side_fraction": 0.1,
-    "led_misplaced_fraction": 0.1, "peak_wheel_command_dps": 400, "search_travel_m": 0.05,
-    "heading_overshoot_deg": 3.0, "searched_losses": 1, "searched_reacquisitions": 1,
-    "reacquire_times_s": [2.0], "unrecovered_losses_s": [], "lateral_error_max_m": 0.03,
-    "lateral_error_mean_m": 0.01, "laps": 2, "off_line_s": 0.5, "obstacle_removed_at_s": 12.0,
-    "resumed_after_s": 2.4, "measured_frames": {"front": 30}, "measured_frames_min": 30,
-    "silent_sensors": [], "sensor_kinds": {"front": "ultrasound"}, "absent_outputs": [],
-    "approach_speed_violation_fraction": 0.1, "reverse_when_far_fraction": 0.1,
-    "stop_overshoot_m": 0.05, "turn_law_violation_fraction": 0.1,
-    "search_law_violation_fraction": 0.1, "envelope_reason": None,
+    "acquired_at_s": 0.5,
+    "target_in_view_fraction": 0.95,
+    "found_after_acquisition_fraction": 0.92,
+    "mean_distance_m": 2.0,
+    "min_distance_m": 1.0,
+    "collisions": {"person": 1, "wall": 2, "furniture": 3},
+    "robot_at_fault_collisions": 1,
+    "tip_overs": 1,
+    "tipped_over_at_s": 3.17,
+    "oscillation_hz": 0.5,
+    "off_target_fraction": 0.05,
+    "mean_centroid_error_px": 1.5,
+    "led_wrong_side_fraction": 0.1,
+    "led_misplaced_fraction": 0.1,
+    "peak_wheel_command_dps": 400,
+    "search_travel_m": 0.05,
+    "heading_overshoot_deg": 3.0,
+    "searched_losses": 1,
+    "searched_reacquisitions": 1,
+    "reacquire_times_s": [2.0],
+    "unrecovered_losses_s": [],
+    "lateral_error_max_m": 0.03,
+    "lateral_error_mean_m": 0.01,
+    "laps": 2,
+    "off_line_s": 0.5,
+    "obstacle_removed_at_s": 12.0,
+    "resumed_after_s": 2.4,
+    "measured_frames": {"front": 30},
+    "measured_frames_min": 30,
+    "silent_sensors": [],
+    "sensor_kinds": {"front": "ultrasound"},
+    "absent_outputs": [],
+    "approach_speed_violation_fraction": 0.1,
+    "reverse_when_far_fraction": 0.1,
+    "stop_overshoot_m": 0.05,
+    "turn_law_violation_fraction": 0.1,
+    "search_law_violation_fraction": 0.1,
+    "envelope_reason": None,
 }
 
 _IN_VIEW = "the target was never found"
@@ -56,54 +80,118 @@ _NO_LINE = "not measured: the run has no floor line or no line sensors"
 #: Checks with a precondition: name -> (a limit the JUDGEABLE run passes, one it fails, the
 #: metrics that leave the check nothing to judge, the reason it then gives).
 JUDGED_IF = {
-    "acquired_within_s": (0.5, 0.4, {"target_in_view_fraction": 0, "acquired_at_s": None},
-                          "the target was never in view"),
-    "found_min_fraction": (0.92, 0.93, {"target_in_view_fraction": 0},
-                           "the target was never in view"),
+    "acquired_within_s": (
+        0.5,
+        0.4,
+        {"target_in_view_fraction": 0, "acquired_at_s": None},
+        "the target was never in view",
+    ),
+    "found_min_fraction": (
+        0.92,
+        0.93,
+        {"target_in_view_fraction": 0},
+        "the target was never in view",
+    ),
     "max_oscillation_hz": (0.5, 0.4, {"oscillation_hz": None}, "the target was never centred"),
-    "max_off_target_fraction": (0.05, 0.04, {"off_target_fraction": None},
-                                "the design never reported the target found with it in view"),
-    "mean_centroid_error_max_px": (1.5, 1.4, {"mean_centroid_error_px": None},
-                                   "the design never reported the target found with it in view"),
-    "max_led_wrong_side_fraction": (0.1, 0.09, {"led_wrong_side_fraction": None},
-                                    "the target was never found to one side or at the centre"),
-    "max_led_misplaced_fraction": (0.1, 0.09, {"led_misplaced_fraction": None},
-                                   "the target was never found inside the window"),
+    "max_off_target_fraction": (
+        0.05,
+        0.04,
+        {"off_target_fraction": None},
+        "the design never reported the target found with it in view",
+    ),
+    "mean_centroid_error_max_px": (
+        1.5,
+        1.4,
+        {"mean_centroid_error_px": None},
+        "the design never reported the target found with it in view",
+    ),
+    "max_led_wrong_side_fraction": (
+        0.1,
+        0.09,
+        {"led_wrong_side_fraction": None},
+        "the target was never found to one side or at the centre",
+    ),
+    "max_led_misplaced_fraction": (
+        0.1,
+        0.09,
+        {"led_misplaced_fraction": None},
+        "the target was never found inside the window",
+    ),
     "max_wheel_command_dps": (400, 399, {"peak_wheel_command_dps": None}, "no wheel command"),
     "max_search_travel_m": (0.05, 0.04, {"search_travel_m": None}, "the design never searched"),
-    "max_heading_overshoot_deg": (3.0, 2.9, {"heading_overshoot_deg": None},
-                                  "no heading to compare"),
-    "reacquired_within_s": (2.0, 1.9, {"searched_losses": 0, "searched_reacquisitions": 0,
-                                       "reacquire_times_s": [0.3]},
-                            "the target was never lost long enough for the design to search"),
+    "max_heading_overshoot_deg": (
+        3.0,
+        2.9,
+        {"heading_overshoot_deg": None},
+        "no heading to compare",
+    ),
+    "reacquired_within_s": (
+        2.0,
+        1.9,
+        {"searched_losses": 0, "searched_reacquisitions": 0, "reacquire_times_s": [0.3]},
+        "the target was never lost long enough for the design to search",
+    ),
     "max_lateral_error_m": (0.03, 0.02, {"lateral_error_max_m": None}, _NO_LINE),
     "min_laps": (2, 3, {"laps": None}, _NO_LINE),
     "max_off_line_s": (0.5, 0.4, {"off_line_s": None}, _NO_LINE),
-    "resumes_within_s": (2.4, 2.3, {"obstacle_removed_at_s": None, "resumed_after_s": None},
-                         ("no furniture was removed during the run "
-                          "(room.furniture.present_until)")),
-    "min_measured_frames": (30, 31, {"measured_frames": {}, "measured_frames_min": None,
-                                     "silent_sensors": [], "sensor_kinds": {}},
-                            "the robot has no sensor that measures ([[robot.sensors]])"),
+    "resumes_within_s": (
+        2.4,
+        2.3,
+        {"obstacle_removed_at_s": None, "resumed_after_s": None},
+        ("no furniture was removed during the run (room.furniture.present_until)"),
+    ),
+    "min_measured_frames": (
+        30,
+        31,
+        {
+            "measured_frames": {},
+            "measured_frames_min": None,
+            "silent_sensors": [],
+            "sensor_kinds": {},
+        },
+        "the robot has no sensor that measures ([[robot.sensors]])",
+    ),
     "max_approach_speed_violation_fraction": (
-        0.1, 0.09, {"approach_speed_violation_fraction": None},
-        "the target was never found centred and wholly in the window"),
+        0.1,
+        0.09,
+        {"approach_speed_violation_fraction": None},
+        "the target was never found centred and wholly in the window",
+    ),
     "max_reverse_when_far_fraction": (
-        0.1, 0.09, {"reverse_when_far_fraction": None},
-        "the target was never found beyond the reversing distance"),
-    "max_stop_overshoot_m": (0.05, 0.04, {"stop_overshoot_m": None},
-                             "the robot never came near the stop distance"),
-    "max_turn_law_violation_fraction": (0.1, 0.09, {"turn_law_violation_fraction": None},
-                                        "the target was never found wholly in the window"),
-    "max_search_law_violation_fraction": (0.1, 0.09, {"search_law_violation_fraction": None},
-                                          "the target was never lost"),
+        0.1,
+        0.09,
+        {"reverse_when_far_fraction": None},
+        "the target was never found beyond the reversing distance",
+    ),
+    "max_stop_overshoot_m": (
+        0.05,
+        0.04,
+        {"stop_overshoot_m": None},
+        "the robot never came near the stop distance",
+    ),
+    "max_turn_law_violation_fraction": (
+        0.1,
+        0.09,
+        {"turn_law_violation_fraction": None},
+        "the target was never found wholly in the window",
+    ),
+    "max_search_law_violation_fraction": (
+        0.1,
+        0.09,
+        {"search_law_violation_fraction": None},
+        "the target was never lost",
+    ),
 }
 #: Checks that always judge: name -> (a limit the JUDGEABLE run passes, one it fails).
 ALWAYS_JUDGED = {
-    "mean_distance_max_m": (2.0, 1.9), "min_distance_min_m": (1.0, 1.1),
-    "max_person_collisions": (1, 0), "max_wall_collisions": (2, 1),
-    "max_furniture_collisions": (3, 2), "max_robot_at_fault_collisions": (1, 0),
-    "max_tip_overs": (1, 0), "target_in_view_min_fraction": (0.95, 0.96),
+    "mean_distance_max_m": (2.0, 1.9),
+    "min_distance_min_m": (1.0, 1.1),
+    "max_person_collisions": (1, 0),
+    "max_wall_collisions": (2, 1),
+    "max_furniture_collisions": (3, 2),
+    "max_robot_at_fault_collisions": (1, 0),
+    "max_tip_overs": (1, 0),
+    "target_in_view_min_fraction": (0.95, 0.96),
 }
 #: Metrics that leave every check with a precondition nothing to judge.
 NOTHING_TO_JUDGE = {**JUDGEABLE}
@@ -119,7 +207,7 @@ def _one(name, limit, metrics):
 def test_every_shipped_check_is_registered_once_and_covered_here():
     names = [c.name for c in SHIPPED_CHECKS]
     assert len(names) == len(set(names))
-    assert names == check_names()[:len(names)]
+    assert names == check_names()[: len(names)]
     assert set(names) == set(JUDGED_IF) | set(ALWAYS_JUDGED)
     assert not set(JUDGED_IF) & set(ALWAYS_JUDGED)
     for c in SHIPPED_CHECKS:
@@ -157,8 +245,13 @@ def test_a_design_lacking_an_output_makes_its_checks_na(check):
 
 def test_failures_keep_their_reasons_apart_from_na():
     # Found never, though in view: acquisition fails (not n/a); a search that never ended fails.
-    m = {**JUDGEABLE, "acquired_at_s": None, "searched_reacquisitions": 0,
-         "reacquire_times_s": [], "unrecovered_losses_s": [0.5]}
+    m = {
+        **JUDGEABLE,
+        "acquired_at_s": None,
+        "searched_reacquisitions": 0,
+        "reacquire_times_s": [],
+        "unrecovered_losses_s": [0.5],
+    }
     c = _one("acquired_within_s", 1.0, m)
     assert c["status"] == "fail" and c["text"] == _IN_VIEW
     c = _one("reacquired_within_s", 4.0, m)
@@ -167,8 +260,12 @@ def test_failures_keep_their_reasons_apart_from_na():
     c = _one("resumes_within_s", 3.0, {**JUDGEABLE, "resumed_after_s": None})
     assert c["status"] == "fail" and "never closed 0.2 m" in c["text"]
     # A silent sensor fails min_measured_frames, naming it.
-    silent = {**JUDGEABLE, "measured_frames": {"front": 0}, "measured_frames_min": 0,
-              "silent_sensors": ["front"]}
+    silent = {
+        **JUDGEABLE,
+        "measured_frames": {"front": 0},
+        "measured_frames_min": 0,
+        "silent_sensors": ["front"],
+    }
     c = _one("min_measured_frames", 1, silent)
     assert c["status"] == "fail" and c["text"].startswith("no measurement at all from front")
 
@@ -185,9 +282,11 @@ def test_the_verdict():
 
 def test_measurement_counts_by_hand():
     nan = np.nan
-    columns = {"front.echo_m": np.array([nan, nan, 0.5, 0.6]),
-               "front.range_m": np.array([nan, nan, nan, 0.6]),
-               "bump.pressed": np.array([0.0, 0.0, 1.0, 0.0])}
+    columns = {
+        "front.echo_m": np.array([nan, nan, 0.5, 0.6]),
+        "front.range_m": np.array([nan, nan, nan, 0.6]),
+        "bump.pressed": np.array([0.0, 0.0, 1.0, 0.0]),
+    }
     sensors = [("front", "ultrasound"), ("bump", "bumper"), ("rear", "ultrasound")]
     # Three frames done: front measured in frame 2 only; the fourth row is not counted.
     m = measurement_metrics(columns, sensors, 3)
@@ -202,10 +301,14 @@ def test_measurement_counts_by_hand():
 def ultrasound_check():
     """A user's check that reads the ultrasound: n/a when no ultrasound measured."""
     check = register_check(
-        name="min_distance_ranged_m", metric="min_distance_m", compare="min",
+        name="min_distance_ranged_m",
+        metric="min_distance_m",
+        compare="min",
         meaning="closest robot-to-target distance, on runs in which the ultrasound ranged",
         message=lambda v, limit, m: f"min distance {v} m (limit >= {limit} m)",
-        limits=(0, 1000, "m"), sensors=("ultrasound",))
+        limits=(0, 1000, "m"),
+        sensors=("ultrasound",),
+    )
     yield check
     unregister_check(check.name)
 
@@ -221,17 +324,37 @@ def test_a_check_reading_a_silent_sensor_is_na(ultrasound_check):
 
 
 def _summary(m, checks, **extra):
-    return {"scenario": "x", "backend": "model", "resolution": "40x24", "seed": 0,
-            "frames": 30, "sim_time_s": 1.0, "wall_time_s": 0.5, "ms_per_frame": 16.0,
-            "realtime_factor": 2.0, "found_fraction": 1.0, "searches": 0, "path_length_m": 0.5,
-            **m, "checks": checks, "verdict": verdict(checks), **extra}
+    return {
+        "scenario": "x",
+        "backend": "model",
+        "resolution": "40x24",
+        "seed": 0,
+        "frames": 30,
+        "sim_time_s": 1.0,
+        "wall_time_s": 0.5,
+        "ms_per_frame": 16.0,
+        "realtime_factor": 2.0,
+        "found_fraction": 1.0,
+        "searches": 0,
+        "path_length_m": 0.5,
+        **m,
+        "checks": checks,
+        "verdict": verdict(checks),
+        **extra,
+    }
 
 
 def test_the_printed_summary_shows_na_the_warning_and_the_na_verdict(ultrasound_check):
-    silent = {**JUDGEABLE, "measured_frames": {"front": 0}, "measured_frames_min": 0,
-              "silent_sensors": ["front"]}
-    checks = evaluate_checks({ultrasound_check.name: 0.5, "max_search_travel_m": 0.1},
-                             {**silent, "search_travel_m": None})
+    silent = {
+        **JUDGEABLE,
+        "measured_frames": {"front": 0},
+        "measured_frames_min": 0,
+        "silent_sensors": ["front"],
+    }
+    checks = evaluate_checks(
+        {ultrasound_check.name: 0.5, "max_search_travel_m": 0.1},
+        {**silent, "search_travel_m": None},
+    )
     text = format_summary(_summary(silent, checks))
     assert "  warning: no measurement at all from sensor(s) front" in text
     assert f"  [n/a] {ultrasound_check.name}: no ultrasound measurement arrived" in text
@@ -254,14 +377,33 @@ def _cli(argv, capsys):
 
 def test_a_run_no_check_could_judge_is_na_in_the_json_and_exits_1(tmp_path, capsys):
     path = tmp_path / "s.json"
-    code, out, err = _cli(["--backend", "model", "--resolution", "80x60", "--duration", "1",
-                           "--rerun", "off", "--quiet", "--summary", str(path),
-                           "--set", "checks={max_search_travel_m = 0.1}"], capsys)
+    code, out, err = _cli(
+        [
+            "--backend",
+            "model",
+            "--resolution",
+            "80x60",
+            "--duration",
+            "1",
+            "--rerun",
+            "off",
+            "--quiet",
+            "--summary",
+            str(path),
+            "--set",
+            "checks={max_search_travel_m = 0.1}",
+        ],
+        capsys,
+    )
     s = json.loads(path.read_text())
     assert s["searches"] == 0  # the design found the person at once and never searched
     (c,) = s["checks"]
     assert (c["name"], c["status"], c["passed"], c["reason"]) == (
-        "max_search_travel_m", "n/a", None, "the design never searched")
+        "max_search_travel_m",
+        "n/a",
+        None,
+        "the design never searched",
+    )
     assert s["verdict"] == "n/a" and code == 1, err
     assert "[n/a] max_search_travel_m: the design never searched" in out
     assert "verdict: N/A (no check could judge this run)" in out
@@ -274,7 +416,8 @@ def test_lost_target_on_a_gopigo3_passes_on_the_checks_that_can_judge():
     assert r.summary["searched_losses"] == 0
     assert by["reacquired_within_s"]["status"] == "n/a"
     assert by["reacquired_within_s"]["reason"] == (
-        "the target was never lost long enough for the design to search")
+        "the target was never lost long enough for the design to search"
+    )
     assert all(c["status"] == "pass" for n, c in by.items() if n != "reacquired_within_s")
     assert r.summary["verdict"] == "pass"
 
@@ -287,12 +430,16 @@ def _row(summary, seed, overrides=(("design.diff_min", 6),)):
 
 def _campaign_rows():
     m = {**JUDGEABLE, "search_travel_m": None, "collisions": {"person": 1}}
-    failing = evaluate_checks({"max_person_collisions": 0, "max_search_travel_m": 0.1,
-                               "acquired_within_s": 1.0}, m)
+    failing = evaluate_checks(
+        {"max_person_collisions": 0, "max_search_travel_m": 0.1, "acquired_within_s": 1.0}, m
+    )
     unjudged = evaluate_checks({"max_search_travel_m": 0.1}, m)
     passing = evaluate_checks({"acquired_within_s": 1.0}, m)
-    return [_row(_summary(m, failing), 0), _row(_summary(m, unjudged), 1),
-            _row(_summary(m, passing), 2)]
+    return [
+        _row(_summary(m, failing), 0),
+        _row(_summary(m, unjudged), 1),
+        _row(_summary(m, passing), 2),
+    ]
 
 
 def test_campaign_rows_keep_failed_and_na_checks_apart(tmp_path):
@@ -317,11 +464,14 @@ def test_campaign_rows_keep_failed_and_na_checks_apart(tmp_path):
 def test_the_campaign_report_lists_na_checks_with_their_reasons(tmp_path):
     rows = _campaign_rows()
     text = format_report(rows, ["design.diff_min"])
-    assert text.splitlines()[0] == ("3 runs: 1 pass, 1 fail, 1 n/a, 0 error, 0 timeout "
-                                    "(pass rate 33%)")
+    assert text.splitlines()[0] == (
+        "3 runs: 1 pass, 1 fail, 1 n/a, 0 error, 0 timeout (pass rate 33%)"
+    )
     assert "  max_person_collisions: 1 run(s)" in text and "  n/a: 1 run(s)" in text
-    assert ("  max_search_travel_m: 2 run(s): the design never searched" in text.split(
-        "checks that could not judge (n/a; not counted as pass or fail):")[1])
+    assert (
+        "  max_search_travel_m: 2 run(s): the design never searched"
+        in text.split("checks that could not judge (n/a; not counted as pass or fail):")[1]
+    )
     path = tmp_path / "report.html"
     write_html(path, rows, ["design.diff_min"], {"name": "t"})
     page = path.read_text()
@@ -355,33 +505,45 @@ def test_the_docs_table_lists_exactly_the_registered_checks():
 @pytest.fixture
 def path_check():
     """A check declared through the registry only."""
-    check = register_check(Check(
-        name="max_path_length_m", metric="path_length_m", compare="max",
-        meaning="the robot drives at most this far",
-        message=lambda v, limit, m: f"drove {v:.2f} m (limit <= {limit} m)",
-        limits=(0, 1000, "m"),
-        precondition=lambda m: "the robot never moved" if not m["path_length_m"] else None))
+    check = register_check(
+        Check(
+            name="max_path_length_m",
+            metric="path_length_m",
+            compare="max",
+            meaning="the robot drives at most this far",
+            message=lambda v, limit, m: f"drove {v:.2f} m (limit <= {limit} m)",
+            limits=(0, 1000, "m"),
+            precondition=lambda m: "the robot never moved" if not m["path_length_m"] else None,
+        )
+    )
     yield check
     unregister_check(check.name)
 
 
 def test_a_check_declared_through_the_registry_shows_everywhere(path_check):
-    assert CHECKS["max_path_length_m"] == (float, (0, 1000, "m"),
-                                           "the robot drives at most this far")
-    with pytest.raises(ScenarioError, match=r"checks.max_path_length_m must be a number in "
-                                            r"0..1000 m, got -1"):
+    assert CHECKS["max_path_length_m"] == (
+        float,
+        (0, 1000, "m"),
+        "the robot drives at most this far",
+    )
+    with pytest.raises(
+        ScenarioError,
+        match=r"checks.max_path_length_m must be a number in "
+        r"0..1000 m, got -1",
+    ):
         load_scenario("follow_person", [*SMALL, "checks.max_path_length_m=-1"])
     s = load_scenario("follow_person", [*SMALL, "checks={max_path_length_m = 100.0}"])
     r = run_scenario(s, backend="model")
     (c,) = r.summary["checks"]
     path = r.summary["path_length_m"]
-    assert path > 0 and (c["name"], c["status"], c["value"]) == ("max_path_length_m", "pass",
-                                                                 path)
+    assert path > 0 and (c["name"], c["status"], c["value"]) == ("max_path_length_m", "pass", path)
     assert f"[ok] max_path_length_m: drove {path:.2f} m (limit <= 100.0 m)" in format_summary(
-        r.summary)
+        r.summary
+    )
     # Its precondition: a robot that never moved gives it nothing to judge.
     assert _one("max_path_length_m", 1.0, {**r.summary, "path_length_m": 0.0})["reason"] == (
-        "the robot never moved")
+        "the robot never moved"
+    )
     row = _row(r.summary, 0)
     assert row["check_max_path_length_m"] is True and row["status"] == "pass"
     # The docs' table of checks does not list it: the docs test names it.
@@ -399,28 +561,40 @@ def test_the_loader_checks_the_new_key():
 
 def test_a_declaration_is_checked():
     def make(**over):
-        return Check(**{"name": "x_max", "metric": "x", "compare": "max", "meaning": "m",
-                        "message": str, **over})
+        return Check(
+            **{
+                "name": "x_max",
+                "metric": "x",
+                "compare": "max",
+                "meaning": "m",
+                "message": str,
+                **over,
+            }
+        )
 
-    for bad, message in (({"compare": "below"}, "compare must be one of"),
-                         ({"outputs": ("wheels",)}, "unknown design output"),
-                         ({"name": "not a name"}, "must be an identifier"),
-                         ({"kind": str}, "kind must be int or float")):
+    for bad, message in (
+        ({"compare": "below"}, "compare must be one of"),
+        ({"outputs": ("wheels",)}, "unknown design output"),
+        ({"name": "not a name"}, "must be an identifier"),
+        ({"kind": str}, "kind must be int or float"),
+    ):
         with pytest.raises(ValueError, match=message):
             make(**bad)
 
 
 def test_a_silent_ultrasound_warns_makes_its_checks_na_and_fails_min_measured_frames(
-        ultrasound_check, capsys):
+    ultrasound_check, capsys
+):
     """A real-clock run too short for any echo (one frame, captured before the first TRIG
     pulse's echo ended): the HC-SR04 connector reports nothing."""
     from fpga_robotics.sim.backends import BackendError, available_backends
 
     if "cxxrtl" not in available_backends():
         pytest.skip("no C++ compiler here: no real-clock backend")
-    s = load_scenario("obstacle_between", [
-        "sim.duration=0.02",
-        f"checks={{min_measured_frames = 1, {ultrasound_check.name} = 0.5}}"])
+    s = load_scenario(
+        "obstacle_between",
+        ["sim.duration=0.02", f"checks={{min_measured_frames = 1, {ultrasound_check.name} = 0.5}}"],
+    )
     try:
         r = run_scenario(s, backend="cxxrtl")
     except BackendError as exc:
@@ -438,4 +612,5 @@ def test_a_silent_ultrasound_warns_makes_its_checks_na_and_fails_min_measured_fr
     only = evaluate_checks({ultrasound_check.name: 0.5}, summary)
     assert verdict(only) == "n/a"
     assert format_summary({**summary, "checks": only, "verdict": verdict(only)}).endswith(
-        "verdict: N/A (no check could judge this run)")
+        "verdict: N/A (no check could judge this run)"
+    )

@@ -10,19 +10,22 @@ import pytest
 from fpga_robotics import cli
 
 
-@pytest.mark.parametrize("argv, prog", [
-    (["run", "--help"], "fpga-robotics run"),
-    (["export", "--help"], "fpga-robotics export"),
-    (["board", "--help"], "fpga-robotics board"),
-    (["bench", "--help"], "fpga-robotics bench design"),
-    (["bench", "design", "--help"], "fpga-robotics bench design"),
-    (["bench", "pysim", "--help"], "fpga-robotics bench pysim"),
-    (["bench", "camera", "--help"], "fpga-robotics bench camera"),
-    (["bench", "world", "--help"], "fpga-robotics bench world"),
-    (["bench", "viewer", "--help"], "fpga-robotics bench viewer"),
-    (["bench", "shadow", "--help"], "fpga-robotics bench shadow"),
-    *[([name, "--help"], f"fpga-robotics {name}") for name in cli.COMMANDS if name != "bench"],
-])
+@pytest.mark.parametrize(
+    "argv, prog",
+    [
+        (["run", "--help"], "fpga-robotics run"),
+        (["export", "--help"], "fpga-robotics export"),
+        (["board", "--help"], "fpga-robotics board"),
+        (["bench", "--help"], "fpga-robotics bench design"),
+        (["bench", "design", "--help"], "fpga-robotics bench design"),
+        (["bench", "pysim", "--help"], "fpga-robotics bench pysim"),
+        (["bench", "camera", "--help"], "fpga-robotics bench camera"),
+        (["bench", "world", "--help"], "fpga-robotics bench world"),
+        (["bench", "viewer", "--help"], "fpga-robotics bench viewer"),
+        (["bench", "shadow", "--help"], "fpga-robotics bench shadow"),
+        *[([name, "--help"], f"fpga-robotics {name}") for name in cli.COMMANDS if name != "bench"],
+    ],
+)
 def test_each_subcommand_shows_its_own_help(argv, prog, capsys):
     with pytest.raises(SystemExit) as info:
         cli.main(argv)
@@ -50,8 +53,10 @@ def test_console_script_and_module_alias_run_the_same_command(tmp_path):
     # `python -m fpga_robotics` is the console script; `python -m fpga_robotics.export` the
     # documented alias: both write the same Verilog.
     a, b = tmp_path / "a.v", tmp_path / "b.v"
-    for argv in ([sys.executable, "-m", "fpga_robotics", "export", "-o", str(a)],
-                 [sys.executable, "-m", "fpga_robotics.export", "-o", str(b)]):
+    for argv in (
+        [sys.executable, "-m", "fpga_robotics", "export", "-o", str(a)],
+        [sys.executable, "-m", "fpga_robotics.export", "-o", str(b)],
+    ):
         subprocess.run(argv, check=True, capture_output=True, timeout=300)
     assert a.read_text() == b.read_text() and "module follow_target" in a.read_text()
 
@@ -63,19 +68,22 @@ def test_version_is_the_installed_package_version(capsys):
     assert capsys.readouterr().out == f"fpga-robotics {version('fpga-robotics')}\n"
 
 
-@pytest.mark.parametrize("argv", [
-    ["run", "--target-color", "purple"],
-    ["run", "--backend", "iverilog"],
-    ["run", "--no-such-option"],
-    ["export", "--top", "nope"],
-    ["ports"],
-    ["readback"],
-    ["readback", "a.rrd", "b.rrd"],
-    ["sweep", "report"],
-    ["formal", "--depth", "deep"],
-    ["mutate", "--mutants", "many"],
-    ["board", "--seed", "x"],
-])
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["run", "--target-color", "purple"],
+        ["run", "--backend", "iverilog"],
+        ["run", "--no-such-option"],
+        ["export", "--top", "nope"],
+        ["ports"],
+        ["readback"],
+        ["readback", "a.rrd", "b.rrd"],
+        ["sweep", "report"],
+        ["formal", "--depth", "deep"],
+        ["mutate", "--mutants", "many"],
+        ["board", "--seed", "x"],
+    ],
+)
 def test_a_bad_argument_is_one_line_naming_the_command(argv, capsys):
     with pytest.raises(SystemExit) as info:
         cli.main(argv)
@@ -94,8 +102,10 @@ def test_run_help_shows_the_default_scenario_values(capsys):
     assert "camera and design resolution (default: the scenario's; follow_person: 160x120)" in out
     assert "simulated seconds (default: the scenario's; follow_person: 30.0)" in out
     assert "initial colour select (default: the scenario's; follow_person: red)" in out
-    assert "--scenario NAME|PATH a shipped scenario (see --list-scenarios) or a .toml file " \
-           "(default: follow_person)" in out
+    assert (
+        "--scenario NAME|PATH a shipped scenario (see --list-scenarios) or a .toml file "
+        "(default: follow_person)" in out
+    )
     assert "--log-every N log every Nth frame's images to the viewer (default: 1)" in out
 
 
@@ -114,14 +124,24 @@ def test_sweep_usage_shows_the_report_form(capsys):
     assert "fpga-robotics sweep report DIR" in usage
 
 
-@pytest.mark.parametrize("module, command", [
-    ("fpga_robotics.run", "run"), ("fpga_robotics.export", "export"),
-    ("fpga_robotics.formal", "formal"), ("fpga_robotics.sweep", "sweep"),
-    ("fpga_robotics.mutation", "mutate"),
-])
+@pytest.mark.parametrize(
+    "module, command",
+    [
+        ("fpga_robotics.run", "run"),
+        ("fpga_robotics.export", "export"),
+        ("fpga_robotics.formal", "formal"),
+        ("fpga_robotics.sweep", "sweep"),
+        ("fpga_robotics.mutation", "mutate"),
+    ],
+)
 def test_module_aliases_name_themselves_as_the_command(module, command):
-    proc = subprocess.run([sys.executable, "-m", module, "--no-such-option"],
-                          capture_output=True, text=True, timeout=120, check=False)
+    proc = subprocess.run(
+        [sys.executable, "-m", module, "--no-such-option"],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        check=False,
+    )
     assert proc.returncode == 2
     assert proc.stderr.startswith(f"fpga-robotics {command}: error: "), proc.stderr
     assert proc.stderr.count("\n") == 1, proc.stderr

@@ -34,25 +34,32 @@ CASES = [
     ("zero duration", ["run", "--duration", "0"], "--duration"),
     ("nan duration", ["run", "--duration", "nan"], "--duration"),
     ("max-frames without source", ["run", "--max-frames", "5"], "--source"),
-    ("negative max-frames", ["run", "--source", "{frames}", "--max-frames", "-1"],
-     "--max-frames"),
+    ("negative max-frames", ["run", "--source", "{frames}", "--max-frames", "-1"], "--max-frames"),
     ("log-every zero", ["run", "--log-every", "0", "--rerun", "save:x.rrd"], "--log-every"),
     ("unknown backend", ["run", "--backend", "iverilog"], "invalid choice"),
     ("video with no codec", ["run", "--save-video", "clip.mkv"], ".mp4"),
     ("video to a folder", ["run", "--save-video", "{dir}"], "is a folder"),
     ("shadow with nothing", ["run", "--shadow", ";"], "--shadow"),
     ("shadow with an unknown key", ["run", "--shadow", "frob=1"], "design.frob"),
-    ("shadow with --source", ["run", "--source", "{frames}", "--shadow", "diff_min=5"],
-     "--shadow"),
-    ("video with --source", ["run", "--source", "{frames}", "--save-video", "clip.mp4"],
-     "--save-video"),
-    ("target colour without a target", ["run", "--set", "people=[]", "--target-color", "green"],
-     "no target"),
+    ("shadow with --source", ["run", "--source", "{frames}", "--shadow", "diff_min=5"], "--shadow"),
+    (
+        "video with --source",
+        ["run", "--source", "{frames}", "--save-video", "clip.mp4"],
+        "--save-video",
+    ),
+    (
+        "target colour without a target",
+        ["run", "--set", "people=[]", "--target-color", "green"],
+        "no target",
+    ),
     # run: ROS bags in and out, live control (issue 16); {bag} is a ROS 2 bag of two
     # 32FC1 images on /cam, {emptybag} one whose only image topic has no messages
     ("bag source with a missing topic", ["run", "--source", "bag:{bag}:/nope"], "no topic"),
-    ("bag source with a bad encoding", ["run", "--source", "bag:{bag}", "--backend", "model"],
-     "32FC1"),
+    (
+        "bag source with a bad encoding",
+        ["run", "--source", "bag:{bag}", "--backend", "model"],
+        "32FC1",
+    ),
     ("empty bag source", ["run", "--source", "bag:{emptybag}"], "no messages"),
     ("missing bag source", ["run", "--source", "bag:nothing_here"], "no such bag"),
     ("bag out over a file", ["run", "--bag", "{file}"], "--bag"),
@@ -62,16 +69,21 @@ CASES = [
     ("live on a port in use", ["run", "--live", "foxglove:{busyport}"], "cannot serve"),
     ("replay of a missing file", ["run", "--replay-inputs", "nope.json"], "no such file"),
     ("replay of a bad input", ["run", "--replay-inputs", "{file}"], "JSON"),
-    ("replay with live", ["run", "--replay-inputs", "{file}", "--live", "foxglove"],
-     "does not go with"),
-    ("interactive with source", ["run", "--source", "{frames}", "--interactive"],
-     "--interactive"),
+    (
+        "replay with live",
+        ["run", "--replay-inputs", "{file}", "--live", "foxglove"],
+        "does not go with",
+    ),
+    ("interactive with source", ["run", "--source", "{frames}", "--interactive"], "--interactive"),
     ("paused alone", ["run", "--paused"], "--paused"),
     ("bag out where nothing can be written", ["run", "--bag", "/proc/bag"], "cannot write"),
     ("interactive without a terminal", ["run", "--interactive"], "needs a terminal"),
     # the recording: checked before the design is built
-    ("recording where nothing can be written", ["run", "--rerun", "save:/proc/r.rrd"],
-     "cannot write"),
+    (
+        "recording where nothing can be written",
+        ["run", "--rerun", "save:/proc/r.rrd"],
+        "cannot write",
+    ),
     ("recording below a file", ["run", "--rerun", "save:{file}/r.rrd"], "not a folder"),
     ("recording to a folder", ["run", "--rerun", "save:folder.rrd"], "is a folder"),
     ("default recording below a file", ["run", "--rerun", "save"], "not a folder"),
@@ -85,16 +97,21 @@ CASES = [
     ("export below a file", ["export", "-o", "{file}/x.v"], "cannot write"),
     ("export bad width", ["export", "--width", "17", "-o", "x.v"], "width"),
     ("board into a file", ["export", "--board", "ulx3s-85f", "-o", "{file}"], "not a folder"),
-    ("board seed without bitstream", ["board", "--board", "ulx3s-85f", "--seed", "2",
-                                      "-o", "out"], "--bitstream"),
+    (
+        "board seed without bitstream",
+        ["board", "--board", "ulx3s-85f", "--seed", "2", "-o", "out"],
+        "--bitstream",
+    ),
     ("unknown board", ["board", "--board", "nexys", "-o", "out"], "unknown board"),
     # bench
     ("bench negative min-seconds", ["bench", "--min-seconds", "-5"], "--min-seconds"),
     ("bench nan min-seconds", ["bench", "design", "--min-seconds", "nan"], "--min-seconds"),
-    ("bench json to a device", ["bench", "--backends", "model", "--json", "/dev/full"],
-     "not a regular file"),
-    ("bench json to a folder", ["bench", "--backends", "model", "--json", "{dir}"],
-     "is a folder"),
+    (
+        "bench json to a device",
+        ["bench", "--backends", "model", "--json", "/dev/full"],
+        "not a regular file",
+    ),
+    ("bench json to a folder", ["bench", "--backends", "model", "--json", "{dir}"], "is a folder"),
     ("pysim bench zero frames", ["bench", "pysim", "--frames", "0"], "--frames"),
 ]
 
@@ -124,9 +141,15 @@ def _float_image_bag(path, n):
         for k in range(n):
             msg = T["sensor_msgs/msg/Image"](
                 header=T["std_msgs/msg/Header"](
-                    stamp=T["builtin_interfaces/msg/Time"](sec=k, nanosec=0), frame_id=""),
-                height=2, width=2, encoding="32FC1", is_bigendian=0, step=8,
-                data=np.zeros(16, np.uint8))
+                    stamp=T["builtin_interfaces/msg/Time"](sec=k, nanosec=0), frame_id=""
+                ),
+                height=2,
+                width=2,
+                encoding="32FC1",
+                is_bigendian=0,
+                step=8,
+                data=np.zeros(16, np.uint8),
+            )
             writer.write(conn, k + 1, store.serialize_cdr(msg, "sensor_msgs/msg/Image"))
     return path
 
@@ -141,8 +164,9 @@ def busy_port():
 
 
 @pytest.mark.parametrize("case, argv, word", CASES, ids=[c[0] for c in CASES])
-def test_bad_input_is_one_line_and_exit_2(case, argv, word, tmp_path, monkeypatch, capsys,
-                                          busy_port):
+def test_bad_input_is_one_line_and_exit_2(
+    case, argv, word, tmp_path, monkeypatch, capsys, busy_port
+):
     import cv2
 
     (tmp_path / "folder").mkdir()
@@ -151,10 +175,14 @@ def test_bad_input_is_one_line_and_exit_2(case, argv, word, tmp_path, monkeypatc
     frames.mkdir()
     for i in range(2):
         cv2.imwrite(str(frames / f"{i}.png"), np.full((12, 16, 3), 40 * i, np.uint8))
-    names = {"dir": str(tmp_path / "folder"), "file": str(tmp_path / "file"),
-             "frames": str(frames), "bag": str(_float_image_bag(tmp_path / "bag", 2)),
-             "emptybag": str(_float_image_bag(tmp_path / "emptybag", 0)),
-             "busyport": str(busy_port)}
+    names = {
+        "dir": str(tmp_path / "folder"),
+        "file": str(tmp_path / "file"),
+        "frames": str(frames),
+        "bag": str(_float_image_bag(tmp_path / "bag", 2)),
+        "emptybag": str(_float_image_bag(tmp_path / "emptybag", 0)),
+        "busyport": str(busy_port),
+    }
     argv = [a.format(**names) for a in argv]
     monkeypatch.chdir(tmp_path)
     (tmp_path / "folder.rrd").mkdir()
@@ -175,8 +203,9 @@ def test_bad_input_is_one_line_and_exit_2(case, argv, word, tmp_path, monkeypatc
     lines = [line for line in err.splitlines() if line.strip()]
     assert "error:" in lines[-1] and word in lines[-1], err
     # One line, or argparse's usage block first and the one error line last.
-    assert len(lines) == 1 or (lines[0].startswith("usage:") and
-                               sum("error:" in line for line in lines) == 1), err
+    assert len(lines) == 1 or (
+        lines[0].startswith("usage:") and sum("error:" in line for line in lines) == 1
+    ), err
     assert _snapshot(tmp_path) == before
     assert stat.S_ISCHR(os.stat("/dev/full").st_mode)
     assert builds == [], f"a simulator was started before the error: {builds}"
@@ -200,6 +229,7 @@ def _forbid_builds(monkeypatch):
         def start(*args, **kwargs):
             builds.append((what,))
             raise RuntimeError("no simulator may start in a bad-input case")
+
         return start
 
     monkeypatch.setattr(compressed, "make_backend", make_backend)

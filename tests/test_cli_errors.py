@@ -25,9 +25,14 @@ def _exception_classes():
     found = []
     for module, path in source_modules():
         for node in ast.walk(ast.parse(path.read_text(), str(path))):
-            if isinstance(node, ast.ClassDef) and node.bases and (
-                    node.name.endswith(("Error", "Unavailable", "Timeout")) or any(
-                        isinstance(b, ast.Name) and b.id == "Exception" for b in node.bases)):
+            if (
+                isinstance(node, ast.ClassDef)
+                and node.bases
+                and (
+                    node.name.endswith(("Error", "Unavailable", "Timeout"))
+                    or any(isinstance(b, ast.Name) and b.id == "Exception" for b in node.bases)
+                )
+            ):
                 found.append(f"{module}.{node.name}")
     return found
 
@@ -37,11 +42,13 @@ CLASSES = _exception_classes()
 
 def test_the_scan_finds_the_known_error_classes():
     # The scan itself must see the classes (a scan that finds nothing passes everything).
-    for name in ("fpga_robotics.sim.camera.frames.FrameError",
-                 "fpga_robotics.sim.backends.port_map.PortMapError",
-                 "fpga_robotics.scenario.load.ScenarioError",
-                 "fpga_robotics.viz.errors.ViewerError",
-                 "fpga_robotics.hw.errors.UsageError"):
+    for name in (
+        "fpga_robotics.sim.camera.frames.FrameError",
+        "fpga_robotics.sim.backends.port_map.PortMapError",
+        "fpga_robotics.scenario.load.ScenarioError",
+        "fpga_robotics.viz.errors.ViewerError",
+        "fpga_robotics.hw.errors.UsageError",
+    ):
         assert name in CLASSES
     assert len(CLASSES) >= 17
 
@@ -87,12 +94,15 @@ def _run(exc, capsys):
     return info.value.code, capsys.readouterr().err
 
 
-@pytest.mark.parametrize("exc", [
-    UsageError("--x must be > 0"),
-    importlib.import_module("fpga_robotics.sim.camera.frames").FrameError("bad frame"),
-    importlib.import_module("fpga_robotics.sim.files").OutputPathError("cannot write x"),
-    FileNotFoundError("no such file: x"),
-])
+@pytest.mark.parametrize(
+    "exc",
+    [
+        UsageError("--x must be > 0"),
+        importlib.import_module("fpga_robotics.sim.camera.frames").FrameError("bad frame"),
+        importlib.import_module("fpga_robotics.sim.files").OutputPathError("cannot write x"),
+        FileNotFoundError("no such file: x"),
+    ],
+)
 def test_a_user_error_is_one_line_and_exit_2(exc, capsys):
     code, err = _run(exc, capsys)
     assert code == USAGE_EXIT

@@ -20,8 +20,10 @@ def test_example_is_written_and_then_checked(tmp_path, capsys):
     code, out, err = _ports([str(path)], capsys)
     assert code == 0, err
     # The six per-frame outputs of follow_target, as docs/foreign.md lists them.
-    assert out == (f"{path}: follow_target, outputs found, proximity, centroid_x, "
-                   "centroid_leds, motor_left, motor_right\n")
+    assert out == (
+        f"{path}: follow_target, outputs found, proximity, centroid_x, "
+        "centroid_leds, motor_left, motor_right\n"
+    )
 
 
 def test_example_never_replaces_a_file(tmp_path, capsys):
@@ -29,15 +31,19 @@ def test_example_never_replaces_a_file(tmp_path, capsys):
     path.write_text("keep me\n")
     code, out, err = _ports(["--example", str(path)], capsys)
     assert code == 2 and out == ""
-    assert err.startswith(f"fpga-robotics ports: error: cannot write {path}") and \
-        err.count("\n") == 1
+    assert (
+        err.startswith(f"fpga-robotics ports: error: cannot write {path}") and err.count("\n") == 1
+    )
     assert path.read_text() == "keep me\n"
 
 
-@pytest.mark.parametrize("text, word", [
-    ("style = \n", "not valid TOML"),
-    ('style = "pixels"\n', "style"),
-])
+@pytest.mark.parametrize(
+    "text, word",
+    [
+        ("style = \n", "not valid TOML"),
+        ('style = "pixels"\n', "style"),
+    ],
+)
 def test_a_bad_port_map_is_one_line(text, word, tmp_path, capsys):
     path = tmp_path / "ports.toml"
     path.write_text(text)
@@ -69,11 +75,19 @@ def test_a_map_is_checked_against_the_design_it_names(tmp_path, capsys):
     assert out.splitlines()[0] == f"{path}: matches {design} (5 ports)"
 
 
-@pytest.mark.parametrize("edit, message", [
-    (('pressed = "bump_i"', 'pressed = "bump_x"'), "has no port 'bump_x'"),
-    (("width = 12, signed = true }\nmotor_right", "width = 16, signed = true }\nmotor_right"),
-     "left_dps"),
-])
+@pytest.mark.parametrize(
+    "edit, message",
+    [
+        (('pressed = "bump_i"', 'pressed = "bump_x"'), "has no port 'bump_x'"),
+        (
+            (
+                "width = 12, signed = true }\nmotor_right",
+                "width = 16, signed = true }\nmotor_right",
+            ),
+            "left_dps",
+        ),
+    ],
+)
 def test_a_map_that_does_not_match_the_design_is_one_line(tmp_path, capsys, edit, message):
     path, design = _noreset(tmp_path, edit)
     code, out, err = _ports([str(path), "--design", design], capsys)

@@ -28,12 +28,15 @@ def _readback(argv, capsys):
     return info.value.code, out, err
 
 
-@pytest.mark.parametrize("entities, frames", [
-    # a line follower: no design/ entity of FollowTarget's at all
-    ({"sensors/line/left": range(7), "robot/wheels": range(7)}, 7),
-    # entities logged at different frames: the frames are their union
-    ({"design/found": range(0, 10, 2), "sensors/ultrasound": range(1, 10, 2)}, 10),
-])
+@pytest.mark.parametrize(
+    "entities, frames",
+    [
+        # a line follower: no design/ entity of FollowTarget's at all
+        ({"sensors/line/left": range(7), "robot/wheels": range(7)}, 7),
+        # entities logged at different frames: the frames are their union
+        ({"design/found": range(0, 10, 2), "sensors/ultrasound": range(1, 10, 2)}, 10),
+    ],
+)
 def test_readback_counts_the_frames_of_any_recording(entities, frames, tmp_path, capsys):
     path = _recording(tmp_path / "r.rrd", entities)
     code, out, err = _readback([str(path)], capsys)

@@ -21,14 +21,17 @@ class FakeIO:
 
 def _bumper(x, heading, margin=0.005, arc=120.0):
     """A GoPiGo3 (radius 0.11 m) at (x, 1) in a 4 x 2 m room: the wall x = 4 is 4 - x away."""
-    world = World.from_config({"room": {"width": 4.0, "depth": 2.0},
-                               "robot": {"model": "gopigo3", "start": [x, 1.0],
-                                         "heading_deg": math.degrees(heading)},
-                               "people": []})
-    (spec,) = parse_connectors({"sensors": [{"kind": "bumper", "margin": margin,
-                                             "arc_deg": arc}]})
-    return BumperConnector(spec.name, spec.mount, spec.params, world=world,
-                           rng=np.random.default_rng(0))
+    world = World.from_config(
+        {
+            "room": {"width": 4.0, "depth": 2.0},
+            "robot": {"model": "gopigo3", "start": [x, 1.0], "heading_deg": math.degrees(heading)},
+            "people": [],
+        }
+    )
+    (spec,) = parse_connectors({"sensors": [{"kind": "bumper", "margin": margin, "arc_deg": arc}]})
+    return BumperConnector(
+        spec.name, spec.mount, spec.params, world=world, rng=np.random.default_rng(0)
+    )
 
 
 def test_pressed_within_the_margin_of_a_wall_ahead_only():
@@ -52,15 +55,24 @@ def test_the_pin_is_poked_only_when_it_changes():
     assert bumper.measurement() == {"pressed": 1}
 
 
-@pytest.mark.parametrize("table, message", [
-    ({"kind": "bumper", "margin": -1}, "robot.sensors[0].margin must be a number in 0..0.1"),
-    ({"kind": "bumper", "colour": 1}, "unknown key 'colour' for a bumper"),
-    ({"kind": "bumpr"}, "unknown connector kind 'bumpr'"),
-    ({"kind": "wheels"}, "declare it in [[robot.actuators]]"),
-    ({"kind": "bumper", "yaw_deg": 999}, "robot.sensors[0].yaw_deg must be a number"),
-    ({"kind": "bumper", "ports": {"pushed": "x"}}, "has no pin 'pushed'"),
-])
+@pytest.mark.parametrize(
+    "table, message",
+    [
+        ({"kind": "bumper", "margin": -1}, "robot.sensors[0].margin must be a number in 0..0.1"),
+        ({"kind": "bumper", "colour": 1}, "unknown key 'colour' for a bumper"),
+        ({"kind": "bumpr"}, "unknown connector kind 'bumpr'"),
+        ({"kind": "wheels"}, "declare it in [[robot.actuators]]"),
+        ({"kind": "bumper", "yaw_deg": 999}, "robot.sensors[0].yaw_deg must be a number"),
+        ({"kind": "bumper", "ports": {"pushed": "x"}}, "has no pin 'pushed'"),
+    ],
+)
 def test_bad_tables_name_the_key(table, message):
-    with pytest.raises(ConnectorError, match=message.replace("[", r"\[").replace("]", r"\]")
-                       .replace("(", r"\(").replace(")", r"\)").replace(".", r"\.")):
+    with pytest.raises(
+        ConnectorError,
+        match=message.replace("[", r"\[")
+        .replace("]", r"\]")
+        .replace("(", r"\(")
+        .replace(")", r"\)")
+        .replace(".", r"\."),
+    ):
         parse_connectors({"sensors": [table]})

@@ -46,8 +46,9 @@ def _io(binding):
 
 
 def _world(**room):
-    return World.from_config({"room": {"width": 4.0, "depth": 6.0, **room},
-                              "robot": {"start": [1.0, 3.0]}, "people": []})
+    return World.from_config(
+        {"room": {"width": 4.0, "depth": 6.0, **room}, "robot": {"start": [1.0, 3.0]}, "people": []}
+    )
 
 
 def _pulse(conn, backend, io, rise, fall):
@@ -68,8 +69,9 @@ def test_both_kinds_are_registered():
 def test_a_trigger_schedules_the_echo_on_its_exact_edges():
     params = UltrasoundConnector.parse({"noise_std": 0.0, "temperature_c": 25.0}, "us")
     # Mounted 0.1 m forward, 0.12 m high: 4.0 - 1.1 = 2.9 m to the wall ahead.
-    conn = UltrasoundConnector("us", Mount(forward=0.1, height=0.12), params,
-                               world=_world(), rng=None)
+    conn = UltrasoundConnector(
+        "us", Mount(forward=0.1, height=0.12), params, world=_world(), rng=None
+    )
     backend, io = _io({"trig": "us_trig", "echo": "us_echo"})
     _pulse(conn, backend, io, 1000, 1500)
     c = 331.3 + 0.606 * 25.0
@@ -103,8 +105,9 @@ def test_noise_comes_from_the_connector_rng():
     params = UltrasoundConnector.parse({"noise_std": 0.01}, "us")
 
     def widths(seed):
-        conn = UltrasoundConnector("us", Mount(height=0.1), params, world=_world(),
-                                   rng=np.random.default_rng(seed))
+        conn = UltrasoundConnector(
+            "us", Mount(height=0.1), params, world=_world(), rng=np.random.default_rng(seed)
+        )
         backend, io = _io({"trig": "t", "echo": "e"})
         for k in range(5):
             _pulse(conn, backend, io, k * 3_000_000, k * 3_000_000 + 500)
@@ -117,8 +120,16 @@ def test_line_bits_are_ordered_from_the_left():
     # The robot at (1, 3) facing +x; a line along x at y = 3.05: under the left sensor only.
     world = _world(lines=[{"points": [[0.5, 3.05], [3.5, 3.05]], "width": 0.019}])
     params = LineSensorsConnector.parse(
-        {"sensors": [{"forward": 0.1, "left": 0.05}, {"forward": 0.1},
-                     {"forward": 0.1, "left": -0.05}], "noise_std": 0.0}, "robot.sensors[1]")
+        {
+            "sensors": [
+                {"forward": 0.1, "left": 0.05},
+                {"forward": 0.1},
+                {"forward": 0.1, "left": -0.05},
+            ],
+            "noise_std": 0.0,
+        },
+        "robot.sensors[1]",
+    )
     conn = LineSensorsConnector("line", Mount(height=0.01), params, world=world, rng=None)
     assert conn.pins["line"].width == 3
     backend, io = _io({"line": "line"})
@@ -132,27 +143,35 @@ def test_line_bits_are_ordered_from_the_left():
     assert overlay["states"] == (1, 0, 0)
 
 
-@pytest.mark.parametrize("kind, table, match", [
-    ("ultrasound", {"cone": 15}, r"us: unknown key 'cone' for an 'ultrasound' connector"),
-    ("ultrasound", {"cone_deg": 0}, r"us\.cone_deg must be a number in degrees > 0"),
-    ("ultrasound", {"temperature_c": "warm"}, r"us\.temperature_c must be a number"),
-    ("ultrasound", {"min_range": 0.5, "max_range": 0.4}, r"us\.max_range must be greater"),
-    ("line_sensors", {}, r"us\.sensors must be an array of 1 to 3 tables"),
-    ("line_sensors", {"sensors": [{}] * 4}, r"us\.sensors must be an array of 1 to 3"),
-    ("line_sensors", {"sensors": [{"left": -0.01}, {"left": 0.01}]},
-     r"us\.sensors\[1\]\.left must be less than sensors\[0\]\.left"),
-    ("line_sensors", {"sensors": [{"up": 1}]}, r"us\.sensors\[0\]: unknown key 'up'"),
-    ("line_sensors", {"sensors": [{}], "threshold": 2}, r"us\.threshold must be a number"),
-    ("line_sensors", {"sensors": [{}], "gain": 2}, r"us: unknown key 'gain'"),
-])
+@pytest.mark.parametrize(
+    "kind, table, match",
+    [
+        ("ultrasound", {"cone": 15}, r"us: unknown key 'cone' for an 'ultrasound' connector"),
+        ("ultrasound", {"cone_deg": 0}, r"us\.cone_deg must be a number in degrees > 0"),
+        ("ultrasound", {"temperature_c": "warm"}, r"us\.temperature_c must be a number"),
+        ("ultrasound", {"min_range": 0.5, "max_range": 0.4}, r"us\.max_range must be greater"),
+        ("line_sensors", {}, r"us\.sensors must be an array of 1 to 3 tables"),
+        ("line_sensors", {"sensors": [{}] * 4}, r"us\.sensors must be an array of 1 to 3"),
+        (
+            "line_sensors",
+            {"sensors": [{"left": -0.01}, {"left": 0.01}]},
+            r"us\.sensors\[1\]\.left must be less than sensors\[0\]\.left",
+        ),
+        ("line_sensors", {"sensors": [{"up": 1}]}, r"us\.sensors\[0\]: unknown key 'up'"),
+        ("line_sensors", {"sensors": [{}], "threshold": 2}, r"us\.threshold must be a number"),
+        ("line_sensors", {"sensors": [{}], "gain": 2}, r"us: unknown key 'gain'"),
+    ],
+)
 def test_bad_tables_name_the_key(kind, table, match):
     with pytest.raises(ConnectorError, match=match):
         connector_class(kind).parse(table, "us")
 
 
 def test_parse_mount_splits_the_mount_keys():
-    mount, rest = parse_mount({"forward": 0.1, "left": -0.02, "height": 0.15, "yaw_deg": 90,
-                               "cone_deg": 20}, "robot.sensors[0]")
+    mount, rest = parse_mount(
+        {"forward": 0.1, "left": -0.02, "height": 0.15, "yaw_deg": 90, "cone_deg": 20},
+        "robot.sensors[0]",
+    )
     assert mount == Mount(0.1, -0.02, 0.15, math.pi / 2) and rest == {"cone_deg": 20}
     with pytest.raises(ConnectorError, match=r"robot\.sensors\[0\]\.height must be a number"):
         parse_mount({"height": -1}, "robot.sensors[0]")
@@ -167,6 +186,7 @@ def test_the_documented_sensor_tables_parse():
         rest = {k: v for k, v in table.items() if k not in ("kind", "name")}
         mount, rest = parse_mount(rest, f"robot.sensors[{i}]")
         params = connector_class(table["kind"]).parse(rest, f"robot.sensors[{i}]")
-        conn = connector_class(table["kind"])(table["name"], mount, params, world=_world(),
-                                              rng=np.random.default_rng(0))
+        conn = connector_class(table["kind"])(
+            table["name"], mount, params, world=_world(), rng=np.random.default_rng(0)
+        )
         assert conn.mount.height == table["height"]

@@ -57,7 +57,11 @@ PAGES = ["README.md", *sorted(p.relative_to(ROOT).as_posix() for p in (ROOT / "d
 
 #: What starts a command line in a shell block.
 COMMAND_PREFIXES = (
-    "python -m fpga_robotics", "python3 -m", "fpga-robotics", "rerun", "openFPGALoader",
+    "python -m fpga_robotics",
+    "python3 -m",
+    "fpga-robotics",
+    "rerun",
+    "openFPGALoader",
     "python -m pytest",
 )
 
@@ -68,7 +72,8 @@ COMMAND_PREFIXES = (
 #: classification test instead of being skipped silently.
 LOOKS_LIKE_COMMAND = re.compile(
     r"^(\$\s+)?(sudo\s+)?(python[\d.]*|pip[\d.]*|pytest|fpga-robotics|fpga_robotics|rerun|"
-    r"openFPGALoader|apt-get|apt|ssh|yowasp-[\w-]+|verilator|make|git|curl|cd|source|\.)(\s|$)")
+    r"openFPGALoader|apt-get|apt|ssh|yowasp-[\w-]+|verilator|make|git|curl|cd|source|\.)(\s|$)"
+)
 
 SHELL_LANGS = {"", "sh", "bash", "shell", "console"}
 
@@ -79,6 +84,7 @@ FAIL_MARK = re.compile(r"\bFAIL\b")
 
 
 # --- Extraction -----------------------------------------------------------------------------------
+
 
 @dataclass(frozen=True)
 class Block:
@@ -130,7 +136,7 @@ def split_comment(line):
         elif ch in "'\"":
             quote = ch
         elif ch == "#" and (i == 0 or line[i - 1].isspace()):
-            return line[:i].rstrip(), line[i + 1:].strip()
+            return line[:i].rstrip(), line[i + 1 :].strip()
     return line.rstrip(), ""
 
 
@@ -239,6 +245,7 @@ def snippet_key(block):
 
 # --- How each command is run ----------------------------------------------------------------------
 
+
 @dataclass(frozen=True)
 class Plan:
     """How a documented command is run here, or why it is not."""
@@ -284,580 +291,930 @@ MAKE_CLIP = "python -m fpga_robotics.run --duration 1 --rerun off --quiet --save
 SCENARIO_NAMES = ("follow_person", "divider", "lighting", "heavy_robot", "lost_target")
 PASS = r"(?m)^verdict: PASS$"
 #: Why docs/camera.md's sensor-model runs keep their scenario's duration.
-_SENSOR_WHY = ("the page gives the verdict of the whole scenario (the divider's mean-distance "
-               "check fails in runs under 15 s; the dimming of lighting lasts from 8 s to 24 s)")
-SAVED_DEFAULT = r"saved \d+ frames .* to runs/follow_person\.rrd .*open it with: rerun runs/follow_person\.rrd"
+_SENSOR_WHY = (
+    "the page gives the verdict of the whole scenario (the divider's mean-distance "
+    "check fails in runs under 15 s; the dimming of lighting lasts from 8 s to 24 s)"
+)
+SAVED_DEFAULT = (
+    r"saved \d+ frames .* to runs/follow_person\.rrd .*open it with: rerun runs/follow_person\.rrd"
+)
 
 _DIVIDER_WHY = (
     "the scenario's own 25 s (about 1 s of wall time): the loose filter's robot turns to the "
     "wood and loses the person from view between 10 and 15 s, which is the failure the page "
-    "means; a run of 10 s or less fails only the mean-distance check, as the default design does")
+    "means; a run of 10 s or less fails only the mean-distance check, as the default design does"
+)
 
 _APPROACH_WHY = (
     "the scenario's own 30 s (about a second of wall time): with the early thresholds the "
     "robot reaches the standing person at 26.7 s; the page's default run must stop short over "
-    "the same time")
+    "the same time"
+)
 
 _ERRATIC_WHY = (
     "the scenario's own 30 s (about a second of wall time): the robot tips at 3.17 s and the "
     "oscillation the page quotes is over the whole run; a 1 s run of the default design fails "
-    "its mean-distance check")
+    "its mean-distance check"
+)
 
 PLANS = {
     # README: two commands on a fresh machine ------------------------------------------------
-    "python3 -m venv .venv && . .venv/bin/activate && pip install -e . && python -m fpga_robotics.run":
-        Plan(part="python -m fpga_robotics.run",
-             part_why="the virtual environment and the install are the ones this test runs in; "
-                      ".ci/run makes them in a fresh clone on every submission",
-             viewer=True, files=("runs/follow_person.rrd",),
-             out=(PASS, SAVED_DEFAULT), last_line=r"runs/follow_person\.rrd$"),
+    "python3 -m venv .venv && . .venv/bin/activate && pip install -e . && python -m fpga_robotics.run": Plan(
+        part="python -m fpga_robotics.run",
+        part_why="the virtual environment and the install are the ones this test runs in; "
+        ".ci/run makes them in a fresh clone on every submission",
+        viewer=True,
+        files=("runs/follow_person.rrd",),
+        out=(PASS, SAVED_DEFAULT),
+        last_line=r"runs/follow_person\.rrd$",
+    ),
     'python3 -m venv .venv && . .venv/bin/activate && pip install -e ".[dev,board]" && '
-    'python -m pytest -q -n auto':
-        Plan(part="python -m pytest -q -n auto", collect=True,
-             part_why="the set-up and the whole test run are CI's own command (.ci/run, checked "
-                      "by test_ci_runs_the_readme_test_command); here the suite is collected",
-             out=(r"\d{3,} tests collected",)),
+    "python -m pytest -q -n auto": Plan(
+        part="python -m pytest -q -n auto",
+        collect=True,
+        part_why="the set-up and the whole test run are CI's own command (.ci/run, checked "
+        "by test_ci_runs_the_readme_test_command); here the suite is collected",
+        out=(r"\d{3,} tests collected",),
+    ),
     # docs/formal.md ------------------------------------------------------------------------------
-    "python -m fpga_robotics.formal":
-        Plan(excused="every formal check, about a minute of wall time with two solver jobs; "
-                     "the same checks run as tests (`pytest -m formal`, "
-                     "tests/test_formal_checks.py), and the documented --only commands run here"),
-    "python -m fpga_robotics.formal --list":
-        Plan(out=(r"(?m)^frame_done\.latency@16x2\s+bmc\s+60\s",
-                  r"(?m)^capture\.no_overflow@fifo_depth=16\s+bmc\s+40\s")),
-    "python -m fpga_robotics.formal --only frame_done.strobe":
-        Plan(out=(r"(?m)^frame_done\.strobe@16x2\s+prove\s+4\s+pass\s",
-                  r"(?m)^1 of 1 checks passed")),
-    "python -m fpga_robotics.formal --only motor --depth 4":
-        Plan(out=(r"(?m)^motor\.limits_hold_search@defaults\s+prove\s+4\s+pass\s",
-                  r"(?m)^motor\.limits_hold_search@odd\s+prove\s+4\s+pass\s",
-                  r"(?m)^2 of 2 checks passed")),
-    "fpga-robotics formal --design counters.py:Saturating":
-        Plan(setup=(f"cp {ROOT / 'tests/data/user_designs/counters.py'} .",),
-             out=(r"(?m)^Saturating\.properties\s+prove\s+3\s+pass\s",
-                  r"(?m)^Saturating\.covers\s+cover\s+12\s+pass\s",
-                  r"(?m)^2 of 2 checks passed")),
-    "fpga-robotics formal --design counters.py:OffByOne":
-        Plan(setup=(f"cp {ROOT / 'tests/data/user_designs/counters.py'} .",),
-             out=(r"(?m)^OffByOne\.properties\s+bmc\s+15\s+FAIL\s",
-                  r"failed assertion \S*counters\.py:40 step 11",
-                  r"counterexample: \S*OffByOne\.properties\.vcd")),
-    "python -m pytest -m formal":
-        Plan(collect=True, out=(r"test_seeded_bug_fails\[tracker\.no_leak@16x2\]",
-                                r"test_check_passes\[cover\.sccb\]")),
+    "python -m fpga_robotics.formal": Plan(
+        excused="every formal check, about a minute of wall time with two solver jobs; "
+        "the same checks run as tests (`pytest -m formal`, "
+        "tests/test_formal_checks.py), and the documented --only commands run here"
+    ),
+    "python -m fpga_robotics.formal --list": Plan(
+        out=(
+            r"(?m)^frame_done\.latency@16x2\s+bmc\s+60\s",
+            r"(?m)^capture\.no_overflow@fifo_depth=16\s+bmc\s+40\s",
+        )
+    ),
+    "python -m fpga_robotics.formal --only frame_done.strobe": Plan(
+        out=(r"(?m)^frame_done\.strobe@16x2\s+prove\s+4\s+pass\s", r"(?m)^1 of 1 checks passed")
+    ),
+    "python -m fpga_robotics.formal --only motor --depth 4": Plan(
+        out=(
+            r"(?m)^motor\.limits_hold_search@defaults\s+prove\s+4\s+pass\s",
+            r"(?m)^motor\.limits_hold_search@odd\s+prove\s+4\s+pass\s",
+            r"(?m)^2 of 2 checks passed",
+        )
+    ),
+    "fpga-robotics formal --design counters.py:Saturating": Plan(
+        setup=(f"cp {ROOT / 'tests/data/user_designs/counters.py'} .",),
+        out=(
+            r"(?m)^Saturating\.properties\s+prove\s+3\s+pass\s",
+            r"(?m)^Saturating\.covers\s+cover\s+12\s+pass\s",
+            r"(?m)^2 of 2 checks passed",
+        ),
+    ),
+    "fpga-robotics formal --design counters.py:OffByOne": Plan(
+        setup=(f"cp {ROOT / 'tests/data/user_designs/counters.py'} .",),
+        out=(
+            r"(?m)^OffByOne\.properties\s+bmc\s+15\s+FAIL\s",
+            r"failed assertion \S*counters\.py:40 step 11",
+            r"counterexample: \S*OffByOne\.properties\.vcd",
+        ),
+    ),
+    "python -m pytest -m formal": Plan(
+        collect=True,
+        out=(
+            r"test_seeded_bug_fails\[tracker\.no_leak@16x2\]",
+            r"test_check_passes\[cover\.sccb\]",
+        ),
+    ),
     # Viewing a recording ---------------------------------------------------------------------
-    "rerun --serve-web --bind 127.0.0.1 runs/follow_person.rrd":
-        Plan(serve=True, setup=(MAKE_RECORDING,)),
-    "rerun out/run.rrd":
-        Plan(excused="opens rerun's native viewer window: needs a display (the web viewer of "
-                     "the same file is checked through `rerun --serve-web`)"),
+    "rerun --serve-web --bind 127.0.0.1 runs/follow_person.rrd": Plan(
+        serve=True, setup=(MAKE_RECORDING,)
+    ),
+    "rerun out/run.rrd": Plan(
+        excused="opens rerun's native viewer window: needs a display (the web viewer of "
+        "the same file is checked through `rerun --serve-web`)"
+    ),
     # README: the first ten minutes -----------------------------------------------------------
     "python -m fpga_robotics.run --target-color green":
-        # Found in every frame: the person is dressed in green and the design selects green.
-        Plan(out=(PASS, r"target: first found at 0\.00 s, in view 100%, found 100%")),
-    "python -m fpga_robotics.run --scenario divider --set design.diff_min=5 --rerun off":
-        Plan(duration="keep", duration_why=_DIVIDER_WHY,
-             out=(r"\[FAIL\] target_in_view_min_fraction",
-                  r"\[FAIL\] max_off_target_fraction: centroid away from the target in 67%")),
-    "python -m fpga_robotics.run --scenario divider --shadow diff_min=5 --rerun off":
-        Plan(duration="keep",
-             duration_why="the page says the default design passes: over the whole scenario "
-                           "(25 s); a run under 15 s fails its mean-distance check",
-             out=(PASS, r"shadow diff_min=5: first differs at frame \d+")),
-    "python -m fpga_robotics.run --duration 5 --rerun off --save-video clip.mp4":
-        Plan(files=("clip.mp4",), out=(PASS,)),
-    "python -m fpga_robotics.run --source clip.mp4 --rerun off":
-        Plan(out=(r"source clip\.mp4 \(video\)", r"target found in 30 frames")),
+    # Found in every frame: the person is dressed in green and the design selects green.
+    Plan(out=(PASS, r"target: first found at 0\.00 s, in view 100%, found 100%")),
+    "python -m fpga_robotics.run --scenario divider --set design.diff_min=5 --rerun off": Plan(
+        duration="keep",
+        duration_why=_DIVIDER_WHY,
+        out=(
+            r"\[FAIL\] target_in_view_min_fraction",
+            r"\[FAIL\] max_off_target_fraction: centroid away from the target in 67%",
+        ),
+    ),
+    "python -m fpga_robotics.run --scenario divider --shadow diff_min=5 --rerun off": Plan(
+        duration="keep",
+        duration_why="the page says the default design passes: over the whole scenario "
+        "(25 s); a run under 15 s fails its mean-distance check",
+        out=(PASS, r"shadow diff_min=5: first differs at frame \d+"),
+    ),
+    "python -m fpga_robotics.run --duration 5 --rerun off --save-video clip.mp4": Plan(
+        files=("clip.mp4",), out=(PASS,)
+    ),
+    "python -m fpga_robotics.run --source clip.mp4 --rerun off": Plan(
+        out=(r"source clip\.mp4 \(video\)", r"target found in 30 frames")
+    ),
     # README and docs/running.md: the closed loop ---------------------------------------------
-    "python -m fpga_robotics.run --list-scenarios":
-        Plan(out=tuple(rf"(?m)^{name}\s" for name in SCENARIO_NAMES)),
-    "python -m fpga_robotics.run --scenario lost_target --rerun off --summary s.json":
-        Plan(duration="keep",
-             duration_why="lost_target's reacquired_within_s needs the person to leave the view "
-                          "and be found again (after about 4 s); a 1 s run fails it (15 s "
-                          "simulated, under a second of wall time)",
-             files=("s.json",), out=(PASS,),
-             summary=(("scenario", "lost_target"), ("verdict", "pass"))),
-    "python -m fpga_robotics.run --resolution 640x480 --backend verilator --duration 5 --rerun off":
-        Plan(slow=True, out=(r"backend verilator\s+640x480", PASS)),
+    "python -m fpga_robotics.run --list-scenarios": Plan(
+        out=tuple(rf"(?m)^{name}\s" for name in SCENARIO_NAMES)
+    ),
+    "python -m fpga_robotics.run --scenario lost_target --rerun off --summary s.json": Plan(
+        duration="keep",
+        duration_why="lost_target's reacquired_within_s needs the person to leave the view "
+        "and be found again (after about 4 s); a 1 s run fails it (15 s "
+        "simulated, under a second of wall time)",
+        files=("s.json",),
+        out=(PASS,),
+        summary=(("scenario", "lost_target"), ("verdict", "pass")),
+    ),
+    "python -m fpga_robotics.run --resolution 640x480 --backend verilator --duration 5 --rerun off": Plan(
+        slow=True, out=(r"backend verilator\s+640x480", PASS)
+    ),
     "python -m fpga_robotics.run":
-        # The page's "typical ending", line by line.
-        Plan(out=(r"(?m)^scenario follow_person\s+backend {fastest}\s+160x120\s+seed 0$",
-                  (r"(?m)^  30 frames, 1\.0 s simulated in [\d.]+ s \([\d.]+ ms/frame, "
-                   r"[\d.]+x real time\)$"),
-                  (r"(?m)^  target: first found at [\d.]+ s, in view \d+%, found \d+%, "
-                   r"\d+ search\(es\)$"),
-                  r"(?m)^  distance: min [\d.]+ m, mean [\d.]+ m; path [\d.]+ m$",
-                  r"(?m)^  collisions: person 0, wall 0, furniture 0$",
-                  r"(?m)^  \[ok\] acquired_within_s: ", PASS)),
-    "python -m fpga_robotics.run --scenario lost_target --rerun off":
-        Plan(duration="keep", duration_why="as for the same command with --summary",
-             out=(PASS,)),
+    # The page's "typical ending", line by line.
+    Plan(
+        out=(
+            r"(?m)^scenario follow_person\s+backend {fastest}\s+160x120\s+seed 0$",
+            (
+                r"(?m)^  30 frames, 1\.0 s simulated in [\d.]+ s \([\d.]+ ms/frame, "
+                r"[\d.]+x real time\)$"
+            ),
+            (
+                r"(?m)^  target: first found at [\d.]+ s, in view \d+%, found \d+%, "
+                r"\d+ search\(es\)$"
+            ),
+            r"(?m)^  distance: min [\d.]+ m, mean [\d.]+ m; path [\d.]+ m$",
+            r"(?m)^  collisions: person 0, wall 0, furniture 0$",
+            r"(?m)^  \[ok\] acquired_within_s: ",
+            PASS,
+        )
+    ),
+    "python -m fpga_robotics.run --scenario lost_target --rerun off": Plan(
+        duration="keep", duration_why="as for the same command with --summary", out=(PASS,)
+    ),
     # docs/stories.md -------------------------------------------------------------------------
-    "python -m pytest -q -m stories tests/test_story_*.py":
-        Plan(collect=True, out=(r"test_story_b_early_thresholds_drive_into_the_person",
-                                r"test_story_c_an_unstable_gain_tips_the_gopigo3",
-                                r"test_story_d_a_too_narrow_sx_puts_the_centroid_off_centre",
-                                r"\(\d+ deselected\)"),
-             not_out=(r"test_the_check_reads_the_at_fault_count",)),
+    "python -m pytest -q -m stories tests/test_story_*.py": Plan(
+        collect=True,
+        out=(
+            r"test_story_b_early_thresholds_drive_into_the_person",
+            r"test_story_c_an_unstable_gain_tips_the_gopigo3",
+            r"test_story_d_a_too_narrow_sx_puts_the_centroid_off_centre",
+            r"\(\d+ deselected\)",
+        ),
+        not_out=(r"test_the_check_reads_the_at_fault_count",),
+    ),
     "python -m fpga_robotics.run --scenario approach --rerun off --set robot.heading_deg=20 "
-    "--set checks.max_heading_overshoot_deg=5":
-        Plan(duration="keep",
-             duration_why="the page says the default gain never turns past the person: over the "
-                           "whole 30 s run (about a second of wall time); in 1 s the robot has "
-                           "not finished its turn, so 0 degrees there would prove nothing",
-             out=(PASS, r"\[ok\] max_heading_overshoot_deg: turned 0\.0 deg")),
+    "--set checks.max_heading_overshoot_deg=5": Plan(
+        duration="keep",
+        duration_why="the page says the default gain never turns past the person: over the "
+        "whole 30 s run (about a second of wall time); in 1 s the robot has "
+        "not finished its turn, so 0 degrees there would prove nothing",
+        out=(PASS, r"\[ok\] max_heading_overshoot_deg: turned 0\.0 deg"),
+    ),
     "python -m fpga_robotics.run --scenario approach --rerun off --set robot.heading_deg=20 "
-    "--set checks.max_heading_overshoot_deg=5 --set design.kp_num=16":
-        Plan(out=(r"\[FAIL\] max_heading_overshoot_deg: turned 11\.0 deg past the target",)),
-    "python -m fpga_robotics.run --scenario divider --rerun off":
-        Plan(duration="keep",
-             duration_why="the page says the default design passes: over the whole scenario "
-                           "(25 s); a run under 15 s fails its mean-distance check",
-             out=(PASS, r"\[ok\] max_off_target_fraction: centroid away from the target in 0%")),
-    "python -m fpga_robotics.run --scenario approach --rerun off":
-        Plan(duration="keep", duration_why=_APPROACH_WHY,
-             out=(PASS, r"\[ok\] max_robot_at_fault_collisions")),
-    "python -m fpga_robotics.run --scenario approach --rerun off --set design.sx_bits=17":
-        Plan(duration="keep",
-             duration_why="the page quotes the whole 30 s run (about a second of wall time): its "
-                          "mean centroid error over the frames found, and the bump at 15.4 s",
-             out=(r"\[FAIL\] mean_centroid_error_max_px: centroid 101\.95 px from the target",
-                  r"\[FAIL\] max_robot_at_fault_collisions")),
-    'python -m fpga_robotics.run --scenario approach --rerun off --set '
-    '"design.proximity_thresholds=[128,256,512,1024,2048,19000,19100]"':
-        Plan(duration="keep", duration_why=_APPROACH_WHY,
-             out=(r"\[FAIL\] max_person_collisions", r"\[FAIL\] max_robot_at_fault_collisions")),
-    "python -m fpga_robotics.run --scenario erratic --rerun off":
-        Plan(duration="keep", duration_why=_ERRATIC_WHY, out=(PASS, r"\[ok\] max_tip_overs")),
-    "python -m fpga_robotics.run --scenario erratic --rerun off --set design.kp_num=32":
-        Plan(duration="keep", duration_why=_ERRATIC_WHY, out=(r"\[FAIL\] max_tip_overs: the robot tipped over at 3\.17 s",)),
-    "python -m fpga_robotics.run --scenario erratic --rerun off --set design.preset=published":
-        Plan(duration="keep", duration_why=_ERRATIC_WHY,
-             out=(r"\[FAIL\] max_oscillation_hz: W changes sign 4\.87 times",)),
-    "python -m fpga_robotics.run --scenario divider --set design.diff_min=5":
-        Plan(duration="keep", duration_why=_DIVIDER_WHY,
-             out=(r"\[FAIL\] target_in_view_min_fraction",)),
-    "python -m fpga_robotics.run --resolution 320x240 --backend verilator --summary s.json":
-        Plan(slow=True, files=("s.json",), out=(r"backend verilator\s+320x240", PASS),
-             summary=(("backend", "verilator"), ("resolution", "320x240"))),
-    "python -m fpga_robotics.run --source clip.mp4 --color red":
-        Plan(setup=(MAKE_CLIP,),
-             out=(r"source clip\.mp4 \(video\)\s+backend \w+\s+160x120\s+colour red",
-                  r"target found in 30 frames")),
+    "--set checks.max_heading_overshoot_deg=5 --set design.kp_num=16": Plan(
+        out=(r"\[FAIL\] max_heading_overshoot_deg: turned 11\.0 deg past the target",)
+    ),
+    "python -m fpga_robotics.run --scenario divider --rerun off": Plan(
+        duration="keep",
+        duration_why="the page says the default design passes: over the whole scenario "
+        "(25 s); a run under 15 s fails its mean-distance check",
+        out=(PASS, r"\[ok\] max_off_target_fraction: centroid away from the target in 0%"),
+    ),
+    "python -m fpga_robotics.run --scenario approach --rerun off": Plan(
+        duration="keep",
+        duration_why=_APPROACH_WHY,
+        out=(PASS, r"\[ok\] max_robot_at_fault_collisions"),
+    ),
+    "python -m fpga_robotics.run --scenario approach --rerun off --set design.sx_bits=17": Plan(
+        duration="keep",
+        duration_why="the page quotes the whole 30 s run (about a second of wall time): its "
+        "mean centroid error over the frames found, and the bump at 15.4 s",
+        out=(
+            r"\[FAIL\] mean_centroid_error_max_px: centroid 101\.95 px from the target",
+            r"\[FAIL\] max_robot_at_fault_collisions",
+        ),
+    ),
+    "python -m fpga_robotics.run --scenario approach --rerun off --set "
+    '"design.proximity_thresholds=[128,256,512,1024,2048,19000,19100]"': Plan(
+        duration="keep",
+        duration_why=_APPROACH_WHY,
+        out=(r"\[FAIL\] max_person_collisions", r"\[FAIL\] max_robot_at_fault_collisions"),
+    ),
+    "python -m fpga_robotics.run --scenario erratic --rerun off": Plan(
+        duration="keep", duration_why=_ERRATIC_WHY, out=(PASS, r"\[ok\] max_tip_overs")
+    ),
+    "python -m fpga_robotics.run --scenario erratic --rerun off --set design.kp_num=32": Plan(
+        duration="keep",
+        duration_why=_ERRATIC_WHY,
+        out=(r"\[FAIL\] max_tip_overs: the robot tipped over at 3\.17 s",),
+    ),
+    "python -m fpga_robotics.run --scenario erratic --rerun off --set design.preset=published": Plan(
+        duration="keep",
+        duration_why=_ERRATIC_WHY,
+        out=(r"\[FAIL\] max_oscillation_hz: W changes sign 4\.87 times",),
+    ),
+    "python -m fpga_robotics.run --scenario divider --set design.diff_min=5": Plan(
+        duration="keep", duration_why=_DIVIDER_WHY, out=(r"\[FAIL\] target_in_view_min_fraction",)
+    ),
+    "python -m fpga_robotics.run --resolution 320x240 --backend verilator --summary s.json": Plan(
+        slow=True,
+        files=("s.json",),
+        out=(r"backend verilator\s+320x240", PASS),
+        summary=(("backend", "verilator"), ("resolution", "320x240")),
+    ),
+    "python -m fpga_robotics.run --source clip.mp4 --color red": Plan(
+        setup=(MAKE_CLIP,),
+        out=(
+            r"source clip\.mp4 \(video\)\s+backend \w+\s+160x120\s+colour red",
+            r"target found in 30 frames",
+        ),
+    ),
     "python -m fpga_robotics.run --scenario follow_person --rerun off --summary s.json":
-        # README quotes the summary's realtime_factor of this command.
-        Plan(files=("s.json",), out=(PASS,), summary=(("realtime_factor", ...),)),
+    # README quotes the summary's realtime_factor of this command.
+    Plan(files=("s.json",), out=(PASS,), summary=(("realtime_factor", ...),)),
     "python -m fpga_robotics.run --scenario follow_person --rerun off --summary s.json "
-    "--resolution 640x480 --duration 10":
-        Plan(files=("s.json",), out=(PASS,),
-             summary=(("resolution", "640x480"), ("realtime_factor", ...))),
+    "--resolution 640x480 --duration 10": Plan(
+        files=("s.json",),
+        out=(PASS,),
+        summary=(("resolution", "640x480"), ("realtime_factor", ...)),
+    ),
     "python -m fpga_robotics.run --backend model --rerun off --quiet --duration 20 "
-    "--scenario lost_target --shadow 'lost_frames=5'":
-        Plan(duration="keep",
-             duration_why="the page shows this run's last lines, frame numbers and counts "
-                           "'of 600' included (model backend: under a second of wall time)",
-             out=(re.escape("  shadow lost_frames=5: first differs at frame 119 (3.97 s): "
-                            "motor_left 208 vs -250, motor_right 512 vs 250"),
-                  re.escape("  shadow frames that differ: motor_left 10, motor_right 10 "
-                            "(of 600)"))),
+    "--scenario lost_target --shadow 'lost_frames=5'": Plan(
+        duration="keep",
+        duration_why="the page shows this run's last lines, frame numbers and counts "
+        "'of 600' included (model backend: under a second of wall time)",
+        out=(
+            re.escape(
+                "  shadow lost_frames=5: first differs at frame 119 (3.97 s): "
+                "motor_left 208 vs -250, motor_right 512 vs 250"
+            ),
+            re.escape("  shadow frames that differ: motor_left 10, motor_right 10 (of 600)"),
+        ),
+    ),
     # docs/campaigns.md: verification campaigns on Dask -------------------------------------
-    "python -m fpga_robotics.sweep regression --dry-run":
-        Plan(out=(r"campaign regression: 180 runs",
-                  (r"(?m)^  python -m fpga_robotics\.run --scenario approach --backend \w+ "
-                   r"--seed 0$"))),
+    "python -m fpga_robotics.sweep regression --dry-run": Plan(
+        out=(
+            r"campaign regression: 180 runs",
+            (
+                r"(?m)^  python -m fpga_robotics\.run --scenario approach --backend \w+ "
+                r"--seed 0$"
+            ),
+        )
+    ),
     "python -m fpga_robotics.sweep regression":
-        # Two short runs on the model backend: the whole campaign takes minutes (the page
-        # gives its measured time); the next command reads the same folder.
-        Plan(shorter=(("--max-runs", "2"), ("--backend", "model"), ("--duration", "2")),
-             files=("runs/sweeps/regression/results.parquet",
-                    "runs/sweeps/regression/results.csv", "runs/sweeps/regression/report.html"),
-             out=(r"2 runs: 2 pass", r"pass rate per scenario:")),
-    "python -m fpga_robotics.sweep report runs/sweeps/regression":
-        Plan(files=("runs/sweeps/regression/report.html",),
-             out=(r"2 runs: 2 pass",), last_line=r"report: runs/sweeps/regression/report\.html$"),
+    # Two short runs on the model backend: the whole campaign takes minutes (the page
+    # gives its measured time); the next command reads the same folder.
+    Plan(
+        shorter=(("--max-runs", "2"), ("--backend", "model"), ("--duration", "2")),
+        files=(
+            "runs/sweeps/regression/results.parquet",
+            "runs/sweeps/regression/results.csv",
+            "runs/sweeps/regression/report.html",
+        ),
+        out=(r"2 runs: 2 pass", r"pass rate per scenario:"),
+    ),
+    "python -m fpga_robotics.sweep report runs/sweeps/regression": Plan(
+        files=("runs/sweeps/regression/report.html",),
+        out=(r"2 runs: 2 pass",),
+        last_line=r"report: runs/sweeps/regression/report\.html$",
+    ),
     "python -m fpga_robotics.sweep filter_tuning":
-        # Two short runs: the page quotes the whole campaign's measured figures.
-        Plan(shorter=(("--max-runs", "2"), ("--backend", "model"), ("--duration", "2")),
-             files=("runs/sweeps/filter_tuning/report.html",),
-             out=(r"2 runs: ", r"pass rate per design\.diff_min:",
-                  r"pass rate per lighting\.ambient:")),
-    "python -m fpga_robotics.sweep robot_variants":
-        Plan(shorter=(("--max-runs", "2"), ("--backend", "model"), ("--duration", "2")),
-             files=("runs/sweeps/robot_variants/report.html",),
-             out=(r"2 runs: ", r"pass rate per robot\.mass:")),
+    # Two short runs: the page quotes the whole campaign's measured figures.
+    Plan(
+        shorter=(("--max-runs", "2"), ("--backend", "model"), ("--duration", "2")),
+        files=("runs/sweeps/filter_tuning/report.html",),
+        out=(r"2 runs: ", r"pass rate per design\.diff_min:", r"pass rate per lighting\.ambient:"),
+    ),
+    "python -m fpga_robotics.sweep robot_variants": Plan(
+        shorter=(("--max-runs", "2"), ("--backend", "model"), ("--duration", "2")),
+        files=("runs/sweeps/robot_variants/report.html",),
+        out=(r"2 runs: ", r"pass rate per robot\.mass:"),
+    ),
     "python -m fpga_robotics.sweep sensor_designs":
-        # Two one-second runs in real-clock timing (the campaign's first two: line_track, whose
-        # lap a second cannot complete).
-        Plan(shorter=(("--max-runs", "2"), ("--duration", "1"), ("--set", "checks.min_laps=0")),
-             files=("runs/sweeps/sensor_designs/report.html",),
-             out=(r"2 runs: ", r"pass rate per scenario:")),
+    # Two one-second runs in real-clock timing (the campaign's first two: line_track, whose
+    # lap a second cannot complete).
+    Plan(
+        shorter=(("--max-runs", "2"), ("--duration", "1"), ("--set", "checks.min_laps=0")),
+        files=("runs/sweeps/sensor_designs/report.html",),
+        out=(r"2 runs: ", r"pass rate per scenario:"),
+    ),
     "python -m fpga_robotics.sweep robustness":
-        # Two short runs: the page gives the whole campaign's results and known limits.
-        Plan(shorter=(("--max-runs", "2"), ("--duration", "2")),
-             files=("runs/sweeps/robustness/report.html",),
-             out=(r"2 runs: ", r"pass rate per robot\.model:")),
-    "python -m fpga_robotics.sweep robustness_small":
-        Plan(shorter=(("--max-runs", "2"), ("--duration", "2")),
-             files=("runs/sweeps/robustness_small/report.html",), out=(r"2 runs: 2 pass",)),
-    "python -m fpga_robotics.sweep regression --scheduler tcp://HOST:8786":
-        Plan(excused="needs a Dask cluster (HOST is the page's placeholder); "
-                     "tests/test_sweep_scheduler.py runs a campaign through a real `dask "
-                     "scheduler` and `dask worker` on 127.0.0.1"),
-    "python -m fpga_robotics.sweep --bench":
-        Plan(shorter=(("--bench-runs", "2"), ("--bench-repeats", "1"), ("--duration", "1")),
-             out=(r"1 worker\(s\): [\d.]+ runs/s",
-                  r"outside run_scenario with 1 worker: [\d.-]+ ms per run")),
+    # Two short runs: the page gives the whole campaign's results and known limits.
+    Plan(
+        shorter=(("--max-runs", "2"), ("--duration", "2")),
+        files=("runs/sweeps/robustness/report.html",),
+        out=(r"2 runs: ", r"pass rate per robot\.model:"),
+    ),
+    "python -m fpga_robotics.sweep robustness_small": Plan(
+        shorter=(("--max-runs", "2"), ("--duration", "2")),
+        files=("runs/sweeps/robustness_small/report.html",),
+        out=(r"2 runs: 2 pass",),
+    ),
+    "python -m fpga_robotics.sweep regression --scheduler tcp://HOST:8786": Plan(
+        excused="needs a Dask cluster (HOST is the page's placeholder); "
+        "tests/test_sweep_scheduler.py runs a campaign through a real `dask "
+        "scheduler` and `dask worker` on 127.0.0.1"
+    ),
+    "python -m fpga_robotics.sweep --bench": Plan(
+        shorter=(("--bench-runs", "2"), ("--bench-repeats", "1"), ("--duration", "1")),
+        out=(
+            r"1 worker\(s\): [\d.]+ runs/s",
+            r"outside run_scenario with 1 worker: [\d.-]+ ms per run",
+        ),
+    ),
     # docs/viewer.md --------------------------------------------------------------------------
-    "python -m fpga_robotics.run --scenario follow_person":
-        Plan(viewer=True, files=("runs/follow_person.rrd",), out=(SAVED_DEFAULT,)),
-    "python -m fpga_robotics.run --scenario follow_person --rerun save:out/run.rrd":
-        Plan(viewer=True, files=("out/run.rrd",),
-             out=(r"saved \d+ frames .* to out/run\.rrd",)),
-    "fpga-robotics bench viewer":
-        Plan(shorter=(("--frames", "2"), ("--repeats", "1")),
-             out=(r"160x120: wall median", r"640x480: wall median")),
+    "python -m fpga_robotics.run --scenario follow_person": Plan(
+        viewer=True, files=("runs/follow_person.rrd",), out=(SAVED_DEFAULT,)
+    ),
+    "python -m fpga_robotics.run --scenario follow_person --rerun save:out/run.rrd": Plan(
+        viewer=True, files=("out/run.rrd",), out=(r"saved \d+ frames .* to out/run\.rrd",)
+    ),
+    "fpga-robotics bench viewer": Plan(
+        shorter=(("--frames", "2"), ("--repeats", "1")),
+        out=(r"160x120: wall median", r"640x480: wall median"),
+    ),
     # docs/foreign.md: your own Verilog design -----------------------------------------------
-    "python -m fpga_robotics.export -o follow_target.v":
-        Plan(files=("follow_target.v",), out=(r"160x120, module follow_target",)),
-    "fpga-robotics ports --example ports.toml":
-        Plan(files=("ports.toml",), out=(r"wrote ports\.toml",)),
-    "python -m fpga_robotics.run --design verilog:follow_target.v --ports ports.toml":
-        Plan(slow=True, out=(PASS, r"(?m)^backend:? .*cxxrtl-foreign|cxxrtl-foreign")),
-    ("python -m fpga_robotics.run --scenario bump_wall.toml --design verilog:bump_stop.v "
-     "--ports bump_stop_ports.toml --rerun off"):
-        Plan(slow=True, setup=(" ".join(["cp", *(str(ROOT / "tests/data" / name) for name in (
-                         "bump_stop.v", "bump_stop_ports.toml", "bump_wall.toml")), "."]),),
-             duration="keep", duration_why="the page quotes the whole run's 120 000 cycles "
-                                           "(12 s at 10 kHz, a twentieth of a second's wall time)",
-             out=(PASS, r"\[ok\] max_wall_collisions")),
+    "python -m fpga_robotics.export -o follow_target.v": Plan(
+        files=("follow_target.v",), out=(r"160x120, module follow_target",)
+    ),
+    "fpga-robotics ports --example ports.toml": Plan(
+        files=("ports.toml",), out=(r"wrote ports\.toml",)
+    ),
+    "python -m fpga_robotics.run --design verilog:follow_target.v --ports ports.toml": Plan(
+        slow=True, out=(PASS, r"(?m)^backend:? .*cxxrtl-foreign|cxxrtl-foreign")
+    ),
+    (
+        "python -m fpga_robotics.run --scenario bump_wall.toml --design verilog:bump_stop.v "
+        "--ports bump_stop_ports.toml --rerun off"
+    ): Plan(
+        slow=True,
+        setup=(
+            " ".join(
+                [
+                    "cp",
+                    *(
+                        str(ROOT / "tests/data" / name)
+                        for name in ("bump_stop.v", "bump_stop_ports.toml", "bump_wall.toml")
+                    ),
+                    ".",
+                ]
+            ),
+        ),
+        duration="keep",
+        duration_why="the page quotes the whole run's 120 000 cycles "
+        "(12 s at 10 kHz, a twentieth of a second's wall time)",
+        out=(PASS, r"\[ok\] max_wall_collisions"),
+    ),
     # docs/your_design.md: your own design, by reference ------------------------------------
-    "fpga-robotics run --scenario wall_stop.toml --rerun off":
-        Plan(setup=(" ".join(["cp", *(str(ROOT / "tests/data/user_designs" / name) for name in (
-                         "wall_stop.py", "wall_stop.toml")), "."]),),
-             duration="keep", duration_why="the page quotes the whole run's stop at the wall "
-                                           "(12 s; about a second of wall time on CXXRTL)",
-             out=(PASS, r"design output distance_mm: last 227, min 218, max 1898",
-                  r"design output stopped: last 1, min 0, max 1")),
-    "fpga-robotics run --scenario wall_stop.toml --shadow wall_stop_v1.py:WallStop --rerun off":
-        Plan(setup=(" ".join(["cp", *(str(ROOT / "tests/data/user_designs" / name) for name in (
-                         "wall_stop.py", "wall_stop.toml")), "."]),
-                    "cp wall_stop.py wall_stop_v1.py"),
-             duration="keep", duration_why="the page quotes the whole run's 360 frames",
-             out=(PASS, (r"shadow wall_stop_v1\.py:WallStop: identical outputs on all 360 "
-                        r"frames"))),
-    "fpga-robotics designs":
-        Plan(out=(r"follow_target_safe  \(built-in\)",
-                  r"connectors: ultrasound \(trig=us_trig, echo=us_echo\)")),
-    "fpga-robotics designs wall_stop.py:WallStop":
-        Plan(setup=(f"cp {ROOT / 'tests/data/user_designs/wall_stop.py'} .",),
-             out=(r"wall_stop\.py:WallStop  \(Amaranth\)",
-                  (r"connectors: wheels \(motor_left=motor_left, motor_right=motor_right\); "
-                  r"ultrasound \(trig=trig, echo=echo\)"),
-                  r"recorded outputs: distance_mm, stopped")),
-    ("fpga-robotics run --scenario bump_wall.toml --design verilog:bump_stop_noreset.v --ports "
-     "bump_stop_noreset_ports.toml --rerun off"):
-        Plan(setup=(" ".join(["cp", str(ROOT / "tests/data/bump_wall.toml"), *(
-                         str(ROOT / "tests/data/user_designs" / name) for name in (
-                             "bump_stop_noreset.v", "bump_stop_noreset_ports.toml")), "."]),),
-             duration="keep", duration_why="the bumper closes after about 8 s of the 12 s",
-             out=(PASS, r"design output hit: last 1, min 0, max 1")),
-
-    "fpga-robotics ports ports.toml":
-        Plan(setup=("fpga-robotics ports --example ports.toml",),
-             out=(r"ports\.toml: follow_target, outputs found, proximity",)),
-    "fpga-robotics ports ports.toml --design verilog:follow_target.v":
-        Plan(setup=("fpga-robotics ports --example ports.toml",
-                    "python -m fpga_robotics.export -o follow_target.v"),
-             out=(r"ports\.toml: matches verilog:follow_target\.v \(\d+ ports\)",)),
-    "python -m fpga_robotics.mutation --mutants 200":
-        Plan(slow=True, shorter=(("--mutants", "12"), ("--width", "80"), ("--height", "60")),
-             out=(r"unit judge: \d+ caught, \d+ equivalent on these frames: score",),
-             files=("runs/mutation/n12-s1/mutants.json", "runs/mutation/n12-s1/mutants.v")),
-    "fpga-robotics mutate --mutants 40 --width 80 --height 60 --out runs/mutation/small":
-        Plan(slow=True, shorter=(("--mutants", "12"),),
-             out=(r"12 mutants of follow_target 80x60",),
-             files=("runs/mutation/small/mutants.json",)),
-    "fpga-robotics mutate --design wall_stop.py:WallStop --mutants 40 --param clock_hz=100000":
-        Plan(setup=(f"cp {ROOT / 'tests/data/user_designs/wall_stop.py'} .",),
-             shorter=(("--mutants", "12"),),
-             out=(r"12 mutants of WallStop \(seed 1\), 100000 cycles of random inputs",
-                  (r"unit judge \(against the unmutated design\): \d+ caught, \d+ equivalent "
-                  r"on these inputs: score")),
-             files=("runs/mutation/WallStop-n12-s1/mutants.json",)),
+    "fpga-robotics run --scenario wall_stop.toml --rerun off": Plan(
+        setup=(
+            " ".join(
+                [
+                    "cp",
+                    *(
+                        str(ROOT / "tests/data/user_designs" / name)
+                        for name in ("wall_stop.py", "wall_stop.toml")
+                    ),
+                    ".",
+                ]
+            ),
+        ),
+        duration="keep",
+        duration_why="the page quotes the whole run's stop at the wall "
+        "(12 s; about a second of wall time on CXXRTL)",
+        out=(
+            PASS,
+            r"design output distance_mm: last 227, min 218, max 1898",
+            r"design output stopped: last 1, min 0, max 1",
+        ),
+    ),
+    "fpga-robotics run --scenario wall_stop.toml --shadow wall_stop_v1.py:WallStop --rerun off": Plan(
+        setup=(
+            " ".join(
+                [
+                    "cp",
+                    *(
+                        str(ROOT / "tests/data/user_designs" / name)
+                        for name in ("wall_stop.py", "wall_stop.toml")
+                    ),
+                    ".",
+                ]
+            ),
+            "cp wall_stop.py wall_stop_v1.py",
+        ),
+        duration="keep",
+        duration_why="the page quotes the whole run's 360 frames",
+        out=(
+            PASS,
+            (
+                r"shadow wall_stop_v1\.py:WallStop: identical outputs on all 360 "
+                r"frames"
+            ),
+        ),
+    ),
+    "fpga-robotics designs": Plan(
+        out=(
+            r"follow_target_safe  \(built-in\)",
+            r"connectors: ultrasound \(trig=us_trig, echo=us_echo\)",
+        )
+    ),
+    "fpga-robotics designs wall_stop.py:WallStop": Plan(
+        setup=(f"cp {ROOT / 'tests/data/user_designs/wall_stop.py'} .",),
+        out=(
+            r"wall_stop\.py:WallStop  \(Amaranth\)",
+            (
+                r"connectors: wheels \(motor_left=motor_left, motor_right=motor_right\); "
+                r"ultrasound \(trig=trig, echo=echo\)"
+            ),
+            r"recorded outputs: distance_mm, stopped",
+        ),
+    ),
+    (
+        "fpga-robotics run --scenario bump_wall.toml --design verilog:bump_stop_noreset.v --ports "
+        "bump_stop_noreset_ports.toml --rerun off"
+    ): Plan(
+        setup=(
+            " ".join(
+                [
+                    "cp",
+                    str(ROOT / "tests/data/bump_wall.toml"),
+                    *(
+                        str(ROOT / "tests/data/user_designs" / name)
+                        for name in ("bump_stop_noreset.v", "bump_stop_noreset_ports.toml")
+                    ),
+                    ".",
+                ]
+            ),
+        ),
+        duration="keep",
+        duration_why="the bumper closes after about 8 s of the 12 s",
+        out=(PASS, r"design output hit: last 1, min 0, max 1"),
+    ),
+    "fpga-robotics ports ports.toml": Plan(
+        setup=("fpga-robotics ports --example ports.toml",),
+        out=(r"ports\.toml: follow_target, outputs found, proximity",),
+    ),
+    "fpga-robotics ports ports.toml --design verilog:follow_target.v": Plan(
+        setup=(
+            "fpga-robotics ports --example ports.toml",
+            "python -m fpga_robotics.export -o follow_target.v",
+        ),
+        out=(r"ports\.toml: matches verilog:follow_target\.v \(\d+ ports\)",),
+    ),
+    "python -m fpga_robotics.mutation --mutants 200": Plan(
+        slow=True,
+        shorter=(("--mutants", "12"), ("--width", "80"), ("--height", "60")),
+        out=(r"unit judge: \d+ caught, \d+ equivalent on these frames: score",),
+        files=("runs/mutation/n12-s1/mutants.json", "runs/mutation/n12-s1/mutants.v"),
+    ),
+    "fpga-robotics mutate --mutants 40 --width 80 --height 60 --out runs/mutation/small": Plan(
+        slow=True,
+        shorter=(("--mutants", "12"),),
+        out=(r"12 mutants of follow_target 80x60",),
+        files=("runs/mutation/small/mutants.json",),
+    ),
+    "fpga-robotics mutate --design wall_stop.py:WallStop --mutants 40 --param clock_hz=100000": Plan(
+        setup=(f"cp {ROOT / 'tests/data/user_designs/wall_stop.py'} .",),
+        shorter=(("--mutants", "12"),),
+        out=(
+            r"12 mutants of WallStop \(seed 1\), 100000 cycles of random inputs",
+            (
+                r"unit judge \(against the unmutated design\): \d+ caught, \d+ equivalent "
+                r"on these inputs: score"
+            ),
+        ),
+        files=("runs/mutation/WallStop-n12-s1/mutants.json",),
+    ),
     "python -m fpga_robotics.mutation --mutants 100 --campaign mutation":
-        # Four mutants at 80x60 on one worker, the campaign's runs made short: the whole
-        # command takes minutes (the page gives its measured time).
-        Plan(slow=True, shorter=(("--mutants", "4"), ("--width", "80"), ("--height", "60"),
-                      ("--workers", "1"), ("--recordings", "1")),
-             out=(r"robot judge \(campaign mutation: \d+ of 9 runs pass unmutated\)",),
-             files=("runs/mutation/n4-s1/report.html", "runs/mutation/n4-s1/robot.jsonl",
-                    "runs/mutation/n4-s1/mutants.json")),
+    # Four mutants at 80x60 on one worker, the campaign's runs made short: the whole
+    # command takes minutes (the page gives its measured time).
+    Plan(
+        slow=True,
+        shorter=(
+            ("--mutants", "4"),
+            ("--width", "80"),
+            ("--height", "60"),
+            ("--workers", "1"),
+            ("--recordings", "1"),
+        ),
+        out=(r"robot judge \(campaign mutation: \d+ of 9 runs pass unmutated\)",),
+        files=(
+            "runs/mutation/n4-s1/report.html",
+            "runs/mutation/n4-s1/robot.jsonl",
+            "runs/mutation/n4-s1/mutants.json",
+        ),
+    ),
     # The robot judge's scaling with workers: the same four mutants at 80x60 as above.
-    ("python -m fpga_robotics.mutation --mutants 30 --campaign mutation --workers 1 "
-     "--recordings 0 --out runs/mutation/scale-w1"):
-        Plan(slow=True, shorter=(("--mutants", "4"), ("--width", "80"), ("--height", "60")),
-             out=((r"robot judge \(campaign mutation: \d+ of 9 runs pass unmutated\).*"
-                   r"mutants/min"),),
-             files=("runs/mutation/scale-w1/mutants.json",)),
-    ("python -m fpga_robotics.mutation --mutants 30 --campaign mutation --workers 2 "
-     "--recordings 0 --out runs/mutation/scale-w2"):
-        Plan(slow=True, shorter=(("--mutants", "4"), ("--width", "80"), ("--height", "60")),
-             out=((r"robot judge \(campaign mutation: \d+ of 9 runs pass unmutated\).*"
-                   r"mutants/min"),),
-             files=("runs/mutation/scale-w2/mutants.json",)),
+    (
+        "python -m fpga_robotics.mutation --mutants 30 --campaign mutation --workers 1 "
+        "--recordings 0 --out runs/mutation/scale-w1"
+    ): Plan(
+        slow=True,
+        shorter=(("--mutants", "4"), ("--width", "80"), ("--height", "60")),
+        out=(
+            (
+                r"robot judge \(campaign mutation: \d+ of 9 runs pass unmutated\).*"
+                r"mutants/min"
+            ),
+        ),
+        files=("runs/mutation/scale-w1/mutants.json",),
+    ),
+    (
+        "python -m fpga_robotics.mutation --mutants 30 --campaign mutation --workers 2 "
+        "--recordings 0 --out runs/mutation/scale-w2"
+    ): Plan(
+        slow=True,
+        shorter=(("--mutants", "4"), ("--width", "80"), ("--height", "60")),
+        out=(
+            (
+                r"robot judge \(campaign mutation: \d+ of 9 runs pass unmutated\).*"
+                r"mutants/min"
+            ),
+        ),
+        files=("runs/mutation/scale-w2/mutants.json",),
+    ),
     # Forked against full robot-judge runs: the same four mutants at 80x60 as above.
-    ("python -m fpga_robotics.mutation --mutants 30 --campaign mutation --workers 2 "
-     "--recordings 0 --out runs/mutation/fork"):
-        Plan(slow=True, shorter=(("--mutants", "4"), ("--width", "80"), ("--height", "60")),
-             out=((r"robot judge \(campaign mutation: \d+ of 9 runs pass unmutated\).*"
-                   r"mutants/min"),),
-             files=("runs/mutation/fork/mutants.json",)),
-    ("python -m fpga_robotics.mutation --mutants 30 --campaign mutation --workers 2 "
-     "--recordings 0 --no-fork --out runs/mutation/no-fork"):
-        Plan(slow=True, shorter=(("--mutants", "4"), ("--width", "80"), ("--height", "60")),
-             out=((r"robot judge \(campaign mutation: \d+ of 9 runs pass unmutated\).*"
-                   r"mutants/min"),),
-             files=("runs/mutation/no-fork/mutants.json",)),
+    (
+        "python -m fpga_robotics.mutation --mutants 30 --campaign mutation --workers 2 "
+        "--recordings 0 --out runs/mutation/fork"
+    ): Plan(
+        slow=True,
+        shorter=(("--mutants", "4"), ("--width", "80"), ("--height", "60")),
+        out=(
+            (
+                r"robot judge \(campaign mutation: \d+ of 9 runs pass unmutated\).*"
+                r"mutants/min"
+            ),
+        ),
+        files=("runs/mutation/fork/mutants.json",),
+    ),
+    (
+        "python -m fpga_robotics.mutation --mutants 30 --campaign mutation --workers 2 "
+        "--recordings 0 --no-fork --out runs/mutation/no-fork"
+    ): Plan(
+        slow=True,
+        shorter=(("--mutants", "4"), ("--width", "80"), ("--height", "60")),
+        out=(
+            (
+                r"robot judge \(campaign mutation: \d+ of 9 runs pass unmutated\).*"
+                r"mutants/min"
+            ),
+        ),
+        files=("runs/mutation/no-fork/mutants.json",),
+    ),
     # The robot judge with the envelopes on three seeds: four mutants at 80x60 each (the page
     # gives the measured scores; the whole commands take tens of minutes).
-    **{f"python -m fpga_robotics.mutation --mutants {n} --campaign mutation --seed {seed} "
-       "--workers 1":
-       Plan(shorter=(("--mutants", "4"), ("--width", "80"), ("--height", "60"),
-                     ("--recordings", "0")),
-            out=(rf"4 mutants of follow_target 80x60 \(seed {seed}\)",
-                 r"robot judge \(campaign mutation: \d+ of 9 runs pass unmutated\)"))
-       for n, seed in ((60, 1), (20, 2), (20, 3))},
+    **{
+        f"python -m fpga_robotics.mutation --mutants {n} --campaign mutation --seed {seed} "
+        "--workers 1": Plan(
+            shorter=(
+                ("--mutants", "4"),
+                ("--width", "80"),
+                ("--height", "60"),
+                ("--recordings", "0"),
+            ),
+            out=(
+                rf"4 mutants of follow_target 80x60 \(seed {seed}\)",
+                r"robot judge \(campaign mutation: \d+ of 9 runs pass unmutated\)",
+            ),
+        )
+        for n, seed in ((60, 1), (20, 2), (20, 3))
+    },
     # The mutation campaign with the unmutated design: two short runs on the model backend
     # (the page gives the whole campaign's results).
-    "python -m fpga_robotics.sweep mutation":
-        Plan(shorter=(("--max-runs", "2"), ("--backend", "model"), ("--duration", "2")),
-             out=(r"2 runs: 2 pass",)),
-    "python -m fpga_robotics.sweep mutation --seeds 0-19 --out runs/sweeps/mutation-20":
-        Plan(shorter=(("--max-runs", "2"), ("--backend", "model"), ("--duration", "2")),
-             files=("runs/sweeps/mutation-20/report.html",), out=(r"2 runs: 2 pass",)),
-    "python -m fpga_robotics.sweep mutation --seeds 0-4 --out runs/sweeps/mutation-5":
-        Plan(shorter=(("--max-runs", "2"), ("--backend", "model"), ("--duration", "2")),
-             files=("runs/sweeps/mutation-5/report.html",), out=(r"2 runs: 2 pass",)),
-    "fpga-robotics bench foreign":
-        Plan(slow=True, shorter=(("--frames", "2"), ("--repeats", "1")),
-             out=(r"verilator \(built-in\) +[\d.]+ ms/frame",
-                  r"foreign follow_target \(stream\) +[\d.]+ ms/frame +\([\d.]+x the built-in\)")),
+    "python -m fpga_robotics.sweep mutation": Plan(
+        shorter=(("--max-runs", "2"), ("--backend", "model"), ("--duration", "2")),
+        out=(r"2 runs: 2 pass",),
+    ),
+    "python -m fpga_robotics.sweep mutation --seeds 0-19 --out runs/sweeps/mutation-20": Plan(
+        shorter=(("--max-runs", "2"), ("--backend", "model"), ("--duration", "2")),
+        files=("runs/sweeps/mutation-20/report.html",),
+        out=(r"2 runs: 2 pass",),
+    ),
+    "python -m fpga_robotics.sweep mutation --seeds 0-4 --out runs/sweeps/mutation-5": Plan(
+        shorter=(("--max-runs", "2"), ("--backend", "model"), ("--duration", "2")),
+        files=("runs/sweeps/mutation-5/report.html",),
+        out=(r"2 runs: 2 pass",),
+    ),
+    "fpga-robotics bench foreign": Plan(
+        slow=True,
+        shorter=(("--frames", "2"), ("--repeats", "1")),
+        out=(
+            r"verilator \(built-in\) +[\d.]+ ms/frame",
+            r"foreign follow_target \(stream\) +[\d.]+ ms/frame +\([\d.]+x the built-in\)",
+        ),
+    ),
     # Verilog export and the board ------------------------------------------------------------
-    "python -m fpga_robotics.export -o build/follow_target.v":
-        Plan(files=("build/follow_target.v",), out=(r"160x120, module follow_target",)),
+    "python -m fpga_robotics.export -o build/follow_target.v": Plan(
+        files=("build/follow_target.v",), out=(r"160x120, module follow_target",)
+    ),
     "python -m fpga_robotics.export -o build/ft320.v --width 320 --height 240 --diff-min 5 "
     "--kp-num 2 --base-dps 0,400,300,200,150,100,-100,-150 "
-    "--proximity-thresholds 512,1024,2048,4096,8192,16384,24576":
-        Plan(files=("build/ft320.v",), out=(r"320x240, module follow_target",)),
+    "--proximity-thresholds 512,1024,2048,4096,8192,16384,24576": Plan(
+        files=("build/ft320.v",), out=(r"320x240, module follow_target",)
+    ),
     "python -m fpga_robotics.export --board ulx3s-85f -o build/ulx3s":
-        # docs/board.md: the board top, its LPF and the rest of Amaranth's build plan.
-        Plan(files=tuple(f"build/ulx3s/{name}" for name in (
-            "ulx3s_follow_target.v", "ulx3s_follow_target.lpf", "ulx3s_follow_target.il",
-            "ulx3s_follow_target.ys", "build_ulx3s_follow_target.sh"))),
-    "python -m fpga_robotics.export --board ulx3s-85f -o build/ulx3s --bitstream":
-        Plan(slow=True, files=("build/ulx3s/ulx3s_follow_target.bit",),
-             out=(r"(?i)sync.*MHz",)),
-    ("python -m fpga_robotics.run --design verilog:design_top.v,centroid.v,color_proc.v,"
-     "frame_buffer.v,motor_ctrl_spi.v --ports \"$(python -c 'import fpga_robotics, pathlib; "
-     "print(pathlib.Path(fpga_robotics.__file__).parent / \"designs/port_maps/published_design_top.toml"
-     "\")')\" --rerun off --shadow published --shadow-backend model"):
-        Plan(excused="runs the published RTL, which this project does not ship (third-party "
-                     "files); the shipped port map is read by test_foreign_verilog.py"),
-    "openFPGALoader -b ulx3s build/ulx3s/ulx3s_follow_target.bit":
-        Plan(excused="programs a ULX3S over USB: needs the board (and openFPGALoader, which is "
-                     "not a Python package)"),
+    # docs/board.md: the board top, its LPF and the rest of Amaranth's build plan.
+    Plan(
+        files=tuple(
+            f"build/ulx3s/{name}"
+            for name in (
+                "ulx3s_follow_target.v",
+                "ulx3s_follow_target.lpf",
+                "ulx3s_follow_target.il",
+                "ulx3s_follow_target.ys",
+                "build_ulx3s_follow_target.sh",
+            )
+        )
+    ),
+    "python -m fpga_robotics.export --board ulx3s-85f -o build/ulx3s --bitstream": Plan(
+        slow=True, files=("build/ulx3s/ulx3s_follow_target.bit",), out=(r"(?i)sync.*MHz",)
+    ),
+    (
+        "python -m fpga_robotics.run --design verilog:design_top.v,centroid.v,color_proc.v,"
+        "frame_buffer.v,motor_ctrl_spi.v --ports \"$(python -c 'import fpga_robotics, pathlib; "
+        'print(pathlib.Path(fpga_robotics.__file__).parent / "designs/port_maps/published_design_top.toml'
+        '")\')" --rerun off --shadow published --shadow-backend model'
+    ): Plan(
+        excused="runs the published RTL, which this project does not ship (third-party "
+        "files); the shipped port map is read by test_foreign_verilog.py"
+    ),
+    "openFPGALoader -b ulx3s build/ulx3s/ulx3s_follow_target.bit": Plan(
+        excused="programs a ULX3S over USB: needs the board (and openFPGALoader, which is "
+        "not a Python package)"
+    ),
     # "includes the slow full build", and without it:
-    "python -m pytest -q tests/test_board_*.py":
-        Plan(collect=True, out=(r"test_bitstream_build_meets_timing",)),
-    'python -m pytest -q tests/test_board_*.py -m "not slow"':
-        Plan(collect=True, out=(r"\(\d+ deselected\)",),
-             not_out=(r"test_bitstream_build_meets_timing",)),
+    "python -m pytest -q tests/test_board_*.py": Plan(
+        collect=True, out=(r"test_bitstream_build_meets_timing",)
+    ),
+    'python -m pytest -q tests/test_board_*.py -m "not slow"': Plan(
+        collect=True, out=(r"\(\d+ deselected\)",), not_out=(r"test_bitstream_build_meets_timing",)
+    ),
     "python -m pytest -q tests/test_hw_color_filter.py tests/test_hw_divider.py "
     "tests/test_hw_tracker.py tests/test_hw_motor.py tests/test_hw_top.py "
-    "tests/test_hw_pysim_backend.py tests/test_export.py tests/test_published_frames.py":
-        Plan(collect=True, out=(r"\d+ tests collected",)),
+    "tests/test_hw_pysim_backend.py tests/test_export.py tests/test_published_frames.py": Plan(
+        collect=True, out=(r"\d+ tests collected",)
+    ),
     # docs/published.md: the published design as a preset -----------------------------------
-    "python -m fpga_robotics.run --set design.preset=published --rerun off":
-        Plan(out=(PASS,)),
-    "python -m fpga_robotics.run --shadow published --rerun off":
-        Plan(duration="keep",
-             duration_why="the page shows this run's last lines, with counts 'of 900': the "
-                          "whole 30 s of follow_person (a second or two of wall time)",
-             out=(PASS,
-                  re.escape("  shadow published: first differs at frame 0 (0.00 s): proximity 4 "
-                            "vs 3, centroid_leds 24 vs 16, motor_left 147 vs 350, motor_right "
-                            "153 vs 225"),
-                  re.escape("  shadow frames that differ: proximity 750, centroid_leds 118, "
-                            "motor_left 900, motor_right 900 (of 900)"))),
-    "python -m fpga_robotics.export --preset published -o build/published.v":
-        Plan(files=("build/published.v",),
-             out=(r"160x120, preset published, module follow_target",)),
+    "python -m fpga_robotics.run --set design.preset=published --rerun off": Plan(out=(PASS,)),
+    "python -m fpga_robotics.run --shadow published --rerun off": Plan(
+        duration="keep",
+        duration_why="the page shows this run's last lines, with counts 'of 900': the "
+        "whole 30 s of follow_person (a second or two of wall time)",
+        out=(
+            PASS,
+            re.escape(
+                "  shadow published: first differs at frame 0 (0.00 s): proximity 4 "
+                "vs 3, centroid_leds 24 vs 16, motor_left 147 vs 350, motor_right "
+                "153 vs 225"
+            ),
+            re.escape(
+                "  shadow frames that differ: proximity 750, centroid_leds 118, "
+                "motor_left 900, motor_right 900 (of 900)"
+            ),
+        ),
+    ),
+    "python -m fpga_robotics.export --preset published -o build/published.v": Plan(
+        files=("build/published.v",), out=(r"160x120, preset published, module follow_target",)
+    ),
     # docs/sensor_designs.md: the sensor designs' exports -------------------------------------
-    "python -m fpga_robotics.export --top follow_target_safe -o build/follow_target_safe.v":
-        Plan(files=("build/follow_target_safe.v",),
-             out=(r"160x120, 50000000 Hz, stop 300 mm, resume 400 mm, module follow_target_safe",)),
+    "python -m fpga_robotics.export --top follow_target_safe -o build/follow_target_safe.v": Plan(
+        files=("build/follow_target_safe.v",),
+        out=(r"160x120, 50000000 Hz, stop 300 mm, resume 400 mm, module follow_target_safe",),
+    ),
     "python -m fpga_robotics.export --top follow_target_safe --stop-mm 250 --resume-mm 350 "
-    "-o build/safe250.v":
-        Plan(files=("build/safe250.v",), out=(r"stop 250 mm, resume 350 mm",)),
-    "python -m fpga_robotics.export --top follow_line --line-n-sensors 2 -o build/follow_line2.v":
-        Plan(files=("build/follow_line2.v",), out=(r"2 sensors, module follow_line",)),
+    "-o build/safe250.v": Plan(files=("build/safe250.v",), out=(r"stop 250 mm, resume 350 mm",)),
+    "python -m fpga_robotics.export --top follow_line --line-n-sensors 2 -o build/follow_line2.v": Plan(
+        files=("build/follow_line2.v",), out=(r"2 sensors, module follow_line",)
+    ),
     "python -m fpga_robotics.export --top follow_line --variant line_inverted_polarity "
-    "-o build/line_inverted.v":
-        Plan(files=("build/line_inverted.v",),
-             out=(r"3 sensors, variant line_inverted_polarity, module follow_line",)),
+    "-o build/line_inverted.v": Plan(
+        files=("build/line_inverted.v",),
+        out=(r"3 sensors, variant line_inverted_polarity, module follow_line",),
+    ),
     "python -m fpga_robotics.export --top follow_target_safe --variant us_echo_counter_narrow "
-    "-o build/safe_narrow.v":
-        Plan(files=("build/safe_narrow.v",),
-             out=(r"variant us_echo_counter_narrow, module follow_target_safe",)),
+    "-o build/safe_narrow.v": Plan(
+        files=("build/safe_narrow.v",),
+        out=(r"variant us_echo_counter_narrow, module follow_target_safe",),
+    ),
     "python -m pytest -q tests/test_hw_ultrasound.py tests/test_hw_safe_follow.py "
     "tests/test_hw_follow_line.py tests/test_hw_follow_line_track.py "
-    "tests/test_export_sensor_designs.py":
-        Plan(collect=True, out=(r"\d+ tests collected",)),
-    "python -m fpga_robotics.run --set design.preset=published":
-        Plan(viewer=True, files=("runs/follow_person.rrd",), out=(PASS, SAVED_DEFAULT)),
+    "tests/test_export_sensor_designs.py": Plan(collect=True, out=(r"\d+ tests collected",)),
+    "python -m fpga_robotics.run --set design.preset=published": Plan(
+        viewer=True, files=("runs/follow_person.rrd",), out=(PASS, SAVED_DEFAULT)
+    ),
     "python -m fpga_robotics.run --set design.preset=published --rerun off --summary "
-    "published.json":
-        Plan(files=("published.json",), out=(PASS,)),
-    "python -m fpga_robotics.run --rerun off --summary ours.json":
-        Plan(files=("ours.json",), out=(PASS,)),
+    "published.json": Plan(files=("published.json",), out=(PASS,)),
+    "python -m fpga_robotics.run --rerun off --summary ours.json": Plan(
+        files=("ours.json",), out=(PASS,)
+    ),
     "python -m fpga_robotics.run --shadow published --set robot.heading_deg=180 --duration 6 "
-    "--rerun off":
-        Plan(duration="keep", duration_why="the page shows this 6 s run's last lines",
-             out=(re.escape("  shadow published: first differs at frame 79 (2.63 s): proximity "
-                            "2 vs 3, motor_left 111 vs 75, motor_right 489 vs 350"),
-                  re.escape("  shadow frames that differ: proximity 96, centroid_leds 1, "
-                            "motor_left 101, motor_right 101 (of 180)"))),
+    "--rerun off": Plan(
+        duration="keep",
+        duration_why="the page shows this 6 s run's last lines",
+        out=(
+            re.escape(
+                "  shadow published: first differs at frame 79 (2.63 s): proximity "
+                "2 vs 3, motor_left 111 vs 75, motor_right 489 vs 350"
+            ),
+            re.escape(
+                "  shadow frames that differ: proximity 96, centroid_leds 1, "
+                "motor_left 101, motor_right 101 (of 180)"
+            ),
+        ),
+    ),
     # Benchmarks ------------------------------------------------------------------------------
-    "fpga-robotics bench":
-        Plan(slow=True, out=tuple(rf"(?m)^{b}\s+{s}\s" for b in ("model", "cxxrtl", "verilator")
-                       for s in ("160x120", "320x240", "640x480"))
-             + (r"(?m)^pysim\s+160x120\s",
-                r"cxxrtl 160x120: FollowTarget at [\d.]+ of the trivial design's cycle rate")),
+    "fpga-robotics bench": Plan(
+        slow=True,
+        out=tuple(
+            rf"(?m)^{b}\s+{s}\s"
+            for b in ("model", "cxxrtl", "verilator")
+            for s in ("160x120", "320x240", "640x480")
+        )
+        + (
+            r"(?m)^pysim\s+160x120\s",
+            r"cxxrtl 160x120: FollowTarget at [\d.]+ of the trivial design's cycle rate",
+        ),
+    ),
     "fpga-robotics bench design --backends cxxrtl,verilator --resolutions 160x120,640x480 "
-    "--frames 30 --min-seconds 2 --published /tmp/published":
-        Plan(excused="needs the published FPGA-Robotics RTL in /tmp/published, which is not part "
-                     "of the project (docs/foreign.md says where it is); "
-                     "tests/test_backends_bench.py runs the option's checks"),
-    "fpga-robotics bench calibrate":
-        Plan(shorter=(("--frames", "2"), ("--repeats", "1")),
-             out=(r"calibration: published preset, (cxxrtl|verilator|model), 160x120",
-                  r"(?m)^wall +[\d.]+ +[\d.]+ +[\d.]+$")),
-    "fpga-robotics bench loop --backend cxxrtl --duration 10 --repeats 3":
-        Plan(shorter=(("--duration", "1"), ("--repeats", "1")),
-             out=(r"closed loop 160x120: follow_person, cxxrtl",
-                  r"closed loop 640x480: follow_person, cxxrtl",
-                  r"the loop against the design alone, CPU time: whole [\d.]+x",
-                  r"target 640x480: [\d.]+x real time by CPU time")),
-    "fpga-robotics bench loop --backend cxxrtl --resolutions 160x120 --profile 12":
-        Plan(shorter=(("--duration", "1"), ("--repeats", "1")),
-             out=(r"cProfile of one run, 12 functions of largest own time",
-                  r"tottime")),
-    "fpga-robotics bench camera":
-        Plan(shorter=(("--frames", "2"), ("--repeats", "1")),
-             out=(r"(?m)^\s*160x120\s+[\d.]+", r"(?m)^\s*640x480\s+[\d.]+")),
+    "--frames 30 --min-seconds 2 --published /tmp/published": Plan(
+        excused="needs the published FPGA-Robotics RTL in /tmp/published, which is not part "
+        "of the project (docs/foreign.md says where it is); "
+        "tests/test_backends_bench.py runs the option's checks"
+    ),
+    "fpga-robotics bench calibrate": Plan(
+        shorter=(("--frames", "2"), ("--repeats", "1")),
+        out=(
+            r"calibration: published preset, (cxxrtl|verilator|model), 160x120",
+            r"(?m)^wall +[\d.]+ +[\d.]+ +[\d.]+$",
+        ),
+    ),
+    "fpga-robotics bench loop --backend cxxrtl --duration 10 --repeats 3": Plan(
+        shorter=(("--duration", "1"), ("--repeats", "1")),
+        out=(
+            r"closed loop 160x120: follow_person, cxxrtl",
+            r"closed loop 640x480: follow_person, cxxrtl",
+            r"the loop against the design alone, CPU time: whole [\d.]+x",
+            r"target 640x480: [\d.]+x real time by CPU time",
+        ),
+    ),
+    "fpga-robotics bench loop --backend cxxrtl --resolutions 160x120 --profile 12": Plan(
+        shorter=(("--duration", "1"), ("--repeats", "1")),
+        out=(r"cProfile of one run, 12 functions of largest own time", r"tottime"),
+    ),
+    "fpga-robotics bench camera": Plan(
+        shorter=(("--frames", "2"), ("--repeats", "1")),
+        out=(r"(?m)^\s*160x120\s+[\d.]+", r"(?m)^\s*640x480\s+[\d.]+"),
+    ),
     # docs/pins.md -------------------------------------------------------------------------------
-    "fpga-robotics bench pins":
-        Plan(slow=True, shorter=(("--seconds", "0.02"), ("--pysim-seconds", "0.0002"), ("--repeats", "1")),
-             out=((r"(?m)^cxxrtl +pins: +[\d.]+ Mcycles/s \(1,000,000 cycles, 1 frames, \d+ stops "
-                  r"a run\); frame path [\d.]+ Mcycles/s, pins/frame [\d.]+ \(median of the runs' "
-                   r"ratios\)$"),
-                  r"(?m)^verilator +pins: +[\d.]+ Mcycles/s",
-                  r"(?m)^pysim +pins: +[\d.]+ Mcycles/s \(10,000 cycles")),
+    "fpga-robotics bench pins": Plan(
+        slow=True,
+        shorter=(("--seconds", "0.02"), ("--pysim-seconds", "0.0002"), ("--repeats", "1")),
+        out=(
+            (
+                r"(?m)^cxxrtl +pins: +[\d.]+ Mcycles/s \(1,000,000 cycles, 1 frames, \d+ stops "
+                r"a run\); frame path [\d.]+ Mcycles/s, pins/frame [\d.]+ \(median of the runs' "
+                r"ratios\)$"
+            ),
+            r"(?m)^verilator +pins: +[\d.]+ Mcycles/s",
+            r"(?m)^pysim +pins: +[\d.]+ Mcycles/s \(10,000 cycles",
+        ),
+    ),
     # docs/camera.md: the sensor model ---------------------------------------------------------
-    "fpga-robotics bench camera --sensor --sizes 160x120,640x480":
-        Plan(shorter=(("--frames", "2"), ("--repeats", "1")),
-             out=(r"(?m)^\s*160x120(\s+[\d.]+){9}$", r"(?m)^\s*640x480(\s+[\d.]+){9}$")),
-    "fpga-robotics bench camera --stage-images docs/images":
-        Plan(files=tuple(f"docs/images/sensor_stage_{i}.png" for i in range(7)),
-             out=(r"sensor_stage_6\.png: RGB444",)),
-    "python -m fpga_robotics.run --scenario divider --backend cxxrtl --set camera.sensor=ov7670":
-        Plan(duration="keep", duration_why=_SENSOR_WHY, out=(PASS,)),
+    "fpga-robotics bench camera --sensor --sizes 160x120,640x480": Plan(
+        shorter=(("--frames", "2"), ("--repeats", "1")),
+        out=(r"(?m)^\s*160x120(\s+[\d.]+){9}$", r"(?m)^\s*640x480(\s+[\d.]+){9}$"),
+    ),
+    "fpga-robotics bench camera --stage-images docs/images": Plan(
+        files=tuple(f"docs/images/sensor_stage_{i}.png" for i in range(7)),
+        out=(r"sensor_stage_6\.png: RGB444",),
+    ),
+    "python -m fpga_robotics.run --scenario divider --backend cxxrtl --set camera.sensor=ov7670": Plan(
+        duration="keep", duration_why=_SENSOR_WHY, out=(PASS,)
+    ),
     "python -m fpga_robotics.run --scenario divider --backend cxxrtl --rerun off "
-    "--set camera.sensor=ov7670":
-        Plan(duration="keep", duration_why=_SENSOR_WHY, out=(PASS,)),
+    "--set camera.sensor=ov7670": Plan(duration="keep", duration_why=_SENSOR_WHY, out=(PASS,)),
     "python -m fpga_robotics.run --scenario lighting --backend cxxrtl --rerun off "
-    "--set camera.sensor=ov7670":
-        Plan(duration="keep", duration_why=_SENSOR_WHY, out=(PASS,)),
+    "--set camera.sensor=ov7670": Plan(duration="keep", duration_why=_SENSOR_WHY, out=(PASS,)),
     "python -m fpga_robotics.run --scenario divider --backend cxxrtl --rerun off "
-    "--set design.diff_min=5 --set camera.sensor=ov7670":
-        Plan(duration="keep", duration_why=_SENSOR_WHY,
-             out=(PASS, r"target: first found at 0\.00 s, in view 100%, found 100%")),
+    "--set design.diff_min=5 --set camera.sensor=ov7670": Plan(
+        duration="keep",
+        duration_why=_SENSOR_WHY,
+        out=(PASS, r"target: first found at 0\.00 s, in view 100%, found 100%"),
+    ),
     "python -m fpga_robotics.run --scenario lighting --backend cxxrtl --rerun off "
     "--set camera.sensor=ov7670 "
-    "--set 'lighting.keyframes=[[0,0.6,0.4],[8,0.28,0.2],[18,0.28,0.2],[24,0.8,0.5]]'":
-        Plan(duration="keep", duration_why=_SENSOR_WHY,
-             out=(PASS, r"target: first found at 0\.00 s, in view 100%, found 100%")),
+    "--set 'lighting.keyframes=[[0,0.6,0.4],[8,0.28,0.2],[18,0.28,0.2],[24,0.8,0.5]]'": Plan(
+        duration="keep",
+        duration_why=_SENSOR_WHY,
+        out=(PASS, r"target: first found at 0\.00 s, in view 100%, found 100%"),
+    ),
     # docs/ros.md: ROS 2 bags and Foxglove -------------------------------------------------------
-    "python -m fpga_robotics.run --bag runs/follow_bag":
-        Plan(files=("runs/follow_bag/metadata.yaml", "runs/follow_bag/follow_bag.mcap"),
-             out=(PASS, r"ROS 2 bag \(30 frames\) written to runs/follow_bag")),
-    "python -m fpga_robotics.run --live foxglove":
-        Plan(out=(PASS, r"Foxglove live: open a WebSocket connection to ws://127\.0\.0\.1:8765",
-                  r"foxglove_layout\.json")),
-    "python -m fpga_robotics.run --interactive":
-        Plan(excused="reads keys from a terminal, and this test gives commands none; "
-                     "tests/test_ros_interactive.py drives it through a pseudo-terminal"),
-    "python -m fpga_robotics.run --interactive --summary steered.json":
-        Plan(excused="reads keys from a terminal, and this test gives commands none; "
-                     "tests/test_ros_interactive.py drives it through a pseudo-terminal "
-                     "(the replay below gets its steered.json from a set-up)"),
+    "python -m fpga_robotics.run --bag runs/follow_bag": Plan(
+        files=("runs/follow_bag/metadata.yaml", "runs/follow_bag/follow_bag.mcap"),
+        out=(PASS, r"ROS 2 bag \(30 frames\) written to runs/follow_bag"),
+    ),
+    "python -m fpga_robotics.run --live foxglove": Plan(
+        out=(
+            PASS,
+            r"Foxglove live: open a WebSocket connection to ws://127\.0\.0\.1:8765",
+            r"foxglove_layout\.json",
+        )
+    ),
+    "python -m fpga_robotics.run --interactive": Plan(
+        excused="reads keys from a terminal, and this test gives commands none; "
+        "tests/test_ros_interactive.py drives it through a pseudo-terminal"
+    ),
+    "python -m fpga_robotics.run --interactive --summary steered.json": Plan(
+        excused="reads keys from a terminal, and this test gives commands none; "
+        "tests/test_ros_interactive.py drives it through a pseudo-terminal "
+        "(the replay below gets its steered.json from a set-up)"
+    ),
     "python -m fpga_robotics.run --replay-inputs steered.json --bag runs/replayed":
-        # Inputs as a steered run records them: the target stopped for ten frames.
-        Plan(setup=(("""echo '{"inputs": [{"frame": 12, "kind": "target_velocity", """
-                     """"value": [0, 0]}, {"frame": 22, "kind": "target_velocity", """
-                     """"value": null}]}' > steered.json"""),),
-             files=("runs/replayed/metadata.yaml",),
-             out=(PASS, r"ROS 2 bag \(30 frames\) written to runs/replayed")),
+    # Inputs as a steered run records them: the target stopped for ten frames.
+    Plan(
+        setup=(
+            (
+                """echo '{"inputs": [{"frame": 12, "kind": "target_velocity", """
+                """"value": [0, 0]}, {"frame": 22, "kind": "target_velocity", """
+                """"value": null}]}' > steered.json"""
+            ),
+        ),
+        files=("runs/replayed/metadata.yaml",),
+        out=(PASS, r"ROS 2 bag \(30 frames\) written to runs/replayed"),
+    ),
     "python -m fpga_robotics.run --source bag:robot_bag:/camera/image_raw --bag runs/robot_outputs":
-        # A run's own bag stands in for a real robot's.
-        Plan(setup=(("python -m fpga_robotics.run --duration 1 --rerun off --quiet "
-                     "--bag robot_bag"),),
-             files=("runs/robot_outputs/metadata.yaml",),
-             out=(r"source bag:robot_bag:/camera/image_raw \(bag\)",
-                  r"target found in 30 frames",
-                  r"ROS 2 bag \(30 frames\) written to runs/robot_outputs")),
-    "fpga-robotics bench ros":
-        Plan(shorter=(("--frames", "2"), ("--repeats", "1")),
-             out=(r"bag  \(--bag\): log_frame median [\d.]+ ms",
-                  (r"live \(--live foxglove, one client\): log_frame median [\d.]+ ms; "
-                   r"client received 26/26 messages"))),
+    # A run's own bag stands in for a real robot's.
+    Plan(
+        setup=(("python -m fpga_robotics.run --duration 1 --rerun off --quiet --bag robot_bag"),),
+        files=("runs/robot_outputs/metadata.yaml",),
+        out=(
+            r"source bag:robot_bag:/camera/image_raw \(bag\)",
+            r"target found in 30 frames",
+            r"ROS 2 bag \(30 frames\) written to runs/robot_outputs",
+        ),
+    ),
+    "fpga-robotics bench ros": Plan(
+        shorter=(("--frames", "2"), ("--repeats", "1")),
+        out=(
+            r"bag  \(--bag\): log_frame median [\d.]+ ms",
+            (
+                r"live \(--live foxglove, one client\): log_frame median [\d.]+ ms; "
+                r"client received 26/26 messages"
+            ),
+        ),
+    ),
     # docs/render3d.md: the 3D renderer ----------------------------------------------------
-    "python -m fpga_robotics.run --scenario follow_person --set camera.renderer=mujoco --rerun off":
-        Plan(out=(PASS,)),
-    "python -m pytest -q tests/test_render3d_agreement.py tests/test_render3d_people.py":
-        Plan(collect=True, out=(r"\d+ tests collected",)),
-    "fpga-robotics bench render3d --figures docs/figures":
-        Plan(files=("docs/figures/divider_3d.png", "docs/figures/lighting_3d.png"),
-             out=(r"wrote docs/figures/divider_3d\.png",)),
-    "python -m fpga_robotics.run --scenario divider_3d --rerun off":
-        Plan(duration="keep",
-             duration_why="the page says the scenario passes: over its own 25 s; a run under "
-                          "15 s fails its mean-distance check, as divider's does",
-             out=(PASS,)),
-    "python -m fpga_robotics.run --scenario divider_3d --set design.diff_min=6 --rerun off":
-        Plan(duration="10",
-             duration_why="the centroid is on the lit wood well within 10 s (the person leaves "
-                          "the view later, failing target_in_view_min_fraction over 25 s)",
-             out=(r"\[FAIL\] max_off_target_fraction",)),
-    "python -m fpga_robotics.run --scenario lighting_3d --rerun off":
-        Plan(duration="keep",
-             duration_why="the page says the scenario passes, dusk and the light's return "
-                          "included (30 s)",
-             out=(PASS,)),
-    "python -m fpga_robotics.run --scenario lighting_3d --set design.diff_min=6 --rerun off":
-        Plan(duration="16",
-             duration_why="dusk falls by 8 s; by 16 s the person has been lost long enough to "
-                          "fail found_min_fraction",
-             out=(r"\[FAIL\] found_min_fraction",)),
-    "fpga-robotics bench render3d":
-        Plan(shorter=(("--frames", "2"), ("--repeats", "1"), ("--seconds", "0.5"),
-                      ("--backend", "model")),
-             out=(r"(?m)^\s*raster\s+[\d.]+\s+[\d.]+\s+[\d.]+",
-                  r"(?m)^\s*3d, shadows 256\s+[\d.]+ ms/frame\s+[\d.]+x real time")),
-    "fpga-robotics bench pysim --frames 7":
-        Plan(shorter=(("--frames", "2"),),
-             out=(r"every frame equal to the golden model", r"median [\d.]+ s wall")),
+    "python -m fpga_robotics.run --scenario follow_person --set camera.renderer=mujoco --rerun off": Plan(
+        out=(PASS,)
+    ),
+    "python -m pytest -q tests/test_render3d_agreement.py tests/test_render3d_people.py": Plan(
+        collect=True, out=(r"\d+ tests collected",)
+    ),
+    "fpga-robotics bench render3d --figures docs/figures": Plan(
+        files=("docs/figures/divider_3d.png", "docs/figures/lighting_3d.png"),
+        out=(r"wrote docs/figures/divider_3d\.png",),
+    ),
+    "python -m fpga_robotics.run --scenario divider_3d --rerun off": Plan(
+        duration="keep",
+        duration_why="the page says the scenario passes: over its own 25 s; a run under "
+        "15 s fails its mean-distance check, as divider's does",
+        out=(PASS,),
+    ),
+    "python -m fpga_robotics.run --scenario divider_3d --set design.diff_min=6 --rerun off": Plan(
+        duration="10",
+        duration_why="the centroid is on the lit wood well within 10 s (the person leaves "
+        "the view later, failing target_in_view_min_fraction over 25 s)",
+        out=(r"\[FAIL\] max_off_target_fraction",),
+    ),
+    "python -m fpga_robotics.run --scenario lighting_3d --rerun off": Plan(
+        duration="keep",
+        duration_why="the page says the scenario passes, dusk and the light's return "
+        "included (30 s)",
+        out=(PASS,),
+    ),
+    "python -m fpga_robotics.run --scenario lighting_3d --set design.diff_min=6 --rerun off": Plan(
+        duration="16",
+        duration_why="dusk falls by 8 s; by 16 s the person has been lost long enough to "
+        "fail found_min_fraction",
+        out=(r"\[FAIL\] found_min_fraction",),
+    ),
+    "fpga-robotics bench render3d": Plan(
+        shorter=(
+            ("--frames", "2"),
+            ("--repeats", "1"),
+            ("--seconds", "0.5"),
+            ("--backend", "model"),
+        ),
+        out=(
+            r"(?m)^\s*raster\s+[\d.]+\s+[\d.]+\s+[\d.]+",
+            r"(?m)^\s*3d, shadows 256\s+[\d.]+ ms/frame\s+[\d.]+x real time",
+        ),
+    ),
+    "fpga-robotics bench pysim --frames 7": Plan(
+        shorter=(("--frames", "2"),),
+        out=(r"every frame equal to the golden model", r"median [\d.]+ s wall"),
+    ),
 }
 
 
@@ -869,8 +1226,9 @@ def _is_design_bench(cmd):
 
 
 def _is(cmd, module, sub):
-    return cmd.startswith((f"python -m fpga_robotics.{module} ", f"fpga-robotics {sub} ")) \
-        or cmd in (f"python -m fpga_robotics.{module}", f"fpga-robotics {sub}")
+    return cmd.startswith(
+        (f"python -m fpga_robotics.{module} ", f"fpga-robotics {sub} ")
+    ) or cmd in (f"python -m fpga_robotics.{module}", f"fpga-robotics {sub}")
 
 
 def _set_option(args, name, value):
@@ -913,6 +1271,7 @@ def effective(doc_text, plan):
 
 # --- Running ----------------------------------------------------------------------------------
 
+
 def command_env():
     """The environment of a documented command: this interpreter's scripts first on PATH,
     and no display (so ``--rerun auto`` saves a file, as on CI)."""
@@ -933,9 +1292,16 @@ class Ran:
 
 def run_shell(command, cwd, timeout=TIMEOUT):
     try:
-        proc = subprocess.run(["bash", "-c", command], check=False, cwd=cwd, env=command_env(),
-                              stdin=subprocess.DEVNULL, capture_output=True, text=True,
-                              timeout=timeout)
+        proc = subprocess.run(
+            ["bash", "-c", command],
+            check=False,
+            cwd=cwd,
+            env=command_env(),
+            stdin=subprocess.DEVNULL,
+            capture_output=True,
+            text=True,
+            timeout=timeout,
+        )
     except subprocess.TimeoutExpired as exc:
         pytest.fail(f"{command!r} did not end within {timeout} s:\n{exc.stdout}\n{exc.stderr}")
     return Ran(command, proc.returncode, proc.stdout + proc.stderr, proc.stdout)
@@ -967,9 +1333,15 @@ def run_server(command, cwd, *, within=60.0):
     log = Path(cwd) / "server.log"
     start = time.monotonic()
     with open(log, "wb") as out:
-        proc = subprocess.Popen(["bash", "-c", command], cwd=cwd, env=command_env(),
-                                stdin=subprocess.DEVNULL, stdout=out, stderr=subprocess.STDOUT,
-                                start_new_session=True)
+        proc = subprocess.Popen(
+            ["bash", "-c", command],
+            cwd=cwd,
+            env=command_env(),
+            stdin=subprocess.DEVNULL,
+            stdout=out,
+            stderr=subprocess.STDOUT,
+            start_new_session=True,
+        )
     try:
         status = None
         while time.monotonic() - start < within and proc.poll() is None:
@@ -989,12 +1361,14 @@ def run_server(command, cwd, *, within=60.0):
             proc.wait(timeout=10)
     printed = log.read_text(errors="replace")
     ran = Ran(command, 0 if status == 200 else 1, printed, printed)
-    assert status == 200, f"{command!r}: no HTTP 200 on 127.0.0.1:{web} within {within} s:\n" \
-                          f"{ran.output}"
+    assert status == 200, (
+        f"{command!r}: no HTTP 200 on 127.0.0.1:{web} within {within} s:\n{ran.output}"
+    )
     assert stopped, f"{command!r} did not stop within 15 s of Ctrl-C"
     # The page says it prints the address to open, with the gRPC port in the URL.
-    assert f"http://127.0.0.1:{web}?url=rerun%2Bhttp%3A%2F%2Flocalhost%3A{grpc}%2Fproxy" \
-        in ran.output, ran.output
+    assert (
+        f"http://127.0.0.1:{web}?url=rerun%2Bhttp%3A%2F%2Flocalhost%3A{grpc}%2Fproxy" in ran.output
+    ), ran.output
     return ran
 
 
@@ -1002,13 +1376,15 @@ def check(doc, plan, ran, folder):
     where = f"{doc.page}:{doc.line}: {ran.command!r}"
     assert ran.returncode == doc.expected_rc, (
         f"{where}: exit code {ran.returncode}, the page says "
-        f"{doc.expected_rc}{' (# FAIL)' if doc.expected_rc else ''}:\n{ran.output[-3000:]}")
+        f"{doc.expected_rc}{' (# FAIL)' if doc.expected_rc else ''}:\n{ran.output[-3000:]}"
+    )
     for name in plan.files:
         assert (folder / name).is_file(), f"{where}: wrote no {name}:\n{ran.output[-2000:]}"
     for pattern in plan.out:
         pattern = pattern.replace("{fastest}", _fastest())
         assert re.search(pattern, ran.output), (
-            f"{where}: no match for {pattern!r} in the output:\n{ran.output[-3000:]}")
+            f"{where}: no match for {pattern!r} in the output:\n{ran.output[-3000:]}"
+        )
     for pattern in plan.not_out:
         assert not re.search(pattern, ran.output), f"{where}: {pattern!r} in the output"
     if plan.last_line:
@@ -1097,47 +1473,75 @@ def test_extraction_of_a_sample_page(tmp_path, monkeypatch):
 
 def test_shortening_rules():
     plan = Plan()
-    assert effective("python -m fpga_robotics.run --duration 5 --save-video c.mp4", plan) == \
-        "python -m fpga_robotics.run --duration 1 --save-video c.mp4 --rerun off --quiet"
-    assert effective("fpga-robotics run --source c.mp4", plan) == \
-        "fpga-robotics run --source c.mp4 --rerun off --quiet"
-    assert effective("python -m fpga_robotics.run --scenario x", Plan(viewer=True)) == \
-        "python -m fpga_robotics.run --scenario x --duration 1 --quiet"
-    assert effective("python -m fpga_robotics.run --duration 20 --quiet",
-                     Plan(duration="keep")) == \
-        "python -m fpga_robotics.run --duration 20 --quiet --rerun off"
-    assert effective("python -m fpga_robotics.bench --frames 30 --json b.json", plan) == \
-        "python -m fpga_robotics.bench --frames 2 --json b.json --min-seconds 0"
-    assert effective("fpga-robotics bench design --json b.json", plan) == \
-        "fpga-robotics bench design --json b.json --frames 2 --min-seconds 0"
-    assert effective("fpga-robotics bench loop --duration 10", plan) == \
-        "fpga-robotics bench loop --duration 10"
+    assert (
+        effective("python -m fpga_robotics.run --duration 5 --save-video c.mp4", plan)
+        == "python -m fpga_robotics.run --duration 1 --save-video c.mp4 --rerun off --quiet"
+    )
+    assert (
+        effective("fpga-robotics run --source c.mp4", plan)
+        == "fpga-robotics run --source c.mp4 --rerun off --quiet"
+    )
+    assert (
+        effective("python -m fpga_robotics.run --scenario x", Plan(viewer=True))
+        == "python -m fpga_robotics.run --scenario x --duration 1 --quiet"
+    )
+    assert (
+        effective("python -m fpga_robotics.run --duration 20 --quiet", Plan(duration="keep"))
+        == "python -m fpga_robotics.run --duration 20 --quiet --rerun off"
+    )
+    assert (
+        effective("python -m fpga_robotics.bench --frames 30 --json b.json", plan)
+        == "python -m fpga_robotics.bench --frames 2 --json b.json --min-seconds 0"
+    )
+    assert (
+        effective("fpga-robotics bench design --json b.json", plan)
+        == "fpga-robotics bench design --json b.json --frames 2 --min-seconds 0"
+    )
+    assert (
+        effective("fpga-robotics bench loop --duration 10", plan)
+        == "fpga-robotics bench loop --duration 10"
+    )
     assert effective("python -m fpga_robotics.run --shadow 'a=1;b=2'", plan).startswith(
-        "python -m fpga_robotics.run --shadow 'a=1;b=2' --duration 1")
-    assert effective("python -m pytest -q tests/test_board_*.py -m \"not slow\"",
-                     Plan(collect=True)) == \
-        "python -m pytest -q tests/test_board_*.py -m 'not slow' --collect-only -p no:cacheprovider"
+        "python -m fpga_robotics.run --shadow 'a=1;b=2' --duration 1"
+    )
+    assert (
+        effective('python -m pytest -q tests/test_board_*.py -m "not slow"', Plan(collect=True))
+        == "python -m pytest -q tests/test_board_*.py -m 'not slow' --collect-only -p no:cacheprovider"
+    )
 
 
 # --- Every command is run or excused --------------------------------------------------------------
+
 
 def test_every_documented_command_is_classified():
     problems = []
     for page in PAGES:
         commands, _, strays = scan_page(page)
-        problems += [f"{s}  (a command line the extractor does not take: make it one of "
-                     f"{COMMAND_PREFIXES} or move it out of the code block)" for s in strays]
-        problems += [f"{c.page}:{c.line}: {c.text}  (not in PLANS: run it or excuse it)"
-                     for c in commands if c.text not in PLANS]
+        problems += [
+            f"{s}  (a command line the extractor does not take: make it one of "
+            f"{COMMAND_PREFIXES} or move it out of the code block)"
+            for s in strays
+        ]
+        problems += [
+            f"{c.page}:{c.line}: {c.text}  (not in PLANS: run it or excuse it)"
+            for c in commands
+            if c.text not in PLANS
+        ]
     used = {c.text for page in PAGES for c in scan_page(page)[0]}
     problems += [f"PLANS entry no page has any more: {key}" for key in PLANS if key not in used]
-    problems += [f"PLANS[{key!r}].part is not a part of the command" for key, plan in PLANS.items()
-                 if plan.part and plan.part not in key.split(" && ")]
+    problems += [
+        f"PLANS[{key!r}].part is not a part of the command"
+        for key, plan in PLANS.items()
+        if plan.part and plan.part not in key.split(" && ")
+    ]
     blocks = {snippet_key(b) for b in python_blocks()}
-    problems += [f"{p}: python block starting {first!r} has no entry in SNIPPETS"
-                 for p, first in sorted(blocks - set(SNIPPETS))]
-    problems += [f"SNIPPETS entry no page has any more: {key}" for key in SNIPPETS
-                 if key not in blocks]
+    problems += [
+        f"{p}: python block starting {first!r} has no entry in SNIPPETS"
+        for p, first in sorted(blocks - set(SNIPPETS))
+    ]
+    problems += [
+        f"SNIPPETS entry no page has any more: {key}" for key in SNIPPETS if key not in blocks
+    ]
     assert not problems, "\n".join(problems)
 
 
@@ -1145,16 +1549,22 @@ def test_shell_blocks_hold_no_synopsis():
     """A shell block is run line by line: a usage synopsis there is not a command."""
     found = [line for page in PAGES for line in synopsis_lines(page)]
     assert not found, "usage synopses in shell blocks (move them into a ```text block):\n" + (
-        "\n".join(found))
+        "\n".join(found)
+    )
 
 
 def test_ci_runs_the_readme_test_command():
     """README: ``.ci/run`` does exactly the README's test command in a fresh clone, and the
     linter's two checks."""
     ci = (ROOT / ".ci" / "run").read_text().splitlines()
-    for step in ("python3 -m venv .venv", ". .venv/bin/activate",
-                 'python -m pip install -q -e ".[dev,board]"', "python -m pytest -q -n auto",
-                 "ruff check .", "ruff format --check ."):
+    for step in (
+        "python3 -m venv .venv",
+        ". .venv/bin/activate",
+        'python -m pip install -q -e ".[dev,board]"',
+        "python -m pytest -q -n auto",
+        "ruff check .",
+        "ruff format --check .",
+    ):
         assert step in ci, f".ci/run does not do {step!r}"
 
 
@@ -1177,8 +1587,10 @@ def test_documented_commands(block, tmp_path):
         run_documented(doc, plan, tmp_path)
         ran_any = True
     if not ran_any:
-        pytest.skip("every command of this block is excused or slow: " + "; ".join(
-            PLANS[d.text].excused or "slow" for d in commands))
+        pytest.skip(
+            "every command of this block is excused or slow: "
+            + "; ".join(PLANS[d.text].excused or "slow" for d in commands)
+        )
 
 
 def _slow_commands():
@@ -1201,13 +1613,17 @@ def test_documented_slow_command(doc, tmp_path):
 
 # --- Python blocks ----------------------------------------------------------------------------
 
+
 class _ShowExpressions(ast.NodeTransformer):
     """Every bare expression statement ``e`` becomes ``_shown.append(e)``, so that what a
     snippet shows (``result.found, result.proximity``) can be checked."""
 
     def visit_Expr(self, node):
-        call = ast.Call(func=ast.Attribute(value=ast.Name("_shown", ast.Load()), attr="append",
-                                           ctx=ast.Load()), args=[node.value], keywords=[])
+        call = ast.Call(
+            func=ast.Attribute(value=ast.Name("_shown", ast.Load()), attr="append", ctx=ast.Load()),
+            args=[node.value],
+            keywords=[],
+        )
         return ast.copy_location(ast.Expr(call), node)
 
 
@@ -1244,7 +1660,11 @@ def snippet_readme_backends(tmp_path, capsys):
     assert filtered.shape == (120, 160) and filtered.dtype == np.uint16
     assert np.array_equal(filtered, expected.filtered)
     assert (found, proximity, centroid_x, motor_left) == (
-        expected.found, expected.proximity, expected.centroid_x, expected.motor_left)
+        expected.found,
+        expected.proximity,
+        expected.centroid_x,
+        expected.motor_left,
+    )
     assert ns["result"] == expected  # cycles included
 
 
@@ -1256,8 +1676,9 @@ def snippet_backends_api(tmp_path, capsys):
     frame = blob_frame(320, 240, "red", rng=2)
     ns = {"rgb_frame": frame}
     yield ns
-    expected = _model_result(frame, FollowTargetParams(width=320, height=240),
-                             line_blank=4, frame_blank=100)
+    expected = _model_result(
+        frame, FollowTargetParams(width=320, height=240), line_blank=4, frame_blank=100
+    )
     assert ns["result"].found
     assert ns["result"] == expected
 
@@ -1271,8 +1692,11 @@ def snippet_backends_waveform(tmp_path, capsys):
     from fpga_robotics.sim.camera.synthetic import blob_frame
 
     (tmp_path / "out").mkdir()
-    ns = {"get_backend": get_backend, "WaveformRequest": WaveformRequest,
-          "params": FollowTargetParams()}
+    ns = {
+        "get_backend": get_backend,
+        "WaveformRequest": WaveformRequest,
+        "params": FollowTargetParams(),
+    }
     shown = yield ns
     design = shown[-1]
     try:
@@ -1355,12 +1779,18 @@ def snippet_published_driving(tmp_path, capsys):
     """docs/published.md: the table of how each design drives on follow_person."""
     yield {}
     out = capsys.readouterr().out
-    assert re.search(r"(?m)^ours +mean 3\.05 m, min 1\.73 m, path 2\.8 m, steering reversals "
-                     r"10, turn-rate sign changes 1, rms turn rate 0\.06 rad/s, frames backing "
-                     r"0$", out), out
-    assert re.search(r"(?m)^published mean 2\.09 m, min 1\.27 m, path 5\.0 m, steering "
-                     r"reversals 276, turn-rate sign changes 132, rms turn rate 0\.26 rad/s, "
-                     r"frames backing 80$", out), out
+    assert re.search(
+        r"(?m)^ours +mean 3\.05 m, min 1\.73 m, path 2\.8 m, steering reversals "
+        r"10, turn-rate sign changes 1, rms turn rate 0\.06 rad/s, frames backing "
+        r"0$",
+        out,
+    ), out
+    assert re.search(
+        r"(?m)^published mean 2\.09 m, min 1\.27 m, path 5\.0 m, steering "
+        r"reversals 276, turn-rate sign changes 132, rms turn rate 0\.26 rad/s, "
+        r"frames backing 80$",
+        out,
+    ), out
 
 
 def snippet_published_lost(tmp_path, capsys):
@@ -1369,8 +1799,9 @@ def snippet_published_lost(tmp_path, capsys):
     out = capsys.readouterr().out
     # The page rounds the re-acquisition times to 1.87 s and 2.03 s.
     assert re.search(r"(?m)^ours lost at frame 115 found again after \[1\.866\d*\] s$", out), out
-    assert re.search(r"(?m)^published lost at frame 113 found again after \[2\.033\d*\] s$",
-                     out), out
+    assert re.search(r"(?m)^published lost at frame 113 found again after \[2\.033\d*\] s$", out), (
+        out
+    )
     assert re.search(r"(?m)^ +115 False 208 512$", out), out
     assert re.search(r"(?m)^ +113 False 325 600$", out), out
 
@@ -1398,8 +1829,11 @@ def snippet_pins(tmp_path, capsys):
     stop, found, centroid_x = shown[-1]
     params = FollowTargetParams()
     last = real_clock_timing(160, 120, 30, 50e6, 1).last_edge(160, 120)
-    assert stop == Stop(last + params.result_latency, "frame_done", 1) == Stop(1559887,
-                                                                               "frame_done", 1)
+    assert (
+        stop
+        == Stop(last + params.result_latency, "frame_done", 1)
+        == Stop(1559887, "frame_done", 1)
+    )
     expected = _model_result(frame, params)
     assert (found, centroid_x) == (int(expected.found), expected.centroid_x)
     assert found == 1
@@ -1438,51 +1872,79 @@ def snippet_your_design(tmp_path, capsys):
 
 
 SNIPPETS = {
-    ("docs/your_design.md", ('"""A design of one\'s own with pin sensors and no camera: drives '
-                            'straight on at ``speed`` DPS')):
-        snippet_your_design,
-    ("docs/connectors.md", "from amaranth import Module, Mux, Signal, signed"):
-        snippet_connectors_own_design,
-    ("docs/pins.md", ("from fpga_robotics.sim.pins import follow_target_source, get_pin_backend, "
-                     "real_clock_timing")):
-        snippet_pins,
-    ("README.md", "from fpga_robotics.hw.params import FollowTargetParams"):
-        snippet_readme_backends,
-    ("docs/backends.md", "from fpga_robotics.hw.params import FollowTargetParams"):
-        snippet_backends_api,
-    ("docs/backends.md", ('get_backend("verilator", params, waveform=WaveformRequest('
-                          '"out/run.fst", first_frame=10,')):
-        snippet_backends_waveform,
-    ("docs/camera.md", "from fpga_robotics.sim.camera import CameraRenderer, render"):
-        snippet_camera,
-    ("docs/running.md", "from fpga_robotics.scenario import load_scenario"):
-        snippet_running,
-    ("docs/viewer.md", "from fpga_robotics.viz import ViewerError, open_recorder"):
-        snippet_viewer,
-    ("docs/published.md",
-     "# Every shipped scenario with the preset, five ways (25 runs on the model backend)"):
-        snippet_published_scenarios,
-    ("docs/published.md", "# How each design drives on follow_person"):
-        snippet_published_driving,
-    ("docs/published.md", "# What each design does when it loses the person (lost_target)"):
-        snippet_published_lost,
-    ("docs/published.md",
-     "# The first camera frame of follow_person through both designs' trackers"):
-        snippet_published_first_frame,
+    (
+        "docs/your_design.md",
+        (
+            '"""A design of one\'s own with pin sensors and no camera: drives '
+            "straight on at ``speed`` DPS"
+        ),
+    ): snippet_your_design,
+    (
+        "docs/connectors.md",
+        "from amaranth import Module, Mux, Signal, signed",
+    ): snippet_connectors_own_design,
+    (
+        "docs/pins.md",
+        (
+            "from fpga_robotics.sim.pins import follow_target_source, get_pin_backend, "
+            "real_clock_timing"
+        ),
+    ): snippet_pins,
+    (
+        "README.md",
+        "from fpga_robotics.hw.params import FollowTargetParams",
+    ): snippet_readme_backends,
+    (
+        "docs/backends.md",
+        "from fpga_robotics.hw.params import FollowTargetParams",
+    ): snippet_backends_api,
+    (
+        "docs/backends.md",
+        (
+            'get_backend("verilator", params, waveform=WaveformRequest('
+            '"out/run.fst", first_frame=10,'
+        ),
+    ): snippet_backends_waveform,
+    (
+        "docs/camera.md",
+        "from fpga_robotics.sim.camera import CameraRenderer, render",
+    ): snippet_camera,
+    ("docs/running.md", "from fpga_robotics.scenario import load_scenario"): snippet_running,
+    ("docs/viewer.md", "from fpga_robotics.viz import ViewerError, open_recorder"): snippet_viewer,
+    (
+        "docs/published.md",
+        "# Every shipped scenario with the preset, five ways (25 runs on the model backend)",
+    ): snippet_published_scenarios,
+    ("docs/published.md", "# How each design drives on follow_person"): snippet_published_driving,
+    (
+        "docs/published.md",
+        "# What each design does when it loses the person (lost_target)",
+    ): snippet_published_lost,
+    (
+        "docs/published.md",
+        "# The first camera frame of follow_person through both designs' trackers",
+    ): snippet_published_first_frame,
 }
 
 
 #: Python blocks that build a Verilator model: run only under ``-m slow``.
 SLOW_SNIPPETS = {
     ("README.md", "from fpga_robotics.hw.params import FollowTargetParams"),
-    ("docs/backends.md", ('get_backend("verilator", params, waveform=WaveformRequest('
-                          '"out/run.fst", first_frame=10,')),
+    (
+        "docs/backends.md",
+        (
+            'get_backend("verilator", params, waveform=WaveformRequest('
+            '"out/run.fst", first_frame=10,'
+        ),
+    ),
 }
 
 
 def _python_params():
-    return [pytest.param(b, marks=pytest.mark.slow) if snippet_key(b) in SLOW_SNIPPETS else b
-            for b in python_blocks()]
+    return [
+        pytest.param(b, marks=pytest.mark.slow) if snippet_key(b) in SLOW_SNIPPETS else b
+        for b in python_blocks()
+    ]
 
 
 @pytest.mark.parametrize("block", _python_params(), ids=lambda b: f"{b.page}:{b.line}")
@@ -1499,6 +1961,7 @@ def test_documented_python(block, tmp_path, monkeypatch, capsys):
 
 
 # --- What is not run, for the report -------------------------------------------------------------
+
 
 def excused_commands():
     """``(where, command, reason)`` of every documented command (or part) not run here."""

@@ -56,20 +56,23 @@ class Figure:
 
 
 def _rows(figures, key):
-    return {(r.get("backend"), r.get("design"), r["width"], r["height"]): r
-            for r in figures[key]}
+    return {(r.get("backend"), r.get("design"), r["width"], r["height"]): r for r in figures[key]}
 
 
 def _verilator_over_cxxrtl(data):
     rows = _rows(data["figures"], "results")
-    return (rows[("verilator", "follow_target", 160, 120)]["cpu_ms_per_frame"]
-            / rows[("cxxrtl", "follow_target", 160, 120)]["cpu_ms_per_frame"])
+    return (
+        rows[("verilator", "follow_target", 160, 120)]["cpu_ms_per_frame"]
+        / rows[("cxxrtl", "follow_target", 160, 120)]["cpu_ms_per_frame"]
+    )
 
 
 def _vga_over_qqvga(data):
     rows = _rows(data["figures"], "results")
-    return (rows[("cxxrtl", "follow_target", 640, 480)]["cpu_ms_per_frame"]
-            / rows[("cxxrtl", "follow_target", 160, 120)]["cpu_ms_per_frame"])
+    return (
+        rows[("cxxrtl", "follow_target", 640, 480)]["cpu_ms_per_frame"]
+        / rows[("cxxrtl", "follow_target", 160, 120)]["cpu_ms_per_frame"]
+    )
 
 
 def _paired_fraction(data):
@@ -135,65 +138,161 @@ def _bag_in_calibrations(data):
 
 
 FIGURES = (
-    Figure("docs/backends.md", "2.7", "0.6",
-           "design --backends cxxrtl,verilator --resolutions 160x120 --no-trivial "
-           "--frames 30 --min-seconds 2",
-           _verilator_over_cxxrtl, "Verilator's CPU time a 160x120 frame over CXXRTL's"),
-    Figure("docs/backends.md", "17", "8",
-           "design --backends cxxrtl --resolutions 160x120,640x480 --no-trivial "
-           "--frames 30 --min-seconds 2",
-           _vga_over_qqvga, "CXXRTL's CPU time a 640x480 frame over a 160x120 one"),
-    Figure("docs/hardware.md", "0.53", "0.1",
-           "design --backends cxxrtl --resolutions 160x120 --frames 30 --min-seconds 2",
-           _paired_fraction, "FollowTarget's cycle rate over the trivial design's, CXXRTL"),
-    Figure("docs/pins.md", "0.9", "0.35",
-           "pins --backends cxxrtl --seconds 0.25 --repeats 3",
-           _pins_over_frames, "CXXRTL: the pin path's cycle rate over the frame path's"),
-    Figure("docs/backends.md", "2.2", "0.8",
-           "loop --backend cxxrtl --resolutions 160x120 --duration 3 --repeats 3",
-           _loop_over_design, "the closed loop's CPU time a frame over the design's alone"),
-    Figure("README.md", "2.2", "0.8",
-           "loop --backend cxxrtl --resolutions 160x120 --duration 3 --repeats 3",
-           _loop_over_design, "the closed loop's CPU time a frame over the design's alone"),
-    Figure("docs/foreign.md", "1.35", "0.3",
-           "foreign --frames 20 --repeats 3",
-           _foreign_over_builtin, "the exported design as a foreign design over built-in"),
-    Figure("docs/camera.md", "0.24", "0.12",
-           "camera --sizes 160x120 --noise 0 --frames 60 --repeats 3 --calibrate",
-           _camera_in_calibrations, "the renderer's CPU time a 160x120 frame, in calibrations"),
-    Figure("docs/camera.md", "3.8", "1.5",
-           "camera --sizes 160x120,640x480 --noise 0 --frames 60 --repeats 3",
-           _camera_vga_over_qqvga, "the renderer's CPU time a 640x480 frame over a 160x120 one"),
-    Figure("docs/running.md", "2.2", "0.8",
-           "loop --backend cxxrtl --resolutions 160x120 --duration 3 --repeats 3",
-           _loop_over_design, "the closed loop's CPU time a frame over the design's alone"),
-    Figure("docs/running.md", "1.35", "0.4",
-           "loop --backend cxxrtl --resolutions 640x480 --duration 3 --repeats 3",
-           _loop_over_design, "the same at 640x480"),
-    Figure("docs/running.md", "1.25", "0.35",
-           "shadow --backend cxxrtl --duration 3 --repeats 3",
-           _shadow_extra_over_own, "what a shadow design adds to a frame over its own time"),
-    Figure("docs/viewer.md", "4.4", "1.5",
-           "viewer --frames 100 --repeats 3 --calibrate",
-           _viewer_in_calibrations, "log_frame's CPU time at 160x120 (PNG), in calibrations"),
-    Figure("docs/viewer.md", "2.5", "0.8",
-           "viewer --frames 100 --repeats 3 --calibrate",
-           _viewer_vga_over_qqvga, "log_frame's CPU time at 640x480 over 160x120"),
-    Figure("docs/ros.md", "1.4", "0.7",
-           "ros --only bag --repeats 3 --calibrate",
-           _bag_in_calibrations, "a bag's CPU time a frame, in calibrations"),
-    Figure("docs/model.md", "0.35", "0.2",
-           "design --backends model --resolutions 160x120 --no-trivial --frames 30 "
-           "--min-seconds 1 --calibrate",
-           _model_in_calibrations, "the model backend's CPU time a 160x120 frame, in calibrations"),
-    Figure("docs/scenarios.md", "0.22", "0.1",
-           "world --frames 300 --repeats 3 --calibrate",
-           _terrain_in_calibrations, "terrain lookups and drive noise a frame, in calibrations"),
-    Figure("docs/scenarios.md", "1.2", "0.4",
-           "world --frames 300 --repeats 3 --calibrate",
-           _physics_in_calibrations, "the default world's physics a frame, in calibrations"),
-    Figure("docs/hardware.md", "2300", "700", "pysim --frames 3 --calibrate",
-           _pysim_in_calibrations, "a pysim frame's CPU time, in calibrations"),
+    Figure(
+        "docs/backends.md",
+        "2.7",
+        "0.6",
+        "design --backends cxxrtl,verilator --resolutions 160x120 --no-trivial "
+        "--frames 30 --min-seconds 2",
+        _verilator_over_cxxrtl,
+        "Verilator's CPU time a 160x120 frame over CXXRTL's",
+    ),
+    Figure(
+        "docs/backends.md",
+        "17",
+        "8",
+        "design --backends cxxrtl --resolutions 160x120,640x480 --no-trivial "
+        "--frames 30 --min-seconds 2",
+        _vga_over_qqvga,
+        "CXXRTL's CPU time a 640x480 frame over a 160x120 one",
+    ),
+    Figure(
+        "docs/hardware.md",
+        "0.53",
+        "0.1",
+        "design --backends cxxrtl --resolutions 160x120 --frames 30 --min-seconds 2",
+        _paired_fraction,
+        "FollowTarget's cycle rate over the trivial design's, CXXRTL",
+    ),
+    Figure(
+        "docs/pins.md",
+        "0.9",
+        "0.35",
+        "pins --backends cxxrtl --seconds 0.25 --repeats 3",
+        _pins_over_frames,
+        "CXXRTL: the pin path's cycle rate over the frame path's",
+    ),
+    Figure(
+        "docs/backends.md",
+        "2.2",
+        "0.8",
+        "loop --backend cxxrtl --resolutions 160x120 --duration 3 --repeats 3",
+        _loop_over_design,
+        "the closed loop's CPU time a frame over the design's alone",
+    ),
+    Figure(
+        "README.md",
+        "2.2",
+        "0.8",
+        "loop --backend cxxrtl --resolutions 160x120 --duration 3 --repeats 3",
+        _loop_over_design,
+        "the closed loop's CPU time a frame over the design's alone",
+    ),
+    Figure(
+        "docs/foreign.md",
+        "1.35",
+        "0.3",
+        "foreign --frames 20 --repeats 3",
+        _foreign_over_builtin,
+        "the exported design as a foreign design over built-in",
+    ),
+    Figure(
+        "docs/camera.md",
+        "0.24",
+        "0.12",
+        "camera --sizes 160x120 --noise 0 --frames 60 --repeats 3 --calibrate",
+        _camera_in_calibrations,
+        "the renderer's CPU time a 160x120 frame, in calibrations",
+    ),
+    Figure(
+        "docs/camera.md",
+        "3.8",
+        "1.5",
+        "camera --sizes 160x120,640x480 --noise 0 --frames 60 --repeats 3",
+        _camera_vga_over_qqvga,
+        "the renderer's CPU time a 640x480 frame over a 160x120 one",
+    ),
+    Figure(
+        "docs/running.md",
+        "2.2",
+        "0.8",
+        "loop --backend cxxrtl --resolutions 160x120 --duration 3 --repeats 3",
+        _loop_over_design,
+        "the closed loop's CPU time a frame over the design's alone",
+    ),
+    Figure(
+        "docs/running.md",
+        "1.35",
+        "0.4",
+        "loop --backend cxxrtl --resolutions 640x480 --duration 3 --repeats 3",
+        _loop_over_design,
+        "the same at 640x480",
+    ),
+    Figure(
+        "docs/running.md",
+        "1.25",
+        "0.35",
+        "shadow --backend cxxrtl --duration 3 --repeats 3",
+        _shadow_extra_over_own,
+        "what a shadow design adds to a frame over its own time",
+    ),
+    Figure(
+        "docs/viewer.md",
+        "4.4",
+        "1.5",
+        "viewer --frames 100 --repeats 3 --calibrate",
+        _viewer_in_calibrations,
+        "log_frame's CPU time at 160x120 (PNG), in calibrations",
+    ),
+    Figure(
+        "docs/viewer.md",
+        "2.5",
+        "0.8",
+        "viewer --frames 100 --repeats 3 --calibrate",
+        _viewer_vga_over_qqvga,
+        "log_frame's CPU time at 640x480 over 160x120",
+    ),
+    Figure(
+        "docs/ros.md",
+        "1.4",
+        "0.7",
+        "ros --only bag --repeats 3 --calibrate",
+        _bag_in_calibrations,
+        "a bag's CPU time a frame, in calibrations",
+    ),
+    Figure(
+        "docs/model.md",
+        "0.35",
+        "0.2",
+        "design --backends model --resolutions 160x120 --no-trivial --frames 30 "
+        "--min-seconds 1 --calibrate",
+        _model_in_calibrations,
+        "the model backend's CPU time a 160x120 frame, in calibrations",
+    ),
+    Figure(
+        "docs/scenarios.md",
+        "0.22",
+        "0.1",
+        "world --frames 300 --repeats 3 --calibrate",
+        _terrain_in_calibrations,
+        "terrain lookups and drive noise a frame, in calibrations",
+    ),
+    Figure(
+        "docs/scenarios.md",
+        "1.2",
+        "0.4",
+        "world --frames 300 --repeats 3 --calibrate",
+        _physics_in_calibrations,
+        "the default world's physics a frame, in calibrations",
+    ),
+    Figure(
+        "docs/hardware.md",
+        "2300",
+        "700",
+        "pysim --frames 3 --calibrate",
+        _pysim_in_calibrations,
+        "a pysim frame's CPU time, in calibrations",
+    ),
 )
 
 
@@ -208,8 +307,9 @@ def quoted(pages=PAGES, root=ROOT):
             if not any(start < m.start() < start + 12 for start in starts):
                 n = text.count("\n", 0, m.start()) + 1
                 raise AssertionError(f"{page}:{n}: a '(ratio' that is not 'N.Nx (ratio ±S)'")
-        found += [(page, text.count("\n", 0, m.start()) + 1, m.group(1), m.group(2))
-                  for m in quotes]
+        found += [
+            (page, text.count("\n", 0, m.start()) + 1, m.group(1), m.group(2)) for m in quotes
+        ]
     return found
 
 
@@ -224,12 +324,17 @@ def test_every_quoted_ratio_has_an_entry_and_every_entry_a_quote():
 
 
 def test_the_quote_pattern(tmp_path):
-    (tmp_path / "a.md").write_text("runs at 1.8x (ratio ±0.4) real time; 0.51x (ratio ±0.1).\n"
-                                   "took 3 ms; written `N.Nx (ratio ±S)`; then 2.5x\n"
-                                   "(ratio ±1) over a line break.\n"
-                                   "```\noutput 9.9x (ratio ±1)\n```\n")
-    assert quoted(["a.md"], tmp_path) == [("a.md", 1, "1.8", "0.4"), ("a.md", 1, "0.51", "0.1"),
-                                          ("a.md", 2, "2.5", "1")]
+    (tmp_path / "a.md").write_text(
+        "runs at 1.8x (ratio ±0.4) real time; 0.51x (ratio ±0.1).\n"
+        "took 3 ms; written `N.Nx (ratio ±S)`; then 2.5x\n"
+        "(ratio ±1) over a line break.\n"
+        "```\noutput 9.9x (ratio ±1)\n```\n"
+    )
+    assert quoted(["a.md"], tmp_path) == [
+        ("a.md", 1, "1.8", "0.4"),
+        ("a.md", 1, "0.51", "0.1"),
+        ("a.md", 2, "2.5", "1"),
+    ]
     (tmp_path / "b.md").write_text("runs at 1.8 times (ratio 0.4) real time\n")
     with pytest.raises(AssertionError, match="b.md:1"):
         quoted(["b.md"], tmp_path)
@@ -255,8 +360,7 @@ def measure(figure, folder):
         what, *argv = figure.command.split()
         path = Path(folder) / f"{what}.json"
         with pytest.raises(SystemExit) as exit_:
-            _call(BENCHMARKS[what][0], [*argv, "--json", str(path)],
-                  f"fpga-robotics bench {what}")
+            _call(BENCHMARKS[what][0], [*argv, "--json", str(path)], f"fpga-robotics bench {what}")
         assert exit_.value.code == 0, figure.command
         _RUNS[figure.command] = json.loads(path.read_text())
     return figure.take(_RUNS[figure.command])
@@ -264,14 +368,17 @@ def measure(figure, folder):
 
 @pytest.mark.slow
 @pytest.mark.timeout(900)
-@pytest.mark.skipif(os.environ.get("FPGA_ROBOTICS_FIGURES") != "1",
-                    reason="times benchmarks: FPGA_ROBOTICS_FIGURES=1 on a quiet machine")
+@pytest.mark.skipif(
+    os.environ.get("FPGA_ROBOTICS_FIGURES") != "1",
+    reason="times benchmarks: FPGA_ROBOTICS_FIGURES=1 on a quiet machine",
+)
 @pytest.mark.parametrize("figure", FIGURES, ids=lambda f: f"{f.page}:{f.ratio}x")
 def test_quoted_ratio_measures_within_its_spread(figure, tmp_path):
     measured = measure(figure, tmp_path)
     assert abs(measured - float(figure.ratio)) <= float(figure.spread), (
         f"{figure.page}: {figure.what}: quoted {figure.ratio}x ±{figure.spread}, "
-        f"measured {measured:.3f}x (fpga-robotics bench {figure.command})")
+        f"measured {measured:.3f}x (fpga-robotics bench {figure.command})"
+    )
 
 
 if __name__ == "__main__":
@@ -282,5 +389,8 @@ if __name__ == "__main__":
             if len(sys.argv) > 1 and not any(a in f.command or a in f.page for a in sys.argv[1:]):
                 continue
             value = measure(f, tmp)
-            print(f"RESULT {f.page}: {f.what}: quoted {f.ratio} ±{f.spread}, measured "
-                  f"{value:.3f}", file=sys.stderr, flush=True)
+            print(
+                f"RESULT {f.page}: {f.what}: quoted {f.ratio} ±{f.spread}, measured {value:.3f}",
+                file=sys.stderr,
+                flush=True,
+            )

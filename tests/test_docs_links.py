@@ -40,7 +40,8 @@ _INLINE_LINK = re.compile(
 )
 _REFERENCE_DEF = re.compile(r"^ {0,3}\[[^\]]+\]:\s*(<[^>\n]*>|\S+)", re.MULTILINE)
 _HTML_ATTR = re.compile(
-    r"<(?:a|img)\b[^>]*?\s(?:href|src)\s*=\s*[\"']([^\"']*)[\"']", re.IGNORECASE)
+    r"<(?:a|img)\b[^>]*?\s(?:href|src)\s*=\s*[\"']([^\"']*)[\"']", re.IGNORECASE
+)
 _HTML_ID = re.compile(r"<[a-z][^>]*?\s(?:id|name)\s*=\s*[\"']([^\"']*)[\"']", re.IGNORECASE)
 _ATX = re.compile(r"^ {0,3}(#{1,6})(?:[ \t]+(.*?))?(?:[ \t]+#+)?[ \t]*$")
 _SETEXT = re.compile(r"^ {0,3}(=+|-+)[ \t]*$")
@@ -75,11 +76,13 @@ def prose(text):
     looks like a link inside code is not taken for one; offsets and line numbers are
     unchanged."""
     lines = text.split("\n")
-    text = "\n".join(_blank(line) if code else line
-                     for line, code in zip(lines, in_code_block(lines)))
+    text = "\n".join(
+        _blank(line) if code else line for line, code in zip(lines, in_code_block(lines))
+    )
     # Code spans may run over a line end, but not over a blank line (a paragraph's end).
     return _CODE_SPAN.sub(
-        lambda m: m.group(0) if "\n\n" in m.group(0) else _blank(m.group(0)), text)
+        lambda m: m.group(0) if "\n\n" in m.group(0) else _blank(m.group(0)), text
+    )
 
 
 def links(text):
@@ -130,9 +133,14 @@ def anchors(text):
         if m:
             titles.append(m.group(2) or "")
         elif (
-            i > 0 and not code[i - 1] and _SETEXT.match(line) and lines[i - 1].strip()
-            and not _ATX.match(lines[i - 1]) and not _SETEXT.match(lines[i - 1])
-            and "|" not in lines[i - 1] and not re.match(r"^ {0,3}([-*+]|\d+[.)])\s", lines[i - 1])
+            i > 0
+            and not code[i - 1]
+            and _SETEXT.match(line)
+            and lines[i - 1].strip()
+            and not _ATX.match(lines[i - 1])
+            and not _SETEXT.match(lines[i - 1])
+            and "|" not in lines[i - 1]
+            and not re.match(r"^ {0,3}([-*+]|\d+[.)])\s", lines[i - 1])
         ):
             titles.append(lines[i - 1].strip())
     result = set(_HTML_ID.findall(text))
@@ -177,18 +185,24 @@ def check_link(page, dest):
 
 # --- The checker itself --------------------------------------------------------------------------
 
-@pytest.mark.parametrize("heading,expected", [
-    ("Latency (clock edges)", "latency-clock-edges"),
-    ("The `pysim` backend", "the-pysim-backend"),
-    ("Published bugs, fixed and tested", "published-bugs-fixed-and-tested"),
-    ("`model` backend (`fpga_robotics.sim.backends.model.ModelBackend`)",
-     "model-backend-fpga_roboticssimbackendsmodelmodelbackend"),
-    ("`[[room.furniture]]`", "roomfurniture"),
-    ("Summary fields (`--summary PATH`)", "summary-fields---summary-path"),
-    ("On the robot: ULX3S + OV7670 + GoPiGo3", "on-the-robot-ulx3s--ov7670--gopigo3"),
-    ("Two **bold** and [linked](x.md) words", "two-bold-and-linked-words"),
-    ("Pixels — and frames", "pixels--and-frames"),
-])
+
+@pytest.mark.parametrize(
+    "heading,expected",
+    [
+        ("Latency (clock edges)", "latency-clock-edges"),
+        ("The `pysim` backend", "the-pysim-backend"),
+        ("Published bugs, fixed and tested", "published-bugs-fixed-and-tested"),
+        (
+            "`model` backend (`fpga_robotics.sim.backends.model.ModelBackend`)",
+            "model-backend-fpga_roboticssimbackendsmodelmodelbackend",
+        ),
+        ("`[[room.furniture]]`", "roomfurniture"),
+        ("Summary fields (`--summary PATH`)", "summary-fields---summary-path"),
+        ("On the robot: ULX3S + OV7670 + GoPiGo3", "on-the-robot-ulx3s--ov7670--gopigo3"),
+        ("Two **bold** and [linked](x.md) words", "two-bold-and-linked-words"),
+        ("Pixels — and frames", "pixels--and-frames"),
+    ],
+)
 def test_slugs_follow_github(heading, expected):
     assert slug(heading_text(heading)) == expected
 
@@ -200,14 +214,18 @@ def test_anchors_number_repeated_headings_and_skip_code():
 
 def test_links_outside_code_only():
     text = (
-        "See [the page](docs/a.md#x) and ![img](pic.png \"title\").\n"
+        'See [the page](docs/a.md#x) and ![img](pic.png "title").\n'
         "`[not](a-link.md)` and\n\n```\n[nor](this.md)\n```\n"
-        "[ref]: <docs/b.md>\n<a href=\"c.md\">c</a> [web](https://example.com)\n"
+        '[ref]: <docs/b.md>\n<a href="c.md">c</a> [web](https://example.com)\n'
         "[multi\nline](d.md)\n"
     )
     assert links(text) == [
-        (1, "docs/a.md#x"), (1, "pic.png"), (7, "docs/b.md"), (8, "c.md"),
-        (8, "https://example.com"), (9, "d.md"),
+        (1, "docs/a.md#x"),
+        (1, "pic.png"),
+        (7, "docs/b.md"),
+        (8, "c.md"),
+        (8, "https://example.com"),
+        (9, "d.md"),
     ]
 
 
@@ -222,6 +240,7 @@ def test_check_link_reports_missing_files_and_anchors():
 
 
 # --- The documentation ---------------------------------------------------------------------------
+
 
 @pytest.mark.parametrize("page", doc_files(), ids=doc_id)
 def test_relative_links_resolve(page):

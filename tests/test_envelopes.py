@@ -19,10 +19,17 @@ from fpga_robotics.hw.params import FollowTargetParams
 RED = 0b100
 #: f = 80 / tan(hfov / 2) = 160 px; the camera 0.5 m up, level; a target 0.2 m in radius,
 #: one red band from the floor to 1 m.
-GEOM = EnvelopeGeometry(width=160, height=120, hfov=2 * math.atan(0.5), mount_height=0.5,
-                        mount_forward=0.0, tilt=0.0, radius=0.2,
-                        bands_sure={c: ([(0.0, 1.0)] if c == RED else []) for c in range(8)},
-                        bands_maybe={c: ([(0.0, 1.0)] if c == RED else []) for c in range(8)})
+GEOM = EnvelopeGeometry(
+    width=160,
+    height=120,
+    hfov=2 * math.atan(0.5),
+    mount_height=0.5,
+    mount_forward=0.0,
+    tilt=0.0,
+    radius=0.2,
+    bands_sure={c: ([(0.0, 1.0)] if c == RED else []) for c in range(8)},
+    bands_maybe={c: ([(0.0, 1.0)] if c == RED else []) for c in range(8)},
+)
 DEFAULT = FollowTargetParams()
 
 
@@ -41,9 +48,13 @@ def _traj(frames):
     the origin facing +x, the target 4 m ahead at ``target_y`` (left positive)."""
     n = len(frames)
     return {
-        "t": np.arange(n) / 30, "x": np.zeros(n), "y": np.zeros(n), "heading": np.zeros(n),
+        "t": np.arange(n) / 30,
+        "x": np.zeros(n),
+        "y": np.zeros(n),
+        "heading": np.zeros(n),
         "found": np.array([f[0] for f in frames], bool),
-        "target_x": np.full(n, 4.0), "target_y": np.array([f[1] for f in frames], float),
+        "target_x": np.full(n, 4.0),
+        "target_y": np.array([f[1] for f in frames], float),
         "motor_left": np.array([f[2] for f in frames], float),
         "motor_right": np.array([f[3] for f in frames], float),
         "color_sel": np.full(n, RED),
@@ -52,8 +63,14 @@ def _traj(frames):
 
 def test_approach_speed_and_reversing_default_and_changed_speed_table():
     # At 4 m every count the geometry allows (532..795) is level 3: base_dps[3] = 200 forward.
-    traj = _traj([(True, 0.0, 200, 200), (True, 0.0, 300, 300), (True, 0.0, -100, -100),
-                  (True, 0.0, 200, 200)])
+    traj = _traj(
+        [
+            (True, 0.0, 200, 200),
+            (True, 0.0, 300, 300),
+            (True, 0.0, -100, -100),
+            (True, 0.0, 200, 200),
+        ]
+    )
     m = envelope_metrics(traj, DEFAULT, GEOM)
     assert m["approach_speed_violation_fraction"] == 0.5  # 300 and -100
     assert m["reverse_when_far_fraction"] == 0.25
@@ -61,8 +78,12 @@ def test_approach_speed_and_reversing_default_and_changed_speed_table():
     faster = DEFAULT.replace(base_dps=(0, 400, 300, 300, 150, 100, -100, -150))
     m = envelope_metrics(traj, faster, GEOM)
     assert m["approach_speed_violation_fraction"] == 0.75
-    assert envelope_metrics(_traj([(True, 0.0, 300, 300)]), faster,
-                            GEOM)["approach_speed_violation_fraction"] == 0.0
+    assert (
+        envelope_metrics(_traj([(True, 0.0, 300, 300)]), faster, GEOM)[
+            "approach_speed_violation_fraction"
+        ]
+        == 0.0
+    )
     # Thresholds halved (64, 128, 256, 512, ...): 532..795 is level 4, 150 DPS.
     halved = DEFAULT.replace(proximity_thresholds=(64, 128, 256, 512, 1024, 2048, 3072))
     m = envelope_metrics(_traj([(True, 0.0, 150, 150), (True, 0.0, 200, 200)]), halved, GEOM)
@@ -82,8 +103,12 @@ def test_turn_law_default_and_changed_gain():
     # kp_num = 4: the band is [-76, -56]; 70 keeps it, 48 breaks it.
     m = envelope_metrics(_traj([good, too_much]), DEFAULT.replace(kp_num=4), GEOM)
     assert m["turn_law_violation_fraction"] == 0.5
-    assert envelope_metrics(_traj([too_much]), DEFAULT.replace(kp_num=4),
-                            GEOM)["turn_law_violation_fraction"] == 0.0
+    assert (
+        envelope_metrics(_traj([too_much]), DEFAULT.replace(kp_num=4), GEOM)[
+            "turn_law_violation_fraction"
+        ]
+        == 0.0
+    )
 
 
 def test_search_law_default_and_changed_search():
@@ -96,18 +121,20 @@ def test_search_law_default_and_changed_search():
     frames = [seen] + [hold] * 14 + [search] * 5
     assert envelope_metrics(_traj(frames), DEFAULT, GEOM)["search_law_violation_fraction"] == 0
     wrong = [seen] + [hold] * 14 + [left_search] * 5
-    assert envelope_metrics(_traj(wrong), DEFAULT,
-                            GEOM)["search_law_violation_fraction"] == round(5 / 19, 4)
+    assert envelope_metrics(_traj(wrong), DEFAULT, GEOM)["search_law_violation_fraction"] == round(
+        5 / 19, 4
+    )
     early = [seen] + [hold] * 10 + [search] * 9
-    assert envelope_metrics(_traj(early), DEFAULT,
-                            GEOM)["search_law_violation_fraction"] == round(4 / 19, 4)
+    assert envelope_metrics(_traj(early), DEFAULT, GEOM)["search_law_violation_fraction"] == round(
+        4 / 19, 4
+    )
     # lost_frames = 11 and search_dps = 100: the search starts at the 11th lost frame.
     changed = DEFAULT.replace(lost_frames=11, search_dps=100)
     early_slow = [seen] + [hold] * 10 + [(False, -0.4, 100, -100)] * 9
-    assert envelope_metrics(_traj(early_slow), changed,
-                            GEOM)["search_law_violation_fraction"] == 0
-    assert envelope_metrics(_traj(early), changed,
-                            GEOM)["search_law_violation_fraction"] == round(9 / 19, 4)  # 250
+    assert envelope_metrics(_traj(early_slow), changed, GEOM)["search_law_violation_fraction"] == 0
+    assert envelope_metrics(_traj(early), changed, GEOM)["search_law_violation_fraction"] == round(
+        9 / 19, 4
+    )  # 250
     # After reset, never seen: the search turns left.
     never = [(False, 0.0, 0, 0)] * 14 + [(False, 0.0, -250, 250)] * 3
     assert envelope_metrics(_traj(never), DEFAULT, GEOM)["search_law_violation_fraction"] == 0
@@ -137,8 +164,10 @@ def test_stop_distance_moves_with_the_reversing_threshold():
     assert near7 == pytest.approx(_solve(_lo, 1200), abs=0.006)
     assert near7 < near < far
     # Never stopping: no stop distance.
-    assert stop_distance_m(GEOM, DEFAULT.replace(base_dps=(1, 400, 300, 200, 150, 100, 50, 40)),
-                           RED) is None
+    assert (
+        stop_distance_m(GEOM, DEFAULT.replace(base_dps=(1, 400, 300, 200, 150, 100, 50, 40)), RED)
+        is None
+    )
 
 
 def test_other_laws_leave_the_envelopes_na():

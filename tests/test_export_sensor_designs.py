@@ -29,9 +29,14 @@ SAFE_PORTS = {
 
 
 def line_ports(n):
-    return {"clk": ("input", 1), "rst": ("input", 1), "line": ("input", n),
-            "motor_left": ("output", 16), "motor_right": ("output", 16),
-            "line_seen": ("output", n)}
+    return {
+        "clk": ("input", 1),
+        "rst": ("input", 1),
+        "line": ("input", n),
+        "motor_left": ("output", 16),
+        "motor_right": ("output", 16),
+        "line_seen": ("output", n),
+    }
 
 
 def module_ports(verilog, name):
@@ -41,7 +46,8 @@ def module_ports(verilog, name):
     names = [n.strip() for n in found.group(1).split(",")]
     ports = {}
     for direction, msb, port in re.findall(
-        r"^\s*(input|output)\s+(?:signed\s+)?(?:\[(\d+):0\]\s+)?(\w+);", found.group(2),
+        r"^\s*(input|output)\s+(?:signed\s+)?(?:\[(\d+):0\]\s+)?(\w+);",
+        found.group(2),
         re.MULTILINE,
     ):
         ports[port] = (direction, int(msb) + 1 if msb else 1)
@@ -74,18 +80,36 @@ def test_follow_target_export_is_unchanged(tmp_path):
     assert default == explicit == generate_verilog()
 
 
-@pytest.mark.parametrize("name,component", [
-    ("follow_target_safe", lambda: FollowTargetSafe()),
-    ("follow_target_safe", lambda: FollowTargetSafe(
-        None, variant_params("us_echo_inverted", UltrasoundParams(
-            clock_hz=1_000_000, period_us=2400, wait_us=500, max_range_mm=300)))),
-    ("follow_target_safe", lambda: FollowTargetSafe(
-        None, variant_params("us_echo_counter_narrow"))),
-    ("follow_line", lambda: FollowLine()),
-    ("follow_line", lambda: FollowLine(FollowLineParams(n_sensors=1, edge_side="right"))),
-    ("follow_line", lambda: FollowLine(variant_params("line_inverted_polarity",
-                                                      FollowLineParams(n_sensors=2)))),
-])
+@pytest.mark.parametrize(
+    "name,component",
+    [
+        ("follow_target_safe", lambda: FollowTargetSafe()),
+        (
+            "follow_target_safe",
+            lambda: FollowTargetSafe(
+                None,
+                variant_params(
+                    "us_echo_inverted",
+                    UltrasoundParams(
+                        clock_hz=1_000_000, period_us=2400, wait_us=500, max_range_mm=300
+                    ),
+                ),
+            ),
+        ),
+        (
+            "follow_target_safe",
+            lambda: FollowTargetSafe(None, variant_params("us_echo_counter_narrow")),
+        ),
+        ("follow_line", lambda: FollowLine()),
+        ("follow_line", lambda: FollowLine(FollowLineParams(n_sensors=1, edge_side="right"))),
+        (
+            "follow_line",
+            lambda: FollowLine(
+                variant_params("line_inverted_polarity", FollowLineParams(n_sensors=2))
+            ),
+        ),
+    ],
+)
 def test_verilator_lints_the_sensor_designs_cleanly(tmp_path, name, component):
     path = tmp_path / f"{name}.v"
     path.write_text(generate_top_verilog(component(), name))
@@ -97,13 +121,22 @@ def test_verilator_lints_the_sensor_designs_cleanly(tmp_path, name, component):
 def test_default_output_is_named_after_the_top(tmp_path, monkeypatch, capsys):
     monkeypatch.chdir(tmp_path)
     with pytest.raises(SystemExit) as exit_info:
-        run_cli(main, ["--top", "follow_line", "--line-base-dps", "180",
-                       "--variant", "line_inverted_polarity"])
+        run_cli(
+            main,
+            [
+                "--top",
+                "follow_line",
+                "--line-base-dps",
+                "180",
+                "--variant",
+                "line_inverted_polarity",
+            ],
+        )
     assert exit_info.value.code == 0
     assert os.listdir(tmp_path / "build") == ["follow_line.v"]
     assert capsys.readouterr().out.strip() == (
-        "wrote build/follow_line.v (3 sensors, variant line_inverted_polarity, module "
-        "follow_line)")
+        "wrote build/follow_line.v (3 sensors, variant line_inverted_polarity, module follow_line)"
+    )
 
 
 def test_options_reach_the_design(tmp_path):
@@ -111,26 +144,41 @@ def test_options_reach_the_design(tmp_path):
     # echo counter is a narrower register.
     plain = export(tmp_path, ["--top", "follow_target_safe"], "a.v")
     stop = export(tmp_path, ["--top", "follow_target_safe", "--stop-mm", "257"], "b.v")
-    narrow = export(tmp_path, ["--top", "follow_target_safe", "--variant",
-                               "us_echo_counter_narrow"], "c.v")
+    narrow = export(
+        tmp_path, ["--top", "follow_target_safe", "--variant", "us_echo_counter_narrow"], "c.v"
+    )
     assert "9'h101" in stop and "9'h101" not in plain  # 257
     assert re.search(r"reg \[20:0\] count\b", plain)
     assert re.search(r"reg \[19:0\] count\b", narrow)
 
 
-@pytest.mark.parametrize("argv,message", [
-    (["--top", "follow_line", "--width", "320"], "--width applies to --top follow_target or"),
-    (["--line-base-dps", "3"], "--line-base-dps applies to --top follow_line"),
-    (["--top", "follow_line", "--stop-mm", "3"], "--stop-mm applies to --top follow_target_safe"),
-    (["--variant", "us_echo_inverted"], "--variant names a seeded bug of a sensor design"),
-    (["--top", "follow_line", "--variant", "us_echo_inverted"],
-     "is a variant of --top follow_target_safe"),
-    (["--top", "follow_line", "--variant", "nope"], "known variants: line_inverted_polarity"),
-    (["--top", "follow_target_safe", "--stop-mm", "500"], "resume_mm=400 must be >= stop_mm=500"),
-    (["--top", "follow_target_safe", "--us-trigger-us", "5"], "trigger_us must be >= 10"),
-    (["--top", "follow_line", "--line-n-sensors", "4"], "n_sensors must be <= 3"),
-    (["--top", "follow_line", "--board", "ulx3s-85f"], "cannot be combined with --top follow_line"),
-])
+@pytest.mark.parametrize(
+    "argv,message",
+    [
+        (["--top", "follow_line", "--width", "320"], "--width applies to --top follow_target or"),
+        (["--line-base-dps", "3"], "--line-base-dps applies to --top follow_line"),
+        (
+            ["--top", "follow_line", "--stop-mm", "3"],
+            "--stop-mm applies to --top follow_target_safe",
+        ),
+        (["--variant", "us_echo_inverted"], "--variant names a seeded bug of a sensor design"),
+        (
+            ["--top", "follow_line", "--variant", "us_echo_inverted"],
+            "is a variant of --top follow_target_safe",
+        ),
+        (["--top", "follow_line", "--variant", "nope"], "known variants: line_inverted_polarity"),
+        (
+            ["--top", "follow_target_safe", "--stop-mm", "500"],
+            "resume_mm=400 must be >= stop_mm=500",
+        ),
+        (["--top", "follow_target_safe", "--us-trigger-us", "5"], "trigger_us must be >= 10"),
+        (["--top", "follow_line", "--line-n-sensors", "4"], "n_sensors must be <= 3"),
+        (
+            ["--top", "follow_line", "--board", "ulx3s-85f"],
+            "cannot be combined with --top follow_line",
+        ),
+    ],
+)
 def test_bad_options_exit_2_with_a_clear_message(tmp_path, capsys, argv, message):
     with pytest.raises(SystemExit) as exit_info:
         run_cli(main, ["-o", str(tmp_path / "x.v"), *argv])
@@ -142,13 +190,39 @@ def test_bad_options_exit_2_with_a_clear_message(tmp_path, capsys, argv, message
 
 def test_module_runs_with_python_m(tmp_path):
     out = tmp_path / "safe.v"
-    result = subprocess.run([sys.executable, "-m", "fpga_robotics.export", "--top",
-                             "follow_target_safe", "-o", str(out)],
-                            capture_output=True, text=True, timeout=300, check=False)
+    result = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "fpga_robotics.export",
+            "--top",
+            "follow_target_safe",
+            "-o",
+            str(out),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        check=False,
+    )
     assert result.returncode == 0, result.stderr
     assert module_ports(out.read_text(), "follow_target_safe") == SAFE_PORTS
-    bad = subprocess.run([sys.executable, "-m", "fpga_robotics.export", "--top", "follow_line",
-                          "--line-n-sensors", "0", "-o", str(tmp_path / "x.v")],
-                         capture_output=True, text=True, timeout=300, check=False)
+    bad = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "fpga_robotics.export",
+            "--top",
+            "follow_line",
+            "--line-n-sensors",
+            "0",
+            "-o",
+            str(tmp_path / "x.v"),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        check=False,
+    )
     assert bad.returncode == 2 and "n_sensors must be >= 1" in bad.stderr
     assert "Traceback" not in bad.stderr and not (tmp_path / "x.v").exists()

@@ -22,11 +22,14 @@ def _write(name):
     return build
 
 
-@pytest.mark.parametrize("build", [
-    lambda: get_backend("verilator", SMALL),
-    lambda: build_cache.get_or_build("pins-verilator-x", "k" * 64, ["a"], _write("a")),
-    lambda: board.build_bitstream("ulx3s-85f", "unused"),
-])
+@pytest.mark.parametrize(
+    "build",
+    [
+        lambda: get_backend("verilator", SMALL),
+        lambda: build_cache.get_or_build("pins-verilator-x", "k" * 64, ["a"], _write("a")),
+        lambda: board.build_bitstream("ulx3s-85f", "unused"),
+    ],
+)
 def test_a_fast_test_cannot_build(build, request):
     with pytest.raises(slow_builds.SlowBuildInFastTier) as info:
         build()
@@ -35,19 +38,29 @@ def test_a_fast_test_cannot_build(build, request):
 
 
 def test_other_builds_go_through(tmp_path):
-    entry = build_cache.get_or_build("cxxrtl-x", "c" * 64, ["lib.so"], _write("lib.so"),
-                                     root=tmp_path)
+    entry = build_cache.get_or_build(
+        "cxxrtl-x", "c" * 64, ["lib.so"], _write("lib.so"), root=tmp_path
+    )
     assert entry.built and (entry.path / "lib.so").read_text() == "built"
 
 
 def test_a_python_process_of_a_fast_test_cannot_build(tmp_path):
-    code = ("from fpga_robotics.sim.backends import build_cache\n"
-            "build_cache.get_or_build('verilator-x', 'k' * 64, ['a'], None)\n")
-    proc = subprocess.run([sys.executable, "-c", code], check=False, cwd=tmp_path,
-                          capture_output=True, text=True, timeout=120)
+    code = (
+        "from fpga_robotics.sim.backends import build_cache\n"
+        "build_cache.get_or_build('verilator-x', 'k' * 64, ['a'], None)\n"
+    )
+    proc = subprocess.run(
+        [sys.executable, "-c", code],
+        check=False,
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert proc.returncode != 0
     assert "test_a_python_process_of_a_fast_test_cannot_build builds a Verilator model" in (
-        proc.stderr)
+        proc.stderr
+    )
 
 
 @pytest.mark.slow

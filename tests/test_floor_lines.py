@@ -73,17 +73,32 @@ def test_config_lines_are_validated_with_the_key_path():
     bad({"points": [[1, 1], [1, 1]]}, r"has no length")
     bad({"points": [[1, 1], [2, 1]], "colour": [0, 0, 0]}, r"did you mean 'color'")
     with pytest.raises(WorldConfigError, match=r"room\.lines\[1\]\.name 'a' is used twice"):
-        World.from_config({"room": {"lines": [{"name": "a", "points": [[1, 1], [2, 1]]},
-                                              {"name": "a", "points": [[1, 2], [2, 2]]}]}})
+        World.from_config(
+            {
+                "room": {
+                    "lines": [
+                        {"name": "a", "points": [[1, 1], [2, 1]]},
+                        {"name": "a", "points": [[1, 2], [2, 2]]},
+                    ]
+                }
+            }
+        )
 
 
 def test_the_world_floor_colour_map_and_scene():
-    world = World.from_config({"room": {
-        "floor_color": [0.6, 0.6, 0.6],
-        "terrain": [{"center": [2.0, 2.0], "size": [1.0, 1.0], "color": [0.2, 0.8, 0.2]}],
-        "lines": [{"name": "tape", "points": [[1.0, 2.0], [3.0, 2.0]], "width": 0.02},
-                  {"points": [[2.0, 1.0], [2.0, 3.0]], "width": 0.04,
-                   "color": [1.0, 1.0, 1.0]}]}, "people": []})
+    world = World.from_config(
+        {
+            "room": {
+                "floor_color": [0.6, 0.6, 0.6],
+                "terrain": [{"center": [2.0, 2.0], "size": [1.0, 1.0], "color": [0.2, 0.8, 0.2]}],
+                "lines": [
+                    {"name": "tape", "points": [[1.0, 2.0], [3.0, 2.0]], "width": 0.02},
+                    {"points": [[2.0, 1.0], [2.0, 3.0]], "width": 0.04, "color": [1.0, 1.0, 1.0]},
+                ],
+            },
+            "people": [],
+        }
+    )
     assert [line.name for line in world.floor_lines] == ["tape", "line1"]
     assert world.floor_color_at(1.2, 2.009) == (0.0, 0.0, 0.0)  # tape off the patch
     assert world.floor_color_at(1.2, 2.011) == (0.6, 0.6, 0.6)  # the floor
@@ -91,8 +106,9 @@ def test_the_world_floor_colour_map_and_scene():
     assert world.floor_color_at(2.0, 2.0) == (1.0, 1.0, 1.0)  # the later line on top
     rng = np.random.default_rng(0)
     x, y = rng.uniform(1.4, 2.6, 3000), rng.uniform(1.4, 2.6, 3000)
-    np.testing.assert_array_equal(world.floor_colors_at(x, y),
-                                  [world.floor_color_at(a, b) for a, b in zip(x, y)])
+    np.testing.assert_array_equal(
+        world.floor_colors_at(x, y), [world.floor_color_at(a, b) for a, b in zip(x, y)]
+    )
     world_map = world.world_map()
     assert world_map.lines == [[(1.0, 2.0), (3.0, 2.0)], [(2.0, 1.0), (2.0, 3.0)]]
     assert world_map.line_widths == [0.02, 0.04]
@@ -105,11 +121,18 @@ def test_the_world_floor_colour_map_and_scene():
 def test_a_line_is_drawn_where_the_pinhole_model_puts_it(tmp_path):
     # A 5 cm black line across the view 1.5 m ahead of a camera 0.3 m high at (1, 3).
     w, h, hfov = 160, 120, 1.047
-    world = World.from_config({"room": {"lines": [{"points": [[2.5, 1.0], [2.5, 5.0]],
-                                                   "width": 0.05}]},
-                               "robot": {"start": [0.92, 3.0], "camera_height": 0.3,
-                                         "camera_forward": 0.08, "camera_tilt_deg": 0},
-                               "people": []})
+    world = World.from_config(
+        {
+            "room": {"lines": [{"points": [[2.5, 1.0], [2.5, 5.0]], "width": 0.05}]},
+            "robot": {
+                "start": [0.92, 3.0],
+                "camera_height": 0.3,
+                "camera_forward": 0.08,
+                "camera_tilt_deg": 0,
+            },
+            "people": [],
+        }
+    )
     pose = world.camera_pose()
     assert pose.x == pytest.approx(1.0)
     image = CameraRenderer(w, h, hfov).render(world.scene(), pose)

@@ -52,8 +52,9 @@ def test_people_stand_on_the_patch_and_a_later_patch_covers_an_earlier_one():
     person = Cylinder(1.5, 0.0, 0.2, (Band(0.0, 1.7, (0.1, 0.1, 0.8)),))
     blue = np.array(_lit((0.1, 0.1, 0.8)))
     under = (((0.5, -1.0), (3.0, -1.0), (3.0, 1.0), (0.5, 1.0)), (0.1, 0.7, 0.1))
-    image = renderer.render(Scene(cylinders=(person,), floor_patches=(under, PATCH),
-                                  lighting=LIGHT), pose)
+    image = renderer.render(
+        Scene(cylinders=(person,), floor_patches=(under, PATCH), lighting=LIGHT), pose
+    )
     col = W // 2
     assert np.all(image[:, col] == _lit(PATCH[1]), axis=1).sum() > 0  # the later one on top
     assert np.all(image[:, col] == _lit(under[1]), axis=1).sum() > 0
@@ -76,13 +77,27 @@ def test_noise_comes_after_the_patches_and_is_seeded():
 def test_the_world_draws_its_coloured_terrain():
     from fpga_robotics.sim.world import World
 
-    world = World.from_config({"room": {"terrain": [
-        {"name": "mat", "center": [3.0, 3.0], "size": [1.0, 1.0], "color": [0.8, 0.1, 0.1]},
-        {"name": "wet", "center": [5.0, 3.0], "size": [1.0, 1.0], "friction": 0.3}]},
-        "robot": {"start": [1.5, 3.0]}, "people": []}, seed=0)
+    world = World.from_config(
+        {
+            "room": {
+                "terrain": [
+                    {
+                        "name": "mat",
+                        "center": [3.0, 3.0],
+                        "size": [1.0, 1.0],
+                        "color": [0.8, 0.1, 0.1],
+                    },
+                    {"name": "wet", "center": [5.0, 3.0], "size": [1.0, 1.0], "friction": 0.3},
+                ]
+            },
+            "robot": {"start": [1.5, 3.0]},
+            "people": [],
+        },
+        seed=0,
+    )
     scene = world.scene()
     assert len(scene.floor_patches) == 1  # the wet patch has no colour: not drawn
-    (poly, color), = scene.floor_patches
+    ((poly, color),) = scene.floor_patches
     assert color == (0.8, 0.1, 0.1) and len(poly) == 4
     assert math.isclose(min(p[0] for p in poly), 2.5) and math.isclose(max(p[1] for p in poly), 3.5)
 
@@ -91,8 +106,15 @@ def test_triangulation_covers_any_simple_polygon():
     from fpga_robotics.sim.camera.render3d.floor_patches import triangulate
 
     def area(poly):
-        return abs(sum(x0 * y1 - x1 * y0 for (x0, y0), (x1, y1)
-                       in zip(poly, list(poly[1:]) + [poly[0]]))) / 2
+        return (
+            abs(
+                sum(
+                    x0 * y1 - x1 * y0
+                    for (x0, y0), (x1, y1) in zip(poly, list(poly[1:]) + [poly[0]])
+                )
+            )
+            / 2
+        )
 
     square = ((0, 0), (2, 0), (2, 2), (0, 2))
     l_shape = ((0, 0), (3, 0), (3, 1), (1, 1), (1, 3), (0, 3))  # not convex, area 5
@@ -111,8 +133,9 @@ def test_triangulation_covers_any_simple_polygon():
 def test_the_3d_model_has_one_flat_mesh_per_triangle():
     from fpga_robotics.sim.camera.render3d.floor_patches import LIFT, patch_assets_and_geoms
 
-    scene = _scene(floor_patches=(PATCH, (((0, 0), (3, 0), (3, 1), (1, 1), (1, 3), (0, 3)),
-                                          (0.2, 0.3, 0.9))))
+    scene = _scene(
+        floor_patches=(PATCH, (((0, 0), (3, 0), (3, 1), (1, 1), (1, 3), (0, 3)), (0.2, 0.3, 0.9)))
+    )
     assets, geoms = patch_assets_and_geoms(scene)
     assert len(assets) == len(geoms) == 2 + 4
     assert 'rgba="0.8 0.1 0.1 1"' in geoms[0] and 'contype="0"' in geoms[0]

@@ -64,8 +64,9 @@ def files(tmp_path_factory):
     (d / "robot_top.v").write_text(RENAMED % {"xmsb": PARAMS.x_bits - 1})
     (d / "robot.toml").write_text(RENAMED_MAP % {"latency": latency})
     (d / "fb_top.v").write_text(FB_TOP % {"w": PARAMS.width, "h": PARAMS.height})
-    (d / "fb.toml").write_text(FB_MAP % {
-        "result": f'result = {{ strobe = "done", latency = {latency} }}'})
+    (d / "fb.toml").write_text(
+        FB_MAP % {"result": f'result = {{ strobe = "done", latency = {latency} }}'}
+    )
     (d / "fb_after.toml").write_text(FB_MAP % {"result": "result = { after_cycles = 200 }"})
     (d / "never.v").write_text(NEVER_DONE)
     (d / "never.toml").write_text(NEVER_DONE_MAP)
@@ -104,10 +105,14 @@ def test_cxxrtl_gives_verilators_results_cycle_for_cycle(files, names, ports, li
 
 
 def test_a_named_timeout_on_cxxrtl_too(files):
-    design = ForeignCxxrtlBackend(PARAMS, files=[files / "never.v"],
-                                  port_map=files / "never.toml")
-    with design, pytest.raises(BackendError, match="frame 0: timeout: the result strobe "
-                                                   "'done' never rose within 500 cycles"):
+    design = ForeignCxxrtlBackend(PARAMS, files=[files / "never.v"], port_map=files / "never.toml")
+    with (
+        design,
+        pytest.raises(
+            BackendError,
+            match="frame 0: timeout: the result strobe 'done' never rose within 500 cycles",
+        ),
+    ):
         design.process_frame(_frames(PARAMS)[0])
 
 
@@ -121,28 +126,34 @@ def test_what_yosys_cannot_read_runs_on_verilator(files):
     with open_foreign_frames("auto", PARAMS, files=paths, port_map=files / "sv.toml") as design:
         assert isinstance(design, ForeignVerilatorBackend)
         assert not isinstance(design, ForeignCxxrtlBackend)
-    with open_foreign_frames("auto", PARAMS, files=[files / "follow_target.v"],
-                             port_map=files / "ft.toml") as design:
+    with open_foreign_frames(
+        "auto", PARAMS, files=[files / "follow_target.v"], port_map=files / "ft.toml"
+    ) as design:
         assert isinstance(design, ForeignCxxrtlBackend)  # the faster, when Yosys reads it
 
 
 def test_runtime_inputs_need_verilator(files, tmp_path):
     # color_sel held by the host as a [runtime] input: set through Verilator's DPI.
     ports = tmp_path / "runtime.toml"
-    ports.write_text((files / "ft.toml").read_text().replace('color = { port = "color_sel" }\n',
-                                                            "") + "\n[runtime]\ncolor_sel = 4\n")
+    ports.write_text(
+        (files / "ft.toml").read_text().replace('color = { port = "color_sel" }\n', "")
+        + "\n[runtime]\ncolor_sel = 4\n"
+    )
     with pytest.raises(BackendError, match="runtime.*--backend verilator"):
         open_foreign_frames("cxxrtl", PARAMS, files=[files / "follow_target.v"], port_map=ports)
-    with open_foreign_frames("auto", PARAMS, files=[files / "follow_target.v"],
-                             port_map=ports) as design:
+    with open_foreign_frames(
+        "auto", PARAMS, files=[files / "follow_target.v"], port_map=ports
+    ) as design:
         assert type(design) is ForeignVerilatorBackend
 
 
 def test_the_closed_loop_on_pins_is_the_same_on_both(tmp_path):
     path = tmp_path / "bump.toml"
     path.write_text(SCENARIO.format(duration=2.0, design=VERILOG_DESIGN))
-    runs = {name: run_scenario(load_scenario(str(path)), backend=name)
-            for name in ("cxxrtl", "verilator")}
+    runs = {
+        name: run_scenario(load_scenario(str(path)), backend=name)
+        for name in ("cxxrtl", "verilator")
+    }
     cxxrtl, verilator = runs["cxxrtl"], runs["verilator"]
     assert cxxrtl.summary["sim_cycles"] == verilator.summary["sim_cycles"] == 20_000
     assert verilator.trajectory["motor_left"][0] == 300

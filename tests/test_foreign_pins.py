@@ -88,15 +88,20 @@ def verilog_run(tmp_path_factory):
 def test_the_verilog_design_stops_short_of_the_wall_by_margin_less_braking(verilog_run):
     from fpga_robotics.sim.world import World
 
-    spec = World.from_config({"room": {"width": 2.0, "depth": 1.0}, "people": [],
-                              "robot": {"model": "gopigo3", "start": [0.5, 0.5]}}).robot_spec
+    spec = World.from_config(
+        {
+            "room": {"width": 2.0, "depth": 1.0},
+            "people": [],
+            "robot": {"model": "gopigo3", "start": [0.5, 0.5]},
+        }
+    ).robot_spec
     traj = verilog_run.trajectory
     assert verilog_run.summary["verdict"] == "pass"
     assert verilog_run.summary["timing"] == "real_clock"
     assert traj["bumper.pressed"][-1] == 1.0
     assert traj["motor_left"][0] == 300 and traj["motor_left"][-1] == 0
     # From 300 DPS at the wheels' ramp: v0^2 / (2 a) of wheel angle, times the wheel radius.
-    braking = math.radians(300.0 ** 2 / (2 * spec.wheel_accel_dps2)) * spec.wheel_radius
+    braking = math.radians(300.0**2 / (2 * spec.wheel_accel_dps2)) * spec.wheel_radius
     gap = ROOM_WIDTH - spec.body_radius - traj["x"][-1]
     # Discrete time moves it by up to a physics step (1/240 s) of travel at 0.17 m/s each:
     # the bumper is sampled at a step's start, the 1 ms actuation delay ends at a step, the
@@ -104,19 +109,32 @@ def test_the_verilog_design_stops_short_of_the_wall_by_margin_less_braking(veril
     step = math.radians(300.0) * spec.wheel_radius / 240
     assert MARGIN - braking - 3 * step <= gap <= MARGIN - braking + step
     # Absent outputs stay absent (the map names no found/proximity/centroid).
-    assert set(verilog_run.summary["absent_outputs"]) == {"found", "proximity", "centroid_x",
-                                                          "centroid_leds"}
+    assert set(verilog_run.summary["absent_outputs"]) == {
+        "found",
+        "proximity",
+        "centroid_x",
+        "centroid_leds",
+    }
 
 
 def test_the_verilog_design_drives_exactly_as_its_amaranth_twin(verilog_run, tmp_path):
-    register_top(Top("bump_stop_twin", "BumpStop in Amaranth", camera=False,
-                     component=BumpStop, takes_follow_target_params=False,
-                     bindings={"wheels": {"motor_left": "motor_left",
-                                          "motor_right": "motor_right"},
-                               "bumper": {"pressed": "bump"}}))
+    register_top(
+        Top(
+            "bump_stop_twin",
+            "BumpStop in Amaranth",
+            camera=False,
+            component=BumpStop,
+            takes_follow_target_params=False,
+            bindings={
+                "wheels": {"motor_left": "motor_left", "motor_right": "motor_right"},
+                "bumper": {"pressed": "bump"},
+            },
+        )
+    )
     try:
-        twin = run_scenario(_scenario(tmp_path, '[design]\ntop = "bump_stop_twin"'),
-                            backend="pysim")
+        twin = run_scenario(
+            _scenario(tmp_path, '[design]\ntop = "bump_stop_twin"'), backend="pysim"
+        )
     finally:
         TOPS.pop("bump_stop_twin", None)
     for key in ("x", "y", "heading", "motor_left", "motor_right", "bumper.pressed"):
@@ -130,8 +148,11 @@ def test_a_verilog_design_runs_on_the_compiled_backends_only(tmp_path):
 
     source = pin_design_source(_scenario(tmp_path, VERILOG_DESIGN, duration=0.1))
     assert set(source.ports) == {"motor_left", "motor_right", "bump_i"}
-    with pytest.raises(PinError, match="the pysim pin backend cannot run a Verilog "
-                                       "design.*use the cxxrtl or verilator backend"):
+    with pytest.raises(
+        PinError,
+        match="the pysim pin backend cannot run a Verilog "
+        "design.*use the cxxrtl or verilator backend",
+    ):
         get_pin_backend("pysim", source)
 
 
@@ -144,18 +165,34 @@ def _map(**extra):
 
 #: (case, port map text or a change to the scenario, words of the one-line error).
 BAD_MAPS = [
-    ("unknown connector kind", _map(**{"[connectors.bumper]": "[connectors.sonar]"}),
-     "connectors.sonar: unknown connector kind; known: bumper, line_sensors, ultrasound"),
-    ("unknown pin", _map(pressed="pushed"),
-     "connectors.bumper.pushed: the bumper connector has no pin 'pushed'"),
-    ("missing port", _map(**{'pressed = "bump_i"': 'pressed = "bump"'}),
-     "connectors.bumper.pressed: the design bump_stop has no port 'bump'"),
-    ("wrong direction", _map(**{'pressed = "bump_i"': 'pressed = "hit_o"\n[constants]\n'
-                                                      'bump_i = 0'}),
-     ("connectors.bumper.pressed: port 'hit_o' of bump_stop is an output; the bumper pin "
-      "'pressed' needs an input")),
-    ("camera as a connector", _map(**{"[connectors.bumper]": "[connectors.camera]"}),
-     "connectors.camera: the camera is bound by pixels and color"),
+    (
+        "unknown connector kind",
+        _map(**{"[connectors.bumper]": "[connectors.sonar]"}),
+        "connectors.sonar: unknown connector kind; known: bumper, line_sensors, ultrasound",
+    ),
+    (
+        "unknown pin",
+        _map(pressed="pushed"),
+        "connectors.bumper.pushed: the bumper connector has no pin 'pushed'",
+    ),
+    (
+        "missing port",
+        _map(**{'pressed = "bump_i"': 'pressed = "bump"'}),
+        "connectors.bumper.pressed: the design bump_stop has no port 'bump'",
+    ),
+    (
+        "wrong direction",
+        _map(**{'pressed = "bump_i"': 'pressed = "hit_o"\n[constants]\nbump_i = 0'}),
+        (
+            "connectors.bumper.pressed: port 'hit_o' of bump_stop is an output; the bumper pin "
+            "'pressed' needs an input"
+        ),
+    ),
+    (
+        "camera as a connector",
+        _map(**{"[connectors.bumper]": "[connectors.camera]"}),
+        "connectors.camera: the camera is bound by pixels and color",
+    ),
 ]
 
 
@@ -172,8 +209,20 @@ def test_bad_connector_maps_are_one_line_errors(case, text, message, tmp_path, c
     ports.write_text(text)
     scenario = tmp_path / "bump.toml"
     scenario.write_text(SCENARIO.format(duration=0.1, design=""))
-    code, err = _run_cli(["--scenario", str(scenario), "--design", f"verilog:{VERILOG}",
-                          "--ports", str(ports), "--rerun", "off", "--quiet"], capsys)
+    code, err = _run_cli(
+        [
+            "--scenario",
+            str(scenario),
+            "--design",
+            f"verilog:{VERILOG}",
+            "--ports",
+            str(ports),
+            "--rerun",
+            "off",
+            "--quiet",
+        ],
+        capsys,
+    )
     assert code == 2
     assert len(err.strip().splitlines()) == 1, err
     assert message in err
@@ -184,31 +233,52 @@ def test_a_too_wide_port_is_refused(tmp_path, capsys):
     wide.write_text(VERILOG.read_text().replace("input bump_i", "input [3:0] bump_i"))
     scenario = tmp_path / "bump.toml"
     scenario.write_text(SCENARIO.format(duration=0.1, design=""))
-    code, err = _run_cli(["--scenario", str(scenario), "--design", f"verilog:{wide}",
-                          "--ports", str(PORTS), "--rerun", "off", "--quiet"], capsys)
+    code, err = _run_cli(
+        [
+            "--scenario",
+            str(scenario),
+            "--design",
+            f"verilog:{wide}",
+            "--ports",
+            str(PORTS),
+            "--rerun",
+            "off",
+            "--quiet",
+        ],
+        capsys,
+    )
     assert code == 2 and len(err.strip().splitlines()) == 1
-    assert ("connectors.bumper.pressed: port 'bump_i' of bump_stop is 4 bits wide; the "
-            "bumper pin 'pressed' takes 1 bit") in err
+    assert (
+        "connectors.bumper.pressed: port 'bump_i' of bump_stop is 4 bits wide; the "
+        "bumper pin 'pressed' takes 1 bit"
+    ) in err
 
 
 def test_other_backends_and_compressed_timing_are_usage_errors(tmp_path, capsys):
     scenario = tmp_path / "bump.toml"
     scenario.write_text(SCENARIO.format(duration=0.1, design=VERILOG_DESIGN))
-    code, err = _run_cli(["--scenario", str(scenario), "--backend", "pysim", "--rerun", "off"],
-                         capsys)
+    code, err = _run_cli(
+        ["--scenario", str(scenario), "--backend", "pysim", "--rerun", "off"], capsys
+    )
     assert code == 2 and "runs on the cxxrtl or verilator backend, not 'pysim'" in err
-    code, err = _run_cli(["--scenario", str(scenario), "--set", 'sim.timing="compressed"',
-                          "--rerun", "off"], capsys)
+    code, err = _run_cli(
+        ["--scenario", str(scenario), "--set", 'sim.timing="compressed"', "--rerun", "off"], capsys
+    )
     assert code == 2 and len(err.strip().splitlines()) == 1
-    assert "needs sim.timing = \"real_clock\"" in err
-    code, err = _run_cli(["--scenario", str(scenario), "--runtime", "mode=1", "--rerun", "off"],
-                         capsys)
+    assert 'needs sim.timing = "real_clock"' in err
+    code, err = _run_cli(
+        ["--scenario", str(scenario), "--runtime", "mode=1", "--rerun", "off"], capsys
+    )
     assert code == 2 and "in real-clock timing they keep the port map's values" in err
 
 
 def test_parse_errors_name_the_key():
-    base = {"top": "t", "clock": {"port": "clk"}, "reset": {"port": "rst"},
-            "outputs": {"motor_left": "l", "motor_right": "r"}}
+    base = {
+        "top": "t",
+        "clock": {"port": "clk"},
+        "reset": {"port": "rst"},
+        "outputs": {"motor_left": "l", "motor_right": "r"},
+    }
     with pytest.raises(PortMapError, match="missing \\[pixels\\]"):
         parse_port_map(base)  # neither a camera nor a connector
     pm = parse_port_map({**base, "connectors": {"bumper": {"pressed": "b"}}})
@@ -218,24 +288,38 @@ def test_parse_errors_name_the_key():
     with pytest.raises(PortMapError, match="port 'l' is mapped more than once"):
         parse_port_map({**base, "connectors": {"bumper": {"pressed": "l"}}})
     with pytest.raises(PortMapError, match="outputs.found is read when a frame's result"):
-        parse_port_map({**base, "outputs": {**base["outputs"], "found": "f"},
-                        "connectors": {"bumper": {"pressed": "b"}}})
+        parse_port_map(
+            {
+                **base,
+                "outputs": {**base["outputs"], "found": "f"},
+                "connectors": {"bumper": {"pressed": "b"}},
+            }
+        )
 
 
 @pytest.mark.slow
 def test_a_camera_design_in_verilog_follows_as_follow_target_does(tmp_path):
     from fpga_robotics.hw.verilog import generate_verilog
 
-    real_clock = ['camera.resolution="40x30"', 'sim.timing="real_clock"', "sim.clock_hz=2e5",
-                  "sim.duration=0.6"]
+    real_clock = [
+        'camera.resolution="40x30"',
+        'sim.timing="real_clock"',
+        "sim.clock_hz=2e5",
+        "sim.duration=0.6",
+    ]
     builtin = load_scenario("follow_person", real_clock)
     params = builtin.params
     (tmp_path / "follow_target.v").write_text(generate_verilog(params))
     (tmp_path / "robot_top.v").write_text(RENAMED % {"xmsb": params.x_bits - 1})
     (tmp_path / "robot.toml").write_text(RENAMED_MAP % {"latency": params.motor_latency})
-    verilog = load_scenario("follow_person", [
-        *real_clock, f'design.verilog=["{tmp_path}/robot_top.v", "{tmp_path}/follow_target.v"]',
-        f'design.ports="{tmp_path}/robot.toml"'])
+    verilog = load_scenario(
+        "follow_person",
+        [
+            *real_clock,
+            f'design.verilog=["{tmp_path}/robot_top.v", "{tmp_path}/follow_target.v"]',
+            f'design.ports="{tmp_path}/robot.toml"',
+        ],
+    )
     theirs = run_scenario(verilog, backend="auto")
     ours = run_scenario(builtin, backend="pysim")
     assert theirs.summary["sim_cycles"] == ours.summary["sim_cycles"] == 120_000
@@ -274,17 +358,28 @@ def test_a_camera_and_ultrasound_design_in_verilog_stops_as_follow_target_safe(t
     from fpga_robotics.hw.safe_follow import FollowTargetSafe
     from fpga_robotics.hw.verilog import generate_verilog
 
-    scene = ['camera.resolution="40x30"', "sim.clock_hz=2e5", "sim.duration=0.5",
-             "robot.start=[2.05, 2.0]"]
+    scene = [
+        'camera.resolution="40x30"',
+        "sim.clock_hz=2e5",
+        "sim.duration=0.5",
+        "robot.start=[2.05, 2.0]",
+    ]
     builtin = load_scenario("obstacle_between", [*scene, "design.ultrasound.clock_hz=200000"])
-    component = build_component(get_top("follow_target_safe"), builtin.params,
-                                builtin.design_tables)
+    component = build_component(
+        get_top("follow_target_safe"), builtin.params, builtin.design_tables
+    )
     assert isinstance(component, FollowTargetSafe)
     (tmp_path / "safe.v").write_text(generate_verilog(component=component))
     (tmp_path / "safe.toml").write_text(SAFE_MAP % {"latency": builtin.params.motor_latency})
-    verilog = load_scenario("obstacle_between", [
-        *scene, 'design.top="follow_target"', f'design.verilog="{tmp_path}/safe.v"',
-        f'design.ports="{tmp_path}/safe.toml"'])
+    verilog = load_scenario(
+        "obstacle_between",
+        [
+            *scene,
+            'design.top="follow_target"',
+            f'design.verilog="{tmp_path}/safe.v"',
+            f'design.ports="{tmp_path}/safe.toml"',
+        ],
+    )
     assert verilog.sim.timing == "real_clock"
     theirs = run_scenario(verilog, backend="auto")
     ours = run_scenario(builtin, backend="pysim")

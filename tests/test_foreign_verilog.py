@@ -2,7 +2,6 @@
 exported follow_target bit for bit against the model, a renamed-ports wrapper written here,
 and bad port maps as one-line errors."""
 
-
 import numpy as np
 import pytest
 from renamed_design import RENAMED, RENAMED_MAP
@@ -121,16 +120,18 @@ def files(tmp_path_factory):
     (d / "never.v").write_text(NEVER_DONE)
     (d / "never.toml").write_text(NEVER_DONE_MAP)
     (d / "fb_top.v").write_text(FB_TOP % {"w": PARAMS.width, "h": PARAMS.height})
-    (d / "fb.toml").write_text(FB_MAP % {
-        "result": f'result = {{ strobe = "done", latency = {PARAMS.motor_latency} }}'})
+    (d / "fb.toml").write_text(
+        FB_MAP % {"result": f'result = {{ strobe = "done", latency = {PARAMS.motor_latency} }}'}
+    )
     (d / "fb_after.toml").write_text(FB_MAP % {"result": "result = { after_cycles = 200 }"})
     return d
 
 
 @pytest.mark.slow
 def test_exported_follow_target_matches_the_model_bit_for_bit(files):
-    design = foreign.ForeignVerilatorBackend(PARAMS, files=[files / "follow_target.v"],
-                                             port_map=files / "ft.toml")
+    design = foreign.ForeignVerilatorBackend(
+        PARAMS, files=[files / "follow_target.v"], port_map=files / "ft.toml"
+    )
     model = get_backend("model", PARAMS)
     try:
         for color in ("red", "green"):
@@ -147,9 +148,11 @@ def test_exported_follow_target_matches_the_model_bit_for_bit(files):
 
 @pytest.mark.slow
 def test_renamed_ports_active_low_reset_and_own_colour_codes(files):
-    design = foreign.ForeignVerilatorBackend(PARAMS, files=[files / "robot_top.v",
-                                                            files / "follow_target.v"],
-                                             port_map=files / "robot.toml")
+    design = foreign.ForeignVerilatorBackend(
+        PARAMS,
+        files=[files / "robot_top.v", files / "follow_target.v"],
+        port_map=files / "robot.toml",
+    )
     model = get_backend("model", PARAMS)
     try:
         design.reset(), model.reset()  # rst is held low (reset_n high) only if inverted
@@ -157,7 +160,10 @@ def test_renamed_ports_active_low_reset_and_own_colour_codes(files):
             for i, frame in enumerate(_frames(PARAMS)):
                 got, want = design.process_frame(frame, color), model.process_frame(frame, color)
                 assert (got.centroid_leds, got.motor_left, got.motor_right, got.cycles) == (
-                    want.centroid_leds, want.motor_left, want.motor_right, want.cycles
+                    want.centroid_leds,
+                    want.motor_left,
+                    want.motor_right,
+                    want.cycles,
                 ), (color, i)
                 # Outputs the design does not map are absent, not zero.
                 assert got.found is None and got.proximity is None and got.centroid_x is None
@@ -170,9 +176,12 @@ def test_renamed_ports_active_low_reset_and_own_colour_codes(files):
 
 @pytest.mark.slow
 def test_fill_absent_gives_zeros(files):
-    design = foreign.ForeignVerilatorBackend(PARAMS, files=[files / "robot_top.v",
-                                                            files / "follow_target.v"],
-                                             port_map=files / "robot.toml", fill_absent=True)
+    design = foreign.ForeignVerilatorBackend(
+        PARAMS,
+        files=[files / "robot_top.v", files / "follow_target.v"],
+        port_map=files / "robot.toml",
+        fill_absent=True,
+    )
     try:
         got = design.process_frame(_frames(PARAMS)[0])
         assert (got.found, got.proximity, got.centroid_x) == (0, 0, 0)
@@ -183,11 +192,15 @@ def test_fill_absent_gives_zeros(files):
 
 @pytest.mark.slow
 def test_a_design_that_never_raises_its_strobe_is_a_named_timeout(files):
-    design = foreign.ForeignVerilatorBackend(PARAMS, files=[files / "never.v"],
-                                             port_map=files / "never.toml")
+    design = foreign.ForeignVerilatorBackend(
+        PARAMS, files=[files / "never.v"], port_map=files / "never.toml"
+    )
     try:
-        with pytest.raises(BackendError, match=r"timeout: the result strobe 'done' never rose "
-                                               r"within 500 cycles"):
+        with pytest.raises(
+            BackendError,
+            match=r"timeout: the result strobe 'done' never rose "
+            r"within 500 cycles",
+        ):
             design.process_frame(_frames(PARAMS)[0])
     finally:
         design.close()
@@ -204,26 +217,43 @@ BASE = STREAM_MAP % {"latency": 1}
 @pytest.mark.parametrize(
     "text, message",
     [
-        (BASE.replace('"centroid_leds"\n', '"leds"\n', 1).replace(
-            'centroid_leds = "leds"', 'centroid_leds = "led_code"'),
-         "has no port 'led_code'"),
+        (
+            BASE.replace('"centroid_leds"\n', '"leds"\n', 1).replace(
+                'centroid_leds = "leds"', 'centroid_leds = "led_code"'
+            ),
+            "has no port 'led_code'",
+        ),
         (BASE.replace('clock = { port = "clk" }\n', ""), r"missing \[clock\]"),
-        (BASE.replace('motor_left = "motor_left"',
-                      'motor_left = { port = "motor_left", width = 8 }'),
-         "'motor_left' of follow_target is 16 bits wide, the map expects 8"),
-        (BASE.replace('proximity = "proximity"\n', "").replace(
-            'centroid_leds = "centroid_leds"', 'centroid_leds = "proximity"'),
-         "'proximity' of follow_target is 3 bits wide, the map expects 8"),
+        (
+            BASE.replace(
+                'motor_left = "motor_left"', 'motor_left = { port = "motor_left", width = 8 }'
+            ),
+            "'motor_left' of follow_target is 16 bits wide, the map expects 8",
+        ),
+        (
+            BASE.replace('proximity = "proximity"\n', "").replace(
+                'centroid_leds = "centroid_leds"', 'centroid_leds = "proximity"'
+            ),
+            "'proximity' of follow_target is 3 bits wide, the map expects 8",
+        ),
         (BASE.replace('color = { port = "color_sel" }\n', ""), "input 'color_sel' .* not mapped"),
-        (BASE.replace('found = "found"\n', "").replace('valid = "pixels__valid"', 'valid = "found"'),
-         "port 'found' of follow_target is an output, the map uses it as an input"),
+        (
+            BASE.replace('found = "found"\n', "").replace(
+                'valid = "pixels__valid"', 'valid = "found"'
+            ),
+            "port 'found' of follow_target is an output, the map uses it as an input",
+        ),
         (BASE.replace('top = "follow_target"', 'top = "nope"'), "Verilator cannot read"),
         (BASE.replace('style = "stream"', 'style = "fifo"'), "style must be one of"),
         ("speed = 3\n" + BASE, "unknown key 'speed'"),
-        (BASE.replace("[outputs]", "[outputs]\nwheels = \"x\""), "unknown key 'outputs.wheels'"),
-        (BASE.replace('color = { port = "color_sel" }',
-                      'color = { port = "color_sel", codes = { red = 9 } }'),
-         "codes.red does not fit"),
+        (BASE.replace("[outputs]", '[outputs]\nwheels = "x"'), "unknown key 'outputs.wheels'"),
+        (
+            BASE.replace(
+                'color = { port = "color_sel" }',
+                'color = { port = "color_sel", codes = { red = 9 } }',
+            ),
+            "codes.red does not fit",
+        ),
         ("top = [", "not valid TOML"),
     ],
 )
@@ -238,10 +268,26 @@ def test_bad_port_maps_are_one_line_errors(files, text, message):
 def test_cli_runs_a_foreign_design_in_closed_loop(files, capsys, top, ports):
     from fpga_robotics.cli import run
 
-    argv = ["--resolution", "80x60", "--duration", "1", "--rerun", "off", "--quiet",
-            "--summary", str(files / f"{top}.json")]
-    code = run.main(["--design", f"verilog:{files / (top + '.v')},{files / 'follow_target.v'}",
-                     "--ports", str(files / f"{ports}.toml"), *argv])
+    argv = [
+        "--resolution",
+        "80x60",
+        "--duration",
+        "1",
+        "--rerun",
+        "off",
+        "--quiet",
+        "--summary",
+        str(files / f"{top}.json"),
+    ]
+    code = run.main(
+        [
+            "--design",
+            f"verilog:{files / (top + '.v')},{files / 'follow_target.v'}",
+            "--ports",
+            str(files / f"{ports}.toml"),
+            *argv,
+        ]
+    )
     out = capsys.readouterr().out
     # These maps leave out found: absent, so the checks made of it are n/a, not failed.
     assert "[n/a] acquired_within_s: not measured: the design has no `found` output" in out
@@ -253,8 +299,14 @@ def test_cli_runs_a_foreign_design_in_closed_loop(files, capsys, top, ports):
     got, want = (json.loads((files / n).read_text()) for n in (f"{top}.json", "builtin.json"))
     assert got["backend"] == "cxxrtl-foreign"  # auto: the faster that reads it
     assert got["found_fraction"] is None and "found" in got["absent_outputs"]
-    for key in ("min_distance_m", "mean_distance_m", "target_in_view_fraction",
-                "path_length_m", "collisions", "frames"):
+    for key in (
+        "min_distance_m",
+        "mean_distance_m",
+        "target_in_view_fraction",
+        "path_length_m",
+        "collisions",
+        "frames",
+    ):
         assert got[key] == want[key], key
 
 
@@ -263,27 +315,66 @@ def test_cli_runs_a_foreign_design_in_closed_loop(files, capsys, top, ports):
     [
         (["--ports", "x.toml"], "--ports goes with --design"),
         (["--design", "verilog:a.v"], "--design needs --ports"),
-        (["--design", "vhdl:a.vhd", "--ports", "x.toml"],
-         "--ports is the port map of a Verilog design: it goes with --design verilog:FILE.v"),
+        (
+            ["--design", "vhdl:a.vhd", "--ports", "x.toml"],
+            "--ports is the port map of a Verilog design: it goes with --design verilog:FILE.v",
+        ),
         (["--design", "vhdl:a.vhd"], "'a.vhd' is not a Python name; write FILE.py:ClassName"),
-        (["--design", "verilog:a.v", "--ports", "x.toml", "--backend", "pysim"],
-         "runs on the cxxrtl or verilator backend, not 'pysim'"),
-        (["--design", "verilog:{dir}/never.v", "--ports", "{dir}/ft.toml"],
-         ("--design: Verilator cannot read the design (top follow_target): %Error: Specified "
-          "--top-module 'follow_target' was not found")),
-        pytest.param(["--design", "verilog:{dir}/never.v", "--ports", "{dir}/never.toml"],
-                     "timeout: the result strobe 'done' never rose", marks=pytest.mark.slow),
-        (["--design", "verilog:{dir}/missing.v", "--ports", "{dir}/never.toml"],
-         "cannot read the Verilog file"),
+        (
+            ["--design", "verilog:a.v", "--ports", "x.toml", "--backend", "pysim"],
+            "runs on the cxxrtl or verilator backend, not 'pysim'",
+        ),
+        (
+            ["--design", "verilog:{dir}/never.v", "--ports", "{dir}/ft.toml"],
+            (
+                "--design: Verilator cannot read the design (top follow_target): %Error: Specified "
+                "--top-module 'follow_target' was not found"
+            ),
+        ),
+        pytest.param(
+            ["--design", "verilog:{dir}/never.v", "--ports", "{dir}/never.toml"],
+            "timeout: the result strobe 'done' never rose",
+            marks=pytest.mark.slow,
+        ),
+        (
+            ["--design", "verilog:{dir}/missing.v", "--ports", "{dir}/never.toml"],
+            "cannot read the Verilog file",
+        ),
         (["--runtime", "mutsel=1"], "--runtime sets [runtime] inputs of a Verilog design"),
-        (["--design", "verilog:{dir}/follow_target.v", "--ports", "{dir}/ft.toml", "--runtime",
-          "mutsel"], "--runtime needs NAME=VALUE with an integer VALUE, got 'mutsel'"),
-        (["--design", "verilog:{dir}/follow_target.v", "--ports", "{dir}/ft.toml", "--runtime",
-          "mutsel=x"], "--runtime needs NAME=VALUE"),
-        pytest.param(["--design", "verilog:{dir}/follow_target.v", "--ports", "{dir}/ft.toml",
-                      "--runtime", "mutsel=1"],
-                     ("--runtime: follow_target has no [runtime] input 'mutsel' (its runtime "
-                      "inputs: none)"), marks=pytest.mark.slow),
+        (
+            [
+                "--design",
+                "verilog:{dir}/follow_target.v",
+                "--ports",
+                "{dir}/ft.toml",
+                "--runtime",
+                "mutsel",
+            ],
+            "--runtime needs NAME=VALUE with an integer VALUE, got 'mutsel'",
+        ),
+        (
+            [
+                "--design",
+                "verilog:{dir}/follow_target.v",
+                "--ports",
+                "{dir}/ft.toml",
+                "--runtime",
+                "mutsel=x",
+            ],
+            "--runtime needs NAME=VALUE",
+        ),
+        pytest.param(
+            [
+                "--design",
+                "verilog:{dir}/follow_target.v",
+                "--ports",
+                "{dir}/ft.toml",
+                "--runtime",
+                "mutsel=1",
+            ],
+            ("--runtime: follow_target has no [runtime] input 'mutsel' (its runtime inputs: none)"),
+            marks=pytest.mark.slow,
+        ),
     ],
 )
 def test_cli_bad_designs_exit_2_with_one_line(files, capsys, argv, message):
@@ -292,8 +383,11 @@ def test_cli_bad_designs_exit_2_with_one_line(files, capsys, argv, message):
 
     argv = [a.replace("{dir}", str(files)) for a in argv]
     with pytest.raises(SystemExit) as info:
-        run_cli(run.main, [*argv, "--resolution", "80x60", "--duration", "0.5", "--rerun",
-                           "off", "--quiet"], prog="fpga-robotics run")
+        run_cli(
+            run.main,
+            [*argv, "--resolution", "80x60", "--duration", "0.5", "--rerun", "off", "--quiet"],
+            prog="fpga-robotics run",
+        )
     assert info.value.code == 2
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and message in err, err
@@ -306,9 +400,12 @@ def _scalars(r):
 @pytest.mark.parametrize("line_blank", [0, 3])
 @pytest.mark.slow
 def test_framebuffer_style_matches_the_model(files, line_blank):
-    design = foreign.ForeignVerilatorBackend(PARAMS, files=[files / "fb_top.v",
-                                                            files / "follow_target.v"],
-                                             port_map=files / "fb.toml", line_blank=line_blank)
+    design = foreign.ForeignVerilatorBackend(
+        PARAMS,
+        files=[files / "fb_top.v", files / "follow_target.v"],
+        port_map=files / "fb.toml",
+        line_blank=line_blank,
+    )
     model = get_backend("model", PARAMS, line_blank=line_blank)
     try:
         for i, frame in enumerate(_frames(PARAMS)):
@@ -321,9 +418,11 @@ def test_framebuffer_style_matches_the_model(files, line_blank):
 
 @pytest.mark.slow
 def test_framebuffer_outputs_read_a_number_of_cycles_after_the_frame(files):
-    design = foreign.ForeignVerilatorBackend(PARAMS, files=[files / "fb_top.v",
-                                                            files / "follow_target.v"],
-                                             port_map=files / "fb_after.toml")
+    design = foreign.ForeignVerilatorBackend(
+        PARAMS,
+        files=[files / "fb_top.v", files / "follow_target.v"],
+        port_map=files / "fb_after.toml",
+    )
     model = get_backend("model", PARAMS)
     try:
         for i, frame in enumerate(_frames(PARAMS)):
@@ -340,35 +439,50 @@ FB_BASE = FB_MAP % {"result": 'result = { strobe = "done" }'}
 @pytest.mark.parametrize(
     "text, message",
     [
-        (FB_BASE.replace('color = { port = "sel" }\n', "").replace('address = "waddr"',
-                                                                     'address = "sel"'),
-         "the 3-bit address port 'sel' cannot address 4800 pixels"),
+        (
+            FB_BASE.replace('color = { port = "sel" }\n', "").replace(
+                'address = "waddr"', 'address = "sel"'
+            ),
+            "the 3-bit address port 'sel' cannot address 4800 pixels",
+        ),
         (FB_BASE.replace('write_enable = "we", ', ""), "missing pixels.write_enable"),
         (FB_BASE.replace('data = "wdata", ', ""), "missing pixels.data"),
-        (FB_BASE.replace('strobe = "done"', 'strobe = "done", after_cycles = 5'),
-         "not both"),
-        (FB_BASE.replace('new_frame = "frame_start"', 'valid = "we"'),
-         "unknown key 'pixels.valid'"),
-        (FB_BASE.replace('new_frame = "frame_start"', 'new_frame = "wdata"'),
-         "'wdata' is mapped more than once"),
-        (BASE.replace('centroid_leds = "centroid_leds"', 'centroid_leds = "proximity"'),
-         "port 'proximity' is mapped more than once"),
+        (FB_BASE.replace('strobe = "done"', 'strobe = "done", after_cycles = 5'), "not both"),
+        (
+            FB_BASE.replace('new_frame = "frame_start"', 'valid = "we"'),
+            "unknown key 'pixels.valid'",
+        ),
+        (
+            FB_BASE.replace('new_frame = "frame_start"', 'new_frame = "wdata"'),
+            "'wdata' is mapped more than once",
+        ),
+        (
+            BASE.replace('centroid_leds = "centroid_leds"', 'centroid_leds = "proximity"'),
+            "port 'proximity' is mapped more than once",
+        ),
     ],
 )
 def test_bad_framebuffer_port_maps(files, text, message):
     with pytest.raises(PortMapError, match=message):
-        foreign.ForeignDesign([files / "fb_top.v", files / "follow_target.v"],
-                              _map_with(files, text), PARAMS)
+        foreign.ForeignDesign(
+            [files / "fb_top.v", files / "follow_target.v"], _map_with(files, text), PARAMS
+        )
 
 
 @pytest.mark.slow
 def test_stream_outputs_read_a_number_of_cycles_after_the_frame(files):
-    text = (files / "ft.toml").read_text().replace(
-        f"result = {{ strobe = \"frame_done\", latency = {PARAMS.motor_latency} }}",
-        "result = { after_cycles = 40 }")
+    text = (
+        (files / "ft.toml")
+        .read_text()
+        .replace(
+            f'result = {{ strobe = "frame_done", latency = {PARAMS.motor_latency} }}',
+            "result = { after_cycles = 40 }",
+        )
+    )
     assert "after_cycles" in text
-    design = foreign.ForeignVerilatorBackend(PARAMS, files=[files / "follow_target.v"],
-                                             port_map=_map_with(files, text, "after.toml"))
+    design = foreign.ForeignVerilatorBackend(
+        PARAMS, files=[files / "follow_target.v"], port_map=_map_with(files, text, "after.toml")
+    )
     model = get_backend("model", PARAMS)
     try:
         for i, frame in enumerate(_frames(PARAMS)):
@@ -411,7 +525,8 @@ def test_included_files_are_found_and_part_of_the_build(files, tmp_path):
     for xor in (0, 1):
         (tmp_path / "sub" / "consts.vh").write_text(f"`define LED_XOR 8'h{xor:02x}\n")
         with foreign.ForeignVerilatorBackend(
-            PARAMS, files=[tmp_path / "inc_top.v", files / "follow_target.v"],
+            PARAMS,
+            files=[tmp_path / "inc_top.v", files / "follow_target.v"],
             port_map=tmp_path / "ports.toml",
         ) as design:
             got = design.process_frame(frame)
@@ -441,19 +556,24 @@ outputs = { motor_left = "ml", motor_right = "mr" }
 """
 
 
-@pytest.mark.parametrize("task, what", [("$stop", r"\$stop or \$fatal"),
-                                        ('$fatal(1, "bad")', r"\$stop or \$fatal"),
-                                        ("$finish", r"\$finish")])
+@pytest.mark.parametrize(
+    "task, what",
+    [
+        ("$stop", r"\$stop or \$fatal"),
+        ('$fatal(1, "bad")', r"\$stop or \$fatal"),
+        ("$finish", r"\$finish"),
+    ],
+)
 @pytest.mark.slow
 def test_stop_fatal_and_finish_are_errors_not_a_dead_process(tmp_path, task, what):
     (tmp_path / "stopper.v").write_text(STOPPER % task)
     (tmp_path / "stopper.toml").write_text(STOPPER_MAP)
     frame = _frames(PARAMS)[0]
     with (
-        foreign.ForeignVerilatorBackend(PARAMS, files=[tmp_path / "stopper.v"],
-                                        port_map=tmp_path / "stopper.toml") as design,
-        pytest.raises(BackendError,
-                      match=rf"frame 0: the design called {what} at stopper\.v:\d+$"),
+        foreign.ForeignVerilatorBackend(
+            PARAMS, files=[tmp_path / "stopper.v"], port_map=tmp_path / "stopper.toml"
+        ) as design,
+        pytest.raises(BackendError, match=rf"frame 0: the design called {what} at stopper\.v:\d+$"),
     ):
         design.process_frame(frame)
 
@@ -508,7 +628,8 @@ def test_constants_tie_inputs_the_world_does_not_drive(tmp_path):
         return path
 
     design = foreign.ForeignVerilatorBackend(
-        PARAMS, files=files, port_map=port_map("[constants]\nmode = 5\ndbg_addr = 0"))
+        PARAMS, files=files, port_map=port_map("[constants]\nmode = 5\ndbg_addr = 0")
+    )
     model = get_backend("model", PARAMS)
     try:
         frames = _frames(PARAMS)
@@ -516,20 +637,26 @@ def test_constants_tie_inputs_the_world_does_not_drive(tmp_path):
         for frame in frames:
             got, want = design.process_frame(frame), model.process_frame(frame)
             assert (got.motor_left, got.motor_right, got.centroid_leds) == (
-                want.motor_left, want.motor_right, want.centroid_leds)
+                want.motor_left,
+                want.motor_right,
+                want.centroid_leds,
+            )
             moved += want.motor_left != 0
         assert moved  # the tie matters: under any other mode the motors would read 0
     finally:
         design.close()
     with pytest.raises(PortMapError, match="'dbg_addr'.*not mapped"):
-        foreign.ForeignVerilatorBackend(PARAMS, files=files,
-                                        port_map=port_map("[constants]\nmode = 5"))
+        foreign.ForeignVerilatorBackend(
+            PARAMS, files=files, port_map=port_map("[constants]\nmode = 5")
+        )
     with pytest.raises(PortMapError, match="constants.mode = 16 does not fit the 4-bit port"):
         foreign.ForeignVerilatorBackend(
-            PARAMS, files=files, port_map=port_map("[constants]\nmode = 16\ndbg_addr = 0"))
+            PARAMS, files=files, port_map=port_map("[constants]\nmode = 16\ndbg_addr = 0")
+        )
     with pytest.raises(PortMapError, match="constants.mode must be an integer >= 0"):
         foreign.ForeignVerilatorBackend(
-            PARAMS, files=files, port_map=port_map('[constants]\nmode = "5"\ndbg_addr = 0'))
+            PARAMS, files=files, port_map=port_map('[constants]\nmode = "5"\ndbg_addr = 0')
+        )
 
 
 @pytest.mark.slow
@@ -540,8 +667,13 @@ def test_runtime_inputs_are_set_between_frames_in_one_build(tmp_path):
     (tmp_path / "follow_target.v").write_text(generate_verilog(PARAMS))
     files = [tmp_path / "moded.v", tmp_path / "follow_target.v"]
     path = tmp_path / "runtime.toml"
-    path.write_text(MODED_MAP % {"latency": PARAMS.motor_latency,
-                                 "constants": "[constants]\ndbg_addr = 0\n[runtime]\nmode = 0"})
+    path.write_text(
+        MODED_MAP
+        % {
+            "latency": PARAMS.motor_latency,
+            "constants": "[constants]\ndbg_addr = 0\n[runtime]\nmode = 0",
+        }
+    )
     design = foreign.ForeignVerilatorBackend(PARAMS, files=files, port_map=path)
     model = get_backend("model", PARAMS)
     try:
@@ -554,29 +686,38 @@ def test_runtime_inputs_are_set_between_frames_in_one_build(tmp_path):
         design.reset()
         got = [design.process_frame(f) for f in frames]
         assert [(g.motor_left, g.motor_right, g.centroid_leds) for g in got] == [
-            (w.motor_left, w.motor_right, w.centroid_leds) for w in want]
+            (w.motor_left, w.motor_right, w.centroid_leds) for w in want
+        ]
         with pytest.raises(BackendError, match="'mode' is 4 bits wide: the value must be 0..15"):
             design.set_runtime("mode", 16)
     finally:
         design.close()
 
 
-@pytest.mark.parametrize("table, message", [
-    ("[runtime]\nmode = -1", "runtime.mode must be an integer >= 0"),
-    ("[runtime]\nmode = true", "runtime.mode must be an integer >= 0"),
-    ("[runtime]\nmode = 16", "runtime.mode = 16 does not fit the 4-bit port"),
-    ("[runtime]\nmode = 1\nclk = 0", "port 'clk' is mapped more than once"),
-    ("[constants]\nmode = 5\n[runtime]\nmode = 1", "port 'mode' is mapped more than once"),
-    ("[runtime]\n" + "\n".join(f"p{i} = 0" for i in range(9)), "at most 8"),
-])
+@pytest.mark.parametrize(
+    "table, message",
+    [
+        ("[runtime]\nmode = -1", "runtime.mode must be an integer >= 0"),
+        ("[runtime]\nmode = true", "runtime.mode must be an integer >= 0"),
+        ("[runtime]\nmode = 16", "runtime.mode = 16 does not fit the 4-bit port"),
+        ("[runtime]\nmode = 1\nclk = 0", "port 'clk' is mapped more than once"),
+        ("[constants]\nmode = 5\n[runtime]\nmode = 1", "port 'mode' is mapped more than once"),
+        ("[runtime]\n" + "\n".join(f"p{i} = 0" for i in range(9)), "at most 8"),
+    ],
+)
 def test_bad_runtime_tables_are_one_line_errors(tmp_path, table, message):
     (tmp_path / "moded.v").write_text(MODED % {"xmsb": PARAMS.x_bits - 1})
     (tmp_path / "follow_target.v").write_text(generate_verilog(PARAMS))
     path = tmp_path / "bad.toml"
-    path.write_text(MODED_MAP % {"latency": PARAMS.motor_latency,
-                                 "constants": table.replace("[runtime]",
-                                                            "[constants]\ndbg_addr = 0\n[runtime]", 1)
-                                 if "[constants]" not in table else table + "\n"})
+    path.write_text(
+        MODED_MAP
+        % {
+            "latency": PARAMS.motor_latency,
+            "constants": table.replace("[runtime]", "[constants]\ndbg_addr = 0\n[runtime]", 1)
+            if "[constants]" not in table
+            else table + "\n",
+        }
+    )
     with pytest.raises(PortMapError, match=message) as info:
         foreign.ForeignDesign([tmp_path / "moded.v", tmp_path / "follow_target.v"], path)
     assert "\n" not in str(info.value)
@@ -590,5 +731,9 @@ def test_the_shipped_map_of_the_published_design_reads():
     path = resources.files("fpga_robotics.designs") / "port_maps" / "published_design_top.toml"
     pm = load_port_map(str(path))
     assert (pm.style, pm.top, pm.strobe, pm.constants) == (
-        "framebuffer", "design_top", "new_centroid", {"addrout": 0})
+        "framebuffer",
+        "design_top",
+        "new_centroid",
+        {"addrout": 0},
+    )
     assert set(pm.outputs) == {"centroid_leds", "proximity", "motor_left", "motor_right"}

@@ -64,8 +64,9 @@ def test_the_reference_is_the_plain_run(scenario, reference):
 
 def test_a_variant_that_never_drives_differently(scenario, reference):
     # Found never reported: no found/lost events, other metrics, same wheels.
-    variant = Altered(scenario.params, lambda k, r: dataclasses.replace(r, found=False,
-                                                                        proximity=0))
+    variant = Altered(
+        scenario.params, lambda k, r: dataclasses.replace(r, found=False, proximity=0)
+    )
     forked, diverged = fork_and_full(reference, scenario, variant)
     assert diverged is None
     assert forked.trajectory["found"].sum() == 0 < reference.result.trajectory["found"].sum()
@@ -81,8 +82,7 @@ def _left_plus(frame):
 def test_a_variant_that_differs_from_the_first_frame(scenario, reference):
     forked, diverged = fork_and_full(reference, scenario, Altered(scenario.params, _left_plus(0)))
     assert diverged == 0
-    assert not np.array_equal(forked.trajectory["heading"],
-                              reference.result.trajectory["heading"])
+    assert not np.array_equal(forked.trajectory["heading"], reference.result.trajectory["heading"])
 
 
 def test_a_variant_that_differs_in_the_last_frame(scenario, reference):
@@ -91,7 +91,8 @@ def test_a_variant_that_differs_in_the_last_frame(scenario, reference):
     forked, diverged = fork_and_full(reference, scenario, variant)
     assert diverged == last
     assert forked.trajectory["motor_left"][last] == (
-        reference.result.trajectory["motor_left"][last] + 90)
+        reference.result.trajectory["motor_left"][last] + 90
+    )
 
 
 def test_a_parameter_variant_is_its_own_full_run(scenario, reference):
@@ -101,8 +102,11 @@ def test_a_parameter_variant_is_its_own_full_run(scenario, reference):
         forked = reference.run_variant(variant, variant_scenario)
         full = run_scenario(variant_scenario, backend=variant)
     assert_same_run(forked, full)
-    assert forked.summary["overrides"] == ["sim.duration=3", "camera.noise_std=4",
-                                           "design.diff_min=9"]
+    assert forked.summary["overrides"] == [
+        "sim.duration=3",
+        "camera.noise_std=4",
+        "design.diff_min=9",
+    ]
 
 
 def test_a_variant_that_parts_between_checkpoints():
@@ -118,8 +122,7 @@ def test_a_variant_that_parts_between_checkpoints():
         full = run_scenario(variant_scenario, backend=variant)
     assert_same_run(forked, full)
     assert 10 < diverged < reference.frames - 1 and diverged % 10 != 0
-    assert not np.array_equal(forked.trajectory["heading"],
-                              reference.result.trajectory["heading"])
+    assert not np.array_equal(forked.trajectory["heading"], reference.result.trajectory["heading"])
 
 
 def test_a_variant_world_must_be_the_reference_world(scenario, reference):

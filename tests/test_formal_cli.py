@@ -32,11 +32,14 @@ def test_missing_tools_is_one_line_with_the_install_hint(capsys, monkeypatch, tm
     assert "property" not in out  # nothing started
 
 
-@pytest.mark.parametrize("argv, message", [
-    (["--only", "no_such_check"], "no formal check named 'no_such_check'"),
-    (["--depth", "0"], "--depth must be at least 1"),
-    (["--jobs", "0"], "--jobs must be at least 1"),
-])
+@pytest.mark.parametrize(
+    "argv, message",
+    [
+        (["--only", "no_such_check"], "no formal check named 'no_such_check'"),
+        (["--depth", "0"], "--depth must be at least 1"),
+        (["--jobs", "0"], "--jobs must be at least 1"),
+    ],
+)
 def test_bad_arguments_are_one_line(argv, message, capsys):
     code, _out, err = run(argv, capsys)
     assert code == 2
@@ -53,9 +56,13 @@ def test_list_names_every_check(capsys):
 
 def test_only_selects_by_name_or_prefix():
     assert [c.name for c in formal.select(CHECKS, ["frame_done"])] == [
-        "frame_done.strobe@16x2", "frame_done.well_formed_only@16x2", "frame_done.latency@16x2"]
+        "frame_done.strobe@16x2",
+        "frame_done.well_formed_only@16x2",
+        "frame_done.latency@16x2",
+    ]
     assert formal.select(CHECKS, ["motor.limits_hold_search@odd"]) == [
-        check_named("motor.limits_hold_search@odd")]
+        check_named("motor.limits_hold_search@odd")
+    ]
     assert formal.select(CHECKS, None) == CHECKS
 
 
@@ -64,11 +71,20 @@ def test_a_failing_check_writes_its_counterexample(capsys, monkeypatch, tmp_path
     """A check whose design has a seeded bug: the row says FAIL, where the statement is, and
     where the VCD is; the exit code is 1."""
     p = FULL_SIZES["160x120"]
-    bad = mutant(MotorController, "return Mux(v > lim, lim, Mux(v < -lim, -lim, v))",
-                 "return Mux(v > lim, lim, v)")
+    bad = mutant(
+        MotorController,
+        "return Mux(v > lim, lim, Mux(v < -lim, -lim, v))",
+        "return Mux(v > lim, lim, v)",
+    )
     real = check_named("motor.limits_hold_search@defaults")
-    broken = FormalCheck("motor.broken", real.mode, real.depth, real.promise,
-                         build=lambda dut=None: real.build(bad(p)), make_dut=lambda: bad(p))
+    broken = FormalCheck(
+        "motor.broken",
+        real.mode,
+        real.depth,
+        real.promise,
+        build=lambda dut=None: real.build(bad(p)),
+        make_dut=lambda: bad(p),
+    )
     monkeypatch.setattr(formal_checks, "CHECKS", [broken, check_named("cover.motor@defaults")])
     traces = tmp_path / "traces"
     code, out, _err = run(["--trace-dir", str(traces)], capsys)
@@ -90,12 +106,14 @@ def test_an_induction_that_does_not_close_is_unknown_not_pass(tmp_path):
     """A search that starts one lost frame early: an induction of 2 cycles cannot close, and
     no counterexample is 2 cycles from reset (it is 15 frames away), so the answer is
     ``unknown`` with the advice to go deeper, and no trace; deeper, it is a FAIL."""
-    bad = mutant(MotorController, "state.count >= p.lost_frames - 1 if p.lost_frames > 1",
-                 "state.count >= p.lost_frames - 2 if p.lost_frames > 2")
+    bad = mutant(
+        MotorController,
+        "state.count >= p.lost_frames - 1 if p.lost_frames > 1",
+        "state.count >= p.lost_frames - 2 if p.lost_frames > 2",
+    )
     check = check_named("motor.limits_hold_search@defaults")
     result = formal.run_check(check, dut=bad(FULL_SIZES["160x120"]), trace_dir=tmp_path)
     assert (result.status, result.trace) == ("unknown", None)
     assert "did not close at depth 2" in result.detail and "--depth" in result.detail
-    deeper = formal.run_check(check, depth=17, dut=bad(FULL_SIZES["160x120"]),
-                              trace_dir=tmp_path)
+    deeper = formal.run_check(check, depth=17, dut=bad(FULL_SIZES["160x120"]), trace_dir=tmp_path)
     assert deeper.status == "FAIL" and deeper.trace.exists()

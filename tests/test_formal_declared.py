@@ -26,31 +26,41 @@ def _cli(argv, capsys):
 def test_a_design_lists_the_checks_it_declares():
     checks = formal.design_checks(SATURATING)
     assert [(c.name, c.mode, c.depth) for c in checks] == [
-        ("Saturating.properties", "prove", 3), ("Saturating.covers", "cover", 12)]
+        ("Saturating.properties", "prove", 3),
+        ("Saturating.covers", "cover", 12),
+    ]
     assert checks[0].promise == "count never passes limit; full exactly at the limit"
     assert [(c.name, c.mode, c.depth) for c in formal.design_checks(OFF_BY_ONE)] == [
-        ("OffByOne.properties", "bmc", 15), ("OffByOne.covers", "cover", 12)]
+        ("OffByOne.properties", "bmc", 15),
+        ("OffByOne.covers", "cover", 12),
+    ]
     assert formal.design_checks(None) == CHECKS == formal.design_checks("follow_target")
 
 
 def test_a_design_without_properties_is_one_line(capsys):
     code, out, err = _cli(["formal", "--design", f"{DESIGNS}/wall_stop.py:WallStop"], capsys)
     assert code == 2 and out == ""
-    assert err.endswith("declares no formal properties: give its class a method "
-                        "formal_properties(self, m) adding Assert statements "
-                        "(docs/formal.md)\n") and err.count("\n") == 1
+    assert (
+        err.endswith(
+            "declares no formal properties: give its class a method "
+            "formal_properties(self, m) adding Assert statements "
+            "(docs/formal.md)\n"
+        )
+        and err.count("\n") == 1
+    )
     with pytest.raises(UsageError, match="Verilog design's properties are not checked"):
         formal.design_checks("verilog:x.v")
 
 
 @pytest.mark.formal
 def test_a_true_property_is_proved_and_its_cover_reached(capsys, tmp_path):
-    code, out, _ = _cli(["formal", "--design", SATURATING, "--trace-dir", str(tmp_path)],
-                        capsys)
+    code, out, _ = _cli(["formal", "--design", SATURATING, "--trace-dir", str(tmp_path)], capsys)
     assert code == 0, out
     rows = [line.split()[:4] for line in out.splitlines()[1:3]]
-    assert rows == [["Saturating.properties", "prove", "3", "pass"],
-                    ["Saturating.covers", "cover", "12", "pass"]]
+    assert rows == [
+        ["Saturating.properties", "prove", "3", "pass"],
+        ["Saturating.covers", "cover", "12", "pass"],
+    ]
     # Full takes limit (10) cycles of up: a 5-cycle search cannot reach it.
     short = formal.run_check(formal.design_checks(SATURATING)[1], depth=5)
     assert short.status == "FAIL" and "unreached cover" in short.detail
@@ -58,8 +68,18 @@ def test_a_true_property_is_proved_and_its_cover_reached(capsys, tmp_path):
 
 @pytest.mark.formal
 def test_a_false_property_fails_with_its_counterexample(capsys, tmp_path):
-    code, out, _ = _cli(["formal", "--design", OFF_BY_ONE, "--only", "OffByOne.properties",
-                         "--trace-dir", str(tmp_path)], capsys)
+    code, out, _ = _cli(
+        [
+            "formal",
+            "--design",
+            OFF_BY_ONE,
+            "--only",
+            "OffByOne.properties",
+            "--trace-dir",
+            str(tmp_path),
+        ],
+        capsys,
+    )
     assert code == 1
     lines = out.splitlines()
     assert lines[1].split()[:4] == ["OffByOne.properties", "bmc", "15", "FAIL"]

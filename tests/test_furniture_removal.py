@@ -6,15 +6,27 @@ import pytest
 from fpga_robotics.sim.world import World, WorldConfigError
 from fpga_robotics.sim.world.ultrasound import HCSR04Params, range_to
 
-BOX = {"name": "crate", "center": [2.0, 3.0], "size": [0.4, 0.4], "height": 0.5,
-       "present_until": 1.5}
+BOX = {
+    "name": "crate",
+    "center": [2.0, 3.0],
+    "size": [0.4, 0.4],
+    "height": 0.5,
+    "present_until": 1.5,
+}
 
 
 def _world(start=(1.0, 3.0)):
-    return World.from_config({"room": {"width": 5.0, "depth": 6.0,
-                                       "furniture": [BOX, {"name": "stays",
-                                                           "center": [4.0, 1.0]}]},
-                              "robot": {"start": list(start)}, "people": []})
+    return World.from_config(
+        {
+            "room": {
+                "width": 5.0,
+                "depth": 6.0,
+                "furniture": [BOX, {"name": "stays", "center": [4.0, 1.0]}],
+            },
+            "robot": {"start": list(start)},
+            "people": [],
+        }
+    )
 
 
 def test_the_box_leaves_at_its_time_with_one_event():
@@ -57,8 +69,11 @@ def test_the_robot_drives_through_where_the_box_was_and_counts_stay():
 
 
 def test_present_until_is_validated():
-    with pytest.raises(WorldConfigError, match=r"room\.furniture\[0\]\.present_until must be "
-                                               r"> 0, got -1"):
+    with pytest.raises(
+        WorldConfigError,
+        match=r"room\.furniture\[0\]\.present_until must be "
+        r"> 0, got -1",
+    ):
         World.from_config({"room": {"furniture": [dict(BOX, present_until=-1)]}})
     with pytest.raises(WorldConfigError, match=r"present_until"):
         World.from_config({"room": {"furniture": [dict(BOX, present_until="soon")]}})

@@ -28,14 +28,21 @@ ALL_PIXELS = np.arange(4096, dtype=np.uint16)
 
 #: docs/contract.md: bit 2 red, bit 1 green, bit 0 blue; a colour is the primaries it mixes.
 PRIMARIES = {
-    "none": "", "blue": "b", "green": "g", "cyan": "gb", "red": "r", "magenta": "rb",
-    "yellow": "rg", "white": "rgb",
+    "none": "",
+    "blue": "b",
+    "green": "g",
+    "cyan": "gb",
+    "red": "r",
+    "magenta": "rb",
+    "yellow": "rg",
+    "white": "rgb",
 }
 
 
 def test_target_color_codes_are_the_contract_bits():
-    expected = {name: 4 * ("r" in mix) + 2 * ("g" in mix) + ("b" in mix)
-                for name, mix in PRIMARIES.items()}
+    expected = {
+        name: 4 * ("r" in mix) + 2 * ("g" in mix) + ("b" in mix) for name, mix in PRIMARIES.items()
+    }
     assert {c.name.lower(): c.value for c in TargetColor} == expected
     assert dict(COLOR_SELECT) == expected
     assert color_select_value("Yellow") == color_select_value(TargetColor.YELLOW) == 0b110
@@ -58,8 +65,9 @@ def run_filter(params, schedule, color_sel):
         "m_valid": dut.matches.valid,
         "m_payload": dut.matches.payload,
     }
-    return run_schedule(dut, dut.pixels, schedule, probes, static=[(dut.color_sel, color_sel)],
-                        tail=4)
+    return run_schedule(
+        dut, dut.pixels, schedule, probes, static=[(dut.color_sel, color_sel)], tail=4
+    )
 
 
 def filtered_transfers(trace):
@@ -109,8 +117,11 @@ def test_latency_flags_and_blanking_pass_through():
         if rng.random() < 0.3:
             schedule.append(None)
         else:
-            schedule.append(pack_transfer(int(rng.integers(0, 4096)), first=rng.random() < 0.1,
-                                          last=rng.random() < 0.2))
+            schedule.append(
+                pack_transfer(
+                    int(rng.integers(0, 4096)), first=rng.random() < 0.1, last=rng.random() < 0.2
+                )
+            )
     trace = run_filter(p, schedule, COLOR_SELECT["none"])
     # With colour "none" every pixel passes unchanged: the output is the input, delayed.
     inputs = [i for i, e in enumerate(schedule) if e is not None]
@@ -142,10 +153,14 @@ def test_color_select_is_sampled_with_each_pixel():
         Step(pack_transfer(green), [(dut.color_sel, COLOR_SELECT["green"])]),
         Step(pack_transfer(red), [(dut.color_sel, COLOR_SELECT["green"])]),
     ]
-    trace = run_schedule(dut, dut.pixels, schedule,
-                         {"valid": dut.filtered.valid, "payload": dut.filtered.payload}, tail=3)
+    trace = run_schedule(
+        dut,
+        dut.pixels,
+        schedule,
+        {"valid": dut.filtered.valid, "payload": dut.filtered.payload},
+        tail=3,
+    )
     assert list(trace["payload"][edges_where(trace, "valid")]) == [red, green, 0]
-
 
 
 def test_single_transfers_with_stream_helpers():

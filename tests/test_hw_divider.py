@@ -87,8 +87,9 @@ def test_zero_divisor_still_finishes_on_time():
     assert results[0][1] == 8
 
 
-@pytest.mark.parametrize("bad,error", [(0, ValueError), (-1, ValueError), (1.5, TypeError),
-                                       (True, TypeError)])
+@pytest.mark.parametrize(
+    "bad,error", [(0, ValueError), (-1, ValueError), (1.5, TypeError), (True, TypeError)]
+)
 def test_widths_are_validated(bad, error):
     with pytest.raises(error, match="quotient_bits"):
         SequentialDivider(8, 8, bad)

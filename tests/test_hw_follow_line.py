@@ -23,8 +23,11 @@ def run_line(params, lines, *, reset_at=None):
     out = []
 
     async def bench(ctx):
-        assert (ctx.get(dut.motor_left), ctx.get(dut.motor_right), ctx.get(dut.line_seen)) \
-            == (0, 0, 0)
+        assert (ctx.get(dut.motor_left), ctx.get(dut.motor_right), ctx.get(dut.line_seen)) == (
+            0,
+            0,
+            0,
+        )
         for i, value in enumerate(lines):
             ctx.set(dut.line, value)
             ctx.set(top.rst, int(i == reset_at))
@@ -56,14 +59,17 @@ def random_lines(n, rng, length):
     return lines[:length]
 
 
-@pytest.mark.parametrize("changes", [
-    {},
-    {"n_sensors": 2},
-    {"n_sensors": 1},
-    {"n_sensors": 1, "edge_side": "right", "gentle_turn_dps": 40},
-    {"active_high": False},
-    {"base_dps": -100, "search_dps": -20, "sharp_turn_dps": 32667, "gentle_turn_dps": 0},
-])
+@pytest.mark.parametrize(
+    "changes",
+    [
+        {},
+        {"n_sensors": 2},
+        {"n_sensors": 1},
+        {"n_sensors": 1, "edge_side": "right", "gentle_turn_dps": 40},
+        {"active_high": False},
+        {"base_dps": -100, "search_dps": -20, "sharp_turn_dps": 32667, "gentle_turn_dps": 0},
+    ],
+)
 def test_random_line_sequences_match_the_model(changes):
     p = FollowLineParams(**changes)
     rng = np.random.default_rng(len(str(changes)))
@@ -75,9 +81,13 @@ def test_three_sensor_law_by_hand():
     # Defaults: base 250, gentle 100, sharp 250, search 150. Bits: sensor 0 (left) is bit 0.
     p = FollowLineParams()
     expected = {
-        0b010: (250, 250), 0b111: (250, 250), 0b101: (250, 250),
-        0b001: (0, 500), 0b011: (150, 350),  # left only: sharp left; left + centre: gentle
-        0b100: (500, 0), 0b110: (350, 150),
+        0b010: (250, 250),
+        0b111: (250, 250),
+        0b101: (250, 250),
+        0b001: (0, 500),
+        0b011: (150, 350),  # left only: sharp left; left + centre: gentle
+        0b100: (500, 0),
+        0b110: (350, 150),
     }
     for bits, command in expected.items():
         lines = [bits] * 4
@@ -104,7 +114,11 @@ def test_timing_after_reset_and_latency():
 def test_two_and_one_sensor_laws_by_hand():
     two = FollowLineParams(n_sensors=2)
     assert [run_line(two, [b] * 3)[-1][1:] for b in range(4)] == [
-        (250, 250), (0, 500), (500, 0), (250, 250)]
+        (250, 250),
+        (0, 500),
+        (500, 0),
+        (250, 250),
+    ]
     one = FollowLineParams(n_sensors=1)  # on the line's left edge: the line lies to the right
     assert run_line(one, [1] * 3)[-1][1:] == (150, 350)  # over the line: back to the left
     assert run_line(one, [0] * 3)[-1][1:] == (350, 150)  # off it: towards it, right
@@ -134,10 +148,12 @@ def test_inverted_polarity_variant_steers_the_wrong_way():
 
 
 def test_bad_parameters_are_refused():
-    for changes, message in (({"n_sensors": 4}, "n_sensors must be <= 3"),
-                             ({"edge_side": "middle"}, "edge_side must be one of"),
-                             ({"active_high": "yes"}, "active_high must be True or False"),
-                             ({"base_dps": 30000, "sharp_turn_dps": 5000}, "does not fit")):
+    for changes, message in (
+        ({"n_sensors": 4}, "n_sensors must be <= 3"),
+        ({"edge_side": "middle"}, "edge_side must be one of"),
+        ({"active_high": "yes"}, "active_high must be True or False"),
+        ({"base_dps": 30000, "sharp_turn_dps": 5000}, "does not fit"),
+    ):
         with pytest.raises((TypeError, ValueError), match=message):
             FollowLineParams(**changes)
     with pytest.raises(ValueError, match="known presets: default, inverted_polarity"):

@@ -26,10 +26,18 @@ def track_points(step=0.005):
     """Points every ``step`` m along the track's centreline, counter-clockwise from the
     middle of the bottom side."""
     X, Y, r = WIDTH_M, HEIGHT_M, RADII
-    sides = [((r[3], 0), (X - r[0], 0)), ((X, r[0]), (X, Y - r[1])),
-             ((X - r[1], Y), (r[2], Y)), ((0, Y - r[2]), (0, r[3]))]
-    corners = [(X - r[0], r[0], r[0], -90), (X - r[1], Y - r[1], r[1], 0),
-               (r[2], Y - r[2], r[2], 90), (r[3], r[3], r[3], 180)]
+    sides = [
+        ((r[3], 0), (X - r[0], 0)),
+        ((X, r[0]), (X, Y - r[1])),
+        ((X - r[1], Y), (r[2], Y)),
+        ((0, Y - r[2]), (0, r[3])),
+    ]
+    corners = [
+        (X - r[0], r[0], r[0], -90),
+        (X - r[1], Y - r[1], r[1], 0),
+        (r[2], Y - r[2], r[2], 90),
+        (r[3], r[3], r[3], 180),
+    ]
     pts = []
     for ((x0, y0), (x1, y1)), (cx, cy, radius, a0) in zip(sides, corners):
         n = max(2, int(math.hypot(x1 - x0, y1 - y0) / step))

@@ -12,8 +12,15 @@ from fpga_robotics.sim.models.follow_target import MotorModel, TrackerResult
 
 
 def tracker_result(found, proximity, centroid_x, leds=0):
-    return TrackerResult(found=bool(found), proximity=proximity, centroid_x=centroid_x,
-                         centroid_leds=leds, count=0, bins=(0,) * 8, sum_x=0)
+    return TrackerResult(
+        found=bool(found),
+        proximity=proximity,
+        centroid_x=centroid_x,
+        centroid_leds=leds,
+        count=0,
+        bins=(0,) * 8,
+        sum_x=0,
+    )
 
 
 def run_motor(params, frames, *, idle=3, reset_after=None):
@@ -75,15 +82,18 @@ def random_frames(params, rng, n, p_found=0.6):
     return frames
 
 
-@pytest.mark.parametrize("changes", [
-    {},
-    {"kp_num": 7, "kp_shift": 2},
-    {"kp_num": -5, "kp_shift": 1},  # negative gain: arithmetic shift of negative products
-    {"kp_num": 200, "max_dps": 300},  # saturation on both sides
-    {"max_dps": 0},
-    {"base_dps": (-500, 32767, -32768, 0, 1, -1, 250, -250), "max_dps": 32767},
-    {"lost_frames": 1, "search_dps": -120},
-])
+@pytest.mark.parametrize(
+    "changes",
+    [
+        {},
+        {"kp_num": 7, "kp_shift": 2},
+        {"kp_num": -5, "kp_shift": 1},  # negative gain: arithmetic shift of negative products
+        {"kp_num": 200, "max_dps": 300},  # saturation on both sides
+        {"max_dps": 0},
+        {"base_dps": (-500, 32767, -32768, 0, 1, -1, 250, -250), "max_dps": 32767},
+        {"lost_frames": 1, "search_dps": -120},
+    ],
+)
 def test_random_sequences_match_the_model(changes):
     p = FollowTargetParams(**changes)
     rng = np.random.default_rng(len(str(changes)))
@@ -144,9 +154,16 @@ def test_reset_returns_to_the_power_on_state():
 
 PUBLISHED_SPEED = (600, 550, 450, 350, 250, 150, -250, -450)
 #: LED code -> (target on the left, DPS the slow wheel loses); centred is 0b0001_1000.
-PUBLISHED_STEER = {0x01: (True, 275), 0x02: (True, 225), 0x04: (True, 175), 0x08: (True, 125),
-                   0x10: (False, 125), 0x20: (False, 175), 0x40: (False, 225),
-                   0x80: (False, 275)}
+PUBLISHED_STEER = {
+    0x01: (True, 275),
+    0x02: (True, 225),
+    0x04: (True, 175),
+    0x08: (True, 125),
+    0x10: (False, 125),
+    0x20: (False, 175),
+    0x40: (False, 225),
+    0x80: (False, 275),
+}
 CENTRED = 0b0001_1000
 
 
@@ -223,18 +240,27 @@ def test_search_side_from_the_leds_is_not_the_sign_of_e():
     assert run_motor(left, [(1, 3, 150, CENTRED), (0, 0, 0, 0)])[1][1] == (-250, 250)
 
 
-@pytest.mark.parametrize("changes", [
-    {},
-    {"steer_dps": (0, 1, 32767, 400), "base_dps": (0, 500, -300, 200, -32768, 32767, -1, 0),
-     "max_dps": 450},  # saturation of the table's values
-    {"steer_dps": (10, 20, 30, 40), "max_dps": 32767,
-     "base_dps": (-32768, 32767, 0, 1, -1, 100, -100, 5)},
-    {"lost_motion": "hold", "lost_frames": 3},
-    {"centred_search_side": "left", "lost_frames": 2, "search_dps": -120},
-    {"motor_law": "p_control", "lost_motion": "hold", "kp_num": 5, "max_dps": 300},
-    {"motor_law": "p_control", "lost_motion": "hold", "search_side_from": "centroid"},
-    {"search_side_from": "centroid", "lost_frames": 1},
-])
+@pytest.mark.parametrize(
+    "changes",
+    [
+        {},
+        {
+            "steer_dps": (0, 1, 32767, 400),
+            "base_dps": (0, 500, -300, 200, -32768, 32767, -1, 0),
+            "max_dps": 450,
+        },  # saturation of the table's values
+        {
+            "steer_dps": (10, 20, 30, 40),
+            "max_dps": 32767,
+            "base_dps": (-32768, 32767, 0, 1, -1, 100, -100, 5),
+        },
+        {"lost_motion": "hold", "lost_frames": 3},
+        {"centred_search_side": "left", "lost_frames": 2, "search_dps": -120},
+        {"motor_law": "p_control", "lost_motion": "hold", "kp_num": 5, "max_dps": 300},
+        {"motor_law": "p_control", "lost_motion": "hold", "search_side_from": "centroid"},
+        {"search_side_from": "centroid", "lost_frames": 1},
+    ],
+)
 def test_published_knobs_random_sequences_match_the_model(changes):
     p = FollowTargetParams.published(**changes)
     rng = np.random.default_rng(len(str(changes)) + 1)
@@ -242,8 +268,14 @@ def test_published_knobs_random_sequences_match_the_model(changes):
     frames = []
     for _ in range(80):
         found = int(rng.random() < 0.5)
-        frames.append((found, int(rng.integers(0, 8)), int(rng.integers(0, p.width)),
-                       int(rng.choice(codes)) if found else int(rng.choice(codes[:3]))))
+        frames.append(
+            (
+                found,
+                int(rng.integers(0, 8)),
+                int(rng.integers(0, p.width)),
+                int(rng.choice(codes)) if found else int(rng.choice(codes[:3])),
+            )
+        )
     for leds in (0x01, 0x80, CENTRED):
         frames += [(1, 6, 40, leds)] + [(0, 7, 0, 0)] * (p.lost_frames + 1)
     assert run_motor(p, frames, idle=1) == model_outputs(p, frames)

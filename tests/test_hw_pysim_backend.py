@@ -25,8 +25,14 @@ def sequence(p, seed, n_lost=None):
     rng = np.random.default_rng(seed)
     out = []
     for colour, cx in (("red", p.width * 0.8), ("blue", p.width * 0.2), ("white", p.width / 2)):
-        out.append((synthetic.blob_frame(p.width, p.height, colour, cx=cx,
-                                         radius=p.height / 3, rng=rng), colour))
+        out.append(
+            (
+                synthetic.blob_frame(
+                    p.width, p.height, colour, cx=cx, radius=p.height / 3, rng=rng
+                ),
+                colour,
+            )
+        )
     for _ in range(p.lost_frames + 1 if n_lost is None else n_lost):
         out.append((synthetic.empty_frame(p.width, p.height, rng=rng), "red"))
     out.append((synthetic.random_frame(p.width, p.height, rng=rng), "none"))
@@ -38,8 +44,10 @@ def sequence(p, seed, n_lost=None):
 def test_frames_match_the_model_backend(line_blank, frame_blank):
     p = small_params()
     frames = sequence(p, seed=line_blank + frame_blank)
-    with PysimBackend(p, line_blank=line_blank, frame_blank=frame_blank) as sim, \
-            ModelBackend(p, line_blank=line_blank, frame_blank=frame_blank) as model:
+    with (
+        PysimBackend(p, line_blank=line_blank, frame_blank=frame_blank) as sim,
+        ModelBackend(p, line_blank=line_blank, frame_blank=frame_blank) as model,
+    ):
         for frame, colour in frames:
             got, want = sim.process_frame(frame, colour), model.process_frame(frame, colour)
             assert got.outputs() == want.outputs()
@@ -65,8 +73,7 @@ def test_packed_and_rgb888_frames_give_the_same_result():
     p = small_params()
     frame, colour = sequence(p, seed=2)[0]
     with PysimBackend(p) as a, PysimBackend(p) as b:
-        assert a.process_frame(frame, colour) == b.process_frame(
-            synthetic.as_rgb444(frame), colour)
+        assert a.process_frame(frame, colour) == b.process_frame(synthetic.as_rgb444(frame), colour)
 
 
 def test_wrong_frame_shape_is_a_clear_error():
@@ -100,8 +107,10 @@ def test_waveform_covers_only_the_requested_frames(tmp_path):
     frames = sequence(p, seed=4)[:4]
     path = tmp_path / "frames_1_2.vcd"
     request = WaveformRequest(str(path), first_frame=1, last_frame=2)
-    with PysimBackend(p, line_blank=1, waveform=request) as traced, \
-            PysimBackend(p, line_blank=1) as plain:
+    with (
+        PysimBackend(p, line_blank=1, waveform=request) as traced,
+        PysimBackend(p, line_blank=1) as plain,
+    ):
         results = []
         for i, (frame, colour) in enumerate(frames):
             results.append(traced.process_frame(frame, colour))
@@ -162,8 +171,9 @@ def test_waveform_starts_with_the_state_at_the_window_start_and_holds_its_edges(
     # the last is frame 1's last; the file ends when frame 2 would start.
     times = sorted({time for time, _, _ in changes if time > 0})
     assert times[0] == (c0 - 0.25) * fs
-    rising = [time for time, code, value in changes
-              if time > 0 and code == ids["clk"] and value == "1"]
+    rising = [
+        time for time, code, value in changes if time > 0 and code == ids["clk"] and value == "1"
+    ]
     assert rising == [(c0 + k - 0.5) * fs for k in range(1, c1 + 1)]
     with open(path) as f:
         assert f.read().rstrip().endswith(f"#{round((c0 + c1 - 0.25) * fs)}")
@@ -200,8 +210,10 @@ def _interrupt_the_third_frame(p, path):
     """Frames 0 and 1 and part of 2 of a backend tracing 1..3, then Ctrl-C (as
     ``KeyboardInterrupt`` from inside the simulation)."""
     frame, colour = sequence(p, seed=8)[0]
-    with pytest.raises(KeyboardInterrupt), \
-            PysimBackend(p, waveform=WaveformRequest(str(path), 1, 3)) as sim:
+    with (
+        pytest.raises(KeyboardInterrupt),
+        PysimBackend(p, waveform=WaveformRequest(str(path), 1, 3)) as sim,
+    ):
         sim.process_frame(frame, colour)
         sim.process_frame(frame, colour)
         calls = iter(range(50))
@@ -238,8 +250,10 @@ def test_an_interrupted_trim_leaves_no_file_at_all(tmp_path, monkeypatch):
     monkeypatch.setattr(pysim, "trim_vcd", interrupted_trim)
     p = small_params()
     frame, colour = sequence(p, seed=8)[0]
-    with pytest.raises(KeyboardInterrupt), \
-            PysimBackend(p, waveform=WaveformRequest(str(tmp_path / "w.vcd"), 0, 0)) as sim:
+    with (
+        pytest.raises(KeyboardInterrupt),
+        PysimBackend(p, waveform=WaveformRequest(str(tmp_path / "w.vcd"), 0, 0)) as sim,
+    ):
         sim.process_frame(frame, colour)
     assert os.listdir(tmp_path) == []
 
@@ -298,10 +312,13 @@ def test_an_unfinished_waveform_leaves_no_file_behind(tmp_path):
     assert os.listdir(tmp_path) == []
 
 
-@pytest.mark.parametrize("size", [
-    (320, 240),
-    pytest.param((640, 480), marks=pytest.mark.slow),
-])
+@pytest.mark.parametrize(
+    "size",
+    [
+        (320, 240),
+        pytest.param((640, 480), marks=pytest.mark.slow),
+    ],
+)
 def test_larger_geometries_match_the_model(size):
     w, h = size
     p = FollowTargetParams(width=w, height=h)

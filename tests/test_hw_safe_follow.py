@@ -23,8 +23,15 @@ MM = {"far": 1500, "stop": 600, "between": 900, "resume": 1166, "at_stop": 700}
 
 
 def red_frame(p, cx, seed=0):
-    rgb = synthetic.blob_frame(p.width, p.height, "red", cx=cx, cy=p.height / 2,
-                               radius=p.height / 3, rng=np.random.default_rng(seed))
+    rgb = synthetic.blob_frame(
+        p.width,
+        p.height,
+        "red",
+        cx=cx,
+        cy=p.height / 2,
+        radius=p.height / 3,
+        rng=np.random.default_rng(seed),
+    )
     return to_rgb444(rgb, p.width, p.height)
 
 
@@ -37,12 +44,26 @@ def run_safe(dut, frames, pulses, edges):
     level = np.zeros(edges + 2, np.int8)
     for a, b in pulses:
         level[a:b] = 1
-    names = ("frame_done", "found", "proximity", "centroid_x", "centroid_leds",
-             "motor_left", "motor_right", "obstacle", "distance_mm", "us_trig")
+    names = (
+        "frame_done",
+        "found",
+        "proximity",
+        "centroid_x",
+        "centroid_leds",
+        "motor_left",
+        "motor_right",
+        "obstacle",
+        "distance_mm",
+        "us_trig",
+    )
     trace = {name: [] for name in names + ("ft_left", "ft_right", "measured", "no_echo")}
     probes = {name: getattr(dut, name) for name in names}
-    probes.update(ft_left=dut.follow_target.motor_left, ft_right=dut.follow_target.motor_right,
-                  measured=dut.ultrasound.measured, no_echo=dut.ultrasound.no_echo)
+    probes.update(
+        ft_left=dut.follow_target.motor_left,
+        ft_right=dut.follow_target.motor_right,
+        measured=dut.ultrasound.measured,
+        no_echo=dut.ultrasound.no_echo,
+    )
 
     async def bench(ctx):
         ctx.set(dut.color_sel, COLOR_SELECT["red"])
@@ -69,8 +90,10 @@ def run_safe(dut, frames, pulses, edges):
 
 
 def measurements_of(trace):
-    return [Measurement(j + 1, int(trace["distance_mm"][j]), bool(trace["no_echo"][j]))
-            for j in np.flatnonzero(trace["measured"])]
+    return [
+        Measurement(j + 1, int(trace["distance_mm"][j]), bool(trace["no_echo"][j]))
+        for j in np.flatnonzero(trace["measured"])
+    ]
 
 
 def test_follow_target_outputs_are_unchanged_without_an_obstacle():
@@ -84,11 +107,16 @@ def test_follow_target_outputs_are_unchanged_without_an_obstacle():
     assert len(done) == 3
     for j, e in zip(done, expected):
         t = e.tracker
-        assert (trace["found"][j], trace["proximity"][j], trace["centroid_x"][j],
-                trace["centroid_leds"][j]) == (t.found, t.proximity, t.centroid_x,
-                                               t.centroid_leds)
+        assert (
+            trace["found"][j],
+            trace["proximity"][j],
+            trace["centroid_x"][j],
+            trace["centroid_leds"][j],
+        ) == (t.found, t.proximity, t.centroid_x, t.centroid_leds)
         assert (trace["motor_left"][j + 1], trace["motor_right"][j + 1]) == (
-            e.motor_left, e.motor_right)
+            e.motor_left,
+            e.motor_right,
+        )
     # No echo at all: every measurement is "no echo", and the interlock never engages.
     assert not trace["obstacle"].any()
     assert measurements_of(trace) == UltrasoundModel(US).measurements(2, [])
@@ -100,8 +128,16 @@ def test_interlock_stops_and_releases_with_hysteresis():
     periods = 9
     fall = [k * US.period_cycles + US.trigger_cycles + 1 for k in range(periods)]
     # Echo widths per period from period 1 on (period 0 streams the frame, no echo).
-    widths = [MM["far"], MM["stop"], MM["between"], MM["resume"], MM["stop"], None,
-              MM["at_stop"], MM["stop"]]
+    widths = [
+        MM["far"],
+        MM["stop"],
+        MM["between"],
+        MM["resume"],
+        MM["stop"],
+        None,
+        MM["at_stop"],
+        MM["stop"],
+    ]
     pulses = [(fall[k] + 40, fall[k] + 40 + w) for k, w in enumerate(widths, 1) if w]
     dut = FollowTargetSafe(p, US, LOCK)
     trace = run_safe(dut, [frame], pulses, edges=periods * US.period_cycles)
@@ -111,7 +147,16 @@ def test_interlock_stops_and_releases_with_hysteresis():
     # By hand (K = 44,958, S = 18): 1500 -> 257 mm, 600 -> 102, 900 -> 154, 1166 -> 199,
     # 700 -> 120; period 6 has no echo.
     assert [m.distance_mm for m in measured] == [
-        DISTANCE_NONE, 257, 102, 154, 199, 102, DISTANCE_NONE, 120, 102]
+        DISTANCE_NONE,
+        257,
+        102,
+        154,
+        199,
+        102,
+        DISTANCE_NONE,
+        120,
+        102,
+    ]
     lock = InterlockModel(LOCK)
     states = [lock.step(m) for m in measured]
     # stop (102 < 120), hold at 154 and 199 (< 200), released by no echo, 120 is not < 120.
@@ -123,8 +168,7 @@ def test_interlock_stops_and_releases_with_hysteresis():
         assert obstacle[m.edge] == state  # trace index m.edge: right after edge m.edge + 1
         assert obstacle[m.edge - 1] == (obstacle[m.edge - 2] if m.edge >= 2 else False)
     changes = np.flatnonzero(np.diff(obstacle.astype(int))) + 2  # edges after which it changed
-    assert list(changes) == [measured[2].edge + 1, measured[6].edge + 1,
-                             measured[8].edge + 1]
+    assert list(changes) == [measured[2].edge + 1, measured[6].edge + 1, measured[8].edge + 1]
 
     # Wheels: 0 exactly while the interlock holds, otherwise FollowTarget's own command
     # (here the frame's tracking command, held).
@@ -144,8 +188,10 @@ def test_latching_variant_releases_only_on_no_echo():
     periods = 5
     fall = [k * US.period_cycles + US.trigger_cycles + 1 for k in range(periods)]
     # Period 0: nothing; then near (102 mm), far (257 mm) twice, nothing.
-    pulses = [(fall[k] + 40, fall[k] + 40 + w)
-              for k, w in ((1, MM["stop"]), (2, MM["far"]), (3, MM["far"]))]
+    pulses = [
+        (fall[k] + 40, fall[k] + 40 + w)
+        for k, w in ((1, MM["stop"]), (2, MM["far"]), (3, MM["far"]))
+    ]
     lock = variant_params("interlock_latches", LOCK)
     dut = FollowTargetSafe(p, US, lock)
     trace = run_safe(dut, [], pulses, edges=periods * US.period_cycles)
@@ -161,10 +207,13 @@ def test_latching_variant_releases_only_on_no_echo():
     assert [correct.step(m) for m in measured] == [False, True, False, False, False]
 
 
-@pytest.mark.parametrize("stop,resume,message", [
-    (400, 300, "resume_mm=300 must be >= stop_mm=400"),
-    (0, 10, "stop_mm must be >= 1"),
-])
+@pytest.mark.parametrize(
+    "stop,resume,message",
+    [
+        (400, 300, "resume_mm=300 must be >= stop_mm=400"),
+        (0, 10, "stop_mm must be >= 1"),
+    ],
+)
 def test_bad_interlock_parameters_are_refused(stop, resume, message):
     with pytest.raises(ValueError, match=message):
         InterlockParams(stop_mm=stop, resume_mm=resume)

@@ -48,8 +48,12 @@ def check_against_model(p, frames, sels, trace, last_index):
     for j, e in zip(done, expected):
         t = e.tracker
         shown = frame_outputs(trace, j)
-        assert (shown["found"], shown["proximity"], shown["centroid_x"],
-                shown["centroid_leds"]) == (t.found, t.proximity, t.centroid_x, t.centroid_leds)
+        assert (
+            shown["found"],
+            shown["proximity"],
+            shown["centroid_x"],
+            shown["centroid_leds"],
+        ) == (t.found, t.proximity, t.centroid_x, t.centroid_leds)
         motors = frame_outputs(trace, j + p.motor_latency)
         assert (motors["motor_left"], motors["motor_right"]) == (e.motor_left, e.motor_right)
     return expected
@@ -63,8 +67,9 @@ def scene_frames(p, seed):
     positions = [p.margin_x, p.width / 2, p.width - p.margin_x - 1, p.width / 4]
     for i, colour in enumerate(COLOURS):
         cx = positions[i % len(positions)]
-        rgb = synthetic.blob_frame(p.width, p.height, colour, cx=cx, cy=p.height / 2,
-                                   radius=p.height / 3, rng=rng)
+        rgb = synthetic.blob_frame(
+            p.width, p.height, colour, cx=cx, cy=p.height / 2, radius=p.height / 3, rng=rng
+        )
         frames.append(packed(rgb, p))
         sels.append(COLOR_SELECT[colour])
     for _ in range(p.lost_frames + 1):
@@ -81,8 +86,10 @@ def test_scenes_of_every_colour_with_blanking_match_the_model():
     p = small_params()
     frames, sels = scene_frames(p, seed=1)
     rng = np.random.default_rng(2)
-    gaps = {int(i): int(n) for i, n in zip(rng.integers(1, p.pixels_per_frame, 30),
-                                           rng.integers(1, 4, 30))}
+    gaps = {
+        int(i): int(n)
+        for i, n in zip(rng.integers(1, p.pixels_per_frame, 30), rng.integers(1, 4, 30))
+    }
     dut = FollowTarget(p)
     trace, last = run_follow_target(dut, frames, sels, line_blank=2, frame_gap=5, gaps=gaps)
     expected = check_against_model(p, frames, sels, trace, last)
@@ -103,8 +110,10 @@ def test_back_to_back_frames_without_any_blanking():
 def test_documented_latencies_and_strobe():
     p = small_params()
     rng = np.random.default_rng(4)
-    frames = [packed(synthetic.blob_frame(p.width, p.height, "green", cx=x, radius=4, rng=rng), p)
-              for x in (10, 40)]
+    frames = [
+        packed(synthetic.blob_frame(p.width, p.height, "green", cx=x, radius=4, rng=rng), p)
+        for x in (10, 40)
+    ]
     sels = [COLOR_SELECT["green"]] * 2
     dut = FollowTarget(p)
     trace, last = run_follow_target(dut, frames, sels, line_blank=1, frame_gap=30)
@@ -133,8 +142,10 @@ def test_malformed_frames_between_good_ones_do_not_leak():
     # the motor state moves only on well-formed frames, as if the others never came.
     p = small_params()
     rng = np.random.default_rng(5)
-    good = [packed(synthetic.blob_frame(p.width, p.height, "red", cx=x, radius=4, rng=rng), p)
-            for x in (12, 30, 36)]
+    good = [
+        packed(synthetic.blob_frame(p.width, p.height, "red", cx=x, radius=4, rng=rng), p)
+        for x in (12, 30, 36)
+    ]
     sel = COLOR_SELECT["red"]
     dut = FollowTarget(p)
     rows = list(good[1])
@@ -142,8 +153,13 @@ def test_malformed_frames_between_good_ones_do_not_leak():
     cut = frame_schedule(good[2])[: p.width * 5 + 7]
     schedule = []
     last = []
-    for part, is_good in ((frame_schedule(good[0]), True), (short, False), (cut, False),
-                          (frame_schedule(good[1]), True), (frame_schedule(good[2]), True)):
+    for part, is_good in (
+        (frame_schedule(good[0]), True),
+        (short, False),
+        (cut, False),
+        (frame_schedule(good[1]), True),
+        (frame_schedule(good[2]), True),
+    ):
         schedule += part
         if is_good:
             last.append(len(schedule) - 1)
@@ -189,14 +205,20 @@ def random_params(rng):
     height = int(rng.integers(2, 9))
     thresholds = tuple(sorted(int(t) for t in rng.integers(0, width * height, 7)))
     return FollowTargetParams(
-        width=width, height=height,
-        margin_x=int(rng.choice(margins)), margin_y=int(rng.integers(0, (height - 1) // 2 + 1)),
-        diff_min=int(rng.integers(0, 16)), similar_max=int(rng.integers(0, 16)),
+        width=width,
+        height=height,
+        margin_x=int(rng.choice(margins)),
+        margin_y=int(rng.integers(0, (height - 1) // 2 + 1)),
+        diff_min=int(rng.integers(0, 16)),
+        similar_max=int(rng.integers(0, 16)),
         white_min=int(rng.integers(0, 16)),
-        min_pixels=int(rng.integers(1, width * height)), proximity_thresholds=thresholds,
+        min_pixels=int(rng.integers(1, width * height)),
+        proximity_thresholds=thresholds,
         base_dps=tuple(int(v) for v in rng.integers(-600, 600, 8)),
-        kp_num=int(rng.integers(-60, 61)), kp_shift=int(rng.integers(0, 5)),
-        max_dps=int(rng.integers(0, 700)), lost_frames=int(rng.integers(1, 4)),
+        kp_num=int(rng.integers(-60, 61)),
+        kp_shift=int(rng.integers(0, 5)),
+        max_dps=int(rng.integers(0, 700)),
+        lost_frames=int(rng.integers(1, 4)),
         search_dps=int(rng.integers(-300, 301)),
     )
 
@@ -220,9 +242,18 @@ def test_random_parameter_sets_match_the_model(seed):
 
 def published_small(**changes):
     """The published preset at the small test geometry (counts scaled down by hand)."""
-    return FollowTargetParams.published(**{
-        "width": 48, "height": 12, "margin_x": 4, "margin_y": 1, "min_pixels": 8,
-        "proximity_thresholds": (8, 8, 8, 30, 60, 100, 200), "lost_frames": 3, **changes})
+    return FollowTargetParams.published(
+        **{
+            "width": 48,
+            "height": 12,
+            "margin_x": 4,
+            "margin_y": 1,
+            "min_pixels": 8,
+            "proximity_thresholds": (8, 8, 8, 30, 60, 100, 200),
+            "lost_frames": 3,
+            **changes,
+        }
+    )
 
 
 def test_published_preset_scenes_match_the_model():
@@ -236,8 +267,10 @@ def test_published_preset_scenes_match_the_model():
     assert len({(e.motor_left, e.motor_right) for e in expected}) >= 5
 
 
-@pytest.mark.parametrize("seed,law,motion", [(0, "table", "drive"), (1, "table", "hold"),
-                                              (2, "p_control", "hold"), (3, "table", "drive")])
+@pytest.mark.parametrize(
+    "seed,law,motion",
+    [(0, "table", "drive"), (1, "table", "hold"), (2, "p_control", "hold"), (3, "table", "drive")],
+)
 def test_random_published_knobs_match_the_model(seed, law, motion):
     rng = np.random.default_rng(300 + seed)
     base = random_params(rng)
@@ -255,8 +288,15 @@ def test_random_published_knobs_match_the_model(seed, law, motion):
         if i in (2, 3, 4):
             rgb = synthetic.empty_frame(p.width, p.height, rng=rng)
         else:
-            rgb = synthetic.blob_frame(p.width, p.height, "red", cx=rng.random() * p.width,
-                                       cy=p.height / 2, radius=p.height / 2, rng=rng)
+            rgb = synthetic.blob_frame(
+                p.width,
+                p.height,
+                "red",
+                cx=rng.random() * p.width,
+                cy=p.height / 2,
+                radius=p.height / 2,
+                rng=rng,
+            )
         frames.append(packed(rgb, p))
         sels.append(COLOR_SELECT["red"] if i != 6 else int(rng.integers(0, 8)))
     dut = FollowTarget(p)

@@ -30,15 +30,20 @@ def run_tracker(params, schedule, tail=None):
     trace = run_schedule(dut, dut.matches, schedule, probes, tail=tail)
     results = []
     for j in edges_where(trace, "frame_done"):
-        results.append((j, TrackerResult(
-            found=bool(trace["found"][j]),
-            proximity=int(trace["proximity"][j]),
-            centroid_x=int(trace["centroid_x"][j]),
-            centroid_leds=int(trace["centroid_leds"][j]),
-            count=int(trace["count"][j]),
-            bins=unpack_lanes(trace["bins"][j], params.count_bits, 8),
-            sum_x=int(trace["sum_x"][j]),
-        )))
+        results.append(
+            (
+                j,
+                TrackerResult(
+                    found=bool(trace["found"][j]),
+                    proximity=int(trace["proximity"][j]),
+                    centroid_x=int(trace["centroid_x"][j]),
+                    centroid_leds=int(trace["centroid_leds"][j]),
+                    count=int(trace["count"][j]),
+                    bins=unpack_lanes(trace["bins"][j], params.count_bits, 8),
+                    sum_x=int(trace["sum_x"][j]),
+                ),
+            )
+        )
     return trace, results
 
 
@@ -121,10 +126,15 @@ def test_blanking_inside_lines_and_between_frames():
     p = small_params()
     rng = np.random.default_rng(3)
     masks = [random_mask(p, rng, 0.2) for _ in range(2)]
-    gaps = {int(i): int(n) for i, n in zip(rng.integers(0, p.pixels_per_frame, 40),
-                                           rng.integers(1, 5, 40))}
-    schedule = (match_lines_schedule(masks[0], line_blank=3, gaps=gaps) + [None] * 11
-                + match_lines_schedule(masks[1], line_blank=1, gaps=gaps))
+    gaps = {
+        int(i): int(n)
+        for i, n in zip(rng.integers(0, p.pixels_per_frame, 40), rng.integers(1, 5, 40))
+    }
+    schedule = (
+        match_lines_schedule(masks[0], line_blank=3, gaps=gaps)
+        + [None] * 11
+        + match_lines_schedule(masks[1], line_blank=1, gaps=gaps)
+    )
     _, results = run_tracker(p, schedule)
     assert [r for _, r in results] == [track_frame(m, p) for m in masks]
 
@@ -170,8 +180,11 @@ def test_every_proximity_level_occurs():
     p = small_params()
     thresholds = p.proximity_thresholds
     rng = np.random.default_rng(11)
-    window = [(y, x) for y in range(p.margin_y, p.height - p.margin_y)
-              for x in range(p.margin_x, p.width - p.margin_x)]
+    window = [
+        (y, x)
+        for y in range(p.margin_y, p.height - p.margin_y)
+        for x in range(p.margin_x, p.width - p.margin_x)
+    ]
     masks = []
     for n in (0, thresholds[0] - 1, *thresholds, thresholds[1] + 3):
         mask = np.zeros((p.height, p.width), bool)
@@ -185,17 +198,20 @@ def test_every_proximity_level_occurs():
     assert [r for _, r in results] == [track_frame(m, p) for m in masks]
 
 
-@pytest.mark.parametrize("columns,leds", [
-    ([4], 0b0000_0001),  # far left: h0 holds half
-    ([9, 10], 0b0000_0010),  # bin 1
-    ([14], 0b0000_0100),  # bin 2
-    ([19], 0b0000_1000),  # bin 3, left of centre
-    ([23, 24], 0b0001_1000),  # centred
-    ([24], 0b0001_0000),  # bin 4
-    ([29], 0b0010_0000),
-    ([34], 0b0100_0000),
-    ([43], 0b1000_0000),  # rightmost window column
-])
+@pytest.mark.parametrize(
+    "columns,leds",
+    [
+        ([4], 0b0000_0001),  # far left: h0 holds half
+        ([9, 10], 0b0000_0010),  # bin 1
+        ([14], 0b0000_0100),  # bin 2
+        ([19], 0b0000_1000),  # bin 3, left of centre
+        ([23, 24], 0b0001_1000),  # centred
+        ([24], 0b0001_0000),  # bin 4
+        ([29], 0b0010_0000),
+        ([34], 0b0100_0000),
+        ([43], 0b1000_0000),  # rightmost window column
+    ],
+)
 def test_led_codes(columns, leds):
     p = small_params()
     mask = window_columns_mask(p, columns)
@@ -237,6 +253,7 @@ def test_full_size_frame_matches_the_model():
 
 # --- malformed framing ---------------------------------------------------------------------
 
+
 def good_and_expected(p, seed=0):
     mask = random_mask(p, np.random.default_rng(seed), 0.3)
     return match_lines_schedule(mask), track_frame(mask, p)
@@ -246,14 +263,17 @@ def lines(p, n_lines, length, value=True):
     return [[value] * length for _ in range(n_lines)]
 
 
-@pytest.mark.parametrize("case", [
-    "first_in_mid_frame",
-    "short_line",
-    "long_line",
-    "too_few_lines",
-    "no_first",
-    "stray_last_then_first",
-])
+@pytest.mark.parametrize(
+    "case",
+    [
+        "first_in_mid_frame",
+        "short_line",
+        "long_line",
+        "too_few_lines",
+        "no_first",
+        "stray_last_then_first",
+    ],
+)
 def test_malformed_frame_gives_nothing_and_does_not_leak(case):
     p = small_params()
     W, H = p.width, p.height
@@ -301,10 +321,14 @@ def test_first_restarts_the_frame_at_any_point():
 
 # --- The published design's tracker knobs ----------------------------------------------------
 
+
 def window_count_mask(p, n, rng):
     """``n`` matching pixels at random places of the window."""
-    window = [(y, x) for y in range(p.margin_y, p.height - p.margin_y)
-              for x in range(p.margin_x, p.width - p.margin_x)]
+    window = [
+        (y, x)
+        for y in range(p.margin_y, p.height - p.margin_y)
+        for x in range(p.margin_x, p.width - p.margin_x)
+    ]
     mask = np.zeros((p.height, p.width), bool)
     for i in rng.permutation(len(window))[:n]:
         mask[window[i]] = True
@@ -315,8 +339,9 @@ def window_count_mask(p, n, rng):
 def test_found_rule(rule, found):
     p = small_params(found_rule=rule)
     rng = np.random.default_rng(2)
-    masks = [window_count_mask(p, n, rng) for n in (p.min_pixels - 1, p.min_pixels,
-                                                     p.min_pixels + 1)]
+    masks = [
+        window_count_mask(p, n, rng) for n in (p.min_pixels - 1, p.min_pixels, p.min_pixels + 1)
+    ]
     _, results = run_tracker(p, frames_schedule(masks))
     assert [r.found for _, r in results] == found
     # Not found: no LED and no centroid; the proximity is counted all the same.
@@ -362,12 +387,15 @@ def test_group_column_offset_moves_each_bins_last_column_to_the_next_group():
     assert b1 == [0x01, 0x02, 0x04, 0x18, 0x20, 0x40, 0x40, 0x18]
 
 
-@pytest.mark.parametrize("changes", [
-    {"group_column_offset": 1},
-    {"group_column_offset": 1, "found_rule": "gt"},
-    {"group_column_offset": 1, "margin_x": 0, "margin_y": 0},  # the last column is the frame's
-    {"group_column_offset": 1, "margin_x": 8, "width": 32, "height": 6, "margin_y": 2},
-])
+@pytest.mark.parametrize(
+    "changes",
+    [
+        {"group_column_offset": 1},
+        {"group_column_offset": 1, "found_rule": "gt"},
+        {"group_column_offset": 1, "margin_x": 0, "margin_y": 0},  # the last column is the frame's
+        {"group_column_offset": 1, "margin_x": 8, "width": 32, "height": 6, "margin_y": 2},
+    ],
+)
 def test_group_column_offset_random_masks_match_the_model(changes):
     p = small_params(**changes)
     rng = np.random.default_rng(len(changes))
@@ -398,5 +426,7 @@ def test_a_narrow_sx_wraps_as_in_the_model(sx_bits):
     for m, r in zip(masks, expected, strict=True):
         assert r.sum_x == track_frame(m, full).sum_x % (1 << sx_bits)
     # The stimulus makes SX wrap, and the centroid move, in some frames.
-    assert any(r.centroid_x != track_frame(m, full).centroid_x
-               for m, r in zip(masks, expected, strict=True))
+    assert any(
+        r.centroid_x != track_frame(m, full).centroid_x
+        for m, r in zip(masks, expected, strict=True)
+    )

@@ -21,7 +21,7 @@ def run_driver(params, pulses, periods):
     n = periods * params.period_cycles
     level = np.zeros(n + 2, np.int8)
     for a, b in pulses:
-        level[a:min(b, n + 2)] = 1
+        level[a : min(b, n + 2)] = 1
     trig, measured = [], []
 
     async def bench(ctx):
@@ -30,8 +30,9 @@ def run_driver(params, pulses, periods):
             await ctx.tick()
             trig.append(ctx.get(dut.trig))
             if ctx.get(dut.measured):
-                measured.append(Measurement(e, ctx.get(dut.distance_mm),
-                                            bool(ctx.get(dut.no_echo))))
+                measured.append(
+                    Measurement(e, ctx.get(dut.distance_mm), bool(ctx.get(dut.no_echo)))
+                )
 
     run_testbench(dut, bench, watchdog=n + 100)
     return np.array(trig), measured
@@ -138,7 +139,7 @@ def test_outputs_hold_between_measurements_and_start_at_zero():
     strobes = [e + 1 for e, s in enumerate(seen) if s[2]]
     assert strobes == [702, p.period_cycles + 13 + 500]
     assert all(s[:2] == (0, 0) for s in seen[:701])
-    assert all(s[:2] == (102, 0) for s in seen[701:strobes[1] - 1])
+    assert all(s[:2] == (102, 0) for s in seen[701 : strobes[1] - 1])
     assert seen[-1][:2] == (DISTANCE_NONE, 1)
 
 
@@ -148,16 +149,25 @@ def test_narrow_counter_variant_wraps_to_a_false_near_reading():
     fall = [k * p.period_cycles + 13 for k in range(3)]
     # 1100 cycles (a surface 188.6 mm away... as read by the correct design: 188 mm) wraps
     # to 76 cycles: 13 mm; 2000 cycles (beyond the range: no echo) reads 976 cycles, 167 mm.
-    pulses = [(fall[0] + 50, fall[0] + 50 + 1100), (fall[1] + 50, fall[1] + 50 + 2000),
-              (fall[2] + 50, fall[2] + 50 + 300)]
+    pulses = [
+        (fall[0] + 50, fall[0] + 50 + 1100),
+        (fall[1] + 50, fall[1] + 50 + 2000),
+        (fall[2] + 50, fall[2] + 50 + 300),
+    ]
     _, measured = run_driver(p, pulses, periods=3)
     assert [(m.distance_mm, m.no_echo) for m in measured] == [
-        ((76 * 44_958) >> 18, False), ((976 * 44_958) >> 18, False), (51, False)]
+        ((76 * 44_958) >> 18, False),
+        ((976 * 44_958) >> 18, False),
+        (51, False),
+    ]
     assert [m.distance_mm for m in measured[:2]] == [13, 167]
     assert measured == UltrasoundModel(p).measurements(3, pulses)
     correct = UltrasoundModel(UltrasoundParams(**SMALL)).measurements(3, pulses)
     assert [(m.distance_mm, m.no_echo) for m in correct] == [
-        (188, False), (DISTANCE_NONE, True), (51, False)]
+        (188, False),
+        (DISTANCE_NONE, True),
+        (51, False),
+    ]
 
 
 def test_narrow_counter_at_50_mhz_by_hand():
@@ -190,14 +200,17 @@ def test_inverted_echo_variant_never_measures():
     assert [m.distance_mm for m in correct] == [51, 102, 17]
 
 
-@pytest.mark.parametrize("changes,message", [
-    ({"trigger_us": 9}, "trigger_us must be >= 10"),
-    ({"period_us": 20_000}, "period_us=20000 is too short"),
-    ({"max_range_mm": 0}, "max_range_mm must be >= 1"),
-    ({"clock_hz": 50e6}, "clock_hz must be an int"),
-    ({"echo_active_high": 1}, "echo_active_high must be True or False"),
-    ({"clock_hz": 100_000, "wait_us": 10}, "too slow"),
-])
+@pytest.mark.parametrize(
+    "changes,message",
+    [
+        ({"trigger_us": 9}, "trigger_us must be >= 10"),
+        ({"period_us": 20_000}, "period_us=20000 is too short"),
+        ({"max_range_mm": 0}, "max_range_mm must be >= 1"),
+        ({"clock_hz": 50e6}, "clock_hz must be an int"),
+        ({"echo_active_high": 1}, "echo_active_high must be True or False"),
+        ({"clock_hz": 100_000, "wait_us": 10}, "too slow"),
+    ],
+)
 def test_bad_parameters_are_refused(changes, message):
     with pytest.raises((TypeError, ValueError), match=message):
         UltrasoundParams(**changes)

@@ -44,16 +44,32 @@ def _wait_for(predicate, timeout):
 @pytest.mark.parametrize("sig, code", [(signal.SIGTERM, 143), (signal.SIGINT, 130)])
 def test_signal_mid_run_keeps_the_recording(sig, code, tmp_path):
     proc = subprocess.Popen(
-        RUN + ["--backend", "model", "--duration", "3600", "--rerun", "save:rec.rrd",
-               "--summary", "s.json", "--quiet"],
-        cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        RUN
+        + [
+            "--backend",
+            "model",
+            "--duration",
+            "3600",
+            "--rerun",
+            "save:rec.rrd",
+            "--summary",
+            "s.json",
+            "--quiet",
+        ],
+        cwd=tmp_path,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
     try:
         # Frames are being written once the recording holds data.
-        assert _wait_for(lambda: any(p.stat().st_size > 100_000
-                                     for p in tmp_path.glob("*.rrd")
-                                     if p.exists()) or
-                         any(p.stat().st_size > 100_000 for p in tmp_path.glob(".*rrd")),
-                         timeout=120), "the run never started recording"
+        assert _wait_for(
+            lambda: (
+                any(p.stat().st_size > 100_000 for p in tmp_path.glob("*.rrd") if p.exists())
+                or any(p.stat().st_size > 100_000 for p in tmp_path.glob(".*rrd"))
+            ),
+            timeout=120,
+        ), "the run never started recording"
         proc.send_signal(sig)
         _out, err = proc.communicate(timeout=60)
     finally:
@@ -75,13 +91,19 @@ def test_sigterm_during_a_compile_ends_the_compiler(tmp_path):
     env = dict(os.environ, FPGA_ROBOTICS_CACHE=str(cache))
     # A resolution no other test builds, so this process compiles for sure.
     proc = subprocess.Popen(
-        RUN + ["--backend", "cxxrtl", "--resolution", "200x96", "--duration", "1",
-               "--rerun", "off"],
-        cwd=tmp_path, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        RUN
+        + ["--backend", "cxxrtl", "--resolution", "200x96", "--duration", "1", "--rerun", "off"],
+        cwd=tmp_path,
+        env=env,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
     try:
         # The compiler proper (cc1plus, started by the g++ driver) is at work in the cache.
-        assert _wait_for(lambda: any("cc1plus" in p for p in _processes_mentioning(str(cache))),
-                         timeout=180), "the compiler never started"
+        assert _wait_for(
+            lambda: any("cc1plus" in p for p in _processes_mentioning(str(cache))), timeout=180
+        ), "the compiler never started"
         time.sleep(1.5)  # well under way
         proc.send_signal(signal.SIGTERM)
         _out, err = proc.communicate(timeout=60)
@@ -89,7 +111,8 @@ def test_sigterm_during_a_compile_ends_the_compiler(tmp_path):
         proc.kill()
     assert proc.returncode == 143, err
     assert "compiling the cxxrtl model" in err  # the user was told why nothing moved
-    assert _wait_for(lambda: not _processes_mentioning(str(cache)), timeout=1), \
+    assert _wait_for(lambda: not _processes_mentioning(str(cache)), timeout=1), (
         _processes_mentioning(str(cache))
+    )
     leftovers = [p.name for p in cache.iterdir() if not p.name.endswith(".lock")]
     assert leftovers == []

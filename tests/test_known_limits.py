@@ -13,42 +13,74 @@ from fpga_robotics.sweep.report import (
     write_html,
 )
 
-BASE = {"name": "t", "scenarios": ["follow_person"], "seeds": "0",
-        "sets": [{"camera.resolution": "80x60"}, {"camera.fps": 15.0}]}
-LIMIT = {"check": "found_min_fraction", "when": {"camera.resolution": "80x60"},
-         "reason": "at 80x60 the target is too few pixels far away"}
+BASE = {
+    "name": "t",
+    "scenarios": ["follow_person"],
+    "seeds": "0",
+    "sets": [{"camera.resolution": "80x60"}, {"camera.fps": 15.0}],
+}
+LIMIT = {
+    "check": "found_min_fraction",
+    "when": {"camera.resolution": "80x60"},
+    "reason": "at 80x60 the target is too few pixels far away",
+}
 
 
 def test_known_limits_are_parsed_with_their_scope():
-    c = load_campaign({**BASE, "known_limits": [LIMIT, {**LIMIT, "scenarios": "divider",
-                                                        "when": {}}]})
+    c = load_campaign(
+        {**BASE, "known_limits": [LIMIT, {**LIMIT, "scenarios": "divider", "when": {}}]}
+    )
     assert c.known_limits == [
-        {"check": ["found_min_fraction"], "when": {"camera.resolution": "80x60"},
-         "scenarios": [], "reason": LIMIT["reason"]},
-        {"check": ["found_min_fraction"], "when": {}, "scenarios": ["divider"],
-         "reason": LIMIT["reason"]}]
-    both = load_campaign({**BASE, "known_limits": [
-        {**LIMIT, "check": ["found_min_fraction", "max_person_collisions"]}]}).known_limits
+        {
+            "check": ["found_min_fraction"],
+            "when": {"camera.resolution": "80x60"},
+            "scenarios": [],
+            "reason": LIMIT["reason"],
+        },
+        {
+            "check": ["found_min_fraction"],
+            "when": {},
+            "scenarios": ["divider"],
+            "reason": LIMIT["reason"],
+        },
+    ]
+    both = load_campaign(
+        {
+            **BASE,
+            "known_limits": [{**LIMIT, "check": ["found_min_fraction", "max_person_collisions"]}],
+        }
+    ).known_limits
     assert both[0]["check"] == ["found_min_fraction", "max_person_collisions"]
     assert load_campaign(dict(BASE)).known_limits == []
 
 
-@pytest.mark.parametrize("entry, says", [
-    ({**LIMIT, "check": "found_min"}, "registered check"),
-    ({**LIMIT, "check": []}, "registered check"),
-    ({**LIMIT, "reason": " "}, "give a reason"),
-    ({**LIMIT, "when": {"camera.noise_std": 0.0}}, "no grid axis or set"),
-    ({**LIMIT, "why": "x"}, "unknown key 'why'"),
-])
+@pytest.mark.parametrize(
+    "entry, says",
+    [
+        ({**LIMIT, "check": "found_min"}, "registered check"),
+        ({**LIMIT, "check": []}, "registered check"),
+        ({**LIMIT, "reason": " "}, "give a reason"),
+        ({**LIMIT, "when": {"camera.noise_std": 0.0}}, "no grid axis or set"),
+        ({**LIMIT, "why": "x"}, "unknown key 'why'"),
+    ],
+)
 def test_a_malformed_known_limit_says_what_is_wrong(entry, says):
     with pytest.raises(CampaignError, match=says):
         load_campaign({**BASE, "known_limits": [entry]})
 
 
 def _row(status, failed="", resolution=None, scenario="follow_person"):
-    return {"scenario": scenario, "seed": 0, "status": status, "failed_checks": failed,
-            "camera.resolution": resolution, "replay": f"replay {scenario} {resolution}",
-            "na_checks": "", "checks_json": "[]", "message": ""}
+    return {
+        "scenario": scenario,
+        "seed": 0,
+        "status": status,
+        "failed_checks": failed,
+        "camera.resolution": resolution,
+        "replay": f"replay {scenario} {resolution}",
+        "na_checks": "",
+        "checks_json": "[]",
+        "message": "",
+    }
 
 
 def test_a_failure_is_explained_only_where_the_limit_applies():
@@ -66,8 +98,12 @@ def test_a_failure_is_explained_only_where_the_limit_applies():
     assert [r["replay"] for r in groups["found_min_fraction"]] == [elsewhere["replay"]]
     assert groups["max_person_collisions"] == [also_other]
     # A limit naming both checks explains the run that failed both.
-    both = load_campaign({**BASE, "known_limits": [
-        {**LIMIT, "check": ["found_min_fraction", "max_person_collisions"]}]}).known_limits
+    both = load_campaign(
+        {
+            **BASE,
+            "known_limits": [{**LIMIT, "check": ["found_min_fraction", "max_person_collisions"]}],
+        }
+    ).known_limits
     assert explained(also_other, both) and not explained(elsewhere, both)
 
 
@@ -75,11 +111,11 @@ def test_the_report_shows_each_known_limit_with_its_reason(tmp_path):
     limits = load_campaign({**BASE, "known_limits": [LIMIT]}).known_limits
     rows = [_row("pass"), _row("fail", "found_min_fraction", "80x60")]
     text = format_report(rows, ["camera.resolution"], limits)
-    assert ("found_min_fraction (camera.resolution=80x60): 1 run(s): "
-            + LIMIT["reason"]) in text
+    assert ("found_min_fraction (camera.resolution=80x60): 1 run(s): " + LIMIT["reason"]) in text
     assert "failures by check" not in text
-    write_html(tmp_path / "report.html", rows, ["camera.resolution"],
-               {"name": "t", "known_limits": limits})
+    write_html(
+        tmp_path / "report.html", rows, ["camera.resolution"], {"name": "t", "known_limits": limits}
+    )
     page = (tmp_path / "report.html").read_text()
     assert "Known limits of the design" in page and LIMIT["reason"] in page
     assert "replay follow_person 80x60" in page
@@ -100,6 +136,9 @@ def test_robustness_small_passes_or_fails_only_at_known_limits(tmp_path):
     campaign = load_campaign(data, source=str(path))
     rows = run_campaign(campaign, tmp_path, workers=1, record="none", quiet=True)
     assert len(rows) == len(campaign.runs)
-    bad = [r["replay"] for r in rows
-           if not (r["status"] == "pass" or explained(r, campaign.known_limits))]
+    bad = [
+        r["replay"]
+        for r in rows
+        if not (r["status"] == "pass" or explained(r, campaign.known_limits))
+    ]
     assert not bad, bad

@@ -15,15 +15,28 @@ import pytest
 ROOT = Path(__file__).resolve().parent.parent
 
 #: Source folder -> installed package.
-PACKAGE_DIRS = {"fpga_robotics": "fpga_robotics", "hw": "fpga_robotics.hw",
-                "sim": "fpga_robotics.sim", "viz": "fpga_robotics.viz"}
+PACKAGE_DIRS = {
+    "fpga_robotics": "fpga_robotics",
+    "hw": "fpga_robotics.hw",
+    "sim": "fpga_robotics.sim",
+    "viz": "fpga_robotics.viz",
+}
 
 #: The rooms, top first: a module may import its own room and the rooms below it. A module's
 #: room is the one with the longest prefix that matches its name (docs/architecture.md).
 ROOMS = [
-    ("aliases", ("fpga_robotics.__main__", "fpga_robotics.run", "fpga_robotics.export",
-                 "fpga_robotics.formal", "fpga_robotics.bench.__main__",
-                 "fpga_robotics.mutation.__main__", "fpga_robotics.sweep.__main__")),
+    (
+        "aliases",
+        (
+            "fpga_robotics.__main__",
+            "fpga_robotics.run",
+            "fpga_robotics.export",
+            "fpga_robotics.formal",
+            "fpga_robotics.bench.__main__",
+            "fpga_robotics.mutation.__main__",
+            "fpga_robotics.sweep.__main__",
+        ),
+    ),
     ("cli", ("fpga_robotics.cli",)),
     ("bench", ("fpga_robotics.bench",)),
     ("mutation", ("fpga_robotics.mutation",)),
@@ -36,8 +49,14 @@ ROOMS = [
     ("connectors", ("fpga_robotics.loop.connectors",)),
     ("ros", ("fpga_robotics.ros",)),
     ("checks", ("fpga_robotics.checks",)),
-    ("cli support", ("fpga_robotics.cli.errors", "fpga_robotics.cli.param_options",
-                     "fpga_robotics.cli.sensor_options")),
+    (
+        "cli support",
+        (
+            "fpga_robotics.cli.errors",
+            "fpga_robotics.cli.param_options",
+            "fpga_robotics.cli.sensor_options",
+        ),
+    ),
     ("package", ("fpga_robotics",)),
     ("viz", ("fpga_robotics.viz",)),
     ("sim", ("fpga_robotics.sim",)),
@@ -54,7 +73,8 @@ def room_of(module, rooms=ROOMS):
     for height, (name, prefixes) in enumerate(reversed(rooms)):
         for prefix in prefixes:
             if (module == prefix or module.startswith(prefix + ".")) and (
-                    best is None or len(prefix) > best[0]):
+                best is None or len(prefix) > best[0]
+            ):
                 best = (len(prefix), height, name)
     return best[1:] if best else (None, None)
 
@@ -74,10 +94,12 @@ def source_modules(root=ROOT, package_dirs=PACKAGE_DIRS):
 
 def _is_main_guard(node):
     test = node.test
-    return (isinstance(test, ast.Compare) and isinstance(test.left, ast.Name)
-            and test.left.id == "__name__"
-            and any(isinstance(c, ast.Constant) and c.value == "__main__"
-                    for c in test.comparators))
+    return (
+        isinstance(test, ast.Compare)
+        and isinstance(test.left, ast.Name)
+        and test.left.id == "__name__"
+        and any(isinstance(c, ast.Constant) and c.value == "__main__" for c in test.comparators)
+    )
 
 
 def _main_guard_lines(tree):
@@ -91,8 +113,12 @@ def _main_guard_lines(tree):
 def _is_import_module_call(node):
     func = node.func
     name = func.attr if isinstance(func, ast.Attribute) else getattr(func, "id", None)
-    return (name in ("import_module", "__import__") and node.args
-            and isinstance(node.args[0], ast.Constant) and isinstance(node.args[0].value, str))
+    return (
+        name in ("import_module", "__import__")
+        and node.args
+        and isinstance(node.args[0], ast.Constant)
+        and isinstance(node.args[0].value, str)
+    )
 
 
 def imports_of(module, path, modules):
@@ -202,20 +228,27 @@ def check(root=ROOT, package_dirs=PACKAGE_DIRS, rooms=ROOMS):
             continue
         theirs, their_room = room_of(imported, rooms)
         if theirs is not None and theirs > mine:
-            problems.append(f"{where}: {my_room} module {module} imports {imported} of the "
-                            f"{their_room} room above it{main_note}")
+            problems.append(
+                f"{where}: {my_room} module {module} imports {imported} of the "
+                f"{their_room} room above it{main_note}"
+            )
     for circle in circles(graph):
         ring = " -> ".join(circle + circle[:1])
-        problems.append(f"import circle: {ring} (move what they share into a module below "
-                        f"both)")
+        problems.append(f"import circle: {ring} (move what they share into a module below both)")
     return problems
 
 
 def test_every_source_module_is_found_and_has_a_room():
     modules = source_modules()
-    assert {"fpga_robotics.hw.top", "fpga_robotics.sim.models.follow_target",
-            "fpga_robotics.viz.recorder", "fpga_robotics.loop", "fpga_robotics.cli.errors",
-            "fpga_robotics.sim.backends.cxxrtl", "fpga_robotics.bench.__main__"} <= set(modules)
+    assert {
+        "fpga_robotics.hw.top",
+        "fpga_robotics.sim.models.follow_target",
+        "fpga_robotics.viz.recorder",
+        "fpga_robotics.loop",
+        "fpga_robotics.cli.errors",
+        "fpga_robotics.sim.backends.cxxrtl",
+        "fpga_robotics.bench.__main__",
+    } <= set(modules)
     assert [m for m in modules if room_of(m)[1] is None] == []
     assert room_of("fpga_robotics.loop.connectors.camera")[1] == "connectors"
     assert room_of("fpga_robotics.cli.errors")[1] == "cli support"
@@ -234,13 +267,17 @@ def test_the_checker_reports_upward_imports_circles_and_main_blocks(tmp_path):
         "sim/__init__.py": "",
         "sim/world.py": "import math\n",
         # an upward import under the __main__ guard (a module keeping its own command line)
-        "sim/tool.py": ("def f():\n    return 1\n\n"
-                        "if __name__ == '__main__':\n"
-                        "    from fpga_robotics.cli import main\n    main()\n"),
+        "sim/tool.py": (
+            "def f():\n    return 1\n\n"
+            "if __name__ == '__main__':\n"
+            "    from fpga_robotics.cli import main\n    main()\n"
+        ),
         # an upward import by a string literal, inside a function
-        "viz/plugin.py": ("import importlib\n\n"
-                          "def load():\n"
-                          "    return importlib.import_module('fpga_robotics.loop.a')\n"),
+        "viz/plugin.py": (
+            "import importlib\n\n"
+            "def load():\n"
+            "    return importlib.import_module('fpga_robotics.loop.a')\n"
+        ),
         # a circle inside one room, one side importing inside a function
         "fpga_robotics/__init__.py": "",
         "fpga_robotics/cli/__init__.py": "def main():\n    pass\n",
@@ -257,20 +294,35 @@ def test_the_checker_reports_upward_imports_circles_and_main_blocks(tmp_path):
     problems = check(tmp_path)
     assert problems == [
         "hw/pure.py:1: gateware imports host package numpy",
-        ("hw/top.py:1: hw module fpga_robotics.hw.top imports fpga_robotics.sim.world of the "
-         "sim room above it"),
-        ("sim/tool.py:5: sim module fpga_robotics.sim.tool imports fpga_robotics.cli of the "
-         "cli room above it (under __main__)"),
-        ("viz/plugin.py:4: viz module fpga_robotics.viz.plugin imports fpga_robotics.loop.a of "
-         "the loop room above it"),
-        ("import circle: fpga_robotics.loop.a -> fpga_robotics.loop.b -> fpga_robotics.loop.a "
-         "(move what they share into a module below both)"),
+        (
+            "hw/top.py:1: hw module fpga_robotics.hw.top imports fpga_robotics.sim.world of the "
+            "sim room above it"
+        ),
+        (
+            "sim/tool.py:5: sim module fpga_robotics.sim.tool imports fpga_robotics.cli of the "
+            "cli room above it (under __main__)"
+        ),
+        (
+            "viz/plugin.py:4: viz module fpga_robotics.viz.plugin imports fpga_robotics.loop.a of "
+            "the loop room above it"
+        ),
+        (
+            "import circle: fpga_robotics.loop.a -> fpga_robotics.loop.b -> fpga_robotics.loop.a "
+            "(move what they share into a module below both)"
+        ),
     ]
 
 
 def test_circles_finds_every_ring_and_nothing_else():
-    graph = {"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"a", "e"}, "e": {"d"}, "f": {"a"},
-             "g": set()}
+    graph = {
+        "a": {"b"},
+        "b": {"c"},
+        "c": {"a"},
+        "d": {"a", "e"},
+        "e": {"d"},
+        "f": {"a"},
+        "g": set(),
+    }
     assert circles(graph) == [["a", "b", "c"], ["d", "e"]]
     assert circles({"a": {"b"}, "b": set()}) == []
 

@@ -11,26 +11,34 @@ W = 160
 
 def _traj(columns, leds, found=True):
     n = len(columns)
-    return {"t": np.arange(n) / 30, "x": np.zeros(n), "y": np.zeros(n),
-            "found": np.full(n, found), "target_distance": np.ones(n),
-            "target_in_view": np.ones(n, bool),
-            "target_column": np.asarray(columns, dtype=float),
-            "centroid_leds": np.asarray(leds), "centroid_x": np.full(n, 80)}
+    return {
+        "t": np.arange(n) / 30,
+        "x": np.zeros(n),
+        "y": np.zeros(n),
+        "found": np.full(n, found),
+        "target_distance": np.ones(n),
+        "target_in_view": np.ones(n, bool),
+        "target_column": np.asarray(columns, dtype=float),
+        "centroid_leds": np.asarray(leds),
+        "centroid_x": np.full(n, 80),
+    }
 
 
 def test_leds_on_the_other_half_or_outer_leds_at_the_centre_are_wrong():
     # Frames: target right (column 120 >= 80 + 20), left (30), centred (82), in between (95,
     # not judged: 15 px from the centre is neither within 10 nor beyond 20), out of view.
     columns = [120, 120, 30, 30, 82, 82, 82, 95, np.nan]
-    leds = [0b1000_0000,   # right LED for a right target: fine
-            0b0000_1000,   # bit 3 (left half) for a right target: wrong
-            0b0000_0001,   # left for left: fine
-            0b0001_0000,   # bit 4 (right half) for a left target: wrong
-            0b0001_1000,   # centred: fine
-            0b0000_0100,   # bit 2 at the centre: fine (a wide target)
-            0b1000_0000,   # bit 7 at the centre: wrong
-            0b0000_0001,   # not judged
-            0b0000_0001]   # not judged (no target column)
+    leds = [
+        0b1000_0000,  # right LED for a right target: fine
+        0b0000_1000,  # bit 3 (left half) for a right target: wrong
+        0b0000_0001,  # left for left: fine
+        0b0001_0000,  # bit 4 (right half) for a left target: wrong
+        0b0001_1000,  # centred: fine
+        0b0000_0100,  # bit 2 at the centre: fine (a wide target)
+        0b1000_0000,  # bit 7 at the centre: wrong
+        0b0000_0001,  # not judged
+        0b0000_0001,
+    ]  # not judged (no target column)
     m = compute_metrics(_traj(columns, leds), [], {}, 1 / 30, width=W)
     assert m["led_wrong_side_fraction"] == pytest.approx(round(3 / 7, 4))
     (c,) = evaluate_checks({"max_led_wrong_side_fraction": 0.5}, m)

@@ -18,9 +18,13 @@ QUIET = KY033Params(noise_std=0.0)
 
 
 def _world(lines, start=(1.0, 3.0)):
-    return World.from_config({"room": {"floor_color": list(FLOOR), "lines": lines},
-                              "robot": {"model": "gopigo3", "start": list(start)},
-                              "people": []})
+    return World.from_config(
+        {
+            "room": {"floor_color": list(FLOOR), "lines": lines},
+            "robot": {"model": "gopigo3", "start": list(start)},
+            "people": [],
+        }
+    )
 
 
 def test_dark_line_high_floor_low_and_the_threshold():
@@ -72,8 +76,7 @@ def test_crossing_a_line_at_known_speed(dps):
     width, dt = 0.019, 0.002
     world = _world([{"points": [[2.0, 1.0], [2.0, 5.0]], "width": width}], start=(1.5, 3.0))
     v = world.robot_spec.wheel_radius * dps * DEG  # the wheels' steady speed, m/s
-    sensors = LineSensorsConnector.parse({"sensors": [{"forward": 0.05}], "noise_std": 0.0},
-                                         "s")
+    sensors = LineSensorsConnector.parse({"sensors": [{"forward": 0.05}], "noise_std": 0.0}, "s")
     conn = LineSensorsConnector("line", Mount(), sensors, world=world, rng=None)
     io = _IO()
     world.set_wheel_dps(dps, dps)

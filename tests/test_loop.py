@@ -37,10 +37,15 @@ def test_follows_the_walking_person_without_colliding():
 
 
 def test_stops_short_of_a_standing_person():
-    s = load_scenario("follow_person", [
-        "people.0.waypoints=[[4.0, 3.0]]", "robot.start=[2.2, 3.0]", "sim.duration=12",
-        "people.0.speed_jitter=0.0",
-    ])
+    s = load_scenario(
+        "follow_person",
+        [
+            "people.0.waypoints=[[4.0, 3.0]]",
+            "robot.start=[2.2, 3.0]",
+            "sim.duration=12",
+            "people.0.speed_jitter=0.0",
+        ],
+    )
     r = run_scenario(s, seed=0, backend="model")
     t = r.trajectory
     d = t["target_distance"]
@@ -73,17 +78,18 @@ def test_searches_towards_the_side_it_lost_the_target_and_finds_it_again():
     spin = slice(k_search, k_found)
     assert (t["motor_left"][spin] == -s.params.search_dps).all()
     assert (t["motor_right"][spin] == s.params.search_dps).all()
-    assert (t["w"][k_search + 20:k_found] > 0.5).all()
+    assert (t["w"][k_search + 20 : k_found] > 0.5).all()
     # And the person really was out of view while it searched, and in view when found.
-    assert not t["target_in_view"][k_lost + 5:k_search].any()
+    assert not t["target_in_view"][k_lost + 5 : k_search].any()
     assert t["target_in_view"][k_found]
     assert r.summary["verdict"] == "pass", r.summary["checks"]
 
 
 def test_commands_take_effect_after_the_actuation_delay():
     for delay_frames in (0, 1, 3):
-        s = load_scenario("lost_target", [
-            "sim.duration=5", f"sim.actuation_delay={delay_frames / 30!r}"])
+        s = load_scenario(
+            "lost_target", ["sim.duration=5", f"sim.actuation_delay={delay_frames / 30!r}"]
+        )
         r = run_scenario(s, seed=0, backend="model")
         t = r.trajectory
         spec_r, spec_l = 0.035, 0.230  # TurtleBot2
@@ -91,10 +97,16 @@ def test_commands_take_effect_after_the_actuation_delay():
             if k < delay_frames:
                 expect = (0.0, 0.0)
             else:
-                expect = dps_to_twist(t["motor_left"][k - delay_frames],
-                                      t["motor_right"][k - delay_frames], spec_r, spec_l)
+                expect = dps_to_twist(
+                    t["motor_left"][k - delay_frames],
+                    t["motor_right"][k - delay_frames],
+                    spec_r,
+                    spec_l,
+                )
             assert (t["cmd_v"][k], t["cmd_w"][k]) == pytest.approx(expect, abs=1e-12), (
-                delay_frames, k)
+                delay_frames,
+                k,
+            )
 
 
 def test_frames_are_captured_on_the_frame_clock():
@@ -133,8 +145,9 @@ def test_a_ready_backend_is_reset_and_reused():
 
 
 def test_frame_records_carry_events_and_the_colour_select():
-    s = load_scenario("follow_person", [
-        "sim.duration=3", "color.changes=[{at = 1.0, color = \"green\"}]"])
+    s = load_scenario(
+        "follow_person", ["sim.duration=3", 'color.changes=[{at = 1.0, color = "green"}]']
+    )
     records = []
     r = run_scenario(s, seed=0, backend="model", on_frame=records.append)
     assert len(records) == r.summary["frames"] == 90
@@ -147,7 +160,8 @@ def test_frame_records_carry_events_and_the_colour_select():
     rec = records[10]
     assert rec.camera_rgb.shape == (120, 160, 3) and rec.camera_rgb.dtype == np.uint8
     assert rec.target_in_view and rec.target_distance == pytest.approx(
-        r.trajectory["target_distance"][10])
+        r.trajectory["target_distance"][10]
+    )
     assert [p.name for p in rec.people] == ["target"]
     assert (rec.robot_x, rec.robot_y) == (r.trajectory["x"][10], r.trajectory["y"][10])
 
@@ -212,8 +226,9 @@ def test_a_compiled_backend_drives_the_robot_exactly_as_the_model_does():
     assert compiled.summary["backend"] == names[0]
     assert compiled.events == model.events
     for name in TRAJECTORY_FIELDS:
-        assert np.array_equal(compiled.trajectory[name], model.trajectory[name],
-                              equal_nan=True), name
+        assert np.array_equal(compiled.trajectory[name], model.trajectory[name], equal_nan=True), (
+            name
+        )
     assert "search started" in [e for _, _, e in compiled.events]
 
 
@@ -227,16 +242,22 @@ def test_camera_pose_and_field_of_view_geometry():
     # 0.5 m radius still reaches into the view (asin(0.5/2) = 14.5 deg); behind: out.
     ahead = (pose.x, pose.y + 2.0)
     assert in_view(pose, hfov, *ahead, 0.2)
-    for deg, radius, expect in ((29, 0.0, True), (31, 0.0, False), (40, 0.5, True),
-                                (40, 0.1, False), (180, 0.2, False)):
+    for deg, radius, expect in (
+        (29, 0.0, True),
+        (31, 0.0, False),
+        (40, 0.5, True),
+        (40, 0.1, False),
+        (180, 0.2, False),
+    ):
         a = math.pi / 2 + math.radians(deg)
         p = (pose.x + 2 * math.cos(a), pose.y + 2 * math.sin(a))
         assert in_view(pose, hfov, *p, radius) is expect, deg
     assert in_view(pose, hfov, pose.x, pose.y - 0.1, 0.2)  # the camera is inside the body
 
 
-@pytest.mark.parametrize("name", ["follow_person", "divider", "lighting", "heavy_robot",
-                                  "lost_target"])
+@pytest.mark.parametrize(
+    "name", ["follow_person", "divider", "lighting", "heavy_robot", "lost_target"]
+)
 def test_every_shipped_scenario_passes_with_the_default_design(name):
     s = load_scenario(name)
     assert s.data["design"] == {}  # the default design
@@ -250,9 +271,10 @@ def test_the_steering_gain_grows_with_the_resolution():
     the pixels, so the robot turns twice as hard and keeps up with the person who escapes
     it at 160x120 (lost_target then judges its search n/a: the loss it is meant to test never happens)."""
     low = run_scenario(load_scenario("lost_target", ["sim.duration=6"]), backend="model")
-    high = run_scenario(load_scenario("lost_target", ["sim.duration=6",
-                                                      'camera.resolution="320x240"']),
-                        backend="model")
+    high = run_scenario(
+        load_scenario("lost_target", ["sim.duration=6", 'camera.resolution="320x240"']),
+        backend="model",
+    )
     assert low.summary["searches"] == 1 and high.summary["searches"] == 0
     assert high.trajectory["found"].all()
     assert np.abs(high.trajectory["w"]).max() > 1.5 * np.abs(low.trajectory["w"][:100]).max()
@@ -281,8 +303,10 @@ def test_camera_mount_defaults_to_the_robots_own(robot):
 def test_camera_mount_from_the_scenario_wins():
     from fpga_robotics.loop.compressed import ClosedLoop
 
-    s = load_scenario("follow_person", ["camera.mount_forward=0.25", "camera.mount_height=0.2",
-                                        "sim.duration=0.1"])
+    s = load_scenario(
+        "follow_person",
+        ["camera.mount_forward=0.25", "camera.mount_height=0.2", "sim.duration=0.1"],
+    )
     pose = ClosedLoop(s, design=ModelBackend(s.params)).camera.pose((0.0, 0.0, 0.0))
     assert (pose.x, pose.height) == pytest.approx((0.25, 0.2))
 

@@ -33,25 +33,45 @@ def test_the_steps_add_up_to_the_whole_loop(backend):
 
 
 def test_the_command_prints_the_breakdown_and_a_profile(capsys):
-    assert loop_bench.main(["--backend", "model", "--resolutions", "160x120", "--duration", "0.5",
-                            "--repeats", "1", "--profile", "5"]) == 0
+    assert (
+        loop_bench.main(
+            [
+                "--backend",
+                "model",
+                "--resolutions",
+                "160x120",
+                "--duration",
+                "0.5",
+                "--repeats",
+                "1",
+                "--profile",
+                "5",
+            ]
+        )
+        == 0
+    )
     out = capsys.readouterr().out
     for label in loop_bench.STEPS.values():
         assert label in out
     assert "the loop as users run it (no timers, no records)" in out
-    for what in ("the timed run against the design's time in it",
-                 "the loop against the design alone, wall clock",
-                 "the loop against the design alone, CPU time"):
+    for what in (
+        "the timed run against the design's time in it",
+        "the loop against the design alone, wall clock",
+        "the loop against the design alone, CPU time",
+    ):
         assert f"{what}: whole " in out and "(target 160x120: <= 2.2x, <= 1.2x)" in out
     assert "function calls" in out and "tottime" in out
 
 
-@pytest.mark.parametrize("argv, message", [
-    (["--repeats", "0"], "--repeats"),
-    (["--duration", "nan"], "--duration"),
-    (["--profile", "-1"], "--profile"),
-    (["--resolutions", "160by120"], "WIDTHxHEIGHT"),
-])
+@pytest.mark.parametrize(
+    "argv, message",
+    [
+        (["--repeats", "0"], "--repeats"),
+        (["--duration", "nan"], "--duration"),
+        (["--profile", "-1"], "--profile"),
+        (["--resolutions", "160by120"], "WIDTHxHEIGHT"),
+    ],
+)
 def test_bad_options_are_usage_errors(argv, message):
     with pytest.raises(UsageError, match=message):
         loop_bench.main(argv)

@@ -24,8 +24,9 @@ def trajectory(found, dist, in_view=None, x=None):
 
 
 def test_distances_fractions_and_path():
-    tr = trajectory([0, 1, 1, 0], [2.0, 1.0, np.nan, 3.0], in_view=[1, 1, 0, 0],
-                    x=[0.0, 0.3, 0.7, 0.7])
+    tr = trajectory(
+        [0, 1, 1, 0], [2.0, 1.0, np.nan, 3.0], in_view=[1, 1, 0, 0], x=[0.0, 0.3, 0.7, 0.7]
+    )
     m = compute_metrics(tr, [], {"person": 1, "wall": 0}, PERIOD)
     assert m["min_distance_m"] == 1.0 and m["mean_distance_m"] == 2.0  # NaN ignored
     assert m["target_in_view_fraction"] == 0.5 and m["found_fraction"] == 0.5
@@ -44,10 +45,21 @@ def test_no_target_at_all():
 
 
 def summary_of(m, checks, **extra):
-    return {"scenario": "x", "backend": "model", "resolution": "160x120", "seed": 0,
-            "frames": 2, "sim_time_s": 0.2, "wall_time_s": 0.01, "ms_per_frame": 5.0,
-            "realtime_factor": 20.0, **m, "checks": checks, "verdict": verdict(checks),
-            **extra}
+    return {
+        "scenario": "x",
+        "backend": "model",
+        "resolution": "160x120",
+        "seed": 0,
+        "frames": 2,
+        "sim_time_s": 0.2,
+        "wall_time_s": 0.01,
+        "ms_per_frame": 5.0,
+        "realtime_factor": 20.0,
+        **m,
+        "checks": checks,
+        "verdict": verdict(checks),
+        **extra,
+    }
 
 
 def test_a_run_without_a_target_person_says_so():
@@ -62,8 +74,10 @@ def test_a_run_without_a_target_person_says_so():
     assert "None" not in text
     assert "  target: none in the scenario (the design reported found in 0% of frames" in text
     assert "  distance: n/a (no target person)" in text
-    assert "[FAIL] mean_distance_max_m: no target person: no distance to compare (limit <= " \
-           "3.5 m)" in text
+    assert (
+        "[FAIL] mean_distance_max_m: no target person: no distance to compare (limit <= "
+        "3.5 m)" in text
+    )
 
 
 def test_a_run_too_fast_to_time_still_prints():
@@ -78,8 +92,14 @@ def events(*items):
 
 def test_loss_episodes_and_reacquisition():
     tr = trajectory([1] * 100, [1.0] * 100)
-    ev = events((0.0, "target found"), (2.0, "target lost"), (3.5, "search started"),
-                (4.0, "target found"), (6.0, "target lost"), (6.5, "target found"))
+    ev = events(
+        (0.0, "target found"),
+        (2.0, "target lost"),
+        (3.5, "search started"),
+        (4.0, "target found"),
+        (6.0, "target lost"),
+        (6.5, "target found"),
+    )
     m = compute_metrics(tr, ev, {}, PERIOD)
     assert m["losses"] == 2 and m["searched_losses"] == 1 and m["searches"] == 1
     assert m["reacquire_times_s"] == [2.0, 0.5] and m["unrecovered_losses_s"] == []
@@ -91,12 +111,14 @@ def test_loss_episodes_and_reacquisition():
 
 def test_reacquisition_needs_a_search_that_ended():
     tr = trajectory([1] * 100, [1.0] * 100)  # 10 s
-    short = compute_metrics(tr, events((0.0, "target found"), (2.0, "target lost"),
-                                       (2.2, "target found")), {}, PERIOD)
+    short = compute_metrics(
+        tr, events((0.0, "target found"), (2.0, "target lost"), (2.2, "target found")), {}, PERIOD
+    )
     (c,) = evaluate_checks({"reacquired_within_s": 5.0}, short)
     assert not c["passed"] and "never lost long enough" in c["text"]
-    open_end = compute_metrics(tr, events((0.0, "target found"), (8.0, "target lost"),
-                                          (9.5, "search started")), {}, PERIOD)
+    open_end = compute_metrics(
+        tr, events((0.0, "target found"), (8.0, "target lost"), (9.5, "search started")), {}, PERIOD
+    )
     assert open_end["unrecovered_losses_s"] == [2.0]  # run ends at 10.0 s
     (c,) = evaluate_checks({"reacquired_within_s": 5.0}, open_end)
     assert not c["passed"] and "ended before" in c["text"]
@@ -105,14 +127,18 @@ def test_reacquisition_needs_a_search_that_ended():
 
 
 def test_each_check_compares_with_its_limit():
-    m = compute_metrics(trajectory([1, 1, 1, 1], [1.0, 0.8, 0.6, 1.4], in_view=[1, 1, 1, 0]),
-                        [], {"person": 0, "wall": 2, "furniture": 0}, PERIOD)
+    m = compute_metrics(
+        trajectory([1, 1, 1, 1], [1.0, 0.8, 0.6, 1.4], in_view=[1, 1, 1, 0]),
+        [],
+        {"person": 0, "wall": 2, "furniture": 0},
+        PERIOD,
+    )
     limits = {
         "acquired_within_s": 0.0,
-        "mean_distance_max_m": 0.9,       # mean 0.95: fails
-        "min_distance_min_m": 0.6,        # min 0.6: passes (inclusive)
+        "mean_distance_max_m": 0.9,  # mean 0.95: fails
+        "min_distance_min_m": 0.6,  # min 0.6: passes (inclusive)
         "max_person_collisions": 0,
-        "max_wall_collisions": 1,          # 2: fails
+        "max_wall_collisions": 1,  # 2: fails
         "max_furniture_collisions": 0,
         "target_in_view_min_fraction": 0.75,
         "found_min_fraction": 1.0,
@@ -120,9 +146,13 @@ def test_each_check_compares_with_its_limit():
     checks = evaluate_checks(limits, m)
     assert [c["name"] for c in checks] == list(limits)
     assert {c["name"]: c["passed"] for c in checks} == {
-        "acquired_within_s": True, "mean_distance_max_m": False, "min_distance_min_m": True,
-        "max_person_collisions": True, "max_wall_collisions": False,
-        "max_furniture_collisions": True, "target_in_view_min_fraction": True,
+        "acquired_within_s": True,
+        "mean_distance_max_m": False,
+        "min_distance_min_m": True,
+        "max_person_collisions": True,
+        "max_wall_collisions": False,
+        "max_furniture_collisions": True,
+        "target_in_view_min_fraction": True,
         "found_min_fraction": True,
     }
     assert verdict(checks) == "fail" and verdict([c for c in checks if c["passed"]]) == "pass"
@@ -132,9 +162,20 @@ def test_each_check_compares_with_its_limit():
 def test_human_summary_mentions_failures():
     m = compute_metrics(trajectory([1, 1], [1.0, 1.0]), [], {"person": 1}, PERIOD)
     checks = evaluate_checks({"max_person_collisions": 0}, m)
-    s = {"scenario": "x", "backend": "model", "resolution": "160x120", "seed": 0,
-         "frames": 2, "sim_time_s": 0.2, "wall_time_s": 0.01, "ms_per_frame": 5.0,
-         "realtime_factor": 20.0, **m, "checks": checks, "verdict": verdict(checks)}
+    s = {
+        "scenario": "x",
+        "backend": "model",
+        "resolution": "160x120",
+        "seed": 0,
+        "frames": 2,
+        "sim_time_s": 0.2,
+        "wall_time_s": 0.01,
+        "ms_per_frame": 5.0,
+        "realtime_factor": 20.0,
+        **m,
+        "checks": checks,
+        "verdict": verdict(checks),
+    }
     text = format_summary(s)
     assert "[FAIL] max_person_collisions: 1 collision(s) with person" in text
     assert text.endswith("verdict: FAIL")

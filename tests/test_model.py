@@ -457,8 +457,9 @@ def test_model_rejects_bad_frames():
 PUBLISHED = FollowTargetParams.published()
 
 
-@pytest.mark.parametrize("count,ge,gt", [(127, False, False), (128, True, False),
-                                         (129, True, True)])
+@pytest.mark.parametrize(
+    "count,ge,gt", [(127, False, False), (128, True, False), (129, True, True)]
+)
 def test_found_rule_by_hand(count, ge, gt):
     assert is_found(count, FollowTargetParams()) is ge
     assert is_found(count, PUBLISHED) is gt
@@ -485,13 +486,23 @@ def test_groups_shifted_by_one_column_by_hand():
     assert centroid_leds((104, 0, 0, 0, 0, 0, 0, 0), 104, True, groups) == 0x01
 
 
-@pytest.mark.parametrize("speed,code,expected", [
-    (600, 0x01, (325, 600)), (600, 0x02, (375, 600)), (600, 0x04, (425, 600)),
-    (600, 0x08, (475, 600)), (600, 0x10, (600, 475)), (600, 0x80, (600, 325)),
-    (350, 0x18, (350, 350)), (150, 0x40, (150, -75)),
-    (-250, 0x01, (-250, 25)), (-450, 0x80, (-175, -450)), (-450, 0x18, (-450, -450)),
-    (600, 0x00, (0, 0)),  # never seen
-])
+@pytest.mark.parametrize(
+    "speed,code,expected",
+    [
+        (600, 0x01, (325, 600)),
+        (600, 0x02, (375, 600)),
+        (600, 0x04, (425, 600)),
+        (600, 0x08, (475, 600)),
+        (600, 0x10, (600, 475)),
+        (600, 0x80, (600, 325)),
+        (350, 0x18, (350, 350)),
+        (150, 0x40, (150, -75)),
+        (-250, 0x01, (-250, 25)),
+        (-450, 0x80, (-175, -450)),
+        (-450, 0x18, (-450, -450)),
+        (600, 0x00, (0, 0)),  # never seen
+    ],
+)
 def test_table_command_by_hand(speed, code, expected):
     assert table_command(speed, code, PUBLISHED) == expected
 

@@ -11,8 +11,15 @@ from fpga_robotics.sim import mutation
 from fpga_robotics.sim.backends import get_backend
 
 PARAMS = FollowTargetParams(width=80, height=60)
-MODULES = {"", "color_filter", "motor", "tracker", "tracker.counter", "tracker.results",
-           "tracker.results.divider"}
+MODULES = {
+    "",
+    "color_filter",
+    "motor",
+    "tracker",
+    "tracker.counter",
+    "tracker.results",
+    "tracker.results.divider",
+}
 
 try:
     mutation.find_yosys()
@@ -53,15 +60,25 @@ def test_each_mutant_names_its_component_and_python_line(mutants):
 
 
 def test_parse_a_known_line():
-    line = ("mutate -mode cnot1 -module follow_target -cell $flatten\\tracker.\\results.$331 "
-            "-port Y -portbit 3 -ctrlbit 7 -wire \\tracker.results.quotient -wirebit 2 "
-            "-src /x/fpga_robotics/hw/tracker.py:226 -src /x/fpga_robotics/hw/tracker.py:226")
+    line = (
+        "mutate -mode cnot1 -module follow_target -cell $flatten\\tracker.\\results.$331 "
+        "-port Y -portbit 3 -ctrlbit 7 -wire \\tracker.results.quotient -wirebit 2 "
+        "-src /x/fpga_robotics/hw/tracker.py:226 -src /x/fpga_robotics/hw/tracker.py:226"
+    )
     m = mutation._parse(5, line)
     assert (m.index, m.mode, m.module, m.port, m.portbit, m.ctrlbit) == (
-        5, "cnot1", "tracker.results", "Y", 3, 7)
+        5,
+        "cnot1",
+        "tracker.results",
+        "Y",
+        3,
+        7,
+    )
     assert (m.signal, m.bit) == ("tracker.results.quotient", 2)
-    assert m.describe() == ("#5 tracker.results: tracker.results.quotient[2] XNOR bit 7 "
-                            "(/x/fpga_robotics/hw/tracker.py:226)")
+    assert m.describe() == (
+        "#5 tracker.results: tracker.results.quotient[2] XNOR bit 7 "
+        "(/x/fpga_robotics/hw/tracker.py:226)"
+    )
     assert mutation.select_width(1) == 1 and mutation.select_width(40) == 6
     assert mutation.select_width(63) == 6 and mutation.select_width(64) == 7
 
@@ -96,13 +113,13 @@ def test_one_build_runs_the_design_and_each_mutant(tmp_path):
     from fpga_robotics.sim.backends.port_map import follow_target_port_map
 
     listed = mutation.list_mutants(PARAMS, 400, seed=1)
-    stuck = next((m for m in listed if m.signal == "filtered__payload" and m.mode == "const1"),
-                 None)
+    stuck = next(
+        (m for m in listed if m.signal == "filtered__payload" and m.mode == "const1"), None
+    )
     assert stuck is not None, "no stuck-at-1 on the filtered payload among 400 mutants"
     others = [m for m in listed if m is not stuck][:5]
     (tmp_path / "m.v").write_text(mutation.mutant_netlist(PARAMS, [stuck, *others]))
-    (tmp_path / "pm.toml").write_text(follow_target_port_map(PARAMS)
-                                      + "\n[runtime]\nmutsel = 0\n")
+    (tmp_path / "pm.toml").write_text(follow_target_port_map(PARAMS) + "\n[runtime]\nmutsel = 0\n")
     rng = np.random.default_rng(3)
     frames = [rng.integers(0, 256, (60, 80, 3), dtype=np.uint8) for _ in range(2)]
     red = np.zeros((60, 80, 3), np.uint8)
@@ -110,8 +127,9 @@ def test_one_build_runs_the_design_and_each_mutant(tmp_path):
     frames.append(red)
     model = get_backend("model", PARAMS)
     want = [model.process_frame(f) for f in frames]
-    design = ForeignVerilatorBackend(PARAMS, files=[tmp_path / "m.v"],
-                                     port_map=tmp_path / "pm.toml")
+    design = ForeignVerilatorBackend(
+        PARAMS, files=[tmp_path / "m.v"], port_map=tmp_path / "pm.toml"
+    )
 
     def run(select):
         design.set_runtime("mutsel", select)
@@ -164,8 +182,10 @@ def test_scores_by_hand():
         return mutation.Mutant(i, "inv", module, "$1", "Y", 0, None, None, None, (), "")
 
     mods = by_module([m(1, "motor"), m(2, "motor"), m(3, ""), m(5, "motor")], unit, robot)
-    assert mods == {"motor": {"total": 3, "unit_caught": 3, "robot_caught": 1},
-                    "top": {"total": 1, "unit_caught": 1, "robot_caught": 0}}
+    assert mods == {
+        "motor": {"total": 3, "unit_caught": 3, "robot_caught": 1},
+        "top": {"total": 1, "unit_caught": 1, "robot_caught": 0},
+    }
 
 
 def test_bad_arguments_are_one_line_errors(tmp_path, monkeypatch):
@@ -173,20 +193,28 @@ def test_bad_arguments_are_one_line_errors(tmp_path, monkeypatch):
     import sys
 
     def run(*argv, env=None):
-        return subprocess.run([sys.executable, "-m", "fpga_robotics.mutation", *argv],
-                              check=False, capture_output=True, text=True, timeout=120,
-                              env=env)
+        return subprocess.run(
+            [sys.executable, "-m", "fpga_robotics.mutation", *argv],
+            check=False,
+            capture_output=True,
+            text=True,
+            timeout=120,
+            env=env,
+        )
 
-    for argv, message in ((["--mutants", "0"], "--mutants must be 1..4000, got 0"),
-                          (["--seed", "-1"], "--seed must be >= 0"),
-                          (["--width", "33"], "bad design parameter")):
+    for argv, message in (
+        (["--mutants", "0"], "--mutants must be 1..4000, got 0"),
+        (["--seed", "-1"], "--seed must be >= 0"),
+        (["--width", "33"], "bad design parameter"),
+    ):
         r = run(*argv, "--out", str(tmp_path / "o"))
         assert r.returncode == 2 and message in r.stderr and "Traceback" not in r.stderr
         assert len(r.stderr.strip().splitlines()) == 1
     import os
 
-    r = run("--mutants", "3", "--out", str(tmp_path / "o"),
-            env={**os.environ, "YOSYS": "no-such-yosys"})
+    r = run(
+        "--mutants", "3", "--out", str(tmp_path / "o"), env={**os.environ, "YOSYS": "no-such-yosys"}
+    )
     assert r.returncode == 2 and "YOSYS='no-such-yosys' is not an executable" in r.stderr
     assert not (tmp_path / "o" / "mutants.json").exists()
 
@@ -205,22 +233,50 @@ def test_a_mutant_runs_in_closed_loop_from_the_command_line(tmp_path, capsys):
 
     listed = mutation.list_mutants(PARAMS, 400, seed=1)
     stuck = next(m for m in listed if m.signal == "filtered__payload" and m.mode == "const1")
-    netlist, ports = write_mutant_design(PARAMS, [stuck, *[m for m in listed if m is not stuck][:5]],
-                                         tmp_path)
-    common = ["--scenario", "follow_person", "--resolution", "80x60", "--duration", "2",
-              "--rerun", "off", "--quiet"]
+    netlist, ports = write_mutant_design(
+        PARAMS, [stuck, *[m for m in listed if m is not stuck][:5]], tmp_path
+    )
+    common = [
+        "--scenario",
+        "follow_person",
+        "--resolution",
+        "80x60",
+        "--duration",
+        "2",
+        "--rerun",
+        "off",
+        "--quiet",
+    ]
     summaries = {}
-    for name, extra in (("builtin", ["--backend", "verilator"]),
-                        ("select0", ["--design", f"verilog:{netlist}", "--ports", ports,
-                                     "--runtime", "mutsel=0"]),
-                        ("stuck", ["--design", f"verilog:{netlist}", "--ports", ports,
-                                   "--runtime", f"mutsel={stuck.index}"])):
+    for name, extra in (
+        ("builtin", ["--backend", "verilator"]),
+        ("select0", ["--design", f"verilog:{netlist}", "--ports", ports, "--runtime", "mutsel=0"]),
+        (
+            "stuck",
+            [
+                "--design",
+                f"verilog:{netlist}",
+                "--ports",
+                ports,
+                "--runtime",
+                f"mutsel={stuck.index}",
+            ],
+        ),
+    ):
         path = tmp_path / f"{name}.json"
         assert run.main([*common, *extra, "--summary", str(path)]) in (0, 1)
         summaries[name] = json.loads(path.read_text())
     capsys.readouterr()
-    keys = ("frames", "min_distance_m", "mean_distance_m", "found_fraction", "path_length_m",
-            "collisions", "verdict", "max_wheel_command_step_dps")
+    keys = (
+        "frames",
+        "min_distance_m",
+        "mean_distance_m",
+        "found_fraction",
+        "path_length_m",
+        "collisions",
+        "verdict",
+        "max_wheel_command_step_dps",
+    )
     for name in ("select0", "stuck"):
         assert summaries[name]["backend"] == "verilator-foreign"
         assert {k: summaries[name][k] for k in keys} == {k: summaries["builtin"][k] for k in keys}
@@ -245,10 +301,12 @@ def test_the_robot_judge_catches_a_wheel_bug_and_not_a_filtered_image_bug(tmp_pa
     wheel = next(m for m in listed if (m.signal, m.bit, m.mode) == ("motor_left", 12, "inv"))
     chosen = [mutation.Mutant(**{**m.__dict__, "index": i}) for i, m in ((1, stuck), (2, wheel))]
     netlist, ports = write_mutant_design(PARAMS, chosen, tmp_path)
-    campaign = load_campaign({"name": "tiny", "scenarios": ["follow_person"], "seeds": "0-1",
-                              "duration": 4.0})
-    baseline, verdicts = robot_judge(campaign, netlist, ports, "80x60", [1, 2], str(tmp_path),
-                                     workers=1, say=lambda text: None)
+    campaign = load_campaign(
+        {"name": "tiny", "scenarios": ["follow_person"], "seeds": "0-1", "duration": 4.0}
+    )
+    baseline, verdicts = robot_judge(
+        campaign, netlist, ports, "80x60", [1, 2], str(tmp_path), workers=1, say=lambda text: None
+    )
     assert baseline["passing"] == [0, 1] and len(baseline["runs"]) == 2
     assert baseline["judged_here"] == 2
     assert "--runtime mutsel=0" in " ".join(baseline["runs"][0])
@@ -262,8 +320,17 @@ def test_the_robot_judge_catches_a_wheel_bug_and_not_a_filtered_image_bug(tmp_pa
     assert blind_spots(unit, robot) == [1]
     lines = (tmp_path / "robot.jsonl").read_text().splitlines()
     assert sorted(json.loads(line)["index"] for line in lines) == [1, 2]
-    _again, resumed = robot_judge(campaign, netlist, ports, "80x60", [1, 2], str(tmp_path),
-                                 workers=1, resume=True, say=lambda text: None)
+    _again, resumed = robot_judge(
+        campaign,
+        netlist,
+        ports,
+        "80x60",
+        [1, 2],
+        str(tmp_path),
+        workers=1,
+        resume=True,
+        say=lambda text: None,
+    )
     assert {k: v["caught"] for k, v in resumed.items()} == robot
     assert _again["judged_here"] == 0
     assert (tmp_path / "robot.jsonl").read_text().splitlines() == lines

@@ -96,30 +96,55 @@ def _cli(argv, capsys):
 @pytest.mark.slow  # a Verilator build of the mutant netlist
 def test_mutate_design_prints_the_scores_of_a_users_design(tmp_path, capsys):
     out = tmp_path / "m"
-    code, text, _ = _cli(["mutate", "--design", f"{DESIGNS}/wall_stop.py:WallStop",
-                          "--param", "clock_hz=100000", "--mutants", "20", "--cycles",
-                          "20000", "--out", str(out), "--quiet"], capsys)
+    code, text, _ = _cli(
+        [
+            "mutate",
+            "--design",
+            f"{DESIGNS}/wall_stop.py:WallStop",
+            "--param",
+            "clock_hz=100000",
+            "--mutants",
+            "20",
+            "--cycles",
+            "20000",
+            "--out",
+            str(out),
+            "--quiet",
+        ],
+        capsys,
+    )
     assert code == 0
     result = json.loads((out / "mutants.json").read_text())
     caught = sum(m["unit"]["caught"] for m in result["mutants"])
-    assert result["unit"] == {"total": 20, "caught": caught, "equivalent": 20 - caught,
-                              "score": caught / 20}
+    assert result["unit"] == {
+        "total": 20,
+        "caught": caught,
+        "equivalent": 20 - caught,
+        "score": caught / 20,
+    }
     assert result["design"]["params"] == {"clock_hz": 100000}
     lines = text.splitlines()
     assert lines[0].startswith("20 mutants of WallStop (seed 1), 20000 cycles of random inputs")
-    assert lines[1] == (f"unit judge (against the unmutated design): {caught} caught, "
-                        f"{20 - caught} equivalent on these inputs: score "
-                        f"{100 * caught / 20:.1f}%")
+    assert lines[1] == (
+        f"unit judge (against the unmutated design): {caught} caught, "
+        f"{20 - caught} equivalent on these inputs: score "
+        f"{100 * caught / 20:.1f}%"
+    )
     assert {m["module"] or "top" for m in result["mutants"]} <= {"top", "us"}
 
 
-@pytest.mark.parametrize("argv, message", [
-    (["--design", "verilog:x.v"], "a Verilog design is not mutated here"),
-    (["--design", "wall_stop.py:WallStop", "--campaign", "mutation"],
-     "with --design only the unit judge runs"),
-    (["--design", "wall_stop.py:WallStop", "--param", "nope"], "--param must be NAME=VALUE"),
-    (["--cycles", "5"], "--param and --cycles go with --design REF"),
-])
+@pytest.mark.parametrize(
+    "argv, message",
+    [
+        (["--design", "verilog:x.v"], "a Verilog design is not mutated here"),
+        (
+            ["--design", "wall_stop.py:WallStop", "--campaign", "mutation"],
+            "with --design only the unit judge runs",
+        ),
+        (["--design", "wall_stop.py:WallStop", "--param", "nope"], "--param must be NAME=VALUE"),
+        (["--cycles", "5"], "--param and --cycles go with --design REF"),
+    ],
+)
 def test_bad_design_arguments_are_one_line(argv, message, capsys, monkeypatch):
     monkeypatch.chdir(DESIGNS)
     code, _, err = _cli(["mutate", *argv], capsys)
@@ -133,12 +158,28 @@ def test_follow_target_against_itself_scores_as_against_the_model(tmp_path, caps
     runs = {}
     for against in ("model", "design"):
         out = tmp_path / against
-        code, text, _ = _cli(["mutate", "--mutants", "12", "--width", "80", "--height", "60",
-                              "--quiet", "--against", against, "--out", str(out)], capsys)
+        code, text, _ = _cli(
+            [
+                "mutate",
+                "--mutants",
+                "12",
+                "--width",
+                "80",
+                "--height",
+                "60",
+                "--quiet",
+                "--against",
+                against,
+                "--out",
+                str(out),
+            ],
+            capsys,
+        )
         assert code == 0
         runs[against] = json.loads((out / "mutants.json").read_text())
         assert runs[against]["against"] == against
     assert "unit judge (against the unmutated design): " in text
-    assert [m["unit"] for m in runs["model"]["mutants"]] == \
-        [m["unit"] for m in runs["design"]["mutants"]]
+    assert [m["unit"] for m in runs["model"]["mutants"]] == [
+        m["unit"] for m in runs["design"]["mutants"]
+    ]
     assert runs["model"]["unit"] == runs["design"]["unit"]

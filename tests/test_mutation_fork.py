@@ -33,13 +33,22 @@ def test_forked_mutant_runs_equal_their_full_runs(tmp_path):
     listed = mutation.list_mutants(PARAMS, 3000, seed=1)
     # Mutants the robot acts on (wheel commands) and ones it may not (the filtered image,
     # the centroid, the tracker's counters): forked at many frames, or never.
-    picks = [next(m for m in listed if (m.signal, m.bit, m.mode) == ("motor_left", 12, "inv")),
-             next(m for m in listed if m.signal == "filtered__payload" and m.mode == "const1")]
+    picks = [
+        next(m for m in listed if (m.signal, m.bit, m.mode) == ("motor_left", 12, "inv")),
+        next(m for m in listed if m.signal == "filtered__payload" and m.mode == "const1"),
+    ]
     picks += [m for m in listed if m not in picks][::300][:6]
     chosen = [mutation.Mutant(**{**m.__dict__, "index": i}) for i, m in enumerate(picks, 1)]
     netlist, ports = write_mutant_design(PARAMS, chosen, tmp_path)
-    campaign = load_campaign({"name": "tiny", "scenarios": ["lost_target"], "seeds": "0",
-                              "duration": 3.0, "set": ["camera.noise_std=4"]})
+    campaign = load_campaign(
+        {
+            "name": "tiny",
+            "scenarios": ["lost_target"],
+            "seeds": "0",
+            "duration": 3.0,
+            "set": ["camera.noise_std=4"],
+        }
+    )
     spec = make_plan(campaign).runs[0]
     ref_argv = mutant_argv(spec.argv(), netlist, ports, 0, "80x60")
     verdicts = set()
@@ -49,6 +58,7 @@ def test_forked_mutant_runs_equal_their_full_runs(tmp_path):
         forked = execute_forked(argv, ref_argv)
         assert forked["status"] == full["status"], m.describe()
         assert {k: v for k, v in forked["summary"].items() if k not in TIMING_FIELDS} == {
-            k: v for k, v in full["summary"].items() if k not in TIMING_FIELDS}, m.describe()
+            k: v for k, v in full["summary"].items() if k not in TIMING_FIELDS
+        }, m.describe()
         verdicts.add(full["status"])
     assert verdicts == {"pass", "fail"}  # both outcomes compared

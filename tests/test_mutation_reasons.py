@@ -19,8 +19,15 @@ W = 160
 
 
 def _verdict(frames=104, differing_frames=0, failure=None, max_difference=None, **differing):
-    v = UnitVerdict(index=1, caught=True, first_frame=0, failure=failure, frames=frames,
-                    frames_differing=differing_frames, max_difference=max_difference or {})
+    v = UnitVerdict(
+        index=1,
+        caught=True,
+        first_frame=0,
+        failure=failure,
+        frames=frames,
+        frames_differing=differing_frames,
+        max_difference=max_difference or {},
+    )
     v.differing.update(differing)
     return v
 
@@ -30,7 +37,8 @@ def test_outputs_no_check_or_wheel_uses():
     assert reason_class(v, W) == "filtered only"
     assert blind_spot_reason(v, W) == (
         "filtered only: differs in 70 of 104 unit frames, only on the filtered video output, "
-        "which no check or wheel uses")
+        "which no check or wheel uses"
+    )
     v = _verdict(differing_frames=3, centroid_leds=3, max_difference={"centroid_leds": 16})
     assert reason_class(v, W) == "LEDs only"
     assert blind_spot_reason(v, W) == "LEDs only: differs in 3 of 104 unit frames (centroid_leds)"
@@ -38,14 +46,21 @@ def test_outputs_no_check_or_wheel_uses():
 
 def test_small_steering_errors_by_their_size():
     # Centroid off by 1 px (5 px is the limit at 160 wide), wheels by 3 DPS (limit 20).
-    v = _verdict(differing_frames=21, centroid_x=21, motor_left=21, motor_right=21,
-                 max_difference={"centroid_x": 1, "motor_left": 3, "motor_right": 3})
+    v = _verdict(
+        differing_frames=21,
+        centroid_x=21,
+        motor_left=21,
+        motor_right=21,
+        max_difference={"centroid_x": 1, "motor_left": 3, "motor_right": 3},
+    )
     assert reason_class(v, W) == "small steering error"
     assert blind_spot_reason(v, W) == (
         "small steering error: differs in 21 of 104 unit frames (centroid_x, motor_left, "
-        "motor_right); centroid off by up to 1 px; wheels off by up to 3 DPS")
+        "motor_right); centroid off by up to 1 px; wheels off by up to 3 DPS"
+    )
     assert reason_class(dataclasses.replace(v, max_difference={"centroid_x": 5}), W) == (
-        "small steering error")
+        "small steering error"
+    )
     # 6 px is no longer small at 160 wide, but is at 320 wide (limit 10 px); in 21 of 104
     # frames (more than 5 %) it is no rare state either.
     wide = dataclasses.replace(v, max_difference={"centroid_x": 6, "motor_left": 3})
@@ -59,19 +74,26 @@ def test_rare_states_and_the_rest():
     v = _verdict(differing_frames=4, motor_right=4, max_difference={"motor_right": 2048})
     assert reason_class(v, W) == "rare state"
     assert blind_spot_reason(v, W) == (
-        "rare state: differs in 4 of 104 unit frames (motor_right); wheels off by up to "
-        "2048 DPS")
+        "rare state: differs in 4 of 104 unit frames (motor_right); wheels off by up to 2048 DPS"
+    )
     v = _verdict(differing_frames=6, motor_right=6, max_difference={"motor_right": 2048})
     assert reason_class(v, W) == "other"
-    v = _verdict(differing_frames=67, found=3, proximity=12, centroid_x=49, motor_left=67,
-                 max_difference={"found": 1, "proximity": 3, "centroid_x": 80,
-                                 "motor_left": 450})
+    v = _verdict(
+        differing_frames=67,
+        found=3,
+        proximity=12,
+        centroid_x=49,
+        motor_left=67,
+        max_difference={"found": 1, "proximity": 3, "centroid_x": 80, "motor_left": 450},
+    )
     assert blind_spot_reason(v, W) == (
         "other: differs in 67 of 104 unit frames (found, proximity, centroid_x, motor_left); "
-        "centroid off by up to 80 px; wheels off by up to 450 DPS; proximity off by up to 3")
+        "centroid off by up to 80 px; wheels off by up to 450 DPS; proximity off by up to 3"
+    )
     v = _verdict(frames=3, differing_frames=1, failure="no frame_done within 20000 cycles")
     assert blind_spot_reason(v, W) == (
-        "frame protocol: no frame_done within 20000 cycles (the closed loop went on)")
+        "frame protocol: no frame_done within 20000 cycles (the closed loop went on)"
+    )
 
 
 class _OffByThree:
@@ -97,8 +119,9 @@ class _OffByThree:
         if k == 2:
             r = dataclasses.replace(r, centroid_x=r.centroid_x + 3)
         if k == 5:
-            r = dataclasses.replace(r, motor_right=r.motor_right - 10,
-                                    filtered=np.zeros_like(r.filtered) + 1)
+            r = dataclasses.replace(
+                r, motor_right=r.motor_right - 10, filtered=np.zeros_like(r.filtered) + 1
+            )
         return r
 
 
@@ -123,25 +146,34 @@ def test_the_report_gives_each_blind_spot_its_reason(tmp_path):
     def mutant(i, module, signal):
         return Mutant(i, "inv", module, "$1", "Y", 0, None, signal, 0, ("hw/x.py:1",), "")
 
-    mutants = [mutant(1, "color_filter", "filtered__payload"),
-               mutant(2, "tracker.counter", "px"), mutant(3, "motor", "motor_left")]
+    mutants = [
+        mutant(1, "color_filter", "filtered__payload"),
+        mutant(2, "tracker.counter", "px"),
+        mutant(3, "motor", "motor_left"),
+    ]
     filtered = _verdict(differing_frames=70, filtered=70)
-    small = _verdict(differing_frames=21, centroid_x=21,
-                     max_difference={"centroid_x": 1, "motor_left": 3})
+    small = _verdict(
+        differing_frames=21, centroid_x=21, max_difference={"centroid_x": 1, "motor_left": 3}
+    )
     wheel = _verdict(differing_frames=90, motor_left=90, max_difference={"motor_left": 4096})
     for k, v in enumerate((filtered, small, wheel), start=1):
         v.index = k
-    robot = {1: {"caught": False, "replay": "python -m fpga_robotics.run --runtime mutsel=1"},
-             2: {"caught": False, "replay": None},
-             3: {"caught": True, "status": "fail", "failed_checks": ["max_wheel_command_dps"]}}
+    robot = {
+        1: {"caught": False, "replay": "python -m fpga_robotics.run --runtime mutsel=1"},
+        2: {"caught": False, "replay": None},
+        3: {"caught": True, "status": "fail", "failed_checks": ["max_wheel_command_dps"]},
+    }
     baseline = {"runs": [["--scenario", "approach"]], "passing": [0]}
-    path = write_report(str(tmp_path), "mutation", mutants, [filtered, small, wheel], robot,
-                        baseline, {}, 160)
+    path = write_report(
+        str(tmp_path), "mutation", mutants, [filtered, small, wheel], robot, baseline, {}, 160
+    )
     with open(path) as f:
         text = f.read()
     assert "why no run shows it" in text
     assert "filtered only: differs in 70 of 104 unit frames" in text
-    assert ("small steering error: differs in 21 of 104 unit frames (centroid_x); centroid "
-            "off by up to 1 px; wheels off by up to 3 DPS") in text
+    assert (
+        "small steering error: differs in 21 of 104 unit frames (centroid_x); centroid "
+        "off by up to 1 px; wheels off by up to 3 DPS"
+    ) in text
     assert "Blind spots: caught by the unit judge, missed by every run (2)" in text
     assert "other: differs in 90" not in text and "max_wheel_command_dps" in text

@@ -22,13 +22,25 @@ def test_the_skeleton_passes_its_own_test(tmp_path, capsys, monkeypatch):
     code, out, _ = _cli(["new", "rover"], capsys)
     assert code == 0 and "next: cd rover && python -m pytest" in out
     project = tmp_path / "rover"
-    assert sorted(p.relative_to(project).as_posix() for p in project.rglob("*") if p.is_file()) \
-        == ["README.md", "design.py", "pyproject.toml", "scenario.toml", "tests/test_scenario.py"]
+    assert sorted(p.relative_to(project).as_posix() for p in project.rglob("*") if p.is_file()) == [
+        "README.md",
+        "design.py",
+        "pyproject.toml",
+        "scenario.toml",
+        "tests/test_scenario.py",
+    ]
     assert 'name = "rover"' in (project / "scenario.toml").read_text()
     assert not [p for p in tmp_path.iterdir() if p.name != "rover"]  # no staging folder left
     env = {k: v for k, v in os.environ.items() if k != "PYTEST_ADDOPTS"}
-    done = subprocess.run([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider"],
-                          cwd=project, capture_output=True, text=True, timeout=300, env=env, check=False)
+    done = subprocess.run(
+        [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider"],
+        cwd=project,
+        capture_output=True,
+        text=True,
+        timeout=300,
+        env=env,
+        check=False,
+    )
     assert done.returncode == 0, done.stdout + done.stderr
     assert "1 passed" in done.stdout
 
@@ -39,9 +51,14 @@ def test_the_skeleton_test_fails_when_the_design_breaks(tmp_path, monkeypatch, c
     assert _cli(["new", "broken"], capsys)[0] == 0
     design = tmp_path / "broken" / "design.py"
     design.write_text(design.read_text().replace("self.stopped.eq(1)", "self.stopped.eq(0)"))
-    done = subprocess.run([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider"],
-                          cwd=tmp_path / "broken", capture_output=True, text=True, timeout=300,
-                          check=False)
+    done = subprocess.run(
+        [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider"],
+        cwd=tmp_path / "broken",
+        capture_output=True,
+        text=True,
+        timeout=300,
+        check=False,
+    )
     assert done.returncode == 1
     assert "[fail] max_wall_collisions" in done.stdout
 
@@ -52,8 +69,10 @@ def test_a_non_empty_folder_is_refused(tmp_path, capsys, monkeypatch):
     (tmp_path / "taken" / "notes.txt").write_text("mine")
     code, out, err = _cli(["new", "taken"], capsys)
     assert code == 2 and out == ""
-    assert err.strip() == ("fpga-robotics new: error: folder 'taken' exists and is not empty; "
-                           "give a new name or empty it")
+    assert err.strip() == (
+        "fpga-robotics new: error: folder 'taken' exists and is not empty; "
+        "give a new name or empty it"
+    )
     assert [p.name for p in (tmp_path / "taken").iterdir()] == ["notes.txt"]
     assert sorted(p.name for p in tmp_path.iterdir()) == ["taken"]
     code, _, err = _cli(["new", "bad name!"], capsys)

@@ -17,9 +17,14 @@ def test_defaults_at_160x120():
     assert (p.kp_num, p.kp_shift, p.max_dps, p.lost_frames, p.search_dps) == (3, 0, 512, 15, 250)
     assert p.x_bits == 8  # centroid_x is 8 bits at 160x120 (docs/contract.md, Ports)
     # The knobs of the published design, at this design's choices.
-    assert (p.found_rule, p.group_column_offset, p.motor_law, p.lost_motion,
-            p.search_side_from, p.centred_search_side) == ("ge", 0, "p_control", "hold",
-                                                           "centroid", "right")
+    assert (
+        p.found_rule,
+        p.group_column_offset,
+        p.motor_law,
+        p.lost_motion,
+        p.search_side_from,
+        p.centred_search_side,
+    ) == ("ge", 0, "p_control", "hold", "centroid", "right")
     assert p.steer_dps == (125, 175, 225, 275)
 
 
@@ -97,8 +102,12 @@ def test_wrong_types_raise_type_error():
 
 
 def test_numpy_integers_are_accepted_and_stored_as_int():
-    p = FollowTargetParams(width=np.int64(320), height=np.uint16(240), kp_num=np.int32(2),
-                           base_dps=tuple(np.arange(8, dtype=np.int16)))
+    p = FollowTargetParams(
+        width=np.int64(320),
+        height=np.uint16(240),
+        kp_num=np.int32(2),
+        base_dps=tuple(np.arange(8, dtype=np.int16)),
+    )
     assert (p.width, p.height, p.kp_num) == (320, 240, 2)
     assert all(type(v) is int for v in (p.width, p.height, p.kp_num, *p.base_dps))
     assert p == FollowTargetParams(width=320, height=240, kp_num=2, base_dps=tuple(range(8)))

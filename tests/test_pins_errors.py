@@ -42,30 +42,56 @@ def pins(request):
         yield backend
 
 
-@pytest.mark.parametrize("call, message", [
-    (lambda p: p.peek("z"), r"unknown port 'z'; the design's ports: x, s, pixels__payload, pixels__valid, y$"),
-    (lambda p: p.poke("z", 1), r"unknown port 'z'"),
-    (lambda p: p.watch(["y", "z"]), r"unknown port 'z'"),
-    (lambda p: p.watch(["x"]), r"port 'x' is an input; only outputs can be watched"),
-    (lambda p: p.poke("y", 1), (r"port 'y' is an output of the design; only inputs can be "
-                               r"driven \(inputs: x, s, pixels__payload, pixels__valid\)")),
-    (lambda p: p.poke("pixels__valid", 1), r"driven by the pixel stream; use stream_frame"),
-    (lambda p: p.poke("x", 8), r"8 does not fit port 'x' \(3-bit unsigned: 0\.\.7\)"),
-    (lambda p: p.poke("x", -1), r"-1 does not fit port 'x'"),
-    (lambda p: p.poke("x", 1.5), r"the value for 'x' must be an int"),
-    (lambda p: p.schedule(p.cycle, "x", 1), (r"edge 5 is in the past \(cycle is 5\); schedule "
-                                            r"changes for edge 6 or later")),
-    (lambda p: p.run(-1), r"run needs a number of cycles >= 0"),
-    (lambda p: p.stream_frame(np.zeros((3, 2), np.uint16), PixelTiming(9, 4)),
-     (r"a frame must be a \(2, 3\) uint16 array of RGB444 pixels \(or \(2, 3, 3\) uint8 "
-     r"RGB888\), not uint16 \(3, 2\)")),
-    (lambda p: p.stream_frame(np.full((2, 3), 0x1000, np.uint16), PixelTiming(9, 4)),
-     r"a packed RGB444 frame holds 12-bit values; found one above 0xFFF"),
-    (lambda p: p.stream_frame(np.zeros((2, 3), np.uint16), PixelTiming(5, 4)),
-     r"the frame starts at edge 5, in the past \(cycle is 5\)"),
-    (lambda p: p.stream_frame(np.zeros((2, 3), np.uint16), PixelTiming(9, 2)),
-     r"line_period >= \(width - 1\) \* pixel_period \+ 1 = 3"),
-])
+@pytest.mark.parametrize(
+    "call, message",
+    [
+        (
+            lambda p: p.peek("z"),
+            r"unknown port 'z'; the design's ports: x, s, pixels__payload, pixels__valid, y$",
+        ),
+        (lambda p: p.poke("z", 1), r"unknown port 'z'"),
+        (lambda p: p.watch(["y", "z"]), r"unknown port 'z'"),
+        (lambda p: p.watch(["x"]), r"port 'x' is an input; only outputs can be watched"),
+        (
+            lambda p: p.poke("y", 1),
+            (
+                r"port 'y' is an output of the design; only inputs can be "
+                r"driven \(inputs: x, s, pixels__payload, pixels__valid\)"
+            ),
+        ),
+        (lambda p: p.poke("pixels__valid", 1), r"driven by the pixel stream; use stream_frame"),
+        (lambda p: p.poke("x", 8), r"8 does not fit port 'x' \(3-bit unsigned: 0\.\.7\)"),
+        (lambda p: p.poke("x", -1), r"-1 does not fit port 'x'"),
+        (lambda p: p.poke("x", 1.5), r"the value for 'x' must be an int"),
+        (
+            lambda p: p.schedule(p.cycle, "x", 1),
+            (
+                r"edge 5 is in the past \(cycle is 5\); schedule "
+                r"changes for edge 6 or later"
+            ),
+        ),
+        (lambda p: p.run(-1), r"run needs a number of cycles >= 0"),
+        (
+            lambda p: p.stream_frame(np.zeros((3, 2), np.uint16), PixelTiming(9, 4)),
+            (
+                r"a frame must be a \(2, 3\) uint16 array of RGB444 pixels \(or \(2, 3, 3\) uint8 "
+                r"RGB888\), not uint16 \(3, 2\)"
+            ),
+        ),
+        (
+            lambda p: p.stream_frame(np.full((2, 3), 0x1000, np.uint16), PixelTiming(9, 4)),
+            r"a packed RGB444 frame holds 12-bit values; found one above 0xFFF",
+        ),
+        (
+            lambda p: p.stream_frame(np.zeros((2, 3), np.uint16), PixelTiming(5, 4)),
+            r"the frame starts at edge 5, in the past \(cycle is 5\)",
+        ),
+        (
+            lambda p: p.stream_frame(np.zeros((2, 3), np.uint16), PixelTiming(9, 2)),
+            r"line_period >= \(width - 1\) \* pixel_period \+ 1 = 3",
+        ),
+    ],
+)
 def test_bad_calls(pins, call, message):
     pins.reset()
     pins.run(5)
@@ -81,16 +107,22 @@ def test_signed_inputs_take_their_range(pins):
     pins.poke("s", -16)
     assert pins.peek("s") == -16
     for bad in (-17, 16):
-        with pytest.raises(PinError, match=rf"{bad} does not fit port 's' \(5-bit signed: "
-                                           r"-16\.\.15\)"):
+        with pytest.raises(
+            PinError,
+            match=rf"{bad} does not fit port 's' \(5-bit signed: "
+            r"-16\.\.15\)",
+        ):
             pins.poke("s", bad)
 
 
 def test_a_frame_while_one_is_pending(pins):
     pins.reset()
     pins.stream_frame(np.ones((2, 3), np.uint16), PixelTiming(start=3, line_period=10))
-    with pytest.raises(PinError, match=r"a frame is still streaming \(its last pixel is at "
-                                       r"edge 15, cycle is 0\); run until frame_pending is"):
+    with pytest.raises(
+        PinError,
+        match=r"a frame is still streaming \(its last pixel is at "
+        r"edge 15, cycle is 0\); run until frame_pending is",
+    ):
         pins.stream_frame(np.ones((2, 3), np.uint16), PixelTiming(start=20, line_period=10))
     pins.run(15)
     assert not pins.frame_pending
@@ -99,16 +131,22 @@ def test_a_frame_while_one_is_pending(pins):
 
 def test_no_pixel_binding():
     source = PinDesignSource(Probe, "test_pins_errors_probe_unbound")
-    with get_pin_backend("pysim", source) as pins, \
-            pytest.raises(PinError, match="no pixel stream binding"):
+    with (
+        get_pin_backend("pysim", source) as pins,
+        pytest.raises(PinError, match="no pixel stream binding"),
+    ):
         pins.stream_frame(np.zeros((2, 3), np.uint16), PixelTiming(1, 4))
 
 
 def test_bad_bindings():
-    with pytest.raises(PinError, match=r"the filtered binding needs a 1-bit output port "
-                                       r"'filtered__valid'"):
-        PinDesignSource(Probe, "k", filtered=("filtered__valid", "filtered__payload"),
-                        frame_size=(3, 2))
+    with pytest.raises(
+        PinError,
+        match=r"the filtered binding needs a 1-bit output port "
+        r"'filtered__valid'",
+    ):
+        PinDesignSource(
+            Probe, "k", filtered=("filtered__valid", "filtered__payload"), frame_size=(3, 2)
+        )
     with pytest.raises(PinError, match=r"needs frame_size=\(width, height\)"):
         PinDesignSource(Probe, "k", pixels=PIXEL_PORTS)
 
@@ -116,15 +154,21 @@ def test_bad_bindings():
 @pytest.mark.parametrize("name", ["cxxrtl", "verilator"])
 def test_missing_compiler(monkeypatch, name):
     monkeypatch.setenv("CXX", "no-such-compiler-here")
-    with pytest.raises(PinError, match=rf"^{name}: the C\+\+ compiler 'no-such-compiler-here' "
-                                       r"named by the CXX environment variable was not found; "
-                                       r"install a C\+\+ compiler"):
+    with pytest.raises(
+        PinError,
+        match=rf"^{name}: the C\+\+ compiler 'no-such-compiler-here' "
+        r"named by the CXX environment variable was not found; "
+        r"install a C\+\+ compiler",
+    ):
         get_pin_backend(name, SOURCE)
 
 
 def test_unknown_backend():
-    with pytest.raises(PinError, match=r"unknown pin backend 'fast'; choose one of: auto, "
-                                       r"pysim, cxxrtl, verilator"):
+    with pytest.raises(
+        PinError,
+        match=r"unknown pin backend 'fast'; choose one of: auto, "
+        r"pysim, cxxrtl, verilator",
+    ):
         get_pin_backend("fast", SOURCE)
 
 
@@ -145,14 +189,17 @@ def test_real_clock_timing():
         real_clock_timing(4000, 480, 30, 50e6, 1)
 
 
-@pytest.mark.parametrize("argv, message", [
-    (["--backends", "cxxrtl,fast"], "unknown backend"),
-    (["--resolution", "160"], "--resolution is WIDTHxHEIGHT"),
-    (["--resolution", "16x12"], "--resolution: the window width"),
-    (["--clock-hz", "1e5"], "too few for 160 pixels; lower the resolution or fps"),
-    (["--repeats", "0"], "--repeats must be 1..1000"),
-    (["--step", "0"], "must be positive"),
-])
+@pytest.mark.parametrize(
+    "argv, message",
+    [
+        (["--backends", "cxxrtl,fast"], "unknown backend"),
+        (["--resolution", "160"], "--resolution is WIDTHxHEIGHT"),
+        (["--resolution", "16x12"], "--resolution: the window width"),
+        (["--clock-hz", "1e5"], "too few for 160 pixels; lower the resolution or fps"),
+        (["--repeats", "0"], "--repeats must be 1..1000"),
+        (["--step", "0"], "must be positive"),
+    ],
+)
 def test_pin_bench_bad_arguments(argv, message):
     from fpga_robotics.bench.pins import main
     from fpga_robotics.cli.errors import UsageError

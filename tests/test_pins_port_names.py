@@ -22,11 +22,21 @@ class Reserved(wiring.Component):
     ``new = -near`` are combinational."""
 
     def __init__(self):
-        super().__init__(wiring.Signature({
-            "delete": In(4), "class": In(1), "top": In(1),
-            "near": Out(8), "far": Out(8), "int": Out(4), "register": Out(1), "eval": Out(8),
-            "new": Out(signed(8)),
-        }))
+        super().__init__(
+            wiring.Signature(
+                {
+                    "delete": In(4),
+                    "class": In(1),
+                    "top": In(1),
+                    "near": Out(8),
+                    "far": Out(8),
+                    "int": Out(4),
+                    "register": Out(1),
+                    "eval": Out(8),
+                    "new": Out(signed(8)),
+                }
+            )
+        )
 
     def elaborate(self, platform):
         m = Module()
@@ -34,8 +44,11 @@ class Reserved(wiring.Component):
         with m.If(p["class"]):
             m.d.sync += p["near"].eq(p["near"] + p["delete"])
         m.d.sync += [p["register"].eq(p["top"]), p["eval"].eq(p["eval"] + 1)]
-        m.d.comb += [p["far"].eq(p["near"] ^ 0x55), p["int"].eq(p["delete"]),
-                     p["new"].eq(-p["near"])]
+        m.d.comb += [
+            p["far"].eq(p["near"] ^ 0x55),
+            p["int"].eq(p["delete"]),
+            p["new"].eq(-p["near"]),
+        ]
         return m
 
 
@@ -61,9 +74,14 @@ class Model:
         if name in INPUTS:
             return self.inputs[name]
         new = -self.near & 0xFF
-        return {"near": self.near, "far": self.near ^ 0x55, "int": self.inputs["delete"],
-                "register": self.register, "eval": self.eval,
-                "new": new - 256 if new & 0x80 else new}[name]
+        return {
+            "near": self.near,
+            "far": self.near ^ 0x55,
+            "int": self.inputs["delete"],
+            "register": self.register,
+            "eval": self.eval,
+            "new": new - 256 if new & 0x80 else new,
+        }[name]
 
 
 def _script(pins, seed):
@@ -94,7 +112,8 @@ def test_reserved_names_run_as_the_model_says(name):
         pins.reset()
         cycle = 0
         for step, (delete, cls, top, edges) in enumerate(
-                [(3, 1, 1, 5), (9, 0, 0, 2), (15, 1, 0, 20), (1, 1, 1, 1)]):
+            [(3, 1, 1, 5), (9, 0, 0, 2), (15, 1, 0, 20), (1, 1, 1, 1)]
+        ):
             for port, value in (("delete", delete), ("class", cls), ("top", top)):
                 pins.poke(port, value)
                 model.inputs[port] = value
@@ -103,7 +122,8 @@ def test_reserved_names_run_as_the_model_says(name):
             for _ in range(edges):
                 model.edge()
             assert {n: pins.peek(n) for n in SOURCE.ports} == {
-                n: model.peek(n) for n in SOURCE.ports}, step
+                n: model.peek(n) for n in SOURCE.ports
+            }, step
 
 
 def test_a_seeded_script_is_the_same_on_every_backend():

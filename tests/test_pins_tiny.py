@@ -68,15 +68,21 @@ class StreamProbe(wiring.Component):
         comb = self.mode == 1
         m.d.comb += [
             self.filtered.valid.eq(Mux(comb, self.pixels.valid, valid) | (self.mode == 3)),
-            self.filtered.payload.eq(Mux(comb, self.pixels.payload,
-                                         Mux(self.mode == 2, payload & ~(1 << 12), payload))),
+            self.filtered.payload.eq(
+                Mux(comb, self.pixels.payload, Mux(self.mode == 2, payload & ~(1 << 12), payload))
+            ),
         ]
         return m
 
 
 BURST = PinDesignSource(BurstCounter, "test_pins_burst_counter")
-PROBE = PinDesignSource(StreamProbe, "test_pins_stream_probe", pixels=PIXEL_PORTS,
-                        filtered=FILTERED_PORTS, frame_size=(4, 3))
+PROBE = PinDesignSource(
+    StreamProbe,
+    "test_pins_stream_probe",
+    pixels=PIXEL_PORTS,
+    filtered=FILTERED_PORTS,
+    frame_size=(4, 3),
+)
 
 
 @pytest.fixture(scope="module", params=BACKENDS)
@@ -157,8 +163,9 @@ def _script(pins, seed):
         elif op == 1:
             pins.poke("b", int(rng.integers(16)))
         elif op == 2:
-            pins.watch([str(n) for n in rng.choice(outputs, int(rng.integers(0, 4)),
-                                                   replace=False)])
+            pins.watch(
+                [str(n) for n in rng.choice(outputs, int(rng.integers(0, 4)), replace=False)]
+            )
         stop = pins.run(int(rng.integers(0, 25)))
         log.append((stop, [pins.peek(n) for n in pins.ports]))
     return log
@@ -231,8 +238,10 @@ def test_back_to_back_frames_keep_their_filtered_streams_apart(probe):
     np.testing.assert_array_equal(pins.filtered_frame(), frames[-1])
 
 
-@pytest.mark.parametrize("mode, message", [(2, "wrong first/last framing flags"),
-                                           (3, "more filtered pixels than the frames")])
+@pytest.mark.parametrize(
+    "mode, message",
+    [(2, "wrong first/last framing flags"), (3, "more filtered pixels than the frames")],
+)
 def test_a_badly_framed_filtered_stream_is_an_error(probe, mode, message):
     pins = probe
     pins.reset()

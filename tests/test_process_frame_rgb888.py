@@ -10,8 +10,9 @@ from fpga_robotics.sim.backends import get_backend
 from fpga_robotics.sim.camera import synthetic
 from fpga_robotics.sim.camera.frames import FrameError, to_rgb444
 
-P = FollowTargetParams(width=40, height=16, diff_min=5, min_pixels=4,
-                       proximity_thresholds=(4, 8, 16, 32, 64, 96, 128))
+P = FollowTargetParams(
+    width=40, height=16, diff_min=5, min_pixels=4, proximity_thresholds=(4, 8, 16, 32, 64, 96, 128)
+)
 COMPILED = ["cxxrtl", pytest.param("verilator", marks=pytest.mark.slow)]
 
 
@@ -21,13 +22,21 @@ def frames(seed, count=12):
     rng = np.random.default_rng(seed)
     seq = []
     for i in range(count):
-        seq.append((rng.integers(0, 256, (P.height, P.width, 3), dtype=np.uint8),
-                    ("red", "green")[i % 2]))
+        seq.append(
+            (rng.integers(0, 256, (P.height, P.width, 3), dtype=np.uint8), ("red", "green")[i % 2])
+        )
     for colour in ("red", "green", "blue"):
-        seq.append((synthetic.blob_frame(P.width, P.height, colour, cx=P.width / 2,
-                                         radius=P.height / 4, rng=rng), colour))
-    seq += [(rng.integers(0, 256, (P.height, P.width, 3), dtype=np.uint8), code)
-            for code in range(8)]
+        seq.append(
+            (
+                synthetic.blob_frame(
+                    P.width, P.height, colour, cx=P.width / 2, radius=P.height / 4, rng=rng
+                ),
+                colour,
+            )
+        )
+    seq += [
+        (rng.integers(0, 256, (P.height, P.width, 3), dtype=np.uint8), code) for code in range(8)
+    ]
     return seq
 
 
@@ -82,14 +91,17 @@ def test_out_receives_the_filtered_frame_every_frame_in_the_same_array(name):
 
 
 @pytest.mark.parametrize("name", ["model", *COMPILED])
-@pytest.mark.parametrize("bad, message", [
-    (np.zeros((16, 41), np.uint16), r"must be a \(16, 40\) uint16 array.*got \(16, 41\)"),
-    (np.zeros((16, 40), np.uint8), r"must be a \(16, 40\) uint16 array.*uint8"),
-    (np.zeros((16, 40), np.int64), r"must be a \(16, 40\) uint16 array.*int64"),
-    (np.zeros((16, 40, 3), np.uint16), r"must be a \(16, 40\) uint16 array"),
-    (np.zeros((40, 16), np.uint16).T, "C-contiguous"),
-    ([[0] * 40] * 16, "must be a numpy array, not list"),
-])
+@pytest.mark.parametrize(
+    "bad, message",
+    [
+        (np.zeros((16, 41), np.uint16), r"must be a \(16, 40\) uint16 array.*got \(16, 41\)"),
+        (np.zeros((16, 40), np.uint8), r"must be a \(16, 40\) uint16 array.*uint8"),
+        (np.zeros((16, 40), np.int64), r"must be a \(16, 40\) uint16 array.*int64"),
+        (np.zeros((16, 40, 3), np.uint16), r"must be a \(16, 40\) uint16 array"),
+        (np.zeros((40, 16), np.uint16).T, "C-contiguous"),
+        ([[0] * 40] * 16, "must be a numpy array, not list"),
+    ],
+)
 def test_a_wrong_out_is_a_clear_error_that_changes_nothing(name, bad, message):
     seq = frames(4, 3)
     ref = expected(seq)

@@ -34,12 +34,12 @@ def frame(columns):
     """``{column: red pixels from the window's top row}``, red margins around."""
     f = np.zeros((H, W), np.uint16)
     f[:TOP, :] = RED
-    f[TOP + ROWS:, :] = RED
+    f[TOP + ROWS :, :] = RED
     f[:, :16] = RED
     f[:, 144:] = RED
     for c, n in columns.items():
         assert 16 <= c <= 143 and 0 <= n <= ROWS
-        f[TOP:TOP + n, c] = RED
+        f[TOP : TOP + n, c] = RED
     return f
 
 
@@ -92,18 +92,34 @@ for k in range(1, 16):
 # --- Found rule and proximity boundaries (N pixels in the leftmost columns) -----------------
 # (N, ours found, ours proximity, published found, published proximity)
 COUNTS = [
-    (127, False, 0, False, 0), (128, True, 1, False, 3), (129, True, 1, True, 3),
-    (255, True, 1, True, 3), (256, True, 2, True, 3), (511, True, 2, True, 3),
-    (512, True, 3, True, 3), (767, True, 3, True, 3), (768, True, 3, True, 3),
-    (1023, True, 3, True, 3), (1024, True, 4, True, 3), (1791, True, 4, True, 3),
-    (1792, True, 4, True, 3), (2047, True, 4, True, 3), (2048, True, 5, True, 3),
-    (3071, True, 5, True, 3), (3072, True, 5, True, 4), (3839, True, 5, True, 4),
-    (3840, True, 5, True, 5), (4095, True, 5, True, 5), (4096, True, 6, True, 6),
-    (6143, True, 6, True, 6), (6144, True, 7, True, 7), (13312, True, 7, True, 7),
+    (127, False, 0, False, 0),
+    (128, True, 1, False, 3),
+    (129, True, 1, True, 3),
+    (255, True, 1, True, 3),
+    (256, True, 2, True, 3),
+    (511, True, 2, True, 3),
+    (512, True, 3, True, 3),
+    (767, True, 3, True, 3),
+    (768, True, 3, True, 3),
+    (1023, True, 3, True, 3),
+    (1024, True, 4, True, 3),
+    (1791, True, 4, True, 3),
+    (1792, True, 4, True, 3),
+    (2047, True, 4, True, 3),
+    (2048, True, 5, True, 3),
+    (3071, True, 5, True, 3),
+    (3072, True, 5, True, 4),
+    (3839, True, 5, True, 4),
+    (3840, True, 5, True, 5),
+    (4095, True, 5, True, 5),
+    (4096, True, 6, True, 6),
+    (6143, True, 6, True, 6),
+    (6144, True, 7, True, 7),
+    (13312, True, 7, True, 7),
 ]
 for n, fo, po, fp, pp in COUNTS:
     # Up to 1664 pixels (16 columns) everything is in bin 0: the leftmost LED when found.
-    leds = (lambda found: (0x01 if found else 0)) if n <= 1664 else (lambda found: None)
+    leds = (lambda found: 0x01 if found else 0) if n <= 1664 else (lambda found: None)
     case(f"N={n}", count_frame(n), expect(fo, po, leds(fo)), expect(fp, pp, leds(fp)))
 
 # --- Two-column bars on every bin boundary (208 pixels: ours level 1, published level 3) ----
@@ -111,16 +127,35 @@ LASTS = [31 + 16 * k for k in range(8)]  # the last column of each bin
 # A_k: (last of bin k, first of bin k+1); B_k: the two last columns of bin k.
 BARS_A = [(c, c + 1) for c in LASTS[:7]]
 BARS_B = [(c - 1, c) for c in LASTS]
-LEDS_OURS = [0x01, 0x02, 0x04, 0x18, 0x20, 0x40, 0x80] + [0x01, 0x02, 0x04, 0x08, 0x10, 0x20,
-                                                          0x40, 0x80]
+LEDS_OURS = [0x01, 0x02, 0x04, 0x18, 0x20, 0x40, 0x80] + [
+    0x01,
+    0x02,
+    0x04,
+    0x08,
+    0x10,
+    0x20,
+    0x40,
+    0x80,
+]
 # Published: the left bar column moves to the next group (and 143 to group 0).
-LEDS_PUBLISHED = [0x01, 0x04, 0x08, 0x10, 0x20, 0x40, 0x80] + [0x01, 0x02, 0x04, 0x18, 0x20,
-                                                               0x40, 0x40, 0x18]
+LEDS_PUBLISHED = [0x01, 0x04, 0x08, 0x10, 0x20, 0x40, 0x80] + [
+    0x01,
+    0x02,
+    0x04,
+    0x18,
+    0x20,
+    0x40,
+    0x40,
+    0x18,
+]
 for (a, b), lo, lp in zip(BARS_A + BARS_B, LEDS_OURS, LEDS_PUBLISHED, strict=True):
     centroid = a  # (a + b) // 2 with b = a + 1
-    case(f"bar {a},{b}", frame({a: ROWS, b: ROWS}),
-         expect(True, 1, lo, ours_command(centroid, 1)),
-         expect(True, 3, lp, published_command(350, lp)))
+    case(
+        f"bar {a},{b}",
+        frame({a: ROWS, b: ROWS}),
+        expect(True, 1, lo, ours_command(centroid, 1)),
+        expect(True, 3, lp, published_command(350, lp)),
+    )
 
 # --- Lost runs of 1, 14 and 15 frames -------------------------------------------------------
 # Sightings (208-pixel bars): (label, columns, ours LEDs, ours centroid, ours side,
@@ -137,35 +172,62 @@ SEARCH = {"left": (-250, 250), "right": (250, -250)}
 for name, (a, b), lo, co, so, lp, sp in SIGHTINGS:
     for run in (1, 14, 15):
         tracking_ours = ours_command(co, 1)
-        case(f"{name} sighting", frame({a: ROWS, b: ROWS}),
-             expect(True, 1, lo, tracking_ours), expect(True, 3, lp, published_command(350, lp)))
+        case(
+            f"{name} sighting",
+            frame({a: ROWS, b: ROWS}),
+            expect(True, 1, lo, tracking_ours),
+            expect(True, 3, lp, published_command(350, lp)),
+        )
         for k in range(1, run + 1):
             ours = tracking_ours if k < 15 else SEARCH[so]
             # Published: on at the empty frame's level 0 (600 DPS) with the last steering.
             published = published_command(600, lp) if k < 15 else SEARCH[sp]
-            case(f"{name}: lost {k} of {run}", EMPTY, expect(False, 0, 0, ours),
-                 expect(False, 0, 0, published))
+            case(
+                f"{name}: lost {k} of {run}",
+                EMPTY,
+                expect(False, 0, 0, ours),
+                expect(False, 0, 0, published),
+            )
 
 # N = 128 exactly: published "not found" yet level 3, so it drives on at 350 DPS; ours finds
 # it. The sighting before: columns 113..143 (3224 pixels; ours level 5, published 4), h7 holds
 # half: LED 7 for both; centroid 128.
-case("right block", block(113, 143), expect(True, 5, 0x80, ours_command(128, 5)),
-     expect(True, 4, 0x80, published_command(250, 0x80)))
+case(
+    "right block",
+    block(113, 143),
+    expect(True, 5, 0x80, ours_command(128, 5)),
+    expect(True, 4, 0x80, published_command(250, 0x80)),
+)
 for k in range(3):
-    case("N=128 after the right block", count_frame(128),
-         expect(True, 1, 0x01, ours_command(16, 1)),  # centroid (16*104 + 17*24) // 128
-         expect(False, 3, 0, published_command(350, 0x80)))
+    case(
+        "N=128 after the right block",
+        count_frame(128),
+        expect(True, 1, 0x01, ours_command(16, 1)),  # centroid (16*104 + 17*24) // 128
+        expect(False, 3, 0, published_command(350, 0x80)),
+    )
 for k in range(2):  # level 0: published on at 600 DPS, still steered by the right block
-    case("N=127 after N=128", count_frame(127), expect(False, 0, 0, ours_command(16, 1)),
-         expect(False, 0, 0, published_command(600, 0x80)))
+    case(
+        "N=127 after N=128",
+        count_frame(127),
+        expect(False, 0, 0, ours_command(16, 1)),
+        expect(False, 0, 0, published_command(600, 0x80)),
+    )
 
 # Backwards: columns 16..75 (6240 pixels, level 7 for both); h0 + h1 holds half: LED 1;
 # centroid 45. Published at -450 DPS, the right wheel 225 DPS slower backwards.
-case("close, left", block(16, 75), expect(True, 7, 0x02, ours_command(45, 7)),
-     expect(True, 7, 0x02, (-450, -225)))
+case(
+    "close, left",
+    block(16, 75),
+    expect(True, 7, 0x02, ours_command(45, 7)),
+    expect(True, 7, 0x02, (-450, -225)),
+)
 for k in range(2):
-    case("lost after close, left", EMPTY, expect(False, 0, 0, ours_command(45, 7)),
-         expect(False, 0, 0, published_command(600, 0x02)))
+    case(
+        "lost after close, left",
+        EMPTY,
+        expect(False, 0, 0, ours_command(45, 7)),
+        expect(False, 0, 0, published_command(600, 0x02)),
+    )
 
 
 def check(results, design):
@@ -173,9 +235,12 @@ def check(results, design):
     bad = []
     for (label, _, expected), r in zip(CASES, results, strict=True):
         e = expected[design]
-        got = {"found": bool(r.found), "proximity": int(r.proximity),
-               "centroid_leds": int(r.centroid_leds),
-               "motors": (int(r.motor_left), int(r.motor_right))}
+        got = {
+            "found": bool(r.found),
+            "proximity": int(r.proximity),
+            "centroid_leds": int(r.centroid_leds),
+            "motors": (int(r.motor_left), int(r.motor_right)),
+        }
         for key, value in e.items():
             if got[key] != value:
                 bad.append(f"{label}: {key} {got[key]} (expected {value})")

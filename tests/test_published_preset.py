@@ -16,15 +16,25 @@ from fpga_robotics.sim.backends import get_backend
 
 #: The published design at 160x120 (docs/published.md).
 PUBLISHED = {
-    "min_pixels": 128, "found_rule": "gt",
+    "min_pixels": 128,
+    "found_rule": "gt",
     "proximity_thresholds": (128, 128, 128, 3072, 3840, 4096, 6144),
-    "group_column_offset": 1, "motor_law": "table",
+    "group_column_offset": 1,
+    "motor_law": "table",
     "base_dps": (600, 550, 450, 350, 250, 150, -250, -450),
-    "steer_dps": (125, 175, 225, 275), "lost_motion": "drive",
-    "search_side_from": "leds", "centred_search_side": "right", "max_dps": 32767,
-    "lost_frames": 15, "search_dps": 250,
+    "steer_dps": (125, 175, 225, 275),
+    "lost_motion": "drive",
+    "search_side_from": "leds",
+    "centred_search_side": "right",
+    "max_dps": 32767,
+    "lost_frames": 15,
+    "search_dps": 250,
     # The colour filter and the window are the defaults.
-    "diff_min": 6, "similar_max": 2, "white_min": 12, "margin_x": 16, "margin_y": 8,
+    "diff_min": 6,
+    "similar_max": 2,
+    "white_min": 12,
+    "margin_x": 16,
+    "margin_y": 8,
 }
 
 
@@ -45,8 +55,7 @@ def test_published_changes_go_on_top_and_counts_scale_with_the_area():
 
 
 def test_unknown_preset_lists_the_known_ones():
-    with pytest.raises(ValueError, match="unknown design preset 'paper'; known presets: "
-                                         "published"):
+    with pytest.raises(ValueError, match="unknown design preset 'paper'; known presets: published"):
         FollowTargetParams.preset("paper")
     assert list(PRESETS) == ["published"]
 
@@ -54,40 +63,52 @@ def test_unknown_preset_lists_the_known_ones():
 def test_defaults_are_not_the_published_design():
     ours, published = FollowTargetParams(), FollowTargetParams.published()
     differ = {k for k in PUBLISHED if getattr(ours, k) != getattr(published, k)}
-    assert differ == {"found_rule", "proximity_thresholds", "group_column_offset", "motor_law",
-                      "base_dps", "lost_motion", "search_side_from", "max_dps"}
+    assert differ == {
+        "found_rule",
+        "proximity_thresholds",
+        "group_column_offset",
+        "motor_law",
+        "base_dps",
+        "lost_motion",
+        "search_side_from",
+        "max_dps",
+    }
 
 
 # --- Scenarios ------------------------------------------------------------------------------
+
 
 def test_scenario_preset_then_the_other_design_keys():
     s = load_scenario("follow_person", ["design.preset=published"])
     assert s.params == FollowTargetParams.published()
     s = load_scenario("follow_person", ["design.max_dps=300", "design.preset=published"])
     assert s.params == FollowTargetParams.published(max_dps=300)  # on top, in any order
-    s = load_scenario("follow_person", ["design.preset=published",
-                                        'camera.resolution="320x240"'])
+    s = load_scenario("follow_person", ["design.preset=published", 'camera.resolution="320x240"'])
     assert s.params == FollowTargetParams.published(width=320, height=240)
 
 
 def test_scenario_file_with_a_preset(tmp_path):
     path = tmp_path / "paper.toml"
-    path.write_text('name = "paper"\n[room]\nwidth = 6.0\ndepth = 5.0\n[robot]\n'
-                    'start = [1.0, 2.5]\n[design]\npreset = "published"\n'
-                    'found_rule = "ge"\nsteer_dps = [100, 150, 200, 250]\n')
+    path.write_text(
+        'name = "paper"\n[room]\nwidth = 6.0\ndepth = 5.0\n[robot]\n'
+        'start = [1.0, 2.5]\n[design]\npreset = "published"\n'
+        'found_rule = "ge"\nsteer_dps = [100, 150, 200, 250]\n'
+    )
     s = load_scenario(str(path))
-    assert s.params == FollowTargetParams.published(found_rule="ge",
-                                                    steer_dps=(100, 150, 200, 250))
+    assert s.params == FollowTargetParams.published(found_rule="ge", steer_dps=(100, 150, 200, 250))
 
 
-@pytest.mark.parametrize("override,message", [
-    ("design.preset=paper", "design.preset must be one of 'published', got 'paper'"),
-    ("design.found_rule=1", "design.found_rule must be a string, one of ge, gt"),
-    ('design.motor_law="pid"', "design.motor_law must be one of p_control, table"),
-    ("design.steer_dps=[1, 2, 3]", "design.steer_dps must be an array of 4 integers"),
-    ("design.group_column_offset=2", "design.group_column_offset must be <= 1"),
-    ("design.lost_motion=drive", "lost_motion='drive' needs motor_law='table'"),
-])
+@pytest.mark.parametrize(
+    "override,message",
+    [
+        ("design.preset=paper", "design.preset must be one of 'published', got 'paper'"),
+        ("design.found_rule=1", "design.found_rule must be a string, one of ge, gt"),
+        ('design.motor_law="pid"', "design.motor_law must be one of p_control, table"),
+        ("design.steer_dps=[1, 2, 3]", "design.steer_dps must be an array of 4 integers"),
+        ("design.group_column_offset=2", "design.group_column_offset must be <= 1"),
+        ("design.lost_motion=drive", "lost_motion='drive' needs motor_law='table'"),
+    ],
+)
 def test_scenario_design_errors_name_the_key(override, message):
     with pytest.raises(ScenarioError) as info:
         load_scenario("follow_person", [override])
@@ -96,6 +117,7 @@ def test_scenario_design_errors_name_the_key(override, message):
 
 
 # --- Export ---------------------------------------------------------------------------------
+
 
 def export(argv, capsys):
     with pytest.raises(SystemExit) as info:
@@ -110,19 +132,27 @@ def test_export_preset_writes_the_presets_verilog(tmp_path, capsys):
     assert code == 0 and "preset published" in stdout
     assert out.read_text() == generate_verilog(FollowTargetParams.published())
     on_top = tmp_path / "on_top.v"
-    assert export(["--preset", "published", "--max-dps", "400", "--found-rule", "ge",
-                   "-o", str(on_top)], capsys)[0] == 0
+    assert (
+        export(
+            ["--preset", "published", "--max-dps", "400", "--found-rule", "ge", "-o", str(on_top)],
+            capsys,
+        )[0]
+        == 0
+    )
     expected = FollowTargetParams.published(max_dps=400, found_rule="ge")
     assert on_top.read_text() == generate_verilog(expected)
 
 
-@pytest.mark.parametrize("argv,message", [
-    (["--preset", "paper"], "unknown --preset 'paper'; known presets: published"),
-    (["--found-rule", "gte"], "found_rule must be one of ge, gt; got 'gte'"),
-    (["--group-column-offset", "2"], "group_column_offset must be <= 1"),
-    (["--steer-dps", "1,2"], "steer_dps needs 4 values"),
-    (["--lost-motion", "drive"], "lost_motion='drive' needs motor_law='table'"),
-])
+@pytest.mark.parametrize(
+    "argv,message",
+    [
+        (["--preset", "paper"], "unknown --preset 'paper'; known presets: published"),
+        (["--found-rule", "gte"], "found_rule must be one of ge, gt; got 'gte'"),
+        (["--group-column-offset", "2"], "group_column_offset must be <= 1"),
+        (["--steer-dps", "1,2"], "steer_dps needs 4 values"),
+        (["--lost-motion", "drive"], "lost_motion='drive' needs motor_law='table'"),
+    ],
+)
 def test_export_bad_preset_or_knob_is_one_line(tmp_path, capsys, argv, message):
     out = tmp_path / "x.v"
     code, _, err = export([*argv, "-o", str(out)], capsys)
@@ -139,6 +169,7 @@ def test_verilator_lints_the_preset_export_cleanly(tmp_path):
 
 
 # --- Shadow runs ----------------------------------------------------------------------------
+
 
 @pytest.mark.parametrize("shadow_backend", ["model", "cxxrtl"])
 def test_shadow_published_first_differs_at_the_first_sighting(shadow_backend):
@@ -166,8 +197,21 @@ def test_shadow_published_first_differs_at_the_first_sighting(shadow_backend):
 
 def test_run_shadow_published_prints_where_the_designs_part(capsys):
     with pytest.raises(SystemExit) as info:
-        run_cli(run_main, ["--backend", "model", "--rerun", "off", "--shadow", "published",
-                           "--duration", "2", "--quiet"], prog="run")
+        run_cli(
+            run_main,
+            [
+                "--backend",
+                "model",
+                "--rerun",
+                "off",
+                "--shadow",
+                "published",
+                "--duration",
+                "2",
+                "--quiet",
+            ],
+            prog="run",
+        )
     out, err = capsys.readouterr()
     assert info.value.code == 0, err
     # follow_person sees the person from the first frame: the designs part at once.
@@ -176,8 +220,21 @@ def test_run_shadow_published_prints_where_the_designs_part(capsys):
 
 def test_run_with_the_preset_as_the_design(capsys):
     with pytest.raises(SystemExit) as info:
-        run_cli(run_main, ["--backend", "model", "--rerun", "off", "--set",
-                           "design.preset=published", "--duration", "2", "--quiet"], prog="run")
+        run_cli(
+            run_main,
+            [
+                "--backend",
+                "model",
+                "--rerun",
+                "off",
+                "--set",
+                "design.preset=published",
+                "--duration",
+                "2",
+                "--quiet",
+            ],
+            prog="run",
+        )
     out, err = capsys.readouterr()
     assert info.value.code == 0, err
     assert "verdict: PASS" in out

@@ -20,10 +20,19 @@ def _wall_scenario(distance, temperature=20.0):
     """follow_target_safe facing the wall x = 4 m, its ultrasound ``distance`` m from it
     (mounted 0.1 m ahead of the robot's centre), nobody in the room, no sensor noise."""
     x = 4.0 - distance - 0.1
-    return load_scenario("obstacle_between", [
-        "sim.duration=0.1", "people=[]", "room.furniture=[]", "room.width=4.0",
-        f"robot.start=[{x}, 2.0]", "robot.sensors.0.noise_std=0.0",
-        f"robot.sensors.0.temperature_c={temperature}", "checks={}"])
+    return load_scenario(
+        "obstacle_between",
+        [
+            "sim.duration=0.1",
+            "people=[]",
+            "room.furniture=[]",
+            "room.width=4.0",
+            f"robot.start=[{x}, 2.0]",
+            "robot.sensors.0.noise_std=0.0",
+            f"robot.sensors.0.temperature_c={temperature}",
+            "checks={}",
+        ],
+    )
 
 
 @pytest.mark.parametrize("distance, temperature", [(1.0, 20.0), (0.5, 0.0), (2.2, 35.0)])
@@ -43,8 +52,9 @@ def test_echo_width_for_a_wall_is_2d_over_c_to_the_cycle(distance, temperature):
 
 
 def test_nothing_in_range_gives_the_time_out_pulse_and_no_distance():
-    s = _wall_scenario(0.3).with_overrides(["room.width=9.0", "robot.start=[1.0, 2.0]",
-                                            "sim.duration=0.2"])
+    s = _wall_scenario(0.3).with_overrides(
+        ["room.width=9.0", "robot.start=[1.0, 2.0]", "sim.duration=0.2"]
+    )
     r = run_scenario(s, backend="cxxrtl")
     t = r.trajectory
     assert t["front.timeout"][-1] == 1
@@ -55,8 +65,10 @@ def test_nothing_in_range_gives_the_time_out_pulse_and_no_distance():
 
 
 def test_the_interlock_stops_the_robot_at_its_threshold_and_releases_it():
-    s = load_scenario("obstacle_between", ["robot.start=[1.7, 2.0]", "sim.duration=9",
-                                           "room.furniture.0.present_until=6.0"])
+    s = load_scenario(
+        "obstacle_between",
+        ["robot.start=[1.7, 2.0]", "sim.duration=9", "room.furniture.0.present_until=6.0"],
+    )
     r = run_scenario(s, backend="cxxrtl")
     t, stop_mm = r.trajectory, s.design_tables["interlock"].stop_mm
     stopped = np.flatnonzero(t["design.obstacle"] > 0)
@@ -73,7 +85,9 @@ def test_the_interlock_stops_the_robot_at_its_threshold_and_releases_it():
     assert np.all(np.abs(t["v"][hold]) < 0.005)
     spec_accel = 1500.0 / 360 * math.pi * 0.0665  # GoPiGo3's wheel ramp, m/s^2
     braking = v * v / (2 * spec_accel)
-    assert stop_mm / 1000 - v * period - braking - 0.02 <= t["front.range_m"][hold[0]] < stop_mm / 1000
+    assert (
+        stop_mm / 1000 - v * period - braking - 0.02 <= t["front.range_m"][hold[0]] < stop_mm / 1000
+    )
     assert r.summary["collisions"].get("furniture", 0) == 0
     # Removed at 6 s: the next measurement sees the person beyond and releases the wheels.
     released = [e for e in r.events if e[2].startswith("interlock: clear")]
@@ -86,8 +100,16 @@ def test_modes_agree_while_the_robot_has_not_moved():
     a = run_scenario(s, backend="model")
     b = run_scenario(s.with_overrides(["sim.timing=real_clock"]), backend="cxxrtl")
     assert a.summary["timing"] == "compressed" and b.summary["timing"] == "real_clock"
-    for name in ("found", "proximity", "centroid_x", "centroid_leds", "motor_left",
-                 "motor_right", "x", "y"):
+    for name in (
+        "found",
+        "proximity",
+        "centroid_x",
+        "centroid_leds",
+        "motor_left",
+        "motor_right",
+        "x",
+        "y",
+    ):
         assert np.array_equal(a.trajectory[name][:2], b.trajectory[name][:2]), name
     assert b.summary["sim_cycles"] == round(0.1 * CLOCK)
 
@@ -100,13 +122,20 @@ def test_real_clock_backends_agree_bit_for_bit():
         for name, column in runs[0].trajectory.items():
             assert np.array_equal(column, r.trajectory[name], equal_nan=True), name
         untimed = {k: v for k, v in r.summary.items() if k not in TIMING_FIELDS + ("backend",)}
-        assert untimed == {k: v for k, v in runs[0].summary.items()
-                           if k not in TIMING_FIELDS + ("backend",)}
+        assert untimed == {
+            k: v for k, v in runs[0].summary.items() if k not in TIMING_FIELDS + ("backend",)
+        }
 
 
 def test_a_buggy_variant_fails_its_named_check():
-    s = load_scenario("line_track", ["sim.duration=8", "design.variant=line_inverted_polarity",
-                                     "checks={max_off_line_s = 1.0}"])
+    s = load_scenario(
+        "line_track",
+        [
+            "sim.duration=8",
+            "design.variant=line_inverted_polarity",
+            "checks={max_off_line_s = 1.0}",
+        ],
+    )
     r = run_scenario(s, backend="cxxrtl")
     assert [c["name"] for c in r.summary["checks"] if c["passed"] is False] == ["max_off_line_s"]
     good = load_scenario("line_track", ["sim.duration=8", "checks={max_off_line_s = 1.0}"])
@@ -114,19 +143,34 @@ def test_a_buggy_variant_fails_its_named_check():
 
 
 def test_the_ultrasound_variant_drives_into_the_box():
-    s = load_scenario("obstacle_between", ["robot.start=[1.7, 2.0]", "sim.duration=6",
-                                           "design.variant=us_echo_inverted",
-                                           "checks={max_furniture_collisions = 0}"])
+    s = load_scenario(
+        "obstacle_between",
+        [
+            "robot.start=[1.7, 2.0]",
+            "sim.duration=6",
+            "design.variant=us_echo_inverted",
+            "checks={max_furniture_collisions = 0}",
+        ],
+    )
     r = run_scenario(s, backend="cxxrtl")
     assert [c["name"] for c in r.summary["checks"] if c["passed"] is False] == [
-        "max_furniture_collisions"]
+        "max_furniture_collisions"
+    ]
 
 
-@pytest.mark.parametrize("overrides, message", [
-    (["robot.sensors=[]"], ("nothing drives its input 'line'; declare a [[robot.sensors]] "
-                            "table with kind = \"line_sensors\"")),
-    (["design.line.n_sensors=2"], "the line_sensors table must list as many sensors"),
-])
+@pytest.mark.parametrize(
+    "overrides, message",
+    [
+        (
+            ["robot.sensors=[]"],
+            (
+                "nothing drives its input 'line'; declare a [[robot.sensors]] "
+                'table with kind = "line_sensors"'
+            ),
+        ),
+        (["design.line.n_sensors=2"], "the line_sensors table must list as many sensors"),
+    ],
+)
 def test_binding_errors_say_what_to_declare(overrides, message):
     s = load_scenario("line_track", overrides)
     with pytest.raises(UsageError, match=message.replace("[", r"\[").replace("]", r"\]")):
@@ -134,7 +178,7 @@ def test_binding_errors_say_what_to_declare(overrides, message):
 
 
 def test_compressed_timing_refuses_a_design_with_pins():
-    with pytest.raises(ScenarioError, match="needs sim.timing = \"real_clock\""):
+    with pytest.raises(ScenarioError, match='needs sim.timing = "real_clock"'):
         load_scenario("line_track", ["sim.timing=compressed"])
 
 

@@ -27,8 +27,11 @@ def divider():
 
 def test_the_divider_is_one_board_of_its_size(divider):
     _, _, model = divider
-    boxes = [(model.geom_pos[i], model.geom_size[i]) for i in range(model.ngeom)
-             if model.geom_type[i] == 6 and model.geom_bodyid[i] == 0]  # mjGEOM_BOX, static
+    boxes = [
+        (model.geom_pos[i], model.geom_size[i])
+        for i in range(model.ngeom)
+        if model.geom_type[i] == 6 and model.geom_bodyid[i] == 0
+    ]  # mjGEOM_BOX, static
     # The scenario's divider: 3.0 x 0.04 m, 1.8 m high, centred at (7.3, 3.0), turned 90 deg.
     match = [(p, s) for p, s in boxes if np.allclose(p, (7.3, 3.0, 0.9), atol=1e-6)]
     assert len(match) == 1
@@ -50,8 +53,11 @@ def test_a_body_per_person_and_a_light_per_lamp(divider):
 def test_textures_average_to_the_surface_colour(divider):
     scene, spec, _ = divider
     wood = scene.walls[-1].color
-    grains = [t for t in spec.textures.values()
-              if np.allclose(t.reshape(-1, 3).mean(axis=0) / 255, wood, atol=0.02)]
+    grains = [
+        t
+        for t in spec.textures.values()
+        if np.allclose(t.reshape(-1, 3).mean(axis=0) / 255, wood, atol=0.02)
+    ]
     assert grains, "no texture averages to the divider's colour"
     flat = build_model_xml(scene, Render3DOptions(textures=False), 160, 120, 45.0)
     for t in flat.textures.values():

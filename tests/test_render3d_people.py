@@ -30,8 +30,10 @@ def test_the_swing_grows_with_speed_up_to_full():
     assert fast == faster == pytest.approx(SWING["hip"])
     # Legs and arms swing against each other.
     a = gait_angles(quarter, 0.5, 1.75)
-    assert a["hip_r"] == -a["hip_l"] and a["shoulder_l"] == -a["hip_l"] * SWING["shoulder"] / \
-        SWING["hip"]
+    assert (
+        a["hip_r"] == -a["hip_l"]
+        and a["shoulder_l"] == -a["hip_l"] * SWING["shoulder"] / SWING["hip"]
+    )
 
 
 def _crossings(values):
@@ -43,9 +45,14 @@ def _crossings(values):
 def test_a_walker_swings_at_speed_over_cycle_length(speed):
     # A person walking 10 m in a straight line at constant speed; the hip angle sampled at
     # 30 frames a second crosses zero twice a cycle: 2 * speed / cycle_length a second.
-    world = World.from_config({"room": {"width": 14.0}, "robot": {"start": [0.5, 0.5]},
-                               "people": [{"waypoints": [[1.0, 3.0], [13.0, 3.0]],
-                                           "speed": speed, "loop": False}]}, 0)
+    world = World.from_config(
+        {
+            "room": {"width": 14.0},
+            "robot": {"start": [0.5, 0.5]},
+            "people": [{"waypoints": [[1.0, 3.0], [13.0, 3.0]], "speed": speed, "loop": False}],
+        },
+        0,
+    )
     hips, seconds = [], 8.0
     for _ in range(int(seconds * 30)):
         world.step(1 / 30)
@@ -59,8 +66,14 @@ def test_a_walker_swings_at_speed_over_cycle_length(speed):
 
 
 def test_the_world_keeps_facing_and_stops_the_gait_at_a_pause():
-    world = World.from_config({"people": [{"waypoints": [[3.0, 3.0], [3.0, 4.0]],
-                                           "speed": 0.5, "pause": 5.0, "loop": False}]}, 0)
+    world = World.from_config(
+        {
+            "people": [
+                {"waypoints": [[3.0, 3.0], [3.0, 4.0]], "speed": 0.5, "pause": 5.0, "loop": False}
+            ]
+        },
+        0,
+    )
     for _ in range(3 * 30):  # 2 s to walk 1 m, then the pause
         world.step(1 / 30)
     (cyl,) = world.scene().cylinders
@@ -107,5 +120,4 @@ def test_rendered_limbs_move_only_when_walking_and_frames_repeat():
     # The same inputs, a new renderer: the same frame, pixel for pixel.
     again = MujocoRenderer(W, H, HFOV)
     c = dataclasses.replace(side, walked=quarter, speed=0.5)
-    assert np.array_equal(again.render(dataclasses.replace(base, cylinders=(c,)), POSE),
-                          walking[0])
+    assert np.array_equal(again.render(dataclasses.replace(base, cylinders=(c,)), POSE), walking[0])

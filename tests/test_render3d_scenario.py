@@ -25,27 +25,38 @@ def test_the_raster_is_the_default_and_the_keys_have_defaults():
 
 
 def test_lamps_and_options_are_read():
-    cam = load_scenario("follow_person", [
-        "camera.shadows=false", "camera.shadow_size=512", "camera.floor=tiles",
-        "camera.shine=0.4",
-        "camera.lamps=[{pos = [7, 3, 2.4], aim = [7.3, 3, 1], color = [1, 0.6, 0.3]}]"]).camera
+    cam = load_scenario(
+        "follow_person",
+        [
+            "camera.shadows=false",
+            "camera.shadow_size=512",
+            "camera.floor=tiles",
+            "camera.shine=0.4",
+            "camera.lamps=[{pos = [7, 3, 2.4], aim = [7.3, 3, 1], color = [1, 0.6, 0.3]}]",
+        ],
+    ).camera
     o = cam.render3d
     assert (o.shadows, o.shadow_size, o.floor, o.shine) == (False, 512, "tiles", 0.4)
     assert o.lamps == (Lamp((7.0, 3.0, 2.4), (7.3, 3.0, 1.0), (1.0, 0.6, 0.3), 45.0, True),)
 
 
-@pytest.mark.parametrize("override, message", [
-    ("camera.renderer=vulkan", "camera.renderer must be one of 'raster', 'mujoco'"),
-    ("camera.shadow_size=10", "camera.shadow_size must be an integer in 64..8192"),
-    ("camera.floor=marble", "camera.floor must be one of"),
-    ("camera.shine=2", "camera.shine must be a number in 0..1"),
-    ("camera.shadows=3", "camera.shadows must be true or false"),
-    ("camera.lamps=[{pos = [1, 2, 2]}]", "camera.lamps[0].aim is required"),
-    ("camera.lamps=[{pos = [1, 2, 2], aim = [1, 2, 2]}]", "must differ from its pos"),
-    ("camera.lamps=[{pos = [1, 2], aim = [1, 2, 0]}]", "camera.lamps[0].pos must be an array"),
-    ("camera.lamps=[{pos = [1, 2, 2], aim = [1, 2, 0], colour = [1, 1, 1]}]",
-     "unknown key camera.lamps[0].colour"),
-])
+@pytest.mark.parametrize(
+    "override, message",
+    [
+        ("camera.renderer=vulkan", "camera.renderer must be one of 'raster', 'mujoco'"),
+        ("camera.shadow_size=10", "camera.shadow_size must be an integer in 64..8192"),
+        ("camera.floor=marble", "camera.floor must be one of"),
+        ("camera.shine=2", "camera.shine must be a number in 0..1"),
+        ("camera.shadows=3", "camera.shadows must be true or false"),
+        ("camera.lamps=[{pos = [1, 2, 2]}]", "camera.lamps[0].aim is required"),
+        ("camera.lamps=[{pos = [1, 2, 2], aim = [1, 2, 2]}]", "must differ from its pos"),
+        ("camera.lamps=[{pos = [1, 2], aim = [1, 2, 0]}]", "camera.lamps[0].pos must be an array"),
+        (
+            "camera.lamps=[{pos = [1, 2, 2], aim = [1, 2, 0], colour = [1, 1, 1]}]",
+            "unknown key camera.lamps[0].colour",
+        ),
+    ],
+)
 def test_bad_values_are_named(override, message):
     with pytest.raises(ScenarioError) as info:
         load_scenario("follow_person", [override])
@@ -53,16 +64,31 @@ def test_bad_values_are_named(override, message):
 
 
 def _run(*args, env=None):
-    return subprocess.run([sys.executable, "-m", "fpga_robotics.run", *args], env=env,
-                          capture_output=True, check=False, text=True, timeout=120)
+    return subprocess.run(
+        [sys.executable, "-m", "fpga_robotics.run", *args],
+        env=env,
+        capture_output=True,
+        check=False,
+        text=True,
+        timeout=120,
+    )
 
 
 def test_missing_mujoco_is_one_line_with_the_install_command(tmp_path):
     # A module named mujoco that fails to import, first on the path.
     (tmp_path / "mujoco.py").write_text("raise ImportError('no mujoco here')\n")
     env = {**os.environ, "PYTHONPATH": str(tmp_path)}
-    r = _run("--set", "camera.renderer=mujoco", "--duration", "0.1", "--rerun", "off",
-             "--backend", "model", env=env)
+    r = _run(
+        "--set",
+        "camera.renderer=mujoco",
+        "--duration",
+        "0.1",
+        "--rerun",
+        "off",
+        "--backend",
+        "model",
+        env=env,
+    )
     assert r.returncode == 2
     assert len(r.stderr.strip().splitlines()) == 1
     assert 'pip install -e ".[realistic]"' in r.stderr and "libegl1" in r.stderr
@@ -71,8 +97,17 @@ def test_missing_mujoco_is_one_line_with_the_install_command(tmp_path):
 @mujoco_missing
 def test_no_opengl_is_one_line_too():
     env = {**os.environ, "MUJOCO_GL": "nonexistent"}
-    r = _run("--set", "camera.renderer=mujoco", "--duration", "0.1", "--rerun", "off",
-             "--backend", "model", env=env)
+    r = _run(
+        "--set",
+        "camera.renderer=mujoco",
+        "--duration",
+        "0.1",
+        "--rerun",
+        "off",
+        "--backend",
+        "model",
+        env=env,
+    )
     assert r.returncode == 2
     assert len(r.stderr.strip().splitlines()) == 1
     assert "OpenGL" in r.stderr and "libegl1" in r.stderr
@@ -84,8 +119,12 @@ def test_the_closed_loop_runs_in_3d_and_repeats_with_the_seed():
 
     def frames(seed):
         out = []
-        r = run_scenario(scenario, seed=seed, backend="model",
-                         on_frame=lambda rec: out.append(rec.camera_rgb.copy()))
+        r = run_scenario(
+            scenario,
+            seed=seed,
+            backend="model",
+            on_frame=lambda rec: out.append(rec.camera_rgb.copy()),
+        )
         return r, out
 
     r1, a = frames(1)

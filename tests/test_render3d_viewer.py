@@ -56,7 +56,8 @@ def test_the_camera_pinhole_and_pose_follow_the_robot(recorded):
         x, y, h = traj["x"][i], traj["y"][i], traj["heading"][i]
         tx, ty, tz = rows.values["Transform3D:translation"][i][0]
         assert (tx, ty, tz) == pytest.approx(
-            (x + forward * math.cos(h), y + forward * math.sin(h), spec.camera_height), abs=1e-5)
+            (x + forward * math.cos(h), y + forward * math.sin(h), spec.camera_height), abs=1e-5
+        )
         m = np.array(rows.values["Transform3D:mat3x3"][i][0]).reshape(3, 3).T  # column-major
         # The camera's forward axis (its third column) is the robot's heading.
         assert m[:, 2] == pytest.approx([math.cos(h), math.sin(h), 0.0], abs=1e-5)
@@ -73,8 +74,9 @@ def test_people_and_robot_are_drawn_each_frame(recorded):
     (head,) = heads.values["Points3D:positions"][-1]
     assert head[2] == pytest.approx(1.63)  # a 1.75 m person's head centre
     (centre,) = robot.values["Cylinders3D:centers"][-1]
-    assert centre[:2] == pytest.approx((result.trajectory["x"][-1], result.trajectory["y"][-1]),
-                                       abs=1e-5)
+    assert centre[:2] == pytest.approx(
+        (result.trajectory["x"][-1], result.trajectory["y"][-1]), abs=1e-5
+    )
 
 
 def test_camera_rotation_maps_the_camera_axes():

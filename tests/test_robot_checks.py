@@ -15,12 +15,19 @@ W = 160
 
 def _traj(columns, leds, found=True, motors=(0, 0), x=None):
     n = len(columns)
-    return {"t": np.arange(n) / 30, "x": np.zeros(n) if x is None else np.asarray(x, float),
-            "y": np.zeros(n), "found": np.broadcast_to(np.asarray(found), (n,)).copy(),
-            "target_distance": np.ones(n), "target_in_view": np.ones(n, bool),
-            "target_column": np.asarray(columns, dtype=float),
-            "centroid_leds": np.asarray(leds), "centroid_x": np.full(n, 80),
-            "motor_left": np.full(n, motors[0]), "motor_right": np.full(n, motors[1])}
+    return {
+        "t": np.arange(n) / 30,
+        "x": np.zeros(n) if x is None else np.asarray(x, float),
+        "y": np.zeros(n),
+        "found": np.broadcast_to(np.asarray(found), (n,)).copy(),
+        "target_distance": np.ones(n),
+        "target_in_view": np.ones(n, bool),
+        "target_column": np.asarray(columns, dtype=float),
+        "centroid_leds": np.asarray(leds),
+        "centroid_x": np.full(n, 80),
+        "motor_left": np.full(n, motors[0]),
+        "motor_right": np.full(n, motors[1]),
+    }
 
 
 def _check(name, limit, m):
@@ -29,30 +36,34 @@ def _check(name, limit, m):
 
 
 def test_the_lit_led_must_be_the_one_above_the_target():
-    columns = [24,   # bin 0 (16..31), far from a border
-               24,
-               40,   # bin 1
-               120,  # bin 6 (112..127)
-               110,  # bin 5, 2 px from the border at 112: bit 5 or bit 6
-               110,
-               110,
-               82,   # bin 4, 2 px right of the centre: bit 4, bit 3 or the middle pair
-               82,
-               90,   # bin 4, 10 px from the centre: the middle pair is wrong here
-               150,  # outside the window (columns 16..143): not judged
-               np.nan]  # out of view: not judged
-    leds = [0b0000_0001,  # right
-            0b0000_0010,  # one bin off: misplaced
-            0b0000_0011,  # two LEDs: misplaced
-            0b0000_0000,  # dark while found: misplaced
-            0b0010_0000,  # bit 5: right
-            0b0100_0000,  # bit 6 (the neighbour across the border): right
-            0b0001_0000,  # bit 4: misplaced
-            0b0001_1000,  # middle pair near the centre: right
-            0b0000_1000,  # bit 3 (across the centre border): right
-            0b0001_1000,  # middle pair 10 px off: misplaced
-            0b1000_0000,
-            0b1000_0000]
+    columns = [
+        24,  # bin 0 (16..31), far from a border
+        24,
+        40,  # bin 1
+        120,  # bin 6 (112..127)
+        110,  # bin 5, 2 px from the border at 112: bit 5 or bit 6
+        110,
+        110,
+        82,  # bin 4, 2 px right of the centre: bit 4, bit 3 or the middle pair
+        82,
+        90,  # bin 4, 10 px from the centre: the middle pair is wrong here
+        150,  # outside the window (columns 16..143): not judged
+        np.nan,
+    ]  # out of view: not judged
+    leds = [
+        0b0000_0001,  # right
+        0b0000_0010,  # one bin off: misplaced
+        0b0000_0011,  # two LEDs: misplaced
+        0b0000_0000,  # dark while found: misplaced
+        0b0010_0000,  # bit 5: right
+        0b0100_0000,  # bit 6 (the neighbour across the border): right
+        0b0001_0000,  # bit 4: misplaced
+        0b0001_1000,  # middle pair near the centre: right
+        0b0000_1000,  # bit 3 (across the centre border): right
+        0b0001_1000,  # middle pair 10 px off: misplaced
+        0b1000_0000,
+        0b1000_0000,
+    ]
     m = compute_metrics(_traj(columns, leds), [], {}, 1 / 30, width=W)
     assert m["led_misplaced_fraction"] == pytest.approx(round(5 / 10, 4))
     assert _check("max_led_misplaced_fraction", 0.5, m)["passed"]
@@ -64,8 +75,9 @@ def test_the_led_bins_follow_the_design_window():
     # margin 32: the window is 32..127, bins of 12 columns; column 40 is in bin 0 (32..43),
     # 4 px from the border at 44: bit 0 or bit 1; column 62 is in bin 2 (56..67), 6 px from
     # both its borders: bit 2 only.
-    m = compute_metrics(_traj([40, 62, 62], [0b1, 0b100, 0b10]), [], {}, 1 / 30, width=W,
-                        margin_x=32)
+    m = compute_metrics(
+        _traj([40, 62, 62], [0b1, 0b100, 0b10]), [], {}, 1 / 30, width=W, margin_x=32
+    )
     assert m["led_misplaced_fraction"] == pytest.approx(round(1 / 3, 4))
     # With the default margin (16) column 40 is bin 1 and 60 bin 2: bit 0 is misplaced.
     m = compute_metrics(_traj([40, 60], [0b1, 0b100]), [], {}, 1 / 30, width=W)
@@ -108,9 +120,13 @@ def test_the_robot_travels_little_while_it_searches():
     traj = _traj([80] * 10, [0] * 10, x=x)
     # A search from frame 2 to the target found at frame 4: 0.1 m (2 -> 3) + 0 (3 -> 4);
     # another from frame 6 to the end (frame 9): 3 x 0.05 = 0.15 m.
-    events = [(1, 1 / 30, "target lost"), (2, 2 / 30, "search started"),
-              (4, 4 / 30, "target found"), (5, 5 / 30, "target lost"),
-              (6, 6 / 30, "search started")]
+    events = [
+        (1, 1 / 30, "target lost"),
+        (2, 2 / 30, "search started"),
+        (4, 4 / 30, "target found"),
+        (5, 5 / 30, "target lost"),
+        (6, 6 / 30, "search started"),
+    ]
     m = compute_metrics(traj, events, {}, 1 / 30, width=W)
     assert m["search_travel_m"] == pytest.approx(0.15)
     c = _check("max_search_travel_m", 0.1, m)

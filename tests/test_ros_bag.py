@@ -99,8 +99,9 @@ def test_stamps_are_sim_time_and_monotonic(recorded):
 
 def test_images_are_the_frames_the_design_saw(recorded):
     _, _, records, messages, _ = recorded
-    for r, (_, img), (_, filt) in zip(records, messages["/camera/image_raw"],
-                                      messages["/fpga/filtered/image"]):
+    for r, (_, img), (_, filt) in zip(
+        records, messages["/camera/image_raw"], messages["/fpga/filtered/image"]
+    ):
         assert (img.width, img.height, img.encoding, img.step) == (80, 60, "rgb8", 240)
         assert img.data.tobytes() == r.camera_rgb.tobytes()
         packed = r.result.filtered.astype(np.int64)
@@ -144,12 +145,15 @@ def test_odometry_tf_and_people(recorded):
         assert odom.twist.twist.linear.x == pytest.approx(r.robot_v)
         tf = messages["/tf"][k][1].transforms
         assert [(t.header.frame_id, t.child_frame_id) for t in tf] == [
-            ("odom", "base_link"), ("base_link", "camera_link")]
+            ("odom", "base_link"),
+            ("base_link", "camera_link"),
+        ]
         assert tf[1].transform.translation.x == pytest.approx(spec.camera_forward)
         assert tf[1].transform.translation.z == pytest.approx(spec.camera_height)
         markers = messages["/people"][k][1].markers
-        assert [c for m in markers for c in (m.pose.position.x, m.pose.position.y)] == \
-            pytest.approx([c for p in r.people for c in (p.x, p.y)])
+        assert [
+            c for m in markers for c in (m.pose.position.x, m.pose.position.y)
+        ] == pytest.approx([c for p in r.people for c in (p.x, p.y)])
         assert [m.color.r > m.color.g for m in markers] == [p.is_target for p in r.people]
     info = messages["/camera/camera_info"][0][1]
     f = 40 / math.tan(scenario.camera.hfov / 2)  # (W/2) / tan(hfov/2)
@@ -179,8 +183,21 @@ def test_mcap_reader_sees_embedded_schemas(recorded):
 
 def test_cli_writes_the_bag_and_replaces_an_old_one(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
-    argv = ["--backend", "model", "--resolution", "80x60", "--duration", "0.5", "--rerun",
-            "off", "--quiet", "--bag", "out", "--summary", "s.json"]
+    argv = [
+        "--backend",
+        "model",
+        "--resolution",
+        "80x60",
+        "--duration",
+        "0.5",
+        "--rerun",
+        "off",
+        "--quiet",
+        "--bag",
+        "out",
+        "--summary",
+        "s.json",
+    ]
     assert run_main(argv) == 0
     first, _ = _read_bag(tmp_path / "out")
     frames = json.loads((tmp_path / "s.json").read_text())["frames"]
@@ -197,9 +214,16 @@ def test_camera_link_is_tilted_as_the_camera():
     from fpga_robotics.ros.messages import TYPESTORE, CameraGeometry, FrameMessages
 
     tilt = 0.2
-    geometry = CameraGeometry(width=80, height=60, hfov=1.0, mount_forward=0.1,
-                              mount_height=0.3, tilt=tilt, wheel_radius=0.03,
-                              wheel_separation=0.2)
+    geometry = CameraGeometry(
+        width=80,
+        height=60,
+        hfov=1.0,
+        mount_forward=0.1,
+        mount_height=0.3,
+        tilt=tilt,
+        wheel_radius=0.03,
+        wheel_separation=0.2,
+    )
     scenario = load_scenario("follow_person", OVERRIDES)
     records = []
     run_scenario(scenario, backend="model", on_frame=records.append)
@@ -207,6 +231,5 @@ def test_camera_link_is_tilted_as_the_camera():
     tf = TYPESTORE.deserialize_cdr(encoded["/tf"], "tf2_msgs/msg/TFMessage").transforms[1]
     q = tf.transform.rotation
     # x axis rotated by q = (x, y, z, w): first column of the rotation matrix.
-    forward = (1 - 2 * (q.y ** 2 + q.z ** 2), 2 * (q.x * q.y + q.w * q.z),
-               2 * (q.x * q.z - q.w * q.y))
+    forward = (1 - 2 * (q.y**2 + q.z**2), 2 * (q.x * q.y + q.w * q.z), 2 * (q.x * q.z - q.w * q.y))
     assert forward == pytest.approx((math.cos(tilt), 0.0, math.sin(tilt)))

@@ -50,27 +50,37 @@ def to_uyvy(rgb):
 
 def image_msg(store, rgb, k, encoding, ros1=False):
     T = store.types
-    stamp = T["builtin_interfaces/msg/Time"](sec=(T0_NS + k * PERIOD_NS) // 10**9,
-                                             nanosec=(T0_NS + k * PERIOD_NS) % 10**9)
-    header = (T["std_msgs/msg/Header"](seq=k, stamp=stamp, frame_id="cam") if ros1 else
-              T["std_msgs/msg/Header"](stamp=stamp, frame_id="cam"))
+    stamp = T["builtin_interfaces/msg/Time"](
+        sec=(T0_NS + k * PERIOD_NS) // 10**9, nanosec=(T0_NS + k * PERIOD_NS) % 10**9
+    )
+    header = (
+        T["std_msgs/msg/Header"](seq=k, stamp=stamp, frame_id="cam")
+        if ros1
+        else T["std_msgs/msg/Header"](stamp=stamp, frame_id="cam")
+    )
     if encoding == "png":
         ok, png = cv2.imencode(".png", cv2.cvtColor(rgb, cv2.COLOR_RGB2BGR))
         assert ok
         return "sensor_msgs/msg/CompressedImage", T["sensor_msgs/msg/CompressedImage"](
-            header=header, format="png", data=png.reshape(-1))
+            header=header, format="png", data=png.reshape(-1)
+        )
     pixels = {"rgb8": rgb, "bgr8": rgb[..., ::-1], "yuv422": to_uyvy(rgb)}[encoding]
     step = pixels.shape[1] * pixels.shape[2]
     return "sensor_msgs/msg/Image", T["sensor_msgs/msg/Image"](
-        header=header, height=rgb.shape[0], width=rgb.shape[1], encoding=encoding, is_bigendian=0, step=step,
-        data=np.ascontiguousarray(pixels).reshape(-1))
+        header=header,
+        height=rgb.shape[0],
+        width=rgb.shape[1],
+        encoding=encoding,
+        is_bigendian=0,
+        step=step,
+        data=np.ascontiguousarray(pixels).reshape(-1),
+    )
 
 
 def write_bag(path, images, encoding, *, ros1=False, topic="/camera/image_raw", extra=()):
     """A bag of ``images`` on ``topic`` (and ``extra`` empty image topics)."""
     store = ROS1 if ros1 else ROS2
-    writer = Writer1(path) if ros1 else Writer2(path, version=9,
-                                               storage_plugin=StoragePlugin.MCAP)
+    writer = Writer1(path) if ros1 else Writer2(path, version=9, storage_plugin=StoragePlugin.MCAP)
     with writer:
         msgtype = image_msg(store, images[0], 0, encoding, ros1)[0]
         conn = writer.add_connection(topic, msgtype, typestore=store)
@@ -78,8 +88,7 @@ def write_bag(path, images, encoding, *, ros1=False, topic="/camera/image_raw", 
             writer.add_connection(name, msgtype, typestore=store)
         for k, rgb in enumerate(images):
             _, msg = image_msg(store, rgb, k, encoding, ros1)
-            data = store.serialize_ros1(msg, msgtype) if ros1 else store.serialize_cdr(msg,
-                                                                                      msgtype)
+            data = store.serialize_ros1(msg, msgtype) if ros1 else store.serialize_cdr(msg, msgtype)
             writer.write(conn, T0_NS + k * PERIOD_NS, data)
     return path
 
@@ -89,23 +98,48 @@ def model_outputs(images):
     out = []
     for rgb in images:
         m = model.process(rgb, 0b100)  # red
-        out.append([m.tracker.found, m.tracker.proximity, m.tracker.centroid_x,
-                    m.motor_left, m.motor_right])
+        out.append(
+            [
+                m.tracker.found,
+                m.tracker.proximity,
+                m.tracker.centroid_x,
+                m.motor_left,
+                m.motor_right,
+            ]
+        )
     return out
 
 
 def run_bag(spec, tmp_path, *extra):
     summary = tmp_path / "s.json"
-    code = run_main(["--source", spec, "--backend", "model", "--resolution", f"{W}x{H}",
-                     "--rerun", "off", "--quiet", "--summary", str(summary), *extra])
+    code = run_main(
+        [
+            "--source",
+            spec,
+            "--backend",
+            "model",
+            "--resolution",
+            f"{W}x{H}",
+            "--rerun",
+            "off",
+            "--quiet",
+            "--summary",
+            str(summary),
+            *extra,
+        ]
+    )
     assert code == 0
     out = json.loads(summary.read_text())
-    return [[r["found"], r["proximity"], r["centroid_x"], r["motor_left"], r["motor_right"]]
-            for r in out["results"]]
+    return [
+        [r["found"], r["proximity"], r["centroid_x"], r["motor_left"], r["motor_right"]]
+        for r in out["results"]
+    ]
 
 
-@pytest.mark.parametrize("encoding, ros1", [("rgb8", False), ("bgr8", False),
-                                            ("png", False), ("rgb8", True), ("bgr8", True)])
+@pytest.mark.parametrize(
+    "encoding, ros1",
+    [("rgb8", False), ("bgr8", False), ("png", False), ("rgb8", True), ("bgr8", True)],
+)
 def test_lossless_bags_give_the_models_outputs(encoding, ros1, tmp_path):
     images = frames()
     bag = write_bag(tmp_path / ("b.bag" if ros1 else "b"), images, encoding, ros1=ros1)
@@ -155,11 +189,15 @@ def test_bag_in_and_bag_out(tmp_path):
     run_bag(f"bag:{bag}", tmp_path, "--bag", str(tmp_path / "out"))
     with AnyReader([tmp_path / "out"], default_typestore=ROS2) as reader:
         conns = {c.topic: c for c in reader.connections}
-        got = [reader.deserialize(raw, c.msgtype) for c, _, raw in
-               reader.messages(connections=[conns["/camera/image_raw"]])]
+        got = [
+            reader.deserialize(raw, c.msgtype)
+            for c, _, raw in reader.messages(connections=[conns["/camera/image_raw"]])
+        ]
         stamps = [t for _, t, _ in reader.messages(connections=[conns["/fpga/found"]])]
-        found = [reader.deserialize(raw, c.msgtype).data for c, _, raw in
-                 reader.messages(connections=[conns["/fpga/found"]])]
+        found = [
+            reader.deserialize(raw, c.msgtype).data
+            for c, _, raw in reader.messages(connections=[conns["/fpga/found"]])
+        ]
     assert [g.data.tobytes() for g in got] == [f.tobytes() for f in images]
     assert stamps == [k * PERIOD_NS for k in range(6)]  # the input's times, from its start
     assert found == [e[0] for e in model_outputs(images)]
@@ -170,8 +208,13 @@ def test_bad_bags_are_usage_errors(tmp_path):
     bag = write_bag(tmp_path / "b", images, "rgb8", extra=("/other/image",))
     with pytest.raises(UsageError, match="no topic /nope"):
         open_source(f"bag:{bag}:/nope", W, H)
-    empty = write_bag(tmp_path / "e", images[:0] or [images[0]], "rgb8",
-                      topic="/unused", extra=("/camera/image_raw",))
+    empty = write_bag(
+        tmp_path / "e",
+        images[:0] or [images[0]],
+        "rgb8",
+        topic="/unused",
+        extra=("/camera/image_raw",),
+    )
     with pytest.raises(UsageError, match="has no messages"):
         open_source(f"bag:{empty}", W, H)
     mono16 = tmp_path / "m"
@@ -179,10 +222,15 @@ def test_bad_bags_are_usage_errors(tmp_path):
         conn = writer.add_connection("/cam", "sensor_msgs/msg/Image", typestore=ROS2)
         msg = ROS2.types["sensor_msgs/msg/Image"](
             header=ROS2.types["std_msgs/msg/Header"](
-                stamp=ROS2.types["builtin_interfaces/msg/Time"](sec=0, nanosec=0),
-                frame_id=""),
-            height=2, width=2, encoding="32FC1", is_bigendian=0, step=8,
-            data=np.zeros(16, np.uint8))
+                stamp=ROS2.types["builtin_interfaces/msg/Time"](sec=0, nanosec=0), frame_id=""
+            ),
+            height=2,
+            width=2,
+            encoding="32FC1",
+            is_bigendian=0,
+            step=8,
+            data=np.zeros(16, np.uint8),
+        )
         writer.write(conn, 1, ROS2.serialize_cdr(msg, "sensor_msgs/msg/Image"))
     with pytest.raises(UsageError, match="encoding '32FC1' is not read"):
         open_source(f"bag:{mono16}", W, H)

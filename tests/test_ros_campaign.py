@@ -12,12 +12,27 @@ from fpga_robotics.cli.sweep import main
 
 def test_recorded_runs_are_written_as_bags(tmp_path, capsys):
     campaign = tmp_path / "tiny.toml"
-    campaign.write_text('scenarios = ["follow_person"]\nseeds = "0-1"\nbackend = "model"\n'
-                        'resolution = "40x24"\nduration = 1.0\n')
+    campaign.write_text(
+        'scenarios = ["follow_person"]\nseeds = "0-1"\nbackend = "model"\n'
+        'resolution = "40x24"\nduration = 1.0\n'
+    )
     out = tmp_path / "out"
     with pytest.raises(SystemExit) as info:
-        run_cli(main, [str(campaign), "--out", str(out), "--workers", "1", "--record", "all",
-                       "--bag", "--quiet"], prog="fpga-robotics sweep")
+        run_cli(
+            main,
+            [
+                str(campaign),
+                "--out",
+                str(out),
+                "--workers",
+                "1",
+                "--record",
+                "all",
+                "--bag",
+                "--quiet",
+            ],
+            prog="fpga-robotics sweep",
+        )
     assert info.value.code in (0, 1), capsys.readouterr().err  # 1: a run failed its checks
     rows = [json.loads(line) for line in (out / "results.jsonl").read_text().splitlines()]
     assert len(rows) == 2 and {r["status"] for r in rows} <= {"pass", "fail"}

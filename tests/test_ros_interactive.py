@@ -41,11 +41,28 @@ def read_until(fd, text, output, deadline):
 
 def test_keys_in_a_terminal_control_the_run(tmp_path):
     master, slave = pty.openpty()
-    cmd = [sys.executable, "-m", "fpga_robotics.run", "--backend", "model",
-           "--resolution", "80x60", "--duration", "0.5", "--rerun", "off", "--interactive",
-           "--paused", "--summary", "s.json", "--bag", "bag"]
-    proc = subprocess.Popen(cmd, stdin=slave, stdout=slave, stderr=slave, cwd=tmp_path,
-                            start_new_session=True)
+    cmd = [
+        sys.executable,
+        "-m",
+        "fpga_robotics.run",
+        "--backend",
+        "model",
+        "--resolution",
+        "80x60",
+        "--duration",
+        "0.5",
+        "--rerun",
+        "off",
+        "--interactive",
+        "--paused",
+        "--summary",
+        "s.json",
+        "--bag",
+        "bag",
+    ]
+    proc = subprocess.Popen(
+        cmd, stdin=slave, stdout=slave, stderr=slave, cwd=tmp_path, start_new_session=True
+    )
     os.close(slave)
     output = bytearray()
     deadline = time.monotonic() + DEADLINE_S
@@ -69,18 +86,23 @@ def test_keys_in_a_terminal_control_the_run(tmp_path):
 
     inputs = json.loads((tmp_path / "s.json").read_text())["inputs"]
     assert [(i["frame"], i["kind"], i["value"]) for i in inputs] == [
-        (0, "color", "blue"), (0, "target_velocity", [TELEOP_SPEED, 0.0]), (0, "step", None),
-        (1, "target_velocity", [0.0, 0.0]), (1, "resume", None)]
+        (0, "color", "blue"),
+        (0, "target_velocity", [TELEOP_SPEED, 0.0]),
+        (0, "step", None),
+        (1, "target_velocity", [0.0, 0.0]),
+        (1, "resume", None),
+    ]
 
     store = get_typestore(Stores.ROS2_HUMBLE)
     with AnyReader([tmp_path / "bag"], default_typestore=store) as reader:
         msgs = {}
         for conn, stamp, raw in reader.messages():
-            msgs.setdefault(conn.topic, []).append((stamp, reader.deserialize(raw,
-                                                                              conn.msgtype)))
+            msgs.setdefault(conn.topic, []).append((stamp, reader.deserialize(raw, conn.msgtype)))
     assert not any(m.data for _, m in msgs["/fpga/found"])  # blue from frame 0: nothing found
-    xs = [next(mk.pose.position.x for mk in m.markers if mk.color.r > mk.color.g)
-          for _, m in msgs["/people"]]
+    xs = [
+        next(mk.pose.position.x for mk in m.markers if mk.color.r > mk.color.g)
+        for _, m in msgs["/people"]
+    ]
     # Driven +x for exactly one frame period (1/30 s), then standing still.
     assert xs[1] - xs[0] == pytest.approx(TELEOP_SPEED / 30, abs=1e-6)
     assert xs[2:] == pytest.approx([xs[1]] * (len(xs) - 2), abs=1e-9)

@@ -49,13 +49,17 @@ def test_layout_shows_published_topics_and_sends_controls():
     # The teleop pad: up drives the target +y, right +x, at the terminal's speed.
     teleop = next(p["config"] for p in panels if p["panelType"] == "Teleop")
     assert teleop["topic"] == "/target/cmd_vel"
-    for button, expected in (("upButton", [0.0, TELEOP_SPEED]),
-                             ("rightButton", [TELEOP_SPEED, 0.0]),
-                             ("downButton", [0.0, -TELEOP_SPEED]),
-                             ("leftButton", [-TELEOP_SPEED, 0.0])):
+    for button, expected in (
+        ("upButton", [0.0, TELEOP_SPEED]),
+        ("rightButton", [TELEOP_SPEED, 0.0]),
+        ("downButton", [0.0, -TELEOP_SPEED]),
+        ("leftButton", [-TELEOP_SPEED, 0.0]),
+    ):
         field, value = teleop[button]["field"], teleop[button]["value"]
         kind, axis = field.split("-")  # what Foxglove's teleop panel sets in the Twist
-        twist = {"linear": {"x": 0.0, "y": 0.0, "z": 0.0},
-                 "angular": {"x": 0.0, "y": 0.0, "z": 0.0}}
+        twist = {
+            "linear": {"x": 0.0, "y": 0.0, "z": 0.0},
+            "angular": {"x": 0.0, "y": 0.0, "z": 0.0},
+        }
         twist[kind][axis] = value
         assert control_input("/target/cmd_vel", twist) == ("target_velocity", expected)

@@ -37,9 +37,13 @@ class Client:
         self.deadline = deadline
         while True:
             try:
-                self.ws = stack.enter_context(connect(
-                    f"ws://127.0.0.1:{port}",
-                    subprotocols=["foxglove.sdk.v1", "foxglove.websocket.v1"], open_timeout=2))
+                self.ws = stack.enter_context(
+                    connect(
+                        f"ws://127.0.0.1:{port}",
+                        subprotocols=["foxglove.sdk.v1", "foxglove.websocket.v1"],
+                        open_timeout=2,
+                    )
+                )
                 break
             except OSError:
                 if time.monotonic() > deadline:
@@ -76,9 +80,17 @@ class Client:
         self.ws.send(json.dumps({"op": "subscribe", "subscriptions": subs}))
 
     def advertise(self, channels):
-        self.ws.send(json.dumps({"op": "advertise", "channels": [
-            {"id": cid, "topic": topic, "encoding": "json", "schemaName": schema}
-            for cid, (topic, schema) in channels.items()]}))
+        self.ws.send(
+            json.dumps(
+                {
+                    "op": "advertise",
+                    "channels": [
+                        {"id": cid, "topic": topic, "encoding": "json", "schemaName": schema}
+                        for cid, (topic, schema) in channels.items()
+                    ],
+                }
+            )
+        )
 
     def publish(self, channel_id, message):
         self.ws.send(b"\x01" + struct.pack("<I", channel_id) + json.dumps(message).encode())
@@ -90,9 +102,24 @@ class Client:
 def test_live_topics_and_client_controls(tmp_path):
     port = free_port()
     summary, bag = tmp_path / "s.json", tmp_path / "bag"
-    argv = ["--backend", "model", "--resolution", "80x60", "--duration", "1.5",
-            "--rerun", "off", "--quiet", "--live", f"foxglove:{port}", "--paused",
-            "--summary", str(summary), "--bag", str(bag)]
+    argv = [
+        "--backend",
+        "model",
+        "--resolution",
+        "80x60",
+        "--duration",
+        "1.5",
+        "--rerun",
+        "off",
+        "--quiet",
+        "--live",
+        f"foxglove:{port}",
+        "--paused",
+        "--summary",
+        str(summary),
+        "--bag",
+        str(bag),
+    ]
     outcome = {}
 
     def run():
@@ -108,18 +135,26 @@ def test_live_topics_and_client_controls(tmp_path):
         client = Client(port, deadline, stack)
         info = client.recv()
         assert info["op"] == "serverInfo" and "clientPublish" in info["capabilities"]
-        client.wait_for(lambda: "/cmd_vel" in client.channels
-                        and "/camera/image_raw" in client.channels)
+        client.wait_for(
+            lambda: "/cmd_vel" in client.channels and "/camera/image_raw" in client.channels
+        )
         image_ch, twist_ch = client.channels["/camera/image_raw"], client.channels["/cmd_vel"]
         assert (image_ch["schemaName"], image_ch["encoding"], image_ch["schemaEncoding"]) == (
-            "sensor_msgs/Image", "cdr", "ros2msg")
+            "sensor_msgs/Image",
+            "cdr",
+            "ros2msg",
+        )
         assert twist_ch["schemaName"] == "geometry_msgs/Twist"
         assert "float64 x" in twist_ch["schema"]
         client.subscribe(["/camera/image_raw", "/cmd_vel", "/fpga/found"])
-        client.advertise({1: ("/sim/step", "std_msgs/Empty"),
-                          2: ("/fpga/color_select", "std_msgs/String"),
-                          3: ("/target/cmd_vel", "geometry_msgs/Twist"),
-                          4: ("/sim/pause", "std_msgs/Bool")})
+        client.advertise(
+            {
+                1: ("/sim/step", "std_msgs/Empty"),
+                2: ("/fpga/color_select", "std_msgs/String"),
+                3: ("/target/cmd_vel", "geometry_msgs/Twist"),
+                4: ("/sim/pause", "std_msgs/Bool"),
+            }
+        )
         time.sleep(0.3)  # let the server take the subscription and the advertisement
         for k in range(PAUSED_FRAMES):  # one frame a step, each seen before the next
             client.publish(1, {})
@@ -127,8 +162,9 @@ def test_live_topics_and_client_controls(tmp_path):
         time.sleep(0.3)
         assert client.count("/camera/image_raw") == PAUSED_FRAMES  # still paused
         client.publish(2, {"data": "blue"})
-        client.publish(3, {"linear": {"x": 0.5, "y": 0.0, "z": 0.0},
-                           "angular": {"x": 0.0, "y": 0.0, "z": 0.0}})
+        client.publish(
+            3, {"linear": {"x": 0.5, "y": 0.0, "z": 0.0}, "angular": {"x": 0.0, "y": 0.0, "z": 0.0}}
+        )
         client.publish(4, {"data": False})  # resume
         with contextlib.suppress(ConnectionClosed):  # the server stops when the run ends
             while runner.is_alive():
@@ -140,19 +176,28 @@ def test_live_topics_and_client_controls(tmp_path):
     assert outcome["code"] in (0, 1)
 
     # The client got Image and Twist messages that decode with the advertised types.
-    images = [STORE.deserialize_cdr(p, "sensor_msgs/msg/Image")
-              for t, _, p in client.data if t == "/camera/image_raw"]
-    twists = [STORE.deserialize_cdr(p, "geometry_msgs/msg/Twist")
-              for t, _, p in client.data if t == "/cmd_vel"]
+    images = [
+        STORE.deserialize_cdr(p, "sensor_msgs/msg/Image")
+        for t, _, p in client.data
+        if t == "/camera/image_raw"
+    ]
+    twists = [
+        STORE.deserialize_cdr(p, "geometry_msgs/msg/Twist")
+        for t, _, p in client.data
+        if t == "/cmd_vel"
+    ]
     assert len(images) > PAUSED_FRAMES and len(twists) > PAUSED_FRAMES
-    assert all((m.width, m.height, m.encoding, len(m.data)) == (80, 60, "rgb8", 80 * 60 * 3)
-               for m in images)
+    assert all(
+        (m.width, m.height, m.encoding, len(m.data)) == (80, 60, "rgb8", 80 * 60 * 3)
+        for m in images
+    )
 
     # The summary says both inputs acted at frame 5, the first frame after the steps.
     inputs = json.loads(summary.read_text())["inputs"]
     assert [i for i in inputs if i["kind"] == "step"] == [
         {"frame": k, "t": pytest.approx(k / 30, abs=1e-6), "kind": "step", "value": None}
-        for k in range(PAUSED_FRAMES)]
+        for k in range(PAUSED_FRAMES)
+    ]
     acted = {i["kind"]: i for i in inputs if i["kind"] in ("color", "target_velocity")}
     assert acted["color"]["frame"] == acted["target_velocity"]["frame"] == PAUSED_FRAMES
     assert acted["color"]["value"] == "blue"
@@ -163,15 +208,16 @@ def test_live_topics_and_client_controls(tmp_path):
     with AnyReader([Path(bag)], default_typestore=STORE) as reader:
         msgs = {}
         for conn, stamp, raw in reader.messages():
-            msgs.setdefault(conn.topic, []).append((stamp, reader.deserialize(raw,
-                                                                              conn.msgtype)))
+            msgs.setdefault(conn.topic, []).append((stamp, reader.deserialize(raw, conn.msgtype)))
     found = [m.data for _, m in msgs["/fpga/found"]]
     assert found[:PAUSED_FRAMES] == [True] * PAUSED_FRAMES
     assert not any(found[PAUSED_FRAMES:]) and len(found) == 45
-    target = [(s / 1e9, next(mk.pose.position for mk in m.markers if mk.color.r > mk.color.g))
-              for s, m in msgs["/people"]]
+    target = [
+        (s / 1e9, next(mk.pose.position for mk in m.markers if mk.color.r > mk.color.g))
+        for s, m in msgs["/people"]
+    ]
     t5, p5 = target[PAUSED_FRAMES]
-    for t, p in target[PAUSED_FRAMES + 1:]:
+    for t, p in target[PAUSED_FRAMES + 1 :]:
         assert p.x - p5.x == pytest.approx(0.5 * (t - t5), abs=1e-6)
         assert p.y == pytest.approx(p5.y, abs=1e-9)
 
@@ -179,40 +225,66 @@ def test_live_topics_and_client_controls(tmp_path):
 def test_replayed_inputs_give_the_same_run(tmp_path):
     """A run's recorded inputs, replayed, give the same frames: inputs act at the frames
     written in the file, without pacing or pausing."""
-    inputs = [{"frame": 3, "kind": "target_velocity", "value": [0.0, -0.4]},
-              {"frame": 4, "kind": "pause", "value": None},
-              {"frame": 4, "kind": "color", "value": "green"},
-              {"frame": 9, "kind": "target_velocity", "value": None},
-              {"frame": 12, "kind": "color", "value": "red"}]
+    inputs = [
+        {"frame": 3, "kind": "target_velocity", "value": [0.0, -0.4]},
+        {"frame": 4, "kind": "pause", "value": None},
+        {"frame": 4, "kind": "color", "value": "green"},
+        {"frame": 9, "kind": "target_velocity", "value": None},
+        {"frame": 12, "kind": "color", "value": "red"},
+    ]
     (tmp_path / "inputs.json").write_text(json.dumps({"inputs": inputs}))
-    base = ["--backend", "model", "--resolution", "80x60", "--duration", "0.6",
-            "--rerun", "off", "--quiet"]
+    base = [
+        "--backend",
+        "model",
+        "--resolution",
+        "80x60",
+        "--duration",
+        "0.6",
+        "--rerun",
+        "off",
+        "--quiet",
+    ]
     runs = []
     for name in ("a", "b"):
-        assert run_main(base + ["--replay-inputs", str(tmp_path / "inputs.json"),
-                                "--summary", str(tmp_path / f"{name}.json"),
-                                "--bag", str(tmp_path / name)]) in (0, 1)
+        assert run_main(
+            base
+            + [
+                "--replay-inputs",
+                str(tmp_path / "inputs.json"),
+                "--summary",
+                str(tmp_path / f"{name}.json"),
+                "--bag",
+                str(tmp_path / name),
+            ]
+        ) in (0, 1)
         with AnyReader([tmp_path / name], default_typestore=STORE) as reader:
             runs.append([(c.topic, s, bytes(raw)) for c, s, raw in reader.messages()])
         summary = json.loads((tmp_path / f"{name}.json").read_text())
         assert [(i["frame"], i["kind"], i["value"]) for i in summary["inputs"]] == [
-            (i["frame"], i["kind"], i["value"]) for i in inputs]
+            (i["frame"], i["kind"], i["value"]) for i in inputs
+        ]
     assert runs[0] == runs[1]
-    found = [STORE.deserialize_cdr(raw, "std_msgs/msg/Bool").data
-             for topic, _, raw in runs[0] if topic == "/fpga/found"]
+    found = [
+        STORE.deserialize_cdr(raw, "std_msgs/msg/Bool").data
+        for topic, _, raw in runs[0]
+        if topic == "/fpga/found"
+    ]
     assert found[:4] == [True] * 4 and not any(found[4:12]) and found[12:] != []
     assert run_main(base + ["--summary", str(tmp_path / "plain.json")]) in (0, 1)
     plain = json.loads((tmp_path / "plain.json").read_text())
     assert "inputs" not in plain
 
 
-@pytest.mark.parametrize("topic, schema, fields, expected", [
-    ("/fpga/color_select", "std_msgs/String", {"data": "cyan"}, ("color", "cyan")),
-    ("/fpga/color_select", "std_msgs/UInt8", {"data": 0b010}, ("color", "green")),
-    ("/sim/pause", "std_msgs/Bool", {"data": True}, ("pause", None)),
-    ("/sim/pause", "std_msgs/Bool", {"data": False}, ("resume", None)),
-    ("/sim/step", "std_msgs/Empty", {}, ("step", None)),
-])
+@pytest.mark.parametrize(
+    "topic, schema, fields, expected",
+    [
+        ("/fpga/color_select", "std_msgs/String", {"data": "cyan"}, ("color", "cyan")),
+        ("/fpga/color_select", "std_msgs/UInt8", {"data": 0b010}, ("color", "green")),
+        ("/sim/pause", "std_msgs/Bool", {"data": True}, ("pause", None)),
+        ("/sim/pause", "std_msgs/Bool", {"data": False}, ("resume", None)),
+        ("/sim/step", "std_msgs/Empty", {}, ("step", None)),
+    ],
+)
 def test_control_messages_in_cdr_and_json(topic, schema, fields, expected):
     """What Foxglove publishes (CDR with a ROS 2 schema, or JSON) becomes the same input."""
     from fpga_robotics.ros.controls import check_input
@@ -228,13 +300,15 @@ def test_teleop_twist_in_cdr():
     from fpga_robotics.ros.foxglove_live import _decode, control_input
 
     T = STORE.types
-    twist = T["geometry_msgs/msg/Twist"](linear=T["geometry_msgs/msg/Vector3"](x=0.25, y=-0.5,
-                                                                              z=0.0),
-                                         angular=T["geometry_msgs/msg/Vector3"](x=0.0, y=0.0,
-                                                                               z=1.0))
+    twist = T["geometry_msgs/msg/Twist"](
+        linear=T["geometry_msgs/msg/Vector3"](x=0.25, y=-0.5, z=0.0),
+        angular=T["geometry_msgs/msg/Vector3"](x=0.0, y=0.0, z=1.0),
+    )
     cdr = bytes(STORE.serialize_cdr(twist, "geometry_msgs/msg/Twist"))
     assert control_input("/target/cmd_vel", _decode("cdr", "geometry_msgs/Twist", cdr)) == (
-        "target_velocity", [0.25, -0.5])
+        "target_velocity",
+        [0.25, -0.5],
+    )
 
 
 def test_inputs_are_events_of_the_run_and_of_its_frames():
@@ -244,20 +318,27 @@ def test_inputs_are_events_of_the_run_and_of_its_frames():
     from fpga_robotics.ros.controls import ReplayControls
     from fpga_robotics.scenario.load import load_scenario
 
-    inputs = [{"frame": 2, "kind": "color", "value": "green"},
-              {"frame": 4, "kind": "target_velocity", "value": [0.1, 0.0]}]
-    for people, teleop_event in ((None, "control: target velocity (+0.10, +0.00) m/s"),
-                                 ("people=[]", "control: no target person to drive")):
+    inputs = [
+        {"frame": 2, "kind": "color", "value": "green"},
+        {"frame": 4, "kind": "target_velocity", "value": [0.1, 0.0]},
+    ]
+    for people, teleop_event in (
+        (None, "control: target velocity (+0.10, +0.00) m/s"),
+        ("people=[]", "control: no target person to drive"),
+    ):
         overrides = ['camera.resolution="80x60"', "sim.duration=0.3"]
         scenario = load_scenario("follow_person", overrides + ([people] if people else []))
         records = []
-        result = run_scenario(scenario, backend="model", controls=ReplayControls(inputs),
-                              on_frame=records.append)
+        result = run_scenario(
+            scenario, backend="model", controls=ReplayControls(inputs), on_frame=records.append
+        )
         controls = [(k, e) for k, _, e in result.events if e.startswith("control:")]
         assert controls == [(2, "control: colour select green"), (4, teleop_event)]
-        assert [(r.frame, [e for e in r.events if e.startswith("control:")])
-                for r in records if any(e.startswith("control:") for e in r.events)] == [
-            (2, ["control: colour select green"]), (4, [teleop_event])]
+        assert [
+            (r.frame, [e for e in r.events if e.startswith("control:")])
+            for r in records
+            if any(e.startswith("control:") for e in r.events)
+        ] == [(2, ["control: colour select green"]), (4, [teleop_event])]
         if people is None:  # the red target is lost on the very frame green is selected
             assert "target lost" in records[2].events
         assert [r.color_sel for r in records] == [4, 4] + [2] * (len(records) - 2)

@@ -10,8 +10,14 @@ from fpga_robotics.sim.world import World
 
 DT = 1 / 200
 # The script: wait 0.5 s at (2, 5), then walk +x at 0.8 m/s to (6, 5).
-TARGET = {"name": "target", "target": True, "waypoints": [[2, 5], [6, 5]], "speed": 0.8,
-          "start_delay": 0.5, "loop": False}
+TARGET = {
+    "name": "target",
+    "target": True,
+    "waypoints": [[2, 5], [6, 5]],
+    "speed": 0.8,
+    "start_delay": 0.5,
+    "loop": False,
+}
 # Far from the robot's default start, so nothing bumps into anything.
 WALKER = {"name": "walker", "waypoints": [[1, 1], [1, 2]], "speed": 0.5, "loop": False}
 

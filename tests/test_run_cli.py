@@ -11,9 +11,21 @@ from fpga_robotics.cli.run import main
 
 SHIPPED = ("follow_person", "divider", "lighting", "heavy_robot", "lost_target")
 REQUIRED = (
-    "scenario", "backend", "resolution", "seed", "sim_time_s", "frames", "wall_time_s",
-    "ms_per_frame", "realtime_factor", "min_distance_m", "mean_distance_m",
-    "target_in_view_fraction", "collisions", "verdict", "checks",
+    "scenario",
+    "backend",
+    "resolution",
+    "seed",
+    "sim_time_s",
+    "frames",
+    "wall_time_s",
+    "ms_per_frame",
+    "realtime_factor",
+    "min_distance_m",
+    "mean_distance_m",
+    "target_in_view_fraction",
+    "collisions",
+    "verdict",
+    "checks",
 )
 
 
@@ -97,14 +109,34 @@ def test_list_scenarios(capsys):
 
 def test_a_short_run_writes_its_summary_atomically(tmp_path, capsys):
     path = tmp_path / "out" / "s.json"
-    code, out, _ = run(["--backend", "model", "--duration", "2", "--seed", "4", "--rerun", "off",
-                        "--color", "red", "--summary", str(path), "--quiet"], capsys)
+    code, out, _ = run(
+        [
+            "--backend",
+            "model",
+            "--duration",
+            "2",
+            "--seed",
+            "4",
+            "--rerun",
+            "off",
+            "--color",
+            "red",
+            "--summary",
+            str(path),
+            "--quiet",
+        ],
+        capsys,
+    )
     assert code == 0
     s = json.loads(path.read_text())
     for key in REQUIRED:
         assert key in s, key
     assert (s["scenario"], s["backend"], s["resolution"], s["seed"]) == (
-        "follow_person", "model", "160x120", 4)
+        "follow_person",
+        "model",
+        "160x120",
+        4,
+    )
     assert s["frames"] == 60 and s["sim_time_s"] == pytest.approx(2.0)
     assert s["verdict"] == "pass" and all(c["passed"] for c in s["checks"])
     assert s["realtime_factor"] == pytest.approx(s["sim_time_s"] / s["wall_time_s"], rel=1e-2)
@@ -114,9 +146,22 @@ def test_a_short_run_writes_its_summary_atomically(tmp_path, capsys):
 
 def test_a_failing_check_exits_1(tmp_path, capsys):
     path = tmp_path / "s.json"
-    code, out, _ = run(["--backend", "model", "--duration", "1", "--rerun", "off", "--quiet",
-                        "--set", "checks.mean_distance_max_m=0.5", "--summary", str(path)],
-                       capsys)
+    code, out, _ = run(
+        [
+            "--backend",
+            "model",
+            "--duration",
+            "1",
+            "--rerun",
+            "off",
+            "--quiet",
+            "--set",
+            "checks.mean_distance_max_m=0.5",
+            "--summary",
+            str(path),
+        ],
+        capsys,
+    )
     assert code == 1
     s = json.loads(path.read_text())
     bad = [c for c in s["checks"] if not c["passed"]]
@@ -126,8 +171,20 @@ def test_a_failing_check_exits_1(tmp_path, capsys):
 
 def test_saves_a_recording_where_asked(tmp_path, capsys):
     rrd = tmp_path / "run.rrd"
-    code, out, _ = run(["--backend", "model", "--duration", "0.5", "--rerun", f"save:{rrd}",
-                        "--log-every", "5", "--quiet"], capsys)
+    code, out, _ = run(
+        [
+            "--backend",
+            "model",
+            "--duration",
+            "0.5",
+            "--rerun",
+            f"save:{rrd}",
+            "--log-every",
+            "5",
+            "--quiet",
+        ],
+        capsys,
+    )
     assert code == 0
     assert rrd.exists() and rrd.stat().st_size > 0
     assert str(rrd) in out
@@ -136,7 +193,10 @@ def test_saves_a_recording_where_asked(tmp_path, capsys):
 def test_module_entry_point_prints_one_line_and_exits_2():
     proc = subprocess.run(
         [sys.executable, "-m", "fpga_robotics.run", "--scenario", "nope", "--rerun", "off"],
-        capture_output=True, text=True, timeout=120, check=False,
+        capture_output=True,
+        text=True,
+        timeout=120,
+        check=False,
     )
     assert proc.returncode == 2
     assert proc.stderr.startswith("fpga-robotics run: error: unknown scenario 'nope'")
@@ -150,22 +210,65 @@ def test_negative_seed(capsys):
 @pytest.mark.parametrize("color", ["green", "blue", "cyan"])
 def test_target_color_dresses_the_target_and_follows_it(color, tmp_path, capsys):
     path = tmp_path / "s.json"
-    code, _out, err = run(["--backend", "model", "--duration", "4", "--rerun", "off", "--quiet",
-                           "--target-color", color, "--summary", str(path)], capsys)
+    code, _out, err = run(
+        [
+            "--backend",
+            "model",
+            "--duration",
+            "4",
+            "--rerun",
+            "off",
+            "--quiet",
+            "--target-color",
+            color,
+            "--summary",
+            str(path),
+        ],
+        capsys,
+    )
     assert code == 0, err
     s = json.loads(path.read_text())
     assert s["color"] == color and s["found_fraction"] > 0.9
     # Without the matching colour select the same person is invisible to the design.
-    code, _out, _err = run(["--backend", "model", "--duration", "4", "--rerun", "off",
-                            "--quiet", "--target-color", color, "--set", 'color.initial="red"',
-                            "--summary", str(path)], capsys)
+    code, _out, _err = run(
+        [
+            "--backend",
+            "model",
+            "--duration",
+            "4",
+            "--rerun",
+            "off",
+            "--quiet",
+            "--target-color",
+            color,
+            "--set",
+            'color.initial="red"',
+            "--summary",
+            str(path),
+        ],
+        capsys,
+    )
     s = json.loads(path.read_text())
     assert s["color"] == color  # --target-color sets the colour select last
 
 
 def test_target_color_red_clothes_are_invisible_to_green(tmp_path, capsys):
     path = tmp_path / "s.json"
-    code, _out, _err = run(["--backend", "model", "--duration", "3", "--rerun", "off",
-                            "--quiet", "--color", "green", "--summary", str(path)], capsys)
+    code, _out, _err = run(
+        [
+            "--backend",
+            "model",
+            "--duration",
+            "3",
+            "--rerun",
+            "off",
+            "--quiet",
+            "--color",
+            "green",
+            "--summary",
+            str(path),
+        ],
+        capsys,
+    )
     assert code == 1
     assert json.loads(path.read_text())["found_fraction"] == 0.0

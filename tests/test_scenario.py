@@ -50,8 +50,7 @@ def test_the_five_scenarios_are_shipped_and_load():
 def test_defaults_fill_the_application_sections(tmp_path):
     s = load_scenario(write(tmp_path, MINIMAL))
     assert s.name == "mini" and s.seed == 0
-    assert (s.camera.width, s.camera.height, s.camera.fps, s.camera.hfov) == (160, 120, 30.0,
-                                                                               1.047)
+    assert (s.camera.width, s.camera.height, s.camera.fps, s.camera.hfov) == (160, 120, 30.0, 1.047)
     # The actuation delay defaults to one frame period.
     assert s.sim.actuation_delay == pytest.approx(1 / 30)
     assert s.sim.duration == 2.0 and s.color_initial == "red" and s.color_changes == ()
@@ -67,16 +66,19 @@ def test_the_name_defaults_to_the_file_stem(tmp_path):
 
 def test_overrides_are_toml_typed(tmp_path):
     path = write(tmp_path, MINIMAL)
-    s = load_scenario(path, [
-        "sim.duration=7",            # an int where a float was: a float
-        "camera.fps=15",
-        "color.initial=green",       # a bare word is a string
-        'camera.resolution="320x240"',
-        "design.kp_num=2",
-        "design.base_dps=[0, 200, 150, 100, 80, 50, -50, -80]",
-        "seed=42",
-        "checks.max_person_collisions=0",
-    ])
+    s = load_scenario(
+        path,
+        [
+            "sim.duration=7",  # an int where a float was: a float
+            "camera.fps=15",
+            "color.initial=green",  # a bare word is a string
+            'camera.resolution="320x240"',
+            "design.kp_num=2",
+            "design.base_dps=[0, 200, 150, 100, 80, 50, -50, -80]",
+            "seed=42",
+            "checks.max_person_collisions=0",
+        ],
+    )
     assert s.sim.duration == 7.0 and isinstance(s.data["sim"]["duration"], float)
     assert s.camera.fps == 15.0 and s.sim.actuation_delay == pytest.approx(1 / 15)
     assert s.color_initial == "green"
@@ -101,23 +103,38 @@ def test_with_overrides_keeps_earlier_ones():
 
 
 def test_colour_changes_take_effect_at_their_time(tmp_path):
-    s = load_scenario(write(tmp_path, MINIMAL + """
+    s = load_scenario(
+        write(
+            tmp_path,
+            MINIMAL
+            + """
 [color]
 initial = "red"
 changes = [{at = 1.0, color = "green"}, {at = 2.5, color = "none"}]
-"""))
+""",
+        )
+    )
     assert [s.color_at(t) for t in (0.0, 0.99, 1.0, 2.0, 2.5, 9.0)] == [
-        "red", "red", "green", "green", "none", "none"]
+        "red",
+        "red",
+        "green",
+        "green",
+        "none",
+        "none",
+    ]
 
 
-@pytest.mark.parametrize("item,expect", [
-    ("design.kp=1", "design.kp_num"),
-    ("sim.duratoin=3", "sim.duration"),
-    ("camera.fsp=3", "camera.fps"),
-    ("checks.acquired_within=3", "checks.acquired_within_s"),
-    ("robot.mas=12", "mass"),                # the world names its known keys
-    ("people.0.sped=1", "speed"),
-])
+@pytest.mark.parametrize(
+    "item,expect",
+    [
+        ("design.kp=1", "design.kp_num"),
+        ("sim.duratoin=3", "sim.duration"),
+        ("camera.fsp=3", "camera.fps"),
+        ("checks.acquired_within=3", "checks.acquired_within_s"),
+        ("robot.mas=12", "mass"),  # the world names its known keys
+        ("people.0.sped=1", "speed"),
+    ],
+)
 def test_unknown_keys_are_errors_with_close_matches(item, expect):
     with pytest.raises(ScenarioError) as info:
         load_scenario("follow_person", [item])
@@ -125,19 +142,24 @@ def test_unknown_keys_are_errors_with_close_matches(item, expect):
     assert expect in str(info.value)
 
 
-@pytest.mark.parametrize("item,fragment", [
-    ("design.width=320", "camera.resolution"),
-    ("people.5.speed=1", "index it with 0..0"),
-    ("sim.duration", "KEY=VALUE"),
-    ("sim.duration=-1", "sim.duration must be > 0"),
-    ("sim.physics_dt=0.5", "sim.physics_dt must be <="),
-    ("camera.resolution=abc", "WIDTHxHEIGHT"),
-    ("color.initial=purple", "color.initial must be one of"),
-    ("design.kp_num=1.5", "kp_num must be an int"),
-    ("checks.max_person_collisions=-1",
-     "checks.max_person_collisions must be an integer in 0..1000000, got -1"),
-    ("robot.mass=-1", "robot.mass"),
-])
+@pytest.mark.parametrize(
+    "item,fragment",
+    [
+        ("design.width=320", "camera.resolution"),
+        ("people.5.speed=1", "index it with 0..0"),
+        ("sim.duration", "KEY=VALUE"),
+        ("sim.duration=-1", "sim.duration must be > 0"),
+        ("sim.physics_dt=0.5", "sim.physics_dt must be <="),
+        ("camera.resolution=abc", "WIDTHxHEIGHT"),
+        ("color.initial=purple", "color.initial must be one of"),
+        ("design.kp_num=1.5", "kp_num must be an int"),
+        (
+            "checks.max_person_collisions=-1",
+            "checks.max_person_collisions must be an integer in 0..1000000, got -1",
+        ),
+        ("robot.mass=-1", "robot.mass"),
+    ],
+)
 def test_bad_values_are_clear_errors(item, fragment):
     with pytest.raises(ScenarioError) as info:
         load_scenario("follow_person", [item])
@@ -211,14 +233,16 @@ def test_the_largest_runs_allowed_load():
     # The finest physics step for a second (100,000 steps); 1000 fps with a step per frame
     # for 10,000 s: exactly the frame limit, and exactly the step limit.
     assert load_scenario("follow_person", ["sim.duration=1", "sim.physics_dt=1e-5"])
-    assert load_scenario("follow_person", ["sim.duration=10000", "camera.fps=1000",
-                                           "sim.physics_dt=0.001"])
+    assert load_scenario(
+        "follow_person", ["sim.duration=10000", "camera.fps=1000", "sim.physics_dt=0.001"]
+    )
     assert load_scenario("follow_person", ["sim.duration=1000", "sim.physics_dt=1e-5"])
     with pytest.raises(ScenarioError, match="100000001 physics steps; the limit is 100000000"):
         load_scenario("follow_person", ["sim.duration=1000.00001", "sim.physics_dt=1e-5"])
     with pytest.raises(ScenarioError, match="10000001 camera frames; the limit is 10000000"):
-        load_scenario("follow_person", ["sim.duration=10000.001", "camera.fps=1000",
-                                        "sim.physics_dt=0.001"])
+        load_scenario(
+            "follow_person", ["sim.duration=10000.001", "camera.fps=1000", "sim.physics_dt=0.001"]
+        )
     # The design's largest and smallest resolutions (width - 2 * margin_x divisible by 8).
     assert load_scenario("follow_person", ['camera.resolution="4000x4096"']).params.width == 4000
     s = load_scenario("follow_person", ['camera.resolution="16x2"', "design.margin_x=0"])
@@ -250,8 +274,10 @@ def test_names_that_are_safe_file_names_are_accepted():
 
 
 def test_array_items_can_be_set_as_the_world_names_them():
-    s = load_scenario("follow_person", ["people[0].shirt_color=[0.1, 0.8, 0.1]",
-                                        "people[0].waypoints[1]=[5.0, 4.0]"])
+    s = load_scenario(
+        "follow_person",
+        ["people[0].shirt_color=[0.1, 0.8, 0.1]", "people[0].waypoints[1]=[5.0, 4.0]"],
+    )
     person = s.world["people"][0]
     assert person["shirt_color"] == [0.1, 0.8, 0.1]
     assert person["waypoints"][1] == [5.0, 4.0]
@@ -269,20 +295,37 @@ def test_a_whole_table_can_be_set_and_its_other_keys_take_their_defaults():
         load_scenario("follow_person", ["camera={fsp = 15.0}"])
 
 
-@pytest.mark.parametrize("item,message", [
-    ("design.base_dps=fast", ("design.base_dps must be an array of 8 integers (wheel DPS per "
-                             "proximity level 0..7), got 'fast'")),
-    ("design.base_dps=[0, 1, 2, 3, 4, 5, 6, 7.5]", "design.base_dps must be an array of 8"),
-    ("design.proximity_thresholds=5", ("design.proximity_thresholds must be an array of 7 "
-                                      "integers (pixel counts of levels 1..7), got 5")),
-    ("design.proximity_thresholds=[7, 6, 5, 4, 3, 2, 1]",
-     "design.proximity_thresholds must be non-decreasing"),
-    ("design.lost_frames=0", "design.lost_frames must be >= 1, got 0"),
-    ("design.margin_x=100", "design.margin_x=100 leaves no window in a frame 160 wide"),
-    ('camera.resolution="4096x4096"', ("invalid design parameters with camera.resolution "
-                                      "4096x4096: the window width")),
-    ("design=1", "design must be a table"),
-])
+@pytest.mark.parametrize(
+    "item,message",
+    [
+        (
+            "design.base_dps=fast",
+            (
+                "design.base_dps must be an array of 8 integers (wheel DPS per "
+                "proximity level 0..7), got 'fast'"
+            ),
+        ),
+        ("design.base_dps=[0, 1, 2, 3, 4, 5, 6, 7.5]", "design.base_dps must be an array of 8"),
+        (
+            "design.proximity_thresholds=5",
+            (
+                "design.proximity_thresholds must be an array of 7 "
+                "integers (pixel counts of levels 1..7), got 5"
+            ),
+        ),
+        (
+            "design.proximity_thresholds=[7, 6, 5, 4, 3, 2, 1]",
+            "design.proximity_thresholds must be non-decreasing",
+        ),
+        ("design.lost_frames=0", "design.lost_frames must be >= 1, got 0"),
+        ("design.margin_x=100", "design.margin_x=100 leaves no window in a frame 160 wide"),
+        (
+            'camera.resolution="4096x4096"',
+            ("invalid design parameters with camera.resolution 4096x4096: the window width"),
+        ),
+        ("design=1", "design must be a table"),
+    ],
+)
 def test_design_values_are_checked_with_their_key(item, message):
     with pytest.raises(ScenarioError) as info:
         load_scenario("follow_person", [item])
@@ -302,22 +345,30 @@ def renderer_accepts(width, height, hfov, tilt):
 
 def scenario_accepts(width, height, hfov, tilt):
     try:
-        load_scenario("follow_person", [f'camera.resolution="{width}x{height}"',
-                                        f"camera.hfov={hfov!r}", f"camera.tilt={tilt!r}"])
+        load_scenario(
+            "follow_person",
+            [
+                f'camera.resolution="{width}x{height}"',
+                f"camera.hfov={hfov!r}",
+                f"camera.tilt={tilt!r}",
+            ],
+        )
     except ScenarioError:
         return False
     return True
 
 
-@pytest.mark.parametrize("width,height,hfov", [(160, 120, 1.047), (320, 240, 2.0),
-                                               (40, 160, 1.0), (160, 120, 3.1)])
+@pytest.mark.parametrize(
+    "width,height,hfov", [(160, 120, 1.047), (320, 240, 2.0), (40, 160, 1.0), (160, 120, 3.1)]
+)
 def test_the_scenario_accepts_the_tilts_the_renderer_draws(width, height, hfov):
     from fpga_robotics.sim.camera.raster import max_tilt
 
     limit = max_tilt(width, height, hfov)
     for tilt in (0.0, limit * 0.999, -limit * 0.999, limit + 1e-4, -limit - 1e-4, 1.5707963):
         assert scenario_accepts(width, height, hfov, tilt) == renderer_accepts(
-            width, height, hfov, tilt), tilt
+            width, height, hfov, tilt
+        ), tilt
 
 
 def test_the_printed_tilt_limit_can_be_used():
@@ -348,8 +399,9 @@ def test_scenario_paths_that_are_not_files(tmp_path, monkeypatch):
     with pytest.raises(ScenarioError, match="is not a regular file"):
         load_scenario("/dev/null")
     monkeypatch.chdir(tmp_path)
-    with pytest.raises(ScenarioError, match="for the shipped scenario give its name: "
-                                            "--scenario lost_target"):
+    with pytest.raises(
+        ScenarioError, match="for the shipped scenario give its name: --scenario lost_target"
+    ):
         load_scenario("lost_target.toml")
     (tmp_path / "lost_target.toml").write_text('description = "mine"\n')
     assert load_scenario("lost_target.toml").description == "mine"  # a local file wins
@@ -363,18 +415,35 @@ def test_scenario_paths_that_are_not_files(tmp_path, monkeypatch):
         load_scenario(big)
 
 
-@pytest.mark.parametrize("item,message", [
-    ("sim.duration=1979-05-27", ("sim.duration must be a finite number in s, > 0 and <= 86400, "
-                                "got datetime.date(1979, 5, 27)")),
-    ("camera.noise_std=nan", ("camera.noise_std must be a finite number in 8-bit levels, >= 0 "
-                             "and <= 64, got nan")),
-    ("camera.fps=inf", ("camera.fps must be a finite number in frames/s, >= 0.1 and <= 1000, "
-                      "got inf")),
-    ("camera.noise_std=65", "camera.noise_std must be <= 64 (8-bit levels), got 65.0"),
-    ("sim.physics_dt=0.1", ("sim.physics_dt must be <= 0.0333333 s (one camera frame period, "
-                           "1 / camera.fps), got 0.1")),
-    ("sim.physics_dt=1e-6", "sim.physics_dt must be >= 1e-05 s, got 1e-06"),
-])
+@pytest.mark.parametrize(
+    "item,message",
+    [
+        (
+            "sim.duration=1979-05-27",
+            (
+                "sim.duration must be a finite number in s, > 0 and <= 86400, "
+                "got datetime.date(1979, 5, 27)"
+            ),
+        ),
+        (
+            "camera.noise_std=nan",
+            ("camera.noise_std must be a finite number in 8-bit levels, >= 0 and <= 64, got nan"),
+        ),
+        (
+            "camera.fps=inf",
+            ("camera.fps must be a finite number in frames/s, >= 0.1 and <= 1000, got inf"),
+        ),
+        ("camera.noise_std=65", "camera.noise_std must be <= 64 (8-bit levels), got 65.0"),
+        (
+            "sim.physics_dt=0.1",
+            (
+                "sim.physics_dt must be <= 0.0333333 s (one camera frame period, "
+                "1 / camera.fps), got 0.1"
+            ),
+        ),
+        ("sim.physics_dt=1e-6", "sim.physics_dt must be >= 1e-05 s, got 1e-06"),
+    ],
+)
 def test_number_messages_give_the_unit_and_the_range(item, message):
     with pytest.raises(ScenarioError) as info:
         load_scenario("follow_person", [item])

@@ -52,26 +52,44 @@ def test_paths_are_relative_to_the_scenario_file(files, monkeypatch):
     assert s.with_overrides(["design.kp_num=5"]).foreign == s.foreign
 
 
-@pytest.mark.parametrize("text, message", [
-    ('[design]\nverilog = ["rtl/missing.v"]\nports = "rtl/ft.toml"\n',
-     "design.verilog: no file 'rtl/missing.v' (looked for "),
-    ('[design]\nverilog = ["rtl/follow_target.v"]\nports = "nope.toml"\n',
-     "design.ports: no file 'nope.toml'"),
-    ('[design]\nverilog = ["rtl/follow_target.v"]\n', "design.verilog needs design.ports"),
-    ('[design]\nports = "rtl/ft.toml"\n', "design.ports goes with design.verilog"),
-    ('[design]\nverilog = []\nports = "rtl/ft.toml"\n',
-     "design.verilog must be an array of Verilog file paths, got []"),
-    ('[design]\nverilog = [3]\nports = "rtl/ft.toml"\n',
-     "design.verilog must be an array of Verilog file paths"),
-    ('[design]\nverilog = ["rtl/follow_target.v"]\nports = 7\n',
-     "design.ports must be the path of a port map (.toml), got 7"),
-    ('[design]\nverilogg = ["a.v"]\n', "unknown key design.verilogg"),
-])
+@pytest.mark.parametrize(
+    "text, message",
+    [
+        (
+            '[design]\nverilog = ["rtl/missing.v"]\nports = "rtl/ft.toml"\n',
+            "design.verilog: no file 'rtl/missing.v' (looked for ",
+        ),
+        (
+            '[design]\nverilog = ["rtl/follow_target.v"]\nports = "nope.toml"\n',
+            "design.ports: no file 'nope.toml'",
+        ),
+        ('[design]\nverilog = ["rtl/follow_target.v"]\n', "design.verilog needs design.ports"),
+        ('[design]\nports = "rtl/ft.toml"\n', "design.ports goes with design.verilog"),
+        (
+            '[design]\nverilog = []\nports = "rtl/ft.toml"\n',
+            "design.verilog must be an array of Verilog file paths, got []",
+        ),
+        (
+            '[design]\nverilog = [3]\nports = "rtl/ft.toml"\n',
+            "design.verilog must be an array of Verilog file paths",
+        ),
+        (
+            '[design]\nverilog = ["rtl/follow_target.v"]\nports = 7\n',
+            "design.ports must be the path of a port map (.toml), got 7",
+        ),
+        ('[design]\nverilogg = ["a.v"]\n', "unknown key design.verilogg"),
+    ],
+)
 def test_bad_entries_are_one_line_errors_at_load(files, text, message):
     path = files / "bad.toml"
     path.write_text(text)
-    with pytest.raises(ScenarioError, match=message.replace("(", r"\(").replace(")", r"\)")
-                       .replace("[", r"\[").replace("]", r"\]")) as info:
+    with pytest.raises(
+        ScenarioError,
+        match=message.replace("(", r"\(")
+        .replace(")", r"\)")
+        .replace("[", r"\[")
+        .replace("]", r"\]"),
+    ) as info:
         load_scenario(str(path))
     assert "\n" not in str(info.value)
 
@@ -88,10 +106,14 @@ def test_the_command_line_overrides_the_scenario(files):
     assert _design_files(_args(design="verilog:x.v,y.v"), foreign) == (["x.v", "y.v"], p)
     assert _design_files(_args(ports="other.toml"), foreign) == (v, "other.toml")
     assert _design_files(_args(design="verilog:x.v", ports="o.toml"), foreign) == (
-        ["x.v"], "o.toml")
+        ["x.v"],
+        "o.toml",
+    )
     assert _design_files(_args(), None) is None
-    with pytest.raises(UsageError, match="the scenario's design.verilog runs on the cxxrtl or "
-                                         "verilator backend, not 'model'"):
+    with pytest.raises(
+        UsageError,
+        match="the scenario's design.verilog runs on the cxxrtl or verilator backend, not 'model'",
+    ):
         _design_files(_args(backend="model"), foreign)
     with pytest.raises(UsageError, match="--ports goes with --design"):
         _design_files(_args(ports="o.toml"), None)
@@ -117,14 +139,32 @@ def test_a_scenario_runs_its_foreign_design_in_closed_loop(files, capsys):
     from fpga_robotics.cli import run
 
     argv = ["--duration", "1", "--rerun", "off", "--quiet"]
-    code = run.main(["--scenario", str(files / "foreign.toml"), *argv,
-                     "--summary", str(files / "foreign.json")])
+    code = run.main(
+        ["--scenario", str(files / "foreign.toml"), *argv, "--summary", str(files / "foreign.json")]
+    )
     assert code == 0, capsys.readouterr().out
-    run.main(["--scenario", str(files / "plain.toml"), "--backend", "model", *argv,
-              "--summary", str(files / "plain.json")])
+    run.main(
+        [
+            "--scenario",
+            str(files / "plain.toml"),
+            "--backend",
+            "model",
+            *argv,
+            "--summary",
+            str(files / "plain.json"),
+        ]
+    )
     got, want = (json.loads((files / n).read_text()) for n in ("foreign.json", "plain.json"))
     assert got["backend"] == "cxxrtl-foreign" and want["backend"] == "model"
     # The exported FollowTarget with its full port map: the same run, figure for figure.
-    for key in ("frames", "min_distance_m", "mean_distance_m", "found_fraction",
-                "target_in_view_fraction", "path_length_m", "collisions", "verdict"):
+    for key in (
+        "frames",
+        "min_distance_m",
+        "mean_distance_m",
+        "found_fraction",
+        "target_in_view_fraction",
+        "path_length_m",
+        "collisions",
+        "verdict",
+    ):
         assert got[key] == want[key], key

@@ -15,8 +15,8 @@ SHIPPED = sorted(shipped_scenarios())
 #: Real-clock scenarios simulate 50 M design cycles a second of world time: 30 and 60 s only.
 REAL_CLOCK = ("line_track", "obstacle_between")
 RUNS = [(name, duration) for name in SHIPPED for duration in (30, 60)] + [
-    pytest.param(name, 120, marks=pytest.mark.slow) for name in SHIPPED
-    if name not in REAL_CLOCK]
+    pytest.param(name, 120, marks=pytest.mark.slow) for name in SHIPPED if name not in REAL_CLOCK
+]
 
 
 @pytest.mark.parametrize("name, duration", RUNS)
@@ -38,7 +38,9 @@ def test_without_yielding_the_person_walks_into_the_reversing_robot():
     assert person["episodes"] == r.summary["collisions"]["person"]
     assert person["contact_s"] > 0 and person["max_impulse_ns"] > 0
     assert r.summary["robot_at_fault_collisions"] == 0  # it was reversing away
-    (frame, _t, _text) = next(e for e in r.events if e[2].startswith("collision with person 'target'"))
+    (frame, _t, _text) = next(
+        e for e in r.events if e[2].startswith("collision with person 'target'")
+    )
     t = r.trajectory
     reverse = 150 * math.pi / 180 * TURTLEBOT2.wheel_radius  # m/s
     before = slice(frame - 30, frame)  # the second before the contact

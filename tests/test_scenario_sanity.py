@@ -27,8 +27,10 @@ def _scenario(tmp_path, body, name="odd"):
 
 def _person(waypoints, target=True, extra=""):
     points = ", ".join(f"[{x}, {y}]" for x, y in waypoints)
-    return (f"[[people]]\nname = \"p\"\ntarget = {str(target).lower()}\n"
-            f"waypoints = [{points}]\nloop = false\n{extra}")
+    return (
+        f'[[people]]\nname = "p"\ntarget = {str(target).lower()}\n'
+        f"waypoints = [{points}]\nloop = false\n{extra}"
+    )
 
 
 def _warnings(tmp_path, body):
@@ -38,15 +40,16 @@ def _warnings(tmp_path, body):
 def test_a_waypoint_inside_furniture(tmp_path):
     body = DESK + _person([(5.0, 2.0), (3.1, 0.9)])
     assert _warnings(tmp_path, body) == [
-        "people[0].waypoints[1] [3.1, 0.9] lies inside furniture 'desk'"]
+        "people[0].waypoints[1] [3.1, 0.9] lies inside furniture 'desk'"
+    ]
 
 
 def test_a_waypoint_that_puts_the_person_into_furniture(tmp_path):
     # 0.15 m above the desk's far edge (y 1.2): closer than the person's radius.
     body = DESK + _person([(5.0, 2.0), (3.1, 1.35)])
     assert _warnings(tmp_path, body) == [
-        ("people[0].waypoints[1] [3.1, 1.35] puts the person (radius 0.2 m) into furniture "
-        "'desk'")]
+        ("people[0].waypoints[1] [3.1, 1.35] puts the person (radius 0.2 m) into furniture 'desk'")
+    ]
     # 0.25 m away: clear.
     assert _warnings(tmp_path, DESK + _person([(5.0, 2.0), (3.1, 1.45)])) == []
 
@@ -54,7 +57,8 @@ def test_a_waypoint_that_puts_the_person_into_furniture(tmp_path):
 def test_a_path_through_furniture(tmp_path):
     body = DESK + _person([(1.0, 0.8), (5.0, 0.8)])
     assert _warnings(tmp_path, body) == [
-        "people[0].waypoints[0] -> [1] walks through furniture 'desk'"]
+        "people[0].waypoints[0] -> [1] walks through furniture 'desk'"
+    ]
     # Passing 0.3 m from the desk's edge (y 1.2 + 0.3): clear of it.
     assert _warnings(tmp_path, DESK + _person([(1.0, 1.5), (5.0, 1.5)])) == []
 
@@ -63,9 +67,11 @@ def test_a_looping_path_is_checked_on_its_way_back(tmp_path):
     # Out along y 2.0 and back diagonally from (5, 0.3) to (1, 2.0): the return leg crosses
     # the desk (at x 3.6 it is at y 0.3 + 1.7 * 0.35 = 0.9).
     body = DESK + _person([(1.0, 2.0), (5.0, 2.0), (5.0, 0.3)]).replace(
-        "loop = false", "loop = true")
+        "loop = false", "loop = true"
+    )
     assert _warnings(tmp_path, body) == [
-        "people[0].waypoints[2] -> [0] walks through furniture 'desk'"]
+        "people[0].waypoints[2] -> [0] walks through furniture 'desk'"
+    ]
 
 
 def test_furniture_that_leaves_the_room_is_not_an_obstacle_to_paths(tmp_path):
@@ -77,20 +83,29 @@ def test_a_path_across_the_robots_start(tmp_path):
     robot = "[robot]\nstart = [1.5, 3.0]\n"
     # 0.3 m from the start: less than 0.2 + 0.177 m, the bodies would touch.
     assert _warnings(tmp_path, robot + _person([(0.5, 3.3), (4.0, 3.3)])) == [
-        ("people[0].waypoints[0] -> [1] passes 0.30 m from robot.start [1.5, 3]: the person "
-        "(radius 0.2 m) walks into the robot (radius 0.177 m) where it starts")]
+        (
+            "people[0].waypoints[0] -> [1] passes 0.30 m from robot.start [1.5, 3]: the person "
+            "(radius 0.2 m) walks into the robot (radius 0.177 m) where it starts"
+        )
+    ]
     # 0.4 m: they pass clear of it.
     assert _warnings(tmp_path, robot + _person([(0.5, 3.4), (4.0, 3.4)])) == []
 
 
 def test_distance_checks_without_a_target(tmp_path):
     body = _person([(5.0, 3.0)], target=False) + (
-        "[checks]\nmean_distance_max_m = 2.0\ntarget_in_view_min_fraction = 0.5\n")
+        "[checks]\nmean_distance_max_m = 2.0\ntarget_in_view_min_fraction = 0.5\n"
+    )
     assert _warnings(tmp_path, body) == [
-        ("checks.mean_distance_max_m = 2 needs a target person (people[].target = true); the "
-        "scenario has none: it always fails"),
-        ("checks.target_in_view_min_fraction = 0.5 needs a target person (people[].target = "
-        "true); the scenario has none: it always fails")]
+        (
+            "checks.mean_distance_max_m = 2 needs a target person (people[].target = true); the "
+            "scenario has none: it always fails"
+        ),
+        (
+            "checks.target_in_view_min_fraction = 0.5 needs a target person (people[].target = "
+            "true); the scenario has none: it always fails"
+        ),
+    ]
 
 
 def test_distance_checks_decided_by_the_bodies_and_the_room(tmp_path):
@@ -98,16 +113,29 @@ def test_distance_checks_decided_by_the_bodies_and_the_room(tmp_path):
     # The centres touch at 0.2 + 0.177 = 0.377 m and are at most
     # hypot(8 - 0.377, 6 - 0.377) = 9.47 m apart in the default 8 m x 6 m room.
     assert _warnings(tmp_path, person + "[checks]\nmean_distance_max_m = 0.3\n") == [
-        ("checks.mean_distance_max_m = 0.3 m is below 0.377 m, the robot's and the target's "
-        "centres when they touch: it always fails")]
+        (
+            "checks.mean_distance_max_m = 0.3 m is below 0.377 m, the robot's and the target's "
+            "centres when they touch: it always fails"
+        )
+    ]
     assert _warnings(tmp_path, person + "[checks]\nmin_distance_min_m = 0.2\n") == [
-        ("checks.min_distance_min_m = 0.2 m is below 0.377 m, the robot's and the target's "
-        "centres when they touch: it always passes (use max_person_collisions for contact)")]
+        (
+            "checks.min_distance_min_m = 0.2 m is below 0.377 m, the robot's and the target's "
+            "centres when they touch: it always passes (use max_person_collisions for contact)"
+        )
+    ]
     assert _warnings(tmp_path, person + "[checks]\nmin_distance_min_m = 9.5\n") == [
-        ("checks.min_distance_min_m = 9.5 m is beyond 9.47 m, the farthest the centres can be "
-        "apart in the room: it always fails")]
-    assert _warnings(tmp_path, person + "[checks]\nmin_distance_min_m = 9.4\n"
-                     "mean_distance_max_m = 0.4\n") == []
+        (
+            "checks.min_distance_min_m = 9.5 m is beyond 9.47 m, the farthest the centres can be "
+            "apart in the room: it always fails"
+        )
+    ]
+    assert (
+        _warnings(
+            tmp_path, person + "[checks]\nmin_distance_min_m = 9.4\nmean_distance_max_m = 0.4\n"
+        )
+        == []
+    )
 
 
 def test_an_override_is_checked_too(tmp_path):
@@ -131,32 +159,63 @@ def _cli(main, argv, capsys, prog):
 
 def test_run_prints_the_warnings_and_strict_refuses(tmp_path, capsys):
     path = _scenario(tmp_path, DESK + _person([(5.0, 2.0), (3.1, 0.9)]))
-    code, out, err = _cli(run_main, ["--scenario", str(path), "--strict", "--rerun", "off",
-                                     "--backend", "model"], capsys, "fpga-robotics run")
+    code, out, err = _cli(
+        run_main,
+        ["--scenario", str(path), "--strict", "--rerun", "off", "--backend", "model"],
+        capsys,
+        "fpga-robotics run",
+    )
     assert code == 2
-    assert err == ("fpga-robotics run: error: scenario 'odd': people[0].waypoints[1] [3.1, 0.9] "
-                   "lies inside furniture 'desk' (--strict)\n")
+    assert err == (
+        "fpga-robotics run: error: scenario 'odd': people[0].waypoints[1] [3.1, 0.9] "
+        "lies inside furniture 'desk' (--strict)\n"
+    )
     assert out == ""
-    code, out, err = _cli(run_main, ["--scenario", str(path), "--rerun", "off", "--quiet",
-                                     "--backend", "model", "--duration", "0.2"], capsys,
-                          "fpga-robotics run")
+    code, out, err = _cli(
+        run_main,
+        [
+            "--scenario",
+            str(path),
+            "--rerun",
+            "off",
+            "--quiet",
+            "--backend",
+            "model",
+            "--duration",
+            "0.2",
+        ],
+        capsys,
+        "fpga-robotics run",
+    )
     assert code in (0, 1)  # it ran
-    assert err.splitlines()[0] == ("warning: scenario 'odd': people[0].waypoints[1] "
-                                   "[3.1, 0.9] lies inside furniture 'desk'")
+    assert err.splitlines()[0] == (
+        "warning: scenario 'odd': people[0].waypoints[1] [3.1, 0.9] lies inside furniture 'desk'"
+    )
     assert "verdict:" in out
 
 
 def test_sweep_strict_refuses_before_any_run(tmp_path, capsys):
     path = _scenario(tmp_path, DESK + _person([(1.0, 0.8), (5.0, 0.8)]))
-    code, out, err = _cli(sweep_main, ["--scenarios", str(path), "--seeds", "0-3", "--dry-run",
-                                       "--strict"], capsys, "fpga-robotics sweep")
+    code, out, err = _cli(
+        sweep_main,
+        ["--scenarios", str(path), "--seeds", "0-3", "--dry-run", "--strict"],
+        capsys,
+        "fpga-robotics sweep",
+    )
     assert code == 2
-    assert err == ("fpga-robotics sweep: error: scenario 'odd': people[0].waypoints[0] -> [1] "
-                   "walks through furniture 'desk' (--strict)\n")
-    code, out, err = _cli(sweep_main, ["--scenarios", str(path), "--seeds", "0-3",
-                                       "--dry-run"], capsys, "fpga-robotics sweep")
+    assert err == (
+        "fpga-robotics sweep: error: scenario 'odd': people[0].waypoints[0] -> [1] "
+        "walks through furniture 'desk' (--strict)\n"
+    )
+    code, out, err = _cli(
+        sweep_main,
+        ["--scenarios", str(path), "--seeds", "0-3", "--dry-run"],
+        capsys,
+        "fpga-robotics sweep",
+    )
     assert code == 0
     # Four runs of one scenario: the warning once.
-    assert err == ("warning: scenario 'odd': people[0].waypoints[0] -> [1] walks through "
-                   "furniture 'desk'\n")
+    assert err == (
+        "warning: scenario 'odd': people[0].waypoints[0] -> [1] walks through furniture 'desk'\n"
+    )
     assert "4 runs" in out

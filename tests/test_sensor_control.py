@@ -13,8 +13,14 @@ from fpga_robotics.sim.camera.sensor.white_balance import grey_world_gains
 
 # A linear camera (no noise, mosaic or gamma) so that the frame's mean luminance is
 # 255.75 * clip(radiance * sensitivity * exposure * gain, 0, 1), rounded to 10-bit codes.
-LINEAR = {"noise": False, "bayer": "off", "gamma": "off", "awb": False, "settle_frames": 0,
-          "sensitivity": 1.2}
+LINEAR = {
+    "noise": False,
+    "bayer": "off",
+    "gamma": "off",
+    "awb": False,
+    "settle_frames": 0,
+    "sensitivity": 1.2,
+}
 
 
 def flat(value):
@@ -30,7 +36,15 @@ def luma_of(exposure_total, value):
 def test_step_rules():
     aec = AutoExposure()  # power-on registers: window 99..117, control zone 64..208
     assert [aec.step_factor(m) for m in (63.9, 64, 98.9, 99, 117, 117.1, 208, 208.1)] == [
-        2.0, 17 / 16, 17 / 16, 1.0, 1.0, 15 / 16, 15 / 16, 0.5]
+        2.0,
+        17 / 16,
+        17 / 16,
+        1.0,
+        1.0,
+        15 / 16,
+        15 / 16,
+        0.5,
+    ]
     aec.set_total(3.0)  # a whole frame of exposure first, then gain
     assert (aec.exposure, aec.gain) == (1.0, 3.0)
     aec.set_total(1e3)
@@ -86,15 +100,17 @@ def test_grey_world_gains():
     assert g == pytest.approx((1.0, 1.25, 5 / 3))
     # Means measured with those gains are equal: the gains stay.
     assert grey_world_gains((0.5, 0.5, 0.5), gains=(1.0, 1.25, 5 / 3)) == pytest.approx(
-        (1.0, 1.25, 5 / 3))
+        (1.0, 1.25, 5 / 3)
+    )
     assert max(grey_world_gains((1.0, 0.1, 0.01))) == pytest.approx(0xFF / 0x40)  # ceiling
 
 
 def test_white_balance_turns_a_grey_card_under_a_coloured_light_grey():
     # A grey card under a warm light (1.0 : 0.8 : 0.6): the AWB gains move a quarter of the way
     # (in log) to (1, 1.25, 5/3) each frame, so the log-error shrinks by 0.75 a frame.
-    params = OV7670Params(noise=False, settle_frames=0, aec=False, exposure=0.5,
-                          awb_speed=0.25, gamma="off")
+    params = OV7670Params(
+        noise=False, settle_frames=0, aec=False, exposure=0.5, awb_speed=0.25, gamma="off"
+    )
     cam = OV7670Sensor(160, 120, params)
     card = np.empty((120, 160, 3), np.uint8)
     card[...] = (200, 160, 120)

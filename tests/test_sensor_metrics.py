@@ -1,6 +1,5 @@
 """The sensor designs' metrics against hand-computed values."""
 
-
 import numpy as np
 import pytest
 
@@ -35,8 +34,12 @@ def test_never_resumed_and_never_removed_both_fail_with_a_reason():
 
 
 def _rows(xs, ys, headings):
-    return {"t": np.arange(len(xs)) * 0.1, "x": np.asarray(xs, float),
-            "y": np.asarray(ys, float), "heading": np.asarray(headings, float)}
+    return {
+        "t": np.arange(len(xs)) * 0.1,
+        "x": np.asarray(xs, float),
+        "y": np.asarray(ys, float),
+        "heading": np.asarray(headings, float),
+    }
 
 
 def test_lateral_error_and_time_off_a_straight_line_by_hand():
@@ -47,16 +50,21 @@ def test_lateral_error_and_time_off_a_straight_line_by_hand():
     tape = FloorLine("tape", ((0.0, 1.0), (4.0, 1.0)), 0.02)
     # One sensor 0.1 m ahead of the robot's centre, the robot heading +x: the sensor's
     # offset from y = 1 is the robot's. Offsets 0, 5 mm (on the 20 mm tape), 30 mm (off it).
-    m = line_metrics(_rows([1.0, 1.1, 1.2], [1.0, 1.005, 0.97], [0.0] * 3), [tape],
-                     [Mount(forward=0.1)], 0.1)
+    m = line_metrics(
+        _rows([1.0, 1.1, 1.2], [1.0, 1.005, 0.97], [0.0] * 3), [tape], [Mount(forward=0.1)], 0.1
+    )
     assert m["lateral_error_max_m"] == pytest.approx(0.03)
     assert m["lateral_error_mean_m"] == pytest.approx(round(0.035 / 3, 4))
     assert m["off_line_s"] == pytest.approx(0.1)  # one row of 0.1 s off the tape
     assert m["laps"] is None  # an open line has no laps
     # Two sensors 10 mm either side: their centre is the robot's line; the one row with the
     # robot 30 mm off still has no sensor on the tape, the 15 mm row has one.
-    m = line_metrics(_rows([1.0, 1.1], [1.015, 0.97], [0.0] * 2), [tape],
-                     [Mount(left=0.01), Mount(left=-0.01)], 0.1)
+    m = line_metrics(
+        _rows([1.0, 1.1], [1.015, 0.97], [0.0] * 2),
+        [tape],
+        [Mount(left=0.01), Mount(left=-0.01)],
+        0.1,
+    )
     assert m["off_line_s"] == pytest.approx(0.1)
     assert m["lateral_error_max_m"] == pytest.approx(0.03)
 

@@ -58,17 +58,26 @@ def test_other_resolutions_and_odd_sizes(room_frame):
 
 def test_the_turn_rate_blurs_by_rate_times_exposure_times_focal_length(room_frame):
     f = focal_length(160, 1.047)
-    cam = OV7670Sensor(160, 120, OV7670Params(aec=False, exposure=0.5, settle_frames=0),
-                       rng=np.random.default_rng(0), frame_period=1 / 30, focal_px=f)
+    cam = OV7670Sensor(
+        160,
+        120,
+        OV7670Params(aec=False, exposure=0.5, settle_frames=0),
+        rng=np.random.default_rng(0),
+        frame_period=1 / 30,
+        focal_px=f,
+    )
     light = cam.light(room_frame, turn_rate=-2.0)
     length = 2.0 * (0.5 / 30) * f  # 4.62 px
     assert cam.last_blur_px == pytest.approx(length)
     expected = motion_blur(cam._radiance.take(room_frame), length)
     assert np.allclose(light, expected.reshape(-1).take(cam._mosaic_index), atol=1e-6)
-    assert np.array_equal(cam.light(room_frame, 0.0),
-                          cam._radiance.take(room_frame).reshape(-1).take(cam._mosaic_index))
-    sharp = OV7670Sensor(160, 120, OV7670Params(motion_blur=False, settle_frames=0),
-                         rng=np.random.default_rng(0))
+    assert np.array_equal(
+        cam.light(room_frame, 0.0),
+        cam._radiance.take(room_frame).reshape(-1).take(cam._mosaic_index),
+    )
+    sharp = OV7670Sensor(
+        160, 120, OV7670Params(motion_blur=False, settle_frames=0), rng=np.random.default_rng(0)
+    )
     sharp.light(room_frame, turn_rate=5.0)
     assert sharp.last_blur_px == 0.0
 
@@ -88,8 +97,11 @@ def test_plain_is_the_default_and_its_frames_are_todays():
     assert loop.camera.sensor is None and loop.camera.sensor_state() is None
     pose, rgb, _ = loop.capture(0.0)
     expected = CameraRenderer(160, 120, s.camera.hfov).render(
-        loop.world.scene(), pose, noise_std=s.camera.noise_std,
-        rng=np.random.default_rng([loop.seed, 0xCA3E]))
+        loop.world.scene(),
+        pose,
+        noise_std=s.camera.noise_std,
+        rng=np.random.default_rng([loop.seed, 0xCA3E]),
+    )
     assert np.array_equal(rgb, expected)
 
 

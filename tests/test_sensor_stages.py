@@ -42,7 +42,15 @@ def test_gamma_passes_through_the_registers_and_interpolates_linearly():
 
 def test_rgb444_keeps_the_top_nibble_of_the_rounded_value():
     assert list(rgb444_levels([0.0, 15.4, 15.6, 16.0, 127.9, 254.6, 300.0, -3.0])) == [
-        0, 0, 16, 16, 128, 240, 240, 0]
+        0,
+        0,
+        16,
+        16,
+        128,
+        240,
+        240,
+        0,
+    ]
     img = np.arange(256, dtype=np.uint8).reshape(16, 16, 1).repeat(3, axis=2)
     out = truncate_rgb444(img)
     assert np.array_equal(out, img & 0xF0)

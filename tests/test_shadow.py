@@ -11,10 +11,14 @@ from fpga_robotics.sim.backends.model import ModelBackend
 
 def test_shadow_spec_becomes_design_overrides():
     assert shadow_overrides("published") == ['design.preset="published"']
-    assert shadow_overrides("diff_min=5; design.kp_num=2") == ["design.diff_min=5",
-                                                               "design.kp_num=2"]
-    assert shadow_overrides("published;max_dps=400") == ['design.preset="published"',
-                                                         "design.max_dps=400"]
+    assert shadow_overrides("diff_min=5; design.kp_num=2") == [
+        "design.diff_min=5",
+        "design.kp_num=2",
+    ]
+    assert shadow_overrides("published;max_dps=400") == [
+        'design.preset="published"',
+        "design.max_dps=400",
+    ]
     with pytest.raises(ValueError, match="preset name"):
         shadow_overrides(" ; ")
 

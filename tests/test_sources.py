@@ -22,7 +22,7 @@ def scene_bgr(k, size=(480, 640)):
     img[::7, :] = 90  # some texture, so that resizing has something to blend
     if k != 3:
         x0 = 120 + 40 * k
-        img[150:400, x0:x0 + 120] = (30, 30, 220)  # BGR: red
+        img[150:400, x0 : x0 + 120] = (30, 30, 220)  # BGR: red
     return img
 
 
@@ -48,8 +48,7 @@ def video(tmp_path):
 
 
 def expected_rgb(bgr):
-    return cv2.cvtColor(cv2.resize(bgr, (W, H), interpolation=cv2.INTER_LINEAR),
-                        cv2.COLOR_BGR2RGB)
+    return cv2.cvtColor(cv2.resize(bgr, (W, H), interpolation=cv2.INTER_LINEAR), cv2.COLOR_BGR2RGB)
 
 
 def test_folder_frames_are_resized_and_converted_to_rgb(folder):
@@ -81,9 +80,13 @@ def test_run_source_matches_the_golden_model_frame_by_frame(folder):
     for k, f in enumerate(open_source(str(folder), W, H)):
         m = model.process(f, 0b100)
         r = out["results"][k]
-        assert (r["found"], r["proximity"], r["centroid_x"], r["motor_left"],
-                r["motor_right"]) == (m.tracker.found, m.tracker.proximity,
-                                      m.tracker.centroid_x, m.motor_left, m.motor_right)
+        assert (r["found"], r["proximity"], r["centroid_x"], r["motor_left"], r["motor_right"]) == (
+            m.tracker.found,
+            m.tracker.proximity,
+            m.tracker.centroid_x,
+            m.motor_left,
+            m.motor_right,
+        )
     found = [r["found"] for r in out["results"]]
     assert found == [True, True, True, False, True]
     # The block moves right: so does the centroid (scaled by 160/640).
@@ -110,8 +113,20 @@ def test_empty_folder_and_bad_specs_are_usage_errors(tmp_path):
 def test_cli_runs_a_video_and_writes_the_results(video, tmp_path, capsys):
     path = tmp_path / "src.json"
     with pytest.raises(SystemExit) as info:
-        run_cli(main, ["--source", str(video), "--backend", "model", "--rerun", "off",
-                       "--summary", str(path), "--quiet"])
+        run_cli(
+            main,
+            [
+                "--source",
+                str(video),
+                "--backend",
+                "model",
+                "--rerun",
+                "off",
+                "--summary",
+                str(path),
+                "--quiet",
+            ],
+        )
     out, _ = capsys.readouterr()
     assert info.value.code == 0
     s = json.loads(path.read_text())
@@ -122,8 +137,22 @@ def test_cli_runs_a_video_and_writes_the_results(video, tmp_path, capsys):
 def test_cli_folder_at_another_resolution(folder, tmp_path, capsys):
     path = tmp_path / "src.json"
     with pytest.raises(SystemExit) as info:
-        run_cli(main, ["--source", str(folder), "--backend", "model", "--rerun", "off",
-                       "--resolution", "320x240", "--summary", str(path), "--quiet"])
+        run_cli(
+            main,
+            [
+                "--source",
+                str(folder),
+                "--backend",
+                "model",
+                "--rerun",
+                "off",
+                "--resolution",
+                "320x240",
+                "--summary",
+                str(path),
+                "--quiet",
+            ],
+        )
     assert info.value.code == 0
     s = json.loads(path.read_text())
     assert s["resolution"] == "320x240" and s["found_frames"] == 4

@@ -29,8 +29,9 @@ def _run(world, seconds):
 
 def test_driving_into_a_standing_person_is_the_robots_fault():
     # 100 DPS on both wheels: v = 0.035 m * 100 deg/s * pi / 180 = 0.061 m/s > 0.02 m/s.
-    world = World.from_config({"robot": {"start": [2.0, 3.0]},
-                                "people": [{"name": "bob", "waypoints": [[3.0, 3.0]]}]}, 0)
+    world = World.from_config(
+        {"robot": {"start": [2.0, 3.0]}, "people": [{"name": "bob", "waypoints": [[3.0, 3.0]]}]}, 0
+    )
     world.set_wheel_dps(100, 100)
     assert 0.035 * math.radians(100) > AT_FAULT_SPEED
     _run(world, 12.0)  # 1 - 0.377 m at 0.061 m/s: touches after about 10.2 s
@@ -39,8 +40,7 @@ def test_driving_into_a_standing_person_is_the_robots_fault():
 
 
 def test_a_person_walking_into_a_standing_robot_is_not_the_robots_fault():
-    person = {"name": "walker", "waypoints": [[6.0, 3.0], [1.0, 3.0]], "speed": 0.5,
-              "loop": False}
+    person = {"name": "walker", "waypoints": [[6.0, 3.0], [1.0, 3.0]], "speed": 0.5, "loop": False}
     world = World.from_config({"robot": {"start": [3.5, 3.0]}, "people": [person]}, 0)
     _run(world, 6.0)  # the person reaches the robot after (2.5 - 0.377) / 0.5 = 4.2 s
     assert world.collision_counts()["person"] == 1
@@ -49,8 +49,9 @@ def test_a_person_walking_into_a_standing_robot_is_not_the_robots_fault():
 
 def test_creeping_into_a_person_below_the_limit_is_not_the_robots_fault():
     # 20 DPS: 0.035 * 20 * pi / 180 = 0.0122 m/s, below the limit.
-    world = World.from_config({"robot": {"start": [3.0, 3.0]},
-                               "people": [{"name": "bob", "waypoints": [[3.5, 3.0]]}]}, 0)
+    world = World.from_config(
+        {"robot": {"start": [3.0, 3.0]}, "people": [{"name": "bob", "waypoints": [[3.5, 3.0]]}]}, 0
+    )
     world.set_wheel_dps(20, 20)
     _run(world, 12.0)  # 0.5 - 0.377 m at 0.0122 m/s: about 10 s
     assert world.collision_counts()["person"] == 1
@@ -61,8 +62,14 @@ def test_creeping_into_a_person_below_the_limit_is_not_the_robots_fault():
 def test_the_check_reads_the_at_fault_count():
     import numpy as np
 
-    traj = {"t": np.zeros(1), "x": np.zeros(1), "y": np.zeros(1), "found": np.ones(1, bool),
-            "target_distance": np.ones(1), "target_in_view": np.ones(1, bool)}
+    traj = {
+        "t": np.zeros(1),
+        "x": np.zeros(1),
+        "y": np.zeros(1),
+        "found": np.ones(1, bool),
+        "target_distance": np.ones(1),
+        "target_in_view": np.ones(1, bool),
+    }
     m = compute_metrics(traj, [], {"person": 2}, 1 / 30, at_fault_collisions=1)
     (c,) = evaluate_checks({"max_robot_at_fault_collisions": 0}, m)
     assert not c["passed"] and c["value"] == 1
@@ -79,12 +86,16 @@ def _failed(r):
 def test_story_b_early_thresholds_drive_into_the_person():
     r = run_scenario(load_scenario("approach", [EARLY_THRESHOLDS]), backend="cxxrtl")
     assert r.summary["verdict"] == "fail"
-    assert {"max_person_collisions", "max_robot_at_fault_collisions",
-            "min_distance_min_m"} <= _failed(r)
+    assert {
+        "max_person_collisions",
+        "max_robot_at_fault_collisions",
+        "min_distance_min_m",
+    } <= _failed(r)
     assert r.summary["robot_at_fault_collisions"] == 1
     # Pushing: the bodies stay in contact at the end of the run.
-    assert r.trajectory["target_distance"][-1] == pytest.approx(0.2 + TURTLEBOT2.body_radius,
-                                                               abs=0.005)
+    assert r.trajectory["target_distance"][-1] == pytest.approx(
+        0.2 + TURTLEBOT2.body_radius, abs=0.005
+    )
 
 
 @pytest.mark.stories

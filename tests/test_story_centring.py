@@ -14,10 +14,16 @@ from fpga_robotics.sim.backends import available_backends
 
 
 def _metrics(centroid, column=80.0, n=30):
-    traj = {"t": np.arange(n) / 30, "x": np.zeros(n), "y": np.zeros(n),
-            "found": np.ones(n, bool), "target_distance": np.ones(n),
-            "target_in_view": np.ones(n, bool), "centroid_x": np.full(n, centroid),
-            "target_column": np.full(n, column)}
+    traj = {
+        "t": np.arange(n) / 30,
+        "x": np.zeros(n),
+        "y": np.zeros(n),
+        "found": np.ones(n, bool),
+        "target_distance": np.ones(n),
+        "target_in_view": np.ones(n, bool),
+        "centroid_x": np.full(n, centroid),
+        "target_column": np.full(n, column),
+    }
     return compute_metrics(traj, [], {}, 1 / 30, width=160)
 
 
@@ -35,8 +41,9 @@ def test_a_sum_of_x_wrapped_in_too_few_bits_fails_the_centring_check():
     assert evaluate_checks({"mean_centroid_error_max_px": 2.0}, good)[0]["passed"]
     (c,) = evaluate_checks({"mean_centroid_error_max_px": 2.0}, bad)
     assert not c["passed"]
-    assert c["text"] == ("centroid 67.00 px from the target's image column on average "
-                         "(limit <= 2.0 px)")
+    assert c["text"] == (
+        "centroid 67.00 px from the target's image column on average (limit <= 2.0 px)"
+    )
 
 
 @pytest.mark.stories

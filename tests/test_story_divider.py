@@ -31,23 +31,36 @@ def test_target_column_straight_ahead_left_and_behind():
 
 def _traj(centroid, column, found):
     n = len(centroid)
-    return {"t": np.arange(n) / 30, "x": np.zeros(n), "y": np.zeros(n),
-            "found": np.asarray(found), "target_distance": np.ones(n),
-            "target_in_view": np.ones(n, bool), "centroid_x": np.asarray(centroid),
-            "target_column": np.asarray(column, float)}
+    return {
+        "t": np.arange(n) / 30,
+        "x": np.zeros(n),
+        "y": np.zeros(n),
+        "found": np.asarray(found),
+        "target_distance": np.ones(n),
+        "target_in_view": np.ones(n, bool),
+        "centroid_x": np.asarray(centroid),
+        "target_column": np.asarray(column, float),
+    }
 
 
 def test_off_target_fraction_counts_frames_found_with_the_target_in_view():
     # Tolerance 160 / 8 = 20 px. Frames: error 0, 21 (off), 19, 50 (off, but not found),
     # target centre out of view (NaN): 1 of 3 counted frames is off target.
-    m = compute_metrics(_traj([80, 101, 99, 130, 10], [80, 80, 80, 80, math.nan],
-                              [True, True, True, False, True]), [], {}, 1 / 30, width=160)
+    m = compute_metrics(
+        _traj([80, 101, 99, 130, 10], [80, 80, 80, 80, math.nan], [True, True, True, False, True]),
+        [],
+        {},
+        1 / 30,
+        width=160,
+    )
     assert m["off_target_fraction"] == pytest.approx(round(1 / 3, 4))
     assert m["mean_centroid_error_px"] == pytest.approx(round(40 / 3, 2))
     (c,) = evaluate_checks({"max_off_target_fraction": 0.05}, m)
     assert not c["passed"]
-    assert c["text"] == ("centroid away from the target in 33% of the frames with the target "
-                         "found and in view (limit <= 5%)")
+    assert c["text"] == (
+        "centroid away from the target in 33% of the frames with the target "
+        "found and in view (limit <= 5%)"
+    )
 
 
 def _failed(r):

@@ -19,8 +19,7 @@ def _failed(r):
 
 
 def test_the_shadow_side_drops_out_of_the_default_filter_at_dusk():
-    r = run_scenario(load_scenario("lighting_3d", [SHORT, "design.diff_min=6"]),
-                     backend="model")
+    r = run_scenario(load_scenario("lighting_3d", [SHORT, "design.diff_min=6"]), backend="model")
     assert "found_min_fraction" in _failed(r)
 
 

@@ -17,8 +17,7 @@ from fpga_robotics.sim.camera import synthetic
 
 NARROW = "design.sx_bits=17"
 
-needs_cxxrtl = pytest.mark.skipif("cxxrtl" not in available_backends(),
-                                  reason="no C++ compiler")
+needs_cxxrtl = pytest.mark.skipif("cxxrtl" not in available_backends(), reason="no C++ compiler")
 
 
 def _centring(result):
@@ -64,7 +63,8 @@ def test_story_d_a_too_narrow_sx_puts_the_centroid_off_centre():
     assert not c["passed"]
     assert bad.summary["mean_centroid_error_px"] > 40.0
     assert c["text"].startswith("centroid ") and c["text"].endswith(
-        "px from the target's image column on average (limit <= 2.0 px)")
+        "px from the target's image column on average (limit <= 2.0 px)"
+    )
     # The first frame, before the robot moves: the person straight ahead (image column 80),
     # the full-width centroid at 79, the wrapped one far left of the centre.
     t0, t1 = good.trajectory, bad.trajectory

@@ -30,15 +30,23 @@ def test_tip_accelerations_of_the_presets():
     assert TURTLEBOT2.tip_step_dps is None and GOPIGO3.tip_step_dps is None
 
 
-@pytest.mark.parametrize("accel_dps2, tips", [
-    (9000, False),   # 0.035 m * 9000 deg/s^2 = 5.50 m/s^2 < 5.64
-    (12000, True),   # 7.33 m/s^2 > 5.64
-])
+@pytest.mark.parametrize(
+    "accel_dps2, tips",
+    [
+        (9000, False),  # 0.035 m * 9000 deg/s^2 = 5.50 m/s^2 < 5.64
+        (12000, True),  # 7.33 m/s^2 > 5.64
+    ],
+)
 def test_a_steep_motor_ramp_tips_the_turtlebot(accel_dps2, tips):
     assert (0.035 * accel_dps2 * DEG > TURTLEBOT2.tip_accel) == tips
     # Traction (100 N / 6.3 kg = 15.9 m/s^2) does not limit the ramp.
-    world = World.from_config({"robot": {"start": [1.0, 3.0], "wheel_accel_dps2": accel_dps2,
-                                         "traction_force": 100.0}, "people": []}, 0)
+    world = World.from_config(
+        {
+            "robot": {"start": [1.0, 3.0], "wheel_accel_dps2": accel_dps2, "traction_force": 100.0},
+            "people": [],
+        },
+        0,
+    )
     world.set_wheel_dps(600, 600)
     _run(world, 0.5)
     events = world.drain_events()
@@ -53,17 +61,30 @@ def test_a_steep_motor_ramp_tips_the_turtlebot(accel_dps2, tips):
 
 def test_traction_limits_the_acceleration_that_tips():
     # The ramp asks 7.33 m/s^2, but 30 N / 6.3 kg = 4.76 m/s^2 is all the wheels can push.
-    world = World.from_config({"robot": {"start": [1.0, 3.0], "wheel_accel_dps2": 12000,
-                                         "traction_force": 30.0}, "people": []}, 0)
+    world = World.from_config(
+        {
+            "robot": {"start": [1.0, 3.0], "wheel_accel_dps2": 12000, "traction_force": 30.0},
+            "people": [],
+        },
+        0,
+    )
     world.set_wheel_dps(600, 600)
     _run(world, 0.5)
     assert world.tipped is None
 
 
 def _gopigo(step_response=0.05):
-    return World.from_config({"robot": {"model": "gopigo3", "start": [1.0, 3.0],
-                                        "motor_step_response": step_response},
-                              "people": []}, 0)
+    return World.from_config(
+        {
+            "robot": {
+                "model": "gopigo3",
+                "start": [1.0, 3.0],
+                "motor_step_response": step_response,
+            },
+            "people": [],
+        },
+        0,
+    )
 
 
 def test_a_jump_of_the_command_beyond_the_step_limit_tips_the_gopigo3():
@@ -88,12 +109,18 @@ def test_a_jump_of_the_command_beyond_the_step_limit_tips_the_gopigo3():
 
 def _traj(cmd_w, centroid_x, found=None):
     n = len(cmd_w)
-    return {"t": np.arange(n) / 30, "x": np.zeros(n), "y": np.zeros(n),
-            "found": np.ones(n, bool) if found is None else np.asarray(found),
-            "target_distance": np.ones(n), "target_in_view": np.ones(n, bool),
-            "cmd_w": np.asarray(cmd_w, float), "centroid_x": np.asarray(centroid_x),
-            "motor_left": np.array([0, 100, -50, -50] + [0] * (n - 4)),
-            "motor_right": np.array([0, 120, 0, 0] + [0] * (n - 4))}
+    return {
+        "t": np.arange(n) / 30,
+        "x": np.zeros(n),
+        "y": np.zeros(n),
+        "found": np.ones(n, bool) if found is None else np.asarray(found),
+        "target_distance": np.ones(n),
+        "target_in_view": np.ones(n, bool),
+        "cmd_w": np.asarray(cmd_w, float),
+        "centroid_x": np.asarray(centroid_x),
+        "motor_left": np.array([0, 100, -50, -50] + [0] * (n - 4)),
+        "motor_right": np.array([0, 120, 0, 0] + [0] * (n - 4)),
+    }
 
 
 def test_oscillation_counts_sign_changes_of_w_while_centred():
@@ -162,20 +189,31 @@ def test_heading_overshoot_is_the_far_side_error_after_the_first_crossing():
     headings = np.radians([-20, -5, 4, 7, 2, -1, 30, 3])
     n = len(headings)
     column = np.where(np.arange(n) == 6, np.nan, 80.0)
-    traj = {"t": np.arange(n) / 30, "x": np.zeros(n), "y": np.zeros(n), "heading": headings,
-            "found": np.ones(n, bool), "target_x": np.ones(n), "target_y": np.zeros(n),
-            "target_distance": np.ones(n), "target_in_view": np.ones(n, bool),
-            "target_column": column}
+    traj = {
+        "t": np.arange(n) / 30,
+        "x": np.zeros(n),
+        "y": np.zeros(n),
+        "heading": headings,
+        "found": np.ones(n, bool),
+        "target_x": np.ones(n),
+        "target_y": np.zeros(n),
+        "target_distance": np.ones(n),
+        "target_in_view": np.ones(n, bool),
+        "target_column": column,
+    }
     m = compute_metrics(traj, [], {}, 1 / 30)
     assert m["heading_overshoot_deg"] == pytest.approx(7.0)
     (c,) = evaluate_checks({"max_heading_overshoot_deg": 5.0}, m)
     assert not c["passed"] and c["text"] == "turned 7.0 deg past the target (limit <= 5.0 deg)"
 
 
-@pytest.mark.parametrize("overrides, overshoot", [
-    ([], (0.0, 0.0)),                       # the default gain turns onto the person
-    (["design.kp_num=16"], (8.0, 14.0)),    # a high gain swings past them
-])
+@pytest.mark.parametrize(
+    "overrides, overshoot",
+    [
+        ([], (0.0, 0.0)),  # the default gain turns onto the person
+        (["design.kp_num=16"], (8.0, 14.0)),  # a high gain swings past them
+    ],
+)
 def test_turning_onto_a_standing_person(overrides, overshoot):
     s = load_scenario("approach", ["robot.heading_deg=20", "sim.duration=10"] + overrides)
     r = run_scenario(s, backend="model")

@@ -51,19 +51,28 @@ def test_bad_campaign_file_is_one_line_and_exit_2(case, tmp_path, monkeypatch, c
     assert not (tmp_path / "out").exists()
 
 
-@pytest.mark.parametrize("argv, message", [
-    (["--workers", "0"], "--workers must be >= 1"),
-    (["--grid", "design.diff_min=4"], "--grid needs KEY=[V1, V2, ...]"),
-    (["--seeds", "5-1"], "is empty"),
-    (["--scheduler", "tcp://127.0.0.1:9", "--workers", "2"], "--workers sizes"),
-    (["nonexistent_campaign"], "unknown campaign"),
-])
+@pytest.mark.parametrize(
+    "argv, message",
+    [
+        (["--workers", "0"], "--workers must be >= 1"),
+        (["--grid", "design.diff_min=4"], "--grid needs KEY=[V1, V2, ...]"),
+        (["--seeds", "5-1"], "is empty"),
+        (["--scheduler", "tcp://127.0.0.1:9", "--workers", "2"], "--workers sizes"),
+        (["nonexistent_campaign"], "unknown campaign"),
+    ],
+)
 def test_bad_options_are_one_line_and_exit_2(argv, message, tmp_path):
     (tmp_path / "c.toml").write_text(GOOD)
     if argv[0] != "nonexistent_campaign":
         argv = ["c.toml", *argv]
-    proc = subprocess.run(SWEEP + argv + ["--quiet"], cwd=tmp_path, check=False, capture_output=True,
-                          text=True, timeout=60)
+    proc = subprocess.run(
+        SWEEP + argv + ["--quiet"],
+        cwd=tmp_path,
+        check=False,
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
     assert proc.returncode == 2, proc.stderr
     lines = proc.stderr.strip().splitlines()
     assert len(lines) == 1 and message in lines[0], lines
@@ -71,22 +80,38 @@ def test_bad_options_are_one_line_and_exit_2(argv, message, tmp_path):
 
 def test_dry_run_counts_and_shows_commands(tmp_path):
     (tmp_path / "c.toml").write_text(GOOD + '[grid]\n"design.diff_min" = [4, 5, 6]\n')
-    proc = subprocess.run(SWEEP + ["c.toml", "--dry-run"], cwd=tmp_path, check=False, capture_output=True,
-                          text=True, timeout=60)
+    proc = subprocess.run(
+        SWEEP + ["c.toml", "--dry-run"],
+        cwd=tmp_path,
+        check=False,
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
     assert proc.returncode == 0, proc.stderr
     lines = proc.stdout.splitlines()
     assert lines[0].startswith("campaign c: 6 runs")
     assert len(lines) == 4
-    assert all(line.strip().startswith("python -m fpga_robotics.run --scenario approach")
-               for line in lines[1:])
+    assert all(
+        line.strip().startswith("python -m fpga_robotics.run --scenario approach")
+        for line in lines[1:]
+    )
 
 
 def test_report_of_a_folder_without_results_is_one_line_and_exit_2(tmp_path):
     (tmp_path / "empty").mkdir()
-    for folder, message in (("empty", "holds no campaign results"),
-                            ("missing", "is not a folder of campaign results")):
-        proc = subprocess.run(SWEEP + ["report", folder], cwd=tmp_path, check=False,
-                              capture_output=True, text=True, timeout=60)
+    for folder, message in (
+        ("empty", "holds no campaign results"),
+        ("missing", "is not a folder of campaign results"),
+    ):
+        proc = subprocess.run(
+            SWEEP + ["report", folder],
+            cwd=tmp_path,
+            check=False,
+            capture_output=True,
+            text=True,
+            timeout=60,
+        )
         assert proc.returncode == 2
         lines = proc.stderr.strip().splitlines()
         assert len(lines) == 1 and message in lines[0], lines

@@ -21,7 +21,7 @@ def _build(log):
             f.write(PAYLOAD[: len(PAYLOAD) // 2])
             f.flush()
             time.sleep(0.3)  # a reader arriving now must wait, not see half a model
-            f.write(PAYLOAD[len(PAYLOAD) // 2:])
+            f.write(PAYLOAD[len(PAYLOAD) // 2 :])
 
     return build
 
@@ -40,8 +40,10 @@ def test_many_processes_build_each_model_once_and_load_it_whole(tmp_path):
     log = tmp_path / "builds.log"
     keys = [hashlib.sha256(str(i).encode()).hexdigest() for i in range(3)]
     # Six processes, each wanting the three models in its own order.
-    procs = [ctx.Process(target=_worker, args=(tmp_path, log, keys[i % 3:] + keys[:i % 3],
-                                               queue)) for i in range(6)]
+    procs = [
+        ctx.Process(target=_worker, args=(tmp_path, log, keys[i % 3 :] + keys[: i % 3], queue))
+        for i in range(6)
+    ]
     for p in procs:
         p.start()
     results = [queue.get(timeout=120) for _ in procs]
@@ -50,13 +52,15 @@ def test_many_processes_build_each_model_once_and_load_it_whole(tmp_path):
         assert p.exitcode == 0
     assert all(ok for seen in results for _key, ok in seen)
     assert len(log.read_text().split()) == len(keys)  # one build per model
-    assert sorted(p.name for p in tmp_path.iterdir() if not p.name.endswith(".lock")) == \
-        sorted(["builds.log", *(f"model-{k[:32]}" for k in keys)])
+    assert sorted(p.name for p in tmp_path.iterdir() if not p.name.endswith(".lock")) == sorted(
+        ["builds.log", *(f"model-{k[:32]}" for k in keys)]
+    )
 
 
 def _build_forever(root, log):
-    build_cache.get_or_build("model", "f" * 64, ["model.bin"],
-                             lambda d: (_build(log)(d), time.sleep(3600)), root=root)
+    build_cache.get_or_build(
+        "model", "f" * 64, ["model.bin"], lambda d: (_build(log)(d), time.sleep(3600)), root=root
+    )
 
 
 def test_a_builder_killed_half_way_leaves_no_entry_and_the_next_one_builds(tmp_path):
@@ -74,8 +78,7 @@ def test_a_builder_killed_half_way_leaves_no_entry_and_the_next_one_builds(tmp_p
     assert not entry_dir.exists()
     # The lock died with its holder: the next process builds at once.
     t0 = time.monotonic()
-    entry = build_cache.get_or_build("model", "f" * 64, ["model.bin"], _build(log),
-                                     root=tmp_path)
+    entry = build_cache.get_or_build("model", "f" * 64, ["model.bin"], _build(log), root=tmp_path)
     assert entry.built and time.monotonic() - t0 < 30
     assert (entry.path / "model.bin").read_bytes() == PAYLOAD
     assert Path(entry.path) == entry_dir

@@ -11,8 +11,12 @@ from fpga_robotics.scenario.load import _parse_value
 from fpga_robotics.sweep import load_campaign
 from fpga_robotics.sweep.campaign import parse_seeds, toml_value
 
-SCALARS = (st.booleans() | st.integers(-2**63, 2**63 - 1)
-           | st.floats(allow_nan=False) | st.text(max_size=20))
+SCALARS = (
+    st.booleans()
+    | st.integers(-(2**63), 2**63 - 1)
+    | st.floats(allow_nan=False)
+    | st.text(max_size=20)
+)
 VALUES = st.recursive(SCALARS, lambda inner: st.lists(inner, max_size=4), max_leaves=10)
 
 
@@ -39,12 +43,29 @@ robot.mass = 12.0
 """)
     campaign = load_campaign(data)
     assert campaign.axes == ["design.diff_min", "lighting.ambient", "robot.mass"]
-    expected = [(sc, combo, seed) for sc in ("approach", "divider")
-                for combo in [*(((("design.diff_min", d), ("lighting.ambient", a)))
-                                for d, a in itertools.product((4, 6), (0.3, 0.5, 0.7))),
-                              (("robot.mass", 12.0),)]
-                for seed in range(3)]
+    expected = [
+        (sc, combo, seed)
+        for sc in ("approach", "divider")
+        for combo in [
+            *(
+                ((("design.diff_min", d), ("lighting.ambient", a)))
+                for d, a in itertools.product((4, 6), (0.3, 0.5, 0.7))
+            ),
+            (("robot.mass", 12.0),),
+        ]
+        for seed in range(3)
+    ]
     assert [(r.scenario, r.overrides, r.seed) for r in campaign.runs] == expected
     run = campaign.runs[0]
-    assert run.argv() == ["--scenario", "approach", "--backend", "auto", "--seed", "0",
-                          "--set", "design.diff_min=4", "--set", "lighting.ambient=0.3"]
+    assert run.argv() == [
+        "--scenario",
+        "approach",
+        "--backend",
+        "auto",
+        "--seed",
+        "0",
+        "--set",
+        "design.diff_min=4",
+        "--set",
+        "lighting.ambient=0.3",
+    ]

@@ -17,8 +17,19 @@ backend = "model"
 resolution = "40x24"
 duration = 20.0
 """
-SWEEP = [sys.executable, "-m", "fpga_robotics.sweep", "c.toml", "--workers", "2",
-         "--out", "out", "--quiet", "--record", "none"]
+SWEEP = [
+    sys.executable,
+    "-m",
+    "fpga_robotics.sweep",
+    "c.toml",
+    "--workers",
+    "2",
+    "--out",
+    "out",
+    "--quiet",
+    "--record",
+    "none",
+]
 
 
 def _processes_in(folder):
@@ -44,8 +55,14 @@ def test_ctrl_c_keeps_finished_runs_and_resume_runs_the_rest(tmp_path):
     (tmp_path / "c.toml").write_text(CAMPAIGN)
     journal = tmp_path / "out" / "results.jsonl"
     # A terminal's Ctrl-C reaches the whole process group: the command and its workers.
-    proc = subprocess.Popen(SWEEP, cwd=tmp_path, stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True, start_new_session=True)
+    proc = subprocess.Popen(
+        SWEEP,
+        cwd=tmp_path,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        start_new_session=True,
+    )
     try:
         end = time.monotonic() + 120
         while _journal_lines(journal) < 2 and time.monotonic() < end:
@@ -68,8 +85,9 @@ def test_ctrl_c_keeps_finished_runs_and_resume_runs_the_rest(tmp_path):
     assert 2 <= len(kept) < 16
     assert all(r["status"] in ("pass", "fail") for r in kept.values())
 
-    proc = subprocess.run(SWEEP + ["--resume"], cwd=tmp_path, check=False, capture_output=True, text=True,
-                          timeout=300)
+    proc = subprocess.run(
+        SWEEP + ["--resume"], cwd=tmp_path, check=False, capture_output=True, text=True, timeout=300
+    )
     assert proc.returncode in (0, 1), proc.stderr
     rows = {r["run_id"]: r for r in load_rows(tmp_path / "out")}
     assert len(rows) == 16 and sorted({r["seed"] for r in rows.values()}) == list(range(16))

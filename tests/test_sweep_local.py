@@ -62,13 +62,21 @@ def small_campaign(tmp_path_factory):
 def test_two_workers_give_the_summaries_of_runs_made_one_by_one(small_campaign):
     out, rows = small_campaign
     assert len(rows) == 2 * (2 + 1) * 2  # scenarios x (grid + the set) x seeds
-    assert {(r["scenario"], r.get("design.diff_min"), r.get("robot.mass"), r["seed"])
-            for r in rows} == {
-        (s, d, m, seed) for s in ("approach", "follow_person")
-        for d, m in ((4, None), (8, None), (None, 8.0)) for seed in (0, 1)}
+    assert {
+        (r["scenario"], r.get("design.diff_min"), r.get("robot.mass"), r["seed"]) for r in rows
+    } == {
+        (s, d, m, seed)
+        for s in ("approach", "follow_person")
+        for d, m in ((4, None), (8, None), (None, 8.0))
+        for seed in (0, 1)
+    }
     for row in rows:
-        _assert_row_matches(row, _direct(row["scenario"], row["seed"], row.get("design.diff_min"),
-                                         row.get("robot.mass")))
+        _assert_row_matches(
+            row,
+            _direct(
+                row["scenario"], row["seed"], row.get("design.diff_min"), row.get("robot.mass")
+            ),
+        )
     # The tables hold the same rows as the run returned.
     import pyarrow.parquet as pq
 
@@ -94,7 +102,8 @@ def test_failing_runs_have_their_recording(small_campaign):
         else:
             assert row["recording"] == ""
     assert sorted(p.name for p in (out / "recordings").iterdir()) == sorted(
-        f"{r['run_id']}.rrd" for r in failing)
+        f"{r['run_id']}.rrd" for r in failing
+    )
 
 
 def test_replay_command_reproduces_the_summary(small_campaign, tmp_path):
@@ -103,21 +112,33 @@ def test_replay_command_reproduces_the_summary(small_campaign, tmp_path):
         argv = shlex.split(row["replay"])
         assert argv[:3] == ["python", "-m", "fpga_robotics.run"]
         summary_path = tmp_path / f"{row['run_id']}.json"
-        proc = subprocess.run([sys.executable, *argv[1:], "--rerun", "off", "--quiet",
-                               "--summary", str(summary_path)],
-                              check=False, capture_output=True, text=True, timeout=120)
+        proc = subprocess.run(
+            [
+                sys.executable,
+                *argv[1:],
+                "--rerun",
+                "off",
+                "--quiet",
+                "--summary",
+                str(summary_path),
+            ],
+            check=False,
+            capture_output=True,
+            text=True,
+            timeout=120,
+        )
         assert proc.returncode == (0 if row["status"] == "pass" else 1), proc.stderr
         _assert_row_matches(row, json.loads(summary_path.read_text()))
 
 
-def test_raising_hanging_and_dying_runs_are_recorded_and_the_rest_complete(tmp_path,
-                                                                          monkeypatch):
+def test_raising_hanging_and_dying_runs_are_recorded_and_the_rest_complete(tmp_path, monkeypatch):
     # Worker processes inherit the environment: seed 1 raises, seed 2 hangs inside a frame
     # (its worker is ended after the timeout), seed 3 ends its worker process.
     monkeypatch.setenv("FPGA_ROBOTICS_SWEEP_FAULT", "raise@1,hang@2,exit@3")
     grid_only = {k: v for k, v in SMALL.items() if k != "sets"}
-    campaign = load_campaign({**grid_only, "scenarios": ["approach"], "seeds": "0-5",
-                              "grid": {"design.diff_min": [4]}})
+    campaign = load_campaign(
+        {**grid_only, "scenarios": ["approach"], "seeds": "0-5", "grid": {"design.diff_min": [4]}}
+    )
     rows = run_campaign(campaign, tmp_path, workers=2, record="none", timeout=3.0)
     by_seed = {r["seed"]: r for r in rows}
     assert sorted(by_seed) == [0, 1, 2, 3, 4, 5]
@@ -132,15 +153,23 @@ def test_a_campaign_with_a_shadow_design_reports_where_it_differs(tmp_path):
     from fpga_robotics.cli.run import _shadow_params
     from fpga_robotics.loop.compressed import make_backend
 
-    campaign = load_campaign({"scenarios": ["approach"], "seeds": [3], "backend": "model",
-                              "duration": 1.0, "shadow": "published"})
+    campaign = load_campaign(
+        {
+            "scenarios": ["approach"],
+            "seeds": [3],
+            "backend": "model",
+            "duration": 1.0,
+            "shadow": "published",
+        }
+    )
     [row] = run_campaign(campaign, tmp_path, workers=1, record="none")
     assert "--shadow published" in row["replay"]
     scenario = load_scenario("approach", ["sim.duration=1.0"])
     shadow = make_backend("model", _shadow_params(scenario, "published"))
     try:
-        direct = run_scenario(scenario, seed=3, backend="model", shadow=shadow,
-                              shadow_label="published").summary
+        direct = run_scenario(
+            scenario, seed=3, backend="model", shadow=shadow, shadow_label="published"
+        ).summary
     finally:
         shadow.close()
     assert direct["shadow"]["differing_frames"]["motor_left"] > 0  # the designs differ

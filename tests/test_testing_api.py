@@ -35,9 +35,12 @@ def test_a_failing_check_is_listed_in_the_assertion(tmp_path, monkeypatch):
     # A design reference relative to the current folder, a stop distance too short for the
     # braking: the robot hits the wall (0.5 m from it at 300 DPS; stop at 10 mm).
     monkeypatch.chdir(DESIGNS)
-    result = run("wall_stop.toml", design="wall_stop.py:WallStop",
-                 params={"stop_mm": 10, "speed": 600}, overrides=["sim.duration=6",
-                                                                  "robot.start=[1.8, 0.5]"])
+    result = run(
+        "wall_stop.toml",
+        design="wall_stop.py:WallStop",
+        params={"stop_mm": 10, "speed": 600},
+        overrides=["sim.duration=6", "robot.start=[1.8, 0.5]"],
+    )
     assert result.check("max_wall_collisions").status == "fail"
     assert not result.passed
     with pytest.raises(AssertionError) as info:

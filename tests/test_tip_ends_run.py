@@ -27,7 +27,8 @@ def _assert_ends_at_the_tip(result):
     assert s["frames"] == k + 1
     assert result.events[-1][2].startswith("tipped over")
     assert {name: len(traj[name]) for name in TRAJECTORY_FIELDS} == dict.fromkeys(
-        TRAJECTORY_FIELDS, k + 1)
+        TRAJECTORY_FIELDS, k + 1
+    )
     assert traj["t"][-1] == pytest.approx(t, abs=1e-6)
     assert s["sim_time_s"] == pytest.approx(t, abs=1e-6)
     assert s["ended_early"] == f"tipped over at {t:.2f} s"
@@ -43,15 +44,17 @@ def test_the_unstable_gain_ends_the_erratic_run_at_the_tip():
     r = run_scenario(s, backend="model", on_frame=records.append)
     _assert_ends_at_the_tip(r)
     assert r.summary["frames"] == 96 and r.summary["ended_early"] == "tipped over at 3.17 s"
-    assert r.summary["frames"] < frame_count(round(s.sim.duration / s.sim.physics_dt),
-                                             s.camera.frame_period, s.sim.physics_dt)
+    assert r.summary["frames"] < frame_count(
+        round(s.sim.duration / s.sim.physics_dt), s.camera.frame_period, s.sim.physics_dt
+    )
     # The viewer and the callback see the same frames; the last one carries the tip.
     assert [rec.frame for rec in records] == list(range(96))
     assert records[-1].events[-1].startswith("tipped over: wheel command jumped 736 DPS")
     # The metrics and checks are evaluated on what ran: the 96 frames up to the fall.
     assert r.summary["found_fraction"] == round(float(r.trajectory["found"].mean()), 4)
     assert r.summary["target_in_view_fraction"] == round(
-        float(r.trajectory["target_in_view"].mean()), 4)
+        float(r.trajectory["target_in_view"].mean()), 4
+    )
 
 
 def test_a_tip_between_frames_ends_the_run_at_the_frame_that_reports_it():
@@ -75,9 +78,23 @@ def test_the_default_run_goes_to_its_end():
 def test_the_cli_reports_the_early_end_and_fails(tmp_path, capsys):
     path = tmp_path / "s.json"
     with pytest.raises(SystemExit) as info:
-        run_cli(main, ["--scenario", "erratic", "--backend", "model", "--rerun", "off",
-                       "--quiet", "--set", TIPS[0], "--summary", str(path)],
-                prog="fpga-robotics run")
+        run_cli(
+            main,
+            [
+                "--scenario",
+                "erratic",
+                "--backend",
+                "model",
+                "--rerun",
+                "off",
+                "--quiet",
+                "--set",
+                TIPS[0],
+                "--summary",
+                str(path),
+            ],
+            prog="fpga-robotics run",
+        )
     out, _ = capsys.readouterr()
     assert info.value.code == 1
     s = json.loads(path.read_text())

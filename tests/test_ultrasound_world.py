@@ -15,9 +15,13 @@ QUIET = HCSR04Params(noise_std=0.0)
 
 
 def _world(width=4.0, furniture=(), people=()):
-    return World.from_config({"room": {"width": width, "depth": 6.0,
-                                       "furniture": list(furniture)},
-                              "robot": {"start": [1.0, 3.0]}, "people": list(people)})
+    return World.from_config(
+        {
+            "room": {"width": width, "depth": 6.0, "furniture": list(furniture)},
+            "robot": {"start": [1.0, 3.0]},
+            "people": list(people),
+        }
+    )
 
 
 def test_speed_of_sound_is_the_linear_fit():
@@ -30,8 +34,7 @@ def test_a_wall_straight_ahead_is_at_its_perpendicular_distance():
     assert range_to(world, 1.1, 3.0, 0.0, 0.1, QUIET) == pytest.approx(2.9, abs=1e-12)
     # Turned by 5 degrees (inside the 7.5 degree half cone) the perpendicular is still in the
     # beam: the range is the same.
-    assert range_to(world, 1.1, 3.0, math.radians(5), 0.1, QUIET) == pytest.approx(2.9,
-                                                                                  abs=1e-12)
+    assert range_to(world, 1.1, 3.0, math.radians(5), 0.1, QUIET) == pytest.approx(2.9, abs=1e-12)
     # Turned by 20 degrees the nearest wall point in the beam is on the cone's edge.
     d = range_to(world, 1.1, 3.0, math.radians(20), 0.1, QUIET)
     assert d == pytest.approx(2.9 / math.cos(math.radians(12.5)), abs=1e-12)
@@ -135,8 +138,13 @@ def test_a_box_corner_at_the_cone_edge(margin_deg, seen):
     b = math.radians(7.5 + margin_deg)
     cx, cy = 1.0 + math.cos(b), 3.0 + math.sin(b)
     centre = [cx + 0.25 * (math.cos(b) - math.sin(b)), cy + 0.25 * (math.sin(b) + math.cos(b))]
-    box = {"name": "box", "center": centre, "size": [0.5, 0.5], "height": 1.0,
-           "angle_deg": math.degrees(b)}
+    box = {
+        "name": "box",
+        "center": centre,
+        "size": [0.5, 0.5],
+        "height": 1.0,
+        "angle_deg": math.degrees(b),
+    }
     d = range_to(_world(furniture=[box]), 1.0, 3.0, 0.0, 0.1, QUIET)
     if seen:
         assert d == pytest.approx(1.0, abs=1e-12)  # the corner itself

@@ -41,8 +41,7 @@ def wall_stop_run(tmp_path_factory):
     path = tmp_path_factory.mktemp("rrd") / "wall.rrd"
     recorder = open_recorder(f"save:{path}", default_path=None)
     try:
-        result = run_scenario(load_scenario(str(WALL_STOP)), backend="cxxrtl",
-                              recorder=recorder)
+        result = run_scenario(load_scenario(str(WALL_STOP)), backend="cxxrtl", recorder=recorder)
     finally:
         recorder.close()
     return result, path
@@ -51,13 +50,19 @@ def wall_stop_run(tmp_path_factory):
 def test_a_design_reference_resolves_its_ports_bindings_and_extra_outputs():
     spec = resolve_design(f"{DESIGNS}/wall_stop.py:WallStop", {"speed": 100})
     assert spec.kind == "amaranth" and spec.params == {"speed": 100}
-    assert spec.ports == {"trig": ("out", 1), "echo": ("in", 1), "motor_left": ("out", 16),
-                          "motor_right": ("out", 16), "distance_mm": ("out", 16),
-                          "stopped": ("out", 1)}
+    assert spec.ports == {
+        "trig": ("out", 1),
+        "echo": ("in", 1),
+        "motor_left": ("out", 16),
+        "motor_right": ("out", 16),
+        "distance_mm": ("out", 16),
+        "stopped": ("out", 1),
+    }
     # By name: trig/echo are the ultrasound's pins, motor_left/right the wheels'.
-    assert spec.bindings == {"ultrasound": {"trig": "trig", "echo": "echo"},
-                             "wheels": {"motor_left": "motor_left",
-                                        "motor_right": "motor_right"}}
+    assert spec.bindings == {
+        "ultrasound": {"trig": "trig", "echo": "echo"},
+        "wheels": {"motor_left": "motor_left", "motor_right": "motor_right"},
+    }
     assert spec.extra_outputs == ("distance_mm", "stopped")
     component = spec.build()
     assert component.speed == 100
@@ -104,8 +109,9 @@ def test_the_extra_outputs_are_viewer_series(wall_stop_run):
 def test_a_camera_design_with_an_output_named_near(tmp_path):
     frames = []
     scenario = load_scenario(str(NEAR_RED))
-    result = run_scenario(scenario, backend="cxxrtl",
-                          on_frame=lambda r: frames.append(r.camera_rgb))
+    result = run_scenario(
+        scenario, backend="cxxrtl", on_frame=lambda r: frames.append(r.camera_rgb)
+    )
     traj = result.trajectory
     assert result.summary["verdict"] == "pass"
     # red_count in row k is frame k-1's (latched at the first pixel of frame k), counted
@@ -123,11 +129,29 @@ def test_a_camera_design_with_an_output_named_near(tmp_path):
 
 def test_run_design_takes_a_reference_and_params_from_the_command_line(tmp_path, capsys):
     summary = tmp_path / "s.json"
-    code, out, _ = _cli(["run", "--scenario", str(WALL_STOP), "--design",
-                         f"{DESIGNS}/wall_stop.py:wall_stop", "--set", "design.params={}",
-                         "--set", "design.params.speed=150", "--duration", "1",
-                         "--backend", "cxxrtl", "--rerun", "off", "--quiet",
-                         "--summary", str(summary)], capsys)
+    code, out, _ = _cli(
+        [
+            "run",
+            "--scenario",
+            str(WALL_STOP),
+            "--design",
+            f"{DESIGNS}/wall_stop.py:wall_stop",
+            "--set",
+            "design.params={}",
+            "--set",
+            "design.params.speed=150",
+            "--duration",
+            "1",
+            "--backend",
+            "cxxrtl",
+            "--rerun",
+            "off",
+            "--quiet",
+            "--summary",
+            str(summary),
+        ],
+        capsys,
+    )
     assert code == 0
     data = json.loads(summary.read_text())
     assert data["extra_outputs"]["stopped"] == {"last": 0, "min": 0, "max": 0}
@@ -148,14 +172,30 @@ BAD = [
     ("missing module", "no_such_package.designs:Design", {}, "no module 'no_such_package'"),
     ("missing name", "broken.py:Missing", {}, "has no 'Missing'; its components: Sized"),
     ("not a component", "broken.py:NotAComponent", {}, "is not an Amaranth wiring.Component"),
-    ("a function that raises", "broken.py:raises", {},
-     "building it raised ValueError: width 4 is not supported"),
-    ("a function returning no component", "broken.py:returns_a_number", {},
-     "it returned int, not an Amaranth wiring.Component"),
-    ("a parameter of the wrong type", "broken.py:Sized", {"width": "wide"},
-     "design.params.width must be an integer"),
-    ("an unknown parameter", "broken.py:Sized", {"depth": 2},
-     "Sized takes no parameter 'depth'; it takes: width"),
+    (
+        "a function that raises",
+        "broken.py:raises",
+        {},
+        "building it raised ValueError: width 4 is not supported",
+    ),
+    (
+        "a function returning no component",
+        "broken.py:returns_a_number",
+        {},
+        "it returned int, not an Amaranth wiring.Component",
+    ),
+    (
+        "a parameter of the wrong type",
+        "broken.py:Sized",
+        {"width": "wide"},
+        "design.params.width must be an integer",
+    ),
+    (
+        "an unknown parameter",
+        "broken.py:Sized",
+        {"depth": 2},
+        "Sized takes no parameter 'depth'; it takes: width",
+    ),
     ("a syntax error", "syntax_error.py:Broken", {}, "loading syntax_error.py (line 1)"),
     ("params of a built-in", "follow_target", {"speed": 1}, "takes its parameters from"),
     ("an unknown name", "follow_me", {}, "unknown design 'follow_me'"),
@@ -163,8 +203,9 @@ BAD = [
 
 
 @pytest.mark.parametrize("case, reference, params, message", BAD, ids=[c[0] for c in BAD])
-def test_bad_references_are_one_line_errors(case, reference, params, message, tmp_path,
-                                            capsys, monkeypatch):
+def test_bad_references_are_one_line_errors(
+    case, reference, params, message, tmp_path, capsys, monkeypatch
+):
     shutil.copy(DESIGNS / "broken.py", tmp_path / "broken.py")
     (tmp_path / "syntax_error.py").write_text("class Broken(\n")  # never closed
     with pytest.raises(DesignError, match=message.replace("(", r"\(").replace(")", r"\)")):
@@ -172,8 +213,20 @@ def test_bad_references_are_one_line_errors(case, reference, params, message, tm
     # The same through the command line: exit 2, one line, nothing written.
     monkeypatch.chdir(tmp_path)
     before = sorted(p.name for p in tmp_path.iterdir())
-    argv = ["run", "--scenario", str(WALL_STOP), "--design", reference, "--rerun",
-            "save:out.rrd", "--summary", "out.json", "--quiet", "--set", "design.params={}"]
+    argv = [
+        "run",
+        "--scenario",
+        str(WALL_STOP),
+        "--design",
+        reference,
+        "--rerun",
+        "save:out.rrd",
+        "--summary",
+        "out.json",
+        "--quiet",
+        "--set",
+        "design.params={}",
+    ]
     for key, value in params.items():
         argv += ["--set", f"design.params.{key}={json.dumps(value)}"]
     code, _, err = _cli(argv, capsys)
@@ -205,9 +258,24 @@ BUMP_WALL = DATA / "bump_wall.toml"
 
 def _verilog_run(capsys, tmp_path, design, ports, *more):
     summary = tmp_path / f"{Path(ports).stem}.json"
-    code, out, err = _cli(["run", "--scenario", str(BUMP_WALL), "--design", design, "--ports",
-                           str(ports), "--rerun", "off", "--quiet", "--summary", str(summary),
-                           *more], capsys)
+    code, out, err = _cli(
+        [
+            "run",
+            "--scenario",
+            str(BUMP_WALL),
+            "--design",
+            design,
+            "--ports",
+            str(ports),
+            "--rerun",
+            "off",
+            "--quiet",
+            "--summary",
+            str(summary),
+            *more,
+        ],
+        capsys,
+    )
     assert code == 0, err
     return json.loads(summary.read_text()), out
 
@@ -215,12 +283,16 @@ def _verilog_run(capsys, tmp_path, design, ports, *more):
 def test_verilog_designs_with_and_without_reset_record_an_unread_output(tmp_path, capsys):
     # tests/data/bump_stop.v (active-low reset) with its hit_o recorded as an extra output.
     ports = tmp_path / "ports.toml"
-    ports.write_text((DATA / "bump_stop_ports.toml").read_text()
-                     + '\n[extra_outputs]\nhit = "hit_o"\n')
+    ports.write_text(
+        (DATA / "bump_stop_ports.toml").read_text() + '\n[extra_outputs]\nhit = "hit_o"\n'
+    )
     with_reset, out = _verilog_run(capsys, tmp_path, f"verilog:{DATA / 'bump_stop.v'}", ports)
-    without, _ = _verilog_run(capsys, tmp_path,
-                              f"verilog:{DESIGNS / 'bump_stop_noreset.v'}",
-                              DESIGNS / "bump_stop_noreset_ports.toml")
+    without, _ = _verilog_run(
+        capsys,
+        tmp_path,
+        f"verilog:{DESIGNS / 'bump_stop_noreset.v'}",
+        DESIGNS / "bump_stop_noreset_ports.toml",
+    )
     for summary in (with_reset, without):
         assert summary["verdict"] == "pass"
         # Driving until the bumper closed, then stopped: hit went 0 -> 1 once.
@@ -234,18 +306,21 @@ def test_verilog_designs_with_and_without_reset_record_an_unread_output(tmp_path
 def test_a_verilog_design_by_reference_in_the_scenario(tmp_path):
     ports = DESIGNS / "bump_stop_noreset_ports.toml"
     text = BUMP_WALL.read_text() + (
-        f'[design]\ntop = "verilog:{DESIGNS / "bump_stop_noreset.v"}"\nports = "{ports}"\n')
+        f'[design]\ntop = "verilog:{DESIGNS / "bump_stop_noreset.v"}"\nports = "{ports}"\n'
+    )
     (tmp_path / "s.toml").write_text(text)
     result = run_scenario(load_scenario(str(tmp_path / "s.toml")), backend="auto")
     traj = result.trajectory
     assert ((traj["design.hit"] == 1) == (traj["motor_left"] == 0)).all()
-    assert ((traj["design.hit"] == 1) == (traj["bumper.pressed"] == 1)
-            ).sum() >= len(traj["t"]) - 1  # the latch follows the bumper within a row
+    assert ((traj["design.hit"] == 1) == (traj["bumper.pressed"] == 1)).sum() >= len(
+        traj["t"]
+    ) - 1  # the latch follows the bumper within a row
 
 
 def test_a_design_without_wheels_runs_and_the_robot_stands(tmp_path):
     text = BUMP_WALL.read_text().replace("start = [0.5, 0.5]", "start = [1.88, 0.5]") + (
-        f'[design]\ntop = "{DESIGNS / "bump_watch.py"}:BumpWatch"\n')
+        f'[design]\ntop = "{DESIGNS / "bump_watch.py"}:BumpWatch"\n'
+    )
     (tmp_path / "s.toml").write_text(text)
     scenario = load_scenario(str(tmp_path / "s.toml"), ["sim.duration=0.5"])
     result = run_scenario(scenario, backend="pysim")
@@ -276,7 +351,8 @@ def test_installed_packages_offer_designs_by_entry_point(tmp_path, monkeypatch, 
     info.mkdir()
     (info / "METADATA").write_text("Metadata-Version: 2.1\nName: my-robot\nVersion: 1.0\n")
     (info / "entry_points.txt").write_text(
-        "[fpga_robotics.designs]\nwall_stopper = my_robot.designs:WallStop\n")
+        "[fpga_robotics.designs]\nwall_stopper = my_robot.designs:WallStop\n"
+    )
     monkeypatch.syspath_prepend(str(tmp_path))
     spec = resolve_design("wall_stopper", {"stop_mm": 100})
     assert spec.reference == "my_robot.designs:WallStop"
@@ -292,21 +368,42 @@ def test_installed_packages_offer_designs_by_entry_point(tmp_path, monkeypatch, 
 def test_shadow_runs_a_previous_version_of_the_design_on_the_same_pins(tmp_path, capsys):
     """--shadow REF in real-clock timing: the shadow gets every input the primary gets; its
     wheels differ exactly while neither has stopped, its measurements never."""
-    old = (DESIGNS / "wall_stop.py").read_text().replace(
-        "Mux(self.stopped, 0, self.speed)", "Mux(self.stopped, 0, self.speed - 50)")
+    old = (
+        (DESIGNS / "wall_stop.py")
+        .read_text()
+        .replace("Mux(self.stopped, 0, self.speed)", "Mux(self.stopped, 0, self.speed - 50)")
+    )
     (tmp_path / "wall_stop_v1.py").write_text(old)
     summary = tmp_path / "s.json"
-    code, out, err = _cli(["run", "--scenario", str(WALL_STOP), "--shadow",
-                           f"{tmp_path}/wall_stop_v1.py:WallStop", "--backend", "cxxrtl",
-                           "--rerun", "off", "--quiet", "--summary", str(summary)], capsys)
+    code, out, err = _cli(
+        [
+            "run",
+            "--scenario",
+            str(WALL_STOP),
+            "--shadow",
+            f"{tmp_path}/wall_stop_v1.py:WallStop",
+            "--backend",
+            "cxxrtl",
+            "--rerun",
+            "off",
+            "--quiet",
+            "--summary",
+            str(summary),
+        ],
+        capsys,
+    )
     assert code == 0, err
     shadow = json.loads(summary.read_text())["shadow"]
     frames = shadow["frames"]
     moving = shadow["differing_frames"]["motor_left"]
     assert shadow["first_divergence"] == {
-        "frame": 0, "time_s": 0.0,
-        "outputs": {"motor_left": {"primary": 300, "shadow": 250},
-                    "motor_right": {"primary": 300, "shadow": 250}}}
+        "frame": 0,
+        "time_s": 0.0,
+        "outputs": {
+            "motor_left": {"primary": 300, "shadow": 250},
+            "motor_right": {"primary": 300, "shadow": 250},
+        },
+    }
     assert shadow["differing_frames"]["motor_right"] == moving
     assert shadow["differing_frames"]["distance_mm"] == 0
     assert shadow["differing_frames"]["stopped"] == 0
@@ -320,14 +417,15 @@ def test_designs_checks_a_verilog_port_map_against_the_design(tmp_path, capsys):
     ports = DESIGNS / "bump_stop_noreset_ports.toml"
     code, out, _ = _cli(["designs", verilog, "--ports", str(ports)], capsys)
     assert code == 0
-    assert "ports: in clk[1], in bump_i[1], out left_dps[12], out right_dps[12], out hit_o[1]" \
-        in out
+    assert (
+        "ports: in clk[1], in bump_i[1], out left_dps[12], out right_dps[12], out hit_o[1]" in out
+    )
     assert "recorded outputs: hit" in out
-    for change, message in ((("bump_i", "bump"),
-                             "the design bump_stop_noreset has no port 'bump'"),
-                            (('hit = "hit_o"', 'hit = "hit"'), "has no port 'hit'"),
-                            (('top = "bump_stop_noreset"', 'top = "bump_stop"'),
-                             "Verilator cannot read")):
+    for change, message in (
+        (("bump_i", "bump"), "the design bump_stop_noreset has no port 'bump'"),
+        (('hit = "hit_o"', 'hit = "hit"'), "has no port 'hit'"),
+        (('top = "bump_stop_noreset"', 'top = "bump_stop"'), "Verilator cannot read"),
+    ):
         bad = tmp_path / "bad.toml"
         bad.write_text(ports.read_text().replace(*change))
         code, _, err = _cli(["designs", verilog, "--ports", str(bad)], capsys)
@@ -344,25 +442,38 @@ def test_a_campaign_takes_design_references_and_their_params_as_axes(tmp_path, m
     (tmp_path / "c.toml").write_text(
         'scenarios = ["wall_stop.toml"]\ndesign = "wall_stop.py:wall_stop"\n'
         'backend = "cxxrtl"\nset = ["design.params={}"]\n'
-        '[grid]\n"design.params.speed" = [100, 200]\n')
+        '[grid]\n"design.params.speed" = [100, 200]\n'
+    )
     monkeypatch.chdir(tmp_path.parent)  # file paths are from the campaign's folder
     data, path = read_campaign_file(str(tmp_path / "c.toml"))
     plan = make_plan(load_campaign(data, source=str(path)))
     assert [r.argv()[r.argv().index("--design") + 1] for r in plan.runs] == [
-        f"{tmp_path.name}/wall_stop.py:wall_stop"] * 2
+        f"{tmp_path.name}/wall_stop.py:wall_stop"
+    ] * 2
     # The design's file names the run: another version of it is another run.
     first = plan.ids[plan.runs[0]]
     (tmp_path / "wall_stop.py").write_text((DESIGNS / "wall_stop.py").read_text() + "\n# v2\n")
-    again = make_plan(load_campaign(read_campaign_file(str(tmp_path / "c.toml"))[0],
-                                    source=str(path)))
+    again = make_plan(
+        load_campaign(read_campaign_file(str(tmp_path / "c.toml"))[0], source=str(path))
+    )
     assert again.ids[again.runs[0]] != first
     assert len(set(plan.ids.values())) == 2
 
 
 def test_export_writes_a_design_of_ones_own_and_refuses_bad_params(tmp_path, capsys):
     out_v = tmp_path / "ws.v"
-    code, out, err = _cli(["export", "--design", f"{DESIGNS}/wall_stop.py:WallStop",
-                           "--param", "speed=200", "-o", str(out_v)], capsys)
+    code, out, err = _cli(
+        [
+            "export",
+            "--design",
+            f"{DESIGNS}/wall_stop.py:WallStop",
+            "--param",
+            "speed=200",
+            "-o",
+            str(out_v),
+        ],
+        capsys,
+    )
     assert code == 0, err
     assert out == f"wrote {out_v} (module WallStop, 6 ports)\n"
     text = out_v.read_text()
@@ -372,8 +483,18 @@ def test_export_writes_a_design_of_ones_own_and_refuses_bad_params(tmp_path, cap
         decl = f"[{width - 1}:0] {port};" if width > 1 else f" {port};"
         assert decl in text, port
     bad = tmp_path / "bad.v"
-    code, out, err = _cli(["export", "--design", f"{DESIGNS}/wall_stop.py:WallStop",
-                           "--param", "speed=fast", "-o", str(bad)], capsys)
+    code, out, err = _cli(
+        [
+            "export",
+            "--design",
+            f"{DESIGNS}/wall_stop.py:WallStop",
+            "--param",
+            "speed=fast",
+            "-o",
+            str(bad),
+        ],
+        capsys,
+    )
     assert (code, out) == (2, "") and err.count("\n") == 1 and "design.params.speed" in err
     assert not bad.exists()
 
@@ -383,21 +504,30 @@ def test_the_exported_verilog_drives_as_its_amaranth_design(tmp_path, capsys):
     """Round trip: wall_stop.py exported, run as Verilog through a port map, gives the
     Amaranth design's trajectory (same stop, same recorded distance) in the same scenario."""
     out_v = tmp_path / "WallStop.v"
-    code, _out, err = _cli(["export", "--design", f"{DESIGNS}/wall_stop.py:WallStop",
-                            "-o", str(out_v)], capsys)
+    code, _out, err = _cli(
+        ["export", "--design", f"{DESIGNS}/wall_stop.py:WallStop", "-o", str(out_v)], capsys
+    )
     assert code == 0, err
     ports = tmp_path / "ports.toml"
-    ports.write_text('top = "WallStop"\nclock = { port = "clk" }\nreset = { port = "rst" }\n'
-                     '[outputs]\nmotor_left = { port = "motor_left", width = 16, signed = true }\n'
-                     'motor_right = { port = "motor_right", width = 16, signed = true }\n'
-                     '[connectors.ultrasound]\ntrig = "trig"\necho = "echo"\n'
-                     '[extra_outputs]\ndistance_mm = "distance_mm"\nstopped = "stopped"\n')
-    amaranth = run_scenario(load_scenario(str(WALL_STOP), ["sim.duration=4"]),
-                            backend="cxxrtl")
-    scenario = load_scenario(str(WALL_STOP), [
-        "sim.duration=4", f'design.top="verilog:{out_v}"', f'design.ports="{ports}"',
-        "design.params={}"])
+    ports.write_text(
+        'top = "WallStop"\nclock = { port = "clk" }\nreset = { port = "rst" }\n'
+        '[outputs]\nmotor_left = { port = "motor_left", width = 16, signed = true }\n'
+        'motor_right = { port = "motor_right", width = 16, signed = true }\n'
+        '[connectors.ultrasound]\ntrig = "trig"\necho = "echo"\n'
+        '[extra_outputs]\ndistance_mm = "distance_mm"\nstopped = "stopped"\n'
+    )
+    amaranth = run_scenario(load_scenario(str(WALL_STOP), ["sim.duration=4"]), backend="cxxrtl")
+    scenario = load_scenario(
+        str(WALL_STOP),
+        [
+            "sim.duration=4",
+            f'design.top="verilog:{out_v}"',
+            f'design.ports="{ports}"',
+            "design.params={}",
+        ],
+    )
     verilog = run_scenario(scenario, backend="verilator")
     for column in ("x", "y", "heading", "motor_left", "design.distance_mm", "design.stopped"):
-        np.testing.assert_array_equal(amaranth.trajectory[column], verilog.trajectory[column],
-                                      err_msg=column)
+        np.testing.assert_array_equal(
+            amaranth.trajectory[column], verilog.trajectory[column], err_msg=column
+        )

@@ -67,7 +67,9 @@ def test_header_kept_values_at_start_dumped_and_only_the_window_copied():
     assert out.startswith(HEADER)
     # At 10: clk fell at 10 itself (at or before the start counts), count is 1 from 5, the
     # alias is not repeated, `late` has no value yet (x), level 0.5 since 0.
-    assert after_header(out) == """\
+    assert (
+        after_header(out)
+        == """\
 #0
 $dumpvars
 0!
@@ -84,11 +86,14 @@ b10 "
 r1.25 $
 #25
 """
+    )
 
 
 def test_a_window_from_time_0_folds_the_changes_at_0_into_the_dump():
     out = trim(HEADER + BODY + "#40\n", 0, 12)
-    assert after_header(out) == """\
+    assert (
+        after_header(out)
+        == """\
 #0
 $dumpvars
 0!
@@ -103,22 +108,24 @@ b1 "
 0!
 #12
 """
+    )
 
 
 def test_a_window_past_the_last_change_is_the_dump_and_the_end():
     out = trim(HEADER + BODY, 100, 200)
-    assert after_header(out) == "#0\n$dumpvars\n0!\nb11 \"\n1#\nr1.25 $\n$end\n#200\n"
+    assert after_header(out) == '#0\n$dumpvars\n0!\nb11 "\n1#\nr1.25 $\n$end\n#200\n'
 
 
 def test_vectors_without_a_value_are_x_and_tokens_may_share_or_split_lines():
-    header = ("$timescale 1ps $end $scope module m $end $var wire 8 % bus $end "
-              "$var reg 1 & bit $end $var wire 3 ' nib $end $upscope $end "
-              "$enddefinitions $end #0 1&\n")
+    header = (
+        "$timescale 1ps $end $scope module m $end $var wire 8 % bus $end "
+        "$var reg 1 & bit $end $var wire 3 ' nib $end $upscope $end "
+        "$enddefinitions $end #0 1&\n"
+    )
     body = "#3 b1010\n%\n#7 0& b1111 % #9 1&\n"
     out = trim(header + body, 4, 9)
-    assert out.startswith(header[:header.index("#0")].rstrip() + "\n")
-    assert after_header(out) == (
-        "#0\n$dumpvars\nb1010 %\n1&\nbx '\n$end\n#7\n0&\nb1111 %\n#9\n")
+    assert out.startswith(header[: header.index("#0")].rstrip() + "\n")
+    assert after_header(out) == ("#0\n$dumpvars\nb1010 %\n1&\nbx '\n$end\n#7\n0&\nb1111 %\n#9\n")
 
 
 def test_the_input_is_read_only_up_to_the_window_end():
@@ -151,13 +158,16 @@ def test_timescale_is_checked_when_given():
         trim(HEADER + BODY, 10, 25, timescale="1 fs")
 
 
-@pytest.mark.parametrize("text,message", [
-    ("hello world\n", "unexpected token 'hello'"),
-    (HEADER.replace("$enddefinitions $end\n", ""), "no \\$enddefinitions"),
-    (HEADER + "#5\nb101\n", "ends inside the value change"),
-    (HEADER + "#5\n?!\n", "unexpected token '\\?!'"),
-    (HEADER + "#five\n", "bad time"),
-])
+@pytest.mark.parametrize(
+    "text,message",
+    [
+        ("hello world\n", "unexpected token 'hello'"),
+        (HEADER.replace("$enddefinitions $end\n", ""), "no \\$enddefinitions"),
+        (HEADER + "#5\nb101\n", "ends inside the value change"),
+        (HEADER + "#5\n?!\n", "unexpected token '\\?!'"),
+        (HEADER + "#five\n", "bad time"),
+    ],
+)
 def test_malformed_input_is_a_clear_error(text, message):
     with pytest.raises(VCDTrimError, match=message):
         trim(text, 1, 100)

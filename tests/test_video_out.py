@@ -23,14 +23,29 @@ def test_saved_video_holds_the_camera_frames(suffix, tmp_path, monkeypatch, caps
     import cv2
 
     monkeypatch.chdir(tmp_path)
-    code, _out, err = cli(["--backend", "model", "--duration", "2", "--rerun", "off",
-                           "--quiet", "--save-video", f"clip{suffix}"], capsys)
+    code, _out, err = cli(
+        [
+            "--backend",
+            "model",
+            "--duration",
+            "2",
+            "--rerun",
+            "off",
+            "--quiet",
+            "--save-video",
+            f"clip{suffix}",
+        ],
+        capsys,
+    )
     assert code == 0, err
     assert sorted(p.name for p in tmp_path.iterdir()) == [f"clip{suffix}"]  # no temp file
 
     frames = []
-    run_scenario(load_scenario("follow_person", ["sim.duration=2"]), backend="model",
-                 on_frame=lambda r: frames.append(r.camera_rgb))
+    run_scenario(
+        load_scenario("follow_person", ["sim.duration=2"]),
+        backend="model",
+        on_frame=lambda r: frames.append(r.camera_rgb),
+    )
     cap = cv2.VideoCapture(str(tmp_path / f"clip{suffix}"))
     decoded = []
     while True:
@@ -47,10 +62,37 @@ def test_saved_video_holds_the_camera_frames(suffix, tmp_path, monkeypatch, caps
 
 def test_source_runs_the_design_on_the_saved_clip(tmp_path, monkeypatch, capsys):
     monkeypatch.chdir(tmp_path)
-    assert cli(["--backend", "model", "--duration", "2", "--rerun", "off", "--quiet",
-                "--save-video", "clip.mp4"], capsys)[0] == 0
-    code, _out, err = cli(["--backend", "model", "--rerun", "off", "--quiet",
-                           "--source", "clip.mp4", "--summary", "s.json"], capsys)
+    assert (
+        cli(
+            [
+                "--backend",
+                "model",
+                "--duration",
+                "2",
+                "--rerun",
+                "off",
+                "--quiet",
+                "--save-video",
+                "clip.mp4",
+            ],
+            capsys,
+        )[0]
+        == 0
+    )
+    code, _out, err = cli(
+        [
+            "--backend",
+            "model",
+            "--rerun",
+            "off",
+            "--quiet",
+            "--source",
+            "clip.mp4",
+            "--summary",
+            "s.json",
+        ],
+        capsys,
+    )
     assert code == 0, err
     s = json.loads((tmp_path / "s.json").read_text())
     assert s["frames"] == 60 and s["found_frames"] >= 57

@@ -159,9 +159,11 @@ def test_the_closing_line_names_a_folder_full_of_recordings(tmp_path, monkeypatc
     rec, msg = record("save", runs / "run.rrd", 3)
     assert os.path.basename(rec.path) == "run-2.rrd"
     held = 2_000_000 + 1_500_000 + size + os.path.getsize(rec.path)
-    assert msg.endswith(f"open it with: rerun {rec.path} "
-                        f"({runs.as_posix()}/ holds {held / 1e6:.0f} MB; "
-                        "--rerun off skips the recording)"), msg
+    assert msg.endswith(
+        f"open it with: rerun {rec.path} "
+        f"({runs.as_posix()}/ holds {held / 1e6:.0f} MB; "
+        "--rerun off skips the recording)"
+    ), msg
 
 
 def test_a_fallback_file_does_not_replace_either(tmp_path, monkeypatch):
@@ -303,8 +305,9 @@ def test_a_process_that_exits_without_closing_leaves_no_partial_file(tmp_path):
             rec.log_frame(frame(i))
         """
     )
-    proc = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
-                          timeout=120, check=False)
+    proc = subprocess.run(
+        [sys.executable, "-c", script], capture_output=True, text=True, timeout=120, check=False
+    )
     assert proc.returncode == 0, proc.stderr
     assert os.listdir(tmp_path) == ["run.rrd"]
     assert frames_in(tmp_path / "run.rrd") == list(range(40))

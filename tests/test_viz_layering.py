@@ -52,7 +52,11 @@ def test_the_viewer_commands_run_from_the_application(tmp_path):
     for args in (["bench", "viewer", "--help"], ["readback"]):
         proc = subprocess.run(
             [sys.executable, "-m", "fpga_robotics", *args],
-            capture_output=True, text=True, timeout=120, check=False, cwd=tmp_path,
+            capture_output=True,
+            text=True,
+            timeout=120,
+            check=False,
+            cwd=tmp_path,
         )
         if args[0] == "bench":
             assert proc.returncode == 0 and "--frames" in proc.stdout, proc.stderr

@@ -165,8 +165,9 @@ def test_without_a_default_path_an_unreachable_viewer_is_an_error(silent_port):
 def test_the_command_line_finishes_and_says_where_the_data_is(peer, tmp_path, request):
     # Issue 11's report: this ran forever, ignoring Ctrl-C, with no verdict and no summary.
     server = request.getfixturevalue(peer)
-    proc = run_cli(["--duration", "3", "--rerun", f"connect:{server.url}", "--summary", "s.json"],
-                   tmp_path)
+    proc = run_cli(
+        ["--duration", "3", "--rerun", f"connect:{server.url}", "--summary", "s.json"], tmp_path
+    )
     assert proc.returncode in (0, 1), proc.stderr
     assert (tmp_path / "s.json").exists()
     saved = tmp_path / "runs" / "follow_person.rrd"
@@ -196,8 +197,10 @@ def test_a_viewer_that_stalls_costs_bounded_time_and_the_copy_is_kept(
 
 
 def test_the_command_line_with_a_stalled_viewer_finishes(stalled_viewer, tmp_path):
-    proc = run_cli(["--duration", "3", "--rerun", f"connect:{stalled_viewer.url}",
-                    "--summary", "s.json"], tmp_path)
+    proc = run_cli(
+        ["--duration", "3", "--rerun", f"connect:{stalled_viewer.url}", "--summary", "s.json"],
+        tmp_path,
+    )
     assert proc.returncode in (0, 1), proc.stderr
     assert (tmp_path / "s.json").exists()
     assert "not every frame may have reached it" in proc.stdout
@@ -308,8 +311,13 @@ def test_ctrl_c_while_closing_on_a_stalled_viewer(stalled_viewer, tmp_path):
         tests=os.path.join(ROOT, "tests"), mode=f"connect:{stalled_viewer.url}",
         default=str(default),
     )  # fmt: skip
-    proc = subprocess.Popen([sys.executable, "-c", script], cwd=tmp_path,
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    proc = subprocess.Popen(
+        [sys.executable, "-c", script],
+        cwd=tmp_path,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
     try:
         assert proc.stdout.readline().strip() == "closing", proc.stderr.read()
         proc.send_signal(signal.SIGINT)  # while close() waits for the stalled viewer

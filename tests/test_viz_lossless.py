@@ -25,8 +25,7 @@ def run(tmp_path_factory):
     seen = []
 
     def keep(record):  # copies: the loop may reuse its arrays
-        seen.append((record.frame, np.array(record.camera_rgb),
-                     np.array(record.result.filtered)))
+        seen.append((record.frame, np.array(record.camera_rgb), np.array(record.result.filtered)))
 
     with open_recorder(f"save:{path}", default_path=str(path)) as rec:
         run_scenario(scenario, backend="cxxrtl", recorder=rec, on_frame=keep)
@@ -41,8 +40,9 @@ def test_camera_and_filtered_frames_read_back_bit_for_bit(run):
     for frame, rgb, packed in seen:
         assert camera[frame].shape == (120, 160, 3)
         np.testing.assert_array_equal(camera[frame], rgb, err_msg=f"camera, frame {frame}")
-        np.testing.assert_array_equal(filtered[frame], rgb444_to_rgb888(packed),
-                                      err_msg=f"filtered, frame {frame}")
+        np.testing.assert_array_equal(
+            filtered[frame], rgb444_to_rgb888(packed), err_msg=f"filtered, frame {frame}"
+        )
     # The target is in view: the filtered frames are not blank (a blank frame proves little).
     assert all(np.count_nonzero(packed) > 100 for _, _, packed in seen)
 

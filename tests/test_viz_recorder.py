@@ -167,10 +167,12 @@ def test_jpeg_quality_0_logs_raw_images(tmp_path):
     assert "EncodedImage:blob" not in values
     fmt = single(values["Image:format"])[2]
     assert (fmt["width"], fmt["height"]) == (32, 24)
-    np.testing.assert_array_equal(single(values["Image:buffer"])[2].reshape(24, 32, 3),
-                                  frames[2].camera_rgb)
-    np.testing.assert_array_equal(images(data, P.CAMERA_FILTERED)[1],
-                                  rgb444_to_rgb888(frames[1].result.filtered))
+    np.testing.assert_array_equal(
+        single(values["Image:buffer"])[2].reshape(24, 32, 3), frames[2].camera_rgb
+    )
+    np.testing.assert_array_equal(
+        images(data, P.CAMERA_FILTERED)[1], rgb444_to_rgb888(frames[1].result.filtered)
+    )
 
 
 def led_states(buffer, fmt, n):

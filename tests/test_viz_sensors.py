@@ -15,7 +15,9 @@ from fpga_robotics.viz.sensors import DESIGN_EXTRA, MAP_LINES, MAP_SENSORS, SENS
 def obstacle_run(tmp_path_factory):
     """obstacle_between for 1 s, the box taken away at 0.5 s, recorded."""
     path = tmp_path_factory.mktemp("rec") / "ob.rrd"
-    s = load_scenario("obstacle_between", ["sim.duration=1.0", "room.furniture.0.present_until=0.5"])
+    s = load_scenario(
+        "obstacle_between", ["sim.duration=1.0", "room.furniture.0.present_until=0.5"]
+    )
     rec = open_recorder(f"save:{path}", default_path=str(path))
     result = run_scenario(s, backend="cxxrtl", recorder=rec)
     rec.close()
@@ -32,7 +34,8 @@ def test_each_measurement_is_a_series_on_the_frames_timeline(obstacle_run):
     mm = data.entities[f"{DESIGN_EXTRA}/distance_mm"]
     assert mm.frames == list(range(n))
     assert [v[0] for v in mm.values["Scalars:scalars"]] == list(
-        result.trajectory["design.distance_mm"])
+        result.trajectory["design.distance_mm"]
+    )
 
 
 def test_the_sensor_and_its_range_are_on_the_map(obstacle_run):
@@ -41,8 +44,9 @@ def test_the_sensor_and_its_range_are_on_the_map(obstacle_run):
     assert len(ray.frames) >= 1
     (x0, y0), (x1, y1) = ray.values["LineStrips2D:strips"][-1][0]
     # From the sensor, as long as the last echo says (the map's y axis is flipped).
-    assert np.hypot(x1 - x0, y1 - y0) == pytest.approx(result.trajectory["front.echo_m"][-1],
-                                                       abs=1e-4)
+    assert np.hypot(x1 - x0, y1 - y0) == pytest.approx(
+        result.trajectory["front.echo_m"][-1], abs=1e-4
+    )
 
 
 def test_the_box_leaves_the_map_when_it_leaves_the_room(obstacle_run):

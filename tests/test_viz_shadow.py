@@ -15,11 +15,17 @@ from fpga_robotics.viz.readback import read_rrd
 def test_shadow_outputs_are_recorded_beside_the_primary(tmp_path):
     s = load_scenario("lost_target", ["sim.duration=5"])
     other = s.with_overrides(["design.lost_frames=5"]).params
-    rec = open_recorder(f"save:{tmp_path / 'run.rrd'}", default_path=str(tmp_path / 'd.rrd'))
+    rec = open_recorder(f"save:{tmp_path / 'run.rrd'}", default_path=str(tmp_path / "d.rrd"))
     shadow_results = []
     with ModelBackend(other) as shadow:
-        r = run_scenario(s, backend="model", recorder=rec, shadow=shadow, shadow_label="five",
-                         on_frame=lambda record: shadow_results.append(record.shadow_result))
+        r = run_scenario(
+            s,
+            backend="model",
+            recorder=rec,
+            shadow=shadow,
+            shadow_label="five",
+            on_frame=lambda record: shadow_results.append(record.shadow_result),
+        )
     rec.close()
     data = read_rrd(str(tmp_path / "run.rrd"))
     n = r.summary["frames"]
@@ -31,8 +37,9 @@ def test_shadow_outputs_are_recorded_beside_the_primary(tmp_path):
     # The shadow design's LEDs as the board would light them, frame by frame.
     k = r.summary["shadow"]["first_divergence"]["frame"]
     led_rows = data.entities[P.SHADOW_LEDS_CENTROID].values["Image:buffer"]
-    assert np.array_equal(np.asarray(led_rows[k]).ravel(),
-                          centroid_image(shadow_results[k].centroid_leds).ravel())
+    assert np.array_equal(
+        np.asarray(led_rows[k]).ravel(), centroid_image(shadow_results[k].centroid_leds).ravel()
+    )
     texts = [str(v) for v in data.entities[P.EVENTS].values["TextLog:text"]]
     assert any("shadow design five diverges" in t for t in texts)
     assert data.blueprints == 2  # the layout with the shadow rows replaces the first one
@@ -41,9 +48,11 @@ def test_shadow_outputs_are_recorded_beside_the_primary(tmp_path):
 
 def test_no_shadow_entities_without_a_shadow(tmp_path):
     s = load_scenario("lost_target", ["sim.duration=1"])
-    rec = open_recorder(f"save:{tmp_path / 'run.rrd'}", default_path=str(tmp_path / 'd.rrd'))
+    rec = open_recorder(f"save:{tmp_path / 'run.rrd'}", default_path=str(tmp_path / "d.rrd"))
     run_scenario(s, backend="model", recorder=rec)
     rec.close()
     data = read_rrd(str(tmp_path / "run.rrd"))
-    assert not any(p.startswith("shadow") or p == P.SHADOW_MOTORS_DPS
-                   for p in list(data.entities) + list(data.static))
+    assert not any(
+        p.startswith("shadow") or p == P.SHADOW_MOTORS_DPS
+        for p in list(data.entities) + list(data.static)
+    )

@@ -56,8 +56,7 @@ def test_contacts_that_resume_within_the_gap_are_one_episode():
 
 
 def test_a_person_walking_steadily_into_a_parked_robot_is_one_episode_not_its_fault():
-    person = {"name": "p1", "waypoints": [[5.0, 3.0], [1.0, 3.0]], "speed": 0.6,
-              "loop": False}
+    person = {"name": "p1", "waypoints": [[5.0, 3.0], [1.0, 3.0]], "speed": 0.6, "loop": False}
     world = _world({"start": [3.0, 3.0]}, [person])
     events = []
     _run(world, 8.0, events)
@@ -66,8 +65,11 @@ def test_a_person_walking_steadily_into_a_parked_robot_is_one_episode_not_its_fa
     touch = (2.0 - CONTACT) / 0.6
     stop = 4.0 / 0.6
     assert [e for _, e in events] == [
-        ("collision with person 'p1' (robot closing 0.00 m/s, person 0.60 m/s: "
-        "not the robot's fault)")]
+        (
+            "collision with person 'p1' (robot closing 0.00 m/s, person 0.60 m/s: "
+            "not the robot's fault)"
+        )
+    ]
     assert events[0][0] == pytest.approx(touch, abs=DT)
     summary = world.collision_summary()
     assert summary["person"]["episodes"] == world.collision_counts()["person"] == 1
@@ -78,15 +80,17 @@ def test_a_person_walking_steadily_into_a_parked_robot_is_one_episode_not_its_fa
 def test_a_creeping_robot_hit_by_a_walking_person_is_not_at_fault():
     # The robot creeps towards the person at 0.06 m/s (above AT_FAULT_SPEED), the person
     # walks into it at 0.6 m/s: the person closed the gap.
-    person = {"name": "p1", "waypoints": [[5.0, 3.0], [1.0, 3.0]], "speed": 0.6,
-              "loop": False}
+    person = {"name": "p1", "waypoints": [[5.0, 3.0], [1.0, 3.0]], "speed": 0.6, "loop": False}
     world = _world({"start": [3.0, 3.0]}, [person])
     world.set_wheel_dps(_dps(0.06), _dps(0.06))
     events = []
     _run(world, 3.0, events)
     assert [e for _, e in events] == [
-        ("collision with person 'p1' (robot closing 0.06 m/s, person 0.60 m/s: "
-        "not the robot's fault)")]
+        (
+            "collision with person 'p1' (robot closing 0.06 m/s, person 0.60 m/s: "
+            "not the robot's fault)"
+        )
+    ]
     assert world.at_fault_collisions() == 0
 
 
@@ -105,8 +109,8 @@ def test_the_robot_driving_into_a_standing_person_is_one_episode_and_its_fault()
     _run(world, 6.0, events)  # it keeps pushing against the person to the end
     touch = _touch_time(300, 1.0 - CONTACT)
     assert [e for _, e in events] == [
-        ("collision with person 'bob' (robot closing 0.18 m/s, person 0.00 m/s: "
-        "the robot's fault)")]
+        ("collision with person 'bob' (robot closing 0.18 m/s, person 0.00 m/s: the robot's fault)")
+    ]
     assert events[0][0] == pytest.approx(touch, abs=DT)
     summary = world.collision_summary()["person"]
     assert summary["episodes"] == 1 and world.at_fault_collisions() == 1
@@ -148,5 +152,8 @@ def test_a_wall_hit_gives_its_contact_time_and_impulse():
     # Stopping m at v in one step, while the drive pushes with its traction for that step.
     expected = TURTLEBOT2.mass * v + TURTLEBOT2.traction_force * DT
     assert wall["max_impulse_ns"] == pytest.approx(expected, rel=0.02)
-    assert world.collision_summary()["person"] == {"episodes": 0, "contact_s": 0.0,
-                                                   "max_impulse_ns": 0.0}
+    assert world.collision_summary()["person"] == {
+        "episodes": 0,
+        "contact_s": 0.0,
+        "max_impulse_ns": 0.0,
+    }

@@ -95,10 +95,13 @@ def test_slower_ramp_from_config():
     assert time_to_reach(world, 0.999, 0.035 * 4 * math.pi) == pytest.approx(1.8, abs=2 * DT)
 
 
-@pytest.mark.parametrize("robot, force, mass", [
-    ({"mass": 30.0}, TURTLEBOT2.traction_force, 30.0),  # heavier robot, same motors
-    ({"traction_force": 3.0}, 3.0, TURTLEBOT2.mass),  # weaker motors
-])
+@pytest.mark.parametrize(
+    "robot, force, mass",
+    [
+        ({"mass": 30.0}, TURTLEBOT2.traction_force, 30.0),  # heavier robot, same motors
+        ({"traction_force": 3.0}, 3.0, TURTLEBOT2.mass),  # weaker motors
+    ],
+)
 def test_heavier_robot_or_weaker_traction_accelerates_slower(robot, force, mass):
     nominal = empty_world({"start": [1.0, 3.0]})
     slow = empty_world({"start": [1.0, 3.0], **robot})
@@ -158,13 +161,13 @@ def test_driving_into_a_standing_person_is_a_collision_and_does_not_move_them():
     assert (state.x, state.y) == pytest.approx((4.0, 3.0), abs=1e-9)
     assert world.collision_counts() == {"person": 1, "wall": 0, "furniture": 0}
     # 1000 DPS: 0.035 m * 1000 * pi / 180 = 0.61 m/s towards a person standing still.
-    assert world.drain_events() == [("collision with person 'bob' (robot closing 0.61 m/s, "
-                                    "person 0.00 m/s: the robot's fault)")]
+    assert world.drain_events() == [
+        ("collision with person 'bob' (robot closing 0.61 m/s, person 0.00 m/s: the robot's fault)")
+    ]
 
 
 def test_a_walking_person_pushes_the_robot_and_keeps_to_their_script():
-    person = {"name": "walker", "waypoints": [[6.0, 3.0], [1.0, 3.0]], "speed": 0.5,
-              "loop": False}
+    person = {"name": "walker", "waypoints": [[6.0, 3.0], [1.0, 3.0]], "speed": 0.5, "loop": False}
     world = empty_world({"start": [3.5, 3.0]}, people=[person])
     run(world, 2.0)  # 1 m walked, nothing touched yet (gap 2.5 - 0.377 m)
     assert world.collision_counts()["person"] == 0
@@ -183,8 +186,13 @@ CONTACT = 0.2 + TURTLEBOT2.body_radius  # centres of a person and the robot when
 
 
 def test_a_yielding_person_waits_for_the_robot_and_then_keeps_to_their_script():
-    person = {"name": "walker", "waypoints": [[6.0, 3.0], [1.0, 3.0]], "speed": 0.5,
-              "loop": False, "yield_gap": 0.3}
+    person = {
+        "name": "walker",
+        "waypoints": [[6.0, 3.0], [1.0, 3.0]],
+        "speed": 0.5,
+        "loop": False,
+        "yield_gap": 0.3,
+    }
     world = empty_world({"start": [3.5, 3.0]}, people=[person])
     run(world, 6.0)  # they would reach the robot after (6 - 3.5 - 0.377) / 0.5 = 4.2 s
     (state,) = world.people_states()
@@ -210,8 +218,7 @@ def test_a_yielding_person_waits_for_the_robot_and_then_keeps_to_their_script():
 def test_a_yielding_person_still_walks_past_the_robot():
     # Their path passes 0.75 m from the robot's centre, 0.37 m between the bodies: never
     # closer than the gap (0.3 m), so they never wait.
-    person = {"waypoints": [[6.0, 3.5], [1.0, 3.5]], "speed": 0.5, "loop": False,
-              "yield_gap": 0.3}
+    person = {"waypoints": [[6.0, 3.5], [1.0, 3.5]], "speed": 0.5, "loop": False, "yield_gap": 0.3}
     world = empty_world({"start": [3.5, 2.75]}, people=[person])
     for _ in range(round(10.0 / DT)):
         world.step(DT)
@@ -221,8 +228,14 @@ def test_a_yielding_person_still_walks_past_the_robot():
 
 
 def test_same_seed_same_trajectory_different_seed_different_people():
-    people = [{"waypoints": [[3, 3], [6, 4], [6, 2]], "speed": 0.6, "speed_jitter": 0.3,
-               "pause": [0.5, 1.0, 0.2]}]
+    people = [
+        {
+            "waypoints": [[3, 3], [6, 4], [6, 2]],
+            "speed": 0.6,
+            "speed_jitter": 0.3,
+            "pause": [0.5, 1.0, 0.2],
+        }
+    ]
 
     def trajectory(seed):
         world = World.from_config({"people": people, "robot": {"start": [1.0, 3.0]}}, seed)
@@ -252,18 +265,29 @@ def test_step_splits_long_steps():
 
 
 @settings(max_examples=15, deadline=None)
-@given(st.lists(st.tuples(st.integers(-1500, 1500), st.integers(-1500, 1500)),
-                min_size=5, max_size=5), st.sampled_from(["turtlebot2", "gopigo3"]))
+@given(
+    st.lists(st.tuples(st.integers(-1500, 1500), st.integers(-1500, 1500)), min_size=5, max_size=5),
+    st.sampled_from(["turtlebot2", "gopigo3"]),
+)
 # Once found with the person's path ending 0.5 m from a wall: the scripted person pinned the
 # robot against the wall and pushed it 2 cm into it (people do not yield; docs/scenarios.md).
 @example([(-764, 971), (0, 7), (1028, 449), (0, 352), (0, 0)], "turtlebot2")
 def test_no_command_sequence_gets_the_robot_out_of_the_room(commands, model):
     # The person walks where it can bump into the robot but never pin it against a wall or
     # the box (at least a robot's diameter away from both).
-    room = {"width": 3.0, "depth": 2.5,
-            "furniture": [{"name": "box", "center": [2.2, 1.2], "size": [0.5, 0.5]}]}
-    world = World.from_config({"room": room, "robot": {"model": model, "start": [0.8, 1.2]},
-                               "people": [{"waypoints": [[1.2, 0.8], [1.2, 1.7]]}]}, seed=1)
+    room = {
+        "width": 3.0,
+        "depth": 2.5,
+        "furniture": [{"name": "box", "center": [2.2, 1.2], "size": [0.5, 0.5]}],
+    }
+    world = World.from_config(
+        {
+            "room": room,
+            "robot": {"model": model, "start": [0.8, 1.2]},
+            "people": [{"waypoints": [[1.2, 0.8], [1.2, 1.7]]}],
+        },
+        seed=1,
+    )
     r = world.robot_spec.body_radius
     for left, right in commands:
         world.set_wheel_dps(left, right)

@@ -15,8 +15,7 @@ def path(person, seed=0):
 
 
 def test_one_way_walk_with_start_delay():
-    p = path({"waypoints": [[1, 1], [3, 1]], "speed": 0.5, "start_delay": 1.0,
-              "loop": False})
+    p = path({"waypoints": [[1, 1], [3, 1]], "speed": 0.5, "start_delay": 1.0, "loop": False})
     assert p.position(0.0) == (1, 1)
     assert p.position(0.9) == (1, 1)
     assert p.position(3.0) == pytest.approx((2.0, 1.0))  # 2 s at 0.5 m/s after the delay
@@ -30,8 +29,12 @@ def test_loop_with_pauses_per_waypoint():
     # Legs: W0->W1 0..2 s, pause 1 s, W1->W2 3..4, pause 1.5 s, W2->W0 5.5..5.5+diag,
     # pause 0.5 s, then round again.
     expected = {
-        1.0: (2.0, 1.0), 2.5: (3.0, 1.0), 3.5: (3.0, 1.5), 5.0: (3.0, 2.0),
-        5.5 + diag / 2: (2.0, 1.5), 5.5 + diag + 0.25: (1.0, 1.0),
+        1.0: (2.0, 1.0),
+        2.5: (3.0, 1.0),
+        3.5: (3.0, 1.5),
+        5.0: (3.0, 2.0),
+        5.5 + diag / 2: (2.0, 1.5),
+        5.5 + diag + 0.25: (1.0, 1.0),
         6.0 + diag + 1.0: (2.0, 1.0),  # second lap
     }
     for t, where in expected.items():
@@ -41,8 +44,13 @@ def test_loop_with_pauses_per_waypoint():
 
 
 def test_world_moves_people_along_their_script_at_their_speed():
-    person = {"name": "walker", "waypoints": [[2, 5], [6, 5]], "speed": 0.8, "pause": 2.0,
-              "start_delay": 0.5}
+    person = {
+        "name": "walker",
+        "waypoints": [[2, 5], [6, 5]],
+        "speed": 0.8,
+        "pause": 2.0,
+        "start_delay": 0.5,
+    }
     world = World.from_config({"people": [person]}, seed=0)
     samples = {}
     for _ in range(round(14.0 * 200)):

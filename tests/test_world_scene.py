@@ -13,8 +13,9 @@ def length(wall):
 
 
 def test_room_walls_enclose_the_room_at_the_configured_height():
-    world = World.from_config({"room": {"width": 5.0, "depth": 4.0, "height": 3.0,
-                                        "wall_color": [0.5, 0.6, 0.7]}}, seed=0)
+    world = World.from_config(
+        {"room": {"width": 5.0, "depth": 4.0, "height": 3.0, "wall_color": [0.5, 0.6, 0.7]}}, seed=0
+    )
     scene = world.scene()
     assert isinstance(scene, Scene)
     assert len(scene.walls) == 4
@@ -26,12 +27,24 @@ def test_room_walls_enclose_the_room_at_the_configured_height():
 
 
 def test_box_has_four_faces_and_divider_two_long_faces():
-    room = {"furniture": [
-        {"name": "table", "center": [3.0, 1.0], "size": [1.2, 0.8], "height": 0.7,
-         "color": [0.3, 0.3, 0.3]},
-        {"name": "divider", "type": "divider", "center": [6.0, 3.0], "size": [2.0, 0.04],
-         "angle_deg": 90},
-    ]}
+    room = {
+        "furniture": [
+            {
+                "name": "table",
+                "center": [3.0, 1.0],
+                "size": [1.2, 0.8],
+                "height": 0.7,
+                "color": [0.3, 0.3, 0.3],
+            },
+            {
+                "name": "divider",
+                "type": "divider",
+                "center": [6.0, 3.0],
+                "size": [2.0, 0.04],
+                "angle_deg": 90,
+            },
+        ]
+    }
     world = World.from_config({"room": room}, seed=0)
     walls = world.scene().walls[4:]
     table, divider = walls[:4], walls[4:]
@@ -48,8 +61,14 @@ def test_box_has_four_faces_and_divider_two_long_faces():
 def test_people_are_banded_cylinders_where_they_stand():
     people = [
         {"name": "target", "waypoints": [[4.0, 2.0]]},
-        {"name": "short", "waypoints": [[6.0, 4.0]], "height": 1.4, "radius": 0.15,
-         "shirt_color": [0.1, 0.2, 0.9], "trousers_color": [0.9, 0.9, 0.9]},
+        {
+            "name": "short",
+            "waypoints": [[6.0, 4.0]],
+            "height": 1.4,
+            "radius": 0.15,
+            "shirt_color": [0.1, 0.2, 0.9],
+            "trousers_color": [0.9, 0.9, 0.9],
+        },
     ]
     scene = World.from_config({"people": people}, seed=0).scene()
     default, short = scene.cylinders
@@ -78,8 +97,13 @@ def test_scene_follows_people_as_they_walk():
 
 
 def test_world_map_has_walls_obstacles_and_bounds():
-    room = {"width": 6.0, "depth": 5.0, "furniture": [
-        {"center": [2.0, 2.0], "size": [1.0, 0.5], "angle_deg": 30, "color": [1.0, 0.5, 0.0]}]}
+    room = {
+        "width": 6.0,
+        "depth": 5.0,
+        "furniture": [
+            {"center": [2.0, 2.0], "size": [1.0, 0.5], "angle_deg": 30, "color": [1.0, 0.5, 0.0]}
+        ],
+    }
     world_map = World.from_config({"room": room}, seed=0).world_map()
     assert world_map.bounds == (0.0, 0.0, 6.0, 5.0)
     assert len(world_map.walls) == 4
@@ -90,9 +114,18 @@ def test_world_map_has_walls_obstacles_and_bounds():
 
 
 def test_camera_pose_is_the_mount_on_the_robot():
-    world = World.from_config({"robot": {"start": [2.0, 3.0], "heading_deg": 90,
-                                         "camera_height": 0.4, "camera_forward": 0.1,
-                                         "camera_tilt_deg": 5}}, seed=0)
+    world = World.from_config(
+        {
+            "robot": {
+                "start": [2.0, 3.0],
+                "heading_deg": 90,
+                "camera_height": 0.4,
+                "camera_forward": 0.1,
+                "camera_tilt_deg": 5,
+            }
+        },
+        seed=0,
+    )
     pose = world.camera_pose()
     assert (pose.x, pose.y) == pytest.approx((2.0, 3.1))
     assert pose.heading == pytest.approx(math.pi / 2)

@@ -28,11 +28,24 @@ def run(world, seconds):
 
 
 def ramp_world(slope_deg, *, friction=1.0, slope_dir_deg=0.0, robot=None, people=()):
-    room = {"width": 8.0, "depth": 6.0, "terrain": [
-        {"name": "ramp", "center": [4.0, 3.0], "size": [6.0, 4.0], "friction": friction,
-         "slope_deg": slope_deg, "slope_dir_deg": slope_dir_deg}]}
-    return World.from_config({"room": room, "robot": {"start": [4.0, 3.0], **(robot or {})},
-                              "people": list(people)}, seed=0)
+    room = {
+        "width": 8.0,
+        "depth": 6.0,
+        "terrain": [
+            {
+                "name": "ramp",
+                "center": [4.0, 3.0],
+                "size": [6.0, 4.0],
+                "friction": friction,
+                "slope_deg": slope_deg,
+                "slope_dir_deg": slope_dir_deg,
+            }
+        ],
+    }
+    return World.from_config(
+        {"room": room, "robot": {"start": [4.0, 3.0], **(robot or {})}, "people": list(people)},
+        seed=0,
+    )
 
 
 def test_polygons_and_the_last_patch_wins():
@@ -40,10 +53,19 @@ def test_polygons_and_the_last_patch_wins():
     assert polygon_contains(square, 1, 1) and not polygon_contains(square, 3, 1)
     l_shape = ((0, 0), (3, 0), (3, 1), (1, 1), (1, 3), (0, 3))
     assert polygon_contains(l_shape, 0.5, 2.5) and not polygon_contains(l_shape, 2, 2)
-    world = World.from_config({"room": {"terrain": [
-        {"name": "carpet", "center": [3, 3], "size": [4, 4], "friction": 0.5},
-        {"name": "wet", "points": [[2, 2], [4, 2], [4, 4], [2, 4]], "friction": 0.1},
-    ]}, "robot": {"start": [1.5, 3.0]}, "people": []}, seed=0)
+    world = World.from_config(
+        {
+            "room": {
+                "terrain": [
+                    {"name": "carpet", "center": [3, 3], "size": [4, 4], "friction": 0.5},
+                    {"name": "wet", "points": [[2, 2], [4, 2], [4, 4], [2, 4]], "friction": 0.1},
+                ]
+            },
+            "robot": {"start": [1.5, 3.0]},
+            "people": [],
+        },
+        seed=0,
+    )
     assert world.terrain.at(3, 3).name == "wet"  # listed last
     assert world.terrain.at(1.5, 3).name == "carpet"
     assert world.terrain.at(6, 3) is None
@@ -98,8 +120,12 @@ def _top_row(rgb, col, color):
 
 
 def test_the_pitch_moves_the_targets_image_row_by_the_pinhole_amount():
-    person = {"name": "t", "target": True, "waypoints": [[7.0, 3.0]],
-              "shirt_color": [0.9, 0.05, 0.05]}
+    person = {
+        "name": "t",
+        "target": True,
+        "waypoints": [[7.0, 3.0]],
+        "shirt_color": [0.9, 0.05, 0.05],
+    }
     width, height, hfov = 160, 120, 1.047
     renderer = CameraRenderer(width, height, hfov)
     f = focal_length(width, hfov)
@@ -162,8 +188,9 @@ def test_gain_errors_are_drawn_once_within_bounds_and_seeded():
 
 def test_slips_come_at_their_rate_and_cut_the_traction():
     rate, duration, h = 0.5, 0.2, 0.01
-    u = MotorUncertainty(Uncertainty(slip_rate_hz=rate, slip_duration_s=duration,
-                                     slip_traction=0.3), seed=1)
+    u = MotorUncertainty(
+        Uncertainty(slip_rate_hz=rate, slip_duration_s=duration, slip_traction=0.3), seed=1
+    )
     total = 4000.0
     slipping = 0
     for i in range(round(total / h)):
@@ -176,8 +203,12 @@ def test_slips_come_at_their_rate_and_cut_the_traction():
 
 
 def test_the_same_seed_gives_the_same_run_and_the_ideal_robot_is_unchanged():
-    robot = {"start": [2.0, 3.0], "motor_gain_error": 0.05, "motor_noise_dps": 15.0,
-             "slip_rate_hz": 1.0}
+    robot = {
+        "start": [2.0, 3.0],
+        "motor_gain_error": 0.05,
+        "motor_noise_dps": 15.0,
+        "slip_rate_hz": 1.0,
+    }
 
     def drive(cfg, seed):
         world = World.from_config({"robot": cfg, "people": []}, seed=seed)
@@ -192,31 +223,49 @@ def test_the_same_seed_gives_the_same_run_and_the_ideal_robot_is_unchanged():
     assert ideal == zeros  # bit for bit: nothing drawn, nothing changed
 
 
-@pytest.mark.parametrize("room, message", [
-    ({"terrain": {"center": [1, 1]}}, "room.terrain must be an array of tables"),
-    ({"terrain": [{"friction": 0.5}]}, "room.terrain[0] needs either points"),
-    ({"terrain": [{"center": [1, 1], "points": [[0, 0], [1, 0], [1, 1]]}]},
-     "room.terrain[0] needs either points"),
-    ({"terrain": [{"points": [[0, 0], [1, 0]]}]}, ("room.terrain[0].points must be an array of "
-                                                  "at least 3 points")),
-    ({"terrain": [{"points": [[0, 0], [1, 1], [2, 2]]}]}, "encloses no area"),
-    ({"terrain": [{"center": [1, 1], "slope_deg": 60}]}, "room.terrain[0].slope_deg must be <= 45"),
-    ({"terrain": [{"center": [1, 1], "friction": 0}]}, "room.terrain[0].friction must be >= 0.01"),
-    ({"terrain": [{"center": [1, 1], "colour": [1, 0, 0]}]}, ("room.terrain[0].colour is not a "
-                                                             "known key (did you mean 'color'?)")),
-    ({"terrain": [{"center": [50, 50]}]}, "room.terrain[0] lies outside the room"),
-])
+@pytest.mark.parametrize(
+    "room, message",
+    [
+        ({"terrain": {"center": [1, 1]}}, "room.terrain must be an array of tables"),
+        ({"terrain": [{"friction": 0.5}]}, "room.terrain[0] needs either points"),
+        (
+            {"terrain": [{"center": [1, 1], "points": [[0, 0], [1, 0], [1, 1]]}]},
+            "room.terrain[0] needs either points",
+        ),
+        (
+            {"terrain": [{"points": [[0, 0], [1, 0]]}]},
+            ("room.terrain[0].points must be an array of at least 3 points"),
+        ),
+        ({"terrain": [{"points": [[0, 0], [1, 1], [2, 2]]}]}, "encloses no area"),
+        (
+            {"terrain": [{"center": [1, 1], "slope_deg": 60}]},
+            "room.terrain[0].slope_deg must be <= 45",
+        ),
+        (
+            {"terrain": [{"center": [1, 1], "friction": 0}]},
+            "room.terrain[0].friction must be >= 0.01",
+        ),
+        (
+            {"terrain": [{"center": [1, 1], "colour": [1, 0, 0]}]},
+            ("room.terrain[0].colour is not a known key (did you mean 'color'?)"),
+        ),
+        ({"terrain": [{"center": [50, 50]}]}, "room.terrain[0] lies outside the room"),
+    ],
+)
 def test_bad_terrain_names_the_key(room, message):
     with pytest.raises(WorldConfigError, match=re.escape(message)):
         World.from_config({"room": room, "people": []}, seed=0)
 
 
-@pytest.mark.parametrize("key, value, message", [
-    ("motor_gain_error", 1.5, "robot.motor_gain_error must be <= 0.9"),
-    ("motor_noise_dps", -1, "robot.motor_noise_dps must be >= 0"),
-    ("slip_rate_hz", "often", "robot.slip_rate_hz must be a number"),
-    ("slip_traction", 0, "robot.slip_traction must be >= 0.01"),
-])
+@pytest.mark.parametrize(
+    "key, value, message",
+    [
+        ("motor_gain_error", 1.5, "robot.motor_gain_error must be <= 0.9"),
+        ("motor_noise_dps", -1, "robot.motor_noise_dps must be >= 0"),
+        ("slip_rate_hz", "often", "robot.slip_rate_hz must be a number"),
+        ("slip_traction", 0, "robot.slip_traction must be >= 0.01"),
+    ],
+)
 def test_bad_uncertainty_names_the_key(key, value, message):
     with pytest.raises(WorldConfigError, match=message):
         World.from_config({"robot": {key: value}, "people": []}, seed=0)
@@ -231,8 +280,11 @@ def test_the_map_shows_the_terrain(tmp_path):
 
     path = tmp_path / "slippery.rrd"
     rec = open_recorder(f"save:{path}", default_path=None)
-    run_scenario(load_scenario("slippery", ['camera.resolution="80x60"', "sim.duration=0.2"]),
-                 backend="model", recorder=rec)
+    run_scenario(
+        load_scenario("slippery", ['camera.resolution="80x60"', "sim.duration=0.2"]),
+        backend="model",
+        recorder=rec,
+    )
     rec.close()
     recording = read_rrd(str(path))
     static = recording.static[P.MAP_TERRAIN]

@@ -44,15 +44,20 @@ def default_blueprint(bounds=None, shadow=False, world3d=False, sensors=(), fram
             x_range=[xmin - pad, xmax + pad], y_range=[-ymax - pad, -ymin + pad]
         )
     plots = rrb.Horizontal(
-        rrb.TimeSeriesView(origin=P.MOTORS if shadow else P.MOTORS_DPS,
-                           name="Wheel DPS (left, right" + (", shadow" if shadow else "")
-                           + ")"),
+        rrb.TimeSeriesView(
+            origin=P.MOTORS if shadow else P.MOTORS_DPS,
+            name="Wheel DPS (left, right" + (", shadow" if shadow else "") + ")",
+        ),
         rrb.TimeSeriesView(origin=P.TWIST_V, name="V m/s (commanded, measured)"),
         rrb.TimeSeriesView(origin=P.TWIST_W, name="W rad/s (commanded, measured)"),
     )
     if not frame_outputs:
-        board = rrb.Vertical(rrb.Spatial2DView(origin=P.CAMERA_RAW, name="Camera"), plots,
-                             row_shares=[4, 3], name="Board")
+        board = rrb.Vertical(
+            rrb.Spatial2DView(origin=P.CAMERA_RAW, name="Camera"),
+            plots,
+            row_shares=[4, 3],
+            name="Board",
+        )
         return _blueprint(board, bounds, map_kwargs, world3d, sensors)
     board = rrb.Vertical(
         rrb.Horizontal(
@@ -64,11 +69,21 @@ def default_blueprint(bounds=None, shadow=False, world3d=False, sensors=(), fram
             rrb.Spatial2DView(origin=P.LEDS_CENTROID, name="Centroid LEDs"),
             column_shares=[7, 8],
         ),
-        *([rrb.Horizontal(
-            rrb.Spatial2DView(origin=P.SHADOW_LEDS_PROXIMITY, name="Shadow design: proximity"),
-            rrb.Spatial2DView(origin=P.SHADOW_LEDS_CENTROID, name="Shadow design: centroid"),
-            column_shares=[7, 8],
-        )] if shadow else []),
+        *(
+            [
+                rrb.Horizontal(
+                    rrb.Spatial2DView(
+                        origin=P.SHADOW_LEDS_PROXIMITY, name="Shadow design: proximity"
+                    ),
+                    rrb.Spatial2DView(
+                        origin=P.SHADOW_LEDS_CENTROID, name="Shadow design: centroid"
+                    ),
+                    column_shares=[7, 8],
+                )
+            ]
+            if shadow
+            else []
+        ),
         plots,
         row_shares=[4, 1, 1, 3] if shadow else [4, 1, 3],
         name="Board",
@@ -88,8 +103,7 @@ def _blueprint(board, bounds, map_kwargs, world3d, sensors):
         rrb.Horizontal(top_down, world3d_view(bounds)) if world3d else top_down,
         rrb.Horizontal(
             rrb.Tabs(
-                *(rrb.TimeSeriesView(origin=path, name=path.split("/", 1)[1])
-                  for path in sensors),
+                *(rrb.TimeSeriesView(origin=path, name=path.split("/", 1)[1]) for path in sensors),
                 rrb.TimeSeriesView(origin=P.DESIGN_TRACKING, name="found, proximity"),
                 rrb.TimeSeriesView(origin=P.DESIGN_CENTROID_X, name="centroid_x"),
                 rrb.TimeSeriesView(origin=P.TARGET_DISTANCE, name="target distance m"),

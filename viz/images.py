@@ -33,9 +33,12 @@ AUTO_JPEG_QUALITY = 85
 MEDIA_TYPES = {"png": "image/png", "jpeg": "image/jpeg"}
 
 _PNG_OPTIONS = [
-    cv2.IMWRITE_PNG_COMPRESSION, 1,
-    cv2.IMWRITE_PNG_STRATEGY, cv2.IMWRITE_PNG_STRATEGY_RLE,
-    cv2.IMWRITE_PNG_FILTER, cv2.IMWRITE_PNG_FAST_FILTERS,
+    cv2.IMWRITE_PNG_COMPRESSION,
+    1,
+    cv2.IMWRITE_PNG_STRATEGY,
+    cv2.IMWRITE_PNG_STRATEGY_RLE,
+    cv2.IMWRITE_PNG_FILTER,
+    cv2.IMWRITE_PNG_FAST_FILTERS,
 ]
 
 # Packed RGB444 -> RGB888 for every 12-bit value: one gather per frame instead of shifts.

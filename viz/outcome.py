@@ -64,7 +64,9 @@ def settle(output, confirmed, problem, frames, images):
         text = failed or f"saved {counted} to {_saved(file, frames)}"
         if problem:
             text = f"{text} ({problem})"
-        return (f"{output.reason}; {text}" if output.reason else text), None if failed else file.path
+        return (
+            f"{output.reason}; {text}" if output.reason else text
+        ), None if failed else file.path
     if file is None:  # a live stream with no default path
         text = f"{output.description}: {counted}"
         return (text if confirmed else f"{text}; {problem}, and no file was kept"), None

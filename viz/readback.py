@@ -73,8 +73,9 @@ def read_rrd(path):
         reader = RrdReader(path)
         chunks = list(reader.stream())
     except RuntimeError as exc:  # rerun's word for a file that is not a recording
-        raise ViewerError(f"{path} is not a rerun recording (.rrd): "
-                          f"{str(exc).splitlines()[0]}") from None
+        raise ViewerError(
+            f"{path} is not a rerun recording (.rrd): {str(exc).splitlines()[0]}"
+        ) from None
     entities, static = {}, {}
     for chunk in chunks:
         name = chunk.entity_path.lstrip("/")
@@ -151,8 +152,9 @@ def _image_bytes(rows):
         blobs = [row[0] for row in rows.values.get(column, ()) if row]
         if blobs:
             if kind is None:
-                types = {t for row in rows.values.get("EncodedImage:media_type", ()) if row
-                         for t in row}
+                types = {
+                    t for row in rows.values.get("EncodedImage:media_type", ()) if row for t in row
+                }
                 kind = "/".join(sorted(t.removeprefix("image/").upper() for t in types)) or "?"
             return f", {kind} {sum(len(b) for b in blobs) / len(blobs) / 1e3:.1f} kB each"
     return ""
@@ -168,8 +170,10 @@ def summary_lines(rec, name):
     if frames:
         head += f", {rec.size_bytes / frames / 1e3:.1f} kB/frame"
     lines = [head, f"blueprints: {rec.blueprints}"]
-    lines += [f"  {path:22s} {len(rec.entities[path]):6d} rows{_image_bytes(rec.entities[path])}"
-              for path in sorted(rec.entities)]
+    lines += [
+        f"  {path:22s} {len(rec.entities[path]):6d} rows{_image_bytes(rec.entities[path])}"
+        for path in sorted(rec.entities)
+    ]
     lines += [
         f"  {path:22s} static: {', '.join(sorted(rec.static[path]))}" for path in sorted(rec.static)
     ]

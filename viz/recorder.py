@@ -117,8 +117,11 @@ def _series(value):
 def _event_level(text):
     """Collisions and a tipped robot stand out in the event log (WARN); the rest is INFO."""
     text = text.lower()
-    return (rr.TextLogLevel.WARN if "collision" in text or text.startswith("tipped over")
-            else rr.TextLogLevel.INFO)
+    return (
+        rr.TextLogLevel.WARN
+        if "collision" in text or text.startswith("tipped over")
+        else rr.TextLogLevel.INFO
+    )
 
 
 class Recorder:
@@ -208,10 +211,16 @@ class Recorder:
         shadow_paths = (P.SHADOW_MOTORS_DPS, P.SHADOW_LEDS_PROXIMITY, P.SHADOW_LEDS_CENTROID)
         for path, names in P.SERIES.items():
             if (path in shadow_paths) == shadow:
-                log(path, rr.SeriesLines(names=list(names), colors=_SERIES_COLORS[path]),
-                    static=True)
-        leds = ((P.SHADOW_LEDS_PROXIMITY, P.SHADOW_LEDS_CENTROID) if shadow
-                else (P.LEDS_PROXIMITY, P.LEDS_CENTROID))
+                log(
+                    path,
+                    rr.SeriesLines(names=list(names), colors=_SERIES_COLORS[path]),
+                    static=True,
+                )
+        leds = (
+            (P.SHADOW_LEDS_PROXIMITY, P.SHADOW_LEDS_CENTROID)
+            if shadow
+            else (P.LEDS_PROXIMITY, P.LEDS_CENTROID)
+        )
         for path, img in (
             (leds[0], proximity_image(0)),
             (leds[1], centroid_image(0)),
@@ -234,9 +243,15 @@ class Recorder:
         if bounds is not None:
             self._bounds = bounds
         with self._guard:
-            self._stream.send_blueprint(default_blueprint(
-                self._bounds, shadow=shadow, world3d=self._world3d is not None,
-                sensors=tuple(self._sensors.series), frame_outputs=self._frame_outputs))
+            self._stream.send_blueprint(
+                default_blueprint(
+                    self._bounds,
+                    shadow=shadow,
+                    world3d=self._world3d is not None,
+                    sensors=tuple(self._sensors.series),
+                    frame_outputs=self._frame_outputs,
+                )
+            )
         self._sensor_series = len(self._sensors.series)
         self._layout_stale = False
         self._blueprint_sent = True
@@ -260,12 +275,19 @@ class Recorder:
         strips_, radii, colors = line_strips(world_map)
         if strips_:  # floor markings (line-following tracks)
             log(MAP_LINES, rr.LineStrips2D(strips_, radii=radii, colors=colors), static=True)
-        terrain = [[_xy(*p) for p in poly] + [_xy(*poly[0])]
-                   for poly in getattr(world_map, "terrain", ()) if poly]
+        terrain = [
+            [_xy(*p) for p in poly] + [_xy(*poly[0])]
+            for poly in getattr(world_map, "terrain", ())
+            if poly
+        ]
         if terrain:  # floor patches (ramps, wet floor), under the furniture
-            log(P.MAP_TERRAIN, rr.LineStrips2D(
-                terrain, colors=[tuple(c) for c in world_map.terrain_colors], radii=0.01),
-                static=True)
+            log(
+                P.MAP_TERRAIN,
+                rr.LineStrips2D(
+                    terrain, colors=[tuple(c) for c in world_map.terrain_colors], radii=0.01
+                ),
+                static=True,
+            )
         self._log_furniture(world_map, 0, 0.0)
 
     def _log_furniture(self, world_map, frame, sim_time):
@@ -278,8 +300,9 @@ class Recorder:
         self._stream.set_time("sim_time", duration=time_ns(sim_time))
         if polygons:
             colors = [tuple(int(c) for c in col) for col in world_map.obstacle_colors]
-            self._stream.log(P.MAP_FURNITURE,
-                             rr.LineStrips2D(polygons, colors=colors or None, radii=0.015))
+            self._stream.log(
+                P.MAP_FURNITURE, rr.LineStrips2D(polygons, colors=colors or None, radii=0.015)
+            )
         else:
             self._stream.log(P.MAP_FURNITURE, rr.Clear(recursive=False))
 
@@ -362,8 +385,9 @@ class Recorder:
             with self._guard:
                 self._log_static_styles(shadow=True)
             self._send_blueprint(shadow=True)
-        self._add_outputs(res, add, P.SHADOW_LEDS_PROXIMITY, P.SHADOW_LEDS_CENTROID,
-                          P.SHADOW_MOTORS_DPS)
+        self._add_outputs(
+            res, add, P.SHADOW_LEDS_PROXIMITY, P.SHADOW_LEDS_CENTROID, P.SHADOW_MOTORS_DPS
+        )
 
     @staticmethod
     def _add_outputs(res, add, proximity_path, centroid_path, motors_path):

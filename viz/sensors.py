@@ -73,14 +73,22 @@ class SensorViews:
                 path = f"{MAP_SENSORS}/{name}/points"
                 self._columns.register(path, points)
                 states = reading.states or (0,) * len(reading.points)
-                add(path, ([(float(x), -float(y)) for x, y in reading.points],
-                           [0.012] * len(reading.points),
-                           [_ON_COLOR if s else _OFF_COLOR for s in states],
-                           [""] * len(reading.points)))
+                add(
+                    path,
+                    (
+                        [(float(x), -float(y)) for x, y in reading.points],
+                        [0.012] * len(reading.points),
+                        [_ON_COLOR if s else _OFF_COLOR for s in states],
+                        [""] * len(reading.points),
+                    ),
+                )
             if reading.rays:
                 path = f"{MAP_SENSORS}/{name}/ray"
                 if self._columns.register(path, strips):
-                    self._stream.log(path, rr.LineStrips2D.from_fields(
-                        colors=_RAY_COLOR, radii=0.008), static=True)
+                    self._stream.log(
+                        path,
+                        rr.LineStrips2D.from_fields(colors=_RAY_COLOR, radii=0.008),
+                        static=True,
+                    )
                 (x0, y0), (x1, y1) = reading.rays[0]
                 add(path, ((float(x0), -float(y0)), (float(x1), -float(y1))))

@@ -115,10 +115,14 @@ def world3d_view(bounds=None):
     if bounds is not None:
         xmin, ymin, xmax, ymax = (float(v) for v in bounds)
         cx, cy, size = (xmin + xmax) / 2, (ymin + ymax) / 2, max(xmax - xmin, ymax - ymin)
-        eye = rrb.EyeControls3D(position=(cx, ymin - 0.45 * size, 0.75 * size),
-                                look_target=(cx, cy, 0.0), eye_up=(0.0, 0.0, 1.0))
+        eye = rrb.EyeControls3D(
+            position=(cx, ymin - 0.45 * size, 0.75 * size),
+            look_target=(cx, cy, 0.0),
+            eye_up=(0.0, 0.0, 1.0),
+        )
     return rrb.Spatial3DView(
-        origin="/", name="World (3D)",
+        origin="/",
+        name="World (3D)",
         contents=[f"+ /{WORLD3D}/**", f"+ /{CAMERA}", f"+ /{P.CAMERA_RAW}"],
         eye_controls=eye,
     )
@@ -140,22 +144,44 @@ class World3D:
         for path, walls in ((ROOM, room), (FURNITURE, rest)):
             if walls:
                 centers, halves, quats, colors = _wall_boxes(walls)
-                log(path, rr.Boxes3D(centers=centers, half_sizes=halves, quaternions=quats,
-                                     colors=colors, fill_mode="solid"), static=True)
+                log(
+                    path,
+                    rr.Boxes3D(
+                        centers=centers,
+                        half_sizes=halves,
+                        quaternions=quats,
+                        colors=colors,
+                        fill_mode="solid",
+                    ),
+                    static=True,
+                )
         xs = [v for w in room for v in (w.x0, w.x1)] or [0.0, 1.0]
         ys = [v for w in room for v in (w.y0, w.y1)] or [0.0, 1.0]
-        log(FLOOR, rr.Boxes3D(centers=[((min(xs) + max(xs)) / 2, (min(ys) + max(ys)) / 2,
-                                        -0.01)],
-                              half_sizes=[((max(xs) - min(xs)) / 2, (max(ys) - min(ys)) / 2,
-                                           0.01)],
-                              colors=[_u8(scene.floor_color)], fill_mode="solid"), static=True)
+        log(
+            FLOOR,
+            rr.Boxes3D(
+                centers=[((min(xs) + max(xs)) / 2, (min(ys) + max(ys)) / 2, -0.01)],
+                half_sizes=[((max(xs) - min(xs)) / 2, (max(ys) - min(ys)) / 2, 0.01)],
+                colors=[_u8(scene.floor_color)],
+                fill_mode="solid",
+            ),
+            static=True,
+        )
         self._walls = scene.walls
 
     def _log_pinhole(self, width, height, hfov):
         f = (width / 2) / math.tan(hfov / 2)
-        self._stream.log(CAMERA, rr.Pinhole(focal_length=f, width=width, height=height,
-                                            camera_xyz=rr.ViewCoordinates.RDF,
-                                            image_plane_distance=0.6), static=True)
+        self._stream.log(
+            CAMERA,
+            rr.Pinhole(
+                focal_length=f,
+                width=width,
+                height=height,
+                camera_xyz=rr.ViewCoordinates.RDF,
+                image_plane_distance=0.6,
+            ),
+            static=True,
+        )
         self._pinhole = (width, height, hfov)
 
     def log_frame(self, record, frame, t):
@@ -172,13 +198,24 @@ class World3D:
         s = self._stream
         s.set_time("frame", sequence=frame)
         s.set_time("sim_time", duration=t)
-        s.log(CAMERA, rr.Transform3D(translation=(pose.x, pose.y, pose.height),
-                                     mat3x3=camera_rotation(pose.heading, pose.tilt)))
+        s.log(
+            CAMERA,
+            rr.Transform3D(
+                translation=(pose.x, pose.y, pose.height),
+                mat3x3=camera_rotation(pose.heading, pose.tilt),
+            ),
+        )
         r = max(float(record.robot_radius), 0.05)
-        s.log(ROBOT, rr.Cylinders3D(lengths=[max(pose.height, 0.1)], radii=[r],
-                                    centers=[(record.robot_x, record.robot_y,
-                                              max(pose.height, 0.1) / 2)],
-                                    colors=[_ROBOT_COLOR], fill_mode="solid"))
+        s.log(
+            ROBOT,
+            rr.Cylinders3D(
+                lengths=[max(pose.height, 0.1)],
+                radii=[r],
+                centers=[(record.robot_x, record.robot_y, max(pose.height, 0.1) / 2)],
+                colors=[_ROBOT_COLOR],
+                fill_mode="solid",
+            ),
+        )
         strips, radii, colors, heads, head_r, head_c = [], [], [], [], [], []
         for cyl in scene.cylinders:
             (st, ra, co), (hc, hr, hcol) = _limbs(cyl)

@@ -25,19 +25,24 @@ class Avoider(wiring.Component):
     distance_mm: Out(16)
     turning: Out(1)
 
-    def __init__(self, speed: int = 300, turn_speed: int = 150, turn_mm: int = 400,
-                 clock_hz: int = 1_000_000):
+    def __init__(
+        self, speed: int = 300, turn_speed: int = 150, turn_mm: int = 400, clock_hz: int = 1_000_000
+    ):
         self.speed, self.turn_speed, self.turn_mm = speed, turn_speed, turn_mm
         # A measurement every 20 ms, echoes up to 2 m (farther is "no echo": the way is clear).
-        self.us = UltrasoundParams(clock_hz=clock_hz, period_us=20_000, wait_us=2_000,
-                                   max_range_mm=2000)
+        self.us = UltrasoundParams(
+            clock_hz=clock_hz, period_us=20_000, wait_us=2_000, max_range_mm=2000
+        )
         super().__init__()
 
     def elaborate(self, platform):
         m = Module()
         m.submodules.us = us = UltrasoundDriver(self.us)
-        m.d.comb += [self.trig.eq(us.trig), us.echo.eq(self.echo),
-                     self.distance_mm.eq(us.distance_mm)]
+        m.d.comb += [
+            self.trig.eq(us.trig),
+            us.echo.eq(self.echo),
+            self.distance_mm.eq(us.distance_mm),
+        ]
         # Decided once per measurement: the wheels hold their command between two.
         with m.If(us.measured):
             m.d.sync += self.turning.eq(~us.no_echo & (us.distance_mm < self.turn_mm))

@@ -58,13 +58,20 @@ def measure_calibration(*, repeats=5, frames=30, backend="auto", seed=0):
                     cpu.append(t.cpu * 1e3)
                 walls.append(scaffold.Spread.of(wall).median)
                 cpus.append(scaffold.Spread.of(cpu).median)
-    return {"what": f"published preset, {name}, {w}x{h}", "backend": name,
-            "frame_ms": scaffold.Spread.of(walls), "cpu_ms": scaffold.Spread.of(cpus)}
+    return {
+        "what": f"published preset, {name}, {w}x{h}",
+        "backend": name,
+        "frame_ms": scaffold.Spread.of(walls),
+        "cpu_ms": scaffold.Spread.of(cpus),
+    }
 
 
 def _options(parser):
-    parser.add_argument("--backend", default="auto",
-                        help="the backend (default auto: the fastest compiled one here)")
+    parser.add_argument(
+        "--backend",
+        default="auto",
+        help="the backend (default auto: the fastest compiled one here)",
+    )
 
 
 def run(args):
@@ -72,8 +79,11 @@ def run(args):
     print(f"calibration: {cal['what']}, {args.frames} frames x {args.repeats} repeats")
     scaffold.print_table(
         ("clock", "ms/frame median", "min", "max"),
-        [(clock, f"{s.median:.4f}", f"{s.min:.4f}", f"{s.max:.4f}")
-         for clock, s in (("wall", cal["frame_ms"]), ("cpu", cal["cpu_ms"]))])
+        [
+            (clock, f"{s.median:.4f}", f"{s.min:.4f}", f"{s.max:.4f}")
+            for clock, s in (("wall", cal["frame_ms"]), ("cpu", cal["cpu_ms"]))
+        ],
+    )
     return {"calibration": cal}
 
 
@@ -82,5 +92,12 @@ def _no_self_calibration(args):
         raise UsageError("--calibrate: this command is the calibration; drop the option")
 
 
-main = scaffold.command(run, __doc__, name="calibrate", options=_options, repeats=5, frames=30,
-                        check=_no_self_calibration)
+main = scaffold.command(
+    run,
+    __doc__,
+    name="calibrate",
+    options=_options,
+    repeats=5,
+    frames=30,
+    check=_no_self_calibration,
+)

@@ -22,23 +22,42 @@ from fpga_robotics.cli.errors import UsageError
 from fpga_robotics.sim.camera.raster import DEFAULT_HFOV, CameraRenderer, focal_length
 from fpga_robotics.sim.camera.scene import Band, CameraPose, Cylinder, Lighting, Scene, Wall
 
-__all__ = ["DEFAULT_SIZES", "STAGES", "benchmark", "camera_loop", "main", "stage_times",
-           "typical_scene"]
+__all__ = [
+    "DEFAULT_SIZES",
+    "STAGES",
+    "benchmark",
+    "camera_loop",
+    "main",
+    "stage_times",
+    "typical_scene",
+]
 
 DEFAULT_SIZES = ((160, 120), (320, 240), (640, 480))
 
 
 def _box(cx, cy, length, width, angle, height, color):
     c, s = math.cos(angle), math.sin(angle)
-    pts = [(-length / 2, -width / 2), (length / 2, -width / 2), (length / 2, width / 2),
-           (-length / 2, width / 2)]
+    pts = [
+        (-length / 2, -width / 2),
+        (length / 2, -width / 2),
+        (length / 2, width / 2),
+        (-length / 2, width / 2),
+    ]
     pts = [(cx + c * x - s * y, cy + s * x + c * y) for x, y in pts]
     return [Wall(*pts[i], *pts[(i + 1) % 4], height, color) for i in range(4)]
 
 
 def _person(x, y, shirt):
-    return Cylinder(x, y, 0.2, (Band(0.0, 0.85, (0.15, 0.15, 0.22)), Band(0.85, 1.45, shirt),
-                                Band(1.5, 1.75, (0.87, 0.68, 0.56))))
+    return Cylinder(
+        x,
+        y,
+        0.2,
+        (
+            Band(0.0, 0.85, (0.15, 0.15, 0.22)),
+            Band(0.85, 1.45, shirt),
+            Band(1.5, 1.75, (0.87, 0.68, 0.56)),
+        ),
+    )
 
 
 def typical_scene():
@@ -48,10 +67,16 @@ def typical_scene():
     walls += _box(1.2, 5.2, 1.2, 0.6, 0.0, 0.9, (0.45, 0.42, 0.38))  # cupboard
     walls += _box(6.8, 1.0, 1.0, 1.0, 0.0, 0.75, (0.35, 0.3, 0.25))  # table
     walls += _box(3.0, 1.2, 0.5, 0.5, 0.6, 0.45, (0.3, 0.35, 0.6))  # stool
-    people = (_person(4.5, 3.5, (0.85, 0.1, 0.1)), _person(6.5, 4.8, (0.2, 0.5, 0.25)),
-              _person(2.0, 2.8, (0.25, 0.3, 0.7)))
-    return Scene(walls=tuple(walls), cylinders=people,
-                 lighting=Lighting(ambient=0.6, intensity=0.5, direction=(1.0, 0.5, -1.0)))
+    people = (
+        _person(4.5, 3.5, (0.85, 0.1, 0.1)),
+        _person(6.5, 4.8, (0.2, 0.5, 0.25)),
+        _person(2.0, 2.8, (0.25, 0.3, 0.7)),
+    )
+    return Scene(
+        walls=tuple(walls),
+        cylinders=people,
+        lighting=Lighting(ambient=0.6, intensity=0.5, direction=(1.0, 0.5, -1.0)),
+    )
 
 
 def camera_loop(frames):
@@ -97,8 +122,13 @@ def stage_times(width, height, *, frames=60, repeats=5, turn_rate=0.5, hfov=DEFA
     renderer = CameraRenderer(width, height, hfov)
     scene = typical_scene()
     images = [renderer.render(scene, pose) for pose in camera_loop(frames)]
-    cam = OV7670Sensor(width, height, OV7670Params(), rng=np.random.default_rng(0),
-                       focal_px=focal_length(width, hfov))
+    cam = OV7670Sensor(
+        width,
+        height,
+        OV7670Params(),
+        rng=np.random.default_rng(0),
+        focal_px=focal_length(width, hfov),
+    )
     for img in images[:5]:  # warm-up (and the settling frames)
         cam.process(img, turn_rate)
     out = {name: [] for name in STAGES + ("frame", "frame_cpu")}
@@ -131,14 +161,27 @@ def stage_times(width, height, *, frames=60, repeats=5, turn_rate=0.5, hfov=DEFA
 
 
 def _options(parser):
-    parser.add_argument("--noise", type=float, default=2.0,
-                        help="also time with sensor noise of this std, 8-bit units (0: skip)")
-    parser.add_argument("--sizes", default=",".join(f"{w}x{h}" for w, h in DEFAULT_SIZES),
-                        help="comma-separated WIDTHxHEIGHT list")
-    parser.add_argument("--sensor", action="store_true",
-                        help="time each stage of the OV7670 sensor model instead of the renderer")
-    parser.add_argument("--stage-images", metavar="DIR",
-                        help="write PNGs of one frame through each sensor stage to DIR, and exit")
+    parser.add_argument(
+        "--noise",
+        type=float,
+        default=2.0,
+        help="also time with sensor noise of this std, 8-bit units (0: skip)",
+    )
+    parser.add_argument(
+        "--sizes",
+        default=",".join(f"{w}x{h}" for w, h in DEFAULT_SIZES),
+        help="comma-separated WIDTHxHEIGHT list",
+    )
+    parser.add_argument(
+        "--sensor",
+        action="store_true",
+        help="time each stage of the OV7670 sensor model instead of the renderer",
+    )
+    parser.add_argument(
+        "--stage-images",
+        metavar="DIR",
+        help="write PNGs of one frame through each sensor stage to DIR, and exit",
+    )
 
 
 def _check(args):
@@ -153,18 +196,24 @@ def run(args):
         return None
     if args.sensor:
         return _sensor_table(args.sizes, args.frames, args.repeats)
-    print(f"camera renderer, typical room ({len(typical_scene().walls)} walls, 3 people), "
-          f"{args.frames} poses x {args.repeats} repeats; median milliseconds per frame "
-          f"(wall clock / CPU time of this process)")
+    print(
+        f"camera renderer, typical room ({len(typical_scene().walls)} walls, 3 people), "
+        f"{args.frames} poses x {args.repeats} repeats; median milliseconds per frame "
+        f"(wall clock / CPU time of this process)"
+    )
     header = ["size", "wall", "cpu"] + (["noise wall", "noise cpu"] if args.noise else [])
     rows, figures = [], []
     for w, h in args.sizes:
         wall, cpu = benchmark(w, h, frames=args.frames, repeats=args.repeats)
-        row = {"size": f"{w}x{h}", "wall_ms": statistics.median(wall),
-               "cpu_ms": statistics.median(cpu)}
+        row = {
+            "size": f"{w}x{h}",
+            "wall_ms": statistics.median(wall),
+            "cpu_ms": statistics.median(cpu),
+        }
         if args.noise:
-            wall, cpu = benchmark(w, h, frames=args.frames, repeats=args.repeats,
-                                  noise_std=args.noise)
+            wall, cpu = benchmark(
+                w, h, frames=args.frames, repeats=args.repeats, noise_std=args.noise
+            )
             row.update(noise_wall_ms=statistics.median(wall), noise_cpu_ms=statistics.median(cpu))
         figures.append(row)
         rows.append([row["size"], *(f"{v:.3f}" for k, v in row.items() if k != "size")])
@@ -173,14 +222,18 @@ def run(args):
 
 
 def _sensor_table(sizes, frames, repeats):
-    print(f"OV7670 sensor model on the renderer's frames of the typical room, turning at "
-          f"0.5 rad/s, {frames} frames x {repeats} repeats; median milliseconds per frame "
-          f"(stages: wall clock; frame: wall / CPU time of this process)")
+    print(
+        f"OV7670 sensor model on the renderer's frames of the typical room, turning at "
+        f"0.5 rad/s, {frames} frames x {repeats} repeats; median milliseconds per frame "
+        f"(stages: wall clock; frame: wall / CPU time of this process)"
+    )
     rows, figures = [], []
     for w, h in sizes:
         t = stage_times(w, h, frames=frames, repeats=repeats)
-        row = {"size": f"{w}x{h}", **{f"{n}_ms": statistics.median(t[n])
-                                      for n in (*STAGES, "frame", "frame_cpu")}}
+        row = {
+            "size": f"{w}x{h}",
+            **{f"{n}_ms": statistics.median(t[n]) for n in (*STAGES, "frame", "frame_cpu")},
+        }
         figures.append(row)
         rows.append([row["size"], *(f"{v:.3f}" for k, v in row.items() if k != "size")])
     scaffold.print_table(["size", *STAGES, "frame", "cpu"], rows, first_width=9)
@@ -198,10 +251,16 @@ def _stage_images(folder):
     from fpga_robotics.sim.files import check_output_dir, write_atomic
 
     folder = check_output_dir(folder, what="--stage-images folder")
-    rgb = CameraRenderer(160, 120, 1.047).render(typical_scene(),
-                                                 CameraPose(2.0, 4.3, -0.3, height=0.3))
-    stages = stage_images(rgb, OV7670Params(), rng=np.random.default_rng(0), turn_rate=1.0,
-                          focal_px=focal_length(160, 1.047))
+    rgb = CameraRenderer(160, 120, 1.047).render(
+        typical_scene(), CameraPose(2.0, 4.3, -0.3, height=0.3)
+    )
+    stages = stage_images(
+        rgb,
+        OV7670Params(),
+        rng=np.random.default_rng(0),
+        turn_rate=1.0,
+        focal_px=focal_length(160, 1.047),
+    )
     folder.mkdir(parents=True, exist_ok=True)
     for i, (title, img) in enumerate(stages):
         big = cv2.resize(img, None, fx=2, fy=2, interpolation=cv2.INTER_NEAREST)
@@ -213,5 +272,6 @@ def _stage_images(folder):
         print(f"{path}: {title}")
 
 
-main = scaffold.command(run, __doc__, name="camera", options=_options, check=_check, repeats=5,
-                        frames=60)
+main = scaffold.command(
+    run, __doc__, name="camera", options=_options, check=_check, repeats=5, frames=60
+)

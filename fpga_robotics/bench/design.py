@@ -82,8 +82,10 @@ def measure(backend, frames, min_seconds=0.0):
         # Per frame, the call's wall time less its C++ loop: the Python side of that call.
         harness = {
             "loop_ms_per_frame": statistics.median(loops) * 1e3,
-            "python_us_per_frame": statistics.median(t - lp for t, lp in zip(times, loops,
-                                                                              strict=True)) * 1e6,
+            "python_us_per_frame": statistics.median(
+                t - lp for t, lp in zip(times, loops, strict=True)
+            )
+            * 1e6,
         }
     return {
         "frames": len(times),
@@ -173,8 +175,13 @@ def run_one(name, params, frames, design, min_seconds=0.0):
 
 
 #: The published design's Verilog files (docs/foreign.md) and its port map.
-PUBLISHED_FILES = ("design_top.v", "centroid.v", "color_proc.v", "frame_buffer.v",
-                   "motor_ctrl_spi.v")
+PUBLISHED_FILES = (
+    "design_top.v",
+    "centroid.v",
+    "color_proc.v",
+    "frame_buffer.v",
+    "motor_ctrl_spi.v",
+)
 PUBLISHED_TARGET_RATIO = 4.5
 
 
@@ -223,8 +230,13 @@ def run_published(paths, name, frames, min_seconds=0.0):
                         times[i].append(time.perf_counter() - start)
                     n += 1
     ms = [statistics.median(t) * 1e3 for t in times]
-    return {"backend": name, "published_ms": ms[0], "ours_ms": ms[1], "ratio": ms[0] / ms[1],
-            "frames": len(times[0])}
+    return {
+        "backend": name,
+        "published_ms": ms[0],
+        "ours_ms": ms[1],
+        "ratio": ms[0] / ms[1],
+        "frames": len(times[0]),
+    }
 
 
 def _options(parser):
@@ -309,9 +321,12 @@ def summary(results, paired=()):
             if pair or trivial:
                 if pair:
                     frac = pair["fraction"]
-                    how = ("measured in alternation; process_frame as users call it against "
-                           "the trivial design's C++ loop" if pair.get("clock") != "cpu" else
-                           "measured in alternation, CPU time: every call waited for a core")
+                    how = (
+                        "measured in alternation; process_frame as users call it against "
+                        "the trivial design's C++ loop"
+                        if pair.get("clock") != "cpu"
+                        else "measured in alternation, CPU time: every call waited for a core"
+                    )
                 else:
                     frac = best["cycles_per_second"] / trivial["cycles_per_second"]
                     how = "from the two rows above"
@@ -346,8 +361,10 @@ def run(args):
         f"{'C++ loop':>9} {'python us':>10} {'Mcycles/s':>10} "
         f"{'build s':>8}"
     )
-    print("ms/frame: process_frame(RGB888 frame) as users call it; C++ loop: its frame loop "
-          "alone (packing included); python us: the rest of the call")
+    print(
+        "ms/frame: process_frame(RGB888 frame) as users call it; C++ loop: its frame loop "
+        "alone (packing included); python us: the rest of the call"
+    )
     print(header)
     print("-" * len(header))
     for w, h in sizes:
@@ -384,11 +401,15 @@ def run(args):
                     except BackendError as exc:
                         raise UsageError(f"the {name} backend cannot run here: {exc}") from None
                     paired.append(pair)
-                    left_out = (f", {pair['preempted']} preempted pairs left out"
-                                if pair["preempted"] else "")
+                    left_out = (
+                        f", {pair['preempted']} preempted pairs left out"
+                        if pair["preempted"]
+                        else ""
+                    )
                     if pair["clock"] == "cpu":
-                        left_out = ("; every pair waited for a core: both timed by their "
-                                    "thread's CPU time")
+                        left_out = (
+                            "; every pair waited for a core: both timed by their thread's CPU time"
+                        )
                     print(
                         f"{name} {w}x{h}: FollowTarget at {pair['fraction']:.2f} of the trivial "
                         f"design's cycle rate (alternating frames, {pair['frames']} each"
@@ -404,9 +425,12 @@ def run(args):
         except BackendError as exc:
             raise UsageError(f"the published RTL cannot run here: {exc}") from None
         r = published_row
-        print(f"published RTL on Verilator 160x120: {r['published_ms']:.3f} ms/frame; {name} "
-              f"process_frame(RGB888) {r['ours_ms']:.3f} ms/frame (alternating frames, "
-              f"{r['frames']} each)", flush=True)
+        print(
+            f"published RTL on Verilator 160x120: {r['published_ms']:.3f} ms/frame; {name} "
+            f"process_frame(RGB888) {r['ours_ms']:.3f} ms/frame (alternating frames, "
+            f"{r['frames']} each)",
+            flush=True,
+        )
         notes.append(
             f"target 160x120: {name} process_frame(RGB888) {r['ratio']:.2f}x as fast as the "
             f"published RTL (>= {PUBLISHED_TARGET_RATIO}x): "
@@ -414,9 +438,13 @@ def run(args):
         )
     for line in notes + summary(results, paired):
         print(line)
-    return {"results": results, "paired": paired, "notes": notes, "published": published_row,
-            "summary": summary(results, paired)}
+    return {
+        "results": results,
+        "paired": paired,
+        "notes": notes,
+        "published": published_row,
+        "summary": summary(results, paired),
+    }
 
 
-main = scaffold.command(run, __doc__, name="design", options=_options, frames=30,
-                        min_seconds=1.0)
+main = scaffold.command(run, __doc__, name="design", options=_options, frames=30, min_seconds=1.0)

@@ -56,13 +56,20 @@ def run(args):
     finally:
         builtin.close()
         foreign.close()
-    print(f"160x120, {args.frames} frames x {args.repeats} passes in alternation; median CPU "
-          f"time a frame:")
+    print(
+        f"160x120, {args.frames} frames x {args.repeats} passes in alternation; median CPU "
+        f"time a frame:"
+    )
     print(f"  verilator (built-in)          {ms_builtin:7.3f} ms/frame")
-    print(f"  foreign follow_target (stream) {ms_foreign:6.3f} ms/frame  "
-          f"({ms_foreign / ms_builtin:.2f}x the built-in)")
-    return {"builtin_cpu_ms": ms_builtin, "foreign_cpu_ms": ms_foreign,
-            "foreign_over_builtin": ms_foreign / ms_builtin}
+    print(
+        f"  foreign follow_target (stream) {ms_foreign:6.3f} ms/frame  "
+        f"({ms_foreign / ms_builtin:.2f}x the built-in)"
+    )
+    return {
+        "builtin_cpu_ms": ms_builtin,
+        "foreign_cpu_ms": ms_foreign,
+        "foreign_over_builtin": ms_foreign / ms_builtin,
+    }
 
 
 main = scaffold.command(run, __doc__, name="foreign", repeats=3, frames=20)

@@ -111,8 +111,7 @@ def _timed_loop_class():
             start = time.perf_counter()
             super().run_frame(k)
             # What the frame took beyond its timed steps: the loop's own bookkeeping.
-            self.spent["other"] += (time.perf_counter() - start
-                                    - (sum(self.spent.values()) - before))
+            self.spent["other"] += time.perf_counter() - start - (sum(self.spent.values()) - before)
 
     return TimedLoop
 
@@ -186,7 +185,7 @@ def _profile(scenario, design, top):
     text = io.StringIO()
     pstats.Stats(profiler, stream=text).sort_stats("tottime").print_stats(top)
     lines = [ln for ln in text.getvalue().splitlines() if ln.strip()]
-    return lines[next(i for i, ln in enumerate(lines) if "function calls" in ln):]
+    return lines[next(i for i, ln in enumerate(lines) if "function calls" in ln) :]
 
 
 def _options(p):
@@ -194,11 +193,19 @@ def _options(p):
 
     p.add_argument("--scenario", default="follow_person")
     p.add_argument("--backend", default="auto", choices=("auto", *BACKEND_NAMES))
-    p.add_argument("--resolutions", default="160x120,640x480",
-                   help="comma-separated WIDTHxHEIGHT list (default 160x120,640x480)")
+    p.add_argument(
+        "--resolutions",
+        default="160x120,640x480",
+        help="comma-separated WIDTHxHEIGHT list (default 160x120,640x480)",
+    )
     p.add_argument("--duration", type=float, default=10.0, help="simulated seconds a run (10)")
-    p.add_argument("--profile", type=int, default=0, metavar="N",
-                   help="also print the N functions of largest own time (cProfile, one run)")
+    p.add_argument(
+        "--profile",
+        type=int,
+        default=0,
+        metavar="N",
+        help="also print the N functions of largest own time (cProfile, one run)",
+    )
 
 
 def _check(args):
@@ -218,8 +225,9 @@ def run(args):
 
     figures = []
     for w, h in args.resolutions:
-        scenario = load_scenario(args.scenario, [f'camera.resolution="{w}x{h}"',
-                                                 f"sim.duration={args.duration}"])
+        scenario = load_scenario(
+            args.scenario, [f'camera.resolution="{w}x{h}"', f"sim.duration={args.duration}"]
+        )
         try:
             design = make_backend(args.backend, scenario.params)
         except BackendError as exc:
@@ -228,40 +236,65 @@ def run(args):
             m = measure(scenario, design, args.repeats)
             figures.append({"size": f"{w}x{h}", "backend": design.name, **m})
             steps = m["steps_ms"]
-            print(f"closed loop {w}x{h}: {scenario.name}, {design.name}, {m['frames']} frames x "
-                  f"{args.repeats} runs; ms per frame (median of the runs)")
+            print(
+                f"closed loop {w}x{h}: {scenario.name}, {design.name}, {m['frames']} frames x "
+                f"{args.repeats} runs; ms per frame (median of the runs)"
+            )
             for key, label in STEPS.items():
                 print(f"  {label:<62} {steps[key]:8.4f}")
             own = steps["loop"] + steps["handover"] + steps["results"]
             print(f"  {'whole loop (this timed run)':<62} {m['loop_ms']:8.4f}")
-            print(f"  {'the loop as users run it (no timers, no records)':<62} "
-                  f"{m['plain_ms']:8.4f}  ({m['realtime']:.1f}x real time)")
-            print(f"  {'the same, CPU time of the thread':<62} {m['plain_cpu_ms']:8.4f}  "
-                  f"({m['cpu_realtime']:.1f}x real time with a core to itself)")
-            print(f"  {'the design alone on the run frames':<62} "
-                  f"{m['design_alone_ms']:8.4f}  (CPU time {m['design_alone_cpu_ms']:.4f})")
+            print(
+                f"  {'the loop as users run it (no timers, no records)':<62} "
+                f"{m['plain_ms']:8.4f}  ({m['realtime']:.1f}x real time)"
+            )
+            print(
+                f"  {'the same, CPU time of the thread':<62} {m['plain_cpu_ms']:8.4f}  "
+                f"({m['cpu_realtime']:.1f}x real time with a core to itself)"
+            )
+            print(
+                f"  {'the design alone on the run frames':<62} "
+                f"{m['design_alone_ms']:8.4f}  (CPU time {m['design_alone_cpu_ms']:.4f})"
+            )
             checks = (
                 ("the timed run against the design's time in it", m["loop_ms"], own),
-                ("the loop against the design alone, wall clock", m["plain_ms"],
-                 m["design_alone_ms"]),
-                ("the loop against the design alone, CPU time", m["plain_cpu_ms"],
-                 m["design_alone_cpu_ms"]),
+                (
+                    "the loop against the design alone, wall clock",
+                    m["plain_ms"],
+                    m["design_alone_ms"],
+                ),
+                (
+                    "the loop against the design alone, CPU time",
+                    m["plain_cpu_ms"],
+                    m["design_alone_cpu_ms"],
+                ),
             )
             for what, whole, ref in checks:
-                line = (f"  {what}: whole {whole / ref:.2f}x, the rest "
-                        f"{(whole - ref) / ref:.2f}x the design")
+                line = (
+                    f"  {what}: whole {whole / ref:.2f}x, the rest "
+                    f"{(whole - ref) / ref:.2f}x the design"
+                )
                 if (w, h) == (160, 120):
-                    ok = (whole / ref <= TARGET_LOOP_RATIO
-                          and (whole - ref) / ref <= TARGET_REST_RATIO)
-                    line += (f" (target 160x120: <= {TARGET_LOOP_RATIO}x, <= "
-                             f"{TARGET_REST_RATIO}x): {'met' if ok else 'MISSED'}")
+                    ok = (
+                        whole / ref <= TARGET_LOOP_RATIO
+                        and (whole - ref) / ref <= TARGET_REST_RATIO
+                    )
+                    line += (
+                        f" (target 160x120: <= {TARGET_LOOP_RATIO}x, <= "
+                        f"{TARGET_REST_RATIO}x): {'met' if ok else 'MISSED'}"
+                    )
                 print(line)
             if (w, h) == (640, 480):
-                for what, factor in (("wall clock", m["realtime"]),
-                                     ("CPU time", m["cpu_realtime"])):
+                for what, factor in (
+                    ("wall clock", m["realtime"]),
+                    ("CPU time", m["cpu_realtime"]),
+                ):
                     verdict = "met" if factor >= TARGET_REALTIME_640 else "MISSED"
-                    print(f"  target 640x480: {factor:.1f}x real time by {what} "
-                          f"(>= {TARGET_REALTIME_640:g}x): {verdict}", flush=True)
+                    print(
+                        f"  target 640x480: {factor:.1f}x real time by {what} "
+                        f"(>= {TARGET_REALTIME_640:g}x): {verdict}",
+                        flush=True,
+                    )
             if args.profile:
                 print(f"  cProfile of one run, {args.profile} functions of largest own time:")
                 for line in _profile(scenario, design, args.profile):

@@ -70,16 +70,27 @@ class EchoedFollowTarget(wiring.Component):
 
 
 def bench_source(params):
-    return PinDesignSource(lambda: EchoedFollowTarget(params),
-                           f"echoed_follow_target_{params.width}x{params.height}",
-                           pixels=PIXEL_PORTS, filtered=FILTERED_PORTS,
-                           frame_size=(params.width, params.height))
+    return PinDesignSource(
+        lambda: EchoedFollowTarget(params),
+        f"echoed_follow_target_{params.width}x{params.height}",
+        pixels=PIXEL_PORTS,
+        filtered=FILTERED_PORTS,
+        frame_size=(params.width, params.height),
+    )
 
 
 def bench_frames(params, count, seed=0):
     w, h = params.width, params.height
-    return [to_rgb444(blob_frame(w, h, "red", cx=w * (0.2 + 0.6 * (i % 7) / 6), cy=h / 2,
-                                 radius=h / 5, rng=seed + i), w, h) for i in range(count)]
+    return [
+        to_rgb444(
+            blob_frame(
+                w, h, "red", cx=w * (0.2 + 0.6 * (i % 7) / 6), cy=h / 2, radius=h / 5, rng=seed + i
+            ),
+            w,
+            h,
+        )
+        for i in range(count)
+    ]
 
 
 def run_once(pins, frames, *, seconds, clock_hz, fps, step_s, toggle_every):
@@ -101,8 +112,9 @@ def run_once(pins, frames, *, seconds, clock_hz, fps, step_s, toggle_every):
             next_toggle += toggle_every
         capture = round(next_frame * frame_cycles) + 1
         if capture <= target and not pins.frame_pending:
-            timing = real_clock_timing(params_w, params_h, fps, clock_hz,
-                                       max(capture, pins.cycle + 1))
+            timing = real_clock_timing(
+                params_w, params_h, fps, clock_hz, max(capture, pins.cycle + 1)
+            )
             pins.stream_frame(frames[next_frame % len(frames)], timing)
             next_frame += 1
             streamed += 1
@@ -126,8 +138,9 @@ def frame_path_once(backend, frames, cycles):
     return done / (time.perf_counter() - start)
 
 
-def benchmark(name, params, *, seconds, repeats, clock_hz, fps, step_s, toggle_every, seed=0,
-              frame_path=True):
+def benchmark(
+    name, params, *, seconds, repeats, clock_hz, fps, step_s, toggle_every, seed=0, frame_path=True
+):
     """Pin backend ``name``'s runs and, with ``frame_path``, the frame backend of the same
     simulator over as many cycles after each run (so that the machine's load of the moment
     weighs on both alike). Returns ``(pin rates, frame rates, runs)``, rates in cycles/s."""
@@ -137,8 +150,15 @@ def benchmark(name, params, *, seconds, repeats, clock_hz, fps, step_s, toggle_e
         pins = stack.enter_context(get_pin_backend(name, bench_source(params)))
         backend = stack.enter_context(get_backend(name, params)) if frame_path else None
         for _ in range(repeats):
-            run = run_once(pins, frames, seconds=seconds, clock_hz=clock_hz, fps=fps,
-                           step_s=step_s, toggle_every=toggle_every)
+            run = run_once(
+                pins,
+                frames,
+                seconds=seconds,
+                clock_hz=clock_hz,
+                fps=fps,
+                step_s=step_s,
+                toggle_every=toggle_every,
+            )
             runs.append(run)
             pin_rates.append(run[1] / run[0])
             if backend is not None:
@@ -147,28 +167,48 @@ def benchmark(name, params, *, seconds, repeats, clock_hz, fps, step_s, toggle_e
 
 
 def _options(parser):
-    parser.add_argument("--backends", default=",".join(BACKENDS),
-                        help=f"comma-separated (default {','.join(BACKENDS)})")
-    parser.add_argument("--resolution", default="160x120",
-                        type=lambda text: scaffold.parse_size(text, "--resolution"))
-    parser.add_argument("--seconds", type=float, default=1.0,
-                        help="simulated seconds per compiled run (default 1)")
-    parser.add_argument("--pysim-seconds", type=float, default=PYSIM_SECONDS,
-                        help=f"simulated seconds per pysim run (default {PYSIM_SECONDS})")
+    parser.add_argument(
+        "--backends",
+        default=",".join(BACKENDS),
+        help=f"comma-separated (default {','.join(BACKENDS)})",
+    )
+    parser.add_argument(
+        "--resolution",
+        default="160x120",
+        type=lambda text: scaffold.parse_size(text, "--resolution"),
+    )
+    parser.add_argument(
+        "--seconds", type=float, default=1.0, help="simulated seconds per compiled run (default 1)"
+    )
+    parser.add_argument(
+        "--pysim-seconds",
+        type=float,
+        default=PYSIM_SECONDS,
+        help=f"simulated seconds per pysim run (default {PYSIM_SECONDS})",
+    )
     parser.add_argument("--clock-hz", type=float, default=50e6)
     parser.add_argument("--fps", type=float, default=30.0)
-    parser.add_argument("--step", type=float, default=1 / 240,
-                        help="physics step in seconds: one run() target (default 1/240)")
-    parser.add_argument("--toggle-every", type=int, default=5000,
-                        help="cycles between toggles of the echoed pin (default 5000)")
+    parser.add_argument(
+        "--step",
+        type=float,
+        default=1 / 240,
+        help="physics step in seconds: one run() target (default 1/240)",
+    )
+    parser.add_argument(
+        "--toggle-every",
+        type=int,
+        default=5000,
+        help="cycles between toggles of the echoed pin (default 5000)",
+    )
 
 
 def run(args):
     names = [n for n in args.backends.split(",") if n]
     unknown = sorted(set(names) - set(BACKENDS))
     if unknown:
-        raise UsageError(f"unknown backend(s) {', '.join(unknown)}; choose from "
-                         f"{', '.join(BACKENDS)}")
+        raise UsageError(
+            f"unknown backend(s) {', '.join(unknown)}; choose from {', '.join(BACKENDS)}"
+        )
     if args.toggle_every < 1 or not (args.seconds > 0 and args.step > 0):
         raise UsageError("--toggle-every, --seconds and --step must be positive")
     width, height = args.resolution
@@ -180,31 +220,46 @@ def run(args):
         timing = real_clock_timing(width, height, args.fps, args.clock_hz, 1)
     except PinError as exc:
         raise UsageError(str(exc)) from None
-    print(f"FollowTarget {width}x{height} + echoed pin, {args.clock_hz / 1e6:g} MHz, "
-          f"{args.fps:g} fps: line_period {timing.line_period}, pixel_period "
-          f"{timing.pixel_period}, ping toggled every {args.toggle_every} cycles, "
-          f"physics step {args.step * 1e3:.3g} ms, median of {args.repeats} runs")
+    print(
+        f"FollowTarget {width}x{height} + echoed pin, {args.clock_hz / 1e6:g} MHz, "
+        f"{args.fps:g} fps: line_period {timing.line_period}, pixel_period "
+        f"{timing.pixel_period}, ping toggled every {args.toggle_every} cycles, "
+        f"physics step {args.step * 1e3:.3g} ms, median of {args.repeats} runs"
+    )
     figures = []
     for name in names:
         seconds = args.pysim_seconds if name == "pysim" else args.seconds
         try:
             pin_rates, frame_rates, runs = benchmark(
-                name, params, seconds=seconds, repeats=args.repeats, clock_hz=args.clock_hz,
-                fps=args.fps, step_s=args.step, toggle_every=args.toggle_every,
-                frame_path=name != "pysim")
+                name,
+                params,
+                seconds=seconds,
+                repeats=args.repeats,
+                clock_hz=args.clock_hz,
+                fps=args.fps,
+                step_s=args.step,
+                toggle_every=args.toggle_every,
+                frame_path=name != "pysim",
+            )
         except (PinError, BackendError) as exc:
             print(f"{name}: not available ({exc})")
             continue
         _, cycles, stops, streamed = runs[0]
         row = {"backend": name, "pins_mcycles_per_s": statistics.median(pin_rates) / 1e6}
-        line = (f"{name:9s} pins: {statistics.median(pin_rates) / 1e6:8.2f} Mcycles/s "
-                f"({cycles:,} cycles, {streamed} frames, {stops} stops a run)")
+        line = (
+            f"{name:9s} pins: {statistics.median(pin_rates) / 1e6:8.2f} Mcycles/s "
+            f"({cycles:,} cycles, {streamed} frames, {stops} stops a run)"
+        )
         if frame_rates:
             ratios = [p / f for p, f in zip(pin_rates, frame_rates, strict=True)]
-            row.update(frame_mcycles_per_s=statistics.median(frame_rates) / 1e6,
-                       pins_over_frame=statistics.median(ratios))
-            line += (f"; frame path {statistics.median(frame_rates) / 1e6:.2f} Mcycles/s, "
-                     f"pins/frame {statistics.median(ratios):.2f} (median of the runs' ratios)")
+            row.update(
+                frame_mcycles_per_s=statistics.median(frame_rates) / 1e6,
+                pins_over_frame=statistics.median(ratios),
+            )
+            line += (
+                f"; frame path {statistics.median(frame_rates) / 1e6:.2f} Mcycles/s, "
+                f"pins/frame {statistics.median(ratios):.2f} (median of the runs' ratios)"
+            )
         print(line)
         figures.append(row)
     return {"backends": figures}

@@ -27,8 +27,11 @@ MODES = {
     "raster": ["camera.renderer=raster"],
     "3d, no shadows": ["camera.renderer=mujoco", "camera.shadows=false"],
     "3d, shadows 256": ["camera.renderer=mujoco", "camera.shadows=true", "camera.shadow_size=256"],
-    "3d, shadows 1024": ["camera.renderer=mujoco", "camera.shadows=true",
-                         "camera.shadow_size=1024"],
+    "3d, shadows 1024": [
+        "camera.renderer=mujoco",
+        "camera.shadows=true",
+        "camera.shadow_size=1024",
+    ],
 }
 
 
@@ -42,9 +45,14 @@ def _poses(world, frames):
     out = []
     for i in range(frames):
         a = 2 * math.pi * i / frames
-        out.append(CameraPose(cx + 0.3 * room.width * math.cos(a),
-                              cy + 0.25 * room.depth * math.sin(a),
-                              a + 2.2 + 0.5 * math.sin(3 * a), height=spec.camera_height))
+        out.append(
+            CameraPose(
+                cx + 0.3 * room.width * math.cos(a),
+                cy + 0.25 * room.depth * math.sin(a),
+                a + 2.2 + 0.5 * math.sin(3 * a),
+                height=spec.camera_height,
+            )
+        )
     return out
 
 
@@ -58,8 +66,9 @@ def _frame_times(mode, size, frames, repeats):
     for _ in range(60):  # the person walks into the room
         world.step(1 / 30)
     scene = world.scene()
-    renderer = make_renderer(scenario.camera.renderer, *size, scenario.camera.hfov,
-                             scenario.camera.render3d)
+    renderer = make_renderer(
+        scenario.camera.renderer, *size, scenario.camera.hfov, scenario.camera.render3d
+    )
     poses = _poses(world, frames)
     renderer.render(scene, poses[0])  # builds the model, compiles the shaders
     wall, cpu = [], []
@@ -97,19 +106,33 @@ def _loop_times(mode, seconds, repeats, backend):
         factor.append(frames * period / (w1 - w0))
         cpu_factor.append(frames * period / (c1 - c0))
         startup.append(w0 - t0)
-    return (statistics.median(ms), statistics.median(factor), statistics.median(cpu_factor),
-            statistics.median(startup))
+    return (
+        statistics.median(ms),
+        statistics.median(factor),
+        statistics.median(cpu_factor),
+        statistics.median(startup),
+    )
 
 
 def _options(ap):
-    ap.add_argument("--seconds", type=float, default=5.0,
-                    help="simulated seconds of each closed-loop run (default 5; 0 skips them)")
+    ap.add_argument(
+        "--seconds",
+        type=float,
+        default=5.0,
+        help="simulated seconds of each closed-loop run (default 5; 0 skips them)",
+    )
     ap.add_argument("--sizes", default="160x120,640x480", help="comma-separated WIDTHxHEIGHT")
     ap.add_argument("--backend", default="auto", help="the design's backend in the closed loop")
-    ap.add_argument("--figures", metavar="DIR",
-                    help="write the figures of docs/render3d.md to DIR instead, and exit")
-    ap.add_argument("--viewer", action="store_true",
-                    help="with --figures: also a screenshot of the viewer (needs a Vulkan driver)")
+    ap.add_argument(
+        "--figures",
+        metavar="DIR",
+        help="write the figures of docs/render3d.md to DIR instead, and exit",
+    )
+    ap.add_argument(
+        "--viewer",
+        action="store_true",
+        help="with --figures: also a screenshot of the viewer (needs a Vulkan driver)",
+    )
 
 
 def _check(args):
@@ -127,29 +150,46 @@ def run(args):
         write_figures(args.figures, viewer=args.viewer)
         return None
     sizes = args.sizes
-    print(f"renderers on the divider_3d room, {args.frames} poses x {args.repeats} repeats; "
-          f"median ms per frame (wall / CPU of this process)")
+    print(
+        f"renderers on the divider_3d room, {args.frames} poses x {args.repeats} repeats; "
+        f"median ms per frame (wall / CPU of this process)"
+    )
     print(f"{'mode':>18}" + "".join(f"  {f'{w}x{h} wall':>14} {'cpu':>7}" for w, h in sizes))
     frames, loops = [], []
     for mode in MODES:
         cells = [_frame_times(mode, size, args.frames, args.repeats) for size in sizes]
-        frames += [{"mode": mode, "size": f"{w}x{h}", "wall_ms": wall, "cpu_ms": cpu}
-                   for (w, h), (wall, cpu) in zip(sizes, cells, strict=True)]
-        print(f"{mode:>18}" + "".join(f"  {wall:14.2f} {cpu:7.2f}" for wall, cpu in cells),
-              flush=True)
+        frames += [
+            {"mode": mode, "size": f"{w}x{h}", "wall_ms": wall, "cpu_ms": cpu}
+            for (w, h), (wall, cpu) in zip(sizes, cells, strict=True)
+        ]
+        print(
+            f"{mode:>18}" + "".join(f"  {wall:14.2f} {cpu:7.2f}" for wall, cpu in cells), flush=True
+        )
     if args.seconds:
-        print(f"closed loop, follow_person, {args.seconds:g} s simulated at 160x120, backend "
-              f"{args.backend}; median of {args.repeats}: wall ms per frame, real-time factor "
-              f"(simulated seconds per wall second, and per CPU second of this process)")
+        print(
+            f"closed loop, follow_person, {args.seconds:g} s simulated at 160x120, backend "
+            f"{args.backend}; median of {args.repeats}: wall ms per frame, real-time factor "
+            f"(simulated seconds per wall second, and per CPU second of this process)"
+        )
         for mode in MODES:
-            ms, factor, cpu, startup = _loop_times(mode, args.seconds, args.repeats,
-                                                   args.backend)
-            loops.append({"mode": mode, "frame_ms": ms, "realtime": factor,
-                          "cpu_realtime": cpu, "startup_s": startup})
-            print(f"{mode:>18}  {ms:8.2f} ms/frame  {factor:6.2f}x real time  "
-                  f"{cpu:6.2f}x per CPU second  (start-up {startup:.1f} s)", flush=True)
+            ms, factor, cpu, startup = _loop_times(mode, args.seconds, args.repeats, args.backend)
+            loops.append(
+                {
+                    "mode": mode,
+                    "frame_ms": ms,
+                    "realtime": factor,
+                    "cpu_realtime": cpu,
+                    "startup_s": startup,
+                }
+            )
+            print(
+                f"{mode:>18}  {ms:8.2f} ms/frame  {factor:6.2f}x real time  "
+                f"{cpu:6.2f}x per CPU second  (start-up {startup:.1f} s)",
+                flush=True,
+            )
     return {"frames": frames, "loop": loops}
 
 
-main = scaffold.command(run, __doc__, name="render3d", options=_options, check=_check,
-                        repeats=3, frames=60)
+main = scaffold.command(
+    run, __doc__, name="render3d", options=_options, check=_check, repeats=3, frames=60
+)

@@ -32,9 +32,16 @@ __all__ = ["bench_bag", "bench_live", "main"]
 def _geometry(width, height):
     from fpga_robotics.ros.messages import CameraGeometry
 
-    return CameraGeometry(width=width, height=height, hfov=1.047, mount_forward=0.1,
-                          mount_height=0.3, tilt=0.0, wheel_radius=0.035,
-                          wheel_separation=0.23)
+    return CameraGeometry(
+        width=width,
+        height=height,
+        hfov=1.047,
+        mount_forward=0.1,
+        mount_height=0.3,
+        tilt=0.0,
+        wheel_radius=0.035,
+        wheel_separation=0.23,
+    )
 
 
 def bench_bag(records, geometry, folder):
@@ -75,8 +82,9 @@ class _Client(threading.Thread):
         from websockets.sync.client import connect
 
         try:
-            with connect(f"ws://127.0.0.1:{self.port}", subprotocols=["foxglove.sdk.v1"],
-                         open_timeout=5) as ws:
+            with connect(
+                f"ws://127.0.0.1:{self.port}", subprotocols=["foxglove.sdk.v1"], open_timeout=5
+            ) as ws:
                 channels = {}
                 from fpga_robotics.ros.messages import TOPICS
 
@@ -84,8 +92,17 @@ class _Client(threading.Thread):
                     msg = json.loads(ws.recv(timeout=5))
                     if msg.get("op") == "advertise":
                         channels.update({c["topic"]: c["id"] for c in msg["channels"]})
-                ws.send(json.dumps({"op": "subscribe", "subscriptions": [
-                    {"id": i, "channelId": cid} for i, cid in enumerate(channels.values())]}))
+                ws.send(
+                    json.dumps(
+                        {
+                            "op": "subscribe",
+                            "subscriptions": [
+                                {"id": i, "channelId": cid}
+                                for i, cid in enumerate(channels.values())
+                            ],
+                        }
+                    )
+                )
                 time.sleep(0.3)  # the server takes the subscription
                 self.subscribed.set()
                 while not self.stop.is_set():
@@ -108,8 +125,9 @@ def bench_live(records, geometry, fps=30.0):
     client.start()
     try:
         if not client.subscribed.wait(10) or client.error is not None:
-            raise UsageError(f"bench ros: the benchmark's client could not subscribe "
-                             f"({client.error})")
+            raise UsageError(
+                f"bench ros: the benchmark's client could not subscribe ({client.error})"
+            )
         sent = sum(len(FrameMessages(geometry).encode(r)) for r in records)
         times = []
         start = time.perf_counter()
@@ -140,8 +158,10 @@ def run(args):
     figures = {}
     records = make_records(width, height, args.frames)
     geometry = _geometry(width, height)
-    print(f"ROS outputs per {width}x{height} frame ({args.frames} frames, median of "
-          f"{args.repeats} runs)")
+    print(
+        f"ROS outputs per {width}x{height} frame ({args.frames} frames, median of "
+        f"{args.repeats} runs)"
+    )
     if args.only in (None, "bag"):
         folder = tempfile.mkdtemp(prefix="fpga-ros-bench-")
         try:
@@ -153,20 +173,28 @@ def run(args):
         first = statistics.median(t[0] for t, _, _ in runs)
         fixed = statistics.median(f for _, f, _ in runs)
         cpu = statistics.median(c for _, _, c in runs)
-        figures["bag"] = {"call_median_ms": 1000 * call, "call_mean_ms": 1000 * mean,
-                          "cpu_ms": 1000 * cpu, "first_call_ms": 1000 * first,
-                          "open_close_ms": 1000 * fixed}
-        print(f"  bag  (--bag): log_frame median {1000 * call:.3f} ms, mean {1000 * mean:.3f} "
-              f"ms after the first, CPU {1000 * cpu:.3f} ms/frame; the first call "
-              f"{1000 * first:.1f} ms; opening and closing the bag {1000 * fixed:.1f} ms once")
+        figures["bag"] = {
+            "call_median_ms": 1000 * call,
+            "call_mean_ms": 1000 * mean,
+            "cpu_ms": 1000 * cpu,
+            "first_call_ms": 1000 * first,
+            "open_close_ms": 1000 * fixed,
+        }
+        print(
+            f"  bag  (--bag): log_frame median {1000 * call:.3f} ms, mean {1000 * mean:.3f} "
+            f"ms after the first, CPU {1000 * cpu:.3f} ms/frame; the first call "
+            f"{1000 * first:.1f} ms; opening and closing the bag {1000 * fixed:.1f} ms once"
+        )
     if args.only in (None, "live"):
         runs = [bench_live(records, geometry) for _ in range(args.repeats)]
         call = statistics.median(statistics.median(t) for t, _, _ in runs)
         sent = sum(s for _, s, _ in runs)
         got = sum(g for _, _, g in runs)
         figures["live"] = {"call_median_ms": 1000 * call, "sent": sent, "received": got}
-        print(f"  live (--live foxglove, one client): log_frame median {1000 * call:.3f} ms; "
-              f"client received {got}/{sent} messages")
+        print(
+            f"  live (--live foxglove, one client): log_frame median {1000 * call:.3f} ms; "
+            f"client received {got}/{sent} messages"
+        )
     return figures
 
 

@@ -27,8 +27,19 @@ from dataclasses import asdict, dataclass
 
 from fpga_robotics.cli.errors import UsageError
 
-__all__ = ["BenchParser", "Spread", "check_json_path", "command", "gc_paused", "parse_size",
-           "parse_sizes", "print_table", "ratios_to", "stopwatch", "write_json"]
+__all__ = [
+    "BenchParser",
+    "Spread",
+    "check_json_path",
+    "command",
+    "gc_paused",
+    "parse_size",
+    "parse_sizes",
+    "print_table",
+    "ratios_to",
+    "stopwatch",
+    "write_json",
+]
 
 #: Largest width or height a benchmark takes (the design's own limit).
 MAX_SIDE = 4096
@@ -130,8 +141,9 @@ def print_table(header, rows, *, first_width=None):
         widths[0] = max(widths[0], first_width)
 
     def line(cells):
-        return "  ".join(f"{c:<{widths[0]}}" if i == 0 else f"{c:>{widths[i]}}"
-                         for i, c in enumerate(cells)).rstrip()
+        return "  ".join(
+            f"{c:<{widths[0]}}" if i == 0 else f"{c:>{widths[i]}}" for i, c in enumerate(cells)
+        ).rstrip()
 
     print(line(header))
     for row in rows:
@@ -157,8 +169,13 @@ def machine():
         compiler = find_compiler().version
     except BackendError:
         compiler = None
-    return {"platform": platform.platform(), "python": platform.python_version(),
-            "cpus": os.cpu_count(), "load_average": os.getloadavg()[0], "compiler": compiler}
+    return {
+        "platform": platform.platform(),
+        "python": platform.python_version(),
+        "cpus": os.cpu_count(),
+        "load_average": os.getloadavg()[0],
+        "compiler": compiler,
+    }
 
 
 def _plain(value):
@@ -187,8 +204,11 @@ _MS_KEY = re.compile(r"(^|_)ms(_|$)")
 
 def _label(item, index):
     """A list entry's name: its backend, design, mode and size where it has them."""
-    parts = [str(item[k]) for k in ("backend", "design", "mode", "world", "size")
-             if isinstance(item, dict) and k in item]
+    parts = [
+        str(item[k])
+        for k in ("backend", "design", "mode", "world", "size")
+        if isinstance(item, dict) and k in item
+    ]
     if isinstance(item, dict) and "width" in item and "height" in item:
         parts.append(f"{item['width']}x{item['height']}")
     return " ".join(parts) or str(index)
@@ -199,15 +219,17 @@ def absolute_times(figures, prefix="", in_ms=False):
     ``ms_per_frame``, or every number under a ``steps_ms`` dict); nested dicts and lists
     walked, a ``Spread`` by its median."""
     out = []
-    items = (figures.items() if isinstance(figures, dict)
-             else ((_label(v, i), v) for i, v in enumerate(figures)))
+    items = (
+        figures.items()
+        if isinstance(figures, dict)
+        else ((_label(v, i), v) for i, v in enumerate(figures))
+    )
     for key, value in items:
         name = f"{prefix}{key}"
         is_ms = in_ms or bool(_MS_KEY.search(str(key)))
         if isinstance(value, (dict, list, tuple)):
             out += absolute_times(value, f"{name}.", is_ms and isinstance(value, dict))
-        elif is_ms and isinstance(value, (int, float, Spread)) \
-                and not isinstance(value, bool):
+        elif is_ms and isinstance(value, (int, float, Spread)) and not isinstance(value, bool):
             out.append((name, value.median if isinstance(value, Spread) else float(value)))
     return out
 
@@ -216,25 +238,38 @@ def ratios_to(figures, reference_ms, cpu_reference_ms=None):
     """Every absolute time of ``figures`` as a multiple of ``reference_ms``; a CPU time (its
     name says ``cpu``) of ``cpu_reference_ms`` where given, so that like meets like."""
     cpu_ref = cpu_reference_ms or reference_ms
-    return [(name, ms, ms / (cpu_ref if "cpu" in name else reference_ms))
-            for name, ms in absolute_times(figures)]
+    return [
+        (name, ms, ms / (cpu_ref if "cpu" in name else reference_ms))
+        for name, ms in absolute_times(figures)
+    ]
 
 
 def _add_common(parser, repeats, frames, min_seconds):
     if repeats is not None:
-        parser.add_argument("--repeats", type=int, default=repeats,
-                            help=f"repeats of each measurement (default {repeats})")
+        parser.add_argument(
+            "--repeats",
+            type=int,
+            default=repeats,
+            help=f"repeats of each measurement (default {repeats})",
+        )
     if frames is not None:
-        parser.add_argument("--frames", type=int, default=frames,
-                            help=f"frames per measurement (default {frames})")
+        parser.add_argument(
+            "--frames", type=int, default=frames, help=f"frames per measurement (default {frames})"
+        )
     if min_seconds is not None:
-        parser.add_argument("--min-seconds", type=float, default=min_seconds,
-                            help="repeat the frames until each case has run this long "
-                                 f"(default {min_seconds:g})")
+        parser.add_argument(
+            "--min-seconds",
+            type=float,
+            default=min_seconds,
+            help=f"repeat the frames until each case has run this long (default {min_seconds:g})",
+        )
     parser.add_argument("--json", metavar="PATH", help="also write the figures to PATH")
-    parser.add_argument("--calibrate", action="store_true",
-                        help="also time the calibration design (bench calibrate) in this run "
-                             "and print every time as a multiple of it")
+    parser.add_argument(
+        "--calibrate",
+        action="store_true",
+        help="also time the calibration design (bench calibrate) in this run "
+        "and print every time as a multiple of it",
+    )
 
 
 def _check_common(args):
@@ -249,8 +284,9 @@ def _check_common(args):
         check_json_path(args.json)
 
 
-def command(run, doc, *, name, options=None, repeats=None, frames=None, min_seconds=None,
-            check=None):
+def command(
+    run, doc, *, name, options=None, repeats=None, frames=None, min_seconds=None, check=None
+):
     """``main(argv=None, prog=...)`` of a benchmark: parse (common options, then the
     subject's ``options(parser)``), check (common, then ``check(args)``), ``run(args)`` ->
     figures, then the calibration and ``--json`` if asked for."""
@@ -285,10 +321,14 @@ def command(run, doc, *, name, options=None, repeats=None, frames=None, min_seco
 def print_calibrated(figures, calibration):
     """Each absolute time of ``figures`` next to the same run's calibration frame time."""
     ref, cpu_ref = calibration["frame_ms"].median, calibration["cpu_ms"].median
-    print(f"calibration ({calibration['what']}): {calibration['frame_ms']:.4f} ms/frame, "
-          f"CPU {calibration['cpu_ms']:.4f} (median, min-max of {calibration['frame_ms'].n}); "
-          f"the times above in calibration frames (CPU times in its CPU time):")
-    rows = [(name, f"{ms:.4g} ms", f"{ratio:.3g}x")
-            for name, ms, ratio in ratios_to(figures, ref, cpu_ref)]
+    print(
+        f"calibration ({calibration['what']}): {calibration['frame_ms']:.4f} ms/frame, "
+        f"CPU {calibration['cpu_ms']:.4f} (median, min-max of {calibration['frame_ms'].n}); "
+        f"the times above in calibration frames (CPU times in its CPU time):"
+    )
+    rows = [
+        (name, f"{ms:.4g} ms", f"{ratio:.3g}x")
+        for name, ms, ratio in ratios_to(figures, ref, cpu_ref)
+    ]
     if rows:
         print_table(("figure", "time", "x calibration"), rows)

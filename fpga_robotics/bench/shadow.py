@@ -39,12 +39,16 @@ def measure(scenario, backend, shadow_params, repeats):
 
     try:
         # The run's frames, for the shadow design alone (an untimed run: recording them costs).
-        run_scenario(scenario, backend=design,
-                     on_frame=lambda record: frames.append((record.camera_rgb, record.color_sel)))
+        run_scenario(
+            scenario,
+            backend=design,
+            on_frame=lambda record: frames.append((record.camera_rgb, record.color_sel)),
+        )
         for _turn in range(repeats):
             alone.append(cpu_ms_per_frame(lambda: run_scenario(scenario, backend=design)))
-            shadowed.append(cpu_ms_per_frame(
-                lambda: run_scenario(scenario, backend=design, shadow=shadow)))
+            shadowed.append(
+                cpu_ms_per_frame(lambda: run_scenario(scenario, backend=design, shadow=shadow))
+            )
             own.append(cpu_ms_per_frame(replay))
     finally:
         design.close()
@@ -56,8 +60,12 @@ def _options(p):
     from fpga_robotics.sim.backends import BACKEND_NAMES
 
     p.add_argument("--scenario", default="follow_person")
-    p.add_argument("--shadow", default="diff_min=5", metavar="SPEC",
-                   help="the shadow design, as run --shadow takes it (default diff_min=5)")
+    p.add_argument(
+        "--shadow",
+        default="diff_min=5",
+        metavar="SPEC",
+        help="the shadow design, as run --shadow takes it (default diff_min=5)",
+    )
     p.add_argument("--backend", default="auto", choices=("auto", *BACKEND_NAMES))
     p.add_argument("--duration", type=float, default=10.0, help="simulated seconds a run")
 
@@ -77,14 +85,20 @@ def run(args):
     shadow_params = _shadow_params(scenario, args.shadow)
     alone, shadowed, own = measure(scenario, args.backend, shadow_params, args.repeats)
     extra = shadowed - alone
-    print(f"{scenario.name}, {args.backend} backend, shadow {args.shadow}, "
-          f"medians of {args.repeats} turns (CPU ms per frame)")
+    print(
+        f"{scenario.name}, {args.backend} backend, shadow {args.shadow}, "
+        f"medians of {args.repeats} turns (CPU ms per frame)"
+    )
     print(f"  closed loop alone           {alone:8.3f}")
     print(f"  closed loop with the shadow {shadowed:8.3f}")
     print(f"  shadow design on its own    {own:8.3f}")
     print(f"  extra per frame / own time  {extra / own:8.2f}  (target <= 1.10)")
-    return {"alone_cpu_ms": alone, "shadowed_cpu_ms": shadowed, "own_cpu_ms": own,
-            "extra_over_own": extra / own}
+    return {
+        "alone_cpu_ms": alone,
+        "shadowed_cpu_ms": shadowed,
+        "own_cpu_ms": own,
+        "extra_over_own": extra / own,
+    }
 
 
 main = scaffold.command(run, __doc__, name="shadow", options=_options, check=_check, repeats=3)

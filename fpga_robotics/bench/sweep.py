@@ -26,10 +26,16 @@ __all__ = ["bench", "main", "measure"]
 def _campaign(runs, args):
     from fpga_robotics.sweep.campaign import load_campaign
 
-    return load_campaign({
-        "name": "bench", "scenarios": [args.scenarios or "follow_person"],
-        "seeds": [*range(runs)], "backend": args.backend or "model",
-        "resolution": args.resolution or "160x120", "duration": args.duration or 10.0})
+    return load_campaign(
+        {
+            "name": "bench",
+            "scenarios": [args.scenarios or "follow_person"],
+            "seeds": [*range(runs)],
+            "backend": args.backend or "model",
+            "resolution": args.resolution or "160x120",
+            "duration": args.duration or 10.0,
+        }
+    )
 
 
 def _once(runs, workers, args):
@@ -41,10 +47,13 @@ def _once(runs, workers, args):
         meta = read_meta(out)
     wall = meta["runs_wall_s"]
     run_s = [r["run_s"] for r in rows]
-    return {"rps": runs / wall, "inside": sum(run_s) / (workers * wall),
-            "outside_s": wall * workers / runs - statistics.mean(run_s),
-            "run_s": statistics.median(run_s),
-            "cpu_s": statistics.median(r["cpu_s"] for r in rows)}
+    return {
+        "rps": runs / wall,
+        "inside": sum(run_s) / (workers * wall),
+        "outside_s": wall * workers / runs - statistics.mean(run_s),
+        "run_s": statistics.median(run_s),
+        "cpu_s": statistics.median(r["cpu_s"] for r in rows),
+    }
 
 
 def bench(args):
@@ -57,34 +66,44 @@ def measure(args):
     """Print the figures and return them: per worker count, the medians."""
     n = args.workers or os.cpu_count() or 1
     runs, repeats = args.bench_runs, args.bench_repeats
-    print(f"campaign benchmark: {runs} runs of {args.scenarios or 'follow_person'}, "
-          f"{args.resolution or '160x120'}, {args.duration or 10.0} s simulated, backend "
-          f"{args.backend or 'model'}; 1 and {n} workers alternately, {repeats} times; "
-          f"load average {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
+    print(
+        f"campaign benchmark: {runs} runs of {args.scenarios or 'follow_person'}, "
+        f"{args.resolution or '160x120'}, {args.duration or 10.0} s simulated, backend "
+        f"{args.backend or 'model'}; 1 and {n} workers alternately, {repeats} times; "
+        f"load average {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores"
+    )
     counts = sorted({1, n})
     samples = {w: [] for w in counts}
     t0 = time.perf_counter()
     for _ in range(repeats):
         for workers in counts:
             samples[workers].append(_once(runs, workers, args))
-    med = {w: {k: statistics.median(s[k] for s in samples[w]) for k in samples[w][0]}
-           for w in counts}
+    med = {
+        w: {k: statistics.median(s[k] for s in samples[w]) for k in samples[w][0]} for w in counts
+    }
     for workers in counts:
         m = med[workers]
-        print(f"  {workers} worker(s): {m['rps']:.2f} runs/s, median run_scenario "
-              f"{m['run_s'] * 1000:.0f} ms (CPU {m['cpu_s'] * 1000:.0f} ms), {m['inside']:.0%} "
-              f"of the workers' time inside run_scenario")
+        print(
+            f"  {workers} worker(s): {m['rps']:.2f} runs/s, median run_scenario "
+            f"{m['run_s'] * 1000:.0f} ms (CPU {m['cpu_s'] * 1000:.0f} ms), {m['inside']:.0%} "
+            f"of the workers' time inside run_scenario"
+        )
     one = med[1]
-    print(f"  outside run_scenario with 1 worker: {one['outside_s'] * 1000:.1f} ms per run "
-          f"({100 * one['outside_s'] / one['run_s']:.1f}% of a run)")
+    print(
+        f"  outside run_scenario with 1 worker: {one['outside_s'] * 1000:.1f} ms per run "
+        f"({100 * one['outside_s'] / one['run_s']:.1f}% of a run)"
+    )
     if n > 1:
         speedup = med[n]["rps"] / med[1]["rps"]
-        print(f"  speed-up with {n} workers: {speedup:.2f}x ({speedup / n:.2f} x N); a run "
-              f"takes {med[n]['run_s'] / med[1]['run_s']:.2f}x as long as with 1 worker")
-    print(f"  ({time.perf_counter() - t0:.0f} s; load average now "
-          f"{os.getloadavg()[0]:.1f})")
-    return {str(w): {**m, "run_ms": m["run_s"] * 1e3, "cpu_ms": m["cpu_s"] * 1e3}
-            for w, m in med.items()}
+        print(
+            f"  speed-up with {n} workers: {speedup:.2f}x ({speedup / n:.2f} x N); a run "
+            f"takes {med[n]['run_s'] / med[1]['run_s']:.2f}x as long as with 1 worker"
+        )
+    print(f"  ({time.perf_counter() - t0:.0f} s; load average now {os.getloadavg()[0]:.1f})")
+    return {
+        str(w): {**m, "run_ms": m["run_s"] * 1e3, "cpu_ms": m["cpu_s"] * 1e3}
+        for w, m in med.items()
+    }
 
 
 def _options(parser):
@@ -104,10 +123,17 @@ def _check(args):
 
 
 def run(args):
-    figures = measure(SimpleNamespace(
-        workers=args.workers, bench_runs=args.runs, bench_repeats=args.repeats,
-        scenarios=args.scenario, backend=args.backend, resolution=args.resolution,
-        duration=args.duration))
+    figures = measure(
+        SimpleNamespace(
+            workers=args.workers,
+            bench_runs=args.runs,
+            bench_repeats=args.repeats,
+            scenarios=args.scenario,
+            backend=args.backend,
+            resolution=args.resolution,
+            duration=args.duration,
+        )
+    )
     return figures
 
 

@@ -146,9 +146,16 @@ def run(args):
                 procs.append(proc * 1e3)
                 sizes.append(size / len(records))
             med = statistics.median
-            figures.append({"size": f"{width}x{height}", "call_median_ms": med(medians),
-                            "call_mean_ms": med(means), "caller_cpu_ms": med(cpus),
-                            "process_cpu_ms": med(procs), "bytes_per_frame": med(sizes)})
+            figures.append(
+                {
+                    "size": f"{width}x{height}",
+                    "call_median_ms": med(medians),
+                    "call_mean_ms": med(means),
+                    "caller_cpu_ms": med(cpus),
+                    "process_cpu_ms": med(procs),
+                    "bytes_per_frame": med(sizes),
+                }
+            )
             print(
                 f"  {width}x{height}: wall median {med(medians):.3f} ms/frame, "
                 f"mean {med(means):.3f} ms/frame; CPU {med(cpus):.3f} ms/frame in the caller, "

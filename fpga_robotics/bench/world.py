@@ -17,12 +17,16 @@ from fpga_robotics.sim.world.world import World
 __all__ = ["TERRAIN_WORLD", "WORLDS", "main", "time_frames", "time_terrain_and_noise"]
 
 _BUSY = {
-    "room": {"furniture": [
-        {"center": [2.0, 1.0]}, {"center": [6.0, 1.0], "angle_deg": 20},
-        {"center": [2.0, 5.0], "size": [1.5, 0.5]}, {"center": [7.0, 5.0]},
-        {"type": "divider", "center": [5.0, 5.2], "name": "divider"},
-        {"center": [0.8, 0.8], "size": [0.5, 0.5]},
-    ]},
+    "room": {
+        "furniture": [
+            {"center": [2.0, 1.0]},
+            {"center": [6.0, 1.0], "angle_deg": 20},
+            {"center": [2.0, 5.0], "size": [1.5, 0.5]},
+            {"center": [7.0, 5.0]},
+            {"type": "divider", "center": [5.0, 5.2], "name": "divider"},
+            {"center": [0.8, 0.8], "size": [0.5, 0.5]},
+        ]
+    },
     "people": [
         {"waypoints": [[4, 3], [6, 4.5], [6.5, 1.5]], "pause": 1.0, "speed_jitter": 0.2},
         {"waypoints": [[1, 3], [7, 3]], "speed": 1.0},
@@ -34,16 +38,17 @@ _BUSY = {
 # The default world with terrain under the whole drive (four patches, a ramp among them) and
 # every drive imperfection on: against "default", the cost of terrain lookup and noise.
 _TERRAIN = {
-    "room": {"terrain": [
-        {"center": [2.0, 3.0], "size": [4.0, 6.0], "friction": 0.8},
-        {"points": [[4, 0], [8, 0], [8, 3], [4, 3]], "friction": 0.5, "color": [0.4, 0.4, 0.5]},
-        {"center": [6.0, 4.5], "size": [4.0, 3.0], "slope_deg": 3.0, "slope_dir_deg": 90},
-        {"center": [4.0, 3.0], "size": [1.0, 1.0], "friction": 0.3},
-    ]},
+    "room": {
+        "terrain": [
+            {"center": [2.0, 3.0], "size": [4.0, 6.0], "friction": 0.8},
+            {"points": [[4, 0], [8, 0], [8, 3], [4, 3]], "friction": 0.5, "color": [0.4, 0.4, 0.5]},
+            {"center": [6.0, 4.5], "size": [4.0, 3.0], "slope_deg": 3.0, "slope_dir_deg": 90},
+            {"center": [4.0, 3.0], "size": [1.0, 1.0], "friction": 0.3},
+        ]
+    },
     "robot": {"motor_gain_error": 0.05, "motor_noise_dps": 10.0, "slip_rate_hz": 0.2},
 }
-WORLDS = {"default": {}, "busy (6 furniture, 5 people)": _BUSY,
-          "terrain, drive noise": _TERRAIN}
+WORLDS = {"default": {}, "busy (6 furniture, 5 people)": _BUSY, "terrain, drive noise": _TERRAIN}
 
 TERRAIN_WORLD = "terrain, drive noise"
 
@@ -93,8 +98,12 @@ def _rate(name, value, hi):
 
 
 def _options(parser):
-    parser.add_argument("--physics-hz", type=float, default=240.0,
-                        help="physics steps per second (default 240, the closed loop's)")
+    parser.add_argument(
+        "--physics-hz",
+        type=float,
+        default=240.0,
+        help="physics steps per second (default 240, the closed loop's)",
+    )
     parser.add_argument("--fps", type=float, default=30.0, help="camera frames per second")
 
 
@@ -106,22 +115,32 @@ def _check(args):
 def run(args):
     steps = math.ceil(args.physics_hz / args.fps)
     dt = 1.0 / args.physics_hz
-    print(f"{steps} steps of {dt * 1e3:.2f} ms per frame, {args.frames} frames, "
-          f"median of {args.repeats} runs")
+    print(
+        f"{steps} steps of {dt * 1e3:.2f} ms per frame, {args.frames} frames, "
+        f"median of {args.repeats} runs"
+    )
     figures = []
     for name, cfg in WORLDS.items():
-        per_frame = statistics.median(time_frames(cfg, args.frames, steps, dt)
-                                      for _ in range(args.repeats))
+        per_frame = statistics.median(
+            time_frames(cfg, args.frames, steps, dt) for _ in range(args.repeats)
+        )
         figures.append({"world": name, "frame_ms": per_frame * 1e3})
-        print(f"  {name:32s} {per_frame * 1e3:7.3f} ms/frame  "
-              f"{per_frame / steps * 1e6:6.1f} us/step (incl. scene and queries)", flush=True)
-    extra = statistics.median(time_terrain_and_noise(args.frames, steps, dt)
-                              for _ in range(args.repeats))
+        print(
+            f"  {name:32s} {per_frame * 1e3:7.3f} ms/frame  "
+            f"{per_frame / steps * 1e6:6.1f} us/step (incl. scene and queries)",
+            flush=True,
+        )
+    extra = statistics.median(
+        time_terrain_and_noise(args.frames, steps, dt) for _ in range(args.repeats)
+    )
     figures.append({"world": "terrain and noise alone", "frame_ms": extra * 1e3})
-    print(f"  {'of which terrain and noise alone':32s} {extra * 1e3:7.3f} ms/frame  "
-          f"{extra / steps * 1e6:6.1f} us/step (4 patches, every imperfection on)")
+    print(
+        f"  {'of which terrain and noise alone':32s} {extra * 1e3:7.3f} ms/frame  "
+        f"{extra / steps * 1e6:6.1f} us/step (4 patches, every imperfection on)"
+    )
     return {"worlds": figures}
 
 
-main = scaffold.command(run, __doc__, name="world", options=_options, check=_check, repeats=5,
-                        frames=900)
+main = scaffold.command(
+    run, __doc__, name="world", options=_options, check=_check, repeats=5, frames=900
+)

@@ -14,8 +14,7 @@ __all__ = ["COMPARISONS", "DESIGN_OUTPUTS", "STATUSES", "Check", "judge", "measu
 #: port map names no such port: its ``FrameResult`` holds None); those are *absent*, never 0:
 #: NaN in the trajectory, listed in ``absent_outputs``, the metrics made of them None, the
 #: checks that need them n/a (left out of the verdict), nothing drawn for them in the viewer.
-DESIGN_OUTPUTS = ("found", "proximity", "centroid_x", "centroid_leds", "motor_left",
-                  "motor_right")
+DESIGN_OUTPUTS = ("found", "proximity", "centroid_x", "centroid_leds", "motor_left", "motor_right")
 
 #: ``max``: the metric must be at most the limit; ``min``: at least the limit.
 COMPARISONS = ("max", "min")
@@ -60,14 +59,17 @@ class Check:
         if not (isinstance(self.name, str) and self.name.isidentifier()):
             raise ValueError(f"a check's name must be an identifier, got {self.name!r}")
         if self.compare not in COMPARISONS:
-            raise ValueError(f"check {self.name}: compare must be one of {COMPARISONS}, "
-                             f"got {self.compare!r}")
+            raise ValueError(
+                f"check {self.name}: compare must be one of {COMPARISONS}, got {self.compare!r}"
+            )
         if self.kind not in (int, float):
             raise ValueError(f"check {self.name}: kind must be int or float, got {self.kind!r}")
         unknown = [o for o in self.outputs if o not in DESIGN_OUTPUTS]
         if unknown:
-            raise ValueError(f"check {self.name}: unknown design output(s) {unknown}; "
-                             f"known: {', '.join(DESIGN_OUTPUTS)}")
+            raise ValueError(
+                f"check {self.name}: unknown design output(s) {unknown}; "
+                f"known: {', '.join(DESIGN_OUTPUTS)}"
+            )
         lo, hi, unit = self.limits
         if not lo <= hi or not isinstance(unit, str):
             raise ValueError(f"check {self.name}: limits must be (lowest, highest, unit)")
@@ -79,15 +81,24 @@ class Check:
 
 def measured(metric, reason):
     """A precondition: the run measured ``metric`` (not None), else ``reason``."""
+
     def precondition(m):
         return reason if m.get(metric) is None else None
+
     return precondition
 
 
 def _result(check, status, value, limit, text, reason=None):
     passed = {"pass": True, "fail": False, "n/a": None}[status]
-    return {"name": check.name, "status": status, "passed": passed, "value": value,
-            "limit": limit, "text": text, "reason": reason}
+    return {
+        "name": check.name,
+        "status": status,
+        "passed": passed,
+        "value": value,
+        "limit": limit,
+        "text": text,
+        "reason": reason,
+    }
 
 
 def _silent(kinds, m):

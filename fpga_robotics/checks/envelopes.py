@@ -36,8 +36,14 @@ import numpy as np
 
 from fpga_robotics.sim.models.follow_target import match_table, proximity_level
 
-__all__ = ["EnvelopeGeometry", "count_bounds", "envelope_geometry", "envelope_metrics",
-           "law_band", "stop_distance_m"]
+__all__ = [
+    "EnvelopeGeometry",
+    "count_bounds",
+    "envelope_geometry",
+    "envelope_metrics",
+    "law_band",
+    "stop_distance_m",
+]
 
 #: Tolerance of the centroid error against the target's image column, pixels.
 E_TOLERANCE_PX = 2.0
@@ -97,8 +103,10 @@ def envelope_geometry(scenario, world_config, camera):
     if target is None:
         return "no target person"
     if scenario.camera.renderer != "raster":
-        return (f"the bands are computed for the 2D renderer's cylinders; camera.renderer = "
-                f"{scenario.camera.renderer!r} draws bodies")
+        return (
+            f"the bands are computed for the 2D renderer's cylinders; camera.renderer = "
+            f"{scenario.camera.renderer!r} draws bodies"
+        )
     light = world_config.lighting
     ambients = [light.ambient] + [k[1] for k in light.keyframes]
     brights = [light.ambient + light.intensity] + [k[1] + k[2] for k in light.keyframes]
@@ -120,9 +128,19 @@ def envelope_geometry(scenario, world_config, camera):
         # band matches surely, and an exposure may last up to a whole frame.
         sure = {code: [] for code in sure}
         exposure = cam.frame_period
-    return EnvelopeGeometry(cam.width, cam.height, cam.hfov, camera.mount_height,
-                            camera.mount_forward, camera.tilt, target.radius, sure, maybe,
-                            yaw=getattr(camera, "yaw_offset", 0.0), exposure_s=exposure)
+    return EnvelopeGeometry(
+        cam.width,
+        cam.height,
+        cam.hfov,
+        camera.mount_height,
+        camera.mount_forward,
+        camera.tilt,
+        target.radius,
+        sure,
+        maybe,
+        yaw=getattr(camera, "yaw_offset", 0.0),
+        exposure_s=exposure,
+    )
 
 
 def _rows(z0, z1, depth, geom, params):
@@ -156,10 +174,13 @@ def count_bounds(distance, bearing, code, geom, params):
         return None
     cols = right - left
     near, far = distance - geom.radius, distance
-    lo = sum(max(0.0, cols - 2) * max(0.0, _rows(z0, z1, far, geom, params) - 2)
-             for z0, z1 in geom.bands_sure[code])
-    hi = sum((cols + 2) * (_rows(z0, z1, near, geom, params) + 2)
-             for z0, z1 in geom.bands_maybe[code])
+    lo = sum(
+        max(0.0, cols - 2) * max(0.0, _rows(z0, z1, far, geom, params) - 2)
+        for z0, z1 in geom.bands_sure[code]
+    )
+    hi = sum(
+        (cols + 2) * (_rows(z0, z1, near, geom, params) + 2) for z0, z1 in geom.bands_maybe[code]
+    )
     return math.floor(lo), math.ceil(hi)
 
 
@@ -230,9 +251,14 @@ def _camera_view(traj, geom):
     return np.hypot(dx, dy), bearing
 
 
-_NAMES = ("approach_speed_violation_fraction", "reverse_when_far_fraction",
-          "turn_law_violation_fraction", "search_law_violation_fraction", "stop_overshoot_m",
-          "envelope_reason")
+_NAMES = (
+    "approach_speed_violation_fraction",
+    "reverse_when_far_fraction",
+    "turn_law_violation_fraction",
+    "search_law_violation_fraction",
+    "stop_overshoot_m",
+    "envelope_reason",
+)
 
 
 def envelope_metrics(traj, params, geom):
@@ -266,8 +292,10 @@ def envelope_metrics(traj, params, geom):
         bounds = count_bounds(float(dist[k]), float(bearing[k]), code, geom, params)
         if bounds is None:
             continue
-        levels = range(proximity_level(bounds[0], params.proximity_thresholds),
-                       proximity_level(bounds[1], params.proximity_thresholds) + 1)
+        levels = range(
+            proximity_level(bounds[0], params.proximity_thresholds),
+            proximity_level(bounds[1], params.proximity_thresholds) + 1,
+        )
         left, right = silhouette(float(dist[k]), float(bearing[k]), geom)
         column = (left + right) / 2 - 0.5  # the pixel index the centre falls on
         tol = E_TOLERANCE_PX
@@ -287,8 +315,9 @@ def envelope_metrics(traj, params, geom):
     out["approach_speed_violation_fraction"] = _fraction(speed)
     out["reverse_when_far_fraction"] = _fraction(reverse)
     out["turn_law_violation_fraction"] = _fraction(steer)
-    out["search_law_violation_fraction"] = _fraction(_search_judged(found, ml, mr, dist,
-                                                                    bearing, geom, params))
+    out["search_law_violation_fraction"] = _fraction(
+        _search_judged(found, ml, mr, dist, bearing, geom, params)
+    )
     stop = stop_distance_m(geom, params, int(codes[0])) if len(codes) else None
     if stop is not None and closest is not None and closest <= stop[1]:
         out["stop_overshoot_m"] = round(max(0.0, stop[0] - float(closest)), 4)

@@ -11,8 +11,16 @@ from collections.abc import Mapping
 from fpga_robotics.checks.check import Check, judge
 from fpga_robotics.checks.shipped import SHIPPED_CHECKS
 
-__all__ = ["CHECKS", "CHECK_OUTPUTS", "check_named", "check_names", "evaluate_checks",
-           "register_check", "unregister_check", "verdict"]
+__all__ = [
+    "CHECKS",
+    "CHECK_OUTPUTS",
+    "check_named",
+    "check_names",
+    "evaluate_checks",
+    "register_check",
+    "unregister_check",
+    "verdict",
+]
 
 _REGISTRY = {}
 

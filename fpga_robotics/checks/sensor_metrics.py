@@ -10,8 +10,13 @@ import numpy as np
 
 from fpga_robotics.sim.world import is_removal_event
 
-__all__ = ["RESUME_CLOSING_M", "line_metrics", "measurement_metrics", "obstacle_metrics",
-           "sensor_check"]
+__all__ = [
+    "RESUME_CLOSING_M",
+    "line_metrics",
+    "measurement_metrics",
+    "obstacle_metrics",
+    "sensor_check",
+]
 
 #: Following has resumed once the robot is this much closer to the target than when the last
 #: obstacle left, m.
@@ -23,8 +28,12 @@ def line_metrics(traj, lines, mounts, period):
     whose line sensors sit at ``mounts`` (``connectors.Mount``s) on the robot, over the floor
     ``lines`` (``FloorLine``s); rows ``period`` s apart. None values without lines or
     sensors."""
-    none = {"lateral_error_max_m": None, "lateral_error_mean_m": None, "off_line_s": None,
-            "laps": None}
+    none = {
+        "lateral_error_max_m": None,
+        "lateral_error_mean_m": None,
+        "off_line_s": None,
+        "laps": None,
+    }
     n = len(traj["t"])
     if not lines or not mounts or n == 0:
         return none
@@ -35,8 +44,9 @@ def line_metrics(traj, lines, mounts, period):
     py = np.array([y + m.forward * s + m.left * c for m in mounts])
     cx, cy = px.mean(axis=0), py.mean(axis=0)
     errors = np.min([line.distance(cx, cy) for line in lines], axis=0)
-    on_line = np.any([line.covers(px.ravel(), py.ravel()).reshape(px.shape)
-                      for line in lines], axis=(0, 1))
+    on_line = np.any(
+        [line.covers(px.ravel(), py.ravel()).reshape(px.shape) for line in lines], axis=(0, 1)
+    )
     off = int(np.count_nonzero(~on_line))
     track = next((line for line in lines if line.closed), None)
     laps = None
@@ -45,9 +55,12 @@ def line_metrics(traj, lines, mounts, period):
         length = track.length
         steps = (steps + length / 2) % length - length / 2  # across the start: the short way
         laps = int(abs(float(steps.sum())) // length)
-    return {"lateral_error_max_m": round(float(errors.max()), 4),
-            "lateral_error_mean_m": round(float(errors.mean()), 4),
-            "off_line_s": round(off * period, 4), "laps": laps}
+    return {
+        "lateral_error_max_m": round(float(errors.max()), 4),
+        "lateral_error_mean_m": round(float(errors.mean()), 4),
+        "off_line_s": round(off * period, 4),
+        "laps": laps,
+    }
 
 
 def obstacle_metrics(traj, events):
@@ -76,13 +89,18 @@ def measurement_metrics(columns, sensors, frames):
     robot's sensors as ``(name, kind)``, ``frames`` the rows done."""
     counts = {}
     for name, _kind in sensors:
-        mine = [np.asarray(v[:frames], dtype=float) for k, v in columns.items()
-                if k.startswith(f"{name}.")]
+        mine = [
+            np.asarray(v[:frames], dtype=float)
+            for k, v in columns.items()
+            if k.startswith(f"{name}.")
+        ]
         counts[name] = int(np.any(~np.isnan(mine), axis=0).sum()) if mine else 0
-    return {"measured_frames": counts,
-            "measured_frames_min": min(counts.values()) if counts else None,
-            "silent_sensors": [name for name, n in counts.items() if n == 0],
-            "sensor_kinds": dict(sensors)}
+    return {
+        "measured_frames": counts,
+        "measured_frames_min": min(counts.values()) if counts else None,
+        "silent_sensors": [name for name, n in counts.items() if n == 0],
+        "sensor_kinds": dict(sensors),
+    }
 
 
 def sensor_check(name, limit, m):

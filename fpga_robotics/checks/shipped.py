@@ -20,14 +20,22 @@ def _never_in_view(m):
 
 def _collisions(kind, meaning):
     return Check(
-        f"max_{kind}_collisions", lambda m: int(m["collisions"].get(kind, 0)), "max", meaning,
+        f"max_{kind}_collisions",
+        lambda m: int(m["collisions"].get(kind, 0)),
+        "max",
+        meaning,
         lambda v, limit, m: f"{v} collision(s) with {kind} (limit {limit})",
-        kind=int, limits=_COUNT)
+        kind=int,
+        limits=_COUNT,
+    )
 
 
 def _tipped(v, limit, m):
-    return ("the robot never tipped over" if v == 0
-            else f"the robot tipped over at {m['tipped_over_at_s']:.2f} s (limit {limit})")
+    return (
+        "the robot never tipped over"
+        if v == 0
+        else f"the robot tipped over at {m['tipped_over_at_s']:.2f} s (limit {limit})"
+    )
 
 
 def _reacquire_time(m):
@@ -42,8 +50,9 @@ def _late(m, limit):
 def _reacquired(v, limit, m):
     """Every searched loss ended with the target found again within the limit, and one did."""
     times = m["reacquire_times_s"]
-    return (m["searched_reacquisitions"] >= 1 and all(x <= limit for x in times)
-            and not _late(m, limit))
+    return (
+        m["searched_reacquisitions"] >= 1 and all(x <= limit for x in times) and not _late(m, limit)
+    )
 
 
 def _reacquired_text(v, limit, m):
@@ -52,8 +61,10 @@ def _reacquired_text(v, limit, m):
         return f"target lost and not found again for {max(late):.2f} s (limit {limit} s)"
     if m["searched_reacquisitions"] == 0:
         return "the design searched but the run ended before it found the target again"
-    return (f"{len(m['reacquire_times_s'])} re-acquisition(s), slowest {v:.2f} s after the "
-            f"loss (limit {limit} s)")
+    return (
+        f"{len(m['reacquire_times_s'])} re-acquisition(s), slowest {v:.2f} s after the "
+        f"loss (limit {limit} s)"
+    )
 
 
 def _found_fraction(v, limit, m):
@@ -63,214 +74,424 @@ def _found_fraction(v, limit, m):
 def _resumed_text(v, limit, m):
     t_r = m["obstacle_removed_at_s"]
     if v is None:
-        return (f"the robot never closed {RESUME_CLOSING_M} m on the target after the obstacle "
-                f"left at {t_r:.2f} s (limit {limit} s)")
-    return (f"closed {RESUME_CLOSING_M} m on the target {v:.2f} s after the obstacle left "
-            f"(limit {limit} s)")
+        return (
+            f"the robot never closed {RESUME_CLOSING_M} m on the target after the obstacle "
+            f"left at {t_r:.2f} s (limit {limit} s)"
+        )
+    return (
+        f"closed {RESUME_CLOSING_M} m on the target {v:.2f} s after the obstacle left "
+        f"(limit {limit} s)"
+    )
 
 
 def _measured_text(v, limit, m):
     silent = m.get("silent_sensors") or []
     if silent:
-        return (f"no measurement at all from {', '.join(silent)} "
-                f"(limit >= {limit} frame(s) with a measurement)")
+        return (
+            f"no measurement at all from {', '.join(silent)} "
+            f"(limit >= {limit} frame(s) with a measurement)"
+        )
     return f"every sensor measured in at least {v} frame(s) (limit >= {limit})"
 
 
 def _envelope(metric, no_frames):
     """A precondition: the envelopes read this design's laws and the run judged a frame."""
+
     def precondition(m):
         if m.get("envelope_reason"):
             return f"no envelope: {m['envelope_reason']}"
         return no_frames if m.get(metric) is None else None
+
     return precondition
 
 
 _WHEELS = ("found", "motor_left", "motor_right")
-_BAND = ("(bands from the design's parameters and the camera's geometry: "
-         "fpga_robotics.checks.envelopes)")
+_BAND = (
+    "(bands from the design's parameters and the camera's geometry: fpga_robotics.checks.envelopes)"
+)
 
 _NO_LINE = "not measured: the run has no floor line or no line sensors"
 
 SHIPPED_CHECKS = (
-    Check("acquired_within_s", "acquired_at_s", "max",
-          "the design reports the target found within this time",
-          lambda v, limit, m: ("the target was never found" if v is None
-                               else f"target first found at {v:.2f} s (limit {limit} s)"),
-          limits=(0, _DAY, "s"), outputs=("found",), precondition=_never_in_view),
-    Check("mean_distance_max_m", "mean_distance_m", "max",
-          "mean robot-to-target distance (centres) at most this",
-          lambda v, limit, m: (f"mean distance {v} m (limit <= {limit} m)" if v is not None
-                               else f"{_NO_TARGET} (limit <= {limit} m)"),
-          limits=(0, 1000, "m")),
-    Check("min_distance_min_m", "min_distance_m", "min",
-          "closest robot-to-target distance (centres) at least this",
-          lambda v, limit, m: (f"min distance {v} m (limit >= {limit} m)" if v is not None
-                               else f"{_NO_TARGET} (limit >= {limit} m)"),
-          limits=(0, 1000, "m")),
+    Check(
+        "acquired_within_s",
+        "acquired_at_s",
+        "max",
+        "the design reports the target found within this time",
+        lambda v, limit, m: (
+            "the target was never found"
+            if v is None
+            else f"target first found at {v:.2f} s (limit {limit} s)"
+        ),
+        limits=(0, _DAY, "s"),
+        outputs=("found",),
+        precondition=_never_in_view,
+    ),
+    Check(
+        "mean_distance_max_m",
+        "mean_distance_m",
+        "max",
+        "mean robot-to-target distance (centres) at most this",
+        lambda v, limit, m: (
+            f"mean distance {v} m (limit <= {limit} m)"
+            if v is not None
+            else f"{_NO_TARGET} (limit <= {limit} m)"
+        ),
+        limits=(0, 1000, "m"),
+    ),
+    Check(
+        "min_distance_min_m",
+        "min_distance_m",
+        "min",
+        "closest robot-to-target distance (centres) at least this",
+        lambda v, limit, m: (
+            f"min distance {v} m (limit >= {limit} m)"
+            if v is not None
+            else f"{_NO_TARGET} (limit >= {limit} m)"
+        ),
+        limits=(0, 1000, "m"),
+    ),
     _collisions("person", "at most this many collisions with a person"),
-    Check("max_robot_at_fault_collisions", "robot_at_fault_collisions", "max",
-          ("at most this many times the robot drove into a person (at the first touch it closed "
-           "the gap faster than the person and than sim.world.AT_FAULT_SPEED)"),
-          lambda v, limit, m: f"the robot drove into a person {v} time(s) (limit {limit})",
-          kind=int, limits=_COUNT),
-    Check("max_tip_overs", "tip_overs", "max",
-          "the robot tipped over at most this often (0: never; sim.world tip-over model)",
-          _tipped, kind=int, limits=(0, 1, "")),
-    Check("max_oscillation_hz", "oscillation_hz", "max",
-          ("the commanded turn rate W changes sign at most this often per second while the "
-           "target is centred"),
-          lambda v, limit, m: (f"W changes sign {v:.2f} times per second with the target "
-                               f"centred (limit {limit})"),
-          limits=(0, 1000, "Hz"), outputs=("found", "centroid_x"),
-          precondition=measured("oscillation_hz", "the target was never centred")),
-    Check("max_off_target_fraction", "off_target_fraction", "max",
-          ("the design's centroid is more than an eighth of the image width from the target's "
-           "image column in at most this fraction of the frames in which it reports found "
-           "with the target's centre in view (a non-target object taken for the target)"),
-          lambda v, limit, m: (f"centroid away from the target in {v:.0%} of the frames with "
-                               f"the target found and in view (limit <= {limit:.0%})"),
-          limits=_FRACTION, outputs=("found", "centroid_x"),
-          precondition=measured("off_target_fraction", "the design never reported the target "
-                                                       "found with it in view")),
-    Check("mean_centroid_error_max_px", "mean_centroid_error_px", "max",
-          ("mean distance of the design's centroid from the target's image column (frames "
-           "found with the target's centre in view) at most this; with the target straight "
-           "ahead, the centroid's distance from the image centre"),
-          lambda v, limit, m: (f"centroid {v:.2f} px from the target's image column on "
-                               f"average (limit <= {limit} px)"),
-          limits=(0, 10000, "px"), outputs=("found", "centroid_x"),
-          precondition=measured("mean_centroid_error_px", "the design never reported the "
-                                                          "target found with it in view")),
-    Check("max_led_wrong_side_fraction", "led_wrong_side_fraction", "max",
-          ("the design's centroid LEDs point the wrong way (an LED of the other half lit with "
-           "the target an eighth of the width or more to one side, an outermost LED lit with "
-           "it within a sixteenth of the centre) in at most this fraction of the frames found "
-           "with the target in view (led_wrong_side_fraction)"),
-          lambda v, limit, m: (f"centroid LEDs point the wrong way in {v:.0%} of the frames "
-                               f"judged (limit <= {limit:.0%})"),
-          limits=_FRACTION, outputs=("found", "centroid_leds"),
-          precondition=measured("led_wrong_side_fraction", "the target was never found to "
-                                                           "one side or at the centre")),
-    Check("max_led_misplaced_fraction", "led_misplaced_fraction", "max",
-          ("the lit centroid LEDs are not the one above the target (the LED of the window's "
-           "eighth that holds the target's image column; near a border between eighths either "
-           "neighbour, near the image centre also the middle pair) in at most this fraction of "
-           "the frames found with the target's centre inside the window "
-           "(led_misplaced_fraction)"),
-          lambda v, limit, m: (f"the lit LEDs are not the one above the target in {v:.1%} of "
-                               f"the frames judged (limit <= {limit:.1%})"),
-          limits=_FRACTION, outputs=("found", "centroid_leds"),
-          precondition=measured("led_misplaced_fraction",
-                                "the target was never found inside the window")),
-    Check("max_wheel_command_dps", "peak_wheel_command_dps", "max",
-          ("the design never commands a wheel faster than this, either way "
-           "(peak_wheel_command_dps): the speed the motors are rated for"),
-          lambda v, limit, m: f"largest wheel command {v} DPS (limit <= {limit:g} DPS)",
-          limits=(0, 32768, "DPS"), outputs=("motor_left", "motor_right"),
-          precondition=measured("peak_wheel_command_dps", "no wheel command")),
-    Check("max_search_travel_m", "search_travel_m", "max",
-          ("while the design searches (from a search started to the target found again) the "
-           "robot's centre travels at most this far: it turns in place (search_travel_m)"),
-          lambda v, limit, m: (f"the robot travelled {v:.2f} m during a search "
-                               f"(limit <= {limit} m)"),
-          limits=(0, 1000, "m"), outputs=("found",),
-          precondition=measured("search_travel_m", "the design never searched")),
-    Check("max_heading_overshoot_deg", "heading_overshoot_deg", "max",
-          "the robot turns at most this far past the target (heading_overshoot_deg)",
-          lambda v, limit, m: f"turned {v:.1f} deg past the target (limit <= {limit} deg)",
-          limits=(0, 180, "deg"),
-          precondition=measured("heading_overshoot_deg", "no heading to compare")),
+    Check(
+        "max_robot_at_fault_collisions",
+        "robot_at_fault_collisions",
+        "max",
+        (
+            "at most this many times the robot drove into a person (at the first touch it closed "
+            "the gap faster than the person and than sim.world.AT_FAULT_SPEED)"
+        ),
+        lambda v, limit, m: f"the robot drove into a person {v} time(s) (limit {limit})",
+        kind=int,
+        limits=_COUNT,
+    ),
+    Check(
+        "max_tip_overs",
+        "tip_overs",
+        "max",
+        "the robot tipped over at most this often (0: never; sim.world tip-over model)",
+        _tipped,
+        kind=int,
+        limits=(0, 1, ""),
+    ),
+    Check(
+        "max_oscillation_hz",
+        "oscillation_hz",
+        "max",
+        (
+            "the commanded turn rate W changes sign at most this often per second while the "
+            "target is centred"
+        ),
+        lambda v, limit, m: (
+            f"W changes sign {v:.2f} times per second with the target centred (limit {limit})"
+        ),
+        limits=(0, 1000, "Hz"),
+        outputs=("found", "centroid_x"),
+        precondition=measured("oscillation_hz", "the target was never centred"),
+    ),
+    Check(
+        "max_off_target_fraction",
+        "off_target_fraction",
+        "max",
+        (
+            "the design's centroid is more than an eighth of the image width from the target's "
+            "image column in at most this fraction of the frames in which it reports found "
+            "with the target's centre in view (a non-target object taken for the target)"
+        ),
+        lambda v, limit, m: (
+            f"centroid away from the target in {v:.0%} of the frames with "
+            f"the target found and in view (limit <= {limit:.0%})"
+        ),
+        limits=_FRACTION,
+        outputs=("found", "centroid_x"),
+        precondition=measured(
+            "off_target_fraction", "the design never reported the target found with it in view"
+        ),
+    ),
+    Check(
+        "mean_centroid_error_max_px",
+        "mean_centroid_error_px",
+        "max",
+        (
+            "mean distance of the design's centroid from the target's image column (frames "
+            "found with the target's centre in view) at most this; with the target straight "
+            "ahead, the centroid's distance from the image centre"
+        ),
+        lambda v, limit, m: (
+            f"centroid {v:.2f} px from the target's image column on average (limit <= {limit} px)"
+        ),
+        limits=(0, 10000, "px"),
+        outputs=("found", "centroid_x"),
+        precondition=measured(
+            "mean_centroid_error_px", "the design never reported the target found with it in view"
+        ),
+    ),
+    Check(
+        "max_led_wrong_side_fraction",
+        "led_wrong_side_fraction",
+        "max",
+        (
+            "the design's centroid LEDs point the wrong way (an LED of the other half lit with "
+            "the target an eighth of the width or more to one side, an outermost LED lit with "
+            "it within a sixteenth of the centre) in at most this fraction of the frames found "
+            "with the target in view (led_wrong_side_fraction)"
+        ),
+        lambda v, limit, m: (
+            f"centroid LEDs point the wrong way in {v:.0%} of the frames "
+            f"judged (limit <= {limit:.0%})"
+        ),
+        limits=_FRACTION,
+        outputs=("found", "centroid_leds"),
+        precondition=measured(
+            "led_wrong_side_fraction", "the target was never found to one side or at the centre"
+        ),
+    ),
+    Check(
+        "max_led_misplaced_fraction",
+        "led_misplaced_fraction",
+        "max",
+        (
+            "the lit centroid LEDs are not the one above the target (the LED of the window's "
+            "eighth that holds the target's image column; near a border between eighths either "
+            "neighbour, near the image centre also the middle pair) in at most this fraction of "
+            "the frames found with the target's centre inside the window "
+            "(led_misplaced_fraction)"
+        ),
+        lambda v, limit, m: (
+            f"the lit LEDs are not the one above the target in {v:.1%} of "
+            f"the frames judged (limit <= {limit:.1%})"
+        ),
+        limits=_FRACTION,
+        outputs=("found", "centroid_leds"),
+        precondition=measured(
+            "led_misplaced_fraction", "the target was never found inside the window"
+        ),
+    ),
+    Check(
+        "max_wheel_command_dps",
+        "peak_wheel_command_dps",
+        "max",
+        (
+            "the design never commands a wheel faster than this, either way "
+            "(peak_wheel_command_dps): the speed the motors are rated for"
+        ),
+        lambda v, limit, m: f"largest wheel command {v} DPS (limit <= {limit:g} DPS)",
+        limits=(0, 32768, "DPS"),
+        outputs=("motor_left", "motor_right"),
+        precondition=measured("peak_wheel_command_dps", "no wheel command"),
+    ),
+    Check(
+        "max_search_travel_m",
+        "search_travel_m",
+        "max",
+        (
+            "while the design searches (from a search started to the target found again) the "
+            "robot's centre travels at most this far: it turns in place (search_travel_m)"
+        ),
+        lambda v, limit, m: f"the robot travelled {v:.2f} m during a search (limit <= {limit} m)",
+        limits=(0, 1000, "m"),
+        outputs=("found",),
+        precondition=measured("search_travel_m", "the design never searched"),
+    ),
+    Check(
+        "max_heading_overshoot_deg",
+        "heading_overshoot_deg",
+        "max",
+        "the robot turns at most this far past the target (heading_overshoot_deg)",
+        lambda v, limit, m: f"turned {v:.1f} deg past the target (limit <= {limit} deg)",
+        limits=(0, 180, "deg"),
+        precondition=measured("heading_overshoot_deg", "no heading to compare"),
+    ),
     _collisions("wall", "at most this many collisions with a wall"),
     _collisions("furniture", "at most this many collisions with furniture"),
-    Check("target_in_view_min_fraction", "target_in_view_fraction", "min",
-          "the target is in the camera's view this often",
-          lambda v, limit, m: f"target in view {v:.0%} of frames (limit >= {limit:.0%})",
-          limits=_FRACTION),
-    Check("found_min_fraction", "found_after_acquisition_fraction", "min",
-          "after first acquisition, the design reports found this often",
-          lambda v, limit, m: (f"found in {v:.0%} of frames after acquisition "
-                               f"(limit >= {limit:.0%})"),
-          limits=_FRACTION, outputs=("found",), precondition=_never_in_view,
-          passes=_found_fraction),
-    Check("reacquired_within_s", _reacquire_time, "max",
-          ("the design lost the target and searched at least once, and every loss ended with "
-           "the target found again within this time"),
-          _reacquired_text, limits=(0, _DAY, "s"), outputs=("found",),
-          precondition=lambda m: ("the target was never lost long enough for the design to "
-                                  "search" if m.get("searched_losses") == 0 else None),
-          passes=_reacquired),
+    Check(
+        "target_in_view_min_fraction",
+        "target_in_view_fraction",
+        "min",
+        "the target is in the camera's view this often",
+        lambda v, limit, m: f"target in view {v:.0%} of frames (limit >= {limit:.0%})",
+        limits=_FRACTION,
+    ),
+    Check(
+        "found_min_fraction",
+        "found_after_acquisition_fraction",
+        "min",
+        "after first acquisition, the design reports found this often",
+        lambda v, limit, m: f"found in {v:.0%} of frames after acquisition (limit >= {limit:.0%})",
+        limits=_FRACTION,
+        outputs=("found",),
+        precondition=_never_in_view,
+        passes=_found_fraction,
+    ),
+    Check(
+        "reacquired_within_s",
+        _reacquire_time,
+        "max",
+        (
+            "the design lost the target and searched at least once, and every loss ended with "
+            "the target found again within this time"
+        ),
+        _reacquired_text,
+        limits=(0, _DAY, "s"),
+        outputs=("found",),
+        precondition=lambda m: (
+            "the target was never lost long enough for the design to search"
+            if m.get("searched_losses") == 0
+            else None
+        ),
+        passes=_reacquired,
+    ),
     # The sensor designs' checks (fpga_robotics.checks.sensor_metrics).
-    Check("max_lateral_error_m", "lateral_error_max_m", "max",
-          ("the line sensors' centre stays within this distance of the nearest floor line's "
-           "centreline"),
-          lambda v, limit, m: (f"line sensors at most {v:.3f} m from the line (mean "
-                               f"{m['lateral_error_mean_m']:.3f} m; limit {limit} m)"),
-          limits=(0, 100, "m"), precondition=measured("lateral_error_max_m", _NO_LINE)),
-    Check("min_laps", "laps", "min",
-          "at least this many whole laps of the closed floor line",
-          lambda v, limit, m: f"{v} whole lap(s) of the track (limit >= {limit})",
-          kind=int, limits=_COUNT, precondition=measured("laps", _NO_LINE)),
-    Check("max_off_line_s", "off_line_s", "max",
-          "at most this long in all with no line sensor over a floor line",
-          lambda v, limit, m: f"{v:.2f} s with no line sensor over the line (limit {limit} s)",
-          limits=(0, _DAY, "s"), precondition=measured("off_line_s", _NO_LINE)),
-    Check("resumes_within_s", "resumed_after_s", "max",
-          (f"after the last piece of furniture is removed, the robot closes "
-           f"{RESUME_CLOSING_M} m on the target within this time"),
-          _resumed_text, limits=(0, _DAY, "s"),
-          precondition=measured("obstacle_removed_at_s", "no furniture was removed during the "
-                                "run (room.furniture.present_until)")),
-    Check("min_measured_frames", "measured_frames_min", "min",
-          ("every measuring sensor of the robot ([[robot.sensors]]) gives a measurement in at "
-           "least this many frames (1: the sensor is not silent)"),
-          _measured_text, kind=int, limits=(0, 10**7, ""),
-          precondition=measured("measured_frames_min",
-                                "the robot has no sensor that measures ([[robot.sensors]])")),
+    Check(
+        "max_lateral_error_m",
+        "lateral_error_max_m",
+        "max",
+        (
+            "the line sensors' centre stays within this distance of the nearest floor line's "
+            "centreline"
+        ),
+        lambda v, limit, m: (
+            f"line sensors at most {v:.3f} m from the line (mean "
+            f"{m['lateral_error_mean_m']:.3f} m; limit {limit} m)"
+        ),
+        limits=(0, 100, "m"),
+        precondition=measured("lateral_error_max_m", _NO_LINE),
+    ),
+    Check(
+        "min_laps",
+        "laps",
+        "min",
+        "at least this many whole laps of the closed floor line",
+        lambda v, limit, m: f"{v} whole lap(s) of the track (limit >= {limit})",
+        kind=int,
+        limits=_COUNT,
+        precondition=measured("laps", _NO_LINE),
+    ),
+    Check(
+        "max_off_line_s",
+        "off_line_s",
+        "max",
+        "at most this long in all with no line sensor over a floor line",
+        lambda v, limit, m: f"{v:.2f} s with no line sensor over the line (limit {limit} s)",
+        limits=(0, _DAY, "s"),
+        precondition=measured("off_line_s", _NO_LINE),
+    ),
+    Check(
+        "resumes_within_s",
+        "resumed_after_s",
+        "max",
+        (
+            f"after the last piece of furniture is removed, the robot closes "
+            f"{RESUME_CLOSING_M} m on the target within this time"
+        ),
+        _resumed_text,
+        limits=(0, _DAY, "s"),
+        precondition=measured(
+            "obstacle_removed_at_s",
+            "no furniture was removed during the run (room.furniture.present_until)",
+        ),
+    ),
+    Check(
+        "min_measured_frames",
+        "measured_frames_min",
+        "min",
+        (
+            "every measuring sensor of the robot ([[robot.sensors]]) gives a measurement in at "
+            "least this many frames (1: the sensor is not silent)"
+        ),
+        _measured_text,
+        kind=int,
+        limits=(0, 10**7, ""),
+        precondition=measured(
+            "measured_frames_min", "the robot has no sensor that measures ([[robot.sensors]])"
+        ),
+    ),
     # Behaviour envelopes (fpga_robotics.checks.envelopes).
-    Check("max_approach_speed_violation_fraction", "approach_speed_violation_fraction", "max",
-          ("with the target found and centred, the commanded forward speed (L + R) / 2 is "
-           "outside the law's speed for the target's distance (base_dps of the proximity "
-           f"levels its pixel count can reach there) in at most this fraction of the frames {_BAND}"),
-          lambda v, limit, m: (f"forward speed outside the approach law in {v:.1%} of the "
-                               f"centred frames (limit <= {limit:.1%})"),
-          limits=_FRACTION, outputs=_WHEELS,
-          precondition=_envelope("approach_speed_violation_fraction",
-                                 "the target was never found centred and wholly in the window")),
-    Check("max_reverse_when_far_fraction", "reverse_when_far_fraction", "max",
-          ("the robot is commanded backwards while the target is farther than the distance at "
-           "which the law reverses, in at most this fraction of the frames found there "
-           f"{_BAND}"),
-          lambda v, limit, m: (f"reversing with the target beyond the reversing distance in "
-                               f"{v:.1%} of those frames (limit <= {limit:.1%})"),
-          limits=_FRACTION, outputs=_WHEELS,
-          precondition=_envelope("reverse_when_far_fraction",
-                                 "the target was never found beyond the reversing distance")),
-    Check("max_stop_overshoot_m", "stop_overshoot_m", "max",
-          ("the robot comes at most this much closer to the target than the distance within "
-           "which the law surely says stop or reverse (the stop distance) "
-           f"{_BAND}"),
-          lambda v, limit, m: (f"came {v:.3f} m inside the stop distance "
-                               f"(limit <= {limit} m)"),
-          limits=(0, 100, "m"), outputs=_WHEELS,
-          precondition=_envelope("stop_overshoot_m",
-                                 "the robot never came near the stop distance")),
-    Check("max_turn_law_violation_fraction", "turn_law_violation_fraction", "max",
-          ("with the target found wholly in the window, the commanded turn (L - R) / 2 is "
-           "outside kp * (the target's column - the image centre), saturating at max_dps, "
-           f"in at most this fraction of the frames {_BAND}"),
-          lambda v, limit, m: (f"turn outside the steering law in {v:.1%} of the frames "
-                               f"judged (limit <= {limit:.1%})"),
-          limits=_FRACTION, outputs=_WHEELS,
-          precondition=_envelope("turn_law_violation_fraction",
-                                 "the target was never found wholly in the window")),
-    Check("max_search_law_violation_fraction", "search_law_violation_fraction", "max",
-          ("with the target lost, the design holds its last command for lost_frames - 1 "
-           "frames, then turns in place at search_dps towards the side the target was last "
-           f"seen on, in all but at most this fraction of the lost frames {_BAND}"),
-          lambda v, limit, m: (f"lost/search command off the law in {v:.1%} of the lost "
-                               f"frames judged (limit <= {limit:.1%})"),
-          limits=_FRACTION, outputs=_WHEELS,
-          precondition=_envelope("search_law_violation_fraction",
-                                 "the target was never lost")),
+    Check(
+        "max_approach_speed_violation_fraction",
+        "approach_speed_violation_fraction",
+        "max",
+        (
+            "with the target found and centred, the commanded forward speed (L + R) / 2 is "
+            "outside the law's speed for the target's distance (base_dps of the proximity "
+            f"levels its pixel count can reach there) in at most this fraction of the frames {_BAND}"
+        ),
+        lambda v, limit, m: (
+            f"forward speed outside the approach law in {v:.1%} of the "
+            f"centred frames (limit <= {limit:.1%})"
+        ),
+        limits=_FRACTION,
+        outputs=_WHEELS,
+        precondition=_envelope(
+            "approach_speed_violation_fraction",
+            "the target was never found centred and wholly in the window",
+        ),
+    ),
+    Check(
+        "max_reverse_when_far_fraction",
+        "reverse_when_far_fraction",
+        "max",
+        (
+            "the robot is commanded backwards while the target is farther than the distance at "
+            "which the law reverses, in at most this fraction of the frames found there "
+            f"{_BAND}"
+        ),
+        lambda v, limit, m: (
+            f"reversing with the target beyond the reversing distance in "
+            f"{v:.1%} of those frames (limit <= {limit:.1%})"
+        ),
+        limits=_FRACTION,
+        outputs=_WHEELS,
+        precondition=_envelope(
+            "reverse_when_far_fraction", "the target was never found beyond the reversing distance"
+        ),
+    ),
+    Check(
+        "max_stop_overshoot_m",
+        "stop_overshoot_m",
+        "max",
+        (
+            "the robot comes at most this much closer to the target than the distance within "
+            "which the law surely says stop or reverse (the stop distance) "
+            f"{_BAND}"
+        ),
+        lambda v, limit, m: f"came {v:.3f} m inside the stop distance (limit <= {limit} m)",
+        limits=(0, 100, "m"),
+        outputs=_WHEELS,
+        precondition=_envelope("stop_overshoot_m", "the robot never came near the stop distance"),
+    ),
+    Check(
+        "max_turn_law_violation_fraction",
+        "turn_law_violation_fraction",
+        "max",
+        (
+            "with the target found wholly in the window, the commanded turn (L - R) / 2 is "
+            "outside kp * (the target's column - the image centre), saturating at max_dps, "
+            f"in at most this fraction of the frames {_BAND}"
+        ),
+        lambda v, limit, m: (
+            f"turn outside the steering law in {v:.1%} of the frames judged (limit <= {limit:.1%})"
+        ),
+        limits=_FRACTION,
+        outputs=_WHEELS,
+        precondition=_envelope(
+            "turn_law_violation_fraction", "the target was never found wholly in the window"
+        ),
+    ),
+    Check(
+        "max_search_law_violation_fraction",
+        "search_law_violation_fraction",
+        "max",
+        (
+            "with the target lost, the design holds its last command for lost_frames - 1 "
+            "frames, then turns in place at search_dps towards the side the target was last "
+            f"seen on, in all but at most this fraction of the lost frames {_BAND}"
+        ),
+        lambda v, limit, m: (
+            f"lost/search command off the law in {v:.1%} of the lost "
+            f"frames judged (limit <= {limit:.1%})"
+        ),
+        limits=_FRACTION,
+        outputs=_WHEELS,
+        precondition=_envelope("search_law_violation_fraction", "the target was never lost"),
+    ),
 )

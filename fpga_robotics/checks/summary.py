@@ -45,7 +45,11 @@ _METRIC_OUTPUTS = {
 
 #: Summary fields that depend on the machine, not on the simulation.
 TIMING_FIELDS = (
-    "wall_time_s", "ms_per_frame", "realtime_factor", "cpu_ms_per_frame", "backend_setup_s",
+    "wall_time_s",
+    "ms_per_frame",
+    "realtime_factor",
+    "cpu_ms_per_frame",
+    "backend_setup_s",
     "cycles_per_wall_s",
 )
 
@@ -62,8 +66,18 @@ OFF_TARGET_FRACTION = 0.125
 CENTRED_FRACTION = 0.125
 
 
-def compute_metrics(traj, events, collisions, frame_period, *, at_fault_collisions=0,
-                    width=None, absent=(), margin_x=None, collision_summary=None):
+def compute_metrics(
+    traj,
+    events,
+    collisions,
+    frame_period,
+    *,
+    at_fault_collisions=0,
+    width=None,
+    absent=(),
+    margin_x=None,
+    collision_summary=None,
+):
     """Reduce a run to numbers.
 
     Parameters
@@ -93,9 +107,16 @@ def compute_metrics(traj, events, collisions, frame_period, *, at_fault_collisio
         present = {k: v for k, v in traj.items() if k not in absent}
         if "found" in absent:  # the metrics below read it; theirs are replaced by None
             present["found"] = np.zeros(len(traj["t"]), bool)
-        m = compute_metrics(present, events, collisions, frame_period,
-                            at_fault_collisions=at_fault_collisions, width=width,
-                            margin_x=margin_x, collision_summary=collision_summary)
+        m = compute_metrics(
+            present,
+            events,
+            collisions,
+            frame_period,
+            at_fault_collisions=at_fault_collisions,
+            width=width,
+            margin_x=margin_x,
+            collision_summary=collision_summary,
+        )
         for name, needs in _METRIC_OUTPUTS.items():
             if any(o in absent for o in needs):
                 m[name] = None
@@ -198,8 +219,10 @@ def _off_target(traj, width):
     if not ok.any():
         return none
     err = np.abs(np.asarray(traj["centroid_x"], dtype=float)[ok] - column[ok])
-    return {"off_target_fraction": _round((err > OFF_TARGET_FRACTION * width).mean()),
-            "mean_centroid_error_px": _round(err.mean(), 2)}
+    return {
+        "off_target_fraction": _round((err > OFF_TARGET_FRACTION * width).mean()),
+        "mean_centroid_error_px": _round(err.mean(), 2),
+    }
 
 
 #: The target is on one side when its image column is at least this fraction of the image
@@ -321,8 +344,9 @@ def _oscillation(traj, width, seconds):
     if width is None or "cmd_w" not in traj or "centroid_x" not in traj or seconds <= 0:
         return None
     w = np.asarray(traj["cmd_w"], dtype=float)
-    centred = traj["found"] & (np.abs(np.asarray(traj["centroid_x"]) - width / 2)
-                               <= CENTRED_FRACTION * width)
+    centred = traj["found"] & (
+        np.abs(np.asarray(traj["centroid_x"]) - width / 2) <= CENTRED_FRACTION * width
+    )
     if not centred.any():
         return None
     flips, last = 0, 0.0
@@ -340,36 +364,52 @@ def format_summary(s):
     rtf = s["realtime_factor"]
     lines = [
         f"scenario {s['scenario']}  backend {s['backend']}  {s['resolution']}  seed {s['seed']}",
-        (f"  {s['frames']} frames, {s['sim_time_s']:.1f} s simulated in {s['wall_time_s']:.2f} s"
-        f" ({s['ms_per_frame']:.2f} ms/frame, "
-        f"{f'{rtf:.1f}x' if rtf is not None else 'n/a'} real time)"),
+        (
+            f"  {s['frames']} frames, {s['sim_time_s']:.1f} s simulated in {s['wall_time_s']:.2f} s"
+            f" ({s['ms_per_frame']:.2f} ms/frame, "
+            f"{f'{rtf:.1f}x' if rtf is not None else 'n/a'} real time)"
+        ),
     ]
     if s.get("timing") is not None:
         rate = s.get("cycles_per_wall_s")
         rate = f", {rate / 1e6:.1f} M/s of wall time" if rate else ""
-        clock = (f"real clock at {s['clock_hz'] / 1e6:g} MHz" if s["timing"] == "real_clock"
-                 else "compressed (clocked while pixels flow)")
+        clock = (
+            f"real clock at {s['clock_hz'] / 1e6:g} MHz"
+            if s["timing"] == "real_clock"
+            else "compressed (clocked while pixels flow)"
+        )
         lines.append(f"  timing: {clock}; {s['sim_cycles']:,} design cycles{rate}")
     if s.get("ended_early"):
         lines.append(f"  run ended early: {s['ended_early']}")
     if s.get("absent_outputs"):
-        lines.append("  design outputs absent (not produced by the design): "
-                     + ", ".join(s["absent_outputs"]))
+        lines.append(
+            "  design outputs absent (not produced by the design): "
+            + ", ".join(s["absent_outputs"])
+        )
     acq = s["acquired_at_s"]
-    found = (f"{s['found_fraction']:.0%}" if s["found_fraction"] is not None
-             else "n/a (no `found` output)")
+    found = (
+        f"{s['found_fraction']:.0%}"
+        if s["found_fraction"] is not None
+        else "n/a (no `found` output)"
+    )
     searches = s["searches"] if s["searches"] is not None else "n/a"
     # Without a target person every distance is missing (the trajectory holds NaN).
     if s["min_distance_m"] is None:
         lines.append(
             f"  target: none in the scenario (the design reported found in "
-            f"{found} of frames, {searches} search(es))")
+            f"{found} of frames, {searches} search(es))"
+        )
         lines.append(f"  distance: n/a (no target person); path {s['path_length_m']:.1f} m")
     else:
         lines.append(
             "  target: "
-            + (f"first found at {acq:.2f} s" if acq is not None
-               else "never found" if s["found_fraction"] is not None else "acquisition n/a")
+            + (
+                f"first found at {acq:.2f} s"
+                if acq is not None
+                else "never found"
+                if s["found_fraction"] is not None
+                else "acquisition n/a"
+            )
             + f", in view {s['target_in_view_fraction']:.0%}, found {found}"
             + f", {searches} search(es)"
         )
@@ -380,10 +420,12 @@ def format_summary(s):
     coll = ", ".join(f"{k} {v}" for k, v in s["collisions"].items()) or "none"
     lines.append(f"  collisions: {coll}")
     if s.get("silent_sensors"):
-        lines.append("  warning: no measurement at all from sensor(s) "
-                     + ", ".join(s["silent_sensors"])
-                     + " (the checks that need them are n/a; checks.min_measured_frames "
-                       "fails such a run)")
+        lines.append(
+            "  warning: no measurement at all from sensor(s) "
+            + ", ".join(s["silent_sensors"])
+            + " (the checks that need them are n/a; checks.min_measured_frames "
+            "fails such a run)"
+        )
     for c in s["checks"]:
         mark = {True: "ok", False: "FAIL", None: "n/a"}[c["passed"]]
         lines.append(f"  [{mark}] {c['name']}: {c['text']}")

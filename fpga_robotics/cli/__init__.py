@@ -31,24 +31,41 @@ __all__ = ["BENCHMARKS", "COMMANDS", "main", "run_command", "version"]
 
 #: Subcommand -> (module with ``main(argv, prog)``, one-line help).
 COMMANDS = {
-    "run": ("fpga_robotics.cli.run", "run a scenario in closed loop (or the design on real frames)"),
+    "run": (
+        "fpga_robotics.cli.run",
+        "run a scenario in closed loop (or the design on real frames)",
+    ),
     "export": ("fpga_robotics.cli.export", "write the design as one Verilog file"),
-    "board": ("fpga_robotics.cli.board",
-              "export a board top (Verilog + LPF) and build its bitstream"),
+    "board": (
+        "fpga_robotics.cli.board",
+        "export a board top (Verilog + LPF) and build its bitstream",
+    ),
     "bench": (None, "print speed figures (see `fpga-robotics bench --list`)"),
-    "designs": ("fpga_robotics.cli.designs",
-                "the designs a run can name: their ports and the connectors they bind"),
-    "ports": ("fpga_robotics.cli.ports",
-              "write (--example) or check a port map for run --design verilog:..."),
-    "mutate": ("fpga_robotics.cli.mutate",
-               "mutation coverage: Yosys mutants of the design against the golden model"),
-    "readback": ("fpga_robotics.cli.readback",
-                 "what a saved .rrd recording holds, entity by entity"),
-    "sweep": ("fpga_robotics.cli.sweep",
-              "a verification campaign: many runs on Dask, results table and report"),
+    "designs": (
+        "fpga_robotics.cli.designs",
+        "the designs a run can name: their ports and the connectors they bind",
+    ),
+    "ports": (
+        "fpga_robotics.cli.ports",
+        "write (--example) or check a port map for run --design verilog:...",
+    ),
+    "mutate": (
+        "fpga_robotics.cli.mutate",
+        "mutation coverage: Yosys mutants of the design against the golden model",
+    ),
+    "readback": (
+        "fpga_robotics.cli.readback",
+        "what a saved .rrd recording holds, entity by entity",
+    ),
+    "sweep": (
+        "fpga_robotics.cli.sweep",
+        "a verification campaign: many runs on Dask, results table and report",
+    ),
     "formal": ("fpga_robotics.cli.formal", "prove the gateware's promises (SymbiYosys, Yices)"),
-    "new": ("fpga_robotics.cli.new",
-            "write a project skeleton: a design, a scenario and a test that runs it"),
+    "new": (
+        "fpga_robotics.cli.new",
+        "write a project skeleton: a design, a scenario and a test that runs it",
+    ),
 }
 
 #: ``fpga-robotics bench WHAT`` -> (module, one-line help); the first is the default.
@@ -57,18 +74,24 @@ BENCHMARKS = {
     "pysim": ("fpga_robotics.bench.pysim", "Amaranth's simulator, checked against the model"),
     "camera": ("fpga_robotics.bench.camera", "the camera renderer"),
     "world": ("fpga_robotics.bench.world", "the physics of the robot world"),
-    "render3d": ("fpga_robotics.bench.render3d",
-                 "the raster and the 3D renderer, per frame and in the closed loop"),
+    "render3d": (
+        "fpga_robotics.bench.render3d",
+        "the raster and the 3D renderer, per frame and in the closed loop",
+    ),
     "viewer": ("fpga_robotics.bench.viewer", "the cost of logging to the rerun viewer"),
     "shadow": ("fpga_robotics.bench.shadow", "a shadow design's cost in the closed loop"),
     "loop": ("fpga_robotics.bench.loop", "where the closed loop's time goes, per frame"),
-    "foreign": ("fpga_robotics.bench.foreign",
-                "a Verilog design through a port map against the built-in Verilator backend"),
+    "foreign": (
+        "fpga_robotics.bench.foreign",
+        "a Verilog design through a port map against the built-in Verilator backend",
+    ),
     "ros": ("fpga_robotics.bench.ros", "writing a ROS 2 bag and publishing live to Foxglove"),
     "pins": ("fpga_robotics.bench.pins", "the pin backends in real-clock time (Mcycles/s)"),
     "sweep": ("fpga_robotics.bench.sweep", "campaign throughput on 1 worker and on N"),
-    "calibrate": ("fpga_robotics.bench.calibrate",
-                  "this machine's calibration frame time: divide a time by it to compare"),
+    "calibrate": (
+        "fpga_robotics.bench.calibrate",
+        "this machine's calibration frame time: divide a time by it to compare",
+    ),
 }
 
 PROG = "fpga-robotics"
@@ -82,13 +105,20 @@ def _listing(usage, heading, table):
 
 
 def _usage():
-    return _listing(f"usage: {PROG} COMMAND [options]   ({PROG} COMMAND --help for its options)"
-                    f"\n       {PROG} --version", "commands", COMMANDS)
+    return _listing(
+        f"usage: {PROG} COMMAND [options]   ({PROG} COMMAND --help for its options)"
+        f"\n       {PROG} --version",
+        "commands",
+        COMMANDS,
+    )
 
 
 def _bench_list():
-    return _listing(f"usage: {PROG} bench [WHAT] [options]   (WHAT defaults to design)",
-                    "benchmarks", BENCHMARKS)
+    return _listing(
+        f"usage: {PROG} bench [WHAT] [options]   (WHAT defaults to design)",
+        "benchmarks",
+        BENCHMARKS,
+    )
 
 
 def version():
@@ -130,8 +160,10 @@ def main(argv=None):
         sys.exit(USAGE_EXIT)
     command, rest = argv[0], argv[1:]
     if command not in COMMANDS:
-        print(f"{PROG}: error: unknown command {command!r}; choose one of: "
-              f"{', '.join(COMMANDS)}", file=sys.stderr)
+        print(
+            f"{PROG}: error: unknown command {command!r}; choose one of: {', '.join(COMMANDS)}",
+            file=sys.stderr,
+        )
         sys.exit(USAGE_EXIT)
     if command == "bench":
         if rest[:1] == ["--list"]:
@@ -139,8 +171,11 @@ def main(argv=None):
             sys.exit(0)
         what = rest[0] if rest and not rest[0].startswith("-") else "design"
         if what not in BENCHMARKS:
-            print(f"{PROG}: error: unknown benchmark {what!r}; choose one of: "
-                  f"{', '.join(BENCHMARKS)}", file=sys.stderr)
+            print(
+                f"{PROG}: error: unknown benchmark {what!r}; choose one of: "
+                f"{', '.join(BENCHMARKS)}",
+                file=sys.stderr,
+            )
             sys.exit(USAGE_EXIT)
         if rest and rest[0] == what:
             rest = rest[1:]

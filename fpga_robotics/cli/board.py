@@ -16,12 +16,22 @@ __all__ = ["add_board_arguments", "main", "run_board"]
 
 def add_board_arguments(parser):
     """The ``--board``/``--bitstream``/``--seed`` options (shared with ``export``)."""
-    parser.add_argument("--board", metavar="NAME",
-                        help=f"export a board top instead: one of {', '.join(board_names())}")
-    parser.add_argument("--bitstream", action="store_true",
-                        help="with --board: also run synthesis, place and route and packing")
-    parser.add_argument("--seed", type=int, default=None,
-                        help="with --bitstream: nextpnr placement seed (default: 1)")
+    parser.add_argument(
+        "--board",
+        metavar="NAME",
+        help=f"export a board top instead: one of {', '.join(board_names())}",
+    )
+    parser.add_argument(
+        "--bitstream",
+        action="store_true",
+        help="with --board: also run synthesis, place and route and packing",
+    )
+    parser.add_argument(
+        "--seed",
+        type=int,
+        default=None,
+        help="with --bitstream: nextpnr placement seed (default: 1)",
+    )
 
 
 def run_board(args, params, out_dir, prog="fpga-robotics board"):
@@ -45,8 +55,7 @@ def run_board(args, params, out_dir, prog="fpga-robotics board"):
         return 1
     print(report.format())
     if not report.timing_ok:
-        print(f"{prog}: error: timing failed (a clock is slower than required)",
-              file=sys.stderr)
+        print(f"{prog}: error: timing failed (a clock is slower than required)", file=sys.stderr)
         return 1
     print(f"wrote {report.bitstream}")
     return 0
@@ -59,13 +68,23 @@ def main(argv=None, prog="fpga-robotics board"):
     )
     boards = board_names()
     # With one board there is nothing to choose: it is the default.
-    parser.add_argument("--board", metavar="NAME", required=len(boards) > 1,
-                        default=boards[0] if len(boards) == 1 else None,
-                        help=f"one of {', '.join(boards)}")
-    parser.add_argument("-o", "--output", metavar="DIR", default=None,
-                        help="output directory (default: build/<board>)")
-    parser.add_argument("--bitstream", action="store_true",
-                        help="run synthesis, place and route and packing too")
+    parser.add_argument(
+        "--board",
+        metavar="NAME",
+        required=len(boards) > 1,
+        default=boards[0] if len(boards) == 1 else None,
+        help=f"one of {', '.join(boards)}",
+    )
+    parser.add_argument(
+        "-o",
+        "--output",
+        metavar="DIR",
+        default=None,
+        help="output directory (default: build/<board>)",
+    )
+    parser.add_argument(
+        "--bitstream", action="store_true", help="run synthesis, place and route and packing too"
+    )
     parser.add_argument("--seed", type=int, default=None, help="nextpnr seed (default: 1)")
     add_param_arguments(parser)
     args = parser.parse_args(argv)

@@ -12,13 +12,25 @@ __all__ = ["describe", "main"]
 
 def build_parser(prog):
     p = argparse.ArgumentParser(
-        prog=prog, description="List the designs a scenario's design.top (or run --design) can "
-                               "name, with their ports and the connectors they bind.")
-    p.add_argument("reference", nargs="?", metavar="REF",
-                   help="describe only this design: a built-in name, FILE.py:Name, "
-                        "package.module:Name or verilog:TOP.v[,MORE.v] with --ports")
-    p.add_argument("--param", dest="params", action="append", default=[], metavar="NAME=VALUE",
-                   help="a parameter of REF (repeatable; TOML values)")
+        prog=prog,
+        description="List the designs a scenario's design.top (or run --design) can "
+        "name, with their ports and the connectors they bind.",
+    )
+    p.add_argument(
+        "reference",
+        nargs="?",
+        metavar="REF",
+        help="describe only this design: a built-in name, FILE.py:Name, "
+        "package.module:Name or verilog:TOP.v[,MORE.v] with --ports",
+    )
+    p.add_argument(
+        "--param",
+        dest="params",
+        action="append",
+        default=[],
+        metavar="NAME=VALUE",
+        help="a parameter of REF (repeatable; TOML values)",
+    )
     p.add_argument("--ports", metavar="PORTS.toml", help="the port map of a verilog: REF")
     return p
 
@@ -42,13 +54,13 @@ def describe(spec, origin):
     """Lines describing a ``DesignSpec``."""
     lines = [f"{spec.reference}  ({origin})  {spec.description}"]
     if spec.ports:
-        lines.append("  ports: " + ", ".join(f"{d} {n}[{w}]" for n, (d, w) in
-                                             spec.ports.items()))
+        lines.append("  ports: " + ", ".join(f"{d} {n}[{w}]" for n, (d, w) in spec.ports.items()))
     else:
-        lines.append("  ports: as Verilator reads them from the files (the port map names "
-                     "them)")
-    binds = "; ".join(f"{kind} ({', '.join(f'{pin}={port}' for pin, port in pins.items())})"
-                      for kind, pins in spec.bindings.items())
+        lines.append("  ports: as Verilator reads them from the files (the port map names them)")
+    binds = "; ".join(
+        f"{kind} ({', '.join(f'{pin}={port}' for pin, port in pins.items())})"
+        for kind, pins in spec.bindings.items()
+    )
     lines.append(f"  connectors: {binds or 'none'}")
     lines.append(f"  recorded outputs: {', '.join(spec.extra_outputs) or 'none'}")
     return lines
@@ -66,17 +78,18 @@ def checked_verilog(spec, ports):
     from fpga_robotics.sim.backends.foreign import ForeignDesign
     from fpga_robotics.sim.backends.port_map import load_port_map
 
-    files = spec.reference[len("verilog:"):].split(",")
+    files = spec.reference[len("verilog:") :].split(",")
     port_map = load_port_map(ports)
     pins = bool(port_map.connectors or port_map.extra_outputs or not port_map.has_pixels)
     try:
         design = ForeignDesign(files, port_map, pins=pins, connector_kinds=connector_kinds())
     except BackendError as exc:
         raise DesignError(f"{ports}: {exc}".splitlines()[0]) from None
-    found = {name: ("in" if d == "input" else "out", width)
-             for name, (d, width, _signed) in design.ports.items()}
-    return dataclasses.replace(spec, ports=found,
-                               extra_outputs=tuple(port_map.extra_outputs))
+    found = {
+        name: ("in" if d == "input" else "out", width)
+        for name, (d, width, _signed) in design.ports.items()
+    }
+    return dataclasses.replace(spec, ports=found, extra_outputs=tuple(port_map.extra_outputs))
 
 
 def main(argv=None, prog="fpga-robotics designs"):

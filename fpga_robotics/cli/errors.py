@@ -36,8 +36,10 @@ def run_cli(main, argv=None, prog=None):
     try:
         code = main(argv)
     except KeyboardInterrupt as exc:
-        print(f"{name}: {'terminated' if isinstance(exc, Terminated) else 'interrupted'}",
-              file=sys.stderr)
+        print(
+            f"{name}: {'terminated' if isinstance(exc, Terminated) else 'interrupted'}",
+            file=sys.stderr,
+        )
         sys.exit(128 + (signal.SIGTERM if isinstance(exc, Terminated) else signal.SIGINT))
     except (UserError, FileNotFoundError) as exc:
         print(f"{name}: error: {exc}", file=sys.stderr)
@@ -45,4 +47,3 @@ def run_cli(main, argv=None, prog=None):
     finally:
         signal.signal(signal.SIGTERM, previous)
     sys.exit(code or 0)
-

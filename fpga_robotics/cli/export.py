@@ -43,21 +43,37 @@ def build_parser(prog="fpga-robotics export"):
     parser = CommandParser(
         prog=prog,
         description="Write a design as one self-contained Verilog file (top module named "
-                    "after --top).",
+        "after --top).",
     )
-    parser.add_argument("--top", default=TOP_NAME, choices=TOPS,
-                        help="the design (default %(default)s; docs/sensor_designs.md for the "
-                             "others)")
-    parser.add_argument("-o", "--output", default=None,
-                        help="output Verilog file (default: build/<top>.v); its directory is "
-                             "created if missing; with --board: the output directory "
-                             "(default build/<board>)")
-    parser.add_argument("--design", metavar="REF",
-                        help="a design of your own instead of --top: FILE.py:Name or "
-                             "package.module:Name (docs/your_design.md); the module is named "
-                             "after Name")
-    parser.add_argument("--param", dest="design_params", action="append", default=[],
-                        metavar="NAME=VALUE", help="a parameter of the --design (repeatable)")
+    parser.add_argument(
+        "--top",
+        default=TOP_NAME,
+        choices=TOPS,
+        help="the design (default %(default)s; docs/sensor_designs.md for the others)",
+    )
+    parser.add_argument(
+        "-o",
+        "--output",
+        default=None,
+        help="output Verilog file (default: build/<top>.v); its directory is "
+        "created if missing; with --board: the output directory "
+        "(default build/<board>)",
+    )
+    parser.add_argument(
+        "--design",
+        metavar="REF",
+        help="a design of your own instead of --top: FILE.py:Name or "
+        "package.module:Name (docs/your_design.md); the module is named "
+        "after Name",
+    )
+    parser.add_argument(
+        "--param",
+        dest="design_params",
+        action="append",
+        default=[],
+        metavar="NAME=VALUE",
+        help="a parameter of the --design (repeatable)",
+    )
     add_board_arguments(parser)
     add_param_arguments(parser)
     add_sensor_arguments(parser)
@@ -113,8 +129,10 @@ def _sensor_top(args, params):
     us = sensor_params_from_args(args, "us", args.top)
     interlock = sensor_params_from_args(args, "interlock", args.top)
     text = generate_top_verilog(FollowTargetSafe(params, us, interlock), args.top)
-    return text, (f"{_follow_target_text(args, params)}, {us.clock_hz} Hz, stop "
-                  f"{interlock.stop_mm} mm, resume {interlock.resume_mm} mm{variant}")
+    return text, (
+        f"{_follow_target_text(args, params)}, {us.clock_hz} Hz, stop "
+        f"{interlock.stop_mm} mm, resume {interlock.resume_mm} mm{variant}"
+    )
 
 
 def _check_options_fit_the_top(args):
@@ -122,22 +140,32 @@ def _check_options_fit_the_top(args):
     for key, (_, _, _, tops) in SENSOR_GROUPS.items():
         given = given_options(args, key)
         if given and args.top not in tops:
-            raise UsageError(f"{', '.join(given)} applies to --top {' or '.join(tops)}, "
-                             f"not to --top {args.top}")
+            raise UsageError(
+                f"{', '.join(given)} applies to --top {' or '.join(tops)}, not to --top {args.top}"
+            )
     if args.variant is not None and args.top == TOP_NAME:
-        raise UsageError("--variant names a seeded bug of a sensor design: it needs --top "
-                         "follow_target_safe or --top follow_line")
+        raise UsageError(
+            "--variant names a seeded bug of a sensor design: it needs --top "
+            "follow_target_safe or --top follow_line"
+        )
     if args.top != TOP_NAME and args.board is not None:
-        raise UsageError(f"--board exports the follow_target board top; it cannot be combined "
-                         f"with --top {args.top}")
+        raise UsageError(
+            f"--board exports the follow_target board top; it cannot be combined "
+            f"with --top {args.top}"
+        )
     if args.top == "follow_line":
         # follow_line reads no FollowTargetParams: any of those options is a mistake.
-        ft_given = [name for name, value in vars(args).items()
-                    if value is not None and _is_follow_target_option(name)]
+        ft_given = [
+            name
+            for name, value in vars(args).items()
+            if value is not None and _is_follow_target_option(name)
+        ]
         if ft_given:
             options = ", ".join("--" + n.replace("_", "-") for n in ft_given)
-            raise UsageError(f"{options} applies to --top follow_target or "
-                             f"follow_target_safe, not to --top follow_line")
+            raise UsageError(
+                f"{options} applies to --top follow_target or "
+                f"follow_target_safe, not to --top follow_line"
+            )
 
 
 def _is_follow_target_option(dest):
@@ -151,16 +179,19 @@ def _export_design(args):
     from fpga_robotics.designs.reference import resolve_design
 
     if args.top != TOP_NAME or args.board is not None or args.bitstream:
-        raise UsageError("--design exports a design of your own: --top, --board and "
-                         "--bitstream go without it")
+        raise UsageError(
+            "--design exports a design of your own: --top, --board and --bitstream go without it"
+        )
     spec = resolve_design(args.design, _params(args.design_params))
     if spec.kind == "verilog":
         raise UsageError(f"--design {args.design} is Verilog already: nothing to export")
     name = spec.reference.rpartition(":")[2] if spec.kind != "builtin" else spec.reference
     output = args.output if args.output is not None else os.path.join("build", f"{name}.v")
     if os.path.isdir(output):
-        raise UsageError(f"{output} is a directory; give the Verilog file's path, e.g. "
-                         f"{os.path.join(output, name + '.v')}")
+        raise UsageError(
+            f"{output} is a directory; give the Verilog file's path, e.g. "
+            f"{os.path.join(output, name + '.v')}"
+        )
     check_output_path(output, what="Verilog file")
     text = generate_top_verilog(spec.build(), name)
     write_atomic(output, text, what="Verilog file")

@@ -30,25 +30,47 @@ def _row(cells, widths):
 
 def build_parser(prog="fpga-robotics formal"):
     parser = CommandParser(
-        prog=prog, description="Prove the gateware's promises with SymbiYosys and Yices "
-        "(docs/formal.md).")
-    parser.add_argument("--only", action="append", metavar="NAME",
-                        help="run only this check, or every check whose name starts with "
-                        "NAME. or NAME@ (repeatable)")
-    parser.add_argument("--depth", type=int, metavar="N",
-                        help="cycles to search (bmc, cover) or the induction length (prove), "
-                        "instead of each check's own")
-    parser.add_argument("--jobs", type=int, default=min(2, os.cpu_count() or 1), metavar="N",
-                        help="checks run at once (default: %(default)s)")
-    parser.add_argument("--trace-dir", type=Path, default=None, metavar="DIR",
-                        help="where counterexample VCDs go (default: "
-                        "$FPGA_ROBOTICS_CACHE/formal-traces, else "
-                        "~/.cache/fpga_robotics/formal-traces)")
+        prog=prog,
+        description="Prove the gateware's promises with SymbiYosys and Yices (docs/formal.md).",
+    )
+    parser.add_argument(
+        "--only",
+        action="append",
+        metavar="NAME",
+        help="run only this check, or every check whose name starts with "
+        "NAME. or NAME@ (repeatable)",
+    )
+    parser.add_argument(
+        "--depth",
+        type=int,
+        metavar="N",
+        help="cycles to search (bmc, cover) or the induction length (prove), "
+        "instead of each check's own",
+    )
+    parser.add_argument(
+        "--jobs",
+        type=int,
+        default=min(2, os.cpu_count() or 1),
+        metavar="N",
+        help="checks run at once (default: %(default)s)",
+    )
+    parser.add_argument(
+        "--trace-dir",
+        type=Path,
+        default=None,
+        metavar="DIR",
+        help="where counterexample VCDs go (default: "
+        "$FPGA_ROBOTICS_CACHE/formal-traces, else "
+        "~/.cache/fpga_robotics/formal-traces)",
+    )
     parser.add_argument("--list", action="store_true", help="list the checks and exit")
-    parser.add_argument("--design", metavar="REF",
-                        help="check the properties this design declares (FILE.py:Name or "
-                        "package.module:Name with formal_properties, docs/formal.md) instead "
-                        "of FollowTarget's")
+    parser.add_argument(
+        "--design",
+        metavar="REF",
+        help="check the properties this design declares (FILE.py:Name or "
+        "package.module:Name with formal_properties, docs/formal.md) instead "
+        "of FollowTarget's",
+    )
     return parser
 
 
@@ -65,8 +87,9 @@ def main(argv=None, prog="fpga-robotics formal"):
         for c in checks:
             print(f"{c.name:<{width}}  {c.mode:<5}  {c.depth:>3}  {c.promise}")
         return 0
-    trace_dir = check_output_dir(args.trace_dir or default_trace_dir(),
-                                 what="counterexample folder")
+    trace_dir = check_output_dir(
+        args.trace_dir or default_trace_dir(), what="counterexample folder"
+    )
     env = formal_env()
     widths = (max(len(c.name) for c in checks), 5, 5, 7, 7)
     print(_row(("property", "mode", "depth", "result", "time"), widths))
@@ -79,8 +102,10 @@ def main(argv=None, prog="fpga-robotics formal"):
     try:
         for r in pool.map(one, checks):  # in the listed order, as each is done
             results.append(r)
-            print(_row((r.name, r.mode, str(r.depth), r.status, f"{r.seconds:.1f}s"), widths),
-                  flush=True)
+            print(
+                _row((r.name, r.mode, str(r.depth), r.status, f"{r.seconds:.1f}s"), widths),
+                flush=True,
+            )
             if not r.passed:
                 if r.detail:
                     print(f"    {r.detail}")
@@ -93,6 +118,8 @@ def main(argv=None, prog="fpga-robotics formal"):
     pool.shutdown()
     failed = [r for r in results if not r.passed]
     total = sum(r.seconds for r in results)
-    print(f"{len(results) - len(failed)} of {len(results)} checks passed "
-          f"({total:.1f}s of solver time)")
+    print(
+        f"{len(results) - len(failed)} of {len(results)} checks passed "
+        f"({total:.1f}s of solver time)"
+    )
     return 1 if failed else 0

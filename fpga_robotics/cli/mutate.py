@@ -36,16 +36,30 @@ def _campaign(name):
     return load_campaign_file(name)
 
 
-def _report_robot(out, campaign, mutants, verdicts, unit, robot, robot_verdicts, baseline,
-                  robot_s, recordings, say, width):
+def _report_robot(
+    out,
+    campaign,
+    mutants,
+    verdicts,
+    unit,
+    robot,
+    robot_verdicts,
+    baseline,
+    robot_s,
+    recordings,
+    say,
+    width,
+):
     """The robot judge's lines, the recordings of the closest runs, and report.html."""
     from fpga_robotics.mutation.report import write_report
 
     rs = robot_score(unit, robot)
     n_runs, n_pass = len(baseline["runs"]), len(baseline["passing"])
-    print(f"robot judge (campaign {campaign.name}: {n_pass} of {n_runs} runs pass unmutated): "
-          f"{rs['caught']} of {rs['judged']} unit-caught mutants caught: score "
-          f"{_percent(rs['score'])}; {_robot_rate(baseline['judged_here'], robot_s)}")
+    print(
+        f"robot judge (campaign {campaign.name}: {n_pass} of {n_runs} runs pass unmutated): "
+        f"{rs['caught']} of {rs['judged']} unit-caught mutants caught: score "
+        f"{_percent(rs['score'])}; {_robot_rate(baseline['judged_here'], robot_s)}"
+    )
     blind = blind_spots(unit, robot)
     by_index = {m.index: m for m in mutants}
     recorded = _record_closest(out, [robot_verdicts[k] for k in blind[:recordings]], say)
@@ -58,10 +72,13 @@ def _report_robot(out, campaign, mutants, verdicts, unit, robot, robot_verdicts,
             print(f"    unit: {effects[k]}")
             print(f"    why: {reasons[k]}")
             if robot_verdicts[k].get("replay"):
-                print(f"    closest run: {robot_verdicts[k]['replay']}"
-                      + (f"  (recording {recorded[k]})" if k in recorded else ""))
-    path = write_report(out, campaign.name, mutants, verdicts, robot_verdicts, baseline,
-                        recorded, width)
+                print(
+                    f"    closest run: {robot_verdicts[k]['replay']}"
+                    + (f"  (recording {recorded[k]})" if k in recorded else "")
+                )
+    path = write_report(
+        out, campaign.name, mutants, verdicts, robot_verdicts, baseline, recorded, width
+    )
     print(f"report: {path}")
 
 
@@ -91,6 +108,7 @@ def _record_closest(out, verdicts, say):
             say(f"recorded the closest run of mutant {v['index']}: {path}")
     return paths
 
+
 DEFAULT_MUTANTS = 100
 MAX_MUTANTS = 4000
 
@@ -99,43 +117,97 @@ def build_parser(prog="fpga-robotics mutate"):
     p = CommandParser(
         prog=prog,
         description="Mutation coverage: Yosys mutants of the design, one build for all of "
-                    "them, each judged against the golden model on fixed frames "
-                    "(docs/mutation.md).")
-    p.add_argument("--mutants", type=int, default=DEFAULT_MUTANTS, metavar="N",
-                   help=f"how many mutants (default {DEFAULT_MUTANTS}, at most {MAX_MUTANTS})")
-    p.add_argument("--seed", type=int, default=1, metavar="S",
-                   help="Yosys's choice of mutants (default 1); the same seed, the same list")
-    p.add_argument("--out", default=None, metavar="DIR",
-                   help="output folder (default runs/mutation/n<N>-s<S>/)")
-    p.add_argument("--campaign", metavar="NAME|PATH",
-                   help="also judge the mutants the unit judge catches by this campaign's "
-                        "closed-loop verdicts (the robot judge; e.g. mutation, regression)")
-    p.add_argument("--workers", type=int, default=None, metavar="N",
-                   help="robot judge: Dask worker processes (default: the machine's cores)")
-    p.add_argument("--scheduler", metavar="ADDRESS",
-                   help="robot judge: an existing Dask scheduler (tcp://HOST:8786)")
-    p.add_argument("--resume", action="store_true",
-                   help="robot judge: keep the mutants already judged in the output folder")
-    p.add_argument("--recordings", type=int, default=5, metavar="N",
-                   help="robot judge: record the closest-to-failing run of the first N blind "
-                        "spots (default 5)")
-    p.add_argument("--fork", action=argparse.BooleanOptionalAction, default=True,
-                   help="robot judge: fork each mutant's runs from the unmutated design's at "
-                        "the first frame its wheel commands differ (default; the same "
-                        "verdicts, docs/mutation.md) or, with --no-fork, run them in full")
+        "them, each judged against the golden model on fixed frames "
+        "(docs/mutation.md).",
+    )
+    p.add_argument(
+        "--mutants",
+        type=int,
+        default=DEFAULT_MUTANTS,
+        metavar="N",
+        help=f"how many mutants (default {DEFAULT_MUTANTS}, at most {MAX_MUTANTS})",
+    )
+    p.add_argument(
+        "--seed",
+        type=int,
+        default=1,
+        metavar="S",
+        help="Yosys's choice of mutants (default 1); the same seed, the same list",
+    )
+    p.add_argument(
+        "--out",
+        default=None,
+        metavar="DIR",
+        help="output folder (default runs/mutation/n<N>-s<S>/)",
+    )
+    p.add_argument(
+        "--campaign",
+        metavar="NAME|PATH",
+        help="also judge the mutants the unit judge catches by this campaign's "
+        "closed-loop verdicts (the robot judge; e.g. mutation, regression)",
+    )
+    p.add_argument(
+        "--workers",
+        type=int,
+        default=None,
+        metavar="N",
+        help="robot judge: Dask worker processes (default: the machine's cores)",
+    )
+    p.add_argument(
+        "--scheduler",
+        metavar="ADDRESS",
+        help="robot judge: an existing Dask scheduler (tcp://HOST:8786)",
+    )
+    p.add_argument(
+        "--resume",
+        action="store_true",
+        help="robot judge: keep the mutants already judged in the output folder",
+    )
+    p.add_argument(
+        "--recordings",
+        type=int,
+        default=5,
+        metavar="N",
+        help="robot judge: record the closest-to-failing run of the first N blind "
+        "spots (default 5)",
+    )
+    p.add_argument(
+        "--fork",
+        action=argparse.BooleanOptionalAction,
+        default=True,
+        help="robot judge: fork each mutant's runs from the unmutated design's at "
+        "the first frame its wheel commands differ (default; the same "
+        "verdicts, docs/mutation.md) or, with --no-fork, run them in full",
+    )
     p.add_argument("--quiet", action="store_true", help="no progress lines")
-    p.add_argument("--against", choices=("model", "design"), default="model",
-                   help="FollowTarget's unit judge compares each mutant with the golden model "
-                        "(default) or with the unmutated design on the same frames")
-    p.add_argument("--design", metavar="REF",
-                   help="mutants of this Amaranth design (FILE.py:Name, package.module:Name; "
-                        "docs/your_design.md) instead of FollowTarget, each judged against "
-                        "the unmutated design on seeded random inputs, cycle by cycle")
-    p.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
-                   help="with --design: one of its parameters (a TOML value; repeatable)")
-    p.add_argument("--cycles", type=int, default=None, metavar="N",
-                   help="with --design: cycles of random inputs per mutant (default "
-                        "100000)")
+    p.add_argument(
+        "--against",
+        choices=("model", "design"),
+        default="model",
+        help="FollowTarget's unit judge compares each mutant with the golden model "
+        "(default) or with the unmutated design on the same frames",
+    )
+    p.add_argument(
+        "--design",
+        metavar="REF",
+        help="mutants of this Amaranth design (FILE.py:Name, package.module:Name; "
+        "docs/your_design.md) instead of FollowTarget, each judged against "
+        "the unmutated design on seeded random inputs, cycle by cycle",
+    )
+    p.add_argument(
+        "--param",
+        action="append",
+        default=[],
+        metavar="NAME=VALUE",
+        help="with --design: one of its parameters (a TOML value; repeatable)",
+    )
+    p.add_argument(
+        "--cycles",
+        type=int,
+        default=None,
+        metavar="N",
+        help="with --design: cycles of random inputs per mutant (default 100000)",
+    )
     add_param_arguments(p)
     return p
 
@@ -162,11 +234,15 @@ def _main_design(args):
     from fpga_robotics.mutation.design_run import DEFAULT_CYCLES, mutate_design
 
     if args.design.startswith("verilog:"):
-        raise UsageError(f"--design {args.design}: mutants are made of Amaranth designs "
-                         f"(FILE.py:Name); a Verilog design is not mutated here")
+        raise UsageError(
+            f"--design {args.design}: mutants are made of Amaranth designs "
+            f"(FILE.py:Name); a Verilog design is not mutated here"
+        )
     if args.campaign is not None:
-        raise UsageError("--campaign (the robot judge) runs FollowTarget's mutants; with "
-                         "--design only the unit judge runs")
+        raise UsageError(
+            "--campaign (the robot judge) runs FollowTarget's mutants; with "
+            "--design only the unit judge runs"
+        )
     cycles = DEFAULT_CYCLES if args.cycles is None else args.cycles
     if not 1 <= cycles <= 100_000_000:
         raise UsageError(f"--cycles must be 1..100000000, got {cycles}")
@@ -185,11 +261,15 @@ def _main_design(args):
         raise UsageError(str(exc).splitlines()[0]) from None
     score, modules = result["unit"], result["modules"]
     rate = (60 * score["total"] / result["unit_judge_s"]) if result["unit_judge_s"] else 0
-    print(f"{score['total']} mutants of {name} (seed {args.seed}), {cycles} cycles of random "
-          f"inputs each; build {result['build_and_list_s']:.1f} s, unit judge {rate:.0f} "
-          f"mutants/min")
-    print(f"unit judge (against the unmutated design): {score['caught']} caught, "
-          f"{score['equivalent']} equivalent on these inputs: score {_percent(score['score'])}")
+    print(
+        f"{score['total']} mutants of {name} (seed {args.seed}), {cycles} cycles of random "
+        f"inputs each; build {result['build_and_list_s']:.1f} s, unit judge {rate:.0f} "
+        f"mutants/min"
+    )
+    print(
+        f"unit judge (against the unmutated design): {score['caught']} caught, "
+        f"{score['equivalent']} equivalent on these inputs: score {_percent(score['score'])}"
+    )
     width = max(len(m) for m in modules)
     for module, row in modules.items():
         print(f"  {module:<{width}}  {row['unit_caught']:>4}/{row['total']:<4} caught")
@@ -212,8 +292,7 @@ def _check(args):
     if args.recordings < 0:
         raise UsageError(f"--recordings must be >= 0, got {args.recordings}")
     if args.campaign is None and (args.workers or args.scheduler or args.resume):
-        raise UsageError("--workers, --scheduler and --resume go with --campaign (the robot "
-                         "judge)")
+        raise UsageError("--workers, --scheduler and --resume go with --campaign (the robot judge)")
 
 
 def _percent(x):
@@ -246,15 +325,20 @@ def main(argv=None, prog="fpga-robotics mutate"):
     build_s = time.perf_counter() - t0
     try:
         frames = judge_frames(params)
-        golden = (golden_results(params, frames) if args.against == "model"
-                  else reference_results(design, frames))
+        golden = (
+            golden_results(params, frames)
+            if args.against == "model"
+            else reference_results(design, frames)
+        )
         t1 = time.perf_counter()
         verdicts = []
         for k, m in enumerate(mutants, start=1):
             verdicts.append(judge_mutant(design, m.index, frames, golden))
             if k == len(mutants) or k * 10 // len(mutants) != (k - 1) * 10 // len(mutants):
-                say(f"unit judge: {k}/{len(mutants)} mutants, "
-                    f"{sum(v.caught for v in verdicts)} caught")
+                say(
+                    f"unit judge: {k}/{len(mutants)} mutants, "
+                    f"{sum(v.caught for v in verdicts)} caught"
+                )
         unit_s = time.perf_counter() - t1
     finally:
         design.close()
@@ -267,52 +351,96 @@ def main(argv=None, prog="fpga-robotics mutate"):
         caught = [v.index for v in verdicts if v.caught]
         t2 = time.perf_counter()
         baseline, robot_verdicts = robot_judge(
-            campaign, netlist, ports, f"{params.width}x{params.height}", caught, out,
-            workers=args.workers, scheduler=args.scheduler, resume=args.resume, say=say, fork=args.fork)
+            campaign,
+            netlist,
+            ports,
+            f"{params.width}x{params.height}",
+            caught,
+            out,
+            workers=args.workers,
+            scheduler=args.scheduler,
+            resume=args.resume,
+            say=say,
+            fork=args.fork,
+        )
         robot_s = time.perf_counter() - t2
     robot = {k: v["caught"] for k, v in robot_verdicts.items()}
     blind = set(blind_spots(unit, robot))
     score = unit_score(unit)
     modules = by_module(mutants, unit, robot)
-    write_json_atomic(os.path.join(out, "mutants.json"), {
-        "design": {"width": params.width, "height": params.height},
-        "seed": args.seed,
-        "against": args.against,
-        "frames": len(frames),
-        "build_and_list_s": round(build_s, 2),
-        "unit_judge_s": round(unit_s, 2),
-        "unit_mutants_per_minute": round(60 * len(mutants) / unit_s, 1) if unit_s else None,
-        "unit": score,
-        "robot": robot_score(unit, robot) if campaign is not None else None,
-        "campaign": campaign.name if campaign is not None else None,
-        "robot_judge_s": round(robot_s, 2) if campaign is not None else None,
-        "baseline": baseline,
-        "modules": modules,
-        "mutants": [{**{k: v for k, v in m.__dict__.items()}, "sources": list(m.sources),
-                     "describe": m.describe(),
-                     "unit": {"caught": v.caught, "first_frame": v.first_frame,
-                              "differing": v.differing, "frames_differing": v.frames_differing,
-                              "max_difference": v.max_difference, "effect": v.effect()},
-                     "robot": robot_verdicts.get(m.index),
-                     "blind_spot_reason": (blind_spot_reason(v, params.width)
-                                           if m.index in blind else None)}
-                    for m, v in zip(mutants, verdicts)],
-    }, what="mutation results")
+    write_json_atomic(
+        os.path.join(out, "mutants.json"),
+        {
+            "design": {"width": params.width, "height": params.height},
+            "seed": args.seed,
+            "against": args.against,
+            "frames": len(frames),
+            "build_and_list_s": round(build_s, 2),
+            "unit_judge_s": round(unit_s, 2),
+            "unit_mutants_per_minute": round(60 * len(mutants) / unit_s, 1) if unit_s else None,
+            "unit": score,
+            "robot": robot_score(unit, robot) if campaign is not None else None,
+            "campaign": campaign.name if campaign is not None else None,
+            "robot_judge_s": round(robot_s, 2) if campaign is not None else None,
+            "baseline": baseline,
+            "modules": modules,
+            "mutants": [
+                {
+                    **{k: v for k, v in m.__dict__.items()},
+                    "sources": list(m.sources),
+                    "describe": m.describe(),
+                    "unit": {
+                        "caught": v.caught,
+                        "first_frame": v.first_frame,
+                        "differing": v.differing,
+                        "frames_differing": v.frames_differing,
+                        "max_difference": v.max_difference,
+                        "effect": v.effect(),
+                    },
+                    "robot": robot_verdicts.get(m.index),
+                    "blind_spot_reason": (
+                        blind_spot_reason(v, params.width) if m.index in blind else None
+                    ),
+                }
+                for m, v in zip(mutants, verdicts)
+            ],
+        },
+        what="mutation results",
+    )
 
-    print(f"{len(mutants)} mutants of follow_target {params.width}x{params.height} "
-          f"(seed {args.seed}), {len(frames)} unit frames; build {build_s:.1f} s, "
-          f"unit judge {60 * len(mutants) / unit_s:.0f} mutants/min")
+    print(
+        f"{len(mutants)} mutants of follow_target {params.width}x{params.height} "
+        f"(seed {args.seed}), {len(frames)} unit frames; build {build_s:.1f} s, "
+        f"unit judge {60 * len(mutants) / unit_s:.0f} mutants/min"
+    )
     against = "" if args.against == "model" else " (against the unmutated design)"
-    print(f"unit judge{against}: {score['caught']} caught, {score['equivalent']} equivalent "
-          f"on these frames: score {_percent(score['score'])}")
+    print(
+        f"unit judge{against}: {score['caught']} caught, {score['equivalent']} equivalent "
+        f"on these frames: score {_percent(score['score'])}"
+    )
     width = max(len(name) for name in modules)
     for name, row in modules.items():
-        robot_part = (f", robot judge {row['robot_caught']:>4}/{row['unit_caught']}"
-                      if campaign is not None else "")
+        robot_part = (
+            f", robot judge {row['robot_caught']:>4}/{row['unit_caught']}"
+            if campaign is not None
+            else ""
+        )
         print(f"  {name:<{width}}  {row['unit_caught']:>4}/{row['total']:<4} caught{robot_part}")
     if campaign is not None:
-        _report_robot(out, campaign, mutants, verdicts, unit, robot, robot_verdicts, baseline,
-                      robot_s, args.recordings, say, params.width)
+        _report_robot(
+            out,
+            campaign,
+            mutants,
+            verdicts,
+            unit,
+            robot,
+            robot_verdicts,
+            baseline,
+            robot_s,
+            args.recordings,
+            say,
+            params.width,
+        )
     missed = [m for m, v in zip(mutants, verdicts) if not v.caught]
     if missed:
         print("equivalent on the unit frames (first 10):")

@@ -19,15 +19,15 @@ from fpga_robotics.cli.errors import UsageError
 
 __all__ = ["main", "write_project"]
 
-_TEMPLATES = ("design.py", "scenario.toml", "README.md", "pyproject.toml",
-              "tests/test_scenario.py")
+_TEMPLATES = ("design.py", "scenario.toml", "README.md", "pyproject.toml", "tests/test_scenario.py")
 #: A scenario name (it names the run's recording): letters, digits, '_', '-', '.'.
 _NAME = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.-]{0,63}")
 
 
 def _template(relative):
-    return (resources.files("fpga_robotics.cli") / "templates" / "new"
-            / f"{relative}.tmpl").read_text(encoding="utf-8")
+    return (
+        resources.files("fpga_robotics.cli") / "templates" / "new" / f"{relative}.tmpl"
+    ).read_text(encoding="utf-8")
 
 
 def write_project(folder):
@@ -35,15 +35,18 @@ def write_project(folder):
     folder = Path(folder)
     name = folder.resolve().name
     if not _NAME.fullmatch(name):
-        raise UsageError(f"{str(folder)!r}: the project's name {name!r} must be ASCII letters, "
-                         f"digits, '_', '-' and '.' (at most 64), starting with a letter, a "
-                         f"digit or '_'")
+        raise UsageError(
+            f"{str(folder)!r}: the project's name {name!r} must be ASCII letters, "
+            f"digits, '_', '-' and '.' (at most 64), starting with a letter, a "
+            f"digit or '_'"
+        )
     if folder.exists():
         if not folder.is_dir():
             raise UsageError(f"{str(folder)!r} exists and is not a folder; give a new name")
         if any(folder.iterdir()):
-            raise UsageError(f"folder {str(folder)!r} exists and is not empty; give a new "
-                             f"name or empty it")
+            raise UsageError(
+                f"folder {str(folder)!r} exists and is not empty; give a new name or empty it"
+            )
     parent = folder.resolve().parent
     if not parent.is_dir():
         raise UsageError(f"no folder {str(parent)!r} to create {name!r} in; create it first")
@@ -67,9 +70,11 @@ def write_project(folder):
 
 def main(argv=None, prog="fpga-robotics new"):
     p = argparse.ArgumentParser(
-        prog=prog, description="Write a project skeleton: an Amaranth design (design.py), a "
+        prog=prog,
+        description="Write a project skeleton: an Amaranth design (design.py), a "
         "scenario it passes (scenario.toml), a pytest test of it and a README. "
-        "Then: cd NAME && python -m pytest")
+        "Then: cd NAME && python -m pytest",
+    )
     p.add_argument("name", metavar="NAME", help="the project's folder (new or empty)")
     args = p.parse_args(argv)
     for path in write_project(args.name):

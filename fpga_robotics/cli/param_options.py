@@ -28,24 +28,42 @@ def add_param_arguments(parser):
     contract's default, or the preset's value)."""
     group = parser.add_argument_group(
         "design parameters (defaults: the contract's, docs/contract.md; with --preset the "
-        "preset's, the other options on top)")
+        "preset's, the other options on top)"
+    )
     # Checked in params_from_args, not by argparse: an unknown name is one line, exit 2.
-    group.add_argument("--preset", default=None, metavar="NAME",
-                       help=f"start from a preset: {', '.join(PRESETS)} "
-                            f"({'; '.join(PRESETS.values())})")
+    group.add_argument(
+        "--preset",
+        default=None,
+        metavar="NAME",
+        help=f"start from a preset: {', '.join(PRESETS)} ({'; '.join(PRESETS.values())})",
+    )
     for f in fields(FollowTargetParams):
         if not f.init:
             continue
         option = "--" + f.name.replace("_", "-")
         if f.name in _TUPLE_PARAMS:
-            group.add_argument(option, type=_int_list, default=None, metavar="A,B,...",
-                               help=f"{f.name} as comma-separated ints")
+            group.add_argument(
+                option,
+                type=_int_list,
+                default=None,
+                metavar="A,B,...",
+                help=f"{f.name} as comma-separated ints",
+            )
         elif f.name in CHOICES:
-            group.add_argument(option, default=None, metavar="{" + ",".join(CHOICES[f.name]) + "}",
-                               help=f"{f.name} (default {f.default})")
+            group.add_argument(
+                option,
+                default=None,
+                metavar="{" + ",".join(CHOICES[f.name]) + "}",
+                help=f"{f.name} (default {f.default})",
+            )
         else:
-            group.add_argument(option, type=int, default=None, metavar="N",
-                               help=f"{f.name} (default {_default_text(f)})")
+            group.add_argument(
+                option,
+                type=int,
+                default=None,
+                metavar="N",
+                help=f"{f.name} (default {_default_text(f)})",
+            )
 
 
 def _default_text(f):

@@ -15,8 +15,11 @@ class DefaultsFormatter(argparse.ArgumentDefaultsHelpFormatter):
 
     def _get_help_string(self, action):
         text = action.help or ""
-        if (action.default in (None, False, [], argparse.SUPPRESS) or "default" in text
-                or not action.option_strings):
+        if (
+            action.default in (None, False, [], argparse.SUPPRESS)
+            or "default" in text
+            or not action.option_strings
+        ):
             return text
         return super()._get_help_string(action)
 

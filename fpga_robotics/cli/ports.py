@@ -10,13 +10,22 @@ __all__ = ["build_parser", "main"]
 
 
 def build_parser(prog="fpga-robotics ports"):
-    parser = CommandParser(prog=prog, description="Write the port map of the exported "
-                           "follow_target (--example) or check a port map file.")
+    parser = CommandParser(
+        prog=prog,
+        description="Write the port map of the exported "
+        "follow_target (--example) or check a port map file.",
+    )
     parser.add_argument("path", help="the port map (TOML)")
-    parser.add_argument("--example", action="store_true",
-                        help="write the follow_target example to PATH (not replacing a file)")
-    parser.add_argument("--design", metavar="verilog:TOP.v[,MORE.v]",
-                        help="check the map against this design's real ports")
+    parser.add_argument(
+        "--example",
+        action="store_true",
+        help="write the follow_target example to PATH (not replacing a file)",
+    )
+    parser.add_argument(
+        "--design",
+        metavar="verilog:TOP.v[,MORE.v]",
+        help="check the map against this design's real ports",
+    )
     return parser
 
 
@@ -40,7 +49,9 @@ def _check_against_design(reference, path):
     from fpga_robotics.designs.reference import DesignError, resolve_design
 
     if not reference.startswith("verilog:"):
-        raise DesignError(f"--design must be a Verilog design, verilog:TOP.v[,MORE.v], got "
-                          f"{reference!r} (an Amaranth design needs no port map)")
+        raise DesignError(
+            f"--design must be a Verilog design, verilog:TOP.v[,MORE.v], got "
+            f"{reference!r} (an Amaranth design needs no port map)"
+        )
     spec = checked_verilog(resolve_design(reference, {}, ports=path), path)
     print(f"{path}: matches {reference} ({len(spec.ports)} ports)")

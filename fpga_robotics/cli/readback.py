@@ -7,8 +7,11 @@ __all__ = ["build_parser", "main"]
 
 
 def build_parser(prog="fpga-robotics readback"):
-    parser = CommandParser(prog=prog, description="What a saved .rrd recording holds: its "
-                           "size, its frames and the rows of each entity.")
+    parser = CommandParser(
+        prog=prog,
+        description="What a saved .rrd recording holds: its "
+        "size, its frames and the rows of each entity.",
+    )
     parser.add_argument("path", metavar="FILE.rrd", help="the recording")
     return parser
 

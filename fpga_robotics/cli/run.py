@@ -52,61 +52,122 @@ def build_parser(prog="fpga-robotics run"):
     p = CommandParser(
         prog=prog,
         description="Run the FollowTarget design in closed loop with a simulated robot, camera "
-                    "and people, and check the scenario's pass criteria.",
+        "and people, and check the scenario's pass criteria.",
     )
-    p.add_argument("--scenario", default=DEFAULT_SCENARIO, metavar="NAME|PATH",
-                   help="a shipped scenario (see --list-scenarios) or a .toml file")
+    p.add_argument(
+        "--scenario",
+        default=DEFAULT_SCENARIO,
+        metavar="NAME|PATH",
+        help="a shipped scenario (see --list-scenarios) or a .toml file",
+    )
     p.add_argument("--list-scenarios", action="store_true", help="list the shipped scenarios")
-    p.add_argument("--backend", default="auto", choices=("auto", *BACKEND_NAMES),
-                   help="design simulator (default auto: the fastest compiled one available)")
-    p.add_argument("--resolution", metavar="WxH",
-                   help="camera and design resolution (default: "
-                        f"{_scenario_default('camera', 'resolution')})")
-    p.add_argument("--color", choices=tuple(COLOR_SELECT),
-                   help=f"initial colour select (default: {_scenario_default('color', 'initial')})")
-    p.add_argument("--target-color", choices=tuple(TARGET_CLOTHING), metavar="C",
-                   help="dress the target person in C and follow C (colour select); one of "
-                        + ", ".join(TARGET_CLOTHING))
-    p.add_argument("--duration", type=float, metavar="S",
-                   help=f"simulated seconds (default: {_scenario_default('sim', 'duration')})")
+    p.add_argument(
+        "--backend",
+        default="auto",
+        choices=("auto", *BACKEND_NAMES),
+        help="design simulator (default auto: the fastest compiled one available)",
+    )
+    p.add_argument(
+        "--resolution",
+        metavar="WxH",
+        help=f"camera and design resolution (default: {_scenario_default('camera', 'resolution')})",
+    )
+    p.add_argument(
+        "--color",
+        choices=tuple(COLOR_SELECT),
+        help=f"initial colour select (default: {_scenario_default('color', 'initial')})",
+    )
+    p.add_argument(
+        "--target-color",
+        choices=tuple(TARGET_CLOTHING),
+        metavar="C",
+        help="dress the target person in C and follow C (colour select); one of "
+        + ", ".join(TARGET_CLOTHING),
+    )
+    p.add_argument(
+        "--duration",
+        type=float,
+        metavar="S",
+        help=f"simulated seconds (default: {_scenario_default('sim', 'duration')})",
+    )
     p.add_argument("--seed", type=int, metavar="N", help="random seed (default: the scenario's)")
     p.add_argument("--realtime", action="store_true", help="pace the simulation to the clock")
     p.add_argument("--summary", metavar="PATH", help="write the summary as JSON")
-    p.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
-                   help="override a scenario value, e.g. robot.mass=12 (repeatable; TOML values)")
-    p.add_argument("--rerun", default="auto", metavar="MODE",
-                   help="viewer: save[:PATH.rrd] (plain save: a new name under runs/), spawn, "
-                        "connect[:URL], serve[:ADDRESS], off; default auto = spawn with a "
-                        "display, else save")
-    p.add_argument("--log-every", type=int, default=1, metavar="N",
-                   help="log every Nth frame's images to the viewer")
-    p.add_argument("--source", metavar="camera:N|VIDEO|FOLDER|bag:PATH[:TOPIC]",
-                   help="run the design on real frames instead of the simulation (no physics)")
+    p.add_argument(
+        "--set",
+        dest="overrides",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="override a scenario value, e.g. robot.mass=12 (repeatable; TOML values)",
+    )
+    p.add_argument(
+        "--rerun",
+        default="auto",
+        metavar="MODE",
+        help="viewer: save[:PATH.rrd] (plain save: a new name under runs/), spawn, "
+        "connect[:URL], serve[:ADDRESS], off; default auto = spawn with a "
+        "display, else save",
+    )
+    p.add_argument(
+        "--log-every",
+        type=int,
+        default=1,
+        metavar="N",
+        help="log every Nth frame's images to the viewer",
+    )
+    p.add_argument(
+        "--source",
+        metavar="camera:N|VIDEO|FOLDER|bag:PATH[:TOPIC]",
+        help="run the design on real frames instead of the simulation (no physics)",
+    )
     p.add_argument("--max-frames", type=int, metavar="N", help="with --source: stop after N")
-    p.add_argument("--shadow", metavar="SPEC",
-                   help="run a second design on the same frames without letting it drive: a "
-                        "preset name (published) and/or design KEY=VALUE items separated by ';' "
-                        "(e.g. 'diff_min=5;kp_num=2'), or in real-clock timing a design "
-                        "reference (e.g. wall_stop_v1.py:WallStop); the summary reports where "
-                        "they differ")
-    p.add_argument("--shadow-backend", choices=("auto", *BACKEND_NAMES), default=None,
-                   help="simulator of the shadow design (default: the same as --backend)")
-    p.add_argument("--design", metavar="REF",
-                   help="the design to run instead of the scenario's design.top: a built-in "
-                        "name, FILE.py:Name or package.module:Name (an Amaranth component, "
-                        "docs/your_design.md), or verilog:TOP.v[,MORE.v...] with --ports "
-                        "(on CXXRTL or Verilator, docs/foreign.md)")
-    p.add_argument("--ports", metavar="PORTS.toml",
-                   help="with --design: the port map of the Verilog design")
-    p.add_argument("--runtime", action="append", default=[], metavar="NAME=VALUE",
-                   help="with a Verilog design: hold its [runtime] input NAME at VALUE for the "
-                        "run (repeatable; e.g. mutsel=3 selects a mutant, docs/mutation.md)")
-    p.add_argument("--save-video", metavar="PATH.mp4|PATH.avi",
-                   help="also write the camera frames as a video (try it with --source)")
+    p.add_argument(
+        "--shadow",
+        metavar="SPEC",
+        help="run a second design on the same frames without letting it drive: a "
+        "preset name (published) and/or design KEY=VALUE items separated by ';' "
+        "(e.g. 'diff_min=5;kp_num=2'), or in real-clock timing a design "
+        "reference (e.g. wall_stop_v1.py:WallStop); the summary reports where "
+        "they differ",
+    )
+    p.add_argument(
+        "--shadow-backend",
+        choices=("auto", *BACKEND_NAMES),
+        default=None,
+        help="simulator of the shadow design (default: the same as --backend)",
+    )
+    p.add_argument(
+        "--design",
+        metavar="REF",
+        help="the design to run instead of the scenario's design.top: a built-in "
+        "name, FILE.py:Name or package.module:Name (an Amaranth component, "
+        "docs/your_design.md), or verilog:TOP.v[,MORE.v...] with --ports "
+        "(on CXXRTL or Verilator, docs/foreign.md)",
+    )
+    p.add_argument(
+        "--ports", metavar="PORTS.toml", help="with --design: the port map of the Verilog design"
+    )
+    p.add_argument(
+        "--runtime",
+        action="append",
+        default=[],
+        metavar="NAME=VALUE",
+        help="with a Verilog design: hold its [runtime] input NAME at VALUE for the "
+        "run (repeatable; e.g. mutsel=3 selects a mutant, docs/mutation.md)",
+    )
+    p.add_argument(
+        "--save-video",
+        metavar="PATH.mp4|PATH.avi",
+        help="also write the camera frames as a video (try it with --source)",
+    )
     p.add_argument("--quiet", action="store_true", help="no progress bar")
-    p.add_argument("--strict", action="store_true",
-                   help="refuse a scenario that loads with warnings (a waypoint inside "
-                        "furniture, a check no run can meet...) instead of printing them")
+    p.add_argument(
+        "--strict",
+        action="store_true",
+        help="refuse a scenario that loads with warnings (a waypoint inside "
+        "furniture, a check no run can meet...) instead of printing them",
+    )
     add_ros_arguments(p)  # --bag, --live, --interactive, --paused, --replay-inputs
     return p
 
@@ -137,8 +198,10 @@ class Progress:
             width = 30
             filled = int(width * done / total)
             rate = done / max(now - self.start, 1e-9)
-            self.stream.write(f"\r{self.label} [{'#' * filled}{'.' * (width - filled)}] "
-                              f"{done}/{total} frames, {rate:.0f} fps")
+            self.stream.write(
+                f"\r{self.label} [{'#' * filled}{'.' * (width - filled)}] "
+                f"{done}/{total} frames, {rate:.0f} fps"
+            )
             self.stream.flush()
         else:
             decile = 10 * done // total
@@ -151,7 +214,6 @@ class Progress:
         if self.tty:
             self.stream.write("\n")
             self.stream.flush()
-
 
 
 def design_override(reference):
@@ -171,9 +233,11 @@ def take_design_reference(args, scenario):
     if args.design is None or args.design.startswith("verilog:"):
         return
     if scenario.foreign is not None:
-        raise UsageError(f"--design {args.design}: scenario {scenario.name!r} names a "
-                         f"Verilog design (design.verilog); remove it there to run "
-                         f"another design")
+        raise UsageError(
+            f"--design {args.design}: scenario {scenario.name!r} names a "
+            f"Verilog design (design.verilog); remove it there to run "
+            f"another design"
+        )
     args.design = None
 
 
@@ -183,8 +247,9 @@ def _overrides(args):
     items = list(args.overrides)
     if args.design is not None and not args.design.startswith("verilog:"):
         if args.ports is not None:
-            raise UsageError("--ports is the port map of a Verilog design: it goes with "
-                             "--design verilog:FILE.v")
+            raise UsageError(
+                "--ports is the port map of a Verilog design: it goes with --design verilog:FILE.v"
+            )
         items.append(design_override(args.design))
     if args.resolution is not None:
         w, h = parse_resolution(args.resolution)
@@ -230,12 +295,16 @@ def _shadow_scenario(scenario, spec):
     if spec is None or not is_design_reference(spec):
         return None
     if scenario.sim.timing != "real_clock":
-        raise UsageError(f"--shadow {spec}: a second design runs on pins, in real-clock "
-                         f"timing; scenario {scenario.name!r} runs in compressed timing "
-                         f"(compare FollowTarget parameters there: --shadow KEY=VALUE)")
+        raise UsageError(
+            f"--shadow {spec}: a second design runs on pins, in real-clock "
+            f"timing; scenario {scenario.name!r} runs in compressed timing "
+            f"(compare FollowTarget parameters there: --shadow KEY=VALUE)"
+        )
     if scenario.foreign is not None:
-        raise UsageError(f"--shadow {spec}: scenario {scenario.name!r} runs a Verilog design "
-                         f"(design.verilog); a shadow design goes with an Amaranth one")
+        raise UsageError(
+            f"--shadow {spec}: scenario {scenario.name!r} runs a Verilog design "
+            f"(design.verilog); a shadow design goes with an Amaranth one"
+        )
     return scenario.with_overrides([design_override(spec)])
 
 
@@ -247,9 +316,13 @@ def _dress_target(scenario, color):
     if index is None:
         raise UsageError(f"--target-color: scenario {scenario.name!r} has no target person")
     rgb = "[" + ", ".join(str(c) for c in TARGET_CLOTHING[color]) + "]"
-    return scenario.with_overrides([f"people.{index}.shirt_color={rgb}",
-                                    f"people.{index}.trousers_color={rgb}",
-                                    f'color.initial="{color}"'])
+    return scenario.with_overrides(
+        [
+            f"people.{index}.shirt_color={rgb}",
+            f"people.{index}.trousers_color={rgb}",
+            f'color.initial="{color}"',
+        ]
+    )
 
 
 def _open_backend(name, params, quiet=False):
@@ -278,8 +351,10 @@ def _open_pin_design(args, scenario):
 
     if scenario.foreign is not None:  # a Verilog design on pins: on CXXRTL or Verilator
         if args.runtime:
-            raise UsageError("--runtime changes [runtime] inputs between frames in compressed "
-                             "timing; in real-clock timing they keep the port map's values")
+            raise UsageError(
+                "--runtime changes [runtime] inputs between frames in compressed "
+                "timing; in real-clock timing they keep the port map's values"
+            )
         try:
             return make_pin_backend(args.backend, scenario, on_build=tell)
         except (BackendError, PinError) as exc:
@@ -312,26 +387,26 @@ def _design_files(args, foreign=None):
         if args.ports is not None:
             raise UsageError("--ports goes with --design verilog:FILE.v")
         if getattr(args, "runtime", None):
-            raise UsageError("--runtime sets [runtime] inputs of a Verilog design: it goes with "
-                             "--design verilog:FILE.v (or a scenario's design.verilog)")
+            raise UsageError(
+                "--runtime sets [runtime] inputs of a Verilog design: it goes with "
+                "--design verilog:FILE.v (or a scenario's design.verilog)"
+            )
         return None
     runtime_values(args)  # a malformed item is an error before any build
     if args.design is not None:
-        if (not args.design.startswith("verilog:")
-                or not args.design[len("verilog:"):].strip(",")):
-            raise UsageError(
-                f"--design must be verilog:FILE.v[,MORE.v...], got {args.design!r}")
-        files = [f for f in args.design[len("verilog:"):].split(",") if f]
+        if not args.design.startswith("verilog:") or not args.design[len("verilog:") :].strip(","):
+            raise UsageError(f"--design must be verilog:FILE.v[,MORE.v...], got {args.design!r}")
+        files = [f for f in args.design[len("verilog:") :].split(",") if f]
     else:
         files = list(foreign.verilog)
-    ports = args.ports if args.ports is not None else (
-        foreign.ports if foreign is not None else None)
+    ports = (
+        args.ports if args.ports is not None else (foreign.ports if foreign is not None else None)
+    )
     if ports is None:
         raise UsageError("--design needs --ports PORTS.toml (the design's port map)")
     if args.backend not in FOREIGN_BACKENDS:
         what = "--design" if args.design is not None else "the scenario's design.verilog"
-        raise UsageError(f"{what} runs on the cxxrtl or verilator backend, not "
-                         f"{args.backend!r}")
+        raise UsageError(f"{what} runs on the cxxrtl or verilator backend, not {args.backend!r}")
     return files, ports
 
 
@@ -351,12 +426,12 @@ def _open_design(args, params, foreign=None):
 
     try:
         # Outputs the map does not name stay None: absent in the summary and the viewer.
-        backend = open_foreign_frames(args.backend, params, files=files, port_map=ports,
-                                      on_build=tell)
+        backend = open_foreign_frames(
+            args.backend, params, files=files, port_map=ports, on_build=tell
+        )
     except BackendError as exc:
         raise UsageError(f"--design: {exc}".splitlines()[0]) from None
-    missing = [k for k in ("motor_left", "motor_right") if k not in
-               backend.design.port_map.outputs]
+    missing = [k for k in ("motor_left", "motor_right") if k not in backend.design.port_map.outputs]
     if missing:
         backend.close()
         raise UsageError(f"--design: the closed loop needs outputs.{missing[0]} in the port map")
@@ -379,8 +454,9 @@ def runtime_values(args):
                 raise ValueError
             values[name.strip()] = int(value.strip(), 0)
         except ValueError:
-            raise UsageError(f"--runtime needs NAME=VALUE with an integer VALUE, got "
-                             f"{item!r}") from None
+            raise UsageError(
+                f"--runtime needs NAME=VALUE with an integer VALUE, got {item!r}"
+            ) from None
     return values
 
 
@@ -454,8 +530,12 @@ def _open_recorder(args, name):
         raise UsageError(f"--log-every must be >= 1, got {args.log_every}")
     from fpga_robotics.viz import open_recorder
 
-    recorder = open_recorder(args.rerun, default_path=f"runs/{name}.rrd", app_id="fpga_robotics",
-                         log_every=args.log_every)
+    recorder = open_recorder(
+        args.rerun,
+        default_path=f"runs/{name}.rrd",
+        app_id="fpga_robotics",
+        log_every=args.log_every,
+    )
     for line in recorder.pop_notices():  # where a live viewer is, or why it fell back
         print(line, file=sys.stderr)
     return recorder
@@ -488,7 +568,8 @@ def _close_outputs(recorder, ros, completed):
 def _frame_callback(video, ros):
     """The ``on_frame`` of a run: the video and the ROS outputs, each when asked for."""
     calls = ([lambda record: video.write(record.camera_rgb)] if video is not None else []) + (
-        [ros.on_frame] if ros.active else [])
+        [ros.on_frame] if ros.active else []
+    )
     if not calls:
         return None
     if len(calls) == 1:
@@ -511,9 +592,11 @@ def _run_source(args, scenario, ros):
 
     ros.check_closed_loop_only()
     if scenario.sim.timing == "real_clock":
-        raise UsageError(f"--source feeds camera frames to the design; scenario "
-                         f"{scenario.name!r} runs in real-clock timing (design.top = "
-                         f"{scenario.top!r}, sensors on pins): run it without --source")
+        raise UsageError(
+            f"--source feeds camera frames to the design; scenario "
+            f"{scenario.name!r} runs in real-clock timing (design.top = "
+            f"{scenario.top!r}, sensors on pins): run it without --source"
+        )
     params = scenario.params
     source = open_source(args.source, params.width, params.height)
     try:
@@ -525,10 +608,16 @@ def _run_source(args, scenario, ros):
             for line in ros.open(scenario, closed_loop=False):
                 print(line, file=sys.stderr)
             progress = None if args.quiet else Progress("frames")
-            out = run_source(source, design, color=scenario.color_initial, recorder=recorder,
-                             progress=progress, max_frames=args.max_frames,
-                             hfov=scenario.camera.hfov,
-                             on_frame=ros.on_frame if ros.active else None)
+            out = run_source(
+                source,
+                design,
+                color=scenario.color_initial,
+                recorder=recorder,
+                progress=progress,
+                max_frames=args.max_frames,
+                hfov=scenario.camera.hfov,
+                on_frame=ros.on_frame if ros.active else None,
+            )
             if progress is not None:
                 progress.finish()
             completed = True
@@ -537,13 +626,19 @@ def _run_source(args, scenario, ros):
             notices = _close_outputs(recorder, ros, completed)
     finally:
         source.close()
-    print(f"source {out['source']} ({out['source_kind']})  backend {out['backend']}  "
-          f"{out['resolution']}  colour {out['color']}")
+    print(
+        f"source {out['source']} ({out['source_kind']})  backend {out['backend']}  "
+        f"{out['resolution']}  colour {out['color']}"
+    )
     if out["frames"]:
-        print(f"  {out['frames']} frames, {out['ms_per_frame']:.2f} ms/frame "
-              f"(design {out['design_ms_per_frame']:.2f} ms)")
-        print(f"  target found in {out['found_frames']} frames ({out['found_fraction']:.0%}), "
-              f"mean proximity {out['mean_proximity']:.2f}")
+        print(
+            f"  {out['frames']} frames, {out['ms_per_frame']:.2f} ms/frame "
+            f"(design {out['design_ms_per_frame']:.2f} ms)"
+        )
+        print(
+            f"  target found in {out['found_frames']} frames ({out['found_fraction']:.0%}), "
+            f"mean proximity {out['mean_proximity']:.2f}"
+        )
     else:
         print("  no frames")
     for line in notices:
@@ -580,16 +675,17 @@ def main(argv=None, prog="fpga-robotics run"):
         if args.shadow is not None:
             raise UsageError("--shadow runs in the closed loop only (not with --source)")
         if args.save_video is not None:
-            raise UsageError("--save-video writes the simulated camera's frames: it goes with "
-                             "the closed loop, not with --source")
+            raise UsageError(
+                "--save-video writes the simulated camera's frames: it goes with "
+                "the closed loop, not with --source"
+            )
         if args.max_frames is not None and args.max_frames < 1:
             raise UsageError(f"--max-frames must be >= 1, got {args.max_frames}")
         return _run_source(args, scenario, ros)
     if args.max_frames is not None:
         raise UsageError("--max-frames only applies with --source (use --duration)")
     shadow_scenario = _shadow_scenario(scenario, args.shadow)
-    shadow_params = None if shadow_scenario is not None else _shadow_params(scenario,
-                                                                            args.shadow)
+    shadow_params = None if shadow_scenario is not None else _shadow_params(scenario, args.shadow)
     if args.save_video is not None:
         from fpga_robotics.loop.video_out import VideoPathError, check_video_path
 
@@ -603,8 +699,10 @@ def main(argv=None, prog="fpga-robotics run"):
     t0 = time.perf_counter()
     if scenario.sim.timing == "real_clock":
         if shadow_params is not None:
-            raise UsageError("--shadow compares frames; it needs a scenario in compressed "
-                             "timing (sim.timing), not real_clock")
+            raise UsageError(
+                "--shadow compares frames; it needs a scenario in compressed "
+                "timing (sim.timing), not real_clock"
+            )
         scenario = _with_design_files(args, scenario)
         design = _open_pin_design(args, scenario)
     else:
@@ -619,18 +717,25 @@ def main(argv=None, prog="fpga-robotics run"):
             shadow_args.backend = args.shadow_backend or args.backend
             shadow = _open_pin_design(shadow_args, shadow_scenario)
         if shadow_params is not None:
-            shadow = _open_backend(args.shadow_backend or args.backend, shadow_params,
-                                   args.quiet)
+            shadow = _open_backend(args.shadow_backend or args.backend, shadow_params, args.quiet)
         setup = time.perf_counter() - t0
         recorder = _open_recorder(args, scenario.name)
         for line in ros.open(scenario):
             print(line, file=sys.stderr)
         progress = None if args.quiet else Progress(scenario.name)
         with _video(args.save_video, scenario.camera.fps) as video:
-            result = run_scenario(scenario, seed=args.seed, backend=design, recorder=recorder,
-                                  progress=progress, realtime=args.realtime, shadow=shadow,
-                                  shadow_label=args.shadow or "shadow",
-                                  on_frame=_frame_callback(video, ros), controls=ros.controls)
+            result = run_scenario(
+                scenario,
+                seed=args.seed,
+                backend=design,
+                recorder=recorder,
+                progress=progress,
+                realtime=args.realtime,
+                shadow=shadow,
+                shadow_label=args.shadow or "shadow",
+                on_frame=_frame_callback(video, ros),
+                controls=ros.controls,
+            )
         if progress is not None:
             progress.finish()
         completed = True

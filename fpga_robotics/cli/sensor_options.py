@@ -46,44 +46,65 @@ def add_sensor_arguments(parser):
         for f in _option_fields(cls):
             default = "derived" if f.default is None else f.default
             if f.name in _CHOICES:
-                group.add_argument(_option(prefix, f.name), dest=_dest(key, f.name),
-                                   default=None, choices=_CHOICES[f.name],
-                                   help=f"{f.name} (default {default})")
+                group.add_argument(
+                    _option(prefix, f.name),
+                    dest=_dest(key, f.name),
+                    default=None,
+                    choices=_CHOICES[f.name],
+                    help=f"{f.name} (default {default})",
+                )
             else:
-                group.add_argument(_option(prefix, f.name), dest=_dest(key, f.name), type=int,
-                                   default=None, metavar="N",
-                                   help=f"{f.name} (default {default})")
+                group.add_argument(
+                    _option(prefix, f.name),
+                    dest=_dest(key, f.name),
+                    type=int,
+                    default=None,
+                    metavar="N",
+                    help=f"{f.name} (default {default})",
+                )
     parser.add_argument(
-        "--variant", default=None, metavar="NAME",
-        help="a seeded buggy variant of the top: " + "; ".join(
-            f"{v.name} (--top {v.design}: {v.bug})" for v in VARIANTS.values()))
+        "--variant",
+        default=None,
+        metavar="NAME",
+        help="a seeded buggy variant of the top: "
+        + "; ".join(f"{v.name} (--top {v.design}: {v.bug})" for v in VARIANTS.values()),
+    )
 
 
 def given_options(args, key):
     """The options of group ``key`` given on the command line, as ``{option: value}``."""
     cls, prefix, _, _ = SENSOR_GROUPS[key]
-    return {_option(prefix, f.name): getattr(args, _dest(key, f.name))
-            for f in _option_fields(cls) if getattr(args, _dest(key, f.name)) is not None}
+    return {
+        _option(prefix, f.name): getattr(args, _dest(key, f.name))
+        for f in _option_fields(cls)
+        if getattr(args, _dest(key, f.name)) is not None
+    }
 
 
 def sensor_params_from_args(args, key, top):
     """The params of group ``key`` from the options (with ``--variant`` applied when it
     changes this class); a bad value, or a variant of another top, raises ``UsageError``."""
     cls, _, heading, _ = SENSOR_GROUPS[key]
-    values = {f.name: getattr(args, _dest(key, f.name)) for f in _option_fields(cls)
-              if getattr(args, _dest(key, f.name)) is not None}
+    values = {
+        f.name: getattr(args, _dest(key, f.name))
+        for f in _option_fields(cls)
+        if getattr(args, _dest(key, f.name)) is not None
+    }
     try:
         params = cls(**values)
     except (TypeError, ValueError) as exc:
         raise UsageError(f"bad {heading} parameter: {exc}") from None
     if args.variant is not None:
         if args.variant not in VARIANTS:
-            raise UsageError(f"unknown --variant {args.variant!r}; known variants: "
-                             f"{', '.join(VARIANTS)}")
+            raise UsageError(
+                f"unknown --variant {args.variant!r}; known variants: {', '.join(VARIANTS)}"
+            )
         variant = VARIANTS[args.variant]
         if variant.design != top:
-            raise UsageError(f"--variant {args.variant} is a variant of --top {variant.design}, "
-                             f"not of --top {top}")
+            raise UsageError(
+                f"--variant {args.variant} is a variant of --top {variant.design}, "
+                f"not of --top {top}"
+            )
         if variant.params_type is cls:
             try:
                 params = variant_params(args.variant, params)

@@ -24,57 +24,116 @@ def build_parser(prog=PROG):
         prog=prog,
         usage=f"%(prog)s [CAMPAIGN] [options]\n       {prog} report DIR",
         description="Run a verification campaign (scenarios x seeds x a grid of overrides) on "
-                    "Dask and report where the design fails. `report DIR` rebuilds a report.",
-        epilog=f"shipped campaigns: {', '.join(shipped_campaigns())}")
-    p.add_argument("campaign", nargs="?", metavar="CAMPAIGN",
-                   help="a shipped campaign name or a .toml file (docs/campaigns.md)")
+        "Dask and report where the design fails. `report DIR` rebuilds a report.",
+        epilog=f"shipped campaigns: {', '.join(shipped_campaigns())}",
+    )
+    p.add_argument(
+        "campaign",
+        nargs="?",
+        metavar="CAMPAIGN",
+        help="a shipped campaign name or a .toml file (docs/campaigns.md)",
+    )
     g = p.add_argument_group("what runs (each overrides the campaign file)")
     g.add_argument("--scenarios", metavar="A,B", help="scenarios, comma-separated")
     g.add_argument("--seeds", metavar="A-B|A,B,C", help="seeds: a range or a list")
     g.add_argument("--backend", metavar="NAME", help="design simulator, as run --backend")
     g.add_argument("--resolution", metavar="WxH", help="as run --resolution")
     g.add_argument("--duration", type=float, metavar="S", help="as run --duration")
-    g.add_argument("--set", dest="fixed", action="append", default=None, metavar="KEY=VALUE",
-                   help="an override for every run, as run --set (repeatable)")
-    g.add_argument("--grid", action="append", default=[], metavar="KEY=[V1,V2]",
-                   help="a grid axis: a TOML list of values (repeatable; replaces the file's "
-                        "axis of that key)")
+    g.add_argument(
+        "--set",
+        dest="fixed",
+        action="append",
+        default=None,
+        metavar="KEY=VALUE",
+        help="an override for every run, as run --set (repeatable)",
+    )
+    g.add_argument(
+        "--grid",
+        action="append",
+        default=[],
+        metavar="KEY=[V1,V2]",
+        help="a grid axis: a TOML list of values (repeatable; replaces the file's "
+        "axis of that key)",
+    )
     g.add_argument("--shadow", metavar="SPEC", help="as run --shadow (e.g. published)")
     g.add_argument("--design", metavar="verilog:TOP.v", help="as run --design")
     g.add_argument("--ports", metavar="PORTS.toml", help="as run --ports")
-    g.add_argument("--timeout", type=float, metavar="S",
-                   help="per-run timeout (default 10x the run's expected time, at least 30 s)")
+    g.add_argument(
+        "--timeout",
+        type=float,
+        metavar="S",
+        help="per-run timeout (default 10x the run's expected time, at least 30 s)",
+    )
     g.add_argument("--max-runs", type=int, metavar="N", help="only the first N runs")
     e = p.add_argument_group("where and how")
-    e.add_argument("--workers", type=int, metavar="N",
-                   help="embedded cluster: N worker processes, one thread each (default: "
-                        "the machine's cores)")
-    e.add_argument("--scheduler", metavar="ADDRESS",
-                   help="use an existing Dask scheduler (tcp://HOST:8786) instead")
+    e.add_argument(
+        "--workers",
+        type=int,
+        metavar="N",
+        help="embedded cluster: N worker processes, one thread each (default: the machine's cores)",
+    )
+    e.add_argument(
+        "--scheduler",
+        metavar="ADDRESS",
+        help="use an existing Dask scheduler (tcp://HOST:8786) instead",
+    )
     e.add_argument("--out", metavar="DIR", help="results folder (default runs/sweeps/NAME)")
-    e.add_argument("--resume", action="store_true",
-                   help="keep the runs already in --out and run only the others")
-    e.add_argument("--record", choices=RECORD, default="failing",
-                   help="save the .rrd recording of failing runs (default), all or none")
-    e.add_argument("--bag", action="store_true",
-                   help="also write each recorded run as a ROS 2 bag, OUT/bags/RUN_ID/ "
-                        "(docs/ros.md)")
-    e.add_argument("--log-every", type=int, default=None, metavar="N",
-                   help="recordings log every Nth frame's images (default "
-                        f"{RECORD_LOG_EVERY}; the replay command records every frame)")
-    e.add_argument("--dry-run", action="store_true",
-                   help="print the run count and three example commands, run nothing")
+    e.add_argument(
+        "--resume",
+        action="store_true",
+        help="keep the runs already in --out and run only the others",
+    )
+    e.add_argument(
+        "--record",
+        choices=RECORD,
+        default="failing",
+        help="save the .rrd recording of failing runs (default), all or none",
+    )
+    e.add_argument(
+        "--bag",
+        action="store_true",
+        help="also write each recorded run as a ROS 2 bag, OUT/bags/RUN_ID/ (docs/ros.md)",
+    )
+    e.add_argument(
+        "--log-every",
+        type=int,
+        default=None,
+        metavar="N",
+        help="recordings log every Nth frame's images (default "
+        f"{RECORD_LOG_EVERY}; the replay command records every frame)",
+    )
+    e.add_argument(
+        "--dry-run",
+        action="store_true",
+        help="print the run count and three example commands, run nothing",
+    )
     e.add_argument("--quiet", action="store_true", help="no progress bar")
-    e.add_argument("--strict", action="store_true",
-                   help="refuse a campaign whose scenarios load with warnings (a waypoint "
-                        "inside furniture, a check no run can meet...) instead of printing "
-                        "them")
-    e.add_argument("--bench", action="store_true",
-                   help="benchmark: the same runs on 1 worker and on N (--workers) workers")
-    e.add_argument("--bench-runs", type=int, default=40, metavar="N",
-                   help="with --bench: runs per measurement (default 40)")
-    e.add_argument("--bench-repeats", type=int, default=3, metavar="N",
-                   help="with --bench: measurements each way (default 3; medians)")
+    e.add_argument(
+        "--strict",
+        action="store_true",
+        help="refuse a campaign whose scenarios load with warnings (a waypoint "
+        "inside furniture, a check no run can meet...) instead of printing "
+        "them",
+    )
+    e.add_argument(
+        "--bench",
+        action="store_true",
+        help="benchmark: the same runs on 1 worker and on N (--workers) workers",
+    )
+    e.add_argument(
+        "--bench-runs",
+        type=int,
+        default=40,
+        metavar="N",
+        help="with --bench: runs per measurement (default 40)",
+    )
+    e.add_argument(
+        "--bench-repeats",
+        type=int,
+        default=3,
+        metavar="N",
+        help="with --bench: measurements each way (default 3; medians)",
+    )
     return p
 
 
@@ -85,9 +144,11 @@ def _merge_options(data, args):
         data["scenarios"] = [s for s in args.scenarios.split(",") if s]
     if args.seeds is not None:
         text = args.seeds.strip()
-        data["seeds"] = ([int(s) for s in text.split(",") if s.strip()]
-                         if "," in text and all(s.strip().isdigit() for s in text.split(","))
-                         else text)
+        data["seeds"] = (
+            [int(s) for s in text.split(",") if s.strip()]
+            if "," in text and all(s.strip().isdigit() for s in text.split(","))
+            else text
+        )
     for key in ("backend", "resolution", "duration", "shadow", "design", "ports", "timeout"):
         value = getattr(args, key)
         if value is not None:
@@ -106,9 +167,11 @@ def _merge_options(data, args):
 def _campaign(args):
     if args.campaign is None:
         if args.scenarios is None:
-            raise UsageError("give a campaign (a shipped name: "
-                             f"{', '.join(shipped_campaigns())}; or a .toml file), or "
-                             "--scenarios")
+            raise UsageError(
+                "give a campaign (a shipped name: "
+                f"{', '.join(shipped_campaigns())}; or a .toml file), or "
+                "--scenarios"
+            )
         data, source = {"name": "campaign"}, ""
     else:
         data, path = read_campaign_file(args.campaign)
@@ -125,17 +188,21 @@ def _check_counts(args):
     if args.timeout is not None and not args.timeout > 0:
         raise UsageError(f"--timeout must be > 0 seconds, got {args.timeout}")
     if args.workers is not None and args.scheduler is not None:
-        raise UsageError("--workers sizes the embedded cluster; with --scheduler the cluster "
-                         "has the workers you started (`dask worker ADDRESS`)")
+        raise UsageError(
+            "--workers sizes the embedded cluster; with --scheduler the cluster "
+            "has the workers you started (`dask worker ADDRESS`)"
+        )
 
 
 def _dry_run(campaign, args):
     from fpga_robotics.sweep.plan import make_plan
 
     plan = make_plan(campaign)
-    runs = plan.runs[:args.max_runs] if args.max_runs else plan.runs
-    print(f"campaign {campaign.name}: {len(runs)} runs "
-          f"({len(plan.builds)} design parameter set(s) to build)")
+    runs = plan.runs[: args.max_runs] if args.max_runs else plan.runs
+    print(
+        f"campaign {campaign.name}: {len(runs)} runs "
+        f"({len(plan.builds)} design parameter set(s) to build)"
+    )
     step = max(1, len(runs) // 3)
     for spec in runs[::step][:3]:
         print(f"  {spec.replay()}")
@@ -143,8 +210,9 @@ def _dry_run(campaign, args):
 
 
 def _report(argv, prog):
-    p = CommandParser(prog=f"{prog} report",
-                      description="Rebuild report.html from a campaign's results.")
+    p = CommandParser(
+        prog=f"{prog} report", description="Rebuild report.html from a campaign's results."
+    )
     p.add_argument("dir", metavar="DIR", help="the campaign's results folder")
     args = p.parse_args(argv)
     from fpga_robotics.sweep.api import report_dir
@@ -183,21 +251,36 @@ def main(argv=None, prog=PROG):
             print(text, file=sys.stderr, flush=True)
 
     if args.bag and args.record == "none":
-        raise UsageError("--bag writes the recorded runs as ROS 2 bags: it needs --record "
-                         "failing (the default) or all")
+        raise UsageError(
+            "--bag writes the recorded runs as ROS 2 bags: it needs --record "
+            "failing (the default) or all"
+        )
     try:
-        rows = run_campaign(campaign, out, workers=args.workers, scheduler=args.scheduler,
-                            resume=args.resume, record=args.record, timeout=args.timeout,
-                            max_runs=args.max_runs, quiet=args.quiet, echo=echo,
-                            log_every=args.log_every or RECORD_LOG_EVERY, bag=args.bag)
+        rows = run_campaign(
+            campaign,
+            out,
+            workers=args.workers,
+            scheduler=args.scheduler,
+            resume=args.resume,
+            record=args.record,
+            timeout=args.timeout,
+            max_runs=args.max_runs,
+            quiet=args.quiet,
+            echo=echo,
+            log_every=args.log_every or RECORD_LOG_EVERY,
+            bag=args.bag,
+        )
     except KeyboardInterrupt:
         kept = len(load_rows(out))
-        print(f"interrupted: {kept} finished run(s) kept in {out}; continue with --resume",
-              file=sys.stderr)
+        print(
+            f"interrupted: {kept} finished run(s) kept in {out}; continue with --resume",
+            file=sys.stderr,
+        )
         raise
     axes = campaign.axes
     print(format_report(rows, axes, campaign.known_limits))
-    print(f"results: {out / 'results.parquet'}, {out / 'results.csv'}; "
-          f"report: {out / 'report.html'}")
+    print(
+        f"results: {out / 'results.parquet'}, {out / 'results.csv'}; report: {out / 'report.html'}"
+    )
     # A failure a [[known_limits]] entry explains is a limit of the design, not a regression.
     return 0 if campaign_passed(rows, campaign.known_limits) else 1

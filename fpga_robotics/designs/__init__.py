@@ -6,5 +6,4 @@ foreign Verilog designs (``port_maps/``)."""
 from fpga_robotics.designs.builtin import TOPS, Top, get_top, register_top
 from fpga_robotics.designs.reference import DesignError, DesignSpec, resolve_design
 
-__all__ = ["TOPS", "DesignError", "DesignSpec", "Top", "get_top", "register_top",
-           "resolve_design"]
+__all__ = ["TOPS", "DesignError", "DesignSpec", "Top", "get_top", "register_top", "resolve_design"]

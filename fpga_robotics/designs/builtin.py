@@ -13,8 +13,17 @@ import dataclasses
 import importlib
 from dataclasses import dataclass, field
 
-__all__ = ["TOPS", "Top", "build_component", "connector_kinds", "design_tables", "foreign_top",
-           "get_top", "register_top", "table_fields"]
+__all__ = [
+    "TOPS",
+    "Top",
+    "build_component",
+    "connector_kinds",
+    "design_tables",
+    "foreign_top",
+    "get_top",
+    "register_top",
+    "table_fields",
+]
 
 
 @dataclass(frozen=True)
@@ -43,21 +52,26 @@ _WHEELS = {"wheels": {"motor_left": "motor_left", "motor_right": "motor_right"}}
 
 TOPS = {
     "follow_target": Top(
-        "follow_target", "FollowTarget: colour filter, tracker and motor controller",
-        camera=True),
+        "follow_target", "FollowTarget: colour filter, tracker and motor controller", camera=True
+    ),
     "follow_target_safe": Top(
         "follow_target_safe",
         "FollowTarget with an HC-SR04 ultrasound driver and an obstacle interlock",
         camera=True,
-        tables={"ultrasound": ("fpga_robotics.hw.sensor_params", "UltrasoundParams"),
-                "interlock": ("fpga_robotics.hw.sensor_params", "InterlockParams")},
-        component=("fpga_robotics.hw.safe_follow", "FollowTargetSafe")),
+        tables={
+            "ultrasound": ("fpga_robotics.hw.sensor_params", "UltrasoundParams"),
+            "interlock": ("fpga_robotics.hw.sensor_params", "InterlockParams"),
+        },
+        component=("fpga_robotics.hw.safe_follow", "FollowTargetSafe"),
+    ),
     "follow_line": Top(
-        "follow_line", "FollowLine: KY-033 line sensors to wheel speeds",
+        "follow_line",
+        "FollowLine: KY-033 line sensors to wheel speeds",
         camera=False,
         tables={"line": ("fpga_robotics.hw.sensor_params", "FollowLineParams")},
         component=("fpga_robotics.hw.follow_line", "FollowLine"),
-        takes_follow_target_params=False),
+        takes_follow_target_params=False,
+    ),
 }
 
 
@@ -73,8 +87,9 @@ def get_top(name):
     try:
         return TOPS[name]
     except KeyError:
-        raise ValueError(f"design.top must be one of {', '.join(map(repr, TOPS))}, "
-                         f"got {name!r}") from None
+        raise ValueError(
+            f"design.top must be one of {', '.join(map(repr, TOPS))}, got {name!r}"
+        ) from None
 
 
 def foreign_top(port_map):
@@ -83,14 +98,21 @@ def foreign_top(port_map):
     ``motor_right`` (the map's ``outputs``), each ``[connectors.<kind>]`` table as it binds.
     Not registered: built from the scenario's map each time."""
     wheels = all(k in port_map.outputs for k in _WHEELS["wheels"])
-    bindings = {**(_WHEELS if wheels else {}),
-                **{kind: dict(pins) for kind, pins in port_map.connectors.items()}}
+    bindings = {
+        **(_WHEELS if wheels else {}),
+        **{kind: dict(pins) for kind, pins in port_map.connectors.items()},
+    }
     if port_map.has_pixels:
         bindings.update(_CAMERA)
-    return Top(f"verilog:{port_map.top}", f"the Verilog design {port_map.top} (port map)",
-               camera=port_map.has_pixels, bindings=bindings,
-               extra_outputs=dict(port_map.extra_outputs), component=None,
-               takes_follow_target_params=False)
+    return Top(
+        f"verilog:{port_map.top}",
+        f"the Verilog design {port_map.top} (port map)",
+        camera=port_map.has_pixels,
+        bindings=bindings,
+        extra_outputs=dict(port_map.extra_outputs),
+        component=None,
+        takes_follow_target_params=False,
+    )
 
 
 def connector_kinds():
@@ -98,8 +120,11 @@ def connector_kinds():
     kind -> {pin: (direction, at most this many bits)} (``port_map.check_connectors``)."""
     from fpga_robotics.loop.connectors import CONNECTORS
 
-    return {kind: {pin: (spec.direction, spec.width) for pin, spec in cls.pins.items()}
-            for kind, cls in CONNECTORS.items() if kind not in ("camera", "wheels")}
+    return {
+        kind: {pin: (spec.direction, spec.width) for pin, spec in cls.pins.items()}
+        for kind, cls in CONNECTORS.items()
+        if kind not in ("camera", "wheels")
+    }
 
 
 def _load(where):
@@ -128,8 +153,9 @@ def design_tables(top, tables, variant=None):
         known = {f.name: f for f in dataclasses.fields(cls) if f.init}
         for name, value in values.items():
             if name not in known:
-                raise ValueError(f"unknown key design.{key}.{name}; known: "
-                                 f"{', '.join(sorted(known))}")
+                raise ValueError(
+                    f"unknown key design.{key}.{name}; known: {', '.join(sorted(known))}"
+                )
             if isinstance(value, list):
                 values[name] = tuple(value)
         try:
@@ -146,9 +172,12 @@ def _with_variant(top, tables, name):
 
     names = [n for n, v in VARIANTS.items() if v.design == top.name]
     if name not in names:
-        raise ValueError(f"design.variant must be one of {', '.join(map(repr, names))} for "
-                         f"design.top = {top.name!r}, got {name!r}" if names else
-                         f"design.top = {top.name!r} has no variants (design.variant)")
+        raise ValueError(
+            f"design.variant must be one of {', '.join(map(repr, names))} for "
+            f"design.top = {top.name!r}, got {name!r}"
+            if names
+            else f"design.top = {top.name!r} has no variants (design.variant)"
+        )
     params_type = VARIANTS[name].params_type
     key = next(k for k, v in tables.items() if isinstance(v, params_type))
     try:

@@ -34,8 +34,17 @@ from pathlib import Path
 from fpga_robotics.designs.builtin import TOPS, Top
 from fpga_robotics.hw.errors import UsageError
 
-__all__ = ["ENTRY_POINT_GROUP", "FRAME_OUTPUTS", "DesignError", "DesignSpec", "bindings_of",
-           "entry_point_designs", "extra_outputs_of", "is_builtin", "resolve_design"]
+__all__ = [
+    "ENTRY_POINT_GROUP",
+    "FRAME_OUTPUTS",
+    "DesignError",
+    "DesignSpec",
+    "bindings_of",
+    "entry_point_designs",
+    "extra_outputs_of",
+    "is_builtin",
+    "resolve_design",
+]
 
 #: The entry-point group through which installed packages offer designs.
 ENTRY_POINT_GROUP = "fpga_robotics.designs"
@@ -107,8 +116,7 @@ def is_builtin(reference):
 
 def entry_point_designs():
     """Designs installed packages register: name -> ``"module:Name"``."""
-    return {ep.name: ep.value
-            for ep in importlib.metadata.entry_points(group=ENTRY_POINT_GROUP)}
+    return {ep.name: ep.value for ep in importlib.metadata.entry_points(group=ENTRY_POINT_GROUP)}
 
 
 def resolve_design(reference, params=None, *, ports=None, base=None):
@@ -118,18 +126,22 @@ def resolve_design(reference, params=None, *, ports=None, base=None):
     paths are taken from (a scenario file's; default the current folder). Raises
     ``DesignError`` (one line: what is wrong and how to fix it)."""
     if not isinstance(reference, str) or not reference.strip():
-        raise DesignError(f"design.top must be a design reference (a built-in name, "
-                          f"FILE.py:Name, package.module:Name or verilog:FILE.v), got "
-                          f"{reference!r}")
+        raise DesignError(
+            f"design.top must be a design reference (a built-in name, "
+            f"FILE.py:Name, package.module:Name or verilog:FILE.v), got "
+            f"{reference!r}"
+        )
     params = dict(params or {})
     reference = reference.strip()
     if reference.startswith("verilog:"):
         return _verilog_spec(reference, ports, base, params)
     if reference in TOPS:
         if params:
-            raise DesignError(f"design.params: the built-in design {reference!r} takes its "
-                              f"parameters from [design] and its own tables, not "
-                              f"design.params ({', '.join(sorted(params))})")
+            raise DesignError(
+                f"design.params: the built-in design {reference!r} takes its "
+                f"parameters from [design] and its own tables, not "
+                f"design.params ({', '.join(sorted(params))})"
+            )
         return _builtin_spec(TOPS[reference])
     installed = entry_point_designs()
     target = installed.get(reference, reference)
@@ -137,7 +149,8 @@ def resolve_design(reference, params=None, *, ports=None, base=None):
         raise DesignError(
             f"unknown design {reference!r}: give a built-in name ({', '.join(TOPS)}"
             f"{', ' + ', '.join(installed) if installed else ''}), FILE.py:Name, "
-            f"package.module:Name or verilog:FILE.v")
+            f"package.module:Name or verilog:FILE.v"
+        )
     where, _, name = target.rpartition(":")
     if where.endswith(".py"):
         path = Path(where).expanduser()
@@ -179,18 +192,24 @@ def _builtin_spec(registered):
     from fpga_robotics.designs.builtin import build_component, design_tables
     from fpga_robotics.hw.params import FollowTargetParams
 
-    component = build_component(registered, FollowTargetParams(),
-                                design_tables(registered, {}))
+    component = build_component(registered, FollowTargetParams(), design_tables(registered, {}))
     ports = component_ports(component)
     bindings = bindings_of(component, ports, registered.bindings)
     extra = {n: n for n in extra_outputs_of(ports, bindings)}
     extra.update(registered.extra_outputs)
-    top = Top(registered.name, registered.description, camera="camera" in bindings,
-              tables=registered.tables, bindings=bindings, extra_outputs=extra,
-              component=registered.component,
-              takes_follow_target_params=registered.takes_follow_target_params)
-    spec = DesignSpec(registered.name, "builtin", registered.description, ports, bindings,
-                      tuple(extra), {}, top)
+    top = Top(
+        registered.name,
+        registered.description,
+        camera="camera" in bindings,
+        tables=registered.tables,
+        bindings=bindings,
+        extra_outputs=extra,
+        component=registered.component,
+        takes_follow_target_params=registered.takes_follow_target_params,
+    )
+    spec = DesignSpec(
+        registered.name, "builtin", registered.description, ports, bindings, tuple(extra), {}, top
+    )
     _TOP_SPECS[id(registered)] = (registered, spec)
     return spec
 
@@ -211,50 +230,72 @@ def _amaranth_spec(reference, frozen_params, _stamp):
     doc = (inspect.getdoc(target) or "").strip().splitlines()
     description = doc[0] if doc else f"the Amaranth design {reference.rpartition(':')[2]}"
     name = reference.rpartition(":")[2]
-    top = Top(name, description, camera="camera" in bindings, bindings=bindings,
-              extra_outputs={n: n for n in extra}, component=factory,
-              takes_follow_target_params=False)
+    top = Top(
+        name,
+        description,
+        camera="camera" in bindings,
+        bindings=bindings,
+        extra_outputs={n: n for n in extra},
+        component=factory,
+        takes_follow_target_params=False,
+    )
     return DesignSpec(reference, "amaranth", description, ports, bindings, extra, params, top)
 
 
 def _load_target(reference):
     where, _, name = reference.rpartition(":")
     if not name.isidentifier():
-        raise DesignError(f"design {reference!r}: {name!r} is not a Python name; write "
-                          f"FILE.py:ClassName or package.module:ClassName")
+        raise DesignError(
+            f"design {reference!r}: {name!r} is not a Python name; write "
+            f"FILE.py:ClassName or package.module:ClassName"
+        )
     if where.endswith(".py"):
         module = _load_file(Path(where), reference)
     else:
         try:
             module = importlib.import_module(where)
         except ModuleNotFoundError as exc:
-            raise DesignError(f"design {reference!r}: no module {exc.name!r}; install the "
-                              f"package or give the file as path/to/file.py:{name}") from None
+            raise DesignError(
+                f"design {reference!r}: no module {exc.name!r}; install the "
+                f"package or give the file as path/to/file.py:{name}"
+            ) from None
         except Exception as exc:  # noqa: BLE001 - the user's module may raise anything
-            raise DesignError(f"design {reference!r}: importing {where} raised "
-                              f"{type(exc).__name__}: {_first_line(exc)}") from None
+            raise DesignError(
+                f"design {reference!r}: importing {where} raised "
+                f"{type(exc).__name__}: {_first_line(exc)}"
+            ) from None
     target = getattr(module, name, None)
     if target is None:
-        found = sorted(n for n, v in vars(module).items() if _is_component_class(v)
-                       and v.__module__ == module.__name__)
-        raise DesignError(f"design {reference!r}: {where} has no {name!r}"
-                          + (f"; its components: {', '.join(found)}" if found else ""))
+        found = sorted(
+            n
+            for n, v in vars(module).items()
+            if _is_component_class(v) and v.__module__ == module.__name__
+        )
+        raise DesignError(
+            f"design {reference!r}: {where} has no {name!r}"
+            + (f"; its components: {', '.join(found)}" if found else "")
+        )
     if not callable(target):
-        raise DesignError(f"design {reference!r}: {name} is a {type(target).__name__}; it "
-                          f"must be a wiring.Component class or a function returning one")
+        raise DesignError(
+            f"design {reference!r}: {name} is a {type(target).__name__}; it "
+            f"must be a wiring.Component class or a function returning one"
+        )
     if inspect.isclass(target) and not _is_component_class(target):
-        raise DesignError(f"design {reference!r}: class {name} is not an Amaranth "
-                          f"wiring.Component; derive it from amaranth.lib.wiring.Component")
+        raise DesignError(
+            f"design {reference!r}: class {name} is not an Amaranth "
+            f"wiring.Component; derive it from amaranth.lib.wiring.Component"
+        )
     return target
 
 
 def _load_file(path, reference):
     if not path.is_file():
-        raise DesignError(f"design {reference!r}: no file {str(path)!r}; give the path of "
-                          f"a .py file (relative paths from the scenario file's folder)")
+        raise DesignError(
+            f"design {reference!r}: no file {str(path)!r}; give the path of "
+            f"a .py file (relative paths from the scenario file's folder)"
+        )
     # A module name of its own per file, so that two files of one name do not collide.
-    name = "fpga_robotics_user_design_" + hashlib.sha256(
-        str(path).encode()).hexdigest()[:12]
+    name = "fpga_robotics_user_design_" + hashlib.sha256(str(path).encode()).hexdigest()[:12]
     spec = importlib.util.spec_from_file_location(name, path)
     module = importlib.util.module_from_spec(spec)
     sys.modules[name] = module
@@ -263,8 +304,10 @@ def _load_file(path, reference):
     except Exception as exc:  # noqa: BLE001 - the user's file may raise anything
         sys.modules.pop(name, None)
         line = _error_line(exc, path)
-        raise DesignError(f"design {reference!r}: loading {path.name}{line} raised "
-                          f"{type(exc).__name__}: {_first_line(exc)}") from None
+        raise DesignError(
+            f"design {reference!r}: loading {path.name}{line} raised "
+            f"{type(exc).__name__}: {_first_line(exc)}"
+        ) from None
     return module
 
 
@@ -298,32 +341,47 @@ def _check_params(target, params, reference):
         signature = inspect.signature(target)
     except (TypeError, ValueError):
         return
-    known = {n: p for n, p in signature.parameters.items()
-             if p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY)}
+    known = {
+        n: p
+        for n, p in signature.parameters.items()
+        if p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY)
+    }
     takes_any = any(p.kind == p.VAR_KEYWORD for p in signature.parameters.values())
     name = reference.rpartition(":")[2]
     for key, value in params.items():
         if key not in known:
             if takes_any:
                 continue
-            raise DesignError(f"design.params.{key}: {name} takes no parameter {key!r}; it "
-                              f"takes: {', '.join(known) or 'none'}")
+            raise DesignError(
+                f"design.params.{key}: {name} takes no parameter {key!r}; it "
+                f"takes: {', '.join(known) or 'none'}"
+            )
         expected = _expected_type(known[key])
         if expected is not None and not _fits(value, expected):
-            raise DesignError(f"design.params.{key} must be {_type_name(expected)} (a "
-                              f"parameter of {name}), got {value!r}")
+            raise DesignError(
+                f"design.params.{key} must be {_type_name(expected)} (a "
+                f"parameter of {name}), got {value!r}"
+            )
     missing = [n for n, p in known.items() if p.default is p.empty and n not in params]
     if missing:
-        raise DesignError(f"design {reference!r}: parameter {missing[0]!r} has no default; "
-                          f"give it in [design.params] (or --set design.params."
-                          f"{missing[0]}=VALUE)")
+        raise DesignError(
+            f"design {reference!r}: parameter {missing[0]!r} has no default; "
+            f"give it in [design.params] (or --set design.params."
+            f"{missing[0]}=VALUE)"
+        )
 
 
 def _expected_type(parameter):
     annotation = parameter.annotation
     if isinstance(annotation, str):  # from __future__ import annotations
-        annotation = {"int": int, "float": float, "bool": bool, "str": str,
-                      "list": list, "tuple": tuple}.get(annotation)
+        annotation = {
+            "int": int,
+            "float": float,
+            "bool": bool,
+            "str": str,
+            "list": list,
+            "tuple": tuple,
+        }.get(annotation)
     if annotation in (int, float, bool, str, list, tuple):
         return annotation
     default = parameter.default
@@ -347,8 +405,14 @@ def _fits(value, expected):
 
 
 def _type_name(kind):
-    return {int: "an integer", float: "a number", bool: "true or false", str: "a string",
-            list: "an array", tuple: "an array"}[kind]
+    return {
+        int: "an integer",
+        float: "a number",
+        bool: "true or false",
+        str: "a string",
+        list: "an array",
+        tuple: "an array",
+    }[kind]
 
 
 def _call(target, params, reference):
@@ -359,11 +423,14 @@ def _call(target, params, reference):
     try:
         component = target(**values)
     except Exception as exc:  # noqa: BLE001 - the user's constructor may raise anything
-        raise DesignError(f"design {reference!r}: building it raised "
-                          f"{type(exc).__name__}: {_first_line(exc)}") from None
+        raise DesignError(
+            f"design {reference!r}: building it raised {type(exc).__name__}: {_first_line(exc)}"
+        ) from None
     if not isinstance(component, wiring.Component):
-        raise DesignError(f"design {reference!r}: it returned {type(component).__name__}, "
-                          f"not an Amaranth wiring.Component")
+        raise DesignError(
+            f"design {reference!r}: it returned {type(component).__name__}, "
+            f"not an Amaranth wiring.Component"
+        )
     return component
 
 
@@ -374,8 +441,10 @@ def component_ports(component):
 
     from fpga_robotics.hw.verilog import verilog_ports
 
-    ports = {name: ("in" if direction == "i" else "out", value.shape().width)
-             for name, (value, direction) in verilog_ports(component).items()}
+    ports = {
+        name: ("in" if direction == "i" else "out", value.shape().width)
+        for name, (value, direction) in verilog_ports(component).items()
+    }
     # Elaborated once, so that neither it nor the submodules its constructor made warn
     # when collected unused (a design that cannot elaborate fails when built for a run).
     with contextlib.suppress(Exception):
@@ -396,36 +465,48 @@ def bindings_of(component, ports, given=None):
     stream input, ``color_sel`` when it has one)."""
     declared = getattr(component, "connectors", None) or {}
     if not isinstance(declared, dict):
-        raise DesignError(f"{type(component).__name__}.connectors must be a dict "
-                          f"{{kind: {{pin: port}}}}, got {declared!r}")
+        raise DesignError(
+            f"{type(component).__name__}.connectors must be a dict "
+            f"{{kind: {{pin: port}}}}, got {declared!r}"
+        )
     declared = {**declared, **(given or {})}
     kinds = _connector_pins()
     bindings = {}
     for kind, pins in declared.items():
         if kind not in kinds:
-            raise DesignError(f"{type(component).__name__}.connectors: unknown connector kind "
-                              f"{kind!r}; known: {', '.join(sorted(kinds))}")
+            raise DesignError(
+                f"{type(component).__name__}.connectors: unknown connector kind "
+                f"{kind!r}; known: {', '.join(sorted(kinds))}"
+            )
         if not isinstance(pins, dict):
-            raise DesignError(f"{type(component).__name__}.connectors[{kind!r}] must be a dict "
-                              f"{{pin: port}}, got {pins!r}")
+            raise DesignError(
+                f"{type(component).__name__}.connectors[{kind!r}] must be a dict "
+                f"{{pin: port}}, got {pins!r}"
+            )
         for pin, port in pins.items():
             if pin not in kinds[kind]:
-                raise DesignError(f"{type(component).__name__}.connectors[{kind!r}]: the "
-                                  f"{kind} connector has no pin {pin!r}; its pins: "
-                                  f"{', '.join(kinds[kind])}")
+                raise DesignError(
+                    f"{type(component).__name__}.connectors[{kind!r}]: the "
+                    f"{kind} connector has no pin {pin!r}; its pins: "
+                    f"{', '.join(kinds[kind])}"
+                )
             if kind == "camera" and pin == "pixels":
                 continue  # the stream: pixels__valid / pixels__payload
             if port not in ports:
-                raise DesignError(f"{type(component).__name__}.connectors[{kind!r}][{pin!r}]: "
-                                  f"no port {port!r}; its ports: {', '.join(ports)}")
+                raise DesignError(
+                    f"{type(component).__name__}.connectors[{kind!r}][{pin!r}]: "
+                    f"no port {port!r}; its ports: {', '.join(ports)}"
+                )
         bindings[kind] = dict(pins)
     for kind, pins in kinds.items():
         if kind in bindings:
             continue
         if kind == "camera":
             if all(ports.get(p, ("",))[0] == "in" for p in CAMERA_PORTS):
-                bindings[kind] = {"pixels": "pixels", **(
-                    {"color_sel": "color_sel"} if "color_sel" in ports else {})}
+                bindings[kind] = {
+                    "pixels": "pixels",
+                    **({"color_sel": "color_sel"} if "color_sel" in ports else {}),
+                }
         elif pins and all(p in ports for p in pins):
             bindings[kind] = {p: p for p in pins}
     return bindings
@@ -435,9 +516,13 @@ def extra_outputs_of(ports, bindings):
     """The outputs no connector reads and that are not FollowTarget's per-frame outputs."""
     bound = {port for pins in bindings.values() for port in pins.values()}
     camera = "camera" in bindings
-    return tuple(name for name, (direction, _width) in ports.items()
-                 if direction == "out" and name not in bound
-                 and not (camera and (name in FRAME_OUTPUTS or name in _STREAM_OUTPUTS)))
+    return tuple(
+        name
+        for name, (direction, _width) in ports.items()
+        if direction == "out"
+        and name not in bound
+        and not (camera and (name in FRAME_OUTPUTS or name in _STREAM_OUTPUTS))
+    )
 
 
 # Verilog designs ------------------------------------------------------------------------
@@ -447,35 +532,49 @@ def _verilog_spec(reference, ports, base, params):
     from fpga_robotics.designs.builtin import foreign_top
     from fpga_robotics.sim.backends.port_map import PortMapError, load_port_map
 
-    files = [f for f in reference[len("verilog:"):].split(",") if f.strip()]
+    files = [f for f in reference[len("verilog:") :].split(",") if f.strip()]
     if not files:
-        raise DesignError(f"design {reference!r}: name the Verilog files, "
-                          f"verilog:TOP.v[,MORE.v...]")
+        raise DesignError(
+            f"design {reference!r}: name the Verilog files, verilog:TOP.v[,MORE.v...]"
+        )
     if params:
-        raise DesignError("design.params: a Verilog design takes no parameters here; set "
-                          "its parameters in the Verilog (or tie inputs in the port map's "
-                          "[constants])")
+        raise DesignError(
+            "design.params: a Verilog design takes no parameters here; set "
+            "its parameters in the Verilog (or tie inputs in the port map's "
+            "[constants])"
+        )
     resolved = []
     for text in files:
         path = Path(text).expanduser()
         if not path.is_absolute() and base is not None:
             path = Path(base) / path
         if not path.is_file():
-            raise DesignError(f"design {reference!r}: no file {text!r} (looked for "
-                              f"{str(path)!r})")
+            raise DesignError(f"design {reference!r}: no file {text!r} (looked for {str(path)!r})")
         resolved.append(str(path))
     if ports is None:
-        raise DesignError(f"design {reference!r} needs its port map: --ports PORTS.toml "
-                          f"(or design.ports in the scenario; docs/foreign.md)")
+        raise DesignError(
+            f"design {reference!r} needs its port map: --ports PORTS.toml "
+            f"(or design.ports in the scenario; docs/foreign.md)"
+        )
     try:
         port_map = load_port_map(ports)
     except PortMapError as exc:
         raise DesignError(f"design {reference!r}: {ports}: {exc}") from None
     top = foreign_top(port_map)
-    wheels = {k: port_map.outputs[k].port for k in ("motor_left", "motor_right")
-              if k in port_map.outputs}
-    bindings = {**{k: v for k, v in top.bindings.items() if k != "wheels"},
-                **({"wheels": wheels} if wheels else {})}
-    return DesignSpec("verilog:" + ",".join(resolved), "verilog",
-                      f"the Verilog design {port_map.top} (port map {ports})", {}, bindings,
-                      (), {}, top)
+    wheels = {
+        k: port_map.outputs[k].port for k in ("motor_left", "motor_right") if k in port_map.outputs
+    }
+    bindings = {
+        **{k: v for k, v in top.bindings.items() if k != "wheels"},
+        **({"wheels": wheels} if wheels else {}),
+    }
+    return DesignSpec(
+        "verilog:" + ",".join(resolved),
+        "verilog",
+        f"the Verilog design {port_map.top} (port map {ports})",
+        {},
+        bindings,
+        (),
+        {},
+        top,
+    )

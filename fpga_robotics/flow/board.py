@@ -85,8 +85,13 @@ def _plan(board, params, nextpnr_opts=(), *, verilog=False):
     factory = board_factory(board)
     try:
         platform, top = factory(params)
-        return platform.build(top, name=DESIGN_NAME, do_build=False, debug_verilog=verilog,
-                              nextpnr_opts=" ".join(nextpnr_opts))
+        return platform.build(
+            top,
+            name=DESIGN_NAME,
+            do_build=False,
+            debug_verilog=verilog,
+            nextpnr_opts=" ".join(nextpnr_opts),
+        )
     except ValueError as exc:  # e.g. a geometry the camera set-up cannot produce
         raise UserError(str(exc)) from None
 
@@ -130,8 +135,8 @@ class ClockTiming:
 class BuildReport:
     """What a place-and-route run gives: resource use and per-clock timing."""
 
-    utilization: dict = field(default_factory=dict)   # cell type -> (used, available)
-    clocks: list = field(default_factory=list)        # ClockTiming
+    utilization: dict = field(default_factory=dict)  # cell type -> (used, available)
+    clocks: list = field(default_factory=list)  # ClockTiming
     seconds: float = 0.0
     bitstream: str = ""
 
@@ -160,8 +165,9 @@ class BuildReport:
         lines.append("timing (maximum frequency vs requirement):")
         for c in self.clocks:
             verdict = "PASS" if c.ok else "FAIL"
-            lines.append(f"  {c.name:32s} {c.achieved_mhz:8.2f} MHz  >= "
-                         f"{c.required_mhz:7.2f} MHz  {verdict}")
+            lines.append(
+                f"  {c.name:32s} {c.achieved_mhz:8.2f} MHz  >= {c.required_mhz:7.2f} MHz  {verdict}"
+            )
         if not self.clocks:
             lines.append("  (no constrained clock found in the report)")
         lines.append(f"build time: {self.seconds:.1f} s")
@@ -170,10 +176,14 @@ class BuildReport:
 
 def parse_nextpnr_report(report):
     """``BuildReport`` from nextpnr's ``--report`` JSON (a dict)."""
-    util = {cell: (int(v["used"]), int(v["available"]))
-            for cell, v in report.get("utilization", {}).items()}
-    clocks = [ClockTiming(name, float(v["achieved"]), float(v["constraint"]))
-              for name, v in sorted(report.get("fmax", {}).items())]
+    util = {
+        cell: (int(v["used"]), int(v["available"]))
+        for cell, v in report.get("utilization", {}).items()
+    }
+    clocks = [
+        ClockTiming(name, float(v["achieved"]), float(v["constraint"]))
+        for name, v in sorted(report.get("fmax", {}).items())
+    ]
     return BuildReport(utilization=util, clocks=clocks)
 
 
@@ -208,8 +218,11 @@ def build_bitstream(board, out_dir, params=None, *, seed=1, log=print):
     tools = find_yowasp_tools()
     report_name = f"{DESIGN_NAME}.report.json"
     # --timing-allow-fail: let nextpnr finish and report, and judge the timing here.
-    plan = _plan(board, params, nextpnr_opts=(
-        f"--seed {int(seed)}", f"--report {report_name}", "--timing-allow-fail"))
+    plan = _plan(
+        board,
+        params,
+        nextpnr_opts=(f"--seed {int(seed)}", f"--report {report_name}", "--timing-allow-fail"),
+    )
     os.makedirs(out_dir, exist_ok=True)
     _write_plan(plan, out_dir, rename_verilog=False)
     for stale in (report_name, f"{DESIGN_NAME}.bit"):  # never report an old run's results
@@ -222,8 +235,14 @@ def build_bitstream(board, out_dir, params=None, *, seed=1, log=print):
     log(f"running Yosys, nextpnr-ecp5 and ecppack (YoWASP) in {out_dir} ...")
     start = time.monotonic()
     with tempfile.TemporaryFile(mode="w+") as output:
-        result = subprocess.run(["sh", script], cwd=out_dir, env=env, stdout=output, check=False,
-                                stderr=subprocess.STDOUT)
+        result = subprocess.run(
+            ["sh", script],
+            cwd=out_dir,
+            env=env,
+            stdout=output,
+            check=False,
+            stderr=subprocess.STDOUT,
+        )
         if result.returncode != 0:
             output.seek(0)
             tail = "".join(output.readlines()[-20:])

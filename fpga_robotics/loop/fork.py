@@ -58,10 +58,9 @@ class _RecordingLoop(ClosedLoop):
         super().run_frame(k)
         texts = [e for _, _, e in self.events[first:]]
         result = self._result
-        mine = (self._ref_events.update(bool(result.found)) if result.found is not None
-                else [])
+        mine = self._ref_events.update(bool(result.found)) if result.found is not None else []
         after = self._before + len(mine)
-        self.world_events.append((texts[:self._before], texts[after:]))
+        self.world_events.append((texts[: self._before], texts[after:]))
 
     def capture(self, t):
         pose, rgb, events = super().capture(t)
@@ -105,15 +104,16 @@ class ReferenceRun:
 
     def __init__(self, scenario, *, design, seed=None, checkpoint_every=30):
         if scenario.sim.timing != "compressed":
-            raise ValueError("forked runs need sim.timing = \"compressed\"")
+            raise ValueError('forked runs need sim.timing = "compressed"')
         if checkpoint_every < 1:
             raise ValueError(f"checkpoint_every must be at least 1, got {checkpoint_every}")
         if design.params != scenario.params:
             raise ValueError("the backend was built for other parameters than the scenario's")
         self.scenario = scenario
         design.reset()
-        self._loop = _RecordingLoop(scenario, seed=seed, design=design,
-                                    checkpoint_every=checkpoint_every)
+        self._loop = _RecordingLoop(
+            scenario, seed=seed, design=design, checkpoint_every=checkpoint_every
+        )
         self.seed = self._loop.seed
         self.result = self._loop.run()
         self.last_divergence = None
@@ -153,10 +153,10 @@ class ReferenceRun:
             return loop.finish_run(wall_start, cpu_start)
         start = [c for c in ref.checkpoints if c.frame <= diverged][-1]
         checkpoint.restore(loop, start)
-        _rewrite_design_part(loop, outputs[:start.frame], ref)
+        _rewrite_design_part(loop, outputs[: start.frame], ref)
         # The variant has run up to frame `diverged` already: from the checkpoint to there
         # the loop gets its outputs as replayed (the frames are the same), then the design.
-        loop.design = _Replayed(outputs[start.frame:], design)
+        loop.design = _Replayed(outputs[start.frame :], design)
         return loop.run(start=start.frame, progress=progress)
 
 
@@ -177,8 +177,9 @@ class _Replayed:
 
 def _outputs(result):
     """What the loop keeps of a ``FrameResult`` (its image buffer may be reused)."""
-    return SimpleNamespace(cycles=result.cycles,
-                           **{name: getattr(result, name) for name in DESIGN_OUTPUTS})
+    return SimpleNamespace(
+        cycles=result.cycles, **{name: getattr(result, name) for name in DESIGN_OUTPUTS}
+    )
 
 
 def _rewrite_design_part(loop, outputs, ref):
@@ -205,5 +206,7 @@ def _check_same_world(reference, variant):
     a = {k: v for k, v in reference.data.items() if k not in VARIANT_SECTIONS}
     b = {k: v for k, v in variant.data.items() if k not in VARIANT_SECTIONS}
     if a != b:
-        raise ValueError("a variant's scenario may differ from the reference's only in its "
-                         f"{', '.join(VARIANT_SECTIONS)} sections")
+        raise ValueError(
+            "a variant's scenario may differ from the reference's only in its "
+            f"{', '.join(VARIANT_SECTIONS)} sections"
+        )

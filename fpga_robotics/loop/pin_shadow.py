@@ -108,12 +108,18 @@ class PinComparison:
             self.differing_frames[name] += 1
         if differ and self.first_divergence is None:
             self.first_divergence = {
-                "frame": frame, "time_s": round(time_s, 6),
-                "outputs": {n: {"primary": int(primary[n]), "shadow": int(shadow[n])}
-                            for n in differ}}
+                "frame": frame,
+                "time_s": round(time_s, 6),
+                "outputs": {
+                    n: {"primary": int(primary[n]), "shadow": int(shadow[n])} for n in differ
+                },
+            }
         return differ
 
     def summary(self):
-        return {"design": self.label, "frames": self.frames,
-                "first_divergence": self.first_divergence,
-                "differing_frames": dict(self.differing_frames)}
+        return {
+            "design": self.label,
+            "frames": self.frames,
+            "first_divergence": self.first_divergence,
+            "differing_frames": dict(self.differing_frames),
+        }

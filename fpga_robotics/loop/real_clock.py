@@ -38,8 +38,14 @@ from fpga_robotics.sim.pins import PinDesignSource, VerilogPinSource, get_pin_ba
 from fpga_robotics.sim.pins.timing import real_clock_timing
 from fpga_robotics.sim.records import SensorReading
 
-__all__ = ["RealClockLoop", "extra_output_stats", "format_extra_outputs", "make_pin_backend",
-           "pin_design_source", "run_real_clock"]
+__all__ = [
+    "RealClockLoop",
+    "extra_output_stats",
+    "format_extra_outputs",
+    "make_pin_backend",
+    "pin_design_source",
+    "run_real_clock",
+]
 
 #: Per-frame outputs read when the frame strobe rises (the wheels are read at the next capture).
 _FRAME_OUTPUTS = ("found", "proximity", "centroid_x", "centroid_leds")
@@ -63,20 +69,29 @@ def pin_design_source(scenario):
     """The pin design of the scenario: a ``PinDesignSource`` of ``design.top`` and its
     tables, or a ``VerilogPinSource`` of its foreign Verilog design."""
     if scenario.foreign is not None:
-        design = ForeignDesign(scenario.foreign.verilog, scenario.foreign.ports,
-                               scenario.params, pins=True, connector_kinds=connector_kinds())
+        design = ForeignDesign(
+            scenario.foreign.verilog,
+            scenario.foreign.ports,
+            scenario.params,
+            pins=True,
+            connector_kinds=connector_kinds(),
+        )
         # Without outputs.motor_left and motor_right the robot stands: the wheels are absent.
         return VerilogPinSource(design)
     top = scenario_top(scenario)
     params, tables = scenario.params, scenario.design_tables
-    described = (f"{scenario.top}:{params!r}:{sorted(tables.items())!r}:"
-                 f"{sorted(scenario.design_params.items())!r}")
+    described = (
+        f"{scenario.top}:{params!r}:{sorted(tables.items())!r}:"
+        f"{sorted(scenario.design_params.items())!r}"
+    )
     name = re.sub(r"[^A-Za-z0-9_]", "_", top.name)[:40]
     key = f"{name}-{hashlib.sha256(described.encode()).hexdigest()[:16]}"
     extra = {}
     if top.camera:
-        extra = {"pixels": ("pixels__valid", "pixels__payload"),
-                 "frame_size": (params.width, params.height)}
+        extra = {
+            "pixels": ("pixels__valid", "pixels__payload"),
+            "frame_size": (params.width, params.height),
+        }
         from fpga_robotics.designs.reference import resolve_design
 
         ports = resolve_design(scenario.top, scenario.design_params).ports
@@ -88,9 +103,11 @@ def pin_design_source(scenario):
 def make_pin_backend(name, scenario, *, on_build=None):
     """A pin-level backend by name ("auto": the fastest compiled one) for the scenario."""
     if name == "model":
-        raise UsageError("the model backend runs whole frames; sim.timing = \"real_clock\" "
-                         "needs a backend that simulates every clock: --backend auto, "
-                         "cxxrtl, verilator or pysim")
+        raise UsageError(
+            'the model backend runs whole frames; sim.timing = "real_clock" '
+            "needs a backend that simulates every clock: --backend auto, "
+            "cxxrtl, verilator or pysim"
+        )
     kwargs = {"on_build": on_build} if on_build is not None else {}
     return get_pin_backend(name, pin_design_source(scenario), **kwargs)
 
@@ -108,15 +125,28 @@ def extra_output_stats(column):
 def format_extra_outputs(summary):
     """The summary's ``extra_outputs`` as lines for the terminal (none without any)."""
     extra = summary.get("extra_outputs") or {}
-    return [f"  design output {name}: last {v['last']}, min {v['min']}, max {v['max']}"
-            for name, v in extra.items()]
+    return [
+        f"  design output {name}: last {v['last']}, min {v['min']}, max {v['max']}"
+        for name, v in extra.items()
+    ]
 
 
 class _PendingRow:
     """Trajectory row ``k`` between its capture and the end of its frame's processing."""
 
-    __slots__ = ("distance", "edge", "events", "filtered", "k", "outputs", "readings", "rgb",
-                 "t", "viewer_events", "visible")
+    __slots__ = (
+        "distance",
+        "edge",
+        "events",
+        "filtered",
+        "k",
+        "outputs",
+        "readings",
+        "rgb",
+        "t",
+        "viewer_events",
+        "visible",
+    )
 
     def __init__(self, k, t, rgb, events, distance, visible, edge, readings):
         self.k, self.t, self.rgb, self.events = k, t, rgb, events
@@ -130,22 +160,44 @@ class _PendingRow:
 class RealClockLoop(ClosedLoop):
     """``ClosedLoop`` in real-clock timing, on a ``PinBackend`` (``design``)."""
 
-    def __init__(self, scenario, *, design, seed=None, recorder=None, on_frame=None,
-                 controls=None, shadow=None, shadow_label="shadow"):
+    def __init__(
+        self,
+        scenario,
+        *,
+        design,
+        seed=None,
+        recorder=None,
+        on_frame=None,
+        controls=None,
+        shadow=None,
+        shadow_label="shadow",
+    ):
         from fpga_robotics.loop.pin_shadow import MirroredPins, PinComparison
 
         if shadow is not None:  # a second design, given every input the primary gets
             design = MirroredPins(design, shadow)
-        super().__init__(scenario, seed=seed, design=design, recorder=recorder,
-                         on_frame=on_frame, controls=controls)
+        super().__init__(
+            scenario,
+            seed=seed,
+            design=design,
+            recorder=recorder,
+            on_frame=on_frame,
+            controls=controls,
+        )
         self.top = scenario_top(scenario)
         self.clock_hz = scenario.sim.clock_hz
         self.pins = design
         self.motors.configure_real_clock(self.dt, scenario.sim.actuation_delay)
         self.sensors = [
-            CONNECTORS[spec.kind](spec.name, spec.mount, spec.params, world=self.world,
-                                  rng=np.random.default_rng([self.seed, _CONNECTOR_STREAM, i]))
-            for i, spec in enumerate(scenario.connectors)]
+            CONNECTORS[spec.kind](
+                spec.name,
+                spec.mount,
+                spec.params,
+                world=self.world,
+                rng=np.random.default_rng([self.seed, _CONNECTOR_STREAM, i]),
+            )
+            for i, spec in enumerate(scenario.connectors)
+        ]
         specs = {c.name: s for c, s in zip(self.sensors, scenario.connectors)}
         self.io = {}  # connector -> PinIO
         self.watched = {}  # design port -> (connector or None, pin)
@@ -169,9 +221,14 @@ class RealClockLoop(ClosedLoop):
         self.extra = {name: np.full(self.n_frames, np.nan) for name in self.top.extra_outputs}
         self.shadow_pins = shadow
         if shadow is not None:
-            outputs = tuple(n for n, p in design.ports.items() if p.direction == "out"
-                            and n in shadow.ports and shadow.ports[n].direction == "out"
-                            and not n.startswith("filtered__"))
+            outputs = tuple(
+                n
+                for n, p in design.ports.items()
+                if p.direction == "out"
+                and n in shadow.ports
+                and shadow.ports[n].direction == "out"
+                and not n.startswith("filtered__")
+            )
             self.comparison = PinComparison(shadow_label, outputs)
         self.measurements = {}  # "<connector>.<key>" -> array per row
 
@@ -185,20 +242,26 @@ class RealClockLoop(ClosedLoop):
                 raise UsageError(
                     f"the {conn.kind} connector {conn.name!r}: design {self.top.name!r} has "
                     f"no port for its pin {pin!r}; bind one with ports = {{{pin} = "
-                    f"\"PORT\"}} in its [[robot.sensors]] table")
+                    f'"PORT"}} in its [[robot.sensors]] table'
+                )
             if port not in ports:
                 raise UsageError(
                     f"the {conn.kind} connector {conn.name!r}: design {self.top.name!r} has "
-                    f"no port {port!r} (for pin {pin!r}); its ports: {', '.join(sorted(ports))}")
+                    f"no port {port!r} (for pin {pin!r}); its ports: {', '.join(sorted(ports))}"
+                )
             p = ports[port]
             if p.direction != spec.direction or p.width != spec.width:
                 raise UsageError(
                     f"the {conn.kind} connector {conn.name!r}: pin {pin!r} is {spec.direction} "
                     f"{spec.width} bit(s) but port {port!r} of design {self.top.name!r} is "
-                    f"{p.direction} {p.width} bit(s)" + (
+                    f"{p.direction} {p.width} bit(s)"
+                    + (
                         "; the line_sensors table must list as many sensors as the design's "
                         "line input has bits (design.line.n_sensors)"
-                        if conn.kind == "line_sensors" else ""))
+                        if conn.kind == "line_sensors"
+                        else ""
+                    )
+                )
         return binding
 
     def _check_inputs_driven(self):
@@ -209,10 +272,14 @@ class RealClockLoop(ClosedLoop):
         for name, port in sorted(self.pins.ports.items()):
             if port.direction == "in" and name not in driven:
                 kinds = [k for k, b in self.top.bindings.items() if name in b.values()]
-                hint = (f"declare a [[robot.sensors]] table with kind = \"{kinds[0]}\""
-                        if kinds else "bind a connector pin to it with ports = {...}")
-                raise UsageError(f"design {self.top.name!r}: nothing drives its input "
-                                 f"{name!r}; {hint}")
+                hint = (
+                    f'declare a [[robot.sensors]] table with kind = "{kinds[0]}"'
+                    if kinds
+                    else "bind a connector pin to it with ports = {...}"
+                )
+                raise UsageError(
+                    f"design {self.top.name!r}: nothing drives its input {name!r}; {hint}"
+                )
 
     # The design clock --------------------------------------------------------------------
 
@@ -249,12 +316,16 @@ class RealClockLoop(ClosedLoop):
         if port == _FRAME_STROBE:
             if value and self.pending is not None and self.pending.outputs is None:
                 # A foreign design's absent outputs are no ports: None in the row.
-                self.pending.outputs = {name: self.pins.peek(name) for name in _FRAME_OUTPUTS
-                                        if name in self.pins.ports}
+                self.pending.outputs = {
+                    name: self.pins.peek(name) for name in _FRAME_OUTPUTS if name in self.pins.ports
+                }
                 self.pending.filtered = self.pins.filtered_frame()
         elif port == "obstacle":
-            text = ("interlock: obstacle, wheels stopped" if value
-                    else "interlock: clear, wheels released")
+            text = (
+                "interlock: obstacle, wheels stopped"
+                if value
+                else "interlock: clear, wheels released"
+            )
             row = self.pending
             self.events.append((row.k if row is not None else 0, round(t, 6), text))
             if row is not None:  # shown in the viewer with the row it happened in
@@ -291,8 +362,9 @@ class RealClockLoop(ClosedLoop):
         if self.top.camera:
             self._stream(rgb)
         distance, visible = self.measure_world(k, t, pose)
-        self.pending = _PendingRow(k, t, rgb, events, distance, visible, self.pins.cycle,
-                                   self.read_sensors(k))
+        self.pending = _PendingRow(
+            k, t, rgb, events, distance, visible, self.pins.cycle, self.read_sensors(k)
+        )
         self.frames_done = k + 1
 
     def read_sensors(self, k):
@@ -302,13 +374,18 @@ class RealClockLoop(ClosedLoop):
             values = conn.measurement()
             for key, value in values.items():
                 column = self.measurements.setdefault(
-                    f"{conn.name}.{key}", np.full(self.n_frames, np.nan))
+                    f"{conn.name}.{key}", np.full(self.n_frames, np.nan)
+                )
                 column[k] = np.nan if value is None else float(value)
             if self.want_records:
                 overlay = conn.map_overlay()
                 readings[conn.name] = SensorReading(
-                    conn.kind, dict(values), tuple(overlay.get("points", ())),
-                    tuple(overlay.get("states", ())), tuple(overlay.get("rays", ())))
+                    conn.kind,
+                    dict(values),
+                    tuple(overlay.get("points", ())),
+                    tuple(overlay.get("states", ())),
+                    tuple(overlay.get("rays", ())),
+                )
         return readings
 
     def _stream(self, rgb):
@@ -316,11 +393,14 @@ class RealClockLoop(ClosedLoop):
         color_port = self.top.bindings["camera"].get("color_sel")
         if color_port is not None:  # a camera design may have no colour select
             self.pins.poke(color_port, self.color_code)
-        timing = real_clock_timing(p.width, p.height, self.scenario.camera.fps, self.clock_hz,
-                                   self.pins.cycle + 1)
+        timing = real_clock_timing(
+            p.width, p.height, self.scenario.camera.fps, self.clock_hz, self.pins.cycle + 1
+        )
         if self.pins.frame_pending:
-            raise UsageError("a camera frame is still streaming when the next is captured; "
-                             "lower camera.fps or raise sim.clock_hz")
+            raise UsageError(
+                "a camera frame is still streaming when the next is captured; "
+                "lower camera.fps or raise sim.clock_hz"
+            )
         self.pins.stream_frame(to_rgb444(rgb, p.width, p.height), timing)
 
     def finish_row(self):
@@ -329,8 +409,7 @@ class RealClockLoop(ClosedLoop):
         if row is None:
             return
         outputs = row.outputs or {}
-        values = {name: (outputs.get(name) if self.top.camera else None)
-                  for name in _FRAME_OUTPUTS}
+        values = {name: (outputs.get(name) if self.top.camera else None) for name in _FRAME_OUTPUTS}
         wheels = self.io[self.motors].binding if self.wheels else {}
         for pin in ("motor_left", "motor_right"):  # absent without wheels
             values[pin] = self.pins.peek(wheels[pin]) if pin in wheels else None
@@ -347,8 +426,17 @@ class RealClockLoop(ClosedLoop):
             events += self.compare_shadow(row)
         self.events += [(row.k, round(row.t, 6), e) for e in events]
         if self.want_records:
-            self.record(row.k, row.t, row.rgb, result, row.distance, row.visible,
-                        events + row.viewer_events, sensors=row.readings, design_extra=extra)
+            self.record(
+                row.k,
+                row.t,
+                row.rgb,
+                result,
+                row.distance,
+                row.visible,
+                events + row.viewer_events,
+                sensors=row.readings,
+                design_extra=extra,
+            )
 
     def compare_shadow(self, row):
         """Row ``row.k``'s outputs of both designs compared; the event of the first
@@ -372,13 +460,14 @@ class RealClockLoop(ClosedLoop):
     def extra_metrics(self):
         """Also the line metrics, over the world's floor lines, from the line sensors' mounts,
         and how often each sensor measured."""
-        mounts = [m for c in self.sensors if c.kind == "line_sensors"
-                  for m in c.sensor_mounts]
-        return {**super().extra_metrics(),
-                **line_metrics(self.traj, getattr(self.world, "floor_lines", ()), mounts,
-                               self.period),
-                **measurement_metrics(self.measurements,
-                                      [(c.name, c.kind) for c in self.sensors], self.frames_done)}
+        mounts = [m for c in self.sensors if c.kind == "line_sensors" for m in c.sensor_mounts]
+        return {
+            **super().extra_metrics(),
+            **line_metrics(self.traj, getattr(self.world, "floor_lines", ()), mounts, self.period),
+            **measurement_metrics(
+                self.measurements, [(c.name, c.kind) for c in self.sensors], self.frames_done
+            ),
+        }
 
     def summarise(self, wall, cpu):
         """Also ``extra_outputs``: the last, smallest and largest value of each output no
@@ -386,31 +475,56 @@ class RealClockLoop(ClosedLoop):
         summary = super().summarise(wall, cpu)
         if self.extra:
             summary["extra_outputs"] = {
-                name: extra_output_stats(self.traj[f"design.{name}"]) for name in self.extra}
+                name: extra_output_stats(self.traj[f"design.{name}"]) for name in self.extra
+            }
         return summary
 
     def timing_summary(self, wall):
         cycles = self.pins.cycle
-        return {"timing": "real_clock", "clock_hz": self.clock_hz, "sim_cycles": cycles,
-                "cycles_per_wall_s": round(cycles / wall) if wall > 0 else None}
+        return {
+            "timing": "real_clock",
+            "clock_hz": self.clock_hz,
+            "sim_cycles": cycles,
+            "cycles_per_wall_s": round(cycles / wall) if wall > 0 else None,
+        }
 
 
-def run_real_clock(scenario, *, seed, backend, recorder, progress, realtime, on_frame, shadow,
-                   shadow_label, controls):
+def run_real_clock(
+    scenario,
+    *,
+    seed,
+    backend,
+    recorder,
+    progress,
+    realtime,
+    on_frame,
+    shadow,
+    shadow_label,
+    controls,
+):
     """``run_scenario`` (fpga_robotics.loop.compressed) in real-clock timing."""
     if shadow is not None and not hasattr(shadow, "ports"):
-        raise UsageError("a shadow in real-clock timing is a design on a pin backend "
-                         "(run --shadow REF); FollowTarget parameters compare frames in "
-                         "sim.timing = \"compressed\"")
+        raise UsageError(
+            "a shadow in real-clock timing is a design on a pin backend "
+            "(run --shadow REF); FollowTarget parameters compare frames in "
+            'sim.timing = "compressed"'
+        )
     owns_backend = isinstance(backend, str)
     design = make_pin_backend(backend, scenario) if owns_backend else backend
     try:
         design.reset()
         if shadow is not None:
             shadow.reset()
-        loop = RealClockLoop(scenario, seed=seed, design=design, recorder=recorder,
-                             on_frame=on_frame, controls=controls, shadow=shadow,
-                             shadow_label=shadow_label)
+        loop = RealClockLoop(
+            scenario,
+            seed=seed,
+            design=design,
+            recorder=recorder,
+            on_frame=on_frame,
+            controls=controls,
+            shadow=shadow,
+            shadow_label=shadow_label,
+        )
         return loop.run(progress=progress, realtime=realtime)
     finally:
         if owns_backend:

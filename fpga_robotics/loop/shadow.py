@@ -10,12 +10,26 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-__all__ = ["COMPARED_OUTPUTS", "ShadowComparison", "differing_outputs", "divergence_event",
-           "format_shadow", "output_value", "shadow_overrides"]
+__all__ = [
+    "COMPARED_OUTPUTS",
+    "ShadowComparison",
+    "differing_outputs",
+    "divergence_event",
+    "format_shadow",
+    "output_value",
+    "shadow_overrides",
+]
 
 #: The outputs compared frame by frame (the filtered image is compared as a pixel count).
-COMPARED_OUTPUTS = ("found", "proximity", "centroid_x", "centroid_leds", "motor_left",
-                    "motor_right", "filtered")
+COMPARED_OUTPUTS = (
+    "found",
+    "proximity",
+    "centroid_x",
+    "centroid_leds",
+    "motor_left",
+    "motor_right",
+    "filtered",
+)
 
 
 def shadow_overrides(spec):
@@ -27,8 +41,10 @@ def shadow_overrides(spec):
     """
     items = [part.strip() for part in str(spec).split(";") if part.strip()]
     if not items:
-        raise ValueError("--shadow needs a preset name or KEY=VALUE items, e.g. "
-                         "--shadow published or --shadow 'diff_min=5;kp_num=2'")
+        raise ValueError(
+            "--shadow needs a preset name or KEY=VALUE items, e.g. "
+            "--shadow published or --shadow 'diff_min=5;kp_num=2'"
+        )
     out = []
     for item in items:
         if "=" not in item:
@@ -81,9 +97,10 @@ class ShadowComparison:
             self.first_divergence = {
                 "frame": frame,
                 "time_s": round(time_s, 6),
-                "outputs": {n: {"primary": output_value(primary, n),
-                                "shadow": output_value(shadow, n)}
-                            for n in differ},
+                "outputs": {
+                    n: {"primary": output_value(primary, n), "shadow": output_value(shadow, n)}
+                    for n in differ
+                },
             }
         return differ
 
@@ -99,7 +116,9 @@ class ShadowComparison:
 
 def divergence_event(label, differ, primary, shadow):
     """The event text for the first frame where the designs part."""
-    parts = ", ".join(f"{n} {output_value(primary, n)} vs {output_value(shadow, n)}" for n in differ)
+    parts = ", ".join(
+        f"{n} {output_value(primary, n)} vs {output_value(shadow, n)}" for n in differ
+    )
     return f"shadow design {label} diverges: {parts}"
 
 
@@ -107,10 +126,15 @@ def format_shadow(summary):
     """Lines for the human summary."""
     first = summary["first_divergence"]
     if first is None:
-        return [(f"  shadow {summary['design']}: identical outputs on all "
-                 f"{summary['frames']} frames")]
+        return [
+            (f"  shadow {summary['design']}: identical outputs on all {summary['frames']} frames")
+        ]
     counts = ", ".join(f"{n} {c}" for n, c in summary["differing_frames"].items() if c)
     what = ", ".join(f"{n} {v['primary']} vs {v['shadow']}" for n, v in first["outputs"].items())
-    return [(f"  shadow {summary['design']}: first differs at frame {first['frame']} "
-             f"({first['time_s']:.2f} s): {what}"),
-            f"  shadow frames that differ: {counts} (of {summary['frames']})"]
+    return [
+        (
+            f"  shadow {summary['design']}: first differs at frame {first['frame']} "
+            f"({first['time_s']:.2f} s): {what}"
+        ),
+        f"  shadow frames that differ: {counts} (of {summary['frames']})",
+    ]

@@ -41,7 +41,7 @@ class FrameSource:
         self._cap = None
         self._files = None
         if self.spec.startswith("camera:"):
-            index = self.spec[len("camera:"):]
+            index = self.spec[len("camera:") :]
             if not index.isdigit():
                 raise UsageError(f"--source camera:N needs a device number, got {self.spec!r}")
             self.kind = "camera"
@@ -58,8 +58,9 @@ class FrameSource:
         path = Path(self.spec)
         if path.is_dir():
             self.kind = "folder"
-            self._files = sorted(p for p in path.iterdir()
-                                 if p.suffix.lower() in IMAGE_SUFFIXES and p.is_file())
+            self._files = sorted(
+                p for p in path.iterdir() if p.suffix.lower() in IMAGE_SUFFIXES and p.is_file()
+            )
             if not self._files:
                 raise UsageError(
                     f"folder {self.spec!r} holds no images ({', '.join(IMAGE_SUFFIXES)})"
@@ -114,8 +115,18 @@ def open_source(spec, width, height):
     return FrameSource(spec, width, height)
 
 
-def run_source(source, design, *, color="red", recorder=None, progress=None, max_frames=None,
-               duration=None, hfov=1.047, on_frame=None):
+def run_source(
+    source,
+    design,
+    *,
+    color="red",
+    recorder=None,
+    progress=None,
+    max_frames=None,
+    duration=None,
+    hfov=1.047,
+    on_frame=None,
+):
     """Run the design on every frame of ``source`` and summarise its outputs.
 
     Returns a JSON-ready dict: the source, frame count, timing, how often the target was
@@ -142,22 +153,37 @@ def run_source(source, design, *, color="red", recorder=None, progress=None, max
             if result.found != was_found:
                 events.append("target found" if result.found else "target lost")
                 was_found = bool(result.found)
-            results.append({
-                "frame": k,
-                "found": bool(result.found),
-                "proximity": int(result.proximity),
-                "centroid_x": int(result.centroid_x),
-                "centroid_leds": int(result.centroid_leds),
-                "motor_left": int(result.motor_left),
-                "motor_right": int(result.motor_right),
-            })
+            results.append(
+                {
+                    "frame": k,
+                    "found": bool(result.found),
+                    "proximity": int(result.proximity),
+                    "centroid_x": int(result.centroid_x),
+                    "centroid_leds": int(result.centroid_leds),
+                    "motor_left": int(result.motor_left),
+                    "motor_right": int(result.motor_right),
+                }
+            )
             if recorder is not None or on_frame is not None:
-                stamp = (source.frame_time(k) if hasattr(source, "frame_time")
-                         else time.perf_counter() - start)
+                stamp = (
+                    source.frame_time(k)
+                    if hasattr(source, "frame_time")
+                    else time.perf_counter() - start
+                )
                 record = FrameRecord(
-                    frame=k, sim_time=stamp, camera_rgb=rgb,
-                    color_sel=sel, result=result, robot_x=0.0, robot_y=0.0, robot_heading=0.0,
-                    robot_v=0.0, robot_w=0.0, cmd_v=0.0, cmd_w=0.0, camera_hfov=hfov,
+                    frame=k,
+                    sim_time=stamp,
+                    camera_rgb=rgb,
+                    color_sel=sel,
+                    result=result,
+                    robot_x=0.0,
+                    robot_y=0.0,
+                    robot_heading=0.0,
+                    robot_v=0.0,
+                    robot_w=0.0,
+                    cmd_v=0.0,
+                    cmd_w=0.0,
+                    camera_hfov=hfov,
                     events=events,
                 )
                 if recorder is not None:

@@ -25,8 +25,9 @@ def check_video_path(path):
     """Raise ``VideoPathError``/``OutputPathError`` unless ``path`` can take a video."""
     path = check_output_path(path, what="--save-video")
     if path.suffix.lower() not in VIDEO_CODECS:
-        raise VideoPathError(f"--save-video {str(path)!r}: give a file ending in "
-                             f"{' or '.join(VIDEO_CODECS)}")
+        raise VideoPathError(
+            f"--save-video {str(path)!r}: give a file ending in {' or '.join(VIDEO_CODECS)}"
+        )
     return path
 
 

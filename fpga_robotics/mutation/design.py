@@ -20,9 +20,13 @@ def write_mutant_design(params, mutants, folder):
     netlist = os.path.join(folder, NETLIST_NAME)
     ports = os.path.join(folder, PORTS_NAME)
     write_atomic(netlist, mutant_netlist(params, mutants), what="mutant netlist")
-    write_atomic(ports, follow_target_port_map(params)
-                 + f"\n# The mutant select (0: the design itself).\n[runtime]\n"
-                   f"{MUTATION_SELECT} = 0\n", what="port map")
+    write_atomic(
+        ports,
+        follow_target_port_map(params)
+        + f"\n# The mutant select (0: the design itself).\n[runtime]\n"
+        f"{MUTATION_SELECT} = 0\n",
+        what="port map",
+    )
     return netlist, ports
 
 

@@ -26,9 +26,10 @@ def design_ports(spec):
 
     component = spec.build()
     Fragment.get(component, None)  # read for its signature only: elaborated, so no warning
-    return {name: Port(name, value.shape().width, "in" if d == "i" else "out",
-                       value.shape().signed)
-            for name, (value, d) in verilog_ports(component).items()}
+    return {
+        name: Port(name, value.shape().width, "in" if d == "i" else "out", value.shape().signed)
+        for name, (value, d) in verilog_ports(component).items()
+    }
 
 
 def mutate_design(spec, n, seed, cycles, out, *, stimulus_seed=0, say=print):
@@ -51,8 +52,10 @@ def mutate_design(spec, n, seed, cycles, out, *, stimulus_seed=0, say=print):
         for k, m in enumerate(mutants, start=1):
             verdicts.append(judge_pin_mutant(backend, m.index, stimulus, cycles, reference))
             if k == len(mutants) or k * 10 // len(mutants) != (k - 1) * 10 // len(mutants):
-                say(f"unit judge: {k}/{len(mutants)} mutants, "
-                    f"{sum(v.caught for v in verdicts)} caught")
+                say(
+                    f"unit judge: {k}/{len(mutants)} mutants, "
+                    f"{sum(v.caught for v in verdicts)} caught"
+                )
         unit_s = time.perf_counter() - t1
     finally:
         backend.close()
@@ -61,17 +64,29 @@ def mutate_design(spec, n, seed, cycles, out, *, stimulus_seed=0, say=print):
         "design": {"reference": spec.reference, "params": spec.params},
         "seed": seed,
         "judge": "the unmutated design, seeded random pin stimulus",
-        "stimulus": {"cycles": cycles, "seed": stimulus_seed,
-                     "inputs": [p for p, port in ports.items() if port.direction == "in"]},
+        "stimulus": {
+            "cycles": cycles,
+            "seed": stimulus_seed,
+            "inputs": [p for p, port in ports.items() if port.direction == "in"],
+        },
         "build_and_list_s": round(build_s, 2),
         "unit_judge_s": round(unit_s, 2),
         "unit": unit_score(unit),
         "modules": by_module(mutants, unit),
-        "mutants": [{**{k: v for k, v in m.__dict__.items()}, "sources": list(m.sources),
-                     "describe": m.describe(),
-                     "unit": {"caught": v.caught, "first_cycle": v.first_cycle,
-                              "differing": v.differing, "effect": v.effect()}}
-                    for m, v in zip(mutants, verdicts)],
+        "mutants": [
+            {
+                **{k: v for k, v in m.__dict__.items()},
+                "sources": list(m.sources),
+                "describe": m.describe(),
+                "unit": {
+                    "caught": v.caught,
+                    "first_cycle": v.first_cycle,
+                    "differing": v.differing,
+                    "effect": v.effect(),
+                },
+            }
+            for m, v in zip(mutants, verdicts)
+        ],
     }
     write_json_atomic(os.path.join(out, "mutants.json"), result, what="mutation results")
     return result

@@ -52,8 +52,7 @@ def reference_outcome(ref_argv):
     out = {"status": "error", "message": "", "summary": None, "recording": None, "run_s": 0.0}
     try:
         summary = dict(_reference(ref_argv).result.summary)
-        out.update(status=summary["verdict"], summary=summary,
-                   run_s=time.perf_counter() - wall0)
+        out.update(status=summary["verdict"], summary=summary, run_s=time.perf_counter() - wall0)
     except Exception as exc:  # noqa: BLE001 (recorded as the baseline's error)
         out.update(status="error", message=f"{type(exc).__name__}: {exc}".splitlines()[0])
     out["wall_s"] = time.perf_counter() - wall0
@@ -99,6 +98,8 @@ def judge_runs_forked(argvs, ref_argvs, timeouts=None):
     """``robot_judge.judge_runs`` with each run forked from its reference run."""
     from .robot_judge import judge_runs
 
-    return judge_runs(argvs, timeouts,
-                      execute=lambda i, argv, timeout: execute_forked(argv, ref_argvs[i],
-                                                                      timeout))
+    return judge_runs(
+        argvs,
+        timeouts,
+        execute=lambda i, argv, timeout: execute_forked(argv, ref_argvs[i], timeout),
+    )

@@ -21,8 +21,15 @@ from ..hw.verilog import TOP_NAME
 from ..sim.mutation import MUTATION_SELECT, mutant_netlist, select_width
 from ..sim.pins.base import Port
 
-__all__ = ["CHANGE_PROBABILITY", "MutantPinSource", "PinVerdict", "judge_pin_mutant",
-           "open_pin_mutants", "pin_stimulus", "pin_trace"]
+__all__ = [
+    "CHANGE_PROBABILITY",
+    "MutantPinSource",
+    "PinVerdict",
+    "judge_pin_mutant",
+    "open_pin_mutants",
+    "pin_stimulus",
+    "pin_trace",
+]
 
 #: The chance that an input takes a new random value at a clock edge.
 CHANGE_PROBABILITY = 1 / 8
@@ -62,8 +69,11 @@ def pin_stimulus(ports, cycles, seed):
         if port.direction != "in" or port.name == MUTATION_SELECT:
             continue
         edges = np.flatnonzero(rng.random(cycles) < CHANGE_PROBABILITY) + 1
-        lo, hi = ((-(1 << (port.width - 1)), 1 << (port.width - 1)) if port.signed
-                  else (0, 1 << port.width))
+        lo, hi = (
+            (-(1 << (port.width - 1)), 1 << (port.width - 1))
+            if port.signed
+            else (0, 1 << port.width)
+        )
         values = rng.integers(lo, hi, size=len(edges), dtype=np.int64)
         changes += [(int(e), port.name, int(v)) for e, v in zip(edges, values)]
     return sorted(changes)
@@ -141,9 +151,13 @@ def judge_pin_mutant(backend, index, stimulus, cycles, reference):
         verdict.caught = True
         verdict.first_cycle = min(firsts.values())
         verdict.first_difference = {
-            name: (_value_at(reference[name], verdict.first_cycle),
-                   _value_at(got[name], verdict.first_cycle))
-            for name, at in firsts.items() if at == verdict.first_cycle}
+            name: (
+                _value_at(reference[name], verdict.first_cycle),
+                _value_at(got[name], verdict.first_cycle),
+            )
+            for name, at in firsts.items()
+            if at == verdict.first_cycle
+        }
     return verdict
 
 

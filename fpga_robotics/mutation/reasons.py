@@ -15,8 +15,13 @@ The classes, in the order they are tried:
 - ``other``: none of these (the documentation says more about each such mutant).
 """
 
-__all__ = ["RARE_FRACTION", "SMALL_CENTROID_FRACTION", "SMALL_WHEEL_DPS", "blind_spot_reason",
-           "reason_class"]
+__all__ = [
+    "RARE_FRACTION",
+    "SMALL_CENTROID_FRACTION",
+    "SMALL_WHEEL_DPS",
+    "blind_spot_reason",
+    "reason_class",
+]
 
 #: A centroid error this fraction of the image width or less is small (5 px at 160x120:
 #: what the LED checks allow near a border).
@@ -45,8 +50,11 @@ def reason_class(verdict, width):
     if outs <= {"centroid_leds"}:
         return "LEDs only"
     big = verdict.max_difference
-    if (outs <= _STEERING and big.get("centroid_x", 0) <= SMALL_CENTROID_FRACTION * width
-            and max(big.get("motor_left", 0), big.get("motor_right", 0)) <= SMALL_WHEEL_DPS):
+    if (
+        outs <= _STEERING
+        and big.get("centroid_x", 0) <= SMALL_CENTROID_FRACTION * width
+        and max(big.get("motor_left", 0), big.get("motor_right", 0)) <= SMALL_WHEEL_DPS
+    ):
         return "small steering error"
     if verdict.frames and verdict.frames_differing <= RARE_FRACTION * verdict.frames:
         return "rare state"
@@ -61,12 +69,16 @@ def blind_spot_reason(verdict, width):
     if cls == "frame protocol":
         return f"frame protocol: {verdict.failure} (the closed loop went on)"
     if cls == "filtered only":
-        return (f"filtered only: differs in {verdict.differing['filtered']} of "
-                f"{verdict.frames} unit frames, only on the filtered video output, which no "
-                f"check or wheel uses")
+        return (
+            f"filtered only: differs in {verdict.differing['filtered']} of "
+            f"{verdict.frames} unit frames, only on the filtered video output, which no "
+            f"check or wheel uses"
+        )
     outs = [name for name, n in verdict.differing.items() if n]
-    text = (f"{cls}: differs in {verdict.frames_differing} of {verdict.frames} unit frames "
-            f"({', '.join(outs)})")
+    text = (
+        f"{cls}: differs in {verdict.frames_differing} of {verdict.frames} unit frames "
+        f"({', '.join(outs)})"
+    )
     big = verdict.max_difference
     if "centroid_x" in big:
         text += f"; centroid off by up to {big['centroid_x']} px"

@@ -27,8 +27,9 @@ def _table(header, rows):
     return f"<table><tr>{head}</tr>{body}</table>"
 
 
-def write_report(out, campaign, mutants, unit_verdicts, robot_verdicts, baseline, recordings,
-                 width):
+def write_report(
+    out, campaign, mutants, unit_verdicts, robot_verdicts, baseline, recordings, width
+):
     """Write ``out/report.html`` (``width``: the design's image width, for the blind spots'
     reasons); returns its path."""
     unit = {v.index: v.caught for v in unit_verdicts}
@@ -39,39 +40,79 @@ def write_report(out, campaign, mutants, unit_verdicts, robot_verdicts, baseline
     reasons = {v.index: blind_spot_reason(v, width) for v in unit_verdicts if v.index in blind}
     by_index = {m.index: m for m in mutants}
     e = html.escape
-    parts = [(f"<!doctype html><meta charset=utf-8><title>Mutation coverage</title>"
-             f"<style>{_STYLE}</style><h1>Mutation coverage of follow_target</h1>"),
-             (f"<p>{us['total']} mutants. Unit judge: {us['caught']} caught, {us['equivalent']} "
-             f"equivalent on the unit frames (score {_pct(us['score'])}). Robot judge "
-             f"(campaign <code>{e(campaign)}</code>, {len(baseline['passing'])} of "
-             f"{len(baseline['runs'])} runs pass unmutated): {rs['caught']} of {rs['judged']} "
-             f"unit-caught mutants caught (score {_pct(rs['score'])}).</p>"),
-             "<h2>By component</h2>",
-             _table(["component", "mutants", "unit judge caught", "robot judge caught"],
-                    [[e(name), r["total"], r["unit_caught"], r["robot_caught"]]
-                     for name, r in by_module(mutants, unit, robot).items()])]
+    parts = [
+        (
+            f"<!doctype html><meta charset=utf-8><title>Mutation coverage</title>"
+            f"<style>{_STYLE}</style><h1>Mutation coverage of follow_target</h1>"
+        ),
+        (
+            f"<p>{us['total']} mutants. Unit judge: {us['caught']} caught, {us['equivalent']} "
+            f"equivalent on the unit frames (score {_pct(us['score'])}). Robot judge "
+            f"(campaign <code>{e(campaign)}</code>, {len(baseline['passing'])} of "
+            f"{len(baseline['runs'])} runs pass unmutated): {rs['caught']} of {rs['judged']} "
+            f"unit-caught mutants caught (score {_pct(rs['score'])}).</p>"
+        ),
+        "<h2>By component</h2>",
+        _table(
+            ["component", "mutants", "unit judge caught", "robot judge caught"],
+            [
+                [e(name), r["total"], r["unit_caught"], r["robot_caught"]]
+                for name, r in by_module(mutants, unit, robot).items()
+            ],
+        ),
+    ]
     rows = []
     for k in sorted(blind, key=lambda i: (by_index[i].module, i)):
         m, v = by_index[k], robot_verdicts[k]
         rec = recordings.get(k)
-        rows.append([e(m.module or "top"), e(m.describe()), e(", ".join(m.sources)),
-                     e(effects[k]), e(reasons[k]), f"<code>{e(v.get('replay') or '')}</code>",
-                     f'<a href="{e(rec)}">{e(rec)}</a>' if rec else ""])
-    parts += [f"<h2>Blind spots: caught by the unit judge, missed by every run ({len(blind)})</h2>",
-              _table(["component", "mutant", "source", "what it does to the outputs",
-                      "why no run shows it", "closest-to-failing run", "recording"], rows)]
+        rows.append(
+            [
+                e(m.module or "top"),
+                e(m.describe()),
+                e(", ".join(m.sources)),
+                e(effects[k]),
+                e(reasons[k]),
+                f"<code>{e(v.get('replay') or '')}</code>",
+                f'<a href="{e(rec)}">{e(rec)}</a>' if rec else "",
+            ]
+        )
+    parts += [
+        f"<h2>Blind spots: caught by the unit judge, missed by every run ({len(blind)})</h2>",
+        _table(
+            [
+                "component",
+                "mutant",
+                "source",
+                "what it does to the outputs",
+                "why no run shows it",
+                "closest-to-failing run",
+                "recording",
+            ],
+            rows,
+        ),
+    ]
     caught_rows = []
     for k, v in sorted(robot_verdicts.items()):
         if v["caught"]:
-            caught_rows.append([e(by_index[k].describe()), e(v["status"]),
-                                e(", ".join(v["failed_checks"]) or v.get("message") or ""),
-                                f"<code>{e(v.get('replay') or '')}</code>"])
-    parts += [f"<h2>Caught by the robot judge ({len(caught_rows)})</h2>",
-              _table(["mutant", "status", "failed checks", "replay"], caught_rows)]
+            caught_rows.append(
+                [
+                    e(by_index[k].describe()),
+                    e(v["status"]),
+                    e(", ".join(v["failed_checks"]) or v.get("message") or ""),
+                    f"<code>{e(v.get('replay') or '')}</code>",
+                ]
+            )
+    parts += [
+        f"<h2>Caught by the robot judge ({len(caught_rows)})</h2>",
+        _table(["mutant", "status", "failed checks", "replay"], caught_rows),
+    ]
     equivalent = [m for m in mutants if not unit.get(m.index)]
-    parts += [f"<h2>Equivalent on the unit frames ({len(equivalent)})</h2>",
-              _table(["mutant", "source"], [[e(m.describe()), e(", ".join(m.sources))]
-                                           for m in equivalent])]
+    parts += [
+        f"<h2>Equivalent on the unit frames ({len(equivalent)})</h2>",
+        _table(
+            ["mutant", "source"], [[e(m.describe()), e(", ".join(m.sources))] for m in equivalent]
+        ),
+    ]
     path = os.path.join(out, "report.html")
     write_atomic(path, "\n".join(parts) + "\n", what="mutation report")
     return path

@@ -17,8 +17,7 @@ import os
 import shlex
 import time
 
-__all__ = ["closest_to_failing", "judge_runs", "mutant_argv", "replay", "robot_judge",
-           "run_margin"]
+__all__ = ["closest_to_failing", "judge_runs", "mutant_argv", "replay", "robot_judge", "run_margin"]
 
 #: Checks whose limit is a lower bound (the value must be at least the limit).
 _LOWER = ("min_distance_min_m", "target_in_view_min_fraction", "found_min_fraction")
@@ -35,8 +34,19 @@ def mutant_argv(argv, netlist, ports, index, resolution):
             skip = True
             continue
         out.append(a)
-    return [*out, "--backend", "verilator", "--resolution", resolution, "--design",
-            f"verilog:{netlist}", "--ports", str(ports), "--runtime", f"mutsel={index}"]
+    return [
+        *out,
+        "--backend",
+        "verilator",
+        "--resolution",
+        resolution,
+        "--design",
+        f"verilog:{netlist}",
+        "--ports",
+        str(ports),
+        "--runtime",
+        f"mutsel={index}",
+    ]
 
 
 def replay(argv):
@@ -50,8 +60,12 @@ def run_margin(summary):
     margins = []
     for c in summary.get("checks", ()):
         v, limit = c.get("value"), c.get("limit")
-        if c.get("passed") is None or isinstance(v, bool) or not isinstance(
-                v, (int, float)) or not isinstance(limit, (int, float)):
+        if (
+            c.get("passed") is None
+            or isinstance(v, bool)
+            or not isinstance(v, (int, float))
+            or not isinstance(limit, (int, float))
+        ):
             continue
         scale = max(abs(float(limit)), 1e-9)
         if c["name"] in _LOWER:
@@ -82,8 +96,10 @@ def judge_runs(argvs, timeouts=None, execute=None):
     from ..sweep import runner
 
     if execute is None:
+
         def execute(i, argv, timeout):
             return runner.execute(argv, timeout=timeout)
+
     t0 = time.perf_counter()
     outcomes = []
     for i, argv in enumerate(argvs):
@@ -91,14 +107,31 @@ def judge_runs(argvs, timeouts=None, execute=None):
         o.pop("recording", None)
         outcomes.append(o)
         if o["status"] != "pass":
-            failed = [c["name"] for c in (o["summary"] or {}).get("checks", ())
-                      if c.get("passed") is False]
-            return {"caught": True, "run": i, "status": o["status"], "message": o["message"],
-                    "failed_checks": failed, "closest": None, "runs": i + 1,
-                    "wall_s": time.perf_counter() - t0}
-    return {"caught": False, "run": None, "status": "pass", "message": "", "failed_checks": [],
-            "closest": closest_to_failing(outcomes), "runs": len(argvs),
-            "wall_s": time.perf_counter() - t0}
+            failed = [
+                c["name"]
+                for c in (o["summary"] or {}).get("checks", ())
+                if c.get("passed") is False
+            ]
+            return {
+                "caught": True,
+                "run": i,
+                "status": o["status"],
+                "message": o["message"],
+                "failed_checks": failed,
+                "closest": None,
+                "runs": i + 1,
+                "wall_s": time.perf_counter() - t0,
+            }
+    return {
+        "caught": False,
+        "run": None,
+        "status": "pass",
+        "message": "",
+        "failed_checks": [],
+        "closest": closest_to_failing(outcomes),
+        "runs": len(argvs),
+        "wall_s": time.perf_counter() - t0,
+    }
 
 
 def _baseline(client, argvs, progress, fork):
@@ -111,11 +144,11 @@ def _baseline(client, argvs, progress, fork):
     if fork:
         from .forked_runs import reference_outcome
 
-        futures = {client.submit(reference_outcome, a, pure=False): i
-                   for i, a in enumerate(argvs)}
+        futures = {client.submit(reference_outcome, a, pure=False): i for i, a in enumerate(argvs)}
     else:
-        futures = {client.submit(runner.execute, a, None, pure=False): i
-                   for i, a in enumerate(argvs)}
+        futures = {
+            client.submit(runner.execute, a, None, pure=False): i for i, a in enumerate(argvs)
+        }
     out = [None] * len(argvs)
     for fut in as_completed(futures):
         out[futures[fut]] = fut.result()
@@ -123,8 +156,21 @@ def _baseline(client, argvs, progress, fork):
     return out
 
 
-def robot_judge(campaign, netlist, ports, resolution, indices, out_dir, *, workers=None,
-                scheduler=None, resume=False, progress=None, say=print, fork=True):
+def robot_judge(
+    campaign,
+    netlist,
+    ports,
+    resolution,
+    indices,
+    out_dir,
+    *,
+    workers=None,
+    scheduler=None,
+    resume=False,
+    progress=None,
+    say=print,
+    fork=True,
+):
     """Judge the mutants ``indices`` by ``campaign``'s closed-loop runs.
 
     Returns ``(baseline, verdicts)``: ``baseline`` is ``{"runs": [argv at mutsel 0, ...],
@@ -144,11 +190,14 @@ def robot_judge(campaign, netlist, ports, resolution, indices, out_dir, *, worke
     tick = progress or (lambda n: None)
     plan = make_plan(campaign)
     if any(k.startswith("design.") for spec in plan.runs for k, _ in spec.overrides) or any(
-            item.startswith("design.") for spec in plan.runs for item in spec.fixed):
+        item.startswith("design.") for spec in plan.runs for item in spec.fixed
+    ):
         from fpga_robotics.hw.errors import UsageError
 
-        raise UsageError("the mutation campaign may not override design.* values: the "
-                         "mutants are of one design (give its parameters to mutate instead)")
+        raise UsageError(
+            "the mutation campaign may not override design.* values: the "
+            "mutants are of one design (give its parameters to mutate instead)"
+        )
     base = [mutant_argv(spec.argv(), netlist, ports, 0, resolution) for spec in plan.runs]
     journal = os.path.join(out_dir, "robot.jsonl")
     verdicts = {}
@@ -169,29 +218,42 @@ def robot_judge(campaign, netlist, ports, resolution, indices, out_dir, *, worke
         # Each mutant's run may take ten times as long as the design's (at least 30 s).
         limits = [max(30.0, 10.0 * outcomes[i].get("wall_s", 3.0)) for i in passing]
         todo = [k for k in indices if k not in verdicts]
-        say(f"robot judge: {len(passing)} of {len(base)} runs pass unmutated; judging "
-            f"{len(todo)} mutants ({len(indices) - len(todo)} already in {journal})")
+        say(
+            f"robot judge: {len(passing)} of {len(base)} runs pass unmutated; judging "
+            f"{len(todo)} mutants ({len(indices) - len(todo)} already in {journal})"
+        )
         futures = {}
         for k in todo:
-            argvs = [mutant_argv(spec.argv(), netlist, ports, k, resolution)
-                     for spec in (plan.runs[i] for i in passing)]
+            argvs = [
+                mutant_argv(spec.argv(), netlist, ports, k, resolution)
+                for spec in (plan.runs[i] for i in passing)
+            ]
             if fork:
                 from .forked_runs import judge_runs_forked
 
                 task = (judge_runs_forked, argvs, [base[i] for i in passing], limits)
             else:
                 task = (judge_runs, argvs, limits)
-            futures[client.submit(*task, pure=False,
-                                  key=f"mutant-{k}-{time.monotonic_ns()}")] = (k, argvs)
+            futures[client.submit(*task, pure=False, key=f"mutant-{k}-{time.monotonic_ns()}")] = (
+                k,
+                argvs,
+            )
         with open(journal, "a") as f:
             for fut in as_completed(futures):
                 k, argvs = futures[fut]
                 try:
                     v = fut.result()
                 except Exception as exc:  # noqa: BLE001 (a worker died: the mutant is caught)
-                    v = {"caught": True, "run": None, "status": "error",
-                         "message": f"{type(exc).__name__}: {exc}".splitlines()[0],
-                         "failed_checks": [], "closest": None, "runs": 0, "wall_s": 0.0}
+                    v = {
+                        "caught": True,
+                        "run": None,
+                        "status": "error",
+                        "message": f"{type(exc).__name__}: {exc}".splitlines()[0],
+                        "failed_checks": [],
+                        "closest": None,
+                        "runs": 0,
+                        "wall_s": 0.0,
+                    }
                 at = v["run"] if v["caught"] else v["closest"]
                 v["argv"] = argvs[at] if at is not None else None
                 v["replay"] = replay(v["argv"]) if at is not None else None
@@ -200,5 +262,7 @@ def robot_judge(campaign, netlist, ports, resolution, indices, out_dir, *, worke
                 f.write(json.dumps(v) + "\n")
                 f.flush()
                 tick(1)
-    return ({"runs": base, "passing": passing, "statuses": statuses, "judged_here": len(todo)},
-            verdicts)
+    return (
+        {"runs": base, "passing": passing, "statuses": statuses, "judged_here": len(todo)},
+        verdicts,
+    )

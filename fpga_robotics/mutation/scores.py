@@ -19,8 +19,12 @@ def _ratio(n, d):
 def unit_score(unit):
     """``{"total", "caught", "equivalent", "score"}`` from ``{index: caught}``."""
     caught = sum(1 for c in unit.values() if c)
-    return {"total": len(unit), "caught": caught, "equivalent": len(unit) - caught,
-            "score": _ratio(caught, len(unit))}
+    return {
+        "total": len(unit),
+        "caught": caught,
+        "equivalent": len(unit) - caught,
+        "score": _ratio(caught, len(unit)),
+    }
 
 
 def robot_score(unit, robot):

@@ -21,8 +21,7 @@ from fpga_robotics.sim.camera import synthetic
 from ..sim.backends import BackendError, get_backend
 from ..sim.mutation import MUTATION_SELECT
 
-__all__ = ["UnitVerdict", "golden_results", "judge_frames", "judge_mutant",
-           "reference_results"]
+__all__ = ["UnitVerdict", "golden_results", "judge_frames", "judge_mutant", "reference_results"]
 
 
 @dataclass
@@ -112,6 +111,7 @@ def judge_mutant(design, index, frames, golden):
         if differ and not verdict.caught:
             verdict.caught = True
             verdict.first_frame = k
-            verdict.first_difference = {n: (output_value(want, n), output_value(got, n))
-                                        for n in differ}
+            verdict.first_difference = {
+                n: (output_value(want, n), output_value(got, n)) for n in differ
+            }
     return verdict

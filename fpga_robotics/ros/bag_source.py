@@ -24,10 +24,15 @@ IMAGE_TYPES = ("sensor_msgs/msg/Image", "sensor_msgs/msg/CompressedImage")
 
 #: Raw image encodings read, with the OpenCV conversion to BGR (None: already BGR).
 ENCODINGS = {
-    "rgb8": "COLOR_RGB2BGR", "bgr8": None, "rgba8": "COLOR_RGBA2BGR",
-    "bgra8": "COLOR_BGRA2BGR", "mono8": "COLOR_GRAY2BGR",
-    "yuv422": "COLOR_YUV2BGR_UYVY", "uyvy": "COLOR_YUV2BGR_UYVY",
-    "yuv422_yuy2": "COLOR_YUV2BGR_YUY2", "yuyv": "COLOR_YUV2BGR_YUY2",
+    "rgb8": "COLOR_RGB2BGR",
+    "bgr8": None,
+    "rgba8": "COLOR_RGBA2BGR",
+    "bgra8": "COLOR_BGRA2BGR",
+    "mono8": "COLOR_GRAY2BGR",
+    "yuv422": "COLOR_YUV2BGR_UYVY",
+    "uyvy": "COLOR_YUV2BGR_UYVY",
+    "yuv422_yuy2": "COLOR_YUV2BGR_YUY2",
+    "yuyv": "COLOR_YUV2BGR_YUY2",
 }
 _CHANNELS = {"rgb8": 3, "bgr8": 3, "rgba8": 4, "bgra8": 4, "mono8": 1}
 
@@ -36,7 +41,7 @@ _DEFAULT_TOPIC = "/camera/image_raw"
 
 def parse_bag_spec(spec):
     """``bag:PATH[:TOPIC]`` (a topic starts with ``/``) to ``(path, topic or None)``."""
-    rest = str(spec)[len("bag:"):]
+    rest = str(spec)[len("bag:") :]
     path, sep, topic = rest.rpartition(":/")
     if not sep:
         path, topic = rest, None
@@ -53,26 +58,34 @@ def decode_image(msg, msgtype):
     if msgtype.endswith("CompressedImage"):
         bgr = cv2.imdecode(data, cv2.IMREAD_COLOR)
         if bgr is None:
-            raise UsageError(f"cannot decode a CompressedImage in format {msg.format!r} "
-                             f"(OpenCV reads JPEG and PNG)")
+            raise UsageError(
+                f"cannot decode a CompressedImage in format {msg.format!r} "
+                f"(OpenCV reads JPEG and PNG)"
+            )
         return bgr
     enc = msg.encoding.lower()
     if enc not in ENCODINGS:
-        raise UsageError(f"image encoding {msg.encoding!r} is not read; use one of "
-                         + ", ".join(ENCODINGS))
+        raise UsageError(
+            f"image encoding {msg.encoding!r} is not read; use one of " + ", ".join(ENCODINGS)
+        )
     h, w = msg.height, msg.width
     if msg.step < w * _CHANNELS.get(enc, 2) or data.size != h * msg.step:
-        raise UsageError(f"a {w}x{h} {enc} image with step {msg.step} cannot hold "
-                         f"{data.size} bytes: the bag's image is malformed")
+        raise UsageError(
+            f"a {w}x{h} {enc} image with step {msg.step} cannot hold "
+            f"{data.size} bytes: the bag's image is malformed"
+        )
     if enc in _CHANNELS:
         c = _CHANNELS[enc]
-        rows = data.reshape(h, msg.step)[:, :w * c]  # rows may be padded to `step`
+        rows = data.reshape(h, msg.step)[:, : w * c]  # rows may be padded to `step`
         img = rows.reshape(h, w, c) if c > 1 else rows.reshape(h, w)
     else:  # 4:2:2, two bytes a pixel
-        img = data.reshape(h, msg.step)[:, :w * 2].reshape(h, w, 2)
+        img = data.reshape(h, msg.step)[:, : w * 2].reshape(h, w, 2)
     conversion = ENCODINGS[enc]
-    return np.ascontiguousarray(img) if conversion is None else cv2.cvtColor(
-        np.ascontiguousarray(img), getattr(cv2, conversion))
+    return (
+        np.ascontiguousarray(img)
+        if conversion is None
+        else cv2.cvtColor(np.ascontiguousarray(img), getattr(cv2, conversion))
+    )
 
 
 class BagSource:
@@ -84,13 +97,14 @@ class BagSource:
         self.width, self.height = width, height
         path, topic = parse_bag_spec(spec)
         if not path.exists():
-            raise UsageError(f"--source {self.spec!r}: no such bag (give a ROS 2 bag folder, "
-                             f"its .mcap/.db3 file, or a ROS 1 .bag file)")
+            raise UsageError(
+                f"--source {self.spec!r}: no such bag (give a ROS 2 bag folder, "
+                f"its .mcap/.db3 file, or a ROS 1 .bag file)"
+            )
         if path.is_file() and path.suffix in (".mcap", ".db3"):
             path = path.parent  # a ROS 2 bag is its folder
         try:
-            self._reader = AnyReader([path],
-                                     default_typestore=get_typestore(Stores.ROS2_HUMBLE))
+            self._reader = AnyReader([path], default_typestore=get_typestore(Stores.ROS2_HUMBLE))
             self._reader.open()
         except (AnyReaderError, OSError, ValueError, KeyError) as exc:
             raise UsageError(f"--source {self.spec!r}: cannot read the bag ({exc})") from None
@@ -98,22 +112,29 @@ class BagSource:
         if topic is None:
             if not images:
                 self.close()
-                raise UsageError(f"bag {str(path)!r} has no sensor_msgs/Image or "
-                                 f"CompressedImage topic")
+                raise UsageError(
+                    f"bag {str(path)!r} has no sensor_msgs/Image or CompressedImage topic"
+                )
             if len(images) > 1 and _DEFAULT_TOPIC not in images:
                 self.close()
-                raise UsageError(f"bag {str(path)!r} has several image topics ("
-                                 + ", ".join(sorted(images)) + f"); pick one with "
-                                 f"bag:{path}:TOPIC")
+                raise UsageError(
+                    f"bag {str(path)!r} has several image topics ("
+                    + ", ".join(sorted(images))
+                    + f"); pick one with "
+                    f"bag:{path}:TOPIC"
+                )
             topic = next(iter(images)) if len(images) == 1 else _DEFAULT_TOPIC
         if topic not in images:
             known = {c.topic: c.msgtype for c in self._reader.connections}
             self.close()
             if topic in known:
-                raise UsageError(f"topic {topic} of bag {str(path)!r} holds {known[topic]}, "
-                                 f"not images")
-            raise UsageError(f"bag {str(path)!r} has no topic {topic}; image topics: "
-                             + (", ".join(sorted(images)) or "none"))
+                raise UsageError(
+                    f"topic {topic} of bag {str(path)!r} holds {known[topic]}, not images"
+                )
+            raise UsageError(
+                f"bag {str(path)!r} has no topic {topic}; image topics: "
+                + (", ".join(sorted(images)) or "none")
+            )
         self.topic = topic
         self._connections = [c for c in self._reader.connections if c.topic == topic]
         if sum(c.msgcount for c in self._connections) == 0:

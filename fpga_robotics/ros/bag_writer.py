@@ -55,15 +55,17 @@ class BagWriter:
     def __init__(self, path, geometry):
         self.path = check_bag_path(path)
         self.path.parent.mkdir(parents=True, exist_ok=True)
-        self._staging = Path(tempfile.mkdtemp(prefix=f".{self.path.name}.", suffix=".partial",
-                                              dir=self.path.parent))
+        self._staging = Path(
+            tempfile.mkdtemp(prefix=f".{self.path.name}.", suffix=".partial", dir=self.path.parent)
+        )
         self._tmp = self._staging / self.path.name  # the .mcap inside is named after it
         self._messages = FrameMessages(geometry)
         self._writer = Writer(self._tmp, version=9, storage_plugin=StoragePlugin.MCAP)
         self._writer.open()
-        self._connections = {topic: self._writer.add_connection(topic, msgtype,
-                                                                 typestore=TYPESTORE)
-                             for topic, msgtype in TOPICS.items()}
+        self._connections = {
+            topic: self._writer.add_connection(topic, msgtype, typestore=TYPESTORE)
+            for topic, msgtype in TOPICS.items()
+        }
         self.frames_logged = 0
         self._notices = []
 

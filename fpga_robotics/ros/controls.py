@@ -19,8 +19,15 @@ from fpga_robotics.hw.errors import UsageError
 
 from ..hw.pixel import COLOR_SELECT, color_select_value
 
-__all__ = ["INPUT_KINDS", "TELEOP_SPEED", "LiveControls", "ReplayControls", "apply_inputs", "check_input",
-           "load_inputs"]
+__all__ = [
+    "INPUT_KINDS",
+    "TELEOP_SPEED",
+    "LiveControls",
+    "ReplayControls",
+    "apply_inputs",
+    "check_input",
+    "load_inputs",
+]
 
 #: Speed of the target person driven by the terminal's arrows and the layout's teleop pad, m/s.
 TELEOP_SPEED = 0.5
@@ -29,8 +36,10 @@ TELEOP_SPEED = 0.5
 INPUT_KINDS = {
     "color": "a colour select name (" + ", ".join(COLOR_SELECT) + ")",
     "target_velocity": "[vx, vy] m/s in the world frame, or null to hand the target back "
-                       "to its script",
-    "pause": "null", "resume": "null", "step": "null",
+    "to its script",
+    "pause": "null",
+    "resume": "null",
+    "step": "null",
     "speed": "a pacing factor > 0 (1 = real time)",
 }
 
@@ -85,8 +94,11 @@ def apply_inputs(loop, inputs):
                 events.append("control: no target person to drive")
                 continue
             loop.world.set_target_velocity(value)
-            events.append("control: target back on its script" if value is None else
-                          f"control: target velocity ({value[0]:+.2f}, {value[1]:+.2f}) m/s")
+            events.append(
+                "control: target back on its script"
+                if value is None
+                else f"control: target velocity ({value[0]:+.2f}, {value[1]:+.2f}) m/s"
+            )
         elif kind == "speed":
             events.append(f"control: speed x{value:g}")
         else:
@@ -201,14 +213,17 @@ def load_inputs(path):
         with open(path) as f:
             data = json.load(f)
     except FileNotFoundError:
-        raise UsageError(f"{what}: no such file (give the --summary JSON of a run with "
-                         f"live input)") from None
+        raise UsageError(
+            f"{what}: no such file (give the --summary JSON of a run with live input)"
+        ) from None
     except (OSError, ValueError) as exc:
         raise UsageError(f"{what}: not readable JSON ({exc})") from None
     if isinstance(data, dict):
         if "inputs" not in data:
-            raise UsageError(f"{what}: the summary has no 'inputs' (it was not a run with "
-                             f"--live or --interactive)")
+            raise UsageError(
+                f"{what}: the summary has no 'inputs' (it was not a run with "
+                f"--live or --interactive)"
+            )
         data = data["inputs"]
     if not isinstance(data, list):
         raise UsageError(f"{what}: expected a list of inputs")

@@ -18,8 +18,14 @@ from fpga_robotics.hw.errors import UsageError
 
 from .messages import TOPICS, TYPESTORE, FrameMessages, msgdef
 
-__all__ = ["CONTROL_TOPICS", "DEFAULT_PORT", "LivePublisher", "check_live_port", "control_input",
-           "parse_live_spec"]
+__all__ = [
+    "CONTROL_TOPICS",
+    "DEFAULT_PORT",
+    "LivePublisher",
+    "check_live_port",
+    "control_input",
+    "parse_live_spec",
+]
 
 DEFAULT_PORT = 8765
 
@@ -55,8 +61,10 @@ def check_live_port(port):
         try:
             s.bind(("127.0.0.1", port))
         except OSError as exc:
-            raise UsageError(f"--live: cannot serve on 127.0.0.1:{port} ({exc.strerror}); "
-                             f"give another port with --live foxglove:PORT") from None
+            raise UsageError(
+                f"--live: cannot serve on 127.0.0.1:{port} ({exc.strerror}); "
+                f"give another port with --live foxglove:PORT"
+            ) from None
 
 
 def _decode(encoding, schema_name, data):
@@ -94,15 +102,19 @@ class _Listener(foxglove.websocket.ServerListener):
             self.publisher.subscribed.add(channel.topic)
 
     def on_client_advertise(self, client, channel):
-        self.channels[(client.id, channel.id)] = (channel.topic, channel.encoding,
-                                                  channel.schema_name)
+        self.channels[(client.id, channel.id)] = (
+            channel.topic,
+            channel.encoding,
+            channel.schema_name,
+        )
 
     def on_client_unadvertise(self, client, client_channel_id):
         self.channels.pop((client.id, client_channel_id), None)
 
     def on_message_data(self, client, client_channel_id, data):
-        topic, encoding, schema_name = self.channels.get((client.id, client_channel_id),
-                                                         (None, None, None))
+        topic, encoding, schema_name = self.channels.get(
+            (client.id, client_channel_id), (None, None, None)
+        )
         if topic not in CONTROL_TOPICS:
             return
         try:
@@ -132,20 +144,33 @@ class LivePublisher:
         self._messages = FrameMessages(geometry)
         self._context = foxglove.Context()
         self._channels = {
-            topic: foxglove.Channel(topic, message_encoding="cdr", context=self._context,
-                                    schema=foxglove.Schema(name=msgtype.replace("/msg/", "/"),
-                                                           encoding="ros2msg",
-                                                           data=msgdef(msgtype).encode()))
-            for topic, msgtype in TOPICS.items()}
+            topic: foxglove.Channel(
+                topic,
+                message_encoding="cdr",
+                context=self._context,
+                schema=foxglove.Schema(
+                    name=msgtype.replace("/msg/", "/"),
+                    encoding="ros2msg",
+                    data=msgdef(msgtype).encode(),
+                ),
+            )
+            for topic, msgtype in TOPICS.items()
+        }
         try:
             self._server = foxglove.start_server(
-                name="fpga_robotics", host="127.0.0.1", port=port, context=self._context,
+                name="fpga_robotics",
+                host="127.0.0.1",
+                port=port,
+                context=self._context,
                 capabilities=[Capability.ClientPublish] if controls is not None else [],
                 supported_encodings=["json", "cdr"],
-                server_listener=_Listener(self) if controls is not None else None)
+                server_listener=_Listener(self) if controls is not None else None,
+            )
         except RuntimeError as exc:  # FoxgloveError: the port is taken, no permission
-            raise UsageError(f"--live: cannot serve on 127.0.0.1:{port} ({exc}); "
-                             f"give another port with --live foxglove:PORT") from None
+            raise UsageError(
+                f"--live: cannot serve on 127.0.0.1:{port} ({exc}); "
+                f"give another port with --live foxglove:PORT"
+            ) from None
         self.port = self._server.port
         self.frames_logged = 0
 
@@ -154,8 +179,9 @@ class LivePublisher:
         return f"ws://127.0.0.1:{self.port}"
 
     def pop_notices(self):
-        return [(f"Foxglove live: open a WebSocket connection to {self.url} "
-                 f"(layout: {layout_path()})")]
+        return [
+            (f"Foxglove live: open a WebSocket connection to {self.url} (layout: {layout_path()})")
+        ]
 
     def log_world_map(self, world_map):
         """Nothing: Foxglove draws the people and the robot from their topics."""

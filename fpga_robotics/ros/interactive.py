@@ -17,11 +17,26 @@ from .controls import TELEOP_SPEED
 
 __all__ = ["KEYS", "TerminalControls", "check_terminal", "key_input"]
 
-_COLORS = {"r": "red", "g": "green", "b": "blue", "y": "yellow", "m": "magenta",
-           "c": "cyan", "w": "white", "n": "none"}
-_MOVES = {"\x1b[A": (0.0, 1.0), "\x1b[B": (0.0, -1.0), "\x1b[C": (1.0, 0.0),
-          "\x1b[D": (-1.0, 0.0), "i": (0.0, 1.0), "k": (0.0, -1.0), "l": (1.0, 0.0),
-          "j": (-1.0, 0.0)}
+_COLORS = {
+    "r": "red",
+    "g": "green",
+    "b": "blue",
+    "y": "yellow",
+    "m": "magenta",
+    "c": "cyan",
+    "w": "white",
+    "n": "none",
+}
+_MOVES = {
+    "\x1b[A": (0.0, 1.0),
+    "\x1b[B": (0.0, -1.0),
+    "\x1b[C": (1.0, 0.0),
+    "\x1b[D": (-1.0, 0.0),
+    "i": (0.0, 1.0),
+    "k": (0.0, -1.0),
+    "l": (1.0, 0.0),
+    "j": (-1.0, 0.0),
+}
 
 #: What each key does (docs/ros.md lists the same).
 KEYS = {
@@ -29,7 +44,7 @@ KEYS = {
     "space or p": "pause / resume",
     "s": "one frame (while paused)",
     "arrows or i j k l": f"drive the target person at {TELEOP_SPEED} m/s (up = +y, "
-                         "right = +x on the map)",
+    "right = +x on the map)",
     "x": "stop the target person",
     "h": "hand the target back to its script",
     "+ -": "pace twice as fast / half as fast",
@@ -63,8 +78,10 @@ def check_terminal(stream=None):
     starts, not when its controls open."""
     stream = sys.stdin if stream is None else stream
     if not stream.isatty():
-        raise UsageError("--interactive needs a terminal on standard input "
-                         "(use --live foxglove or --replay-inputs otherwise)")
+        raise UsageError(
+            "--interactive needs a terminal on standard input "
+            "(use --live foxglove or --replay-inputs otherwise)"
+        )
 
 
 class TerminalControls:

@@ -19,8 +19,7 @@ from fpga_robotics.sim.camera.raster import focal_length
 
 from ..sim.world.kinematics import dps_to_twist
 
-__all__ = ["TOPICS", "TYPESTORE", "CameraGeometry", "FrameMessages", "camera_geometry",
-           "msgdef"]
+__all__ = ["TOPICS", "TYPESTORE", "CameraGeometry", "FrameMessages", "camera_geometry", "msgdef"]
 
 #: The typestore every message is built and read with (ROS 2 Humble definitions).
 TYPESTORE = get_typestore(Stores.ROS2_HUMBLE)
@@ -95,11 +94,15 @@ def camera_geometry(scenario):
     spec = parse_world_config(scenario.world).robot.spec
     cam = scenario.camera
     return CameraGeometry(
-        width=cam.width, height=cam.height, hfov=cam.hfov,
+        width=cam.width,
+        height=cam.height,
+        hfov=cam.hfov,
         mount_forward=cam.mount_forward if cam.mount_forward is not None else spec.camera_forward,
         mount_height=cam.mount_height if cam.mount_height is not None else spec.camera_height,
         tilt=cam.tilt if cam.tilt is not None else spec.camera_tilt,
-        wheel_radius=spec.wheel_radius, wheel_separation=spec.wheel_separation)
+        wheel_radius=spec.wheel_radius,
+        wheel_separation=spec.wheel_separation,
+    )
 
 
 def _stamp(ns):
@@ -122,18 +125,26 @@ class FrameMessages:
         f = focal_length(g.width, g.hfov)
         cx, cy = g.width / 2, g.height / 2
         self._camera_info = {
-            "height": g.height, "width": g.width, "distortion_model": "plumb_bob",
-            "d": np.zeros(5), "k": np.array([f, 0, cx, 0, f, cy, 0, 0, 1], float),
+            "height": g.height,
+            "width": g.width,
+            "distortion_model": "plumb_bob",
+            "d": np.zeros(5),
+            "k": np.array([f, 0, cx, 0, f, cy, 0, 0, 1], float),
             "r": np.eye(3).ravel(),
             "p": np.array([f, 0, cx, 0, 0, f, cy, 0, 0, 0, 1, 0], float),
-            "binning_x": 0, "binning_y": 0,
-            "roi": _T["sensor_msgs/msg/RegionOfInterest"](x_offset=0, y_offset=0, height=0,
-                                                          width=0, do_rectify=False)}
+            "binning_x": 0,
+            "binning_y": 0,
+            "roi": _T["sensor_msgs/msg/RegionOfInterest"](
+                x_offset=0, y_offset=0, height=0, width=0, do_rectify=False
+            ),
+        }
         self._mount = _T["geometry_msgs/msg/Transform"](
             translation=_Vector3(x=g.mount_forward, y=0.0, z=g.mount_height),
-            rotation=_pitch(-g.tilt))  # about +y (left): a positive pitch looks down
+            rotation=_pitch(-g.tilt),
+        )  # about +y (left): a positive pitch looks down
         self._dps_layout = _MultiArrayLayout(
-            dim=[_MultiArrayDimension(label="left,right", size=2, stride=2)], data_offset=0)
+            dim=[_MultiArrayDimension(label="left,right", size=2, stride=2)], data_offset=0
+        )
         self._zero = _Vector3(x=0.0, y=0.0, z=0.0)
         self._covariance = np.zeros(36)
         self._ser = TYPESTORE.serialize_cdr
@@ -141,8 +152,14 @@ class FrameMessages:
     def _image(self, header, rgb):
         h, w = rgb.shape[:2]
         return _T["sensor_msgs/msg/Image"](
-            header=header, height=h, width=w, encoding="rgb8", is_bigendian=0, step=w * 3,
-            data=np.ascontiguousarray(rgb, np.uint8).reshape(-1))
+            header=header,
+            height=h,
+            width=w,
+            encoding="rgb8",
+            is_bigendian=0,
+            step=w * 3,
+            data=np.ascontiguousarray(rgb, np.uint8).reshape(-1),
+        )
 
     def encode(self, record):
         """``[(topic, stamp_ns, cdr_bytes), ...]`` for one ``FrameRecord``."""
@@ -154,47 +171,98 @@ class FrameMessages:
         out = [
             ("/clock", T["rosgraph_msgs/msg/Clock"](clock=stamp)),
             ("/camera/image_raw", self._image(cam_header, record.camera_rgb)),
-            ("/camera/camera_info", T["sensor_msgs/msg/CameraInfo"](header=cam_header,
-                                                                   **self._camera_info)),
+            (
+                "/camera/camera_info",
+                T["sensor_msgs/msg/CameraInfo"](header=cam_header, **self._camera_info),
+            ),
         ]
         r = record.result
         if r.filtered is not None:
-            out.append(("/fpga/filtered/image",
-                        self._image(cam_header, np.take(_RGB444_LUT, r.filtered, axis=0))))
-        for topic, value, cls in (("/fpga/found", r.found, "Bool"),
-                                  ("/fpga/proximity", r.proximity, "UInt8"),
-                                  ("/fpga/centroid_x", r.centroid_x, "UInt16"),
-                                  ("/fpga/centroid_leds", r.centroid_leds, "UInt8")):
+            out.append(
+                (
+                    "/fpga/filtered/image",
+                    self._image(cam_header, np.take(_RGB444_LUT, r.filtered, axis=0)),
+                )
+            )
+        for topic, value, cls in (
+            ("/fpga/found", r.found, "Bool"),
+            ("/fpga/proximity", r.proximity, "UInt8"),
+            ("/fpga/centroid_x", r.centroid_x, "UInt16"),
+            ("/fpga/centroid_leds", r.centroid_leds, "UInt8"),
+        ):
             if value is not None:
-                out.append((topic, T[f"std_msgs/msg/{cls}"](
-                    data=bool(value) if cls == "Bool" else int(value))))
+                out.append(
+                    (
+                        topic,
+                        T[f"std_msgs/msg/{cls}"](data=bool(value) if cls == "Bool" else int(value)),
+                    )
+                )
         if r.motor_left is not None and r.motor_right is not None:
             left, right = int(r.motor_left), int(r.motor_right)
-            out.append(("/fpga/wheel_dps", T["std_msgs/msg/Int16MultiArray"](
-                layout=self._dps_layout, data=np.array([left, right], np.int16))))
+            out.append(
+                (
+                    "/fpga/wheel_dps",
+                    T["std_msgs/msg/Int16MultiArray"](
+                        layout=self._dps_layout, data=np.array([left, right], np.int16)
+                    ),
+                )
+            )
             v, w = dps_to_twist(left, right, g.wheel_radius, g.wheel_separation)
-            out.append(("/cmd_vel", _Twist(linear=_Vector3(x=v, y=0.0, z=0.0),
-                                           angular=_Vector3(x=0.0, y=0.0, z=w))))
-        pose = _Pose(position=_Point(x=float(record.robot_x), y=float(record.robot_y), z=0.0),
-                     orientation=_yaw(float(record.robot_heading)))
-        out.append(("/odom", T["nav_msgs/msg/Odometry"](
-            header=odom_header, child_frame_id="base_link",
-            pose=T["geometry_msgs/msg/PoseWithCovariance"](pose=pose,
-                                                            covariance=self._covariance),
-            twist=T["geometry_msgs/msg/TwistWithCovariance"](
-                twist=_Twist(linear=_Vector3(x=float(record.robot_v), y=0.0, z=0.0),
-                             angular=_Vector3(x=0.0, y=0.0, z=float(record.robot_w))),
-                covariance=self._covariance))))
-        Transform, Stamped = T["geometry_msgs/msg/Transform"], T[
-            "geometry_msgs/msg/TransformStamped"]
-        out.append(("/tf", T["tf2_msgs/msg/TFMessage"](transforms=[
-            Stamped(header=odom_header, child_frame_id="base_link",
-                    transform=Transform(translation=_Vector3(x=pose.position.x,
-                                                             y=pose.position.y, z=0.0),
-                                        rotation=pose.orientation)),
-            Stamped(header=_Header(stamp=stamp, frame_id="base_link"),
-                    child_frame_id="camera_link", transform=self._mount),
-        ])))
+            out.append(
+                (
+                    "/cmd_vel",
+                    _Twist(linear=_Vector3(x=v, y=0.0, z=0.0), angular=_Vector3(x=0.0, y=0.0, z=w)),
+                )
+            )
+        pose = _Pose(
+            position=_Point(x=float(record.robot_x), y=float(record.robot_y), z=0.0),
+            orientation=_yaw(float(record.robot_heading)),
+        )
+        out.append(
+            (
+                "/odom",
+                T["nav_msgs/msg/Odometry"](
+                    header=odom_header,
+                    child_frame_id="base_link",
+                    pose=T["geometry_msgs/msg/PoseWithCovariance"](
+                        pose=pose, covariance=self._covariance
+                    ),
+                    twist=T["geometry_msgs/msg/TwistWithCovariance"](
+                        twist=_Twist(
+                            linear=_Vector3(x=float(record.robot_v), y=0.0, z=0.0),
+                            angular=_Vector3(x=0.0, y=0.0, z=float(record.robot_w)),
+                        ),
+                        covariance=self._covariance,
+                    ),
+                ),
+            )
+        )
+        Transform, Stamped = (
+            T["geometry_msgs/msg/Transform"],
+            T["geometry_msgs/msg/TransformStamped"],
+        )
+        out.append(
+            (
+                "/tf",
+                T["tf2_msgs/msg/TFMessage"](
+                    transforms=[
+                        Stamped(
+                            header=odom_header,
+                            child_frame_id="base_link",
+                            transform=Transform(
+                                translation=_Vector3(x=pose.position.x, y=pose.position.y, z=0.0),
+                                rotation=pose.orientation,
+                            ),
+                        ),
+                        Stamped(
+                            header=_Header(stamp=stamp, frame_id="base_link"),
+                            child_frame_id="camera_link",
+                            transform=self._mount,
+                        ),
+                    ]
+                ),
+            )
+        )
         out.append(("/people", self._people(odom_header, record.people)))
         return [(topic, ns, ser(msg, TOPICS[topic])) for topic, msg in out]
 
@@ -203,17 +271,34 @@ class FrameMessages:
         markers = []
         for i, p in enumerate(people):
             rgba = _TARGET_RGBA if p.is_target else _PERSON_RGBA
-            markers.append(Marker(
-                header=header, ns="people", id=i, type=Marker.CYLINDER, action=Marker.ADD,
-                pose=_Pose(position=_Point(x=float(p.x), y=float(p.y), z=_PERSON_HEIGHT / 2),
-                           orientation=_yaw(0.0)),
-                scale=_Vector3(x=2 * p.radius, y=2 * p.radius, z=_PERSON_HEIGHT),
-                color=_ColorRGBA(r=rgba[0], g=rgba[1], b=rgba[2], a=rgba[3]),
-                lifetime=_Duration(sec=0, nanosec=0), frame_locked=False, points=[], colors=[],
-                texture_resource="", texture=_T["sensor_msgs/msg/CompressedImage"](
-                    header=header, format="", data=np.zeros(0, np.uint8)),
-                uv_coordinates=[], text=p.name, mesh_resource="",
-                mesh_file=_T["visualization_msgs/msg/MeshFile"](filename="",
-                                                                data=np.zeros(0, np.uint8)),
-                mesh_use_embedded_materials=False))
+            markers.append(
+                Marker(
+                    header=header,
+                    ns="people",
+                    id=i,
+                    type=Marker.CYLINDER,
+                    action=Marker.ADD,
+                    pose=_Pose(
+                        position=_Point(x=float(p.x), y=float(p.y), z=_PERSON_HEIGHT / 2),
+                        orientation=_yaw(0.0),
+                    ),
+                    scale=_Vector3(x=2 * p.radius, y=2 * p.radius, z=_PERSON_HEIGHT),
+                    color=_ColorRGBA(r=rgba[0], g=rgba[1], b=rgba[2], a=rgba[3]),
+                    lifetime=_Duration(sec=0, nanosec=0),
+                    frame_locked=False,
+                    points=[],
+                    colors=[],
+                    texture_resource="",
+                    texture=_T["sensor_msgs/msg/CompressedImage"](
+                        header=header, format="", data=np.zeros(0, np.uint8)
+                    ),
+                    uv_coordinates=[],
+                    text=p.name,
+                    mesh_resource="",
+                    mesh_file=_T["visualization_msgs/msg/MeshFile"](
+                        filename="", data=np.zeros(0, np.uint8)
+                    ),
+                    mesh_use_embedded_materials=False,
+                )
+            )
         return _T["visualization_msgs/msg/MarkerArray"](markers=markers)

@@ -10,21 +10,32 @@ __all__ = ["RosOutputs", "add_ros_arguments"]
 
 
 def add_ros_arguments(p):
-    p.add_argument("--bag", metavar="PATH",
-                   help="also write the run as a ROS 2 bag (MCAP storage) in the folder PATH "
-                        "(docs/ros.md)")
-    p.add_argument("--live", metavar="foxglove[:PORT]",
-                   help="publish the run's topics on a Foxglove WebSocket server on localhost "
-                        "(default port 8765), paced to real time, with live control from "
-                        "the client")
-    p.add_argument("--interactive", action="store_true",
-                   help="control the run from the terminal: keys for colour, pause, step, "
-                        "driving the target person, speed (docs/ros.md)")
-    p.add_argument("--paused", action="store_true",
-                   help="with --live or --interactive: start paused")
-    p.add_argument("--replay-inputs", metavar="SUMMARY.json",
-                   help="replay the live inputs a run recorded (its --summary JSON) at the "
-                        "same frames")
+    p.add_argument(
+        "--bag",
+        metavar="PATH",
+        help="also write the run as a ROS 2 bag (MCAP storage) in the folder PATH (docs/ros.md)",
+    )
+    p.add_argument(
+        "--live",
+        metavar="foxglove[:PORT]",
+        help="publish the run's topics on a Foxglove WebSocket server on localhost "
+        "(default port 8765), paced to real time, with live control from "
+        "the client",
+    )
+    p.add_argument(
+        "--interactive",
+        action="store_true",
+        help="control the run from the terminal: keys for colour, pause, step, "
+        "driving the target person, speed (docs/ros.md)",
+    )
+    p.add_argument(
+        "--paused", action="store_true", help="with --live or --interactive: start paused"
+    )
+    p.add_argument(
+        "--replay-inputs",
+        metavar="SUMMARY.json",
+        help="replay the live inputs a run recorded (its --summary JSON) at the same frames",
+    )
 
 
 class RosOutputs:
@@ -48,8 +59,10 @@ class RosOutputs:
             check_live_port(self.port)
         if args.replay_inputs is not None:
             if self.port is not None or self.interactive:
-                raise UsageError("--replay-inputs replays a run's inputs; it does not go with "
-                                 "--live or --interactive")
+                raise UsageError(
+                    "--replay-inputs replays a run's inputs; it does not go with "
+                    "--live or --interactive"
+                )
             from .controls import load_inputs
 
             self.replay = load_inputs(args.replay_inputs)
@@ -76,8 +89,12 @@ class RosOutputs:
 
     @property
     def active(self):
-        return self.bag_path is not None or self.port is not None or self.replay is not None \
+        return (
+            self.bag_path is not None
+            or self.port is not None
+            or self.replay is not None
             or self.interactive
+        )
 
     def open(self, scenario, *, closed_loop=True):
         """Start what the options ask for; returns the notices to print now."""
@@ -129,9 +146,11 @@ class RosOutputs:
         if self.controls is not None:
             self.controls.close()
             if completed and self.replay is None and self.controls.log:
-                notices.append(f"{len(self.controls.log)} live input(s) applied; the "
-                               f"summary's 'inputs' replay them (--summary PATH, then "
-                               f"--replay-inputs PATH)")
+                notices.append(
+                    f"{len(self.controls.log)} live input(s) applied; the "
+                    f"summary's 'inputs' replay them (--summary PATH, then "
+                    f"--replay-inputs PATH)"
+                )
         for sink in self._sinks:
             if sink is self._bag and not completed:
                 sink.abandon()

@@ -83,8 +83,14 @@ _FOREIGN_KEYS = ("verilog", "ports")
 _TOP_TABLES = ("ultrasound", "interlock", "line")
 #: ``design.params``: the keyword arguments of a design of one's own (designs/reference.py).
 _TOP_DESIGN_KEYS = ("top", "variant", "params", *_TOP_TABLES)
-_DESIGN_KEYS = ("preset",) + _TOP_DESIGN_KEYS + _FOREIGN_KEYS + tuple(f.name for f in fields(FollowTargetParams) if f.init and
-                                   f.name not in ("width", "height"))
+_DESIGN_KEYS = (
+    ("preset",)
+    + _TOP_DESIGN_KEYS
+    + _FOREIGN_KEYS
+    + tuple(
+        f.name for f in fields(FollowTargetParams) if f.init and f.name not in ("width", "height")
+    )
+)
 #: Design parameters that are arrays: their length and what the values are.
 _DESIGN_ARRAYS = {
     "base_dps": (len(DEFAULT_BASE_DPS), "wheel DPS per proximity level 0..7"),
@@ -95,8 +101,13 @@ _DESIGN_ARRAYS = {
 #: Defaults of the application's sections (a key absent here is unknown).
 DEFAULTS = {
     # timing: "auto" (compressed for camera-only designs), "compressed" or "real_clock".
-    "sim": {"duration": 20.0, "physics_dt": 1.0 / 240.0, "actuation_delay": None,
-            "timing": "auto", "clock_hz": 50e6},
+    "sim": {
+        "duration": 20.0,
+        "physics_dt": 1.0 / 240.0,
+        "actuation_delay": None,
+        "timing": "auto",
+        "clock_hz": 50e6,
+    },
     "camera": {
         "resolution": "160x120",
         "fps": 30.0,
@@ -337,16 +348,20 @@ def _resolve(name_or_path):
                 f"(or give the path of a .toml file)"
             )
     if path.is_dir():
-        raise ScenarioError(f"scenario {text!r} is a folder; give a .toml file in it or the "
-                            f"name of a shipped scenario")
+        raise ScenarioError(
+            f"scenario {text!r} is a folder; give a .toml file in it or the "
+            f"name of a shipped scenario"
+        )
     if path.exists() and not path.is_file():
-        raise ScenarioError(f"scenario file {text!r} is not a regular file (a device or "
-                            f"pipe); give a .toml file")
+        raise ScenarioError(
+            f"scenario file {text!r} is not a regular file (a device or pipe); give a .toml file"
+        )
     if not path.exists():
         if path.suffix == ".toml" and path.name == text and path.stem in shipped_scenarios():
             raise ScenarioError(
                 f"scenario file {text!r} does not exist here; for the shipped scenario "
-                f"give its name: --scenario {path.stem}")
+                f"give its name: --scenario {path.stem}"
+            )
         raise ScenarioError(f"scenario file {text!r} does not exist")
     return path
 
@@ -378,8 +393,10 @@ def load_scenario(name_or_path, overrides=()):
     try:
         size = path.stat().st_size
         if size > MAX_FILE_BYTES:
-            raise ScenarioError(f"scenario file {str(path)!r} is {size} bytes; a scenario is at "
-                                f"most {MAX_FILE_BYTES} bytes")
+            raise ScenarioError(
+                f"scenario file {str(path)!r} is {size} bytes; a scenario is at "
+                f"most {MAX_FILE_BYTES} bytes"
+            )
         data = tomllib.loads(path.read_text())
     except tomllib.TOMLDecodeError as exc:
         raise ScenarioError(f"{path}: malformed TOML: {exc}") from None
@@ -414,7 +431,8 @@ def _check_sections(data, path):
         if not isinstance(value, dict):
             raise ScenarioError(
                 f"{where}{section} must be a table ([{section}] in a file, --set "
-                f"{section}.KEY=VALUE on the command line), got {value!r}")
+                f"{section}.KEY=VALUE on the command line), got {value!r}"
+            )
         allowed = allowed_keys[section]
         _check_subtables(value, DEFAULTS.get(section, {}), section, where)
         for key in value:
@@ -434,12 +452,16 @@ def _check_subtables(table, defaults, section, where):
         if isinstance(default, dict) and key in table:
             sub = table[key]
             if not isinstance(sub, dict):
-                raise ScenarioError(f"{where}{section}.{key} must be a table ([{section}.{key}] "
-                                    f"in a file), got {sub!r}")
+                raise ScenarioError(
+                    f"{where}{section}.{key} must be a table ([{section}.{key}] "
+                    f"in a file), got {sub!r}"
+                )
             for k in sub:
                 if k not in default:
-                    raise ScenarioError(f"{where}unknown key {section}.{key}.{k}"
-                                        f"{_close(k, default, f'{section}.{key}')}")
+                    raise ScenarioError(
+                        f"{where}unknown key {section}.{key}.{k}"
+                        f"{_close(k, default, f'{section}.{key}')}"
+                    )
 
 
 def _fill_defaults(data):
@@ -537,8 +559,10 @@ def _set_path(data, key, value, shown):
         optional = _optional_keys(parts[:i])
         if part not in node and part not in optional and not (in_world and last):
             if parts[:i] == ["design"] and part in ("width", "height"):
-                raise ScenarioError(f"design.{part} comes from camera.resolution; "
-                                    f"set camera.resolution=WxH (or --resolution) instead")
+                raise ScenarioError(
+                    f"design.{part} comes from camera.resolution; "
+                    f"set camera.resolution=WxH (or --resolution) instead"
+                )
             raise ScenarioError(_unknown_key_message(data, key, here, shown))
         if last:
             node[part] = _coerce(node.get(part), value)
@@ -608,12 +632,15 @@ def _in_range(value, name, lo, hi, unit, *, lo_open=False, note=""):
     if not (_is_number(value) and math.isfinite(value)):
         bounds = [f"{'>' if lo_open else '>='} {lo:g}"] if lo is not None else []
         bounds += [f"<= {hi:g}"] if hi is not None else []
-        raise ScenarioError(f"{name} must be a finite number{' in ' + unit if unit else ''}"
-                            f"{', ' + ' and '.join(bounds) if bounds else ''}, got {value!r}")
+        raise ScenarioError(
+            f"{name} must be a finite number{' in ' + unit if unit else ''}"
+            f"{', ' + ' and '.join(bounds) if bounds else ''}, got {value!r}"
+        )
     unit = f" ({unit})" if " " in unit else f" {unit}" if unit else ""
     if lo is not None and (value <= lo if lo_open else value < lo):
-        raise ScenarioError(f"{name} must be {'>' if lo_open else '>='} {lo:g}{unit}, "
-                            f"got {value!r}")
+        raise ScenarioError(
+            f"{name} must be {'>' if lo_open else '>='} {lo:g}{unit}, got {value!r}"
+        )
     if hi is not None and value > hi:
         raise ScenarioError(f"{name} must be <= {hi:g}{unit}{note}, got {value!r}")
     return float(value)
@@ -627,8 +654,15 @@ def _limited(data, name, *, optional=False, hi=None, note=""):
     if optional and value is None:
         return None
     lo, limit_hi, unit = LIMITS[name]
-    return _in_range(value, name, lo, limit_hi if hi is None else hi, unit,
-                     lo_open=name in _LO_EXCLUDED, note=note)
+    return _in_range(
+        value,
+        name,
+        lo,
+        limit_hi if hi is None else hi,
+        unit,
+        lo_open=name in _LO_EXCLUDED,
+        note=note,
+    )
 
 
 def _color(value, where):
@@ -660,19 +694,22 @@ def _check_name(name):
         raise ScenarioError(
             f"name {name!r} cannot be a file name (a recording is saved as runs/<name>.rrd): "
             f"use at most {MAX_NAME_LENGTH} ASCII letters, digits, '_', '-' and '.', "
-            f"starting with a letter, a digit or '_'")
+            f"starting with a letter, a digit or '_'"
+        )
     return name
 
 
 def _camera(data):
     cam = data["camera"]
     width, height = parse_resolution(cam["resolution"])
-    if not (WIDTH_RANGE[0] <= width <= WIDTH_RANGE[1]
-            and HEIGHT_RANGE[0] <= height <= HEIGHT_RANGE[1]):
+    if not (
+        WIDTH_RANGE[0] <= width <= WIDTH_RANGE[1] and HEIGHT_RANGE[0] <= height <= HEIGHT_RANGE[1]
+    ):
         raise ScenarioError(
             f"camera.resolution {width}x{height}: the width must be {WIDTH_RANGE[0]}.."
             f"{WIDTH_RANGE[1]} and the height {HEIGHT_RANGE[0]}..{HEIGHT_RANGE[1]} pixels "
-            f"(the design's limits)")
+            f"(the design's limits)"
+        )
     renderer, render3d = parse_render_keys(cam, data.get("seed", 0))
     return CameraConfig(
         width=width,
@@ -694,8 +731,7 @@ def _camera(data):
 
 def _choice(value, name, choices):
     if value not in choices:
-        raise ScenarioError(f"{name} must be one of {', '.join(map(repr, choices))}, "
-                            f"got {value!r}")
+        raise ScenarioError(f"{name} must be one of {', '.join(map(repr, choices))}, got {value!r}")
     return value
 
 
@@ -711,18 +747,26 @@ def _sensor_params(table):
         if kind == "float":
             value = _in_range(value, name, *limits, unit)
         if kind == "int" and not (_is_int(value) and limits[0] <= value <= limits[1]):
-            raise ScenarioError(f"{name} must be an integer {limits[0]}..{limits[1]} ({unit}), "
-                                f"got {value!r}")
-        if kind == "pair" and not (isinstance(value, list) and len(value) == 2
-                                   and all(_is_int(v) and limits[0] <= v <= limits[1]
-                                           for v in value) and value[0] < value[1]):
-            raise ScenarioError(f"{name} must be [low, high], integers {limits[0]}..{limits[1]} "
-                                f"with low < high ({unit}), got {value!r}")
+            raise ScenarioError(
+                f"{name} must be an integer {limits[0]}..{limits[1]} ({unit}), got {value!r}"
+            )
+        if kind == "pair" and not (
+            isinstance(value, list)
+            and len(value) == 2
+            and all(_is_int(v) and limits[0] <= v <= limits[1] for v in value)
+            and value[0] < value[1]
+        ):
+            raise ScenarioError(
+                f"{name} must be [low, high], integers {limits[0]}..{limits[1]} "
+                f"with low < high ({unit}), got {value!r}"
+            )
         values[key] = tuple(value) if kind == "pair" else value
     (lo, hi), (fast_lo, fast_hi) = values["aec_window"], values["aec_fast_zone"]
     if not fast_lo <= lo < hi <= fast_hi:
-        raise ScenarioError(f"camera.ov7670.aec_window {[lo, hi]} must lie inside "
-                            f"camera.ov7670.aec_fast_zone {[fast_lo, fast_hi]}")
+        raise ScenarioError(
+            f"camera.ov7670.aec_window {[lo, hi]} must lie inside "
+            f"camera.ov7670.aec_fast_zone {[fast_lo, fast_hi]}"
+        )
     return OV7670Params.from_dict(values)
 
 
@@ -731,8 +775,10 @@ def _check_camera_geometry(camera, world):
     ceiling, and no ray looking straight up or down (``sim.camera.max_tilt``)."""
     ceiling = world.room.height
     if camera.mount_height is not None and not camera.mount_height < ceiling:
-        raise ScenarioError(f"camera.mount_height must be below the ceiling (room.height = "
-                            f"{ceiling:g} m), got {camera.mount_height:g}")
+        raise ScenarioError(
+            f"camera.mount_height must be below the ceiling (room.height = "
+            f"{ceiling:g} m), got {camera.mount_height:g}"
+        )
     w, h, hfov = camera.width, camera.height, camera.hfov
     vfov = vertical_fov(w, h, hfov)
     limit = max_tilt(w, h, hfov)
@@ -740,7 +786,8 @@ def _check_camera_geometry(camera, world):
         raise ScenarioError(
             f"camera.hfov must be at most {_floor(max_hfov(w, h), 4)} rad at camera.resolution "
             f"{w}x{h}, got {hfov:g} (a vertical field of view of {vfov:.3f} rad: the top and "
-            f"bottom rows would look straight up or down)")
+            f"bottom rows would look straight up or down)"
+        )
     if camera.tilt is not None:
         tilt, key, shown, unit = camera.tilt, "camera.tilt", _floor(limit, 4), "rad"
     else:
@@ -751,34 +798,39 @@ def _check_camera_geometry(camera, world):
         raise ScenarioError(
             f"|{key}| must be at most {shown} {unit} with camera.hfov {hfov:g} rad at "
             f"{w}x{h} (vertical field of view {vfov:.3f} rad; beyond it rows would look "
-            f"straight up or down), got {got:g}")
+            f"straight up or down), got {got:g}"
+        )
 
 
 def _sim(data, camera):
     sim = data["sim"]
     duration = _limited(data, "sim.duration", note=" (one day)")
     period = camera.frame_period
-    dt = _limited(data, "sim.physics_dt", hi=period,
-                  note=" (one camera frame period, 1 / camera.fps)")
+    dt = _limited(
+        data, "sim.physics_dt", hi=period, note=" (one camera frame period, 1 / camera.fps)"
+    )
     timing = _choice(sim.get("timing", "auto"), "sim.timing", TIMINGS)
     clock_hz = _limited(data, "sim.clock_hz")
     if sim.get("actuation_delay") is not None:
         delay = _limited(data, "sim.actuation_delay")
     else:
         delay = None  # one frame period, or REAL_CLOCK_ACTUATION_DELAY (_resolve_timing)
-    config = SimConfig(duration=duration, physics_dt=dt, actuation_delay=delay, timing=timing,
-                       clock_hz=clock_hz)
+    config = SimConfig(
+        duration=duration, physics_dt=dt, actuation_delay=delay, timing=timing, clock_hz=clock_hz
+    )
     steps = max(1, round(duration / dt))  # as the closed loop counts them
     if steps > MAX_PHYSICS_STEPS:
         raise ScenarioError(
             f"sim.duration {duration:g} s / sim.physics_dt {dt:g} s = {steps} physics steps; "
             f"the limit is {MAX_PHYSICS_STEPS}: shorten sim.duration or lengthen "
-            f"sim.physics_dt")
+            f"sim.physics_dt"
+        )
     frames = frame_count(steps, period, dt)
     if frames > MAX_FRAMES:
         raise ScenarioError(
             f"sim.duration {duration:g} s at camera.fps {camera.fps:g} = {frames} camera "
-            f"frames; the limit is {MAX_FRAMES}: shorten sim.duration or lower camera.fps")
+            f"frames; the limit is {MAX_FRAMES}: shorten sim.duration or lower camera.fps"
+        )
     return config
 
 
@@ -787,14 +839,13 @@ def _color_changes(data):
     initial = _color(color["initial"], "color.initial")
     changes = color["changes"]
     if not isinstance(changes, list):
-        raise ScenarioError("color.changes must be a list of {at = seconds, color = \"...\"}")
+        raise ScenarioError('color.changes must be a list of {at = seconds, color = "..."}')
     lo, hi, unit = LIMITS["color.changes.at"]
     parsed = []
     for i, change in enumerate(changes):
         where = f"color.changes[{i}]"
         if not isinstance(change, dict) or set(change) != {"at", "color"}:
-            raise ScenarioError(f"{where} must be {{at = seconds, color = \"name\"}}, got "
-                                f"{change!r}")
+            raise ScenarioError(f'{where} must be {{at = seconds, color = "name"}}, got {change!r}')
         at = change["at"]
         if not (_is_number(at) and math.isfinite(at) and lo <= at <= hi):
             raise ScenarioError(f"{where}.at must be a time in {lo:g}..{hi:g} {unit}, got {at!r}")
@@ -812,28 +863,37 @@ def _foreign(design, source):
     top = design.get("top")
     if isinstance(top, str) and top.startswith("verilog:"):
         if verilog is not None:
-            raise ScenarioError("give the Verilog files once: design.top = \"verilog:...\" or "
-                                "design.verilog, not both")
-        verilog = [f for f in top[len("verilog:"):].split(",") if f.strip()]
+            raise ScenarioError(
+                'give the Verilog files once: design.top = "verilog:..." or '
+                "design.verilog, not both"
+            )
+        verilog = [f for f in top[len("verilog:") :].split(",") if f.strip()]
         if ports is None:
-            raise ScenarioError(f"design.top = {top!r} needs design.ports = \"ports.toml\" "
-                                f"(the design's port map, docs/foreign.md)")
+            raise ScenarioError(
+                f'design.top = {top!r} needs design.ports = "ports.toml" '
+                f"(the design's port map, docs/foreign.md)"
+            )
     if verilog is None and ports is None:
         return None
     if verilog is None:
-        raise ScenarioError("design.ports goes with design.verilog = [\"top.v\", ...]")
+        raise ScenarioError('design.ports goes with design.verilog = ["top.v", ...]')
     if ports is None:
-        raise ScenarioError("design.verilog needs design.ports = \"ports.toml\" (the design's "
-                            "port map, docs/foreign.md)")
+        raise ScenarioError(
+            'design.verilog needs design.ports = "ports.toml" (the design\'s '
+            "port map, docs/foreign.md)"
+        )
     if isinstance(verilog, str):
         verilog = [verilog]
-    if not (isinstance(verilog, list) and verilog
-            and all(isinstance(f, str) and f.strip() for f in verilog)):
-        raise ScenarioError(f"design.verilog must be an array of Verilog file paths, "
-                            f"got {verilog!r}")
+    if not (
+        isinstance(verilog, list)
+        and verilog
+        and all(isinstance(f, str) and f.strip() for f in verilog)
+    ):
+        raise ScenarioError(
+            f"design.verilog must be an array of Verilog file paths, got {verilog!r}"
+        )
     if not (isinstance(ports, str) and ports.strip()):
-        raise ScenarioError(f"design.ports must be the path of a port map (.toml), "
-                            f"got {ports!r}")
+        raise ScenarioError(f"design.ports must be the path of a port map (.toml), got {ports!r}")
     base = Path(source).parent if source else Path(".")
 
     def existing(key, text):
@@ -843,8 +903,9 @@ def _foreign(design, source):
             raise ScenarioError(f"design.{key}: no file {text!r} (looked for {str(path)!r})")
         return str(path)
 
-    return ForeignDesignFiles(tuple(existing("verilog", f) for f in verilog),
-                              existing("ports", ports))
+    return ForeignDesignFiles(
+        tuple(existing("verilog", f) for f in verilog), existing("ports", ports)
+    )
 
 
 def _design(data, width, height):
@@ -855,20 +916,24 @@ def _design(data, width, height):
     for key, value in design.items():
         if key in CHOICES:
             if not isinstance(value, str):
-                raise ScenarioError(f"design.{key} must be a string, one of "
-                                    f"{', '.join(CHOICES[key])}; got {value!r}")
+                raise ScenarioError(
+                    f"design.{key} must be a string, one of "
+                    f"{', '.join(CHOICES[key])}; got {value!r}"
+                )
         elif key in _DESIGN_ARRAYS:
             n, what = _DESIGN_ARRAYS[key]
             if not (isinstance(value, list) and len(value) == n and all(map(_is_int, value))):
                 raise ScenarioError(
-                    f"design.{key} must be an array of {n} integers ({what}), got {value!r}")
+                    f"design.{key} must be an array of {n} integers ({what}), got {value!r}"
+                )
         elif not _is_int(value):
             raise ScenarioError(f"design.{key} must be an integer, got {value!r}")
     values = {}
     if preset is not None:
         if preset not in PRESETS:
-            raise ScenarioError(f"design.preset must be one of {', '.join(map(repr, PRESETS))}, "
-                                f"got {preset!r}")
+            raise ScenarioError(
+                f"design.preset must be one of {', '.join(map(repr, PRESETS))}, got {preset!r}"
+            )
         # The preset first, the scenario's other design keys on top.
         values = preset_values(preset, width, height)
     values.update(design)
@@ -879,8 +944,9 @@ def _design(data, width, height):
         field = re.match(r"\w+", message)
         if field and field.group() in design:  # "kp_shift must be <= 15, got 99"
             raise ScenarioError(f"design.{message}") from None
-        raise ScenarioError(f"invalid design parameters with camera.resolution "
-                            f"{width}x{height}: {message}") from None
+        raise ScenarioError(
+            f"invalid design parameters with camera.resolution {width}x{height}: {message}"
+        ) from None
 
 
 def _top(design, source):
@@ -892,21 +958,29 @@ def _top(design, source):
     top = design.get("top", "follow_target")
     params = design.get("params", {})
     if not isinstance(params, dict):
-        raise ScenarioError(f"design.params must be a table ([design.params] in a file, "
-                            f"--set design.params.NAME=VALUE), got {params!r}")
+        raise ScenarioError(
+            f"design.params must be a table ([design.params] in a file, "
+            f"--set design.params.NAME=VALUE), got {params!r}"
+        )
     if isinstance(top, str) and top.startswith("verilog:"):
         top = "follow_target"  # the design is the scenario's foreign one (design.ports)
         if params:
-            raise ScenarioError("design.params: a Verilog design takes no parameters here; "
-                                "set them in the Verilog (or tie inputs in [constants])")
+            raise ScenarioError(
+                "design.params: a Verilog design takes no parameters here; "
+                "set them in the Verilog (or tie inputs in [constants])"
+            )
     if not isinstance(top, str) or top not in TOPS:
         given = [k for k in _TOP_TABLES if design.get(k) is not None]
         if given:
-            raise ScenarioError(f"design.{given[0]} is a table of a built-in design; a "
-                                f"design of your own takes design.params")
+            raise ScenarioError(
+                f"design.{given[0]} is a table of a built-in design; a "
+                f"design of your own takes design.params"
+            )
         if design.get("variant") is not None:
-            raise ScenarioError("design.variant names a buggy variant of a built-in design; "
-                                f"design.top = {top!r} has none")
+            raise ScenarioError(
+                "design.variant names a buggy variant of a built-in design; "
+                f"design.top = {top!r} has none"
+            )
         base = Path(source).parent if source else None
         try:
             spec = resolve_design(top, params, base=base)
@@ -914,9 +988,11 @@ def _top(design, source):
             raise ScenarioError(str(exc)) from None
         return spec.reference, {}, dict(spec.params)
     if params:
-        raise ScenarioError(f"design.params: the built-in design {top!r} takes its "
-                            f"parameters from [design] and its own tables "
-                            f"({', '.join(TOPS[top].tables) or 'none'}), not design.params")
+        raise ScenarioError(
+            f"design.params: the built-in design {top!r} takes its "
+            f"parameters from [design] and its own tables "
+            f"({', '.join(TOPS[top].tables) or 'none'}), not design.params"
+        )
     spec = TOPS[top]
     tables = {}
     for key in ("ultrasound", "interlock", "line"):
@@ -924,11 +1000,14 @@ def _top(design, source):
         if value is None:
             continue
         if key not in spec.tables:
-            raise ScenarioError(f"design.{key} is a table of another design; design.top = "
-                                f"{top!r} takes: {', '.join(spec.tables) or 'none'}")
+            raise ScenarioError(
+                f"design.{key} is a table of another design; design.top = "
+                f"{top!r} takes: {', '.join(spec.tables) or 'none'}"
+            )
         if not isinstance(value, dict):
-            raise ScenarioError(f"design.{key} must be a table ([design.{key}] in a file), "
-                                f"got {value!r}")
+            raise ScenarioError(
+                f"design.{key} must be a table ([design.{key}] in a file), got {value!r}"
+            )
         tables[key] = dict(value)
     try:
         return top, design_tables(spec, tables, design.get("variant")), {}
@@ -970,8 +1049,10 @@ def _resolve_timing(sim, camera, top, connectors, foreign):
     if timing == "auto":
         timing = "real_clock" if pins else "compressed"
     elif timing == "compressed" and pins:
-        raise ScenarioError(f"sim.timing = \"compressed\" runs the design only while pixels "
-                            f"flow; {pins[0]} needs sim.timing = \"real_clock\" (or \"auto\")")
+        raise ScenarioError(
+            f'sim.timing = "compressed" runs the design only while pixels '
+            f'flow; {pins[0]} needs sim.timing = "real_clock" (or "auto")'
+        )
     delay = sim.actuation_delay
     if delay is None:
         delay = REAL_CLOCK_ACTUATION_DELAY if timing == "real_clock" else camera.frame_period
@@ -988,8 +1069,7 @@ def _checks(data):
                 raise ScenarioError(f"{name} must be an integer in {lo}..{hi}, got {limit!r}")
         elif not (_is_number(limit) and math.isfinite(limit) and lo <= limit <= hi):
             unit = f" {unit}" if unit else ""
-            raise ScenarioError(f"{name} must be a number in {lo:g}..{hi:g}{unit}, "
-                                f"got {limit!r}")
+            raise ScenarioError(f"{name} must be a number in {lo:g}..{hi:g}{unit}, got {limit!r}")
     return checks
 
 

@@ -51,22 +51,30 @@ def _boolean(value, name):
 def _lamp(item, i):
     where = f"camera.lamps[{i}]"
     if not isinstance(item, dict):
-        raise ScenarioError(f"{where} must be a table {{pos = [x, y, z], aim = [x, y, z], ...}}, "
-                     f"got {item!r}")
+        raise ScenarioError(
+            f"{where} must be a table {{pos = [x, y, z], aim = [x, y, z], ...}}, got {item!r}"
+        )
     unknown = [k for k in item if k not in _LAMP_KEYS]
     if unknown:
-        raise ScenarioError(f"unknown key {where}.{unknown[0]}; known keys: {', '.join(_LAMP_KEYS)}")
+        raise ScenarioError(
+            f"unknown key {where}.{unknown[0]}; known keys: {', '.join(_LAMP_KEYS)}"
+        )
     for key in ("pos", "aim"):
         if key not in item:
             raise ScenarioError(f"{where}.{key} is required: a point [x, y, z] in m")
     pos = _vector(item["pos"], f"{where}.pos", -100, 100)
     aim = _vector(item["aim"], f"{where}.aim", -100, 100)
     if pos == aim:
-        raise ScenarioError(f"{where}.aim must differ from its pos (the lamp shines from pos to aim)")
-    return Lamp(pos=pos, aim=aim,
-                color=_vector(item.get("color", [0.5, 0.5, 0.5]), f"{where}.color", 0, 10),
-                cutoff_deg=_number(item.get("cutoff_deg", 45.0), f"{where}.cutoff_deg", 1, 90),
-                shadows=_boolean(item.get("shadows", True), f"{where}.shadows"))
+        raise ScenarioError(
+            f"{where}.aim must differ from its pos (the lamp shines from pos to aim)"
+        )
+    return Lamp(
+        pos=pos,
+        aim=aim,
+        color=_vector(item.get("color", [0.5, 0.5, 0.5]), f"{where}.color", 0, 10),
+        cutoff_deg=_number(item.get("cutoff_deg", 45.0), f"{where}.cutoff_deg", 1, 90),
+        shadows=_boolean(item.get("shadows", True), f"{where}.shadows"),
+    )
 
 
 def parse_render_keys(cam, seed):
@@ -74,20 +82,25 @@ def parse_render_keys(cam, seed):
     raises a ``ScenarioError`` naming the key."""
     renderer = cam["renderer"]
     if renderer not in RENDERERS:
-        raise ScenarioError(f"camera.renderer must be one of {', '.join(map(repr, RENDERERS))}, "
-                     f"got {renderer!r}")
+        raise ScenarioError(
+            f"camera.renderer must be one of {', '.join(map(repr, RENDERERS))}, got {renderer!r}"
+        )
     size = cam["shadow_size"]
     if isinstance(size, bool) or not isinstance(size, int) or not 64 <= size <= 8192:
-        raise ScenarioError(f"camera.shadow_size must be an integer in 64..8192 (pixels of a "
-                     f"light's shadow map), got {size!r}")
+        raise ScenarioError(
+            f"camera.shadow_size must be an integer in 64..8192 (pixels of a "
+            f"light's shadow map), got {size!r}"
+        )
     floor = cam["floor"]
     if floor not in FLOORS:
-        raise ScenarioError(f"camera.floor must be one of {', '.join(map(repr, FLOORS))}, "
-                     f"got {floor!r}")
+        raise ScenarioError(
+            f"camera.floor must be one of {', '.join(map(repr, FLOORS))}, got {floor!r}"
+        )
     lamps = cam["lamps"]
     if not isinstance(lamps, list):
-        raise ScenarioError(f"camera.lamps must be an array of tables ([[camera.lamps]]), "
-                     f"got {lamps!r}")
+        raise ScenarioError(
+            f"camera.lamps must be an array of tables ([[camera.lamps]]), got {lamps!r}"
+        )
     options = Render3DOptions(
         shadows=_boolean(cam["shadows"], "camera.shadows"),
         shadow_size=size,
@@ -98,4 +111,3 @@ def parse_render_keys(cam, seed):
         seed=seed,
     )
     return renderer, options
-

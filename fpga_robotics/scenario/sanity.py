@@ -23,10 +23,15 @@ def _check_warnings(world, checks):
     target = next((p for p in world.people if p.target), None)
     out = []
     for key in _TARGET_CHECKS:
-        if key in checks and target is None and not (
-                key == "target_in_view_min_fraction" and checks[key] == 0):
-            out.append(f"checks.{key} = {checks[key]:g} needs a target person "
-                       f"(people[].target = true); the scenario has none: it always fails")
+        if (
+            key in checks
+            and target is None
+            and not (key == "target_in_view_min_fraction" and checks[key] == 0)
+        ):
+            out.append(
+                f"checks.{key} = {checks[key]:g} needs a target person "
+                f"(people[].target = true); the scenario has none: it always fails"
+            )
     if target is None:
         return out
     robot_r = world.robot.spec.body_radius
@@ -35,16 +40,22 @@ def _check_warnings(world, checks):
     farthest = math.hypot(room.width - touch, room.depth - touch)
     limit = checks.get("mean_distance_max_m")
     if limit is not None and limit < touch - _OVERLAP:
-        out.append(f"checks.mean_distance_max_m = {limit:g} m is below {touch:.3f} m, the "
-                   f"robot's and the target's centres when they touch: it always fails")
+        out.append(
+            f"checks.mean_distance_max_m = {limit:g} m is below {touch:.3f} m, the "
+            f"robot's and the target's centres when they touch: it always fails"
+        )
     limit = checks.get("min_distance_min_m")
     if limit is not None and limit < touch - _OVERLAP:
-        out.append(f"checks.min_distance_min_m = {limit:g} m is below {touch:.3f} m, the "
-                   f"robot's and the target's centres when they touch: it always passes "
-                   f"(use max_person_collisions for contact)")
+        out.append(
+            f"checks.min_distance_min_m = {limit:g} m is below {touch:.3f} m, the "
+            f"robot's and the target's centres when they touch: it always passes "
+            f"(use max_person_collisions for contact)"
+        )
     elif limit is not None and limit > farthest:
-        out.append(f"checks.min_distance_min_m = {limit:g} m is beyond {farthest:.2f} m, the "
-                   f"farthest the centres can be apart in the room: it always fails")
+        out.append(
+            f"checks.min_distance_min_m = {limit:g} m is beyond {farthest:.2f} m, the "
+            f"farthest the centres can be apart in the room: it always fails"
+        )
     return out
 
 

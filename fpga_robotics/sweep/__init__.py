@@ -9,8 +9,16 @@
 from .api import report_dir, run_campaign
 from .campaign import Campaign, CampaignError, RunSpec, load_campaign, read_campaign_file
 
-__all__ = ["Campaign", "CampaignError", "RunSpec", "load_campaign", "load_campaign_file",
-           "read_campaign_file", "report_dir", "run_campaign"]
+__all__ = [
+    "Campaign",
+    "CampaignError",
+    "RunSpec",
+    "load_campaign",
+    "load_campaign_file",
+    "read_campaign_file",
+    "report_dir",
+    "run_campaign",
+]
 
 
 def load_campaign_file(name_or_path):

@@ -13,9 +13,22 @@ from .results import ResultStore, load_rows, read_meta, write_meta
 __all__ = ["report_dir", "run_campaign", "wait_for_a_worker"]
 
 
-def run_campaign(campaign, out_dir, *, workers=None, scheduler=None, resume=False,
-                 record="failing", timeout=None, max_runs=None, quiet=True, client=None,
-                 echo=None, log_every=RECORD_LOG_EVERY, bag=False):
+def run_campaign(
+    campaign,
+    out_dir,
+    *,
+    workers=None,
+    scheduler=None,
+    resume=False,
+    record="failing",
+    timeout=None,
+    max_runs=None,
+    quiet=True,
+    client=None,
+    echo=None,
+    log_every=RECORD_LOG_EVERY,
+    bag=False,
+):
     """Run ``campaign`` (a ``Campaign``) and return its results rows (list of dicts, one per
     run, in the order they finished; with ``resume`` the rows already in ``out_dir`` too).
 
@@ -30,14 +43,25 @@ def run_campaign(campaign, out_dir, *, workers=None, scheduler=None, resume=Fals
         plan.runs = plan.runs[:max_runs]
     out_dir = Path(out_dir)
     store = ResultStore(out_dir, resume=resume)
-    meta = {"name": campaign.name, "description": campaign.description,
-            "source": campaign.source, "axes": campaign.axes, "runs": len(plan.runs),
-            "backend": sorted({s.backend for s in plan.runs}), "version": __version__,
-            "scheduler": scheduler, "workers": workers, "known_limits": campaign.known_limits}
+    meta = {
+        "name": campaign.name,
+        "description": campaign.description,
+        "source": campaign.source,
+        "axes": campaign.axes,
+        "runs": len(plan.runs),
+        "backend": sorted({s.backend for s in plan.runs}),
+        "version": __version__,
+        "scheduler": scheduler,
+        "workers": workers,
+        "known_limits": campaign.known_limits,
+    }
     t0 = time.perf_counter()
     try:
-        with (_given(client) if client is not None else
-              open_client(scheduler=scheduler, workers=workers)) as c:
+        with (
+            _given(client)
+            if client is not None
+            else open_client(scheduler=scheduler, workers=workers)
+        ) as c:
             wait_for_a_worker(c, scheduler)
             t_build = time.perf_counter()
             builds = build_all(c, plan)
@@ -47,11 +71,21 @@ def run_campaign(campaign, out_dir, *, workers=None, scheduler=None, resume=Fals
             done = store.done_ids()
             already = len({plan.ids[s] for s in plan.runs} & done)
             if already:
-                say(f"{already} of {len(plan.runs)} runs already in {out_dir} (--resume): "
-                    f"running the other {len(plan.runs) - already}")
+                say(
+                    f"{already} of {len(plan.runs)} runs already in {out_dir} (--resume): "
+                    f"running the other {len(plan.runs) - already}"
+                )
             t_runs = time.perf_counter()
-            meta["ran"] = run_plan(c, plan, store, record=record, timeout=timeout,
-                                   quiet=quiet, log_every=log_every, bag=bag)
+            meta["ran"] = run_plan(
+                c,
+                plan,
+                store,
+                record=record,
+                timeout=timeout,
+                quiet=quiet,
+                log_every=log_every,
+                bag=bag,
+            )
             meta["runs_wall_s"] = round(time.perf_counter() - t_runs, 3)
             meta["workers"] = len(c.scheduler_info()["workers"])
     finally:
@@ -76,9 +110,10 @@ def wait_for_a_worker(client, scheduler):
     try:
         client.wait_for_workers(1, timeout=WORKER_WAIT_S)
     except TimeoutError:
-        raise UsageError(f"no Dask worker joined the scheduler {scheduler} within "
-                         f"{WORKER_WAIT_S} s; start workers with `dask worker {scheduler}`") \
-            from None
+        raise UsageError(
+            f"no Dask worker joined the scheduler {scheduler} within "
+            f"{WORKER_WAIT_S} s; start workers with `dask worker {scheduler}`"
+        ) from None
 
 
 class _given:
@@ -99,10 +134,13 @@ def report_dir(out_dir):
     out_dir = Path(out_dir)
     rows = load_rows(out_dir)
     if not rows:
-        raise UsageError(f"{out_dir} holds no campaign results (results.jsonl or "
-                         f"results.parquet); run a campaign with --out {out_dir} first")
+        raise UsageError(
+            f"{out_dir} holds no campaign results (results.jsonl or "
+            f"results.parquet); run a campaign with --out {out_dir} first"
+        )
     meta = read_meta(out_dir)
-    axes = meta.get("axes") or sorted({k for r in rows for k in r if "." in k and
-                                       not k.startswith(("check_", "collisions_"))})
+    axes = meta.get("axes") or sorted(
+        {k for r in rows for k in r if "." in k and not k.startswith(("check_", "collisions_"))}
+    )
     write_html(out_dir / "report.html", rows, axes, meta)
     return format_report(rows, axes, meta.get("known_limits") or ())

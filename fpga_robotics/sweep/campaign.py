@@ -51,12 +51,34 @@ from fpga_robotics.hw.errors import UsageError
 
 from .. import __version__
 
-__all__ = ["Campaign", "CampaignError", "RunSpec", "load_campaign", "parse_seeds",
-           "shipped_campaigns", "toml_value"]
+__all__ = [
+    "Campaign",
+    "CampaignError",
+    "RunSpec",
+    "load_campaign",
+    "parse_seeds",
+    "shipped_campaigns",
+    "toml_value",
+]
 
 #: Keys a campaign file may hold.
-KEYS = ("name", "description", "scenarios", "seeds", "backend", "resolution", "duration",
-        "shadow", "design", "ports", "set", "timeout", "grid", "sets", "known_limits")
+KEYS = (
+    "name",
+    "description",
+    "scenarios",
+    "seeds",
+    "backend",
+    "resolution",
+    "duration",
+    "shadow",
+    "design",
+    "ports",
+    "set",
+    "timeout",
+    "grid",
+    "sets",
+    "known_limits",
+)
 #: Keys of a ``[[known_limits]]`` entry.
 LIMIT_KEYS = ("check", "reason", "when", "scenarios")
 
@@ -72,16 +94,16 @@ class CampaignError(UsageError):
 class RunSpec:
     """One run of a campaign."""
 
-    scenario: str          # as the campaign names it (shipped name or path)
+    scenario: str  # as the campaign names it (shipped name or path)
     seed: int
-    overrides: tuple       # ((key, value), ...) from the grid or a set, in file order
+    overrides: tuple  # ((key, value), ...) from the grid or a set, in file order
     backend: str
     resolution: str | None = None
     duration: float | None = None
     shadow: str | None = None
     design: str | None = None
     ports: str | None = None
-    fixed: tuple = ()      # the campaign's fixed ``set`` items (KEY=VALUE text)
+    fixed: tuple = ()  # the campaign's fixed ``set`` items (KEY=VALUE text)
 
     def set_items(self):
         return [*self.fixed, *(f"{k}={toml_value(v)}" for k, v in self.overrides)]
@@ -114,10 +136,10 @@ class Campaign:
     name: str
     description: str
     runs: list
-    axes: list                 # grid/set keys, the override columns of the results
+    axes: list  # grid/set keys, the override columns of the results
     timeout: float | None = None
     source: str = ""
-    identities: dict = field(default_factory=dict)   # filled by plan.identify
+    identities: dict = field(default_factory=dict)  # filled by plan.identify
     #: ``[[known_limits]]``: failures that are limits of the design, each with its reason.
     known_limits: list = field(default_factory=list)
 
@@ -139,8 +161,9 @@ def toml_value(v):
     if isinstance(v, (list, tuple)):
         return "[" + ", ".join(toml_value(x) for x in v) + "]"
     if isinstance(v, dict):
-        return "{" + ", ".join(f"{_toml_string(str(k))} = {toml_value(x)}"
-                               for k, x in v.items()) + "}"
+        return (
+            "{" + ", ".join(f"{_toml_string(str(k))} = {toml_value(x)}" for k, x in v.items()) + "}"
+        )
     raise CampaignError(f"cannot write {v!r} as a --set value")
 
 
@@ -154,7 +177,7 @@ def parse_seeds(value, where="seeds"):
     from fpga_robotics.scenario.load import MAX_SEED
 
     if isinstance(value, bool):
-        raise CampaignError(f"{where} must be \"A-B\" or a list of integers, got {value!r}")
+        raise CampaignError(f'{where} must be "A-B" or a list of integers, got {value!r}')
     if isinstance(value, int):
         seeds = [value]
     elif isinstance(value, str):
@@ -164,23 +187,26 @@ def parse_seeds(value, where="seeds"):
             a = int(lo)
             b = int(hi) if sep else a
         except ValueError:
-            raise CampaignError(f"{where} must be \"A-B\" (e.g. \"0-19\") or a list of "
-                                f"integers, got {value!r}") from None
+            raise CampaignError(
+                f'{where} must be "A-B" (e.g. "0-19") or a list of integers, got {value!r}'
+            ) from None
         if b < a:
-            raise CampaignError(f"{where} range {value!r} is empty: write the lower seed first "
-                                f"(e.g. \"{b}-{a}\")")
+            raise CampaignError(
+                f'{where} range {value!r} is empty: write the lower seed first (e.g. "{b}-{a}")'
+            )
         if b - a + 1 > MAX_RUNS:
-            raise CampaignError(f"{where} range {value!r} has {b - a + 1} seeds; at most "
-                                f"{MAX_RUNS}")
+            raise CampaignError(
+                f"{where} range {value!r} has {b - a + 1} seeds; at most {MAX_RUNS}"
+            )
         seeds = list(range(a, b + 1))
     elif isinstance(value, list):
         if not all(isinstance(s, int) and not isinstance(s, bool) for s in value):
             raise CampaignError(f"{where} list must hold integers only, got {value!r}")
         seeds = list(dict.fromkeys(value))
     else:
-        raise CampaignError(f"{where} must be \"A-B\" or a list of integers, got {value!r}")
+        raise CampaignError(f'{where} must be "A-B" or a list of integers, got {value!r}')
     if not seeds:
-        raise CampaignError(f"{where} is empty: give at least one seed (e.g. \"0-4\")")
+        raise CampaignError(f'{where} is empty: give at least one seed (e.g. "0-4")')
     bad = [s for s in seeds if not 0 <= s <= MAX_SEED]
     if bad:
         raise CampaignError(f"{where}: seed {bad[0]} is out of range 0..{MAX_SEED}")
@@ -196,12 +222,16 @@ def _flatten(table, prefix, where):
             out += _flatten(value, f"{path}.", where)
         elif isinstance(value, list):
             if not value:
-                raise CampaignError(f"{where} {path!r} has no values: give a list of at "
-                                    f"least one value (e.g. {path} = [4, 6])")
+                raise CampaignError(
+                    f"{where} {path!r} has no values: give a list of at "
+                    f"least one value (e.g. {path} = [4, 6])"
+                )
             out.append((path, value))
         else:
-            raise CampaignError(f"{where} {path!r} must be a list of values, got {value!r} "
-                                f"(write {path} = [{toml_value(value)}])")
+            raise CampaignError(
+                f"{where} {path!r} must be a list of values, got {value!r} "
+                f"(write {path} = [{toml_value(value)}])"
+            )
     return out
 
 
@@ -209,7 +239,7 @@ def _set_items(items, where):
     if isinstance(items, str):
         items = [items]
     if not isinstance(items, list) or not all(isinstance(i, str) and "=" in i for i in items):
-        raise CampaignError(f"{where} must be a list of \"KEY=VALUE\" strings, got {items!r}")
+        raise CampaignError(f'{where} must be a list of "KEY=VALUE" strings, got {items!r}')
     return tuple(items)
 
 
@@ -220,17 +250,19 @@ def _combos(data):
     if "grid" in data:
         grid = data["grid"]
         if not isinstance(grid, dict) or not grid:
-            raise CampaignError("grid is empty: give at least one key with a list of values "
-                                "(e.g. [grid] \"design.diff_min\" = [4, 6, 8]), or leave it out")
+            raise CampaignError(
+                "grid is empty: give at least one key with a list of values "
+                '(e.g. [grid] "design.diff_min" = [4, 6, 8]), or leave it out'
+            )
         pairs = _flatten(grid, "", "grid key")
         axes = [k for k, _ in pairs]
-        combos = [tuple(zip(axes, values)) for values in
-                  itertools.product(*(v for _, v in pairs))]
+        combos = [tuple(zip(axes, values)) for values in itertools.product(*(v for _, v in pairs))]
     if "sets" in data:
         sets = data["sets"]
         if not isinstance(sets, list) or not sets or not all(isinstance(s, dict) for s in sets):
-            raise CampaignError("sets must be a non-empty list of tables ([[sets]] with "
-                                "KEY = VALUE lines)")
+            raise CampaignError(
+                "sets must be a non-empty list of tables ([[sets]] with KEY = VALUE lines)"
+            )
         for i, s in enumerate(sets):
             if not s:
                 raise CampaignError(f"sets[{i}] is empty: give at least one KEY = VALUE")
@@ -260,39 +292,54 @@ def _known_limits(data, axes):
 
     limits = data.get("known_limits", [])
     if not isinstance(limits, list) or not all(isinstance(x, dict) for x in limits):
-        raise CampaignError("known_limits must be a list of tables ([[known_limits]] with "
-                            "check = NAME and reason = TEXT)")
+        raise CampaignError(
+            "known_limits must be a list of tables ([[known_limits]] with "
+            "check = NAME and reason = TEXT)"
+        )
     out = []
     for i, entry in enumerate(limits):
         where = f"known_limits[{i}]"
         unknown = [k for k in entry if k not in LIMIT_KEYS]
         if unknown:
-            raise CampaignError(f"{where}: unknown key {unknown[0]!r}; an entry holds "
-                                f"{', '.join(LIMIT_KEYS)}")
+            raise CampaignError(
+                f"{where}: unknown key {unknown[0]!r}; an entry holds {', '.join(LIMIT_KEYS)}"
+            )
         checks, reason = entry.get("check"), entry.get("reason")
         checks = [checks] if isinstance(checks, str) else checks
-        if (not isinstance(checks, list) or not checks
-                or any(c not in check_names() for c in checks)):
-            raise CampaignError(f"{where}: check must name a registered check (or a list of "
-                                f"them), got {entry.get('check')!r}")
+        if (
+            not isinstance(checks, list)
+            or not checks
+            or any(c not in check_names() for c in checks)
+        ):
+            raise CampaignError(
+                f"{where}: check must name a registered check (or a list of "
+                f"them), got {entry.get('check')!r}"
+            )
         if not isinstance(reason, str) or not reason.strip():
-            raise CampaignError(f"{where}: give a reason (why the design fails "
-                                f"{', '.join(checks)} there)")
-        when = dict(_flatten_values(entry.get("when", {}), "")) if isinstance(
-            entry.get("when", {}), dict) else None
+            raise CampaignError(
+                f"{where}: give a reason (why the design fails {', '.join(checks)} there)"
+            )
+        when = (
+            dict(_flatten_values(entry.get("when", {}), ""))
+            if isinstance(entry.get("when", {}), dict)
+            else None
+        )
         if when is None:
             raise CampaignError(f"{where}: when must be a table of override KEY = VALUE")
         stray = [k for k in when if k not in axes]
         if stray:
-            raise CampaignError(f"{where}: when names {stray[0]!r}, which no grid axis or set "
-                                f"of the campaign varies")
+            raise CampaignError(
+                f"{where}: when names {stray[0]!r}, which no grid axis or set "
+                f"of the campaign varies"
+            )
         scenarios = entry.get("scenarios", [])
         if isinstance(scenarios, str):
             scenarios = [scenarios]
         if not isinstance(scenarios, list) or not all(isinstance(x, str) for x in scenarios):
             raise CampaignError(f"{where}: scenarios must be a list of scenario names")
-        out.append({"check": checks, "reason": reason.strip(), "when": when,
-                    "scenarios": list(scenarios)})
+        out.append(
+            {"check": checks, "reason": reason.strip(), "when": when, "scenarios": list(scenarios)}
+        )
     return out
 
 
@@ -308,8 +355,11 @@ def _typed(data, key, types, what):
 def shipped_campaigns():
     """Names → paths of the campaigns shipped with the package."""
     folder = resources.files("fpga_robotics.sweep") / "campaigns"
-    return {e.name[:-5]: str(e) for e in sorted(folder.iterdir(), key=lambda e: e.name)
-            if e.name.endswith(".toml")}
+    return {
+        e.name[:-5]: str(e)
+        for e in sorted(folder.iterdir(), key=lambda e: e.name)
+        if e.name.endswith(".toml")
+    }
 
 
 def _resolve(name_or_path):
@@ -322,8 +372,10 @@ def _resolve(name_or_path):
         return Path(shipped[text])
     if path.is_dir():
         raise CampaignError(f"campaign {text!r} is a folder; give a .toml file")
-    raise CampaignError(f"unknown campaign {text!r}: no such file, and the shipped campaigns "
-                        f"are {', '.join(shipped)}")
+    raise CampaignError(
+        f"unknown campaign {text!r}: no such file, and the shipped campaigns "
+        f"are {', '.join(shipped)}"
+    )
 
 
 def read_campaign_file(name_or_path):
@@ -341,8 +393,9 @@ def read_campaign_file(name_or_path):
 
         close = difflib.get_close_matches(unknown[0], KEYS, n=1)
         hint = f" (did you mean {close[0]!r}?)" if close else ""
-        raise CampaignError(f"{path}: unknown key {unknown[0]!r}{hint}; a campaign holds "
-                            f"{', '.join(KEYS)}")
+        raise CampaignError(
+            f"{path}: unknown key {unknown[0]!r}{hint}; a campaign holds {', '.join(KEYS)}"
+        )
     data.setdefault("name", path.stem)
     _file_paths(data, path.parent)
     return data, path
@@ -359,13 +412,17 @@ def load_campaign(data, *, source=""):
         scenarios = data.get("scenarios")
         if isinstance(scenarios, str):
             scenarios = [scenarios]
-        if not scenarios or not isinstance(scenarios, list) or not all(
-                isinstance(s, str) and s for s in scenarios):
-            raise CampaignError("scenarios must be a non-empty list of shipped scenario names "
-                                "or .toml paths")
+        if (
+            not scenarios
+            or not isinstance(scenarios, list)
+            or not all(isinstance(s, str) and s for s in scenarios)
+        ):
+            raise CampaignError(
+                "scenarios must be a non-empty list of shipped scenario names or .toml paths"
+            )
         seeds = parse_seeds(data.get("seeds", "0"))
         backend = _typed(data, "backend", str, "a backend name") or "auto"
-        resolution = _typed(data, "resolution", str, "\"WxH\"")
+        resolution = _typed(data, "resolution", str, '"WxH"')
         duration = _typed(data, "duration", (int, float), "a number of seconds")
         if duration is not None and not 0 < duration < math.inf:
             raise CampaignError(f"duration must be > 0 seconds, got {duration}")
@@ -375,21 +432,40 @@ def load_campaign(data, *, source=""):
         fixed = _set_items(data.get("set", []), "set")
         combos, axes = _combos(data)
         known_limits = _known_limits(data, axes)
-        base = RunSpec(scenario="", seed=0, overrides=(), backend=backend,
-                       resolution=resolution, duration=duration,
-                       shadow=_typed(data, "shadow", str, "a shadow spec (e.g. \"published\")"),
-                       design=_typed(data, "design", str,
-                                     "a design reference (\"FILE.py:Name\", \"verilog:FILE.v\")"),
-                       ports=_typed(data, "ports", str, "a port map path"), fixed=fixed)
+        base = RunSpec(
+            scenario="",
+            seed=0,
+            overrides=(),
+            backend=backend,
+            resolution=resolution,
+            duration=duration,
+            shadow=_typed(data, "shadow", str, 'a shadow spec (e.g. "published")'),
+            design=_typed(
+                data, "design", str, 'a design reference ("FILE.py:Name", "verilog:FILE.v")'
+            ),
+            ports=_typed(data, "ports", str, "a port map path"),
+            fixed=fixed,
+        )
         count = len(scenarios) * len(seeds) * len(combos)
         if count > MAX_RUNS:
             raise CampaignError(f"the campaign has {count} runs; at most {MAX_RUNS}")
-        runs = [replace(base, scenario=sc, seed=seed, overrides=combo)
-                for sc in scenarios for combo in combos for seed in seeds]
+        runs = [
+            replace(base, scenario=sc, seed=seed, overrides=combo)
+            for sc in scenarios
+            for combo in combos
+            for seed in seeds
+        ]
     except CampaignError as exc:
         raise CampaignError(f"{where}{exc}") from None
-    return Campaign(name=name, description=data.get("description", ""), runs=runs, axes=axes,
-                    timeout=timeout, source=source, known_limits=known_limits)
+    return Campaign(
+        name=name,
+        description=data.get("description", ""),
+        runs=runs,
+        axes=axes,
+        timeout=timeout,
+        source=source,
+        known_limits=known_limits,
+    )
 
 
 def run_identity(spec, scenario_source, extra_files=()):
@@ -412,8 +488,11 @@ def run_identity(spec, scenario_source, extra_files=()):
 def _near(value, base):
     """A path given in a campaign file, relative to the file's folder, as a path from here
     (so that replay commands work where the campaign was started)."""
-    if not isinstance(value, str) or "/" not in value and not value.endswith((".toml", ".v", ".py",
-                                                                               ".sv")):
+    if (
+        not isinstance(value, str)
+        or "/" not in value
+        and not value.endswith((".toml", ".v", ".py", ".sv"))
+    ):
         return value
     path = Path(value)
     if not path.is_absolute():
@@ -434,7 +513,7 @@ def _file_paths(data, base):
     if isinstance(data.get("ports"), str):
         data["ports"] = _near(data["ports"], base)
     if isinstance(data.get("design"), str) and data["design"].startswith("verilog:"):
-        files = data["design"][len("verilog:"):].split(",")
+        files = data["design"][len("verilog:") :].split(",")
         data["design"] = "verilog:" + ",".join(_near(f, base) for f in files if f)
     elif isinstance(data.get("design"), str) and ".py:" in data["design"]:
         where, _, name = data["design"].rpartition(":")

@@ -22,7 +22,14 @@ from ..sim.files import write_atomic
 from . import runner
 from .results import make_row
 
-__all__ = ["DEFAULT_TIMEOUT_FACTOR", "MIN_TIMEOUT_S", "RECORD_LOG_EVERY", "build_all", "open_client", "run_plan"]
+__all__ = [
+    "DEFAULT_TIMEOUT_FACTOR",
+    "MIN_TIMEOUT_S",
+    "RECORD_LOG_EVERY",
+    "build_all",
+    "open_client",
+    "run_plan",
+]
 
 #: A campaign's recordings log the images of every this many frames (a run's recording at
 #: 160x120 is about 45 MB with every frame; the replay command records every frame).
@@ -49,8 +56,10 @@ def open_client(scheduler=None, workers=None):
         try:
             client = Client(scheduler, timeout="10s")
         except (OSError, TimeoutError, ValueError) as exc:
-            raise UsageError(f"cannot reach the Dask scheduler at {scheduler!r} ({exc}); start "
-                             f"one with `dask scheduler` and give its tcp://HOST:PORT") from None
+            raise UsageError(
+                f"cannot reach the Dask scheduler at {scheduler!r} ({exc}); start "
+                f"one with `dask scheduler` and give its tcp://HOST:PORT"
+            ) from None
         try:
             yield client
         finally:
@@ -79,12 +88,21 @@ def open_client(scheduler=None, workers=None):
 
 @contextlib.contextmanager
 def _local_cluster(dask, LocalCluster, n):
-    with dask.config.set({"distributed.scheduler.allowed-failures": 0,
-                          "distributed.scheduler.worker-saturation": 1.0,
-                          "distributed.worker.daemon": False,
-                          "distributed.admin.system-monitor.gil.enabled": False}):
-        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                               dashboard_address=":0", silence_logs=logging.CRITICAL)
+    with dask.config.set(
+        {
+            "distributed.scheduler.allowed-failures": 0,
+            "distributed.scheduler.worker-saturation": 1.0,
+            "distributed.worker.daemon": False,
+            "distributed.admin.system-monitor.gil.enabled": False,
+        }
+    ):
+        cluster = LocalCluster(
+            n_workers=n,
+            threads_per_worker=1,
+            processes=True,
+            dashboard_address=":0",
+            silence_logs=logging.CRITICAL,
+        )
     try:
         yield cluster
     finally:
@@ -125,8 +143,9 @@ class _Timeouts:
         if samples:
             per_frame = statistics.median(samples[-50:])
         else:
-            per_frame = (_GUESS_PER_FRAME_S
-                         + pixels * _GUESS_S_PER_PIXEL_FRAME.get(spec.backend, _GUESS_DEFAULT))
+            per_frame = _GUESS_PER_FRAME_S + pixels * _GUESS_S_PER_PIXEL_FRAME.get(
+                spec.backend, _GUESS_DEFAULT
+            )
         return max(MIN_TIMEOUT_S, DEFAULT_TIMEOUT_FACTOR * frames * per_frame)
 
 
@@ -134,8 +153,9 @@ def _progress(total, quiet):
     from tqdm import tqdm
 
     disable = quiet or bool(os.environ.get("CI")) or not sys.stderr.isatty()
-    return tqdm(total=total, unit="run", disable=disable, file=sys.stderr, smoothing=0.1,
-                dynamic_ncols=True)
+    return tqdm(
+        total=total, unit="run", disable=disable, file=sys.stderr, smoothing=0.1, dynamic_ncols=True
+    )
 
 
 def build_all(client, plan):
@@ -144,8 +164,9 @@ def build_all(client, plan):
     user's to fix (``UsageError``)."""
     from distributed import wait
 
-    futures = {client.submit(runner.build_designs, argv, pure=False): argv
-               for argv in plan.builds.values()}
+    futures = {
+        client.submit(runner.build_designs, argv, pure=False): argv for argv in plan.builds.values()
+    }
     wait(list(futures))
     times = []
     for fut, argv in futures.items():
@@ -156,8 +177,18 @@ def build_all(client, plan):
     return times
 
 
-def run_plan(client, plan, store, *, record="failing", timeout=None, quiet=False,
-             on_row=None, log_every=RECORD_LOG_EVERY, bag=False):
+def run_plan(
+    client,
+    plan,
+    store,
+    *,
+    record="failing",
+    timeout=None,
+    quiet=False,
+    on_row=None,
+    log_every=RECORD_LOG_EVERY,
+    bag=False,
+):
     """Run every planned run not already in ``store``; returns the number run.
     Recordings log every ``log_every``-th frame's images (every frame's numbers)."""
     from distributed import as_completed
@@ -173,7 +204,7 @@ def run_plan(client, plan, store, *, record="failing", timeout=None, quiet=False
     timeouts = _Timeouts(timeout)
     window = max(2, 2 * sum(client.nthreads().values()) or 2)
     pending = list(reversed(todo))
-    running = {}   # future -> (spec, submitted at, timeout, recording pass)
+    running = {}  # future -> (spec, submitted at, timeout, recording pass)
     done_rows = {}
     failures = 0
     bar = _progress(len(todo), quiet)
@@ -184,8 +215,9 @@ def run_plan(client, plan, store, *, record="failing", timeout=None, quiet=False
         limit = timeouts(spec, frames, pixels)
         key = f"run-{plan.ids[spec]}-{time.monotonic_ns()}"
         rec = log_every if (recording or record == "all") else False
-        fut = client.submit(runner.execute, spec.argv(), limit, rec, key, pure=False, key=key,
-                            bag=bool(bag and rec))
+        fut = client.submit(
+            runner.execute, spec.argv(), limit, rec, key, pure=False, key=key, bag=bool(bag and rec)
+        )
         running[fut] = (spec, time.monotonic(), limit, recording)
         completed.add(fut)
 
@@ -201,8 +233,9 @@ def run_plan(client, plan, store, *, record="failing", timeout=None, quiet=False
             if recording:  # the recording pass of a failing run: attach its .rrd
                 row = done_rows.pop(plan.ids[spec], None)
                 if row is not None and outcome.get("recording"):
-                    row["recording"] = _save_recording(store.dir, plan.ids[spec],
-                                                       outcome["recording"])
+                    row["recording"] = _save_recording(
+                        store.dir, plan.ids[spec], outcome["recording"]
+                    )
                     if outcome.get("bag"):
                         row["bag"] = _save_bag(store.dir, plan.ids[spec], outcome["bag"])
                     store.add(row)
@@ -210,8 +243,7 @@ def run_plan(client, plan, store, *, record="failing", timeout=None, quiet=False
                 continue
             row = make_row(spec, plan.ids[spec], plan.names[spec], outcome)
             if outcome.get("recording"):
-                row["recording"] = _save_recording(store.dir, row["run_id"],
-                                                   outcome["recording"])
+                row["recording"] = _save_recording(store.dir, row["run_id"], outcome["recording"])
             if outcome.get("bag"):
                 row["bag"] = _save_bag(store.dir, row["run_id"], outcome["bag"])
             store.add(row)
@@ -255,9 +287,11 @@ def _outcome(client, fut, limit):
         return fut.result()
     except KilledWorker:
         if _timed_out(client, fut.key):
-            return {"status": "timeout",
-                    "message": f"no result within the per-run timeout of {limit:.3g} s: the "
-                               f"run stopped making progress and its worker was ended"}
+            return {
+                "status": "timeout",
+                "message": f"no result within the per-run timeout of {limit:.3g} s: the "
+                f"run stopped making progress and its worker was ended",
+            }
         return {"status": "error", "message": "the worker running it died (a crash or a kill)"}
     except Exception as exc:  # noqa: BLE001 (a lost connection, a cancelled task: recorded)
         return {"status": "error", "message": f"{type(exc).__name__}: {exc}".splitlines()[0]}
@@ -285,4 +319,3 @@ def _save_recording(out_dir, run_id, data):
     path.parent.mkdir(parents=True, exist_ok=True)
     write_atomic(path, data, what="recording")
     return str(path.relative_to(out_dir))
-

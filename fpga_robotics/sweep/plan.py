@@ -13,11 +13,11 @@ __all__ = ["Plan", "make_plan"]
 
 @dataclass
 class Plan:
-    runs: list                                       # RunSpec, in campaign order
-    ids: dict = field(default_factory=dict)          # RunSpec -> identity
-    names: dict = field(default_factory=dict)        # RunSpec -> scenario name
-    frames: dict = field(default_factory=dict)       # RunSpec -> (frames, pixels)
-    builds: dict = field(default_factory=dict)       # design key -> argv of one run
+    runs: list  # RunSpec, in campaign order
+    ids: dict = field(default_factory=dict)  # RunSpec -> identity
+    names: dict = field(default_factory=dict)  # RunSpec -> scenario name
+    frames: dict = field(default_factory=dict)  # RunSpec -> (frames, pixels)
+    builds: dict = field(default_factory=dict)  # design key -> argv of one run
 
 
 def _concrete_backend(spec):
@@ -39,8 +39,9 @@ def make_plan(campaign):
     checked = {}
     for spec in campaign.runs:
         if spec.backend not in ("auto", *BACKEND_NAMES):
-            raise UsageError(f"backend must be one of auto, {', '.join(BACKEND_NAMES)}; got "
-                             f"{spec.backend!r}")
+            raise UsageError(
+                f"backend must be one of auto, {', '.join(BACKEND_NAMES)}; got {spec.backend!r}"
+            )
         spec = _concrete_backend(spec)
         shape = replace(spec, seed=0)
         if shape not in checked:
@@ -48,20 +49,26 @@ def make_plan(campaign):
                 args, scenario, shadow_params = load_run(spec.argv())
             except UsageError as exc:
                 what = " ".join(spec.set_items())
-                raise UsageError(f"run of {spec.scenario}{' with ' + what if what else ''}: "
-                                 f"{exc}") from None
+                raise UsageError(
+                    f"run of {spec.scenario}{' with ' + what if what else ''}: {exc}"
+                ) from None
             files = []
             if scenario.foreign is not None:
                 files = [*scenario.foreign.verilog, scenario.foreign.ports]
             if args.design is not None:
-                files = [*args.design[len("verilog:"):].split(","), args.ports]
+                files = [*args.design[len("verilog:") :].split(","), args.ports]
             where = scenario.top.rpartition(":")[0]
             if where.endswith(".py"):  # a design of one's own: its file names the run too
                 files.append(where)
             key = (_design_key(args, scenario), repr(shadow_params))
             frames = round(scenario.sim.duration * scenario.camera.fps)
-            checked[shape] = (scenario, files, key, frames,
-                              scenario.camera.width * scenario.camera.height)
+            checked[shape] = (
+                scenario,
+                files,
+                key,
+                frames,
+                scenario.camera.width * scenario.camera.height,
+            )
             plan.builds.setdefault(key, spec.argv())
         scenario, files, _key, frames, pixels = checked[shape]
         plan.runs.append(spec)

@@ -13,9 +13,11 @@ from ..sim.files import write_atomic
 __all__ = ["failures_by_check", "format_report", "na_by_check", "write_html"]
 
 #: Metric distributions shown: column, label.
-METRICS = (("min_distance_m", "closest distance to the target (m)"),
-           ("found_fraction", "fraction of frames with the target found"),
-           ("collisions_total", "collisions (person + wall + furniture)"))
+METRICS = (
+    ("min_distance_m", "closest distance to the target (m)"),
+    ("found_fraction", "fraction of frames with the target found"),
+    ("collisions_total", "collisions (person + wall + furniture)"),
+)
 #: Replay commands listed per failed check in the terminal summary.
 SHOWN_PER_CHECK = 3
 
@@ -71,22 +73,28 @@ def known_limit(row, name, known_limits):
 def explained(row, known_limits):
     """Whether the run failed and every check it failed is a known limit of the design."""
     failed = _failed(row)
-    return (row["status"] == "fail" and bool(failed)
-            and all(known_limit(row, n, known_limits) for n in failed))
+    return (
+        row["status"] == "fail"
+        and bool(failed)
+        and all(known_limit(row, n, known_limits) for n in failed)
+    )
 
 
 def campaign_passed(rows, known_limits=()):
     """Every run passed, or failed only where a known limit of the design explains it."""
-    return bool(rows) and all(r["status"] == "pass" or explained(r, known_limits)
-                              for r in rows)
+    return bool(rows) and all(r["status"] == "pass" or explained(r, known_limits) for r in rows)
 
 
 def known_limits_met(rows, known_limits):
     """``[(entry, rows), ...]``: each known limit with the failing runs it explains."""
     out = []
     for entry in known_limits:
-        met = [r for r in rows if r["status"] == "fail"
-               and any(known_limit(r, n, [entry]) is entry for n in _failed(r))]
+        met = [
+            r
+            for r in rows
+            if r["status"] == "fail"
+            and any(known_limit(r, n, [entry]) is entry for n in _failed(r))
+        ]
         out.append((entry, met))
     return out
 
@@ -112,8 +120,11 @@ def _na_reasons(row):
         checks = json.loads(row.get("checks_json") or "[]")
     except ValueError:
         checks = []
-    reasons = {c["name"]: c.get("reason") or c.get("text") or "" for c in checks
-               if isinstance(c, dict) and c.get("passed") is None}
+    reasons = {
+        c["name"]: c.get("reason") or c.get("text") or ""
+        for c in checks
+        if isinstance(c, dict) and c.get("passed") is None
+    }
     return {n: reasons.get(n, "") for n in names}
 
 
@@ -135,10 +146,14 @@ def _limit_text(entry):
 
 def format_report(rows, axes, known_limits=()):
     """The terminal summary (several lines)."""
-    counts = {s: sum(r["status"] == s for r in rows) for s in ("pass", "fail", "n/a", "error",
-                                                               "timeout")}
-    lines = [f"{len(rows)} runs: " + ", ".join(f"{n} {s}" for s, n in counts.items())
-             + f" (pass rate {_rate(rows):.0%})"]
+    counts = {
+        s: sum(r["status"] == s for r in rows) for s in ("pass", "fail", "n/a", "error", "timeout")
+    }
+    lines = [
+        f"{len(rows)} runs: "
+        + ", ".join(f"{n} {s}" for s, n in counts.items())
+        + f" (pass rate {_rate(rows):.0%})"
+    ]
     lines.append("pass rate per scenario:")
     for name, group in _by(rows, "scenario").items():
         lines.append(f"  {name:<20} {_rate(group):6.0%}  ({len(group)} runs)")
@@ -161,16 +176,18 @@ def format_report(rows, axes, known_limits=()):
                 if r["status"] in ("error", "timeout") and r.get("message"):
                     lines.append(f"      {r['message']}")
             if len(group) > SHOWN_PER_CHECK:
-                lines.append(f"    ... and {len(group) - SHOWN_PER_CHECK} more "
-                             f"(report.html, results.csv)")
+                lines.append(
+                    f"    ... and {len(group) - SHOWN_PER_CHECK} more (report.html, results.csv)"
+                )
     na = na_by_check(rows)
     if na:
         lines.append("checks that could not judge (n/a; not counted as pass or fail):")
         for name, group in na.items():
             reasons = sorted({reason for _, reason in group})
-            lines.append(f"  {name}: {len(group)} run(s): {reasons[0]}"
-                         + (f" (and {len(reasons) - 1} other reason(s))"
-                            if len(reasons) > 1 else ""))
+            lines.append(
+                f"  {name}: {len(group)} run(s): {reasons[0]}"
+                + (f" (and {len(reasons) - 1} other reason(s))" if len(reasons) > 1 else "")
+            )
     return "\n".join(lines)
 
 
@@ -220,8 +237,15 @@ def _heatmap(rows, x_axis, y_axis, label):
         for i in range(len(xs)):
             if not np.isnan(grid[j, i]):
                 v = grid[j, i]  # white on the dark ends of the colour map
-                ax.text(i, j, f"{v:.0f}", ha="center", va="center", fontsize=9,
-                        color="white" if v < 25 or v > 75 else "black")
+                ax.text(
+                    i,
+                    j,
+                    f"{v:.0f}",
+                    ha="center",
+                    va="center",
+                    fontsize=9,
+                    color="white" if v < 25 or v > 75 else "black",
+                )
     fig.colorbar(im, ax=ax, label="pass rate (%)")
     ax.set_title(f"{label}: pass rate (%)")
     return _png(fig)
@@ -235,8 +259,11 @@ def _histogram(rows, column, label):
     every = [r[column] for r in rows if isinstance(r.get(column), (int, float))]
     bins = np.histogram_bin_edges(every, bins=20)  # the same bins for passes and failures
     for status, color in (("pass", "#4a7"), ("fail", "#c44")):
-        values = [r[column] for r in rows if r["status"] == status
-                  and isinstance(r.get(column), (int, float))]
+        values = [
+            r[column]
+            for r in rows
+            if r["status"] == status and isinstance(r.get(column), (int, float))
+        ]
         if values:
             ax.hist(values, bins=bins, alpha=0.6, color=color, label=f"{status} ({len(values)})")
     ax.set_xlabel(label)
@@ -266,24 +293,36 @@ def write_html(path, rows, axes, meta):
     rows = _with_totals(rows)
     esc = html.escape
     title = f"Campaign {meta.get('name', '')}"
-    parts = [f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>{esc(title)}</title>",
-             ("<style>body{font-family:sans-serif;margin:2em;max-width:70em}"
-              "code{background:#eee;padding:0 .2em;word-break:break-all}"
-              "td,th{padding:.2em .6em;text-align:left}img{margin:.5em}</style></head><body>"),
-             f"<h1>{esc(title)}</h1>"]
+    parts = [
+        f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>{esc(title)}</title>",
+        (
+            "<style>body{font-family:sans-serif;margin:2em;max-width:70em}"
+            "code{background:#eee;padding:0 .2em;word-break:break-all}"
+            "td,th{padding:.2em .6em;text-align:left}img{margin:.5em}</style></head><body>"
+        ),
+        f"<h1>{esc(title)}</h1>",
+    ]
     if meta.get("description"):
         parts.append(f"<p>{esc(meta['description'])}</p>")
     known_limits = meta.get("known_limits") or ()
     summary = format_report(rows, axes, known_limits).splitlines()[0]
     parts.append(f"<p><b>{esc(summary)}</b></p>")
-    facts = [(k, meta[k]) for k in ("backend", "workers", "scheduler", "wall_s", "build_s",
-                                     "version") if meta.get(k) is not None]
+    facts = [
+        (k, meta[k])
+        for k in ("backend", "workers", "scheduler", "wall_s", "build_s", "version")
+        if meta.get(k) is not None
+    ]
     if facts:
-        parts.append("<table>" + "".join(f"<tr><th>{esc(k)}</th><td>{esc(str(v))}</td></tr>"
-                                         for k, v in facts) + "</table>")
+        parts.append(
+            "<table>"
+            + "".join(f"<tr><th>{esc(k)}</th><td>{esc(str(v))}</td></tr>" for k, v in facts)
+            + "</table>"
+        )
     if rows:
         parts.append("<h2>Pass rate</h2>")
-        parts.append(f"<img src='{_bar_figure(_by(rows, 'scenario'), 'per scenario', 'scenario')}'>")
+        parts.append(
+            f"<img src='{_bar_figure(_by(rows, 'scenario'), 'per scenario', 'scenario')}'>"
+        )
         for axis in axes:
             parts.append(f"<img src='{_bar_figure(_by(rows, axis), f'per {axis}', axis)}'>")
         if len(axes) >= 2:  # one map per scenario: each has its own conditions
@@ -296,46 +335,62 @@ def write_html(path, rows, axes, meta):
                 parts.append(f"<img src='{_histogram(rows, column, label)}'>")
     if known_limits:
         parts.append("<h2>Known limits of the design</h2>")
-        parts.append("<p>Failures the campaign expects: a limit of the design under that "
-                     "variation, with the reason. They are not counted against it.</p>")
+        parts.append(
+            "<p>Failures the campaign expects: a limit of the design under that "
+            "variation, with the reason. They are not counted against it.</p>"
+        )
         for entry, group in known_limits_met(rows, known_limits):
-            parts.append(f"<h3>{esc(_limit_text(entry))}: {len(group)} run(s)</h3>"
-                         f"<p>{esc(entry['reason'])}</p>")
+            parts.append(
+                f"<h3>{esc(_limit_text(entry))}: {len(group)} run(s)</h3>"
+                f"<p>{esc(entry['reason'])}</p>"
+            )
             if group:
                 parts.append("<table><tr><th>scenario</th><th>seed</th><th>replay</th></tr>")
                 for r in group:
-                    parts.append(f"<tr><td>{esc(str(r['scenario']))}</td><td>{r['seed']}</td>"
-                                 f"<td><code>{esc(r['replay'])}</code></td></tr>")
+                    parts.append(
+                        f"<tr><td>{esc(str(r['scenario']))}</td><td>{r['seed']}</td>"
+                        f"<td><code>{esc(r['replay'])}</code></td></tr>"
+                    )
                 parts.append("</table>")
     groups = failures_by_check(rows, known_limits)
     parts.append("<h2>Failing runs by check</h2>")
     if not groups:
-        parts.append("<p>None: every run passed"
-                     + (" or failed only by a known limit.</p>" if known_limits else ".</p>"))
+        parts.append(
+            "<p>None: every run passed"
+            + (" or failed only by a known limit.</p>" if known_limits else ".</p>")
+        )
     for name, group in groups.items():
         parts.append(f"<h3>{esc(name)} ({len(group)} run(s))</h3><table>")
-        parts.append("<tr><th>scenario</th><th>seed</th><th>what</th><th>replay</th>"
-                     "<th>recording</th></tr>")
+        parts.append(
+            "<tr><th>scenario</th><th>seed</th><th>what</th><th>replay</th><th>recording</th></tr>"
+        )
         for r in group:
             rec = r.get("recording") or ""
             link = f"<a href='{esc(rec)}'>{esc(Path(rec).name)}</a>" if rec else ""
-            parts.append(f"<tr><td>{esc(str(r['scenario']))}</td><td>{r['seed']}</td>"
-                         f"<td>{esc(r.get('message') or '')}</td>"
-                         f"<td><code>{esc(r['replay'])}</code></td><td>{link}</td></tr>")
+            parts.append(
+                f"<tr><td>{esc(str(r['scenario']))}</td><td>{r['seed']}</td>"
+                f"<td>{esc(r.get('message') or '')}</td>"
+                f"<td><code>{esc(r['replay'])}</code></td><td>{link}</td></tr>"
+            )
         parts.append("</table>")
     na = na_by_check(rows)
     if na:
         parts.append("<h2>Checks that could not judge (n/a)</h2>")
-        parts.append("<p>Neither a pass nor a failure: the run gave the check nothing to judge. "
-                     "A run whose every check is n/a has the status n/a.</p>")
+        parts.append(
+            "<p>Neither a pass nor a failure: the run gave the check nothing to judge. "
+            "A run whose every check is n/a has the status n/a.</p>"
+        )
     for name, group in na.items():
         parts.append(f"<h3>{esc(name)} ({len(group)} run(s))</h3><table>")
-        parts.append("<tr><th>scenario</th><th>seed</th><th>status</th><th>reason</th>"
-                     "<th>replay</th></tr>")
+        parts.append(
+            "<tr><th>scenario</th><th>seed</th><th>status</th><th>reason</th><th>replay</th></tr>"
+        )
         for r, reason in group:
-            parts.append(f"<tr><td>{esc(str(r['scenario']))}</td><td>{r['seed']}</td>"
-                         f"<td>{esc(r['status'])}</td><td>{esc(reason)}</td>"
-                         f"<td><code>{esc(r['replay'])}</code></td></tr>")
+            parts.append(
+                f"<tr><td>{esc(str(r['scenario']))}</td><td>{r['seed']}</td>"
+                f"<td>{esc(r['status'])}</td><td>{esc(reason)}</td>"
+                f"<td><code>{esc(r['replay'])}</code></td></tr>"
+            )
         parts.append("</table>")
     parts.append("</body></html>")
     write_atomic(path, "\n".join(parts), what="report")

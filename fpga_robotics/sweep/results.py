@@ -30,8 +30,20 @@ CSV = "results.csv"
 META = "campaign.json"
 
 #: Columns every row has, first in the tables.
-LEAD = ("run_id", "scenario", "seed", "status", "message", "failed_checks", "na_checks",
-        "wall_s", "cpu_s", "run_s", "replay", "recording")
+LEAD = (
+    "run_id",
+    "scenario",
+    "seed",
+    "status",
+    "message",
+    "failed_checks",
+    "na_checks",
+    "wall_s",
+    "cpu_s",
+    "run_s",
+    "replay",
+    "recording",
+)
 
 
 def _cell(value):
@@ -98,8 +110,7 @@ def _column_type(values):
         return pa.bool_()
     if present and all(isinstance(v, int) and not isinstance(v, bool) for v in present):
         return pa.int64()
-    if present and all(isinstance(v, (int, float)) and not isinstance(v, bool)
-                       for v in present):
+    if present and all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in present):
         return pa.float64()
     return pa.string()
 
@@ -122,8 +133,9 @@ def _table(rows):
         values = [row.get(name) for row in rows]
         kind = _column_type(values)
         if kind == pa.string():
-            values = [None if v is None else (v if isinstance(v, str) else json.dumps(v))
-                      for v in values]
+            values = [
+                None if v is None else (v if isinstance(v, str) else json.dumps(v)) for v in values
+            ]
         elif kind == pa.float64():
             values = [None if v is None else float(v) for v in values]
         arrays[name] = pa.array(values, type=kind)

@@ -45,7 +45,7 @@ def _loaded(argv):
     argv = list(argv)
     i = argv.index("--seed") if "--seed" in argv else None
     seed = argv[i + 1] if i is not None else None
-    shape = tuple(argv[:i] + argv[i + 2:]) if i is not None else tuple(argv)
+    shape = tuple(argv[:i] + argv[i + 2 :]) if i is not None else tuple(argv)
     if shape not in _loads:
         if len(_loads) >= 64:
             _loads.clear()
@@ -84,10 +84,18 @@ def load_run(argv):
 
 
 def _design_key(args, scenario):
-    return ("design", args.backend, args.design, args.ports, repr(scenario.foreign),
-            repr(scenario.params), scenario.sim.timing, scenario.top,
-            repr(sorted(scenario.design_tables.items())),
-            repr(sorted(scenario.design_params.items())))
+    return (
+        "design",
+        args.backend,
+        args.design,
+        args.ports,
+        repr(scenario.foreign),
+        repr(scenario.params),
+        scenario.sim.timing,
+        scenario.top,
+        repr(sorted(scenario.design_tables.items())),
+        repr(sorted(scenario.design_params.items())),
+    )
 
 
 def _open(key, opener):
@@ -107,13 +115,17 @@ def _designs_for(args, scenario, shadow_params):
     if scenario.sim.timing == "real_clock":  # a pin-level backend (fpga_robotics.loop.real_clock)
         design = _open(_design_key(args, scenario), lambda: run._open_pin_design(args, scenario))
     else:
-        design = _open(_design_key(args, scenario),
-                       lambda: run._open_design(args, scenario.params, scenario.foreign))
+        design = _open(
+            _design_key(args, scenario),
+            lambda: run._open_design(args, scenario.params, scenario.foreign),
+        )
     shadow = None
     if shadow_params is not None:
         name = args.shadow_backend or args.backend
-        shadow = _open(("shadow", name, repr(shadow_params)),
-                       lambda: run._open_backend(name, shadow_params, True))
+        shadow = _open(
+            ("shadow", name, repr(shadow_params)),
+            lambda: run._open_backend(name, shadow_params, True),
+        )
     return design, shadow
 
 
@@ -161,8 +173,10 @@ class _Deadline:
             if self.fault == "hang":
                 time.sleep(10**6)
         if self.timeout is not None and time.perf_counter() - self.start > self.timeout:
-            raise RunTimeout(f"no result within the per-run timeout of {self.timeout:.3g} s "
-                             f"(frame {done} of {total})")
+            raise RunTimeout(
+                f"no result within the per-run timeout of {self.timeout:.3g} s "
+                f"(frame {done} of {total})"
+            )
 
     def _expire(self):
         """End this worker process (its nanny starts a new one), telling the scheduler why."""
@@ -205,13 +219,20 @@ def execute(argv, timeout=None, record=False, tag=None, bag=False):
         recorder, rrd = (None, None)
         if record:
             recorder, rrd = _recorder(args, scenario.name, int(record))
-        bag_writer, bag_dir = (_bag_writer(scenario) if record and bag else (None, None))
+        bag_writer, bag_dir = _bag_writer(scenario) if record and bag else (None, None)
         t_run = time.perf_counter()
         try:
-            result = run_scenario(scenario, seed=args.seed, backend=design, recorder=recorder,
-                                  progress=deadline, realtime=False, shadow=shadow,
-                                  shadow_label=args.shadow or "shadow",
-                                  on_frame=bag_writer.log_frame if bag_writer else None)
+            result = run_scenario(
+                scenario,
+                seed=args.seed,
+                backend=design,
+                recorder=recorder,
+                progress=deadline,
+                realtime=False,
+                shadow=shadow,
+                shadow_label=args.shadow or "shadow",
+                on_frame=bag_writer.log_frame if bag_writer else None,
+            )
             if bag_writer is not None:
                 bag_writer.close()
                 out["bag"] = _read_bag(bag_dir)

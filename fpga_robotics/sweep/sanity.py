@@ -22,8 +22,14 @@ def report_campaign_warnings(campaign, strict, stream, error):
             continue
         seen.add(key)
         # The run's own overrides, as ``run`` makes them of its options.
-        args = Namespace(overrides=list(spec.set_items()), resolution=spec.resolution,
-                         duration=spec.duration, color=None, design=None, ports=None)
+        args = Namespace(
+            overrides=list(spec.set_items()),
+            resolution=spec.resolution,
+            duration=spec.duration,
+            color=None,
+            design=None,
+            ports=None,
+        )
         try:
             scenario = load_scenario(spec.scenario, run._overrides(args))
         except UsageError:  # the run reports it as its own failure

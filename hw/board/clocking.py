@@ -148,7 +148,9 @@ class BoardClocking(Elaboratable):
         self.reset_in = reset_in
         self.in_freq = in_freq
         self.sys_clk_freq = sys_clk_freq
-        self.pll_params = None if in_freq == sys_clk_freq else ecp5_pll_params(in_freq, sys_clk_freq)
+        self.pll_params = (
+            None if in_freq == sys_clk_freq else ecp5_pll_params(in_freq, sys_clk_freq)
+        )
 
     def elaborate(self, platform):
         m = Module()

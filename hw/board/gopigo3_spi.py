@@ -95,12 +95,14 @@ class SPIByteMaster(CheckedArguments, wiring.Component):
 
     def __init__(self, *, half_period):
         self.half_period = int(half_period)
-        super().__init__({
-            "bytes": In(stream.Signature(SPIByte)),
-            "sclk": Out(1),
-            "copi": Out(1),
-            "cs": Out(1),
-        })
+        super().__init__(
+            {
+                "bytes": In(stream.Signature(SPIByte)),
+                "sclk": Out(1),
+                "copi": Out(1),
+                "cs": Out(1),
+            }
+        )
 
     def elaborate(self, platform):
         m = Module()
@@ -118,8 +120,11 @@ class SPIByteMaster(CheckedArguments, wiring.Component):
                 m.d.comb += self.bytes.ready.eq(timer == 0)
                 with m.If(self.bytes.valid & (timer == 0)):
                     m.d.sync += [
-                        shift.eq(self.bytes.payload.data), end.eq(self.bytes.payload.end),
-                        bit.eq(0), self.cs.eq(1), timer.eq(self.half_period - 1),
+                        shift.eq(self.bytes.payload.data),
+                        end.eq(self.bytes.payload.end),
+                        bit.eq(0),
+                        self.cs.eq(1),
+                        timer.eq(self.half_period - 1),
                     ]
                     m.next = "LOW"
             with m.State("LOW"), m.If(timer == 0):
@@ -130,8 +135,11 @@ class SPIByteMaster(CheckedArguments, wiring.Component):
                 # SCLK high: the peripheral sampled COPI on the rising edge
                 m.d.sync += self.sclk.eq(0)
                 with m.If(bit != 7):
-                    m.d.sync += [shift.eq(shift << 1), bit.eq(bit + 1),
-                                 timer.eq(self.half_period - 1)]
+                    m.d.sync += [
+                        shift.eq(shift << 1),
+                        bit.eq(bit + 1),
+                        timer.eq(self.half_period - 1),
+                    ]
                     m.next = "LOW"
                 with m.Else():
                     m.next = "NEXT"
@@ -141,8 +149,10 @@ class SPIByteMaster(CheckedArguments, wiring.Component):
                     m.d.comb += self.bytes.ready.eq(1)
                     with m.If(self.bytes.valid):
                         m.d.sync += [
-                            shift.eq(self.bytes.payload.data), end.eq(self.bytes.payload.end),
-                            bit.eq(0), timer.eq(self.half_period - 1),
+                            shift.eq(self.bytes.payload.data),
+                            end.eq(self.bytes.payload.end),
+                            bit.eq(0),
+                            timer.eq(self.half_period - 1),
                         ]
                         m.next = "LOW"
                 with m.Else():
@@ -194,15 +204,17 @@ class GoPiGo3Motors(CheckedArguments, wiring.Component):
         self.dps_limit = int(dps_limit)
         self.power_limit = int(power_limit)
         self.spi = SPIByteMaster(half_period=half_period)
-        super().__init__({
-            "update": In(1),
-            "left": In(signed(16)),
-            "right": In(signed(16)),
-            "sclk": Out(1),
-            "copi": Out(1),
-            "cs": Out(1),
-            "busy": Out(1),
-        })
+        super().__init__(
+            {
+                "update": In(1),
+                "left": In(signed(16)),
+                "right": In(signed(16)),
+                "sclk": Out(1),
+                "copi": Out(1),
+                "cs": Out(1),
+                "busy": Out(1),
+            }
+        )
 
     def elaborate(self, platform):
         m = Module()
@@ -221,8 +233,11 @@ class GoPiGo3Motors(CheckedArguments, wiring.Component):
         next_left = Signal(signed(16))
         next_right = Signal(signed(16))
         with m.If(self.update):
-            m.d.sync += [pending.eq(1), next_left.eq(ticks(self.left)),
-                         next_right.eq(ticks(self.right))]
+            m.d.sync += [
+                pending.eq(1),
+                next_left.eq(ticks(self.left)),
+                next_right.eq(ticks(self.right)),
+            ]
 
         # The message being sent: its type, port and 16-bit argument.
         limits = Signal()
@@ -237,8 +252,9 @@ class GoPiGo3Motors(CheckedArguments, wiring.Component):
             with m.Case(0):
                 m.d.comb += contents.eq(GOPIGO3_ADDRESS)
             with m.Case(1):
-                m.d.comb += contents.eq(Mux(limits, GoPiGo3Message.SET_MOTOR_LIMITS,
-                                            GoPiGo3Message.SET_MOTOR_DPS))
+                m.d.comb += contents.eq(
+                    Mux(limits, GoPiGo3Message.SET_MOTOR_LIMITS, GoPiGo3Message.SET_MOTOR_DPS)
+                )
             with m.Case(2):
                 m.d.comb += contents.eq(port)
             with m.Case(3):
@@ -247,8 +263,10 @@ class GoPiGo3Motors(CheckedArguments, wiring.Component):
                 m.d.comb += contents.eq(Mux(limits, value[8:16], value[0:8]))
             with m.Case(5):
                 m.d.comb += contents.eq(value[0:8])
-        m.d.comb += [spi.bytes.payload.data.eq(contents),
-                     spi.bytes.payload.end.eq(byte == length - 1)]
+        m.d.comb += [
+            spi.bytes.payload.data.eq(contents),
+            spi.bytes.payload.end.eq(byte == length - 1),
+        ]
 
         limit_ticks = Const(self.dps_limit * TICKS_PER_DEGREE, 16)
         wait = Signal(range(self.startup_wait + 1), init=self.startup_wait)
@@ -257,14 +275,22 @@ class GoPiGo3Motors(CheckedArguments, wiring.Component):
                 with m.If(wait != 0):
                     m.d.sync += wait.eq(wait - 1)
                 with m.Else():
-                    m.d.sync += [limits.eq(1), port.eq(MOTOR_LEFT), value.eq(limit_ticks),
-                                 byte.eq(0)]
+                    m.d.sync += [
+                        limits.eq(1),
+                        port.eq(MOTOR_LEFT),
+                        value.eq(limit_ticks),
+                        byte.eq(0),
+                    ]
                     m.next = "SEND"
             with m.State("IDLE"), m.If(pending):
                 m.d.sync += pending.eq(0)
                 m.d.sync += [
-                    limits.eq(0), port.eq(MOTOR_LEFT), value.eq(next_left),
-                    cur_right.eq(next_right), right_next.eq(1), byte.eq(0),
+                    limits.eq(0),
+                    port.eq(MOTOR_LEFT),
+                    value.eq(next_left),
+                    cur_right.eq(next_right),
+                    right_next.eq(1),
+                    byte.eq(0),
                 ]
                 with m.If(self.update):  # a new update in this very cycle stays pending
                     m.d.sync += pending.eq(1)
@@ -278,8 +304,11 @@ class GoPiGo3Motors(CheckedArguments, wiring.Component):
                         with m.If(limits & (port == MOTOR_LEFT)):
                             m.d.sync += port.eq(MOTOR_RIGHT)
                         with m.Elif(~limits & right_next):
-                            m.d.sync += [port.eq(MOTOR_RIGHT), value.eq(cur_right),
-                                         right_next.eq(0)]
+                            m.d.sync += [
+                                port.eq(MOTOR_RIGHT),
+                                value.eq(cur_right),
+                                right_next.eq(0),
+                            ]
                         with m.Else():
                             m.next = "IDLE"
         with m.If(pending):

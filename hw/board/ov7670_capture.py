@@ -62,21 +62,25 @@ class OV7670Capture(CheckedArguments, wiring.Component):
     def __init__(self, *, pclk_domain="pclk", fifo_depth=16):
         self.pclk_domain = pclk_domain
         self.fifo_depth = int(fifo_depth)
-        super().__init__({
-            "data": In(8),
-            "href": In(1),
-            "vsync": In(1),
-            "pixels": Out(pixel_stream_signature()),
-            "overflow": Out(1),
-        })
+        super().__init__(
+            {
+                "data": In(8),
+                "href": In(1),
+                "vsync": In(1),
+                "pixels": Out(pixel_stream_signature()),
+                "overflow": Out(1),
+            }
+        )
 
     def elaborate(self, platform):
         m = Module()
         pclk = m.d[self.pclk_domain]
 
         m.submodules.fifo = fifo = AsyncFIFO(
-            width=FramedPixel.size, depth=self.fifo_depth,
-            r_domain="sync", w_domain=self.pclk_domain,
+            width=FramedPixel.size,
+            depth=self.fifo_depth,
+            r_domain="sync",
+            w_domain=self.pclk_domain,
         )
 
         # Input registers: everything is sampled on the same PCLK edge.
@@ -85,10 +89,10 @@ class OV7670Capture(CheckedArguments, wiring.Component):
         vsync = Signal()
         pclk += [data.eq(self.data), href.eq(self.href), vsync.eq(self.vsync)]
 
-        high_byte = Signal(4)          # red, from the first byte of the pixel
-        second = Signal()              # the next byte in the line is a pixel's second byte
-        frame_start = Signal()         # no pixel yet since the last VSYNC
-        held = Signal(FramedPixel)     # the previous pixel, not yet written
+        high_byte = Signal(4)  # red, from the first byte of the pixel
+        second = Signal()  # the next byte in the line is a pixel's second byte
+        frame_start = Signal()  # no pixel yet since the last VSYNC
+        held = Signal(FramedPixel)  # the previous pixel, not yet written
         held_valid = Signal()
 
         write = Signal()

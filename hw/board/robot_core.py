@@ -37,8 +37,17 @@ class RobotTiming:
         the first GoPiGo3 message.
     """
 
-    def __init__(self, sys_clk_freq=50e6, *, xclk_freq=12.5e6, sccb_freq=100e3, spi_freq=500e3,
-                 camera_wait=10e-3, reset_wait=10e-3, motor_wait=100e-3):
+    def __init__(
+        self,
+        sys_clk_freq=50e6,
+        *,
+        xclk_freq=12.5e6,
+        sccb_freq=100e3,
+        spi_freq=500e3,
+        camera_wait=10e-3,
+        reset_wait=10e-3,
+        motor_wait=100e-3,
+    ):
         ratio = sys_clk_freq / xclk_freq
         if ratio != int(ratio) or int(ratio) % 2:
             raise ValueError(
@@ -54,8 +63,7 @@ class RobotTiming:
         self.motor_wait = round(sys_clk_freq * motor_wait)
 
     @classmethod
-    def from_cycles(cls, *, xclk_half, sccb_quarter, spi_half, camera_wait, reset_wait,
-                    motor_wait):
+    def from_cycles(cls, *, xclk_half, sccb_quarter, spi_half, camera_wait, reset_wait, motor_wait):
         """Explicit cycle counts (fast simulations use small ones)."""
         t = cls.__new__(cls)
         t.sys_clk_freq = None
@@ -111,37 +119,51 @@ class RobotCore(CheckedArguments, wiring.Component):
             raise TypeError(f"params must be a FollowTargetParams, not {params!r}")
         for name in ("xclk_half", "sccb_quarter", "spi_half"):
             check_int(name, getattr(t, name), 1)
-        SCCBInit.check_arguments(sccb_table, quarter_period=t.sccb_quarter,
-                                 reset_wait=t.reset_wait, startup_wait=t.camera_wait)
-        GoPiGo3Motors.check_arguments(half_period=t.spi_half, startup_wait=t.motor_wait,
-                                      dps_limit=gopigo3_dps_limit(params))
+        SCCBInit.check_arguments(
+            sccb_table,
+            quarter_period=t.sccb_quarter,
+            reset_wait=t.reset_wait,
+            startup_wait=t.camera_wait,
+        )
+        GoPiGo3Motors.check_arguments(
+            half_period=t.spi_half, startup_wait=t.motor_wait, dps_limit=gopigo3_dps_limit(params)
+        )
 
     def __init__(self, params=None, timing=None, *, sccb_table=OV7670_INIT):
         self.params = FollowTargetParams() if params is None else params
         self.timing = RobotTiming() if timing is None else timing
         t = self.timing
         self.design = FollowTarget(self.params)
-        self.sccb = SCCBInit(sccb_table, quarter_period=t.sccb_quarter,
-                             reset_wait=t.reset_wait, startup_wait=t.camera_wait)
-        self.motors = GoPiGo3Motors(half_period=t.spi_half, startup_wait=t.motor_wait,
-                                    dps_limit=gopigo3_dps_limit(self.params))
-        super().__init__({
-            "cam_data": In(8),
-            "cam_href": In(1),
-            "cam_vsync": In(1),
-            "xclk": Out(1),
-            "cam_reset": Out(1),
-            "sioc": Out(1, init=1),
-            "siod_o": Out(1, init=1),
-            "siod_oe": Out(1, init=1),
-            "switches": In(3),
-            "leds": Out(8),
-            "spi_sclk": Out(1),
-            "spi_copi": Out(1),
-            "spi_cs": Out(1),
-            "camera_ready": Out(1),
-            "overflow": Out(1),
-        })
+        self.sccb = SCCBInit(
+            sccb_table,
+            quarter_period=t.sccb_quarter,
+            reset_wait=t.reset_wait,
+            startup_wait=t.camera_wait,
+        )
+        self.motors = GoPiGo3Motors(
+            half_period=t.spi_half,
+            startup_wait=t.motor_wait,
+            dps_limit=gopigo3_dps_limit(self.params),
+        )
+        super().__init__(
+            {
+                "cam_data": In(8),
+                "cam_href": In(1),
+                "cam_vsync": In(1),
+                "xclk": Out(1),
+                "cam_reset": Out(1),
+                "sioc": Out(1, init=1),
+                "siod_o": Out(1, init=1),
+                "siod_oe": Out(1, init=1),
+                "switches": In(3),
+                "leds": Out(8),
+                "spi_sclk": Out(1),
+                "spi_copi": Out(1),
+                "spi_cs": Out(1),
+                "camera_ready": Out(1),
+                "overflow": Out(1),
+            }
+        )
 
     def elaborate(self, platform):
         m = Module()

@@ -94,8 +94,9 @@ class SCCBInit(CheckedArguments, wiring.Component):
     """
 
     @staticmethod
-    def check_arguments(table=OV7670_INIT, *, quarter_period, reset_wait, startup_wait=0,
-                        device_id=OV7670_SCCB_ID):
+    def check_arguments(
+        table=OV7670_INIT, *, quarter_period, reset_wait, startup_wait=0, device_id=OV7670_SCCB_ID
+    ):
         """Raise ``TypeError``/``ValueError`` unless ``SCCBInit`` accepts these arguments."""
         if iter(table) is table:  # read once here and once by the constructor
             raise TypeError("the SCCB register table must be a sequence, not an iterator")
@@ -109,20 +110,29 @@ class SCCBInit(CheckedArguments, wiring.Component):
         check_int("startup_wait", startup_wait, 0)
         check_int("device_id", device_id, 0, 0xFF)
 
-    def __init__(self, table=OV7670_INIT, *, quarter_period, reset_wait, startup_wait=0,
-                 device_id=OV7670_SCCB_ID):
+    def __init__(
+        self,
+        table=OV7670_INIT,
+        *,
+        quarter_period,
+        reset_wait,
+        startup_wait=0,
+        device_id=OV7670_SCCB_ID,
+    ):
         table = tuple(table)  # checked in check_arguments, before the component existed
         self.table = table
         self.quarter_period = int(quarter_period)
         self.reset_wait = int(reset_wait)
         self.startup_wait = int(startup_wait)
         self.device_id = int(device_id)
-        super().__init__({
-            "sioc": Out(1, init=1),
-            "siod_o": Out(1, init=1),
-            "siod_oe": Out(1, init=1),
-            "done": Out(1),
-        })
+        super().__init__(
+            {
+                "sioc": Out(1, init=1),
+                "siod_o": Out(1, init=1),
+                "siod_oe": Out(1, init=1),
+                "done": Out(1),
+            }
+        )
 
     def elaborate(self, platform):
         m = Module()
@@ -141,8 +151,9 @@ class SCCBInit(CheckedArguments, wiring.Component):
         quarter = Signal(2)
         bit = Signal(range(_BITS))
         gap = 4 * self.quarter_period  # bus free time between two writes: one bit time
-        wait = Signal(range(max(self.reset_wait, self.startup_wait, gap) + 1),
-                      init=self.startup_wait)
+        wait = Signal(
+            range(max(self.reset_wait, self.startup_wait, gap) + 1), init=self.startup_wait
+        )
 
         # The 27-bit frame of the current entry, MSB first; don't-care bits are 1 (released).
         reg = Signal(8)
@@ -153,8 +164,9 @@ class SCCBInit(CheckedArguments, wiring.Component):
                 with m.Case(i):
                     m.d.comb += [reg.eq(w.reg), value.eq(w.value), wait_after.eq(w.wait_after)]
         frame = Signal(_BITS)
-        m.d.comb += frame.eq(Cat(Const(1, 1), value, Const(1, 1), reg, Const(1, 1),
-                                 Const(self.device_id, 8)))
+        m.d.comb += frame.eq(
+            Cat(Const(1, 1), value, Const(1, 1), reg, Const(1, 1), Const(self.device_id, 8))
+        )
         current = Signal()
         in_order = Cat(frame[i] for i in reversed(range(_BITS)))  # bit k = k-th sent
         m.d.comb += current.eq(in_order.bit_select(bit, 1))

@@ -84,8 +84,9 @@ class ULX3SFollowTarget(CheckedArguments, Elaboratable):
         m.domains.sync = ClockDomain("sync")
         clk25 = pin("clk25", 0, "i")
         fire1 = pin("button_fire", 0, "i")
-        m.submodules.clocking = BoardClocking(clk25.i, fire1.i, in_freq=OSC_FREQ,
-                                              sys_clk_freq=self.sys_clk_freq)
+        m.submodules.clocking = BoardClocking(
+            clk25.i, fire1.i, in_freq=OSC_FREQ, sys_clk_freq=self.sys_clk_freq
+        )
 
         cam = platform.request("ov7670", 0, dir="-")
         pclk = sub(cam, "pclk", "i")

@@ -38,8 +38,9 @@ def contract_match(m, p, r, g, b, color_sel):
         TargetColor.YELLOW: (absdiff(sr, sg) <= sim) & (mn(sr, sg) - sb >= d),
         TargetColor.MAGENTA: (absdiff(sr, sb) <= sim) & (mn(sr, sb) - sg >= d),
         TargetColor.CYAN: (absdiff(sg, sb) <= sim) & (mn(sg, sb) - sr >= d),
-        TargetColor.WHITE: ((mx(sr, mx(sg, sb)) - mn(sr, mn(sg, sb)) <= sim)
-                            & (mn(sr, mn(sg, sb)) >= wm)),
+        TargetColor.WHITE: (
+            (mx(sr, mx(sg, sb)) - mn(sr, mn(sg, sb)) <= sim) & (mn(sr, mn(sg, sb)) >= wm)
+        ),
     }
     result = 0
     for color, test in table.items():
@@ -59,8 +60,11 @@ class ColorFilterHarness(Harness):
         m.submodules.dut = dut
         width = len(dut.pixels.payload.as_value())
         valid, payload, color_sel = AnySeq(1), AnySeq(width), AnySeq(3)
-        m.d.comb += [dut.pixels.valid.eq(valid), dut.pixels.payload.eq(payload),
-                     dut.color_sel.eq(color_sel)]
+        m.d.comb += [
+            dut.pixels.valid.eq(valid),
+            dut.pixels.payload.eq(payload),
+            dut.color_sel.eq(color_sel),
+        ]
         pix = dut.pixels.payload
         match = contract_match(m, p, pix.pixel.r, pix.pixel.g, pix.pixel.b, color_sel)
         expected = Signal.like(dut.pixels.payload)
@@ -76,9 +80,17 @@ class ColorFilterHarness(Harness):
             m.d.comb += [
                 Assert(out.as_value() == was, "filtered pixel or flags differ from the table"),
                 Assert(dut.matches.payload.match == was_match, "match bit differs"),
-                Assert((dut.matches.payload.first == out.first)
-                       & (dut.matches.payload.last == out.last), "match flags differ"),
+                Assert(
+                    (dut.matches.payload.first == out.first)
+                    & (dut.matches.payload.last == out.last),
+                    "match flags differ",
+                ),
             ]
-        m.d.comb += [Cover(dut.filtered.valid & dut.matches.payload.match
-                           & (delayed(m, color_sel, 1) == color.value))
-                     for color in TargetColor]
+        m.d.comb += [
+            Cover(
+                dut.filtered.valid
+                & dut.matches.payload.match
+                & (delayed(m, color_sel, 1) == color.value)
+            )
+            for color in TargetColor
+        ]

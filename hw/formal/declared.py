@@ -56,16 +56,27 @@ def declared_checks(name, make_dut):
     mode = getattr(cls, "formal_mode", "bmc")
     depth = int(getattr(cls, "formal_depth", DEFAULT_DEPTH))
     doc = (getattr(cls, PROPERTY_HOOK).__doc__ or "").strip().splitlines()
-    checks = [FormalCheck(f"{name}.properties", mode, depth,
-                          doc[0] if doc else f"the properties {cls.__name__} declares",
-                          build=lambda dut=None: DeclaredHarness(dut or make_dut(), PROPERTY_HOOK),
-                          make_dut=make_dut)]
+    checks = [
+        FormalCheck(
+            f"{name}.properties",
+            mode,
+            depth,
+            doc[0] if doc else f"the properties {cls.__name__} declares",
+            build=lambda dut=None: DeclaredHarness(dut or make_dut(), PROPERTY_HOOK),
+            make_dut=make_dut,
+        )
+    ]
     if callable(getattr(cls, COVER_HOOK, None)):
         doc = (getattr(cls, COVER_HOOK).__doc__ or "").strip().splitlines()
         cover_depth = int(getattr(cls, "formal_cover_depth", depth))
-        checks.append(FormalCheck(f"{name}.covers", "cover", cover_depth,
-                                  doc[0] if doc else f"the covers {cls.__name__} declares",
-                                  build=lambda dut=None: DeclaredHarness(dut or make_dut(),
-                                                                         COVER_HOOK),
-                                  make_dut=make_dut))
+        checks.append(
+            FormalCheck(
+                f"{name}.covers",
+                "cover",
+                cover_depth,
+                doc[0] if doc else f"the covers {cls.__name__} declares",
+                build=lambda dut=None: DeclaredHarness(dut or make_dut(), COVER_HOOK),
+                make_dut=make_dut,
+            )
+        )
     return checks

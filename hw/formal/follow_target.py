@@ -34,8 +34,7 @@ class _FreeInputs(Harness):
             dut.color_sel.eq(AnySeq(3)),
         ]
         payload = dut.pixels.payload
-        return FramingMonitor(m, p.width, p.height, dut.pixels.valid, payload.first,
-                              payload.last)
+        return FramingMonitor(m, p.width, p.height, dut.pixels.valid, payload.first, payload.last)
 
 
 class FrameDoneHarness(_FreeInputs):

@@ -26,22 +26,27 @@ class MotorHarness(Harness):
         self.dut = MotorController(params) if dut is None else dut
         p = self.dut.params
         if p.lost_motion != "hold" or abs(p.search_dps) > p.max_dps:
-            raise ValueError("the motor promises are stated for lost_motion='hold' and "
-                             "abs(search_dps) <= max_dps")
+            raise ValueError(
+                "the motor promises are stated for lost_motion='hold' and "
+                "abs(search_dps) <= max_dps"
+            )
 
     def check(self, m):
         dut, p = self.dut, self.dut.params
         m.submodules.dut = dut
         m.d.comb += [
-            dut.update.eq(AnySeq(1)), dut.found.eq(AnySeq(1)),
-            dut.proximity.eq(AnySeq(3)), dut.centroid_x.eq(AnySeq(p.x_bits)),
+            dut.update.eq(AnySeq(1)),
+            dut.found.eq(AnySeq(1)),
+            dut.proximity.eq(AnySeq(3)),
+            dut.centroid_x.eq(AnySeq(p.x_bits)),
         ]
         if p.motor_uses_leds:
             m.d.comb += dut.leds.eq(AnySeq(8))
 
         for wheel in (dut.left, dut.right):
-            m.d.comb += Assert((wheel <= p.max_dps) & (wheel >= -p.max_dps),
-                               "wheel speed beyond max_dps")
+            m.d.comb += Assert(
+                (wheel <= p.max_dps) & (wheel >= -p.max_dps), "wheel speed beyond max_dps"
+            )
 
         # The contract's state, from the inputs alone.
         lost = Signal(range(p.lost_frames + 1))
@@ -67,8 +72,10 @@ class MotorHarness(Harness):
                     turn = Mux(right_side, p.search_dps, -p.search_dps)
                     m.d.sync += [expect_left.eq(turn), expect_right.eq(-turn)]
         with m.If(check):
-            m.d.comb += Assert((dut.left == expect_left) & (dut.right == expect_right),
-                               "lost frame: neither held nor searching")
+            m.d.comb += Assert(
+                (dut.left == expect_left) & (dut.right == expect_right),
+                "lost frame: neither held nor searching",
+            )
         m.d.comb += [
             Cover(check & (lost == p.lost_frames) & (dut.left == p.search_dps)),
             Cover(check & (lost == p.lost_frames) & (dut.left == -p.search_dps)),

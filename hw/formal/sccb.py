@@ -12,8 +12,10 @@ from .harness import Harness, delayed
 __all__ = ["SCCB_TABLE", "SCCBHarness", "write_bits"]
 
 #: Two writes, the first with the reset wait after it: every path of the sequencer.
-SCCB_TABLE = (RegisterWrite(0x12, 0x80, "reset", wait_after=True),
-              RegisterWrite(0x8C, 0x02, "RGB444"))
+SCCB_TABLE = (
+    RegisterWrite(0x12, 0x80, "reset", wait_after=True),
+    RegisterWrite(0x8C, 0x02, "RGB444"),
+)
 
 
 def write_bits(device_id, entry):
@@ -29,8 +31,11 @@ class SCCBHarness(Harness):
 
     def __init__(self, dut=None):
         super().__init__()
-        self.dut = (SCCBInit(SCCB_TABLE, quarter_period=1, reset_wait=6, startup_wait=2)
-                    if dut is None else dut)
+        self.dut = (
+            SCCBInit(SCCB_TABLE, quarter_period=1, reset_wait=6, startup_wait=2)
+            if dut is None
+            else dut
+        )
 
     def check(self, m):
         dut = self.dut
@@ -46,8 +51,10 @@ class SCCBHarness(Harness):
         busy = Signal()  # between a START and its STOP
         edges = Signal(range(29))  # SIOC rising edges since the START
         index = Signal(range(len(dut.table) + 1))  # writes completed
-        m.d.comb += Assert(~dut.sioc | (line == was_line) | start | stop,
-                           "SIOD changed with SIOC high, not as a START or STOP")
+        m.d.comb += Assert(
+            ~dut.sioc | (line == was_line) | start | stop,
+            "SIOD changed with SIOC high, not as a START or STOP",
+        )
         with m.If(start):
             m.d.comb += Assert(~busy, "START inside a write")
             m.d.sync += [busy.eq(1), edges.eq(0)]
@@ -63,11 +70,13 @@ class SCCBHarness(Harness):
                         if bit is None:
                             m.d.comb += Assert(~dut.siod_oe, "SIOD driven on a don't-care bit")
                         else:
-                            m.d.comb += Assert(dut.siod_oe & (dut.siod_o == bit),
-                                               f"write {i} bit {k} is not {bit}")
+                            m.d.comb += Assert(
+                                dut.siod_oe & (dut.siod_o == bit), f"write {i} bit {k} is not {bit}"
+                            )
         m.d.comb += [
             Assert(~rising | busy, "SIOC pulse outside a write"),
-            Assert(~dut.done | (~busy & (index == len(dut.table))),
-                   "done before every write has ended"),
+            Assert(
+                ~dut.done | (~busy & (index == len(dut.table))), "done before every write has ended"
+            ),
             Cover(dut.done),
         ]

@@ -14,8 +14,13 @@ __all__ = ["FULL_SIZES", "SMALL"]
 
 #: 16x2 frames, an 8-column window (4 columns of margin each side, bins 1 column wide).
 SMALL = FollowTargetParams(
-    width=16, height=2, margin_x=4, margin_y=0, min_pixels=2,
-    proximity_thresholds=(2, 3, 4, 6, 8, 10, 12), lost_frames=2,
+    width=16,
+    height=2,
+    margin_x=4,
+    margin_y=0,
+    min_pixels=2,
+    proximity_thresholds=(2, 3, 4, 6, 8, 10, 12),
+    lost_frames=2,
 )
 
 #: The resolutions the project runs, with their default parameters.

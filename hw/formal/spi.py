@@ -46,8 +46,12 @@ class SPIHarness(Harness):
         pulses = Signal(range(9))
         with m.If(taken):
             m.d.comb += Assert(~pending, "byte taken before the last one went out")
-            m.d.sync += [expect.eq(dut.bytes.payload.data), expect_end.eq(dut.bytes.payload.end),
-                         pending.eq(1), pulses.eq(0)]
+            m.d.sync += [
+                expect.eq(dut.bytes.payload.data),
+                expect_end.eq(dut.bytes.payload.end),
+                pending.eq(1),
+                pulses.eq(0),
+            ]
         with m.Elif(rising):
             m.d.comb += Assert(pending, "SCLK pulse with no byte to send")
             m.d.sync += [got.eq(got << 1 | copi), pulses.eq(pulses + 1)]

@@ -60,8 +60,9 @@ class NoLeakMiter(Harness):
                 Assert(a.counts.sum_x == b.counts.sum_x, "SX differs"),
             ]
             if a.params.group_column_offset:
-                m.d.comb += Assert(Value.cast(a.counts.edges) == Value.cast(b.counts.edges),
-                                   "edges differ")
+                m.d.comb += Assert(
+                    Value.cast(a.counts.edges) == Value.cast(b.counts.edges), "edges differ"
+                )
 
 
 def _tree(values):
@@ -85,9 +86,17 @@ def contract_leds(p, bins, count, found):
             code = Mux(s >= half, 1 << led, code)
         return code
 
-    return Mux(~found, 0, Mux(centred, 0b0001_1000,
-               Mux(left > right, from_edge((0, 1, 2), (0, 1, 2, 3)),
-                   from_edge((7, 6, 5), (7, 6, 5, 4)))))
+    return Mux(
+        ~found,
+        0,
+        Mux(
+            centred,
+            0b0001_1000,
+            Mux(
+                left > right, from_edge((0, 1, 2), (0, 1, 2, 3)), from_edge((7, 6, 5), (7, 6, 5, 4))
+            ),
+        ),
+    )
 
 
 class _FreeCounts(Harness):
@@ -148,7 +157,8 @@ class ResultsFormulas(_FreeCounts):
             with m.If(done):
                 m.d.comb += Assert(
                     Mux(found, (q * count <= sum_x) & (sum_x < (q + 1) * count), q == 0),
-                    "centroid_x is not SX // N (0 when not found)")
+                    "centroid_x is not SX // N (0 when not found)",
+                )
             m.d.comb += [
                 Cover(done & dut.found & (dut.centroid_x == p.margin_x)),
                 Cover(done & dut.found & (dut.centroid_x == p.width - p.margin_x - 1)),
@@ -159,8 +169,10 @@ class ResultsFormulas(_FreeCounts):
             m.d.comb += [
                 Assert(dut.found == found, "found is not N >= min_pixels"),
                 Assert(dut.proximity == proximity, "proximity is not #thresholds <= N"),
-                Assert(dut.centroid_leds == contract_leds(p, bins, count, found),
-                       "centroid_leds is not the contract's LED code"),
+                Assert(
+                    dut.centroid_leds == contract_leds(p, bins, count, found),
+                    "centroid_leds is not the contract's LED code",
+                ),
             ]
         m.d.comb += [
             Cover(done & (dut.proximity == 7)),

@@ -160,12 +160,18 @@ def check_out(out, width, height):
     """Raise ``FrameError`` unless ``out`` can receive a ``width`` x ``height`` filtered frame:
     a C-contiguous, writable (height, width) uint16 numpy array."""
     if not isinstance(out, np.ndarray):
-        raise FrameError(f"out= must be a numpy array, not {type(out).__name__}; make one with "
-                         f"numpy.empty(({height}, {width}), numpy.uint16)")
+        raise FrameError(
+            f"out= must be a numpy array, not {type(out).__name__}; make one with "
+            f"numpy.empty(({height}, {width}), numpy.uint16)"
+        )
     if out.shape != (height, width) or out.dtype != np.uint16:
-        raise FrameError(f"out= must be a ({height}, {width}) uint16 array for a {width}x{height} "
-                         f"design, got {out.shape} {out.dtype}; make one with "
-                         f"numpy.empty(({height}, {width}), numpy.uint16)")
+        raise FrameError(
+            f"out= must be a ({height}, {width}) uint16 array for a {width}x{height} "
+            f"design, got {out.shape} {out.dtype}; make one with "
+            f"numpy.empty(({height}, {width}), numpy.uint16)"
+        )
     if not (out.flags.c_contiguous and out.flags.writeable):
-        raise FrameError("out= must be a C-contiguous, writable array (not a view with strides "
-                         "or a read-only array)")
+        raise FrameError(
+            "out= must be a C-contiguous, writable array (not a view with strides "
+            "or a read-only array)"
+        )

@@ -23,8 +23,14 @@ from .base import BackendError, DesignBackend, FrameResult, check_out
 from .designs import DesignSource
 from .lifecycle import BuildPlan, bind_library, load_built
 
-__all__ = ["ABI_VERSION", "HARNESS_DIR", "LIBRARY_NAME", "BuildPlan", "CompiledBackend",
-           "HarnessFrames"]
+__all__ = [
+    "ABI_VERSION",
+    "HARNESS_DIR",
+    "LIBRARY_NAME",
+    "BuildPlan",
+    "CompiledBackend",
+    "HarnessFrames",
+]
 
 #: Directory of the C++ harness sources (package data).
 HARNESS_DIR = Path(__file__).resolve().parent
@@ -66,8 +72,9 @@ class _Library:
     )
 
     def __init__(self, path):
-        self.lib = bind_library(path, self._ENTRIES, what="compiled model",
-                                abi_entry="fr_abi_version", abi=ABI_VERSION)
+        self.lib = bind_library(
+            path, self._ENTRIES, what="compiled model", abi_entry="fr_abi_version", abi=ABI_VERSION
+        )
         self.path = path
         #: Simulator evaluations per clock cycle (1 when every output is read from flip-flops).
         self.evals_per_cycle = self.lib.fr_evals_per_cycle()
@@ -98,15 +105,22 @@ class HarnessFrames:
 
     def process_frame(self, frame, color_sel="red", *, out=None):
         # The common case first, in as few steps as possible: this runs once per frame.
-        code = (color_sel if type(color_sel) is int and 0 <= color_sel <= 7
-                else color_select_value(color_sel))
+        code = (
+            color_sel
+            if type(color_sel) is int and 0 <= color_sel <= 7
+            else color_select_value(color_sel)
+        )
         if out is None:
             filtered = np.empty(self._shape, np.uint16)
         else:
             check_out(out, self._shape[1], self._shape[0])
             filtered = out
-        if (type(frame) is np.ndarray and frame.dtype is _U8 and frame.shape == self._rgb_shape
-                and frame.flags.c_contiguous):
+        if (
+            type(frame) is np.ndarray
+            and frame.dtype is _U8
+            and frame.shape == self._rgb_shape
+            and frame.flags.c_contiguous
+        ):
             result = self._run_harness(self._entry_rgb888, frame, code, filtered)
         else:
             packed = to_rgb444(frame, self._shape[1], self._shape[0])
@@ -115,8 +129,9 @@ class HarnessFrames:
         return result
 
     def _run_frame(self, packed, color_sel):
-        return self._run_harness(self._entry_packed, packed, color_sel,
-                                 np.empty(self._shape, np.uint16))
+        return self._run_harness(
+            self._entry_packed, packed, color_sel, np.empty(self._shape, np.uint16)
+        )
 
     @property
     def last_loop_seconds(self):
@@ -142,7 +157,13 @@ class CompiledBackend(HarnessFrames, DesignBackend):
     waveform_formats = (".vcd",)
 
     def __init__(
-        self, params=None, *, line_blank=0, frame_blank=0, waveform=None, design="follow_target",
+        self,
+        params=None,
+        *,
+        line_blank=0,
+        frame_blank=0,
+        waveform=None,
+        design="follow_target",
         on_build=None,
     ):
         super().__init__(params, line_blank=line_blank, frame_blank=frame_blank, waveform=waveform)
@@ -187,16 +208,21 @@ class CompiledBackend(HarnessFrames, DesignBackend):
     def _load(self, variant):
         """Build (or find in the cache) and load the library (``lifecycle.load_built``)."""
         #: The cache entry in use (``built`` tells whether this construction built it).
-        self.cache_entry, library = load_built(self.build_plan(self.source, variant),
-                                               LIBRARY_NAME, _Library,
-                                               on_build=self._build_notice)
+        self.cache_entry, library = load_built(
+            self.build_plan(self.source, variant),
+            LIBRARY_NAME,
+            _Library,
+            on_build=self._build_notice,
+        )
         return library
 
     def _build_notice(self):
         if self._on_build is not None:
             p = self.params
-            self._on_build(f"compiling the {self.name} model of {self.source.design} at "
-                           f"{p.width}x{p.height} (once; later runs load it from the cache)")
+            self._on_build(
+                f"compiling the {self.name} model of {self.source.design} at "
+                f"{p.width}x{p.height} (once; later runs load it from the cache)"
+            )
 
     @staticmethod
     def build_plan(source, variant):
@@ -223,19 +249,20 @@ class CompiledBackend(HarnessFrames, DesignBackend):
             if self._trace_state == "open":
                 self._library.lib.fr_trace_enable(self._handle, int(tracing))
         self._args[2] = color_sel
-        status = entry(self._handle, _address(frame), self._args_address, _address(filtered),
-                       self._out_address)
+        status = entry(
+            self._handle, _address(frame), self._args_address, _address(filtered), self._out_address
+        )
         if self.waveform is not None and tracing and index >= self.waveform.last_frame:
             self._finish_trace()
         cycles, found, proximity, centroid_x, leds, left, right, n_filtered, _, bad, _ = (
-            self._out.tolist())
+            self._out.tolist()
+        )
         if status != 0:
             message = _STATUS.get(status, f"harness status {status}").format(
                 cycles=cycles, filtered=n_filtered, pixels=filtered.size, bad=bad
             )
             raise BackendError(f"{self.name}: frame {index}: {message}")
-        return FrameResult(filtered, bool(found), proximity, centroid_x, leds, left, right,
-                           cycles)
+        return FrameResult(filtered, bool(found), proximity, centroid_x, leds, left, right, cycles)
 
     # Waveforms ---------------------------------------------------------------------------------
 

@@ -3,7 +3,6 @@ against the CXXRTL runtime headers of Amaranth's builtin Yosys, driven frame by 
 C++ harness (cxxrtl_harness.cpp + frame_driver.h) through ctypes.
 """
 
-
 from . import build_cache
 from .base import BackendError
 from .compiled import ABI_VERSION, HARNESS_DIR, LIBRARY_NAME, CompiledBackend

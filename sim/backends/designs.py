@@ -14,7 +14,6 @@ __all__ = ["DESIGNS", "TOP_NAME", "DesignSource"]
 DESIGNS = ("follow_target", "passthrough", "passthrough_comb")
 
 
-
 class DesignSource:
     """One design at one parameter set: its latencies and generated sources.
 

@@ -46,12 +46,27 @@ from .port_map import OUTPUTS, PortMapError, check_connectors, check_widths, loa
 from .toolchain import find_compiler, find_make, run_tool, verilator_root, verilator_version
 from .verilator import CXX_FLAGS, MAKE_FLAGS, VERILATOR_FLAGS
 
-__all__ = ["ForeignDesign", "ForeignVerilatorBackend", "design_ports", "pin_ports", "wrapper_verilog"]
+__all__ = [
+    "ForeignDesign",
+    "ForeignVerilatorBackend",
+    "design_ports",
+    "pin_ports",
+    "wrapper_verilog",
+]
 
 WRAPPER = "fr_foreign_top"
 #: The wrapper's own port names (docs/contract.md): no connector port may take one.
-_WRAPPER_PORTS = ("clk", "rst", "pixels__valid", "pixels__payload", "color_sel",
-                  "filtered__valid", "filtered__payload", "frame_done", *OUTPUTS)
+_WRAPPER_PORTS = (
+    "clk",
+    "rst",
+    "pixels__valid",
+    "pixels__payload",
+    "color_sel",
+    "filtered__valid",
+    "filtered__payload",
+    "frame_done",
+    *OUTPUTS,
+)
 _HARNESS_FILES = ("verilator_harness.cpp", "frame_driver.h", "verilator_clock.h")
 _LINT_FLAGS = ("-Wno-fatal", "-Wno-lint", "-Wno-style")
 
@@ -80,30 +95,42 @@ class ForeignDesign:
             try:
                 self.sources[f.name] = f.read_text()
             except (OSError, UnicodeDecodeError) as exc:
-                raise PortMapError(f"cannot read the Verilog file {f}: "
-                                   f"{getattr(exc, 'strerror', None) or exc}") from None
+                raise PortMapError(
+                    f"cannot read the Verilog file {f}: {getattr(exc, 'strerror', None) or exc}"
+                ) from None
         if len(self.sources) != len(self.files):
             raise PortMapError("two Verilog files have the same name")
         #: Files named by `include, found next to the including file or a listed one: copied
         #: next to the sources and part of the build's cache key.
         self.includes = _includes(self.files)
-        self.port_map = port_map if not isinstance(port_map, (str, os.PathLike)) \
-            else load_port_map(port_map)
+        self.port_map = (
+            port_map if not isinstance(port_map, (str, os.PathLike)) else load_port_map(port_map)
+        )
         pm = self.port_map
         if not pins and (pm.connectors or pm.extra_outputs or not pm.has_pixels):
-            what = (f"binds connectors ([connectors.{next(iter(pm.connectors))}])"
-                    if pm.connectors else "records [extra_outputs]" if pm.extra_outputs
-                    else "has no pixel stream")
-            raise PortMapError(f"port map: {pm.top}'s map {what}: the design runs in real-clock "
-                               "timing (sim.timing = \"real_clock\", on the verilator backend) "
-                               "with the scenario's [[robot.sensors]]")
-        passed = {**pm.connector_ports(),
-                  **{port: f"extra_outputs.{name}" for name, port in pm.extra_outputs.items()}}
+            what = (
+                f"binds connectors ([connectors.{next(iter(pm.connectors))}])"
+                if pm.connectors
+                else "records [extra_outputs]"
+                if pm.extra_outputs
+                else "has no pixel stream"
+            )
+            raise PortMapError(
+                f"port map: {pm.top}'s map {what}: the design runs in real-clock "
+                'timing (sim.timing = "real_clock", on the verilator backend) '
+                "with the scenario's [[robot.sensors]]"
+            )
+        passed = {
+            **pm.connector_ports(),
+            **{port: f"extra_outputs.{name}" for name, port in pm.extra_outputs.items()},
+        }
         clash = sorted(set(passed) & set(_WRAPPER_PORTS))
         if clash:
-            raise PortMapError(f"port map: {passed[clash[0]]}: the port name "
-                               f"{clash[0]!r} is reserved for the wrapper's own ports; rename "
-                               "it in the design")
+            raise PortMapError(
+                f"port map: {passed[clash[0]]}: the port name "
+                f"{clash[0]!r} is reserved for the wrapper's own ports; rename "
+                "it in the design"
+            )
         self.pins = pins
         self.ports = design_ports(self.sources, self.port_map.top, self.includes)
         check_widths(self.port_map, self.ports, self.params.width * self.params.height)
@@ -113,11 +140,14 @@ class ForeignDesign:
             out = self.port_map.outputs.get(key)
             if out is not None and self.ports[out.port][1] > 16:
                 raise PortMapError(f"port map: outputs.{key} is wider than 16 bits")
-        if "found" in self.port_map.outputs and self.ports[
-                self.port_map.outputs["found"].port][1] != 1:
+        if (
+            "found" in self.port_map.outputs
+            and self.ports[self.port_map.outputs["found"].port][1] != 1
+        ):
             raise PortMapError("port map: outputs.found must be a 1-bit port")
-        self.wrapper = wrapper_verilog(self.port_map, self.ports, self.params.width,
-                                       self.params.height, pins=pins)
+        self.wrapper = wrapper_verilog(
+            self.port_map, self.ports, self.params.width, self.params.height, pins=pins
+        )
 
     def digest(self):
         h = hashlib.sha256()
@@ -153,8 +183,10 @@ def _includes(files):
                     try:
                         found[name] = candidate.read_text()
                     except (OSError, UnicodeDecodeError) as exc:
-                        raise PortMapError(f"cannot read the included file {candidate}: "
-                                           f"{getattr(exc, 'strerror', None) or exc}") from None
+                        raise PortMapError(
+                            f"cannot read the included file {candidate}: "
+                            f"{getattr(exc, 'strerror', None) or exc}"
+                        ) from None
                     todo.append((candidate, candidate.parent))
                     break
     return found
@@ -192,20 +224,33 @@ def design_ports(sources, top, includes=None):
     with tempfile.TemporaryDirectory(prefix="fr-foreign-") as tmp:
         paths = _write_sources(tmp, sources, includes)
         code, output = run_captured(
-            [root / "bin" / "verilator", "--json-only", *_LINT_FLAGS, "--top-module", top,
-             f"-I{Path(tmp) / 'src'}",
-             "--Mdir", Path(tmp) / "obj", *paths],
-            cwd=tmp, env=dict(os.environ, VERILATOR_ROOT=str(root)),
+            [
+                root / "bin" / "verilator",
+                "--json-only",
+                *_LINT_FLAGS,
+                "--top-module",
+                top,
+                f"-I{Path(tmp) / 'src'}",
+                "--Mdir",
+                Path(tmp) / "obj",
+                *paths,
+            ],
+            cwd=tmp,
+            env=dict(os.environ, VERILATOR_ROOT=str(root)),
         )
         if code != 0:
             errors = [line for line in output.splitlines() if line.startswith("%Error")]
             first = (errors or output.strip().splitlines() or ["(no output)"])[0]
-            raise PortMapError(f"Verilator cannot read the design (top {top}): "
-                               f"{first.replace(str(Path(tmp) / 'src') + '/', '')}")
+            raise PortMapError(
+                f"Verilator cannot read the design (top {top}): "
+                f"{first.replace(str(Path(tmp) / 'src') + '/', '')}"
+            )
         tree = json.loads(next((Path(tmp) / "obj").glob("*.tree.json")).read_text())
     dtypes = _dtypes(tree, {})
-    module = next((m for m in tree["modulesp"] if m.get("origName", m["name"]) == top
-                   or m["name"] == top), None)
+    module = next(
+        (m for m in tree["modulesp"] if m.get("origName", m["name"]) == top or m["name"] == top),
+        None,
+    )
     if module is None:
         raise PortMapError(f"Verilator found no module {top}")
     ports = {}
@@ -214,8 +259,10 @@ def design_ports(sources, top, includes=None):
             continue
         direction = {"INPUT": "input", "OUTPUT": "output"}.get(var.get("direction"))
         if direction is None:
-            raise PortMapError(f"port {var['name']!r} of {top} is {var.get('direction')}: only "
-                               "inputs and outputs are supported")
+            raise PortMapError(
+                f"port {var['name']!r} of {top} is {var.get('direction')}: only "
+                "inputs and outputs are supported"
+            )
         dtype = dtypes.get(var.get("dtypep"), {})
         rng = dtype.get("range")
         width = 1
@@ -250,15 +297,17 @@ def wrapper_verilog(pm, ports, width, height, pins=False):
             f"  wire fr_end = pixels__valid && fr_addr == {aw}'d{last};\n"
             "  always @(posedge clk)\n"
             f"    if (rst) fr_next <= {aw}'d0;\n"
-            f"    else if (pixels__valid) fr_next <= fr_addr + {aw}'d1;")
+            f"    else if (pixels__valid) fr_next <= fr_addr + {aw}'d1;"
+        )
     if not pm.has_pixels:
         pass
     elif pm.style == "framebuffer":
         conns.append(f".{pm.data}(pixels__payload[11:0])")
         conns.append(f".{pm.address}(fr_addr)")
         if pm.new_frame:
-            body.append("  reg fr_new_frame;\n"
-                        "  always @(posedge clk) fr_new_frame <= !rst && fr_end;")
+            body.append(
+                "  reg fr_new_frame;\n  always @(posedge clk) fr_new_frame <= !rst && fr_end;"
+            )
             conns.append(f".{pm.new_frame}(fr_new_frame)")
     elif pm.payload:
         conns.append(f".{pm.payload}(pixels__payload)")
@@ -272,10 +321,12 @@ def wrapper_verilog(pm, ports, width, height, pins=False):
         width = ports[pm.color_port][1]
         cases = "\n".join(
             f"      3'd{code_of}: fr_sel = {width}'d{code};"
-            for code_of, code in sorted(
-(COLOR_SELECT[n], c) for n, c in pm.color_codes.items()))
-        body.append(f"  reg [{width - 1}:0] fr_sel;\n  always @* begin\n    case (color_sel)\n"
-                    f"{cases}\n      default: fr_sel = {width}'d0;\n    endcase\n  end")
+            for code_of, code in sorted((COLOR_SELECT[n], c) for n, c in pm.color_codes.items())
+        )
+        body.append(
+            f"  reg [{width - 1}:0] fr_sel;\n  always @* begin\n    case (color_sel)\n"
+            f"{cases}\n      default: fr_sel = {width}'d0;\n    endcase\n  end"
+        )
         conns.append(f".{pm.color_port}(fr_sel)")
     # The pin loop reads the per-frame outputs when frame_done rises; the frame harness reads
     # them `latency` edges after it (1 with after_cycles): on pins frame_done is delayed by
@@ -289,7 +340,8 @@ def wrapper_verilog(pm, ports, width, height, pins=False):
             "    if (rst) fr_read <= 32'd0;\n"
             f"    else if (fr_result) fr_read <= 32'd{delay};\n"
             "    else if (fr_read != 32'd0) fr_read <= fr_read - 32'd1;\n"
-            "  assign frame_done = fr_read == 32'd1;")
+            "  assign frame_done = fr_read == 32'd1;"
+        )
     if pm.strobe:
         conns.append(f".{pm.strobe}({done})")
     elif pm.has_pixels:
@@ -301,11 +353,17 @@ def wrapper_verilog(pm, ports, width, height, pins=False):
             "    if (rst) fr_wait <= 32'd0;\n"
             f"    else if (fr_end) fr_wait <= 32'd{pm.after_cycles};\n"
             "    else if (fr_wait != 32'd0) fr_wait <= fr_wait - 32'd1;\n"
-            f"  assign {done} = fr_wait == 32'd1;")
+            f"  assign {done} = fr_wait == 32'd1;"
+        )
     decls, header = [], []
-    for key, (out_width, _) in (("found", (1, 0)), ("proximity", (16, 0)),
-                                ("centroid_x", (16, 0)), ("centroid_leds", (16, 0)),
-                                ("motor_left", (16, 0)), ("motor_right", (16, 0))):
+    for key, (out_width, _) in (
+        ("found", (1, 0)),
+        ("proximity", (16, 0)),
+        ("centroid_x", (16, 0)),
+        ("centroid_leds", (16, 0)),
+        ("motor_left", (16, 0)),
+        ("motor_right", (16, 0)),
+    ):
         out = pm.outputs.get(key)
         if out is None:
             if not pins:
@@ -318,8 +376,11 @@ def wrapper_verilog(pm, ports, width, height, pins=False):
         if width == out_width:
             body.append(f"  assign {key} = fr_{key};")
         else:
-            fill = (f"{{{out_width - width}{{fr_{key}[{width - 1}]}}}}" if out.signed
-                    else f"{out_width - width}'d0")
+            fill = (
+                f"{{{out_width - width}{{fr_{key}[{width - 1}]}}}}"
+                if out.signed
+                else f"{out_width - width}'d0"
+            )
             body.append(f"  assign {key} = {{{fill}, fr_{key}}};")
     for name, value in pm.constants.items():
         conns.append(f".{name}({ports[name][1]}'d{value})")
@@ -333,12 +394,16 @@ def wrapper_verilog(pm, ports, width, height, pins=False):
         body.append('  import "DPI-C" function int fr_runtime_value(input int index);')
     for index, name in enumerate(() if pins else pm.runtime):
         width = ports[name][1]
-        body.append(f"  reg [{width - 1}:0] fr_rt_{index};\n"
-                    f"  always @(posedge clk) fr_rt_{index} <= fr_runtime_value({index});")
+        body.append(
+            f"  reg [{width - 1}:0] fr_rt_{index};\n"
+            f"  always @(posedge clk) fr_rt_{index} <= fr_runtime_value({index});"
+        )
         conns.append(f".{name}(fr_rt_{index})")
     if pm.filtered_valid:
-        conns += [f".{pm.filtered_valid}(filtered__valid)",
-                  f".{pm.filtered_payload}(filtered__payload)"]
+        conns += [
+            f".{pm.filtered_valid}(filtered__valid)",
+            f".{pm.filtered_payload}(filtered__payload)",
+        ]
     elif not pins:
         body.append("  assign filtered__valid = 1'b0;\n  assign filtered__payload = 14'd0;")
     conn_text = ",\n    ".join(conns)
@@ -365,8 +430,12 @@ endmodule
 def _pin_wrapper(pm, ports, outputs, decls, body, conns):
     header = ["input clk", "input rst"]
     if pm.has_pixels:
-        header += ["input pixels__valid", "input [13:0] pixels__payload", "input [2:0] color_sel",
-                   "output frame_done"]
+        header += [
+            "input pixels__valid",
+            "input [13:0] pixels__payload",
+            "input [2:0] color_sel",
+            "output frame_done",
+        ]
     if pm.filtered_valid:
         header += ["output filtered__valid", "output [13:0] filtered__payload"]
     header += outputs
@@ -396,8 +465,12 @@ def pin_ports(design):
     ``out``, width, signed), clock and reset left out (the pin driver's own)."""
     pm, ports = design.port_map, {}
     if pm.has_pixels:
-        ports.update(pixels__valid=("in", 1, False), pixels__payload=("in", 14, False),
-                     color_sel=("in", 3, False), frame_done=("out", 1, False))
+        ports.update(
+            pixels__valid=("in", 1, False),
+            pixels__payload=("in", 14, False),
+            color_sel=("in", 3, False),
+            frame_done=("out", 1, False),
+        )
     if pm.filtered_valid:
         ports.update(filtered__valid=("out", 1, False), filtered__payload=("out", 14, False))
     for key in OUTPUTS:
@@ -458,16 +531,18 @@ def foreign_build_plan(design):
     root = verilator_root()
     harness = read_sources(_HARNESS_FILES, HARNESS_DIR)
     cflags = " ".join([*CXX_FLAGS, "-DVL_USER_STOP", "-DVL_USER_FINISH"])
-    key = build_cache.build_key({
-        "flow": "verilator-foreign",
-        "abi": ABI_VERSION,
-        "source": design.digest(),
-        "hooks": digest(_HOOKS),
-        "harness": {f: digest(t) for f, t in harness.items()},
-        "flags": [*VERILATOR_FLAGS, cflags, *MAKE_FLAGS],
-        "compiler": compiler.version,
-        "verilator": verilator_version(),
-    })
+    key = build_cache.build_key(
+        {
+            "flow": "verilator-foreign",
+            "abi": ABI_VERSION,
+            "source": design.digest(),
+            "hooks": digest(_HOOKS),
+            "harness": {f: digest(t) for f, t in harness.items()},
+            "flags": [*VERILATOR_FLAGS, cflags, *MAKE_FLAGS],
+            "compiler": compiler.version,
+            "verilator": verilator_version(),
+        }
+    )
 
     def build(directory):
         paths = _write_sources(directory, design.sources, design.includes)
@@ -479,13 +554,33 @@ def foreign_build_plan(design):
         env = dict(os.environ, VERILATOR_ROOT=str(root))
         make_flags = [*MAKE_FLAGS, f"CXX={compiler.path}", f"LINK={compiler.path}"]
         run_tool(
-            [root / "bin" / "verilator", *VERILATOR_FLAGS, "-j", "2", f"-I{directory / 'src'}",
-             "--top-module", WRAPPER, "--prefix", "Vfollow_target",
-             "--Mdir", directory / "obj", "-CFLAGS", f"{cflags} -I{directory}",
-             "-LDFLAGS", "-shared", "-MAKEFLAGS", " ".join(make_flags),
-             "-o", directory / LIBRARY_NAME, directory / "fr_wrapper.v", *paths,
-             directory / "verilator_harness.cpp", directory / "fr_foreign_hooks.cpp"],
-            cwd=directory, env=env,
+            [
+                root / "bin" / "verilator",
+                *VERILATOR_FLAGS,
+                "-j",
+                "2",
+                f"-I{directory / 'src'}",
+                "--top-module",
+                WRAPPER,
+                "--prefix",
+                "Vfollow_target",
+                "--Mdir",
+                directory / "obj",
+                "-CFLAGS",
+                f"{cflags} -I{directory}",
+                "-LDFLAGS",
+                "-shared",
+                "-MAKEFLAGS",
+                " ".join(make_flags),
+                "-o",
+                directory / LIBRARY_NAME,
+                directory / "fr_wrapper.v",
+                *paths,
+                directory / "verilator_harness.cpp",
+                directory / "fr_foreign_hooks.cpp",
+            ],
+            cwd=directory,
+            env=env,
             what=f"building the Verilator model of {design.port_map.top}",
         )
 
@@ -504,24 +599,44 @@ class ForeignVerilatorBackend(HarnessFrames, DesignBackend):
     #: The simulator, as the build notice names it.
     flow = "Verilator"
 
-    def __init__(self, params=None, *, design=None, files=None, port_map=None, line_blank=0,
-                 frame_blank=0, waveform=None, on_build=None, fill_absent=False):
+    def __init__(
+        self,
+        params=None,
+        *,
+        design=None,
+        files=None,
+        port_map=None,
+        line_blank=0,
+        frame_blank=0,
+        waveform=None,
+        on_build=None,
+        fill_absent=False,
+    ):
         super().__init__(params, line_blank=line_blank, frame_blank=frame_blank)
         if waveform is not None:
             raise BackendError("the foreign Verilog backend writes no waveforms yet")
-        self.design = (design if design is not None
-                       else ForeignDesign(files, port_map, self.params))
-        if (self.design.params.width, self.design.params.height) != (self.params.width,
-                                                                    self.params.height):
+        self.design = design if design is not None else ForeignDesign(files, port_map, self.params)
+        if (self.design.params.width, self.design.params.height) != (
+            self.params.width,
+            self.params.height,
+        ):
             raise BackendError("the ForeignDesign was made for another frame size")
         self.fill_absent = fill_absent
         self._handle = None
-        notice = None if on_build is None else (
-            lambda: on_build(f"compiling the {self.flow} model of {self.design.port_map.top} "
-                             "(once; later runs load it from the cache)"))
+        notice = (
+            None
+            if on_build is None
+            else (
+                lambda: on_build(
+                    f"compiling the {self.flow} model of {self.design.port_map.top} "
+                    "(once; later runs load it from the cache)"
+                )
+            )
+        )
         self._runtime = dict(self.design.port_map.runtime)
-        self.cache_entry, self._library = load_built(self._build_plan(self.design),
-                                                     LIBRARY_NAME, _Library, on_build=notice)
+        self.cache_entry, self._library = load_built(
+            self._build_plan(self.design), LIBRARY_NAME, _Library, on_build=notice
+        )
         self._bind_hooks(self._library.lib)
         self._apply_runtime()
         self._handle = self._library.lib.fr_create()
@@ -529,10 +644,17 @@ class ForeignVerilatorBackend(HarnessFrames, DesignBackend):
         pixel_edges = p.height * (p.width + line_blank)
         self._out = np.zeros(_N_OUT, np.int64)
         self._args = np.array(
-            [p.width, p.height, 0, line_blank, frame_blank,
-             1 if pm.after_cycles else pm.latency,
-             pixel_edges + frame_blank + (pm.after_cycles or pm.latency) + pm.timeout],
-            np.int64)
+            [
+                p.width,
+                p.height,
+                0,
+                line_blank,
+                frame_blank,
+                1 if pm.after_cycles else pm.latency,
+                pixel_edges + frame_blank + (pm.after_cycles or pm.latency) + pm.timeout,
+            ],
+            np.int64,
+        )
         assert len(self._args) == _N_ARGS
         self._init_harness()
 
@@ -562,13 +684,19 @@ class ForeignVerilatorBackend(HarnessFrames, DesignBackend):
         pm = self.design.port_map
         if name not in pm.runtime:
             known = ", ".join(pm.runtime) or "none"
-            raise BackendError(f"{pm.top} has no [runtime] input {name!r} (its runtime "
-                               f"inputs: {known})")
+            raise BackendError(
+                f"{pm.top} has no [runtime] input {name!r} (its runtime inputs: {known})"
+            )
         width = self.design.ports[name][1]
-        if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or not (
-                0 <= value < 1 << width):
-            raise BackendError(f"runtime input {name!r} is {width} bits wide: the value must "
-                               f"be 0..{(1 << width) - 1}, got {value!r}")
+        if (
+            isinstance(value, bool)
+            or not isinstance(value, (int, np.integer))
+            or not (0 <= value < 1 << width)
+        ):
+            raise BackendError(
+                f"runtime input {name!r} is {width} bits wide: the value must "
+                f"be 0..{(1 << width) - 1}, got {value!r}"
+            )
         self._runtime[name] = int(value)
         self._apply_runtime()
 
@@ -584,14 +712,17 @@ class ForeignVerilatorBackend(HarnessFrames, DesignBackend):
         pm = self.design.port_map
         names = [n for n, c in COLOR_SELECT.items() if c == color_sel]
         if pm.color_port and names[0] not in pm.color_codes:
-            raise BackendError(f"{pm.top} has no code for colour {names[0]!r} "
-                               f"(color.codes: {', '.join(pm.color_codes)})")
+            raise BackendError(
+                f"{pm.top} has no code for colour {names[0]!r} "
+                f"(color.codes: {', '.join(pm.color_codes)})"
+            )
         self._args[2] = color_sel
         if self._runtime:
             self._apply_runtime()
         out = self._out
-        status = entry(self._handle, _address(frame), self._args_address, _address(filtered),
-                       self._out_address)
+        status = entry(
+            self._handle, _address(frame), self._args_address, _address(filtered), self._out_address
+        )
         index = self.frames_processed
         stopped = self._stop()
         if stopped:
@@ -602,12 +733,14 @@ class ForeignVerilatorBackend(HarnessFrames, DesignBackend):
         if status == 1:
             raise BackendError(
                 f"{pm.top}: frame {index}: timeout: the result strobe {pm.strobe!r} never "
-                f"rose within {pm.timeout} cycles (result.timeout) after the frame")
+                f"rose within {pm.timeout} cycles (result.timeout) after the frame"
+            )
         if status == 3 and pm.filtered_valid is None:
             status = 0
         if status != 0:
             message = _STATUS.get(status, f"harness status {status}").format(
-                cycles=int(out[0]), filtered=int(out[7]), pixels=filtered.size, bad=int(out[9]))
+                cycles=int(out[0]), filtered=int(out[7]), pixels=filtered.size, bad=int(out[9])
+            )
             raise BackendError(f"{pm.top}: frame {index}: {message}")
         absent = 0 if self.fill_absent else None
         values = {}

@@ -33,16 +33,16 @@ def open_foreign_frames(name, params, *, files, port_map, **kwargs):
     from .foreign_cxxrtl import ForeignCxxrtlBackend
 
     if name not in FOREIGN_BACKENDS:
-        raise BackendError(f"a Verilog design runs on the cxxrtl or verilator backend, not "
-                           f"{name!r}")
+        raise BackendError(
+            f"a Verilog design runs on the cxxrtl or verilator backend, not {name!r}"
+        )
     design = ForeignDesign(files, port_map, params)
     if name == "verilator" or (name == "auto" and verilator_only(design)):
         return ForeignVerilatorBackend(params, design=design, **kwargs)
     if name == "cxxrtl":
         reason = verilator_only(design)
         if reason:
-            raise BackendError(f"{design.port_map.top}: {reason}: run it with --backend "
-                               "verilator")
+            raise BackendError(f"{design.port_map.top}: {reason}: run it with --backend verilator")
         return ForeignCxxrtlBackend(params, design=design, **kwargs)
     try:
         return ForeignCxxrtlBackend(params, design=design, **kwargs)

@@ -30,8 +30,10 @@ def foreign_cxxrtl_plan(design):
     """The ``BuildPlan`` of a ``ForeignDesign`` (frames, no waveform) on CXXRTL."""
     pm = design.port_map
     if pm.runtime:
-        raise BackendError(f"{pm.top}'s [runtime] inputs are set through Verilator's DPI: run "
-                           "it with --backend verilator")
+        raise BackendError(
+            f"{pm.top}'s [runtime] inputs are set through Verilator's DPI: run "
+            "it with --backend verilator"
+        )
     return cxxrtl_build_plan(_YosysSource(design), "plain", include=runtime_include_dir())
 
 

@@ -9,7 +9,6 @@ reconstructed from the model at cycle level (see ``model_waveform``); it cannot 
 signals: use the ``pysim``, ``cxxrtl`` or ``verilator`` backend for those.
 """
 
-
 from ..models.follow_target import FollowTargetModel
 from .base import DesignBackend, FrameResult
 from .model_waveform import ModelWaveformWriter

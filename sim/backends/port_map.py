@@ -23,8 +23,16 @@ from ...hw.pixel import COLOR_SELECT
 from .base import BackendError
 
 __all__ = [
-    "OUTPUTS", "Output", "PortMap", "PortMapError", "check_connectors", "check_widths",
-    "follow_target_port_map", "load_port_map", "parse_port_map", "write_follow_target_port_map",
+    "OUTPUTS",
+    "Output",
+    "PortMap",
+    "PortMapError",
+    "check_connectors",
+    "check_widths",
+    "follow_target_port_map",
+    "load_port_map",
+    "parse_port_map",
+    "write_follow_target_port_map",
 ]
 
 #: Per-frame outputs a port map may name: FrameResult field -> (default width, signed).
@@ -37,12 +45,27 @@ OUTPUTS = {
     "motor_right": (16, True),
 }
 _STYLES = ("stream", "framebuffer")
-_TOP_KEYS = {"style", "top", "clock", "reset", "pixels", "color", "result", "outputs", "filtered",
-             "constants", "runtime", "connectors", "extra_outputs"}
+_TOP_KEYS = {
+    "style",
+    "top",
+    "clock",
+    "reset",
+    "pixels",
+    "color",
+    "result",
+    "outputs",
+    "filtered",
+    "constants",
+    "runtime",
+    "connectors",
+    "extra_outputs",
+}
 #: Connector kinds the map binds elsewhere: the camera by ``pixels``/``color``, the wheels by
 #: ``outputs.motor_left``/``motor_right``.
-_BOUND_ELSEWHERE = {"camera": "pixels and color", "wheels": "outputs.motor_left and "
-                    "outputs.motor_right"}
+_BOUND_ELSEWHERE = {
+    "camera": "pixels and color",
+    "wheels": "outputs.motor_left and outputs.motor_right",
+}
 #: Outputs read when the frame's result is ready: they need a pixel stream.
 _FRAME_ONLY = ("found", "proximity", "centroid_x", "centroid_leds")
 #: At most this many ``[runtime]`` inputs.
@@ -98,8 +121,11 @@ class PortMap:
 
     def connector_ports(self):
         """Design port -> its key ``connectors.<kind>.<pin>``."""
-        return {port: f"connectors.{kind}.{pin}" for kind, pins in self.connectors.items()
-                for pin, port in pins.items()}
+        return {
+            port: f"connectors.{kind}.{pin}"
+            for kind, pins in self.connectors.items()
+            for pin, port in pins.items()
+        }
 
     def inputs(self):
         """Input port name -> expected width (None: checked elsewhere). Connector ports are
@@ -175,8 +201,9 @@ def _unknown(table, allowed, where):
 def _int(table, key, where, default, low, high):
     value = table.get(key, default)
     if isinstance(value, bool) or not isinstance(value, int) or not low <= value <= high:
-        raise PortMapError(f"port map: {where}.{key} must be an integer in {low}..{high}, "
-                           f"got {value!r}")
+        raise PortMapError(
+            f"port map: {where}.{key} must be an integer in {low}..{high}, got {value!r}"
+        )
     return value
 
 
@@ -206,8 +233,10 @@ def parse_port_map(data):
     if not pixels:
         for key in ("color", "result", "filtered"):
             if key in data:
-                raise PortMapError(f"port map: [{key}] goes with a pixel stream; this map has "
-                                   "no pixels (a design without a camera)")
+                raise PortMapError(
+                    f"port map: [{key}] goes with a pixel stream; this map has "
+                    "no pixels (a design without a camera)"
+                )
     elif style == "framebuffer":
         _unknown(pixels, {"write_enable", "address", "data", "new_frame"}, "pixels.")
         valid = _name(pixels, "write_enable", "pixels")
@@ -220,13 +249,14 @@ def parse_port_map(data):
         payload = _name(pixels, "payload", "pixels", required=False)
         data_port = _name(pixels, "data", "pixels", required=False)
         if (payload is None) == (data_port is None):
-            raise PortMapError("port map: give pixels.payload (14 bits with the first/last "
-                               "flags) or pixels.data (12-bit RGB444), not both or neither")
+            raise PortMapError(
+                "port map: give pixels.payload (14 bits with the first/last "
+                "flags) or pixels.data (12-bit RGB444), not both or neither"
+            )
         first = _name(pixels, "first", "pixels", required=False)
         last = _name(pixels, "last", "pixels", required=False)
         if payload is not None and (first or last):
-            raise PortMapError("port map: pixels.first/last go with pixels.data, not with "
-                               "payload")
+            raise PortMapError("port map: pixels.first/last go with pixels.data, not with payload")
 
     color = _table(data, "color", "", required=False)
     _unknown(color, {"port", "width", "codes"}, "color.")
@@ -238,8 +268,9 @@ def parse_port_map(data):
         raise PortMapError("port map: color.codes must be a table of colour = code")
     for name, code in codes.items():
         if name not in COLOR_SELECT:
-            raise PortMapError(f"port map: color.codes: unknown colour {name!r}; "
-                               f"known: {', '.join(COLOR_SELECT)}")
+            raise PortMapError(
+                f"port map: color.codes: unknown colour {name!r}; known: {', '.join(COLOR_SELECT)}"
+            )
         if isinstance(code, bool) or not isinstance(code, int) or code < 0:
             raise PortMapError(f"port map: color.codes.{name} must be an integer >= 0")
     color_width = color.get("width")
@@ -248,13 +279,15 @@ def parse_port_map(data):
 
     result = _table(data, "result", "", required=bool(pixels))
     _unknown(result, {"strobe", "latency", "timeout", "after_cycles"}, "result.")
-    strobe = _name(result, "strobe", "result",
-                   required=bool(pixels) and "after_cycles" not in result)
+    strobe = _name(
+        result, "strobe", "result", required=bool(pixels) and "after_cycles" not in result
+    )
     after_cycles = None
     if "after_cycles" in result:
         if strobe is not None or "latency" in result:
-            raise PortMapError("port map: give result.strobe (and latency) or "
-                               "result.after_cycles, not both")
+            raise PortMapError(
+                "port map: give result.strobe (and latency) or result.after_cycles, not both"
+            )
         after_cycles = _int(result, "after_cycles", "result", None, 1, 1 << 20)
     latency = _int(result, "latency", "result", 0, 0, 1 << 20)
     timeout = _int(result, "timeout", "result", 100_000, 1, 1 << 30)
@@ -280,16 +313,20 @@ def parse_port_map(data):
     extra = _table(data, "extra_outputs", "", required=False)
     for name, port in extra.items():
         if not name.isidentifier() or name in OUTPUTS:
-            raise PortMapError(f"port map: extra_outputs.{name}: the name must be a Python "
-                               f"name other than the [outputs] keys")
+            raise PortMapError(
+                f"port map: extra_outputs.{name}: the name must be a Python "
+                f"name other than the [outputs] keys"
+            )
         _name(extra, name, "extra_outputs")
     if not outputs and not extra and not connectors:
         raise PortMapError("port map: [outputs] names no output")
     if not pixels:
         frame_only = [k for k in _FRAME_ONLY if k in outputs]
         if frame_only:
-            raise PortMapError(f"port map: outputs.{frame_only[0]} is read when a frame's "
-                               "result is ready: it needs a pixel stream (pixels)")
+            raise PortMapError(
+                f"port map: outputs.{frame_only[0]} is read when a frame's "
+                "result is ready: it needs a pixel stream (pixels)"
+            )
 
     filtered = _table(data, "filtered", "", required=False)
     _unknown(filtered, {"valid", "payload"}, "filtered.")
@@ -303,38 +340,75 @@ def parse_port_map(data):
         if not name.isidentifier():
             raise PortMapError(f"port map: constants.{name}: not a port name")
         if isinstance(value, bool) or not isinstance(value, int) or value < 0:
-            raise PortMapError(f"port map: constants.{name} must be an integer >= 0, got "
-                               f"{value!r}")
+            raise PortMapError(f"port map: constants.{name} must be an integer >= 0, got {value!r}")
     # Inputs held at a value the host sets between frames (a mutant select, a mode):
     # [runtime] port = initial value.
     runtime = _table(data, "runtime", "", required=False)
     if len(runtime) > MAX_RUNTIME:
-        raise PortMapError(f"port map: [runtime] names {len(runtime)} inputs (at most "
-                           f"{MAX_RUNTIME})")
+        raise PortMapError(
+            f"port map: [runtime] names {len(runtime)} inputs (at most {MAX_RUNTIME})"
+        )
     for name, value in runtime.items():
         if not name.isidentifier():
             raise PortMapError(f"port map: runtime.{name}: not a port name")
         if isinstance(value, bool) or not isinstance(value, int) or value < 0:
-            raise PortMapError(f"port map: runtime.{name} must be an integer >= 0 (its "
-                               f"initial value), got {value!r}")
+            raise PortMapError(
+                f"port map: runtime.{name} must be an integer >= 0 (its "
+                f"initial value), got {value!r}"
+            )
     port_map = PortMap(
-        top=top, clock=_name(clock, "port", "clock"),
+        top=top,
+        clock=_name(clock, "port", "clock"),
         reset=_name(reset, "port", "reset", required=bool(reset)),
-        reset_active_low=active_low, valid=valid, payload=payload,
-        data=data_port, first=first, last=last, color_port=color_port, color_codes=codes,
-        color_width=color_width, strobe=strobe, latency=latency, timeout=timeout,
-        outputs=outputs, filtered_valid=f_valid, filtered_payload=f_payload, style=style,
-        address=address, new_frame=new_frame, after_cycles=after_cycles,
-        constants=dict(constants), runtime=dict(runtime), connectors=connectors,
+        reset_active_low=active_low,
+        valid=valid,
+        payload=payload,
+        data=data_port,
+        first=first,
+        last=last,
+        color_port=color_port,
+        color_codes=codes,
+        color_width=color_width,
+        strobe=strobe,
+        latency=latency,
+        timeout=timeout,
+        outputs=outputs,
+        filtered_valid=f_valid,
+        filtered_payload=f_payload,
+        style=style,
+        address=address,
+        new_frame=new_frame,
+        after_cycles=after_cycles,
+        constants=dict(constants),
+        runtime=dict(runtime),
+        connectors=connectors,
         extra_outputs=dict(extra),
     )
     pm = port_map
-    names = [n for n in (pm.clock, pm.reset, pm.valid, pm.payload, pm.data, pm.first, pm.last,
-                         pm.address, pm.new_frame, pm.color_port, pm.strobe,
-                         *(o.port for o in pm.outputs.values()), pm.filtered_valid,
-                         pm.filtered_payload, *pm.constants, *pm.runtime,
-                         *pm.extra_outputs.values(),
-                         *(p for pins in pm.connectors.values() for p in pins.values())) if n]
+    names = [
+        n
+        for n in (
+            pm.clock,
+            pm.reset,
+            pm.valid,
+            pm.payload,
+            pm.data,
+            pm.first,
+            pm.last,
+            pm.address,
+            pm.new_frame,
+            pm.color_port,
+            pm.strobe,
+            *(o.port for o in pm.outputs.values()),
+            pm.filtered_valid,
+            pm.filtered_payload,
+            *pm.constants,
+            *pm.runtime,
+            *pm.extra_outputs.values(),
+            *(p for pins in pm.connectors.values() for p in pins.values()),
+        )
+        if n
+    ]
     dup = sorted({n for n in names if names.count(n) > 1})
     if dup:
         raise PortMapError(f"port map: port {dup[0]!r} is mapped more than once")
@@ -351,10 +425,12 @@ def _connectors(data):
         if not kind.isidentifier():
             raise PortMapError(f"port map: {where}: not a connector kind")
         if kind in _BOUND_ELSEWHERE:
-            raise PortMapError(f"port map: {where}: the {kind} is bound by "
-                               f"{_BOUND_ELSEWHERE[kind]}, not a [connectors] table")
+            raise PortMapError(
+                f"port map: {where}: the {kind} is bound by "
+                f"{_BOUND_ELSEWHERE[kind]}, not a [connectors] table"
+            )
         if not isinstance(pins, dict) or not pins:
-            raise PortMapError(f"port map: {where} must be a table of pin = \"port\"")
+            raise PortMapError(f'port map: {where} must be a table of pin = "port"')
         for pin in pins:
             _name(pins, pin, where)
         out[kind] = dict(pins)
@@ -382,46 +458,63 @@ def check_widths(port_map, ports, pixels=None):
     for direction, wanted in (("input", port_map.inputs()), ("output", port_map.output_ports())):
         for name, width in wanted.items():
             if name not in ports:
-                raise PortMapError(f"port map: the design {port_map.top} has no port {name!r} "
-                                   f"(its ports: {', '.join(ports)})")
+                raise PortMapError(
+                    f"port map: the design {port_map.top} has no port {name!r} "
+                    f"(its ports: {', '.join(ports)})"
+                )
             actual_dir, actual_width, _ = ports[name]
             if actual_dir != direction:
-                raise PortMapError(f"port map: port {name!r} of {port_map.top} is an "
-                                   f"{actual_dir}, the map uses it as an {direction}")
+                raise PortMapError(
+                    f"port map: port {name!r} of {port_map.top} is an "
+                    f"{actual_dir}, the map uses it as an {direction}"
+                )
             if width is not None and actual_width != width:
-                raise PortMapError(f"port map: port {name!r} of {port_map.top} is "
-                                   f"{actual_width} bits wide, the map expects {width}")
+                raise PortMapError(
+                    f"port map: port {name!r} of {port_map.top} is "
+                    f"{actual_width} bits wide, the map expects {width}"
+                )
             if actual_width > 32:
-                raise PortMapError(f"port map: port {name!r} is {actual_width} bits wide "
-                                   "(at most 32)")
+                raise PortMapError(
+                    f"port map: port {name!r} is {actual_width} bits wide (at most 32)"
+                )
     if port_map.address and pixels is not None:
         width = ports[port_map.address][1]
         if (pixels - 1) >> width:
-            raise PortMapError(f"port map: the {width}-bit address port {port_map.address!r} "
-                               f"cannot address {pixels} pixels")
+            raise PortMapError(
+                f"port map: the {width}-bit address port {port_map.address!r} "
+                f"cannot address {pixels} pixels"
+            )
     if port_map.color_port:
         width = ports[port_map.color_port][1]
         too_big = [n for n, c in port_map.color_codes.items() if c >= 1 << width]
         if too_big:
-            raise PortMapError(f"port map: color.codes.{too_big[0]} does not fit the "
-                               f"{width}-bit port {port_map.color_port!r}")
+            raise PortMapError(
+                f"port map: color.codes.{too_big[0]} does not fit the "
+                f"{width}-bit port {port_map.color_port!r}"
+            )
     for table, values in (("constants", port_map.constants), ("runtime", port_map.runtime)):
         for name, value in values.items():
             if value >> ports[name][1]:
-                raise PortMapError(f"port map: {table}.{name} = {value} does not fit the "
-                                   f"{ports[name][1]}-bit port")
+                raise PortMapError(
+                    f"port map: {table}.{name} = {value} does not fit the {ports[name][1]}-bit port"
+                )
     for port, key in port_map.connector_ports().items():
         if port not in ports:
-            raise PortMapError(f"port map: {key}: the design {port_map.top} has no port "
-                               f"{port!r} (its ports: {', '.join(ports)})")
+            raise PortMapError(
+                f"port map: {key}: the design {port_map.top} has no port "
+                f"{port!r} (its ports: {', '.join(ports)})"
+            )
         if ports[port][1] > 32:
-            raise PortMapError(f"port map: {key}: port {port!r} is {ports[port][1]} bits wide "
-                               "(at most 32)")
+            raise PortMapError(
+                f"port map: {key}: port {port!r} is {ports[port][1]} bits wide (at most 32)"
+            )
     mapped = {**port_map.inputs(), **port_map.connector_ports()}
     unconnected = [n for n, (d, _, _) in ports.items() if d == "input" and n not in mapped]
     if unconnected:
-        raise PortMapError(f"port map: input {unconnected[0]!r} of {port_map.top} is not "
-                           "mapped (every input must be driven)")
+        raise PortMapError(
+            f"port map: input {unconnected[0]!r} of {port_map.top} is not "
+            "mapped (every input must be driven)"
+        )
 
 
 def check_connectors(port_map, ports, kinds):
@@ -431,27 +524,37 @@ def check_connectors(port_map, ports, kinds):
     key of the first problem."""
     for kind, pins in port_map.connectors.items():
         if kind not in kinds:
-            raise PortMapError(f"port map: connectors.{kind}: unknown connector kind; known: "
-                               f"{', '.join(sorted(kinds))}")
+            raise PortMapError(
+                f"port map: connectors.{kind}: unknown connector kind; known: "
+                f"{', '.join(sorted(kinds))}"
+            )
         known = kinds[kind]
         for pin, port in pins.items():
             key = f"connectors.{kind}.{pin}"
             if pin not in known:
-                raise PortMapError(f"port map: {key}: the {kind} connector has no pin {pin!r}; "
-                                   f"its pins: {', '.join(known)}")
+                raise PortMapError(
+                    f"port map: {key}: the {kind} connector has no pin {pin!r}; "
+                    f"its pins: {', '.join(known)}"
+                )
             if port not in ports:
-                raise PortMapError(f"port map: {key}: the design {port_map.top} has no port "
-                                   f"{port!r} (its ports: {', '.join(ports)})")
+                raise PortMapError(
+                    f"port map: {key}: the design {port_map.top} has no port "
+                    f"{port!r} (its ports: {', '.join(ports)})"
+                )
             direction, width = known[pin]
             wanted = {"in": "input", "out": "output"}[direction]
             actual_dir, actual_width, _ = ports[port]
             if actual_dir != wanted:
-                raise PortMapError(f"port map: {key}: port {port!r} of {port_map.top} is an "
-                                   f"{actual_dir}; the {kind} pin {pin!r} needs an {wanted}")
+                raise PortMapError(
+                    f"port map: {key}: port {port!r} of {port_map.top} is an "
+                    f"{actual_dir}; the {kind} pin {pin!r} needs an {wanted}"
+                )
             if actual_width > width:
-                raise PortMapError(f"port map: {key}: port {port!r} of {port_map.top} is "
-                                   f"{actual_width} bits wide; the {kind} pin {pin!r} takes "
-                                   + (f"{width} bit" if width == 1 else f"at most {width} bits"))
+                raise PortMapError(
+                    f"port map: {key}: port {port!r} of {port_map.top} is "
+                    f"{actual_width} bits wide; the {kind} pin {pin!r} takes "
+                    + (f"{width} bit" if width == 1 else f"at most {width} bits")
+                )
 
 
 #: The port map of the exported ``follow_target`` (docs/foreign.md).

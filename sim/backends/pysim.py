@@ -167,8 +167,11 @@ class PysimBackend(DesignBackend):
         try:
             result = self._submit(("frame", packed, color_sel))
         finally:
-            if (recording is not None and recording.start is not None
-                    and index >= self.waveform.last_frame):
+            if (
+                recording is not None
+                and recording.start is not None
+                and index >= self.waveform.last_frame
+            ):
                 self._finish_trace()
         return result
 
@@ -319,8 +322,9 @@ class _Recording:
 
     def __init__(self, sim, path):
         path = Path(os.path.abspath(os.fspath(path)))
-        fd, raw = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=".untrimmed.vcd",
-                                   dir=path.parent)
+        fd, raw = tempfile.mkstemp(
+            prefix=f".{path.stem}.", suffix=".untrimmed.vcd", dir=path.parent
+        )
         os.close(fd)
         self.raw = Path(raw)
         self._cleanup = weakref.finalize(self, self.raw.unlink, missing_ok=True)

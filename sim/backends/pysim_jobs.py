@@ -45,8 +45,9 @@ class JobLoop:
 
     def submit(self, job):
         if self._broken is not None:
-            raise self._error(f"the pysim simulation failed earlier ({self._broken}); create a "
-                              "new backend")
+            raise self._error(
+                f"the pysim simulation failed earlier ({self._broken}); create a new backend"
+            )
         self.start()
         self._job, self._outcome = job, None
         advance = self._sim.advance

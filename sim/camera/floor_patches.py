@@ -41,8 +41,12 @@ def patch_index(polygons, x, y):
         py = np.array([p[1] for p in poly], dtype=float)
         # Only the points in the polygon's bounding box are tested edge by edge: a marking's
         # narrow strips cover a small part of the floor.
-        box = ((flat_x >= px.min()) & (flat_x <= px.max()) & (flat_y >= py.min())
-               & (flat_y <= py.max()))
+        box = (
+            (flat_x >= px.min())
+            & (flat_x <= px.max())
+            & (flat_y >= py.min())
+            & (flat_y <= py.max())
+        )
         idx = np.flatnonzero(box)
         if idx.size == 0:
             continue
@@ -69,8 +73,9 @@ def paint_floor_patches(renderer, scene, pose, shade):
     (the floor's, ``camera.floor_shade``)."""
     plain = dataclasses.replace(scene, floor_patches=())
     image = renderer.render(plain, pose)
-    other = renderer.render(dataclasses.replace(plain, floor_color=_other_floor(scene.floor_color)),
-                            pose)
+    other = renderer.render(
+        dataclasses.replace(plain, floor_color=_other_floor(scene.floor_color)), pose
+    )
     # Channel by channel: several times faster than .any(axis=2) on a (H, W, 3) array.
     changed = image[..., 0] != other[..., 0]
     changed |= image[..., 1] != other[..., 1]

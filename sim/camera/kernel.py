@@ -19,8 +19,15 @@ __all__ = ["camera_kernel"]
 _SOURCE = Path(__file__).resolve().parent / "kernel.cpp"
 _LIBRARY = "libcamera_kernel.so"
 #: No fused multiply-adds and no fast-math: the hits must be numpy's to the last bit.
-_FLAGS = ("-std=c++17", "-O2", "-ffp-contract=off", "-fno-fast-math", "-fPIC",
-          "-fvisibility=hidden", "-shared")
+_FLAGS = (
+    "-std=c++17",
+    "-O2",
+    "-ffp-contract=off",
+    "-fno-fast-math",
+    "-fPIC",
+    "-fvisibility=hidden",
+    "-shared",
+)
 _VP = ctypes.c_void_p
 _I64 = ctypes.c_int64
 
@@ -38,19 +45,60 @@ class CameraKernel:
             raise OSError("unexpected camera_kernel library version")
         paint = lib.fr_camera_paint
         paint.restype = None
-        paint.argtypes = [_VP, _I64, _VP, _I64, _I64, _VP, _VP, _VP, _VP, _I64, _VP, _I64, _VP,
-                              _VP]
+        paint.argtypes = [_VP, _I64, _VP, _I64, _I64, _VP, _VP, _VP, _VP, _I64, _VP, _I64, _VP, _VP]
         self.paint = paint
         hits = lib.fr_camera_hits
         hits.restype = None
         _D = ctypes.c_double
-        hits.argtypes = [_I64, _VP, _VP, _D, _D, _D, _D, _I64, _VP, _I64, _VP, _I64, _VP, _D,
-                         _D, _D, _D, _D, _VP, _VP, _VP]
+        hits.argtypes = [
+            _I64,
+            _VP,
+            _VP,
+            _D,
+            _D,
+            _D,
+            _D,
+            _I64,
+            _VP,
+            _I64,
+            _VP,
+            _I64,
+            _VP,
+            _D,
+            _D,
+            _D,
+            _D,
+            _D,
+            _VP,
+            _VP,
+            _VP,
+        ]
         self.hits = hits
         layers = lib.fr_camera_layers
         layers.restype = _I64
-        layers.argtypes = [_I64, _I64, _I64, _VP, _VP, _VP, _VP, _VP, _D, _D, _D, _I64, _I64,
-                           _D, _D, _D, _D, _D, _D, _VP, _VP]
+        layers.argtypes = [
+            _I64,
+            _I64,
+            _I64,
+            _VP,
+            _VP,
+            _VP,
+            _VP,
+            _VP,
+            _D,
+            _D,
+            _D,
+            _I64,
+            _I64,
+            _D,
+            _D,
+            _D,
+            _D,
+            _D,
+            _D,
+            _VP,
+            _VP,
+        ]
         self.layers = layers
         self.path = path
 
@@ -78,8 +126,13 @@ class NoiseTable:
         self.base = int(table[0])
         self.steps = len(self.at) if monotone and len(self.at) <= MAX_STEPS else 0
         #: The paint call's last five arguments, after the noise indices.
-        self.arguments = (self.block.ctypes.data, self.sub.ctypes.data, self.steps,
-                          self.at.ctypes.data if len(self.at) else None, self.base)
+        self.arguments = (
+            self.block.ctypes.data,
+            self.sub.ctypes.data,
+            self.steps,
+            self.at.ctypes.data if len(self.at) else None,
+            self.base,
+        )
 
 
 @functools.cache
@@ -93,18 +146,22 @@ def camera_kernel():
     try:
         compiler = find_compiler()
         source = _SOURCE.read_text()
-        key = build_cache.build_key({
-            "flow": "camera-kernel",
-            "source": hashlib.sha256(source.encode()).hexdigest(),
-            "flags": list(_FLAGS),
-            "compiler": compiler.version,
-        })
+        key = build_cache.build_key(
+            {
+                "flow": "camera-kernel",
+                "source": hashlib.sha256(source.encode()).hexdigest(),
+                "flags": list(_FLAGS),
+                "compiler": compiler.version,
+            }
+        )
 
         def build(directory):
             (directory / _SOURCE.name).write_text(source)
-            run_tool([compiler.path, *_FLAGS, directory / _SOURCE.name, "-o",
-                      directory / _LIBRARY], cwd=directory,
-                     what=f"compiling the camera's pixel stage ({compiler.path})")
+            run_tool(
+                [compiler.path, *_FLAGS, directory / _SOURCE.name, "-o", directory / _LIBRARY],
+                cwd=directory,
+                what=f"compiling the camera's pixel stage ({compiler.path})",
+            )
 
         entry = build_cache.get_or_build("camera-kernel", key, [_LIBRARY], build)
         return CameraKernel(entry.file(_LIBRARY))

@@ -162,8 +162,11 @@ def _cylinder_arrays(cylinders, previous=None):
     for i, c in enumerate(cylinders):
         centres[i] = (c.x, c.y, c.radius)
     bands = tuple(c.bands for c in cylinders)
-    same_bands = previous is not None and len(previous.bands) == len(bands) and all(
-        a is b for a, b in zip(bands, previous.bands))
+    same_bands = (
+        previous is not None
+        and len(previous.bands) == len(bands)
+        and all(a is b for a, b in zip(bands, previous.bands))
+    )
     if not same_bands:
         owner, z, albedo = [], [], []
         for i, c in enumerate(cylinders):
@@ -175,9 +178,17 @@ def _cylinder_arrays(cylinders, previous=None):
         raise ValueError("cylinders need finite centres and a radius > 0")
     centres = np.ascontiguousarray(centres.T)
     if same_bands:
-        return _Cylinders(centres[0], centres[1], centres[2], previous.band_owner,
-                          previous.band_z0, previous.band_z1, previous.band_albedo, bands,
-                          centres)
+        return _Cylinders(
+            centres[0],
+            centres[1],
+            centres[2],
+            previous.band_owner,
+            previous.band_z0,
+            previous.band_z1,
+            previous.band_albedo,
+            bands,
+            centres,
+        )
     z = np.ascontiguousarray(np.asarray(z, dtype=float).reshape(-1, 2).T)
     return _Cylinders(
         centres[0],
@@ -326,9 +337,13 @@ class CameraRenderer:
             (height, width, 3) uint8 RGB image.
         """
         if not isinstance(scene, Scene):
-            raise TypeError(f"scene must be a fpga_robotics.sim.camera.scene.Scene, not {type(scene)}")
+            raise TypeError(
+                f"scene must be a fpga_robotics.sim.camera.scene.Scene, not {type(scene)}"
+            )
         if not isinstance(pose, CameraPose):
-            raise TypeError(f"pose must be a fpga_robotics.sim.camera.scene.CameraPose, not {type(pose)}")
+            raise TypeError(
+                f"pose must be a fpga_robotics.sim.camera.scene.CameraPose, not {type(pose)}"
+            )
         if noise_std:
             _check_noise(noise_std, rng)
         if scene.floor_patches:
@@ -368,8 +383,17 @@ class CameraRenderer:
                 indices = self._noise_indices(rng)  # held until the call returns
                 noise = indices.__array_interface__["data"][0]
         with rng.bit_generator.lock if noise_std else contextlib.nullcontext():
-            self._kernel.paint(starts_at, starts.shape[1], palette_at, self.width, self.height,
-                               image.__array_interface__["data"][0], noise, *table, *draw)
+            self._kernel.paint(
+                starts_at,
+                starts.shape[1],
+                palette_at,
+                self.width,
+                self.height,
+                image.__array_interface__["data"][0],
+                noise,
+                *table,
+                *draw,
+            )
         return image
 
     def _direct_draw(self, rng):
@@ -381,8 +405,11 @@ class CameraRenderer:
             return None, None
         if self._draw_for is None or self._draw_for[0] is not bits:
             c = bits.ctypes
-            self._draw_for = (bits, ctypes.cast(c.next_uint64, ctypes.c_void_p).value,
-                              c.state_address)
+            self._draw_for = (
+                bits,
+                ctypes.cast(c.next_uint64, ctypes.c_void_p).value,
+                c.state_address,
+            )
         return self._draw_for[1:]
 
     def _noise_indices(self, rng):
@@ -432,8 +459,7 @@ class CameraRenderer:
         ceiling = float(scene.ceiling_height)
         if not (0.0 < h < ceiling):
             raise ValueError(
-                f"camera height {h} m must be between the floor (0) and the ceiling "
-                f"({ceiling} m)"
+                f"camera height {h} m must be between the floor (0) and the ceiling ({ceiling} m)"
             )
         if abs(tilt) > self.max_tilt:
             raise ValueError(
@@ -453,8 +479,9 @@ class CameraRenderer:
         hits = self._hits_compiled if self._kernel is not None else self._hits
         depth, shade = hits(walls, cyls, cx, cy, pose.heading, ambient, intensity, light)
         if self._kernel is not None and tilt == 0.0:
-            layers = self._layers_compiled(depth, shade, z0, z1, albedo, h, horizon, floor_rgb,
-                                           ceil_rgb)
+            layers = self._layers_compiled(
+                depth, shade, z0, z1, albedo, h, horizon, floor_rgb, ceil_rgb
+            )
             if layers is not None:
                 return layers
             return self._paint_background(horizon, floor_rgb, ceil_rgb)
@@ -523,14 +550,30 @@ class CameraRenderer:
             runs = 2 * self.max_layers + 2
             self._layer_starts = np.empty(W * runs, dtype=np.int32)
             self._layer_palette = np.empty(W * runs, dtype=np.uint32)
-            self._layer_addresses = (self._layer_starts.ctypes.data,
-                                     self._layer_palette.ctypes.data)
+            self._layer_addresses = (
+                self._layer_starts.ctypes.data,
+                self._layer_palette.ctypes.data,
+            )
         depth_at, shade_at = self._hit_addresses
         z0_at, z1_at, albedo_at = self._surfaces_addresses
         k = self._kernel.layers(
-            W, self.height, n, depth_at, shade_at, z0_at, z1_at, albedo_at, h, self._row_axis,
-            self.focal, self.max_layers, horizon, *map(float, ceil_rgb), *map(float, floor_rgb),
-            *self._layer_addresses)
+            W,
+            self.height,
+            n,
+            depth_at,
+            shade_at,
+            z0_at,
+            z1_at,
+            albedo_at,
+            h,
+            self._row_axis,
+            self.focal,
+            self.max_layers,
+            horizon,
+            *map(float, ceil_rgb),
+            *map(float, floor_rgb),
+            *self._layer_addresses,
+        )
         if k == 0:
             return None
         runs = 2 * k + 2
@@ -605,10 +648,27 @@ class CameraRenderer:
         if cyls.band_owner is not self._hit_owner:
             self._hit_owner, self._owner_address = cyls.band_owner, _address(cyls.band_owner)
         self._kernel.hits(
-            self.width, self._slope_address, self._slope_sq1_address, math.cos(heading),
-            math.sin(heading), cx, cy, n_walls, self._walls_address, n_cyls,
-            _address(cyls.centres), n_bands, self._owner_address, NEAR, ambient, intensity,
-            float(light[0]), float(light[1]), self._scratch_address, *self._hit_addresses)
+            self.width,
+            self._slope_address,
+            self._slope_sq1_address,
+            math.cos(heading),
+            math.sin(heading),
+            cx,
+            cy,
+            n_walls,
+            self._walls_address,
+            n_cyls,
+            _address(cyls.centres),
+            n_bands,
+            self._owner_address,
+            NEAR,
+            ambient,
+            intensity,
+            float(light[0]),
+            float(light[1]),
+            self._scratch_address,
+            *self._hit_addresses,
+        )
         return self._hit_scratch
 
     def _rows_covered(self, depth, z0, z1, h, tilt):

@@ -29,12 +29,20 @@ def action(params, seen, side):
         other = "right" if params.edge_side == "left" else "left"
         return f"gentle_{params.edge_side if seen[0] else other}", side
     if params.n_sensors == 2:
-        return {(0, 0): "straight", (1, 1): "straight",
-                (1, 0): "sharp_left", (0, 1): "sharp_right"}[seen], side
+        return {
+            (0, 0): "straight",
+            (1, 1): "straight",
+            (1, 0): "sharp_left",
+            (0, 1): "sharp_right",
+        }[seen], side
     table = {
-        (0, 1, 0): "straight", (1, 1, 1): "straight", (1, 0, 1): "straight",
-        (1, 0, 0): "sharp_left", (1, 1, 0): "gentle_left",
-        (0, 0, 1): "sharp_right", (0, 1, 1): "gentle_right",
+        (0, 1, 0): "straight",
+        (1, 1, 1): "straight",
+        (1, 0, 1): "straight",
+        (1, 0, 0): "sharp_left",
+        (1, 1, 0): "gentle_left",
+        (0, 0, 1): "sharp_right",
+        (0, 1, 1): "gentle_right",
     }
     return table.get(seen, f"search_{side}"), side
 

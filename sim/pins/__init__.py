@@ -7,9 +7,21 @@ from .design import FILTERED_PORTS, PIXEL_PORTS, PinDesignSource, follow_target_
 from .timing import real_clock_timing
 from .verilog import VerilogPinSource
 
-__all__ = ["FILTERED_PORTS", "PIN_BACKENDS", "PIXEL_PORTS", "PinBackend", "PinDesignSource",
-           "PinError", "PixelTiming", "Port", "Stop", "VerilogPinSource", "follow_target_source",
-           "get_pin_backend", "real_clock_timing"]
+__all__ = [
+    "FILTERED_PORTS",
+    "PIN_BACKENDS",
+    "PIXEL_PORTS",
+    "PinBackend",
+    "PinDesignSource",
+    "PinError",
+    "PixelTiming",
+    "Port",
+    "Stop",
+    "VerilogPinSource",
+    "follow_target_source",
+    "get_pin_backend",
+    "real_clock_timing",
+]
 
 #: Backend names ``get_pin_backend`` accepts; ``auto`` tries the compiled ones fastest first.
 PIN_BACKENDS = ("auto", "pysim", "cxxrtl", "verilator")
@@ -35,9 +47,11 @@ def get_pin_backend(name, source, **kwargs):
     if isinstance(source, VerilogPinSource):
         # Amaranth's simulator takes Amaranth designs only.
         if name == "pysim":
-            raise PinError(f"the pysim pin backend cannot run a Verilog design "
-                           f"({source.design.port_map.top}); use the cxxrtl or verilator "
-                           "backend")
+            raise PinError(
+                f"the pysim pin backend cannot run a Verilog design "
+                f"({source.design.port_map.top}); use the cxxrtl or verilator "
+                "backend"
+            )
         if name != "auto":
             return _backend_class(name)(source, **kwargs)
         try:

@@ -90,25 +90,37 @@ def cxxrtl_plan(source):
     accessors = cxxrtl_accessors(source, exprs, commit)
     harness = _sources("pin_cxxrtl.cpp", _DRIVER, "cxxrtl_clock.h")
     flags = list(CXXRTL_FLAGS)
-    key = build_cache.build_key({
-        "flow": "pins-cxxrtl",
-        "abi": ABI_VERSION,
-        "design": source.key,
-        "source": digest(model + accessors),
-        "harness": {name: digest(text) for name, text in harness.items()},
-        "flags": flags,
-        "compiler": compiler.version,
-        "runtime": str(include),
-    })
+    key = build_cache.build_key(
+        {
+            "flow": "pins-cxxrtl",
+            "abi": ABI_VERSION,
+            "design": source.key,
+            "source": digest(model + accessors),
+            "harness": {name: digest(text) for name, text in harness.items()},
+            "flags": flags,
+            "compiler": compiler.version,
+            "runtime": str(include),
+        }
+    )
 
     def build(directory):
         (directory / "design.cc").write_text(model)
         (directory / "pin_design.h").write_text(accessors)
         for name, text in harness.items():
             (directory / name).write_text(text)
-        run_tool([compiler.path, *flags, f"-I{directory}", f"-I{include}",
-                  directory / "pin_cxxrtl.cpp", "-o", directory / LIBRARY_NAME],
-                 cwd=directory, what=f"compiling the CXXRTL pin model ({compiler.path})")
+        run_tool(
+            [
+                compiler.path,
+                *flags,
+                f"-I{directory}",
+                f"-I{include}",
+                directory / "pin_cxxrtl.cpp",
+                "-o",
+                directory / LIBRARY_NAME,
+            ],
+            cwd=directory,
+            what=f"compiling the CXXRTL pin model ({compiler.path})",
+        )
 
     return BuildPlan(f"pins-cxxrtl-{source.key}", key, [LIBRARY_NAME], build)
 
@@ -135,16 +147,18 @@ def verilator_plan(source):
     harness = _sources("pin_verilator.cpp", _DRIVER, "verilator_clock.h")
     cflags = " ".join(VERILATOR_CXX_FLAGS)
     jobs = str(max(1, min(os.cpu_count() or 1, 4)))
-    key = build_cache.build_key({
-        "flow": "pins-verilator",
-        "abi": ABI_VERSION,
-        "design": source.key,
-        "source": digest(text + accessors),
-        "harness": {name: digest(text) for name, text in harness.items()},
-        "flags": [*VERILATOR_FLAGS, cflags, *MAKE_FLAGS],
-        "compiler": compiler.version,
-        "verilator": verilator_version(),
-    })
+    key = build_cache.build_key(
+        {
+            "flow": "pins-verilator",
+            "abi": ABI_VERSION,
+            "design": source.key,
+            "source": digest(text + accessors),
+            "harness": {name: digest(text) for name, text in harness.items()},
+            "flags": [*VERILATOR_FLAGS, cflags, *MAKE_FLAGS],
+            "compiler": compiler.version,
+            "verilator": verilator_version(),
+        }
+    )
 
     def build(directory):
         for name, body in files.items():
@@ -156,21 +170,47 @@ def verilator_plan(source):
             (directory / name).write_text(body)
         env = dict(os.environ, VERILATOR_ROOT=str(root))
         make_flags = [*MAKE_FLAGS, f"CXX={compiler.path}", f"LINK={compiler.path}"]
-        run_tool([root / "bin" / "verilator", *VERILATOR_FLAGS, "-j", jobs,
-                  "--top-module", PIN_WRAPPER, "--prefix", "Vfollow_target", f"-I{directory / 'src'}",
-                  "--Mdir", directory / "obj",
-                  "-CFLAGS", f"{cflags} -I{directory}", "-LDFLAGS", "-shared",
-                  "-MAKEFLAGS", " ".join(make_flags), "-o", directory / LIBRARY_NAME,
-                  *(directory / name for name in compiled), directory / "pin_verilator.cpp"],
-                 cwd=directory, env=env,
-                 what=f"building the Verilator pin model (make, {compiler.path})")
+        run_tool(
+            [
+                root / "bin" / "verilator",
+                *VERILATOR_FLAGS,
+                "-j",
+                jobs,
+                "--top-module",
+                PIN_WRAPPER,
+                "--prefix",
+                "Vfollow_target",
+                f"-I{directory / 'src'}",
+                "--Mdir",
+                directory / "obj",
+                "-CFLAGS",
+                f"{cflags} -I{directory}",
+                "-LDFLAGS",
+                "-shared",
+                "-MAKEFLAGS",
+                " ".join(make_flags),
+                "-o",
+                directory / LIBRARY_NAME,
+                *(directory / name for name in compiled),
+                directory / "pin_verilator.cpp",
+            ],
+            cwd=directory,
+            env=env,
+            what=f"building the Verilator pin model (make, {compiler.path})",
+        )
 
     return BuildPlan(f"pins-verilator-{source.key}", key, [LIBRARY_NAME], build)
 
 
 def _load(path):
-    return bind_library(path, _ENTRIES, what="compiled pin model", abi_entry="pin_abi_version",
-                        abi=ABI_VERSION, error=PinError)
+    return bind_library(
+        path,
+        _ENTRIES,
+        what="compiled pin model",
+        abi_entry="pin_abi_version",
+        abi=ABI_VERSION,
+        error=PinError,
+    )
 
 
 def _address(array):
@@ -209,14 +249,17 @@ class CompiledPins(HostPins):
         self.evals_per_cycle = self._lib.pin_evals_per_cycle()
 
     def _build_and_load(self):
-        self.cache_entry, lib = load_built(type(self).plan(self.source), LIBRARY_NAME, _load,
-                                           on_build=self._notice, error=PinError)
+        self.cache_entry, lib = load_built(
+            type(self).plan(self.source), LIBRARY_NAME, _load, on_build=self._notice, error=PinError
+        )
         return lib
 
     def _notice(self):
         if self._on_build is not None:
-            self._on_build(f"compiling the {self.name} pin model of {self.source.key} (once; "
-                           f"later runs load it from the cache)")
+            self._on_build(
+                f"compiling the {self.name} pin model of {self.source.key} (once; "
+                f"later runs load it from the cache)"
+            )
 
     def _raw_reset(self):
         self._lib.pin_reset(self._handle)
@@ -236,10 +279,13 @@ class CompiledPins(HostPins):
 
     def _raw_stream(self, frame, timing, capture):
         height, width = frame.shape
-        self._geometry[:] = (width, height, timing.start, timing.line_period,
-                             timing.pixel_period)
-        status = self._lib.pin_stream(self._handle, _address(frame), _address(self._geometry),
-                                      None if capture is None else _address(capture))
+        self._geometry[:] = (width, height, timing.start, timing.line_period, timing.pixel_period)
+        status = self._lib.pin_stream(
+            self._handle,
+            _address(frame),
+            _address(self._geometry),
+            None if capture is None else _address(capture),
+        )
         if status != 0:
             raise PinError(f"{self.name}: the pin model rejected the frame (status {status})")
 

@@ -72,16 +72,18 @@ class PinDesignSource:
         ports = {}
         for name, (value, direction) in verilog_ports(component).items():
             shape = value.shape()
-            ports[name] = Port(name, shape.width, "in" if direction == "i" else "out",
-                               shape.signed)
+            ports[name] = Port(name, shape.width, "in" if direction == "i" else "out", shape.signed)
         taken = [name for name in ("clk", "rst") if name in ports]
         if taken:
-            raise PinError(f"design {key!r} has a port named {taken[0]!r}, the name of the "
-                           f"clock domain's own {'clock' if taken[0] == 'clk' else 'reset'}; "
-                           "rename the port")
+            raise PinError(
+                f"design {key!r} has a port named {taken[0]!r}, the name of the "
+                f"clock domain's own {'clock' if taken[0] == 'clk' else 'reset'}; "
+                "rename the port"
+            )
         if len(ports) > MAX_PORTS:
-            raise PinError(f"design {key!r} has {len(ports)} ports; the pin backends take at "
-                           f"most {MAX_PORTS}")
+            raise PinError(
+                f"design {key!r} has {len(ports)} ports; the pin backends take at most {MAX_PORTS}"
+            )
         wide = [p.name for p in ports.values() if p.width > 64]
         if wide:
             raise PinError(f"ports wider than 64 bits are not supported: {', '.join(wide)}")
@@ -93,8 +95,9 @@ class PinDesignSource:
             raise PinError("a pixel stream binding needs frame_size=(width, height)")
         if frame_size is not None:
             width, height = frame_size
-            if not (isinstance(width, int) and isinstance(height, int) and width >= 1
-                    and height >= 1):
+            if not (
+                isinstance(width, int) and isinstance(height, int) and width >= 1 and height >= 1
+            ):
                 raise PinError(f"frame_size must be two positive ints, not {frame_size!r}")
             frame_size = (width, height)
         self.frame_size = frame_size
@@ -106,8 +109,10 @@ class PinDesignSource:
         for name, width in ((valid, 1), (payload, PAYLOAD_BITS)):
             port = self.ports.get(name)
             if port is None or port.direction != direction or port.width != width:
-                raise PinError(f"the {what} binding needs a {width}-bit {direction}put port "
-                               f"{name!r}; the design's ports: {', '.join(self.ports)}")
+                raise PinError(
+                    f"the {what} binding needs a {width}-bit {direction}put port "
+                    f"{name!r}; the design's ports: {', '.join(self.ports)}"
+                )
         return (valid, payload)
 
     def component(self):
@@ -136,6 +141,10 @@ def follow_target_source(params=None):
     from ...hw.top import FollowTarget
 
     params = FollowTargetParams() if params is None else params
-    return PinDesignSource(lambda: FollowTarget(params), f"follow_target_{params.width}x"
-                           f"{params.height}", pixels=PIXEL_PORTS, filtered=FILTERED_PORTS,
-                           frame_size=(params.width, params.height))
+    return PinDesignSource(
+        lambda: FollowTarget(params),
+        f"follow_target_{params.width}x{params.height}",
+        pixels=PIXEL_PORTS,
+        filtered=FILTERED_PORTS,
+        frame_size=(params.width, params.height),
+    )

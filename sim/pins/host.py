@@ -19,8 +19,7 @@ def capture_error(too_many, bad_index):
     """The ``PinError`` of a filtered stream that does not frame the frames streamed."""
     if too_many:
         return PinError("the design put out more filtered pixels than the frames streamed")
-    return PinError(f"filtered pixel {bad_index} of a frame carries wrong first/last framing "
-                    f"flags")
+    return PinError(f"filtered pixel {bad_index} of a frame carries wrong first/last framing flags")
 
 
 class HostPins(PinBackend):
@@ -49,8 +48,10 @@ class HostPins(PinBackend):
     def _input(self, name):
         index, port = self._port(name)
         if port.direction != "in":
-            raise PinError(f"port {name!r} is an output of the design; only inputs can be "
-                           f"driven (inputs: {', '.join(self._inputs())})")
+            raise PinError(
+                f"port {name!r} is an output of the design; only inputs can be "
+                f"driven (inputs: {', '.join(self._inputs())})"
+            )
         if name in self._stream_ports:
             raise PinError(f"port {name!r} is driven by the pixel stream; use stream_frame")
         return index, port
@@ -65,12 +66,16 @@ class HostPins(PinBackend):
         if not isinstance(value, (int, np.integer)):
             raise PinError(f"the value for {port.name!r} must be an int, not {value!r}")
         value = int(value)
-        lo, hi = ((-(1 << (port.width - 1)), (1 << (port.width - 1)) - 1) if port.signed
-                  else (0, (1 << port.width) - 1))
+        lo, hi = (
+            (-(1 << (port.width - 1)), (1 << (port.width - 1)) - 1)
+            if port.signed
+            else (0, (1 << port.width) - 1)
+        )
         if not lo <= value <= hi:
             kind = "signed" if port.signed else "unsigned"
-            raise PinError(f"{value} does not fit port {port.name!r} ({port.width}-bit "
-                           f"{kind}: {lo}..{hi})")
+            raise PinError(
+                f"{value} does not fit port {port.name!r} ({port.width}-bit {kind}: {lo}..{hi})"
+            )
         return value & ((1 << port.width) - 1)
 
     @staticmethod
@@ -107,8 +112,10 @@ class HostPins(PinBackend):
         if isinstance(edge, bool) or not isinstance(edge, (int, np.integer)):
             raise PinError(f"the edge must be an int, not {edge!r}")
         if edge <= self._cycle:
-            raise PinError(f"edge {edge} is in the past (cycle is {self._cycle}); schedule "
-                           f"changes for edge {self._cycle + 1} or later")
+            raise PinError(
+                f"edge {edge} is in the past (cycle is {self._cycle}); schedule "
+                f"changes for edge {self._cycle + 1} or later"
+            )
         self._raw_schedule(int(edge), index, raw)
 
     def watch(self, names):
@@ -130,36 +137,45 @@ class HostPins(PinBackend):
     def stream_frame(self, packed, timing):
         source = self.source
         if source.pixels is None:
-            raise PinError("this design has no pixel stream binding (PinDesignSource "
-                           "pixels=...)")
+            raise PinError("this design has no pixel stream binding (PinDesignSource pixels=...)")
         width, height = source.frame_size
         shape = getattr(packed, "shape", None)
         if shape not in ((height, width), (height, width, 3)):
-            raise PinError(f"a frame must be a ({height}, {width}) uint16 array of RGB444 "
-                           f"pixels (or ({height}, {width}, 3) uint8 RGB888), not "
-                           f"{getattr(packed, 'dtype', type(packed).__name__)} {shape}")
+            raise PinError(
+                f"a frame must be a ({height}, {width}) uint16 array of RGB444 "
+                f"pixels (or ({height}, {width}, 3) uint8 RGB888), not "
+                f"{getattr(packed, 'dtype', type(packed).__name__)} {shape}"
+            )
         try:
             frame = to_rgb444(packed, width, height)
         except FrameError as exc:
             raise PinError(str(exc)) from None
         if self.frame_pending:
-            raise PinError(f"a frame is still streaming (its last pixel is at edge "
-                           f"{self._last_pixel_edge}, cycle is {self._cycle}); run until "
-                           f"frame_pending is False first")
+            raise PinError(
+                f"a frame is still streaming (its last pixel is at edge "
+                f"{self._last_pixel_edge}, cycle is {self._cycle}); run until "
+                f"frame_pending is False first"
+            )
         if not isinstance(timing, PixelTiming):
             raise PinError(f"timing must be a PixelTiming, not {timing!r}")
         if timing.start <= self._cycle:
-            raise PinError(f"the frame starts at edge {timing.start}, in the past (cycle is "
-                           f"{self._cycle}); start it at edge {self._cycle + 1} or later")
+            raise PinError(
+                f"the frame starts at edge {timing.start}, in the past (cycle is "
+                f"{self._cycle}); start it at edge {self._cycle + 1} or later"
+            )
         if timing.pixel_period < 1 or timing.line_period < (width - 1) * timing.pixel_period + 1:
-            raise PinError(f"pixel_period must be >= 1 and line_period >= (width - 1) * "
-                           f"pixel_period + 1 = {(width - 1) * max(1, timing.pixel_period) + 1} "
-                           f"so that lines do not overlap (got {timing})")
+            raise PinError(
+                f"pixel_period must be >= 1 and line_period >= (width - 1) * "
+                f"pixel_period + 1 = {(width - 1) * max(1, timing.pixel_period) + 1} "
+                f"so that lines do not overlap (got {timing})"
+            )
         capture = None
         if source.filtered is not None:
             if len(self._captures) >= 2:
-                raise PinError("two frames' filtered streams are still incomplete; the "
-                               "design's filtered output lags by more than a frame")
+                raise PinError(
+                    "two frames' filtered streams are still incomplete; the "
+                    "design's filtered output lags by more than a frame"
+                )
             capture = np.zeros((height, width), np.uint16)
             self._captures.append(capture)
         self._raw_stream(frame, timing, capture)

@@ -30,6 +30,8 @@ def real_clock_timing(width, height, fps, clock_hz, start_edge):
     active, whole = ACTIVE_LINE_FRACTION
     pixel_period = max(1, (line_period * active // whole) // width)
     if line_period < (width - 1) * pixel_period + 1:
-        raise PinError(f"a {clock_hz:g} Hz clock has {line_period} cycles per line at {fps:g} "
-                       f"fps, too few for {width} pixels; lower the resolution or fps")
+        raise PinError(
+            f"a {clock_hz:g} Hz clock has {line_period} cycles per line at {fps:g} "
+            f"fps, too few for {width} pixels; lower the resolution or fps"
+        )
     return PixelTiming(start=start_edge, line_period=line_period, pixel_period=pixel_period)

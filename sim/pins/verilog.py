@@ -38,11 +38,15 @@ class VerilogPinSource:
         self.design = design
         pm = design.port_map
         self.key = f"verilog-{pm.top}-{design.digest()[:16]}"
-        self.ports = {name: Port(name, width, direction, signed)
-                      for name, (direction, width, signed) in pin_ports(design).items()}
+        self.ports = {
+            name: Port(name, width, direction, signed)
+            for name, (direction, width, signed) in pin_ports(design).items()
+        }
         if len(self.ports) > MAX_PORTS:
-            raise PinError(f"design {pm.top!r} has {len(self.ports)} ports; the pin backends "
-                           f"take at most {MAX_PORTS}")
+            raise PinError(
+                f"design {pm.top!r} has {len(self.ports)} ports; the pin backends "
+                f"take at most {MAX_PORTS}"
+            )
         self.pixels = PIXEL_PORTS if pm.has_pixels else None
         self.filtered = FILTERED_PORTS if pm.filtered_valid else None
         params = design.params
@@ -66,8 +70,9 @@ class VerilogPinSource:
         from ..backends.verilog_cxxrtl import verilog_to_cxxrtl
 
         d = self.design
-        return verilog_to_cxxrtl({"fr_wrapper.v": d.wrapper, **d.sources}, self.verilog_top,
-                                 d.includes)
+        return verilog_to_cxxrtl(
+            {"fr_wrapper.v": d.wrapper, **d.sources}, self.verilog_top, d.includes
+        )
 
     #: Whether every output is a flip-flop is not known for a foreign design: the harness
     #: evaluates twice per edge (the edge, then the settling on the next edge's inputs).

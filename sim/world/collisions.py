@@ -14,8 +14,14 @@ fault when it closed faster than the other body and faster than ``AT_FAULT_SPEED
 import math
 from collections import deque
 
-__all__ = ["AT_FAULT_SPEED", "EPISODE_GAP", "FAULT_WINDOW", "CollisionLog", "MotionHistory",
-           "closing_speeds"]
+__all__ = [
+    "AT_FAULT_SPEED",
+    "EPISODE_GAP",
+    "FAULT_WINDOW",
+    "CollisionLog",
+    "MotionHistory",
+    "closing_speeds",
+]
 
 #: A contact that resumes within this time (s) of its end is the same collision.
 EPISODE_GAP = 0.5
@@ -64,8 +70,7 @@ class CollisionLog:
 
     def __init__(self, kinds, gap=EPISODE_GAP):
         self.gap = gap
-        self._stats = {k: {"episodes": 0, "contact_s": 0.0, "max_impulse_ns": 0.0}
-                       for k in kinds}
+        self._stats = {k: {"episodes": 0, "contact_s": 0.0, "max_impulse_ns": 0.0} for k in kinds}
         self._at_fault = dict.fromkeys(self._stats, 0)
         self._bodies = {}  # (kind, name) -> _Episode
         self._per_name = {}  # (kind, name) -> episodes
@@ -124,11 +129,16 @@ class CollisionLog:
         ``now`` counts up to ``now``."""
         out = {}
         for kind, s in self._stats.items():
-            ongoing = sum(now - ep.since for ep in self._bodies.values()
-                          if ep.kind == kind and ep.since is not None)
-            out[kind] = {"episodes": s["episodes"],
-                         "contact_s": round(s["contact_s"] + ongoing, 4),
-                         "max_impulse_ns": round(s["max_impulse_ns"], 4)}
+            ongoing = sum(
+                now - ep.since
+                for ep in self._bodies.values()
+                if ep.kind == kind and ep.since is not None
+            )
+            out[kind] = {
+                "episodes": s["episodes"],
+                "contact_s": round(s["contact_s"] + ongoing, 4),
+                "max_impulse_ns": round(s["max_impulse_ns"], 4),
+            }
         return out
 
 

@@ -180,7 +180,6 @@ def _fmt(point):
     return "[" + ", ".join(f"{c:g}" for c in point) + "]"
 
 
-
 def _check_vector(value, path, n, what, **bounds):
     if not isinstance(value, (list, tuple)) or len(value) != n:
         raise WorldConfigError(f"{path} must be {what}, got {_show(value)}")
@@ -225,7 +224,8 @@ class _Table:
         value = self.raw(key, default)
         if not isinstance(value, str) or not value:
             raise WorldConfigError(
-                f"{self.key(key)} must be a non-empty string, got {_show(value)}")
+                f"{self.key(key)} must be a non-empty string, got {_show(value)}"
+            )
         if choices is not None and value not in choices:
             options = ", ".join(repr(c) for c in choices)
             raise WorldConfigError(f"{self.key(key)} must be one of {options}, got {value!r}")
@@ -235,8 +235,9 @@ class _Table:
         if key not in self.table:
             self.known.append(key)
             return tuple(default)
-        return _check_vector(self.raw(key), self.key(key), 3,
-                             "a colour [r, g, b] with each in 0..1", ge=0, le=1)
+        return _check_vector(
+            self.raw(key), self.key(key), 3, "a colour [r, g, b] with each in 0..1", ge=0, le=1
+        )
 
     def point(self, key, default):
         if key not in self.table:
@@ -251,8 +252,7 @@ class _Table:
             close = difflib.get_close_matches(str(key), self.known, n=1)
             hint = f" (did you mean {close[0]!r}?)" if close else ""
             known = ", ".join(self.known)
-            raise WorldConfigError(
-                f"{self.key(key)} is not a known key{hint}; known keys: {known}")
+            raise WorldConfigError(f"{self.key(key)} is not a known key{hint}; known keys: {known}")
 
 
 def _parse_furniture(item, path, index):
@@ -287,17 +287,21 @@ def _parse_line(item, path, index, room):
         raise WorldConfigError(
             f"{t.key('points')} must be an array of at least {least} points [x, y] "
             f"({'a closed' if closed else 'an open'} line), got "
-            f"{_show(points) if points is not None else 'nothing'}")
-    centreline = tuple(_check_vector(p, f"{t.key('points')}[{i}]", 2, "a point [x, y] in m")
-                       for i, p in enumerate(points))
+            f"{_show(points) if points is not None else 'nothing'}"
+        )
+    centreline = tuple(
+        _check_vector(p, f"{t.key('points')}[{i}]", 2, "a point [x, y] in m")
+        for i, p in enumerate(points)
+    )
     width = t.number("width", 0.019, gt=0, le=1, unit="m")
     color = t.color("color", _LINE_COLOR)
     t.finish()
     w, d = room
     for i, (x, y) in enumerate(centreline):
         if not (0 <= x <= w and 0 <= y <= d):
-            raise WorldConfigError(f"{t.key('points')}[{i}] {_fmt((x, y))} is outside the room "
-                                   f"(0..{w:g} x 0..{d:g} m)")
+            raise WorldConfigError(
+                f"{t.key('points')}[{i}] {_fmt((x, y))} is outside the room (0..{w:g} x 0..{d:g} m)"
+            )
     line = FloorLine(name, centreline, width, color, closed)
     if line.length < 1e-6:
         raise WorldConfigError(f"{t.key('points')} has no length (all the points are the same)")
@@ -309,24 +313,31 @@ def _parse_terrain(item, path, index, room):
     name = t.string("name", f"terrain{index}")
     has_points, has_center = t.has("points"), t.has("center")
     if has_points == has_center:
-        raise WorldConfigError(f"{path} needs either points = [[x, y], ...] (a polygon) or "
-                               f"center = [x, y] with size = [length, width] (a rectangle)")
+        raise WorldConfigError(
+            f"{path} needs either points = [[x, y], ...] (a polygon) or "
+            f"center = [x, y] with size = [length, width] (a rectangle)"
+        )
     if has_points:
         points = t.raw("points")
         if not isinstance(points, list) or len(points) < 3:
-            raise WorldConfigError(f"{t.key('points')} must be an array of at least 3 points "
-                                   f"[x, y], got {_show(points)}")
-        polygon = tuple(_check_vector(p, f"{t.key('points')}[{i}]", 2, "a point [x, y] in m")
-                        for i, p in enumerate(points))
-        area = 0.5 * abs(sum(x0 * y1 - x1 * y0 for (x0, y0), (x1, y1)
-                             in zip(polygon, polygon[1:] + polygon[:1])))
+            raise WorldConfigError(
+                f"{t.key('points')} must be an array of at least 3 points "
+                f"[x, y], got {_show(points)}"
+            )
+        polygon = tuple(
+            _check_vector(p, f"{t.key('points')}[{i}]", 2, "a point [x, y] in m")
+            for i, p in enumerate(points)
+        )
+        area = 0.5 * abs(
+            sum(x0 * y1 - x1 * y0 for (x0, y0), (x1, y1) in zip(polygon, polygon[1:] + polygon[:1]))
+        )
         if area < 1e-4:
-            raise WorldConfigError(f"{t.key('points')} encloses no area (the points are on "
-                                   f"a line)")
+            raise WorldConfigError(f"{t.key('points')} encloses no area (the points are on a line)")
     else:
         center = t.point("center", None)
-        size = _check_vector(t.raw("size", (1.0, 1.0)), t.key("size"), 2,
-                             "[length, width] in m", ge=0.01, le=100)
+        size = _check_vector(
+            t.raw("size", (1.0, 1.0)), t.key("size"), 2, "[length, width] in m", ge=0.01, le=100
+        )
         angle = t.number("angle_deg", 0.0, ge=-360, le=360) * DEG
         shape = FurnitureConfig(name, "box", center, size, angle, 0.0, (0, 0, 0))
         polygon = tuple(tuple(c) for c in shape.corners())
@@ -336,11 +347,11 @@ def _parse_terrain(item, path, index, room):
     # No colour: the patch is not drawn (a wet floor looks like the floor).
     color = t.color("color", (0.0, 0.0, 0.0)) if t.has("color") else t.raw("color")
     t.finish()
-    inside = [(x, y) for x, y in polygon if -1e-9 <= x <= room[0] + 1e-9
-              and -1e-9 <= y <= room[1] + 1e-9]
+    inside = [
+        (x, y) for x, y in polygon if -1e-9 <= x <= room[0] + 1e-9 and -1e-9 <= y <= room[1] + 1e-9
+    ]
     if not inside:
-        raise WorldConfigError(f"{path} lies outside the room (0..{room[0]:g} x "
-                               f"0..{room[1]:g} m)")
+        raise WorldConfigError(f"{path} lies outside the room (0..{room[0]:g} x 0..{room[1]:g} m)")
     return TerrainPatch(name, polygon, friction, slope, slope_dir, color)
 
 
@@ -355,21 +366,28 @@ def _parse_room(section):
     items = t.raw("furniture", [])
     if not isinstance(items, list):
         raise WorldConfigError(
-            f"room.furniture must be an array of tables ([[room.furniture]]), got {_show(items)}")
-    furniture = tuple(_parse_furniture(item, f"room.furniture[{i}]", i)
-                      for i, item in enumerate(items))
+            f"room.furniture must be an array of tables ([[room.furniture]]), got {_show(items)}"
+        )
+    furniture = tuple(
+        _parse_furniture(item, f"room.furniture[{i}]", i) for i, item in enumerate(items)
+    )
     patches = t.raw("terrain", [])
     if not isinstance(patches, list):
         raise WorldConfigError(
-            f"room.terrain must be an array of tables ([[room.terrain]]), got {_show(patches)}")
-    terrain = tuple(_parse_terrain(item, f"room.terrain[{i}]", i, (width, depth))
-                    for i, item in enumerate(patches))
+            f"room.terrain must be an array of tables ([[room.terrain]]), got {_show(patches)}"
+        )
+    terrain = tuple(
+        _parse_terrain(item, f"room.terrain[{i}]", i, (width, depth))
+        for i, item in enumerate(patches)
+    )
     raw_lines = t.raw("lines", [])
     if not isinstance(raw_lines, list):
         raise WorldConfigError(
-            f"room.lines must be an array of tables ([[room.lines]]), got {_show(raw_lines)}")
-    lines = tuple(_parse_line(item, f"room.lines[{i}]", i, (width, depth))
-                  for i, item in enumerate(raw_lines))
+            f"room.lines must be an array of tables ([[room.lines]]), got {_show(raw_lines)}"
+        )
+    lines = tuple(
+        _parse_line(item, f"room.lines[{i}]", i, (width, depth)) for i, item in enumerate(raw_lines)
+    )
     line_names = [line.name for line in lines]
     for i, name in enumerate(line_names):
         if name in line_names[:i]:
@@ -381,11 +399,14 @@ def _parse_room(section):
     for i, f in enumerate(furniture):
         x, y = f.center
         if not (0 < x < width and 0 < y < depth):
-            raise WorldConfigError(f"room.furniture[{i}].center {_fmt(f.center)} is outside "
-                                   f"the room (0..{width:g} x 0..{depth:g} m)")
+            raise WorldConfigError(
+                f"room.furniture[{i}].center {_fmt(f.center)} is outside "
+                f"the room (0..{width:g} x 0..{depth:g} m)"
+            )
     t.finish()
-    return RoomConfig(width, depth, height, wall_color, floor_color, ceiling_color, furniture,
-                      terrain, lines)
+    return RoomConfig(
+        width, depth, height, wall_color, floor_color, ceiling_color, furniture, terrain, lines
+    )
 
 
 def _inside(point, radius, room):
@@ -413,18 +434,22 @@ def _parse_robot(section, room):
     ):
         fields[key] = t.number(key, getattr(base, key), **bounds)
     fields["traction_torque"] = t.number(
-        "traction_torque", fields["traction_force"] * fields["wheel_separation"] / 2,
-        gt=0, le=1e5, unit="N m")
-    fields["camera_tilt"] = t.number("camera_tilt_deg", base.camera_tilt / DEG,
-                                     ge=-85, le=85) * DEG
+        "traction_torque",
+        fields["traction_force"] * fields["wheel_separation"] / 2,
+        gt=0,
+        le=1e5,
+        unit="N m",
+    )
+    fields["camera_tilt"] = t.number("camera_tilt_deg", base.camera_tilt / DEG, ge=-85, le=85) * DEG
     for key, bounds in (
         ("com_height", {"gt": 0, "le": 5, "unit": "m"}),
         ("support_half_length", {"gt": 0, "le": 5, "unit": "m"}),
     ):
         fields[key] = t.number(key, getattr(base, key), **bounds)
     # None (the presets' value): commands are ramped, a jump never tips the robot.
-    fields["motor_step_response"] = t.number("motor_step_response", base.motor_step_response,
-                                             gt=0, le=10, unit="s")
+    fields["motor_step_response"] = t.number(
+        "motor_step_response", base.motor_step_response, gt=0, le=10, unit="s"
+    )
     uncertainty = Uncertainty(
         motor_gain_error=t.number("motor_gain_error", 0.0, ge=0, le=0.9),
         motor_noise_dps=t.number("motor_noise_dps", 0.0, ge=0, le=10000, unit="deg/s"),
@@ -437,26 +462,30 @@ def _parse_robot(section, room):
         # The renderer draws from between the floor and the ceiling only.
         raise WorldConfigError(
             f"robot.camera_height must be below the ceiling (room.height = {room.height:g} m), "
-            f"got {fields['camera_height']:g}")
+            f"got {fields['camera_height']:g}"
+        )
     spec = base.with_overrides(**fields)
     if not _inside(start, spec.body_radius, room):
         raise WorldConfigError(
             f"robot.start {_fmt(start)} puts the robot (radius {spec.body_radius:g} m) outside "
-            f"the room (0..{room.width:g} x 0..{room.depth:g} m)")
+            f"the room (0..{room.width:g} x 0..{room.depth:g} m)"
+        )
     return RobotConfig(spec, tuple(start), heading, uncertainty)
 
 
 def _default_people(room):
     w, d = room.width, room.depth
-    return [{
-        "name": "target",
-        "target": True,
-        "waypoints": [[0.5 * w, 0.5 * d], [0.75 * w, 0.75 * d], [0.8 * w, 0.25 * d]],
-        "speed": 0.4,
-        "pause": 2.0,
-        "loop": True,
-        "start_delay": 1.0,
-    }]
+    return [
+        {
+            "name": "target",
+            "target": True,
+            "waypoints": [[0.5 * w, 0.5 * d], [0.75 * w, 0.75 * d], [0.8 * w, 0.25 * d]],
+            "speed": 0.4,
+            "pause": 2.0,
+            "loop": True,
+            "start_delay": 1.0,
+        }
+    ]
 
 
 def _parse_person(item, path, index, room):
@@ -468,9 +497,12 @@ def _parse_person(item, path, index, room):
         raise WorldConfigError(f"{path}.waypoints is required: an array of [x, y] points in m")
     if not isinstance(raw, list) or not raw:
         raise WorldConfigError(
-            f"{path}.waypoints must be a non-empty array of [x, y] points, got {_show(raw)}")
-    waypoints = tuple(_check_vector(p, f"{path}.waypoints[{i}]", 2, "a point [x, y] in m")
-                      for i, p in enumerate(raw))
+            f"{path}.waypoints must be a non-empty array of [x, y] points, got {_show(raw)}"
+        )
+    waypoints = tuple(
+        _check_vector(p, f"{path}.waypoints[{i}]", 2, "a point [x, y] in m")
+        for i, p in enumerate(raw)
+    )
     speed = t.number("speed", 0.5, gt=0, le=5, unit="m/s")
     jitter = t.number("speed_jitter", 0.0, ge=0, le=0.9)
     pause = t.raw("pause", 1.0)
@@ -478,12 +510,14 @@ def _parse_person(item, path, index, room):
         if len(pause) != len(waypoints):
             raise WorldConfigError(
                 f"{path}.pause must be one number or one per waypoint ({len(waypoints)}), "
-                f"got {len(pause)} values")
-        pauses = tuple(_check_number(p, f"{path}.pause[{i}]", ge=0, le=3600, unit="s")
-                       for i, p in enumerate(pause))
+                f"got {len(pause)} values"
+            )
+        pauses = tuple(
+            _check_number(p, f"{path}.pause[{i}]", ge=0, le=3600, unit="s")
+            for i, p in enumerate(pause)
+        )
     else:
-        pauses = (_check_number(pause, f"{path}.pause", ge=0, le=3600, unit="s"),) * len(
-            waypoints)
+        pauses = (_check_number(pause, f"{path}.pause", ge=0, le=3600, unit="s"),) * len(waypoints)
     loop = t.boolean("loop", True)
     start_delay = t.number("start_delay", 0.0, ge=0, le=MAX_TIME, unit="s")
     yield_gap = t.number("yield_gap", 0.0, ge=0, le=5, unit="m")
@@ -497,9 +531,24 @@ def _parse_person(item, path, index, room):
         if not _inside(p, radius, room):
             raise WorldConfigError(
                 f"{path}.waypoints[{i}] {_fmt(p)} puts the person (radius {radius:g} m) outside "
-                f"the room (0..{room.width:g} x 0..{room.depth:g} m)")
-    return PersonConfig(name, target, waypoints, speed, jitter, pauses, loop, start_delay,
-                        yield_gap, radius, height, shirt, trousers, skin)
+                f"the room (0..{room.width:g} x 0..{room.depth:g} m)"
+            )
+    return PersonConfig(
+        name,
+        target,
+        waypoints,
+        speed,
+        jitter,
+        pauses,
+        loop,
+        start_delay,
+        yield_gap,
+        radius,
+        height,
+        shirt,
+        trousers,
+        skin,
+    )
 
 
 def _parse_people(section, room):
@@ -507,7 +556,8 @@ def _parse_people(section, room):
         section = _default_people(room)
     if not isinstance(section, list):
         raise WorldConfigError(
-            f"people must be an array of tables ([[people]]), got {_show(section)}")
+            f"people must be an array of tables ([[people]]), got {_show(section)}"
+        )
     people = tuple(_parse_person(item, f"people[{i}]", i, room) for i, item in enumerate(section))
     names = [p.name for p in people]
     for i, name in enumerate(names):
@@ -517,7 +567,8 @@ def _parse_people(section, room):
     if len(targets) > 1:
         raise WorldConfigError(
             f"people[{targets[1]}].target: only one person can be the target "
-            f"(people[{targets[0]}] already is)")
+            f"(people[{targets[0]}] already is)"
+        )
     return people
 
 
@@ -526,27 +577,38 @@ def _parse_lighting(section):
     ambient = t.number("ambient", 0.6, ge=0, le=2)
     intensity = t.number("intensity", 0.5, ge=0, le=2)
     direction = t.raw("direction", [1.0, 0.5, -1.0])
-    direction = _check_vector(direction, "lighting.direction", 3,
-                              "a vector [dx, dy, dz], each -1000..1000", ge=-1000, le=1000)
+    direction = _check_vector(
+        direction,
+        "lighting.direction",
+        3,
+        "a vector [dx, dy, dz], each -1000..1000",
+        ge=-1000,
+        le=1000,
+    )
     if math.hypot(*direction) < 1e-3:
         raise WorldConfigError(
-            f"lighting.direction must have a length of at least 0.001, got {_fmt(direction)}")
+            f"lighting.direction must have a length of at least 0.001, got {_fmt(direction)}"
+        )
     raw = t.raw("keyframes", [])
     if not isinstance(raw, list):
         raise WorldConfigError(
-            f"lighting.keyframes must be an array of [t, ambient, intensity], got {_show(raw)}")
+            f"lighting.keyframes must be an array of [t, ambient, intensity], got {_show(raw)}"
+        )
     keyframes = []
     for i, k in enumerate(raw):
         p = f"lighting.keyframes[{i}]"
         if not isinstance(k, (list, tuple)) or len(k) != 3:
             raise WorldConfigError(f"{p} must be [t, ambient, intensity], got {_show(k)}")
-        frame = (_check_number(k[0], f"{p}[0] (t)", ge=0, le=MAX_TIME, unit="s"),
-                 _check_number(k[1], f"{p}[1] (ambient)", ge=0, le=2),
-                 _check_number(k[2], f"{p}[2] (intensity)", ge=0, le=2))
+        frame = (
+            _check_number(k[0], f"{p}[0] (t)", ge=0, le=MAX_TIME, unit="s"),
+            _check_number(k[1], f"{p}[1] (ambient)", ge=0, le=2),
+            _check_number(k[2], f"{p}[2] (intensity)", ge=0, le=2),
+        )
         if keyframes and frame[0] < keyframes[-1][0]:
             raise WorldConfigError(
                 f"{p}[0] (t) must not be earlier than the previous keyframe's "
-                f"({keyframes[-1][0]:g} s), got {frame[0]:g}")
+                f"({keyframes[-1][0]:g} s), got {frame[0]:g}"
+            )
         keyframes.append(frame)
     interpolation = t.string("interpolation", "linear", choices=("linear", "step"))
     t.finish()
@@ -579,8 +641,9 @@ def parse_world_config(cfg):
         if key not in WORLD_SECTIONS:
             close = difflib.get_close_matches(str(key), WORLD_SECTIONS, n=1)
             hint = f" (did you mean {close[0]!r}?)" if close else ""
-            raise WorldConfigError(f"{key} is not a world section{hint}; the sections are "
-                                   + ", ".join(WORLD_SECTIONS))
+            raise WorldConfigError(
+                f"{key} is not a world section{hint}; the sections are " + ", ".join(WORLD_SECTIONS)
+            )
     room = _parse_room(cfg.get("room"))
     robot = _parse_robot(cfg.get("robot"), room)
     people = _parse_people(cfg.get("people"), room)

@@ -29,8 +29,9 @@ def spot_offsets(radius):
     """The points averaged over a spot of ``radius``: its centre and six around it at two
     thirds of the radius (equal areas, roughly)."""
     r = 2.0 * radius / 3.0
-    return [(0.0, 0.0)] + [(r * math.cos(k * math.pi / 3), r * math.sin(k * math.pi / 3))
-                           for k in range(6)]
+    return [(0.0, 0.0)] + [
+        (r * math.cos(k * math.pi / 3), r * math.sin(k * math.pi / 3)) for k in range(6)
+    ]
 
 
 @dataclass(frozen=True)
@@ -76,8 +77,9 @@ class KY033:
         if p.height > p.max_height:
             return [1] * len(points)
         centres = np.asarray(points, dtype=float).reshape(-1, 2)
-        colors = world.floor_colors_at((centres[:, :1] + self._dx).ravel(),
-                                       (centres[:, 1:] + self._dy).ravel())
+        colors = world.floor_colors_at(
+            (centres[:, :1] + self._dx).ravel(), (centres[:, 1:] + self._dy).ravel()
+        )
         values = (colors @ _LUMA).reshape(len(centres), -1).mean(axis=1)
         if p.noise_std > 0:
             values = values + p.noise_std * self.rng.standard_normal(len(centres))

@@ -53,8 +53,7 @@ class FloorLine:
         half = self.width / 2.0
         lo = pts.min(axis=0) - half
         hi = pts.max(axis=0) + half
-        object.__setattr__(self, "bounds", (float(lo[0]), float(lo[1]), float(hi[0]),
-                                            float(hi[1])))
+        object.__setattr__(self, "bounds", (float(lo[0]), float(lo[1]), float(hi[0]), float(hi[1])))
 
     @property
     def length(self):
@@ -103,8 +102,13 @@ class FloorLine:
         ends = a + d
         # turn[i]: the bend at the joint between segment i and i + 1 (wrapping when closed).
         joints = n if self.closed else n - 1
-        turn = [math.atan2(u[i, 0] * u[(i + 1) % n, 1] - u[i, 1] * u[(i + 1) % n, 0],
-                           float(u[i] @ u[(i + 1) % n])) for i in range(joints)]
+        turn = [
+            math.atan2(
+                u[i, 0] * u[(i + 1) % n, 1] - u[i, 1] * u[(i + 1) % n, 0],
+                float(u[i] @ u[(i + 1) % n]),
+            )
+            for i in range(joints)
+        ]
         mitred = [abs(t) <= MITRE_TURN for t in turn]
 
         def offset(i, side, at_end):
@@ -152,6 +156,10 @@ class FloorLine:
 
 def _disc(center, radius):
     cx, cy = center
-    return [(float(cx + radius * math.cos(2 * math.pi * k / DISC_SIDES)),
-             float(cy + radius * math.sin(2 * math.pi * k / DISC_SIDES)))
-            for k in range(DISC_SIDES)]
+    return [
+        (
+            float(cx + radius * math.cos(2 * math.pi * k / DISC_SIDES)),
+            float(cy + radius * math.sin(2 * math.pi * k / DISC_SIDES)),
+        )
+        for k in range(DISC_SIDES)
+    ]

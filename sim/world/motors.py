@@ -71,10 +71,10 @@ class DriveMotors:
     def commanded_twist(self):
         """``(v, w)`` the current DPS command asks for, by the real kinematics (not clamped,
         not ramped: what the design commanded)."""
-        return dps_to_twist(*self.command_dps, self.spec.wheel_radius,
-                            self.spec.wheel_separation)
+        return dps_to_twist(*self.command_dps, self.spec.wheel_radius, self.spec.wheel_separation)
 
     def motor_twist(self):
         """``(v, w)`` of the wheels' current (ramped, clamped) speeds."""
-        return wheels_to_twist(self.left.speed, self.right.speed, self.spec.wheel_radius,
-                               self.spec.wheel_separation)
+        return wheels_to_twist(
+            self.left.speed, self.right.speed, self.spec.wheel_radius, self.spec.wheel_separation
+        )

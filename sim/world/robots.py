@@ -106,7 +106,7 @@ class RobotSpec:
     @property
     def moment(self):
         """Moment of inertia of the body as a uniform disc, kg m^2."""
-        return 0.5 * self.mass * self.body_radius ** 2
+        return 0.5 * self.mass * self.body_radius**2
 
     def with_overrides(self, **fields):
         """A copy with some fields replaced."""
@@ -177,4 +177,3 @@ ROBOT_MODELS = {spec.name: spec for spec in (TURTLEBOT2, GOPIGO3)}
 def robot_model(name):
     """The preset called ``name``; ``KeyError`` if there is none."""
     return ROBOT_MODELS[name]
-

@@ -38,14 +38,17 @@ def furniture_faces(item):
 def scene_walls(room, removed=frozenset()):
     """Every static vertical surface as ``sim.scene.Wall`` (room walls then furniture, but
     the items named in ``removed``)."""
-    walls = [Wall(a[0], a[1], b[0], b[1], room.height, tuple(room.wall_color), "room")
-             for a, b in room_segments(room)]
+    walls = [
+        Wall(a[0], a[1], b[0], b[1], room.height, tuple(room.wall_color), "room")
+        for a, b in room_segments(room)
+    ]
     for item in room.furniture:
         if item.name in removed:
             continue
-        walls += [Wall(a[0], a[1], b[0], b[1], item.height, tuple(item.color), item.kind,
-                       item.name)
-                  for a, b in furniture_faces(item)]
+        walls += [
+            Wall(a[0], a[1], b[0], b[1], item.height, tuple(item.color), item.kind, item.name)
+            for a, b in furniture_faces(item)
+        ]
     return tuple(walls)
 
 
@@ -56,8 +59,12 @@ def add_static_shapes(space, room, *, wall_type, furniture_type, friction):
     w, d = room.width, room.depth
     shapes = {}
     # Centre lines a half thickness outside the room, extended past the corners.
-    for a, b in (((-2 * r, -r), (w + 2 * r, -r)), ((w + r, -2 * r), (w + r, d + 2 * r)),
-                 ((w + 2 * r, d + r), (-2 * r, d + r)), ((-r, d + 2 * r), (-r, -2 * r))):
+    for a, b in (
+        ((-2 * r, -r), (w + 2 * r, -r)),
+        ((w + r, -2 * r), (w + r, d + 2 * r)),
+        ((w + 2 * r, d + r), (-2 * r, d + r)),
+        ((-r, d + 2 * r), (-r, -2 * r)),
+    ):
         shape = pymunk.Segment(body, a, b, r)
         shapes[shape] = ("wall", None)
     for item in room.furniture:

@@ -29,8 +29,7 @@ def _point_segment(p, a, b):
     (px, py), (ax, ay), (bx, by) = p, a, b
     dx, dy = bx - ax, by - ay
     length2 = dx * dx + dy * dy
-    f = 0.0 if length2 == 0.0 else max(0.0, min(1.0, ((px - ax) * dx + (py - ay) * dy)
-                                                / length2))
+    f = 0.0 if length2 == 0.0 else max(0.0, min(1.0, ((px - ax) * dx + (py - ay) * dy) / length2))
     return math.hypot(px - ax - f * dx, py - ay - f * dy)
 
 
@@ -49,8 +48,10 @@ def segment_distance(a, b, polygon):
     edges = [(polygon[i], polygon[(i + 1) % n]) for i in range(n)]
     if any(_segments_cross(a, b, c, d) for c, d in edges):
         return 0.0
-    return min(min(_point_segment(c, a, b), _point_segment(a, c, d), _point_segment(b, c, d))
-               for c, d in edges)
+    return min(
+        min(_point_segment(c, a, b), _point_segment(a, c, d), _point_segment(b, c, d))
+        for c, d in edges
+    )
 
 
 def _fmt(point):
@@ -69,8 +70,7 @@ def _legs(person):
 def world_warnings(config):
     """One line per suspicious placement in ``config`` (a ``config.WorldConfig``)."""
     warnings = []
-    furniture = [(f.name, f.corners()) for f in config.room.furniture
-                 if f.present_until is None]
+    furniture = [(f.name, f.corners()) for f in config.room.furniture if f.present_until is None]
     start = config.robot.start
     robot_radius = config.robot.spec.body_radius
     for i, person in enumerate(config.people):
@@ -82,19 +82,25 @@ def world_warnings(config):
                     warnings.append(f"{path}[{j}] {_fmt(p)} lies inside furniture {name!r}")
                     inside.add((j, name))
                 elif segment_distance(p, p, poly) < person.radius:
-                    warnings.append(f"{path}[{j}] {_fmt(p)} puts the person (radius "
-                                    f"{person.radius:g} m) into furniture {name!r}")
+                    warnings.append(
+                        f"{path}[{j}] {_fmt(p)} puts the person (radius "
+                        f"{person.radius:g} m) into furniture {name!r}"
+                    )
                     inside.add((j, name))
         for j, k in _legs(person):
             a, b = person.waypoints[j], person.waypoints[k]
             for name, poly in furniture:
-                if ((j, name) not in inside and (k, name) not in inside
-                        and segment_distance(a, b, poly) < person.radius):
+                if (
+                    (j, name) not in inside
+                    and (k, name) not in inside
+                    and segment_distance(a, b, poly) < person.radius
+                ):
                     warnings.append(f"{path}[{j}] -> [{k}] walks through furniture {name!r}")
             d = _point_segment(start, a, b)
             if a != b and d < robot_radius + person.radius:
                 warnings.append(
                     f"{path}[{j}] -> [{k}] passes {d:.2f} m from robot.start {_fmt(start)}: "
                     f"the person (radius {person.radius:g} m) walks into the robot (radius "
-                    f"{robot_radius:g} m) where it starts")
+                    f"{robot_radius:g} m) where it starts"
+                )
     return warnings

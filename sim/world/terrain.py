@@ -76,9 +76,15 @@ class TerrainMap:
     def __init__(self, patches, width=None, depth=None):
         self.patches = tuple(patches)
         # Bounding boxes first: most exact lookups are far from most patches.
-        self._boxes = [(min(p[0] for p in t.polygon), min(p[1] for p in t.polygon),
-                        max(p[0] for p in t.polygon), max(p[1] for p in t.polygon))
-                       for t in self.patches]
+        self._boxes = [
+            (
+                min(p[0] for p in t.polygon),
+                min(p[1] for p in t.polygon),
+                max(p[0] for p in t.polygon),
+                max(p[1] for p in t.polygon),
+            )
+            for t in self.patches
+        ]
         self._grid = None
         if self.patches and width and depth:
             self._grid = self._build_grid(width, depth)
@@ -90,8 +96,11 @@ class TerrainMap:
         nx, ny = math.ceil(width / cell), math.ceil(depth / cell)
         gx, gy = np.meshgrid(np.arange(nx + 1) * cell, np.arange(ny + 1) * cell)
         corner = patch_index([t.polygon for t in self.patches], gx, gy)
-        pure = ((corner[:-1, :-1] == corner[1:, :-1]) & (corner[:-1, :-1] == corner[:-1, 1:])
-                & (corner[:-1, :-1] == corner[1:, 1:]))
+        pure = (
+            (corner[:-1, :-1] == corner[1:, :-1])
+            & (corner[:-1, :-1] == corner[:-1, 1:])
+            & (corner[:-1, :-1] == corner[1:, 1:])
+        )
         grid = np.where(pure, corner[:-1, :-1], _MIXED)
         # Every cell an edge passes through or near (samples a quarter cell apart, and their
         # neighbours) is tested exactly.

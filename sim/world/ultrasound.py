@@ -91,7 +91,8 @@ def _polygon_near_far(points):
     far = max(math.hypot(*p) for p in points)
     inside = len(points) >= 3 and all(
         (q[0] - p[0]) * -p[1] - (q[1] - p[1]) * -p[0] >= 0.0
-        for p, q in zip(points, points[1:] + points[:1]))
+        for p, q in zip(points, points[1:] + points[:1])
+    )
     if inside:
         return 0.0, far
     near = min(_segment_near_far(points[i - 1], points[i])[0] for i in range(len(points)))
@@ -171,8 +172,11 @@ def range_to(world, x, y, heading, height, params=HCSR04Params()):
         if dist > r and (centre[0] * c + centre[1] * s) >= dist * math.cos(half):
             near = dist - r
         else:
-            hits = [t for t in (_ray_circle(e, centre, r) for e in (left_edge, right_edge))
-                    if t is not None]
+            hits = [
+                t
+                for t in (_ray_circle(e, centre, r) for e in (left_edge, right_edge))
+                if t is not None
+            ]
             if dist <= r:
                 hits.append(0.0)
             if not hits:

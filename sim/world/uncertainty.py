@@ -76,8 +76,9 @@ class MotorUncertainty:
             left, right = left * gl, right * gr
         if c.slip_rate_hz > 0.0 and t >= self.slip_until and self._uniform() < self._p_slip:
             self.slip_until = t + c.slip_duration_s
-            self.events.append(f"wheel slip: traction x{c.slip_traction:g} for "
-                                f"{c.slip_duration_s:g} s")
+            self.events.append(
+                f"wheel slip: traction x{c.slip_traction:g} for {c.slip_duration_s:g} s"
+            )
         return left, right, (c.slip_traction if t < self.slip_until else 1.0)
 
     def drain_events(self):

@@ -29,6 +29,7 @@ from .uncertainty import MotorUncertainty
 
 __all__ = ["AT_FAULT_SPEED", "MAX_SUBSTEP", "World", "is_removal_event", "removal_event"]
 
+
 def removal_event(name):
     """The event a piece of furniture leaving the room (``present_until``) gives."""
     return f"furniture {name!r} removed"
@@ -53,8 +54,18 @@ def _speed(v):
 
 
 class _Person:
-    __slots__ = ("bands", "body", "config", "facing", "offset", "path", "shape", "teleop",
-                 "waited", "walked")
+    __slots__ = (
+        "bands",
+        "body",
+        "config",
+        "facing",
+        "offset",
+        "path",
+        "shape",
+        "teleop",
+        "waited",
+        "walked",
+    )
 
     def __init__(self, config, path, body, shape):
         self.config = config
@@ -123,14 +134,18 @@ class World:
         self._painted = TerrainMap(painted, config.room.width, config.room.depth)
         # The camera draws the painted patches, then the markings over them.
         self._floor_patches = tuple((t.polygon, t.color) for t in painted) + tuple(
-            (tuple(poly), line.color) for line in self.floor_lines for poly in line.polygons())
+            (tuple(poly), line.color) for line in self.floor_lines for poly in line.polygons()
+        )
         self._patch = None  # the terrain patch under the robot's centre
         self._traction = 1.0  # the factor the joints' forces are set to
         self._downhill_cache = {}  # id(patch) -> gravity's downhill force on the robot
         # Motor gain, noise and slips: a stream of their own (None for the ideal robot), so
         # that they never shift the people's randomness.
-        self.uncertainty = (MotorUncertainty(config.robot.uncertainty, self.seed)
-                            if config.robot.uncertainty else None)
+        self.uncertainty = (
+            MotorUncertainty(config.robot.uncertainty, self.seed)
+            if config.robot.uncertainty
+            else None
+        )
 
         self.space = space = pymunk.Space()
         space.gravity = (0.0, 0.0)
@@ -161,14 +176,17 @@ class World:
         space.add(body, shape, control, pivot, gear)
         self._patch = self.terrain.at(*config.robot.start) if self.terrain else None
 
-        self._names = add_static_shapes(space, config.room, wall_type=_WALL,
-                                        furniture_type=_FURNITURE, friction=_FRICTION)
-        self._furniture_shapes = {name: shape for shape, (kind, name) in self._names.items()
-                                  if kind == "furniture"}
+        self._names = add_static_shapes(
+            space, config.room, wall_type=_WALL, furniture_type=_FURNITURE, friction=_FRICTION
+        )
+        self._furniture_shapes = {
+            name: shape for shape, (kind, name) in self._names.items() if kind == "furniture"
+        }
         self._removed = set()
         # (time, name) of the furniture that leaves the room, earliest first.
-        self._removals = sorted((f.present_until, f.name) for f in config.room.furniture
-                                if f.present_until is not None)
+        self._removals = sorted(
+            (f.present_until, f.name) for f in config.room.furniture if f.present_until is not None
+        )
         self.people = []
         # One generator per person, so a person's jitter does not depend on the others or on
         # the order in which their paths are queried.
@@ -200,8 +218,13 @@ class World:
         self._motor_v = 0.0  # the wheels' forward speed at the last sub-step, m/s
         self._events = []
         for ctype in (_WALL, _FURNITURE, _PERSON):
-            space.on_collision(_ROBOT, ctype, begin=self._on_begin,
-                               post_solve=self._on_post_solve, separate=self._on_separate)
+            space.on_collision(
+                _ROBOT,
+                ctype,
+                begin=self._on_begin,
+                post_solve=self._on_post_solve,
+                separate=self._on_separate,
+            )
 
         self._static_walls = scene_walls(config.room)
         self._world_map = self._build_map()
@@ -212,13 +235,16 @@ class World:
         return WorldMap(
             *map_data(room, self._removed),
             terrain=[list(t.polygon) for t in room.terrain],
-            terrain_colors=[tuple(round(c * 255) for c in (t.color or (0.55, 0.7, 0.9)))
-                            for t in room.terrain],
-            lines=[[tuple(p) for p in line.points] + ([tuple(line.points[0])] if line.closed
-                                                       else [])
-                   for line in self.floor_lines],
+            terrain_colors=[
+                tuple(round(c * 255) for c in (t.color or (0.55, 0.7, 0.9))) for t in room.terrain
+            ],
+            lines=[
+                [tuple(p) for p in line.points] + ([tuple(line.points[0])] if line.closed else [])
+                for line in self.floor_lines
+            ],
             line_widths=[line.width for line in self.floor_lines],
-            line_colors=[tuple(round(c * 255) for c in line.color) for line in self.floor_lines])
+            line_colors=[tuple(round(c * 255) for c in line.color) for line in self.floor_lines],
+        )
 
     @classmethod
     def from_config(cls, cfg=None, seed=0):
@@ -234,16 +260,19 @@ class World:
         if not self._collisions.begin(kind, name, other, self._now):
             return  # still touching, or touching again within the episode gap
         if kind != "person":
-            self._events.append(f"collision with {kind} {name!r}" if name
-                                else f"collision with {kind}")
+            self._events.append(
+                f"collision with {kind} {name!r}" if name else f"collision with {kind}"
+            )
             return
         robot_c, person_c = self._closing_speeds(other)
         fault = robot_c > AT_FAULT_SPEED and robot_c > person_c
         if fault:
             self._collisions.record_fault(kind)
         verdict = "the robot's fault" if fault else "not the robot's fault"
-        self._events.append(f"collision with person {name!r} (robot closing {_speed(robot_c)} "
-                            f"m/s, person {_speed(person_c)} m/s: {verdict})")
+        self._events.append(
+            f"collision with person {name!r} (robot closing {_speed(robot_c)} "
+            f"m/s, person {_speed(person_c)} m/s: {verdict})"
+        )
 
     def _closing_speeds(self, person_shape):
         """The robot's and the person's speeds towards each other at a first touch, m/s,
@@ -294,8 +323,9 @@ class World:
             # The body follows the wheels at most at traction_force / mass.
             accel = min(abs(v - self._motor_v) / h, spec.traction_force / spec.mass)
             if accel > spec.tip_accel:
-                self._tip(f"longitudinal acceleration {accel:.2f} m/s^2 > "
-                          f"{spec.tip_accel:.2f} m/s^2")
+                self._tip(
+                    f"longitudinal acceleration {accel:.2f} m/s^2 > {spec.tip_accel:.2f} m/s^2"
+                )
         self._motor_v = v
         w = r * (wr - wl) / spec.wheel_separation
         a = body.angle
@@ -317,8 +347,10 @@ class World:
             if gap > 0.0 and person.teleop is None:
                 # Wait (the script pauses) rather than step closer to the robot than the gap.
                 ahead = math.hypot(x - rx, y - ry)
-                if (ahead < math.hypot(px - rx, py - ry)
-                        and ahead - person.config.radius - spec.body_radius < gap):
+                if (
+                    ahead < math.hypot(px - rx, py - ry)
+                    and ahead - person.config.radius - spec.body_radius < gap
+                ):
                     person.waited += h
                     x, y = px, py
             # Arrive exactly on the script; the velocity lets contacts push the robot.
@@ -354,8 +386,9 @@ class World:
         patch = self.terrain.at(x, y) if self.terrain else None
         if patch is not self._patch:
             self._patch = patch
-            self._events.append(f"terrain: on {patch.name!r}" if patch is not None
-                                else "terrain: off the patches")
+            self._events.append(
+                f"terrain: on {patch.name!r}" if patch is not None else "terrain: off the patches"
+            )
         factor = slip * (patch.friction if patch is not None else 1.0)
         if factor != self._traction:
             self._traction = factor
@@ -367,8 +400,7 @@ class World:
     def _downhill(self, patch):
         force = self._downhill_cache.get(id(patch))
         if force is None:
-            force = self._downhill_cache[id(patch)] = patch.downhill_force(
-                self.robot_spec.mass, G)
+            force = self._downhill_cache[id(patch)] = patch.downhill_force(self.robot_spec.mass, G)
         return force
 
     def terrain_under_robot(self):
@@ -451,17 +483,22 @@ class World:
         """The robot's camera as ``sim.scene.CameraPose`` (mount from ``robot_spec``)."""
         spec = self.robot_spec
         x, y, heading = self.robot_pose()
-        return CameraPose(x=x + spec.camera_forward * math.cos(heading),
-                          y=y + spec.camera_forward * math.sin(heading), heading=heading,
-                          height=spec.camera_height, tilt=spec.camera_tilt + self.camera_pitch())
+        return CameraPose(
+            x=x + spec.camera_forward * math.cos(heading),
+            y=y + spec.camera_forward * math.sin(heading),
+            heading=heading,
+            height=spec.camera_height,
+            tilt=spec.camera_tilt + self.camera_pitch(),
+        )
 
     def people_states(self):
         """Every person's position, as ``records.PersonState``."""
         states = []
         for p in self.people:
             x, y = p.body.position
-            states.append(PersonState(p.config.name, float(x), float(y), p.config.radius,
-                                      p.config.target))
+            states.append(
+                PersonState(p.config.name, float(x), float(y), p.config.radius, p.config.target)
+            )
         return states
 
     def target_position(self):
@@ -482,13 +519,26 @@ class World:
         for p in self.people:
             x, y = p.body.position
             vx, vy = p.body.velocity
-            cylinders.append(Cylinder(x=float(x), y=float(y), radius=p.config.radius,
-                                      bands=p.bands, facing=p.facing,
-                                      speed=math.hypot(vx, vy), walked=p.walked))
-        return Scene(walls=self._static_walls, cylinders=tuple(cylinders),
-                     floor_color=tuple(room.floor_color),
-                     ceiling_color=tuple(room.ceiling_color), ceiling_height=room.height,
-                     lighting=self.lighting.at(self.time), floor_patches=self._floor_patches)
+            cylinders.append(
+                Cylinder(
+                    x=float(x),
+                    y=float(y),
+                    radius=p.config.radius,
+                    bands=p.bands,
+                    facing=p.facing,
+                    speed=math.hypot(vx, vy),
+                    walked=p.walked,
+                )
+            )
+        return Scene(
+            walls=self._static_walls,
+            cylinders=tuple(cylinders),
+            floor_color=tuple(room.floor_color),
+            ceiling_color=tuple(room.ceiling_color),
+            ceiling_height=room.height,
+            lighting=self.lighting.at(self.time),
+            floor_patches=self._floor_patches,
+        )
 
     def world_map(self):
         """Geometry for the viewer's top-down map (``records.WorldMap``); a new map after

@@ -22,7 +22,8 @@ def _verilator_model(args, kwargs):
 #: module -> [(function inside it, what it builds, which calls are refused (None: all))].
 ENTRY_POINTS = {
     "fpga_robotics.sim.backends.build_cache": [
-        ("get_or_build", "a Verilator model", _verilator_model)],
+        ("get_or_build", "a Verilator model", _verilator_model)
+    ],
     "fpga_robotics.flow.board": [("find_yowasp_tools", "place and route (nextpnr)", None)],
 }
 
@@ -36,7 +37,7 @@ def _guarded(original, what, refused, test):
         if refused is None or refused(args, kwargs):
             raise SlowBuildInFastTier(
                 f"{test} builds {what} but is not marked slow: the fast tier "
-                f"(pytest -m \"not slow\") builds no Verilator model and runs no place and "
+                f'(pytest -m "not slow") builds no Verilator model and runs no place and '
                 f"route; mark the test @pytest.mark.slow"
             )
         return original(*args, **kwargs)

@@ -39,7 +39,8 @@ def test_a_wall_inside_the_sensors_blind_zone_is_hit():
     # The design's blind spot, and a test that can fail: a module that hears nothing nearer
     # than 350 mm answers with its time-out pulse, which the design reads as "far away", so
     # it speeds up again just before the wall.
-    result = run(HERE / "ranger.toml",
-                 overrides=["robot.sensors[0].min_range=0.35", "sim.duration=20"])
+    result = run(
+        HERE / "ranger.toml", overrides=["robot.sensors[0].min_range=0.35", "sim.duration=20"]
+    )
     assert result.check("max_wall_collisions").status == "fail"
     assert result.trajectory["design.range"].max() > 6000  # the time-out, read as a range

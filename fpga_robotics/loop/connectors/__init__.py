@@ -6,13 +6,13 @@ Importing this package registers every shipped kind: ``camera`` (rendered frames
 robot)."""
 
 from fpga_robotics.loop.connectors.base import (
-           CONNECTORS,
-           Connector,
-           ConnectorError,
-           Mount,
-           Pin,
-           PinIO,
-           register,
+    CONNECTORS,
+    Connector,
+    ConnectorError,
+    Mount,
+    Pin,
+    PinIO,
+    register,
 )
 from fpga_robotics.loop.connectors.bumper import BumperConnector
 from fpga_robotics.loop.connectors.camera import CameraConnector, camera_pose, in_view
@@ -21,18 +21,18 @@ from fpga_robotics.loop.connectors.motors import MotorConnector
 from fpga_robotics.loop.connectors.ultrasound import UltrasoundConnector
 
 __all__ = [
-           "CONNECTORS",
-           "BumperConnector",
-           "CameraConnector",
-           "Connector",
-           "ConnectorError",
-           "LineSensorsConnector",
-           "MotorConnector",
-           "Mount",
-           "Pin",
-           "PinIO",
-           "UltrasoundConnector",
-           "camera_pose",
-           "in_view",
-           "register",
+    "CONNECTORS",
+    "BumperConnector",
+    "CameraConnector",
+    "Connector",
+    "ConnectorError",
+    "LineSensorsConnector",
+    "MotorConnector",
+    "Mount",
+    "Pin",
+    "PinIO",
+    "UltrasoundConnector",
+    "camera_pose",
+    "in_view",
+    "register",
 ]

@@ -21,8 +21,19 @@ from typing import ClassVar
 
 from fpga_robotics.hw.errors import UserError
 
-__all__ = ["CONNECTORS", "MOUNT_KEYS", "Connector", "ConnectorError", "Mount", "Pin", "PinIO",
-           "check_number", "connector_class", "parse_mount", "register"]
+__all__ = [
+    "CONNECTORS",
+    "MOUNT_KEYS",
+    "Connector",
+    "ConnectorError",
+    "Mount",
+    "Pin",
+    "PinIO",
+    "check_number",
+    "connector_class",
+    "parse_mount",
+    "register",
+]
 
 #: kind -> Connector subclass.
 CONNECTORS = {}
@@ -56,8 +67,11 @@ class Mount:
     def world_pose(self, x, y, heading):
         """``(x, y, heading)`` of the mount in the world for a robot at ``(x, y, heading)``."""
         c, s = math.cos(heading), math.sin(heading)
-        return (x + self.forward * c - self.left * s, y + self.forward * s + self.left * c,
-                heading + self.yaw)
+        return (
+            x + self.forward * c - self.left * s,
+            y + self.forward * s + self.left * c,
+            heading + self.yaw,
+        )
 
 
 class PinIO:
@@ -118,8 +132,9 @@ class Connector:
         ``name`` and the mount keys); return the params object. Raise ``ConnectorError``
         naming ``where`` (e.g. ``robot.sensors[0]``) and the key."""
         if table:
-            raise ConnectorError(f"{where}: unknown key {min(table)!r} for a "
-                                 f"{cls.kind!r} connector")
+            raise ConnectorError(
+                f"{where}: unknown key {min(table)!r} for a {cls.kind!r} connector"
+            )
 
     def start(self, io):
         """Called once, after the design's reset, before the first physics step."""
@@ -151,12 +166,18 @@ def check_number(table, key, default, where, *, lo, hi, unit="", lo_open=False):
     """``table[key]`` (or ``default``) as a float within ``lo..hi`` (``lo`` excluded with
     ``lo_open``); a ``ConnectorError`` naming ``where.key`` otherwise."""
     value = table.get(key, default)
-    ok = (isinstance(value, (int, float)) and not isinstance(value, bool)
-          and math.isfinite(value) and (value > lo if lo_open else value >= lo) and value <= hi)
+    ok = (
+        isinstance(value, (int, float))
+        and not isinstance(value, bool)
+        and math.isfinite(value)
+        and (value > lo if lo_open else value >= lo)
+        and value <= hi
+    )
     if not ok:
         span = f"{'>' if lo_open else '>='} {lo:g} and <= {hi:g}"
-        raise ConnectorError(f"{where}.{key} must be a number{' in ' + unit if unit else ''} "
-                             f"{span}, got {value!r}")
+        raise ConnectorError(
+            f"{where}.{key} must be a number{' in ' + unit if unit else ''} {span}, got {value!r}"
+        )
     return float(value)
 
 
@@ -164,11 +185,12 @@ def parse_mount(table, where):
     """Split a connector table into its ``Mount`` (keys ``MOUNT_KEYS``: m, m, m, degrees)
     and the rest (a new dict); a ``ConnectorError`` naming ``where`` for a bad value."""
     rest = {k: v for k, v in table.items() if k not in MOUNT_KEYS}
-    mount = Mount(forward=check_number(table, "forward", 0.0, where, lo=-2, hi=2, unit="m"),
-                  left=check_number(table, "left", 0.0, where, lo=-2, hi=2, unit="m"),
-                  height=check_number(table, "height", 0.0, where, lo=0, hi=3, unit="m"),
-                  yaw=math.radians(check_number(table, "yaw_deg", 0.0, where, lo=-360,
-                                                hi=360)))
+    mount = Mount(
+        forward=check_number(table, "forward", 0.0, where, lo=-2, hi=2, unit="m"),
+        left=check_number(table, "left", 0.0, where, lo=-2, hi=2, unit="m"),
+        height=check_number(table, "height", 0.0, where, lo=0, hi=3, unit="m"),
+        yaw=math.radians(check_number(table, "yaw_deg", 0.0, where, lo=-360, hi=360)),
+    )
     return mount, rest
 
 
@@ -184,5 +206,7 @@ def connector_class(kind, where="robot.sensors"):
     try:
         return CONNECTORS[kind]
     except KeyError:
-        raise ConnectorError(f"{where}: unknown connector kind {kind!r}; choose one of: "
-                             f"{', '.join(sorted(CONNECTORS))}") from None
+        raise ConnectorError(
+            f"{where}: unknown connector kind {kind!r}; choose one of: "
+            f"{', '.join(sorted(CONNECTORS))}"
+        ) from None

@@ -37,14 +37,20 @@ class BumperConnector(Connector):
         values = {}
         for key, value in table.items():
             if key not in limits:
-                raise ConnectorError(f"{where}: unknown key {key!r} for a bumper; its keys: "
-                                     f"{', '.join(limits)} (and the mount: forward, left, "
-                                     f"height, yaw)")
+                raise ConnectorError(
+                    f"{where}: unknown key {key!r} for a bumper; its keys: "
+                    f"{', '.join(limits)} (and the mount: forward, left, "
+                    f"height, yaw)"
+                )
             lo, hi = limits[key]
-            if isinstance(value, bool) or not isinstance(value, (int, float)) or not (
-                    lo <= value <= hi):
-                raise ConnectorError(f"{where}.{key} must be a number in {lo:g}..{hi:g}, "
-                                     f"got {value!r}")
+            if (
+                isinstance(value, bool)
+                or not isinstance(value, (int, float))
+                or not (lo <= value <= hi)
+            ):
+                raise ConnectorError(
+                    f"{where}.{key} must be a number in {lo:g}..{hi:g}, got {value!r}"
+                )
             values[key] = value
         return BumperParams(**values)
 

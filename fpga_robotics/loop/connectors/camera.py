@@ -18,8 +18,15 @@ from fpga_robotics.hw.errors import UsageError
 from fpga_robotics.loop.connectors.base import Connector, Mount, Pin, register
 from fpga_robotics.sim.camera.scene import CameraPose
 
-__all__ = ["SENSOR_STREAM", "CameraConnector", "ExposureDrift", "camera_pose", "in_view",
-           "make_renderer", "make_sensor"]
+__all__ = [
+    "SENSOR_STREAM",
+    "CameraConnector",
+    "ExposureDrift",
+    "camera_pose",
+    "in_view",
+    "make_renderer",
+    "make_sensor",
+]
 
 #: Correlation time of the exposure drift, s: a slow change (clouds, a lamp warming up).
 DRIFT_TAU = 10.0
@@ -48,8 +55,10 @@ class ExposureDrift:
     def apply(self, rgb):
         """``rgb`` (uint8) times the next gain, rounded and clipped to 0..255."""
         g = self.gain()
-        return np.clip(rgb.astype(np.float32) * np.float32(g) + np.float32(0.5), 0,
-                       255).astype(np.uint8)
+        return np.clip(rgb.astype(np.float32) * np.float32(g) + np.float32(0.5), 0, 255).astype(
+            np.uint8
+        )
+
 
 #: The sensor model's random stream is ``default_rng([seed, SENSOR_STREAM])``: its own, so that
 #: it shifts neither the world's randomness nor the plain path's noise.
@@ -63,9 +72,15 @@ def make_sensor(cam, seed):
     from fpga_robotics.sim.camera.raster import focal_length
     from fpga_robotics.sim.camera.sensor import OV7670Sensor
 
-    return OV7670Sensor(cam.width, cam.height, cam.ov7670,
-                        rng=np.random.default_rng([seed, SENSOR_STREAM]),
-                        frame_period=cam.frame_period, focal_px=focal_length(cam.width, cam.hfov))
+    return OV7670Sensor(
+        cam.width,
+        cam.height,
+        cam.ov7670,
+        rng=np.random.default_rng([seed, SENSOR_STREAM]),
+        frame_period=cam.frame_period,
+        focal_px=focal_length(cam.width, cam.hfov),
+    )
+
 
 def make_renderer(name, width, height, hfov, render3d=None):
     """The renderer ``camera.renderer`` names; a missing MuJoCo or OpenGL is a
@@ -82,9 +97,8 @@ def make_renderer(name, width, height, hfov, render3d=None):
         renderer = MujocoRenderer(width, height, hfov, render3d)
         renderer.prepare()
     except Render3DUnavailable as exc:
-        raise UsageError(f"camera.renderer = \"mujoco\": {exc}") from None
+        raise UsageError(f'camera.renderer = "mujoco": {exc}') from None
     return renderer
-
 
 
 def camera_pose(robot_pose, *, height, forward=0.0, tilt=0.0):
@@ -149,9 +163,24 @@ class CameraConnector(Connector):
         The 3D renderer's options (shadows, textures, lamps); None: its defaults.
     """
 
-    def __init__(self, width, height, hfov, *, mount_height, mount_forward=0.0, tilt=0.0,
-                 noise_std=0.0, rng=None, sensor=None, turn_rate=None, yaw_offset=0.0,
-                 drift=None, renderer="raster", render3d=None):
+    def __init__(
+        self,
+        width,
+        height,
+        hfov,
+        *,
+        mount_height,
+        mount_forward=0.0,
+        tilt=0.0,
+        noise_std=0.0,
+        rng=None,
+        sensor=None,
+        turn_rate=None,
+        yaw_offset=0.0,
+        drift=None,
+        renderer="raster",
+        render3d=None,
+    ):
         self.name, self.params, self.world = "camera", None, None
         self.width, self.height, self.hfov = width, height, hfov
         self.mount_height, self.mount_forward, self.tilt = mount_height, mount_forward, tilt
@@ -167,14 +196,14 @@ class CameraConnector(Connector):
     @property
     def mount(self):
         """Where the camera sits (``base.Mount``), from the constructor's fields."""
-        return Mount(forward=self.mount_forward, height=self.mount_height,
-                     yaw=self.yaw_offset)
+        return Mount(forward=self.mount_forward, height=self.mount_height, yaw=self.yaw_offset)
 
     def pose(self, robot_pose, pitch=0.0):
         """The camera's pose on a robot at ``robot_pose``; ``pitch`` (rad) adds to the
         mount's tilt (the slope under the robot)."""
-        pose = camera_pose(robot_pose, height=self.mount_height, forward=self.mount_forward,
-                           tilt=self.tilt + pitch)
+        pose = camera_pose(
+            robot_pose, height=self.mount_height, forward=self.mount_forward, tilt=self.tilt + pitch
+        )
         if self.yaw_offset:
             pose = replace(pose, heading=pose.heading + self.yaw_offset)
         return pose

@@ -61,8 +61,14 @@ class LineSensorsConnector(Connector):
         #: and added to the connector's mount (also what the line metrics follow).
         c, s = math.cos(mount.yaw), math.sin(mount.yaw)
         self.sensor_mounts = tuple(
-            Mount(forward=mount.forward + f * c - left * s, left=mount.left + f * s + left * c,
-                  height=mount.height, yaw=mount.yaw) for f, left in params.sensors)
+            Mount(
+                forward=mount.forward + f * c - left * s,
+                left=mount.left + f * s + left * c,
+                height=mount.height,
+                yaw=mount.yaw,
+            )
+            for f, left in params.sensors
+        )
         self.bits = 0
         self.positions = []
 
@@ -72,33 +78,46 @@ class LineSensorsConnector(Connector):
         sensors = table.pop("sensors", None)
         unknown = sorted(k for k in table if k not in _MODULE_KEYS)
         if unknown:
-            raise ConnectorError(f"{where}: unknown key {unknown[0]!r} for a 'line_sensors' "
-                                 f"connector; its keys: sensors, {', '.join(_MODULE_KEYS)}")
-        if (not isinstance(sensors, list) or not 1 <= len(sensors) <= MAX_SENSORS
-                or not all(isinstance(s, dict) for s in sensors)):
+            raise ConnectorError(
+                f"{where}: unknown key {unknown[0]!r} for a 'line_sensors' "
+                f"connector; its keys: sensors, {', '.join(_MODULE_KEYS)}"
+            )
+        if (
+            not isinstance(sensors, list)
+            or not 1 <= len(sensors) <= MAX_SENSORS
+            or not all(isinstance(s, dict) for s in sensors)
+        ):
             raise ConnectorError(
                 f"{where}.sensors must be an array of 1 to {MAX_SENSORS} tables "
                 f"{{forward = m, left = m}}, ordered from the robot's left to its right, got "
-                f"{sensors!r}")
+                f"{sensors!r}"
+            )
         offsets = []
         for i, s in enumerate(sensors):
             here = f"{where}.sensors[{i}]"
             extra = sorted(k for k in s if k not in ("forward", "left"))
             if extra:
-                raise ConnectorError(f"{here}: unknown key {extra[0]!r}; its keys: forward, "
-                                     f"left")
-            offsets.append((check_number(s, "forward", 0.0, here, lo=-1, hi=1, unit="m"),
-                            check_number(s, "left", 0.0, here, lo=-1, hi=1, unit="m")))
+                raise ConnectorError(f"{here}: unknown key {extra[0]!r}; its keys: forward, left")
+            offsets.append(
+                (
+                    check_number(s, "forward", 0.0, here, lo=-1, hi=1, unit="m"),
+                    check_number(s, "left", 0.0, here, lo=-1, hi=1, unit="m"),
+                )
+            )
         for i in range(1, len(offsets)):
             if not offsets[i][1] < offsets[i - 1][1]:
                 raise ConnectorError(
                     f"{where}.sensors[{i}].left must be less than sensors[{i - 1}].left "
                     f"({offsets[i - 1][1]:g} m): the sensors are listed from the robot's "
-                    f"left (bit 0) to its right, got {offsets[i][1]:g}")
+                    f"left (bit 0) to its right, got {offsets[i][1]:g}"
+                )
         defaults = KY033Params()
-        values = {key: check_number(table, key, getattr(defaults, key), where, lo=lo, hi=hi,
-                                    unit=unit, lo_open=open_)
-                  for key, (lo, hi, unit, open_) in _MODULE_KEYS.items()}
+        values = {
+            key: check_number(
+                table, key, getattr(defaults, key), where, lo=lo, hi=hi, unit=unit, lo_open=open_
+            )
+            for key, (lo, hi, unit, open_) in _MODULE_KEYS.items()
+        }
         return LineSensorsParams(tuple(offsets), replace(defaults, **values))
 
     def sensor_positions(self):
@@ -127,5 +146,7 @@ class LineSensorsConnector(Connector):
 
     def map_overlay(self):
         """Each sensor where it read the floor, lit when its bit is 1 (over the line)."""
-        return {"points": tuple((float(x), float(y)) for x, y in self.positions),
-                "states": tuple(self.bits >> i & 1 for i in range(len(self.positions)))}
+        return {
+            "points": tuple((float(x), float(y)) for x, y in self.positions),
+            "states": tuple(self.bits >> i & 1 for i in range(len(self.positions))),
+        }

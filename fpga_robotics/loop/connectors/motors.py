@@ -33,7 +33,10 @@ class MotorConnector(Connector):
 
     kind = "wheels"
     role = "actuator"
-    pins: ClassVar[dict] = {"motor_left": Pin("out", 16, signed=True), "motor_right": Pin("out", 16, signed=True)}
+    pins: ClassVar[dict] = {
+        "motor_left": Pin("out", 16, signed=True),
+        "motor_right": Pin("out", 16, signed=True),
+    }
     watch = ("motor_left", "motor_right")
 
     def __init__(self, world):

@@ -55,14 +55,21 @@ class UltrasoundConnector(Connector):
         defaults = HCSR04Params()
         unknown = sorted(k for k in table if k not in _KEYS)
         if unknown:
-            raise ConnectorError(f"{where}: unknown key {unknown[0]!r} for an 'ultrasound' "
-                                 f"connector; its keys: {', '.join(_KEYS)}")
-        values = {key: check_number(table, key, getattr(defaults, key), where, lo=lo, hi=hi,
-                                    unit=unit, lo_open=open_)
-                  for key, (lo, hi, unit, open_) in _KEYS.items()}
+            raise ConnectorError(
+                f"{where}: unknown key {unknown[0]!r} for an 'ultrasound' "
+                f"connector; its keys: {', '.join(_KEYS)}"
+            )
+        values = {
+            key: check_number(
+                table, key, getattr(defaults, key), where, lo=lo, hi=hi, unit=unit, lo_open=open_
+            )
+            for key, (lo, hi, unit, open_) in _KEYS.items()
+        }
         if not values["min_range"] < values["max_range"]:
-            raise ConnectorError(f"{where}.max_range must be greater than min_range "
-                                 f"({values['min_range']:g} m), got {values['max_range']:g}")
+            raise ConnectorError(
+                f"{where}.max_range must be greater than min_range "
+                f"({values['min_range']:g} m), got {values['max_range']:g}"
+            )
         return HCSR04Params(**values)
 
     def start(self, io):
@@ -115,6 +122,7 @@ class UltrasoundConnector(Connector):
         m = self.measurement()
         if m and not m["timeout"]:
             reach = m["echo_m"]
-            out["rays"] = (((x, y), (x + reach * math.cos(heading),
-                                     y + reach * math.sin(heading))),)
+            out["rays"] = (
+                ((x, y), (x + reach * math.cos(heading), y + reach * math.sin(heading))),
+            )
         return out

@@ -36,8 +36,7 @@ FULL_SWING_SPEED = 0.5
 #: Full swing amplitudes, rad: hip (leg forward/back), knee bend, shoulder, elbow bend.
 SWING = {"hip": 0.42, "knee": 0.6, "shoulder": 0.35, "elbow": 0.3}
 #: Joint names in the order the renderer declares them (left then right).
-JOINTS = ("hip_l", "knee_l", "hip_r", "knee_r", "shoulder_l", "elbow_l", "shoulder_r",
-          "elbow_r")
+JOINTS = ("hip_l", "knee_l", "hip_r", "knee_r", "shoulder_l", "elbow_l", "shoulder_r", "elbow_r")
 
 SHOES = (0.12, 0.1, 0.09)
 HAIR = (0.2, 0.13, 0.08)
@@ -64,8 +63,11 @@ def body_colors(bands, height):
                 return tuple(band.color)
         return default
 
-    return BodyColors(shirt=at(1.2, (0.5, 0.5, 0.5)), trousers=at(0.45, (0.2, 0.2, 0.25)),
-                      skin=at(1.62, (0.87, 0.68, 0.56)))
+    return BodyColors(
+        shirt=at(1.2, (0.5, 0.5, 0.5)),
+        trousers=at(0.45, (0.2, 0.2, 0.25)),
+        skin=at(1.62, (0.87, 0.68, 0.56)),
+    )
 
 
 def person_height(bands):

@@ -32,8 +32,7 @@ def triangulate(polygon):
         for i in range(len(pts)):
             a, b, c = pts[i - 1], pts[i], pts[(i + 1) % len(pts)]
             convex = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]) > 1e-12
-            if convex and not any(_inside_triangle(p, a, b, c) for p in pts
-                                  if p not in (a, b, c)):
+            if convex and not any(_inside_triangle(p, a, b, c) for p in pts if p not in (a, b, c)):
                 out.append((a, b, c))
                 del pts[i]
                 break
@@ -51,9 +50,9 @@ def patch_assets_and_geoms(scene):
         rgba = " ".join(f"{c:.6g}" for c in (*color, 1.0))
         for t, tri in enumerate(triangulate(polygon)):
             name = f"floor_patch{k}_{t}"
-            verts = " ".join(f"{x:.6g} {y:.6g} {z:.6g}" for x, y in tri
-                             for z in (LIFT / 2, LIFT))
+            verts = " ".join(f"{x:.6g} {y:.6g} {z:.6g}" for x, y in tri for z in (LIFT / 2, LIFT))
             assets.append(f'<mesh name="{name}" vertex="{verts}"/>')
-            geoms.append(f'<geom type="mesh" mesh="{name}" rgba="{rgba}" contype="0" '
-                         f'conaffinity="0"/>')
+            geoms.append(
+                f'<geom type="mesh" mesh="{name}" rgba="{rgba}" contype="0" conaffinity="0"/>'
+            )
     return assets, geoms

@@ -25,8 +25,13 @@ __all__ = ["ModelSpec", "build_model_xml"]
 #: Thickness of the room's wall slabs and of lone walls, m.
 SLAB = 0.05
 #: Texture size and the metres one texture covers, per kind.
-_TEXTURES = {"paint": (256, 2.0), "planks": (512, 0.9), "tiles": (256, 1.6),
-             "grain": (256, 1.0), "plain": (8, 1.0)}
+_TEXTURES = {
+    "paint": (256, 2.0),
+    "planks": (512, 0.9),
+    "tiles": (256, 1.6),
+    "grain": (256, 1.0),
+    "plain": (8, 1.0),
+}
 
 
 @dataclass
@@ -69,11 +74,13 @@ class _Materials:
         repeat = 1.0 / metres
         self.assets.append(
             f'<texture name="{tex}" type="{"2d" if flat else "cube"}" builtin="flat" '
-            f'width="{size}" height="{size}" rgb1="1 1 1"/>')
+            f'width="{size}" height="{size}" rgb1="1 1 1"/>'
+        )
         self.assets.append(
             f'<material name="{mat}" texture="{tex}" texuniform="{"true" if flat else "false"}" '
             f'texrepeat="{repeat:.6g} {repeat:.6g}" specular="{specular:.6g}" '
-            f'shininess="0.3" reflectance="0"/>')
+            f'shininess="0.3" reflectance="0"/>'
+        )
         self._names[key] = mat
         return mat
 
@@ -95,8 +102,10 @@ def _slab(w, thickness, offset):
     cx = (w.x0 + w.x1) / 2 + offset * nx
     cy = (w.y0 + w.y1) / 2 + offset * ny
     angle = math.atan2(ey, ex)
-    return (f'pos="{_f((cx, cy, w.height / 2))}" euler="0 0 {angle:.6g}" '
-            f'size="{_f((length / 2, thickness / 2, w.height / 2))}"')
+    return (
+        f'pos="{_f((cx, cy, w.height / 2))}" euler="0 0 {angle:.6g}" '
+        f'size="{_f((length / 2, thickness / 2, w.height / 2))}"'
+    )
 
 
 def _static_geoms(scene, mats):
@@ -113,8 +122,10 @@ def _static_geoms(scene, mats):
                 ex, ey = w.x1 - w.x0, w.y1 - w.y0
                 left = -ey * (cx - w.x0) + ex * (cy - w.y0) > 0
                 mat = mats.get("paint", w.color)
-                out.append(f'<geom type="box" {_slab(w, SLAB, -SLAB / 2 if left else SLAB / 2)} '
-                           f'material="{mat}"/>')
+                out.append(
+                    f'<geom type="box" {_slab(w, SLAB, -SLAB / 2 if left else SLAB / 2)} '
+                    f'material="{mat}"/>'
+                )
         elif kind == "box" and len(ws) == 4:
             w0, w1 = ws[0], ws[1]
             length = math.hypot(w0.x1 - w0.x0, w0.y1 - w0.y0)
@@ -123,9 +134,11 @@ def _static_geoms(scene, mats):
             cy_ = sum(w.y0 for w in ws) / 4
             angle = math.atan2(w0.y1 - w0.y0, w0.x1 - w0.x0)
             mat = mats.get("paint", w0.color)
-            out.append(f'<geom type="box" pos="{_f((cx_, cy_, w0.height / 2))}" '
-                       f'euler="0 0 {angle:.6g}" '
-                       f'size="{_f((length / 2, width / 2, w0.height / 2))}" material="{mat}"/>')
+            out.append(
+                f'<geom type="box" pos="{_f((cx_, cy_, w0.height / 2))}" '
+                f'euler="0 0 {angle:.6g}" '
+                f'size="{_f((length / 2, width / 2, w0.height / 2))}" material="{mat}"/>'
+            )
         elif kind == "divider" and len(ws) == 2:
             a, b = ws
             length = math.hypot(a.x1 - a.x0, a.y1 - a.y0)
@@ -134,10 +147,12 @@ def _static_geoms(scene, mats):
             cy_ = (a.y0 + a.y1 + b.y0 + b.y1) / 4
             angle = math.atan2(a.y1 - a.y0, a.x1 - a.x0)
             mat = mats.get("grain", a.color, mats.options.shine * 0.6)
-            out.append(f'<geom type="box" pos="{_f((cx_, cy_, a.height / 2))}" '
-                       f'euler="0 0 {angle:.6g}" '
-                       f'size="{_f((length / 2, max(thick, 0.005) / 2, a.height / 2))}" '
-                       f'material="{mat}"/>')
+            out.append(
+                f'<geom type="box" pos="{_f((cx_, cy_, a.height / 2))}" '
+                f'euler="0 0 {angle:.6g}" '
+                f'size="{_f((length / 2, max(thick, 0.005) / 2, a.height / 2))}" '
+                f'material="{mat}"/>'
+            )
         else:
             for w in ws:
                 mat = mats.get("plain", w.color)
@@ -164,49 +179,75 @@ def _person(i, cyl, mats, shine):
     torso = (0.13 * k, 0.12 * k, (1.40 - 0.85) / 2 * s)
     upper_arm, forearm = 0.29 * s, 0.27 * s
     thigh, shin = 0.40 * s, 0.40 * s
-    lines = [f'<body name="{name}" mocap="true" pos="{_f((cyl.x, cyl.y, 0))}">',
-             (f'<geom type="box" pos="{_f((0, 0, (0.85 + 1.40) / 2 * s))}" size="{_f(torso)}" '
-             f'material="{shirt}"/>'),
-             # Hips in the trousers' colour: they hide the torso's underside from a camera
-             # below it, as the raster's bands do.
-             (f'<geom type="box" pos="{_f((0, 0, 0.785 * s))}" '
-             f'size="{_f((0.128 * k, 0.118 * k, 0.075 * s))}" material="{trousers}"/>'),
-             # Shoulders: a bar across the top of the torso.
-             (f'<geom type="capsule" fromto="{_f((0, -0.115 * k, 1.40 * s, 0, 0.115 * k, 1.40 * s))}"'
-             f' size="{0.05 * k:.6g}" material="{shirt}"/>'),
-             (f'<geom type="cylinder" pos="{_f((0, 0, 1.47 * s))}" '
-             f'size="{_f((0.045 * k, 0.05 * s))}" material="{skin}"/>'),
-             (f'<geom type="ellipsoid" pos="{_f((0, 0, 1.625 * s))}" '
-             f'size="{_f((0.1 * k, 0.085 * k, 0.115 * s))}" material="{skin}"/>'),
-             (f'<geom type="ellipsoid" pos="{_f((-0.015 * k, 0, 1.68 * s))}" '
-             f'size="{_f((0.1 * k, 0.09 * k, 0.075 * s))}" material="{hair}"/>')]
+    lines = [
+        f'<body name="{name}" mocap="true" pos="{_f((cyl.x, cyl.y, 0))}">',
+        (
+            f'<geom type="box" pos="{_f((0, 0, (0.85 + 1.40) / 2 * s))}" size="{_f(torso)}" '
+            f'material="{shirt}"/>'
+        ),
+        # Hips in the trousers' colour: they hide the torso's underside from a camera
+        # below it, as the raster's bands do.
+        (
+            f'<geom type="box" pos="{_f((0, 0, 0.785 * s))}" '
+            f'size="{_f((0.128 * k, 0.118 * k, 0.075 * s))}" material="{trousers}"/>'
+        ),
+        # Shoulders: a bar across the top of the torso.
+        (
+            f'<geom type="capsule" fromto="{_f((0, -0.115 * k, 1.40 * s, 0, 0.115 * k, 1.40 * s))}"'
+            f' size="{0.05 * k:.6g}" material="{shirt}"/>'
+        ),
+        (
+            f'<geom type="cylinder" pos="{_f((0, 0, 1.47 * s))}" '
+            f'size="{_f((0.045 * k, 0.05 * s))}" material="{skin}"/>'
+        ),
+        (
+            f'<geom type="ellipsoid" pos="{_f((0, 0, 1.625 * s))}" '
+            f'size="{_f((0.1 * k, 0.085 * k, 0.115 * s))}" material="{skin}"/>'
+        ),
+        (
+            f'<geom type="ellipsoid" pos="{_f((-0.015 * k, 0, 1.68 * s))}" '
+            f'size="{_f((0.1 * k, 0.09 * k, 0.075 * s))}" material="{hair}"/>'
+        ),
+    ]
     for side, y in (("l", sh_y), ("r", -sh_y)):
         lines += [
             f'<body pos="{_f((0, y, 1.40 * s))}">',
             f'<joint name="{joints["shoulder_" + side]}" type="hinge" axis="0 -1 0"/>',
-            (f'<geom type="capsule" fromto="{_f((0, 0, 0, 0, 0, -upper_arm))}" '
-            f'size="{arm_r:.6g}" material="{shirt}"/>'),
+            (
+                f'<geom type="capsule" fromto="{_f((0, 0, 0, 0, 0, -upper_arm))}" '
+                f'size="{arm_r:.6g}" material="{shirt}"/>'
+            ),
             f'<body pos="{_f((0, 0, -upper_arm))}">',
             f'<joint name="{joints["elbow_" + side]}" type="hinge" axis="0 -1 0"/>',
-            (f'<geom type="capsule" fromto="{_f((0, 0, 0, 0, 0, -forearm))}" '
-            f'size="{arm_r * 0.9:.6g}" material="{shirt}"/>'),
-            (f'<geom type="sphere" pos="{_f((0, 0, -forearm - 0.05 * s))}" '
-            f'size="{0.045 * k:.6g}" material="{skin}"/>'),
+            (
+                f'<geom type="capsule" fromto="{_f((0, 0, 0, 0, 0, -forearm))}" '
+                f'size="{arm_r * 0.9:.6g}" material="{shirt}"/>'
+            ),
+            (
+                f'<geom type="sphere" pos="{_f((0, 0, -forearm - 0.05 * s))}" '
+                f'size="{0.045 * k:.6g}" material="{skin}"/>'
+            ),
             "</body></body>",
         ]
     for side, y in (("l", hip_y), ("r", -hip_y)):
         lines += [
             f'<body pos="{_f((0, y, hip_z))}">',
             f'<joint name="{joints["hip_" + side]}" type="hinge" axis="0 -1 0"/>',
-            (f'<geom type="capsule" fromto="{_f((0, 0, 0, 0, 0, -thigh))}" '
-            f'size="{leg_r:.6g}" material="{trousers}"/>'),
+            (
+                f'<geom type="capsule" fromto="{_f((0, 0, 0, 0, 0, -thigh))}" '
+                f'size="{leg_r:.6g}" material="{trousers}"/>'
+            ),
             f'<body pos="{_f((0, 0, -thigh))}">',
             # A knee bends the shin backwards.
             f'<joint name="{joints["knee_" + side]}" type="hinge" axis="0 1 0"/>',
-            (f'<geom type="capsule" fromto="{_f((0, 0, 0, 0, 0, -shin))}" '
-            f'size="{leg_r * 0.85:.6g}" material="{trousers}"/>'),
-            (f'<geom type="box" pos="{_f((0.04 * k, 0, -shin - 0.01 * s))}" '
-            f'size="{_f((0.12 * k, 0.05 * k, 0.045 * s))}" material="{shoes}"/>'),
+            (
+                f'<geom type="capsule" fromto="{_f((0, 0, 0, 0, 0, -shin))}" '
+                f'size="{leg_r * 0.85:.6g}" material="{trousers}"/>'
+            ),
+            (
+                f'<geom type="box" pos="{_f((0.04 * k, 0, -shin - 0.01 * s))}" '
+                f'size="{_f((0.12 * k, 0.05 * k, 0.045 * s))}" material="{shoes}"/>'
+            ),
             "</body></body>",
         ]
     lines.append("</body>")
@@ -227,8 +268,10 @@ def build_model_xml(scene, options, width, height, fovy_deg):
     ceiling = scene.ceiling_height
     body = []
     floor_mat = mats.get(floor_kind, scene.floor_color, flat=True)
-    body.append(f'<geom type="plane" pos="{_f((cx, cy, 0))}" '
-                f'size="{_f((half + SLAB, half + SLAB, 0.1))}" material="{floor_mat}"/>')
+    body.append(
+        f'<geom type="plane" pos="{_f((cx, cy, 0))}" '
+        f'size="{_f((half + SLAB, half + SLAB, 0.1))}" material="{floor_mat}"/>'
+    )
     body += _static_geoms(scene, mats)
     patch_assets, patch_geoms = patch_assets_and_geoms(scene)  # terrain drawn on the floor
     body += patch_geoms
@@ -237,13 +280,16 @@ def build_model_xml(scene, options, width, height, fovy_deg):
         name, joints, lines = _person(i, cyl, mats, options.shine)
         people.append((name, joints))
         body += lines
-    body.append('<body name="eye" mocap="true"><camera name="eye" '
-                f'fovy="{fovy_deg:.8g}"/></body>')
+    body.append(f'<body name="eye" mocap="true"><camera name="eye" fovy="{fovy_deg:.8g}"/></body>')
     # Light 0: the scene's directional light, above the room (its shadow map covers it).
     # Its strengths are set every frame from Scene.lighting.
     shadow = "true" if options.shadows else "false"
-    lights = [(f'<light name="sun" directional="true" pos="{_f((cx, cy, ceiling + 4 * half))}" '
-              f'dir="1 0.5 -1" castshadow="{shadow}" ambient="0 0 0" specular="0.3 0.3 0.3"/>')]
+    lights = [
+        (
+            f'<light name="sun" directional="true" pos="{_f((cx, cy, ceiling + 4 * half))}" '
+            f'dir="1 0.5 -1" castshadow="{shadow}" ambient="0 0 0" specular="0.3 0.3 0.3"/>'
+        )
+    ]
     for j, lamp in enumerate(options.lamps):
         d = [a - p for a, p in zip(lamp.aim, lamp.pos)]
         cast = "true" if options.shadows and lamp.shadows else "false"
@@ -251,29 +297,36 @@ def build_model_xml(scene, options, width, height, fovy_deg):
             f'<light name="lamp{j}" directional="false" pos="{_f(lamp.pos)}" dir="{_f(d)}" '
             f'cutoff="{lamp.cutoff_deg:.6g}" exponent="2" diffuse="{_f(lamp.color)}" '
             f'specular="{_f([0.5 * c for c in lamp.color])}" ambient="0 0 0" '
-            f'attenuation="1 0 0" castshadow="{cast}"/>')
-    xml = "\n".join([
-        '<mujoco model="scene">',
-        '<compiler angle="radian"/>',
-        "<visual>",
-        f'<global offwidth="{max(width, 1)}" offheight="{max(height, 1)}"/>',
-        f'<quality shadowsize="{options.shadow_size}" offsamples="0"/>',
-        '<headlight active="1" ambient="0 0 0" diffuse="0 0 0" specular="0 0 0"/>',
-        (f'<map znear="0.005" zfar="{8 * half + 2 * ceiling:.6g}" shadowclip="1.2" '
-        f'shadowscale="0.6" haze="0"/>'),
-        '<rgba haze="0 0 0 1"/>',
-        "</visual>",
-        f'<statistic center="{_f((cx, cy, ceiling / 2))}" extent="{half * 1.2:.6g}"/>',
-        "<asset>",
-        ('<texture name="ceiling" type="skybox" builtin="flat" width="8" height="8" '
-        'rgb1="1 1 1" rgb2="1 1 1"/>'),
-        *mats.assets,
-        *patch_assets,
-        "</asset>",
-        "<worldbody>",
-        *lights,
-        *body,
-        "</worldbody>",
-        "</mujoco>",
-    ])
+            f'attenuation="1 0 0" castshadow="{cast}"/>'
+        )
+    xml = "\n".join(
+        [
+            '<mujoco model="scene">',
+            '<compiler angle="radian"/>',
+            "<visual>",
+            f'<global offwidth="{max(width, 1)}" offheight="{max(height, 1)}"/>',
+            f'<quality shadowsize="{options.shadow_size}" offsamples="0"/>',
+            '<headlight active="1" ambient="0 0 0" diffuse="0 0 0" specular="0 0 0"/>',
+            (
+                f'<map znear="0.005" zfar="{8 * half + 2 * ceiling:.6g}" shadowclip="1.2" '
+                f'shadowscale="0.6" haze="0"/>'
+            ),
+            '<rgba haze="0 0 0 1"/>',
+            "</visual>",
+            f'<statistic center="{_f((cx, cy, ceiling / 2))}" extent="{half * 1.2:.6g}"/>',
+            "<asset>",
+            (
+                '<texture name="ceiling" type="skybox" builtin="flat" width="8" height="8" '
+                'rgb1="1 1 1" rgb2="1 1 1"/>'
+            ),
+            *mats.assets,
+            *patch_assets,
+            "</asset>",
+            "<worldbody>",
+            *lights,
+            *body,
+            "</worldbody>",
+            "</mujoco>",
+        ]
+    )
     return ModelSpec(xml, mats.textures, people, len(options.lamps))

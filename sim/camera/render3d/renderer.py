@@ -27,8 +27,10 @@ from .options import Render3DOptions
 
 __all__ = ["INSTALL_HINT", "MujocoRenderer", "Render3DUnavailable", "load_mujoco"]
 
-INSTALL_HINT = ('install it with: pip install -e ".[realistic]" and, on Debian/Ubuntu, '
-                "apt-get install libegl1 libgl1-mesa-dri")
+INSTALL_HINT = (
+    'install it with: pip install -e ".[realistic]" and, on Debian/Ubuntu, '
+    "apt-get install libegl1 libgl1-mesa-dri"
+)
 
 
 class Render3DUnavailable(UserError, RuntimeError):
@@ -53,7 +55,8 @@ def load_mujoco():
 def _no_context(exc):
     return Render3DUnavailable(
         f"no off-screen OpenGL context for the 3D renderer (MUJOCO_GL="
-        f"{os.environ.get('MUJOCO_GL')}: {exc}); {INSTALL_HINT}")
+        f"{os.environ.get('MUJOCO_GL')}: {exc}); {INSTALL_HINT}"
+    )
 
 
 def _quat_yaw(angle):
@@ -105,8 +108,10 @@ class MujocoRenderer:
         self._sky = None
 
     def __repr__(self):
-        return (f"MujocoRenderer(width={self.width}, height={self.height}, hfov={self.hfov}, "
-                f"options={self.options})")
+        return (
+            f"MujocoRenderer(width={self.width}, height={self.height}, hfov={self.hfov}, "
+            f"options={self.options})"
+        )
 
     def prepare(self):
         """Check now that an off-screen OpenGL context can be made (else
@@ -129,9 +134,14 @@ class MujocoRenderer:
 
     def _layout_key(self, scene):
         # Compared by value (a tuple compares its items by identity first: cheap per frame).
-        return (scene.walls, tuple((c.bands, c.radius) for c in scene.cylinders),
-                scene.floor_color, scene.ceiling_color, scene.ceiling_height,
-                getattr(scene, "floor_patches", ()))
+        return (
+            scene.walls,
+            tuple((c.bands, c.radius) for c in scene.cylinders),
+            scene.floor_color,
+            scene.ceiling_color,
+            scene.ceiling_height,
+            getattr(scene, "floor_patches", ()),
+        )
 
     def _build(self, scene):
         mj = self._mj
@@ -141,7 +151,7 @@ class MujocoRenderer:
         for name, rgb in spec.textures.items():
             tid = mj.mj_name2id(model, mj.mjtObj.mjOBJ_TEXTURE, name)
             adr = model.tex_adr[tid]
-            model.tex_data[adr:adr + rgb.size] = rgb.ravel()
+            model.tex_data[adr : adr + rgb.size] = rgb.ravel()
         self._sky_id = mj.mj_name2id(model, mj.mjtObj.mjOBJ_TEXTURE, "ceiling")
         self._centre = np.array(model.stat.center)
         self.model, self.data = model, mj.MjData(model)
@@ -176,7 +186,7 @@ class MujocoRenderer:
         if self._sky is None or not np.array_equal(sky, self._sky):
             adr = m.tex_adr[self._sky_id]
             n = m.tex_width[self._sky_id] * m.tex_height[self._sky_id] * 3
-            m.tex_data[adr:adr + n] = np.tile(np.rint(sky * 255).astype(np.uint8), n // 3)
+            m.tex_data[adr : adr + n] = np.tile(np.rint(sky * 255).astype(np.uint8), n // 3)
             if self._renderer is not None:
                 self._mj.mjr_uploadTexture(m, self._renderer._mjr_context, self._sky_id)
             self._sky = sky
@@ -201,16 +211,24 @@ class MujocoRenderer:
         ``CameraRenderer.render`` does.
         """
         if not isinstance(scene, Scene):
-            raise TypeError(f"scene must be a fpga_robotics.sim.camera.scene.Scene, not {type(scene)}")
+            raise TypeError(
+                f"scene must be a fpga_robotics.sim.camera.scene.Scene, not {type(scene)}"
+            )
         if not isinstance(pose, CameraPose):
-            raise TypeError(f"pose must be a fpga_robotics.sim.camera.scene.CameraPose, not {type(pose)}")
+            raise TypeError(
+                f"pose must be a fpga_robotics.sim.camera.scene.CameraPose, not {type(pose)}"
+            )
         ceiling = float(scene.ceiling_height)
         if not 0.0 < pose.height < ceiling:
-            raise ValueError(f"camera height {pose.height} m must be between the floor (0) and "
-                             f"the ceiling ({ceiling} m)")
+            raise ValueError(
+                f"camera height {pose.height} m must be between the floor (0) and "
+                f"the ceiling ({ceiling} m)"
+            )
         if abs(pose.tilt) > self._raster.max_tilt:
-            raise ValueError(f"camera tilt {pose.tilt:.4f} rad would look straight up or down; "
-                             f"keep |tilt| <= {self._raster.max_tilt:.4f} rad")
+            raise ValueError(
+                f"camera tilt {pose.tilt:.4f} rad would look straight up or down; "
+                f"keep |tilt| <= {self._raster.max_tilt:.4f} rad"
+            )
         if self._key != self._layout_key(scene):
             self._scene_ceiling = np.asarray(scene.ceiling_color, dtype=float)
             self._build(scene)

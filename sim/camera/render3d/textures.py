@@ -26,7 +26,7 @@ def _periodic_noise(rng, size, falloff):
     fx, fy = np.meshgrid(f, f)
     radius = np.hypot(fx, fy)
     radius[0, 0] = np.inf
-    spectrum = (rng.standard_normal((size, size)) + 1j * rng.standard_normal((size, size)))
+    spectrum = rng.standard_normal((size, size)) + 1j * rng.standard_normal((size, size))
     noise = np.fft.ifft2(spectrum / radius**falloff).real
     return (noise - noise.mean()) / (noise.std() + 1e-12)
 
@@ -40,8 +40,11 @@ def modulation(kind, size, seed):
     if kind == "plain":
         return np.ones((size, size))
     if kind == "paint":
-        return (1.0 + 0.035 * _periodic_noise(rng, size, 1.6)
-                + 0.015 * rng.standard_normal((size, size)))
+        return (
+            1.0
+            + 0.035 * _periodic_noise(rng, size, 1.6)
+            + 0.015 * rng.standard_normal((size, size))
+        )
     if kind == "tiles":
         n = 4  # tiles per texture side
         cell = (u * n).astype(int)

@@ -44,11 +44,12 @@ def stage_images(rgb, params, *, rng, turn_rate, frame_period=1 / 30, focal_px=N
     s = cam.state()
     return [
         ("rendered", rgb),
-        (f"motion blur {s['blur_px']:.1f} px", np.clip(blurred * 255 + 0.5, 0, 255)
-         .astype(np.uint8)),
+        (
+            f"motion blur {s['blur_px']:.1f} px",
+            np.clip(blurred * 255 + 0.5, 0, 255).astype(np.uint8),
+        ),
         ("Bayer mosaic (BGGR)", mosaic_light),
-        (f"exposure {s['exposure_s'] * 1e3:.1f} ms, gain {s['gain']:.2f}, noise, WB",
-         mosaic_codes),
+        (f"exposure {s['exposure_s'] * 1e3:.1f} ms, gain {s['gain']:.2f}, noise, WB", mosaic_codes),
         ("demosaic (linear)", linear),
         ("gamma", gamma),
         ("RGB444", out),

@@ -48,8 +48,10 @@ class PixelNoise:
 
     def __init__(self, shape, snr_db, dynamic_range_db, rng):
         if not isinstance(rng, np.random.Generator):
-            raise TypeError("the sensor's noise needs rng=numpy.random.Generator "
-                            "(e.g. np.random.default_rng(seed))")
+            raise TypeError(
+                "the sensor's noise needs rng=numpy.random.Generator "
+                "(e.g. np.random.default_rng(seed))"
+            )
         self.full_well, self.read_noise = well_and_read_noise(snr_db, dynamic_range_db)
         self.rng = rng
         self._table = _normal_quantiles()

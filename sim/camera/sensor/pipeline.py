@@ -57,15 +57,18 @@ class OV7670Sensor:
         Focal length in pixels (the motion blur's scale).
     """
 
-    def __init__(self, width, height, params=None, *, rng=None, frame_period=1 / 30,
-                 focal_px=None):
+    def __init__(self, width, height, params=None, *, rng=None, frame_period=1 / 30, focal_px=None):
         p = params if params is not None else OV7670Params()
         self.params = p
         self.width, self.height = width, height
         self.frame_period = frame_period
         self.focal_px = focal_px if focal_px is not None else width / 2
-        self.aec = AutoExposure(window=tuple(p.aec_window), fast_zone=tuple(p.aec_fast_zone),
-                                max_gain=p.max_gain, enabled=p.aec)
+        self.aec = AutoExposure(
+            window=tuple(p.aec_window),
+            fast_zone=tuple(p.aec_fast_zone),
+            max_gain=p.max_gain,
+            enabled=p.aec,
+        )
         self.aec.set_total(p.exposure * p.gain)
         self.awb = AutoWhiteBalance(speed=p.awb_speed, enabled=p.awb)
         plane = (height, width) if p.bayer != "off" else (height, width, 3)
@@ -83,8 +86,9 @@ class OV7670Sensor:
         else:
             self._channels = bayer_channels(height, width, p.bayer)
             # Flat index of each pixel's filter channel in an (H, W, 3) image.
-            self._mosaic_index = (np.arange(height * width) * 3
-                                  + self._channels.ravel()).reshape(height, width)
+            self._mosaic_index = (np.arange(height * width) * 3 + self._channels.ravel()).reshape(
+                height, width
+            )
             tile = BAYER_ORDERS[p.bayer]
             self._tile = [(i, j, tile[2 * i + j]) for i in (0, 1) for j in (0, 1)]
             self._codes = np.empty((height, width), dtype=np.uint16)
@@ -111,8 +115,10 @@ class OV7670Sensor:
         """The camera's frame (H, W, 3) uint8, low nibbles zero, of the rendered ``rgb``;
         ``turn_rate`` (rad/s) is the robot's during this frame's exposure."""
         if rgb.shape != (self.height, self.width, 3) or rgb.dtype != np.uint8:
-            raise ValueError(f"the sensor takes ({self.height}, {self.width}, 3) uint8 frames, "
-                             f"got {rgb.shape} {rgb.dtype}")
+            raise ValueError(
+                f"the sensor takes ({self.height}, {self.width}, 3) uint8 frames, "
+                f"got {rgb.shape} {rgb.dtype}"
+            )
         if self.frames == 0:
             for _ in range(self.params.settle_frames):
                 self._frame(rgb, turn_rate)
