@@ -23,7 +23,7 @@ NOT_USER_ERRORS = {
 def _exception_classes():
     """``module.Class`` of every class in the packages whose name says it is an error."""
     found = []
-    for module, path in source_modules():
+    for module, path in source_modules().items():
         for node in ast.walk(ast.parse(path.read_text(), str(path))):
             if (
                 isinstance(node, ast.ClassDef)
