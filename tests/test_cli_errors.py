@@ -45,7 +45,7 @@ def test_the_scan_finds_the_known_error_classes():
     for name in (
         "fpga_robotics.sim.camera.frames.FrameError",
         "fpga_robotics.sim.backends.port_map.PortMapError",
-        "fpga_robotics.scenario.load.ScenarioError",
+        "fpga_robotics.scenario.errors.ScenarioError",
         "fpga_robotics.viz.errors.ViewerError",
         "fpga_robotics.hw.errors.UsageError",
     ):

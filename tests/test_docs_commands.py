@@ -370,7 +370,7 @@ PLANS = {
         setup=(f"cp {ROOT / 'tests/data/user_designs/counters.py'} .",),
         out=(
             r"(?m)^OffByOne\.properties\s+bmc\s+15\s+FAIL\s",
-            r"failed assertion \S*counters\.py:40 step 11",
+            r"failed assertion \S*counters\.py:41 step 11",
             r"counterexample: \S*OffByOne\.properties\.vcd",
         ),
     ),
@@ -774,6 +774,7 @@ PLANS = {
         files=("runs/mutation/small/mutants.json",),
     ),
     "fpga-robotics mutate --design wall_stop.py:WallStop --mutants 40 --param clock_hz=100000": Plan(
+        slow=True,
         setup=(f"cp {ROOT / 'tests/data/user_designs/wall_stop.py'} .",),
         shorter=(("--mutants", "12"),),
         out=(
@@ -867,6 +868,7 @@ PLANS = {
     **{
         f"python -m fpga_robotics.mutation --mutants {n} --campaign mutation --seed {seed} "
         "--workers 1": Plan(
+            slow=True,
             shorter=(
                 ("--mutants", "4"),
                 ("--width", "80"),

@@ -29,7 +29,7 @@ PAGES = ["README.md", *sorted(p.relative_to(ROOT).as_posix() for p in (ROOT / "d
 QUOTE = re.compile(r"(\d+(?:\.\d+)?)x\s+\(ratio\s+±(\d+(?:\.\d+)?)\)")
 #: Anything that looks like the start of a quote, to catch a malformed one.
 LOOSE = re.compile(r"\(ratio\b")
-CODE = re.compile(r"`[^`]*`")
+CODE = re.compile(r"``.+?``|`[^`]*`", re.DOTALL)  # a double-backtick span may hold a backtick
 FENCE = re.compile(r"^ {0,3}(```|~~~)")
 
 
