@@ -109,7 +109,7 @@ def test_calibrate_option_prints_each_time_in_calibration_frames(monkeypatch, tm
         "frame_ms": scaffold.Spread.of([0.25, 0.2, 0.3]),
         "cpu_ms": scaffold.Spread.of([0.125]),
     }
-    monkeypatch.setattr(calibrate, "measure_calibration", lambda **_: reference)
+    monkeypatch.setattr(scaffold, "measure_calibration", lambda **_: reference)
     path = tmp_path / "f.json"
     assert _command([])(["--calibrate", "--json", str(path)]) == 0
     out = capsys.readouterr().out

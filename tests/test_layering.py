@@ -41,6 +41,7 @@ ROOMS = [
     ("bench", ("fpga_robotics.bench",)),
     ("mutation", ("fpga_robotics.mutation",)),
     ("sweep", ("fpga_robotics.sweep",)),
+    ("testing", ("fpga_robotics.testing",)),
     ("run command", ("fpga_robotics.cli.run",)),
     ("flow", ("fpga_robotics.flow",)),
     ("scenario", ("fpga_robotics.scenario",)),
@@ -53,6 +54,7 @@ ROOMS = [
         "cli support",
         (
             "fpga_robotics.cli.errors",
+            "fpga_robotics.cli.parser",
             "fpga_robotics.cli.param_options",
             "fpga_robotics.cli.sensor_options",
         ),

@@ -3,7 +3,8 @@
 import numpy as np
 import pytest
 
-from fpga_robotics.checks.sensor_metrics import RESUME_CLOSING_M, obstacle_metrics, sensor_check
+from fpga_robotics.checks.registry import sensor_check
+from fpga_robotics.checks.sensor_metrics import RESUME_CLOSING_M, obstacle_metrics
 
 
 def _traj(t, d):

@@ -14,13 +14,11 @@ import statistics
 import time
 from pathlib import Path
 
-import numpy as np
-
 from fpga_robotics.bench import scaffold
+from fpga_robotics.bench.frames import bench_frames
 from fpga_robotics.cli.errors import UsageError
 from fpga_robotics.hw.params import FollowTargetParams
 from fpga_robotics.sim.backends import BACKEND_NAMES, COMPILED_BACKENDS, BackendError, get_backend
-from fpga_robotics.sim.camera import synthetic
 
 __all__ = ["main", "measure", "measure_paired", "parse_resolutions"]
 
@@ -43,14 +41,6 @@ TARGET_PYSIM_MS_160 = 1000.0
 
 def parse_resolutions(text):
     return scaffold.parse_sizes(text, "a resolution")
-
-
-def bench_frames(width, height, count, seed):
-    """Frames a robot would see: a target sweeping across a noisy background (RGB888, as a
-    camera or the renderer gives them)."""
-    rng = np.random.default_rng(seed)
-    states = synthetic.scenario_states("sweep", width, height, n_frames=count)
-    return [np.ascontiguousarray(f) for f in synthetic.sequence(width, height, states, rng=rng)]
 
 
 def _loop_seconds(backend):

@@ -116,3 +116,10 @@ def verdict(check_results):
     if check_results and all(c["passed"] is None for c in check_results):
         return "n/a"
     return "pass"
+
+
+def sensor_check(name, limit, m):
+    """``(passed, text)`` of the check ``name`` against the metrics ``m`` (``passed`` None when
+    it cannot judge)."""
+    (c,) = evaluate_checks({name: limit}, m)
+    return c["passed"], c["text"]

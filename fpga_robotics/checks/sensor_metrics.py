@@ -15,7 +15,6 @@ __all__ = [
     "line_metrics",
     "measurement_metrics",
     "obstacle_metrics",
-    "sensor_check",
 ]
 
 #: Following has resumed once the robot is this much closer to the target than when the last
@@ -101,12 +100,3 @@ def measurement_metrics(columns, sensors, frames):
         "silent_sensors": [name for name, n in counts.items() if n == 0],
         "sensor_kinds": dict(sensors),
     }
-
-
-def sensor_check(name, limit, m):
-    """``(passed, text)`` of the check ``name`` against the metrics ``m`` (``passed`` None when
-    it cannot judge; ``fpga_robotics.checks.registry``)."""
-    from fpga_robotics.checks.registry import evaluate_checks
-
-    (c,) = evaluate_checks({name: limit}, m)
-    return c["passed"], c["text"]

@@ -9,7 +9,7 @@ design are run in full (``runner.execute``).
 
 import time
 
-__all__ = ["execute_forked", "judge_runs_forked", "reference_outcome"]
+__all__ = ["execute_forked", "reference_outcome"]
 
 #: References a worker keeps (one per campaign run: the mutation campaign has nine).
 _KEEP = 16
@@ -92,14 +92,3 @@ def execute_forked(argv, ref_argv, timeout=None):
     out["wall_s"] = time.perf_counter() - wall0
     out["cpu_s"] = time.process_time() - cpu0
     return out
-
-
-def judge_runs_forked(argvs, ref_argvs, timeouts=None):
-    """``robot_judge.judge_runs`` with each run forked from its reference run."""
-    from .robot_judge import judge_runs
-
-    return judge_runs(
-        argvs,
-        timeouts,
-        execute=lambda i, argv, timeout: execute_forked(argv, ref_argvs[i], timeout),
-    )

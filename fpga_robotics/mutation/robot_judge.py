@@ -17,7 +17,17 @@ import os
 import shlex
 import time
 
-__all__ = ["closest_to_failing", "judge_runs", "mutant_argv", "replay", "robot_judge", "run_margin"]
+from .forked_runs import execute_forked, reference_outcome
+
+__all__ = [
+    "closest_to_failing",
+    "judge_runs",
+    "judge_runs_forked",
+    "mutant_argv",
+    "replay",
+    "robot_judge",
+    "run_margin",
+]
 
 #: Checks whose limit is a lower bound (the value must be at least the limit).
 _LOWER = ("min_distance_min_m", "target_in_view_min_fraction", "found_min_fraction")
@@ -142,8 +152,6 @@ def _baseline(client, argvs, progress, fork):
     from ..sweep import runner
 
     if fork:
-        from .forked_runs import reference_outcome
-
         futures = {client.submit(reference_outcome, a, pure=False): i for i, a in enumerate(argvs)}
     else:
         futures = {
@@ -229,8 +237,6 @@ def robot_judge(
                 for spec in (plan.runs[i] for i in passing)
             ]
             if fork:
-                from .forked_runs import judge_runs_forked
-
                 task = (judge_runs_forked, argvs, [base[i] for i in passing], limits)
             else:
                 task = (judge_runs, argvs, limits)
@@ -265,4 +271,13 @@ def robot_judge(
     return (
         {"runs": base, "passing": passing, "statuses": statuses, "judged_here": len(todo)},
         verdicts,
+    )
+
+
+def judge_runs_forked(argvs, ref_argvs, timeouts=None):
+    """``judge_runs`` with each run forked from its reference run (``forked_runs``)."""
+    return judge_runs(
+        argvs,
+        timeouts,
+        execute=lambda i, argv, timeout: execute_forked(argv, ref_argvs[i], timeout),
     )
