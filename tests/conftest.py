@@ -37,3 +37,10 @@ def _fast_tier_builds_nothing_slow(request, monkeypatch):
     monkeypatch.setenv("FPGA_ROBOTICS_FAST_TIER", test)
     path = os.environ.get("PYTHONPATH")
     monkeypatch.setenv("PYTHONPATH", os.pathsep.join(filter(None, [str(FAST_TIER_DIR), path])))
+
+
+def pytest_collection_modifyitems(items):
+    """The formal proofs run SymbiYosys for minutes: slow-tier too, not the edit-test loop."""
+    for item in items:
+        if item.get_closest_marker("formal") and not item.get_closest_marker("slow"):
+            item.add_marker(pytest.mark.slow)
