@@ -119,7 +119,7 @@ def test_switches_select_colour(switches, colour):
 
 def test_unknown_board_lists_supported_ones():
     proc = subprocess.run(
-        [sys.executable, "-m", "fpga_robotics.flow.board", "--board", "nope"],
+        [sys.executable, "-m", "fpga_robotics", "board", "--board", "nope"],
         capture_output=True,
         text=True,
         timeout=120,

@@ -370,7 +370,7 @@ PLANS = {
         setup=(f"cp {ROOT / 'tests/data/user_designs/counters.py'} .",),
         out=(
             r"(?m)^OffByOne\.properties\s+bmc\s+15\s+FAIL\s",
-            r"failed assertion \S*counters\.py:41 step 11",
+            r"failed assertion \S*counters\.py:40 step 11",
             r"counterexample: \S*OffByOne\.properties\.vcd",
         ),
     ),
@@ -641,7 +641,12 @@ PLANS = {
         files=("ports.toml",), out=(r"wrote ports\.toml",)
     ),
     "python -m fpga_robotics.run --design verilog:follow_target.v --ports ports.toml": Plan(
-        slow=True, out=(PASS, r"(?m)^backend:? .*cxxrtl-foreign|cxxrtl-foreign")
+        slow=True,
+        setup=(
+            "python -m fpga_robotics.export -o follow_target.v",
+            "fpga-robotics ports --example ports.toml",
+        ),
+        out=(PASS, r"(?m)^backend:? .*cxxrtl-foreign|cxxrtl-foreign"),
     ),
     (
         "python -m fpga_robotics.run --scenario bump_wall.toml --design verilog:bump_stop.v "

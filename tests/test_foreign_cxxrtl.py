@@ -83,6 +83,7 @@ EXAMPLES = [
 ]
 
 
+@pytest.mark.slow  # builds a Verilator model
 @pytest.mark.parametrize("names, ports, line_blank", EXAMPLES)
 def test_cxxrtl_gives_verilators_results_cycle_for_cycle(files, names, ports, line_blank):
     paths = [files / n for n in names]
@@ -116,6 +117,7 @@ def test_a_named_timeout_on_cxxrtl_too(files):
         design.process_frame(_frames(PARAMS)[0])
 
 
+@pytest.mark.slow  # builds a Verilator model
 def test_what_yosys_cannot_read_runs_on_verilator(files):
     paths = [files / "sv_top.v", files / "follow_target.v"]
     with pytest.raises(BackendError) as info:
@@ -132,6 +134,7 @@ def test_what_yosys_cannot_read_runs_on_verilator(files):
         assert isinstance(design, ForeignCxxrtlBackend)  # the faster, when Yosys reads it
 
 
+@pytest.mark.slow  # builds a Verilator model
 def test_runtime_inputs_need_verilator(files, tmp_path):
     # color_sel held by the host as a [runtime] input: set through Verilator's DPI.
     ports = tmp_path / "runtime.toml"
@@ -147,6 +150,7 @@ def test_runtime_inputs_need_verilator(files, tmp_path):
         assert type(design) is ForeignVerilatorBackend
 
 
+@pytest.mark.slow  # builds a Verilator model
 def test_the_closed_loop_on_pins_is_the_same_on_both(tmp_path):
     path = tmp_path / "bump.toml"
     path.write_text(SCENARIO.format(duration=2.0, design=VERILOG_DESIGN))

@@ -76,7 +76,11 @@ BUGS = {
     ),
     "tracker.no_leak@16x2": (
         "a first clears the bins but not SX",
-        lambda: mutant(WindowCounter, "bins.eq(0), sx.eq(0),", "bins.eq(0),")(SMALL),
+        lambda: mutant(
+            WindowCounter,
+            "bins.eq(0),\n                sx.eq(0),",
+            "bins.eq(0),",
+        )(SMALL),
     ),
     "motor.limits_hold_search@defaults": (
         "the search starts one lost frame early",
@@ -167,7 +171,8 @@ BUGS = {
     "cover.results@160x120": (
         "proximity stops at 6",
         lambda: results_with(
-            "for t in p.proximity_thresholds),", "for t in p.proximity_thresholds[:6]),"
+            "for t in p.proximity_thresholds\n",
+            "for t in p.proximity_thresholds[:6]\n",
         ),
     ),
 }

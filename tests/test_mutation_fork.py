@@ -57,8 +57,12 @@ def test_forked_mutant_runs_equal_their_full_runs(tmp_path):
         full = runner.execute(argv)
         forked = execute_forked(argv, ref_argv)
         assert forked["status"] == full["status"], m.describe()
-        assert {k: v for k, v in forked["summary"].items() if k not in TIMING_FIELDS} == {
-            k: v for k, v in full["summary"].items() if k not in TIMING_FIELDS
-        }, m.describe()
+        if full["summary"] is None:  # the run stopped with an error: the same one
+            assert forked["summary"] is None and forked["message"] == full["message"]
+        else:
+            assert {k: v for k, v in forked["summary"].items() if k not in TIMING_FIELDS} == {
+                k: v for k, v in full["summary"].items() if k not in TIMING_FIELDS
+            }, m.describe()
         verdicts.add(full["status"])
-    assert verdicts == {"pass", "fail"}  # both outcomes compared
+    # A passing run and one that did not pass (a failed check, or a design that stopped) compared.
+    assert "pass" in verdicts and len(verdicts) > 1, verdicts

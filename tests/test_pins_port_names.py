@@ -105,7 +105,10 @@ def test_the_ports_keep_their_names():
     assert SOURCE.ports["new"].signed
 
 
-@pytest.mark.parametrize("name", BACKENDS)
+@pytest.mark.parametrize(
+    "name",
+    [pytest.param(b, marks=pytest.mark.slow) if b == "verilator" else b for b in BACKENDS],
+)
 def test_reserved_names_run_as_the_model_says(name):
     model = Model()
     with get_pin_backend(name, SOURCE) as pins:
@@ -126,6 +129,7 @@ def test_reserved_names_run_as_the_model_says(name):
             }, step
 
 
+@pytest.mark.slow  # builds the Verilator pin model
 def test_a_seeded_script_is_the_same_on_every_backend():
     logs = {}
     for name in BACKENDS:

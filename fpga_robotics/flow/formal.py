@@ -226,7 +226,7 @@ def design_checks(reference=None, params=None):
     """The formal checks of a design reference (docs/your_design.md): ``follow_target`` (or
     None) has the project's own list, ``hw.formal.CHECKS``; a design of one's own the
     properties it declares (``formal_properties``/``formal_covers``, docs/formal.md). A design
-    that declares none, or a Verilog one, is a ``UserError``."""
+    that declares none, or a Verilog one, is a ``UsageError``."""
     from fpga_robotics.hw.formal import CHECKS
     from fpga_robotics.hw.formal.declared import PROPERTY_HOOK, declared_checks
 

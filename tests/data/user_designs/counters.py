@@ -16,8 +16,8 @@ class Saturating(wiring.Component):
     full: Out(1)
 
     formal_mode = "prove"
-    formal_depth = 3  # the induction's length
-    formal_cover_depth = 12  # the counter is full after limit (10) cycles of up
+    formal_depth = 3          # the induction's length
+    formal_cover_depth = 12   # the counter is full after limit (10) cycles of up
 
     def __init__(self, limit: int = 10):
         self.limit = limit
@@ -37,10 +37,8 @@ class Saturating(wiring.Component):
 
     def formal_properties(self, m):
         """count never passes limit; full exactly at the limit"""
-        m.d.comb += [
-            Assert(self.count <= self.limit, "count passed the limit"),
-            Assert(self.full == (self.count == self.limit), "full is wrong"),
-        ]
+        m.d.comb += [Assert(self.count <= self.limit, "count passed the limit"),
+                     Assert(self.full == (self.count == self.limit), "full is wrong")]
 
     def formal_covers(self, m):
         """the counter reaches full"""

@@ -18,16 +18,14 @@ class NearRed(wiring.Component):
 
     def __init__(self, speed: int = 200, near_pixels: int = 60):
         self.speed, self.near_pixels = speed, near_pixels
-        super().__init__(
-            {
-                "pixels": In(pixel_stream_signature()),
-                "color_sel": In(3),
-                "motor_left": Out(signed(16)),
-                "motor_right": Out(signed(16)),
-                "near": Out(1),
-                "red_count": Out(16),
-            }
-        )
+        super().__init__({
+            "pixels": In(pixel_stream_signature()),
+            "color_sel": In(3),
+            "motor_left": Out(signed(16)),
+            "motor_right": Out(signed(16)),
+            "near": Out(1),
+            "red_count": Out(16),
+        })
 
     def elaborate(self, platform):
         m = Module()
@@ -36,11 +34,8 @@ class NearRed(wiring.Component):
         count = Signal(16)
         with m.If(self.pixels.valid):
             with m.If(self.pixels.payload.first):  # a new frame: the last one's count out
-                m.d.sync += [
-                    self.red_count.eq(count),
-                    count.eq(red),
-                    self.near.eq(count > self.near_pixels),
-                ]
+                m.d.sync += [self.red_count.eq(count), count.eq(red),
+                             self.near.eq(count > self.near_pixels)]
             with m.Else():
                 m.d.sync += count.eq(count + red)
         speed = Mux(self.near, 0, self.speed)

@@ -26,19 +26,15 @@ class WallStop(wiring.Component):
 
     def __init__(self, speed: int = 300, stop_mm: int = 250, clock_hz: int = 1_000_000):
         self.speed, self.stop_mm = speed, stop_mm
-        self.us = UltrasoundParams(
-            clock_hz=clock_hz, period_us=20_000, wait_us=2_000, max_range_mm=2000
-        )
+        self.us = UltrasoundParams(clock_hz=clock_hz, period_us=20_000, wait_us=2_000,
+                                   max_range_mm=2000)
         super().__init__()
 
     def elaborate(self, platform):
         m = Module()
         m.submodules.us = us = UltrasoundDriver(self.us)
-        m.d.comb += [
-            self.trig.eq(us.trig),
-            us.echo.eq(self.echo),
-            self.distance_mm.eq(us.distance_mm),
-        ]
+        m.d.comb += [self.trig.eq(us.trig), us.echo.eq(self.echo),
+                     self.distance_mm.eq(us.distance_mm)]
         with m.If(us.measured):
             m.d.sync += self.stopped.eq(~us.no_echo & (us.distance_mm < self.stop_mm))
         speed = Mux(self.stopped, 0, self.speed)
