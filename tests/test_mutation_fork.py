@@ -23,6 +23,7 @@ def _toolchain():
 
 
 @pytest.mark.skipif(_toolchain() is not None, reason="no Yosys or Verilator toolchain")
+@pytest.mark.slow  # builds the mutants' Verilator model
 def test_forked_mutant_runs_equal_their_full_runs(tmp_path):
     from fpga_robotics.mutation.design import write_mutant_design
     from fpga_robotics.mutation.forked_runs import execute_forked

@@ -20,7 +20,7 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
-from fpga_robotics.hw.errors import UserError
+from fpga_robotics.hw.errors import UsageError, UserError
 from fpga_robotics.sim.files import atomic_path
 
 __all__ = [
@@ -235,7 +235,7 @@ def design_checks(reference=None, params=None):
     from fpga_robotics.designs.reference import resolve_design
 
     if reference.startswith("verilog:"):
-        raise UserError(
+        raise UsageError(
             f"--design {reference}: a Verilog design's properties are not "
             f"checked here; give an Amaranth design (FILE.py:Name)"
         )
@@ -243,7 +243,7 @@ def design_checks(reference=None, params=None):
     name = reference if spec.kind == "builtin" else spec.reference.rpartition(":")[2]
     checks = declared_checks(name, spec.build)
     if not checks:
-        raise UserError(
+        raise UsageError(
             f"design {reference!r} declares no formal properties: give its class "
             f"a method {PROPERTY_HOOK}(self, m) adding Assert statements "
             f"(docs/formal.md)"
