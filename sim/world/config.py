@@ -11,11 +11,28 @@ import difflib
 import math
 from dataclasses import dataclass
 
+from pydantic_core import PydanticCustomError
+
 from fpga_robotics.hw.errors import UserError
 
+from .keys import (
+    DEFAULT_SHIRT,
+    DEFAULT_SKIN,
+    DEFAULT_TROUSERS,
+    MAX_TIME,
+    FurnitureKeys,
+    LightingKeys,
+    LineKeys,
+    PersonKeys,
+    Point,
+    RobotKeys,
+    RoomKeys,
+    TerrainKeys,
+)
 from .kinematics import DEG
 from .markings import FloorLine
 from .robots import ROBOT_MODELS
+from .schema import check_of, show, validate
 from .terrain import TerrainPatch
 
 __all__ = [
@@ -38,18 +55,9 @@ __all__ = [
 #: The scenario sections that describe the world.
 WORLD_SECTIONS = ("room", "robot", "people", "lighting")
 
-#: The latest time (s) a world description may name (keyframes, start delays): one day.
-MAX_TIME = 86400.0
-
-DEFAULT_SHIRT = (0.85, 0.1, 0.1)
-DEFAULT_TROUSERS = (0.15, 0.15, 0.22)
-DEFAULT_SKIN = (0.87, 0.68, 0.56)
 #: Red-brown wood: the divider that the published colour filter mistook for a red shirt.
 DIVIDER_WOOD = (0.55, 0.27, 0.15)
 _BOX_COLOR = (0.45, 0.42, 0.38)
-_WALL_COLOR = (0.8, 0.78, 0.72)
-_FLOOR_COLOR = (0.55, 0.55, 0.5)
-_CEILING_COLOR = (0.9, 0.9, 0.9)
 
 
 class WorldConfigError(UserError, ValueError):
@@ -147,266 +155,136 @@ class WorldConfig:
     lighting: LightingConfig
 
 
-def _show(value):
-    if isinstance(value, dict):
-        return "a table"
-    if isinstance(value, (list, tuple)):
-        return f"{list(value)!r} (array)"
-    return f"{value!r} ({type(value).__name__})"
-
-
-def _is_number(value):
-    return isinstance(value, (int, float)) and not isinstance(value, bool)
-
-
-def _check_number(value, path, *, gt=None, ge=None, le=None, unit=""):
-    """Return ``value`` as a float if it is a finite number within the bounds."""
-    finite = _is_number(value) and math.isfinite(value)
-    checks = [(f"> {b:g}", finite and value > b) for b in (gt,) if b is not None]
-    checks += [(f">= {b:g}", finite and value >= b) for b in (ge,) if b is not None]
-    checks += [(f"<= {b:g}", finite and value <= b) for b in (le,) if b is not None]
-    if not finite:
-        what = "a number" + (f" in {unit}" if unit else "")
-        if checks:
-            what += " " + " and ".join(text for text, _ in checks)
-        raise WorldConfigError(f"{path} must be {what}, got {_show(value)}")
-    for text, ok in checks:
-        if not ok:
-            raise WorldConfigError(f"{path} must be {text}, got {value!r}")
-    return float(value)
-
-
 def _fmt(point):
     return "[" + ", ".join(f"{c:g}" for c in point) + "]"
 
 
-def _check_vector(value, path, n, what, **bounds):
-    if not isinstance(value, (list, tuple)) or len(value) != n:
-        raise WorldConfigError(f"{path} must be {what}, got {_show(value)}")
-    return tuple(_check_number(v, f"{path}[{i}]", **bounds) for i, v in enumerate(value))
-
-
-class _Table:
-    """Reads the keys of one table and reports the ones never read as unknown."""
-
-    def __init__(self, table, path):
-        if table is None:
-            table = {}
-        if not isinstance(table, dict):
-            raise WorldConfigError(f"{path} must be a table, got {_show(table)}")
-        self.table = table
-        self.path = path
-        self.known = []
-
-    def key(self, key):
-        return f"{self.path}.{key}" if self.path else key
-
-    def has(self, key):
-        return key in self.table
-
-    def raw(self, key, default=None):
-        self.known.append(key)
-        return self.table.get(key, default)
-
-    def number(self, key, default, **bounds):
-        if key not in self.table:
-            self.known.append(key)
-            return default
-        return _check_number(self.raw(key), self.key(key), **bounds)
-
-    def boolean(self, key, default):
-        value = self.raw(key, default)
-        if not isinstance(value, bool):
-            raise WorldConfigError(f"{self.key(key)} must be true or false, got {_show(value)}")
-        return value
-
-    def string(self, key, default, choices=None):
-        value = self.raw(key, default)
-        if not isinstance(value, str) or not value:
-            raise WorldConfigError(
-                f"{self.key(key)} must be a non-empty string, got {_show(value)}"
-            )
-        if choices is not None and value not in choices:
-            options = ", ".join(repr(c) for c in choices)
-            raise WorldConfigError(f"{self.key(key)} must be one of {options}, got {value!r}")
-        return value
-
-    def color(self, key, default):
-        if key not in self.table:
-            self.known.append(key)
-            return tuple(default)
-        return _check_vector(
-            self.raw(key), self.key(key), 3, "a colour [r, g, b] with each in 0..1", ge=0, le=1
-        )
-
-    def point(self, key, default):
-        if key not in self.table:
-            self.known.append(key)
-            return default
-        return _check_vector(self.raw(key), self.key(key), 2, "a point [x, y] in m")
-
-    def finish(self):
-        unknown = [k for k in self.table if k not in self.known]
-        if unknown:
-            key = unknown[0]
-            close = difflib.get_close_matches(str(key), self.known, n=1)
-            hint = f" (did you mean {close[0]!r}?)" if close else ""
-            known = ", ".join(self.known)
-            raise WorldConfigError(f"{self.key(key)} is not a known key{hint}; known keys: {known}")
+def _keys(model, table, path):
+    """The table's keys validated by its model (``sim.world.keys``)."""
+    return validate(model, table, path, WorldConfigError)
 
 
 def _parse_furniture(item, path, index):
-    t = _Table(item, path)
-    name = t.string("name", f"furniture{index}")
-    kind = t.string("type", "box", choices=("box", "divider"))
-    if not t.has("center"):
-        raise WorldConfigError(f"{t.key('center')} is required: the centre [x, y] in m")
-    center = t.point("center", None)
-    divider = kind == "divider"
-    size = t.raw("size", (1.5, 0.03) if divider else (1.0, 0.6))
-    size = _check_vector(size, t.key("size"), 2, "[length, width] in m", ge=0.01, le=100)
-    angle = t.number("angle_deg", 0.0, ge=-360, le=360) * DEG
-    height = t.number("height", 1.6 if divider else 0.75, gt=0, le=10, unit="m")
-    color = t.color("color", DIVIDER_WOOD if divider else _BOX_COLOR)
-    present_until = t.number("present_until", None, gt=0, le=MAX_TIME, unit="s")
-    t.finish()
-    return FurnitureConfig(name, kind, center, size, angle, height, color, present_until)
-
-
-#: Floor markings' default colour: black electrical tape.
-_LINE_COLOR = (0.0, 0.0, 0.0)
+    k = _keys(FurnitureKeys, item, path)
+    divider = k.type == "divider"
+    return FurnitureConfig(
+        k.name or f"furniture{index}",
+        k.type,
+        k.center,
+        k.size or ((1.5, 0.03) if divider else (1.0, 0.6)),
+        k.angle_deg * DEG,
+        k.height or (1.6 if divider else 0.75),
+        k.color or (DIVIDER_WOOD if divider else _BOX_COLOR),
+        k.present_until,
+    )
 
 
 def _parse_line(item, path, index, room):
-    t = _Table(item, path)
-    name = t.string("name", f"line{index}")
-    points = t.raw("points")
-    closed = t.boolean("closed", False)
-    least = 3 if closed else 2
+    k = _keys(LineKeys, item, path)
+    least = 3 if k.closed else 2
+    points = k.points
     if not isinstance(points, list) or len(points) < least:
         raise WorldConfigError(
-            f"{t.key('points')} must be an array of at least {least} points [x, y] "
-            f"({'a closed' if closed else 'an open'} line), got "
-            f"{_show(points) if points is not None else 'nothing'}"
+            f"{path}.points must be an array of at least {least} points [x, y] "
+            f"({'a closed' if k.closed else 'an open'} line), got "
+            f"{show(points) if points is not None else 'nothing'}"
         )
-    centreline = tuple(
-        _check_vector(p, f"{t.key('points')}[{i}]", 2, "a point [x, y] in m")
-        for i, p in enumerate(points)
-    )
-    width = t.number("width", 0.019, gt=0, le=1, unit="m")
-    color = t.color("color", _LINE_COLOR)
-    t.finish()
+    centreline = tuple(_point(p, f"{path}.points[{i}]") for i, p in enumerate(points))
     w, d = room
     for i, (x, y) in enumerate(centreline):
         if not (0 <= x <= w and 0 <= y <= d):
             raise WorldConfigError(
-                f"{t.key('points')}[{i}] {_fmt((x, y))} is outside the room (0..{w:g} x 0..{d:g} m)"
+                f"{path}.points[{i}] {_fmt((x, y))} is outside the room (0..{w:g} x 0..{d:g} m)"
             )
-    line = FloorLine(name, centreline, width, color, closed)
+    line = FloorLine(k.name or f"line{index}", centreline, k.width, k.color, k.closed)
     if line.length < 1e-6:
-        raise WorldConfigError(f"{t.key('points')} has no length (all the points are the same)")
+        raise WorldConfigError(f"{path}.points has no length (all the points are the same)")
     return line
 
 
+def _point(value, path):
+    try:
+        return check_of(Point)(value)
+    except PydanticCustomError as exc:
+        raise WorldConfigError(f"{path}{exc.context.get('sub', '')} {exc.message()}") from None
+
+
 def _parse_terrain(item, path, index, room):
-    t = _Table(item, path)
-    name = t.string("name", f"terrain{index}")
-    has_points, has_center = t.has("points"), t.has("center")
-    if has_points == has_center:
+    k = _keys(TerrainKeys, item, path)
+    has_points = k.points is not None
+    if has_points == (k.center is not None):
         raise WorldConfigError(
             f"{path} needs either points = [[x, y], ...] (a polygon) or "
             f"center = [x, y] with size = [length, width] (a rectangle)"
         )
     if has_points:
-        points = t.raw("points")
-        if not isinstance(points, list) or len(points) < 3:
-            raise WorldConfigError(
-                f"{t.key('points')} must be an array of at least 3 points "
-                f"[x, y], got {_show(points)}"
-            )
-        polygon = tuple(
-            _check_vector(p, f"{t.key('points')}[{i}]", 2, "a point [x, y] in m")
-            for i, p in enumerate(points)
-        )
+        polygon = k.points
         area = 0.5 * abs(
             sum(x0 * y1 - x1 * y0 for (x0, y0), (x1, y1) in zip(polygon, polygon[1:] + polygon[:1]))
         )
         if area < 1e-4:
-            raise WorldConfigError(f"{t.key('points')} encloses no area (the points are on a line)")
+            raise WorldConfigError(f"{path}.points encloses no area (the points are on a line)")
     else:
-        center = t.point("center", None)
-        size = _check_vector(
-            t.raw("size", (1.0, 1.0)), t.key("size"), 2, "[length, width] in m", ge=0.01, le=100
-        )
-        angle = t.number("angle_deg", 0.0, ge=-360, le=360) * DEG
-        shape = FurnitureConfig(name, "box", center, size, angle, 0.0, (0, 0, 0))
+        shape = FurnitureConfig("", "box", k.center, k.size, k.angle_deg * DEG, 0.0, (0, 0, 0))
         polygon = tuple(tuple(c) for c in shape.corners())
-    friction = t.number("friction", 1.0, ge=0.01, le=10)
-    slope = t.number("slope_deg", 0.0, ge=0, le=45) * DEG
-    slope_dir = t.number("slope_dir_deg", 0.0, ge=-360, le=360) * DEG
-    # No colour: the patch is not drawn (a wet floor looks like the floor).
-    color = t.color("color", (0.0, 0.0, 0.0)) if t.has("color") else t.raw("color")
-    t.finish()
     inside = [
         (x, y) for x, y in polygon if -1e-9 <= x <= room[0] + 1e-9 and -1e-9 <= y <= room[1] + 1e-9
     ]
     if not inside:
         raise WorldConfigError(f"{path} lies outside the room (0..{room[0]:g} x 0..{room[1]:g} m)")
-    return TerrainPatch(name, polygon, friction, slope, slope_dir, color)
+    name = k.name or f"terrain{index}"
+    return TerrainPatch(
+        name, polygon, k.friction, k.slope_deg * DEG, k.slope_dir_deg * DEG, k.color
+    )
+
+
+def _unique(names, path):
+    for i, name in enumerate(names):
+        if name in names[:i]:
+            raise WorldConfigError(f"{path}[{i}].name {name!r} is used twice")
 
 
 def _parse_room(section):
-    t = _Table(section, "room")
-    width = t.number("width", 8.0, gt=0.5, le=100, unit="m")
-    depth = t.number("depth", 6.0, gt=0.5, le=100, unit="m")
-    height = t.number("height", 2.5, gt=0.2, le=20, unit="m")
-    wall_color = t.color("wall_color", _WALL_COLOR)
-    floor_color = t.color("floor_color", _FLOOR_COLOR)
-    ceiling_color = t.color("ceiling_color", _CEILING_COLOR)
-    items = t.raw("furniture", [])
-    if not isinstance(items, list):
-        raise WorldConfigError(
-            f"room.furniture must be an array of tables ([[room.furniture]]), got {_show(items)}"
-        )
+    k = _keys(RoomKeys, section, "room")
+    room = (k.width, k.depth)
     furniture = tuple(
-        _parse_furniture(item, f"room.furniture[{i}]", i) for i, item in enumerate(items)
+        _parse_furniture(item, f"room.furniture[{i}]", i)
+        for i, item in enumerate(_raw(section, "furniture"))
     )
-    patches = t.raw("terrain", [])
-    if not isinstance(patches, list):
-        raise WorldConfigError(
-            f"room.terrain must be an array of tables ([[room.terrain]]), got {_show(patches)}"
-        )
     terrain = tuple(
-        _parse_terrain(item, f"room.terrain[{i}]", i, (width, depth))
-        for i, item in enumerate(patches)
+        _parse_terrain(item, f"room.terrain[{i}]", i, room)
+        for i, item in enumerate(_raw(section, "terrain"))
     )
-    raw_lines = t.raw("lines", [])
-    if not isinstance(raw_lines, list):
-        raise WorldConfigError(
-            f"room.lines must be an array of tables ([[room.lines]]), got {_show(raw_lines)}"
-        )
     lines = tuple(
-        _parse_line(item, f"room.lines[{i}]", i, (width, depth)) for i, item in enumerate(raw_lines)
+        _parse_line(item, f"room.lines[{i}]", i, room)
+        for i, item in enumerate(_raw(section, "lines"))
     )
-    line_names = [line.name for line in lines]
-    for i, name in enumerate(line_names):
-        if name in line_names[:i]:
-            raise WorldConfigError(f"room.lines[{i}].name {name!r} is used twice")
-    names = [f.name for f in furniture]
-    for i, name in enumerate(names):
-        if name in names[:i]:
-            raise WorldConfigError(f"room.furniture[{i}].name {name!r} is used twice")
+    _unique([line.name for line in lines], "room.lines")
+    _unique([f.name for f in furniture], "room.furniture")
     for i, f in enumerate(furniture):
         x, y = f.center
-        if not (0 < x < width and 0 < y < depth):
+        if not (0 < x < k.width and 0 < y < k.depth):
             raise WorldConfigError(
                 f"room.furniture[{i}].center {_fmt(f.center)} is outside "
-                f"the room (0..{width:g} x 0..{depth:g} m)"
+                f"the room (0..{k.width:g} x 0..{k.depth:g} m)"
             )
-    t.finish()
     return RoomConfig(
-        width, depth, height, wall_color, floor_color, ceiling_color, furniture, terrain, lines
+        k.width,
+        k.depth,
+        k.height,
+        k.wall_color,
+        k.floor_color,
+        k.ceiling_color,
+        furniture,
+        terrain,
+        lines,
     )
+
+
+def _raw(section, key):
+    """The raw tables of an array of tables (the model has checked them): each is parsed
+    again by its own parser, which knows its index and the room."""
+    return (section or {}).get(key, [])
 
 
 def _inside(point, radius, room):
@@ -414,50 +292,45 @@ def _inside(point, radius, room):
     return radius <= x <= room.width - radius and radius <= y <= room.depth - radius
 
 
+#: Robot keys that override the robot model's value of the same name.
+_SPEC_KEYS = (
+    "mass",
+    "body_radius",
+    "wheel_radius",
+    "wheel_separation",
+    "max_wheel_dps",
+    "wheel_accel_dps2",
+    "traction_force",
+    "camera_height",
+    "camera_forward",
+    "com_height",
+    "support_half_length",
+    "motor_step_response",
+)
+
+
 def _parse_robot(section, room):
-    t = _Table(section, "robot")
-    model = t.string("model", "turtlebot2", choices=tuple(ROBOT_MODELS))
-    base = ROBOT_MODELS[model]
-    start = t.point("start", (min(1.5, room.width / 2), room.depth / 2))
-    heading = t.number("heading_deg", 0.0, ge=-360, le=360) * DEG
-    fields = {}
-    for key, bounds in (
-        ("mass", {"ge": 0.05, "le": 1000, "unit": "kg"}),
-        ("body_radius", {"ge": 0.02, "le": 2, "unit": "m"}),
-        ("wheel_radius", {"ge": 0.005, "le": 1, "unit": "m"}),
-        ("wheel_separation", {"ge": 0.02, "le": 3, "unit": "m"}),
-        ("max_wheel_dps", {"gt": 0, "le": 100000, "unit": "deg/s"}),
-        ("wheel_accel_dps2", {"gt": 0, "le": 1e6, "unit": "deg/s^2"}),
-        ("traction_force", {"gt": 0, "le": 1e5, "unit": "N"}),
-        ("camera_height", {"gt": 0, "le": 5, "unit": "m"}),
-        ("camera_forward", {"ge": -2, "le": 2, "unit": "m"}),
-    ):
-        fields[key] = t.number(key, getattr(base, key), **bounds)
-    fields["traction_torque"] = t.number(
-        "traction_torque",
-        fields["traction_force"] * fields["wheel_separation"] / 2,
-        gt=0,
-        le=1e5,
-        unit="N m",
+    k = _keys(RobotKeys, section, "robot")
+    base = ROBOT_MODELS[k.model]
+    start = k.start or (min(1.5, room.width / 2), room.depth / 2)
+    fields = {
+        key: getattr(base, key) if getattr(k, key) is None else getattr(k, key)
+        for key in _SPEC_KEYS
+    }
+    fields["traction_torque"] = (
+        fields["traction_force"] * fields["wheel_separation"] / 2
+        if k.traction_torque is None
+        else k.traction_torque
     )
-    fields["camera_tilt"] = t.number("camera_tilt_deg", base.camera_tilt / DEG, ge=-85, le=85) * DEG
-    for key, bounds in (
-        ("com_height", {"gt": 0, "le": 5, "unit": "m"}),
-        ("support_half_length", {"gt": 0, "le": 5, "unit": "m"}),
-    ):
-        fields[key] = t.number(key, getattr(base, key), **bounds)
-    # None (the presets' value): commands are ramped, a jump never tips the robot.
-    fields["motor_step_response"] = t.number(
-        "motor_step_response", base.motor_step_response, gt=0, le=10, unit="s"
-    )
+    tilt_deg = base.camera_tilt / DEG if k.camera_tilt_deg is None else k.camera_tilt_deg
+    fields["camera_tilt"] = tilt_deg * DEG
     uncertainty = Uncertainty(
-        motor_gain_error=t.number("motor_gain_error", 0.0, ge=0, le=0.9),
-        motor_noise_dps=t.number("motor_noise_dps", 0.0, ge=0, le=10000, unit="deg/s"),
-        slip_rate_hz=t.number("slip_rate_hz", 0.0, ge=0, le=100, unit="1/s"),
-        slip_duration_s=t.number("slip_duration_s", 0.2, gt=0, le=60, unit="s"),
-        slip_traction=t.number("slip_traction", 0.2, ge=0.01, le=1),
+        motor_gain_error=k.motor_gain_error,
+        motor_noise_dps=k.motor_noise_dps,
+        slip_rate_hz=k.slip_rate_hz,
+        slip_duration_s=k.slip_duration_s,
+        slip_traction=k.slip_traction,
     )
-    t.finish()
     if not fields["camera_height"] < room.height:
         # The renderer draws from between the floor and the ceiling only.
         raise WorldConfigError(
@@ -470,7 +343,7 @@ def _parse_robot(section, room):
             f"robot.start {_fmt(start)} puts the robot (radius {spec.body_radius:g} m) outside "
             f"the room (0..{room.width:g} x 0..{room.depth:g} m)"
         )
-    return RobotConfig(spec, tuple(start), heading, uncertainty)
+    return RobotConfig(spec, tuple(start), k.heading_deg * DEG, uncertainty)
 
 
 def _default_people(room):
@@ -489,65 +362,38 @@ def _default_people(room):
 
 
 def _parse_person(item, path, index, room):
-    t = _Table(item, path)
-    name = t.string("name", f"person{index}")
-    target = t.boolean("target", index == 0)
-    raw = t.raw("waypoints")
-    if raw is None:
-        raise WorldConfigError(f"{path}.waypoints is required: an array of [x, y] points in m")
-    if not isinstance(raw, list) or not raw:
-        raise WorldConfigError(
-            f"{path}.waypoints must be a non-empty array of [x, y] points, got {_show(raw)}"
-        )
-    waypoints = tuple(
-        _check_vector(p, f"{path}.waypoints[{i}]", 2, "a point [x, y] in m")
-        for i, p in enumerate(raw)
-    )
-    speed = t.number("speed", 0.5, gt=0, le=5, unit="m/s")
-    jitter = t.number("speed_jitter", 0.0, ge=0, le=0.9)
-    pause = t.raw("pause", 1.0)
-    if isinstance(pause, list):
-        if len(pause) != len(waypoints):
+    k = _keys(PersonKeys, item, path)
+    waypoints = k.waypoints
+    if isinstance(k.pause, tuple):
+        if len(k.pause) != len(waypoints):
             raise WorldConfigError(
                 f"{path}.pause must be one number or one per waypoint ({len(waypoints)}), "
-                f"got {len(pause)} values"
+                f"got {len(k.pause)} values"
             )
-        pauses = tuple(
-            _check_number(p, f"{path}.pause[{i}]", ge=0, le=3600, unit="s")
-            for i, p in enumerate(pause)
-        )
+        pauses = k.pause
     else:
-        pauses = (_check_number(pause, f"{path}.pause", ge=0, le=3600, unit="s"),) * len(waypoints)
-    loop = t.boolean("loop", True)
-    start_delay = t.number("start_delay", 0.0, ge=0, le=MAX_TIME, unit="s")
-    yield_gap = t.number("yield_gap", 0.0, ge=0, le=5, unit="m")
-    radius = t.number("radius", 0.2, ge=0.05, le=1, unit="m")
-    height = t.number("height", 1.75, ge=0.5, le=2.5, unit="m")
-    shirt = t.color("shirt_color", DEFAULT_SHIRT)
-    trousers = t.color("trousers_color", DEFAULT_TROUSERS)
-    skin = t.color("skin_color", DEFAULT_SKIN)
-    t.finish()
+        pauses = (k.pause,) * len(waypoints)
     for i, p in enumerate(waypoints):
-        if not _inside(p, radius, room):
+        if not _inside(p, k.radius, room):
             raise WorldConfigError(
-                f"{path}.waypoints[{i}] {_fmt(p)} puts the person (radius {radius:g} m) outside "
-                f"the room (0..{room.width:g} x 0..{room.depth:g} m)"
+                f"{path}.waypoints[{i}] {_fmt(p)} puts the person (radius {k.radius:g} m) "
+                f"outside the room (0..{room.width:g} x 0..{room.depth:g} m)"
             )
     return PersonConfig(
-        name,
-        target,
+        k.name or f"person{index}",
+        index == 0 if k.target is None else k.target,
         waypoints,
-        speed,
-        jitter,
+        k.speed,
+        k.speed_jitter,
         pauses,
-        loop,
-        start_delay,
-        yield_gap,
-        radius,
-        height,
-        shirt,
-        trousers,
-        skin,
+        k.loop,
+        k.start_delay,
+        k.yield_gap,
+        k.radius,
+        k.height,
+        k.shirt_color,
+        k.trousers_color,
+        k.skin_color,
     )
 
 
@@ -556,13 +402,10 @@ def _parse_people(section, room):
         section = _default_people(room)
     if not isinstance(section, list):
         raise WorldConfigError(
-            f"people must be an array of tables ([[people]]), got {_show(section)}"
+            f"people must be an array of tables ([[people]]), got {show(section)}"
         )
     people = tuple(_parse_person(item, f"people[{i}]", i, room) for i, item in enumerate(section))
-    names = [p.name for p in people]
-    for i, name in enumerate(names):
-        if name in names[:i]:
-            raise WorldConfigError(f"people[{i}].name {name!r} is used twice")
+    _unique([p.name for p in people], "people")
     targets = [i for i, p in enumerate(people) if p.target]
     if len(targets) > 1:
         raise WorldConfigError(
@@ -573,46 +416,12 @@ def _parse_people(section, room):
 
 
 def _parse_lighting(section):
-    t = _Table(section, "lighting")
-    ambient = t.number("ambient", 0.6, ge=0, le=2)
-    intensity = t.number("intensity", 0.5, ge=0, le=2)
-    direction = t.raw("direction", [1.0, 0.5, -1.0])
-    direction = _check_vector(
-        direction,
-        "lighting.direction",
-        3,
-        "a vector [dx, dy, dz], each -1000..1000",
-        ge=-1000,
-        le=1000,
-    )
-    if math.hypot(*direction) < 1e-3:
+    k = _keys(LightingKeys, section, "lighting")
+    if math.hypot(*k.direction) < 1e-3:
         raise WorldConfigError(
-            f"lighting.direction must have a length of at least 0.001, got {_fmt(direction)}"
+            f"lighting.direction must have a length of at least 0.001, got {_fmt(k.direction)}"
         )
-    raw = t.raw("keyframes", [])
-    if not isinstance(raw, list):
-        raise WorldConfigError(
-            f"lighting.keyframes must be an array of [t, ambient, intensity], got {_show(raw)}"
-        )
-    keyframes = []
-    for i, k in enumerate(raw):
-        p = f"lighting.keyframes[{i}]"
-        if not isinstance(k, (list, tuple)) or len(k) != 3:
-            raise WorldConfigError(f"{p} must be [t, ambient, intensity], got {_show(k)}")
-        frame = (
-            _check_number(k[0], f"{p}[0] (t)", ge=0, le=MAX_TIME, unit="s"),
-            _check_number(k[1], f"{p}[1] (ambient)", ge=0, le=2),
-            _check_number(k[2], f"{p}[2] (intensity)", ge=0, le=2),
-        )
-        if keyframes and frame[0] < keyframes[-1][0]:
-            raise WorldConfigError(
-                f"{p}[0] (t) must not be earlier than the previous keyframe's "
-                f"({keyframes[-1][0]:g} s), got {frame[0]:g}"
-            )
-        keyframes.append(frame)
-    interpolation = t.string("interpolation", "linear", choices=("linear", "step"))
-    t.finish()
-    return LightingConfig(ambient, intensity, direction, tuple(keyframes), interpolation)
+    return LightingConfig(k.ambient, k.intensity, k.direction, k.keyframes, k.interpolation)
 
 
 def parse_world_config(cfg):
@@ -636,7 +445,7 @@ def parse_world_config(cfg):
     if cfg is None:
         cfg = {}
     if not isinstance(cfg, dict):
-        raise WorldConfigError(f"the world configuration must be a table, got {_show(cfg)}")
+        raise WorldConfigError(f"the world configuration must be a table, got {show(cfg)}")
     for key in cfg:
         if key not in WORLD_SECTIONS:
             close = difflib.get_close_matches(str(key), WORLD_SECTIONS, n=1)
