@@ -19,20 +19,26 @@ import math
 from dataclasses import dataclass
 from typing import ClassVar
 
+from pydantic_core import PydanticCustomError
+
 from fpga_robotics.hw.errors import UserError
+from fpga_robotics.sim.world.schema import KeyModel, Number, check_of, validate
 
 __all__ = [
     "CONNECTORS",
     "MOUNT_KEYS",
     "Connector",
     "ConnectorError",
+    "ConnectorKeys",
     "Mount",
+    "MountKeys",
     "Pin",
     "PinIO",
     "check_number",
     "connector_class",
     "parse_mount",
     "register",
+    "validate_value",
 ]
 
 #: kind -> Connector subclass.
@@ -106,9 +112,25 @@ class PinIO:
         return self.backend.peek(self.binding[pin])
 
 
+class ConnectorKeys(KeyModel):
+    """The keys of a connector kind's table (besides ``kind``, ``name``, ``ports`` and the
+    mount): a kind declares its own subclass, one field per key (``Number(..., style=
+    "bounds")`` for the connectors' messages), and sets it as ``Connector.keys``."""
+
+    @classmethod
+    def unknown_key(cls, path, key):
+        where = path.rpartition(".")[0]
+        kind = f" for a {cls.label!r} connector" if cls.label else ""
+        return (
+            f"{where}: unknown key {key!r}{kind}; its keys: {', '.join(cls.keys())} "
+            f"(and the mount: {', '.join(MOUNT_KEYS)})"
+        )
+
+
 class Connector:
-    """Base class of every connector kind. Subclasses set ``kind``, ``pins``, ``watch`` and
-    implement ``parse`` and the hooks they need."""
+    """Base class of every connector kind. Subclasses set ``kind``, ``pins``, ``watch``,
+    declare their keys (``keys``, a ``ConnectorKeys`` model, or their own ``parse``) and
+    implement the hooks they need."""
 
     #: The registry key, the scenario's ``kind = "..."``.
     kind: ClassVar[str] = ""
@@ -118,6 +140,8 @@ class Connector:
     pins: ClassVar[dict] = {}
     #: Design outputs (pin roles) whose change calls ``on_change``.
     watch: ClassVar[tuple] = ()
+    #: The kind's scenario keys (a ``ConnectorKeys`` subclass); None: no keys of its own.
+    keys: ClassVar[type | None] = None
 
     def __init__(self, name, mount, params, *, world, rng):
         self.name = name
@@ -129,12 +153,21 @@ class Connector:
     @classmethod
     def parse(cls, table, where):
         """Validate the kind's parameters in ``table`` (the scenario table without ``kind``,
-        ``name`` and the mount keys); return the params object. Raise ``ConnectorError``
-        naming ``where`` (e.g. ``robot.sensors[0]``) and the key."""
-        if table:
-            raise ConnectorError(
-                f"{where}: unknown key {min(table)!r} for a {cls.kind!r} connector"
-            )
+        ``name`` and the mount keys) against ``keys``; return the params object (the
+        validated ``keys`` model; override ``params_of`` for another). Raise
+        ``ConnectorError`` naming ``where`` (e.g. ``robot.sensors[0]``) and the key."""
+        if cls.keys is None:
+            if table:
+                raise ConnectorError(
+                    f"{where}: unknown key {min(table)!r} for a {cls.kind!r} connector"
+                )
+            return None
+        return cls.params_of(validate(cls.keys, table, where, ConnectorError))
+
+    @classmethod
+    def params_of(cls, keys):
+        """The params object of the validated keys (by default the keys model itself)."""
+        return keys
 
     def start(self, io):
         """Called once, after the design's reset, before the first physics step."""
@@ -162,34 +195,42 @@ class Connector:
 MOUNT_KEYS = ("forward", "left", "height", "yaw_deg")
 
 
+class MountKeys(KeyModel):
+    """Where a connector sits: ``forward``, ``left`` of the robot's centre and ``height``
+    above the floor (m), ``yaw_deg`` from the robot's heading (left positive)."""
+
+    forward: Number(ge=-2, le=2, unit="m", style="bounds") = 0.0
+    left: Number(ge=-2, le=2, unit="m", style="bounds") = 0.0
+    height: Number(ge=0, le=3, unit="m", style="bounds") = 0.0
+    yaw_deg: Number(ge=-360, le=360, style="bounds") = 0.0
+
+
 def check_number(table, key, default, where, *, lo, hi, unit="", lo_open=False):
     """``table[key]`` (or ``default``) as a float within ``lo..hi`` (``lo`` excluded with
     ``lo_open``); a ``ConnectorError`` naming ``where.key`` otherwise."""
-    value = table.get(key, default)
-    ok = (
-        isinstance(value, (int, float))
-        and not isinstance(value, bool)
-        and math.isfinite(value)
-        and (value > lo if lo_open else value >= lo)
-        and value <= hi
-    )
-    if not ok:
-        span = f"{'>' if lo_open else '>='} {lo:g} and <= {hi:g}"
-        raise ConnectorError(
-            f"{where}.{key} must be a number{' in ' + unit if unit else ''} {span}, got {value!r}"
-        )
-    return float(value)
+    bound = {"gt": lo} if lo_open else {"ge": lo}
+    check = check_of(Number(**bound, le=hi, unit=unit, style="bounds"))
+    return validate_value(check, table.get(key, default), f"{where}.{key}")
+
+
+def validate_value(check, value, path):
+    """``check(value)`` (a key type's check, ``sim.world.schema.check_of``); a
+    ``ConnectorError`` naming ``path`` otherwise."""
+    try:
+        return check(value)
+    except PydanticCustomError as exc:
+        raise ConnectorError(f"{path}{exc.context.get('sub', '')} {exc.message()}") from None
 
 
 def parse_mount(table, where):
     """Split a connector table into its ``Mount`` (keys ``MOUNT_KEYS``: m, m, m, degrees)
     and the rest (a new dict); a ``ConnectorError`` naming ``where`` for a bad value."""
     rest = {k: v for k, v in table.items() if k not in MOUNT_KEYS}
+    keys = validate(
+        MountKeys, {k: v for k, v in table.items() if k in MOUNT_KEYS}, where, ConnectorError
+    )
     mount = Mount(
-        forward=check_number(table, "forward", 0.0, where, lo=-2, hi=2, unit="m"),
-        left=check_number(table, "left", 0.0, where, lo=-2, hi=2, unit="m"),
-        height=check_number(table, "height", 0.0, where, lo=0, hi=3, unit="m"),
-        yaw=math.radians(check_number(table, "yaw_deg", 0.0, where, lo=-360, hi=360)),
+        forward=keys.forward, left=keys.left, height=keys.height, yaw=math.radians(keys.yaw_deg)
     )
     return mount, rest
 
@@ -198,6 +239,8 @@ def register(cls):
     """Class decorator: make ``cls`` available as ``kind = cls.kind`` in scenarios."""
     if not cls.kind or cls.kind in CONNECTORS:
         raise ValueError(f"connector kind {cls.kind!r} is empty or taken")
+    if cls.keys is not None and not cls.keys.label:
+        cls.keys.label = cls.kind  # its unknown-key message names the kind
     CONNECTORS[cls.kind] = cls
     return cls
 
