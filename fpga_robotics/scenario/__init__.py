@@ -1,6 +1,6 @@
 """Scenarios as data: the shipped files (``shipped/``), loading, ``--set`` overrides and
-validation (``load.py``), the connector tables (``connectors.py``) and the renderer's keys
-(``render3d_keys.py``)."""
+validation (``load.py``), the keys of every section (``schema.py``) and the connector tables
+(``connectors.py``)."""
 
 from fpga_robotics.scenario.load import (
     DEFAULTS,

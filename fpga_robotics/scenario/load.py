@@ -18,8 +18,9 @@ A scenario file has two kinds of sections. The world's sections (``room``, ``rob
 
 Top-level keys: ``name``, ``description``, ``seed`` (default seed of a run).
 
-Everything is checked when the scenario is loaded, before a run starts: types, the range of
-every number (``LIMITS`` below and docs/scenarios.md), the size of the run (physics steps and
+Everything is checked when the scenario is loaded, before a run starts: types and the range
+of every key (the key models of ``fpga_robotics.scenario.schema`` and ``sim.world.keys``,
+docs/scenarios.md), the relations between keys, the size of the run (physics steps and
 camera frames, counted as ``fpga_robotics.loop`` counts them) and the camera's geometry as
 the renderer will draw it.
 """
@@ -29,41 +30,48 @@ import difflib
 import math
 import re
 import tomllib
-from dataclasses import dataclass, field, fields, replace
+from dataclasses import dataclass, field, replace
 from importlib import resources
 from pathlib import Path
 
+from pydantic_core import PydanticCustomError
+
 from fpga_robotics.checks.summary import CHECKS
 from fpga_robotics.designs.builtin import TOPS, design_tables, table_fields
-from fpga_robotics.hw.params import (
-    CHOICES,
-    DEFAULT_BASE_DPS,
-    DEFAULT_PROXIMITY_THRESHOLDS,
-    DEFAULT_STEER_DPS,
-    PRESETS,
-    FollowTargetParams,
-    preset_values,
-)
-from fpga_robotics.hw.pixel import COLOR_SELECT
+from fpga_robotics.hw.params import PRESETS, FollowTargetParams, preset_values
 from fpga_robotics.loop.compressed import frame_count
 from fpga_robotics.loop.connectors import ConnectorError
 from fpga_robotics.scenario.connectors import parse_connectors
 from fpga_robotics.scenario.errors import ScenarioError
-from fpga_robotics.scenario.render3d_keys import RENDER_DEFAULTS, parse_render_keys
 from fpga_robotics.scenario.sanity import scenario_warnings
+from fpga_robotics.scenario.schema import (
+    MAX_SEED,
+    TIMINGS,
+    CameraKeys,
+    ColorKeys,
+    SimKeys,
+    TopKeys,
+    checks_keys,
+    defaults_of,
+    design_keys,
+    ov7670_keys,
+)
 from fpga_robotics.sim.backends.port_map import PortMapError, load_port_map
 from fpga_robotics.sim.camera.raster import max_hfov, max_tilt, vertical_fov
-from fpga_robotics.sim.camera.sensor import PARAMS as SENSOR_PARAMS
+from fpga_robotics.sim.camera.render3d.options import Lamp, Render3DOptions
 from fpga_robotics.sim.camera.sensor import OV7670Params
 from fpga_robotics.sim.world import World, WorldConfigError
-from fpga_robotics.sim.world.config import MAX_TIME, WORLD_SECTIONS
+from fpga_robotics.sim.world.config import WORLD_SECTIONS
+from fpga_robotics.sim.world.schema import Number, check_of, validate
 
 __all__ = [
-    "LIMITS",
+    "DEFAULTS",
     "MAX_FILE_BYTES",
     "MAX_FRAMES",
     "MAX_NAME_LENGTH",
     "MAX_PHYSICS_STEPS",
+    "MAX_SEED",
+    "TIMINGS",
     "WORLD_SECTIONS",
     "CameraConfig",
     "ForeignDesignFiles",
@@ -83,69 +91,26 @@ _FOREIGN_KEYS = ("verilog", "ports")
 _TOP_TABLES = ("ultrasound", "interlock", "line")
 #: ``design.params``: the keyword arguments of a design of one's own (designs/reference.py).
 _TOP_DESIGN_KEYS = ("top", "variant", "params", *_TOP_TABLES)
-_DESIGN_KEYS = (
-    ("preset",)
-    + _TOP_DESIGN_KEYS
-    + _FOREIGN_KEYS
-    + tuple(
-        f.name for f in fields(FollowTargetParams) if f.init and f.name not in ("width", "height")
-    )
-)
-#: Design parameters that are arrays: their length and what the values are.
-_DESIGN_ARRAYS = {
-    "base_dps": (len(DEFAULT_BASE_DPS), "wheel DPS per proximity level 0..7"),
-    "proximity_thresholds": (len(DEFAULT_PROXIMITY_THRESHOLDS), "pixel counts of levels 1..7"),
-    "steer_dps": (len(DEFAULT_STEER_DPS), "DPS by LED distance 0..3 from the centre"),
-}
 
-#: Defaults of the application's sections (a key absent here is unknown).
+
+def _section_models():
+    """The key model of each application section (``[checks]`` follows its registry)."""
+    return {
+        "sim": SimKeys,
+        "camera": CameraKeys,
+        "color": ColorKeys,
+        "design": design_keys(),
+        "checks": checks_keys(),
+    }
+
+
+#: Defaults of the application's sections (a key absent here is unknown; None: no default),
+#: from their key models (fpga_robotics.scenario.schema).
 DEFAULTS = {
-    # timing: "auto" (compressed for camera-only designs), "compressed" or "real_clock".
-    "sim": {
-        "duration": 20.0,
-        "physics_dt": 1.0 / 240.0,
-        "actuation_delay": None,
-        "timing": "auto",
-        "clock_hz": 50e6,
-    },
-    "camera": {
-        "resolution": "160x120",
-        "fps": 30.0,
-        "hfov": 1.047,
-        "mount_height": None,  # None: the robot model's camera mount
-        "mount_forward": None,
-        "tilt": None,
-        "noise_std": 0.0,
-        "yaw_offset_deg": 0.0,  # the mount knocked off its pose (positive: turned left)
-        "exposure_drift": 0.0,  # std of the log brightness gain's slow drift (10 s correlation)
-        # The sensor model after the renderer (camera.sensor, camera.ov7670.*).
-        "sensor": "plain",
-        "ov7670": {k: list(v[0]) if v[1] == "pair" else v[0] for k, v in SENSOR_PARAMS.items()},
-        **RENDER_DEFAULTS,  # renderer, shadows, ... (fpga_robotics.scenario.render3d_keys)
-    },
-    "color": {"initial": "red", "changes": []},
+    "sim": defaults_of(SimKeys),
+    "camera": {**defaults_of(CameraKeys), "ov7670": defaults_of(ov7670_keys())},
+    "color": defaults_of(ColorKeys),
 }
-
-#: The range of every number of the application's sections: key → (lo, hi, unit). Chosen so
-#: that no sensible run comes near them, while an absurd one fails at once with the limit
-#: instead of computing for hours (docs/scenarios.md, "Limits").
-LIMITS = {
-    "sim.duration": (0.0, MAX_TIME, "s"),  # one day
-    "sim.physics_dt": (1e-5, None, "s"),  # at most one frame period (1 / camera.fps)
-    "sim.actuation_delay": (0.0, 10.0, "s"),
-    "sim.clock_hz": (1e3, 1e9, "Hz"),
-    "camera.fps": (0.1, 1000.0, "frames/s"),
-    "camera.hfov": (0.01, 3.1, "rad"),  # and narrow enough for the image's aspect ratio
-    "camera.mount_height": (0.0, None, "m"),  # and below the ceiling (room.height)
-    "camera.mount_forward": (-2.0, 2.0, "m"),
-    "camera.tilt": (-math.pi / 2, math.pi / 2, "rad"),  # and what the field of view allows
-    "camera.noise_std": (0.0, 64.0, "8-bit levels"),
-    "camera.yaw_offset_deg": (-45.0, 45.0, "deg"),
-    "camera.exposure_drift": (0.0, 2.0, ""),
-    "color.changes.at": (0.0, MAX_TIME, "s"),
-}
-#: Keys whose lower bound is excluded.
-_LO_EXCLUDED = ("sim.duration", "camera.mount_height")
 #: Camera and design resolution: the design's limits (``FollowTargetParams``).
 WIDTH_RANGE = (16, 4096)
 HEIGHT_RANGE = (2, 4096)
@@ -154,8 +119,6 @@ MAX_PHYSICS_STEPS = 10**8
 #: ... and this many camera frames (``sim.duration * camera.fps``; about 150 bytes each of
 #: trajectory in memory).
 MAX_FRAMES = 10**7
-#: Seeds are integers 0..2**63-1.
-MAX_SEED = 2**63 - 1
 #: A scenario's name is a file name (``runs/<name>.rrd``): ASCII letters, digits, ``_ - .``,
 #: not starting with ``.`` or ``-``, at most this long.
 MAX_NAME_LENGTH = 64
@@ -208,8 +171,6 @@ class CameraConfig:
         return 1.0 / self.fps
 
 
-#: ``sim.timing`` values.
-TIMINGS = ("auto", "compressed", "real_clock")
 #: In real-clock timing the readout and the processing are simulated, so the default
 #: actuation delay is only the command's trip to the motor controller (one SPI message), s.
 REAL_CLOCK_ACTUATION_DELAY = 0.001
@@ -425,7 +386,7 @@ def _check_sections(data, path):
     for key in data:
         if key not in known:
             raise ScenarioError(f"{where}unknown top-level key {key!r}{_close(key, known)}")
-    allowed_keys = {**DEFAULTS, "design": _DESIGN_KEYS, "checks": CHECKS}
+    models = _section_models()
     for section in _APP_SECTIONS:
         value = data.get(section, {})
         if not isinstance(value, dict):
@@ -433,17 +394,11 @@ def _check_sections(data, path):
                 f"{where}{section} must be a table ([{section}] in a file, --set "
                 f"{section}.KEY=VALUE on the command line), got {value!r}"
             )
-        allowed = allowed_keys[section]
+        model = models[section]
         _check_subtables(value, DEFAULTS.get(section, {}), section, where)
         for key in value:
-            if key not in allowed:
-                if section == "design" and key in ("width", "height"):
-                    raise ScenarioError(
-                        f"{where}design.{key} comes from camera.resolution; set that instead"
-                    )
-                raise ScenarioError(
-                    f"{where}unknown key {section}.{key}{_close(key, allowed, section)}"
-                )
+            if key not in model.key_names():
+                raise ScenarioError(where + model.unknown_key(f"{section}.{key}", key))
 
 
 def _check_subtables(table, defaults, section, where):
@@ -514,7 +469,7 @@ def _known_paths(data):
 
     walk("", data)
     out += list(WORLD_SECTIONS)
-    out += [f"design.{k}" for k in _DESIGN_KEYS]
+    out += [f"design.{k}" for k in design_keys().key_names()]
     out += [f"checks.{k}" for k in CHECKS]
     out += [f"{s}.{k}" for s, d in DEFAULTS.items() for k in d]
     return sorted(set(out))
@@ -590,7 +545,7 @@ def _optional_keys(parents):
         return ()
     section = parents[0]
     if section == "design":
-        return _DESIGN_KEYS
+        return design_keys().key_names()
     if section == "checks":
         return CHECKS
     return tuple(DEFAULTS.get(section, ()))
@@ -618,57 +573,17 @@ def _coerce(old, value):
 # Validation ---------------------------------------------------------------------------------
 
 
-def _is_int(value):
-    return isinstance(value, int) and not isinstance(value, bool)
+def _keys(model, table, prefix):
+    """The table's keys validated by their model; a ``ScenarioError`` naming the key."""
+    return validate(model, table, prefix, ScenarioError)
 
 
-def _is_number(value):
-    return isinstance(value, (int, float)) and not isinstance(value, bool)
-
-
-def _in_range(value, name, lo, hi, unit, *, lo_open=False, note=""):
-    """``value`` as a float if it is a finite number in ``lo..hi`` (``None``: no bound);
-    ``note`` explains the upper bound."""
-    if not (_is_number(value) and math.isfinite(value)):
-        bounds = [f"{'>' if lo_open else '>='} {lo:g}"] if lo is not None else []
-        bounds += [f"<= {hi:g}"] if hi is not None else []
-        raise ScenarioError(
-            f"{name} must be a finite number{' in ' + unit if unit else ''}"
-            f"{', ' + ' and '.join(bounds) if bounds else ''}, got {value!r}"
-        )
-    unit = f" ({unit})" if " " in unit else f" {unit}" if unit else ""
-    if lo is not None and (value <= lo if lo_open else value < lo):
-        raise ScenarioError(
-            f"{name} must be {'>' if lo_open else '>='} {lo:g}{unit}, got {value!r}"
-        )
-    if hi is not None and value > hi:
-        raise ScenarioError(f"{name} must be <= {hi:g}{unit}{note}, got {value!r}")
-    return float(value)
-
-
-def _limited(data, name, *, optional=False, hi=None, note=""):
-    """The value of ``section.key`` checked against ``LIMITS`` (``hi`` overrides its upper
-    bound); ``None`` for an optional key that is not given."""
-    section, key = name.split(".")
-    value = data[section].get(key)
-    if optional and value is None:
-        return None
-    lo, limit_hi, unit = LIMITS[name]
-    return _in_range(
-        value,
-        name,
-        lo,
-        limit_hi if hi is None else hi,
-        unit,
-        lo_open=name in _LO_EXCLUDED,
-        note=note,
-    )
-
-
-def _color(value, where):
-    if not isinstance(value, str) or value.lower() not in COLOR_SELECT:
-        raise ScenarioError(f"{where} must be one of {', '.join(COLOR_SELECT)}; got {value!r}")
-    return value.lower()
+def _check(key_type, value, path):
+    """``value`` checked by one key type (for a bound that depends on other keys)."""
+    try:
+        return check_of(key_type)(value)
+    except PydanticCustomError as exc:
+        raise ScenarioError(f"{path}{exc.context.get('sub', '')} {exc.message()}") from None
 
 
 def _floor(x, digits):
@@ -700,8 +615,8 @@ def _check_name(name):
 
 
 def _camera(data):
-    cam = data["camera"]
-    width, height = parse_resolution(cam["resolution"])
+    k = _keys(CameraKeys, data["camera"], "camera")
+    width, height = parse_resolution(k.resolution)
     if not (
         WIDTH_RANGE[0] <= width <= WIDTH_RANGE[1] and HEIGHT_RANGE[0] <= height <= HEIGHT_RANGE[1]
     ):
@@ -710,57 +625,36 @@ def _camera(data):
             f"{WIDTH_RANGE[1]} and the height {HEIGHT_RANGE[0]}..{HEIGHT_RANGE[1]} pixels "
             f"(the design's limits)"
         )
-    renderer, render3d = parse_render_keys(cam, data.get("seed", 0))
+    render3d = Render3DOptions(
+        shadows=k.shadows,
+        shadow_size=k.shadow_size,
+        textures=k.textures,
+        floor=k.floor,
+        shine=k.shine,
+        lamps=tuple(Lamp(**lamp.model_dump()) for lamp in k.lamps),
+        seed=data.get("seed", 0),
+    )
     return CameraConfig(
         width=width,
         height=height,
-        fps=_limited(data, "camera.fps"),
-        hfov=_limited(data, "camera.hfov"),
-        mount_height=_limited(data, "camera.mount_height", optional=True),
-        mount_forward=_limited(data, "camera.mount_forward", optional=True),
-        tilt=_limited(data, "camera.tilt", optional=True),
-        noise_std=_limited(data, "camera.noise_std"),
-        yaw_offset=math.radians(_limited(data, "camera.yaw_offset_deg")),
-        exposure_drift=_limited(data, "camera.exposure_drift"),
-        sensor=_choice(cam["sensor"], "camera.sensor", ("plain", "ov7670")),
-        ov7670=_sensor_params(cam["ov7670"]),
-        renderer=renderer,
+        fps=k.fps,
+        hfov=k.hfov,
+        mount_height=k.mount_height,
+        mount_forward=k.mount_forward,
+        tilt=k.tilt,
+        noise_std=k.noise_std,
+        yaw_offset=math.radians(k.yaw_offset_deg),
+        exposure_drift=k.exposure_drift,
+        sensor=k.sensor,
+        ov7670=_sensor_params(data["camera"]["ov7670"]),
+        renderer=k.renderer,
         render3d=render3d,
     )
 
 
-def _choice(value, name, choices):
-    if value not in choices:
-        raise ScenarioError(f"{name} must be one of {', '.join(map(repr, choices))}, got {value!r}")
-    return value
-
-
 def _sensor_params(table):
-    """``[camera.ov7670]`` checked against ``sim.sensor.PARAMS``."""
-    values = {}
-    for key, (_, kind, limits, unit, _) in SENSOR_PARAMS.items():
-        name, value = f"camera.ov7670.{key}", table[key]
-        if kind == "bool" and not isinstance(value, bool):
-            raise ScenarioError(f"{name} must be true or false, got {value!r}")
-        if kind == "choice":
-            _choice(value, name, limits)
-        if kind == "float":
-            value = _in_range(value, name, *limits, unit)
-        if kind == "int" and not (_is_int(value) and limits[0] <= value <= limits[1]):
-            raise ScenarioError(
-                f"{name} must be an integer {limits[0]}..{limits[1]} ({unit}), got {value!r}"
-            )
-        if kind == "pair" and not (
-            isinstance(value, list)
-            and len(value) == 2
-            and all(_is_int(v) and limits[0] <= v <= limits[1] for v in value)
-            and value[0] < value[1]
-        ):
-            raise ScenarioError(
-                f"{name} must be [low, high], integers {limits[0]}..{limits[1]} "
-                f"with low < high ({unit}), got {value!r}"
-            )
-        values[key] = tuple(value) if kind == "pair" else value
+    """``[camera.ov7670]`` (its keys from ``sim.sensor.PARAMS``)."""
+    values = dict(_keys(ov7670_keys(), table, "camera.ov7670"))
     (lo, hi), (fast_lo, fast_hi) = values["aec_window"], values["aec_fast_zone"]
     if not fast_lo <= lo < hi <= fast_hi:
         raise ScenarioError(
@@ -803,20 +697,25 @@ def _check_camera_geometry(camera, world):
 
 
 def _sim(data, camera):
-    sim = data["sim"]
-    duration = _limited(data, "sim.duration", note=" (one day)")
+    k = _keys(SimKeys, data["sim"], "sim")
     period = camera.frame_period
-    dt = _limited(
-        data, "sim.physics_dt", hi=period, note=" (one camera frame period, 1 / camera.fps)"
+    # The physics step: at most one frame period (a bound that depends on camera.fps).
+    step = Number(
+        ge=1e-5,
+        le=period,
+        unit="s",
+        style="scenario",
+        note=" (one camera frame period, 1 / camera.fps)",
     )
-    timing = _choice(sim.get("timing", "auto"), "sim.timing", TIMINGS)
-    clock_hz = _limited(data, "sim.clock_hz")
-    if sim.get("actuation_delay") is not None:
-        delay = _limited(data, "sim.actuation_delay")
-    else:
-        delay = None  # one frame period, or REAL_CLOCK_ACTUATION_DELAY (_resolve_timing)
+    dt = _check(step, k.physics_dt, "sim.physics_dt")
+    duration = k.duration
+    # None: one frame period, or REAL_CLOCK_ACTUATION_DELAY (_resolve_timing).
     config = SimConfig(
-        duration=duration, physics_dt=dt, actuation_delay=delay, timing=timing, clock_hz=clock_hz
+        duration=duration,
+        physics_dt=dt,
+        actuation_delay=k.actuation_delay,
+        timing=k.timing,
+        clock_hz=k.clock_hz,
     )
     steps = max(1, round(duration / dt))  # as the closed loop counts them
     if steps > MAX_PHYSICS_STEPS:
@@ -835,24 +734,8 @@ def _sim(data, camera):
 
 
 def _color_changes(data):
-    color = data["color"]
-    initial = _color(color["initial"], "color.initial")
-    changes = color["changes"]
-    if not isinstance(changes, list):
-        raise ScenarioError('color.changes must be a list of {at = seconds, color = "..."}')
-    lo, hi, unit = LIMITS["color.changes.at"]
-    parsed = []
-    for i, change in enumerate(changes):
-        where = f"color.changes[{i}]"
-        if not isinstance(change, dict) or set(change) != {"at", "color"}:
-            raise ScenarioError(f'{where} must be {{at = seconds, color = "name"}}, got {change!r}')
-        at = change["at"]
-        if not (_is_number(at) and math.isfinite(at) and lo <= at <= hi):
-            raise ScenarioError(f"{where}.at must be a time in {lo:g}..{hi:g} {unit}, got {at!r}")
-        parsed.append((float(at), _color(change["color"], f"{where}.color")))
-    if [a for a, _ in parsed] != sorted(a for a, _ in parsed):
-        raise ScenarioError("color.changes must be in time order")
-    return initial, tuple(parsed)
+    k = _keys(ColorKeys, data["color"], "color")
+    return k.initial, k.changes
 
 
 def _foreign(design, source):
@@ -913,21 +796,7 @@ def _design(data, width, height):
     for key in _FOREIGN_KEYS + _TOP_DESIGN_KEYS:
         design.pop(key, None)
     preset = design.pop("preset", None)
-    for key, value in design.items():
-        if key in CHOICES:
-            if not isinstance(value, str):
-                raise ScenarioError(
-                    f"design.{key} must be a string, one of "
-                    f"{', '.join(CHOICES[key])}; got {value!r}"
-                )
-        elif key in _DESIGN_ARRAYS:
-            n, what = _DESIGN_ARRAYS[key]
-            if not (isinstance(value, list) and len(value) == n and all(map(_is_int, value))):
-                raise ScenarioError(
-                    f"design.{key} must be an array of {n} integers ({what}), got {value!r}"
-                )
-        elif not _is_int(value):
-            raise ScenarioError(f"design.{key} must be an integer, got {value!r}")
+    _keys(design_keys(), design, "design")  # the types; FollowTargetParams the ranges
     values = {}
     if preset is not None:
         if preset not in PRESETS:
@@ -1060,27 +929,14 @@ def _resolve_timing(sim, camera, top, connectors, foreign):
 
 
 def _checks(data):
-    checks = dict(data["checks"])
-    for key, limit in checks.items():
-        kind, (lo, hi, unit), _meaning = CHECKS[key]
-        name = f"checks.{key}"
-        if kind is int:
-            if not (_is_int(limit) and lo <= limit <= hi):
-                raise ScenarioError(f"{name} must be an integer in {lo}..{hi}, got {limit!r}")
-        elif not (_is_number(limit) and math.isfinite(limit) and lo <= limit <= hi):
-            unit = f" {unit}" if unit else ""
-            raise ScenarioError(f"{name} must be a number in {lo:g}..{hi:g}{unit}, got {limit!r}")
-    return checks
+    _keys(checks_keys(), data["checks"], "checks")
+    return dict(data["checks"])
 
 
 def _build(data, source, overrides):
     name = _check_name(data.get("name"))
-    description = data.get("description", "")
-    if not isinstance(description, str):
-        raise ScenarioError(f"description must be a string, got {description!r}")
-    seed = data.get("seed", 0)
-    if not (_is_int(seed) and 0 <= seed <= MAX_SEED):
-        raise ScenarioError(f"seed must be an integer in 0..{MAX_SEED}, got {seed!r}")
+    top_keys = _keys(TopKeys, {k: data[k] for k in ("description", "seed") if k in data}, "")
+    description, seed = top_keys.description, data.get("seed", 0)
     for section in WORLD_SECTIONS:
         if section in data and not isinstance(data[section], (dict, list)):
             raise ScenarioError(f"[{section}] must be a table")

@@ -225,14 +225,14 @@ class KeyModel(BaseModel):
     label: ClassVar[str] = ""
 
     @classmethod
-    def keys(cls):
+    def key_names(cls):
         """The table's keys, in declared order (a field's alias where it has one)."""
         return [f.alias or name for name, f in cls.model_fields.items()]
 
     @classmethod
     def unknown_key(cls, path, key):
         """The message for a key the table does not declare."""
-        known = cls.keys()
+        known = cls.key_names()
         close = difflib.get_close_matches(str(key), known, n=1)
         hint = f" (did you mean {close[0]!r}?)" if close else ""
         return f"{path} is not a known key{hint}; known keys: {', '.join(known)}"

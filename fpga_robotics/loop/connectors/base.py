@@ -122,7 +122,7 @@ class ConnectorKeys(KeyModel):
         where = path.rpartition(".")[0]
         kind = f" for a {cls.label!r} connector" if cls.label else ""
         return (
-            f"{where}: unknown key {key!r}{kind}; its keys: {', '.join(cls.keys())} "
+            f"{where}: unknown key {key!r}{kind}; its keys: {', '.join(cls.key_names())} "
             f"(and the mount: {', '.join(MOUNT_KEYS)})"
         )
 
