@@ -82,21 +82,36 @@ class ScenarioKeys(KeyModel):
 
 
 class TopKeys(ScenarioKeys):
-    """The keys outside any section (the sections themselves are checked by the loader)."""
+    """The keys outside any section."""
 
-    description: Text(style="scenario", doc="one line shown by the scenario list") = ""
-    seed: Integer(ge=0, le=MAX_SEED, doc="the default seed of a run") = 0
+    #: A file name (the loader checks it and defaults it to the file's name).
+    name: Annotated[object, Field(description="the run's recording is runs/<name>.rrd")] = None
+    description: Text(style="scenario", doc="one line, shown by the scenario list") = ""
+    seed: Integer(ge=0, le=MAX_SEED, doc="the default seed of a run (`--seed`)") = 0
 
 
 class SimKeys(ScenarioKeys):
-    duration: _scenario_number(gt=0, le=MAX_TIME, unit="s", note=" (one day)") = 20.0
-    # At most one frame period (1 / camera.fps): checked with the camera (load.py).
-    physics_dt: _scenario_number(ge=1e-5, unit="s") = 1.0 / 240.0
-    #: None: one frame period (compressed timing) or one SPI message (real-clock timing).
-    actuation_delay: _scenario_number(ge=0, le=10, unit="s") = None
-    #: "auto": compressed for camera-only designs, else real-clock.
-    timing: Text(choices=TIMINGS, style="scenario") = "auto"
-    clock_hz: _scenario_number(ge=1e3, le=1e9, unit="Hz", doc="design clock") = 50e6
+    duration: _scenario_number(
+        gt=0, le=MAX_TIME, unit="s", note=" (one day)", doc="simulated time of a run"
+    ) = 20.0
+    physics_dt: _scenario_number(
+        ge=1e-5, unit="s", doc="physics step; at most one camera frame period (`1 / camera.fps`)"
+    ) = 1.0 / 240.0
+    actuation_delay: _scenario_number(
+        ge=0,
+        le=10,
+        unit="s",
+        doc="a command's way to the wheels; unset: one frame period (compressed timing) or "
+        "0.001 s, one SPI message (real-clock timing)",
+    ) = None
+    timing: Text(
+        choices=TIMINGS,
+        style="scenario",
+        doc='"auto": "compressed" for a camera-only design, else "real_clock" (docs/running.md)',
+    ) = "auto"
+    clock_hz: _scenario_number(
+        ge=1e3, le=1e9, unit="Hz", doc="the design's clock in real-clock timing"
+    ) = 50e6
 
 
 def _vector3(lo, hi):
@@ -114,9 +129,9 @@ class LampKeys(ScenarioKeys):
 
     pos: Annotated[_vector3(-100, 100), Field(description="a point [x, y, z] in m")]
     aim: Annotated[_vector3(-100, 100), Field(description="a point [x, y, z] in m")]
-    color: _vector3(0, 10) = (0.5, 0.5, 0.5)
-    cutoff_deg: Number(ge=1, le=90, unit="", style="span") = 45.0
-    shadows: Flag(style="scenario") = True
+    color: Annotated[_vector3(0, 10), Field(description="its light, r, g, b")] = (0.5, 0.5, 0.5)
+    cutoff_deg: Number(ge=1, le=90, style="span", doc="the cone's half angle, deg") = 45.0
+    shadows: Flag(style="scenario", doc="casts shadows (when camera.shadows)") = True
 
     @classmethod
     def unknown_key(cls, path, key):
@@ -177,36 +192,67 @@ def ov7670_keys():
 
 
 class CameraKeys(ScenarioKeys):
-    #: "WxH" or [W, H]: parsed by ``load.parse_resolution`` (its own message).
-    resolution: Annotated[object, Field(description='"WxH", e.g. "160x120"')] = "160x120"
-    fps: _scenario_number(ge=0.1, le=1000.0, unit="frames/s") = 30.0
-    # And narrow enough for the image's aspect ratio (load.py).
-    hfov: _scenario_number(ge=0.01, le=3.1, unit="rad", doc="horizontal field of view") = 1.047
-    # None: the robot model's camera mount. Below the ceiling (room.height, load.py).
-    mount_height: _scenario_number(gt=0, unit="m") = None
-    mount_forward: _scenario_number(ge=-2, le=2, unit="m") = None
-    # And what the field of view allows (load.py).
-    tilt: _scenario_number(ge=-math.pi / 2, le=math.pi / 2, unit="rad", doc="up positive") = None
-    noise_std: _scenario_number(ge=0, le=64, unit="8-bit levels") = 0.0
-    #: The mount knocked off its pose (positive: turned left).
-    yaw_offset_deg: _scenario_number(ge=-45, le=45, unit="deg") = 0.0
-    #: Std of the log brightness gain's slow drift (10 s correlation).
-    exposure_drift: _scenario_number(ge=0, le=2, unit="") = 0.0
-    #: The sensor model after the renderer ("ov7670": camera.ov7670.*, docs/camera.md).
-    sensor: Text(choices=("plain", "ov7670"), style="scenario") = "plain"
-    ov7670: Annotated[object, Field(description="[camera.ov7670] sensor parameters")] = None
-    # The renderer and the 3D renderer's keys (docs/render3d.md).
-    renderer: Text(choices=RENDERERS, style="scenario") = "raster"
-    shadows: Flag(style="scenario") = True
+    resolution: Annotated[
+        object, Field(description='"WxH": width 16..4096, height 2..4096 (the design\'s limits)')
+    ] = "160x120"
+    fps: _scenario_number(ge=0.1, le=1000.0, unit="frames/s", doc="frame rate") = 30.0
+    hfov: _scenario_number(
+        ge=0.01,
+        le=3.1,
+        unit="rad",
+        doc="horizontal field of view; at most what the aspect ratio allows with the tilt",
+    ) = 1.047
+    mount_height: _scenario_number(
+        gt=0, unit="m", doc="above the floor, below the ceiling; unset: robot.camera_height"
+    ) = None
+    mount_forward: _scenario_number(
+        ge=-2, le=2, unit="m", doc="ahead of the robot's centre; unset: robot.camera_forward"
+    ) = None
+    tilt: _scenario_number(
+        ge=-math.pi / 2,
+        le=math.pi / 2,
+        unit="rad",
+        doc="up positive, within the field-of-view limit; unset: robot.camera_tilt_deg",
+    ) = None
+    noise_std: _scenario_number(
+        ge=0, le=64, unit="8-bit levels", doc="Gaussian noise on each pixel"
+    ) = 0.0
+    yaw_offset_deg: _scenario_number(
+        ge=-45, le=45, unit="deg", doc="the mount knocked off its pose (positive: turned left)"
+    ) = 0.0
+    exposure_drift: _scenario_number(
+        ge=0, le=2, unit="", doc="std of the log brightness gain's slow drift (10 s correlation)"
+    ) = 0.0
+    sensor: Text(
+        choices=("plain", "ov7670"),
+        style="scenario",
+        doc='the sensor model after the renderer ("ov7670": [camera.ov7670], docs/camera.md)',
+    ) = "plain"
+    ov7670: Annotated[
+        object, Field(description="the OV7670 model's parameters (docs/camera.md)")
+    ] = None
+    renderer: Text(
+        choices=RENDERERS, style="scenario", doc='"mujoco": the 3D renderer (docs/render3d.md)'
+    ) = "raster"
+    shadows: Flag(style="scenario", doc="3D renderer: shadows") = True
     shadow_size: Integer(
         ge=64,
         le=8192,
+        doc="3D renderer: pixels of a light's shadow map",
         message="must be an integer in {lo}..{hi} (pixels of a light's shadow map), got {value!r}",
     ) = 256
-    textures: Flag(style="scenario") = True
-    floor: Text(choices=FLOORS, style="scenario") = "planks"
-    shine: Number(ge=0, le=1, style="span") = 0.0
-    lamps: Annotated[list[LampKeys], BeforeValidator(_lamps)] = ()
+    textures: Flag(
+        style="scenario", doc="3D renderer: textures on walls, floor and wood; false: flat colours"
+    ) = True
+    floor: Text(choices=FLOORS, style="scenario", doc="3D renderer: the floor's texture") = "planks"
+    shine: Number(
+        ge=0, le=1, style="span", doc="3D renderer: specular strength of clothes and wood"
+    ) = 0.0
+    lamps: Annotated[
+        list[LampKeys],
+        BeforeValidator(_lamps),
+        Field(description="3D renderer: spot lamps ([[camera.lamps]])"),
+    ] = ()
 
 
 def _color(value):
@@ -238,8 +284,12 @@ def _changes(value):
 
 
 class ColorKeys(ScenarioKeys):
-    initial: Color = "red"
-    changes: Annotated[object, BeforeValidator(_changes)] = ()
+    initial: Annotated[Color, Field(description="the colour the design selects at t = 0")] = "red"
+    changes: Annotated[
+        object,
+        BeforeValidator(_changes),
+        Field(description='[{at = s, color = "..."}, ...], in time order, at 0..86400 s'),
+    ] = ()
 
 
 def _design_key(name):
