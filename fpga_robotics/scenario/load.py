@@ -163,7 +163,7 @@ class CameraConfig:
     exposure_drift: float = 0.0  # std of the log brightness gain (CameraConnector)
     sensor: str = "plain"  # "plain" or "ov7670" (sim.sensor, with the parameters below)
     ov7670: OV7670Params = field(default_factory=OV7670Params)
-    renderer: str = "raster"  # "raster" or "mujoco" (fpga_robotics.scenario.render3d_keys)
+    renderer: str = "raster"  # "raster" or "mujoco" (docs/render3d.md)
     render3d: object = None  # sim.render3d.Render3DOptions
 
     @property
