@@ -16,10 +16,14 @@ out the pixel stream (a design without a camera).
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Annotated, ClassVar
+
+from pydantic import BeforeValidator, Field
 
 from fpga_robotics.hw.errors import UserError
 
 from ...hw.pixel import COLOR_SELECT
+from ..world.schema import Flag, Integer, KeyModel, Text, fail, validate
 from .base import BackendError
 
 __all__ = [
@@ -45,21 +49,6 @@ OUTPUTS = {
     "motor_right": (16, True),
 }
 _STYLES = ("stream", "framebuffer")
-_TOP_KEYS = {
-    "style",
-    "top",
-    "clock",
-    "reset",
-    "pixels",
-    "color",
-    "result",
-    "outputs",
-    "filtered",
-    "constants",
-    "runtime",
-    "connectors",
-    "extra_outputs",
-}
 #: Connector kinds the map binds elsewhere: the camera by ``pixels``/``color``, the wheels by
 #: ``outputs.motor_left``/``motor_right``.
 _BOUND_ELSEWHERE = {
@@ -168,221 +157,320 @@ class PortMap:
         return ports
 
 
-def _table(data, key, where, required=True):
-    value = data.get(key)
-    if value is None:
-        if required:
-            raise PortMapError(f"port map: missing [{key}]{where}")
-        return {}
-    if not isinstance(value, dict):
-        raise PortMapError(f"port map: {key} must be a table")
-    return value
+# The keys of a port map, each table a model (sim.world.schema) -------------------------------
 
 
-def _name(table, key, where, required=True):
-    value = table.get(key)
-    if value is None:
-        if required:
-            raise PortMapError(f"port map: missing {where}.{key} (a port name)")
-        return None
+class _MapKeys(KeyModel):
+    """A table of a port map: an unknown key lists the allowed ones; reported first."""
+
+    unknown_first: ClassVar[bool] = True
+
+    @classmethod
+    def unknown_key(cls, path, key):
+        return f"unknown key '{path}'; allowed: {', '.join(sorted(cls.key_names()))}"
+
+    @classmethod
+    def missing_key(cls, path, key, doc):
+        return f"missing [{path}]" if doc == "table" else f"missing {path} (a port name)"
+
+
+def _port_name(value):
     if not isinstance(value, str) or not value.isidentifier():
-        raise PortMapError(f"port map: {where}.{key} must be a Verilog port name, got {value!r}")
+        fail(f"must be a Verilog port name, got {value!r}")
     return value
 
 
-def _unknown(table, allowed, where):
-    extra = sorted(set(table) - set(allowed))
-    if extra:
-        raise PortMapError(
-            f"port map: unknown key '{where}{extra[0]}'; allowed: {', '.join(sorted(allowed))}"
-        )
+#: A Verilog port name.
+PortName = Annotated[str, BeforeValidator(_port_name)]
 
 
-def _int(table, key, where, default, low, high):
-    value = table.get(key, default)
-    if isinstance(value, bool) or not isinstance(value, int) or not low <= value <= high:
-        raise PortMapError(
-            f"port map: {where}.{key} must be an integer in {low}..{high}, got {value!r}"
-        )
+def _table(model, doc=""):
+    """A sub-table (``doc="table"``: its absence is reported as ``missing [key]``)."""
+    return Annotated[model, Field(description=doc)]
+
+
+def _ports_of(what, value_check=None):
+    """A table ``name = value`` of ports (``[constants]``, ``[runtime]``)."""
+
+    def check(table):
+        if not isinstance(table, dict):
+            fail("must be a table")
+        for name, value in table.items():
+            if not name.isidentifier():
+                fail("not a port name", sub=f".{name}:")
+            if value_check is not None:
+                value_check(value, name)
+        return dict(table)
+
+    return Annotated[object, BeforeValidator(check), Field(description=what)]
+
+
+def _level(note):
+    def check(value, name):
+        if isinstance(value, bool) or not isinstance(value, int) or value < 0:
+            fail(f"must be an integer >= 0{note}, got {value!r}", sub=f".{name}")
+
+    return check
+
+
+def _extra_outputs(table):
+    if not isinstance(table, dict):
+        fail("must be a table")
+    for name, port in table.items():
+        if not name.isidentifier() or name in OUTPUTS:
+            fail(
+                "the name must be a Python name other than the [outputs] keys",
+                sub=f".{name}:",
+            )
+        if not isinstance(port, str) or not port.isidentifier():
+            fail(f"must be a Verilog port name, got {port!r}", sub=f".{name}")
+    return dict(table)
+
+
+def _connector_tables(table):
+    """``[connectors.<kind>]``: kind -> {pin: port}; names only (the kinds and their pins are
+    checked by ``check_connectors``)."""
+    if not isinstance(table, dict):
+        fail("must be a table")
+    for kind, pins in table.items():
+        if not kind.isidentifier():
+            fail("not a connector kind", sub=f".{kind}:")
+        if kind in _BOUND_ELSEWHERE:
+            fail(
+                f"the {kind} is bound by {_BOUND_ELSEWHERE[kind]}, not a [connectors] table",
+                sub=f".{kind}:",
+            )
+        if not isinstance(pins, dict) or not pins:
+            fail('must be a table of pin = "port"', sub=f".{kind}")
+        for pin, port in pins.items():
+            if not isinstance(port, str) or not port.isidentifier():
+                fail(f"must be a Verilog port name, got {port!r}", sub=f".{kind}.{pin}")
+    return {kind: dict(pins) for kind, pins in table.items()}
+
+
+def _codes(codes):
+    if not isinstance(codes, dict) or not codes:
+        fail("must be a table of colour = code")
+    for name, code in codes.items():
+        if name not in COLOR_SELECT:
+            fail(f"unknown colour {name!r}; known: {', '.join(COLOR_SELECT)}", sub=":")
+        if isinstance(code, bool) or not isinstance(code, int) or code < 0:
+            fail("must be an integer >= 0", sub=f".{name}")
+    return dict(codes)
+
+
+def _top_name(value):
+    if not isinstance(value, str) or not value.isidentifier():
+        fail(f"must be the top module's name, got {value!r}")
     return value
+
+
+class ClockKeys(_MapKeys):
+    port: PortName
+
+
+class ResetKeys(_MapKeys):
+    port: PortName = None  # required when [reset] is given
+    active_low: Flag(style="scenario") = False
+
+
+class StreamPixelKeys(_MapKeys):
+    """``payload`` (14 bits: data, first, last) or ``data`` (12-bit RGB444, with optional
+    ``first``/``last`` flags)."""
+
+    valid: PortName
+    payload: PortName = None
+    data: PortName = None
+    first: PortName = None
+    last: PortName = None
+
+
+class FramebufferPixelKeys(_MapKeys):
+    write_enable: PortName
+    address: PortName
+    data: PortName
+    new_frame: PortName = None
+
+
+class ColorKeys(_MapKeys):
+    port: PortName = None
+    width: Integer(ge=1, le=32) = None
+    codes: Annotated[object, BeforeValidator(_codes)] = None  # None: the project's codes
+
+
+class ResultKeys(_MapKeys):
+    """``strobe`` (with ``latency``) or ``after_cycles``."""
+
+    strobe: PortName = None
+    latency: Integer(ge=0, le=1 << 20) = None  # None: 0
+    timeout: Integer(ge=1, le=1 << 30) = 100_000
+    after_cycles: Integer(ge=1, le=1 << 20) = None
+
+
+class OutputKeys(_MapKeys):
+    port: PortName
+    width: Integer(ge=1, le=32) = None  # None: the output's default (OUTPUTS)
+    signed: Flag(style="scenario") = None
+
+
+def _output(value):
+    if isinstance(value, str):
+        return {"port": value}
+    if not isinstance(value, dict):
+        fail("must be a port name or a table")
+    return value
+
+
+_Output = Annotated[OutputKeys, BeforeValidator(_output)]
+
+
+class OutputsKeys(_MapKeys):
+    found: _Output = None
+    proximity: _Output = None
+    centroid_x: _Output = None
+    centroid_leds: _Output = None
+    motor_left: _Output = None
+    motor_right: _Output = None
+
+
+class FilteredKeys(_MapKeys):
+    valid: PortName
+    payload: PortName
+
+
+class PortMapKeys(_MapKeys):
+    """A port map file. ``pixels`` is read by the style's model (``StreamPixelKeys`` or
+    ``FramebufferPixelKeys``); the relations between tables are checked by
+    ``parse_port_map``."""
+
+    style: Text(choices=_STYLES, style="scenario") = "stream"
+    top: Annotated[str, BeforeValidator(_top_name)] = None
+    clock: _table(ClockKeys, "table")
+    reset: _table(ResetKeys) = None  # no [reset]: the design has none
+    pixels: Annotated[object, Field(description="table")] = None
+    color: _table(ColorKeys) = None
+    result: _table(ResultKeys) = None
+    outputs: _table(OutputsKeys) = None
+    filtered: _table(FilteredKeys) = None
+    # Inputs the world does not drive (a read address of a debug port, a mode pin) tied to
+    # a value.
+    constants: _ports_of("input port = value", _level("")) = Field(default_factory=dict)
+    # Inputs held at a value the host sets between frames (a mutant select, a mode).
+    runtime: _ports_of("input port = initial value", _level(" (its initial value)")) = Field(
+        default_factory=dict
+    )
+    connectors: Annotated[object, BeforeValidator(_connector_tables)] = Field(default_factory=dict)
+    extra_outputs: Annotated[object, BeforeValidator(_extra_outputs)] = Field(default_factory=dict)
+
+
+assert OUTPUTS.keys() == OutputsKeys.model_fields.keys()
+
+
+def _error(message):
+    return PortMapError(f"port map: {message}")
 
 
 def parse_port_map(data):
     """A ``PortMap`` from the TOML document ``data`` (a dict); ``PortMapError`` if invalid."""
-    _unknown(data, _TOP_KEYS, "")
-    style = data.get("style", "stream")
-    if style not in _STYLES:
-        raise PortMapError(f"port map: style must be one of {', '.join(_STYLES)}, got {style!r}")
-    top = data.get("top")
-    if not isinstance(top, str) or not top.isidentifier():
-        raise PortMapError(f"port map: top must be the top module's name, got {top!r}")
+    if isinstance(data, dict) and "top" not in data:
+        data = {**data, "top": None}  # reported as "top must be the top module's name"
+    k = validate(PortMapKeys, data, "", _error)
+    style, connectors = k.style, k.connectors
+    reset = k.reset if k.reset is not None else ResetKeys()
+    if k.reset is not None and k.reset.port is None:
+        raise _error("missing reset.port (a port name)")
 
-    clock = _table(data, "clock", "")
-    _unknown(clock, {"port"}, "clock.")
-    # No [reset]: a design without one (its registers start at their initial values).
-    reset = _table(data, "reset", "", required=False)
-    _unknown(reset, {"port", "active_low"}, "reset.")
-    active_low = reset.get("active_low", False)
-    if not isinstance(active_low, bool):
-        raise PortMapError("port map: reset.active_low must be true or false")
-
-    connectors = _connectors(data)
     # A design without a camera (only connectors and wheels) has no pixel stream.
-    pixels = _table(data, "pixels", "", required=not connectors)
+    if k.pixels is None and not connectors:
+        raise _error("missing [pixels]")
     address = new_frame = payload = first = last = valid = data_port = None
-    if not pixels:
+    if not k.pixels:
         for key in ("color", "result", "filtered"):
             if key in data:
-                raise PortMapError(
-                    f"port map: [{key}] goes with a pixel stream; this map has "
+                raise _error(
+                    f"[{key}] goes with a pixel stream; this map has "
                     "no pixels (a design without a camera)"
                 )
     elif style == "framebuffer":
-        _unknown(pixels, {"write_enable", "address", "data", "new_frame"}, "pixels.")
-        valid = _name(pixels, "write_enable", "pixels")
-        address = _name(pixels, "address", "pixels")
-        data_port = _name(pixels, "data", "pixels")
-        new_frame = _name(pixels, "new_frame", "pixels", required=False)
+        pixels = validate(FramebufferPixelKeys, k.pixels, "pixels", _error)
+        valid, address, data_port = pixels.write_enable, pixels.address, pixels.data
+        new_frame = pixels.new_frame
     else:
-        _unknown(pixels, {"valid", "payload", "data", "first", "last"}, "pixels.")
-        valid = _name(pixels, "valid", "pixels")
-        payload = _name(pixels, "payload", "pixels", required=False)
-        data_port = _name(pixels, "data", "pixels", required=False)
+        pixels = validate(StreamPixelKeys, k.pixels, "pixels", _error)
+        valid, payload, data_port = pixels.valid, pixels.payload, pixels.data
         if (payload is None) == (data_port is None):
-            raise PortMapError(
-                "port map: give pixels.payload (14 bits with the first/last "
+            raise _error(
+                "give pixels.payload (14 bits with the first/last "
                 "flags) or pixels.data (12-bit RGB444), not both or neither"
             )
-        first = _name(pixels, "first", "pixels", required=False)
-        last = _name(pixels, "last", "pixels", required=False)
+        first, last = pixels.first, pixels.last
         if payload is not None and (first or last):
-            raise PortMapError("port map: pixels.first/last go with pixels.data, not with payload")
+            raise _error("pixels.first/last go with pixels.data, not with payload")
 
-    color = _table(data, "color", "", required=False)
-    _unknown(color, {"port", "width", "codes"}, "color.")
-    color_port = _name(color, "port", "color", required=False)
-    codes = color.get("codes")
-    if codes is None:
-        codes = dict(COLOR_SELECT)
-    if not isinstance(codes, dict) or not codes:
-        raise PortMapError("port map: color.codes must be a table of colour = code")
-    for name, code in codes.items():
-        if name not in COLOR_SELECT:
-            raise PortMapError(
-                f"port map: color.codes: unknown colour {name!r}; known: {', '.join(COLOR_SELECT)}"
-            )
-        if isinstance(code, bool) or not isinstance(code, int) or code < 0:
-            raise PortMapError(f"port map: color.codes.{name} must be an integer >= 0")
-    color_width = color.get("width")
-    if color_width is not None:
-        color_width = _int(color, "width", "color", None, 1, 32)
+    color = k.color if k.color is not None else ColorKeys()
+    codes = color.codes if color.codes is not None else dict(COLOR_SELECT)
 
-    result = _table(data, "result", "", required=bool(pixels))
-    _unknown(result, {"strobe", "latency", "timeout", "after_cycles"}, "result.")
-    strobe = _name(
-        result, "strobe", "result", required=bool(pixels) and "after_cycles" not in result
-    )
-    after_cycles = None
-    if "after_cycles" in result:
-        if strobe is not None or "latency" in result:
-            raise PortMapError(
-                "port map: give result.strobe (and latency) or result.after_cycles, not both"
-            )
-        after_cycles = _int(result, "after_cycles", "result", None, 1, 1 << 20)
-    latency = _int(result, "latency", "result", 0, 0, 1 << 20)
-    timeout = _int(result, "timeout", "result", 100_000, 1, 1 << 30)
+    result = k.result
+    if result is None:
+        if k.pixels:
+            raise _error("missing [result]")
+        result = ResultKeys()
+    if result.after_cycles is not None:
+        if result.strobe is not None or result.latency is not None:
+            raise _error("give result.strobe (and latency) or result.after_cycles, not both")
+    elif k.pixels and result.strobe is None:
+        raise _error("missing result.strobe (a port name)")
 
-    out_table = _table(data, "outputs", "", required=False)
-    _unknown(out_table, set(OUTPUTS), "outputs.")
     outputs = {}
-    for key, value in out_table.items():
+    for key, value in k.outputs or OutputsKeys():
+        if value is None:
+            continue
         default_width, default_signed = OUTPUTS[key]
-        if isinstance(value, str):
-            value = {"port": value}
-        if not isinstance(value, dict):
-            raise PortMapError(f"port map: outputs.{key} must be a port name or a table")
-        _unknown(value, {"port", "width", "signed"}, f"outputs.{key}.")
-        port = _name(value, "port", f"outputs.{key}")
-        width = value.get("width", default_width)
-        if width is not None:
-            width = _int({"width": width}, "width", f"outputs.{key}", None, 1, 32)
-        signed = value.get("signed", default_signed)
-        if not isinstance(signed, bool):
-            raise PortMapError(f"port map: outputs.{key}.signed must be true or false")
-        outputs[key] = Output(port, width, signed)
-    extra = _table(data, "extra_outputs", "", required=False)
-    for name, port in extra.items():
-        if not name.isidentifier() or name in OUTPUTS:
-            raise PortMapError(
-                f"port map: extra_outputs.{name}: the name must be a Python "
-                f"name other than the [outputs] keys"
-            )
-        _name(extra, name, "extra_outputs")
+        outputs[key] = Output(
+            value.port,
+            default_width if value.width is None else value.width,
+            default_signed if value.signed is None else value.signed,
+        )
+    extra = k.extra_outputs
     if not outputs and not extra and not connectors:
-        raise PortMapError("port map: [outputs] names no output")
-    if not pixels:
-        frame_only = [k for k in _FRAME_ONLY if k in outputs]
+        raise _error("[outputs] names no output")
+    if not k.pixels:
+        frame_only = [key for key in _FRAME_ONLY if key in outputs]
         if frame_only:
-            raise PortMapError(
-                f"port map: outputs.{frame_only[0]} is read when a frame's "
+            raise _error(
+                f"outputs.{frame_only[0]} is read when a frame's "
                 "result is ready: it needs a pixel stream (pixels)"
             )
-
-    filtered = _table(data, "filtered", "", required=False)
-    _unknown(filtered, {"valid", "payload"}, "filtered.")
-    f_valid = _name(filtered, "valid", "filtered", required=bool(filtered))
-    f_payload = _name(filtered, "payload", "filtered", required=bool(filtered))
-
-    # Inputs the world does not drive (a read address of a debug port, a mode pin) tied to a
-    # value: [constants] port = value.
-    constants = _table(data, "constants", "", required=False)
-    for name, value in constants.items():
-        if not name.isidentifier():
-            raise PortMapError(f"port map: constants.{name}: not a port name")
-        if isinstance(value, bool) or not isinstance(value, int) or value < 0:
-            raise PortMapError(f"port map: constants.{name} must be an integer >= 0, got {value!r}")
-    # Inputs held at a value the host sets between frames (a mutant select, a mode):
-    # [runtime] port = initial value.
-    runtime = _table(data, "runtime", "", required=False)
-    if len(runtime) > MAX_RUNTIME:
-        raise PortMapError(
-            f"port map: [runtime] names {len(runtime)} inputs (at most {MAX_RUNTIME})"
-        )
-    for name, value in runtime.items():
-        if not name.isidentifier():
-            raise PortMapError(f"port map: runtime.{name}: not a port name")
-        if isinstance(value, bool) or not isinstance(value, int) or value < 0:
-            raise PortMapError(
-                f"port map: runtime.{name} must be an integer >= 0 (its "
-                f"initial value), got {value!r}"
-            )
+    filtered = k.filtered
+    if len(k.runtime) > MAX_RUNTIME:
+        raise _error(f"[runtime] names {len(k.runtime)} inputs (at most {MAX_RUNTIME})")
     port_map = PortMap(
-        top=top,
-        clock=_name(clock, "port", "clock"),
-        reset=_name(reset, "port", "reset", required=bool(reset)),
-        reset_active_low=active_low,
+        top=k.top,
+        clock=k.clock.port,
+        reset=reset.port,
+        reset_active_low=reset.active_low,
         valid=valid,
         payload=payload,
         data=data_port,
         first=first,
         last=last,
-        color_port=color_port,
+        color_port=color.port,
         color_codes=codes,
-        color_width=color_width,
-        strobe=strobe,
-        latency=latency,
-        timeout=timeout,
+        color_width=color.width,
+        strobe=result.strobe,
+        latency=result.latency or 0,
+        timeout=result.timeout,
         outputs=outputs,
-        filtered_valid=f_valid,
-        filtered_payload=f_payload,
+        filtered_valid=filtered.valid if filtered else None,
+        filtered_payload=filtered.payload if filtered else None,
         style=style,
         address=address,
         new_frame=new_frame,
-        after_cycles=after_cycles,
-        constants=dict(constants),
-        runtime=dict(runtime),
+        after_cycles=result.after_cycles,
+        constants=k.constants,
+        runtime=k.runtime,
         connectors=connectors,
-        extra_outputs=dict(extra),
+        extra_outputs=extra,
     )
     pm = port_map
     names = [
@@ -411,30 +499,8 @@ def parse_port_map(data):
     ]
     dup = sorted({n for n in names if names.count(n) > 1})
     if dup:
-        raise PortMapError(f"port map: port {dup[0]!r} is mapped more than once")
+        raise _error(f"port {dup[0]!r} is mapped more than once")
     return port_map
-
-
-def _connectors(data):
-    """``[connectors.<kind>]`` tables: kind -> {pin: port}; names only (the kinds and their
-    pins are checked by ``check_connectors``)."""
-    table = _table(data, "connectors", "", required=False)
-    out = {}
-    for kind, pins in table.items():
-        where = f"connectors.{kind}"
-        if not kind.isidentifier():
-            raise PortMapError(f"port map: {where}: not a connector kind")
-        if kind in _BOUND_ELSEWHERE:
-            raise PortMapError(
-                f"port map: {where}: the {kind} is bound by "
-                f"{_BOUND_ELSEWHERE[kind]}, not a [connectors] table"
-            )
-        if not isinstance(pins, dict) or not pins:
-            raise PortMapError(f'port map: {where} must be a table of pin = "port"')
-        for pin in pins:
-            _name(pins, pin, where)
-        out[kind] = dict(pins)
-    return out
 
 
 def load_port_map(path):

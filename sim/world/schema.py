@@ -223,6 +223,9 @@ class KeyModel(BaseModel):
 
     #: What a path of this table is called in the unknown-key message.
     label: ClassVar[str] = ""
+    #: Report an unknown key before a wrong value (else after: a typo is the likelier
+    #: mistake when a value is also wrong, but a wrong value names its key exactly).
+    unknown_first: ClassVar[bool] = False
 
     @classmethod
     def key_names(cls):
@@ -236,6 +239,11 @@ class KeyModel(BaseModel):
         close = difflib.get_close_matches(str(key), known, n=1)
         hint = f" (did you mean {close[0]!r}?)" if close else ""
         return f"{path} is not a known key{hint}; known keys: {', '.join(known)}"
+
+    @classmethod
+    def missing_key(cls, path, key, doc):
+        """The message for a required key that is not given (``doc``: its description)."""
+        return f"{path} is required" + (f": {doc}" if doc else "")
 
 
 def key_path(prefix, loc):
@@ -278,9 +286,9 @@ def _inner_model(annotation):
 
 def message_of(exc, model, prefix):
     """The one-line message of the first error of a ``ValidationError``: key errors in their
-    declared order before unknown keys (a wrong value is reported before a typo)."""
+    declared order, unknown keys after them (before them with ``model.unknown_first``)."""
     errors = exc.errors(include_url=False)
-    errors.sort(key=lambda e: e["type"] == "extra_forbidden")
+    errors.sort(key=lambda e: (e["type"] == "extra_forbidden") != model.unknown_first)
     err = errors[0]
     loc = tuple(err["loc"])
     path = key_path(prefix, loc)
@@ -293,9 +301,9 @@ def message_of(exc, model, prefix):
         holder = _model_at(model, loc)
         field = holder.model_fields.get(loc[-1])
         doc = field.description if field is not None else ""
-        return f"{path} is required" + (f": {doc}" if doc else "")
+        return holder.missing_key(path, loc[-1], doc)
     if kind in ("model_type", "dict_type", "model_attributes_type"):
-        return f"{path} must be a table, got {show(err['input'])}"
+        return f"{path or 'the document'} must be a table, got {show(err['input'])}"
     if kind == "value_error":
         # A model validator's relation between keys: its message names the keys.
         text = str(err["ctx"].get("error", err["msg"]))
