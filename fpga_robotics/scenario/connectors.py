@@ -9,13 +9,54 @@ binding, and the kind's own parameters (checked by its ``parse``).
 
 import re
 from dataclasses import dataclass, field
+from typing import Annotated
+
+from pydantic import BeforeValidator, ConfigDict, Field
 
 from fpga_robotics.loop.connectors import CONNECTORS, ConnectorError
 from fpga_robotics.loop.connectors.base import Mount, parse_mount
+from fpga_robotics.sim.world.schema import KeyModel, fail, validate
 
-__all__ = ["ConnectorSpec", "parse_connectors"]
+__all__ = ["ConnectorSpec", "ConnectorTableKeys", "parse_connectors"]
 
 _NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]{0,31}")
+
+
+def _kinds():
+    return ", ".join(sorted(CONNECTORS))
+
+
+def _kind(value):
+    if not isinstance(value, str) or value not in CONNECTORS:
+        fail(f"unknown connector kind {value!r}; choose one of: {_kinds()}", sub=":")
+    return value
+
+
+def _name(value):
+    if not (isinstance(value, str) and _NAME.fullmatch(value)):
+        fail(f"must be a word of letters, digits and _ (at most 32), got {value!r}")
+    return value
+
+
+def _ports(value):
+    if not (isinstance(value, dict) and all(isinstance(p, str) and p for p in value.values())):
+        fail(f'must be a table pin = "design_port", got {value!r}')
+    return dict(value)
+
+
+class ConnectorTableKeys(KeyModel):
+    """The keys every ``[[robot.sensors]]`` / ``[[robot.actuators]]`` table has; the mount's
+    are ``MountKeys``, the rest the kind's own ``keys`` (``loop.connectors.base``)."""
+
+    model_config = ConfigDict(extra="allow", frozen=True)
+
+    kind: Annotated[str, BeforeValidator(_kind), Field(description="a registered kind")]
+    name: Annotated[str, BeforeValidator(_name)] = None  # None: the kind, numbered
+    ports: Annotated[dict, BeforeValidator(_ports)] = Field(default_factory=dict)
+
+    @classmethod
+    def missing_key(cls, path, key, doc):
+        return f'{path.rpartition(".")[0]} needs kind = "...", one of: {_kinds()}'
 
 
 @dataclass(frozen=True)
@@ -43,42 +84,22 @@ def parse_connectors(robot):
             where = f"robot.{key}[{i}]"
             if not isinstance(table, dict):
                 raise ConnectorError(f"{where} must be a table, got {table!r}")
-            table = dict(table)
-            kind = table.pop("kind", None)
-            if kind is None:
-                raise ConnectorError(
-                    f'{where} needs kind = "...", one of: {", ".join(sorted(CONNECTORS))}'
-                )
-            if not isinstance(kind, str) or kind not in CONNECTORS:
-                raise ConnectorError(
-                    f"{where}.kind: unknown connector kind {kind!r}; choose "
-                    f"one of: {', '.join(sorted(CONNECTORS))}"
-                )
+            common = validate(ConnectorTableKeys, table, where, ConnectorError)
+            kind, ports = common.kind, common.ports
+            table = dict(common.model_extra)  # the mount's keys and the kind's own
             cls = CONNECTORS[kind]
             if cls.role != role:
                 raise ConnectorError(
                     f"{where}: a {kind!r} connector is an {cls.role}; "
                     f"declare it in [[robot.{cls.role}s]]"
                 )
-            name = table.pop("name", None)
+            name = common.name
             if name is None:
                 name = kind if kind not in names else f"{kind}{i}"
-            if not (isinstance(name, str) and _NAME.fullmatch(name)):
-                raise ConnectorError(
-                    f"{where}.name must be a word of letters, digits and _ "
-                    f"(at most 32), got {name!r}"
-                )
             if name in names:
                 raise ConnectorError(f"{where}.name {name!r} is used twice")
             names.add(name)
             mount, table = parse_mount(table, where)
-            ports = table.pop("ports", {})
-            if not (
-                isinstance(ports, dict) and all(isinstance(p, str) and p for p in ports.values())
-            ):
-                raise ConnectorError(
-                    f'{where}.ports must be a table pin = "design_port", got {ports!r}'
-                )
             for pin in ports:
                 if pin not in cls.pins:
                     raise ConnectorError(
