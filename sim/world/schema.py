@@ -17,7 +17,6 @@ import math
 from dataclasses import dataclass
 from typing import Annotated, ClassVar
 
-import annotated_types
 from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, ValidationError
 from pydantic_core import PydanticCustomError
 
@@ -110,11 +109,9 @@ class _NumberCheck:
         fail(f"must be {failed[0]}, got {value!r}")
 
 
-def _constraints(gt, ge, le):
-    out = [annotated_types.Gt(gt)] if gt is not None else []
-    out += [annotated_types.Ge(ge)] if ge is not None else []
-    out += [annotated_types.Le(le)] if le is not None else []
-    return out
+def _bounds(gt=None, ge=None, le=None):
+    """The bounds as pydantic's (they are also in the model's JSON schema)."""
+    return {k: v for k, v in (("gt", gt), ("ge", ge), ("le", le)) if v is not None}
 
 
 def Number(*, gt=None, ge=None, le=None, unit="", doc="", style="world", note=""):
@@ -123,8 +120,7 @@ def Number(*, gt=None, ge=None, le=None, unit="", doc="", style="world", note=""
     return Annotated[
         float,
         BeforeValidator(check),
-        *_constraints(gt, ge, le),
-        Field(description=doc, json_schema_extra={"unit": unit}),
+        Field(description=doc, json_schema_extra={"unit": unit}, **_bounds(gt, ge, le)),
     ]
 
 
@@ -141,9 +137,7 @@ def Integer(*, ge, le, unit="", doc="", message=None):
     return Annotated[
         int,
         BeforeValidator(check),
-        annotated_types.Ge(ge),
-        annotated_types.Le(le),
-        Field(description=doc, json_schema_extra={"unit": unit}),
+        Field(description=doc, json_schema_extra={"unit": unit}, **_bounds(ge=ge, le=le)),
     ]
 
 
