@@ -83,7 +83,7 @@ __all__ = [
     "shipped_scenarios",
 ]
 
-_TOP_KEYS = ("name", "description", "seed")
+_TOP_KEYS = tuple(TopKeys.key_names())  # name, description, seed
 _APP_SECTIONS = ("sim", "camera", "color", "design", "checks")
 #: A foreign Verilog design instead of FollowTarget (docs/foreign.md): its files and port map.
 _FOREIGN_KEYS = ("verilog", "ports")
