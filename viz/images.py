@@ -6,8 +6,9 @@ bit. Two kinds of frame are logged:
 - RGB444 (``encode_rgb444``): the camera frame as the design receives it and the design's
   filtered frame, packed ``r << 8 | g << 4 | b`` and shown as RGB888 ``c << 4`` (the
   contract's way back, docs/contract.md). A rendered frame has a few dozen of the 4096 colours,
-  so it is written as a palette PNG (one byte a pixel, fewer when 16 colours or less, Pillow);
-  a frame of more than 256 colours falls back to an RGB PNG.
+  so it is written as a palette PNG (one byte a pixel, Pillow); a frame of more than 256
+  colours falls back to an RGB PNG. Always 8 bits a sample: the rerun viewer refuses an
+  image stream whose PNGs change bit depth from frame to frame.
 - RGB888 (``encode_frame``): the full 8-bit render. Its sensor noise defeats deflate's string
   matches, so only runs are looked for (``STRATEGY_RLE``), after the filter libpng picks per
   row among none, sub and up.
@@ -60,6 +61,9 @@ _PNG_OPTIONS = [
 # zlib level of the palette PNGs: 4 is the first with lazy matching, about a fifth smaller
 # than 1 at the same cost on rendered frames; 6 saves a tenth more at twice the time.
 _PALETTE_PNG_LEVEL = 4
+
+# The fewest palette entries Pillow writes at 8 bits a pixel.
+_MIN_PALETTE = 17
 
 # Packed RGB444 -> RGB888 for every 12-bit value: one gather per frame instead of shifts.
 _RGB444_LUT = rgb444_to_rgb888(np.arange(4096, dtype=np.uint16)[None, :])[0]
@@ -129,7 +133,11 @@ def _palette_png(packed):
     index = np.zeros(4096, np.uint8)
     index[present] = np.arange(len(present), dtype=np.uint8)
     img = Image.fromarray(index[packed])
-    img.putpalette(_RGB444_LUT[present].tobytes())  # an "L" image becomes "P"
+    # At least 17 entries: Pillow packs a palette of 16 or fewer into fewer bits a pixel,
+    # which the viewer refuses mid-stream. An "L" image becomes "P".
+    palette = np.zeros((max(len(present), _MIN_PALETTE), 3), np.uint8)
+    palette[: len(present)] = _RGB444_LUT[present]
+    img.putpalette(palette.tobytes())
     buf = io.BytesIO()
     img.save(buf, "PNG", compress_level=_PALETTE_PNG_LEVEL)
     return buf.getvalue()
