@@ -395,3 +395,31 @@ def test_readback_summary(saved, capsys):
         readback_main([])
     assert info.value.code == 2
     assert capsys.readouterr().err.startswith("fpga-robotics readback: error: ")
+
+
+def chunk_rows(path, entity):
+    """The row count of each chunk of ``entity`` in the file, in file order."""
+    from rerun.chunk import RrdReader
+
+    return [
+        c.to_record_batch().num_rows
+        for c in RrdReader(str(path)).stream()
+        if c.entity_path.lstrip("/") == entity and not c.is_static
+    ]
+
+
+def test_a_file_alone_is_chunked_by_frames_not_by_time(tmp_path, monkeypatch):
+    # The buffer's clock jumps a second a call: the live modes' 0.1 s limit would send
+    # every frame.
+    import types
+
+    from fpga_robotics.viz import columns
+
+    ticks = iter(range(10**6))
+    monkeypatch.setattr(
+        columns, "time", types.SimpleNamespace(monotonic=lambda: float(next(ticks)))
+    )
+    frames = make_frames(300)
+    path = record(tmp_path / "file.rrd", frames).path
+    assert chunk_rows(path, P.MOTORS_DPS) == [128, 128, 44]
+    assert chunk_rows(path, P.CAMERA_RAW) == [128, 128, 44]

@@ -540,8 +540,9 @@ def open_recorder(
     Raises
     ------
     ViewerError
-        A malformed mode, ``log_every``, ``jpeg_quality`` or ``camera``; a file that cannot be written
-        (checked now, before any frame); a live sink that cannot work with no default path.
+        A malformed mode, ``log_every``, ``jpeg_quality`` or ``camera``; a file that cannot be
+        written (checked now, before any frame); a live sink that cannot work with no default
+        path.
     """
     parsed = parse_mode(mode, default_path)
     options = {

@@ -121,7 +121,7 @@ def build_parser(prog="fpga-robotics run"):
         choices=("rgb444", "rgb888"),
         default="rgb444",
         help="the camera frame in the recording: rgb444 (default) as the design receives it, "
-        "each channel's top 4 bits; rgb888 the full 8-bit render (about 6 times the file)",
+        "each channel's top 4 bits; rgb888 the full 8-bit render (about 5 times the file)",
     )
     p.add_argument(
         "--source",
