@@ -37,6 +37,7 @@ CASES = [
     ("negative max-frames", ["run", "--source", "{frames}", "--max-frames", "-1"], "--max-frames"),
     ("log-every zero", ["run", "--log-every", "0", "--rerun", "save:x.rrd"], "--log-every"),
     ("unknown backend", ["run", "--backend", "iverilog"], "invalid choice"),
+    ("unknown camera format", ["run", "--record-camera", "rgb565"], "invalid choice"),
     ("video with no codec", ["run", "--save-video", "clip.mkv"], ".mp4"),
     ("video to a folder", ["run", "--save-video", "{dir}"], "is a folder"),
     ("shadow with nothing", ["run", "--shadow", ";"], "--shadow"),

@@ -156,7 +156,8 @@ def test_small_frames_are_logged_as_png_and_exact(saved):
     raw, filt = images(data, P.CAMERA_RAW), images(data, P.CAMERA_FILTERED)
     assert sorted(raw) == sorted(filt) == list(range(len(frames)))
     for i, f in enumerate(frames):
-        np.testing.assert_array_equal(raw[i], f.camera_rgb)
+        # The camera frame as the design receives it: each channel's top four bits.
+        np.testing.assert_array_equal(raw[i], f.camera_rgb & 0xF0)
         np.testing.assert_array_equal(filt[i], rgb444_to_rgb888(f.result.filtered))
 
 
@@ -168,7 +169,7 @@ def test_jpeg_quality_0_logs_raw_images(tmp_path):
     fmt = single(values["Image:format"])[2]
     assert (fmt["width"], fmt["height"]) == (32, 24)
     np.testing.assert_array_equal(
-        single(values["Image:buffer"])[2].reshape(24, 32, 3), frames[2].camera_rgb
+        single(values["Image:buffer"])[2].reshape(24, 32, 3), frames[2].camera_rgb & 0xF0
     )
     np.testing.assert_array_equal(
         images(data, P.CAMERA_FILTERED)[1], rgb444_to_rgb888(frames[1].result.filtered)
@@ -296,7 +297,7 @@ def test_log_every_and_jpeg(tmp_path):
         bgr = cv2.imdecode(blob, cv2.IMREAD_COLOR)
         assert bgr.shape == (48, 64, 3)
         rgb = cv2.cvtColor(bgr, cv2.COLOR_BGR2RGB)
-        original = frames[3 * k].camera_rgb
+        original = frames[3 * k].camera_rgb & 0xF0  # the JPEG of what the design saw
         assert np.abs(rgb.astype(int) - original).mean() < 4.0  # the same picture
     filt = single(data.entities[P.CAMERA_FILTERED].values["EncodedImage:blob"])
     assert cv2.imdecode(filt[0], cv2.IMREAD_COLOR).shape == (48, 64, 3)
@@ -311,7 +312,7 @@ def test_auto_compression_depends_on_frame_size(tmp_path):
     # jpeg_quality=0: raw whatever the size.
     data = read_rrd(str(record(tmp_path / "raw.rrd", big, jpeg_quality=0).path))
     buf = data.entities[P.CAMERA_RAW].values["Image:buffer"][1][0]
-    np.testing.assert_array_equal(buf.reshape(144, 192, 3), big[1].camera_rgb)
+    np.testing.assert_array_equal(buf.reshape(144, 192, 3), big[1].camera_rgb & 0xF0)
 
 
 def test_file_appears_only_when_closed(tmp_path):
@@ -352,7 +353,7 @@ def test_context_manager_saves_on_error(tmp_path):
 def test_two_recorders_in_one_process_do_not_mix(tmp_path):
     a, b = tmp_path / "a.rrd", tmp_path / "b.rrd"
     fa, fb = make_frames(5, seed=1), make_frames(7, seed=2)
-    ra = open_recorder(f"save:{a}", default_path=str(a))
+    ra = open_recorder(f"save:{a}", default_path=str(a), camera="rgb888")
     rb = open_recorder(f"save:{b}", default_path=str(b))
     for i in range(7):
         if i < 5:
@@ -363,8 +364,9 @@ def test_two_recorders_in_one_process_do_not_mix(tmp_path):
     da, db = read_rrd(str(a)), read_rrd(str(b))
     assert da.entities[P.CAMERA_RAW].frames == list(range(5))
     assert db.entities[P.CAMERA_RAW].frames == list(range(7))
+    # Each keeps its own camera format: a the full render, b what the design received.
     np.testing.assert_array_equal(images(da, P.CAMERA_RAW)[4], fa[4].camera_rgb)
-    np.testing.assert_array_equal(images(db, P.CAMERA_RAW)[6], fb[6].camera_rgb)
+    np.testing.assert_array_equal(images(db, P.CAMERA_RAW)[6], fb[6].camera_rgb & 0xF0)
 
 
 def test_off_records_nothing(tmp_path):
@@ -393,3 +395,31 @@ def test_readback_summary(saved, capsys):
         readback_main([])
     assert info.value.code == 2
     assert capsys.readouterr().err.startswith("fpga-robotics readback: error: ")
+
+
+def chunk_rows(path, entity):
+    """The row count of each chunk of ``entity`` in the file, in file order."""
+    from rerun.chunk import RrdReader
+
+    return [
+        c.to_record_batch().num_rows
+        for c in RrdReader(str(path)).stream()
+        if c.entity_path.lstrip("/") == entity and not c.is_static
+    ]
+
+
+def test_a_file_alone_is_chunked_by_frames_not_by_time(tmp_path, monkeypatch):
+    # The buffer's clock jumps a second a call: the live modes' 0.1 s limit would send
+    # every frame.
+    import types
+
+    from fpga_robotics.viz import columns
+
+    ticks = iter(range(10**6))
+    monkeypatch.setattr(
+        columns, "time", types.SimpleNamespace(monotonic=lambda: float(next(ticks)))
+    )
+    frames = make_frames(300)
+    path = record(tmp_path / "file.rrd", frames).path
+    assert chunk_rows(path, P.MOTORS_DPS) == [128, 128, 44]
+    assert chunk_rows(path, P.CAMERA_RAW) == [128, 128, 44]

@@ -30,8 +30,17 @@ def _trail_range():
     )
 
 
-def default_blueprint(bounds=None, shadow=False, world3d=False, sensors=(), frame_outputs=True):
+_CAMERA_NAMES = {
+    "rgb444": "Camera (RGB444, as the design receives it)",
+    "rgb888": "Camera (RGB888)",
+}
+
+
+def default_blueprint(
+    bounds=None, shadow=False, world3d=False, sensors=(), frame_outputs=True, camera="rgb444"
+):
     """The layout sent to the viewer; ``bounds`` ``(xmin, ymin, xmax, ymax)`` frame the map;
+    ``camera`` (``rgb444`` or ``rgb888``, how the camera frame is recorded) names its view;
     ``shadow`` adds a second LED row and the shadow design's wheel speeds; ``world3d`` puts
     the world in 3D (``viz.world3d``) beside the map; ``sensors`` (series entity paths,
     ``viz.sensors``) come first among the plots under the map, one tab each."""
@@ -53,7 +62,7 @@ def default_blueprint(bounds=None, shadow=False, world3d=False, sensors=(), fram
     )
     if not frame_outputs:
         board = rrb.Vertical(
-            rrb.Spatial2DView(origin=P.CAMERA_RAW, name="Camera"),
+            rrb.Spatial2DView(origin=P.CAMERA_RAW, name=_CAMERA_NAMES[camera]),
             plots,
             row_shares=[4, 3],
             name="Board",
@@ -61,7 +70,7 @@ def default_blueprint(bounds=None, shadow=False, world3d=False, sensors=(), fram
         return _blueprint(board, bounds, map_kwargs, world3d, sensors)
     board = rrb.Vertical(
         rrb.Horizontal(
-            rrb.Spatial2DView(origin=P.CAMERA_RAW, name="Camera"),
+            rrb.Spatial2DView(origin=P.CAMERA_RAW, name=_CAMERA_NAMES[camera]),
             rrb.Spatial2DView(origin=P.CAMERA_FILTERED, name="Filtered (design output)"),
         ),
         rrb.Horizontal(

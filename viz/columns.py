@@ -5,6 +5,11 @@ fifteen small entities. Buffering their rows and sending each entity's rows as o
 every few frames (or every 0.1 s, so a live viewer lags by at most that) keeps logging far
 below a millisecond per frame. Each row keeps its own ``frame`` and ``sim_time``, so the
 recording is the same as with one ``rr.log`` per row.
+
+A file nobody watches live (``FILE_ONLY``) is sent every 128 frames, whatever the time: every
+column sent is a chunk with its own schema, so fewer, longer chunks make a smaller file, and
+its chunks no longer depend on the machine's speed. The images buffered are bounded all the
+same (``MAX_IMAGE_BYTES``).
 """
 
 import contextlib
@@ -29,6 +34,10 @@ __all__ = [
 #: Send when this many frames are buffered or this much wall time passed since the last send.
 MAX_FRAMES = 32
 MAX_SECONDS = 0.1
+#: ``(frames, seconds)`` for a file nobody watches live: no time limit.
+FILE_ONLY = (128, None)
+#: Send, whatever the frames and time, when the images buffered hold this many bytes.
+MAX_IMAGE_BYTES = 32 << 20
 
 
 def time_ns(seconds):
@@ -105,8 +114,11 @@ class ColumnBuffer:
     around each send (``viz.live.StallWatch``: a viewer that blocks it for long is cut off).
     """
 
-    def __init__(self, stream, builders, guard=None):
+    def __init__(self, stream, builders, guard=None, *, max_frames=None, max_seconds=MAX_SECONDS):
         self._stream = stream
+        self._max_frames = MAX_FRAMES if max_frames is None else max_frames
+        self._max_seconds = max_seconds  # None: no time limit
+        self._image_bytes = 0
         self._builders = builders
         self._guard = guard if guard is not None else contextlib.nullcontext()
         self._rows = {path: _Rows() for path in builders}
@@ -127,11 +139,20 @@ class ColumnBuffer:
         r.frames.append(frame)
         r.times.append(t_ns)
         r.data.append(row)
+        if isinstance(row, bytes | np.ndarray):  # an image (PNG, JPEG or raw)
+            self._image_bytes += len(row) if isinstance(row, bytes) else row.nbytes
 
     def end_frame(self):
         """Count a frame; send when enough frames or time have gone by."""
         self._frames += 1
-        if self._frames >= MAX_FRAMES or time.monotonic() - self._last_send >= MAX_SECONDS:
+        if (
+            self._frames >= self._max_frames
+            or self._image_bytes >= MAX_IMAGE_BYTES
+            or (
+                self._max_seconds is not None
+                and time.monotonic() - self._last_send >= self._max_seconds
+            )
+        ):
             self.flush()
 
     def flush(self):
@@ -152,4 +173,5 @@ class ColumnBuffer:
                 )
             self._rows[key] = _Rows()
         self._frames = 0
+        self._image_bytes = 0
         self._last_send = time.monotonic()

@@ -7,7 +7,8 @@ depends only on the run.
 
 What is logged per frame (entity paths in ``viz.paths``):
 
-- every ``log_every``-th frame (``frame % log_every == 0``): the camera frame and the design's
+- every ``log_every``-th frame (``frame % log_every == 0``): the camera frame (by default as
+  the design receives it, RGB444; ``camera="rgb888"``: the full 8-bit render) and the design's
   filtered frame, PNG (lossless) up to 160x120 and JPEG above (``jpeg_quality``);
 - every frame: the LEDs (small images), the scalar series (found, proximity, centroid_x,
   DPS, V, W, target distance), the robot, field of view, people and trails on the map, and
@@ -26,6 +27,8 @@ import rerun as rr
 from . import paths as P
 from .blueprint import default_blueprint
 from .columns import (
+    FILE_ONLY,
+    MAX_SECONDS,
     ColumnBuffer,
     arrows,
     images,
@@ -38,7 +41,13 @@ from .columns import (
     time_ns,
 )
 from .errors import ViewerError
-from .images import check_jpeg_quality, encode_frame, filtered_rgb
+from .images import (
+    as_received,
+    check_camera_format,
+    check_jpeg_quality,
+    encode_frame,
+    encode_rgb444,
+)
 from .leds import centroid_image, proximity_image
 from .modes import parse_mode
 from .outcome import settle
@@ -149,7 +158,7 @@ class Recorder:
         web viewer's address.
     """
 
-    def __init__(self, stream, output, *, log_every=1, jpeg_quality=None):
+    def __init__(self, stream, output, *, log_every=1, jpeg_quality=None, camera="rgb444"):
         self._stream = stream
         self._output = output
         self.mode = output.kind if output is not None else "off"
@@ -158,6 +167,7 @@ class Recorder:
         self.notice = output.reason if output is not None else None
         self.log_every = log_every
         self.jpeg_quality = jpeg_quality
+        self.camera = camera
         self.frames_logged = 0
         self.images_logged = 0
         self.delivered = None
@@ -183,7 +193,11 @@ class Recorder:
         self._last_target = None
         if stream is not None:
             self._guard = output.guard()
-            self._columns = ColumnBuffer(stream, _COLUMN_BUILDERS, self._guard)
+            # A file alone is sent in longer columns: a smaller file (viz.columns).
+            frames, seconds = FILE_ONLY if self.mode == "save" else (None, MAX_SECONDS)
+            self._columns = ColumnBuffer(
+                stream, _COLUMN_BUILDERS, self._guard, max_frames=frames, max_seconds=seconds
+            )
             self._sensors = SensorViews(stream, self._columns)
             # Never closed (dropped, or open at exit): the file still gets its real name.
             self._abandoned = weakref.finalize(
@@ -250,6 +264,7 @@ class Recorder:
                     world3d=self._world3d is not None,
                     sensors=tuple(self._sensors.series),
                     frame_outputs=self._frame_outputs,
+                    camera=self.camera,
                 )
             )
         self._sensor_series = len(self._sensors.series)
@@ -341,10 +356,13 @@ class Recorder:
 
         if frame % self.log_every == 0:
             q = self.jpeg_quality
-            kind, data = encode_frame(record.camera_rgb, q)
+            if self.camera == "rgb444":
+                kind, data = encode_rgb444(as_received(record.camera_rgb), q)
+            else:
+                kind, data = encode_frame(record.camera_rgb, q)
             add((P.CAMERA_RAW, kind), data)
             if res.filtered is not None:  # a design without a filtered stream: no image
-                kind, data = encode_frame(filtered_rgb(res.filtered), q)
+                kind, data = encode_rgb444(res.filtered, q)
                 add((P.CAMERA_FILTERED, kind), data)
             self.images_logged += 1
         if record.events:
@@ -486,7 +504,15 @@ class Recorder:
         return f"Recorder(mode={self.mode!r}, {where!r}, frames_logged={self.frames_logged})"
 
 
-def open_recorder(mode, *, default_path, app_id="fpga_robotics", log_every=1, jpeg_quality=None):
+def open_recorder(
+    mode,
+    *,
+    default_path,
+    app_id="fpga_robotics",
+    log_every=1,
+    jpeg_quality=None,
+    camera="rgb444",
+):
     """Open a recorder for ``mode`` (see ``viz.modes``); returns a ``Recorder``.
 
     Parameters
@@ -506,17 +532,23 @@ def open_recorder(mode, *, default_path, app_id="fpga_robotics", log_every=1, jp
     jpeg_quality : int or None
         ``None`` PNG (lossless) up to 160x120 and JPEG quality 85 above; ``0`` always raw
         (uncompressed, exact); 1..100 always JPEG at that quality.
+    camera : str
+        ``rgb444`` (default): the camera frame as the design receives it, each channel's top
+        four bits (``c >> 4``), shown as ``c << 4`` like the filtered frame; ``rgb888``: the
+        full 8-bit render, its low bits (sensor noise the design never sees) included.
 
     Raises
     ------
     ViewerError
-        A malformed mode, ``log_every`` or ``jpeg_quality``; a file that cannot be written
-        (checked now, before any frame); a live sink that cannot work with no default path.
+        A malformed mode, ``log_every``, ``jpeg_quality`` or ``camera``; a file that cannot be
+        written (checked now, before any frame); a live sink that cannot work with no default
+        path.
     """
     parsed = parse_mode(mode, default_path)
     options = {
         "log_every": _check_log_every(log_every),
         "jpeg_quality": check_jpeg_quality(jpeg_quality),
+        "camera": check_camera_format(camera),
     }
     if parsed.kind == "off":
         return Recorder(None, None, **options)

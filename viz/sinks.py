@@ -18,6 +18,7 @@ import contextlib
 import ipaddress
 import time
 import uuid
+from datetime import timedelta
 from urllib.parse import quote
 
 import rerun as rr
@@ -126,14 +127,24 @@ def _finish_file_only(stream):
     return True, None
 
 
+def _file_batcher():
+    # The rows of ``rr.log`` calls (the 3D world: 4 entities a frame) batched by count, about
+    # 128 frames a chunk, like the columns (viz.columns.FILE_ONLY); no time limit.
+    return rr.ChunkBatcherConfig(
+        flush_tick=timedelta(days=1), flush_num_bytes=8 << 20, flush_num_rows=512
+    )
+
+
 class SinkUnavailable(UserError, RuntimeError):
     """The requested live sink cannot work here; the message says why."""
 
 
-def new_stream(app_id):
+def new_stream(app_id, file_only=False):
     # One stream per recorder, never the global one; no wall-clock timeline, so a recording
-    # depends only on the run.
-    stream = rr.RecordingStream(app_id, recording_id=uuid.uuid4())
+    # depends only on the run. A file nobody watches live is batched by rows alone, never
+    # by time: longer chunks, a smaller file, and the same chunks on any machine.
+    config = _file_batcher() if file_only else None
+    stream = rr.RecordingStream(app_id, recording_id=uuid.uuid4(), batcher_config=config)
     stream.set_log_time_enabled(False)
     return stream
 
@@ -250,7 +261,7 @@ def open_output(mode, app_id):
     if mode.kind == "save":
         file = RecordingFile(mode.path, fresh=mode.fresh)
         try:
-            stream = new_stream(app_id)
+            stream = new_stream(app_id, file_only=True)
             stream.set_sinks(*_file_sink(file))
         except BaseException:
             file.discard()
@@ -267,7 +278,8 @@ def open_output(mode, app_id):
                 raise ViewerError(
                     f"viewer mode {mode.kind!r} cannot work here ({exc}); use save:PATH.rrd"
                 ) from None
-            stream = new_stream(app_id)  # the first one may have had sinks: start clean
+            # The first one may have had sinks: start clean.
+            stream = new_stream(app_id, file_only=True)
             stream.set_sinks(*_file_sink(file))
             out = Output("save", file, reason=f"{mode.kind}: {exc}")
             out.opening.append(f"{out.reason}; the recording goes to {file.path} instead")

@@ -117,6 +117,13 @@ def build_parser(prog="fpga-robotics run"):
         help="log every Nth frame's images to the viewer",
     )
     p.add_argument(
+        "--record-camera",
+        choices=("rgb444", "rgb888"),
+        default="rgb444",
+        help="the camera frame in the recording: rgb444 (default) as the design receives it, "
+        "each channel's top 4 bits; rgb888 the full 8-bit render (about 5 times the file)",
+    )
+    p.add_argument(
         "--source",
         metavar="camera:N|VIDEO|FOLDER|bag:PATH[:TOPIC]",
         help="run the design on real frames instead of the simulation (no physics)",
@@ -535,6 +542,7 @@ def _open_recorder(args, name):
         default_path=f"runs/{name}.rrd",
         app_id="fpga_robotics",
         log_every=args.log_every,
+        camera=args.record_camera,
     )
     for line in recorder.pop_notices():  # where a live viewer is, or why it fell back
         print(line, file=sys.stderr)
