@@ -112,3 +112,26 @@ def test_a_user_error_is_one_line_and_exit_2(exc, capsys):
 def test_any_other_error_keeps_its_traceback(capsys):
     with pytest.raises(ValueError, match="a bug"):
         _run(ValueError("a bug"), capsys)
+
+
+def test_a_reader_that_goes_away_stops_the_command_quietly():
+    """`fpga-robotics readback x.rrd | head`: the closed pipe ends the command with SIGPIPE's
+    exit code and no traceback."""
+    import subprocess
+    import sys
+
+    code = (
+        "from fpga_robotics.cli.errors import run_cli\n"
+        "def main(argv):\n"
+        "    for i in range(100000):\n"
+        "        print('line', i)\n"
+        "run_cli(main)\n"
+    )
+    proc = subprocess.Popen(
+        [sys.executable, "-c", code], stdout=subprocess.PIPE, stderr=subprocess.PIPE
+    )
+    proc.stdout.readline()
+    proc.stdout.close()
+    stderr = proc.stderr.read().decode()
+    assert proc.wait(timeout=60) == 141
+    assert "Traceback" not in stderr and "BrokenPipe" not in stderr, stderr

@@ -6,6 +6,7 @@ application layer, do they become one line on stderr and exit code 2. A bug anyw
 still shows its traceback.
 """
 
+import os
 import signal
 import sys
 
@@ -44,6 +45,11 @@ def run_cli(main, argv=None, prog=None):
     except (UserError, FileNotFoundError) as exc:
         print(f"{name}: error: {exc}", file=sys.stderr)
         sys.exit(USAGE_EXIT)
+    except BrokenPipeError:
+        # The reader went away (`| head`): stop quietly, as Unix tools do, and keep Python's
+        # flush at exit from failing again on the closed pipe.
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        sys.exit(128 + signal.SIGPIPE)
     finally:
         signal.signal(signal.SIGTERM, previous)
     sys.exit(code or 0)
