@@ -163,7 +163,7 @@ class LidarConnector(_LidarBase):
 
     def start(self, io):
         self._reset()
-        self._last_edge = io.cycle
+        self._last_edge = io.cycle - 1  # no pulse yet
         io.poke("valid", 0)
 
     def before_step(self, io, t, dt):
