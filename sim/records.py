@@ -86,3 +86,5 @@ class SensorReading:
     points: tuple = ()
     states: tuple = ()
     rays: tuple = ()
+    #: Height (m) of the points in the 3D view (a LIDAR's scan plane).
+    height: float = 0.0

@@ -40,6 +40,7 @@ from .columns import (
 from .errors import ViewerError
 from .images import check_jpeg_quality, encode_frame, filtered_rgb
 from .leds import centroid_image, proximity_image
+from .lidar import log_scans_3d
 from .modes import parse_mode
 from .outcome import settle
 from .sensors import MAP_LINES, SensorViews, line_strips
@@ -374,6 +375,7 @@ class Recorder:
         if self._world3d is not None and record.scene is not None:
             with self._guard:
                 self._world3d.log_frame(record, frame, t)
+                log_scans_3d(self._stream, record, frame, t)
         if self._layout_stale:
             self._send_blueprint(shadow=self._shadow_seen)
         self.frames_logged += 1

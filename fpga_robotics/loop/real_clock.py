@@ -385,6 +385,7 @@ class RealClockLoop(ClosedLoop):
                     tuple(overlay.get("points", ())),
                     tuple(overlay.get("states", ())),
                     tuple(overlay.get("rays", ())),
+                    float(overlay.get("height", 0.0)),
                 )
         return readings
 

@@ -149,9 +149,10 @@ class _LidarBase(Connector):
         return out
 
     def map_overlay(self):
-        """The last revolution's returns, where they hit (world x, y)."""
+        """The last revolution's returns, where they hit (world x, y), at the scan plane's
+        height for the 3D view."""
         pts = tuple((px, py) for s, px, py in self.last_revolution if s.distance_q2)
-        return {"points": pts, "states": (1,) * len(pts)}
+        return {"points": pts, "states": (1,) * len(pts), "height": self.mount.height}
 
 
 @register
