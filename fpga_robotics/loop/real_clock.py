@@ -386,6 +386,7 @@ class RealClockLoop(ClosedLoop):
                     tuple(overlay.get("states", ())),
                     tuple(overlay.get("rays", ())),
                     float(overlay.get("height", 0.0)),
+                    overlay.get("scan"),
                 )
         return readings
 

@@ -1,6 +1,8 @@
 """Python model of ``NearestObstacle`` (numpy, no Amaranth), from its docstring: each
 revolution's nearest counted sample, published when the next revolution starts."""
 
+import itertools
+
 import numpy as np
 
 from fpga_robotics.hw.lidar_params import NearestParams
@@ -19,7 +21,7 @@ def nearest_per_revolution(samples, params=None):
     starts = np.flatnonzero(a[:, 3] != 0)
     out, mm, q6 = [], 0, 0
     bounds = [0, *starts.tolist()]
-    for lo, hi in zip(bounds, bounds[1:]):
+    for lo, hi in itertools.pairwise(bounds):
         rev = np.arange(lo, hi)
         rev = rev[counts[rev]]
         if len(rev):

@@ -39,6 +39,7 @@ __all__ = [
     "FULL_TURN_Q6",
     "LidarParams",
     "LidarSample",
+    "Revolution",
     "Scan",
     "cast",
     "decode_packets",
@@ -95,6 +96,22 @@ class LidarSample:
     @property
     def distance_m(self):
         return self.distance_q2 / 4000.0
+
+
+@dataclass(frozen=True)
+class Revolution:
+    """One whole revolution as a ``sensor_msgs/LaserScan`` carries it (the angles still
+    clockwise, as the sensor's)."""
+
+    start_time: float  # world time of its first sample, s
+    first_deg: float  # the exact angle of its first sample, clockwise
+    step_deg: float  # the head's turn from one sample to the next
+    ranges: tuple  # m, one a sample; 0: no return
+    qualities: tuple
+    time_increment: float  # s between samples
+    scan_time: float  # s a revolution
+    range_min: float
+    range_max: float
 
 
 def sample_angles(params, first, count):

@@ -30,7 +30,9 @@ from fpga_robotics.loop.connectors.base import (
 )
 from fpga_robotics.sim.world.lidar import (
     DESCRIPTOR,
+    FULL_TURN_Q6,
     LidarParams,
+    Revolution,
     Scan,
     packet_bytes,
     uart_levels,
@@ -131,6 +133,25 @@ class _LidarBase(Connector):
             np.array([s.quality for s in rev]),
         )
 
+    def revolution(self):
+        """The last complete revolution as a ``Revolution`` (None before the first)."""
+        if not self.last_revolution:
+            return None
+        p = self.params
+        first = self.last_revolution[0][0].index
+        _, ranges, qualities = self.revolution_ranges()
+        return Revolution(
+            start_time=self.scan.instant(first),
+            first_deg=float(first * p.step % FULL_TURN_Q6) / 64.0,
+            step_deg=float(p.step) / 64.0,
+            ranges=tuple(float(r) for r in ranges),
+            qualities=tuple(int(q) for q in qualities),
+            time_increment=1.0 / p.sample_rate,
+            scan_time=1.0 / p.scan_hz,
+            range_min=p.min_range,
+            range_max=p.max_range,
+        )
+
     def measurement(self):
         """The last complete revolution: the nearest return (``nearest_m``, its bearing
         ``nearest_deg`` clockwise from the sensor's forward), the fraction of samples that
@@ -150,9 +171,14 @@ class _LidarBase(Connector):
 
     def map_overlay(self):
         """The last revolution's returns, where they hit (world x, y), at the scan plane's
-        height for the 3D view."""
+        height for the 3D view, and the revolution itself (for a bag's LaserScan)."""
         pts = tuple((px, py) for s, px, py in self.last_revolution if s.distance_q2)
-        return {"points": pts, "states": (1,) * len(pts), "height": self.mount.height}
+        return {
+            "points": pts,
+            "states": (1,) * len(pts),
+            "height": self.mount.height,
+            "scan": self.revolution(),
+        }
 
 
 @register
