@@ -10,7 +10,7 @@ from dataclasses import dataclass, fields, replace
 from .errors import ParamError
 from .validate import check_int
 
-__all__ = ["CorridorParams", "NearestParams"]
+__all__ = ["CorridorParams", "NearestParams", "UartParams"]
 
 _INT16_MAX = (1 << 15) - 1
 
@@ -75,3 +75,34 @@ class CorridorParams(_Params):
                 f"base_dps +- steer_dps = {abs(self.base_dps) + self.steer_dps} does not fit a "
                 f"signed 16-bit wheel command (max {_INT16_MAX})"
             )
+
+
+@dataclass(frozen=True)
+class UartParams(_Params):
+    """The serial receiver of ``CorridorFollowUart``: the design's clock and the LIDAR's baud
+    rate (8N1). A bit lasts ``bit_cycles = round(clock_hz / baud)`` cycles; the receiver
+    samples each bit in its middle counted from the start bit's fall, so the rounding may shift
+    the stop bit's sample by at most 40% of a bit."""
+
+    clock_hz: int = 50_000_000
+    baud: int = 115_200
+
+    def __post_init__(self):
+        self._check("clock_hz", 1000, 1_000_000_000)
+        self._check("baud", 300, 10_000_000)
+        if self.bit_cycles < 4:
+            raise ParamError(
+                f"clock_hz={self.clock_hz} is too slow for baud={self.baud}: a bit must last at "
+                f"least 4 cycles, it lasts {self.clock_hz / self.baud:.2f}"
+            )
+        drift = abs(self.bit_cycles * self.baud - self.clock_hz) / self.clock_hz * 9.5
+        if drift > 0.4:
+            raise ParamError(
+                f"clock_hz={self.clock_hz} / baud={self.baud} = {self.clock_hz / self.baud:.2f} "
+                f"cycles a bit, rounded to {self.bit_cycles}: the stop bit would be sampled "
+                f"{drift:.0%} of a bit off its middle (at most 40%)"
+            )
+
+    @property
+    def bit_cycles(self):
+        return (self.clock_hz + self.baud // 2) // self.baud

@@ -40,7 +40,7 @@ def scans(tmp_path_factory):
 
 
 def test_one_laser_scan_a_revolution(scans):
-    msgs, readings = scans
+    msgs, _ = scans
     # 0.6 s at 5.5 rev/s: revolutions end at 0.182, 0.364, 0.546 s: three whole ones.
     assert len(msgs) == 3
     starts = [m.header.stamp.sec + m.header.stamp.nanosec * 1e-9 for m in msgs]

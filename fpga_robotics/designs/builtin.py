@@ -83,6 +83,18 @@ TOPS = {
         component=("fpga_robotics.hw.corridor_follow", "CorridorFollow"),
         takes_follow_target_params=False,
     ),
+    "corridor_follow_uart": Top(
+        "corridor_follow_uart",
+        "CorridorFollow on the LIDAR's serial protocol: a UART and a packet decoder before it",
+        camera=False,
+        tables={
+            "corridor": ("fpga_robotics.hw.lidar_params", "CorridorParams"),
+            "nearest": ("fpga_robotics.hw.lidar_params", "NearestParams"),
+            "uart": ("fpga_robotics.hw.lidar_params", "UartParams"),
+        },
+        component=("fpga_robotics.hw.corridor_follow_uart", "CorridorFollowUart"),
+        takes_follow_target_params=False,
+    ),
 }
 
 
