@@ -2,7 +2,7 @@
 ``RplidarDecoder`` (the standard scan's bytes to a stream of samples)."""
 
 from amaranth import Cat, Module, Signal
-from amaranth.lib import stream, wiring
+from amaranth.lib import enum, stream, wiring
 from amaranth.lib.wiring import In, Out
 
 from .lidar_params import UartParams
@@ -13,6 +13,15 @@ __all__ = ["DESCRIPTOR", "RplidarDecoder", "UartRx"]
 
 #: The standard scan's response descriptor (``sim/world/lidar.py``).
 DESCRIPTOR = (0xA5, 0x5A, 0x05, 0x00, 0x00, 0x40, 0x81)
+
+
+class _Rx(enum.Enum, shape=3):
+    # From 1: a state compared with 0 becomes a multi-bit "!" that Verilator warns about.
+    IDLE = 1
+    START = 2
+    DATA = 3
+    STOP = 4
+    WAIT_HIGH = 5
 
 
 class UartRx(CheckedArguments, wiring.Component):
@@ -51,37 +60,42 @@ class UartRx(CheckedArguments, wiring.Component):
         bit = Signal(range(10))
         shift = Signal(8)
         m.d.sync += [self.bytes.valid.eq(0), self.framing_error.eq(0)]
-        with m.FSM():
-            with m.State("idle"), m.If(~line):
-                m.d.sync += timer.eq(n // 2 - 1)
-                m.next = "start"
-            with m.State("start"):
-                with m.If(timer != 0):
-                    m.d.sync += timer.eq(timer - 1)
-                with m.Elif(line):
-                    m.next = "idle"  # a glitch, not a start bit
-                with m.Else():
-                    m.d.sync += [timer.eq(n - 1), bit.eq(0)]
-                    m.next = "data"
-            with m.State("data"):
-                with m.If(timer != 0):
-                    m.d.sync += timer.eq(timer - 1)
-                with m.Else():
-                    m.d.sync += [timer.eq(n - 1), shift.eq(Cat(shift[1:], line)), bit.eq(bit + 1)]
-                    with m.If(bit == 7):
-                        m.next = "stop"
-            with m.State("stop"):
-                with m.If(timer != 0):
-                    m.d.sync += timer.eq(timer - 1)
-                with m.Elif(line):
-                    m.d.sync += [self.bytes.payload.eq(shift), self.bytes.valid.eq(1)]
-                    m.next = "idle"
-                with m.Else():
-                    m.d.sync += self.framing_error.eq(1)
-                    m.next = "wait_high"
-            with m.State("wait_high"), m.If(line):
-                m.next = "idle"
+        state = Signal(_Rx, init=_Rx.IDLE)
+        with m.If(state == _Rx.IDLE), m.If(~line):
+            m.d.sync += [timer.eq(n // 2 - 1), state.eq(_Rx.START)]
+        with m.Elif(state == _Rx.START):
+            with m.If(timer != 0):
+                m.d.sync += timer.eq(timer - 1)
+            with m.Elif(line):
+                m.d.sync += state.eq(_Rx.IDLE)  # a glitch, not a start bit
+            with m.Else():
+                m.d.sync += [timer.eq(n - 1), bit.eq(0), state.eq(_Rx.DATA)]
+        with m.Elif(state == _Rx.DATA):
+            with m.If(timer != 0):
+                m.d.sync += timer.eq(timer - 1)
+            with m.Else():
+                m.d.sync += [timer.eq(n - 1), shift.eq(Cat(shift[1:], line)), bit.eq(bit + 1)]
+                with m.If(bit == 7):
+                    m.d.sync += state.eq(_Rx.STOP)
+        with m.Elif(state == _Rx.STOP):
+            with m.If(timer != 0):
+                m.d.sync += timer.eq(timer - 1)
+            with m.Elif(line):
+                m.d.sync += [
+                    self.bytes.payload.eq(shift),
+                    self.bytes.valid.eq(1),
+                    state.eq(_Rx.IDLE),
+                ]
+            with m.Else():
+                m.d.sync += [self.framing_error.eq(1), state.eq(_Rx.WAIT_HIGH)]
+        with m.Else(), m.If(line):  # WAIT_HIGH: the line high again
+            m.d.sync += state.eq(_Rx.IDLE)
         return m
+
+
+def _equals(value, const):
+    # "== 0" written as "not any": Amaranth emits it as a multi-bit "!" otherwise.
+    return value == const if const else ~value.any()
 
 
 class RplidarDecoder(wiring.Component):
@@ -108,39 +122,39 @@ class RplidarDecoder(wiring.Component):
         packet = Signal(32)  # bytes 0..3
         s = self.samples.payload
         m.d.sync += self.samples.valid.eq(0)
-        with m.If(self.bytes.valid):
-            with m.If(~self.synced), m.Switch(matched):
-                for k, value in enumerate(DESCRIPTOR):
-                    with m.Case(k):
-                        with m.If(b == value):
-                            if k == len(DESCRIPTOR) - 1:
-                                m.d.sync += [self.synced.eq(1), index.eq(0)]
-                            else:
-                                m.d.sync += matched.eq(k + 1)
-                        with m.Else():
-                            m.d.sync += matched.eq(b == DESCRIPTOR[0])
-            with m.Else(), m.Switch(index):
-                with m.Case(0):
-                    with m.If(b[0] == b[1]):
-                        m.d.sync += self.resyncs.eq(self.resyncs + 1)
+        with m.If(self.bytes.valid & ~self.synced):
+            # Matching the descriptor: one more byte right, or start again (at 1 on an A5).
+            for k, value in enumerate(DESCRIPTOR):
+                with m.If(_equals(matched, k)):
+                    with m.If(_equals(b, value)):
+                        if k == len(DESCRIPTOR) - 1:
+                            m.d.sync += [self.synced.eq(1), index.eq(0)]
+                        else:
+                            m.d.sync += matched.eq(k + 1)
                     with m.Else():
-                        m.d.sync += [packet[0:8].eq(b), index.eq(1)]
-                with m.Case(1):
-                    with m.If(~b[0]):
-                        m.d.sync += [self.resyncs.eq(self.resyncs + 1), index.eq(0)]
-                    with m.Else():
-                        m.d.sync += [packet[8:16].eq(b), index.eq(2)]
-                with m.Case(2):
-                    m.d.sync += [packet[16:24].eq(b), index.eq(3)]
-                with m.Case(3):
-                    m.d.sync += [packet[24:32].eq(b), index.eq(4)]
-                with m.Case(4):
-                    m.d.sync += [
-                        s.quality.eq(packet[2:8]),
-                        s.start.eq(packet[0]),
-                        s.angle_q6.eq(packet[9:24]),
-                        s.distance_q2.eq(Cat(packet[24:32], b)),
-                        self.samples.valid.eq(1),
-                        index.eq(0),
-                    ]
+                        m.d.sync += matched.eq(_equals(b, DESCRIPTOR[0]))
+        with m.Elif(self.bytes.valid):
+            with m.If(~index.any()):  # index 0
+                with m.If(b[0] == b[1]):  # S = !S: not a first byte
+                    m.d.sync += self.resyncs.eq(self.resyncs + 1)
+                with m.Else():
+                    m.d.sync += [packet[0:8].eq(b), index.eq(1)]
+            with m.Elif(index == 1):
+                with m.If(~b[0]):  # check bit C = 0: begin again
+                    m.d.sync += [self.resyncs.eq(self.resyncs + 1), index.eq(0)]
+                with m.Else():
+                    m.d.sync += [packet[8:16].eq(b), index.eq(2)]
+            with m.Elif(index == 2):
+                m.d.sync += [packet[16:24].eq(b), index.eq(3)]
+            with m.Elif(index == 3):
+                m.d.sync += [packet[24:32].eq(b), index.eq(4)]
+            with m.Else():  # byte 4
+                m.d.sync += [
+                    s.quality.eq(packet[2:8]),
+                    s.start.eq(packet[0]),
+                    s.angle_q6.eq(packet[9:24]),
+                    s.distance_q2.eq(Cat(packet[24:32], b)),
+                    self.samples.valid.eq(1),
+                    index.eq(0),
+                ]
         return m

@@ -1,6 +1,6 @@
 """``NearestObstacle``: the nearest return of each LIDAR revolution and its bearing."""
 
-from amaranth import Module, Signal
+from amaranth import Cat, Module, Signal
 from amaranth.lib import data, stream, wiring
 from amaranth.lib.wiring import In, Out
 
@@ -65,9 +65,13 @@ class NearestObstacle(CheckedArguments, wiring.Component):
         run = Signal(SampleLayout)  # the revolution's nearest counted sample so far
         run_found = Signal()
         counts = Signal()
-        m.d.comb += counts.eq(
-            (s.distance_q2 != 0) & (s.quality >= p.min_quality) & (s.distance_q2 >= p.min_mm * 4)
-        )
+        terms = [s.distance_q2 != 0]
+        # Bounds of 0 pass everything: left out (a constant comparison is a lint warning).
+        if p.min_quality:
+            terms.append(s.quality >= p.min_quality)
+        if p.min_mm:
+            terms.append(s.distance_q2 >= p.min_mm * 4)
+        m.d.comb += counts.eq(Cat(*terms).all())
         m.d.sync += self.updated.eq(0)
         with m.If(self.samples.valid):
             with m.If(s.start):
