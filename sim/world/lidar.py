@@ -18,7 +18,8 @@ as the signal is above the threshold (a linear fade); beyond ``max_incidence_deg
 returns (glancing). No return, or a surface outside ``min_range..max_range``, is what the
 RPLIDAR reports as an invalid sample: distance 0, quality 0. A return carries Gaussian range
 noise of ``noise_frac`` of the range (the datasheet's accuracy, 1% of range up to 3 m) and
-the quality ``quality`` (the A1 reports 15 for a good return in standard mode).
+the quality ``quality`` (one value for every return here; the part's follows the return's
+strength).
 
 The protocol (Slamtec's interface protocol, ``SCAN`` request ``A5 20``): the answer starts
 with the response descriptor ``A5 5A 05 00 00 40 81`` (5-byte answers, repeated, type 0x81),
