@@ -1,6 +1,7 @@
 """NearestObstacle against its numpy model (sim/models/nearest_obstacle.py) on random scans,
 its outputs by hand on a tiny one, and CorridorFollow's wheel commands against the control
-law by hand, the mirrored-bearing variant's commands included."""
+law by hand and against its model (sim/models/corridor_follow.py) on random scans, the
+mirrored-bearing variant's commands included."""
 
 import numpy as np
 import pytest
@@ -11,6 +12,7 @@ from fpga_robotics.hw.lidar_params import CorridorParams, NearestParams
 from fpga_robotics.hw.lidar_sample import pack_sample, unpack_sample
 from fpga_robotics.hw.nearest_obstacle import NearestObstacle
 from fpga_robotics.hw.variants import variant_params
+from fpga_robotics.sim.models.corridor_follow import corridor_commands
 from fpga_robotics.sim.models.nearest_obstacle import nearest_per_revolution
 from fpga_robotics.sim.world.lidar import LidarSample
 
@@ -154,3 +156,44 @@ def test_the_mirrored_variant_steers_towards_the_wall():
     assert corridor_command(bug, 1, 400, 90 * 64) == (390, 210)
     assert run_corridor(bug, [(1600, 90 * 64)]) == (390, 210)
     assert run_corridor(bug, [(1000, 250 * 64)]) == (210, 390)
+
+
+def run_corridor_scan(params, samples):
+    """CorridorFollow fed ``samples`` two cycles apart; its wheel command two edges after each
+    start sample (the revolution it ends published, then the command loaded)."""
+    dut = CorridorFollow(params)
+    top = WithReset(dut)
+    out = []
+
+    async def bench(ctx):
+        for sample in samples:
+            ctx.set(dut.lidar.payload.as_value(), _payload(*sample))
+            ctx.set(dut.lidar.valid, 1)
+            await ctx.tick()
+            ctx.set(dut.lidar.valid, 0)
+            await ctx.tick()
+            if sample[3]:
+                out.append((ctx.get(dut.motor_left), ctx.get(dut.motor_right)))
+
+    run_testbench(top, bench, watchdog=len(samples) * 2 + 50)
+    return out
+
+
+def corridor_scan(rng, n):
+    """Revolutions of 3..12 samples, near and far, at any bearing: every case of the law."""
+    out = []
+    while len(out) < n:
+        for j in range(int(rng.integers(3, 12))):
+            mm = int(rng.choice([rng.integers(150, 320), rng.integers(280, 450), 2000]))
+            dropout = rng.random() < 0.15
+            out.append((int(rng.integers(0, 23040)), 0 if dropout else mm * 4, 15, int(j == 0)))
+    return out[:n]
+
+
+@pytest.mark.parametrize("variant", [None, "lidar_bearing_mirrored"])
+def test_corridor_follow_matches_its_model(variant):
+    p = CorridorParams() if variant is None else variant_params(variant, CorridorParams())
+    samples = corridor_scan(np.random.default_rng(3), 400)
+    expected = corridor_commands(samples, p)
+    assert run_corridor_scan(p, samples) == expected
+    assert len(set(expected)) >= 5  # straight, both steers, both turns seen
