@@ -1229,6 +1229,11 @@ PLANS = {
     "fpga-robotics export --design corridor_follow_uart -o corridor_follow_uart.v": Plan(
         files=("corridor_follow_uart.v",), out=(r"module corridor_follow_uart, 8 ports",)
     ),
+    "fpga-robotics export --top corridor_follow --variant lidar_bearing_mirrored -o "
+    "corridor_mirrored.v": Plan(
+        files=("corridor_mirrored.v",),
+        out=(r"variant lidar_bearing_mirrored, module corridor_follow",),
+    ),
     "fpga-robotics run --scenario corridor": Plan(
         out=(PASS, r"design output nearest_mm: last \d+", r"collisions: person 0, wall 0")
     ),
