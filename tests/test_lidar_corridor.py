@@ -32,3 +32,11 @@ def test_the_mirrored_variant_fails_max_wall_collisions():
         "corridor", [*FAST, "sim.duration=8", "design.variant=lidar_bearing_mirrored"]
     )
     assert _failed(run_scenario(s, backend="cxxrtl")) == ["max_wall_collisions"]
+
+
+def test_the_lidar_campaign_runs_both_bindings_over_seeds():
+    from fpga_robotics.sweep import load_campaign_file
+
+    campaign = load_campaign_file("lidar")
+    runs = sorted((r.scenario, r.seed) for r in campaign.runs)
+    assert runs == [(s, seed) for s in ("corridor", "corridor_uart") for seed in range(5)]
