@@ -10,6 +10,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 from .errors import ParamError
+from .lidar_params import CorridorParams
 from .sensor_params import FollowLineParams, InterlockParams, UltrasoundParams
 
 __all__ = ["VARIANTS", "Variant", "variant_params"]
@@ -74,6 +75,16 @@ VARIANTS = {
             "stopped, only an empty view (no echo at all) releases the wheels",
             fails="obstacle_between: following resumes when the box is gone: the person (or any "
             "surface within 4 m) keeps answering, so the robot never moves again",
+        ),
+        Variant(
+            name="lidar_bearing_mirrored",
+            design="corridor_follow",
+            params_type=CorridorParams,
+            changes=lambda p: {"clockwise": False},
+            bug="reads the RPLIDAR's bearings counter-clockwise (they are clockwise): a wall on "
+            "the right looks like one on the left",
+            fails="corridor: no contact with the walls (max_wall_collisions): the robot steers "
+            "towards the nearer wall instead of away from it",
         ),
     )
 }

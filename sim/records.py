@@ -86,3 +86,7 @@ class SensorReading:
     points: tuple = ()
     states: tuple = ()
     rays: tuple = ()
+    #: Height (m) of the points in the 3D view (a LIDAR's scan plane).
+    height: float = 0.0
+    #: A LIDAR's last whole revolution (``sim.world.lidar.Revolution``), None for others.
+    scan: object = None

@@ -1222,6 +1222,43 @@ PLANS = {
         shorter=(("--frames", "2"),),
         out=(r"every frame equal to the golden model", r"median [\d.]+ s wall"),
     ),
+    # docs/lidar.md: the LIDAR and the corridor follower -----------------------------------------
+    "fpga-robotics export --design corridor_follow -o corridor_follow.v": Plan(
+        files=("corridor_follow.v",), out=(r"module corridor_follow, 7 ports",)
+    ),
+    "fpga-robotics export --design corridor_follow_uart -o corridor_follow_uart.v": Plan(
+        files=("corridor_follow_uart.v",), out=(r"module corridor_follow_uart, 8 ports",)
+    ),
+    "fpga-robotics export --top corridor_follow --variant lidar_bearing_mirrored -o "
+    "corridor_mirrored.v": Plan(
+        files=("corridor_mirrored.v",),
+        out=(r"variant lidar_bearing_mirrored, module corridor_follow",),
+    ),
+    "fpga-robotics run --scenario corridor": Plan(
+        out=(PASS, r"design output nearest_mm: last \d+", r"collisions: person 0, wall 0")
+    ),
+    "fpga-robotics run --scenario corridor_uart": Plan(
+        out=(PASS, r"design output framing_errors: last 0", r"design output resyncs: last 0")
+    ),
+    "fpga-robotics run --scenario corridor --duration 8 --set "
+    "design.variant=lidar_bearing_mirrored": Plan(
+        slow=True,
+        duration="keep",
+        duration_why="the page says the variant fails within these 8 s",
+        out=(r"\[FAIL\] max_wall_collisions", r"(?m)^verdict: FAIL$"),
+    ),
+    "fpga-robotics run --scenario corridor --bag corridor_bag": Plan(
+        files=("corridor_bag/metadata.yaml", "corridor_bag/corridor_bag.mcap"),
+        out=(PASS, r"ROS 2 bag \(30 frames\) written to corridor_bag"),
+    ),
+    "fpga-robotics bench lidar": Plan(
+        slow=True,
+        shorter=(("--duration", "0.5"), ("--repeats", "1")),
+        out=(
+            r"revolution / frame: [\d.]+ \(median of the turns\)",
+            r"(?m)^  UART   binding, real clock at 50 MHz: [\d.]+ \([\d.]+-[\d.]+\) Mcycles",
+        ),
+    ),
 }
 
 

@@ -137,7 +137,34 @@ def _bag_in_calibrations(data):
     return data["figures"]["bag"]["cpu_ms"] / data["calibration"]["cpu_ms"]["median"]
 
 
+def _revolution_over_frame(data):
+    return data["figures"]["revolution_over_frame"]
+
+
+def _stream_over_uart(data):
+    f = data["figures"]
+    return (
+        f["lidar_stream_mcycles_per_cpu_s"]["median"] / f["lidar_uart_mcycles_per_cpu_s"]["median"]
+    )
+
+
 FIGURES = (
+    Figure(
+        "docs/lidar.md",
+        "75",
+        "35",
+        "lidar",
+        _revolution_over_frame,
+        "a LIDAR revolution's CPU time (stream binding, 50 MHz) over a 160x120 FollowTarget frame's",
+    ),
+    Figure(
+        "docs/lidar.md",
+        "2.1",
+        "0.6",
+        "lidar",
+        _stream_over_uart,
+        "the stream binding's design cycles per CPU second over the UART binding's",
+    ),
     Figure(
         "docs/backends.md",
         "2.7",

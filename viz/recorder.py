@@ -49,6 +49,7 @@ from .images import (
     encode_rgb444,
 )
 from .leds import centroid_image, proximity_image
+from .lidar import log_scans_3d
 from .modes import parse_mode
 from .outcome import settle
 from .sensors import MAP_LINES, SensorViews, line_strips
@@ -392,6 +393,7 @@ class Recorder:
         if self._world3d is not None and record.scene is not None:
             with self._guard:
                 self._world3d.log_frame(record, frame, t)
+                log_scans_3d(self._stream, record, frame, t)
         if self._layout_stale:
             self._send_blueprint(shadow=self._shadow_seen)
         self.frames_logged += 1

@@ -5,10 +5,11 @@
     fpga-robotics export --board ulx3s-85f -o DIR [--bitstream]   (board top + LPF)
     fpga-robotics export --top follow_target_safe [--stop-mm 250 --us-period-us ...]
     fpga-robotics export --top follow_line [--line-n-sensors 2 --variant ...]
+    fpga-robotics export --top corridor_follow[_uart] [--corridor-keep-mm 500 --variant ...]
     fpga-robotics export --design my_design.py:MyDesign [--param NAME=VALUE ...] -o x.v
 
 ``--top`` picks the design (default ``follow_target``; docs/sensor_designs.md describes the
-other two), and the Verilog module is named after it. Every ``FollowTargetParams`` field is an
+sensor designs, docs/lidar.md the corridor followers), and the Verilog module is named after it. Every ``FollowTargetParams`` field is an
 option (``--diff-min 5``, ``--base-dps 0,400,...``; ``follow_target`` and
 ``follow_target_safe``); ``--preset NAME`` starts from a preset, the other options on top. The
 sensor designs' parameters are options too (``fpga_robotics.cli.sensor_options``), and
@@ -30,6 +31,8 @@ from fpga_robotics.cli.sensor_options import (
     sensor_params_from_args,
 )
 from fpga_robotics.flow.export import TOPS, generate_top_verilog
+from fpga_robotics.hw.corridor_follow import CorridorFollow
+from fpga_robotics.hw.corridor_follow_uart import CorridorFollowUart
 from fpga_robotics.hw.follow_line import FollowLine
 from fpga_robotics.hw.params import FollowTargetParams
 from fpga_robotics.hw.safe_follow import FollowTargetSafe
@@ -88,7 +91,7 @@ def main(argv=None, prog="fpga-robotics export"):
     if args.design_params:
         raise UsageError("--param sets a parameter of a --design REF (a design of your own)")
     _check_options_fit_the_top(args)
-    params = params_from_args(args) if args.top != "follow_line" else None
+    params = params_from_args(args) if args.top not in _NO_FOLLOW_TARGET else None
     if args.board is not None:  # a board top instead (fpga_robotics.flow.board)
         out_dir = args.output
         if out_dir is None:
@@ -120,8 +123,22 @@ def _follow_target_text(args, params):
 
 
 def _sensor_top(args, params):
-    """``(Verilog text, description)`` of ``follow_target_safe`` or ``follow_line``."""
+    """``(Verilog text, description)`` of ``follow_target_safe``, ``follow_line`` or a
+    corridor follower."""
     variant = f", variant {args.variant}" if args.variant is not None else ""
+    if args.top in ("corridor_follow", "corridor_follow_uart"):
+        corridor = sensor_params_from_args(args, "corridor", args.top)
+        nearest = sensor_params_from_args(args, "nearest", args.top)
+        if args.top == "corridor_follow":
+            return generate_top_verilog(CorridorFollow(corridor, nearest), args.top), (
+                f"keep {corridor.keep_mm} mm, stop {corridor.stop_mm} mm{variant}"
+            )
+        uart = sensor_params_from_args(args, "uart", args.top)
+        text = generate_top_verilog(CorridorFollowUart(corridor, nearest, uart), args.top)
+        return text, (
+            f"keep {corridor.keep_mm} mm, stop {corridor.stop_mm} mm, {uart.baud} baud at "
+            f"{uart.clock_hz} Hz{variant}"
+        )
     if args.top == "follow_line":
         line = sensor_params_from_args(args, "line", args.top)
         sensors = f"{line.n_sensors} sensor{'s' if line.n_sensors > 1 else ''}"
@@ -153,8 +170,8 @@ def _check_options_fit_the_top(args):
             f"--board exports the follow_target board top; it cannot be combined "
             f"with --top {args.top}"
         )
-    if args.top == "follow_line":
-        # follow_line reads no FollowTargetParams: any of those options is a mistake.
+    if args.top in _NO_FOLLOW_TARGET:
+        # These read no FollowTargetParams: any of those options is a mistake.
         ft_given = [
             name
             for name, value in vars(args).items()
@@ -164,8 +181,12 @@ def _check_options_fit_the_top(args):
             options = ", ".join("--" + n.replace("_", "-") for n in ft_given)
             raise UsageError(
                 f"{options} applies to --top follow_target or "
-                f"follow_target_safe, not to --top follow_line"
+                f"follow_target_safe, not to --top {args.top}"
             )
+
+
+#: The tops that take no FollowTargetParams.
+_NO_FOLLOW_TARGET = ("follow_line", "corridor_follow", "corridor_follow_uart")
 
 
 def _is_follow_target_option(dest):

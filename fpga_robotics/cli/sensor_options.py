@@ -6,6 +6,7 @@ for a seeded buggy variant (``hw/variants.py``)."""
 from dataclasses import MISSING, fields
 
 from fpga_robotics.cli.errors import UsageError
+from fpga_robotics.hw.lidar_params import CorridorParams, NearestParams, UartParams
 from fpga_robotics.hw.sensor_params import (
     EDGE_SIDES,
     FollowLineParams,
@@ -16,12 +17,17 @@ from fpga_robotics.hw.variants import VARIANTS, variant_params
 
 __all__ = ["SENSOR_GROUPS", "add_sensor_arguments", "given_options", "sensor_params_from_args"]
 
+_CORRIDOR_TOPS = ("corridor_follow", "corridor_follow_uart")
+
 #: key -> (params class, option prefix, heading, the tops that read it). Boolean fields are
 #: no options: the seeded variants that flip them are named by ``--variant``.
 SENSOR_GROUPS = {
     "us": (UltrasoundParams, "us-", "HC-SR04 ultrasound driver", ("follow_target_safe",)),
     "interlock": (InterlockParams, "", "obstacle interlock", ("follow_target_safe",)),
     "line": (FollowLineParams, "line-", "line follower", ("follow_line",)),
+    "corridor": (CorridorParams, "corridor-", "corridor follower", _CORRIDOR_TOPS),
+    "nearest": (NearestParams, "nearest-", "LIDAR nearest obstacle", _CORRIDOR_TOPS),
+    "uart": (UartParams, "uart-", "LIDAR serial link", ("corridor_follow_uart",)),
 }
 
 _CHOICES = {"edge_side": EDGE_SIDES}

@@ -72,6 +72,29 @@ TOPS = {
         component=("fpga_robotics.hw.follow_line", "FollowLine"),
         takes_follow_target_params=False,
     ),
+    "corridor_follow": Top(
+        "corridor_follow",
+        "CorridorFollow: a LIDAR's nearest return per revolution keeps it clear of the walls",
+        camera=False,
+        tables={
+            "corridor": ("fpga_robotics.hw.lidar_params", "CorridorParams"),
+            "nearest": ("fpga_robotics.hw.lidar_params", "NearestParams"),
+        },
+        component=("fpga_robotics.hw.corridor_follow", "CorridorFollow"),
+        takes_follow_target_params=False,
+    ),
+    "corridor_follow_uart": Top(
+        "corridor_follow_uart",
+        "CorridorFollow on the LIDAR's serial protocol: a UART and a packet decoder before it",
+        camera=False,
+        tables={
+            "corridor": ("fpga_robotics.hw.lidar_params", "CorridorParams"),
+            "nearest": ("fpga_robotics.hw.lidar_params", "NearestParams"),
+            "uart": ("fpga_robotics.hw.lidar_params", "UartParams"),
+        },
+        component=("fpga_robotics.hw.corridor_follow_uart", "CorridorFollowUart"),
+        takes_follow_target_params=False,
+    ),
 }
 
 

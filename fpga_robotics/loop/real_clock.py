@@ -385,6 +385,8 @@ class RealClockLoop(ClosedLoop):
                     tuple(overlay.get("points", ())),
                     tuple(overlay.get("states", ())),
                     tuple(overlay.get("rays", ())),
+                    float(overlay.get("height", 0.0)),
+                    overlay.get("scan"),
                 )
         return readings
 

@@ -4,7 +4,7 @@ A display connector like the rerun recorder (``viz.recorder``): ``log_frame(reco
 every ``FrameRecord``, ``close()`` at the end. The bag is written into a hidden folder next to
 ``PATH`` and renamed to ``PATH`` only when complete (an existing bag there is replaced); a run
 that fails or is interrupted leaves nothing behind (``abandon()``). The topics and their types
-are ``messages.TOPICS``; ``ros2 bag info PATH`` and Foxglove open the result.
+are ``messages.TOPICS`` (and a LIDAR's ``/<name>/scan``, ``laser_scan``); ``ros2 bag info PATH`` and Foxglove open the result.
 """
 
 import contextlib
@@ -18,6 +18,7 @@ from rosbags.rosbag2 import StoragePlugin, Writer, WriterError
 from fpga_robotics.hw.errors import UsageError
 from fpga_robotics.sim.files import check_output_dir
 
+from .laser_scan import SCAN_TYPE, LaserScans
 from .messages import TOPICS, TYPESTORE, FrameMessages, camera_geometry
 
 __all__ = ["BagWriter", "check_bag_path", "open_bag_writer"]
@@ -66,6 +67,7 @@ class BagWriter:
             topic: self._writer.add_connection(topic, msgtype, typestore=TYPESTORE)
             for topic, msgtype in TOPICS.items()
         }
+        self._scans = LaserScans()  # a LIDAR's revolutions, on topics made when first seen
         self.frames_logged = 0
         self._notices = []
 
@@ -75,6 +77,10 @@ class BagWriter:
     def log_frame(self, record):
         write, conns = self._writer.write, self._connections
         for topic, ns, data in self._messages.encode(record):
+            write(conns[topic], ns, data)
+        for topic, ns, data in self._scans.encode(record):
+            if topic not in conns:
+                conns[topic] = self._writer.add_connection(topic, SCAN_TYPE, typestore=TYPESTORE)
             write(conns[topic], ns, data)
         self.frames_logged += 1
 

@@ -88,7 +88,7 @@ _APP_SECTIONS = ("sim", "camera", "color", "design", "checks")
 #: A foreign Verilog design instead of FollowTarget (docs/foreign.md): its files and port map.
 _FOREIGN_KEYS = ("verilog", "ports")
 #: ``design.top`` (fpga_robotics.designs), a buggy ``variant``, and the tops' parameter tables.
-_TOP_TABLES = ("ultrasound", "interlock", "line")
+_TOP_TABLES = tuple(dict.fromkeys(key for top in TOPS.values() for key in top.tables))
 #: ``design.params``: the keyword arguments of a design of one's own (designs/reference.py).
 _TOP_DESIGN_KEYS = ("top", "variant", "params", *_TOP_TABLES)
 
@@ -864,7 +864,7 @@ def _top(design, source):
         )
     spec = TOPS[top]
     tables = {}
-    for key in ("ultrasound", "interlock", "line"):
+    for key in _TOP_TABLES:
         value = design.get(key)
         if value is None:
             continue

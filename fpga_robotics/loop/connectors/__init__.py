@@ -2,8 +2,8 @@
 docs/connectors.md): what the design's pins see of the world and what they do to it.
 Importing this package registers every shipped kind: ``camera`` (rendered frames in),
 ``wheels`` (wheel commands out, after the actuation delay), ``bumper`` (a contact switch),
-``ultrasound`` (an HC-SR04: TRIG out, ECHO in) and ``line_sensors`` (KY-033s under the
-robot)."""
+``ultrasound`` (an HC-SR04: TRIG out, ECHO in), ``line_sensors`` (KY-033s under the
+robot) and ``lidar``/``lidar_uart`` (an RPLIDAR A1 class scanner)."""
 
 from fpga_robotics.loop.connectors.base import (
     CONNECTORS,
@@ -16,6 +16,7 @@ from fpga_robotics.loop.connectors.base import (
 )
 from fpga_robotics.loop.connectors.bumper import BumperConnector
 from fpga_robotics.loop.connectors.camera import CameraConnector, camera_pose, in_view
+from fpga_robotics.loop.connectors.lidar import LidarConnector, LidarUartConnector
 from fpga_robotics.loop.connectors.line_sensors import LineSensorsConnector
 from fpga_robotics.loop.connectors.motors import MotorConnector
 from fpga_robotics.loop.connectors.ultrasound import UltrasoundConnector
@@ -26,6 +27,8 @@ __all__ = [
     "CameraConnector",
     "Connector",
     "ConnectorError",
+    "LidarConnector",
+    "LidarUartConnector",
     "LineSensorsConnector",
     "MotorConnector",
     "Mount",
