@@ -52,9 +52,14 @@ def heavy_tests():
     return [line.split("#")[0].strip() for line in lines if line.split("#")[0].strip()]
 
 
-def _is_heavy(nodeid, heavy):
-    # A line without brackets names every parametrization of its test.
-    return any(nodeid == h or (nodeid.startswith(h + "[") and "[" not in h) for h in heavy)
+def is_heavy(nodeid, heavy):
+    """A line names a test, every parametrization of a test (no brackets), or a whole file."""
+    return any(
+        nodeid == h
+        or (nodeid.startswith(h + "[") and "[" not in h)
+        or ("::" not in h and nodeid.startswith(h + "::"))
+        for h in heavy
+    )
 
 
 def pytest_collection_modifyitems(items):
@@ -67,6 +72,6 @@ def pytest_collection_modifyitems(items):
         if (
             item.get_closest_marker("formal")
             or item.originalname in DOCS_RUNS
-            or _is_heavy(item.nodeid, heavy)
+            or is_heavy(item.nodeid, heavy)
         ):
             item.add_marker(pytest.mark.slow)
