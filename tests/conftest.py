@@ -7,7 +7,9 @@ locally.
 The fast tier (``python -m pytest -m "not slow"``) builds no Verilator model and runs no
 place and route: a test not marked ``slow`` that reaches one of those builds fails, naming
 itself and the build (tests/fast_tier/slow_builds.py), in its own process and in the Python
-processes it starts.
+processes it starts. The documentation's end-to-end blocks and the tests named in
+tests/fast_tier/heavy_tests.txt are slow-tier too, so that the fast tier stays an edit-test loop
+of a few minutes.
 """
 
 import os
@@ -39,8 +41,37 @@ def _fast_tier_builds_nothing_slow(request, monkeypatch):
     monkeypatch.setenv("PYTHONPATH", os.pathsep.join(filter(None, [str(FAST_TIER_DIR), path])))
 
 
+#: The documentation's own command and Python blocks run end to end (closed-loop runs,
+#: campaigns, exports): the full suite runs them, the edit-test loop does not.
+DOCS_RUNS = ("test_documented_commands", "test_documented_python")
+
+
+def heavy_tests():
+    """The node ids of tests/fast_tier/heavy_tests.txt (a comment after ``#`` gives the cost)."""
+    lines = (FAST_TIER_DIR / "heavy_tests.txt").read_text().splitlines()
+    return [line.split("#")[0].strip() for line in lines if line.split("#")[0].strip()]
+
+
+def is_heavy(nodeid, heavy):
+    """A line names a test, every parametrization of a test (no brackets), or a whole file."""
+    return any(
+        nodeid == h
+        or (nodeid.startswith(h + "[") and "[" not in h)
+        or ("::" not in h and nodeid.startswith(h + "::"))
+        for h in heavy
+    )
+
+
 def pytest_collection_modifyitems(items):
-    """The formal proofs run SymbiYosys for minutes: slow-tier too, not the edit-test loop."""
+    """Slow-tier too, not the edit-test loop: the formal proofs (SymbiYosys runs minutes), the
+    documentation's end-to-end blocks and the tests listed as heavy."""
+    heavy = heavy_tests()
     for item in items:
-        if item.get_closest_marker("formal") and not item.get_closest_marker("slow"):
+        if item.get_closest_marker("slow"):
+            continue
+        if (
+            item.get_closest_marker("formal")
+            or item.originalname in DOCS_RUNS
+            or is_heavy(item.nodeid, heavy)
+        ):
             item.add_marker(pytest.mark.slow)

@@ -68,3 +68,49 @@ def test_a_slow_test_reaches_the_real_entry_points():
     for name, entries in slow_builds.ENTRY_POINTS.items():
         for attr, _, _ in entries:
             assert not hasattr(getattr(sys.modules[name], attr), "guarded"), (name, attr)
+
+
+def test_every_heavy_test_named_exists():
+    """A renamed or removed test must leave tests/fast_tier/heavy_tests.txt too, or the list
+    would silently stop marking anything."""
+    from conftest import heavy_tests, is_heavy
+
+    listed = heavy_tests()
+    assert listed, "heavy_tests.txt names no test"
+    result = subprocess.run(
+        [sys.executable, "-m", "pytest", "--collect-only", "-q", "-p", "no:cacheprovider"]
+        + sorted({h.split("::")[0] for h in listed}),
+        check=False,
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
+    collected = [line.strip() for line in result.stdout.splitlines() if "::" in line]
+    missing = [h for h in listed if not any(is_heavy(c, [h]) for c in collected)]
+    assert not missing, f"heavy_tests.txt names tests that do not exist: {missing}"
+
+
+def test_heavy_and_docs_tests_are_slow_tier():
+    result = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "pytest",
+            "--collect-only",
+            "-q",
+            "-m",
+            "not slow",
+            "-p",
+            "no:cacheprovider",
+            "tests/test_real_clock.py",
+            "tests/test_docs_commands.py",
+        ],
+        check=False,
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
+    fast = result.stdout.splitlines()
+    assert any("test_real_clock.py::" in t for t in fast), result.stdout[-2000:]
+    assert not any("test_the_ultrasound_variant_drives_into_the_box" in t for t in fast)
+    assert not any("test_documented_commands[" in t for t in fast)
