@@ -11,6 +11,7 @@ from dataclasses import dataclass
 
 from .errors import ParamError
 from .sensor_params import FollowLineParams, InterlockParams, UltrasoundParams
+from .turret_params import TurretParams
 
 __all__ = ["VARIANTS", "Variant", "variant_params"]
 
@@ -74,6 +75,16 @@ VARIANTS = {
             "stopped, only an empty view (no echo at all) releases the wheels",
             fails="obstacle_between: following resumes when the box is gone: the person (or any "
             "surface within 4 m) keeps answering, so the robot never moves again",
+        ),
+        Variant(
+            name="turret_pan_inverted",
+            design="turret_tracker",
+            params_type=TurretParams,
+            changes=lambda p: {"inverted": True},
+            bug="the pan law's sign is flipped: a target right of the image centre turns the "
+            "camera left, away from it",
+            fails="turret: the pan camera's target centred (camera_target_centred_min_fraction): "
+            "the camera turns away until the target leaves its view or the servo its range",
         ),
     )
 }

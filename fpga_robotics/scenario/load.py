@@ -46,7 +46,7 @@ from fpga_robotics.hw.params import (
 )
 from fpga_robotics.hw.pixel import COLOR_SELECT
 from fpga_robotics.loop.compressed import frame_count
-from fpga_robotics.loop.connectors import ConnectorError
+from fpga_robotics.loop.connectors import CONNECTORS, ConnectorError
 from fpga_robotics.scenario.connectors import parse_connectors
 from fpga_robotics.scenario.errors import ScenarioError
 from fpga_robotics.scenario.render3d_keys import RENDER_DEFAULTS, parse_render_keys
@@ -80,7 +80,7 @@ _APP_SECTIONS = ("sim", "camera", "color", "design", "checks")
 #: A foreign Verilog design instead of FollowTarget (docs/foreign.md): its files and port map.
 _FOREIGN_KEYS = ("verilog", "ports")
 #: ``design.top`` (fpga_robotics.designs), a buggy ``variant``, and the tops' parameter tables.
-_TOP_TABLES = ("ultrasound", "interlock", "line")
+_TOP_TABLES = ("ultrasound", "interlock", "line", "turret")
 #: ``design.params``: the keyword arguments of a design of one's own (designs/reference.py).
 _TOP_DESIGN_KEYS = ("top", "variant", "params", *_TOP_TABLES)
 _DESIGN_KEYS = (
@@ -995,7 +995,7 @@ def _top(design, source):
         )
     spec = TOPS[top]
     tables = {}
-    for key in ("ultrasound", "interlock", "line"):
+    for key in _TOP_TABLES:
         value = design.get(key)
         if value is None:
             continue
@@ -1029,9 +1029,15 @@ def _connectors(world):
 def _resolve_timing(sim, camera, top, connectors, foreign):
     """``sim.timing = "auto"`` made definite; a design or connector with pins of its own
     needs real-clock timing."""
-    # Every design but the camera-only follow_target has pins of its own.
-    pins = [f"the {c.kind} connector" for c in connectors]
-    if top != "follow_target":
+    # Every design but the camera-only follow_target has pins of its own; further cameras
+    # and servos act once a frame, on a design with frame-level channels for them.
+    frame_level = top in TOPS and bool(TOPS[top].frame_channels)
+    pins = [
+        f"the {c.kind} connector"
+        for c in connectors
+        if not (frame_level and getattr(CONNECTORS[c.kind], "frame_level", False))
+    ]
+    if top != "follow_target" and not frame_level:
         pins.insert(0, f"design.top = {top!r}")
     if foreign is not None:
         # A port map that binds connectors (or has no camera) is a design with pins.
@@ -1052,6 +1058,11 @@ def _resolve_timing(sim, camera, top, connectors, foreign):
         raise ScenarioError(
             f'sim.timing = "compressed" runs the design only while pixels '
             f'flow; {pins[0]} needs sim.timing = "real_clock" (or "auto")'
+        )
+    if timing == "real_clock" and any(c.kind in ("camera", "servo") for c in connectors):
+        raise ScenarioError(
+            "cameras and servos in [[robot.sensors]]/[[robot.actuators]] run in "
+            'sim.timing = "compressed" (or "auto"); the real clock streams one camera'
         )
     delay = sim.actuation_delay
     if delay is None:

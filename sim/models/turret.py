@@ -9,7 +9,7 @@ from fpga_robotics.hw.turret_params import TurretParams
 from ..camera.frames import to_rgb444
 from .follow_target import TrackerResult, match_table, track_frame
 
-__all__ = ["TurretAimModel", "TurretFrame", "aim_step"]
+__all__ = ["TurretAimModel", "TurretChannel", "TurretFrame", "aim_step"]
 
 
 def aim_step(angle, tracker, params):
@@ -50,3 +50,35 @@ class TurretAimModel:
         tracker = track_frame(match_table(color_sel, tp)[packed], tp)
         self.angle = aim_step(self.angle, tracker, self.params)
         return TurretFrame(tracker, self.angle)
+
+
+class TurretChannel:
+    """``TurretTracker``'s turret channel as the closed loop's compressed timing runs it: one
+    pan-camera frame in, the design's ports out (``{port: value}``), by the numpy model.
+
+    Parameters
+    ----------
+    tables : dict
+        The scenario's design tables (``turret``: a ``TurretParams``; absent: the defaults).
+    """
+
+    #: The colour select port of the channel's pixel bundle.
+    color_port = "turret_color_sel"
+    #: The outputs the viewer shows with the camera's image: found, centroid column.
+    view_ports = ("turret_found", "turret_centroid_x")
+
+    def __init__(self, tables):
+        self.model = TurretAimModel(tables.get("turret"))
+        tp = self.model.params
+        self.frame_size = (tp.width, tp.height)
+
+    def reset(self):
+        self.model.reset()
+
+    def process(self, frame, color_sel):
+        out = self.model.process(frame, color_sel)
+        return {
+            "turret_found": int(out.tracker.found),
+            "turret_centroid_x": out.tracker.centroid_x,
+            "servo_angle": out.angle,
+        }

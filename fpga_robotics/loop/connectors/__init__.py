@@ -3,7 +3,7 @@ docs/connectors.md): what the design's pins see of the world and what they do to
 Importing this package registers every shipped kind: ``camera`` (rendered frames in),
 ``wheels`` (wheel commands out, after the actuation delay), ``bumper`` (a contact switch),
 ``ultrasound`` (an HC-SR04: TRIG out, ECHO in) and ``line_sensors`` (KY-033s under the
-robot)."""
+robot) and ``servo`` (a pan servo turning what is mounted on it)."""
 
 from fpga_robotics.loop.connectors.base import (
     CONNECTORS,
@@ -18,6 +18,7 @@ from fpga_robotics.loop.connectors.bumper import BumperConnector
 from fpga_robotics.loop.connectors.camera import CameraConnector, camera_pose, in_view
 from fpga_robotics.loop.connectors.line_sensors import LineSensorsConnector
 from fpga_robotics.loop.connectors.motors import MotorConnector
+from fpga_robotics.loop.connectors.servo import ServoConnector
 from fpga_robotics.loop.connectors.ultrasound import UltrasoundConnector
 
 __all__ = [
@@ -31,6 +32,7 @@ __all__ = [
     "Mount",
     "Pin",
     "PinIO",
+    "ServoConnector",
     "UltrasoundConnector",
     "camera_pose",
     "in_view",
