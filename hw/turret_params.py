@@ -50,7 +50,7 @@ class TurretParams:
             object.__setattr__(self, name, check_int(name, getattr(self, name), lo, hi))
         if not isinstance(self.inverted, bool):
             raise TypeError(f"inverted must be True or False, not {self.inverted!r}")
-        self.tracker_params  # the frame geometry must suit the tracker (window of 8 bins)
+        _ = self.tracker_params  # the frame geometry must suit the tracker (window of 8 bins)
 
     @property
     def tracker_params(self):

@@ -7,6 +7,8 @@ error into the servo's 10-bit signed angle (``TurretParams``). The two channels 
 nothing but the clock: the body camera's frames steer the wheels as in ``FollowTarget``.
 """
 
+from typing import ClassVar
+
 from amaranth import Module, Signal, signed
 from amaranth.lib import wiring
 from amaranth.lib.wiring import In, Out
@@ -131,9 +133,7 @@ class TurretTracker(wiring.Component):
     """
 
     #: The ports the connectors bind (designs/reference.py): the pan camera and the servo.
-    connectors = {
-        "servo": {"angle": "servo_angle"},
-    }
+    connectors: ClassVar[dict] = {"servo": {"angle": "servo_angle"}}
 
     def __init__(self, params=None, turret=None):
         self.follow = FollowTarget(params)
