@@ -9,6 +9,7 @@ outputs and the event log.
 import rerun.blueprint as rrb
 
 from . import paths as P
+from .cameras import CAMERAS
 from .world3d import world3d_view
 
 __all__ = ["default_blueprint"]
@@ -30,11 +31,17 @@ def _trail_range():
     )
 
 
-def default_blueprint(bounds=None, shadow=False, world3d=False, sensors=(), frame_outputs=True):
+def default_blueprint(
+    bounds=None, shadow=False, world3d=False, sensors=(), frame_outputs=True, cameras=()
+):
     """The layout sent to the viewer; ``bounds`` ``(xmin, ymin, xmax, ymax)`` frame the map;
     ``shadow`` adds a second LED row and the shadow design's wheel speeds; ``world3d`` puts
     the world in 3D (``viz.world3d``) beside the map; ``sensors`` (series entity paths,
-    ``viz.sensors``) come first among the plots under the map, one tab each."""
+    ``viz.sensors``) come first among the plots under the map, one tab each; ``cameras``
+    (further cameras' names, ``viz.cameras``) get a panel each beside the camera's."""
+    further = [
+        rrb.Spatial2DView(origin=f"{CAMERAS}/{name}", name=f"Camera {name}") for name in cameras
+    ]
     map_kwargs = {}
     if bounds is not None:
         xmin, ymin, xmax, ymax = (float(v) for v in bounds)
@@ -53,7 +60,9 @@ def default_blueprint(bounds=None, shadow=False, world3d=False, sensors=(), fram
     )
     if not frame_outputs:
         board = rrb.Vertical(
-            rrb.Spatial2DView(origin=P.CAMERA_RAW, name="Camera"),
+            rrb.Horizontal(rrb.Spatial2DView(origin=P.CAMERA_RAW, name="Camera"), *further)
+            if further
+            else rrb.Spatial2DView(origin=P.CAMERA_RAW, name="Camera"),
             plots,
             row_shares=[4, 3],
             name="Board",
@@ -63,6 +72,7 @@ def default_blueprint(bounds=None, shadow=False, world3d=False, sensors=(), fram
         rrb.Horizontal(
             rrb.Spatial2DView(origin=P.CAMERA_RAW, name="Camera"),
             rrb.Spatial2DView(origin=P.CAMERA_FILTERED, name="Filtered (design output)"),
+            *further,
         ),
         rrb.Horizontal(
             rrb.Spatial2DView(origin=P.LEDS_PROXIMITY, name="Proximity LEDs"),
