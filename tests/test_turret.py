@@ -155,3 +155,17 @@ def test_a_camera_on_a_missing_servo_is_a_clear_error(tmp_path):
         run_scenario(load_scenario(write(tmp_path, text)), backend="model")
     with pytest.raises(ScenarioError, match="the real clock streams one camera"):
         load_scenario(write(tmp_path, TWO_CAMERAS), ["sim.timing=real_clock"])
+
+
+def test_the_cameras_benchmark_prints_both_runs_and_their_ratio(capsys, tmp_path):
+    import json
+
+    from fpga_robotics.bench.cameras import main
+
+    assert main(["--seconds", "0.5", "--repeats", "1", "--json", str(tmp_path / "c.json")]) == 0
+    out = capsys.readouterr().out
+    assert "one camera:" in out and "two cameras:" in out
+    figures = json.loads((tmp_path / "c.json").read_text())["figures"]
+    two, one = figures["two cameras"]["frame_ms"], figures["one camera"]["frame_ms"]
+    assert figures["ratio"] == pytest.approx(two["median"] / one["median"])
+    assert f"two cameras / one camera: {figures['ratio']:.2f}" in out

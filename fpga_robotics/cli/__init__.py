@@ -88,6 +88,7 @@ BENCHMARKS = {
     "ros": ("fpga_robotics.bench.ros", "writing a ROS 2 bag and publishing live to Foxglove"),
     "pins": ("fpga_robotics.bench.pins", "the pin backends in real-clock time (Mcycles/s)"),
     "sweep": ("fpga_robotics.bench.sweep", "campaign throughput on 1 worker and on N"),
+    "cameras": ("fpga_robotics.bench.cameras", "the closed loop with two cameras against one"),
     "calibrate": (
         "fpga_robotics.bench.calibrate",
         "this machine's calibration frame time: divide a time by it to compare",

@@ -1029,13 +1029,13 @@ def _connectors(world):
 def _resolve_timing(sim, camera, top, connectors, foreign):
     """``sim.timing = "auto"`` made definite; a design or connector with pins of its own
     needs real-clock timing."""
-    # Every design but the camera-only follow_target has pins of its own; further cameras
-    # and servos act once a frame, on a design with frame-level channels for them.
+    # Every design but the camera-only follow_target has pins of its own, unless it has
+    # frame-level channels for further cameras; cameras and servos act once a frame.
     frame_level = top in TOPS and bool(TOPS[top].frame_channels)
     pins = [
         f"the {c.kind} connector"
         for c in connectors
-        if not (frame_level and getattr(CONNECTORS[c.kind], "frame_level", False))
+        if not getattr(CONNECTORS[c.kind], "frame_level", False)
     ]
     if top != "follow_target" and not frame_level:
         pins.insert(0, f"design.top = {top!r}")
