@@ -7,6 +7,7 @@ import math
 
 import numpy as np
 import pytest
+from render3d_scenes import mujoco_missing
 
 from fpga_robotics.hw.errors import UsageError
 from fpga_robotics.loop.compressed import run_scenario
@@ -85,6 +86,15 @@ def test_two_cameras_see_their_targets_at_the_pinhole_columns(tmp_path):
     # Its first command: the P law on that column, -(5 * (34 - 80)) >> 2 = +57 (turn left).
     cx = int(t["turret.turret_centroid_x"][0])
     assert t["pan.command"][1] == -((5 * (cx - 80)) >> 2)
+
+
+@mujoco_missing
+def test_both_cameras_see_the_pinhole_columns_in_3d_too(tmp_path):
+    scenario = load_scenario(write(tmp_path, TWO_CAMERAS), ["camera.renderer=mujoco"])
+    t = run_scenario(scenario, backend="model").trajectory
+    f = 80 / math.tan(math.radians(30))
+    assert t["centroid_x"][0] == pytest.approx(80 - f * (-0.5 / 3.0), abs=2)
+    assert t["turret.turret_centroid_x"][0] == pytest.approx(80 - f * (1.0 / 3.0), abs=2)
 
 
 def test_the_servo_slews_at_its_speed_after_the_actuation_delay(tmp_path):
