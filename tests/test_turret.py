@@ -179,3 +179,47 @@ def test_the_cameras_benchmark_prints_both_runs_and_their_ratio(capsys, tmp_path
     two, one = figures["two cameras"]["frame_ms"], figures["one camera"]["frame_ms"]
     assert figures["ratio"] == pytest.approx(two["median"] / one["median"])
     assert f"two cameras / one camera: {figures['ratio']:.2f}" in out
+
+
+def test_the_bag_has_each_camera_once_per_capture(tmp_path):
+    from rosbags.highlevel import AnyReader
+    from rosbags.typesys import Stores, get_typestore
+
+    from fpga_robotics.ros.bag_writer import open_bag_writer
+
+    # The body camera at 10 fps, the pan camera at 5: its frames at 0, 0.2 and 0.4 s.
+    text = TWO_CAMERAS.replace("duration = 0.2", "duration = 0.6").replace(
+        "fps = 10.0\nhfov_deg", "fps = 5.0\nhfov_deg"
+    )
+    scenario = load_scenario(write(tmp_path, text))
+    bag = tmp_path / "bag"
+    writer = open_bag_writer(bag, scenario)
+    views = {}
+
+    def on_frame(record):
+        view = record.cameras["turret"]
+        views[round(view.sim_time * 1e9)] = view
+        writer.log_frame(record)
+
+    run_scenario(scenario, backend="model", on_frame=on_frame)
+    writer.close()
+    out = {}
+    with AnyReader([bag], default_typestore=get_typestore(Stores.ROS2_HUMBLE)) as reader:
+        for conn, stamp, raw in reader.messages():
+            out.setdefault(conn.topic, []).append((stamp, reader.deserialize(raw, conn.msgtype)))
+    images = out["/cameras/turret/image_raw"]
+    assert [stamp for stamp, _ in images] == [0, 200_000_000, 400_000_000] == sorted(views)
+    for stamp, msg in images:
+        assert msg.header.frame_id == "turret_link"
+        assert msg.data.tobytes() == views[stamp].rgb.tobytes()
+    info = out["/cameras/turret/camera_info"][0][1]
+    assert info.k[0] == pytest.approx(80 / math.tan(math.radians(30)))
+    placed = [
+        t.transform
+        for _, m in out["/tf"]
+        for t in m.transforms
+        if t.child_frame_id == "turret_link"
+    ]
+    first = placed[0].translation
+    assert (first.x, first.y, first.z) == pytest.approx((1.55, 3.0, 0.22))
+    assert len(out["/camera/image_raw"]) == 6  # the body camera's, as before
