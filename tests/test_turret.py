@@ -223,3 +223,25 @@ def test_the_bag_has_each_camera_once_per_capture(tmp_path):
     first = placed[0].translation
     assert (first.x, first.y, first.z) == pytest.approx((1.55, 3.0, 0.22))
     assert len(out["/camera/image_raw"]) == 6  # the body camera's, as before
+
+
+def test_the_turret_campaign_runs_the_design_and_catches_its_bug(tmp_path):
+    from fpga_robotics.sweep import load_campaign, run_campaign
+    from fpga_robotics.sweep.campaign import read_campaign_file
+
+    data = read_campaign_file("turret")
+    data = dict(data[0] if isinstance(data, tuple) else data)
+    data.update(seeds=[1], duration=4.0)
+    rows = run_campaign(load_campaign(data), tmp_path, workers=1, record="none")
+    by_set = {
+        row["design.variant"] if row.get("design.variant") else "default": row for row in rows
+    }
+    assert by_set["default"]["status"] == "pass"
+    bad = by_set["turret_pan_inverted"]
+    assert bad["status"] == "fail" and "camera_target_centred_min_fraction" in bad["failed_checks"]
+    direct = run_scenario(
+        load_scenario("turret", ["sim.duration=4.0", "design.variant=turret_pan_inverted"]),
+        seed=1,
+        backend="model",
+    ).summary
+    assert bad["camera_target_centred_fraction"] == direct["camera_target_centred_fraction"]
