@@ -11,6 +11,12 @@ channel's frame-level model). An output of the channel a servo is bound to (``an
 the wheel commands; the horn then slews at the servo's speed (sim/world/servo.py), one
 physics step at a time. Trajectory rows (one per body-camera frame) sample every camera's
 latest outputs and every servo's angle at the row's instant.
+
+In real-clock timing (``use_pins``) the design itself is the channel: each capture's pixels
+reach its port bundle spread over the frame period as the body camera's do
+(``sim.pins.timing.real_clock_timing``, scheduled edge by edge), and the servo hears its pin
+change at the very edge (the loop watches it), its command acting ``sim.actuation_delay``
+later.
 """
 
 import importlib
@@ -21,6 +27,7 @@ import numpy as np
 from fpga_robotics.hw.errors import UsageError
 from fpga_robotics.hw.pixel import color_select_value
 from fpga_robotics.loop.connectors import CONNECTORS, CameraConnector, in_view
+from fpga_robotics.sim.camera.frames import to_rgb444
 from fpga_robotics.sim.camera.scene import CameraPose
 from fpga_robotics.sim.records import CameraView, SensorReading
 
@@ -44,6 +51,7 @@ class RigCamera:
         self.next_step = 0
         self.outputs = {}
         self.view = None  # the latest CameraView
+        self.streaming_until = None  # real-clock timing: the edge after its frame's last pixel
 
     def pose(self, world):
         """The camera's pose now: the body's pose, the servo's mount and angle if it is on
@@ -71,7 +79,20 @@ class CameraRig:
         self.dt, self.delay_steps = dt, delay
         self.people = people  # names of the scenario's people
         self.columns = {}
-        self.samples = []  # per row: {camera: (in_view, bearing_deg or nan)}
+        self.pins = None  # real-clock timing: the design on its pin backend (use_pins)
+
+    def use_pins(self, pins, clock_hz):
+        """Real-clock timing: stream the captures into ``pins`` (a ``PinBackend``) on a
+        ``clock_hz`` clock instead of the channels' models."""
+        self.pins, self.clock_hz = pins, clock_hz
+
+    def driven_ports(self):
+        """The design inputs the cameras drive (their port bundles)."""
+        ports = set()
+        for cam in self.cameras:
+            if cam.port:
+                ports |= {f"{cam.port}__valid", f"{cam.port}__payload", cam.color_port}
+        return ports
 
     @classmethod
     def build(cls, scenario, world, seed, top):
@@ -112,7 +133,10 @@ class CameraRig:
     def _capture(self, cam, step, world):
         pose = cam.pose(world)
         rgb = cam.connector.capture(world.scene(), pose)
-        if cam.channel is not None:
+        if self.pins is not None:
+            if cam.channel is not None:
+                self._stream(cam, rgb)
+        elif cam.channel is not None:
             cam.outputs = cam.channel.process(rgb, cam.color_code)
             for servo in self.servos.values():
                 if servo.port in cam.outputs:
@@ -130,6 +154,34 @@ class CameraRig:
         )
         cam.frames += 1
         cam.next_step = round(cam.frames * cam.params.frame_period / self.dt)
+
+    def _stream(self, cam, rgb):
+        """The frame's pixels on the camera's port bundle, one scheduled beat each, from the
+        next edge on, as an OV7670 spreads them over the frame period."""
+        from fpga_robotics.sim.pins.timing import real_clock_timing
+
+        p, pins = cam.params, self.pins
+        if cam.streaming_until is not None and cam.streaming_until > pins.cycle:
+            raise UsageError(
+                f"camera {cam.name!r}: a frame is still streaming when the next is captured; "
+                "lower its fps or raise sim.clock_hz"
+            )
+        timing = real_clock_timing(p.width, p.height, p.fps, self.clock_hz, pins.cycle + 1)
+        packed = to_rgb444(rgb, p.width, p.height).astype(np.int64)
+        packed[0, 0] |= 1 << 12  # first
+        packed[:, -1] |= 1 << 13  # last (of each line)
+        valid, payload = f"{cam.port}__valid", f"{cam.port}__payload"
+        pins.poke(cam.color_port, cam.color_code)
+        gap = timing.pixel_period > 1
+        for y in range(p.height):
+            row = packed[y].tolist()
+            for x in range(p.width):
+                edge = timing.edge_of(y, x)
+                pins.schedule(edge, payload, row[x])
+                pins.schedule(edge, valid, 1)
+                if gap or x == p.width - 1:
+                    pins.schedule(edge + 1, valid, 0)
+        cam.streaming_until = timing.last_edge(p.width, p.height) + 1
 
     def after_step(self, dt):
         for servo in self.servos.values():
@@ -150,6 +202,9 @@ class CameraRig:
                 put(f"{name}.{key}", value)
         people = {p.name: p for p in world.people_states()}
         for cam in self.cameras:
+            if self.pins is not None and cam.channel is not None:  # the design's ports now
+                ports = [*cam.channel.view_ports, *(s.port for s in self.servos.values())]
+                cam.outputs = {port: self.pins.peek(port) for port in ports if port}
             for port, value in cam.outputs.items():
                 put(f"{cam.name}.{port}", value)
             target = people.get(cam.params.target)

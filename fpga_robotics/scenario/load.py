@@ -1059,11 +1059,6 @@ def _resolve_timing(sim, camera, top, connectors, foreign):
             f'sim.timing = "compressed" runs the design only while pixels '
             f'flow; {pins[0]} needs sim.timing = "real_clock" (or "auto")'
         )
-    if timing == "real_clock" and any(c.kind in ("camera", "servo") for c in connectors):
-        raise ScenarioError(
-            "cameras and servos in [[robot.sensors]]/[[robot.actuators]] run in "
-            'sim.timing = "compressed" (or "auto"); the real clock streams one camera'
-        )
     delay = sim.actuation_delay
     if delay is None:
         delay = REAL_CLOCK_ACTUATION_DELAY if timing == "real_clock" else camera.frame_period
