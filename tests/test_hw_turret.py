@@ -100,3 +100,27 @@ def test_turret_tracker_exports_with_both_channels():
         assert port in text
     assert "input [13:0] turret_pixels__payload" in text
     assert "output [9:0] servo_angle" in text
+
+
+def test_export_writes_turret_tracker_and_its_variant(tmp_path, capsys):
+    import os
+
+    import pytest
+
+    from fpga_robotics.cli.errors import run_cli
+    from fpga_robotics.cli.export import main
+
+    def export(argv, name):
+        with pytest.raises(SystemExit) as exit_info:
+            run_cli(main, ["-o", str(tmp_path / name), "--top", "turret_tracker", *argv])
+        return exit_info.value.code
+
+    assert export([], "plain.v") == 0
+    assert export(["--variant", "turret_pan_inverted"], "inverted.v") == 0
+    plain, inverted = ((tmp_path / n).read_text() for n in ("plain.v", "inverted.v"))
+    assert "module turret_tracker" in plain and plain != inverted
+    capsys.readouterr()
+    assert export(["--variant", "us_echo_inverted"], "bad.v") == 2
+    err = capsys.readouterr().err
+    assert "no variant of --top turret_tracker; known variants: turret_pan_inverted" in err
+    assert sorted(os.listdir(tmp_path)) == ["inverted.v", "plain.v"]

@@ -152,8 +152,10 @@ def test_the_viewer_shows_each_camera_and_its_view_on_the_map(tmp_path):
     rec.close()
     data = read_rrd(str(path))
     n = result.summary["frames"]
-    images = [e for name, e in data.entities.items() if name.startswith(f"{CAMERAS}/turret")]
-    assert images and images[0].frames == list(range(n))
+    assert data.entities[f"{CAMERAS}/turret/image"].frames == list(range(n))
+    # Its pinhole in the world: the 3D view shows the image on its frustum.
+    placed = data.entities[f"{CAMERAS}/turret"].values["Transform3D:translation"][0][0]
+    assert placed == pytest.approx((1.55, 3.0, 0.22))
     fov = data.entities[f"{MAP_CAMERAS}/turret"]
     _, (x, y), _ = fov.values["LineStrips2D:strips"][0][0]
     assert (x, -y) == pytest.approx((1.55, 3.0))  # the pan camera's place, y flipped back

@@ -40,7 +40,8 @@ def default_blueprint(
     ``viz.sensors``) come first among the plots under the map, one tab each; ``cameras``
     (further cameras' names, ``viz.cameras``) get a panel each beside the camera's."""
     further = [
-        rrb.Spatial2DView(origin=f"{CAMERAS}/{name}", name=f"Camera {name}") for name in cameras
+        rrb.Spatial2DView(origin=f"{CAMERAS}/{name}/image", name=f"Camera {name}")
+        for name in cameras
     ]
     map_kwargs = {}
     if bounds is not None:

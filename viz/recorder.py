@@ -380,6 +380,8 @@ class Recorder:
                 images=frame % self.log_every == 0,
                 jpeg_quality=self.jpeg_quality,
                 reach=self._ray,
+                frame=frame,
+                t=t,
             )
         if len(self._sensors.series) != self._sensor_series:
             self._layout_stale = True
