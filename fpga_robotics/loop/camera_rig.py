@@ -109,7 +109,8 @@ class CameraRig:
                 rng=np.random.default_rng([seed, _SERVO_STREAM, i]),
             )
             servo.configure(scenario.sim.physics_dt, scenario.sim.actuation_delay)
-            servo.port = spec.ports.get("angle") or top.bindings.get("servo", {}).get("angle")
+            bound = top.bindings.get("servo", {}) if top is not None else {}
+            servo.port = spec.ports.get("angle") or bound.get("angle")
             servos[spec.name] = servo
         people = [p.name for p in world.people_states()]
         cameras = [
@@ -285,11 +286,13 @@ def _camera(scenario, spec, index, seed, top, servos, people):
     port = spec.ports.get("pixels")
     channel = color_port = None
     if port is not None:
-        where_to = top.frame_channels.get(port)
+        channels = top.frame_channels if top is not None else {}
+        where_to = channels.get(port)
         if where_to is None:
+            name = top.name if top is not None else scenario.top
             raise UsageError(
-                f"{where}: design {top.name!r} has no frame channel on pixels = {port!r}; "
-                f"its channels: {', '.join(top.frame_channels) or 'none'}"
+                f"{where}: design {name!r} has no frame channel on pixels = {port!r}; "
+                f"its channels: {', '.join(channels) or 'none'}"
             )
         module, name = where_to
         channel = getattr(importlib.import_module(module), name)(scenario.design_tables)

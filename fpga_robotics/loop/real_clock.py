@@ -217,6 +217,7 @@ class RealClockLoop(ClosedLoop):
         if self.rig is not None:  # the rig streams its cameras; its servos hear their pins
             self.rig.use_pins(design, self.clock_hz)
             for servo in self.rig.servos.values():
+                servo.port = servo.port or self.top.bindings.get("servo", {}).get("angle")
                 if servo.port is not None:
                     self.io[servo] = PinIO(design, {"angle": servo.port}, self.clock_hz)
                     self.watched[servo.port] = (servo, "angle")
