@@ -4,6 +4,8 @@ target centred while the body turns (and its seeded bug fails the named check), 
 shows each camera."""
 
 import math
+import re
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -267,3 +269,26 @@ def test_real_clock_streams_the_pan_camera_and_agrees_on_the_first_frame(tmp_pat
     # turned by whole steps of 2.5 degrees (600 deg/s at 240 steps a second) by row 1.
     assert t["pan.angle_deg"][1] / 2.5 == pytest.approx(round(t["pan.angle_deg"][1] / 2.5))
     assert 0 < t["pan.angle_deg"][1] <= 2.5 * round((0.1 - 0.094) * 240 + 1)
+
+
+@pytest.mark.parametrize(
+    "old, new, message",
+    [
+        (
+            'resolution = "160x120"\nfps = 15.0\nhfov_deg',
+            'resolution = "160by120"\nfps = 15.0\nhfov_deg',
+            "robot.sensors[0].resolution must look like WIDTHxHEIGHT",
+        ),
+        ('color = "blue"', 'color = "purple"', "robot.sensors[0].color must be one of"),
+        ("centred_deg = 10.0", "centred = 10.0", "unknown key 'centred' for a 'camera' connector"),
+        ("speed_deg_s = 600.0", "speed_deg_s = 0.0", "robot.actuators[0].speed_deg_s must be"),
+        ("speed_deg_s = 600.0", "range = 90", "unknown key 'range' for a 'servo' connector"),
+    ],
+)
+def test_bad_camera_and_servo_keys_are_named(tmp_path, old, new, message):
+    from fpga_robotics.scenario.load import ScenarioError, shipped_scenarios
+
+    text = Path(shipped_scenarios()["turret"][0]).read_text()
+    assert old in text
+    with pytest.raises(ScenarioError, match=re.escape(message)):
+        load_scenario(write(tmp_path, text.replace(old, new)))
