@@ -292,3 +292,34 @@ def test_bad_camera_and_servo_keys_are_named(tmp_path, old, new, message):
     assert old in text
     with pytest.raises(ScenarioError, match=re.escape(message)):
         load_scenario(write(tmp_path, text.replace(old, new)))
+
+
+def test_any_number_of_cameras_each_on_its_own_mount(tmp_path):
+    # A third camera on the body, looking left (yaw 90 degrees), filming only, watching blue:
+    # from (1.5, 3.0) the blue person at (4.55, 4.0) is atan2(1.0, 3.05) - 90 = -71.8 degrees
+    # off its axis, outside its 60 degrees.
+    side = """
+[[robot.sensors]]
+kind = "camera"
+name = "side"
+yaw_deg = 90.0
+height = 0.15
+resolution = "80x60"
+fps = 5.0
+target = "blue"
+"""
+    text = TWO_CAMERAS.replace("[[people]]", side + "[[people]]", 1)
+    records = []
+    result = run_scenario(
+        load_scenario(write(tmp_path, text)), backend="model", on_frame=records.append
+    )
+    t = result.trajectory
+    expected = math.degrees(math.atan2(1.0, 3.05)) - 90
+    assert t["side.target_bearing_deg"][0] == pytest.approx(expected)
+    assert t["side.target_in_view"][0] == 0
+    assert t["turret.target_in_view"][0] == 1  # the pan camera sees blue at the same instant
+    assert set(records[0].cameras) == {"turret", "side"}
+    assert records[0].cameras["side"].rgb.shape == (60, 80, 3)
+    cams = result.summary["cameras"]
+    assert (cams["side"]["channel"], cams["turret"]["channel"]) == (None, "model")
+    assert cams["side"]["frames"] == 1 and cams["turret"]["frames"] == 2  # 5 and 10 fps, 0.2 s

@@ -80,6 +80,7 @@ class CameraRig:
         self.people = people  # names of the scenario's people
         self.columns = {}
         self.pins = None  # real-clock timing: the design on its pin backend (use_pins)
+        self.end_step = math.inf  # the run's last physics step (no capture at or after it)
 
     def use_pins(self, pins, clock_hz):
         """Real-clock timing: stream the captures into ``pins`` (a ``PinBackend``) on a
@@ -118,7 +119,9 @@ class CameraRig:
             for i, spec in enumerate(s for s in specs if s.kind == "camera")
         ]
         delay = round(scenario.sim.actuation_delay / scenario.sim.physics_dt)
-        return cls(cameras, servos, scenario.sim.physics_dt, delay, people)
+        rig = cls(cameras, servos, scenario.sim.physics_dt, delay, people)
+        rig.end_step = max(1, round(scenario.sim.duration / scenario.sim.physics_dt))
+        return rig
 
     # The physics steps ---------------------------------------------------------------------
 
@@ -128,7 +131,7 @@ class CameraRig:
         for servo in self.servos.values():
             servo.apply_due(step)
         for cam in self.cameras:
-            if cam.next_step == step:
+            if cam.next_step == step < self.end_step:  # as the body camera: inside the run
                 self._capture(cam, step, world)
 
     def _capture(self, cam, step, world):
@@ -243,6 +246,13 @@ class CameraRig:
             centred = np.abs(bearing) <= cam.params.centred_deg
             per[cam.name] = {
                 "frames": cam.frames,
+                # What ran its design channel: the channel's model (compressed timing) or the
+                # design on the pin backend (real clock); none for a camera that only films.
+                "channel": None
+                if cam.channel is None
+                else "model"
+                if self.pins is None
+                else "design",
                 "target_in_view_fraction": round(float(np.mean(seen == 1.0)), 4) if rows else None,
                 "target_centred_fraction": round(float(np.mean(centred)), 4) if rows else None,
                 "max_abs_bearing_deg": round(float(np.nanmax(np.abs(bearing))), 2)
