@@ -12,6 +12,7 @@ from dataclasses import dataclass
 from .errors import ParamError
 from .lidar_params import CorridorParams
 from .sensor_params import FollowLineParams, InterlockParams, UltrasoundParams
+from .turret_params import TurretParams
 
 __all__ = ["VARIANTS", "Variant", "variant_params"]
 
@@ -85,6 +86,16 @@ VARIANTS = {
             "the right looks like one on the left",
             fails="corridor: no contact with the walls (max_wall_collisions): the robot steers "
             "towards the nearer wall instead of away from it",
+        ),
+        Variant(
+            name="turret_pan_inverted",
+            design="turret_tracker",
+            params_type=TurretParams,
+            changes=lambda p: {"inverted": True},
+            bug="the pan law's sign is flipped: a target right of the image centre turns the "
+            "camera left, away from it",
+            fails="turret: the pan camera's target centred (camera_target_centred_min_fraction): "
+            "the camera turns away until the target leaves its view or the servo its range",
         ),
     )
 }

@@ -11,7 +11,7 @@ import numpy as np
 
 from .backends.base import FrameResult
 
-__all__ = ["FrameRecord", "PersonState", "SensorReading", "WorldMap"]
+__all__ = ["CameraView", "FrameRecord", "PersonState", "SensorReading", "WorldMap"]
 
 
 @dataclass(frozen=True)
@@ -72,6 +72,9 @@ class FrameRecord:
     # distance_mm, obstacle, line_seen).
     sensors: dict = field(default_factory=dict)
     design_extra: dict = field(default_factory=dict)
+    # Further cameras ([[robot.sensors]] kind = "camera"): {name: CameraView}, each its
+    # latest capture at this frame's instant.
+    cameras: dict = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -90,3 +93,17 @@ class SensorReading:
     height: float = 0.0
     #: A LIDAR's last whole revolution (``sim.world.lidar.Revolution``), None for others.
     scan: object = None
+
+
+@dataclass(frozen=True, eq=False)
+class CameraView:
+    """A further camera's latest capture for the viewer: the image, where it was taken
+    (``CameraPose``), its field of view (rad), when (s), and what the design's channel on it
+    made of it (``found``, ``centroid_x``; None when the channel has no such output)."""
+
+    rgb: np.ndarray
+    pose: object
+    hfov: float
+    sim_time: float
+    found: bool | None = None
+    centroid_x: int | None = None

@@ -73,6 +73,8 @@ JUDGEABLE = {
     "turn_law_violation_fraction": 0.1,
     "search_law_violation_fraction": 0.1,
     "envelope_reason": None,
+    "camera_target_in_view_fraction": 0.9,
+    "camera_target_centred_fraction": 0.8,
 }
 
 _IN_VIEW = "the target was never found"
@@ -180,6 +182,18 @@ JUDGED_IF = {
         0.09,
         {"search_law_violation_fraction": None},
         "the target was never lost",
+    ),
+    "camera_target_in_view_min_fraction": (
+        0.9,
+        0.91,
+        {"camera_target_in_view_fraction": None},
+        "no further camera has a target",
+    ),
+    "camera_target_centred_min_fraction": (
+        0.8,
+        0.81,
+        {"camera_target_centred_fraction": None},
+        "no further camera has a target",
     ),
 }
 #: Checks that always judge: name -> (a limit the JUDGEABLE run passes, one it fails).

@@ -320,6 +320,14 @@ FIGURES = (
         _pysim_in_calibrations,
         "a pysim frame's CPU time, in calibrations",
     ),
+    Figure(
+        "docs/turret.md",
+        "1.18",
+        "0.3",
+        "cameras --repeats 5",
+        lambda data: data["figures"]["cpu_ratio"],
+        "turret: the two-camera loop's CPU time a frame over the one-camera loop's",
+    ),
 )
 
 

@@ -9,6 +9,7 @@ outputs and the event log.
 import rerun.blueprint as rrb
 
 from . import paths as P
+from .cameras import CAMERAS
 from .world3d import world3d_view
 
 __all__ = ["default_blueprint"]
@@ -37,13 +38,24 @@ _CAMERA_NAMES = {
 
 
 def default_blueprint(
-    bounds=None, shadow=False, world3d=False, sensors=(), frame_outputs=True, camera="rgb444"
+    bounds=None,
+    shadow=False,
+    world3d=False,
+    sensors=(),
+    frame_outputs=True,
+    camera="rgb444",
+    cameras=(),
 ):
     """The layout sent to the viewer; ``bounds`` ``(xmin, ymin, xmax, ymax)`` frame the map;
     ``camera`` (``rgb444`` or ``rgb888``, how the camera frame is recorded) names its view;
     ``shadow`` adds a second LED row and the shadow design's wheel speeds; ``world3d`` puts
     the world in 3D (``viz.world3d``) beside the map; ``sensors`` (series entity paths,
-    ``viz.sensors``) come first among the plots under the map, one tab each."""
+    ``viz.sensors``) come first among the plots under the map, one tab each; ``cameras``
+    (further cameras' names, ``viz.cameras``) get a panel each beside the camera's."""
+    further = [
+        rrb.Spatial2DView(origin=f"{CAMERAS}/{name}/image", name=f"Camera {name}")
+        for name in cameras
+    ]
     map_kwargs = {}
     if bounds is not None:
         xmin, ymin, xmax, ymax = (float(v) for v in bounds)
@@ -62,7 +74,11 @@ def default_blueprint(
     )
     if not frame_outputs:
         board = rrb.Vertical(
-            rrb.Spatial2DView(origin=P.CAMERA_RAW, name=_CAMERA_NAMES[camera]),
+            rrb.Horizontal(
+                rrb.Spatial2DView(origin=P.CAMERA_RAW, name=_CAMERA_NAMES[camera]), *further
+            )
+            if further
+            else rrb.Spatial2DView(origin=P.CAMERA_RAW, name=_CAMERA_NAMES[camera]),
             plots,
             row_shares=[4, 3],
             name="Board",
@@ -72,6 +88,7 @@ def default_blueprint(
         rrb.Horizontal(
             rrb.Spatial2DView(origin=P.CAMERA_RAW, name=_CAMERA_NAMES[camera]),
             rrb.Spatial2DView(origin=P.CAMERA_FILTERED, name="Filtered (design output)"),
+            *further,
         ),
         rrb.Horizontal(
             rrb.Spatial2DView(origin=P.LEDS_PROXIMITY, name="Proximity LEDs"),

@@ -26,6 +26,7 @@ import rerun as rr
 
 from . import paths as P
 from .blueprint import default_blueprint
+from .cameras import CameraPanels
 from .columns import (
     FILE_ONLY,
     MAX_SECONDS,
@@ -186,6 +187,7 @@ class Recorder:
         self._world3d = None  # viz.world3d.World3D, made at the first record with a scene
         self._layout_stale = False  # the layout sent lacks a view that is now needed
         self._sensor_series = 0  # sensor series in the layout sent (viz.sensors)
+        self._camera_panels = 0  # further cameras in the layout sent (viz.cameras)
         # Whether the design has a filtered image or LEDs (follow_line has neither): the
         # first frame tells.
         self._frame_outputs = True
@@ -200,6 +202,7 @@ class Recorder:
                 stream, _COLUMN_BUILDERS, self._guard, max_frames=frames, max_seconds=seconds
             )
             self._sensors = SensorViews(stream, self._columns)
+            self._cameras = CameraPanels(stream, self._columns)
             # Never closed (dropped, or open at exit): the file still gets its real name.
             self._abandoned = weakref.finalize(
                 self, _close_abandoned, self._columns, output, stream
@@ -266,9 +269,11 @@ class Recorder:
                     sensors=tuple(self._sensors.series),
                     frame_outputs=self._frame_outputs,
                     camera=self.camera,
+                    cameras=tuple(self._cameras.names),
                 )
             )
         self._sensor_series = len(self._sensors.series)
+        self._camera_panels = len(self._cameras.names)
         self._layout_stale = False
         self._blueprint_sent = True
 
@@ -388,7 +393,18 @@ class Recorder:
         self._add_map(record, add)
         with self._guard:
             self._sensors.log(record, add)
+            self._cameras.log(
+                record,
+                add,
+                images=frame % self.log_every == 0,
+                jpeg_quality=self.jpeg_quality,
+                reach=self._ray,
+                frame=frame,
+                t=t,
+            )
         if len(self._sensors.series) != self._sensor_series:
+            self._layout_stale = True
+        if len(self._cameras.names) != self._camera_panels:
             self._layout_stale = True
         if self._world3d is not None and record.scene is not None:
             with self._guard:

@@ -123,7 +123,8 @@ def world3d_view(bounds=None):
     return rrb.Spatial3DView(
         origin="/",
         name="World (3D)",
-        contents=[f"+ /{WORLD3D}/**", f"+ /{CAMERA}", f"+ /{P.CAMERA_RAW}"],
+        # Further cameras (viz.cameras): each pinhole with its image, at cameras/<name>.
+        contents=[f"+ /{WORLD3D}/**", f"+ /{CAMERA}", f"+ /{P.CAMERA_RAW}", "+ /cameras/**"],
         eye_controls=eye,
     )
 

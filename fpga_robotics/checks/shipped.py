@@ -494,4 +494,30 @@ SHIPPED_CHECKS = (
         outputs=_WHEELS,
         precondition=_envelope("search_law_violation_fraction", "the target was never lost"),
     ),
+    Check(
+        "camera_target_in_view_min_fraction",
+        "camera_target_in_view_fraction",
+        "min",
+        (
+            "every further camera with a target ([[robot.sensors]] camera, target = ...) has "
+            "its target in view this often (the least of them)"
+        ),
+        lambda v, limit, m: f"a camera's target in view {v:.0%} of frames (limit >= {limit:.0%})",
+        limits=_FRACTION,
+        precondition=measured("camera_target_in_view_fraction", "no further camera has a target"),
+    ),
+    Check(
+        "camera_target_centred_min_fraction",
+        "camera_target_centred_fraction",
+        "min",
+        (
+            "every further camera with a target has it within its centred_deg of the axis "
+            "this often (the least of them): a pan camera keeps its target centred"
+        ),
+        lambda v, limit, m: (
+            f"a camera's target centred in {v:.0%} of frames (limit >= {limit:.0%})"
+        ),
+        limits=_FRACTION,
+        precondition=measured("camera_target_centred_fraction", "no further camera has a target"),
+    ),
 )

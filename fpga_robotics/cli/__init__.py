@@ -92,6 +92,7 @@ BENCHMARKS = {
         "fpga_robotics.bench.lidar",
         "a LIDAR revolution against a camera frame; the UART binding's cycles per second",
     ),
+    "cameras": ("fpga_robotics.bench.cameras", "the closed loop with two cameras against one"),
     "calibrate": (
         "fpga_robotics.bench.calibrate",
         "this machine's calibration frame time: divide a time by it to compare",

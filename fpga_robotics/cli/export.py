@@ -139,6 +139,11 @@ def _sensor_top(args, params):
             f"keep {corridor.keep_mm} mm, stop {corridor.stop_mm} mm, {uart.baud} baud at "
             f"{uart.clock_hz} Hz{variant}"
         )
+    if args.top == "turret_tracker":
+        from fpga_robotics.hw.turret_tracker import TurretTracker
+
+        text = generate_top_verilog(TurretTracker(params, _turret_params(args)), args.top)
+        return text, f"{_follow_target_text(args, params)}, pan camera on a servo{variant}"
     if args.top == "follow_line":
         line = sensor_params_from_args(args, "line", args.top)
         sensors = f"{line.n_sensors} sensor{'s' if line.n_sensors > 1 else ''}"
@@ -150,6 +155,22 @@ def _sensor_top(args, params):
         f"{_follow_target_text(args, params)}, {us.clock_hz} Hz, stop "
         f"{interlock.stop_mm} mm, resume {interlock.resume_mm} mm{variant}"
     )
+
+
+def _turret_params(args):
+    """The turret channel's parameters: the defaults, or a seeded bug of ``turret_tracker``."""
+    from fpga_robotics.hw.turret_params import TurretParams
+    from fpga_robotics.hw.variants import VARIANTS, variant_params
+
+    if args.variant is None:
+        return TurretParams()
+    if args.variant not in VARIANTS or VARIANTS[args.variant].design != args.top:
+        names = [n for n, v in VARIANTS.items() if v.design == args.top]
+        raise UsageError(
+            f"--variant {args.variant!r} is no variant of --top {args.top}; known variants: "
+            f"{', '.join(names)}"
+        )
+    return variant_params(args.variant)
 
 
 def _check_options_fit_the_top(args):

@@ -45,6 +45,9 @@ class Top:
     component: object = ("fpga_robotics.hw.top", "FollowTarget")
     #: Whether the FollowTarget params (``[design]`` keys) are the first argument.
     takes_follow_target_params: bool = True
+    #: Compressed timing: pixel port bundle of a further camera -> (module, class) of the
+    #: frame-level model of the design's channel on it (``loop/camera_rig.py``).
+    frame_channels: dict = field(default_factory=dict)
 
 
 _CAMERA = {"camera": {"pixels": "pixels", "color_sel": "color_sel"}}
@@ -94,6 +97,15 @@ TOPS = {
         },
         component=("fpga_robotics.hw.corridor_follow_uart", "CorridorFollowUart"),
         takes_follow_target_params=False,
+    ),
+    "turret_tracker": Top(
+        "turret_tracker",
+        "TurretTracker: FollowTarget, and a pan camera on a servo that keeps a second target centred",
+        camera=True,
+        tables={"turret": ("fpga_robotics.hw.turret_params", "TurretParams")},
+        component=("fpga_robotics.hw.turret_tracker", "TurretTracker"),
+        bindings={"servo": {"angle": "servo_angle"}},
+        frame_channels={"turret_pixels": ("fpga_robotics.sim.models.turret", "TurretChannel")},
     ),
 }
 

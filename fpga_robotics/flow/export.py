@@ -9,7 +9,14 @@ from fpga_robotics.hw.verilog import TOP_NAME, generate_verilog, verilog_ports
 __all__ = ["TOPS", "generate_top_verilog", "generate_verilog"]
 
 #: The designs ``--top`` exports; each is also its Verilog module's name.
-TOPS = (TOP_NAME, "follow_target_safe", "follow_line", "corridor_follow", "corridor_follow_uart")
+TOPS = (
+    TOP_NAME,
+    "follow_target_safe",
+    "follow_line",
+    "corridor_follow",
+    "corridor_follow_uart",
+    "turret_tracker",
+)
 
 
 def generate_top_verilog(component, name):

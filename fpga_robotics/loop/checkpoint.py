@@ -33,6 +33,8 @@ STATE = (
     "color",
     "scheduled_color",
     "color_code",
+    # Further cameras and servos (loop/camera_rig.py), with their channels' state.
+    "rig",
 )
 
 
@@ -53,6 +55,8 @@ def _never_changing(loop):
     """Objects of the state that no step changes, shared rather than copied: the renderer,
     and the terrain maps with their (frozen) patches, which the world compares by identity."""
     shared = [loop.camera.renderer]
+    if loop.rig is not None:
+        shared += [cam.connector.renderer for cam in loop.rig.cameras]
     for terrain in (loop.world.terrain, loop.world._painted):
         shared += [terrain, *terrain.patches]
     return shared

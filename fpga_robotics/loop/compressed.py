@@ -19,7 +19,9 @@ import numpy as np
 from fpga_robotics.checks.envelopes import envelope_geometry, envelope_metrics
 from fpga_robotics.checks.sensor_metrics import obstacle_metrics
 from fpga_robotics.checks.summary import DESIGN_OUTPUTS, compute_metrics, evaluate_checks, verdict
+from fpga_robotics.designs.builtin import TOPS
 from fpga_robotics.hw.pixel import color_select_value
+from fpga_robotics.loop.camera_rig import CameraRig
 from fpga_robotics.loop.connectors import CameraConnector, MotorConnector, in_view
 from fpga_robotics.loop.connectors.camera import ExposureDrift, make_sensor
 from fpga_robotics.loop.shadow import ShadowComparison, divergence_event
@@ -194,6 +196,9 @@ class ClosedLoop:
         # A second design on the same frames, never driving the robot (fpga_robotics.loop.shadow).
         self.shadow = shadow
         self.comparison = ShadowComparison(shadow_label) if shadow is not None else None
+        # Further cameras and pan servos ([[robot.sensors]] cameras, [[robot.actuators]]
+        # servos); None without any, and then nothing below changes.
+        self.rig = CameraRig.build(scenario, self.world, self.seed, TOPS.get(scenario.top))
 
     def _build_camera(self, cam, spec):
         """The camera on the robot; mount values the scenario leaves unset are the robot's."""
@@ -233,11 +238,18 @@ class ClosedLoop:
 
     def advance_physics(self, to_step):
         """Step the world up to ``to_step``, applying each motor command when it is due."""
+        rig = self.rig
         while self.step < to_step:
             self.motors.apply_due(self.step)
+            if rig is not None:
+                rig.before_step(self.step, self.world)
             self.world.step(self.dt)
+            if rig is not None:
+                rig.after_step(self.dt)
             self.step += 1
         self.motors.apply_due(self.step)  # commands that take effect at this very instant
+        if rig is not None:  # captures at this very instant, before the row samples them
+            rig.before_step(self.step, self.world)
 
     def capture(self, t):
         """The camera image at time ``t``, with the events since the last frame."""
@@ -372,10 +384,15 @@ class ClosedLoop:
         # A command that acts at once (no actuation delay) may tip the robot: this frame's.
         events += self.world.drain_events()
         distance, visible = self.measure(k, t, pose, result)
+        extra = {}
+        if self.rig is not None:
+            self.rig.sample(k, self.n_frames, self.world)
+            if self.want_records:
+                extra = {"cameras": self.rig.views(), "sensors": self.rig.readings(self.world)}
         self.events += [(k, round(t, 6), e) for e in events]
         self.frames_done = k + 1
         if self.want_records:
-            self.record(k, t, rgb, result, distance, visible, events, shadow_result)
+            self.record(k, t, rgb, result, distance, visible, events, shadow_result, **extra)
 
     def tipped_over(self):
         """Whether the robot has tipped over; if so the run ends (``ended_early``)."""
@@ -419,6 +436,8 @@ class ClosedLoop:
     def finish_run(self, wall_start, cpu_start):
         """The ``RunResult`` once the frames and the physics after them are done."""
         self.after_frames()
+        if self.rig is not None:  # "<servo>.angle_deg", "<camera>.turret_found" ...
+            self.traj.update(self.rig.columns)
         if self.ended_early is not None:  # the trajectory holds the frames done, every field alike
             self.traj = {name: a[: self.frames_done] for name, a in self.traj.items()}
         for name in self.absent:
@@ -437,9 +456,11 @@ class ClosedLoop:
         left (fpga_robotics.checks.sensor_metrics), and the behaviour envelopes
         (fpga_robotics.checks.envelopes)."""
         geometry = envelope_geometry(self.scenario, self.world.config, self.camera)
+        rig = self.rig.metrics(self.frames_done) if self.rig is not None else {}
         return {
             **obstacle_metrics(self.traj, self.events),
             **envelope_metrics(self.traj, self.scenario.params, geometry),
+            **rig,
         }
 
     def timing_summary(self, wall):

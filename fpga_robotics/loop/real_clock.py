@@ -135,6 +135,7 @@ class _PendingRow:
     """Trajectory row ``k`` between its capture and the end of its frame's processing."""
 
     __slots__ = (
+        "cameras",
         "distance",
         "edge",
         "events",
@@ -155,6 +156,7 @@ class _PendingRow:
         self.outputs = None  # the per-frame outputs, at the frame strobe
         self.filtered = None
         self.viewer_events = []  # events already in the run's list at their exact time
+        self.cameras = {}  # further cameras' latest captures (loop/camera_rig.py)
 
 
 class RealClockLoop(ClosedLoop):
@@ -188,6 +190,8 @@ class RealClockLoop(ClosedLoop):
         self.clock_hz = scenario.sim.clock_hz
         self.pins = design
         self.motors.configure_real_clock(self.dt, scenario.sim.actuation_delay)
+        # Further cameras and servos are the rig's (loop/camera_rig.py); the rest are here.
+        connectors = [c for c in scenario.connectors if c.kind not in ("camera", "servo")]
         self.sensors = [
             CONNECTORS[spec.kind](
                 spec.name,
@@ -196,9 +200,9 @@ class RealClockLoop(ClosedLoop):
                 world=self.world,
                 rng=np.random.default_rng([self.seed, _CONNECTOR_STREAM, i]),
             )
-            for i, spec in enumerate(scenario.connectors)
+            for i, spec in enumerate(connectors)
         ]
-        specs = {c.name: s for c, s in zip(self.sensors, scenario.connectors)}
+        specs = {c.name: s for c, s in zip(self.sensors, connectors)}
         self.io = {}  # connector -> PinIO
         self.watched = {}  # design port -> (connector or None, pin)
         # A design without wheel outputs leaves the robot standing: the motors get no pins.
@@ -210,6 +214,13 @@ class RealClockLoop(ClosedLoop):
             self.io[conn] = PinIO(design, self._checked(conn, binding), self.clock_hz)
             for pin in conn.watch:
                 self.watched[self.io[conn].binding[pin]] = (conn, pin)
+        if self.rig is not None:  # the rig streams its cameras; its servos hear their pins
+            self.rig.use_pins(design, self.clock_hz)
+            for servo in self.rig.servos.values():
+                servo.port = servo.port or self.top.bindings.get("servo", {}).get("angle")
+                if servo.port is not None:
+                    self.io[servo] = PinIO(design, {"angle": servo.port}, self.clock_hz)
+                    self.watched[servo.port] = (servo, "angle")
         self._check_inputs_driven()
         if self.top.camera and _FRAME_STROBE in design.ports:  # FollowTarget's frame outputs
             self.watched[_FRAME_STROBE] = (None, _FRAME_STROBE)
@@ -269,6 +280,8 @@ class RealClockLoop(ClosedLoop):
         driven = {port for io in self.io.values() for pin, port in io.binding.items()}
         if self.top.camera:
             driven |= {"pixels__valid", "pixels__payload", "color_sel"}
+        if self.rig is not None:
+            driven |= self.rig.driven_ports()
         for name, port in sorted(self.pins.ports.items()):
             if port.direction == "in" and name not in driven:
                 kinds = [k for k, b in self.top.bindings.items() if name in b.values()]
@@ -332,15 +345,20 @@ class RealClockLoop(ClosedLoop):
                 row.viewer_events.append(text)
 
     def advance_physics(self, to_step):
+        rig = self.rig
         while self.step < to_step:
             t = self.step * self.dt
             for conn in self.sensors:
                 conn.before_step(self.io[conn], t, self.dt)
+            if rig is not None:  # due servo commands, captures streamed from the next edge
+                rig.before_step(self.step, self.world)
             self.run_design_to(self.edge_of_step(self.step + 1))
             for conn in self.sensors:
                 conn.after_step(self.io[conn], t + self.dt)
             self.motors.apply_due(self.step)
             self.world.step(self.dt)
+            if rig is not None:
+                rig.after_step(self.dt)
             self.step += 1
         self.motors.apply_due(self.step)
 
@@ -362,9 +380,15 @@ class RealClockLoop(ClosedLoop):
         if self.top.camera:
             self._stream(rgb)
         distance, visible = self.measure_world(k, t, pose)
-        self.pending = _PendingRow(
-            k, t, rgb, events, distance, visible, self.pins.cycle, self.read_sensors(k)
-        )
+        readings = self.read_sensors(k)
+        cameras = {}
+        if self.rig is not None:
+            self.rig.sample(k, self.n_frames, self.world)
+            if self.want_records:
+                readings.update(self.rig.readings(self.world))
+                cameras = self.rig.views()
+        self.pending = _PendingRow(k, t, rgb, events, distance, visible, self.pins.cycle, readings)
+        self.pending.cameras = cameras
         self.frames_done = k + 1
 
     def read_sensors(self, k):
@@ -438,6 +462,7 @@ class RealClockLoop(ClosedLoop):
                 events + row.viewer_events,
                 sensors=row.readings,
                 design_extra=extra,
+                cameras=row.cameras,
             )
 
     def compare_shadow(self, row):

@@ -77,6 +77,10 @@ class BagWriter:
     def log_frame(self, record):
         write, conns = self._writer.write, self._connections
         for topic, ns, data in self._messages.encode(record):
+            if topic not in conns:  # a further camera's, from its first capture on
+                conns[topic] = self._writer.add_connection(
+                    topic, self._messages.topic_types[topic], typestore=TYPESTORE
+                )
             write(conns[topic], ns, data)
         for topic, ns, data in self._scans.encode(record):
             if topic not in conns:

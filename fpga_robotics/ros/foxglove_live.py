@@ -189,7 +189,9 @@ class LivePublisher:
     def log_frame(self, record):
         channels = self._channels
         for topic, ns, data in self._messages.encode(record):
-            channels[topic].log(bytes(data), log_time=ns)
+            channel = channels.get(topic)
+            if channel is not None:  # further cameras' topics are in the bag only
+                channel.log(bytes(data), log_time=ns)
         self.frames_logged += 1
 
     def close(self):

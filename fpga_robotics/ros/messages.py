@@ -6,7 +6,10 @@ triples: the same bytes go into a bag (``bag_writer``) and out on the live Foxgl
 start). Frames: ``odom`` (the world: x, y on the floor, z up, headings counter-clockwise
 from +x, as in ROS REP 103), ``base_link`` (the robot), ``camera_link`` (the camera on its
 mount, x forward, pitched by the camera's tilt). An output the design lacks (None) is not
-published for that frame.
+published for that frame. Each further camera (``FrameRecord.cameras``) has its own topics,
+``/cameras/<name>/image_raw`` and ``camera_info`` (``camera_topics``), stamped at its own
+capture instant and written once per capture, in its frame ``<name>_link`` (placed in
+``odom`` on ``/tf``: on a servo it turns with the horn).
 """
 
 import math
@@ -19,7 +22,15 @@ from fpga_robotics.sim.camera.raster import focal_length
 
 from ..sim.world.kinematics import dps_to_twist
 
-__all__ = ["TOPICS", "TYPESTORE", "CameraGeometry", "FrameMessages", "camera_geometry", "msgdef"]
+__all__ = [
+    "TOPICS",
+    "TYPESTORE",
+    "CameraGeometry",
+    "FrameMessages",
+    "camera_geometry",
+    "camera_topics",
+    "msgdef",
+]
 
 #: The typestore every message is built and read with (ROS 2 Humble definitions).
 TYPESTORE = get_typestore(Stores.ROS2_HUMBLE)
@@ -40,6 +51,15 @@ TOPICS = {
     "/tf": "tf2_msgs/msg/TFMessage",
     "/people": "visualization_msgs/msg/MarkerArray",
 }
+
+
+def camera_topics(name):
+    """A further camera's topics with their message types."""
+    return {
+        f"/cameras/{name}/image_raw": "sensor_msgs/msg/Image",
+        f"/cameras/{name}/camera_info": "sensor_msgs/msg/CameraInfo",
+    }
+
 
 _T = TYPESTORE.types
 _Time = _T["builtin_interfaces/msg/Time"]
@@ -146,6 +166,9 @@ class FrameMessages:
             dim=[_MultiArrayDimension(label="left,right", size=2, stride=2)], data_offset=0
         )
         self._zero = _Vector3(x=0.0, y=0.0, z=0.0)
+        #: Topic -> message type of every topic written so far (TOPICS and cameras' ones).
+        self.topic_types = dict(TOPICS)
+        self._captured = {}  # further camera -> the capture instant last written
         self._covariance = np.zeros(36)
         self._ser = TYPESTORE.serialize_cdr
 
@@ -160,6 +183,50 @@ class FrameMessages:
             step=w * 3,
             data=np.ascontiguousarray(rgb, np.uint8).reshape(-1),
         )
+
+    def _info_of(self, header, width, height, hfov):
+        f = focal_length(width, hfov)
+        return _T["sensor_msgs/msg/CameraInfo"](
+            header=header,
+            **{
+                **self._camera_info,
+                "height": height,
+                "width": width,
+                "k": np.array([f, 0, width / 2, 0, f, height / 2, 0, 0, 1], float),
+                "p": np.array([f, 0, width / 2, 0, 0, f, height / 2, 0, 0, 0, 1, 0], float),
+            },
+        )
+
+    def _further_cameras(self, record):
+        """Each further camera's image, calibration and place, once per capture."""
+        out = []
+        for name, view in (getattr(record, "cameras", None) or {}).items():
+            if self._captured.get(name) == view.sim_time:
+                continue
+            self._captured[name] = view.sim_time
+            self.topic_types.update(camera_topics(name))
+            stamp = _stamp(round(view.sim_time * 1e9))
+            header = _Header(stamp=stamp, frame_id=f"{name}_link")
+            h, w = view.rgb.shape[:2]
+            p = view.pose
+            # Yaw about z, then the tilt about the camera's y (a positive tilt looks up).
+            cy, sy = math.cos(p.heading / 2), math.sin(p.heading / 2)
+            cp, sp = math.cos(-p.tilt / 2), math.sin(-p.tilt / 2)
+            rotation = _Quaternion(x=-sy * sp, y=cy * sp, z=sy * cp, w=cy * cp)
+            place = _T["geometry_msgs/msg/TransformStamped"](
+                header=_Header(stamp=stamp, frame_id="odom"),
+                child_frame_id=f"{name}_link",
+                transform=_T["geometry_msgs/msg/Transform"](
+                    translation=_Vector3(x=float(p.x), y=float(p.y), z=float(p.height)),
+                    rotation=rotation,
+                ),
+            )
+            out += [
+                (f"/cameras/{name}/image_raw", self._image(header, view.rgb)),
+                (f"/cameras/{name}/camera_info", self._info_of(header, w, h, view.hfov)),
+                ("/tf", _T["tf2_msgs/msg/TFMessage"](transforms=[place])),
+            ]
+        return out
 
     def encode(self, record):
         """``[(topic, stamp_ns, cdr_bytes), ...]`` for one ``FrameRecord``."""
@@ -264,7 +331,9 @@ class FrameMessages:
             )
         )
         out.append(("/people", self._people(odom_header, record.people)))
-        return [(topic, ns, ser(msg, TOPICS[topic])) for topic, msg in out]
+        out += self._further_cameras(record)
+        types = self.topic_types
+        return [(topic, ns, ser(msg, types[topic])) for topic, msg in out]
 
     def _people(self, header, people):
         Marker = _T["visualization_msgs/msg/Marker"]

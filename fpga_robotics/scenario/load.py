@@ -40,7 +40,7 @@ from fpga_robotics.checks.summary import CHECKS
 from fpga_robotics.designs.builtin import TOPS, design_tables, table_fields
 from fpga_robotics.hw.params import PRESETS, FollowTargetParams, preset_values
 from fpga_robotics.loop.compressed import frame_count
-from fpga_robotics.loop.connectors import ConnectorError
+from fpga_robotics.loop.connectors import CONNECTORS, ConnectorError
 from fpga_robotics.scenario.connectors import parse_connectors
 from fpga_robotics.scenario.errors import ScenarioError
 from fpga_robotics.scenario.sanity import scenario_warnings
@@ -898,9 +898,15 @@ def _connectors(world):
 def _resolve_timing(sim, camera, top, connectors, foreign):
     """``sim.timing = "auto"`` made definite; a design or connector with pins of its own
     needs real-clock timing."""
-    # Every design but the camera-only follow_target has pins of its own.
-    pins = [f"the {c.kind} connector" for c in connectors]
-    if top != "follow_target":
+    # Every design but the camera-only follow_target has pins of its own, unless it has
+    # frame-level channels for further cameras; cameras and servos act once a frame.
+    frame_level = top in TOPS and bool(TOPS[top].frame_channels)
+    pins = [
+        f"the {c.kind} connector"
+        for c in connectors
+        if not getattr(CONNECTORS[c.kind], "frame_level", False)
+    ]
+    if top != "follow_target" and not frame_level:
         pins.insert(0, f"design.top = {top!r}")
     if foreign is not None:
         # A port map that binds connectors (or has no camera) is a design with pins.

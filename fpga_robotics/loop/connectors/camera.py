@@ -9,18 +9,27 @@ sensor, and the capture is what the OV7670 makes of it.
 """
 
 import math
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from typing import ClassVar
 
 import numpy as np
 
 from fpga_robotics.hw.errors import UsageError
-from fpga_robotics.loop.connectors.base import Connector, Mount, Pin, register
+from fpga_robotics.hw.pixel import COLOR_SELECT
+from fpga_robotics.loop.connectors.base import (
+    Connector,
+    ConnectorError,
+    Mount,
+    Pin,
+    check_number,
+    register,
+)
 from fpga_robotics.sim.camera.scene import CameraPose
 
 __all__ = [
     "SENSOR_STREAM",
     "CameraConnector",
+    "CameraParams",
     "ExposureDrift",
     "camera_pose",
     "in_view",
@@ -127,6 +136,65 @@ def in_view(pose, hfov, px, py, radius):
     return abs(bearing) - math.asin(radius / dist) < hfov / 2
 
 
+@dataclass(frozen=True)
+class CameraParams:
+    """The keys of a ``[[robot.sensors]]`` camera (one more than the ``[camera]`` one):
+    ``resolution``, ``fps``, ``hfov_deg``, ``tilt_deg``, ``noise_std``, ``on`` (the name of the
+    servo it is mounted on, or none: on the body), ``color`` (the colour select its port
+    bundle gets), and for the checks ``target`` (the person it should keep in view) and
+    ``centred_deg`` (how far off its axis that person may be and still count as centred)."""
+
+    width: int = 160
+    height: int = 120
+    fps: float = 10.0
+    hfov: float = math.radians(60.0)
+    tilt: float = 0.0
+    noise_std: float = 0.0
+    on: str | None = None
+    color: str = "red"
+    target: str | None = None
+    centred_deg: float = 10.0
+
+    @property
+    def frame_period(self):
+        return 1.0 / self.fps
+
+
+_CAMERA_KEYS = (
+    "resolution",
+    "fps",
+    "hfov_deg",
+    "tilt_deg",
+    "noise_std",
+    "on",
+    "color",
+    "target",
+    "centred_deg",
+)
+
+
+def _resolution(text, where):
+    parts = text.lower().split("x") if isinstance(text, str) else []
+    if len(parts) == 2 and all(p.isdigit() for p in parts):
+        w, h = int(parts[0]), int(parts[1])
+        if 16 <= w <= 4096 and 16 <= h <= 4096:
+            return w, h
+    raise ConnectorError(
+        f"{where}.resolution must look like WIDTHxHEIGHT (16..4096 each), e.g. 160x120; "
+        f"got {text!r}"
+    )
+
+
+def _word(table, key, where, choices=None):
+    value = table.get(key)
+    if value is None:
+        return None
+    if not isinstance(value, str) or (choices is not None and value not in choices):
+        shown = f"one of {', '.join(choices)}" if choices is not None else "a name"
+        raise ConnectorError(f"{where}.{key} must be {shown}, got {value!r}")
+    return value
+
+
 @register
 class CameraConnector(Connector):
     """Renders what the robot's camera sees: the connector of kind ``camera``, bound to the
@@ -192,6 +260,38 @@ class CameraConnector(Connector):
 
     kind = "camera"
     pins: ClassVar[dict] = {"pixels": Pin("in", 14), "color_sel": Pin("in", 3)}
+    #: Runs in compressed timing: a frame through the design's channel on its port bundle.
+    frame_level = True
+
+    @classmethod
+    def parse(cls, table, where):
+        """A ``[[robot.sensors]]`` camera's keys (``CameraParams``)."""
+        unknown = sorted(set(table) - set(_CAMERA_KEYS))
+        if unknown:
+            raise ConnectorError(
+                f"{where}: unknown key {unknown[0]!r} for a 'camera' connector; its keys: "
+                f"{', '.join(_CAMERA_KEYS)} and the mount"
+            )
+        width, height = _resolution(table.get("resolution", "160x120"), where)
+        color = _word(table, "color", where, tuple(COLOR_SELECT)) or "red"
+        return CameraParams(
+            width=width,
+            height=height,
+            fps=check_number(table, "fps", 10.0, where, lo=0, hi=240, lo_open=True),
+            hfov=math.radians(
+                check_number(table, "hfov_deg", 60.0, where, lo=1, hi=170, unit="deg")
+            ),
+            tilt=math.radians(
+                check_number(table, "tilt_deg", 0.0, where, lo=-60, hi=60, unit="deg")
+            ),
+            noise_std=check_number(table, "noise_std", 0.0, where, lo=0, hi=64),
+            on=_word(table, "on", where),
+            color=color,
+            target=_word(table, "target", where),
+            centred_deg=check_number(
+                table, "centred_deg", 10.0, where, lo=0, hi=90, unit="deg", lo_open=True
+            ),
+        )
 
     @property
     def mount(self):

@@ -1,0 +1,64 @@
+"""Elaboration parameters of the turret channel of ``TurretTracker`` (``TurretParams``):
+the pan camera's resolution and the proportional law that turns its centroid error into a
+servo angle.
+
+Plain Python (no Amaranth import), like ``params.py``: the gateware, the numpy model
+(``sim/models/turret.py``) and the scenarios share these objects.
+"""
+
+from dataclasses import dataclass, fields, replace
+
+from .params import FollowTargetParams
+from .validate import check_int
+
+__all__ = ["ANGLE_BITS", "TurretParams"]
+
+#: Width of the servo command: the published system's 10-bit signed angle (+-500 = +-90 deg).
+ANGLE_BITS = 10
+
+
+@dataclass(frozen=True)
+class TurretParams:
+    """The turret channel: a colour filter and tracker on the pan camera's frames, then the
+    servo angle ``a`` updated once a found frame as ``a -= sign * ((kp_num * e) >>
+    kp_shift)``, ``e = centroid_x - width // 2`` (pixels, right positive), saturating at
+    ``+-angle_limit``. ``a`` grows to the left (the servo's convention), so a target right of
+    the image centre turns the camera right. A lost frame holds the angle."""
+
+    #: The pan camera's resolution (its frames' size; the filter's thresholds are the
+    #: defaults of ``FollowTargetParams``).
+    width: int = 160
+    height: int = 120
+    #: The gain: ``kp_num / 2**kp_shift`` command units per pixel of error. At 160 px over
+    #: 60 degrees a pixel near the centre is 0.41 deg = 2.3 units: 5/4 corrects about half
+    #: the error a frame, which stays stable with the frame of delay the loop has.
+    kp_num: int = 5
+    kp_shift: int = 2
+    #: The largest angle commanded (500: 90 degrees either way).
+    angle_limit: int = 500
+    #: True turns the camera away from the target (a seeded bug: ``hw/variants.py``).
+    inverted: bool = False
+
+    def __post_init__(self):
+        for name, lo, hi in (
+            ("width", 16, 4096),
+            ("height", 16, 4096),
+            ("kp_num", 0, 255),
+            ("kp_shift", 0, 15),
+            ("angle_limit", 0, (1 << (ANGLE_BITS - 1)) - 1),
+        ):
+            object.__setattr__(self, name, check_int(name, getattr(self, name), lo, hi))
+        if not isinstance(self.inverted, bool):
+            raise TypeError(f"inverted must be True or False, not {self.inverted!r}")
+        _ = self.tracker_params  # the frame geometry must suit the tracker (window of 8 bins)
+
+    @property
+    def tracker_params(self):
+        """The ``FollowTargetParams`` of the channel's colour filter and tracker."""
+        return FollowTargetParams(width=self.width, height=self.height)
+
+    def replace(self, **changes):
+        return replace(self, **changes)
+
+    def as_dict(self):
+        return {f.name: getattr(self, f.name) for f in fields(self)}
