@@ -19,6 +19,7 @@ from pydantic import BeforeValidator, Field, create_model, model_validator
 from pydantic_core import PydanticCustomError
 
 from fpga_robotics.checks.summary import CHECKS
+from fpga_robotics.designs.builtin import TOPS
 from fpga_robotics.hw.params import (
     CHOICES,
     DEFAULT_BASE_DPS,
@@ -327,16 +328,15 @@ DESIGN_ARRAYS = {
     "proximity_thresholds": (len(DEFAULT_PROXIMITY_THRESHOLDS), "pixel counts of levels 1..7"),
     "steer_dps": (len(DEFAULT_STEER_DPS), "DPS by LED distance 0..3 from the centre"),
 }
-#: ``design.top`` and its tables, a foreign design's files: checked by load.py (they name
-#: files and designs); ``design.preset``: ``FollowTargetParams.published()`` first.
+#: ``design.top``, every built-in top's parameter tables, a foreign design's files: checked
+#: by load.py (they name files and designs); ``design.preset``:
+#: ``FollowTargetParams.published()`` first.
 DESIGN_OTHER_KEYS = (
     "preset",
     "top",
     "variant",
     "params",
-    "ultrasound",
-    "interlock",
-    "line",
+    *dict.fromkeys(key for top in TOPS.values() for key in top.tables),
     "verilog",
     "ports",
 )
