@@ -133,13 +133,79 @@ def test_mutate_design_prints_the_scores_of_a_users_design(tmp_path, capsys):
     assert {m["module"] or "top" for m in result["mutants"]} <= {"top", "us"}
 
 
+@pytest.mark.slow  # a Verilator build of the mutant netlist, closed-loop runs of its mutants
+def test_robot_judge_of_a_users_design_matches_its_runs(tmp_path, capsys):
+    """``mutate --design REF --campaign C``: each unit-caught mutant of WallStop runs the
+    campaign in closed loop; its verdict must be the one its replayed run gives, and the
+    unmutated design (``mutsel = 0``) passes the same run."""
+    from fpga_robotics.sweep import runner
+
+    campaign = tmp_path / "wall.toml"
+    campaign.write_text(
+        f'description = "wall_stop at its wall"\nscenarios = ["{DESIGNS}/wall_stop.toml"]\n'
+        'seeds = "0"\nbackend = "auto"\n'
+    )
+    out = tmp_path / "m"
+    code, text, _ = _cli(
+        [
+            "mutate",
+            "--design",
+            f"{DESIGNS}/wall_stop.py:WallStop",
+            "--mutants",
+            "8",
+            "--cycles",
+            "20000",
+            "--campaign",
+            str(campaign),
+            "--workers",
+            "1",
+            "--out",
+            str(out),
+            "--quiet",
+        ],
+        capsys,
+    )
+    assert code == 0
+    result = json.loads((out / "mutants.json").read_text())
+    assert result["baseline"]["statuses"] == ["pass"]
+    unit_caught = {m["index"] for m in result["mutants"] if m["unit"]["caught"]}
+    judged = {m["index"]: m["robot"] for m in result["mutants"] if m["robot"] is not None}
+    assert set(judged) == unit_caught and unit_caught
+    robot_caught = sum(v["caught"] for v in judged.values())
+    assert result["robot"] == {
+        "judged": len(judged),
+        "caught": robot_caught,
+        "score": robot_caught / len(judged),
+    }
+    assert f"{robot_caught} of {len(judged)} unit-caught mutants caught" in text
+    # The runs again, one by one, outside the judge: the same verdicts.
+    base = runner.execute(result["baseline"]["runs"][0])
+    assert base["status"] == "pass"
+    for index, v in judged.items():
+        if v["status"] == "timeout":  # a mutant that slows the loop down: caught by its time
+            continue
+        again = runner.execute(v["argv"])
+        assert again["status"] == v["status"], index
+        assert [c["name"] for c in again["summary"]["checks"] if c["passed"] is False] == (
+            v["failed_checks"]
+        )
+    # A mutant that stops WallStop from ever stopping is caught: it drives into the wall.
+    never_stops = [
+        m
+        for m in result["mutants"]
+        if m["unit"]["caught"] and m["unit"]["effect"].count("stopped 1 -> 0")
+    ]
+    for m in never_stops:
+        assert judged[m["index"]]["failed_checks"] == ["max_wall_collisions"]
+
+
 @pytest.mark.parametrize(
     "argv, message",
     [
         (["--design", "verilog:x.v"], "a Verilog design is not mutated here"),
         (
-            ["--design", "wall_stop.py:WallStop", "--campaign", "mutation"],
-            "with --design only the unit judge runs",
+            ["--design", "wall_stop.py:WallStop", "--campaign", "nosuch"],
+            "unknown campaign 'nosuch'",
         ),
         (["--design", "wall_stop.py:WallStop", "--param", "nope"], "--param must be NAME=VALUE"),
         (["--cycles", "5"], "--param and --cycles go with --design REF"),

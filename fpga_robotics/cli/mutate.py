@@ -238,11 +238,7 @@ def _main_design(args):
             f"--design {args.design}: mutants are made of Amaranth designs "
             f"(FILE.py:Name); a Verilog design is not mutated here"
         )
-    if args.campaign is not None:
-        raise UsageError(
-            "--campaign (the robot judge) runs FollowTarget's mutants; with "
-            "--design only the unit judge runs"
-        )
+    campaign = _campaign(args.campaign) if args.campaign is not None else None
     cycles = DEFAULT_CYCLES if args.cycles is None else args.cycles
     if not 1 <= cycles <= 100_000_000:
         raise UsageError(f"--cycles must be 1..100000000, got {cycles}")
@@ -256,7 +252,21 @@ def _main_design(args):
             print(text, file=sys.stderr, flush=True)
 
     try:
-        result = mutate_design(spec, args.mutants, args.seed, cycles, out, say=say)
+        result = mutate_design(
+            spec,
+            args.mutants,
+            args.seed,
+            cycles,
+            out,
+            say=say,
+            campaign=campaign,
+            robot={
+                "workers": args.workers,
+                "scheduler": args.scheduler,
+                "resume": args.resume,
+                "fork": args.fork,
+            },
+        )
     except MutationError as exc:
         raise UsageError(str(exc).splitlines()[0]) from None
     score, modules = result["unit"], result["modules"]
@@ -272,7 +282,14 @@ def _main_design(args):
     )
     width = max(len(m) for m in modules)
     for module, row in modules.items():
-        print(f"  {module:<{width}}  {row['unit_caught']:>4}/{row['total']:<4} caught")
+        robot_part = (
+            f", robot judge {row['robot_caught']:>4}/{row['unit_caught']}"
+            if campaign is not None
+            else ""
+        )
+        print(f"  {module:<{width}}  {row['unit_caught']:>4}/{row['total']:<4} caught{robot_part}")
+    if campaign is not None:
+        _report_design_robot(result, campaign)
     missed = [m for m in result["mutants"] if not m["unit"]["caught"]]
     if missed:
         print("equivalent on these inputs (first 10):")
@@ -280,6 +297,28 @@ def _main_design(args):
             print(f"  {m['describe']}")
     print(f"wrote {os.path.join(out, 'mutants.json')}")
     return 0
+
+
+def _report_design_robot(result, campaign):
+    """The robot judge's lines for a design of one's own: its score and blind spots."""
+    rs, baseline = result["robot"], result["baseline"]
+    n_runs, n_pass = len(baseline["runs"]), len(baseline["passing"])
+    print(
+        f"robot judge (campaign {campaign.name}: {n_pass} of {n_runs} runs pass unmutated): "
+        f"{rs['caught']} of {rs['judged']} unit-caught mutants caught: score "
+        f"{_percent(rs['score'])}; {_robot_rate(baseline['judged_here'], result['robot_judge_s'])}"
+    )
+    if not n_pass:
+        print("no run passes with the unmutated design: the robot judge has no run to judge by")
+        return
+    blind = [m for m in result["mutants"] if m["robot"] is not None and not m["robot"]["caught"]]
+    if blind:
+        print(f"blind spots: caught by the unit judge, missed by every run ({len(blind)}):")
+        for m in blind:
+            print(f"  {m['describe']}")
+            print(f"    unit: {m['unit']['effect']}")
+            if m["robot"].get("replay"):
+                print(f"    closest run: {m['robot']['replay']}")
 
 
 def _check(args):

@@ -5,11 +5,12 @@ random pin stimulus (``pin_judge``), with the same scores as FollowTarget's unit
 import os
 import time
 
-from ..sim.files import write_json_atomic
+from ..sim.files import write_atomic, write_json_atomic
 from ..sim.mutation import component_rtlil, list_mutants
 from ..sim.pins.base import Port
+from .design import NETLIST_NAME, PORTS_NAME, design_mutant_port_map, netlist_has_reset
 from .pin_judge import MutantPinSource, judge_pin_mutant, open_pin_mutants, pin_stimulus, pin_trace
-from .scores import by_module, unit_score
+from .scores import by_module, robot_score, unit_score
 
 __all__ = ["DEFAULT_CYCLES", "design_ports", "mutate_design"]
 
@@ -32,9 +33,15 @@ def design_ports(spec):
     }
 
 
-def mutate_design(spec, n, seed, cycles, out, *, stimulus_seed=0, say=print):
+def mutate_design(
+    spec, n, seed, cycles, out, *, stimulus_seed=0, say=print, campaign=None, robot=None
+):
     """Mutants of ``spec`` (a resolved Amaranth ``DesignSpec``) judged on ``cycles`` cycles;
-    writes ``out/mutants.json`` and returns its content."""
+    writes ``out/mutants.json`` (and the mutant netlist with its port map, for the robot
+    judge) and returns its content. With ``campaign`` the mutants the unit judge catches go
+    on to the robot judge (``robot_judge.robot_judge`` with the keyword arguments ``robot``:
+    workers, scheduler, resume, fork): the campaign's runs in closed loop, each with the
+    mutant netlist as its Verilog design."""
     t0 = time.perf_counter()
     ports = design_ports(spec)
     rtlil_text = component_rtlil(spec.build())
@@ -60,6 +67,33 @@ def mutate_design(spec, n, seed, cycles, out, *, stimulus_seed=0, say=print):
     finally:
         backend.close()
     unit = {v.index: v.caught for v in verdicts}
+    # The netlist and its port map as a Verilog design the closed loop runs (the robot
+    # judge: one build, ``--runtime mutsel=K`` picks the mutant).
+    netlist = os.path.join(out, NETLIST_NAME)
+    write_atomic(netlist, source.verilog, what="mutant netlist")
+    port_map = os.path.join(out, PORTS_NAME)
+    write_atomic(
+        port_map,
+        design_mutant_port_map(spec, ports, reset=netlist_has_reset(source.verilog)),
+        what="port map",
+    )
+    robot_verdicts, baseline, robot_s = {}, None, None
+    if campaign is not None:
+        from .robot_judge import robot_judge
+
+        t2 = time.perf_counter()
+        baseline, robot_verdicts = robot_judge(
+            campaign,
+            os.path.abspath(netlist),
+            os.path.abspath(port_map),
+            None,
+            [v.index for v in verdicts if v.caught],
+            out,
+            say=say,
+            **(robot or {}),
+        )
+        robot_s = time.perf_counter() - t2
+    caught_by_robot = {k: v["caught"] for k, v in robot_verdicts.items()}
     result = {
         "design": {"reference": spec.reference, "params": spec.params},
         "seed": seed,
@@ -71,8 +105,14 @@ def mutate_design(spec, n, seed, cycles, out, *, stimulus_seed=0, say=print):
         },
         "build_and_list_s": round(build_s, 2),
         "unit_judge_s": round(unit_s, 2),
+        "netlist": NETLIST_NAME,
+        "ports": PORTS_NAME,
         "unit": unit_score(unit),
-        "modules": by_module(mutants, unit),
+        "robot": robot_score(unit, caught_by_robot) if campaign is not None else None,
+        "campaign": campaign.name if campaign is not None else None,
+        "robot_judge_s": round(robot_s, 2) if robot_s is not None else None,
+        "baseline": baseline,
+        "modules": by_module(mutants, unit, caught_by_robot),
         "mutants": [
             {
                 **{k: v for k, v in m.__dict__.items()},
@@ -84,6 +124,7 @@ def mutate_design(spec, n, seed, cycles, out, *, stimulus_seed=0, say=print):
                     "differing": v.differing,
                     "effect": v.effect(),
                 },
+                "robot": robot_verdicts.get(m.index),
             }
             for m, v in zip(mutants, verdicts)
         ],
