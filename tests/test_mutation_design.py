@@ -202,13 +202,19 @@ def test_robot_judge_of_a_users_design_matches_its_runs(tmp_path, capsys):
 @pytest.mark.parametrize(
     "argv, message",
     [
-        (["--design", "verilog:x.v"], "a Verilog design is not mutated here"),
+        (["--design", "verilog:x.v"], "no file 'x.v'"),
+        (["--design", "bump_stop_noreset.v"], "unknown design 'bump_stop_noreset.v'"),
+        (
+            ["--design", "verilog:bump_stop_noreset.v"],
+            "needs its port map: --ports PORTS.toml",
+        ),
+        (["--design", "wall_stop.py:WallStop", "--ports", "x.toml"], "--ports is the port map"),
         (
             ["--design", "wall_stop.py:WallStop", "--campaign", "nosuch"],
             "unknown campaign 'nosuch'",
         ),
         (["--design", "wall_stop.py:WallStop", "--param", "nope"], "--param must be NAME=VALUE"),
-        (["--cycles", "5"], "--param and --cycles go with --design REF"),
+        (["--cycles", "5"], "--param, --ports and --cycles go with --design REF"),
     ],
 )
 def test_bad_design_arguments_are_one_line(argv, message, capsys, monkeypatch):
@@ -249,3 +255,77 @@ def test_follow_target_against_itself_scores_as_against_the_model(tmp_path, caps
         m["unit"] for m in runs["design"]["mutants"]
     ]
     assert runs["model"]["unit"] == runs["design"]["unit"]
+
+
+def bump_stop_trace(stimulus, cycles):
+    """tests/data/bump_stop.v by hand: ``hit`` latches at the first edge ``bump_i`` is 1; the
+    wheels run at 300 DPS until then, 0 after (``{output: [(cycle, value), ...]}``)."""
+    levels = {}
+    for edge, name, value in stimulus:
+        if name == "bump_i":
+            levels[edge] = value
+    hit_at, level = None, 0
+    for edge in range(1, cycles + 1):
+        level = levels.get(edge, level)
+        if level:
+            hit_at = edge
+            break
+    trace = {"motor_left": [(0, 300)], "motor_right": [(0, 300)]}
+    if hit_at is not None:
+        trace["motor_left"].append((hit_at, 0))
+        trace["motor_right"].append((hit_at, 0))
+    return trace
+
+
+@pytest.mark.slow  # Verilator builds of the Verilog design's mutant netlist
+def test_mutants_of_a_verilog_design_against_a_hand_model(tmp_path, capsys):
+    """``mutate --design verilog:FILE --ports MAP``: Yosys reads the Verilog, the unmutated
+    netlist (``mutsel = 0``) behaves as the hand model of bump_stop.v, and a mutant is caught
+    exactly when its outputs differ from the model's."""
+    from fpga_robotics.designs.builtin import connector_kinds
+    from fpga_robotics.sim.backends.foreign import ForeignDesign
+    from fpga_robotics.sim.pins.compiled import VerilatorPins
+    from fpga_robotics.sim.pins.verilog import VerilogPinSource
+
+    data = Path(__file__).parent / "data"
+    out, cycles = tmp_path / "m", 2000
+    code, text, _ = _cli(
+        [
+            "mutate",
+            "--design",
+            f"verilog:{data / 'bump_stop.v'}",
+            "--port-map",
+            str(data / "bump_stop_ports.toml"),
+            "--mutants",
+            "10",
+            "--cycles",
+            str(cycles),
+            "--out",
+            str(out),
+            "--quiet",
+        ],
+        capsys,
+    )
+    assert code == 0
+    result = json.loads((out / "mutants.json").read_text())
+    assert text.splitlines()[0].startswith("10 mutants of bump_stop (seed 1)")
+    source = VerilogPinSource(
+        ForeignDesign(
+            [out / "mutants.v"],
+            out / "mutants_ports.toml",
+            pins=True,
+            connector_kinds=connector_kinds(),
+        )
+    )
+    backend = VerilatorPins(source)
+    try:
+        ports = {p: port for p, port in backend.ports.items() if p in ("bump_i", "mutsel")}
+        stimulus = pin_stimulus(ports, cycles, 0)
+        outputs = ["motor_left", "motor_right"]  # hit_o: no output of the port map
+        model = bump_stop_trace(stimulus, cycles)
+        assert pin_trace(backend, 0, stimulus, cycles, outputs) == model
+        for m in result["mutants"]:
+            got = pin_trace(backend, m["index"], stimulus, cycles, outputs)
+            assert m["unit"]["caught"] == (got != model), m["describe"]
+    finally:
+        backend.close()

@@ -14,6 +14,7 @@ __all__ = [
     "design_mutant_port_map",
     "netlist_has_reset",
     "open_mutant_design",
+    "with_mutant_select",
     "write_mutant_design",
 ]
 
@@ -106,3 +107,20 @@ def design_mutant_port_map(spec, ports, *, reset=True, select=MUTATION_SELECT):
         lines += [f"{_key(name)} = {q(name)}" for name in spec.extra_outputs]
     lines += ["", "# The mutant select (0: the design itself).", "[runtime]", f"{select} = 0", ""]
     return "\n".join(lines)
+
+
+def with_mutant_select(port_map_text, select=MUTATION_SELECT):
+    """A Verilog design's port map (TOML text) with ``select`` a ``[runtime]`` input at 0:
+    the port map of its mutant netlist."""
+    import re
+
+    line = f"{select} = 0  # the mutant select (0: the design itself)"
+    if re.search(r"^\s*\[runtime\]\s*(#.*)?$", port_map_text, re.MULTILINE):
+        return re.sub(
+            r"^(\s*\[runtime\]\s*(#.*)?)$",
+            lambda m: m.group(1) + "\n" + line,
+            port_map_text,
+            count=1,
+            flags=re.MULTILINE,
+        )
+    return port_map_text.rstrip("\n") + "\n\n[runtime]\n" + line + "\n"

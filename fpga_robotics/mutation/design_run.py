@@ -6,13 +6,19 @@ import os
 import time
 
 from ..sim.files import write_atomic, write_json_atomic
-from ..sim.mutation import component_rtlil, list_mutants
+from ..sim.mutation import MUTATION_SELECT, component_rtlil, list_mutants, mutant_netlist
 from ..sim.pins.base import Port
-from .design import NETLIST_NAME, PORTS_NAME, design_mutant_port_map, netlist_has_reset
+from .design import (
+    NETLIST_NAME,
+    PORTS_NAME,
+    design_mutant_port_map,
+    netlist_has_reset,
+    with_mutant_select,
+)
 from .pin_judge import MutantPinSource, judge_pin_mutant, open_pin_mutants, pin_stimulus, pin_trace
 from .scores import by_module, robot_score, unit_score
 
-__all__ = ["DEFAULT_CYCLES", "design_ports", "mutate_design"]
+__all__ = ["DEFAULT_CYCLES", "design_ports", "mutate_design", "mutate_verilog_design"]
 
 #: Cycles of random stimulus per mutant by default (five 20 ms ultrasound periods at 1 MHz).
 DEFAULT_CYCLES = 100_000
@@ -50,6 +56,111 @@ def mutate_design(
     source = MutantPinSource(rtlil_text, ports, mutants, name)
     backend = open_pin_mutants(source, on_build=lambda t: say(f"{t} ..."))
     build_s = time.perf_counter() - t0
+    # The netlist and its port map as a Verilog design the closed loop runs (the robot
+    # judge: one build, ``--runtime mutsel=K`` picks the mutant).
+    netlist = os.path.join(out, NETLIST_NAME)
+    write_atomic(netlist, source.verilog, what="mutant netlist")
+    port_map = os.path.join(out, PORTS_NAME)
+    write_atomic(
+        port_map,
+        design_mutant_port_map(spec, ports, reset=netlist_has_reset(source.verilog)),
+        what="port map",
+    )
+    return _judge(
+        {"reference": spec.reference, "params": spec.params},
+        backend,
+        ports,
+        mutants,
+        (netlist, port_map),
+        build_s,
+        seed,
+        cycles,
+        out,
+        stimulus_seed=stimulus_seed,
+        say=say,
+        campaign=campaign,
+        robot=robot,
+    )
+
+
+def mutate_verilog_design(
+    files,
+    ports_path,
+    n,
+    seed,
+    cycles,
+    out,
+    *,
+    stimulus_seed=0,
+    say=print,
+    campaign=None,
+    robot=None,
+):
+    """``mutate_design`` for a Verilog design: ``files`` with its port map ``ports_path``.
+    Yosys reads the files (``read_verilog``) and mutates the map's top module; the mutant
+    netlist's port map is the design's with ``mutsel`` a ``[runtime]`` input, and the unit
+    judge drives the inputs the map gives the pin backend (its connector pins, ``[runtime]``
+    inputs aside)."""
+    from ..designs.builtin import connector_kinds
+    from ..sim.backends.foreign import ForeignDesign
+    from ..sim.pins.compiled import VerilatorPins
+    from ..sim.pins.verilog import VerilogPinSource
+
+    t0 = time.perf_counter()
+    design = ForeignDesign(files, ports_path, pins=True, connector_kinds=connector_kinds())
+    top = design.port_map.top
+    mutants = list_mutants(None, n, seed, verilog=design.sources, top=top)
+    os.makedirs(out, exist_ok=True)
+    netlist = os.path.join(out, NETLIST_NAME)
+    verilog = mutant_netlist(None, mutants, verilog=design.sources, top=top)
+    write_atomic(netlist, verilog, what="mutant netlist")
+    port_map = os.path.join(out, PORTS_NAME)
+    with open(ports_path) as f:
+        write_atomic(port_map, with_mutant_select(f.read()), what="port map")
+    source = VerilogPinSource(
+        ForeignDesign([netlist], port_map, pins=True, connector_kinds=connector_kinds())
+    )
+    backend = VerilatorPins(source, on_build=lambda t: say(f"{t} ..."))
+    build_s = time.perf_counter() - t0
+    driven = {p: port for p, port in backend.ports.items() if p not in (source.pixels or ())}
+    driven = {p: port for p, port in driven.items() if p not in source.runtime}
+    driven[MUTATION_SELECT] = backend.ports[MUTATION_SELECT]
+    return _judge(
+        {"reference": "verilog:" + ",".join(str(f) for f in files), "ports": str(ports_path)},
+        backend,
+        driven,
+        mutants,
+        (netlist, port_map),
+        build_s,
+        seed,
+        cycles,
+        out,
+        stimulus_seed=stimulus_seed,
+        say=say,
+        campaign=campaign,
+        robot=robot,
+    )
+
+
+def _judge(
+    design,
+    backend,
+    ports,
+    mutants,
+    files,
+    build_s,
+    seed,
+    cycles,
+    out,
+    *,
+    stimulus_seed,
+    say,
+    campaign,
+    robot,
+):
+    """The unit judge of ``mutants`` on ``backend`` (closed here), then the robot judge with
+    ``campaign``; writes and returns ``mutants.json``'s content."""
+    netlist, port_map = files
     outputs = [p for p, port in ports.items() if port.direction == "out"]
     stimulus = pin_stimulus(ports, cycles, stimulus_seed)
     try:
@@ -67,16 +178,6 @@ def mutate_design(
     finally:
         backend.close()
     unit = {v.index: v.caught for v in verdicts}
-    # The netlist and its port map as a Verilog design the closed loop runs (the robot
-    # judge: one build, ``--runtime mutsel=K`` picks the mutant).
-    netlist = os.path.join(out, NETLIST_NAME)
-    write_atomic(netlist, source.verilog, what="mutant netlist")
-    port_map = os.path.join(out, PORTS_NAME)
-    write_atomic(
-        port_map,
-        design_mutant_port_map(spec, ports, reset=netlist_has_reset(source.verilog)),
-        what="port map",
-    )
     robot_verdicts, baseline, robot_s = {}, None, None
     if campaign is not None:
         from .robot_judge import robot_judge
@@ -95,7 +196,7 @@ def mutate_design(
         robot_s = time.perf_counter() - t2
     caught_by_robot = {k: v["caught"] for k, v in robot_verdicts.items()}
     result = {
-        "design": {"reference": spec.reference, "params": spec.params},
+        "design": design,
         "seed": seed,
         "judge": "the unmutated design, seeded random pin stimulus",
         "stimulus": {
