@@ -18,7 +18,7 @@ from rosbags.rosbag2 import StoragePlugin, Writer, WriterError
 from fpga_robotics.hw.errors import UsageError
 from fpga_robotics.sim.files import check_output_dir
 
-from .messages import TOPICS, TYPESTORE, FrameMessages, camera_geometry
+from .messages import TOPICS, TYPESTORE, FrameMessages, camera_geometry, topic_type
 
 __all__ = ["BagWriter", "check_bag_path", "open_bag_writer"]
 
@@ -75,6 +75,10 @@ class BagWriter:
     def log_frame(self, record):
         write, conns = self._writer.write, self._connections
         for topic, ns, data in self._messages.encode(record):
+            if topic not in conns:  # an extra output of the design, first seen now
+                conns[topic] = self._writer.add_connection(
+                    topic, topic_type(topic), typestore=TYPESTORE
+                )
             write(conns[topic], ns, data)
         self.frames_logged += 1
 
