@@ -268,7 +268,8 @@ class RealClockLoop(ClosedLoop):
         """Every design input is driven: by the camera's stream, a connector's pin or the
         backend (a Verilog design's ``[runtime]`` inputs)."""
         driven = {port for io in self.io.values() for pin, port in io.binding.items()}
-        driven |= set(getattr(self.pins.source, "runtime", None) or ())
+        pins = getattr(self.pins, "primary", self.pins)  # a shadow's MirroredPins: its primary
+        driven |= set(getattr(getattr(pins, "source", None), "runtime", None) or ())
         if self.top.camera:
             driven |= {"pixels__valid", "pixels__payload", "color_sel"}
         for name, port in sorted(self.pins.ports.items()):
