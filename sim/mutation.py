@@ -194,20 +194,35 @@ def component_rtlil(component):
     return rtlil.convert(component, name=TOP_NAME, ports=ports)
 
 
-def list_mutants(params=None, n=100, seed=1, *, rtlil_text=None):
+def _read_design(work, params, rtlil_text, verilog):
+    """Yosys lines that read the design into ``work``: ``verilog`` (``{file name: text}``,
+    then ``read_verilog``), else ``rtlil_text`` or ``FollowTarget(params)``'s RTLIL."""
+    if verilog is not None:
+        lines = []
+        for name, text in verilog.items():
+            with open(os.path.join(work, name), "w") as f:
+                f.write(text)
+            lines.append(f"read_verilog -sv {name}")
+        return lines
+    with open(os.path.join(work, "design.il"), "w") as f:
+        f.write(_rtlil(params) if rtlil_text is None else rtlil_text)
+    return ["read_rtlil design.il"]
+
+
+def list_mutants(params=None, n=100, seed=1, *, rtlil_text=None, verilog=None, top=TOP_NAME):
     """``n`` mutants of ``FollowTarget(params)`` (or of the design ``rtlil_text``, from
-    ``component_rtlil``) chosen by Yosys with ``seed`` (the same arguments give the same
+    ``component_rtlil``, or of the Verilog design ``verilog``, ``{file name: text}`` with
+    its top module ``top``) chosen by Yosys with ``seed`` (the same arguments give the same
     list). Yosys may return fewer when the design has fewer places."""
     params = params if params is not None else FollowTargetParams()
     if not 1 <= int(n) <= 100_000:
         raise ValueError(f"the number of mutants must be 1..100000, got {n}")
     with tempfile.TemporaryDirectory(prefix="fr-mutate-") as work:
-        with open(os.path.join(work, "design.il"), "w") as f:
-            f.write(_rtlil(params) if rtlil_text is None else rtlil_text)
+        read = _read_design(work, params, rtlil_text, verilog)
         _yosys(
             [
-                "read_rtlil design.il",
-                *(s.format(top=TOP_NAME) for s in _PREPARE),
+                *read,
+                *(s.format(top=top) for s in _PREPARE),
                 f"mutate -list {int(n)} -seed {int(seed)} -o mutants.ys",
             ],
             work,
@@ -220,17 +235,16 @@ def list_mutants(params=None, n=100, seed=1, *, rtlil_text=None):
 _MUTATE = re.compile(r"^mutate\s")
 
 
-def mutant_netlist(params, mutants, *, rtlil_text=None):
+def mutant_netlist(params, mutants, *, rtlil_text=None, verilog=None, top=TOP_NAME):
     """Verilog of ``FollowTarget(params)`` (or of the design ``rtlil_text``, from
     ``component_rtlil``) with every mutant behind ``mutsel`` (``select_width(len(mutants))``
     bits; ``mutsel = m.index`` selects ``m``). Top module ``follow_target``, the design's own
-    ports plus ``mutsel``."""
+    ports plus ``mutsel`` (a Verilog design, ``verilog``: its module ``top``)."""
     params = params if params is not None else FollowTargetParams()
     width = select_width(max((m.index for m in mutants), default=0))
     with tempfile.TemporaryDirectory(prefix="fr-mutate-") as work:
-        with open(os.path.join(work, "design.il"), "w") as f:
-            f.write(_rtlil(params) if rtlil_text is None else rtlil_text)
-        lines = ["read_rtlil design.il", *(s.format(top=TOP_NAME) for s in _PREPARE)]
+        read = _read_design(work, params, rtlil_text, verilog)
+        lines = [*read, *(s.format(top=top) for s in _PREPARE)]
         for m in mutants:
             lines.append(
                 _MUTATE.sub(f"mutate -ctrl {MUTATION_SELECT} {width} {m.index} ", m.command)

@@ -19,6 +19,9 @@ import pytest
 
 from fpga_robotics import cli
 
+#: Designs of one's own the cases name.
+DESIGNS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "data", "user_designs")
+
 #: (case id, argv, a word the message must contain). ``{dir}``, ``{file}``, ``{frames}`` are
 #: an existing folder, an existing regular file and a folder of two PNG frames.
 CASES = [
@@ -104,6 +107,34 @@ CASES = [
         "--bitstream",
     ),
     ("unknown board", ["board", "--board", "nexys", "-o", "out"], "unknown board"),
+    # a design of one's own on the board, mutated, proved
+    (
+        "board design without wheels",
+        ["board", "--design", f"{DESIGNS}/counters.py:Saturating", "-o", "out"],
+        "has no output 'motor_left'",
+    ),
+    ("board param without design", ["board", "--param", "a=1", "-o", "out"], "--param goes"),
+    (
+        "formal Verilog without assertions",
+        ["formal", "--design", f"verilog:{DESIGNS}/bump_stop_noreset.v"],
+        "no assert or cover statement",
+    ),
+    (
+        "formal port map of an Amaranth design",
+        ["formal", "--design", f"{DESIGNS}/counters.py:Saturating", "--ports", "p.toml"],
+        "--ports is the port map of a Verilog design",
+    ),
+    (
+        "mutate Verilog without its port map",
+        ["mutate", "--design", f"verilog:{DESIGNS}/bump_stop_noreset.v"],
+        "needs its port map",
+    ),
+    (
+        "mutate Verilog with a parameter",
+        ["mutate", "--design", f"verilog:{DESIGNS}/bump_stop_noreset.v", "--param", "a=1"],
+        "takes no parameters",
+    ),
+    ("mutate port map without design", ["mutate", "--ports", "p.toml"], "--ports"),
     # bench
     ("bench negative min-seconds", ["bench", "--min-seconds", "-5"], "--min-seconds"),
     ("bench nan min-seconds", ["bench", "design", "--min-seconds", "nan"], "--min-seconds"),

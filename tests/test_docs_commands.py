@@ -717,6 +717,88 @@ PLANS = {
             ),
         ),
     ),
+    (
+        "fpga-robotics mutate --design wall_stop.py:WallStop --mutants 8 --cycles 20000 "
+        "--campaign wall_stop_campaign.toml --workers 1"
+    ): Plan(
+        slow=True,
+        setup=(
+            " ".join(
+                [
+                    "cp",
+                    *(
+                        str(ROOT / "tests/data/user_designs" / name)
+                        for name in ("wall_stop.py", "wall_stop.toml", "wall_stop_campaign.toml")
+                    ),
+                    ".",
+                ]
+            ),
+        ),
+        out=(
+            (
+                r"unit judge \(against the unmutated design\): 3 caught, 5 equivalent on "
+                r"these inputs: score 37\.5%"
+            ),
+            (
+                r"robot judge \(campaign wall_stop_campaign: 1 of 1 runs pass unmutated\): "
+                r"3 of 3 unit-caught mutants caught: score 100\.0%"
+            ),
+        ),
+        files=(
+            "runs/mutation/WallStop-n8-s1/mutants.json",
+            "runs/mutation/WallStop-n8-s1/mutants_ports.toml",
+        ),
+    ),
+    (
+        "fpga-robotics mutate --design verilog:bump_stop.v --ports bump_stop_ports.toml "
+        "--mutants 10 --cycles 2000"
+    ): Plan(
+        slow=True,
+        setup=(
+            " ".join(
+                [
+                    "cp",
+                    *(
+                        str(ROOT / "tests/data" / name)
+                        for name in ("bump_stop.v", "bump_stop_ports.toml")
+                    ),
+                    ".",
+                ]
+            ),
+        ),
+        out=(
+            (
+                r"unit judge \(against the unmutated design\): 8 caught, 2 equivalent on "
+                r"these inputs: score 80\.0%"
+            ),
+        ),
+        files=("runs/mutation/bump_stop-n10-s1/mutants.json",),
+    ),
+    "fpga-robotics formal --design verilog:bump_stop_formal.v": Plan(
+        slow=True,
+        setup=(f"cp {ROOT / 'tests/data/user_designs/bump_stop_formal.v'} .",),
+        out=(
+            r"(?m)^bump_stop_formal\.asserts\s+prove\s+20\s+pass\s",
+            r"(?m)^bump_stop_formal\.covers\s+cover\s+20\s+pass\s",
+            r"(?m)^2 of 2 checks passed",
+        ),
+    ),
+    (
+        "fpga-robotics board --design wall_stop.py:WallStop --param clock_hz=50000000 "
+        "-o build/wall_stop"
+    ): Plan(
+        setup=(f"cp {ROOT / 'tests/data/user_designs/wall_stop.py'} .",),
+        out=(r"trig: header gpio 7\+ \(site A6\)", r"echo: header gpio 7- \(site B6\)"),
+        files=("build/wall_stop/ulx3s_follow_target.v", "build/wall_stop/ulx3s_follow_target.lpf"),
+    ),
+    "fpga-robotics bench user_verilog": Plan(
+        slow=True,
+        shorter=(("--seconds", "0.2"), ("--repeats", "1")),
+        out=(
+            r"(?m)^cxxrtl +[\d.]+ +[\d.]+ +1\.00$",
+            r"(?m)^verilator +[\d.]+ +[\d.]+ +[\d.]+$",
+        ),
+    ),
     "fpga-robotics designs": Plan(
         out=(
             r"follow_target_safe  \(built-in\)",

@@ -48,8 +48,56 @@ def test_a_design_without_properties_is_one_line(capsys):
         )
         and err.count("\n") == 1
     )
-    with pytest.raises(UsageError, match="Verilog design's properties are not checked"):
+    with pytest.raises(UsageError, match="cannot read the Verilog file x.v"):
         formal.design_checks("verilog:x.v")
+    code, out, err = _cli(["formal", "--design", f"verilog:{DESIGNS}/bump_stop_noreset.v"], capsys)
+    assert code == 2 and out == "" and err.count("\n") == 1
+    assert "bump_stop_noreset.v: no assert or cover statement to check" in err
+
+
+VERILOG = DESIGNS / "bump_stop_formal.v"
+
+
+def test_a_verilog_design_lists_its_assertions_and_covers(capsys):
+    code, out, _ = _cli(["formal", "--design", f"verilog:{VERILOG}", "--list"], capsys)
+    assert code == 0
+    assert [line.split()[:3] for line in out.splitlines()] == [
+        ["bump_stop_formal.asserts", "prove", "20"],
+        ["bump_stop_formal.covers", "cover", "20"],
+    ]
+
+
+@pytest.mark.formal
+@pytest.mark.slow  # two SymbiYosys proofs and a counterexample
+def test_the_assertions_of_a_verilog_design_are_proved_and_a_broken_one_fails(capsys, tmp_path):
+    code, out, _ = _cli(
+        ["formal", "--design", f"verilog:{VERILOG}", "--trace-dir", str(tmp_path)], capsys
+    )
+    assert code == 0, out
+    assert [line.split()[:4] for line in out.splitlines()[1:3]] == [
+        ["bump_stop_formal.asserts", "prove", "20", "pass"],
+        ["bump_stop_formal.covers", "cover", "20", "pass"],
+    ]
+    # Not sticky any more: the robot drives on when the bumper opens, against line 20.
+    broken = tmp_path / "bump_stop_formal.v"
+    broken.write_text(VERILOG.read_text().replace("if (bump_i) hit <= 1'b1;", "hit <= bump_i;"))
+    code, out, _ = _cli(
+        [
+            "formal",
+            "--design",
+            f"verilog:{broken}",
+            "--only",
+            "bump_stop_formal.asserts",
+            "--trace-dir",
+            str(tmp_path / "traces"),
+        ],
+        capsys,
+    )
+    assert code == 1
+    lines = out.splitlines()
+    assert lines[1].split()[:4] == ["bump_stop_formal.asserts", "prove", "20", "FAIL"]
+    assert lines[2].strip().startswith("failed assertion bump_stop_formal.v:20.")
+    assert "$enddefinitions" in (tmp_path / "traces" / "bump_stop_formal.asserts.vcd").read_text()
 
 
 @pytest.mark.formal

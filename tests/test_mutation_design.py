@@ -133,16 +133,88 @@ def test_mutate_design_prints_the_scores_of_a_users_design(tmp_path, capsys):
     assert {m["module"] or "top" for m in result["mutants"]} <= {"top", "us"}
 
 
+@pytest.mark.slow  # a Verilator build of the mutant netlist, closed-loop runs of its mutants
+def test_robot_judge_of_a_users_design_matches_its_runs(tmp_path, capsys):
+    """``mutate --design REF --campaign C``: each unit-caught mutant of WallStop runs the
+    campaign in closed loop; its verdict must be the one its replayed run gives, and the
+    unmutated design (``mutsel = 0``) passes the same run."""
+    from fpga_robotics.sweep import runner
+
+    campaign = tmp_path / "wall.toml"
+    campaign.write_text(
+        f'description = "wall_stop at its wall"\nscenarios = ["{DESIGNS}/wall_stop.toml"]\n'
+        'seeds = "0"\nbackend = "auto"\n'
+    )
+    out = tmp_path / "m"
+    code, text, _ = _cli(
+        [
+            "mutate",
+            "--design",
+            f"{DESIGNS}/wall_stop.py:WallStop",
+            "--mutants",
+            "8",
+            "--cycles",
+            "20000",
+            "--campaign",
+            str(campaign),
+            "--workers",
+            "1",
+            "--out",
+            str(out),
+            "--quiet",
+        ],
+        capsys,
+    )
+    assert code == 0
+    result = json.loads((out / "mutants.json").read_text())
+    assert result["baseline"]["statuses"] == ["pass"]
+    unit_caught = {m["index"] for m in result["mutants"] if m["unit"]["caught"]}
+    judged = {m["index"]: m["robot"] for m in result["mutants"] if m["robot"] is not None}
+    assert set(judged) == unit_caught and unit_caught
+    robot_caught = sum(v["caught"] for v in judged.values())
+    assert result["robot"] == {
+        "judged": len(judged),
+        "caught": robot_caught,
+        "score": robot_caught / len(judged),
+    }
+    assert f"{robot_caught} of {len(judged)} unit-caught mutants caught" in text
+    # The runs again, one by one, outside the judge: the same verdicts.
+    base = runner.execute(result["baseline"]["runs"][0])
+    assert base["status"] == "pass"
+    for index, v in judged.items():
+        if v["status"] == "timeout":  # a mutant that slows the loop down: caught by its time
+            continue
+        again = runner.execute(v["argv"])
+        assert again["status"] == v["status"], index
+        assert [c["name"] for c in again["summary"]["checks"] if c["passed"] is False] == (
+            v["failed_checks"]
+        )
+    # A mutant that stops WallStop from ever stopping is caught: it drives into the wall.
+    never_stops = [
+        m
+        for m in result["mutants"]
+        if m["unit"]["caught"] and m["unit"]["effect"].count("stopped 1 -> 0")
+    ]
+    for m in never_stops:
+        assert judged[m["index"]]["failed_checks"] == ["max_wall_collisions"]
+
+
 @pytest.mark.parametrize(
     "argv, message",
     [
-        (["--design", "verilog:x.v"], "a Verilog design is not mutated here"),
+        (["--design", "verilog:x.v"], "no file 'x.v'"),
+        (["--design", "bump_stop_noreset.v"], "unknown design 'bump_stop_noreset.v'"),
         (
-            ["--design", "wall_stop.py:WallStop", "--campaign", "mutation"],
-            "with --design only the unit judge runs",
+            ["--design", "verilog:bump_stop_noreset.v"],
+            "needs its port map: --ports PORTS.toml",
+        ),
+        (["--design", "wall_stop.py:WallStop", "--ports", "x.toml"], "--ports is the port map"),
+        (
+            ["--design", "wall_stop.py:WallStop", "--campaign", "nosuch"],
+            "unknown campaign 'nosuch'",
         ),
         (["--design", "wall_stop.py:WallStop", "--param", "nope"], "--param must be NAME=VALUE"),
-        (["--cycles", "5"], "--param and --cycles go with --design REF"),
+        (["--cycles", "5"], "--param, --ports and --cycles go with --design REF"),
     ],
 )
 def test_bad_design_arguments_are_one_line(argv, message, capsys, monkeypatch):
@@ -183,3 +255,77 @@ def test_follow_target_against_itself_scores_as_against_the_model(tmp_path, caps
         m["unit"] for m in runs["design"]["mutants"]
     ]
     assert runs["model"]["unit"] == runs["design"]["unit"]
+
+
+def bump_stop_trace(stimulus, cycles):
+    """tests/data/bump_stop.v by hand: ``hit`` latches at the first edge ``bump_i`` is 1; the
+    wheels run at 300 DPS until then, 0 after (``{output: [(cycle, value), ...]}``)."""
+    levels = {}
+    for edge, name, value in stimulus:
+        if name == "bump_i":
+            levels[edge] = value
+    hit_at, level = None, 0
+    for edge in range(1, cycles + 1):
+        level = levels.get(edge, level)
+        if level:
+            hit_at = edge
+            break
+    trace = {"motor_left": [(0, 300)], "motor_right": [(0, 300)]}
+    if hit_at is not None:
+        trace["motor_left"].append((hit_at, 0))
+        trace["motor_right"].append((hit_at, 0))
+    return trace
+
+
+@pytest.mark.slow  # Verilator builds of the Verilog design's mutant netlist
+def test_mutants_of_a_verilog_design_against_a_hand_model(tmp_path, capsys):
+    """``mutate --design verilog:FILE --ports MAP``: Yosys reads the Verilog, the unmutated
+    netlist (``mutsel = 0``) behaves as the hand model of bump_stop.v, and a mutant is caught
+    exactly when its outputs differ from the model's."""
+    from fpga_robotics.designs.builtin import connector_kinds
+    from fpga_robotics.sim.backends.foreign import ForeignDesign
+    from fpga_robotics.sim.pins.compiled import VerilatorPins
+    from fpga_robotics.sim.pins.verilog import VerilogPinSource
+
+    data = Path(__file__).parent / "data"
+    out, cycles = tmp_path / "m", 2000
+    code, text, _ = _cli(
+        [
+            "mutate",
+            "--design",
+            f"verilog:{data / 'bump_stop.v'}",
+            "--port-map",
+            str(data / "bump_stop_ports.toml"),
+            "--mutants",
+            "10",
+            "--cycles",
+            str(cycles),
+            "--out",
+            str(out),
+            "--quiet",
+        ],
+        capsys,
+    )
+    assert code == 0
+    result = json.loads((out / "mutants.json").read_text())
+    assert text.splitlines()[0].startswith("10 mutants of bump_stop (seed 1)")
+    source = VerilogPinSource(
+        ForeignDesign(
+            [out / "mutants.v"],
+            out / "mutants_ports.toml",
+            pins=True,
+            connector_kinds=connector_kinds(),
+        )
+    )
+    backend = VerilatorPins(source)
+    try:
+        ports = {p: port for p, port in backend.ports.items() if p in ("bump_i", "mutsel")}
+        stimulus = pin_stimulus(ports, cycles, 0)
+        outputs = ["motor_left", "motor_right"]  # hit_o: no output of the port map
+        model = bump_stop_trace(stimulus, cycles)
+        assert pin_trace(backend, 0, stimulus, cycles, outputs) == model
+        for m in result["mutants"]:
+            got = pin_trace(backend, m["index"], stimulus, cycles, outputs)
+            assert m["unit"]["caught"] == (got != model), m["describe"]
+    finally:
+        backend.close()

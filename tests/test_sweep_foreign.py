@@ -43,7 +43,8 @@ def test_a_foreign_design_without_found_in_a_campaign(tmp_path):
     rows = run_campaign(campaign, tmp_path / "out", workers=1, record="none")
     assert sorted(r["seed"] for r in rows) == [0, 1]
     for row in rows:
-        assert row["backend"] == "verilator-foreign"
+        # backend auto: CXXRTL, which reads this Verilog (sim/backends/foreign_choice.py).
+        assert row["backend"] == "cxxrtl-foreign"
         assert json.loads(row["absent_outputs"]) == ["found", "centroid_x", "centroid_leds"]
         assert row["found_fraction"] is None and row["acquired_at_s"] is None
         assert row["check_acquired_within_s"] is None  # not measured, not failed

@@ -87,6 +87,10 @@ BENCHMARKS = {
     ),
     "ros": ("fpga_robotics.bench.ros", "writing a ROS 2 bag and publishing live to Foxglove"),
     "pins": ("fpga_robotics.bench.pins", "the pin backends in real-clock time (Mcycles/s)"),
+    "user_verilog": (
+        "fpga_robotics.bench.user_verilog",
+        "a user's Verilog design in real-clock timing on each backend (Mcycles/s)",
+    ),
     "sweep": ("fpga_robotics.bench.sweep", "campaign throughput on 1 worker and on N"),
     "lidar": (
         "fpga_robotics.bench.lidar",

@@ -8,7 +8,14 @@ import sys
 from fpga_robotics.cli.errors import UsageError
 from fpga_robotics.cli.param_options import add_param_arguments, params_from_args
 from fpga_robotics.cli.parser import CommandParser
-from fpga_robotics.flow.board import board_factory, board_names, build_bitstream, export_board
+from fpga_robotics.flow.board import (
+    board_factory,
+    board_names,
+    board_ports,
+    build_bitstream,
+    export_board,
+    header_pins,
+)
 from fpga_robotics.sim.files import check_output_dir
 
 __all__ = ["add_board_arguments", "main", "run_board"]
@@ -34,22 +41,28 @@ def add_board_arguments(parser):
     )
 
 
-def run_board(args, params, out_dir, prog="fpga-robotics board"):
-    """Export (and optionally build) ``args.board`` into ``out_dir``; returns an exit code."""
+def run_board(args, params, out_dir, prog="fpga-robotics board", design=None):
+    """Export (and optionally build) ``args.board`` into ``out_dir`` (with ``design``, a
+    ``DesignSpec``, on it instead of FollowTarget); returns an exit code."""
     board_factory(args.board)
+    if design is not None:
+        board_ports(design)  # a port the board cannot serve: one line, nothing written
     if args.seed is not None and not args.bitstream:
         raise UsageError("--seed is nextpnr's placement seed: it needs --bitstream")
     seed = 1 if args.seed is None else args.seed
     check_output_dir(out_dir, what="board output folder")
     if not args.bitstream:
-        written = export_board(args.board, out_dir, params)
+        written = export_board(args.board, out_dir, params, design=design)
+        if design is not None:
+            for port, pin, site in header_pins(design):
+                print(f"{port}: header {pin} (site {site})")
         for path in written:
             if path.endswith((".v", ".lpf")):
                 print(f"wrote {path}")
         print(f"wrote {len(written)} files for board {args.board} in {out_dir}")
         return 0
     try:
-        report = build_bitstream(args.board, out_dir, params, seed=seed)
+        report = build_bitstream(args.board, out_dir, params, seed=seed, design=design)
     except RuntimeError as exc:
         print(f"{prog}: error: {exc}", file=sys.stderr)
         return 1
@@ -86,7 +99,31 @@ def main(argv=None, prog="fpga-robotics board"):
         "--bitstream", action="store_true", help="run synthesis, place and route and packing too"
     )
     parser.add_argument("--seed", type=int, default=None, help="nextpnr seed (default: 1)")
+    parser.add_argument(
+        "--design",
+        metavar="REF",
+        help="put this design of your own on the board instead of FollowTarget "
+        "(FILE.py:Name, package.module:Name; docs/your_design.md): the camera stream, "
+        "the wheels and its connector pins on header pins",
+    )
+    parser.add_argument(
+        "--param",
+        action="append",
+        default=[],
+        metavar="NAME=VALUE",
+        help="with --design: one of its parameters (a TOML value; repeatable)",
+    )
     add_param_arguments(parser)
     args = parser.parse_args(argv)
     params = params_from_args(args)
-    return run_board(args, params, args.output or os.path.join("build", args.board), prog)
+    design = None
+    if args.design is not None:
+        from fpga_robotics.cli.mutate import _design_params
+        from fpga_robotics.designs.reference import resolve_design
+
+        design = resolve_design(args.design, _design_params(args.param))
+    elif args.param:
+        raise UsageError("--param goes with --design REF (a design of your own)")
+    return run_board(
+        args, params, args.output or os.path.join("build", args.board), prog, design=design
+    )

@@ -68,8 +68,16 @@ def build_parser(prog="fpga-robotics formal"):
         "--design",
         metavar="REF",
         help="check the properties this design declares (FILE.py:Name or "
-        "package.module:Name with formal_properties, docs/formal.md) instead "
+        "package.module:Name with formal_properties, docs/formal.md; or "
+        "verilog:FILES, its assert and cover statements) instead "
         "of FollowTarget's",
+    )
+    parser.add_argument(
+        "--ports",
+        "--port-map",
+        dest="ports",
+        metavar="PORTS.toml",
+        help="with --design verilog:FILES: its port map (names the top module)",
     )
     return parser
 
@@ -81,7 +89,7 @@ def main(argv=None, prog="fpga-robotics formal"):
     if args.jobs < 1:
         raise UsageError(f"--jobs must be at least 1, got {args.jobs}")
 
-    checks = select(design_checks(args.design), args.only)
+    checks = select(design_checks(args.design, ports=args.ports), args.only)
     if args.list:
         width = max(len(c.name) for c in checks)
         for c in checks:

@@ -190,8 +190,9 @@ def build_parser(prog="fpga-robotics mutate"):
     p.add_argument(
         "--design",
         metavar="REF",
-        help="mutants of this Amaranth design (FILE.py:Name, package.module:Name; "
-        "docs/your_design.md) instead of FollowTarget, each judged against "
+        help="mutants of this design (FILE.py:Name, package.module:Name, or "
+        "verilog:FILES with --ports; docs/your_design.md) instead of FollowTarget, each "
+        "judged against "
         "the unmutated design on seeded random inputs, cycle by cycle",
     )
     p.add_argument(
@@ -200,6 +201,13 @@ def build_parser(prog="fpga-robotics mutate"):
         default=[],
         metavar="NAME=VALUE",
         help="with --design: one of its parameters (a TOML value; repeatable)",
+    )
+    p.add_argument(
+        "--ports",
+        "--port-map",
+        dest="ports",
+        metavar="PORTS.toml",
+        help="with --design verilog:FILES: the design's port map (docs/foreign.md)",
     )
     p.add_argument(
         "--cycles",
@@ -232,22 +240,28 @@ def _main_design(args):
     """``--design REF``: the mutants of a design of one's own against itself."""
     from fpga_robotics.designs.reference import resolve_design
     from fpga_robotics.mutation.design_run import DEFAULT_CYCLES, mutate_design
+    from fpga_robotics.sim.backends.base import BackendError
+    from fpga_robotics.sim.pins import PinError
 
-    if args.design.startswith("verilog:"):
+    verilog = args.design.startswith("verilog:")
+    if verilog and args.param:
         raise UsageError(
-            f"--design {args.design}: mutants are made of Amaranth designs "
-            f"(FILE.py:Name); a Verilog design is not mutated here"
+            "--param: a Verilog design takes no parameters here; set them in the Verilog"
         )
-    if args.campaign is not None:
-        raise UsageError(
-            "--campaign (the robot judge) runs FollowTarget's mutants; with "
-            "--design only the unit judge runs"
-        )
+    if not verilog and args.ports is not None:
+        raise UsageError("--ports is the port map of a Verilog design: it goes with verilog:FILES")
     cycles = DEFAULT_CYCLES if args.cycles is None else args.cycles
     if not 1 <= cycles <= 100_000_000:
         raise UsageError(f"--cycles must be 1..100000000, got {cycles}")
-    spec = resolve_design(args.design, _design_params(args.param))
-    name = spec.reference.rpartition(":")[2]
+    if verilog:
+        # Resolved as a run resolves it: every file there, the port map readable.
+        spec = resolve_design(args.design, ports=args.ports)
+        files = spec.reference[len("verilog:") :].split(",")
+        name = os.path.splitext(os.path.basename(files[0]))[0]
+    else:
+        spec = resolve_design(args.design, _design_params(args.param))
+        name = spec.reference.rpartition(":")[2]
+    campaign = _campaign(args.campaign) if args.campaign is not None else None
     out = args.out or os.path.join("runs", "mutation", f"{name}-n{args.mutants}-s{args.seed}")
     check_output_dir(out, what="output folder")
 
@@ -255,9 +269,43 @@ def _main_design(args):
         if not args.quiet:
             print(text, file=sys.stderr, flush=True)
 
+    from fpga_robotics.mutation.design_run import mutate_verilog_design
+
     try:
-        result = mutate_design(spec, args.mutants, args.seed, cycles, out, say=say)
-    except MutationError as exc:
+        if verilog:
+            result = mutate_verilog_design(
+                files,
+                args.ports,
+                args.mutants,
+                args.seed,
+                cycles,
+                out,
+                say=say,
+                campaign=campaign,
+                robot={
+                    "workers": args.workers,
+                    "scheduler": args.scheduler,
+                    "resume": args.resume,
+                    "fork": args.fork,
+                },
+            )
+        else:
+            result = mutate_design(
+                spec,
+                args.mutants,
+                args.seed,
+                cycles,
+                out,
+                say=say,
+                campaign=campaign,
+                robot={
+                    "workers": args.workers,
+                    "scheduler": args.scheduler,
+                    "resume": args.resume,
+                    "fork": args.fork,
+                },
+            )
+    except (MutationError, BackendError, PinError) as exc:
         raise UsageError(str(exc).splitlines()[0]) from None
     score, modules = result["unit"], result["modules"]
     rate = (60 * score["total"] / result["unit_judge_s"]) if result["unit_judge_s"] else 0
@@ -272,7 +320,14 @@ def _main_design(args):
     )
     width = max(len(m) for m in modules)
     for module, row in modules.items():
-        print(f"  {module:<{width}}  {row['unit_caught']:>4}/{row['total']:<4} caught")
+        robot_part = (
+            f", robot judge {row['robot_caught']:>4}/{row['unit_caught']}"
+            if campaign is not None
+            else ""
+        )
+        print(f"  {module:<{width}}  {row['unit_caught']:>4}/{row['total']:<4} caught{robot_part}")
+    if campaign is not None:
+        _report_design_robot(result, campaign)
     missed = [m for m in result["mutants"] if not m["unit"]["caught"]]
     if missed:
         print("equivalent on these inputs (first 10):")
@@ -280,6 +335,28 @@ def _main_design(args):
             print(f"  {m['describe']}")
     print(f"wrote {os.path.join(out, 'mutants.json')}")
     return 0
+
+
+def _report_design_robot(result, campaign):
+    """The robot judge's lines for a design of one's own: its score and blind spots."""
+    rs, baseline = result["robot"], result["baseline"]
+    n_runs, n_pass = len(baseline["runs"]), len(baseline["passing"])
+    print(
+        f"robot judge (campaign {campaign.name}: {n_pass} of {n_runs} runs pass unmutated): "
+        f"{rs['caught']} of {rs['judged']} unit-caught mutants caught: score "
+        f"{_percent(rs['score'])}; {_robot_rate(baseline['judged_here'], result['robot_judge_s'])}"
+    )
+    if not n_pass:
+        print("no run passes with the unmutated design: the robot judge has no run to judge by")
+        return
+    blind = [m for m in result["mutants"] if m["robot"] is not None and not m["robot"]["caught"]]
+    if blind:
+        print(f"blind spots: caught by the unit judge, missed by every run ({len(blind)}):")
+        for m in blind:
+            print(f"  {m['describe']}")
+            print(f"    unit: {m['unit']['effect']}")
+            if m["robot"].get("replay"):
+                print(f"    closest run: {m['robot']['replay']}")
 
 
 def _check(args):
@@ -304,8 +381,10 @@ def main(argv=None, prog="fpga-robotics mutate"):
     _check(args)
     if args.design is not None and args.design != "follow_target":
         return _main_design(args)
-    if args.param or args.cycles is not None:
-        raise UsageError("--param and --cycles go with --design REF (a design of your own)")
+    if args.param or args.cycles is not None or args.ports is not None:
+        raise UsageError(
+            "--param, --ports and --cycles go with --design REF (a design of your own)"
+        )
     params = params_from_args(args)
     campaign = _campaign(args.campaign) if args.campaign is not None else None
     out = args.out or os.path.join("runs", "mutation", f"n{args.mutants}-s{args.seed}")

@@ -357,15 +357,16 @@ def _open_pin_design(args, scenario):
             print(f"{text} ...", file=sys.stderr, flush=True)
 
     if scenario.foreign is not None:  # a Verilog design on pins: on CXXRTL or Verilator
-        if args.runtime:
-            raise UsageError(
-                "--runtime changes [runtime] inputs between frames in compressed "
-                "timing; in real-clock timing they keep the port map's values"
-            )
         try:
-            return make_pin_backend(args.backend, scenario, on_build=tell)
+            design = make_pin_backend(args.backend, scenario, on_build=tell)
         except (BackendError, PinError) as exc:
             raise UsageError(f"--design: {exc}".splitlines()[0]) from None
+        try:
+            apply_runtime(design, args)  # held from every reset on
+        except UsageError:
+            design.close()
+            raise
+        return design
     try:
         return make_pin_backend(args.backend, scenario, on_build=tell)
     except (BackendError, PinError, ValueError, ImportError) as exc:
@@ -471,11 +472,12 @@ def apply_runtime(design, args):
     """Hold the design's ``[runtime]`` inputs at the ``--runtime`` values (a design opened
     once and reused for several runs gets its values again before each)."""
     from fpga_robotics.sim.backends.base import BackendError
+    from fpga_robotics.sim.pins import PinError
 
     for name, value in runtime_values(args).items():
         try:
             design.set_runtime(name, value)
-        except BackendError as exc:
+        except (BackendError, PinError) as exc:
             raise UsageError(f"--runtime: {exc}") from None
 
 

@@ -26,8 +26,10 @@ __all__ = [
     "BuildReport",
     "ClockTiming",
     "board_names",
+    "board_ports",
     "build_bitstream",
     "export_board",
+    "header_pins",
     "parse_nextpnr_report",
 ]
 
@@ -81,8 +83,110 @@ def _label_clocks(board, report):
     ]
 
 
-def _plan(board, params, nextpnr_opts=(), *, verilog=False):
-    factory = board_factory(board)
+#: Inputs the board drives itself when the design has them (the camera's stream, the DIP
+#: switches' colour code).
+_CAMERA_INPUTS = ("pixels__valid", "pixels__payload", "color_sel")
+
+
+def board_ports(spec, board="ulx3s-85f"):
+    """How a design of one's own (``spec``, a resolved Amaranth ``DesignSpec``) meets the
+    board: ``{"camera": bool, "header": [(port, "i"|"o")]}``. A port the board cannot serve
+    is a ``UserError`` naming it: the wheels must be ``motor_left``/``motor_right`` (signed,
+    at most 16 bits), ``color_sel`` 3 bits, ``centroid_leds`` at most 8 bits, every other
+    input a 1-bit pin of a connector (it goes to a header pin), and there are
+    ``len(HEADER_SITES)`` header pins."""
+    from fpga_robotics.hw.board.ulx3s_user_top import HEADER_SITES
+
+    board_factory(board)
+    if spec.kind != "amaranth":
+        raise UserError(
+            f"design {spec.reference!r}: the board takes an Amaranth design of one's own "
+            f"(FILE.py:Name, package.module:Name); FollowTarget is the default"
+        )
+    name = spec.reference.rpartition(":")[2]
+    ports, bindings = spec.ports, spec.bindings
+    wheels = bindings.get("wheels", {})
+    for pin in ("motor_left", "motor_right"):
+        port = wheels.get(pin)
+        if port is None or ports.get(port, ("",))[0] != "out":
+            raise UserError(
+                f"design {name}: the board drives the GoPiGo3 wheels from outputs "
+                f"motor_left and motor_right; {name} has no output {pin!r}"
+            )
+        if ports[port][1] > 16:
+            raise UserError(
+                f"design {name}: port {port!r} (the wheels' {pin}) is {ports[port][1]} bits; "
+                f"the GoPiGo3 takes at most 16 (signed DPS)"
+            )
+    if wheels != {"motor_left": "motor_left", "motor_right": "motor_right"}:
+        raise UserError(
+            f"design {name}: the board wires the wheels to ports named motor_left and "
+            f"motor_right; rename {', '.join(v for v in wheels.values())} so"
+        )
+    camera = "camera" in bindings
+    if camera and ports.get("color_sel", ("in", 3))[1] != 3:
+        raise UserError(
+            f"design {name}: port 'color_sel' is {ports['color_sel'][1]} bits; the board's "
+            f"DIP switches give the 3-bit colour code"
+        )
+    if ports.get("centroid_leds", ("out", 0))[1] > 8:
+        raise UserError(f"design {name}: port 'centroid_leds' is wider than the 8 user LEDs")
+    pins_of = {
+        port: (kind, pin)
+        for kind, pins in bindings.items()
+        if kind not in ("wheels", "camera")
+        for pin, port in pins.items()
+    }
+    header = []
+    for port, (direction, width) in ports.items():
+        if port in ("motor_left", "motor_right") or (camera and port in _CAMERA_INPUTS):
+            continue
+        if port in pins_of:
+            kind, pin = pins_of[port]
+            if width != 1 or "__" in port:
+                raise UserError(
+                    f"design {name}: port {port!r} (the {kind} connector's {pin}) is "
+                    f"{width} bits; the board's header pins take 1-bit ports"
+                )
+            header.append((port, "i" if direction == "in" else "o"))
+        elif direction == "in":
+            raise UserError(
+                f"design {name}: input {port!r} is no pin of the board: it takes the "
+                f"camera stream (pixels, color_sel), the wheels (motor_left, motor_right) "
+                f"and connector pins (trig, echo, pressed, ...) on header pins"
+            )
+    if len(header) > len(HEADER_SITES):
+        raise UserError(
+            f"design {name}: {len(header)} connector pins, the board's header has "
+            f"{len(HEADER_SITES)} free"
+        )
+    return {"camera": camera, "header": header}
+
+
+def _user_factory(spec):
+    def factory(params):
+        from fpga_robotics.hw.board.ulx3s_user_top import ULX3SUserDesign, ulx3s_user_platform
+
+        wiring = board_ports(spec)
+        return ulx3s_user_platform(wiring["header"]), ULX3SUserDesign(
+            spec.build(), header=wiring["header"], camera=wiring["camera"]
+        )
+
+    return factory
+
+
+def header_pins(spec):
+    """``[(port, header pin, site)]``: where a design's connector pins are on the board."""
+    from fpga_robotics.hw.board.ulx3s_user_top import HEADER_SITES
+
+    return [
+        (port, pin, site)
+        for (port, _d), (pin, site) in zip(board_ports(spec)["header"], HEADER_SITES)
+    ]
+
+
+def _plan(board, params, nextpnr_opts=(), *, verilog=False, design=None):
+    factory = board_factory(board) if design is None else _user_factory(design)
     try:
         platform, top = factory(params)
         return platform.build(
@@ -111,13 +215,14 @@ def _write_plan(plan, out_dir, *, rename_verilog=True):
     return written
 
 
-def export_board(board, out_dir, params=None):
+def export_board(board, out_dir, params=None, design=None):
     """Write the board top's Verilog (``<name>.v``), pin constraints (``<name>.lpf``) and the
-    rest of the build plan (RTLIL, Yosys script, build script) into ``out_dir``."""
+    rest of the build plan (RTLIL, Yosys script, build script) into ``out_dir``; ``design``
+    (a ``DesignSpec``) puts a design of one's own on the board instead of FollowTarget."""
     from fpga_robotics.hw.params import FollowTargetParams
 
     params = FollowTargetParams() if params is None else params
-    return _write_plan(_plan(board, params, verilog=True), out_dir)
+    return _write_plan(_plan(board, params, verilog=True, design=design), out_dir)
 
 
 @dataclass(frozen=True)
@@ -206,7 +311,7 @@ def find_yowasp_tools():
     return found
 
 
-def build_bitstream(board, out_dir, params=None, *, seed=1, log=print):
+def build_bitstream(board, out_dir, params=None, *, seed=1, log=print, design=None):
     """Synthesise, place and route, and pack ``board``'s top into ``out_dir``.
 
     Returns a ``BuildReport``; raises ``UserError`` when a tool is missing and
@@ -222,6 +327,7 @@ def build_bitstream(board, out_dir, params=None, *, seed=1, log=print):
         board,
         params,
         nextpnr_opts=(f"--seed {int(seed)}", f"--report {report_name}", "--timing-allow-fail"),
+        design=design,
     )
     os.makedirs(out_dir, exist_ok=True)
     _write_plan(plan, out_dir, rename_verilog=False)

@@ -17,7 +17,7 @@ import sys
 import tempfile
 import threading
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from fpga_robotics.hw.errors import UsageError, UserError
@@ -25,12 +25,14 @@ from fpga_robotics.sim.files import atomic_path
 
 __all__ = [
     "CheckResult",
+    "VerilogCheck",
     "default_trace_dir",
     "design_checks",
     "end_running",
     "formal_env",
     "run_check",
     "select",
+    "verilog_checks",
 ]
 
 #: The programs a check needs, and the pip package that ships each.
@@ -118,8 +120,9 @@ def _summary(output):
     for line in output.splitlines():
         if "summary:" in line and any(w in line for w in wanted):
             text = line.split("summary:", 1)[1].strip()
-            text = re.sub(r"top\.\S*_witness_\.\S+ at ", "", text)
-            found.append(text)
+            text = re.sub(r"\S*_witness_\.\S+ at ", "", text)
+            if not any(f.startswith(text) for f in found):  # once, with its step
+                found.append(text)
     return "; ".join(found)
 
 
@@ -186,19 +189,100 @@ def _trace_name(name):
     return re.sub(r"[^A-Za-z0-9._-]+", "_", name) + ".vcd"
 
 
-def run_check(check, *, depth=None, dut=None, trace_dir=None, env=None, timeout=None):
-    """Run one ``FormalCheck`` (around ``dut``, or the real design) and return its
-    ``CheckResult``. A counterexample is copied to ``trace_dir`` (atomically) when given."""
-    from amaranth.back import rtlil
+@dataclass
+class VerilogCheck:
+    """The immediate ``assert``/``assume``/``cover`` statements of a Verilog design, as
+    ``read_verilog -formal`` reads them: one run proves the assertions (``prove``) or reaches
+    the covers (``cover``). ``sources``: file name -> text; ``top`` the top module (None:
+    Yosys finds it)."""
 
+    name: str
+    mode: str
+    depth: int
+    promise: str
+    sources: dict = field(repr=False)
+    top: str | None = None
+
+
+def verilog_sby_script(check, depth):
+    """The SymbiYosys job of a ``VerilogCheck``: its files read with ``-formal``."""
+    top = f"prep -top {check.top}" if check.top else "prep -auto-top"
+    return "\n".join(
+        [
+            "[options]",
+            f"mode {check.mode}",
+            f"depth {depth}",
+            "",
+            "[engines]",
+            "smtbmc yices",
+            "",
+            "[script]",
+            *(f"read_verilog -sv -formal {name}" for name in check.sources),
+            top,
+            "",
+            "[files]",
+            *check.sources,
+            "",
+        ]
+    )
+
+
+_ASSERT = re.compile(r"\bassert\s*(property\s*)?\(")
+_COVER = re.compile(r"\bcover\s*(property\s*)?\(")
+
+
+def verilog_checks(files, top=None, depth=20):
+    """The ``VerilogCheck``s of Verilog ``files`` (top module ``top``, e.g. a port map's):
+    ``<top>.asserts`` when the files assert anything, ``<top>.covers`` when they cover
+    anything. A file that cannot be read, or files without either, are a ``UsageError``."""
+    sources = {}
+    for f in files:
+        path = Path(f)
+        try:
+            sources[path.name] = path.read_text()
+        except (OSError, UnicodeDecodeError) as exc:
+            raise UsageError(
+                f"cannot read the Verilog file {f}: {getattr(exc, 'strerror', None) or exc}"
+            ) from None
+    if len(sources) != len(files):
+        raise UsageError("two Verilog files have the same name")
+    text = "\n".join(re.sub(r"//[^\n]*", "", t) for t in sources.values())
+    name = top or Path(files[0]).stem
+    checks = []
+    if _ASSERT.search(text):
+        promise = "every assert statement of the Verilog holds (assume statements assumed)"
+        checks.append(VerilogCheck(f"{name}.asserts", "prove", depth, promise, sources, top))
+    if _COVER.search(text):
+        promise = "every cover statement of the Verilog is reachable"
+        checks.append(VerilogCheck(f"{name}.covers", "cover", depth, promise, sources, top))
+    if not checks:
+        raise UsageError(
+            f"{', '.join(files)}: no assert or cover statement to check; add immediate "
+            f"assertions in an always block, e.g. always @(posedge clk) assert(...); "
+            f"(read with read_verilog -formal, docs/formal.md)"
+        )
+    return checks
+
+
+def run_check(check, *, depth=None, dut=None, trace_dir=None, env=None, timeout=None):
+    """Run one ``FormalCheck`` (around ``dut``, or the real design) or ``VerilogCheck`` and
+    return its ``CheckResult``. A counterexample is copied to ``trace_dir`` (atomically) when
+    given."""
     env = formal_env() if env is None else env
     depth = check.depth if depth is None else depth
-    harness = check.build(dut)
     started = time.perf_counter()
     with tempfile.TemporaryDirectory(prefix="fpga_robotics-formal-") as work:
         work = Path(work)
-        (work / "top.il").write_text(rtlil.convert(harness, ports=harness.ports()))
-        (work / "check.sby").write_text(sby_script(check, depth))
+        if isinstance(check, VerilogCheck):
+            for name, text in check.sources.items():
+                (work / name).write_text(text)
+            (work / "check.sby").write_text(verilog_sby_script(check, depth))
+        else:
+            from amaranth.back import rtlil
+
+            harness = check.build(dut)
+            (work / "top.il").write_text(rtlil.convert(harness, ports=harness.ports()))
+            (work / "check.sby").write_text(sby_script(check, depth))
         output = _run_sby(work, env, timeout)
         seconds = time.perf_counter() - started
         status_file = work / "check" / "status"
@@ -222,11 +306,13 @@ def run_check(check, *, depth=None, dut=None, trace_dir=None, env=None, timeout=
     return CheckResult(check.name, check.mode, depth, status, seconds, detail, trace)
 
 
-def design_checks(reference=None, params=None):
+def design_checks(reference=None, params=None, ports=None):
     """The formal checks of a design reference (docs/your_design.md): ``follow_target`` (or
     None) has the project's own list, ``hw.formal.CHECKS``; a design of one's own the
-    properties it declares (``formal_properties``/``formal_covers``, docs/formal.md). A design
-    that declares none, or a Verilog one, is a ``UsageError``."""
+    properties it declares (``formal_properties``/``formal_covers``, docs/formal.md); a
+    Verilog one (``verilog:FILES``, its top from the port map ``ports`` when given) the
+    assert and cover statements it holds (``verilog_checks``). A design that declares none is
+    a ``UsageError``."""
     from fpga_robotics.hw.formal import CHECKS
     from fpga_robotics.hw.formal.declared import PROPERTY_HOOK, declared_checks
 
@@ -235,10 +321,20 @@ def design_checks(reference=None, params=None):
     from fpga_robotics.designs.reference import resolve_design
 
     if reference.startswith("verilog:"):
-        raise UsageError(
-            f"--design {reference}: a Verilog design's properties are not "
-            f"checked here; give an Amaranth design (FILE.py:Name)"
-        )
+        files = [f for f in reference[len("verilog:") :].split(",") if f.strip()]
+        if not files:
+            raise UsageError(f"--design {reference}: name the Verilog files, verilog:TOP.v")
+        top = None
+        if ports is not None:
+            from fpga_robotics.sim.backends.port_map import PortMapError, load_port_map
+
+            try:
+                top = load_port_map(ports).top
+            except PortMapError as exc:
+                raise UsageError(f"--ports {ports}: {exc}") from None
+        return verilog_checks(files, top)
+    if ports is not None:
+        raise UsageError("--ports is the port map of a Verilog design: it goes with verilog:FILES")
     spec = resolve_design(reference, params)
     name = reference if spec.kind == "builtin" else spec.reference.rpartition(":")[2]
     checks = declared_checks(name, spec.build)

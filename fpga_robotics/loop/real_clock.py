@@ -276,8 +276,11 @@ class RealClockLoop(ClosedLoop):
         return binding
 
     def _check_inputs_driven(self):
-        """Every design input is driven: by the camera's stream or a connector's pin."""
+        """Every design input is driven: by the camera's stream, a connector's pin or the
+        backend (a Verilog design's ``[runtime]`` inputs)."""
         driven = {port for io in self.io.values() for pin, port in io.binding.items()}
+        pins = getattr(self.pins, "primary", self.pins)  # a shadow's MirroredPins: its primary
+        driven |= set(getattr(getattr(pins, "source", None), "runtime", None) or ())
         if self.top.camera:
             driven |= {"pixels__valid", "pixels__payload", "color_sel"}
         if self.rig is not None:

@@ -8,7 +8,15 @@ from ..sim.backends.port_map import follow_target_port_map
 from ..sim.files import write_atomic
 from ..sim.mutation import MUTATION_SELECT, mutant_netlist
 
-__all__ = ["NETLIST_NAME", "PORTS_NAME", "open_mutant_design", "write_mutant_design"]
+__all__ = [
+    "NETLIST_NAME",
+    "PORTS_NAME",
+    "design_mutant_port_map",
+    "netlist_has_reset",
+    "open_mutant_design",
+    "with_mutant_select",
+    "write_mutant_design",
+]
 
 NETLIST_NAME = "mutants.v"
 PORTS_NAME = "mutants_ports.toml"
@@ -33,3 +41,86 @@ def write_mutant_design(params, mutants, folder):
 def open_mutant_design(params, netlist, ports, *, on_build=None):
     """A backend of the mutant netlist (built once, then loaded from the cache)."""
     return ForeignVerilatorBackend(params, files=[netlist], port_map=ports, on_build=on_build)
+
+
+def _key(name):
+    """A TOML key: bare when it can be, quoted otherwise."""
+    import json
+
+    return name if name.replace("_", "a").replace("-", "a").isalnum() else json.dumps(name)
+
+
+def netlist_has_reset(verilog):
+    """Whether the netlist's top has Amaranth's ``rst`` input (a design with a sync domain)."""
+    import re
+
+    return re.search(r"^\s*input\s+rst\s*;", verilog, re.MULTILINE) is not None
+
+
+def design_mutant_port_map(spec, ports, *, reset=True, select=MUTATION_SELECT):
+    """TOML text: the port map of the mutant netlist of a design of one's own (``spec``, a
+    resolved ``DesignSpec``; ``ports``: name -> ``Port`` as ``design_run.design_ports`` gives
+    them), its bindings as the design declares them, ``mutsel`` a ``[runtime]`` input;
+    ``reset``: whether the netlist has Amaranth's ``rst``."""
+    import json
+
+    from ..hw.verilog import TOP_NAME
+
+    q = json.dumps
+    lines = [
+        "# The mutant netlist of " + spec.reference.rpartition("/")[2] + " (generated).",
+        f"top = {q(TOP_NAME)}",
+        'clock = { port = "clk" }',
+    ]
+    if reset:
+        lines.append('reset = { port = "rst" }')
+    camera = spec.bindings.get("camera")
+    if camera is not None:
+        lines.append('pixels = { valid = "pixels__valid", payload = "pixels__payload" }')
+        if camera.get("color_sel"):
+            lines.append(f"color = {{ port = {q(camera['color_sel'])} }}")
+        if ports.get("frame_done") is not None and ports["frame_done"].direction == "out":
+            lines.append('result = { strobe = "frame_done", timeout = 100000 }')
+        else:
+            lines.append("result = { after_cycles = 1 }")
+        if "filtered__valid" in ports and "filtered__payload" in ports:
+            lines.append('filtered = { valid = "filtered__valid", payload = "filtered__payload" }')
+    outputs = dict(spec.bindings.get("wheels", {}))
+    if camera is not None:
+        outputs.update({k: k for k in ("found", "proximity", "centroid_x", "centroid_leds")})
+    out_lines = []
+    for key, port in outputs.items():
+        p = ports.get(port)
+        if p is None or p.direction != "out":
+            continue
+        signed = "true" if p.signed else "false"
+        out_lines.append(f"{key} = {{ port = {q(port)}, width = {p.width}, signed = {signed} }}")
+    if out_lines:
+        lines += ["", "[outputs]", *out_lines]
+    for kind, pins in spec.bindings.items():
+        if kind in ("wheels", "camera"):
+            continue
+        lines += ["", f"[connectors.{_key(kind)}]"]
+        lines += [f"{_key(pin)} = {q(port)}" for pin, port in pins.items()]
+    if spec.extra_outputs:
+        lines += ["", "[extra_outputs]"]
+        lines += [f"{_key(name)} = {q(name)}" for name in spec.extra_outputs]
+    lines += ["", "# The mutant select (0: the design itself).", "[runtime]", f"{select} = 0", ""]
+    return "\n".join(lines)
+
+
+def with_mutant_select(port_map_text, select=MUTATION_SELECT):
+    """A Verilog design's port map (TOML text) with ``select`` a ``[runtime]`` input at 0:
+    the port map of its mutant netlist."""
+    import re
+
+    line = f"{select} = 0  # the mutant select (0: the design itself)"
+    if re.search(r"^\s*\[runtime\]\s*(#.*)?$", port_map_text, re.MULTILINE):
+        return re.sub(
+            r"^(\s*\[runtime\]\s*(#.*)?)$",
+            lambda m: m.group(1) + "\n" + line,
+            port_map_text,
+            count=1,
+            flags=re.MULTILINE,
+        )
+    return port_map_text.rstrip("\n") + "\n\n[runtime]\n" + line + "\n"

@@ -5,13 +5,20 @@ random pin stimulus (``pin_judge``), with the same scores as FollowTarget's unit
 import os
 import time
 
-from ..sim.files import write_json_atomic
-from ..sim.mutation import component_rtlil, list_mutants
+from ..sim.files import write_atomic, write_json_atomic
+from ..sim.mutation import MUTATION_SELECT, component_rtlil, list_mutants, mutant_netlist
 from ..sim.pins.base import Port
+from .design import (
+    NETLIST_NAME,
+    PORTS_NAME,
+    design_mutant_port_map,
+    netlist_has_reset,
+    with_mutant_select,
+)
 from .pin_judge import MutantPinSource, judge_pin_mutant, open_pin_mutants, pin_stimulus, pin_trace
-from .scores import by_module, unit_score
+from .scores import by_module, robot_score, unit_score
 
-__all__ = ["DEFAULT_CYCLES", "design_ports", "mutate_design"]
+__all__ = ["DEFAULT_CYCLES", "design_ports", "mutate_design", "mutate_verilog_design"]
 
 #: Cycles of random stimulus per mutant by default (five 20 ms ultrasound periods at 1 MHz).
 DEFAULT_CYCLES = 100_000
@@ -32,9 +39,15 @@ def design_ports(spec):
     }
 
 
-def mutate_design(spec, n, seed, cycles, out, *, stimulus_seed=0, say=print):
+def mutate_design(
+    spec, n, seed, cycles, out, *, stimulus_seed=0, say=print, campaign=None, robot=None
+):
     """Mutants of ``spec`` (a resolved Amaranth ``DesignSpec``) judged on ``cycles`` cycles;
-    writes ``out/mutants.json`` and returns its content."""
+    writes ``out/mutants.json`` (and the mutant netlist with its port map, for the robot
+    judge) and returns its content. With ``campaign`` the mutants the unit judge catches go
+    on to the robot judge (``robot_judge.robot_judge`` with the keyword arguments ``robot``:
+    workers, scheduler, resume, fork): the campaign's runs in closed loop, each with the
+    mutant netlist as its Verilog design."""
     t0 = time.perf_counter()
     ports = design_ports(spec)
     rtlil_text = component_rtlil(spec.build())
@@ -43,6 +56,111 @@ def mutate_design(spec, n, seed, cycles, out, *, stimulus_seed=0, say=print):
     source = MutantPinSource(rtlil_text, ports, mutants, name)
     backend = open_pin_mutants(source, on_build=lambda t: say(f"{t} ..."))
     build_s = time.perf_counter() - t0
+    # The netlist and its port map as a Verilog design the closed loop runs (the robot
+    # judge: one build, ``--runtime mutsel=K`` picks the mutant).
+    netlist = os.path.join(out, NETLIST_NAME)
+    write_atomic(netlist, source.verilog, what="mutant netlist")
+    port_map = os.path.join(out, PORTS_NAME)
+    write_atomic(
+        port_map,
+        design_mutant_port_map(spec, ports, reset=netlist_has_reset(source.verilog)),
+        what="port map",
+    )
+    return _judge(
+        {"reference": spec.reference, "params": spec.params},
+        backend,
+        ports,
+        mutants,
+        (netlist, port_map),
+        build_s,
+        seed,
+        cycles,
+        out,
+        stimulus_seed=stimulus_seed,
+        say=say,
+        campaign=campaign,
+        robot=robot,
+    )
+
+
+def mutate_verilog_design(
+    files,
+    ports_path,
+    n,
+    seed,
+    cycles,
+    out,
+    *,
+    stimulus_seed=0,
+    say=print,
+    campaign=None,
+    robot=None,
+):
+    """``mutate_design`` for a Verilog design: ``files`` with its port map ``ports_path``.
+    Yosys reads the files (``read_verilog``) and mutates the map's top module; the mutant
+    netlist's port map is the design's with ``mutsel`` a ``[runtime]`` input, and the unit
+    judge drives the inputs the map gives the pin backend (its connector pins, ``[runtime]``
+    inputs aside)."""
+    from ..designs.builtin import connector_kinds
+    from ..sim.backends.foreign import ForeignDesign
+    from ..sim.pins.compiled import VerilatorPins
+    from ..sim.pins.verilog import VerilogPinSource
+
+    t0 = time.perf_counter()
+    design = ForeignDesign(files, ports_path, pins=True, connector_kinds=connector_kinds())
+    top = design.port_map.top
+    mutants = list_mutants(None, n, seed, verilog=design.sources, top=top)
+    os.makedirs(out, exist_ok=True)
+    netlist = os.path.join(out, NETLIST_NAME)
+    verilog = mutant_netlist(None, mutants, verilog=design.sources, top=top)
+    write_atomic(netlist, verilog, what="mutant netlist")
+    port_map = os.path.join(out, PORTS_NAME)
+    with open(ports_path) as f:
+        write_atomic(port_map, with_mutant_select(f.read()), what="port map")
+    source = VerilogPinSource(
+        ForeignDesign([netlist], port_map, pins=True, connector_kinds=connector_kinds())
+    )
+    backend = VerilatorPins(source, on_build=lambda t: say(f"{t} ..."))
+    build_s = time.perf_counter() - t0
+    driven = {p: port for p, port in backend.ports.items() if p not in (source.pixels or ())}
+    driven = {p: port for p, port in driven.items() if p not in source.runtime}
+    driven[MUTATION_SELECT] = backend.ports[MUTATION_SELECT]
+    return _judge(
+        {"reference": "verilog:" + ",".join(str(f) for f in files), "ports": str(ports_path)},
+        backend,
+        driven,
+        mutants,
+        (netlist, port_map),
+        build_s,
+        seed,
+        cycles,
+        out,
+        stimulus_seed=stimulus_seed,
+        say=say,
+        campaign=campaign,
+        robot=robot,
+    )
+
+
+def _judge(
+    design,
+    backend,
+    ports,
+    mutants,
+    files,
+    build_s,
+    seed,
+    cycles,
+    out,
+    *,
+    stimulus_seed,
+    say,
+    campaign,
+    robot,
+):
+    """The unit judge of ``mutants`` on ``backend`` (closed here), then the robot judge with
+    ``campaign``; writes and returns ``mutants.json``'s content."""
+    netlist, port_map = files
     outputs = [p for p, port in ports.items() if port.direction == "out"]
     stimulus = pin_stimulus(ports, cycles, stimulus_seed)
     try:
@@ -60,8 +178,25 @@ def mutate_design(spec, n, seed, cycles, out, *, stimulus_seed=0, say=print):
     finally:
         backend.close()
     unit = {v.index: v.caught for v in verdicts}
+    robot_verdicts, baseline, robot_s = {}, None, None
+    if campaign is not None:
+        from .robot_judge import robot_judge
+
+        t2 = time.perf_counter()
+        baseline, robot_verdicts = robot_judge(
+            campaign,
+            os.path.abspath(netlist),
+            os.path.abspath(port_map),
+            None,
+            [v.index for v in verdicts if v.caught],
+            out,
+            say=say,
+            **(robot or {}),
+        )
+        robot_s = time.perf_counter() - t2
+    caught_by_robot = {k: v["caught"] for k, v in robot_verdicts.items()}
     result = {
-        "design": {"reference": spec.reference, "params": spec.params},
+        "design": design,
         "seed": seed,
         "judge": "the unmutated design, seeded random pin stimulus",
         "stimulus": {
@@ -71,8 +206,14 @@ def mutate_design(spec, n, seed, cycles, out, *, stimulus_seed=0, say=print):
         },
         "build_and_list_s": round(build_s, 2),
         "unit_judge_s": round(unit_s, 2),
+        "netlist": NETLIST_NAME,
+        "ports": PORTS_NAME,
         "unit": unit_score(unit),
-        "modules": by_module(mutants, unit),
+        "robot": robot_score(unit, caught_by_robot) if campaign is not None else None,
+        "campaign": campaign.name if campaign is not None else None,
+        "robot_judge_s": round(robot_s, 2) if robot_s is not None else None,
+        "baseline": baseline,
+        "modules": by_module(mutants, unit, caught_by_robot),
         "mutants": [
             {
                 **{k: v for k, v in m.__dict__.items()},
@@ -84,6 +225,7 @@ def mutate_design(spec, n, seed, cycles, out, *, stimulus_seed=0, say=print):
                     "differing": v.differing,
                     "effect": v.effect(),
                 },
+                "robot": robot_verdicts.get(m.index),
             }
             for m, v in zip(mutants, verdicts)
         ],

@@ -34,7 +34,8 @@ _LOWER = ("min_distance_min_m", "target_in_view_min_fraction", "found_min_fracti
 
 
 def mutant_argv(argv, netlist, ports, index, resolution):
-    """A campaign run's arguments with mutant ``index`` of the netlist as the design."""
+    """A campaign run's arguments with mutant ``index`` of the netlist as the design (at
+    ``resolution``, or the scenario's when None: a design without a camera)."""
     out, skip = [], False
     for a in argv:
         if skip:
@@ -48,8 +49,7 @@ def mutant_argv(argv, netlist, ports, index, resolution):
         *out,
         "--backend",
         "verilator",
-        "--resolution",
-        resolution,
+        *(("--resolution", resolution) if resolution is not None else ()),
         "--design",
         f"verilog:{netlist}",
         "--ports",

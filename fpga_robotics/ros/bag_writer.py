@@ -19,7 +19,7 @@ from fpga_robotics.hw.errors import UsageError
 from fpga_robotics.sim.files import check_output_dir
 
 from .laser_scan import SCAN_TYPE, LaserScans
-from .messages import TOPICS, TYPESTORE, FrameMessages, camera_geometry
+from .messages import TOPICS, TYPESTORE, FrameMessages, camera_geometry, topic_type
 
 __all__ = ["BagWriter", "check_bag_path", "open_bag_writer"]
 
@@ -77,10 +77,9 @@ class BagWriter:
     def log_frame(self, record):
         write, conns = self._writer.write, self._connections
         for topic, ns, data in self._messages.encode(record):
-            if topic not in conns:  # a further camera's, from its first capture on
-                conns[topic] = self._writer.add_connection(
-                    topic, self._messages.topic_types[topic], typestore=TYPESTORE
-                )
+            if topic not in conns:  # a further camera's or an extra output's, first seen now
+                kind = self._messages.topic_types.get(topic) or topic_type(topic)
+                conns[topic] = self._writer.add_connection(topic, kind, typestore=TYPESTORE)
             write(conns[topic], ns, data)
         for topic, ns, data in self._scans.encode(record):
             if topic not in conns:

@@ -16,7 +16,7 @@ from foxglove.websocket import Capability
 
 from fpga_robotics.hw.errors import UsageError
 
-from .messages import TOPICS, TYPESTORE, FrameMessages, msgdef
+from .messages import TOPICS, TYPESTORE, FrameMessages, msgdef, topic_type
 
 __all__ = [
     "CONTROL_TOPICS",
@@ -143,19 +143,7 @@ class LivePublisher:
         self.rejected = []  # client messages that could not be used, with why
         self._messages = FrameMessages(geometry)
         self._context = foxglove.Context()
-        self._channels = {
-            topic: foxglove.Channel(
-                topic,
-                message_encoding="cdr",
-                context=self._context,
-                schema=foxglove.Schema(
-                    name=msgtype.replace("/msg/", "/"),
-                    encoding="ros2msg",
-                    data=msgdef(msgtype).encode(),
-                ),
-            )
-            for topic, msgtype in TOPICS.items()
-        }
+        self._channels = {topic: self._channel(topic, msgtype) for topic, msgtype in TOPICS.items()}
         try:
             self._server = foxglove.start_server(
                 name="fpga_robotics",
@@ -174,6 +162,18 @@ class LivePublisher:
         self.port = self._server.port
         self.frames_logged = 0
 
+    def _channel(self, topic, msgtype):
+        return foxglove.Channel(
+            topic,
+            message_encoding="cdr",
+            context=self._context,
+            schema=foxglove.Schema(
+                name=msgtype.replace("/msg/", "/"),
+                encoding="ros2msg",
+                data=msgdef(msgtype).encode(),
+            ),
+        )
+
     @property
     def url(self):
         return f"ws://127.0.0.1:{self.port}"
@@ -189,6 +189,9 @@ class LivePublisher:
     def log_frame(self, record):
         channels = self._channels
         for topic, ns, data in self._messages.encode(record):
+            if topic not in channels and topic_type(topic) is not None:
+                # an extra output of the design, first seen now
+                channels[topic] = self._channel(topic, topic_type(topic))
             channel = channels.get(topic)
             if channel is not None:  # further cameras' topics are in the bag only
                 channel.log(bytes(data), log_time=ns)

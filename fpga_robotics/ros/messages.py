@@ -13,6 +13,7 @@ capture instant and written once per capture, in its frame ``<name>_link`` (plac
 """
 
 import math
+import re
 from dataclasses import dataclass
 
 import numpy as np
@@ -23,13 +24,17 @@ from fpga_robotics.sim.camera.raster import focal_length
 from ..sim.world.kinematics import dps_to_twist
 
 __all__ = [
+    "EXTRA_PREFIX",
+    "EXTRA_TYPE",
     "TOPICS",
     "TYPESTORE",
     "CameraGeometry",
     "FrameMessages",
     "camera_geometry",
     "camera_topics",
+    "extra_topic",
     "msgdef",
+    "topic_type",
 ]
 
 #: The typestore every message is built and read with (ROS 2 Humble definitions).
@@ -59,6 +64,26 @@ def camera_topics(name):
         f"/cameras/{name}/image_raw": "sensor_msgs/msg/Image",
         f"/cameras/{name}/camera_info": "sensor_msgs/msg/CameraInfo",
     }
+
+
+#: A design's extra outputs (every output no connector reads): one topic each, named
+#: ``EXTRA_PREFIX + name``, of type ``EXTRA_TYPE`` (a signed 64-bit integer holds any value
+#: of a port up to 63 bits, signed or not), published from the frame they first appear in.
+EXTRA_PREFIX = "/design/extra/"
+EXTRA_TYPE = "std_msgs/msg/Int64"
+
+
+def extra_topic(name):
+    """The topic of extra output ``name`` (characters a ROS name cannot hold become ``_``)."""
+    token = re.sub(r"_+", "_", re.sub(r"[^A-Za-z0-9_]", "_", name)).strip("_") or "output"
+    if token[0].isdigit():
+        token = "o" + token
+    return EXTRA_PREFIX + token
+
+
+def topic_type(topic):
+    """The message type of a topic the runs publish (``TOPICS`` or an extra output's)."""
+    return TOPICS.get(topic) or (EXTRA_TYPE if topic.startswith(EXTRA_PREFIX) else None)
 
 
 _T = TYPESTORE.types
@@ -264,6 +289,9 @@ class FrameMessages:
                         T[f"std_msgs/msg/{cls}"](data=bool(value) if cls == "Bool" else int(value)),
                     )
                 )
+        for name, value in (getattr(record, "design_extra", None) or {}).items():
+            if value is not None and not math.isnan(value):  # NaN: no value at this frame
+                out.append((extra_topic(name), T[EXTRA_TYPE](data=int(value))))
         if r.motor_left is not None and r.motor_right is not None:
             left, right = int(r.motor_left), int(r.motor_right)
             out.append(
@@ -333,7 +361,7 @@ class FrameMessages:
         out.append(("/people", self._people(odom_header, record.people)))
         out += self._further_cameras(record)
         types = self.topic_types
-        return [(topic, ns, ser(msg, types[topic])) for topic, msg in out]
+        return [(topic, ns, ser(msg, types.get(topic) or topic_type(topic))) for topic, msg in out]
 
     def _people(self, header, people):
         Marker = _T["visualization_msgs/msg/Marker"]

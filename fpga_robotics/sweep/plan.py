@@ -23,6 +23,10 @@ class Plan:
 def _concrete_backend(spec):
     if spec.backend != "auto":
         return spec
+    if spec.design is not None and spec.design.startswith("verilog:"):
+        # As run takes it: CXXRTL where Yosys reads the Verilog, else Verilator
+        # (sim/backends/foreign_choice.py); each worker builds with the same choice.
+        return spec
     if spec.design is not None:
         return replace(spec, backend="verilator")
     from ..sim.backends import fastest_backend_name

@@ -80,6 +80,8 @@ def load_run(argv):
     run.take_design_reference(args, scenario)
     shadow_params = run._shadow_params(scenario, args.shadow)
     run._design_files(args, scenario.foreign)
+    if scenario.sim.timing == "real_clock":  # the pin design is the scenario's foreign one
+        scenario = run._with_design_files(args, scenario)
     return args, scenario, shadow_params
 
 

@@ -280,7 +280,8 @@ def wrapper_verilog(pm, ports, width, height, pins=False):
 
     ``pins=True`` (the pin backend): only the ports the map gives (no pixel stream, strobe
     or colour select without ``pixels``, no absent outputs), the connector ports passed
-    through under their own names, ``[runtime]`` inputs held at their initial values."""
+    through under their own names, ``[runtime]`` inputs too (the pin backend holds them at
+    their values, ``HostPins.set_runtime``)."""
     conns = [f".{pm.clock}(clk)"]
     if pm.reset:
         conns.append(f".{pm.reset}({'~rst' if pm.reset_active_low else 'rst'})")
@@ -384,11 +385,7 @@ def wrapper_verilog(pm, ports, width, height, pins=False):
             body.append(f"  assign {key} = {{{fill}, fr_{key}}};")
     for name, value in pm.constants.items():
         conns.append(f".{name}({ports[name][1]}'d{value})")
-    if pins:
-        # No host hooks in the pin model: each [runtime] input keeps its initial value.
-        for name, value in pm.runtime.items():
-            conns.append(f".{name}({ports[name][1]}'d{value})")
-    elif pm.runtime:
+    if pm.runtime and not pins:
         # Held in registers loaded every clock from the host's values (fr_foreign_set_runtime,
         # in the hooks compiled with the design), so a new value acts from the next edge.
         body.append('  import "DPI-C" function int fr_runtime_value(input int index);')
@@ -439,7 +436,7 @@ def _pin_wrapper(pm, ports, outputs, decls, body, conns):
     if pm.filtered_valid:
         header += ["output filtered__valid", "output [13:0] filtered__payload"]
     header += outputs
-    for port in (*pm.connector_ports(), *pm.extra_outputs.values()):
+    for port in (*pm.connector_ports(), *pm.extra_outputs.values(), *pm.runtime):
         direction, width, signed = ports[port]
         # Escaped identifiers: a port may have any name the design's Verilog gives it.
         header.append(f"{direction} {'signed ' if signed else ''}[{width - 1}:0] \\{port} ")
@@ -477,7 +474,7 @@ def pin_ports(design):
         if key in pm.outputs:
             # The contract's wheel speeds are signed 16 bits; the other outputs unsigned.
             ports[key] = ("out", 1 if key == "found" else 16, key.startswith("motor_"))
-    for port in (*pm.connector_ports(), *pm.extra_outputs.values()):
+    for port in (*pm.connector_ports(), *pm.extra_outputs.values(), *pm.runtime):
         direction, width, signed = design.ports[port]
         ports[port] = ("in" if direction == "input" else "out", width, signed)
     return ports

@@ -36,6 +36,8 @@ class HostPins(PinBackend):
         self._captures = deque()  # buffers of frames whose filtered stream is still coming
         self._filtered = None
         self._captured = 0  # frames the simulator has completed (its counter)
+        # [runtime] inputs of a Verilog design: held at these values from every reset on.
+        self._held = dict(getattr(source, "runtime", None) or {})
 
     # --- values ---------------------------------------------------------------------------
 
@@ -97,6 +99,19 @@ class HostPins(PinBackend):
         self._captures.clear()
         self._filtered = None
         self._captured = 0
+        for name, value in self._held.items():
+            self.poke(name, value)
+
+    def set_runtime(self, name, value):
+        """Hold the ``[runtime]`` input ``name`` at ``value``, now and after every reset (one
+        build of the model for every value, e.g. a mutant select)."""
+        if name not in self._held:
+            known = ", ".join(self._held) or "none"
+            raise PinError(
+                f"the design has no [runtime] input {name!r} (its runtime inputs: {known})"
+            )
+        self.poke(name, value)
+        self._held[name] = int(value)
 
     def poke(self, name, value):
         index, port = self._input(name)

@@ -47,6 +47,8 @@ class VerilogPinSource:
                 f"design {pm.top!r} has {len(self.ports)} ports; the pin backends "
                 f"take at most {MAX_PORTS}"
             )
+        #: ``[runtime]`` inputs -> the values the backend holds them at (``set_runtime``).
+        self.runtime = dict(pm.runtime)
         self.pixels = PIXEL_PORTS if pm.has_pixels else None
         self.filtered = FILTERED_PORTS if pm.filtered_valid else None
         params = design.params
