@@ -132,7 +132,10 @@ def test_checks_that_need_an_absent_output_are_na_and_left_out_of_the_verdict(ru
     )
     text = format_summary({**part.summary, "checks": checks})
     assert "[n/a] acquired_within_s" in text and "found n/a" in text
-    assert "design outputs absent (not produced by the design): found, centroid_x" in text
+    assert (
+        "tracker outputs absent (no such port, or no camera frame to latch them): found, centroid_x"
+        in text
+    )
 
 
 def test_compute_metrics_by_hand():

@@ -383,7 +383,7 @@ def format_summary(s):
         lines.append(f"  run ended early: {s['ended_early']}")
     if s.get("absent_outputs"):
         lines.append(
-            "  design outputs absent (not produced by the design): "
+            "  tracker outputs absent (no such port, or no camera frame to latch them): "
             + ", ".join(s["absent_outputs"])
         )
     acq = s["acquired_at_s"]
