@@ -19,6 +19,7 @@ from pathlib import Path
 
 from fpga_robotics.hw.errors import UserError
 
+from ...hw.params import FollowTargetParams
 from ...hw.pixel import COLOR_SELECT
 from .base import BackendError
 
@@ -581,8 +582,6 @@ motor_right = {{ port = "motor_right", width = 16, signed = true }}
 
 def follow_target_port_map(params=None):
     """TOML text: the port map of the exported ``follow_target`` at ``params``."""
-    from ...hw.params import FollowTargetParams
-
     params = params if params is not None else FollowTargetParams()
     return _FOLLOW_TARGET_MAP.format(latency=params.motor_latency)
 
