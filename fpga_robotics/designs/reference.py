@@ -31,8 +31,14 @@ import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from fpga_robotics.designs.builtin import TOPS, Top
+from amaranth.hdl import Fragment
+from amaranth.lib import wiring
+
+from fpga_robotics.designs.builtin import TOPS, Top, build_component, design_tables, foreign_top
 from fpga_robotics.hw.errors import UsageError
+from fpga_robotics.hw.params import FollowTargetParams
+from fpga_robotics.hw.verilog import verilog_ports
+from fpga_robotics.sim.backends.port_map import PortMapError, load_port_map
 
 __all__ = [
     "ENTRY_POINT_GROUP",
@@ -103,9 +109,6 @@ class DesignSpec:
         if self.kind == "verilog":
             raise DesignError(f"design {self.reference!r} is Verilog: Verilator builds it")
         if self.kind == "builtin":
-            from fpga_robotics.designs.builtin import build_component, design_tables
-            from fpga_robotics.hw.params import FollowTargetParams
-
             return build_component(self.top, FollowTargetParams(), design_tables(self.top, {}))
         return self.top.component()
 
@@ -189,8 +192,6 @@ def _builtin_spec(registered):
     cached = _TOP_SPECS.get(id(registered))
     if cached is not None and cached[0] is registered:
         return cached[1]
-    from fpga_robotics.designs.builtin import build_component, design_tables
-    from fpga_robotics.hw.params import FollowTargetParams
 
     component = build_component(registered, FollowTargetParams(), design_tables(registered, {}))
     ports = component_ports(component)
@@ -329,8 +330,6 @@ def _first_line(exc):
 
 
 def _is_component_class(value):
-    from amaranth.lib import wiring
-
     return inspect.isclass(value) and issubclass(value, wiring.Component)
 
 
@@ -417,8 +416,6 @@ def _type_name(kind):
 
 def _call(target, params, reference):
     """``target(**params)``, the component it returns (an error names what went wrong)."""
-    from amaranth.lib import wiring
-
     values = {k: tuple(v) if isinstance(v, list) else v for k, v in params.items()}
     try:
         component = target(**values)
@@ -437,10 +434,6 @@ def _call(target, params, reference):
 def component_ports(component):
     """Port name (as the generated Verilog names it) -> (direction, width). The component
     was only looked at: it is marked so that Amaranth does not warn it was never used."""
-    from amaranth.hdl import Fragment
-
-    from fpga_robotics.hw.verilog import verilog_ports
-
     ports = {
         name: ("in" if direction == "i" else "out", value.shape().width)
         for name, (value, direction) in verilog_ports(component).items()
@@ -454,7 +447,7 @@ def component_ports(component):
 
 def _connector_pins():
     """Connector kind -> its pin names (the camera's stream is its ``pixels`` pin)."""
-    from fpga_robotics.loop.connectors import CONNECTORS
+    from fpga_robotics.loop.connectors import CONNECTORS  # lazy: circle via loop's init
 
     return {kind: tuple(cls.pins) for kind, cls in CONNECTORS.items()}
 
@@ -529,9 +522,6 @@ def extra_outputs_of(ports, bindings):
 
 
 def _verilog_spec(reference, ports, base, params):
-    from fpga_robotics.designs.builtin import foreign_top
-    from fpga_robotics.sim.backends.port_map import PortMapError, load_port_map
-
     files = [f for f in reference[len("verilog:") :].split(",") if f.strip()]
     if not files:
         raise DesignError(
