@@ -20,7 +20,12 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
+from amaranth.back import rtlil
+
+from fpga_robotics.designs.reference import resolve_design
 from fpga_robotics.hw.errors import UsageError, UserError
+from fpga_robotics.hw.formal import CHECKS
+from fpga_robotics.hw.formal.declared import PROPERTY_HOOK, declared_checks
 from fpga_robotics.sim.files import atomic_path
 
 __all__ = [
@@ -189,8 +194,6 @@ def _trace_name(name):
 def run_check(check, *, depth=None, dut=None, trace_dir=None, env=None, timeout=None):
     """Run one ``FormalCheck`` (around ``dut``, or the real design) and return its
     ``CheckResult``. A counterexample is copied to ``trace_dir`` (atomically) when given."""
-    from amaranth.back import rtlil
-
     env = formal_env() if env is None else env
     depth = check.depth if depth is None else depth
     harness = check.build(dut)
@@ -227,12 +230,8 @@ def design_checks(reference=None, params=None):
     None) has the project's own list, ``hw.formal.CHECKS``; a design of one's own the
     properties it declares (``formal_properties``/``formal_covers``, docs/formal.md). A design
     that declares none, or a Verilog one, is a ``UsageError``."""
-    from fpga_robotics.hw.formal import CHECKS
-    from fpga_robotics.hw.formal.declared import PROPERTY_HOOK, declared_checks
-
     if reference is None or reference == "follow_target":
         return list(CHECKS)
-    from fpga_robotics.designs.reference import resolve_design
 
     if reference.startswith("verilog:"):
         raise UsageError(

@@ -35,6 +35,7 @@ from pathlib import Path
 
 from fpga_robotics.checks.summary import CHECKS
 from fpga_robotics.designs.builtin import TOPS, design_tables, table_fields
+from fpga_robotics.designs.reference import DesignError, resolve_design
 from fpga_robotics.hw.params import (
     CHOICES,
     DEFAULT_BASE_DPS,
@@ -953,8 +954,6 @@ def _top(design, source):
     """``design.top``, its parameter tables (a ``design.variant`` applied first) and
     ``design.params``; a design of one's own is resolved here (designs/reference.py), its
     reference made independent of the current folder."""
-    from fpga_robotics.designs.reference import DesignError, resolve_design
-
     top = design.get("top", "follow_target")
     params = design.get("params", {})
     if not isinstance(params, dict):
