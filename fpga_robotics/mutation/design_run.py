@@ -5,6 +5,9 @@ random pin stimulus (``pin_judge``), with the same scores as FollowTarget's unit
 import os
 import time
 
+from amaranth.hdl import Fragment
+
+from ..hw.verilog import verilog_ports
 from ..sim.files import write_json_atomic
 from ..sim.mutation import component_rtlil, list_mutants
 from ..sim.pins.base import Port
@@ -20,10 +23,6 @@ DEFAULT_CYCLES = 100_000
 def design_ports(spec):
     """The ports of the design ``spec`` (a ``DesignSpec``) as pin ``Port``s, named as the
     generated Verilog names them."""
-    from amaranth.hdl import Fragment
-
-    from ..hw.verilog import verilog_ports
-
     component = spec.build()
     Fragment.get(component, None)  # read for its signature only: elaborated, so no warning
     return {
