@@ -10,9 +10,6 @@ import tomllib
 from fpga_robotics.cli.errors import UsageError, run_cli
 from fpga_robotics.designs.builtin import TOPS, connector_kinds
 from fpga_robotics.designs.reference import DesignError, entry_point_designs, resolve_design
-from fpga_robotics.sim.backends.base import BackendError
-from fpga_robotics.sim.backends.foreign import ForeignDesign
-from fpga_robotics.sim.backends.port_map import load_port_map
 
 __all__ = ["describe", "main"]
 
@@ -75,6 +72,10 @@ def checked_verilog(spec, ports):
     """A Verilog design's spec with its ports as Verilator reads them, the port map checked
     against them (names, directions, widths, every input driven, the connectors' pins):
     ``DesignError`` for the first mismatch."""
+    from fpga_robotics.sim.backends.base import BackendError  # lazy: the simulator (~0.5 s)
+    from fpga_robotics.sim.backends.foreign import ForeignDesign  # lazy: the simulator (~0.5 s)
+    from fpga_robotics.sim.backends.port_map import load_port_map  # lazy: the simulator (~0.5 s)
+
     files = spec.reference[len("verilog:") :].split(",")
     port_map = load_port_map(ports)
     pins = bool(port_map.connectors or port_map.extra_outputs or not port_map.has_pixels)

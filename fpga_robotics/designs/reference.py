@@ -31,14 +31,9 @@ import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from amaranth.hdl import Fragment
-from amaranth.lib import wiring
-
 from fpga_robotics.designs.builtin import TOPS, Top, build_component, design_tables, foreign_top
 from fpga_robotics.hw.errors import UsageError
 from fpga_robotics.hw.params import FollowTargetParams
-from fpga_robotics.hw.verilog import verilog_ports
-from fpga_robotics.sim.backends.port_map import PortMapError, load_port_map
 
 __all__ = [
     "ENTRY_POINT_GROUP",
@@ -330,6 +325,8 @@ def _first_line(exc):
 
 
 def _is_component_class(value):
+    from amaranth.lib import wiring  # lazy: Amaranth (~0.3 s)
+
     return inspect.isclass(value) and issubclass(value, wiring.Component)
 
 
@@ -416,6 +413,8 @@ def _type_name(kind):
 
 def _call(target, params, reference):
     """``target(**params)``, the component it returns (an error names what went wrong)."""
+    from amaranth.lib import wiring  # lazy: Amaranth (~0.3 s)
+
     values = {k: tuple(v) if isinstance(v, list) else v for k, v in params.items()}
     try:
         component = target(**values)
@@ -434,6 +433,10 @@ def _call(target, params, reference):
 def component_ports(component):
     """Port name (as the generated Verilog names it) -> (direction, width). The component
     was only looked at: it is marked so that Amaranth does not warn it was never used."""
+    from amaranth.hdl import Fragment  # lazy: Amaranth (~0.3 s)
+
+    from fpga_robotics.hw.verilog import verilog_ports  # lazy: Amaranth (~0.3 s)
+
     ports = {
         name: ("in" if direction == "i" else "out", value.shape().width)
         for name, (value, direction) in verilog_ports(component).items()
@@ -522,6 +525,11 @@ def extra_outputs_of(ports, bindings):
 
 
 def _verilog_spec(reference, ports, base, params):
+    from fpga_robotics.sim.backends.port_map import (  # lazy: the simulator (~0.5 s)
+        PortMapError,
+        load_port_map,
+    )
+
     files = [f for f in reference[len("verilog:") :].split(",") if f.strip()]
     if not files:
         raise DesignError(
