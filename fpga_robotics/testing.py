@@ -20,6 +20,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from fpga_robotics.hw.errors import UsageError
+from fpga_robotics.loop.compressed import run_scenario
+from fpga_robotics.scenario.load import load_scenario
 
 __all__ = ["Check", "Result", "run"]
 
@@ -163,9 +165,6 @@ def run(
     recorder : optional
         A viewer recorder (``fpga_robotics.viz.open_recorder``), not closed here.
     """
-    from fpga_robotics.loop.compressed import run_scenario
-    from fpga_robotics.scenario.load import load_scenario
-
     items = [*_design_overrides(design, params, ports), *overrides]
     loaded = load_scenario(str(scenario), items)
     return Result(run_scenario(loaded, seed=seed, backend=backend, recorder=recorder), loaded)

@@ -245,8 +245,9 @@ def test_bad_input_is_one_line_and_exit_2(
 
 def _forbid_builds(monkeypatch):
     """Record (and refuse) every start of a design simulator but the numpy model's."""
+    from fpga_robotics.cli import run
     from fpga_robotics.loop import compressed, real_clock
-    from fpga_robotics.sim.backends import foreign
+    from fpga_robotics.sim.backends import foreign, foreign_choice
 
     builds = []
     real_make_backend = compressed.make_backend
@@ -264,7 +265,11 @@ def _forbid_builds(monkeypatch):
 
         return start
 
-    monkeypatch.setattr(compressed, "make_backend", make_backend)
-    monkeypatch.setattr(real_clock, "make_pin_backend", refuse("make_pin_backend"))
-    monkeypatch.setattr(foreign, "ForeignVerilatorBackend", refuse("ForeignVerilatorBackend"))
+    # Each where it is defined and where it is imported by name.
+    for module in (compressed, run):
+        monkeypatch.setattr(module, "make_backend", make_backend)
+    for module in (real_clock, run):
+        monkeypatch.setattr(module, "make_pin_backend", refuse("make_pin_backend"))
+    for module in (foreign, foreign_choice):
+        monkeypatch.setattr(module, "ForeignVerilatorBackend", refuse("ForeignVerilatorBackend"))
     return builds

@@ -85,7 +85,9 @@ def test_a_failing_check_writes_its_counterexample(capsys, monkeypatch, tmp_path
         build=lambda dut=None: real.build(bad(p)),
         make_dut=lambda: bad(p),
     )
-    monkeypatch.setattr(formal_checks, "CHECKS", [broken, check_named("cover.motor@defaults")])
+    checks = [broken, check_named("cover.motor@defaults")]
+    monkeypatch.setattr(formal_checks, "CHECKS", checks)
+    monkeypatch.setattr(formal, "CHECKS", checks)  # flow.formal's own name for the list
     traces = tmp_path / "traces"
     code, out, _err = run(["--trace-dir", str(traces)], capsys)
     assert code == 1

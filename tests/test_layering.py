@@ -4,10 +4,13 @@ the gateware imports no host code, and nothing leans on Amaranth's private inter
 
 Every import counts: at the top of a module, inside a function, under
 ``if __name__ == "__main__":``, and the module named by a string literal in
-``importlib.import_module("...")``.
+``importlib.import_module("...")``. Imports sit at the top of their module; one left inside a
+function says why on its line, ``# lazy: <reason>`` (an optional dependency, a heavy one most
+commands skip, a circle through a package's ``__init__``).
 """
 
 import ast
+import re
 from pathlib import Path
 
 import pytest
@@ -240,6 +243,38 @@ def check(root=ROOT, package_dirs=PACKAGE_DIRS, rooms=ROOMS):
     return problems
 
 
+_LAZY_REASON = re.compile(r"#\s*lazy:\s*\S")
+
+
+def _function_body_imports(tree):
+    """Every ``import`` statement inside a function (or method) body of ``tree``."""
+    found = []
+
+    def visit(node, in_function):
+        for child in ast.iter_child_nodes(node):
+            if in_function and isinstance(child, (ast.Import, ast.ImportFrom)):
+                found.append(child)
+            visit(child, in_function or isinstance(child, (ast.FunctionDef, ast.AsyncFunctionDef)))
+
+    visit(tree, False)
+    return found
+
+
+def unexplained_lazy_imports(root=ROOT, package_dirs=PACKAGE_DIRS):
+    """``path:line: statement`` of every import inside a function whose lines carry no
+    ``# lazy: <reason>`` comment."""
+    problems = []
+    for path in source_modules(root, package_dirs).values():
+        text = path.read_text()
+        lines = text.splitlines()
+        for node in _function_body_imports(ast.parse(text, str(path))):
+            statement = lines[node.lineno - 1 : node.end_lineno]
+            if not any(_LAZY_REASON.search(line) for line in statement):
+                where = f"{path.relative_to(root)}:{node.lineno}"
+                problems.append(f"{where}: {statement[0].strip()} (move it to the top, or say why)")
+    return problems
+
+
 def test_every_source_module_is_found_and_has_a_room():
     modules = source_modules()
     assert {
@@ -337,3 +372,44 @@ def test_no_private_amaranth_internals(needle):
             if needle in line.split("#", 1)[0]:
                 hits.append(f"{path.relative_to(ROOT)}:{n}: {line.strip()}")
     assert hits == []
+
+
+def test_imports_inside_functions_say_why():
+    assert unexplained_lazy_imports() == []
+
+
+def test_the_checker_reports_function_imports_without_a_reason(tmp_path):
+    files = {
+        "sim/__init__.py": "",
+        "sim/plain.py": (
+            "import json\n\n"
+            "if __name__ == '__main__':\n    import sys\n"  # module level: not in a function
+            "def dump(x):\n    import pickle\n    return pickle.dumps(x)\n"
+        ),
+        "sim/explained.py": (
+            "def load():\n"
+            "    import mujoco  # lazy: optional dependency\n"
+            "    from numpy import (  # lazy: heavy\n        zeros,\n    )\n"
+            "    return mujoco, zeros\n"
+        ),
+        "viz/nested.py": (
+            "class Viewer:\n"
+            "    def open(self):\n"
+            "        def inner():\n            from . import other\n"
+            "        return inner\n\n"
+            "async def serve():\n    import rerun  # lazy:\n"  # a reason must follow
+            "    # lazy: a comment on another line does not count\n    import os\n"
+        ),
+        "viz/other.py": "",
+    }
+    for name, text in files.items():
+        path = tmp_path / name
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(text)
+    problems = unexplained_lazy_imports(tmp_path, {"sim": "fpga_robotics.sim", "viz": "viz"})
+    assert problems == [
+        "sim/plain.py:6: import pickle (move it to the top, or say why)",
+        "viz/nested.py:4: from . import other (move it to the top, or say why)",
+        "viz/nested.py:8: import rerun  # lazy: (move it to the top, or say why)",
+        "viz/nested.py:10: import os (move it to the top, or say why)",
+    ]

@@ -39,7 +39,7 @@ def _viewer_binary():
     # The binary itself rather than the `rerun` console script, which would run it as a child:
     # then the pid we know is the viewer's own.
     try:
-        import rerun_cli
+        import rerun_cli  # lazy: optional, the rerun on PATH serves as well
 
         exe = os.path.join(os.path.dirname(rerun_cli.__file__), "rerun")
         if os.path.isfile(exe) and os.access(exe, os.X_OK):

@@ -15,12 +15,17 @@ import math
 import statistics
 import time
 
+import cv2
 import numpy as np
 
 from fpga_robotics.bench import scaffold
 from fpga_robotics.cli.errors import UsageError
 from fpga_robotics.sim.camera.raster import DEFAULT_HFOV, CameraRenderer, focal_length
 from fpga_robotics.sim.camera.scene import Band, CameraPose, Cylinder, Lighting, Scene, Wall
+from fpga_robotics.sim.camera.sensor import OV7670Params
+from fpga_robotics.sim.camera.sensor.figure import stage_images
+from fpga_robotics.sim.camera.sensor.pipeline import OV7670Sensor
+from fpga_robotics.sim.files import check_output_dir, write_atomic
 
 __all__ = [
     "DEFAULT_SIZES",
@@ -116,9 +121,6 @@ STAGES = ("light", "expose", "noise", "amplify", "demosaic", "tone", "adapt")
 
 def stage_times(width, height, *, frames=60, repeats=5, turn_rate=0.5, hfov=DEFAULT_HFOV):
     """``{stage: [ms, ...], "frame": [...], "frame_cpu": [...]}``, ``frames * repeats`` each."""
-    from fpga_robotics.sim.camera.sensor.params import OV7670Params
-    from fpga_robotics.sim.camera.sensor.pipeline import OV7670Sensor
-
     renderer = CameraRenderer(width, height, hfov)
     scene = typical_scene()
     images = [renderer.render(scene, pose) for pose in camera_loop(frames)]
@@ -243,13 +245,6 @@ def _sensor_table(sizes, frames, repeats):
 def _stage_images(folder):
     """One 160x120 view of the typical room (the red person beside the divider, the robot
     turning at 1 rad/s) through each stage, shown twice the size, one PNG a stage."""
-    import cv2
-    import numpy as np
-
-    from fpga_robotics.sim.camera.sensor import OV7670Params
-    from fpga_robotics.sim.camera.sensor.figure import stage_images
-    from fpga_robotics.sim.files import check_output_dir, write_atomic
-
     folder = check_output_dir(folder, what="--stage-images folder")
     rgb = CameraRenderer(160, 120, 1.047).render(
         typical_scene(), CameraPose(2.0, 4.3, -0.3, height=0.3)

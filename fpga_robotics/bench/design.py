@@ -12,6 +12,7 @@ reported separately.
 
 import statistics
 import time
+from importlib import resources
 from pathlib import Path
 
 from fpga_robotics.bench import scaffold
@@ -19,6 +20,8 @@ from fpga_robotics.bench.frames import bench_frames
 from fpga_robotics.cli.errors import UsageError
 from fpga_robotics.hw.params import FollowTargetParams
 from fpga_robotics.sim.backends import BACKEND_NAMES, COMPILED_BACKENDS, BackendError, get_backend
+from fpga_robotics.sim.backends.foreign import ForeignVerilatorBackend
+from fpga_robotics.sim.camera.frames import to_rgb444
 
 __all__ = ["main", "measure", "measure_paired", "parse_resolutions"]
 
@@ -191,11 +194,6 @@ def run_published(paths, name, frames, min_seconds=0.0):
     """The published RTL on Verilator (foreign harness, frames packed beforehand as its own
     harness has them) against backend ``name``'s ``process_frame`` of the same RGB888
     frames as users call it, frame by frame in alternation; median ms of each, and ratio."""
-    from importlib import resources
-
-    from fpga_robotics.sim.backends.foreign import ForeignVerilatorBackend
-    from fpga_robotics.sim.camera.frames import to_rgb444
-
     params = FollowTargetParams(width=160, height=120)
     port_map = resources.files("fpga_robotics.designs") / "port_maps" / "published_design_top.toml"
     packed = [to_rgb444(f, params.width, params.height) for f in frames]

@@ -25,6 +25,9 @@ import time
 
 from fpga_robotics.bench import scaffold
 from fpga_robotics.cli.errors import UsageError
+from fpga_robotics.loop.compressed import ClosedLoop, make_backend, run_scenario
+from fpga_robotics.scenario.load import load_scenario
+from fpga_robotics.sim.backends import BACKEND_NAMES, BackendError
 
 __all__ = ["STEPS", "main", "measure"]
 
@@ -48,8 +51,6 @@ STEPS = {
 
 
 def _timed_loop_class():
-    from fpga_robotics.loop.compressed import ClosedLoop
-
     class TimedLoop(ClosedLoop):
         """``ClosedLoop`` whose steps add their wall time to ``self.spent``."""
 
@@ -130,8 +131,6 @@ def measure(scenario, design, repeats):
     the real-time factors); the design alone on the frames of a first untimed run
     (``design_alone_ms``, ``design_alone_cpu_ms``). A turn runs the three one after the other,
     so that all see the same period of a shared machine."""
-    from fpga_robotics.loop.compressed import ClosedLoop
-
     TimedLoop = _timed_loop_class()
     design.reset()
     first = TimedLoop(scenario, design=design)  # also warms up; keeps the frames to replay
@@ -175,8 +174,6 @@ def measure(scenario, design, repeats):
 
 
 def _profile(scenario, design, top):
-    from fpga_robotics.loop.compressed import run_scenario
-
     design.reset()
     profiler = cProfile.Profile()
     profiler.enable()
@@ -189,8 +186,6 @@ def _profile(scenario, design, top):
 
 
 def _options(p):
-    from fpga_robotics.sim.backends import BACKEND_NAMES
-
     p.add_argument("--scenario", default="follow_person")
     p.add_argument("--backend", default="auto", choices=("auto", *BACKEND_NAMES))
     p.add_argument(
@@ -219,10 +214,6 @@ def _check(args):
 
 
 def run(args):
-    from fpga_robotics.loop.compressed import make_backend
-    from fpga_robotics.scenario.load import load_scenario
-    from fpga_robotics.sim.backends import BackendError
-
     figures = []
     for w, h in args.resolutions:
         scenario = load_scenario(

@@ -18,7 +18,13 @@ import statistics
 import time
 
 from fpga_robotics.bench import scaffold
+from fpga_robotics.bench.render3d_figures import write_figures
 from fpga_robotics.cli.errors import UsageError
+from fpga_robotics.loop.compressed import run_scenario
+from fpga_robotics.loop.connectors.camera import make_renderer
+from fpga_robotics.scenario.load import load_scenario
+from fpga_robotics.sim.camera.scene import CameraPose
+from fpga_robotics.sim.world import World
 
 __all__ = ["MODES", "main"]
 
@@ -37,8 +43,6 @@ MODES = {
 
 def _poses(world, frames):
     """``frames`` camera poses on an ellipse through the room, looking ahead and inwards."""
-    from fpga_robotics.sim.camera.scene import CameraPose
-
     room = world.config.room
     cx, cy = room.width / 2, room.depth / 2
     spec = world.robot_spec
@@ -57,10 +61,6 @@ def _poses(world, frames):
 
 
 def _frame_times(mode, size, frames, repeats):
-    from fpga_robotics.loop.connectors.camera import make_renderer
-    from fpga_robotics.scenario.load import load_scenario
-    from fpga_robotics.sim.world import World
-
     scenario = load_scenario("divider_3d", MODES[mode])
     world = World.from_config(scenario.world, 0)
     for _ in range(60):  # the person walks into the room
@@ -90,9 +90,6 @@ def _loop_times(mode, seconds, repeats, backend):
     """Median wall ms per frame, real-time factor and the same per CPU second, from the first
     frame to the last (the renderer's start-up, an OpenGL context and the model, left out:
     ``startup`` seconds, its median)."""
-    from fpga_robotics.loop.compressed import run_scenario
-    from fpga_robotics.scenario.load import load_scenario
-
     scenario = load_scenario("follow_person", [*MODES[mode], f"sim.duration={seconds}"])
     period = scenario.camera.frame_period
     ms, factor, cpu_factor, startup = [], [], [], []
@@ -145,8 +142,6 @@ def _check(args):
 
 def run(args):
     if args.figures is not None:
-        from fpga_robotics.bench.render3d_figures import write_figures
-
         write_figures(args.figures, viewer=args.viewer)
         return None
     sizes = args.sizes

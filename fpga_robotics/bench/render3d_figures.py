@@ -9,9 +9,22 @@ viewer's window (headless, 1920x1080) after 3 s of ``divider_3d`` in closed loop
 world in 3D beside the map; it needs a Vulkan driver (on Debian ``mesa-vulkan-drivers``).
 """
 
+import tempfile
+import time
 from pathlib import Path
 
+import cv2
 import numpy as np
+
+from fpga_robotics.cli.errors import UsageError
+from fpga_robotics.hw.params import FollowTargetParams
+from fpga_robotics.loop.compressed import run_scenario
+from fpga_robotics.loop.connectors.camera import make_renderer
+from fpga_robotics.scenario.load import load_scenario
+from fpga_robotics.sim.camera.frames import rgb444_to_rgb888, to_rgb444
+from fpga_robotics.sim.files import check_output_dir, write_atomic
+from fpga_robotics.sim.models.follow_target import filter_frame
+from fpga_robotics.sim.world import World
 
 __all__ = ["FIGURES", "figure", "write_figures"]
 
@@ -26,13 +39,6 @@ FILTER_DIFF_MIN = 6
 
 def figure(name, t, overrides=()):
     """The (2H, 2W, 3) uint8 figure of scenario ``name`` at time ``t``."""
-    from fpga_robotics.hw.params import FollowTargetParams
-    from fpga_robotics.loop.connectors.camera import make_renderer
-    from fpga_robotics.scenario.load import load_scenario
-    from fpga_robotics.sim.camera.frames import rgb444_to_rgb888, to_rgb444
-    from fpga_robotics.sim.models.follow_target import filter_frame
-    from fpga_robotics.sim.world import World
-
     scenario = load_scenario(name, list(overrides))
     cam = scenario.camera
     world = World.from_config(scenario.world, scenario.seed)
@@ -52,11 +58,6 @@ def figure(name, t, overrides=()):
 
 def write_figures(folder, viewer=False):
     """Write ``FOLDER/<scenario>.png`` for each of ``FIGURES`` (and the viewer's screenshot)."""
-    import cv2
-
-    from fpga_robotics.cli.errors import UsageError
-    from fpga_robotics.sim.files import check_output_dir, write_atomic
-
     folder = Path(folder)
     check_output_dir(folder)
     folder.mkdir(parents=True, exist_ok=True)
@@ -76,14 +77,9 @@ def write_figures(folder, viewer=False):
 
 def _viewer_screenshot(path, port=9877):
     """Run ``divider_3d`` for 3 s into a recording and save the headless viewer's window."""
-    import tempfile
-    import time
+    import rerun.experimental as rrx  # lazy: rerun costs ~1 s; only the screenshot needs it
 
-    import rerun.experimental as rrx
-
-    from fpga_robotics.loop.compressed import run_scenario
-    from fpga_robotics.scenario.load import load_scenario
-    from fpga_robotics.viz import open_recorder
+    from fpga_robotics.viz import open_recorder  # lazy: viz imports rerun (~1 s)
 
     with tempfile.TemporaryDirectory() as tmp:
         rrd = str(Path(tmp) / "divider_3d.rrd")

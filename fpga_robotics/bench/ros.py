@@ -23,15 +23,19 @@ import threading
 import time
 from pathlib import Path
 
+from websockets.sync.client import connect
+
 from fpga_robotics.bench import scaffold
+from fpga_robotics.bench.viewer import make_records
 from fpga_robotics.cli.errors import UsageError
+from fpga_robotics.ros.bag_writer import BagWriter
+from fpga_robotics.ros.foxglove_live import LivePublisher
+from fpga_robotics.ros.messages import TOPICS, CameraGeometry, FrameMessages
 
 __all__ = ["bench_bag", "bench_live", "main"]
 
 
 def _geometry(width, height):
-    from fpga_robotics.ros.messages import CameraGeometry
-
     return CameraGeometry(
         width=width,
         height=height,
@@ -47,8 +51,6 @@ def _geometry(width, height):
 def bench_bag(records, geometry, folder):
     """Per-call seconds of ``log_frame``, the seconds of opening plus closing the bag (once
     per run: the connections, the MCAP summary, the rename) and the CPU seconds per frame."""
-    from fpga_robotics.ros.bag_writer import BagWriter
-
     path = Path(folder) / f"bag-{time.monotonic_ns()}"
     t0 = time.perf_counter()
     writer = BagWriter(path, geometry)
@@ -79,14 +81,11 @@ class _Client(threading.Thread):
         self.error = None
 
     def run(self):
-        from websockets.sync.client import connect
-
         try:
             with connect(
                 f"ws://127.0.0.1:{self.port}", subprotocols=["foxglove.sdk.v1"], open_timeout=5
             ) as ws:
                 channels = {}
-                from fpga_robotics.ros.messages import TOPICS
 
                 while len(channels) < len(TOPICS):
                     msg = json.loads(ws.recv(timeout=5))
@@ -117,9 +116,6 @@ class _Client(threading.Thread):
 def bench_live(records, geometry, fps=30.0):
     """Per-call seconds of ``LivePublisher.log_frame`` with one client; messages sent and
     received."""
-    from fpga_robotics.ros.foxglove_live import LivePublisher
-    from fpga_robotics.ros.messages import FrameMessages
-
     live = LivePublisher(0, geometry)
     client = _Client(live.port)
     client.start()
@@ -152,8 +148,6 @@ def _options(p):
 
 
 def run(args):
-    from fpga_robotics.bench.viewer import make_records
-
     width, height = scaffold.parse_size(args.resolution, "--resolution")
     figures = {}
     records = make_records(width, height, args.frames)

@@ -24,6 +24,9 @@ from dataclasses import asdict
 from fpga_robotics.bench.calibration import measure_calibration
 from fpga_robotics.bench.timing import Spread, Times, gc_paused, stopwatch  # noqa: F401 (the scaffold's names)
 from fpga_robotics.cli.errors import UsageError
+from fpga_robotics.sim.backends import BackendError
+from fpga_robotics.sim.backends.toolchain import find_compiler
+from fpga_robotics.sim.files import check_output_path, write_json_atomic
 
 __all__ = [
     "BenchParser",
@@ -91,8 +94,6 @@ def print_table(header, rows, *, first_width=None):
 
 def check_json_path(path):
     """Checked before measuring, not after minutes of it."""
-    from fpga_robotics.sim.files import check_output_path
-
     directory = os.path.dirname(os.path.abspath(path))
     if not os.path.isdir(directory):
         raise UsageError(f"cannot write {path}: no directory {directory}")
@@ -101,9 +102,6 @@ def check_json_path(path):
 
 def machine():
     """What the figures were measured on."""
-    from fpga_robotics.sim.backends import BackendError
-    from fpga_robotics.sim.backends.toolchain import find_compiler
-
     try:
         compiler = find_compiler().version
     except BackendError:
@@ -130,8 +128,6 @@ def _plain(value):
 
 def write_json(path, prog, figures, calibration=None):
     """``figures`` (and the calibration, if measured) with the machine, written atomically."""
-    from fpga_robotics.sim.files import write_json_atomic
-
     data = {"command": prog, "machine": machine(), "figures": _plain(figures)}
     if calibration is not None:
         data["calibration"] = _plain(calibration)

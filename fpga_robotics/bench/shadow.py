@@ -13,6 +13,10 @@ import time
 
 from fpga_robotics.bench import scaffold
 from fpga_robotics.cli.errors import UsageError
+from fpga_robotics.cli.run import _shadow_params
+from fpga_robotics.loop.compressed import make_backend, run_scenario
+from fpga_robotics.scenario.load import load_scenario
+from fpga_robotics.sim.backends import BACKEND_NAMES
 
 __all__ = ["main", "measure"]
 
@@ -20,8 +24,6 @@ __all__ = ["main", "measure"]
 def measure(scenario, backend, shadow_params, repeats):
     """``(alone_ms, shadowed_ms, own_ms)``: medians of CPU milliseconds per frame over
     ``repeats`` turns."""
-    from fpga_robotics.loop.compressed import make_backend, run_scenario
-
     design = make_backend(backend, scenario.params)
     shadow = make_backend(backend, shadow_params)
     frames = []
@@ -57,8 +59,6 @@ def measure(scenario, backend, shadow_params, repeats):
 
 
 def _options(p):
-    from fpga_robotics.sim.backends import BACKEND_NAMES
-
     p.add_argument("--scenario", default="follow_person")
     p.add_argument(
         "--shadow",
@@ -78,9 +78,6 @@ def _check(args):
 
 
 def run(args):
-    from fpga_robotics.cli.run import _shadow_params
-    from fpga_robotics.scenario.load import load_scenario
-
     scenario = load_scenario(args.scenario, [f"sim.duration={args.duration!r}"])
     shadow_params = _shadow_params(scenario, args.shadow)
     alone, shadowed, own = measure(scenario, args.backend, shadow_params, args.repeats)

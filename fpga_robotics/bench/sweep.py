@@ -19,13 +19,14 @@ from types import SimpleNamespace
 
 from fpga_robotics.bench import scaffold
 from fpga_robotics.cli.errors import UsageError
+from fpga_robotics.sweep.api import run_campaign
+from fpga_robotics.sweep.campaign import load_campaign
+from fpga_robotics.sweep.results import read_meta
 
 __all__ = ["bench", "main", "measure"]
 
 
 def _campaign(runs, args):
-    from fpga_robotics.sweep.campaign import load_campaign
-
     return load_campaign(
         {
             "name": "bench",
@@ -39,9 +40,6 @@ def _campaign(runs, args):
 
 
 def _once(runs, workers, args):
-    from fpga_robotics.sweep.api import run_campaign
-    from fpga_robotics.sweep.results import read_meta
-
     with tempfile.TemporaryDirectory(prefix="sweep-bench-") as out:
         rows = run_campaign(_campaign(runs, args), out, workers=workers, record="none")
         meta = read_meta(out)

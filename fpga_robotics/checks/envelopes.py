@@ -35,6 +35,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from fpga_robotics.sim.models.follow_target import match_table, proximity_level
+from fpga_robotics.sim.world.people import person_bands
 
 __all__ = [
     "EnvelopeGeometry",
@@ -97,8 +98,6 @@ def envelope_geometry(scenario, world_config, camera):
     """The ``EnvelopeGeometry`` of a run (``scenario``, its ``WorldConfig``, its
     ``CameraConnector``), or why there is none (a string): no target person, or a renderer
     that draws bodies rather than the cylinders the bounds are computed for."""
-    from fpga_robotics.sim.world.people import person_bands
-
     target = next((p for p in world_config.people if p.target), None)
     if target is None:
         return "no target person"

@@ -132,8 +132,8 @@ def _bench_list():
 
 def version():
     """The installed package's version (``fpga-robotics --version``)."""
-    from importlib.metadata import PackageNotFoundError
-    from importlib.metadata import version as package_version
+    from importlib.metadata import PackageNotFoundError  # lazy: ~40 ms at every start
+    from importlib.metadata import version as package_version  # lazy: ~40 ms at every start
 
     try:
         return package_version("fpga-robotics")

@@ -3,9 +3,13 @@ the ``fpga_robotics.designs`` entry points, or the reference given), with their 
 connectors they bind and the outputs recorded under their own names."""
 
 import argparse
+import dataclasses
 import sys
+import tomllib
 
 from fpga_robotics.cli.errors import UsageError, run_cli
+from fpga_robotics.designs.builtin import TOPS, connector_kinds
+from fpga_robotics.designs.reference import DesignError, entry_point_designs, resolve_design
 
 __all__ = ["describe", "main"]
 
@@ -36,8 +40,6 @@ def build_parser(prog):
 
 
 def _params(items):
-    import tomllib
-
     params = {}
     for item in items:
         name, sep, text = item.partition("=")
@@ -70,13 +72,9 @@ def checked_verilog(spec, ports):
     """A Verilog design's spec with its ports as Verilator reads them, the port map checked
     against them (names, directions, widths, every input driven, the connectors' pins):
     ``DesignError`` for the first mismatch."""
-    import dataclasses
-
-    from fpga_robotics.designs.builtin import connector_kinds
-    from fpga_robotics.designs.reference import DesignError
-    from fpga_robotics.sim.backends.base import BackendError
-    from fpga_robotics.sim.backends.foreign import ForeignDesign
-    from fpga_robotics.sim.backends.port_map import load_port_map
+    from fpga_robotics.sim.backends.base import BackendError  # lazy: the simulator (~0.5 s)
+    from fpga_robotics.sim.backends.foreign import ForeignDesign  # lazy: the simulator (~0.5 s)
+    from fpga_robotics.sim.backends.port_map import load_port_map  # lazy: the simulator (~0.5 s)
 
     files = spec.reference[len("verilog:") :].split(",")
     port_map = load_port_map(ports)
@@ -93,9 +91,6 @@ def checked_verilog(spec, ports):
 
 
 def main(argv=None, prog="fpga-robotics designs"):
-    from fpga_robotics.designs.builtin import TOPS
-    from fpga_robotics.designs.reference import entry_point_designs, resolve_design
-
     args = build_parser(prog).parse_args(argv)
     params = _params(args.params)
     if args.reference is None:

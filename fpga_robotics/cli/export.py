@@ -21,6 +21,7 @@ import os
 from dataclasses import fields
 
 from fpga_robotics.cli.board import add_board_arguments, run_board
+from fpga_robotics.cli.designs import _params
 from fpga_robotics.cli.errors import UsageError
 from fpga_robotics.cli.param_options import add_param_arguments, params_from_args
 from fpga_robotics.cli.parser import CommandParser
@@ -30,6 +31,7 @@ from fpga_robotics.cli.sensor_options import (
     given_options,
     sensor_params_from_args,
 )
+from fpga_robotics.designs.reference import resolve_design
 from fpga_robotics.flow.export import TOPS, generate_top_verilog
 from fpga_robotics.hw.corridor_follow import CorridorFollow
 from fpga_robotics.hw.corridor_follow_uart import CorridorFollowUart
@@ -217,9 +219,6 @@ def _is_follow_target_option(dest):
 def _export_design(args):
     """``--design REF``: any Amaranth design of one's own as Verilog, its module named after
     the class or function the reference names; its other options must not be given."""
-    from fpga_robotics.cli.designs import _params
-    from fpga_robotics.designs.reference import resolve_design
-
     if args.top != TOP_NAME or args.board is not None or args.bitstream:
         raise UsageError(
             "--design exports a design of your own: --top, --board and --bitstream go without it"

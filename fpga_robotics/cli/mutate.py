@@ -11,12 +11,17 @@ import argparse
 import os
 import sys
 import time
+import tomllib
 
 from fpga_robotics.cli.errors import UsageError
 from fpga_robotics.cli.param_options import add_param_arguments, params_from_args
 from fpga_robotics.cli.parser import CommandParser
+from fpga_robotics.designs.reference import resolve_design
 from fpga_robotics.mutation.design import open_mutant_design, write_mutant_design
+from fpga_robotics.mutation.design_run import DEFAULT_CYCLES, mutate_design
 from fpga_robotics.mutation.reasons import blind_spot_reason
+from fpga_robotics.mutation.report import write_report
+from fpga_robotics.mutation.robot_judge import robot_judge
 from fpga_robotics.mutation.scores import blind_spots, by_module, robot_score, unit_score
 from fpga_robotics.mutation.unit_judge import (
     golden_results,
@@ -24,15 +29,16 @@ from fpga_robotics.mutation.unit_judge import (
     judge_mutant,
     reference_results,
 )
-from fpga_robotics.sim.files import check_output_dir, write_json_atomic
+from fpga_robotics.sim.backends.base import BackendError
+from fpga_robotics.sim.files import check_output_dir, write_atomic, write_json_atomic
 from fpga_robotics.sim.mutation import MutationError, list_mutants
+from fpga_robotics.sim.pins import PinError
+from fpga_robotics.sweep import load_campaign_file, runner
 
 __all__ = ["main"]
 
 
 def _campaign(name):
-    from fpga_robotics.sweep import load_campaign_file
-
     return load_campaign_file(name)
 
 
@@ -51,8 +57,6 @@ def _report_robot(
     width,
 ):
     """The robot judge's lines, the recordings of the closest runs, and report.html."""
-    from fpga_robotics.mutation.report import write_report
-
     rs = robot_score(unit, robot)
     n_runs, n_pass = len(baseline["runs"]), len(baseline["passing"])
     print(
@@ -92,9 +96,6 @@ def _robot_rate(judged_here, seconds):
 
 def _record_closest(out, verdicts, say):
     """Record the closest-to-failing run of each verdict; ``{index: path}``."""
-    from fpga_robotics.sim.files import write_atomic
-    from fpga_robotics.sweep import runner
-
     paths = {}
     for v in verdicts:
         if not v.get("argv"):
@@ -222,8 +223,6 @@ def build_parser(prog="fpga-robotics mutate"):
 
 def _design_params(items):
     """``--param NAME=VALUE`` items as a dict (values parsed as TOML, else text)."""
-    import tomllib
-
     params = {}
     for item in items:
         name, sep, text = item.partition("=")
@@ -238,11 +237,6 @@ def _design_params(items):
 
 def _main_design(args):
     """``--design REF``: the mutants of a design of one's own against itself."""
-    from fpga_robotics.designs.reference import resolve_design
-    from fpga_robotics.mutation.design_run import DEFAULT_CYCLES, mutate_design
-    from fpga_robotics.sim.backends.base import BackendError
-    from fpga_robotics.sim.pins import PinError
-
     verilog = args.design.startswith("verilog:")
     if verilog and args.param:
         raise UsageError(
@@ -425,8 +419,6 @@ def main(argv=None, prog="fpga-robotics mutate"):
     unit = {v.index: v.caught for v in verdicts}
     robot_verdicts, baseline = {}, None
     if campaign is not None:
-        from fpga_robotics.mutation.robot_judge import robot_judge
-
         caught = [v.index for v in verdicts if v.caught]
         t2 = time.perf_counter()
         baseline, robot_verdicts = robot_judge(

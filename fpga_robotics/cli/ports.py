@@ -3,7 +3,9 @@ or check a port map file (docs/foreign.md); with ``--design verilog:FILES`` the 
 against the design's real ports as Verilator reads them (names, directions, widths, every input
 driven, the connectors' pins)."""
 
+from fpga_robotics.cli.designs import checked_verilog
 from fpga_robotics.cli.parser import CommandParser
+from fpga_robotics.designs.reference import DesignError, resolve_design
 from fpga_robotics.sim.backends.port_map import load_port_map, write_follow_target_port_map
 
 __all__ = ["build_parser", "main"]
@@ -45,9 +47,6 @@ def main(argv=None, prog="fpga-robotics ports"):
 
 def _check_against_design(reference, path):
     """Raise a one-line ``DesignError`` at the first way the map and the design disagree."""
-    from fpga_robotics.cli.designs import checked_verilog
-    from fpga_robotics.designs.reference import DesignError, resolve_design
-
     if not reference.startswith("verilog:"):
         raise DesignError(
             f"--design must be a Verilog design, verilog:TOP.v[,MORE.v], got "

@@ -7,17 +7,41 @@ usage error (bad argument, unknown scenario or key, malformed file, unopenable s
 simulator).
 """
 
+import contextlib
+import copy
+import dataclasses
+import json
 import sys
 import time
+import tomllib
+from importlib import resources
 from pathlib import Path
 
+from fpga_robotics.checks.summary import format_summary
 from fpga_robotics.cli.errors import UsageError
 from fpga_robotics.cli.parser import CommandParser
 from fpga_robotics.hw.pixel import COLOR_SELECT
+from fpga_robotics.loop.compressed import make_backend, run_scenario
+from fpga_robotics.loop.pin_shadow import is_design_reference
+from fpga_robotics.loop.real_clock import format_extra_outputs, make_pin_backend
+from fpga_robotics.loop.shadow import format_shadow, shadow_overrides
+from fpga_robotics.loop.sources import open_source, run_source
+from fpga_robotics.loop.video_out import CameraVideo, VideoPathError, check_video_path
 from fpga_robotics.ros.run_options import RosOutputs, add_ros_arguments
+from fpga_robotics.scenario.load import (
+    MAX_SEED,
+    ForeignDesignFiles,
+    load_scenario,
+    parse_resolution,
+    shipped_scenarios,
+)
+from fpga_robotics.scenario.sanity import report_warnings
 from fpga_robotics.sim.backends import BACKEND_NAMES
-from fpga_robotics.sim.backends.foreign_choice import FOREIGN_BACKENDS
+from fpga_robotics.sim.backends.base import BackendError
+from fpga_robotics.sim.backends.foreign_choice import FOREIGN_BACKENDS, open_foreign_frames
+from fpga_robotics.sim.camera.render3d.renderer import Render3DUnavailable, load_mujoco
 from fpga_robotics.sim.files import check_output_path, write_json_atomic
+from fpga_robotics.sim.pins import PinError
 
 __all__ = ["TARGET_CLOTHING", "Progress", "build_parser", "main"]
 
@@ -40,9 +64,6 @@ DEFAULT_SCENARIO = "follow_person"
 def _scenario_default(section, key):
     """The default scenario's ``[section] key`` as ``--help`` shows it (read from its TOML
     file, not loaded: ``--help`` stays quick)."""
-    import tomllib
-    from importlib import resources
-
     path = resources.files("fpga_robotics.scenario") / "shipped" / f"{DEFAULT_SCENARIO}.toml"
     value = tomllib.loads(path.read_text()).get(section, {}).get(key)
     return "the scenario's" if value is None else f"the scenario's; {DEFAULT_SCENARIO}: {value}"
@@ -226,8 +247,6 @@ class Progress:
 def design_override(reference):
     """``--design REF`` (not ``verilog:``) as the override ``design.top="REF"``, a file path
     made absolute (a scenario file's relative paths are from its own folder)."""
-    import json
-
     where, sep, name = reference.rpartition(":")
     if sep and where.endswith(".py"):
         reference = f"{Path(where).expanduser().resolve()}:{name}"
@@ -249,8 +268,6 @@ def take_design_reference(args, scenario):
 
 
 def _overrides(args):
-    from fpga_robotics.scenario.load import parse_resolution
-
     items = list(args.overrides)
     if args.design is not None and not args.design.startswith("verilog:"):
         if args.ports is not None:
@@ -272,11 +289,8 @@ def _overrides(args):
 
 def _video(path, fps):
     """A ``CameraVideo`` context for ``--save-video``, or a context that yields None."""
-    import contextlib
-
     if path is None:
         return contextlib.nullcontext()
-    from fpga_robotics.loop.video_out import CameraVideo
 
     return CameraVideo(path, fps)
 
@@ -285,7 +299,6 @@ def _shadow_params(scenario, spec):
     """The shadow design's parameters: the scenario's design with ``--shadow`` applied."""
     if spec is None:
         return None
-    from fpga_robotics.loop.shadow import shadow_overrides
 
     try:
         items = shadow_overrides(spec)
@@ -297,8 +310,6 @@ def _shadow_params(scenario, spec):
 def _shadow_scenario(scenario, spec):
     """With ``--shadow REF`` (a design reference): the scenario running that design instead
     (its ``[design.params]`` kept); None for a FollowTarget parameter shadow."""
-    from fpga_robotics.loop.pin_shadow import is_design_reference
-
     if spec is None or not is_design_reference(spec):
         return None
     if scenario.sim.timing != "real_clock":
@@ -333,9 +344,6 @@ def _dress_target(scenario, color):
 
 
 def _open_backend(name, params, quiet=False):
-    from fpga_robotics.loop.compressed import make_backend
-    from fpga_robotics.sim.backends.base import BackendError
-
     def tell(text):  # a first run compiles the model for seconds: say so
         if not quiet:
             print(f"{text} ...", file=sys.stderr, flush=True)
@@ -348,9 +356,6 @@ def _open_backend(name, params, quiet=False):
 
 def _open_pin_design(args, scenario):
     """The scenario's design on a pin-level backend (real-clock timing)."""
-    from fpga_robotics.loop.real_clock import make_pin_backend
-    from fpga_robotics.sim.backends.base import BackendError
-    from fpga_robotics.sim.pins import PinError
 
     def tell(text):
         if not args.quiet:
@@ -379,9 +384,6 @@ def _with_design_files(args, scenario):
     design_files = _design_files(args, scenario.foreign)
     if design_files is None:
         return scenario
-    import dataclasses
-
-    from fpga_robotics.scenario.load import ForeignDesignFiles
 
     files, ports = design_files
     return dataclasses.replace(scenario, foreign=ForeignDesignFiles(tuple(files), str(ports)))
@@ -425,8 +427,6 @@ def _open_design(args, params, foreign=None):
     if design_files is None:
         return _open_backend(args.backend, params, args.quiet)
     files, ports = design_files
-    from fpga_robotics.sim.backends.base import BackendError
-    from fpga_robotics.sim.backends.foreign_choice import open_foreign_frames
 
     def tell(text):
         if not args.quiet:
@@ -471,9 +471,6 @@ def runtime_values(args):
 def apply_runtime(design, args):
     """Hold the design's ``[runtime]`` inputs at the ``--runtime`` values (a design opened
     once and reused for several runs gets its values again before each)."""
-    from fpga_robotics.sim.backends.base import BackendError
-    from fpga_robotics.sim.pins import PinError
-
     for name, value in runtime_values(args).items():
         try:
             design.set_runtime(name, value)
@@ -489,8 +486,6 @@ class _UserDesign:
         self._backend = backend
 
     def process_frame(self, frame, color_sel="red"):
-        from fpga_robotics.sim.backends.base import BackendError
-
         try:
             return self._backend.process_frame(frame, color_sel)
         except BackendError as exc:
@@ -512,7 +507,7 @@ def _check_recording(args, name):
     never fails on its recording after the work."""
     if args.rerun == "off":
         return
-    from fpga_robotics.viz.modes import parse_mode
+    from fpga_robotics.viz.modes import parse_mode  # lazy: viz imports rerun (~1 s)
 
     mode = parse_mode(args.rerun, default_path=f"runs/{name}.rrd")
     if mode.path is not None:
@@ -524,7 +519,6 @@ def _check_renderer(scenario):
     not when the first frame is drawn."""
     if scenario.camera.renderer != "mujoco":
         return
-    from fpga_robotics.sim.camera.render3d.renderer import Render3DUnavailable, load_mujoco
 
     try:
         load_mujoco()
@@ -537,7 +531,7 @@ def _open_recorder(args, name):
         return None
     if args.log_every < 1:
         raise UsageError(f"--log-every must be >= 1, got {args.log_every}")
-    from fpga_robotics.viz import open_recorder
+    from fpga_robotics.viz import open_recorder  # lazy: viz imports rerun (~1 s)
 
     recorder = open_recorder(
         args.rerun,
@@ -588,8 +582,6 @@ def _frame_callback(video, ros):
 
 
 def _list_scenarios():
-    from fpga_robotics.scenario.load import shipped_scenarios
-
     shipped = shipped_scenarios()
     width = max(len(n) for n in shipped)
     for name, (_path, desc) in shipped.items():
@@ -598,8 +590,6 @@ def _list_scenarios():
 
 
 def _run_source(args, scenario, ros):
-    from fpga_robotics.loop.sources import open_source, run_source
-
     ros.check_closed_loop_only()
     if scenario.sim.timing == "real_clock":
         raise UsageError(
@@ -663,11 +653,6 @@ def main(argv=None, prog="fpga-robotics run"):
     if args.list_scenarios:
         return _list_scenarios()
 
-    from fpga_robotics.checks.summary import format_summary
-    from fpga_robotics.loop.compressed import run_scenario
-    from fpga_robotics.scenario.load import MAX_SEED, load_scenario
-    from fpga_robotics.scenario.sanity import report_warnings
-
     if args.seed is not None and not 0 <= args.seed <= MAX_SEED:
         raise UsageError(f"--seed must be in 0..{MAX_SEED}, got {args.seed}")
     if args.log_every < 1:  # checked now, before a model is built
@@ -697,8 +682,6 @@ def main(argv=None, prog="fpga-robotics run"):
     shadow_scenario = _shadow_scenario(scenario, args.shadow)
     shadow_params = None if shadow_scenario is not None else _shadow_params(scenario, args.shadow)
     if args.save_video is not None:
-        from fpga_robotics.loop.video_out import VideoPathError, check_video_path
-
         try:
             check_video_path(args.save_video)
         except VideoPathError as exc:
@@ -721,8 +704,6 @@ def main(argv=None, prog="fpga-robotics run"):
     completed = False
     try:
         if shadow_scenario is not None:
-            import copy
-
             shadow_args = copy.copy(args)
             shadow_args.backend = args.shadow_backend or args.backend
             shadow = _open_pin_design(shadow_args, shadow_scenario)
@@ -758,13 +739,10 @@ def main(argv=None, prog="fpga-robotics run"):
     summary["backend_setup_s"] = round(setup, 3)
     summary.update(ros.summary_items())  # the live inputs, for --replay-inputs
     print(format_summary(summary))
-    from fpga_robotics.loop.real_clock import format_extra_outputs
 
     for line in format_extra_outputs(summary):
         print(line)
     if "shadow" in summary:
-        from fpga_robotics.loop.shadow import format_shadow
-
         print("\n".join(format_shadow(summary["shadow"])))
     for line in notices:
         print(line)

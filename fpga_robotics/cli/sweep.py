@@ -10,8 +10,12 @@ from pathlib import Path
 from fpga_robotics.cli.errors import UsageError
 from fpga_robotics.cli.parser import CommandParser
 from fpga_robotics.sim.files import check_output_dir
+from fpga_robotics.sweep.api import report_dir, run_campaign
 from fpga_robotics.sweep.campaign import load_campaign, read_campaign_file, shipped_campaigns
 from fpga_robotics.sweep.engine import RECORD_LOG_EVERY
+from fpga_robotics.sweep.plan import make_plan
+from fpga_robotics.sweep.report import campaign_passed, format_report
+from fpga_robotics.sweep.results import load_rows
 
 __all__ = ["build_parser", "main"]
 
@@ -138,7 +142,7 @@ def build_parser(prog=PROG):
 
 
 def _merge_options(data, args):
-    from fpga_robotics.scenario.load import _parse_value
+    from fpga_robotics.scenario.load import _parse_value  # lazy: the run stack (~1 s)
 
     if args.scenarios is not None:
         data["scenarios"] = [s for s in args.scenarios.split(",") if s]
@@ -195,8 +199,6 @@ def _check_counts(args):
 
 
 def _dry_run(campaign, args):
-    from fpga_robotics.sweep.plan import make_plan
-
     plan = make_plan(campaign)
     runs = plan.runs[: args.max_runs] if args.max_runs else plan.runs
     print(
@@ -215,7 +217,6 @@ def _report(argv, prog):
     )
     p.add_argument("dir", metavar="DIR", help="the campaign's results folder")
     args = p.parse_args(argv)
-    from fpga_robotics.sweep.api import report_dir
 
     if not Path(args.dir).is_dir():
         raise UsageError(f"{args.dir} is not a folder of campaign results")
@@ -231,20 +232,17 @@ def main(argv=None, prog=PROG):
     args = build_parser(prog).parse_args(argv)
     _check_counts(args)
     if args.bench:
-        from fpga_robotics.bench.sweep import bench
+        from fpga_robotics.bench.sweep import bench  # lazy: the run stack (~1 s)
 
         return bench(args)
     campaign = _campaign(args)
-    from fpga_robotics.sweep.sanity import report_campaign_warnings
+    from fpga_robotics.sweep.sanity import report_campaign_warnings  # lazy: the run stack (~1 s)
 
     report_campaign_warnings(campaign, args.strict, sys.stderr, UsageError)
     if args.dry_run:
         return _dry_run(campaign, args)
     out = Path(args.out) if args.out else Path("runs") / "sweeps" / campaign.name
     check_output_dir(out, what="--out")
-    from fpga_robotics.sweep.api import run_campaign
-    from fpga_robotics.sweep.report import campaign_passed, format_report
-    from fpga_robotics.sweep.results import load_rows
 
     def echo(text):
         if not args.quiet:

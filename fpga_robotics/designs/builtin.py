@@ -13,6 +13,8 @@ import dataclasses
 import importlib
 from dataclasses import dataclass, field
 
+from fpga_robotics.hw.variants import VARIANTS, variant_params
+
 __all__ = [
     "TOPS",
     "Top",
@@ -153,7 +155,7 @@ def foreign_top(port_map):
 def connector_kinds():
     """Every registered connector kind with pins bound by a port map's ``[connectors]``:
     kind -> {pin: (direction, at most this many bits)} (``port_map.check_connectors``)."""
-    from fpga_robotics.loop.connectors import CONNECTORS
+    from fpga_robotics.loop.connectors import CONNECTORS  # lazy: circle via loop's init
 
     return {
         kind: {pin: (spec.direction, spec.width) for pin, spec in cls.pins.items()}
@@ -203,8 +205,6 @@ def design_tables(top, tables, variant=None):
 
 
 def _with_variant(top, tables, name):
-    from fpga_robotics.hw.variants import VARIANTS, variant_params
-
     names = [n for n, v in VARIANTS.items() if v.design == top.name]
     if name not in names:
         raise ValueError(

@@ -31,8 +31,9 @@ import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from fpga_robotics.designs.builtin import TOPS, Top
+from fpga_robotics.designs.builtin import TOPS, Top, build_component, design_tables, foreign_top
 from fpga_robotics.hw.errors import UsageError
+from fpga_robotics.hw.params import FollowTargetParams
 
 __all__ = [
     "ENTRY_POINT_GROUP",
@@ -103,9 +104,6 @@ class DesignSpec:
         if self.kind == "verilog":
             raise DesignError(f"design {self.reference!r} is Verilog: Verilator builds it")
         if self.kind == "builtin":
-            from fpga_robotics.designs.builtin import build_component, design_tables
-            from fpga_robotics.hw.params import FollowTargetParams
-
             return build_component(self.top, FollowTargetParams(), design_tables(self.top, {}))
         return self.top.component()
 
@@ -189,8 +187,6 @@ def _builtin_spec(registered):
     cached = _TOP_SPECS.get(id(registered))
     if cached is not None and cached[0] is registered:
         return cached[1]
-    from fpga_robotics.designs.builtin import build_component, design_tables
-    from fpga_robotics.hw.params import FollowTargetParams
 
     component = build_component(registered, FollowTargetParams(), design_tables(registered, {}))
     ports = component_ports(component)
@@ -329,7 +325,7 @@ def _first_line(exc):
 
 
 def _is_component_class(value):
-    from amaranth.lib import wiring
+    from amaranth.lib import wiring  # lazy: Amaranth (~0.3 s)
 
     return inspect.isclass(value) and issubclass(value, wiring.Component)
 
@@ -417,7 +413,7 @@ def _type_name(kind):
 
 def _call(target, params, reference):
     """``target(**params)``, the component it returns (an error names what went wrong)."""
-    from amaranth.lib import wiring
+    from amaranth.lib import wiring  # lazy: Amaranth (~0.3 s)
 
     values = {k: tuple(v) if isinstance(v, list) else v for k, v in params.items()}
     try:
@@ -437,9 +433,9 @@ def _call(target, params, reference):
 def component_ports(component):
     """Port name (as the generated Verilog names it) -> (direction, width). The component
     was only looked at: it is marked so that Amaranth does not warn it was never used."""
-    from amaranth.hdl import Fragment
+    from amaranth.hdl import Fragment  # lazy: Amaranth (~0.3 s)
 
-    from fpga_robotics.hw.verilog import verilog_ports
+    from fpga_robotics.hw.verilog import verilog_ports  # lazy: Amaranth (~0.3 s)
 
     ports = {
         name: ("in" if direction == "i" else "out", value.shape().width)
@@ -454,7 +450,7 @@ def component_ports(component):
 
 def _connector_pins():
     """Connector kind -> its pin names (the camera's stream is its ``pixels`` pin)."""
-    from fpga_robotics.loop.connectors import CONNECTORS
+    from fpga_robotics.loop.connectors import CONNECTORS  # lazy: circle via loop's init
 
     return {kind: tuple(cls.pins) for kind, cls in CONNECTORS.items()}
 
@@ -529,8 +525,10 @@ def extra_outputs_of(ports, bindings):
 
 
 def _verilog_spec(reference, ports, base, params):
-    from fpga_robotics.designs.builtin import foreign_top
-    from fpga_robotics.sim.backends.port_map import PortMapError, load_port_map
+    from fpga_robotics.sim.backends.port_map import (  # lazy: the simulator (~0.5 s)
+        PortMapError,
+        load_port_map,
+    )
 
     files = [f for f in reference[len("verilog:") :].split(",") if f.strip()]
     if not files:

@@ -18,7 +18,9 @@ import tempfile
 import time
 from dataclasses import dataclass, field
 
+from fpga_robotics.hw.board.ulx3s_top import ULX3SFollowTarget, ulx3s_platform
 from fpga_robotics.hw.errors import UserError
+from fpga_robotics.hw.params import FollowTargetParams
 from fpga_robotics.sim.files import write_atomic
 
 __all__ = [
@@ -45,8 +47,6 @@ YOWASP_TOOLS = {
 
 
 def _ulx3s_85f(params):
-    from fpga_robotics.hw.board.ulx3s_top import ULX3SFollowTarget, ulx3s_platform
-
     return ulx3s_platform(), ULX3SFollowTarget(params)
 
 
@@ -219,8 +219,6 @@ def export_board(board, out_dir, params=None, design=None):
     """Write the board top's Verilog (``<name>.v``), pin constraints (``<name>.lpf``) and the
     rest of the build plan (RTLIL, Yosys script, build script) into ``out_dir``; ``design``
     (a ``DesignSpec``) puts a design of one's own on the board instead of FollowTarget."""
-    from fpga_robotics.hw.params import FollowTargetParams
-
     params = FollowTargetParams() if params is None else params
     return _write_plan(_plan(board, params, verilog=True, design=design), out_dir)
 
@@ -317,8 +315,6 @@ def build_bitstream(board, out_dir, params=None, *, seed=1, log=print, design=No
     Returns a ``BuildReport``; raises ``UserError`` when a tool is missing and
     ``RuntimeError`` (naming the log file) when a tool fails.
     """
-    from fpga_robotics.hw.params import FollowTargetParams
-
     params = FollowTargetParams() if params is None else params
     tools = find_yowasp_tools()
     report_name = f"{DESIGN_NAME}.report.json"

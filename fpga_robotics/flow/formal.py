@@ -20,7 +20,13 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from amaranth.back import rtlil
+
+from fpga_robotics.designs.reference import resolve_design
 from fpga_robotics.hw.errors import UsageError, UserError
+from fpga_robotics.hw.formal import CHECKS
+from fpga_robotics.hw.formal.declared import PROPERTY_HOOK, declared_checks
+from fpga_robotics.sim.backends.port_map import PortMapError, load_port_map
 from fpga_robotics.sim.files import atomic_path
 
 __all__ = [
@@ -278,8 +284,6 @@ def run_check(check, *, depth=None, dut=None, trace_dir=None, env=None, timeout=
                 (work / name).write_text(text)
             (work / "check.sby").write_text(verilog_sby_script(check, depth))
         else:
-            from amaranth.back import rtlil
-
             harness = check.build(dut)
             (work / "top.il").write_text(rtlil.convert(harness, ports=harness.ports()))
             (work / "check.sby").write_text(sby_script(check, depth))
@@ -313,12 +317,8 @@ def design_checks(reference=None, params=None, ports=None):
     Verilog one (``verilog:FILES``, its top from the port map ``ports`` when given) the
     assert and cover statements it holds (``verilog_checks``). A design that declares none is
     a ``UsageError``."""
-    from fpga_robotics.hw.formal import CHECKS
-    from fpga_robotics.hw.formal.declared import PROPERTY_HOOK, declared_checks
-
     if reference is None or reference == "follow_target":
         return list(CHECKS)
-    from fpga_robotics.designs.reference import resolve_design
 
     if reference.startswith("verilog:"):
         files = [f for f in reference[len("verilog:") :].split(",") if f.strip()]
@@ -326,8 +326,6 @@ def design_checks(reference=None, params=None, ports=None):
             raise UsageError(f"--design {reference}: name the Verilog files, verilog:TOP.v")
         top = None
         if ports is not None:
-            from fpga_robotics.sim.backends.port_map import PortMapError, load_port_map
-
             try:
                 top = load_port_map(ports).top
             except PortMapError as exc:

@@ -9,15 +9,15 @@ first row where an output differs is the place to look.
 
 from dataclasses import dataclass, field
 
+from fpga_robotics.designs.builtin import TOPS
+from fpga_robotics.designs.reference import entry_point_designs
+
 __all__ = ["MirroredPins", "PinComparison", "is_design_reference"]
 
 
 def is_design_reference(spec):
     """Whether ``--shadow SPEC`` names a design (a built-in or installed name, ``FILE.py:Name``,
     ``module:Name``) rather than FollowTarget parameters (a preset, ``KEY=VALUE`` items)."""
-    from fpga_robotics.designs.builtin import TOPS
-    from fpga_robotics.designs.reference import entry_point_designs
-
     spec = str(spec).strip()
     if "=" in spec or ";" in spec:
         return False

@@ -27,9 +27,11 @@ import numpy as np
 
 from fpga_robotics.checks.sensor_metrics import line_metrics, measurement_metrics
 from fpga_robotics.designs.builtin import build_component, connector_kinds, foreign_top
+from fpga_robotics.designs.reference import resolve_design
 from fpga_robotics.hw.errors import UsageError
 from fpga_robotics.loop.compressed import TIMINGS, ClosedLoop
 from fpga_robotics.loop.connectors import CONNECTORS, PinIO
+from fpga_robotics.loop.pin_shadow import MirroredPins, PinComparison
 from fpga_robotics.sim.backends.base import FrameResult
 from fpga_robotics.sim.backends.foreign import ForeignDesign
 from fpga_robotics.sim.backends.port_map import load_port_map
@@ -60,7 +62,6 @@ def scenario_top(scenario):
     (``design.verilog``) the one its port map describes."""
     if scenario.foreign is not None:
         return foreign_top(load_port_map(scenario.foreign.ports))
-    from fpga_robotics.designs.reference import resolve_design
 
     return resolve_design(scenario.top, scenario.design_params).top
 
@@ -92,7 +93,6 @@ def pin_design_source(scenario):
             "pixels": ("pixels__valid", "pixels__payload"),
             "frame_size": (params.width, params.height),
         }
-        from fpga_robotics.designs.reference import resolve_design
 
         ports = resolve_design(scenario.top, scenario.design_params).ports
         if ports.get("filtered__valid", ("",))[0] == "out" and "filtered__payload" in ports:
@@ -174,8 +174,6 @@ class RealClockLoop(ClosedLoop):
         shadow=None,
         shadow_label="shadow",
     ):
-        from fpga_robotics.loop.pin_shadow import MirroredPins, PinComparison
-
         if shadow is not None:  # a second design, given every input the primary gets
             design = MirroredPins(design, shadow)
         super().__init__(

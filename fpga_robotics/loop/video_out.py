@@ -8,6 +8,8 @@ exactly, the frames of the run.
 
 from contextlib import ExitStack
 
+import cv2
+
 from fpga_robotics.hw.errors import UserError
 from fpga_robotics.sim.files import atomic_path, check_output_path
 
@@ -46,8 +48,6 @@ class CameraVideo:
         return self
 
     def write(self, rgb):
-        import cv2
-
         if self._writer is None:  # the size is known with the first frame
             height, width = rgb.shape[:2]
             fourcc = cv2.VideoWriter_fourcc(*VIDEO_CODECS[self.path.suffix.lower()])

@@ -5,6 +5,9 @@ random pin stimulus (``pin_judge``), with the same scores as FollowTarget's unit
 import os
 import time
 
+from amaranth.hdl import Fragment
+
+from ..hw.verilog import verilog_ports
 from ..sim.files import write_atomic, write_json_atomic
 from ..sim.mutation import MUTATION_SELECT, component_rtlil, list_mutants, mutant_netlist
 from ..sim.pins.base import Port
@@ -27,10 +30,6 @@ DEFAULT_CYCLES = 100_000
 def design_ports(spec):
     """The ports of the design ``spec`` (a ``DesignSpec``) as pin ``Port``s, named as the
     generated Verilog names them."""
-    from amaranth.hdl import Fragment
-
-    from ..hw.verilog import verilog_ports
-
     component = spec.build()
     Fragment.get(component, None)  # read for its signature only: elaborated, so no warning
     return {

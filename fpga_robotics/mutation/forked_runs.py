@@ -9,6 +9,11 @@ design are run in full (``runner.execute``).
 
 import time
 
+from fpga_robotics.cli import run
+from fpga_robotics.loop.fork import ReferenceRun
+
+from ..sweep import runner
+
 __all__ = ["execute_forked", "reference_outcome"]
 
 #: References a worker keeps (one per campaign run: the mutation campaign has nine).
@@ -18,11 +23,6 @@ _references = {}
 
 def _reference(ref_argv):
     """The worker's ``ReferenceRun`` of the unmutated design for ``ref_argv`` (built once)."""
-    from fpga_robotics.cli import run
-    from fpga_robotics.loop.fork import ReferenceRun
-
-    from ..sweep import runner
-
     key = tuple(ref_argv)
     if key not in _references:
         if len(_references) >= _KEEP:
@@ -35,8 +35,6 @@ def _reference(ref_argv):
 
 
 def _forkable(argv):
-    from ..sweep import runner
-
     _, scenario, shadow_params = runner.load_run(list(argv))
     return scenario.sim.timing == "compressed" and shadow_params is None
 
@@ -44,8 +42,6 @@ def _forkable(argv):
 def reference_outcome(ref_argv):
     """``runner.execute(ref_argv)`` of a run with the unmutated design, which the worker keeps
     as the reference of the mutants' runs (the robot judge's baseline)."""
-    from ..sweep import runner
-
     if not _forkable(ref_argv):
         return runner.execute(ref_argv)
     wall0, cpu0 = time.perf_counter(), time.process_time()
@@ -63,10 +59,6 @@ def reference_outcome(ref_argv):
 def execute_forked(argv, ref_argv, timeout=None):
     """``runner.execute(argv, timeout)`` for a mutant's run, forked from the reference run
     ``ref_argv`` (the same run with the unmutated design); the same outcome dict."""
-    from fpga_robotics.cli import run
-
-    from ..sweep import runner
-
     wall0, cpu0 = time.perf_counter(), time.process_time()
     out = {"status": "error", "message": "", "summary": None, "recording": None, "run_s": 0.0}
     deadline = None

@@ -20,6 +20,7 @@ import numpy as np
 from ..hw.verilog import TOP_NAME
 from ..sim.mutation import MUTATION_SELECT, mutant_netlist, select_width
 from ..sim.pins.base import Port
+from ..sim.pins.compiled import VerilatorPins
 
 __all__ = [
     "CHANGE_PROBABILITY",
@@ -163,6 +164,4 @@ def judge_pin_mutant(backend, index, stimulus, cycles, reference):
 
 def open_pin_mutants(source, *, on_build=None):
     """The Verilator pin model of a ``MutantPinSource`` (built once, then from the cache)."""
-    from ..sim.pins.compiled import VerilatorPins
-
     return VerilatorPins(source, on_build=on_build)

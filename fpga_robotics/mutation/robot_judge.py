@@ -17,6 +17,12 @@ import os
 import shlex
 import time
 
+from fpga_robotics.hw.errors import UsageError
+
+from ..sweep import runner
+from ..sweep.api import wait_for_a_worker
+from ..sweep.engine import open_client
+from ..sweep.plan import make_plan
 from .forked_runs import execute_forked, reference_outcome
 
 __all__ = [
@@ -103,8 +109,6 @@ def judge_runs(argvs, timeouts=None, execute=None):
     (``run``: the index of the first run that did not pass; ``closest``: of a mutant not
     caught, the run nearest to failing). ``execute(i, argv, timeout)`` runs run ``i``
     (default ``runner.execute``; forked runs: fpga_robotics.mutation.forked_runs)."""
-    from ..sweep import runner
-
     if execute is None:
 
         def execute(i, argv, timeout):
@@ -147,9 +151,7 @@ def judge_runs(argvs, timeouts=None, execute=None):
 def _baseline(client, argvs, progress, fork):
     """The campaign with the unmutated design: ``[outcome]`` in order (with ``fork``, each
     worker keeps its runs as references for the mutants')."""
-    from distributed import as_completed
-
-    from ..sweep import runner
+    from distributed import as_completed  # lazy: Dask costs ~1 s; only a run needs it
 
     if fork:
         futures = {client.submit(reference_outcome, a, pure=False): i for i, a in enumerate(argvs)}
@@ -189,19 +191,13 @@ def robot_judge(
     ones there). With ``fork`` each mutant's run is forked from the unmutated design's
     (fpga_robotics.mutation.forked_runs): the same verdicts, most of the world not
     re-simulated."""
-    from distributed import as_completed
-
-    from ..sweep.api import wait_for_a_worker
-    from ..sweep.engine import open_client
-    from ..sweep.plan import make_plan
+    from distributed import as_completed  # lazy: Dask costs ~1 s; only a run needs it
 
     tick = progress or (lambda n: None)
     plan = make_plan(campaign)
     if any(k.startswith("design.") for spec in plan.runs for k, _ in spec.overrides) or any(
         item.startswith("design.") for spec in plan.runs for item in spec.fixed
     ):
-        from fpga_robotics.hw.errors import UsageError
-
         raise UsageError(
             "the mutation campaign may not override design.* values: the "
             "mutants are of one design (give its parameters to mutate instead)"

@@ -10,6 +10,7 @@ each message becomes a ``LiveControls`` input, applied at the next frame boundar
 import json
 import socket
 import threading
+from pathlib import Path
 
 import foxglove
 from foxglove.websocket import Capability
@@ -206,6 +207,4 @@ class LivePublisher:
 
 def layout_path():
     """The Foxglove layout shipped with the package."""
-    from pathlib import Path
-
     return Path(__file__).with_name("foxglove_layout.json")

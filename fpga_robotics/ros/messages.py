@@ -21,6 +21,7 @@ from rosbags.typesys import Stores, get_typestore
 
 from fpga_robotics.sim.camera.raster import focal_length
 
+from ..sim.world.config import parse_world_config
 from ..sim.world.kinematics import dps_to_twist
 
 __all__ = [
@@ -134,8 +135,6 @@ class CameraGeometry:
 def camera_geometry(scenario):
     """The ``CameraGeometry`` of a scenario: its camera, on its robot (mount values the
     scenario leaves unset are the robot's, as in the closed loop)."""
-    from ..sim.world.config import parse_world_config
-
     spec = parse_world_config(scenario.world).robot.spec
     cam = scenario.camera
     return CameraGeometry(

@@ -6,6 +6,14 @@ writer, the Foxglove server and the controls; ``on_frame`` is the per-frame call
 ``close(completed)`` finishes the bag (or removes it after a failure) and stops the rest.
 """
 
+from fpga_robotics.hw.errors import UsageError
+
+from .bag_writer import BagWriter, check_bag_path
+from .controls import LiveControls, ReplayControls, load_inputs
+from .foxglove_live import LivePublisher, check_live_port, parse_live_spec
+from .interactive import TerminalControls, check_terminal
+from .messages import camera_geometry
+
 __all__ = ["RosOutputs", "add_ros_arguments"]
 
 
@@ -42,19 +50,13 @@ class RosOutputs:
     """The ROS/Foxglove side of one run; see the module docstring."""
 
     def __init__(self, args):
-        from fpga_robotics.hw.errors import UsageError
-
         self.bag_path = args.bag
         self.port = None
         self.interactive = args.interactive
         self.replay = None
         if args.bag is not None:
-            from .bag_writer import check_bag_path
-
             check_bag_path(args.bag)
         if args.live is not None:
-            from .foxglove_live import check_live_port, parse_live_spec
-
             self.port = parse_live_spec(args.live)
             check_live_port(self.port)
         if args.replay_inputs is not None:
@@ -63,12 +65,9 @@ class RosOutputs:
                     "--replay-inputs replays a run's inputs; it does not go with "
                     "--live or --interactive"
                 )
-            from .controls import load_inputs
 
             self.replay = load_inputs(args.replay_inputs)
         if self.interactive:
-            from .interactive import check_terminal
-
             check_terminal()
         self.live_control = self.port is not None or self.interactive
         if args.paused and not self.live_control:
@@ -80,8 +79,6 @@ class RosOutputs:
 
     def check_closed_loop_only(self):
         """With ``--source`` (no simulation) there is nothing to control."""
-        from fpga_robotics.hw.errors import UsageError
-
         if self.interactive:
             raise UsageError("--interactive controls the closed loop (not with --source)")
         if self.replay is not None:
@@ -98,9 +95,6 @@ class RosOutputs:
 
     def open(self, scenario, *, closed_loop=True):
         """Start what the options ask for; returns the notices to print now."""
-        from .controls import LiveControls, ReplayControls
-        from .messages import camera_geometry
-
         notices = []
         geometry = camera_geometry(scenario)
         try:
@@ -109,19 +103,13 @@ class RosOutputs:
             elif self.live_control and closed_loop:
                 self.controls = LiveControls(speed=1.0, paused=self.start_paused)
             if self.bag_path is not None:
-                from .bag_writer import BagWriter
-
                 self._bag = BagWriter(self.bag_path, geometry)
                 self._sinks.append(self._bag)
             if self.port is not None:
-                from .foxglove_live import LivePublisher
-
                 live = LivePublisher(self.port, geometry, self.controls)
                 self._sinks.append(live)
                 notices += live.pop_notices()
             if self.interactive:
-                from .interactive import TerminalControls
-
                 self._terminal = TerminalControls(self.controls)
                 notices += self._terminal.help_lines()
         except BaseException:

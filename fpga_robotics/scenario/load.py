@@ -38,7 +38,12 @@ from pydantic_core import PydanticCustomError
 
 from fpga_robotics.checks.summary import CHECKS
 from fpga_robotics.designs.builtin import TOPS, design_tables, table_fields
-from fpga_robotics.hw.params import PRESETS, FollowTargetParams, preset_values
+from fpga_robotics.designs.reference import DesignError, resolve_design
+from fpga_robotics.hw.params import (
+    PRESETS,
+    FollowTargetParams,
+    preset_values,
+)
 from fpga_robotics.loop.compressed import frame_count
 from fpga_robotics.loop.connectors import CONNECTORS, ConnectorError
 from fpga_robotics.scenario.connectors import parse_connectors
@@ -822,8 +827,6 @@ def _top(design, source):
     """``design.top``, its parameter tables (a ``design.variant`` applied first) and
     ``design.params``; a design of one's own is resolved here (designs/reference.py), its
     reference made independent of the current folder."""
-    from fpga_robotics.designs.reference import DesignError, resolve_design
-
     top = design.get("top", "follow_target")
     params = design.get("params", {})
     if not isinstance(params, dict):

@@ -4,6 +4,8 @@ one code path)."""
 import time
 from pathlib import Path
 
+from fpga_robotics.hw.errors import UsageError
+
 from .. import __version__
 from .engine import RECORD_LOG_EVERY, build_all, open_client, run_plan
 from .plan import make_plan
@@ -105,8 +107,6 @@ WORKER_WAIT_S = 60
 def wait_for_a_worker(client, scheduler):
     """Wait (``WORKER_WAIT_S``) for a first worker; a scheduler without one is the user's to
     fix (``UsageError`` saying how to start workers)."""
-    from fpga_robotics.hw.errors import UsageError
-
     try:
         client.wait_for_workers(1, timeout=WORKER_WAIT_S)
     except TimeoutError:
@@ -129,8 +129,6 @@ class _given:
 
 def report_dir(out_dir):
     """Rebuild ``report.html`` in ``out_dir`` from its results; returns the terminal summary."""
-    from fpga_robotics.hw.errors import UsageError
-
     out_dir = Path(out_dir)
     rows = load_rows(out_dir)
     if not rows:

@@ -36,12 +36,14 @@ explicit set. A run *is* its ``python -m fpga_robotics.run`` argument list: the 
 it with ``run``'s own parser, so the replay command of a row is the run itself.
 """
 
+import difflib
 import hashlib
 import itertools
 import json
 import math
 import os
 import re
+import shlex
 import tomllib
 from dataclasses import dataclass, field, replace
 from importlib import resources
@@ -126,8 +128,6 @@ class RunSpec:
         return out
 
     def replay(self):
-        import shlex
-
         return shlex.join(["python", "-m", "fpga_robotics.run", *self.argv()])
 
 
@@ -174,7 +174,7 @@ def _toml_string(text):
 
 def parse_seeds(value, where="seeds"):
     """``"0-19"``, ``"7"``, an integer or a list of integers → a list of seeds."""
-    from fpga_robotics.scenario.load import MAX_SEED
+    from fpga_robotics.scenario.load import MAX_SEED  # lazy: the run stack (~1 s)
 
     if isinstance(value, bool):
         raise CampaignError(f'{where} must be "A-B" or a list of integers, got {value!r}')
@@ -288,7 +288,7 @@ def _known_limits(data, axes):
     """The ``[[known_limits]]`` entries, checked: each names a registered check and a reason,
     optionally ``when`` (override key -> value, keys among the grid/sets axes) and
     ``scenarios``."""
-    from fpga_robotics.checks.registry import check_names
+    from fpga_robotics.checks.registry import check_names  # lazy: the run stack (~1 s)
 
     limits = data.get("known_limits", [])
     if not isinstance(limits, list) or not all(isinstance(x, dict) for x in limits):
@@ -389,8 +389,6 @@ def read_campaign_file(name_or_path):
         raise CampaignError(f"cannot read campaign file {path}: {exc}") from None
     unknown = [k for k in data if k not in KEYS]
     if unknown:
-        import difflib
-
         close = difflib.get_close_matches(unknown[0], KEYS, n=1)
         hint = f" (did you mean {close[0]!r}?)" if close else ""
         raise CampaignError(

@@ -10,9 +10,12 @@ queued, closes the client and stops an embedded cluster's workers; the rows so f
 import contextlib
 import logging
 import os
+import shutil
 import signal
 import statistics
 import sys
+import tempfile
+import threading
 import time
 from pathlib import Path
 
@@ -49,8 +52,8 @@ def open_client(scheduler=None, workers=None):
     """A ``distributed.Client``: to ``scheduler`` (an address), or to a new ``LocalCluster``
     of ``workers`` processes (default: the machine's cores), each with one thread. The
     embedded cluster's scheduler gives up on a run whose worker dies at once (no retry)."""
-    import dask
-    from distributed import Client, LocalCluster
+    import dask  # lazy: Dask costs ~1 s; only a run needs it
+    from distributed import Client, LocalCluster  # lazy: Dask costs ~1 s; only a run needs it
 
     if scheduler is not None:
         try:
@@ -110,15 +113,13 @@ def _local_cluster(dask, LocalCluster, n):
 
 
 def _ignore_interrupts_plugin():
-    from distributed import WorkerPlugin
+    from distributed import WorkerPlugin  # lazy: Dask costs ~1 s; only a run needs it
 
     class IgnoreInterrupts(WorkerPlugin):
         """Worker plugin of the embedded cluster: the worker process ignores SIGINT (its
         campaign's process ends it)."""
 
         def setup(self, worker):
-            import threading
-
             if threading.current_thread() is threading.main_thread():
                 signal.signal(signal.SIGINT, signal.SIG_IGN)
 
@@ -150,7 +151,7 @@ class _Timeouts:
 
 
 def _progress(total, quiet):
-    from tqdm import tqdm
+    from tqdm import tqdm  # lazy: ~0.1 s; only a campaign run shows it
 
     disable = quiet or bool(os.environ.get("CI")) or not sys.stderr.isatty()
     return tqdm(
@@ -162,7 +163,7 @@ def build_all(client, plan):
     """Build (or load from the build cache) every design the plan needs, one task per
     parameter set; returns the seconds each took. A design that cannot be built is the
     user's to fix (``UsageError``)."""
-    from distributed import wait
+    from distributed import wait  # lazy: Dask costs ~1 s; only a run needs it
 
     futures = {
         client.submit(runner.build_designs, argv, pure=False): argv for argv in plan.builds.values()
@@ -191,7 +192,7 @@ def run_plan(
 ):
     """Run every planned run not already in ``store``; returns the number run.
     Recordings log every ``log_every``-th frame's images (every frame's numbers)."""
-    from distributed import as_completed
+    from distributed import as_completed  # lazy: Dask costs ~1 s; only a run needs it
 
     todo, seen = [], store.done_ids()
     for spec in plan.runs:
@@ -281,7 +282,7 @@ def _timed_out(client, key):
 
 
 def _outcome(client, fut, limit):
-    from distributed import KilledWorker
+    from distributed import KilledWorker  # lazy: Dask costs ~1 s; only a run needs it
 
     try:
         return fut.result()
@@ -299,9 +300,6 @@ def _outcome(client, fut, limit):
 
 def _save_bag(out_dir, run_id, files):
     """Write a run's ROS 2 bag (its files) to ``bags/<run_id>/``, whole or not at all."""
-    import shutil
-    import tempfile
-
     bags = Path(out_dir) / "bags"
     bags.mkdir(parents=True, exist_ok=True)
     staging = Path(tempfile.mkdtemp(prefix=f".{run_id}.", dir=bags))

@@ -29,7 +29,7 @@ def _concrete_backend(spec):
         return spec
     if spec.design is not None:
         return replace(spec, backend="verilator")
-    from ..sim.backends import fastest_backend_name
+    from ..sim.backends import fastest_backend_name  # lazy: the simulator (~0.5 s)
 
     return replace(spec, backend=fastest_backend_name())
 
@@ -37,7 +37,7 @@ def _concrete_backend(spec):
 def make_plan(campaign):
     """Check every run (``UsageError`` naming the run's scenario and overrides) and name it.
     Runs differing only by seed share one check."""
-    from ..sim.backends import BACKEND_NAMES
+    from ..sim.backends import BACKEND_NAMES  # lazy: the simulator (~0.5 s)
 
     plan = Plan(runs=[])
     checked = {}

@@ -13,9 +13,15 @@ making progress, at its first frame; the test suite uses it to check that a camp
 such runs and goes on.
 """
 
+import argparse
 import os
+import shutil
+import tempfile
 import threading
 import time
+from pathlib import Path
+
+from fpga_robotics.hw.errors import UsageError
 
 __all__ = ["TIMEOUT_TOPIC", "RunTimeout", "build_designs", "execute", "load_run"]
 
@@ -40,8 +46,6 @@ class RunTimeout(Exception):
 def _loaded(argv):
     """``load_run`` of the runs of a worker, remembered by their arguments other than the
     seed (the scenario does not depend on it): a campaign's runs differ mostly by seed."""
-    import argparse
-
     argv = list(argv)
     i = argv.index("--seed") if "--seed" in argv else None
     seed = argv[i + 1] if i is not None else None
@@ -54,8 +58,7 @@ def _loaded(argv):
     args = argparse.Namespace(**vars(args))
     if seed is not None:
         args.seed = int(seed)
-        from fpga_robotics.hw.errors import UsageError
-        from fpga_robotics.scenario.load import MAX_SEED
+        from fpga_robotics.scenario.load import MAX_SEED  # lazy: the run stack (~1 s)
 
         if not 0 <= args.seed <= MAX_SEED:
             raise UsageError(f"--seed must be in 0..{MAX_SEED}, got {args.seed}")
@@ -68,9 +71,11 @@ _loads = {}
 def load_run(argv):
     """``(args, scenario, shadow_params)`` of a run, checked as ``run`` checks them
     (``UsageError`` with one line when something is wrong)."""
-    from fpga_robotics.cli import run
-    from fpga_robotics.hw.errors import UsageError
-    from fpga_robotics.scenario.load import MAX_SEED, load_scenario
+    from fpga_robotics.cli import run  # lazy: the run stack (~1 s)
+    from fpga_robotics.scenario.load import (  # lazy: the run stack (~1 s)
+        MAX_SEED,
+        load_scenario,
+    )
 
     args = run.build_parser().parse_args(argv)
     args.quiet = True
@@ -112,7 +117,7 @@ def _open(key, opener):
 
 
 def _designs_for(args, scenario, shadow_params):
-    from fpga_robotics.cli import run
+    from fpga_robotics.cli import run  # lazy: the run stack (~1 s)
 
     if scenario.sim.timing == "real_clock":  # a pin-level backend (fpga_robotics.loop.real_clock)
         design = _open(_design_key(args, scenario), lambda: run._open_pin_design(args, scenario))
@@ -194,7 +199,7 @@ class _Deadline:
 
 def _current_worker():
     try:
-        from distributed import get_worker
+        from distributed import get_worker  # lazy: Dask costs ~1 s; only a run needs it
 
         return get_worker()
     except (ImportError, ValueError):  # called outside a Dask worker
@@ -206,8 +211,8 @@ def execute(argv, timeout=None, record=False, tag=None, bag=False):
     log every how many frames' images to the recording); returns ``{"status", "message", "summary", "wall_s", "cpu_s",
     "run_s", "recording", "bag"}`` (``recording``: the ``.rrd`` bytes when ``record``;
     ``bag``: with ``bag`` and ``record``, the ROS 2 bag's files as ``{name: bytes}``)."""
-    from fpga_robotics.cli import run
-    from fpga_robotics.loop.compressed import run_scenario
+    from fpga_robotics.cli import run  # lazy: the run stack (~1 s)
+    from fpga_robotics.loop.compressed import run_scenario  # lazy: the run stack (~1 s)
 
     wall0, cpu0 = time.perf_counter(), time.process_time()
     out = {"status": "error", "message": "", "summary": None, "recording": None, "run_s": 0.0}
@@ -244,7 +249,6 @@ def execute(argv, timeout=None, record=False, tag=None, bag=False):
                 run._close_recorder(recorder, True)
             if bag_writer is not None:
                 bag_writer.abandon()  # nothing left once closed; a partial bag otherwise
-                import shutil
 
                 shutil.rmtree(bag_dir, ignore_errors=True)
         if rrd is not None:
@@ -266,10 +270,7 @@ def execute(argv, timeout=None, record=False, tag=None, bag=False):
 
 def _bag_writer(scenario):
     """A ROS 2 bag writer into a temporary folder (``fpga_robotics.ros``), and the folder."""
-    import tempfile
-    from pathlib import Path
-
-    from ..ros.bag_writer import open_bag_writer
+    from ..ros.bag_writer import open_bag_writer  # lazy: the run stack (~1 s)
 
     folder = Path(tempfile.mkdtemp(prefix="sweep-bag-"))
     return open_bag_writer(folder / "bag", scenario), folder
@@ -282,10 +283,7 @@ def _read_bag(folder):
 
 
 def _recorder(args, name, log_every):
-    import tempfile
-    from pathlib import Path
-
-    from fpga_robotics.cli import run
+    from fpga_robotics.cli import run  # lazy: the run stack (~1 s)
 
     fd, path = tempfile.mkstemp(prefix=f"sweep-{name}-", suffix=".rrd")
     os.close(fd)

@@ -2,7 +2,11 @@
 each scenario is loaded once per distinct set of overrides the campaign gives it."""
 
 from argparse import Namespace
+from dataclasses import replace
 
+from fpga_robotics.cli import run
+from fpga_robotics.hw.errors import UsageError
+from fpga_robotics.scenario.load import load_scenario
 from fpga_robotics.scenario.sanity import report_warnings
 
 __all__ = ["report_campaign_warnings"]
@@ -11,10 +15,6 @@ __all__ = ["report_campaign_warnings"]
 def report_campaign_warnings(campaign, strict, stream, error):
     """Print the warnings of every scenario the campaign runs (each line once); with
     ``strict`` raise ``error`` with the first instead."""
-    from fpga_robotics.cli import run
-    from fpga_robotics.hw.errors import UsageError
-    from fpga_robotics.scenario.load import load_scenario
-
     seen = set()
     for spec in campaign.runs:
         key = (spec.scenario, spec.resolution, spec.duration, tuple(spec.set_items()))
@@ -41,6 +41,4 @@ def report_campaign_warnings(campaign, strict, stream, error):
 
 
 def _with_warnings(scenario, warnings):
-    from dataclasses import replace
-
     return replace(scenario, warnings=warnings)

@@ -13,6 +13,7 @@ The compiled ones are built once per parameter set and cached on disk (see build
 import importlib
 
 from .base import BackendError, DesignBackend, FrameResult, WaveformRequest
+from .toolchain import find_compiler, find_make, verilator_root
 
 __all__ = [
     "BACKEND_NAMES",
@@ -63,8 +64,6 @@ def get_backend(name, params=None, **kwargs):
 
 def _works(name):
     try:
-        from .toolchain import find_compiler, find_make, verilator_root
-
         find_compiler()
         if name == "verilator":
             find_make()

@@ -6,7 +6,9 @@ port list of docs/contract.md, so one harness drives either.
 import functools
 
 from ...hw.params import FollowTargetParams
+from ...hw.top import FollowTarget
 from ...hw.verilog import TOP_NAME, generate_cxxrtl, generate_verilog
+from .passthrough import PassThrough
 
 __all__ = ["DESIGNS", "TOP_NAME", "DesignSource"]
 
@@ -39,14 +41,10 @@ class DesignSource:
 
     @staticmethod
     def _passthrough_class():
-        from .passthrough import PassThrough
-
         return PassThrough
 
     def component(self):
         if self.design == "follow_target":
-            from ...hw.top import FollowTarget
-
             return FollowTarget(self.params)
         return self._passthrough_class()(
             self.params, registered_outputs=self.design == "passthrough"

@@ -26,6 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ...hw.params import FollowTargetParams
 from ...hw.pixel import COLOR_SELECT
 from ..processes import run_captured
 from . import build_cache
@@ -82,8 +83,6 @@ class ForeignDesign:
     """
 
     def __init__(self, files, port_map, params=None, *, pins=False, connector_kinds=None):
-        from ...hw.params import FollowTargetParams
-
         self.params = params if params is not None else FollowTargetParams()
         if isinstance(files, (str, os.PathLike)):
             files = [files]

@@ -6,6 +6,8 @@ needs what only Verilator does (``verilator_only``) or Yosys cannot read it.
 import re
 
 from .base import BackendError
+from .foreign import ForeignDesign, ForeignVerilatorBackend
+from .foreign_cxxrtl import ForeignCxxrtlBackend
 
 __all__ = ["FOREIGN_BACKENDS", "open_foreign_frames", "verilator_only"]
 
@@ -29,9 +31,6 @@ def verilator_only(design):
 def open_foreign_frames(name, params, *, files, port_map, **kwargs):
     """The frame backend ``name`` (see ``FOREIGN_BACKENDS``) of a Verilog design;
     ``kwargs`` go to the backend (``on_build``, ``fill_absent``...)."""
-    from .foreign import ForeignDesign, ForeignVerilatorBackend
-    from .foreign_cxxrtl import ForeignCxxrtlBackend
-
     if name not in FOREIGN_BACKENDS:
         raise BackendError(
             f"a Verilog design runs on the cxxrtl or verilator backend, not {name!r}"

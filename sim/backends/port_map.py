@@ -22,6 +22,7 @@ from pydantic import BeforeValidator, Field
 
 from fpga_robotics.hw.errors import UserError
 
+from ...hw.params import FollowTargetParams
 from ...hw.pixel import COLOR_SELECT
 from ..world.schema import Flag, Integer, KeyModel, Text, fail, validate
 from .base import BackendError
@@ -647,8 +648,6 @@ motor_right = {{ port = "motor_right", width = 16, signed = true }}
 
 def follow_target_port_map(params=None):
     """TOML text: the port map of the exported ``follow_target`` at ``params``."""
-    from ...hw.params import FollowTargetParams
-
     params = params if params is not None else FollowTargetParams()
     return _FOLLOW_TARGET_MAP.format(latency=params.motor_latency)
 

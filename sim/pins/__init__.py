@@ -3,7 +3,9 @@ Amaranth's simulator (``pysim``, the reference) or a compiled model (``cxxrtl``,
 ``verilator``); docs/pins.md."""
 
 from .base import PinBackend, PinError, PixelTiming, Port, Stop
+from .compiled import CxxrtlPins, VerilatorPins
 from .design import FILTERED_PORTS, PIXEL_PORTS, PinDesignSource, follow_target_source
+from .pysim import PysimPins
 from .timing import real_clock_timing
 from .verilog import VerilogPinSource
 
@@ -30,10 +32,7 @@ _AUTO_ORDER = ("cxxrtl", "verilator")
 
 def _backend_class(name):
     if name == "pysim":
-        from .pysim import PysimPins
-
         return PysimPins
-    from .compiled import CxxrtlPins, VerilatorPins
 
     return CxxrtlPins if name == "cxxrtl" else VerilatorPins
 

@@ -11,6 +11,8 @@ import functools
 from amaranth.hdl import Fragment
 from amaranth.lib import wiring
 
+from ...hw.params import FollowTargetParams
+from ...hw.top import FollowTarget
 from ...hw.verilog import generate_cxxrtl, generate_verilog, verilog_ports
 from .base import PinError, Port
 
@@ -137,9 +139,6 @@ class PinDesignSource:
 def follow_target_source(params=None):
     """``FollowTarget(params)`` (hw/top.py) as a ``PinDesignSource``, its pixel and filtered
     streams bound."""
-    from ...hw.params import FollowTargetParams
-    from ...hw.top import FollowTarget
-
     params = FollowTargetParams() if params is None else params
     return PinDesignSource(
         lambda: FollowTarget(params),

@@ -11,6 +11,8 @@ model (``cxxrtl``); Amaranth's simulator cannot take Verilog.
 import functools
 import hashlib
 
+from ..backends.foreign import WRAPPER, pin_ports
+from ..backends.verilog_cxxrtl import verilog_to_cxxrtl
 from .base import PinError, Port
 from .design import FILTERED_PORTS, MAX_PORTS, PIXEL_PORTS
 
@@ -30,8 +32,6 @@ class VerilogPinSource:
     verilog_top = "fr_foreign_top"
 
     def __init__(self, design):
-        from ..backends.foreign import WRAPPER, pin_ports
-
         if not design.pins:
             raise PinError("a VerilogPinSource needs a ForeignDesign made with pins=True")
         assert WRAPPER == self.verilog_top
@@ -69,8 +69,6 @@ class VerilogPinSource:
     def cxxrtl(self):
         """CXXRTL C++ text of the wrapper and the design (class ``p_follow__target``), written
         by Yosys; ``BackendError`` for what Yosys cannot read."""
-        from ..backends.verilog_cxxrtl import verilog_to_cxxrtl
-
         d = self.design
         return verilog_to_cxxrtl(
             {"fr_wrapper.v": d.wrapper, **d.sources}, self.verilog_top, d.includes

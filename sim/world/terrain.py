@@ -19,6 +19,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..camera.floor_patches import patch_index
+
 __all__ = ["TerrainMap", "TerrainPatch", "polygon_contains", "slope_pitch"]
 
 
@@ -90,8 +92,6 @@ class TerrainMap:
             self._grid = self._build_grid(width, depth)
 
     def _build_grid(self, width, depth):
-        from ..camera.floor_patches import patch_index
-
         cell = max(MIN_CELL, math.sqrt(width * depth / MAX_CELLS))
         nx, ny = math.ceil(width / cell), math.ceil(depth / cell)
         gx, gy = np.meshgrid(np.arange(nx + 1) * cell, np.arange(ny + 1) * cell)

@@ -24,7 +24,10 @@ from fpga_robotics.loop.connectors.base import (
     check_number,
     register,
 )
+from fpga_robotics.sim.camera.raster import CameraRenderer, focal_length
+from fpga_robotics.sim.camera.render3d import MujocoRenderer, Render3DUnavailable
 from fpga_robotics.sim.camera.scene import CameraPose
+from fpga_robotics.sim.camera.sensor import OV7670Sensor
 
 __all__ = [
     "SENSOR_STREAM",
@@ -78,8 +81,6 @@ def make_sensor(cam, seed):
     """The sensor model a scenario's ``CameraConfig`` asks for (``None``: the plain path)."""
     if cam.sensor == "plain":
         return None
-    from fpga_robotics.sim.camera.raster import focal_length
-    from fpga_robotics.sim.camera.sensor import OV7670Sensor
 
     return OV7670Sensor(
         cam.width,
@@ -95,12 +96,9 @@ def make_renderer(name, width, height, hfov, render3d=None):
     """The renderer ``camera.renderer`` names; a missing MuJoCo or OpenGL is a
     ``UsageError`` that says how to install them."""
     if name == "raster":
-        from fpga_robotics.sim.camera.raster import CameraRenderer
-
         return CameraRenderer(width, height, hfov)
     if name != "mujoco":
         raise ValueError(f"renderer must be 'raster' or 'mujoco', got {name!r}")
-    from fpga_robotics.sim.camera.render3d import MujocoRenderer, Render3DUnavailable
 
     try:
         renderer = MujocoRenderer(width, height, hfov, render3d)

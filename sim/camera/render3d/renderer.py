@@ -44,7 +44,7 @@ def load_mujoco():
     # chose another (MUJOCO_GL=osmesa).
     os.environ.setdefault("MUJOCO_GL", "egl")
     try:
-        import mujoco
+        import mujoco  # lazy: optional (realistic extra), after MUJOCO_GL is set
     except ImportError:
         raise Render3DUnavailable(f"the 3D renderer needs MuJoCo; {INSTALL_HINT}") from None
     except RuntimeError as exc:  # MuJoCo refuses an unknown MUJOCO_GL

@@ -9,6 +9,7 @@ fpga-robotics bench camera --stage-images docs/images``).
 
 import numpy as np
 
+from .blur import motion_blur
 from .pipeline import OV7670Sensor
 
 __all__ = ["stage_images"]
@@ -29,8 +30,6 @@ def stage_images(rgb, params, *, rng, turn_rate, frame_period=1 / 30, focal_px=N
     raw = cam.light(rgb, turn_rate)
     blurred = cam._radiance.take(rgb)
     if cam.last_blur_px:
-        from .blur import motion_blur
-
         blurred = motion_blur(blurred, cam.last_blur_px)
     mosaic_light = _as_mosaic_image(raw, cam._channels, 255.0)
     q = cam.expose(raw)
