@@ -14,12 +14,13 @@ import time
 
 from fpga_robotics.bench import scaffold
 from fpga_robotics.cli.errors import UsageError
+from fpga_robotics.loop.compressed import run_scenario
+from fpga_robotics.scenario.load import load_scenario
 
 __all__ = ["main"]
 
 
 def _scenarios(seconds):
-    from fpga_robotics.scenario.load import load_scenario
 
     two = load_scenario("turret", [f"sim.duration={seconds}"])
     one = dataclasses.replace(two, connectors=())
@@ -27,7 +28,6 @@ def _scenarios(seconds):
 
 
 def _times(scenario, backend):
-    from fpga_robotics.loop.compressed import run_scenario
 
     w0, c0 = time.perf_counter(), time.process_time()
     result = run_scenario(scenario, backend=backend)

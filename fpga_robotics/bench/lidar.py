@@ -15,6 +15,8 @@ import statistics
 
 from fpga_robotics.bench import scaffold
 from fpga_robotics.cli.errors import UsageError
+from fpga_robotics.loop.compressed import run_scenario
+from fpga_robotics.scenario.load import load_scenario
 
 __all__ = ["main", "measure"]
 
@@ -27,8 +29,6 @@ _RUNS = {
 
 def measure(backend, duration, repeats):
     """``{run: [(cpu_s, summary), ...]}`` of the three runs, in turns."""
-    from fpga_robotics.loop.compressed import run_scenario
-    from fpga_robotics.scenario.load import load_scenario
 
     def load(key, seconds):
         extra = ['camera.resolution="160x120"'] if key == "camera_frame" else []

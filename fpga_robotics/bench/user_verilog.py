@@ -24,6 +24,12 @@ from fpga_robotics.bench import scaffold
 from fpga_robotics.cli.errors import UsageError
 from fpga_robotics.hw.sensor_params import UltrasoundParams
 from fpga_robotics.hw.ultrasound import UltrasoundDriver
+from fpga_robotics.hw.verilog import generate_verilog
+from fpga_robotics.loop import run_scenario
+from fpga_robotics.loop.real_clock import make_pin_backend
+from fpga_robotics.scenario.load import load_scenario
+from fpga_robotics.sim.backends import BackendError
+from fpga_robotics.sim.pins import PinError
 
 __all__ = ["WallStopDesign", "main", "measure"]
 
@@ -101,7 +107,6 @@ class WallStopDesign(wiring.Component):
 
 def write_design(folder, clock_hz, seconds):
     """The design's Verilog, port map and scenario in ``folder``; the scenario's path."""
-    from fpga_robotics.hw.verilog import generate_verilog
 
     folder = Path(folder)
     (folder / "design.v").write_text(generate_verilog(component=WallStopDesign(int(clock_hz))))
@@ -114,9 +119,6 @@ def write_design(folder, clock_hz, seconds):
 def measure(scenario_path, backend, repeats):
     """``(wall, cpu)``: seconds of each of ``repeats`` closed-loop runs on ``backend`` (the
     model built once before, not timed), on the wall clock and this process's CPU clock."""
-    from fpga_robotics.loop import run_scenario
-    from fpga_robotics.loop.real_clock import make_pin_backend
-    from fpga_robotics.scenario.load import load_scenario
 
     scenario = load_scenario(str(scenario_path))
     design = make_pin_backend(backend, scenario)
@@ -152,8 +154,6 @@ def _check(args):
 
 
 def run(args):
-    from fpga_robotics.sim.backends import BackendError
-    from fpga_robotics.sim.pins import PinError
 
     cycles = args.clock_hz * args.seconds
     rates, rows, figures = {}, [], {}

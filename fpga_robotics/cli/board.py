@@ -6,8 +6,10 @@ import os
 import sys
 
 from fpga_robotics.cli.errors import UsageError
+from fpga_robotics.cli.mutate import _design_params
 from fpga_robotics.cli.param_options import add_param_arguments, params_from_args
 from fpga_robotics.cli.parser import CommandParser
+from fpga_robotics.designs.reference import resolve_design
 from fpga_robotics.flow.board import (
     board_factory,
     board_names,
@@ -118,9 +120,6 @@ def main(argv=None, prog="fpga-robotics board"):
     params = params_from_args(args)
     design = None
     if args.design is not None:
-        from fpga_robotics.cli.mutate import _design_params
-        from fpga_robotics.designs.reference import resolve_design
-
         design = resolve_design(args.design, _design_params(args.param))
     elif args.param:
         raise UsageError("--param goes with --design REF (a design of your own)")

@@ -38,6 +38,9 @@ from fpga_robotics.hw.corridor_follow_uart import CorridorFollowUart
 from fpga_robotics.hw.follow_line import FollowLine
 from fpga_robotics.hw.params import FollowTargetParams
 from fpga_robotics.hw.safe_follow import FollowTargetSafe
+from fpga_robotics.hw.turret_params import TurretParams
+from fpga_robotics.hw.turret_tracker import TurretTracker
+from fpga_robotics.hw.variants import VARIANTS, variant_params
 from fpga_robotics.hw.verilog import TOP_NAME, generate_verilog
 from fpga_robotics.sim.files import check_output_path, write_atomic
 
@@ -142,8 +145,6 @@ def _sensor_top(args, params):
             f"{uart.clock_hz} Hz{variant}"
         )
     if args.top == "turret_tracker":
-        from fpga_robotics.hw.turret_tracker import TurretTracker
-
         text = generate_top_verilog(TurretTracker(params, _turret_params(args)), args.top)
         return text, f"{_follow_target_text(args, params)}, pan camera on a servo{variant}"
     if args.top == "follow_line":
@@ -161,8 +162,6 @@ def _sensor_top(args, params):
 
 def _turret_params(args):
     """The turret channel's parameters: the defaults, or a seeded bug of ``turret_tracker``."""
-    from fpga_robotics.hw.turret_params import TurretParams
-    from fpga_robotics.hw.variants import VARIANTS, variant_params
 
     if args.variant is None:
         return TurretParams()

@@ -18,7 +18,7 @@ from fpga_robotics.cli.param_options import add_param_arguments, params_from_arg
 from fpga_robotics.cli.parser import CommandParser
 from fpga_robotics.designs.reference import resolve_design
 from fpga_robotics.mutation.design import open_mutant_design, write_mutant_design
-from fpga_robotics.mutation.design_run import DEFAULT_CYCLES, mutate_design
+from fpga_robotics.mutation.design_run import DEFAULT_CYCLES, mutate_design, mutate_verilog_design
 from fpga_robotics.mutation.reasons import blind_spot_reason
 from fpga_robotics.mutation.report import write_report
 from fpga_robotics.mutation.robot_judge import robot_judge
@@ -262,8 +262,6 @@ def _main_design(args):
     def say(text):
         if not args.quiet:
             print(text, file=sys.stderr, flush=True)
-
-    from fpga_robotics.mutation.design_run import mutate_verilog_design
 
     try:
         if verilog:

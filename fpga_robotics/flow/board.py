@@ -19,6 +19,7 @@ import time
 from dataclasses import dataclass, field
 
 from fpga_robotics.hw.board.ulx3s_top import ULX3SFollowTarget, ulx3s_platform
+from fpga_robotics.hw.board.ulx3s_user_top import HEADER_SITES, ULX3SUserDesign, ulx3s_user_platform
 from fpga_robotics.hw.errors import UserError
 from fpga_robotics.hw.params import FollowTargetParams
 from fpga_robotics.sim.files import write_atomic
@@ -95,7 +96,6 @@ def board_ports(spec, board="ulx3s-85f"):
     at most 16 bits), ``color_sel`` 3 bits, ``centroid_leds`` at most 8 bits, every other
     input a 1-bit pin of a connector (it goes to a header pin), and there are
     ``len(HEADER_SITES)`` header pins."""
-    from fpga_robotics.hw.board.ulx3s_user_top import HEADER_SITES
 
     board_factory(board)
     if spec.kind != "amaranth":
@@ -165,7 +165,6 @@ def board_ports(spec, board="ulx3s-85f"):
 
 def _user_factory(spec):
     def factory(params):
-        from fpga_robotics.hw.board.ulx3s_user_top import ULX3SUserDesign, ulx3s_user_platform
 
         wiring = board_ports(spec)
         return ulx3s_user_platform(wiring["header"]), ULX3SUserDesign(
@@ -177,7 +176,6 @@ def _user_factory(spec):
 
 def header_pins(spec):
     """``[(port, header pin, site)]``: where a design's connector pins are on the board."""
-    from fpga_robotics.hw.board.ulx3s_user_top import HEADER_SITES
 
     return [
         (port, pin, site)

@@ -29,6 +29,7 @@ from fpga_robotics.hw.pixel import color_select_value
 from fpga_robotics.loop.connectors import CONNECTORS, CameraConnector, in_view
 from fpga_robotics.sim.camera.frames import to_rgb444
 from fpga_robotics.sim.camera.scene import CameraPose
+from fpga_robotics.sim.pins.timing import real_clock_timing
 from fpga_robotics.sim.records import CameraView, SensorReading
 
 __all__ = ["CameraRig", "RigCamera"]
@@ -162,7 +163,6 @@ class CameraRig:
     def _stream(self, cam, rgb):
         """The frame's pixels on the camera's port bundle, one scheduled beat each, from the
         next edge on, as an OV7670 spreads them over the frame period."""
-        from fpga_robotics.sim.pins.timing import real_clock_timing
 
         p, pins = cam.params, self.pins
         if cam.streaming_until is not None and cam.streaming_until > pins.cycle:

@@ -1,8 +1,11 @@
 """The mutant netlist as a design the backends run: one Verilator build holds every mutant,
 ``mutsel`` (a ``[runtime]`` input of its port map) picks one between runs."""
 
+import json
 import os
+import re
 
+from ..hw.verilog import TOP_NAME
 from ..sim.backends.foreign import ForeignVerilatorBackend
 from ..sim.backends.port_map import follow_target_port_map
 from ..sim.files import write_atomic
@@ -45,14 +48,12 @@ def open_mutant_design(params, netlist, ports, *, on_build=None):
 
 def _key(name):
     """A TOML key: bare when it can be, quoted otherwise."""
-    import json
 
     return name if name.replace("_", "a").replace("-", "a").isalnum() else json.dumps(name)
 
 
 def netlist_has_reset(verilog):
     """Whether the netlist's top has Amaranth's ``rst`` input (a design with a sync domain)."""
-    import re
 
     return re.search(r"^\s*input\s+rst\s*;", verilog, re.MULTILINE) is not None
 
@@ -62,9 +63,6 @@ def design_mutant_port_map(spec, ports, *, reset=True, select=MUTATION_SELECT):
     resolved ``DesignSpec``; ``ports``: name -> ``Port`` as ``design_run.design_ports`` gives
     them), its bindings as the design declares them, ``mutsel`` a ``[runtime]`` input;
     ``reset``: whether the netlist has Amaranth's ``rst``."""
-    import json
-
-    from ..hw.verilog import TOP_NAME
 
     q = json.dumps
     lines = [
@@ -112,7 +110,6 @@ def design_mutant_port_map(spec, ports, *, reset=True, select=MUTATION_SELECT):
 def with_mutant_select(port_map_text, select=MUTATION_SELECT):
     """A Verilog design's port map (TOML text) with ``select`` a ``[runtime]`` input at 0:
     the port map of its mutant netlist."""
-    import re
 
     line = f"{select} = 0  # the mutant select (0: the design itself)"
     if re.search(r"^\s*\[runtime\]\s*(#.*)?$", port_map_text, re.MULTILINE):

@@ -7,10 +7,14 @@ import time
 
 from amaranth.hdl import Fragment
 
+from ..designs.builtin import connector_kinds
 from ..hw.verilog import verilog_ports
+from ..sim.backends.foreign import ForeignDesign
 from ..sim.files import write_atomic, write_json_atomic
 from ..sim.mutation import MUTATION_SELECT, component_rtlil, list_mutants, mutant_netlist
 from ..sim.pins.base import Port
+from ..sim.pins.compiled import VerilatorPins
+from ..sim.pins.verilog import VerilogPinSource
 from .design import (
     NETLIST_NAME,
     PORTS_NAME,
@@ -19,6 +23,7 @@ from .design import (
     with_mutant_select,
 )
 from .pin_judge import MutantPinSource, judge_pin_mutant, open_pin_mutants, pin_stimulus, pin_trace
+from .robot_judge import robot_judge
 from .scores import by_module, robot_score, unit_score
 
 __all__ = ["DEFAULT_CYCLES", "design_ports", "mutate_design", "mutate_verilog_design"]
@@ -100,10 +105,6 @@ def mutate_verilog_design(
     netlist's port map is the design's with ``mutsel`` a ``[runtime]`` input, and the unit
     judge drives the inputs the map gives the pin backend (its connector pins, ``[runtime]``
     inputs aside)."""
-    from ..designs.builtin import connector_kinds
-    from ..sim.backends.foreign import ForeignDesign
-    from ..sim.pins.compiled import VerilatorPins
-    from ..sim.pins.verilog import VerilogPinSource
 
     t0 = time.perf_counter()
     design = ForeignDesign(files, ports_path, pins=True, connector_kinds=connector_kinds())
@@ -179,8 +180,6 @@ def _judge(
     unit = {v.index: v.caught for v in verdicts}
     robot_verdicts, baseline, robot_s = {}, None, None
     if campaign is not None:
-        from .robot_judge import robot_judge
-
         t2 = time.perf_counter()
         baseline, robot_verdicts = robot_judge(
             campaign,
