@@ -225,6 +225,11 @@ class ClosedLoop:
             turn_rate=self.camera_turn_rate,
         )
 
+    def restored(self):
+        """Called once a checkpoint's state is in place (fpga_robotics.loop.checkpoint): what
+        the state refers to of the loop itself is bound again."""
+        self.camera.turn_rate = self.camera_turn_rate
+
     def camera_turn_rate(self):
         """The robot's turn rate now, rad/s (the sensor model's motion blur)."""
         return self.world.robot_velocity()[1]

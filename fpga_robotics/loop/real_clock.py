@@ -160,6 +160,19 @@ class _PendingRow:
 class RealClockLoop(ClosedLoop):
     """``ClosedLoop`` in real-clock timing, on a ``PinBackend`` (``design``)."""
 
+    #: What a world checkpoint (fpga_robotics.loop.checkpoint) keeps beyond a compressed
+    #: loop's state: the pin connectors and what the loop knows of the pins.
+    EXTRA_STATE = (
+        "sensors",
+        "io",
+        "watched",
+        "last",
+        "pending",
+        "frame_outputs",
+        "extra",
+        "measurements",
+    )
+
     def __init__(
         self,
         scenario,
@@ -231,6 +244,17 @@ class RealClockLoop(ClosedLoop):
             )
             self.comparison = PinComparison(shadow_label, outputs)
         self.measurements = {}  # "<connector>.<key>" -> array per row
+
+    def use_design(self, pins):
+        """Drive ``pins`` from now on (a design brought to the loop's state, e.g. by
+        fpga_robotics.loop.pin_journal)."""
+        self.design = self.pins = pins
+        self.restored()
+
+    def restored(self):
+        super().restored()
+        for io in self.io.values():  # the connectors talk to this loop's design
+            io.backend = self.pins
 
     # Binding ----------------------------------------------------------------------------
 
