@@ -131,7 +131,7 @@ class ReferenceRun:
         reference's. ``progress(done, total)`` is called after every frame replayed or run
         (it may raise to stop the run)."""
         scenario = self.scenario if scenario is None else scenario
-        _check_same_world(self.scenario, scenario)
+        check_same_world(self.scenario, scenario)
         if design.params != scenario.params:
             raise ValueError("the backend was built for other parameters than the scenario's")
         wall_start, cpu_start = time.perf_counter(), time.process_time()
@@ -200,7 +200,7 @@ def _rewrite_design_part(loop, outputs, ref):
     loop.events = events + [e for e in loop.events if e[0] >= n]
 
 
-def _check_same_world(reference, variant):
+def check_same_world(reference, variant):
     if reference is variant:
         return
     a = {k: v for k, v in reference.data.items() if k not in VARIANT_SECTIONS}

@@ -28,7 +28,7 @@ import numpy as np
 from fpga_robotics.checks.sensor_metrics import line_metrics, measurement_metrics
 from fpga_robotics.designs.builtin import build_component, connector_kinds, foreign_top
 from fpga_robotics.hw.errors import UsageError
-from fpga_robotics.loop.compressed import TIMINGS, ClosedLoop
+from fpga_robotics.loop.compressed import TIMINGS, ClosedLoop, run_loop
 from fpga_robotics.loop.connectors import CONNECTORS, PinIO
 from fpga_robotics.sim.backends.base import FrameResult
 from fpga_robotics.sim.backends.foreign import ForeignDesign
@@ -533,13 +533,10 @@ def run_real_clock(
             "(run --shadow REF); FollowTarget parameters compare frames in "
             'sim.timing = "compressed"'
         )
-    owns_backend = isinstance(backend, str)
-    design = make_pin_backend(backend, scenario) if owns_backend else backend
-    try:
-        design.reset()
-        if shadow is not None:
-            shadow.reset()
-        loop = RealClockLoop(
+    return run_loop(
+        backend,
+        lambda name: make_pin_backend(name, scenario),
+        lambda design: RealClockLoop(
             scenario,
             seed=seed,
             design=design,
@@ -548,11 +545,11 @@ def run_real_clock(
             controls=controls,
             shadow=shadow,
             shadow_label=shadow_label,
-        )
-        return loop.run(progress=progress, realtime=realtime)
-    finally:
-        if owns_backend:
-            design.close()
+        ),
+        shadow=shadow,
+        progress=progress,
+        realtime=realtime,
+    )
 
 
 TIMINGS["real_clock"] = run_real_clock
