@@ -75,7 +75,7 @@ def take(loop):
     memo[id(loop.camera.turn_rate)] = None
     names = STATE + getattr(loop, "EXTRA_STATE", ())
     state = copy.deepcopy({name: getattr(loop, name) for name in names}, memo)
-    calls = getattr(getattr(loop, "pins", None), "calls", None)
+    calls = getattr(getattr(loop, "primary", None), "calls", None)
     return Checkpoint(loop.frames_done, state, shared, None if calls is None else len(calls))
 
 

@@ -29,29 +29,31 @@ from fpga_robotics.loop.compressed import run_scenario
 from fpga_robotics.loop.fork import ReferenceRun, check_same_world
 from fpga_robotics.loop.pin_journal import JournalPins, PlayBack, first_difference
 from fpga_robotics.loop.real_clock import RealClockLoop
+from fpga_robotics.loop.shadow import is_shadow_event
 
 __all__ = ["PinReferenceRun", "reference_run"]
 
 
-def reference_run(scenario, *, design, seed=None, checkpoint_every=30):
+def reference_run(scenario, *, design, seed=None, checkpoint_every=30, **run_args):
     """The reference run for the scenario's timing: a ``ReferenceRun`` (compressed, a
-    frame-level design) or a ``PinReferenceRun`` (real clock, a pin design)."""
+    frame-level design) or a ``PinReferenceRun`` (real clock, a pin design); ``run_args``
+    as theirs (``progress``, ``recorder``, ``on_frame``, ``shadow``, ``shadow_label``)."""
     kind = PinReferenceRun if scenario.sim.timing == "real_clock" else ReferenceRun
-    return kind(scenario, design=design, seed=seed, checkpoint_every=checkpoint_every)
+    return kind(scenario, design=design, seed=seed, checkpoint_every=checkpoint_every, **run_args)
 
 
 class _RecordingPinLoop(RealClockLoop):
     """A real-clock loop that takes the checkpoints variants restore."""
 
-    def __init__(self, scenario, *, seed, design, checkpoint_every):
-        super().__init__(scenario, seed=seed, design=design)
+    def __init__(self, scenario, *, seed, design, checkpoint_every, **loop_args):
+        super().__init__(scenario, seed=seed, design=design, **loop_args)
         self.every = checkpoint_every
         self.checkpoints = []  # in frame order
         self.frame_calls = []  # the journal's length as each frame starts
         self.final = None
 
     def run_frame(self, k):
-        self.frame_calls.append(len(self.pins.calls))
+        self.frame_calls.append(len(self.primary.calls))
         if k % self.every == 0:
             self.checkpoints.append(checkpoint.take(self))
         super().run_frame(k)
@@ -85,21 +87,31 @@ class PinReferenceRun:
     seed : int, optional
     checkpoint_every : int
         Frames between world checkpoints.
+    progress, **loop_args
+        As ``ReferenceRun``'s (a ``shadow`` is a pin design, given the primary's inputs).
     """
 
-    def __init__(self, scenario, *, design, seed=None, checkpoint_every=30):
+    def __init__(
+        self, scenario, *, design, seed=None, checkpoint_every=30, progress=None, **loop_args
+    ):
         if scenario.sim.timing != "real_clock":
             raise ValueError('PinReferenceRun needs sim.timing = "real_clock"')
         if checkpoint_every < 1:
             raise ValueError(f"checkpoint_every must be at least 1, got {checkpoint_every}")
         self.scenario = scenario
         design.reset()
+        if loop_args.get("shadow") is not None:
+            loop_args["shadow"].reset()
         self.journal = JournalPins(design)
         self._loop = _RecordingPinLoop(
-            scenario, seed=seed, design=self.journal, checkpoint_every=checkpoint_every
+            scenario,
+            seed=seed,
+            design=self.journal,
+            checkpoint_every=checkpoint_every,
+            **loop_args,
         )
         self.seed = self._loop.seed
-        self.result = self._loop.run()
+        self.result = self._loop.run(progress=progress)
         self.last_divergence = None
 
     @property
@@ -129,11 +141,18 @@ class PinReferenceRun:
             self.last_divergence = None
             rest = calls[ref.final.design_calls :]
             loop.use_design(PlayBack(design, rest, rest[0].cycle if rest else design.cycle))
-            checkpoint.restore(loop, ref.final)
+            _restore(loop, ref.final)
             return loop.finish_run(wall_start, cpu_start)
         self.last_divergence = bisect.bisect_right(starts, i) - 1
         start = [c for c in ref.checkpoints if c.design_calls <= i][-1]
         first = start.design_calls
         loop.use_design(PlayBack(design, calls[first : i + 1], calls[first].cycle, last=answer))
-        checkpoint.restore(loop, start)
+        _restore(loop, start)
         return loop.run(start=start.frame, progress=progress)
+
+
+def _restore(loop, saved):
+    """The reference's state into the variant's loop, without the reference's shadow's
+    events (a variant runs without one)."""
+    checkpoint.restore(loop, saved)
+    loop.events = [e for e in loop.events if not is_shadow_event(e[2])]

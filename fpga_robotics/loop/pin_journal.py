@@ -57,6 +57,9 @@ class JournalPins:
     def __init__(self, design):
         self.design = design
         self.calls = []
+        #: The design itself, for a look that is no part of the loop's calls (a shadow's
+        #: comparison).
+        self.unrecorded = design
 
     @property
     def name(self):

@@ -187,6 +187,7 @@ class RealClockLoop(ClosedLoop):
     ):
         from fpga_robotics.loop.pin_shadow import MirroredPins, PinComparison
 
+        self.primary = design  # the primary's own backend (a journal, when forking)
         if shadow is not None:  # a second design, given every input the primary gets
             design = MirroredPins(design, shadow)
         super().__init__(
@@ -467,7 +468,9 @@ class RealClockLoop(ClosedLoop):
         divergence."""
         c = self.comparison
         first = c.first_divergence is None
-        primary = {n: self.pins.primary.peek(n) for n in c.outputs}
+        # Read past a journal (fpga_robotics.loop.pin_journal): the loop's own calls only.
+        design = getattr(self.pins.primary, "unrecorded", self.pins.primary)
+        primary = {n: design.peek(n) for n in c.outputs}
         shadow = {n: self.shadow_pins.peek(n) for n in c.outputs}
         differ = c.compare(row.k, row.t, primary, shadow)
         if not (differ and first):
