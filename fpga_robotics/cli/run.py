@@ -349,13 +349,13 @@ def _run_continued(args, scenario, design, shadow, shadow_scenario, **run_args):
     return continued
 
 
-def _format_continued(s):
+def _format_continued(s, label):
     """Lines for the human summary: the shadow design's own run."""
     from fpga_robotics.checks.summary import format_summary
 
     parted = s["parted_at_frame"]
     where = "never drove differently" if parted is None else f"drives from frame {parted}"
-    lines = [f"  shadow {s['backend']} on its own ({where}):"]
+    lines = [f"  shadow {label} on its own ({where}):"]
     return lines + ["  " + line for line in format_summary(s).splitlines()]
 
 
@@ -829,7 +829,7 @@ def main(argv=None, prog="fpga-robotics run"):
 
         print("\n".join(format_shadow(summary["shadow"])))
     if "shadow_continued" in summary:
-        print("\n".join(_format_continued(summary["shadow_continued"])))
+        print("\n".join(_format_continued(summary["shadow_continued"], args.shadow)))
     for line in notices:
         print(line)
     if args.save_video is not None:
