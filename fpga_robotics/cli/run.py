@@ -281,6 +281,12 @@ def _video(path, fps):
     return CameraVideo(path, fps)
 
 
+def _shadow_params(scenario, spec):
+    """The shadow design's parameters: the scenario's design with ``--shadow`` applied."""
+    shadow = _shadow_params_scenario(scenario, spec)
+    return None if shadow is None else shadow.params
+
+
 def _shadow_params_scenario(scenario, spec):
     """The scenario with the design ``--shadow`` describes (FollowTarget parameters)."""
     if spec is None:
