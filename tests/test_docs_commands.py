@@ -1081,6 +1081,13 @@ PLANS = {
         shorter=(("--duration", "1"), ("--repeats", "1")),
         out=(r"cProfile of one run, 12 functions of largest own time", r"tottime"),
     ),
+    "fpga-robotics bench fork": Plan(
+        shorter=(("--duration", "3"), ("--values", "5,20")),
+        out=(
+            r"every forked result equals its full run",
+            r"full runs / forked \(reference included\)\s+[\d.]+x",
+        ),
+    ),
     "fpga-robotics bench camera": Plan(
         shorter=(("--frames", "2"), ("--repeats", "1")),
         out=(r"(?m)^\s*160x120\s+[\d.]+", r"(?m)^\s*640x480\s+[\d.]+"),
