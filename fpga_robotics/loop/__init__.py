@@ -5,7 +5,8 @@
 what the design's pins see of the world and do to it; ``shadow.py`` runs a second design on
 the same frames; ``checkpoint.py`` saves and restores a loop's world at a frame boundary,
 ``fork.py`` (frames) and ``pin_fork.py`` (real clock, with ``pin_journal.py``: a pin design's
-calls, replayed) run design variants from a reference run's recordings and checkpoints;
+calls, replayed) run design variants from a reference run's recordings and checkpoints,
+``continuation.py`` lets a shadow design drive from where it parts (``run --shadow-continue``);
 ``sources.py`` feeds frames from outside the simulation.
 """
 
