@@ -551,6 +551,18 @@ PLANS = {
             re.escape("  shadow frames that differ: motor_left 10, motor_right 10 (of 600)"),
         ),
     ),
+    "python -m fpga_robotics.run --backend model --rerun off --quiet --duration 20 "
+    "--scenario lost_target --shadow 'lost_frames=5' --shadow-continue": Plan(
+        duration="keep",
+        duration_why="the page shows the frame the shadow takes over at and its run's "
+        "figures (model backend: seconds of wall time)",
+        out=(
+            re.escape("  shadow lost_frames=5 on its own (drives from frame 119):"),
+            re.escape("  scenario lost_target  backend model  160x120  seed 0"),
+            r"distance: min 0\.89 m, mean 1\.35 m; path 1\.0 m",
+            r"(?m)^  verdict: PASS$",
+        ),
+    ),
     # docs/campaigns.md: verification campaigns on Dask -------------------------------------
     "python -m fpga_robotics.sweep regression --dry-run": Plan(
         out=(
@@ -1150,6 +1162,13 @@ PLANS = {
     "fpga-robotics bench loop --backend cxxrtl --resolutions 160x120 --profile 12": Plan(
         shorter=(("--duration", "1"), ("--repeats", "1")),
         out=(r"cProfile of one run, 12 functions of largest own time", r"tottime"),
+    ),
+    "fpga-robotics bench fork": Plan(
+        shorter=(("--duration", "3"), ("--values", "5,20")),
+        out=(
+            r"every forked result equals its full run",
+            r"full runs / forked \(reference included\)\s+[\d.]+x",
+        ),
     ),
     "fpga-robotics bench camera": Plan(
         shorter=(("--frames", "2"), ("--repeats", "1")),

@@ -31,6 +31,7 @@ MAP_FOV = "map/fov"
 MAP_PEOPLE = "map/people"
 TRAIL_ROBOT = "map/trails/robot"
 TRAIL_TARGET = "map/trails/target"
+TRAILS = "map/trails"  # + "/<name>": a whole path drawn at once (Recorder.log_trail)
 
 #: Series names of the multi-valued scalar entities, in logged order.
 SERIES = {

@@ -66,6 +66,7 @@ _TARGET_COLOR = (255, 70, 70)
 _PERSON_COLOR = (170, 170, 190)
 _TRAIL_ROBOT_COLOR = (60, 160, 255)
 _TRAIL_TARGET_COLOR = (255, 110, 110)
+_TRAIL_OTHER_COLOR = (200, 120, 255)
 _SERIES_COLORS = {
     P.DESIGN_TRACKING: [(80, 220, 80), (255, 170, 30)],
     P.MOTORS_DPS: [(80, 170, 255), (255, 120, 80)],
@@ -467,6 +468,20 @@ class Recorder:
         if target is not None:
             add(P.TRAIL_TARGET, (self._last_target or target, target))
         self._last_target = target
+
+    def log_trail(self, name, x, y):
+        """A whole path drawn on the map at once, at ``map/trails/<name>``: the robot's path
+        as another design drove it (``run --shadow-continue``)."""
+        self._check_open()
+        if self._stream is None:
+            return
+        points = [_xy(a, b) for a, b in zip(x, y, strict=True)]
+        with self._guard:
+            self._stream.log(
+                f"{P.TRAILS}/{name}",
+                rr.LineStrips2D([points], colors=_TRAIL_OTHER_COLOR, radii=0.01),
+                static=True,
+            )
 
     # End ---------------------------------------------------------------------------------------
 

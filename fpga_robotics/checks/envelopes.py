@@ -217,10 +217,25 @@ def _stop_level(params):
     return next((lvl for lvl in range(1, 8) if params.base_dps[lvl] <= 0), None)
 
 
+#: ``stop_distance_m``'s answers: a sweep of 3940 distances that depends on the camera and
+#: the design only, the same for every run of a campaign's scenario (the geometry's repr,
+#: exact for its floats, stands for it).
+_STOP_DISTANCES = {}
+
+
 def stop_distance_m(geom, params, code):
     """``(near, far)``: within ``near`` m (camera to the target's centre, target straight
     ahead) the law surely says stop or reverse; beyond ``far`` it surely drives forward.
     None when the law never stops or the bounds never reach its level."""
+    key = (repr(geom), params, code)
+    if key not in _STOP_DISTANCES:
+        if len(_STOP_DISTANCES) >= 256:
+            _STOP_DISTANCES.clear()
+        _STOP_DISTANCES[key] = _stop_distance(geom, params, code)
+    return _STOP_DISTANCES[key]
+
+
+def _stop_distance(geom, params, code):
     level = _stop_level(params)
     if level is None:
         return None

@@ -80,6 +80,10 @@ BENCHMARKS = {
     ),
     "viewer": ("fpga_robotics.bench.viewer", "the cost of logging to the rerun viewer"),
     "shadow": ("fpga_robotics.bench.shadow", "a shadow design's cost in the closed loop"),
+    "fork": (
+        "fpga_robotics.bench.fork",
+        "design variants forked from one reference run against run in full",
+    ),
     "loop": ("fpga_robotics.bench.loop", "where the closed loop's time goes, per frame"),
     "foreign": (
         "fpga_robotics.bench.foreign",

@@ -160,6 +160,13 @@ def build_parser(prog="fpga-robotics run"):
         "they differ",
     )
     p.add_argument(
+        "--shadow-continue",
+        action="store_true",
+        help="with --shadow: once the shadow would drive differently, let it drive from "
+        "there (the world restored at that point) and report its own run beside the "
+        "primary's",
+    )
+    p.add_argument(
         "--shadow-backend",
         choices=("auto", *BACKEND_NAMES),
         default=None,
@@ -297,6 +304,12 @@ def _video(path, fps):
 
 def _shadow_params(scenario, spec):
     """The shadow design's parameters: the scenario's design with ``--shadow`` applied."""
+    shadow = _shadow_params_scenario(scenario, spec)
+    return None if shadow is None else shadow.params
+
+
+def _shadow_params_scenario(scenario, spec):
+    """The scenario with the design ``--shadow`` describes (FollowTarget parameters)."""
     if spec is None:
         return None
 
@@ -304,7 +317,7 @@ def _shadow_params(scenario, spec):
         items = shadow_overrides(spec)
     except ValueError as exc:
         raise UsageError(str(exc)) from None
-    return scenario.with_overrides(items).params
+    return scenario.with_overrides(items)
 
 
 def _shadow_scenario(scenario, spec):
@@ -324,6 +337,50 @@ def _shadow_scenario(scenario, spec):
             f"(design.verilog); a shadow design goes with an Amaranth one"
         )
     return scenario.with_overrides([design_override(spec)])
+
+
+def _check_continue(args, ros):
+    """--shadow-continue's companions, checked before anything is built."""
+    if not args.shadow_continue:
+        return
+    if args.shadow is None:
+        raise UsageError("--shadow-continue lets the --shadow design drive: give --shadow SPEC")
+    if ros.live_control or ros.replay is not None or args.realtime:
+        raise UsageError(
+            "--shadow-continue replays the run without live inputs or pacing: leave out "
+            "--realtime, --live, --interactive and --replay-inputs"
+        )
+
+
+def _run_continued(args, scenario, design, shadow, shadow_scenario, **run_args):
+    """The run with its shadow, then the shadow's own run from where it parts
+    (fpga_robotics.loop.continuation); the shadow's path drawn on the viewer's map."""
+    from fpga_robotics.loop.continuation import run_continued
+
+    continued = run_continued(
+        scenario,
+        design=design,
+        shadow=shadow,
+        shadow_scenario=shadow_scenario,
+        seed=args.seed,
+        shadow_label=args.shadow,
+        **run_args,
+    )
+    recorder = run_args.get("recorder")
+    if recorder is not None:
+        t = continued.shadow.trajectory
+        recorder.log_trail("shadow", t["x"], t["y"])
+    return continued
+
+
+def _format_continued(s, label):
+    """Lines for the human summary: the shadow design's own run."""
+    from fpga_robotics.checks.summary import format_summary
+
+    parted = s["parted_at_frame"]
+    where = "never drove differently" if parted is None else f"drives from frame {parted}"
+    lines = [f"  shadow {label} on its own ({where}):"]
+    return lines + ["  " + line for line in format_summary(s).splitlines()]
 
 
 def _dress_target(scenario, color):
@@ -680,7 +737,11 @@ def main(argv=None, prog="fpga-robotics run"):
     if args.max_frames is not None:
         raise UsageError("--max-frames only applies with --source (use --duration)")
     shadow_scenario = _shadow_scenario(scenario, args.shadow)
-    shadow_params = None if shadow_scenario is not None else _shadow_params(scenario, args.shadow)
+    params_scenario = None
+    if shadow_scenario is None:
+        params_scenario = _shadow_params_scenario(scenario, args.shadow)
+    shadow_params = None if params_scenario is None else params_scenario.params
+    _check_continue(args, ros)
     if args.save_video is not None:
         try:
             check_video_path(args.save_video)
@@ -715,18 +776,31 @@ def main(argv=None, prog="fpga-robotics run"):
             print(line, file=sys.stderr)
         progress = None if args.quiet else Progress(scenario.name)
         with _video(args.save_video, scenario.camera.fps) as video:
-            result = run_scenario(
-                scenario,
-                seed=args.seed,
-                backend=design,
-                recorder=recorder,
-                progress=progress,
-                realtime=args.realtime,
-                shadow=shadow,
-                shadow_label=args.shadow or "shadow",
-                on_frame=_frame_callback(video, ros),
-                controls=ros.controls,
-            )
+            if args.shadow_continue:
+                continued = _run_continued(
+                    args,
+                    scenario,
+                    design,
+                    shadow,
+                    shadow_scenario or params_scenario,
+                    recorder=recorder,
+                    progress=progress,
+                    on_frame=_frame_callback(video, ros),
+                )
+                result = continued.main
+            else:
+                result = run_scenario(
+                    scenario,
+                    seed=args.seed,
+                    backend=design,
+                    recorder=recorder,
+                    progress=progress,
+                    realtime=args.realtime,
+                    shadow=shadow,
+                    shadow_label=args.shadow or "shadow",
+                    on_frame=_frame_callback(video, ros),
+                    controls=ros.controls,
+                )
         if progress is not None:
             progress.finish()
         completed = True
@@ -737,6 +811,10 @@ def main(argv=None, prog="fpga-robotics run"):
         notices = _close_outputs(recorder, ros, completed)
     summary = dict(result.summary)
     summary["backend_setup_s"] = round(setup, 3)
+    if args.shadow_continue:
+        from fpga_robotics.loop.continuation import continuation_summary
+
+        summary["shadow_continued"] = continuation_summary(continued)
     summary.update(ros.summary_items())  # the live inputs, for --replay-inputs
     print(format_summary(summary))
 
@@ -744,6 +822,8 @@ def main(argv=None, prog="fpga-robotics run"):
         print(line)
     if "shadow" in summary:
         print("\n".join(format_shadow(summary["shadow"])))
+    if "shadow_continued" in summary:
+        print("\n".join(_format_continued(summary["shadow_continued"], args.shadow)))
     for line in notices:
         print(line)
     if args.save_video is not None:

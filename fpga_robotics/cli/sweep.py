@@ -99,6 +99,12 @@ def build_parser(prog=PROG):
         help="also write each recorded run as a ROS 2 bag, OUT/bags/RUN_ID/ (docs/ros.md)",
     )
     e.add_argument(
+        "--no-fork",
+        action="store_true",
+        help="run every run in full (default: runs that differ only in their design are "
+        "forked from one reference run, with the same results)",
+    )
+    e.add_argument(
         "--log-every",
         type=int,
         default=None,
@@ -267,6 +273,7 @@ def main(argv=None, prog=PROG):
             echo=echo,
             log_every=args.log_every or RECORD_LOG_EVERY,
             bag=args.bag,
+            fork=not args.no_fork,
         )
     except KeyboardInterrupt:
         kept = len(load_rows(out))

@@ -43,6 +43,7 @@ __all__ = [
     "RunResult",
     "frame_count",
     "make_backend",
+    "run_loop",
     "run_scenario",
 ]
 
@@ -229,6 +230,11 @@ class ClosedLoop:
             sensor=make_sensor(cam, self.seed),
             turn_rate=self.camera_turn_rate,
         )
+
+    def restored(self):
+        """Called once a checkpoint's state is in place (fpga_robotics.loop.checkpoint): what
+        the state refers to of the loop itself is bound again."""
+        self.camera.turn_rate = self.camera_turn_rate
 
     def camera_turn_rate(self):
         """The robot's turn rate now, rad/s (the sensor model's motion blur)."""
@@ -604,15 +610,11 @@ def run_scenario(
             shadow_label=shadow_label,
             controls=controls,
         )
-    owns_backend = isinstance(backend, str)
-    design = make_backend(backend, scenario.params) if owns_backend else backend
-    try:
+
+    def build(design):
         if design.params != scenario.params:
             raise ValueError("the backend was built for other parameters than the scenario's")
-        design.reset()
-        if shadow is not None:
-            shadow.reset()
-        loop = ClosedLoop(
+        return ClosedLoop(
             scenario,
             seed=seed,
             design=design,
@@ -622,7 +624,28 @@ def run_scenario(
             shadow_label=shadow_label,
             controls=controls,
         )
-        return loop.run(progress=progress, realtime=realtime)
+
+    return run_loop(
+        backend,
+        lambda name: make_backend(name, scenario.params),
+        build,
+        shadow=shadow,
+        progress=progress,
+        realtime=realtime,
+    )
+
+
+def run_loop(backend, open_backend, build_loop, *, shadow=None, progress=None, realtime=False):
+    """Run a loop on ``backend``: a ready design (the caller keeps it) or a name, opened
+    with ``open_backend(name)`` and closed after. The design and the ``shadow`` are reset,
+    ``build_loop(design)`` makes the loop, which runs to its ``RunResult``."""
+    owns_backend = isinstance(backend, str)
+    design = open_backend(backend) if owns_backend else backend
+    try:
+        design.reset()
+        if shadow is not None:
+            shadow.reset()
+        return build_loop(design).run(progress=progress, realtime=realtime)
     finally:
         if owns_backend:
             design.close()

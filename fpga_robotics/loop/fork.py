@@ -40,8 +40,8 @@ VARIANT_SECTIONS = ("name", "description", "design", "checks")
 class _RecordingLoop(ClosedLoop):
     """A closed loop that records what variants of its design need (see ``ReferenceRun``)."""
 
-    def __init__(self, scenario, *, seed, design, checkpoint_every):
-        super().__init__(scenario, seed=seed, design=design)
+    def __init__(self, scenario, *, seed, design, checkpoint_every, **loop_args):
+        super().__init__(scenario, seed=seed, design=design, **loop_args)
         self.every = checkpoint_every
         self.checkpoints = []  # in frame order
         self.seen = []  # (rgb, colour code) per frame
@@ -50,6 +50,7 @@ class _RecordingLoop(ClosedLoop):
         self.final = None  # the checkpoint once the frames and the physics after them are done
         self._ref_events = _DesignEvents(scenario.params.lost_frames)
         self._before = 0
+        self._shadow_events = 0  # the shadow's, after the design's: no variant has them
 
     def run_frame(self, k):
         if k % self.every == 0:
@@ -59,7 +60,7 @@ class _RecordingLoop(ClosedLoop):
         texts = [e for _, _, e in self.events[first:]]
         result = self._result
         mine = self._ref_events.update(bool(result.found)) if result.found is not None else []
-        after = self._before + len(mine)
+        after = self._before + len(mine) + self._shadow_events
         self.world_events.append((texts[: self._before], texts[after:]))
 
     def capture(self, t):
@@ -72,6 +73,11 @@ class _RecordingLoop(ClosedLoop):
         self._result = result = super().process(k, rgb)
         self.commands.append((_dps(result.motor_left), _dps(result.motor_right)))
         return result
+
+    def process_shadow(self, k, t, rgb, result):
+        shadow_result, events = super().process_shadow(k, t, rgb, result)
+        self._shadow_events = len(events)
+        return shadow_result, events
 
     def finish_run(self, wall_start, cpu_start):
         self.final = checkpoint.take(self)
@@ -92,6 +98,11 @@ class ReferenceRun:
     checkpoint_every : int
         Frames between world checkpoints: fewer frames re-simulated per diverging variant
         against more memory and copying.
+    progress : callable(done, total), optional
+        Called after every frame of the reference's run.
+    **loop_args
+        More ``ClosedLoop`` arguments for the reference's run: ``recorder``, ``on_frame``,
+        ``shadow`` (reset here) and ``shadow_label``.
 
     Attributes
     ----------
@@ -102,7 +113,9 @@ class ReferenceRun:
         none did).
     """
 
-    def __init__(self, scenario, *, design, seed=None, checkpoint_every=30):
+    def __init__(
+        self, scenario, *, design, seed=None, checkpoint_every=30, progress=None, **loop_args
+    ):
         if scenario.sim.timing != "compressed":
             raise ValueError('forked runs need sim.timing = "compressed"')
         if checkpoint_every < 1:
@@ -111,11 +124,13 @@ class ReferenceRun:
             raise ValueError("the backend was built for other parameters than the scenario's")
         self.scenario = scenario
         design.reset()
+        if loop_args.get("shadow") is not None:
+            loop_args["shadow"].reset()
         self._loop = _RecordingLoop(
-            scenario, seed=seed, design=design, checkpoint_every=checkpoint_every
+            scenario, seed=seed, design=design, checkpoint_every=checkpoint_every, **loop_args
         )
         self.seed = self._loop.seed
-        self.result = self._loop.run()
+        self.result = self._loop.run(progress=progress)
         self.last_divergence = None
 
     @property
@@ -131,7 +146,7 @@ class ReferenceRun:
         reference's. ``progress(done, total)`` is called after every frame replayed or run
         (it may raise to stop the run)."""
         scenario = self.scenario if scenario is None else scenario
-        _check_same_world(self.scenario, scenario)
+        check_same_world(self.scenario, scenario)
         if design.params != scenario.params:
             raise ValueError("the backend was built for other parameters than the scenario's")
         wall_start, cpu_start = time.perf_counter(), time.process_time()
@@ -200,7 +215,7 @@ def _rewrite_design_part(loop, outputs, ref):
     loop.events = events + [e for e in loop.events if e[0] >= n]
 
 
-def _check_same_world(reference, variant):
+def check_same_world(reference, variant):
     if reference is variant:
         return
     a = {k: v for k, v in reference.data.items() if k not in VARIANT_SECTIONS}

@@ -29,7 +29,7 @@ from fpga_robotics.checks.sensor_metrics import line_metrics, measurement_metric
 from fpga_robotics.designs.builtin import build_component, connector_kinds, foreign_top
 from fpga_robotics.designs.reference import resolve_design
 from fpga_robotics.hw.errors import UsageError
-from fpga_robotics.loop.compressed import TIMINGS, ClosedLoop
+from fpga_robotics.loop.compressed import TIMINGS, ClosedLoop, run_loop
 from fpga_robotics.loop.connectors import CONNECTORS, PinIO
 from fpga_robotics.loop.pin_shadow import MirroredPins, PinComparison
 from fpga_robotics.sim.backends.base import FrameResult
@@ -162,6 +162,19 @@ class _PendingRow:
 class RealClockLoop(ClosedLoop):
     """``ClosedLoop`` in real-clock timing, on a ``PinBackend`` (``design``)."""
 
+    #: What a world checkpoint (fpga_robotics.loop.checkpoint) keeps beyond a compressed
+    #: loop's state: the pin connectors and what the loop knows of the pins.
+    EXTRA_STATE = (
+        "sensors",
+        "io",
+        "watched",
+        "last",
+        "pending",
+        "frame_outputs",
+        "extra",
+        "measurements",
+    )
+
     def __init__(
         self,
         scenario,
@@ -174,6 +187,7 @@ class RealClockLoop(ClosedLoop):
         shadow=None,
         shadow_label="shadow",
     ):
+        self.primary = design  # the primary's own backend (a journal, when forking)
         if shadow is not None:  # a second design, given every input the primary gets
             design = MirroredPins(design, shadow)
         super().__init__(
@@ -240,6 +254,17 @@ class RealClockLoop(ClosedLoop):
             )
             self.comparison = PinComparison(shadow_label, outputs)
         self.measurements = {}  # "<connector>.<key>" -> array per row
+
+    def use_design(self, pins):
+        """Drive ``pins`` from now on (a design brought to the loop's state, e.g. by
+        fpga_robotics.loop.pin_journal)."""
+        self.design = self.pins = pins
+        self.restored()
+
+    def restored(self):
+        super().restored()
+        for io in self.io.values():  # the connectors talk to this loop's design
+            io.backend = self.pins
 
     # Binding ----------------------------------------------------------------------------
 
@@ -471,7 +496,9 @@ class RealClockLoop(ClosedLoop):
         divergence."""
         c = self.comparison
         first = c.first_divergence is None
-        primary = {n: self.pins.primary.peek(n) for n in c.outputs}
+        # Read past a journal (fpga_robotics.loop.pin_journal): the loop's own calls only.
+        design = getattr(self.pins.primary, "unrecorded", self.pins.primary)
+        primary = {n: design.peek(n) for n in c.outputs}
         shadow = {n: self.shadow_pins.peek(n) for n in c.outputs}
         differ = c.compare(row.k, row.t, primary, shadow)
         if not (differ and first):
@@ -537,13 +564,10 @@ def run_real_clock(
             "(run --shadow REF); FollowTarget parameters compare frames in "
             'sim.timing = "compressed"'
         )
-    owns_backend = isinstance(backend, str)
-    design = make_pin_backend(backend, scenario) if owns_backend else backend
-    try:
-        design.reset()
-        if shadow is not None:
-            shadow.reset()
-        loop = RealClockLoop(
+    return run_loop(
+        backend,
+        lambda name: make_pin_backend(name, scenario),
+        lambda design: RealClockLoop(
             scenario,
             seed=seed,
             design=design,
@@ -552,11 +576,11 @@ def run_real_clock(
             controls=controls,
             shadow=shadow,
             shadow_label=shadow_label,
-        )
-        return loop.run(progress=progress, realtime=realtime)
-    finally:
-        if owns_backend:
-            design.close()
+        ),
+        shadow=shadow,
+        progress=progress,
+        realtime=realtime,
+    )
 
 
 TIMINGS["real_clock"] = run_real_clock

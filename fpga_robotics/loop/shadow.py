@@ -16,6 +16,7 @@ __all__ = [
     "differing_outputs",
     "divergence_event",
     "format_shadow",
+    "is_shadow_event",
     "output_value",
     "shadow_overrides",
 ]
@@ -120,6 +121,11 @@ def divergence_event(label, differ, primary, shadow):
         f"{n} {output_value(primary, n)} vs {output_value(shadow, n)}" for n in differ
     )
     return f"shadow design {label} diverges: {parts}"
+
+
+def is_shadow_event(text):
+    """Whether an event is a shadow design's (``divergence_event``, pin_shadow's alike)."""
+    return text.startswith("shadow design ")
 
 
 def format_shadow(summary):

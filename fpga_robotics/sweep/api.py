@@ -30,6 +30,7 @@ def run_campaign(
     echo=None,
     log_every=RECORD_LOG_EVERY,
     bag=False,
+    fork=True,
 ):
     """Run ``campaign`` (a ``Campaign``) and return its results rows (list of dicts, one per
     run, in the order they finished; with ``resume`` the rows already in ``out_dir`` too).
@@ -37,7 +38,8 @@ def run_campaign(
     ``client``: an open ``distributed.Client`` to use (else one is opened: ``scheduler`` or
     an embedded cluster of ``workers`` processes). ``echo(text)``: where progress notes go.
     ``bag``: the recorded runs (``record``) are also written as ROS 2 bags, ``bags/<run_id>/``
-    (docs/ros.md).
+    (docs/ros.md). ``fork``: runs that differ only in their design run as one reference
+    run and forked variants (fork_groups; the same rows), False runs each in full.
     """
     say = echo or (lambda text: None)
     plan = make_plan(campaign)
@@ -87,6 +89,7 @@ def run_campaign(
                 quiet=quiet,
                 log_every=log_every,
                 bag=bag,
+                fork=fork,
             )
             meta["runs_wall_s"] = round(time.perf_counter() - t_runs, 3)
             meta["workers"] = len(c.scheduler_info()["workers"])

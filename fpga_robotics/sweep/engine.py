@@ -22,7 +22,7 @@ from pathlib import Path
 from fpga_robotics.hw.errors import UsageError
 
 from ..sim.files import write_atomic
-from . import runner
+from . import fork_groups, runner
 from .results import make_row
 
 __all__ = [
@@ -189,9 +189,12 @@ def run_plan(
     on_row=None,
     log_every=RECORD_LOG_EVERY,
     bag=False,
+    fork=True,
 ):
     """Run every planned run not already in ``store``; returns the number run.
-    Recordings log every ``log_every``-th frame's images (every frame's numbers)."""
+    Recordings log every ``log_every``-th frame's images (every frame's numbers). With
+    ``fork``, runs of one world are run as a reference and forked variants (fork_groups),
+    unless every run is recorded."""
     from distributed import as_completed  # lazy: Dask costs ~1 s; only a run needs it
 
     todo, seen = [], store.done_ids()
@@ -204,34 +207,71 @@ def run_plan(
         return 0
     timeouts = _Timeouts(timeout)
     window = max(2, 2 * sum(client.nthreads().values()) or 2)
-    pending = list(reversed(todo))
-    running = {}  # future -> (spec, submitted at, timeout, recording pass)
+    if fork and record != "all":
+        groups = fork_groups.fork_groups(todo, plan.worlds)
+    else:
+        groups = [[spec] for spec in todo]
+    pending = list(reversed(groups))
+    running = {}  # future -> (specs, submitted at, timeout, recording pass)
     done_rows = {}
     failures = 0
     bar = _progress(len(todo), quiet)
     completed = as_completed()
 
-    def submit(spec, recording=False):
-        frames, pixels = plan.frames[spec]
-        limit = timeouts(spec, frames, pixels)
-        key = f"run-{plan.ids[spec]}-{time.monotonic_ns()}"
-        rec = log_every if (recording or record == "all") else False
-        fut = client.submit(
-            runner.execute, spec.argv(), limit, rec, key, pure=False, key=key, bag=bool(bag and rec)
-        )
-        running[fut] = (spec, time.monotonic(), limit, recording)
+    def submit(specs, recording=False):
+        limits = [timeouts(spec, *plan.frames[spec]) for spec in specs]
+        key = f"run-{plan.ids[specs[0]]}-{time.monotonic_ns()}"
+        if len(specs) > 1:  # one world: a reference run and forked variants
+            tags = [f"{key}-{i}" for i in range(len(specs))]
+            argvs = [spec.argv() for spec in specs]
+            fut = client.submit(fork_groups.execute_group, argvs, limits, tags, pure=False, key=key)
+        else:
+            rec = log_every if (recording or record == "all") else False
+            fut = client.submit(
+                runner.execute,
+                specs[0].argv(),
+                limits[0],
+                rec,
+                key,
+                pure=False,
+                key=key,
+                bag=bool(bag and rec),
+            )
+        running[fut] = (specs, time.monotonic(), sum(limits), recording)
         completed.add(fut)
 
     def top_up():
         while pending and len(running) < window:
             submit(pending.pop())
 
+    def finished(spec, outcome):
+        nonlocal failures
+        row = make_row(spec, plan.ids[spec], plan.names[spec], outcome)
+        if outcome.get("recording"):
+            row["recording"] = _save_recording(store.dir, row["run_id"], outcome["recording"])
+        if outcome.get("bag"):
+            row["bag"] = _save_bag(store.dir, row["run_id"], outcome["bag"])
+        store.add(row)
+        if on_row is not None:
+            on_row(row)
+        frames, pixels = plan.frames[spec]
+        if outcome["status"] in ("pass", "fail", "n/a"):  # a finished run, whatever its verdict
+            timeouts.learn(spec.backend, frames, pixels, outcome.get("run_s", 0.0))
+        if outcome["status"] != "pass":
+            failures += 1
+        if outcome["status"] == "fail" and record == "failing":
+            done_rows[row["run_id"]] = row
+            submit([spec], recording=True)
+        bar.update(1)
+        bar.set_postfix_str(f"{failures} not passed", refresh=False)
+
     try:
         top_up()
         for fut in completed:
-            spec, _submitted, limit, recording = running.pop(fut)
+            specs, _submitted, limit, recording = running.pop(fut)
             outcome = _outcome(client, fut, limit)
             if recording:  # the recording pass of a failing run: attach its .rrd
+                spec = specs[0]
                 row = done_rows.pop(plan.ids[spec], None)
                 if row is not None and outcome.get("recording"):
                     row["recording"] = _save_recording(
@@ -242,24 +282,10 @@ def run_plan(
                     store.add(row)
                 top_up()
                 continue
-            row = make_row(spec, plan.ids[spec], plan.names[spec], outcome)
-            if outcome.get("recording"):
-                row["recording"] = _save_recording(store.dir, row["run_id"], outcome["recording"])
-            if outcome.get("bag"):
-                row["bag"] = _save_bag(store.dir, row["run_id"], outcome["bag"])
-            store.add(row)
-            if on_row is not None:
-                on_row(row)
-            frames, pixels = plan.frames[spec]
-            if outcome["status"] in ("pass", "fail", "n/a"):  # a finished run, whatever its verdict
-                timeouts.learn(spec.backend, frames, pixels, outcome.get("run_s", 0.0))
-            if outcome["status"] != "pass":
-                failures += 1
-            if outcome["status"] == "fail" and record == "failing":
-                done_rows[row["run_id"]] = row
-                submit(spec, recording=True)
-            bar.update(1)
-            bar.set_postfix_str(f"{failures} not passed", refresh=False)
+            # A group's task gives one outcome per run (or one for all: its worker died).
+            outcomes = outcome if isinstance(outcome, list) else [outcome] * len(specs)
+            for spec, each in zip(specs, outcomes, strict=True):
+                finished(spec, each)
             top_up()
     finally:
         if running:
@@ -274,7 +300,9 @@ def _timed_out(client, key):
     end = time.monotonic() + 3.0  # the event may arrive just after the worker's death
     while True:
         events = client.get_events(runner.TIMEOUT_TOPIC)
-        if any(msg.get("tag") == key for _t, msg in events):
+        # A group's runs are tagged KEY-<index> (fork_groups.execute_group).
+        tags = [str(msg.get("tag")) for _t, msg in events]
+        if any(tag == key or tag.startswith(f"{key}-") for tag in tags):
             return True
         if time.monotonic() > end:
             return False

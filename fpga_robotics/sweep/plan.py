@@ -6,6 +6,7 @@ from dataclasses import dataclass, field, replace
 from fpga_robotics.hw.errors import UsageError
 
 from .campaign import run_identity
+from .fork_groups import world_key
 from .runner import _design_key, load_run
 
 __all__ = ["Plan", "make_plan"]
@@ -18,6 +19,7 @@ class Plan:
     names: dict = field(default_factory=dict)  # RunSpec -> scenario name
     frames: dict = field(default_factory=dict)  # RunSpec -> (frames, pixels)
     builds: dict = field(default_factory=dict)  # design key -> argv of one run
+    worlds: dict = field(default_factory=dict)  # RunSpec -> its world (fork_groups), or None
 
 
 def _concrete_backend(spec):
@@ -72,9 +74,11 @@ def make_plan(campaign):
                 key,
                 frames,
                 scenario.camera.width * scenario.camera.height,
+                world_key(args, scenario, shadow_params),
             )
             plan.builds.setdefault(key, spec.argv())
-        scenario, files, _key, frames, pixels = checked[shape]
+        scenario, files, _key, frames, pixels, world = checked[shape]
+        plan.worlds[spec] = world
         plan.runs.append(spec)
         plan.ids[spec] = run_identity(spec, scenario.source, files)
         plan.names[spec] = scenario.name

@@ -1,0 +1,158 @@
+"""Fork at divergence in real-clock timing: pin design variants judged against one
+reference run, each re-simulated in the world only from where it parts from the reference.
+
+A ``PinReferenceRun`` runs the reference design (a ``PinBackend``) in a real-clock loop
+through a journal (fpga_robotics.loop.pin_journal) and takes a world checkpoint
+(fpga_robotics.loop.checkpoint) every ``checkpoint_every`` frames and at the end.
+
+``run_variant(design)`` puts the variant through the reference's journal alone (no world, no
+connectors): the same pokes, schedules and pixel streams at the same edges, until the first
+call whose answer differs from the reference's (a watched pin changing elsewhere, a frame
+output or an extra output read otherwise). Up to that call the loop would have done exactly
+what it did with the reference, so:
+
+- if no answer differs, the variant's run is the reference's (its own name in the summary);
+- otherwise the world is restored from the last checkpoint before that call and the loop
+  runs on from there, its calls answered from the journal up to that call and by the variant
+  (already there) after it.
+
+Either way the ``RunResult`` equals the variant's full run, the wall-clock fields excepted.
+A variant whose pins the loop binds otherwise (other ports, connectors, extra outputs) has
+nothing to share with the reference: it gets a full run.
+"""
+
+import bisect
+import time
+
+from fpga_robotics.loop import checkpoint
+from fpga_robotics.loop.compressed import run_scenario
+from fpga_robotics.loop.fork import ReferenceRun, check_same_world
+from fpga_robotics.loop.pin_journal import JournalPins, PlayBack, first_difference
+from fpga_robotics.loop.real_clock import RealClockLoop
+from fpga_robotics.loop.shadow import is_shadow_event
+
+__all__ = ["PinReferenceRun", "reference_run"]
+
+
+def reference_run(scenario, *, design, seed=None, checkpoint_every=30, **run_args):
+    """The reference run for the scenario's timing: a ``ReferenceRun`` (compressed, a
+    frame-level design) or a ``PinReferenceRun`` (real clock, a pin design); ``run_args``
+    as theirs (``progress``, ``recorder``, ``on_frame``, ``shadow``, ``shadow_label``)."""
+    kind = PinReferenceRun if scenario.sim.timing == "real_clock" else ReferenceRun
+    return kind(scenario, design=design, seed=seed, checkpoint_every=checkpoint_every, **run_args)
+
+
+class _RecordingPinLoop(RealClockLoop):
+    """A real-clock loop that takes the checkpoints variants restore."""
+
+    def __init__(self, scenario, *, seed, design, checkpoint_every, **loop_args):
+        super().__init__(scenario, seed=seed, design=design, **loop_args)
+        self.every = checkpoint_every
+        self.checkpoints = []  # in frame order
+        self.frame_calls = []  # the journal's length as each frame starts
+        self.final = None
+
+    def run_frame(self, k):
+        self.frame_calls.append(len(self.primary.calls))
+        if k % self.every == 0:
+            self.checkpoints.append(checkpoint.take(self))
+        super().run_frame(k)
+
+    def finish_run(self, wall_start, cpu_start):
+        self.final = checkpoint.take(self)
+        return super().finish_run(wall_start, cpu_start)
+
+
+def _interface(loop):
+    """How the loop binds its design: what must agree for a variant to share the journal."""
+    return (
+        dict(loop.pins.ports),
+        {c.name: io.binding for c, io in loop.io.items()},
+        sorted(loop.watched),
+        loop.top.camera,
+        dict(loop.top.extra_outputs),
+    )
+
+
+class PinReferenceRun:
+    """The reference pin design's real-clock run of ``scenario``, ready to fork variants
+    from; the interface of ``fpga_robotics.loop.fork.ReferenceRun``.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        In real-clock timing.
+    design : PinBackend
+        The reference design, for ``scenario``; reset here, not closed.
+    seed : int, optional
+    checkpoint_every : int
+        Frames between world checkpoints.
+    progress, **loop_args
+        As ``ReferenceRun``'s (a ``shadow`` is a pin design, given the primary's inputs).
+    """
+
+    def __init__(
+        self, scenario, *, design, seed=None, checkpoint_every=30, progress=None, **loop_args
+    ):
+        if scenario.sim.timing != "real_clock":
+            raise ValueError('PinReferenceRun needs sim.timing = "real_clock"')
+        if checkpoint_every < 1:
+            raise ValueError(f"checkpoint_every must be at least 1, got {checkpoint_every}")
+        self.scenario = scenario
+        design.reset()
+        if loop_args.get("shadow") is not None:
+            loop_args["shadow"].reset()
+        self.journal = JournalPins(design)
+        self._loop = _RecordingPinLoop(
+            scenario,
+            seed=seed,
+            design=self.journal,
+            checkpoint_every=checkpoint_every,
+            **loop_args,
+        )
+        self.seed = self._loop.seed
+        self.result = self._loop.run(progress=progress)
+        self.last_divergence = None
+
+    @property
+    def frames(self):
+        return self._loop.frames_done
+
+    def run_variant(self, design, scenario=None, *, progress=None):
+        """The run of ``design`` (a ``PinBackend`` for ``scenario``; reset here, not closed)
+        in the reference's world. ``scenario`` as in ``ReferenceRun.run_variant``;
+        ``progress(done, total)`` after every frame replayed or run."""
+        scenario = self.scenario if scenario is None else scenario
+        check_same_world(self.scenario, scenario)
+        wall_start, cpu_start = time.perf_counter(), time.process_time()
+        ref, calls = self._loop, self.journal.calls
+        loop = RealClockLoop(scenario, seed=self.seed, design=design)
+        if _interface(loop) != _interface(ref):
+            self.last_divergence = 0
+            return run_scenario(scenario, seed=self.seed, backend=design, progress=progress)
+        starts = ref.frame_calls
+
+        def replayed(i):
+            if progress is not None and i + 1 in starts[1:]:
+                progress(bisect.bisect_right(starts, i), ref.n_frames)
+
+        i, answer = first_difference(design, calls, replayed)
+        if i is None:
+            self.last_divergence = None
+            rest = calls[ref.final.design_calls :]
+            loop.use_design(PlayBack(design, rest, rest[0].cycle if rest else design.cycle))
+            _restore(loop, ref.final)
+            return loop.finish_run(wall_start, cpu_start)
+        self.last_divergence = bisect.bisect_right(starts, i) - 1
+        start = [c for c in ref.checkpoints if c.design_calls <= i][-1]
+        first = start.design_calls
+        loop.use_design(PlayBack(design, calls[first : i + 1], calls[first].cycle, last=answer))
+        _restore(loop, start)
+        return loop.run(start=start.frame, progress=progress)
+
+
+def _restore(loop, saved):
+    """The reference's state into the variant's loop, without the reference's shadow's
+    events (a variant runs without one)."""
+    checkpoint.restore(loop, saved)
+    loop.events = [e for e in loop.events if not is_shadow_event(e[2])]

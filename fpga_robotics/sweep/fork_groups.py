@@ -1,0 +1,95 @@
+"""Campaign runs that share a world, run as one reference run and forked variants.
+
+Runs of one scenario and seed whose scenarios differ only in their design or checks (a
+parameter sweep, design references) see the same world until their designs drive
+differently: such a group is one Dask task that runs its first member in full as a fork
+reference (fpga_robotics.loop.fork, pin_fork) and every other as a variant of it, each
+re-simulated in the world only from where it parts. Every member's row is the row its own
+full run gives (the times excepted). Runs with a shadow design or ``[runtime]`` values, and
+campaigns that record every run, are run one by one as before; so is everything with
+``sweep --no-fork``.
+"""
+
+import json
+import time
+
+from fpga_robotics.loop.fork import VARIANT_SECTIONS
+
+from . import runner
+
+__all__ = ["execute_group", "fork_groups", "world_key"]
+
+
+def world_key(args, scenario, shadow_params):
+    """What runs of one shape must share to be forked from one another (with the seed), or
+    None for a run that is run on its own."""
+    if shadow_params is not None or args.shadow is not None or getattr(args, "runtime", None):
+        return None
+    if scenario.sim.timing not in ("compressed", "real_clock"):
+        return None
+    world = {k: v for k, v in scenario.data.items() if k not in VARIANT_SECTIONS}
+    return json.dumps(world, sort_keys=True, default=repr)
+
+
+def fork_groups(specs, worlds):
+    """``specs`` as groups to run: runs of one world (``worlds[spec]``, None alone) and seed
+    together, in the order their first member comes."""
+    groups, index = [], {}
+    for spec in specs:
+        world = worlds.get(spec)
+        if world is None:
+            groups.append([spec])
+            continue
+        key = (world, spec.seed)
+        if key not in index:
+            index[key] = len(groups)
+            groups.append([])
+        groups[index[key]].append(spec)
+    return groups
+
+
+def execute_group(argvs, timeouts, tags):
+    """Run a group's runs (``run`` argument lists of one world), the first that completes
+    as the reference, the others forked from it; returns one outcome per run as
+    ``runner.execute`` does."""
+    from fpga_robotics.loop.compressed import run_scenario
+    from fpga_robotics.loop.pin_fork import reference_run
+
+    outcomes, reference = [], None
+    for argv, timeout, tag in zip(argvs, timeouts, tags, strict=True):
+        wall0, cpu0 = time.perf_counter(), time.process_time()
+        out = {"status": "error", "message": "", "summary": None, "recording": None, "run_s": 0.0}
+        deadline = None
+        try:
+            args, scenario, _shadow = runner._loaded(argv)
+            design, _ = runner._designs_for(args, scenario, None)
+            deadline = runner._Deadline(timeout, runner._fault(args.seed), tag)
+            t_run = time.perf_counter()
+            try:
+                if reference is None:
+                    reference = reference_run(
+                        scenario, design=design, seed=args.seed, progress=deadline
+                    )
+                    result = reference.result
+                else:
+                    try:
+                        result = reference.run_variant(design, scenario, progress=deadline)
+                    except ValueError:  # not a variant of it after all: a run of its own
+                        result = run_scenario(
+                            scenario, seed=args.seed, backend=design, progress=deadline
+                        )
+            finally:
+                out["run_s"] = time.perf_counter() - t_run
+            summary = dict(result.summary)
+            out.update(status=summary["verdict"], summary=summary)
+        except runner.RunTimeout as exc:
+            out.update(status="timeout", message=str(exc))
+        except Exception as exc:  # noqa: BLE001 (the campaign records it and goes on)
+            out.update(status="error", message=f"{type(exc).__name__}: {exc}".splitlines()[0])
+        finally:
+            if deadline is not None:
+                deadline.cancel()
+        out["wall_s"] = time.perf_counter() - wall0
+        out["cpu_s"] = time.process_time() - cpu0
+        outcomes.append(out)
+    return outcomes

@@ -1,0 +1,123 @@
+"""Fork at divergence in real-clock timing: a pin design variant judged against a reference
+run gives the same result as its own full run, whether it never parts from the reference,
+parts at frame 0, only in the last frame, or in between (restored from a checkpoint)."""
+
+import numpy as np
+import pytest
+from run_equality import assert_same_run
+
+from fpga_robotics.loop.compressed import run_scenario
+from fpga_robotics.loop.pin_fork import PinReferenceRun, reference_run
+from fpga_robotics.loop.real_clock import make_pin_backend
+from fpga_robotics.scenario.load import load_scenario
+
+
+class FasterLeftWheel:
+    """A pin design whose left wheel pin reads ``extra`` higher from edge ``edge`` on (a
+    design that parts from its original there); every other call passes through."""
+
+    def __init__(self, design, edge, extra=120):
+        self.inner, self.edge, self.extra = design, edge, extra
+        self.name = "faster_left"
+
+    def __getattr__(self, name):
+        return getattr(self.inner, name)
+
+    @property
+    def cycle(self):
+        return self.inner.cycle
+
+    @property
+    def frame_pending(self):
+        return self.inner.frame_pending
+
+    def peek(self, name):
+        value = self.inner.peek(name)
+        if name == "motor_left" and self.inner.cycle >= self.edge:
+            value += self.extra
+        return value
+
+
+@pytest.fixture(scope="module")
+def scenario():
+    return load_scenario("line_track", ["sim.duration=1.5"])
+
+
+@pytest.fixture(scope="module")
+def reference(scenario):
+    with make_pin_backend("cxxrtl", scenario) as design:
+        yield reference_run(scenario, design=design, checkpoint_every=7)
+
+
+def fork_and_full(reference, scenario, variant):
+    forked = reference.run_variant(variant, scenario)
+    diverged = reference.last_divergence
+    assert_same_run(forked, run_scenario(scenario, backend=variant))
+    return forked, diverged
+
+
+def test_the_reference_is_the_plain_run(scenario, reference):
+    assert isinstance(reference, PinReferenceRun)
+    with make_pin_backend("cxxrtl", scenario) as design:
+        assert_same_run(reference.result, run_scenario(scenario, backend=design))
+
+
+def test_the_same_design_never_parts(scenario, reference):
+    with make_pin_backend("cxxrtl", scenario) as variant:
+        forked, diverged = fork_and_full(reference, scenario, variant)
+    assert diverged is None
+    assert_same_run(forked, reference.result)
+
+
+def test_a_variant_that_parts_at_frame_0(scenario, reference):
+    # Its wheel pins out of reset are another command already.
+    with make_pin_backend("cxxrtl", scenario) as design:
+        forked, diverged = fork_and_full(reference, scenario, FasterLeftWheel(design, 0))
+    assert diverged == 0
+    assert not np.array_equal(forked.trajectory["heading"], reference.result.trajectory["heading"])
+
+
+def test_a_parameter_variant_is_its_own_full_run(scenario, reference):
+    # The wheels turn only once the design's first command is out: frame 1.
+    slower = scenario.with_overrides(["design.line.base_dps=300"])
+    with make_pin_backend("cxxrtl", slower) as variant:
+        forked = reference.run_variant(variant, slower)
+        assert reference.last_divergence == 1
+        assert_same_run(forked, run_scenario(slower, backend=variant))
+    assert forked.summary["overrides"][-1] == "design.line.base_dps=300"
+    assert not np.array_equal(forked.trajectory["x"], reference.result.trajectory["x"])
+
+
+def _edge_of_frame(reference, scenario, k):
+    loop = reference._loop
+    return loop.edge_of_step(round(k * loop.period / loop.dt))
+
+
+def test_a_variant_that_parts_in_the_last_frame(scenario, reference):
+    last = reference.frames - 1
+    with make_pin_backend("cxxrtl", scenario) as design:
+        variant = FasterLeftWheel(design, _edge_of_frame(reference, scenario, last))
+        forked, diverged = fork_and_full(reference, scenario, variant)
+    assert diverged == last
+    ref = reference.result.trajectory
+    assert np.array_equal(forked.trajectory["x"], ref["x"])
+    assert forked.trajectory["motor_left"][last - 1] == ref["motor_left"][last - 1] + 120
+
+
+def test_a_variant_that_parts_between_checkpoints(scenario, reference):
+    k = 17  # between the checkpoints at frames 14 and 21
+    with make_pin_backend("cxxrtl", scenario) as design:
+        variant = FasterLeftWheel(design, _edge_of_frame(reference, scenario, k))
+        forked, diverged = fork_and_full(reference, scenario, variant)
+    assert diverged == k
+    ref = reference.result.trajectory
+    # Row k - 1's wheels are read at frame k's capture: from there on the left one is faster.
+    left = forked.trajectory["motor_left"]
+    assert np.array_equal(left[: k - 1], ref["motor_left"][: k - 1])
+    assert np.array_equal(left[k - 1 :], ref["motor_left"][k - 1 :] + 120)
+
+
+def test_a_variant_world_must_be_the_reference_world(scenario, reference):
+    other = scenario.with_overrides(["seed=99"])
+    with make_pin_backend("cxxrtl", other) as variant, pytest.raises(ValueError, match="differ"):
+        reference.run_variant(variant, other)

@@ -1,0 +1,51 @@
+"""Campaign runs that differ only in their design are grouped by world and run as one
+reference run and forked variants: the rows are those of the runs made in full."""
+
+from fpga_robotics.checks.summary import TIMING_FIELDS
+from fpga_robotics.sweep import load_campaign, run_campaign
+from fpga_robotics.sweep.fork_groups import fork_groups
+from fpga_robotics.sweep.plan import make_plan
+
+#: Two seeds, four designs each (when to search and which way), and a heavier robot (another
+#: world) for one of them.
+CAMPAIGN = {
+    "name": "forked",
+    "scenarios": ["lost_target"],
+    "seeds": "0-1",
+    "backend": "model",
+    "resolution": "80x60",
+    "duration": 6.0,
+    "grid": {"design.lost_frames": [5, 15], "design.search_dps": [-300, 250]},
+    "sets": [{"robot.mass": 8.0, "design.lost_frames": 5}],
+}
+
+#: Row fields that measure the machine, not the run.
+TIMES = {"wall_s", "cpu_s", "run_s", *TIMING_FIELDS}
+
+
+def test_runs_are_grouped_by_world_and_seed():
+    plan = make_plan(load_campaign(dict(CAMPAIGN)))
+    groups = fork_groups(plan.runs, plan.worlds)
+    sizes = sorted(len(g) for g in groups)
+    # Per seed: the four grid designs in one world; the heavier robot's world alone.
+    assert sizes == [1, 1, 4, 4]
+    for group in groups:
+        assert len({s.seed for s in group}) == 1
+        assert len({dict(s.overrides).get("robot.mass") for s in group}) == 1
+
+
+def test_forked_rows_are_the_full_runs_rows(tmp_path):
+    campaign = load_campaign(dict(CAMPAIGN))
+    forked = run_campaign(campaign, tmp_path / "forked", workers=1, record="none")
+    full = run_campaign(campaign, tmp_path / "full", workers=1, record="none", fork=False)
+
+    def by_id(rows):
+        return {r["run_id"]: {k: v for k, v in r.items() if k not in TIMES} for r in rows}
+
+    a, b = by_id(forked), by_id(full)
+    assert len(a) == 10 and a.keys() == b.keys()
+    for run_id, row in a.items():
+        assert row == b[run_id], row["replay"]
+    # The designs did part: not every run of a seed drove the same path.
+    paths = {(r["seed"], r["path_length_m"]) for r in a.values()}
+    assert len(paths) > 2
