@@ -13,7 +13,13 @@ import statistics
 import time
 
 from fpga_robotics.bench import scaffold
+from fpga_robotics.checks import envelopes
 from fpga_robotics.cli.errors import UsageError
+from fpga_robotics.loop.compressed import make_backend, run_scenario
+from fpga_robotics.loop.pin_fork import reference_run
+from fpga_robotics.loop.real_clock import make_pin_backend
+from fpga_robotics.scenario.load import load_scenario
+from fpga_robotics.sim.backends import BACKEND_NAMES
 
 __all__ = ["main", "measure"]
 
@@ -31,16 +37,11 @@ def measure(scenario, variants, backend, checkpoint_every=30):
     """``(full_cpu_s, forked_cpu_s, parted)``: CPU seconds of the variants' full runs and of
     the reference plus the forked runs, and each variant's first differing frame (None: never
     differed). Raises ``AssertionError`` if a forked result is not its full run."""
-    from fpga_robotics.loop.compressed import make_backend, run_scenario
-    from fpga_robotics.loop.pin_fork import reference_run
-    from fpga_robotics.loop.real_clock import make_pin_backend
 
     def open_design(s):
         if s.sim.timing == "real_clock":
             return make_pin_backend(backend, s)
         return make_backend(backend, s.params)
-
-    from fpga_robotics.checks import envelopes
 
     designs = [open_design(s) for s in variants]
     base = open_design(scenario)
@@ -67,7 +68,6 @@ def measure(scenario, variants, backend, checkpoint_every=30):
 
 
 def _options(p):
-    from fpga_robotics.sim.backends import BACKEND_NAMES
 
     p.add_argument("--scenario", default="lost_target")
     p.add_argument("--key", default="design.lost_frames", help="the design key the variants set")
@@ -93,7 +93,6 @@ def _check(args):
 
 
 def run(args):
-    from fpga_robotics.scenario.load import load_scenario
 
     scenario = load_scenario(args.scenario, [f"sim.duration={args.duration!r}"])
     values = [v.strip() for v in args.values.split(",") if v.strip()]

@@ -22,6 +22,7 @@ from fpga_robotics.cli.errors import UsageError
 from fpga_robotics.cli.parser import CommandParser
 from fpga_robotics.hw.pixel import COLOR_SELECT
 from fpga_robotics.loop.compressed import make_backend, run_scenario
+from fpga_robotics.loop.continuation import continuation_summary, run_continued
 from fpga_robotics.loop.pin_shadow import is_design_reference
 from fpga_robotics.loop.real_clock import format_extra_outputs, make_pin_backend
 from fpga_robotics.loop.shadow import format_shadow, shadow_overrides
@@ -355,7 +356,6 @@ def _check_continue(args, ros):
 def _run_continued(args, scenario, design, shadow, shadow_scenario, **run_args):
     """The run with its shadow, then the shadow's own run from where it parts
     (fpga_robotics.loop.continuation); the shadow's path drawn on the viewer's map."""
-    from fpga_robotics.loop.continuation import run_continued
 
     continued = run_continued(
         scenario,
@@ -375,7 +375,6 @@ def _run_continued(args, scenario, design, shadow, shadow_scenario, **run_args):
 
 def _format_continued(s, label):
     """Lines for the human summary: the shadow design's own run."""
-    from fpga_robotics.checks.summary import format_summary
 
     parted = s["parted_at_frame"]
     where = "never drove differently" if parted is None else f"drives from frame {parted}"
@@ -812,8 +811,6 @@ def main(argv=None, prog="fpga-robotics run"):
     summary = dict(result.summary)
     summary["backend_setup_s"] = round(setup, 3)
     if args.shadow_continue:
-        from fpga_robotics.loop.continuation import continuation_summary
-
         summary["shadow_continued"] = continuation_summary(continued)
     summary.update(ros.summary_items())  # the live inputs, for --replay-inputs
     print(format_summary(summary))
