@@ -37,6 +37,16 @@ __all__ = ["ReferenceRun"]
 VARIANT_SECTIONS = ("name", "description", "design", "checks")
 
 
+def forkable(scenario):
+    """Whether a variant's run of ``scenario`` can be forked from a reference run: the fork
+    finds where a variant parts from the world by its wheel commands, so a robot whose design
+    also moves a servo, or sees through further cameras, runs in full."""
+    return not any(
+        spec.role == "actuator" or spec.kind == "camera"
+        for spec in getattr(scenario, "connectors", ())
+    )
+
+
 class _RecordingLoop(ClosedLoop):
     """A closed loop that records what variants of its design need (see ``ReferenceRun``)."""
 
@@ -118,6 +128,8 @@ class ReferenceRun:
     ):
         if scenario.sim.timing != "compressed":
             raise ValueError('forked runs need sim.timing = "compressed"')
+        if not forkable(scenario):
+            raise ValueError("forked runs need a robot whose only actuators are its wheels")
         if checkpoint_every < 1:
             raise ValueError(f"checkpoint_every must be at least 1, got {checkpoint_every}")
         if design.params != scenario.params:

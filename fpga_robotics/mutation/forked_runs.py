@@ -10,7 +10,7 @@ design are run in full (``runner.execute``).
 import time
 
 from fpga_robotics.cli import run
-from fpga_robotics.loop.fork import ReferenceRun
+from fpga_robotics.loop.fork import ReferenceRun, forkable
 
 from ..sweep import runner
 
@@ -36,7 +36,7 @@ def _reference(ref_argv):
 
 def _forkable(argv):
     _, scenario, shadow_params = runner.load_run(list(argv))
-    return scenario.sim.timing == "compressed" and shadow_params is None
+    return scenario.sim.timing == "compressed" and shadow_params is None and forkable(scenario)
 
 
 def reference_outcome(ref_argv):
