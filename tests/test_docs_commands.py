@@ -803,7 +803,7 @@ PLANS = {
             ("--workers", "1"),
             ("--recordings", "1"),
         ),
-        out=(r"robot judge \(campaign mutation: \d+ of 9 runs pass unmutated\)",),
+        out=(r"robot judge \(campaign mutation: \d+ of 10 runs pass unmutated\)",),
         files=(
             "runs/mutation/n4-s1/report.html",
             "runs/mutation/n4-s1/robot.jsonl",
@@ -819,7 +819,7 @@ PLANS = {
         shorter=(("--mutants", "4"), ("--width", "80"), ("--height", "60")),
         out=(
             (
-                r"robot judge \(campaign mutation: \d+ of 9 runs pass unmutated\).*"
+                r"robot judge \(campaign mutation: \d+ of 10 runs pass unmutated\).*"
                 r"mutants/min"
             ),
         ),
@@ -833,7 +833,7 @@ PLANS = {
         shorter=(("--mutants", "4"), ("--width", "80"), ("--height", "60")),
         out=(
             (
-                r"robot judge \(campaign mutation: \d+ of 9 runs pass unmutated\).*"
+                r"robot judge \(campaign mutation: \d+ of 10 runs pass unmutated\).*"
                 r"mutants/min"
             ),
         ),
@@ -848,7 +848,7 @@ PLANS = {
         shorter=(("--mutants", "4"), ("--width", "80"), ("--height", "60")),
         out=(
             (
-                r"robot judge \(campaign mutation: \d+ of 9 runs pass unmutated\).*"
+                r"robot judge \(campaign mutation: \d+ of 10 runs pass unmutated\).*"
                 r"mutants/min"
             ),
         ),
@@ -862,7 +862,7 @@ PLANS = {
         shorter=(("--mutants", "4"), ("--width", "80"), ("--height", "60")),
         out=(
             (
-                r"robot judge \(campaign mutation: \d+ of 9 runs pass unmutated\).*"
+                r"robot judge \(campaign mutation: \d+ of 10 runs pass unmutated\).*"
                 r"mutants/min"
             ),
         ),
@@ -882,10 +882,10 @@ PLANS = {
             ),
             out=(
                 rf"4 mutants of follow_target 80x60 \(seed {seed}\)",
-                r"robot judge \(campaign mutation: \d+ of 9 runs pass unmutated\)",
+                r"robot judge \(campaign mutation: \d+ of 10 runs pass unmutated\)",
             ),
         )
-        for n, seed in ((60, 1), (20, 2), (20, 3))
+        for n, seed in ((60, 1), (60, 2), (60, 3))
     },
     # The mutation campaign with the unmutated design: two short runs on the model backend
     # (the page gives the whole campaign's results).

@@ -236,3 +236,19 @@ def test_search_side_unsure_when_the_visible_part_spans_the_centre():
     for search in ((250, -250), (-250, 250)):
         m = envelope_metrics(_leaving(0.5, -0.3, search), DEFAULT, GEOM)
         assert m["search_law_violation_fraction"] == 0
+
+
+def test_search_side_tolerates_the_smear_of_a_turn():
+    # 4 m ahead, 5 px right of the centre (y = -4 * 5 / 160 = -0.125 m): the side is sure with
+    # E_TOLERANCE_PX (2 px). With the sensor model's exposure (1/30 s) and the robot turning at
+    # 2 rad/s, half the smear is 2 * (1/30) * 160 / 2 = 5.33 px: 7.33 px in all, no sure side.
+    import dataclasses
+
+    sensor = dataclasses.replace(GEOM, exposure_s=1 / 30)
+    wrong = [(True, -0.125, 248, 152)] + [(False, -0.125, 248, 152)] * 14
+    wrong += [(False, -0.125, -250, 250)] * 5
+    for w, judged_wrong in ((0.0, 5), (1.0, 5), (2.0, 0)):
+        traj = _traj(wrong)
+        traj["w"] = np.full(len(wrong), w)
+        m = envelope_metrics(traj, DEFAULT, sensor)
+        assert m["search_law_violation_fraction"] == round(judged_wrong / (14 + judged_wrong), 4)

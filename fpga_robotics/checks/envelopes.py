@@ -316,8 +316,13 @@ def envelope_metrics(traj, params, geom):
     out["approach_speed_violation_fraction"] = _fraction(speed)
     out["reverse_when_far_fraction"] = _fraction(reverse)
     out["turn_law_violation_fraction"] = _fraction(steer)
+    # A sighting's side, like the centroid error, gets half the smear of a turn during the
+    # exposure on top of E_TOLERANCE_PX.
+    side_tol = np.full(len(found), E_TOLERANCE_PX)
+    if geom.exposure_s and "w" in traj:
+        side_tol += np.abs(np.asarray(traj["w"], float)) * geom.exposure_s * geom.focal / 2
     out["search_law_violation_fraction"] = _fraction(
-        _search_judged(found, ml, mr, dist, bearing, geom, params)
+        _search_judged(found, ml, mr, dist, bearing, geom, params, side_tol)
     )
     stop = stop_distance_m(geom, params, int(codes[0])) if len(codes) else None
     if stop is not None and closest is not None and closest <= stop[1]:
@@ -325,7 +330,7 @@ def envelope_metrics(traj, params, geom):
     return out
 
 
-def _search_judged(found, ml, mr, dist, bearing, geom, params):
+def _search_judged(found, ml, mr, dist, bearing, geom, params, side_tol):
     """Per judged lost frame, whether the design broke the lost law: hold the last command
     for lost frames 1..lost_frames-1, then turn in place at ``search_dps`` towards the side the
     target was last seen on (left after reset). A sighting within ``E_TOLERANCE_PX`` of the
@@ -335,7 +340,7 @@ def _search_judged(found, ml, mr, dist, bearing, geom, params):
     for k in range(len(found)):
         if found[k]:
             lost = 0
-            side = sure_side(float(dist[k]), float(bearing[k]), geom, params)
+            side = sure_side(float(dist[k]), float(bearing[k]), geom, params, side_tol[k])
             continue
         if lost == 0:  # the command shown when the loss began is the one to hold
             held = (ml[k - 1], mr[k - 1]) if k else (0.0, 0.0)
@@ -348,12 +353,12 @@ def _search_judged(found, ml, mr, dist, bearing, geom, params):
     return out
 
 
-def sure_side(distance, bearing, geom, params):
+def sure_side(distance, bearing, geom, params, tol=E_TOLERANCE_PX):
     """The side of the image centre the design's centroid surely falls on with the target
     at ``distance`` (m) and ``bearing`` (rad, left positive): +1 right, -1 left, 0 not sure.
 
     The centroid is the mean column of the target's pixels inside the window's columns. With
-    the whole silhouette there it lies within ``E_TOLERANCE_PX`` of the silhouette's middle;
+    the whole silhouette there it lies within ``tol`` pixels of the silhouette's middle;
     with part of the silhouette beyond the window's edge (a target leaving the view, the
     usual last sighting before a loss) it lies somewhere in the part inside, so the side is
     sure only when all of that part is on one side."""
@@ -366,15 +371,15 @@ def sure_side(distance, bearing, geom, params):
     centre = geom.width / 2
     if edge_lo <= left and right <= edge_hi:
         offset = (left + right) / 2 - centre
-        if abs(offset) <= E_TOLERANCE_PX:
+        if abs(offset) <= tol:
             return 0
         return 1 if offset > 0 else -1
     lo, hi = max(left, edge_lo), min(right, edge_hi)
     if hi <= lo:
         return 0
-    if lo > centre + E_TOLERANCE_PX:
+    if lo > centre + tol:
         return 1
-    if hi < centre - E_TOLERANCE_PX:
+    if hi < centre - tol:
         return -1
     return 0
 
