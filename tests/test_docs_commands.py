@@ -893,12 +893,7 @@ PLANS = {
         shorter=(("--max-runs", "2"), ("--backend", "model"), ("--duration", "2")),
         out=(r"2 runs: 2 pass",),
     ),
-    "python -m fpga_robotics.sweep mutation --seeds 0-19 --out runs/sweeps/mutation-20": Plan(
-        shorter=(("--max-runs", "2"), ("--backend", "model"), ("--duration", "2")),
-        files=("runs/sweeps/mutation-20/report.html",),
-        out=(r"2 runs: 2 pass",),
-    ),
-    "python -m fpga_robotics.sweep mutation --seeds 0-4 --out runs/sweeps/mutation-5": Plan(
+    "python -m fpga_robotics.sweep mutation --seeds 0-4 --workers 1 --out runs/sweeps/mutation-5": Plan(
         shorter=(("--max-runs", "2"), ("--backend", "model"), ("--duration", "2")),
         files=("runs/sweeps/mutation-5/report.html",),
         out=(r"2 runs: 2 pass",),
