@@ -187,3 +187,68 @@ def test_no_geometry_leaves_the_envelopes_na_with_its_reason():
     assert m["approach_speed_violation_fraction"] is None
     (c,) = evaluate_checks({"max_turn_law_violation_fraction": 0.0}, m)
     assert c["status"] == "n/a" and c["reason"] == "no envelope: no target person"
+
+
+def _leaving(distance, bearing, search):
+    """Seen once at ``distance`` (m) and ``bearing`` (rad, left positive), then lost: 14 held
+    frames and 5 of ``search`` (motor_left, motor_right)."""
+    traj = _traj(
+        [(True, 0.0, 248, 152)] + [(False, 0.0, 248, 152)] * 14 + [(False, 0.0, *search)] * 5
+    )
+    traj["target_x"][:] = distance * math.cos(bearing)
+    traj["target_y"][:] = distance * math.sin(bearing)
+    return traj
+
+
+def test_search_side_of_a_target_leaving_the_view():
+    # 1 m away at a bearing of -0.55 rad, its centre beyond the half field of view (0.4636 rad):
+    # the silhouette's half-angle asin(0.2) = 0.2014 rad puts its columns at
+    # 80 + 160 tan(0.3486) = 138.2 to 80 + 160 tan(0.7514) = 229.9. The part inside the window
+    # (columns 16..144) is 138.2..144, all right of the centre (80): the search turns right.
+    right, left = (250, -250), (-250, 250)
+    m = envelope_metrics(_leaving(1.0, -0.55, right), DEFAULT, GEOM)
+    assert m["search_law_violation_fraction"] == 0
+    m = envelope_metrics(_leaving(1.0, -0.55, left), DEFAULT, GEOM)
+    assert m["search_law_violation_fraction"] == round(5 / 19, 4)
+    # A search 2 DPS off search_dps is off the law as well.
+    m = envelope_metrics(_leaving(1.0, -0.55, (248, -250)), DEFAULT, GEOM)
+    assert m["search_law_violation_fraction"] == round(5 / 19, 4)
+    # The mirror image: leaving on the left, the search turns left.
+    assert (
+        envelope_metrics(_leaving(1.0, 0.55, left), DEFAULT, GEOM)["search_law_violation_fraction"]
+        == 0
+    )
+    assert envelope_metrics(_leaving(1.0, 0.55, right), DEFAULT, GEOM)[
+        "search_law_violation_fraction"
+    ] == round(5 / 19, 4)
+    # margin_x = 64: the window is columns 64..96 and the silhouette (138.2..229.9) lies
+    # wholly outside it; the last sighting has no sure side, only the 14 held frames count.
+    narrow = DEFAULT.replace(margin_x=64)
+    for search in (right, left):
+        m = envelope_metrics(_leaving(1.0, -0.55, search), narrow, GEOM)
+        assert m["search_law_violation_fraction"] == 0
+
+
+def test_search_side_unsure_when_the_visible_part_spans_the_centre():
+    # 0.5 m away at -0.3 rad: half-angle asin(0.4) = 0.4115 rad, columns
+    # 80 - 160 tan(0.1115) = 62.1 to 80 + 160 tan(0.7115) = 217.9; inside the window 62.1..144
+    # spans the centre, so the centroid's side is not sure: either search passes.
+    for search in ((250, -250), (-250, 250)):
+        m = envelope_metrics(_leaving(0.5, -0.3, search), DEFAULT, GEOM)
+        assert m["search_law_violation_fraction"] == 0
+
+
+def test_search_side_tolerates_the_smear_of_a_turn():
+    # 4 m ahead, 5 px right of the centre (y = -4 * 5 / 160 = -0.125 m): the side is sure with
+    # E_TOLERANCE_PX (2 px). With the sensor model's exposure (1/30 s) and the robot turning at
+    # 2 rad/s, half the smear is 2 * (1/30) * 160 / 2 = 5.33 px: 7.33 px in all, no sure side.
+    import dataclasses
+
+    sensor = dataclasses.replace(GEOM, exposure_s=1 / 30)
+    wrong = [(True, -0.125, 248, 152)] + [(False, -0.125, 248, 152)] * 14
+    wrong += [(False, -0.125, -250, 250)] * 5
+    for w, judged_wrong in ((0.0, 5), (1.0, 5), (2.0, 0)):
+        traj = _traj(wrong)
+        traj["w"] = np.full(len(wrong), w)
+        m = envelope_metrics(traj, DEFAULT, sensor)
+        assert m["search_law_violation_fraction"] == round(judged_wrong / (14 + judged_wrong), 4)

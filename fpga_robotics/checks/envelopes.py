@@ -44,6 +44,7 @@ __all__ = [
     "envelope_metrics",
     "law_band",
     "stop_distance_m",
+    "sure_side",
 ]
 
 #: Tolerance of the centroid error against the target's image column, pixels.
@@ -329,8 +330,13 @@ def envelope_metrics(traj, params, geom):
     out["approach_speed_violation_fraction"] = _fraction(speed)
     out["reverse_when_far_fraction"] = _fraction(reverse)
     out["turn_law_violation_fraction"] = _fraction(steer)
+    # A sighting's side, like the centroid error, gets half the smear of a turn during the
+    # exposure on top of E_TOLERANCE_PX.
+    side_tol = np.full(len(found), E_TOLERANCE_PX)
+    if geom.exposure_s and "w" in traj:
+        side_tol += np.abs(np.asarray(traj["w"], float)) * geom.exposure_s * geom.focal / 2
     out["search_law_violation_fraction"] = _fraction(
-        _search_judged(found, ml, mr, dist, bearing, geom, params)
+        _search_judged(found, ml, mr, dist, bearing, geom, params, side_tol)
     )
     stop = stop_distance_m(geom, params, int(codes[0])) if len(codes) else None
     if stop is not None and closest is not None and closest <= stop[1]:
@@ -338,22 +344,17 @@ def envelope_metrics(traj, params, geom):
     return out
 
 
-def _search_judged(found, ml, mr, dist, bearing, geom, params):
+def _search_judged(found, ml, mr, dist, bearing, geom, params, side_tol):
     """Per judged lost frame, whether the design broke the lost law: hold the last command
     for lost frames 1..lost_frames-1, then turn in place at ``search_dps`` towards the side the
     target was last seen on (left after reset). A sighting within ``E_TOLERANCE_PX`` of the
-    image centre has no sure side: its search frames are not judged."""
+    image centre has no sure side (``sure_side``): its search frames are not judged."""
     out = []
     lost, side, held = 0, -1, (0.0, 0.0)  # side: -1 left, +1 right, 0 unknown
     for k in range(len(found)):
         if found[k]:
             lost = 0
-            side = 0
-            if math.isfinite(dist[k]) and abs(bearing[k]) < geom.hfov / 2:
-                left, right = silhouette(float(dist[k]), float(bearing[k]), geom)
-                offset = (left + right) / 2 - geom.width / 2
-                if abs(offset) > E_TOLERANCE_PX:
-                    side = 1 if offset > 0 else -1
+            side = sure_side(float(dist[k]), float(bearing[k]), geom, params, side_tol[k])
             continue
         if lost == 0:  # the command shown when the loss began is the one to hold
             held = (ml[k - 1], mr[k - 1]) if k else (0.0, 0.0)
@@ -364,6 +365,37 @@ def _search_judged(found, ml, mr, dist, bearing, geom, params):
             s = params.search_dps * side
             out.append((ml[k], mr[k]) != (s, -s))
     return out
+
+
+def sure_side(distance, bearing, geom, params, tol=E_TOLERANCE_PX):
+    """The side of the image centre the design's centroid surely falls on with the target
+    at ``distance`` (m) and ``bearing`` (rad, left positive): +1 right, -1 left, 0 not sure.
+
+    The centroid is the mean column of the target's pixels inside the window's columns. With
+    the whole silhouette there it lies within ``tol`` pixels of the silhouette's middle;
+    with part of the silhouette beyond the window's edge (a target leaving the view, the
+    usual last sighting before a loss) it lies somewhere in the part inside, so the side is
+    sure only when all of that part is on one side."""
+    if not math.isfinite(distance) or distance <= geom.radius:
+        return 0
+    if abs(bearing) + math.asin(geom.radius / distance) >= math.pi / 2 - 1e-6:
+        return 0  # an edge of the silhouette at or behind the camera's plane
+    left, right = silhouette(distance, bearing, geom)
+    edge_lo, edge_hi = params.margin_x, geom.width - params.margin_x
+    centre = geom.width / 2
+    if edge_lo <= left and right <= edge_hi:
+        offset = (left + right) / 2 - centre
+        if abs(offset) <= tol:
+            return 0
+        return 1 if offset > 0 else -1
+    lo, hi = max(left, edge_lo), min(right, edge_hi)
+    if hi <= lo:
+        return 0
+    if lo > centre + tol:
+        return 1
+    if hi < centre - tol:
+        return -1
+    return 0
 
 
 def _fraction(flags):
