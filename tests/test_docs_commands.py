@@ -966,7 +966,7 @@ PLANS = {
     # gives the measured scores; the whole commands take tens of minutes).
     **{
         f"python -m fpga_robotics.mutation --mutants {n} --campaign mutation --seed {seed} "
-        "--workers 1": Plan(
+        f"--workers {workers}": Plan(
             slow=True,
             shorter=(
                 ("--mutants", "4"),
@@ -979,7 +979,7 @@ PLANS = {
                 r"robot judge \(campaign mutation: \d+ of 10 runs pass unmutated\)",
             ),
         )
-        for n, seed in ((60, 2), (60, 3))
+        for n, seed, workers in ((60, 1, 2), (60, 2, 1), (60, 3, 1))
     },
     # The mutation campaign with the unmutated design: two short runs on the model backend
     # (the page gives the whole campaign's results).
