@@ -334,11 +334,14 @@ class GoPiGo3Motors(CheckedArguments, wiring.Component):
                     value.eq(next_left),
                     cur_right.eq(next_right),
                     right_next.eq(1),
-                    cur_servo.eq(next_servo),
-                    servo_next.eq(int(self.servo)),
-                    servo_msg.eq(0),
                     byte.eq(0),
                 ]
+                if self.servo:  # without a servo these stay 0: wheel messages only
+                    m.d.sync += [
+                        cur_servo.eq(next_servo),
+                        servo_next.eq(1),
+                        servo_msg.eq(0),
+                    ]
                 with m.If(self.update):  # a new update in this very cycle stays pending
                     m.d.sync += pending.eq(1)
                 m.next = "SEND"
@@ -356,13 +359,14 @@ class GoPiGo3Motors(CheckedArguments, wiring.Component):
                                 value.eq(cur_right),
                                 right_next.eq(0),
                             ]
-                        with m.Elif(~limits & servo_next):
-                            m.d.sync += [
-                                port.eq(SERVO_1),
-                                value.eq(cur_servo),
-                                servo_msg.eq(1),
-                                servo_next.eq(0),
-                            ]
+                        if self.servo:
+                            with m.Elif(~limits & servo_next):
+                                m.d.sync += [
+                                    port.eq(SERVO_1),
+                                    value.eq(cur_servo),
+                                    servo_msg.eq(1),
+                                    servo_next.eq(0),
+                                ]
                         with m.Else():
                             m.next = "IDLE"
         with m.If(pending):
