@@ -4,7 +4,7 @@ they must be the GoPiGo3 protocol's messages for the commanded speeds."""
 import pytest
 from amaranth.sim import Simulator
 
-from fpga_robotics.hw.board.gopigo3_spi import GoPiGo3Motors, dps_to_ticks
+from fpga_robotics.hw.board.gopigo3_spi import GoPiGo3Motors, dps_to_ticks, servo_pulse_us
 
 HALF = 3
 STARTUP = 20
@@ -21,7 +21,7 @@ def dps_message(port, dps):
 
 
 def run_spi(updates, *, max_cycles=20000, **kwargs):
-    """Drive ``updates`` [(cycle, left, right)], return the decoded messages and bus checks."""
+    """Drive ``updates`` [(cycle, left, right[, servo_angle])], return the decoded messages and bus checks."""
     dut = GoPiGo3Motors(half_period=HALF, startup_wait=STARTUP, **kwargs)
     sim = Simulator(dut)
     sim.add_clock(1e-6)
@@ -35,9 +35,11 @@ def run_spi(updates, *, max_cycles=20000, **kwargs):
         pending = list(updates)
         for cycle in range(max_cycles):  # watchdog
             if pending and pending[0][0] == cycle:
-                _, left, right = pending.pop(0)
+                _, left, right, *servo = pending.pop(0)
                 ctx.set(dut.left, left)
                 ctx.set(dut.right, right)
+                if servo:
+                    ctx.set(dut.servo_angle, servo[0])
                 ctx.set(dut.update, 1)
             else:
                 ctx.set(dut.update, 0)
@@ -112,12 +114,41 @@ def test_custom_limits():
     assert messages == [limits_message(1, 300, 50), limits_message(2, 300, 50)]
 
 
+def test_servo_message_after_the_wheels():
+    # SET_SERVO (type 9, set_servo(SERVO_1, us)): 1500 us + the command, clamped to +-500.
+    # By hand: 0 -> 1500 = 0x05DC; 250 -> 1750 = 0x06D6; -500 -> 1000 = 0x03E8;
+    # 511 (beyond the end stop) -> 2000 = 0x07D0; -512 -> 1000 = 0x03E8.
+    angles = [(0, 0x05, 0xDC), (250, 0x06, 0xD6), (-500, 0x03, 0xE8), (511, 0x07, 0xD0)]
+    angles.append((-512, 0x03, 0xE8))
+    updates = [(1500 + 1500 * k, 10 * k, -10 * k, a) for k, (a, _, _) in enumerate(angles)]
+    messages, _, _ = run_spi(updates, servo=True)
+    expected = [limits_message(0x01), limits_message(0x02)]
+    for (_, left, right, _), (_, hi, lo) in zip(updates, angles):
+        expected += [dps_message(0x01, left), dps_message(0x02, right), [8, 9, 1, hi, lo]]
+    assert messages == expected
+    assert [servo_pulse_us(a) for a, _, _ in angles] == [1500, 1750, 1000, 2000, 1000]
+
+
+def test_latest_servo_command_wins_while_busy():
+    updates = [(1500, 1, 2, 100), (1520, 3, 4, 200), (1540, 5, 6, -300)]
+    messages, _, _ = run_spi(updates, servo=True)
+    assert messages[2:] == [
+        dps_message(1, 1),
+        dps_message(2, 2),
+        [8, 9, 1, 1600 >> 8, 1600 & 0xFF],
+        dps_message(1, 5),
+        dps_message(2, 6),
+        [8, 9, 1, 1200 >> 8, 1200 & 0xFF],
+    ]
+
+
 @pytest.mark.parametrize(
     "kwargs,error",
     [
         ({"dps_limit": -1}, ValueError),
         ({"power_limit": 101}, ValueError),
         ({"startup_wait": 1.5}, TypeError),
+        ({"servo": 1}, TypeError),
     ],
 )
 def test_bad_arguments(kwargs, error):

@@ -67,6 +67,40 @@ def test_a_camera_design_gets_the_camera_and_the_switches(tmp_path, capsys):
     assert "switch_0__io" in lpf
 
 
+PAN_DESIGN = """
+from amaranth import Module, signed
+from amaranth.lib import wiring
+from amaranth.lib.wiring import Out
+
+
+class Pan(wiring.Component):
+    motor_left: Out(signed(16))
+    motor_right: Out(signed(16))
+    angle: Out(signed(WIDTH))
+
+    def elaborate(self, platform):
+        m = Module()
+        m.d.comb += self.angle.eq(-250)
+        return m
+"""
+
+
+def test_a_servo_angle_goes_to_the_gopigo3_with_the_wheels(tmp_path, capsys, monkeypatch):
+    # A port named after the servo connector's pin: its 10 bits go to the SPI sequencer
+    # (SET_SERVO, tested byte for byte in test_board_gopigo3_spi.py), not to a header pin.
+    (tmp_path / "pan.py").write_text(PAN_DESIGN.replace("WIDTH", "10"))
+    monkeypatch.chdir(tmp_path)
+    code, text, _ = _cli(["board", "--design", "pan.py:Pan", "-o", "b"], capsys)
+    assert code == 0 and "header" not in text
+    verilog = (tmp_path / "b" / "ulx3s_follow_target.v").read_text()
+    assert "fr_header" not in verilog
+    assert "assign servo_angle = 10'h306;" in verilog  # -250, the design's command
+    assert re.search(r"reg \[15:0\] cur_servo", verilog)  # the sequencer's servo message
+    # A design without a servo: the sequencer sends the wheels only.
+    code, _, _ = _cli(["board", "--design", WALL_STOP, "-o", "w"], capsys)
+    assert code == 0 and "cur_servo" not in (tmp_path / "w" / "ulx3s_follow_target.v").read_text()
+
+
 MODE_DESIGN = """
 from amaranth import Module, signed
 from amaranth.lib import wiring
@@ -96,11 +130,13 @@ class WithMode(wiring.Component):
             ),
         ),
         ("mode.py:WithMode", "design WithMode: input 'mode' is no pin of the board"),
+        ("pan12.py:Pan", "the board sends the servo's angle from an output of at most 10 bits"),
         ("verilog:x.v", "no file 'x.v'"),
     ],
 )
 def test_ports_the_board_cannot_serve_are_one_line(design, message, tmp_path, capsys, monkeypatch):
     (tmp_path / "mode.py").write_text(MODE_DESIGN)
+    (tmp_path / "pan12.py").write_text(PAN_DESIGN.replace("WIDTH", "12"))
     monkeypatch.chdir(tmp_path)
     code, out, err = _cli(["board", "--design", design, "-o", "b"], capsys)
     assert code == 2 and out == "" and err.count("\n") == 1

@@ -91,9 +91,10 @@ _CAMERA_INPUTS = ("pixels__valid", "pixels__payload", "color_sel")
 
 def board_ports(spec, board="ulx3s-85f"):
     """How a design of one's own (``spec``, a resolved Amaranth ``DesignSpec``) meets the
-    board: ``{"camera": bool, "header": [(port, "i"|"o")]}``. A port the board cannot serve
-    is a ``UserError`` naming it: the wheels must be ``motor_left``/``motor_right`` (signed,
-    at most 16 bits), ``color_sel`` 3 bits, ``centroid_leds`` at most 8 bits, every other
+    board: ``{"camera": bool, "servo": port or None, "header": [(port, "i"|"o")]}``. A port
+    the board cannot serve is a ``UserError`` naming it: the wheels must be
+    ``motor_left``/``motor_right`` (signed, at most 16 bits), a servo's angle an output of at
+    most 10 bits (sent with the wheels over SPI, one servo), ``color_sel`` 3 bits, ``centroid_leds`` at most 8 bits, every other
     input a 1-bit pin of a connector (it goes to a header pin), and there are
     ``len(HEADER_SITES)`` header pins."""
 
@@ -131,15 +132,21 @@ def board_ports(spec, board="ulx3s-85f"):
         )
     if ports.get("centroid_leds", ("out", 0))[1] > 8:
         raise UserError(f"design {name}: port 'centroid_leds' is wider than the 8 user LEDs")
+    servo = bindings.get("servo", {}).get("angle")
+    if servo is not None and (ports.get(servo, ("",))[0] != "out" or ports[servo][1] > 10):
+        raise UserError(
+            f"design {name}: the board sends the servo's angle from an output of at most "
+            f"10 bits (signed, +-500 = +-90 degrees); {servo!r} is not one"
+        )
     pins_of = {
         port: (kind, pin)
         for kind, pins in bindings.items()
-        if kind not in ("wheels", "camera")
+        if kind not in ("wheels", "camera", "servo")
         for pin, port in pins.items()
     }
     header = []
     for port, (direction, width) in ports.items():
-        if port in ("motor_left", "motor_right") or (camera and port in _CAMERA_INPUTS):
+        if port in ("motor_left", "motor_right", servo) or (camera and port in _CAMERA_INPUTS):
             continue
         if port in pins_of:
             kind, pin = pins_of[port]
@@ -160,7 +167,7 @@ def board_ports(spec, board="ulx3s-85f"):
             f"design {name}: {len(header)} connector pins, the board's header has "
             f"{len(HEADER_SITES)} free"
         )
-    return {"camera": camera, "header": header}
+    return {"camera": camera, "servo": servo, "header": header}
 
 
 def _user_factory(spec):
@@ -168,7 +175,7 @@ def _user_factory(spec):
 
         wiring = board_ports(spec)
         return ulx3s_user_platform(wiring["header"]), ULX3SUserDesign(
-            spec.build(), header=wiring["header"], camera=wiring["camera"]
+            spec.build(), header=wiring["header"], camera=wiring["camera"], servo=wiring["servo"]
         )
 
     return factory

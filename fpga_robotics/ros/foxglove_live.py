@@ -2,7 +2,8 @@
 and live control from the client.
 
 The server listens on localhost only and publishes the same ROS 2 messages as the bag
-(``messages.TOPICS``, CDR with their ``ros2msg`` schemas) as each frame is done. Clients may
+(``messages.TOPICS``, further cameras' ``/cameras/<name>/...`` and a LIDAR's
+``/<name>/scan``, CDR with their ``ros2msg`` schemas) as each frame is done. Clients may
 publish (client-publish capability) on the control topics ``CONTROL_TOPICS``, in JSON or CDR;
 each message becomes a ``LiveControls`` input, applied at the next frame boundary.
 """
@@ -17,6 +18,7 @@ from foxglove.websocket import Capability
 
 from fpga_robotics.hw.errors import UsageError
 
+from .laser_scan import SCAN_TYPE, LaserScans
 from .messages import TOPICS, TYPESTORE, FrameMessages, msgdef, topic_type
 
 __all__ = [
@@ -143,6 +145,7 @@ class LivePublisher:
         self.subscribed = set()
         self.rejected = []  # client messages that could not be used, with why
         self._messages = FrameMessages(geometry)
+        self._scans = LaserScans()  # a LIDAR's revolutions, on channels made when first seen
         self._context = foxglove.Context()
         self._channels = {topic: self._channel(topic, msgtype) for topic, msgtype in TOPICS.items()}
         try:
@@ -190,12 +193,14 @@ class LivePublisher:
     def log_frame(self, record):
         channels = self._channels
         for topic, ns, data in self._messages.encode(record):
-            if topic not in channels and topic_type(topic) is not None:
-                # an extra output of the design, first seen now
-                channels[topic] = self._channel(topic, topic_type(topic))
-            channel = channels.get(topic)
-            if channel is not None:  # further cameras' topics are in the bag only
-                channel.log(bytes(data), log_time=ns)
+            if topic not in channels:  # a further camera's or an extra output's, first seen now
+                kind = self._messages.topic_types.get(topic) or topic_type(topic)
+                channels[topic] = self._channel(topic, kind)
+            channels[topic].log(bytes(data), log_time=ns)
+        for topic, ns, data in self._scans.encode(record):
+            if topic not in channels:
+                channels[topic] = self._channel(topic, SCAN_TYPE)
+            channels[topic].log(bytes(data), log_time=ns)
         self.frames_logged += 1
 
     def close(self):

@@ -2,12 +2,13 @@
 
 The GoPiGo3's motor controller is an SPI peripheral at address 0x08 (SPI mode 0, 500 kHz in
 Dexter Industries' own driver). Every message starts with the address and a message type; this
-design only writes, and ignores MISO. The two messages used, with their byte layouts (from the
-GoPiGo3 Python driver's ``set_motor_limits`` and ``set_motor_dps``):
+design only writes, and ignores MISO. The messages used, with their byte layouts (from the
+GoPiGo3 Python driver's ``set_motor_limits``, ``set_motor_dps`` and ``set_servo``):
 
 ===============  ====================================================================
 SET_MOTOR_LIMITS ``0x08, 0x0F, port mask, power limit (%), dps hi, dps lo``
 SET_MOTOR_DPS    ``0x08, 0x0E, port mask, speed hi, speed lo``
+SET_SERVO        ``0x08, 0x09, servo port mask, pulse width (us) hi, lo``
 ===============  ====================================================================
 
 Port masks: left motor 0x01, right motor 0x02. Speeds and the speed limit are in encoder ticks
@@ -19,6 +20,11 @@ After reset the sequencer waits ``startup_wait`` cycles (the GoPiGo3 may power u
 SET_MOTOR_LIMITS once per motor, then, for every ``update`` strobe, SET_MOTOR_DPS for the left
 then the right wheel with the values latched at the strobe. Chip select goes high between
 messages. An update that arrives during a transfer is kept (the latest one) and sent next.
+
+With ``servo=True`` every update also latches ``servo_angle`` (the published 10-bit signed
+command, +-500 for +-90 degrees) and sends SET_SERVO to servo port 1 after the right wheel:
+pulse width 1500 + angle microseconds, the angle clamped to +-500 (1000..2000 us), as the
+simulated servo stops at its end stops beyond +-500.
 """
 
 import enum
@@ -33,12 +39,14 @@ __all__ = [
     "GOPIGO3_ADDRESS",
     "MOTOR_LEFT",
     "MOTOR_RIGHT",
+    "SERVO_1",
     "TICKS_PER_DEGREE",
     "GoPiGo3Message",
     "GoPiGo3Motors",
     "SPIByte",
     "SPIByteMaster",
     "dps_to_ticks",
+    "servo_pulse_us",
 ]
 
 GOPIGO3_ADDRESS = 0x08
@@ -47,12 +55,17 @@ GOPIGO3_MAX_DPS_LIMIT = (1 << 14) - 1
 MOTOR_LEFT = 0x01
 MOTOR_RIGHT = 0x02
 TICKS_PER_DEGREE = 2
+SERVO_1 = 0x01
+#: The servo pulse for command 0 (centred) and the largest command (+-90 degrees), microseconds.
+SERVO_CENTRE_US = 1500
+SERVO_FULL_COMMAND = 500
 
 
 class GoPiGo3Message(enum.IntEnum):
     """GoPiGo3 SPI message types used here."""
 
     SET_LED = 0x06
+    SET_SERVO = 0x09
     SET_MOTOR_DPS = 0x0E
     SET_MOTOR_LIMITS = 0x0F
 
@@ -60,6 +73,11 @@ class GoPiGo3Message(enum.IntEnum):
 def dps_to_ticks(dps):
     """Host reference: degrees per second -> the signed 16-bit ticks/s the GoPiGo3 is sent."""
     return max(-(1 << 15), min((1 << 15) - 1, dps * TICKS_PER_DEGREE))
+
+
+def servo_pulse_us(angle):
+    """Host reference: a servo command (signed, +-500 = +-90 degrees) -> SET_SERVO's pulse, us."""
+    return SERVO_CENTRE_US + max(-SERVO_FULL_COMMAND, min(SERVO_FULL_COMMAND, angle))
 
 
 #: One byte for the SPI master; ``end`` releases chip select after it.
@@ -177,6 +195,8 @@ class GoPiGo3Motors(CheckedArguments, wiring.Component):
         Speed limit set once per motor, degrees per second (512, the published value).
     power_limit : int
         Power limit in percent, 0 = none (the driver's default).
+    servo : bool
+        Also send ``servo_angle`` to servo port 1 on every update.
 
     Members
     -------
@@ -184,6 +204,8 @@ class GoPiGo3Motors(CheckedArguments, wiring.Component):
         Strobe: latch ``left``/``right`` and send them.
     left, right : In(signed(16))
         Wheel speeds in degrees per second.
+    servo_angle : In(signed(10))
+        The servo command (only with ``servo``).
     sclk, copi, cs : Out(1)
         The SPI bus (``cs`` active high).
     busy : Out(1)
@@ -191,30 +213,34 @@ class GoPiGo3Motors(CheckedArguments, wiring.Component):
     """
 
     @staticmethod
-    def check_arguments(*, half_period, startup_wait=0, dps_limit=512, power_limit=0):
+    def check_arguments(*, half_period, startup_wait=0, dps_limit=512, power_limit=0, servo=False):
         """Raise ``TypeError``/``ValueError`` unless ``GoPiGo3Motors`` accepts the arguments."""
         SPIByteMaster.check_arguments(half_period=half_period)
         check_int("startup_wait", startup_wait, 0)
         check_int("dps_limit", dps_limit, 0, GOPIGO3_MAX_DPS_LIMIT)
         check_int("power_limit", power_limit, 0, 100)
+        if not isinstance(servo, bool):
+            raise TypeError(f"servo must be True or False, not {servo!r}")
 
-    def __init__(self, *, half_period, startup_wait=0, dps_limit=512, power_limit=0):
+    def __init__(self, *, half_period, startup_wait=0, dps_limit=512, power_limit=0, servo=False):
         self.half_period = int(half_period)
         self.startup_wait = int(startup_wait)
         self.dps_limit = int(dps_limit)
         self.power_limit = int(power_limit)
+        self.servo = servo
         self.spi = SPIByteMaster(half_period=half_period)
-        super().__init__(
-            {
-                "update": In(1),
-                "left": In(signed(16)),
-                "right": In(signed(16)),
-                "sclk": Out(1),
-                "copi": Out(1),
-                "cs": Out(1),
-                "busy": Out(1),
-            }
-        )
+        members = {
+            "update": In(1),
+            "left": In(signed(16)),
+            "right": In(signed(16)),
+            "sclk": Out(1),
+            "copi": Out(1),
+            "cs": Out(1),
+            "busy": Out(1),
+        }
+        if servo:
+            members["servo_angle"] = In(signed(10))
+        super().__init__(members)
 
     def elaborate(self, platform):
         m = Module()
@@ -229,15 +255,26 @@ class GoPiGo3Motors(CheckedArguments, wiring.Component):
             m.d.comb += out.eq(Mux(t > 32767, 32767, Mux(t < -32768, -32768, t)))
             return out
 
+        def pulse(angle):
+            # 1500 + angle us, the angle clamped to +-500: 1000..2000 fits 16 bits unsigned.
+            out = Signal(16)
+            full = SERVO_FULL_COMMAND
+            clamped = Mux(angle > full, full, Mux(angle < -full, -full, angle))
+            m.d.comb += out.eq(SERVO_CENTRE_US + clamped)
+            return out
+
         pending = Signal()
         next_left = Signal(signed(16))
         next_right = Signal(signed(16))
+        next_servo = Signal(16)
         with m.If(self.update):
             m.d.sync += [
                 pending.eq(1),
                 next_left.eq(ticks(self.left)),
                 next_right.eq(ticks(self.right)),
             ]
+            if self.servo:
+                m.d.sync += next_servo.eq(pulse(self.servo_angle))
 
         # The message being sent: its type, port and 16-bit argument.
         limits = Signal()
@@ -246,6 +283,9 @@ class GoPiGo3Motors(CheckedArguments, wiring.Component):
         byte = Signal(range(6))
         right_next = Signal()  # the left DPS message is out; the right one follows
         cur_right = Signal(16)
+        servo_msg = Signal()  # the message being sent is SET_SERVO
+        servo_next = Signal()  # SET_SERVO follows the right wheel's message
+        cur_servo = Signal(16)
         length = Mux(limits, 6, 5)
         contents = Signal(8)
         with m.Switch(byte):
@@ -253,7 +293,11 @@ class GoPiGo3Motors(CheckedArguments, wiring.Component):
                 m.d.comb += contents.eq(GOPIGO3_ADDRESS)
             with m.Case(1):
                 m.d.comb += contents.eq(
-                    Mux(limits, GoPiGo3Message.SET_MOTOR_LIMITS, GoPiGo3Message.SET_MOTOR_DPS)
+                    Mux(
+                        limits,
+                        GoPiGo3Message.SET_MOTOR_LIMITS,
+                        Mux(servo_msg, GoPiGo3Message.SET_SERVO, GoPiGo3Message.SET_MOTOR_DPS),
+                    )
                 )
             with m.Case(2):
                 m.d.comb += contents.eq(port)
@@ -292,6 +336,12 @@ class GoPiGo3Motors(CheckedArguments, wiring.Component):
                     right_next.eq(1),
                     byte.eq(0),
                 ]
+                if self.servo:  # without a servo these stay 0: wheel messages only
+                    m.d.sync += [
+                        cur_servo.eq(next_servo),
+                        servo_next.eq(1),
+                        servo_msg.eq(0),
+                    ]
                 with m.If(self.update):  # a new update in this very cycle stays pending
                     m.d.sync += pending.eq(1)
                 m.next = "SEND"
@@ -309,6 +359,14 @@ class GoPiGo3Motors(CheckedArguments, wiring.Component):
                                 value.eq(cur_right),
                                 right_next.eq(0),
                             ]
+                        if self.servo:
+                            with m.Elif(~limits & servo_next):
+                                m.d.sync += [
+                                    port.eq(SERVO_1),
+                                    value.eq(cur_servo),
+                                    servo_msg.eq(1),
+                                    servo_next.eq(0),
+                                ]
                         with m.Else():
                             m.next = "IDLE"
         with m.If(pending):

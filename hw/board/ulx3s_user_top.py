@@ -5,7 +5,8 @@ The design's ports meet the board where the simulation's connectors meet them:
 - the camera's framed pixel stream ``pixels`` (OV7670, SCCB, capture and clock crossing as in
   ``robot_core``), ``color_sel`` from the DIP switches SW1..SW3;
 - the GoPiGo3 wheels, ``motor_left``/``motor_right``, sent over SPI at every ``frame_done``
-  of a camera design, else every ``update_s`` (50 Hz by default);
+  of a camera design, else every ``update_s`` (50 Hz by default), and with them a servo's
+  angle (the port ``servo`` names) as SET_SERVO to the GoPiGo3's servo port 1;
 - the 8 user LEDs show ``centroid_leds`` when the design has it;
 - every other connector pin (an ultrasound's ``trig``/``echo``, a bumper's ``pressed``, ...)
   on a free pin of GPIO header J1, in the order ``HEADER_SITES`` lists them.
@@ -71,12 +72,14 @@ class ULX3SUserDesign(Elaboratable):
     """Board top around ``design`` (an Amaranth component already checked on the host).
 
     ``header``: ``[(port, "i"|"o")]`` the design's 1-bit connector ports, on the header pins
-    in order; ``camera``: whether ``pixels`` is a stream input; ``update_s``: the wheel
-    update period of a design without ``frame_done``.
+    in order; ``camera``: whether ``pixels`` is a stream input; ``servo``: the output port of
+    the servo's angle, or None; ``update_s``: the wheel update period of a design without
+    ``frame_done``.
     """
 
-    def __init__(self, design, *, header=(), camera=False, update_s=0.02, params=None):
+    def __init__(self, design, *, header=(), camera=False, servo=None, update_s=0.02, params=None):
         self.design = design
+        self.servo = servo
         self.header = list(header)
         self.camera = camera
         self.update_s = update_s
@@ -165,7 +168,10 @@ class ULX3SUserDesign(Elaboratable):
             half_period=t.spi_half,
             startup_wait=t.motor_wait,
             dps_limit=gopigo3_dps_limit(self.params),
+            servo=self.servo is not None,
         )
+        if self.servo is not None:
+            m.d.comb += motors.servo_angle.eq(getattr(design, self.servo))
         spi = platform.request("gopigo3_spi", 0, dir="-")
         m.d.comb += [
             motors.update.eq(update),
