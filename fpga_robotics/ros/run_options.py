@@ -8,11 +8,8 @@ writer, the Foxglove server and the controls; ``on_frame`` is the per-frame call
 
 from fpga_robotics.hw.errors import UsageError
 
-from .bag_writer import BagWriter, check_bag_path
 from .controls import LiveControls, ReplayControls, load_inputs
-from .foxglove_live import LivePublisher, check_live_port, parse_live_spec
 from .interactive import TerminalControls, check_terminal
-from .messages import camera_geometry
 
 __all__ = ["RosOutputs", "add_ros_arguments"]
 
@@ -55,8 +52,15 @@ class RosOutputs:
         self.interactive = args.interactive
         self.replay = None
         if args.bag is not None:
+            from .bag_writer import check_bag_path  # lazy: rosbags (~0.15 s), only for --bag
+
             check_bag_path(args.bag)
         if args.live is not None:
+            from .foxglove_live import (  # lazy: foxglove and rosbags, only for --live
+                check_live_port,
+                parse_live_spec,
+            )
+
             self.port = parse_live_spec(args.live)
             check_live_port(self.port)
         if args.replay_inputs is not None:
@@ -96,6 +100,12 @@ class RosOutputs:
     def open(self, scenario, *, closed_loop=True):
         """Start what the options ask for; returns the notices to print now."""
         notices = []
+        if not self.active:
+            return notices
+        from .bag_writer import BagWriter  # lazy: rosbags (~0.15 s), only for these options
+        from .foxglove_live import LivePublisher  # lazy: foxglove, only for these options
+        from .messages import camera_geometry  # lazy: rosbags' type store (~0.1 s)
+
         geometry = camera_geometry(scenario)
         try:
             if self.replay is not None:
