@@ -168,7 +168,7 @@ BAD_MAPS = [
     (
         "unknown connector kind",
         _map(**{"[connectors.bumper]": "[connectors.sonar]"}),
-        "connectors.sonar: unknown connector kind; known: bumper, line_sensors, ultrasound",
+        "connectors.sonar: unknown connector kind; known: bumper, ",
     ),
     (
         "unknown pin",
