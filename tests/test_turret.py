@@ -16,7 +16,7 @@ from fpga_robotics.loop.compressed import run_scenario
 from fpga_robotics.scenario.load import load_scenario
 from fpga_robotics.viz import open_recorder
 from fpga_robotics.viz.cameras import CAMERAS, MAP_CAMERAS
-from fpga_robotics.viz.readback import read_rrd
+from fpga_robotics.viz.readback import images, read_rrd
 
 #: Two cameras, both 60 degrees wide at 160 px: f = 80 / tan(30 deg) = 138.56 px. The robot
 #: (GoPiGo3, its camera 0.08 m ahead of the centre) stands at (1.5, 3.0) facing +x; the red
@@ -149,13 +149,21 @@ def test_the_inverted_pan_fails_the_centred_check(turret_runs):
 def test_the_viewer_shows_each_camera_and_its_view_on_the_map(tmp_path):
     path = tmp_path / "t.rrd"
     rec = open_recorder(f"save:{path}", default_path=str(path))
+    seen = []
     result = run_scenario(
-        load_scenario(write(tmp_path, TWO_CAMERAS)), backend="model", recorder=rec
+        load_scenario(write(tmp_path, TWO_CAMERAS)),
+        backend="model",
+        recorder=rec,
+        on_frame=lambda record: seen.append(record.cameras["turret"].rgb.copy()),
     )
     rec.close()
     data = read_rrd(str(path))
     n = result.summary["frames"]
     assert data.entities[f"{CAMERAS}/turret/image"].frames == list(range(n))
+    # Recorded as the design receives it (RGB444, shown as c << 4), losslessly.
+    read = images(data, f"{CAMERAS}/turret/image")
+    for k in (0, n // 2, n - 1):
+        np.testing.assert_array_equal(read[k], seen[k] & 0xF0)
     # Its pinhole in the world: the 3D view shows the image on its frustum.
     placed = data.entities[f"{CAMERAS}/turret"].values["Transform3D:translation"][0][0]
     assert placed == pytest.approx((1.55, 3.0, 0.22))

@@ -13,7 +13,7 @@ import math
 import rerun as rr
 
 from .columns import jpegs, pngs, rgb_images, strips
-from .images import encode_frame
+from .images import as_received, encode_frame, encode_rgb444
 from .world3d import camera_rotation
 
 __all__ = ["CAMERAS", "MAP_CAMERAS", "CameraPanels"]
@@ -32,9 +32,11 @@ class CameraPanels:
         self._columns = columns
         self.names = []  # cameras seen, in first-seen order (the layout's panels)
 
-    def log(self, record, add, *, images, jpeg_quality, reach, frame, t):
+    def log(self, record, add, *, images, jpeg_quality, reach, frame, t, camera="rgb444"):
         """``images``: this frame logs camera images (``log_every``); ``reach``: the map's
-        field-of-view length, m; ``frame``, ``t``: the record's frame and time (ns)."""
+        field-of-view length, m; ``frame``, ``t``: the record's frame and time (ns);
+        ``camera``: how images are recorded, as the body camera's (``rgb444``: as a design
+        receives them, ``rgb888``: the render)."""
         s = self._stream
         for name, view in (getattr(record, "cameras", None) or {}).items():
             h, w = view.rgb.shape[:2]
@@ -64,7 +66,10 @@ class CameraPanels:
                 ),
             )
             if images:
-                kind, data = encode_frame(view.rgb, jpeg_quality)
+                if camera == "rgb444":
+                    kind, data = encode_rgb444(as_received(view.rgb), jpeg_quality)
+                else:
+                    kind, data = encode_frame(view.rgb, jpeg_quality)
                 key = (f"{CAMERAS}/{name}/image", kind)
                 self._columns.register(key, _BUILDERS[kind])
                 add(key, data)

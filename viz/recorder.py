@@ -402,6 +402,7 @@ class Recorder:
                 reach=self._ray,
                 frame=frame,
                 t=t,
+                camera=self.camera,
             )
         if len(self._sensors.series) != self._sensor_series:
             self._layout_stale = True
