@@ -263,40 +263,20 @@ def _main_design(args):
         if not args.quiet:
             print(text, file=sys.stderr, flush=True)
 
+    robot = {
+        "workers": args.workers,
+        "scheduler": args.scheduler,
+        "resume": args.resume,
+        "fork": args.fork,
+    }
+    judged = {"say": say, "campaign": campaign, "robot": robot}
     try:
         if verilog:
             result = mutate_verilog_design(
-                files,
-                args.ports,
-                args.mutants,
-                args.seed,
-                cycles,
-                out,
-                say=say,
-                campaign=campaign,
-                robot={
-                    "workers": args.workers,
-                    "scheduler": args.scheduler,
-                    "resume": args.resume,
-                    "fork": args.fork,
-                },
+                files, args.ports, args.mutants, args.seed, cycles, out, **judged
             )
         else:
-            result = mutate_design(
-                spec,
-                args.mutants,
-                args.seed,
-                cycles,
-                out,
-                say=say,
-                campaign=campaign,
-                robot={
-                    "workers": args.workers,
-                    "scheduler": args.scheduler,
-                    "resume": args.resume,
-                    "fork": args.fork,
-                },
-            )
+            result = mutate_design(spec, args.mutants, args.seed, cycles, out, **judged)
     except (MutationError, BackendError, PinError) as exc:
         raise UsageError(str(exc).splitlines()[0]) from None
     score, modules = result["unit"], result["modules"]
