@@ -213,6 +213,29 @@ def check_number(table, key, default, where, *, lo, hi, unit="", lo_open=False):
     return validate_value(check, table.get(key, default), f"{where}.{key}")
 
 
+def refuse_unknown_keys(table, known, where, kind, listed=None):
+    """A ``ConnectorError`` naming the first key of ``table`` not in ``known`` and the keys a
+    ``kind`` table holds (``listed``, or ``known`` joined)."""
+    unknown = sorted(k for k in table if k not in known)
+    if unknown:
+        article = "an" if kind[0] in "aeiou" else "a"
+        raise ConnectorError(
+            f"{where}: unknown key {unknown[0]!r} for {article} {kind!r} connector; its keys: "
+            f"{listed or ', '.join(known)}"
+        )
+
+
+def check_numbers(table, keys, defaults, where):
+    """``{key: check_number(...)}`` for ``keys`` ``{key: (lo, hi, unit, lo_open)}``, each
+    defaulting to the attribute of ``defaults`` of its name."""
+    return {
+        key: check_number(
+            table, key, getattr(defaults, key), where, lo=lo, hi=hi, unit=unit, lo_open=lo_open
+        )
+        for key, (lo, hi, unit, lo_open) in keys.items()
+    }
+
+
 def validate_value(check, value, path):
     """``check(value)`` (a key type's check, ``sim.world.schema.check_of``); a
     ``ConnectorError`` naming ``path`` otherwise."""

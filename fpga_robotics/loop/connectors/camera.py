@@ -22,6 +22,7 @@ from fpga_robotics.loop.connectors.base import (
     Mount,
     Pin,
     check_number,
+    refuse_unknown_keys,
     register,
 )
 from fpga_robotics.sim.camera.raster import CameraRenderer, focal_length
@@ -264,12 +265,9 @@ class CameraConnector(Connector):
     @classmethod
     def parse(cls, table, where):
         """A ``[[robot.sensors]]`` camera's keys (``CameraParams``)."""
-        unknown = sorted(set(table) - set(_CAMERA_KEYS))
-        if unknown:
-            raise ConnectorError(
-                f"{where}: unknown key {unknown[0]!r} for a 'camera' connector; its keys: "
-                f"{', '.join(_CAMERA_KEYS)} and the mount"
-            )
+        refuse_unknown_keys(
+            table, _CAMERA_KEYS, where, cls.kind, f"{', '.join(_CAMERA_KEYS)} and the mount"
+        )
         width, height = _resolution(table.get("resolution", "160x120"), where)
         color = _word(table, "color", where, tuple(COLOR_SELECT)) or "red"
         return CameraParams(

@@ -25,7 +25,8 @@ from fpga_robotics.loop.connectors.base import (
     Connector,
     ConnectorError,
     Pin,
-    check_number,
+    check_numbers,
+    refuse_unknown_keys,
     register,
 )
 from fpga_robotics.sim.world.lidar import (
@@ -71,18 +72,8 @@ class _LidarBase(Connector):
     @classmethod
     def parse(cls, table, where):
         defaults = LidarParams()
-        unknown = sorted(k for k in table if k not in _KEYS)
-        if unknown:
-            raise ConnectorError(
-                f"{where}: unknown key {unknown[0]!r} for a {cls.kind!r} connector; its keys: "
-                f"{', '.join(_KEYS)}"
-            )
-        values = {
-            key: check_number(
-                table, key, getattr(defaults, key), where, lo=lo, hi=hi, unit=unit, lo_open=open_
-            )
-            for key, (lo, hi, unit, open_) in _KEYS.items()
-        }
+        refuse_unknown_keys(table, _KEYS, where, cls.kind)
+        values = check_numbers(table, _KEYS, defaults, where)
         if not values["min_range"] < values["max_range"]:
             raise ConnectorError(
                 f"{where}.max_range must be greater than min_range "

@@ -18,6 +18,7 @@ from fpga_robotics.loop.connectors.base import (
     Mount,
     Pin,
     check_number,
+    refuse_unknown_keys,
     register,
 )
 from fpga_robotics.sim.world.line_sensor import KY033, KY033Params
@@ -76,12 +77,9 @@ class LineSensorsConnector(Connector):
     def parse(cls, table, where):
         table = dict(table)
         sensors = table.pop("sensors", None)
-        unknown = sorted(k for k in table if k not in _MODULE_KEYS)
-        if unknown:
-            raise ConnectorError(
-                f"{where}: unknown key {unknown[0]!r} for a 'line_sensors' "
-                f"connector; its keys: sensors, {', '.join(_MODULE_KEYS)}"
-            )
+        refuse_unknown_keys(
+            table, _MODULE_KEYS, where, cls.kind, f"sensors, {', '.join(_MODULE_KEYS)}"
+        )
         if (
             not isinstance(sensors, list)
             or not 1 <= len(sensors) <= MAX_SENSORS

@@ -14,7 +14,8 @@ from fpga_robotics.loop.connectors.base import (
     Connector,
     ConnectorError,
     Pin,
-    check_number,
+    check_numbers,
+    refuse_unknown_keys,
     register,
 )
 from fpga_robotics.sim.world.ultrasound import HCSR04Module, HCSR04Params, range_to
@@ -53,18 +54,8 @@ class UltrasoundConnector(Connector):
     @classmethod
     def parse(cls, table, where):
         defaults = HCSR04Params()
-        unknown = sorted(k for k in table if k not in _KEYS)
-        if unknown:
-            raise ConnectorError(
-                f"{where}: unknown key {unknown[0]!r} for an 'ultrasound' "
-                f"connector; its keys: {', '.join(_KEYS)}"
-            )
-        values = {
-            key: check_number(
-                table, key, getattr(defaults, key), where, lo=lo, hi=hi, unit=unit, lo_open=open_
-            )
-            for key, (lo, hi, unit, open_) in _KEYS.items()
-        }
+        refuse_unknown_keys(table, _KEYS, where, cls.kind)
+        values = check_numbers(table, _KEYS, defaults, where)
         if not values["min_range"] < values["max_range"]:
             raise ConnectorError(
                 f"{where}.max_range must be greater than min_range "
