@@ -20,7 +20,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from fpga_robotics.hw.errors import UsageError
-from fpga_robotics.loop.compressed import run_scenario
+from fpga_robotics.loop.timings import run_scenario
 from fpga_robotics.scenario.load import load_scenario
 
 __all__ = ["Check", "Result", "run"]

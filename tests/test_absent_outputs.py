@@ -17,8 +17,8 @@ from fpga_robotics.checks.summary import (
     format_summary,
     verdict,
 )
-from fpga_robotics.loop.compressed import run_scenario
 from fpga_robotics.loop.shadow import ShadowComparison
+from fpga_robotics.loop.timings import run_scenario
 from fpga_robotics.scenario.load import load_scenario
 from fpga_robotics.sim.backends import get_backend
 from fpga_robotics.viz import open_recorder

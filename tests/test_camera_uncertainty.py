@@ -7,8 +7,8 @@ import math
 import numpy as np
 import pytest
 
-from fpga_robotics.loop.compressed import run_scenario
 from fpga_robotics.loop.connectors.camera import DRIFT_TAU, CameraConnector, ExposureDrift
+from fpga_robotics.loop.timings import run_scenario
 from fpga_robotics.scenario.load import ScenarioError, load_scenario
 from fpga_robotics.sim.camera.raster import focal_length
 

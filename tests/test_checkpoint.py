@@ -5,7 +5,8 @@ import pytest
 from run_equality import assert_same_run
 
 from fpga_robotics.loop import checkpoint
-from fpga_robotics.loop.compressed import ClosedLoop, run_scenario
+from fpga_robotics.loop.compressed import ClosedLoop
+from fpga_robotics.loop.timings import run_scenario
 from fpga_robotics.scenario.load import load_scenario, shipped_scenarios
 from fpga_robotics.sim.backends.model import ModelBackend
 

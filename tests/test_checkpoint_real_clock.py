@@ -6,9 +6,9 @@ import pytest
 from run_equality import assert_same_run
 
 from fpga_robotics.loop import checkpoint
-from fpga_robotics.loop.compressed import run_scenario
 from fpga_robotics.loop.pin_journal import JournalPins, replay
 from fpga_robotics.loop.real_clock import RealClockLoop, make_pin_backend
+from fpga_robotics.loop.timings import run_scenario
 from fpga_robotics.scenario.load import load_scenario, shipped_scenarios
 
 REAL_CLOCK = [n for n in shipped_scenarios() if load_scenario(n).sim.timing == "real_clock"]

@@ -24,7 +24,7 @@ from fpga_robotics.checks.shipped import SHIPPED_CHECKS
 from fpga_robotics.checks.summary import format_summary
 from fpga_robotics.cli.errors import run_cli
 from fpga_robotics.cli.run import main as run_main
-from fpga_robotics.loop.compressed import run_scenario
+from fpga_robotics.loop.timings import run_scenario
 from fpga_robotics.scenario.load import ScenarioError, load_scenario
 from fpga_robotics.sweep.campaign import RunSpec
 from fpga_robotics.sweep.report import format_report, write_html

@@ -1887,7 +1887,7 @@ def snippet_running(tmp_path, capsys):
 def snippet_viewer(tmp_path, capsys):
     """docs/viewer.md: a recorder fed a world's map and a run's frame records; the file gets
     its real name and the last notice says how to open it."""
-    from fpga_robotics.loop.compressed import run_scenario
+    from fpga_robotics.loop.timings import run_scenario
     from fpga_robotics.scenario.load import load_scenario
     from fpga_robotics.sim.world import World
 

@@ -5,7 +5,7 @@ other scenarios reach levels 3 to 6 only, with red targets)."""
 import numpy as np
 import pytest
 
-from fpga_robotics.loop.compressed import run_scenario
+from fpga_robotics.loop.timings import run_scenario
 from fpga_robotics.scenario.load import load_scenario
 from fpga_robotics.sweep.campaign import load_campaign, read_campaign_file
 

@@ -20,7 +20,7 @@ from test_foreign_verilog import (
 )
 
 from fpga_robotics.hw.verilog import generate_verilog
-from fpga_robotics.loop.compressed import run_scenario
+from fpga_robotics.loop.timings import run_scenario
 from fpga_robotics.scenario.load import load_scenario
 from fpga_robotics.sim.backends import BackendError
 from fpga_robotics.sim.backends.foreign import ForeignVerilatorBackend

@@ -22,7 +22,7 @@ from renamed_design import RENAMED, RENAMED_MAP
 from fpga_robotics.cli.errors import run_cli
 from fpga_robotics.cli.run import main as run_main
 from fpga_robotics.designs.builtin import TOPS, Top, register_top
-from fpga_robotics.loop.compressed import run_scenario
+from fpga_robotics.loop.timings import run_scenario
 from fpga_robotics.scenario.load import load_scenario
 from fpga_robotics.sim.backends.port_map import PortMapError, parse_port_map
 

@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 from run_equality import assert_same_run
 
-from fpga_robotics.loop.compressed import run_scenario
 from fpga_robotics.loop.fork import ReferenceRun
+from fpga_robotics.loop.timings import run_scenario
 from fpga_robotics.scenario.load import load_scenario
 from fpga_robotics.sim.backends.model import ModelBackend
 

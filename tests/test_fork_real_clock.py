@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 from run_equality import assert_same_run
 
-from fpga_robotics.loop.compressed import run_scenario
 from fpga_robotics.loop.pin_fork import PinReferenceRun, reference_run
 from fpga_robotics.loop.real_clock import make_pin_backend
+from fpga_robotics.loop.timings import run_scenario
 from fpga_robotics.scenario.load import load_scenario
 
 

@@ -126,12 +126,23 @@ def _is_import_module_call(node):
     )
 
 
+def _lazy_attribute_lines(tree):
+    """The lines of a module-level ``def __getattr__`` (PEP 562): a package ``__init__`` that
+    hands out a name this way imports its module only when the name is asked for."""
+    lines = set()
+    for node in tree.body:
+        if isinstance(node, ast.FunctionDef) and node.name == "__getattr__":
+            lines.update(range(node.lineno, node.end_lineno + 1))
+    return lines
+
+
 def imports_of(module, path, modules):
-    """``(line, imported module, under a __main__ guard)`` for every import in the file:
-    ``from package import name`` is the module ``package.name`` where that is a module of
-    ``modules``, else ``package``; relative imports are resolved."""
+    """``(line, imported module, under a __main__ guard, in a package's __getattr__)`` for
+    every import in the file: ``from package import name`` is the module ``package.name``
+    where that is a module of ``modules``, else ``package``; relative imports are resolved."""
     tree = ast.parse(path.read_text(), str(path))
     in_main = _main_guard_lines(tree)
+    in_getattr = _lazy_attribute_lines(tree) if path.name == "__init__.py" else set()
     base = module.split(".") if path.name == "__init__.py" else module.split(".")[:-1]
     found = []
     for node in ast.walk(tree):
@@ -150,7 +161,9 @@ def imports_of(module, path, modules):
                 targets.append(package)
         elif isinstance(node, ast.Call) and _is_import_module_call(node):
             targets = [node.args[0].value]
-        found.extend((node.lineno, t, node.lineno in in_main) for t in targets)
+        found.extend(
+            (node.lineno, t, node.lineno in in_main, node.lineno in in_getattr) for t in targets
+        )
     return found
 
 
@@ -161,15 +174,43 @@ def _project_module(name, modules):
     return name or None
 
 
+def _packages_run(module, imported, modules):
+    """The project modules that importing ``imported`` from ``module`` runs: every package
+    ``__init__`` on the way down (``a``, ``a.b`` for ``a.b.c``) and ``imported`` itself. The
+    packages ``module`` lives in are left out (Python begins them before ``module``), unless
+    ``imported`` is one of them: a name taken from that ``__init__``."""
+    parts = imported.split(".")
+    run = [".".join(parts[:n]) for n in range(1, len(parts))]
+    own = {".".join(module.split(".")[:n]) for n in range(1, module.count(".") + 1)}
+    if modules[module].name == "__init__.py":
+        own.add(module)
+    return [m for m in run if m in modules and m not in own] + [imported]
+
+
 def import_graph(modules):
-    """``{module: {imported project module: first line}}`` and the list of every import."""
+    """``{module: {imported project module: first line}}`` and the list of every import.
+    Importing ``a.b.c`` depends on ``a/__init__``, ``a/b/__init__`` and ``a/b/c``, so a circle
+    that closes through a package's ``__init__`` is a circle too."""
+    found = {m: imports_of(m, path, modules) for m, path in modules.items()}
+    # What a package's __getattr__ imports: a dependency of whoever takes names from it.
+    on_request = {m: [] for m in modules}
+    for module, imports in found.items():
+        for _line, target, _in_main, in_getattr in imports:
+            imported = _project_module(target, modules)
+            if in_getattr and imported is not None and imported != module:
+                on_request[module].append(imported)
     graph, every = {m: {} for m in modules}, []
-    for module, path in modules.items():
-        for line, target, in_main in imports_of(module, path, modules):
+    for module, imports in found.items():
+        for line, target, in_main, in_getattr in imports:
             every.append((module, line, target, in_main))
             imported = _project_module(target, modules)
-            if imported is not None and imported != module:
-                graph[module].setdefault(imported, line)
+            if in_getattr or imported is None or imported == module:
+                continue
+            for runs in _packages_run(module, imported, modules):
+                graph[module].setdefault(runs, line)
+            for asked in on_request[imported] if target == imported else ():
+                for runs in _packages_run(module, asked, modules):
+                    graph[module].setdefault(runs, line)
     return graph, every
 
 

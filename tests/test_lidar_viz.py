@@ -4,7 +4,7 @@ returns as points on the 2D map and, at the scan plane's height, in the 3D view.
 import numpy as np
 import pytest
 
-from fpga_robotics.loop.compressed import run_scenario
+from fpga_robotics.loop.timings import run_scenario
 from fpga_robotics.scenario.load import load_scenario
 from fpga_robotics.viz import open_recorder
 from fpga_robotics.viz.lidar import SCANS3D

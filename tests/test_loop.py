@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 
 from fpga_robotics.checks.summary import TIMING_FIELDS
-from fpga_robotics.loop.compressed import TRAJECTORY_FIELDS, run_scenario
+from fpga_robotics.loop.compressed import TRAJECTORY_FIELDS
+from fpga_robotics.loop.timings import run_scenario
 from fpga_robotics.scenario.load import load_scenario
 from fpga_robotics.sim.backends.model import ModelBackend
 from fpga_robotics.sim.world.kinematics import dps_to_twist

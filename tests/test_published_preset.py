@@ -10,7 +10,7 @@ from fpga_robotics.cli.export import main as export_main
 from fpga_robotics.cli.run import main as run_main
 from fpga_robotics.hw.params import PRESETS, FollowTargetParams
 from fpga_robotics.hw.verilog import generate_verilog
-from fpga_robotics.loop.compressed import run_scenario
+from fpga_robotics.loop.timings import run_scenario
 from fpga_robotics.scenario.load import ScenarioError, load_scenario
 from fpga_robotics.sim.backends import get_backend
 

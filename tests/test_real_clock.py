@@ -8,7 +8,7 @@ import pytest
 
 from fpga_robotics.checks.summary import TIMING_FIELDS
 from fpga_robotics.cli.errors import UsageError
-from fpga_robotics.loop.compressed import run_scenario
+from fpga_robotics.loop.timings import run_scenario
 from fpga_robotics.scenario.load import ScenarioError, load_scenario
 from fpga_robotics.sim.models.ultrasound_driver import UltrasoundModel
 from fpga_robotics.sim.world.ultrasound import speed_of_sound

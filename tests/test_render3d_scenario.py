@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 from render3d_scenes import mujoco_missing
 
-from fpga_robotics.loop.compressed import run_scenario
 from fpga_robotics.loop.connectors.camera import CameraConnector
+from fpga_robotics.loop.timings import run_scenario
 from fpga_robotics.scenario.load import ScenarioError, load_scenario
 from fpga_robotics.sim.camera.raster import CameraRenderer
 from fpga_robotics.sim.camera.render3d import Lamp

@@ -13,7 +13,7 @@ from rosbags.highlevel import AnyReader
 from rosbags.typesys import Stores, get_typestore
 
 from fpga_robotics.cli.run import main as run_main
-from fpga_robotics.loop.compressed import run_scenario
+from fpga_robotics.loop.timings import run_scenario
 from fpga_robotics.ros.bag_writer import open_bag_writer
 from fpga_robotics.scenario.load import load_scenario
 from fpga_robotics.sim.world.config import parse_world_config

@@ -314,7 +314,7 @@ def test_teleop_twist_in_cdr():
 def test_inputs_are_events_of_the_run_and_of_its_frames():
     """Each applied input is an event of the run (the summary's count, the rerun event log
     through the frame records) at its frame; a teleop without a target is an event too."""
-    from fpga_robotics.loop.compressed import run_scenario
+    from fpga_robotics.loop.timings import run_scenario
     from fpga_robotics.ros.controls import ReplayControls
     from fpga_robotics.scenario.load import load_scenario
 

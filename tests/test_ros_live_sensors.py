@@ -15,7 +15,7 @@ import pytest
 from test_ros_live import STORE, Client
 from test_turret import TWO_CAMERAS, write
 
-from fpga_robotics.loop.compressed import run_scenario
+from fpga_robotics.loop.timings import run_scenario
 from fpga_robotics.ros.foxglove_live import LivePublisher
 from fpga_robotics.ros.messages import camera_geometry
 from fpga_robotics.scenario.load import load_scenario

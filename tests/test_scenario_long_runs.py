@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from fpga_robotics.loop.compressed import run_scenario
+from fpga_robotics.loop.timings import run_scenario
 from fpga_robotics.scenario.load import load_scenario, shipped_scenarios
 from fpga_robotics.sim.world import TURTLEBOT2
 

@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from fpga_robotics.loop.compressed import run_scenario
 from fpga_robotics.loop.shadow import COMPARED_OUTPUTS, shadow_overrides
+from fpga_robotics.loop.timings import run_scenario
 from fpga_robotics.scenario.load import load_scenario
 from fpga_robotics.sim.backends.model import ModelBackend
 

@@ -8,9 +8,9 @@ import pytest
 from run_equality import assert_same_run
 
 from fpga_robotics.cli.run import main as run_main
-from fpga_robotics.loop.compressed import run_scenario
 from fpga_robotics.loop.continuation import run_continued
 from fpga_robotics.loop.real_clock import make_pin_backend
+from fpga_robotics.loop.timings import run_scenario
 from fpga_robotics.scenario.load import load_scenario
 from fpga_robotics.sim.backends.model import ModelBackend
 from fpga_robotics.viz import paths as P

@@ -6,7 +6,7 @@ scenario's ``diff_min = 8`` rejects it and tracks the person."""
 import pytest
 from render3d_scenes import mujoco_missing
 
-from fpga_robotics.loop.compressed import run_scenario
+from fpga_robotics.loop.timings import run_scenario
 from fpga_robotics.scenario.load import load_scenario
 
 pytestmark = [pytest.mark.stories, mujoco_missing]

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from fpga_robotics.hw.params import FollowTargetParams
-from fpga_robotics.loop.compressed import run_scenario
+from fpga_robotics.loop.timings import run_scenario
 from fpga_robotics.scenario.load import load_scenario
 from fpga_robotics.sim.backends import available_backends, get_backend
 from fpga_robotics.sim.camera import synthetic

@@ -6,7 +6,7 @@ import math
 
 import pytest
 
-from fpga_robotics.loop.compressed import run_scenario
+from fpga_robotics.loop.timings import run_scenario
 from fpga_robotics.scenario.load import load_scenario
 from fpga_robotics.sim.backends import available_backends
 from fpga_robotics.sim.world.robots import G

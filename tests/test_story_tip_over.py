@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from fpga_robotics.checks.summary import compute_metrics, evaluate_checks
-from fpga_robotics.loop.compressed import run_scenario
+from fpga_robotics.loop.timings import run_scenario
 from fpga_robotics.scenario.load import load_scenario
 from fpga_robotics.sim.backends import available_backends
 from fpga_robotics.sim.world import GOPIGO3, TURTLEBOT2, World

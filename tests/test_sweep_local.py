@@ -10,7 +10,7 @@ import sys
 import pytest
 
 from fpga_robotics.checks.summary import TIMING_FIELDS
-from fpga_robotics.loop.compressed import run_scenario
+from fpga_robotics.loop.timings import run_scenario
 from fpga_robotics.scenario.load import load_scenario
 from fpga_robotics.sweep import load_campaign, report_dir, run_campaign
 

@@ -8,7 +8,8 @@ import pytest
 from fpga_robotics.checks.summary import format_summary
 from fpga_robotics.cli.errors import run_cli
 from fpga_robotics.cli.run import main
-from fpga_robotics.loop.compressed import TRAJECTORY_FIELDS, frame_count, run_scenario
+from fpga_robotics.loop.compressed import TRAJECTORY_FIELDS, frame_count
+from fpga_robotics.loop.timings import run_scenario
 from fpga_robotics.scenario.load import load_scenario
 
 TIPS = ["design.kp_num=32"]  # docs/stories.md, story (c)

@@ -12,7 +12,7 @@ import pytest
 from render3d_scenes import mujoco_missing
 
 from fpga_robotics.hw.errors import UsageError
-from fpga_robotics.loop.compressed import run_scenario
+from fpga_robotics.loop.timings import run_scenario
 from fpga_robotics.scenario.load import load_scenario
 from fpga_robotics.viz import open_recorder
 from fpga_robotics.viz.cameras import CAMERAS, MAP_CAMERAS

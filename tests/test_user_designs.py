@@ -15,7 +15,7 @@ from amaranth.hdl import Fragment
 
 from fpga_robotics import cli
 from fpga_robotics.designs.reference import DesignError, resolve_design
-from fpga_robotics.loop.compressed import run_scenario
+from fpga_robotics.loop.timings import run_scenario
 from fpga_robotics.scenario.load import ScenarioError, load_scenario
 from fpga_robotics.sim.camera.frames import to_rgb444
 

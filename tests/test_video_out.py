@@ -7,7 +7,7 @@ import pytest
 
 from fpga_robotics.cli.errors import run_cli
 from fpga_robotics.cli.run import main
-from fpga_robotics.loop.compressed import run_scenario
+from fpga_robotics.loop.timings import run_scenario
 from fpga_robotics.scenario.load import load_scenario
 
 

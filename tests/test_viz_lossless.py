@@ -10,7 +10,7 @@ the saved .rrd (``viz.readback.images``) and compared with them. By the hardware
 import numpy as np
 import pytest
 
-from fpga_robotics.loop.compressed import run_scenario
+from fpga_robotics.loop.timings import run_scenario
 from fpga_robotics.scenario.load import load_scenario
 from fpga_robotics.sim.camera.frames import rgb444_to_rgb888
 from fpga_robotics.viz import ViewerError, open_recorder

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from fpga_robotics.loop.compressed import run_scenario
+from fpga_robotics.loop.timings import run_scenario
 from fpga_robotics.scenario.load import load_scenario
 from fpga_robotics.viz import open_recorder
 from fpga_robotics.viz import paths as P

@@ -3,7 +3,7 @@ first divergence among the events, a layout with both."""
 
 import numpy as np
 
-from fpga_robotics.loop.compressed import run_scenario
+from fpga_robotics.loop.timings import run_scenario
 from fpga_robotics.scenario.load import load_scenario
 from fpga_robotics.sim.backends.model import ModelBackend
 from fpga_robotics.viz import open_recorder

@@ -272,7 +272,7 @@ def test_bad_uncertainty_names_the_key(key, value, message):
 
 
 def test_the_map_shows_the_terrain(tmp_path):
-    from fpga_robotics.loop.compressed import run_scenario
+    from fpga_robotics.loop.timings import run_scenario
     from fpga_robotics.scenario.load import load_scenario
     from fpga_robotics.viz import open_recorder
     from fpga_robotics.viz import paths as P

@@ -15,7 +15,7 @@ import statistics
 
 from fpga_robotics.bench import scaffold
 from fpga_robotics.cli.errors import UsageError
-from fpga_robotics.loop.compressed import run_scenario
+from fpga_robotics.loop.timings import run_scenario
 from fpga_robotics.scenario.load import load_scenario
 
 __all__ = ["main", "measure"]

@@ -20,8 +20,8 @@ import time
 from fpga_robotics.bench import scaffold
 from fpga_robotics.bench.render3d_figures import write_figures
 from fpga_robotics.cli.errors import UsageError
-from fpga_robotics.loop.compressed import run_scenario
 from fpga_robotics.loop.connectors.camera import make_renderer
+from fpga_robotics.loop.timings import run_scenario
 from fpga_robotics.scenario.load import load_scenario
 from fpga_robotics.sim.camera.scene import CameraPose
 from fpga_robotics.sim.world import World

@@ -18,8 +18,8 @@ import numpy as np
 
 from fpga_robotics.cli.errors import UsageError
 from fpga_robotics.hw.params import FollowTargetParams
-from fpga_robotics.loop.compressed import run_scenario
 from fpga_robotics.loop.connectors.camera import make_renderer
+from fpga_robotics.loop.timings import run_scenario
 from fpga_robotics.scenario.load import load_scenario
 from fpga_robotics.sim.camera.frames import rgb444_to_rgb888, to_rgb444
 from fpga_robotics.sim.files import check_output_dir, write_atomic

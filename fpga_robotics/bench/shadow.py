@@ -14,7 +14,8 @@ import time
 from fpga_robotics.bench import scaffold
 from fpga_robotics.cli.errors import UsageError
 from fpga_robotics.cli.run import _shadow_params
-from fpga_robotics.loop.compressed import make_backend, run_scenario
+from fpga_robotics.loop.compressed import make_backend
+from fpga_robotics.loop.timings import run_scenario
 from fpga_robotics.scenario.load import load_scenario
 from fpga_robotics.sim.backends import BACKEND_NAMES
 

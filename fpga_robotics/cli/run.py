@@ -21,12 +21,13 @@ from fpga_robotics.checks.summary import format_summary
 from fpga_robotics.cli.errors import UsageError
 from fpga_robotics.cli.parser import CommandParser
 from fpga_robotics.hw.pixel import COLOR_SELECT
-from fpga_robotics.loop.compressed import make_backend, run_scenario
+from fpga_robotics.loop.compressed import make_backend
 from fpga_robotics.loop.continuation import continuation_summary, run_continued
 from fpga_robotics.loop.pin_shadow import is_design_reference
 from fpga_robotics.loop.real_clock import format_extra_outputs, make_pin_backend
 from fpga_robotics.loop.shadow import format_shadow, shadow_overrides
 from fpga_robotics.loop.sources import open_source, run_source
+from fpga_robotics.loop.timings import run_scenario
 from fpga_robotics.loop.video_out import CameraVideo, VideoPathError, check_video_path
 from fpga_robotics.ros.run_options import RosOutputs, add_ros_arguments
 from fpga_robotics.scenario.load import (

@@ -6,7 +6,7 @@ rendered, the design processes it with the colour select in force, and its wheel
 (DPS) takes effect ``sim.actuation_delay`` seconds later (rounded to a step), the previous
 command staying in force until then. A robot that tips over ends the run at the frame that
 reports it (``RunResult``, summary ``ended_early``). Everything is a function of the scenario
-and the seed: ``run_scenario`` keeps no global state and can be called many times in one
+and the seed: ``run_compressed`` keeps no global state and can be called many times in one
 process.
 """
 
@@ -31,12 +31,6 @@ from fpga_robotics.sim.camera.raster import focal_length
 from fpga_robotics.sim.records import FrameRecord
 from fpga_robotics.sim.world import World, is_removal_event
 
-#: ``sim.timing`` -> the function ``run_scenario`` hands a scenario in that timing to (with
-#: its own arguments). The real-clock loop registers itself there: it builds on
-#: ``ClosedLoop``, so this module cannot import it; the ``fpga_robotics.loop`` package,
-#: imported before any of its modules, imports both.
-TIMINGS = {}
-
 __all__ = [
     "TRAJECTORY_FIELDS",
     "ClosedLoop",
@@ -44,7 +38,7 @@ __all__ = [
     "frame_count",
     "make_backend",
     "run_loop",
-    "run_scenario",
+    "run_compressed",
 ]
 
 #: Per-frame arrays of ``RunResult.trajectory`` (one entry per camera frame, at capture time).
@@ -556,7 +550,7 @@ def _empty_trajectory(n_frames):
     return traj
 
 
-def run_scenario(
+def run_compressed(
     scenario,
     *,
     seed=None,
@@ -569,47 +563,7 @@ def run_scenario(
     shadow_label="shadow",
     controls=None,
 ):
-    """Run one scenario in closed loop and measure it.
-
-    Parameters
-    ----------
-    scenario : Scenario
-        From ``fpga_robotics.scenario.load_scenario``.
-    seed : int, optional
-        Fixes every random choice (world and camera noise); default the scenario's seed.
-    backend : str or DesignBackend
-        A backend name ("auto", "model", "pysim", "cxxrtl", "verilator") or a ready backend
-        built for ``scenario.params`` (it is reset first; the caller keeps ownership).
-    recorder : object with log_world_map, log_frame, optional
-        The viewer (``fpga_robotics.viz.open_recorder``); not closed here.
-    progress : callable(frames_done, frames_total), optional
-    realtime : bool
-        Pace the simulation to the wall clock.
-    on_frame : callable(FrameRecord), optional
-        Called for every frame (tests, custom logging).
-    shadow : DesignBackend, optional
-        A second design run on the same frames in lockstep, never driving the robot; the
-        summary gains ``shadow`` (first divergence, differing frames per output). Reset
-        first; the caller keeps ownership.
-    shadow_label : str
-        How the summary and the events name the shadow design.
-    controls : object with inputs_for(frame, t), optional
-        Live control inputs (``fpga_robotics.ros.controls``): colour select, the target
-        driven by hand, pause and step; applied just after each frame's capture.
-    """
-    if scenario.sim.timing != "compressed":
-        return TIMINGS[scenario.sim.timing](
-            scenario,
-            seed=seed,
-            backend=backend,
-            recorder=recorder,
-            progress=progress,
-            realtime=realtime,
-            on_frame=on_frame,
-            shadow=shadow,
-            shadow_label=shadow_label,
-            controls=controls,
-        )
+    """``run_scenario`` (fpga_robotics.loop.timings) in compressed timing."""
 
     def build(design):
         if design.params != scenario.params:

@@ -25,11 +25,11 @@ import bisect
 import time
 
 from fpga_robotics.loop import checkpoint
-from fpga_robotics.loop.compressed import run_scenario
 from fpga_robotics.loop.fork import ReferenceRun, check_same_world
 from fpga_robotics.loop.pin_journal import JournalPins, PlayBack, first_difference
 from fpga_robotics.loop.real_clock import RealClockLoop
 from fpga_robotics.loop.shadow import is_shadow_event
+from fpga_robotics.loop.timings import run_scenario
 
 __all__ = ["PinReferenceRun", "reference_run"]
 

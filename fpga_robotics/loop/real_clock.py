@@ -29,7 +29,7 @@ from fpga_robotics.checks.sensor_metrics import line_metrics, measurement_metric
 from fpga_robotics.designs.builtin import build_component, connector_kinds, foreign_top
 from fpga_robotics.designs.reference import resolve_design
 from fpga_robotics.hw.errors import UsageError
-from fpga_robotics.loop.compressed import TIMINGS, ClosedLoop, run_loop
+from fpga_robotics.loop.compressed import ClosedLoop, run_loop
 from fpga_robotics.loop.connectors import CONNECTORS, PinIO
 from fpga_robotics.loop.pin_shadow import MirroredPins, PinComparison
 from fpga_robotics.sim.backends.base import FrameResult
@@ -557,7 +557,7 @@ def run_real_clock(
     shadow_label,
     controls,
 ):
-    """``run_scenario`` (fpga_robotics.loop.compressed) in real-clock timing."""
+    """``run_scenario`` (fpga_robotics.loop.timings) in real-clock timing."""
     if shadow is not None and not hasattr(shadow, "ports"):
         raise UsageError(
             "a shadow in real-clock timing is a design on a pin backend "
@@ -581,6 +581,3 @@ def run_real_clock(
         progress=progress,
         realtime=realtime,
     )
-
-
-TIMINGS["real_clock"] = run_real_clock

@@ -52,8 +52,8 @@ def execute_group(argvs, timeouts, tags):
     """Run a group's runs (``run`` argument lists of one world), the first that completes
     as the reference, the others forked from it; returns one outcome per run as
     ``runner.execute`` does."""
-    from fpga_robotics.loop.compressed import run_scenario  # lazy: the run stack (~1 s)
     from fpga_robotics.loop.pin_fork import reference_run  # lazy: the run stack (~1 s)
+    from fpga_robotics.loop.timings import run_scenario  # lazy: the run stack (~1 s)
 
     outcomes, reference = [], None
     for argv, timeout, tag in zip(argvs, timeouts, tags, strict=True):

@@ -212,7 +212,7 @@ def execute(argv, timeout=None, record=False, tag=None, bag=False):
     "run_s", "recording", "bag"}`` (``recording``: the ``.rrd`` bytes when ``record``;
     ``bag``: with ``bag`` and ``record``, the ROS 2 bag's files as ``{name: bytes}``)."""
     from fpga_robotics.cli import run  # lazy: the run stack (~1 s)
-    from fpga_robotics.loop.compressed import run_scenario  # lazy: the run stack (~1 s)
+    from fpga_robotics.loop.timings import run_scenario  # lazy: the run stack (~1 s)
 
     wall0, cpu0 = time.perf_counter(), time.process_time()
     out = {"status": "error", "message": "", "summary": None, "recording": None, "run_s": 0.0}
