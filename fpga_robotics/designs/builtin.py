@@ -14,6 +14,7 @@ import importlib
 from dataclasses import dataclass, field
 
 from fpga_robotics.hw.variants import VARIANTS, variant_params
+from fpga_robotics.loop.connectors import CONNECTORS
 
 __all__ = [
     "TOPS",
@@ -155,8 +156,6 @@ def foreign_top(port_map):
 def connector_kinds():
     """Every registered connector kind with pins bound by a port map's ``[connectors]``:
     kind -> {pin: (direction, at most this many bits)} (``port_map.check_connectors``)."""
-    from fpga_robotics.loop.connectors import CONNECTORS  # lazy: circle via loop's init
-
     return {
         kind: {pin: (spec.direction, spec.width) for pin, spec in cls.pins.items()}
         for kind, cls in CONNECTORS.items()

@@ -34,6 +34,7 @@ from pathlib import Path
 from fpga_robotics.designs.builtin import TOPS, Top, build_component, design_tables, foreign_top
 from fpga_robotics.hw.errors import UsageError
 from fpga_robotics.hw.params import FollowTargetParams
+from fpga_robotics.loop.connectors import CONNECTORS
 
 __all__ = [
     "ENTRY_POINT_GROUP",
@@ -450,8 +451,6 @@ def component_ports(component):
 
 def _connector_pins():
     """Connector kind -> its pin names (the camera's stream is its ``pixels`` pin)."""
-    from fpga_robotics.loop.connectors import CONNECTORS  # lazy: circle via loop's init
-
     return {kind: tuple(cls.pins) for kind, cls in CONNECTORS.items()}
 
 
