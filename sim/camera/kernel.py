@@ -14,6 +14,10 @@ from pathlib import Path
 
 import numpy as np
 
+from ..backends import build_cache
+from ..backends.base import BackendError
+from ..backends.toolchain import find_compiler, run_tool
+
 __all__ = ["camera_kernel"]
 
 _SOURCE = Path(__file__).resolve().parent / "kernel.cpp"
@@ -139,10 +143,6 @@ class NoiseTable:
 def camera_kernel():
     """The compiled per-pixel stage, or None where it cannot be built or loaded (no
     compiler, an unwritable cache): the renderer then uses numpy, with the same result."""
-    from ..backends import build_cache  # lazy: circle via the sim.camera package init
-    from ..backends.base import BackendError  # lazy: circle via the sim.camera package init
-    from ..backends.toolchain import find_compiler, run_tool  # lazy: circle via sim.camera's init
-
     try:
         compiler = find_compiler()
         source = _SOURCE.read_text()
