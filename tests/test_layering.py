@@ -4,9 +4,12 @@ the gateware imports no host code, and nothing leans on Amaranth's private inter
 
 Every import counts: at the top of a module, inside a function, under
 ``if __name__ == "__main__":``, and the module named by a string literal in
-``importlib.import_module("...")``. Imports sit at the top of their module; one left inside a
-function says why on its line, ``# lazy: <reason>`` (an optional dependency, a heavy one most
-commands skip, a circle through a package's ``__init__``).
+``importlib.import_module("...")``. Importing ``a.b.c`` runs ``a/__init__.py`` and
+``a/b/__init__.py`` too, so a circle may close through a package's ``__init__``; a name a
+package hands out on first use (a module-level ``__getattr__``, PEP 562) is a dependency of
+the module that takes it. Imports sit at the top of their module; one left inside a function
+says why on its line, ``# lazy: <reason>`` (an optional dependency, a heavy one most commands
+skip); a circle is no reason: it is reported wherever its imports sit.
 """
 
 import ast
@@ -285,6 +288,7 @@ def check(root=ROOT, package_dirs=PACKAGE_DIRS, rooms=ROOMS):
 
 
 _LAZY_REASON = re.compile(r"#\s*lazy:\s*\S")
+_LAZY_CIRCLE = re.compile(r"#\s*lazy:.*\bcircle", re.IGNORECASE)
 
 
 def _function_body_imports(tree):
@@ -310,9 +314,13 @@ def unexplained_lazy_imports(root=ROOT, package_dirs=PACKAGE_DIRS):
         lines = text.splitlines()
         for node in _function_body_imports(ast.parse(text, str(path))):
             statement = lines[node.lineno - 1 : node.end_lineno]
+            where = f"{path.relative_to(root)}:{node.lineno}"
             if not any(_LAZY_REASON.search(line) for line in statement):
-                where = f"{path.relative_to(root)}:{node.lineno}"
                 problems.append(f"{where}: {statement[0].strip()} (move it to the top, or say why)")
+            elif any(_LAZY_CIRCLE.search(line) for line in statement):
+                problems.append(
+                    f"{where}: {statement[0].strip()} (a circle is no reason: remove it)"
+                )
     return problems
 
 
@@ -391,6 +399,60 @@ def test_the_checker_reports_upward_imports_circles_and_main_blocks(tmp_path):
     ]
 
 
+def _tree(root, files):
+    for name, text in files.items():
+        path = root / name
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(text)
+    return root
+
+
+_RING_ADVICE = " (move what they share into a module below both)"
+
+
+def test_a_circle_through_a_package_init_is_a_circle(tmp_path):
+    # backends' tool imports the camera's frames, which runs the camera package's __init__,
+    # which imports the renderer, which imports the tool back: a circle that no two modules
+    # close by naming each other, held only by an import inside a function.
+    files = {
+        "sim/__init__.py": "",
+        "sim/cam/__init__.py": "from .raster import render\n",
+        "sim/cam/raster.py": (
+            "def render():\n    from ..back.tool import build  # lazy: circle\n    return build\n"
+        ),
+        "sim/cam/frames.py": "import math\n",
+        "sim/back/__init__.py": "",
+        "sim/back/tool.py": "from ..cam import frames\n\ndef build():\n    return frames\n",
+    }
+    assert check(_tree(tmp_path, files)) == [
+        "import circle: fpga_robotics.sim.back.tool -> fpga_robotics.sim.cam -> "
+        "fpga_robotics.sim.cam.raster -> fpga_robotics.sim.back.tool" + _RING_ADVICE
+    ]
+
+
+def test_a_package_name_handed_out_on_use_depends_its_taker_only(tmp_path):
+    lazy_init = (
+        "def __getattr__(name):\n"
+        "    from . import raster  # lazy: on use\n"
+        "    return getattr(raster, name)\n"
+    )
+    files = {
+        "sim/__init__.py": "",
+        "sim/cam/__init__.py": lazy_init,
+        "sim/cam/raster.py": "from ..back import tool\n",
+        "sim/cam/frames.py": "",
+        "sim/back/__init__.py": "",
+        "sim/back/tool.py": "from ..cam import frames\n",
+    }
+    assert check(_tree(tmp_path, files)) == []
+    # Taking the renderer's name from the package does depend on the renderer.
+    (tmp_path / "sim/back/tool.py").write_text("from ..cam import render\n")
+    assert check(tmp_path) == [
+        "import circle: fpga_robotics.sim.back.tool -> fpga_robotics.sim.cam.raster -> "
+        "fpga_robotics.sim.back.tool" + _RING_ADVICE
+    ]
+
+
 def test_circles_finds_every_ring_and_nothing_else():
     graph = {
         "a": {"b"},
@@ -432,6 +494,7 @@ def test_the_checker_reports_function_imports_without_a_reason(tmp_path):
             "    import mujoco  # lazy: optional dependency\n"
             "    from numpy import (  # lazy: heavy\n        zeros,\n    )\n"
             "    return mujoco, zeros\n"
+            "def cycle():\n    from . import plain  # lazy: circle via the package init\n"
         ),
         "viz/nested.py": (
             "class Viewer:\n"
@@ -449,6 +512,8 @@ def test_the_checker_reports_function_imports_without_a_reason(tmp_path):
         path.write_text(text)
     problems = unexplained_lazy_imports(tmp_path, {"sim": "fpga_robotics.sim", "viz": "viz"})
     assert problems == [
+        "sim/explained.py:8: from . import plain  # lazy: circle via the package init "
+        "(a circle is no reason: remove it)",
         "sim/plain.py:6: import pickle (move it to the top, or say why)",
         "viz/nested.py:4: from . import other (move it to the top, or say why)",
         "viz/nested.py:8: import rerun  # lazy: (move it to the top, or say why)",
