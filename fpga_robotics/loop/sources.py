@@ -13,7 +13,6 @@ import cv2
 
 from fpga_robotics.hw.errors import UsageError
 from fpga_robotics.hw.pixel import color_select_value
-from fpga_robotics.ros.bag_source import BagSource
 from fpga_robotics.sim.camera.opencv_frames import to_design_rgb
 from fpga_robotics.sim.records import FrameRecord
 
@@ -111,6 +110,8 @@ def open_source(spec, width, height):
     """Open ``spec`` (``camera:N``, a video file, a folder of images, ``bag:PATH[:TOPIC]``) at
     ``width`` x ``height``; ``UsageError`` when it cannot be opened."""
     if str(spec).startswith("bag:"):  # a ROS bag (fpga_robotics.ros.bag_source)
+        from fpga_robotics.ros.bag_source import BagSource  # lazy: rosbags (~30 ms), for bags only
+
         return BagSource(spec, width, height)
     return FrameSource(spec, width, height)
 

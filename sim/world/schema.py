@@ -213,7 +213,9 @@ def Tables(message, *, doc=""):
 class KeyModel(BaseModel):
     """A table of a scenario: its keys are the fields; anything else is an unknown key."""
 
-    model_config = ConfigDict(extra="forbid", frozen=True, populate_by_name=True)
+    # defer_build: a table's validator is built when a scenario first has the table, so a
+    # start-up pays only for the tables its scenario uses.
+    model_config = ConfigDict(extra="forbid", frozen=True, populate_by_name=True, defer_build=True)
 
     #: What a path of this table is called in the unknown-key message.
     label: ClassVar[str] = ""
