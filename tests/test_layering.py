@@ -512,8 +512,10 @@ def test_the_checker_reports_function_imports_without_a_reason(tmp_path):
         path.write_text(text)
     problems = unexplained_lazy_imports(tmp_path, {"sim": "fpga_robotics.sim", "viz": "viz"})
     assert problems == [
-        "sim/explained.py:8: from . import plain  # lazy: circle via the package init "
-        "(a circle is no reason: remove it)",
+        (
+            "sim/explained.py:8: from . import plain  # lazy: circle via the package init "
+            "(a circle is no reason: remove it)"
+        ),
         "sim/plain.py:6: import pickle (move it to the top, or say why)",
         "viz/nested.py:4: from . import other (move it to the top, or say why)",
         "viz/nested.py:8: import rerun  # lazy: (move it to the top, or say why)",

@@ -37,8 +37,8 @@ __all__ = [
     "RunResult",
     "frame_count",
     "make_backend",
-    "run_loop",
     "run_compressed",
+    "run_loop",
 ]
 
 #: Per-frame arrays of ``RunResult.trajectory`` (one entry per camera frame, at capture time).
