@@ -18,6 +18,8 @@ import tempfile
 import time
 from dataclasses import dataclass, field
 
+from fpga_robotics.designs.builtin import connector_kinds
+from fpga_robotics.flow.board_verilog import VerilogOnBoard, verilog_board_ports, verilog_files
 from fpga_robotics.hw.board.ulx3s_top import ULX3SFollowTarget, ulx3s_platform
 from fpga_robotics.hw.board.ulx3s_user_top import HEADER_SITES, ULX3SUserDesign, ulx3s_user_platform
 from fpga_robotics.hw.errors import UserError
@@ -99,10 +101,12 @@ def board_ports(spec, board="ulx3s-85f"):
     ``len(HEADER_SITES)`` header pins."""
 
     board_factory(board)
+    if spec.kind == "verilog":
+        return verilog_board_ports(spec, connector_kinds(), HEADER_SITES)
     if spec.kind != "amaranth":
         raise UserError(
-            f"design {spec.reference!r}: the board takes an Amaranth design of one's own "
-            f"(FILE.py:Name, package.module:Name); FollowTarget is the default"
+            f"design {spec.reference!r}: the board takes a design of one's own "
+            f"(FILE.py:Name, package.module:Name, verilog:FILES); FollowTarget is the default"
         )
     name = spec.reference.rpartition(":")[2]
     ports, bindings = spec.ports, spec.bindings
@@ -172,10 +176,22 @@ def board_ports(spec, board="ulx3s-85f"):
 
 def _user_factory(spec):
     def factory(params):
-
         wiring = board_ports(spec)
-        return ulx3s_user_platform(wiring["header"]), ULX3SUserDesign(
-            spec.build(), header=wiring["header"], camera=wiring["camera"], servo=wiring["servo"]
+        platform = ulx3s_user_platform(wiring["header"])
+        if spec.kind == "verilog":
+            # Yosys reads the design's files (and those they include) with the generated top.
+            for name, text in verilog_files(spec):
+                if name.startswith(DESIGN_NAME + "."):
+                    raise UserError(
+                        f"design {spec.port_map.top}: rename {name!r}: the board build "
+                        f"writes its own files as {DESIGN_NAME}.*"
+                    )
+                platform.add_file(name, text)
+            design = VerilogOnBoard(spec.port_map, servo=wiring["servo"], header=wiring["header"])
+        else:
+            design = spec.build()
+        return platform, ULX3SUserDesign(
+            design, header=wiring["header"], camera=wiring["camera"], servo=wiring["servo"]
         )
 
     return factory
@@ -213,6 +229,7 @@ def _write_plan(plan, out_dir, *, rename_verilog=True):
         if rename_verilog and filename == f"{DESIGN_NAME}.debug.v":
             target = f"{DESIGN_NAME}.v"
         path = os.path.join(out_dir, target)
+        os.makedirs(os.path.dirname(path), exist_ok=True)  # an included file in a subfolder
         if isinstance(content, bytes):
             content = content.decode()
         write_atomic(path, content, what="board build file")
