@@ -42,7 +42,7 @@ def verilog_board_ports(spec, kinds, header_sites):
             )
     if pm.has_pixels and pm.style != "stream":
         raise UserError(
-            f"design {name}: the board's camera gives a pixel stream (style = \"stream\"); "
+            f'design {name}: the board\'s camera gives a pixel stream (style = "stream"); '
             f"a {pm.style} design does not run on it"
         )
     if pm.color_port and any(c not in COLOR_SELECT for c in pm.color_codes):
