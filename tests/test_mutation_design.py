@@ -329,3 +329,22 @@ def test_mutants_of_a_verilog_design_against_a_hand_model(tmp_path, capsys):
             assert m["unit"]["caught"] == (got != model), m["describe"]
     finally:
         backend.close()
+
+
+@pytest.mark.slow  # a Verilator build of the mutant netlist
+def test_a_verilog_design_that_includes_a_header_is_mutated(tmp_path, capsys):
+    """Yosys reads red_count.v with the header it `include`s next to it: the header's
+    `define values reach the mutant netlist and the mutants are red_count.v's."""
+    data = Path(__file__).parent / "data" / "red_count"
+    out = tmp_path / "m"
+    argv = ["--design", f"verilog:{data / 'red_count.v'}", "--ports"]
+    argv += [str(data / "red_count_ports.toml"), "--mutants", "3", "--cycles", "2000"]
+    code, text, _ = _cli(["mutate", *argv, "--out", str(out), "--quiet"], capsys)
+    assert code == 0
+    assert text.splitlines()[0].startswith("3 mutants of red_count (seed 1)")
+    netlist = (out / "mutants.v").read_text()
+    # `SPEED (16'sd200) and `MIN_PIXELS (17'd20) from red_count_defs.vh
+    assert "16'h00c8" in netlist and "17'h00014" in netlist
+    result = json.loads((out / "mutants.json").read_text())
+    assert len(result["mutants"]) == 3
+    assert all("red_count.v:" in m["describe"] for m in result["mutants"])
