@@ -826,6 +826,15 @@ PLANS = {
             r"(?m)^verilator +[\d.]+ +[\d.]+ +[\d.]+$",
         ),
     ),
+    "fpga-robotics bench user_verilog --design wall_stop.py:WallStop": Plan(
+        slow=True,
+        setup=(f"cp {ROOT / 'tests/data/user_designs/wall_stop.py'} .",),
+        shorter=(("--seconds", "0.2"), ("--repeats", "1")),
+        out=(
+            r"wall_stop.py:WallStop in real-clock timing",
+            r"(?m)^cxxrtl +[\d.]+ +[\d.]+ +[\d.]+ +[\d.]+$",
+        ),
+    ),
     "fpga-robotics designs": Plan(
         out=(
             r"follow_target_safe  \(built-in\)",
