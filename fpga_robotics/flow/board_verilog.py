@@ -76,29 +76,47 @@ def verilog_board_ports(spec, kinds, header_sites):
 
 def verilog_files(spec):
     """``[(name in the build folder, text)]``: the design's files and every file they
-    ``include`` (looked for in the including file's folder), each once."""
+    ``include`` (looked for next to the including file, then next to each listed file, as
+    the simulation looks), each once; an absolute include name is left to Yosys."""
     files = [Path(f) for f in spec.reference[len("verilog:") :].split(",")]
+    top = spec.port_map.top
     out, seen = [], {}
-    pending = [(f, f.name) for f in files]
-    while pending:
-        path, name = pending.pop(0)
-        if name in seen:
-            if seen[name] != path.resolve():
-                raise UserError(
-                    f"design {spec.port_map.top}: two files named {name!r} "
-                    f"({seen[name]}, {path}); the board build puts them in one folder"
-                )
-            continue
-        if not path.is_file():
+    for path in files:
+        if path.name in seen:
             raise UserError(
-                f"design {spec.port_map.top}: included file {name!r} not found "
-                f"(looked for {str(path)!r})"
+                f"design {top}: two files named {path.name!r} ({seen[path.name]}, {path}); "
+                f"the board build puts them in one folder"
             )
-        seen[name] = path.resolve()
-        text = path.read_text()
-        out.append((name, text))
-        for inc in _INCLUDE.findall(text):
-            pending.append((path.parent / inc, str(Path(name).parent / inc).removeprefix("./")))
+        seen[path.name] = path
+        out.append((path.name, path.read_text()))
+    pending = [(path, text) for (_, text), path in zip(out, files)]
+    while pending:
+        path, text = pending.pop(0)
+        for name in _INCLUDE.findall(text):
+            if name in seen or Path(name).is_absolute():
+                continue
+            if ".." in Path(name).parts:
+                raise UserError(
+                    f"design {top}: {path.name} includes {name!r}; the board build writes "
+                    f"included files next to the top: name them without '..'"
+                )
+            found = next(
+                (
+                    b / name
+                    for b in (path.parent, *(f.parent for f in files))
+                    if (b / name).is_file()
+                ),
+                None,
+            )
+            if found is None:
+                raise UserError(
+                    f"design {top}: included file {name!r} not found (looked next to "
+                    f"{path.name} and the listed files)"
+                )
+            seen[name] = found
+            included = found.read_text()
+            out.append((name, included))
+            pending.append((found, included))
     return out
 
 
