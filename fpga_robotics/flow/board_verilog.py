@@ -172,7 +172,8 @@ class VerilogOnBoard(Elaboratable):
             if pm.color_port:
                 # The switches give this project's colour code; the map may code colours
                 # otherwise.
-                code = Signal(max(pm.color_width or 1, 1))
+                widest = max((v.bit_length() for v in pm.color_codes.values()), default=1)
+                code = Signal(max(pm.color_width or 1, widest, 1))
                 with m.Switch(self._members["color_sel"]):
                     for color, value in pm.color_codes.items():
                         with m.Case(COLOR_SELECT[color]):
