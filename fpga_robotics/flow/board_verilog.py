@@ -88,7 +88,7 @@ def verilog_files(spec):
                 f"the board build puts them in one folder"
             )
         seen[path.name] = path
-        out.append((path.name, path.read_text()))
+        out.append((path.name, _read(path, top)))
     pending = [(path, text) for (_, text), path in zip(out, files)]
     while pending:
         path, text = pending.pop(0)
@@ -114,10 +114,19 @@ def verilog_files(spec):
                     f"{path.name} and the listed files)"
                 )
             seen[name] = found
-            included = found.read_text()
+            included = _read(found, top)
             out.append((name, included))
             pending.append((found, included))
     return out
+
+
+def _read(path, top):
+    try:
+        return path.read_text()
+    except (OSError, UnicodeDecodeError) as exc:
+        raise UserError(
+            f"design {top}: cannot read {path}: {getattr(exc, 'strerror', None) or exc}"
+        ) from None
 
 
 class VerilogOnBoard(Elaboratable):
