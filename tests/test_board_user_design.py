@@ -368,3 +368,10 @@ def test_the_exported_follow_target_as_a_verilog_design_on_the_board(tmp_path, c
     )
     assert proc.returncode == 0, proc.stdout[-2000:] + proc.stderr
     assert "Resizing cell port" not in proc.stdout + proc.stderr
+
+
+def test_a_port_map_without_a_design_is_one_line(tmp_path, capsys):
+    code, out, err = _cli(["board", "--ports", RED_COUNT[3], "-o", str(tmp_path / "b")], capsys)
+    assert code == 2 and out == "" and err.count("\n") == 1, err
+    assert "--ports goes with --design REF" in err
+    assert not (tmp_path / "b").exists()
