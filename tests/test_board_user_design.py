@@ -375,3 +375,35 @@ def test_a_port_map_without_a_design_is_one_line(tmp_path, capsys):
     assert code == 2 and out == "" and err.count("\n") == 1, err
     assert "--ports goes with --design REF" in err
     assert not (tmp_path / "b").exists()
+
+
+# The turret application: two cameras and the servo ------------------------------------------
+
+
+def test_turret_tracker_gets_a_second_camera_and_the_servo(tmp_path, capsys):
+    from fpga_robotics.hw.board.pins import CAMERA_PINS, TURRET_CAMERA_PINS
+    from fpga_robotics.hw.board.ulx3s_user_top import HEADER_SITES, header_sites
+
+    out = tmp_path / "b"
+    code, text, _ = _cli(["board", "--design", "turret_tracker", "-o", str(out)], capsys)
+    assert code == 0 and "header" not in text
+    lpf = (out / "ulx3s_follow_target.lpf").read_text()
+    for number, pins in ((0, CAMERA_PINS), (1, TURRET_CAMERA_PINS)):
+        assert f'LOCATE COMP "ov7670_{number}__pclk__io" SITE "{pins["pclk"]}";' in lpf
+        for bit, site in enumerate(pins["data"]):
+            assert f'LOCATE COMP "ov7670_{number}__data__io[{bit}]" SITE "{site}";' in lpf
+    assert "ov7670_1__reset" not in lpf  # the first camera's reset pin drives both
+    verilog = (out / "ulx3s_follow_target.v").read_text()
+    # Each camera its own capture in its own byte-clock domain.
+    assert re.search(r"^module \\ulx3s_follow_target\.capture \(pclk_clk", verilog, re.MULTILINE)
+    assert re.search(r"^module \\ulx3s_follow_target\.capture_1 \(pclk_1_clk", verilog, re.MULTILINE)
+    # The servo's angle goes to the SPI sequencer with the wheels.
+    motors = re.search(r"^module \\ulx3s_follow_target\.motors \(([^)]*)\)", verilog, re.MULTILINE)
+    assert "servo_angle" in motors.group(1).split(", ")
+    # Connector pins of a design with a pan camera stay off its pins.
+    turret_sites = {
+        s for v in TURRET_CAMERA_PINS.values() for s in ([v] if isinstance(v, str) else v)
+    }
+    free = header_sites(True)
+    assert len(free) == len(HEADER_SITES) - len(turret_sites) == 22
+    assert not turret_sites & {site for _pin, site in free}
