@@ -396,7 +396,9 @@ def test_turret_tracker_gets_a_second_camera_and_the_servo(tmp_path, capsys):
     verilog = (out / "ulx3s_follow_target.v").read_text()
     # Each camera its own capture in its own byte-clock domain.
     assert re.search(r"^module \\ulx3s_follow_target\.capture \(pclk_clk", verilog, re.MULTILINE)
-    assert re.search(r"^module \\ulx3s_follow_target\.capture_1 \(pclk_1_clk", verilog, re.MULTILINE)
+    assert re.search(
+        r"^module \\ulx3s_follow_target\.capture_1 \(pclk_1_clk", verilog, re.MULTILINE
+    )
     # The servo's angle goes to the SPI sequencer with the wheels.
     motors = re.search(r"^module \\ulx3s_follow_target\.motors \(([^)]*)\)", verilog, re.MULTILINE)
     assert "servo_angle" in motors.group(1).split(", ")
@@ -407,3 +409,23 @@ def test_turret_tracker_gets_a_second_camera_and_the_servo(tmp_path, capsys):
     free = header_sites(True)
     assert len(free) == len(HEADER_SITES) - len(turret_sites) == 22
     assert not turret_sites & {site for _pin, site in free}
+
+
+@pytest.mark.slow
+def test_turret_tracker_builds_a_bitstream_that_meets_timing(tmp_path):
+    """Both cameras' byte clocks and the design clock meet their constraints."""
+    proc = subprocess.run(
+        [sys.executable, "-m", "fpga_robotics", "board", "--design", "turret_tracker"]
+        + ["-o", str(tmp_path), "--bitstream"],
+        capture_output=True,
+        text=True,
+        timeout=1500,
+        check=False,
+    )
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    report = parse_nextpnr_report(
+        json.loads((tmp_path / "ulx3s_follow_target.report.json").read_text())
+    )
+    assert report.timing_ok, report.format()
+    assert sorted(round(c.required_mhz, 3) for c in report.clocks) == [12.5, 12.5, 50.0]
+    assert (tmp_path / "ulx3s_follow_target.bit").stat().st_size > 100_000
