@@ -818,6 +818,9 @@ PLANS = {
             "build/bump_stop/bump_stop.v",
         ),
     ),
+    "fpga-robotics board --design turret_tracker -o build/turret": Plan(
+        files=("build/turret/ulx3s_follow_target.v", "build/turret/ulx3s_follow_target.lpf"),
+    ),
     "fpga-robotics bench user_verilog": Plan(
         slow=True,
         shorter=(("--seconds", "0.2"), ("--repeats", "1")),
