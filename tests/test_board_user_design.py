@@ -429,3 +429,20 @@ def test_turret_tracker_builds_a_bitstream_that_meets_timing(tmp_path):
     assert report.timing_ok, report.format()
     assert sorted(round(c.required_mhz, 3) for c in report.clocks) == [12.5, 12.5, 50.0]
     assert (tmp_path / "ulx3s_follow_target.bit").stat().st_size > 100_000
+
+
+@pytest.mark.slow  # elaborates FollowTarget with its ultrasound (over a second)
+def test_built_in_designs_on_the_board(tmp_path, capsys):
+    # follow_target_safe: FollowTarget with an HC-SR04, its pins on the header.
+    code, text, _ = _cli(
+        ["board", "--design", "follow_target_safe", "-o", str(tmp_path / "s")], capsys
+    )
+    assert code == 0
+    assert text.splitlines()[:2] == [
+        "us_trig: header gpio 7+ (site A6)",
+        "us_echo: header gpio 7- (site B6)",
+    ]
+    # follow_target is the board's own top, without --design.
+    code, out, err = _cli(["board", "--design", "follow_target", "-o", str(tmp_path / "f")], capsys)
+    assert code == 2 and out == "" and "run fpga-robotics board without --design" in err
+    assert not (tmp_path / "f").exists()
