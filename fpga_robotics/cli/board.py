@@ -105,7 +105,8 @@ def main(argv=None, prog="fpga-robotics board"):
         "--design",
         metavar="REF",
         help="put this design of your own on the board instead of FollowTarget "
-        "(FILE.py:Name, package.module:Name, verilog:FILES with --ports; "
+        "(a built-in name such as turret_tracker, FILE.py:Name, package.module:Name, "
+        "verilog:FILES with --ports; "
         "docs/your_design.md): the camera stream, the wheels and its connector pins on "
         "header pins",
     )
