@@ -194,10 +194,17 @@ def component_rtlil(component):
     return rtlil.convert(component, name=TOP_NAME, ports=ports)
 
 
-def _read_design(work, params, rtlil_text, verilog):
+def _read_design(work, params, rtlil_text, verilog, includes=None):
     """Yosys lines that read the design into ``work``: ``verilog`` (``{file name: text}``,
-    then ``read_verilog``), else ``rtlil_text`` or ``FollowTarget(params)``'s RTLIL."""
+    then ``read_verilog``; ``includes``, ``{name: text}``, the files they `include, written
+    next to them and not read on their own), else ``rtlil_text`` or ``FollowTarget(params)``'s
+    RTLIL."""
     if verilog is not None:
+        for name, text in (includes or {}).items():
+            path = os.path.join(work, name)
+            os.makedirs(os.path.dirname(path), exist_ok=True)
+            with open(path, "w") as f:
+                f.write(text)
         lines = []
         for name, text in verilog.items():
             with open(os.path.join(work, name), "w") as f:
@@ -209,16 +216,18 @@ def _read_design(work, params, rtlil_text, verilog):
     return ["read_rtlil design.il"]
 
 
-def list_mutants(params=None, n=100, seed=1, *, rtlil_text=None, verilog=None, top=TOP_NAME):
+def list_mutants(
+    params=None, n=100, seed=1, *, rtlil_text=None, verilog=None, top=TOP_NAME, includes=None
+):
     """``n`` mutants of ``FollowTarget(params)`` (or of the design ``rtlil_text``, from
     ``component_rtlil``, or of the Verilog design ``verilog``, ``{file name: text}`` with
-    its top module ``top``) chosen by Yosys with ``seed`` (the same arguments give the same
+    its top module ``top`` and the files it `include, ``includes``) chosen by Yosys with ``seed`` (the same arguments give the same
     list). Yosys may return fewer when the design has fewer places."""
     params = params if params is not None else FollowTargetParams()
     if not 1 <= int(n) <= 100_000:
         raise ValueError(f"the number of mutants must be 1..100000, got {n}")
     with tempfile.TemporaryDirectory(prefix="fr-mutate-") as work:
-        read = _read_design(work, params, rtlil_text, verilog)
+        read = _read_design(work, params, rtlil_text, verilog, includes)
         _yosys(
             [
                 *read,
@@ -235,7 +244,7 @@ def list_mutants(params=None, n=100, seed=1, *, rtlil_text=None, verilog=None, t
 _MUTATE = re.compile(r"^mutate\s")
 
 
-def mutant_netlist(params, mutants, *, rtlil_text=None, verilog=None, top=TOP_NAME):
+def mutant_netlist(params, mutants, *, rtlil_text=None, verilog=None, top=TOP_NAME, includes=None):
     """Verilog of ``FollowTarget(params)`` (or of the design ``rtlil_text``, from
     ``component_rtlil``) with every mutant behind ``mutsel`` (``select_width(len(mutants))``
     bits; ``mutsel = m.index`` selects ``m``). Top module ``follow_target``, the design's own
@@ -243,7 +252,7 @@ def mutant_netlist(params, mutants, *, rtlil_text=None, verilog=None, top=TOP_NA
     params = params if params is not None else FollowTargetParams()
     width = select_width(max((m.index for m in mutants), default=0))
     with tempfile.TemporaryDirectory(prefix="fr-mutate-") as work:
-        read = _read_design(work, params, rtlil_text, verilog)
+        read = _read_design(work, params, rtlil_text, verilog, includes)
         lines = [*read, *(s.format(top=top) for s in _PREPARE)]
         for m in mutants:
             lines.append(

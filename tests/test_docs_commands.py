@@ -803,12 +803,39 @@ PLANS = {
         out=(r"trig: header gpio 7\+ \(site A6\)", r"echo: header gpio 7- \(site B6\)"),
         files=("build/wall_stop/ulx3s_follow_target.v", "build/wall_stop/ulx3s_follow_target.lpf"),
     ),
+    (
+        "fpga-robotics board --design verilog:bump_stop.v --ports bump_stop_ports.toml "
+        "-o build/bump_stop"
+    ): Plan(
+        setup=(
+            f"cp {ROOT / 'tests/data/bump_stop.v'} .",
+            f"cp {ROOT / 'tests/data/bump_stop_ports.toml'} .",
+        ),
+        out=(r"bump_i: header gpio 7\+ \(site A6\)",),
+        files=(
+            "build/bump_stop/ulx3s_follow_target.v",
+            "build/bump_stop/ulx3s_follow_target.lpf",
+            "build/bump_stop/bump_stop.v",
+        ),
+    ),
+    "fpga-robotics board --design turret_tracker -o build/turret": Plan(
+        files=("build/turret/ulx3s_follow_target.v", "build/turret/ulx3s_follow_target.lpf"),
+    ),
     "fpga-robotics bench user_verilog": Plan(
         slow=True,
         shorter=(("--seconds", "0.2"), ("--repeats", "1")),
         out=(
             r"(?m)^cxxrtl +[\d.]+ +[\d.]+ +1\.00$",
             r"(?m)^verilator +[\d.]+ +[\d.]+ +[\d.]+$",
+        ),
+    ),
+    "fpga-robotics bench user_verilog --design wall_stop.py:WallStop": Plan(
+        slow=True,
+        setup=(f"cp {ROOT / 'tests/data/user_designs/wall_stop.py'} .",),
+        shorter=(("--seconds", "0.2"), ("--repeats", "1")),
+        out=(
+            r"wall_stop.py:WallStop in real-clock timing",
+            r"(?m)^cxxrtl +[\d.]+ +[\d.]+ +[\d.]+ +[\d.]+$",
         ),
     ),
     "fpga-robotics designs": Plan(

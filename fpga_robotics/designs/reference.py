@@ -84,6 +84,8 @@ class DesignSpec:
         The keyword arguments the component is built with.
     top : Top
         What the closed loop runs (``fpga_robotics.designs.builtin.Top``).
+    port_map : PortMap or None
+        A Verilog design's port map as read (``sim.backends.port_map.PortMap``).
     """
 
     reference: str
@@ -94,6 +96,7 @@ class DesignSpec:
     extra_outputs: tuple
     params: dict = field(default_factory=dict)
     top: Top = None
+    port_map: object = None
 
     @property
     def camera(self):
@@ -574,4 +577,5 @@ def _verilog_spec(reference, ports, base, params):
         (),
         {},
         top,
+        port_map,
     )

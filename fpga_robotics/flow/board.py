@@ -18,8 +18,15 @@ import tempfile
 import time
 from dataclasses import dataclass, field
 
+from fpga_robotics.designs.builtin import connector_kinds
+from fpga_robotics.flow.board_verilog import VerilogOnBoard, verilog_board_ports, verilog_files
 from fpga_robotics.hw.board.ulx3s_top import ULX3SFollowTarget, ulx3s_platform
-from fpga_robotics.hw.board.ulx3s_user_top import HEADER_SITES, ULX3SUserDesign, ulx3s_user_platform
+from fpga_robotics.hw.board.ulx3s_user_top import (
+    HEADER_SITES,
+    ULX3SUserDesign,
+    header_sites,
+    ulx3s_user_platform,
+)
 from fpga_robotics.hw.errors import UserError
 from fpga_robotics.hw.params import FollowTargetParams
 from fpga_robotics.sim.files import write_atomic
@@ -87,6 +94,8 @@ def _label_clocks(board, report):
 #: Inputs the board drives itself when the design has them (the camera's stream, the DIP
 #: switches' colour code).
 _CAMERA_INPUTS = ("pixels__valid", "pixels__payload", "color_sel")
+#: The same of a pan camera (the turret application's second camera).
+_TURRET_INPUTS = ("turret_pixels__valid", "turret_pixels__payload", "turret_color_sel")
 
 
 def board_ports(spec, board="ulx3s-85f"):
@@ -99,10 +108,12 @@ def board_ports(spec, board="ulx3s-85f"):
     ``len(HEADER_SITES)`` header pins."""
 
     board_factory(board)
-    if spec.kind != "amaranth":
+    if spec.kind == "verilog":
+        return verilog_board_ports(spec, connector_kinds(), HEADER_SITES)
+    if spec.kind == "builtin" and spec.reference == "follow_target":
         raise UserError(
-            f"design {spec.reference!r}: the board takes an Amaranth design of one's own "
-            f"(FILE.py:Name, package.module:Name); FollowTarget is the default"
+            "design 'follow_target' is the board's own top: run fpga-robotics board without "
+            "--design"
         )
     name = spec.reference.rpartition(":")[2]
     ports, bindings = spec.ports, spec.bindings
@@ -125,11 +136,13 @@ def board_ports(spec, board="ulx3s-85f"):
             f"motor_right; rename {', '.join(v for v in wheels.values())} so"
         )
     camera = "camera" in bindings
-    if camera and ports.get("color_sel", ("in", 3))[1] != 3:
-        raise UserError(
-            f"design {name}: port 'color_sel' is {ports['color_sel'][1]} bits; the board's "
-            f"DIP switches give the 3-bit colour code"
-        )
+    turret = all(ports.get(p, ("",))[0] == "in" for p in _TURRET_INPUTS[:2])
+    for on, port in ((camera, "color_sel"), (turret, "turret_color_sel")):
+        if on and ports.get(port, ("in", 3))[1] != 3:
+            raise UserError(
+                f"design {name}: port {port!r} is {ports[port][1]} bits; the board's "
+                f"DIP switches give the 3-bit colour code"
+            )
     if ports.get("centroid_leds", ("out", 0))[1] > 8:
         raise UserError(f"design {name}: port 'centroid_leds' is wider than the 8 user LEDs")
     servo = bindings.get("servo", {}).get("angle")
@@ -148,6 +161,8 @@ def board_ports(spec, board="ulx3s-85f"):
     for port, (direction, width) in ports.items():
         if port in ("motor_left", "motor_right", servo) or (camera and port in _CAMERA_INPUTS):
             continue
+        if turret and port in _TURRET_INPUTS:
+            continue
         if port in pins_of:
             kind, pin = pins_of[port]
             if width != 1 or "__" in port:
@@ -162,20 +177,36 @@ def board_ports(spec, board="ulx3s-85f"):
                 f"camera stream (pixels, color_sel), the wheels (motor_left, motor_right) "
                 f"and connector pins (trig, echo, pressed, ...) on header pins"
             )
-    if len(header) > len(HEADER_SITES):
+    free = header_sites(turret)
+    if len(header) > len(free):
         raise UserError(
-            f"design {name}: {len(header)} connector pins, the board's header has "
-            f"{len(HEADER_SITES)} free"
+            f"design {name}: {len(header)} connector pins, the board's header has {len(free)} free"
         )
-    return {"camera": camera, "servo": servo, "header": header}
+    return {"camera": camera, "turret_camera": turret, "servo": servo, "header": header}
 
 
 def _user_factory(spec):
     def factory(params):
-
         wiring = board_ports(spec)
-        return ulx3s_user_platform(wiring["header"]), ULX3SUserDesign(
-            spec.build(), header=wiring["header"], camera=wiring["camera"], servo=wiring["servo"]
+        platform = ulx3s_user_platform(wiring["header"], wiring.get("turret_camera", False))
+        if spec.kind == "verilog":
+            # Yosys reads the design's files (and those they include) with the generated top.
+            for name, text in verilog_files(spec):
+                if name.startswith(DESIGN_NAME + "."):
+                    raise UserError(
+                        f"design {spec.port_map.top}: rename {name!r}: the board build "
+                        f"writes its own files as {DESIGN_NAME}.*"
+                    )
+                platform.add_file(name, text)
+            design = VerilogOnBoard(spec.port_map, servo=wiring["servo"], header=wiring["header"])
+        else:
+            design = spec.build()
+        return platform, ULX3SUserDesign(
+            design,
+            header=wiring["header"],
+            camera=wiring["camera"],
+            turret_camera=wiring.get("turret_camera", False),
+            servo=wiring["servo"],
         )
 
     return factory
@@ -184,10 +215,9 @@ def _user_factory(spec):
 def header_pins(spec):
     """``[(port, header pin, site)]``: where a design's connector pins are on the board."""
 
-    return [
-        (port, pin, site)
-        for (port, _d), (pin, site) in zip(board_ports(spec)["header"], HEADER_SITES)
-    ]
+    wiring = board_ports(spec)
+    sites = header_sites(wiring.get("turret_camera", False))
+    return [(port, pin, site) for (port, _d), (pin, site) in zip(wiring["header"], sites)]
 
 
 def _plan(board, params, nextpnr_opts=(), *, verilog=False, design=None):
@@ -213,6 +243,7 @@ def _write_plan(plan, out_dir, *, rename_verilog=True):
         if rename_verilog and filename == f"{DESIGN_NAME}.debug.v":
             target = f"{DESIGN_NAME}.v"
         path = os.path.join(out_dir, target)
+        os.makedirs(os.path.dirname(path), exist_ok=True)  # an included file in a subfolder
         if isinstance(content, bytes):
             content = content.decode()
         write_atomic(path, content, what="board build file")

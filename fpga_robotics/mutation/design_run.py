@@ -109,10 +109,11 @@ def mutate_verilog_design(
     t0 = time.perf_counter()
     design = ForeignDesign(files, ports_path, pins=True, connector_kinds=connector_kinds())
     top = design.port_map.top
-    mutants = list_mutants(None, n, seed, verilog=design.sources, top=top)
+    sources = {"verilog": design.sources, "top": top, "includes": design.includes}
+    mutants = list_mutants(None, n, seed, **sources)
     os.makedirs(out, exist_ok=True)
     netlist = os.path.join(out, NETLIST_NAME)
-    verilog = mutant_netlist(None, mutants, verilog=design.sources, top=top)
+    verilog = mutant_netlist(None, mutants, **sources)
     write_atomic(netlist, verilog, what="mutant netlist")
     port_map = os.path.join(out, PORTS_NAME)
     with open(ports_path) as f:

@@ -31,6 +31,11 @@ mosi       E17     gpio 20-          out    GoPiGo3 SPI data out
 
 The camera's PWDN pin is not wired in the published assignment: tie it low (most OV7670
 modules pull it down already). Every pin is LVCMOS33.
+
+A second, pan camera (a design with ``turret_pixels``, the turret application) has no
+published assignment; ``TURRET_CAMERA_PINS`` puts it on header pairs 22-27 and 19, pins the
+board's own wiring leaves free, with its reset wired to the first camera's (one pin drives
+both).
 """
 
 from amaranth.build import Attrs, Clock, Pins, PinsN, Resource, Subsignal
@@ -39,8 +44,10 @@ __all__ = [
     "CAMERA_PINS",
     "GOPIGO3_SPI_PINS",
     "MAX_PCLK_HZ",
+    "TURRET_CAMERA_PINS",
     "camera_resources",
     "gopigo3_spi_resources",
+    "turret_camera_resources",
 ]
 
 #: Camera signal -> ECP5 site (BG381 package). ``data`` lists bit 0 first.
@@ -53,6 +60,18 @@ CAMERA_PINS = {
     "siod": "H4",
     "sioc": "G5",
     "reset_n": "C18",
+}
+
+#: The pan camera's signal -> ECP5 site (gpio 22+..25- data, 26+/- xclk/pclk, 27+/- href/vsync,
+#: 19+/- siod/sioc); no reset pin of its own.
+TURRET_CAMERA_PINS = {
+    "data": ("B15", "C15", "B17", "C17", "C16", "D16", "D14", "E14"),
+    "xclk": "B13",
+    "pclk": "C13",
+    "href": "D13",
+    "vsync": "E13",
+    "siod": "F17",
+    "sioc": "G18",
 }
 
 #: GoPiGo3 SPI signal -> ECP5 site.
@@ -70,24 +89,30 @@ MAX_PCLK_HZ = 12.5e6
 _IO = Attrs(IO_TYPE="LVCMOS33")
 
 
+def _camera(number, p):
+    return Resource(
+        "ov7670",
+        number,
+        Subsignal("data", Pins(" ".join(p["data"]), dir="i")),
+        Subsignal("xclk", Pins(p["xclk"], dir="o"), Attrs(DRIVE="8")),
+        Subsignal("pclk", Pins(p["pclk"], dir="i"), Clock(MAX_PCLK_HZ)),
+        Subsignal("href", Pins(p["href"], dir="i")),
+        Subsignal("vsync", Pins(p["vsync"], dir="i")),
+        Subsignal("siod", Pins(p["siod"], dir="io"), Attrs(PULLMODE="UP")),
+        Subsignal("sioc", Pins(p["sioc"], dir="o"), Attrs(PULLMODE="UP")),
+        *([Subsignal("reset", PinsN(p["reset_n"], dir="o"))] if "reset_n" in p else []),
+        _IO,
+    )
+
+
 def camera_resources():
     """The OV7670 as one Amaranth ``Resource`` named ``ov7670``."""
-    p = CAMERA_PINS
-    return [
-        Resource(
-            "ov7670",
-            0,
-            Subsignal("data", Pins(" ".join(p["data"]), dir="i")),
-            Subsignal("xclk", Pins(p["xclk"], dir="o"), Attrs(DRIVE="8")),
-            Subsignal("pclk", Pins(p["pclk"], dir="i"), Clock(MAX_PCLK_HZ)),
-            Subsignal("href", Pins(p["href"], dir="i")),
-            Subsignal("vsync", Pins(p["vsync"], dir="i")),
-            Subsignal("siod", Pins(p["siod"], dir="io"), Attrs(PULLMODE="UP")),
-            Subsignal("sioc", Pins(p["sioc"], dir="o"), Attrs(PULLMODE="UP")),
-            Subsignal("reset", PinsN(p["reset_n"], dir="o")),
-            _IO,
-        )
-    ]
+    return [_camera(0, CAMERA_PINS)]
+
+
+def turret_camera_resources():
+    """The pan camera: ``ov7670`` number 1."""
+    return [_camera(1, TURRET_CAMERA_PINS)]
 
 
 def gopigo3_spi_resources():

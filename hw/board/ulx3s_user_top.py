@@ -3,7 +3,9 @@
 The design's ports meet the board where the simulation's connectors meet them:
 
 - the camera's framed pixel stream ``pixels`` (OV7670, SCCB, capture and clock crossing as in
-  ``robot_core``), ``color_sel`` from the DIP switches SW1..SW3;
+  ``robot_core``), ``color_sel`` from the DIP switches SW1..SW3; a pan camera's
+  ``turret_pixels`` from a second OV7670 (``pins.TURRET_CAMERA_PINS``), ``turret_color_sel``
+  from the same switches;
 - the GoPiGo3 wheels, ``motor_left``/``motor_right``, sent over SPI at every ``frame_done``
   of a camera design, else every ``update_s`` (50 Hz by default), and with them a servo's
   angle (the port ``servo`` names) as SET_SERVO to the GoPiGo3's servo port 1;
@@ -25,11 +27,18 @@ from .clocking import BoardClocking
 from .color_select import SwitchColorSelect
 from .gopigo3_spi import GoPiGo3Motors
 from .ov7670_capture import OV7670Capture
+from .pins import TURRET_CAMERA_PINS, turret_camera_resources
 from .robot_core import RobotTiming, gopigo3_dps_limit
 from .sccb import OV7670_INIT, SCCBInit
 from .ulx3s_top import OSC_FREQ, SYS_CLK_FREQ, ulx3s_platform
 
-__all__ = ["HEADER_SITES", "ULX3SUserDesign", "header_resources", "ulx3s_user_platform"]
+__all__ = [
+    "HEADER_SITES",
+    "ULX3SUserDesign",
+    "header_resources",
+    "header_sites",
+    "ulx3s_user_platform",
+]
 
 #: GPIO header J1 pins the camera and the GoPiGo3 leave free (``gpio`` pairs 7-12, 14-19,
 #: 22-27 of the ULX3S), as (connector pin, ECP5 site).
@@ -59,12 +68,21 @@ HEADER_SITES = tuple(
 )
 
 
-def header_resources(ports):
+def header_sites(turret_camera=False):
+    """``HEADER_SITES`` without the pan camera's pins when the design has one."""
+    if not turret_camera:
+        return HEADER_SITES
+    taken = {s for v in TURRET_CAMERA_PINS.values() for s in ((v,) if isinstance(v, str) else v)}
+    return tuple((pin, site) for pin, site in HEADER_SITES if site not in taken)
+
+
+def header_resources(ports, turret_camera=False):
     """One resource ``fr_header`` per header port (``[(name, direction)]``), numbered in
-    order, on ``HEADER_SITES``."""
+    order, on ``header_sites(turret_camera)``."""
+    sites = header_sites(turret_camera)
     return [
         Resource("fr_header", k, Pins(site, dir=direction), Attrs(IO_TYPE="LVCMOS33"))
-        for k, ((_name, direction), (_pin, site)) in enumerate(zip(ports, HEADER_SITES))
+        for k, ((_name, direction), (_pin, site)) in enumerate(zip(ports, sites))
     ]
 
 
@@ -77,8 +95,19 @@ class ULX3SUserDesign(Elaboratable):
     ``frame_done``.
     """
 
-    def __init__(self, design, *, header=(), camera=False, servo=None, update_s=0.02, params=None):
+    def __init__(
+        self,
+        design,
+        *,
+        header=(),
+        camera=False,
+        turret_camera=False,
+        servo=None,
+        update_s=0.02,
+        params=None,
+    ):
         self.design = design
+        self.turret_camera = turret_camera
         self.servo = servo
         self.header = list(header)
         self.camera = camera
@@ -88,6 +117,48 @@ class ULX3SUserDesign(Elaboratable):
 
     def _port(self, name):
         return getattr(self.design, name, None)
+
+    def _camera(self, m, platform, fire1, number, stream, xclk):
+        """OV7670 ``number`` (its SCCB set-up, capture in its own pclk domain) onto the
+        design's ``stream``."""
+        t = self.timing
+        cam = platform.request("ov7670", number, dir="-")
+        tag = "" if number == 0 else f"_{number}"
+
+        def sub(subsignal, direction):
+            buf = io.Buffer(direction, getattr(cam, subsignal))
+            m.submodules[f"{subsignal}{tag}_buffer"] = buf
+            return buf
+
+        domain = f"pclk{tag}"
+        pclk = sub("pclk", "i")
+        m.domains += ClockDomain(domain, local=True)
+        m.d.comb += ClockSignal(domain).eq(pclk.i)
+        m.submodules[f"{domain}_reset"] = ResetSynchronizer(fire1.i, domain=domain)
+        sccb = SCCBInit(
+            OV7670_INIT,
+            quarter_period=t.sccb_quarter,
+            reset_wait=t.reset_wait,
+            startup_wait=t.camera_wait,
+        )
+        m.submodules[f"sccb{tag}"] = sccb
+        siod = sub("siod", "io")
+        capture = OV7670Capture(pclk_domain=domain)
+        m.submodules[f"capture{tag}"] = capture
+        m.d.comb += [
+            capture.data.eq(sub("data", "i").i),
+            capture.href.eq(sub("href", "i").i),
+            capture.vsync.eq(sub("vsync", "i").i),
+            sub("xclk", "o").o.eq(xclk),
+            sub("sioc", "o").o.eq(sccb.sioc),
+            siod.o.eq(sccb.siod_o),
+            siod.oe.eq(sccb.siod_oe),
+            # Only RGB444 frames reach the design: nothing before the registers are set.
+            stream.valid.eq(capture.pixels.valid & sccb.done),
+            stream.payload.eq(capture.pixels.payload),
+        ]
+        if hasattr(cam, "reset"):
+            m.d.comb += sub("reset", "o").o.eq(0)
 
     def elaborate(self, platform):
         m = Module()
@@ -111,44 +182,25 @@ class ULX3SUserDesign(Elaboratable):
         )
         m.submodules.design = design = self.design
 
-        if self.camera:
-            cam = platform.request("ov7670", 0, dir="-")
-            pclk = sub(cam, "pclk", "i")
-            m.domains.pclk = ClockDomain("pclk", local=True)
-            m.d.comb += ClockSignal("pclk").eq(pclk.i)
-            m.submodules.pclk_reset = ResetSynchronizer(fire1.i, domain="pclk")
-            xclk, count = Signal(), Signal(range(t.xclk_half))
+        switch_color = None
+        if self.camera or self.turret_camera:
+            xclk, count = Signal(), Signal(range(t.xclk_half))  # both cameras' master clock
             with m.If(count == t.xclk_half - 1):
                 m.d.sync += [count.eq(0), xclk.eq(~xclk)]
             with m.Else():
                 m.d.sync += count.eq(count + 1)
-            m.submodules.sccb = sccb = SCCBInit(
-                OV7670_INIT,
-                quarter_period=t.sccb_quarter,
-                reset_wait=t.reset_wait,
-                startup_wait=t.camera_wait,
-            )
-            siod = sub(cam, "siod", "io")
-            m.submodules.capture = capture = OV7670Capture(pclk_domain="pclk")
-            m.d.comb += [
-                capture.data.eq(sub(cam, "data", "i").i),
-                capture.href.eq(sub(cam, "href", "i").i),
-                capture.vsync.eq(sub(cam, "vsync", "i").i),
-                sub(cam, "xclk", "o").o.eq(xclk),
-                sub(cam, "reset", "o").o.eq(0),
-                sub(cam, "sioc", "o").o.eq(sccb.sioc),
-                siod.o.eq(sccb.siod_o),
-                siod.oe.eq(sccb.siod_oe),
-                # Only RGB444 frames reach the design: nothing before the registers are set.
-                design.pixels.valid.eq(capture.pixels.valid & sccb.done),
-                design.pixels.payload.eq(capture.pixels.payload),
-            ]
-            if self._port("color_sel") is not None:
+            if any(self._port(n) is not None for n in ("color_sel", "turret_color_sel")):
                 m.submodules.color_select = color = SwitchColorSelect()
-                m.d.comb += [
-                    color.switches.eq(Cat(pin("switch", i, "i").i for i in range(3))),
-                    design.color_sel.eq(color.color_sel),
-                ]
+                m.d.comb += color.switches.eq(Cat(pin("switch", i, "i").i for i in range(3)))
+                switch_color = color.color_sel
+        for number, prefix, wanted in ((0, "", self.camera), (1, "turret_", self.turret_camera)):
+            if not wanted:
+                continue
+            stream = getattr(design, f"{prefix}pixels")
+            self._camera(m, platform, fire1, number, stream, xclk)
+            color_port = self._port(f"{prefix}color_sel")
+            if color_port is not None:  # the switches' colour, for each camera
+                m.d.comb += color_port.eq(switch_color)
 
         leds = self._port("centroid_leds")
         for i in range(8):
@@ -193,8 +245,11 @@ class ULX3SUserDesign(Elaboratable):
         return m
 
 
-def ulx3s_user_platform(header):
-    """``ulx3s_platform()`` with the header pins of ``header`` (``[(port, direction)]``)."""
+def ulx3s_user_platform(header, turret_camera=False):
+    """``ulx3s_platform()`` with the header pins of ``header`` (``[(port, direction)]``) and
+    the pan camera if asked for."""
     platform = ulx3s_platform()
-    platform.add_resources(header_resources(header))
+    platform.add_resources(header_resources(header, turret_camera))
+    if turret_camera:
+        platform.add_resources(turret_camera_resources())
     return platform
