@@ -43,9 +43,10 @@ class TurretParams:
     kp_shift: int = 2
     #: The largest angle commanded (500: 90 degrees either way).
     angle_limit: int = 500
-    #: Consecutive lost frames after which the camera searches (8: about half a second at
-    #: 15 fps, long enough to ride out a person passing in front of the target).
-    lost_frames: int = 8
+    #: Consecutive lost frames after which the camera searches (20: 1.3 s at 15 fps, long
+    #: enough to ride out the person the body follows passing in front of the target; the
+    #: shipped ``turret`` fails its centred check at 20 s with 8, and at 120 s with 30).
+    lost_frames: int = 20
     #: The search's rate, command units a frame: 16 units (2.9 degrees) at 15 fps is 43
     #: degrees a second, well inside the field of view per frame (60 degrees = 333 units), so
     #: the sweep cannot skip over the target; a full 180-degree sweep takes 4.2 s.
