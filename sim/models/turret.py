@@ -97,6 +97,10 @@ class TurretChannel:
     color_port = "turret_color_sel"
     #: The outputs the viewer shows with the camera's image: found, centroid column.
     view_ports = ("turret_found", "turret_centroid_x")
+    #: The design's pulse at a frame's results and the outputs ``process`` returns: what a
+    #: clocked backend reads off the design instead (fpga_robotics.loop.pin_channel).
+    done_port = "turret_frame_done"
+    output_ports = ("turret_found", "turret_centroid_x", "servo_angle")
 
     def __init__(self, tables):
         self.model = TurretAimModel(tables.get("turret"))
