@@ -201,9 +201,10 @@ class ClosedLoop:
         # Further cameras and pan servos ([[robot.sensors]] cameras, [[robot.actuators]]
         # servos); None without any, and then nothing below changes.
         self.rig = CameraRig.build(scenario, self.world, self.seed, TOPS.get(scenario.top))
-        if self.rig is not None and sim.timing == "compressed":
-            if getattr(design, "name", None) in PIN_CHANNEL_BACKENDS:  # the design's channels
-                self.rig.run_channels_on(design.name, scenario, TOPS[scenario.top])
+        # On a clocked backend the further cameras' channels run on the design too.
+        clocked = getattr(design, "name", None) in PIN_CHANNEL_BACKENDS
+        if self.rig is not None and sim.timing == "compressed" and clocked:
+            self.rig.run_channels_on(design.name, scenario, TOPS[scenario.top])
 
     def _build_camera(self, cam, spec):
         """The camera on the robot; mount values the scenario leaves unset are the robot's."""

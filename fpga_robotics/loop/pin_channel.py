@@ -82,3 +82,11 @@ class PinFrameChannel:
 
     def close(self):
         self.pins.close()
+
+    def __deepcopy__(self, memo):
+        # A loop checkpoint (fpga_robotics.loop.checkpoint) copies the rig; a simulator's
+        # state is not a Python object it can copy.
+        raise TypeError(
+            f"a design channel running on {self.backend} cannot be checkpointed; "
+            "run the loop on the model backend"
+        )
