@@ -23,7 +23,14 @@ class TurretParams:
     servo angle ``a`` updated once a found frame as ``a -= sign * ((kp_num * e) >>
     kp_shift)``, ``e = centroid_x - width // 2`` (pixels, right positive), saturating at
     ``+-angle_limit``. ``a`` grows to the left (the servo's convention), so a target right of
-    the image centre turns the camera right. A lost frame holds the angle."""
+    the image centre turns the camera right. A found frame also remembers the side the target
+    was on (``e < 0``: left; ``e = 0`` keeps the side).
+
+    A lost frame holds the angle until ``lost_frames`` frames in a row have missed the target;
+    from that frame on each lost frame sweeps the angle ``search_step`` units towards the
+    remembered side, and at ``+-angle_limit`` the sweep stops there and turns back, so the
+    camera scans its whole range at ``search_step`` units a frame until it finds the target
+    again. ``search_step = 0`` holds the angle for ever."""
 
     #: The pan camera's resolution (its frames' size; the filter's thresholds are the
     #: defaults of ``FollowTargetParams``).
@@ -36,6 +43,14 @@ class TurretParams:
     kp_shift: int = 2
     #: The largest angle commanded (500: 90 degrees either way).
     angle_limit: int = 500
+    #: Consecutive lost frames after which the camera searches (20: 1.3 s at 15 fps, long
+    #: enough to ride out the person the body follows passing in front of the target; the
+    #: shipped ``turret`` fails its centred check at 20 s with 8, and at 120 s with 30).
+    lost_frames: int = 20
+    #: The search's rate, command units a frame: 16 units (2.9 degrees) at 15 fps is 43
+    #: degrees a second, well inside the field of view per frame (60 degrees = 333 units), so
+    #: the sweep cannot skip over the target; a full 180-degree sweep takes 4.2 s.
+    search_step: int = 16
     #: True turns the camera away from the target (a seeded bug: ``hw/variants.py``).
     inverted: bool = False
 
@@ -46,6 +61,8 @@ class TurretParams:
             ("kp_num", 0, 255),
             ("kp_shift", 0, 15),
             ("angle_limit", 0, (1 << (ANGLE_BITS - 1)) - 1),
+            ("lost_frames", 1, 255),
+            ("search_step", 0, 255),
         ):
             object.__setattr__(self, name, check_int(name, getattr(self, name), lo, hi))
         if not isinstance(self.inverted, bool):

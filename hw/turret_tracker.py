@@ -3,13 +3,14 @@ second target centred (the published turret application).
 
 The turret channel (``TurretAim``) reuses FollowTarget's colour filter and tracker on the pan
 camera's own pixel stream and colour select, then ``ServoAim`` turns the tracker's centroid
-error into the servo's 10-bit signed angle (``TurretParams``). The two channels share
+error into the servo's 10-bit signed angle (``TurretParams``), and sweeps it in search of the
+target once the target has been lost for ``lost_frames`` frames. The two channels share
 nothing but the clock: the body camera's frames steer the wheels as in ``FollowTarget``.
 """
 
 from typing import ClassVar
 
-from amaranth import Module, Signal, signed
+from amaranth import Module, Mux, Signal, signed
 from amaranth.lib import wiring
 from amaranth.lib.wiring import In, Out
 
@@ -23,7 +24,9 @@ __all__ = ["ServoAim", "TurretAim", "TurretTracker"]
 
 
 class ServoAim(wiring.Component):
-    """The proportional pan law of ``TurretParams``, once a frame.
+    """The proportional pan law of ``TurretParams``, once a frame, and its search: after
+    ``lost_frames`` lost frames in a row the angle sweeps ``search_step`` a frame towards the
+    side the target was last seen on, turning back at the limits.
 
     Members
     -------
@@ -33,6 +36,8 @@ class ServoAim(wiring.Component):
     centroid_x : ``In(x_bits)``
     angle : ``Out(signed(10))``
         The servo command, registered: it shows a frame's update one cycle after ``update``.
+    lost_count : ``Out(range(lost_frames + 1))``
+        Consecutive lost frames, saturating at ``lost_frames`` (the camera is searching).
     """
 
     def __init__(self, params):
@@ -46,6 +51,7 @@ class ServoAim(wiring.Component):
                 "found": In(1),
                 "centroid_x": In(x_bits),
                 "angle": Out(signed(ANGLE_BITS)),
+                "lost_count": Out(range(params.lost_frames + 1)),
             }
         )
 
@@ -60,13 +66,36 @@ class ServoAim(wiring.Component):
             step.eq((error * p.kp_num) >> p.kp_shift),  # arithmetic shift: floor division
             wide.eq(self.angle + step if p.inverted else self.angle - step),
         ]
+        # The side the target was last seen on (1: left, the reset value) sets the search's
+        # direction.
+        left = Signal(init=1)
+        lost_next = Signal.like(self.lost_count)
+        sweep = Signal(signed(ANGLE_BITS + 2))
+        m.d.comb += [
+            lost_next.eq(Mux(self.lost_count == p.lost_frames, p.lost_frames, self.lost_count + 1)),
+            sweep.eq(Mux(left, self.angle + p.search_step, self.angle - p.search_step)),
+        ]
         with m.If(self.update & self.found):
+            m.d.sync += self.lost_count.eq(0)
+            with m.If(error < 0):
+                m.d.sync += left.eq(1)
+            with m.Elif(error > 0):
+                m.d.sync += left.eq(0)
             with m.If(wide > p.angle_limit):
                 m.d.sync += self.angle.eq(p.angle_limit)
             with m.Elif(wide < -p.angle_limit):
                 m.d.sync += self.angle.eq(-p.angle_limit)
             with m.Else():
                 m.d.sync += self.angle.eq(wide)
+        with m.Elif(self.update):
+            m.d.sync += self.lost_count.eq(lost_next)
+            with m.If(lost_next == p.lost_frames):
+                with m.If(sweep >= p.angle_limit):
+                    m.d.sync += [self.angle.eq(p.angle_limit), left.eq(0)]
+                with m.Elif(sweep <= -p.angle_limit):
+                    m.d.sync += [self.angle.eq(-p.angle_limit), left.eq(1)]
+                with m.Else():
+                    m.d.sync += self.angle.eq(sweep)
         return m
 
 

@@ -94,6 +94,34 @@ def test_saturation_and_the_inverted_variant():
     assert seen[0][2] == (5 * (seen[0][1] - 40)) >> 2 > 0  # turns away from the target
 
 
+def test_a_lost_target_is_searched_for_by_a_hand_computed_sweep():
+    # Lost from reset: the side is left, so after lost_frames = 2 the angle climbs 100 a
+    # frame, stops at the limit 250 and turns, and stops at -250 and turns again.
+    search = SMALL.replace(lost_frames=2, search_step=100, angle_limit=250)
+    empty = to_rgb444(np.full((SMALL.height, SMALL.width, 3), 90, np.uint8), 80, 40)
+    frames = [empty] * 10 + [blob(search, 60)] + [empty] * 3
+    seen = run_aim(search, frames)
+    sweep = [0, 100, 200, 250, 150, 50, -50, -150, -250, -150]
+    assert [s[2] for s in seen[:10]] == sweep
+    assert not any(s[0] for s in seen[:10])
+    found, cx, angle = seen[10]
+    assert found and cx > 40 and angle == -150 - ((5 * (cx - 40)) >> 2)
+    # Found right of the centre: the search now starts rightwards after two lost frames,
+    # reaches the limit at once (angle - 100 < -250), stops there and turns back.
+    assert angle - 100 < -250
+    assert [s[2] for s in seen[11:]] == [angle, -250, -150]
+    model = TurretAimModel(search)
+    expected = [model.process(f, COLOR_SELECT["blue"]) for f in frames]
+    assert [(int(e.tracker.found), e.tracker.centroid_x, e.angle) for e in expected] == seen
+
+
+def test_search_step_zero_holds_the_angle_for_ever():
+    still = SMALL.replace(lost_frames=1, search_step=0)
+    empty = to_rgb444(np.full((SMALL.height, SMALL.width, 3), 90, np.uint8), 80, 40)
+    seen = run_aim(still, [blob(still, 25), empty, empty])
+    assert seen[0][2] > 0 and [s[2] for s in seen[1:]] == [seen[0][2]] * 2
+
+
 def test_turret_tracker_exports_with_both_channels():
     text = generate_verilog(component=TurretTracker())
     for port in ("turret_pixels__payload", "turret_color_sel", "servo_angle", "motor_left"):

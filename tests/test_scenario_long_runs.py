@@ -14,12 +14,6 @@ from fpga_robotics.sim.world import TURTLEBOT2
 SHIPPED = sorted(shipped_scenarios())
 #: Real-clock scenarios simulate 50 M design cycles a second of world time: 30 and 60 s only.
 REAL_CLOCK = ("line_track", "obstacle_between")
-#: Scenarios whose story lasts a bounded time, with the longest duration that still tells it.
-BOUNDED = {
-    # The robot closes in on the crossing person until its turns, or the red person passing
-    # in front of the blue one, lose the pan camera its person (docs/turret.md).
-    "turret": 30,
-}
 #: The edit-test loop keeps the 30 s runs of the compressed scenarios; the rest is slow-tier.
 RUNS = [
     (name, 30) if name not in REAL_CLOCK else pytest.param(name, 30, marks=pytest.mark.slow)
@@ -28,7 +22,7 @@ RUNS = [
     pytest.param(name, duration, marks=pytest.mark.slow)
     for name in SHIPPED
     for duration in (60, 120)
-    if not (duration == 120 and name in REAL_CLOCK) and duration <= BOUNDED.get(name, duration)
+    if not (duration == 120 and name in REAL_CLOCK)
 ]
 
 

@@ -12,6 +12,7 @@ import pytest
 from render3d_scenes import mujoco_missing
 
 from fpga_robotics.hw.errors import UsageError
+from fpga_robotics.hw.turret_params import TurretParams
 from fpga_robotics.loop.timings import run_scenario
 from fpga_robotics.scenario.load import load_scenario
 from fpga_robotics.viz import open_recorder
@@ -129,8 +130,10 @@ def test_the_turret_keeps_its_target_centred_while_the_body_turns(turret_runs):
     heading = np.degrees(t["heading"][settled])
     assert heading.max() - heading.min() > 30  # the body turns while following the red person
     bearing = t["turret.target_bearing_deg"][settled]
-    # The pan camera keeps the blue person within 7 degrees, half the time within 1.
-    assert np.max(np.abs(bearing)) < 7.0 and np.median(np.abs(bearing)) < 1.0
+    # The pan camera keeps the blue person within 7 degrees, half the time within 1, but for
+    # the few frames after its search has turned it while the red person hid the blue one.
+    assert np.mean(np.abs(bearing) < 7.0) > 0.98 and np.median(np.abs(bearing)) < 1.0
+    assert np.max(np.abs(bearing)) < 15.0
     # ... because the servo turns against the body: the camera's world direction follows the
     # person's, whatever the heading.
     pan = t["pan.angle_deg"][settled]
@@ -144,6 +147,29 @@ def test_the_inverted_pan_fails_the_centred_check(turret_runs):
     checks = {c["name"]: c["status"] for c in bad.summary["checks"]}
     assert checks["camera_target_centred_min_fraction"] == "fail"
     assert checks["max_person_collisions"] == "pass"  # the body's channel is unchanged
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_the_turret_searches_and_passes_a_minute(seed):
+    """Over a minute the pan camera loses its person (the red one passes in front, the body
+    turns); the search finds them again, so the camera checks pass, and without it (the
+    angle held for ever) they fail."""
+    s = load_scenario("turret", ["sim.duration=60"])
+    r = run_scenario(s, seed=seed, backend="model")
+    assert r.summary["verdict"] == "pass", [c["text"] for c in r.summary["checks"]]
+    found = r.trajectory["turret.turret_found"].astype(bool)
+    # Some loss outlasted lost_frames (the camera searched) and ended in a found frame.
+    refound = np.flatnonzero(found[1:] & ~found[:-1]) + 1
+    lost_before = [np.argmax(found[:i][::-1]) for i in refound]  # lost frames before each
+    assert max(lost_before) > TurretParams().lost_frames
+    if seed == 0:
+        held = run_scenario(
+            load_scenario("turret", ["sim.duration=60", "design.turret.search_step=0"]),
+            seed=seed,
+            backend="model",
+        )
+        checks = {c["name"]: c["status"] for c in held.summary["checks"]}
+        assert checks["camera_target_in_view_min_fraction"] == "fail"
 
 
 def test_the_viewer_shows_each_camera_and_its_view_on_the_map(tmp_path):

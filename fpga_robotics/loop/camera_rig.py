@@ -27,6 +27,7 @@ import numpy as np
 from fpga_robotics.hw.errors import UsageError
 from fpga_robotics.hw.pixel import color_select_value
 from fpga_robotics.loop.connectors import CONNECTORS, CameraConnector, in_view
+from fpga_robotics.loop.pin_channel import PinFrameChannel
 from fpga_robotics.sim.camera.frames import to_rgb444
 from fpga_robotics.sim.camera.scene import CameraPose
 from fpga_robotics.sim.pins.timing import real_clock_timing
@@ -47,6 +48,7 @@ class RigCamera:
         self.name, self.mount = spec.name, spec.mount
         self.connector, self.servo = connector, servo
         self.channel, self.port, self.color_port = channel, port, color_port
+        self.channel_ran = "model"  # or the clocked backend running it (run_channels_on)
         self.color_code = color_select_value(self.params.color)
         self.frames = 0
         self.next_step = 0
@@ -87,6 +89,22 @@ class CameraRig:
         """Real-clock timing: stream the captures into ``pins`` (a ``PinBackend``) on a
         ``clock_hz`` clock instead of the channels' models."""
         self.pins, self.clock_hz = pins, clock_hz
+
+    def run_channels_on(self, backend, scenario, top, *, on_build=None):
+        """Compressed timing on a clocked backend (``pysim``, ``cxxrtl``, ``verilator``): each
+        camera's channel runs on the design itself on that pin backend instead of its model."""
+        for cam in self.cameras:
+            if cam.channel is not None:
+                cam.channel = PinFrameChannel(
+                    cam.channel, scenario, top, cam.port, backend, on_build=on_build
+                )
+                cam.channel_ran = backend
+
+    def close(self):
+        for cam in self.cameras:
+            close = getattr(cam.channel, "close", None)
+            if close is not None:
+                close()
 
     def driven_ports(self):
         """The design inputs the cameras drive (their port bundles)."""
@@ -246,13 +264,14 @@ class CameraRig:
             centred = np.abs(bearing) <= cam.params.centred_deg
             per[cam.name] = {
                 "frames": cam.frames,
-                # What ran its design channel: the channel's model (compressed timing) or the
-                # design on the pin backend (real clock); none for a camera that only films.
+                # What ran its design channel: the channel's model or the design on a clocked
+                # backend (compressed timing), the design on the pin backend (real clock);
+                # none for a camera that only films.
                 "channel": None
                 if cam.channel is None
-                else "model"
-                if self.pins is None
-                else "design",
+                else "design"
+                if self.pins is not None
+                else cam.channel_ran,
                 "target_in_view_fraction": round(float(np.mean(seen == 1.0)), 4) if rows else None,
                 "target_centred_fraction": round(float(np.mean(centred)), 4) if rows else None,
                 "max_abs_bearing_deg": round(float(np.nanmax(np.abs(bearing))), 2)

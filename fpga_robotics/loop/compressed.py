@@ -24,6 +24,7 @@ from fpga_robotics.hw.pixel import color_select_value
 from fpga_robotics.loop.camera_rig import CameraRig
 from fpga_robotics.loop.connectors import CameraConnector, MotorConnector, in_view
 from fpga_robotics.loop.connectors.camera import ExposureDrift, make_sensor
+from fpga_robotics.loop.pin_channel import PIN_CHANNEL_BACKENDS
 from fpga_robotics.loop.shadow import ShadowComparison, divergence_event
 from fpga_robotics.ros.controls import apply_inputs
 from fpga_robotics.sim.backends import fastest_backend_name, get_backend
@@ -194,6 +195,10 @@ class ClosedLoop:
         # Further cameras and pan servos ([[robot.sensors]] cameras, [[robot.actuators]]
         # servos); None without any, and then nothing below changes.
         self.rig = CameraRig.build(scenario, self.world, self.seed, TOPS.get(scenario.top))
+        # On a clocked backend the further cameras' channels run on the design too.
+        clocked = getattr(design, "name", None) in PIN_CHANNEL_BACKENDS
+        if self.rig is not None and sim.timing == "compressed" and clocked:
+            self.rig.run_channels_on(design.name, scenario, TOPS[scenario.top])
 
     def _build_camera(self, cam, spec):
         """The camera on the robot; mount values the scenario leaves unset are the robot's."""
@@ -599,7 +604,12 @@ def run_loop(backend, open_backend, build_loop, *, shadow=None, progress=None, r
         design.reset()
         if shadow is not None:
             shadow.reset()
-        return build_loop(design).run(progress=progress, realtime=realtime)
+        loop = build_loop(design)
+        try:
+            return loop.run(progress=progress, realtime=realtime)
+        finally:
+            if getattr(loop, "rig", None) is not None:
+                loop.rig.close()
     finally:
         if owns_backend:
             design.close()
