@@ -5,7 +5,7 @@ model's servo commands and turret outputs frame for frame, its search included."
 import numpy as np
 import pytest
 
-from fpga_robotics.loop.compressed import run_scenario
+from fpga_robotics.loop.timings import run_scenario
 from fpga_robotics.scenario.load import load_scenario
 
 COLUMNS = ("turret.turret_found", "turret.turret_centroid_x", "pan.command", "pan.angle_deg")
