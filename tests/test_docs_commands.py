@@ -962,7 +962,7 @@ PLANS = {
     ),
     # Forked against full robot-judge runs: the same four mutants at 80x60 as above.
     (
-        "python -m fpga_robotics.mutation --mutants 30 --campaign mutation --workers 2 "
+        "python -m fpga_robotics.mutation --mutants 60 --seed 0 --campaign mutation --workers 2 "
         "--recordings 0 --out runs/mutation/fork"
     ): Plan(
         slow=True,
@@ -976,7 +976,7 @@ PLANS = {
         files=("runs/mutation/fork/mutants.json",),
     ),
     (
-        "python -m fpga_robotics.mutation --mutants 30 --campaign mutation --workers 2 "
+        "python -m fpga_robotics.mutation --mutants 60 --seed 0 --campaign mutation --workers 2 "
         "--recordings 0 --no-fork --out runs/mutation/no-fork"
     ): Plan(
         slow=True,
