@@ -21,6 +21,11 @@ reference's. Up to that frame the variant saw exactly the reference's images, so
 
 Either way the ``RunResult`` equals the variant's full run (``run_scenario``): trajectory,
 events and summary, the wall-clock timing fields excepted.
+
+A ``ReferenceRun`` holds its design and checkpoints that share objects with its loop, so it
+stays in its process; ``portable()`` is the same reference picklable
+(fpga_robotics.loop.reference_data), which ``ReferenceRun.from_portable`` opens in another
+process with the same variants' results.
 """
 
 import time
@@ -29,6 +34,7 @@ from types import SimpleNamespace
 from fpga_robotics.checks.summary import DESIGN_OUTPUTS
 from fpga_robotics.loop import checkpoint
 from fpga_robotics.loop.compressed import ClosedLoop, _DesignEvents, _dps
+from fpga_robotics.loop.reference_data import ReferenceData, pack_frames, recorded_of
 
 __all__ = ["ReferenceRun"]
 
@@ -149,6 +155,32 @@ class ReferenceRun:
     def frames(self):
         """How many frames the reference ran."""
         return len(self._loop.commands)
+
+    def portable(self):
+        """This reference as a ``ReferenceData``: picklable, for another process."""
+        ref = self._loop
+        return ReferenceData(
+            scenario=self.scenario,
+            seed=self.seed,
+            result=self.result,
+            frames=pack_frames(ref.seen),
+            colors=[color for _, color in ref.seen],
+            commands=list(ref.commands),
+            world_events=list(ref.world_events),
+            n_frames=ref.n_frames,
+            checkpoints=[checkpoint.portable(c) for c in ref.checkpoints],
+            final=checkpoint.portable(ref.final),
+        )
+
+    @classmethod
+    def from_portable(cls, data):
+        """The ``ReferenceRun`` that ``data`` (``portable()``) was made from, without its
+        design: ``run_variant`` gives the same results as the original's."""
+        self = cls.__new__(cls)
+        self.scenario, self.seed, self.result = data.scenario, data.seed, data.result
+        self._loop = recorded_of(data)
+        self.last_divergence = None
+        return self
 
     def run_variant(self, design, scenario=None, *, progress=None):
         """The run of ``design`` (reset here, not closed) in the reference's world.

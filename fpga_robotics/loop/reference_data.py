@@ -1,0 +1,78 @@
+"""A reference run (fpga_robotics.loop.fork) in a form another process can take: what
+``ReferenceRun.run_variant`` reads of it, with nothing bound to the process that ran it.
+
+The images are one contiguous ``uint8`` array (a frame is a view into it: one buffer to
+pickle and to keep), the world checkpoints are ``PortableCheckpoint`` bytes that restore
+into the variant's own loop. Made by ``ReferenceRun.portable()``, opened again by
+``ReferenceRun.from_portable``.
+"""
+
+from dataclasses import dataclass
+from types import SimpleNamespace
+
+import numpy as np
+
+__all__ = ["ReferenceData", "recorded_of"]
+
+
+@dataclass(eq=False)
+class ReferenceData:
+    """A reference run, picklable and self-contained.
+
+    Attributes
+    ----------
+    scenario : Scenario
+    seed : int
+    result : RunResult
+        The reference's own run.
+    frames : numpy.ndarray
+        ``(frames, height, width, 3)`` uint8: the image of every frame the reference ran.
+    colors : list of int
+        The colour select of every frame.
+    commands : list of (int, int)
+        The wheel commands (DPS) of every frame, as the motors took them.
+    world_events : list of (list of str, list of str)
+        The world's events before and after the design's own, per frame.
+    n_frames : int
+        The frames of the whole run (more than ``len(frames)`` for a robot that tipped over).
+    checkpoints : list of PortableCheckpoint
+        In frame order.
+    final : PortableCheckpoint
+        Once the frames and the physics after them are done.
+    """
+
+    scenario: object
+    seed: int
+    result: object
+    frames: np.ndarray
+    colors: list
+    commands: list
+    world_events: list
+    n_frames: int
+    checkpoints: list
+    final: object
+
+    @property
+    def nbytes(self):
+        """Roughly how much memory it takes: the images and the checkpoints."""
+        saved = [*self.checkpoints, self.final]
+        return self.frames.nbytes + sum(len(c.blob) for c in saved)
+
+
+def pack_frames(seen):
+    """The images of ``seen`` ((rgb, colour code) per frame) as one contiguous array."""
+    if not seen:
+        return np.zeros((0, 0, 0, 3), np.uint8)
+    return np.stack([rgb for rgb, _ in seen])
+
+
+def recorded_of(data):
+    """What ``ReferenceRun.run_variant`` reads of its recording loop, from ``data``."""
+    return SimpleNamespace(
+        seen=list(zip(data.frames, data.colors)),
+        commands=data.commands,
+        world_events=data.world_events,
+        n_frames=data.n_frames,
+        checkpoints=data.checkpoints,
+        final=data.final,
+    )

@@ -1,0 +1,118 @@
+"""A reference run in its portable form (``ReferenceRun.portable``), pickled and opened again,
+judges variants exactly as the reference itself: in this process, and in a fresh one that
+never ran the reference (its renderer, terrain and design are its own)."""
+
+import dataclasses
+import multiprocessing
+import pickle
+from concurrent.futures import ProcessPoolExecutor
+
+import numpy as np
+import pytest
+from run_equality import assert_same_run
+from test_fork import Altered, _left_plus
+
+from fpga_robotics.loop import checkpoint
+from fpga_robotics.loop.compressed import ClosedLoop
+from fpga_robotics.loop.fork import ReferenceRun
+from fpga_robotics.loop.timings import run_scenario
+from fpga_robotics.scenario.load import load_scenario
+from fpga_robotics.sim.backends.model import ModelBackend
+
+# A noisy camera and a target that walks away; terrain patches under the robot; a low-grip
+# floor; the divider's furniture: every kind of shared object a checkpoint names.
+SCENARIOS = ["lost_target", "ramp", "slippery", "divider"]
+OVERRIDES = ["sim.duration=2.5", "camera.noise_std=4"]
+
+
+def _variants(params, frames):
+    """(name, design): one that never drives differently (found never reported), one that
+    parts at frame 0, one that parts two frames before the end."""
+    return [
+        ("never", Altered(params, lambda k, r: dataclasses.replace(r, found=False, proximity=0))),
+        ("first", Altered(params, _left_plus(0))),
+        ("late", Altered(params, _left_plus(frames - 2))),
+    ]
+
+
+def _judged(reference, scenario):
+    """``{name: (RunResult, divergence frame)}`` of the variants against ``reference``."""
+    out = {}
+    for name, variant in _variants(scenario.params, reference.frames):
+        result = reference.run_variant(variant)
+        out[name] = (result, reference.last_divergence)
+    return out
+
+
+def _judged_elsewhere(blob):
+    """In a fresh process: the variants judged against the pickled portable reference."""
+    reference = ReferenceRun.from_portable(pickle.loads(blob))
+    return _judged(reference, reference.scenario)
+
+
+@pytest.fixture(scope="module", params=SCENARIOS)
+def shared(request):
+    scenario = load_scenario(request.param, OVERRIDES)
+    with ModelBackend(scenario.params) as design:
+        reference = ReferenceRun(scenario, design=design, checkpoint_every=7)
+    blob = pickle.dumps(reference.portable())
+    return scenario, reference, blob
+
+
+def test_the_portable_reference_judges_as_the_reference(shared):
+    scenario, reference, blob = shared
+    opened = ReferenceRun.from_portable(pickle.loads(blob))
+    assert opened.frames == reference.frames and opened.seed == reference.seed
+    assert_same_run(opened.result, reference.result)
+    mine, theirs = _judged(reference, scenario), _judged(opened, scenario)
+    assert [d for _, d in mine.values()] == [None, 0, reference.frames - 2]
+    for name, (result, diverged) in theirs.items():
+        assert diverged == mine[name][1], name
+        assert_same_run(result, mine[name][0])
+
+
+def test_a_fresh_process_judges_as_the_full_runs():
+    # The one process the reference never ran in: each variant's result is its full run.
+    scenario = load_scenario("ramp", OVERRIDES)
+    with ModelBackend(scenario.params) as design:
+        reference = ReferenceRun(scenario, design=design, checkpoint_every=7)
+    blob = pickle.dumps(reference.portable())
+    spawn = multiprocessing.get_context("spawn")
+    with ProcessPoolExecutor(1, mp_context=spawn) as pool:
+        elsewhere = pool.submit(_judged_elsewhere, blob).result(timeout=600)
+    for name, variant in _variants(scenario.params, reference.frames):
+        result, diverged = elsewhere[name]
+        assert_same_run(result, run_scenario(scenario, backend=variant))
+        assert (diverged is None) == (name == "never"), name
+    # The late variant re-simulated from a checkpoint, not from the start.
+    assert elsewhere["late"][1] == reference.frames - 2 > 7
+
+
+def test_the_images_are_one_buffer():
+    scenario = load_scenario("lost_target", ["sim.duration=1"])
+    with ModelBackend(scenario.params) as design:
+        reference = ReferenceRun(scenario, design=design)
+    data = reference.portable()
+    cam = scenario.camera
+    assert data.frames.shape == (reference.frames, cam.height, cam.width, 3)
+    assert data.frames.dtype == np.uint8 and data.frames.flags.c_contiguous
+    opened = ReferenceRun.from_portable(data)
+    for (rgb, color), (mine, my_color) in zip(opened._loop.seen, reference._loop.seen):
+        assert np.shares_memory(rgb, data.frames) and np.array_equal(rgb, mine)
+        assert color == my_color
+    assert data.nbytes > data.frames.nbytes
+
+
+def test_a_checkpoint_restores_only_into_its_own_scenario():
+    # The ramp's terrain has patches the flat floor lacks: the shared objects do not match.
+    ramp = load_scenario("ramp", ["sim.duration=0.5"])
+    flat = load_scenario("follow_person", ["sim.duration=0.5"])
+    with ModelBackend(ramp.params) as design:
+        design.reset()
+        saved = checkpoint.portable(checkpoint.take(ClosedLoop(ramp, design=design)))
+        with pytest.raises(ValueError, match="its own scenario"):
+            checkpoint.restore(ClosedLoop(flat, design=design), saved)
+        # Into a loop of its own scenario it restores (the state it was taken with).
+        loop = ClosedLoop(ramp, design=design)
+        checkpoint.restore(loop, saved)
+        assert loop.frames_done == saved.frame == 0
