@@ -1,5 +1,8 @@
 """The robot judge's forked runs: a mutant's run forked from the unmutated design's gives the
-summary and verdict of its full run (``runner.execute``), mutant by mutant."""
+summary and verdict of its full run (``runner.execute``), mutant by mutant, whether the worker
+ran the reference itself or was handed it by the worker that did (``reference_share``)."""
+
+import pickle
 
 import pytest
 from run_equality import TIMING_FIELDS
@@ -25,8 +28,9 @@ def _toolchain():
 @pytest.mark.skipif(_toolchain() is not None, reason="no Yosys or Verilator toolchain")
 @pytest.mark.slow  # builds the mutants' Verilator model
 def test_forked_mutant_runs_equal_their_full_runs(tmp_path):
+    from fpga_robotics.mutation import forked_runs
     from fpga_robotics.mutation.design import write_mutant_design
-    from fpga_robotics.mutation.forked_runs import execute_forked
+    from fpga_robotics.mutation.forked_runs import execute_forked, outcome_of, reference_share
     from fpga_robotics.mutation.robot_judge import mutant_argv
     from fpga_robotics.sweep import load_campaign, runner
     from fpga_robotics.sweep.plan import make_plan
@@ -52,18 +56,29 @@ def test_forked_mutant_runs_equal_their_full_runs(tmp_path):
     )
     spec = make_plan(campaign).runs[0]
     ref_argv = mutant_argv(spec.argv(), netlist, ports, 0, "80x60")
+    # The baseline's run, as another worker gets it (pickled), then forgotten here: the
+    # mutants' runs below open the reference from it.
+    shared = reference_share(ref_argv)
+    baseline = runner.execute(ref_argv)
+    assert outcome_of(shared)["status"] == baseline["status"] == "pass"
+    assert shared["reference"].result.summary["frames"] == baseline["summary"]["frames"]
+    shared = pickle.loads(pickle.dumps(shared))
+    forked_runs._references.clear()
     verdicts = set()
     for m in chosen:
         argv = mutant_argv(spec.argv(), netlist, ports, m.index, "80x60")
         full = runner.execute(argv)
-        forked = execute_forked(argv, ref_argv)
-        assert forked["status"] == full["status"], m.describe()
-        if full["summary"] is None:  # the run stopped with an error: the same one
-            assert forked["summary"] is None and forked["message"] == full["message"]
-        else:
-            assert {k: v for k, v in forked["summary"].items() if k not in TIMING_FIELDS} == {
-                k: v for k, v in full["summary"].items() if k not in TIMING_FIELDS
-            }, m.describe()
+        handed = execute_forked(argv, ref_argv, shared=shared)
+        forked_runs._references.clear()
+        for forked in (handed, execute_forked(argv, ref_argv)):  # the latter runs it here
+            assert forked["status"] == full["status"], m.describe()
+            if full["summary"] is None:  # the run stopped with an error: the same one
+                assert forked["summary"] is None and forked["message"] == full["message"]
+            else:
+                assert {k: v for k, v in forked["summary"].items() if k not in TIMING_FIELDS} == {
+                    k: v for k, v in full["summary"].items() if k not in TIMING_FIELDS
+                }, m.describe()
+        forked_runs._references.clear()
         verdicts.add(full["status"])
     # A passing run and one that did not pass (a failed check, or a design that stopped) compared.
     assert "pass" in verdicts and len(verdicts) > 1, verdicts

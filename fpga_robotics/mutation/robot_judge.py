@@ -23,7 +23,7 @@ from ..sweep import runner
 from ..sweep.api import wait_for_a_worker
 from ..sweep.engine import open_client
 from ..sweep.plan import make_plan
-from .forked_runs import execute_forked, reference_outcome
+from .forked_runs import execute_forked, outcome_of, reference_share
 
 __all__ = [
     "closest_to_failing",
@@ -149,12 +149,16 @@ def judge_runs(argvs, timeouts=None, execute=None):
 
 
 def _baseline(client, argvs, progress, fork):
-    """The campaign with the unmutated design: ``[outcome]`` in order (with ``fork``, each
-    worker keeps its runs as references for the mutants')."""
+    """The campaign with the unmutated design: ``([outcome] in order, shared)``. With
+    ``fork``, ``shared`` are the futures of the runs' ``reference_share`` results, kept in
+    the cluster for the mutants' tasks (each reference run once); else None."""
     from distributed import as_completed  # lazy: Dask costs ~1 s; only a run needs it
 
+    shared = None
     if fork:
-        futures = {client.submit(reference_outcome, a, pure=False): i for i, a in enumerate(argvs)}
+        shared = [client.submit(reference_share, a, pure=False) for a in argvs]
+        # The outcomes come on their own: the references stay on the workers.
+        futures = {client.submit(outcome_of, s, pure=False): i for i, s in enumerate(shared)}
     else:
         futures = {
             client.submit(runner.execute, a, None, pure=False): i for i, a in enumerate(argvs)
@@ -163,7 +167,7 @@ def _baseline(client, argvs, progress, fork):
     for fut in as_completed(futures):
         out[futures[fut]] = fut.result()
         progress(1)
-    return out
+    return out, shared
 
 
 def robot_judge(
@@ -216,7 +220,7 @@ def robot_judge(
     with open_client(scheduler=scheduler, workers=workers) as client:
         wait_for_a_worker(client, scheduler)
         say(f"robot judge: {len(base)} campaign runs with the unmutated design first")
-        outcomes = _baseline(client, base, tick, fork)
+        outcomes, shared = _baseline(client, base, tick, fork)
         passing = [i for i, o in enumerate(outcomes) if o["status"] == "pass"]
         statuses = [o["status"] for o in outcomes]
         # Each mutant's run may take ten times as long as the design's (at least 30 s).
@@ -233,7 +237,8 @@ def robot_judge(
                 for spec in (plan.runs[i] for i in passing)
             ]
             if fork:
-                task = (judge_runs_forked, argvs, [base[i] for i in passing], limits)
+                refs = [shared[i] for i in passing]  # Dask hands each worker their results
+                task = (judge_runs_forked, argvs, [base[i] for i in passing], limits, refs)
             else:
                 task = (judge_runs, argvs, limits)
             futures[client.submit(*task, pure=False, key=f"mutant-{k}-{time.monotonic_ns()}")] = (
@@ -270,10 +275,14 @@ def robot_judge(
     )
 
 
-def judge_runs_forked(argvs, ref_argvs, timeouts=None):
-    """``judge_runs`` with each run forked from its reference run (``forked_runs``)."""
+def judge_runs_forked(argvs, ref_argvs, timeouts=None, shared=None):
+    """``judge_runs`` with each run forked from its reference run (``forked_runs``);
+    ``shared``: the reference runs' ``reference_share`` results (None: each worker runs
+    them itself)."""
     return judge_runs(
         argvs,
         timeouts,
-        execute=lambda i, argv, timeout: execute_forked(argv, ref_argvs[i], timeout),
+        execute=lambda i, argv, timeout: execute_forked(
+            argv, ref_argvs[i], timeout, None if shared is None else shared[i]
+        ),
     )
