@@ -97,6 +97,9 @@ def altered_tops():
             base, name=name, frame_channels={"turret_pixels": (__name__, cls.__name__)}
         )
         names.append(name)
+    # The servo bound to no output: the pan camera never turns.
+    TOPS["turret_unbound"] = dataclasses.replace(base, name="turret_unbound", bindings={})
+    names.append("turret_unbound")
     yield
     for name in names:
         del TOPS[name]
@@ -226,6 +229,38 @@ def test_pan_captures_between_body_frames():
     assert diverged is None
     _, diverged = fork_and_full(reference, s, ["design.top=turret_servoplus"])
     assert diverged == expected[LATE_CAPTURE] == 27  # 40 / 15 s: in the frame at 2.7 s
+
+
+def test_a_variant_that_binds_the_servo_otherwise_runs_in_full(scenario, reference):
+    forked, diverged = fork_and_full(reference, scenario, ["design.top=turret_unbound"])
+    assert diverged == 0
+    assert np.all(forked.trajectory["pan.angle_deg"] == 0)
+
+
+def test_the_turret_campaign_forked_gives_the_full_runs_rows(tmp_path):
+    from fpga_robotics.checks.summary import TIMING_FIELDS
+    from fpga_robotics.sweep import load_campaign, run_campaign
+    from fpga_robotics.sweep.campaign import read_campaign_file
+    from fpga_robotics.sweep.fork_groups import fork_groups
+    from fpga_robotics.sweep.plan import make_plan
+
+    data = read_campaign_file("turret")
+    data = dict(data[0] if isinstance(data, tuple) else data)
+    data.update(seeds=[0, 1], duration=4.0)
+    campaign = load_campaign(data)
+    plan = make_plan(campaign)
+    # Per seed: as shipped and its bug, one world.
+    assert sorted(len(g) for g in fork_groups(plan.runs, plan.worlds)) == [2, 2]
+    forked = run_campaign(campaign, tmp_path / "forked", workers=1, record="none")
+    full = run_campaign(campaign, tmp_path / "full", workers=1, record="none", fork=False)
+    times = {"wall_s", "cpu_s", "run_s", *TIMING_FIELDS}
+
+    def by_id(rows):
+        return {r["run_id"]: {k: v for k, v in r.items() if k not in times} for r in rows}
+
+    a, b = by_id(forked), by_id(full)
+    assert len(a) == 4 and a == b
+    assert sorted(r["status"] for r in a.values()) == ["fail", "fail", "pass", "pass"]
 
 
 @pytest.mark.slow  # the design simulated in Python, twice over, for every frame
