@@ -140,8 +140,9 @@ class ReferenceRun:
     result : RunResult
         The reference's own run.
     last_divergence : int or None
-        For the last ``run_variant``: the first frame whose wheel command differed (None if
-        none did).
+        For the last ``run_variant``: the first frame where a wheel or servo command
+        differed (None if none did; 0 for a variant whose further cameras or servos bind
+        its design otherwise, which has nothing to share and runs in full).
     """
 
     def __init__(
