@@ -359,7 +359,7 @@ def _rig_interface(loop):
             cam.name,
             cam.port,
             cam.color_port,
-            None if cam.channel is None else tuple(cam.channel.output_ports),
+            None if cam.channel is None else tuple(getattr(cam.channel, "output_ports", ())),
         )
         for cam in rig.cameras
     )
