@@ -139,7 +139,7 @@ def capture_frame(scenario, spec_name, j):
     return sum(1 for s in body if s < step and s < n)
 
 
-def test_robots_with_a_rig_fork_in_compressed_timing_only():
+def test_robots_with_a_rig_fork_in_both_timings():
     turret = load_scenario("turret", ["sim.duration=0.2"])
     assert forkable(turret)
 
@@ -148,9 +148,8 @@ def test_robots_with_a_rig_fork_in_compressed_timing_only():
         runtime = None
 
     assert world_key(Args(), turret, None) is not None
-    # Real-clock timing: a restored rig would stream into the reference's pins.
-    assert not forkable(load_scenario("turret", ["sim.duration=0.2", "sim.timing=real_clock"]))
-    assert forkable(load_scenario("follow_person", ["sim.duration=0.2", "sim.timing=real_clock"]))
+    real_clock = load_scenario("turret", ["sim.duration=0.2", "sim.timing=real_clock"])
+    assert forkable(real_clock) and world_key(Args(), real_clock, None) is not None
 
 
 def test_the_reference_is_the_plain_run(scenario, reference):
