@@ -129,23 +129,3 @@ def test_a_variant_world_must_be_the_reference_world(scenario, reference):
     other = scenario.with_overrides(["seed=99"])
     with ModelBackend(other.params) as variant, pytest.raises(ValueError, match="differ"):
         reference.run_variant(variant, other)
-
-
-def test_a_robot_with_a_servo_or_further_cameras_is_not_forked():
-    """The fork finds where a variant parts by its wheel commands; a servo's angle also moves
-    the world (the pan camera), so such runs are run in full, never forked."""
-    from fpga_robotics.loop.fork import ReferenceRun, forkable
-    from fpga_robotics.scenario.load import load_scenario
-    from fpga_robotics.sweep.fork_groups import world_key
-
-    turret = load_scenario("turret", ["sim.duration=0.2"])
-    assert not forkable(turret)
-    assert forkable(load_scenario("follow_person", ["sim.duration=0.2"]))
-    with pytest.raises(ValueError, match="only actuators are its wheels"):
-        ReferenceRun(turret, design=None)
-
-    class Args:
-        shadow = None
-        runtime = None
-
-    assert world_key(Args(), turret, None) is None

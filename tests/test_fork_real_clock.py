@@ -121,3 +121,21 @@ def test_a_variant_world_must_be_the_reference_world(scenario, reference):
     other = scenario.with_overrides(["seed=99"])
     with make_pin_backend("cxxrtl", other) as variant, pytest.raises(ValueError, match="differ"):
         reference.run_variant(variant, other)
+
+
+@pytest.mark.slow
+def test_a_robot_with_a_pan_camera_forks_in_real_clock_timing():
+    # The turret robot: the pan camera streams into the design's pins and its servo follows
+    # them, so after a restore both must talk to the variant's design, not the reference's.
+    turret = load_scenario("turret", ["sim.duration=6", "sim.timing=real_clock"])
+    with make_pin_backend("cxxrtl", turret) as design:
+        reference = reference_run(turret, design=design)
+    # A smaller search step turns the pan camera otherwise once it has lost the target.
+    other = turret.with_overrides(["design.turret.search_step=3"])
+    with make_pin_backend("cxxrtl", other) as variant:
+        forked = reference.run_variant(variant, other)
+        diverged = reference.last_divergence
+        assert_same_run(forked, run_scenario(other, backend=variant))
+    assert diverged is not None and diverged >= 30  # restored from a later checkpoint
+    ref = reference.result.trajectory
+    assert not np.array_equal(forked.trajectory["turret.servo_angle"], ref["turret.servo_angle"])

@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 from run_equality import assert_same_run
 from test_fork import Altered, _left_plus
+from test_fork_rig import LATE_CAPTURE, altered_tops  # noqa: F401 (the altered turret tops)
 
 from fpga_robotics.loop import checkpoint
 from fpga_robotics.loop.compressed import ClosedLoop
@@ -69,6 +70,31 @@ def test_the_portable_reference_judges_as_the_reference(shared):
     for name, (result, diverged) in theirs.items():
         assert diverged == mine[name][1], name
         assert_same_run(result, mine[name][0])
+
+
+def test_a_portable_turret_reference_judges_as_the_reference():
+    # A servo and a pan camera: the further camera's captures and the servo commands travel
+    # with the reference; its channel's state is the variant's own on restore.
+    scenario = load_scenario("turret", ["sim.duration=6"])
+    with ModelBackend(scenario.params) as design:
+        reference = ReferenceRun(scenario, design=design, checkpoint_every=7)
+    data = reference.portable()
+    assert data.captures and data.rig_interface is not None
+    opened = ReferenceRun.from_portable(pickle.loads(pickle.dumps(data)))
+    diverged = []
+    for overrides in (
+        ["design.top=turret_neverfound"],  # never parts
+        ["design.variant=turret_pan_inverted"],  # the servo from the first frame
+        ["design.top=turret_servoplus"],  # the servo, late
+    ):
+        variant = scenario.with_overrides(overrides)
+        with ModelBackend(variant.params) as design:
+            mine = reference.run_variant(design, variant)
+            theirs = opened.run_variant(design, variant)
+        assert opened.last_divergence == reference.last_divergence, overrides
+        assert_same_run(theirs, mine)
+        diverged.append(opened.last_divergence)
+    assert diverged == [None, 0, LATE_CAPTURE]
 
 
 def test_a_fresh_process_judges_as_the_full_runs():

@@ -216,8 +216,7 @@ class CameraRig:
         target's bearing off its axis (deg) and visibility now."""
 
         def put(name, value):
-            column = self.columns.setdefault(name, np.full(n_rows, np.nan))
-            column[k] = np.nan if value is None else float(value)
+            self.put(name, k, n_rows, value)
 
         for name, servo in self.servos.items():
             for key, value in servo.measurement().items():
@@ -236,6 +235,11 @@ class CameraRig:
             visible = in_view(pose, cam.params.hfov, target.x, target.y, target.radius)
             put(f"{cam.name}.target_in_view", visible)
             put(f"{cam.name}.target_bearing_deg", angle_off_axis(pose, target.x, target.y))
+
+    def put(self, name, k, n_rows, value):
+        """Column ``name``'s row ``k`` (of ``n_rows``); None is NaN."""
+        column = self.columns.setdefault(name, np.full(n_rows, np.nan))
+        column[k] = np.nan if value is None else float(value)
 
     def views(self):
         return {cam.name: cam.view for cam in self.cameras if cam.view is not None}

@@ -5,10 +5,16 @@ A ``ReferenceRun`` is one closed-loop run of a reference design (compressed timi
 keeps what a variant design needs: the image and colour select of every frame, the wheel
 commands the reference gave, the world's events around the design's own, and a world
 checkpoint (fpga_robotics.loop.checkpoint) every ``checkpoint_every`` frames and at the end.
+A robot with further cameras and servos (fpga_robotics.loop.camera_rig) adds every capture
+its design channels were given (image, colour select) and their outputs, among them the
+servo commands.
 
 ``run_variant(design)`` first replays the variant on the recorded images alone (no
-rendering, no physics) until the first frame whose wheel command differs from the
-reference's. Up to that frame the variant saw exactly the reference's images, so:
+rendering, no physics), in the order the reference's run gave them (a frame's further
+captures before its body frame), until the first frame where an output that drives the world
+differs from the reference's: a wheel command, or a servo command from one of its channels
+(the variant's own, built from its scenario). Up to there the variant saw exactly the
+reference's images, so:
 
 - if no command differs, its world is the reference's world: its result is the reference's
   with the variant's own design outputs, design events (found, lost, search started) and
@@ -16,8 +22,9 @@ reference's. Up to that frame the variant saw exactly the reference's images, so
 - if frame ``k``'s command differs, the world is restored from the last checkpoint at or
   before ``k`` and the run continues in closed loop from there: up to frame ``k`` with the
   variant's outputs as replayed (its images there are the reference's), then with the
-  variant design itself, which has processed frame ``k`` already. The design is simulated
-  once per frame, the world only from the checkpoint on.
+  variant design itself, which has processed frame ``k`` already (its channels likewise:
+  the captures they replayed, then themselves). The design is simulated once per frame, the
+  world only from the checkpoint on.
 
 Either way the ``RunResult`` equals the variant's full run (``run_scenario``): trajectory,
 events and summary, the wall-clock timing fields excepted.
@@ -33,7 +40,7 @@ from types import SimpleNamespace
 
 from fpga_robotics.checks.summary import DESIGN_OUTPUTS
 from fpga_robotics.loop import checkpoint
-from fpga_robotics.loop.compressed import ClosedLoop, _DesignEvents, _dps
+from fpga_robotics.loop.compressed import ClosedLoop, _DesignEvents, _dps, run_compressed
 from fpga_robotics.loop.reference_data import ReferenceData, pack_frames, recorded_of
 
 __all__ = ["ReferenceRun"]
@@ -44,13 +51,13 @@ VARIANT_SECTIONS = ("name", "description", "design", "checks")
 
 
 def forkable(scenario):
-    """Whether a variant's run of ``scenario`` can be forked from a reference run: the fork
-    finds where a variant parts from the world by its wheel commands, so a robot whose design
-    also moves a servo, or sees through further cameras, runs in full."""
-    return not any(
-        spec.role == "actuator" or spec.kind == "camera"
-        for spec in getattr(scenario, "connectors", ())
-    )
+    """Whether a variant's run of ``scenario`` can be forked from a reference run: every
+    robot's can. In compressed timing a servo's commands and further cameras' captures are
+    recorded and replayed as the wheels' and the body camera's are; in real-clock timing
+    (fpga_robotics.loop.pin_fork) the journal of the design's pins holds them all. Kept as
+    the one place a future exception would be stated."""
+    del scenario
+    return True
 
 
 class _RecordingLoop(ClosedLoop):
@@ -67,6 +74,14 @@ class _RecordingLoop(ClosedLoop):
         self._ref_events = _DesignEvents(scenario.params.lost_frames)
         self._before = 0
         self._shadow_events = 0  # the shadow's, after the design's: no variant has them
+        # Further cameras' channels: every capture, in the order the run made them.
+        self.captures = []  # _Capture
+        self.rig_interface = _rig_interface(self)
+        self.servo_ports = _servo_ports(self)
+        if self.rig is not None:
+            for i, cam in enumerate(self.rig.cameras):
+                if cam.channel is not None:
+                    cam.channel = _RecordingChannel(cam.channel, i, self)
 
     def run_frame(self, k):
         if k % self.every == 0:
@@ -125,8 +140,9 @@ class ReferenceRun:
     result : RunResult
         The reference's own run.
     last_divergence : int or None
-        For the last ``run_variant``: the first frame whose wheel command differed (None if
-        none did).
+        For the last ``run_variant``: the first frame where a wheel or servo command
+        differed (None if none did; 0 for a variant whose further cameras or servos bind
+        its design otherwise, which has nothing to share and runs in full).
     """
 
     def __init__(
@@ -134,8 +150,6 @@ class ReferenceRun:
     ):
         if scenario.sim.timing != "compressed":
             raise ValueError('forked runs need sim.timing = "compressed"')
-        if not forkable(scenario):
-            raise ValueError("forked runs need a robot whose only actuators are its wheels")
         if checkpoint_every < 1:
             raise ValueError(f"checkpoint_every must be at least 1, got {checkpoint_every}")
         if design.params != scenario.params:
@@ -148,7 +162,11 @@ class ReferenceRun:
             scenario, seed=seed, design=design, checkpoint_every=checkpoint_every, **loop_args
         )
         self.seed = self._loop.seed
-        self.result = self._loop.run(progress=progress)
+        try:
+            self.result = self._loop.run(progress=progress)
+        finally:  # its channels are done with: each variant runs its own
+            if self._loop.rig is not None:
+                self._loop.rig.close()
         self.last_divergence = None
 
     @property
@@ -170,6 +188,9 @@ class ReferenceRun:
             n_frames=ref.n_frames,
             checkpoints=[checkpoint.portable(c) for c in ref.checkpoints],
             final=checkpoint.portable(ref.final),
+            captures=list(ref.captures),
+            rig_interface=ref.rig_interface,
+            servo_ports=ref.servo_ports,
         )
 
     @classmethod
@@ -196,27 +217,80 @@ class ReferenceRun:
         wall_start, cpu_start = time.perf_counter(), time.process_time()
         ref = self._loop
         design.reset()
-        outputs, diverged = [], None
-        for k, (rgb, color) in enumerate(ref.seen):
-            outputs.append(_outputs(design.process_frame(rgb, color)))
-            if progress is not None:
-                progress(k + 1, ref.n_frames)
-            if (_dps(outputs[k].motor_left), _dps(outputs[k].motor_right)) != ref.commands[k]:
-                diverged = k
-                break
-        self.last_divergence = diverged
         loop = ClosedLoop(scenario, seed=self.seed, design=design)
-        if diverged is None:
-            checkpoint.restore(loop, ref.final)
-            _rewrite_design_part(loop, outputs, ref)
-            return loop.finish_run(wall_start, cpu_start)
-        start = [c for c in ref.checkpoints if c.frame <= diverged][-1]
-        checkpoint.restore(loop, start)
-        _rewrite_design_part(loop, outputs[: start.frame], ref)
-        # The variant has run up to frame `diverged` already: from the checkpoint to there
-        # the loop gets its outputs as replayed (the frames are the same), then the design.
-        loop.design = _Replayed(outputs[start.frame :], design)
-        return loop.run(start=start.frame, progress=progress)
+        channels = [cam.channel for cam in loop.rig.cameras] if loop.rig is not None else []
+        try:
+            if _rig_interface(loop) != ref.rig_interface:  # nothing to share: a run of its own
+                self.last_divergence = 0
+                return run_compressed(scenario, seed=self.seed, backend=design, progress=progress)
+            ran = [cam.channel_ran for cam in loop.rig.cameras] if loop.rig is not None else []
+            outputs, captured, diverged = _replay(design, channels, ref, progress)
+            self.last_divergence = diverged
+            if diverged is None:
+                checkpoint.restore(loop, ref.final)
+                _rewrite_design_part(loop, outputs, ref)
+                _hand_over_channels(loop, channels, ran, captured, ref, len(outputs))
+                return loop.finish_run(wall_start, cpu_start)
+            start = [c for c in ref.checkpoints if c.frame <= diverged][-1]
+            checkpoint.restore(loop, start)
+            _rewrite_design_part(loop, outputs[: start.frame], ref)
+            _hand_over_channels(loop, channels, ran, captured, ref, start.frame)
+            # The variant has run up to frame `diverged` already: from the checkpoint to there
+            # the loop gets its outputs as replayed (the frames are the same), then the design.
+            loop.design = _Replayed(outputs[start.frame :], design)
+            return loop.run(start=start.frame, progress=progress)
+        finally:
+            for channel in channels:
+                close = getattr(channel, "close", None)
+                if close is not None:
+                    close()
+
+
+def _replay(design, channels, ref, progress):
+    """The variant's ``design`` and ``channels`` (one per further camera, None for one that
+    only films) on the reference's recorded inputs, in the order its run gave them, until
+    the first output that drives the world differs. Returns the design's outputs per frame,
+    each channel's outputs per capture, and the frame of the first difference (None)."""
+    outputs, captured = [], [[] for _ in channels]
+    captures, i, n = ref.captures, 0, len(ref.seen)
+    for k in range(n + 1):  # k = n: the captures after the last frame
+        while i < len(captures) and captures[i].frame == k:
+            cap = captures[i]
+            i += 1
+            out = dict(channels[cap.camera].process(cap.rgb, cap.color))
+            captured[cap.camera].append(out)
+            if _driving(out, ref.servo_ports) != _driving(cap.outputs, ref.servo_ports):
+                return outputs, captured, k
+        if k == n:
+            break
+        rgb, color = ref.seen[k]
+        outputs.append(_outputs(design.process_frame(rgb, color)))
+        if progress is not None:
+            progress(k + 1, ref.n_frames)
+        if (_dps(outputs[k].motor_left), _dps(outputs[k].motor_right)) != ref.commands[k]:
+            return outputs, captured, k
+    return outputs, captured, None
+
+
+def _hand_over_channels(loop, channels, ran, captured, ref, frame):
+    """Give a ``loop`` restored at ``frame`` the variant's ``channels``: their outputs as
+    replayed for the captures from ``frame`` on, then the channels themselves; the
+    latest outputs and the rows before ``frame`` theirs."""
+    rig = loop.rig
+    for i, channel in enumerate(channels):
+        if channel is None:
+            continue
+        cam, frames = rig.cameras[i], [c.frame for c in ref.captures if c.camera == i]
+        done = sum(f < frame for f in frames)  # its captures before the checkpoint
+        cam.channel = _ReplayedChannel(captured[i][done:], channel)
+        cam.channel_ran = ran[i]
+        cam.outputs = dict(captured[i][done - 1]) if done else {}
+        seen = 0  # its captures up to each row (the row samples the latest)
+        for k in range(frame):
+            while seen < len(frames) and frames[seen] <= k:
+                seen += 1
+            for port, value in (captured[i][seen - 1] if seen else {}).items():
+                rig.put(f"{cam.name}.{port}", k, loop.n_frames, value)
 
 
 class _Replayed:
@@ -232,6 +306,104 @@ class _Replayed:
         if self.outputs:
             return self.outputs.pop(0)
         return self.design.process_frame(rgb, color_sel)
+
+
+class _ReplayedChannel:
+    """A further camera's channel that gives recorded outputs for its first captures, then
+    hands over to ``channel`` (which has processed those captures already)."""
+
+    def __init__(self, outputs, channel):
+        self.outputs = list(outputs)
+        self.channel = channel
+
+    def __getattr__(self, name):  # the channel's ports (view_ports ...)
+        if name == "channel":
+            raise AttributeError(name)
+        return getattr(self.channel, name)
+
+    def process(self, frame, color_sel):
+        if self.outputs:
+            return self.outputs.pop(0)
+        return self.channel.process(frame, color_sel)
+
+
+class _Capture:
+    """One capture of a further camera in the reference's run: the camera's index, the
+    frame it came in (before that frame's body capture; the frame count after the last), the
+    image and colour select its channel was given and the outputs the channel gave."""
+
+    __slots__ = ("camera", "color", "frame", "outputs", "rgb")
+
+    def __init__(self, camera, frame, rgb, color, outputs):
+        self.camera, self.frame, self.rgb, self.color = camera, frame, rgb, color
+        self.outputs = outputs
+
+
+class _RecordingChannel:
+    """A further camera's channel in the reference's run: every capture it is given goes to
+    the loop's ``captures``."""
+
+    def __init__(self, channel, camera, loop):
+        self.channel, self.camera, self.loop = channel, camera, loop
+
+    def __getattr__(self, name):  # the channel's ports (view_ports ...)
+        if name in ("channel", "camera", "loop"):
+            raise AttributeError(name)
+        return getattr(self.channel, name)
+
+    def process(self, frame, color_sel):
+        outputs = self.channel.process(frame, color_sel)
+        capture = _Capture(self.camera, self.loop.frames_done, frame, color_sel, dict(outputs))
+        self.loop.captures.append(capture)
+        return outputs
+
+    def close(self):
+        close = getattr(self.channel, "close", None)
+        if close is not None:
+            close()
+
+    def __deepcopy__(self, memo):
+        # In a checkpoint: a variant's run puts its own channel in its place.
+        return _Detached(self.camera)
+
+
+class _Detached:
+    """A recorded channel in a checkpoint, replaced by the variant's on restore."""
+
+    def __init__(self, camera):
+        self.camera = camera
+
+    def process(self, frame, color_sel):
+        raise RuntimeError(f"camera {self.camera}'s channel was not handed over on restore")
+
+
+def _rig_interface(loop):
+    """How the loop's rig binds its design (None without a rig): what must agree for a
+    variant to replay the reference's captures."""
+    rig = loop.rig
+    if rig is None:
+        return None
+    cameras = tuple(
+        (
+            cam.name,
+            cam.port,
+            cam.color_port,
+            None if cam.channel is None else tuple(getattr(cam.channel, "output_ports", ())),
+        )
+        for cam in rig.cameras
+    )
+    return cameras, tuple((name, s.port) for name, s in rig.servos.items())
+
+
+def _servo_ports(loop):
+    """The channel outputs that command a servo."""
+    servos = loop.rig.servos.values() if loop.rig is not None else ()
+    return frozenset(s.port for s in servos if s.port is not None)
+
+
+def _driving(outputs, ports):
+    """Of a channel's outputs, those that drive the world (servo commands)."""
+    return {port: outputs[port] for port in ports if port in outputs}
 
 
 def _outputs(result):

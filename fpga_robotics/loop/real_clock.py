@@ -265,6 +265,8 @@ class RealClockLoop(ClosedLoop):
         super().restored()
         for io in self.io.values():  # the connectors talk to this loop's design
             io.backend = self.pins
+        if self.rig is not None:  # so do further cameras and servos
+            self.rig.pins = self.pins
 
     # Binding ----------------------------------------------------------------------------
 

@@ -39,6 +39,13 @@ class ReferenceData:
         In frame order.
     final : PortableCheckpoint
         Once the frames and the physics after them are done.
+    captures : list
+        Further cameras' captures with their channels' outputs, in the order the run made
+        them (fpga_robotics.loop.fork); empty without a rig.
+    rig_interface : tuple or None
+        How the rig binds the design: a variant's must be the same to replay the captures.
+    servo_ports : frozenset
+        The channel outputs that command a servo.
     """
 
     scenario: object
@@ -51,12 +58,16 @@ class ReferenceData:
     n_frames: int
     checkpoints: list
     final: object
+    captures: list
+    rig_interface: object
+    servo_ports: frozenset
 
     @property
     def nbytes(self):
         """Roughly how much memory it takes: the images and the checkpoints."""
         saved = [*self.checkpoints, self.final]
-        return self.frames.nbytes + sum(len(c.blob) for c in saved)
+        captured = sum(c.rgb.nbytes for c in self.captures)
+        return self.frames.nbytes + captured + sum(len(c.blob) for c in saved)
 
 
 def pack_frames(seen):
@@ -75,4 +86,7 @@ def recorded_of(data):
         n_frames=data.n_frames,
         checkpoints=data.checkpoints,
         final=data.final,
+        captures=data.captures,
+        rig_interface=data.rig_interface,
+        servo_ports=data.servo_ports,
     )

@@ -10,7 +10,6 @@ full run. Runs in real-clock timing or with a shadow design are run in full
 (``runner.execute``).
 """
 
-import time
 import uuid
 
 from fpga_robotics.cli import run
@@ -66,22 +65,17 @@ def reference_share(ref_argv):
     the reference opened from that data."""
     if not _forkable(ref_argv):
         return {"outcome": runner.execute(ref_argv), "reference": None, "token": None}
-    wall0, cpu0 = time.perf_counter(), time.process_time()
-    out = {"status": "error", "message": "", "summary": None, "recording": None, "run_s": 0.0}
-    shared = {"outcome": out, "reference": None, "token": uuid.uuid4().hex}
-    try:
-        reference = _build(ref_argv)
-        out["run_s"] = time.perf_counter() - wall0
+    shared = {"outcome": None, "reference": None, "token": uuid.uuid4().hex}
+    with runner.RunOutcome() as outcome:
+        with outcome.running():
+            reference = _build(ref_argv)
         shared["reference"] = reference.portable()
         # Kept as opened from the data: its images are the data's, not a second copy.
         _reference(ref_argv, shared)
-        summary = dict(reference.result.summary)
-        out.update(status=summary["verdict"], summary=summary)
-    except Exception as exc:  # noqa: BLE001 (recorded as the baseline's error)
-        out.update(status="error", message=f"{type(exc).__name__}: {exc}".splitlines()[0])
+        outcome.record(reference.result)
+    if outcome.out["summary"] is None:  # it erred: nothing to share
         shared["reference"] = None
-    out["wall_s"] = time.perf_counter() - wall0
-    out["cpu_s"] = time.process_time() - cpu0
+    shared["outcome"] = outcome.out
     return shared
 
 
@@ -95,10 +89,7 @@ def execute_forked(argv, ref_argv, timeout=None, shared=None):
     ``ref_argv`` (the same run with the unmutated design); the same outcome dict.
     ``shared``: that run's ``reference_share`` result, whose reference this worker opens
     rather than running it again (None: run here, once per worker)."""
-    wall0, cpu0 = time.perf_counter(), time.process_time()
-    out = {"status": "error", "message": "", "summary": None, "recording": None, "run_s": 0.0}
-    deadline = None
-    try:
+    with runner.RunOutcome() as outcome:
         if not _forkable(ref_argv):
             return runner.execute(argv, timeout=timeout)
         usable = shared is not None and shared["reference"] is not None
@@ -106,18 +97,8 @@ def execute_forked(argv, ref_argv, timeout=None, shared=None):
         args, scenario, shadow_params = runner.load_run(list(argv))
         design, _ = runner._designs_for(args, scenario, shadow_params)
         run.apply_runtime(design, args)
-        deadline = runner._Deadline(timeout, None)
-        t_run = time.perf_counter()
-        result = reference.run_variant(design, scenario, progress=deadline)
-        out["run_s"] = time.perf_counter() - t_run
-        out.update(status=result.summary["verdict"], summary=dict(result.summary))
-    except runner.RunTimeout as exc:
-        out.update(status="timeout", message=str(exc))
-    except Exception as exc:  # noqa: BLE001 (the mutant's run errs: it is caught)
-        out.update(status="error", message=f"{type(exc).__name__}: {exc}".splitlines()[0])
-    finally:
-        if deadline is not None:
-            deadline.cancel()
-    out["wall_s"] = time.perf_counter() - wall0
-    out["cpu_s"] = time.process_time() - cpu0
-    return out
+        outcome.deadline = deadline = runner._Deadline(timeout, None)
+        with outcome.running():
+            result = reference.run_variant(design, scenario, progress=deadline)
+        outcome.record(result)
+    return outcome.out

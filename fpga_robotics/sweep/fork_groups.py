@@ -11,7 +11,6 @@ campaigns that record every run, are run one by one as before; so is everything 
 """
 
 import json
-import time
 
 from fpga_robotics.loop.fork import VARIANT_SECTIONS, forkable
 
@@ -57,15 +56,11 @@ def execute_group(argvs, timeouts, tags):
 
     outcomes, reference = [], None
     for argv, timeout, tag in zip(argvs, timeouts, tags, strict=True):
-        wall0, cpu0 = time.perf_counter(), time.process_time()
-        out = {"status": "error", "message": "", "summary": None, "recording": None, "run_s": 0.0}
-        deadline = None
-        try:
+        with runner.RunOutcome() as outcome:
             args, scenario, _shadow = runner._loaded(argv)
             design, _ = runner._designs_for(args, scenario, None)
-            deadline = runner._Deadline(timeout, runner._fault(args.seed), tag)
-            t_run = time.perf_counter()
-            try:
+            outcome.deadline = deadline = runner._Deadline(timeout, runner._fault(args.seed), tag)
+            with outcome.running():
                 if reference is None:
                     reference = reference_run(
                         scenario, design=design, seed=args.seed, progress=deadline
@@ -78,18 +73,6 @@ def execute_group(argvs, timeouts, tags):
                         result = run_scenario(
                             scenario, seed=args.seed, backend=design, progress=deadline
                         )
-            finally:
-                out["run_s"] = time.perf_counter() - t_run
-            summary = dict(result.summary)
-            out.update(status=summary["verdict"], summary=summary)
-        except runner.RunTimeout as exc:
-            out.update(status="timeout", message=str(exc))
-        except Exception as exc:  # noqa: BLE001 (the campaign records it and goes on)
-            out.update(status="error", message=f"{type(exc).__name__}: {exc}".splitlines()[0])
-        finally:
-            if deadline is not None:
-                deadline.cancel()
-        out["wall_s"] = time.perf_counter() - wall0
-        out["cpu_s"] = time.process_time() - cpu0
-        outcomes.append(out)
+            outcome.record(result)
+        outcomes.append(outcome.out)
     return outcomes

@@ -14,6 +14,7 @@ such runs and goes on.
 """
 
 import argparse
+import contextlib
 import os
 import shutil
 import tempfile
@@ -23,7 +24,7 @@ from pathlib import Path
 
 from fpga_robotics.hw.errors import UsageError
 
-__all__ = ["TIMEOUT_TOPIC", "RunTimeout", "build_designs", "execute", "load_run"]
+__all__ = ["TIMEOUT_TOPIC", "RunOutcome", "RunTimeout", "build_designs", "execute", "load_run"]
 
 #: The Dask event topic under which a worker says it ends itself for a stuck run (the client
 #: then records that run as ``timeout``, not as a crash).
@@ -206,6 +207,48 @@ def _current_worker():
         return None
 
 
+class RunOutcome:
+    """How every campaign task records one run, as a context manager: ``out`` is the
+    outcome dict (``status``: the summary's verdict, ``"timeout"`` or ``"error"`` with the
+    exception's first line in ``message``; ``summary``; ``run_s``, ``wall_s``, ``cpu_s``).
+    An exception in the body becomes the outcome (the campaign records it and goes on);
+    ``deadline``, once set, is cancelled at the end."""
+
+    def __init__(self):
+        self._wall0, self._cpu0 = time.perf_counter(), time.process_time()
+        self.out = {"status": "error", "message": "", "summary": None, "recording": None}
+        self.out["run_s"] = 0.0
+        self.deadline = None
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, kind, exc, tb):
+        if isinstance(exc, RunTimeout):
+            self.out.update(status="timeout", message=str(exc))
+        elif isinstance(exc, Exception):
+            self.out.update(status="error", message=f"{type(exc).__name__}: {exc}".splitlines()[0])
+        if self.deadline is not None:
+            self.deadline.cancel()
+        self.out["wall_s"] = time.perf_counter() - self._wall0
+        self.out["cpu_s"] = time.process_time() - self._cpu0
+        return isinstance(exc, Exception)  # never KeyboardInterrupt or SystemExit
+
+    @contextlib.contextmanager
+    def running(self):
+        """Times the run itself (``run_s``), whether it ends or raises."""
+        t_run = time.perf_counter()
+        try:
+            yield
+        finally:
+            self.out["run_s"] = time.perf_counter() - t_run
+
+    def record(self, result):
+        """The run's ``RunResult``: its summary and verdict."""
+        summary = dict(result.summary)
+        self.out.update(status=summary["verdict"], summary=summary)
+
+
 def execute(argv, timeout=None, record=False, tag=None, bag=False):
     """Run one campaign run (``tag``: its name, for the timeout event; ``record``: False, or
     log every how many frames' images to the recording); returns ``{"status", "message", "summary", "wall_s", "cpu_s",
@@ -214,58 +257,44 @@ def execute(argv, timeout=None, record=False, tag=None, bag=False):
     from fpga_robotics.cli import run  # lazy: the run stack (~1 s)
     from fpga_robotics.loop.timings import run_scenario  # lazy: the run stack (~1 s)
 
-    wall0, cpu0 = time.perf_counter(), time.process_time()
-    out = {"status": "error", "message": "", "summary": None, "recording": None, "run_s": 0.0}
-    deadline = None
-    try:
+    with RunOutcome() as outcome:
+        out = outcome.out
         args, scenario, shadow_params = _loaded(argv)
         design, shadow = _designs_for(args, scenario, shadow_params)
         if getattr(args, "runtime", None):  # a kept design gets this run's [runtime] values
             run.apply_runtime(design, args)
-        deadline = _Deadline(timeout, _fault(args.seed), tag)
+        outcome.deadline = deadline = _Deadline(timeout, _fault(args.seed), tag)
         recorder, rrd = (None, None)
         if record:
             recorder, rrd = _recorder(args, scenario.name, int(record))
         bag_writer, bag_dir = _bag_writer(scenario) if record and bag else (None, None)
-        t_run = time.perf_counter()
         try:
-            result = run_scenario(
-                scenario,
-                seed=args.seed,
-                backend=design,
-                recorder=recorder,
-                progress=deadline,
-                realtime=False,
-                shadow=shadow,
-                shadow_label=args.shadow or "shadow",
-                on_frame=bag_writer.log_frame if bag_writer else None,
-            )
-            if bag_writer is not None:
-                bag_writer.close()
-                out["bag"] = _read_bag(bag_dir)
+            with outcome.running():
+                result = run_scenario(
+                    scenario,
+                    seed=args.seed,
+                    backend=design,
+                    recorder=recorder,
+                    progress=deadline,
+                    realtime=False,
+                    shadow=shadow,
+                    shadow_label=args.shadow or "shadow",
+                    on_frame=bag_writer.log_frame if bag_writer else None,
+                )
+                if bag_writer is not None:
+                    bag_writer.close()
+                    out["bag"] = _read_bag(bag_dir)
         finally:
-            out["run_s"] = time.perf_counter() - t_run
             if recorder is not None:
                 run._close_recorder(recorder, True)
             if bag_writer is not None:
                 bag_writer.abandon()  # nothing left once closed; a partial bag otherwise
-
                 shutil.rmtree(bag_dir, ignore_errors=True)
         if rrd is not None:
             out["recording"] = rrd.read_bytes()
             rrd.unlink(missing_ok=True)
-        summary = dict(result.summary)
-        out.update(status=summary["verdict"], summary=summary)
-    except RunTimeout as exc:
-        out.update(status="timeout", message=str(exc))
-    except Exception as exc:  # noqa: BLE001 (the campaign records it and goes on)
-        out.update(status="error", message=f"{type(exc).__name__}: {exc}".splitlines()[0])
-    finally:
-        if deadline is not None:
-            deadline.cancel()
-    out["wall_s"] = time.perf_counter() - wall0
-    out["cpu_s"] = time.process_time() - cpu0
-    return out
+        outcome.record(result)
+    return outcome.out
 
 
 def _bag_writer(scenario):
