@@ -12,7 +12,7 @@ from run_equality import assert_same_run
 
 from fpga_robotics.designs.builtin import TOPS
 from fpga_robotics.loop.compressed import make_backend
-from fpga_robotics.loop.fork import ReferenceRun, forkable
+from fpga_robotics.loop.fork import ReferenceRun
 from fpga_robotics.loop.timings import run_scenario
 from fpga_robotics.scenario.load import load_scenario
 from fpga_robotics.sim.backends.model import ModelBackend
@@ -139,9 +139,8 @@ def capture_frame(scenario, spec_name, j):
     return sum(1 for s in body if s < step and s < n)
 
 
-def test_robots_with_a_rig_fork_in_both_timings():
+def test_campaigns_group_robots_with_a_rig_by_world_in_both_timings():
     turret = load_scenario("turret", ["sim.duration=0.2"])
-    assert forkable(turret)
 
     class Args:
         shadow = None
@@ -149,7 +148,7 @@ def test_robots_with_a_rig_fork_in_both_timings():
 
     assert world_key(Args(), turret, None) is not None
     real_clock = load_scenario("turret", ["sim.duration=0.2", "sim.timing=real_clock"])
-    assert forkable(real_clock) and world_key(Args(), real_clock, None) is not None
+    assert world_key(Args(), real_clock, None) is not None
 
 
 def test_the_reference_is_the_plain_run(scenario, reference):

@@ -50,16 +50,6 @@ __all__ = ["ReferenceRun"]
 VARIANT_SECTIONS = ("name", "description", "design", "checks")
 
 
-def forkable(scenario):
-    """Whether a variant's run of ``scenario`` can be forked from a reference run: every
-    robot's can. In compressed timing a servo's commands and further cameras' captures are
-    recorded and replayed as the wheels' and the body camera's are; in real-clock timing
-    (fpga_robotics.loop.pin_fork) the journal of the design's pins holds them all. Kept as
-    the one place a future exception would be stated."""
-    del scenario
-    return True
-
-
 class _RecordingLoop(ClosedLoop):
     """A closed loop that records what variants of its design need (see ``ReferenceRun``)."""
 

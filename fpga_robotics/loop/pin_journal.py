@@ -70,6 +70,11 @@ class JournalPins:
         return self.design.ports
 
     @property
+    def source(self):
+        """The design's source: its ``[runtime]`` inputs are held by the backend, no call."""
+        return getattr(self.design, "source", None)
+
+    @property
     def cycle(self):
         return self.design.cycle
 
@@ -173,6 +178,10 @@ class PlayBack:
     @property
     def ports(self):
         return self.live.ports
+
+    @property
+    def source(self):
+        return getattr(self.live, "source", None)
 
     @property
     def playing(self):

@@ -5,15 +5,17 @@ Each campaign run goes once with the unmutated design (``mutsel = 0``), on which
 (``ReferenceData``), which the Dask cluster keeps and hands to every mutant's task; a
 worker opens each reference once (``ReferenceRun.from_portable``) and keeps it. A mutant's
 run of the same scenario is then replayed on the recorded frames and re-simulated only from
-where its wheel commands part from the reference's. Its summary and verdict are those of its
-full run. Runs in real-clock timing or with a shadow design are run in full
-(``runner.execute``).
+where its design drives differently. Its summary and verdict are those of its full run. In
+real-clock timing the reference is a ``PinReferenceRun`` (fpga_robotics.loop.pin_fork: the
+design's pin calls journaled), which has no portable form: each worker that needs one runs it
+once. Runs with a shadow design are run in full (``runner.execute``).
 """
 
 import uuid
 
 from fpga_robotics.cli import run
-from fpga_robotics.loop.fork import ReferenceRun, forkable
+from fpga_robotics.loop.fork import ReferenceRun
+from fpga_robotics.loop.pin_fork import reference_run
 
 from ..sweep import runner
 
@@ -25,11 +27,12 @@ _references = {}
 
 
 def _build(ref_argv):
-    """The ``ReferenceRun`` of the unmutated design for ``ref_argv``, run here."""
+    """The reference run of the unmutated design for ``ref_argv`` (a ``ReferenceRun``, or a
+    ``PinReferenceRun`` in real-clock timing), run here."""
     args, scenario, shadow_params = runner.load_run(list(ref_argv))
     design, _ = runner._designs_for(args, scenario, shadow_params)
     run.apply_runtime(design, args)
-    return ReferenceRun(scenario, design=design, seed=args.seed)
+    return reference_run(scenario, design=design, seed=args.seed)
 
 
 def _keep(key, reference, token=None):
@@ -55,13 +58,13 @@ def _reference(ref_argv, shared=None):
 
 def _forkable(argv):
     _, scenario, shadow_params = runner.load_run(list(argv))
-    return scenario.sim.timing == "compressed" and shadow_params is None and forkable(scenario)
+    return shadow_params is None and scenario.sim.timing in ("compressed", "real_clock")
 
 
 def reference_share(ref_argv):
     """A run with the unmutated design (the robot judge's baseline): ``{"outcome":
     runner.execute(ref_argv)'s dict, "reference": its ReferenceData, "token": naming this
-    reference}`` (reference None for a run that is not forked or erred). This worker keeps
+    reference}`` (reference None for a run that is not forked, runs in real-clock timing or erred). This worker keeps
     the reference opened from that data."""
     if not _forkable(ref_argv):
         return {"outcome": runner.execute(ref_argv), "reference": None, "token": None}
@@ -69,9 +72,12 @@ def reference_share(ref_argv):
     with runner.RunOutcome() as outcome:
         with outcome.running():
             reference = _build(ref_argv)
-        shared["reference"] = reference.portable()
-        # Kept as opened from the data: its images are the data's, not a second copy.
-        _reference(ref_argv, shared)
+        if isinstance(reference, ReferenceRun):
+            shared["reference"] = reference.portable()
+            # Kept as opened from the data: its images are the data's, not a second copy.
+            _reference(ref_argv, shared)
+        else:  # real-clock: kept here; other workers run their own
+            _keep(tuple(ref_argv), reference)
         outcome.record(reference.result)
     if outcome.out["summary"] is None:  # it erred: nothing to share
         shared["reference"] = None

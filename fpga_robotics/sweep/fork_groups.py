@@ -12,7 +12,7 @@ campaigns that record every run, are run one by one as before; so is everything 
 
 import json
 
-from fpga_robotics.loop.fork import VARIANT_SECTIONS, forkable
+from fpga_robotics.loop.fork import VARIANT_SECTIONS
 
 from . import runner
 
@@ -24,7 +24,7 @@ def world_key(args, scenario, shadow_params):
     None for a run that is run on its own."""
     if shadow_params is not None or args.shadow is not None or getattr(args, "runtime", None):
         return None
-    if scenario.sim.timing not in ("compressed", "real_clock") or not forkable(scenario):
+    if scenario.sim.timing not in ("compressed", "real_clock"):
         return None
     world = {k: v for k, v in scenario.data.items() if k not in VARIANT_SECTIONS}
     return json.dumps(world, sort_keys=True, default=repr)
