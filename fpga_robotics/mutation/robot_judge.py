@@ -237,7 +237,8 @@ def robot_judge(
         settled = {k: settled[k] for k in todo if k in settled}
         closest = closest_to_failing([outcomes[i] for i in passing])
         if settled:
-            say(f"robot judge: {len(settled)} mutants settled by their fan-out cone, no run")
+            n = len(settled)
+            say(f"robot judge: {n} mutant{'s' * (n != 1)} settled by the fan-out cone, no run")
         futures = {}
         for k in (k for k in todo if k not in settled):
             argvs = [
