@@ -245,7 +245,12 @@ def _toolchain():
 @pytest.mark.slow  # builds the mutants' Verilator model and runs the closed loop
 def test_a_mutant_settled_by_its_cone_runs_as_the_design_does(tmp_path):
     from fpga_robotics.mutation.design import open_mutant_design, write_mutant_design
-    from fpga_robotics.mutation.robot_judge import closest_to_failing, judge_runs, mutant_argv
+    from fpga_robotics.mutation.robot_judge import (
+        closest_to_failing,
+        judge_runs,
+        mutant_argv,
+        robot_judge,
+    )
     from fpga_robotics.mutation.unit_judge import golden_results, judge_frames, judge_mutant
     from fpga_robotics.sweep import load_campaign, runner
     from fpga_robotics.sweep.plan import make_plan
@@ -291,6 +296,23 @@ def test_a_mutant_settled_by_its_cone_runs_as_the_design_does(tmp_path):
     )
     same = ("caught", "run", "status", "message", "failed_checks", "closest")
     assert {k: full[k] for k in same} == {k: settled[k] for k in same}
+    # The robot judge gives that verdict without a run (only the baseline runs).
+    (tmp_path / "judge").mkdir()
+    _baseline, verdicts = robot_judge(
+        campaign,
+        netlist,
+        ports,
+        "80x60",
+        [verdict.index],
+        str(tmp_path / "judge"),
+        workers=1,
+        say=lambda text: None,
+        cones={verdict.index: cones[candidates[verdict.index - 1].index]},
+    )
+    judged = verdicts[verdict.index]
+    assert {k: judged[k] for k in same} == {k: full[k] for k in same}
+    assert judged["judged_by"] == "cone" and judged["runs"] == 0
+    assert judged["argv"] == argvs[full["closest"]]
     # Each run's summary is the unmutated design's (the wall-clock fields aside).
     assert len(outcomes) == len(passing)
     for i, o in zip(passing, outcomes):
