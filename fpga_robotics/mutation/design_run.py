@@ -13,6 +13,7 @@ from ..sim.backends.foreign import ForeignDesign
 from ..sim.files import write_atomic, write_json_atomic
 from ..sim.mutation import (
     MUTATION_SELECT,
+    MutationError,
     component_rtlil,
     list_mutants,
     mutant_cones,
@@ -194,7 +195,10 @@ def _judge(
         caught = [v.index for v in verdicts if v.caught]
         if (robot or {}).get("fork", True):  # --no-fork: every run in full
             t3 = time.perf_counter()
-            cones = cones_of([m for m in mutants if m.index in caught])
+            try:
+                cones = cones_of([m for m in mutants if m.index in caught])
+            except MutationError as exc:  # no verdict without a run then: all run
+                say(f"fan-out cones: {str(exc).splitlines()[0]}; every mutant runs")
             cone_s = time.perf_counter() - t3
         t2 = time.perf_counter()
         baseline, robot_verdicts = robot_judge(
