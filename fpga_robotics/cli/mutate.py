@@ -31,7 +31,7 @@ from fpga_robotics.mutation.unit_judge import (
 )
 from fpga_robotics.sim.backends.base import BackendError
 from fpga_robotics.sim.files import check_output_dir, write_atomic, write_json_atomic
-from fpga_robotics.sim.mutation import MutationError, list_mutants
+from fpga_robotics.sim.mutation import MutationError, list_mutants, mutant_cones
 from fpga_robotics.sim.pins import PinError
 from fpga_robotics.sweep import load_campaign_file, runner
 
@@ -63,6 +63,7 @@ def _report_robot(
         f"robot judge (campaign {campaign.name}: {n_pass} of {n_runs} runs pass unmutated): "
         f"{rs['caught']} of {rs['judged']} unit-caught mutants caught: score "
         f"{_percent(rs['score'])}; {_robot_rate(baseline['judged_here'], robot_s)}"
+        + _settled(robot_verdicts)
     )
     blind = blind_spots(unit, robot)
     by_index = {m.index: m for m in mutants}
@@ -75,6 +76,8 @@ def _report_robot(
             print(f"  {by_index[k].describe()}")
             print(f"    unit: {effects[k]}")
             print(f"    why: {reasons[k]}")
+            if robot_verdicts[k].get("judged_by") == "cone":
+                print(f"    {_cone_note(robot_verdicts[k])}")
             if robot_verdicts[k].get("replay"):
                 print(
                     f"    closest run: {robot_verdicts[k]['replay']}"
@@ -84,6 +87,18 @@ def _report_robot(
         out, campaign.name, mutants, verdicts, robot_verdicts, baseline, recorded, width
     )
     print(f"report: {path}")
+
+
+def _cone_note(verdict):
+    """One line on a verdict given by the mutant's fan-out cone."""
+    reached = verdict.get("cone_outputs") or ["no output"]
+    return f"no run made: its fan-out cone reaches only {', '.join(reached)}"
+
+
+def _settled(robot_verdicts):
+    """``"; N settled by their fan-out cone"`` (or nothing): the verdicts given without a run."""
+    n = sum(1 for v in robot_verdicts.values() if v.get("judged_by") == "cone")
+    return f"; {n} settled by their fan-out cone (no run)" if n else ""
 
 
 def _robot_rate(judged_here, seconds):
@@ -285,6 +300,7 @@ def _main_design(args):
         f"{score['total']} mutants of {name} (seed {args.seed}), {cycles} cycles of random "
         f"inputs each; build {result['build_and_list_s']:.1f} s, unit judge {rate:.0f} "
         f"mutants/min"
+        + (f", fan-out cones {result['cone_s']:.1f} s" if result.get("cone_s") is not None else "")
     )
     print(
         f"unit judge (against the unmutated design): {score['caught']} caught, "
@@ -317,6 +333,7 @@ def _report_design_robot(result, campaign):
         f"robot judge (campaign {campaign.name}: {n_pass} of {n_runs} runs pass unmutated): "
         f"{rs['caught']} of {rs['judged']} unit-caught mutants caught: score "
         f"{_percent(rs['score'])}; {_robot_rate(baseline['judged_here'], result['robot_judge_s'])}"
+        + _settled({m["index"]: m["robot"] for m in result["mutants"] if m["robot"]})
     )
     if not n_pass:
         print("no run passes with the unmutated design: the robot judge has no run to judge by")
@@ -327,6 +344,8 @@ def _report_design_robot(result, campaign):
         for m in blind:
             print(f"  {m['describe']}")
             print(f"    unit: {m['unit']['effect']}")
+            if m["robot"].get("judged_by") == "cone":
+                print(f"    {_cone_note(m['robot'])}")
             if m["robot"].get("replay"):
                 print(f"    closest run: {m['robot']['replay']}")
 
@@ -396,8 +415,16 @@ def main(argv=None, prog="fpga-robotics mutate"):
 
     unit = {v.index: v.caught for v in verdicts}
     robot_verdicts, baseline = {}, None
+    cones, cone_s = None, None
     if campaign is not None:
         caught = [v.index for v in verdicts if v.caught]
+        if args.fork:  # --no-fork: every run in full, as before
+            t3 = time.perf_counter()
+            try:
+                cones = mutant_cones(params, [m for m in mutants if m.index in caught])
+            except MutationError as exc:  # no verdict without a run then: all run
+                say(f"fan-out cones: {str(exc).splitlines()[0]}; every mutant runs")
+            cone_s = time.perf_counter() - t3
         t2 = time.perf_counter()
         baseline, robot_verdicts = robot_judge(
             campaign,
@@ -411,6 +438,7 @@ def main(argv=None, prog="fpga-robotics mutate"):
             resume=args.resume,
             say=say,
             fork=args.fork,
+            cones=cones,
         )
         robot_s = time.perf_counter() - t2
     robot = {k: v["caught"] for k, v in robot_verdicts.items()}
@@ -431,6 +459,7 @@ def main(argv=None, prog="fpga-robotics mutate"):
             "robot": robot_score(unit, robot) if campaign is not None else None,
             "campaign": campaign.name if campaign is not None else None,
             "robot_judge_s": round(robot_s, 2) if campaign is not None else None,
+            "cone_s": round(cone_s, 2) if cone_s is not None else None,
             "baseline": baseline,
             "modules": modules,
             "mutants": [
@@ -461,6 +490,7 @@ def main(argv=None, prog="fpga-robotics mutate"):
         f"{len(mutants)} mutants of follow_target {params.width}x{params.height} "
         f"(seed {args.seed}), {len(frames)} unit frames; build {build_s:.1f} s, "
         f"unit judge {60 * len(mutants) / unit_s:.0f} mutants/min"
+        + (f", fan-out cones {cone_s:.1f} s" if cone_s is not None else "")
     )
     against = "" if args.against == "model" else " (against the unmutated design)"
     print(

@@ -11,7 +11,14 @@ from ..designs.builtin import connector_kinds
 from ..hw.verilog import verilog_ports
 from ..sim.backends.foreign import ForeignDesign
 from ..sim.files import write_atomic, write_json_atomic
-from ..sim.mutation import MUTATION_SELECT, component_rtlil, list_mutants, mutant_netlist
+from ..sim.mutation import (
+    MUTATION_SELECT,
+    MutationError,
+    component_rtlil,
+    list_mutants,
+    mutant_cones,
+    mutant_netlist,
+)
 from ..sim.pins.base import Port
 from ..sim.pins.compiled import VerilatorPins
 from ..sim.pins.verilog import VerilogPinSource
@@ -84,6 +91,7 @@ def mutate_design(
         say=say,
         campaign=campaign,
         robot=robot,
+        cones_of=lambda some: mutant_cones(None, some, rtlil_text=rtlil_text),
     )
 
 
@@ -140,6 +148,7 @@ def mutate_verilog_design(
         say=say,
         campaign=campaign,
         robot=robot,
+        cones_of=lambda some: mutant_cones(None, some, **sources),
     )
 
 
@@ -158,9 +167,11 @@ def _judge(
     say,
     campaign,
     robot,
+    cones_of,
 ):
     """The unit judge of ``mutants`` on ``backend`` (closed here), then the robot judge with
-    ``campaign``; writes and returns ``mutants.json``'s content."""
+    ``campaign`` (forked: first the fan-out cones of the caught mutants, ``cones_of``);
+    writes and returns ``mutants.json``'s content."""
     netlist, port_map = files
     outputs = [p for p, port in ports.items() if port.direction == "out"]
     stimulus = pin_stimulus(ports, cycles, stimulus_seed)
@@ -179,17 +190,26 @@ def _judge(
     finally:
         backend.close()
     unit = {v.index: v.caught for v in verdicts}
-    robot_verdicts, baseline, robot_s = {}, None, None
+    robot_verdicts, baseline, robot_s, cones, cone_s = {}, None, None, None, None
     if campaign is not None:
+        caught = [v.index for v in verdicts if v.caught]
+        if (robot or {}).get("fork", True):  # --no-fork: every run in full
+            t3 = time.perf_counter()
+            try:
+                cones = cones_of([m for m in mutants if m.index in caught])
+            except MutationError as exc:  # no verdict without a run then: all run
+                say(f"fan-out cones: {str(exc).splitlines()[0]}; every mutant runs")
+            cone_s = time.perf_counter() - t3
         t2 = time.perf_counter()
         baseline, robot_verdicts = robot_judge(
             campaign,
             os.path.abspath(netlist),
             os.path.abspath(port_map),
             None,
-            [v.index for v in verdicts if v.caught],
+            caught,
             out,
             say=say,
+            cones=cones,
             **(robot or {}),
         )
         robot_s = time.perf_counter() - t2
@@ -211,6 +231,7 @@ def _judge(
         "robot": robot_score(unit, caught_by_robot) if campaign is not None else None,
         "campaign": campaign.name if campaign is not None else None,
         "robot_judge_s": round(robot_s, 2) if robot_s is not None else None,
+        "cone_s": round(cone_s, 2) if cone_s is not None else None,
         "baseline": baseline,
         "modules": by_module(mutants, unit, caught_by_robot),
         "mutants": [

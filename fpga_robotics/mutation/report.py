@@ -27,6 +27,15 @@ def _table(header, rows):
     return f"<table><tr>{head}</tr>{body}</table>"
 
 
+def _cone_note(verdict):
+    """A verdict given by the mutant's fan-out cone: no run was made (the unmutated design's
+    closest run stands for it)."""
+    if verdict.get("judged_by") != "cone":
+        return ""
+    reached = ", ".join(verdict.get("cone_outputs") or ["no output"])
+    return f"<br>no run made: its fan-out cone reaches only {html.escape(reached)}"
+
+
 def write_report(
     out, campaign, mutants, unit_verdicts, robot_verdicts, baseline, recordings, width
 ):
@@ -72,7 +81,7 @@ def write_report(
                 e(", ".join(m.sources)),
                 e(effects[k]),
                 e(reasons[k]),
-                f"<code>{e(v.get('replay') or '')}</code>",
+                f"<code>{e(v.get('replay') or '')}</code>" + _cone_note(v),
                 f'<a href="{e(rec)}">{e(rec)}</a>' if rec else "",
             ]
         )

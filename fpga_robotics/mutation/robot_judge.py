@@ -23,6 +23,7 @@ from ..sweep import runner
 from ..sweep.api import wait_for_a_worker
 from ..sweep.engine import open_client
 from ..sweep.plan import make_plan
+from .cone import cone_verdict, settled_by_cone
 from .forked_runs import execute_forked, outcome_of, reference_share
 
 __all__ = [
@@ -184,6 +185,7 @@ def robot_judge(
     progress=None,
     say=print,
     fork=True,
+    cones=None,
 ):
     """Judge the mutants ``indices`` by ``campaign``'s closed-loop runs.
 
@@ -194,7 +196,9 @@ def robot_judge(
     Verdicts are appended to ``out_dir/robot.jsonl`` as they come (``resume`` keeps the
     ones there). With ``fork`` each mutant's run is forked from the unmutated design's
     (fpga_robotics.mutation.forked_runs): the same verdicts, most of the world not
-    re-simulated."""
+    re-simulated; and a mutant whose fan-out cone (``cones``: ``{index: reach}``, from
+    ``sim.mutation.mutant_cones``) reaches no output the runs read gets its verdict without
+    a run (fpga_robotics.mutation.cone)."""
     from distributed import as_completed  # lazy: Dask costs ~1 s; only a run needs it
 
     tick = progress or (lambda n: None)
@@ -230,8 +234,17 @@ def robot_judge(
             f"robot judge: {len(passing)} of {len(base)} runs pass unmutated; judging "
             f"{len(todo)} mutants ({len(indices) - len(todo)} already in {journal})"
         )
+        # A fault no run can see passes every run as the design does: no run made.
+        settled = (
+            settled_by_cone(cones, ports, [base[i] for i in passing]) if fork and cones else {}
+        )
+        settled = {k: settled[k] for k in todo if k in settled}
+        closest = closest_to_failing([outcomes[i] for i in passing])
+        if settled:
+            n = len(settled)
+            say(f"robot judge: {n} mutant{'s' * (n != 1)} settled by the fan-out cone, no run")
         futures = {}
-        for k in todo:
+        for k in (k for k in todo if k not in settled):
             argvs = [
                 mutant_argv(spec.argv(), netlist, ports, k, resolution)
                 for spec in (plan.runs[i] for i in passing)
@@ -246,6 +259,15 @@ def robot_judge(
                 argvs,
             )
         with open(journal, "a") as f:
+            for k, reached in settled.items():
+                v = cone_verdict(reached, closest)
+                at = plan.runs[passing[closest]].argv() if closest is not None else None
+                v["argv"] = at and mutant_argv(at, netlist, ports, k, resolution)
+                v["replay"] = replay(v["argv"]) if at else None
+                v["index"] = k
+                verdicts[k] = v
+                f.write(json.dumps(v) + "\n")
+                tick(1)
             for fut in as_completed(futures):
                 k, argvs = futures[fut]
                 try:
