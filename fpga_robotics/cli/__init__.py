@@ -85,6 +85,10 @@ BENCHMARKS = {
         "fpga_robotics.bench.fork",
         "design variants forked from one reference run against run in full",
     ),
+    "mutant_replay": (
+        "fpga_robotics.bench.mutant_replay",
+        "the most a forked mutant run can save: the mutant netlist's replay against a full run",
+    ),
     "loop": ("fpga_robotics.bench.loop", "where the closed loop's time goes, per frame"),
     "foreign": (
         "fpga_robotics.bench.foreign",
