@@ -1207,6 +1207,14 @@ PLANS = {
             r"full runs / forked \(reference included\)\s+[\d.]+x",
         ),
     ),
+    "fpga-robotics bench mutant_replay": Plan(
+        slow=True,
+        shorter=(("--duration", "1"), ("--mutants", "4"), ("--repeats", "1")),
+        out=(
+            r"the netlist alone on the recorded frames\s+[\d.]+ ms",
+            r"forking gains at most [\d.]+x",
+        ),
+    ),
     "fpga-robotics bench camera": Plan(
         shorter=(("--frames", "2"), ("--repeats", "1")),
         out=(r"(?m)^\s*160x120\s+[\d.]+", r"(?m)^\s*640x480\s+[\d.]+"),
