@@ -5,7 +5,8 @@ frame's pixels back to back (the default for FollowTarget), ``real_clock.py`` ev
 cycle at its instant of world time; ``connectors/`` are what the design's pins see of the
 world and do to it; ``shadow.py`` runs a second design on the same frames; ``checkpoint.py`` saves and restores a loop's world at a frame boundary,
 ``fork.py`` (frames) and ``pin_fork.py`` (real clock, with ``pin_journal.py``: a pin design's
-calls, replayed) run design variants from a reference run's recordings and checkpoints,
+calls, replayed) run design variants from a reference run's recordings and checkpoints
+(``reference_data.py``: a frame-level reference in a picklable form, for another process),
 ``continuation.py`` lets a shadow design drive from where it parts (``run --shadow-continue``);
 ``sources.py`` feeds frames from outside the simulation.
 """
