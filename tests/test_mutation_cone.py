@@ -5,6 +5,7 @@ its runs in full give."""
 
 import pytest
 from run_equality import TIMING_FIELDS
+from toolchains import needs_mutation_toolchain
 
 from fpga_robotics.hw.params import FollowTargetParams
 from fpga_robotics.mutation.cone import (
@@ -229,19 +230,7 @@ def test_another_mutants_mux_does_not_widen_a_cone():
 # --- the verdict equals the runs in full: Verilator ----------------------------------------
 
 
-def _toolchain():
-    from fpga_robotics.sim.backends import BackendError
-    from fpga_robotics.sim.backends import toolchain as tc
-
-    try:
-        mutation.find_yosys()
-        tc.find_compiler(), tc.find_make(), tc.verilator_root()
-    except (mutation.MutationError, BackendError) as exc:  # pragma: no cover - the machine
-        return str(exc)
-    return None
-
-
-@pytest.mark.skipif(_toolchain() is not None, reason="no Yosys or Verilator toolchain")
+@needs_mutation_toolchain
 @pytest.mark.slow  # builds the mutants' Verilator model and runs the closed loop
 def test_a_mutant_settled_by_its_cone_runs_as_the_design_does(tmp_path):
     from fpga_robotics.mutation.design import open_mutant_design, write_mutant_design

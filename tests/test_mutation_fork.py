@@ -6,6 +6,7 @@ import pickle
 
 import pytest
 from run_equality import TIMING_FIELDS
+from toolchains import needs_mutation_toolchain
 
 from fpga_robotics.hw.params import FollowTargetParams
 from fpga_robotics.sim import mutation
@@ -13,19 +14,7 @@ from fpga_robotics.sim import mutation
 PARAMS = FollowTargetParams(width=80, height=60)
 
 
-def _toolchain():
-    from fpga_robotics.sim.backends import BackendError
-    from fpga_robotics.sim.backends import toolchain as tc
-
-    try:
-        mutation.find_yosys()
-        tc.find_compiler(), tc.find_make(), tc.verilator_root()
-    except (mutation.MutationError, BackendError) as exc:  # pragma: no cover - the machine
-        return str(exc)
-    return None
-
-
-@pytest.mark.skipif(_toolchain() is not None, reason="no Yosys or Verilator toolchain")
+@needs_mutation_toolchain
 @pytest.mark.slow  # builds the mutants' Verilator model
 def test_forked_mutant_runs_equal_their_full_runs(tmp_path):
     from fpga_robotics.mutation import forked_runs

@@ -12,6 +12,7 @@ import pytest
 from run_equality import assert_same_run
 from test_fork import Altered, _left_plus
 from test_fork_rig import LATE_CAPTURE, altered_tops  # noqa: F401 (the altered turret tops)
+from toolchains import needs_mutation_toolchain
 
 from fpga_robotics.loop import checkpoint
 from fpga_robotics.loop.compressed import ClosedLoop
@@ -144,20 +145,7 @@ def test_a_checkpoint_restores_only_into_its_own_scenario():
         assert loop.frames_done == saved.frame == 0
 
 
-def _toolchain():
-    from fpga_robotics.sim import mutation
-    from fpga_robotics.sim.backends import BackendError
-    from fpga_robotics.sim.backends import toolchain as tc
-
-    try:
-        mutation.find_yosys()
-        tc.find_compiler(), tc.find_make(), tc.verilator_root()
-    except (mutation.MutationError, BackendError) as exc:  # pragma: no cover - the machine
-        return str(exc)
-    return None
-
-
-@pytest.mark.skipif(_toolchain() is not None, reason="no Yosys or Verilator toolchain")
+@needs_mutation_toolchain
 @pytest.mark.slow  # builds the mutants' Verilator model
 def test_two_workers_judge_against_the_same_references(tmp_path):
     """The robot judge on two Dask workers: every worker holds the baseline's references, the
