@@ -35,6 +35,7 @@ stays in its process; ``portable()`` is the same reference picklable
 process with the same variants' results.
 """
 
+import collections
 import time
 from types import SimpleNamespace
 
@@ -272,7 +273,7 @@ def _hand_over_channels(loop, channels, ran, captured, ref, frame):
             continue
         cam, frames = rig.cameras[i], [c.frame for c in ref.captures if c.camera == i]
         done = sum(f < frame for f in frames)  # its captures before the checkpoint
-        cam.channel = _ReplayedChannel(captured[i][done:], channel)
+        cam.channel = _Replayed(captured[i][done:], channel)
         cam.channel_ran = ran[i]
         cam.outputs = dict(captured[i][done - 1]) if done else {}
         seen = 0  # its captures up to each row (the row samples the latest)
@@ -284,37 +285,24 @@ def _hand_over_channels(loop, channels, ran, captured, ref, frame):
 
 
 class _Replayed:
-    """A design that gives recorded outputs for its first frames, then hands over to
-    ``design`` (which has processed those frames already)."""
+    """A design (``process_frame``) or a further camera's channel (``process``) that gives
+    recorded outputs for its first calls, then hands over to ``live``, which has made those
+    calls already."""
 
-    def __init__(self, outputs, design):
-        self.outputs = list(outputs)
-        self.design = design
-        self.name = design.name
+    def __init__(self, outputs, live):
+        self.outputs = collections.deque(outputs)
+        self.live = live
+
+    def __getattr__(self, name):  # the live one's name, ports (view_ports ...)
+        if name in ("outputs", "live"):
+            raise AttributeError(name)
+        return getattr(self.live, name)
 
     def process_frame(self, rgb, color_sel):
-        if self.outputs:
-            return self.outputs.pop(0)
-        return self.design.process_frame(rgb, color_sel)
-
-
-class _ReplayedChannel:
-    """A further camera's channel that gives recorded outputs for its first captures, then
-    hands over to ``channel`` (which has processed those captures already)."""
-
-    def __init__(self, outputs, channel):
-        self.outputs = list(outputs)
-        self.channel = channel
-
-    def __getattr__(self, name):  # the channel's ports (view_ports ...)
-        if name == "channel":
-            raise AttributeError(name)
-        return getattr(self.channel, name)
+        return self.outputs.popleft() if self.outputs else self.live.process_frame(rgb, color_sel)
 
     def process(self, frame, color_sel):
-        if self.outputs:
-            return self.outputs.pop(0)
-        return self.channel.process(frame, color_sel)
+        return self.outputs.popleft() if self.outputs else self.live.process(frame, color_sel)
 
 
 class _Capture:
