@@ -28,16 +28,19 @@ from fpga_robotics.hw.errors import UserError
 from ..hw.params import FollowTargetParams
 from ..hw.top import FollowTarget
 from ..hw.verilog import TOP_NAME, verilog_ports
+from .mutant_watch import WATCH_PORT, add_watch
 from .processes import run_captured
 
 __all__ = [
     "MUTATION_SELECT",
+    "WATCH_PORT",
     "Mutant",
     "MutationError",
     "component_rtlil",
     "cone_reach",
     "find_yosys",
     "list_mutants",
+    "max_index",
     "mutant_cones",
     "mutant_netlist",
     "select_width",
@@ -248,13 +251,17 @@ def list_mutants(
 _MUTATE = re.compile(r"^mutate\s")
 
 
-def mutant_netlist(params, mutants, *, rtlil_text=None, verilog=None, top=TOP_NAME, includes=None):
+def mutant_netlist(
+    params, mutants, *, rtlil_text=None, verilog=None, top=TOP_NAME, includes=None, watch=True
+):
     """Verilog of ``FollowTarget(params)`` (or of the design ``rtlil_text``, from
     ``component_rtlil``) with every mutant behind ``mutsel`` (``select_width(len(mutants))``
     bits; ``mutsel = m.index`` selects ``m``). Top module ``follow_target``, the design's own
-    ports plus ``mutsel`` (a Verilog design, ``verilog``: its module ``top``)."""
+    ports plus ``mutsel`` (a Verilog design, ``verilog``: its module ``top``) and, with
+    ``watch``, the output ``mutinf`` (``sim.mutant_watch``: bit ``k - 1`` high in a cycle
+    where mutant ``k`` would act)."""
     params = params if params is not None else FollowTargetParams()
-    width = select_width(max((m.index for m in mutants), default=0))
+    width = select_width(max_index(mutants))
     with tempfile.TemporaryDirectory(prefix="fr-mutate-") as work:
         read = _read_design(work, params, rtlil_text, verilog, includes)
         lines = [*read, *(s.format(top=top) for s in _PREPARE)]
@@ -262,10 +269,23 @@ def mutant_netlist(params, mutants, *, rtlil_text=None, verilog=None, top=TOP_NA
             lines.append(
                 _MUTATE.sub(f"mutate -ctrl {MUTATION_SELECT} {width} {m.index} ", m.command)
             )
-        lines += ["opt_clean", "write_verilog -noattr mutants.v"]
-        _yosys(lines, work)
+        if not watch:
+            _yosys([*lines, "opt_clean", "write_verilog -noattr mutants.v"], work)
+        else:
+            _yosys([*lines, "opt_clean", "write_rtlil mutants.il"], work)
+            path = os.path.join(work, "mutants.il")
+            with open(path) as f:
+                text = add_watch(f.read(), top, MUTATION_SELECT, max_index(mutants))
+            with open(path, "w") as f:
+                f.write(text)
+            _yosys(["read_rtlil mutants.il", "write_verilog -noattr mutants.v"], work)
         with open(os.path.join(work, "mutants.v")) as f:
             return f.read()
+
+
+def max_index(mutants):
+    """The largest ``mutsel`` value of ``mutants`` (0 for none)."""
+    return max((m.index for m in mutants), default=0)
 
 
 #: Cells that act beyond the outputs (a message, a stop of the simulation): a fault that

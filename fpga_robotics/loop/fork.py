@@ -69,6 +69,9 @@ class _RecordingLoop(ClosedLoop):
         self.captures = []  # _Capture
         self.rig_interface = _rig_interface(self)
         self.servo_ports = _servo_ports(self)
+        # Watch bit -> the frame it first rose in; None: the design has no watch.
+        self.watch_first = None
+        self._watch = getattr(design, "watch_risen", None)
         if self.rig is not None:
             for i, cam in enumerate(self.rig.cameras):
                 if cam.channel is not None:
@@ -94,6 +97,11 @@ class _RecordingLoop(ClosedLoop):
     def process(self, k, rgb):
         self._result = result = super().process(k, rgb)
         self.commands.append((_dps(result.motor_left), _dps(result.motor_right)))
+        risen = self._watch() if self._watch is not None else None
+        if risen is not None:  # the reset's bits come with frame 0's
+            self.watch_first = {} if self.watch_first is None else self.watch_first
+            for bit in risen:
+                self.watch_first.setdefault(bit, k)
         return result
 
     def process_shadow(self, k, t, rgb, result):
@@ -182,6 +190,7 @@ class ReferenceRun:
             captures=list(ref.captures),
             rig_interface=ref.rig_interface,
             servo_ports=ref.servo_ports,
+            watch_first=None if ref.watch_first is None else dict(ref.watch_first),
         )
 
     @classmethod
@@ -194,13 +203,24 @@ class ReferenceRun:
         self.last_divergence = None
         return self
 
-    def run_variant(self, design, scenario=None, *, progress=None):
+    def watch_first(self, bit):
+        """The frame in which bit ``bit`` of the reference design's watch output first rose
+        (None: it never did); ``ValueError`` if the reference design had no watch."""
+        if self._loop.watch_first is None:
+            raise ValueError("the reference design has no watch output")
+        return self._loop.watch_first.get(bit)
+
+    def run_variant(self, design, scenario=None, *, progress=None, watch_bit=None):
         """The run of ``design`` (reset here, not closed) in the reference's world.
 
         ``scenario`` is the variant's own scenario when its design parameters or checks
         differ (its world, camera, timing and seed must be the reference's); default the
         reference's. ``progress(done, total)`` is called after every frame replayed or run
-        (it may raise to stop the run)."""
+        (it may raise to stop the run). ``watch_bit``: the bit of the reference design's
+        watch output that rises wherever the variant would act otherwise than the
+        reference (a mutant's, sim.mutant_watch); if it never rose in the reference's run,
+        the variant's run is the reference's and its design is not run at all (ignored
+        when the reference design had no watch)."""
         scenario = self.scenario if scenario is None else scenario
         check_same_world(self.scenario, scenario)
         if design.params != scenario.params:
@@ -211,6 +231,13 @@ class ReferenceRun:
         loop = ClosedLoop(scenario, seed=self.seed, design=design)
         channels = [cam.channel for cam in loop.rig.cameras] if loop.rig is not None else []
         try:
+            acting = any(c is not None for c in channels)  # channels of the variant's own
+            watched = watch_bit is not None and ref.watch_first is not None
+            if watched and not acting and ref.watch_first.get(watch_bit) is None:
+                # Every signal of the variant is the reference design's, frame for frame.
+                self.last_divergence = None
+                checkpoint.restore(loop, ref.final)
+                return loop.finish_run(wall_start, cpu_start)
             if _rig_interface(loop) != ref.rig_interface:  # nothing to share: a run of its own
                 self.last_divergence = 0
                 return run_compressed(scenario, seed=self.seed, backend=design, progress=progress)

@@ -46,6 +46,9 @@ class ReferenceData:
         How the rig binds the design: a variant's must be the same to replay the captures.
     servo_ports : frozenset
         The channel outputs that command a servo.
+    watch_first : dict or None
+        The frame each bit of the reference design's watch output first rose in (None: the
+        design has no watch).
     """
 
     scenario: object
@@ -61,6 +64,7 @@ class ReferenceData:
     captures: list
     rig_interface: object
     servo_ports: frozenset
+    watch_first: dict | None = None
 
     @property
     def nbytes(self):
@@ -89,4 +93,5 @@ def recorded_of(data):
         captures=data.captures,
         rig_interface=data.rig_interface,
         servo_ports=data.servo_ports,
+        watch_first=data.watch_first,
     )

@@ -4,12 +4,13 @@
 import json
 import os
 import re
+import tomllib
 
 from ..hw.verilog import TOP_NAME
 from ..sim.backends.foreign import ForeignVerilatorBackend
 from ..sim.backends.port_map import follow_target_port_map
 from ..sim.files import write_atomic
-from ..sim.mutation import MUTATION_SELECT, mutant_netlist
+from ..sim.mutation import MUTATION_SELECT, WATCH_PORT, mutant_netlist
 
 __all__ = [
     "NETLIST_NAME",
@@ -22,6 +23,8 @@ __all__ = [
 ]
 
 NETLIST_NAME = "mutants.v"
+#: Where each mutant first acts, watched at ``mutsel = 0`` (sim.mutant_watch).
+_WATCH_TABLE = f'\n# Bit k-1 rises where mutant k would act.\n[watch]\nport = "{WATCH_PORT}"\n'
 PORTS_NAME = "mutants_ports.toml"
 
 
@@ -35,7 +38,7 @@ def write_mutant_design(params, mutants, folder):
         ports,
         follow_target_port_map(params)
         + f"\n# The mutant select (0: the design itself).\n[runtime]\n"
-        f"{MUTATION_SELECT} = 0\n",
+        f"{MUTATION_SELECT} = 0\n" + _WATCH_TABLE,
         what="port map",
     )
     return netlist, ports
@@ -104,20 +107,23 @@ def design_mutant_port_map(spec, ports, *, reset=True, select=MUTATION_SELECT):
         lines += ["", "[extra_outputs]"]
         lines += [f"{_key(name)} = {q(name)}" for name in spec.extra_outputs]
     lines += ["", "# The mutant select (0: the design itself).", "[runtime]", f"{select} = 0", ""]
-    return "\n".join(lines)
+    return "\n".join(lines) + _WATCH_TABLE
 
 
 def with_mutant_select(port_map_text, select=MUTATION_SELECT):
-    """A Verilog design's port map (TOML text) with ``select`` a ``[runtime]`` input at 0:
-    the port map of its mutant netlist."""
+    """A Verilog design's port map (TOML text) with ``select`` a ``[runtime]`` input at 0
+    and ``[watch]`` the netlist's ``mutinf``: the port map of its mutant netlist."""
 
     line = f"{select} = 0  # the mutant select (0: the design itself)"
     if re.search(r"^\s*\[runtime\]\s*(#.*)?$", port_map_text, re.MULTILINE):
-        return re.sub(
+        text = re.sub(
             r"^(\s*\[runtime\]\s*(#.*)?)$",
             lambda m: m.group(1) + "\n" + line,
             port_map_text,
             count=1,
             flags=re.MULTILINE,
         )
-    return port_map_text.rstrip("\n") + "\n\n[runtime]\n" + line + "\n"
+    else:
+        text = port_map_text.rstrip("\n") + "\n\n[runtime]\n" + line + "\n"
+    # A map that watches an output of its own keeps it: its mutants' runs are made in full.
+    return text if "watch" in tomllib.loads(port_map_text) else text + _WATCH_TABLE

@@ -8,7 +8,9 @@ run of the same scenario is then replayed on the recorded frames and re-simulate
 where its design drives differently. Its summary and verdict are those of its full run. In
 real-clock timing the reference is a ``PinReferenceRun`` (fpga_robotics.loop.pin_fork: the
 design's pin calls journaled), which has no portable form: each worker that needs one runs it
-once. Runs with a shadow design are run in full (``runner.execute``).
+once. Runs with a shadow design are run in full (``runner.execute``). A mutant whose bit of
+the netlist's watch output never rose in the reference's run (sim.mutant_watch: it never
+acted) gets the reference's run without its design being run.
 """
 
 import uuid
@@ -17,6 +19,7 @@ from fpga_robotics.cli import run
 from fpga_robotics.loop.fork import ReferenceRun
 from fpga_robotics.loop.pin_fork import reference_run
 
+from ..sim.mutation import MUTATION_SELECT, WATCH_PORT
 from ..sweep import runner
 
 __all__ = ["execute_forked", "reference_share"]
@@ -104,7 +107,22 @@ def execute_forked(argv, ref_argv, timeout=None, shared=None):
         design, _ = runner._designs_for(args, scenario, shadow_params)
         run.apply_runtime(design, args)
         outcome.deadline = deadline = runner._Deadline(timeout, None)
+        bit = _watch_bit(design, args)
+        kwargs = (
+            {"watch_bit": bit} if bit is not None and isinstance(reference, ReferenceRun) else {}
+        )
         with outcome.running():
-            result = reference.run_variant(design, scenario, progress=deadline)
+            result = reference.run_variant(design, scenario, progress=deadline, **kwargs)
         outcome.record(result)
     return outcome.out
+
+
+def _watch_bit(design, args):
+    """The bit of the mutant netlist's watch output (sim.mutant_watch) that rises where the
+    mutant ``args`` selects would act: ``mutsel - 1``; None for the design itself or a
+    netlist without the watch."""
+    port_map = getattr(getattr(design, "design", None), "port_map", None)
+    if port_map is None or port_map.watch != WATCH_PORT:
+        return None
+    k = run.runtime_values(args).get(MUTATION_SELECT, 0)
+    return k - 1 if k > 0 else None

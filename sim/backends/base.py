@@ -120,6 +120,11 @@ class DesignBackend(ABC):
         self._reset()
         self.frames_processed = 0
 
+    def watch_risen(self):
+        """The bits of the design's watch output (a mutant netlist's ``mutinf``) that rose
+        since the last call or reset; None for a backend or design without one."""
+        return
+
     def process_frame(self, frame, color_sel="red", *, out=None):
         """Run one frame through the design and return its ``FrameResult``.
 

@@ -104,6 +104,9 @@ class PortMap:
     connectors: dict = field(default_factory=dict)
     #: name -> design output recorded under that name (``[extra_outputs]``; real-clock timing).
     extra_outputs: dict = field(default_factory=dict)
+    #: An output of any width whose bits the Verilator frame backend watches on every clock
+    #: (``[watch]``): the frame each bit first rises in (``watch_risen``).
+    watch: str | None = None
 
     @property
     def has_pixels(self):
@@ -270,6 +273,10 @@ class ClockKeys(_MapKeys):
     port: PortName
 
 
+class WatchKeys(_MapKeys):
+    port: PortName
+
+
 class ResetKeys(_MapKeys):
     port: PortName = None  # required when [reset] is given
     active_low: Flag(style="scenario") = False
@@ -362,6 +369,8 @@ class PortMapKeys(_MapKeys):
     )
     connectors: Annotated[object, BeforeValidator(_connector_tables)] = Field(default_factory=dict)
     extra_outputs: Annotated[object, BeforeValidator(_extra_outputs)] = Field(default_factory=dict)
+    # An output whose bits are watched on every clock (a mutant netlist's ``mutinf``).
+    watch: _table(WatchKeys) = None
 
 
 assert OUTPUTS.keys() == OutputsKeys.model_fields.keys()
@@ -472,6 +481,7 @@ def parse_port_map(data):
         runtime=k.runtime,
         connectors=connectors,
         extra_outputs=extra,
+        watch=k.watch.port if k.watch is not None else None,
     )
     pm = port_map
     names = [
@@ -494,6 +504,7 @@ def parse_port_map(data):
             *pm.constants,
             *pm.runtime,
             *pm.extra_outputs.values(),
+            pm.watch,
             *(p for pins in pm.connectors.values() for p in pins.values()),
         )
         if n
@@ -544,6 +555,13 @@ def check_widths(port_map, ports, pixels=None):
                 raise PortMapError(
                     f"port map: port {name!r} is {actual_width} bits wide (at most 32)"
                 )
+    if port_map.watch is not None:
+        actual = ports.get(port_map.watch)
+        if actual is None or actual[0] != "output":
+            raise PortMapError(
+                f"port map: watch.port {port_map.watch!r} must be an output of "
+                f"{port_map.top} (its ports: {', '.join(ports)})"
+            )
     if port_map.address and pixels is not None:
         width = ports[port_map.address][1]
         if (pixels - 1) >> width:
