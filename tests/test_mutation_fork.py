@@ -69,5 +69,41 @@ def test_forked_mutant_runs_equal_their_full_runs(tmp_path):
                 }, m.describe()
         forked_runs._references.clear()
         verdicts.add(full["status"])
+        if full["summary"] is None:  # stopped with an error: no fork record
+            assert "fork" not in handed
+            continue
+        fork, frames = handed["fork"], full["summary"]["frames"]
+        if m.index == 1:  # motor_left[12] inverted: parts at once, all of the world again
+            assert fork["parted_at"] == fork["world_from"] == 0 and fork["design_ran"]
+        if fork["parted_at"] is None:  # the world is the reference's throughout
+            assert fork["world_from"] is None and frames == fork["frames"]
+        else:  # the world again from a checkpoint (every 30 frames) at or before parting
+            assert fork["parted_at"] - 30 < fork["world_from"] <= fork["parted_at"], fork
+            assert fork["world_from"] % 30 == 0 and frames == fork["frames"]
     # A passing run and one that did not pass (a failed check, or a design that stopped) compared.
     assert "pass" in verdicts and len(verdicts) > 1, verdicts
+
+
+def test_the_fork_line_counts_runs_and_the_frames_simulated_again():
+    from fpga_robotics.cli.mutate import _fork_line
+
+    def fork(parted_at, world_from, ran=True, frames=450):
+        return {
+            "frames": frames,
+            "parted_at": parted_at,
+            "world_from": world_from,
+            "design_ran": ran,
+        }
+
+    verdicts = {
+        1: {"forks": [fork(None, None, ran=False), fork(None, None), fork(40, 30)]},
+        2: {"forks": [fork(0, 0, frames=300)]},
+        3: {"judged_by": "cone", "runs": 0},  # settled: no run, no fork record
+        4: None,
+    }
+    # 4 runs; the world again for 450 - 30 + 300 frames of 1650.
+    assert _fork_line(verdicts) == (
+        "forked runs: 4; 2 never parted from the unmutated design's (1 without running the "
+        "mutant: it never acted); the world simulated again for 720 of 1650 frames (43.6%)"
+    )
+    assert _fork_line({1: {"runs": 10}}) is None  # --no-fork: no record

@@ -65,6 +65,9 @@ def _report_robot(
         f"{_percent(rs['score'])}; {_robot_rate(baseline['judged_here'], robot_s)}"
         + _settled(robot_verdicts)
     )
+    forked = _fork_line(robot_verdicts)
+    if forked:
+        print(forked)
     blind = blind_spots(unit, robot)
     by_index = {m.index: m for m in mutants}
     recorded = _record_closest(out, [robot_verdicts[k] for k in blind[:recordings]], say)
@@ -99,6 +102,24 @@ def _settled(robot_verdicts):
     """``"; N settled by their fan-out cone"`` (or nothing): the verdicts given without a run."""
     n = sum(1 for v in robot_verdicts.values() if v.get("judged_by") == "cone")
     return f"; {n} settled by their fan-out cone (no run)" if n else ""
+
+
+def _fork_line(robot_verdicts):
+    """What forking saved: how many forked runs never parted from the unmutated design's,
+    how many of those did not run the mutant at all (its watch bit never rose), and the
+    share of frames whose world was simulated again (None without forked runs)."""
+    forks = [f for v in robot_verdicts.values() if v for f in v.get("forks", ())]
+    if not forks:
+        return None
+    never = sum(1 for f in forks if f["parted_at"] is None)
+    unrun = sum(1 for f in forks if not f["design_ran"])
+    frames = sum(f["frames"] for f in forks)
+    world = sum(f["frames"] - f["world_from"] for f in forks if f["world_from"] is not None)
+    return (
+        f"forked runs: {len(forks)}; {never} never parted from the unmutated design's "
+        f"({unrun} without running the mutant: it never acted); the world simulated again "
+        f"for {world} of {frames} frames ({_percent(world / max(frames, 1))})"
+    )
 
 
 def _robot_rate(judged_here, seconds):
@@ -335,6 +356,9 @@ def _report_design_robot(result, campaign):
         f"{_percent(rs['score'])}; {_robot_rate(baseline['judged_here'], result['robot_judge_s'])}"
         + _settled({m["index"]: m["robot"] for m in result["mutants"] if m["robot"]})
     )
+    forked = _fork_line({m["index"]: m["robot"] for m in result["mutants"] if m["robot"]})
+    if forked:
+        print(forked)
     if not n_pass:
         print("no run passes with the unmutated design: the robot judge has no run to judge by")
         return

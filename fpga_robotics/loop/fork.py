@@ -142,6 +142,12 @@ class ReferenceRun:
         For the last ``run_variant``: the first frame where a wheel or servo command
         differed (None if none did; 0 for a variant whose further cameras or servos bind
         its design otherwise, which has nothing to share and runs in full).
+    last_world_from : int or None
+        For the last ``run_variant``: the frame from which the world was simulated again
+        (the checkpoint restored; None: not at all).
+    last_design_ran : bool
+        For the last ``run_variant``: whether the variant's design was run (not for one
+        whose watch bit never rose).
     """
 
     def __init__(
@@ -166,7 +172,8 @@ class ReferenceRun:
         finally:  # its channels are done with: each variant runs its own
             if self._loop.rig is not None:
                 self._loop.rig.close()
-        self.last_divergence = None
+        self.last_divergence = self.last_world_from = None
+        self.last_design_ran = True
 
     @property
     def frames(self):
@@ -200,7 +207,8 @@ class ReferenceRun:
         self = cls.__new__(cls)
         self.scenario, self.seed, self.result = data.scenario, data.seed, data.result
         self._loop = recorded_of(data)
-        self.last_divergence = None
+        self.last_divergence = self.last_world_from = None
+        self.last_design_ran = True
         return self
 
     def watch_first(self, bit):
@@ -235,21 +243,25 @@ class ReferenceRun:
             watched = watch_bit is not None and ref.watch_first is not None
             if watched and not acting and ref.watch_first.get(watch_bit) is None:
                 # Every signal of the variant is the reference design's, frame for frame.
-                self.last_divergence = None
+                self.last_divergence = self.last_world_from = None
+                self.last_design_ran = False
                 checkpoint.restore(loop, ref.final)
                 return loop.finish_run(wall_start, cpu_start)
+            self.last_design_ran = True
             if _rig_interface(loop) != ref.rig_interface:  # nothing to share: a run of its own
-                self.last_divergence = 0
+                self.last_divergence = self.last_world_from = 0
                 return run_compressed(scenario, seed=self.seed, backend=design, progress=progress)
             ran = [cam.channel_ran for cam in loop.rig.cameras] if loop.rig is not None else []
             outputs, captured, diverged = _replay(design, channels, ref, progress)
             self.last_divergence = diverged
+            self.last_world_from = None
             if diverged is None:
                 checkpoint.restore(loop, ref.final)
                 _rewrite_design_part(loop, outputs, ref)
                 _hand_over_channels(loop, channels, ran, captured, ref, len(outputs))
                 return loop.finish_run(wall_start, cpu_start)
             start = [c for c in ref.checkpoints if c.frame <= diverged][-1]
+            self.last_world_from = start.frame
             checkpoint.restore(loop, start)
             _rewrite_design_part(loop, outputs[: start.frame], ref)
             _hand_over_channels(loop, channels, ran, captured, ref, start.frame)

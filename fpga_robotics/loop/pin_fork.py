@@ -112,7 +112,8 @@ class PinReferenceRun:
         )
         self.seed = self._loop.seed
         self.result = self._loop.run(progress=progress)
-        self.last_divergence = None
+        self.last_divergence = self.last_world_from = None  # as ReferenceRun's
+        self.last_design_ran = True
 
     @property
     def frames(self):
@@ -128,7 +129,7 @@ class PinReferenceRun:
         ref, calls = self._loop, self.journal.calls
         loop = RealClockLoop(scenario, seed=self.seed, design=design)
         if _interface(loop) != _interface(ref):
-            self.last_divergence = 0
+            self.last_divergence = self.last_world_from = 0
             return run_scenario(scenario, seed=self.seed, backend=design, progress=progress)
         starts = ref.frame_calls
 
@@ -138,13 +139,14 @@ class PinReferenceRun:
 
         i, answer = first_difference(design, calls, replayed)
         if i is None:
-            self.last_divergence = None
+            self.last_divergence = self.last_world_from = None
             rest = calls[ref.final.design_calls :]
             loop.use_design(PlayBack(design, rest, rest[0].cycle if rest else design.cycle))
             _restore(loop, ref.final)
             return loop.finish_run(wall_start, cpu_start)
         self.last_divergence = bisect.bisect_right(starts, i) - 1
         start = [c for c in ref.checkpoints if c.design_calls <= i][-1]
+        self.last_world_from = start.frame
         first = start.design_calls
         loop.use_design(PlayBack(design, calls[first : i + 1], calls[first].cycle, last=answer))
         _restore(loop, start)

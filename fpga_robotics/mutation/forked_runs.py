@@ -95,7 +95,10 @@ def outcome_of(shared):
 
 def execute_forked(argv, ref_argv, timeout=None, shared=None):
     """``runner.execute(argv, timeout)`` for a mutant's run, forked from the reference run
-    ``ref_argv`` (the same run with the unmutated design); the same outcome dict.
+    ``ref_argv`` (the same run with the unmutated design); the same outcome dict, with
+    ``"fork"``: the run's ``frames``, the frame its wheels or servos parted from the
+    reference's (``parted_at``, None: never), the frame the world was simulated again from
+    (``world_from``, None: not at all) and whether its design ran (``design_ran``).
     ``shared``: that run's ``reference_share`` result, whose reference this worker opens
     rather than running it again (None: run here, once per worker)."""
     with runner.RunOutcome() as outcome:
@@ -114,6 +117,12 @@ def execute_forked(argv, ref_argv, timeout=None, shared=None):
         with outcome.running():
             result = reference.run_variant(design, scenario, progress=deadline, **kwargs)
         outcome.record(result)
+        outcome.out["fork"] = {
+            "frames": reference.frames,
+            "parted_at": reference.last_divergence,
+            "world_from": reference.last_world_from,
+            "design_ran": reference.last_design_ran,
+        }
     return outcome.out
 
 

@@ -108,7 +108,8 @@ def judge_runs(argvs, timeouts=None, execute=None):
     """The Dask task of one mutant: its runs in order until one does not pass. Returns
     ``{"caught", "run", "status", "message", "failed_checks", "closest", "runs", "wall_s"}``
     (``run``: the index of the first run that did not pass; ``closest``: of a mutant not
-    caught, the run nearest to failing). ``execute(i, argv, timeout)`` runs run ``i``
+    caught, the run nearest to failing), and ``"forks"`` for forked runs: their
+    ``forked_runs.execute_forked`` records, in order. ``execute(i, argv, timeout)`` runs run ``i``
     (default ``runner.execute``; forked runs: fpga_robotics.mutation.forked_runs)."""
     if execute is None:
 
@@ -117,10 +118,13 @@ def judge_runs(argvs, timeouts=None, execute=None):
 
     t0 = time.perf_counter()
     outcomes = []
+    forks = []  # each forked run's "fork" record (forked_runs.execute_forked)
     for i, argv in enumerate(argvs):
         o = execute(i, argv, None if timeouts is None else timeouts[i])
         o.pop("recording", None)
         outcomes.append(o)
+        if o.get("fork") is not None:
+            forks.append(o["fork"])
         if o["status"] != "pass":
             failed = [
                 c["name"]
@@ -136,6 +140,7 @@ def judge_runs(argvs, timeouts=None, execute=None):
                 "closest": None,
                 "runs": i + 1,
                 "wall_s": time.perf_counter() - t0,
+                **({"forks": forks} if forks else {}),
             }
     return {
         "caught": False,
@@ -146,6 +151,7 @@ def judge_runs(argvs, timeouts=None, execute=None):
         "closest": closest_to_failing(outcomes),
         "runs": len(argvs),
         "wall_s": time.perf_counter() - t0,
+        **({"forks": forks} if forks else {}),
     }
 
 
