@@ -269,16 +269,23 @@ def mutant_netlist(
             lines.append(
                 _MUTATE.sub(f"mutate -ctrl {MUTATION_SELECT} {width} {m.index} ", m.command)
             )
+        # splitnets -driver: a wire driven bit by bit by several cells (a mutant's mux on one
+        # of its bits) becomes one wire per driver, so Verilator sees no false combinational
+        # loop through it (UNOPTFLAT) and evaluates each cell once a cycle.
+        lines += ["opt_clean", "splitnets -driver"]
         if not watch:
-            _yosys([*lines, "opt_clean", "write_verilog -noattr mutants.v"], work)
+            _yosys([*lines, "write_verilog -noattr mutants.v"], work)
         else:
-            _yosys([*lines, "opt_clean", "write_rtlil mutants.il"], work)
+            _yosys([*lines, "write_rtlil mutants.il"], work)
             path = os.path.join(work, "mutants.il")
             with open(path) as f:
                 text = add_watch(f.read(), top, MUTATION_SELECT, max_index(mutants))
             with open(path, "w") as f:
                 f.write(text)
-            _yosys(["read_rtlil mutants.il", "write_verilog -noattr mutants.v"], work)
+            _yosys(
+                ["read_rtlil mutants.il", "splitnets -driver", "write_verilog -noattr mutants.v"],
+                work,
+            )
         with open(os.path.join(work, "mutants.v")) as f:
             return f.read()
 

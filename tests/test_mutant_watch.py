@@ -115,7 +115,11 @@ def _outputs(result):
 @pytest.mark.slow  # builds the mutants' Verilator model
 def test_the_watch_bounds_where_every_mutant_of_a_seed_first_differs(tmp_path):
     from fpga_robotics.loop.fork import ReferenceRun
-    from fpga_robotics.mutation.design import open_mutant_design, write_mutant_design
+    from fpga_robotics.mutation.design import (
+        WATCH_PORTS_NAME,
+        open_mutant_design,
+        write_mutant_design,
+    )
     from fpga_robotics.scenario.load import load_scenario
 
     scenario = load_scenario(
@@ -124,7 +128,7 @@ def test_the_watch_bounds_where_every_mutant_of_a_seed_first_differs(tmp_path):
     mutants = mutation.list_mutants(PARAMS, 40, seed=2)
     netlist, ports = write_mutant_design(PARAMS, mutants, tmp_path)
     assert re.search(rf"output \[{len(mutants) - 1}:0\] {WATCH_PORT};", Path(netlist).read_text())
-    design = open_mutant_design(PARAMS, netlist, ports)
+    design = open_mutant_design(PARAMS, netlist, Path(ports).with_name(WATCH_PORTS_NAME))
     try:
         reference = ReferenceRun(scenario, design=design)
         seen = reference._loop.seen
@@ -163,13 +167,17 @@ def test_the_watch_bounds_where_every_mutant_of_a_seed_first_differs(tmp_path):
 def test_a_mutant_that_never_acts_is_given_the_reference_run_without_running(tmp_path):
     from fpga_robotics.loop.fork import ReferenceRun
     from fpga_robotics.loop.timings import run_scenario
-    from fpga_robotics.mutation.design import open_mutant_design, write_mutant_design
+    from fpga_robotics.mutation.design import (
+        WATCH_PORTS_NAME,
+        open_mutant_design,
+        write_mutant_design,
+    )
     from fpga_robotics.scenario.load import load_scenario
 
     scenario = load_scenario("follow_person", ["sim.duration=2.0", 'camera.resolution="80x60"'])
     mutants = mutation.list_mutants(PARAMS, 40, seed=2)
     netlist, ports = write_mutant_design(PARAMS, mutants, tmp_path)
-    design = open_mutant_design(PARAMS, netlist, ports)
+    design = open_mutant_design(PARAMS, netlist, Path(ports).with_name(WATCH_PORTS_NAME))
     try:
         reference = ReferenceRun(scenario, design=design)
         quiet = [m for m in mutants if reference.watch_first(m.index - 1) is None]

@@ -18,7 +18,7 @@ PARAMS = FollowTargetParams(width=80, height=60)
 @pytest.mark.slow  # builds the mutants' Verilator model
 def test_forked_mutant_runs_equal_their_full_runs(tmp_path):
     from fpga_robotics.mutation import forked_runs
-    from fpga_robotics.mutation.design import write_mutant_design
+    from fpga_robotics.mutation.design import WATCH_PORTS_NAME, write_mutant_design
     from fpga_robotics.mutation.forked_runs import execute_forked, outcome_of, reference_share
     from fpga_robotics.mutation.robot_judge import mutant_argv
     from fpga_robotics.sweep import load_campaign, runner
@@ -53,10 +53,10 @@ def test_forked_mutant_runs_equal_their_full_runs(tmp_path):
     assert shared["reference"].result.summary["frames"] == baseline["summary"]["frames"]
     shared = pickle.loads(pickle.dumps(shared))
     forked_runs._references.clear()
-    verdicts = set()
+    verdicts, fulls = set(), {}
     for m in chosen:
         argv = mutant_argv(spec.argv(), netlist, ports, m.index, "80x60")
-        full = runner.execute(argv)
+        fulls[m.index] = full = runner.execute(argv)
         handed = execute_forked(argv, ref_argv, shared=shared)
         forked_runs._references.clear()
         for forked in (handed, execute_forked(argv, ref_argv)):  # the latter runs it here
@@ -82,6 +82,22 @@ def test_forked_mutant_runs_equal_their_full_runs(tmp_path):
             assert fork["world_from"] % 30 == 0 and frames == fork["frames"]
     # A passing run and one that did not pass (a failed check, or a design that stopped) compared.
     assert "pass" in verdicts and len(verdicts) > 1, verdicts
+
+    # The reference with the netlist's watch output watched: a mutant that never acted is
+    # given the reference's run without its design run, still its full run.
+    watch_argv = mutant_argv(spec.argv(), netlist, tmp_path / WATCH_PORTS_NAME, 0, "80x60")
+    unrun = 0
+    for m in chosen:
+        argv = mutant_argv(spec.argv(), netlist, ports, m.index, "80x60")
+        forked, full = execute_forked(argv, watch_argv, watch_bit=m.index - 1), fulls[m.index]
+        assert forked["status"] == full["status"], m.describe()
+        if full["summary"] is not None:
+            assert {k: v for k, v in forked["summary"].items() if k not in TIMING_FIELDS} == {
+                k: v for k, v in full["summary"].items() if k not in TIMING_FIELDS
+            }, m.describe()
+            unrun += not forked["fork"]["design_ran"]
+    forked_runs._references.clear()
+    assert unrun >= 1  # the check above covers a mutant given the reference's run
 
 
 def test_the_fork_line_counts_runs_and_the_frames_simulated_again():

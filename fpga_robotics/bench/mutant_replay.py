@@ -4,11 +4,13 @@ A mutant's forked run that never parts from the unmutated design's still replays
 netlist on every recorded frame (fpga_robotics.loop.fork): only the world (rendering,
 physics) is saved. This benchmark runs a scenario once with the mutant netlist at
 ``mutsel = 0`` on Verilator (as the robot judge runs it) as a fork reference, then replays
-the netlist alone on the recorded frames, and FollowTarget's own model on the same frames on
-Verilator and CXXRTL, one process, CPU time. The replay's share of the full run is what a
+the netlist alone on the recorded frames (as a mutant's run does; then with its watch
+output watched, as the robot judge's unmutated runs do), and FollowTarget's own model on the
+same frames on Verilator and CXXRTL, one process, CPU time. The replay's share of the full run is what a
 mutant that never parts still costs: the fork's speed-up is at most its inverse.
 """
 
+import os
 import tempfile
 import time
 
@@ -16,7 +18,11 @@ from fpga_robotics.bench import scaffold
 from fpga_robotics.cli.errors import UsageError
 from fpga_robotics.loop.compressed import make_backend
 from fpga_robotics.loop.fork import ReferenceRun
-from fpga_robotics.mutation.design import open_mutant_design, write_mutant_design
+from fpga_robotics.mutation.design import (
+    WATCH_PORTS_NAME,
+    open_mutant_design,
+    write_mutant_design,
+)
 from fpga_robotics.scenario.load import ScenarioError, load_scenario, parse_resolution
 from fpga_robotics.sim.mutation import list_mutants
 
@@ -74,6 +80,11 @@ def run(args):
             netlist_ms = replay_ms(design, seen, args.repeats)
         finally:
             design.close()
+        watched = open_mutant_design(params, netlist, os.path.join(folder, WATCH_PORTS_NAME))
+        try:
+            watched_ms = replay_ms(watched, seen, args.repeats)
+        finally:
+            watched.close()
     own = {}
     for name in ("verilator", "cxxrtl"):
         backend = make_backend(name, params)
@@ -90,6 +101,7 @@ def run(args):
     )
     print(f"  full run, mutant netlist at mutsel=0 (Verilator)   {full_ms:7.2f} ms")
     print(f"  the netlist alone on the recorded frames           {netlist_ms:7.2f} ms")
+    print(f"  the same with its watch output watched             {watched_ms:7.2f} ms")
     print(f"  FollowTarget's own model alone, Verilator          {own['verilator']:7.2f} ms")
     print(f"  FollowTarget's own model alone, CXXRTL             {own['cxxrtl']:7.2f} ms")
     print(
@@ -100,6 +112,7 @@ def run(args):
         "frames": frames,
         "full_ms": full_ms,
         "netlist_ms": netlist_ms,
+        "watched_ms": watched_ms,
         "own_verilator_ms": own["verilator"],
         "own_cxxrtl_ms": own["cxxrtl"],
         "fork_ceiling": 1 / share,

@@ -17,7 +17,11 @@ from fpga_robotics.cli.errors import UsageError
 from fpga_robotics.cli.param_options import add_param_arguments, params_from_args
 from fpga_robotics.cli.parser import CommandParser
 from fpga_robotics.designs.reference import resolve_design
-from fpga_robotics.mutation.design import open_mutant_design, write_mutant_design
+from fpga_robotics.mutation.design import (
+    WATCH_PORTS_NAME,
+    open_mutant_design,
+    write_mutant_design,
+)
 from fpga_robotics.mutation.design_run import DEFAULT_CYCLES, mutate_design, mutate_verilog_design
 from fpga_robotics.mutation.reasons import blind_spot_reason
 from fpga_robotics.mutation.report import write_report
@@ -463,6 +467,7 @@ def main(argv=None, prog="fpga-robotics mutate"):
             say=say,
             fork=args.fork,
             cones=cones,
+            watch_ports=os.path.join(out, WATCH_PORTS_NAME),
         )
         robot_s = time.perf_counter() - t2
     robot = {k: v["caught"] for k, v in robot_verdicts.items()}

@@ -15,6 +15,7 @@ from ..sim.mutation import MUTATION_SELECT, WATCH_PORT, mutant_netlist
 __all__ = [
     "NETLIST_NAME",
     "PORTS_NAME",
+    "WATCH_PORTS_NAME",
     "design_mutant_port_map",
     "netlist_has_reset",
     "open_mutant_design",
@@ -26,21 +27,24 @@ NETLIST_NAME = "mutants.v"
 #: Where each mutant first acts, watched at ``mutsel = 0`` (sim.mutant_watch).
 _WATCH_TABLE = f'\n# Bit k-1 rises where mutant k would act.\n[watch]\nport = "{WATCH_PORT}"\n'
 PORTS_NAME = "mutants_ports.toml"
+#: The same port map with the watch output watched: for the unmutated design's runs only
+#: (a mutant's run needs no watch, and its model runs faster without one).
+WATCH_PORTS_NAME = "mutants_watch_ports.toml"
 
 
 def write_mutant_design(params, mutants, folder):
-    """Write the netlist and its port map into ``folder``; return their paths."""
+    """Write the netlist and its port maps into ``folder`` (``PORTS_NAME`` and, with the
+    watch, ``WATCH_PORTS_NAME``); return the paths of the netlist and of the first map."""
     os.makedirs(folder, exist_ok=True)
     netlist = os.path.join(folder, NETLIST_NAME)
     ports = os.path.join(folder, PORTS_NAME)
     write_atomic(netlist, mutant_netlist(params, mutants), what="mutant netlist")
-    write_atomic(
-        ports,
+    text = (
         follow_target_port_map(params)
-        + f"\n# The mutant select (0: the design itself).\n[runtime]\n"
-        f"{MUTATION_SELECT} = 0\n" + _WATCH_TABLE,
-        what="port map",
+        + f"\n# The mutant select (0: the design itself).\n[runtime]\n{MUTATION_SELECT} = 0\n"
     )
+    write_atomic(ports, text, what="port map")
+    write_atomic(os.path.join(folder, WATCH_PORTS_NAME), text + _WATCH_TABLE, what="port map")
     return netlist, ports
 
 
@@ -61,11 +65,12 @@ def netlist_has_reset(verilog):
     return re.search(r"^\s*input\s+rst\s*;", verilog, re.MULTILINE) is not None
 
 
-def design_mutant_port_map(spec, ports, *, reset=True, select=MUTATION_SELECT):
+def design_mutant_port_map(spec, ports, *, reset=True, select=MUTATION_SELECT, watch=False):
     """TOML text: the port map of the mutant netlist of a design of one's own (``spec``, a
     resolved ``DesignSpec``; ``ports``: name -> ``Port`` as ``design_run.design_ports`` gives
     them), its bindings as the design declares them, ``mutsel`` a ``[runtime]`` input;
-    ``reset``: whether the netlist has Amaranth's ``rst``."""
+    ``reset``: whether the netlist has Amaranth's ``rst``; ``watch``: with ``[watch]`` its
+    ``mutinf``."""
 
     q = json.dumps
     lines = [
@@ -107,12 +112,13 @@ def design_mutant_port_map(spec, ports, *, reset=True, select=MUTATION_SELECT):
         lines += ["", "[extra_outputs]"]
         lines += [f"{_key(name)} = {q(name)}" for name in spec.extra_outputs]
     lines += ["", "# The mutant select (0: the design itself).", "[runtime]", f"{select} = 0", ""]
-    return "\n".join(lines) + _WATCH_TABLE
+    return "\n".join(lines) + (_WATCH_TABLE if watch else "")
 
 
-def with_mutant_select(port_map_text, select=MUTATION_SELECT):
-    """A Verilog design's port map (TOML text) with ``select`` a ``[runtime]`` input at 0
-    and ``[watch]`` the netlist's ``mutinf``: the port map of its mutant netlist."""
+def with_mutant_select(port_map_text, select=MUTATION_SELECT, watch=False):
+    """A Verilog design's port map (TOML text) with ``select`` a ``[runtime]`` input at 0:
+    the port map of its mutant netlist; ``watch``: with ``[watch]`` its ``mutinf`` (None if
+    the map watches an output of its own)."""
 
     line = f"{select} = 0  # the mutant select (0: the design itself)"
     if re.search(r"^\s*\[runtime\]\s*(#.*)?$", port_map_text, re.MULTILINE):
@@ -125,5 +131,7 @@ def with_mutant_select(port_map_text, select=MUTATION_SELECT):
         )
     else:
         text = port_map_text.rstrip("\n") + "\n\n[runtime]\n" + line + "\n"
+    if not watch:
+        return text
     # A map that watches an output of its own keeps it: its mutants' runs are made in full.
-    return text if "watch" in tomllib.loads(port_map_text) else text + _WATCH_TABLE
+    return None if "watch" in tomllib.loads(port_map_text) else text + _WATCH_TABLE

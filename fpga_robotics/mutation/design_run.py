@@ -25,6 +25,7 @@ from ..sim.pins.verilog import VerilogPinSource
 from .design import (
     NETLIST_NAME,
     PORTS_NAME,
+    WATCH_PORTS_NAME,
     design_mutant_port_map,
     netlist_has_reset,
     with_mutant_select,
@@ -71,18 +72,17 @@ def mutate_design(
     # judge: one build, ``--runtime mutsel=K`` picks the mutant).
     netlist = os.path.join(out, NETLIST_NAME)
     write_atomic(netlist, source.verilog, what="mutant netlist")
-    port_map = os.path.join(out, PORTS_NAME)
-    write_atomic(
-        port_map,
-        design_mutant_port_map(spec, ports, reset=netlist_has_reset(source.verilog)),
-        what="port map",
-    )
+    port_map, watch_map = os.path.join(out, PORTS_NAME), os.path.join(out, WATCH_PORTS_NAME)
+    reset = netlist_has_reset(source.verilog)
+    for path, watch in ((port_map, False), (watch_map, True)):
+        text = design_mutant_port_map(spec, ports, reset=reset, watch=watch)
+        write_atomic(path, text, what="port map")
     return _judge(
         {"reference": spec.reference, "params": spec.params},
         backend,
         ports,
         mutants,
-        (netlist, port_map),
+        (netlist, port_map, watch_map),
         build_s,
         seed,
         cycles,
@@ -123,9 +123,15 @@ def mutate_verilog_design(
     netlist = os.path.join(out, NETLIST_NAME)
     verilog = mutant_netlist(None, mutants, **sources)
     write_atomic(netlist, verilog, what="mutant netlist")
-    port_map = os.path.join(out, PORTS_NAME)
+    port_map, watch_map = os.path.join(out, PORTS_NAME), os.path.join(out, WATCH_PORTS_NAME)
     with open(ports_path) as f:
-        write_atomic(port_map, with_mutant_select(f.read()), what="port map")
+        text = f.read()
+    write_atomic(port_map, with_mutant_select(text), what="port map")
+    watched = with_mutant_select(text, watch=True)
+    if watched is None:  # the map watches an output of its own: no mutant watch
+        watch_map = None
+    else:
+        write_atomic(watch_map, watched, what="port map")
     source = VerilogPinSource(
         ForeignDesign([netlist], port_map, pins=True, connector_kinds=connector_kinds())
     )
@@ -139,7 +145,7 @@ def mutate_verilog_design(
         backend,
         driven,
         mutants,
-        (netlist, port_map),
+        (netlist, port_map, watch_map),
         build_s,
         seed,
         cycles,
@@ -172,7 +178,7 @@ def _judge(
     """The unit judge of ``mutants`` on ``backend`` (closed here), then the robot judge with
     ``campaign`` (forked: first the fan-out cones of the caught mutants, ``cones_of``);
     writes and returns ``mutants.json``'s content."""
-    netlist, port_map = files
+    netlist, port_map, watch_map = files
     outputs = [p for p, port in ports.items() if port.direction == "out"]
     stimulus = pin_stimulus(ports, cycles, stimulus_seed)
     try:
@@ -210,6 +216,7 @@ def _judge(
             out,
             say=say,
             cones=cones,
+            watch_ports=watch_map and os.path.abspath(watch_map),
             **(robot or {}),
         )
         robot_s = time.perf_counter() - t2

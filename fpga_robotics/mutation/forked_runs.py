@@ -8,9 +8,10 @@ run of the same scenario is then replayed on the recorded frames and re-simulate
 where its design drives differently. Its summary and verdict are those of its full run. In
 real-clock timing the reference is a ``PinReferenceRun`` (fpga_robotics.loop.pin_fork: the
 design's pin calls journaled), which has no portable form: each worker that needs one runs it
-once. Runs with a shadow design are run in full (``runner.execute``). A mutant whose bit of
-the netlist's watch output never rose in the reference's run (sim.mutant_watch: it never
-acted) gets the reference's run without its design being run.
+once. Runs with a shadow design are run in full (``runner.execute``). When the references
+ran with the netlist's watch output watched (the robot judge's ``watch_ports``), a mutant
+whose bit never rose in a reference's run (sim.mutant_watch: it never acted there) gets that
+run without its design being run.
 """
 
 import uuid
@@ -19,7 +20,6 @@ from fpga_robotics.cli import run
 from fpga_robotics.loop.fork import ReferenceRun
 from fpga_robotics.loop.pin_fork import reference_run
 
-from ..sim.mutation import MUTATION_SELECT, WATCH_PORT
 from ..sweep import runner
 
 __all__ = ["execute_forked", "reference_share"]
@@ -93,14 +93,16 @@ def outcome_of(shared):
     return shared["outcome"]
 
 
-def execute_forked(argv, ref_argv, timeout=None, shared=None):
+def execute_forked(argv, ref_argv, timeout=None, shared=None, watch_bit=None):
     """``runner.execute(argv, timeout)`` for a mutant's run, forked from the reference run
     ``ref_argv`` (the same run with the unmutated design); the same outcome dict, with
     ``"fork"``: the run's ``frames``, the frame its wheels or servos parted from the
     reference's (``parted_at``, None: never), the frame the world was simulated again from
     (``world_from``, None: not at all) and whether its design ran (``design_ran``).
     ``shared``: that run's ``reference_share`` result, whose reference this worker opens
-    rather than running it again (None: run here, once per worker)."""
+    rather than running it again (None: run here, once per worker). ``watch_bit``: the
+    mutant's bit of the netlist's watch output, when the reference ran with it watched
+    (sim.mutant_watch: ``mutsel - 1``); a mutant whose bit never rose is not run."""
     with runner.RunOutcome() as outcome:
         if not _forkable(ref_argv):
             return runner.execute(argv, timeout=timeout)
@@ -110,10 +112,8 @@ def execute_forked(argv, ref_argv, timeout=None, shared=None):
         design, _ = runner._designs_for(args, scenario, shadow_params)
         run.apply_runtime(design, args)
         outcome.deadline = deadline = runner._Deadline(timeout, None)
-        bit = _watch_bit(design, args)
-        kwargs = (
-            {"watch_bit": bit} if bit is not None and isinstance(reference, ReferenceRun) else {}
-        )
+        watched = watch_bit is not None and isinstance(reference, ReferenceRun)
+        kwargs = {"watch_bit": watch_bit} if watched else {}
         with outcome.running():
             result = reference.run_variant(design, scenario, progress=deadline, **kwargs)
         outcome.record(result)
@@ -124,14 +124,3 @@ def execute_forked(argv, ref_argv, timeout=None, shared=None):
             "design_ran": reference.last_design_ran,
         }
     return outcome.out
-
-
-def _watch_bit(design, args):
-    """The bit of the mutant netlist's watch output (sim.mutant_watch) that rises where the
-    mutant ``args`` selects would act: ``mutsel - 1``; None for the design itself or a
-    netlist without the watch."""
-    port_map = getattr(getattr(design, "design", None), "port_map", None)
-    if port_map is None or port_map.watch != WATCH_PORT:
-        return None
-    k = run.runtime_values(args).get(MUTATION_SELECT, 0)
-    return k - 1 if k > 0 else None

@@ -192,6 +192,7 @@ def robot_judge(
     say=print,
     fork=True,
     cones=None,
+    watch_ports=None,
 ):
     """Judge the mutants ``indices`` by ``campaign``'s closed-loop runs.
 
@@ -204,7 +205,9 @@ def robot_judge(
     (fpga_robotics.mutation.forked_runs): the same verdicts, most of the world not
     re-simulated; and a mutant whose fan-out cone (``cones``: ``{index: reach}``, from
     ``sim.mutation.mutant_cones``) reaches no output the runs read gets its verdict without
-    a run (fpga_robotics.mutation.cone)."""
+    a run (fpga_robotics.mutation.cone). ``watch_ports``: the netlist's port map with its
+    watch output watched (``design.write_mutant_design``); with ``fork`` the unmutated runs
+    use it, and a mutant that never acted in one of them is given it without a run."""
     from distributed import as_completed  # lazy: Dask costs ~1 s; only a run needs it
 
     tick = progress or (lambda n: None)
@@ -216,7 +219,10 @@ def robot_judge(
             "the mutation campaign may not override design.* values: the "
             "mutants are of one design (give its parameters to mutate instead)"
         )
-    base = [mutant_argv(spec.argv(), netlist, ports, 0, resolution) for spec in plan.runs]
+    watch_ports = watch_ports if fork else None
+    base = [
+        mutant_argv(spec.argv(), netlist, watch_ports or ports, 0, resolution) for spec in plan.runs
+    ]
     journal = os.path.join(out_dir, "robot.jsonl")
     verdicts = {}
     if resume and os.path.exists(journal):
@@ -257,7 +263,8 @@ def robot_judge(
             ]
             if fork:
                 refs = [shared[i] for i in passing]  # Dask hands each worker their results
-                task = (judge_runs_forked, argvs, [base[i] for i in passing], limits, refs)
+                bit = k - 1 if watch_ports else None  # sim.mutant_watch
+                task = (judge_runs_forked, argvs, [base[i] for i in passing], limits, refs, bit)
             else:
                 task = (judge_runs, argvs, limits)
             futures[client.submit(*task, pure=False, key=f"mutant-{k}-{time.monotonic_ns()}")] = (
@@ -303,14 +310,14 @@ def robot_judge(
     )
 
 
-def judge_runs_forked(argvs, ref_argvs, timeouts=None, shared=None):
+def judge_runs_forked(argvs, ref_argvs, timeouts=None, shared=None, watch_bit=None):
     """``judge_runs`` with each run forked from its reference run (``forked_runs``);
     ``shared``: the reference runs' ``reference_share`` results (None: each worker runs
-    them itself)."""
+    them itself); ``watch_bit``: the mutant's bit of the references' watch output."""
     return judge_runs(
         argvs,
         timeouts,
         execute=lambda i, argv, timeout: execute_forked(
-            argv, ref_argvs[i], timeout, None if shared is None else shared[i]
+            argv, ref_argvs[i], timeout, None if shared is None else shared[i], watch_bit
         ),
     )

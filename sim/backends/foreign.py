@@ -427,24 +427,30 @@ endmodule
 
 
 def _watch_verilog(width):
-    """The watch of ``[watch]``: each bit that rises, at any evaluation (after a clock edge
-    or where the harness reads the outputs, between edges), is noted once through DPI
-    (``fr_watch_rose``, in the hooks); the bits seen are cleared by reset, and the host
-    clears its record before a reset (``watch_risen``). An evaluation Verilator makes twice
-    may note a bit early, never late."""
+    """The watch of ``[watch]``: each bit that is high where the harness evaluates the model
+    is noted once through DPI (``fr_watch_rose``, in the hooks). The values a clock edge
+    samples are those before it (``posedge``); the harness reads the outputs after an
+    evaluation with the clock low (``negedge``), between edges. The bits seen are cleared by
+    reset (the host clears its record before a reset, ``watch_risen``); DPI is called only
+    for a bit not seen yet, so a watch costs two reductions a cycle."""
+    note = (
+        "    if (|(fr_watch & ~fr_watch_seen))\n"
+        f"      for (fr_watch_i = 0; fr_watch_i < {width}; fr_watch_i = fr_watch_i + 1)\n"
+        "        if (fr_watch[fr_watch_i] && !fr_watch_seen[fr_watch_i])\n"
+        "          fr_watch_rose(fr_watch_i);\n"
+    )
     return (
         f"  wire [{width - 1}:0] fr_watch;\n"
         f"  reg [{width - 1}:0] fr_watch_seen = {width}'d0;\n"
         '  import "DPI-C" function void fr_watch_rose(input int index);\n'
         "  integer fr_watch_i;\n"
-        "  always @* begin\n"
-        "    if (|(fr_watch & ~fr_watch_seen))\n"
-        f"      for (fr_watch_i = 0; fr_watch_i < {width}; fr_watch_i = fr_watch_i + 1)\n"
-        "        if (fr_watch[fr_watch_i] && !fr_watch_seen[fr_watch_i])\n"
-        "          fr_watch_rose(fr_watch_i);\n"
+        "  always @(negedge clk) begin\n"
+        f"{note}"
         "  end\n"
-        "  always @(posedge clk)\n"
-        f"    fr_watch_seen <= rst ? {width}'d0 : fr_watch_seen | fr_watch;"
+        "  always @(posedge clk) begin\n"
+        f"{note}"
+        f"    fr_watch_seen <= rst ? {width}'d0 : fr_watch_seen | fr_watch;\n"
+        "  end"
     )
 
 
@@ -757,7 +763,8 @@ class ForeignVerilatorBackend(HarnessFrames, DesignBackend):
 
     def _reset(self):
         self._apply_runtime()
-        self._library.lib.fr_foreign_watch_clear()
+        if self.design.port_map.watch is not None:
+            self._library.lib.fr_foreign_watch_clear()
         self._library.lib.fr_reset(self._handle)
 
     def watch_risen(self):

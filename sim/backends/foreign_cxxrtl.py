@@ -34,6 +34,11 @@ def foreign_cxxrtl_plan(design):
             f"{pm.top}'s [runtime] inputs are set through Verilator's DPI: run "
             "it with --backend verilator"
         )
+    if pm.watch:
+        raise BackendError(
+            f"{pm.top}'s [watch] output is watched through Verilator's DPI: run "
+            "it with --backend verilator"
+        )
     return cxxrtl_build_plan(_YosysSource(design), "plain", include=runtime_include_dir())
 
 
