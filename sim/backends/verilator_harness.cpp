@@ -9,6 +9,8 @@
 // and this Verilator keeps that previous value in a member we can see, the harness holds clk
 // high and clears the remembered value instead, so each eval() is one rising edge. Traced
 // builds keep the real clock so that the waveform shows it.
+#include <algorithm>
+#include <cstring>
 #include <memory>
 
 #include "Vfollow_target.h"
@@ -136,3 +138,15 @@ struct Sim : TraceBase {
 }  // namespace
 
 FR_DEFINE_C_API(Sim)
+
+#ifdef FR_WATCH
+// [watch] (a foreign design's fr_ports.h defines FR_WATCH): the wrapper's fr_watch_any
+// output, whatever Verilator's type for its width, as little-endian 32-bit words.
+FR_EXPORT int fr_watch_read(void *h, uint32_t *out, int words) {
+    const auto &port = static_cast<Sim *>(h)->top->fr_watch_any;
+    const size_t room = static_cast<size_t>(words) * 4;
+    std::memset(out, 0, room);
+    std::memcpy(out, &port, std::min(sizeof(port), room));
+    return static_cast<int>(std::min(sizeof(port), room));
+}
+#endif
