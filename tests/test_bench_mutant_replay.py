@@ -52,4 +52,6 @@ def test_the_full_run_costs_more_than_its_netlist_alone(capsys):
     # The full run is the netlist's frames plus the world's: more than the netlist alone.
     assert figures["full_ms"] > figures["netlist_ms"] > 0
     assert figures["fork_ceiling"] == pytest.approx(figures["full_ms"] / figures["netlist_ms"])
-    assert "forking gains at most" in capsys.readouterr().out
+    assert figures["watched_ms"] > 0
+    out = capsys.readouterr().out
+    assert "forking gains at most" in out and "with its watch output watched" in out

@@ -1212,6 +1212,7 @@ PLANS = {
         shorter=(("--duration", "1"), ("--mutants", "4"), ("--repeats", "1")),
         out=(
             r"the netlist alone on the recorded frames\s+[\d.]+ ms",
+            r"the same with its watch output watched\s+[\d.]+ ms",
             r"forking gains at most [\d.]+x",
         ),
     ),
