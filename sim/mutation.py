@@ -40,7 +40,6 @@ __all__ = [
     "cone_reach",
     "find_yosys",
     "list_mutants",
-    "max_index",
     "mutant_cones",
     "mutant_netlist",
     "select_width",
@@ -261,7 +260,7 @@ def mutant_netlist(
     ``watch``, the output ``mutinf`` (``sim.mutant_watch``: bit ``k - 1`` high in a cycle
     where mutant ``k`` would act)."""
     params = params if params is not None else FollowTargetParams()
-    width = select_width(max_index(mutants))
+    width = select_width(_max_index(mutants))
     with tempfile.TemporaryDirectory(prefix="fr-mutate-") as work:
         read = _read_design(work, params, rtlil_text, verilog, includes)
         lines = [*read, *(s.format(top=top) for s in _PREPARE)]
@@ -279,7 +278,7 @@ def mutant_netlist(
             _yosys([*lines, "write_rtlil mutants.il"], work)
             path = os.path.join(work, "mutants.il")
             with open(path) as f:
-                text = add_watch(f.read(), top, MUTATION_SELECT, max_index(mutants))
+                text = add_watch(f.read(), top, MUTATION_SELECT, _max_index(mutants))
             with open(path, "w") as f:
                 f.write(text)
             _yosys(
@@ -290,7 +289,7 @@ def mutant_netlist(
             return f.read()
 
 
-def max_index(mutants):
+def _max_index(mutants):
     """The largest ``mutsel`` value of ``mutants`` (0 for none)."""
     return max((m.index for m in mutants), default=0)
 

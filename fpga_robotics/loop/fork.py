@@ -239,9 +239,10 @@ class ReferenceRun:
         loop = ClosedLoop(scenario, seed=self.seed, design=design)
         channels = [cam.channel for cam in loop.rig.cameras] if loop.rig is not None else []
         try:
-            acting = any(c is not None for c in channels)  # channels of the variant's own
+            # A variant with camera channels of its own has more than its design to run.
+            has_channels = any(c is not None for c in channels)
             watched = watch_bit is not None and ref.watch_first is not None
-            if watched and not acting and ref.watch_first.get(watch_bit) is None:
+            if watched and not has_channels and ref.watch_first.get(watch_bit) is None:
                 # Every signal of the variant is the reference design's, frame for frame.
                 self.last_divergence = self.last_world_from = None
                 self.last_design_ran = False

@@ -24,17 +24,17 @@ __all__ = [
 ]
 
 NETLIST_NAME = "mutants.v"
-#: Where each mutant first acts, watched at ``mutsel = 0`` (sim.mutant_watch).
-_WATCH_TABLE = f'\n# Bit k-1 rises where mutant k would act.\n[watch]\nport = "{WATCH_PORT}"\n'
 PORTS_NAME = "mutants_ports.toml"
 #: The same port map with the watch output watched: for the unmutated design's runs only
 #: (a mutant's run needs no watch, and its model runs faster without one).
 WATCH_PORTS_NAME = "mutants_watch_ports.toml"
+#: Where each mutant acts, watched at ``mutsel = 0`` (sim.mutant_watch).
+_WATCH_TABLE = f'\n# Bit k-1 rises where mutant k would act.\n[watch]\nport = "{WATCH_PORT}"\n'
 
 
 def write_mutant_design(params, mutants, folder):
-    """Write the netlist and its port maps into ``folder`` (``PORTS_NAME`` and, with the
-    watch, ``WATCH_PORTS_NAME``); return the paths of the netlist and of the first map."""
+    """Write the netlist and its port maps into ``folder`` (``PORTS_NAME``, and
+    ``WATCH_PORTS_NAME`` with the watch); return the paths of the netlist and of the first."""
     os.makedirs(folder, exist_ok=True)
     netlist = os.path.join(folder, NETLIST_NAME)
     ports = os.path.join(folder, PORTS_NAME)

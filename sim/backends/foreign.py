@@ -536,7 +536,6 @@ extern "C" __attribute__((visibility("default"))) void fr_foreign_set_runtime(in
     if (index >= 0 && index < 8)
         fr_runtime[index] = value;
 }
-
 """
 
 
