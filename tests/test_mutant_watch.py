@@ -18,7 +18,7 @@ from toolchains import needs_mutation_toolchain
 from fpga_robotics.hw.params import FollowTargetParams
 from fpga_robotics.sim import mutation
 from fpga_robotics.sim.backends import BackendError
-from fpga_robotics.sim.backends.port_map import PortMapError, parse_port_map
+from fpga_robotics.sim.backends.port_map import PortMapError, check_widths, parse_port_map
 from fpga_robotics.sim.mutant_watch import WATCH_PORT, add_watch
 
 PARAMS = FollowTargetParams(width=80, height=60)
@@ -105,6 +105,14 @@ def test_the_port_map_watch_must_name_an_output():
         parse_port_map({**base, "watch": {"prt": "w"}})
     with pytest.raises(PortMapError, match="mapped more than once"):
         parse_port_map({**base, "watch": {"port": "ml"}})
+    # Against the design's ports: the watched port must exist and be an output.
+    watching = parse_port_map({**base, "watch": {"port": "w"}})
+    ports = {"clk": ("input", 1, False), "v": ("input", 1, False), "p": ("input", 14, False)}
+    ports |= {"done": ("output", 1, False), "ml": ("output", 16, True)}
+    check_widths(watching, {**ports, "w": ("output", 60, False)})  # any width
+    for bad in ({}, {"w": ("input", 60, False)}):
+        with pytest.raises(PortMapError, match="watch.port 'w' must be an output"):
+            check_widths(watching, {**ports, **bad})
 
 
 def _outputs(result):
