@@ -6,8 +6,9 @@ physics) is saved. This benchmark runs a scenario once with the mutant netlist a
 ``mutsel = 0`` on Verilator (as the robot judge runs it) as a fork reference, then replays
 the netlist alone on the recorded frames (as a mutant's run does; then with its watch
 output watched, as the robot judge's unmutated runs do), and FollowTarget's own model on the
-same frames on Verilator and CXXRTL, one process, CPU time. The replay's share of the full run is what a
-mutant that never parts still costs: the fork's speed-up is at most its inverse.
+same frames on Verilator and CXXRTL, one process, CPU time. The replay's share of the full
+run is what a mutant that never parts still costs: the fork's speed-up is at most its
+inverse.
 """
 
 import os

@@ -109,8 +109,8 @@ def judge_runs(argvs, timeouts=None, execute=None):
     ``{"caught", "run", "status", "message", "failed_checks", "closest", "runs", "wall_s"}``
     (``run``: the index of the first run that did not pass; ``closest``: of a mutant not
     caught, the run nearest to failing), and ``"forks"`` for forked runs: their
-    ``forked_runs.execute_forked`` records, in order. ``execute(i, argv, timeout)`` runs run ``i``
-    (default ``runner.execute``; forked runs: fpga_robotics.mutation.forked_runs)."""
+    ``forked_runs.execute_forked`` records, in order. ``execute(i, argv, timeout)`` runs
+    run ``i`` (default ``runner.execute``; forked runs: fpga_robotics.mutation.forked_runs)."""
     if execute is None:
 
         def execute(i, argv, timeout):
