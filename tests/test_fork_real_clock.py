@@ -111,10 +111,14 @@ def test_a_variant_that_parts_between_checkpoints(scenario, reference):
         forked, diverged = fork_and_full(reference, scenario, variant)
     assert diverged == k
     ref = reference.result.trajectory
-    # Row k - 1's wheels are read at frame k's capture: from there on the left one is faster.
+    # Row k - 1's wheels are read at frame k's capture: the left one is faster there, and
+    # the robot turns off its reference path from then on (the design answers the turn).
     left = forked.trajectory["motor_left"]
     assert np.array_equal(left[: k - 1], ref["motor_left"][: k - 1])
-    assert np.array_equal(left[k - 1 :], ref["motor_left"][k - 1 :] + 120)
+    assert left[k - 1] == ref["motor_left"][k - 1] + 120
+    heading = forked.trajectory["heading"]
+    assert np.array_equal(heading[: k + 1], ref["heading"][: k + 1])
+    assert not np.array_equal(heading[k + 1 :], ref["heading"][k + 1 :])
 
 
 def test_a_variant_world_must_be_the_reference_world(scenario, reference):

@@ -2,9 +2,10 @@
 
 Edge ``e`` of the design clock happens at ``e / sim.clock_hz`` seconds (50 MHz by default, as
 on the board). The world advances in physics steps of ``sim.physics_dt``; within each step the
-design runs the step's edges, stopping wherever a watched output changes (a wheel pin, an
-ultrasound TRIG, the frame strobe) so that the connector concerned acts at that very edge
-(``fpga_robotics.loop.connectors.base``). Per step:
+design runs the step's edges, stopping wherever a watched output changes (an ultrasound TRIG,
+a servo's angle, the frame strobe) so that the connector concerned acts at that very edge
+(``fpga_robotics.loop.connectors.base``), and where the wheel pins are sampled (the last edge
+whose change acts at a step: fpga_robotics.loop.connectors.motors). Per step:
 
 1. every sensor connector's ``before_step`` drives its inputs for the step (values now or at
    exact future edges);
@@ -332,14 +333,19 @@ class RealClockLoop(ClosedLoop):
         self.last = {port: self.pins.peek(port) for port in self.watched}
         # The wheel pins' values out of reset are a command too (a design may start moving).
         if self.wheels:
-            self.motors.on_change(self.io[self.motors], "motor_left", None, 0.0)
+            self.motors.sample(self.io[self.motors])
         for conn in self.sensors:
             conn.start(self.io[conn])
 
     def run_design_to(self, edge):
-        """Run the design up to ``edge``, handling every watched change where it happens."""
+        """Run the design up to ``edge``, handling every watched change where it happens
+        and sampling the wheel pins where the motors need them."""
+        wheels = self.io[self.motors] if self.wheels else None
         while self.pins.cycle < edge:
-            stop = self.pins.run(edge - self.pins.cycle)
+            due = edge if wheels is None else self.motors.sample_edge_after(wheels, self.pins.cycle)
+            stop = self.pins.run(min(edge, due) - self.pins.cycle)
+            if wheels is not None and self.pins.cycle == due:
+                self.motors.sample(wheels)
             if stop.port is None:
                 continue
             t = stop.cycle / self.clock_hz

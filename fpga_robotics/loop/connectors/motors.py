@@ -22,8 +22,12 @@ class MotorConnector(Connector):
     ``wheels``, bound to the design's ``motor_left`` and ``motor_right`` outputs.
 
     In frame timing the closed loop schedules each frame's command itself. In real-clock
-    timing the pins are watched: a change at edge ``e`` takes effect at the first physics
-    step at or after ``e / clock_hz + delay`` (``configure_real_clock``).
+    timing a change at edge ``e`` takes effect at the first physics step at or after
+    ``e / clock_hz + delay`` (``configure_real_clock``; ``step_of``), the last change that
+    falls on a step winning. So the pins are not watched but sampled, once per step, at the
+    last edge whose change would act at that step (``sample_edge_after``, ``sample``): the
+    same commands at the same steps, and a design whose wheel pins change every cycle (a
+    mutant's, say) costs one stop a step rather than one an edge.
 
     Parameters
     ----------
@@ -37,25 +41,51 @@ class MotorConnector(Connector):
         "motor_left": Pin("out", 16, signed=True),
         "motor_right": Pin("out", 16, signed=True),
     }
-    watch = ("motor_left", "motor_right")
+    watch = ()  # sampled instead (sample_edge_after)
 
     def __init__(self, world):
         self.name, self.mount, self.params, self.world = "wheels", None, None, world
         self._pending = deque()  # (step, left, right), in step order
         self.applied = (0, 0)
         self.dt = self.delay = None  # real-clock timing only
+        self.sampled = None  # real-clock timing: the pins' values at the last sample
 
     def configure_real_clock(self, dt, delay):
         """Real-clock timing: physics steps of ``dt`` s, commands acting ``delay`` s after the
         pins change."""
         self.dt, self.delay = dt, delay
 
-    def on_change(self, io, pin, value, t):
-        """A wheel pin changed at edge ``io.cycle``: both pins' values act after the delay."""
-        step = math.ceil((io.time_of(io.cycle) + self.delay) / self.dt - 1e-9)
-        if self._pending and step < self._pending[-1][0]:
-            step = self._pending[-1][0]
-        self.schedule(step, io.peek("motor_left"), io.peek("motor_right"))
+    def step_of(self, io, edge):
+        """The physics step at which a change of the pins at ``edge`` takes effect."""
+        return math.ceil((io.time_of(edge) + self.delay) / self.dt - 1e-9)
+
+    def _last_edge_of(self, io, step):
+        """The last edge whose change takes effect at or before ``step`` (-1: none)."""
+        edge = max(-1, math.floor((step * self.dt - self.delay) * io.clock_hz))
+        while self.step_of(io, edge + 1) <= step:  # the float estimate, made exact
+            edge += 1
+        while edge >= 0 and self.step_of(io, edge) > step:
+            edge -= 1
+        return edge
+
+    def sample_edge_after(self, io, edge):
+        """The next edge after ``edge`` at which the pins must be sampled: the last one
+        whose change takes effect at its step."""
+        step = self.step_of(io, edge)
+        while (last := self._last_edge_of(io, step)) <= edge:
+            step += 1
+        return last
+
+    def sample(self, io):
+        """Real-clock timing: read the pins at edge ``io.cycle`` (out of reset, or a
+        ``sample_edge_after`` edge); a new pair of values acts after the delay."""
+        value = (io.peek("motor_left"), io.peek("motor_right"))
+        if value != self.sampled:
+            self.sampled = value
+            step = self.step_of(io, io.cycle)
+            if self._pending and step < self._pending[-1][0]:
+                step = self._pending[-1][0]
+            self.schedule(step, *value)
 
     def schedule(self, step, left_dps, right_dps):
         """Apply ``(left_dps, right_dps)`` at physics step ``step`` (not before)."""
