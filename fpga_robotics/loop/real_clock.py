@@ -231,9 +231,8 @@ class RealClockLoop(ClosedLoop):
             self.rig.use_pins(design, self.clock_hz)
             for servo in self.rig.servos.values():
                 servo.port = servo.port or self.top.bindings.get("servo", {}).get("angle")
-                if servo.port is not None:
+                if servo.port is not None:  # sampled, as the wheels (run_design_to)
                     self.io[servo] = PinIO(design, {"angle": servo.port}, self.clock_hz)
-                    self.watched[servo.port] = (servo, "angle")
         self._check_inputs_driven()
         if self.top.camera and _FRAME_STROBE in design.ports:  # FollowTarget's frame outputs
             self.watched[_FRAME_STROBE] = (None, _FRAME_STROBE)
@@ -331,21 +330,32 @@ class RealClockLoop(ClosedLoop):
     def start_design(self):
         self.pins.watch(list(self.watched))
         self.last = {port: self.pins.peek(port) for port in self.watched}
-        # The wheel pins' values out of reset are a command too (a design may start moving).
-        if self.wheels:
-            self.motors.sample(self.io[self.motors])
+        # The actuator pins' values out of reset are a command too (a design may start moving).
+        for conn in self.sampled_actuators():
+            conn.sample(self.io[conn])
         for conn in self.sensors:
             conn.start(self.io[conn])
 
+    def sampled_actuators(self):
+        """The connectors whose pins are sampled once a step rather than watched
+        (fpga_robotics.loop.connectors.sampling): the wheels, the servos the design drives."""
+        servos = self.rig.servos.values() if self.rig is not None else ()
+        return [
+            *((self.motors,) if self.wheels else ()),
+            *(s for s in servos if s.port is not None),
+        ]
+
     def run_design_to(self, edge):
         """Run the design up to ``edge``, handling every watched change where it happens
-        and sampling the wheel pins where the motors need them."""
-        wheels = self.io[self.motors] if self.wheels else None
+        and sampling the actuators' pins where their commands are decided."""
+        sampled = [(conn, self.io[conn]) for conn in self.sampled_actuators()]
         while self.pins.cycle < edge:
-            due = edge if wheels is None else self.motors.sample_edge_after(wheels, self.pins.cycle)
+            # They share dt and delay, so their sample edges agree; a sample more is harmless.
+            due = min((c.sample_edge_after(io, self.pins.cycle) for c, io in sampled), default=edge)
             stop = self.pins.run(min(edge, due) - self.pins.cycle)
-            if wheels is not None and self.pins.cycle == due:
-                self.motors.sample(wheels)
+            if self.pins.cycle == due:
+                for conn, io in sampled:
+                    conn.sample(io)
             if stop.port is None:
                 continue
             t = stop.cycle / self.clock_hz

@@ -7,27 +7,24 @@ physics step at which it takes effect and applied with ``world.set_wheel_dps`` w
 simulation reaches that step; until then the previous command stays in force.
 """
 
-import math
 from collections import deque
 from typing import ClassVar
 
 from fpga_robotics.loop.connectors.base import Connector, Pin, register
+from fpga_robotics.loop.connectors.sampling import StepSampling
 
 __all__ = ["MotorConnector"]
 
 
 @register
-class MotorConnector(Connector):
+class MotorConnector(StepSampling, Connector):
     """Delayed delivery of wheel commands (DPS) to the world: the connector of kind
     ``wheels``, bound to the design's ``motor_left`` and ``motor_right`` outputs.
 
     In frame timing the closed loop schedules each frame's command itself. In real-clock
     timing a change at edge ``e`` takes effect at the first physics step at or after
-    ``e / clock_hz + delay`` (``configure_real_clock``; ``step_of``), the last change that
-    falls on a step winning. So the pins are not watched but sampled, once per step, at the
-    last edge whose change would act at that step (``sample_edge_after``, ``sample``): the
-    same commands at the same steps, and a design whose wheel pins change every cycle (a
-    mutant's, say) costs one stop a step rather than one an edge.
+    ``e / clock_hz + delay`` (``configure_real_clock``), the last change that falls on a
+    step winning: the pins are sampled once a step (``connectors.sampling``, ``sample``).
 
     Parameters
     ----------
@@ -47,34 +44,12 @@ class MotorConnector(Connector):
         self.name, self.mount, self.params, self.world = "wheels", None, None, world
         self._pending = deque()  # (step, left, right), in step order
         self.applied = (0, 0)
-        self.dt = self.delay = None  # real-clock timing only
         self.sampled = None  # real-clock timing: the pins' values at the last sample
 
     def configure_real_clock(self, dt, delay):
         """Real-clock timing: physics steps of ``dt`` s, commands acting ``delay`` s after the
         pins change."""
-        self.dt, self.delay = dt, delay
-
-    def step_of(self, io, edge):
-        """The physics step at which a change of the pins at ``edge`` takes effect."""
-        return math.ceil((io.time_of(edge) + self.delay) / self.dt - 1e-9)
-
-    def _last_edge_of(self, io, step):
-        """The last edge whose change takes effect at or before ``step`` (-1: none)."""
-        edge = max(-1, math.floor((step * self.dt - self.delay) * io.clock_hz))
-        while self.step_of(io, edge + 1) <= step:  # the float estimate, made exact
-            edge += 1
-        while edge >= 0 and self.step_of(io, edge) > step:
-            edge -= 1
-        return edge
-
-    def sample_edge_after(self, io, edge):
-        """The next edge after ``edge`` at which the pins must be sampled: the last one
-        whose change takes effect at its step."""
-        step = self.step_of(io, edge)
-        while (last := self._last_edge_of(io, step)) <= edge:
-            step += 1
-        return last
+        self.configure(dt, delay)
 
     def sample(self, io):
         """Real-clock timing: read the pins at edge ``io.cycle`` (out of reset, or a

@@ -14,6 +14,7 @@ from collections import deque
 from typing import ClassVar
 
 from fpga_robotics.loop.connectors.base import Connector, Pin, check_number, register
+from fpga_robotics.loop.connectors.sampling import StepSampling
 from fpga_robotics.sim.world.servo import SERVO_RANGE_DEG, SERVO_SPEED_DEG_S, ServoModel
 
 __all__ = ["ServoConnector", "ServoParams"]
@@ -39,13 +40,14 @@ class ServoParams:
 
 
 @register
-class ServoConnector(Connector):
-    """A pan servo on the robot, driven by the design's ``angle`` output."""
+class ServoConnector(StepSampling, Connector):
+    """A pan servo on the robot, driven by the design's ``angle`` output (in real-clock
+    timing sampled once a physics step: ``connectors.sampling``, ``sample``)."""
 
     kind = "servo"
     role = "actuator"
     pins: ClassVar[dict] = {"angle": Pin("out", 10, signed=True)}
-    watch = ("angle",)
+    watch = ()  # sampled instead
     #: Runs in compressed timing: each frame's command acts after the actuation delay.
     frame_level = True
 
@@ -54,7 +56,7 @@ class ServoConnector(Connector):
         self.model = ServoModel(speed=math.radians(params.speed_deg_s), range_deg=params.range_deg)
         self._pending = deque()  # (physics step, command), in step order
         self.commanded = 0
-        self.dt = self.delay = None
+        self.sampled = 0  # real-clock timing: the pin at the last sample (0: the horn's rest)
 
     @classmethod
     def parse(cls, table, where):
@@ -78,20 +80,19 @@ class ServoConnector(Connector):
         )
         return params
 
-    def configure(self, dt, delay):
-        """Physics steps of ``dt`` s; a command acts ``delay`` s after the design gives it."""
-        self.dt, self.delay = dt, delay
-
     def schedule(self, step, command):
         """The command ``command`` acts at physics step ``step`` (not before)."""
         if self._pending and step < self._pending[-1][0]:
             step = self._pending[-1][0]
         self._pending.append((step, int(command)))
 
-    def on_change(self, io, pin, value, t):
-        """Real-clock timing: the angle pin changed at edge ``io.cycle``."""
-        step = math.ceil((io.time_of(io.cycle) + self.delay) / self.dt - 1e-9)
-        self.schedule(step, value)
+    def sample(self, io):
+        """Real-clock timing: read the angle pin at edge ``io.cycle``; a new value acts
+        after the delay."""
+        value = io.peek("angle")
+        if value != self.sampled:
+            self.sampled = value
+            self.schedule(self.step_of(io, io.cycle), value)
 
     def apply_due(self, step):
         while self._pending and self._pending[0][0] <= step:
