@@ -3,9 +3,9 @@
 Edge ``e`` of the design clock happens at ``e / sim.clock_hz`` seconds (50 MHz by default, as
 on the board). The world advances in physics steps of ``sim.physics_dt``; within each step the
 design runs the step's edges, stopping wherever a watched output changes (an ultrasound TRIG,
-a servo's angle, the frame strobe) so that the connector concerned acts at that very edge
-(``fpga_robotics.loop.connectors.base``), and where the wheel pins are sampled (the last edge
-whose change acts at a step: fpga_robotics.loop.connectors.motors). Per step:
+the frame strobe) so that the connector concerned acts at that very edge
+(``fpga_robotics.loop.connectors.base``), and where the wheel and servo pins are sampled (the
+last edge whose change acts at a step: fpga_robotics.loop.connectors.sampling). Per step:
 
 1. every sensor connector's ``before_step`` drives its inputs for the step (values now or at
    exact future edges);
