@@ -753,8 +753,9 @@ PLANS = {
             ),
             (
                 r"robot judge \(campaign wall_stop_campaign: 1 of 1 runs pass unmutated\): "
-                r"3 of 3 unit-caught mutants caught: score 100\.0%"
+                r"2 of 3 unit-caught mutants caught: score 66\.7%"
             ),
+            r"#2 top: stopped\[0\] inverted",
         ),
         files=(
             "runs/mutation/WallStop-n8-s1/mutants.json",
