@@ -14,7 +14,7 @@ first rises in (fpga_robotics.loop.fork): a mutant's run can then skip its frame
 
 import re
 
-__all__ = ["WATCH_PORT", "add_watch"]
+__all__ = ["WATCH_PORT", "add_watch", "module_span"]
 
 #: The output of the mutant netlist that shows where each mutant acts.
 WATCH_PORT = "mutinf"
@@ -24,7 +24,7 @@ _CONNECT = re.compile(r"^    connect \\(\w+) (.+)$", re.MULTILINE)
 _PORT_NUMBER = re.compile(r"^  wire (?:width \d+ )?(?:input|output|inout) (\d+) ", re.MULTILINE)
 
 
-def _module_text(rtlil, top):
+def module_span(rtlil, top):
     """The span of module ``top`` in ``rtlil`` (start, end of its body before ``end``)."""
     start = re.search(rf"^module \\{re.escape(top)}$", rtlil, re.MULTILINE)
     if start is None:
@@ -39,7 +39,7 @@ def add_watch(rtlil, top, select, count, port=WATCH_PORT):
     faulty value differs from the design's. A mutant whose mux is not found gets a bit tied
     high (it counts as acting from the start: its runs are made in full). Without mutants
     the output is one bit, tied low."""
-    begin, end = _module_text(rtlil, top)
+    begin, end = module_span(rtlil, top)
     body = rtlil[begin:end]
     cells = [(kind, dict(_CONNECT.findall(text))) for kind, _, text in _CELL.findall(body)]
     selects = {}  # the $eq's output wire -> mutant index

@@ -28,6 +28,7 @@ from fpga_robotics.hw.errors import UserError
 from ..hw.params import FollowTargetParams
 from ..hw.top import FollowTarget
 from ..hw.verilog import TOP_NAME, verilog_ports
+from .mutant_inits import restore_inits
 from .mutant_watch import WATCH_PORT, add_watch
 from .processes import run_captured
 
@@ -272,19 +273,18 @@ def mutant_netlist(
         # of its bits) becomes one wire per driver, so Verilator sees no false combinational
         # loop through it (UNOPTFLAT) and evaluates each cell once a cycle.
         lines += ["opt_clean", "splitnets -driver"]
-        if not watch:
-            _yosys([*lines, "write_verilog -noattr mutants.v"], work)
-        else:
-            _yosys([*lines, "write_rtlil mutants.il"], work)
-            path = os.path.join(work, "mutants.il")
-            with open(path) as f:
-                text = add_watch(f.read(), top, MUTATION_SELECT, _max_index(mutants))
-            with open(path, "w") as f:
-                f.write(text)
-            _yosys(
-                ["read_rtlil mutants.il", "splitnets -driver", "write_verilog -noattr mutants.v"],
-                work,
-            )
+        _yosys([*lines, "write_rtlil mutants.il"], work)
+        path = os.path.join(work, "mutants.il")
+        with open(path) as f:
+            text = restore_inits(f.read(), top)  # registers without a reset keep their start
+        if watch:
+            text = add_watch(text, top, MUTATION_SELECT, _max_index(mutants))
+        with open(path, "w") as f:
+            f.write(text)
+        _yosys(
+            ["read_rtlil mutants.il", "splitnets -driver", "write_verilog -noattr mutants.v"],
+            work,
+        )
         with open(os.path.join(work, "mutants.v")) as f:
             return f.read()
 

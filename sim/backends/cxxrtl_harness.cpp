@@ -13,6 +13,7 @@
 // edge instead (as the traced build always does, so that the waveform shows the clock).
 #include <cstdio>
 #include <memory>
+#include <new>
 
 #include "design.cc"
 #include "fr_model.h"
@@ -53,6 +54,18 @@ struct Sim : TraceBase {
         top.p_pixels____valid.set<bool>(valid);
         top.p_pixels____payload.set<uint16_t>(payload);
         top.p_color__sel.set<uint8_t>(color_sel);
+    }
+    // The model as when it was built: every register and memory at its initial value, which
+    // a design without a reset needs. A traced model keeps its state (its waveform writer
+    // holds the model's items; a traced backend is opened for one run).
+    inline void restart() {
+#ifndef FR_TRACE
+        top.~Top();
+        new (&top) Top();
+#ifdef FR_ONE_EVAL
+        fr_cxxrtl::one_eval_init(top);
+#endif
+#endif
     }
     inline void set_rst(bool on) { top.p_rst.set<bool>(on); }
     inline void settle() {

@@ -162,9 +162,12 @@ int run_frame(S &sim, const Source &pixel, const int64_t *args, uint16_t *filter
     return status;
 }
 
-// Synchronous reset: rst high for one rising edge, not counted in any frame.
+// From the power-on state (what the reset does not reach, a register without one or a
+// memory, must not carry over from an earlier run), then a synchronous reset: rst high for
+// one rising edge, not counted in any frame.
 template <class S>
 void reset(S &sim) {
+    sim.restart();
     sim.set_inputs(false, 0, 0);
     sim.set_rst(true);
     sim.settle();

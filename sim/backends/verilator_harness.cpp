@@ -74,6 +74,19 @@ struct Sim : TraceBase {
         top->pixels___05Fpayload = payload;
         top->color_sel = color_sel;
     }
+    // The model as when it was built: every register and memory at its initial value, which
+    // a design without a reset needs. A traced model keeps its state (its waveform writer
+    // holds the model; a traced backend is opened for one run).
+    inline void restart() {
+#ifndef FR_TRACE
+        top->final();
+        top.reset();
+        top.reset(new Vfollow_target(context.get(), "follow_target"));
+        top->clk = 0;
+        top->rst = 0;
+        top->eval();
+#endif
+    }
     inline void set_rst(bool on) { top->rst = on; }
     inline void eval() {
 #if defined(FR_VERILATOR_PUBLIC_EVAL) || defined(FR_TRACE)  // tracing needs eval()'s bookkeeping

@@ -4,6 +4,7 @@
 // (FR_REGISTERED_OUTPUTS: the accessors read the outputs from those flip-flops right after
 // the edge), else two (sim/backends/cxxrtl_clock.h).
 #include <cstdint>
+#include <new>
 
 #include "design.cc"
 
@@ -28,6 +29,15 @@ struct Sim {
     inline void settle() { fr_cxxrtl::step_settle(top); }
     inline void edge() { fr_cxxrtl::step_edge(top); }
 #endif
+    // The model as when it was built, in place: every register and memory at its initial
+    // value, which a design without a reset needs.
+    inline void restart() {
+        top.~PinTop();
+        new (&top) PinTop();
+#ifdef FR_REGISTERED_OUTPUTS
+        fr_cxxrtl::one_eval_init(top);
+#endif
+    }
     inline void set_rst(bool on) { top.p_rst.set<bool>(on); }
 };
 

@@ -72,6 +72,9 @@ struct Driver {
     Driver() { reset(); }
 
     void reset() {
+        // From the power-on state: what the reset does not reach (a register without one, a
+        // memory) must not carry over from an earlier run.
+        sim.restart();
         pin_zero_inputs(sim.top);
         sim.set_rst(true);
         sim.settle();

@@ -6,6 +6,7 @@
 // high (the edge) and one with it low (settling the combinational outputs on the next edge's
 // inputs); the scheduler is called directly after the first eval() (verilator_clock.h).
 #include <memory>
+#include <new>
 
 #include "Vfollow_target.h"
 #include "Vfollow_target___024root.h"
@@ -35,6 +36,17 @@ struct ModelHolder {
         model->eval();
     }
     ~ModelHolder() { model->final(); }
+    // The model as when it was built, in place (the harness keeps a reference to it): every
+    // register and memory at its initial value, which a design without a reset needs.
+    void restart() {
+        model->final();
+        Vfollow_target *m = model.get();
+        m->~Vfollow_target();
+        new (m) Vfollow_target(context.get(), "follow_target");
+        m->clk = 0;
+        m->rst = 0;
+        m->eval();
+    }
 };
 
 struct Sim {
@@ -43,6 +55,7 @@ struct Sim {
     Vfollow_target &top = *holder.model;
 
     inline void eval() { Vfollow_target___024root___eval(top.rootp); }
+    inline void restart() { holder.restart(); }
     inline void set_rst(bool on) { top.rst = on; }
     inline void settle() {
         if (ONE_EVAL)
