@@ -2,6 +2,8 @@
 run gives the same result as its own full run, whether it never parts from the reference,
 parts at frame 0, only in the last frame, or in between (restored from a checkpoint)."""
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 from run_equality import assert_same_run
@@ -10,6 +12,8 @@ from fpga_robotics.loop.pin_fork import PinReferenceRun, reference_run
 from fpga_robotics.loop.real_clock import make_pin_backend
 from fpga_robotics.loop.timings import run_scenario
 from fpga_robotics.scenario.load import load_scenario
+
+WALL_STOP = Path(__file__).parent / "data" / "user_designs" / "wall_stop.toml"
 
 
 class FasterLeftWheel:
@@ -143,3 +147,74 @@ def test_a_robot_with_a_pan_camera_forks_in_real_clock_timing():
     assert diverged is not None and diverged >= 30  # restored from a later checkpoint
     ref = reference.result.trajectory
     assert not np.array_equal(forked.trajectory["turret.servo_angle"], ref["turret.servo_angle"])
+
+
+class OtherReadings:
+    """A pin design whose extra output ``port`` reads ``extra`` higher from edge ``edge`` on
+    (an output that drives nothing), and optionally whose left wheel pin reads 120 higher
+    from ``wheel_edge`` on."""
+
+    def __init__(self, design, port, edge, extra=7, wheel_edge=None):
+        self.inner, self.port, self.edge, self.extra = design, port, edge, extra
+        self.wheel_edge = wheel_edge
+        self.name = "other_readings"
+
+    def __getattr__(self, name):
+        return getattr(self.inner, name)
+
+    @property
+    def cycle(self):
+        return self.inner.cycle
+
+    @property
+    def frame_pending(self):
+        return self.inner.frame_pending
+
+    def peek(self, name):
+        value = self.inner.peek(name)
+        if name == self.port and self.inner.cycle >= self.edge:
+            value += self.extra
+        if name == "motor_left" and self.wheel_edge is not None:
+            value += 120 if self.inner.cycle >= self.wheel_edge else 0
+        return value
+
+
+@pytest.fixture(scope="module")
+def wall_stop():
+    """A user design with extra outputs (distance_mm, stopped), 3 s, and its reference."""
+    s = load_scenario(str(WALL_STOP), ["sim.duration=3"])
+    with make_pin_backend("cxxrtl", s) as design:
+        yield s, reference_run(s, design=design, checkpoint_every=20)
+
+
+def test_a_variant_that_differs_only_in_an_extra_output_keeps_the_reference_world(wall_stop):
+    scenario, reference = wall_stop
+    k = 25
+    with make_pin_backend("cxxrtl", scenario) as design:
+        variant = OtherReadings(design, "distance_mm", _edge_of_frame(reference, scenario, k))
+        forked, diverged = fork_and_full(reference, scenario, variant)
+    # The distance it reports drives nothing: no frame parts, no world simulated again.
+    assert diverged is None and reference.last_world_from is None
+    ref = reference.result.trajectory
+    ours = forked.trajectory["design.distance_mm"]
+    assert np.array_equal(ours[: k - 1], ref["design.distance_mm"][: k - 1])
+    assert np.array_equal(ours[k:], ref["design.distance_mm"][k:] + 7)
+    assert np.array_equal(forked.trajectory["x"], ref["x"])
+
+
+def test_a_variant_whose_extra_output_differs_before_it_parts_keeps_both(wall_stop):
+    # The extra output differs from frame 5 (before the checkpoint at 20), the wheels from
+    # frame 50: the world is simulated again from 40, the rows before it get the variant's
+    # extra output, and the result is its full run's.
+    scenario, reference = wall_stop
+    with make_pin_backend("cxxrtl", scenario) as design:
+        variant = OtherReadings(
+            design,
+            "distance_mm",
+            _edge_of_frame(reference, scenario, 5),
+            wheel_edge=_edge_of_frame(reference, scenario, 50),
+        )
+        forked, diverged = fork_and_full(reference, scenario, variant)
+    assert diverged == 50 and reference.last_world_from == 40
+    ref = reference.result.trajectory["design.distance_mm"]
+    assert np.array_equal(forked.trajectory["design.distance_mm"][5:40], ref[5:40] + 7)

@@ -50,6 +50,7 @@ class _RecordingPinLoop(RealClockLoop):
         self.every = checkpoint_every
         self.checkpoints = []  # in frame order
         self.frame_calls = []  # the journal's length as each frame starts
+        self.extra_reads = {}  # journal index of a read of an extra output -> (row, name)
         self.final = None
 
     def run_frame(self, k):
@@ -57,6 +58,16 @@ class _RecordingPinLoop(RealClockLoop):
         if k % self.every == 0:
             self.checkpoints.append(checkpoint.take(self))
         super().run_frame(k)
+
+    def finish_row(self):
+        row, start = self.pending, len(self.primary.calls)
+        super().finish_row()
+        if row is None:
+            return
+        names = {port: name for name, port in self.top.extra_outputs.items()}
+        for i, call in enumerate(self.primary.calls[start:], start):
+            if call.op == "peek" and call.args[0] in names:
+                self.extra_reads[i] = (row.k, names[call.args[0]])
 
     def finish_run(self, wall_start, cpu_start):
         self.final = checkpoint.take(self)
@@ -137,20 +148,41 @@ class PinReferenceRun:
             if progress is not None and i + 1 in starts[1:]:
                 progress(bisect.bisect_right(starts, i), ref.n_frames)
 
-        i, answer = first_difference(design, calls, replayed)
+        # Its extra outputs drive nothing: where only they differ, the world is the same.
+        i, answer, extra = first_difference(design, calls, replayed, ref.extra_reads)
         if i is None:
             self.last_divergence = self.last_world_from = None
-            rest = calls[ref.final.design_calls :]
-            loop.use_design(PlayBack(design, rest, rest[0].cycle if rest else design.cycle))
+            last = ref.final.design_calls
+            rest = calls[last:]
+            loop.use_design(
+                PlayBack(
+                    design,
+                    rest,
+                    rest[0].cycle if rest else design.cycle,
+                    answers={j - last: a for j, a in extra.items() if j >= last},
+                )
+            )
             _restore(loop, ref.final)
+            _rewrite_extra(loop, ref, extra, last)
             return loop.finish_run(wall_start, cpu_start)
         self.last_divergence = bisect.bisect_right(starts, i) - 1
         start = [c for c in ref.checkpoints if c.design_calls <= i][-1]
         self.last_world_from = start.frame
         first = start.design_calls
-        loop.use_design(PlayBack(design, calls[first : i + 1], calls[first].cycle, last=answer))
+        answers = {j - first: a for j, a in extra.items() if j >= first}
+        loop.use_design(PlayBack(design, calls[first : i + 1], calls[first].cycle, answer, answers))
         _restore(loop, start)
+        _rewrite_extra(loop, ref, extra, first)
         return loop.run(start=start.frame, progress=progress)
+
+
+def _rewrite_extra(loop, ref, extra, before):
+    """The variant's own reads of its extra outputs (``extra``: journal index -> value) made
+    before journal index ``before`` into the rows of a restored ``loop``."""
+    for i, value in extra.items():
+        if i < before:
+            k, name = ref.extra_reads[i]
+            loop.extra[name][k] = float(value)
 
 
 def _restore(loop, saved):

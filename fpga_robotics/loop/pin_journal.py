@@ -144,30 +144,38 @@ def _run_to(design, edge):
         design.run(edge - design.cycle)
 
 
-def first_difference(design, calls, progress=None):
+def first_difference(design, calls, progress=None, tolerated=()):
     """Reset ``design`` and make ``calls`` on it in order until one's answer differs from
-    the recorded one: returns ``(index, answer)`` of that call, or ``(None, None)`` when
-    every answer agreed. ``progress(index)`` is called after every call."""
+    the recorded one: returns ``(index, answer, differing)``: that call's index and answer,
+    or ``(None, None, ...)`` when every answer agreed. The calls whose indices are in
+    ``tolerated`` (reads of outputs that drive nothing) may differ: their answers go into
+    ``differing`` (``{index: answer}``) and the calls go on. ``progress(index)`` is called
+    after every call."""
     design.reset()
+    differing = {}
     for i, call in enumerate(calls):
         answer = _call(design, call.op, call.args)
         if not _same(answer, call.answer):
-            return i, answer
+            if i not in tolerated:
+                return i, answer, differing
+            differing[i] = answer
         if progress is not None:
             progress(i)
-    return None, None
+    return None, None, differing
 
 
 class PlayBack:
     """A pin design for a loop restored from a checkpoint: it answers ``calls`` (the calls
     the reference loop made from the checkpoint on, checked against the loop's own) with
-    their recorded answers, ``last`` (when given) with that answer instead, then passes every
-    call on to ``design`` (which has made those calls already)."""
+    their recorded answers (``answers``: the live design's own, where its differed), ``last``
+    (when given) with that answer instead, then passes every call on to ``design`` (which has
+    made those calls already)."""
 
-    def __init__(self, design, calls, cycle, last=RECORDED):
+    def __init__(self, design, calls, cycle, last=RECORDED, answers=None):
         self.live = design
         self.calls = list(calls)
         self.last = last  # the answer of the final call, when it is the live design's own
+        self.answers = answers or {}  # {index in calls: the live design's answer there}
         self.i = 0
         self._cycle = cycle
 
@@ -200,8 +208,11 @@ class PlayBack:
                 f"the restored loop called {op}{args!r} where the reference called "
                 f"{call.op}{call.args!r}: the run is not deterministic"
             )
-        self.i += 1
-        answer = call.answer if self.playing or self.last is RECORDED else self.last
+        i, self.i = self.i, self.i + 1
+        if self.playing or self.last is RECORDED:
+            answer = self.answers.get(i, call.answer)
+        else:
+            answer = self.last
         if op == "run":
             self._cycle = answer.cycle
         return answer
