@@ -12,12 +12,10 @@ its mux drives (through a chain of muxes when several mutants sit on one bit).
 
 import re
 
-from .mutant_watch import module_span
+from .mutant_watch import module_cells, module_span
 
 __all__ = ["restore_inits"]
 
-_CELL = re.compile(r"^  cell (\S+) (\S+)\n(.*?)^  end\n", re.MULTILINE | re.DOTALL)
-_CONNECT = re.compile(r"^    connect \\(\w+) (.+)$", re.MULTILINE)
 #: A wire with the attributes before it: (attributes text, its options, name).
 _WIRE = re.compile(r"((?:^  attribute .*\n)*)^  wire ((?:\S+ )*?)(\S+)$", re.MULTILINE)
 _WIDTH = re.compile(r"\bwidth (\d+)")
@@ -53,8 +51,7 @@ def restore_inits(rtlil, top):
             inits[name] = bits[::-1]  # index i is bit i
     driven_by_ff = set()
     muxes = []  # (A wire, Y (wire, index))
-    for kind, _, text in _CELL.findall(body):
-        conns = dict(_CONNECT.findall(text))
+    for kind, conns in module_cells(body):
         if "Q" in conns and kind.startswith("$") and "ff" in kind:
             driven_by_ff.update(re.findall(r"\$auto\$mutate\S*", conns["Q"]))
         if kind == "$mux" and conns.get("A", "").startswith("$auto$mutate"):

@@ -14,7 +14,7 @@ first rises in (fpga_robotics.loop.fork): a mutant's run can then skip its frame
 
 import re
 
-__all__ = ["WATCH_PORT", "add_watch", "module_span"]
+__all__ = ["WATCH_PORT", "add_watch", "module_cells", "module_span"]
 
 #: The output of the mutant netlist that shows where each mutant acts.
 WATCH_PORT = "mutinf"
@@ -22,6 +22,11 @@ WATCH_PORT = "mutinf"
 _CELL = re.compile(r"^  cell (\S+) (\S+)\n(.*?)^  end\n", re.MULTILINE | re.DOTALL)
 _CONNECT = re.compile(r"^    connect \\(\w+) (.+)$", re.MULTILINE)
 _PORT_NUMBER = re.compile(r"^  wire (?:width \d+ )?(?:input|output|inout) (\d+) ", re.MULTILINE)
+
+
+def module_cells(body):
+    """The cells of a module's RTLIL ``body``: ``[(kind, {port: connected signal})]``."""
+    return [(kind, dict(_CONNECT.findall(text))) for kind, _, text in _CELL.findall(body)]
 
 
 def module_span(rtlil, top):
@@ -41,7 +46,7 @@ def add_watch(rtlil, top, select, count, port=WATCH_PORT):
     the output is one bit, tied low."""
     begin, end = module_span(rtlil, top)
     body = rtlil[begin:end]
-    cells = [(kind, dict(_CONNECT.findall(text))) for kind, _, text in _CELL.findall(body)]
+    cells = module_cells(body)
     selects = {}  # the $eq's output wire -> mutant index
     for kind, conns in cells:
         if kind == "$eq" and conns.get("A") == f"\\{select}":
