@@ -6,6 +6,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from pin_proxy import PinProxy
 from run_equality import assert_same_run
 
 from fpga_robotics.loop.pin_fork import PinReferenceRun, reference_run
@@ -16,24 +17,14 @@ from fpga_robotics.scenario.load import load_scenario
 WALL_STOP = Path(__file__).parent / "data" / "user_designs" / "wall_stop.toml"
 
 
-class FasterLeftWheel:
+class FasterLeftWheel(PinProxy):
     """A pin design whose left wheel pin reads ``extra`` higher from edge ``edge`` on (a
     design that parts from its original there); every other call passes through."""
 
     def __init__(self, design, edge, extra=120):
-        self.inner, self.edge, self.extra = design, edge, extra
+        super().__init__(design)
+        self.edge, self.extra = edge, extra
         self.name = "faster_left"
-
-    def __getattr__(self, name):
-        return getattr(self.inner, name)
-
-    @property
-    def cycle(self):
-        return self.inner.cycle
-
-    @property
-    def frame_pending(self):
-        return self.inner.frame_pending
 
     def peek(self, name):
         value = self.inner.peek(name)
@@ -149,33 +140,19 @@ def test_a_robot_with_a_pan_camera_forks_in_real_clock_timing():
     assert not np.array_equal(forked.trajectory["turret.servo_angle"], ref["turret.servo_angle"])
 
 
-class OtherReadings:
+class OtherReading(PinProxy):
     """A pin design whose extra output ``port`` reads ``extra`` higher from edge ``edge`` on
-    (an output that drives nothing), and optionally whose left wheel pin reads 120 higher
-    from ``wheel_edge`` on."""
+    (an output that drives nothing)."""
 
-    def __init__(self, design, port, edge, extra=7, wheel_edge=None):
-        self.inner, self.port, self.edge, self.extra = design, port, edge, extra
-        self.wheel_edge = wheel_edge
-        self.name = "other_readings"
-
-    def __getattr__(self, name):
-        return getattr(self.inner, name)
-
-    @property
-    def cycle(self):
-        return self.inner.cycle
-
-    @property
-    def frame_pending(self):
-        return self.inner.frame_pending
+    def __init__(self, design, port, edge, extra=7):
+        super().__init__(design)
+        self.port, self.edge, self.extra = port, edge, extra
+        self.name = "other_reading"
 
     def peek(self, name):
         value = self.inner.peek(name)
         if name == self.port and self.inner.cycle >= self.edge:
             value += self.extra
-        if name == "motor_left" and self.wheel_edge is not None:
-            value += 120 if self.inner.cycle >= self.wheel_edge else 0
         return value
 
 
@@ -191,7 +168,7 @@ def test_a_variant_that_differs_only_in_an_extra_output_keeps_the_reference_worl
     scenario, reference = wall_stop
     k = 25
     with make_pin_backend("cxxrtl", scenario) as design:
-        variant = OtherReadings(design, "distance_mm", _edge_of_frame(reference, scenario, k))
+        variant = OtherReading(design, "distance_mm", _edge_of_frame(reference, scenario, k))
         forked, diverged = fork_and_full(reference, scenario, variant)
     # The distance it reports drives nothing: no frame parts, no world simulated again.
     assert diverged is None and reference.last_world_from is None
@@ -208,11 +185,9 @@ def test_a_variant_whose_extra_output_differs_before_it_parts_keeps_both(wall_st
     # extra output, and the result is its full run's.
     scenario, reference = wall_stop
     with make_pin_backend("cxxrtl", scenario) as design:
-        variant = OtherReadings(
-            design,
-            "distance_mm",
-            _edge_of_frame(reference, scenario, 5),
-            wheel_edge=_edge_of_frame(reference, scenario, 50),
+        variant = FasterLeftWheel(
+            OtherReading(design, "distance_mm", _edge_of_frame(reference, scenario, 5)),
+            _edge_of_frame(reference, scenario, 50),
         )
         forked, diverged = fork_and_full(reference, scenario, variant)
     assert diverged == 50 and reference.last_world_from == 40

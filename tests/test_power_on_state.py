@@ -19,7 +19,8 @@ RANGER = ROOT / "examples" / "verilog_ranger" / "ranger.toml"
 COUNTER = ROOT / "tests" / "data" / "frame_counter"
 
 
-def _same(a, b):
+def _differing(a, b):
+    """The trajectory columns in which runs ``a`` and ``b`` differ."""
     return [
         k
         for k in a.trajectory
@@ -40,8 +41,8 @@ def test_a_pin_design_without_reset_runs_the_same_twice_on_one_backend(backend):
         )
     with make_pin_backend(backend, scenario) as fresh:
         expected = run_scenario(scenario, backend=fresh)
-    assert _same(first, expected) == []
-    assert _same(second, expected) == []
+    assert _differing(first, expected) == []
+    assert _differing(second, expected) == []
     assert np.nanmax(expected.trajectory["x"]) > expected.trajectory["x"][0]  # it moved
 
 
@@ -76,4 +77,4 @@ def test_the_compiled_followtarget_frame_backends_repeat_a_run_exactly(backend):
     design, _ = runner._designs_for(args, scenario, shadow)
     first = run_scenario(scenario, backend=design)
     second = run_scenario(scenario, backend=design)
-    assert _same(first, second) == []
+    assert _differing(first, second) == []

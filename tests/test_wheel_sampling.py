@@ -8,6 +8,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from pin_proxy import PinProxy
 
 from fpga_robotics.loop.connectors.motors import MotorConnector
 from fpga_robotics.loop.real_clock import make_pin_backend
@@ -61,22 +62,12 @@ def test_the_sample_edges_are_the_last_edge_acting_at_each_step(clock_hz, dt, de
     assert got == [e for e in expected if e > 0]
 
 
-class _CountingPins:
+class _CountingPins(PinProxy):
     """A pin backend that counts the loop's ``run`` calls (its stops)."""
 
     def __init__(self, inner):
-        self.inner, self.runs = inner, 0
-
-    def __getattr__(self, name):
-        return getattr(self.inner, name)
-
-    @property
-    def cycle(self):
-        return self.inner.cycle
-
-    @property
-    def frame_pending(self):
-        return self.inner.frame_pending
+        super().__init__(inner)
+        self.runs = 0
 
     def run(self, cycles):
         self.runs += 1

@@ -51,6 +51,7 @@ class _RecordingPinLoop(RealClockLoop):
         self.checkpoints = []  # in frame order
         self.frame_calls = []  # the journal's length as each frame starts
         self.extra_reads = {}  # journal index of a read of an extra output -> (row, name)
+        self._extra_names = {port: name for name, port in self.top.extra_outputs.items()}
         self.final = None
 
     def run_frame(self, k):
@@ -64,7 +65,7 @@ class _RecordingPinLoop(RealClockLoop):
         super().finish_row()
         if row is None:
             return
-        names = {port: name for name, port in self.top.extra_outputs.items()}
+        names = self._extra_names
         for i, call in enumerate(self.primary.calls[start:], start):
             if call.op == "peek" and call.args[0] in names:
                 self.extra_reads[i] = (row.k, names[call.args[0]])
