@@ -274,8 +274,9 @@ def test_a_mutant_settled_by_its_cone_runs_as_the_design_does(tmp_path):
     argvs = [mutant_argv(specs[i].argv(), netlist, ports, verdict.index, "80x60") for i in passing]
     outcomes = []
 
-    def execute(i, argv, timeout):
-        outcomes.append(runner.execute(argv, timeout=timeout))
+    def execute(i, argv, limit):
+        seconds, stops = limit
+        outcomes.append(runner.execute(argv, timeout=seconds, stop_limit=stops))
         return dict(outcomes[-1])
 
     full = judge_runs(argvs, execute=execute)

@@ -31,11 +31,14 @@ _references = {}
 
 def _build(ref_argv):
     """The reference run of the unmutated design for ``ref_argv`` (a ``ReferenceRun``, or a
-    ``PinReferenceRun`` in real-clock timing), run here."""
+    ``PinReferenceRun`` in real-clock timing), run here, and the watched changes its design
+    stopped at (``runner.stops_of``)."""
     args, scenario, shadow_params = runner.load_run(list(ref_argv))
     design, _ = runner._designs_for(args, scenario, shadow_params)
     run.apply_runtime(design, args)
-    return reference_run(scenario, design=design, seed=args.seed)
+    runner.set_stop_limit(design, None)  # a kept design may carry a mutant's budget
+    reference = reference_run(scenario, design=design, seed=args.seed)
+    return reference, runner.stops_of(design)
 
 
 def _keep(key, reference, token=None):
@@ -52,7 +55,7 @@ def _reference(ref_argv, shared=None):
     key = tuple(ref_argv)
     kept_token, reference = _references.get(key, (None, None))
     if shared is None:
-        return reference if reference is not None else _keep(key, _build(ref_argv))
+        return reference if reference is not None else _keep(key, _build(ref_argv)[0])
     # The token, not the object: Dask may hand a worker the same result twice.
     if reference is not None and kept_token == shared["token"]:
         return reference
@@ -74,7 +77,7 @@ def reference_share(ref_argv):
     shared = {"outcome": None, "reference": None, "token": uuid.uuid4().hex}
     with runner.RunOutcome() as outcome:
         with outcome.running():
-            reference = _build(ref_argv)
+            reference, stops = _build(ref_argv)
         if isinstance(reference, ReferenceRun):
             shared["reference"] = reference.portable()
             # Kept as opened from the data: its images are the data's, not a second copy.
@@ -82,6 +85,7 @@ def reference_share(ref_argv):
         else:  # real-clock: kept here; other workers run their own
             _keep(tuple(ref_argv), reference)
         outcome.record(reference.result)
+        outcome.out["design_stops"] = stops
     if outcome.out["summary"] is None:  # it erred: nothing to share
         shared["reference"] = None
     shared["outcome"] = outcome.out
@@ -93,7 +97,7 @@ def outcome_of(shared):
     return shared["outcome"]
 
 
-def execute_forked(argv, ref_argv, timeout=None, shared=None, watch_bit=None):
+def execute_forked(argv, ref_argv, timeout=None, shared=None, watch_bit=None, stop_limit=None):
     """``runner.execute(argv, timeout)`` for a mutant's run, forked from the reference run
     ``ref_argv`` (the same run with the unmutated design); the same outcome dict, with
     ``"fork"``: the run's ``frames``, the frame its wheels or servos parted from the
@@ -102,20 +106,26 @@ def execute_forked(argv, ref_argv, timeout=None, shared=None, watch_bit=None):
     ``shared``: that run's ``reference_share`` result, whose reference this worker opens
     rather than running it again (None: run here, once per worker). ``watch_bit``: the
     mutant's bit of the netlist's watch output, when the reference ran with it watched
-    (sim.mutant_watch: ``mutsel - 1``); a mutant whose bit never rose is not run."""
+    (sim.mutant_watch: ``mutsel - 1``); a mutant whose bit never rose is not run.
+    ``stop_limit``: as ``runner.execute``'s (the forked run counts its design's stops as
+    the full run does: each call the design answers live, whether replayed or not)."""
     with runner.RunOutcome() as outcome:
         if not _forkable(ref_argv):
-            return runner.execute(argv, timeout=timeout)
+            return runner.execute(argv, timeout=timeout, stop_limit=stop_limit)
         usable = shared is not None and shared["reference"] is not None
         reference = _reference(ref_argv, shared if usable else None)
         args, scenario, shadow_params = runner.load_run(list(argv))
         design, _ = runner._designs_for(args, scenario, shadow_params)
         run.apply_runtime(design, args)
+        runner.set_stop_limit(design, stop_limit)
         outcome.deadline = deadline = runner._Deadline(timeout, None)
         watched = watch_bit is not None and isinstance(reference, ReferenceRun)
         kwargs = {"watch_bit": watch_bit} if watched else {}
-        with outcome.running():
-            result = reference.run_variant(design, scenario, progress=deadline, **kwargs)
+        try:
+            with outcome.running():
+                result = reference.run_variant(design, scenario, progress=deadline, **kwargs)
+        finally:
+            outcome.out["design_stops"] = runner.stops_of(design)
         outcome.record(result)
         outcome.out["fork"] = {
             "frames": reference.frames,

@@ -33,6 +33,7 @@ __all__ = [
     "mutant_argv",
     "replay",
     "robot_judge",
+    "run_limits",
     "run_margin",
 ]
 
@@ -104,23 +105,39 @@ def closest_to_failing(outcomes):
     return best
 
 
-def judge_runs(argvs, timeouts=None, execute=None):
+def run_limits(outcome):
+    """A mutant's limits for a run whose unmutated outcome is ``outcome``: ``(seconds,
+    stops)``. ``stops``, the budget that decides a ``timeout``, counts the design's own work,
+    so the verdict is the same on any machine: ten times the watched output changes the
+    unmutated design stopped at, plus 10,000 (None for a frame-level design, whose frames'
+    cycle watchdog bounds its work). ``seconds`` only catches a run that hangs outside the
+    design's cycles: 30 times the unmutated run's, at least 120 s."""
+    stops = outcome.get("design_stops")
+    return (
+        max(120.0, 30.0 * outcome.get("wall_s", 3.0)),
+        None if stops is None else 10 * stops + 10_000,
+    )
+
+
+def judge_runs(argvs, limits=None, execute=None):
     """The Dask task of one mutant: its runs in order until one does not pass. Returns
     ``{"caught", "run", "status", "message", "failed_checks", "closest", "runs", "wall_s"}``
     (``run``: the index of the first run that did not pass; ``closest``: of a mutant not
     caught, the run nearest to failing), and ``"forks"`` for forked runs: their
-    ``forked_runs.execute_forked`` records, in order. ``execute(i, argv, timeout)`` runs
-    run ``i`` (default ``runner.execute``; forked runs: fpga_robotics.mutation.forked_runs)."""
+    ``forked_runs.execute_forked`` records, in order. ``limits``: each run's ``(seconds,
+    stops)`` (``run_limits``; None: no limits). ``execute(i, argv, limit)`` runs run ``i``
+    (default ``runner.execute``; forked runs: fpga_robotics.mutation.forked_runs)."""
     if execute is None:
 
-        def execute(i, argv, timeout):
-            return runner.execute(argv, timeout=timeout)
+        def execute(i, argv, limit):
+            seconds, stops = limit
+            return runner.execute(argv, timeout=seconds, stop_limit=stops)
 
     t0 = time.perf_counter()
     outcomes = []
     forks = []  # each forked run's "fork" record (forked_runs.execute_forked)
     for i, argv in enumerate(argvs):
-        o = execute(i, argv, None if timeouts is None else timeouts[i])
+        o = execute(i, argv, (None, None) if limits is None else limits[i])
         o.pop("recording", None)
         outcomes.append(o)
         if o.get("fork") is not None:
@@ -239,8 +256,7 @@ def robot_judge(
         outcomes, shared = _baseline(client, base, tick, fork)
         passing = [i for i, o in enumerate(outcomes) if o["status"] == "pass"]
         statuses = [o["status"] for o in outcomes]
-        # Each mutant's run may take ten times as long as the design's (at least 30 s).
-        limits = [max(30.0, 10.0 * outcomes[i].get("wall_s", 3.0)) for i in passing]
+        limits = [run_limits(outcomes[i]) for i in passing]
         todo = [k for k in indices if k not in verdicts]
         say(
             f"robot judge: {len(passing)} of {len(base)} runs pass unmutated; judging "
@@ -310,14 +326,19 @@ def robot_judge(
     )
 
 
-def judge_runs_forked(argvs, ref_argvs, timeouts=None, shared=None, watch_bit=None):
+def judge_runs_forked(argvs, ref_argvs, limits=None, shared=None, watch_bit=None):
     """``judge_runs`` with each run forked from its reference run (``forked_runs``);
     ``shared``: the reference runs' ``reference_share`` results (None: each worker runs
     them itself); ``watch_bit``: the mutant's bit of the references' watch output."""
     return judge_runs(
         argvs,
-        timeouts,
-        execute=lambda i, argv, timeout: execute_forked(
-            argv, ref_argvs[i], timeout, None if shared is None else shared[i], watch_bit
+        limits,
+        execute=lambda i, argv, limit: execute_forked(
+            argv,
+            ref_argvs[i],
+            limit[0],
+            None if shared is None else shared[i],
+            watch_bit,
+            stop_limit=limit[1],
         ),
     )

@@ -24,7 +24,16 @@ from pathlib import Path
 
 from fpga_robotics.hw.errors import UsageError
 
-__all__ = ["TIMEOUT_TOPIC", "RunOutcome", "RunTimeout", "build_designs", "execute", "load_run"]
+__all__ = [
+    "TIMEOUT_TOPIC",
+    "RunOutcome",
+    "RunTimeout",
+    "build_designs",
+    "execute",
+    "load_run",
+    "set_stop_limit",
+    "stops_of",
+]
 
 #: The Dask event topic under which a worker says it ends itself for a stuck run (the client
 #: then records that run as ``timeout``, not as a crash).
@@ -207,6 +216,27 @@ def _current_worker():
         return None
 
 
+def _over_stop_budget(exc):
+    if exc is None:
+        return False
+    from fpga_robotics.sim.pins.base import StopLimit  # lazy: loaded by any run that raises it
+
+    return isinstance(exc, StopLimit)
+
+
+def set_stop_limit(design, limit):
+    """Give a run's design its stop budget (``limit`` watched changes, None: none). A
+    frame-level design has none: its frames' cycle watchdog bounds its work."""
+    if hasattr(design, "stop_limit"):
+        design.stop_limit = limit
+
+
+def stops_of(design):
+    """The watched changes a pin-level design stopped at in its last run (None: a frame-level
+    design)."""
+    return getattr(design, "stops", None)
+
+
 class RunOutcome:
     """How every campaign task records one run, as a context manager: ``out`` is the
     outcome dict (``status``: the summary's verdict, ``"timeout"`` or ``"error"`` with the
@@ -224,7 +254,7 @@ class RunOutcome:
         return self
 
     def __exit__(self, kind, exc, tb):
-        if isinstance(exc, RunTimeout):
+        if isinstance(exc, RunTimeout) or _over_stop_budget(exc):
             self.out.update(status="timeout", message=str(exc))
         elif isinstance(exc, Exception):
             self.out.update(status="error", message=f"{type(exc).__name__}: {exc}".splitlines()[0])
@@ -249,11 +279,14 @@ class RunOutcome:
         self.out.update(status=summary["verdict"], summary=summary)
 
 
-def execute(argv, timeout=None, record=False, tag=None, bag=False):
+def execute(argv, timeout=None, record=False, tag=None, bag=False, stop_limit=None):
     """Run one campaign run (``tag``: its name, for the timeout event; ``record``: False, or
-    log every how many frames' images to the recording); returns ``{"status", "message", "summary", "wall_s", "cpu_s",
-    "run_s", "recording", "bag"}`` (``recording``: the ``.rrd`` bytes when ``record``;
-    ``bag``: with ``bag`` and ``record``, the ROS 2 bag's files as ``{name: bytes}``)."""
+    log every how many frames' images to the recording); returns ``{"status", "message",
+    "summary", "wall_s", "cpu_s", "run_s", "recording", "bag", "design_stops"}``
+    (``recording``: the ``.rrd`` bytes when ``record``; ``bag``: with ``bag`` and ``record``,
+    the ROS 2 bag's files as ``{name: bytes}``; ``design_stops``: ``stops_of`` the design).
+    ``stop_limit``: a pin-level design's stop budget (``set_stop_limit``); over it the run
+    is a ``timeout``, wherever it is run."""
     from fpga_robotics.cli import run  # lazy: the run stack (~1 s)
     from fpga_robotics.loop.timings import run_scenario  # lazy: the run stack (~1 s)
 
@@ -263,6 +296,7 @@ def execute(argv, timeout=None, record=False, tag=None, bag=False):
         design, shadow = _designs_for(args, scenario, shadow_params)
         if getattr(args, "runtime", None):  # a kept design gets this run's [runtime] values
             run.apply_runtime(design, args)
+        set_stop_limit(design, stop_limit)  # a kept design: this run's, or none
         outcome.deadline = deadline = _Deadline(timeout, _fault(args.seed), tag)
         recorder, rrd = (None, None)
         if record:
@@ -285,6 +319,7 @@ def execute(argv, timeout=None, record=False, tag=None, bag=False):
                     bag_writer.close()
                     out["bag"] = _read_bag(bag_dir)
         finally:
+            out["design_stops"] = stops_of(design)
             if recorder is not None:
                 run._close_recorder(recorder, True)
             if bag_writer is not None:

@@ -2,7 +2,7 @@
 Amaranth's simulator (``pysim``, the reference) or a compiled model (``cxxrtl``,
 ``verilator``); docs/pins.md."""
 
-from .base import PinBackend, PinError, PixelTiming, Port, Stop
+from .base import PinBackend, PinError, PixelTiming, Port, Stop, StopLimit
 from .compiled import CxxrtlPins, VerilatorPins
 from .design import FILTERED_PORTS, PIXEL_PORTS, PinDesignSource, follow_target_source
 from .pysim import PysimPins
@@ -19,6 +19,7 @@ __all__ = [
     "PixelTiming",
     "Port",
     "Stop",
+    "StopLimit",
     "VerilogPinSource",
     "follow_target_source",
     "get_pin_backend",

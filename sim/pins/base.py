@@ -28,11 +28,17 @@ from dataclasses import dataclass
 
 from fpga_robotics.hw.errors import UserError
 
-__all__ = ["PinBackend", "PinError", "PixelTiming", "Port", "Stop"]
+__all__ = ["PinBackend", "PinError", "PixelTiming", "Port", "Stop", "StopLimit"]
 
 
 class PinError(UserError, RuntimeError):
     """A pin-level run cannot go on: unknown port, a value out of range, a missing tool."""
+
+
+class StopLimit(RuntimeError):
+    """``run`` stopped at a watched change more often since the reset than the backend's
+    ``stop_limit`` allows: a budget of work counted in the design's own changes, so that
+    where it ends does not depend on the machine's speed."""
 
 
 @dataclass(frozen=True)

@@ -10,7 +10,7 @@ from collections import deque
 import numpy as np
 
 from ..camera.frames import FrameError, to_rgb444
-from .base import PinBackend, PinError, PixelTiming, Stop
+from .base import PinBackend, PinError, PixelTiming, Stop, StopLimit
 
 __all__ = ["HostPins", "capture_error"]
 
@@ -38,6 +38,10 @@ class HostPins(PinBackend):
         self._captured = 0  # frames the simulator has completed (its counter)
         # [runtime] inputs of a Verilog design: held at these values from every reset on.
         self._held = dict(getattr(source, "runtime", None) or {})
+        #: Watched changes ``run`` stopped at since the reset.
+        self.stops = 0
+        #: More stops than this since the reset raise ``StopLimit`` (None: no limit).
+        self.stop_limit = None
 
     # --- values ---------------------------------------------------------------------------
 
@@ -99,6 +103,7 @@ class HostPins(PinBackend):
         self._captures.clear()
         self._filtered = None
         self._captured = 0
+        self.stops = 0
         for name, value in self._held.items():
             self.poke(name, value)
 
@@ -210,6 +215,12 @@ class HostPins(PinBackend):
         if index < 0:
             return Stop(cycle)
         port = self._port_list[index]
+        self.stops += 1
+        if self.stop_limit is not None and self.stops > self.stop_limit:
+            raise StopLimit(
+                f"the design's watched outputs changed more than {self.stop_limit} times "
+                f"(the last: {port.name} at edge {cycle}), over this run's budget"
+            )
         return Stop(cycle, port.name, self._cooked(port, raw))
 
     # --- what a backend implements -----------------------------------------------------------
