@@ -9,7 +9,7 @@ Run at ``mutsel = 0`` (the design itself), the watch tells for every mutant at o
 it ever acts: a mutant whose bit never rises in a run behaves in that run exactly as the
 design does, cycle for cycle (its mux gives ``A`` whichever way it is set, so every signal,
 and the world they drive, stays the design's). The closed loop records the frame each bit
-first rises in (fpga_robotics.loop.fork): a mutant's run can then skip its frames before it.
+first rises in (fpga_robotics.loop.fork); a forked run skips a mutant whose bit never rose.
 """
 
 import re

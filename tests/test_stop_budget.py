@@ -72,8 +72,19 @@ def test_a_run_over_its_budget_times_out_at_the_same_change_full_or_forked(backe
 
 
 def test_the_judge_s_limits_count_stops_for_pin_designs_only():
-    # Ten times the unmutated run's stops and 10,000 more; seconds only for a hang.
-    assert run_limits({"design_stops": 37, "wall_s": 2.0}) == (120.0, 10_370)
-    assert run_limits({"design_stops": 0, "wall_s": 10.0}) == (300.0, 10_000)
+    # A hundred times the unmutated run's stops and a million more; seconds only for a hang.
+    assert run_limits({"design_stops": 37, "wall_s": 2.0}) == (120.0, 1_003_700)
+    assert run_limits({"design_stops": 0, "wall_s": 10.0}) == (300.0, 1_000_000)
     # A frame-level design: its frames' cycle watchdog bounds its work.
     assert run_limits({"design_stops": None, "wall_s": 1.0}) == (120.0, None)
+
+
+def test_wall_stop_stops_twice_a_trigger_period():
+    # docs/your_design.md: WallStop triggers every 20 ms (period_us) and the loop stops at
+    # each TRIG rise and fall: 12 s / 20 ms * 2 = 1,200, so its mutants' budget is 1,120,000.
+    scenario = Path(__file__).parent / "data" / "user_designs" / "wall_stop.toml"
+    outcome = runner.execute(["--scenario", str(scenario), "--seed", "0"])
+    assert outcome["status"] == "pass", outcome["message"]
+    sim = load_scenario(str(scenario)).sim
+    assert outcome["design_stops"] == round(sim.duration / 0.020) * 2 == 1200
+    assert run_limits(outcome)[1] == 1_120_000

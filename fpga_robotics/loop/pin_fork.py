@@ -45,9 +45,13 @@ def reference_run(scenario, *, design, seed=None, checkpoint_every=30, **run_arg
 class _RecordingPinLoop(RealClockLoop):
     """A real-clock loop that takes the checkpoints variants restore."""
 
-    def __init__(self, scenario, *, seed, design, checkpoint_every, **loop_args):
+    def __init__(self, scenario, *, seed, design, checkpoint_every, watch=None, **loop_args):
         super().__init__(scenario, seed=seed, design=design, **loop_args)
         self.every = checkpoint_every
+        # Watch bit -> the row it first rose in (None: no watch); ``watch`` reads the
+        # design itself, not through the journal, which variants replay.
+        self._watch = watch
+        self.watch_first = None if watch is None else {}
         self.checkpoints = []  # in frame order
         self.frame_calls = []  # the journal's length as each frame starts
         self.extra_reads = {}  # journal index of a read of an extra output -> (row, name)
@@ -65,20 +69,28 @@ class _RecordingPinLoop(RealClockLoop):
         super().finish_row()
         if row is None:
             return
+        self._read_watch(row.k)
         names = self._extra_names
         for i, call in enumerate(self.primary.calls[start:], start):
             if call.op == "peek" and call.args[0] in names:
                 self.extra_reads[i] = (row.k, names[call.args[0]])
 
+    def _read_watch(self, k):
+        for bit in self._watch() if self._watch is not None else ():
+            self.watch_first.setdefault(bit, k)
+
     def finish_run(self, wall_start, cpu_start):
         self.final = checkpoint.take(self)
+        self._read_watch(self.frames_done)  # what rose after the last row
         return super().finish_run(wall_start, cpu_start)
 
 
 def _interface(loop):
-    """How the loop binds its design: what must agree for a variant to share the journal."""
+    """How the loop binds its design: what must agree for a variant to share the journal
+    (the reference's watch outputs aside: only the reference is watched)."""
+    watch = {name for name, _ in getattr(loop.pins.source, "watch", None) or ()}
     return (
-        dict(loop.pins.ports),
+        {name: port for name, port in loop.pins.ports.items() if name not in watch},
         {c.name: io.binding for c, io in loop.io.items()},
         sorted(loop.watched),
         loop.top.camera,
@@ -120,10 +132,12 @@ class PinReferenceRun:
             seed=seed,
             design=self.journal,
             checkpoint_every=checkpoint_every,
+            watch=_watch_of(design),
             **loop_args,
         )
         self.seed = self._loop.seed
         self.result = self._loop.run(progress=progress)
+        self._end_cycle = design.cycle  # where a variant that is not run ends
         self.last_divergence = self.last_world_from = None  # as ReferenceRun's
         self.last_design_ran = True
 
@@ -131,15 +145,24 @@ class PinReferenceRun:
     def frames(self):
         return self._loop.frames_done
 
-    def run_variant(self, design, scenario=None, *, progress=None):
+    def watch_first(self, bit):
+        """The row in which bit ``bit`` of the reference design's watch output first rose
+        (None: it never did); ``ValueError`` if the reference design had no watch."""
+        if self._loop.watch_first is None:
+            raise ValueError("the reference design has no watch output")
+        return self._loop.watch_first.get(bit)
+
+    def run_variant(self, design, scenario=None, *, progress=None, watch_bit=None):
         """The run of ``design`` (a ``PinBackend`` for ``scenario``; reset here, not closed)
         in the reference's world. ``scenario`` as in ``ReferenceRun.run_variant``;
-        ``progress(done, total)`` after every frame replayed or run."""
+        ``progress(done, total)`` after every frame replayed or run. ``watch_bit``: as
+        ``ReferenceRun.run_variant``'s (a mutant whose bit never rose is not run)."""
         scenario = self.scenario if scenario is None else scenario
         check_same_world(self.scenario, scenario)
         wall_start, cpu_start = time.perf_counter(), time.process_time()
         ref, calls = self._loop, self.journal.calls
         loop = RealClockLoop(scenario, seed=self.seed, design=design)
+        self.last_design_ran = True
         if _interface(loop) != _interface(ref):
             self.last_divergence = self.last_world_from = 0
             return run_scenario(scenario, seed=self.seed, backend=design, progress=progress)
@@ -149,8 +172,15 @@ class PinReferenceRun:
             if progress is not None and i + 1 in starts[1:]:
                 progress(bisect.bisect_right(starts, i), ref.n_frames)
 
-        # Its extra outputs drive nothing: where only they differ, the world is the same.
-        i, answer, extra = first_difference(design, calls, replayed, ref.extra_reads)
+        watched = watch_bit is not None and ref.watch_first is not None
+        if watched and ref.watch_first.get(watch_bit) is None:
+            # Every signal of the variant is the reference design's, edge for edge: every
+            # answer is the journal's.
+            i, extra = None, {}
+            self.last_design_ran = False
+        else:
+            # Its extra outputs drive nothing: where only they differ, the world is the same.
+            i, answer, extra = first_difference(design, calls, replayed, ref.extra_reads)
         if i is None:
             self.last_divergence = self.last_world_from = None
             last = ref.final.design_calls
@@ -159,7 +189,7 @@ class PinReferenceRun:
                 PlayBack(
                     design,
                     rest,
-                    rest[0].cycle if rest else design.cycle,
+                    rest[0].cycle if rest else self._end_cycle,
                     answers={j - last: a for j, a in extra.items() if j >= last},
                 )
             )
@@ -175,6 +205,12 @@ class PinReferenceRun:
         _restore(loop, start)
         _rewrite_extra(loop, ref, extra, first)
         return loop.run(start=start.frame, progress=progress)
+
+
+def _watch_of(design):
+    """The reader of a pin design's ``[watch]`` output (None without one)."""
+    source = getattr(design, "source", None)
+    return design.watch_risen if getattr(source, "watch", None) else None
 
 
 def _rewrite_extra(loop, ref, extra, before):

@@ -119,11 +119,11 @@ def execute_forked(argv, ref_argv, timeout=None, shared=None, watch_bit=None, st
         run.apply_runtime(design, args)
         runner.set_stop_limit(design, stop_limit)
         outcome.deadline = deadline = runner._Deadline(timeout, None)
-        watched = watch_bit is not None and isinstance(reference, ReferenceRun)
-        kwargs = {"watch_bit": watch_bit} if watched else {}
         try:
             with outcome.running():
-                result = reference.run_variant(design, scenario, progress=deadline, **kwargs)
+                result = reference.run_variant(
+                    design, scenario, progress=deadline, watch_bit=watch_bit
+                )
         finally:
             outcome.out["design_stops"] = runner.stops_of(design)
         outcome.record(result)

@@ -108,14 +108,16 @@ def closest_to_failing(outcomes):
 def run_limits(outcome):
     """A mutant's limits for a run whose unmutated outcome is ``outcome``: ``(seconds,
     stops)``. ``stops``, the budget that decides a ``timeout``, counts the design's own work,
-    so the verdict is the same on any machine: ten times the watched output changes the
-    unmutated design stopped at, plus 10,000 (None for a frame-level design, whose frames'
-    cycle watchdog bounds its work). ``seconds`` only catches a run that hangs outside the
+    so the verdict is the same on any machine: a hundred times the watched output changes
+    the unmutated design stopped at, plus a million (None for a frame-level design, whose
+    frames' cycle watchdog bounds its work). A mutant that only triggers a sensor far more
+    often runs to its end and is judged by its checks; one that changes a watched output at
+    nearly every edge of a fast clock does not end in reasonable time. ``seconds`` only catches a run that hangs outside the
     design's cycles: 30 times the unmutated run's, at least 120 s."""
     stops = outcome.get("design_stops")
     return (
         max(120.0, 30.0 * outcome.get("wall_s", 3.0)),
-        None if stops is None else 10 * stops + 10_000,
+        None if stops is None else 100 * stops + 1_000_000,
     )
 
 

@@ -52,6 +52,7 @@ __all__ = [
     "ForeignVerilatorBackend",
     "design_ports",
     "pin_ports",
+    "watch_chunks",
     "wrapper_verilog",
 ]
 
@@ -395,8 +396,8 @@ def wrapper_verilog(pm, ports, width, height, pins=False):
             f"  always @(posedge clk) fr_rt_{index} <= fr_runtime_value({index});"
         )
         conns.append(f".{name}(fr_rt_{index})")
-    if pm.watch and not pins:
-        body.append(_watch_verilog(ports[pm.watch][1]))
+    if pm.watch:
+        body.append(_watch_verilog(ports[pm.watch][1], declare=pins))
         conns.append(f".{pm.watch}(fr_watch)")
     if pm.filtered_valid:
         conns += [
@@ -427,13 +428,15 @@ endmodule
 """
 
 
-def _watch_verilog(width):
+def _watch_verilog(width, declare=False):
     """The watch of ``[watch]``: ``fr_watch_any``, the bits of the watched output that were
     high at a clock edge since the last reset (the values the edge samples, the reset's own
     edge included) or are high now, where the harness reads the outputs between edges. The
-    host reads it once a frame (``watch_risen``)."""
+    host reads it once a frame (``watch_risen``). ``declare``: ``fr_watch_any`` is a wire of
+    the wrapper, not its output (the pin wrapper gives it out in ``watch_chunks``)."""
     return (
-        f"  wire [{width - 1}:0] fr_watch;\n"
+        (f"  wire [{width - 1}:0] fr_watch_any;\n" if declare else "")
+        + f"  wire [{width - 1}:0] fr_watch;\n"
         f"  reg [{width - 1}:0] fr_watch_seen = {width}'d0;\n"
         "  always @(posedge clk)\n"
         "    fr_watch_seen <= rst ? fr_watch : fr_watch_seen | fr_watch;\n"
@@ -453,6 +456,9 @@ def _pin_wrapper(pm, ports, outputs, decls, body, conns):
     if pm.filtered_valid:
         header += ["output filtered__valid", "output [13:0] filtered__payload"]
     header += outputs
+    for name, low, width in watch_chunks(pm, ports):
+        header.append(f"output [{width - 1}:0] {name}")
+        body.append(f"  assign {name} = fr_watch_any[{low + width - 1}:{low}];")
     for port in (*pm.connector_ports(), *pm.extra_outputs.values(), *pm.runtime):
         direction, width, signed = ports[port]
         # Escaped identifiers: a port may have any name the design's Verilog gives it.
@@ -472,6 +478,18 @@ module {WRAPPER} (
   );
 endmodule
 """
+
+
+def watch_chunks(pm, ports):
+    """The pin wrapper's outputs that give ``fr_watch_any`` (``[watch]``): ``[(name, lowest
+    bit, width)]``, 64 bits each at most (a pin port's widest), none without a watch."""
+    if not pm.watch:
+        return []
+    width = ports[pm.watch][1]
+    return [
+        (f"fr_watch_any_{i}", low, min(64, width - low))
+        for i, low in enumerate(range(0, width, 64))
+    ]
 
 
 def pin_ports(design):
@@ -494,6 +512,8 @@ def pin_ports(design):
     for port in (*pm.connector_ports(), *pm.extra_outputs.values(), *pm.runtime):
         direction, width, signed = design.ports[port]
         ports[port] = ("in" if direction == "input" else "out", width, signed)
+    for name, _, width in watch_chunks(pm, design.ports):
+        ports[name] = ("out", width, False)
     return ports
 
 

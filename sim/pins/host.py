@@ -38,6 +38,7 @@ class HostPins(PinBackend):
         self._captured = 0  # frames the simulator has completed (its counter)
         # [runtime] inputs of a Verilog design: held at these values from every reset on.
         self._held = dict(getattr(source, "runtime", None) or {})
+        self._watch_known = 0  # the [watch] bits watch_risen gave since the reset
         #: Watched changes ``run`` stopped at since the reset.
         self.stops = 0
         #: More stops than this since the reset raise ``StopLimit`` (None: no limit).
@@ -104,8 +105,22 @@ class HostPins(PinBackend):
         self._filtered = None
         self._captured = 0
         self.stops = 0
+        self._watch_known = 0
         for name, value in self._held.items():
             self.poke(name, value)
+
+    def watch_risen(self):
+        """The bits of the design's ``[watch]`` output that rose since the reset (at a clock
+        edge, or high now) and were not given by an earlier call, in bit order; None for a
+        design without one (the source's ``watch``, sim.pins.verilog)."""
+        chunks = getattr(self.source, "watch", None)
+        if not chunks:
+            return None
+        now = 0
+        for name, low in chunks:
+            now |= self.peek(name) << low
+        new, self._watch_known = now & ~self._watch_known, self._watch_known | now
+        return [bit for bit in range(new.bit_length()) if new >> bit & 1]
 
     def set_runtime(self, name, value):
         """Hold the ``[runtime]`` input ``name`` at ``value``, now and after every reset (one

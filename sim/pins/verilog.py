@@ -11,7 +11,7 @@ model (``cxxrtl``); Amaranth's simulator cannot take Verilog.
 import functools
 import hashlib
 
-from ..backends.foreign import WRAPPER, pin_ports
+from ..backends.foreign import WRAPPER, pin_ports, watch_chunks
 from ..backends.verilog_cxxrtl import verilog_to_cxxrtl
 from .base import PinError, Port
 from .design import FILTERED_PORTS, MAX_PORTS, PIXEL_PORTS
@@ -24,8 +24,9 @@ class VerilogPinSource:
 
     Its ports are the wrapper's: ``pixels__valid``/``pixels__payload``, ``color_sel`` and
     ``frame_done`` when the map has a pixel stream, the outputs the map names (``found``,
-    ``motor_left``, ...; absent ones are not ports), ``filtered__*`` with ``[filtered]``, and
-    every connector port under the design's own name.
+    ``motor_left``, ...; absent ones are not ports), ``filtered__*`` with ``[filtered]``,
+    every connector port under the design's own name, and with ``[watch]`` the bits its
+    output rose in since the reset (``fr_watch_any_0``, ...: ``watch``).
     """
 
     #: The wrapper's module: the pin harness's model (``--prefix Vfollow_target``).
@@ -49,6 +50,9 @@ class VerilogPinSource:
             )
         #: ``[runtime]`` inputs -> the values the backend holds them at (``set_runtime``).
         self.runtime = dict(pm.runtime)
+        #: The ``[watch]`` output's bits since the reset, as outputs of 64 bits at most:
+        #: ``[(port, lowest bit)]`` (``HostPins.watch_risen``).
+        self.watch = [(name, low) for name, low, _ in watch_chunks(pm, design.ports)]
         self.pixels = PIXEL_PORTS if pm.has_pixels else None
         self.filtered = FILTERED_PORTS if pm.filtered_valid else None
         params = design.params
