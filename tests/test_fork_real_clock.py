@@ -2,6 +2,7 @@
 run gives the same result as its own full run, whether it never parts from the reference,
 parts at frame 0, only in the last frame, or in between (restored from a checkpoint)."""
 
+import pickle
 from pathlib import Path
 
 import numpy as np
@@ -114,6 +115,30 @@ def test_a_variant_that_parts_between_checkpoints(scenario, reference):
     heading = forked.trajectory["heading"]
     assert np.array_equal(heading[: k + 1], ref["heading"][: k + 1])
     assert not np.array_equal(heading[k + 1 :], ref["heading"][k + 1 :])
+
+
+def test_the_portable_reference_forks_as_the_reference(scenario, reference):
+    # Pickled and opened again (as another worker gets it), without its design: each variant
+    # parts where it parts from the original, restored from the same checkpoint, and its run
+    # is its full run.
+    opened = PinReferenceRun.from_portable(pickle.loads(pickle.dumps(reference.portable())))
+    assert opened.frames == reference.frames
+    last = reference.frames - 1
+    parted = []
+    for k in (None, 0, 17, last):
+        with make_pin_backend("cxxrtl", scenario) as design:
+            edge = None if k is None else _edge_of_frame(reference, scenario, k)
+            variant = design if k is None else FasterLeftWheel(design, edge)
+            theirs = opened.run_variant(variant, scenario)
+            mine = reference.run_variant(variant, scenario)
+            assert (opened.last_divergence, opened.last_world_from) == (
+                reference.last_divergence,
+                reference.last_world_from,
+            ), k
+            assert_same_run(theirs, mine)
+            assert_same_run(theirs, run_scenario(scenario, backend=variant))
+            parted.append(opened.last_divergence)
+    assert parted == [None, 0, 17, last]
 
 
 def test_a_variant_world_must_be_the_reference_world(scenario, reference):

@@ -87,14 +87,15 @@ class PortableCheckpoint:
         return unpickler.load()
 
 
-#: The design's place among the shared objects.
-_DESIGN = 1
+#: The design's places among the shared objects: the loop's design, and a real-clock loop's
+#: pins (the reference's journal; a variant's own pins or play-back).
+_DESIGN = (1, 2)
 
 
 def _never_changing(loop):
     """Objects of the state that no step changes, shared rather than copied: the renderer,
     and the terrain maps with their (frozen) patches, which the world compares by identity."""
-    shared = [loop.camera.renderer, loop.design, getattr(loop, "pins", None)]  # _DESIGN: 1
+    shared = [loop.camera.renderer, loop.design, getattr(loop, "pins", None)]  # _DESIGN
     if loop.rig is not None:
         shared += [cam.connector.renderer for cam in loop.rig.cameras]
     for terrain in (loop.world.terrain, loop.world._painted):
@@ -105,7 +106,7 @@ def _never_changing(loop):
 def _kinds(shared):
     """The types of the shared objects (``_never_changing``), the design's left out: a
     variant's design restores the reference's checkpoints."""
-    return [type(x).__name__ for i, x in enumerate(shared) if i != _DESIGN]
+    return [type(x).__name__ for i, x in enumerate(shared) if i not in _DESIGN]
 
 
 def take(loop):

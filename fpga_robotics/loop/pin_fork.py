@@ -23,11 +23,13 @@ nothing to share with the reference: it gets a full run.
 
 import bisect
 import time
+from types import SimpleNamespace
 
 from fpga_robotics.loop import checkpoint
 from fpga_robotics.loop.fork import ReferenceRun, check_same_world
 from fpga_robotics.loop.pin_journal import JournalPins, PlayBack, first_difference
 from fpga_robotics.loop.real_clock import RealClockLoop
+from fpga_robotics.loop.reference_data import PinReferenceData
 from fpga_robotics.loop.shadow import is_shadow_event
 from fpga_robotics.loop.timings import run_scenario
 
@@ -138,8 +140,50 @@ class PinReferenceRun:
         self.seed = self._loop.seed
         self.result = self._loop.run(progress=progress)
         self._end_cycle = design.cycle  # where a variant that is not run ends
+        self._interface = _interface(self._loop)
         self.last_divergence = self.last_world_from = None  # as ReferenceRun's
         self.last_design_ran = True
+
+    def portable(self):
+        """This reference as a ``PinReferenceData``: picklable, for another process."""
+        ref = self._loop
+        return PinReferenceData(
+            scenario=self.scenario,
+            seed=self.seed,
+            result=self.result,
+            calls=list(self.journal.calls),
+            frame_calls=list(ref.frame_calls),
+            extra_reads=dict(ref.extra_reads),
+            n_frames=ref.n_frames,
+            frames_done=ref.frames_done,
+            checkpoints=[checkpoint.portable(c) for c in ref.checkpoints],
+            final=checkpoint.portable(ref.final),
+            watch_first=None if ref.watch_first is None else dict(ref.watch_first),
+            interface=self._interface,
+            end_cycle=self._end_cycle,
+        )
+
+    @classmethod
+    def from_portable(cls, data):
+        """The ``PinReferenceRun`` that ``data`` (``portable()``) was made from, without its
+        design: ``run_variant`` gives the same results as the original's."""
+        self = cls.__new__(cls)
+        self.scenario, self.seed, self.result = data.scenario, data.seed, data.result
+        self.journal = SimpleNamespace(calls=data.calls)
+        # What run_variant reads of the recording loop.
+        self._loop = SimpleNamespace(
+            frame_calls=data.frame_calls,
+            extra_reads=data.extra_reads,
+            n_frames=data.n_frames,
+            frames_done=data.frames_done,
+            checkpoints=data.checkpoints,
+            final=data.final,
+            watch_first=data.watch_first,
+        )
+        self._interface, self._end_cycle = data.interface, data.end_cycle
+        self.last_divergence = self.last_world_from = None
+        self.last_design_ran = True
+        return self
 
     @property
     def frames(self):
@@ -163,7 +207,7 @@ class PinReferenceRun:
         ref, calls = self._loop, self.journal.calls
         loop = RealClockLoop(scenario, seed=self.seed, design=design)
         self.last_design_ran = True
-        if _interface(loop) != _interface(ref):
+        if _interface(loop) != self._interface:
             self.last_divergence = self.last_world_from = 0
             return run_scenario(scenario, seed=self.seed, backend=design, progress=progress)
         starts = ref.frame_calls

@@ -1,10 +1,11 @@
-"""A reference run (fpga_robotics.loop.fork) in a form another process can take: what
-``ReferenceRun.run_variant`` reads of it, with nothing bound to the process that ran it.
+"""A reference run (fpga_robotics.loop.fork, fpga_robotics.loop.pin_fork) in a form another
+process can take: what ``run_variant`` reads of it, with nothing bound to the process that
+ran it.
 
 The images are one contiguous ``uint8`` array (a frame is a view into it: one buffer to
 pickle and to keep), the world checkpoints are ``PortableCheckpoint`` bytes that restore
-into the variant's own loop. Made by ``ReferenceRun.portable()``, opened again by
-``ReferenceRun.from_portable``.
+into the variant's own loop. Made by ``ReferenceRun.portable()`` (``PinReferenceRun``'s: the
+journal of the design's pin calls instead of images), opened again by ``from_portable``.
 """
 
 from dataclasses import dataclass
@@ -12,7 +13,7 @@ from types import SimpleNamespace
 
 import numpy as np
 
-__all__ = ["ReferenceData", "recorded_of"]
+__all__ = ["PinReferenceData", "ReferenceData", "recorded_of"]
 
 
 @dataclass(eq=False)
@@ -72,6 +73,57 @@ class ReferenceData:
         saved = [*self.checkpoints, self.final]
         captured = sum(c.rgb.nbytes for c in self.captures)
         return self.frames.nbytes + captured + sum(len(c.blob) for c in saved)
+
+
+@dataclass(eq=False)
+class PinReferenceData:
+    """A real-clock reference run (``PinReferenceRun``), picklable and self-contained.
+
+    Attributes
+    ----------
+    scenario, seed, result
+        As ``ReferenceData``'s.
+    calls : list of Call
+        The journal of the design's pin calls, with their answers (fpga_robotics.loop.
+        pin_journal).
+    frame_calls : list of int
+        The journal's length as each frame started.
+    extra_reads : dict
+        Journal index of a read of an extra output -> (row, name).
+    n_frames, frames_done : int
+        The frames of the whole run, and those it ran.
+    checkpoints : list of PortableCheckpoint
+        In frame order, each with the journal's length where it was taken.
+    final : PortableCheckpoint
+        At the end of the run.
+    watch_first : dict or None
+        As ``ReferenceData``'s, by row.
+    interface : tuple
+        How the loop bound its design (pin_fork's ``_interface``).
+    end_cycle : int
+        The design's cycle at the end of the run.
+    """
+
+    scenario: object
+    seed: int
+    result: object
+    calls: list
+    frame_calls: list
+    extra_reads: dict
+    n_frames: int
+    frames_done: int
+    checkpoints: list
+    final: object
+    watch_first: dict | None
+    interface: tuple
+    end_cycle: int
+
+    @property
+    def nbytes(self):
+        """Roughly how much memory the checkpoints and the journal's pixel streams take."""
+        saved = [*self.checkpoints, self.final]
+        streamed = sum(a.nbytes for c in self.calls for a in c.args if isinstance(a, np.ndarray))
+        return streamed + sum(len(c.blob) for c in saved)
 
 
 def pack_frames(seen):

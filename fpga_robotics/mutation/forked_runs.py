@@ -7,8 +7,8 @@ worker opens each reference once (``ReferenceRun.from_portable``) and keeps it. 
 run of the same scenario is then replayed on the recorded frames and re-simulated only from
 where its design drives differently. Its summary and verdict are those of its full run. In
 real-clock timing the reference is a ``PinReferenceRun`` (fpga_robotics.loop.pin_fork: the
-design's pin calls journaled), which has no portable form: each worker that needs one runs it
-once. Runs with a shadow design are run in full (``runner.execute``). When the references
+design's pin calls journaled; ``PinReferenceData`` its portable form). Runs with a shadow
+design are run in full (``runner.execute``). When the references
 ran with the netlist's watch output watched (the robot judge's ``watch_ports``), a mutant
 whose bit never rose in a reference's run (sim.mutant_watch: it never acted there) gets that
 run without its design being run.
@@ -18,7 +18,8 @@ import uuid
 
 from fpga_robotics.cli import run
 from fpga_robotics.loop.fork import ReferenceRun
-from fpga_robotics.loop.pin_fork import reference_run
+from fpga_robotics.loop.pin_fork import PinReferenceRun, reference_run
+from fpga_robotics.loop.reference_data import PinReferenceData
 
 from ..sweep import runner
 
@@ -50,8 +51,9 @@ def _keep(key, reference, token=None):
 
 
 def _reference(ref_argv, shared=None):
-    """The worker's ``ReferenceRun`` for ``ref_argv``: opened from ``shared`` (its
-    ``reference_share`` result) when given, else run here; once per worker either way."""
+    """The worker's ``ReferenceRun`` (``PinReferenceRun``) for ``ref_argv``: opened from
+    ``shared`` (its ``reference_share`` result) when given, else run here; once per worker
+    either way."""
     key = tuple(ref_argv)
     kept_token, reference = _references.get(key, (None, None))
     if shared is None:
@@ -59,7 +61,9 @@ def _reference(ref_argv, shared=None):
     # The token, not the object: Dask may hand a worker the same result twice.
     if reference is not None and kept_token == shared["token"]:
         return reference
-    return _keep(key, ReferenceRun.from_portable(shared["reference"]), shared["token"])
+    data = shared["reference"]
+    kind = PinReferenceRun if isinstance(data, PinReferenceData) else ReferenceRun
+    return _keep(key, kind.from_portable(data), shared["token"])
 
 
 def _forkable(argv):
@@ -69,21 +73,18 @@ def _forkable(argv):
 
 def reference_share(ref_argv):
     """A run with the unmutated design (the robot judge's baseline): ``{"outcome":
-    runner.execute(ref_argv)'s dict, "reference": its ReferenceData, "token": naming this
-    reference}`` (reference None for a run that is not forked, runs in real-clock timing or erred). This worker keeps
-    the reference opened from that data."""
+    runner.execute(ref_argv)'s dict, "reference": its ReferenceData (PinReferenceData in
+    real-clock timing), "token": naming this reference}`` (reference None for a run that is
+    not forked or erred). This worker keeps the reference opened from that data."""
     if not _forkable(ref_argv):
         return {"outcome": runner.execute(ref_argv), "reference": None, "token": None}
     shared = {"outcome": None, "reference": None, "token": uuid.uuid4().hex}
     with runner.RunOutcome() as outcome:
         with outcome.running():
             reference, stops = _build(ref_argv)
-        if isinstance(reference, ReferenceRun):
-            shared["reference"] = reference.portable()
-            # Kept as opened from the data: its images are the data's, not a second copy.
-            _reference(ref_argv, shared)
-        else:  # real-clock: kept here; other workers run their own
-            _keep(tuple(ref_argv), reference)
+        shared["reference"] = reference.portable()
+        # Kept as opened from the data: its images (journal) are the data's, not a copy.
+        _reference(ref_argv, shared)
         outcome.record(reference.result)
         outcome.out["design_stops"] = stops
     if outcome.out["summary"] is None:  # it erred: nothing to share
