@@ -25,7 +25,7 @@ from fpga_robotics.mutation.design import (
 from fpga_robotics.mutation.design_run import DEFAULT_CYCLES, mutate_design, mutate_verilog_design
 from fpga_robotics.mutation.reasons import blind_spot_reason
 from fpga_robotics.mutation.report import write_report
-from fpga_robotics.mutation.robot_judge import robot_judge
+from fpga_robotics.mutation.robot_judge import check_resume, mutants_key, robot_judge
 from fpga_robotics.mutation.scores import blind_spots, by_module, robot_score, unit_score
 from fpga_robotics.mutation.unit_judge import (
     golden_results,
@@ -418,6 +418,9 @@ def main(argv=None, prog="fpga-robotics mutate"):
         mutants = list_mutants(params, args.mutants, args.seed)
     except MutationError as exc:
         raise UsageError(str(exc).splitlines()[0]) from None
+    key = mutants_key(repr(params), mutants)
+    if args.resume and campaign is not None:
+        check_resume(out, key)
     netlist, ports = write_mutant_design(params, mutants, out)
     design = open_mutant_design(params, netlist, ports, on_build=lambda t: say(f"{t} ..."))
     build_s = time.perf_counter() - t0
@@ -468,6 +471,7 @@ def main(argv=None, prog="fpga-robotics mutate"):
             fork=args.fork,
             cones=cones,
             watch_ports=os.path.join(out, WATCH_PORTS_NAME),
+            mutants=key,
         )
         robot_s = time.perf_counter() - t2
     robot = {k: v["caught"] for k, v in robot_verdicts.items()}

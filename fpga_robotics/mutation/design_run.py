@@ -31,7 +31,7 @@ from .design import (
     with_mutant_select,
 )
 from .pin_judge import MutantPinSource, judge_pin_mutant, open_pin_mutants, pin_stimulus, pin_trace
-from .robot_judge import robot_judge
+from .robot_judge import check_resume, mutants_key, robot_judge
 from .scores import by_module, robot_score, unit_score
 
 __all__ = ["DEFAULT_CYCLES", "design_ports", "mutate_design", "mutate_verilog_design"]
@@ -64,6 +64,7 @@ def mutate_design(
     ports = design_ports(spec)
     rtlil_text = component_rtlil(spec.build())
     mutants = list_mutants(None, n, seed, rtlil_text=rtlil_text)
+    robot = _keyed(robot, out, mutants_key(rtlil_text, mutants))
     name = spec.reference.rpartition(":")[2] or spec.reference
     source = MutantPinSource(rtlil_text, ports, mutants, name)
     backend = open_pin_mutants(source, on_build=lambda t: say(f"{t} ..."))
@@ -119,6 +120,7 @@ def mutate_verilog_design(
     top = design.port_map.top
     sources = {"verilog": design.sources, "top": top, "includes": design.includes}
     mutants = list_mutants(None, n, seed, **sources)
+    robot = _keyed(robot, out, mutants_key(design.digest(), mutants))
     os.makedirs(out, exist_ok=True)
     netlist = os.path.join(out, NETLIST_NAME)
     verilog = mutant_netlist(None, mutants, **sources)
@@ -156,6 +158,15 @@ def mutate_verilog_design(
         robot=robot,
         cones_of=lambda some: mutant_cones(None, some, **sources),
     )
+
+
+def _keyed(robot, out, key):
+    """The robot judge's keyword arguments with the mutants' key; with ``resume``, checked
+    against the journal in ``out`` first (``check_resume``: before anything is written)."""
+    robot = dict(robot or {})
+    if robot.get("resume"):
+        check_resume(out, key)
+    return {**robot, "mutants": key}
 
 
 def _judge(

@@ -12,6 +12,7 @@ Every run is a ``python -m fpga_robotics.run`` argument list (the campaign's, wi
 design's resolution), so each verdict comes with the command that replays it.
 """
 
+import hashlib
 import json
 import os
 import shlex
@@ -27,10 +28,12 @@ from .cone import cone_verdict, settled_by_cone
 from .forked_runs import execute_forked, outcome_of, reference_share
 
 __all__ = [
+    "check_resume",
     "closest_to_failing",
     "judge_runs",
     "judge_runs_forked",
     "mutant_argv",
+    "mutants_key",
     "replay",
     "robot_judge",
     "run_limits",
@@ -39,6 +42,33 @@ __all__ = [
 
 #: Checks whose limit is a lower bound (the value must be at least the limit).
 _LOWER = ("min_distance_min_m", "target_in_view_min_fraction", "found_min_fraction")
+
+
+#: The robot judge's journal in the output folder (what ``--resume`` keeps).
+JOURNAL_NAME = "robot.jsonl"
+
+
+def mutants_key(design, mutants):
+    """What names a set of mutants: ``design`` (text that names the unmutated design, its
+    parameters or its source) and each mutant's Yosys command, in order. A journal row
+    carries it, so ``--resume`` keeps only verdicts of these very mutants."""
+    text = "\n".join([design, *(m.command for m in mutants)])
+    return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
+def check_resume(out_dir, key):
+    """``UsageError`` if ``out_dir``'s journal holds verdicts of other mutants than ``key``
+    names (another design, seed or ``--mutants``): call it before writing anything there."""
+    journal = os.path.join(out_dir, JOURNAL_NAME)
+    if not os.path.exists(journal):
+        return
+    with open(journal) as f:
+        keys = {json.loads(line).get("mutants") for line in f if line.strip()}
+    if keys - {key}:
+        raise UsageError(
+            f"--resume: {journal} holds verdicts of other mutants (another design, --seed "
+            "or --mutants): give the same ones, or drop --resume to judge these afresh"
+        )
 
 
 def mutant_argv(argv, netlist, ports, index, resolution):
@@ -212,6 +242,7 @@ def robot_judge(
     fork=True,
     cones=None,
     watch_ports=None,
+    mutants=None,
 ):
     """Judge the mutants ``indices`` by ``campaign``'s closed-loop runs.
 
@@ -226,7 +257,9 @@ def robot_judge(
     ``sim.mutation.mutant_cones``) reaches no output the runs read gets its verdict without
     a run (fpga_robotics.mutation.cone). ``watch_ports``: the netlist's port map with its
     watch output watched (``design.write_mutant_design``); with ``fork`` the unmutated runs
-    use it, and a mutant that never acted in one of them is given it without a run."""
+    use it, and a mutant that never acted in one of them is given it without a run.
+    ``mutants``: their ``mutants_key``, in every journal row (``resume`` keeps only rows of
+    the same; ``check_resume`` refuses others before anything is written)."""
     from distributed import as_completed  # lazy: Dask costs ~1 s; only a run needs it
 
     tick = progress or (lambda n: None)
@@ -242,14 +275,15 @@ def robot_judge(
     base = [
         mutant_argv(spec.argv(), netlist, watch_ports or ports, 0, resolution) for spec in plan.runs
     ]
-    journal = os.path.join(out_dir, "robot.jsonl")
+    journal = os.path.join(out_dir, JOURNAL_NAME)
     verdicts = {}
     if resume and os.path.exists(journal):
         with open(journal) as f:
             for line in f:
                 if line.strip():
                     row = json.loads(line)
-                    verdicts[int(row["index"])] = row
+                    if row.get("mutants") == mutants:
+                        verdicts[int(row["index"])] = row
     elif os.path.exists(journal):
         os.remove(journal)
     with open_client(scheduler=scheduler, workers=workers) as client:
@@ -295,7 +329,7 @@ def robot_judge(
                 at = plan.runs[passing[closest]].argv() if closest is not None else None
                 v["argv"] = at and mutant_argv(at, netlist, ports, k, resolution)
                 v["replay"] = replay(v["argv"]) if at else None
-                v["index"] = k
+                v["index"], v["mutants"] = k, mutants
                 verdicts[k] = v
                 f.write(json.dumps(v) + "\n")
                 tick(1)
@@ -317,7 +351,7 @@ def robot_judge(
                 at = v["run"] if v["caught"] else v["closest"]
                 v["argv"] = argvs[at] if at is not None else None
                 v["replay"] = replay(v["argv"]) if at is not None else None
-                v["index"] = k
+                v["index"], v["mutants"] = k, mutants
                 verdicts[k] = v
                 f.write(json.dumps(v) + "\n")
                 f.flush()
