@@ -46,6 +46,29 @@ def _campaign(name):
     return load_campaign_file(name)
 
 
+def _exit_code(baseline):
+    """1 when a campaign was given and none of its runs passes unmutated (no robot judge),
+    else 0."""
+    return 1 if baseline is not None and not baseline["passing"] else 0
+
+
+def _no_run_passes(baseline):
+    """With no campaign run passing unmutated: say so, and why the first ones did not pass
+    (True); else False."""
+    if baseline["passing"]:
+        return False
+    print("no run passes with the unmutated design: the robot judge has no run to judge by")
+    shown = 3
+    for argv, status, message in list(
+        zip(baseline["runs"], baseline["statuses"], baseline["messages"], strict=True)
+    )[:shown]:
+        where = " ".join(argv[argv.index("--scenario") : argv.index("--scenario") + 2])
+        print(f"  {where}: {status}" + (f": {message}" if message else ""))
+    if len(baseline["runs"]) > shown:
+        print(f"  ... and {len(baseline['runs']) - shown} more")
+    return True
+
+
 def _report_robot(
     out,
     campaign,
@@ -66,12 +89,13 @@ def _report_robot(
     print(
         f"robot judge (campaign {campaign.name}: {n_pass} of {n_runs} runs pass unmutated): "
         f"{rs['caught']} of {rs['judged']} unit-caught mutants caught: score "
-        f"{_percent(rs['score'])}; {_robot_rate(baseline['judged_here'], robot_s)}"
-        + _settled(robot_verdicts)
+        f"{_percent(rs['score'])}; {_robot_rate(baseline, robot_s)}" + _settled(robot_verdicts)
     )
     forked = _fork_line(robot_verdicts)
     if forked:
         print(forked)
+    if _no_run_passes(baseline):
+        return
     blind = blind_spots(unit, robot)
     by_index = {m.index: m for m in mutants}
     recorded = _record_closest(out, [robot_verdicts[k] for k in blind[:recordings]], say)
@@ -126,9 +150,12 @@ def _fork_line(robot_verdicts):
     )
 
 
-def _robot_rate(judged_here, seconds):
+def _robot_rate(baseline, seconds):
     """The robot judge's rate: the mutants it judged in this run (not those ``--resume``
     kept) per minute of its wall time, the baseline runs included."""
+    judged_here = baseline["judged_here"]
+    if not baseline["passing"]:
+        return "no mutant judged"
     if not judged_here:
         return "no mutant judged in this run (all kept by --resume)"
     return f"{60 * judged_here / max(seconds, 1e-9):.0f} mutants/min"
@@ -347,7 +374,7 @@ def _main_design(args):
         for m in missed[:10]:
             print(f"  {m['describe']}")
     print(f"wrote {os.path.join(out, 'mutants.json')}")
-    return 0
+    return _exit_code(result["baseline"])
 
 
 def _report_design_robot(result, campaign):
@@ -357,14 +384,13 @@ def _report_design_robot(result, campaign):
     print(
         f"robot judge (campaign {campaign.name}: {n_pass} of {n_runs} runs pass unmutated): "
         f"{rs['caught']} of {rs['judged']} unit-caught mutants caught: score "
-        f"{_percent(rs['score'])}; {_robot_rate(baseline['judged_here'], result['robot_judge_s'])}"
+        f"{_percent(rs['score'])}; {_robot_rate(baseline, result['robot_judge_s'])}"
         + _settled({m["index"]: m["robot"] for m in result["mutants"] if m["robot"]})
     )
     forked = _fork_line({m["index"]: m["robot"] for m in result["mutants"] if m["robot"]})
     if forked:
         print(forked)
-    if not n_pass:
-        print("no run passes with the unmutated design: the robot judge has no run to judge by")
+    if _no_run_passes(baseline):
         return
     blind = [m for m in result["mutants"] if m["robot"] is not None and not m["robot"]["caught"]]
     if blind:
@@ -559,4 +585,4 @@ def main(argv=None, prog="fpga-robotics mutate"):
         for m in missed[:10]:
             print(f"  {m.describe()}")
     print(f"wrote {os.path.join(out, 'mutants.json')}")
-    return 0
+    return _exit_code(baseline)

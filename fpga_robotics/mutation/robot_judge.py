@@ -151,6 +151,16 @@ def run_limits(outcome):
     )
 
 
+def _failed_checks(outcome):
+    """A run's failed checks as text ("" when none failed)."""
+    failed = [
+        c["name"]
+        for c in (outcome.get("summary") or {}).get("checks", ())
+        if c.get("passed") is False
+    ]
+    return f"failed checks: {', '.join(failed)}" if failed else ""
+
+
 def judge_runs(argvs, limits=None, execute=None):
     """The Dask task of one mutant: its runs in order until one does not pass. Returns
     ``{"caught", "run", "status", "message", "failed_checks", "closest", "runs", "wall_s"}``
@@ -247,9 +257,10 @@ def robot_judge(
     """Judge the mutants ``indices`` by ``campaign``'s closed-loop runs.
 
     Returns ``(baseline, verdicts)``: ``baseline`` is ``{"runs": [argv at mutsel 0, ...],
-    "passing": [their indices], "statuses": [...], "judged_here": how many mutants this call
-    judged (the others were kept from the journal)}``; ``verdicts`` is ``{index: judge_runs
-    result}`` (with the replay command of the run that caught it, or of the closest run).
+    "passing": [their indices], "statuses": [...], "messages": [why each did not pass, or
+    ""], "judged_here": how many mutants this call judged (the others were kept from the
+    journal)}``; ``verdicts`` is ``{index: judge_runs result}`` (with the replay command of
+    the run that caught it, or of the closest run; empty when no run passes unmutated).
     Verdicts are appended to ``out_dir/robot.jsonl`` as they come (``resume`` keeps the
     ones there). With ``fork`` each mutant's run is forked from the unmutated design's
     (fpga_robotics.mutation.forked_runs): the same verdicts, most of the world not
@@ -292,6 +303,19 @@ def robot_judge(
         outcomes, shared = _baseline(client, base, tick, fork)
         passing = [i for i, o in enumerate(outcomes) if o["status"] == "pass"]
         statuses = [o["status"] for o in outcomes]
+        messages = [o.get("message") or _failed_checks(o) for o in outcomes]
+        if not passing:  # nothing to judge by: no verdict, rather than a pass of no run
+            say(f"robot judge: no run of the {len(base)} passes with the unmutated design")
+            return (
+                {
+                    "runs": base,
+                    "passing": [],
+                    "statuses": statuses,
+                    "messages": messages,
+                    "judged_here": 0,
+                },
+                {},
+            )
         limits = [run_limits(outcomes[i]) for i in passing]
         todo = [k for k in indices if k not in verdicts]
         say(
@@ -357,7 +381,13 @@ def robot_judge(
                 f.flush()
                 tick(1)
     return (
-        {"runs": base, "passing": passing, "statuses": statuses, "judged_here": len(todo)},
+        {
+            "runs": base,
+            "passing": passing,
+            "statuses": statuses,
+            "messages": messages,
+            "judged_here": len(todo),
+        },
         verdicts,
     )
 

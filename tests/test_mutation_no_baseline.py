@@ -1,0 +1,54 @@
+"""A campaign none of whose runs passes with the unmutated design cannot judge a mutant:
+``mutate`` says why each run did not pass, judges no mutant (no verdict of "passed every
+run" from no run at all) and exits with 1."""
+
+import json
+from pathlib import Path
+
+import pytest
+
+from fpga_robotics import cli
+
+DATA = Path(__file__).parent / "data"
+
+
+@pytest.mark.slow  # a Verilator build of the mutant netlist, a Dask worker
+def test_no_passing_run_judges_no_mutant_and_says_why(tmp_path, capsys):
+    campaign = tmp_path / "strict.toml"
+    # bump_stop drives at 300 DPS: a limit of 100 fails its own run.
+    campaign.write_text(
+        f'scenarios = ["{DATA / "bump_wall.toml"}"]\nseeds = "0"\nduration = 2.0\n'
+        'set = ["checks.max_wheel_command_dps=100"]\n'
+    )
+    out = tmp_path / "m"
+    with pytest.raises(SystemExit) as info:
+        cli.main(
+            [
+                "mutate",
+                "--design",
+                f"verilog:{DATA / 'bump_stop.v'}",
+                "--ports",
+                str(DATA / "bump_stop_ports.toml"),
+                "--mutants",
+                "4",
+                "--cycles",
+                "2000",
+                "--campaign",
+                str(campaign),
+                "--workers",
+                "1",
+                "--out",
+                str(out),
+                "--quiet",
+            ]
+        )
+    text = capsys.readouterr().out
+    assert info.value.code == 1
+    assert "no run passes with the unmutated design" in text
+    assert "bump_wall.toml: fail: failed checks: max_wheel_command_dps" in text
+    assert "0 of 0 unit-caught mutants caught: score n/a; no mutant judged" in text
+    result = json.loads((out / "mutants.json").read_text())
+    assert result["baseline"]["passing"] == [] and result["baseline"]["statuses"] == ["fail"]
+    assert all(m["robot"] is None for m in result["mutants"])
+    assert result["robot"]["judged"] == 0
+    assert not (out / "robot.jsonl").exists() or not (out / "robot.jsonl").read_text().strip()
