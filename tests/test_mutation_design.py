@@ -215,6 +215,12 @@ def test_robot_judge_of_a_users_design_matches_its_runs(tmp_path, capsys):
         ),
         (["--design", "wall_stop.py:WallStop", "--param", "nope"], "--param must be NAME=VALUE"),
         (["--cycles", "5"], "--param, --ports and --cycles go with --design REF"),
+        (
+            ["--design", "wall_stop.py:WallStop", "--width", "80", "--kp-num", "5"],
+            "--width, --kp-num: FollowTarget's options",
+        ),
+        (["--design", "wall_stop.py:WallStop", "--against", "model"], "--against: FollowTarget"),
+        (["--design", "wall_stop.py:WallStop", "--preset", "published"], "--preset: FollowTarget"),
     ],
 )
 def test_bad_design_arguments_are_one_line(argv, message, capsys, monkeypatch):

@@ -12,11 +12,13 @@ import os
 import sys
 import time
 import tomllib
+from dataclasses import fields
 
 from fpga_robotics.cli.errors import UsageError
 from fpga_robotics.cli.param_options import add_param_arguments, params_from_args
 from fpga_robotics.cli.parser import CommandParser
 from fpga_robotics.designs.reference import resolve_design
+from fpga_robotics.hw.params import FollowTargetParams
 from fpga_robotics.mutation.design import (
     WATCH_PORTS_NAME,
     open_mutant_design,
@@ -251,7 +253,7 @@ def build_parser(prog="fpga-robotics mutate"):
     p.add_argument(
         "--against",
         choices=("model", "design"),
-        default="model",
+        default=None,
         help="FollowTarget's unit judge compares each mutant with the golden model "
         "(default) or with the unmutated design on the same frames",
     )
@@ -302,8 +304,21 @@ def _design_params(items):
     return params
 
 
+def _followtarget_options(args):
+    """The FollowTarget options given (``--preset``, its parameters, ``--against``), as typed."""
+    given = [name for name in ("preset", "against") if getattr(args, name) is not None]
+    given += [f.name for f in fields(FollowTargetParams) if getattr(args, f.name, None) is not None]
+    return ["--" + name.replace("_", "-") for name in given]
+
+
 def _main_design(args):
     """``--design REF``: the mutants of a design of one's own against itself."""
+    given = _followtarget_options(args)
+    if given:
+        raise UsageError(
+            f"{', '.join(given)}: FollowTarget's options; with --design REF the mutants are "
+            "judged against the unmutated design (give its parameters as --param NAME=VALUE)"
+        )
     verilog = args.design.startswith("verilog:")
     if verilog and args.param:
         raise UsageError(
@@ -426,6 +441,7 @@ def main(argv=None, prog="fpga-robotics mutate"):
     _check(args)
     if args.design is not None and args.design != "follow_target":
         return _main_design(args)
+    args.against = args.against or "model"
     if args.param or args.cycles is not None or args.ports is not None:
         raise UsageError(
             "--param, --ports and --cycles go with --design REF (a design of your own)"
