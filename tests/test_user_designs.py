@@ -197,6 +197,24 @@ BAD = [
         "Sized takes no parameter 'depth'; it takes: width",
     ),
     ("a syntax error", "syntax_error.py:Broken", {}, "loading syntax_error.py (line 1)"),
+    (
+        "an elaborate that raises",
+        "unelaborated.py:ElaborateRaises",
+        {},
+        "does not elaborate: ValueError: no such speed table (unelaborated.py:17)",
+    ),
+    (
+        "a signal driven from two domains",
+        "unelaborated.py:DrivenTwice",
+        {},
+        "does not elaborate: SyntaxError: Driver-driver conflict",
+    ),
+    (
+        "an elaborate that returns nothing",
+        "unelaborated.py:NoReturn",
+        {},
+        "returned None; missing return statement?",
+    ),
     ("params of a built-in", "follow_target", {"speed": 1}, "takes its parameters from"),
     ("an unknown name", "follow_me", {}, "unknown design 'follow_me'"),
 ]
@@ -207,6 +225,7 @@ def test_bad_references_are_one_line_errors(
     case, reference, params, message, tmp_path, capsys, monkeypatch
 ):
     shutil.copy(DESIGNS / "broken.py", tmp_path / "broken.py")
+    shutil.copy(DESIGNS / "unelaborated.py", tmp_path / "unelaborated.py")
     (tmp_path / "syntax_error.py").write_text("class Broken(\n")  # never closed
     with pytest.raises(DesignError, match=message.replace("(", r"\(").replace(")", r"\)")):
         resolve_design(reference, params, base=tmp_path)
@@ -234,6 +253,29 @@ def test_bad_references_are_one_line_errors(
     assert len(err.strip().splitlines()) == 1, err
     assert message in err
     assert sorted(p.name for p in tmp_path.iterdir() if p.name != "__pycache__") == before
+
+
+def test_a_design_without_a_clock_is_refused_where_it_would_be_simulated(
+    tmp_path, capsys, monkeypatch
+):
+    # Combinational logic only: it resolves (it may be exported for a board), but nothing
+    # here can clock it, so run and mutate say so in one line.
+    shutil.copy(DESIGNS / "unelaborated.py", tmp_path / "unelaborated.py")
+    spec = resolve_design("unelaborated.py:NoClock", {}, base=tmp_path)
+    assert not spec.clocked
+    assert resolve_design(str(DESIGNS / "wall_stop.py") + ":WallStop", {}).clocked
+    message = "has no clock: nothing in its sync domain (m.d.sync)"
+    monkeypatch.chdir(tmp_path)
+    for argv in (
+        ["run", "--scenario", str(WALL_STOP), "--design", "unelaborated.py:NoClock",
+         "--rerun", "off", "--set", "design.params={}"],
+        ["mutate", "--design", "unelaborated.py:NoClock", "--mutants", "2", "--quiet"],
+    ):  # fmt: skip
+        code, _, err = _cli(argv, capsys)
+        assert code == 2 and len(err.strip().splitlines()) == 1 and message in err, err
+    assert sorted(p.name for p in tmp_path.iterdir() if p.name != "__pycache__") == [
+        "unelaborated.py"
+    ]
 
 
 def test_a_scenario_names_its_design_relative_to_its_folder(tmp_path):

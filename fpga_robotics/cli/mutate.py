@@ -336,6 +336,7 @@ def _main_design(args):
         name = os.path.splitext(os.path.basename(files[0]))[0]
     else:
         spec = resolve_design(args.design, _design_params(args.param))
+        spec.require_clock()
         name = spec.reference.rpartition(":")[2]
     campaign = _campaign(args.campaign) if args.campaign is not None else None
     out = args.out or os.path.join("runs", "mutation", f"{name}-n{args.mutants}-s{args.seed}")

@@ -431,6 +431,8 @@ def _open_pin_design(args, scenario):
         return design
     try:
         return make_pin_backend(args.backend, scenario, on_build=tell)
+    except UsageError:  # the design's own (no clock ...): already what to fix
+        raise
     except (BackendError, PinError, ValueError, ImportError) as exc:
         raise UsageError(f"backend {args.backend!r} cannot run here: {exc}") from None
 

@@ -27,7 +27,10 @@ import importlib
 import importlib.metadata
 import importlib.util
 import inspect
+import re
 import sys
+import traceback
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -86,6 +89,8 @@ class DesignSpec:
         What the closed loop runs (``fpga_robotics.designs.builtin.Top``).
     port_map : PortMap or None
         A Verilog design's port map as read (``sim.backends.port_map.PortMap``).
+    clocked : bool
+        Whether it has a clock (an Amaranth design of one's own may have none).
     """
 
     reference: str
@@ -97,10 +102,21 @@ class DesignSpec:
     params: dict = field(default_factory=dict)
     top: Top = None
     port_map: object = None
+    clocked: bool = True
 
     @property
     def camera(self):
         return "camera" in self.bindings
+
+    def require_clock(self):
+        """``DesignError`` for a design without a clock (nothing in its ``sync`` domain): a
+        simulator here clocks it (an exported design need not have one)."""
+        if not self.clocked:
+            raise DesignError(
+                f"design {self.reference!r} has no clock: nothing in its sync domain "
+                "(m.d.sync). The simulators here clock the design, so give it at least one "
+                "register"
+            )
 
     def build(self):
         """A new Amaranth component of the design (a built-in one at its default
@@ -224,6 +240,7 @@ def _amaranth_spec(reference, frozen_params, _stamp):
     _check_params(target, params, reference)
     factory = functools.partial(_call, target, params, reference)
     component = factory()
+    clocked = _check_elaborates(component, target, reference)
     ports = component_ports(component)
     bindings = bindings_of(component, ports)
     extra = extra_outputs_of(ports, bindings)
@@ -239,7 +256,50 @@ def _amaranth_spec(reference, frozen_params, _stamp):
         component=factory,
         takes_follow_target_params=False,
     )
-    return DesignSpec(reference, "amaranth", description, ports, bindings, extra, params, top)
+    return DesignSpec(
+        reference, "amaranth", description, ports, bindings, extra, params, top, clocked=clocked
+    )
+
+
+def _check_elaborates(component, target, reference):
+    """``DesignError`` (one line) if ``component``, made by the user's ``target``, does not
+    elaborate to a netlist: its ``elaborate`` raises or returns nothing, or it drives a
+    signal from two places. Found here, before any simulator is built for it. Returns
+    whether it has a clock (anything in its ``sync`` domain)."""
+    from amaranth.back import rtlil  # lazy: only a design of one's own is converted here
+    from amaranth.hdl import UnusedElaboratable  # lazy: as rtlil
+
+    from fpga_robotics.hw.verilog import verilog_ports  # lazy: as rtlil
+
+    # Its ports as the generated Verilog has them (constant members are none).
+    ports = {name: (value, None) for name, (value, _) in verilog_ports(component).items()}
+    try:
+        with warnings.catch_warnings(record=True) as said:
+            warnings.simplefilter("always")
+            text = rtlil.convert(component, ports=ports)
+    except Exception as exc:  # noqa: BLE001 - the user's elaborate may raise anything
+        # The modules its elaborate made are never used now: no warning for each at exit.
+        warnings.filterwarnings("ignore", category=UnusedElaboratable)
+        # What Amaranth said on the way ("elaborate() returned None; missing return?").
+        hint = next((f"; {w.message}" for w in said if w.category is UserWarning), "")
+        raise DesignError(
+            f"design {reference!r} does not elaborate: {type(exc).__name__}: "
+            f"{_first_line(exc)}{_user_line(exc, target)}{hint}"
+        ) from None
+    for w in said:  # a design that elaborates keeps its warnings
+        warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+    return bool(re.search(r"^  wire .*\binput \d+ +\\clk$", text, re.MULTILINE))
+
+
+def _user_line(exc, target):
+    """`` (file.py:LINE)``: where in the design's own file ``exc`` was raised ("" if not
+    there)."""
+    try:
+        source = inspect.getsourcefile(target)
+    except TypeError:
+        return ""
+    frames = [f for f in traceback.extract_tb(exc.__traceback__) if f.filename == source]
+    return f" ({Path(source).name}:{frames[-1].lineno})" if frames else ""
 
 
 def _load_target(reference):
@@ -341,6 +401,11 @@ def _check_params(target, params, reference):
         signature = inspect.signature(target)
     except (TypeError, ValueError):
         return
+    from amaranth.lib import wiring  # lazy: Amaranth (~0.3 s)
+
+    if inspect.isclass(target) and target.__init__ is wiring.Component.__init__:
+        # Its signature is in its annotations: Component's own arguments are not its params.
+        signature = inspect.Signature()
     known = {
         n: p
         for n, p in signature.parameters.items()

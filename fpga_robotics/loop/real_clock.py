@@ -63,8 +63,9 @@ def scenario_top(scenario):
     (``design.verilog``) the one its port map describes."""
     if scenario.foreign is not None:
         return foreign_top(load_port_map(scenario.foreign.ports))
-
-    return resolve_design(scenario.top, scenario.design_params).top
+    spec = resolve_design(scenario.top, scenario.design_params)
+    spec.require_clock()
+    return spec.top
 
 
 def pin_design_source(scenario):

@@ -1,0 +1,37 @@
+"""Designs that build but do not elaborate, or have no clock: each is one clear line
+(tests/test_user_designs.py)."""
+
+from amaranth import Module, signed
+from amaranth.lib import wiring
+from amaranth.lib.wiring import In, Out
+
+
+class _Wheels(wiring.Component):
+    line: In(2)
+    motor_left: Out(signed(16))
+    motor_right: Out(signed(16))
+
+
+class ElaborateRaises(_Wheels):
+    def elaborate(self, platform):
+        raise ValueError("no such speed table")
+
+
+class DrivenTwice(_Wheels):
+    def elaborate(self, platform):
+        m = Module()
+        m.d.comb += self.motor_left.eq(1)
+        m.d.sync += self.motor_left.eq(2)
+        return m
+
+
+class NoReturn(_Wheels):
+    def elaborate(self, platform):
+        Module()
+
+
+class NoClock(_Wheels):
+    def elaborate(self, platform):
+        m = Module()
+        m.d.comb += [self.motor_left.eq(self.line * 100), self.motor_right.eq(100)]
+        return m
