@@ -6,6 +6,7 @@ counters.py): the unmutated netlist's trace must be the model's, and a mutant is
 exactly when its trace differs from the model's."""
 
 import json
+import re
 from pathlib import Path
 
 import pytest
@@ -214,7 +215,7 @@ def test_robot_judge_of_a_users_design_matches_its_runs(tmp_path, capsys):
             "unknown campaign 'nosuch'",
         ),
         (["--design", "wall_stop.py:WallStop", "--param", "nope"], "--param must be NAME=VALUE"),
-        (["--cycles", "5"], "--param, --ports and --cycles go with --design REF"),
+        (["--cycles", "5"], "--param, --ports, --cycles and --resolution go with --design REF"),
         (
             ["--design", "wall_stop.py:WallStop", "--width", "80", "--kp-num", "5"],
             "--width, --kp-num: FollowTarget's options",
@@ -356,6 +357,51 @@ def test_a_verilog_design_that_includes_a_header_is_mutated(tmp_path, capsys):
     assert all("red_count.v:" in m["describe"] for m in result["mutants"])
 
 
+@pytest.mark.slow  # a Verilator build of the mutant netlist
+def test_a_verilog_camera_design_s_unit_judge_streams_frames(tmp_path, capsys):
+    """red_count.v counts a frame's red pixels at the last pixel of its 120th line: only a
+    stream framed as the camera frames it (first, last of each line) ever gives it a count.
+    Its unmutated netlist drives on from the end of the first frame, as counted by hand."""
+    from fpga_robotics.designs.builtin import connector_kinds
+    from fpga_robotics.sim.backends.foreign import ForeignDesign
+    from fpga_robotics.sim.pins.compiled import VerilatorPins
+    from fpga_robotics.sim.pins.verilog import VerilogPinSource
+
+    data = Path(__file__).parent / "data" / "red_count"
+    out, cycles, (width, height) = tmp_path / "m", 3000, (8, 120)
+    argv = ["--design", f"verilog:{data / 'red_count.v'}", "--ports"]
+    argv += [str(data / "red_count_ports.toml"), "--mutants", "8", "--cycles", str(cycles)]
+    argv += ["--resolution", f"{width}x{height}", "--out", str(out), "--quiet"]
+    code, _, _ = _cli(["mutate", *argv], capsys)
+    assert code == 0
+    result = json.loads((out / "mutants.json").read_text())
+    assert result["stimulus"]["frame"] == [width, height]
+    assert {"pixels__valid", "pixels__payload"} <= set(result["stimulus"]["inputs"])
+    source = VerilogPinSource(
+        ForeignDesign(
+            [out / "mutants.v"], out / "mutants_ports.toml", pins=True,
+            connector_kinds=connector_kinds(),
+        ),
+        stream=False,
+    )  # fmt: skip
+    backend = VerilatorPins(source)
+    try:
+        ports = {p: port for p, port in backend.ports.items() if p != "mutsel"}
+        stimulus = pin_stimulus(ports, cycles, 0, (width, height))
+        # The first frame's pixels are edges 1 .. W*H; red: the red nibble at least 8.
+        last = width * height
+        first_frame = [v for e, p, v in stimulus if p == "pixels__payload" and e <= last]
+        red = sum((v >> 8) & 0xF >= 8 for v in first_frame)
+        assert len(first_frame) == last and red > 20  # MIN_PIXELS
+        model = {name: [(0, 0), (last, 200)] for name in ("motor_left", "motor_right")}
+        assert pin_trace(backend, 0, stimulus, cycles, list(model)) == model
+        for m in result["mutants"]:
+            got = pin_trace(backend, m["index"], stimulus, cycles, list(model))
+            assert m["unit"]["caught"] == (got != model), m["describe"]
+    finally:
+        backend.close()
+
+
 @pytest.mark.slow  # a Verilator build of the mutant netlist, closed-loop runs of its mutants
 def test_robot_judge_of_a_camera_design(tmp_path, capsys):
     """``mutate --design REF --campaign C`` of NearRed, a camera design of one's own: the
@@ -389,11 +435,17 @@ def test_robot_judge_of_a_camera_design(tmp_path, capsys):
     for index, v in judged.items():
         again = runner.execute(v["argv"])
         assert again["status"] == v["status"], index
+
+    # A mutant whose frame count comes out 2048 or more above the design's (seed 1's third:
+    # bit 11 of the count's sum stuck at 1) is near from its first frame on (near_pixels
+    # 300), so the robot never drives: it stays 2.5 m away.
+    def count_raised(effect):
+        found = re.search(r"red_count (\d+) -> (\d+)", effect)
+        return found is not None and int(found[2]) - int(found[1]) >= 2048
+
     never_drives = [
-        m
-        for m in result["mutants"]
-        if m["unit"]["caught"] and "motor_left 400 -> 0" in m["unit"]["effect"]
+        m for m in result["mutants"] if m["unit"]["caught"] and count_raised(m["unit"]["effect"])
     ]
-    assert never_drives  # seed 1's third mutant holds near high
+    assert never_drives
     for m in never_drives:
         assert judged[m["index"]]["failed_checks"] == ["mean_distance_max_m"]

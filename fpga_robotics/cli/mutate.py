@@ -24,7 +24,12 @@ from fpga_robotics.mutation.design import (
     open_mutant_design,
     write_mutant_design,
 )
-from fpga_robotics.mutation.design_run import DEFAULT_CYCLES, mutate_design, mutate_verilog_design
+from fpga_robotics.mutation.design_run import (
+    DEFAULT_CYCLES,
+    DEFAULT_FRAME,
+    mutate_design,
+    mutate_verilog_design,
+)
 from fpga_robotics.mutation.reasons import blind_spot_reason
 from fpga_robotics.mutation.report import write_report
 from fpga_robotics.mutation.robot_judge import check_resume, mutants_key, robot_judge
@@ -266,6 +271,12 @@ def build_parser(prog="fpga-robotics mutate"):
         "the unmutated design on seeded random inputs, cycle by cycle",
     )
     p.add_argument(
+        "--resolution",
+        metavar="WxH",
+        help="with --design, a camera design's unit judge streams frames of this size "
+        "(default 160x120)",
+    )
+    p.add_argument(
         "--param",
         action="append",
         default=[],
@@ -304,6 +315,14 @@ def _design_params(items):
     return params
 
 
+def _resolution(text):
+    """``WxH`` as (width, height); ``UsageError`` otherwise."""
+    w, x, h = text.lower().partition("x")
+    if not (x and w.isdigit() and h.isdigit() and 1 <= int(w) <= 4096 and 1 <= int(h) <= 4096):
+        raise UsageError(f"--resolution must be WIDTHxHEIGHT such as 160x120, got {text!r}")
+    return int(w), int(h)
+
+
 def _followtarget_options(args):
     """The FollowTarget options given (``--preset``, its parameters, ``--against``), as typed."""
     given = [name for name in ("preset", "against") if getattr(args, name) is not None]
@@ -326,6 +345,7 @@ def _main_design(args):
         )
     if not verilog and args.ports is not None:
         raise UsageError("--ports is the port map of a Verilog design: it goes with verilog:FILES")
+    frame = _resolution(args.resolution) if args.resolution is not None else DEFAULT_FRAME
     cycles = DEFAULT_CYCLES if args.cycles is None else args.cycles
     if not 1 <= cycles <= 100_000_000:
         raise UsageError(f"--cycles must be 1..100000000, got {cycles}")
@@ -352,7 +372,7 @@ def _main_design(args):
         "resume": args.resume,
         "fork": args.fork,
     }
-    judged = {"say": say, "campaign": campaign, "robot": robot}
+    judged = {"say": say, "campaign": campaign, "robot": robot, "frame": frame}
     try:
         if verilog:
             result = mutate_verilog_design(
@@ -443,9 +463,10 @@ def main(argv=None, prog="fpga-robotics mutate"):
     if args.design is not None and args.design != "follow_target":
         return _main_design(args)
     args.against = args.against or "model"
-    if args.param or args.cycles is not None or args.ports is not None:
+    if args.param or args.cycles is not None or args.ports is not None or args.resolution:
         raise UsageError(
-            "--param, --ports and --cycles go with --design REF (a design of your own)"
+            "--param, --ports, --cycles and --resolution go with --design REF (a design of "
+            "your own; FollowTarget's frame size is --width and --height)"
         )
     params = params_from_args(args)
     campaign = _campaign(args.campaign) if args.campaign is not None else None

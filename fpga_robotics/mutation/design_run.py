@@ -30,14 +30,29 @@ from .design import (
     netlist_has_reset,
     with_mutant_select,
 )
-from .pin_judge import MutantPinSource, judge_pin_mutant, open_pin_mutants, pin_stimulus, pin_trace
+from .pin_judge import (
+    MutantPinSource,
+    judge_pin_mutant,
+    open_pin_mutants,
+    pin_stimulus,
+    pin_trace,
+    streams_frames,
+)
 from .robot_judge import check_resume, mutants_key, robot_judge
 from .scores import by_module, robot_score, unit_score
 
-__all__ = ["DEFAULT_CYCLES", "design_ports", "mutate_design", "mutate_verilog_design"]
+__all__ = [
+    "DEFAULT_CYCLES",
+    "DEFAULT_FRAME",
+    "design_ports",
+    "mutate_design",
+    "mutate_verilog_design",
+]
 
 #: Cycles of random stimulus per mutant by default (five 20 ms ultrasound periods at 1 MHz).
 DEFAULT_CYCLES = 100_000
+#: The frames a camera design's unit judge streams by default (width, height): the camera's.
+DEFAULT_FRAME = (160, 120)
 
 
 def design_ports(spec):
@@ -52,14 +67,25 @@ def design_ports(spec):
 
 
 def mutate_design(
-    spec, n, seed, cycles, out, *, stimulus_seed=0, say=print, campaign=None, robot=None
+    spec,
+    n,
+    seed,
+    cycles,
+    out,
+    *,
+    stimulus_seed=0,
+    say=print,
+    campaign=None,
+    robot=None,
+    frame=DEFAULT_FRAME,
 ):
     """Mutants of ``spec`` (a resolved Amaranth ``DesignSpec``) judged on ``cycles`` cycles;
     writes ``out/mutants.json`` (and the mutant netlist with its port map, for the robot
     judge) and returns its content. With ``campaign`` the mutants the unit judge catches go
     on to the robot judge (``robot_judge.robot_judge`` with the keyword arguments ``robot``:
     workers, scheduler, resume, fork): the campaign's runs in closed loop, each with the
-    mutant netlist as its Verilog design."""
+    mutant netlist as its Verilog design. ``frame``: (width, height) of the frames a camera
+    design's pixel stream carries in the unit judge (pin_judge)."""
     t0 = time.perf_counter()
     ports = design_ports(spec)
     rtlil_text = component_rtlil(spec.build())
@@ -89,6 +115,7 @@ def mutate_design(
         cycles,
         out,
         stimulus_seed=stimulus_seed,
+        frame=frame,
         say=say,
         campaign=campaign,
         robot=robot,
@@ -108,12 +135,13 @@ def mutate_verilog_design(
     say=print,
     campaign=None,
     robot=None,
+    frame=DEFAULT_FRAME,
 ):
     """``mutate_design`` for a Verilog design: ``files`` with its port map ``ports_path``.
     Yosys reads the files (``read_verilog``) and mutates the map's top module; the mutant
     netlist's port map is the design's with ``mutsel`` a ``[runtime]`` input, and the unit
-    judge drives the inputs the map gives the pin backend (its connector pins, ``[runtime]``
-    inputs aside)."""
+    judge drives every input the map gives the pin backend (its connector pins, the pixel
+    stream's and colour select's ports; ``[runtime]`` inputs aside)."""
 
     t0 = time.perf_counter()
     design = ForeignDesign(files, ports_path, pins=True, connector_kinds=connector_kinds())
@@ -134,13 +162,14 @@ def mutate_verilog_design(
         watch_map = None
     else:
         write_atomic(watch_map, watched, what="port map")
+    # The pixel ports driven as any input, each edge at random (as an Amaranth design's).
     source = VerilogPinSource(
-        ForeignDesign([netlist], port_map, pins=True, connector_kinds=connector_kinds())
+        ForeignDesign([netlist], port_map, pins=True, connector_kinds=connector_kinds()),
+        stream=False,
     )
     backend = VerilatorPins(source, on_build=lambda t: say(f"{t} ..."))
     build_s = time.perf_counter() - t0
-    driven = {p: port for p, port in backend.ports.items() if p not in (source.pixels or ())}
-    driven = {p: port for p, port in driven.items() if p not in source.runtime}
+    driven = {p: port for p, port in backend.ports.items() if p not in source.runtime}
     driven[MUTATION_SELECT] = backend.ports[MUTATION_SELECT]
     return _judge(
         {"reference": "verilog:" + ",".join(str(f) for f in files), "ports": str(ports_path)},
@@ -153,6 +182,7 @@ def mutate_verilog_design(
         cycles,
         out,
         stimulus_seed=stimulus_seed,
+        frame=frame,
         say=say,
         campaign=campaign,
         robot=robot,
@@ -181,6 +211,7 @@ def _judge(
     out,
     *,
     stimulus_seed,
+    frame,
     say,
     campaign,
     robot,
@@ -191,7 +222,8 @@ def _judge(
     writes and returns ``mutants.json``'s content."""
     netlist, port_map, watch_map = files
     outputs = [p for p, port in ports.items() if port.direction == "out"]
-    stimulus = pin_stimulus(ports, cycles, stimulus_seed)
+    framed = streams_frames(ports)
+    stimulus = pin_stimulus(ports, cycles, stimulus_seed, frame if framed else None)
     try:
         t1 = time.perf_counter()
         reference = pin_trace(backend, 0, stimulus, cycles, outputs)
@@ -239,7 +271,11 @@ def _judge(
         "stimulus": {
             "cycles": cycles,
             "seed": stimulus_seed,
-            "inputs": [p for p, port in ports.items() if port.direction == "in"],
+            "inputs": [
+                p for p, port in ports.items() if port.direction == "in" and p != MUTATION_SELECT
+            ],
+            # The pixel stream's frames (width, height), for a camera design.
+            "frame": list(frame) if framed else None,
         },
         "build_and_list_s": round(build_s, 2),
         "unit_judge_s": round(unit_s, 2),

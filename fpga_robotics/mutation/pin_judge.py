@@ -1,10 +1,13 @@
-"""The unit judge of a design without a camera: each mutant against the unmutated design on
-the same pin stimulus, cycle by cycle.
+"""The unit judge of a design on pins: each mutant against the unmutated design on the same
+pin stimulus, cycle by cycle.
 
 The stimulus is seeded random: every input port (``mutsel`` aside) changes, at each clock
 edge with probability ``CHANGE_PROBABILITY``, to a new random value of its width, so a bit
 holds for a few cycles on average and long enough now and then for counters and pulse
-measurements to see it. The mutant netlist (every mutant behind ``mutsel``) is compiled once
+measurements to see it. A camera design's pixel stream (``pixels__valid``,
+``pixels__payload``) carries frames instead, as the camera gives them: random RGB444 pixels
+in raster order at one a cycle, the first pixel flagged ``first`` and each line's last
+``last``, a line's time without pixels between frames, for as many frames as the cycles hold. The mutant netlist (every mutant behind ``mutsel``) is compiled once
 as a Verilator pin model (sim/pins); each run starts from a reset with ``mutsel`` held, applies
 the same stimulus, and records every change of every output (the model stops at each one).
 ``mutsel = 0`` gives the reference. A mutant is *caught* when any output's changes differ
@@ -30,10 +33,15 @@ __all__ = [
     "open_pin_mutants",
     "pin_stimulus",
     "pin_trace",
+    "streams_frames",
 ]
 
 #: The chance that an input takes a new random value at a clock edge.
 CHANGE_PROBABILITY = 1 / 8
+#: A camera design's pixel stream: (valid, payload) inputs.
+STREAM_PORTS = ("pixels__valid", "pixels__payload")
+#: The payload's flags above its RGB444 pixel.
+_FIRST, _LAST = 1 << 12, 1 << 13
 
 
 class MutantPinSource:
@@ -61,13 +69,23 @@ class MutantPinSource:
         return {"mutants.v": self.verilog}, ["mutants.v"]
 
 
-def pin_stimulus(ports, cycles, seed):
+def streams_frames(ports):
+    """Whether ``ports`` (name -> ``Port``) take a camera's pixel stream."""
+    return all(name in ports and ports[name].direction == "in" for name in STREAM_PORTS)
+
+
+def pin_stimulus(ports, cycles, seed, frame=None):
     """``[(edge, input, value)]``: the seeded random changes of every input (``ports``:
-    name -> ``Port``; ``mutsel`` left out) over ``cycles`` edges, in edge order."""
+    name -> ``Port``; ``mutsel`` left out) over ``cycles`` edges, in edge order; with
+    ``frame`` (width, height) and a pixel stream (``streams_frames``), frames of random
+    pixels on it (module doc)."""
     rng = np.random.default_rng(seed)
     changes = []
+    framed = frame is not None and streams_frames(ports)
     for port in ports.values():
         if port.direction != "in" or port.name == MUTATION_SELECT:
+            continue
+        if framed and port.name in STREAM_PORTS:
             continue
         edges = np.flatnonzero(rng.random(cycles) < CHANGE_PROBABILITY) + 1
         lo, hi = (
@@ -77,7 +95,27 @@ def pin_stimulus(ports, cycles, seed):
         )
         values = rng.integers(lo, hi, size=len(edges), dtype=np.int64)
         changes += [(int(e), port.name, int(v)) for e, v in zip(edges, values)]
+    if framed:
+        changes += _frames(rng, frame, cycles)
     return sorted(changes)
+
+
+def _frames(rng, frame, cycles):
+    """The pixel stream's changes: frames of random pixels from edge 1 (module doc)."""
+    width, height = frame
+    valid, payload = STREAM_PORTS
+    flags = np.zeros(width * height, np.int64)
+    flags[width - 1 :: width] |= _LAST
+    flags[0] |= _FIRST
+    changes, start = [], 1
+    while start <= cycles:
+        pixels = rng.integers(0, 1 << 12, size=width * height, dtype=np.int64) | flags
+        shown = min(width * height, cycles - start + 1)
+        changes.append((start, valid, 1))
+        changes += [(start + k, payload, int(pixels[k])) for k in range(shown)]
+        changes.append((start + width * height, valid, 0))
+        start += width * (height + 1)  # a line's time without pixels between frames
+    return [c for c in changes if c[0] <= cycles]
 
 
 def pin_trace(backend, index, stimulus, cycles, outputs):

@@ -26,13 +26,14 @@ class VerilogPinSource:
     ``frame_done`` when the map has a pixel stream, the outputs the map names (``found``,
     ``motor_left``, ...; absent ones are not ports), ``filtered__*`` with ``[filtered]``,
     every connector port under the design's own name, and with ``[watch]`` the bits its
-    output rose in since the reset (``fr_watch_any_0``, ...: ``watch``).
+    output rose in since the reset (``fr_watch_any_0``, ...: ``watch``). ``stream=False``:
+    the pixel ports are plain inputs (no ``stream_frame``).
     """
 
     #: The wrapper's module: the pin harness's model (``--prefix Vfollow_target``).
     verilog_top = "fr_foreign_top"
 
-    def __init__(self, design):
+    def __init__(self, design, *, stream=True):
         if not design.pins:
             raise PinError("a VerilogPinSource needs a ForeignDesign made with pins=True")
         assert WRAPPER == self.verilog_top
@@ -53,10 +54,15 @@ class VerilogPinSource:
         #: The ``[watch]`` output's bits since the reset, as outputs of 64 bits at most:
         #: ``[(port, lowest bit)]`` (``HostPins.watch_risen``).
         self.watch = [(name, low) for name, low, _ in watch_chunks(pm, design.ports)]
-        self.pixels = PIXEL_PORTS if pm.has_pixels else None
-        self.filtered = FILTERED_PORTS if pm.filtered_valid else None
+        # Without the stream (``stream=False``) the pixel ports are inputs like any other,
+        # each edge's value given by ``poke`` (a unit judge's random stimulus).
+        streamed = pm.has_pixels and stream
+        if pm.has_pixels and not stream:
+            self.key += "-unstreamed"
+        self.pixels = PIXEL_PORTS if streamed else None
+        self.filtered = FILTERED_PORTS if pm.filtered_valid and streamed else None
         params = design.params
-        self.frame_size = (params.width, params.height) if pm.has_pixels else None
+        self.frame_size = (params.width, params.height) if streamed else None
 
     def verilog_files(self):
         """``(files, compiled)``: every file to write (relative path -> text, the design's
