@@ -449,3 +449,33 @@ def test_robot_judge_of_a_camera_design(tmp_path, capsys):
     assert never_drives
     for m in never_drives:
         assert judged[m["index"]]["failed_checks"] == ["mean_distance_max_m"]
+
+
+@pytest.mark.parametrize(
+    "campaign, message",
+    [
+        ('scenarios = ["nowhere.toml"]', "scenario file 'nowhere.toml' does not exist"),
+        (
+            'scenarios = ["wall_stop.toml"]\n[grid]\n"robot.mas" = [1.0]',
+            "robot.mas is not a known key (did you mean 'mass'?)",
+        ),
+        (
+            'scenarios = ["wall_stop.toml"]\nset = ["design.params.speed=100"]',
+            "may not override design.* values",
+        ),
+        ('scenarios = ["wall_stop.toml"]\ndesign = "wall_stop.py:WallStop"', "may not give design"),
+        ('scenarios = ["wall_stop.toml"]\nbackend = "pysim"', "backend 'pysim'"),
+    ],
+)
+def test_a_campaign_the_robot_judge_cannot_run_is_refused_first(
+    campaign, message, tmp_path, capsys, monkeypatch
+):
+    # Checked before the netlist is built or the output folder made: one line, nothing written.
+    for name in ("wall_stop.py", "wall_stop.toml"):
+        (tmp_path / name).write_text((DESIGNS / name).read_text())
+    (tmp_path / "c.toml").write_text(campaign + "\n")
+    monkeypatch.chdir(tmp_path)
+    argv = ["mutate", "--design", "wall_stop.py:WallStop", "--campaign", "c.toml"]
+    code, _, err = _cli([*argv, "--out", "m"], capsys)
+    assert code == 2 and message in err and err.count("\n") == 1, err
+    assert not (tmp_path / "m").exists()

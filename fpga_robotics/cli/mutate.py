@@ -32,7 +32,12 @@ from fpga_robotics.mutation.design_run import (
 )
 from fpga_robotics.mutation.reasons import blind_spot_reason
 from fpga_robotics.mutation.report import write_report
-from fpga_robotics.mutation.robot_judge import check_resume, mutants_key, robot_judge
+from fpga_robotics.mutation.robot_judge import (
+    check_campaign,
+    check_resume,
+    mutants_key,
+    robot_judge,
+)
 from fpga_robotics.mutation.scores import blind_spots, by_module, robot_score, unit_score
 from fpga_robotics.mutation.unit_judge import (
     golden_results,
@@ -50,7 +55,11 @@ __all__ = ["main"]
 
 
 def _campaign(name):
-    return load_campaign_file(name)
+    """The campaign ``name`` with every run checked (``check_campaign``): a typo fails here,
+    before anything is built or written."""
+    campaign = load_campaign_file(name)
+    check_campaign(campaign)
+    return campaign
 
 
 def _exit_code(baseline):

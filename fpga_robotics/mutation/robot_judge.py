@@ -28,6 +28,7 @@ from .cone import cone_verdict, settled_by_cone
 from .forked_runs import execute_forked, outcome_of, reference_share
 
 __all__ = [
+    "check_campaign",
     "check_resume",
     "closest_to_failing",
     "judge_runs",
@@ -46,6 +47,35 @@ _LOWER = ("min_distance_min_m", "target_in_view_min_fraction", "found_min_fracti
 
 #: The robot judge's journal in the output folder (what ``--resume`` keeps).
 JOURNAL_NAME = "robot.jsonl"
+
+
+def check_campaign(campaign):
+    """``campaign``'s plan (``sweep.plan.make_plan``: every run's scenario and overrides
+    loaded), or ``UsageError`` for what a mutation campaign may not hold: its runs take the
+    mutant netlist as their design, on Verilator, so no ``design``, ``ports`` or
+    ``design.*`` values of its own and no other backend. Call it before anything is built
+    or written."""
+    runs = campaign.runs
+    for key, what in (("design", "design = ..."), ("ports", "ports = ...")):
+        if any(getattr(spec, key) is not None for spec in runs):
+            raise UsageError(
+                f"the mutation campaign may not give {what}: its runs take the mutant "
+                "netlist as their design (the mutants are of one design)"
+            )
+    other = sorted({spec.backend for spec in runs} - {"auto", "verilator"})
+    if other:
+        raise UsageError(
+            f"the mutation campaign's backend {other[0]!r}: the mutant netlist runs on "
+            'Verilator (backend = "auto" or "verilator")'
+        )
+    if any(k.startswith("design.") for spec in runs for k, _ in spec.overrides) or any(
+        item.startswith("design.") for spec in runs for item in spec.fixed
+    ):
+        raise UsageError(
+            "the mutation campaign may not override design.* values: the "
+            "mutants are of one design (give its parameters to mutate instead)"
+        )
+    return make_plan(campaign)
 
 
 def mutants_key(design, mutants):
@@ -274,14 +304,7 @@ def robot_judge(
     from distributed import as_completed  # lazy: Dask costs ~1 s; only a run needs it
 
     tick = progress or (lambda n: None)
-    plan = make_plan(campaign)
-    if any(k.startswith("design.") for spec in plan.runs for k, _ in spec.overrides) or any(
-        item.startswith("design.") for spec in plan.runs for item in spec.fixed
-    ):
-        raise UsageError(
-            "the mutation campaign may not override design.* values: the "
-            "mutants are of one design (give its parameters to mutate instead)"
-        )
+    plan = check_campaign(campaign)
     watch_ports = watch_ports if fork else None
     base = [
         mutant_argv(spec.argv(), netlist, watch_ports or ports, 0, resolution) for spec in plan.runs
