@@ -263,6 +263,8 @@ def test_a_design_without_a_clock_is_refused_where_it_would_be_simulated(
     shutil.copy(DESIGNS / "unelaborated.py", tmp_path / "unelaborated.py")
     spec = resolve_design("unelaborated.py:NoClock", {}, base=tmp_path)
     assert not spec.clocked
+    # No docstring of its own: described by its name, not by wiring.Component's docstring.
+    assert spec.description == "the Amaranth design NoClock"
     assert resolve_design(str(DESIGNS / "wall_stop.py") + ":WallStop", {}).clocked
     message = "has no clock: nothing in its sync domain (m.d.sync)"
     monkeypatch.chdir(tmp_path)

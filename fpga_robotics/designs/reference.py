@@ -244,7 +244,9 @@ def _amaranth_spec(reference, frozen_params, _stamp):
     ports = component_ports(component)
     bindings = bindings_of(component, ports)
     extra = extra_outputs_of(ports, bindings)
-    doc = (inspect.getdoc(target) or "").strip().splitlines()
+    # Its own docstring only: a class without one would show wiring.Component's.
+    own = target.__dict__.get("__doc__") if inspect.isclass(target) else target.__doc__
+    doc = (inspect.cleandoc(own) if own else "").strip().splitlines()
     description = doc[0] if doc else f"the Amaranth design {reference.rpartition(':')[2]}"
     name = reference.rpartition(":")[2]
     top = Top(
@@ -352,7 +354,8 @@ def _load_file(path, reference):
     if not path.is_file():
         raise DesignError(
             f"design {reference!r}: no file {str(path)!r}; give the path of "
-            f"a .py file (relative paths from the scenario file's folder)"
+            f"a .py file (a relative path is taken from the current folder, or in a "
+            f"scenario file from that file's folder)"
         )
     # A module name of its own per file, so that two files of one name do not collide.
     name = "fpga_robotics_user_design_" + hashlib.sha256(str(path).encode()).hexdigest()[:12]
