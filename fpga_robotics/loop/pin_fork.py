@@ -90,7 +90,8 @@ class _RecordingPinLoop(RealClockLoop):
 def _interface(loop):
     """How the loop binds its design: what must agree for a variant to share the journal
     (the reference's watch outputs aside: only the reference is watched)."""
-    watch = {name for name, _ in getattr(loop.pins.source, "watch", None) or ()}
+    source = getattr(loop.pins, "source", None)
+    watch = {name for name, _ in getattr(source, "watch", None) or ()}
     return (
         {name: port for name, port in loop.pins.ports.items() if name not in watch},
         {c.name: io.binding for c, io in loop.io.items()},
