@@ -172,8 +172,9 @@ def run_limits(outcome):
     the unmutated design stopped at, plus a million (None for a frame-level design, whose
     frames' cycle watchdog bounds its work). A mutant that only triggers a sensor far more
     often runs to its end and is judged by its checks; one that changes a watched output at
-    nearly every edge of a fast clock does not end in reasonable time. ``seconds`` only catches a run that hangs outside the
-    design's cycles: 30 times the unmutated run's, at least 120 s."""
+    nearly every edge of a fast clock does not end in reasonable time. ``seconds`` only
+    catches a run that hangs outside the design's cycles: 30 times the unmutated run's, at
+    least 120 s."""
     stops = outcome.get("design_stops")
     return (
         max(120.0, 30.0 * outcome.get("wall_s", 3.0)),
