@@ -47,6 +47,19 @@ CASES = [
     ("shadow with an unknown key", ["run", "--shadow", "frob=1"], "design.frob"),
     ("shadow with --source", ["run", "--source", "{frames}", "--shadow", "diff_min=5"], "--shadow"),
     (
+        "shadow design on the model backend",
+        [
+            "run",
+            "--scenario",
+            os.path.join(DESIGNS, "wall_stop.toml"),
+            "--shadow",
+            os.path.join(DESIGNS, "wall_stop.py") + ":WallStop",
+            "--shadow-backend",
+            "model",
+        ],
+        "--shadow-backend model runs whole frames",
+    ),
+    (
         "video with --source",
         ["run", "--source", "{frames}", "--save-video", "clip.mp4"],
         "--save-video",

@@ -78,6 +78,13 @@ def test_paths_are_relative_to_the_scenario_file(files, monkeypatch):
             "design.ports must be the path of a port map (.toml), got 7",
         ),
         ('[design]\nverilogg = ["a.v"]\n', "unknown key design.verilogg"),
+        (
+            (
+                '[design]\nverilog = ["rtl/follow_target.v"]\nports = "rtl/ft.toml"\n'
+                "[design.params]\ngain = 4\n"
+            ),
+            "design.params: a Verilog design takes no parameters here",
+        ),
     ],
 )
 def test_bad_entries_are_one_line_errors_at_load(files, text, message):

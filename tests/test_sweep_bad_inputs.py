@@ -31,6 +31,10 @@ CASES = {
     "bad backend": (GOOD.replace('"model"', '"fpga"'), "backend must be one of"),
     "malformed toml": (GOOD + "grid = [\n", "malformed TOML"),
     "not a list": (GOOD + '[grid]\n"design.diff_min" = 4\n', "must be a list of values"),
+    "a parameter shadow in real-clock timing": (
+        'scenarios = ["line_track"]\nduration = 1.0\nshadow = "published"\n',
+        "--shadow compares frames; it needs a scenario in compressed timing",
+    ),
 }
 
 

@@ -174,3 +174,40 @@ def test_a_campaign_with_a_shadow_design_reports_where_it_differs(tmp_path):
         shadow.close()
     assert direct["shadow"]["differing_frames"]["motor_left"] > 0  # the designs differ
     _assert_row_matches(row, direct)
+
+
+def test_a_campaign_with_a_shadow_design_on_pins_runs_it_as_run_does(tmp_path, monkeypatch):
+    # --shadow REF in real-clock timing: a second design on pins beside the primary, as
+    # `run --shadow REF` runs it (the same design: no frame differs).
+    from pathlib import Path
+
+    from fpga_robotics.loop.real_clock import make_pin_backend
+
+    data = Path(__file__).parent / "data" / "user_designs"
+    monkeypatch.chdir(data)
+    campaign = load_campaign(
+        {
+            "scenarios": [str(data / "wall_stop.toml")],
+            "seeds": [0, 1],
+            "duration": 2.0,
+            "shadow": "wall_stop.py:WallStop",
+        }
+    )
+    rows = run_campaign(campaign, tmp_path, workers=1, record="none")
+    assert len(rows) == 2
+    for row in rows:
+        assert row["status"] == "pass", row["message"]
+        scenario = load_scenario(str(data / "wall_stop.toml"), ["sim.duration=2.0"])
+        with (
+            make_pin_backend("auto", scenario) as design,
+            make_pin_backend("auto", scenario) as shadow,
+        ):
+            direct = run_scenario(
+                scenario,
+                seed=row["seed"],
+                backend=design,
+                shadow=shadow,
+                shadow_label="wall_stop.py:WallStop",
+            ).summary
+        assert not any(direct["shadow"]["differing_frames"].values())
+        _assert_row_matches(row, direct)

@@ -739,6 +739,11 @@ def main(argv=None, prog="fpga-robotics run"):
     if args.max_frames is not None:
         raise UsageError("--max-frames only applies with --source (use --duration)")
     shadow_scenario = _shadow_scenario(scenario, args.shadow)
+    if shadow_scenario is not None and args.shadow_backend == "model":
+        raise UsageError(
+            "--shadow-backend model runs whole frames; a shadow design on pins needs "
+            "--shadow-backend auto, cxxrtl, verilator or pysim"
+        )
     params_scenario = None
     if shadow_scenario is None:
         params_scenario = _shadow_params_scenario(scenario, args.shadow)

@@ -834,7 +834,9 @@ def _top(design, source):
             f"design.params must be a table ([design.params] in a file, "
             f"--set design.params.NAME=VALUE), got {params!r}"
         )
-    if isinstance(top, str) and top.startswith("verilog:"):
+    # The scenario's own Verilog (design.verilog) when it names no other design.top.
+    verilog = design.get("verilog") is not None and "top" not in design
+    if verilog or (isinstance(top, str) and top.startswith("verilog:")):
         top = "follow_target"  # the design is the scenario's foreign one (design.ports)
         if params:
             raise ScenarioError(

@@ -80,7 +80,9 @@ _loads = {}
 
 def load_run(argv):
     """``(args, scenario, shadow_params)`` of a run, checked as ``run`` checks them
-    (``UsageError`` with one line when something is wrong)."""
+    (``UsageError`` with one line when something is wrong). ``shadow_params``: the
+    ``--shadow``'s FollowTarget parameters, or for a shadow design (``--shadow REF``,
+    real-clock timing) the scenario that runs it; None without a shadow."""
     from fpga_robotics.cli import run  # lazy: the run stack (~1 s)
     from fpga_robotics.scenario.load import (  # lazy: the run stack (~1 s)
         MAX_SEED,
@@ -93,7 +95,16 @@ def load_run(argv):
         raise UsageError(f"--seed must be in 0..{MAX_SEED}, got {args.seed}")
     scenario = load_scenario(args.scenario, run._overrides(args))
     run.take_design_reference(args, scenario)
-    shadow_params = run._shadow_params(scenario, args.shadow)
+    # As run takes --shadow: a design reference is a second design on pins, else
+    # FollowTarget parameters, which compare frames.
+    shadow_params = run._shadow_scenario(scenario, args.shadow)
+    if shadow_params is None:
+        shadow_params = run._shadow_params(scenario, args.shadow)
+        if shadow_params is not None and scenario.sim.timing == "real_clock":
+            raise UsageError(
+                "--shadow compares frames; it needs a scenario in compressed "
+                "timing (sim.timing), not real_clock"
+            )
     run._design_files(args, scenario.foreign)
     if scenario.sim.timing == "real_clock":  # the pin design is the scenario's foreign one
         scenario = run._with_design_files(args, scenario)
@@ -137,8 +148,14 @@ def _designs_for(args, scenario, shadow_params):
             lambda: run._open_design(args, scenario.params, scenario.foreign),
         )
     shadow = None
-    if shadow_params is not None:
-        name = args.shadow_backend or args.backend
+    name = args.shadow_backend or args.backend
+    if hasattr(shadow_params, "sim"):  # a shadow design: its scenario, on pins
+        shadow_args = argparse.Namespace(**{**vars(args), "backend": name})
+        shadow = _open(
+            ("shadow", *_design_key(shadow_args, shadow_params)),
+            lambda: run._open_pin_design(shadow_args, shadow_params),
+        )
+    elif shadow_params is not None:
         shadow = _open(
             ("shadow", name, repr(shadow_params)),
             lambda: run._open_backend(name, shadow_params, True),

@@ -117,7 +117,7 @@ class ForeignDesign:
             )
             raise PortMapError(
                 f"port map: {pm.top}'s map {what}: the design runs in real-clock "
-                'timing (sim.timing = "real_clock", on the verilator backend) '
+                'timing (sim.timing = "real_clock", on the cxxrtl or verilator pin backend) '
                 "with the scenario's [[robot.sensors]]"
             )
         passed = {
