@@ -37,6 +37,7 @@ from fpga_robotics.mutation.robot_judge import (
     check_resume,
     mutants_key,
     robot_judge,
+    start_prebuild,
 )
 from fpga_robotics.mutation.scores import blind_spots, by_module, robot_score, unit_score
 from fpga_robotics.mutation.unit_judge import (
@@ -495,6 +496,14 @@ def main(argv=None, prog="fpga-robotics mutate"):
     if args.resume and campaign is not None:
         check_resume(out, key)
     netlist, ports = write_mutant_design(params, mutants, out)
+    watch_ports = os.path.join(out, WATCH_PORTS_NAME)
+    resolution = f"{params.width}x{params.height}"
+    # The references' model (with the watch) builds while the unit judge runs.
+    prebuilt = (
+        start_prebuild(campaign, netlist, watch_ports, resolution)
+        if campaign is not None and args.fork
+        else None
+    )
     design = open_mutant_design(params, netlist, ports, on_build=lambda t: say(f"{t} ..."))
     build_s = time.perf_counter() - t0
     try:
@@ -543,8 +552,9 @@ def main(argv=None, prog="fpga-robotics mutate"):
             say=say,
             fork=args.fork,
             cones=cones,
-            watch_ports=os.path.join(out, WATCH_PORTS_NAME),
+            watch_ports=watch_ports,
             mutants=key,
+            prebuilt=prebuilt,
         )
         robot_s = time.perf_counter() - t2
     robot = {k: v["caught"] for k, v in robot_verdicts.items()}

@@ -38,7 +38,7 @@ from .pin_judge import (
     pin_trace,
     streams_frames,
 )
-from .robot_judge import check_resume, mutants_key, robot_judge
+from .robot_judge import check_resume, mutants_key, robot_judge, start_prebuild
 from .scores import by_module, robot_score, unit_score
 
 __all__ = [
@@ -93,8 +93,6 @@ def mutate_design(
     robot = _keyed(robot, out, mutants_key(rtlil_text, mutants))
     name = spec.reference.rpartition(":")[2] or spec.reference
     source = MutantPinSource(rtlil_text, ports, mutants, name)
-    backend = open_pin_mutants(source, on_build=lambda t: say(f"{t} ..."))
-    build_s = time.perf_counter() - t0
     # The netlist and its port map as a Verilog design the closed loop runs (the robot
     # judge: one build, ``--runtime mutsel=K`` picks the mutant).
     netlist = os.path.join(out, NETLIST_NAME)
@@ -104,6 +102,9 @@ def mutate_design(
     for path, watch in ((port_map, False), (watch_map, True)):
         text = design_mutant_port_map(spec, ports, reset=reset, watch=watch)
         write_atomic(path, text, what="port map")
+    prebuilt = _prebuild(campaign, robot, netlist, watch_map)
+    backend = open_pin_mutants(source, on_build=lambda t: say(f"{t} ..."))
+    build_s = time.perf_counter() - t0
     return _judge(
         {"reference": spec.reference, "params": spec.params},
         backend,
@@ -119,6 +120,7 @@ def mutate_design(
         say=say,
         campaign=campaign,
         robot=robot,
+        prebuilt=prebuilt,
         cones_of=lambda some: mutant_cones(None, some, rtlil_text=rtlil_text),
     )
 
@@ -162,6 +164,7 @@ def mutate_verilog_design(
         watch_map = None
     else:
         write_atomic(watch_map, watched, what="port map")
+    prebuilt = _prebuild(campaign, robot, netlist, watch_map)
     # The pixel ports driven as any input, each edge at random (as an Amaranth design's).
     source = VerilogPinSource(
         ForeignDesign([netlist], port_map, pins=True, connector_kinds=connector_kinds()),
@@ -186,8 +189,17 @@ def mutate_verilog_design(
         say=say,
         campaign=campaign,
         robot=robot,
+        prebuilt=prebuilt,
         cones_of=lambda some: mutant_cones(None, some, **sources),
     )
+
+
+def _prebuild(campaign, robot, netlist, watch_map):
+    """With a forked robot judge, the references' model (the netlist with its watch, a model
+    of its own) building in a thread beside the unit judge's (``start_prebuild``)."""
+    if campaign is None or not (robot or {}).get("fork", True) or not watch_map:
+        return None
+    return start_prebuild(campaign, os.path.abspath(netlist), os.path.abspath(watch_map), None)
 
 
 def _keyed(robot, out, key):
@@ -215,6 +227,7 @@ def _judge(
     say,
     campaign,
     robot,
+    prebuilt,
     cones_of,
 ):
     """The unit judge of ``mutants`` on ``backend`` (closed here), then the robot judge with
@@ -260,6 +273,7 @@ def _judge(
             say=say,
             cones=cones,
             watch_ports=watch_map and os.path.abspath(watch_map),
+            prebuilt=prebuilt,
             **(robot or {}),
         )
         robot_s = time.perf_counter() - t2

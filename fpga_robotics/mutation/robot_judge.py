@@ -16,6 +16,7 @@ import hashlib
 import json
 import os
 import shlex
+import threading
 import time
 
 from fpga_robotics.hw.errors import UsageError
@@ -39,6 +40,7 @@ __all__ = [
     "robot_judge",
     "run_limits",
     "run_margin",
+    "start_prebuild",
 ]
 
 #: Checks whose limit is a lower bound (the value must be at least the limit).
@@ -76,6 +78,24 @@ def check_campaign(campaign):
             "mutants are of one design (give its parameters to mutate instead)"
         )
     return make_plan(campaign)
+
+
+def start_prebuild(campaign, netlist, ports, resolution):
+    """Build, in a thread of this process, the model the robot judge's unmutated runs open
+    (``netlist`` with ``ports``, its watch map: a model of its own), while the unit judge
+    runs; returns the thread, for ``robot_judge(prebuilt=...)`` to wait for. A build that
+    fails here fails again, with its message, in the run that needs it."""
+
+    def build():
+        for spec in make_plan(campaign).runs:
+            try:
+                runner.build_designs(mutant_argv(spec.argv(), netlist, ports, 0, resolution))
+            except Exception:  # noqa: BLE001 - the run reports it
+                return
+
+    thread = threading.Thread(target=build, name="prebuild", daemon=True)
+    thread.start()
+    return thread
 
 
 def mutants_key(design, mutants):
@@ -284,6 +304,7 @@ def robot_judge(
     cones=None,
     watch_ports=None,
     mutants=None,
+    prebuilt=None,
 ):
     """Judge the mutants ``indices`` by ``campaign``'s closed-loop runs.
 
@@ -301,7 +322,8 @@ def robot_judge(
     watch output watched (``design.write_mutant_design``); with ``fork`` the unmutated runs
     use it, and a mutant that never acted in one of them is given it without a run.
     ``mutants``: their ``mutants_key``, in every journal row (``resume`` keeps only rows of
-    the same; ``check_resume`` refuses others before anything is written)."""
+    the same; ``check_resume`` refuses others before anything is written). ``prebuilt``:
+    the ``start_prebuild`` thread to wait for before the runs."""
     from distributed import as_completed  # lazy: Dask costs ~1 s; only a run needs it
 
     tick = progress or (lambda n: None)
@@ -321,6 +343,8 @@ def robot_judge(
                         verdicts[int(row["index"])] = row
     elif os.path.exists(journal):
         os.remove(journal)
+    if prebuilt is not None:
+        prebuilt.join()
     with open_client(scheduler=scheduler, workers=workers) as client:
         wait_for_a_worker(client, scheduler)
         say(f"robot judge: {len(base)} campaign runs with the unmutated design first")
