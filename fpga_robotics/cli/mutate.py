@@ -79,8 +79,8 @@ def _no_run_passes(baseline):
     for argv, status, message in list(
         zip(baseline["runs"], baseline["statuses"], baseline["messages"], strict=True)
     )[:shown]:
-        where = " ".join(argv[argv.index("--scenario") : argv.index("--scenario") + 2])
-        print(f"  {where}: {status}" + (f": {message}" if message else ""))
+        scenario = argv[argv.index("--scenario") + 1]
+        print(f"  --scenario {scenario}: {status}" + (f": {message}" if message else ""))
     if len(baseline["runs"]) > shown:
         print(f"  ... and {len(baseline['runs']) - shown} more")
     return True

@@ -190,13 +190,6 @@ class PinReferenceRun:
     def frames(self):
         return self._loop.frames_done
 
-    def watch_first(self, bit):
-        """The row in which bit ``bit`` of the reference design's watch output first rose
-        (None: it never did); ``ValueError`` if the reference design had no watch."""
-        if self._loop.watch_first is None:
-            raise ValueError("the reference design has no watch output")
-        return self._loop.watch_first.get(bit)
-
     def run_variant(self, design, scenario=None, *, progress=None, watch_bit=None):
         """The run of ``design`` (a ``PinBackend`` for ``scenario``; reset here, not closed)
         in the reference's world. ``scenario`` as in ``ReferenceRun.run_variant``;

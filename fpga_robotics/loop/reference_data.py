@@ -118,13 +118,6 @@ class PinReferenceData:
     interface: tuple
     end_cycle: int
 
-    @property
-    def nbytes(self):
-        """Roughly how much memory the checkpoints and the journal's pixel streams take."""
-        saved = [*self.checkpoints, self.final]
-        streamed = sum(a.nbytes for c in self.calls for a in c.args if isinstance(a, np.ndarray))
-        return streamed + sum(len(c.blob) for c in saved)
-
 
 def pack_frames(seen):
     """The images of ``seen`` ((rgb, colour code) per frame) as one contiguous array."""

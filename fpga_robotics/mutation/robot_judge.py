@@ -203,13 +203,15 @@ def run_limits(outcome):
 
 
 def _failed_checks(outcome):
-    """A run's failed checks as text ("" when none failed)."""
-    failed = [
-        c["name"]
-        for c in (outcome.get("summary") or {}).get("checks", ())
-        if c.get("passed") is False
-    ]
-    return f"failed checks: {', '.join(failed)}" if failed else ""
+    """The names of a run's failed checks (none without a summary)."""
+    checks = (outcome.get("summary") or {}).get("checks", ())
+    return [c["name"] for c in checks if c.get("passed") is False]
+
+
+def _why_not_passed(outcome):
+    """Why a run did not pass: its error or timeout, else its failed checks ("" if none)."""
+    failed = _failed_checks(outcome)
+    return outcome.get("message") or (f"failed checks: {', '.join(failed)}" if failed else "")
 
 
 def judge_runs(argvs, limits=None, execute=None):
@@ -236,17 +238,12 @@ def judge_runs(argvs, limits=None, execute=None):
         if o.get("fork") is not None:
             forks.append(o["fork"])
         if o["status"] != "pass":
-            failed = [
-                c["name"]
-                for c in (o["summary"] or {}).get("checks", ())
-                if c.get("passed") is False
-            ]
             return {
                 "caught": True,
                 "run": i,
                 "status": o["status"],
                 "message": o["message"],
-                "failed_checks": failed,
+                "failed_checks": _failed_checks(o),
                 "closest": None,
                 "runs": i + 1,
                 "wall_s": time.perf_counter() - t0,
@@ -351,7 +348,7 @@ def robot_judge(
         outcomes, shared = _baseline(client, base, tick, fork)
         passing = [i for i, o in enumerate(outcomes) if o["status"] == "pass"]
         statuses = [o["status"] for o in outcomes]
-        messages = [o.get("message") or _failed_checks(o) for o in outcomes]
+        messages = [_why_not_passed(o) for o in outcomes]
         if not passing:  # nothing to judge by: no verdict, rather than a pass of no run
             say(f"robot judge: no run of the {len(base)} passes with the unmutated design")
             return (
