@@ -3,41 +3,15 @@ the unmutated netlist's run (``PinReferenceRun``) give their full runs' summarie
 mutant whose watch bit never rose there (it never acted) is given that run without its design
 being run."""
 
-from pathlib import Path
-
 import pytest
+from bump_mutate import DATA, mutate_bump_stop
 from run_equality import TIMING_FIELDS
 
-from fpga_robotics import cli
 from fpga_robotics.mutation import forked_runs
 from fpga_robotics.mutation.design import PORTS_NAME, WATCH_PORTS_NAME
 from fpga_robotics.mutation.forked_runs import execute_forked, reference_share
 from fpga_robotics.mutation.robot_judge import mutant_argv
 from fpga_robotics.sweep import runner
-
-DATA = Path(__file__).parent / "data"
-
-
-def _mutate(out, capsys):
-    with pytest.raises(SystemExit) as info:
-        cli.main(
-            [
-                "mutate",
-                "--design",
-                f"verilog:{DATA / 'bump_stop.v'}",
-                "--ports",
-                str(DATA / "bump_stop_ports.toml"),
-                "--mutants",
-                "12",
-                "--cycles",
-                "2000",
-                "--out",
-                str(out),
-                "--quiet",
-            ]
-        )
-    capsys.readouterr()
-    assert info.value.code == 0
 
 
 def _without_timing(summary):
@@ -47,7 +21,8 @@ def _without_timing(summary):
 @pytest.mark.slow  # Verilator builds of the mutant netlist (its map, and with its watch)
 def test_pin_mutants_forked_with_the_watch_equal_their_full_runs(tmp_path, capsys):
     out = tmp_path / "m"
-    _mutate(out, capsys)
+    code, _, err = mutate_bump_stop(out, capsys, "--mutants", "12")
+    assert code == 0, err
     netlist, ports, watched = out / "mutants.v", out / PORTS_NAME, out / WATCH_PORTS_NAME
     # 3 s: the robot drives 0.5 m of the 1.5 m to the wall, so the bumper never closes and
     # the mutants of the stop path (bump_i, hit) never act; those of the speeds do.

@@ -3,13 +3,9 @@
 run" from no run at all) and exits with 1."""
 
 import json
-from pathlib import Path
 
 import pytest
-
-from fpga_robotics import cli
-
-DATA = Path(__file__).parent / "data"
+from bump_mutate import DATA, mutate_bump_stop
 
 
 @pytest.mark.slow  # a Verilator build of the mutant netlist, a Dask worker
@@ -21,29 +17,10 @@ def test_no_passing_run_judges_no_mutant_and_says_why(tmp_path, capsys):
         'set = ["checks.max_wheel_command_dps=100"]\n'
     )
     out = tmp_path / "m"
-    with pytest.raises(SystemExit) as info:
-        cli.main(
-            [
-                "mutate",
-                "--design",
-                f"verilog:{DATA / 'bump_stop.v'}",
-                "--ports",
-                str(DATA / "bump_stop_ports.toml"),
-                "--mutants",
-                "4",
-                "--cycles",
-                "2000",
-                "--campaign",
-                str(campaign),
-                "--workers",
-                "1",
-                "--out",
-                str(out),
-                "--quiet",
-            ]
-        )
-    text = capsys.readouterr().out
-    assert info.value.code == 1
+    code, text, _ = mutate_bump_stop(
+        out, capsys, "--mutants", "4", "--campaign", str(campaign), "--workers", "1"
+    )
+    assert code == 1
     assert "no run passes with the unmutated design" in text
     assert "bump_wall.toml: fail: failed checks: max_wheel_command_dps" in text
     assert "0 of 0 unit-caught mutants caught: score n/a; no mutant judged" in text

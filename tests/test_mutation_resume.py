@@ -3,46 +3,23 @@ the very same mutants; a journal of other mutants (another seed) is refused befo
 in the output folder is touched."""
 
 import json
-from pathlib import Path
 
 import pytest
+from bump_mutate import DATA, mutate_bump_stop
 
-from fpga_robotics import cli
-
-DATA = Path(__file__).parent / "data"
 SAME = ("caught", "run", "status", "failed_checks", "closest")
 
 
 def _mutate(out, seed, capsys, *more):
     campaign = out.parent / "bump.toml"
     campaign.write_text(f'scenarios = ["{DATA / "bump_wall.toml"}"]\nseeds = "0"\nduration = 3.0\n')
-    argv = [
-        "mutate",
-        "--design",
-        f"verilog:{DATA / 'bump_stop.v'}",
-        "--ports",
-        str(DATA / "bump_stop_ports.toml"),
-        "--mutants",
-        "6",
-        "--seed",
-        str(seed),
-        "--cycles",
-        "2000",
-        "--campaign",
-        str(campaign),
-        "--workers",
-        "1",
-        "--recordings",
-        "0",
-        "--out",
-        str(out),
-        "--quiet",
-        *more,
-    ]
-    with pytest.raises(SystemExit) as info:
-        cli.main(argv)
-    captured = capsys.readouterr()
-    return info.value.code, captured.err
+    code, _, err = mutate_bump_stop(
+        out,
+        capsys,
+        *("--mutants", "6", "--seed", str(seed), "--campaign", str(campaign)),
+        *("--workers", "1", "--recordings", "0", *more),
+    )
+    return code, err
 
 
 def _rows(out):
