@@ -222,6 +222,10 @@ def test_robot_judge_of_a_users_design_matches_its_runs(tmp_path, capsys):
         ),
         (["--design", "wall_stop.py:WallStop", "--against", "model"], "--against: FollowTarget"),
         (["--design", "wall_stop.py:WallStop", "--preset", "published"], "--preset: FollowTarget"),
+        (
+            ["--design", "wall_stop.py:WallStop", "--resolution", "40"],
+            "--resolution must be WIDTHxHEIGHT such as 160x120, got '40'",
+        ),
     ],
 )
 def test_bad_design_arguments_are_one_line(argv, message, capsys, monkeypatch):
