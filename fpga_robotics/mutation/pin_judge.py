@@ -31,6 +31,7 @@ from ..sim.pins.compiled import VerilatorPins
 __all__ = [
     "CHANGE_PROBABILITY",
     "MutantPinSource",
+    "PinStimulus",
     "PinVerdict",
     "judge_pin_mutant",
     "open_pin_mutants",
@@ -100,7 +101,34 @@ def pin_stimulus(ports, cycles, seed, frame=None):
         changes += [(int(e), port.name, int(v)) for e, v in zip(edges, values)]
     if framed:
         changes += _frames(rng, frame, cycles)
-    return sorted(changes)
+    return PinStimulus(sorted(changes))
+
+
+class PinStimulus(list):
+    """A stimulus: ``(edge, input, value)`` changes in edge order, and the same grouped by
+    input (``by_input``) as ``schedule_many`` takes them, once for every mutant."""
+
+    @functools.cached_property
+    def by_input(self):
+        return _by_input(self)
+
+
+def _by_input(changes):
+    """``{input: (edges, values)}`` of ``changes``, each input's in edge order."""
+    grouped = {}
+    for edge, name, value in changes:
+        grouped.setdefault(name, ([], []))
+        grouped[name][0].append(edge)
+        grouped[name][1].append(value)
+    return {name: (np.array(e, np.int64), _values(v)) for name, (e, v) in grouped.items()}
+
+
+def _values(values):
+    """int64 where every value fits, else Python ints (a 64-bit unsigned input)."""
+    try:
+        return np.array(values, np.int64)
+    except OverflowError:
+        return np.array(values, object)
 
 
 def _frames(rng, frame, cycles):
@@ -126,18 +154,12 @@ def pin_trace(backend, index, stimulus, cycles, outputs):
     value), ...]}``, its value at cycle 0 and every change after."""
     backend.reset()
     backend.poke(MUTATION_SELECT, index)
-    for edge, name, value in stimulus:
-        backend.schedule(edge, name, value)
+    grouped = stimulus.by_input if isinstance(stimulus, PinStimulus) else _by_input(stimulus)
+    for name, (edges, values) in grouped.items():
+        backend.schedule_many(name, edges, values)
     trace = {name: [(0, backend.peek(name))] for name in outputs}
-    backend.watch(list(outputs))
-    while backend.cycle < cycles:
-        stop = backend.run(cycles - backend.cycle)
-        for name in outputs:
-            value = backend.peek(name)
-            if trace[name][-1][1] != value:
-                trace[name].append((backend.cycle, value))
-        if stop.port is None:
-            break
+    for name, changes in backend.record_changes(cycles, list(outputs)).items():
+        trace[name] += changes
     return trace
 
 

@@ -43,11 +43,13 @@ __all__ = ["CompiledPins", "CxxrtlPins", "VerilatorPins"]
 SOURCE_DIR = Path(__file__).resolve().parent
 LIBRARY_NAME = "libpins.so"
 #: Must match ``pin::ABI_VERSION`` in pin_driver.h.
-ABI_VERSION = 1
+ABI_VERSION = 2
 _DRIVER = "pin_driver.h"
 # Layout of run()'s result array (enum Out in pin_driver.h) and its status codes.
-_N_OUT = 6
+_N_OUT = 7
 _TOO_MANY_FILTERED = 1  # the other failure of a run: 2, wrong framing flags
+#: Changes ``pin_record`` writes per call.
+_RECORD_CHUNK = 65536
 
 _VP = ctypes.c_void_p
 _I64 = ctypes.c_int64
@@ -62,6 +64,8 @@ _ENTRIES = (
     ("pin_poke", None, [_VP, ctypes.c_int, _U64]),
     ("pin_peek", _U64, [_VP, ctypes.c_int]),
     ("pin_schedule", None, [_VP, _I64, ctypes.c_int, _U64]),
+    ("pin_schedule_many", None, [_VP, ctypes.c_int, _VP, _VP, _I64]),
+    ("pin_record", ctypes.c_int, [_VP, _I64, _VP, _I64, _VP]),
     ("pin_watch", None, [_VP, _VP, _I64]),
     ("pin_stream", ctypes.c_int, [_VP, _VP, _VP, _VP]),
     ("pin_run", ctypes.c_int, [_VP, _I64, _VP]),
@@ -273,6 +277,33 @@ class CompiledPins(HostPins):
     def _raw_schedule(self, edge, index, raw):
         self._lib.pin_schedule(self._handle, edge, index, raw)
 
+    def _raw_schedule_many(self, index, edges, raws):
+        if edges[0] == self._cycle + 1:  # that edge's inputs are on already: a poke
+            self._raw_schedule(int(edges[0]), index, int(raws[0]))
+            edges, raws = edges[1:], raws[1:]
+        edges, raws = np.ascontiguousarray(edges), np.ascontiguousarray(raws)
+        self._lib.pin_schedule_many(
+            self._handle, index, _address(edges), _address(raws), len(edges)
+        )
+
+    def _raw_record(self, cycles):
+        end = self._cycle + cycles
+        buffer = np.zeros((_RECORD_CHUNK, 3), np.int64)
+        while True:
+            status = self._lib.pin_record(
+                self._handle, end - self._cycle, _address(buffer), _RECORD_CHUNK, self._out_address
+            )
+            cycle, _port, _value, captured, _pending, bad, recorded = self._out.tolist()
+            if status:
+                self._cycle = cycle
+                raise capture_error(status == _TOO_MANY_FILTERED, bad)
+            self._ran_to(cycle, captured)
+            rows = buffer[:recorded]
+            raws = rows[:, 2].astype(np.uint64).tolist()
+            yield from zip(rows[:, 0].tolist(), rows[:, 1].tolist(), raws)
+            if recorded < _RECORD_CHUNK:
+                return
+
     def _raw_watch(self, indices):
         order = np.array(indices, np.int32)
         self._lib.pin_watch(self._handle, _address(order), len(order))
@@ -292,7 +323,7 @@ class CompiledPins(HostPins):
     def _raw_run(self, cycles):
         out = self._out
         status = self._run_entry(self._handle, cycles, self._out_address)
-        cycle, port, value, captured, _pending, bad = out.tolist()  # enum Out
+        cycle, port, value, captured, _pending, bad, _recorded = out.tolist()  # enum Out
         if status:
             self._cycle = cycle
             raise capture_error(status == _TOO_MANY_FILTERED, bad)

@@ -153,6 +153,65 @@ class HostPins(PinBackend):
             )
         self._raw_schedule(int(edge), index, raw)
 
+    def schedule_many(self, name, edges, values):
+        """``schedule`` for many changes of input ``name`` at once: ``values[k]`` from edge
+        ``edges[k]`` on, the edges strictly increasing and after ``cycle`` (a frame's pixels,
+        a seeded stimulus: one call instead of one a change)."""
+        index, port = self._input(name)
+        edges = np.asarray(edges)
+        values = np.asarray(values)
+        if edges.ndim != 1 or values.shape != edges.shape:
+            raise PinError(
+                f"schedule_many needs edges and values of one length, got shapes "
+                f"{edges.shape} and {values.shape}"
+            )
+        if len(edges) == 0:
+            return
+        if edges.dtype.kind not in "iu":
+            raise PinError(f"the edges must be ints, not {edges.dtype}")
+        edges = edges.astype(np.int64)
+        if (np.diff(edges) <= 0).any():
+            raise PinError("the edges of schedule_many must be strictly increasing")
+        if edges[0] <= self._cycle:
+            raise PinError(
+                f"edge {int(edges[0])} is in the past (cycle is {self._cycle}); schedule "
+                f"changes for edge {self._cycle + 1} or later"
+            )
+        self._raw_schedule_many(index, edges, self._raw_array(port, values))
+
+    def _raw_array(self, port, values):
+        """``_raw`` of every value, as uint64."""
+        if values.dtype.kind not in "iub" or port.width >= 64:
+            return np.array([self._raw(port, v) for v in values.tolist()], np.uint64)
+        values = values.astype(np.int64)
+        lo, hi = (
+            (-(1 << (port.width - 1)), (1 << (port.width - 1)) - 1)
+            if port.signed
+            else (0, (1 << port.width) - 1)
+        )
+        bad = (values < lo) | (values > hi)
+        if bad.any():
+            self._raw(port, int(values[np.argmax(bad)]))  # raises, with the message
+        return (values & ((1 << port.width) - 1)).astype(np.uint64)
+
+    def record_changes(self, cycles, names):
+        """Run ``cycles`` edges watching the outputs ``names`` (``watch``); returns every
+        change: ``{name: [(cycle, value), ...]}`` in order, as a ``run`` loop would give
+        them, one stop each (counted in ``stops``)."""
+        self.watch(names)
+        changes = {name: [] for name in names}
+        end = self._cycle + cycles
+        for cycle, index, raw in self._raw_record(cycles):
+            port = self._port_list[index]
+            changes[port.name].append((cycle, self._cooked(port, raw)))
+            self.stops += 1
+        if self.stop_limit is not None and self.stops > self.stop_limit:
+            raise StopLimit(
+                f"the design's watched outputs changed more than {self.stop_limit} times "
+                f"by edge {end}, over this run's budget"
+            )
+        return changes
+
     def watch(self, names):
         if isinstance(names, str):
             names = [names]
@@ -223,10 +282,7 @@ class HostPins(PinBackend):
         if isinstance(cycles, bool) or not isinstance(cycles, (int, np.integer)) or cycles < 0:
             raise PinError(f"run needs a number of cycles >= 0, not {cycles!r}")
         cycle, index, raw, captured = self._raw_run(int(cycles))
-        self._cycle = cycle
-        while self._captured < captured:
-            self._filtered = self._captures.popleft()
-            self._captured += 1
+        self._ran_to(cycle, captured)
         if index < 0:
             return Stop(cycle)
         port = self._port_list[index]
@@ -238,7 +294,29 @@ class HostPins(PinBackend):
             )
         return Stop(cycle, port.name, self._cooked(port, raw))
 
+    def _ran_to(self, cycle, captured):
+        """The bookkeeping after a run to ``cycle`` (``captured`` frames filtered so far)."""
+        self._cycle = cycle
+        while self._captured < captured:
+            self._filtered = self._captures.popleft()
+            self._captured += 1
+
     # --- what a backend implements -----------------------------------------------------------
+
+    def _raw_schedule_many(self, index, edges, raws):
+        for edge, raw in zip(edges.tolist(), raws.tolist()):
+            self._raw_schedule(edge, index, raw)
+
+    def _raw_record(self, cycles):
+        """``(cycle, port index, raw value)`` of every watched change over ``cycles``
+        edges (a ``run`` loop; a compiled backend runs it in the model)."""
+        end = self._cycle + cycles
+        while True:
+            cycle, index, raw, captured = self._raw_run(end - self._cycle)
+            self._ran_to(cycle, captured)
+            if index < 0:
+                return
+            yield cycle, index, raw
 
     def _raw_reset(self):
         raise NotImplementedError

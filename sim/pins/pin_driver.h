@@ -30,9 +30,9 @@
 namespace pin {
 
 // Bump when an entry point or the result layout changes (checked by the Python side).
-constexpr int ABI_VERSION = 1;
+constexpr int ABI_VERSION = 2;
 
-enum Out { O_CYCLE, O_PORT, O_VALUE, O_CAPTURED, O_PENDING, O_BAD_INDEX, O_COUNT };
+enum Out { O_CYCLE, O_PORT, O_VALUE, O_CAPTURED, O_PENDING, O_BAD_INDEX, O_RECORDED, O_COUNT };
 enum Status { OK = 0, TOO_MANY_FILTERED = 1, BAD_FILTERED_FLAGS = 2, BAD_ARGUMENTS = 3,
               CAPTURES_FULL = 4 };
 
@@ -158,6 +158,22 @@ struct Driver {
         update_next_event();
     }
 
+    // Many changes of one input, their edges increasing and after `cycle + 1`: merged
+    // into the queue at once (a frame's pixels, a unit judge's stimulus).
+    void schedule_many(int port, const int64_t *edges, const uint64_t *values, int64_t n) {
+        if (n <= 0)
+            return;
+        const size_t old_size = queue.size();
+        queue.reserve(old_size + n);
+        for (int64_t k = 0; k < n; ++k)
+            queue.push_back(Change{edges[k], port, values[k]});
+        // Stable: a change already queued for an edge stays before the new ones of it.
+        std::inplace_merge(queue.begin() + head, queue.begin() + old_size, queue.end(),
+                           [](const Change &a, const Change &b) { return a.edge < b.edge; });
+        next_due = queue[head].edge;
+        update_next_event();
+    }
+
     void watch(const int32_t *ports, int64_t n) {
         mask = 0;
         order.assign(ports, ports + n);
@@ -249,6 +265,27 @@ struct Driver {
         out[O_BAD_INDEX] = bad_index;
         return status;
     }
+
+    // `run` again and again over `n` edges, each watched change written to `changes` as
+    // (cycle, port, value), up to `cap` of them; out[O_RECORDED] says how many. Ends early
+    // (out[O_PORT] >= 0) when `cap` is reached or a run fails (its status returned).
+    int record(int64_t n, int64_t *changes, int64_t cap, int64_t *out) {
+        const int64_t end = cycle + n;
+        int64_t k = 0;
+        int status = OK;
+        out[O_PORT] = -1;
+        while (k < cap) {
+            status = run(end - cycle, out);
+            if (status != OK || out[O_PORT] < 0)
+                break;
+            changes[3 * k] = out[O_CYCLE];
+            changes[3 * k + 1] = out[O_PORT];
+            changes[3 * k + 2] = out[O_VALUE];
+            ++k;
+        }
+        out[O_RECORDED] = k;
+        return status;
+    }
 };
 
 }  // namespace pin
@@ -270,6 +307,14 @@ struct Driver {
     }                                                                                         \
     PIN_EXPORT void pin_schedule(void *h, int64_t edge, int port, uint64_t value) {           \
         static_cast<PinDriver *>(h)->schedule(edge, port, value);                             \
+    }                                                                                         \
+    PIN_EXPORT void pin_schedule_many(void *h, int port, const int64_t *edges,                \
+                                      const uint64_t *values, int64_t n) {                    \
+        static_cast<PinDriver *>(h)->schedule_many(port, edges, values, n);                   \
+    }                                                                                         \
+    PIN_EXPORT int pin_record(void *h, int64_t n, int64_t *changes, int64_t cap,              \
+                              int64_t *out) {                                                 \
+        return static_cast<PinDriver *>(h)->record(n, changes, cap, out);                     \
     }                                                                                         \
     PIN_EXPORT void pin_watch(void *h, const int32_t *ports, int64_t n) {                     \
         static_cast<PinDriver *>(h)->watch(ports, n);                                         \
