@@ -73,17 +73,20 @@ class HostPins(PinBackend):
         if not isinstance(value, (int, np.integer)):
             raise PinError(f"the value for {port.name!r} must be an int, not {value!r}")
         value = int(value)
-        lo, hi = (
-            (-(1 << (port.width - 1)), (1 << (port.width - 1)) - 1)
-            if port.signed
-            else (0, (1 << port.width) - 1)
-        )
+        lo, hi = HostPins._range(port)
         if not lo <= value <= hi:
             kind = "signed" if port.signed else "unsigned"
             raise PinError(
                 f"{value} does not fit port {port.name!r} ({port.width}-bit {kind}: {lo}..{hi})"
             )
         return value & ((1 << port.width) - 1)
+
+    @staticmethod
+    def _range(port):
+        """The values ``port`` takes: ``(lowest, highest)``."""
+        if port.signed:
+            return -(1 << (port.width - 1)), (1 << (port.width - 1)) - 1
+        return 0, (1 << port.width) - 1
 
     @staticmethod
     def _cooked(port, raw):
@@ -184,11 +187,7 @@ class HostPins(PinBackend):
         if values.dtype.kind not in "iub" or port.width >= 64:
             return np.array([self._raw(port, v) for v in values.tolist()], np.uint64)
         values = values.astype(np.int64)
-        lo, hi = (
-            (-(1 << (port.width - 1)), (1 << (port.width - 1)) - 1)
-            if port.signed
-            else (0, (1 << port.width) - 1)
-        )
+        lo, hi = self._range(port)
         bad = (values < lo) | (values > hi)
         if bad.any():
             self._raw(port, int(values[np.argmax(bad)]))  # raises, with the message
