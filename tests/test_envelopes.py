@@ -252,3 +252,15 @@ def test_search_side_tolerates_the_smear_of_a_turn():
         traj["w"] = np.full(len(wrong), w)
         m = envelope_metrics(traj, DEFAULT, sensor)
         assert m["search_law_violation_fraction"] == round(judged_wrong / (14 + judged_wrong), 4)
+
+
+def test_a_design_without_a_found_output_leaves_the_envelopes_na():
+    """A design of one's own without ``found`` records NaN there: no frame counts as a
+    sighting (NaN is not True), whatever its wheels do."""
+    traj = _traj([(True, 0.0, 512, -512)] * 5)  # spinning at full speed: far outside the law
+    assert envelope_metrics(traj, DEFAULT, GEOM)["turn_law_violation_fraction"] == 1.0
+    traj["found"] = np.full(len(traj["found"]), np.nan)
+    m = envelope_metrics(traj, DEFAULT, GEOM)
+    assert m["envelope_reason"] == "the design has no found output"
+    assert m["turn_law_violation_fraction"] is None
+    assert m["approach_speed_violation_fraction"] is None

@@ -288,7 +288,11 @@ def envelope_metrics(traj, params, geom):
     if why is not None:
         out["envelope_reason"] = why
         return out
-    found = np.asarray(traj["found"], bool)
+    found = np.asarray(traj["found"], float)
+    if np.isnan(found).any():  # a design of one's own without the output records NaN
+        out["envelope_reason"] = "the design has no found output"
+        return out
+    found = found.astype(bool)
     ml = np.asarray(traj["motor_left"], float)
     mr = np.asarray(traj["motor_right"], float)
     if np.isnan(ml).any() or np.isnan(mr).any():
