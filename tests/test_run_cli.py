@@ -272,3 +272,37 @@ def test_target_color_red_clothes_are_invisible_to_green(tmp_path, capsys):
     )
     assert code == 1
     assert json.loads(path.read_text())["found_fraction"] == 0.0
+
+
+@pytest.mark.parametrize(
+    "people",
+    [
+        "",  # no [[people]]: the world's default person is the target
+        '[[people]]\nname = "walker"\nwaypoints = [[4.0, 2.0], [4.5, 2.0]]\nspeed = 0.2\n',
+    ],
+)
+def test_target_color_dresses_an_implied_target(people, tmp_path, capsys):
+    """The target is the first person when no person says ``target``, or the default person
+    of a file without people: --target-color dresses it as it dresses an explicit one."""
+    scenario = tmp_path / "implied.toml"
+    scenario.write_text(f'name = "implied"\n[sim]\nduration = 3.0\n{people}')
+    path = tmp_path / "s.json"
+    args = ["--scenario", str(scenario), "--backend", "model", "--rerun", "off", "--quiet"]
+    code, _out, err = run([*args, "--target-color", "green", "--summary", str(path)], capsys)
+    assert code in (0, 1), err
+    green = json.loads(path.read_text())
+    assert green["color"] == "green" and green["found_fraction"] > 0.5
+    # Undressed, the (red) person is invisible to a green colour select.
+    code, _out, err = run([*args, "--color", "green", "--summary", str(path)], capsys)
+    assert json.loads(path.read_text())["found_fraction"] == 0.0
+
+
+def test_target_color_refuses_a_scenario_whose_first_person_is_not_the_target(tmp_path, capsys):
+    scenario = tmp_path / "none.toml"
+    scenario.write_text(
+        '[[people]]\nname = "passer"\ntarget = false\nwaypoints = [[4.0, 2.0], [4.5, 2.0]]\n'
+    )
+    err = usage_error(
+        ["--scenario", str(scenario), "--target-color", "green", "--rerun", "off"], capsys
+    )
+    assert "has no target person" in err

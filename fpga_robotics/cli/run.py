@@ -386,8 +386,7 @@ def _format_continued(s, label):
 def _dress_target(scenario, color):
     """The scenario with its target person dressed in ``color`` and the design's colour
     select set to it (later colour changes of the scenario are kept)."""
-    people = scenario.data.get("people", [])
-    index = next((i for i, p in enumerate(people) if p.get("target")), None)
+    scenario, index = scenario.target_person()
     if index is None:
         raise UsageError(f"--target-color: scenario {scenario.name!r} has no target person")
     rgb = "[" + ", ".join(str(c) for c in TARGET_CLOTHING[color]) + "]"

@@ -66,7 +66,7 @@ from fpga_robotics.sim.camera.raster import max_hfov, max_tilt, vertical_fov
 from fpga_robotics.sim.camera.render3d.options import Lamp, Render3DOptions
 from fpga_robotics.sim.camera.sensor import OV7670Params
 from fpga_robotics.sim.world import World, WorldConfigError
-from fpga_robotics.sim.world.config import WORLD_SECTIONS
+from fpga_robotics.sim.world.config import WORLD_SECTIONS, default_people
 from fpga_robotics.sim.world.schema import Number, check_of, validate
 
 __all__ = [
@@ -267,6 +267,23 @@ class Scenario:
             if at <= t + 1e-12:
                 color = c
         return color
+
+    def target_person(self):
+        """``(scenario, index)``: this scenario with its people written out in ``data``
+        (the world's default person where the file gives none, so that overrides can name
+        ``people.0``) and the index of its target person (``target = true``, else the first
+        person, as the world takes them), or None without one."""
+        scenario = self
+        if "people" not in self.data:
+            data = copy.deepcopy(self.data)
+            data["people"] = default_people(_check_world(self.world).room)
+            scenario = _finish(data, self.source, self.overrides)
+        people = scenario.data["people"]
+        explicit = [i for i, p in enumerate(people) if p.get("target")]
+        if explicit:
+            return scenario, explicit[0]
+        first = people[0] if people else None
+        return scenario, 0 if first is not None and first.get("target") is None else None
 
     def with_overrides(self, overrides):
         """A new scenario: this one's data with more ``KEY=VALUE`` overrides applied."""

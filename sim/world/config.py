@@ -346,7 +346,8 @@ def _parse_robot(section, room):
     return RobotConfig(spec, tuple(start), k.heading_deg * DEG, uncertainty)
 
 
-def _default_people(room):
+def default_people(room):
+    """The people of a world whose file gives none: one target walking a loop."""
     w, d = room.width, room.depth
     return [
         {
@@ -399,7 +400,7 @@ def _parse_person(item, path, index, room):
 
 def _parse_people(section, room):
     if section is None:
-        section = _default_people(room)
+        section = default_people(room)
     if not isinstance(section, list):
         raise WorldConfigError(
             f"people must be an array of tables ([[people]]), got {show(section)}"
