@@ -245,6 +245,12 @@ def list_mutants(
         )
         with open(os.path.join(work, "mutants.ys")) as f:
             lines = [line for line in f.read().splitlines() if line.strip()]
+    if not lines:
+        raise MutationError(
+            f"Yosys found nothing to mutate in {top if verilog is not None else 'the design'}: "
+            "its netlist has no cell or flip-flop left (outputs tied to constants are "
+            "optimised away); a design needs logic to have mutants"
+        )
     return [_parse(k + 1, line) for k, line in enumerate(lines)]
 
 

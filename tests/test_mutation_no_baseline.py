@@ -24,6 +24,9 @@ def test_no_passing_run_judges_no_mutant_and_says_why(tmp_path, capsys):
     assert "no run passes with the unmutated design" in text
     assert "bump_wall.toml: fail: failed checks: max_wheel_command_dps" in text
     assert "0 of 0 unit-caught mutants caught: score n/a; no mutant judged" in text
+    assert "robot judge" not in "".join(  # no module's robot score from no run
+        line for line in text.splitlines() if line.startswith("  ") and " caught" in line
+    )
     result = json.loads((out / "mutants.json").read_text())
     assert result["baseline"]["passing"] == [] and result["baseline"]["statuses"] == ["fail"]
     assert all(m["robot"] is None for m in result["mutants"])

@@ -8,7 +8,9 @@ frame shows.
 """
 
 import argparse
+import contextlib
 import os
+import shutil
 import sys
 import time
 import tomllib
@@ -67,6 +69,16 @@ def _exit_code(baseline):
     """1 when a campaign was given and none of its runs passes unmutated (no robot judge),
     else 0."""
     return 1 if baseline is not None and not baseline["passing"] else 0
+
+
+def _print_modules(modules, robot_judged):
+    """A line per module: its unit score and, where the robot judge ran, its robot score."""
+    width = max(len(name) for name in modules)
+    for name, row in modules.items():
+        robot_part = (
+            f", robot judge {row['robot_caught']:>4}/{row['unit_caught']}" if robot_judged else ""
+        )
+        print(f"  {name:<{width}}  {row['unit_caught']:>4}/{row['total']:<4} caught{robot_part}")
 
 
 def _no_run_passes(baseline):
@@ -340,6 +352,32 @@ def _followtarget_options(args):
     return ["--" + name.replace("_", "-") for name in given]
 
 
+def _one_line(exc):
+    """An error's first line; where it ends in a colon (a tool failed, its output follows),
+    with the tool's first error line after it."""
+    lines = [line.strip() for line in str(exc).splitlines() if line.strip()]
+    if not lines:
+        return type(exc).__name__
+    if lines[0].endswith(":") and len(lines) > 1:
+        detail = next((x for x in lines[1:] if "error" in x.lower()), lines[1])
+        return f"{lines[0]} {detail}"
+    return lines[0]
+
+
+@contextlib.contextmanager
+def _removed_on_error(out):
+    """Nothing half-written: a folder this command made is removed again when it fails
+    before the robot judge has journaled a verdict (a journal is kept for --resume, and so
+    is a folder that was there before)."""
+    existed = os.path.exists(out)
+    try:
+        yield
+    except Exception:
+        if not existed and not os.path.exists(os.path.join(out, "robot.jsonl")):
+            shutil.rmtree(out, ignore_errors=True)
+        raise
+
+
 def _main_design(args):
     """``--design REF``: the mutants of a design of one's own against itself."""
     given = _followtarget_options(args)
@@ -384,14 +422,15 @@ def _main_design(args):
     }
     judged = {"say": say, "campaign": campaign, "robot": robot, "frame": frame}
     try:
-        if verilog:
-            result = mutate_verilog_design(
-                files, args.ports, args.mutants, args.seed, cycles, out, **judged
-            )
-        else:
-            result = mutate_design(spec, args.mutants, args.seed, cycles, out, **judged)
+        with _removed_on_error(out):
+            if verilog:
+                result = mutate_verilog_design(
+                    files, args.ports, args.mutants, args.seed, cycles, out, **judged
+                )
+            else:
+                result = mutate_design(spec, args.mutants, args.seed, cycles, out, **judged)
     except (MutationError, BackendError, PinError) as exc:
-        raise UsageError(str(exc).splitlines()[0]) from None
+        raise UsageError(_one_line(exc)) from None
     score, modules = result["unit"], result["modules"]
     rate = (60 * score["total"] / result["unit_judge_s"]) if result["unit_judge_s"] else 0
     print(
@@ -404,14 +443,7 @@ def _main_design(args):
         f"unit judge (against the unmutated design): {score['caught']} caught, "
         f"{score['equivalent']} equivalent on these inputs: score {_percent(score['score'])}"
     )
-    width = max(len(m) for m in modules)
-    for module, row in modules.items():
-        robot_part = (
-            f", robot judge {row['robot_caught']:>4}/{row['unit_caught']}"
-            if campaign is not None
-            else ""
-        )
-        print(f"  {module:<{width}}  {row['unit_caught']:>4}/{row['total']:<4} caught{robot_part}")
+    _print_modules(modules, campaign is not None and not _exit_code(result["baseline"]))
     if campaign is not None:
         _report_design_robot(result, campaign)
     missed = [m for m in result["mutants"] if not m["unit"]["caught"]]
@@ -482,6 +514,13 @@ def main(argv=None, prog="fpga-robotics mutate"):
     campaign = _campaign(args.campaign) if args.campaign is not None else None
     out = args.out or os.path.join("runs", "mutation", f"n{args.mutants}-s{args.seed}")
     check_output_dir(out, what="output folder")
+
+    with _removed_on_error(out):
+        return _mutate_follow_target(args, params, campaign, out)
+
+
+def _mutate_follow_target(args, params, campaign, out):
+    """FollowTarget's mutants: listed, built, judged and reported in ``out``."""
 
     def say(text):
         if not args.quiet:
@@ -613,14 +652,7 @@ def main(argv=None, prog="fpga-robotics mutate"):
         f"unit judge{against}: {score['caught']} caught, {score['equivalent']} equivalent "
         f"on these frames: score {_percent(score['score'])}"
     )
-    width = max(len(name) for name in modules)
-    for name, row in modules.items():
-        robot_part = (
-            f", robot judge {row['robot_caught']:>4}/{row['unit_caught']}"
-            if campaign is not None
-            else ""
-        )
-        print(f"  {name:<{width}}  {row['unit_caught']:>4}/{row['total']:<4} caught{robot_part}")
+    _print_modules(modules, campaign is not None and not _exit_code(baseline))
     if campaign is not None:
         _report_robot(
             out,

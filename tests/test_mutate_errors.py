@@ -1,0 +1,71 @@
+"""``mutate``'s failures: one line that says what is wrong, and nothing half-written."""
+
+import os
+
+import pytest
+
+from fpga_robotics.cli.errors import run_cli
+from fpga_robotics.cli.mutate import _one_line, _removed_on_error, main
+from fpga_robotics.sim.backends.base import BackendError
+
+ZERO = '''
+from amaranth import Module, Signal, signed
+from amaranth.lib import wiring
+from amaranth.lib.wiring import Out
+
+
+class Zero(wiring.Component):
+    """Wheels tied to 0 and a register nothing reads: no logic left for Yosys to mutate."""
+
+    motor_left: Out(signed(16))
+    motor_right: Out(signed(16))
+
+    def elaborate(self, platform):
+        m = Module()
+        unread = Signal()
+        m.d.sync += unread.eq(~unread)
+        m.d.comb += [self.motor_left.eq(0), self.motor_right.eq(0)]
+        return m
+'''
+
+
+def test_a_design_without_logic_has_nothing_to_mutate(tmp_path, capsys, monkeypatch):
+    (tmp_path / "zero.py").write_text(ZERO)
+    monkeypatch.chdir(tmp_path)
+    out = tmp_path / "m"
+    with pytest.raises(SystemExit) as exc:
+        run_cli(main, ["--design", "zero.py:Zero", "--mutants", "4", "--out", str(out)], "mutate")
+    assert exc.value.code == 2
+    err = capsys.readouterr().err
+    assert "nothing to mutate" in err and "Traceback" not in err
+    assert len(err.strip().splitlines()) == 1
+    assert not out.exists()
+
+
+def test_a_tool_failure_names_its_error_line():
+    exc = BackendError(
+        "verilator: building the Verilator pin model (make, /usr/bin/g++) failed (exit 1):\n"
+        "  make: entering\n  %Error-PINNOTFOUND: mutants.v:3: Pin not found: 'mutsel'\n"
+    )
+    assert _one_line(exc) == (
+        "verilator: building the Verilator pin model (make, /usr/bin/g++) failed (exit 1): "
+        "%Error-PINNOTFOUND: mutants.v:3: Pin not found: 'mutsel'"
+    )
+    assert _one_line(BackendError("one line\nmore")) == "one line"
+
+
+@pytest.mark.parametrize(
+    ("existed", "journal", "kept"),
+    [(False, False, False), (True, False, True), (False, True, True)],
+)
+def test_a_failed_command_removes_only_the_folder_it_made(tmp_path, existed, journal, kept):
+    out = tmp_path / "m"
+    if existed:
+        out.mkdir()
+    with pytest.raises(RuntimeError), _removed_on_error(str(out)):
+        out.mkdir(exist_ok=True)
+        (out / "mutants.v").write_text("module m; endmodule\n")
+        if journal:  # a verdict journaled for --resume is worth keeping
+            (out / "robot.jsonl").write_text("{}\n")
+        raise RuntimeError("the build failed")
+    assert os.path.exists(out) == kept
