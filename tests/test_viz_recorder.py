@@ -423,3 +423,31 @@ def test_a_file_alone_is_chunked_by_frames_not_by_time(tmp_path, monkeypatch):
     path = record(tmp_path / "file.rrd", frames).path
     assert chunk_rows(path, P.MOTORS_DPS) == [128, 128, 44]
     assert chunk_rows(path, P.CAMERA_RAW) == [128, 128, 44]
+
+
+@pytest.mark.parametrize("where", ["_add_map", "_send_blueprint"])
+def test_a_frame_cut_short_by_ctrl_c_is_neither_kept_nor_counted(tmp_path, monkeypatch, where):
+    """Ctrl-C in the middle of logging frame 3 (after its images and motors): the file
+    holds frames 0..2 and the closing line counts exactly those."""
+    path = tmp_path / "cut.rrd"
+    frames = make_frames(4)
+    with (
+        pytest.raises(KeyboardInterrupt),
+        open_recorder(f"save:{path}", default_path=str(path)) as rec,
+    ):
+        for f in frames[:3]:
+            rec.log_frame(f)
+        original = getattr(rec, where)
+
+        def interrupted(*args, **kwargs):
+            original(*args, **kwargs)
+            raise KeyboardInterrupt
+
+        monkeypatch.setattr(rec, where, interrupted)
+        rec._layout_stale = True  # so that the blueprint is sent again for frame 3
+        rec.log_frame(frames[3])
+    data = read_rrd(str(path))
+    for entity in (P.CAMERA_RAW, P.MOTORS_DPS, P.TWIST_V):
+        assert data.entities[entity].frames == [0, 1, 2], entity
+    assert rec.frames_logged == 3 and rec.images_logged == 3
+    assert "saved 3 frames (3 with images)" in rec.close()

@@ -142,6 +142,17 @@ class ColumnBuffer:
         if isinstance(row, bytes | np.ndarray):  # an image (PNG, JPEG or raw)
             self._image_bytes += len(row) if isinstance(row, bytes) else row.nbytes
 
+    def drop_frame(self, frame):
+        """Drop the rows of ``frame`` not sent yet: a frame whose logging was cut short (Ctrl-C)
+        is not kept in part."""
+        for r in self._rows.values():
+            while r.frames and r.frames[-1] == frame:
+                r.frames.pop()
+                r.times.pop()
+                row = r.data.pop()
+                if isinstance(row, bytes | np.ndarray):
+                    self._image_bytes -= len(row) if isinstance(row, bytes) else row.nbytes
+
     def end_frame(self):
         """Count a frame; send when enough frames or time have gone by."""
         self._frames += 1

@@ -173,6 +173,7 @@ class Recorder:
         self.camera = camera
         self.frames_logged = 0
         self.images_logged = 0
+        self._open_frame = None  # the frame log_frame is adding rows of
         self.delivered = None
         self.viewer_pid = output.viewer_pid if output is not None else None
         self.live_url = output.live_url if output is not None else None
@@ -350,6 +351,7 @@ class Recorder:
         if not self._blueprint_sent:
             self._send_blueprint()
         frame = int(record.frame)
+        self._open_frame = frame  # until its last row is added (close drops a partial one)
         t = time_ns(record.sim_time)
         res = record.result
         if not self._first_frame_seen:
@@ -371,7 +373,6 @@ class Recorder:
             if res.filtered is not None:  # a design without a filtered stream: no image
                 kind, data = encode_rgb444(res.filtered, q)
                 add((P.CAMERA_FILTERED, kind), data)
-            self.images_logged += 1
         if record.events:
             s = self._stream
             s.set_time("frame", sequence=frame)
@@ -415,6 +416,8 @@ class Recorder:
         if self._layout_stale:
             self._send_blueprint(shadow=self._shadow_seen)
         self.frames_logged += 1
+        self.images_logged += frame % self.log_every == 0
+        self._open_frame = None
         self._columns.end_frame()
 
     def _add_shadow(self, res, add):
@@ -503,6 +506,8 @@ class Recorder:
             self.notices.append("viewer off: nothing was recorded")
         else:
             confirmed, problem = False, "closing was interrupted"
+            if self._open_frame is not None:
+                self._columns.drop_frame(self._open_frame)
             try:
                 self._columns.flush()
                 confirmed, problem = self._output.finish(self._stream)
