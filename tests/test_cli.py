@@ -42,11 +42,21 @@ def test_top_level_help_lists_every_command(capsys):
         assert f"  {name} " in out
 
 
-def test_bench_list_names_every_benchmark(capsys):
-    with pytest.raises(SystemExit):
-        cli.main(["bench", "--list"])
+@pytest.mark.parametrize("flag", ["--list", "--help", "-h"])
+def test_bench_list_names_every_benchmark(flag, capsys):
+    with pytest.raises(SystemExit) as exc:
+        cli.main(["bench", flag])
+    assert exc.value.code == 0
     out = capsys.readouterr().out
+    assert out.startswith("usage: fpga-robotics bench [WHAT]")
     assert all(f"  {name} " in out for name in cli.BENCHMARKS)
+
+
+def test_a_benchmarks_help_has_no_markup(capsys):
+    with pytest.raises(SystemExit):
+        cli.main(["bench", "camera", "--help"])
+    out = capsys.readouterr().out
+    assert "usage: fpga-robotics bench camera" in out and "``" not in out
 
 
 def test_console_script_and_module_alias_run_the_same_command(tmp_path):

@@ -28,6 +28,16 @@ CASES = [
     ("no command", [], "command"),
     ("unknown command", ["fly"], "unknown command"),
     ("unknown benchmark", ["bench", "gpu"], "unknown benchmark"),
+    ("bench negative seed", ["bench", "design", "--backends", "model", "--seed", "-1"], "--seed"),
+    ("bench empty backends", ["bench", "design", "--backends", ","], "--backends"),
+    (
+        "bench resolution the design refuses",
+        ["bench", "design", "--backends", "model", "--resolutions", "160x120,1x1"],
+        "1x1",
+    ),
+    ("bench negative pysim pixels", ["bench", "design", "--pysim-max-pixels", "-5"], "pixels"),
+    ("bench render3d unknown backend", ["bench", "render3d", "--backend", "foo"], "--backend"),
+    ("bench mutant_replay negative seed", ["bench", "mutant_replay", "--seed", "-1"], "--seed"),
     # run: outputs checked before the run, never replaced when not a regular file
     ("summary to a device", ["run", "--summary", "/dev/full"], "not a regular file"),
     ("summary to a folder", ["run", "--summary", "{dir}"], "is a folder"),
@@ -242,8 +252,9 @@ def test_bad_input_is_one_line_and_exit_2(
     with pytest.raises(SystemExit) as exit_info:
         cli.main(argv)
 
-    err = capsys.readouterr().err
+    out, err = capsys.readouterr()
     assert exit_info.value.code == 2, err
+    assert out == "", f"printed before the error: {out!r}"
     assert "Traceback" not in err
     lines = [line for line in err.splitlines() if line.strip()]
     assert "error:" in lines[-1] and word in lines[-1], err

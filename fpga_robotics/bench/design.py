@@ -338,9 +338,21 @@ def run(args):
     for n in names:
         if n not in BACKEND_NAMES:
             raise UsageError(f"unknown backend {n!r}; choose from {', '.join(BACKEND_NAMES)}")
+    if not names:
+        raise UsageError(f"--backends is empty; give some of {', '.join(BACKEND_NAMES)}")
+    names = list(dict.fromkeys(names))  # each backend once
     sizes = parse_resolutions(args.resolutions)
     if args.pysim_frames < 1:
         raise UsageError(f"--pysim-frames must be at least 1, got {args.pysim_frames}")
+    if args.pysim_max_pixels < 0:
+        raise UsageError(f"--pysim-max-pixels must be >= 0, got {args.pysim_max_pixels}")
+    if args.seed < 0:
+        raise UsageError(f"--seed must be >= 0, got {args.seed}")
+    for w, h in sizes:  # every resolution checked before the table starts
+        try:
+            FollowTargetParams(width=w, height=h)
+        except (TypeError, ValueError) as exc:
+            raise UsageError(f"resolution {w}x{h}: {exc}") from None
     published = published_files(args.published) if args.published else None
 
     results, paired, notes = [], [], []

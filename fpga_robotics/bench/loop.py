@@ -210,7 +210,9 @@ def _check(args):
     if not args.repeats <= 100:
         raise UsageError(f"--repeats must be 1..100, got {args.repeats}")
     if not (math.isfinite(args.duration) and 0 < args.duration <= 600):
-        raise UsageError(f"--duration must be 0..600 simulated seconds, got {args.duration}")
+        raise UsageError(
+            f"--duration must be more than 0 and at most 600 simulated seconds, got {args.duration}"
+        )
     if not 0 <= args.profile <= 200:
         raise UsageError(f"--profile must be 0..200 functions, got {args.profile}")
     args.resolutions = scaffold.parse_sizes(args.resolutions, "a resolution")

@@ -57,6 +57,8 @@ def _check(args):
         raise UsageError(f"--duration must be in (0, 600] s, got {args.duration}")
     if not 1 <= args.mutants <= 1000:
         raise UsageError(f"--mutants must be in 1..1000, got {args.mutants}")
+    if args.seed < 0:
+        raise UsageError(f"--seed must be >= 0, got {args.seed}")
     try:
         parse_resolution(args.resolution)
     except ScenarioError as exc:

@@ -23,6 +23,7 @@ from fpga_robotics.cli.errors import UsageError
 from fpga_robotics.loop.connectors.camera import make_renderer
 from fpga_robotics.loop.timings import run_scenario
 from fpga_robotics.scenario.load import load_scenario
+from fpga_robotics.sim.backends import BACKEND_NAMES
 from fpga_robotics.sim.camera.scene import CameraPose
 from fpga_robotics.sim.world import World
 
@@ -137,6 +138,11 @@ def _check(args):
         raise UsageError(f"--seconds must be 0..3600, got {args.seconds}")
     if args.viewer and args.figures is None:
         raise UsageError("--viewer goes with --figures DIR")
+    if args.backend not in ("auto", *BACKEND_NAMES):
+        raise UsageError(
+            f"--backend {args.backend!r} is not a backend; choose one of: auto, "
+            f"{', '.join(BACKEND_NAMES)}"
+        )
     args.sizes = scaffold.parse_sizes(args.sizes)
 
 

@@ -249,7 +249,7 @@ def command(
     """``main(argv=None, prog=...)`` of a benchmark: parse (common options, then the
     subject's ``options(parser)``), check (common, then ``check(args)``), ``run(args)`` ->
     figures, then the calibration and ``--json`` if asked for."""
-    description = doc.strip().split("\n\n")[0]
+    description = doc.strip().split("\n\n")[0].replace("``", "")  # no RST in --help
 
     def main(argv=None, prog=f"fpga-robotics bench {name}"):
         parser = BenchParser(prog=prog, description=description)

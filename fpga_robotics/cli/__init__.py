@@ -200,13 +200,15 @@ def main(argv=None):
         )
         sys.exit(USAGE_EXIT)
     if command == "bench":
-        if rest[:1] == ["--list"]:
+        if rest[:1] in (["--list"], ["-h"], ["--help"]):
             print(_bench_list())
+            if rest[0] != "--list":
+                print(f"\n{PROG} bench WHAT --help gives a benchmark's options.")
             sys.exit(0)
         what = rest[0] if rest and not rest[0].startswith("-") else "design"
         if what not in BENCHMARKS:
             print(
-                f"{PROG}: error: unknown benchmark {what!r}; choose one of: "
+                f"{PROG} bench: error: unknown benchmark {what!r}; choose one of: "
                 f"{', '.join(BENCHMARKS)}",
                 file=sys.stderr,
             )
