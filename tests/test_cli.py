@@ -16,7 +16,7 @@ from fpga_robotics import cli
         (["run", "--help"], "fpga-robotics run"),
         (["export", "--help"], "fpga-robotics export"),
         (["board", "--help"], "fpga-robotics board"),
-        (["bench", "--help"], "fpga-robotics bench design"),
+        (["bench", "--help"], "fpga-robotics bench [WHAT]"),
         (["bench", "design", "--help"], "fpga-robotics bench design"),
         (["bench", "pysim", "--help"], "fpga-robotics bench pysim"),
         (["bench", "camera", "--help"], "fpga-robotics bench camera"),
