@@ -28,6 +28,7 @@ CASES = [
     ("no command", [], "command"),
     ("unknown command", ["fly"], "unknown command"),
     ("unknown benchmark", ["bench", "gpu"], "unknown benchmark"),
+    ("formal ports without a design", ["formal", "--ports", "{file}"], "--ports"),
     ("bench negative seed", ["bench", "design", "--backends", "model", "--seed", "-1"], "--seed"),
     ("bench empty backends", ["bench", "design", "--backends", ","], "--backends"),
     (

@@ -317,6 +317,8 @@ def design_checks(reference=None, params=None, ports=None):
     Verilog one (``verilog:FILES``, its top from the port map ``ports`` when given) the
     assert and cover statements it holds (``verilog_checks``). A design that declares none is
     a ``UsageError``."""
+    if ports is not None and (reference is None or not reference.startswith("verilog:")):
+        raise UsageError("--ports is the port map of a Verilog design: it goes with verilog:FILES")
     if reference is None or reference == "follow_target":
         return list(CHECKS)
 
@@ -331,8 +333,6 @@ def design_checks(reference=None, params=None, ports=None):
             except PortMapError as exc:
                 raise UsageError(f"--ports {ports}: {exc}") from None
         return verilog_checks(files, top)
-    if ports is not None:
-        raise UsageError("--ports is the port map of a Verilog design: it goes with verilog:FILES")
     spec = resolve_design(reference, params)
     name = reference if spec.kind == "builtin" else spec.reference.rpartition(":")[2]
     checks = declared_checks(name, spec.build)
