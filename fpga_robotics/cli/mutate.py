@@ -271,7 +271,7 @@ def build_parser(prog="fpga-robotics mutate"):
     p.add_argument(
         "--fork",
         action=argparse.BooleanOptionalAction,
-        default=True,
+        default=None,
         help="robot judge: fork each mutant's runs from the unmutated design's at "
         "the first frame its wheel commands differ (default; the same "
         "verdicts, docs/mutation.md) or, with --no-fork, run them in full",
@@ -491,8 +491,14 @@ def _check(args):
         raise UsageError(f"--workers must be 1..256, got {args.workers}")
     if args.recordings < 0:
         raise UsageError(f"--recordings must be >= 0, got {args.recordings}")
-    if args.campaign is None and (args.workers or args.scheduler or args.resume):
-        raise UsageError("--workers, --scheduler and --resume go with --campaign (the robot judge)")
+    if args.campaign is None and (
+        args.workers or args.scheduler or args.resume or args.fork is not None
+    ):
+        raise UsageError(
+            "--workers, --scheduler, --resume and --fork/--no-fork go with --campaign "
+            "(the robot judge)"
+        )
+    args.fork = True if args.fork is None else args.fork
 
 
 def _percent(x):
