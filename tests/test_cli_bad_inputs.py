@@ -49,6 +49,7 @@ CASES = [
     ("zero duration", ["run", "--duration", "0"], "--duration"),
     ("nan duration", ["run", "--duration", "nan"], "--duration"),
     ("max-frames without source", ["run", "--max-frames", "5"], "--source"),
+    ("duration with source", ["run", "--source", "{frames}", "--duration", "1"], "--duration"),
     ("negative max-frames", ["run", "--source", "{frames}", "--max-frames", "-1"], "--max-frames"),
     ("log-every zero", ["run", "--log-every", "0", "--rerun", "save:x.rrd"], "--log-every"),
     ("unknown backend", ["run", "--backend", "iverilog"], "invalid choice"),

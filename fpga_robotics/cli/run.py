@@ -734,6 +734,11 @@ def main(argv=None, prog="fpga-robotics run"):
             )
         if args.max_frames is not None and args.max_frames < 1:
             raise UsageError(f"--max-frames must be >= 1, got {args.max_frames}")
+        if args.duration is not None:
+            raise UsageError(
+                "--duration is the closed loop's length; with --source the frames decide "
+                "it (--max-frames N takes the first N)"
+            )
         return _run_source(args, scenario, ros)
     if args.max_frames is not None:
         raise UsageError("--max-frames only applies with --source (use --duration)")
