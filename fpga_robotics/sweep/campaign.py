@@ -28,7 +28,7 @@ A campaign is a TOML file (docs/campaigns.md)::
     [[known_limits]]                        # optional: a failure that is a limit of the design
     check = "found_min_fraction"            # the check that fails (or a list of checks)
     when = {"camera.resolution" = "80x60"}  # optional: the runs' overrides it applies to
-    scenarios = ["divider"]                 # optional: the scenarios it applies to
+    scenarios = ["divider"]                 # optional: the scenarios it applies to (by name)
     reason = "at 80x60 the target is ..."   # why: shown in the report
 
 The runs are, for every scenario and seed, the cartesian product of the grid plus each
