@@ -3,6 +3,7 @@ and nothing written."""
 
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 
@@ -119,3 +120,75 @@ def test_report_of_a_folder_without_results_is_one_line_and_exit_2(tmp_path):
         assert proc.returncode == 2
         lines = proc.stderr.strip().splitlines()
         assert len(lines) == 1 and message in lines[0], lines
+
+
+#: A command-line value that is wrong: the error names the option, not the campaign file.
+BAD_OPTION_VALUES = {
+    "--seeds": (["--seeds", "x"], "--seeds must be A-B (e.g. 0-19) or A,B,C, got 'x'"),
+    "--seeds range": (["--seeds", "5-1"], "--seeds range '5-1' is empty"),
+    "--set": (["--set", "robot.mass"], "--set needs KEY=VALUE (e.g. robot.mass=12)"),
+    "--grid": (["--grid", "design.diff_min=[]"], "--grid needs KEY=[V1, V2, ...]"),
+    "--duration": (["--duration", "-1"], "--duration must be > 0 seconds"),
+    "--scenarios": (["--scenarios", ","], "--scenarios needs scenario names"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(BAD_OPTION_VALUES))
+def test_a_bad_option_value_is_blamed_on_the_option(case, tmp_path, monkeypatch, capsys):
+    argv, message = BAD_OPTION_VALUES[case]
+    (tmp_path / "c.toml").write_text(GOOD)
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(SystemExit) as exit_info:
+        run_cli(main, ["c.toml", *argv, "--out", "out", "--quiet"], prog="fpga-robotics sweep")
+    assert exit_info.value.code == 2
+    lines = capsys.readouterr().err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith(f"fpga-robotics sweep: error: {message}"), lines
+    assert not (tmp_path / "out").exists()
+
+
+LIMIT = '[[known_limits]]\ncheck = "found_min_fraction"\nreason = "x"\n'
+
+
+def test_a_known_limit_of_a_scenario_not_run_is_an_error_unless_scenarios_is_given(
+    tmp_path, monkeypatch, capsys
+):
+    (tmp_path / "c.toml").write_text(GOOD + LIMIT + 'scenarios = ["aproach"]\n')
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(SystemExit) as exit_info:
+        run_cli(main, ["c.toml", "--out", "out", "--quiet"], prog="fpga-robotics sweep")
+    assert exit_info.value.code == 2
+    lines = capsys.readouterr().err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith(
+        "fpga-robotics sweep: error: c.toml: known_limits[0]: scenarios names 'aproach', "
+        "which the campaign does not run"
+    ), lines
+    assert not (tmp_path / "out").exists()
+    # The file's own scenario is accepted; with --scenarios choosing others, an entry for a
+    # scenario of the file that is not run just does not apply.
+    (tmp_path / "c.toml").write_text(GOOD + LIMIT + 'scenarios = ["approach"]\n')
+    assert main(["c.toml", "--dry-run"]) == 0
+    assert main(["c.toml", "--scenarios", "divider", "--dry-run"]) == 0
+
+
+def test_two_scenario_files_of_one_name_are_an_error_naming_both(tmp_path, monkeypatch, capsys):
+    from fpga_robotics.scenario.load import load_scenario
+
+    # A copy of the shipped `approach` elsewhere: another file, the same name.
+    shipped = load_scenario("approach").source
+    (tmp_path / "mine.toml").write_text(Path(shipped).read_text())
+    (tmp_path / "c.toml").write_text(GOOD.replace('["approach"]', '["approach", "mine.toml"]'))
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(SystemExit) as exit_info:
+        run_cli(main, ["c.toml", "--out", "out", "--quiet"], prog="fpga-robotics sweep")
+    assert exit_info.value.code == 2
+    lines = capsys.readouterr().err.strip().splitlines()
+    assert len(lines) == 1, lines
+    assert lines[0] == (
+        f"fpga-robotics sweep: error: c.toml: scenarios approach ({shipped}) and mine.toml "
+        "are two files with the same name 'approach' (results are grouped by name): give "
+        'one of them another name = "..."'
+    )
+    assert not (tmp_path / "out").exists()
+    # The same file twice (by name and by path) is one scenario: no error.
+    (tmp_path / "c.toml").write_text(GOOD.replace('["approach"]', f'["approach", "{shipped}"]'))
+    assert main(["c.toml", "--dry-run"]) == 0

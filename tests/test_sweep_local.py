@@ -104,6 +104,12 @@ def test_failing_runs_have_their_recording(small_campaign):
     assert sorted(p.name for p in (out / "recordings").iterdir()) == sorted(
         f"{r['run_id']}.rrd" for r in failing
     )
+    # results.jsonl: one line per run, a failing run's with its recording.
+    lines = [json.loads(line) for line in (out / "results.jsonl").read_text().splitlines()]
+    assert sorted(r["run_id"] for r in lines) == sorted(r["run_id"] for r in rows)
+    for line in lines:
+        failed = line["run_id"] in {r["run_id"] for r in failing}
+        assert line["recording"] == (f"recordings/{line['run_id']}.rrd" if failed else "")
 
 
 def test_replay_command_reproduces_the_summary(small_campaign, tmp_path):

@@ -4,6 +4,7 @@ Exit status: 0 when every run passed, 1 when some did not, 2 for a usage error (
 malformed campaign file, unknown scenario or key, bad override value, unreachable scheduler).
 """
 
+import math
 import sys
 from pathlib import Path
 
@@ -11,7 +12,12 @@ from fpga_robotics.cli.errors import UsageError
 from fpga_robotics.cli.parser import CommandParser
 from fpga_robotics.sim.files import check_output_dir
 from fpga_robotics.sweep.api import report_dir, run_campaign
-from fpga_robotics.sweep.campaign import load_campaign, read_campaign_file, shipped_campaigns
+from fpga_robotics.sweep.campaign import (
+    load_campaign,
+    parse_seeds,
+    read_campaign_file,
+    shipped_campaigns,
+)
 from fpga_robotics.sweep.engine import RECORD_LOG_EVERY
 from fpga_robotics.sweep.plan import make_plan
 from fpga_robotics.sweep.report import campaign_passed, format_report
@@ -148,28 +154,43 @@ def build_parser(prog=PROG):
 
 
 def _merge_options(data, args):
+    """The command-line values into the campaign's table, each checked first: an error
+    names the option, not the campaign file."""
     from fpga_robotics.scenario.load import _parse_value  # lazy: the run stack (~1 s)
 
     if args.scenarios is not None:
-        data["scenarios"] = [s for s in args.scenarios.split(",") if s]
+        data["scenarios"] = [s.strip() for s in args.scenarios.split(",") if s.strip()]
+        if not data["scenarios"]:
+            raise UsageError(
+                f"--scenarios needs scenario names or .toml paths (A,B), got {args.scenarios!r}"
+            )
     if args.seeds is not None:
         text = args.seeds.strip()
+        parts = [s.strip() for s in text.split(",")]
         data["seeds"] = (
-            [int(s) for s in text.split(",") if s.strip()]
-            if "," in text and all(s.strip().isdigit() for s in text.split(","))
+            [int(s) for s in parts if s]
+            if "," in text and all(s.isdigit() for s in parts if s)
             else text
         )
+        parse_seeds(data["seeds"], where="--seeds", forms="A-B (e.g. 0-19) or A,B,C")
+    if args.duration is not None and not 0 < args.duration < math.inf:
+        raise UsageError(f"--duration must be > 0 seconds, got {args.duration}")
     for key in ("backend", "resolution", "duration", "shadow", "design", "ports", "timeout"):
         value = getattr(args, key)
         if value is not None:
             data[key] = value
     if args.fixed is not None:
+        for item in args.fixed:
+            if not item.partition("=")[0].strip() or "=" not in item:
+                raise UsageError(f"--set needs KEY=VALUE (e.g. robot.mass=12), got {item!r}")
         data["set"] = list(data.get("set", [])) + args.fixed
     for item in args.grid:
         key, sep, text = item.partition("=")
         values = _parse_value(text) if sep else None
-        if not key.strip() or not isinstance(values, list):
-            raise UsageError(f"--grid needs KEY=[V1, V2, ...] (a TOML list), got {item!r}")
+        if not key.strip() or not isinstance(values, list) or not values:
+            raise UsageError(
+                f"--grid needs KEY=[V1, V2, ...] (a TOML list of at least one value), got {item!r}"
+            )
         grid = data.get("grid") if isinstance(data.get("grid"), dict) else {}
         data["grid"] = {**grid, key.strip(): values}
 
@@ -187,7 +208,7 @@ def _campaign(args):
         data, path = read_campaign_file(args.campaign)
         source = str(path)
     _merge_options(data, args)
-    return load_campaign(data, source=source)
+    return load_campaign(data, source=source, scenarios_replaced=args.scenarios is not None)
 
 
 def _check_counts(args):

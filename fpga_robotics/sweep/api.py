@@ -33,7 +33,8 @@ def run_campaign(
     fork=True,
 ):
     """Run ``campaign`` (a ``Campaign``) and return its results rows (list of dicts, one per
-    run, in the order they finished; with ``resume`` the rows already in ``out_dir`` too).
+    run, in the order they finished; with ``resume`` the rows already in ``out_dir`` of runs
+    of this campaign too: a row whose run's identity changed is dropped and run again).
 
     ``client``: an open ``distributed.Client`` to use (else one is opened: ``scheduler`` or
     an embedded cluster of ``workers`` processes). ``echo(text)``: where progress notes go.
@@ -43,10 +44,18 @@ def run_campaign(
     """
     say = echo or (lambda text: None)
     plan = make_plan(campaign)
+    # --resume keeps the finished runs of the whole campaign (--max-runs limits what runs now).
+    run_ids = set(plan.ids.values())
     if max_runs is not None:
         plan.runs = plan.runs[:max_runs]
     out_dir = Path(out_dir)
-    store = ResultStore(out_dir, resume=resume)
+    store = ResultStore(out_dir, resume=resume, run_ids=run_ids)
+    if store.dropped:
+        say(
+            f"--resume: {store.dropped} earlier row(s) in {out_dir} not kept (errors, "
+            f"timeouts, and runs this campaign no longer makes: an edited scenario or "
+            f"design file, another option or package version)"
+        )
     meta = {
         "name": campaign.name,
         "description": campaign.description,

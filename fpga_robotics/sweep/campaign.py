@@ -28,7 +28,7 @@ A campaign is a TOML file (docs/campaigns.md)::
     [[known_limits]]                        # optional: a failure that is a limit of the design
     check = "found_min_fraction"            # the check that fails (or a list of checks)
     when = {"camera.resolution" = "80x60"}  # optional: the runs' overrides it applies to
-    scenarios = ["divider"]                 # optional: the scenarios it applies to
+    scenarios = ["divider"]                 # optional: the scenarios it applies to (by name)
     reason = "at 80x60 the target is ..."   # why: shown in the report
 
 The runs are, for every scenario and seed, the cartesian product of the grid plus each
@@ -142,6 +142,9 @@ class Campaign:
     identities: dict = field(default_factory=dict)  # filled by plan.identify
     #: ``[[known_limits]]``: failures that are limits of the design, each with its reason.
     known_limits: list = field(default_factory=list)
+    #: The scenarios were replaced on the command line (``--scenarios``): a known limit may
+    #: then name a scenario of the file that this campaign does not run (it does not apply).
+    scenarios_replaced: bool = False
 
 
 def toml_value(v):
@@ -172,12 +175,17 @@ def _toml_string(text):
     return json.dumps(text, ensure_ascii=False).replace("\x7f", "\\u007f")
 
 
-def parse_seeds(value, where="seeds"):
-    """``"0-19"``, ``"7"``, an integer or a list of integers → a list of seeds."""
+#: How seeds are written in a campaign file (the messages of ``parse_seeds``).
+SEED_FORMS = '"A-B" (e.g. "0-19") or a list of integers'
+
+
+def parse_seeds(value, where="seeds", forms=SEED_FORMS):
+    """``"0-19"``, ``"7"``, an integer or a list of integers → a list of seeds. ``where``
+    and ``forms``: the setting and how seeds are written there, for the messages."""
     from fpga_robotics.scenario.load import MAX_SEED  # lazy: the run stack (~1 s)
 
     if isinstance(value, bool):
-        raise CampaignError(f'{where} must be "A-B" or a list of integers, got {value!r}')
+        raise CampaignError(f"{where} must be {forms}, got {value!r}")
     if isinstance(value, int):
         seeds = [value]
     elif isinstance(value, str):
@@ -187,9 +195,7 @@ def parse_seeds(value, where="seeds"):
             a = int(lo)
             b = int(hi) if sep else a
         except ValueError:
-            raise CampaignError(
-                f'{where} must be "A-B" (e.g. "0-19") or a list of integers, got {value!r}'
-            ) from None
+            raise CampaignError(f"{where} must be {forms}, got {value!r}") from None
         if b < a:
             raise CampaignError(
                 f'{where} range {value!r} is empty: write the lower seed first (e.g. "{b}-{a}")'
@@ -204,7 +210,7 @@ def parse_seeds(value, where="seeds"):
             raise CampaignError(f"{where} list must hold integers only, got {value!r}")
         seeds = list(dict.fromkeys(value))
     else:
-        raise CampaignError(f'{where} must be "A-B" or a list of integers, got {value!r}')
+        raise CampaignError(f"{where} must be {forms}, got {value!r}")
     if not seeds:
         raise CampaignError(f'{where} is empty: give at least one seed (e.g. "0-4")')
     bad = [s for s in seeds if not 0 <= s <= MAX_SEED]
@@ -399,9 +405,10 @@ def read_campaign_file(name_or_path):
     return data, path
 
 
-def load_campaign(data, *, source=""):
+def load_campaign(data, *, source="", scenarios_replaced=False):
     """The ``Campaign`` of a checked table (``read_campaign_file`` plus command-line
-    options merged in). Scenarios and overrides are checked by ``plan.validate``."""
+    options merged in). Scenarios and overrides are checked by ``plan.make_plan``.
+    ``scenarios_replaced``: the command line replaced the file's scenarios."""
     where = f"{source}: " if source else ""
     try:
         name = _typed(data, "name", str, "a string") or "campaign"
@@ -463,6 +470,7 @@ def load_campaign(data, *, source=""):
         timeout=timeout,
         source=source,
         known_limits=known_limits,
+        scenarios_replaced=scenarios_replaced,
     )
 
 

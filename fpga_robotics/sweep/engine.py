@@ -213,7 +213,9 @@ def run_plan(
         groups = [[spec] for spec in todo]
     pending = list(reversed(groups))
     running = {}  # future -> (specs, submitted at, timeout, recording pass)
-    done_rows = {}
+    # Failing runs waiting for their recording pass: a run's row is stored once, with its
+    # recording (results.jsonl holds one line per run).
+    awaiting = {}
     failures = 0
     bar = _progress(len(todo), quiet)
     completed = as_completed()
@@ -244,9 +246,7 @@ def run_plan(
         while pending and len(running) < window:
             submit(pending.pop())
 
-    def finished(spec, outcome):
-        nonlocal failures
-        row = make_row(spec, plan.ids[spec], plan.names[spec], outcome)
+    def keep(row, outcome):
         if outcome.get("recording"):
             row["recording"] = _save_recording(store.dir, row["run_id"], outcome["recording"])
         if outcome.get("bag"):
@@ -254,14 +254,20 @@ def run_plan(
         store.add(row)
         if on_row is not None:
             on_row(row)
+
+    def finished(spec, outcome):
+        nonlocal failures
+        row = make_row(spec, plan.ids[spec], plan.names[spec], outcome)
+        if outcome["status"] == "fail" and record == "failing":
+            awaiting[row["run_id"]] = row  # stored when its recording pass is back
+            submit([spec], recording=True)
+        else:
+            keep(row, outcome)
         frames, pixels = plan.frames[spec]
         if outcome["status"] in ("pass", "fail", "n/a"):  # a finished run, whatever its verdict
             timeouts.learn(spec.backend, frames, pixels, outcome.get("run_s", 0.0))
         if outcome["status"] != "pass":
             failures += 1
-        if outcome["status"] == "fail" and record == "failing":
-            done_rows[row["run_id"]] = row
-            submit([spec], recording=True)
         bar.update(1)
         bar.set_postfix_str(f"{failures} not passed", refresh=False)
 
@@ -270,16 +276,10 @@ def run_plan(
         for fut in completed:
             specs, _submitted, limit, recording = running.pop(fut)
             outcome = _outcome(client, fut, limit)
-            if recording:  # the recording pass of a failing run: attach its .rrd
-                spec = specs[0]
-                row = done_rows.pop(plan.ids[spec], None)
-                if row is not None and outcome.get("recording"):
-                    row["recording"] = _save_recording(
-                        store.dir, plan.ids[spec], outcome["recording"]
-                    )
-                    if outcome.get("bag"):
-                        row["bag"] = _save_bag(store.dir, plan.ids[spec], outcome["bag"])
-                    store.add(row)
+            if recording:  # the recording pass of a failing run: its row, with the .rrd
+                row = awaiting.pop(plan.ids[specs[0]], None)
+                if row is not None:  # (a recording pass that failed: the row without one)
+                    keep(row, outcome)
                 top_up()
                 continue
             # A group's task gives one outcome per run (or one for all: its worker died).
@@ -290,6 +290,8 @@ def run_plan(
     finally:
         if running:
             client.cancel(list(running))
+        for row in awaiting.values():  # interrupted before their recording: finished runs
+            store.add(row)
         bar.close()
         store.flush()
     return len(todo)

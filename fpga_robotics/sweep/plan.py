@@ -2,6 +2,7 @@
 and grouped by the design it needs (each parameter set is built once)."""
 
 from dataclasses import dataclass, field, replace
+from pathlib import Path
 
 from fpga_robotics.hw.errors import UsageError
 
@@ -38,11 +39,13 @@ def _concrete_backend(spec):
 
 def make_plan(campaign):
     """Check every run (``UsageError`` naming the run's scenario and overrides) and name it.
-    Runs differing only by seed share one check."""
+    Runs differing only by seed share one check. Two scenario files of one name, and a
+    known limit naming a scenario the campaign does not run, are usage errors too."""
     from ..sim.backends import BACKEND_NAMES  # lazy: the simulator (~0.5 s)
 
     plan = Plan(runs=[])
     checked = {}
+    files_named = {}  # scenario name -> {resolved file: (as the campaign gives it, file)}
     for spec in campaign.runs:
         if spec.backend not in ("auto", *BACKEND_NAMES):
             raise UsageError(
@@ -77,10 +80,51 @@ def make_plan(campaign):
                 world_key(args, scenario, shadow_params),
             )
             plan.builds.setdefault(key, spec.argv())
+            files_named.setdefault(scenario.name, {}).setdefault(
+                str(Path(scenario.source).resolve()) if scenario.source else spec.scenario,
+                (spec.scenario, scenario.source),
+            )
         scenario, files, _key, frames, pixels, world = checked[shape]
         plan.worlds[spec] = world
         plan.runs.append(spec)
         plan.ids[spec] = run_identity(spec, scenario.source, files)
         plan.names[spec] = scenario.name
         plan.frames[spec] = (frames, pixels)
+    where = f"{campaign.source}: " if campaign.source else ""
+    _one_file_per_name(files_named, where)
+    _limits_name_run_scenarios(campaign, set(files_named), where)
     return plan
+
+
+def _shown(given, source):
+    """A scenario as the campaign gives it, with its file when the name does not say it."""
+    if source and Path(given).resolve() != Path(source).resolve():
+        return f"{given} ({source})"
+    return given
+
+
+def _one_file_per_name(files_named, where):
+    """Rows, pass rates and known limits go by a scenario's name: two files of one name
+    would be counted as one scenario."""
+    for name, files in files_named.items():
+        if len(files) > 1:
+            (a, sa), (b, sb) = list(files.values())[:2]
+            raise UsageError(
+                f"{where}scenarios {_shown(a, sa)} and {_shown(b, sb)} are two files with the "
+                f"same name {name!r} (results are grouped by name): give one of them another "
+                f'name = "..."'
+            )
+
+
+def _limits_name_run_scenarios(campaign, names, where):
+    """A known limit's ``scenarios`` must be scenarios the campaign runs (a typo would
+    otherwise explain nothing, silently); unless the command line chose the scenarios."""
+    if campaign.scenarios_replaced:
+        return
+    for i, entry in enumerate(campaign.known_limits):
+        stray = [n for n in entry["scenarios"] if n not in names]
+        if stray:
+            raise UsageError(
+                f"{where}known_limits[{i}]: scenarios names {stray[0]!r}, which the campaign "
+                f"does not run (its scenarios are named {', '.join(sorted(names))})"
+            )

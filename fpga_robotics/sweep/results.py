@@ -10,6 +10,8 @@ keeps every finished run; a torn last line is ignored on reading). ``results.par
 import csv
 import io
 import json
+import re
+import shutil
 import time
 from pathlib import Path
 
@@ -143,17 +145,30 @@ def _table(rows):
 
 
 class ResultStore:
-    """The results folder of a campaign. ``resume``: keep the rows already there."""
+    """The results folder of a campaign. ``resume``: keep the rows already there that are
+    finished runs of the campaign: ``run_ids``, the identities of its runs (None: every
+    finished run). ``dropped``: how many rows already there were not kept."""
 
     FLUSH_EVERY_S = 2.0
 
-    def __init__(self, out_dir, *, resume=False):
+    def __init__(self, out_dir, *, resume=False, run_ids=None):
         self.dir = Path(out_dir)
         self.dir.mkdir(parents=True, exist_ok=True)
         rows = load_rows(self.dir) if resume else []
-        # Runs to do again (errors, timeouts) are dropped from the journal too.
-        self._rows = {r["run_id"]: r for r in rows if r.get("status") in DONE}
+        # Runs to do again (errors, timeouts) are dropped from the journal too, and so are
+        # rows of runs the campaign no longer makes (a scenario or design file edited, an
+        # option or the package version changed: the identity differs), with their
+        # recordings: the campaign's run under its new identity replaces them.
+        self._rows = {
+            r["run_id"]: r
+            for r in rows
+            if r.get("status") in DONE and (run_ids is None or r["run_id"] in run_ids)
+        }
+        stale = [r["run_id"] for r in rows if r["run_id"] not in self._rows]
+        self.dropped = len(stale)
         self._rewrite_journal()
+        for run_id in stale:
+            self._remove_files_of(run_id)
         self._journal = open(self.dir / JOURNAL, "a")  # noqa: SIM115 (open for the campaign)
         self._last_flush = time.monotonic()
         self._dirty = True
@@ -161,6 +176,13 @@ class ResultStore:
     def _rewrite_journal(self):
         text = "".join(json.dumps(r) + "\n" for r in self.rows)
         write_atomic(self.dir / JOURNAL, text, what="results journal")
+
+    def _remove_files_of(self, run_id):
+        """A dropped run's recording and bag (``recordings/<id>.rrd``, ``bags/<id>/``)."""
+        if not re.fullmatch(r"[0-9a-f]+", str(run_id)):  # a hand-edited row: not a file name
+            return
+        (self.dir / "recordings" / f"{run_id}.rrd").unlink(missing_ok=True)
+        shutil.rmtree(self.dir / "bags" / run_id, ignore_errors=True)
 
     @property
     def rows(self):

@@ -1,0 +1,84 @@
+"""``--resume`` after a scenario file was edited: the runs of the old file are run again and
+their rows replaced (with their recordings), so the results hold each run of the campaign
+once, judged by the file as it is now."""
+
+import csv
+import json
+
+from fpga_robotics.sweep import load_campaign, run_campaign
+from fpga_robotics.sweep.results import load_rows
+
+#: A target walking away from a robot that cannot keep up: the mean distance grows past a few
+#: metres, so the check's limit decides the verdict.
+SCENARIO = """name = "walkaway"
+[room]
+width = 20.0
+depth = 4.0
+[robot]
+start = [1.5, 2.0]
+heading_deg = 0.0
+[[people]]
+name = "runner"
+waypoints = [[3.5, 2.0], [19.0, 2.0]]
+speed = 1.0
+loop = false
+[checks]
+mean_distance_max_m = {limit}
+"""
+
+
+def _campaign(path):
+    return load_campaign(
+        {
+            "scenarios": [str(path)],
+            "seeds": [0, 1],
+            "backend": "model",
+            "resolution": "40x24",
+            "duration": 2.0,
+            "grid": {"people.0.speed": [0.2, 1.0]},
+        }
+    )
+
+
+def _limits(rows):
+    """Each run's (seed, speed) -> the mean-distance limit its row was judged by."""
+    out = {}
+    for row in rows:
+        [check] = [c for c in json.loads(row["checks_json"]) if c["name"] == "mean_distance_max_m"]
+        out[(row["seed"], row["people.0.speed"])] = check["limit"]
+    return out
+
+
+def test_resume_after_editing_the_scenario_replaces_the_runs_of_the_old_file(tmp_path):
+    scenario = tmp_path / "walkaway.toml"
+    out = tmp_path / "out"
+    runs = {(seed, speed) for seed in (0, 1) for speed in (0.2, 1.0)}
+
+    # A limit no run meets: every run fails and is recorded.
+    scenario.write_text(SCENARIO.format(limit=0.5))
+    first = run_campaign(_campaign(scenario), out, workers=1, record="failing")
+    assert len(first) == 4 and {r["status"] for r in first} == {"fail"}
+    old_ids = {r["run_id"] for r in first}
+    assert {p.stem for p in (out / "recordings").iterdir()} == old_ids
+
+    # A limit every run meets: the same runs, judged again by the new file.
+    scenario.write_text(SCENARIO.format(limit=50.0))
+    rows = run_campaign(_campaign(scenario), out, workers=1, record="failing", resume=True)
+    assert len(rows) == 4 and {r["status"] for r in rows} == {"pass"}
+    assert not {r["run_id"] for r in rows} & old_ids
+    assert _limits(rows) == dict.fromkeys(runs, 50.0)
+    # Every reader sees each run once: the journal, the CSV table, the rows read back.
+    assert len((out / "results.jsonl").read_text().splitlines()) == 4
+    with open(out / "results.csv", newline="") as f:
+        table = list(csv.DictReader(f))
+    assert sorted((int(r["seed"]), float(r["people.0.speed"])) for r in table) == sorted(runs)
+    assert _limits(load_rows(out)) == dict.fromkeys(runs, 50.0)
+    # The old runs' recordings went with their rows (the new runs pass: none recorded).
+    assert list((out / "recordings").iterdir()) == []
+
+    # Resuming the file as it is runs nothing; --max-runs limits what runs, not what is kept.
+    again = run_campaign(
+        _campaign(scenario), out, workers=1, record="failing", resume=True, max_runs=1
+    )
+    assert sorted(r["run_id"] for r in again) == sorted(r["run_id"] for r in rows)
+    assert json.loads((out / "campaign.json").read_text())["ran"] == 0
