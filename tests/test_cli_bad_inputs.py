@@ -50,6 +50,11 @@ CASES = [
     ("nan duration", ["run", "--duration", "nan"], "--duration"),
     ("max-frames without source", ["run", "--max-frames", "5"], "--source"),
     ("duration with source", ["run", "--source", "{frames}", "--duration", "1"], "--duration"),
+    (
+        "parameter shadow in real-clock timing",
+        ["run", "--scenario", "line_track", "--shadow", "diff_min=5"],
+        "real-clock timing, where --shadow takes a design reference",
+    ),
     ("negative max-frames", ["run", "--source", "{frames}", "--max-frames", "-1"], "--max-frames"),
     ("log-every zero", ["run", "--log-every", "0", "--rerun", "save:x.rrd"], "--log-every"),
     ("unknown backend", ["run", "--backend", "iverilog"], "invalid choice"),

@@ -34,7 +34,7 @@ CASES = {
     "not a list": (GOOD + '[grid]\n"design.diff_min" = 4\n', "must be a list of values"),
     "a parameter shadow in real-clock timing": (
         'scenarios = ["line_track"]\nduration = 1.0\nshadow = "published"\n',
-        "--shadow compares frames; it needs a scenario in compressed timing",
+        "this scenario runs in real-clock timing, where --shadow takes a design reference",
     ),
 }
 

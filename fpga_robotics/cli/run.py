@@ -765,8 +765,10 @@ def main(argv=None, prog="fpga-robotics run"):
     if scenario.sim.timing == "real_clock":
         if shadow_params is not None:
             raise UsageError(
-                "--shadow compares frames; it needs a scenario in compressed "
-                "timing (sim.timing), not real_clock"
+                "--shadow NAME=VALUE shadows FollowTarget with other parameters, frame "
+                "by frame, in compressed timing; this scenario runs in real-clock timing, "
+                "where --shadow takes a design reference (FILE.py:Name, a built-in "
+                "design's name)"
             )
         scenario = _with_design_files(args, scenario)
         design = _open_pin_design(args, scenario)

@@ -102,8 +102,10 @@ def load_run(argv):
         shadow_params = run._shadow_params(scenario, args.shadow)
         if shadow_params is not None and scenario.sim.timing == "real_clock":
             raise UsageError(
-                "--shadow compares frames; it needs a scenario in compressed "
-                "timing (sim.timing), not real_clock"
+                "--shadow NAME=VALUE shadows FollowTarget with other parameters, frame "
+                "by frame, in compressed timing; this scenario runs in real-clock timing, "
+                "where --shadow takes a design reference (FILE.py:Name, a built-in "
+                "design's name)"
             )
     run._design_files(args, scenario.foreign)
     if scenario.sim.timing == "real_clock":  # the pin design is the scenario's foreign one
