@@ -149,7 +149,7 @@ def test_unknown_keys_are_errors_with_close_matches(item, expect):
         ("people.5.speed=1", "index it with 0..0"),
         ("sim.duration", "KEY=VALUE"),
         ("sim.duration=-1", "sim.duration must be > 0"),
-        ("sim.physics_dt=0.5", "sim.physics_dt must be <="),
+        ("sim.physics_dt=0.5", "sim.physics_dt 0.5 s is longer than a camera frame period"),
         ("camera.resolution=abc", "WIDTHxHEIGHT"),
         ("color.initial=purple", "color.initial must be one of"),
         ("design.kp_num=1.5", "kp_num must be an int"),
@@ -437,9 +437,16 @@ def test_scenario_paths_that_are_not_files(tmp_path, monkeypatch):
         (
             "sim.physics_dt=0.1",
             (
-                "sim.physics_dt must be <= 0.0333333 s (one camera frame period, "
-                "1 / camera.fps), got 0.1"
+                "sim.physics_dt 0.1 s is longer than a camera frame period (1 / camera.fps "
+                "30 = 0.0333333 s); a physics step must be at most one frame: set "
+                "sim.physics_dt to 0.0333333 or less, or lower camera.fps"
             ),
+        ),
+        (  # the default step (1/240 s) against a faster camera: both keys named
+            "camera.fps=1000",
+            "sim.physics_dt 0.00416667 s is longer than a camera frame period (1 / camera.fps "
+            "1000 = 0.001 s); a physics step must be at most one frame: set sim.physics_dt to "
+            "0.001 or less, or lower camera.fps",
         ),
         ("sim.physics_dt=1e-6", "sim.physics_dt must be >= 1e-05 s, got 1e-06"),
     ],

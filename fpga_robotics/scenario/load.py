@@ -721,6 +721,12 @@ def _check_camera_geometry(camera, world):
 def _sim(data, camera):
     k = _keys(SimKeys, data["sim"], "sim")
     period = camera.frame_period
+    if isinstance(k.physics_dt, int | float) and k.physics_dt > period:  # names both keys
+        raise ScenarioError(
+            f"sim.physics_dt {k.physics_dt:g} s is longer than a camera frame period "
+            f"(1 / camera.fps {camera.fps:g} = {period:g} s); a physics step must be at most "
+            f"one frame: set sim.physics_dt to {period:g} or less, or lower camera.fps"
+        )
     # The physics step: at most one frame period (a bound that depends on camera.fps).
     step = Number(
         ge=1e-5,
