@@ -444,9 +444,11 @@ def test_scenario_paths_that_are_not_files(tmp_path, monkeypatch):
         ),
         (  # the default step (1/240 s) against a faster camera: both keys named
             "camera.fps=1000",
-            "sim.physics_dt 0.00416667 s is longer than a camera frame period (1 / camera.fps "
-            "1000 = 0.001 s); a physics step must be at most one frame: set sim.physics_dt to "
-            "0.001 or less, or lower camera.fps",
+            (
+                "sim.physics_dt 0.00416667 s is longer than a camera frame period (1 / "
+                "camera.fps 1000 = 0.001 s); a physics step must be at most one frame: set "
+                "sim.physics_dt to 0.001 or less, or lower camera.fps"
+            ),
         ),
         ("sim.physics_dt=1e-6", "sim.physics_dt must be >= 1e-05 s, got 1e-06"),
     ],
