@@ -390,7 +390,7 @@ def format_summary(s):
     found = (
         f"{s['found_fraction']:.0%}"
         if s["found_fraction"] is not None
-        else "n/a (no `found` output)"
+        else "n/a (no tracker `found` output)"
     )
     searches = s["searches"] if s["searches"] is not None else "n/a"
     # Without a target person every distance is missing (the trajectory holds NaN).
