@@ -110,9 +110,9 @@ def check_follow_target_design(args, subject):
     """One line when ``--design`` names a design this subject cannot time."""
     if args.design != "follow_target":
         raise UsageError(
-            f"bench {subject} times follow_target (its frame path and its own world); "
-            f"{args.design} runs in real-clock timing: time it with fpga-robotics bench "
-            f"user_verilog --design {args.design} (--ports MAP for verilog:FILES)"
+            f"bench {subject} times follow_target only (its frame path and its own world); "
+            f"a design of your own ({args.design}) is timed by fpga-robotics bench "
+            f"user_verilog --design REF (--ports MAP for verilog:FILES)"
         )
 
 
