@@ -337,10 +337,12 @@ def _load_target(reference):
             f"design {reference!r}: {where} has no {name!r}"
             + (f"; its components: {', '.join(found)}" if found else "")
         )
-    if not callable(target):
+    if not _is_factory(target):
+        # A callable object (a data.StructLayout, a built component) is no design either.
         raise DesignError(
-            f"design {reference!r}: {name} is a {type(target).__name__}; it "
-            f"must be a wiring.Component class or a function returning one"
+            f"design {reference!r}: {name} is a {type(target).__name__}, not a "
+            f"wiring.Component class or a function returning one"
+            + ("; name its class" if _is_component(target) else "")
         )
     if inspect.isclass(target) and not _is_component_class(target):
         raise DesignError(
@@ -389,6 +391,20 @@ def _error_line(exc, path):
 def _first_line(exc):
     text = str(exc).strip()
     return text.splitlines()[0] if text else "(no message)"
+
+
+def _is_factory(value):
+    """A class, a function or a method (a ``functools.partial`` of one): what a design
+    reference may name."""
+    if isinstance(value, functools.partial):
+        value = value.func
+    return inspect.isclass(value) or inspect.isroutine(value)
+
+
+def _is_component(value):
+    from amaranth.lib import wiring  # lazy: Amaranth (~0.3 s)
+
+    return isinstance(value, wiring.Component)
 
 
 def _is_component_class(value):
