@@ -591,7 +591,31 @@ def bindings_of(component, ports, given=None):
                 }
         elif pins and all(p in ports for p in pins):
             bindings[kind] = {p: p for p in pins}
+    if "wheels" in bindings:
+        _check_wheels(component, bindings["wheels"])
     return bindings
+
+
+def _check_wheels(component, wheels):
+    """``DesignError`` unless every wheel port is a signed output of at most the connector's
+    16 bits (a narrower one is sign-extended, as a Verilog design's)."""
+    from fpga_robotics.hw.verilog import verilog_ports  # lazy: Amaranth (~0.3 s)
+
+    found = verilog_ports(component)
+    for pin, spec in CONNECTORS["wheels"].pins.items():
+        port = wheels.get(pin)
+        if port not in found:
+            continue
+        value, direction = found[port]
+        shape = value.shape()
+        if direction != "o" or not shape.signed or shape.width > spec.width:
+            kind = f"{'signed' if shape.signed else 'unsigned'}({shape.width})"
+            raise DesignError(
+                f"design {type(component).__name__}: port {port!r} (the wheels' {pin} pin) is "
+                f"{'an output' if direction == 'o' else 'an input'} of {kind}; the wheels "
+                f"take a signed output of at most {spec.width} bits, e.g. "
+                f"Out(signed({spec.width}))"
+            )
 
 
 def extra_outputs_of(ports, bindings):

@@ -133,6 +133,15 @@ def format_extra_outputs(summary):
     ]
 
 
+def _port_fits(port, pin):
+    """Whether design ``port`` can be connector ``pin``: of its width, or for a signed output
+    pin (the wheels' DPS, a servo's angle) a narrower signed output, which the backends read
+    sign-extended."""
+    if port.width == pin.width:
+        return True
+    return pin.direction == "out" and pin.signed and port.signed and port.width < pin.width
+
+
 class _PendingRow:
     """Trajectory row ``k`` between its capture and the end of its frame's processing."""
 
@@ -287,15 +296,19 @@ class RealClockLoop(ClosedLoop):
                     f"no port {port!r} (for pin {pin!r}); its ports: {', '.join(sorted(ports))}"
                 )
             p = ports[port]
-            if p.direction != spec.direction or p.width != spec.width:
+            if p.direction != spec.direction or not _port_fits(p, spec):
+                extended = spec.direction == "out" and spec.signed
                 raise UsageError(
                     f"the {conn.kind} connector {conn.name!r}: pin {pin!r} is {spec.direction} "
-                    f"{spec.width} bit(s) but port {port!r} of design {self.top.name!r} is "
-                    f"{p.direction} {p.width} bit(s)"
+                    f"{spec.width} bit(s){' signed' if extended else ''} but port {port!r} of "
+                    f"design {self.top.name!r} is {p.direction} {p.width} bit(s)"
+                    f"{' signed' if p.signed else ''}"
                     + (
                         "; the line_sensors table must list as many sensors as the design's "
                         "line input has bits (design.line.n_sensors)"
                         if conn.kind == "line_sensors"
+                        else f"; a signed output of at most {spec.width} bits is sign-extended"
+                        if extended
                         else ""
                     )
                 )
