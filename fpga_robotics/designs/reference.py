@@ -49,6 +49,7 @@ __all__ = [
     "extra_outputs_of",
     "is_builtin",
     "resolve_design",
+    "stream_ports",
 ]
 
 #: The entry-point group through which installed packages offer designs.
@@ -573,7 +574,8 @@ def bindings_of(component, ports, given=None):
                     f"{', '.join(kinds[kind])}"
                 )
             if kind == "camera" and pin == "pixels":
-                continue  # the stream: pixels__valid / pixels__payload
+                _check_stream(component, port, ports)
+                continue
             if port not in ports:
                 raise DesignError(
                     f"{type(component).__name__}.connectors[{kind!r}][{pin!r}]: "
@@ -616,6 +618,30 @@ def _check_wheels(component, wheels):
                 f"take a signed output of at most {spec.width} bits, e.g. "
                 f"Out(signed({spec.width}))"
             )
+
+
+def stream_ports(bindings):
+    """``(valid, payload)``: the input ports of the camera's pixel stream as the bindings
+    name it (``cam: In(stream)`` is ``cam__valid``/``cam__payload``); None without a camera."""
+    camera = bindings.get("camera")
+    if camera is None:
+        return None
+    name = camera.get("pixels", "pixels")
+    return (f"{name}__valid", f"{name}__payload")
+
+
+def _check_stream(component, port, ports):
+    """``DesignError`` unless ``port`` names a pixel stream input of the design: a 1-bit
+    ``PORT__valid`` and a 14-bit ``PORT__payload`` (``In(pixel_stream_signature())``)."""
+    name = type(component).__name__
+    valid, payload = f"{port}__valid", f"{port}__payload"
+    if ports.get(valid) == ("in", 1) and ports.get(payload) == ("in", 14):
+        return
+    raise DesignError(
+        f"{name}.connectors['camera']['pixels']: {port!r} is no pixel stream input of "
+        f"{name} (ports {valid} of 1 bit and {payload} of 14 bits, "
+        f"In(pixel_stream_signature())); its ports: {', '.join(ports)}"
+    )
 
 
 def extra_outputs_of(ports, bindings):

@@ -28,7 +28,7 @@ import numpy as np
 
 from fpga_robotics.checks.sensor_metrics import line_metrics, measurement_metrics
 from fpga_robotics.designs.builtin import build_component, connector_kinds, foreign_top
-from fpga_robotics.designs.reference import resolve_design
+from fpga_robotics.designs.reference import resolve_design, stream_ports
 from fpga_robotics.hw.errors import UsageError
 from fpga_robotics.loop.compressed import ClosedLoop, run_loop
 from fpga_robotics.loop.connectors import CONNECTORS, PinIO
@@ -91,10 +91,7 @@ def pin_design_source(scenario):
     key = f"{name}-{hashlib.sha256(described.encode()).hexdigest()[:16]}"
     extra = {}
     if top.camera:
-        extra = {
-            "pixels": ("pixels__valid", "pixels__payload"),
-            "frame_size": (params.width, params.height),
-        }
+        extra = {"pixels": stream_ports(top.bindings), "frame_size": (params.width, params.height)}
 
         ports = resolve_design(scenario.top, scenario.design_params).ports
         if ports.get("filtered__valid", ("",))[0] == "out" and "filtered__payload" in ports:
@@ -321,7 +318,7 @@ class RealClockLoop(ClosedLoop):
         pins = getattr(self.pins, "primary", self.pins)  # a shadow's MirroredPins: its primary
         driven |= set(getattr(getattr(pins, "source", None), "runtime", None) or ())
         if self.top.camera:
-            driven |= {"pixels__valid", "pixels__payload", "color_sel"}
+            driven |= {*stream_ports(self.top.bindings), *self.top.bindings["camera"].values()}
         if self.rig is not None:
             driven |= self.rig.driven_ports()
         for name, port in sorted(self.pins.ports.items()):
