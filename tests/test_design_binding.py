@@ -2,6 +2,7 @@
 than the connector's 16 bits are read sign-extended, wider or unsigned ones are refused in
 one line; a camera stream declared under the design's own port name is streamed to it."""
 
+import json
 import re
 import tomllib
 from pathlib import Path
@@ -130,3 +131,19 @@ def test_mutate_streams_frames_on_the_declared_stream():
     # The robot judge's port map streams the camera's frames on the same ports.
     text = design_mutant_port_map(spec, ports)
     assert tomllib.loads(text)["pixels"] == {"valid": "cam__valid", "payload": "cam__payload"}
+
+
+def test_a_shadow_with_its_own_stream_name_is_streamed_the_same_frames(tmp_path, capsys):
+    # NearRed (the stream named pixels) with NearRedCam (cam) as its shadow: the same logic,
+    # so its red counts match frame for frame only if it is streamed the frames too.
+    summary = tmp_path / "s.json"
+    argv = ["run", "--scenario", str(DESIGNS / "near_red.toml"), "--shadow", NEAR_RED_CAM]
+    argv += ["--backend", "cxxrtl", "--set", "sim.duration=2.0", "--rerun", "off", "--quiet"]
+    with pytest.raises(SystemExit) as info:
+        cli.main([*argv, "--summary", str(summary)])
+    assert info.value.code == 0, capsys.readouterr().err
+    trajectory_counts = json.loads(summary.read_text())["extra_outputs"]["red_count"]
+    assert trajectory_counts["max"] > 0
+    shadow = json.loads(summary.read_text())["shadow"]
+    assert shadow["frames"] == 20 and shadow["first_divergence"] is None
+    assert shadow["differing_frames"] == {"near": 0, "red_count": 0}
