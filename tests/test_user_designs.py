@@ -173,6 +173,12 @@ BAD = [
     ("missing name", "broken.py:Missing", {}, "has no 'Missing'; its components: Sized"),
     ("not a component", "broken.py:NotAComponent", {}, "is not an Amaranth wiring.Component"),
     (
+        "a callable object that is no component",
+        "broken.py:Stats",
+        {"target": 1},
+        "Stats is a StructLayout, not a wiring.Component class or a function returning one",
+    ),
+    (
         "a function that raises",
         "broken.py:raises",
         {},

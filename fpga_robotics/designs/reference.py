@@ -49,6 +49,7 @@ __all__ = [
     "extra_outputs_of",
     "is_builtin",
     "resolve_design",
+    "stream_ports",
 ]
 
 #: The entry-point group through which installed packages offer designs.
@@ -337,10 +338,12 @@ def _load_target(reference):
             f"design {reference!r}: {where} has no {name!r}"
             + (f"; its components: {', '.join(found)}" if found else "")
         )
-    if not callable(target):
+    if not _is_factory(target):
+        # A callable object (a data.StructLayout, a built component) is no design either.
         raise DesignError(
-            f"design {reference!r}: {name} is a {type(target).__name__}; it "
-            f"must be a wiring.Component class or a function returning one"
+            f"design {reference!r}: {name} is a {type(target).__name__}, not a "
+            f"wiring.Component class or a function returning one"
+            + ("; name its class" if _is_component(target) else "")
         )
     if inspect.isclass(target) and not _is_component_class(target):
         raise DesignError(
@@ -389,6 +392,20 @@ def _error_line(exc, path):
 def _first_line(exc):
     text = str(exc).strip()
     return text.splitlines()[0] if text else "(no message)"
+
+
+def _is_factory(value):
+    """A class, a function or a method (a ``functools.partial`` of one): what a design
+    reference may name."""
+    if isinstance(value, functools.partial):
+        value = value.func
+    return inspect.isclass(value) or inspect.isroutine(value)
+
+
+def _is_component(value):
+    from amaranth.lib import wiring  # lazy: Amaranth (~0.3 s)
+
+    return isinstance(value, wiring.Component)
 
 
 def _is_component_class(value):
@@ -557,7 +574,8 @@ def bindings_of(component, ports, given=None):
                     f"{', '.join(kinds[kind])}"
                 )
             if kind == "camera" and pin == "pixels":
-                continue  # the stream: pixels__valid / pixels__payload
+                _check_stream(component, port, ports)
+                continue
             if port not in ports:
                 raise DesignError(
                     f"{type(component).__name__}.connectors[{kind!r}][{pin!r}]: "
@@ -575,7 +593,55 @@ def bindings_of(component, ports, given=None):
                 }
         elif pins and all(p in ports for p in pins):
             bindings[kind] = {p: p for p in pins}
+    if "wheels" in bindings:
+        _check_wheels(component, bindings["wheels"])
     return bindings
+
+
+def _check_wheels(component, wheels):
+    """``DesignError`` unless every wheel port is a signed output of at most the connector's
+    16 bits (a narrower one is sign-extended, as a Verilog design's)."""
+    from fpga_robotics.hw.verilog import verilog_ports  # lazy: Amaranth (~0.3 s)
+
+    found = verilog_ports(component)
+    for pin, spec in CONNECTORS["wheels"].pins.items():
+        port = wheels.get(pin)
+        if port not in found:
+            continue
+        value, direction = found[port]
+        shape = value.shape()
+        if direction != "o" or not shape.signed or shape.width > spec.width:
+            kind = f"{'signed' if shape.signed else 'unsigned'}({shape.width})"
+            raise DesignError(
+                f"design {type(component).__name__}: port {port!r} (the wheels' {pin} pin) is "
+                f"{'an output' if direction == 'o' else 'an input'} of {kind}; the wheels "
+                f"take a signed output of at most {spec.width} bits, e.g. "
+                f"Out(signed({spec.width}))"
+            )
+
+
+def stream_ports(bindings):
+    """``(valid, payload)``: the input ports of the camera's pixel stream as the bindings
+    name it (``cam: In(stream)`` is ``cam__valid``/``cam__payload``); None without a camera."""
+    camera = bindings.get("camera")
+    if camera is None:
+        return None
+    name = camera.get("pixels", "pixels")
+    return (f"{name}__valid", f"{name}__payload")
+
+
+def _check_stream(component, port, ports):
+    """``DesignError`` unless ``port`` names a pixel stream input of the design: a 1-bit
+    ``PORT__valid`` and a 14-bit ``PORT__payload`` (``In(pixel_stream_signature())``)."""
+    name = type(component).__name__
+    valid, payload = f"{port}__valid", f"{port}__payload"
+    if ports.get(valid) == ("in", 1) and ports.get(payload) == ("in", 14):
+        return
+    raise DesignError(
+        f"{name}.connectors['camera']['pixels']: {port!r} is no pixel stream input of "
+        f"{name} (ports {valid} of 1 bit and {payload} of 14 bits, "
+        f"In(pixel_stream_signature())); its ports: {', '.join(ports)}"
+    )
 
 
 def extra_outputs_of(ports, bindings):

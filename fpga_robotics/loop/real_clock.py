@@ -28,7 +28,7 @@ import numpy as np
 
 from fpga_robotics.checks.sensor_metrics import line_metrics, measurement_metrics
 from fpga_robotics.designs.builtin import build_component, connector_kinds, foreign_top
-from fpga_robotics.designs.reference import resolve_design
+from fpga_robotics.designs.reference import resolve_design, stream_ports
 from fpga_robotics.hw.errors import UsageError
 from fpga_robotics.loop.compressed import ClosedLoop, run_loop
 from fpga_robotics.loop.connectors import CONNECTORS, PinIO
@@ -91,10 +91,7 @@ def pin_design_source(scenario):
     key = f"{name}-{hashlib.sha256(described.encode()).hexdigest()[:16]}"
     extra = {}
     if top.camera:
-        extra = {
-            "pixels": ("pixels__valid", "pixels__payload"),
-            "frame_size": (params.width, params.height),
-        }
+        extra = {"pixels": stream_ports(top.bindings), "frame_size": (params.width, params.height)}
 
         ports = resolve_design(scenario.top, scenario.design_params).ports
         if ports.get("filtered__valid", ("",))[0] == "out" and "filtered__payload" in ports:
@@ -131,6 +128,15 @@ def format_extra_outputs(summary):
         f"  design output {name}: last {v['last']}, min {v['min']}, max {v['max']}"
         for name, v in extra.items()
     ]
+
+
+def _port_fits(port, pin):
+    """Whether design ``port`` can be connector ``pin``: of its width, or for a signed output
+    pin (the wheels' DPS, a servo's angle) a narrower signed output, which the backends read
+    sign-extended."""
+    if port.width == pin.width:
+        return True
+    return pin.direction == "out" and pin.signed and port.signed and port.width < pin.width
 
 
 class _PendingRow:
@@ -287,15 +293,19 @@ class RealClockLoop(ClosedLoop):
                     f"no port {port!r} (for pin {pin!r}); its ports: {', '.join(sorted(ports))}"
                 )
             p = ports[port]
-            if p.direction != spec.direction or p.width != spec.width:
+            if p.direction != spec.direction or not _port_fits(p, spec):
+                extended = spec.direction == "out" and spec.signed
                 raise UsageError(
                     f"the {conn.kind} connector {conn.name!r}: pin {pin!r} is {spec.direction} "
-                    f"{spec.width} bit(s) but port {port!r} of design {self.top.name!r} is "
-                    f"{p.direction} {p.width} bit(s)"
+                    f"{spec.width} bit(s){' signed' if extended else ''} but port {port!r} of "
+                    f"design {self.top.name!r} is {p.direction} {p.width} bit(s)"
+                    f"{' signed' if p.signed else ''}"
                     + (
                         "; the line_sensors table must list as many sensors as the design's "
                         "line input has bits (design.line.n_sensors)"
                         if conn.kind == "line_sensors"
+                        else f"; a signed output of at most {spec.width} bits is sign-extended"
+                        if extended
                         else ""
                     )
                 )
@@ -308,7 +318,7 @@ class RealClockLoop(ClosedLoop):
         pins = getattr(self.pins, "primary", self.pins)  # a shadow's MirroredPins: its primary
         driven |= set(getattr(getattr(pins, "source", None), "runtime", None) or ())
         if self.top.camera:
-            driven |= {"pixels__valid", "pixels__payload", "color_sel"}
+            driven |= {*stream_ports(self.top.bindings), *self.top.bindings["camera"].values()}
         if self.rig is not None:
             driven |= self.rig.driven_ports()
         for name, port in sorted(self.pins.ports.items()):

@@ -6,6 +6,7 @@ import os
 import re
 import tomllib
 
+from ..designs.reference import stream_ports
 from ..hw.verilog import TOP_NAME
 from ..sim.backends.foreign import ForeignVerilatorBackend
 from ..sim.backends.port_map import follow_target_port_map
@@ -82,7 +83,8 @@ def design_mutant_port_map(spec, ports, *, reset=True, select=MUTATION_SELECT, w
         lines.append('reset = { port = "rst" }')
     camera = spec.bindings.get("camera")
     if camera is not None:
-        lines.append('pixels = { valid = "pixels__valid", payload = "pixels__payload" }')
+        valid, payload = stream_ports(spec.bindings)
+        lines.append(f"pixels = {{ valid = {q(valid)}, payload = {q(payload)} }}")
         if camera.get("color_sel"):
             lines.append(f"color = {{ port = {q(camera['color_sel'])} }}")
         if ports.get("frame_done") is not None and ports["frame_done"].direction == "out":

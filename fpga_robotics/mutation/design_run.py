@@ -8,6 +8,7 @@ import time
 from amaranth.hdl import Fragment
 
 from ..designs.builtin import connector_kinds
+from ..designs.reference import stream_ports
 from ..hw.verilog import verilog_ports
 from ..sim.backends.foreign import ForeignDesign
 from ..sim.files import write_atomic, write_json_atomic
@@ -31,6 +32,7 @@ from .design import (
     with_mutant_select,
 )
 from .pin_judge import (
+    STREAM_PORTS,
     MutantPinSource,
     judge_pin_mutant,
     open_pin_mutants,
@@ -122,6 +124,7 @@ def mutate_design(
         robot=robot,
         prebuilt=prebuilt,
         cones_of=lambda some: mutant_cones(None, some, rtlil_text=rtlil_text),
+        stream=stream_ports(spec.bindings),
     )
 
 
@@ -229,14 +232,15 @@ def _judge(
     robot,
     prebuilt,
     cones_of,
+    stream=STREAM_PORTS,
 ):
     """The unit judge of ``mutants`` on ``backend`` (closed here), then the robot judge with
     ``campaign`` (forked: first the fan-out cones of the caught mutants, ``cones_of``);
     writes and returns ``mutants.json``'s content."""
     netlist, port_map, watch_map = files
     outputs = [p for p, port in ports.items() if port.direction == "out"]
-    framed = streams_frames(ports)
-    stimulus = pin_stimulus(ports, cycles, stimulus_seed, frame if framed else None)
+    framed = streams_frames(ports, stream)
+    stimulus = pin_stimulus(ports, cycles, stimulus_seed, frame if framed else None, stream)
     try:
         t1 = time.perf_counter()
         reference = pin_trace(backend, 0, stimulus, cycles, outputs)

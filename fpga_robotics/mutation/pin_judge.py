@@ -5,7 +5,7 @@ The stimulus is seeded random: every input port (``mutsel`` aside) changes, at e
 edge with probability ``CHANGE_PROBABILITY``, to a new random value of its width, so a bit
 holds for a few cycles on average and long enough now and then for counters and pulse
 measurements to see it. A camera design's pixel stream (``pixels__valid``,
-``pixels__payload``) carries frames instead, as the camera gives them: random RGB444 pixels
+``pixels__payload``, or the ports its camera binding names) carries frames instead, as the camera gives them: random RGB444 pixels
 in raster order at one a cycle, the first pixel flagged ``first`` and each line's last
 ``last``, a line's time without pixels between frames, for as many frames as the cycles
 hold.
@@ -73,23 +73,26 @@ class MutantPinSource:
         return {"mutants.v": self.verilog}, ["mutants.v"]
 
 
-def streams_frames(ports):
-    """Whether ``ports`` (name -> ``Port``) take a camera's pixel stream."""
-    return all(name in ports and ports[name].direction == "in" for name in STREAM_PORTS)
+def streams_frames(ports, stream=STREAM_PORTS):
+    """Whether ``ports`` (name -> ``Port``) take a camera's pixel stream on ``stream``, its
+    (valid, payload) inputs as the design binds them (None: no camera bound)."""
+    return stream is not None and all(
+        name in ports and ports[name].direction == "in" for name in stream
+    )
 
 
-def pin_stimulus(ports, cycles, seed, frame=None):
+def pin_stimulus(ports, cycles, seed, frame=None, stream=STREAM_PORTS):
     """``[(edge, input, value)]``: the seeded random changes of every input (``ports``:
     name -> ``Port``; ``mutsel`` left out) over ``cycles`` edges, in edge order; with
-    ``frame`` (width, height) and a pixel stream (``streams_frames``), frames of random
-    pixels on it (module doc)."""
+    ``frame`` (width, height) and a pixel stream on ``stream`` (``streams_frames``), frames
+    of random pixels on it (module doc)."""
     rng = np.random.default_rng(seed)
     changes = []
-    framed = frame is not None and streams_frames(ports)
+    framed = frame is not None and streams_frames(ports, stream)
     for port in ports.values():
         if port.direction != "in" or port.name == MUTATION_SELECT:
             continue
-        if framed and port.name in STREAM_PORTS:
+        if framed and port.name in stream:
             continue
         edges = np.flatnonzero(rng.random(cycles) < CHANGE_PROBABILITY) + 1
         lo, hi = (
@@ -100,7 +103,7 @@ def pin_stimulus(ports, cycles, seed, frame=None):
         values = rng.integers(lo, hi, size=len(edges), dtype=np.int64)
         changes += [(int(e), port.name, int(v)) for e, v in zip(edges, values)]
     if framed:
-        changes += _frames(rng, frame, cycles)
+        changes += _frames(rng, frame, cycles, stream)
     return PinStimulus(sorted(changes))
 
 
@@ -131,10 +134,10 @@ def _values(values):
         return np.array(values, object)
 
 
-def _frames(rng, frame, cycles):
+def _frames(rng, frame, cycles, stream):
     """The pixel stream's changes: frames of random pixels from edge 1 (module doc)."""
     width, height = frame
-    valid, payload = STREAM_PORTS
+    valid, payload = stream
     flags = np.zeros(width * height, np.int64)
     flags[width - 1 :: width] |= _LAST
     flags[0] |= _FIRST

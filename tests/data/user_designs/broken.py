@@ -1,11 +1,15 @@
 """Design references that must fail with one clear line (tests/test_user_designs.py)."""
 
-from amaranth.lib import wiring
+from amaranth.lib import data, wiring
 from amaranth.lib.wiring import Out
 
 
 class NotAComponent:
     """A class, but no Amaranth component."""
+
+
+#: Callable (a layout makes a view of a value), but neither a component class nor a function.
+Stats = data.StructLayout({"count": 12, "seen": 1})
 
 
 def raises(width: int = 4):

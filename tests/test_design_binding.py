@@ -1,0 +1,149 @@
+"""How a design of one's own meets the connectors (docs/your_design.md): wheel ports narrower
+than the connector's 16 bits are read sign-extended, wider or unsigned ones are refused in
+one line; a camera stream declared under the design's own port name is streamed to it."""
+
+import json
+import re
+import tomllib
+from pathlib import Path
+
+import pytest
+
+from fpga_robotics import cli
+from fpga_robotics.designs.reference import DesignError, resolve_design, stream_ports
+from fpga_robotics.loop.timings import run_scenario
+from fpga_robotics.mutation.design import design_mutant_port_map
+from fpga_robotics.mutation.design_run import design_ports
+from fpga_robotics.mutation.pin_judge import pin_stimulus, streams_frames
+from fpga_robotics.scenario.load import load_scenario
+from fpga_robotics.sim.camera.frames import to_rgb444
+
+DESIGNS = Path(__file__).parent / "data" / "user_designs"
+NARROW = f"{DESIGNS / 'narrow_wheels.py'}:NarrowWheels"
+
+#: A room to stand in; the design drives constant wheel commands.
+STRAIGHT = """
+name = "narrow"
+people = []
+[sim]
+duration = 0.5
+clock_hz = 10000.0
+[design]
+top = "{top}"
+[room]
+width = 4.0
+depth = 2.0
+[robot]
+model = "gopigo3"
+start = [2.0, 1.0]
+"""
+
+
+def test_narrow_signed_wheels_are_read_sign_extended(tmp_path):
+    (tmp_path / "s.toml").write_text(STRAIGHT.format(top=NARROW))
+    result = run_scenario(load_scenario(str(tmp_path / "s.toml")), backend="pysim")
+    traj = result.trajectory
+    # -100 in 8 bits is 0x9C: read unsigned it would be 156.
+    assert (traj["motor_left"][1:] == -100).all() and (traj["motor_right"][1:] == 60).all()
+    # The left wheel backwards, the right forwards: the robot turns left (heading grows).
+    assert traj["heading"][-1] > traj["heading"][0]
+
+
+@pytest.mark.parametrize(
+    "params, message",
+    [
+        (
+            {"width": 17},
+            "port 'motor_left' (the wheels' motor_left pin) is an output of signed(17)",
+        ),
+        (
+            {"width": 16, "signed_wheels": False},
+            "is an output of unsigned(16); the wheels take a signed output of at most 16 bits",
+        ),
+    ],
+)
+def test_wide_or_unsigned_wheels_are_one_line_errors(params, message, tmp_path, capsys):
+    with pytest.raises(DesignError, match=message.replace("(", r"\(").replace(")", r"\)")):
+        resolve_design(NARROW, params)
+    # Every command that resolves the design says the same: designs, run.
+    argv = [NARROW] + [f"--param={k}={str(v).lower()}" for k, v in params.items()]
+    (tmp_path / "s.toml").write_text(STRAIGHT.format(top=NARROW))
+    sets = [a for k, v in params.items() for a in ("--set", f"design.params.{k}={str(v).lower()}")]
+    for command in (
+        ["designs", *argv],
+        ["run", "--scenario", str(tmp_path / "s.toml"), "--rerun", "off", *sets],
+    ):
+        with pytest.raises(SystemExit) as info:
+            cli.main(command)
+        err = capsys.readouterr().err
+        assert info.value.code == 2 and len(err.strip().splitlines()) == 1, err
+        assert message in err
+
+
+# A camera under the design's own port names ----------------------------------------------
+
+NEAR_RED_CAM = f"{DESIGNS / 'near_red_cam.py'}:NearRedCam"
+
+
+def test_a_camera_declared_under_its_own_port_name_is_streamed_to(tmp_path):
+    frames = []
+    scenario = load_scenario(
+        str(DESIGNS / "near_red.toml"), [f'design.top="{NEAR_RED_CAM}"', "sim.duration=3.0"]
+    )
+    result = run_scenario(
+        scenario, backend="cxxrtl", on_frame=lambda r: frames.append(r.camera_rgb)
+    )
+    traj = result.trajectory
+    # red_count in row k is frame k-1's, counted here from the camera's own frames:
+    # strongly red RGB444 pixels (as near_red.py's, whose ports have the default names).
+    w, h = scenario.camera.width, scenario.camera.height
+    packed = [to_rgb444(f, w, h) for f in frames]
+    counts = [int(((p >> 8 >= 8) & ((p >> 4) & 15 < 5) & (p & 15 < 5)).sum()) for p in packed]
+    assert max(counts) > 0
+    assert list(traj["design.red_count"][1:]) == counts[:-1]
+    # The wheels declared as wheel_l/wheel_r: 400 DPS (design.params.speed) until near.
+    assert set(traj["motor_left"][1:]) <= {0.0, 400.0} and traj["motor_left"][1] == 400
+    assert set(result.summary["extra_outputs"]) == {"near", "red_count"}
+
+
+def test_a_declared_stream_that_is_no_stream_input_is_one_line_error(capsys):
+    message = "connectors['camera']['pixels']: 'wheel_l' is no pixel stream input of NearRedCam"
+    with pytest.raises(DesignError, match=re.escape(message)):
+        resolve_design(NEAR_RED_CAM, {"stream": "wheel_l"})
+    with pytest.raises(SystemExit) as info:
+        cli.main(["designs", NEAR_RED_CAM, '--param=stream="wheel_l"'])
+    err = capsys.readouterr().err
+    assert info.value.code == 2 and len(err.strip().splitlines()) == 1 and message in err
+
+
+def test_mutate_streams_frames_on_the_declared_stream():
+    spec = resolve_design(NEAR_RED_CAM)
+    ports = design_ports(spec)
+    stream = stream_ports(spec.bindings)
+    assert stream == ("cam__valid", "cam__payload") and streams_frames(ports, stream)
+    stimulus = pin_stimulus(ports, 40, seed=3, frame=(4, 3), stream=stream)
+    # Frames of 12 pixels from edge 1, a line (4 edges) between them: valid rises at 1, 17
+    # and 33 and falls after each frame's last pixel; never a random change.
+    valid = [(e, v) for e, p, v in stimulus if p == "cam__valid"]
+    assert valid == [(1, 1), (13, 0), (17, 1), (29, 0), (33, 1)]
+    payload = [e for e, p, _ in stimulus if p == "cam__payload"]
+    assert payload == [*range(1, 13), *range(17, 29), *range(33, 41)]
+    # The robot judge's port map streams the camera's frames on the same ports.
+    text = design_mutant_port_map(spec, ports)
+    assert tomllib.loads(text)["pixels"] == {"valid": "cam__valid", "payload": "cam__payload"}
+
+
+def test_a_shadow_with_its_own_stream_name_is_streamed_the_same_frames(tmp_path, capsys):
+    # NearRed (the stream named pixels) with NearRedCam (cam) as its shadow: the same logic,
+    # so its red counts match frame for frame only if it is streamed the frames too.
+    summary = tmp_path / "s.json"
+    argv = ["run", "--scenario", str(DESIGNS / "near_red.toml"), "--shadow", NEAR_RED_CAM]
+    argv += ["--backend", "cxxrtl", "--set", "sim.duration=2.0", "--rerun", "off", "--quiet"]
+    with pytest.raises(SystemExit) as info:
+        cli.main([*argv, "--summary", str(summary)])
+    assert info.value.code == 0, capsys.readouterr().err
+    trajectory_counts = json.loads(summary.read_text())["extra_outputs"]["red_count"]
+    assert trajectory_counts["max"] > 0
+    shadow = json.loads(summary.read_text())["shadow"]
+    assert shadow["frames"] == 20 and shadow["first_divergence"] is None
+    assert shadow["differing_frames"] == {"near": 0, "red_count": 0}
