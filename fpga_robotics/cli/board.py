@@ -5,9 +5,14 @@ A timing failure or a failed tool is exit code 1."""
 import os
 import sys
 
+from fpga_robotics.cli.designs import checked_verilog
 from fpga_robotics.cli.errors import UsageError
 from fpga_robotics.cli.mutate import _design_params
-from fpga_robotics.cli.param_options import add_param_arguments, params_from_args
+from fpga_robotics.cli.param_options import (
+    add_param_arguments,
+    params_from_args,
+    refuse_followtarget_options,
+)
 from fpga_robotics.cli.parser import CommandParser
 from fpga_robotics.designs.reference import resolve_design
 from fpga_robotics.flow.board import (
@@ -127,7 +132,13 @@ def main(argv=None, prog="fpga-robotics board"):
     params = params_from_args(args)
     design = None
     if args.design is not None:
+        # The board top's own options would be silently ignored with a design of one's own.
+        refuse_followtarget_options(args, "--design REF puts a design of your own on the board")
         design = resolve_design(args.design, _design_params(args.param), ports=args.ports)
+        if design.kind == "verilog":
+            # Read as ports/run read it: a syntax error or a map that does not fit the
+            # design is one line here, before anything is written.
+            design = checked_verilog(design, args.ports)
     elif args.param or args.ports:
         raise UsageError(
             f"{'--param' if args.param else '--ports'} goes with --design REF (a design of "
