@@ -456,7 +456,9 @@ PORT_CASES = DESIGNS / "port_cases.py"
 
 def _board_instances(verilog):
     """``{instance: {port: net}}`` of the board top module's submodule instances."""
-    top = re.search(r"^module ulx3s_follow_target\(.*?^endmodule", verilog, re.MULTILINE | re.DOTALL).group(0)
+    top = re.search(
+        r"^module ulx3s_follow_target\(.*?^endmodule", verilog, re.MULTILINE | re.DOTALL
+    ).group(0)
     return {
         name: dict(re.findall(r"\.(\w+)\(([^)]*?)\s*\)", body))
         for name, body in re.findall(
@@ -502,7 +504,7 @@ def _bump_turn(tmp_path, edit=None, where="bump_turn.v"):
         (
             ('pressed = "bumper_n"', 'pressed = "bumpr"'),
             "bump_turn_ports.toml",
-            "bumpr",
+            "the design bump_turn has no port 'bumpr'",
         ),
     ],
     ids=["syntax", "syntax-in-include", "wrong-width", "no-such-port"],
