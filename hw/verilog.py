@@ -6,12 +6,20 @@ backend compiles; ``port_values`` is the port list every back-end conversion use
 
 from amaranth.back import cxxrtl, verilog
 from amaranth.hdl import Const, Value, ValueCastable
+from amaranth.hdl._ir import PortDirection  # no public name in Amaranth 0.5; its back-ends use it
 from amaranth.lib import wiring
 
 from .params import FollowTargetParams
 from .top import FollowTarget
 
-__all__ = ["TOP_NAME", "generate_cxxrtl", "generate_verilog", "port_values", "verilog_ports"]
+__all__ = [
+    "TOP_NAME",
+    "directed_ports",
+    "generate_cxxrtl",
+    "generate_verilog",
+    "port_values",
+    "verilog_ports",
+]
 
 #: Module name of the top in the generated Verilog and C++.
 TOP_NAME = "follow_target"
@@ -39,6 +47,17 @@ def verilog_ports(component):
     return {
         "__".join(map(str, path)): (value, "i" if member.flow == wiring.In else "o")
         for path, member, value in _port_items(component)
+    }
+
+
+def directed_ports(component):
+    """``{name: (value, PortDirection)}``: the ports ``verilog_ports`` names, each with its
+    declared direction, as Amaranth's own conversion gives them. An output the design never
+    drives stays an output (constant 0); with direction None Amaranth would infer an input."""
+    directions = {"i": PortDirection.Input, "o": PortDirection.Output}
+    return {
+        name: (value, directions[direction])
+        for name, (value, direction) in verilog_ports(component).items()
     }
 
 

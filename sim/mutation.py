@@ -30,7 +30,7 @@ from fpga_robotics.hw.errors import UserError
 
 from ..hw.params import FollowTargetParams
 from ..hw.top import FollowTarget
-from ..hw.verilog import TOP_NAME, verilog_ports
+from ..hw.verilog import TOP_NAME, directed_ports
 from .mutant_inits import restore_inits
 from .mutant_watch import WATCH_PORT, add_watch
 from .processes import run_captured
@@ -202,10 +202,10 @@ def _parse(index, line):
 
 def component_rtlil(component):
     """RTLIL of any Amaranth component, top module ``follow_target`` (the name the mutant
-    netlists and the pin models use), its ports named as the generated Verilog names them."""
-    ports = {name: (value, None) for name, (value, _) in verilog_ports(component).items()}
+    netlists and the pin models use), its ports named as the generated Verilog names them and
+    in their declared directions (an output it never drives is an output, constant 0)."""
     with _located_outside_stdlib():
-        return rtlil.convert(component, name=TOP_NAME, ports=ports)
+        return rtlil.convert(component, name=TOP_NAME, ports=directed_ports(component))
 
 
 #: Python's own library (site-packages aside): no place of a design's.

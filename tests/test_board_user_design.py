@@ -446,3 +446,98 @@ def test_built_in_designs_on_the_board(tmp_path, capsys):
     code, out, err = _cli(["board", "--design", "follow_target", "-o", str(tmp_path / "f")], capsys)
     assert code == 2 and out == "" and "run fpga-robotics board without --design" in err
     assert not (tmp_path / "f").exists()
+
+
+# A design checked before anything is written; the wheels bound as a run binds them ---------
+
+BUMP_TURN = DATA / "bump_turn"
+PORT_CASES = DESIGNS / "port_cases.py"
+
+
+def _board_instances(verilog):
+    """``{instance: {port: net}}`` of the board top module's submodule instances."""
+    top = re.search(
+        r"^module ulx3s_follow_target\(.*?^endmodule", verilog, re.MULTILINE | re.DOTALL
+    ).group(0)
+    return {
+        name: dict(re.findall(r"\.(\w+)\(([^)]*?)\s*\)", body))
+        for name, body in re.findall(
+            r"^\s*\\ulx3s_follow_target\.\S+\s+\\?(\w+)\s*\((.*?)\);", top, re.MULTILINE | re.DOTALL
+        )
+    }
+
+
+def test_declared_wheels_drive_the_gopigo3(tmp_path, capsys):
+    out = tmp_path / "b"
+    code, _, err = _cli(
+        ["board", "--design", f"{PORT_CASES}:OwnWheelNames", "-o", str(out)], capsys
+    )
+    assert code == 0, err
+    instances = _board_instances((out / "ulx3s_follow_target.v").read_text())
+    design, motors = instances["design"], instances["motors"]
+    # The design's declared wheel outputs are the nets the SPI motor driver sends.
+    assert design["wheel_l"] == motors["left"]
+    assert design["wheel_r"] == motors["right"]
+    assert "motor_left" not in design
+
+
+def _bump_turn(tmp_path, edit=None, where="bump_turn.v"):
+    """A copy of the bump_turn design (its include in inc/), ``edit`` (old, new) applied to
+    ``where``; returns the ``--design``/``--ports`` options."""
+    for name in ("bump_turn.v", "bump_turn_ports.toml", "bt_wrong.toml", "inc/bt_consts.vh"):
+        text = (BUMP_TURN / name).read_text()
+        if edit is not None and name == where:
+            assert edit[0] in text
+            text = text.replace(edit[0], edit[1], 1)
+        (tmp_path / name).parent.mkdir(exist_ok=True)
+        (tmp_path / name).write_text(text)
+    ports = "bt_wrong.toml" if where == "bt_wrong.toml" else "bump_turn_ports.toml"
+    return ["--design", f"verilog:{tmp_path}/bump_turn.v", "--ports", str(tmp_path / ports)]
+
+
+@pytest.mark.parametrize(
+    "edit, where, message",
+    [
+        (("reg [1:0] st;", "reg [1:0] st"), "bump_turn.v", "bump_turn.v:12:3: syntax error"),
+        (("12'sd250;", "12sd250"), "inc/bt_consts.vh", "inc/bt_consts.vh:1:35: syntax error"),
+        (None, "bt_wrong.toml", "port 'ml' of bump_turn is 12 bits wide, the map expects 16"),
+        (
+            ('pressed = "bumper_n"', 'pressed = "bumpr"'),
+            "bump_turn_ports.toml",
+            "the design bump_turn has no port 'bumpr'",
+        ),
+    ],
+    ids=["syntax", "syntax-in-include", "wrong-width", "no-such-port"],
+)
+@pytest.mark.parametrize("bitstream", [[], ["--bitstream"]], ids=["export", "bitstream"])
+def test_a_verilog_design_is_checked_before_anything_is_written(
+    edit, where, message, bitstream, tmp_path, capsys
+):
+    argv = _bump_turn(tmp_path, edit, where)
+    out = tmp_path / "b"
+    code, text, err = _cli(["board", *argv, "-o", str(out), *bitstream], capsys)
+    assert code == 2 and text == "" and err.count("\n") == 1, err
+    assert message in err
+    assert not out.exists()
+
+
+def test_the_unedited_bump_turn_goes_on_the_board(tmp_path, capsys):
+    """The cases above fail for their edit alone."""
+    code, text, err = _cli(["board", *_bump_turn(tmp_path), "-o", str(tmp_path / "b")], capsys)
+    assert code == 0, err
+    assert text.splitlines()[0] == "bumper_n: header gpio 7+ (site A6)"
+
+
+@pytest.mark.parametrize(
+    "options, given",
+    [
+        (["--width", "80"], "--width"),
+        (["--kp-num", "7", "--preset", "published"], "--preset, --kp-num"),
+    ],
+)
+def test_follow_target_options_with_a_design_are_refused(options, given, tmp_path, capsys):
+    argv = ["board", "--design", WALL_STOP, *options, "-o", str(tmp_path / "b")]
+    code, text, err = _cli(argv, capsys)
+    assert code == 2 and text == "" and err.count("\n") == 1, err
+    assert f"{given}: FollowTarget's options; --design REF puts a design of your own" in err
+    assert not (tmp_path / "b").exists()

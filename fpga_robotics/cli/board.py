@@ -5,9 +5,14 @@ A timing failure or a failed tool is exit code 1."""
 import os
 import sys
 
+from fpga_robotics.cli.designs import checked_verilog
 from fpga_robotics.cli.errors import UsageError
 from fpga_robotics.cli.mutate import _design_params
-from fpga_robotics.cli.param_options import add_param_arguments, params_from_args
+from fpga_robotics.cli.param_options import (
+    add_param_arguments,
+    params_from_args,
+    refuse_followtarget_options,
+)
 from fpga_robotics.cli.parser import CommandParser
 from fpga_robotics.designs.reference import resolve_design
 from fpga_robotics.flow.board import (
@@ -18,6 +23,7 @@ from fpga_robotics.flow.board import (
     export_board,
     header_pins,
 )
+from fpga_robotics.flow.board_verilog import verilog_files
 from fpga_robotics.sim.files import check_output_dir
 
 __all__ = ["add_board_arguments", "main", "run_board"]
@@ -49,6 +55,11 @@ def run_board(args, params, out_dir, prog="fpga-robotics board", design=None):
     board_factory(args.board)
     if design is not None:
         board_ports(design)  # a port the board cannot serve: one line, nothing written
+        if design.kind == "verilog":
+            verilog_files(design)  # an included file not found: said as the board says it
+            # Read as ports and run read it: a syntax error, or a map that does not fit
+            # the design, is one line here, before anything is written.
+            design = checked_verilog(design, args.ports)
     if args.seed is not None and not args.bitstream:
         raise UsageError("--seed is nextpnr's placement seed: it needs --bitstream")
     seed = 1 if args.seed is None else args.seed
@@ -127,6 +138,8 @@ def main(argv=None, prog="fpga-robotics board"):
     params = params_from_args(args)
     design = None
     if args.design is not None:
+        # The board top's own options would be silently ignored with a design of one's own.
+        refuse_followtarget_options(args, "--design REF puts a design of your own on the board")
         design = resolve_design(args.design, _design_params(args.param), ports=args.ports)
     elif args.param or args.ports:
         raise UsageError(

@@ -23,7 +23,11 @@ from dataclasses import fields
 from fpga_robotics.cli.board import add_board_arguments, run_board
 from fpga_robotics.cli.designs import _params
 from fpga_robotics.cli.errors import UsageError
-from fpga_robotics.cli.param_options import add_param_arguments, params_from_args
+from fpga_robotics.cli.param_options import (
+    add_param_arguments,
+    params_from_args,
+    refuse_followtarget_options,
+)
 from fpga_robotics.cli.parser import CommandParser
 from fpga_robotics.cli.sensor_options import (
     SENSOR_GROUPS,
@@ -32,7 +36,7 @@ from fpga_robotics.cli.sensor_options import (
     sensor_params_from_args,
 )
 from fpga_robotics.designs.reference import resolve_design
-from fpga_robotics.flow.export import TOPS, generate_top_verilog
+from fpga_robotics.flow.export import TOPS, check_port_names, generate_top_verilog
 from fpga_robotics.hw.corridor_follow import CorridorFollow
 from fpga_robotics.hw.corridor_follow_uart import CorridorFollowUart
 from fpga_robotics.hw.follow_line import FollowLine
@@ -222,6 +226,17 @@ def _export_design(args):
         raise UsageError(
             "--design exports a design of your own: --top, --board and --bitstream go without it"
         )
+    # Options of the built-in tops would be silently ignored: refused, as mutate does.
+    refuse_followtarget_options(args, "--design REF exports a design of your own")
+    for key, (_, _, _, tops) in SENSOR_GROUPS.items():
+        given = given_options(args, key)
+        if given:
+            raise UsageError(
+                f"{', '.join(given)} applies to --top {' or '.join(tops)}, not to --design REF "
+                "(give its parameters as --param NAME=VALUE)"
+            )
+    if args.variant is not None:
+        raise UsageError("--variant names a seeded bug of a built-in top: it goes without --design")
     spec = resolve_design(args.design, _params(args.design_params))
     if spec.kind == "verilog":
         raise UsageError(f"--design {args.design} is Verilog already: nothing to export")
@@ -232,6 +247,7 @@ def _export_design(args):
             f"{output} is a directory; give the Verilog file's path, e.g. "
             f"{os.path.join(output, name + '.v')}"
         )
+    check_port_names(spec.ports, name)
     check_output_path(output, what="Verilog file")
     text = generate_top_verilog(spec.build(), name)
     write_atomic(output, text, what="Verilog file")

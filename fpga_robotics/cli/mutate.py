@@ -14,13 +14,15 @@ import shutil
 import sys
 import time
 import tomllib
-from dataclasses import fields
 
 from fpga_robotics.cli.errors import UsageError
-from fpga_robotics.cli.param_options import add_param_arguments, params_from_args
+from fpga_robotics.cli.param_options import (
+    add_param_arguments,
+    params_from_args,
+    refuse_followtarget_options,
+)
 from fpga_robotics.cli.parser import CommandParser
 from fpga_robotics.designs.reference import resolve_design
-from fpga_robotics.hw.params import FollowTargetParams
 from fpga_robotics.mutation.design import (
     WATCH_PORTS_NAME,
     open_mutant_design,
@@ -345,13 +347,6 @@ def _resolution(text):
     return int(w), int(h)
 
 
-def _followtarget_options(args):
-    """The FollowTarget options given (``--preset``, its parameters, ``--against``), as typed."""
-    given = [name for name in ("preset", "against") if getattr(args, name) is not None]
-    given += [f.name for f in fields(FollowTargetParams) if getattr(args, f.name, None) is not None]
-    return ["--" + name.replace("_", "-") for name in given]
-
-
 def _one_line(exc):
     """An error's first line; where it ends in a colon (a tool failed, its output follows),
     with the tool's first error line after it."""
@@ -380,12 +375,9 @@ def _removed_on_error(out):
 
 def _main_design(args):
     """``--design REF``: the mutants of a design of one's own against itself."""
-    given = _followtarget_options(args)
-    if given:
-        raise UsageError(
-            f"{', '.join(given)}: FollowTarget's options; with --design REF the mutants are "
-            "judged against the unmutated design (give its parameters as --param NAME=VALUE)"
-        )
+    refuse_followtarget_options(
+        args, "with --design REF the mutants are judged against the unmutated design"
+    )
     verilog = args.design.startswith("verilog:")
     if verilog and args.param:
         raise UsageError(

@@ -8,7 +8,7 @@ from dataclasses import fields
 from fpga_robotics.cli.errors import UsageError
 from fpga_robotics.hw.params import CHOICES, PRESETS, FollowTargetParams
 
-__all__ = ["add_param_arguments", "params_from_args"]
+__all__ = ["add_param_arguments", "params_from_args", "refuse_followtarget_options"]
 
 #: Parameters given as a comma-separated list of ints on the command line.
 _TUPLE_PARAMS = ("proximity_thresholds", "base_dps", "steer_dps")
@@ -90,3 +90,17 @@ def params_from_args(args):
         return FollowTargetParams(**given)
     except (ValueError, TypeError) as exc:
         raise UsageError(f"bad design parameter: {exc}") from None
+
+
+def refuse_followtarget_options(args, consequence):
+    """``UsageError`` naming the FollowTarget options given (``--preset``, its parameters,
+    ``--against`` where the command has it), as typed: with ``--design REF`` they would be
+    silently ignored; ``consequence`` says what the command does instead."""
+    given = [name for name in ("preset", "against") if getattr(args, name, None) is not None]
+    given += [f.name for f in fields(FollowTargetParams) if getattr(args, f.name, None) is not None]
+    if given:
+        options = ", ".join("--" + name.replace("_", "-") for name in given)
+        raise UsageError(
+            f"{options}: FollowTarget's options; {consequence} (give its parameters as "
+            "--param NAME=VALUE)"
+        )

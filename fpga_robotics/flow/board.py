@@ -18,6 +18,8 @@ import tempfile
 import time
 from dataclasses import dataclass, field
 
+from amaranth.hdl import Elaboratable
+
 from fpga_robotics.designs.builtin import connector_kinds
 from fpga_robotics.flow.board_verilog import VerilogOnBoard, verilog_board_ports, verilog_files
 from fpga_robotics.hw.board.ulx3s_top import ULX3SFollowTarget, ulx3s_platform
@@ -130,11 +132,6 @@ def board_ports(spec, board="ulx3s-85f"):
                 f"design {name}: port {port!r} (the wheels' {pin}) is {ports[port][1]} bits; "
                 f"the GoPiGo3 takes at most 16 (signed DPS)"
             )
-    if wheels != {"motor_left": "motor_left", "motor_right": "motor_right"}:
-        raise UserError(
-            f"design {name}: the board wires the wheels to ports named motor_left and "
-            f"motor_right; rename {', '.join(v for v in wheels.values())} so"
-        )
     camera = "camera" in bindings
     turret = all(ports.get(p, ("",))[0] == "in" for p in _TURRET_INPUTS[:2])
     for on, port in ((camera, "color_sel"), (turret, "turret_color_sel")):
@@ -159,7 +156,7 @@ def board_ports(spec, board="ulx3s-85f"):
     }
     header = []
     for port, (direction, width) in ports.items():
-        if port in ("motor_left", "motor_right", servo) or (camera and port in _CAMERA_INPUTS):
+        if port in wheels.values() or port == servo or (camera and port in _CAMERA_INPUTS):
             continue
         if turret and port in _TURRET_INPUTS:
             continue
@@ -182,7 +179,29 @@ def board_ports(spec, board="ulx3s-85f"):
         raise UserError(
             f"design {name}: {len(header)} connector pins, the board's header has {len(free)} free"
         )
-    return {"camera": camera, "turret_camera": turret, "servo": servo, "header": header}
+    return {
+        "camera": camera,
+        "turret_camera": turret,
+        "servo": servo,
+        "header": header,
+        "wheels": wheels,
+    }
+
+
+class _BoundWheels(Elaboratable):
+    """``design`` as the board top reads it: the outputs its wheels binding names (the
+    binding a run uses, ``DesignSpec.bindings``) as ``motor_left``/``motor_right``, every
+    other member its own."""
+
+    def __init__(self, design, wheels):
+        self._design, self._wheels = design, dict(wheels)
+
+    def __getattr__(self, name):
+        wheels = self.__dict__.get("_wheels", {})
+        return getattr(self.__dict__["_design"], wheels.get(name, name))
+
+    def elaborate(self, platform):
+        return self._design
 
 
 def _user_factory(spec):
@@ -201,6 +220,8 @@ def _user_factory(spec):
             design = VerilogOnBoard(spec.port_map, servo=wiring["servo"], header=wiring["header"])
         else:
             design = spec.build()
+            if any(pin != port for pin, port in wiring["wheels"].items()):
+                design = _BoundWheels(design, wiring["wheels"])
         return platform, ULX3SUserDesign(
             design,
             header=wiring["header"],

@@ -1,0 +1,108 @@
+"""``fpga-robotics export --design REF``: a design of one's own as Verilog, each port in the
+direction its signature declares (the independent expectation: Amaranth's own
+``verilog.convert`` of the component, and the signature itself); a port named after the
+clock and the built-in tops' options are one line, exit 2, nothing written."""
+
+import re
+from pathlib import Path
+
+import pytest
+from amaranth.back import verilog
+
+from fpga_robotics import cli
+from fpga_robotics.designs.reference import resolve_design
+from fpga_robotics.sim.mutation import component_rtlil
+
+DESIGNS = Path(__file__).parent / "data" / "user_designs"
+PORT_CASES = DESIGNS / "port_cases.py"
+
+
+def _cli(argv, capsys):
+    with pytest.raises(SystemExit) as info:
+        cli.main(argv)
+    out = capsys.readouterr()
+    return info.value.code, out.out, out.err
+
+
+def _verilog_directions(text):
+    """``{port: "input"|"output"}`` of the top module's port declarations."""
+    return {
+        name: direction
+        for direction, name in re.findall(
+            r"^\s*(input|output)\s+(?:\[[^\]]*\]\s*)?(\S+)\s*;", text, re.MULTILINE
+        )
+    }
+
+
+def test_undriven_outputs_stay_outputs_driven_to_zero(tmp_path, capsys):
+    out = tmp_path / "nothing.v"
+    code, text, err = _cli(["export", "--design", f"{PORT_CASES}:Nothing", "-o", str(out)], capsys)
+    assert code == 0, err
+    assert text == f"wrote {out} (module Nothing, 3 ports)\n"
+    exported = out.read_text()
+    directions = _verilog_directions(exported)
+    # As declared: go In, the wheels Out (never driven), plus the clock domain's own ports.
+    assert directions == {
+        "clk": "input",
+        "rst": "input",
+        "go": "input",
+        "motor_left": "output",
+        "motor_right": "output",
+    }
+    assert "assign motor_left = 16'h0000;" in exported
+    assert "assign motor_right = 16'h0000;" in exported
+    # Amaranth's own conversion of the component gives the same directions.
+    component = resolve_design(f"{PORT_CASES}:Nothing").build()
+    assert _verilog_directions(verilog.convert(component, name="Nothing")) == directions
+
+
+def test_the_mutation_netlist_keeps_the_declared_directions():
+    rtlil = component_rtlil(resolve_design(f"{PORT_CASES}:Nothing").build())
+    wires = {
+        name: direction
+        for direction, name in re.findall(
+            r"^\s*wire width \d+ (input|output) \d+ +(?:signed )?\\(\S+)$", rtlil, re.MULTILINE
+        )
+    }
+    assert wires["motor_left"] == wires["motor_right"] == "output"
+    assert wires["go"] == "input"
+
+
+def test_a_port_named_clk_is_one_line(tmp_path, capsys):
+    out = tmp_path / "clk.v"
+    code, text, err = _cli(["export", "--design", f"{PORT_CASES}:ClkPort", "-o", str(out)], capsys)
+    assert code == 2 and text == "" and err.count("\n") == 1
+    assert err == (
+        "fpga-robotics export: error: design 'ClkPort' has a port named 'clk', the name of "
+        "the clock domain's own clock; rename the port\n"
+    )
+    assert not out.exists()
+
+
+@pytest.mark.parametrize(
+    "options, message",
+    [
+        (["--width", "80"], "--width: FollowTarget's options; --design REF exports a design"),
+        (["--kp-num", "7", "--preset", "published"], "--preset, --kp-num: FollowTarget's options"),
+        (["--us-clock-hz", "5"], "--us-clock-hz applies to --top follow_target_safe, not to"),
+        (["--variant", "stuck_left"], "--variant names a seeded bug of a built-in top"),
+    ],
+)
+def test_options_of_the_built_in_tops_are_refused(options, message, tmp_path, capsys):
+    out = tmp_path / "x.v"
+    argv = ["export", "--design", f"{DESIGNS}/wall_stop.py:WallStop", *options, "-o", str(out)]
+    code, text, err = _cli(argv, capsys)
+    assert code == 2 and text == "" and err.count("\n") == 1, err
+    assert message in err
+    assert not out.exists()
+
+
+def test_mutate_refuses_them_with_the_same_words(capsys):
+    argv = ["mutate", "--design", f"{DESIGNS}/wall_stop.py:WallStop", "--width", "80"]
+    code, text, err = _cli(argv, capsys)
+    assert code == 2 and text == ""
+    assert err == (
+        "fpga-robotics mutate: error: --width: FollowTarget's options; with --design REF the "
+        "mutants are judged against the unmutated design (give its parameters as --param "
+        "NAME=VALUE)\n"
+    )
