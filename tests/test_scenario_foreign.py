@@ -4,13 +4,14 @@ errors; ``--design`` and ``--ports`` override them (docs/foreign.md)."""
 
 import argparse
 import json
+from pathlib import Path
 
 import pytest
 
 from fpga_robotics.cli.errors import UsageError
-from fpga_robotics.cli.run import _design_files
+from fpga_robotics.cli.run import _design_files, _with_design_files
 from fpga_robotics.hw.params import FollowTargetParams
-from fpga_robotics.scenario.load import ScenarioError, load_scenario
+from fpga_robotics.scenario.load import ForeignDesignFiles, ScenarioError, load_scenario
 from fpga_robotics.sim.backends.port_map import follow_target_port_map
 
 PARAMS = FollowTargetParams(width=80, height=60)
@@ -124,6 +125,33 @@ def test_the_command_line_overrides_the_scenario(files):
         _design_files(_args(backend="model"), foreign)
     with pytest.raises(UsageError, match="--ports goes with --design"):
         _design_files(_args(ports="o.toml"), None)
+
+
+#: A user's line follower in Verilog (its port map binds the line sensors).
+LINE_FOLLOW = Path(__file__).parent / "data" / "line_follow_verilog"
+
+
+def test_a_verilog_design_top_replaces_a_built_in_design_and_its_tables(tmp_path):
+    # line_track runs follow_line with a [design.line] table; design.top = "verilog:..."
+    # with design.ports replaces that design as run --design/--ports does.
+    files = [str(LINE_FOLLOW / "lf_top.v"), str(LINE_FOLLOW / "lf_core.v")]
+    ports = str(LINE_FOLLOW / "lf_ports.toml")
+    top = f"verilog:{','.join(files)}"
+    by_set = load_scenario("line_track", [f'design.top="{top}"', f'design.ports="{ports}"'])
+    assert by_set.foreign == ForeignDesignFiles(tuple(files), ports)
+    assert by_set.design_tables == {}
+    by_option = _with_design_files(
+        _args(design=top, ports=ports, backend="cxxrtl"), load_scenario("line_track")
+    )
+    assert by_set.foreign == by_option.foreign
+    assert by_set.sim == by_option.sim and by_set.sim.timing == "real_clock"
+    # The same in a scenario file that keeps the table.
+    text = Path(by_set.source).read_text()
+    assert "[design.line]" in text
+    path = tmp_path / "my_line.toml"
+    path.write_text(text.replace('top = "follow_line"', f'top = "{top}"\nports = "{ports}"'))
+    in_file = load_scenario(str(path))
+    assert in_file.foreign == by_set.foreign and in_file.design_tables == {}
 
 
 def _toolchain():

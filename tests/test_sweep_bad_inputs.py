@@ -1,14 +1,16 @@
 """Bad campaign files and options: one line saying what is wrong, exit code 2, nothing run
 and nothing written."""
 
+import json
 import subprocess
 import sys
 from pathlib import Path
 
 import pytest
 
-from fpga_robotics.cli.errors import run_cli
+from fpga_robotics.cli.errors import UsageError, run_cli
 from fpga_robotics.cli.sweep import main
+from fpga_robotics.sim.backends import available_backends
 
 SWEEP = [sys.executable, "-m", "fpga_robotics.sweep"]
 
@@ -130,6 +132,10 @@ BAD_OPTION_VALUES = {
     "--grid": (["--grid", "design.diff_min=[]"], "--grid needs KEY=[V1, V2, ...]"),
     "--duration": (["--duration", "-1"], "--duration must be > 0 seconds"),
     "--scenarios": (["--scenarios", ","], "--scenarios needs scenario names"),
+    "--scheduler": (
+        ["--scheduler", "notaurl"],
+        "--scheduler must be a Dask scheduler address tcp://HOST:PORT",
+    ),
 }
 
 
@@ -192,3 +198,66 @@ def test_two_scenario_files_of_one_name_are_an_error_naming_both(tmp_path, monke
     # The same file twice (by name and by path) is one scenario: no error.
     (tmp_path / "c.toml").write_text(GOOD.replace('["approach"]', f'["approach", "{shipped}"]'))
     assert main(["c.toml", "--dry-run"]) == 0
+
+
+#: A port nothing listens on: Dask gives up on it after its 10 s connect timeout.
+NOBODY = "tcp://127.0.0.1:1"
+
+
+def test_an_unreachable_scheduler_writes_no_results_folder(tmp_path, monkeypatch, capsys):
+    (tmp_path / "c.toml").write_text(GOOD)
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(SystemExit) as exit_info:
+        run_cli(
+            main,
+            ["c.toml", "--scheduler", NOBODY, "--out", "new/out", "--quiet"],
+            prog="fpga-robotics sweep",
+        )
+    assert exit_info.value.code == 2
+    lines = capsys.readouterr().err.strip().splitlines()
+    assert len(lines) == 1 and "cannot reach the Dask scheduler" in lines[0], lines
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["c.toml"]
+
+
+def test_an_unreachable_scheduler_leaves_earlier_results_as_they_were(tmp_path, monkeypatch):
+    # A results folder a later --resume could use: a row of a run of another campaign, which
+    # a resumed campaign would drop from the journal once it opened the folder.
+    out = tmp_path / "out"
+    out.mkdir()
+    journal = json.dumps({"run_id": "0123abcd", "status": "pass", "seed": 0}) + "\n"
+    (out / "results.jsonl").write_text(journal)
+    (tmp_path / "c.toml").write_text(GOOD)
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(UsageError, match="cannot reach the Dask scheduler"):
+        main(["c.toml", "--scheduler", NOBODY, "--out", "out", "--resume", "--quiet"])
+    assert [p.name for p in out.iterdir()] == ["results.jsonl"]
+    assert (out / "results.jsonl").read_text() == journal
+
+
+@pytest.mark.skipif("cxxrtl" not in available_backends(), reason="no CXXRTL toolchain")
+def test_a_design_that_does_not_build_leaves_no_results_folder(tmp_path, monkeypatch, capsys):
+    # The folder is made once the cluster is up; the build fails after it: the folder this
+    # command made goes again, as no run finished.
+    (tmp_path / "top.v").write_text(
+        "module top(input clock, output [15:0] wl, output [15:0] wr);\nwire oops = ;\nendmodule\n"
+    )
+    (tmp_path / "ports.toml").write_text(
+        'top = "top"\nclock = { port = "clock" }\n[outputs]\n'
+        'motor_left = { port = "wl", width = 16, signed = true }\n'
+        'motor_right = { port = "wr", width = 16, signed = true }\n'
+    )
+    (tmp_path / "c.toml").write_text(
+        'scenarios = ["line_track"]\nbackend = "cxxrtl"\nduration = 0.1\n'
+        'design = "verilog:top.v"\nports = "ports.toml"\n'
+    )
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(SystemExit) as exit_info:
+        run_cli(
+            main,
+            ["c.toml", "--workers", "1", "--out", "new/out", "--quiet"],
+            prog="fpga-robotics sweep",
+        )
+    assert exit_info.value.code == 2
+    lines = capsys.readouterr().err.strip().splitlines()
+    assert len(lines) == 1 and "building the design of" in lines[0], lines
+    assert not (tmp_path / "new").exists()

@@ -866,6 +866,10 @@ def _top(design, source):
                 "design.params: a Verilog design takes no parameters here; "
                 "set them in the Verilog (or tie inputs in [constants])"
             )
+        if not verilog:
+            # design.top = "verilog:..." replaces the scenario's design, as run --design
+            # does: the built-in design's tables (a line_track's [design.line]) go with it.
+            return top, {}, {}
     if not isinstance(top, str) or top not in TOPS:
         given = [k for k in _TOP_TABLES if design.get(k) is not None]
         if given:

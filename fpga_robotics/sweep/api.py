@@ -1,6 +1,7 @@
 """``run_campaign``: plan, build, run and report a campaign (the command's and the API's
 one code path)."""
 
+import shutil
 import time
 from pathlib import Path
 
@@ -49,13 +50,9 @@ def run_campaign(
     if max_runs is not None:
         plan.runs = plan.runs[:max_runs]
     out_dir = Path(out_dir)
-    store = ResultStore(out_dir, resume=resume, run_ids=run_ids)
-    if store.dropped:
-        say(
-            f"--resume: {store.dropped} earlier row(s) in {out_dir} not kept (errors, "
-            f"timeouts, and runs this campaign no longer makes: an edited scenario or "
-            f"design file, another option or package version)"
-        )
+    # The folders this call makes: removed again when it fails before any run finished (a
+    # folder that was there, with results --resume could use, is never removed).
+    made = _first_missing(out_dir)
     meta = {
         "name": campaign.name,
         "description": campaign.description,
@@ -69,6 +66,7 @@ def run_campaign(
         "known_limits": campaign.known_limits,
     }
     t0 = time.perf_counter()
+    store = None
     try:
         with (
             _given(client)
@@ -76,6 +74,15 @@ def run_campaign(
             else open_client(scheduler=scheduler, workers=workers)
         ) as c:
             wait_for_a_worker(c, scheduler)
+            # The folder only once the cluster is there: an unreachable scheduler writes
+            # nothing.
+            store = ResultStore(out_dir, resume=resume, run_ids=run_ids)
+            if store.dropped:
+                say(
+                    f"--resume: {store.dropped} earlier row(s) in {out_dir} not kept "
+                    f"(errors, timeouts, and runs this campaign no longer makes: an edited "
+                    f"scenario or design file, another option or package version)"
+                )
             t_build = time.perf_counter()
             builds = build_all(c, plan)
             meta["build_s"] = round(time.perf_counter() - t_build, 3)
@@ -102,14 +109,31 @@ def run_campaign(
             )
             meta["runs_wall_s"] = round(time.perf_counter() - t_runs, 3)
             meta["workers"] = len(c.scheduler_info()["workers"])
+    except Exception:
+        if store is not None:
+            store.close()
+        if made is not None and (store is None or not store.rows):
+            shutil.rmtree(made, ignore_errors=True)
+            store = None
+        raise
     finally:
-        store.close()
-        meta["wall_s"] = round(time.perf_counter() - t0, 3)
-        write_meta(out_dir, meta)
-        rows = store.rows
-        if rows:
-            write_html(out_dir / "report.html", rows, campaign.axes, meta)
-    return rows
+        if store is not None:
+            store.close()
+            meta["wall_s"] = round(time.perf_counter() - t0, 3)
+            write_meta(out_dir, meta)
+            if store.rows:
+                write_html(out_dir / "report.html", store.rows, campaign.axes, meta)
+    return store.rows
+
+
+def _first_missing(path):
+    """The outermost folder of ``path`` that does not exist yet (None: ``path`` exists)."""
+    missing = None
+    for folder in (path, *path.parents):
+        if folder.exists():
+            break
+        missing = folder
+    return missing
 
 
 #: How long a campaign waits for a first worker to join an existing scheduler.

@@ -19,8 +19,9 @@ A campaign is a TOML file (docs/campaigns.md)::
     [grid]                                  # every key run --set accepts, a list of values
     "design.diff_min" = [4, 6, 8]
     "lighting.ambient" = [0.25, 0.7]
-    # "design.top" = ["follow_target", "follow_target_safe"]: designs as an axis (a file
-    # reference there is relative to the scenario file's folder, as in the scenario)
+    # "design.top" = ["follow_target", "verilog:top.v"]: designs as an axis (file references
+    # in grid, sets and set values are relative to this file, as design and ports are; the
+    # campaign's ports go with every verilog: design)
 
     [[sets]]                                # optional explicit override sets
     "robot.mass" = 12
@@ -454,10 +455,11 @@ def load_campaign(data, *, source="", scenarios_replaced=False):
         count = len(scenarios) * len(seeds) * len(combos)
         if count > MAX_RUNS:
             raise CampaignError(f"the campaign has {count} runs; at most {MAX_RUNS}")
+        shapes = [_with_ports(replace(base, overrides=combo)) for combo in combos]
         runs = [
-            replace(base, scenario=sc, seed=seed, overrides=combo)
+            replace(shape, scenario=sc, seed=seed)
             for sc in scenarios
-            for combo in combos
+            for shape in shapes
             for seed in seeds
         ]
     except CampaignError as exc:
@@ -472,6 +474,29 @@ def load_campaign(data, *, source="", scenarios_replaced=False):
         known_limits=known_limits,
         scenarios_replaced=scenarios_replaced,
     )
+
+
+def _with_ports(spec):
+    """The campaign's ``ports`` go with every Verilog design of its runs: with no campaign
+    ``design``, a run whose overrides make ``design.top`` a ``verilog:`` design gets them as
+    ``design.ports`` (unless it sets that itself), and a run whose overrides name another
+    design takes none."""
+    if spec.ports is None or spec.design is not None:
+        return spec
+    from fpga_robotics.scenario.load import _parse_value  # lazy: the run stack (~1 s)
+
+    overrides = {}
+    for item in spec.fixed:
+        key, _, text = item.partition("=")
+        overrides[key.strip()] = _parse_value(text)
+    overrides.update(spec.overrides)
+    if "design.top" not in overrides:
+        return spec  # the scenario's own design (its design.verilog): --ports replaces its map
+    top = overrides["design.top"]
+    if not (isinstance(top, str) and top.startswith("verilog:")) or "design.ports" in overrides:
+        return replace(spec, ports=None)
+    ports = f"design.ports={toml_value(os.path.abspath(spec.ports))}"
+    return replace(spec, ports=None, fixed=(*spec.fixed, ports))
 
 
 def run_identity(spec, scenario_source, extra_files=()):
@@ -511,7 +536,89 @@ def _near(value, base):
         return str(path)
 
 
+#: Override keys whose values name files (a design reference, Verilog files, a port map).
+DESIGN_FILE_KEYS = ("design.top", "design.verilog", "design.ports")
+
+
+def _absolute(text, base):
+    """A file path given in a campaign file, relative to the file's folder (or, when only
+    there, to the current folder), made absolute: a run's override is read relative to its
+    scenario's folder, so it must not depend on a folder at all."""
+    path = Path(text).expanduser()
+    if not path.is_absolute():
+        candidate = base / path
+        if candidate.exists() or not path.exists():
+            path = candidate
+    return os.path.abspath(path)
+
+
+def _design_value(key, value, base):
+    """An override value of ``key`` (one of ``DESIGN_FILE_KEYS``) with the files it names
+    made absolute; a built-in design's or a module's name stays as it is."""
+    if key == "design.top" and isinstance(value, str):
+        if value.startswith("verilog:"):
+            files = value[len("verilog:") :].split(",")
+            return "verilog:" + ",".join(_absolute(f, base) for f in files if f)
+        where, sep, name = value.rpartition(":")
+        if sep and where.endswith(".py"):
+            return f"{_absolute(where, base)}:{name}"
+        return value
+    if key == "design.ports" and isinstance(value, str) and value.strip():
+        return _absolute(value, base)
+    if key == "design.verilog":
+        if isinstance(value, str) and value.strip():
+            return _absolute(value, base)
+        if isinstance(value, list):
+            return [_absolute(f, base) if isinstance(f, str) and f.strip() else f for f in value]
+    return value
+
+
+def _design_paths(table, base, axis, prefix=""):
+    """The design file references among ``table``'s override keys (nested or dotted) made
+    absolute, in place; ``axis``: each value is a list of values (a grid)."""
+    for key, value in table.items():
+        path = f"{prefix}{key}"
+        if isinstance(value, dict):
+            _design_paths(value, base, axis, f"{path}.")
+        elif path in DESIGN_FILE_KEYS:
+            if axis and isinstance(value, list):
+                table[key] = [_design_value(path, v, base) for v in value]
+            elif not axis:
+                table[key] = _design_value(path, value, base)
+
+
+def _design_set_item(item, base):
+    """A ``set`` item ``KEY=VALUE`` whose key names files, those made absolute."""
+    from fpga_robotics.scenario.load import _parse_value  # lazy: the run stack (~1 s)
+
+    key, sep, text = item.partition("=")
+    if not sep or key.strip() not in DESIGN_FILE_KEYS:
+        return item
+    value = _parse_value(text)
+    new = _design_value(key.strip(), value, base)
+    return item if new == value else f"{key.strip()}={toml_value(new)}"
+
+
 def _file_paths(data, base):
+    """Paths in a campaign file are relative to the file: its scenarios, design and ports
+    (as paths from the current folder, for the replay commands) and the design files its
+    grid, sets, set items and known limits name (absolute: a run's override is read from its
+    scenario's folder)."""
+    if isinstance(data.get("grid"), dict):
+        _design_paths(data["grid"], base, axis=True)
+    if isinstance(data.get("sets"), list):
+        for table in data["sets"]:
+            if isinstance(table, dict):
+                _design_paths(table, base, axis=False)
+    if isinstance(data.get("known_limits"), list):
+        for entry in data["known_limits"]:
+            if isinstance(entry, dict) and isinstance(entry.get("when"), dict):
+                _design_paths(entry["when"], base, axis=False)
+    items = data.get("set")
+    if isinstance(items, str):
+        items = [items]
+    if isinstance(items, list) and all(isinstance(i, str) for i in items):
+        data["set"] = [_design_set_item(i, base) for i in items]
     if isinstance(data.get("scenarios"), list):
         data["scenarios"] = [_near(s, base) for s in data["scenarios"]]
     elif isinstance(data.get("scenarios"), str):

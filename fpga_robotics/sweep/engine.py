@@ -30,6 +30,7 @@ __all__ = [
     "MIN_TIMEOUT_S",
     "RECORD_LOG_EVERY",
     "build_all",
+    "check_scheduler_address",
     "open_client",
     "run_plan",
 ]
@@ -47,6 +48,23 @@ _GUESS_DEFAULT = 2e-7
 _GUESS_PER_FRAME_S = 2e-3
 
 
+def check_scheduler_address(address):
+    """A scheduler address that Dask can dial (``tcp://HOST:PORT``, or another scheme of
+    Dask's with a host and port), checked before anything is written: ``UsageError``
+    otherwise."""
+    from distributed.comm import get_address_host_port  # lazy: Dask costs ~1 s
+
+    try:
+        host, _ = get_address_host_port(address)
+        if not host:
+            raise ValueError("no host")
+    except (ValueError, TypeError) as exc:
+        raise UsageError(
+            f"--scheduler must be a Dask scheduler address tcp://HOST:PORT (e.g. "
+            f"tcp://127.0.0.1:8786), got {address!r} ({exc})"
+        ) from None
+
+
 @contextlib.contextmanager
 def open_client(scheduler=None, workers=None):
     """A ``distributed.Client``: to ``scheduler`` (an address), or to a new ``LocalCluster``
@@ -56,6 +74,7 @@ def open_client(scheduler=None, workers=None):
     from distributed import Client, LocalCluster  # lazy: Dask costs ~1 s; only a run needs it
 
     if scheduler is not None:
+        check_scheduler_address(scheduler)
         try:
             client = Client(scheduler, timeout="10s")
         except (OSError, TimeoutError, ValueError) as exc:
