@@ -581,3 +581,16 @@ def test_the_exported_verilog_drives_as_its_amaranth_design(tmp_path, capsys):
         np.testing.assert_array_equal(
             amaranth.trajectory[column], verilog.trajectory[column], err_msg=column
         )
+
+
+def test_a_design_top_given_on_the_command_line_replaces_the_files_design():
+    """line_track's file runs follow_line with a [design.line] table: another design.top from
+    an override (run --design) drops that table, the same top keeps it, and a file that names
+    a design of its own beside a built-in's table is still refused."""
+    own = f"design.top={json.dumps(str(DESIGNS / 'wall_stop.py') + ':WallStop')}"
+    replaced = load_scenario("line_track", [own])
+    assert replaced.top.endswith("wall_stop.py:WallStop") and replaced.design_tables == {}
+    same = load_scenario("line_track", ['design.top="follow_line"'])
+    assert same.design_tables["line"].base_dps == 450  # the file's table, kept
+    with pytest.raises(ScenarioError, match="design.line is a table of a built-in design"):
+        load_scenario("line_track", [own, "design.line.base_dps=300"])

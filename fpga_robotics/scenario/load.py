@@ -390,8 +390,26 @@ def load_scenario(name_or_path, overrides=()):
         data["name"] = _default_name(path)
     _fill_defaults(data)
     overrides = tuple(overrides or ())
+    _drop_replaced_design(data, overrides)
     _apply_overrides(data, overrides)
     return _finish(data, str(path), overrides)
+
+
+def _drop_replaced_design(data, overrides):
+    """An override that names another ``design.top`` (``run --design REF``) replaces the
+    file's design: the file's tables of built-in designs that the new one does not take, and
+    its ``variant``, go with the old design (its ``design.params`` stay, docs/your_design.md)."""
+    if not any(o.split("=", 1)[0].strip() == "design.top" for o in overrides):
+        return
+    probe = copy.deepcopy(data)
+    _apply_overrides(probe, overrides)  # a bad override fails here as it would below
+    old, new = data["design"].get("top", "follow_target"), probe["design"].get("top")
+    if new == old:
+        return
+    kept = TOPS[new].tables if isinstance(new, str) and new in TOPS else ()
+    for key in (*_TOP_TABLES, "variant"):
+        if key not in kept:
+            data["design"].pop(key, None)
 
 
 def _finish(data, source, overrides):
