@@ -203,3 +203,31 @@ def test_a_scenario_runs_its_foreign_design_in_closed_loop(files, capsys):
         "verdict",
     ):
         assert got[key] == want[key], key
+
+
+def test_run_design_verilog_replaces_the_scenarios_own_design(tmp_path):
+    """``run --design verilog:FILES --ports MAP`` on a scenario whose design is one's own
+    (with [design.params]): the Verilog design is the scenario's (its files, no parameters of
+    the design it replaces); a --set design.params is refused, not ignored."""
+    from fpga_robotics.cli import run
+
+    data = Path(__file__).parent / "data"
+    lf = data / "line_follow_verilog"
+    args = argparse.Namespace(
+        overrides=[],
+        design=f"verilog:{lf / 'lf_top.v'},{lf / 'lf_core.v'}",
+        ports=str(lf / "lf_ports.toml"),
+        backend="cxxrtl",
+        resolution=None,
+        duration=None,
+        color=None,
+    )
+    own = data / "user_designs" / "wall_stop.toml"
+    assert load_scenario(str(own)).design_params == {"speed": 300, "stop_mm": 250}
+    scenario = load_scenario(str(own), run._overrides(args))
+    assert scenario.design_params == {}
+    assert scenario.foreign.verilog == (str(lf / "lf_top.v"), str(lf / "lf_core.v"))
+    assert scenario.foreign.ports == str(lf / "lf_ports.toml")
+    args.overrides = ["design.params.speed=100"]
+    with pytest.raises(UsageError, match="a Verilog design .* takes no parameters"):
+        run._overrides(args)

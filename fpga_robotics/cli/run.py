@@ -262,6 +262,27 @@ def design_override(reference):
     return f"design.top={json.dumps(reference)}"
 
 
+def _verilog_overrides(args, items):
+    """``--design verilog:FILES`` (and ``--ports``) as the scenario's ``design.top`` (and
+    ``design.ports``), paths made absolute: the scenario is loaded with the Verilog design
+    in place of its own (its timing, no parameters of the design it replaces)."""
+    given = [i.split("=", 1)[0].strip() for i in items]
+    if any(key.startswith("design.params") for key in given):
+        raise UsageError(
+            "design.params: a Verilog design (--design verilog:...) takes no parameters; "
+            "set them in the Verilog (or tie inputs in its port map's [constants])"
+        )
+    files = [f for f in args.design[len("verilog:") :].split(",") if f.strip()]
+    paths = [Path(f).expanduser() for f in [*files, args.ports or ""]]
+    if not files or args.ports is None or not all(p.is_file() for p in paths):
+        return []  # the scenario's port map, or _design_files says what --design needs
+    if args.backend not in FOREIGN_BACKENDS:
+        return []  # _design_files names the backends
+    absolute = ",".join(str(Path(f).expanduser().resolve()) for f in files)
+    ports = str(Path(args.ports).expanduser().resolve())
+    return [f"design.top={json.dumps('verilog:' + absolute)}", f"design.ports={json.dumps(ports)}"]
+
+
 def take_design_reference(args, scenario):
     """After loading: a ``--design`` reference other than ``verilog:`` is the scenario's
     ``design.top`` now (``_overrides``); ``args.design`` keeps only Verilog files."""
@@ -284,6 +305,8 @@ def _overrides(args):
                 "--ports is the port map of a Verilog design: it goes with --design verilog:FILE.v"
             )
         items.append(design_override(args.design))
+    elif args.design is not None:
+        items += _verilog_overrides(args, items)
     if args.resolution is not None:
         w, h = parse_resolution(args.resolution)
         items.append(f'camera.resolution="{w}x{h}"')

@@ -403,13 +403,21 @@ def _drop_replaced_design(data, overrides):
         return
     probe = copy.deepcopy(data)
     _apply_overrides(probe, overrides)  # a bad override fails here as it would below
-    old, new = data["design"].get("top", "follow_target"), probe["design"].get("top")
+    design = data["design"]
+    old, new = design.get("top", "follow_target"), probe["design"].get("top")
     if new == old:
         return
     kept = TOPS[new].tables if isinstance(new, str) and new in TOPS else ()
     for key in (*_TOP_TABLES, "variant"):
         if key not in kept:
-            data["design"].pop(key, None)
+            design.pop(key, None)
+    if isinstance(new, str) and new.startswith("verilog:"):
+        # A Verilog design takes no parameters, and its files are the override's: the
+        # file's own Verilog goes, its port map too where the overrides give another.
+        design.pop("params", None)
+        design.pop("verilog", None)
+        if any(o.split("=", 1)[0].strip() == "design.ports" for o in overrides):
+            design.pop("ports", None)
 
 
 def _finish(data, source, overrides):
