@@ -78,4 +78,4 @@ def test_designs_the_benchmark_cannot_run_are_one_line(argv, message, tmp_path, 
 def test_the_follow_target_subjects_point_a_design_of_ones_own_to_user_verilog(subject, capsys):
     code, out, err = _cli(["bench", subject, "--design", WALL_STOP], capsys)
     assert code == 2 and out == "" and err.count("\n") == 1, err
-    assert f"time it with fpga-robotics bench user_verilog --design {WALL_STOP}" in err
+    assert f"({WALL_STOP}) is timed by fpga-robotics bench user_verilog --design REF" in err
