@@ -297,6 +297,23 @@ def take_design_reference(args, scenario):
     args.design = None
 
 
+def load_run_scenario(args):
+    """The scenario a run of ``args`` runs: ``--scenario`` with the command line's overrides.
+    The ones that put ``--design verilog:`` in place are not recorded as the run's own
+    (its summary names the design by ``--design``, as before)."""
+    items = _overrides(args)
+    scenario = load_scenario(args.scenario, items)
+    verilog = set(_verilog_overrides(args, items)) if _is_verilog(args) else set()
+    if not verilog:
+        return scenario
+    kept = tuple(o for o in scenario.overrides if o not in verilog)
+    return dataclasses.replace(scenario, overrides=kept)
+
+
+def _is_verilog(args):
+    return args.design is not None and args.design.startswith("verilog:")
+
+
 def _overrides(args):
     items = list(args.overrides)
     if args.design is not None and not args.design.startswith("verilog:"):
@@ -741,7 +758,7 @@ def main(argv=None, prog="fpga-robotics run"):
     if args.summary is not None:  # checked now, not after a long run
         check_output_path(args.summary, what="--summary")
     ros = RosOutputs(args)  # --bag, --live ...: checked now, not after a long run
-    scenario = load_scenario(args.scenario, _overrides(args))
+    scenario = load_run_scenario(args)
     take_design_reference(args, scenario)
     if args.target_color is not None:
         scenario = _dress_target(scenario, args.target_color)

@@ -86,14 +86,13 @@ def load_run(argv):
     from fpga_robotics.cli import run  # lazy: the run stack (~1 s)
     from fpga_robotics.scenario.load import (  # lazy: the run stack (~1 s)
         MAX_SEED,
-        load_scenario,
     )
 
     args = run.build_parser().parse_args(argv)
     args.quiet = True
     if args.seed is not None and not 0 <= args.seed <= MAX_SEED:
         raise UsageError(f"--seed must be in 0..{MAX_SEED}, got {args.seed}")
-    scenario = load_scenario(args.scenario, run._overrides(args))
+    scenario = run.load_run_scenario(args)
     run.take_design_reference(args, scenario)
     # As run takes --shadow: a design reference is a second design on pins, else
     # FollowTarget parameters, which compare frames.
