@@ -490,7 +490,7 @@ PLANS = {
         duration_why="the page quotes the whole 30 s run (about a second of wall time): its "
         "mean centroid error over the frames found, and the bump at 15.4 s",
         out=(
-            r"\[FAIL\] mean_centroid_error_max_px: centroid 101\.95 px from the target",
+            r"\[FAIL\] mean_centroid_error_max_px: centroid 89\.09 px from the target",
             r"\[FAIL\] max_robot_at_fault_collisions",
         ),
     ),

@@ -34,6 +34,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from fpga_robotics.checks.window import whole_in_window, window_columns
+from fpga_robotics.sim.camera.raster import silhouette_columns
 from fpga_robotics.sim.models.follow_target import match_table, proximity_level
 from fpga_robotics.sim.world.people import person_bands
 
@@ -158,9 +160,7 @@ def _rows(z0, z1, depth, geom, params):
 
 def silhouette(distance, bearing, geom):
     """``(left, right)`` image columns of the target's silhouette (continuous pixels)."""
-    a = math.asin(min(1.0, geom.radius / distance))
-    f, c = geom.focal, geom.width / 2
-    return c - f * math.tan(bearing + a), c - f * math.tan(bearing - a)
+    return silhouette_columns(distance, bearing, geom.radius, geom.width, geom.hfov)
 
 
 def count_bounds(distance, bearing, code, geom, params):
@@ -170,7 +170,7 @@ def count_bounds(distance, bearing, code, geom, params):
     if distance <= geom.radius or abs(bearing) >= geom.hfov / 2:
         return None
     left, right = silhouette(distance, bearing, geom)
-    if left < params.margin_x or right > geom.width - params.margin_x:
+    if not whole_in_window(left, right, geom.width, params.margin_x):
         return None
     cols = right - left
     near, far = distance - geom.radius, distance
@@ -385,9 +385,9 @@ def sure_side(distance, bearing, geom, params, tol=E_TOLERANCE_PX):
     if abs(bearing) + math.asin(geom.radius / distance) >= math.pi / 2 - 1e-6:
         return 0  # an edge of the silhouette at or behind the camera's plane
     left, right = silhouette(distance, bearing, geom)
-    edge_lo, edge_hi = params.margin_x, geom.width - params.margin_x
+    edge_lo, edge_hi = window_columns(geom.width, params.margin_x)
     centre = geom.width / 2
-    if edge_lo <= left and right <= edge_hi:
+    if whole_in_window(left, right, geom.width, params.margin_x):
         offset = (left + right) / 2 - centre
         if abs(offset) <= tol:
             return 0

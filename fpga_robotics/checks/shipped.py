@@ -194,8 +194,10 @@ SHIPPED_CHECKS = (
         "max",
         (
             "the design's centroid is more than an eighth of the image width from the target's "
-            "image column in at most this fraction of the frames in which it reports found "
-            "with the target's centre in view (a non-target object taken for the target)"
+            "image column (with the target partly beyond the tracking window's edge, from the "
+            "middle of its part inside) in at most this fraction of the frames in which it "
+            "reports found with the target's centre in view (a non-target object taken for "
+            "the target)"
         ),
         lambda v, limit, m: (
             f"centroid away from the target in {v:.0%} of the frames with "
@@ -212,9 +214,10 @@ SHIPPED_CHECKS = (
         "mean_centroid_error_px",
         "max",
         (
-            "mean distance of the design's centroid from the target's image column (frames "
-            "found with the target's centre in view) at most this; with the target straight "
-            "ahead, the centroid's distance from the image centre"
+            "mean distance of the design's centroid from the target's image column (with the "
+            "target partly beyond the tracking window's edge, from the middle of its part "
+            "inside; frames found with the target's centre in view) at most this; with the "
+            "target straight ahead, the centroid's distance from the image centre"
         ),
         lambda v, limit, m: (
             f"centroid {v:.2f} px from the target's image column on average (limit <= {limit} px)"

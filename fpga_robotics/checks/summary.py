@@ -11,6 +11,7 @@ import numpy as np
 
 from fpga_robotics.checks.check import DESIGN_OUTPUTS
 from fpga_robotics.checks.registry import CHECK_OUTPUTS, CHECKS, evaluate_checks, verdict
+from fpga_robotics.checks.window import visible_middle, whole_in_window
 
 __all__ = [
     "CHECKS",
@@ -84,7 +85,9 @@ def compute_metrics(
     ----------
     traj : dict of numpy arrays, one entry per camera frame
         ``t``, ``x``, ``y``, ``found``, ``target_distance`` (NaN without target),
-        ``target_in_view``.
+        ``target_in_view``; for the centroid metrics ``target_column``, ``centroid_x`` and
+        ``target_left``, ``target_right`` (the target's silhouette; without them the centroid
+        is compared with the target's column whatever the window cuts off).
     events : list of (frame, time, text)
     collisions : dict kind → count
     frame_period : float
@@ -98,7 +101,8 @@ def compute_metrics(
         metrics made of them are None, and ``absent_outputs`` lists them.
     margin_x : int, optional
         The columns the design's tracking window leaves on each side (the LEDs sit above its
-        eighths); default ``width // 10``, the design's default.
+        eighths; the centroid metrics compare the design's centroid with the part of the
+        target inside it); default ``width // 10``, the design's default.
     collision_summary : dict, optional
         ``World.collision_summary()``: per kind, episodes, contact time and largest impulse.
     """
@@ -169,7 +173,7 @@ def compute_metrics(
         "tip_overs": len(tipped),
         "max_wheel_command_step_dps": _max_command_step(traj),
         "oscillation_hz": _oscillation(traj, width, n * frame_period),
-        **_off_target(traj, width),
+        **_off_target(traj, width, margin_x),
         "led_wrong_side_fraction": _led_wrong_side(traj, width),
         "led_misplaced_fraction": _led_misplaced(traj, width, margin_x),
         "peak_wheel_command_dps": _peak_command(traj),
@@ -206,19 +210,31 @@ def _heading_overshoot(traj):
     return _round(best, 2)
 
 
-def _off_target(traj, width):
-    """How far the design's centroid is from the target's image column (``target_column``),
-    over the frames in which it reports found and the target's centre is in view: the
-    fraction of them with an error above ``OFF_TARGET_FRACTION * width``, and the mean error
-    (pixels). None without such frames or fields."""
+def _off_target(traj, width, margin_x=None):
+    """How far the design's centroid is from where it should see the target, over the frames
+    in which it reports found with the target's centre in view: the target's image column
+    (``target_column``) with its silhouette (``target_left`` .. ``target_right``) wholly
+    inside the tracking window's columns, else the middle of the part inside (the tracker
+    counts only the pixels there; ``visible_middle``; a frame with no part inside is left
+    out). The fraction of those frames with an error above ``OFF_TARGET_FRACTION * width``,
+    and the mean error (pixels). None without such frames or fields."""
     none = {"off_target_fraction": None, "mean_centroid_error_px": None}
     if width is None or "target_column" not in traj or "centroid_x" not in traj:
         return none
     column = np.asarray(traj["target_column"], dtype=float)
-    ok = traj["found"] & ~np.isnan(column)
+    expected = column
+    if "target_left" in traj and "target_right" in traj:
+        left = np.asarray(traj["target_left"], dtype=float)
+        right = np.asarray(traj["target_right"], dtype=float)
+        expected = np.where(
+            whole_in_window(left, right, width, margin_x),
+            column,
+            visible_middle(left, right, width, margin_x),
+        )
+    ok = traj["found"] & ~np.isnan(column) & ~np.isnan(expected)
     if not ok.any():
         return none
-    err = np.abs(np.asarray(traj["centroid_x"], dtype=float)[ok] - column[ok])
+    err = np.abs(np.asarray(traj["centroid_x"], dtype=float)[ok] - expected[ok])
     return {
         "off_target_fraction": _round((err > OFF_TARGET_FRACTION * width).mean()),
         "mean_centroid_error_px": _round(err.mean(), 2),

@@ -28,7 +28,7 @@ from fpga_robotics.loop.pin_channel import PIN_CHANNEL_BACKENDS
 from fpga_robotics.loop.shadow import ShadowComparison, divergence_event
 from fpga_robotics.ros.controls import apply_inputs
 from fpga_robotics.sim.backends import fastest_backend_name, get_backend
-from fpga_robotics.sim.camera.raster import focal_length
+from fpga_robotics.sim.camera.raster import focal_length, silhouette_columns
 from fpga_robotics.sim.records import FrameRecord
 from fpga_robotics.sim.world import World, is_removal_event
 
@@ -64,6 +64,8 @@ TRAJECTORY_FIELDS = (
     "target_distance",
     "target_in_view",
     "target_column",
+    "target_left",
+    "target_right",
 )
 
 
@@ -317,8 +319,10 @@ class ClosedLoop:
             dist = math.hypot(tx - rx, ty - ry)
             visible = in_view(pose, self.scenario.camera.hfov, tx, ty, self.target_radius)
             column = target_column(pose, self.scenario.camera, tx, ty)
+            edges = target_silhouette(pose, self.scenario.camera, tx, ty, self.target_radius)
         else:
             tx = ty = dist = column = math.nan
+            edges = (math.nan, math.nan)
             visible = False
         row = self.traj
         row["t"][k], row["x"][k], row["y"][k], row["heading"][k] = t, rx, ry, heading
@@ -327,6 +331,7 @@ class ClosedLoop:
         row["target_x"][k], row["target_y"][k] = tx, ty
         row["target_distance"][k], row["target_in_view"][k] = dist, visible
         row["target_column"][k] = column
+        row["target_left"][k], row["target_right"][k] = edges
         return (None if target is None else dist), visible
 
     def store_outputs(self, k, result):
@@ -532,6 +537,18 @@ def target_column(pose, cam, x, y):
     if abs(bearing) >= cam.hfov / 2:
         return math.nan
     return cam.width / 2 - focal_length(cam.width, cam.hfov) * math.tan(bearing)
+
+
+def target_silhouette(pose, cam, x, y, radius):
+    """``(left, right)``: the image columns (continuous pixels) of the edges of the silhouette
+    of a person of ``radius`` at ``(x, y)`` seen by a camera at ``pose`` (an edge beyond the
+    camera's side: -inf or +inf); NaN with the person's centre behind the camera."""
+    bearing = math.atan2(y - pose.y, x - pose.x) - pose.heading
+    bearing = (bearing + math.pi) % (2 * math.pi) - math.pi
+    if abs(bearing) >= math.pi / 2:
+        return math.nan, math.nan
+    distance = math.hypot(x - pose.x, y - pose.y)
+    return silhouette_columns(distance, bearing, radius, cam.width, cam.hfov)
 
 
 def _dps(command):

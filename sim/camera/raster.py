@@ -58,6 +58,7 @@ __all__ = [
     "max_hfov",
     "max_tilt",
     "render",
+    "silhouette_columns",
     "vertical_fov",
 ]
 
@@ -105,6 +106,22 @@ class _Cylinders:
 def focal_length(width, hfov):
     """The pinhole focal length in pixels, ``(width/2) / tan(hfov/2)`` (square pixels)."""
     return (width / 2) / math.tan(hfov / 2)
+
+
+def silhouette_columns(distance, bearing, radius, width, hfov):
+    """``(left, right)``: the image columns (continuous pixels, 0 = the left edge) of the
+    silhouette of an upright cylinder of ``radius`` whose axis stands ``distance`` from the
+    camera at ``bearing`` (rad, left positive, in front of the camera): its tangents from the
+    camera, ``bearing +- asin(radius / distance)``, at ``W/2 - f tan(angle)``. An edge at or
+    behind the camera's plane is at -inf (left) or +inf (right); a camera inside the cylinder
+    has it on both sides."""
+    if distance <= radius:
+        return -math.inf, math.inf
+    a = math.asin(radius / distance)
+    f, c = focal_length(width, hfov), width / 2
+    left = -math.inf if bearing + a >= math.pi / 2 else c - f * math.tan(bearing + a)
+    right = math.inf if bearing - a <= -math.pi / 2 else c - f * math.tan(bearing - a)
+    return left, right
 
 
 def vertical_fov(width, height, hfov):
