@@ -628,3 +628,14 @@ def test_a_silent_ultrasound_warns_makes_its_checks_na_and_fails_min_measured_fr
     assert format_summary({**summary, "checks": only, "verdict": verdict(only)}).endswith(
         "verdict: N/A (no check could judge this run)"
     )
+
+
+@pytest.mark.parametrize(
+    ("fraction", "shown"),
+    [(0.9967, "99.7%"), (0.99996, "99.996%"), (1.0, "100%"), (0.004, "0.4%"), (0.5, "50%")],
+)
+def test_a_fraction_is_not_rounded_to_all_or_nothing(fraction, shown):
+    """0.9967 of the frames is not "100%" (a limit of 100% fails it)."""
+    c = _one("target_in_view_min_fraction", 1.0, {"target_in_view_fraction": fraction})
+    assert f"target in view {shown} of frames" in c["text"]
+    assert c["status"] == ("pass" if fraction == 1.0 else "fail")

@@ -13,6 +13,17 @@ _FRACTION = (0, 1, "")
 _NO_TARGET = "no target person: no distance to compare"
 
 
+def _pct(v):
+    """A fraction as a whole percentage, but never 0% or 100% for what is not exactly that
+    (0.9967 is 99.7%, not 100%)."""
+    for digits in range(5):
+        text = f"{v:.{digits}%}"
+        shown = float(text[:-1])
+        if not ((shown == 100 and v < 1) or (shown == 0 and v > 0)):
+            return text
+    return text
+
+
 def _never_in_view(m):
     """A precondition: the target was in the camera's view at least once."""
     return "the target was never in view" if m.get("target_in_view_fraction") == 0 else None
@@ -200,7 +211,7 @@ SHIPPED_CHECKS = (
             "the target)"
         ),
         lambda v, limit, m: (
-            f"centroid away from the target in {v:.0%} of the frames with "
+            f"centroid away from the target in {_pct(v)} of the frames with "
             f"the target found and in view (limit <= {limit:.0%})"
         ),
         limits=_FRACTION,
@@ -239,7 +250,7 @@ SHIPPED_CHECKS = (
             "with the target in view (led_wrong_side_fraction)"
         ),
         lambda v, limit, m: (
-            f"centroid LEDs point the wrong way in {v:.0%} of the frames "
+            f"centroid LEDs point the wrong way in {_pct(v)} of the frames "
             f"judged (limit <= {limit:.0%})"
         ),
         limits=_FRACTION,
@@ -311,7 +322,7 @@ SHIPPED_CHECKS = (
         "target_in_view_fraction",
         "min",
         "the target is in the camera's view this often",
-        lambda v, limit, m: f"target in view {v:.0%} of frames (limit >= {limit:.0%})",
+        lambda v, limit, m: f"target in view {_pct(v)} of frames (limit >= {limit:.0%})",
         limits=_FRACTION,
     ),
     Check(
@@ -319,7 +330,9 @@ SHIPPED_CHECKS = (
         "found_after_acquisition_fraction",
         "min",
         "after first acquisition, the design reports found this often",
-        lambda v, limit, m: f"found in {v:.0%} of frames after acquisition (limit >= {limit:.0%})",
+        lambda v, limit, m: (
+            f"found in {_pct(v)} of frames after acquisition (limit >= {limit:.0%})"
+        ),
         limits=_FRACTION,
         outputs=("found",),
         precondition=_never_in_view,
@@ -505,7 +518,7 @@ SHIPPED_CHECKS = (
             "every further camera with a target ([[robot.sensors]] camera, target = ...) has "
             "its target in view this often (the least of them)"
         ),
-        lambda v, limit, m: f"a camera's target in view {v:.0%} of frames (limit >= {limit:.0%})",
+        lambda v, limit, m: f"a camera's target in view {_pct(v)} of frames (limit >= {limit:.0%})",
         limits=_FRACTION,
         precondition=measured("camera_target_in_view_fraction", "no further camera has a target"),
     ),
@@ -518,7 +531,7 @@ SHIPPED_CHECKS = (
             "this often (the least of them): a pan camera keeps its target centred"
         ),
         lambda v, limit, m: (
-            f"a camera's target centred in {v:.0%} of frames (limit >= {limit:.0%})"
+            f"a camera's target centred in {_pct(v)} of frames (limit >= {limit:.0%})"
         ),
         limits=_FRACTION,
         precondition=measured("camera_target_centred_fraction", "no further camera has a target"),
