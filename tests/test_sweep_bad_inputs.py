@@ -239,12 +239,14 @@ def test_a_design_that_does_not_build_leaves_no_results_folder(tmp_path, monkeyp
     # The folder is made once the cluster is up; the build fails after it: the folder this
     # command made goes again, as no run finished.
     (tmp_path / "top.v").write_text(
-        "module top(input clock, output [15:0] wl, output [15:0] wr);\nwire oops = ;\nendmodule\n"
+        "module top(input clock, input [2:0] sens, output [15:0] wl, output [15:0] wr);\n"
+        "wire oops = ;\nendmodule\n"
     )
-    (tmp_path / "ports.toml").write_text(
+    (tmp_path / "ports.toml").write_text(  # a map that fits line_track: the build fails
         'top = "top"\nclock = { port = "clock" }\n[outputs]\n'
         'motor_left = { port = "wl", width = 16, signed = true }\n'
         'motor_right = { port = "wr", width = 16, signed = true }\n'
+        '[connectors.line_sensors]\nline = "sens"\n'
     )
     (tmp_path / "c.toml").write_text(
         'scenarios = ["line_track"]\nbackend = "cxxrtl"\nduration = 0.1\n'
