@@ -173,3 +173,37 @@ def test_a_result_strobe_later_than_the_timeout_is_the_named_timeout(tmp_path):
                 "300 cycles (result.timeout) after the frame"
             )
             assert pins.cycle == last + 300 + 1  # raised at the timeout's very edge
+
+
+ASSERTER = """\
+module asserter (input clk, input rst, input bump, output reg [15:0] n);
+  always @(posedge clk) begin
+    if (rst) n <= 16'd0; else n <= n + 16'd1;
+    if (!rst) assert (n != 16'd50);
+    if (!rst && n == 16'd20) $display("asserter: n is %0d", n);
+  end
+endmodule
+"""
+ASSERTER_MAP = """\
+top = "asserter"
+clock = { port = "clk" }
+reset = { port = "rst" }
+[connectors.bumper]
+pressed = "bump"
+[extra_outputs]
+count = "n"
+"""
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("simulator", ["cxxrtl", "verilator"])
+def test_a_failing_assertion_is_not_checked_and_display_prints(simulator, tmp_path, capfd):
+    # Verilator builds with --noassert; CXXRTL would abort the process on the $check cell
+    # Yosys makes of it. Both run on, and print the design's $display (a $print cell).
+    (tmp_path / "asserter.v").write_text(ASSERTER)
+    (tmp_path / "asserter.toml").write_text(ASSERTER_MAP)
+    design = ForeignDesign([tmp_path / "asserter.v"], tmp_path / "asserter.toml", pins=True)
+    with get_pin_backend(simulator, VerilogPinSource(design)) as pins:
+        assert pins.run(100).cycle == 100
+        assert pins.peek("n") == 100
+    assert capfd.readouterr().out.splitlines() == ["asserter: n is 20"]
