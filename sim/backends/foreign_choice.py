@@ -14,7 +14,8 @@ __all__ = ["FOREIGN_BACKENDS", "open_foreign_frames", "verilator_only"]
 #: Backend names a Verilog design runs on.
 FOREIGN_BACKENDS = ("auto", "cxxrtl", "verilator")
 
-# Verilator turns these into errors the backend reports; CXXRTL's build does not catch them.
+# Yosys refuses these outside an initial block; the Verilator backends (frames and pins)
+# turn them into errors naming the call.
 _SYSTEM_STOPS = re.compile(r"\$(stop|fatal|finish)\b")
 
 
