@@ -207,3 +207,83 @@ def test_a_failing_assertion_is_not_checked_and_display_prints(simulator, tmp_pa
         assert pins.run(100).cycle == 100
         assert pins.peek("n") == 100
     assert capfd.readouterr().out.splitlines() == ["asserter: n is 20"]
+
+
+FINISHER = """\
+// A camera design: its strobe rises after each frame's last pixel; it calls $finish at
+// the third frame's (frame 2's) last pixel.
+module frame_finisher #(parameter integer PIXELS = 1200) (
+  input clk, input rst, input px_valid, input [13:0] px_payload,
+  output reg done, output signed [15:0] ml, output signed [15:0] mr
+);
+  reg [15:0] seen;
+  reg [7:0] frames;
+  wire [15:0] index = px_payload[12] ? 16'd0 : seen;
+  always @(posedge clk) begin
+    done <= 1'b0;
+    if (rst) begin
+      seen <= 16'd0; frames <= 8'd0;
+    end else if (px_valid) begin
+      seen <= index + 16'd1;
+      if (index == PIXELS - 1) begin
+        done <= 1'b1; frames <= frames + 8'd1;
+        if (frames == 8'd2) $finish;
+      end
+    end
+  end
+  assign ml = 16'sd0;
+  assign mr = 16'sd0;
+endmodule
+"""
+FINISHER_MAP = """\
+top = "frame_finisher"
+clock = { port = "clk" }
+reset = { port = "rst" }
+pixels = { valid = "px_valid", payload = "px_payload" }
+result = { strobe = "done", latency = 1 }
+outputs = { motor_left = "ml", motor_right = "mr" }
+"""
+FINISHER_SCENARIO = """
+people = []
+[sim]
+duration = 1.0
+clock_hz = 200000.0
+[camera]
+resolution = "40x30"
+fps = 10.0
+"""
+
+
+@pytest.mark.slow
+def test_a_call_ends_a_run_alike_in_both_timings(tmp_path, capsys):
+    # Frame 2's call, in either timing: the same error (real-clock adds the edge), no
+    # summary, and the recording closed with the frames before it.
+    (tmp_path / "frame_finisher.v").write_text(FINISHER)
+    (tmp_path / "finisher.toml").write_text(FINISHER_MAP)
+    (tmp_path / "scenario.toml").write_text(FINISHER_SCENARIO)
+    line = FINISHER.splitlines().index("        if (frames == 8'd2) $finish;") + 1
+    error = (
+        "fpga-robotics run: error: --design: frame_finisher: frame 2: the design called "
+        f"$finish at frame_finisher.v:{line}"
+    )
+    # Frame 2 is captured at edge 40000 (0.2 s at 200 kHz); its pixels from the next edge.
+    edge = real_clock_timing(40, 30, 10.0, 200000.0, 40001).last_edge(40, 30)
+    suffix = {"compressed": "", "real_clock": f" (edge {edge}, {edge / 200000.0:.6g} s)"}
+    for timing in ("compressed", "real_clock"):
+        recording = tmp_path / f"{timing}.rrd"
+        code, captured = _run(
+            [
+                *("--scenario", str(tmp_path / "scenario.toml")),
+                *("--design", f"verilog:{tmp_path / 'frame_finisher.v'}"),
+                *("--ports", str(tmp_path / "finisher.toml")),
+                *("--set", f'sim.timing="{timing}"'),
+                *("--rerun", f"save:{recording}", "--quiet"),
+            ],
+            capsys,
+        )
+        assert code == 2
+        lines = captured.err.splitlines()
+        assert lines[-1] == error + suffix[timing]
+        assert any(x.startswith(f"saved 2 frames (2 with images) to {recording}") for x in lines)
+        assert recording.is_file()
+        assert "verdict" not in captured.out
