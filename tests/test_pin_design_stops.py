@@ -19,6 +19,7 @@ from fpga_robotics.cli.run import main as run_main
 from fpga_robotics.loop.timings import run_scenario
 from fpga_robotics.scenario.load import load_scenario
 from fpga_robotics.sim.backends.foreign import ForeignDesign
+from fpga_robotics.sim.backends.foreign_choice import verilator_only
 from fpga_robotics.sim.pins import (
     DesignError,
     DesignStopped,
@@ -88,6 +89,17 @@ def test_cxxrtl_is_refused_for_a_design_that_calls_them():
     # Yosys refuses $finish/$stop/$fatal outside an initial block: said before any build.
     with pytest.raises(PinError, match=r"^stopper: it calls \$stop, \$fatal or \$finish, .*"):
         get_pin_backend("cxxrtl", _stopper_source())
+
+
+def test_a_call_named_in_a_comment_only_does_not_need_verilator(tmp_path):
+    text = STOPPER.read_text()
+    for call in ("$finish;", "$stop;", '$fatal(1, "stopper: fatal at n = %0d", n);'):
+        text = text.replace(call, "/* no call */ ;")
+    assert "$finish" in text  # still named, in the header comment
+    (tmp_path / "stopper.v").write_text(text)
+    design = ForeignDesign([tmp_path / "stopper.v"], STOPPER_PORTS, pins=True)
+    assert verilator_only(design) is None
+    assert verilator_only(_stopper_source().design).startswith("it calls $stop, $fatal")
 
 
 @pytest.mark.slow

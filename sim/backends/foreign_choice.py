@@ -17,6 +17,7 @@ FOREIGN_BACKENDS = ("auto", "cxxrtl", "verilator")
 # Yosys refuses these outside an initial block; the Verilator backends (frames and pins)
 # turn them into errors naming the call.
 _SYSTEM_STOPS = re.compile(r"\$(stop|fatal|finish)\b")
+_COMMENTS = re.compile(r"/\*.*?\*/|//[^\n]*", re.DOTALL)
 
 
 def verilator_only(design):
@@ -24,7 +25,7 @@ def verilator_only(design):
     if design.port_map.runtime and not design.pins:
         return "its [runtime] inputs are set through Verilator's DPI"
     texts = [*design.sources.values(), *design.includes.values()]
-    if any(_SYSTEM_STOPS.search(text) for text in texts):
+    if any(_SYSTEM_STOPS.search(_COMMENTS.sub("", text)) for text in texts):
         return "it calls $stop, $fatal or $finish, which the Verilator backend reports"
     return None
 
