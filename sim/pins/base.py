@@ -28,11 +28,35 @@ from dataclasses import dataclass
 
 from fpga_robotics.hw.errors import UserError
 
-__all__ = ["PinBackend", "PinError", "PixelTiming", "Port", "Stop", "StopLimit"]
+__all__ = [
+    "DesignError",
+    "DesignStopped",
+    "PinBackend",
+    "PinError",
+    "PixelTiming",
+    "Port",
+    "Stop",
+    "StopLimit",
+]
 
 
 class PinError(UserError, RuntimeError):
     """A pin-level run cannot go on: unknown port, a value out of range, a missing tool."""
+
+
+class DesignError(PinError):
+    """The design itself ended a run: it called ``$finish``, ``$stop`` or ``$fatal``
+    (``DesignStopped``), or its result strobe never rose (the real-clock loop)."""
+
+
+class DesignStopped(DesignError):
+    """The design called ``$finish``, ``$stop`` or ``$fatal`` (``call``: which, and the file
+    and line of the call) at edge ``cycle``; the model runs no further edge until the next
+    ``reset()``."""
+
+    def __init__(self, call, cycle):
+        self.call, self.cycle = call, cycle
+        super().__init__(f"the design called {call} (edge {cycle})")
 
 
 class StopLimit(RuntimeError):

@@ -7,6 +7,7 @@ per ``run``, ``poke``, ``peek``, ``schedule``, ``watch`` and ``stream_frame``.
 import contextlib
 import ctypes
 import os
+import re
 from pathlib import Path
 
 import numpy as np
@@ -33,7 +34,7 @@ from ..backends.toolchain import (
 from ..backends.verilator import CXX_FLAGS as VERILATOR_CXX_FLAGS
 from ..backends.verilator import MAKE_FLAGS, VERILATOR_FLAGS
 from ..backends.verilog_cxxrtl import runtime_include_dir
-from .base import PinError
+from .base import DesignStopped, PinError
 from .codegen import PIN_WRAPPER, cxxrtl_accessors, verilator_accessors, verilator_wrapper
 from .host import HostPins, capture_error
 
@@ -43,11 +44,12 @@ __all__ = ["CompiledPins", "CxxrtlPins", "VerilatorPins"]
 SOURCE_DIR = Path(__file__).resolve().parent
 LIBRARY_NAME = "libpins.so"
 #: Must match ``pin::ABI_VERSION`` in pin_driver.h.
-ABI_VERSION = 2
+ABI_VERSION = 3
 _DRIVER = "pin_driver.h"
 # Layout of run()'s result array (enum Out in pin_driver.h) and its status codes.
 _N_OUT = 7
 _TOO_MANY_FILTERED = 1  # the other failure of a run: 2, wrong framing flags
+_STOPPED = 5  # the design called $finish, $stop or $fatal
 #: Changes ``pin_record`` writes per call.
 _RECORD_CHUNK = 65536
 
@@ -69,6 +71,7 @@ _ENTRIES = (
     ("pin_watch", None, [_VP, _VP, _I64]),
     ("pin_stream", ctypes.c_int, [_VP, _VP, _VP, _VP]),
     ("pin_run", ctypes.c_int, [_VP, _I64, _VP]),
+    ("pin_stop_message", ctypes.c_char_p, [_VP]),
 )
 
 
@@ -149,7 +152,9 @@ def verilator_plan(source):
     text = "".join(f"{name}\0{body}\0" for name, body in files.items())
     accessors = verilator_accessors(source, registered)
     harness = _sources("pin_verilator.cpp", _DRIVER, "verilator_clock.h")
-    cflags = " ".join(VERILATOR_CXX_FLAGS)
+    # $finish, $stop and $fatal reach the harness's hooks (pin_verilator.cpp), not the
+    # process's exit.
+    cflags = " ".join([*VERILATOR_CXX_FLAGS, "-DVL_USER_STOP", "-DVL_USER_FINISH"])
     jobs = str(max(1, min(os.cpu_count() or 1, 4)))
     key = build_cache.build_key(
         {
@@ -296,7 +301,7 @@ class CompiledPins(HostPins):
             cycle, _port, _value, captured, _pending, bad, recorded = self._out.tolist()
             if status:
                 self._cycle = cycle
-                raise capture_error(status == _TOO_MANY_FILTERED, bad)
+                raise self._run_error(status, bad)
             self._ran_to(cycle, captured)
             rows = buffer[:recorded]
             raws = rows[:, 2].astype(np.uint64).tolist()
@@ -326,8 +331,16 @@ class CompiledPins(HostPins):
         cycle, port, value, captured, _pending, bad, _recorded = out.tolist()  # enum Out
         if status:
             self._cycle = cycle
-            raise capture_error(status == _TOO_MANY_FILTERED, bad)
+            raise self._run_error(status, bad)
         return cycle, port, value & 0xFFFF_FFFF_FFFF_FFFF, captured
+
+    def _run_error(self, status, bad):
+        """The error of a run that ended with ``status``."""
+        if status != _STOPPED:
+            return capture_error(status == _TOO_MANY_FILTERED, bad)
+        text = (self._lib.pin_stop_message(self._handle) or b"").decode(errors="replace")
+        # The file as the user named it, not its copy in the build folder.
+        return DesignStopped(re.sub(r" at (?:\S*/)?src/", " at ", text), self._cycle)
 
     def close(self):
         if self._handle is not None:

@@ -13,7 +13,9 @@
 // A simulator adapter `S` (pin_cxxrtl.cpp, pin_verilator.cpp) provides:
 //   evals_per_cycle, set_rst(bool), edge() (one rising edge), settle() (evaluate the
 //   combinational logic with the inputs now; nothing to do when every output is a
-//   flip-flop), and `top`, the model that the generated pin_design.h functions take:
+//   flip-flop), stop_pending() (the design called $finish, $stop or $fatal: the run ends
+//   there with status STOPPED) and stop_message(), restart(), and `top`, the model that the
+//   generated pin_design.h functions take:
 //   pin_set_input(top, i, v), pin_get(top, i), pin_zero_inputs(top),
 //   pin_diff(top, mask, prev), pin_set_pixel(top, valid, payload),
 //   pin_filtered_valid(top), pin_filtered_payload(top), and PIN_HAS_PIXELS,
@@ -30,11 +32,11 @@
 namespace pin {
 
 // Bump when an entry point or the result layout changes (checked by the Python side).
-constexpr int ABI_VERSION = 2;
+constexpr int ABI_VERSION = 3;
 
 enum Out { O_CYCLE, O_PORT, O_VALUE, O_CAPTURED, O_PENDING, O_BAD_INDEX, O_RECORDED, O_COUNT };
 enum Status { OK = 0, TOO_MANY_FILTERED = 1, BAD_FILTERED_FLAGS = 2, BAD_ARGUMENTS = 3,
-              CAPTURES_FULL = 4 };
+              CAPTURES_FULL = 4, STOPPED = 5 };
 
 constexpr int64_t NEVER = INT64_MAX;
 constexpr uint16_t FIRST = 1u << 12, LAST = 1u << 13, PIXEL = 0x0FFF;
@@ -92,6 +94,7 @@ struct Driver {
         mask = 0;
         order.clear();
         sim.settle();
+        sim.stop_pending();  // a call in the reset is this model's: noted now
     }
 
     void update_next_event() { next_event = std::min(next_due, std::min(next_pixel, valid_off)); }
@@ -138,11 +141,13 @@ struct Driver {
         if (next_event == cycle + 1)
             apply_events(cycle + 1);
         sim.settle();
+        sim.stop_pending();  // a call in this evaluation is this model's: noted now
     }
 
     void poke(int port, uint64_t value) {
         pin_set_input(sim.top, port, value);
         sim.settle();
+        sim.stop_pending();
     }
 
     void schedule(int64_t edge, int port, uint64_t value) {
@@ -232,7 +237,10 @@ struct Driver {
         const int64_t end = cycle + n;
         int status = OK;
         uint64_t diff = pin_diff(sim.top, mask, prev);
-        while (!diff && cycle < end) {
+        // A design that stopped (here or on an earlier host call) runs no further edge.
+        if (__builtin_expect(sim.stop_pending(), 0))
+            status = STOPPED;
+        while (status == OK && !diff && cycle < end) {
 #if PIN_HAS_FILTERED
             // The beat the coming edge samples, as a consumer of the stream sees it.
             if (__builtin_expect(pin_filtered_valid(sim.top), 0) && !capture()) {
@@ -245,6 +253,10 @@ struct Driver {
             if (__builtin_expect(next_event == next, 0))
                 apply_events(next);
             sim.settle();
+            if (__builtin_expect(sim.stop_pending(), 0)) {
+                status = STOPPED;  // at this edge: its outputs are not compared
+                break;
+            }
             diff = pin_diff(sim.top, mask, prev);
         }
         out[O_PORT] = -1;
@@ -325,6 +337,9 @@ struct Driver {
     }                                                                                         \
     PIN_EXPORT int pin_run(void *h, int64_t n, int64_t *out) {                                \
         return static_cast<PinDriver *>(h)->run(n, out);                                      \
+    }                                                                                         \
+    PIN_EXPORT const char *pin_stop_message(void *h) {                                        \
+        return static_cast<PinDriver *>(h)->sim.stop_message();                               \
     }
 
 #endif

@@ -5,6 +5,12 @@
 // this Verilator lets the harness clear its remembered clock, else an eval() with the clock
 // high (the edge) and one with it low (settling the combinational outputs on the next edge's
 // inputs); the scheduler is called directly after the first eval() (verilator_clock.h).
+//
+// $finish, $stop and $fatal (built with VL_USER_FINISH and VL_USER_STOP) are noted here
+// instead of being printed and, for $stop and $fatal, exiting the whole process; the driver
+// checks the note after each evaluation and ends the run there (status STOPPED).
+#include <cstdio>
+#include <cstring>
 #include <memory>
 #include <new>
 
@@ -17,6 +23,28 @@ using PinTop = Vfollow_target;
 #include "pin_design.h"
 #include "pin_driver.h"
 #include "verilator_clock.h"
+
+namespace {
+
+// The call of the model evaluated last (each run is single-threaded: the driver takes the
+// note right after the evaluation that made it, so it goes to the right model).
+char fr_call_text[600];
+bool fr_call_pending = false;
+
+void fr_note_call(const char *what, const char *filename, int linenum) {
+    if (!fr_call_pending)
+        std::snprintf(fr_call_text, sizeof fr_call_text, "%s at %s:%d", what, filename, linenum);
+    fr_call_pending = true;
+}
+
+}  // namespace
+
+void vl_stop(const char *filename, int linenum, const char *) {
+    fr_note_call("$stop or $fatal", filename, linenum);
+}
+void vl_finish(const char *filename, int linenum, const char *) {
+    fr_note_call("$finish", filename, linenum);
+}
 
 namespace {
 
@@ -53,9 +81,24 @@ struct Sim {
     static constexpr int evals_per_cycle = ONE_EVAL ? 1 : 2;
     ModelHolder holder;
     Vfollow_target &top = *holder.model;
+    // The first $finish/$stop/$fatal since the restart ("" while none).
+    char stop_text[sizeof fr_call_text] = "";
 
     inline void eval() { Vfollow_target___024root___eval(top.rootp); }
-    inline void restart() { holder.restart(); }
+    inline void restart() {
+        holder.restart();
+        fr_call_pending = false;  // a call while rebuilding belongs to no run
+        stop_text[0] = '\0';
+    }
+    inline bool stop_pending() {
+        if (fr_call_pending) {
+            if (!stop_text[0])
+                std::memcpy(stop_text, fr_call_text, sizeof stop_text);
+            fr_call_pending = false;
+        }
+        return stop_text[0] != '\0';
+    }
+    inline const char *stop_message() { return stop_pending() ? stop_text : nullptr; }
     inline void set_rst(bool on) { top.rst = on; }
     inline void settle() {
         if (ONE_EVAL)
