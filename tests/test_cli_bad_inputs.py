@@ -29,6 +29,11 @@ CASES = [
     ("unknown command", ["fly"], "unknown command"),
     ("unknown benchmark", ["bench", "gpu"], "unknown benchmark"),
     ("formal ports without a design", ["formal", "--ports", "{file}"], "--ports"),
+    (
+        "designs ports of an Amaranth design",
+        ["designs", "follow_target", "--ports", "{file}"],
+        "--ports",
+    ),
     ("mutate fork without a campaign", ["mutate", "--mutants", "2", "--no-fork"], "--campaign"),
     ("bench negative seed", ["bench", "design", "--backends", "model", "--seed", "-1"], "--seed"),
     ("bench empty backends", ["bench", "design", "--backends", ","], "--backends"),

@@ -101,6 +101,8 @@ def main(argv=None, prog="fpga-robotics designs"):
         for name, target in entry_point_designs().items():
             print("\n".join(describe(resolve_design(name), f"installed: {target}")))
         return 0
+    if args.ports is not None and not args.reference.startswith("verilog:"):
+        raise UsageError("--ports is the port map of a Verilog design: it goes with verilog:FILES")
     spec = resolve_design(args.reference, params, ports=args.ports)
     if spec.kind == "verilog":
         spec = checked_verilog(spec, args.ports)
