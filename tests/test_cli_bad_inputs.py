@@ -56,6 +56,11 @@ CASES = [
     ("max-frames without source", ["run", "--max-frames", "5"], "--source"),
     ("duration with source", ["run", "--source", "{frames}", "--duration", "1"], "--duration"),
     (
+        "colour of a design without a camera",
+        ["run", "--scenario", "line_track", "--color", "green"],
+        "no camera input",
+    ),
+    (
         "parameter shadow in real-clock timing",
         ["run", "--scenario", "line_track", "--shadow", "diff_min=5"],
         "real-clock timing, where --shadow takes a design reference",

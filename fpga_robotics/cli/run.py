@@ -20,6 +20,7 @@ from pathlib import Path
 from fpga_robotics.checks.summary import format_summary
 from fpga_robotics.cli.errors import UsageError
 from fpga_robotics.cli.parser import CommandParser
+from fpga_robotics.designs.builtin import TOPS
 from fpga_robotics.hw.pixel import COLOR_SELECT
 from fpga_robotics.loop.compressed import make_backend
 from fpga_robotics.loop.continuation import continuation_summary, run_continued
@@ -312,6 +313,18 @@ def load_run_scenario(args):
 
 def _is_verilog(args):
     return args.design is not None and args.design.startswith("verilog:")
+
+
+def _check_color_option(args, scenario):
+    """``--color`` sets a camera design's colour select: a built-in design without a camera
+    input (FollowLine) has none to set."""
+    top = TOPS.get(scenario.top)
+    if args.color is None or scenario.foreign is not None or top is None or top.camera:
+        return
+    raise UsageError(
+        f"--color sets the colour select of a camera design; {scenario.top} (scenario "
+        f"{scenario.name!r}) has no camera input"
+    )
 
 
 def _overrides(args):
@@ -760,6 +773,7 @@ def main(argv=None, prog="fpga-robotics run"):
     ros = RosOutputs(args)  # --bag, --live ...: checked now, not after a long run
     scenario = load_run_scenario(args)
     take_design_reference(args, scenario)
+    _check_color_option(args, scenario)
     if args.target_color is not None:
         scenario = _dress_target(scenario, args.target_color)
     report_warnings(scenario, args.strict, sys.stderr, UsageError)
