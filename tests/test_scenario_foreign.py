@@ -214,6 +214,7 @@ def test_run_design_verilog_replaces_the_scenarios_own_design(tmp_path):
     data = Path(__file__).parent / "data"
     lf = data / "line_follow_verilog"
     args = argparse.Namespace(
+        scenario=None,
         overrides=[],
         design=f"verilog:{lf / 'lf_top.v'},{lf / 'lf_core.v'}",
         ports=str(lf / "lf_ports.toml"),
@@ -224,10 +225,11 @@ def test_run_design_verilog_replaces_the_scenarios_own_design(tmp_path):
     )
     own = data / "user_designs" / "wall_stop.toml"
     assert load_scenario(str(own)).design_params == {"speed": 300, "stop_mm": 250}
-    scenario = load_scenario(str(own), run._overrides(args))
+    args.scenario = str(own)
+    scenario = run.load_run_scenario(args)
     assert scenario.design_params == {}
     assert scenario.foreign.verilog == (str(lf / "lf_top.v"), str(lf / "lf_core.v"))
     assert scenario.foreign.ports == str(lf / "lf_ports.toml")
     args.overrides = ["design.params.speed=100"]
     with pytest.raises(UsageError, match="a Verilog design .* takes no parameters"):
-        run._overrides(args)
+        run.load_run_scenario(args)

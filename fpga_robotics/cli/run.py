@@ -303,12 +303,11 @@ def load_run_scenario(args):
     The ones that put ``--design verilog:`` in place are not recorded as the run's own
     (its summary names the design by ``--design``, as before)."""
     items = _overrides(args)
-    scenario = load_scenario(args.scenario, items)
-    verilog = set(_verilog_overrides(args, items)) if _is_verilog(args) else set()
+    verilog = _verilog_overrides(args, items) if _is_verilog(args) else []
+    scenario = load_scenario(args.scenario, [*items, *verilog])
     if not verilog:
         return scenario
-    kept = tuple(o for o in scenario.overrides if o not in verilog)
-    return dataclasses.replace(scenario, overrides=kept)
+    return dataclasses.replace(scenario, overrides=tuple(items))
 
 
 def _is_verilog(args):
@@ -335,8 +334,6 @@ def _overrides(args):
                 "--ports is the port map of a Verilog design: it goes with --design verilog:FILE.v"
             )
         items.append(design_override(args.design))
-    elif args.design is not None:
-        items += _verilog_overrides(args, items)
     if args.resolution is not None:
         w, h = parse_resolution(args.resolution)
         items.append(f'camera.resolution="{w}x{h}"')
