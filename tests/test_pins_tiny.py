@@ -352,3 +352,9 @@ def test_a_seeded_bulk_stimulus_is_recorded_the_same_on_every_backend():
     assert min(v for _, v in records["pysim"]["neg"]) < 0
     assert records["cxxrtl"] == records["pysim"]
     assert records["verilator"] == records["pysim"]
+
+
+def test_record_changes_refuses_a_bad_number_of_cycles(burst):
+    burst.reset()
+    with pytest.raises(PinError, match="cycles >= 0"):
+        burst.record_changes(-1, ["last"])

@@ -5,14 +5,15 @@ The stimulus is seeded random: every input port (``mutsel`` aside) changes, at e
 edge with probability ``CHANGE_PROBABILITY``, to a new random value of its width, so a bit
 holds for a few cycles on average and long enough now and then for counters and pulse
 measurements to see it. A camera design's pixel stream (``pixels__valid``,
-``pixels__payload``, or the ports its camera binding names) carries frames instead, as the camera gives them: random RGB444 pixels
-in raster order at one a cycle, the first pixel flagged ``first`` and each line's last
-``last``, a line's time without pixels between frames, for as many frames as the cycles
-hold.
+``pixels__payload``, or the ports its camera binding names) carries frames instead, as the
+camera gives them: random RGB444 pixels in raster order at one a cycle, the first pixel
+flagged ``first`` and each line's last ``last``, a line's time without pixels between
+frames, for as many frames as the cycles hold.
 
 The mutant netlist (every mutant behind ``mutsel``) is compiled once as a Verilator pin
 model (sim/pins); each run starts from a reset with ``mutsel`` held, applies the same
-stimulus, and records every change of every output (the model stops at each one).
+stimulus (``schedule_many``), and records every change of every output (the model's own
+run loop, ``record_changes``).
 ``mutsel = 0`` gives the reference. A mutant is *caught* when any output's changes differ
 from the reference's (a value, or the cycle it came at).
 """

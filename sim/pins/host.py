@@ -196,11 +196,13 @@ class HostPins(PinBackend):
     def record_changes(self, cycles, names):
         """Run ``cycles`` edges watching the outputs ``names`` (``watch``); returns every
         change: ``{name: [(cycle, value), ...]}`` in order, as a ``run`` loop would give
-        them, one stop each (counted in ``stops``)."""
+        them, one stop each (counted in ``stops``; ``stop_limit`` is checked once they are
+        all recorded)."""
+        self._check_cycles(cycles)
         self.watch(names)
         changes = {name: [] for name in names}
         end = self._cycle + cycles
-        for cycle, index, raw in self._raw_record(cycles):
+        for cycle, index, raw in self._raw_record(int(cycles)):
             port = self._port_list[index]
             changes[port.name].append((cycle, self._cooked(port, raw)))
             self.stops += 1
@@ -277,9 +279,13 @@ class HostPins(PinBackend):
     def filtered_frame(self):
         return self._filtered
 
-    def run(self, cycles):
+    @staticmethod
+    def _check_cycles(cycles):
         if isinstance(cycles, bool) or not isinstance(cycles, (int, np.integer)) or cycles < 0:
             raise PinError(f"run needs a number of cycles >= 0, not {cycles!r}")
+
+    def run(self, cycles):
+        self._check_cycles(cycles)
         cycle, index, raw, captured = self._raw_run(int(cycles))
         self._ran_to(cycle, captured)
         if index < 0:
