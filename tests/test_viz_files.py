@@ -280,6 +280,19 @@ def test_an_interrupt_while_opening_leaves_no_file(tmp_path, monkeypatch):
     assert os.listdir(tmp_path) == []
 
 
+def test_a_run_that_ends_before_its_first_frame_writes_no_file(tmp_path):
+    # An error before the first frame (or Ctrl-C) leaves no empty recording, and an earlier
+    # recording at the same path is left as it was.
+    path = tmp_path / "mine.rrd"
+    rec, line = record(f"save:{path}", tmp_path / "d.rrd", 0)
+    assert "no frame was recorded" in line and rec.path is None
+    assert os.listdir(tmp_path) == []
+    record(f"save:{path}", tmp_path / "d.rrd", 2)
+    rec, line = record(f"save:{path}", tmp_path / "d.rrd", 0)
+    assert "no file was written" in line
+    assert os.listdir(tmp_path) == ["mine.rrd"] and frames_in(path) == [0, 1]
+
+
 def test_a_recorder_never_closed_still_leaves_its_file_under_the_real_name(tmp_path):
     import gc
 

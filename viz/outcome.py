@@ -59,6 +59,14 @@ def settle(output, confirmed, problem, frames, images):
     """
     counted = f"{frames} frames ({images} with images)"
     file = output.file
+    if frames == 0 and file is not None:
+        # The run stopped before its first frame (an error, Ctrl-C): an empty recording
+        # would only replace an earlier one or sit there looking like a run.
+        file.discard()
+        text = "no frame was recorded, so no file was written"
+        if output.kind != "save":
+            return f"{output.description}: {text}", None
+        return (f"{output.reason}; {text}" if output.reason else text), None
     if output.kind == "save":
         failed = _keep(file)
         text = failed or f"saved {counted} to {_saved(file, frames)}"

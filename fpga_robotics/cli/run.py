@@ -25,7 +25,12 @@ from fpga_robotics.hw.pixel import COLOR_SELECT
 from fpga_robotics.loop.compressed import make_backend
 from fpga_robotics.loop.continuation import continuation_summary, run_continued
 from fpga_robotics.loop.pin_shadow import is_design_reference
-from fpga_robotics.loop.real_clock import format_extra_outputs, make_pin_backend
+from fpga_robotics.loop.real_clock import (
+    check_bindings,
+    format_extra_outputs,
+    make_pin_backend,
+    scenario_top,
+)
 from fpga_robotics.loop.shadow import format_shadow, shadow_overrides
 from fpga_robotics.loop.sources import open_source, run_source
 from fpga_robotics.loop.timings import run_scenario
@@ -315,13 +320,17 @@ def _is_verilog(args):
 
 
 def _check_color_option(args, scenario):
-    """``--color`` sets a camera design's colour select: a built-in design without a camera
-    input (FollowLine) has none to set."""
-    top = TOPS.get(scenario.top)
-    if args.color is None or scenario.foreign is not None or top is None or top.camera:
+    """``--color`` sets a camera design's colour select: a design without a camera input
+    (FollowLine, a design of one's own or a Verilog port map without a pixel stream) has
+    none to set."""
+    if args.color is None:
+        return
+    top = scenario_top(scenario) if scenario.foreign is not None else TOPS.get(scenario.top)
+    top = top or scenario_top(scenario)
+    if top.camera:
         return
     raise UsageError(
-        f"--color sets the colour select of a camera design; {scenario.top} (scenario "
+        f"--color sets the colour select of a camera design; {top.name} (scenario "
         f"{scenario.name!r}) has no camera input"
     )
 
@@ -822,6 +831,9 @@ def main(argv=None, prog="fpga-robotics run"):
                 "design's name)"
             )
         scenario = _with_design_files(args, scenario)
+        check_bindings(scenario)  # before the model is built
+        if shadow_scenario is not None:
+            check_bindings(shadow_scenario)
         design = _open_pin_design(args, scenario)
     else:
         design = _open_design(args, scenario.params, scenario.foreign)

@@ -75,6 +75,26 @@ def scenario_top(scenario):
     return spec.top
 
 
+def check_bindings(scenario):
+    """``UsageError`` for a sensor pin that the scenario's design binds to no port: checked
+    from the design's declarations and the port map, before a model is built."""
+    top = scenario_top(scenario)
+    for spec in scenario.connectors:
+        if spec.kind in ("camera", "servo"):  # the rig's (loop/camera_rig.py)
+            continue
+        binding = {**top.bindings.get(spec.kind, {}), **spec.ports}
+        for pin in CONNECTORS[spec.kind].pins:
+            if binding.get(pin) is None:
+                raise _unbound(spec.kind, spec.name, top, pin)
+
+
+def _unbound(kind, name, top, pin):
+    return UsageError(
+        f"the {kind} connector {name!r}: design {top.name!r} has no port for its pin "
+        f'{pin!r}; bind one with ports = {{{pin} = "PORT"}} in its [[robot.sensors]] table'
+    )
+
+
 def pin_design_source(scenario):
     """The pin design of the scenario: a ``PinDesignSource`` of ``design.top`` and its
     tables, or a ``VerilogPinSource`` of its foreign Verilog design."""
@@ -305,11 +325,7 @@ class RealClockLoop(ClosedLoop):
         for pin, spec in conn.pins.items():
             port = binding.get(pin)
             if port is None:
-                raise UsageError(
-                    f"the {conn.kind} connector {conn.name!r}: design {self.top.name!r} has "
-                    f"no port for its pin {pin!r}; bind one with ports = {{{pin} = "
-                    f'"PORT"}} in its [[robot.sensors]] table'
-                )
+                raise _unbound(conn.kind, conn.name, self.top, pin)
             if port not in ports:
                 raise UsageError(
                     f"the {conn.kind} connector {conn.name!r}: design {self.top.name!r} has "
