@@ -462,6 +462,78 @@ def test_shadow_runs_a_previous_version_of_the_design_on_the_same_pins(tmp_path,
     assert "first differs at frame 0 (0.00 s): motor_left 300 vs 250" in out
 
 
+_BUMP_STOP_AMARANTH = """
+from amaranth import Module, Signal, signed
+from amaranth.lib import wiring
+from amaranth.lib.wiring import In, Out
+
+
+class BumpStop(wiring.Component):
+    pressed: In(1)
+    motor_left: Out(signed(16))
+    motor_right: Out(signed(16))
+
+    def elaborate(self, platform):
+        m = Module()
+        hit = Signal()
+        with m.If(self.pressed):
+            m.d.sync += hit.eq(1)
+        with m.If(~hit):
+            m.d.comb += [self.motor_left.eq(300), self.motor_right.eq(300)]
+        return m
+"""
+
+
+@pytest.mark.parametrize("verilog_shadow", [True, False], ids=["verilog shadow", "amaranth shadow"])
+def test_a_verilog_design_shadows_an_amaranth_one_and_the_other_way(
+    tmp_path, capsys, verilog_shadow
+):
+    """--shadow verilog:FILE.v --shadow-ports MAP beside an Amaranth design, and an Amaranth
+    shadow beside a Verilog design: the bumper closes for both at once (the shadow gets the
+    primary's inputs), so they differ exactly while the robot drives (300 against 250 DPS)."""
+    data = DESIGNS.parent
+    (tmp_path / "bump_stop.py").write_text(_BUMP_STOP_AMARANTH)
+    v2 = (data / "bump_stop.v").read_text().replace("12'sd300", "12'sd250")
+    (tmp_path / "bump_v2.v").write_text(v2)
+    amaranth, verilog = f"{tmp_path}/bump_stop.py:BumpStop", f"verilog:{tmp_path}/bump_v2.v"
+    ports = str(data / "bump_stop_ports.toml")
+    if verilog_shadow:
+        design = ["--design", amaranth, "--shadow", verilog, "--shadow-ports", ports]
+    else:
+        design = ["--design", verilog, "--ports", ports, "--shadow", amaranth]
+    summary = tmp_path / "s.json"
+    argv = ["run", "--scenario", str(data / "bump_wall.toml"), *design, "--rerun", "off"]
+    code, _, err = _cli([*argv, "--quiet", "--summary", str(summary)], capsys)
+    assert code == 0, err
+    shadow = json.loads(summary.read_text())["shadow"]
+    first, other = (300, 250) if verilog_shadow else (250, 300)
+    assert shadow["first_divergence"]["frame"] == 0
+    assert shadow["first_divergence"]["outputs"]["motor_left"] == {
+        "primary": first,
+        "shadow": other,
+    }
+    moving = shadow["differing_frames"]["motor_left"]
+    assert 0 < moving < shadow["frames"] == 360
+    assert shadow["differing_frames"]["motor_right"] == moving
+
+
+def test_a_verilog_shadow_needs_its_port_map_and_files(tmp_path, capsys):
+    data = DESIGNS.parent
+    base = ["run", "--scenario", str(data / "bump_wall.toml"), "--rerun", "off"]
+    base += ["--design", "verilog:" + str(data / "bump_stop.v")]
+    base += ["--ports", str(data / "bump_stop_ports.toml")]
+    for extra, words in [
+        (["--shadow", "verilog:" + str(data / "bump_stop.v")], "needs --shadow-ports"),
+        (["--shadow", "verilog:nope.v", "--shadow-ports", str(data / "bump_stop_ports.toml")],
+         "no such file: nope.v"),
+        (["--shadow-ports", str(data / "bump_stop_ports.toml")], "goes with --shadow verilog"),
+        (["--shadow", "verilog:" + str(data / "bump_stop.v"), "--shadow-ports",
+          str(data / "bump_wall.toml")], "--shadow-ports"),
+    ]:  # fmt: skip
+        code, _, err = _cli([*base, *extra], capsys)
+        assert code == 2 and words in err and "Traceback" not in err, err
+
+
 def test_designs_checks_a_verilog_port_map_against_the_design(tmp_path, capsys):
     verilog = f"verilog:{DESIGNS / 'bump_stop_noreset.v'}"
     ports = DESIGNS / "bump_stop_noreset_ports.toml"

@@ -36,6 +36,7 @@ from fpga_robotics.loop.sources import open_source, run_source
 from fpga_robotics.loop.timings import run_scenario
 from fpga_robotics.loop.video_out import CameraVideo, VideoPathError, check_video_path
 from fpga_robotics.ros.run_options import RosOutputs, add_ros_arguments
+from fpga_robotics.scenario.errors import ScenarioError
 from fpga_robotics.scenario.load import (
     MAX_SEED,
     ForeignDesignFiles,
@@ -47,6 +48,7 @@ from fpga_robotics.scenario.sanity import report_warnings
 from fpga_robotics.sim.backends import BACKEND_NAMES
 from fpga_robotics.sim.backends.base import BackendError
 from fpga_robotics.sim.backends.foreign_choice import FOREIGN_BACKENDS, open_foreign_frames
+from fpga_robotics.sim.backends.port_map import load_port_map
 from fpga_robotics.sim.camera.render3d.renderer import Render3DUnavailable, load_mujoco
 from fpga_robotics.sim.files import check_output_path, write_json_atomic
 from fpga_robotics.sim.pins import DesignError, PinError
@@ -164,8 +166,8 @@ def build_parser(prog="fpga-robotics run"):
         help="run a second design on the same frames without letting it drive: a "
         "preset name (published) and/or design KEY=VALUE items separated by ';' "
         "(e.g. 'diff_min=5;kp_num=2'), or in real-clock timing a design "
-        "reference (e.g. wall_stop_v1.py:WallStop); the summary reports where "
-        "they differ",
+        "reference (e.g. wall_stop_v1.py:WallStop, or verilog:v1.v with "
+        "--shadow-ports); the summary reports where they differ",
     )
     p.add_argument(
         "--shadow-continue",
@@ -173,6 +175,12 @@ def build_parser(prog="fpga-robotics run"):
         help="with --shadow: once the shadow would drive differently, let it drive from "
         "there (the world restored at that point) and report its own run beside the "
         "primary's",
+    )
+    p.add_argument(
+        "--shadow-ports",
+        metavar="MAP",
+        help="the port map of a Verilog shadow design (--shadow verilog:TOP.v[,MORE.v...], "
+        "docs/foreign.md)",
     )
     p.add_argument(
         "--shadow-backend",
@@ -381,9 +389,16 @@ def _shadow_params_scenario(scenario, spec):
     return scenario.with_overrides(items)
 
 
-def _shadow_scenario(scenario, spec):
+def _shadow_scenario(scenario, spec, ports=None):
     """With ``--shadow REF`` (a design reference): the scenario running that design instead
-    (its ``[design.params]`` kept); None for a FollowTarget parameter shadow."""
+    (its ``[design.params]`` kept; a Verilog one, ``verilog:FILES`` with ``ports``, takes
+    none); None for a FollowTarget parameter shadow."""
+    verilog = spec is not None and str(spec).startswith("verilog:")
+    if ports is not None and not verilog:
+        raise UsageError(
+            "--shadow-ports is the port map of a Verilog shadow design: it goes with "
+            "--shadow verilog:FILE.v"
+        )
     if spec is None or not is_design_reference(spec):
         return None
     if scenario.sim.timing != "real_clock":
@@ -392,12 +407,51 @@ def _shadow_scenario(scenario, spec):
             f"timing; scenario {scenario.name!r} runs in compressed timing "
             f"(compare FollowTarget parameters there: --shadow KEY=VALUE)"
         )
-    if scenario.foreign is not None:
+    if not verilog:
+        return scenario.with_overrides([design_override(spec)])
+    files = [f for f in spec[len("verilog:") :].split(",") if f.strip()]
+    if not files:
+        raise UsageError(f"--shadow must be verilog:FILE.v[,MORE.v...], got {spec!r}")
+    if ports is None:
         raise UsageError(
-            f"--shadow {spec}: scenario {scenario.name!r} runs a Verilog design "
-            f"(design.verilog); a shadow design goes with an Amaranth one"
+            "--shadow verilog:... needs --shadow-ports PORTS.toml (the shadow design's port map)"
         )
-    return scenario.with_overrides([design_override(spec)])
+    for what, path in [*(("--shadow", f) for f in files), ("--shadow-ports", ports)]:
+        if not Path(path).expanduser().is_file():
+            raise UsageError(f"{what}: no such file: {path}")
+    absolute = ",".join(str(Path(f).expanduser().resolve()) for f in files)
+    try:
+        return scenario.with_overrides(
+            [
+                f"design.top={json.dumps('verilog:' + absolute)}",
+                f"design.ports={json.dumps(str(Path(ports).expanduser().resolve()))}",
+            ]
+        )
+    except ScenarioError as exc:
+        raise UsageError(f"--shadow-ports {ports}: {exc}") from None
+
+
+def _shadow_args(args, shadow_scenario):
+    """The options a shadow design on pins is opened with: ``--shadow-backend`` (default
+    ``--backend``; ``auto`` for a Verilog shadow beside a design on pysim), and of the
+    ``--runtime`` values those its own port map declares."""
+    shadow_args = copy.copy(args)
+    shadow_args.backend = args.shadow_backend or args.backend
+    shadow_args.runtime = []
+    if shadow_scenario.foreign is None:
+        return shadow_args
+    if args.shadow_backend is None and args.backend not in FOREIGN_BACKENDS:
+        shadow_args.backend = "auto"
+    if shadow_args.backend not in FOREIGN_BACKENDS:
+        raise UsageError(
+            f"a Verilog shadow design runs on the cxxrtl or verilator backend, not "
+            f"--shadow-backend {shadow_args.backend!r}"
+        )
+    declared = load_port_map(shadow_scenario.foreign.ports).runtime
+    shadow_args.runtime = [
+        item for item in (args.runtime or []) if item.split("=", 1)[0].strip() in declared
+    ]
+    return shadow_args
 
 
 def _check_continue(args, ros):
@@ -802,7 +856,8 @@ def main(argv=None, prog="fpga-robotics run"):
         return _run_source(args, scenario, ros)
     if args.max_frames is not None:
         raise UsageError("--max-frames only applies with --source (use --duration)")
-    shadow_scenario = _shadow_scenario(scenario, args.shadow)
+    shadow_scenario = _shadow_scenario(scenario, args.shadow, args.shadow_ports)
+    shadow_args = None if shadow_scenario is None else _shadow_args(args, shadow_scenario)
     if shadow_scenario is not None and args.shadow_backend == "model":
         raise UsageError(
             "--shadow-backend model runs whole frames; a shadow design on pins needs "
@@ -841,8 +896,6 @@ def main(argv=None, prog="fpga-robotics run"):
     completed = False
     try:
         if shadow_scenario is not None:
-            shadow_args = copy.copy(args)
-            shadow_args.backend = args.shadow_backend or args.backend
             shadow = _open_pin_design(shadow_args, shadow_scenario)
         if shadow_params is not None:
             shadow = _open_backend(args.shadow_backend or args.backend, shadow_params, args.quiet)

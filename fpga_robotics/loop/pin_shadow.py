@@ -26,11 +26,20 @@ def is_design_reference(spec):
 
 class MirroredPins:
     """The primary ``PinBackend`` as the loop sees it, every input it is given also given to
-    ``shadow`` (the inputs the shadow has of the same name), both at the same edge."""
+    ``shadow``, both at the same edge: to the shadow's input that serves the same connector
+    pin (``mirror``; a Verilog design's ports keep their own names), else to its input of
+    the same name."""
 
     def __init__(self, primary, shadow):
         self.primary, self.shadow = primary, shadow
         self._inputs = {n for n, p in shadow.ports.items() if p.direction == "in"}
+        self._to_shadow = {n: n for n in self._inputs}  # primary input -> shadow input
+
+    def mirror(self, primary_port, shadow_port):
+        """Give the shadow's input ``shadow_port`` what the primary's ``primary_port`` gets
+        (both bound to one connector pin); ignored for a port the shadow does not have."""
+        if shadow_port in self._inputs:
+            self._to_shadow[primary_port] = shadow_port
 
     @property
     def name(self):
@@ -54,13 +63,13 @@ class MirroredPins:
 
     def poke(self, name, value):
         self.primary.poke(name, value)
-        if name in self._inputs:
-            self.shadow.poke(name, value)
+        if name in self._to_shadow:
+            self.shadow.poke(self._to_shadow[name], value)
 
     def schedule(self, edge, name, value):
         self.primary.schedule(edge, name, value)
-        if name in self._inputs:
-            self.shadow.schedule(edge, name, value)
+        if name in self._to_shadow:
+            self.shadow.schedule(edge, self._to_shadow[name], value)
 
     def stream_frame(self, packed, timing):
         self.primary.stream_frame(packed, timing)

@@ -146,7 +146,11 @@ def make_pin_backend(name, scenario, *, on_build=None):
             "cxxrtl, verilator or pysim"
         )
     kwargs = {"on_build": on_build} if on_build is not None else {}
-    return get_pin_backend(name, pin_design_source(scenario), **kwargs)
+    backend = get_pin_backend(name, pin_design_source(scenario), **kwargs)
+    # Which port serves which connector pin: a loop that runs it as a shadow mirrors the
+    # primary's inputs by it (pin_shadow.MirroredPins).
+    backend.connector_bindings = scenario_top(scenario).bindings
+    return backend
 
 
 def extra_output_stats(column):
@@ -280,6 +284,8 @@ class RealClockLoop(ClosedLoop):
                 if servo.port is not None:  # sampled, as the wheels (run_design_to)
                     self.io[servo] = PinIO(design, {"angle": servo.port}, self.clock_hz)
         self._check_inputs_driven()
+        if shadow is not None:
+            self._mirror_connectors(getattr(shadow, "connector_bindings", {}), specs)
         if self.top.camera and _FRAME_STROBE in design.ports:  # FollowTarget's frame outputs
             self.watched[_FRAME_STROBE] = (None, _FRAME_STROBE)
         if "obstacle" in self.top.extra_outputs.values():  # the interlock's events
@@ -349,6 +355,23 @@ class RealClockLoop(ClosedLoop):
                     )
                 )
         return binding
+
+    def _mirror_connectors(self, bindings, specs):
+        """Give the shadow design's input bound to each connector pin what the primary's
+        input bound to it gets (``bindings``: the shadow's, its sensors' ``ports`` tables as
+        the primary's)."""
+        camera = {pin: port for pin, port in self.top.bindings.get("camera", {}).items()}
+        for pin, port in camera.items():
+            other = bindings.get("camera", {}).get(pin)
+            if other is not None:
+                self.pins.mirror(port, other)
+        for conn, io in self.io.items():
+            binding = dict(bindings.get(conn.kind, {}))
+            if conn.name in specs:
+                binding.update(specs[conn.name].ports)
+            for pin, spec in conn.pins.items():
+                if spec.direction == "in" and binding.get(pin) is not None:
+                    self.pins.mirror(io.binding[pin], binding[pin])
 
     def _check_inputs_driven(self):
         """Every design input is driven: by the camera's stream, a connector's pin or the

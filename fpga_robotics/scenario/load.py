@@ -289,6 +289,7 @@ class Scenario:
         """A new scenario: this one's data with more ``KEY=VALUE`` overrides applied."""
         data = copy.deepcopy(self.data)
         overrides = tuple(overrides)
+        _drop_replaced_design(data, overrides)  # as loading with them does
         _apply_overrides(data, overrides)
         return _finish(data, self.source, tuple(self.overrides) + overrides)
 
@@ -398,13 +399,16 @@ def load_scenario(name_or_path, overrides=()):
 def _drop_replaced_design(data, overrides):
     """An override that names another ``design.top`` (``run --design REF``) replaces the
     file's design: the file's tables of built-in designs that the new one does not take, and
-    its ``variant``, go with the old design (its ``design.params`` stay, docs/your_design.md)."""
+    its ``variant``, go with the old design (its ``design.params`` stay, docs/your_design.md);
+    so do a Verilog design's files and port map."""
     if not any(o.split("=", 1)[0].strip() == "design.top" for o in overrides):
         return
     probe = copy.deepcopy(data)
     _apply_overrides(probe, overrides)  # a bad override fails here as it would below
     design = data["design"]
     old, new = design.get("top", "follow_target"), probe["design"].get("top")
+    if design.get("verilog") is not None and "top" not in design:
+        old = None  # the file's own Verilog design (design.verilog)
     if new == old:
         return
     kept = TOPS[new].tables if isinstance(new, str) and new in TOPS else ()
@@ -418,6 +422,10 @@ def _drop_replaced_design(data, overrides):
         design.pop("verilog", None)
         if any(o.split("=", 1)[0].strip() == "design.ports" for o in overrides):
             design.pop("ports", None)
+    elif old is None or (isinstance(old, str) and old.startswith("verilog:")):
+        # An Amaranth design in place of the file's Verilog one: its files go.
+        design.pop("verilog", None)
+        design.pop("ports", None)
 
 
 def _finish(data, source, overrides):

@@ -96,7 +96,7 @@ def load_run(argv):
     run.take_design_reference(args, scenario)
     # As run takes --shadow: a design reference is a second design on pins, else
     # FollowTarget parameters, which compare frames.
-    shadow_params = run._shadow_scenario(scenario, args.shadow)
+    shadow_params = run._shadow_scenario(scenario, args.shadow, args.shadow_ports)
     if shadow_params is None:
         shadow_params = run._shadow_params(scenario, args.shadow)
         if shadow_params is not None and scenario.sim.timing == "real_clock":
@@ -151,7 +151,7 @@ def _designs_for(args, scenario, shadow_params):
     shadow = None
     name = args.shadow_backend or args.backend
     if hasattr(shadow_params, "sim"):  # a shadow design: its scenario, on pins
-        shadow_args = argparse.Namespace(**{**vars(args), "backend": name})
+        shadow_args = run._shadow_args(args, shadow_params)
         shadow = _open(
             ("shadow", *_design_key(shadow_args, shadow_params)),
             lambda: run._open_pin_design(shadow_args, shadow_params),
