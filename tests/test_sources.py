@@ -1,12 +1,13 @@
 """Frames from a video file or an image folder, resized and run through the design."""
 
+import itertools
 import json
 
 import cv2
 import numpy as np
 import pytest
 
-from fpga_robotics.cli.errors import UsageError, run_cli
+from fpga_robotics.cli.errors import Terminated, UsageError, run_cli
 from fpga_robotics.cli.run import main
 from fpga_robotics.hw.params import FollowTargetParams
 from fpga_robotics.loop.sources import open_source, run_source
@@ -156,3 +157,79 @@ def test_cli_folder_at_another_resolution(folder, tmp_path, capsys):
     assert info.value.code == 0
     s = json.loads(path.read_text())
     assert s["resolution"] == "320x240" and s["found_frames"] == 4
+
+
+class _Frames:
+    """Two frames from a source of ``kind``."""
+
+    spec = "two frames"
+
+    def __init__(self, kind):
+        self.kind = kind
+
+    def __iter__(self):
+        return iter([expected_rgb(scene_bgr(0))] * 2)
+
+    def close(self):
+        pass
+
+
+class _CutOff:
+    """``source``'s first two frames, then ``interrupt`` (Ctrl-C or SIGTERM arriving mid-run)."""
+
+    def __init__(self, source, interrupt):
+        self.source, self.interrupt = source, interrupt
+        self.spec, self.kind = source.spec, source.kind
+
+    def __iter__(self):
+        yield from itertools.islice(self.source, 2)
+        raise self.interrupt()
+
+    def close(self):
+        self.source.close()
+
+
+def test_a_camera_runs_until_ctrl_c():
+    params = FollowTargetParams(width=W, height=H)
+    out = run_source(_CutOff(_Frames("camera"), KeyboardInterrupt), ModelBackend(params))
+    assert out["frames"] == 2 and out["found_frames"] == 2
+
+
+@pytest.mark.parametrize(
+    "kind, interrupt",
+    [(kind, KeyboardInterrupt) for kind in ("video", "folder", "bag")]
+    + [(kind, Terminated) for kind in ("camera", "video", "folder", "bag")],
+)
+def test_an_interrupted_finite_source_or_a_terminated_run_is_not_a_result(kind, interrupt):
+    params = FollowTargetParams(width=W, height=H)
+    with pytest.raises(interrupt):
+        run_source(_CutOff(_Frames(kind), interrupt), ModelBackend(params))
+
+
+@pytest.mark.parametrize("interrupt, code", [(KeyboardInterrupt, 130), (Terminated, 143)])
+def test_cli_video_cut_off_exits_as_interrupted_and_writes_no_summary(
+    video, tmp_path, monkeypatch, interrupt, code
+):
+    monkeypatch.setattr(
+        "fpga_robotics.cli.run.open_source",
+        lambda spec, width, height: _CutOff(open_source(spec, width, height), interrupt),
+    )
+    summary, recording = tmp_path / "s.json", tmp_path / "r.rrd"
+    with pytest.raises(SystemExit) as info:
+        run_cli(
+            main,
+            [
+                "--source",
+                str(video),
+                "--backend",
+                "model",
+                "--rerun",
+                f"save:{recording}",
+                "--summary",
+                str(summary),
+                "--quiet",
+            ],
+        )
+    assert info.value.code == code
+    assert not summary.exists()  # no summary of a cut-off run
+    assert recording.exists()  # the recording is closed under its own name

@@ -11,6 +11,7 @@ from pathlib import Path
 
 import cv2
 
+from fpga_robotics.cli.errors import Terminated
 from fpga_robotics.hw.errors import UsageError
 from fpga_robotics.hw.pixel import color_select_value
 from fpga_robotics.sim.camera.opencv_frames import to_design_rgb
@@ -193,8 +194,11 @@ def run_source(
                     on_frame(record)
             if progress is not None:
                 progress(k + 1, None)
-    except KeyboardInterrupt:
-        pass  # a camera runs until interrupted: report what was seen
+    except KeyboardInterrupt as exc:
+        # A camera runs until Ctrl-C: report what was seen. A finite source cut off, or any
+        # source terminated (SIGTERM), ends as an interrupted closed loop does.
+        if source.kind != "camera" or isinstance(exc, Terminated):
+            raise
     wall = time.perf_counter() - start
     n = len(results)
     found = sum(r["found"] for r in results)
