@@ -13,6 +13,7 @@ from fpga_robotics.hw.params import FollowTargetParams
 from fpga_robotics.loop.sources import open_source, run_source
 from fpga_robotics.sim.backends.model import ModelBackend
 from fpga_robotics.sim.models.follow_target import FollowTargetModel
+from fpga_robotics.sim.world.robots import GOPIGO3
 
 W, H = 160, 120
 
@@ -233,3 +234,19 @@ def test_cli_video_cut_off_exits_as_interrupted_and_writes_no_summary(
     assert info.value.code == code
     assert not summary.exists()  # no summary of a cut-off run
     assert recording.exists()  # the recording is closed under its own name
+
+
+def test_frames_carry_the_twist_the_design_commands_on_the_robots_wheels(folder):
+    params = FollowTargetParams(width=W, height=H)
+    records = []
+    out = run_source(
+        open_source(str(folder), W, H), ModelBackend(params), robot=GOPIGO3, on_frame=records.append
+    )
+    # Differential drive by hand: v = r (wl + wr) / 2, w = r (wr - wl) / separation.
+    r, sep = GOPIGO3.wheel_radius, GOPIGO3.wheel_separation
+    for row, record in zip(out["results"], records, strict=True):
+        left, right = np.radians(row["motor_left"]), np.radians(row["motor_right"])
+        assert record.cmd_v == pytest.approx(r * (left + right) / 2)
+        assert record.cmd_w == pytest.approx(r * (right - left) / sep)
+        assert (record.robot_v, record.robot_w) == (0.0, 0.0)  # nothing moves
+    assert any(record.cmd_v > 0 for record in records)  # the design drives towards the block

@@ -52,6 +52,7 @@ from fpga_robotics.sim.backends.port_map import load_port_map
 from fpga_robotics.sim.camera.render3d.renderer import Render3DUnavailable, load_mujoco
 from fpga_robotics.sim.files import check_output_path, write_json_atomic
 from fpga_robotics.sim.pins import DesignError, PinError
+from fpga_robotics.sim.world.config import parse_world_config
 
 __all__ = ["TARGET_CLOTHING", "Progress", "build_parser", "main"]
 
@@ -787,6 +788,7 @@ def _run_source(args, scenario, ros):
                 progress=progress,
                 max_frames=args.max_frames,
                 hfov=scenario.camera.hfov,
+                robot=parse_world_config(scenario.world).robot.spec,
                 on_frame=ros.on_frame if ros.active else None,
             )
             if progress is not None:

@@ -16,6 +16,8 @@ from fpga_robotics.hw.errors import UsageError
 from fpga_robotics.hw.pixel import color_select_value
 from fpga_robotics.sim.camera.opencv_frames import to_design_rgb
 from fpga_robotics.sim.records import FrameRecord
+from fpga_robotics.sim.world.kinematics import dps_to_twist
+from fpga_robotics.sim.world.robots import TURTLEBOT2
 
 __all__ = ["IMAGE_SUFFIXES", "FrameSource", "open_source", "run_source", "to_design_rgb"]
 
@@ -127,6 +129,7 @@ def run_source(
     max_frames=None,
     duration=None,
     hfov=1.047,
+    robot=TURTLEBOT2,
     on_frame=None,
 ):
     """Run the design on every frame of ``source`` and summarise its outputs.
@@ -134,7 +137,9 @@ def run_source(
     Returns a JSON-ready dict: the source, frame count, timing, how often the target was
     found, and the per-frame outputs (``results``). ``on_frame(FrameRecord)`` is called for
     every frame; a source with recorded times (a bag: ``frame_time(k)``) stamps the frames
-    with them, others with the wall time since the start.
+    with them, others with the wall time since the start. The frames' commanded twist
+    (``cmd_v``, ``cmd_w``) is the design's DPS through ``robot``'s wheels (a ``RobotSpec``:
+    the scenario's robot, as ``/cmd_vel`` in a bag); nothing moves, so the measured one is 0.
     """
     sel = color_select_value(color)
     design.reset()
@@ -172,6 +177,12 @@ def run_source(
                     if hasattr(source, "frame_time")
                     else time.perf_counter() - start
                 )
+                cmd_v, cmd_w = dps_to_twist(
+                    int(result.motor_left),
+                    int(result.motor_right),
+                    robot.wheel_radius,
+                    robot.wheel_separation,
+                )
                 record = FrameRecord(
                     frame=k,
                     sim_time=stamp,
@@ -183,8 +194,8 @@ def run_source(
                     robot_heading=0.0,
                     robot_v=0.0,
                     robot_w=0.0,
-                    cmd_v=0.0,
-                    cmd_w=0.0,
+                    cmd_v=cmd_v,
+                    cmd_w=cmd_w,
                     camera_hfov=hfov,
                     events=events,
                 )
