@@ -14,7 +14,7 @@ from rosbags.rosbag2 import StoragePlugin
 from rosbags.rosbag2 import Writer as Writer2
 from rosbags.typesys import Stores, get_typestore
 
-from fpga_robotics.cli.errors import UsageError
+from fpga_robotics.cli.errors import UsageError, run_cli
 from fpga_robotics.cli.run import main as run_main
 from fpga_robotics.hw.params import FollowTargetParams
 from fpga_robotics.loop.sources import open_source
@@ -264,3 +264,87 @@ def test_the_recordings_commanded_twist_is_the_bags_cmd_vel(tmp_path):
     assert v == pytest.approx([t.linear.x for t in twists])
     assert w == pytest.approx([t.angular.z for t in twists])
     assert len(v) == 6 and any(x > 0 for x in v)  # the design drives
+
+
+def test_an_encoding_not_read_after_the_first_image_is_refused_before_anything_is_written(
+    tmp_path, capsys
+):
+    images = frames()
+    bag = tmp_path / "mixed"
+    with Writer2(bag, version=9, storage_plugin=StoragePlugin.MCAP) as writer:
+        conn = writer.add_connection("/camera/image_raw", "sensor_msgs/msg/Image", typestore=ROS2)
+        for k, rgb in enumerate(images):
+            _, msg = image_msg(ROS2, rgb, k, "rgb8")
+            if k >= 4:  # the camera driver switched to 16-bit grey
+                msg.encoding, msg.step = "mono16", 2 * W
+                msg.data = np.zeros(2 * W * H, np.uint8)
+            writer.write(
+                conn, T0_NS + k * PERIOD_NS, ROS2.serialize_cdr(msg, "sensor_msgs/msg/Image")
+            )
+    out = tmp_path / "out"
+    out.mkdir()
+    with pytest.raises(SystemExit) as info:
+        run_cli(
+            run_main,
+            [
+                "--source",
+                f"bag:{bag}",
+                "--backend",
+                "model",
+                "--resolution",
+                f"{W}x{H}",
+                "--quiet",
+                "--rerun",
+                f"save:{out / 'r.rrd'}",
+                "--summary",
+                str(out / "s.json"),
+                "--bag",
+                str(out / "b"),
+            ],
+        )
+    err = capsys.readouterr().err
+    assert info.value.code == 2
+    assert "frame 4: image encoding 'mono16' is not read" in err
+    assert "--max-frames 4" in err
+    assert list(out.iterdir()) == []  # nothing written
+    # The frames before it run.
+    assert len(run_bag(f"bag:{bag}", tmp_path, "--max-frames", "4")) == 4
+
+
+def test_a_compressed_image_that_does_not_decode_ends_the_run_naming_its_frame(tmp_path, capsys):
+    images = frames()
+    bag = tmp_path / "damaged"
+    with Writer2(bag, version=9, storage_plugin=StoragePlugin.MCAP) as writer:
+        conn = writer.add_connection(
+            "/camera/image_raw", "sensor_msgs/msg/CompressedImage", typestore=ROS2
+        )
+        for k, rgb in enumerate(images):
+            msgtype, msg = image_msg(ROS2, rgb, k, "png")
+            if k == 3:
+                msg.data = msg.data[:40]  # cut off in transfer
+            writer.write(conn, T0_NS + k * PERIOD_NS, ROS2.serialize_cdr(msg, msgtype))
+    out = tmp_path / "out"
+    out.mkdir()
+    with pytest.raises(SystemExit) as info:
+        run_cli(
+            run_main,
+            [
+                "--source",
+                f"bag:{bag}",
+                "--backend",
+                "model",
+                "--resolution",
+                f"{W}x{H}",
+                "--quiet",
+                "--rerun",
+                "off",
+                "--summary",
+                str(out / "s.json"),
+                "--bag",
+                str(out / "b"),
+            ],
+        )
+    err = capsys.readouterr().err
+    assert info.value.code == 2
+    assert "frame 3: cannot decode a CompressedImage" in err and "--max-frames 3" in err
+    assert list(out.iterdir()) == []  # no bag, no summary of the cut-off run

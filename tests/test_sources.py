@@ -213,7 +213,7 @@ def test_cli_video_cut_off_exits_as_interrupted_and_writes_no_summary(
 ):
     monkeypatch.setattr(
         "fpga_robotics.cli.run.open_source",
-        lambda spec, width, height: _CutOff(open_source(spec, width, height), interrupt),
+        lambda *args: _CutOff(open_source(*args), interrupt),
     )
     summary, recording = tmp_path / "s.json", tmp_path / "r.rrd"
     with pytest.raises(SystemExit) as info:

@@ -770,7 +770,7 @@ def _run_source(args, scenario, ros):
             f"{scenario.top!r}, sensors on pins): run it without --source"
         )
     params = scenario.params
-    source = open_source(args.source, params.width, params.height)
+    source = open_source(args.source, params.width, params.height, args.max_frames)
     try:
         design = _open_design(args, params, scenario.foreign)
         recorder = None

@@ -7,6 +7,7 @@ runs the design on each frame (no physics) and reports what it found.
 """
 
 import time
+from itertools import islice
 from pathlib import Path
 
 import cv2
@@ -109,13 +110,14 @@ class FrameSource:
             self._cap = None
 
 
-def open_source(spec, width, height):
+def open_source(spec, width, height, max_frames=None):
     """Open ``spec`` (``camera:N``, a video file, a folder of images, ``bag:PATH[:TOPIC]``) at
-    ``width`` x ``height``; ``UsageError`` when it cannot be opened."""
+    ``width`` x ``height``; ``UsageError`` when it cannot be opened. A bag's images are all
+    checked now (the first ``max_frames`` of them, when given)."""
     if str(spec).startswith("bag:"):  # a ROS bag (fpga_robotics.ros.bag_source)
         from fpga_robotics.ros.bag_source import BagSource  # lazy: rosbags (~30 ms), for bags only
 
-        return BagSource(spec, width, height)
+        return BagSource(spec, width, height, max_frames)
     return FrameSource(spec, width, height)
 
 
@@ -148,9 +150,8 @@ def run_source(
     design_time = 0.0
     was_found = False
     try:
-        for k, rgb in enumerate(source):
-            if max_frames is not None and k >= max_frames:
-                break
+        # islice: no frame past the last is read (a bag checked only that far, a camera).
+        for k, rgb in enumerate(islice(source, max_frames)):
             if duration is not None and time.perf_counter() - start >= duration:
                 break
             t0 = time.perf_counter()

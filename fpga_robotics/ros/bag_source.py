@@ -8,6 +8,7 @@ the bag's only image topic is used (``/camera/image_raw`` when there are several
 frames keep the bag's times: ``frame_time(k)`` is seconds since the first frame.
 """
 
+from itertools import islice
 from pathlib import Path
 
 import cv2
@@ -52,6 +53,24 @@ def parse_bag_spec(spec):
     return Path(path), topic
 
 
+def check_image(msg, msgtype):
+    """``UsageError`` for a raw image whose encoding is not read or whose size does not fit
+    its data (a CompressedImage shows whether it can be read only when it is decoded)."""
+    if msgtype.endswith("CompressedImage"):
+        return
+    enc = msg.encoding.lower()
+    if enc not in ENCODINGS:
+        raise UsageError(
+            f"image encoding {msg.encoding!r} is not read; use one of " + ", ".join(ENCODINGS)
+        )
+    h, w, size = msg.height, msg.width, len(msg.data)
+    if msg.step < w * _CHANNELS.get(enc, 2) or size != h * msg.step:
+        raise UsageError(
+            f"a {w}x{h} {enc} image with step {msg.step} cannot hold "
+            f"{size} bytes: the bag's image is malformed"
+        )
+
+
 def decode_image(msg, msgtype):
     """A bag image message as a BGR uint8 array; ``UsageError`` for an encoding not read."""
     data = np.frombuffer(memoryview(msg.data), np.uint8)
@@ -63,17 +82,9 @@ def decode_image(msg, msgtype):
                 f"(OpenCV reads JPEG and PNG)"
             )
         return bgr
+    check_image(msg, msgtype)
     enc = msg.encoding.lower()
-    if enc not in ENCODINGS:
-        raise UsageError(
-            f"image encoding {msg.encoding!r} is not read; use one of " + ", ".join(ENCODINGS)
-        )
     h, w = msg.height, msg.width
-    if msg.step < w * _CHANNELS.get(enc, 2) or data.size != h * msg.step:
-        raise UsageError(
-            f"a {w}x{h} {enc} image with step {msg.step} cannot hold "
-            f"{data.size} bytes: the bag's image is malformed"
-        )
     if enc in _CHANNELS:
         c = _CHANNELS[enc]
         rows = data.reshape(h, msg.step)[:, : w * c]  # rows may be padded to `step`
@@ -89,9 +100,10 @@ def decode_image(msg, msgtype):
 
 
 class BagSource:
-    """The images of one topic of a bag, as RGB888 frames at ``width`` x ``height``."""
+    """The images of one topic of a bag, as RGB888 frames at ``width`` x ``height``; with
+    ``max_frames`` the run takes the first ones only, and only they are checked."""
 
-    def __init__(self, spec, width, height):
+    def __init__(self, spec, width, height, max_frames=None):
         self.spec = str(spec)
         self.kind = "bag"
         self.width, self.height = width, height
@@ -135,19 +147,28 @@ class BagSource:
                 f"bag {str(path)!r} has no topic {topic}; image topics: "
                 + (", ".join(sorted(images)) or "none")
             )
-        self.topic = topic
+        self.topic, self._path = topic, path
         self._connections = [c for c in self._reader.connections if c.topic == topic]
         if sum(c.msgcount for c in self._connections) == 0:
             self.close()
             raise UsageError(f"topic {topic} of bag {str(path)!r} has no messages")
         self._stamps = []
-        # The first image is decoded now: a bad encoding is reported before the run starts.
-        conn, _, raw = next(self._reader.messages(connections=self._connections))
-        try:
-            decode_image(self._reader.deserialize(raw, conn.msgtype), conn.msgtype)
-        except UsageError as exc:
-            self.close()
-            raise UsageError(f"bag {str(path)!r} topic {topic}: {exc}") from None
+        # Every image the run will take is checked now and the first one decoded: an image
+        # it cannot read is reported before anything is written, not after a part of the run.
+        messages = islice(self._reader.messages(connections=self._connections), max_frames)
+        for k, (conn, _, raw) in enumerate(messages):
+            msg = self._reader.deserialize(raw, conn.msgtype)
+            try:
+                (decode_image if k == 0 else check_image)(msg, conn.msgtype)
+            except UsageError as exc:
+                self.close()
+                raise self._unreadable(k, exc) from None
+
+    def _unreadable(self, k, exc):
+        """The error for frame ``k``, which cannot be read: it says which, and how to run
+        the frames before it."""
+        cut = f"; --max-frames {k} runs the frames before it" if k else ""
+        return UsageError(f"bag {str(self._path)!r} topic {self.topic}, frame {k}: {exc}{cut}")
 
     def frame_time(self, k):
         """Seconds from the first frame to frame ``k`` (by the bag's times)."""
@@ -155,10 +176,14 @@ class BagSource:
 
     def __iter__(self):
         reader = self._reader
-        for conn, stamp, raw in reader.messages(connections=self._connections):
+        for k, (conn, stamp, raw) in enumerate(reader.messages(connections=self._connections)):
             msg = reader.deserialize(raw, conn.msgtype)
+            try:
+                bgr = decode_image(msg, conn.msgtype)
+            except UsageError as exc:  # a CompressedImage: decoded only now
+                raise self._unreadable(k, exc) from None
             self._stamps.append(stamp)
-            yield to_design_rgb(decode_image(msg, conn.msgtype), self.width, self.height)
+            yield to_design_rgb(bgr, self.width, self.height)
 
     def close(self):
         if self._reader is not None:
