@@ -99,7 +99,7 @@ class Client:
         return sum(1 for t, _, _ in self.data if t == topic)
 
 
-def test_live_topics_and_client_controls(tmp_path):
+def test_live_topics_and_client_controls(tmp_path, capsys):
     port = free_port()
     summary, bag = tmp_path / "s.json", tmp_path / "bag"
     argv = [
@@ -153,6 +153,7 @@ def test_live_topics_and_client_controls(tmp_path):
                 2: ("/fpga/color_select", "std_msgs/String"),
                 3: ("/target/cmd_vel", "geometry_msgs/Twist"),
                 4: ("/sim/pause", "std_msgs/Bool"),
+                5: ("/fpga/colour_select", "std_msgs/String"),  # misspelt
             }
         )
         time.sleep(0.3)  # let the server take the subscription and the advertisement
@@ -161,6 +162,10 @@ def test_live_topics_and_client_controls(tmp_path):
             client.wait_for(lambda k=k: client.count("/camera/image_raw") >= k + 1)
         time.sleep(0.3)
         assert client.count("/camera/image_raw") == PAUSED_FRAMES  # still paused
+        client.publish(2, {"data": "purple"})  # not a colour select: refused, said why
+        client.publish(2, {"data": "purple"})
+        client.publish(2, {"colour": "blue"})  # not a std_msgs/String
+        client.publish(5, {"data": "blue"})
         client.publish(2, {"data": "blue"})
         client.publish(
             3, {"linear": {"x": 0.5, "y": 0.0, "z": 0.0}, "angular": {"x": 0.0, "y": 0.0, "z": 0.0}}
@@ -202,6 +207,23 @@ def test_live_topics_and_client_controls(tmp_path):
     assert acted["color"]["frame"] == acted["target_velocity"]["frame"] == PAUSED_FRAMES
     assert acted["color"]["value"] == "blue"
     assert acted["target_velocity"]["value"] == [0.5, 0.0]
+
+    # The messages the run could not use are said at once, each reason once, and at the end
+    # and in the summary with their counts.
+    out, err = capsys.readouterr()
+    purple = "/fpga/color_select: unknown colour 'purple'"
+    shape = "/fpga/color_select: not a std_msgs/String or std_msgs/UInt8 (KeyError: 'data')"
+    topic = "/fpga/colour_select: not a control topic; those are /fpga/color_select, "
+    for line in (purple, shape, topic):
+        assert err.count(f"Foxglove live: a message not used: {line}") == 1, err
+    assert "Foxglove live: 4 message(s) not used: " + purple in out
+    refused = json.loads(summary.read_text())["refused_inputs"]
+    assert [(r["topic"], r["messages"]) for r in refused] == [
+        ("/fpga/color_select", 2),
+        ("/fpga/color_select", 1),
+        ("/fpga/colour_select", 1),
+    ]
+    assert refused[0]["reason"].startswith("unknown colour 'purple'")
 
     # The bag shows their effect: nothing blue to find from frame 5 on; the target walks
     # +x at 0.5 m/s from frame 5's instant, its script paused (y stays put).

@@ -5,11 +5,14 @@ The server listens on localhost only and publishes the same ROS 2 messages as th
 (``messages.TOPICS``, further cameras' ``/cameras/<name>/...`` and a LIDAR's
 ``/<name>/scan``, CDR with their ``ros2msg`` schemas) as each frame is done. Clients may
 publish (client-publish capability) on the control topics ``CONTROL_TOPICS``, in JSON or CDR;
-each message becomes a ``LiveControls`` input, applied at the next frame boundary.
+each message becomes a ``LiveControls`` input, applied at the next frame boundary. A message
+the run cannot use (a topic that controls nothing, a value out of range, an unreadable
+message) is said at once on stderr and listed in the closing notice and the summary.
 """
 
 import json
 import socket
+import sys
 import threading
 from pathlib import Path
 
@@ -119,12 +122,25 @@ class _Listener(foxglove.websocket.ServerListener):
             (client.id, client_channel_id), (None, None, None)
         )
         if topic not in CONTROL_TOPICS:
+            self.publisher.refuse(
+                topic, "not a control topic; those are " + ", ".join(CONTROL_TOPICS)
+            )
             return
         try:
             kind, value = control_input(topic, _decode(encoding, schema_name, data))
             self.publisher.controls.submit(kind, value)
         except Exception as exc:  # noqa: BLE001 - a client's bad message never stops the run
-            self.publisher.rejected.append(f"{topic}: {exc}")
+            self.publisher.refuse(topic, _refusal(topic, exc))
+
+
+def _refusal(topic, exc):
+    """Why a message on the control topic ``topic`` could not be used, in words."""
+    if isinstance(exc, json.JSONDecodeError):
+        return f"not JSON ({exc})"
+    if isinstance(exc, (ValueError, TypeError)):  # a value the input does not take
+        return str(exc)
+    types = " or ".join(t.replace("/msg/", "/") for t in CONTROL_TOPICS[topic])
+    return f"not a {types} ({type(exc).__name__}: {exc})"
 
 
 class LivePublisher:
@@ -143,7 +159,7 @@ class LivePublisher:
         self.controls = controls
         self.lock = threading.Lock()
         self.subscribed = set()
-        self.rejected = []  # client messages that could not be used, with why
+        self.refused = {}  # (topic, why) -> how many client messages were not used for it
         self._messages = FrameMessages(geometry)
         self._scans = LaserScans()  # a LIDAR's revolutions, on channels made when first seen
         self._context = foxglove.Context()
@@ -178,6 +194,23 @@ class LivePublisher:
             ),
         )
 
+    def refuse(self, topic, reason):
+        """A client message the run cannot use: said at once on stderr (each reason once),
+        and counted for the closing notice and the summary."""
+        with self.lock:
+            count = self.refused[topic, reason] = self.refused.get((topic, reason), 0) + 1
+        if count == 1:
+            clear = "\r\033[K" if sys.stderr.isatty() else ""  # a progress bar may be drawn
+            print(f"{clear}Foxglove live: a message not used: {topic}: {reason}", file=sys.stderr)
+
+    def refused_inputs(self):
+        """The refused messages for the summary: ``[{"topic", "reason", "messages"}, ...]``."""
+        with self.lock:
+            return [
+                {"topic": topic, "reason": reason, "messages": count}
+                for (topic, reason), count in self.refused.items()
+            ]
+
     @property
     def url(self):
         return f"ws://127.0.0.1:{self.port}"
@@ -204,10 +237,20 @@ class LivePublisher:
         self.frames_logged += 1
 
     def close(self):
+        """Stop the server; returns the notice of the client messages not used ("" if none)."""
         if self._server is not None:
             self._server.stop()
             self._server = None
-        return ""
+        refused = self.refused_inputs()
+        if not refused:
+            return ""
+        return f"Foxglove live: {sum(r['messages'] for r in refused)} message(s) not used: " + (
+            "; ".join(
+                f"{r['topic']}: {r['reason']}"
+                + (f" (x{r['messages']})" if r["messages"] > 1 else "")
+                for r in refused
+            )
+        )
 
 
 def layout_path():

@@ -79,7 +79,7 @@ class RosOutputs:
         self.start_paused = args.paused
         self.controls = None
         self._sinks = []  # bag writer, live publisher: each has log_frame and close
-        self._bag = self._terminal = None
+        self._bag = self._terminal = self._live = None
 
     def check_closed_loop_only(self):
         """With ``--source`` (no simulation) there is nothing to control."""
@@ -116,9 +116,9 @@ class RosOutputs:
                 self._bag = BagWriter(self.bag_path, geometry)
                 self._sinks.append(self._bag)
             if self.port is not None:
-                live = LivePublisher(self.port, geometry, self.controls)
-                self._sinks.append(live)
-                notices += live.pop_notices()
+                self._live = LivePublisher(self.port, geometry, self.controls)
+                self._sinks.append(self._live)
+                notices += self._live.pop_notices()
             if self.interactive:
                 self._terminal = TerminalControls(self.controls)
                 notices += self._terminal.help_lines()
@@ -132,8 +132,12 @@ class RosOutputs:
             sink.log_frame(record)
 
     def summary_items(self):
-        """``{"inputs": [...]}`` when the run had live or replayed inputs."""
-        return {} if self.controls is None else {"inputs": list(self.controls.log)}
+        """``{"inputs": [...]}`` when the run had live or replayed inputs, and with a live
+        server that took client messages, ``"refused_inputs"``: those it could not use."""
+        items = {} if self.controls is None else {"inputs": list(self.controls.log)}
+        if self._live is not None and self._live.controls is not None:
+            items["refused_inputs"] = self._live.refused_inputs()
+        return items
 
     def close(self, completed):
         """Stop everything; the bag is kept only for a completed run. Returns notices."""
