@@ -3,6 +3,7 @@ edge of its instant (stream), and the serial line's levels decoded as a UART wou
 bit, against the protocol's framing (descriptor, 5-byte packets) and the walls by hand."""
 
 import math
+import re
 
 import numpy as np
 import pytest
@@ -163,9 +164,38 @@ def test_uart_packets_follow_their_samples():
         ({"min_range": 0.9, "max_range": 0.8}, "max_range must be greater than min_range"),
         ({"sample_rate": 100, "scan_hz": 15}, "sample_rate must be at least 10 samples"),
         ({"quality": 2.5}, "quality must be a whole number"),
+        # 16 bits of mm x 4: a farther return could not be reported.
+        (
+            {"max_range": 40},
+            (
+                "max_range must be a number in m >= 0.5 and <= 16.38 (a sample's distance_q2, "
+                "16 bits of mm x 4, carries at most 16.38 m), got 40"
+            ),
+        ),
         ({"spin": 1}, "unknown key 'spin' for a 'lidar' connector"),
     ],
 )
 def test_bad_keys_are_named(table, message):
-    with pytest.raises(ConnectorError, match=message.replace("(", r"\(")):
+    with pytest.raises(ConnectorError, match=re.escape(message)):
         parse_connectors({"sensors": [{"kind": "lidar", **table}]})
+
+
+def test_the_farthest_range_reports_a_wall_beyond_it_as_no_return():
+    """At max_range = 16.38 m (the most 16 bits of mm x 4 carry) a wall 16 m away is
+    reported at its distance, one 19 m away as no return (distance 0, quality 0)."""
+    world = World.from_config(
+        {
+            "room": {"width": 20.0, "depth": 32.0},
+            "robot": {"model": "gopigo3", "start": [1.0, 16.0], "heading_deg": 0.0},
+            "people": [],
+        }
+    )
+    table = {"kind": "lidar", "height": 0.2, "noise_frac": 0, "dark_return": 0, "max_range": 16.38}
+    (spec,) = parse_connectors({"sensors": [table]})
+    conn = LidarConnector(
+        spec.name, spec.mount, spec.params, world=world, rng=np.random.default_rng(0)
+    )
+    samples = conn.scan.samples(world, 0, 364, 1.0, 16.0, 0.0, 0.2)
+    ahead, left = samples[0], samples[273]  # 0 and 270.27 degrees clockwise
+    assert (ahead.distance_q2, ahead.quality) == (0, 0)  # the wall x = 20, 19 m
+    assert left.distance_m == pytest.approx(16.0 / math.cos(math.radians(0.27)), abs=1e-3)

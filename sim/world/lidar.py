@@ -38,6 +38,7 @@ import numpy as np
 __all__ = [
     "DESCRIPTOR",
     "FULL_TURN_Q6",
+    "MAX_RANGE_M",
     "LidarParams",
     "LidarSample",
     "Revolution",
@@ -51,6 +52,9 @@ __all__ = [
 
 #: 360 degrees in the protocol's angle unit (1/64 degree).
 FULL_TURN_Q6 = 360 * 64
+#: The farthest ``max_range``: a sample's ``distance_q2`` is 16 bits of mm x 4, at most
+#: 16383.75 mm (the A1 reaches 12 m; longer-range parts use other packet formats).
+MAX_RANGE_M = 16.38
 #: The SCAN request's response descriptor: start flags A5 5A, length 5 with send mode 1
 #: (multiple responses) in its top two bits (0x40000005, little endian), data type 0x81.
 DESCRIPTOR = bytes((0xA5, 0x5A, 0x05, 0x00, 0x00, 0x40, 0x81))
@@ -269,6 +273,7 @@ class Scan:
         out = []
         for j in range(count):
             if returned[j]:
+                # Noise can carry a return near MAX_RANGE_M past what 16 bits hold.
                 d_q2 = min(0xFFFF, max(1, round(float(measured[j]) * 4000.0)))
                 quality = p.quality
             else:

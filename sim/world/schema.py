@@ -74,7 +74,7 @@ class _NumberCheck:
     le: float | None = None
     unit: str = ""
     style: str = "world"
-    note: str = ""  # why the upper bound (scenario style)
+    note: str = ""  # why the upper bound (scenario and bounds styles)
 
     def bounds(self):
         out = [(f"> {self.gt:g}", lambda v: v > self.gt)] if self.gt is not None else []
@@ -95,7 +95,8 @@ class _NumberCheck:
             unit = f" {self.unit}" if self.unit else ""
             fail(f"must be a number in {lo:g}..{self.le:g}{unit}, got {value!r}")
         if self.style == "bounds":
-            fail(f"must be a number{in_unit} {' and '.join(texts)}, got {value!r}")
+            note = self.note if finite and failed[0].startswith("<") else ""
+            fail(f"must be a number{in_unit} {' and '.join(texts)}{note}, got {value!r}")
         if self.style == "scenario":
             if not finite:
                 span = f", {' and '.join(texts)}" if texts else ""

@@ -205,11 +205,12 @@ class MountKeys(KeyModel):
     yaw_deg: Number(ge=-360, le=360, style="bounds") = 0.0
 
 
-def check_number(table, key, default, where, *, lo, hi, unit="", lo_open=False):
+def check_number(table, key, default, where, *, lo, hi, unit="", lo_open=False, note=""):
     """``table[key]`` (or ``default``) as a float within ``lo..hi`` (``lo`` excluded with
-    ``lo_open``); a ``ConnectorError`` naming ``where.key`` otherwise."""
+    ``lo_open``); a ``ConnectorError`` naming ``where.key`` otherwise (with ``note``, why
+    the upper bound, when above it)."""
     bound = {"gt": lo} if lo_open else {"ge": lo}
-    check = check_of(Number(**bound, le=hi, unit=unit, style="bounds"))
+    check = check_of(Number(**bound, le=hi, unit=unit, style="bounds", note=note))
     return validate_value(check, table.get(key, default), f"{where}.{key}")
 
 
@@ -226,13 +227,21 @@ def refuse_unknown_keys(table, known, where, kind, listed=None):
 
 
 def check_numbers(table, keys, defaults, where):
-    """``{key: check_number(...)}`` for ``keys`` ``{key: (lo, hi, unit, lo_open)}``, each
-    defaulting to the attribute of ``defaults`` of its name."""
+    """``{key: check_number(...)}`` for ``keys`` ``{key: (lo, hi, unit, lo_open[, note])}``,
+    each defaulting to the attribute of ``defaults`` of its name."""
     return {
         key: check_number(
-            table, key, getattr(defaults, key), where, lo=lo, hi=hi, unit=unit, lo_open=lo_open
+            table,
+            key,
+            getattr(defaults, key),
+            where,
+            lo=lo,
+            hi=hi,
+            unit=unit,
+            lo_open=lo_open,
+            note=note[0] if note else "",
         )
-        for key, (lo, hi, unit, lo_open) in keys.items()
+        for key, (lo, hi, unit, lo_open, *note) in keys.items()
     }
 
 

@@ -32,6 +32,7 @@ from fpga_robotics.loop.connectors.base import (
 from fpga_robotics.sim.world.lidar import (
     DESCRIPTOR,
     FULL_TURN_Q6,
+    MAX_RANGE_M,
     LidarParams,
     Revolution,
     Scan,
@@ -41,12 +42,19 @@ from fpga_robotics.sim.world.lidar import (
 
 __all__ = ["LidarConnector", "LidarUartConnector"]
 
-#: key -> (lower bound, upper bound, unit, lower bound excluded) of the scenario table.
+#: key -> (lower bound, upper bound, unit, lower bound excluded[, why the upper bound]) of
+#: the scenario table.
 _KEYS = {
     "scan_hz": (1.0, 15.0, "Hz", False),
     "sample_rate": (100.0, 8000.0, "samples/s", False),
     "min_range": (0.0, 1.0, "m", False),
-    "max_range": (0.5, 40.0, "m", False),
+    "max_range": (
+        0.5,
+        MAX_RANGE_M,
+        "m",
+        False,
+        " (a sample's distance_q2, 16 bits of mm x 4, carries at most 16.38 m)",
+    ),
     "noise_frac": (0.0, 0.2, "", False),
     "dark_return": (0.0, 1.0, "", False),
     "max_incidence_deg": (0.0, 90.0, "degrees", True),
