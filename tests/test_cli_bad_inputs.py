@@ -165,6 +165,22 @@ CASES = [
     ("recording below a file", ["run", "--rerun", "save:{file}/r.rrd"], "not a folder"),
     ("recording to a folder", ["run", "--rerun", "save:folder.rrd"], "is a folder"),
     ("default recording below a file", ["run", "--rerun", "save"], "not a folder"),
+    # a LIDAR the run cannot carry: refused at load, before the recording is opened
+    (
+        "lidar serial link slower than its samples",
+        ["run", "--scenario", "corridor_uart", "--set", "robot.sensors.0.sample_rate=8000"],
+        "need baud at least 400000",
+    ),
+    (
+        "lidar clock slower than two edges a sample",
+        ["run", "--scenario", "corridor", "--set", "sim.clock_hz=3000", "--rerun", "save:x.rrd"],
+        "sim.clock_hz at least 4000",
+    ),
+    (
+        "lidar above the ceiling",
+        ["run", "--scenario", "corridor", "--set", "robot.sensors.0.height=2.6"],
+        "below the ceiling",
+    ),
     # a 3D scenario without the realistic extra (MuJoCo not importable)
     ("3D scenario without the realistic extra", ["run", "--scenario", "divider_3d"], "MuJoCo"),
     # export

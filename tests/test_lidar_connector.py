@@ -11,6 +11,8 @@ import pytest
 from fpga_robotics.hw.lidar_sample import unpack_sample
 from fpga_robotics.loop.connectors import ConnectorError, LidarConnector, LidarUartConnector
 from fpga_robotics.scenario.connectors import parse_connectors
+from fpga_robotics.scenario.errors import ScenarioError
+from fpga_robotics.scenario.load import load_scenario
 from fpga_robotics.sim.world import World
 
 CLOCK_HZ = 1_000_000
@@ -52,8 +54,9 @@ def _connector(cls, **keys):
     return cls(spec.name, spec.mount, spec.params, world=world, rng=np.random.default_rng(0))
 
 
-def _run(conn, seconds, dt=1 / 240):
+def _run(conn, seconds, dt=1 / 240, clock_hz=CLOCK_HZ):
     io = FakeIO()
+    io.clock_hz = clock_hz
     conn.start(io)
     t = 0.0
     for _ in range(round(seconds / dt)):
@@ -97,7 +100,7 @@ def test_stream_samples_at_their_instants():
 
 def _line_bytes(transitions, bit_edges, end):
     """Decode the rx line as an 8N1 receiver: wait for a fall, sample each bit's middle."""
-    edges = np.array([e for e, _ in transitions])
+    edges = np.array([e for e, _ in transitions], dtype=float)  # as the bit times: no casts
     levels = [v for _, v in transitions]
 
     def level(edge):
@@ -199,3 +202,77 @@ def test_the_farthest_range_reports_a_wall_beyond_it_as_no_return():
     ahead, left = samples[0], samples[273]  # 0 and 270.27 degrees clockwise
     assert (ahead.distance_q2, ahead.quality) == (0, 0)  # the wall x = 20, 19 m
     assert left.distance_m == pytest.approx(16.0 / math.cos(math.radians(0.27)), abs=1e-3)
+
+
+@pytest.mark.parametrize(
+    "keys, message",
+    [
+        (
+            {"sample_rate": 8000},
+            (
+                "robot.sensors[0]: 8000 samples/s of 50 bits (5 bytes 8N1) need baud at least "
+                "400000, or sample_rate at most 2304 (baud is 115200)"
+            ),
+        ),
+        # 1200 baud carries 24 samples/s, fewer than any sample_rate allowed.
+        (
+            {"baud": 1200},
+            (
+                "robot.sensors[0]: 2000 samples/s of 50 bits (5 bytes 8N1) need baud at least "
+                "100000 (baud is 1200)"
+            ),
+        ),
+    ],
+)
+def test_a_serial_link_slower_than_the_samples_is_refused(keys, message):
+    with pytest.raises(ConnectorError, match=re.escape(message)):
+        parse_connectors({"sensors": [{"kind": "lidar_uart", **keys}]})
+
+
+def test_a_serial_link_at_its_limit_keeps_up():
+    """2304 samples/s fill 115200 baud (50 bits a packet): after a second on the wire, every
+    sample taken has arrived but the last two (still behind the descriptor's 70 bits)."""
+    io = _run(_connector(LidarUartConnector, sample_rate=2304), 1.0)
+    data = bytes(_line_bytes(io.events["rx"][1:], CLOCK_HZ / 115200, io.cycle))
+    assert data[:7] == bytes.fromhex("A55A0500004081")
+    assert len(data[7:]) // 5 >= 2304 - 2
+
+
+def test_a_stream_at_two_edges_a_sample_keeps_up():
+    # 2000 samples/s on a 4 kHz clock: sample i is due at edge 2 i. Sample 0 waits for the
+    # first edge after the start (1), which puts every later one an edge late, no more.
+    io = _run(_connector(LidarConnector), 1.0, clock_hz=4000)
+    rises = [e for e, v in io.events["valid"][1:] if v]
+    assert rises == [2 * i + 1 for i in range(2000)]
+
+
+@pytest.mark.parametrize(
+    "scenario, sets, message",
+    [
+        (
+            "corridor",
+            ["sim.clock_hz=3000"],
+            (
+                "robot.sensors[0]: 2000 samples/s need two clock edges a sample: sim.clock_hz at "
+                "least 4000, or sample_rate at most 1500 (sim.clock_hz is 3000)"
+            ),
+        ),
+        (
+            "corridor_uart",
+            ["sim.clock_hz=100000"],
+            (
+                "robot.sensors[0]: 115200 baud needs a clock edge a bit: sim.clock_hz at least "
+                "115200, or baud at most 100000 (sim.clock_hz is 100000)"
+            ),
+        ),
+        # The walls end at the ceiling: a scan plane above it would pass over them.
+        (
+            "corridor",
+            ["room.height=2.0", "robot.sensors.0.height=2.9"],
+            "robot.sensors[0].height must be below the ceiling (room.height = 2 m), got 2.9",
+        ),
+    ],
+)
+def test_a_lidar_that_does_not_fit_the_run_is_refused_at_load(scenario, sets, message):
+    with pytest.raises(ScenarioError, match=re.escape(message)):
+        load_scenario(scenario, sets)

@@ -961,6 +961,18 @@ def _connectors(world):
         raise ScenarioError(str(exc)) from None
 
 
+def _check_connectors_in_run(connectors, sim, room):
+    """Each connector table against the run's clock and the room (``Connector.check_run``)."""
+    counts = {}
+    for spec in connectors:
+        index = counts[spec.role] = counts.get(spec.role, -1) + 1
+        where = f"robot.{spec.role}s[{index}]"
+        try:
+            CONNECTORS[spec.kind].check_run(spec.params, spec.mount, where, sim, room)
+        except ConnectorError as exc:
+            raise ScenarioError(str(exc)) from None
+
+
 def _resolve_timing(sim, camera, top, connectors, foreign):
     """``sim.timing = "auto"`` made definite; a design or connector with pins of its own
     needs real-clock timing."""
@@ -1025,6 +1037,7 @@ def _build(data, source, overrides):
     sim = _resolve_timing(sim, camera, top, connectors, foreign)
     world_config = _check_world(world)
     _check_camera_geometry(camera, world_config)
+    _check_connectors_in_run(connectors, sim, world_config.room)
     return Scenario(
         name=name,
         description=description,

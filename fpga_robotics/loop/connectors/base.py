@@ -165,6 +165,13 @@ class Connector:
         return cls.params_of(validate(cls.keys, table, where, ConnectorError))
 
     @classmethod
+    def check_run(cls, params, mount, where, sim, room):
+        """Check the parsed table against the rest of the scenario, at load: ``sim`` (the
+        ``[sim]`` config, its timing resolved: ``clock_hz``) and ``room`` (the room's
+        config: ``height``). Raise ``ConnectorError`` naming ``where``; by default nothing
+        to check."""
+
+    @classmethod
     def params_of(cls, keys):
         """The params object of the validated keys (by default the keys model itself)."""
         return keys

@@ -42,6 +42,9 @@ from fpga_robotics.sim.world.lidar import (
 
 __all__ = ["LidarConnector", "LidarUartConnector"]
 
+#: The bits of a sample's packet on the line: 5 bytes, each with a start and a stop bit.
+PACKET_BITS = 50
+
 #: key -> (lower bound, upper bound, unit, lower bound excluded[, why the upper bound]) of
 #: the scenario table.
 _KEYS = {
@@ -61,6 +64,16 @@ _KEYS = {
     "quality": (1.0, 63.0, "", False),
     "baud": (1200.0, 4_000_000.0, "baud", False),
 }
+
+
+def _lowest_rate(params):
+    """The least ``sample_rate`` the table allows at its ``scan_hz``."""
+    return max(_KEYS["sample_rate"][0], 10 * params.scan_hz)
+
+
+def _or_at_most(key, most, lowest):
+    """``", or KEY at most MOST"`` when that is an allowed value (at least ``lowest``)."""
+    return f", or {key} at most {most:g}" if most >= lowest else ""
 
 
 class _LidarBase(Connector):
@@ -98,6 +111,15 @@ class _LidarBase(Connector):
                 raise ConnectorError(f"{where}.{key} must be a whole number, got {values[key]!r}")
             values[key] = int(values[key])
         return LidarParams(**values)
+
+    @classmethod
+    def check_run(cls, params, mount, where, sim, room):
+        # Above the ceiling the scan plane would pass over the walls.
+        if not mount.height < room.height:
+            raise ConnectorError(
+                f"{where}.height must be below the ceiling (room.height = {room.height:g} m), "
+                f"got {mount.height:g}"
+            )
 
     def sensor_pose(self):
         """``(x, y, heading)`` of the sensor in the world now."""
@@ -187,6 +209,19 @@ class LidarConnector(_LidarBase):
     kind = "lidar"
     pins: ClassVar[dict] = {"valid": Pin("in", 1), "payload": Pin("in", SAMPLE_BITS)}
 
+    @classmethod
+    def check_run(cls, params, mount, where, sim, room):
+        super().check_run(params, mount, where, sim, room)
+        # valid is high for one edge a sample: a slower clock delays the samples more and
+        # more, without bound.
+        if sim.clock_hz < 2 * params.sample_rate:
+            raise ConnectorError(
+                f"{where}: {params.sample_rate:g} samples/s need two clock edges a sample: "
+                f"sim.clock_hz at least {2 * params.sample_rate:g}"
+                f"{_or_at_most('sample_rate', sim.clock_hz / 2, _lowest_rate(params))} "
+                f"(sim.clock_hz is {sim.clock_hz:g})"
+            )
+
     def start(self, io):
         self._reset()
         self._last_edge = io.cycle - 1  # no pulse yet
@@ -208,6 +243,31 @@ class LidarUartConnector(_LidarBase):
 
     kind = "lidar_uart"
     pins: ClassVar[dict] = {"rx": Pin("in", 1)}
+
+    @classmethod
+    def parse(cls, table, where):
+        params = super().parse(table, where)
+        # A sensor has no unbounded buffer: a link slower than its samples would deliver
+        # them later and later.
+        if params.baud < PACKET_BITS * params.sample_rate:
+            raise ConnectorError(
+                f"{where}: {params.sample_rate:g} samples/s of {PACKET_BITS} bits (5 bytes "
+                f"8N1) need baud at least {PACKET_BITS * params.sample_rate:g}"
+                f"{_or_at_most('sample_rate', params.baud / PACKET_BITS, _lowest_rate(params))} "
+                f"(baud is {params.baud})"
+            )
+        return params
+
+    @classmethod
+    def check_run(cls, params, mount, where, sim, room):
+        super().check_run(params, mount, where, sim, room)
+        if sim.clock_hz < params.baud:
+            lowest_baud = PACKET_BITS * params.sample_rate
+            raise ConnectorError(
+                f"{where}: {params.baud} baud needs a clock edge a bit: sim.clock_hz at least "
+                f"{params.baud}{_or_at_most('baud', math.floor(sim.clock_hz), lowest_baud)} "
+                f"(sim.clock_hz is {sim.clock_hz:g})"
+            )
 
     def start(self, io):
         self._reset()
