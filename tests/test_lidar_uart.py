@@ -3,6 +3,8 @@ connector does, come out of UartRx and RplidarDecoder as the samples they encode
 byte is dropped by the resynchronisation; a low stop bit is a framing error. And the
 corridor_uart scenario passes."""
 
+import re
+
 import pytest
 from amaranth import Module
 from amaranth.lib import wiring
@@ -12,7 +14,7 @@ from fpga_robotics.hw.lidar_params import UartParams
 from fpga_robotics.hw.lidar_sample import unpack_sample
 from fpga_robotics.hw.lidar_uart import RplidarDecoder, UartRx
 from fpga_robotics.loop import run_scenario
-from fpga_robotics.scenario import load_scenario
+from fpga_robotics.scenario import ScenarioError, load_scenario
 from fpga_robotics.sim.world.lidar import DESCRIPTOR, LidarSample, packet_bytes, uart_levels
 
 #: 8 cycles a bit.
@@ -108,11 +110,53 @@ def test_a_low_stop_bit_is_a_framing_error():
 
 @pytest.mark.slow
 def test_the_corridor_passes_over_the_serial_link():
-    s = load_scenario(
-        "corridor_uart", ["sim.clock_hz=1000000", "design.uart.clock_hz=1000000", "sim.duration=8"]
-    )
+    s = load_scenario("corridor_uart", ["sim.clock_hz=1000000", "sim.duration=8"])
     r = run_scenario(s, backend="cxxrtl")
     assert r.passed, r.summary["checks"]
     assert r.trajectory["design.framing_errors"][-1] == 0
     assert r.trajectory["design.resyncs"][-1] == 0
     assert r.trajectory["design.found"][-1] == 1
+
+
+def test_the_uart_takes_the_runs_clock_and_baud():
+    """[design.uart] left out: the receiver runs on sim.clock_hz at the LIDAR's baud."""
+    s = load_scenario("corridor_uart", ["sim.clock_hz=10000000", "robot.sensors.0.baud=230400"])
+    assert s.design_tables["uart"] == UartParams(clock_hz=10_000_000, baud=230_400)
+    # On a 1 MHz clock the design decodes every byte: a revolution found, no framing error.
+    s = load_scenario("corridor_uart", ["sim.clock_hz=1000000", "sim.duration=0.5"])
+    r = run_scenario(s, backend="cxxrtl")
+    assert r.trajectory["design.found"][-1] == 1
+    assert r.trajectory["design.framing_errors"][-1] == 0
+
+
+@pytest.mark.parametrize(
+    "sets, message",
+    [
+        (
+            ["sim.clock_hz=10000000", "design.uart.clock_hz=50000000"],
+            (
+                "design.uart.clock_hz 50000000 does not match sim.clock_hz 10000000; leave "
+                "design.uart.clock_hz out to take it"
+            ),
+        ),
+        (
+            ["design.uart.baud=57600"],
+            (
+                "design.uart.baud 57600 does not match robot.sensors[0].baud 115200; leave "
+                "design.uart.baud out to take it"
+            ),
+        ),
+        # Values the user did not write: the message says where they come from.
+        (
+            ["sim.clock_hz=200000"],
+            (
+                "design.uart: clock_hz=200000 is too slow for baud=115200: a bit must last at "
+                "least 4 cycles, it lasts 1.74 (clock_hz is sim.clock_hz, baud is "
+                "robot.sensors[0].baud)"
+            ),
+        ),
+    ],
+)
+def test_a_uart_off_the_runs_clock_or_baud_is_refused(sets, message):
+    with pytest.raises(ScenarioError, match=re.escape(message)):
+        load_scenario("corridor_uart", sets)

@@ -39,6 +39,8 @@ from pydantic_core import PydanticCustomError
 from fpga_robotics.checks.summary import CHECKS
 from fpga_robotics.designs.builtin import TOPS, design_tables, table_fields
 from fpga_robotics.designs.reference import DesignError, resolve_design
+from fpga_robotics.hw.errors import ParamError
+from fpga_robotics.hw.lidar_params import UartParams
 from fpga_robotics.hw.params import (
     PRESETS,
     FollowTargetParams,
@@ -950,6 +952,39 @@ def _top(design, source):
         raise ScenarioError(str(exc)) from None
 
 
+def _run_uart(design, sim, connectors):
+    """``[design]`` with the UART of a built-in design that has one (``[design.uart]``) on
+    the run's clock and LIDAR link: a key left out takes ``sim.clock_hz`` or the
+    ``lidar_uart`` table's ``baud``; a different value is refused, since the receiver would
+    time every bit wrong and never decode a byte."""
+    top, uart = design.get("top"), design.get("uart", {})
+    if not (top in TOPS and "uart" in TOPS[top].tables and isinstance(uart, dict)):
+        return design
+    run = {"clock_hz": (round(sim.clock_hz), "sim.clock_hz")}
+    sensors = [c for c in connectors if c.role == "sensor"]
+    links = [i for i, c in enumerate(sensors) if c.kind == "lidar_uart"]
+    if links:
+        run["baud"] = (sensors[links[0]].params.baud, f"robot.sensors[{links[0]}].baud")
+    for key, (value, source) in run.items():
+        given = uart.get(key, value)
+        if isinstance(given, int | float) and not isinstance(given, bool) and given != value:
+            raise ScenarioError(
+                f"design.uart.{key} {given:.15g} does not match {source} {value}; leave "
+                f"design.uart.{key} out to take it"
+            )
+    taken = {key: value for key, (value, _) in run.items() if key not in uart}
+    if taken:
+        # Say where a value the user did not write comes from.
+        try:
+            UartParams(**{**uart, **taken})
+        except ParamError as exc:
+            sources = ", ".join(f"{key} is {run[key][1]}" for key in taken)
+            raise ScenarioError(f"design.uart: {exc} ({sources})") from None
+        except TypeError:
+            pass  # a value of the wrong type or name: design_tables says so
+    return {**design, "uart": {**uart, **taken}}
+
+
 def _connectors(world):
     """``robot.sensors`` / ``robot.actuators``, taken out of the world's ``robot`` table."""
     robot = world.get("robot")
@@ -1030,10 +1065,10 @@ def _build(data, source, overrides):
     initial, changes = _color_changes(data)
     params = _design(data, camera.width, camera.height)
     foreign = _foreign(dict(data["design"]), source)
-    top, tables, design_params = _top(data["design"], source)
-    checks = _checks(data)
     world = {s: copy.deepcopy(data[s]) for s in WORLD_SECTIONS if s in data}
     connectors = _connectors(world)
+    top, tables, design_params = _top(_run_uart(data["design"], sim, connectors), source)
+    checks = _checks(data)
     sim = _resolve_timing(sim, camera, top, connectors, foreign)
     world_config = _check_world(world)
     _check_camera_geometry(camera, world_config)
