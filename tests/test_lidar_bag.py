@@ -1,18 +1,25 @@
 """A corridor run's LIDAR written to a ROS 2 bag as sensor_msgs/LaserScan, read back with
 rosbags: one message per revolution, its angles counter-clockwise (ROS) from the RPLIDAR's
-clockwise ones, its ranges the connector's, no return as +inf."""
+clockwise ones, its ranges the connector's, no return as +inf; and a LIDAR mounted off the
+centre and turned, whose scan placed by its /tf lands on the walls."""
 
 import math
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
 from rosbags.highlevel import AnyReader
 from rosbags.typesys import Stores, get_typestore
 
+from fpga_robotics.loop.connectors import LidarConnector
 from fpga_robotics.loop.timings import run_scenario
 from fpga_robotics.ros.bag_writer import open_bag_writer
+from fpga_robotics.ros.laser_scan import LaserScans
+from fpga_robotics.ros.messages import TYPESTORE
+from fpga_robotics.scenario.connectors import parse_connectors
 from fpga_robotics.scenario.load import load_scenario
+from fpga_robotics.sim.world import World
 
 
 @pytest.fixture(scope="module")
@@ -63,4 +70,47 @@ def test_angles_and_ranges(scans):
     expected[expected == 0] = np.inf
     assert np.array_equal(m.ranges, expected)
     assert np.array_equal(m.intensities, np.array(last.qualities, dtype=np.float32))
-    assert m.header.frame_id == "base_link"
+    assert m.header.frame_id == "lidar_link"
+
+
+def test_a_turned_lidar_off_the_centre_lands_on_the_walls():
+    """A LIDAR 0.1 m ahead and 0.05 m left of the centre, turned 90 degrees left, on a robot
+    at (1, 1) heading 30 degrees in a 4 x 3 m room: each return, placed by the scan's /tf in
+    base_link and by the robot's pose in the room, lies on a wall."""
+    world = World.from_config(
+        {
+            "room": {"width": 4.0, "depth": 3.0},
+            "robot": {"model": "gopigo3", "start": [1.0, 1.0], "heading_deg": 30.0},
+            "people": [],
+        }
+    )
+    table = {"kind": "lidar", "name": "side", "forward": 0.1, "left": 0.05, "height": 0.2}
+    (spec,) = parse_connectors(
+        {"sensors": [{**table, "yaw_deg": 90, "noise_frac": 0, "dark_return": 0}]}
+    )
+    conn = LidarConnector(
+        spec.name, spec.mount, spec.params, world=world, rng=np.random.default_rng(0)
+    )
+    conn.take(0.2)  # a revolution (0.18 s) and the start of the next
+    record = SimpleNamespace(
+        sim_time=0.2, sensors={"side": SimpleNamespace(scan=conn.revolution())}
+    )
+    (tf_topic, _, tf_cdr), (topic, _, cdr) = LaserScans().encode(record)
+    assert (tf_topic, topic) == ("/tf", "/side/scan")
+    (place,) = TYPESTORE.deserialize_cdr(tf_cdr, "tf2_msgs/msg/TFMessage").transforms
+    scan = TYPESTORE.deserialize_cdr(cdr, "sensor_msgs/msg/LaserScan")
+    assert (place.header.frame_id, place.child_frame_id) == ("base_link", scan.header.frame_id)
+    offset = place.transform.translation
+    assert (offset.x, offset.y, offset.z) == pytest.approx((0.1, 0.05, 0.2))
+    r = scan.ranges
+    ok = np.isfinite(r)
+    assert ok.mean() > 0.8
+    a = scan.angle_min + scan.angle_increment * np.arange(len(r))
+    bx, by = offset.x + r[ok] * np.cos(a[ok]), offset.y + r[ok] * np.sin(a[ok])
+    h = math.radians(30)
+    x = 1.0 + bx * math.cos(h) - by * math.sin(h)
+    y = 1.0 + bx * math.sin(h) + by * math.cos(h)
+    off_wall = np.minimum.reduce([abs(x), abs(x - 4.0), abs(y), abs(y - 3.0)])
+    assert off_wall.max() < 1e-3
+    # The sensor's forward (its first sample) points 90 degrees left of the robot's.
+    assert scan.angle_min == pytest.approx(math.radians(90), abs=math.radians(1))

@@ -125,6 +125,6 @@ def test_a_lidar_scan_is_published_live():
         scan = scans[m.header.stamp.sec * 10**9 + m.header.stamp.nanosec]
         expected = np.array(scan.ranges, dtype=np.float32)
         expected[expected == 0] = np.inf  # no return
-        assert np.array_equal(m.ranges, expected) and m.header.frame_id == "base_link"
+        assert np.array_equal(m.ranges, expected) and m.header.frame_id == "lidar_link"
         assert m.angle_increment == pytest.approx(-math.radians(0.99), abs=1e-7)
     assert [round(s * 1e9) for s in (0.182, 0.364)] == sorted(scans)[1:]

@@ -117,6 +117,12 @@ class Revolution:
     scan_time: float  # s a revolution
     range_min: float
     range_max: float
+    # Where the sensor sits on the robot: m ahead of and left of its centre, m above the
+    # floor, and its forward's turn from the robot's heading (degrees, counter-clockwise).
+    mount_forward: float = 0.0
+    mount_left: float = 0.0
+    mount_height: float = 0.0
+    mount_yaw_deg: float = 0.0
 
 
 def sample_angles(params, first, count):

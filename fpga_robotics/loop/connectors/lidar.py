@@ -171,6 +171,10 @@ class _LidarBase(Connector):
             scan_time=1.0 / p.scan_hz,
             range_min=p.min_range,
             range_max=p.max_range,
+            mount_forward=self.mount.forward,
+            mount_left=self.mount.left,
+            mount_height=self.mount.height,
+            mount_yaw_deg=math.degrees(self.mount.yaw),
         )
 
     def measurement(self):
