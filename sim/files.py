@@ -26,6 +26,7 @@ __all__ = [
     "atomic_path",
     "check_output_dir",
     "check_output_path",
+    "default_dir_mode",
     "default_file_mode",
     "write_atomic",
     "write_json_atomic",
@@ -36,12 +37,22 @@ class OutputPathError(UserError, ValueError):
     """An output path that cannot be written; the message names the path and the fix."""
 
 
+def _umask():
+    umask = os.umask(0)  # read only by setting it: put it back at once
+    os.umask(umask)
+    return umask
+
+
 def default_file_mode():
     """The mode ``open()`` would give a new file under the current umask (``mkstemp`` files
     are private, 0600; outputs should not be)."""
-    umask = os.umask(0)
-    os.umask(umask)
-    return 0o666 & ~umask
+    return 0o666 & ~_umask()
+
+
+def default_dir_mode():
+    """The mode ``mkdir`` would give a new folder under the current umask (``mkdtemp``
+    folders are private, 0700; outputs should not be)."""
+    return 0o777 & ~_umask()
 
 
 def _existing_ancestor(path):

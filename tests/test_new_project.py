@@ -2,6 +2,7 @@
 it (``cd NAME && python -m pytest``); an existing non-empty folder refused, nothing written."""
 
 import os
+import stat
 import subprocess
 import sys
 
@@ -43,6 +44,18 @@ def test_the_skeleton_passes_its_own_test(tmp_path, capsys, monkeypatch):
     )
     assert done.returncode == 0, done.stdout + done.stderr
     assert "1 passed" in done.stdout
+
+
+def test_the_project_folder_gets_the_mode_of_a_plain_mkdir(tmp_path, capsys, monkeypatch):
+    # Readable as the umask allows, as its tests/ folder is (not mkdtemp's private 0700).
+    monkeypatch.chdir(tmp_path)
+    umask = os.umask(0o027)
+    try:
+        assert _cli(["new", "shared"], capsys)[0] == 0
+    finally:
+        os.umask(umask)
+    for folder in (tmp_path / "shared", tmp_path / "shared" / "tests"):
+        assert stat.S_IMODE(folder.stat().st_mode) == 0o750, folder
 
 
 def test_the_skeleton_test_fails_when_the_design_breaks(tmp_path, monkeypatch, capsys):

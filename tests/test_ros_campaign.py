@@ -35,10 +35,12 @@ def test_recorded_runs_are_written_as_bags(tmp_path, capsys):
         )
     assert info.value.code in (0, 1), capsys.readouterr().err  # 1: a run failed its checks
     rows = [json.loads(line) for line in (out / "results.jsonl").read_text().splitlines()]
+    mkdir_mode = (out / "recordings").stat().st_mode & 0o777  # a folder made by mkdir
     assert len(rows) == 2 and {r["status"] for r in rows} <= {"pass", "fail"}
     for row in rows:
         bag = out / row["bag"]
         assert bag == out / "bags" / row["run_id"] and (bag / "metadata.yaml").is_file()
+        assert bag.stat().st_mode & 0o777 == mkdir_mode  # not mkdtemp's private 0700
         with AnyReader([bag]) as reader:
             images = [c for c in reader.connections if c.topic == "/camera/image_raw"]
             assert sum(1 for _ in reader.messages(connections=images)) == row["frames"]

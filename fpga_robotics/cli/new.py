@@ -16,6 +16,7 @@ from importlib import resources
 from pathlib import Path
 
 from fpga_robotics.cli.errors import UsageError
+from fpga_robotics.sim.files import default_dir_mode
 
 __all__ = ["main", "write_project"]
 
@@ -59,6 +60,7 @@ def write_project(folder):
             target = staging / relative
             target.parent.mkdir(parents=True, exist_ok=True)
             target.write_text(text, encoding="utf-8")
+        os.chmod(staging, default_dir_mode())  # mkdtemp's folder is private
         if folder.exists():
             folder.rmdir()  # empty: checked above
         staging.rename(folder)

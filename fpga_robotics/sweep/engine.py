@@ -21,7 +21,7 @@ from pathlib import Path
 
 from fpga_robotics.hw.errors import UsageError
 
-from ..sim.files import write_atomic
+from ..sim.files import default_dir_mode, write_atomic
 from . import fork_groups, runner
 from .results import make_row
 
@@ -354,6 +354,7 @@ def _save_bag(out_dir, run_id, files):
     staging = Path(tempfile.mkdtemp(prefix=f".{run_id}.", dir=bags))
     for name, data in files.items():
         (staging / name).write_bytes(data)
+    os.chmod(staging, default_dir_mode())  # mkdtemp's folder is private
     final = bags / run_id
     if final.exists():
         shutil.rmtree(final)
