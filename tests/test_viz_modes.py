@@ -73,6 +73,7 @@ def private_ports(monkeypatch):
             "rerun+http://10.0.0.2:9000/proxy",
         ),
         ("serve", "serve", "d.rrd", None),
+        ("serve:127.0.0.1", "serve", "d.rrd", None),
         ("off", "off", "d.rrd", None),
     ],
 )
@@ -93,6 +94,8 @@ def test_parse_valid_modes(text, kind, path, url):
         ("off:1", "takes no argument"),
         ("connect:http://localhost:9876", "not a rerun viewer URL"),
         ("connect:rerun+http://localhost:port/proxy", "port"),
+        ("serve:999.1.1.1", "not an IP address"),
+        ("serve:192.0.2.1", "not an address of this machine"),  # TEST-NET-1: never local
         (42, "must be a string"),
     ],
 )

@@ -11,8 +11,8 @@ Modes (the string a user types):
 - ``off`` record nothing;
 - ``auto`` (or ``None``) ``spawn`` where a display exists, else ``save`` to the default path.
 
-Parsing only looks at the string; the file system and the network are checked when the
-recorder opens.
+Parsing looks at the string, and for ``serve:IP`` whether that address is this machine's; the
+file system and the rest of the network are checked when the recorder opens.
 """
 
 import ipaddress
@@ -22,6 +22,7 @@ from dataclasses import dataclass
 from urllib.parse import urlsplit
 
 from .errors import ViewerError
+from .net import port_is_free
 from .outfile import check_rrd_name
 
 __all__ = [
@@ -110,13 +111,14 @@ def _check_url(url):
 
 
 def _check_bind(address):
+    hint = "use serve (this machine only) or serve:0.0.0.0 (every network interface)"
     try:
-        return str(ipaddress.ip_address(address))
+        bind = str(ipaddress.ip_address(address))
     except ValueError:
-        raise ViewerError(
-            f"serve:{address}: not an IP address to listen on; use serve (this machine only) "
-            "or serve:0.0.0.0 (every network interface)"
-        ) from None
+        raise ViewerError(f"serve:{address}: not an IP address to listen on; {hint}") from None
+    if not port_is_free(bind, 0):  # port 0: any port, so only the address is tried
+        raise ViewerError(f"serve:{address}: not an address of this machine; {hint}")
+    return bind
 
 
 def parse_mode(mode, default_path, *, environ=None, platform=None):
