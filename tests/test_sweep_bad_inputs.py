@@ -66,6 +66,7 @@ def test_bad_campaign_file_is_one_line_and_exit_2(case, tmp_path, monkeypatch, c
         (["--seeds", "5-1"], "is empty"),
         (["--scheduler", "tcp://127.0.0.1:9", "--workers", "2"], "--workers sizes"),
         (["nonexistent_campaign"], "unknown campaign"),
+        (["--record", "none", "--log-every", "3"], "--log-every shapes the recordings"),
     ],
 )
 def test_bad_options_are_one_line_and_exit_2(argv, message, tmp_path):

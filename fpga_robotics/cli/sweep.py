@@ -282,6 +282,10 @@ def main(argv=None, prog=PROG):
             "--bag writes the recorded runs as ROS 2 bags: it needs --record "
             "failing (the default) or all"
         )
+    if args.log_every is not None and args.record == "none":
+        raise UsageError(
+            "--log-every shapes the recordings: it needs --record failing (the default) or all"
+        )
     try:
         rows = run_campaign(
             campaign,
