@@ -26,6 +26,7 @@ __all__ = [
     "atomic_path",
     "check_output_dir",
     "check_output_path",
+    "check_paths_apart",
     "default_dir_mode",
     "default_file_mode",
     "write_atomic",
@@ -115,6 +116,44 @@ def check_output_dir(path, *, what="output folder"):
     else:
         _check_folder(_existing_ancestor(path), path, what)
     return path
+
+
+def _relation(path, other):
+    """How ``path`` lies to ``other`` (both resolved): the same, inside it, holding it, or
+    apart (None)."""
+    if path == other:
+        return "is the same path as"
+    if other in path.parents:
+        return "is inside"
+    if path in other.parents:
+        return "holds"
+    return None
+
+
+def check_paths_apart(outputs, inputs=()):
+    """Refuse outputs that would overwrite one another or an input of the same job.
+
+    ``outputs`` and ``inputs`` are ``(name, path)`` pairs, ``name`` saying where the path comes
+    from (``"--summary"``); a folder (a bag, a folder of images) holds all below it. Raises
+    ``OutputPathError`` naming both paths when two outputs are the same path or one is inside
+    the other, or an output is an input, is inside one or holds one.
+    """
+    resolved = [(name, str(path), Path(path).resolve()) for name, path in outputs]
+    for index, (name, path, real) in enumerate(resolved):
+        for other_name, other_path, other_real in resolved[:index]:
+            relation = _relation(real, other_real)
+            if relation:
+                raise OutputPathError(
+                    f"{name} {path!r} {relation} {other_name} {other_path!r}; "
+                    "give each output its own path"
+                )
+        for input_name, input_path in inputs:
+            relation = _relation(real, Path(input_path).resolve())
+            if relation:
+                raise OutputPathError(
+                    f"{name} {path!r} {relation} the input {input_name} {str(input_path)!r}; "
+                    "give the output a path outside the inputs"
+                )
 
 
 class PendingOutput:

@@ -100,6 +100,14 @@ CASES = [
     ),
     ("negative max-frames", ["run", "--source", "{frames}", "--max-frames", "-1"], "--max-frames"),
     ("log-every zero", ["run", "--log-every", "0", "--rerun", "save:x.rrd"], "--log-every"),
+    # run: options that would do nothing
+    ("log-every without a recording", ["run", "--log-every", "5", "--rerun", "off"], "--log-every"),
+    (
+        "camera format without a recording",
+        ["run", "--record-camera", "rgb888", "--rerun", "off"],
+        "--record-camera",
+    ),
+    ("shadow backend without a shadow", ["run", "--shadow-backend", "model"], "give --shadow"),
     ("unknown backend", ["run", "--backend", "iverilog"], "invalid choice"),
     ("unknown camera format", ["run", "--record-camera", "rgb565"], "invalid choice"),
     ("video with no codec", ["run", "--save-video", "clip.mkv"], ".mp4"),
@@ -180,6 +188,49 @@ CASES = [
         "lidar above the ceiling",
         ["run", "--scenario", "corridor", "--set", "robot.sensors.0.height=2.6"],
         "below the ceiling",
+    ),
+    (
+        "serving on an address not of this machine",
+        ["run", "--rerun", "serve:192.0.2.1"],
+        "not an address of this machine",
+    ),
+    # run: outputs written over one another or over an input
+    (
+        "summary and recording to one file",
+        ["run", "--summary", "x.rrd", "--rerun", "save:x.rrd"],
+        "give each output its own path",
+    ),
+    (
+        "summary and video to one file",
+        ["run", "--save-video", "v.mp4", "--summary", "v.mp4"],
+        "--save-video 'v.mp4'",
+    ),
+    (
+        "summary inside the bag",
+        ["run", "--bag", "b", "--summary", "b/metadata.yaml"],
+        "is inside --bag 'b'",
+    ),
+    ("recording inside the bag", ["run", "--bag", "b", "--rerun", "save:b/x.rrd"], "--bag 'b'"),
+    ("video inside the bag", ["run", "--bag", "b", "--save-video", "b/v.mp4"], "--bag 'b'"),
+    (
+        "bag out over the bag source",
+        ["run", "--source", "bag:{bag}", "--bag", "{bag}"],
+        "the input --source",
+    ),
+    (
+        "summary into the bag source",
+        ["run", "--source", "bag:{bag}/bag.mcap", "--summary", "{bag}/s.json"],
+        "the input --source",
+    ),
+    (
+        "summary over the video source",
+        ["run", "--source", "{file}", "--summary", "{file}"],
+        "the input --source",
+    ),
+    (
+        "recording into the frames source",
+        ["run", "--source", "{frames}", "--rerun", "save:{frames}/r.rrd"],
+        "inside the input --source",
     ),
     # a 3D scenario without the realistic extra (MuJoCo not importable)
     ("3D scenario without the realistic extra", ["run", "--scenario", "divider_3d"], "MuJoCo"),

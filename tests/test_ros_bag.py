@@ -208,6 +208,28 @@ def test_cli_writes_the_bag_and_replaces_an_old_one(tmp_path, monkeypatch):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["out", "s.json"]
 
 
+@pytest.mark.parametrize("intruder", ["file", "folder"])
+def test_what_appears_at_the_bag_path_during_the_run_is_never_replaced(intruder, tmp_path):
+    # Only a bag is replaced: a file or a folder written there meanwhile stays, and the new
+    # bag is kept where the closing line says.
+    scenario = load_scenario("follow_person", [*OVERRIDES, "sim.duration=0.1"])
+    path = tmp_path / "out"
+    writer = open_bag_writer(path, scenario)
+    run_scenario(scenario, backend="model", on_frame=writer.log_frame)
+    if intruder == "file":
+        path.write_text("keep me\n")
+    else:
+        path.mkdir()
+        (path / "v.mp4").write_text("keep me\n")
+    line = writer.close()
+    kept = path if intruder == "file" else path / "v.mp4"
+    assert kept.read_text() == "keep me\n"
+    assert line.startswith("ROS 2 bag (3 frames) kept in ") and "not replaced" in line
+    staged = Path(line.split(" kept in ")[1].split(": ")[0])
+    messages, _ = _read_bag(staged)
+    assert len(messages["/camera/image_raw"]) == 3
+
+
 def test_camera_link_is_tilted_as_the_camera():
     """The sim's tilt is positive looking up; in ROS (x forward, y left, z up) the camera's
     x axis then points up: rotated by the tf's quaternion it gains +z."""

@@ -3,6 +3,7 @@
 import json
 import subprocess
 import sys
+from importlib import resources
 
 import pytest
 
@@ -98,6 +99,17 @@ def test_bad_duration_and_log_every(capsys):
     assert "--duration" in usage_error(["--duration", "0", "--rerun", "off"], capsys)
     err = usage_error(["--log-every", "0", "--duration", "0.1", "--backend", "model"], capsys)
     assert "log-every" in err or "log_every" in err
+
+
+def test_a_summary_over_the_scenario_file_is_refused(tmp_path, capsys):
+    scenario = tmp_path / "mine.toml"
+    text = (resources.files("fpga_robotics.scenario") / "shipped" / "divider.toml").read_text()
+    scenario.write_text(text)
+    argv = ["--scenario", str(scenario), "--backend", "model", "--duration", "0.1"]
+    err = usage_error([*argv, "--rerun", "off", "--summary", str(scenario)], capsys)
+    assert "is the same path as the input --scenario" in err and len(err.splitlines()) == 1
+    assert scenario.read_text() == text
+    assert [p.name for p in tmp_path.iterdir()] == ["mine.toml"]
 
 
 def test_list_scenarios(capsys):

@@ -50,7 +50,7 @@ from fpga_robotics.sim.backends.base import BackendError
 from fpga_robotics.sim.backends.foreign_choice import FOREIGN_BACKENDS, open_foreign_frames
 from fpga_robotics.sim.backends.port_map import load_port_map
 from fpga_robotics.sim.camera.render3d.renderer import Render3DUnavailable, load_mujoco
-from fpga_robotics.sim.files import check_output_path, write_json_atomic
+from fpga_robotics.sim.files import check_output_path, check_paths_apart, write_json_atomic
 from fpga_robotics.sim.pins import DesignError, PinError
 from fpga_robotics.sim.world.config import parse_world_config
 
@@ -141,17 +141,16 @@ def build_parser(prog="fpga-robotics run"):
         "connect[:URL], serve[:ADDRESS], off; default auto = spawn with a "
         "display, else save",
     )
+    # Recording options default to None, so that one given without a recording is refused.
     p.add_argument(
         "--log-every",
         type=int,
-        default=1,
         metavar="N",
-        help="log every Nth frame's images to the viewer",
+        help="log every Nth frame's images to the viewer (default 1: every frame)",
     )
     p.add_argument(
         "--record-camera",
         choices=("rgb444", "rgb888"),
-        default="rgb444",
         help="the camera frame in the recording: rgb444 (default) as the design receives it, "
         "each channel's top 4 bits; rgb888 the full 8-bit render (about 5 times the file)",
     )
@@ -676,14 +675,54 @@ def _recording_name(args, scenario):
 
 def _check_recording(args, name):
     """The ``--rerun`` mode and the file it would write, checked before any build: a run
-    never fails on its recording after the work."""
+    never fails on its recording after the work. Returns that file (None without one)."""
     if args.rerun == "off":
-        return
+        return None
     from fpga_robotics.viz.modes import parse_mode  # lazy: viz imports rerun (~1 s)
 
     mode = parse_mode(args.rerun, default_path=f"runs/{name}.rrd")
     if mode.path is not None:
         check_output_path(mode.path, what="recording")
+    return mode.path
+
+
+def _input_paths(args):
+    """The files and folders the run reads, as ``(option, path)``: no output may be one, be
+    inside one or hold one (a ``--source`` is often a real robot's recording, made once)."""
+    paths = [
+        ("--scenario", args.scenario),
+        ("--replay-inputs", args.replay_inputs),
+        ("--ports", args.ports),
+        ("--shadow-ports", args.shadow_ports),
+    ]
+    for option, reference in (("--design", args.design), ("--shadow", args.shadow)):
+        if reference is not None and reference.startswith("verilog:"):
+            paths += [(option, f) for f in reference[len("verilog:") :].split(",")]
+        elif reference is not None:
+            paths.append((option, reference.rpartition(":")[0]))  # FILE.py:Name
+    paths = [(option, Path(p).expanduser()) for option, p in paths if p]
+    paths = [(option, p) for option, p in paths if p.is_file()]  # not names: files read
+    if args.source is not None and args.source.startswith("bag:"):
+        from fpga_robotics.ros.bag_source import parse_bag_spec  # lazy: rosbags, for bags only
+
+        bag, _topic = parse_bag_spec(args.source)
+        # A ROS 2 bag is its folder, whichever of its files was named.
+        paths.append(("--source", bag.parent if bag.suffix in (".mcap", ".db3") else bag))
+    elif args.source is not None and not args.source.startswith("camera:"):
+        paths.append(("--source", Path(args.source)))  # a video file or a folder of images
+    return paths
+
+
+def _output_paths(args, recording):
+    """The files and folders the run writes, as ``(option, path)``; ``recording`` is the
+    ``--rerun`` mode's file."""
+    paths = [
+        ("--bag", args.bag),
+        ("the recording", recording),
+        ("--save-video", args.save_video),
+        ("--summary", args.summary),
+    ]
+    return [(option, path) for option, path in paths if path is not None]
 
 
 def _check_renderer(scenario):
@@ -698,19 +737,30 @@ def _check_renderer(scenario):
         raise UsageError(f'camera.renderer = "mujoco": {exc}') from None
 
 
+def _refuse_idle_options(args):
+    """Options that would do nothing, refused: those of the recording with ``--rerun off``,
+    ``--shadow-backend`` without a shadow."""
+    if args.log_every is not None and args.log_every < 1:
+        raise UsageError(f"--log-every must be >= 1, got {args.log_every}")
+    for option, value in (("--log-every", args.log_every), ("--record-camera", args.record_camera)):
+        if value is not None and args.rerun == "off":
+            raise UsageError(f"{option} shapes the recording: it does not go with --rerun off")
+    if args.shadow_backend is not None and args.shadow is None:
+        raise UsageError("--shadow-backend is the simulator of the --shadow design: give --shadow")
+
+
 def _open_recorder(args, name):
     if args.rerun == "off":
         return None
-    if args.log_every < 1:
-        raise UsageError(f"--log-every must be >= 1, got {args.log_every}")
     from fpga_robotics.viz import open_recorder  # lazy: viz imports rerun (~1 s)
 
+    # An option not given keeps open_recorder's default (every frame, rgb444).
+    options = {"log_every": args.log_every, "camera": args.record_camera}
     recorder = open_recorder(
         args.rerun,
         default_path=f"runs/{name}.rrd",
         app_id="fpga_robotics",
-        log_every=args.log_every,
-        camera=args.record_camera,
+        **{key: value for key, value in options.items() if value is not None},
     )
     for line in recorder.pop_notices():  # where a live viewer is, or why it fell back
         print(line, file=sys.stderr)
@@ -826,10 +876,10 @@ def main(argv=None, prog="fpga-robotics run"):
     if args.list_scenarios:
         return _list_scenarios()
 
+    inputs = _input_paths(args)  # before --design's file is taken into the scenario
     if args.seed is not None and not 0 <= args.seed <= MAX_SEED:
         raise UsageError(f"--seed must be in 0..{MAX_SEED}, got {args.seed}")
-    if args.log_every < 1:  # checked now, before a model is built
-        raise UsageError(f"--log-every must be >= 1, got {args.log_every}")
+    _refuse_idle_options(args)  # checked now, before a model is built
     if args.summary is not None:  # checked now, not after a long run
         check_output_path(args.summary, what="--summary")
     ros = RosOutputs(args)  # --bag, --live ...: checked now, not after a long run
@@ -839,7 +889,9 @@ def main(argv=None, prog="fpga-robotics run"):
     if args.target_color is not None:
         scenario = _dress_target(scenario, args.target_color)
     report_warnings(scenario, args.strict, sys.stderr, UsageError)
-    _check_recording(args, _recording_name(args, scenario))
+    recording = _check_recording(args, _recording_name(args, scenario))
+    # One output written over another, or over an input, would lose it: refused now.
+    check_paths_apart(_output_paths(args, recording), inputs)
     if args.source is not None:
         if args.shadow is not None:
             raise UsageError("--shadow runs in the closed loop only (not with --source)")

@@ -2,9 +2,10 @@
 
 A display connector like the rerun recorder (``viz.recorder``): ``log_frame(record)`` for
 every ``FrameRecord``, ``close()`` at the end. The bag is written into a hidden folder next to
-``PATH`` and renamed to ``PATH`` only when complete (an existing bag there is replaced); a run
-that fails or is interrupted leaves nothing behind (``abandon()``). The topics and their types
-are ``messages.TOPICS`` (and a LIDAR's ``/<name>/scan``, ``laser_scan``); ``ros2 bag info PATH`` and Foxglove open the result.
+``PATH`` and renamed to ``PATH`` only when complete (an existing bag there is replaced; anything
+else found there then is left alone, and the bag stays in the hidden folder, as ``close()``
+says); a run that fails or is interrupted leaves nothing behind (``abandon()``). The topics and
+their types are ``messages.TOPICS`` (and a LIDAR's ``/<name>/scan``, ``laser_scan``); ``ros2 bag info PATH`` and Foxglove open the result.
 """
 
 import contextlib
@@ -24,13 +25,17 @@ from .messages import TOPICS, TYPESTORE, FrameMessages, camera_geometry, topic_t
 __all__ = ["BagWriter", "check_bag_path", "open_bag_writer"]
 
 
+def _is_bag(path):
+    return path.is_dir() and (path / "metadata.yaml").is_file()
+
+
 def check_bag_path(path):
     """``PATH`` must be new, or a bag (a folder with ``metadata.yaml``) to replace, in a
     folder we can write; returns it as a ``Path``."""
     if path is None or str(path).strip() == "":
         raise UsageError("--bag: the path is empty; give a folder name for the bag")
     path = Path(path)
-    if path.exists() and not (path.is_dir() and (path / "metadata.yaml").is_file()):
+    if path.exists() and not _is_bag(path):
         what = "a folder that is not a ROS 2 bag" if path.is_dir() else "a file"
         raise UsageError(f"--bag {str(path)!r} exists and is {what}; give a new name")
     check_output_dir(path, what="--bag")  # a write is tried for real: os.access trusts root
@@ -98,10 +103,19 @@ class BagWriter:
         writer, self._writer = self._writer, None
         try:
             writer.close()
-            old = None
+        except BaseException:
+            shutil.rmtree(self._staging, ignore_errors=True)
+            raise
+        # Checked again now: something other than a bag may have been written there meanwhile.
+        if (self.path.exists() or self.path.is_symlink()) and not _is_bag(self.path):
+            return (
+                f"ROS 2 bag ({self.frames_logged} frames) kept in {self._tmp}: {self.path} is "
+                f"no longer a ROS 2 bag (something else was written there during the run), "
+                f"so it was not replaced"
+            )
+        try:
             if self.path.exists():  # a bag from an earlier run: replaced only now
-                old = self._staging / "old"
-                os.replace(self.path, old)
+                os.replace(self.path, self._staging / "old")
             os.replace(self._tmp, self.path)
         finally:
             shutil.rmtree(self._staging, ignore_errors=True)
