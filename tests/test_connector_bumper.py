@@ -61,7 +61,11 @@ def test_the_pin_is_poked_only_when_it_changes():
         ({"kind": "bumper", "margin": -1}, "robot.sensors[0].margin must be a number in 0..0.1"),
         ({"kind": "bumper", "colour": 1}, "unknown key 'colour' for a bumper"),
         ({"kind": "bumpr"}, "unknown connector kind 'bumpr'"),
-        ({"kind": "wheels"}, "declare it in [[robot.actuators]]"),
+        (
+            {"kind": "servo"},
+            "a 'servo' connector is an actuator; declare it in [[robot.actuators]]",
+        ),
+        ({"kind": "wheels"}, "robot.sensors[0].kind: the wheels are always there"),
         ({"kind": "bumper", "yaw_deg": 999}, "robot.sensors[0].yaw_deg must be a number"),
         ({"kind": "bumper", "ports": {"pushed": "x"}}, "has no pin 'pushed'"),
     ],

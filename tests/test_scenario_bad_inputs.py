@@ -254,6 +254,35 @@ CASES = [
         ["--set", "camera.ov7670.snr_db=1e300"],
         "camera.ov7670.snr_db must be <= 80",
     ),
+    # connector tables: the wheels are not declared, further cameras fit the room and the step
+    (
+        "wheels-declared",
+        ["--scenario", "corridor", "--set", 'robot.actuators=[{kind="wheels"}]'],
+        "robot.actuators[0].kind: the wheels are always there, bound in the design",
+    ),
+    (
+        "sensor-as-actuator",
+        ["--scenario", "corridor", "--set", 'robot.actuators=[{kind="lidar"}]'],
+        "robot.actuators[0]: a 'lidar' connector is a sensor; declare it in [[robot.sensors]]",
+    ),
+    (
+        "camera-above-ceiling",
+        ["--scenario", "turret", "--duration", "0.2", "--set", "robot.sensors.0.height=2.6"],
+        "robot.sensors[0].height 2.6 m must be below the ceiling (room.height 2.5 m)",
+    ),
+    (
+        "camera-on-the-floor",
+        ["--scenario", "turret", "--duration", "0.2", "--set", "robot.sensors.0.height=0"],
+        "robot.sensors[0] (camera 'turret'): give its height above the floor",
+    ),
+    (
+        "camera-faster-than-physics",
+        [
+            *("--scenario", "turret", "--duration", "0.2"),
+            *("--set", "robot.sensors.0.fps=150", "--set", "sim.physics_dt=0.01"),
+        ],
+        "robot.sensors[0].fps 150 is more than one frame a physics step (sim.physics_dt 0.01 s",
+    ),
 ]
 
 

@@ -310,8 +310,6 @@ def _camera(scenario, spec, index, seed, top, servos, people):
                 f"{where}: on = {p.on!r} names no servo; declare [[robot.actuators]] "
                 f'kind = "servo", name = {p.on!r}, or mount the camera on the body (no on)'
             )
-    if spec.mount.height <= 0:
-        raise UsageError(f"{where}: give its height above the floor (height = m, > 0)")
     if p.target is not None and p.target not in people:
         raise UsageError(
             f"{where}: target = {p.target!r} names no person; the people: {', '.join(people)}"

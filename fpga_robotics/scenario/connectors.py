@@ -22,11 +22,22 @@ __all__ = ["ConnectorSpec", "ConnectorTableKeys", "parse_connectors"]
 _NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]{0,31}")
 
 
+#: The wheels are always there, bound by the design (its motor_left and motor_right): no table
+#: declares them.
+_NOT_DECLARED = ("wheels",)
+
+
 def _kinds():
-    return ", ".join(sorted(CONNECTORS))
+    return ", ".join(sorted(k for k in CONNECTORS if k not in _NOT_DECLARED))
 
 
 def _kind(value):
+    if value in _NOT_DECLARED:
+        fail(
+            "the wheels are always there, bound in the design (its motor_left and "
+            "motor_right outputs, or its connectors attribute); leave this table out",
+            sub=":",
+        )
     if not isinstance(value, str) or value not in CONNECTORS:
         fail(f"unknown connector kind {value!r}; choose one of: {_kinds()}", sub=":")
     return value
@@ -67,6 +78,7 @@ class ConnectorSpec:
     mount: Mount
     params: object
     ports: dict = field(default_factory=dict)  # pin -> design port (overrides the design's)
+    where: str = ""  # the table, for messages: "robot.sensors[0]"
 
 
 def parse_connectors(robot):
@@ -89,8 +101,9 @@ def parse_connectors(robot):
             table = dict(common.model_extra)  # the mount's keys and the kind's own
             cls = CONNECTORS[kind]
             if cls.role != role:
+                article = "an" if cls.role == "actuator" else "a"
                 raise ConnectorError(
-                    f"{where}: a {kind!r} connector is an {cls.role}; "
+                    f"{where}: a {kind!r} connector is {article} {cls.role}; "
                     f"declare it in [[robot.{cls.role}s]]"
                 )
             name = common.name
@@ -107,5 +120,5 @@ def parse_connectors(robot):
                         f"{pin!r}; its pins: {', '.join(cls.pins)}"
                     )
             params = cls.parse(table, where)
-            specs.append(ConnectorSpec(kind, name, role, mount, params, dict(ports)))
+            specs.append(ConnectorSpec(kind, name, role, mount, params, dict(ports), where))
     return tuple(specs)

@@ -754,6 +754,32 @@ def _check_camera_geometry(camera, world):
         )
 
 
+def _check_further_cameras(connectors, sim, world):
+    """Each ``[[robot.sensors]]`` camera, as the body camera: between floor and ceiling, and
+    at most one frame a physics step (the rig captures at physics steps)."""
+    ceiling, dt = world.room.height, sim.physics_dt
+    for spec in connectors:
+        if spec.kind != "camera":
+            continue
+        height, fps = spec.mount.height, spec.params.fps
+        if height <= 0:
+            raise ScenarioError(
+                f"{spec.where} (camera {spec.name!r}): give its height above the floor "
+                "(height = m, > 0)"
+            )
+        if height >= ceiling:
+            raise ScenarioError(
+                f"{spec.where}.height {height:g} m must be below the ceiling (room.height "
+                f"{ceiling:g} m)"
+            )
+        if dt > spec.params.frame_period:
+            raise ScenarioError(
+                f"{spec.where}.fps {fps:g} is more than one frame a physics step "
+                f"(sim.physics_dt {dt:g} s: at most {1 / dt:g}); lower it or shorten "
+                "sim.physics_dt"
+            )
+
+
 def _sim(data, camera):
     k = _keys(SimKeys, data["sim"], "sim")
     period = camera.frame_period
@@ -1073,6 +1099,7 @@ def _build(data, source, overrides):
     world_config = _check_world(world)
     _check_camera_geometry(camera, world_config)
     _check_connectors_in_run(connectors, sim, world_config.room)
+    _check_further_cameras(connectors, sim, world_config)
     return Scenario(
         name=name,
         description=description,
