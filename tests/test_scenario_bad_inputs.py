@@ -28,6 +28,18 @@ FILES = {
     "[camera.ov7670]\nmax_gian = 8\n",
 }
 
+#: The shipped turret, short; its servo bound to a port, and a second camera on the pan one's bundle.
+TURRET = ("--scenario", "turret", "--duration", "0.2")
+SERVO = 'robot.actuators.0.ports={{angle="{}"}}'
+TWO_CAMERAS = (
+    'robot.sensors=[{kind="camera", name="pancam", height=0.2, ports={pixels="turret_pixels"}}, '
+    '{kind="camera", name="rear", height=0.3, yaw_deg=180, ports={pixels="turret_pixels"}}]'
+)
+TWO_CAMERAS_SAY = (
+    "robot.sensors[1] (rear) drives input 'turret_pixels__valid', which robot.sensors[0] "
+    "(pancam) drives too; bind it to another port bundle"
+)
+
 # (id, arguments, text the one line must contain)
 CASES = [
     # 5. absurd sizes: refused at load with the limit, instead of a silent hang
@@ -282,6 +294,52 @@ CASES = [
             *("--set", "robot.sensors.0.fps=150", "--set", "sim.physics_dt=0.01"),
         ],
         "robot.sensors[0].fps 150 is more than one frame a physics step (sim.physics_dt 0.01 s",
+    ),
+    # a servo's port: a 10-bit signed output, and in compressed timing a channel's
+    (
+        "servo-on-an-input",
+        [*TURRET, "--set", 'sim.timing="real_clock"', "--set", SERVO.format("color_sel")],
+        (
+            "the servo connector 'pan': pin 'angle' is out 10 bit(s) signed but port "
+            "'color_sel' of design 'turret_tracker' is in 3 bit(s)"
+        ),
+    ),
+    (
+        "servo-on-a-wider-output",
+        [*TURRET, "--set", 'sim.timing="real_clock"', "--set", SERVO.format("motor_left")],
+        "port 'motor_left' of design 'turret_tracker' is out 16 bit(s) signed",
+    ),
+    (
+        "servo-on-an-unsigned-output",
+        [*TURRET, "--set", SERVO.format("turret_centroid_x")],
+        "port 'turret_centroid_x' of design 'turret_tracker' is out 8 bit(s);",
+    ),
+    (
+        "servo-on-no-channel",
+        [*TURRET, "--set", SERVO.format("centroid_x")],
+        (
+            "in compressed timing a servo hears an output of a further camera's channel of "
+            "design 'turret_tracker' (servo_angle, turret_centroid_x, turret_found), not "
+            "'centroid_x'"
+        ),
+    ),
+    # one table drives a design input
+    (
+        "two-lidars-on-one-stream",
+        [
+            *("--scenario", "corridor", "--duration", "0.2"),
+            *("--set", 'robot.sensors=[{kind="lidar"}, {kind="lidar", yaw_deg=180}]'),
+        ],
+        (
+            "robot.sensors[1] (lidar1) drives input 'lidar__valid', which robot.sensors[0] "
+            '(lidar) drives too; bind it elsewhere with ports = {valid = "PORT", payload = "PORT"}'
+        ),
+    ),
+    ("two-cameras-on-one-bundle", [*TURRET, "--set", TWO_CAMERAS], TWO_CAMERAS_SAY),
+    (
+        "two-cameras-on-one-bundle-real-clock",
+        [*TURRET, "--set", TWO_CAMERAS, "--set", 'sim.timing="real_clock"'],
+        TWO_CAMERAS_SAY,
     ),
 ]
 

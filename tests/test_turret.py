@@ -204,6 +204,14 @@ def test_a_camera_on_a_missing_servo_is_a_clear_error(tmp_path):
         run_scenario(load_scenario(write(tmp_path, text)), backend="model")
 
 
+def test_a_servo_on_a_port_no_channel_gives_is_refused_from_python_too(tmp_path):
+    # The body camera's centroid_x is FollowTarget's output, not the turret channel's: in
+    # compressed timing nothing would ever command the servo.
+    text = TWO_CAMERAS.replace('kind = "servo"', 'kind = "servo"\nports = { angle = "centroid_x" }')
+    with pytest.raises(UsageError, match="in compressed timing a servo hears an output of a"):
+        run_scenario(load_scenario(write(tmp_path, text)), backend="model")
+
+
 def test_the_cameras_benchmark_prints_both_runs_and_their_ratio(capsys, tmp_path):
     import json
 

@@ -22,15 +22,11 @@ from fpga_robotics.cli.errors import UsageError
 from fpga_robotics.cli.parser import CommandParser
 from fpga_robotics.designs.builtin import TOPS
 from fpga_robotics.hw.pixel import COLOR_SELECT
+from fpga_robotics.loop.bindings import check_bindings, scenario_top
 from fpga_robotics.loop.compressed import make_backend
 from fpga_robotics.loop.continuation import continuation_summary, run_continued
 from fpga_robotics.loop.pin_shadow import is_design_reference
-from fpga_robotics.loop.real_clock import (
-    check_bindings,
-    format_extra_outputs,
-    make_pin_backend,
-    scenario_top,
-)
+from fpga_robotics.loop.real_clock import format_extra_outputs, make_pin_backend
 from fpga_robotics.loop.shadow import format_shadow, shadow_overrides
 from fpga_robotics.loop.sources import open_source, run_source
 from fpga_robotics.loop.timings import run_scenario
@@ -945,6 +941,7 @@ def main(argv=None, prog="fpga-robotics run"):
             check_bindings(shadow_scenario)
         design = _open_pin_design(args, scenario)
     else:
+        check_bindings(scenario)  # before the model is built
         design = _open_design(args, scenario.params, scenario.foreign)
     shadow = recorder = None
     completed = False

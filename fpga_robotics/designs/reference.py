@@ -92,6 +92,8 @@ class DesignSpec:
         A Verilog design's port map as read (``sim.backends.port_map.PortMap``).
     clocked : bool
         Whether it has a clock (an Amaranth design of one's own may have none).
+    signed : frozenset
+        The names of its ports of a signed shape (``ports`` has direction and width).
     """
 
     reference: str
@@ -104,6 +106,7 @@ class DesignSpec:
     top: Top = None
     port_map: object = None
     clocked: bool = True
+    signed: frozenset = frozenset()
 
     @property
     def camera(self):
@@ -210,6 +213,7 @@ def _builtin_spec(registered):
         return cached[1]
 
     component = build_component(registered, FollowTargetParams(), design_tables(registered, {}))
+    signed = signed_ports(component)
     ports = component_ports(component)
     bindings = bindings_of(component, ports, registered.bindings)
     extra = {n: n for n in extra_outputs_of(ports, bindings)}
@@ -225,7 +229,15 @@ def _builtin_spec(registered):
         takes_follow_target_params=registered.takes_follow_target_params,
     )
     spec = DesignSpec(
-        registered.name, "builtin", registered.description, ports, bindings, tuple(extra), {}, top
+        registered.name,
+        "builtin",
+        registered.description,
+        ports,
+        bindings,
+        tuple(extra),
+        {},
+        top,
+        signed=signed,
     )
     _TOP_SPECS[id(registered)] = (registered, spec)
     return spec
@@ -242,6 +254,7 @@ def _amaranth_spec(reference, frozen_params, _stamp):
     factory = functools.partial(_call, target, params, reference)
     component = factory()
     clocked = _check_elaborates(component, target, reference)
+    signed = signed_ports(component)
     ports = component_ports(component)
     bindings = bindings_of(component, ports)
     extra = extra_outputs_of(ports, bindings)
@@ -260,7 +273,16 @@ def _amaranth_spec(reference, frozen_params, _stamp):
         takes_follow_target_params=False,
     )
     return DesignSpec(
-        reference, "amaranth", description, ports, bindings, extra, params, top, clocked=clocked
+        reference,
+        "amaranth",
+        description,
+        ports,
+        bindings,
+        extra,
+        params,
+        top,
+        clocked=clocked,
+        signed=signed,
     )
 
 
@@ -535,6 +557,15 @@ def component_ports(component):
     with contextlib.suppress(Exception):
         Fragment.get(component, None)
     return ports
+
+
+def signed_ports(component):
+    """The names (as ``component_ports`` gives them) of the component's signed ports."""
+    from fpga_robotics.hw.verilog import verilog_ports  # lazy: Amaranth (~0.3 s)
+
+    return frozenset(
+        name for name, (value, _) in verilog_ports(component).items() if value.shape().signed
+    )
 
 
 def _connector_pins():

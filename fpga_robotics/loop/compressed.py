@@ -21,6 +21,7 @@ from fpga_robotics.checks.sensor_metrics import obstacle_metrics
 from fpga_robotics.checks.summary import DESIGN_OUTPUTS, compute_metrics, evaluate_checks, verdict
 from fpga_robotics.designs.builtin import TOPS
 from fpga_robotics.hw.pixel import color_select_value
+from fpga_robotics.loop.bindings import check_bindings
 from fpga_robotics.loop.camera_rig import CameraRig
 from fpga_robotics.loop.connectors import CameraConnector, MotorConnector, in_view
 from fpga_robotics.loop.connectors.camera import ExposureDrift, make_sensor
@@ -196,6 +197,7 @@ class ClosedLoop:
         self.comparison = ShadowComparison(shadow_label) if shadow is not None else None
         # Further cameras and pan servos ([[robot.sensors]] cameras, [[robot.actuators]]
         # servos); None without any, and then nothing below changes.
+        check_bindings(scenario)  # as the command line does before the design is built
         self.rig = CameraRig.build(scenario, self.world, self.seed, TOPS.get(scenario.top))
         # On a clocked backend the further cameras' channels run on the design too.
         clocked = getattr(design, "name", None) in PIN_CHANNEL_BACKENDS

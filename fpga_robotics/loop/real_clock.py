@@ -28,9 +28,15 @@ from collections import deque
 import numpy as np
 
 from fpga_robotics.checks.sensor_metrics import line_metrics, measurement_metrics
-from fpga_robotics.designs.builtin import build_component, connector_kinds, foreign_top
+from fpga_robotics.designs.builtin import build_component, connector_kinds
 from fpga_robotics.designs.reference import resolve_design, stream_ports
 from fpga_robotics.hw.errors import UsageError
+from fpga_robotics.loop.bindings import (
+    no_port,
+    port_misfit,
+    scenario_top,
+    unbound,
+)
 from fpga_robotics.loop.compressed import ClosedLoop, run_loop
 from fpga_robotics.loop.connectors import CONNECTORS, PinIO
 from fpga_robotics.loop.pin_shadow import MirroredPins, PinComparison
@@ -62,37 +68,6 @@ _FRAME_OUTPUTS = ("found", "proximity", "centroid_x", "centroid_leds")
 _FRAME_STROBE = "frame_done"
 #: Each connector's random stream: ``default_rng([seed, _CONNECTOR_STREAM, index])``.
 _CONNECTOR_STREAM = 0xC011
-
-
-def scenario_top(scenario):
-    """The ``Top`` (fpga_robotics.designs) the scenario runs: ``design.top`` resolved
-    (designs/reference.py: its bindings and extra outputs), or for a foreign Verilog design
-    (``design.verilog``) the one its port map describes."""
-    if scenario.foreign is not None:
-        return foreign_top(load_port_map(scenario.foreign.ports))
-    spec = resolve_design(scenario.top, scenario.design_params)
-    spec.require_clock()
-    return spec.top
-
-
-def check_bindings(scenario):
-    """``UsageError`` for a sensor pin that the scenario's design binds to no port: checked
-    from the design's declarations and the port map, before a model is built."""
-    top = scenario_top(scenario)
-    for spec in scenario.connectors:
-        if spec.kind in ("camera", "servo"):  # the rig's (loop/camera_rig.py)
-            continue
-        binding = {**top.bindings.get(spec.kind, {}), **spec.ports}
-        for pin in CONNECTORS[spec.kind].pins:
-            if binding.get(pin) is None:
-                raise _unbound(spec.kind, spec.name, top, pin)
-
-
-def _unbound(kind, name, top, pin):
-    return UsageError(
-        f"the {kind} connector {name!r}: design {top.name!r} has no port for its pin "
-        f'{pin!r}; bind one with ports = {{{pin} = "PORT"}} in its [[robot.sensors]] table'
-    )
 
 
 def pin_design_source(scenario):
@@ -170,15 +145,6 @@ def format_extra_outputs(summary):
         f"  design output {name}: last {v['last']}, min {v['min']}, max {v['max']}"
         for name, v in extra.items()
     ]
-
-
-def _port_fits(port, pin):
-    """Whether design ``port`` can be connector ``pin``: of its width, or for a signed output
-    pin (the wheels' DPS, a servo's angle) a narrower signed output, which the backends read
-    sign-extended."""
-    if port.width == pin.width:
-        return True
-    return pin.direction == "out" and pin.signed and port.signed and port.width < pin.width
 
 
 class _PendingRow:
@@ -282,7 +248,8 @@ class RealClockLoop(ClosedLoop):
             for servo in self.rig.servos.values():
                 servo.port = servo.port or self.top.bindings.get("servo", {}).get("angle")
                 if servo.port is not None:  # sampled, as the wheels (run_design_to)
-                    self.io[servo] = PinIO(design, {"angle": servo.port}, self.clock_hz)
+                    binding = self._checked(servo, {"angle": servo.port})
+                    self.io[servo] = PinIO(design, binding, self.clock_hz)
         self._check_inputs_driven()
         if shadow is not None:
             self._mirror_connectors(getattr(shadow, "connector_bindings", {}), specs)
@@ -328,32 +295,15 @@ class RealClockLoop(ClosedLoop):
 
     def _checked(self, conn, binding):
         ports = self.pins.ports
-        for pin, spec in conn.pins.items():
+        for pin in conn.pins:
             port = binding.get(pin)
             if port is None:
-                raise _unbound(conn.kind, conn.name, self.top, pin)
+                raise unbound(conn.kind, conn.name, self.top, pin)
             if port not in ports:
-                raise UsageError(
-                    f"the {conn.kind} connector {conn.name!r}: design {self.top.name!r} has "
-                    f"no port {port!r} (for pin {pin!r}); its ports: {', '.join(sorted(ports))}"
-                )
-            p = ports[port]
-            if p.direction != spec.direction or not _port_fits(p, spec):
-                extended = spec.direction == "out" and spec.signed
-                raise UsageError(
-                    f"the {conn.kind} connector {conn.name!r}: pin {pin!r} is {spec.direction} "
-                    f"{spec.width} bit(s){' signed' if extended else ''} but port {port!r} of "
-                    f"design {self.top.name!r} is {p.direction} {p.width} bit(s)"
-                    f"{' signed' if p.signed else ''}"
-                    + (
-                        "; the line_sensors table must list as many sensors as the design's "
-                        "line input has bits (design.line.n_sensors)"
-                        if conn.kind == "line_sensors"
-                        else f"; a signed output of at most {spec.width} bits is sign-extended"
-                        if extended
-                        else ""
-                    )
-                )
+                raise no_port(conn.kind, conn.name, self.top, pin, port, ports)
+            misfit = port_misfit(conn.kind, conn.name, self.top, pin, ports[port])
+            if misfit is not None:
+                raise UsageError(misfit)
         return binding
 
     def _mirror_connectors(self, bindings, specs):

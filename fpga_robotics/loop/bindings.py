@@ -1,0 +1,175 @@
+"""What a scenario's connectors bind to, checked from the design's declarations before a model
+is built (``check_bindings``), and the test a pin's port passes (``port_misfit``), which the
+real-clock loop applies again to the ports of the built design (a Verilog design's are known
+only then).
+"""
+
+import importlib
+
+from fpga_robotics.designs.builtin import TOPS, foreign_top
+from fpga_robotics.designs.reference import resolve_design
+from fpga_robotics.hw.errors import UsageError
+from fpga_robotics.loop.connectors import CONNECTORS
+from fpga_robotics.sim.backends.port_map import load_port_map
+from fpga_robotics.sim.pins import Port
+
+__all__ = ["check_bindings", "port_misfit", "scenario_top", "unbound"]
+
+
+def scenario_top(scenario):
+    """The ``Top`` (fpga_robotics.designs) the scenario runs: ``design.top`` resolved
+    (designs/reference.py: its bindings and extra outputs), or for a foreign Verilog design
+    (``design.verilog``) the one its port map describes."""
+    if scenario.foreign is not None:
+        return foreign_top(load_port_map(scenario.foreign.ports))
+    spec = resolve_design(scenario.top, scenario.design_params)
+    spec.require_clock()
+    return spec.top
+
+
+def check_bindings(scenario):
+    """``UsageError`` for a connector binding the scenario's design cannot take, from the
+    design's declarations and the port map, before a model is built: a sensor pin bound to
+    no port, a design input two tables drive, a servo's port of the wrong kind."""
+    if not scenario.connectors:
+        return
+    top = scenario_top(scenario)
+    for spec in scenario.connectors:
+        if spec.kind in ("camera", "servo"):  # the rig's (loop/camera_rig.py)
+            continue
+        binding = {**top.bindings.get(spec.kind, {}), **spec.ports}
+        for pin in CONNECTORS[spec.kind].pins:
+            if binding.get(pin) is None:
+                raise unbound(spec.kind, spec.name, top, pin)
+    registered = TOPS.get(scenario.top) if scenario.foreign is None else None
+    _check_single_drivers(scenario, top, registered)
+    for spec in scenario.connectors:
+        if spec.kind == "servo":
+            _check_servo(scenario, spec, top, registered)
+
+
+def unbound(kind, name, top, pin):
+    return UsageError(
+        f"the {kind} connector {name!r}: design {top.name!r} has no port for its pin "
+        f'{pin!r}; bind one with ports = {{{pin} = "PORT"}} in its [[robot.sensors]] table'
+    )
+
+
+def no_port(kind, name, top, pin, port, ports):
+    return UsageError(
+        f"the {kind} connector {name!r}: design {top.name!r} has no port {port!r} (for pin "
+        f"{pin!r}); its ports: {', '.join(sorted(ports))}"
+    )
+
+
+def port_misfit(kind, name, top, pin, port):
+    """Why design ``port`` (a ``sim.pins.Port``) cannot be connector pin ``pin`` of the
+    ``kind`` connector ``name``, or None when it can: of the pin's direction and width, or
+    for a signed output pin (the wheels' DPS, a servo's angle) a narrower signed output, which
+    the backends read sign-extended."""
+    spec = CONNECTORS[kind].pins[pin]
+    fits = port.width == spec.width or (
+        spec.direction == "out" and spec.signed and port.signed and port.width < spec.width
+    )
+    if port.direction == spec.direction and fits:
+        return None
+    extended = spec.direction == "out" and spec.signed
+    if kind == "line_sensors":
+        hint = (
+            "; the line_sensors table must list as many sensors as the design's line input "
+            "has bits (design.line.n_sensors)"
+        )
+    else:
+        hint = (
+            f"; a signed output of at most {spec.width} bits is sign-extended" if extended else ""
+        )
+    return (
+        f"the {kind} connector {name!r}: pin {pin!r} is {spec.direction} {spec.width} bit(s)"
+        f"{' signed' if extended else ''} but port {port.name!r} of design {top.name!r} is "
+        f"{port.direction} {port.width} bit(s){' signed' if port.signed else ''}{hint}"
+    )
+
+
+def _check_single_drivers(scenario, top, registered):
+    """Each design input is driven by one table: two LIDARs on one stream, or two cameras on
+    one port bundle, would mix their data on the same pins."""
+    drivers = {}  # design input -> the table that drives it
+    for spec in scenario.connectors:
+        for port in _inputs_driven(spec, top, registered):
+            other = drivers.setdefault(port, spec)
+            if other is not spec:
+                if spec.kind == "camera":
+                    how = (
+                        'to another port bundle with ports = {pixels = "BUNDLE"}, or drop its '
+                        "ports to film only"
+                    )
+                else:
+                    pins = ", ".join(f'{pin} = "PORT"' for pin in _input_pins(spec.kind))
+                    how = f"elsewhere with ports = {{{pins}}}, or leave it out"
+                raise UsageError(
+                    f"{spec.where} ({spec.name}) drives input {port!r}, which {other.where} "
+                    f"({other.name}) drives too; bind it {how}"
+                )
+
+
+def _input_pins(kind):
+    return [pin for pin, spec in CONNECTORS[kind].pins.items() if spec.direction == "in"]
+
+
+def _inputs_driven(spec, top, registered):
+    """The design inputs a connector table drives: a camera's port bundle (and its colour
+    select), a sensor's input pins as bound."""
+    if spec.kind == "camera":
+        bundle = spec.ports.get("pixels")
+        if bundle is None:
+            return []  # films only
+        channel = _channel_class(registered, bundle)
+        color = spec.ports.get("color_sel", getattr(channel, "color_port", None))
+        return [f"{bundle}__valid", f"{bundle}__payload", *([color] if color else [])]
+    binding = {**top.bindings.get(spec.kind, {}), **spec.ports}
+    return [binding[pin] for pin in _input_pins(spec.kind) if binding.get(pin) is not None]
+
+
+def _channel_class(registered, bundle):
+    """The frame-level model of the channel on pixel bundle ``bundle`` of ``registered`` (a
+    built-in ``Top``: only those have further-camera channels), or None."""
+    where = (registered.frame_channels if registered is not None else {}).get(bundle)
+    if where is None:
+        return None
+    module, name = where
+    return getattr(importlib.import_module(module), name)
+
+
+def _check_servo(scenario, spec, top, registered):
+    """A servo's port: in compressed timing an output of one of the design's further-camera
+    channels (nothing else runs then), and an output of the servo's 10 bits, signed."""
+    port = spec.ports.get("angle") or top.bindings.get("servo", {}).get("angle")
+    if port is None:
+        return  # a servo the design does not drive stays at rest
+    if scenario.sim.timing == "compressed":
+        channels = registered.frame_channels if registered is not None else {}
+        outputs = sorted(
+            {
+                name
+                for bundle in channels
+                for name in _channel_class(registered, bundle).output_ports
+            }
+        )
+        if port not in outputs:
+            raise UsageError(
+                f"the servo connector {spec.name!r}: in compressed timing a servo hears an "
+                f"output of a further camera's channel of design {top.name!r} "
+                f"({', '.join(outputs) or 'it has none'}), not {port!r}; bind it to one, or "
+                'run sim.timing = "real_clock"'
+            )
+    if scenario.foreign is not None:
+        return  # a Verilog design's ports are known once it is built (RealClockLoop)
+    design = resolve_design(scenario.top, scenario.design_params)
+    if port not in design.ports:
+        raise no_port("servo", spec.name, top, "angle", port, design.ports)
+    direction, width = design.ports[port]
+    misfit = port_misfit(
+        "servo", spec.name, top, "angle", Port(port, width, direction, port in design.signed)
+    )
+    if misfit is not None:
+        raise UsageError(misfit)
