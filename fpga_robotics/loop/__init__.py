@@ -3,7 +3,8 @@
 ``timings.py`` runs a scenario in the timing it asks for: ``compressed.py`` runs a camera
 frame's pixels back to back (the default for FollowTarget), ``real_clock.py`` every design
 cycle at its instant of world time; ``connectors/`` are what the design's pins see of the
-world and do to it; ``shadow.py`` runs a second design on the same frames; ``checkpoint.py`` saves and restores a loop's world at a frame boundary,
+world and do to it, ``bindings.py`` checks what the scenario's connectors bind to before a
+design is built; ``shadow.py`` runs a second design on the same frames; ``checkpoint.py`` saves and restores a loop's world at a frame boundary,
 ``fork.py`` (frames) and ``pin_fork.py`` (real clock, with ``pin_journal.py``: a pin design's
 calls, replayed) run design variants from a reference run's recordings and checkpoints
 (``reference_data.py``: a frame-level reference in a picklable form, for another process),
