@@ -195,9 +195,9 @@ class ClosedLoop:
         # A second design on the same frames, never driving the robot (fpga_robotics.loop.shadow).
         self.shadow = shadow
         self.comparison = ShadowComparison(shadow_label) if shadow is not None else None
+        check_bindings(scenario)  # as the command line does, before it builds the design
         # Further cameras and pan servos ([[robot.sensors]] cameras, [[robot.actuators]]
         # servos); None without any, and then nothing below changes.
-        check_bindings(scenario)  # as the command line does before the design is built
         self.rig = CameraRig.build(scenario, self.world, self.seed, TOPS.get(scenario.top))
         # On a clocked backend the further cameras' channels run on the design too.
         clocked = getattr(design, "name", None) in PIN_CHANNEL_BACKENDS
