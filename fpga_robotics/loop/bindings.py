@@ -6,11 +6,11 @@ only then).
 
 import importlib
 
-from fpga_robotics.designs.builtin import TOPS, foreign_top
+from fpga_robotics.designs.builtin import TOPS, connector_kinds, foreign_top
 from fpga_robotics.designs.reference import resolve_design
 from fpga_robotics.hw.errors import UsageError
 from fpga_robotics.loop.connectors import CONNECTORS
-from fpga_robotics.sim.backends.port_map import load_port_map
+from fpga_robotics.sim.backends.port_map import check_connector_names, load_port_map
 from fpga_robotics.sim.pins import Port
 
 __all__ = ["check_bindings", "port_misfit", "scenario_top", "unbound"]
@@ -21,7 +21,9 @@ def scenario_top(scenario):
     (designs/reference.py: its bindings and extra outputs), or for a foreign Verilog design
     (``design.verilog``) the one its port map describes."""
     if scenario.foreign is not None:
-        return foreign_top(load_port_map(scenario.foreign.ports))
+        port_map = load_port_map(scenario.foreign.ports)
+        check_connector_names(port_map, connector_kinds())  # before its bindings are read
+        return foreign_top(port_map)
     spec = resolve_design(scenario.top, scenario.design_params)
     spec.require_clock()
     return spec.top

@@ -32,6 +32,7 @@ __all__ = [
     "Output",
     "PortMap",
     "PortMapError",
+    "check_connector_names",
     "check_connectors",
     "check_widths",
     "follow_target_port_map",
@@ -602,25 +603,33 @@ def check_widths(port_map, ports, pixels=None):
         )
 
 
-def check_connectors(port_map, ports, kinds):
-    """Check ``port_map``'s ``[connectors]`` against the design's ``ports`` (as for
-    ``check_widths``) and the connector ``kinds`` the application knows: kind -> {pin: (direction
-    seen from the design, "in" or "out"; at most this many bits)}. ``PortMapError`` names the
-    key of the first problem."""
+def check_connector_names(port_map, kinds):
+    """Check that ``port_map``'s ``[connectors]`` name connector ``kinds`` the application
+    knows and their pins (``check_connectors``' first checks; no design needed)."""
     for kind, pins in port_map.connectors.items():
         if kind not in kinds:
             raise PortMapError(
                 f"port map: connectors.{kind}: unknown connector kind; known: "
                 f"{', '.join(sorted(kinds))}"
             )
+        for pin in pins:
+            if pin not in kinds[kind]:
+                raise PortMapError(
+                    f"port map: connectors.{kind}.{pin}: the {kind} connector has no pin "
+                    f"{pin!r}; its pins: {', '.join(kinds[kind])}"
+                )
+
+
+def check_connectors(port_map, ports, kinds):
+    """Check ``port_map``'s ``[connectors]`` against the design's ``ports`` (as for
+    ``check_widths``) and the connector ``kinds`` the application knows: kind -> {pin: (direction
+    seen from the design, "in" or "out"; at most this many bits)}. ``PortMapError`` names the
+    key of the first problem."""
+    check_connector_names(port_map, kinds)
+    for kind, pins in port_map.connectors.items():
         known = kinds[kind]
         for pin, port in pins.items():
             key = f"connectors.{kind}.{pin}"
-            if pin not in known:
-                raise PortMapError(
-                    f"port map: {key}: the {kind} connector has no pin {pin!r}; "
-                    f"its pins: {', '.join(known)}"
-                )
             if port not in ports:
                 raise PortMapError(
                     f"port map: {key}: the design {port_map.top} has no port "
