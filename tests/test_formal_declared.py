@@ -2,6 +2,7 @@
 ``fpga-robotics formal --design REF`` proves a true one and gives the counterexample of a
 false one."""
 
+import textwrap
 from pathlib import Path
 
 import pytest
@@ -137,3 +138,147 @@ def test_a_false_property_fails_with_its_counterexample(capsys, tmp_path):
     assert lines[3].strip() == f"counterexample: {trace}"
     assert "$enddefinitions" in trace.read_text()
     assert lines[-1].startswith("0 of 1 checks passed")
+
+
+def _counters_with(tmp_path, extra):
+    """counters.py with the classes ``extra`` appended, as a file of one's own."""
+    path = tmp_path / "mine.py"
+    path.write_text((DESIGNS / "counters.py").read_text() + textwrap.dedent(extra))
+    return path
+
+
+def _line_of(path, text):
+    return next(i for i, line in enumerate(path.read_text().splitlines(), 1) if text in line)
+
+
+@pytest.mark.formal
+def test_an_unreached_cover_names_its_statement(tmp_path):
+    """SymbiYosys lists the unreached covers on the lines after its header: each is named,
+    file and line, and a reached one is not."""
+    path = _counters_with(
+        tmp_path,
+        '''
+        class NeverPast(Saturating):
+            def formal_covers(self, m):
+                """full, and one past the limit"""
+                m.d.comb += Cover(self.full)
+                m.d.comb += Cover(self.count == self.limit + 1)  # never
+        ''',
+    )
+    check = formal.design_checks(f"{path}:NeverPast")[1]
+    result = formal.run_check(check)
+    line = _line_of(path, "# never")
+    assert (result.status, result.detail) == ("FAIL", f"unreached cover statement {path}:{line}")
+
+
+@pytest.mark.formal
+def test_assumptions_that_contradict_each_other_are_said_so(tmp_path):
+    path = _counters_with(
+        tmp_path,
+        '''
+        class Contradicting(Saturating):
+            formal_mode = "bmc"
+            def formal_properties(self, m):
+                """count is always 3"""
+                m.d.comb += [Assume(self.up & ~self.up), Assert(self.count == 3)]
+        ''',
+    )
+    result = formal.run_check(formal.design_checks(f"{path}:Contradicting")[0], depth=3)
+    assert result.status == "error"
+    assert result.detail.startswith("the design's assumptions contradict each other by step 0")
+    assert result.detail.endswith("(SymbiYosys: engine_0: Assumptions are unsatisfiable!)")
+
+
+@pytest.mark.parametrize(
+    "extra, message",
+    [
+        ('formal_mode = "induct"', 'formal_mode must be "bmc" or "prove", not \'induct\''),
+        ("formal_depth = 0", "formal_depth must be a whole number of cycles, at least 1, not 0"),
+        ('formal_depth = "5"', "formal_depth must be a whole number of cycles, at least 1"),
+        ("formal_cover_depth = 2.5", "formal_cover_depth must be a whole number of cycles"),
+        (
+            "def formal_properties(self, m):\n    raise ValueError('boom')  # raises",
+            "formal_properties raised ValueError: boom (mine.py:LINE)",
+        ),
+        (
+            "def formal_properties(self, m):\n    m.d.comb += self.full.eq(1)",
+            "formal_properties raised DriverConflict: Signal (sig full) bit 0 driven from",
+        ),
+        (
+            "def formal_covers(self, m):\n    pass",
+            "formal_covers adds no Cover statement; add one (m.d.comb += Cover(...))",
+        ),
+    ],
+)
+def test_a_bad_declaration_is_one_line_before_any_check(extra, message, tmp_path, capsys):
+    body = textwrap.indent(extra, "    ")
+    path = _counters_with(tmp_path, f"\n\nclass Bad(Saturating):\n{body}\n")
+    if "LINE" in message:
+        message = message.replace("LINE", str(_line_of(path, "# raises")))
+    code, out, err = _cli(["formal", "--design", f"{path}:Bad", "--trace-dir", "t"], capsys)
+    assert (code, out) == (2, "")  # no table started
+    assert err.startswith(f"fpga-robotics formal: error: design Bad: {message}")
+    assert err.count("\n") == 1
+
+
+TWO_TOPS = """\
+module counter (input clk, input up, output reg [3:0] count);
+  initial count = 0;
+  always @(posedge clk) if (up && count <= 4'd9) count <= count + 1;
+`ifdef FORMAL
+  always @(*) assert(count <= 4'd10);
+  /* always @(*) cover(count == 4'd12); */
+`endif
+endmodule
+
+module other (input clk, output reg x);
+  initial x = 0;
+  always @(posedge clk) x <= 1;
+`ifdef FORMAL
+  always @(*) cover(x);
+`endif
+endmodule
+"""
+
+
+def test_a_verilog_file_with_two_tops_asks_which_one(tmp_path, capsys):
+    path = tmp_path / "counter.v"
+    path.write_text(TWO_TOPS)
+    code, out, err = _cli(["formal", "--design", f"verilog:{path}", "--list"], capsys)
+    assert (code, out) == (2, "") and err.count("\n") == 1
+    assert "2 modules no other instantiates (counter, other): mark the one to check" in err
+
+
+def test_the_checks_are_those_of_the_top_yosys_uses(tmp_path, capsys):
+    """Marked (* top *), other is checked: its cover, not counter's assertion. Marked the
+    other way, counter's assertion only: its cover is inside a comment."""
+    path = tmp_path / "counter.v"
+    path.write_text(TWO_TOPS.replace("module other", "(* top *) module other"))
+    code, out, _ = _cli(["formal", "--design", f"verilog:{path}", "--list"], capsys)
+    assert code == 0
+    assert [line.split()[:2] for line in out.splitlines()] == [["other.covers", "cover"]]
+    path.write_text("(* top *)\n" + TWO_TOPS)
+    code, out, _ = _cli(["formal", "--design", f"verilog:{path}", "--list"], capsys)
+    assert code == 0
+    assert [line.split()[:2] for line in out.splitlines()] == [["counter.asserts", "prove"]]
+    path.write_text(
+        TWO_TOPS.replace("module other", "(* top *) module other").replace(
+            "cover(x)", "assume(x == 0)"
+        )
+    )
+    code, out, err = _cli(["formal", "--design", f"verilog:{path}", "--list"], capsys)
+    assert (code, out) == (2, "")
+    assert "no assert or cover statement to check in module other or under it" in err
+
+
+def test_verilog_yosys_cannot_read_or_a_missing_top_is_one_line(tmp_path):
+    path = tmp_path / "counter.v"
+    path.write_text(TWO_TOPS.replace("x <= 1;", "x <= ;"))
+    with pytest.raises(UsageError, match=r"Yosys cannot read the Verilog: counter.v:12: ERROR"):
+        formal.design_checks(f"verilog:{path}")
+    path.write_text(TWO_TOPS)
+    ports = DESIGNS / "bump_stop_noreset_ports.toml"
+    with pytest.raises(
+        UsageError, match=r"no module bump_stop_noreset \(the port map's top\); its modules: "
+    ):
+        formal.design_checks(f"verilog:{path}", ports=str(ports))

