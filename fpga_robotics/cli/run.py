@@ -142,7 +142,7 @@ def build_parser(prog="fpga-robotics run"):
         "--log-every",
         type=int,
         metavar="N",
-        help="log every Nth frame's images to the viewer (default 1: every frame)",
+        help="log every Nth frame's images to the viewer (default: 1)",
     )
     p.add_argument(
         "--record-camera",
