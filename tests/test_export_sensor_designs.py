@@ -161,7 +161,13 @@ def test_options_reach_the_design(tmp_path):
             ["--top", "follow_line", "--stop-mm", "3"],
             "--stop-mm applies to --top follow_target_safe",
         ),
-        (["--variant", "us_echo_inverted"], "--variant names a seeded bug of a sensor design"),
+        (
+            ["--variant", "us_echo_inverted"],
+            "--variant us_echo_inverted is a seeded bug of --top follow_target_safe",
+        ),
+        (["--variant", "lidar_bearing_mirrored"], "bug of --top corridor_follow: it needs --top"),
+        (["--variant", "turret_pan_inverted"], "it needs --top turret_tracker"),
+        (["--variant", "nope"], "unknown --variant 'nope'; known variants: line_inverted"),
         (
             ["--top", "follow_line", "--variant", "us_echo_inverted"],
             "is a variant of --top follow_target_safe",

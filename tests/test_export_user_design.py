@@ -4,6 +4,7 @@ direction its signature declares (the independent expectation: Amaranth's own
 clock and the built-in tops' options are one line, exit 2, nothing written."""
 
 import re
+import shutil
 from pathlib import Path
 
 import pytest
@@ -86,6 +87,7 @@ def test_a_port_named_clk_is_one_line(tmp_path, capsys):
         (["--kp-num", "7", "--preset", "published"], "--preset, --kp-num: FollowTarget's options"),
         (["--us-clock-hz", "5"], "--us-clock-hz applies to --top follow_target_safe, not to"),
         (["--variant", "stuck_left"], "--variant names a seeded bug of a built-in top"),
+        (["--seed", "0"], "--top, --board, --bitstream and --seed go without it"),
     ],
 )
 def test_options_of_the_built_in_tops_are_refused(options, message, tmp_path, capsys):
@@ -106,3 +108,69 @@ def test_mutate_refuses_them_with_the_same_words(capsys):
         "mutants are judged against the unmutated design (give its parameters as --param "
         "NAME=VALUE)\n"
     )
+
+
+def test_a_verilog_design_is_said_to_be_verilog_already(tmp_path, capsys):
+    # Not asked for a port map first: export has no --ports.
+    out = tmp_path / "x.v"
+    argv = ["export", "--design", f"verilog:{DESIGNS}/WallStop.v", "-o", str(out)]
+    code, text, err = _cli(argv, capsys)
+    assert code == 2 and text == ""
+    assert err == (
+        f"fpga-robotics export: error: --design verilog:{DESIGNS}/WallStop.v is Verilog "
+        "already: nothing to export\n"
+    )
+    assert not out.exists()
+
+
+def test_the_output_may_not_be_the_design_s_own_file(tmp_path, capsys, monkeypatch):
+    source = tmp_path / "wall_stop.py"
+    shutil.copy(DESIGNS / "wall_stop.py", source)
+    monkeypatch.chdir(tmp_path)
+    code, text, err = _cli(
+        ["export", "--design", "./wall_stop.py:WallStop", "-o", str(source)], capsys
+    )
+    assert code == 2 and text == "" and err.count("\n") == 1
+    assert f"-o {str(source)!r} is the same path as the input --design 'wall_stop.py'" in err
+    assert source.read_bytes() == (DESIGNS / "wall_stop.py").read_bytes()
+
+
+@pytest.mark.parametrize(
+    "options",
+    [
+        ["--stop-mm", "250", "--resume-mm", "300"],
+        ["--diff-min", "5", "--variant", "us_echo_inverted"],
+    ],
+)
+def test_a_built_in_name_takes_its_own_options_as_top_does(options, tmp_path, capsys):
+    by_design, by_top, plain = tmp_path / "d.v", tmp_path / "t.v", tmp_path / "p.v"
+    for argv in (
+        ["--design", "follow_target_safe", *options, "-o", str(by_design)],
+        ["--top", "follow_target_safe", *options, "-o", str(by_top)],
+        ["--top", "follow_target_safe", "-o", str(plain)],
+    ):
+        code, _, err = _cli(["export", *argv], capsys)
+        assert code == 0, err
+    assert by_design.read_text() == by_top.read_text() != plain.read_text()
+
+
+@pytest.mark.parametrize(
+    "design, params, message",
+    [
+        ("follow_target", ["diff_min=5"], "takes its own options instead: --diff-min 5"),
+        (
+            "follow_target_safe",
+            ["stop_mm=200", "kp_num=2"],
+            "takes its own options instead: --stop-mm 200 --kp-num 2",
+        ),
+        ("follow_line", ["stop_mm=200"], "follow_line has no option for stop_mm"),
+    ],
+)
+def test_param_with_a_built_in_name_names_the_options(design, params, message, tmp_path, capsys):
+    out = tmp_path / "x.v"
+    argv = ["export", "--design", design, "-o", str(out)]
+    argv += [item for param in params for item in ("--param", param)]
+    code, text, err = _cli(argv, capsys)
+    assert code == 2 and text == "" and err.count("\n") == 1
+    assert "--param sets a parameter of a design of your own" in err and message in err
+    assert not out.exists()

@@ -7,6 +7,7 @@
     fpga-robotics export --top follow_line [--line-n-sensors 2 --variant ...]
     fpga-robotics export --top corridor_follow[_uart] [--corridor-keep-mm 500 --variant ...]
     fpga-robotics export --design my_design.py:MyDesign [--param NAME=VALUE ...] -o x.v
+    fpga-robotics export --design follow_target_safe [--stop-mm 250 ...]   (= --top NAME)
 
 ``--top`` picks the design (default ``follow_target``; docs/sensor_designs.md describes the
 sensor designs, docs/lidar.md the corridor followers), and the Verilog module is named after it. Every ``FollowTargetParams`` field is an
@@ -19,6 +20,7 @@ the top does not read prints what is wrong and exits with code 2.
 
 import os
 from dataclasses import fields
+from pathlib import Path
 
 from fpga_robotics.cli.board import add_board_arguments, run_board
 from fpga_robotics.cli.designs import _params
@@ -33,9 +35,10 @@ from fpga_robotics.cli.sensor_options import (
     SENSOR_GROUPS,
     add_sensor_arguments,
     given_options,
+    sensor_option,
     sensor_params_from_args,
 )
-from fpga_robotics.designs.reference import resolve_design
+from fpga_robotics.designs.reference import is_builtin, resolve_design
 from fpga_robotics.flow.export import TOPS, check_port_names, generate_top_verilog
 from fpga_robotics.hw.corridor_follow import CorridorFollow
 from fpga_robotics.hw.corridor_follow_uart import CorridorFollowUart
@@ -46,7 +49,7 @@ from fpga_robotics.hw.turret_params import TurretParams
 from fpga_robotics.hw.turret_tracker import TurretTracker
 from fpga_robotics.hw.variants import VARIANTS, variant_params
 from fpga_robotics.hw.verilog import TOP_NAME, generate_verilog
-from fpga_robotics.sim.files import check_output_path, write_atomic
+from fpga_robotics.sim.files import check_output_path, check_paths_apart, write_atomic
 
 __all__ = ["build_parser", "main"]
 
@@ -76,7 +79,7 @@ def build_parser(prog="fpga-robotics export"):
         metavar="REF",
         help="a design of your own instead of --top: FILE.py:Name or "
         "package.module:Name (docs/your_design.md); the module is named "
-        "after Name",
+        "after Name (a built-in design's name is --top NAME, with its options)",
     )
     parser.add_argument(
         "--param",
@@ -96,7 +99,19 @@ def main(argv=None, prog="fpga-robotics export"):
     parser = build_parser(prog)
     args = parser.parse_args(argv)  # a bad option: one line, exit 2
     if args.design is not None:
-        return _export_design(args)
+        if (
+            args.top != TOP_NAME
+            or args.board is not None
+            or args.bitstream
+            or args.seed is not None
+        ):
+            raise UsageError(
+                "--design exports one design as a Verilog file: --top, --board, --bitstream "
+                "and --seed go without it (fpga-robotics board --design REF puts it on a board)"
+            )
+        if not is_builtin(args.design.strip()):
+            return _export_design(args)
+        _take_builtin_as_top(args)
     if args.design_params:
         raise UsageError("--param sets a parameter of a --design REF (a design of your own)")
     _check_options_fit_the_top(args)
@@ -187,9 +202,13 @@ def _check_options_fit_the_top(args):
                 f"{', '.join(given)} applies to --top {' or '.join(tops)}, not to --top {args.top}"
             )
     if args.variant is not None and args.top == TOP_NAME:
+        if args.variant not in VARIANTS:
+            raise UsageError(
+                f"unknown --variant {args.variant!r}; known variants: {', '.join(VARIANTS)}"
+            )
+        top = VARIANTS[args.variant].design
         raise UsageError(
-            "--variant names a seeded bug of a sensor design: it needs --top "
-            "follow_target_safe or --top follow_line"
+            f"--variant {args.variant} is a seeded bug of --top {top}: it needs --top {top}"
         )
     if args.top != TOP_NAME and args.board is not None:
         raise UsageError(
@@ -219,13 +238,37 @@ def _is_follow_target_option(dest):
     return dest == "preset" or dest in {f.name for f in fields(FollowTargetParams) if f.init}
 
 
+def _take_builtin_as_top(args):
+    """``--design NAME`` of a built-in design is ``--top NAME``, with that top's options."""
+    name = args.design.strip()
+    if args.design_params:
+        params = [item.partition("=") for item in args.design_params]
+        options = [(_option_for(name, key.strip()), key, value) for key, _, value in params]
+        unknown = [key for option, key, _ in options if option is None]
+        if unknown:
+            raise UsageError(
+                f"--param sets a parameter of a design of your own; the built-in design {name} "
+                f"has no option for {', '.join(unknown)} (fpga-robotics export --help)"
+            )
+        raise UsageError(
+            f"--param sets a parameter of a design of your own; the built-in design {name} "
+            f"takes its own options instead: {' '.join(f'{o} {v}' for o, _, v in options)}"
+        )
+    args.top, args.design = name, None
+
+
+def _option_for(top, name):
+    """The option that sets parameter ``name`` of the built-in ``top`` (None if none does)."""
+    if top not in _NO_FOLLOW_TARGET and _is_follow_target_option(name):
+        return "--" + name.replace("_", "-")
+    return sensor_option(top, name)
+
+
 def _export_design(args):
     """``--design REF``: any Amaranth design of one's own as Verilog, its module named after
     the class or function the reference names; its other options must not be given."""
-    if args.top != TOP_NAME or args.board is not None or args.bitstream:
-        raise UsageError(
-            "--design exports a design of your own: --top, --board and --bitstream go without it"
-        )
+    if args.design.strip().startswith("verilog:"):  # said before its port map is asked for
+        raise UsageError(f"--design {args.design} is Verilog already: nothing to export")
     # Options of the built-in tops would be silently ignored: refused, as mutate does.
     refuse_followtarget_options(args, "--design REF exports a design of your own")
     for key, (_, _, _, tops) in SENSOR_GROUPS.items():
@@ -237,10 +280,10 @@ def _export_design(args):
             )
     if args.variant is not None:
         raise UsageError("--variant names a seeded bug of a built-in top: it goes without --design")
+    if args.output is not None:  # Verilog written over the design's own file would lose it
+        check_paths_apart([("-o", args.output)], _design_file(args.design))
     spec = resolve_design(args.design, _params(args.design_params))
-    if spec.kind == "verilog":
-        raise UsageError(f"--design {args.design} is Verilog already: nothing to export")
-    name = spec.reference.rpartition(":")[2] if spec.kind != "builtin" else spec.reference
+    name = spec.reference.rpartition(":")[2]
     output = args.output if args.output is not None else os.path.join("build", f"{name}.v")
     if os.path.isdir(output):
         raise UsageError(
@@ -253,3 +296,9 @@ def _export_design(args):
     write_atomic(output, text, what="Verilog file")
     print(f"wrote {output} (module {name}, {len(spec.ports)} ports)")
     return 0
+
+
+def _design_file(reference):
+    """``[("--design", FILE.py)]`` of a ``FILE.py:Name`` reference, else ``[]``."""
+    path = Path(reference.strip().rpartition(":")[0]).expanduser()
+    return [("--design", path)] if path.is_file() else []

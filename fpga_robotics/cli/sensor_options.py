@@ -15,7 +15,13 @@ from fpga_robotics.hw.sensor_params import (
 )
 from fpga_robotics.hw.variants import VARIANTS, variant_params
 
-__all__ = ["SENSOR_GROUPS", "add_sensor_arguments", "given_options", "sensor_params_from_args"]
+__all__ = [
+    "SENSOR_GROUPS",
+    "add_sensor_arguments",
+    "given_options",
+    "sensor_option",
+    "sensor_params_from_args",
+]
 
 _CORRIDOR_TOPS = ("corridor_follow", "corridor_follow_uart")
 
@@ -75,6 +81,15 @@ def add_sensor_arguments(parser):
         help="a seeded buggy variant of the top: "
         + "; ".join(f"{v.name} (--top {v.design}: {v.bug})" for v in VARIANTS.values()),
     )
+
+
+def sensor_option(top, name):
+    """The option that sets parameter ``name`` of the sensor design ``top`` (None if none
+    does): ``sensor_option("follow_target_safe", "stop_mm")`` is ``"--stop-mm"``."""
+    for cls, prefix, _, tops in SENSOR_GROUPS.values():
+        if top in tops and name in {f.name for f in _option_fields(cls)}:
+            return _option(prefix, name)
+    return None
 
 
 def given_options(args, key):
