@@ -541,3 +541,100 @@ def test_follow_target_options_with_a_design_are_refused(options, given, tmp_pat
     assert code == 2 and text == "" and err.count("\n") == 1, err
     assert f"{given}: FollowTarget's options; --design REF puts a design of your own" in err
     assert not (tmp_path / "b").exists()
+
+
+def test_a_declared_camera_gets_the_camera_and_the_switches(tmp_path, capsys):
+    # NearRedCam binds the camera's stream to `cam` and its colour select to `sel`, as a run
+    # binds them (tests/test_user_designs.py runs it): the OV7670's capture feeds `cam`, the
+    # DIP switches `sel`, as they feed NearRed's `pixels` and `color_sel`.
+    out = tmp_path / "b"
+    argv = ["board", "--design", f"{DESIGNS}/near_red_cam.py:NearRedCam", "-o", str(out)]
+    code, text, err = _cli(argv, capsys)
+    assert code == 0, err
+    assert "header" not in text
+    instances = _board_instances((out / "ulx3s_follow_target.v").read_text())
+    design, capture = instances["design"], instances["capture"]
+    assert design["cam__payload"] == capture["pixels__payload"]
+    assert instances["color_select"]["color_sel"] == "sel"
+    lpf = (out / "ulx3s_follow_target.lpf").read_text()
+    for site in ("B11", "A8", "C8", "B8", "H4"):  # camera data 0, pclk, href, vsync, siod
+        assert f'SITE "{site}";' in lpf
+    assert "switch_0__io" in lpf
+
+
+def test_a_camera_binding_without_a_stream_is_one_line(tmp_path, capsys):
+    design = tmp_path / "sel_only.py"
+    design.write_text(
+        "from amaranth import Module, signed\n"
+        "from amaranth.lib import wiring\n"
+        "from amaranth.lib.wiring import In, Out\n\n\n"
+        "class SelOnly(wiring.Component):\n"
+        '    connectors = {"camera": {"color_sel": "sel"}}\n'
+        "    sel: In(3)\n"
+        "    motor_left: Out(signed(16))\n"
+        "    motor_right: Out(signed(16))\n\n"
+        "    def elaborate(self, platform):\n"
+        "        m = Module()\n"
+        "        m.d.sync += self.motor_left.eq(self.sel)\n"
+        "        return m\n"
+    )
+    out = tmp_path / "b"
+    code, text, err = _cli(["board", "--design", f"{design}:SelOnly", "-o", str(out)], capsys)
+    assert code == 2 and text == ""
+    assert err == (
+        "fpga-robotics board: error: design SelOnly: its camera binding names no pixel stream "
+        "('pixels'); the board's camera gives one\n"
+    )
+    assert not out.exists()
+
+
+def test_ports_with_an_amaranth_design_is_refused(tmp_path, capsys):
+    # As run, formal and mutate refuse it: the map would be silently ignored.
+    out = tmp_path / "b"
+    ports = DESIGNS / "bump_stop_noreset_ports.toml"
+    argv = ["board", "--design", WALL_STOP, "--ports", str(ports), "-o", str(out)]
+    code, text, err = _cli(argv, capsys)
+    assert code == 2 and text == ""
+    assert err == (
+        "fpga-robotics board: error: --ports is the port map of a Verilog design: it goes "
+        "with --design verilog:FILES\n"
+    )
+    assert not out.exists()
+
+
+@pytest.mark.parametrize(
+    "design, options, message",
+    [
+        (
+            "follow_target_safe",
+            ["--diff-min", "5"],
+            (
+                "--diff-min: the built-in design follow_target_safe goes on the board at its "
+                "default parameters; with others, export its Verilog (fpga-robotics export --top "
+                "follow_target_safe ...) and give that as --design verilog:FILE.v --ports MAP"
+            ),
+        ),
+        (
+            "turret_tracker",
+            ["--param", "stop_mm=200"],
+            (
+                "--param stop_mm=200: the built-in design turret_tracker goes on the board at its "
+                "default parameters"
+            ),
+        ),
+        (
+            "follow_target",
+            ["--kp-num", "2"],
+            (
+                "--kp-num: design 'follow_target' is the board's own top: run fpga-robotics board "
+                "without --design, with its options"
+            ),
+        ),
+    ],
+)
+def test_parameters_of_a_built_in_design_say_what_to_do(design, options, message, tmp_path, capsys):
+    out = tmp_path / "b"
+    code, text, err = _cli(["board", "--design", design, *options, "-o", str(out)], capsys)
+    assert code == 2 and text == "" and err.count("\n") == 1, err
+    assert message in err
+    assert not out.exists()

@@ -10,11 +10,12 @@ from fpga_robotics.cli.errors import UsageError
 from fpga_robotics.cli.mutate import _design_params
 from fpga_robotics.cli.param_options import (
     add_param_arguments,
+    given_followtarget_options,
     params_from_args,
     refuse_followtarget_options,
 )
 from fpga_robotics.cli.parser import CommandParser
-from fpga_robotics.designs.reference import resolve_design
+from fpga_robotics.designs.reference import is_builtin, resolve_design
 from fpga_robotics.flow.board import (
     board_factory,
     board_names,
@@ -138,6 +139,13 @@ def main(argv=None, prog="fpga-robotics board"):
     params = params_from_args(args)
     design = None
     if args.design is not None:
+        reference = args.design.strip()
+        if args.ports is not None and not reference.startswith("verilog:"):
+            raise UsageError(
+                "--ports is the port map of a Verilog design: it goes with --design verilog:FILES"
+            )
+        if is_builtin(reference):
+            _refuse_builtin_parameters(args, reference)
         # The board top's own options would be silently ignored with a design of one's own.
         refuse_followtarget_options(args, "--design REF puts a design of your own on the board")
         design = resolve_design(args.design, _design_params(args.param), ports=args.ports)
@@ -148,4 +156,24 @@ def main(argv=None, prog="fpga-robotics board"):
         )
     return run_board(
         args, params, args.output or os.path.join("build", args.board), prog, design=design
+    )
+
+
+def _refuse_builtin_parameters(args, name):
+    """A built-in design goes on the board at its default parameters: an option or
+    ``--param`` for it is a usage error saying so (it would be ignored, or sent to
+    ``--param``, which a built-in design does not take)."""
+    given = given_followtarget_options(args) + [f"--param {item}" for item in args.param]
+    if not given:
+        return
+    options = ", ".join(given)
+    if name == "follow_target":
+        raise UsageError(
+            f"{options}: design 'follow_target' is the board's own top: run fpga-robotics "
+            "board without --design, with its options (--diff-min 5, ...)"
+        )
+    raise UsageError(
+        f"{options}: the built-in design {name} goes on the board at its default parameters; "
+        f"with others, export its Verilog (fpga-robotics export --top {name} ...) and give "
+        "that as --design verilog:FILE.v --ports MAP"
     )

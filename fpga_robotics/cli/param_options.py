@@ -92,14 +92,20 @@ def params_from_args(args):
         raise UsageError(f"bad design parameter: {exc}") from None
 
 
-def refuse_followtarget_options(args, consequence):
-    """``UsageError`` naming the FollowTarget options given (``--preset``, its parameters,
-    ``--against`` where the command has it), as typed: with ``--design REF`` they would be
-    silently ignored; ``consequence`` says what the command does instead."""
+def given_followtarget_options(args):
+    """The FollowTarget options given (``--preset``, its parameters, ``--against`` where the
+    command has it), as typed: ``["--preset", "--kp-num"]``."""
     given = [name for name in ("preset", "against") if getattr(args, name, None) is not None]
     given += [f.name for f in fields(FollowTargetParams) if getattr(args, f.name, None) is not None]
+    return ["--" + name.replace("_", "-") for name in given]
+
+
+def refuse_followtarget_options(args, consequence):
+    """``UsageError`` naming the FollowTarget options given: with ``--design REF`` they would
+    be silently ignored; ``consequence`` says what the command does instead."""
+    given = given_followtarget_options(args)
     if given:
-        options = ", ".join("--" + name.replace("_", "-") for name in given)
+        options = ", ".join(given)
         raise UsageError(
             f"{options}: FollowTarget's options; {consequence} (give its parameters as "
             "--param NAME=VALUE)"

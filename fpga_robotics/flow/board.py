@@ -93,19 +93,19 @@ def _label_clocks(board, report):
     ]
 
 
-#: Inputs the board drives itself when the design has them (the camera's stream, the DIP
-#: switches' colour code).
-_CAMERA_INPUTS = ("pixels__valid", "pixels__payload", "color_sel")
-#: The same of a pan camera (the turret application's second camera).
+#: Inputs the board drives itself when the design has them: a pan camera's stream and the
+#: DIP switches' colour code for it (the turret application's second camera).
 _TURRET_INPUTS = ("turret_pixels__valid", "turret_pixels__payload", "turret_color_sel")
 
 
 def board_ports(spec, board="ulx3s-85f"):
     """How a design of one's own (``spec``, a resolved Amaranth ``DesignSpec``) meets the
-    board: ``{"camera": bool, "servo": port or None, "header": [(port, "i"|"o")]}``. A port
-    the board cannot serve is a ``UserError`` naming it: the wheels must be
-    ``motor_left``/``motor_right`` (signed, at most 16 bits), a servo's angle an output of at
-    most 10 bits (sent with the wheels over SPI, one servo), ``color_sel`` 3 bits, ``centroid_leds`` at most 8 bits, every other
+    board: ``{"camera": bool, "servo": port or None, "header": [(port, "i"|"o")], "wheels":
+    {pin: port}, "camera_pins": {pin: port}}``, the wheels and the camera bound as a run binds
+    them. A port the board cannot serve is a ``UserError`` naming it: the wheels must be
+    ``motor_left``/``motor_right`` or bound as such (signed, at most 16 bits), a servo's angle
+    an output of at most 10 bits (sent with the wheels over SPI, one servo), the camera a
+    pixel stream, its colour select 3 bits, ``centroid_leds`` at most 8 bits, every other
     input a 1-bit pin of a connector (it goes to a header pin), and there are
     ``len(HEADER_SITES)`` header pins."""
 
@@ -132,9 +132,20 @@ def board_ports(spec, board="ulx3s-85f"):
                 f"design {name}: port {port!r} (the wheels' {pin}) is {ports[port][1]} bits; "
                 f"the GoPiGo3 takes at most 16 (signed DPS)"
             )
-    camera = "camera" in bindings
+    # The camera's ports as the run binds them (a declaration may name them otherwise).
+    camera = bindings.get("camera", {})
+    if camera and "pixels" not in camera:
+        raise UserError(
+            f"design {name}: its camera binding names no pixel stream ('pixels'); the board's "
+            "camera gives one"
+        )
+    camera_inputs = (
+        {f"{camera['pixels']}__valid", f"{camera['pixels']}__payload", camera.get("color_sel")}
+        if camera
+        else set()
+    )
     turret = all(ports.get(p, ("",))[0] == "in" for p in _TURRET_INPUTS[:2])
-    for on, port in ((camera, "color_sel"), (turret, "turret_color_sel")):
+    for on, port in ((camera, camera.get("color_sel")), (turret, "turret_color_sel")):
         if on and ports.get(port, ("in", 3))[1] != 3:
             raise UserError(
                 f"design {name}: port {port!r} is {ports[port][1]} bits; the board's "
@@ -156,7 +167,7 @@ def board_ports(spec, board="ulx3s-85f"):
     }
     header = []
     for port, (direction, width) in ports.items():
-        if port in wheels.values() or port == servo or (camera and port in _CAMERA_INPUTS):
+        if port in wheels.values() or port == servo or port in camera_inputs:
             continue
         if turret and port in _TURRET_INPUTS:
             continue
@@ -180,25 +191,26 @@ def board_ports(spec, board="ulx3s-85f"):
             f"design {name}: {len(header)} connector pins, the board's header has {len(free)} free"
         )
     return {
-        "camera": camera,
+        "camera": bool(camera),
         "turret_camera": turret,
         "servo": servo,
         "header": header,
         "wheels": wheels,
+        "camera_pins": camera,
     }
 
 
-class _BoundWheels(Elaboratable):
-    """``design`` as the board top reads it: the outputs its wheels binding names (the
-    binding a run uses, ``DesignSpec.bindings``) as ``motor_left``/``motor_right``, every
-    other member its own."""
+class _BoundPorts(Elaboratable):
+    """``design`` as the board top reads it: the ports its wheels and camera bindings name
+    (the bindings a run uses, ``DesignSpec.bindings``) as ``motor_left``/``motor_right``,
+    ``pixels`` and ``color_sel``, every other member its own."""
 
-    def __init__(self, design, wheels):
-        self._design, self._wheels = design, dict(wheels)
+    def __init__(self, design, bound):
+        self._design, self._bound = design, dict(bound)
 
     def __getattr__(self, name):
-        wheels = self.__dict__.get("_wheels", {})
-        return getattr(self.__dict__["_design"], wheels.get(name, name))
+        bound = self.__dict__.get("_bound", {})
+        return getattr(self.__dict__["_design"], bound.get(name, name))
 
     def elaborate(self, platform):
         return self._design
@@ -220,8 +232,9 @@ def _user_factory(spec):
             design = VerilogOnBoard(spec.port_map, servo=wiring["servo"], header=wiring["header"])
         else:
             design = spec.build()
-            if any(pin != port for pin, port in wiring["wheels"].items()):
-                design = _BoundWheels(design, wiring["wheels"])
+            bound = {**wiring["wheels"], **wiring["camera_pins"]}
+            if any(pin != port for pin, port in bound.items()):
+                design = _BoundPorts(design, bound)
         return platform, ULX3SUserDesign(
             design,
             header=wiring["header"],
