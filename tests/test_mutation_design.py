@@ -5,6 +5,7 @@ The independent expectation is a Python model of ``Saturating`` (tests/data/user
 counters.py): the unmutated netlist's trace must be the model's, and a mutant is caught
 exactly when its trace differs from the model's."""
 
+import html
 import json
 import re
 from pathlib import Path
@@ -453,6 +454,41 @@ def test_robot_judge_of_a_camera_design(tmp_path, capsys):
     assert never_drives
     for m in never_drives:
         assert judged[m["index"]]["failed_checks"] == ["mean_distance_max_m"]
+
+
+@pytest.mark.slow  # a Verilator build of the mutant netlist, closed-loop runs of its mutants
+def test_a_design_s_blind_spots_are_recorded_and_reported(tmp_path, capsys):
+    """``mutate --design verilog:... --campaign C --recordings 1``, as FollowTarget's: the
+    closest run of the first blind spot is recorded, report.html lists every blind spot. In
+    3 s the robot never reaches the wall, so every unit-caught mutant is a blind spot. The
+    unit judge of 100 cycles takes far under 0.01 s: its rate is still the mutants over its
+    time, at least the mutants over the whole command's."""
+    import time
+
+    from bump_mutate import DATA, mutate_bump_stop
+
+    campaign = tmp_path / "bump.toml"
+    campaign.write_text(f'scenarios = ["{DATA / "bump_wall.toml"}"]\nseeds = "0"\nduration = 3.0\n')
+    out = tmp_path / "m"
+    more = ["--mutants", "6", "--cycles", "100", "--campaign", str(campaign), "--workers", "1"]
+    t0 = time.perf_counter()
+    code, text, _ = mutate_bump_stop(out, capsys, *more, "--recordings", "1")
+    elapsed = time.perf_counter() - t0
+    assert code == 0
+    rate = int(re.search(r"unit judge (\d+) mutants/min", text)[1])
+    assert rate >= 60 * 6 / elapsed
+    result = json.loads((out / "mutants.json").read_text())
+    blind = [m for m in result["mutants"] if m["robot"] and not m["robot"]["caught"]]
+    assert len(blind) >= 2 and len(blind) == result["robot"]["judged"]
+    first = f"recordings/mutant{blind[0]['index']}.rrd"
+    assert [p.name for p in (out / "recordings").iterdir()] == [Path(first).name]
+    assert (out / first).stat().st_size > 0
+    assert text.count("  (recording ") == 1 and f"(recording {first})" in text
+    assert f"report: {out / 'report.html'}" in text
+    page = (out / "report.html").read_text()
+    assert "Mutation coverage of bump_stop" in page and f'<a href="{first}">' in page
+    for m in blind:
+        assert html.escape(m["describe"]) in page and html.escape(m["unit"]["effect"]) in page
 
 
 @pytest.mark.parametrize(

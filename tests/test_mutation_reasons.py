@@ -137,20 +137,53 @@ def test_the_unit_judge_keeps_the_frames_and_the_largest_differences():
     assert reason_class(v, 80) == "rare state"
 
 
+def _results(rows, robot, reasons=None):
+    """mutants.json's content for ``rows`` (``(Mutant, unit verdict)``), the robot verdicts
+    ``robot`` (``{index: verdict}``) and, for FollowTarget, the blind spots' ``reasons``
+    (``{index: reason}``), as ``mutate`` writes it."""
+    from fpga_robotics.mutation.scores import by_module, robot_score, unit_score
+
+    mutants = [m for m, _ in rows]
+    unit = {v.index: v.caught for _, v in rows}
+    caught = {k: v["caught"] for k, v in robot.items()}
+    return {
+        "unit": unit_score(unit),
+        "robot": robot_score(unit, caught),
+        "campaign": "mutation",
+        "baseline": {"runs": [["--scenario", "approach"]], "passing": [0]},
+        "modules": by_module(mutants, unit, caught),
+        "mutants": [
+            {
+                **m.__dict__,
+                "sources": list(m.sources),
+                "describe": m.describe(),
+                "unit": {"caught": v.caught, "effect": v.effect()},
+                "robot": robot.get(m.index),
+                **({"blind_spot_reason": reasons.get(m.index)} if reasons is not None else {}),
+            }
+            for m, v in rows
+        ],
+    }
+
+
+def _mutant(i, module, signal):
+    from fpga_robotics.sim.mutation import Mutant
+
+    return Mutant(i, "inv", module, "$1", "Y", 0, None, signal, 0, ("hw/x.py:1",), "")
+
+
+ROBOT = {
+    1: {"caught": False, "replay": "python -m fpga_robotics.run --runtime mutsel=1"},
+    2: {"caught": False, "replay": None},
+    3: {"caught": True, "status": "fail", "failed_checks": ["max_wheel_command_dps"]},
+}
+
+
 def test_the_report_gives_each_blind_spot_its_reason(tmp_path):
     """report.html: mutant 1 (only the filtered image differs) and 2 (a 1 px centroid error)
     are blind spots, each with its reason; mutant 3, caught by a run, has none."""
     from fpga_robotics.mutation.report import write_report
-    from fpga_robotics.sim.mutation import Mutant
 
-    def mutant(i, module, signal):
-        return Mutant(i, "inv", module, "$1", "Y", 0, None, signal, 0, ("hw/x.py:1",), "")
-
-    mutants = [
-        mutant(1, "color_filter", "filtered__payload"),
-        mutant(2, "tracker.counter", "px"),
-        mutant(3, "motor", "motor_left"),
-    ]
     filtered = _verdict(differing_frames=70, filtered=70)
     small = _verdict(
         differing_frames=21, centroid_x=21, max_difference={"centroid_x": 1, "motor_left": 3}
@@ -158,14 +191,15 @@ def test_the_report_gives_each_blind_spot_its_reason(tmp_path):
     wheel = _verdict(differing_frames=90, motor_left=90, max_difference={"motor_left": 4096})
     for k, v in enumerate((filtered, small, wheel), start=1):
         v.index = k
-    robot = {
-        1: {"caught": False, "replay": "python -m fpga_robotics.run --runtime mutsel=1"},
-        2: {"caught": False, "replay": None},
-        3: {"caught": True, "status": "fail", "failed_checks": ["max_wheel_command_dps"]},
-    }
-    baseline = {"runs": [["--scenario", "approach"]], "passing": [0]}
+    rows = [
+        (_mutant(1, "color_filter", "filtered__payload"), filtered),
+        (_mutant(2, "tracker.counter", "px"), small),
+        (_mutant(3, "motor", "motor_left"), wheel),
+    ]
+    reasons = {k: blind_spot_reason(v, W) for k, v in ((1, filtered), (2, small))}
+    results = _results(rows, ROBOT, reasons)
     path = write_report(
-        str(tmp_path), "mutation", mutants, [filtered, small, wheel], robot, baseline, {}, 160
+        str(tmp_path), results, {1: "recordings/mutant1.rrd"}, title="ft", inputs="the unit frames"
     )
     with open(path) as f:
         text = f.read()
@@ -177,3 +211,23 @@ def test_the_report_gives_each_blind_spot_its_reason(tmp_path):
     ) in text
     assert "Blind spots: caught by the unit judge, missed by every run (2)" in text
     assert "other: differs in 90" not in text and "max_wheel_command_dps" in text
+    assert '<a href="recordings/mutant1.rrd">' in text
+
+
+def test_a_design_s_report_has_no_reason_column(tmp_path):
+    """A design of one's own has no reason classes (they read FollowTarget's outputs): its
+    report lists the same blind spots without the column."""
+    from fpga_robotics.mutation.pin_judge import PinVerdict
+    from fpga_robotics.mutation.report import write_report
+
+    verdicts = [PinVerdict(k, True, 3, {"hit": True}, {"hit": (0, 1)}, 2000) for k in (1, 2, 3)]
+    rows = [(_mutant(v.index, "", "hit"), v) for v in verdicts]
+    path = write_report(
+        str(tmp_path), _results(rows, ROBOT), {}, title="BumpGuard", inputs="these inputs"
+    )
+    with open(path) as f:
+        text = f.read()
+    assert "Mutation coverage of BumpGuard" in text and "equivalent on these inputs" in text
+    assert "Blind spots: caught by the unit judge, missed by every run (2)" in text
+    assert text.count("differs from cycle 3: hit 0 -&gt; 1") == 2
+    assert "why no run shows it" not in text

@@ -100,26 +100,16 @@ def _no_run_passes(baseline):
     return True
 
 
-def _report_robot(
-    out,
-    campaign,
-    mutants,
-    verdicts,
-    unit,
-    robot,
-    robot_verdicts,
-    baseline,
-    robot_s,
-    recordings,
-    say,
-    width,
-):
-    """The robot judge's lines, the recordings of the closest runs, and report.html."""
-    rs = robot_score(unit, robot)
+def _report_robot(out, results, robot_s, recordings, say, *, title, inputs):
+    """The robot judge's lines, the recordings of the closest runs of the first
+    ``recordings`` blind spots, and report.html (``results``: mutants.json's content;
+    ``title`` and ``inputs`` as ``write_report`` takes them)."""
+    rs, baseline = results["robot"], results["baseline"]
+    robot_verdicts = {m["index"]: m["robot"] for m in results["mutants"] if m["robot"]}
     n_runs, n_pass = len(baseline["runs"]), len(baseline["passing"])
     print(
-        f"robot judge (campaign {campaign.name}: {n_pass} of {n_runs} runs pass unmutated): "
-        f"{rs['caught']} of {rs['judged']} unit-caught mutants caught: score "
+        f"robot judge (campaign {results['campaign']}: {n_pass} of {n_runs} runs pass "
+        f"unmutated): {rs['caught']} of {rs['judged']} unit-caught mutants caught: score "
         f"{_percent(rs['score'])}; {_robot_rate(baseline, robot_s)}" + _settled(robot_verdicts)
     )
     forked = _fork_line(robot_verdicts)
@@ -127,27 +117,25 @@ def _report_robot(
         print(forked)
     if _no_run_passes(baseline):
         return
-    blind = blind_spots(unit, robot)
-    by_index = {m.index: m for m in mutants}
-    recorded = _record_closest(out, [robot_verdicts[k] for k in blind[:recordings]], say)
+    blind = [m for m in results["mutants"] if m["robot"] and not m["robot"]["caught"]]
+    recorded = _record_closest(out, [m["robot"] for m in blind[:recordings]], say)
     if blind:
         print(f"blind spots: caught by the unit judge, missed by every run ({len(blind)}):")
-        effects = {v.index: v.effect() for v in verdicts}
-        reasons = {v.index: blind_spot_reason(v, width) for v in verdicts if v.index in blind}
-        for k in blind:
-            print(f"  {by_index[k].describe()}")
-            print(f"    unit: {effects[k]}")
-            print(f"    why: {reasons[k]}")
-            if robot_verdicts[k].get("judged_by") == "cone":
-                print(f"    {_cone_note(robot_verdicts[k])}")
-            if robot_verdicts[k].get("replay"):
-                print(
-                    f"    closest run: {robot_verdicts[k]['replay']}"
-                    + (f"  (recording {recorded[k]})" if k in recorded else "")
-                )
-    path = write_report(
-        out, campaign.name, mutants, verdicts, robot_verdicts, baseline, recorded, width
-    )
+    for m in blind:
+        v = m["robot"]
+        print(f"  {m['describe']}")
+        print(f"    unit: {m['unit']['effect']}")
+        if m.get("blind_spot_reason"):
+            print(f"    why: {m['blind_spot_reason']}")
+        if v.get("judged_by") == "cone":
+            print(f"    {_cone_note(v)}")
+        if v.get("replay"):
+            recording = recorded.get(m["index"])
+            print(
+                f"    closest run: {v['replay']}"
+                + (f"  (recording {recording})" if recording else "")
+            )
+    path = write_report(out, results, recorded, title=title, inputs=inputs)
     print(f"report: {path}")
 
 
@@ -424,11 +412,10 @@ def _main_design(args):
     except (MutationError, BackendError, PinError) as exc:
         raise UsageError(_one_line(exc)) from None
     score, modules = result["unit"], result["modules"]
-    rate = (60 * score["total"] / result["unit_judge_s"]) if result["unit_judge_s"] else 0
     print(
         f"{score['total']} mutants of {name} (seed {args.seed}), {cycles} cycles of random "
-        f"inputs each; build {result['build_and_list_s']:.1f} s, unit judge {rate:.0f} "
-        f"mutants/min"
+        f"inputs each; build {result['build_and_list_s']:.1f} s, unit judge "
+        f"{result['unit_mutants_per_minute']:.0f} mutants/min"
         + (f", fan-out cones {result['cone_s']:.1f} s" if result.get("cone_s") is not None else "")
     )
     print(
@@ -437,7 +424,15 @@ def _main_design(args):
     )
     _print_modules(modules, campaign is not None and not _exit_code(result["baseline"]))
     if campaign is not None:
-        _report_design_robot(result, campaign)
+        _report_robot(
+            out,
+            result,
+            result["robot_judge_s"],
+            args.recordings,
+            say,
+            title=name,
+            inputs="these inputs",
+        )
     missed = [m for m in result["mutants"] if not m["unit"]["caught"]]
     if missed:
         print("equivalent on these inputs (first 10):")
@@ -445,33 +440,6 @@ def _main_design(args):
             print(f"  {m['describe']}")
     print(f"wrote {os.path.join(out, 'mutants.json')}")
     return _exit_code(result["baseline"])
-
-
-def _report_design_robot(result, campaign):
-    """The robot judge's lines for a design of one's own: its score and blind spots."""
-    rs, baseline = result["robot"], result["baseline"]
-    n_runs, n_pass = len(baseline["runs"]), len(baseline["passing"])
-    print(
-        f"robot judge (campaign {campaign.name}: {n_pass} of {n_runs} runs pass unmutated): "
-        f"{rs['caught']} of {rs['judged']} unit-caught mutants caught: score "
-        f"{_percent(rs['score'])}; {_robot_rate(baseline, result['robot_judge_s'])}"
-        + _settled({m["index"]: m["robot"] for m in result["mutants"] if m["robot"]})
-    )
-    forked = _fork_line({m["index"]: m["robot"] for m in result["mutants"] if m["robot"]})
-    if forked:
-        print(forked)
-    if _no_run_passes(baseline):
-        return
-    blind = [m for m in result["mutants"] if m["robot"] is not None and not m["robot"]["caught"]]
-    if blind:
-        print(f"blind spots: caught by the unit judge, missed by every run ({len(blind)}):")
-        for m in blind:
-            print(f"  {m['describe']}")
-            print(f"    unit: {m['unit']['effect']}")
-            if m["robot"].get("judged_by") == "cone":
-                print(f"    {_cone_note(m['robot'])}")
-            if m["robot"].get("replay"):
-                print(f"    closest run: {m['robot']['replay']}")
 
 
 def _check(args):
@@ -598,46 +566,43 @@ def _mutate_follow_target(args, params, campaign, out):
     blind = set(blind_spots(unit, robot))
     score = unit_score(unit)
     modules = by_module(mutants, unit, robot)
-    write_json_atomic(
-        os.path.join(out, "mutants.json"),
-        {
-            "design": {"width": params.width, "height": params.height},
-            "seed": args.seed,
-            "against": args.against,
-            "frames": len(frames),
-            "build_and_list_s": round(build_s, 2),
-            "unit_judge_s": round(unit_s, 2),
-            "unit_mutants_per_minute": round(60 * len(mutants) / unit_s, 1) if unit_s else None,
-            "unit": score,
-            "robot": robot_score(unit, robot) if campaign is not None else None,
-            "campaign": campaign.name if campaign is not None else None,
-            "robot_judge_s": round(robot_s, 2) if campaign is not None else None,
-            "cone_s": round(cone_s, 2) if cone_s is not None else None,
-            "baseline": baseline,
-            "modules": modules,
-            "mutants": [
-                {
-                    **{k: v for k, v in m.__dict__.items()},
-                    "sources": list(m.sources),
-                    "describe": m.describe(),
-                    "unit": {
-                        "caught": v.caught,
-                        "first_frame": v.first_frame,
-                        "differing": v.differing,
-                        "frames_differing": v.frames_differing,
-                        "max_difference": v.max_difference,
-                        "effect": v.effect(),
-                    },
-                    "robot": robot_verdicts.get(m.index),
-                    "blind_spot_reason": (
-                        blind_spot_reason(v, params.width) if m.index in blind else None
-                    ),
-                }
-                for m, v in zip(mutants, verdicts)
-            ],
-        },
-        what="mutation results",
-    )
+    results = {
+        "design": {"width": params.width, "height": params.height},
+        "seed": args.seed,
+        "against": args.against,
+        "frames": len(frames),
+        "build_and_list_s": round(build_s, 2),
+        "unit_judge_s": round(unit_s, 2),
+        "unit_mutants_per_minute": round(60 * len(mutants) / unit_s, 1) if unit_s else None,
+        "unit": score,
+        "robot": robot_score(unit, robot) if campaign is not None else None,
+        "campaign": campaign.name if campaign is not None else None,
+        "robot_judge_s": round(robot_s, 2) if campaign is not None else None,
+        "cone_s": round(cone_s, 2) if cone_s is not None else None,
+        "baseline": baseline,
+        "modules": modules,
+        "mutants": [
+            {
+                **{k: v for k, v in m.__dict__.items()},
+                "sources": list(m.sources),
+                "describe": m.describe(),
+                "unit": {
+                    "caught": v.caught,
+                    "first_frame": v.first_frame,
+                    "differing": v.differing,
+                    "frames_differing": v.frames_differing,
+                    "max_difference": v.max_difference,
+                    "effect": v.effect(),
+                },
+                "robot": robot_verdicts.get(m.index),
+                "blind_spot_reason": (
+                    blind_spot_reason(v, params.width) if m.index in blind else None
+                ),
+            }
+            for m, v in zip(mutants, verdicts)
+        ],
+    }
+    write_json_atomic(os.path.join(out, "mutants.json"), results, what="mutation results")
 
     print(
         f"{len(mutants)} mutants of follow_target {params.width}x{params.height} "
@@ -654,17 +619,12 @@ def _mutate_follow_target(args, params, campaign, out):
     if campaign is not None:
         _report_robot(
             out,
-            campaign,
-            mutants,
-            verdicts,
-            unit,
-            robot,
-            robot_verdicts,
-            baseline,
+            results,
             robot_s,
             args.recordings,
             say,
-            params.width,
+            title=f"follow_target {params.width}x{params.height}",
+            inputs="the unit frames",
         )
     missed = [m for m, v in zip(mutants, verdicts) if not v.caught]
     if missed:

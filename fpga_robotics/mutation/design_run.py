@@ -297,6 +297,8 @@ def _judge(
         },
         "build_and_list_s": round(build_s, 2),
         "unit_judge_s": round(unit_s, 2),
+        # From the unrounded time: a fast unit judge takes well under 0.01 s.
+        "unit_mutants_per_minute": round(60 * len(mutants) / max(unit_s, 1e-9), 1),
         "netlist": NETLIST_NAME,
         "ports": PORTS_NAME,
         "unit": unit_score(unit),

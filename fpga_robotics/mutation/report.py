@@ -1,14 +1,12 @@
 """``report.html`` of a mutation run: the scores, the components, the robot-level blind spots
-(module, signal, source line, what the mutant does, why no run shows it, the replay command
-and recording of the closest-to-failing run) and the mutants no unit frame shows. One
-self-contained file."""
+(module, signal, source line, what the mutant does, why no run shows it where a reason is
+known, the replay command and recording of the closest-to-failing run) and the mutants the
+unit judge does not catch. One self-contained file."""
 
 import html
 import os
 
 from ..sim.files import write_atomic
-from .reasons import blind_spot_reason
-from .scores import blind_spots, by_module, robot_score, unit_score
 
 __all__ = ["write_report"]
 
@@ -36,28 +34,26 @@ def _cone_note(verdict):
     return f"<br>no run made: its fan-out cone reaches only {html.escape(reached)}"
 
 
-def write_report(
-    out, campaign, mutants, unit_verdicts, robot_verdicts, baseline, recordings, width
-):
-    """Write ``out/report.html`` (``width``: the design's image width, for the blind spots'
-    reasons); returns its path."""
-    unit = {v.index: v.caught for v in unit_verdicts}
-    robot = {k: v["caught"] for k, v in robot_verdicts.items()}
-    us, rs = unit_score(unit), robot_score(unit, robot)
-    effects = {v.index: v.effect() for v in unit_verdicts}
-    blind = blind_spots(unit, robot)
-    reasons = {v.index: blind_spot_reason(v, width) for v in unit_verdicts if v.index in blind}
-    by_index = {m.index: m for m in mutants}
+def write_report(out, results, recordings, *, title, inputs):
+    """Write ``out/report.html`` from ``results`` (``mutants.json``'s content: its scores,
+    campaign, baseline, modules and mutants with their verdicts); ``recordings``: ``{index:
+    path}`` of the recorded closest runs; ``title``: the design; ``inputs``: what the unit
+    judge ran the mutants on ("the unit frames"). Returns its path."""
+    us, rs, baseline = results["unit"], results["robot"], results["baseline"]
+    rows = results["mutants"]
+    blind = [m for m in rows if m["robot"] is not None and not m["robot"]["caught"]]
+    # The reason classes read FollowTarget's outputs: other designs' blind spots have none.
+    with_reason = any(m.get("blind_spot_reason") for m in blind)
     e = html.escape
     parts = [
         (
             f"<!doctype html><meta charset=utf-8><title>Mutation coverage</title>"
-            f"<style>{_STYLE}</style><h1>Mutation coverage of follow_target</h1>"
+            f"<style>{_STYLE}</style><h1>Mutation coverage of {e(title)}</h1>"
         ),
         (
             f"<p>{us['total']} mutants. Unit judge: {us['caught']} caught, {us['equivalent']} "
-            f"equivalent on the unit frames (score {_pct(us['score'])}). Robot judge "
-            f"(campaign <code>{e(campaign)}</code>, {len(baseline['passing'])} of "
+            f"equivalent on {e(inputs)} (score {_pct(us['score'])}). Robot judge "
+            f"(campaign <code>{e(results['campaign'])}</code>, {len(baseline['passing'])} of "
             f"{len(baseline['runs'])} runs pass unmutated): {rs['caught']} of {rs['judged']} "
             f"unit-caught mutants caught (score {_pct(rs['score'])}).</p>"
         ),
@@ -66,21 +62,20 @@ def write_report(
             ["component", "mutants", "unit judge caught", "robot judge caught"],
             [
                 [e(name), r["total"], r["unit_caught"], r["robot_caught"]]
-                for name, r in by_module(mutants, unit, robot).items()
+                for name, r in results["modules"].items()
             ],
         ),
     ]
-    rows = []
-    for k in sorted(blind, key=lambda i: (by_index[i].module, i)):
-        m, v = by_index[k], robot_verdicts[k]
-        rec = recordings.get(k)
-        rows.append(
+    blind_rows = []
+    for m in sorted(blind, key=lambda m: (m["module"], m["index"])):
+        v, rec = m["robot"], recordings.get(m["index"])
+        blind_rows.append(
             [
-                e(m.module or "top"),
-                e(m.describe()),
-                e(", ".join(m.sources)),
-                e(effects[k]),
-                e(reasons[k]),
+                e(m["module"] or "top"),
+                e(m["describe"]),
+                e(", ".join(m["sources"])),
+                e(m["unit"]["effect"]),
+                *([e(m.get("blind_spot_reason") or "")] if with_reason else []),
                 f"<code>{e(v.get('replay') or '')}</code>" + _cone_note(v),
                 f'<a href="{e(rec)}">{e(rec)}</a>' if rec else "",
             ]
@@ -93,33 +88,33 @@ def write_report(
                 "mutant",
                 "source",
                 "what it does to the outputs",
-                "why no run shows it",
+                *(["why no run shows it"] if with_reason else []),
                 "closest-to-failing run",
                 "recording",
             ],
-            rows,
+            blind_rows,
         ),
     ]
-    caught_rows = []
-    for k, v in sorted(robot_verdicts.items()):
-        if v["caught"]:
-            caught_rows.append(
-                [
-                    e(by_index[k].describe()),
-                    e(v["status"]),
-                    e(", ".join(v["failed_checks"]) or v.get("message") or ""),
-                    f"<code>{e(v.get('replay') or '')}</code>",
-                ]
-            )
+    caught_rows = [
+        [
+            e(m["describe"]),
+            e(m["robot"]["status"]),
+            e(", ".join(m["robot"]["failed_checks"]) or m["robot"].get("message") or ""),
+            f"<code>{e(m['robot'].get('replay') or '')}</code>",
+        ]
+        for m in rows
+        if m["robot"] is not None and m["robot"]["caught"]
+    ]
     parts += [
         f"<h2>Caught by the robot judge ({len(caught_rows)})</h2>",
         _table(["mutant", "status", "failed checks", "replay"], caught_rows),
     ]
-    equivalent = [m for m in mutants if not unit.get(m.index)]
+    equivalent = [m for m in rows if not m["unit"]["caught"]]
     parts += [
-        f"<h2>Equivalent on the unit frames ({len(equivalent)})</h2>",
+        f"<h2>Equivalent on {e(inputs)} ({len(equivalent)})</h2>",
         _table(
-            ["mutant", "source"], [[e(m.describe()), e(", ".join(m.sources))] for m in equivalent]
+            ["mutant", "source"],
+            [[e(m["describe"]), e(", ".join(m["sources"]))] for m in equivalent],
         ),
     ]
     path = os.path.join(out, "report.html")
