@@ -1,5 +1,6 @@
 """``mutate --resume``: the robot judge keeps the verdicts already in its journal, but only of
-the very same mutants; a journal of other mutants (another seed) is refused before anything
+the very same mutants judged by the very same campaign runs; a journal of other mutants
+(another seed) or of other runs (the campaign's duration edited) is refused before anything
 in the output folder is touched."""
 
 import json
@@ -10,9 +11,11 @@ from bump_mutate import DATA, mutate_bump_stop
 SAME = ("caught", "run", "status", "failed_checks", "closest")
 
 
-def _mutate(out, seed, capsys, *more):
+def _mutate(out, seed, capsys, *more, duration=3.0):
     campaign = out.parent / "bump.toml"
-    campaign.write_text(f'scenarios = ["{DATA / "bump_wall.toml"}"]\nseeds = "0"\nduration = 3.0\n')
+    campaign.write_text(
+        f'scenarios = ["{DATA / "bump_wall.toml"}"]\nseeds = "0"\nduration = {duration}\n'
+    )
     code, _, err = mutate_bump_stop(
         out,
         capsys,
@@ -49,4 +52,9 @@ def test_resume_keeps_only_verdicts_of_the_same_mutants(tmp_path, capsys):
     assert code == 2
     assert "--resume:" in err and "holds verdicts of other mutants" in err
     assert "Traceback" not in err
+    assert {p.name: p.read_bytes() for p in out.iterdir()} == before
+    # The same mutants, the campaign's runs made 2 s: their verdicts are not these runs'.
+    code, err = _mutate(out, 1, capsys, "--resume", duration=2.0)
+    assert code == 2 and err.count("\n") == 1
+    assert "holds verdicts judged by other runs than campaign bump's" in err
     assert {p.name: p.read_bytes() for p in out.iterdir()} == before

@@ -248,7 +248,8 @@ def build_parser(prog="fpga-robotics mutate"):
     p.add_argument(
         "--resume",
         action="store_true",
-        help="robot judge: keep the mutants already judged in the output folder",
+        help="robot judge: keep the mutants already judged in the output folder by the "
+        "same campaign's runs",
     )
     p.add_argument(
         "--recordings",
@@ -499,7 +500,7 @@ def _mutate_follow_target(args, params, campaign, out):
         raise UsageError(str(exc).splitlines()[0]) from None
     key = mutants_key(repr(params), mutants)
     if args.resume and campaign is not None:
-        check_resume(out, key)
+        check_resume(out, key, campaign)
     netlist, ports = write_mutant_design(params, mutants, out)
     watch_ports = os.path.join(out, WATCH_PORTS_NAME)
     resolution = f"{params.width}x{params.height}"

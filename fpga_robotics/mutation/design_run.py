@@ -92,7 +92,7 @@ def mutate_design(
     ports = design_ports(spec)
     rtlil_text = component_rtlil(spec.build())
     mutants = list_mutants(None, n, seed, rtlil_text=rtlil_text)
-    robot = _keyed(robot, out, mutants_key(rtlil_text, mutants))
+    robot = _keyed(robot, out, mutants_key(rtlil_text, mutants), campaign)
     name = spec.reference.rpartition(":")[2] or spec.reference
     source = MutantPinSource(rtlil_text, ports, mutants, name)
     # The netlist and its port map as a Verilog design the closed loop runs (the robot
@@ -153,7 +153,7 @@ def mutate_verilog_design(
     top = design.port_map.top
     sources = {"verilog": design.sources, "top": top, "includes": design.includes}
     mutants = list_mutants(None, n, seed, **sources)
-    robot = _keyed(robot, out, mutants_key(design.digest(), mutants))
+    robot = _keyed(robot, out, mutants_key(design.digest(), mutants), campaign)
     os.makedirs(out, exist_ok=True)
     netlist = os.path.join(out, NETLIST_NAME)
     verilog = mutant_netlist(None, mutants, **sources)
@@ -205,12 +205,13 @@ def _prebuild(campaign, robot, netlist, watch_map):
     return start_prebuild(campaign, os.path.abspath(netlist), os.path.abspath(watch_map), None)
 
 
-def _keyed(robot, out, key):
+def _keyed(robot, out, key, campaign):
     """The robot judge's keyword arguments with the mutants' key; with ``resume``, checked
-    against the journal in ``out`` first (``check_resume``: before anything is written)."""
+    with ``campaign`` against the journal in ``out`` first (``check_resume``: before
+    anything is written)."""
     robot = dict(robot or {})
     if robot.get("resume"):
-        check_resume(out, key)
+        check_resume(out, key, campaign)
     return {**robot, "mutants": key}
 
 

@@ -29,6 +29,7 @@ from .cone import cone_verdict, settled_by_cone
 from .forked_runs import execute_forked, outcome_of, reference_share
 
 __all__ = [
+    "campaign_runs_key",
     "check_campaign",
     "check_resume",
     "closest_to_failing",
@@ -106,18 +107,35 @@ def mutants_key(design, mutants):
     return hashlib.sha256(text.encode()).hexdigest()[:16]
 
 
-def check_resume(out_dir, key):
+def campaign_runs_key(plan):
+    """What names the runs that judge the mutants: each run's identity in ``plan`` (sweep's
+    ``run_identity``: the scenario's content, seed, duration, overrides, checks), in order. A
+    journal row carries it, so ``--resume`` keeps only verdicts of these very runs."""
+    text = "\n".join(plan.ids[spec] for spec in plan.runs)
+    return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
+def check_resume(out_dir, key, campaign):
     """``UsageError`` if ``out_dir``'s journal holds verdicts of other mutants than ``key``
-    names (another design, seed or ``--mutants``): call it before writing anything there."""
+    names (another design, seed or ``--mutants``) or verdicts judged by other runs than
+    ``campaign``'s: call it before writing anything there."""
     journal = os.path.join(out_dir, JOURNAL_NAME)
     if not os.path.exists(journal):
         return
     with open(journal) as f:
-        keys = {json.loads(line).get("mutants") for line in f if line.strip()}
-    if keys - {key}:
+        rows = [json.loads(line) for line in f if line.strip()]
+    if {row.get("mutants") for row in rows} - {key}:
         raise UsageError(
             f"--resume: {journal} holds verdicts of other mutants (another design, --seed "
             "or --mutants): give the same ones, or drop --resume to judge these afresh"
+        )
+    runs = campaign_runs_key(check_campaign(campaign))
+    if {row.get("campaign_runs") for row in rows} - {runs}:
+        raise UsageError(
+            f"--resume: {journal} holds verdicts judged by other runs than campaign "
+            f"{campaign.name}'s (another campaign, or its scenarios, seeds, duration, checks "
+            "or overrides since changed): give the same campaign, or drop --resume to judge "
+            "these afresh"
         )
 
 
@@ -318,13 +336,15 @@ def robot_judge(
     a run (fpga_robotics.mutation.cone). ``watch_ports``: the netlist's port map with its
     watch output watched (``design.write_mutant_design``); with ``fork`` the unmutated runs
     use it, and a mutant that never acted in one of them is given it without a run.
-    ``mutants``: their ``mutants_key``, in every journal row (``resume`` keeps only rows of
-    the same; ``check_resume`` refuses others before anything is written). ``prebuilt``:
-    the ``start_prebuild`` thread to wait for before the runs."""
+    ``mutants``: their ``mutants_key``, in every journal row with the ``campaign_runs_key``
+    (``resume`` keeps only rows of the same mutants and runs; ``check_resume`` refuses others
+    before anything is written). ``prebuilt``: the ``start_prebuild`` thread to wait for
+    before the runs."""
     from distributed import as_completed  # lazy: Dask costs ~1 s; only a run needs it
 
     tick = progress or (lambda n: None)
     plan = check_campaign(campaign)
+    runs_key = campaign_runs_key(plan)
     watch_ports = watch_ports if fork else None
     base = [
         mutant_argv(spec.argv(), netlist, watch_ports or ports, 0, resolution) for spec in plan.runs
@@ -336,7 +356,7 @@ def robot_judge(
             for line in f:
                 if line.strip():
                     row = json.loads(line)
-                    if row.get("mutants") == mutants:
+                    if (row.get("mutants"), row.get("campaign_runs")) == (mutants, runs_key):
                         verdicts[int(row["index"])] = row
     elif os.path.exists(journal):
         os.remove(journal)
@@ -398,7 +418,7 @@ def robot_judge(
                 at = plan.runs[passing[closest]].argv() if closest is not None else None
                 v["argv"] = at and mutant_argv(at, netlist, ports, k, resolution)
                 v["replay"] = replay(v["argv"]) if at else None
-                v["index"], v["mutants"] = k, mutants
+                v["index"], v["mutants"], v["campaign_runs"] = k, mutants, runs_key
                 verdicts[k] = v
                 f.write(json.dumps(v) + "\n")
                 tick(1)
@@ -420,7 +440,7 @@ def robot_judge(
                 at = v["run"] if v["caught"] else v["closest"]
                 v["argv"] = argvs[at] if at is not None else None
                 v["replay"] = replay(v["argv"]) if at is not None else None
-                v["index"], v["mutants"] = k, mutants
+                v["index"], v["mutants"], v["campaign_runs"] = k, mutants, runs_key
                 verdicts[k] = v
                 f.write(json.dumps(v) + "\n")
                 f.flush()
