@@ -82,3 +82,54 @@ def test_resume_after_editing_the_scenario_replaces_the_runs_of_the_old_file(tmp
     )
     assert sorted(r["run_id"] for r in again) == sorted(r["run_id"] for r in rows)
     assert json.loads((out / "campaign.json").read_text())["ran"] == 0
+
+
+def _without(row, *keys):
+    return {k: v for k, v in row.items() if k not in keys}
+
+
+def test_resume_records_the_kept_runs_the_new_record_option_asks_for(tmp_path):
+    """Kept runs of a campaign that recorded less (``--record none``) get the recordings and
+    bags a resumed ``--record``/``--bag`` asks for, with their rows otherwise unchanged."""
+    scenario = tmp_path / "walkaway.toml"
+    out = tmp_path / "out"
+    # The slow target stays within 2.5 m on average, the fast one does not.
+    scenario.write_text(SCENARIO.format(limit=2.5))
+    campaign = load_campaign(
+        {
+            "scenarios": [str(scenario)],
+            "seeds": [0],
+            "backend": "model",
+            "resolution": "40x24",
+            "duration": 2.0,
+            "grid": {"people.0.speed": [0.2, 1.0]},
+        }
+    )
+    first = {r["run_id"]: r for r in run_campaign(campaign, out, workers=1, record="none")}
+    assert sorted(r["status"] for r in first.values()) == ["fail", "pass"]
+    assert not (out / "recordings").exists()
+
+    # --record failing: the failing run is recorded now, the passing one is not.
+    rows = {r["run_id"]: r for r in run_campaign(campaign, out, workers=1, resume=True)}
+    for run_id, row in rows.items():
+        assert _without(row, "recording") == _without(first[run_id], "recording")
+        wanted = f"recordings/{run_id}.rrd" if row["status"] == "fail" else ""
+        assert row["recording"] == wanted
+    assert [p.name for p in (out / "recordings").iterdir()] == [
+        f"{r}.rrd" for r in rows if rows[r]["status"] == "fail"
+    ]
+    assert json.loads((out / "campaign.json").read_text())["ran"] == 0
+
+    # --record all --bag: every kept run gets its recording and its bag.
+    rows = run_campaign(campaign, out, workers=1, resume=True, record="all", bag=True)
+    for row in rows:
+        assert row["recording"] == f"recordings/{row['run_id']}.rrd"
+        assert row["bag"] == f"bags/{row['run_id']}"
+        assert (out / row["recording"]).is_file()
+        assert (out / row["bag"] / "metadata.yaml").is_file()
+        assert _without(row, "recording", "bag") == _without(first[row["run_id"]], "recording")
+
+    # Everything asked for is there: resuming again runs and records nothing (the journal
+    # holds the two kept rows, no line was added).
+    run_campaign(campaign, out, workers=1, resume=True, record="all", bag=True)
+    assert len((out / "results.jsonl").read_text().splitlines()) == 2

@@ -8,7 +8,7 @@ from pathlib import Path
 from fpga_robotics.hw.errors import UsageError
 
 from .. import __version__
-from .engine import RECORD_LOG_EVERY, build_all, open_client, run_plan
+from .engine import RECORD_LOG_EVERY, build_all, kept_to_record, open_client, run_plan
 from .plan import make_plan
 from .report import format_report, write_html
 from .results import ResultStore, load_rows, read_meta, write_meta
@@ -94,6 +94,13 @@ def run_campaign(
                 say(
                     f"{already} of {len(plan.runs)} runs already in {out_dir} (--resume): "
                     f"running the other {len(plan.runs) - already}"
+                )
+            unrecorded = len(kept_to_record(plan, store, record, bag))
+            if unrecorded:
+                what = "recording or bag" if bag else "recording"
+                say(
+                    f"recording {unrecorded} kept run(s) that have no {what} "
+                    f"(--record {record}{' --bag' if bag else ''})"
                 )
             t_runs = time.perf_counter()
             meta["ran"] = run_plan(

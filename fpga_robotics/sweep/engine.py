@@ -31,6 +31,7 @@ __all__ = [
     "RECORD_LOG_EVERY",
     "build_all",
     "check_scheduler_address",
+    "kept_to_record",
     "open_client",
     "run_plan",
 ]
@@ -210,7 +211,8 @@ def run_plan(
     bag=False,
     fork=True,
 ):
-    """Run every planned run not already in ``store``; returns the number run.
+    """Run every planned run not already in ``store``, and record the kept ones that lack
+    the recording ``record`` asks for (``kept_to_record``); returns the number run.
     Recordings log every ``log_every``-th frame's images (every frame's numbers). With
     ``fork``, runs of one world are run as a reference and forked variants (fork_groups),
     unless every run is recorded."""
@@ -222,7 +224,8 @@ def run_plan(
         if rid not in seen:
             seen.add(rid)
             todo.append(spec)
-    if not todo:
+    to_record = kept_to_record(plan, store, record, bag)
+    if not todo and not to_record:
         return 0
     timeouts = _Timeouts(timeout)
     window = max(2, 2 * sum(client.nthreads().values()) or 2)
@@ -230,11 +233,15 @@ def run_plan(
         groups = fork_groups.fork_groups(todo, plan.worlds)
     else:
         groups = [[spec] for spec in todo]
-    pending = list(reversed(groups))
+    # (specs, recording pass), the last first: the new runs, then the kept runs' recordings.
+    pending = [([spec], True) for spec in reversed(to_record)]
+    pending += [(group, False) for group in reversed(groups)]
     running = {}  # future -> (specs, submitted at, timeout, recording pass)
     # Failing runs waiting for their recording pass: a run's row is stored once, with its
-    # recording (results.jsonl holds one line per run).
-    awaiting = {}
+    # recording (results.jsonl holds one line per run). Kept runs to record wait with their
+    # kept rows.
+    kept = {row["run_id"]: row for row in store.rows}
+    awaiting = {plan.ids[spec]: kept[plan.ids[spec]] for spec in to_record}
     failures = 0
     bar = _progress(len(todo), quiet)
     completed = as_completed()
@@ -263,7 +270,7 @@ def run_plan(
 
     def top_up():
         while pending and len(running) < window:
-            submit(pending.pop())
+            submit(*pending.pop())
 
     def keep(row, outcome):
         if outcome.get("recording"):
@@ -309,11 +316,29 @@ def run_plan(
     finally:
         if running:
             client.cancel(list(running))
-        for row in awaiting.values():  # interrupted before their recording: finished runs
-            store.add(row)
+        for rid, row in awaiting.items():  # interrupted before their recording: finished runs
+            if rid not in kept:
+                store.add(row)
         bar.close()
         store.flush()
     return len(todo)
+
+
+def kept_to_record(plan, store, record, bag):
+    """The runs of ``plan`` kept in ``store`` (``--resume``) that lack the recording
+    ``record`` asks for (or, with ``bag``, the bag): an earlier campaign ran with less. Runs
+    are deterministic, so a recording pass makes them without judging the run again."""
+    wanted = {"all": ("pass", "fail", "n/a"), "failing": ("fail",)}.get(record, ())
+    files = ("recording", "bag") if bag else ("recording",)
+    rows = {row["run_id"]: row for row in store.rows}
+    missing = {}
+    for spec in plan.runs:
+        row = rows.get(plan.ids[spec])
+        if row is None or row["status"] not in wanted:
+            continue
+        if not all(row.get(key) and (store.dir / row[key]).exists() for key in files):
+            missing.setdefault(row["run_id"], spec)
+    return list(missing.values())
 
 
 def _timed_out(client, key):
