@@ -8,6 +8,9 @@ import subprocess
 import sys
 import time
 
+import pytest
+
+from fpga_robotics.sweep import report_dir
 from fpga_robotics.sweep.results import load_rows
 
 #: 16 runs of about half a second each on the model backend: long enough to interrupt.
@@ -84,6 +87,10 @@ def test_ctrl_c_keeps_finished_runs_and_resume_runs_the_rest(tmp_path):
     kept = {r["run_id"]: r for r in load_rows(tmp_path / "out")}
     assert 2 <= len(kept) < 16
     assert all(r["status"] in ("pass", "fail") for r in kept.values())
+    # The report of the partial campaign says so, in report.html and `sweep report`.
+    headline = f"{len(kept)} of 16 runs (the campaign was interrupted; continue it with --resume)"
+    assert f"<b>{headline}: " in (tmp_path / "out" / "report.html").read_text()
+    assert report_dir(tmp_path / "out").startswith(f"{headline}: ")
 
     proc = subprocess.run(
         SWEEP + ["--resume"], cwd=tmp_path, check=False, capture_output=True, text=True, timeout=300
@@ -96,4 +103,31 @@ def test_ctrl_c_keeps_finished_runs_and_resume_runs_the_rest(tmp_path):
         assert rows[run_id] == row
     meta = json.loads((tmp_path / "out" / "campaign.json").read_text())
     assert meta["ran"] == 16 - len(kept)
+    assert meta["missing"] == 0
     assert "16 runs:" in proc.stdout
+    assert "<b>16 runs: " in (tmp_path / "out" / "report.html").read_text()
+
+
+def test_ctrl_c_while_the_report_is_drawn_leaves_no_stale_report(tmp_path, monkeypatch, capsys):
+    """Ctrl-C after the runs, while report.html is drawn: the rows are kept, the report of an
+    earlier campaign in the folder is not left to describe them, and the closing line says
+    how to draw it."""
+    from fpga_robotics.cli import sweep as cli
+    from fpga_robotics.sweep import api
+
+    (tmp_path / "c.toml").write_text(CAMPAIGN.replace('"0-15"', "[0]").replace("20.0", "1.0"))
+    monkeypatch.chdir(tmp_path)
+    argv = ["c.toml", "--workers", "1", "--out", "out", "--quiet", "--record", "none"]
+    assert cli.main(argv) == 1  # follow_person in 1 s: its checks fail
+    assert (tmp_path / "out" / "report.html").is_file()
+
+    def interrupted(*_args):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(api, "write_html", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        cli.main([*argv, "--resume"])
+    assert not (tmp_path / "out" / "report.html").exists()
+    assert len(load_rows(tmp_path / "out")) == 1
+    err = capsys.readouterr().err
+    assert "no report.html: `fpga-robotics sweep report out` writes it" in err

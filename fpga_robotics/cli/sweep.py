@@ -304,8 +304,14 @@ def main(argv=None, prog=PROG):
         )
     except KeyboardInterrupt:
         kept = len(load_rows(out))
+        unreported = (
+            f" (no report.html: `{prog} report {out}` writes it)"
+            if kept and not (out / "report.html").exists()
+            else ""
+        )
         print(
-            f"interrupted: {kept} finished run(s) kept in {out}; continue with --resume",
+            f"interrupted: {kept} finished run(s) kept in {out}{unreported}; continue with "
+            f"--resume",
             file=sys.stderr,
         )
         raise

@@ -127,10 +127,23 @@ def run_campaign(
         if store is not None:
             store.close()
             meta["wall_s"] = round(time.perf_counter() - t0, 3)
+            # Runs that never ran (an interrupted campaign): the report counts them.
+            meta["missing"] = len({plan.ids[s] for s in plan.runs} - store.done_ids())
             write_meta(out_dir, meta)
             if store.rows:
-                write_html(out_dir / "report.html", store.rows, campaign.axes, meta)
+                _write_report(out_dir, store.rows, campaign.axes, meta)
     return store.rows
+
+
+def _write_report(out_dir, rows, axes, meta):
+    path = out_dir / "report.html"
+    try:
+        write_html(path, rows, axes, meta)
+    except KeyboardInterrupt:
+        # Interrupted while drawing: no report rather than an earlier one that no longer
+        # describes the results (`sweep report DIR` draws it).
+        path.unlink(missing_ok=True)
+        raise
 
 
 def _first_missing(path):
@@ -184,4 +197,4 @@ def report_dir(out_dir):
         {k for r in rows for k in r if "." in k and not k.startswith(("check_", "collisions_"))}
     )
     write_html(out_dir / "report.html", rows, axes, meta)
-    return format_report(rows, axes, meta.get("known_limits") or ())
+    return format_report(rows, axes, meta.get("known_limits") or (), meta.get("missing", 0))

@@ -144,13 +144,20 @@ def _limit_text(entry):
     return f"{', '.join(_names(entry))} ({scope})"
 
 
-def format_report(rows, axes, known_limits=()):
-    """The terminal summary (several lines)."""
+def format_report(rows, axes, known_limits=(), missing=0):
+    """The terminal summary (several lines). ``missing``: the campaign's runs that never ran
+    (it was interrupted), which the first line counts."""
     counts = {
         s: sum(r["status"] == s for r in rows) for s in ("pass", "fail", "n/a", "error", "timeout")
     }
+    runs = (
+        f"{len(rows)} of {len(rows) + missing} runs (the campaign was interrupted; continue "
+        f"it with --resume)"
+        if missing
+        else f"{len(rows)} runs"
+    )
     lines = [
-        f"{len(rows)} runs: "
+        f"{runs}: "
         + ", ".join(f"{n} {s}" for s, n in counts.items())
         + f" (pass rate {_rate(rows):.0%})"
     ]
@@ -286,7 +293,8 @@ def _with_totals(rows):
 def write_html(path, rows, axes, meta):
     """``report.html``: pass rates, the heatmap of the first two grid axes, metric
     distributions, the failing runs grouped by check, each with its replay command, and the
-    checks that could not judge some runs (n/a), with their reasons."""
+    checks that could not judge some runs (n/a), with their reasons. ``meta``: the campaign's
+    ``campaign.json`` (``missing``: how many of its runs never ran)."""
     import matplotlib  # lazy: pyplot costs ~1.5 s; only plots need it
 
     matplotlib.use("Agg")
@@ -305,7 +313,7 @@ def write_html(path, rows, axes, meta):
     if meta.get("description"):
         parts.append(f"<p>{esc(meta['description'])}</p>")
     known_limits = meta.get("known_limits") or ()
-    summary = format_report(rows, axes, known_limits).splitlines()[0]
+    summary = format_report(rows, axes, known_limits, meta.get("missing", 0)).splitlines()[0]
     parts.append(f"<p><b>{esc(summary)}</b></p>")
     facts = [
         (k, meta[k])
