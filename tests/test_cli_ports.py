@@ -100,3 +100,51 @@ def test_design_must_be_verilog(tmp_path, capsys):
     path, _design = _noreset(tmp_path)
     code, _out, err = _ports([str(path), "--design", "follow_target"], capsys)
     assert code == 2 and "must be a Verilog design" in err
+
+
+@pytest.mark.parametrize(
+    "edit, message",
+    [
+        (
+            ("[connectors.bumper]", "[connectors.sonar]"),
+            (
+                "port map: connectors.sonar: unknown connector kind; known: bumper, lidar, "
+                "lidar_uart, line_sensors, servo, ultrasound"
+            ),
+        ),
+        (
+            ('pressed = "bump_i"', 'pushed = "bump_i"'),
+            (
+                "port map: connectors.bumper.pushed: the bumper connector has no pin 'pushed'; "
+                "its pins: pressed"
+            ),
+        ),
+    ],
+)
+def test_the_map_only_check_refuses_an_unknown_connector_kind_or_pin(
+    tmp_path, capsys, edit, message
+):
+    """Without --design, as with it: the connector kinds and their pins need no design."""
+    path, _design = _noreset(tmp_path, edit)
+    code, out, err = _ports([str(path)], capsys)
+    assert (code, out) == (2, "")
+    assert err == f"fpga-robotics ports: error: {message}\n"
+
+
+def test_docs_list_every_connector_kind_a_port_map_binds():
+    from pathlib import Path
+
+    from fpga_robotics.designs.builtin import connector_kinds
+
+    docs = (Path(__file__).parents[1] / "docs" / "foreign.md").read_text()
+    section = docs.split("## Sensors on pins")[1].split("```")[0]
+    assert sorted(connector_kinds()) == [
+        "bumper",
+        "lidar",
+        "lidar_uart",
+        "line_sensors",
+        "servo",
+        "ultrasound",
+    ]
+    for kind in connector_kinds():
+        assert f"`{kind}`" in section, kind

@@ -5,8 +5,13 @@ driven, the connectors' pins)."""
 
 from fpga_robotics.cli.designs import checked_verilog
 from fpga_robotics.cli.parser import CommandParser
+from fpga_robotics.designs.builtin import connector_kinds
 from fpga_robotics.designs.reference import DesignError, resolve_design
-from fpga_robotics.sim.backends.port_map import load_port_map, write_follow_target_port_map
+from fpga_robotics.sim.backends.port_map import (
+    check_connector_names,
+    load_port_map,
+    write_follow_target_port_map,
+)
 
 __all__ = ["build_parser", "main"]
 
@@ -38,6 +43,7 @@ def main(argv=None, prog="fpga-robotics ports"):
         print(f"wrote {args.path}")
         return 0
     port_map = load_port_map(args.path)
+    check_connector_names(port_map, connector_kinds())  # the connector kinds need no design
     if args.design is not None:
         _check_against_design(args.design, args.path)
     connectors = "".join(f", connectors.{kind}" for kind in port_map.connectors)
