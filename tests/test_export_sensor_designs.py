@@ -152,10 +152,34 @@ def test_options_reach_the_design(tmp_path):
     assert re.search(r"reg \[19:0\] count\b", narrow)
 
 
+def test_turret_tracker_takes_the_follow_target_options_for_its_body_camera(tmp_path, capsys):
+    """--width/--height size the body camera's channel; the pan camera's stays 160x120."""
+    out = tmp_path / "t.v"
+    assert (
+        main(["--top", "turret_tracker", "--width", "320", "--height", "240", "-o", str(out)]) == 0
+    )
+    assert capsys.readouterr().out == (
+        f"wrote {out} (body camera 320x240, pan camera 160x120 on a servo, module turret_tracker)\n"
+    )
+    text = out.read_text()
+    assert re.search(r"output \[8:0\] centroid_x;", text)  # 320 columns
+    assert re.search(r"output \[7:0\] turret_centroid_x;", text)  # 160 columns
+
+
 @pytest.mark.parametrize(
     "argv,message",
     [
-        (["--top", "follow_line", "--width", "320"], "--width applies to --top follow_target or"),
+        (
+            ["--top", "follow_line", "--width", "320"],
+            (
+                "--width applies to --top follow_target, follow_target_safe or turret_tracker (its "
+                "body camera's channel), not to --top follow_line"
+            ),
+        ),
+        (
+            ["--top", "corridor_follow", "--preset", "published"],
+            "--preset applies to --top follow_target, follow_target_safe or turret_tracker",
+        ),
         (["--line-base-dps", "3"], "--line-base-dps applies to --top follow_line"),
         (
             ["--top", "follow_line", "--stop-mm", "3"],

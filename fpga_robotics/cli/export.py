@@ -10,11 +10,12 @@
     fpga-robotics export --design follow_target_safe [--stop-mm 250 ...]   (= --top NAME)
 
 ``--top`` picks the design (default ``follow_target``; docs/sensor_designs.md describes the
-sensor designs, docs/lidar.md the corridor followers), and the Verilog module is named after it. Every ``FollowTargetParams`` field is an
-option (``--diff-min 5``, ``--base-dps 0,400,...``; ``follow_target`` and
-``follow_target_safe``); ``--preset NAME`` starts from a preset, the other options on top. The
-sensor designs' parameters are options too (``fpga_robotics.cli.sensor_options``), and
-``--variant NAME`` exports a seeded buggy variant. A bad value, an unknown preset or an option
+sensor designs, docs/lidar.md the corridor followers), and the Verilog module is named after
+it. Every ``FollowTargetParams`` field is an option (``--diff-min 5``, ``--base-dps
+0,400,...``; ``follow_target``, ``follow_target_safe`` and ``turret_tracker``'s body camera);
+``--preset NAME`` starts from a preset, the other options on top. The sensor designs'
+parameters are options too (``fpga_robotics.cli.sensor_options``), and ``--variant NAME``
+exports a seeded buggy variant. A bad value, an unknown preset or an option
 the top does not read prints what is wrong and exits with code 2.
 """
 
@@ -164,8 +165,12 @@ def _sensor_top(args, params):
             f"{uart.clock_hz} Hz{variant}"
         )
     if args.top == "turret_tracker":
-        text = generate_top_verilog(TurretTracker(params, _turret_params(args)), args.top)
-        return text, f"{_follow_target_text(args, params)}, pan camera on a servo{variant}"
+        turret = _turret_params(args)  # no option sets it: its defaults, or a variant's
+        text = generate_top_verilog(TurretTracker(params, turret), args.top)
+        return text, (
+            f"body camera {_follow_target_text(args, params)}, pan camera "
+            f"{turret.width}x{turret.height} on a servo{variant}"
+        )
     if args.top == "follow_line":
         line = sensor_params_from_args(args, "line", args.top)
         sensors = f"{line.n_sensors} sensor{'s' if line.n_sensors > 1 else ''}"
@@ -224,13 +229,14 @@ def _check_options_fit_the_top(args):
         ]
         if ft_given:
             options = ", ".join("--" + n.replace("_", "-") for n in ft_given)
+            tops = [top for top in TOPS if top not in _NO_FOLLOW_TARGET]
             raise UsageError(
-                f"{options} applies to --top follow_target or "
-                f"follow_target_safe, not to --top {args.top}"
+                f"{options} applies to --top {', '.join(tops[:-1])} or {tops[-1]} (its body "
+                f"camera's channel), not to --top {args.top}"
             )
 
 
-#: The tops that take no FollowTargetParams.
+#: The tops that take no FollowTargetParams (turret_tracker takes them for its body camera).
 _NO_FOLLOW_TARGET = ("follow_line", "corridor_follow", "corridor_follow_uart")
 
 
