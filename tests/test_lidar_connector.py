@@ -176,6 +176,8 @@ def test_uart_packets_follow_their_samples():
             ),
         ),
         ({"spin": 1}, "unknown key 'spin' for a 'lidar' connector"),
+        # The serial link's rate: the stream binding has no use for it.
+        ({"baud": 57600}, "unknown key 'baud' for a 'lidar' connector"),
     ],
 )
 def test_bad_keys_are_named(table, message):
@@ -277,3 +279,8 @@ def test_a_stream_at_two_edges_a_sample_keeps_up():
 def test_a_lidar_that_does_not_fit_the_run_is_refused_at_load(scenario, sets, message):
     with pytest.raises(ScenarioError, match=re.escape(message)):
         load_scenario(scenario, sets)
+
+
+def test_the_serial_binding_takes_its_baud():
+    [spec] = parse_connectors({"sensors": [{"kind": "lidar_uart", "baud": 230400}]})
+    assert spec.params.baud == 230400

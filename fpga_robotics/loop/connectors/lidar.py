@@ -79,6 +79,9 @@ def _or_at_most(key, most, lowest):
 class _LidarBase(Connector):
     """What both bindings share: the keys, the scan, and what is reported of it."""
 
+    #: Keys of ``_KEYS`` the binding has no use for: refused, as unknown keys are.
+    unused_keys: ClassVar[tuple] = ()
+
     def __init__(self, name, mount, params, *, world, rng):
         super().__init__(name, mount, params, world=world, rng=rng)
         self.scan = Scan(params, rng)
@@ -93,7 +96,8 @@ class _LidarBase(Connector):
     @classmethod
     def parse(cls, table, where):
         defaults = LidarParams()
-        refuse_unknown_keys(table, _KEYS, where, cls.kind)
+        keys = {key: bounds for key, bounds in _KEYS.items() if key not in cls.unused_keys}
+        refuse_unknown_keys(table, keys, where, cls.kind)
         values = check_numbers(table, _KEYS, defaults, where)
         if not values["min_range"] < values["max_range"]:
             raise ConnectorError(
@@ -212,6 +216,7 @@ class LidarConnector(_LidarBase):
 
     kind = "lidar"
     pins: ClassVar[dict] = {"valid": Pin("in", 1), "payload": Pin("in", SAMPLE_BITS)}
+    unused_keys = ("baud",)  # the serial link's (lidar_uart)
 
     @classmethod
     def check_run(cls, params, mount, where, sim, room):
