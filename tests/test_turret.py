@@ -350,6 +350,14 @@ height = 0.15
 resolution = "80x60"
 fps = 5.0
 target = "blue"
+
+[[robot.sensors]]
+kind = "camera"
+name = "rear"
+yaw_deg = 180.0
+height = 0.15
+resolution = "80x60"
+fps = 5.0
 """
     text = TWO_CAMERAS.replace("[[people]]", side + "[[people]]", 1)
     records = []
@@ -361,8 +369,17 @@ target = "blue"
     assert t["side.target_bearing_deg"][0] == pytest.approx(expected)
     assert t["side.target_in_view"][0] == 0
     assert t["turret.target_in_view"][0] == 1  # the pan camera sees blue at the same instant
-    assert set(records[0].cameras) == {"turret", "side"}
+    assert set(records[0].cameras) == {"turret", "side", "rear"}
     assert records[0].cameras["side"].rgb.shape == (60, 80, 3)
     cams = result.summary["cameras"]
     assert (cams["side"]["channel"], cams["turret"]["channel"]) == (None, "model")
     assert cams["side"]["frames"] == 1 and cams["turret"]["frames"] == 2  # 5 and 10 fps, 0.2 s
+    # A camera without a target is listed too, with nothing to judge.
+    assert cams["rear"] == {
+        "frames": 1,
+        "channel": None,
+        "target_in_view_fraction": None,
+        "target_centred_fraction": None,
+        "max_abs_bearing_deg": None,
+    }
+    assert result.summary["camera_target_in_view_fraction"] == 0.0  # side's, not rear's

@@ -257,15 +257,11 @@ class CameraRig:
         return readings
 
     def metrics(self, rows):
-        """Per camera with a target: how often it was in view and within ``centred_deg`` of
-        the axis; the smallest of each over the cameras (``camera_target_*_fraction``)."""
+        """Per camera: its frames, what ran its channel and, with a target, how often that
+        was in view and within ``centred_deg`` of the axis (None without one); the smallest
+        of each over the cameras with a target (``camera_target_*_fraction``)."""
         per = {}
         for cam in self.cameras:
-            if cam.params.target is None:
-                continue
-            seen = self.columns[f"{cam.name}.target_in_view"][:rows]
-            bearing = self.columns[f"{cam.name}.target_bearing_deg"][:rows]
-            centred = np.abs(bearing) <= cam.params.centred_deg
             per[cam.name] = {
                 "frames": cam.frames,
                 # What ran its design channel: the channel's model or the design on a clocked
@@ -276,18 +272,31 @@ class CameraRig:
                 else "design"
                 if self.pins is not None
                 else cam.channel_ran,
-                "target_in_view_fraction": round(float(np.mean(seen == 1.0)), 4) if rows else None,
-                "target_centred_fraction": round(float(np.mean(centred)), 4) if rows else None,
-                "max_abs_bearing_deg": round(float(np.nanmax(np.abs(bearing))), 2)
-                if rows
-                else None,
+                **self._target_metrics(cam, rows),
             }
-        fractions = [v["target_in_view_fraction"] for v in per.values()]
-        centred = [v["target_centred_fraction"] for v in per.values()]
+        judged = [v for v in per.values() if v["target_in_view_fraction"] is not None]
+        fractions = [v["target_in_view_fraction"] for v in judged]
+        centred = [v["target_centred_fraction"] for v in judged]
         return {
             "cameras": per,
             "camera_target_in_view_fraction": min(fractions) if fractions else None,
             "camera_target_centred_fraction": min(centred) if centred else None,
+        }
+
+    def _target_metrics(self, cam, rows):
+        """How often ``cam``'s target was in view and centred in the first ``rows`` rows, and
+        the most it strayed (each None without a target or rows)."""
+        if cam.params.target is None or not rows:
+            return dict.fromkeys(
+                ("target_in_view_fraction", "target_centred_fraction", "max_abs_bearing_deg")
+            )
+        seen = self.columns[f"{cam.name}.target_in_view"][:rows]
+        bearing = self.columns[f"{cam.name}.target_bearing_deg"][:rows]
+        centred = np.abs(bearing) <= cam.params.centred_deg
+        return {
+            "target_in_view_fraction": round(float(np.mean(seen == 1.0)), 4),
+            "target_centred_fraction": round(float(np.mean(centred)), 4),
+            "max_abs_bearing_deg": round(float(np.nanmax(np.abs(bearing))), 2),
         }
 
 
