@@ -1221,6 +1221,15 @@ PLANS = {
         shorter=(("--frames", "2"), ("--repeats", "1")),
         out=(r"(?m)^\s*160x120\s+[\d.]+", r"(?m)^\s*640x480\s+[\d.]+"),
     ),
+    # docs/turret.md -----------------------------------------------------------------------------
+    "fpga-robotics bench cameras --repeats 5": Plan(
+        shorter=(("--seconds", "0.5"), ("--repeats", "1")),
+        out=(
+            r"(?m)^ +one camera: +[\d.]+ \([\d.]+-[\d.]+\) ms/frame, CPU [\d.]+",
+            r"(?m)^ +two cameras: +[\d.]+ \([\d.]+-[\d.]+\) ms/frame, CPU [\d.]+",
+            r"(?m)^two cameras / one camera: [\d.]+ \(CPU [\d.]+\)$",
+        ),
+    ),
     # docs/pins.md -------------------------------------------------------------------------------
     "fpga-robotics bench pins": Plan(
         slow=True,

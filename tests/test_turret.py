@@ -226,6 +226,25 @@ def test_the_cameras_benchmark_prints_both_runs_and_their_ratio(capsys, tmp_path
     assert f"two cameras / one camera: {figures['ratio']:.2f}" in out
 
 
+def test_the_cameras_benchmark_warms_up_before_it_times(monkeypatch, capsys):
+    """An untimed short run of each loop comes first, so that --repeats 1 is no cold run."""
+    from types import SimpleNamespace
+
+    from fpga_robotics.bench import cameras
+
+    runs = []  # (connectors of the run, its simulated seconds), in order
+
+    def run_scenario(scenario, backend):
+        runs.append((len(scenario.connectors), scenario.sim.duration))
+        return SimpleNamespace(summary={"frames": 1})
+
+    monkeypatch.setattr(cameras, "run_scenario", run_scenario)
+    assert cameras.main(["--seconds", "2", "--repeats", "1"]) == 0
+    capsys.readouterr()
+    # The pan camera and its servo are the turret's two connectors.
+    assert runs == [(0, cameras.WARM_UP_S), (2, cameras.WARM_UP_S), (0, 2.0), (2, 2.0)]
+
+
 def test_the_bag_has_each_camera_once_per_capture(tmp_path):
     from rosbags.highlevel import AnyReader
     from rosbags.typesys import Stores, get_typestore
