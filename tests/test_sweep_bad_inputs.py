@@ -67,6 +67,10 @@ def test_bad_campaign_file_is_one_line_and_exit_2(case, tmp_path, monkeypatch, c
         (["--scheduler", "tcp://127.0.0.1:9", "--workers", "2"], "--workers sizes"),
         (["nonexistent_campaign"], "unknown campaign"),
         (["--record", "none", "--log-every", "3"], "--log-every shapes the recordings"),
+        # --dry-run checks what the run would check.
+        (["--record", "none", "--bag", "--dry-run"], "--bag writes the recorded runs"),
+        (["--record", "none", "--log-every", "3", "--dry-run"], "--log-every shapes"),
+        (["--resume", "--out", "c.toml", "--dry-run"], "--out 'c.toml' exists and is not a"),
     ],
 )
 def test_bad_options_are_one_line_and_exit_2(argv, message, tmp_path):

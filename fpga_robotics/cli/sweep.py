@@ -211,13 +211,22 @@ def _campaign(args):
     return load_campaign(data, source=source, scenarios_replaced=args.scenarios is not None)
 
 
-def _check_counts(args):
+def _check_options(args):
     for name in ("workers", "max_runs", "bench_runs", "bench_repeats", "log_every"):
         value = getattr(args, name)
         if value is not None and value < 1:
             raise UsageError(f"--{name.replace('_', '-')} must be >= 1, got {value}")
     if args.timeout is not None and not args.timeout > 0:
         raise UsageError(f"--timeout must be > 0 seconds, got {args.timeout}")
+    if args.bag and args.record == "none":
+        raise UsageError(
+            "--bag writes the recorded runs as ROS 2 bags: it needs --record "
+            "failing (the default) or all"
+        )
+    if args.log_every is not None and args.record == "none":
+        raise UsageError(
+            "--log-every shapes the recordings: it needs --record failing (the default) or all"
+        )
     if args.workers is not None and args.scheduler is not None:
         raise UsageError(
             "--workers sizes the embedded cluster; with --scheduler the cluster "
@@ -259,7 +268,7 @@ def main(argv=None, prog=PROG):
     if argv[:1] == ["report"]:
         return _report(argv[1:], prog)
     args = build_parser(prog).parse_args(argv)
-    _check_counts(args)
+    _check_options(args)
     if args.bench:
         from fpga_robotics.bench.sweep import bench  # lazy: the run stack (~1 s)
 
@@ -268,24 +277,15 @@ def main(argv=None, prog=PROG):
     from fpga_robotics.sweep.sanity import report_campaign_warnings  # lazy: the run stack (~1 s)
 
     report_campaign_warnings(campaign, args.strict, sys.stderr, UsageError)
+    out = Path(args.out) if args.out else Path("runs") / "sweeps" / campaign.name
+    check_output_dir(out, what="--out")  # --dry-run too: it says the command would run
     if args.dry_run:
         return _dry_run(campaign, args)
-    out = Path(args.out) if args.out else Path("runs") / "sweeps" / campaign.name
-    check_output_dir(out, what="--out")
 
     def echo(text):
         if not args.quiet:
             print(text, file=sys.stderr, flush=True)
 
-    if args.bag and args.record == "none":
-        raise UsageError(
-            "--bag writes the recorded runs as ROS 2 bags: it needs --record "
-            "failing (the default) or all"
-        )
-    if args.log_every is not None and args.record == "none":
-        raise UsageError(
-            "--log-every shapes the recordings: it needs --record failing (the default) or all"
-        )
     try:
         rows = run_campaign(
             campaign,
