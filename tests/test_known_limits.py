@@ -61,12 +61,41 @@ def test_known_limits_are_parsed_with_their_scope():
         ({**LIMIT, "check": []}, "registered check"),
         ({**LIMIT, "reason": " "}, "give a reason"),
         ({**LIMIT, "when": {"camera.noise_std": 0.0}}, "no grid axis or set"),
+        # A value no run has would explain nothing, silently.
+        (
+            {**LIMIT, "when": {"camera.resolution": "80x61"}},
+            (
+                'when camera.resolution = "80x61" matches no run \\(the campaign\'s values of '
+                'camera.resolution: "80x60"\\)'
+            ),
+        ),
+        (
+            {**LIMIT, "when": {"camera.resolution": "80x60", "camera.fps": 15.0}},
+            'when camera.resolution = "80x60", camera.fps = 15.0 matches no run',
+        ),
         ({**LIMIT, "why": "x"}, "unknown key 'why'"),
     ],
 )
 def test_a_malformed_known_limit_says_what_is_wrong(entry, says):
     with pytest.raises(CampaignError, match=says):
         load_campaign({**BASE, "known_limits": [entry]})
+
+
+def test_a_known_limit_off_an_axis_the_command_line_replaced_does_not_apply():
+    grid = {**BASE, "sets": [{"camera.fps": 15.0}], "grid": {"camera.resolution": ["160x120"]}}
+    limits = [LIMIT, {**LIMIT, "when": {"camera.fps": 30.0}}]
+    # --grid replaced the resolution axis: the entry for 80x60 does not apply. The fps of
+    # the file's sets is still checked.
+    with pytest.raises(CampaignError, match="when camera.fps = 30.0 matches no run"):
+        load_campaign(
+            {**grid, "known_limits": limits}, command_line={"grid": ["camera.resolution"]}
+        )
+    with pytest.raises(CampaignError, match='when camera.resolution = "80x60" matches no run'):
+        load_campaign({**grid, "known_limits": [LIMIT]})
+    c = load_campaign(
+        {**grid, "known_limits": [LIMIT]}, command_line={"grid": ["camera.resolution"]}
+    )
+    assert c.known_limits[0]["when"] == {"camera.resolution": "80x60"}
 
 
 def _row(status, failed="", resolution=None, scenario="follow_person"):

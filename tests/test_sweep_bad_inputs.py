@@ -38,6 +38,44 @@ CASES = {
         'scenarios = ["line_track"]\nduration = 1.0\nshadow = "published"\n',
         "this scenario runs in real-clock timing, where --shadow takes a design reference",
     ),
+    # A value for every run that the runs' overrides give too: a run would take one of them
+    # and its row be labelled with the other.
+    "a set item on a grid axis": (
+        GOOD + 'set = ["design.diff_min=5"]\n[grid]\n"design.diff_min" = [4, 6]\n',
+        (
+            'c.toml: set item "design.diff_min=5" gives every run its design.diff_min, and the '
+            "[grid] axis design.diff_min varies it: give it in one of them"
+        ),
+    ),
+    "a set item in a set": (
+        GOOD + 'set = ["robot.mass=12"]\n[[sets]]\n"robot.mass" = 10.0\n',
+        'set item "robot.mass=12" gives every run its robot.mass, and sets[0] varies it',
+    ),
+    "a design and a design.top axis": (
+        GOOD + 'design = "mine.py:Mine"\n[grid]\n"design.top" = ["follow_target"]\n',
+        (
+            'design = "mine.py:Mine" gives every run its design.top, and the [grid] axis '
+            "design.top varies it"
+        ),
+    ),
+    "a design and a design.top set item": (
+        GOOD + 'design = "mine.py:Mine"\nset = [\'design.top="follow_line"\']\n',
+        (
+            'design = "mine.py:Mine" gives every run its design.top, and set item '
+            '"design.top=\\"follow_line\\"" gives it too'
+        ),
+    ),
+    "a Verilog design without its port map": (
+        GOOD + 'design = "verilog:top.v"\n',
+        'run of approach: design = "verilog:top.v" needs ports = "PORTS.toml" (its port map)',
+    ),
+    "a port map without a Verilog design": (
+        GOOD + 'ports = "top_ports.toml"\n',
+        (
+            'run of approach: ports = "top_ports.toml" is the port map of a Verilog design, and '
+            'the run has none: give design = "verilog:FILE.v" with it, or leave ports out'
+        ),
+    ),
 }
 
 
@@ -155,6 +193,55 @@ def test_a_bad_option_value_is_blamed_on_the_option(case, tmp_path, monkeypatch,
     lines = capsys.readouterr().err.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith(f"fpga-robotics sweep: error: {message}"), lines
     assert not (tmp_path / "out").exists()
+
+
+#: Values the command line gives every run, or a design, that the file's runs vary: the error
+#: names the option.
+GIVEN_TWICE = {
+    "--set on a grid axis": (
+        '[grid]\n"design.diff_min" = [4, 6]\n',
+        ["--set", "design.diff_min=5"],
+        (
+            "--set design.diff_min=5 gives every run its design.diff_min, and the [grid] axis "
+            "design.diff_min varies it"
+        ),
+    ),
+    "--grid on a set item": (
+        'set = ["design.diff_min=5"]\n',
+        ["--grid", "design.diff_min=[4, 6]"],
+        (
+            'set item "design.diff_min=5" gives every run its design.diff_min, and --grid '
+            "design.diff_min varies it"
+        ),
+    ),
+    "--design on a design.top axis": (
+        '[grid]\n"design.top" = ["follow_target", "follow_line"]\n',
+        ["--design", "mine.py:Mine"],
+        (
+            "--design mine.py:Mine gives every run its design.top, and the [grid] axis "
+            "design.top varies it"
+        ),
+    ),
+    "--design verilog without --ports": (
+        "",
+        ["--design", "verilog:top.v"],
+        "run of approach: --design needs --ports PORTS.toml (the design's port map)",
+    ),
+}
+
+
+@pytest.mark.parametrize("case", sorted(GIVEN_TWICE))
+def test_a_value_given_twice_is_refused_naming_the_option(case, tmp_path, monkeypatch, capsys):
+    text, argv, message = GIVEN_TWICE[case]
+    (tmp_path / "c.toml").write_text(GOOD + text)
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(SystemExit) as exit_info:
+        run_cli(main, ["c.toml", *argv, "--dry-run"], prog="fpga-robotics sweep")
+    assert exit_info.value.code == 2
+    captured = capsys.readouterr()
+    lines = captured.err.strip().splitlines()
+    assert len(lines) == 1 and message in lines[0], lines
+    assert captured.out == ""
 
 
 LIMIT = '[[known_limits]]\ncheck = "found_min_fraction"\nreason = "x"\n'

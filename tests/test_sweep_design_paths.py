@@ -104,6 +104,21 @@ def test_design_files_in_set_items_and_sets_are_relative_to_the_campaign_file(tr
     assert main([str(tree / "camp" / "c.toml"), "--dry-run"]) == 0
 
 
+def test_a_run_that_gives_its_own_port_map_takes_not_the_campaigns(tree):
+    # The scenario's own Verilog design: the campaign's ports replace its map (run --ports),
+    # but not in a run that sets design.ports itself (--ports would replace that too, and its
+    # row name a map it did not run).
+    ports = tree / "designs" / "ports.toml"
+    campaign = _campaign(
+        tree,
+        'ports = "../designs/ports.toml"\n[[sets]]\n"design.ports" = "other.toml"\n'
+        '[[sets]]\n"robot.mass" = 1.0\n',
+    )
+    own, other = campaign.runs
+    assert _sets(own) == ({"design.ports": json.dumps(str(tree / "camp" / "other.toml"))}, False)
+    assert _sets(other)[1] and other.ports == os.path.relpath(ports)
+
+
 def test_a_known_limit_names_a_design_as_the_grid_does(tree):
     # `when` matches the rows' values: its design reference is read as the grid's is.
     campaign = _campaign(

@@ -50,7 +50,7 @@ from fpga_robotics.sim.files import check_output_path, check_paths_apart, write_
 from fpga_robotics.sim.pins import DesignError, PinError
 from fpga_robotics.sim.world.config import parse_world_config
 
-__all__ = ["TARGET_CLOTHING", "Progress", "build_parser", "main"]
+__all__ = ["TARGET_CLOTHING", "PortMapUnpaired", "Progress", "build_parser", "main"]
 
 #: Clothing (shirt and trousers, linear RGB 0..1) that each colour select picks out clearly
 #: under the shipped scenarios' lighting: one channel group well above the others.
@@ -556,13 +556,18 @@ def _with_design_files(args, scenario):
     return dataclasses.replace(scenario, foreign=ForeignDesignFiles(tuple(files), str(ports)))
 
 
+class PortMapUnpaired(UsageError):
+    """A Verilog design without a port map, or a port map without a Verilog design (a
+    campaign says it in its file's words when the file gave them)."""
+
+
 def _design_files(args, foreign=None):
     """The Verilog files and port map of the foreign design (None without one): ``--design``
     and ``--ports``, each overriding the scenario's ``[design] verilog`` / ``ports``
     (``foreign``, a ``ForeignDesignFiles``); checks they go together."""
     if args.design is None and foreign is None:
         if args.ports is not None:
-            raise UsageError("--ports goes with --design verilog:FILE.v")
+            raise PortMapUnpaired("--ports goes with --design verilog:FILE.v")
         if getattr(args, "runtime", None):
             raise UsageError(
                 "--runtime sets [runtime] inputs of a Verilog design: it goes with "
@@ -580,7 +585,7 @@ def _design_files(args, foreign=None):
         args.ports if args.ports is not None else (foreign.ports if foreign is not None else None)
     )
     if ports is None:
-        raise UsageError("--design needs --ports PORTS.toml (the design's port map)")
+        raise PortMapUnpaired("--design needs --ports PORTS.toml (the design's port map)")
     if args.backend not in FOREIGN_BACKENDS:
         what = "--design" if args.design is not None else "the scenario's design.verilog"
         raise UsageError(f"{what} runs on the cxxrtl or verilator backend, not {args.backend!r}")

@@ -155,7 +155,8 @@ def build_parser(prog=PROG):
 
 def _merge_options(data, args):
     """The command-line values into the campaign's table, each checked first: an error
-    names the option, not the campaign file."""
+    names the option, not the campaign file. Returns what the command line gave, as
+    ``load_campaign``'s ``command_line``."""
     from fpga_robotics.scenario.load import _parse_value  # lazy: the run stack (~1 s)
 
     if args.scenarios is not None:
@@ -193,6 +194,9 @@ def _merge_options(data, args):
             )
         grid = data.get("grid") if isinstance(data.get("grid"), dict) else {}
         data["grid"] = {**grid, key.strip(): values}
+    given = {k: True for k in ("scenarios", "design", "ports") if getattr(args, k) is not None}
+    grid = [item.partition("=")[0].strip() for item in args.grid]
+    return {**given, "set": args.fixed or [], "grid": grid}
 
 
 def _campaign(args):
@@ -207,8 +211,8 @@ def _campaign(args):
     else:
         data, path = read_campaign_file(args.campaign)
         source = str(path)
-    _merge_options(data, args)
-    return load_campaign(data, source=source, scenarios_replaced=args.scenarios is not None)
+    command_line = _merge_options(data, args)
+    return load_campaign(data, source=source, command_line=command_line)
 
 
 def _check_options(args):

@@ -143,9 +143,14 @@ class Campaign:
     identities: dict = field(default_factory=dict)  # filled by plan.identify
     #: ``[[known_limits]]``: failures that are limits of the design, each with its reason.
     known_limits: list = field(default_factory=list)
-    #: The scenarios were replaced on the command line (``--scenarios``): a known limit may
-    #: then name a scenario of the file that this campaign does not run (it does not apply).
-    scenarios_replaced: bool = False
+    #: What the command line gave (``load_campaign``'s ``command_line``).
+    command_line: dict = field(default_factory=dict)
+
+    @property
+    def scenarios_replaced(self):
+        """The command line replaced the scenarios (``--scenarios``): a known limit may then
+        name a scenario of the file that this campaign does not run (it does not apply)."""
+        return bool(self.command_line.get("scenarios"))
 
 
 def toml_value(v):
@@ -291,9 +296,85 @@ def _flatten_values(table, prefix):
     return out
 
 
-def _known_limits(data, axes):
+#: Override keys that choose the design, which a campaign's ``design`` chooses for every run.
+DESIGN_CHOICE_KEYS = ("design.top", "design.verilog")
+
+
+def _given_once(data, fixed, command_line):
+    """Refuse a value the campaign gives every run (a ``set`` item; ``design``, and with it
+    ``ports``) that the runs' overrides give too (a grid axis, a ``[[sets]]`` table, a ``set``
+    item): a run takes one of them (run's last ``--set``, its ``--design``) while its row
+    would be labelled with the other. Each is named as it was given: by its option when the
+    command line gave it, else in the file's words."""
+    every = {}  # key -> how the campaign gives it to every run
+    if data.get("design") is not None:
+        how = (
+            f"--design {data['design']}"
+            if command_line.get("design")
+            else f"design = {toml_value(data['design'])}"
+        )
+        every.update(dict.fromkeys(DESIGN_CHOICE_KEYS, how))
+        if data.get("ports") is not None:  # run's --ports replaces the design's design.ports
+            every["design.ports"] = (
+                f"--ports {data['ports']}"
+                if command_line.get("ports")
+                else f"ports = {toml_value(data['ports'])}"
+            )
+    given = []  # (key, how, varied) of each override
+    for item in fixed:
+        how = (
+            f"--set {item}"
+            if item in command_line.get("set", ())
+            else f"set item {toml_value(item)}"
+        )
+        given.append((item.partition("=")[0].strip(), how, False))
+    for key, _ in _flatten(data.get("grid") or {}, "", "grid key"):
+        how = f"--grid {key}" if key in command_line.get("grid", ()) else f"the [grid] axis {key}"
+        given.append((key, how, True))
+    for i, table in enumerate(data.get("sets") or []):
+        given += [(key, f"sets[{i}]", True) for key, _ in _flatten_values(table, "")]
+    for key, how, varied in given:
+        if key in every:
+            raise CampaignError(
+                f"{every[key]} gives every run its {key}, and {how} "
+                f"{'varies it' if varied else 'gives it too'}: give it in one of them"
+            )
+        if not varied:
+            every[key] = how  # a later --set replaces an earlier set item of the key
+
+
+def _comparable(value):
+    """An override value as the runs' values are compared (a list as a tuple)."""
+    if isinstance(value, (list, tuple)):
+        return tuple(_comparable(v) for v in value)
+    return value
+
+
+def _when_matches_a_run(where, when, combos, replaced):
+    """A known limit's ``when`` must match some run: a value no run has (a typo, ``"3000"``
+    for 3000) would otherwise explain nothing, silently. An axis the command line replaced
+    (``--grid``) may leave a value out (the entry then does not apply)."""
+    wanted = {k: _comparable(v) for k, v in when.items() if k not in replaced}
+    runs = [{k: _comparable(v) for k, v in combo} for combo in combos]
+    for key, value in wanted.items():
+        values = []
+        for run in runs:
+            if key in run and run[key] not in values:
+                values.append(run[key])
+        if value not in values:
+            raise CampaignError(
+                f"{where}: when {key} = {toml_value(when[key])} matches no run (the "
+                f"campaign's values of {key}: {', '.join(toml_value(v) for v in values)})"
+            )
+    if not any(all(k in run and run[k] == v for k, v in wanted.items()) for run in runs):
+        shown = ", ".join(f"{k} = {toml_value(when[k])}" for k in wanted)
+        raise CampaignError(f"{where}: when {shown} matches no run (no run has them all)")
+
+
+def _known_limits(data, axes, combos, replaced=()):
     """The ``[[known_limits]]`` entries, checked: each names a registered check and a reason,
-    optionally ``when`` (override key -> value, keys among the grid/sets axes) and
+    optionally ``when`` (override key -> value, keys among the grid/sets axes, matching
+    some run of ``combos`` but on the axes the command line ``replaced``) and
     ``scenarios``."""
     from fpga_robotics.checks.registry import check_names  # lazy: the run stack (~1 s)
 
@@ -339,6 +420,7 @@ def _known_limits(data, axes):
                 f"{where}: when names {stray[0]!r}, which no grid axis or set "
                 f"of the campaign varies"
             )
+        _when_matches_a_run(where, when, combos, replaced)
         scenarios = entry.get("scenarios", [])
         if isinstance(scenarios, str):
             scenarios = [scenarios]
@@ -406,11 +488,14 @@ def read_campaign_file(name_or_path):
     return data, path
 
 
-def load_campaign(data, *, source="", scenarios_replaced=False):
+def load_campaign(data, *, source="", command_line=None):
     """The ``Campaign`` of a checked table (``read_campaign_file`` plus command-line
     options merged in). Scenarios and overrides are checked by ``plan.make_plan``.
-    ``scenarios_replaced``: the command line replaced the file's scenarios."""
+    ``command_line``: what of ``data`` the command line gave, ``{"scenarios": True,
+    "design": True, "ports": True, "set": [ITEM, ...], "grid": [KEY, ...]}`` (any left
+    out), so that messages name those values by their options."""
     where = f"{source}: " if source else ""
+    command_line = command_line or {}
     try:
         name = _typed(data, "name", str, "a string") or "campaign"
         # The name makes the default results folder: a plain file name.
@@ -437,7 +522,8 @@ def load_campaign(data, *, source="", scenarios_replaced=False):
             raise CampaignError(f"timeout must be > 0 seconds, got {timeout}")
         fixed = _set_items(data.get("set", []), "set")
         combos, axes = _combos(data)
-        known_limits = _known_limits(data, axes)
+        _given_once(data, fixed, command_line)
+        known_limits = _known_limits(data, axes, combos, command_line.get("grid", ()))
         base = RunSpec(
             scenario="",
             seed=0,
@@ -472,7 +558,7 @@ def load_campaign(data, *, source="", scenarios_replaced=False):
         timeout=timeout,
         source=source,
         known_limits=known_limits,
-        scenarios_replaced=scenarios_replaced,
+        command_line=command_line,
     )
 
 
@@ -480,7 +566,7 @@ def _with_ports(spec):
     """The campaign's ``ports`` go with every Verilog design of its runs: with no campaign
     ``design``, a run whose overrides make ``design.top`` a ``verilog:`` design gets them as
     ``design.ports`` (unless it sets that itself), and a run whose overrides name another
-    design takes none."""
+    design, or give the scenario's own Verilog design its ``design.ports``, takes none."""
     if spec.ports is None or spec.design is not None:
         return spec
     from fpga_robotics.scenario.load import _parse_value  # lazy: the run stack (~1 s)
@@ -491,7 +577,9 @@ def _with_ports(spec):
         overrides[key.strip()] = _parse_value(text)
     overrides.update(spec.overrides)
     if "design.top" not in overrides:
-        return spec  # the scenario's own design (its design.verilog): --ports replaces its map
+        # The scenario's own design (its design.verilog): --ports replaces its map, unless
+        # the run gives one (run's --ports would replace that too).
+        return replace(spec, ports=None) if "design.ports" in overrides else spec
     top = overrides["design.top"]
     if not (isinstance(top, str) and top.startswith("verilog:")) or "design.ports" in overrides:
         return replace(spec, ports=None)

@@ -6,7 +6,7 @@ from pathlib import Path
 
 from fpga_robotics.hw.errors import UsageError
 
-from .campaign import run_identity
+from .campaign import run_identity, toml_value
 from .fork_groups import world_key
 from .runner import _design_key, load_run
 
@@ -41,6 +41,7 @@ def make_plan(campaign):
     """Check every run (``UsageError`` naming the run's scenario and overrides) and name it.
     Runs differing only by seed share one check. Two scenario files of one name, and a
     known limit naming a scenario the campaign does not run, are usage errors too."""
+    from ..cli.run import PortMapUnpaired  # lazy: the run stack (~1 s)
     from ..sim.backends import BACKEND_NAMES  # lazy: the simulator (~0.5 s)
 
     plan = Plan(runs=[])
@@ -58,6 +59,8 @@ def make_plan(campaign):
                 args, scenario, shadow_params = load_run(spec.argv())
             except UsageError as exc:
                 what = " ".join(spec.set_items())
+                if isinstance(exc, PortMapUnpaired):
+                    exc = _port_map_unpaired(spec, campaign.command_line) or exc
                 raise UsageError(
                     f"run of {spec.scenario}{' with ' + what if what else ''}: {exc}"
                 ) from None
@@ -94,6 +97,22 @@ def make_plan(campaign):
     _one_file_per_name(files_named, where)
     _limits_name_run_scenarios(campaign, set(files_named), where)
     return plan
+
+
+def _port_map_unpaired(spec, command_line):
+    """run's message for a Verilog design without a port map (or a port map without one) in
+    the campaign file's words, when the file gave the value (None: the command line did, and
+    run's message names its option)."""
+    if spec.ports is None:
+        if command_line.get("design"):
+            return None
+        return f'design = {toml_value(spec.design)} needs ports = "PORTS.toml" (its port map)'
+    if command_line.get("ports"):
+        return None
+    return (
+        f"ports = {toml_value(spec.ports)} is the port map of a Verilog design, and the run "
+        f'has none: give design = "verilog:FILE.v" with it, or leave ports out'
+    )
 
 
 def _shown(given, source):
