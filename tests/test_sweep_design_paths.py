@@ -119,6 +119,27 @@ def test_a_run_that_gives_its_own_port_map_takes_not_the_campaigns(tree):
     assert _sets(other)[1] and other.ports == os.path.relpath(ports)
 
 
+def test_backend_auto_takes_what_run_takes_for_each_design(tree):
+    from fpga_robotics.sim.backends import fastest_backend_name
+    from fpga_robotics.sweep.plan import make_plan
+
+    def backends(text):
+        path = tree / "camp" / "auto.toml"
+        path.write_text(HEAD.replace('"cxxrtl"', '"auto"') + text)
+        return [spec.backend for spec in make_plan(load_campaign_file(str(path))).runs]
+
+    # run --backend auto puts a design of one's own on the fastest compiled backend (its pins
+    # on CXXRTL, else Verilator), as the campaign's design or as a design.top ...
+    fastest = fastest_backend_name()
+    assert backends('design = "../designs/bump_watch.py:BumpWatch"\n') == [fastest]
+    # ... and leaves a Verilog design to the foreign choice, design by design (Verilator for
+    # one CXXRTL cannot run): its runs stay on auto.
+    assert backends(
+        'ports = "../designs/ports.toml"\n[grid]\n"design.top" = '
+        '["verilog:../designs/bump_stop_noreset.v", "../designs/bump_watch.py:BumpWatch"]\n'
+    ) == ["auto", fastest]
+
+
 def test_a_known_limit_names_a_design_as_the_grid_does(tree):
     # `when` matches the rows' values: its design reference is read as the grid's is.
     campaign = _campaign(

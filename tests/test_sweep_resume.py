@@ -1,12 +1,19 @@
 """``--resume`` after a scenario file was edited: the runs of the old file are run again and
 their rows replaced (with their recordings), so the results hold each run of the campaign
-once, judged by the file as it is now."""
+once, judged by the file as it is now; and a design changed through a file it includes or
+imports makes other runs."""
 
 import csv
 import json
+import shutil
+import subprocess
+import sys
+from pathlib import Path
 
 from fpga_robotics.sweep import load_campaign, run_campaign
 from fpga_robotics.sweep.results import load_rows
+
+DATA = Path(__file__).parent / "data"
 
 #: A target walking away from a robot that cannot keep up: the mean distance grows past a few
 #: metres, so the check's limit decides the verdict.
@@ -133,3 +140,81 @@ def test_resume_records_the_kept_runs_the_new_record_option_asks_for(tmp_path):
     # holds the two kept rows, no line was added).
     run_campaign(campaign, out, workers=1, resume=True, record="all", bag=True)
     assert len((out / "results.jsonl").read_text().splitlines()) == 2
+
+
+#: A campaign's run identities, printed by a fresh interpreter: a design's imports are modules
+#: of the process that plans, and a new one reads their files as they are now.
+PLAN_IDS = (
+    "import sys\n"
+    "from fpga_robotics.sweep import load_campaign_file\n"
+    "from fpga_robotics.sweep.plan import make_plan\n"
+    "plan = make_plan(load_campaign_file(sys.argv[1]))\n"
+    "print(' '.join(plan.ids[s] for s in plan.runs))\n"
+)
+
+#: A bumper stop of one's own whose speed comes from a module next to it.
+GUARD = """import sys
+from pathlib import Path
+
+from amaranth import Module, Mux, Signal, signed
+from amaranth.lib import wiring
+from amaranth.lib.wiring import In, Out
+
+sys.path.insert(0, str(Path(__file__).parent))
+from helper import SPEED  # noqa: E402
+
+
+class Guard(wiring.Component):
+    pressed: In(1)
+    motor_left: Out(signed(16))
+    motor_right: Out(signed(16))
+
+    def elaborate(self, platform):
+        m = Module()
+        hit = Signal()
+        with m.If(self.pressed):
+            m.d.sync += hit.eq(1)
+        m.d.comb += [self.motor_left.eq(Mux(hit, 0, SPEED)), self.motor_right.eq(self.motor_left)]
+        return m
+"""
+
+
+def test_a_run_is_another_run_after_a_change_to_a_file_its_design_includes_or_imports(tmp_path):
+    # What --resume keeps goes by the runs' identities: a design changed through a file the
+    # campaign does not name must not keep its old rows.
+    for name in ("bump_wall.toml", "bump_stop_ports.toml"):
+        shutil.copy(DATA / name, tmp_path / name)
+    verilog = (DATA / "bump_stop.v").read_text()
+    (tmp_path / "inc.v").write_text(
+        verilog.replace(");\n  reg hit;", ');\n  `include "speed.vh"\n  reg hit;').replace(
+            "12'sd300", "SPEED"
+        )
+    )
+    (tmp_path / "speed.vh").write_text("localparam signed [11:0] SPEED = 12'sd300;\n")
+    (tmp_path / "guard.py").write_text(GUARD)
+    (tmp_path / "helper.py").write_text("SPEED = 300\n")
+    (tmp_path / "c.toml").write_text(
+        'scenarios = ["bump_wall.toml"]\n[[sets]]\n"design.top" = "verilog:inc.v"\n'
+        '"design.ports" = "bump_stop_ports.toml"\n[[sets]]\n"design.top" = "guard.py:Guard"\n'
+    )
+
+    def ids():
+        done = subprocess.run(
+            [sys.executable, "-c", PLAN_IDS, "c.toml"],
+            cwd=tmp_path,
+            capture_output=True,
+            text=True,
+            timeout=120,
+            check=True,
+        )
+        return done.stdout.split()
+
+    verilog_run, amaranth_run = ids()
+    # The Verilog design's `include file changes: its run is another run, the other is not.
+    (tmp_path / "speed.vh").write_text("localparam signed [11:0] SPEED = 12'sd100;\n")
+    verilog_now, amaranth_now = ids()
+    assert verilog_now != verilog_run and amaranth_now == amaranth_run
+    # The module the Amaranth design imports changes: the other way round.
+    (tmp_path / "helper.py").write_text("SPEED = 100\n")
+    verilog_later, amaranth_later = ids()
+    assert verilog_later == verilog_now and amaranth_later != amaranth_run

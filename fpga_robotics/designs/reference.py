@@ -94,6 +94,9 @@ class DesignSpec:
         Whether it has a clock (an Amaranth design of one's own may have none).
     signed : frozenset
         The names of its ports of a signed shape (``ports`` has direction and width).
+    netlist_digest : str
+        An Amaranth design of one's own: sha256 of its elaborated netlist, what it is
+        whatever its file imports or reads (a campaign's run identity hashes it).
     """
 
     reference: str
@@ -107,6 +110,7 @@ class DesignSpec:
     port_map: object = None
     clocked: bool = True
     signed: frozenset = frozenset()
+    netlist_digest: str = ""
 
     @property
     def camera(self):
@@ -253,7 +257,7 @@ def _amaranth_spec(reference, frozen_params, _stamp):
     _check_params(target, params, reference)
     factory = functools.partial(_call, target, params, reference)
     component = factory()
-    clocked = _check_elaborates(component, target, reference)
+    clocked, netlist_digest = _check_elaborates(component, target, reference)
     signed = signed_ports(component)
     ports = component_ports(component)
     bindings = bindings_of(component, ports)
@@ -283,6 +287,7 @@ def _amaranth_spec(reference, frozen_params, _stamp):
         top,
         clocked=clocked,
         signed=signed,
+        netlist_digest=netlist_digest,
     )
 
 
@@ -290,7 +295,7 @@ def _check_elaborates(component, target, reference):
     """``DesignError`` (one line) if ``component``, made by the user's ``target``, does not
     elaborate to a netlist: its ``elaborate`` raises or returns nothing, or it drives a
     signal from two places. Found here, before any simulator is built for it. Returns
-    whether it has a clock (anything in its ``sync`` domain)."""
+    whether it has a clock (anything in its ``sync`` domain) and the netlist's sha256."""
     from amaranth.back import rtlil  # lazy: only a design of one's own is converted here
     from amaranth.hdl import UnusedElaboratable  # lazy: as rtlil
 
@@ -313,7 +318,8 @@ def _check_elaborates(component, target, reference):
         ) from None
     for w in said:  # a design that elaborates keeps its warnings
         warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
-    return bool(re.search(r"^  wire .*\binput \d+ +\\clk$", text, re.MULTILINE))
+    clocked = bool(re.search(r"^  wire .*\binput \d+ +\\clk$", text, re.MULTILINE))
+    return clocked, hashlib.sha256(text.encode()).hexdigest()
 
 
 def _user_line(exc, target):

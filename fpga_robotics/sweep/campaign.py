@@ -587,20 +587,19 @@ def _with_ports(spec):
     return replace(spec, ports=None, fixed=(*spec.fixed, ports))
 
 
-def run_identity(spec, scenario_source, extra_files=()):
+def run_identity(spec, scenario_source, design_digest=""):
     """The hash that names a run: scenario content, overrides, seed, backend, resolution,
-    duration, design files and the package version (the same run in another folder or
-    campaign has the same identity)."""
+    duration, its designs as built (``runner.design_digest``) and the package version (the
+    same run in another folder or campaign has the same identity)."""
     h = hashlib.sha256()
     argv = spec.argv()
     argv[1] = "<scenario>"  # the content counts, not the path
-    blob = {"argv": argv, "version": __version__}
+    blob = {"argv": argv, "version": __version__, "design": design_digest}
     h.update(json.dumps(blob, sort_keys=True).encode())
-    for path in (scenario_source, *extra_files):
-        try:
-            h.update(Path(path).read_bytes())
-        except OSError:
-            h.update(str(path).encode())
+    try:
+        h.update(Path(scenario_source).read_bytes())
+    except OSError:
+        h.update(str(scenario_source).encode())
     return h.hexdigest()[:16]
 
 

@@ -8,7 +8,7 @@ from fpga_robotics.hw.errors import UsageError
 
 from .campaign import run_identity, toml_value
 from .fork_groups import world_key
-from .runner import _design_key, load_run
+from .runner import _design_key, design_digest, load_run
 
 __all__ = ["Plan", "make_plan"]
 
@@ -23,18 +23,16 @@ class Plan:
     worlds: dict = field(default_factory=dict)  # RunSpec -> its world (fork_groups), or None
 
 
-def _concrete_backend(spec):
-    if spec.backend != "auto":
-        return spec
-    if spec.design is not None and spec.design.startswith("verilog:"):
-        # As run takes it: CXXRTL where Yosys reads the Verilog, else Verilator
-        # (sim/backends/foreign_choice.py); each worker builds with the same choice.
-        return spec
-    if spec.design is not None:
-        return replace(spec, backend="verilator")
+def _concrete_backend(spec, scenario, shadow):
+    """The backend ``run --backend`` takes for the run (its designs as loaded, overrides
+    and all), so that each worker builds with the same choice: ``auto`` stays beside a
+    Verilog design (CXXRTL where Yosys reads it, else Verilator: sim/backends/foreign_choice.py,
+    design by design); other designs take the fastest compiled backend here."""
+    if spec.backend != "auto" or scenario.foreign is not None or getattr(shadow, "foreign", None):
+        return spec.backend
     from ..sim.backends import fastest_backend_name  # lazy: the simulator (~0.5 s)
 
-    return replace(spec, backend=fastest_backend_name())
+    return fastest_backend_name()
 
 
 def make_plan(campaign):
@@ -46,13 +44,13 @@ def make_plan(campaign):
 
     plan = Plan(runs=[])
     checked = {}
+    digests = {}  # design key -> design_digest
     files_named = {}  # scenario name -> {resolved file: (as the campaign gives it, file)}
     for spec in campaign.runs:
         if spec.backend not in ("auto", *BACKEND_NAMES):
             raise UsageError(
                 f"backend must be one of auto, {', '.join(BACKEND_NAMES)}; got {spec.backend!r}"
             )
-        spec = _concrete_backend(spec)
         shape = replace(spec, seed=0)
         if shape not in checked:
             try:
@@ -64,33 +62,33 @@ def make_plan(campaign):
                 raise UsageError(
                     f"run of {spec.scenario}{' with ' + what if what else ''}: {exc}"
                 ) from None
-            files = []
-            if scenario.foreign is not None:
-                files = [*scenario.foreign.verilog, scenario.foreign.ports]
-            if args.design is not None:
-                files = [*args.design[len("verilog:") :].split(","), args.ports]
-            where = scenario.top.rpartition(":")[0]
-            if where.endswith(".py"):  # a design of one's own: its file names the run too
-                files.append(where)
+            # A shadow design's scenario (None: no shadow, or FollowTarget parameters).
+            shadow = shadow_params if hasattr(shadow_params, "sim") else None
+            # Loading depends on the backend only for a Verilog design, where auto stays:
+            # the run as loaded is the run on the concrete backend.
+            args.backend = _concrete_backend(spec, scenario, shadow)
             key = (_design_key(args, scenario), repr(shadow_params))
+            if key not in digests:
+                digests[key] = design_digest(args, scenario, shadow)
             frames = round(scenario.sim.duration * scenario.camera.fps)
             checked[shape] = (
                 scenario,
-                files,
-                key,
+                digests[key],
                 frames,
                 scenario.camera.width * scenario.camera.height,
                 world_key(args, scenario, shadow_params),
+                args.backend,
             )
-            plan.builds.setdefault(key, spec.argv())
+            plan.builds.setdefault(key, replace(spec, backend=args.backend).argv())
             files_named.setdefault(scenario.name, {}).setdefault(
                 str(Path(scenario.source).resolve()) if scenario.source else spec.scenario,
                 (spec.scenario, scenario.source),
             )
-        scenario, files, _key, frames, pixels, world = checked[shape]
+        scenario, digest, frames, pixels, world, backend = checked[shape]
+        spec = replace(spec, backend=backend)
         plan.worlds[spec] = world
         plan.runs.append(spec)
-        plan.ids[spec] = run_identity(spec, scenario.source, files)
+        plan.ids[spec] = run_identity(spec, scenario.source, digest)
         plan.names[spec] = scenario.name
         plan.frames[spec] = (frames, pixels)
     where = f"{campaign.source}: " if campaign.source else ""

@@ -15,6 +15,7 @@ such runs and goes on.
 
 import argparse
 import contextlib
+import hashlib
 import os
 import shutil
 import tempfile
@@ -29,6 +30,7 @@ __all__ = [
     "RunOutcome",
     "RunTimeout",
     "build_designs",
+    "design_digest",
     "execute",
     "load_run",
     "set_stop_limit",
@@ -125,6 +127,47 @@ def _design_key(args, scenario):
         repr(sorted(scenario.design_tables.items())),
         repr(sorted(scenario.design_params.items())),
     )
+
+
+def design_digest(args, scenario, shadow=None):
+    """sha256 of a run's designs as they are built, for the run's identity: a Verilog
+    design's files, port map and the files they `include (as the build cache hashes them); a
+    design of one's own: its file and its netlist as elaborated (whatever its file imports or
+    reads). A built-in design is the package's: its version names it. ``shadow``: the
+    scenario of a shadow design."""
+    from fpga_robotics.cli import run  # lazy: the run stack (~1 s)
+    from fpga_robotics.designs.reference import is_builtin, resolve_design
+    from fpga_robotics.sim.backends.foreign import verilog_includes
+
+    h = hashlib.sha256()
+    designs = [(scenario, run._design_files(args, scenario.foreign))]
+    if shadow is not None:
+        foreign = shadow.foreign
+        designs.append((shadow, None if foreign is None else (foreign.verilog, foreign.ports)))
+    for of, verilog in designs:
+        if verilog is not None:
+            files, ports = verilog
+            paths = [Path(f).expanduser() for f in files]
+            for path in [*paths, Path(ports).expanduser()]:
+                h.update(_content(path))
+            for name, text in sorted(verilog_includes(paths).items()):
+                h.update(f"{name}\0{text}\0".encode())
+        elif not is_builtin(of.top):
+            # Its file, as a Verilog design's (any edit makes another run), and its netlist:
+            # what the modules it imports and the files it reads make of it.
+            where = of.top.rpartition(":")[0]
+            if where.endswith(".py"):
+                h.update(_content(Path(where)))
+            h.update(resolve_design(of.top, of.design_params).netlist_digest.encode())
+    return h.hexdigest()
+
+
+def _content(path):
+    """A file's bytes; its name when it cannot be read (the build says why)."""
+    try:
+        return path.read_bytes() + b"\0"
+    except OSError:
+        return f"{path}\0".encode()
 
 
 def _open(key, opener):

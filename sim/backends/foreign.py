@@ -52,6 +52,7 @@ __all__ = [
     "ForeignVerilatorBackend",
     "design_ports",
     "pin_ports",
+    "verilog_includes",
     "watch_chunks",
     "wrapper_verilog",
 ]
@@ -102,7 +103,7 @@ class ForeignDesign:
             raise PortMapError("two Verilog files have the same name")
         #: Files named by `include, found next to the including file or a listed one: copied
         #: next to the sources and part of the build's cache key.
-        self.includes = _includes(self.files)
+        self.includes = verilog_includes(self.files)
         self.port_map = (
             port_map if not isinstance(port_map, (str, os.PathLike)) else load_port_map(port_map)
         )
@@ -162,7 +163,7 @@ class ForeignDesign:
 _INCLUDE = re.compile(r'`include\s+"([^"]+)"')
 
 
-def _includes(files):
+def verilog_includes(files):
     """``include name -> text`` of every file the sources `include (recursively) that is
     found relative to the including file's folder or a listed file's folder; one that is not
     found is left to Verilator to report."""
