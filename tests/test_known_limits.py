@@ -10,8 +10,10 @@ from fpga_robotics.sweep.report import (
     explained,
     failures_by_check,
     format_report,
+    known_limit,
     write_html,
 )
+from fpga_robotics.sweep.results import make_row
 
 BASE = {
     "name": "t",
@@ -171,3 +173,25 @@ def test_robustness_small_passes_or_fails_only_at_known_limits(tmp_path):
         if not (r["status"] == "pass" or explained(r, campaign.known_limits))
     ]
     assert not bad, bad
+
+
+def test_a_known_limit_on_a_list_value_matches_the_runs_with_it():
+    # A colour axis: the row keeps the list as JSON text, the entry as a tuple.
+    green, red = [0, 200, 0], [255, 0, 0]
+    c = load_campaign(
+        {
+            "name": "t",
+            "scenarios": ["follow_person"],
+            "seeds": "0",
+            "grid": {"people.0.shirt_color": [red, green]},
+            "known_limits": [{**LIMIT, "when": {"people.0.shirt_color": green}}],
+        }
+    )
+    rows = {}
+    for spec in c.runs:
+        outcome = {"status": "fail", "message": "", "summary": None, "wall_s": 0.0}
+        row = make_row(spec, "id", "follow_person", outcome)
+        row["failed_checks"] = "found_min_fraction"
+        rows[tuple(dict(spec.overrides)["people.0.shirt_color"])] = row
+    assert known_limit(rows[tuple(green)], "found_min_fraction", c.known_limits) is not None
+    assert known_limit(rows[tuple(red)], "found_min_fraction", c.known_limits) is None

@@ -9,6 +9,7 @@ from collections import defaultdict
 from pathlib import Path
 
 from ..sim.files import write_atomic
+from .results import _cell
 
 __all__ = ["failures_by_check", "format_report", "na_by_check", "write_html"]
 
@@ -65,7 +66,8 @@ def known_limit(row, name, known_limits):
             continue
         if entry.get("scenarios") and row.get("scenario") not in entry["scenarios"]:
             continue
-        if all(row.get(k) == v for k, v in (entry.get("when") or {}).items()):
+        when = (entry.get("when") or {}).items()
+        if all(row.get(k) == _cell(list(v) if isinstance(v, tuple) else v) for k, v in when):
             return entry
     return None
 
