@@ -1381,10 +1381,11 @@ PLANS = {
     ),
     # docs/lidar.md: the LIDAR and the corridor follower -----------------------------------------
     "fpga-robotics export --design corridor_follow -o corridor_follow.v": Plan(
-        files=("corridor_follow.v",), out=(r"module corridor_follow, 7 ports",)
+        files=("corridor_follow.v",), out=(r"keep 420 mm, stop 300 mm, module corridor_follow\)",)
     ),
     "fpga-robotics export --design corridor_follow_uart -o corridor_follow_uart.v": Plan(
-        files=("corridor_follow_uart.v",), out=(r"module corridor_follow_uart, 8 ports",)
+        files=("corridor_follow_uart.v",),
+        out=(r"115200 baud at 50000000 Hz, module corridor_follow_uart\)",),
     ),
     "fpga-robotics export --top corridor_follow --variant lidar_bearing_mirrored -o "
     "corridor_mirrored.v": Plan(

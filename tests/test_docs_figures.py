@@ -322,8 +322,8 @@ FIGURES = (
     ),
     Figure(
         "docs/turret.md",
-        "1.18",
-        "0.3",
+        "1.75",
+        "0.2",
         "cameras --repeats 5",
         lambda data: data["figures"]["cpu_ratio"],
         "turret: the two-camera loop's CPU time a frame over the one-camera loop's",
