@@ -136,8 +136,8 @@ def design_digest(args, scenario, shadow=None):
     reads). A built-in design is the package's: its version names it. ``shadow``: the
     scenario of a shadow design."""
     from fpga_robotics.cli import run  # lazy: the run stack (~1 s)
-    from fpga_robotics.designs.reference import is_builtin, resolve_design
-    from fpga_robotics.sim.backends.foreign import verilog_includes
+    from fpga_robotics.designs.reference import is_builtin, resolve_design  # lazy: as run
+    from fpga_robotics.sim.backends.foreign import verilog_includes  # lazy: as run
 
     h = hashlib.sha256()
     designs = [(scenario, run._design_files(args, scenario.foreign))]
