@@ -517,6 +517,35 @@ def test_a_verilog_design_shadows_an_amaranth_one_and_the_other_way(
     assert shadow["differing_frames"]["motor_right"] == moving
 
 
+def test_design_runs_an_amaranth_design_in_place_of_a_scenario_s_verilog_one(tmp_path, capsys):
+    """--design FILE.py:Name on a scenario whose design.verilog names another design: the
+    Amaranth one runs (300 DPS, farther than the Verilog one's 250 in the same time)."""
+    data = DESIGNS.parent
+    (tmp_path / "bump_stop.py").write_text(_BUMP_STOP_AMARANTH)
+    v2 = (data / "bump_stop.v").read_text().replace("12'sd300", "12'sd250")
+    (tmp_path / "bump_v2.v").write_text(v2)
+    scenario = (
+        (data / "bump_wall.toml")
+        .read_text()
+        .replace(
+            "[sim]",
+            f'[design]\nverilog = ["bump_v2.v"]\nports = "{data / "bump_stop_ports.toml"}"\n[sim]',
+        )
+    )
+    (tmp_path / "v.toml").write_text(scenario)
+    paths = {}
+    for name, design in (
+        ("verilog", []),
+        ("amaranth", ["--design", f"{tmp_path}/bump_stop.py:BumpStop"]),
+    ):
+        summary = tmp_path / f"{name}.json"
+        argv = ["run", "--scenario", str(tmp_path / "v.toml"), *design, "--duration", "3"]
+        code, _, err = _cli([*argv, "--rerun", "off", "--quiet", "--summary", str(summary)], capsys)
+        assert code == 0, err
+        paths[name] = json.loads(summary.read_text())["path_length_m"]
+    assert paths["amaranth"] / paths["verilog"] == pytest.approx(300 / 250, rel=0.05)
+
+
 def test_a_verilog_shadow_needs_its_port_map_and_files(tmp_path, capsys):
     data = DESIGNS.parent
     base = ["run", "--scenario", str(data / "bump_wall.toml"), "--rerun", "off"]

@@ -298,13 +298,7 @@ def take_design_reference(args, scenario):
     ``design.top`` now (``_overrides``); ``args.design`` keeps only Verilog files."""
     if args.design is None or args.design.startswith("verilog:"):
         return
-    if scenario.foreign is not None:
-        raise UsageError(
-            f"--design {args.design}: scenario {scenario.name!r} names a "
-            f"Verilog design (design.verilog); remove it there to run "
-            f"another design"
-        )
-    args.design = None
+    args.design = None  # the scenario's Verilog files went with its design (load)
 
 
 def load_run_scenario(args):

@@ -310,8 +310,7 @@ class RealClockLoop(ClosedLoop):
         """Give the shadow design's input bound to each connector pin what the primary's
         input bound to it gets (``bindings``: the shadow's, its sensors' ``ports`` tables as
         the primary's)."""
-        camera = {pin: port for pin, port in self.top.bindings.get("camera", {}).items()}
-        for pin, port in camera.items():
+        for pin, port in self.top.bindings.get("camera", {}).items():
             other = bindings.get("camera", {}).get(pin)
             if other is not None:
                 self.pins.mirror(port, other)
