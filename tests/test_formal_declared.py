@@ -205,6 +205,10 @@ def test_assumptions_that_contradict_each_other_are_said_so(tmp_path):
             "formal_properties raised DriverConflict: Signal (sig full) bit 0 driven from",
         ),
         (
+            "def formal_properties(self, m):\n    m.d.comb += Assume(self.up)",
+            "formal_properties adds no Assert statement; add one (m.d.comb += Assert(",
+        ),
+        (
             "def formal_covers(self, m):\n    pass",
             "formal_covers adds no Cover statement; add one (m.d.comb += Cover(...))",
         ),

@@ -55,8 +55,9 @@ class DeclaredHarness(Harness):
 def declared_checks(name, make_dut):
     """The ``FormalCheck`` list of a design built by ``make_dut()``, named ``name.properties``
     and ``name.covers``: empty when its class declares no ``formal_properties``. A mode or
-    depth out of range, a hook that raises (or adds statements Amaranth refuses) and a
-    ``formal_covers`` without a ``Cover`` are a ``UsageError`` naming the design, here rather
+    depth out of range, a hook that raises (or adds statements Amaranth refuses), a
+    ``formal_properties`` without an ``Assert`` and a ``formal_covers`` without a ``Cover`` are
+    a ``UsageError`` naming the design, here rather
     than once the checks run."""
     sample = make_dut()
     cls = type(sample)
@@ -76,11 +77,16 @@ def declared_checks(name, make_dut):
     for hook, part, hook_mode, hook_depth in hooks:
         build = _builder(make_dut, hook)
         text = _converted(name, cls, hook, build())
+        # SymbiYosys passes a run with nothing to check or reach: it would show nothing.
         if hook == COVER_HOOK and '\\FLAVOR "cover"' not in text:
-            # SymbiYosys passes a cover run with nothing to reach: it would show nothing.
             raise UsageError(
                 f"design {name}: {COVER_HOOK} adds no Cover statement; add one "
                 f"(m.d.comb += Cover(...)) or leave the method out"
+            )
+        if hook == PROPERTY_HOOK and '\\FLAVOR "assert"' not in text:
+            raise UsageError(
+                f"design {name}: {PROPERTY_HOOK} adds no Assert statement; add one "
+                f'(m.d.comb += Assert(..., "what is wrong")) or leave the method out'
             )
         doc = (getattr(cls, hook).__doc__ or "").strip().splitlines()
         promise = doc[0] if doc else f"the {part} {cls.__name__} declares"
