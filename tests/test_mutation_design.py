@@ -180,6 +180,15 @@ def test_robot_judge_of_a_users_design_matches_its_runs(tmp_path, capsys):
         "score": robot_caught / len(judged),
     }
     assert f"{robot_caught} of {len(judged)} unit-caught mutants caught" in text
+    # Each blind spot says why, from its unit data: the share of the cycles it differs in.
+    for m in result["mutants"]:
+        if m["robot"] is not None and not m["robot"]["caught"]:
+            share = 100 * m["unit"]["cycles_differing"] / 20000
+            cls = m["blind_spot_reason"].split(":")[0]
+            assert cls in ("recorded only", "rare state", "other")
+            assert share <= 5 if cls == "rare state" else cls == "recorded only" or share > 5
+        else:
+            assert m["blind_spot_reason"] is None
     # The runs again, one by one, outside the judge: the same verdicts.
     base = runner.execute(result["baseline"]["runs"][0])
     assert base["status"] == "pass"

@@ -214,20 +214,111 @@ def test_the_report_gives_each_blind_spot_its_reason(tmp_path):
     assert '<a href="recordings/mutant1.rrd">' in text
 
 
-def test_a_design_s_report_has_no_reason_column(tmp_path):
-    """A design of one's own has no reason classes (they read FollowTarget's outputs): its
-    report lists the same blind spots without the column."""
+class _TwoTraces:
+    """A pin backend stand-in whose outputs follow a fixed change list per ``mutsel``."""
+
+    def __init__(self, traces):
+        self.traces, self.mutsel = traces, 0
+
+    def reset(self):
+        pass
+
+    def poke(self, name, value):
+        self.mutsel = value
+
+    def schedule_many(self, name, edges, values):
+        pass
+
+    def peek(self, name):
+        return self.traces[self.mutsel][name][0][1]
+
+    def record_changes(self, cycles, outputs):
+        return {name: self.traces[self.mutsel][name][1:] for name in outputs}
+
+
+def _pin_verdict(mutant, design, cycles=1000, ports=None):
+    from fpga_robotics.mutation.pin_judge import judge_pin_mutant, pin_trace
+
+    backend = _TwoTraces({0: design, 1: mutant})
+    reference = pin_trace(backend, 0, [], cycles, list(design))
+    return judge_pin_mutant(backend, 1, [], cycles, reference, ports)
+
+
+def test_a_pin_verdict_counts_the_cycles_its_outputs_differ():
+    """By hand: motor differs in cycles 100-149 (by 40, signed: 20 against -20) and
+    200-299 (by 5); led in 120-179; any output in 100-179 and 200-299: 180 cycles."""
+    from fpga_robotics.sim.pins.base import Port
+
+    design = {
+        "motor": [(0, 0), (100, 20), (150, 0), (200, 5), (300, 0)],
+        "led": [(0, 0)],
+        "still": [(0, 7)],
+    }
+    mutant = {
+        "motor": [(0, 0), (100, 0xFFEC), (150, 0), (300, 0)],  # -20 in 16 bits
+        "led": [(0, 0), (120, 1), (180, 0)],
+        "still": [(0, 7)],
+    }
+    ports = {"motor": Port("motor", 16, "out", True)}
+    v = _pin_verdict(mutant, design, ports=ports)
+    assert v.caught and v.first_cycle == 100
+    assert v.extent == {"motor": (150, 40), "led": (60, 1)}
+    assert v.cycles_differing == 180
+    # Read unsigned, -20 is 65516: 65496 from 20.
+    assert _pin_verdict(mutant, design).extent["motor"] == (150, 65496)
+
+
+def test_a_pin_blind_spot_s_reason_class():
+    """The classes of a design's blind spots: filtered only, recorded only, rare state (at
+    most 5% of the cycles), other."""
+    from fpga_robotics.mutation.reasons import pin_blind_spot_reason
+
+    design = {"motor": [(0, 0)], "dist": [(0, 0)], "px": [(0, 0)]}
+    pixels = _pin_verdict({**design, "px": [(0, 0), (10, 3)]}, design)
+    assert pin_blind_spot_reason(pixels, "px", {"dist"}) == (
+        "filtered only: differs during 99% of the 1000 random-input cycles (px: 990 cycles, "
+        "off by up to 3), from cycle 10; only the filtered video's payload, whose pixels no "
+        "check or wheel uses"
+    )
+    recorded = _pin_verdict({**design, "dist": [(0, 0), (500, 9)]}, design)
+    assert pin_blind_spot_reason(recorded, "px", {"dist"}).startswith(
+        "recorded only: differs during 50% of the 1000 random-input cycles (dist: 500 cycles"
+    )
+    rare = _pin_verdict({**design, "motor": [(0, 0), (400, 300), (450, 0)]}, design)
+    assert pin_blind_spot_reason(rare, "px", {"dist"}) == (
+        "rare state: differs during 5% of the 1000 random-input cycles (motor: 50 cycles, "
+        "off by up to 300), from cycle 400"
+    )
+    often = _pin_verdict({**design, "motor": [(0, 0), (400, 300), (451, 0)]}, design)
+    assert pin_blind_spot_reason(often, "px", {"dist"}).startswith("other: differs during 5.1%")
+    # A wheel with the recorded output: it moves the robot, so not "recorded only".
+    both = _pin_verdict({**design, "motor": [(0, 1)], "dist": [(0, 1)]}, design)
+    assert pin_blind_spot_reason(both, "px", {"dist"}).startswith("other: differs during 100%")
+
+
+def test_a_design_s_report_gives_each_blind_spot_its_reason(tmp_path):
+    """A design of one's own: its report lists its blind spots with the pin reasons."""
     from fpga_robotics.mutation.pin_judge import PinVerdict
+    from fpga_robotics.mutation.reasons import pin_blind_spot_reason
     from fpga_robotics.mutation.report import write_report
 
-    verdicts = [PinVerdict(k, True, 3, {"hit": True}, {"hit": (0, 1)}, 2000) for k in (1, 2, 3)]
+    verdicts = [
+        PinVerdict(k, True, 3, {"hit": True}, {"hit": (0, 1)}, 2000, {"hit": (9, 1)}, 9)
+        for k in (1, 2, 3)
+    ]
     rows = [(_mutant(v.index, "", "hit"), v) for v in verdicts]
+    reasons = {k: pin_blind_spot_reason(verdicts[k - 1]) for k in (1, 2)}
     path = write_report(
-        str(tmp_path), _results(rows, ROBOT), {}, title="BumpGuard", inputs="these inputs"
+        str(tmp_path),
+        _results(rows, ROBOT, reasons),
+        {},
+        title="BumpGuard",
+        inputs="these inputs",
     )
     with open(path) as f:
         text = f.read()
     assert "Mutation coverage of BumpGuard" in text and "equivalent on these inputs" in text
     assert "Blind spots: caught by the unit judge, missed by every run (2)" in text
     assert text.count("differs from cycle 3: hit 0 -&gt; 1") == 2
-    assert "why no run shows it" not in text
+    assert "why no run shows it" in text
+    assert text.count("rare state: differs during 0.45% of the 2000 random-input cycles") == 2

@@ -11,6 +11,7 @@ from ..designs.builtin import connector_kinds
 from ..designs.reference import stream_ports
 from ..hw.verilog import verilog_ports
 from ..sim.backends.foreign import ForeignDesign
+from ..sim.backends.port_map import load_port_map
 from ..sim.files import write_atomic, write_json_atomic
 from ..sim.mutation import (
     MUTATION_SELECT,
@@ -40,8 +41,9 @@ from .pin_judge import (
     pin_trace,
     streams_frames,
 )
+from .reasons import pin_blind_spot_reason
 from .robot_judge import check_resume, mutants_key, robot_judge, start_prebuild
-from .scores import by_module, robot_score, unit_score
+from .scores import blind_spots, by_module, robot_score, unit_score
 
 __all__ = [
     "DEFAULT_CYCLES",
@@ -247,7 +249,7 @@ def _judge(
         reference = pin_trace(backend, 0, stimulus, cycles, outputs)
         verdicts = []
         for k, m in enumerate(mutants, start=1):
-            verdicts.append(judge_pin_mutant(backend, m.index, stimulus, cycles, reference))
+            verdicts.append(judge_pin_mutant(backend, m.index, stimulus, cycles, reference, ports))
             if k == len(mutants) or k * 10 // len(mutants) != (k - 1) * 10 // len(mutants):
                 say(
                     f"unit judge: {k}/{len(mutants)} mutants, "
@@ -283,6 +285,9 @@ def _judge(
         )
         robot_s = time.perf_counter() - t2
     caught_by_robot = {k: v["caught"] for k, v in robot_verdicts.items()}
+    blind = set(blind_spots(unit, caught_by_robot))
+    mapped = load_port_map(port_map)
+    filtered, recorded = mapped.filtered_payload, set(mapped.extra_outputs.values())
     result = {
         "design": design,
         "seed": seed,
@@ -318,9 +323,15 @@ def _judge(
                     "caught": v.caught,
                     "first_cycle": v.first_cycle,
                     "differing": v.differing,
+                    # output -> [cycles during which it differs, largest difference]
+                    "extent": {name: list(e) for name, e in v.extent.items()},
+                    "cycles_differing": v.cycles_differing,
                     "effect": v.effect(),
                 },
                 "robot": robot_verdicts.get(m.index),
+                "blind_spot_reason": (
+                    pin_blind_spot_reason(v, filtered, recorded) if m.index in blind else None
+                ),
             }
             for m, v in zip(mutants, verdicts)
         ],

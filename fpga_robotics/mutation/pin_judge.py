@@ -177,6 +177,11 @@ class PinVerdict:
     differing: dict = field(default_factory=dict)  # output -> True if its changes differ
     first_difference: dict = field(default_factory=dict)  # output -> (design, mutant) there
     cycles: int = 0
+    # output -> (cycles during which it differs, the largest difference of its values), for
+    # each output that differs, and the cycles during which any output differs: what the
+    # blind spots' reasons read (reasons.py).
+    extent: dict = field(default_factory=dict)
+    cycles_differing: int = 0
 
     def effect(self):
         if not self.caught:
@@ -205,16 +210,57 @@ def _first_divergence(want, got):
     return None
 
 
-def judge_pin_mutant(backend, index, stimulus, cycles, reference):
-    """Mutant ``index`` against ``reference`` (``pin_trace`` of index 0): a ``PinVerdict``."""
+def _extent(want, got, cycles, port):
+    """(the spans ``(start, end)`` of cycles in which two change lists of one output give
+    different values, the largest difference of the values then), over cycles 0 to
+    ``cycles - 1``; the values read as signed numbers when ``port`` (a ``Port``, or None)
+    says so."""
+
+    def number(value):
+        if port is not None and port.signed and value >> (port.width - 1) & 1:
+            return value - (1 << port.width)
+        return value
+
+    # Both lists walked once, in cycle order: an output may change every cycle.
+    events = sorted([(at, 0, v) for at, v in want] + [(at, 1, v) for at, v in got])
+    values = [want[0][1], got[0][1]]
+    spans, largest, k = [], 0, 0
+    while k < len(events) and events[k][0] < cycles:
+        start = events[k][0]
+        while k < len(events) and events[k][0] == start:
+            values[events[k][1]] = events[k][2]
+            k += 1
+        end = min(events[k][0] if k < len(events) else cycles, cycles)
+        if values[0] != values[1]:
+            spans.append((start, end))
+            largest = max(largest, abs(number(values[0]) - number(values[1])))
+    return spans, largest
+
+
+def _covered(spans):
+    """Cycles in the union of ``spans``."""
+    total, reach = 0, 0
+    for start, end in sorted(spans):
+        total += max(0, end - max(start, reach))
+        reach = max(reach, end)
+    return total
+
+
+def judge_pin_mutant(backend, index, stimulus, cycles, reference, ports=None):
+    """Mutant ``index`` against ``reference`` (``pin_trace`` of index 0): a ``PinVerdict``.
+    ``ports`` (name -> ``Port``, optional) tells which outputs are signed."""
     got = pin_trace(backend, index, stimulus, cycles, reference)
     verdict = PinVerdict(index=index, caught=False, cycles=cycles)
-    firsts = {}
+    firsts, spans = {}, []
     for name, want in reference.items():
         at = _first_divergence(want, got[name])
         verdict.differing[name] = at is not None
         if at is not None:
             firsts[name] = at
+            own, largest = _extent(want, got[name], cycles, (ports or {}).get(name))
+            verdict.extent[name] = (sum(end - start for start, end in own), largest)
+            spans += own
+    verdict.cycles_differing = _covered(spans)
     if firsts:
         verdict.caught = True
         verdict.first_cycle = min(firsts.values())

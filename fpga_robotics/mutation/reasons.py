@@ -13,6 +13,14 @@ The classes, in the order they are tried:
 - ``rare state``: the outputs differ in at most ``RARE_FRACTION`` of the unit frames (a state
   the runs reach seldom or never, e.g. one proximity level or one side's search);
 - ``other``: none of these (the documentation says more about each such mutant).
+
+A design of one's own (``mutate --design``) has no golden model and outputs of its own, so
+its blind spots' classes read the pin unit judge's data (``PinVerdict``: the outputs that
+differ, during how many of the random-input cycles, by how much): ``filtered only`` (only
+the filtered stream's payload differs), ``recorded only`` (only outputs its port map lists
+as ``[extra_outputs]``: recorded, read by no check, moving nothing), ``rare state`` (the
+outputs differ during at most ``RARE_FRACTION`` of the cycles) or
+``other``.
 """
 
 __all__ = [
@@ -20,6 +28,7 @@ __all__ = [
     "SMALL_CENTROID_FRACTION",
     "SMALL_WHEEL_DPS",
     "blind_spot_reason",
+    "pin_blind_spot_reason",
     "reason_class",
 ]
 
@@ -87,4 +96,36 @@ def blind_spot_reason(verdict, width):
         text += f"; wheels off by up to {wheels} DPS"
     if "proximity" in big:
         text += f"; proximity off by up to {big['proximity']}"
+    return text
+
+
+def pin_blind_spot_reason(verdict, filtered=None, recorded=()):
+    """One line for a blind spot of a design of one's own (``verdict``: its ``PinVerdict``;
+    ``filtered``: the name of the design's filtered-stream payload output, if any;
+    ``recorded``: its outputs that are only recorded), e.g.
+    ``"rare state: differs during 0.18% of the 100000 random-input cycles (motor_left: 180
+    cycles, off by up to 40), from cycle 51234"``."""
+    extent = {name: verdict.extent.get(name, (0, 0)) for name, d in verdict.differing.items() if d}
+    during = verdict.cycles_differing
+    if filtered is not None and set(extent) == {filtered}:
+        cls = "filtered only"
+    elif set(extent) <= set(recorded):
+        cls = "recorded only"
+    elif during <= RARE_FRACTION * verdict.cycles:
+        cls = "rare state"
+    else:
+        cls = "other"
+    share = 100 * during / verdict.cycles if verdict.cycles else 0.0
+    share = f"{share:.0f}" if share >= 10 else f"{share:.2g}"  # 37%, 2.5%, 0.03%
+    outputs = "; ".join(
+        f"{name}: {n} cycles, off by up to {largest}" for name, (n, largest) in extent.items()
+    )
+    text = (
+        f"{cls}: differs during {share}% of the {verdict.cycles} random-input cycles "
+        f"({outputs}), from cycle {verdict.first_cycle}"
+    )
+    if cls == "filtered only":
+        text += "; only the filtered video's payload, whose pixels no check or wheel uses"
+    elif cls == "recorded only":
+        text += "; only outputs that are recorded, which no check reads and nothing acts on"
     return text

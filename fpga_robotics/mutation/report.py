@@ -42,7 +42,7 @@ def write_report(out, results, recordings, *, title, inputs):
     us, rs, baseline = results["unit"], results["robot"], results["baseline"]
     rows = results["mutants"]
     blind = [m for m in rows if m["robot"] is not None and not m["robot"]["caught"]]
-    # The reason classes read FollowTarget's outputs: other designs' blind spots have none.
+    # Every blind spot has a reason (reasons.py) but those judged before reasons existed.
     with_reason = any(m.get("blind_spot_reason") for m in blind)
     e = html.escape
     parts = [
