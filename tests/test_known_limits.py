@@ -141,6 +141,7 @@ def test_a_failure_is_explained_only_where_the_limit_applies():
 def test_the_report_shows_each_known_limit_with_its_reason(tmp_path):
     limits = load_campaign({**BASE, "known_limits": [LIMIT]}).known_limits
     rows = [_row("pass"), _row("fail", "found_min_fraction", "80x60")]
+    rows[1]["recording"] = "recordings/abc123.rrd"  # a failing run's, as the sweep keeps it
     text = format_report(rows, ["camera.resolution"], limits)
     assert ("found_min_fraction (camera.resolution=80x60): 1 run(s): " + LIMIT["reason"]) in text
     assert "failures by check" not in text
@@ -150,6 +151,9 @@ def test_the_report_shows_each_known_limit_with_its_reason(tmp_path):
     page = (tmp_path / "report.html").read_text()
     assert "Known limits of the design" in page and LIMIT["reason"] in page
     assert "replay follow_person 80x60" in page
+    # The known limit's table links the run's recording, as the failing runs' tables do.
+    limit_table = page[page.index("Known limits of the design") : page.index("Failing runs")]
+    assert "<a href='recordings/abc123.rrd'>abc123.rrd</a>" in limit_table
 
 
 def test_the_shipped_robustness_campaigns_load():

@@ -292,6 +292,12 @@ def _with_totals(rows):
     return out
 
 
+def _recording(row):
+    """A link to the run's recording, if the campaign kept one."""
+    rec = row.get("recording") or ""
+    return f"<a href='{html.escape(rec)}'>{html.escape(Path(rec).name)}</a>" if rec else ""
+
+
 def write_html(path, rows, axes, meta):
     """``report.html``: pass rates, the heatmap of the first two grid axes, metric
     distributions, the failing runs grouped by check, each with its replay command, and the
@@ -355,11 +361,14 @@ def write_html(path, rows, axes, meta):
                 f"<p>{esc(entry['reason'])}</p>"
             )
             if group:
-                parts.append("<table><tr><th>scenario</th><th>seed</th><th>replay</th></tr>")
+                parts.append(
+                    "<table><tr><th>scenario</th><th>seed</th><th>replay</th>"
+                    "<th>recording</th></tr>"
+                )
                 for r in group:
                     parts.append(
                         f"<tr><td>{esc(str(r['scenario']))}</td><td>{r['seed']}</td>"
-                        f"<td><code>{esc(r['replay'])}</code></td></tr>"
+                        f"<td><code>{esc(r['replay'])}</code></td><td>{_recording(r)}</td></tr>"
                     )
                 parts.append("</table>")
     groups = failures_by_check(rows, known_limits)
@@ -375,12 +384,10 @@ def write_html(path, rows, axes, meta):
             "<tr><th>scenario</th><th>seed</th><th>what</th><th>replay</th><th>recording</th></tr>"
         )
         for r in group:
-            rec = r.get("recording") or ""
-            link = f"<a href='{esc(rec)}'>{esc(Path(rec).name)}</a>" if rec else ""
             parts.append(
                 f"<tr><td>{esc(str(r['scenario']))}</td><td>{r['seed']}</td>"
                 f"<td>{esc(r.get('message') or '')}</td>"
-                f"<td><code>{esc(r['replay'])}</code></td><td>{link}</td></tr>"
+                f"<td><code>{esc(r['replay'])}</code></td><td>{_recording(r)}</td></tr>"
             )
         parts.append("</table>")
     na = na_by_check(rows)
