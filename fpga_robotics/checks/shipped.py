@@ -13,20 +13,38 @@ _FRACTION = (0, 1, "")
 _NO_TARGET = "no target person: no distance to compare"
 
 
-def _pct(v):
+def _pct(v, limit=None, least_digits=0):
     """A fraction as a whole percentage, but never 0% or 100% for what is not exactly that
-    (0.9967 is 99.7%, not 100%)."""
-    for digits in range(5):
+    (0.9967 is 99.7%, not 100%), and with a ``limit`` never shown equal to it, or on its
+    other side, when it is not (0.4004 against 40% is 40.04%); ``least_digits`` decimals
+    at least."""
+    for digits in range(least_digits, 7):
         text = f"{v:.{digits}%}"
         shown = float(text[:-1])
-        if not ((shown == 100 and v < 1) or (shown == 0 and v > 0)):
-            return text
+        if (shown == 100 and v < 1) or (shown == 0 and v > 0):
+            continue
+        if limit is not None and v != limit:
+            bound = float(_limit_pct(limit)[:-1])
+            if (shown > bound) != (v > limit) or shown == bound:
+                continue
+        return text
     return text
 
 
-def _never_in_view(m):
-    """A precondition: the target was in the camera's view at least once."""
-    return "the target was never in view" if m.get("target_in_view_fraction") == 0 else None
+def _limit_pct(limit):
+    """A check's fraction limit as a percentage, as set (0.1595 is 15.95%, 0.02 is 2%)."""
+    return f"{round(limit * 100, 6):g}%"
+
+
+def _never_found(m):
+    """Why the target was never found, for a failed check's message. Where the camera
+    points is the design's doing (it turns the robot), so a target never in view is a
+    failure to find it, not a run the check cannot judge."""
+    if m.get("mean_distance_m") is None:
+        return "the target was never found (the scenario has no target person)"
+    if m.get("target_in_view_fraction") == 0:
+        return "the target was never found (never in the camera's view)"
+    return "the target was never found"
 
 
 def _collisions(kind, meaning):
@@ -130,13 +148,12 @@ SHIPPED_CHECKS = (
         "max",
         "the design reports the target found within this time",
         lambda v, limit, m: (
-            "the target was never found"
+            f"{_never_found(m)} (limit {limit} s)"
             if v is None
             else f"target first found at {v:.2f} s (limit {limit} s)"
         ),
         limits=(0, _DAY, "s"),
         outputs=("found",),
-        precondition=_never_in_view,
     ),
     Check(
         "mean_distance_max_m",
@@ -211,8 +228,8 @@ SHIPPED_CHECKS = (
             "the target)"
         ),
         lambda v, limit, m: (
-            f"centroid away from the target in {_pct(v)} of the frames with "
-            f"the target found and in view (limit <= {limit:.0%})"
+            f"centroid away from the target in {_pct(v, limit)} of the frames with "
+            f"the target found and in view (limit <= {_limit_pct(limit)})"
         ),
         limits=_FRACTION,
         outputs=("found", "centroid_x"),
@@ -250,8 +267,8 @@ SHIPPED_CHECKS = (
             "with the target in view (led_wrong_side_fraction)"
         ),
         lambda v, limit, m: (
-            f"centroid LEDs point the wrong way in {_pct(v)} of the frames "
-            f"judged (limit <= {limit:.0%})"
+            f"centroid LEDs point the wrong way in {_pct(v, limit)} of the frames "
+            f"judged (limit <= {_limit_pct(limit)})"
         ),
         limits=_FRACTION,
         outputs=("found", "centroid_leds"),
@@ -271,8 +288,8 @@ SHIPPED_CHECKS = (
             "(led_misplaced_fraction)"
         ),
         lambda v, limit, m: (
-            f"the lit LEDs are not the one above the target in {v:.1%} of "
-            f"the frames judged (limit <= {limit:.1%})"
+            f"the lit LEDs are not the one above the target in {_pct(v, limit, 1)} of "
+            f"the frames judged (limit <= {_limit_pct(limit)})"
         ),
         limits=_FRACTION,
         outputs=("found", "centroid_leds"),
@@ -322,7 +339,9 @@ SHIPPED_CHECKS = (
         "target_in_view_fraction",
         "min",
         "the target is in the camera's view this often",
-        lambda v, limit, m: f"target in view {_pct(v)} of frames (limit >= {limit:.0%})",
+        lambda v, limit, m: (
+            f"target in view {_pct(v, limit)} of frames (limit >= {_limit_pct(limit)})"
+        ),
         limits=_FRACTION,
     ),
     Check(
@@ -331,11 +350,13 @@ SHIPPED_CHECKS = (
         "min",
         "after first acquisition, the design reports found this often",
         lambda v, limit, m: (
-            f"found in {_pct(v)} of frames after acquisition (limit >= {limit:.0%})"
+            f"{_never_found(m)} (limit >= {_limit_pct(limit)} of the frames after it is)"
+            if m["acquired_at_s"] is None
+            else f"found in {_pct(v, limit)} of frames after acquisition "
+            f"(limit >= {_limit_pct(limit)})"
         ),
         limits=_FRACTION,
         outputs=("found",),
-        precondition=_never_in_view,
         passes=_found_fraction,
     ),
     Check(
@@ -432,8 +453,8 @@ SHIPPED_CHECKS = (
             f"levels its pixel count can reach there) in at most this fraction of the frames {_BAND}"
         ),
         lambda v, limit, m: (
-            f"forward speed outside the approach law in {v:.1%} of the "
-            f"centred frames (limit <= {limit:.1%})"
+            f"forward speed outside the approach law in {_pct(v, limit, 1)} of the "
+            f"centred frames (limit <= {_limit_pct(limit)})"
         ),
         limits=_FRACTION,
         outputs=_WHEELS,
@@ -453,7 +474,7 @@ SHIPPED_CHECKS = (
         ),
         lambda v, limit, m: (
             f"reversing with the target beyond the reversing distance in "
-            f"{v:.1%} of those frames (limit <= {limit:.1%})"
+            f"{_pct(v, limit, 1)} of those frames (limit <= {_limit_pct(limit)})"
         ),
         limits=_FRACTION,
         outputs=_WHEELS,
@@ -485,7 +506,7 @@ SHIPPED_CHECKS = (
             f"in at most this fraction of the frames {_BAND}"
         ),
         lambda v, limit, m: (
-            f"turn outside the steering law in {v:.1%} of the frames judged (limit <= {limit:.1%})"
+            f"turn outside the steering law in {_pct(v, limit, 1)} of the frames judged (limit <= {_limit_pct(limit)})"
         ),
         limits=_FRACTION,
         outputs=_WHEELS,
@@ -503,8 +524,8 @@ SHIPPED_CHECKS = (
             f"seen on, in all but at most this fraction of the lost frames {_BAND}"
         ),
         lambda v, limit, m: (
-            f"lost/search command off the law in {v:.1%} of the lost "
-            f"frames judged (limit <= {limit:.1%})"
+            f"lost/search command off the law in {_pct(v, limit, 1)} of the lost "
+            f"frames judged (limit <= {_limit_pct(limit)})"
         ),
         limits=_FRACTION,
         outputs=_WHEELS,
@@ -518,7 +539,9 @@ SHIPPED_CHECKS = (
             "every further camera with a target ([[robot.sensors]] camera, target = ...) has "
             "its target in view this often (the least of them)"
         ),
-        lambda v, limit, m: f"a camera's target in view {_pct(v)} of frames (limit >= {limit:.0%})",
+        lambda v, limit, m: (
+            f"a camera's target in view {_pct(v, limit)} of frames (limit >= {_limit_pct(limit)})"
+        ),
         limits=_FRACTION,
         precondition=measured("camera_target_in_view_fraction", "no further camera has a target"),
     ),
@@ -531,7 +554,7 @@ SHIPPED_CHECKS = (
             "this often (the least of them): a pan camera keeps its target centred"
         ),
         lambda v, limit, m: (
-            f"a camera's target centred in {_pct(v)} of frames (limit >= {limit:.0%})"
+            f"a camera's target centred in {_pct(v, limit)} of frames (limit >= {_limit_pct(limit)})"
         ),
         limits=_FRACTION,
         precondition=measured("camera_target_centred_fraction", "no further camera has a target"),
