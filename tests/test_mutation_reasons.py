@@ -266,6 +266,9 @@ def test_a_pin_verdict_counts_the_cycles_its_outputs_differ():
     assert v.cycles_differing == 180
     # Read unsigned, -20 is 65516: 65496 from 20.
     assert _pin_verdict(mutant, design).extent["motor"] == (150, 65496)
+    # The pin model gives a signed port's values signed already: -20 stays -20.
+    signed = {**mutant, "motor": [(0, 0), (100, -20), (150, 0), (300, 0)]}
+    assert _pin_verdict(signed, design, ports=ports).extent["motor"] == (150, 40)
 
 
 def test_a_pin_blind_spot_s_reason_class():

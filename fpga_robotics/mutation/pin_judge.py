@@ -217,7 +217,9 @@ def _extent(want, got, cycles, port):
     says so."""
 
     def number(value):
-        if port is not None and port.signed and value >> (port.width - 1) & 1:
+        # A signed port's changes come signed from the pin model; a raw pattern with its
+        # sign bit set (a Verilog port read unsigned) is made so here.
+        if port is not None and port.signed and value >= 0 and value >> (port.width - 1) & 1:
             return value - (1 << port.width)
         return value
 
