@@ -18,6 +18,8 @@ def _pct(v, limit=None, least_digits=0):
     (0.9967 is 99.7%, not 100%), and with a ``limit`` never shown equal to it, or on its
     other side, when it is not (0.4004 against 40% is 40.04%); ``least_digits`` decimals
     at least."""
+    if limit is not None and v == limit:
+        return _limit_pct(limit)  # as the limit reads: 40.67% against 40.67%, not 41%
     for digits in range(least_digits, 7):
         text = f"{v:.{digits}%}"
         shown = float(text[:-1])
