@@ -100,6 +100,15 @@ def test_waveform_format_and_range_errors(tmp_path):
         get_backend("cxxrtl", PARAMS, waveform=WaveformRequest(str(tmp_path / "w.vcd"), 3, 1))
     with pytest.raises(BackendError, match="no directory"):
         get_backend("cxxrtl", PARAMS, waveform=WaveformRequest(str(tmp_path / "no" / "w.vcd")))
+    # Frames are counted from 0: a negative or fractional one would never be traced.
+    for first, last in ((-5, -2), (-1, 1), (1.5, 3)):
+        for backend in ("model", "cxxrtl"):
+            with pytest.raises(BackendError, match="must be a frame number"):
+                get_backend(
+                    backend, PARAMS, waveform=WaveformRequest(str(tmp_path / "w.vcd"), first, last)
+                )
+    with pytest.raises(BackendError, match=r"\.vcd waveforms only.*verilator backend for \.fst"):
+        get_backend("model", PARAMS, waveform=WaveformRequest(str(tmp_path / "w.fst")))
 
 
 @pytest.mark.slow

@@ -55,6 +55,13 @@ class WaveformRequest:
                 f"the {backend_name} backend writes {'/'.join(suffixes)} waveforms only, got "
                 f"{path!r}; use a {suffixes[0]} path{f' ({hint})' if hint else ''}"
             )
+        for name in ("first_frame", "last_frame"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, int) or value < 0:
+                raise BackendError(
+                    f"the waveform's {name} must be a frame number (a whole number, 0 or "
+                    f"more), got {value!r}"
+                )
         directory = os.path.dirname(os.path.abspath(path))
         if not os.path.isdir(directory):
             raise BackendError(f"cannot write the waveform: no directory {directory!r}")

@@ -48,7 +48,7 @@ class ModelBackend(DesignBackend):
     def __init__(self, params=None, *, line_blank=0, frame_blank=0, waveform=None):
         super().__init__(params, line_blank=line_blank, frame_blank=frame_blank, waveform=waveform)
         if waveform is not None:
-            waveform.check("model", hint="or the pysim/cxxrtl/verilator backend for other formats")
+            waveform.check("model", hint="or the verilator backend for .fst")
         self.model = FollowTargetModel(self.params)
         self._cycles = frame_cycles(self.params, line_blank, frame_blank)
         self._tracer = None
