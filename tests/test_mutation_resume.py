@@ -37,9 +37,11 @@ def test_resume_keeps_only_verdicts_of_the_same_mutants(tmp_path, capsys):
     assert code == 0, err
     first = _rows(out)
     assert len(first) >= 2 and len({r["mutants"] for r in first.values()}) == 1
-    # Interrupted after two verdicts: resumed, the others are judged, and all are as before.
+    # Killed while writing its third verdict (the line torn): resumed, the others are judged,
+    # and all are as before.
     journal = out / "robot.jsonl"
-    journal.write_text("".join(line + "\n" for line in journal.read_text().splitlines()[:2]))
+    lines = journal.read_text().splitlines()
+    journal.write_text("".join(line + "\n" for line in lines[:2]) + lines[2][: len(lines[2]) // 2])
     code, err = _mutate(out, 1, capsys, "--resume")
     assert code == 0, err
     again = _rows(out)
@@ -58,3 +60,15 @@ def test_resume_keeps_only_verdicts_of_the_same_mutants(tmp_path, capsys):
     assert code == 2 and err.count("\n") == 1
     assert "holds verdicts judged by other runs than campaign bump's" in err
     assert {p.name: p.read_bytes() for p in out.iterdir()} == before
+
+
+def test_a_torn_last_line_of_the_journal_is_not_a_verdict(tmp_path):
+    """A row cut short by a kill is left out (its mutant is judged again), the rows before
+    it are kept."""
+    from fpga_robotics.mutation.same_verdicts import journal_rows, read_journal
+
+    rows = [{"index": 3, "caught": True}, {"index": 5, "caught": False}]
+    text = "".join(json.dumps(r) + "\n" for r in rows)
+    (tmp_path / "robot.jsonl").write_text(text + json.dumps({"index": 7, "caught": True})[:12])
+    assert journal_rows(tmp_path / "robot.jsonl") == rows
+    assert read_journal(tmp_path) == {3: rows[0], 5: rows[1]}

@@ -21,12 +21,14 @@ import time
 
 from fpga_robotics.hw.errors import UsageError
 
+from ..sim.files import write_atomic
 from ..sweep import runner
 from ..sweep.api import wait_for_a_worker
 from ..sweep.engine import open_client
 from ..sweep.plan import make_plan
 from .cone import cone_verdict, settled_by_cone
 from .forked_runs import execute_forked, outcome_of, reference_share
+from .same_verdicts import journal_rows
 
 __all__ = [
     "campaign_runs_key",
@@ -122,8 +124,7 @@ def check_resume(out_dir, key, campaign):
     journal = os.path.join(out_dir, JOURNAL_NAME)
     if not os.path.exists(journal):
         return
-    with open(journal) as f:
-        rows = [json.loads(line) for line in f if line.strip()]
+    rows = journal_rows(journal)
     if {row.get("mutants") for row in rows} - {key}:
         raise UsageError(
             f"--resume: {journal} holds verdicts of other mutants (another design, --seed "
@@ -352,12 +353,13 @@ def robot_judge(
     journal = os.path.join(out_dir, JOURNAL_NAME)
     verdicts = {}
     if resume and os.path.exists(journal):
-        with open(journal) as f:
-            for line in f:
-                if line.strip():
-                    row = json.loads(line)
-                    if (row.get("mutants"), row.get("campaign_runs")) == (mutants, runs_key):
-                        verdicts[int(row["index"])] = row
+        for row in journal_rows(journal):
+            if (row.get("mutants"), row.get("campaign_runs")) == (mutants, runs_key):
+                verdicts[int(row["index"])] = row
+        # Written again whole: a torn last line would swallow the first row appended to it.
+        write_atomic(
+            journal, "".join(json.dumps(v) + "\n" for v in verdicts.values()), what="journal"
+        )
     elif os.path.exists(journal):
         os.remove(journal)
     if prebuilt is not None:

@@ -4,22 +4,32 @@
 import json
 import os
 
-__all__ = ["VERDICT_FIELDS", "differing_verdicts", "read_journal"]
+__all__ = ["VERDICT_FIELDS", "differing_verdicts", "journal_rows", "read_journal"]
 
 #: What makes a robot verdict: caught or not, the first run that did not pass, how it did
 #: not pass and which checks failed, and for a blind spot the run closest to failing.
 VERDICT_FIELDS = ("caught", "run", "status", "failed_checks", "closest")
 
 
+def journal_rows(path):
+    """The verdict rows of the journal at ``path``, in order. A line that is not a whole row
+    (the last one, torn by a kill while it was written) is left out: its mutant is not
+    judged yet."""
+    rows = []
+    with open(path) as f:
+        for line in f:
+            try:
+                row = json.loads(line)
+            except ValueError:
+                continue
+            if isinstance(row, dict) and "index" in row:
+                rows.append(row)
+    return rows
+
+
 def read_journal(out_dir):
     """``{mutant index: verdict row}`` of ``out_dir/robot.jsonl``."""
-    rows = {}
-    with open(os.path.join(out_dir, "robot.jsonl")) as f:
-        for line in f:
-            if line.strip():
-                row = json.loads(line)
-                rows[int(row["index"])] = row
-    return rows
+    return {int(row["index"]): row for row in journal_rows(os.path.join(out_dir, "robot.jsonl"))}
 
 
 def differing_verdicts(a, b):
