@@ -69,3 +69,31 @@ robot.mass = 12.0
         "--set",
         "lighting.ambient=0.3",
     ]
+
+
+def test_a_grid_axis_of_lists_plans_a_run_for_each_list():
+    """A key whose value is a list (a start position, waypoints) as a grid axis or in a set:
+    each run takes the whole list (it crashed the planner: a list is not hashable)."""
+    from fpga_robotics.sweep.plan import make_plan
+
+    data = tomllib.loads("""
+scenarios = ["follow_person"]
+seeds = "0"
+[grid]
+"robot.start" = [[0.5, 0.6], [0.9, 0.5]]
+[[sets]]
+"people.0.waypoints" = [[3.0, 2.0], [4.0, 2.0]]
+""")
+    campaign = load_campaign(data)
+    plan = make_plan(campaign)
+    sets = [[a for a in spec.argv() if "=" in a] for spec in plan.runs]
+    assert sets == [
+        ["robot.start=[0.5, 0.6]"],
+        ["robot.start=[0.9, 0.5]"],
+        ["people.0.waypoints=[[3.0, 2.0], [4.0, 2.0]]"],
+    ]
+    assert [_parse_value(s[0].partition("=")[2]) for s in sets] == [
+        [0.5, 0.6],
+        [0.9, 0.5],
+        [[3.0, 2.0], [4.0, 2.0]],
+    ]

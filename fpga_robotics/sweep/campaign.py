@@ -268,7 +268,8 @@ def _combos(data):
             )
         pairs = _flatten(grid, "", "grid key")
         axes = [k for k, _ in pairs]
-        combos = [tuple(zip(axes, values)) for values in itertools.product(*(v for _, v in pairs))]
+        values = [[_hashable(v) for v in vs] for _, vs in pairs]
+        combos = [tuple(zip(axes, combo)) for combo in itertools.product(*values)]
     if "sets" in data:
         sets = data["sets"]
         if not isinstance(sets, list) or not sets or not all(isinstance(s, dict) for s in sets):
@@ -291,9 +292,15 @@ def _flatten_values(table, prefix):
     for key, value in table.items():
         if isinstance(value, dict):
             out += _flatten_values(value, f"{prefix}{key}.")
-        else:  # a list value (a colour) as a tuple: a run's overrides are hashable
-            out.append((f"{prefix}{key}", tuple(value) if isinstance(value, list) else value))
+        else:
+            out.append((f"{prefix}{key}", _hashable(value)))
     return out
+
+
+def _hashable(value):
+    """A list value (a colour, a start position, waypoints) as tuples, all the way down: a
+    run's overrides are hashable."""
+    return tuple(_hashable(v) for v in value) if isinstance(value, list) else value
 
 
 #: Override keys that choose the design, which a campaign's ``design`` chooses for every run.
