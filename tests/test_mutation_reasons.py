@@ -325,3 +325,34 @@ def test_a_design_s_report_gives_each_blind_spot_its_reason(tmp_path):
     assert text.count("differs from cycle 3: hit 0 -&gt; 1") == 2
     assert "why no run shows it" in text
     assert text.count("rare state: differs during 0.45% of the 2000 random-input cycles") == 2
+
+
+def test_a_filtered_image_difference_is_counted_in_pixels():
+    """Two filtered pixels swapped (one on, one off): the image differs though the count of
+    matching pixels does not; the effect says how many pixels differ, not "1819 -> 1819"."""
+    params = FollowTargetParams()
+    frames = judge_frames(params)[:3]
+    golden = golden_results(params, frames)
+
+    class Swapping:
+        def set_runtime(self, name, value):
+            pass
+
+        def reset(self):
+            self.k = 0
+
+        def process_frame(self, frame, color):
+            want = golden[self.k]
+            self.k += 1
+            if self.k < 2:
+                return want
+            image = want.filtered.copy()
+            on, off = np.argwhere(image != 0)[0], np.argwhere(image == 0)[0]
+            image[tuple(off)], image[tuple(on)] = image[tuple(on)], 0
+            return dataclasses.replace(want, filtered=image)
+
+    v = judge_mutant(Swapping(), 1, frames, golden)
+    matching = int((golden[1].filtered != 0).sum())
+    assert v.first_frame == 1 and v.first_difference == {"filtered": (matching, matching)}
+    assert v.first_filtered_pixels == 2
+    assert v.effect() == "differs from frame 1: filtered 2 pixel(s) differ; filtered in 2 frame(s)"

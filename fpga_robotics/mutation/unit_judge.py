@@ -39,6 +39,9 @@ class UnitVerdict:
     frames_differing: int = 0  # frames in which any output differs
     # scalar output -> the largest |model - mutant| over the frames (found counts 0/1)
     max_difference: dict = field(default_factory=dict)
+    # the filtered image's pixels that differ in the first frame with a difference: its
+    # first_difference (matching pixels, model -> mutant) may be equal when pixels differ
+    first_filtered_pixels: int = 0
 
     def effect(self):
         """One line: what the mutant does to the outputs."""
@@ -47,7 +50,12 @@ class UnitVerdict:
         if self.failure is not None:
             return f"frame {self.first_frame}: {self.failure}"
         parts = [f"{name} in {n} frame(s)" for name, n in self.differing.items() if n]
-        first = ", ".join(f"{k} {v[0]} -> {v[1]}" for k, v in self.first_difference.items())
+        first = ", ".join(
+            f"filtered {self.first_filtered_pixels} pixel(s) differ"
+            if k == "filtered"
+            else f"{k} {v[0]} -> {v[1]}"
+            for k, v in self.first_difference.items()
+        )
         return f"differs from frame {self.first_frame}: {first}; " + ", ".join(parts)
 
 
@@ -114,4 +122,6 @@ def judge_mutant(design, index, frames, golden):
             verdict.first_difference = {
                 n: (output_value(want, n), output_value(got, n)) for n in differ
             }
+            if "filtered" in differ:
+                verdict.first_filtered_pixels = int((want.filtered != got.filtered).sum())
     return verdict
