@@ -67,8 +67,10 @@ class Mutant:
 
     ``index`` is the value of ``mutsel`` that selects it (1..N); ``mode`` one of ``inv``
     (the bit inverted), ``const0``/``const1`` (forced), ``cnot0`` (XNORed with another bit of
-    the same signal, ``ctrlbit``: inverted where that bit is 0), ``cnot1`` (XORed with it:
-    inverted where it is 1); ``module`` the component path inside ``FollowTarget`` ("" for
+    the same cell port, ``ctrlbit``: inverted where that bit is 0), ``cnot1`` (XORed with it:
+    inverted where it is 1); the port's bit ``portbit`` is the mutated one, and another bit of
+    the port may carry another signal (a register of a whole struct), so the control bit is
+    named by the port, ``Q[12]``, not as a bit of ``signal``; ``module`` the component path inside ``FollowTarget`` ("" for
     the top); ``signal`` and ``bit`` the wire it shows on (None when the cell drives no named
     wire); ``sources`` the Python lines of that signal, relative to the package
     (``hw/tracker.py:226``); ``command`` the ``mutate`` command itself.
@@ -92,8 +94,8 @@ class Mutant:
             "inv": "inverted",
             "const0": "stuck at 0",
             "const1": "stuck at 1",
-            "cnot0": f"XNOR bit {self.ctrlbit}",
-            "cnot1": f"XOR bit {self.ctrlbit}",
+            "cnot0": f"XNOR {self.port}[{self.ctrlbit}]",
+            "cnot1": f"XOR {self.port}[{self.ctrlbit}]",
         }
         cell = self.cell.rpartition(".")[2] if self.cell.startswith("$flatten") else self.cell
         where = (

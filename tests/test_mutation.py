@@ -83,7 +83,7 @@ def test_parse_a_known_line():
     )
     assert (m.signal, m.bit) == ("tracker.results.quotient", 2)
     assert m.describe() == (
-        "#5 tracker.results: tracker.results.quotient[2] XOR bit 7 "
+        "#5 tracker.results: tracker.results.quotient[2] XOR Y[7] "
         "(/x/fpga_robotics/hw/tracker.py:226)"
     )
     assert mutation.select_width(1) == 1 and mutation.select_width(40) == 6
@@ -101,7 +101,7 @@ def test_a_cnot_mutant_is_described_as_the_gate_yosys_puts_in(mutants, netlist):
         own, faulty = watch.groups()
         gate = re.search(rf"assign {re.escape(faulty)} = {re.escape(own)} (~\^|\^) ", netlist)
         name = {"~^": "XNOR", "^": "XOR"}[gate.group(1)]
-        assert f" {name} bit {m.ctrlbit} " in m.describe(), (m.command, gate.group(0))
+        assert f" {name} {m.port}[{m.ctrlbit}] " in m.describe(), (m.command, gate.group(0))
 
 
 def test_the_netlist_has_a_select_input_per_mutant(netlist):
