@@ -169,6 +169,11 @@ def test_the_ultrasound_variant_drives_into_the_box():
             ),
         ),
         (["design.line.n_sensors=2"], "the line_sensors table must list as many sensors"),
+        # Two sensors on the three-bit input: the third bit was left undriven, silently.
+        (
+            ["robot.sensors[0].sensors=[{forward=0.0,left=0.018},{forward=0.0,left=-0.018}]"],
+            "pin 'line' is in 2 bit.s. but port 'line' of design 'follow_line' is in 3 bit",
+        ),
     ],
 )
 def test_binding_errors_say_what_to_declare(overrides, message):

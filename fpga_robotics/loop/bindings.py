@@ -64,12 +64,13 @@ def no_port(kind, name, top, pin, port, ports):
     )
 
 
-def port_misfit(kind, name, top, pin, port):
+def port_misfit(kind, name, top, pin, port, spec=None):
     """Why design ``port`` (a ``sim.pins.Port``) cannot be connector pin ``pin`` of the
     ``kind`` connector ``name``, or None when it can: of the pin's direction and width, or
     for a signed output pin (the wheels' DPS, a servo's angle) a narrower signed output, which
-    the backends read sign-extended."""
-    spec = CONNECTORS[kind].pins[pin]
+    the backends read sign-extended. ``spec``: the connector's own ``Pin`` where its width is
+    set per connector (a line_sensors table's sensors), else the kind's."""
+    spec = spec or CONNECTORS[kind].pins[pin]
     fits = port.width == spec.width or (
         spec.direction == "out" and spec.signed and port.signed and port.width < spec.width
     )

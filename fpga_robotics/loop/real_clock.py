@@ -301,7 +301,7 @@ class RealClockLoop(ClosedLoop):
                 raise unbound(conn.kind, conn.name, self.top, pin)
             if port not in ports:
                 raise no_port(conn.kind, conn.name, self.top, pin, port, ports)
-            misfit = port_misfit(conn.kind, conn.name, self.top, pin, ports[port])
+            misfit = port_misfit(conn.kind, conn.name, self.top, pin, ports[port], conn.pins[pin])
             if misfit is not None:
                 raise UsageError(misfit)
         return binding
