@@ -105,6 +105,7 @@ class PinComparison:
     differing_frames: dict = field(default_factory=dict)
     first_divergence: dict | None = None
     frames: int = 0
+    params: dict | None = None  # a design of one's own's [design.params]; None: it takes none
 
     def __post_init__(self):
         self.differing_frames = dict.fromkeys(self.outputs, 0)
@@ -126,8 +127,10 @@ class PinComparison:
         return differ
 
     def summary(self):
+        params = {} if self.params is None else {"params": dict(self.params)}
         return {
             "design": self.label,
+            **params,
             "frames": self.frames,
             "first_divergence": self.first_divergence,
             "differing_frames": dict(self.differing_frames),

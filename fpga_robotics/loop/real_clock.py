@@ -28,7 +28,7 @@ from collections import deque
 import numpy as np
 
 from fpga_robotics.checks.sensor_metrics import line_metrics, measurement_metrics
-from fpga_robotics.designs.builtin import build_component, connector_kinds
+from fpga_robotics.designs.builtin import TOPS, build_component, connector_kinds
 from fpga_robotics.designs.reference import resolve_design, stream_ports
 from fpga_robotics.hw.errors import UsageError
 from fpga_robotics.loop.bindings import (
@@ -123,8 +123,11 @@ def make_pin_backend(name, scenario, *, on_build=None):
     kwargs = {"on_build": on_build} if on_build is not None else {}
     backend = get_pin_backend(name, pin_design_source(scenario), **kwargs)
     # Which port serves which connector pin: a loop that runs it as a shadow mirrors the
-    # primary's inputs by it (pin_shadow.MirroredPins).
+    # primary's inputs by it (pin_shadow.MirroredPins), and reports the parameters of a
+    # design of one's own (None: it takes none).
     backend.connector_bindings = scenario_top(scenario).bindings
+    own = scenario.foreign is None and scenario.top not in TOPS
+    backend.design_params = dict(scenario.design_params) if own else None
     return backend
 
 
@@ -275,7 +278,8 @@ class RealClockLoop(ClosedLoop):
                 and shadow.ports[n].direction == "out"
                 and not n.startswith("filtered__")
             )
-            self.comparison = PinComparison(shadow_label, outputs)
+            params = getattr(shadow, "design_params", None)
+            self.comparison = PinComparison(shadow_label, outputs, params=params)
         self.measurements = {}  # "<connector>.<key>" -> array per row
 
     def use_design(self, pins):
