@@ -122,10 +122,12 @@ def make_pin_backend(name, scenario, *, on_build=None):
         )
     kwargs = {"on_build": on_build} if on_build is not None else {}
     backend = get_pin_backend(name, pin_design_source(scenario), **kwargs)
+    top = scenario_top(scenario)
     # Which port serves which connector pin: a loop that runs it as a shadow mirrors the
-    # primary's inputs by it (pin_shadow.MirroredPins), and reports the parameters of a
-    # design of one's own (None: it takes none).
-    backend.connector_bindings = scenario_top(scenario).bindings
+    # primary's inputs by it (pin_shadow.MirroredPins), records its wheels and extra
+    # outputs, and reports the parameters of a design of one's own (None: it takes none).
+    backend.connector_bindings = top.bindings
+    backend.extra_outputs = dict(top.extra_outputs)
     own = scenario.foreign is None and scenario.top not in TOPS
     backend.design_params = dict(scenario.design_params) if own else None
     return backend
@@ -550,8 +552,11 @@ class RealClockLoop(ClosedLoop):
         for name, port in self.top.extra_outputs.items():
             extra[name] = self.pins.peek(port)
             self.extra[name][row.k] = float(extra[name])
+        shadow = {}
         if self.shadow_pins is not None:
             events += self.compare_shadow(row)
+            if self.want_records:
+                shadow = self.shadow_outputs()
         self.events += [(row.k, round(row.t, 6), e) for e in events]
         if self.want_records:
             self.record(
@@ -565,7 +570,27 @@ class RealClockLoop(ClosedLoop):
                 sensors=row.readings,
                 design_extra=extra,
                 cameras=row.cameras,
+                **shadow,
             )
+
+    def shadow_outputs(self):
+        """The shadow design's outputs now, as the row's record holds them: its per-frame
+        outputs and wheels (through its own ports) as ``shadow_result``, the outputs no
+        connector reads as ``shadow_extra``."""
+        pins = self.shadow_pins
+        bindings = pins.connector_bindings
+        camera = "camera" in bindings
+        values = {
+            name: pins.peek(name) if camera and name in pins.ports else None
+            for name in _FRAME_OUTPUTS
+        }
+        wheels = bindings.get("wheels", {})
+        for pin in ("motor_left", "motor_right"):
+            values[pin] = pins.peek(wheels[pin]) if pin in wheels else None
+        return {
+            "shadow_result": FrameResult(filtered=None, cycles=None, **values),
+            "shadow_extra": {name: pins.peek(port) for name, port in pins.extra_outputs.items()},
+        }
 
     def compare_shadow(self, row):
         """Row ``row.k``'s outputs of both designs compared; the event of the first
