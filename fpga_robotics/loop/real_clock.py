@@ -272,17 +272,32 @@ class RealClockLoop(ClosedLoop):
         self.extra = {name: np.full(self.n_frames, np.nan) for name in self.top.extra_outputs}
         self.shadow_pins = shadow
         if shadow is not None:
-            outputs = tuple(
-                n
-                for n, p in design.ports.items()
-                if p.direction == "out"
-                and n in shadow.ports
-                and shadow.ports[n].direction == "out"
-                and not n.startswith("filtered__")
-            )
+            self.compared = self._compared_outputs(shadow)
             params = getattr(shadow, "design_params", None)
-            self.comparison = PinComparison(shadow_label, outputs, params=params)
+            self.comparison = PinComparison(shadow_label, tuple(self.compared), params=params)
         self.measurements = {}  # "<connector>.<key>" -> array per row
+
+    def _compared_outputs(self, shadow):
+        """Output -> (primary's port, shadow's port), compared at every row: the wheels
+        through the ports each design binds them to (a new version may rename them), every
+        other output both designs have by its name."""
+        wheels = self.top.bindings.get("wheels", {})
+        shadow_wheels = getattr(shadow, "connector_bindings", {}).get("wheels", {})
+        wheel_of = {port: pin for pin, port in wheels.items()}
+        compared = {}
+        for name, port in self.pins.ports.items():
+            if port.direction != "out" or name.startswith("filtered__"):
+                continue
+            pin = wheel_of.get(name)
+            if pin is not None:
+                if pin in shadow_wheels:
+                    compared[pin] = (name, shadow_wheels[pin])
+                continue
+            other = shadow.ports.get(name)
+            wheel = name in shadow_wheels.values()  # the shadow's, compared as its wheel
+            if other is not None and other.direction == "out" and not wheel:
+                compared[name] = (name, name)
+        return compared
 
     def use_design(self, pins):
         """Drive ``pins`` from now on (a design brought to the loop's state, e.g. by
@@ -599,8 +614,8 @@ class RealClockLoop(ClosedLoop):
         first = c.first_divergence is None
         # Read past a journal (fpga_robotics.loop.pin_journal): the loop's own calls only.
         design = getattr(self.pins.primary, "unrecorded", self.pins.primary)
-        primary = {n: design.peek(n) for n in c.outputs}
-        shadow = {n: self.shadow_pins.peek(n) for n in c.outputs}
+        primary = {n: design.peek(port) for n, (port, _) in self.compared.items()}
+        shadow = {n: self.shadow_pins.peek(port) for n, (_, port) in self.compared.items()}
         differ = c.compare(row.k, row.t, primary, shadow)
         if not (differ and first):
             return []
