@@ -72,6 +72,7 @@ class FrameRecord:
     # distance_mm, obstacle, line_seen).
     sensors: dict = field(default_factory=dict)
     design_extra: dict = field(default_factory=dict)
+    shadow_extra: dict = field(default_factory=dict)  # a shadow design's, as design_extra
     # Further cameras ([[robot.sensors]] kind = "camera"): {name: CameraView}, each its
     # latest capture at this frame's instant.
     cameras: dict = field(default_factory=dict)

@@ -146,4 +146,31 @@ def test_a_shadow_with_its_own_stream_name_is_streamed_the_same_frames(tmp_path,
     assert trajectory_counts["max"] > 0
     shadow = json.loads(summary.read_text())["shadow"]
     assert shadow["frames"] == 20 and shadow["first_divergence"] is None
-    assert shadow["differing_frames"] == {"near": 0, "red_count": 0}
+    assert shadow["differing_frames"] == {
+        "motor_left": 0,
+        "motor_right": 0,
+        "near": 0,
+        "red_count": 0,
+    }
+
+
+def test_a_shadow_s_wheels_under_other_port_names_are_compared_as_the_wheels(tmp_path, capsys):
+    # NearRedCam drives wheel_l/wheel_r, NearRed motor_left/motor_right: at 300 DPS against
+    # 400 they differ on every row the robot drives, and only there.
+    summary = tmp_path / "s.json"
+    argv = ["run", "--scenario", str(DESIGNS / "near_red.toml"), "--shadow", NEAR_RED_CAM]
+    argv += ["--shadow-param", "speed=300", "--set", "robot.start=[2.2, 1.5]"]
+    argv += ["--backend", "cxxrtl", "--duration", "2", "--rerun", "off", "--quiet"]
+    with pytest.raises(SystemExit) as info:
+        cli.main([*argv, "--summary", str(summary)])
+    assert info.value.code == 0, capsys.readouterr().err
+    result = json.loads(summary.read_text())
+    first = result["shadow"]["first_divergence"]
+    assert first["frame"] == 0
+    assert first["outputs"] == {
+        "motor_left": {"primary": 400, "shadow": 300},
+        "motor_right": {"primary": 400, "shadow": 300},
+    }
+    driving = result["shadow"]["differing_frames"]["motor_left"]
+    assert 0 < driving < 20 and result["extra_outputs"]["near"]["last"] == 1
+    assert result["shadow"]["differing_frames"]["near"] == 0

@@ -724,8 +724,35 @@ PLANS = {
         out=(
             PASS,
             (
-                r"shadow wall_stop_v1\.py:WallStop: identical outputs on all 360 "
-                r"frames"
+                r"shadow wall_stop_v1\.py:WallStop with speed=300, stop_mm=250: identical "
+                r"outputs on all 360 frames"
+            ),
+        ),
+    ),
+    (
+        "fpga-robotics run --scenario wall_stop.toml --shadow wall_stop_v2.py:WallStop "
+        "--shadow-param stop_mm=100 --rerun off"
+    ): Plan(
+        setup=(
+            " ".join(
+                [
+                    "cp",
+                    *(
+                        str(ROOT / "tests/data/user_designs" / name)
+                        for name in ("wall_stop.py", "wall_stop.toml")
+                    ),
+                    ".",
+                ]
+            ),
+            "sed 's/stop_mm: int = 250/stop_mm: int = 100/' wall_stop.py > wall_stop_v2.py",
+        ),
+        duration="keep",
+        duration_why="the page quotes the frame (9.60 s) where the shadow drives on",
+        out=(
+            PASS,
+            re.escape(
+                "shadow wall_stop_v2.py:WallStop with speed=300, stop_mm=100: first differs "
+                "at frame 288 (9.60 s): motor_left 0 vs 300, motor_right 0 vs 300, stopped 1 vs 0"
             ),
         ),
     ),

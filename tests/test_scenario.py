@@ -147,6 +147,8 @@ def test_unknown_keys_are_errors_with_close_matches(item, expect):
     [
         ("design.width=320", "camera.resolution"),
         ("people.5.speed=1", "index it with 0..0"),
+        ("color.changes.0.at=2", "color.changes is an empty list; set it whole: --set 'color."),
+        ("room.furniture.0.height=1", "the scenario has no room.furniture to index"),
         ("sim.duration", "KEY=VALUE"),
         ("sim.duration=-1", "sim.duration must be > 0"),
         ("sim.physics_dt=0.5", "sim.physics_dt 0.5 s is longer than a camera frame period"),
@@ -465,3 +467,10 @@ def test_with_overrides_checks_the_same():
         s.with_overrides(["camera=5"])
     with pytest.raises(ScenarioError, match="one day"):
         s.with_overrides(["sim.duration=1e9"])
+
+
+def test_an_array_the_scenario_leaves_out_is_set_whole_then_by_index():
+    s = load_scenario(
+        "follow_person", ["room.furniture=[{center = [4, 3]}]", "room.furniture.0.height=1"]
+    )
+    assert s.world["room"]["furniture"] == [{"center": [4, 3], "height": 1}]

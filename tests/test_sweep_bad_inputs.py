@@ -36,7 +36,7 @@ CASES = {
     "not a list": (GOOD + '[grid]\n"design.diff_min" = 4\n', "must be a list of values"),
     "a parameter shadow in real-clock timing": (
         'scenarios = ["line_track"]\nduration = 1.0\nshadow = "published"\n',
-        "this scenario runs in real-clock timing, where --shadow takes a design reference",
+        "scenario 'line_track' runs in real-clock timing, where --shadow takes a design reference",
     ),
     # A value for every run that the runs' overrides give too: a run would take one of them
     # and its row be labelled with the other.

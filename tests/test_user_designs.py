@@ -462,6 +462,50 @@ def test_shadow_runs_a_previous_version_of_the_design_on_the_same_pins(tmp_path,
     assert "first differs at frame 0 (0.00 s): motor_left 300 vs 250" in out
 
 
+def test_a_shadow_runs_with_the_scenario_s_params_it_takes_and_its_own(tmp_path, capsys):
+    """--shadow REF gets the scenario's [design.params] its signature takes (a changed
+    default the scenario sets does not show: the summary names the params), --shadow-param
+    NAME=VALUE gives it its own; a previous version without a parameter runs without it."""
+    v2 = (DESIGNS / "wall_stop.py").read_text().replace("stop_mm: int = 250", "stop_mm: int = 100")
+    (tmp_path / "wall_stop_v2.py").write_text(v2)
+    # Started 0.6 m from the wall: the primary stops after about 1.3 s, v2 at 100 mm later.
+    base = ["run", "--scenario", str(WALL_STOP), "--set", "robot.start=[1.9, 0.5]"]
+    base += ["--duration", "3", "--backend", "cxxrtl", "--rerun", "off", "--quiet"]
+
+    def shadow(*options):
+        summary = tmp_path / "s.json"
+        code, out, err = _cli([*base, *options, "--summary", str(summary)], capsys)
+        assert code == 0, err
+        return json.loads(summary.read_text())["shadow"], out
+
+    v2 = f"{tmp_path}/wall_stop_v2.py:WallStop"
+    same, out = shadow("--shadow", v2)
+    assert same["params"] == {"speed": 300, "stop_mm": 250}
+    assert same["first_divergence"] is None
+    assert f"shadow {v2} with speed=300, stop_mm=250: identical outputs on all 90 frames" in out
+    own, out = shadow("--shadow", v2, "--shadow-param", "stop_mm=100")
+    assert own["params"] == {"speed": 300, "stop_mm": 100}
+    first = own["first_divergence"]
+    assert first["outputs"]["motor_left"] == {"primary": 0, "shadow": 300}
+    assert first["outputs"]["stopped"] == {"primary": 1, "shadow": 0}
+    assert f"shadow {v2} with speed=300, stop_mm=100: first differs at frame" in out
+    function, _ = shadow("--shadow", f"{DESIGNS}/wall_stop.py:wall_stop")  # takes speed only
+    assert function["params"] == {"speed": 300}
+    assert function["first_divergence"] is None
+
+
+def test_a_shadow_parameter_without_default_is_asked_for_by_shadow_param(tmp_path, capsys):
+    needs = (
+        DESIGNS / "wall_stop.py"
+    ).read_text() + "\n\ndef needs(gap: int):\n    return WallStop(stop_mm=gap)\n"
+    (tmp_path / "needs.py").write_text(needs)
+    argv = ["run", "--scenario", str(WALL_STOP), "--shadow", f"{tmp_path}/needs.py:needs"]
+    code, _, err = _cli([*argv, "--rerun", "off"], capsys)
+    assert code == 2 and len(err.strip().splitlines()) == 1, err
+    assert "parameter 'gap' has no default" in err
+    assert "give it with --shadow-param gap=VALUE" in err
+
+
 _BUMP_STOP_AMARANTH = """
 from amaranth import Module, Signal, signed
 from amaranth.lib import wiring

@@ -1,8 +1,12 @@
 """A shadow design in the recording: a second LED row and DPS series beside the primary's, the
 first divergence among the events, a layout with both."""
 
-import numpy as np
+from pathlib import Path
 
+import numpy as np
+import pytest
+
+from fpga_robotics import cli
 from fpga_robotics.loop.timings import run_scenario
 from fpga_robotics.scenario.load import load_scenario
 from fpga_robotics.sim.backends.model import ModelBackend
@@ -56,3 +60,30 @@ def test_no_shadow_entities_without_a_shadow(tmp_path):
         p.startswith("shadow") or p == P.SHADOW_MOTORS_DPS
         for p in list(data.entities) + list(data.static)
     )
+
+
+def test_a_shadow_design_on_pins_is_recorded_through_its_own_ports(tmp_path, capsys):
+    """Real-clock timing, --shadow REF: the shadow's wheels (declared as wheel_l/wheel_r)
+    and its extra outputs are recorded row by row beside the primary's. NearRedCam is
+    NearRed's logic under other port names, here at 300 DPS against the primary's 400."""
+    designs = Path(__file__).parent / "data" / "user_designs"
+    path = tmp_path / "run.rrd"
+    argv = ["run", "--scenario", str(designs / "near_red.toml"), "--duration", "2"]
+    argv += ["--set", "robot.start=[2.2, 1.5]"]  # near the person within the run
+    argv += ["--shadow", f"{designs / 'near_red_cam.py'}:NearRedCam", "--shadow-param", "speed=300"]
+    with pytest.raises(SystemExit) as info:
+        cli.main([*argv, "--backend", "cxxrtl", "--rerun", f"save:{path}", "--quiet"])
+    assert info.value.code == 0, capsys.readouterr().err
+    data = read_rrd(str(path))
+
+    def series(entity):
+        assert data.entities[entity].frames == list(range(20)), entity
+        return np.array(data.entities[entity].values["Scalars:scalars"], float).reshape(20, -1)
+
+    primary, shadow = series(P.MOTORS_DPS), series(P.SHADOW_MOTORS_DPS)
+    assert set(primary.ravel()) == {0.0, 400.0}  # it drives, then stops near the person
+    assert np.array_equal(shadow * 4, primary * 3)  # the same decisions, at 300 DPS
+    for name in ("red_count", "near"):
+        own = series(f"design/shadow_extra/{name}")
+        assert np.array_equal(own, series(f"design/extra/{name}")), name
+    assert P.SHADOW_LEDS_PROXIMITY not in data.entities  # NearRedCam has no LEDs

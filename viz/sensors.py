@@ -4,7 +4,8 @@ design saw at its pins, on the frames' timeline, and where the sensors are on th
 - ``sensors/<name>/<key>``: one series per measurement (an ultrasound's ``echo_edges`` in
   design clock cycles and ``echo_m`` in metres, a line sensor's bits ...);
 - ``design/extra/<output>``: the design's outputs beyond FollowTarget's (``distance_mm``,
-  ``obstacle``, ``line_seen``);
+  ``obstacle``, ``line_seen``); ``design/shadow_extra/<output>`` a shadow design's
+  (``run --shadow REF``);
 - ``map/sensors/<name>``: the sensors' points (bright when their state is 1: over a line,
   pressed) and rays (an ultrasound's measured range from the sensor);
 - ``map/lines``: the floor markings, drawn once with the map.
@@ -16,10 +17,19 @@ import rerun as rr
 
 from .columns import points, scalars, strips
 
-__all__ = ["DESIGN_EXTRA", "MAP_LINES", "MAP_SENSORS", "SENSORS", "SensorViews", "line_strips"]
+__all__ = [
+    "DESIGN_EXTRA",
+    "MAP_LINES",
+    "MAP_SENSORS",
+    "SENSORS",
+    "SHADOW_EXTRA",
+    "SensorViews",
+    "line_strips",
+]
 
 SENSORS = "sensors"
 DESIGN_EXTRA = "design/extra"
+SHADOW_EXTRA = "design/shadow_extra"
 MAP_SENSORS = "map/sensors"
 MAP_LINES = "map/lines"
 
@@ -58,11 +68,15 @@ class SensorViews:
             self.series.append(path)
 
     def log(self, record, add):
-        for name, value in (getattr(record, "design_extra", None) or {}).items():
-            path = f"{DESIGN_EXTRA}/{name}"
-            self._series(path, name)
-            add(path, (float(value),))
-            self.seen = True
+        for root, extra in (
+            (DESIGN_EXTRA, getattr(record, "design_extra", None)),
+            (SHADOW_EXTRA, getattr(record, "shadow_extra", None)),
+        ):
+            for name, value in (extra or {}).items():
+                path = f"{root}/{name}"
+                self._series(path, name)
+                add(path, (float(value),))
+                self.seen = True
         for name, reading in (getattr(record, "sensors", None) or {}).items():
             self.seen = True
             for key, value in reading.values.items():

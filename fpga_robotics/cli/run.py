@@ -21,6 +21,7 @@ from fpga_robotics.checks.summary import format_summary
 from fpga_robotics.cli.errors import UsageError
 from fpga_robotics.cli.parser import CommandParser
 from fpga_robotics.designs.builtin import TOPS
+from fpga_robotics.designs.reference import design_parameters
 from fpga_robotics.hw.pixel import COLOR_SELECT
 from fpga_robotics.loop.bindings import check_bindings, scenario_top
 from fpga_robotics.loop.compressed import make_backend
@@ -177,6 +178,14 @@ def build_parser(prog="fpga-robotics run"):
         metavar="MAP",
         help="the port map of a Verilog shadow design (--shadow verilog:TOP.v[,MORE.v...], "
         "docs/foreign.md)",
+    )
+    p.add_argument(
+        "--shadow-param",
+        action="append",
+        default=[],
+        metavar="NAME=VALUE",
+        help="with --shadow FILE.py:Name: a parameter of the shadow design (repeatable); "
+        "it has the scenario's [design.params] its signature takes, these on top",
     )
     p.add_argument(
         "--shadow-backend",
@@ -361,44 +370,83 @@ def _video(path, fps):
     return CameraVideo(path, fps)
 
 
-def _shadow_params(scenario, spec):
-    """The shadow design's parameters: the scenario's design with ``--shadow`` applied."""
-    shadow = _shadow_params_scenario(scenario, spec)
-    return None if shadow is None else shadow.params
-
-
-def _shadow_params_scenario(scenario, spec):
-    """The scenario with the design ``--shadow`` describes (FollowTarget parameters)."""
-    if spec is None:
-        return None
-
-    try:
-        items = shadow_overrides(spec)
-    except ValueError as exc:
-        raise UsageError(str(exc)) from None
-    return scenario.with_overrides(items)
-
-
-def _shadow_scenario(scenario, spec, ports=None):
-    """With ``--shadow REF`` (a design reference): the scenario running that design instead
-    (its ``[design.params]`` kept; a Verilog one, ``verilog:FILES`` with ``ports``, takes
-    none); None for a FollowTarget parameter shadow."""
-    verilog = spec is not None and str(spec).startswith("verilog:")
-    if ports is not None and not verilog:
+def shadow_designs(args, scenario):
+    """``(shadow_scenario, params_scenario)`` of ``--shadow``: the scenario running a second
+    design on pins (``--shadow REF``, real-clock timing), or the scenario with FollowTarget's
+    other parameters (a preset, ``KEY=VALUE`` items: compressed timing); None for the one
+    not given. Checked before anything is built, an error naming ``--shadow``."""
+    spec = args.shadow
+    if args.shadow_ports is not None and not str(spec).startswith("verilog:"):
         raise UsageError(
             "--shadow-ports is the port map of a Verilog shadow design: it goes with "
             "--shadow verilog:FILE.v"
         )
-    if spec is None or not is_design_reference(spec):
-        return None
+    reference = spec is not None and is_design_reference(spec)
+    if args.shadow_param and not reference:
+        raise UsageError(
+            "--shadow-param gives a shadow design its parameters: it goes with "
+            "--shadow FILE.py:Name (a design reference)"
+        )
+    if spec is None:
+        return None, None
+    if reference:
+        return _shadow_scenario(scenario, spec, args.shadow_ports, args.shadow_param), None
+    if scenario.sim.timing == "real_clock":
+        raise UsageError(
+            f"--shadow {spec}: a preset or KEY=VALUE items shadow FollowTarget with other "
+            f"parameters, frame by frame, in compressed timing; scenario {scenario.name!r} "
+            f"runs in real-clock timing, where --shadow takes a design reference "
+            f"(FILE.py:Name, a built-in design's name, verilog:FILE.v)"
+        )
+    return None, _shadow_params_scenario(scenario, spec)
+
+
+def _shadow_params(scenario, spec):
+    """The FollowTarget parameters of ``--shadow SPEC`` (a preset, ``KEY=VALUE`` items)."""
+    return _shadow_params_scenario(scenario, spec).params
+
+
+def _shadow_params_scenario(scenario, spec):
+    """The scenario with the FollowTarget parameters ``--shadow`` describes. Only they
+    reach the shadow (a backend of whole frames): an item that changes the design itself
+    (``top``, ``verilog``, a design's tables or params) is refused, not ignored."""
+    try:
+        shadow = scenario.with_overrides(shadow_overrides(spec))
+    except (ValueError, ScenarioError) as exc:
+        raise UsageError(f"--shadow {spec}: {exc}") from None
+    design = ("top", "foreign", "design_tables", "design_params")
+    if any(getattr(shadow, key) != getattr(scenario, key) for key in design):
+        raise UsageError(
+            f"--shadow {spec}: in compressed timing the shadow is FollowTarget with other "
+            f"[design] values (a preset, KEY=VALUE items), not another design; a second "
+            f"design runs beside in real-clock timing: --set sim.timing=real_clock "
+            f"--shadow REF (FILE.py:Name, a built-in design's name)"
+        )
+    return shadow
+
+
+def _shadow_scenario(scenario, spec, ports, params):
+    """With ``--shadow REF`` (a design reference): the scenario running that design instead,
+    with the scenario's ``[design.params]`` that its signature takes and ``params``
+    (``--shadow-param NAME=VALUE``) on top; a Verilog one, ``verilog:FILES`` with ``ports``,
+    takes none."""
     if scenario.sim.timing != "real_clock":
         raise UsageError(
             f"--shadow {spec}: a second design runs on pins, in real-clock "
             f"timing; scenario {scenario.name!r} runs in compressed timing "
             f"(compare FollowTarget parameters there: --shadow KEY=VALUE)"
         )
-    if not verilog:
-        return scenario.with_overrides([design_override(spec)])
+    if not spec.startswith("verilog:"):
+        overrides = [design_override(spec), *_shadow_param_overrides(scenario, spec, params)]
+        try:
+            return scenario.with_overrides(overrides)
+        except ScenarioError as exc:
+            raise UsageError(f"--shadow {spec}: {exc}") from None
+    if params:
+        raise UsageError(
+            f"--shadow-param: a Verilog shadow design ({spec}) takes no parameters; "
+            f"set them in the Verilog (or tie inputs in its port map's [constants])"
+        )
     files = [f for f in spec[len("verilog:") :].split(",") if f.strip()]
     if not files:
         raise UsageError(f"--shadow must be verilog:FILE.v[,MORE.v...], got {spec!r}")
@@ -415,10 +463,47 @@ def _shadow_scenario(scenario, spec, ports=None):
             [
                 f"design.top={json.dumps('verilog:' + absolute)}",
                 f"design.ports={json.dumps(str(Path(ports).expanduser().resolve()))}",
+                "design.params={}",  # the primary's are not a Verilog design's
             ]
         )
     except ScenarioError as exc:
         raise UsageError(f"--shadow-ports {ports}: {exc}") from None
+
+
+def _shadow_param_overrides(scenario, spec, params):
+    """The overrides that give the shadow design ``spec`` its ``[design.params]``: those of
+    the scenario its signature takes (a previous version may lack a newer parameter), then
+    ``params`` (``NAME=VALUE`` items, values as ``--set`` takes them)."""
+    try:
+        takes = design_parameters(spec)
+    except UsageError as exc:  # the reference's DesignError: no such file, no such name ...
+        raise UsageError(f"--shadow {spec}: {exc}") from None
+    given = {}
+    for item in params:
+        name, sep, value = (part.strip() for part in item.partition("="))
+        if not sep or not name.isidentifier():
+            raise UsageError(f"--shadow-param needs NAME=VALUE (e.g. stop_mm=100), got {item!r}")
+        if spec in TOPS:
+            raise UsageError(
+                f"--shadow-param: the built-in design {spec!r} takes its parameters from "
+                f"the scenario's [design], not --shadow-param"
+            )
+        if takes is not None and name not in takes:
+            raise UsageError(
+                f"--shadow-param {name}: {spec} takes no parameter {name!r}; "
+                f"it takes: {', '.join(takes) or 'none'}"
+            )
+        given[name] = value
+    kept = {n: v for n, v in scenario.design_params.items() if takes is None or n in takes}
+    missing = [n for n, required in (takes or {}).items() if required and n not in kept]
+    missing = [n for n in missing if n not in given]
+    if missing:
+        raise UsageError(
+            f"--shadow {spec}: parameter {missing[0]!r} has no default and the scenario "
+            f"does not give it; give it with --shadow-param {missing[0]}=VALUE"
+        )
+    table = ", ".join(f"{n} = {json.dumps(v)}" for n, v in kept.items())
+    return [f"design.params={{{table}}}", *(f"design.params.{n}={v}" for n, v in given.items())]
 
 
 def _shadow_args(args, shadow_scenario):
@@ -513,8 +598,9 @@ def _open_backend(name, params, quiet=False):
         raise UsageError(f"backend {name!r} cannot run here: {exc}") from None
 
 
-def _open_pin_design(args, scenario):
-    """The scenario's design on a pin-level backend (real-clock timing)."""
+def _open_pin_design(args, scenario, option="--design"):
+    """The scenario's design on a pin-level backend (real-clock timing); ``option`` names
+    the design in an error of its Verilog (``--shadow REF`` for a shadow design)."""
 
     def tell(text):
         if not args.quiet:
@@ -524,7 +610,7 @@ def _open_pin_design(args, scenario):
         try:
             design = make_pin_backend(args.backend, scenario, on_build=tell)
         except (BackendError, PinError) as exc:
-            raise UsageError(f"--design: {exc}".splitlines()[0]) from None
+            raise UsageError(f"{option}: {exc}".splitlines()[0]) from None
         try:
             apply_runtime(design, args)  # held from every reset on
         except UsageError:
@@ -905,16 +991,13 @@ def main(argv=None, prog="fpga-robotics run"):
         return _run_source(args, scenario, ros)
     if args.max_frames is not None:
         raise UsageError("--max-frames only applies with --source (use --duration)")
-    shadow_scenario = _shadow_scenario(scenario, args.shadow, args.shadow_ports)
+    shadow_scenario, params_scenario = shadow_designs(args, scenario)
     shadow_args = None if shadow_scenario is None else _shadow_args(args, shadow_scenario)
     if shadow_scenario is not None and args.shadow_backend == "model":
         raise UsageError(
             "--shadow-backend model runs whole frames; a shadow design on pins needs "
             "--shadow-backend auto, cxxrtl, verilator or pysim"
         )
-    params_scenario = None
-    if shadow_scenario is None:
-        params_scenario = _shadow_params_scenario(scenario, args.shadow)
     shadow_params = None if params_scenario is None else params_scenario.params
     _check_continue(args, ros)
     if args.save_video is not None:
@@ -927,17 +1010,13 @@ def main(argv=None, prog="fpga-robotics run"):
     _check_renderer(scenario)
     t0 = time.perf_counter()
     if scenario.sim.timing == "real_clock":
-        if shadow_params is not None:
-            raise UsageError(
-                "--shadow NAME=VALUE shadows FollowTarget with other parameters, frame "
-                "by frame, in compressed timing; this scenario runs in real-clock timing, "
-                "where --shadow takes a design reference (FILE.py:Name, a built-in "
-                "design's name)"
-            )
         scenario = _with_design_files(args, scenario)
         check_bindings(scenario)  # before the model is built
         if shadow_scenario is not None:
-            check_bindings(shadow_scenario)
+            try:
+                check_bindings(shadow_scenario)
+            except UsageError as exc:
+                raise UsageError(f"--shadow {args.shadow}: {exc}") from None
         design = _open_pin_design(args, scenario)
     else:
         check_bindings(scenario)  # before the model is built
@@ -946,7 +1025,7 @@ def main(argv=None, prog="fpga-robotics run"):
     completed = False
     try:
         if shadow_scenario is not None:
-            shadow = _open_pin_design(shadow_args, shadow_scenario)
+            shadow = _open_pin_design(shadow_args, shadow_scenario, f"--shadow {args.shadow}")
         if shadow_params is not None:
             shadow = _open_backend(args.shadow_backend or args.backend, shadow_params, args.quiet)
         setup = time.perf_counter() - t0

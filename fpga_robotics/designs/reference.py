@@ -45,6 +45,7 @@ __all__ = [
     "DesignError",
     "DesignSpec",
     "bindings_of",
+    "design_parameters",
     "entry_point_designs",
     "extra_outputs_of",
     "is_builtin",
@@ -169,6 +170,28 @@ def resolve_design(reference, params=None, *, ports=None, base=None):
                 f"design.params ({', '.join(sorted(params))})"
             )
         return _builtin_spec(TOPS[reference])
+    reference = _own_reference(reference, base)
+    frozen = tuple(sorted((k, _freeze(v)) for k, v in params.items()))
+    return _amaranth_spec(reference, frozen, _stamp(reference))
+
+
+def design_parameters(reference, base=None):
+    """The ``[design.params]`` names ``reference`` takes, as ``{name: required}`` (required:
+    it has no default); ``{}`` for a built-in or Verilog design (they take none), None for
+    a design that takes any name (``**kwargs``). Raises ``DesignError`` as
+    ``resolve_design`` does for a reference that does not load."""
+    reference = str(reference).strip()
+    if reference.startswith("verilog:") or reference in TOPS:
+        return {}
+    known, takes_any = _signature_parameters(_load_target(_own_reference(reference, base)))
+    if takes_any:
+        return None
+    return {n: p.default is p.empty for n, p in known.items()}
+
+
+def _own_reference(reference, base):
+    """A design of one's own's reference as ``_amaranth_spec`` takes it: a file path made
+    absolute (from ``base``), an installed design's name as its ``module:Name``."""
     installed = entry_point_designs()
     target = installed.get(reference, reference)
     if ":" not in target:
@@ -182,11 +205,8 @@ def resolve_design(reference, params=None, *, ports=None, base=None):
         path = Path(where).expanduser()
         if not path.is_absolute() and base is not None:
             path = Path(base) / path
-        reference = f"{path.resolve()}:{name}"
-    else:
-        reference = target  # an installed design's name stands for its module:Name
-    frozen = tuple(sorted((k, _freeze(v)) for k, v in params.items()))
-    return _amaranth_spec(reference, frozen, _stamp(reference))
+        return f"{path.resolve()}:{name}"
+    return target  # an installed design's name stands for its module:Name
 
 
 def _freeze(value):
@@ -445,21 +465,7 @@ def _is_component_class(value):
 def _check_params(target, params, reference):
     """``params`` against the signature of ``target``: known names, required ones given,
     each value of its annotation's (or default's) type."""
-    try:
-        signature = inspect.signature(target)
-    except (TypeError, ValueError):
-        return
-    from amaranth.lib import wiring  # lazy: Amaranth (~0.3 s)
-
-    if inspect.isclass(target) and target.__init__ is wiring.Component.__init__:
-        # Its signature is in its annotations: Component's own arguments are not its params.
-        signature = inspect.Signature()
-    known = {
-        n: p
-        for n, p in signature.parameters.items()
-        if p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY)
-    }
-    takes_any = any(p.kind == p.VAR_KEYWORD for p in signature.parameters.values())
+    known, takes_any = _signature_parameters(target)
     name = reference.rpartition(":")[2]
     for key, value in params.items():
         if key not in known:
@@ -482,6 +488,28 @@ def _check_params(target, params, reference):
             f"give it in [design.params] (or --set design.params."
             f"{missing[0]}=VALUE)"
         )
+
+
+def _signature_parameters(target):
+    """``(known, takes_any)``: the parameters ``target`` takes by name ({name:
+    inspect.Parameter}) and whether it takes any other (``**kwargs``, or a signature
+    Python cannot read)."""
+    try:
+        signature = inspect.signature(target)
+    except (TypeError, ValueError):
+        return {}, True
+    from amaranth.lib import wiring  # lazy: Amaranth (~0.3 s)
+
+    if inspect.isclass(target) and target.__init__ is wiring.Component.__init__:
+        # Its signature is in its annotations: Component's own arguments are not its params.
+        signature = inspect.Signature()
+    known = {
+        n: p
+        for n, p in signature.parameters.items()
+        if p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY)
+    }
+    takes_any = any(p.kind == p.VAR_KEYWORD for p in signature.parameters.values())
+    return known, takes_any
 
 
 def _expected_type(parameter):

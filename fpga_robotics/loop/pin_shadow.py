@@ -1,6 +1,7 @@
 """Shadow runs in real-clock timing: a second design (``run --shadow REF``) gets, cycle for
 cycle, the inputs the primary design gets (the connectors' pins, the camera's stream) without
-driving anything; at every trajectory row their outputs of the same names are compared.
+driving anything; at every trajectory row their wheels (through the ports each binds them
+to) and their other outputs of the same names are compared.
 
 This is how a new version of a design of one's own is checked against the previous one in
 the closed loop: the robot moves as the primary decides, both see the same world, and the
@@ -97,14 +98,16 @@ class MirroredPins:
 
 @dataclass
 class PinComparison:
-    """Where the shadow's outputs differ from the primary's, row by row, over the outputs both
-    designs have (the same keys as ``loop.shadow.ShadowComparison.summary``)."""
+    """Where the shadow's outputs differ from the primary's, row by row, over ``outputs``
+    (the wheels and the outputs both designs have; the same keys as
+    ``loop.shadow.ShadowComparison.summary``)."""
 
     label: str
     outputs: tuple = ()
     differing_frames: dict = field(default_factory=dict)
     first_divergence: dict | None = None
     frames: int = 0
+    params: dict | None = None  # a design of one's own's [design.params]; None: it takes none
 
     def __post_init__(self):
         self.differing_frames = dict.fromkeys(self.outputs, 0)
@@ -126,8 +129,10 @@ class PinComparison:
         return differ
 
     def summary(self):
+        params = {} if self.params is None else {"params": dict(self.params)}
         return {
             "design": self.label,
+            **params,
             "frames": self.frames,
             "first_divergence": self.first_divergence,
             "differing_frames": dict(self.differing_frames),

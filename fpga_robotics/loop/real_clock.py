@@ -28,7 +28,7 @@ from collections import deque
 import numpy as np
 
 from fpga_robotics.checks.sensor_metrics import line_metrics, measurement_metrics
-from fpga_robotics.designs.builtin import build_component, connector_kinds
+from fpga_robotics.designs.builtin import TOPS, build_component, connector_kinds
 from fpga_robotics.designs.reference import resolve_design, stream_ports
 from fpga_robotics.hw.errors import UsageError
 from fpga_robotics.loop.bindings import (
@@ -122,9 +122,14 @@ def make_pin_backend(name, scenario, *, on_build=None):
         )
     kwargs = {"on_build": on_build} if on_build is not None else {}
     backend = get_pin_backend(name, pin_design_source(scenario), **kwargs)
+    top = scenario_top(scenario)
     # Which port serves which connector pin: a loop that runs it as a shadow mirrors the
-    # primary's inputs by it (pin_shadow.MirroredPins).
-    backend.connector_bindings = scenario_top(scenario).bindings
+    # primary's inputs by it (pin_shadow.MirroredPins), records its wheels and extra
+    # outputs, and reports the parameters of a design of one's own (None: it takes none).
+    backend.connector_bindings = top.bindings
+    backend.extra_outputs = dict(top.extra_outputs)
+    own = scenario.foreign is None and scenario.top not in TOPS
+    backend.design_params = dict(scenario.design_params) if own else None
     return backend
 
 
@@ -267,16 +272,32 @@ class RealClockLoop(ClosedLoop):
         self.extra = {name: np.full(self.n_frames, np.nan) for name in self.top.extra_outputs}
         self.shadow_pins = shadow
         if shadow is not None:
-            outputs = tuple(
-                n
-                for n, p in design.ports.items()
-                if p.direction == "out"
-                and n in shadow.ports
-                and shadow.ports[n].direction == "out"
-                and not n.startswith("filtered__")
-            )
-            self.comparison = PinComparison(shadow_label, outputs)
+            self.compared = self._compared_outputs(shadow)
+            params = getattr(shadow, "design_params", None)
+            self.comparison = PinComparison(shadow_label, tuple(self.compared), params=params)
         self.measurements = {}  # "<connector>.<key>" -> array per row
+
+    def _compared_outputs(self, shadow):
+        """Output -> (primary's port, shadow's port), compared at every row: the wheels
+        through the ports each design binds them to (a new version may rename them), every
+        other output both designs have by its name."""
+        wheels = self.top.bindings.get("wheels", {})
+        shadow_wheels = getattr(shadow, "connector_bindings", {}).get("wheels", {})
+        wheel_of = {port: pin for pin, port in wheels.items()}
+        compared = {}
+        for name, port in self.pins.ports.items():
+            if port.direction != "out" or name.startswith("filtered__"):
+                continue
+            pin = wheel_of.get(name)
+            if pin is not None:
+                if pin in shadow_wheels:
+                    compared[pin] = (name, shadow_wheels[pin])
+                continue
+            other = shadow.ports.get(name)
+            wheel = name in shadow_wheels.values()  # the shadow's, compared as its wheel
+            if other is not None and other.direction == "out" and not wheel:
+                compared[name] = (name, name)
+        return compared
 
     def use_design(self, pins):
         """Drive ``pins`` from now on (a design brought to the loop's state, e.g. by
@@ -546,8 +567,11 @@ class RealClockLoop(ClosedLoop):
         for name, port in self.top.extra_outputs.items():
             extra[name] = self.pins.peek(port)
             self.extra[name][row.k] = float(extra[name])
+        shadow = {}
         if self.shadow_pins is not None:
             events += self.compare_shadow(row)
+            if self.want_records:
+                shadow = self.shadow_outputs()
         self.events += [(row.k, round(row.t, 6), e) for e in events]
         if self.want_records:
             self.record(
@@ -561,7 +585,27 @@ class RealClockLoop(ClosedLoop):
                 sensors=row.readings,
                 design_extra=extra,
                 cameras=row.cameras,
+                **shadow,
             )
+
+    def shadow_outputs(self):
+        """The shadow design's outputs now, as the row's record holds them: its per-frame
+        outputs and wheels (through its own ports) as ``shadow_result``, the outputs no
+        connector reads as ``shadow_extra``."""
+        pins = self.shadow_pins
+        bindings = pins.connector_bindings
+        camera = "camera" in bindings
+        values = {
+            name: pins.peek(name) if camera and name in pins.ports else None
+            for name in _FRAME_OUTPUTS
+        }
+        wheels = bindings.get("wheels", {})
+        for pin in ("motor_left", "motor_right"):
+            values[pin] = pins.peek(wheels[pin]) if pin in wheels else None
+        return {
+            "shadow_result": FrameResult(filtered=None, cycles=None, **values),
+            "shadow_extra": {name: pins.peek(port) for name, port in pins.extra_outputs.items()},
+        }
 
     def compare_shadow(self, row):
         """Row ``row.k``'s outputs of both designs compared; the event of the first
@@ -570,8 +614,8 @@ class RealClockLoop(ClosedLoop):
         first = c.first_divergence is None
         # Read past a journal (fpga_robotics.loop.pin_journal): the loop's own calls only.
         design = getattr(self.pins.primary, "unrecorded", self.pins.primary)
-        primary = {n: design.peek(n) for n in c.outputs}
-        shadow = {n: self.shadow_pins.peek(n) for n in c.outputs}
+        primary = {n: design.peek(port) for n, (port, _) in self.compared.items()}
+        shadow = {n: self.shadow_pins.peek(port) for n, (_, port) in self.compared.items()}
         differ = c.compare(row.k, row.t, primary, shadow)
         if not (differ and first):
             return []

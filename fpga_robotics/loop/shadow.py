@@ -129,17 +129,20 @@ def is_shadow_event(text):
 
 
 def format_shadow(summary):
-    """Lines for the human summary."""
+    """Lines for the human summary; a design of one's own is named with the parameters it
+    ran with (``params``: a changed default the scenario sets does not show)."""
     first = summary["first_divergence"]
+    label = summary["design"]
+    if "params" in summary:
+        given = ", ".join(f"{n}={v!r}" for n, v in summary["params"].items())
+        label += f" with {given or 'its defaults'}"
     if first is None:
-        return [
-            (f"  shadow {summary['design']}: identical outputs on all {summary['frames']} frames")
-        ]
+        return [f"  shadow {label}: identical outputs on all {summary['frames']} frames"]
     counts = ", ".join(f"{n} {c}" for n, c in summary["differing_frames"].items() if c)
     what = ", ".join(f"{n} {v['primary']} vs {v['shadow']}" for n, v in first["outputs"].items())
     return [
         (
-            f"  shadow {summary['design']}: first differs at frame {first['frame']} "
+            f"  shadow {label}: first differs at frame {first['frame']} "
             f"({first['time_s']:.2f} s): {what}"
         ),
         f"  shadow frames that differ: {counts} (of {summary['frames']})",

@@ -69,6 +69,7 @@ from fpga_robotics.sim.camera.render3d.options import Lamp, Render3DOptions
 from fpga_robotics.sim.camera.sensor import OV7670Params
 from fpga_robotics.sim.world import World, WorldConfigError
 from fpga_robotics.sim.world.config import WORLD_SECTIONS, default_people
+from fpga_robotics.sim.world.keys import WORLD_KEY_MODELS
 from fpga_robotics.sim.world.schema import Number, check_of, validate
 
 __all__ = [
@@ -551,6 +552,11 @@ def _set_path(data, key, value, shown):
         last = i == len(parts) - 1
         here = ".".join(parts[: i + 1])
         if isinstance(node, list):
+            if not node:
+                raise ScenarioError(
+                    f"unknown key {shown!r}: {'.'.join(parts[:i])} is an empty list; set it "
+                    f"whole: --set '{'.'.join(parts[:i])}=[...]' (a TOML array)"
+                )
             if not part.isdigit() or int(part) >= len(node):
                 raise ScenarioError(
                     f"unknown key {shown!r}: {'.'.join(parts[:i])} is a list of {len(node)} "
@@ -570,6 +576,12 @@ def _set_path(data, key, value, shown):
         if i == 0 and in_world and part not in data and parts[0] != "people" and not last:
             node[part] = {}
         optional = _optional_keys(parts[:i])
+        if not last and part not in node and here in _WORLD_ARRAYS and parts[i + 1].isdigit():
+            # A list the world may hold (room.furniture) but this scenario does not.
+            raise ScenarioError(
+                f"unknown key {shown!r}: the scenario has no {here} to index; set it "
+                f"whole: --set '{here}=[...]' (a TOML array)"
+            )
         if part not in node and part not in optional and not (in_world and last):
             if parts[:i] == ["design"] and part in ("width", "height"):
                 raise ScenarioError(
@@ -583,6 +595,11 @@ def _set_path(data, key, value, shown):
         if part not in node and parts[:i] == ["design"] and part in (*_TOP_TABLES, "params"):
             node[part] = {}  # a design parameter table the file does not give
         node = node[part]
+
+
+#: The world's arrays of tables inside a section (``room.furniture`` ...): a scenario may
+#: leave one out, and ``--set`` then cannot index it.
+_WORLD_ARRAYS = frozenset(path for path in WORLD_KEY_MODELS if "." in path)
 
 
 class _AnyName:

@@ -98,16 +98,9 @@ def load_run(argv):
     run.take_design_reference(args, scenario)
     # As run takes --shadow: a design reference is a second design on pins, else
     # FollowTarget parameters, which compare frames.
-    shadow_params = run._shadow_scenario(scenario, args.shadow, args.shadow_ports)
-    if shadow_params is None:
-        shadow_params = run._shadow_params(scenario, args.shadow)
-        if shadow_params is not None and scenario.sim.timing == "real_clock":
-            raise UsageError(
-                "--shadow NAME=VALUE shadows FollowTarget with other parameters, frame "
-                "by frame, in compressed timing; this scenario runs in real-clock timing, "
-                "where --shadow takes a design reference (FILE.py:Name, a built-in "
-                "design's name)"
-            )
+    shadow_params, params_scenario = run.shadow_designs(args, scenario)
+    if params_scenario is not None:
+        shadow_params = params_scenario.params
     run._design_files(args, scenario.foreign)
     if scenario.sim.timing == "real_clock":  # the pin design is the scenario's foreign one
         scenario = run._with_design_files(args, scenario)
@@ -197,7 +190,7 @@ def _designs_for(args, scenario, shadow_params):
         shadow_args = run._shadow_args(args, shadow_params)
         shadow = _open(
             ("shadow", *_design_key(shadow_args, shadow_params)),
-            lambda: run._open_pin_design(shadow_args, shadow_params),
+            lambda: run._open_pin_design(shadow_args, shadow_params, f"--shadow {args.shadow}"),
         )
     elif shadow_params is not None:
         shadow = _open(
