@@ -69,3 +69,28 @@ def test_first_divergence_is_where_the_shorter_lost_count_starts_searching():
     events = [e for k, _t, e in r.events if k == expected]
     assert any(e.startswith("shadow design lost_frames=5 diverges") for e in events)
     assert r.summary["shadow"]["differing_frames"]["found"] == 0
+
+
+def test_a_filtered_image_that_parts_says_how_many_pixels_differ():
+    """Two filtered pixels swapped: the images differ but their counts of matching pixels do
+    not, so the first divergence says how many pixels differ, not "1819 vs 1819"."""
+    import dataclasses
+
+    from fpga_robotics.loop.shadow import ShadowComparison, divergence_event, format_shadow
+    from fpga_robotics.mutation.unit_judge import golden_results, judge_frames
+
+    params = load_scenario("approach").params
+    frame = judge_frames(params)[0]
+    (primary,) = golden_results(params, [frame])
+    image = primary.filtered.copy()
+    on, off = tuple(np.argwhere(image != 0)[0]), tuple(np.argwhere(image == 0)[0])
+    image[off], image[on] = image[on], 0
+    shadow = dataclasses.replace(primary, filtered=image)
+    comparison = ShadowComparison("swap")
+    assert comparison.compare(0, 0.0, primary, shadow) == ["filtered"]
+    first = comparison.summary()["first_divergence"]["outputs"]["filtered"]
+    assert first["primary"] == first["shadow"] and first["pixels_differing"] == 2
+    assert "filtered 2 pixel(s) differ" in format_shadow(comparison.summary())[0]
+    assert divergence_event("swap", ["filtered"], primary, shadow) == (
+        "shadow design swap diverges: filtered 2 pixel(s) differ"
+    )

@@ -98,10 +98,7 @@ class ShadowComparison:
             self.first_divergence = {
                 "frame": frame,
                 "time_s": round(time_s, 6),
-                "outputs": {
-                    n: {"primary": output_value(primary, n), "shadow": output_value(shadow, n)}
-                    for n in differ
-                },
+                "outputs": {n: _first_values(primary, shadow, n) for n in differ},
             }
         return differ
 
@@ -115,11 +112,24 @@ class ShadowComparison:
         }
 
 
+def _first_values(primary, shadow, name):
+    """The two designs' values of output ``name`` where they first part; for the filtered
+    image also how many pixels differ (its counts of matching pixels may be equal)."""
+    values = {"primary": output_value(primary, name), "shadow": output_value(shadow, name)}
+    if name == "filtered":
+        values["pixels_differing"] = int((primary.filtered != shadow.filtered).sum())
+    return values
+
+
+def _difference(name, values):
+    if "pixels_differing" in values:
+        return f"filtered {values['pixels_differing']} pixel(s) differ"
+    return f"{name} {values['primary']} vs {values['shadow']}"
+
+
 def divergence_event(label, differ, primary, shadow):
     """The event text for the first frame where the designs part."""
-    parts = ", ".join(
-        f"{n} {output_value(primary, n)} vs {output_value(shadow, n)}" for n in differ
-    )
+    parts = ", ".join(_difference(n, _first_values(primary, shadow, n)) for n in differ)
     return f"shadow design {label} diverges: {parts}"
 
 
@@ -139,7 +149,7 @@ def format_shadow(summary):
     if first is None:
         return [f"  shadow {label}: identical outputs on all {summary['frames']} frames"]
     counts = ", ".join(f"{n} {c}" for n, c in summary["differing_frames"].items() if c)
-    what = ", ".join(f"{n} {v['primary']} vs {v['shadow']}" for n, v in first["outputs"].items())
+    what = ", ".join(_difference(n, v) for n, v in first["outputs"].items())
     return [
         (
             f"  shadow {label}: first differs at frame {first['frame']} "
