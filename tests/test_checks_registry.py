@@ -70,6 +70,8 @@ JUDGEABLE = {
     "approach_speed_violation_fraction": 0.1,
     "reverse_when_far_fraction": 0.1,
     "stop_overshoot_m": 0.05,
+    "stop_distance_m": 1.2,
+    "stop_closest_m": 1.1,
     "turn_law_violation_fraction": 0.1,
     "search_law_violation_fraction": 0.1,
     "envelope_reason": None,

@@ -489,11 +489,16 @@ SHIPPED_CHECKS = (
         "stop_overshoot_m",
         "max",
         (
-            "the robot comes at most this much closer to the target than the distance within "
-            "which the law surely says stop or reverse (the stop distance) "
+            "the robot drives at most this far inside the distance within which the law surely "
+            "says stop or reverse (the stop distance, camera to the target's centre): its own "
+            "driving, not a start inside it nor the target walking up to it "
             f"{_BAND}"
         ),
-        lambda v, limit, m: f"came {v:.3f} m inside the stop distance (limit <= {limit} m)",
+        lambda v, limit, m: (
+            f"drove {v:.3f} m inside the stop distance (stop distance "
+            f"{m['stop_distance_m']:.3f} m, closest {m['stop_closest_m']:.3f} m, camera to the "
+            f"target's centre; limit <= {limit} m)"
+        ),
         limits=(0, 100, "m"),
         outputs=_WHEELS,
         precondition=_envelope("stop_overshoot_m", "the robot never came near the stop distance"),
