@@ -329,7 +329,10 @@ SHIPPED_CHECKS = (
         "max_heading_overshoot_deg",
         "heading_overshoot_deg",
         "max",
-        "the robot turns at most this far past the target (heading_overshoot_deg)",
+        (
+            "the robot turns at most this far past the heading that puts the target on the "
+            "camera's axis (heading_overshoot_deg)"
+        ),
         lambda v, limit, m: f"turned {v:.1f} deg past the target (limit <= {limit} deg)",
         limits=(0, 180, "deg"),
         precondition=measured("heading_overshoot_deg", "no heading to compare"),

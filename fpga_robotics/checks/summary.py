@@ -78,6 +78,7 @@ def compute_metrics(
     absent=(),
     margin_x=None,
     collision_summary=None,
+    camera_mount=None,
 ):
     """Reduce a run to numbers.
 
@@ -105,6 +106,9 @@ def compute_metrics(
         target inside it); default ``width // 10``, the design's default.
     collision_summary : dict, optional
         ``World.collision_summary()``: per kind, episodes, contact time and largest impulse.
+    camera_mount : fpga_robotics.loop.connectors.base.Mount, optional
+        Where the camera sits on the robot and its yaw off the heading (the heading
+        overshoot is measured from the camera's axis); default the robot's centre and heading.
     """
     absent = [name for name in DESIGN_OUTPUTS if name in set(absent)]
     if absent:
@@ -120,6 +124,7 @@ def compute_metrics(
             width=width,
             margin_x=margin_x,
             collision_summary=collision_summary,
+            camera_mount=camera_mount,
         )
         for name, needs in _METRIC_OUTPUTS.items():
             if any(o in absent for o in needs):
@@ -178,23 +183,24 @@ def compute_metrics(
         "led_misplaced_fraction": _led_misplaced(traj, width, margin_x),
         "peak_wheel_command_dps": _peak_command(traj),
         "search_travel_m": _search_travel(traj, events),
-        "heading_overshoot_deg": _heading_overshoot(traj),
+        "heading_overshoot_deg": _heading_overshoot(traj, camera_mount),
         "absent_outputs": [],
     }
 
 
-def _heading_overshoot(traj):
-    """How far the robot turns past the target, degrees: the largest bearing error (the
-    target's bearing from the robot's centre, relative to its heading) on the far side once
-    the error has changed sign, over frames with the target's centre in view (a frame out of
-    view starts afresh). Meaningful with a standing target (a step response, e.g. ``approach``
-    with ``robot.heading_deg=20``); a walking target crossing the robot's axis counts too.
-    None without the fields."""
+def _heading_overshoot(traj, mount=None):
+    """How far the robot turns past the target, degrees: the largest bearing error on the far
+    side once the error has changed sign, over frames with the target's centre in view (a
+    frame out of view starts afresh). The bearing error is the turn in place that would put
+    the target on the camera's axis (``_aim_error``; the camera at ``mount``, a
+    ``connectors.base.Mount``, or at the robot's centre along its heading without one), so a
+    camera yawed on its mount is on the target when the robot's body is not. Meaningful with a
+    standing target (a step response, e.g. ``approach`` with ``robot.heading_deg=20``); a
+    walking target crossing the robot's axis counts too. None without the fields."""
     need = ("x", "y", "heading", "target_x", "target_y", "target_column")
     if any(k not in traj for k in need) or len(traj["x"]) == 0:
         return None
-    b = np.arctan2(traj["target_y"] - traj["y"], traj["target_x"] - traj["x"]) - traj["heading"]
-    b = np.degrees((b + np.pi) % (2 * np.pi) - np.pi)
+    b = np.degrees(_aim_error(traj, mount))
     best, last, crossed = 0.0, 0.0, False
     for bk, seen in zip(b, ~np.isnan(np.asarray(traj["target_column"], dtype=float))):
         if not seen:
@@ -208,6 +214,23 @@ def _heading_overshoot(traj):
             best = max(best, abs(float(bk)))
         last = sign
     return _round(best, 2)
+
+
+def _aim_error(traj, mount):
+    """Per frame, the turn in place (rad, left positive) that puts the target's centre on the
+    camera's axis. The camera sits at ``m = (forward, left)`` of the robot's centre, looking
+    ``yaw`` off its heading; it is on the target when the target, ``r`` from the centre, lies
+    at ``m + s u(yaw)`` in the robot's frame, ``s`` the root of ``|m + s u(yaw)| = r``: at
+    the angle ``a`` of that point from the heading. The error is the target's bearing from the
+    centre less ``a`` (``a`` is 0 for a camera on the robot's axis looking ahead)."""
+    dx, dy = traj["target_x"] - traj["x"], traj["target_y"] - traj["y"]
+    bearing = np.arctan2(dy, dx) - traj["heading"]
+    if mount is not None:
+        fwd, left, yaw = mount.forward, mount.left, mount.yaw
+        along = fwd * np.cos(yaw) + left * np.sin(yaw)  # m . u(yaw)
+        s = -along + np.sqrt(np.maximum(0.0, along**2 - fwd**2 - left**2 + dx**2 + dy**2))
+        bearing = bearing - np.arctan2(left + s * np.sin(yaw), fwd + s * np.cos(yaw))
+    return (bearing + np.pi) % (2 * np.pi) - np.pi
 
 
 def _off_target(traj, width, margin_x=None):

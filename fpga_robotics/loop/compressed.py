@@ -498,6 +498,7 @@ class ClosedLoop:
             width=cam.width,
             absent=self.absent,
             margin_x=scenario.params.margin_x,
+            camera_mount=self.camera.mount,
         )
         metrics.update(self.extra_metrics())
         checks = evaluate_checks(scenario.checks, metrics)
