@@ -120,10 +120,35 @@ def test_reacquisition_needs_a_search_that_ended():
         tr, events((0.0, "target found"), (8.0, "target lost"), (9.5, "search started")), {}, PERIOD
     )
     assert open_end["unrecovered_losses_s"] == [2.0]  # run ends at 10.0 s
+    # Lost 2 s before the end, within a 5 s limit: the run was cut short, nothing to judge.
     (c,) = evaluate_checks({"reacquired_within_s": 5.0}, open_end)
-    assert not c["passed"] and "ended before" in c["text"]
+    assert c["status"] == "n/a" and c["reason"] == (
+        "the run ended 2.00 s after the target was lost, the design still searching, within "
+        "the 5.0 s limit: no re-acquisition to judge"
+    )
     (c,) = evaluate_checks({"reacquired_within_s": 1.0}, open_end)
-    assert not c["passed"] and "not found again for 2.00 s" in c["text"]
+    assert c["status"] == "fail" and c["text"] == (
+        "target lost and not found again for 2.00 s (limit 1.0 s)"
+    )
+    # A search that ended (found again 1.5 s after the loss) is judged; a younger open one
+    # after it does not fail the run.
+    judged = compute_metrics(
+        tr,
+        events(
+            (0.0, "target found"),
+            (2.0, "target lost"),
+            (3.0, "search started"),
+            (3.5, "target found"),
+            (8.0, "target lost"),
+            (9.5, "search started"),
+        ),
+        {},
+        PERIOD,
+    )
+    (c,) = evaluate_checks({"reacquired_within_s": 2.5}, judged)
+    assert c["status"] == "pass" and c["value"] == 1.5
+    (c,) = evaluate_checks({"reacquired_within_s": 1.8}, judged)
+    assert c["status"] == "fail" and "not found again for 2.00 s" in c["text"]
 
 
 def test_each_check_compares_with_its_limit():

@@ -79,19 +79,24 @@ def _late(m, limit):
 
 
 def _reacquired(v, limit, m):
-    """Every searched loss ended with the target found again within the limit, and one did."""
-    times = m["reacquire_times_s"]
-    return (
-        m["searched_reacquisitions"] >= 1 and all(x <= limit for x in times) and not _late(m, limit)
-    )
+    """No loss took longer than the limit to end, none still open at the end is older than
+    it, and a searched loss ended with the target found: a pass. With the only searched loss
+    still open, younger than the limit, when the run ended there is nothing to judge (None):
+    the run was cut short, not the design."""
+    if any(x > limit for x in m["reacquire_times_s"]) or _late(m, limit):
+        return False
+    return True if m["searched_reacquisitions"] >= 1 else None
 
 
 def _reacquired_text(v, limit, m):
     late = _late(m, limit)
     if late:
         return f"target lost and not found again for {max(late):.2f} s (limit {limit} s)"
-    if m["searched_reacquisitions"] == 0:
-        return "the design searched but the run ended before it found the target again"
+    if _reacquired(v, limit, m) is None:
+        return (
+            f"the run ended {m['unrecovered_losses_s'][-1]:.2f} s after the target was lost, "
+            f"the design still searching, within the {limit} s limit: no re-acquisition to judge"
+        )
     return (
         f"{len(m['reacquire_times_s'])} re-acquisition(s), slowest {v:.2f} s after the "
         f"loss (limit {limit} s)"
