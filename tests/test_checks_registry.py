@@ -561,9 +561,10 @@ def test_a_check_declared_through_the_registry_shows_everywhere(path_check):
     s = load_scenario("follow_person", [*SMALL, "checks={max_path_length_m = 100.0}"])
     r = run_scenario(s, backend="model")
     (c,) = r.summary["checks"]
-    path = r.summary["path_length_m"]
-    assert path > 0 and (c["name"], c["status"], c["value"]) == ("max_path_length_m", "pass", path)
-    assert f"[ok] max_path_length_m: drove {path:.2f} m (limit <= 100.0 m)" in format_summary(
+    path = r.summary["path_length_m"]  # shown to 4 decimals; the check judged it unrounded
+    assert path > 0 and (c["name"], c["status"]) == ("max_path_length_m", "pass")
+    assert round(c["value"], 4) == path
+    assert f"[ok] max_path_length_m: drove {c['value']:.2f} m (limit <= 100.0 m)" in format_summary(
         r.summary
     )
     # Its precondition: a robot that never moved gives it nothing to judge.

@@ -123,19 +123,15 @@ def test_search_law_default_and_changed_search():
     frames = [seen] + [hold] * 14 + [search] * 5
     assert envelope_metrics(_traj(frames), DEFAULT, GEOM)["search_law_violation_fraction"] == 0
     wrong = [seen] + [hold] * 14 + [left_search] * 5
-    assert envelope_metrics(_traj(wrong), DEFAULT, GEOM)["search_law_violation_fraction"] == round(
-        5 / 19, 4
-    )
+    assert envelope_metrics(_traj(wrong), DEFAULT, GEOM)["search_law_violation_fraction"] == 5 / 19
     early = [seen] + [hold] * 10 + [search] * 9
-    assert envelope_metrics(_traj(early), DEFAULT, GEOM)["search_law_violation_fraction"] == round(
-        4 / 19, 4
-    )
+    assert envelope_metrics(_traj(early), DEFAULT, GEOM)["search_law_violation_fraction"] == 4 / 19
     # lost_frames = 11 and search_dps = 100: the search starts at the 11th lost frame.
     changed = DEFAULT.replace(lost_frames=11, search_dps=100)
     early_slow = [seen] + [hold] * 10 + [(False, -0.4, 100, -100)] * 9
     assert envelope_metrics(_traj(early_slow), changed, GEOM)["search_law_violation_fraction"] == 0
-    assert envelope_metrics(_traj(early), changed, GEOM)["search_law_violation_fraction"] == round(
-        9 / 19, 4
+    assert (
+        envelope_metrics(_traj(early), changed, GEOM)["search_law_violation_fraction"] == 9 / 19
     )  # 250
     # After reset, never seen: the search turns left.
     never = [(False, 0.0, 0, 0)] * 14 + [(False, 0.0, -250, 250)] * 3
@@ -268,18 +264,19 @@ def test_search_side_of_a_target_leaving_the_view():
     m = envelope_metrics(_leaving(1.0, -0.55, right), DEFAULT, GEOM)
     assert m["search_law_violation_fraction"] == 0
     m = envelope_metrics(_leaving(1.0, -0.55, left), DEFAULT, GEOM)
-    assert m["search_law_violation_fraction"] == round(5 / 19, 4)
+    assert m["search_law_violation_fraction"] == 5 / 19
     # A search 2 DPS off search_dps is off the law as well.
     m = envelope_metrics(_leaving(1.0, -0.55, (248, -250)), DEFAULT, GEOM)
-    assert m["search_law_violation_fraction"] == round(5 / 19, 4)
+    assert m["search_law_violation_fraction"] == 5 / 19
     # The mirror image: leaving on the left, the search turns left.
     assert (
         envelope_metrics(_leaving(1.0, 0.55, left), DEFAULT, GEOM)["search_law_violation_fraction"]
         == 0
     )
-    assert envelope_metrics(_leaving(1.0, 0.55, right), DEFAULT, GEOM)[
-        "search_law_violation_fraction"
-    ] == round(5 / 19, 4)
+    assert (
+        envelope_metrics(_leaving(1.0, 0.55, right), DEFAULT, GEOM)["search_law_violation_fraction"]
+        == 5 / 19
+    )
     # margin_x = 64: the window is columns 64..96 and the silhouette (138.2..229.9) lies
     # wholly outside it; the last sighting has no sure side, only the 14 held frames count.
     narrow = DEFAULT.replace(margin_x=64)
@@ -310,7 +307,7 @@ def test_search_side_tolerates_the_smear_of_a_turn():
         traj = _traj(wrong)
         traj["w"] = np.full(len(wrong), w)
         m = envelope_metrics(traj, DEFAULT, sensor)
-        assert m["search_law_violation_fraction"] == round(judged_wrong / (14 + judged_wrong), 4)
+        assert m["search_law_violation_fraction"] == judged_wrong / (14 + judged_wrong)
 
 
 def test_a_design_without_a_found_output_leaves_the_envelopes_na():

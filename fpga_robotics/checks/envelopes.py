@@ -351,8 +351,8 @@ def envelope_metrics(traj, params, geom):
         _search_judged(found, ml, mr, dist, bearing, geom, params, side_tol)
     )
     if stop is not None and closest is not None and closest <= stop[1]:
-        out["stop_overshoot_m"] = round(float(overshoot), 4)
-        out["stop_distance_m"], out["stop_closest_m"] = stop[0], round(float(closest), 4)
+        out["stop_overshoot_m"] = float(overshoot)
+        out["stop_distance_m"], out["stop_closest_m"] = stop[0], float(closest)
     return out
 
 
@@ -429,4 +429,4 @@ def sure_side(distance, bearing, geom, params, tol=E_TOLERANCE_PX):
 
 
 def _fraction(flags):
-    return round(float(np.mean(flags)), 4) if flags else None
+    return float(np.mean(flags)) if flags else None

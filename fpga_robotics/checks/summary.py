@@ -21,6 +21,7 @@ __all__ = [
     "compute_metrics",
     "evaluate_checks",
     "format_summary",
+    "rounded",
     "verdict",
 ]
 
@@ -55,8 +56,40 @@ TIMING_FIELDS = (
 )
 
 
-def _round(x, digits=4):
-    return None if x is None else round(float(x), digits)
+def _float(x):
+    return None if x is None else float(x)
+
+
+def _time(x):
+    """A time (s) at the microsecond the run's events are stamped with, free of the float
+    noise of ``k * period`` (1.0000000000000002 s is 1 s, at a limit of 1 s)."""
+    return None if x is None else round(float(x), 6)
+
+
+#: Decimals the summary shows a metric with (``rounded``): 4, or these.
+SHOWN_DECIMALS = {
+    "mean_centroid_error_px": 2,
+    "heading_overshoot_deg": 2,
+    "max_abs_bearing_deg": 2,
+    "obstacle_removed_at_s": 6,
+}
+
+
+def rounded(metrics):
+    """The metrics as the summary shows them: every float, also in lists and tables, to 4
+    decimals or its ``SHOWN_DECIMALS``. The checks judge the metrics before this: a target in
+    view in 1 frame of 20004 meets a limit of 0.001%, though its fraction shows as 0.0."""
+    return {name: _rounded(value, name) for name, value in metrics.items()}
+
+
+def _rounded(value, name):
+    if isinstance(value, dict):
+        return {k: _rounded(v, k) for k, v in value.items()}
+    if isinstance(value, list):
+        return [_rounded(v, name) for v in value]
+    if isinstance(value, float):
+        return round(value, SHOWN_DECIMALS.get(name, 4))
+    return value
 
 
 #: The design's centroid points away from the target when it is further than this fraction of
@@ -154,16 +187,16 @@ def compute_metrics(
             open_ep[1] = time
             open_ep = None
     end_time = float(t[-1]) + frame_period if n else 0.0
-    reacq = [round(f - lost, 4) for lost, f, _ in episodes if f is not None]
-    unrecovered = [round(end_time - lost, 4) for lost, f, _ in episodes if f is None]
+    reacq = [_time(f - lost) for lost, f, _ in episodes if f is not None]
+    unrecovered = [_time(end_time - lost) for lost, f, _ in episodes if f is None]
     tipped = [(time, text) for _f, time, text in events if text.startswith("tipped over")]
     return {
-        "min_distance_m": _round(dist[valid].min()) if valid.any() else None,
-        "mean_distance_m": _round(dist[valid].mean()) if valid.any() else None,
-        "target_in_view_fraction": _round(traj["target_in_view"].mean()) if n else 0.0,
-        "found_fraction": _round(found.mean()) if n else 0.0,
-        "found_after_acquisition_fraction": _round(found_after),
-        "acquired_at_s": _round(acquired_at),
+        "min_distance_m": float(dist[valid].min()) if valid.any() else None,
+        "mean_distance_m": float(dist[valid].mean()) if valid.any() else None,
+        "target_in_view_fraction": float(traj["target_in_view"].mean()) if n else 0.0,
+        "found_fraction": float(found.mean()) if n else 0.0,
+        "found_after_acquisition_fraction": found_after,
+        "acquired_at_s": _time(acquired_at),
         "collisions": dict(collisions),
         "robot_at_fault_collisions": int(at_fault_collisions),
         "collision_summary": dict(collision_summary or {}),
@@ -173,8 +206,8 @@ def compute_metrics(
         "searched_reacquisitions": sum(1 for ep in episodes if ep[2] and ep[1] is not None),
         "reacquire_times_s": reacq,
         "unrecovered_losses_s": unrecovered,
-        "path_length_m": _round(path),
-        "tipped_over_at_s": _round(tipped[0][0]) if tipped else None,
+        "path_length_m": path,
+        "tipped_over_at_s": _time(tipped[0][0]) if tipped else None,
         "tip_overs": len(tipped),
         "max_wheel_command_step_dps": _max_command_step(traj),
         "oscillation_hz": _oscillation(traj, width, n * frame_period),
@@ -213,7 +246,7 @@ def _heading_overshoot(traj, mount=None):
         if crossed:
             best = max(best, abs(float(bk)))
         last = sign
-    return _round(best, 2)
+    return best
 
 
 def _aim_error(traj, mount):
@@ -259,8 +292,8 @@ def _off_target(traj, width, margin_x=None):
         return none
     err = np.abs(np.asarray(traj["centroid_x"], dtype=float)[ok] - expected[ok])
     return {
-        "off_target_fraction": _round((err > OFF_TARGET_FRACTION * width).mean()),
-        "mean_centroid_error_px": _round(err.mean(), 2),
+        "off_target_fraction": float((err > OFF_TARGET_FRACTION * width).mean()),
+        "mean_centroid_error_px": float(err.mean()),
     }
 
 
@@ -290,7 +323,7 @@ def _led_wrong_side(traj, width):
     other_half = np.where(offset < 0, leds & 0xF0, leds & 0x0F) != 0
     outer = (leds & 0b1100_0011) != 0
     wrong = (side & other_half) | (centre & outer)
-    return _round(wrong[judged].mean())
+    return float(wrong[judged].mean())
 
 
 #: Near a border between two of the window's eighths, or near the image centre, the LED
@@ -329,7 +362,7 @@ def _led_misplaced(traj, width, margin_x=None):
     right = np.clip(((col + tol - margin) // bin_width).astype(np.int64), 0, 7)
     ok = (leds == allowed) | (leds == np.left_shift(1, left)) | (leds == np.left_shift(1, right))
     ok |= (np.abs(col - width / 2) <= tol) & (leds == LED_CENTRED)
-    return _round((~ok).mean())
+    return float((~ok).mean())
 
 
 def _peak_command(traj):
@@ -360,7 +393,7 @@ def _search_travel(traj, events):
         seg = slice(a, min(b, len(x) - 1) + 1)
         travel = float(np.hypot(np.diff(x[seg]), np.diff(y[seg])).sum())
         longest = travel if longest is None else max(longest, travel)
-    return _round(longest)
+    return _float(longest)
 
 
 def _max_command_step(traj):
@@ -395,7 +428,9 @@ def _oscillation(traj, width, seconds):
         elif wk != 0:
             flips += bool(last * wk < 0)
             last = wk
-    return _round(flips / (seconds * centred.mean()))
+    # Sign changes over the centred frames' time: to 1e-6 Hz, free of the float noise of
+    # the frame period (3 in 3 s is 1 Hz, at a limit of 1 Hz).
+    return round(flips / (seconds * centred.mean()), 6)
 
 
 def format_summary(s):
