@@ -152,7 +152,7 @@ def test_compute_metrics_by_hand():
         "motor_right": np.array([0, -20, 10]),
     }
     m = compute_metrics(traj, [], {}, 0.1)
-    assert m["acquired_at_s"] == 0.1 and m["found_fraction"] == round(2 / 3, 4)
+    assert m["acquired_at_s"] == 0.1 and m["found_fraction"] == 2 / 3
     assert m["max_wheel_command_step_dps"] == 40  # |0 - 40|
     nan = {**traj, "found": np.full(3, np.nan), "motor_left": np.full(3, np.nan)}
     m = compute_metrics(nan, [], {}, 0.1, absent={"found", "motor_left"})

@@ -70,6 +70,8 @@ JUDGEABLE = {
     "approach_speed_violation_fraction": 0.1,
     "reverse_when_far_fraction": 0.1,
     "stop_overshoot_m": 0.05,
+    "stop_distance_m": 1.2,
+    "stop_closest_m": 1.1,
     "turn_law_violation_fraction": 0.1,
     "search_law_violation_fraction": 0.1,
     "envelope_reason": None,
@@ -248,7 +250,8 @@ def test_a_design_lacking_an_output_makes_its_checks_na(check):
 
 
 def test_failures_keep_their_reasons_apart_from_na():
-    # Found never, though in view: acquisition fails (not n/a); a search that never ended fails.
+    # Found never, though in view: acquisition fails (not n/a); a search still open at the
+    # end, 0.5 s after the loss, is younger than the 4 s limit: nothing to judge.
     m = {
         **JUDGEABLE,
         "acquired_at_s": None,
@@ -271,7 +274,14 @@ def test_failures_keep_their_reasons_apart_from_na():
         "after it is)"
     )
     c = _one("reacquired_within_s", 4.0, m)
-    assert c["status"] == "fail" and "ended before it found the target again" in c["text"]
+    assert c["status"] == "n/a" and c["reason"] == (
+        "the run ended 0.50 s after the target was lost, the design still searching, within "
+        "the 4.0 s limit: no re-acquisition to judge"
+    )
+    c = _one("reacquired_within_s", 0.4, m)
+    assert c["status"] == "fail" and c["text"] == (
+        "target lost and not found again for 0.50 s (limit 0.4 s)"
+    )
     # The furniture left but the robot never closed in: a failure.
     c = _one("resumes_within_s", 3.0, {**JUDGEABLE, "resumed_after_s": None})
     assert c["status"] == "fail" and "never closed 0.2 m" in c["text"]
@@ -551,9 +561,10 @@ def test_a_check_declared_through_the_registry_shows_everywhere(path_check):
     s = load_scenario("follow_person", [*SMALL, "checks={max_path_length_m = 100.0}"])
     r = run_scenario(s, backend="model")
     (c,) = r.summary["checks"]
-    path = r.summary["path_length_m"]
-    assert path > 0 and (c["name"], c["status"], c["value"]) == ("max_path_length_m", "pass", path)
-    assert f"[ok] max_path_length_m: drove {path:.2f} m (limit <= 100.0 m)" in format_summary(
+    path = r.summary["path_length_m"]  # shown to 4 decimals; the check judged it unrounded
+    assert path > 0 and (c["name"], c["status"]) == ("max_path_length_m", "pass")
+    assert round(c["value"], 4) == path
+    assert f"[ok] max_path_length_m: drove {c['value']:.2f} m (limit <= 100.0 m)" in format_summary(
         r.summary
     )
     # Its precondition: a robot that never moved gives it nothing to judge.

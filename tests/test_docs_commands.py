@@ -420,7 +420,7 @@ PLANS = {
     "python -m fpga_robotics.run --scenario lost_target --rerun off --summary s.json": Plan(
         duration="keep",
         duration_why="lost_target's reacquired_within_s needs the person to leave the view "
-        "and be found again (after about 4 s); a 1 s run fails it (15 s "
+        "and be found again (after about 4 s); a shorter run leaves it nothing to judge (15 s "
         "simulated, under a second of wall time)",
         files=("s.json",),
         out=(PASS,),

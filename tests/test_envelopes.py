@@ -15,6 +15,8 @@ from fpga_robotics.checks.envelopes import (
 )
 from fpga_robotics.checks.registry import evaluate_checks
 from fpga_robotics.hw.params import FollowTargetParams
+from fpga_robotics.loop.timings import run_scenario
+from fpga_robotics.scenario.load import load_scenario
 
 RED = 0b100
 #: f = 80 / tan(hfov / 2) = 160 px; the camera 0.5 m up, level; a target 0.2 m in radius,
@@ -121,19 +123,15 @@ def test_search_law_default_and_changed_search():
     frames = [seen] + [hold] * 14 + [search] * 5
     assert envelope_metrics(_traj(frames), DEFAULT, GEOM)["search_law_violation_fraction"] == 0
     wrong = [seen] + [hold] * 14 + [left_search] * 5
-    assert envelope_metrics(_traj(wrong), DEFAULT, GEOM)["search_law_violation_fraction"] == round(
-        5 / 19, 4
-    )
+    assert envelope_metrics(_traj(wrong), DEFAULT, GEOM)["search_law_violation_fraction"] == 5 / 19
     early = [seen] + [hold] * 10 + [search] * 9
-    assert envelope_metrics(_traj(early), DEFAULT, GEOM)["search_law_violation_fraction"] == round(
-        4 / 19, 4
-    )
+    assert envelope_metrics(_traj(early), DEFAULT, GEOM)["search_law_violation_fraction"] == 4 / 19
     # lost_frames = 11 and search_dps = 100: the search starts at the 11th lost frame.
     changed = DEFAULT.replace(lost_frames=11, search_dps=100)
     early_slow = [seen] + [hold] * 10 + [(False, -0.4, 100, -100)] * 9
     assert envelope_metrics(_traj(early_slow), changed, GEOM)["search_law_violation_fraction"] == 0
-    assert envelope_metrics(_traj(early), changed, GEOM)["search_law_violation_fraction"] == round(
-        9 / 19, 4
+    assert (
+        envelope_metrics(_traj(early), changed, GEOM)["search_law_violation_fraction"] == 9 / 19
     )  # 250
     # After reset, never seen: the search turns left.
     never = [(False, 0.0, 0, 0)] * 14 + [(False, 0.0, -250, 250)] * 3
@@ -168,6 +166,63 @@ def test_stop_distance_moves_with_the_reversing_threshold():
         stop_distance_m(GEOM, DEFAULT.replace(base_dps=(1, 400, 300, 200, 150, 100, 50, 40)), RED)
         is None
     )
+
+
+def _on_the_axis(robot_x, target_x):
+    """The robot at ``robot_x`` and the target at ``target_x`` on the x axis, per frame, the
+    robot facing it (+x) and the target found in every frame (GEOM: the camera at the
+    robot's centre)."""
+    traj = _traj([(True, 0.0, 0, 0)] * len(robot_x))
+    traj["x"] = np.array(robot_x, float)
+    traj["target_x"] = np.array(target_x, float)
+    return traj
+
+
+#: GEOM's stop distance with the default law: 1.53 m (test_stop_distance_...: lo(d) reaches
+#: the level-6 threshold there), surely driving on beyond 1.745 m.
+NEAR = 1.53
+
+
+@pytest.mark.parametrize(
+    "robot_x, target_x, overshoot, closest",
+    [
+        # Drives in from 2 m to 1.3 m, then backs off: 1.53 - 1.3 m, all its own driving.
+        ([0.0, 0.3, 0.6, 0.7, 0.6], [2.0] * 5, 0.23, 1.3),
+        # Starts 1.3 m away, inside, and backs off: it drove nothing inside.
+        ([0.7, 0.65, 0.6, 0.5], [2.0] * 4, 0.0, 1.3),
+        # The target walks up from 2 m to 1.28 m while the robot backs off 2 cm a frame.
+        ([0.0, -0.02, -0.04, -0.06, -0.08], [2.0, 1.8, 1.6, 1.4, 1.2], 0.0, 1.28),
+        # Starts inside at 1.3 m and drives 0.1 m further in: the law said stop.
+        ([0.7, 0.75, 0.8], [2.0] * 3, 0.1, 1.2),
+        # Both close in from 1.6 m: the target 0.1 m a frame, the robot 0.05 m, its three
+        # steps (0.15 m) inside (1.45, 1.3 and 1.15 m) its own.
+        ([0.0, 0.05, 0.10, 0.15], [1.6, 1.5, 1.4, 1.3], 0.15, 1.15),
+    ],
+)
+def test_stop_overshoot_counts_the_robots_own_driving_inside(robot_x, target_x, overshoot, closest):
+    assert stop_distance_m(GEOM, DEFAULT, RED)[0] == NEAR
+    m = envelope_metrics(_on_the_axis(robot_x, target_x), DEFAULT, GEOM)
+    assert m["stop_overshoot_m"] == pytest.approx(overshoot, abs=1e-9)
+    assert (m["stop_distance_m"], m["stop_closest_m"]) == (NEAR, pytest.approx(closest))
+    (c,) = evaluate_checks({"max_stop_overshoot_m": 0.05}, m)
+    assert c["passed"] == (overshoot <= 0.05)
+    assert c["text"] == (
+        f"drove {overshoot:.3f} m inside the stop distance (stop distance 1.530 m, closest "
+        f"{closest:.3f} m, camera to the target's centre; limit <= 0.05 m)"
+    )
+
+
+def test_stop_overshoot_of_a_robot_put_inside_the_stop_distance():
+    """approach with the person 1.0 m ahead (centres): the camera, 0.1 m ahead of the
+    centre, starts 0.9 m from them, inside the 1.14 m stop distance, and the design backs
+    off from the first frame: closest 0.9 m, nothing driven inside."""
+    s = load_scenario(
+        "approach", ["people.0.waypoints=[[2.5, 3.0]]", "sim.duration=1", "checks={}"]
+    )
+    m = run_scenario(s, backend="model").summary
+    assert m["stop_distance_m"] > 1.0
+    assert m["stop_closest_m"] == pytest.approx(0.9, abs=1e-6)
+    assert m["stop_overshoot_m"] == 0.0
 
 
 def test_other_laws_leave_the_envelopes_na():
@@ -209,18 +264,19 @@ def test_search_side_of_a_target_leaving_the_view():
     m = envelope_metrics(_leaving(1.0, -0.55, right), DEFAULT, GEOM)
     assert m["search_law_violation_fraction"] == 0
     m = envelope_metrics(_leaving(1.0, -0.55, left), DEFAULT, GEOM)
-    assert m["search_law_violation_fraction"] == round(5 / 19, 4)
+    assert m["search_law_violation_fraction"] == 5 / 19
     # A search 2 DPS off search_dps is off the law as well.
     m = envelope_metrics(_leaving(1.0, -0.55, (248, -250)), DEFAULT, GEOM)
-    assert m["search_law_violation_fraction"] == round(5 / 19, 4)
+    assert m["search_law_violation_fraction"] == 5 / 19
     # The mirror image: leaving on the left, the search turns left.
     assert (
         envelope_metrics(_leaving(1.0, 0.55, left), DEFAULT, GEOM)["search_law_violation_fraction"]
         == 0
     )
-    assert envelope_metrics(_leaving(1.0, 0.55, right), DEFAULT, GEOM)[
-        "search_law_violation_fraction"
-    ] == round(5 / 19, 4)
+    assert (
+        envelope_metrics(_leaving(1.0, 0.55, right), DEFAULT, GEOM)["search_law_violation_fraction"]
+        == 5 / 19
+    )
     # margin_x = 64: the window is columns 64..96 and the silhouette (138.2..229.9) lies
     # wholly outside it; the last sighting has no sure side, only the 14 held frames count.
     narrow = DEFAULT.replace(margin_x=64)
@@ -251,7 +307,7 @@ def test_search_side_tolerates_the_smear_of_a_turn():
         traj = _traj(wrong)
         traj["w"] = np.full(len(wrong), w)
         m = envelope_metrics(traj, DEFAULT, sensor)
-        assert m["search_law_violation_fraction"] == round(judged_wrong / (14 + judged_wrong), 4)
+        assert m["search_law_violation_fraction"] == judged_wrong / (14 + judged_wrong)
 
 
 def test_a_design_without_a_found_output_leaves_the_envelopes_na():

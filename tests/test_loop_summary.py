@@ -5,7 +5,13 @@ import io
 import numpy as np
 import pytest
 
-from fpga_robotics.checks.summary import compute_metrics, evaluate_checks, format_summary, verdict
+from fpga_robotics.checks.summary import (
+    compute_metrics,
+    evaluate_checks,
+    format_summary,
+    rounded,
+    verdict,
+)
 from fpga_robotics.cli.run import Progress, write_json_atomic
 
 PERIOD = 0.1
@@ -34,6 +40,43 @@ def test_distances_fractions_and_path():
     assert m["found_after_acquisition_fraction"] == pytest.approx(2 / 3, abs=1e-4)
     assert m["path_length_m"] == pytest.approx(0.7)
     assert m["collisions"] == {"person": 1, "wall": 0}
+
+
+def test_checks_judge_the_unrounded_metrics():
+    # In view in 1 frame of 20004 (0.005%): 0.0 to the summary's 4 decimals, yet it meets
+    # a limit of 0.001%, and it was in view, if never found.
+    n = 20004
+    glimpse = compute_metrics(
+        trajectory([0] * n, [2.0] * n, in_view=[1] + [0] * (n - 1)), [], {}, PERIOD
+    )
+    assert glimpse["target_in_view_fraction"] == 1 / n
+    assert rounded(glimpse)["target_in_view_fraction"] == 0.0
+    in_view, acquired = evaluate_checks(
+        {"target_in_view_min_fraction": 0.00001, "acquired_within_s": 1.0}, glimpse
+    )
+    assert in_view["status"] == "pass" and in_view["value"] == 1 / n
+    assert in_view["text"] == "target in view 0.005% of frames (limit >= 0.001%)"
+    assert acquired["text"] == "the target was never found (limit 1.0 s)"
+    # In view in 22499 frames of 25000 (89.996%): 0.9 to 4 decimals, yet short of 90%.
+    n = 25000
+    short = compute_metrics(
+        trajectory([1] * n, [2.0] * n, in_view=[1] * 22499 + [0] * 2501), [], {}, PERIOD
+    )
+    assert rounded(short)["target_in_view_fraction"] == 0.9
+    (c,) = evaluate_checks({"target_in_view_min_fraction": 0.9}, short)
+    assert c["status"] == "fail" and c["text"] == (
+        "target in view 89.996% of frames (limit >= 90%)"
+    )
+    # A distance 0.04 mm short of its limit reads as short of it.
+    close = compute_metrics(trajectory([1, 1], [0.59996, 1.0]), [], {}, PERIOD)
+    (c,) = evaluate_checks({"min_distance_min_m": 0.6}, close)
+    assert c["status"] == "fail" and c["text"] == "min distance 0.59996 m (limit >= 0.6 m)"
+    # Found in frame 3 at 0.1 s a frame: 3 * 0.1 = 0.30000000000000004 in float arithmetic,
+    # the time of the frame 0.3 s, at the microsecond the events are stamped with.
+    third = compute_metrics(trajectory([0, 0, 0, 1], [1.0] * 4), [], {}, PERIOD)
+    assert third["acquired_at_s"] == 0.3
+    (c,) = evaluate_checks({"acquired_within_s": 0.3}, third)
+    assert c["status"] == "pass" and c["text"] == "target first found at 0.30 s (limit 0.3 s)"
 
 
 def test_no_target_at_all():
@@ -120,10 +163,35 @@ def test_reacquisition_needs_a_search_that_ended():
         tr, events((0.0, "target found"), (8.0, "target lost"), (9.5, "search started")), {}, PERIOD
     )
     assert open_end["unrecovered_losses_s"] == [2.0]  # run ends at 10.0 s
+    # Lost 2 s before the end, within a 5 s limit: the run was cut short, nothing to judge.
     (c,) = evaluate_checks({"reacquired_within_s": 5.0}, open_end)
-    assert not c["passed"] and "ended before" in c["text"]
+    assert c["status"] == "n/a" and c["reason"] == (
+        "the run ended 2.00 s after the target was lost, the design still searching, within "
+        "the 5.0 s limit: no re-acquisition to judge"
+    )
     (c,) = evaluate_checks({"reacquired_within_s": 1.0}, open_end)
-    assert not c["passed"] and "not found again for 2.00 s" in c["text"]
+    assert c["status"] == "fail" and c["text"] == (
+        "target lost and not found again for 2.00 s (limit 1.0 s)"
+    )
+    # A search that ended (found again 1.5 s after the loss) is judged; a younger open one
+    # after it does not fail the run.
+    judged = compute_metrics(
+        tr,
+        events(
+            (0.0, "target found"),
+            (2.0, "target lost"),
+            (3.0, "search started"),
+            (3.5, "target found"),
+            (8.0, "target lost"),
+            (9.5, "search started"),
+        ),
+        {},
+        PERIOD,
+    )
+    (c,) = evaluate_checks({"reacquired_within_s": 2.5}, judged)
+    assert c["status"] == "pass" and c["value"] == 1.5
+    (c,) = evaluate_checks({"reacquired_within_s": 1.8}, judged)
+    assert c["status"] == "fail" and "not found again for 2.00 s" in c["text"]
 
 
 def test_each_check_compares_with_its_limit():

@@ -40,7 +40,8 @@ class Check:
     precondition : ``precondition(metrics)`` -> None when the run can be judged, else the
         reason it cannot (the check is n/a, e.g. "the design never searched").
     passes : ``passes(value, limit, metrics)`` for a criterion that is more than one comparison
-        (None: ``compare`` decides).
+        (None: ``compare`` decides); it returns True, False, or None when the run leaves
+        nothing to judge against this limit (the check is n/a, its message the reason).
     """
 
     name: str
@@ -136,4 +137,7 @@ def judge(check, limit, m):
         ok = False
     else:
         ok = v <= limit if check.compare == "max" else v >= limit
-    return _result(check, "pass" if ok else "fail", v, limit, check.message(v, limit, m))
+    text = check.message(v, limit, m)
+    if ok is None:
+        return _result(check, "n/a", None, limit, text, text)
+    return _result(check, "pass" if ok else "fail", v, limit, text)

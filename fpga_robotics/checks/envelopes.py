@@ -272,6 +272,8 @@ _NAMES = (
     "turn_law_violation_fraction",
     "search_law_violation_fraction",
     "stop_overshoot_m",
+    "stop_distance_m",
+    "stop_closest_m",
     "envelope_reason",
 )
 
@@ -279,7 +281,9 @@ _NAMES = (
 def envelope_metrics(traj, params, geom):
     """The envelope metrics of a run (``geom``: ``envelope_geometry``'s answer): fractions of
     the judged frames outside each band (None when no frame could be judged), the stop
-    overshoot (m) and ``envelope_reason`` (why nothing could be judged at all, else None)."""
+    overshoot (m) with the stop distance and the closest judged distance it is measured
+    against (camera to the target's centre, m), and ``envelope_reason`` (why nothing could be
+    judged at all, else None)."""
     out = dict.fromkeys(_NAMES)
     why = geom if isinstance(geom, str) else _supported(params)
     need = ("found", "motor_left", "motor_right", "target_x", "color_sel", "heading")
@@ -303,7 +307,9 @@ def envelope_metrics(traj, params, geom):
     codes = np.asarray(traj["color_sel"], np.int64)
     w, centred_px = geom.width, geom.width * CENTRED_PX_FRACTION
     speed, reverse, steer = [], [], []
-    closest = None
+    stop = stop_distance_m(geom, params, int(codes[0])) if len(codes) else None
+    own = _own_depth(traj, dist, stop[0]) if stop is not None else None
+    closest = overshoot = None
     for k in np.flatnonzero(found):
         if not math.isfinite(dist[k]):
             continue
@@ -331,6 +337,8 @@ def envelope_metrics(traj, params, geom):
         steer.append(not t_lo <= turn[k] <= t_hi)
         if abs(bearing[k]) < geom.hfov / 2:
             closest = dist[k] if closest is None else min(closest, dist[k])
+            if own is not None:
+                overshoot = own[k] if overshoot is None else max(overshoot, own[k])
     out["approach_speed_violation_fraction"] = _fraction(speed)
     out["reverse_when_far_fraction"] = _fraction(reverse)
     out["turn_law_violation_fraction"] = _fraction(steer)
@@ -342,10 +350,28 @@ def envelope_metrics(traj, params, geom):
     out["search_law_violation_fraction"] = _fraction(
         _search_judged(found, ml, mr, dist, bearing, geom, params, side_tol)
     )
-    stop = stop_distance_m(geom, params, int(codes[0])) if len(codes) else None
     if stop is not None and closest is not None and closest <= stop[1]:
-        out["stop_overshoot_m"] = round(max(0.0, stop[0] - float(closest)), 4)
+        out["stop_overshoot_m"] = float(overshoot)
+        out["stop_distance_m"], out["stop_closest_m"] = stop[0], float(closest)
     return out
+
+
+def _own_depth(traj, dist, near):
+    """Per frame, how far inside the stop distance ``near`` (m) the robot's own driving has
+    taken it: its centre's closing on the target (held where it stood the frame before; a
+    turn in place closes nothing) adds up while the camera is inside, never below 0 nor
+    beyond the camera's depth there. The rest of the depth is not the robot's doing: it
+    started there, or the target walked up to it (the law then reverses at most)."""
+    x, y = np.asarray(traj["x"], float), np.asarray(traj["y"], float)
+    tx, ty = np.asarray(traj["target_x"], float), np.asarray(traj["target_y"], float)
+    before = np.hypot(tx[:-1] - x[:-1], ty[:-1] - y[:-1])
+    closing = before - np.hypot(tx[:-1] - x[1:], ty[:-1] - y[1:])
+    depth = np.maximum(0.0, near - dist)
+    own = np.zeros(len(dist))
+    for k in range(1, len(dist)):
+        if math.isfinite(depth[k]) and math.isfinite(closing[k - 1]):
+            own[k] = min(max(0.0, own[k - 1] + closing[k - 1]), depth[k])
+    return own
 
 
 def _search_judged(found, ml, mr, dist, bearing, geom, params, side_tol):
@@ -403,4 +429,4 @@ def sure_side(distance, bearing, geom, params, tol=E_TOLERANCE_PX):
 
 
 def _fraction(flags):
-    return round(float(np.mean(flags)), 4) if flags else None
+    return float(np.mean(flags)) if flags else None

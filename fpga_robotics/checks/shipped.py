@@ -33,6 +33,27 @@ def _pct(v, limit=None, least_digits=0):
     return text
 
 
+def _decimals(v, limit, least_digits):
+    """How many decimals show ``v`` against ``limit``: ``least_digits``, or more where fewer
+    would show it equal to the limit, or on its other side, when it is not (the checks judge
+    unrounded values: a distance of 0.59996 m against 0.6 m reads 0.59996, not 0.6000)."""
+    for digits in range(least_digits, 16):
+        shown = round(v, digits)
+        if v == limit or (shown != limit and (shown > limit) == (v > limit)):
+            return digits
+    return 16
+
+
+def _num(v, limit, least_digits):
+    """``v`` with ``_decimals`` decimals."""
+    return f"{v:.{_decimals(v, limit, least_digits)}f}"
+
+
+def _metres(v, limit):
+    """A distance to at most 4 decimals (1.0, 3.0058), more only as ``_decimals`` needs."""
+    return round(v, _decimals(v, limit, 4))
+
+
 def _limit_pct(limit):
     """A check's fraction limit as a percentage, as set (0.1595 is 15.95%, 0.02 is 2%)."""
     return f"{round(limit * 100, 6):g}%"
@@ -79,22 +100,30 @@ def _late(m, limit):
 
 
 def _reacquired(v, limit, m):
-    """Every searched loss ended with the target found again within the limit, and one did."""
-    times = m["reacquire_times_s"]
-    return (
-        m["searched_reacquisitions"] >= 1 and all(x <= limit for x in times) and not _late(m, limit)
-    )
+    """No loss took longer than the limit to end, none still open at the end is older than
+    it, and a searched loss ended with the target found: a pass. With the only searched loss
+    still open, younger than the limit, when the run ended there is nothing to judge (None):
+    the run was cut short, not the design."""
+    if any(x > limit for x in m["reacquire_times_s"]) or _late(m, limit):
+        return False
+    return True if m["searched_reacquisitions"] >= 1 else None
 
 
 def _reacquired_text(v, limit, m):
     late = _late(m, limit)
     if late:
-        return f"target lost and not found again for {max(late):.2f} s (limit {limit} s)"
-    if m["searched_reacquisitions"] == 0:
-        return "the design searched but the run ended before it found the target again"
+        return (
+            f"target lost and not found again for {_num(max(late), limit, 2)} s (limit {limit} s)"
+        )
+    if _reacquired(v, limit, m) is None:
+        return (
+            f"the run ended {_num(m['unrecovered_losses_s'][-1], limit, 2)} s after the target "
+            f"was lost, the design still searching, within the {limit} s limit: no "
+            "re-acquisition to judge"
+        )
     return (
-        f"{len(m['reacquire_times_s'])} re-acquisition(s), slowest {v:.2f} s after the "
-        f"loss (limit {limit} s)"
+        f"{len(m['reacquire_times_s'])} re-acquisition(s), slowest {_num(v, limit, 2)} s "
+        f"after the loss (limit {limit} s)"
     )
 
 
@@ -152,7 +181,7 @@ SHIPPED_CHECKS = (
         lambda v, limit, m: (
             f"{_never_found(m)} (limit {limit} s)"
             if v is None
-            else f"target first found at {v:.2f} s (limit {limit} s)"
+            else f"target first found at {_num(v, limit, 2)} s (limit {limit} s)"
         ),
         limits=(0, _DAY, "s"),
         outputs=("found",),
@@ -163,7 +192,7 @@ SHIPPED_CHECKS = (
         "max",
         "mean robot-to-target distance (centres) at most this",
         lambda v, limit, m: (
-            f"mean distance {v} m (limit <= {limit} m)"
+            f"mean distance {_metres(v, limit)} m (limit <= {limit} m)"
             if v is not None
             else f"{_NO_TARGET} (limit <= {limit} m)"
         ),
@@ -175,7 +204,7 @@ SHIPPED_CHECKS = (
         "min",
         "closest robot-to-target distance (centres) at least this",
         lambda v, limit, m: (
-            f"min distance {v} m (limit >= {limit} m)"
+            f"min distance {_metres(v, limit)} m (limit >= {limit} m)"
             if v is not None
             else f"{_NO_TARGET} (limit >= {limit} m)"
         ),
@@ -212,7 +241,8 @@ SHIPPED_CHECKS = (
             "target is centred"
         ),
         lambda v, limit, m: (
-            f"W changes sign {v:.2f} times per second with the target centred (limit {limit})"
+            f"W changes sign {_num(v, limit, 2)} times per second with the target centred "
+            f"(limit {limit})"
         ),
         limits=(0, 1000, "Hz"),
         outputs=("found", "centroid_x"),
@@ -250,7 +280,8 @@ SHIPPED_CHECKS = (
             "target straight ahead, the centroid's distance from the image centre"
         ),
         lambda v, limit, m: (
-            f"centroid {v:.2f} px from the target's image column on average (limit <= {limit} px)"
+            f"centroid {_num(v, limit, 2)} px from the target's image column on average "
+            f"(limit <= {limit} px)"
         ),
         limits=(0, 10000, "px"),
         outputs=("found", "centroid_x"),
@@ -320,7 +351,9 @@ SHIPPED_CHECKS = (
             "while the design searches (from a search started to the target found again) the "
             "robot's centre travels at most this far: it turns in place (search_travel_m)"
         ),
-        lambda v, limit, m: f"the robot travelled {v:.2f} m during a search (limit <= {limit} m)",
+        lambda v, limit, m: (
+            f"the robot travelled {_num(v, limit, 2)} m during a search (limit <= {limit} m)"
+        ),
         limits=(0, 1000, "m"),
         outputs=("found",),
         precondition=measured("search_travel_m", "the design never searched"),
@@ -329,8 +362,13 @@ SHIPPED_CHECKS = (
         "max_heading_overshoot_deg",
         "heading_overshoot_deg",
         "max",
-        "the robot turns at most this far past the target (heading_overshoot_deg)",
-        lambda v, limit, m: f"turned {v:.1f} deg past the target (limit <= {limit} deg)",
+        (
+            "the robot turns at most this far past the heading that puts the target on the "
+            "camera's axis (heading_overshoot_deg)"
+        ),
+        lambda v, limit, m: (
+            f"turned {_num(v, limit, 1)} deg past the target (limit <= {limit} deg)"
+        ),
         limits=(0, 180, "deg"),
         precondition=measured("heading_overshoot_deg", "no heading to compare"),
     ),
@@ -489,11 +527,16 @@ SHIPPED_CHECKS = (
         "stop_overshoot_m",
         "max",
         (
-            "the robot comes at most this much closer to the target than the distance within "
-            "which the law surely says stop or reverse (the stop distance) "
+            "the robot drives at most this far inside the distance within which the law surely "
+            "says stop or reverse (the stop distance, camera to the target's centre): its own "
+            "driving, not a start inside it nor the target walking up to it "
             f"{_BAND}"
         ),
-        lambda v, limit, m: f"came {v:.3f} m inside the stop distance (limit <= {limit} m)",
+        lambda v, limit, m: (
+            f"drove {_num(v, limit, 3)} m inside the stop distance (stop distance "
+            f"{m['stop_distance_m']:.3f} m, closest {m['stop_closest_m']:.3f} m, camera to the "
+            f"target's centre; limit <= {limit} m)"
+        ),
         limits=(0, 100, "m"),
         outputs=_WHEELS,
         precondition=_envelope("stop_overshoot_m", "the robot never came near the stop distance"),

@@ -21,6 +21,7 @@ __all__ = [
     "compute_metrics",
     "evaluate_checks",
     "format_summary",
+    "rounded",
     "verdict",
 ]
 
@@ -55,8 +56,40 @@ TIMING_FIELDS = (
 )
 
 
-def _round(x, digits=4):
-    return None if x is None else round(float(x), digits)
+def _float(x):
+    return None if x is None else float(x)
+
+
+def _time(x):
+    """A time (s) at the microsecond the run's events are stamped with, free of the float
+    noise of ``k * period`` (1.0000000000000002 s is 1 s, at a limit of 1 s)."""
+    return None if x is None else round(float(x), 6)
+
+
+#: Decimals the summary shows a metric with (``rounded``): 4, or these.
+SHOWN_DECIMALS = {
+    "mean_centroid_error_px": 2,
+    "heading_overshoot_deg": 2,
+    "max_abs_bearing_deg": 2,
+    "obstacle_removed_at_s": 6,
+}
+
+
+def rounded(metrics):
+    """The metrics as the summary shows them: every float, also in lists and tables, to 4
+    decimals or its ``SHOWN_DECIMALS``. The checks judge the metrics before this: a target in
+    view in 1 frame of 20004 meets a limit of 0.001%, though its fraction shows as 0.0."""
+    return {name: _rounded(value, name) for name, value in metrics.items()}
+
+
+def _rounded(value, name):
+    if isinstance(value, dict):
+        return {k: _rounded(v, k) for k, v in value.items()}
+    if isinstance(value, list):
+        return [_rounded(v, name) for v in value]
+    if isinstance(value, float):
+        return round(value, SHOWN_DECIMALS.get(name, 4))
+    return value
 
 
 #: The design's centroid points away from the target when it is further than this fraction of
@@ -78,6 +111,7 @@ def compute_metrics(
     absent=(),
     margin_x=None,
     collision_summary=None,
+    camera_mount=None,
 ):
     """Reduce a run to numbers.
 
@@ -105,6 +139,9 @@ def compute_metrics(
         target inside it); default ``width // 10``, the design's default.
     collision_summary : dict, optional
         ``World.collision_summary()``: per kind, episodes, contact time and largest impulse.
+    camera_mount : fpga_robotics.loop.connectors.base.Mount, optional
+        Where the camera sits on the robot and its yaw off the heading (the heading
+        overshoot is measured from the camera's axis); default the robot's centre and heading.
     """
     absent = [name for name in DESIGN_OUTPUTS if name in set(absent)]
     if absent:
@@ -120,6 +157,7 @@ def compute_metrics(
             width=width,
             margin_x=margin_x,
             collision_summary=collision_summary,
+            camera_mount=camera_mount,
         )
         for name, needs in _METRIC_OUTPUTS.items():
             if any(o in absent for o in needs):
@@ -149,16 +187,16 @@ def compute_metrics(
             open_ep[1] = time
             open_ep = None
     end_time = float(t[-1]) + frame_period if n else 0.0
-    reacq = [round(f - lost, 4) for lost, f, _ in episodes if f is not None]
-    unrecovered = [round(end_time - lost, 4) for lost, f, _ in episodes if f is None]
+    reacq = [_time(f - lost) for lost, f, _ in episodes if f is not None]
+    unrecovered = [_time(end_time - lost) for lost, f, _ in episodes if f is None]
     tipped = [(time, text) for _f, time, text in events if text.startswith("tipped over")]
     return {
-        "min_distance_m": _round(dist[valid].min()) if valid.any() else None,
-        "mean_distance_m": _round(dist[valid].mean()) if valid.any() else None,
-        "target_in_view_fraction": _round(traj["target_in_view"].mean()) if n else 0.0,
-        "found_fraction": _round(found.mean()) if n else 0.0,
-        "found_after_acquisition_fraction": _round(found_after),
-        "acquired_at_s": _round(acquired_at),
+        "min_distance_m": float(dist[valid].min()) if valid.any() else None,
+        "mean_distance_m": float(dist[valid].mean()) if valid.any() else None,
+        "target_in_view_fraction": float(traj["target_in_view"].mean()) if n else 0.0,
+        "found_fraction": float(found.mean()) if n else 0.0,
+        "found_after_acquisition_fraction": found_after,
+        "acquired_at_s": _time(acquired_at),
         "collisions": dict(collisions),
         "robot_at_fault_collisions": int(at_fault_collisions),
         "collision_summary": dict(collision_summary or {}),
@@ -168,8 +206,8 @@ def compute_metrics(
         "searched_reacquisitions": sum(1 for ep in episodes if ep[2] and ep[1] is not None),
         "reacquire_times_s": reacq,
         "unrecovered_losses_s": unrecovered,
-        "path_length_m": _round(path),
-        "tipped_over_at_s": _round(tipped[0][0]) if tipped else None,
+        "path_length_m": path,
+        "tipped_over_at_s": _time(tipped[0][0]) if tipped else None,
         "tip_overs": len(tipped),
         "max_wheel_command_step_dps": _max_command_step(traj),
         "oscillation_hz": _oscillation(traj, width, n * frame_period),
@@ -178,23 +216,24 @@ def compute_metrics(
         "led_misplaced_fraction": _led_misplaced(traj, width, margin_x),
         "peak_wheel_command_dps": _peak_command(traj),
         "search_travel_m": _search_travel(traj, events),
-        "heading_overshoot_deg": _heading_overshoot(traj),
+        "heading_overshoot_deg": _heading_overshoot(traj, camera_mount),
         "absent_outputs": [],
     }
 
 
-def _heading_overshoot(traj):
-    """How far the robot turns past the target, degrees: the largest bearing error (the
-    target's bearing from the robot's centre, relative to its heading) on the far side once
-    the error has changed sign, over frames with the target's centre in view (a frame out of
-    view starts afresh). Meaningful with a standing target (a step response, e.g. ``approach``
-    with ``robot.heading_deg=20``); a walking target crossing the robot's axis counts too.
-    None without the fields."""
+def _heading_overshoot(traj, mount=None):
+    """How far the robot turns past the target, degrees: the largest bearing error on the far
+    side once the error has changed sign, over frames with the target's centre in view (a
+    frame out of view starts afresh). The bearing error is the turn in place that would put
+    the target on the camera's axis (``_aim_error``; the camera at ``mount``, a
+    ``connectors.base.Mount``, or at the robot's centre along its heading without one), so a
+    camera yawed on its mount is on the target when the robot's body is not. Meaningful with a
+    standing target (a step response, e.g. ``approach`` with ``robot.heading_deg=20``); a
+    walking target crossing the robot's axis counts too. None without the fields."""
     need = ("x", "y", "heading", "target_x", "target_y", "target_column")
     if any(k not in traj for k in need) or len(traj["x"]) == 0:
         return None
-    b = np.arctan2(traj["target_y"] - traj["y"], traj["target_x"] - traj["x"]) - traj["heading"]
-    b = np.degrees((b + np.pi) % (2 * np.pi) - np.pi)
+    b = np.degrees(_aim_error(traj, mount))
     best, last, crossed = 0.0, 0.0, False
     for bk, seen in zip(b, ~np.isnan(np.asarray(traj["target_column"], dtype=float))):
         if not seen:
@@ -207,7 +246,24 @@ def _heading_overshoot(traj):
         if crossed:
             best = max(best, abs(float(bk)))
         last = sign
-    return _round(best, 2)
+    return best
+
+
+def _aim_error(traj, mount):
+    """Per frame, the turn in place (rad, left positive) that puts the target's centre on the
+    camera's axis. The camera sits at ``m = (forward, left)`` of the robot's centre, looking
+    ``yaw`` off its heading; it is on the target when the target, ``r`` from the centre, lies
+    at ``m + s u(yaw)`` in the robot's frame, ``s`` the root of ``|m + s u(yaw)| = r``: at
+    the angle ``a`` of that point from the heading. The error is the target's bearing from the
+    centre less ``a`` (``a`` is 0 for a camera on the robot's axis looking ahead)."""
+    dx, dy = traj["target_x"] - traj["x"], traj["target_y"] - traj["y"]
+    bearing = np.arctan2(dy, dx) - traj["heading"]
+    if mount is not None:
+        fwd, left, yaw = mount.forward, mount.left, mount.yaw
+        along = fwd * np.cos(yaw) + left * np.sin(yaw)  # m . u(yaw)
+        s = -along + np.sqrt(np.maximum(0.0, along**2 - fwd**2 - left**2 + dx**2 + dy**2))
+        bearing = bearing - np.arctan2(left + s * np.sin(yaw), fwd + s * np.cos(yaw))
+    return (bearing + np.pi) % (2 * np.pi) - np.pi
 
 
 def _off_target(traj, width, margin_x=None):
@@ -236,8 +292,8 @@ def _off_target(traj, width, margin_x=None):
         return none
     err = np.abs(np.asarray(traj["centroid_x"], dtype=float)[ok] - expected[ok])
     return {
-        "off_target_fraction": _round((err > OFF_TARGET_FRACTION * width).mean()),
-        "mean_centroid_error_px": _round(err.mean(), 2),
+        "off_target_fraction": float((err > OFF_TARGET_FRACTION * width).mean()),
+        "mean_centroid_error_px": float(err.mean()),
     }
 
 
@@ -267,7 +323,7 @@ def _led_wrong_side(traj, width):
     other_half = np.where(offset < 0, leds & 0xF0, leds & 0x0F) != 0
     outer = (leds & 0b1100_0011) != 0
     wrong = (side & other_half) | (centre & outer)
-    return _round(wrong[judged].mean())
+    return float(wrong[judged].mean())
 
 
 #: Near a border between two of the window's eighths, or near the image centre, the LED
@@ -306,7 +362,7 @@ def _led_misplaced(traj, width, margin_x=None):
     right = np.clip(((col + tol - margin) // bin_width).astype(np.int64), 0, 7)
     ok = (leds == allowed) | (leds == np.left_shift(1, left)) | (leds == np.left_shift(1, right))
     ok |= (np.abs(col - width / 2) <= tol) & (leds == LED_CENTRED)
-    return _round((~ok).mean())
+    return float((~ok).mean())
 
 
 def _peak_command(traj):
@@ -337,7 +393,7 @@ def _search_travel(traj, events):
         seg = slice(a, min(b, len(x) - 1) + 1)
         travel = float(np.hypot(np.diff(x[seg]), np.diff(y[seg])).sum())
         longest = travel if longest is None else max(longest, travel)
-    return _round(longest)
+    return _float(longest)
 
 
 def _max_command_step(traj):
@@ -372,7 +428,9 @@ def _oscillation(traj, width, seconds):
         elif wk != 0:
             flips += bool(last * wk < 0)
             last = wk
-    return _round(flips / (seconds * centred.mean()))
+    # Sign changes over the centred frames' time: to 1e-6 Hz, free of the float noise of
+    # the frame period (3 in 3 s is 1 Hz, at a limit of 1 Hz).
+    return round(flips / (seconds * centred.mean()), 6)
 
 
 def format_summary(s):

@@ -294,9 +294,9 @@ class CameraRig:
         bearing = self.columns[f"{cam.name}.target_bearing_deg"][:rows]
         centred = np.abs(bearing) <= cam.params.centred_deg
         return {
-            "target_in_view_fraction": round(float(np.mean(seen == 1.0)), 4),
-            "target_centred_fraction": round(float(np.mean(centred)), 4),
-            "max_abs_bearing_deg": round(float(np.nanmax(np.abs(bearing))), 2),
+            "target_in_view_fraction": float(np.mean(seen == 1.0)),
+            "target_centred_fraction": float(np.mean(centred)),
+            "max_abs_bearing_deg": float(np.nanmax(np.abs(bearing))),
         }
 
 

@@ -18,7 +18,13 @@ import numpy as np
 
 from fpga_robotics.checks.envelopes import envelope_geometry, envelope_metrics
 from fpga_robotics.checks.sensor_metrics import obstacle_metrics
-from fpga_robotics.checks.summary import DESIGN_OUTPUTS, compute_metrics, evaluate_checks, verdict
+from fpga_robotics.checks.summary import (
+    DESIGN_OUTPUTS,
+    compute_metrics,
+    evaluate_checks,
+    rounded,
+    verdict,
+)
 from fpga_robotics.designs.builtin import TOPS
 from fpga_robotics.hw.pixel import color_select_value
 from fpga_robotics.loop.bindings import check_bindings
@@ -498,9 +504,10 @@ class ClosedLoop:
             width=cam.width,
             absent=self.absent,
             margin_x=scenario.params.margin_x,
+            camera_mount=self.camera.mount,
         )
         metrics.update(self.extra_metrics())
-        checks = evaluate_checks(scenario.checks, metrics)
+        checks = evaluate_checks(scenario.checks, metrics)  # on the unrounded metrics
         shadow = {"shadow": self.comparison.summary()} if self.comparison is not None else {}
         return {
             "scenario": scenario.name,
@@ -521,7 +528,7 @@ class ClosedLoop:
             # CPU time of this process: the cost per frame on a machine busy with other work.
             "cpu_ms_per_frame": round(1000.0 * cpu / max(1, n_frames), 4),
             **self.timing_summary(wall),
-            **metrics,
+            **rounded(metrics),
             "events": len(self.events),
             "verdict": verdict(checks),
             "checks": checks,
