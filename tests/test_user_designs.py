@@ -715,7 +715,8 @@ def test_a_bad_parameter_is_told_as_the_command_takes_it(tmp_path, capsys, monke
             code, out, err = _cli([*command, *extra], capsys)
             assert (code, out, err.count("\n")) == (2, "", 1), err
             assert message in err, err
-    code, _, err = _cli(["run", "--scenario", str(WALL_STOP), "--design", "p.py:P"], capsys)
+    run = ["run", "--scenario", str(WALL_STOP), "--design", "p.py:P", "--set", "design.params={}"]
+    code, _, err = _cli(run, capsys)
     assert code == 2
     assert "give it in [design.params] (or --set design.params.speed=VALUE)" in err
     assert sorted(p.name for p in tmp_path.iterdir() if p.name != "__pycache__") == ["p.py"]
