@@ -138,6 +138,22 @@ def test_checks_that_need_an_absent_output_are_na_and_left_out_of_the_verdict(ru
     )
 
 
+def test_the_summary_names_absent_wheels_as_wheels_and_no_recorded_output_absent(runs):
+    # A camera-less design with a `found` output of its own and no wheels: its `found` is
+    # recorded (no frame latches it for the checks), the wheels are absent.
+    _, part = runs
+    absent = ["found", "proximity", "centroid_x", "centroid_leds", "motor_left", "motor_right"]
+    extra = {"found": {"last": 1, "min": 0, "max": 1}}
+    text = format_summary({**part.summary, "absent_outputs": absent, "extra_outputs": extra})
+    lines = text.splitlines()
+    assert (
+        "  tracker outputs absent (no such port, or no camera frame to latch them): "
+        "proximity, centroid_x, centroid_leds"
+    ) in lines
+    assert "  wheel outputs absent (no wheels bound: 0 DPS): motor_left, motor_right" in lines
+    assert "outputs absent" not in format_summary({**part.summary, "absent_outputs": []})
+
+
 def test_compute_metrics_by_hand():
     # Three frames: found in the last two; with `found` absent the found metrics are None.
     traj = {

@@ -33,6 +33,21 @@ def test_each_subcommand_shows_its_own_help(argv, prog, capsys):
     assert capsys.readouterr().out.startswith(f"usage: {prog}")
 
 
+@pytest.mark.parametrize(
+    "argv, says",
+    [
+        # run and sweep run any design, not only FollowTarget or a Verilog one.
+        (["run", "--help"], "Run a design (the scenario's, FollowTarget by default, or --design"),
+        (["sweep", "--help"], "--design REF "),
+    ],
+)
+def test_the_design_options_are_told_as_they_are(argv, says, capsys):
+    with pytest.raises(SystemExit) as info:
+        cli.main(argv)
+    out = " ".join(capsys.readouterr().out.split())
+    assert info.value.code == 0 and says in out
+
+
 def test_top_level_help_lists_every_command(capsys):
     with pytest.raises(SystemExit) as info:
         cli.main(["--help"])

@@ -37,6 +37,15 @@ def test_example_never_replaces_a_file(tmp_path, capsys):
     assert path.read_text() == "keep me\n"
 
 
+def test_example_is_not_written_for_a_design(tmp_path, capsys):
+    # It would be follow_target's map, not the design's, and the design left unchecked.
+    path = tmp_path / "ports.toml"
+    code, out, err = _ports(["--example", str(path), "--design", "verilog:mine.v"], capsys)
+    assert (code, out, err.count("\n")) == (2, "", 1)
+    assert "--example writes the exported follow_target's port map, not one for --design" in err
+    assert not path.exists()
+
+
 @pytest.mark.parametrize(
     "text, word",
     [

@@ -1,6 +1,8 @@
 """``fpga-robotics readback``: the frames of any design's recording (whatever entities it
 logs), ``--help``, and a file that is not a recording as one line with exit code 2."""
 
+import warnings
+
 import pytest
 import rerun as rr
 
@@ -58,3 +60,17 @@ def test_a_file_that_is_not_a_recording_is_one_line(tmp_path, capsys):
     code, _, err = _readback([str(junk)], capsys)
     assert code == 2
     assert err.count("\n") == 1 and "is not a rerun recording" in err
+
+
+def test_a_cut_off_recording_is_one_line(tmp_path, capsys):
+    # Cut in its last message, as a copy of a recording still being written: rerun warns of
+    # the missing footer before it fails; only the error is said.
+    path = _recording(tmp_path / "r.rrd", {"design/found": range(50)})
+    data = path.read_bytes()
+    cut = tmp_path / "cut.rrd"
+    cut.write_bytes(data[: len(data) // 2])
+    with warnings.catch_warnings(record=True) as said:  # on stderr outside pytest
+        warnings.simplefilter("always")
+        code, out, err = _readback([str(cut)], capsys)
+    assert (code, out) == (2, "") and [str(w.message) for w in said] == []
+    assert err.count("\n") == 1 and "is not a rerun recording" in err, err

@@ -174,3 +174,114 @@ def test_a_shadow_s_wheels_under_other_port_names_are_compared_as_the_wheels(tmp
     driving = result["shadow"]["differing_frames"]["motor_left"]
     assert 0 < driving < 20 and result["extra_outputs"]["near"]["last"] == 1
     assert result["shadow"]["differing_frames"]["near"] == 0
+
+
+# Part of a connector by name ----------------------------------------------------------------
+
+PARTIAL = """
+from amaranth import Module, signed
+from amaranth.lib import wiring
+from amaranth.lib.wiring import In, Out
+
+from fpga_robotics.hw.pixel import pixel_stream_signature
+
+WHEELS = {"motor_left": Out(signed(16)), "motor_right": Out(signed(16))}
+
+
+class Ports(wiring.Component):
+    def __init__(self, ports):
+        super().__init__(ports)
+
+    def elaborate(self, platform):
+        m = Module()
+        m.d.sync += self.motor_left.eq(1)
+        return m
+
+
+def one_wheel():
+    return Ports({"motor_left": Out(signed(16))})
+
+
+def misspelt_wheel():
+    return Ports({"motor_left": Out(signed(16)), "motor_rigth": Out(signed(16))})
+
+
+def trig_alone():
+    return Ports({**WHEELS, "trig": Out(1)})
+
+
+def color_sel_alone():
+    return Ports({**WHEELS, "color_sel": In(3)})
+
+
+def plain_pixels():
+    return Ports({**WHEELS, "pixels": In(14)})
+
+
+def outputs_named_as_input_pins():
+    return Ports({**WHEELS, "echo": Out(1), "valid": Out(1), "pixels": Out(14)})
+"""
+
+
+@pytest.mark.parametrize(
+    "name, message",
+    [
+        (
+            "one_wheel",
+            (
+                "design Ports has motor_left but no motor_right: the wheels connector binds by "
+                "name only when the design has motor_left and motor_right; add motor_right: "
+                "Out(signed(16))"
+            ),
+        ),
+        ("misspelt_wheel", "design Ports has motor_left but no motor_right"),
+        (
+            "trig_alone",
+            (
+                "design Ports has trig but no echo: the ultrasound connector binds by name only "
+                "when the design has trig and echo; add echo: In(1)"
+            ),
+        ),
+        (
+            "color_sel_alone",
+            (
+                "design Ports has color_sel but no pixels: the camera connector binds by name "
+                "only when the design has pixels; add pixels: "
+                "In(fpga_robotics.hw.pixel.pixel_stream_signature())"
+            ),
+        ),
+        (
+            "plain_pixels",
+            (
+                "design Ports: port 'pixels' is not the camera's pixel stream (ports "
+                "pixels__valid of 1 bit and pixels__payload of 14 bits, "
+                "In(fpga_robotics.hw.pixel.pixel_stream_signature())); its ports: motor_left, "
+                "motor_right, pixels"
+            ),
+        ),
+    ],
+)
+def test_part_of_a_connector_by_name_is_a_one_line_error(name, message, tmp_path, capsys):
+    # Bound by name only as a whole, the connector would silently bind none of its pins:
+    # a robot without wheels, a camera streaming to nothing.
+    (tmp_path / "partial.py").write_text(PARTIAL)
+    reference = f"{tmp_path / 'partial.py'}:{name}"
+    with pytest.raises(DesignError, match=re.escape(message)):
+        resolve_design(reference)
+    (tmp_path / "s.toml").write_text(STRAIGHT.format(top=reference))
+    for command in (
+        ["designs", reference],
+        ["run", "--scenario", str(tmp_path / "s.toml"), "--rerun", "off"],
+    ):
+        with pytest.raises(SystemExit) as info:
+            cli.main(command)
+        err = capsys.readouterr().err
+        assert info.value.code == 2 and len(err.strip().splitlines()) == 1, err
+        assert message in err
+
+
+def test_an_output_named_as_an_input_pin_is_an_output_of_its_own(tmp_path):
+    (tmp_path / "partial.py").write_text(PARTIAL)
+    spec = resolve_design(f"{tmp_path / 'partial.py'}:outputs_named_as_input_pins")
+    assert list(spec.bindings) == ["wheels"]
+    assert spec.extra_outputs == ("echo", "valid", "pixels")

@@ -197,3 +197,21 @@ def test_a_verilog_grid_value_runs_as_run_design_ports(tmp_path, monkeypatch):
             if isinstance(by_run[key], dict)
             else by_run[key]
         ), key
+
+
+def test_max_runs_builds_only_the_designs_of_the_runs_it_keeps(tree, capsys):
+    from fpga_robotics.sweep.plan import make_plan
+
+    campaign = _campaign(
+        tree, '[grid]\n"design.top" = ["../designs/bump_watch.py:BumpWatch", "follow_target"]\n'
+    )
+    path = str(tree / "camp" / "c.toml")
+    assert main([path, "--dry-run"]) == 0
+    assert ": 2 runs (2 design parameter set(s) to build)" in capsys.readouterr().out
+    assert main([path, "--dry-run", "--max-runs", "1"]) == 0
+    assert ": 1 runs (1 design parameter set(s) to build)" in capsys.readouterr().out
+    plan = make_plan(campaign)
+    plan.keep_first(1)
+    # The one build left is the kept run's design, BumpWatch.
+    (argv,) = plan.builds.values()
+    assert any(a.endswith('bump_watch.py:BumpWatch"') for a in argv), argv

@@ -221,6 +221,18 @@ BAD = [
         {},
         "returned None; missing return statement?",
     ),
+    (
+        "a port named after the clock",
+        f"{DESIGNS / 'port_cases.py'}:ClkPort",
+        {},
+        "design 'ClkPort' has a port named 'clk', the name of the clock domain's own clock",
+    ),
+    (
+        "no file or module before the colon",
+        ":WallStop",
+        {},
+        "name the file or module before ':' (FILE.py:WallStop or package.module:WallStop)",
+    ),
     ("params of a built-in", "follow_target", {"speed": 1}, "takes its parameters from"),
     ("an unknown name", "follow_me", {}, "unknown design 'follow_me'"),
 ]
@@ -628,6 +640,20 @@ def test_designs_checks_a_verilog_port_map_against_the_design(tmp_path, capsys):
         assert message in err, err
 
 
+def test_designs_shows_a_verilog_camera_on_the_ports_its_map_names(tmp_path, capsys):
+    red_count = Path(__file__).parent / "data" / "red_count"
+    verilog, ports = f"verilog:{red_count / 'red_count.v'}", red_count / "red_count_ports.toml"
+    code, out, _ = _cli(["designs", verilog, "--ports", str(ports)], capsys)
+    assert code == 0
+    # Its own ports, as its wheels are: no colour port, as its map has none.
+    assert "connectors: camera (pixels=pix_valid/pix_payload); wheels (motor_left=left, " in out
+    with_color = tmp_path / "ports.toml"
+    text = ports.read_text().replace("\nresult", '\ncolor = { port = "sel" }\nresult')
+    with_color.write_text(text)
+    spec = resolve_design(verilog, ports=str(with_color))
+    assert spec.bindings["camera"] == {"pixels": "pix_valid/pix_payload", "color_sel": "sel"}
+
+
 def test_a_campaign_takes_design_references_and_their_params_as_axes(tmp_path, monkeypatch):
     from fpga_robotics.sweep.campaign import load_campaign, read_campaign_file
     from fpga_robotics.sweep.plan import make_plan
@@ -690,8 +716,54 @@ def test_export_writes_a_design_of_ones_own_and_refuses_bad_params(tmp_path, cap
         ],
         capsys,
     )
-    assert (code, out) == (2, "") and err.count("\n") == 1 and "design.params.speed" in err
+    assert (code, out) == (2, "") and err.count("\n") == 1
+    assert "--param speed must be an integer (a parameter of WallStop), got 'fast'" in err
     assert not bad.exists()
+
+
+NEEDS_SPEED = """
+from amaranth import Module, signed
+from amaranth.lib import wiring
+from amaranth.lib.wiring import Out
+
+
+class P(wiring.Component):
+    motor_left: Out(signed(16))
+    motor_right: Out(signed(16))
+
+    def __init__(self, speed):
+        self.speed = speed
+        super().__init__()
+
+    def elaborate(self, platform):
+        m = Module()
+        m.d.sync += [self.motor_left.eq(self.speed), self.motor_right.eq(self.speed)]
+        return m
+"""
+
+
+def test_a_bad_parameter_is_told_as_the_command_takes_it(tmp_path, capsys, monkeypatch):
+    # designs, export, board and mutate take a design's parameters as --param; a run as
+    # [design.params] or --set.
+    (tmp_path / "p.py").write_text(NEEDS_SPEED)
+    monkeypatch.chdir(tmp_path)
+    missing = "parameter 'speed' has no default; give it as --param speed=VALUE"
+    unknown = "--param spd: P takes no parameter 'spd'; it takes: speed"
+    for command in (
+        ["designs", "p.py:P"],
+        ["export", "--design", "p.py:P", "-o", "p.v"],
+        ["board", "--design", "p.py:P", "-o", "board"],
+        ["mutate", "--design", "p.py:P", "--out", "mutants"],
+    ):
+        for extra, message in (([], missing), (["--param", "spd=1"], unknown)):
+            code, out, err = _cli([*command, *extra], capsys)
+            assert (code, out, err.count("\n")) == (2, "", 1), err
+            assert message in err, err
+    run = ["run", "--scenario", str(WALL_STOP), "--design", "p.py:P", "--set", "design.params={}"]
+    code, _, err = _cli(run, capsys)
+    assert code == 2
+    assert "give it in [design.params] (or --set design.params.speed=VALUE)" in err
+    assert sorted(p.name for p in tmp_path.iterdir() if p.name != "__pycache__") == ["p.py"]
 
 
 @pytest.mark.slow

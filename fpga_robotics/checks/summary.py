@@ -45,6 +45,9 @@ _METRIC_OUTPUTS = {
     "search_travel_m": ("found",),
 }
 
+#: The design outputs the wheels connector reads.
+_WHEEL_OUTPUTS = ("motor_left", "motor_right")
+
 #: Summary fields that depend on the machine, not on the simulation.
 TIMING_FIELDS = (
     "wall_time_s",
@@ -455,11 +458,17 @@ def format_summary(s):
         lines.append(f"  timing: {clock}; {s['sim_cycles']:,} design cycles{rate}")
     if s.get("ended_early"):
         lines.append(f"  run ended early: {s['ended_early']}")
-    if s.get("absent_outputs"):
+    # An output recorded under its own name (a camera-less design's `found`) is no absentee.
+    absent = [n for n in s.get("absent_outputs") or () if n not in (s.get("extra_outputs") or {})]
+    tracker = [n for n in absent if n not in _WHEEL_OUTPUTS]
+    if tracker:
         lines.append(
             "  tracker outputs absent (no such port, or no camera frame to latch them): "
-            + ", ".join(s["absent_outputs"])
+            + ", ".join(tracker)
         )
+    wheels = [n for n in absent if n in _WHEEL_OUTPUTS]
+    if wheels:
+        lines.append(f"  wheel outputs absent (no wheels bound: 0 DPS): {', '.join(wheels)}")
     acq = s["acquired_at_s"]
     found = (
         f"{s['found_fraction']:.0%}"

@@ -148,7 +148,9 @@ def main(argv=None, prog="fpga-robotics board"):
             _refuse_builtin_parameters(args, reference)
         # The board top's own options would be silently ignored with a design of one's own.
         refuse_followtarget_options(args, "--design REF puts a design of your own on the board")
-        design = resolve_design(args.design, _design_params(args.param), ports=args.ports)
+        design = resolve_design(
+            args.design, _design_params(args.param), ports=args.ports, option="--param"
+        )
     elif args.param or args.ports:
         raise UsageError(
             f"{'--param' if args.param else '--ports'} goes with --design REF (a design of "

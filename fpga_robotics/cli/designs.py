@@ -103,7 +103,7 @@ def main(argv=None, prog="fpga-robotics designs"):
         return 0
     if args.ports is not None and not args.reference.startswith("verilog:"):
         raise UsageError("--ports is the port map of a Verilog design: it goes with verilog:FILES")
-    spec = resolve_design(args.reference, params, ports=args.ports)
+    spec = resolve_design(args.reference, params, ports=args.ports, option="--param")
     if spec.kind == "verilog":
         spec = checked_verilog(spec, args.ports)
     origin = {"builtin": "built-in", "amaranth": "Amaranth", "verilog": "Verilog"}[spec.kind]

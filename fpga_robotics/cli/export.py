@@ -40,7 +40,7 @@ from fpga_robotics.cli.sensor_options import (
     sensor_params_from_args,
 )
 from fpga_robotics.designs.reference import is_builtin, resolve_design
-from fpga_robotics.flow.export import TOPS, check_port_names, generate_top_verilog
+from fpga_robotics.flow.export import TOPS, generate_top_verilog
 from fpga_robotics.hw.corridor_follow import CorridorFollow
 from fpga_robotics.hw.corridor_follow_uart import CorridorFollowUart
 from fpga_robotics.hw.follow_line import FollowLine
@@ -288,7 +288,7 @@ def _export_design(args):
         raise UsageError("--variant names a seeded bug of a built-in top: it goes without --design")
     if args.output is not None:  # Verilog written over the design's own file would lose it
         check_paths_apart([("-o", args.output)], _design_file(args.design))
-    spec = resolve_design(args.design, _params(args.design_params))
+    spec = resolve_design(args.design, _params(args.design_params), option="--param")
     name = spec.reference.rpartition(":")[2]
     output = args.output if args.output is not None else os.path.join("build", f"{name}.v")
     if os.path.isdir(output):
@@ -296,7 +296,6 @@ def _export_design(args):
             f"{output} is a directory; give the Verilog file's path, e.g. "
             f"{os.path.join(output, name + '.v')}"
         )
-    check_port_names(spec.ports, name)
     check_output_path(output, what="Verilog file")
     text = generate_top_verilog(spec.build(), name)
     write_atomic(output, text, what="Verilog file")

@@ -384,7 +384,7 @@ def _main_design(args):
         files = spec.reference[len("verilog:") :].split(",")
         name = os.path.splitext(os.path.basename(files[0]))[0]
     else:
-        spec = resolve_design(args.design, _design_params(args.param))
+        spec = resolve_design(args.design, _design_params(args.param), option="--param")
         spec.require_clock()
         name = spec.reference.rpartition(":")[2]
     campaign = _campaign(args.campaign) if args.campaign is not None else None

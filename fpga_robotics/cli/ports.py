@@ -4,6 +4,7 @@ against the design's real ports as Verilator reads them (names, directions, widt
 driven, the connectors' pins)."""
 
 from fpga_robotics.cli.designs import checked_verilog
+from fpga_robotics.cli.errors import UsageError
 from fpga_robotics.cli.parser import CommandParser
 from fpga_robotics.designs.builtin import connector_kinds
 from fpga_robotics.designs.reference import DesignError, resolve_design
@@ -26,7 +27,8 @@ def build_parser(prog="fpga-robotics ports"):
     parser.add_argument(
         "--example",
         action="store_true",
-        help="write the follow_target example to PATH (not replacing a file)",
+        help="write the exported follow_target's map to PATH (not replacing a file); "
+        "without --design",
     )
     parser.add_argument(
         "--design",
@@ -38,6 +40,14 @@ def build_parser(prog="fpga-robotics ports"):
 
 def main(argv=None, prog="fpga-robotics ports"):
     args = build_parser(prog).parse_args(argv)
+    if args.example and args.design is not None:
+        # The example is follow_target's map: written "for" a design of one's own it would
+        # name ports that design does not have.
+        raise UsageError(
+            "--example writes the exported follow_target's port map, not one for --design; "
+            "write your design's map from it (docs/foreign.md), then check it with "
+            f"fpga-robotics ports {args.path} --design {args.design}"
+        )
     if args.example:
         write_follow_target_port_map(args.path)
         print(f"wrote {args.path}")

@@ -80,8 +80,9 @@ def _scenario_default(section, key):
 def build_parser(prog="fpga-robotics run"):
     p = CommandParser(
         prog=prog,
-        description="Run the FollowTarget design in closed loop with a simulated robot, camera "
-        "and people, and check the scenario's pass criteria.",
+        description="Run a design (the scenario's, FollowTarget by default, or --design REF) "
+        "in closed loop with a simulated robot, its sensors and people, and check the "
+        "scenario's pass criteria.",
     )
     p.add_argument(
         "--scenario",

@@ -66,7 +66,7 @@ def build_parser(prog=PROG):
         "axis of that key)",
     )
     g.add_argument("--shadow", metavar="SPEC", help="as run --shadow (e.g. published)")
-    g.add_argument("--design", metavar="verilog:TOP.v", help="as run --design")
+    g.add_argument("--design", metavar="REF", help="as run --design")
     g.add_argument("--ports", metavar="PORTS.toml", help="as run --ports")
     g.add_argument(
         "--timeout",
@@ -242,7 +242,9 @@ def _check_options(args):
 
 def _dry_run(campaign, args):
     plan = make_plan(campaign)
-    runs = plan.runs[: args.max_runs] if args.max_runs else plan.runs
+    if args.max_runs:
+        plan.keep_first(args.max_runs)
+    runs = plan.runs
     print(
         f"campaign {campaign.name}: {len(runs)} runs "
         f"({len(plan.builds)} design parameter set(s) to build)"

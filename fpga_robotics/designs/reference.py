@@ -67,6 +67,26 @@ class DesignError(UsageError, ValueError):
     """A design reference that cannot be resolved: the message says what and how to fix it."""
 
 
+class _ParamError(DesignError):
+    """A parameter ``key`` the design cannot take, ``text`` what is wrong with it: said for
+    ``[design.params]``, or by ``said_for`` for the command-line option the parameters came
+    from (``"--param"``)."""
+
+    def __init__(self, key, text):
+        self.key, self.text = key, text
+        super().__init__(self.said_for(None))
+
+    def said_for(self, option):
+        where = f"design.params.{self.key}" if option is None else f"{option} {self.key}"
+        how = (
+            f"in [design.params] (or --set design.params.{self.key}=VALUE)"
+            if option is None
+            else f"as {option} {self.key}=VALUE"
+        )
+        # Not str.format: the text quotes the user's values, which may hold braces.
+        return self.text.replace("{where}", where).replace("{how}", how)
+
+
 @dataclass(frozen=True, eq=False)
 class DesignSpec:
     """A resolved design reference.
@@ -82,7 +102,8 @@ class DesignSpec:
         Port name -> (direction ``"in"``/``"out"``, width); empty for a Verilog design (its
         widths come from Verilator when it is built).
     bindings : dict
-        Connector kind -> {connector pin: design port}.
+        Connector kind -> {connector pin: design port} (a Verilog design's camera
+        ``pixels``: the ports of its stream, ``"valid/payload"``).
     extra_outputs : tuple
         The outputs no connector reads, recorded under their own names.
     params : dict
@@ -146,12 +167,14 @@ def entry_point_designs():
     return {ep.name: ep.value for ep in importlib.metadata.entry_points(group=ENTRY_POINT_GROUP)}
 
 
-def resolve_design(reference, params=None, *, ports=None, base=None):
+def resolve_design(reference, params=None, *, ports=None, base=None, option=None):
     """The ``DesignSpec`` of ``reference`` built with ``params`` (``[design.params]``).
 
     ``ports`` is the port map of a ``verilog:`` reference; ``base`` the folder relative file
-    paths are taken from (a scenario file's; default the current folder). Raises
-    ``DesignError`` (one line: what is wrong and how to fix it)."""
+    paths are taken from (a scenario file's; default the current folder); ``option`` the
+    command-line option ``params`` came from (``"--param"``; None: a scenario's
+    ``[design.params]``), which errors about them name. Raises ``DesignError`` (one line:
+    what is wrong and how to fix it)."""
     if not isinstance(reference, str) or not reference.strip():
         raise DesignError(
             f"design.top must be a design reference (a built-in name, "
@@ -161,18 +184,22 @@ def resolve_design(reference, params=None, *, ports=None, base=None):
     params = dict(params or {})
     reference = reference.strip()
     if reference.startswith("verilog:"):
-        return _verilog_spec(reference, ports, base, params)
+        return _verilog_spec(reference, ports, base, params, option)
     if reference in TOPS:
         if params:
+            given = option or "design.params"
             raise DesignError(
-                f"design.params: the built-in design {reference!r} takes its "
+                f"{given}: the built-in design {reference!r} takes its "
                 f"parameters from [design] and its own tables, not "
-                f"design.params ({', '.join(sorted(params))})"
+                f"{given} ({', '.join(sorted(params))})"
             )
         return _builtin_spec(TOPS[reference])
     reference = _own_reference(reference, base)
     frozen = tuple(sorted((k, _freeze(v)) for k, v in params.items()))
-    return _amaranth_spec(reference, frozen, _stamp(reference))
+    try:
+        return _amaranth_spec(reference, frozen, _stamp(reference))
+    except _ParamError as exc:
+        raise DesignError(exc.said_for(option)) from None
 
 
 def design_parameters(reference, base=None):
@@ -201,6 +228,11 @@ def _own_reference(reference, base):
             f"package.module:Name or verilog:FILE.v"
         )
     where, _, name = target.rpartition(":")
+    if not where.strip():
+        raise DesignError(
+            f"design {reference!r}: name the file or module before ':' "
+            f"(FILE.py:{name or 'Name'} or package.module:{name or 'Name'})"
+        )
     if where.endswith(".py"):
         path = Path(where).expanduser()
         if not path.is_absolute() and base is not None:
@@ -280,6 +312,7 @@ def _amaranth_spec(reference, frozen_params, _stamp):
     clocked, netlist_digest = _check_elaborates(component, target, reference)
     signed = signed_ports(component)
     ports = component_ports(component)
+    _check_port_names(ports, reference.rpartition(":")[2])
     bindings = bindings_of(component, ports)
     extra = extra_outputs_of(ports, bindings)
     # Its own docstring only: a class without one would show wiring.Component's.
@@ -340,6 +373,17 @@ def _check_elaborates(component, target, reference):
         warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
     clocked = bool(re.search(r"^  wire .*\binput \d+ +\\clk$", text, re.MULTILINE))
     return clocked, hashlib.sha256(text.encode()).hexdigest()
+
+
+def _check_port_names(ports, name):
+    """``DesignError`` if a port of design ``name`` is named ``clk`` or ``rst``: those are the
+    clock domain's own ports, and Amaranth would rename the design's (``clk$3``)."""
+    taken = [port for port in ("clk", "rst") if port in ports]
+    if taken:
+        raise DesignError(
+            f"design {name!r} has a port named {taken[0]!r}, the name of the clock domain's "
+            f"own {'clock' if taken[0] == 'clk' else 'reset'}; rename the port"
+        )
 
 
 def _user_line(exc, target):
@@ -471,22 +515,22 @@ def _check_params(target, params, reference):
         if key not in known:
             if takes_any:
                 continue
-            raise DesignError(
-                f"design.params.{key}: {name} takes no parameter {key!r}; it "
-                f"takes: {', '.join(known) or 'none'}"
+            raise _ParamError(
+                key,
+                f"{{where}}: {name} takes no parameter {key!r}; it takes: "
+                f"{', '.join(known) or 'none'}",
             )
         expected = _expected_type(known[key])
         if expected is not None and not _fits(value, expected):
-            raise DesignError(
-                f"design.params.{key} must be {_type_name(expected)} (a "
-                f"parameter of {name}), got {value!r}"
+            raise _ParamError(
+                key,
+                f"{{where}} must be {_type_name(expected)} (a parameter of {name}), got {value!r}",
             )
     missing = [n for n, p in known.items() if p.default is p.empty and n not in params]
     if missing:
-        raise DesignError(
-            f"design {reference!r}: parameter {missing[0]!r} has no default; "
-            f"give it in [design.params] (or --set design.params."
-            f"{missing[0]}=VALUE)"
+        raise _ParamError(
+            missing[0],
+            f"design {reference!r}: parameter {missing[0]!r} has no default; give it {{how}}",
         )
 
 
@@ -611,11 +655,11 @@ def bindings_of(component, ports, given=None):
     """Connector kind -> {pin: port}: ``given`` and the component's declared ``connectors``,
     then every kind whose pins are all ports of the same names (the camera: ``pixels`` a
     stream input, ``color_sel`` when it has one)."""
+    name = type(component).__name__
     declared = getattr(component, "connectors", None) or {}
     if not isinstance(declared, dict):
         raise DesignError(
-            f"{type(component).__name__}.connectors must be a dict "
-            f"{{kind: {{pin: port}}}}, got {declared!r}"
+            f"{name}.connectors must be a dict {{kind: {{pin: port}}}}, got {declared!r}"
         )
     declared = {**declared, **(given or {})}
     kinds = _connector_pins()
@@ -623,27 +667,31 @@ def bindings_of(component, ports, given=None):
     for kind, pins in declared.items():
         if kind not in kinds:
             raise DesignError(
-                f"{type(component).__name__}.connectors: unknown connector kind "
+                f"{name}.connectors: unknown connector kind "
                 f"{kind!r}; known: {', '.join(sorted(kinds))}"
             )
         if not isinstance(pins, dict):
             raise DesignError(
-                f"{type(component).__name__}.connectors[{kind!r}] must be a dict "
-                f"{{pin: port}}, got {pins!r}"
+                f"{name}.connectors[{kind!r}] must be a dict {{pin: port}}, got {pins!r}"
             )
         for pin, port in pins.items():
             if pin not in kinds[kind]:
                 raise DesignError(
-                    f"{type(component).__name__}.connectors[{kind!r}]: the "
+                    f"{name}.connectors[{kind!r}]: the "
                     f"{kind} connector has no pin {pin!r}; its pins: "
                     f"{', '.join(kinds[kind])}"
                 )
             if kind == "camera" and pin == "pixels":
-                _check_stream(component, port, ports)
+                _check_stream(
+                    port,
+                    ports,
+                    f"{name}.connectors['camera']['pixels']: {port!r} is no pixel stream "
+                    f"input of {name}",
+                )
                 continue
             if port not in ports:
                 raise DesignError(
-                    f"{type(component).__name__}.connectors[{kind!r}][{pin!r}]: "
+                    f"{name}.connectors[{kind!r}][{pin!r}]: "
                     f"no port {port!r}; its ports: {', '.join(ports)}"
                 )
         bindings[kind] = dict(pins)
@@ -656,11 +704,57 @@ def bindings_of(component, ports, given=None):
                     "pixels": "pixels",
                     **({"color_sel": "color_sel"} if "color_sel" in ports else {}),
                 }
+            elif _inputs_named(ports, "pixels"):
+                # An input named pixels meant for the camera, of some other shape.
+                _check_stream(
+                    "pixels",
+                    ports,
+                    f"design {name}: port 'pixels' is not the camera's pixel stream",
+                )
+            elif ports.get("color_sel", ("",))[0] == "in":
+                _refuse_partial(name, kind, ["color_sel"], ["pixels"])
         elif pins and all(p in ports for p in pins):
             bindings[kind] = {p: p for p in pins}
+        else:
+            # A typo or a forgotten pin would silently leave the whole connector unbound.
+            spec = CONNECTORS[kind].pins
+            present = [p for p in pins if ports.get(p, ("",))[0] == spec[p].direction]
+            if present:
+                _refuse_partial(name, kind, present, [p for p in pins if p not in ports])
     if "wheels" in bindings:
         _check_wheels(component, bindings["wheels"])
     return bindings
+
+
+def _inputs_named(ports, port):
+    """Whether the design has an input ``port``, or one of a stream ``port``'s members."""
+    return any(
+        direction == "in" and (name == port or name.startswith(f"{port}__"))
+        for name, (direction, _width) in ports.items()
+    )
+
+
+def _refuse_partial(name, kind, present, missing):
+    """``DesignError``: design ``name`` has some of connector ``kind``'s pins by name
+    (``present``) but not the ``missing`` ones, so the connector binds none of them."""
+    pins = CONNECTORS[kind].pins
+    if kind == "camera":  # its color_sel is optional, its pixels a stream
+        needed = ["pixels"]
+        wanted = "pixels: In(fpga_robotics.hw.pixel.pixel_stream_signature())"
+    else:
+        needed = list(pins)
+        wanted = ", ".join(f"{p}: {_pin_shape(pins[p])}" for p in missing)
+    raise DesignError(
+        f"design {name} has {', '.join(present)} but no {', '.join(missing)}: the {kind} "
+        f"connector binds by name only when the design has {' and '.join(needed)}; add "
+        f'{wanted}, or declare connectors = {{"{kind}": {{pin: port}}}} (docs/your_design.md)'
+    )
+
+
+def _pin_shape(pin):
+    """The port a connector pin takes, as an Amaranth annotation: ``Out(signed(16))``."""
+    shape = f"signed({pin.width})" if pin.signed else str(pin.width)
+    return f"{'In' if pin.direction == 'in' else 'Out'}({shape})"
 
 
 def _check_wheels(component, wheels):
@@ -695,17 +789,16 @@ def stream_ports(bindings):
     return (f"{name}__valid", f"{name}__payload")
 
 
-def _check_stream(component, port, ports):
-    """``DesignError`` unless ``port`` names a pixel stream input of the design: a 1-bit
-    ``PORT__valid`` and a 14-bit ``PORT__payload`` (``In(pixel_stream_signature())``)."""
-    name = type(component).__name__
+def _check_stream(port, ports, problem):
+    """``DesignError`` saying ``problem`` unless ``port`` names a pixel stream input of the
+    design: a 1-bit ``PORT__valid`` and a 14-bit ``PORT__payload``
+    (``In(pixel_stream_signature())``)."""
     valid, payload = f"{port}__valid", f"{port}__payload"
     if ports.get(valid) == ("in", 1) and ports.get(payload) == ("in", 14):
         return
     raise DesignError(
-        f"{name}.connectors['camera']['pixels']: {port!r} is no pixel stream input of "
-        f"{name} (ports {valid} of 1 bit and {payload} of 14 bits, "
-        f"In(pixel_stream_signature())); its ports: {', '.join(ports)}"
+        f"{problem} (ports {valid} of 1 bit and {payload} of 14 bits, "
+        f"In(fpga_robotics.hw.pixel.pixel_stream_signature())); its ports: {', '.join(ports)}"
     )
 
 
@@ -725,7 +818,7 @@ def extra_outputs_of(ports, bindings):
 # Verilog designs ------------------------------------------------------------------------
 
 
-def _verilog_spec(reference, ports, base, params):
+def _verilog_spec(reference, ports, base, params, option):
     from fpga_robotics.sim.backends.port_map import (  # lazy: the simulator (~0.5 s)
         PortMapError,
         load_port_map,
@@ -738,7 +831,7 @@ def _verilog_spec(reference, ports, base, params):
         )
     if params:
         raise DesignError(
-            "design.params: a Verilog design takes no parameters here; set "
+            f"{option or 'design.params'}: a Verilog design takes no parameters here; set "
             "its parameters in the Verilog (or tie inputs in the port map's "
             "[constants])"
         )
@@ -760,11 +853,21 @@ def _verilog_spec(reference, ports, base, params):
     except PortMapError as exc:
         raise DesignError(f"design {reference!r}: {ports}: {exc}") from None
     top = foreign_top(port_map)
+    # The design's own ports, as the map names them (top.bindings has the wrapper's names).
+    camera = {}
+    if port_map.has_pixels:
+        stream = (port_map.valid, port_map.payload, port_map.data, port_map.first, port_map.last)
+        if port_map.style == "framebuffer":
+            stream = (port_map.valid, port_map.address, port_map.data, port_map.new_frame)
+        camera["pixels"] = "/".join(p for p in stream if p)
+        if port_map.color_port:
+            camera["color_sel"] = port_map.color_port
     wheels = {
         k: port_map.outputs[k].port for k in ("motor_left", "motor_right") if k in port_map.outputs
     }
     bindings = {
-        **{k: v for k, v in top.bindings.items() if k != "wheels"},
+        **{k: v for k, v in top.bindings.items() if k not in ("camera", "wheels")},
+        **({"camera": camera} if camera else {}),
         **({"wheels": wheels} if wheels else {}),
     }
     return DesignSpec(

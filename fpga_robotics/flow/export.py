@@ -4,10 +4,9 @@
 
 from amaranth.back import verilog
 
-from fpga_robotics.hw.errors import UserError
 from fpga_robotics.hw.verilog import TOP_NAME, directed_ports, generate_verilog
 
-__all__ = ["TOPS", "check_port_names", "generate_top_verilog", "generate_verilog"]
+__all__ = ["TOPS", "generate_top_verilog", "generate_verilog"]
 
 #: The designs ``--top`` exports; each is also its Verilog module's name.
 TOPS = (
@@ -27,14 +26,3 @@ def generate_top_verilog(component, name):
     Each port keeps its declared direction: an output the design never drives is still an
     output (constant 0), as Amaranth's own conversion makes it."""
     return verilog.convert(component, name=name, ports=directed_ports(component), emit_src=False)
-
-
-def check_port_names(ports, name):
-    """``UserError`` if a port of design ``name`` is named ``clk`` or ``rst``: those are the
-    clock domain's own ports, and Amaranth would rename the design's (``clk$3``)."""
-    taken = [port for port in ("clk", "rst") if port in ports]
-    if taken:
-        raise UserError(
-            f"design {name!r} has a port named {taken[0]!r}, the name of the clock domain's "
-            f"own {'clock' if taken[0] == 'clk' else 'reset'}; rename the port"
-        )

@@ -48,7 +48,7 @@ def run_campaign(
     # --resume keeps the finished runs of the whole campaign (--max-runs limits what runs now).
     run_ids = set(plan.ids.values())
     if max_runs is not None:
-        plan.runs = plan.runs[:max_runs]
+        plan.keep_first(max_runs)
     out_dir = Path(out_dir)
     # The folders this call makes: removed again when it fails before any run finished (a
     # folder that was there, with results --resume could use, is never removed).

@@ -21,6 +21,13 @@ class Plan:
     frames: dict = field(default_factory=dict)  # RunSpec -> (frames, pixels)
     builds: dict = field(default_factory=dict)  # design key -> argv of one run
     worlds: dict = field(default_factory=dict)  # RunSpec -> its world (fork_groups), or None
+    build_keys: dict = field(default_factory=dict)  # RunSpec -> its design key (builds)
+
+    def keep_first(self, n):
+        """Only the first ``n`` runs, and only the builds they need (``--max-runs``)."""
+        self.runs = self.runs[:n]
+        needed = {self.build_keys[spec] for spec in self.runs}
+        self.builds = {key: argv for key, argv in self.builds.items() if key in needed}
 
 
 def _concrete_backend(spec, scenario, shadow):
@@ -72,6 +79,7 @@ def make_plan(campaign):
                 digests[key] = design_digest(args, scenario, shadow)
             frames = round(scenario.sim.duration * scenario.camera.fps)
             checked[shape] = (
+                key,
                 scenario,
                 digests[key],
                 frames,
@@ -84,8 +92,9 @@ def make_plan(campaign):
                 str(Path(scenario.source).resolve()) if scenario.source else spec.scenario,
                 (spec.scenario, scenario.source),
             )
-        scenario, digest, frames, pixels, world, backend = checked[shape]
+        key, scenario, digest, frames, pixels, world, backend = checked[shape]
         spec = replace(spec, backend=backend)
+        plan.build_keys[spec] = key
         plan.worlds[spec] = world
         plan.runs.append(spec)
         plan.ids[spec] = run_identity(spec, scenario.source, digest)
