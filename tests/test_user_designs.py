@@ -7,6 +7,7 @@ The designs live in tests/data/user_designs/, outside the package, as a user's w
 
 import json
 import shutil
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -125,6 +126,40 @@ def test_a_camera_design_with_an_output_named_near(tmp_path):
     assert near[0] == 0 and near[-1] == 1  # drove up to the person, then stopped
     assert ((traj["motor_left"] == 0) == (near == 1)).all()
     assert set(result.summary["extra_outputs"]) == {"near", "red_count"}
+
+
+def test_a_design_file_imports_the_modules_beside_it(tmp_path, monkeypatch, capsys):
+    """Wherever the command runs: two versions of a design, each with a helper.py of its
+    own, each get theirs."""
+    top = (
+        "from amaranth import Module, signed\n"
+        "from amaranth.lib import wiring\n"
+        "from amaranth.lib.wiring import In, Out\n"
+        "from helper import SPEED\n\n\n"
+        "class Top(wiring.Component):\n"
+        "    pressed: In(1)\n"
+        "    motor_left: Out(signed(16))\n"
+        "    motor_right: Out(signed(16))\n\n"
+        "    def elaborate(self, platform):\n"
+        "        m = Module()\n"
+        "        m.d.sync += [self.motor_left.eq(SPEED), self.motor_right.eq(SPEED)]\n"
+        "        return m\n"
+    )
+    for version, speed in (("v1", 100), ("v2", 200)):
+        (tmp_path / version).mkdir()
+        (tmp_path / version / "top.py").write_text(top)
+        (tmp_path / version / "helper.py").write_text(f"SPEED = {speed}\n")
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    monkeypatch.chdir(elsewhere)
+    path = list(sys.path)
+    for version, speed in (("v1", 100), ("v2", 200)):
+        component = resolve_design(f"../{version}/top.py:Top", base=elsewhere).build()
+        Fragment.get(component, None)  # used: Amaranth warns of a component never elaborated
+        assert sys.modules[type(component).__module__].SPEED == speed, version
+    assert sys.path == path and "helper" not in sys.modules
+    code, out, err = _cli(["designs", "../v1/top.py:Top"], capsys)
+    assert code == 0 and "connectors: bumper (pressed=pressed); wheels" in out, err
 
 
 def test_run_design_takes_a_reference_and_params_from_the_command_line(tmp_path, capsys):

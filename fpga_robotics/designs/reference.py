@@ -394,7 +394,8 @@ def _load_file(path, reference):
     module = importlib.util.module_from_spec(spec)
     sys.modules[name] = module
     try:
-        spec.loader.exec_module(module)
+        with _importing_beside(path):
+            spec.loader.exec_module(module)
     except Exception as exc:  # noqa: BLE001 - the user's file may raise anything
         sys.modules.pop(name, None)
         line = _error_line(exc, path)
@@ -403,6 +404,25 @@ def _load_file(path, reference):
             f"{type(exc).__name__}: {_first_line(exc)}"
         ) from None
     return module
+
+
+@contextlib.contextmanager
+def _importing_beside(path):
+    """The folder of the design file ``path`` first on ``sys.path`` while it loads, so that it
+    imports the modules beside it (``from helper import Latch``) wherever the command runs.
+    The modules it so imports are then forgotten by name: another design's ``helper.py``, or
+    this one's after an edit, is imported afresh (the design keeps what it imported)."""
+    folder = path.parent
+    known = {name.partition(".")[0] for name in sys.modules}
+    sys.path.insert(0, str(folder))
+    try:
+        yield
+    finally:
+        sys.path.remove(str(folder))
+        for name, module in list(sys.modules.items()):
+            origin = getattr(getattr(module, "__spec__", None), "origin", None)
+            if name.partition(".")[0] not in known and origin and folder in Path(origin).parents:
+                del sys.modules[name]
 
 
 def _error_line(exc, path):
