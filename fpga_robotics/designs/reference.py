@@ -116,6 +116,24 @@ class DesignSpec:
     def camera(self):
         return "camera" in self.bindings
 
+    def real_clock_reason(self):
+        """Why the design runs in real-clock timing only, or None for a camera-only design,
+        which compressed timing runs frame by frame (fpga_robotics.loop.pin_frames): it
+        binds no connector but the camera and the wheels, has no input the camera does not
+        drive, and raises a 1-bit ``frame_done`` once a frame, when its results are out."""
+        others = [kind for kind in self.bindings if kind not in ("camera", "wheels")]
+        if others:
+            return f"it binds the {others[0]} connector"
+        if not self.camera:
+            return "it has no camera input"
+        camera = {*stream_ports(self.bindings), *self.bindings["camera"].values()}
+        inputs = [n for n, (d, _) in self.ports.items() if d == "in" and n not in camera]
+        if inputs:
+            return f"its input {inputs[0]!r} is not the camera's"
+        if self.ports.get("frame_done") != ("out", 1):
+            return "it has no 1-bit frame_done output to say when a frame's results are out"
+        return None
+
     def require_clock(self):
         """``DesignError`` for a design without a clock (nothing in its ``sync`` domain): a
         simulator here clocks it (an exported design need not have one)."""
