@@ -203,6 +203,27 @@ def test_a_camera_only_design_drives_in_compressed_timing_and_records_its_output
     assert [s[0] for s in scalars] == list(traj["design.red_sum"])
 
 
+def test_an_unchanged_copy_of_follow_target_runs_as_the_built_in_does():
+    """follow_target_copy.py, FollowTarget as a design of one's own, runs frame by frame on
+    its pin backend: every column of the built-in's compressed run, bit for bit."""
+    items = ["sim.duration=4", 'camera.resolution="80x60"']
+    copy = [
+        f'design.top="{DESIGNS / "follow_target_copy.py"}:follow_target_copy"',
+        "design.params.width=80",
+        "design.params.height=60",
+    ]
+    builtin = run_scenario(load_scenario("follow_person", items), backend="cxxrtl")
+    scenario = load_scenario("follow_person", [*items, *copy])
+    assert scenario.sim.timing == "compressed"
+    own = run_scenario(scenario, backend="cxxrtl")
+    assert set(own.trajectory) == set(builtin.trajectory)
+    for column, values in builtin.trajectory.items():
+        np.testing.assert_array_equal(own.trajectory[column], values, err_msg=column)
+    assert builtin.trajectory["found"].all()
+    assert len(set(builtin.trajectory["motor_left"])) > 1  # it steers
+    assert own.summary["verdict"] == builtin.summary["verdict"] == "pass"
+
+
 def test_compressed_timing_names_what_keeps_a_design_on_the_real_clock(tmp_path, capsys):
     for scenario, reason in (
         (WALL_STOP, "(it binds the ultrasound connector)"),
