@@ -7,6 +7,7 @@ The designs live in tests/data/user_designs/, outside the package, as a user's w
 
 import json
 import shutil
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -125,6 +126,157 @@ def test_a_camera_design_with_an_output_named_near(tmp_path):
     assert near[0] == 0 and near[-1] == 1  # drove up to the person, then stopped
     assert ((traj["motor_left"] == 0) == (near == 1)).all()
     assert set(result.summary["extra_outputs"]) == {"near", "red_count"}
+
+
+# A camera-only design of one's own: compressed timing ------------------------------------
+
+RED_FRAMES = DESIGNS / "red_frames.toml"
+
+
+def _red_frames_run(scenario, **kwargs):
+    """The run on CXXRTL and its frames' strongly red RGB444 pixels, counted as
+    red_frames.py counts them."""
+    frames = []
+    result = run_scenario(
+        scenario, backend="cxxrtl", on_frame=lambda r: frames.append(r.camera_rgb), **kwargs
+    )
+    packed = [to_rgb444(f, scenario.camera.width, scenario.camera.height) for f in frames]
+    counts = [((p >> 8 >= 8) & ((p >> 4) & 15 < 5) & (p & 15 < 5)).sum() for p in packed]
+    return result, np.array(counts)
+
+
+def test_a_camera_only_design_gives_the_same_outputs_in_both_timings():
+    """red_frames.py binds only the camera and the wheels and raises frame_done: "auto" runs
+    it frame by frame. Before a robot that stands (speed 0: both timings see the same frames
+    of a person walking past), every frame's outputs are real-clock timing's, and the
+    frames' own red pixels: red_sum, added up over several edges after frame_done, too."""
+    items = [
+        "sim.duration=3",
+        "design.params.speed=0",
+        "design.params.min_pixels=110",
+        "people.0.waypoints=[[3.5, 0.6], [2.5, 2.4]]",
+    ]
+    runs = {}
+    for timing in ("auto", "real_clock"):
+        scenario = load_scenario(str(RED_FRAMES), [*items, f'sim.timing="{timing}"'])
+        runs[scenario.sim.timing] = _red_frames_run(scenario)
+    (fast, counts), (slow, slow_counts) = runs["compressed"], runs["real_clock"]
+    assert fast.summary["timing"] == "compressed" and slow.summary["timing"] == "real_clock"
+    np.testing.assert_array_equal(counts, slow_counts)  # the same frames
+    assert len(set(counts)) > 3 and (counts < 110).any() and (counts >= 110).any()
+    history = np.array([counts[max(0, k - 3) : k + 1].sum() for k in range(len(counts))])
+    expected = {
+        "found": counts >= 110,
+        "design.red_count": counts,
+        "design.red_sum": history,
+        "motor_left": np.zeros(len(counts)),
+    }
+    for column, values in expected.items():
+        np.testing.assert_array_equal(fast.trajectory[column], values, err_msg=column)
+        np.testing.assert_array_equal(slow.trajectory[column], values, err_msg=column)
+    assert fast.summary["extra_outputs"] == slow.summary["extra_outputs"]
+    assert fast.summary["sim_cycles"] < slow.summary["sim_cycles"] / 5
+
+
+def test_a_camera_only_design_drives_in_compressed_timing_and_records_its_outputs(tmp_path):
+    from fpga_robotics.viz import open_recorder
+    from fpga_robotics.viz.readback import read_rrd
+
+    scenario = load_scenario(str(RED_FRAMES))
+    assert scenario.sim.timing == "compressed"
+    recorder = open_recorder(f"save:{tmp_path / 'red.rrd'}", default_path=None)
+    try:
+        result, counts = _red_frames_run(scenario, recorder=recorder)
+    finally:
+        recorder.close()
+    traj = result.trajectory
+    # Frame k's own count drives frame k's command: 400 DPS while found and not near.
+    np.testing.assert_array_equal(traj["design.red_count"], counts)
+    np.testing.assert_array_equal(traj["motor_left"], np.where(counts <= 300, 400, 0))
+    assert traj["motor_left"][0] == 400 and traj["motor_left"][-1] == 0
+    assert traj["x"][-1] > traj["x"][0] + 0.5  # drove up to the person, then stopped
+    assert result.summary["verdict"] == "pass"
+    assert result.summary["extra_outputs"]["red_count"]["max"] == counts.max()
+    entities = read_rrd(str(tmp_path / "red.rrd")).entities
+    rows = entities["design/extra/red_sum"]
+    scalars = next(v for k, v in rows.values.items() if "calar" in k)
+    assert [s[0] for s in scalars] == list(traj["design.red_sum"])
+
+
+def test_an_unchanged_copy_of_follow_target_runs_as_the_built_in_does():
+    """follow_target_copy.py, FollowTarget as a design of one's own, runs frame by frame on
+    its pin backend: every column of the built-in's compressed run, bit for bit."""
+    items = ["sim.duration=4", 'camera.resolution="80x60"']
+    copy = [
+        f'design.top="{DESIGNS / "follow_target_copy.py"}:follow_target_copy"',
+        "design.params.width=80",
+        "design.params.height=60",
+    ]
+    builtin = run_scenario(load_scenario("follow_person", items), backend="cxxrtl")
+    scenario = load_scenario("follow_person", [*items, *copy])
+    assert scenario.sim.timing == "compressed"
+    own = run_scenario(scenario, backend="cxxrtl")
+    assert set(own.trajectory) == set(builtin.trajectory)
+    for column, values in builtin.trajectory.items():
+        np.testing.assert_array_equal(own.trajectory[column], values, err_msg=column)
+    assert builtin.trajectory["found"].all()
+    assert len(set(builtin.trajectory["motor_left"])) > 1  # it steers
+    assert own.summary["verdict"] == builtin.summary["verdict"] == "pass"
+
+
+def test_compressed_timing_names_what_keeps_a_design_on_the_real_clock(tmp_path, capsys):
+    for scenario, reason in (
+        (WALL_STOP, "(it binds the ultrasound connector)"),
+        (NEAR_RED, "(it has no 1-bit frame_done output to say when a frame's results are out)"),
+    ):
+        assert load_scenario(str(scenario)).sim.timing == "real_clock"
+        with pytest.raises(ScenarioError) as info:
+            load_scenario(str(scenario), ['sim.timing="compressed"'])
+        assert reason in str(info.value) and 'needs sim.timing = "real_clock"' in str(info.value)
+    # A second design runs beside it on pins: "auto" is real-clock timing then.
+    from fpga_robotics.cli.run import build_parser, load_run_scenario
+
+    argv = ["--scenario", str(RED_FRAMES), "--shadow", f"{DESIGNS}/red_frames.py:RedFrames"]
+    assert load_run_scenario(build_parser().parse_args(argv)).sim.timing == "real_clock"
+    # A frame whose frame_done never rises (the design counts 31 rows of 30) is one line.
+    argv = ["run", "--scenario", str(RED_FRAMES), "--set", "design.params.height=31"]
+    code, out, err = _cli([*argv, "--duration", "0.2", "--rerun", "off", "--quiet"], capsys)
+    assert (code, out) == (2, "") and err.count("\n") == 1, err
+    assert "frame 0: frame_done did not rise within 20,000 edges" in err
+
+
+def test_a_design_file_imports_the_modules_beside_it(tmp_path, monkeypatch, capsys):
+    """Wherever the command runs: two versions of a design, each with a helper.py of its
+    own, each get theirs."""
+    top = (
+        "from amaranth import Module, signed\n"
+        "from amaranth.lib import wiring\n"
+        "from amaranth.lib.wiring import In, Out\n"
+        "from helper import SPEED\n\n\n"
+        "class Top(wiring.Component):\n"
+        "    pressed: In(1)\n"
+        "    motor_left: Out(signed(16))\n"
+        "    motor_right: Out(signed(16))\n\n"
+        "    def elaborate(self, platform):\n"
+        "        m = Module()\n"
+        "        m.d.sync += [self.motor_left.eq(SPEED), self.motor_right.eq(SPEED)]\n"
+        "        return m\n"
+    )
+    for version, speed in (("v1", 100), ("v2", 200)):
+        (tmp_path / version).mkdir()
+        (tmp_path / version / "top.py").write_text(top)
+        (tmp_path / version / "helper.py").write_text(f"SPEED = {speed}\n")
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    monkeypatch.chdir(elsewhere)
+    path = list(sys.path)
+    for version, speed in (("v1", 100), ("v2", 200)):
+        component = resolve_design(f"../{version}/top.py:Top", base=elsewhere).build()
+        Fragment.get(component, None)  # used: Amaranth warns of a component never elaborated
+        assert sys.modules[type(component).__module__].SPEED == speed, version
+    assert sys.path == path and "helper" not in sys.modules
+    code, out, err = _cli(["designs", "../v1/top.py:Top"], capsys)
+    assert code == 0 and "connectors: bumper (pressed=pressed); wheels" in out, err
 
 
 def test_run_design_takes_a_reference_and_params_from_the_command_line(tmp_path, capsys):

@@ -26,6 +26,7 @@ from fpga_robotics.hw.pixel import COLOR_SELECT
 from fpga_robotics.loop.bindings import check_bindings, scenario_top
 from fpga_robotics.loop.compressed import make_backend
 from fpga_robotics.loop.continuation import continuation_summary, run_continued
+from fpga_robotics.loop.pin_frames import PinFrames, check_frame_backend
 from fpga_robotics.loop.pin_shadow import is_design_reference
 from fpga_robotics.loop.real_clock import format_extra_outputs, make_pin_backend
 from fpga_robotics.loop.shadow import format_shadow, shadow_overrides
@@ -318,6 +319,13 @@ def load_run_scenario(args):
     items = _overrides(args)
     verilog = _verilog_overrides(args, items) if _is_verilog(args) else []
     scenario = load_scenario(args.scenario, [*items, *verilog])
+    chosen = scenario.data["sim"]["timing"] == "auto" and scenario.sim.timing == "compressed"
+    if chosen and scenario.top not in TOPS and args.shadow is not None:
+        # A shadow beside a design of one's own is a design on pins (FollowTarget parameters
+        # compare FollowTarget's frames): "auto" is real-clock timing then, for a camera-only
+        # design too.
+        items.append('sim.timing="real_clock"')
+        scenario = load_scenario(args.scenario, [*items, *verilog])
     if not verilog:
         return scenario
     return dataclasses.replace(scenario, overrides=tuple(items))
@@ -673,10 +681,14 @@ def _design_files(args, foreign=None):
     return files, ports
 
 
-def _open_design(args, params, foreign=None):
-    """The main design: ``--design`` (or the scenario's ``foreign`` design), else
-    FollowTarget, on ``--backend``."""
-    design_files = _design_files(args, foreign)
+def _open_design(args, scenario):
+    """The main design in compressed timing: ``--design`` (or the scenario's foreign
+    design), a design of one's own frame by frame on its pin backend, else FollowTarget, on
+    ``--backend``."""
+    params = scenario.params
+    design_files = _design_files(args, scenario.foreign)
+    if design_files is None and scenario.top not in TOPS:
+        return _open_pin_frames(args, scenario)
     if design_files is None:
         return _open_backend(args.backend, params, args.quiet)
     files, ports = design_files
@@ -703,6 +715,13 @@ def _open_design(args, params, foreign=None):
         backend.close()
         raise
     return design
+
+
+def _open_pin_frames(args, scenario):
+    """A camera-only design of one's own in compressed timing (fpga_robotics.loop.pin_frames)
+    on the pin backend ``--backend``."""
+    check_frame_backend(args.backend, scenario)
+    return PinFrames(scenario, _open_pin_design(args, scenario))
 
 
 def runtime_values(args):
@@ -904,7 +923,7 @@ def _run_source(args, scenario, ros):
     params = scenario.params
     source = open_source(args.source, params.width, params.height, args.max_frames)
     try:
-        design = _open_design(args, params, scenario.foreign)
+        design = _open_design(args, scenario)
         recorder = None
         completed = False
         try:
@@ -940,9 +959,10 @@ def _run_source(args, scenario, ros):
             f"  {out['frames']} frames, {out['ms_per_frame']:.2f} ms/frame "
             f"(design {out['design_ms_per_frame']:.2f} ms)"
         )
+        proximity = out["mean_proximity"]  # None: the design has no proximity output
         print(
-            f"  target found in {out['found_frames']} frames ({out['found_fraction']:.0%}), "
-            f"mean proximity {out['mean_proximity']:.2f}"
+            f"  target found in {out['found_frames']} frames ({out['found_fraction']:.0%})"
+            + ("" if proximity is None else f", mean proximity {proximity:.2f}")
         )
     else:
         print("  no frames")
@@ -1021,7 +1041,7 @@ def main(argv=None, prog="fpga-robotics run"):
         design = _open_pin_design(args, scenario)
     else:
         check_bindings(scenario)  # before the model is built
-        design = _open_design(args, scenario.params, scenario.foreign)
+        design = _open_design(args, scenario)
     shadow = recorder = None
     completed = False
     try:

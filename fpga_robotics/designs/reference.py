@@ -138,6 +138,24 @@ class DesignSpec:
     def camera(self):
         return "camera" in self.bindings
 
+    def real_clock_reason(self):
+        """Why the design runs in real-clock timing only, or None for a camera-only design,
+        which compressed timing runs frame by frame (fpga_robotics.loop.pin_frames): it
+        binds no connector but the camera and the wheels, has no input the camera does not
+        drive, and raises a 1-bit ``frame_done`` once a frame, when its results are out."""
+        others = [kind for kind in self.bindings if kind not in ("camera", "wheels")]
+        if others:
+            return f"it binds the {others[0]} connector"
+        if not self.camera:
+            return "it has no camera input"
+        camera = {*stream_ports(self.bindings), *self.bindings["camera"].values()}
+        inputs = [n for n, (d, _) in self.ports.items() if d == "in" and n not in camera]
+        if inputs:
+            return f"its input {inputs[0]!r} is not the camera's"
+        if self.ports.get("frame_done") != ("out", 1):
+            return "it has no 1-bit frame_done output to say when a frame's results are out"
+        return None
+
     def require_clock(self):
         """``DesignError`` for a design without a clock (nothing in its ``sync`` domain): a
         simulator here clocks it (an exported design need not have one)."""
@@ -458,7 +476,8 @@ def _load_file(path, reference):
     module = importlib.util.module_from_spec(spec)
     sys.modules[name] = module
     try:
-        spec.loader.exec_module(module)
+        with _importing_beside(path):
+            spec.loader.exec_module(module)
     except Exception as exc:  # noqa: BLE001 - the user's file may raise anything
         sys.modules.pop(name, None)
         line = _error_line(exc, path)
@@ -467,6 +486,25 @@ def _load_file(path, reference):
             f"{type(exc).__name__}: {_first_line(exc)}"
         ) from None
     return module
+
+
+@contextlib.contextmanager
+def _importing_beside(path):
+    """The folder of the design file ``path`` first on ``sys.path`` while it loads, so that it
+    imports the modules beside it (``from helper import Latch``) wherever the command runs.
+    The modules it so imports are then forgotten by name: another design's ``helper.py``, or
+    this one's after an edit, is imported afresh (the design keeps what it imported)."""
+    folder = path.parent
+    known = {name.partition(".")[0] for name in sys.modules}
+    sys.path.insert(0, str(folder))
+    try:
+        yield
+    finally:
+        sys.path.remove(str(folder))
+        for name, module in list(sys.modules.items()):
+            origin = getattr(getattr(module, "__spec__", None), "origin", None)
+            if name.partition(".")[0] not in known and origin and folder in Path(origin).parents:
+                del sys.modules[name]
 
 
 def _error_line(exc, path):

@@ -43,6 +43,7 @@ __all__ = [
     "TRAJECTORY_FIELDS",
     "ClosedLoop",
     "RunResult",
+    "extra_output_stats",
     "frame_count",
     "make_backend",
     "run_compressed",
@@ -110,6 +111,16 @@ def make_backend(name, params, *, on_build=None):
     if name == "auto":
         name = fastest_backend_name()
     return get_backend(name, params, on_build=on_build)
+
+
+def extra_output_stats(column):
+    """``{"last", "min", "max"}`` of an extra output's trajectory column (None where no row
+    holds a value)."""
+    values = np.asarray(column, float)
+    values = values[np.isfinite(values)]
+    if not len(values):
+        return {"last": None, "min": None, "max": None}
+    return {"last": int(values[-1]), "min": int(values.min()), "max": int(values.max())}
 
 
 def frame_count(duration_steps, frame_period, physics_dt):
@@ -343,7 +354,8 @@ class ClosedLoop:
         return (None if target is None else dist), visible
 
     def store_outputs(self, k, result):
-        """Row ``k``'s design outputs from ``result`` (a ``FrameResult``)."""
+        """Row ``k``'s design outputs from ``result`` (a ``FrameResult``), its extra outputs
+        in columns ``design.<name>``."""
         if result.cycles is not None:
             self.cycles += result.cycles
         for name in DESIGN_OUTPUTS:  # an absent one (None) drives its wheel at 0 DPS
@@ -352,6 +364,8 @@ class ClosedLoop:
                 self.absent.add(name)  # stored as 0 here, NaN once the run is done (summary.py)
             else:
                 self.traj[name][k] = value
+        for name, value in (result.extra or {}).items():
+            self.traj.setdefault(f"design.{name}", np.full(self.n_frames, np.nan))[k] = value
 
     def record(self, k, t, rgb, result, distance, visible, events, shadow_result=None, **extra):
         """Hand the frame to the viewer and the ``on_frame`` callback; ``extra`` are more
@@ -402,11 +416,11 @@ class ClosedLoop:
         # A command that acts at once (no actuation delay) may tip the robot: this frame's.
         events += self.world.drain_events()
         distance, visible = self.measure(k, t, pose, result)
-        extra = {}
+        extra = {"design_extra": result.extra} if result.extra else {}
         if self.rig is not None:
             self.rig.sample(k, self.n_frames, self.world)
             if self.want_records:
-                extra = {"cameras": self.rig.views(), "sensors": self.rig.readings(self.world)}
+                extra.update(cameras=self.rig.views(), sensors=self.rig.readings(self.world))
         self.events += [(k, round(t, 6), e) for e in events]
         self.frames_done = k + 1
         if self.want_records:
@@ -509,6 +523,12 @@ class ClosedLoop:
         metrics.update(self.extra_metrics())
         checks = evaluate_checks(scenario.checks, metrics)  # on the unrounded metrics
         shadow = {"shadow": self.comparison.summary()} if self.comparison is not None else {}
+        # The last, smallest and largest value of each output no connector reads.
+        extra = {
+            name.removeprefix("design."): extra_output_stats(column)
+            for name, column in self.traj.items()
+            if name.startswith("design.")
+        }
         return {
             "scenario": scenario.name,
             "backend": self.design.name,
@@ -533,6 +553,7 @@ class ClosedLoop:
             "verdict": verdict(checks),
             "checks": checks,
             **shadow,
+            **({"extra_outputs": extra} if extra else {}),
         }
 
 
@@ -610,6 +631,9 @@ def run_compressed(
             controls=controls,
         )
 
+    if isinstance(backend, str) and scenario.top not in TOPS:
+        # A backend name opens FollowTarget; run_scenario opens a design of one's own.
+        raise ValueError("a design of one's own runs on a ready backend (loop.pin_frames)")
     return run_loop(
         backend,
         lambda name: make_backend(name, scenario.params),

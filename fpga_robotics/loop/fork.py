@@ -427,16 +427,21 @@ def _driving(outputs, ports):
 def _outputs(result):
     """What the loop keeps of a ``FrameResult`` (its image buffer may be reused)."""
     return SimpleNamespace(
-        cycles=result.cycles, **{name: getattr(result, name) for name in DESIGN_OUTPUTS}
+        cycles=result.cycles,
+        extra=result.extra,
+        **{name: getattr(result, name) for name in DESIGN_OUTPUTS},
     )
 
 
 def _rewrite_design_part(loop, outputs, ref):
     """Make the first ``len(outputs)`` frames of a restored ``loop`` the variant's: its design
-    outputs, cycles, absent outputs and design events, among the reference world's events."""
+    outputs (its extra outputs too), cycles, absent outputs and design events, among the
+    reference world's events."""
     n = len(outputs)
     for name in DESIGN_OUTPUTS:
         loop.traj[name][:n] = 0
+    for name in [c for c in loop.traj if c.startswith("design.")]:  # the reference's extras
+        del loop.traj[name]
     loop.absent, loop.cycles = set(), 0
     loop.design_events = _DesignEvents(loop.scenario.params.lost_frames)
     events = []

@@ -56,7 +56,6 @@ from fpga_robotics.sim.records import SensorReading
 
 __all__ = [
     "RealClockLoop",
-    "extra_output_stats",
     "format_extra_outputs",
     "make_pin_backend",
     "pin_design_source",
@@ -131,16 +130,6 @@ def make_pin_backend(name, scenario, *, on_build=None):
     own = scenario.foreign is None and scenario.top not in TOPS
     backend.design_params = dict(scenario.design_params) if own else None
     return backend
-
-
-def extra_output_stats(column):
-    """``{"last", "min", "max"}`` of an extra output's trajectory column (None where no row
-    holds a value)."""
-    values = np.asarray(column, float)
-    values = values[np.isfinite(values)]
-    if not len(values):
-        return {"last": None, "min": None, "max": None}
-    return {"last": int(values[-1]), "min": int(values.min()), "max": int(values.max())}
 
 
 def format_extra_outputs(summary):
@@ -639,16 +628,6 @@ class RealClockLoop(ClosedLoop):
                 self.measurements, [(c.name, c.kind) for c in self.sensors], self.frames_done
             ),
         }
-
-    def summarise(self, wall, cpu):
-        """Also ``extra_outputs``: the last, smallest and largest value of each output no
-        connector reads (its trajectory column ``design.<name>``)."""
-        summary = super().summarise(wall, cpu)
-        if self.extra:
-            summary["extra_outputs"] = {
-                name: extra_output_stats(self.traj[f"design.{name}"]) for name in self.extra
-            }
-        return summary
 
     def timing_summary(self, wall):
         cycles = self.pins.cycle

@@ -24,6 +24,8 @@ __all__ = ["IMAGE_SUFFIXES", "FrameSource", "open_source", "run_source", "to_des
 
 #: Files of a folder source that are read as frames (in sorted name order).
 IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff", ".ppm", ".pgm")
+#: The per-frame outputs ``run_source`` reports besides ``found``.
+_OUTPUTS = ("proximity", "centroid_x", "centroid_leds", "motor_left", "motor_right")
 
 
 class FrameSource:
@@ -161,15 +163,15 @@ def run_source(
             if result.found != was_found:
                 events.append("target found" if result.found else "target lost")
                 was_found = bool(result.found)
+            # An output the design lacks (a design of one's own, a port map) is None.
             results.append(
                 {
                     "frame": k,
                     "found": bool(result.found),
-                    "proximity": int(result.proximity),
-                    "centroid_x": int(result.centroid_x),
-                    "centroid_leds": int(result.centroid_leds),
-                    "motor_left": int(result.motor_left),
-                    "motor_right": int(result.motor_right),
+                    **{
+                        name: None if getattr(result, name) is None else int(getattr(result, name))
+                        for name in _OUTPUTS
+                    },
                 }
             )
             if recorder is not None or on_frame is not None:
@@ -179,8 +181,8 @@ def run_source(
                     else time.perf_counter() - start
                 )
                 cmd_v, cmd_w = dps_to_twist(
-                    int(result.motor_left),
-                    int(result.motor_right),
+                    int(result.motor_left or 0),
+                    int(result.motor_right or 0),
                     robot.wheel_radius,
                     robot.wheel_separation,
                 )
@@ -214,6 +216,7 @@ def run_source(
     wall = time.perf_counter() - start
     n = len(results)
     found = sum(r["found"] for r in results)
+    proximity = [r["proximity"] for r in results if r["proximity"] is not None]
     return {
         "source": source.spec,
         "source_kind": source.kind,
@@ -226,6 +229,6 @@ def run_source(
         "design_ms_per_frame": round(1000.0 * design_time / n, 4) if n else None,
         "found_frames": found,
         "found_fraction": round(found / n, 4) if n else 0.0,
-        "mean_proximity": round(sum(r["proximity"] for r in results) / n, 4) if n else None,
+        "mean_proximity": round(sum(proximity) / len(proximity), 4) if proximity else None,
         "results": results,
     }

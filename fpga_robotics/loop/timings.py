@@ -1,6 +1,8 @@
 """``run_scenario``: one scenario in the loop timing it asks for (``sim.timing``)."""
 
+from fpga_robotics.designs.builtin import TOPS
 from fpga_robotics.loop.compressed import run_compressed
+from fpga_robotics.loop.pin_frames import open_pin_frames
 from fpga_robotics.loop.real_clock import run_real_clock
 
 __all__ = ["TIMINGS", "run_scenario"]
@@ -51,6 +53,22 @@ def run_scenario(
         Live control inputs (``fpga_robotics.ros.controls``): colour select, the target
         driven by hand, pause and step; applied just after each frame's capture.
     """
+    own = scenario.top not in TOPS and scenario.sim.timing == "compressed"
+    if own and isinstance(backend, str):
+        # A camera-only design of one's own: frame by frame on its pin backend, closed after.
+        with open_pin_frames(backend, scenario) as design:
+            return run_compressed(
+                scenario,
+                seed=seed,
+                backend=design,
+                recorder=recorder,
+                progress=progress,
+                realtime=realtime,
+                on_frame=on_frame,
+                shadow=shadow,
+                shadow_label=shadow_label,
+                controls=controls,
+            )
     return TIMINGS[scenario.sim.timing](
         scenario,
         seed=seed,

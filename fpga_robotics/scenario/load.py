@@ -1051,18 +1051,24 @@ def _check_connectors_in_run(connectors, sim, room):
             raise ScenarioError(str(exc)) from None
 
 
-def _resolve_timing(sim, camera, top, connectors, foreign):
+def _resolve_timing(sim, camera, top, design_params, connectors, foreign):
     """``sim.timing = "auto"`` made definite; a design or connector with pins of its own
     needs real-clock timing."""
-    # Every design but the camera-only follow_target has pins of its own, unless it has
-    # frame-level channels for further cameras; cameras and servos act once a frame.
-    frame_level = top in TOPS and bool(TOPS[top].frame_channels)
+    # Every built-in design but the camera-only follow_target has pins of its own, unless
+    # it has frame-level channels for further cameras; cameras and servos act once a frame.
+    # A design of one's own streams only its camera frame by frame: any connector needs pins.
+    own = top not in TOPS
+    frame_level = not own and bool(TOPS[top].frame_channels)
     pins = [
         f"the {c.kind} connector"
         for c in connectors
-        if not getattr(CONNECTORS[c.kind], "frame_level", False)
+        if own or not getattr(CONNECTORS[c.kind], "frame_level", False)
     ]
-    if top != "follow_target" and not frame_level:
+    if own:
+        reason = resolve_design(top, design_params).real_clock_reason()
+        if reason is not None:
+            pins.insert(0, f"design.top = {top!r} ({reason})")
+    elif top != "follow_target" and not frame_level:
         pins.insert(0, f"design.top = {top!r}")
     if foreign is not None:
         # A port map that binds connectors (or has no camera) is a design with pins.
@@ -1112,7 +1118,7 @@ def _build(data, source, overrides):
     connectors = _connectors(world)
     top, tables, design_params = _top(_run_uart(data["design"], sim, connectors), source)
     checks = _checks(data)
-    sim = _resolve_timing(sim, camera, top, connectors, foreign)
+    sim = _resolve_timing(sim, camera, top, design_params, connectors, foreign)
     world_config = _check_world(world)
     _check_camera_geometry(camera, world_config)
     _check_connectors_in_run(connectors, sim, world_config.room)

@@ -108,7 +108,8 @@ class SimKeys(ScenarioKeys):
     timing: Text(
         choices=TIMINGS,
         style="scenario",
-        doc='"auto": "compressed" for a camera-only design, else "real_clock" (docs/running.md)',
+        doc='"auto": "compressed" for a camera-only design (docs/your_design.md), else '
+        '"real_clock" (docs/running.md)',
     ) = "auto"
     clock_hz: _scenario_number(
         ge=1e3, le=1e9, unit="Hz", doc="the design's clock in real-clock timing"

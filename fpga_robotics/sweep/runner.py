@@ -182,7 +182,7 @@ def _designs_for(args, scenario, shadow_params):
     else:
         design = _open(
             _design_key(args, scenario),
-            lambda: run._open_design(args, scenario.params, scenario.foreign),
+            lambda: run._open_design(args, scenario),
         )
     shadow = None
     name = args.shadow_backend or args.backend

@@ -84,6 +84,8 @@ class FrameResult:
     motor_left: int  # signed DPS
     motor_right: int  # signed DPS
     cycles: int
+    #: A design of one's own: its outputs no connector reads, by name (None: none).
+    extra: dict = None
 
     def outputs(self):
         """The per-frame scalar outputs as a tuple (for comparisons across backends)."""
