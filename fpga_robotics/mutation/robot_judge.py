@@ -338,8 +338,9 @@ def robot_judge(
     watch output watched (``design.write_mutant_design``); with ``fork`` the unmutated runs
     use it, and a mutant that never acted in one of them is given it without a run.
     ``mutants``: their ``mutants_key``, in every journal row with the ``campaign_runs_key``
-    (``resume`` keeps only rows of the same mutants and runs; ``check_resume`` refuses others
-    before anything is written). ``prebuilt``: the ``start_prebuild`` thread to wait for
+    (``resume`` keeps only rows of the same mutants and runs, and of ``indices``: the journal
+    is written again with those alone; ``check_resume`` refuses others before anything is
+    written). ``prebuilt``: the ``start_prebuild`` thread to wait for
     before the runs."""
     from distributed import as_completed  # lazy: Dask costs ~1 s; only a run needs it
 
@@ -353,8 +354,12 @@ def robot_judge(
     journal = os.path.join(out_dir, JOURNAL_NAME)
     verdicts = {}
     if resume and os.path.exists(journal):
+        # Only the mutants judged now: one the unit judge no longer catches (other --cycles,
+        # --against, ...) has no robot verdict in this run's scores.
+        wanted = set(indices)
         for row in journal_rows(journal):
-            if (row.get("mutants"), row.get("campaign_runs")) == (mutants, runs_key):
+            same = (row.get("mutants"), row.get("campaign_runs")) == (mutants, runs_key)
+            if same and int(row["index"]) in wanted:
                 verdicts[int(row["index"])] = row
         # Written again whole: a torn last line would swallow the first row appended to it.
         write_atomic(
