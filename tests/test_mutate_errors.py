@@ -69,3 +69,44 @@ def test_a_failed_command_removes_only_the_folder_it_made(tmp_path, existed, jou
             (out / "robot.jsonl").write_text("{}\n")
         raise RuntimeError("the build failed")
     assert os.path.exists(out) == kept
+
+
+@pytest.mark.parametrize(
+    ("more", "message"),
+    [
+        (
+            ["--scheduler", "tcp://127.0.0.1:8786", "--workers", "3"],
+            "--workers sizes the embedded cluster; with --scheduler the cluster has the workers",
+        ),
+        (["--scheduler", "foo"], "--scheduler must be a Dask scheduler address tcp://HOST:PORT"),
+    ],
+)
+def test_scheduler_options_are_refused_before_anything_runs(tmp_path, capsys, more, message):
+    # Not a slow test: a mutant build here would fail it (tests/fast_tier/slow_builds.py).
+    out = tmp_path / "m"
+    argv = ["--mutants", "4", "--campaign", "mutation", "--out", str(out), *more]
+    with pytest.raises(SystemExit) as exc:
+        run_cli(main, argv, "mutate")
+    err = capsys.readouterr().err
+    assert exc.value.code == 2 and message in err and len(err.strip().splitlines()) == 1
+    assert not out.exists()
+
+
+def test_an_unreachable_scheduler_is_refused_before_the_build(tmp_path, capsys, monkeypatch):
+    from fpga_robotics.cli import mutate
+    from fpga_robotics.hw.errors import UsageError
+
+    dialled = []
+
+    def unreachable(scheduler=None, workers=None):
+        dialled.append(scheduler)
+        raise UsageError(f"cannot reach the Dask scheduler at {scheduler!r}")
+
+    monkeypatch.setattr(mutate, "open_client", unreachable)
+    out = tmp_path / "m"
+    argv = ["--mutants", "4", "--campaign", "mutation", "--out", str(out)]
+    with pytest.raises(SystemExit) as exc:
+        run_cli(main, [*argv, "--scheduler", "tcp://127.0.0.1:1"], "mutate")
+    assert exc.value.code == 2 and dialled == ["tcp://127.0.0.1:1"]
+    assert "cannot reach the Dask scheduler" in capsys.readouterr().err
+    assert not out.exists()

@@ -55,6 +55,7 @@ from fpga_robotics.sim.files import check_output_dir, write_atomic, write_json_a
 from fpga_robotics.sim.mutation import MutationError, list_mutants, mutant_cones
 from fpga_robotics.sim.pins import PinError
 from fpga_robotics.sweep import load_campaign_file, runner
+from fpga_robotics.sweep.engine import check_scheduler_address, open_client
 
 __all__ = ["main"]
 
@@ -362,6 +363,15 @@ def _removed_on_error(out):
         raise
 
 
+def _reach_scheduler(address):
+    """With ``--scheduler``, connect to it once before anything is built: one that cannot be
+    reached is refused in seconds, not after the build and the unit judge (its workers may
+    still join while they run)."""
+    if address is not None:
+        with open_client(scheduler=address):
+            pass
+
+
 def _main_design(args):
     """``--design REF``: the mutants of a design of one's own against itself."""
     refuse_followtarget_options(
@@ -390,6 +400,7 @@ def _main_design(args):
     campaign = _campaign(args.campaign) if args.campaign is not None else None
     out = args.out or os.path.join("runs", "mutation", f"{name}-n{args.mutants}-s{args.seed}")
     check_output_dir(out, what="output folder")
+    _reach_scheduler(args.scheduler)
 
     def say(text):
         if not args.quiet:
@@ -459,6 +470,13 @@ def _check(args):
             "--workers, --scheduler, --resume and --fork/--no-fork go with --campaign "
             "(the robot judge)"
         )
+    if args.workers is not None and args.scheduler is not None:
+        raise UsageError(
+            "--workers sizes the embedded cluster; with --scheduler the cluster "
+            "has the workers you started (`dask worker ADDRESS`)"
+        )
+    if args.scheduler is not None:
+        check_scheduler_address(args.scheduler)
     args.fork = True if args.fork is None else args.fork
 
 
@@ -481,6 +499,7 @@ def main(argv=None, prog="fpga-robotics mutate"):
     campaign = _campaign(args.campaign) if args.campaign is not None else None
     out = args.out or os.path.join("runs", "mutation", f"n{args.mutants}-s{args.seed}")
     check_output_dir(out, what="output folder")
+    _reach_scheduler(args.scheduler)
 
     with _removed_on_error(out):
         return _mutate_follow_target(args, params, campaign, out)
