@@ -37,6 +37,7 @@ from fpga_robotics.mutation.design_run import (
 from fpga_robotics.mutation.reasons import blind_spot_reason
 from fpga_robotics.mutation.report import write_report
 from fpga_robotics.mutation.robot_judge import (
+    JOURNAL_NAME,
     check_campaign,
     check_resume,
     mutants_key,
@@ -138,6 +139,18 @@ def _report_robot(out, results, robot_s, recordings, say, *, title, inputs):
             )
     path = write_report(out, results, recorded, title=title, inputs=inputs)
     print(f"report: {path}")
+
+
+def _forget_earlier_run(out, campaign):
+    """Remove what an earlier run left in ``out`` beside the new ``mutants.json``: its
+    report.html and recordings (this run writes them again only where the robot judge has a
+    run to judge by) and, without ``campaign``, its robot judge's journal."""
+    for name in ("report.html", "recordings", *((JOURNAL_NAME,) if campaign is None else ())):
+        path = os.path.join(out, name)
+        if os.path.isdir(path):
+            shutil.rmtree(path)
+        elif os.path.exists(path):
+            os.remove(path)
 
 
 def _cone_note(verdict):
@@ -423,6 +436,7 @@ def _main_design(args):
                 result = mutate_design(spec, args.mutants, args.seed, cycles, out, **judged)
     except (MutationError, BackendError, PinError) as exc:
         raise UsageError(_one_line(exc)) from None
+    _forget_earlier_run(out, campaign)
     score, modules = result["unit"], result["modules"]
     print(
         f"{score['total']} mutants of {name} (seed {args.seed}), {cycles} cycles of random "
@@ -623,6 +637,7 @@ def _mutate_follow_target(args, params, campaign, out):
         ],
     }
     write_json_atomic(os.path.join(out, "mutants.json"), results, what="mutation results")
+    _forget_earlier_run(out, campaign)
 
     print(
         f"{len(mutants)} mutants of follow_target {params.width}x{params.height} "

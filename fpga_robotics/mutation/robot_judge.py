@@ -31,6 +31,7 @@ from .forked_runs import execute_forked, outcome_of, reference_share
 from .same_verdicts import journal_rows
 
 __all__ = [
+    "JOURNAL_NAME",
     "campaign_runs_key",
     "check_campaign",
     "check_resume",
