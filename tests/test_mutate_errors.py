@@ -110,3 +110,45 @@ def test_an_unreachable_scheduler_is_refused_before_the_build(tmp_path, capsys, 
     assert exc.value.code == 2 and dialled == ["tcp://127.0.0.1:1"]
     assert "cannot reach the Dask scheduler" in capsys.readouterr().err
     assert not out.exists()
+
+
+@pytest.mark.parametrize(
+    "asks",
+    [
+        'resolution = "80x60"',
+        "set = ['camera.resolution=\"80x60\"']",
+        '[grid]\n"camera.resolution" = ["160x120", "80x60"]',
+    ],
+)
+def test_a_campaign_resolution_other_than_the_netlist_s_is_refused(tmp_path, capsys, asks):
+    # FollowTarget's netlist is built for --width x --height (160x120): its runs all take it.
+    campaign = tmp_path / "c.toml"
+    campaign.write_text(f'scenarios = ["follow_person"]\nseeds = "0"\n{asks}\n')
+    out = tmp_path / "m"
+    with pytest.raises(SystemExit) as exc:
+        run_cli(main, ["--mutants", "4", "--campaign", str(campaign), "--out", str(out)], "mutate")
+    err = capsys.readouterr().err
+    assert exc.value.code == 2 and len(err.strip().splitlines()) == 1
+    assert "the mutation campaign asks for resolution 80x60 (follow_person)" in err
+    assert "the mutant netlist is built for 160x120" in err and "--width, --height" in err
+    assert not out.exists()
+
+
+def test_a_campaign_resolution_is_the_one_its_runs_take(tmp_path):
+    from fpga_robotics.mutation.robot_judge import check_campaign, mutant_argv
+    from fpga_robotics.sweep import load_campaign_file
+
+    campaign = tmp_path / "c.toml"
+    campaign.write_text(
+        'scenarios = ["follow_person"]\nseeds = "0"\nresolution = "80x60"\n'
+        'set = ["camera.resolution=[80, 60]"]\n'
+    )
+    plan = check_campaign(load_campaign_file(str(campaign)), "80x60")  # the netlist's: kept
+    (argv,) = [spec.argv() for spec in plan.runs]
+    # FollowTarget's netlist sets the resolution; a design of one's own runs at the campaign's.
+    ft = mutant_argv(argv, "mutants.v", "ports.toml", 1, "160x120")
+    own = mutant_argv(argv, "mutants.v", "ports.toml", 1, None)
+    assert ft[ft.index("--resolution") :][:2] == ["--resolution", "160x120"]
+    assert ft.count("--resolution") == 1
+    assert own[own.index("--resolution") :][:2] == ["--resolution", "80x60"]
+    assert own.count("--resolution") == 1

@@ -61,11 +61,11 @@ from fpga_robotics.sweep.engine import check_scheduler_address, open_client
 __all__ = ["main"]
 
 
-def _campaign(name):
-    """The campaign ``name`` with every run checked (``check_campaign``): a typo fails here,
-    before anything is built or written."""
+def _campaign(name, resolution=None):
+    """The campaign ``name`` with every run checked (``check_campaign``, with the mutant
+    netlist's ``resolution``): a typo fails here, before anything is built or written."""
     campaign = load_campaign_file(name)
-    check_campaign(campaign)
+    check_campaign(campaign, resolution)
     return campaign
 
 
@@ -510,7 +510,9 @@ def main(argv=None, prog="fpga-robotics mutate"):
             "your own; FollowTarget's frame size is --width and --height)"
         )
     params = params_from_args(args)
-    campaign = _campaign(args.campaign) if args.campaign is not None else None
+    # The mutant netlist is built for this frame size: every robot judge run takes it.
+    resolution = f"{params.width}x{params.height}"
+    campaign = _campaign(args.campaign, resolution) if args.campaign is not None else None
     out = args.out or os.path.join("runs", "mutation", f"n{args.mutants}-s{args.seed}")
     check_output_dir(out, what="output folder")
     _reach_scheduler(args.scheduler)

@@ -18,9 +18,11 @@ import os
 import shlex
 import threading
 import time
+import tomllib
 
 from fpga_robotics.hw.errors import UsageError
 
+from ..scenario.load import parse_resolution
 from ..sim.files import write_atomic
 from ..sweep import runner
 from ..sweep.api import wait_for_a_worker
@@ -55,12 +57,28 @@ _LOWER = ("min_distance_min_m", "target_in_view_min_fraction", "found_min_fracti
 JOURNAL_NAME = "robot.jsonl"
 
 
-def check_campaign(campaign):
+def _asked_resolutions(spec):
+    """The camera resolutions a campaign run asks for itself, as (width, height): its
+    ``resolution`` and its ``camera.resolution`` sets (values as ``run --set`` reads them)."""
+    asked = [spec.resolution] if spec.resolution is not None else []
+    asked += [value for key, value in spec.overrides if key == "camera.resolution"]
+    for item in spec.fixed:
+        key, _, text = item.partition("=")
+        if key.strip() == "camera.resolution":
+            try:
+                asked.append(tomllib.loads(f"v = {text}")["v"])
+            except tomllib.TOMLDecodeError:
+                asked.append(text.strip())
+    return [parse_resolution(value) for value in asked]
+
+
+def check_campaign(campaign, resolution=None):
     """``campaign``'s plan (``sweep.plan.make_plan``: every run's scenario and overrides
     loaded), or ``UsageError`` for what a mutation campaign may not hold: its runs take the
     mutant netlist as their design, on Verilator, so no ``design``, ``ports`` or
-    ``design.*`` values of its own and no other backend. Call it before anything is built
-    or written."""
+    ``design.*`` values of its own and no other backend; with ``resolution`` ("WxH": the
+    frame size the netlist is built for, which every run takes) no other resolution. Call
+    it before anything is built or written."""
     runs = campaign.runs
     for key, what in (("design", "design = ..."), ("ports", "ports = ...")):
         if any(getattr(spec, key) is not None for spec in runs):
@@ -81,7 +99,18 @@ def check_campaign(campaign):
             "the mutation campaign may not override design.* values: the "
             "mutants are of one design (give its parameters to mutate instead)"
         )
-    return make_plan(campaign)
+    plan = make_plan(campaign)
+    if resolution is not None:  # read after make_plan has checked every run's values
+        built_for = parse_resolution(resolution)
+        for spec in runs:
+            other = next((r for r in _asked_resolutions(spec) if r != built_for), None)
+            if other is not None:
+                raise UsageError(
+                    f"the mutation campaign asks for resolution {other[0]}x{other[1]} "
+                    f"({spec.scenario}): the mutant netlist is built for {resolution}, which "
+                    "every run takes (give the frame size to mutate instead: --width, --height)"
+                )
+    return plan
 
 
 def start_prebuild(campaign, netlist, ports, resolution):
@@ -143,13 +172,17 @@ def check_resume(out_dir, key, campaign):
 
 def mutant_argv(argv, netlist, ports, index, resolution):
     """A campaign run's arguments with mutant ``index`` of the netlist as the design (at
-    ``resolution``, or the scenario's when None: a design without a camera)."""
+    ``resolution``; when None, a design of one's own, at the run's: the campaign's or its
+    scenario's)."""
+    replaced = ("--backend", "--design", "--ports", "--runtime")
+    if resolution is not None:
+        replaced += ("--resolution",)
     out, skip = [], False
     for a in argv:
         if skip:
             skip = False
             continue
-        if a in ("--backend", "--design", "--ports", "--runtime", "--resolution"):
+        if a in replaced:
             skip = True
             continue
         out.append(a)
