@@ -212,6 +212,8 @@ def _record_closest(out, verdicts, say):
 
 DEFAULT_MUTANTS = 100
 MAX_MUTANTS = 4000
+#: Yosys reads ``mutate -seed`` into a C int: a larger seed wraps (2**32 + 1 gives seed 1's list).
+MAX_SEED = 2**31 - 1
 
 
 def build_parser(prog="fpga-robotics mutate"):
@@ -233,7 +235,8 @@ def build_parser(prog="fpga-robotics mutate"):
         type=int,
         default=1,
         metavar="S",
-        help="Yosys's choice of mutants (default 1); the same seed, the same list",
+        help=f"Yosys's choice of mutants (default 1, at most {MAX_SEED}); the same seed, "
+        "the same list",
     )
     p.add_argument(
         "--out",
@@ -471,8 +474,8 @@ def _main_design(args):
 def _check(args):
     if not 1 <= args.mutants <= MAX_MUTANTS:
         raise UsageError(f"--mutants must be 1..{MAX_MUTANTS}, got {args.mutants}")
-    if args.seed < 0:
-        raise UsageError(f"--seed must be >= 0, got {args.seed}")
+    if not 0 <= args.seed <= MAX_SEED:
+        raise UsageError(f"--seed must be 0..{MAX_SEED}, got {args.seed}")
     if args.workers is not None and not 1 <= args.workers <= 256:
         raise UsageError(f"--workers must be 1..256, got {args.workers}")
     if args.recordings < 0:
