@@ -1,5 +1,6 @@
 """``mutate``'s failures: one line that says what is wrong, and nothing half-written."""
 
+import json
 import os
 
 import pytest
@@ -54,21 +55,39 @@ def test_a_tool_failure_names_its_error_line():
     assert _one_line(BackendError("one line\nmore")) == "one line"
 
 
+@pytest.mark.parametrize("failure", [RuntimeError, KeyboardInterrupt])
 @pytest.mark.parametrize(
     ("existed", "journal", "kept"),
     [(False, False, False), (True, False, True), (False, True, True)],
 )
-def test_a_failed_command_removes_only_the_folder_it_made(tmp_path, existed, journal, kept):
+def test_a_failed_command_removes_only_the_folder_it_made(
+    tmp_path, failure, existed, journal, kept
+):
     out = tmp_path / "m"
     if existed:
         out.mkdir()
-    with pytest.raises(RuntimeError), _removed_on_error(str(out)):
+    with pytest.raises(failure), _removed_on_error(str(out), None):
         out.mkdir(exist_ok=True)
         (out / "mutants.v").write_text("module m; endmodule\n")
         if journal:  # a verdict journaled for --resume is worth keeping
             (out / "robot.jsonl").write_text("{}\n")
-        raise RuntimeError("the build failed")
+        raise failure("the build failed")
     assert os.path.exists(out) == kept
+
+
+def test_an_interrupted_robot_judge_says_what_it_kept(tmp_path, capsys):
+    out = tmp_path / "m"
+    rows = [{"index": 2, "caught": True}, {"index": 5, "caught": False}]
+    with pytest.raises(KeyboardInterrupt), _removed_on_error(str(out), "mutation"):
+        out.mkdir()
+        text = "".join(json.dumps(row) + "\n" for row in rows)
+        (out / "robot.jsonl").write_text(text + '{"index": 7, "cau')  # the third one torn
+        raise KeyboardInterrupt
+    err = capsys.readouterr().err
+    assert err == (
+        f"interrupted: 2 robot judge verdict(s) kept in {out / 'robot.jsonl'}; "
+        "continue with --resume\n"
+    )
 
 
 @pytest.mark.parametrize(

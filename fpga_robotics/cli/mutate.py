@@ -44,6 +44,7 @@ from fpga_robotics.mutation.robot_judge import (
     robot_judge,
     start_prebuild,
 )
+from fpga_robotics.mutation.same_verdicts import journal_rows
 from fpga_robotics.mutation.scores import blind_spots, by_module, robot_score, unit_score
 from fpga_robotics.mutation.unit_judge import (
     golden_results,
@@ -366,16 +367,26 @@ def _one_line(exc):
 
 
 @contextlib.contextmanager
-def _removed_on_error(out):
-    """Nothing half-written: a folder this command made is removed again when it fails
-    before the robot judge has journaled a verdict (a journal is kept for --resume, and so
-    is a folder that was there before)."""
+def _removed_on_error(out, campaign):
+    """Nothing half-written: a folder this command made is removed again when it fails or is
+    interrupted before the robot judge has journaled a verdict (a journal is kept for
+    --resume, and so is a folder that was there before). Interrupted with verdicts in the
+    journal of a robot judge (``campaign``), say how many and how to go on."""
     existed = os.path.exists(out)
     try:
         yield
-    except Exception:
-        if not existed and not os.path.exists(os.path.join(out, "robot.jsonl")):
+    except (Exception, KeyboardInterrupt) as exc:
+        journal = os.path.join(out, JOURNAL_NAME)
+        if not existed and not os.path.exists(journal):
             shutil.rmtree(out, ignore_errors=True)
+        elif isinstance(exc, KeyboardInterrupt) and campaign is not None:
+            kept = len(journal_rows(journal)) if os.path.exists(journal) else 0
+            if kept:
+                print(
+                    f"interrupted: {kept} robot judge verdict(s) kept in {journal}; "
+                    "continue with --resume",
+                    file=sys.stderr,
+                )
         raise
 
 
@@ -430,7 +441,7 @@ def _main_design(args):
     }
     judged = {"say": say, "campaign": campaign, "robot": robot, "frame": frame}
     try:
-        with _removed_on_error(out):
+        with _removed_on_error(out, campaign):
             if verilog:
                 result = mutate_verilog_design(
                     files, args.ports, args.mutants, args.seed, cycles, out, **judged
@@ -520,7 +531,7 @@ def main(argv=None, prog="fpga-robotics mutate"):
     check_output_dir(out, what="output folder")
     _reach_scheduler(args.scheduler)
 
-    with _removed_on_error(out):
+    with _removed_on_error(out, campaign):
         return _mutate_follow_target(args, params, campaign, out)
 
 
