@@ -281,8 +281,12 @@ def test_parse_errors_name_the_key():
         "reset": {"port": "rst"},
         "outputs": {"motor_left": "l", "motor_right": "r"},
     }
+    # Wheels alone: a design without a camera and without connectors (it runs on pins).
+    pm = parse_port_map(base)
+    assert not pm.has_pixels and not pm.connectors
+    assert set(pm.outputs) == {"motor_left", "motor_right"}
     with pytest.raises(PortMapError, match="missing \\[pixels\\]"):
-        parse_port_map(base)  # neither a camera nor a connector
+        parse_port_map({k: v for k, v in base.items() if k != "outputs"})  # nothing at all
     pm = parse_port_map({**base, "connectors": {"bumper": {"pressed": "b"}}})
     assert not pm.has_pixels and pm.connector_ports() == {"b": "connectors.bumper.pressed"}
     with pytest.raises(PortMapError, match="connectors.bumper.pressed must be a Verilog port"):

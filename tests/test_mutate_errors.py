@@ -1,5 +1,6 @@
 """``mutate``'s failures: one line that says what is wrong, and nothing half-written."""
 
+import json
 import os
 
 import pytest
@@ -54,18 +55,119 @@ def test_a_tool_failure_names_its_error_line():
     assert _one_line(BackendError("one line\nmore")) == "one line"
 
 
+@pytest.mark.parametrize("failure", [RuntimeError, KeyboardInterrupt])
 @pytest.mark.parametrize(
     ("existed", "journal", "kept"),
     [(False, False, False), (True, False, True), (False, True, True)],
 )
-def test_a_failed_command_removes_only_the_folder_it_made(tmp_path, existed, journal, kept):
+def test_a_failed_command_removes_only_the_folder_it_made(
+    tmp_path, failure, existed, journal, kept
+):
     out = tmp_path / "m"
     if existed:
         out.mkdir()
-    with pytest.raises(RuntimeError), _removed_on_error(str(out)):
+    with pytest.raises(failure), _removed_on_error(str(out), None):
         out.mkdir(exist_ok=True)
         (out / "mutants.v").write_text("module m; endmodule\n")
         if journal:  # a verdict journaled for --resume is worth keeping
             (out / "robot.jsonl").write_text("{}\n")
-        raise RuntimeError("the build failed")
+        raise failure("the build failed")
     assert os.path.exists(out) == kept
+
+
+def test_an_interrupted_robot_judge_says_what_it_kept(tmp_path, capsys):
+    out = tmp_path / "m"
+    rows = [{"index": 2, "caught": True}, {"index": 5, "caught": False}]
+    with pytest.raises(KeyboardInterrupt), _removed_on_error(str(out), "mutation"):
+        out.mkdir()
+        text = "".join(json.dumps(row) + "\n" for row in rows)
+        (out / "robot.jsonl").write_text(text + '{"index": 7, "cau')  # the third one torn
+        raise KeyboardInterrupt
+    err = capsys.readouterr().err
+    assert err == (
+        f"interrupted: 2 robot judge verdict(s) kept in {out / 'robot.jsonl'}; "
+        "continue with --resume\n"
+    )
+
+
+@pytest.mark.parametrize(
+    ("more", "message"),
+    [
+        (
+            ["--scheduler", "tcp://127.0.0.1:8786", "--workers", "3"],
+            "--workers sizes the embedded cluster; with --scheduler the cluster has the workers",
+        ),
+        (["--scheduler", "foo"], "--scheduler must be a Dask scheduler address tcp://HOST:PORT"),
+    ],
+)
+def test_scheduler_options_are_refused_before_anything_runs(tmp_path, capsys, more, message):
+    # Not a slow test: a mutant build here would fail it (tests/fast_tier/slow_builds.py).
+    out = tmp_path / "m"
+    argv = ["--mutants", "4", "--campaign", "mutation", "--out", str(out), *more]
+    with pytest.raises(SystemExit) as exc:
+        run_cli(main, argv, "mutate")
+    err = capsys.readouterr().err
+    assert exc.value.code == 2 and message in err and len(err.strip().splitlines()) == 1
+    assert not out.exists()
+
+
+def test_an_unreachable_scheduler_is_refused_before_the_build(tmp_path, capsys, monkeypatch):
+    from fpga_robotics.cli import mutate
+    from fpga_robotics.hw.errors import UsageError
+
+    dialled = []
+
+    def unreachable(scheduler=None, workers=None):
+        dialled.append(scheduler)
+        raise UsageError(f"cannot reach the Dask scheduler at {scheduler!r}")
+
+    monkeypatch.setattr(mutate, "open_client", unreachable)
+    out = tmp_path / "m"
+    argv = ["--mutants", "4", "--campaign", "mutation", "--out", str(out)]
+    with pytest.raises(SystemExit) as exc:
+        run_cli(main, [*argv, "--scheduler", "tcp://127.0.0.1:1"], "mutate")
+    assert exc.value.code == 2 and dialled == ["tcp://127.0.0.1:1"]
+    assert "cannot reach the Dask scheduler" in capsys.readouterr().err
+    assert not out.exists()
+
+
+@pytest.mark.parametrize(
+    "asks",
+    [
+        'resolution = "80x60"',
+        "set = ['camera.resolution=\"80x60\"']",
+        '[grid]\n"camera.resolution" = ["160x120", "80x60"]',
+    ],
+)
+def test_a_campaign_resolution_other_than_the_netlist_s_is_refused(tmp_path, capsys, asks):
+    # FollowTarget's netlist is built for --width x --height (160x120): its runs all take it.
+    campaign = tmp_path / "c.toml"
+    campaign.write_text(f'scenarios = ["follow_person"]\nseeds = "0"\n{asks}\n')
+    out = tmp_path / "m"
+    with pytest.raises(SystemExit) as exc:
+        run_cli(main, ["--mutants", "4", "--campaign", str(campaign), "--out", str(out)], "mutate")
+    err = capsys.readouterr().err
+    assert exc.value.code == 2 and len(err.strip().splitlines()) == 1
+    assert "the mutation campaign asks for resolution 80x60 (follow_person)" in err
+    assert "the mutant netlist is built for 160x120" in err and "--width, --height" in err
+    assert not out.exists()
+
+
+def test_a_campaign_resolution_is_the_one_its_runs_take(tmp_path):
+    from fpga_robotics.mutation.robot_judge import check_campaign, mutant_argv
+    from fpga_robotics.sweep import load_campaign_file
+
+    campaign = tmp_path / "c.toml"
+    campaign.write_text(
+        'scenarios = ["follow_person"]\nseeds = "0"\nresolution = "80x60"\n'
+        'set = ["camera.resolution=[80, 60]"]\n'
+    )
+    plan = check_campaign(load_campaign_file(str(campaign)), "80x60")  # the netlist's: kept
+    (argv,) = [spec.argv() for spec in plan.runs]
+    # FollowTarget's netlist sets the resolution; a design of one's own runs at the campaign's.
+    ft = mutant_argv(argv, "mutants.v", "ports.toml", 1, "160x120")
+    own = mutant_argv(argv, "mutants.v", "ports.toml", 1, None)
+    assert ft[ft.index("--resolution") :][:2] == ["--resolution", "160x120"]
+    assert ft.count("--resolution") == 1
+    assert own[own.index("--resolution") :][:2] == ["--resolution", "80x60"]
+    assert own.count("--resolution") == 1

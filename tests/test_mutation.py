@@ -224,7 +224,9 @@ def test_bad_arguments_are_one_line_errors(tmp_path, monkeypatch):
 
     for argv, message in (
         (["--mutants", "0"], "--mutants must be 1..4000, got 0"),
-        (["--seed", "-1"], "--seed must be >= 0"),
+        (["--seed", "-1"], "--seed must be 0..2147483647, got -1"),
+        # Yosys reads the seed into a C int: 2**32 + 1 would give seed 1's mutants.
+        (["--seed", "4294967297"], "--seed must be 0..2147483647, got 4294967297"),
         (["--width", "33"], "bad design parameter"),
     ):
         r = run(*argv, "--out", str(tmp_path / "o"))

@@ -278,6 +278,25 @@ def test_follow_target_against_itself_scores_as_against_the_model(tmp_path, caps
     assert runs["model"]["unit"] == runs["design"]["unit"]
 
 
+@pytest.mark.slow  # a Verilator build of the mutant netlist
+def test_a_design_with_only_wheels_is_mutated(tmp_path, capsys):
+    # Toggler has neither a camera nor a connector: its mutant netlist's port map binds the
+    # wheels alone. It drives 200 and 400 DPS in turn, so a wheel bit's mutant is caught
+    # exactly when it changes the bit in one of them (an inverted bit always does).
+    out = tmp_path / "m"
+    argv = ["mutate", "--design", f"{DESIGNS}/toggler.py:Toggler", "--mutants", "6"]
+    code, _, err = _cli([*argv, "--cycles", "200", "--out", str(out), "--quiet"], capsys)
+    assert code == 0, err
+    result = json.loads((out / "mutants.json").read_text())
+    assert result["unit"]["total"] == 6
+    on_wheels = [m for m in result["mutants"] if m["signal"] in ("motor_left", "motor_right")]
+    assert on_wheels
+    for m in on_wheels:
+        bits = [(value >> m["bit"]) & 1 for value in (200, 400)]
+        expected = {"inv": True, "const0": 1 in bits, "const1": 0 in bits}[m["mode"]]
+        assert m["unit"]["caught"] == expected, m["describe"]
+
+
 def bump_stop_trace(stimulus, cycles):
     """tests/data/bump_stop.v by hand: ``hit`` latches at the first edge ``bump_i`` is 1; the
     wheels run at 300 DPS until then, 0 after (``{output: [(cycle, value), ...]}``)."""

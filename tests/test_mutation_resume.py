@@ -1,7 +1,7 @@
 """``mutate --resume``: the robot judge keeps the verdicts already in its journal, but only of
 the very same mutants judged by the very same campaign runs; a journal of other mutants
 (another seed) or of other runs (the campaign's duration edited) is refused before anything
-in the output folder is touched."""
+in the output folder is touched; and only of the mutants the unit judge catches this time."""
 
 import json
 
@@ -60,6 +60,18 @@ def test_resume_keeps_only_verdicts_of_the_same_mutants(tmp_path, capsys):
     assert code == 2 and err.count("\n") == 1
     assert "holds verdicts judged by other runs than campaign bump's" in err
     assert {p.name: p.read_bytes() for p in out.iterdir()} == before
+    # Resumed on 3 unit cycles, the unit judge catches fewer of them: only those have robot
+    # verdicts, in the scores, the lists and the journal alike.
+    code, err = _mutate(out, 1, capsys, "--resume", "--cycles", "3")
+    assert code == 0, err
+    result = json.loads((out / "mutants.json").read_text())
+    unit_caught = {m["index"] for m in result["mutants"] if m["unit"]["caught"]}
+    assert unit_caught < set(first)
+    assert {m["index"] for m in result["mutants"] if m["robot"]} == unit_caught
+    assert result["robot"]["judged"] == len(unit_caught)
+    assert {k: {f: r[f] for f in SAME} for k, r in _rows(out).items()} == {
+        k: {f: r[f] for f in SAME} for k, r in first.items() if k in unit_caught
+    }
 
 
 def test_a_torn_last_line_of_the_journal_is_not_a_verdict(tmp_path):

@@ -37,12 +37,14 @@ from fpga_robotics.mutation.design_run import (
 from fpga_robotics.mutation.reasons import blind_spot_reason
 from fpga_robotics.mutation.report import write_report
 from fpga_robotics.mutation.robot_judge import (
+    JOURNAL_NAME,
     check_campaign,
     check_resume,
     mutants_key,
     robot_judge,
     start_prebuild,
 )
+from fpga_robotics.mutation.same_verdicts import journal_rows
 from fpga_robotics.mutation.scores import blind_spots, by_module, robot_score, unit_score
 from fpga_robotics.mutation.unit_judge import (
     golden_results,
@@ -55,15 +57,16 @@ from fpga_robotics.sim.files import check_output_dir, write_atomic, write_json_a
 from fpga_robotics.sim.mutation import MutationError, list_mutants, mutant_cones
 from fpga_robotics.sim.pins import PinError
 from fpga_robotics.sweep import load_campaign_file, runner
+from fpga_robotics.sweep.engine import check_scheduler_address, open_client
 
 __all__ = ["main"]
 
 
-def _campaign(name):
-    """The campaign ``name`` with every run checked (``check_campaign``): a typo fails here,
-    before anything is built or written."""
+def _campaign(name, resolution=None):
+    """The campaign ``name`` with every run checked (``check_campaign``, with the mutant
+    netlist's ``resolution``): a typo fails here, before anything is built or written."""
     campaign = load_campaign_file(name)
-    check_campaign(campaign)
+    check_campaign(campaign, resolution)
     return campaign
 
 
@@ -139,6 +142,18 @@ def _report_robot(out, results, robot_s, recordings, say, *, title, inputs):
     print(f"report: {path}")
 
 
+def _forget_earlier_run(out, campaign):
+    """Remove what an earlier run left in ``out`` beside the new ``mutants.json``: its
+    report.html and recordings (this run writes them again only where the robot judge has a
+    run to judge by) and, without ``campaign``, its robot judge's journal."""
+    for name in ("report.html", "recordings", *((JOURNAL_NAME,) if campaign is None else ())):
+        path = os.path.join(out, name)
+        if os.path.isdir(path):
+            shutil.rmtree(path)
+        elif os.path.exists(path):
+            os.remove(path)
+
+
 def _cone_note(verdict):
     """One line on a verdict given by the mutant's fan-out cone."""
     reached = verdict.get("cone_outputs") or ["no output"]
@@ -198,6 +213,8 @@ def _record_closest(out, verdicts, say):
 
 DEFAULT_MUTANTS = 100
 MAX_MUTANTS = 4000
+#: Yosys reads ``mutate -seed`` into a C int: a larger seed wraps (2**32 + 1 gives seed 1's list).
+MAX_SEED = 2**31 - 1
 
 
 def build_parser(prog="fpga-robotics mutate"):
@@ -219,7 +236,8 @@ def build_parser(prog="fpga-robotics mutate"):
         type=int,
         default=1,
         metavar="S",
-        help="Yosys's choice of mutants (default 1); the same seed, the same list",
+        help=f"Yosys's choice of mutants (default 1, at most {MAX_SEED}); the same seed, "
+        "the same list",
     )
     p.add_argument(
         "--out",
@@ -349,17 +367,36 @@ def _one_line(exc):
 
 
 @contextlib.contextmanager
-def _removed_on_error(out):
-    """Nothing half-written: a folder this command made is removed again when it fails
-    before the robot judge has journaled a verdict (a journal is kept for --resume, and so
-    is a folder that was there before)."""
+def _removed_on_error(out, campaign):
+    """Nothing half-written: a folder this command made is removed again when it fails or is
+    interrupted before the robot judge has journaled a verdict (a journal is kept for
+    --resume, and so is a folder that was there before). Interrupted with verdicts in the
+    journal of a robot judge (``campaign``), say how many and how to go on."""
     existed = os.path.exists(out)
     try:
         yield
-    except Exception:
-        if not existed and not os.path.exists(os.path.join(out, "robot.jsonl")):
+    except (Exception, KeyboardInterrupt) as exc:
+        journal = os.path.join(out, JOURNAL_NAME)
+        if not existed and not os.path.exists(journal):
             shutil.rmtree(out, ignore_errors=True)
+        elif isinstance(exc, KeyboardInterrupt) and campaign is not None:
+            kept = len(journal_rows(journal)) if os.path.exists(journal) else 0
+            if kept:
+                print(
+                    f"interrupted: {kept} robot judge verdict(s) kept in {journal}; "
+                    "continue with --resume",
+                    file=sys.stderr,
+                )
         raise
+
+
+def _reach_scheduler(address):
+    """With ``--scheduler``, connect to it once before anything is built: one that cannot be
+    reached is refused in seconds, not after the build and the unit judge (its workers may
+    still join while they run)."""
+    if address is not None:
+        with open_client(scheduler=address):
+            pass
 
 
 def _main_design(args):
@@ -390,6 +427,7 @@ def _main_design(args):
     campaign = _campaign(args.campaign) if args.campaign is not None else None
     out = args.out or os.path.join("runs", "mutation", f"{name}-n{args.mutants}-s{args.seed}")
     check_output_dir(out, what="output folder")
+    _reach_scheduler(args.scheduler)
 
     def say(text):
         if not args.quiet:
@@ -403,7 +441,7 @@ def _main_design(args):
     }
     judged = {"say": say, "campaign": campaign, "robot": robot, "frame": frame}
     try:
-        with _removed_on_error(out):
+        with _removed_on_error(out, campaign):
             if verilog:
                 result = mutate_verilog_design(
                     files, args.ports, args.mutants, args.seed, cycles, out, **judged
@@ -412,6 +450,7 @@ def _main_design(args):
                 result = mutate_design(spec, args.mutants, args.seed, cycles, out, **judged)
     except (MutationError, BackendError, PinError) as exc:
         raise UsageError(_one_line(exc)) from None
+    _forget_earlier_run(out, campaign)
     score, modules = result["unit"], result["modules"]
     print(
         f"{score['total']} mutants of {name} (seed {args.seed}), {cycles} cycles of random "
@@ -446,8 +485,8 @@ def _main_design(args):
 def _check(args):
     if not 1 <= args.mutants <= MAX_MUTANTS:
         raise UsageError(f"--mutants must be 1..{MAX_MUTANTS}, got {args.mutants}")
-    if args.seed < 0:
-        raise UsageError(f"--seed must be >= 0, got {args.seed}")
+    if not 0 <= args.seed <= MAX_SEED:
+        raise UsageError(f"--seed must be 0..{MAX_SEED}, got {args.seed}")
     if args.workers is not None and not 1 <= args.workers <= 256:
         raise UsageError(f"--workers must be 1..256, got {args.workers}")
     if args.recordings < 0:
@@ -459,6 +498,13 @@ def _check(args):
             "--workers, --scheduler, --resume and --fork/--no-fork go with --campaign "
             "(the robot judge)"
         )
+    if args.workers is not None and args.scheduler is not None:
+        raise UsageError(
+            "--workers sizes the embedded cluster; with --scheduler the cluster "
+            "has the workers you started (`dask worker ADDRESS`)"
+        )
+    if args.scheduler is not None:
+        check_scheduler_address(args.scheduler)
     args.fork = True if args.fork is None else args.fork
 
 
@@ -478,11 +524,14 @@ def main(argv=None, prog="fpga-robotics mutate"):
             "your own; FollowTarget's frame size is --width and --height)"
         )
     params = params_from_args(args)
-    campaign = _campaign(args.campaign) if args.campaign is not None else None
+    # The mutant netlist is built for this frame size: every robot judge run takes it.
+    resolution = f"{params.width}x{params.height}"
+    campaign = _campaign(args.campaign, resolution) if args.campaign is not None else None
     out = args.out or os.path.join("runs", "mutation", f"n{args.mutants}-s{args.seed}")
     check_output_dir(out, what="output folder")
+    _reach_scheduler(args.scheduler)
 
-    with _removed_on_error(out):
+    with _removed_on_error(out, campaign):
         return _mutate_follow_target(args, params, campaign, out)
 
 
@@ -604,6 +653,7 @@ def _mutate_follow_target(args, params, campaign, out):
         ],
     }
     write_json_atomic(os.path.join(out, "mutants.json"), results, what="mutation results")
+    _forget_earlier_run(out, campaign)
 
     print(
         f"{len(mutants)} mutants of follow_target {params.width}x{params.height} "

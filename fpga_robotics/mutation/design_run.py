@@ -106,6 +106,7 @@ def mutate_design(
     for path, watch in ((port_map, False), (watch_map, True)):
         text = design_mutant_port_map(spec, ports, reset=reset, watch=watch)
         write_atomic(path, text, what="port map")
+    mapped = load_port_map(port_map)  # read before the build: a map it refuses stops here
     prebuilt = _prebuild(campaign, robot, netlist, watch_map)
     backend = open_pin_mutants(source, on_build=lambda t: say(f"{t} ..."))
     build_s = time.perf_counter() - t0
@@ -115,6 +116,7 @@ def mutate_design(
         ports,
         mutants,
         (netlist, port_map, watch_map),
+        mapped,
         build_s,
         seed,
         cycles,
@@ -171,10 +173,8 @@ def mutate_verilog_design(
         write_atomic(watch_map, watched, what="port map")
     prebuilt = _prebuild(campaign, robot, netlist, watch_map)
     # The pixel ports driven as any input, each edge at random (as an Amaranth design's).
-    source = VerilogPinSource(
-        ForeignDesign([netlist], port_map, pins=True, connector_kinds=connector_kinds()),
-        stream=False,
-    )
+    mutant_design = ForeignDesign([netlist], port_map, pins=True, connector_kinds=connector_kinds())
+    source = VerilogPinSource(mutant_design, stream=False)
     backend = VerilatorPins(source, on_build=lambda t: say(f"{t} ..."))
     build_s = time.perf_counter() - t0
     driven = {p: port for p, port in backend.ports.items() if p not in source.runtime}
@@ -185,6 +185,7 @@ def mutate_verilog_design(
         driven,
         mutants,
         (netlist, port_map, watch_map),
+        mutant_design.port_map,
         build_s,
         seed,
         cycles,
@@ -223,6 +224,7 @@ def _judge(
     ports,
     mutants,
     files,
+    mapped,
     build_s,
     seed,
     cycles,
@@ -239,7 +241,8 @@ def _judge(
 ):
     """The unit judge of ``mutants`` on ``backend`` (closed here), then the robot judge with
     ``campaign`` (forked: first the fan-out cones of the caught mutants, ``cones_of``);
-    writes and returns ``mutants.json``'s content."""
+    writes and returns ``mutants.json``'s content. ``files``: the paths of the netlist and
+    its port maps; ``mapped``: the first, parsed (``PortMap``)."""
     netlist, port_map, watch_map = files
     outputs = [p for p, port in ports.items() if port.direction == "out"]
     framed = streams_frames(ports, stream)
@@ -286,7 +289,6 @@ def _judge(
         robot_s = time.perf_counter() - t2
     caught_by_robot = {k: v["caught"] for k, v in robot_verdicts.items()}
     blind = set(blind_spots(unit, caught_by_robot))
-    mapped = load_port_map(port_map)
     filtered, recorded = mapped.filtered_payload, set(mapped.extra_outputs.values())
     result = {
         "design": design,

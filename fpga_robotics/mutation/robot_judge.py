@@ -18,9 +18,11 @@ import os
 import shlex
 import threading
 import time
+import tomllib
 
 from fpga_robotics.hw.errors import UsageError
 
+from ..scenario.load import parse_resolution
 from ..sim.files import write_atomic
 from ..sweep import runner
 from ..sweep.api import wait_for_a_worker
@@ -31,6 +33,7 @@ from .forked_runs import execute_forked, outcome_of, reference_share
 from .same_verdicts import journal_rows
 
 __all__ = [
+    "JOURNAL_NAME",
     "campaign_runs_key",
     "check_campaign",
     "check_resume",
@@ -54,12 +57,28 @@ _LOWER = ("min_distance_min_m", "target_in_view_min_fraction", "found_min_fracti
 JOURNAL_NAME = "robot.jsonl"
 
 
-def check_campaign(campaign):
+def _asked_resolutions(spec):
+    """The camera resolutions a campaign run asks for itself, as (width, height): its
+    ``resolution`` and its ``camera.resolution`` sets (values as ``run --set`` reads them)."""
+    asked = [spec.resolution] if spec.resolution is not None else []
+    asked += [value for key, value in spec.overrides if key == "camera.resolution"]
+    for item in spec.fixed:
+        key, _, text = item.partition("=")
+        if key.strip() == "camera.resolution":
+            try:
+                asked.append(tomllib.loads(f"v = {text}")["v"])
+            except tomllib.TOMLDecodeError:
+                asked.append(text.strip())
+    return [parse_resolution(value) for value in asked]
+
+
+def check_campaign(campaign, resolution=None):
     """``campaign``'s plan (``sweep.plan.make_plan``: every run's scenario and overrides
     loaded), or ``UsageError`` for what a mutation campaign may not hold: its runs take the
     mutant netlist as their design, on Verilator, so no ``design``, ``ports`` or
-    ``design.*`` values of its own and no other backend. Call it before anything is built
-    or written."""
+    ``design.*`` values of its own and no other backend; with ``resolution`` ("WxH": the
+    frame size the netlist is built for, which every run takes) no other resolution. Call
+    it before anything is built or written."""
     runs = campaign.runs
     for key, what in (("design", "design = ..."), ("ports", "ports = ...")):
         if any(getattr(spec, key) is not None for spec in runs):
@@ -80,7 +99,18 @@ def check_campaign(campaign):
             "the mutation campaign may not override design.* values: the "
             "mutants are of one design (give its parameters to mutate instead)"
         )
-    return make_plan(campaign)
+    plan = make_plan(campaign)
+    if resolution is not None:  # read after make_plan has checked every run's values
+        built_for = parse_resolution(resolution)
+        for spec in runs:
+            other = next((r for r in _asked_resolutions(spec) if r != built_for), None)
+            if other is not None:
+                raise UsageError(
+                    f"the mutation campaign asks for resolution {other[0]}x{other[1]} "
+                    f"({spec.scenario}): the mutant netlist is built for {resolution}, which "
+                    "every run takes (give the frame size to mutate instead: --width, --height)"
+                )
+    return plan
 
 
 def start_prebuild(campaign, netlist, ports, resolution):
@@ -142,13 +172,17 @@ def check_resume(out_dir, key, campaign):
 
 def mutant_argv(argv, netlist, ports, index, resolution):
     """A campaign run's arguments with mutant ``index`` of the netlist as the design (at
-    ``resolution``, or the scenario's when None: a design without a camera)."""
+    ``resolution``; when None, a design of one's own, at the run's: the campaign's or its
+    scenario's)."""
+    replaced = ("--backend", "--design", "--ports", "--runtime")
+    if resolution is not None:
+        replaced += ("--resolution",)
     out, skip = [], False
     for a in argv:
         if skip:
             skip = False
             continue
-        if a in ("--backend", "--design", "--ports", "--runtime", "--resolution"):
+        if a in replaced:
             skip = True
             continue
         out.append(a)
@@ -338,8 +372,9 @@ def robot_judge(
     watch output watched (``design.write_mutant_design``); with ``fork`` the unmutated runs
     use it, and a mutant that never acted in one of them is given it without a run.
     ``mutants``: their ``mutants_key``, in every journal row with the ``campaign_runs_key``
-    (``resume`` keeps only rows of the same mutants and runs; ``check_resume`` refuses others
-    before anything is written). ``prebuilt``: the ``start_prebuild`` thread to wait for
+    (``resume`` keeps only rows of the same mutants and runs, and of ``indices``: the journal
+    is written again with those alone; ``check_resume`` refuses others before anything is
+    written). ``prebuilt``: the ``start_prebuild`` thread to wait for
     before the runs."""
     from distributed import as_completed  # lazy: Dask costs ~1 s; only a run needs it
 
@@ -353,8 +388,12 @@ def robot_judge(
     journal = os.path.join(out_dir, JOURNAL_NAME)
     verdicts = {}
     if resume and os.path.exists(journal):
+        # Only the mutants judged now: one the unit judge no longer catches (other --cycles,
+        # --against, ...) has no robot verdict in this run's scores.
+        wanted = set(indices)
         for row in journal_rows(journal):
-            if (row.get("mutants"), row.get("campaign_runs")) == (mutants, runs_key):
+            same = (row.get("mutants"), row.get("campaign_runs")) == (mutants, runs_key)
+            if same and int(row["index"]) in wanted:
                 verdicts[int(row["index"])] = row
         # Written again whole: a torn last line would swallow the first row appended to it.
         write_atomic(

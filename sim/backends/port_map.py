@@ -9,8 +9,8 @@ new-frame pulse the cycle after the frame's last pixel).
 ``[connectors.<kind>]`` tables bind the pins of sensor and actuator connectors (an
 ultrasound's ``trig``/``echo``, a bumper's ``pressed``) to ports of the design: such a design
 runs in real-clock timing on the Verilator pin backend; ``check_connectors`` checks the
-bindings against the connector kinds the application knows. A map with connectors may leave
-out the pixel stream (a design without a camera).
+bindings against the connector kinds the application knows. A map may leave out the pixel
+stream (a design without a camera: connectors, wheels or ``[extra_outputs]`` only).
 """
 
 import tomllib
@@ -391,8 +391,9 @@ def parse_port_map(data):
     if k.reset is not None and k.reset.port is None:
         raise _error("missing reset.port (a port name)")
 
-    # A design without a camera (only connectors and wheels) has no pixel stream.
-    if k.pixels is None and not connectors:
+    # A design without a camera (connectors, wheels or recorded outputs only) has no pixel
+    # stream; a map with none of these names nothing the design does.
+    if k.pixels is None and not connectors and k.outputs is None and not k.extra_outputs:
         raise _error("missing [pixels]")
     address = new_frame = payload = first = last = valid = data_port = None
     if not k.pixels:
