@@ -37,6 +37,7 @@ from .mutant_watch import WATCH_PORT, add_watch
 from .processes import run_captured
 
 __all__ = [
+    "MAX_MUTANT_SEED",
     "MUTATION_SELECT",
     "WATCH_PORT",
     "Mutant",
@@ -52,6 +53,8 @@ __all__ = [
 
 #: The input of the mutant netlist that selects the mutant (0: none).
 MUTATION_SELECT = "mutsel"
+#: Yosys reads ``mutate -seed`` into a C int: a larger seed wraps (2**32 + 1 gives seed 1's list).
+MAX_MUTANT_SEED = 2**31 - 1
 
 _PREPARE = ("hierarchy -top {top}", "proc", "flatten", "opt_clean")
 _HW_DIR = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))  # the package root

@@ -35,6 +35,8 @@ def test_replay_feeds_every_recorded_frame_after_a_reset_each_time():
         (["--mutants", "0"], "--mutants must be in 1..1000"),
         (["--duration", "0"], "--duration must be in"),
         (["--resolution", "12"], "--resolution: resolution must look like WIDTHxHEIGHT"),
+        # Yosys reads the seed into a C int: 2**32 + 1 would give seed 1's mutants.
+        (["--seed", str(2**32 + 1)], "--seed must be 0..2147483647"),
     ],
 )
 def test_bad_arguments_are_usage_errors(argv, message):

@@ -25,7 +25,7 @@ from fpga_robotics.mutation.design import (
     write_mutant_design,
 )
 from fpga_robotics.scenario.load import ScenarioError, load_scenario, parse_resolution
-from fpga_robotics.sim.mutation import list_mutants
+from fpga_robotics.sim.mutation import MAX_MUTANT_SEED, list_mutants
 
 __all__ = ["main", "replay_ms"]
 
@@ -57,8 +57,8 @@ def _check(args):
         raise UsageError(f"--duration must be in (0, 600] s, got {args.duration}")
     if not 1 <= args.mutants <= 1000:
         raise UsageError(f"--mutants must be in 1..1000, got {args.mutants}")
-    if args.seed < 0:
-        raise UsageError(f"--seed must be >= 0, got {args.seed}")
+    if not 0 <= args.seed <= MAX_MUTANT_SEED:
+        raise UsageError(f"--seed must be 0..{MAX_MUTANT_SEED}, got {args.seed}")
     try:
         parse_resolution(args.resolution)
     except ScenarioError as exc:

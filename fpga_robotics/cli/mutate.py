@@ -54,7 +54,7 @@ from fpga_robotics.mutation.unit_judge import (
 )
 from fpga_robotics.sim.backends.base import BackendError
 from fpga_robotics.sim.files import check_output_dir, write_atomic, write_json_atomic
-from fpga_robotics.sim.mutation import MutationError, list_mutants, mutant_cones
+from fpga_robotics.sim.mutation import MAX_MUTANT_SEED, MutationError, list_mutants, mutant_cones
 from fpga_robotics.sim.pins import PinError
 from fpga_robotics.sweep import load_campaign_file, runner
 from fpga_robotics.sweep.engine import check_scheduler_address, open_client
@@ -213,8 +213,7 @@ def _record_closest(out, verdicts, say):
 
 DEFAULT_MUTANTS = 100
 MAX_MUTANTS = 4000
-#: Yosys reads ``mutate -seed`` into a C int: a larger seed wraps (2**32 + 1 gives seed 1's list).
-MAX_SEED = 2**31 - 1
+MAX_SEED = MAX_MUTANT_SEED
 
 
 def build_parser(prog="fpga-robotics mutate"):
