@@ -272,9 +272,9 @@ def test_failures_keep_their_reasons_apart_from_na():
     )
     c = _one("reacquired_within_s", 4.0, m)
     assert c["status"] == "fail" and "ended before it found the target again" in c["text"]
-    # The furniture left but the robot never closed in: a failure.
+    # The furniture left but the robot never drove towards the target: a failure.
     c = _one("resumes_within_s", 3.0, {**JUDGEABLE, "resumed_after_s": None})
-    assert c["status"] == "fail" and "never closed 0.2 m" in c["text"]
+    assert c["status"] == "fail" and "never drove 0.2 m towards the target" in c["text"]
     # A silent sensor fails min_measured_frames, naming it.
     silent = {
         **JUDGEABLE,
