@@ -185,15 +185,16 @@ def _row_span(z0, z1, near, far, geom, params):
     ``t``), which rises to one maximum at ``p = sqrt(z0' z1') |tan t|`` when both edges lie
     on the same side of the camera. The least and most lie at those depths or the ends."""
     h, t = geom.mount_height, geom.tilt
-    depths = [near, far]
+    inside = []
     for z in (z0, z1):
         for edge in (params.margin_y, geom.height - params.margin_y):
             angle = math.atan((geom.height / 2 - edge) / geom.focal) + t
             if 0 < (z - h) * angle and abs(angle) < math.pi / 2:
-                depths.append((z - h) / math.tan(angle))
+                inside.append((z - h) / math.tan(angle))
     if (z0 - h) * (z1 - h) > 0:
-        depths.append(math.sqrt((z0 - h) * (z1 - h)) * abs(math.tan(t)))
-    spans = [_rows(z0, z1, p, geom, params) for p in depths if near <= p <= far]
+        inside.append(math.sqrt((z0 - h) * (z1 - h)) * abs(math.tan(t)))
+    depths = [near, far] + [p for p in inside if near < p < far]
+    spans = [_rows(z0, z1, p, geom, params) for p in depths]
     return min(spans), max(spans)
 
 
