@@ -37,27 +37,27 @@ DEFAULT = FollowTargetParams()
 
 
 def test_count_bounds_at_4_m_by_hand():
-    # Half-width f tan(asin(0.2 / 4)) = 8.01 px: 16.02 columns. The visible side's depths run
-    # from 3.8 m (its middle) to 4 - 0.2**2 / 4 = 3.99 m (the silhouette's edges). Rows at
-    # 3.99 m: 60 -+ 160 * 0.5 / 3.99 (40.1 rows); at 3.8 m 38.95..81.05 (42.1 rows); window
-    # rows 8..112. lo = (16.02 - 2) * (40.1 - 2) = 534.2, hi = (16.02 + 2) * (42.1 + 2) = 794.8.
-    assert count_bounds(4.0, 0.0, RED, GEOM, DEFAULT) == (534, 795)
+    # Half-width f tan(asin(0.2 / 4)) = 8.01 px: 16.02 columns. The body's depths lie between
+    # its nearest point (3.8 m) and its axis (4 m). Rows at 4 m: 60 -+ 160 * 0.5 / 4 = 40..80
+    # (40 rows); at 3.8 m 38.95..81.05 (42.1 rows); window rows 8..112.
+    # lo = (16.02 - 2) * (40 - 2) = 532.8, hi = (16.02 + 2) * (42.1 + 2) = 794.7.
+    assert count_bounds(4.0, 0.0, RED, GEOM, DEFAULT) == (532, 795)
     assert count_bounds(4.0, 0.0, 0b010, GEOM, DEFAULT) == (0, 0)  # no green band
     # The silhouette leaves the window (columns 16..144) past a bearing of ~0.4 rad.
     assert count_bounds(4.0, 0.45, RED, GEOM, DEFAULT) is None
 
 
 def test_count_bounds_of_a_band_cut_by_the_window_top_by_hand():
-    # A band from 1 to 2 m (0.5..1.5 m above the camera) 2.2 m away: depths 2.0 (middle) to
-    # 2.2 - 0.04 / 2.2 = 2.1818 m (edges). Its top row 60 - 160 * 1.5 / p is above the
-    # window's top row 8 at both; its bottom row 60 - 80 / p is 20 at 2.0 m and 23.33 at
-    # 2.18 m: the edges' columns hold more rows (15.33) than the middle (12). Columns
+    # A band from 1 to 2 m (0.5..1.5 m above the camera) 2.2 m away: depths from 2.0 m (the
+    # nearest point) to 2.2 m (the axis). Its top row 60 - 160 * 1.5 / p is above the window's
+    # top row 8 at both; its bottom row 60 - 80 / p is 20 at 2.0 m and 23.64 at 2.2 m: the
+    # farther a column's depth the more rows it holds (12 at 2.0 m, 15.64 at 2.2 m). Columns
     # 320 tan(asin(0.2 / 2.2)) = 29.21. lo = (29.21 - 2) * (12 - 2) = 272.1,
-    # hi = (29.21 + 2) * (15.33 + 2) = 541.0.
+    # hi = (29.21 + 2) * (15.64 + 2) = 550.5.
     geom = dataclasses.replace(
         GEOM, bands_sure={RED: [(1.0, 2.0)]}, bands_maybe={RED: [(1.0, 2.0)]}
     )
-    assert count_bounds(2.2, 0.0, RED, geom, DEFAULT) == (272, 542)
+    assert count_bounds(2.2, 0.0, RED, geom, DEFAULT) == (272, 551)
 
 
 @pytest.mark.parametrize("tilt", [-0.35, 0.0, 0.3])
@@ -193,11 +193,9 @@ def test_search_law_default_and_changed_search():
 
 
 def _lo(d):
-    """The lower count bound straight ahead, from the geometry by hand (rows unclipped, at the
-    silhouette's edges, the visible side's farthest depth d - 0.2**2 / d)."""
+    """The lower count bound straight ahead, from the geometry by hand (rows unclipped)."""
     cols = 2 * 160 * math.tan(math.asin(0.2 / d))
-    far = d - 0.04 / d
-    return (cols - 2) * (160 * 0.5 / far + 160 * 0.5 / far - 2)
+    return (cols - 2) * (160 * 0.5 / d + 160 * 0.5 / d - 2)
 
 
 def _solve(f, threshold, a=0.5, b=20.0):

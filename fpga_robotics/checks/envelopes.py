@@ -12,10 +12,10 @@ those bands. Stated tolerances (nothing tuned to a run):
 
 - count: the silhouette's width and each band's rows +-1 pixel (edge quantisation), the rows
   inside the window the fewest (lower bound) and the most (upper bound) the band covers at
-  any depth of the body's visible side (a band cut by the window's top or bottom row covers
-  more rows further away); a band counts towards the lower bound only if its colour matches
-  in the darkest light of the scenario (ambient alone) and in its brightest, towards the upper
-  one if in either;
+  any depth from the body's point nearest the camera to its axis (a band cut by the window's
+  top or bottom row covers more rows further away); a band counts towards the lower bound
+  only if its colour matches in the darkest light of the scenario (ambient alone) and in its
+  brightest, towards the upper one if in either;
 - centroid error ``e``: +-2 pixels (the centroid's floor and the half-pixel of the column),
   plus a quarter of the silhouette's width when a band that may count does not match in
   ambient light alone (its shaded side then drops out and the centroid moves to the lit side);
@@ -163,15 +163,12 @@ def _rows(z0, z1, depth, geom, params):
 
 
 def _depths(distance, bearing, radius):
-    """``(near, far)``: the least and greatest depth (m along the camera's axis, the depth the
-    renderer draws a column's rows at) of the visible side of an upright cylinder of
-    ``radius`` whose axis stands ``distance`` from the camera at ``bearing`` (rad): the point
-    of it nearest the camera's plane, and the tangent point of the silhouette's edge nearer
-    the optical axis."""
-    a = math.asin(radius / distance)
-    near = distance * math.cos(bearing) - radius
-    far = math.sqrt(distance**2 - radius**2) * math.cos(abs(bearing) - a)
-    return near, far
+    """``(near, far)``: depths (m along the camera's axis, the depth the renderer draws a
+    column's rows at) between which every visible point of an upright cylinder of ``radius``
+    lies, its axis ``distance`` from the camera at ``bearing`` (rad): the point of it nearest
+    the camera's plane, and the axis's distance, beyond the silhouette's edges (at most
+    ``sqrt(distance**2 - radius**2)``)."""
+    return distance * math.cos(bearing) - radius, distance
 
 
 def _row_span(z0, z1, near, far, geom, params):
@@ -215,7 +212,7 @@ def count_bounds(distance, bearing, code, geom, params):
     cols = right - left
     near, far = _depths(distance, bearing, geom.radius)
     # Every column shows each band at its own depth: the count lies between the columns
-    # times the fewest rows a band covers at any of those depths and times the most.
+    # times the fewest rows a band covers at any depth from near to far and times the most.
     lo = hi = 0.0
     for z0, z1 in geom.bands_sure[code]:
         lo += max(0.0, cols - 2) * max(0.0, _row_span(z0, z1, near, far, geom, params)[0] - 2)
