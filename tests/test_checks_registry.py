@@ -282,9 +282,9 @@ def test_failures_keep_their_reasons_apart_from_na():
     assert c["status"] == "fail" and c["text"] == (
         "target lost and not found again for 0.50 s (limit 0.4 s)"
     )
-    # The furniture left but the robot never closed in: a failure.
+    # The furniture left but the robot never drove towards the target: a failure.
     c = _one("resumes_within_s", 3.0, {**JUDGEABLE, "resumed_after_s": None})
-    assert c["status"] == "fail" and "never closed 0.2 m" in c["text"]
+    assert c["status"] == "fail" and "never drove 0.2 m towards the target" in c["text"]
     # A silent sensor fails min_measured_frames, naming it.
     silent = {
         **JUDGEABLE,

@@ -2,6 +2,7 @@
 camera's geometry and the design's parameters: the defaults, and changed parameters that move
 each band."""
 
+import dataclasses
 import math
 
 import numpy as np
@@ -17,6 +18,8 @@ from fpga_robotics.checks.registry import evaluate_checks
 from fpga_robotics.hw.params import FollowTargetParams
 from fpga_robotics.loop.timings import run_scenario
 from fpga_robotics.scenario.load import load_scenario
+from fpga_robotics.sim.camera.raster import render
+from fpga_robotics.sim.camera.scene import Band, CameraPose, Cylinder, Lighting, Scene
 
 RED = 0b100
 #: f = 80 / tan(hfov / 2) = 160 px; the camera 0.5 m up, level; a target 0.2 m in radius,
@@ -36,13 +39,62 @@ DEFAULT = FollowTargetParams()
 
 
 def test_count_bounds_at_4_m_by_hand():
-    # Half-width f tan(asin(0.2 / 4)) = 8.01 px: 16.02 columns. Rows at 4 m: 60 -+ 160 * 0.5 / 4
-    # = 40..80 (40 rows); at the near side (3.8 m) 38.95..81.05 (42.1 rows); window rows 8..112.
+    # Half-width f tan(asin(0.2 / 4)) = 8.01 px: 16.02 columns. The body's depths lie between
+    # its nearest point (3.8 m) and its axis (4 m). Rows at 4 m: 60 -+ 160 * 0.5 / 4 = 40..80
+    # (40 rows); at 3.8 m 38.95..81.05 (42.1 rows); window rows 8..112.
     # lo = (16.02 - 2) * (40 - 2) = 532.8, hi = (16.02 + 2) * (42.1 + 2) = 794.7.
     assert count_bounds(4.0, 0.0, RED, GEOM, DEFAULT) == (532, 795)
     assert count_bounds(4.0, 0.0, 0b010, GEOM, DEFAULT) == (0, 0)  # no green band
     # The silhouette leaves the window (columns 16..144) past a bearing of ~0.4 rad.
     assert count_bounds(4.0, 0.45, RED, GEOM, DEFAULT) is None
+
+
+def test_count_bounds_of_a_band_cut_by_the_window_top_by_hand():
+    # A band from 1 to 2 m (0.5..1.5 m above the camera) 2.2 m away: depths from 2.0 m (the
+    # nearest point) to 2.2 m (the axis). Its top row 60 - 160 * 1.5 / p is above the window's
+    # top row 8 at both; its bottom row 60 - 80 / p is 20 at 2.0 m and 23.64 at 2.2 m: the
+    # farther a column's depth the more rows it holds (12 at 2.0 m, 15.64 at 2.2 m). Columns
+    # 320 tan(asin(0.2 / 2.2)) = 29.21. lo = (29.21 - 2) * (12 - 2) = 272.1,
+    # hi = (29.21 + 2) * (15.64 + 2) = 550.5.
+    geom = dataclasses.replace(
+        GEOM, bands_sure={RED: [(1.0, 2.0)]}, bands_maybe={RED: [(1.0, 2.0)]}
+    )
+    assert count_bounds(2.2, 0.0, RED, geom, DEFAULT) == (272, 551)
+
+
+@pytest.mark.parametrize("tilt", [-0.35, 0.0, 0.3])
+@pytest.mark.parametrize("mount_height", [0.1, 0.3, 0.9])
+def test_count_bounds_hold_the_rendered_count(mount_height, tilt):
+    """The pixels the renderer draws of a band, inside the window, lie within the bounds:
+    bands cut by the window's top or bottom row, on either side of the camera, straight
+    ahead and off to a side (a red band over a blue floor and under a blue ceiling, in even
+    light: every red pixel is the band's)."""
+    light = Lighting(ambient=1.0, intensity=0.0)
+    width, height, hfov = 160, 120, 1.047
+    window_rows = slice(DEFAULT.margin_y, height - DEFAULT.margin_y)
+    window_cols = slice(width // 10, width - width // 10)
+    for z0, z1 in [(0.0, 0.5), (0.2, 0.35), (0.85, 1.45), (1.2, 1.7), (0.0, 1.75)]:
+        bands = {RED: [(z0, z1)]}
+        geom = EnvelopeGeometry(width, height, hfov, mount_height, 0.0, tilt, 0.2, bands, bands)
+        for distance in (0.6, 1.0, 1.9, 4.0):
+            for bearing in (0.0, -0.3):
+                bounds = count_bounds(distance, bearing, RED, geom, DEFAULT)
+                if bounds is None:
+                    continue
+                person = Cylinder(
+                    x=distance * math.cos(bearing),
+                    y=distance * math.sin(bearing),
+                    radius=0.2,
+                    bands=(Band(z0, z1, (1.0, 0.0, 0.0)),),
+                )
+                blue = (0.0, 0.0, 1.0)
+                scene = Scene(
+                    cylinders=(person,), lighting=light, floor_color=blue, ceiling_color=blue
+                )
+                pose = CameraPose(0.0, 0.0, 0.0, height=mount_height, tilt=tilt)
+                image = render(scene, pose, width, height, hfov)[window_rows, window_cols]
+                count = int(np.count_nonzero(image[..., 0] > 128))
+                assert bounds[0] <= count <= bounds[1], (z0, z1, distance, bearing)
 
 
 def _traj(frames):
@@ -298,8 +350,6 @@ def test_search_side_tolerates_the_smear_of_a_turn():
     # 4 m ahead, 5 px right of the centre (y = -4 * 5 / 160 = -0.125 m): the side is sure with
     # E_TOLERANCE_PX (2 px). With the sensor model's exposure (1/30 s) and the robot turning at
     # 2 rad/s, half the smear is 2 * (1/30) * 160 / 2 = 5.33 px: 7.33 px in all, no sure side.
-    import dataclasses
-
     sensor = dataclasses.replace(GEOM, exposure_s=1 / 30)
     wrong = [(True, -0.125, 248, 152)] + [(False, -0.125, 248, 152)] * 14
     wrong += [(False, -0.125, -250, 250)] * 5

@@ -1,6 +1,7 @@
 """The closed loop with the golden-model backend: following, stopping, searching, timing."""
 
 import math
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -238,11 +239,11 @@ def test_camera_pose_and_field_of_view_geometry():
 
     pose = camera_pose((1.0, 2.0, math.pi / 2), height=0.3, forward=0.1, tilt=0.05)
     assert (pose.x, pose.y, pose.height, pose.tilt) == pytest.approx((1.0, 2.1, 0.3, 0.05))
-    hfov = math.radians(60)
+    cam = SimpleNamespace(width=160, height=120, hfov=math.radians(60))
     # Straight ahead, 2 m away: in view. 29 deg off-axis: in; 40 deg: the centre is out but a
     # 0.5 m radius still reaches into the view (asin(0.5/2) = 14.5 deg); behind: out.
     ahead = (pose.x, pose.y + 2.0)
-    assert in_view(pose, hfov, *ahead, 0.2)
+    assert in_view(pose, cam, *ahead, 0.2, 1.75)
     for deg, radius, expect in (
         (29, 0.0, True),
         (31, 0.0, False),
@@ -252,8 +253,84 @@ def test_camera_pose_and_field_of_view_geometry():
     ):
         a = math.pi / 2 + math.radians(deg)
         p = (pose.x + 2 * math.cos(a), pose.y + 2 * math.sin(a))
-        assert in_view(pose, hfov, *p, radius) is expect, deg
-    assert in_view(pose, hfov, pose.x, pose.y - 0.1, 0.2)  # the camera is inside the body
+        assert in_view(pose, cam, *p, radius, 1.75) is expect, deg
+    assert in_view(pose, cam, pose.x, pose.y - 0.1, 0.2, 1.75)  # the camera is inside the body
+
+
+#: The default camera: 160x120, hfov 1.047 rad, f = 80 / tan(0.5235) = 138.6 px, half the
+#: vertical field of view atan(60 / 138.6) = 0.4087 rad.
+CAM = SimpleNamespace(width=160, height=120, hfov=1.047)
+HALF_VFOV = math.atan(60 / (80 / math.tan(1.047 / 2)))
+
+
+def _rendered_pixels(pose, distance, bearing, radius, height):
+    """The pixels the renderer draws of a red cylinder (blue floor and ceiling, even light)."""
+    from fpga_robotics.sim.camera.raster import render
+    from fpga_robotics.sim.camera.scene import Band, Cylinder, Lighting, Scene
+
+    x = pose.x + distance * math.cos(pose.heading + bearing)
+    y = pose.y + distance * math.sin(pose.heading + bearing)
+    person = Cylinder(x=x, y=y, radius=radius, bands=(Band(0.0, height, (1.0, 0.0, 0.0)),))
+    blue = (0.0, 0.0, 1.0)
+    scene = Scene(
+        cylinders=(person,),
+        lighting=Lighting(ambient=1.0, intensity=0.0),
+        floor_color=blue,
+        ceiling_color=blue,
+        ceiling_height=10.0,
+    )
+    image = render(scene, pose, CAM.width, CAM.height, CAM.hfov)
+    return int(np.count_nonzero(image[..., 0] > 128))
+
+
+def test_field_of_view_is_vertical_too():
+    from fpga_robotics.loop.connectors import in_view
+    from fpga_robotics.sim.camera.scene import CameraPose
+
+    # A person 1.75 m tall, 0.2 m in radius, 1.3 m straight ahead of a camera 0.3 m up: its
+    # near side (1.1 m deep) shows the feet atan(-0.3 / 1.1) = -0.2663 rad below the level,
+    # the lowest it reaches. Tilted down by more than 0.2663 + 0.4087 = 0.6750 rad the image's
+    # top row looks below the feet: nothing of the person is in the image.
+    edge = math.atan(0.3 / 1.1) + HALF_VFOV
+    for tilt, expect in ((-edge + 0.02, True), (-edge - 0.02, False), (-1.0, False)):
+        pose = CameraPose(0.0, 0.0, 0.0, height=0.3, tilt=tilt)
+        assert in_view(pose, CAM, 1.3, 0.0, 0.2, 1.75) is expect, tilt
+        assert (_rendered_pixels(pose, 1.3, 0.0, 0.2, 1.75) > 0) is expect, tilt
+    # Tilted up by 0.6 rad, the image's bottom row looks 0.6 - 0.4087 = 0.1913 rad up: the
+    # head's top, 1.45 m above the camera, is at atan(1.45 / 3.8) = 0.3645 rad 4 m away (in)
+    # and at atan(1.45 / 9.8) = 0.1469 rad 10 m away (out).
+    pose = CameraPose(0.0, 0.0, 0.0, height=0.3, tilt=0.6)
+    for distance, expect in ((4.0, True), (10.0, False)):
+        assert in_view(pose, CAM, distance, 0.0, 0.2, 1.75) is expect, distance
+        assert (_rendered_pixels(pose, distance, 0.0, 0.2, 1.75) > 0) is expect, distance
+    # A child 1.0 m tall 2 m ahead of a level camera 2.0 m up (a ceiling camera): the head's
+    # top at atan(-1.0 / 1.8) = -0.5071 rad is below the image's bottom row (-0.4087).
+    pose = CameraPose(0.0, 0.0, 0.0, height=2.0, tilt=0.0)
+    assert not in_view(pose, CAM, 2.0, 0.0, 0.2, 1.0)
+    assert in_view(pose, CAM, 2.0, 0.0, 0.2, 1.75)  # a grown-up's head is in
+
+
+def test_a_person_the_renderer_draws_is_in_view():
+    """Wherever the renderer draws a pixel of the person, in_view says so: camera heights
+    and tilts, people short and tall, near and far, ahead and at the edge of the view."""
+    from fpga_robotics.loop.connectors import in_view
+    from fpga_robotics.sim.camera.scene import CameraPose
+
+    for cam_height, tilt in ((0.3, -0.9), (0.3, 0.0), (0.3, 0.6), (1.5, -0.5), (2.2, 0.2)):
+        pose = CameraPose(0.0, 0.0, 0.0, height=cam_height, tilt=tilt)
+        for distance in (0.5, 1.3, 3.0, 8.0):
+            for bearing in (0.0, 0.45, -0.7):
+                for height in (0.6, 1.75):
+                    drawn = _rendered_pixels(pose, distance, bearing, 0.25, height)
+                    if drawn:
+                        assert in_view(
+                            pose,
+                            CAM,
+                            distance * math.cos(bearing),
+                            distance * math.sin(bearing),
+                            0.25,
+                            height,
+                        )
 
 
 @pytest.mark.parametrize(

@@ -7,31 +7,70 @@ from fpga_robotics.checks.registry import sensor_check
 from fpga_robotics.checks.sensor_metrics import RESUME_CLOSING_M, obstacle_metrics
 
 
-def _traj(t, d):
-    return {"t": np.asarray(t, float), "target_distance": np.asarray(d, float)}
+def _traj(t, robot_x, target_x, robot_y=None):
+    """Rows at times ``t``: the robot and the target on the line y = 0 (the robot at
+    ``robot_y`` off it when given)."""
+    n = len(t)
+    return {
+        "t": np.asarray(t, float),
+        "x": np.asarray(robot_x, float),
+        "y": np.zeros(n) if robot_y is None else np.asarray(robot_y, float),
+        "target_x": np.asarray(target_x, float),
+        "target_y": np.zeros(n),
+    }
 
 
-def test_resumed_after_is_the_first_row_the_robot_is_closer_by_the_margin():
-    # Removed at 1.0 s; distance 2.0 m then; 1.75 m (0.25 closer) first at 1.6 s.
+REMOVED = [(3, 1.0, "furniture 'box' removed"), (0, 0.0, "target found")]
+
+
+def test_resumed_after_is_the_first_row_the_robot_has_driven_the_margin_towards_the_target():
+    # Removed at 1.0 s, the target standing at x = 3: the robot drives 0.1 m by 1.4 s (not
+    # enough), 0.25 m by 1.6 s.
     t = [0.0, 0.5, 1.0, 1.2, 1.4, 1.6, 1.8]
-    d = [2.5, 2.0, 2.0, 2.0, 1.9, 1.75, 1.5]
-    events = [(3, 1.0, "furniture 'box' removed"), (0, 0.0, "target found")]
-    m = obstacle_metrics(_traj(t, d), events)
+    x = [0.5, 1.0, 1.0, 1.0, 1.1, 1.25, 1.5]
+    m = obstacle_metrics(_traj(t, x, [3.0] * 7), REMOVED)
     assert m["obstacle_removed_at_s"] == 1.0
-    assert 1.9 > 2.0 - RESUME_CLOSING_M  # 1.4 s is not enough
+    assert 0.1 < RESUME_CLOSING_M < 0.25
     assert m["resumed_after_s"] == pytest.approx(0.6)
     assert sensor_check("resumes_within_s", 1.0, m)[0] is True
     assert sensor_check("resumes_within_s", 0.5, m)[0] is False
 
 
-def test_never_resumed_and_never_removed_both_fail_with_a_reason():
-    m = obstacle_metrics(_traj([0, 1, 2], [2.0, 2.0, 1.95]), [(1, 1.0, "furniture 'b' removed")])
+def test_a_person_walking_up_to_a_robot_that_stays_put_is_not_a_resumption():
+    # The robot stands at x = 1 while the person walks from 3 to 2: 1 m closer, robot 0 m.
+    t = [1.0, 1.5, 2.0, 2.5, 3.0]
+    m = obstacle_metrics(_traj(t, [1.0] * 5, [3.0, 2.75, 2.5, 2.25, 2.0]), REMOVED)
     assert m["resumed_after_s"] is None
     ok, text = sensor_check("resumes_within_s", 5.0, m)
-    assert not ok and "never closed" in text
-    m = obstacle_metrics(_traj([0, 1], [2.0, 1.0]), [])
+    assert not ok and text.startswith("the robot never drove 0.2 m towards the target")
+    # Following a person who walks away as fast: the distance stays 2 m, the robot drives
+    # 0.25 m a row towards them: 0.25 >= 0.2 after the first step, at 1.5 s.
+    walk = [1.0, 1.25, 1.5, 1.75, 2.0]
+    m = obstacle_metrics(_traj(t, walk, [w + 2.0 for w in walk]), REMOVED)
+    assert m["resumed_after_s"] == pytest.approx(0.5)
+    assert sensor_check("resumes_within_s", 1.0, m)[1] == (
+        "drove 0.2 m towards the target 0.50 s after the obstacle left (limit 1.0 s)"
+    )
+
+
+def test_only_the_motion_along_the_direction_to_the_target_counts():
+    # The target at (3, 0); the robot drives from (1, 0) 0.3 m a row along +y: 0.9 m of path.
+    # Along the direction to the target at each step's start: (0, 0.3) . (2, 0) / 2 = 0, then
+    # (0, 0.3) . (2, -0.3) / 2.0224 = -0.0445 (away), then less still: never 0.2 m towards it.
+    t = [1.0, 1.5, 2.0, 2.5]
+    m = obstacle_metrics(_traj(t, [1.0] * 4, [3.0] * 4, robot_y=[0.0, 0.3, 0.6, 0.9]), REMOVED)
+    assert m["resumed_after_s"] is None
+    # The same path along +x, straight at the target: 0.3 m by the first step, at 1.5 s.
+    m = obstacle_metrics(_traj(t, [1.0, 1.3, 1.6, 1.9], [3.0] * 4), REMOVED)
+    assert m["resumed_after_s"] == pytest.approx(0.5)
+
+
+def test_never_removed_is_not_judged_and_no_target_never_resumes():
+    m = obstacle_metrics(_traj([0, 1], [1.0, 2.0], [3.0, 3.0]), [])
     ok, text = sensor_check("resumes_within_s", 5.0, m)
     assert not ok and "no furniture was removed" in text
+    m = obstacle_metrics(_traj([1.0, 2.0], [1.0, 2.0], [np.nan] * 2), REMOVED)
+    assert m["resumed_after_s"] is None
 
 
 def _rows(xs, ys, headings):

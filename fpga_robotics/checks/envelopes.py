@@ -10,10 +10,12 @@ target's image column gives the centroid error ``e`` and so the law's turn
 (``motor_left``, ``motor_right``: forward ``(L + R) / 2``, turn ``(L - R) / 2``) must fall in
 those bands. Stated tolerances (nothing tuned to a run):
 
-- count: the silhouette's width and each band's rows +-1 pixel (edge quantisation), rows at
-  the nearest depth of the body for the upper bound and at its centre for the lower one; a
-  band counts towards the lower bound only if its colour matches in the darkest light of the
-  scenario (ambient alone) and in its brightest, towards the upper one if in either;
+- count: the silhouette's width and each band's rows +-1 pixel (edge quantisation), the rows
+  inside the window the fewest (lower bound) and the most (upper bound) the band covers at
+  any depth from the body's point nearest the camera to its axis (a band cut by the window's
+  top or bottom row covers more rows further away); a band counts towards the lower bound
+  only if its colour matches in the darkest light of the scenario (ambient alone) and in its
+  brightest, towards the upper one if in either;
 - centroid error ``e``: +-2 pixels (the centroid's floor and the half-pixel of the column),
   plus a quarter of the silhouette's width when a band that may count does not match in
   ambient light alone (its shaded side then drops out and the centroid moves to the lit side);
@@ -145,17 +147,52 @@ def envelope_geometry(scenario, world_config, camera):
     )
 
 
+def _row(z, depth, geom):
+    """The image row (continuous) where height ``z`` at ``depth`` (m along the camera's axis)
+    lands, as the renderer draws it (``sim.camera.raster``: tilt rotates each column's
+    vertical fan of rays; a ray at or past straight up or down is clipped)."""
+    lim = math.pi / 2 - 1e-6
+    angle = math.atan2(z - geom.mount_height, depth) - geom.tilt
+    return geom.height / 2 - geom.focal * math.tan(max(-lim, min(lim, angle)))
+
+
 def _rows(z0, z1, depth, geom, params):
     """Rows of the window (continuous) a band from ``z0`` to ``z1`` covers at ``depth``."""
-    f, h = geom.focal, geom.mount_height
-    axis = geom.height / 2
-
-    def row(z):
-        return axis - f * math.tan(math.atan2(z - h, depth) - geom.tilt)
-
-    top, bottom = row(z1), row(z0)
     lo, hi = params.margin_y, geom.height - params.margin_y
-    return max(0.0, min(bottom, hi) - max(top, lo))
+    return max(0.0, min(_row(z0, depth, geom), hi) - max(_row(z1, depth, geom), lo))
+
+
+def _depths(distance, bearing, radius):
+    """``(near, far)``: depths (m along the camera's axis, the depth the renderer draws a
+    column's rows at) between which every visible point of an upright cylinder of ``radius``
+    lies, its axis ``distance`` from the camera at ``bearing`` (rad): the point of it nearest
+    the camera's plane, and the axis's distance, beyond the silhouette's edges (at most
+    ``sqrt(distance**2 - radius**2)``)."""
+    return distance * math.cos(bearing) - radius, distance
+
+
+def _row_span(z0, z1, near, far, geom, params):
+    """``(least, most)`` rows of the window (continuous) a band from ``z0`` to ``z1`` covers at
+    any depth from ``near`` to ``far``.
+
+    Each edge's row moves monotonically with the depth (towards the horizon), so between the
+    depths where an edge crosses the window's top or bottom row the covered rows change
+    monotonically, except with both edges inside the window: there they are ``f p (z1 - z0)
+    / ((p cos t + z1' sin t)(p cos t + z0' sin t))`` (heights ``z'`` from the camera, tilt
+    ``t``), which rises to one maximum at ``p = sqrt(z0' z1') |tan t|`` when both edges lie
+    on the same side of the camera. The least and most lie at those depths or the ends."""
+    h, t = geom.mount_height, geom.tilt
+    inside = []
+    for z in (z0, z1):
+        for edge in (params.margin_y, geom.height - params.margin_y):
+            angle = math.atan((geom.height / 2 - edge) / geom.focal) + t
+            if 0 < (z - h) * angle and abs(angle) < math.pi / 2:
+                inside.append((z - h) / math.tan(angle))
+    if (z0 - h) * (z1 - h) > 0:
+        inside.append(math.sqrt((z0 - h) * (z1 - h)) * abs(math.tan(t)))
+    depths = [near, far] + [p for p in inside if near < p < far]
+    spans = [_rows(z0, z1, p, geom, params) for p in depths]
+    return min(spans), max(spans)
 
 
 def silhouette(distance, bearing, geom):
@@ -173,14 +210,14 @@ def count_bounds(distance, bearing, code, geom, params):
     if not whole_in_window(left, right, geom.width, params.margin_x):
         return None
     cols = right - left
-    near, far = distance - geom.radius, distance
-    lo = sum(
-        max(0.0, cols - 2) * max(0.0, _rows(z0, z1, far, geom, params) - 2)
-        for z0, z1 in geom.bands_sure[code]
-    )
-    hi = sum(
-        (cols + 2) * (_rows(z0, z1, near, geom, params) + 2) for z0, z1 in geom.bands_maybe[code]
-    )
+    near, far = _depths(distance, bearing, geom.radius)
+    # Every column shows each band at its own depth: the count lies between the columns
+    # times the fewest rows a band covers at any depth from near to far and times the most.
+    lo = hi = 0.0
+    for z0, z1 in geom.bands_sure[code]:
+        lo += max(0.0, cols - 2) * max(0.0, _row_span(z0, z1, near, far, geom, params)[0] - 2)
+    for z0, z1 in geom.bands_maybe[code]:
+        hi += (cols + 2) * (_row_span(z0, z1, near, far, geom, params)[1] + 2)
     return math.floor(lo), math.ceil(hi)
 
 

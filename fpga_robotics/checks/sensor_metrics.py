@@ -4,8 +4,6 @@ gone, and how often each sensor measured (``fpga_robotics.checks.shipped`` decla
 checks).
 """
 
-import math
-
 import numpy as np
 
 from fpga_robotics.sim.world import is_removal_event
@@ -17,7 +15,7 @@ __all__ = [
     "obstacle_metrics",
 ]
 
-#: Following has resumed once the robot is this much closer to the target than when the last
+#: Following has resumed once the robot has driven this far towards the target since the last
 #: obstacle left, m.
 RESUME_CLOSING_M = 0.2
 
@@ -64,19 +62,24 @@ def line_metrics(traj, lines, mounts, period):
 
 def obstacle_metrics(traj, events):
     """``obstacle_removed_at_s`` (the last furniture removal) and ``resumed_after_s`` (from
-    then until the robot is ``RESUME_CLOSING_M`` closer to the target; None if never)."""
+    then until the robot has driven ``RESUME_CLOSING_M`` towards the target; None if never).
+
+    Only the robot's own motion counts: each step's displacement along the direction from the
+    robot to the target at the step's start, summed. A person walking up to a robot that
+    stays put brings them closer without the robot resuming anything."""
     removed = [t for _, t, text in events if is_removal_event(text)]
     if not removed:
         return {"obstacle_removed_at_s": None, "resumed_after_s": None}
     t_r = max(removed)
-    t, d = traj["t"], traj["target_distance"]
+    t = traj["t"]
     after = np.flatnonzero(t >= t_r - 1e-9)
-    resumed = None
-    if len(after) and not math.isnan(d[after[0]]):
-        start = d[after[0]]
-        closer = after[d[after] <= start - RESUME_CLOSING_M]
-        if len(closer):
-            resumed = round(float(t[closer[0]] - t_r), 4)
+    x, y, tx, ty = (np.asarray(traj[k], float)[after] for k in ("x", "y", "target_x", "target_y"))
+    to_x, to_y = (tx - x)[:-1], (ty - y)[:-1]
+    step = np.diff(x) * to_x + np.diff(y) * to_y
+    # NaN without a target person: never resumed.
+    progress = np.cumsum(step / np.maximum(np.hypot(to_x, to_y), 1e-9))
+    reached = np.flatnonzero(progress >= RESUME_CLOSING_M)
+    resumed = round(float(t[after[reached[0] + 1]] - t_r), 4) if len(reached) else None
     return {"obstacle_removed_at_s": round(t_r, 6), "resumed_after_s": resumed}
 
 

@@ -135,11 +135,11 @@ def _resumed_text(v, limit, m):
     t_r = m["obstacle_removed_at_s"]
     if v is None:
         return (
-            f"the robot never closed {RESUME_CLOSING_M} m on the target after the obstacle "
-            f"left at {t_r:.2f} s (limit {limit} s)"
+            f"the robot never drove {RESUME_CLOSING_M} m towards the target after the "
+            f"obstacle left at {t_r:.2f} s (limit {limit} s)"
         )
     return (
-        f"closed {RESUME_CLOSING_M} m on the target {v:.2f} s after the obstacle left "
+        f"drove {RESUME_CLOSING_M} m towards the target {v:.2f} s after the obstacle left "
         f"(limit {limit} s)"
     )
 
@@ -457,8 +457,9 @@ SHIPPED_CHECKS = (
         "resumed_after_s",
         "max",
         (
-            f"after the last piece of furniture is removed, the robot closes "
-            f"{RESUME_CLOSING_M} m on the target within this time"
+            f"after the last piece of furniture is removed, the robot drives "
+            f"{RESUME_CLOSING_M} m towards the target within this time (its own motion: a "
+            f"person walking up to it does not count)"
         ),
         _resumed_text,
         limits=(0, _DAY, "s"),

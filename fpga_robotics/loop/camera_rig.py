@@ -222,6 +222,7 @@ class CameraRig:
             for key, value in servo.measurement().items():
                 put(f"{name}.{key}", value)
         people = {p.name: p for p in world.people_states()}
+        heights = {p.name: p.height for p in world.config.people}
         for cam in self.cameras:
             if self.pins is not None and cam.channel is not None:  # the design's ports now
                 ports = [*cam.channel.view_ports, *(s.port for s in self.servos.values())]
@@ -232,7 +233,9 @@ class CameraRig:
             if target is None:
                 continue
             pose = cam.pose(world)
-            visible = in_view(pose, cam.params.hfov, target.x, target.y, target.radius)
+            visible = in_view(
+                pose, cam.params, target.x, target.y, target.radius, heights[target.name]
+            )
             put(f"{cam.name}.target_in_view", visible)
             put(f"{cam.name}.target_bearing_deg", angle_off_axis(pose, target.x, target.y))
 

@@ -205,6 +205,7 @@ class ClosedLoop:
         self.target_radius = next(
             (p.radius for p in self.world.people_states() if p.is_target), 0.0
         )
+        self.target_height = next((p.height for p in self.world.config.people if p.target), 0.0)
         self.color = self.scheduled_color = scenario.color_at(0.0)
         self.color_code = color_select_value(self.color)
         # Live control inputs (fpga_robotics.ros.controls), asked once per frame.
@@ -336,7 +337,9 @@ class ClosedLoop:
         if target is not None:
             tx, ty = target
             dist = math.hypot(tx - rx, ty - ry)
-            visible = in_view(pose, self.scenario.camera.hfov, tx, ty, self.target_radius)
+            visible = in_view(
+                pose, self.scenario.camera, tx, ty, self.target_radius, self.target_height
+            )
             column = target_column(pose, self.scenario.camera, tx, ty)
             edges = target_silhouette(pose, self.scenario.camera, tx, ty, self.target_radius)
         else:

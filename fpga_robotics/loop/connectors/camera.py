@@ -25,7 +25,7 @@ from fpga_robotics.loop.connectors.base import (
     refuse_unknown_keys,
     register,
 )
-from fpga_robotics.sim.camera.raster import CameraRenderer, focal_length
+from fpga_robotics.sim.camera.raster import CameraRenderer, focal_length, vertical_fov
 from fpga_robotics.sim.camera.render3d import MujocoRenderer, Render3DUnavailable
 from fpga_robotics.sim.camera.scene import CameraPose
 from fpga_robotics.sim.camera.sensor import OV7670Sensor
@@ -121,9 +121,11 @@ def camera_pose(robot_pose, *, height, forward=0.0, tilt=0.0):
     )
 
 
-def in_view(pose, hfov, px, py, radius):
-    """Whether an upright cylinder at ``(px, py)`` is (at least partly) inside the horizontal
-    field of view of a camera at ``pose``. Occlusion is not considered."""
+def in_view(pose, cam, px, py, radius, height):
+    """Whether an upright cylinder at ``(px, py)``, ``radius`` wide and ``height`` tall on the
+    floor, is (at least partly) in the image of a camera at ``pose`` (``cam``: its ``width``,
+    ``height`` and ``hfov``), as the renderer draws it (``sim.camera.raster``): some column of
+    the field of view meets its side at rows of the image. Occlusion is not considered."""
     dx, dy = px - pose.x, py - pose.y
     dist = math.hypot(dx, dy)
     if dist <= radius:
@@ -132,7 +134,34 @@ def in_view(pose, hfov, px, py, radius):
     bearing = (bearing + math.pi) % (2 * math.pi) - math.pi
     if abs(bearing) >= math.pi / 2:
         return False  # behind the camera
-    return abs(bearing) - math.asin(radius / dist) < hfov / 2
+    half = math.asin(radius / dist)
+    if abs(bearing) - half >= cam.hfov / 2:
+        return False  # beside the field of view
+    lo, hi = max(bearing - half, -cam.hfov / 2), min(bearing + half, cam.hfov / 2)
+    # The columns from angle lo to hi meet the near side at depths that fall to the point of
+    # it nearest the camera's plane and rise again: the least and greatest are among those.
+    nearest = math.atan2(dist * math.sin(bearing), dist * math.cos(bearing) - radius)
+    angles = [lo, hi] + ([nearest] if lo < nearest < hi else [])
+    depths = [_hit_depth(dist, bearing, radius, a) for a in angles]
+    near, far = min(depths), max(depths)
+    # At depth p the side spans the elevations atan(-h / p) to atan((height - h) / p) (the
+    # renderer's rows, tilt rotating each column's fan of rays); each end moves monotonically
+    # with p, so the columns together show it from the lowest of those at near and far to
+    # the highest, against the image's tilt -+ half its vertical field of view.
+    lowest = min(math.atan2(-pose.height, near), math.atan2(-pose.height, far))
+    highest = max(math.atan2(height - pose.height, p) for p in (near, far))
+    half_vfov = vertical_fov(cam.width, cam.height, cam.hfov) / 2
+    return lowest < pose.tilt + half_vfov and highest > pose.tilt - half_vfov
+
+
+def _hit_depth(distance, bearing, radius, angle):
+    """The depth (m along the camera's axis) at which the column ``angle`` (rad off the axis,
+    left positive) meets the near side of an upright cylinder of ``radius`` whose axis stands
+    ``distance`` from the camera at ``bearing``: the nearer root of the ray ``(p, p tan
+    angle)`` on its circle (the silhouette's edge, where the ray only grazes it, included)."""
+    cx, cy, slope = distance * math.cos(bearing), distance * math.sin(bearing), math.tan(angle)
+    b, a = cx + cy * slope, 1 + slope * slope
+    return (b - math.sqrt(max(0.0, b * b - a * (distance**2 - radius**2)))) / a
 
 
 @dataclass(frozen=True)
