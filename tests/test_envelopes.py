@@ -144,6 +144,21 @@ def test_approach_speed_and_reversing_default_and_changed_speed_table():
     assert m["approach_speed_violation_fraction"] == 0.5
 
 
+def test_approach_speed_at_the_frames_camera_tilt():
+    # On a ramp the camera looks 0.35 rad up (the trajectory's camera_tilt): at 4 m the band's
+    # top (1 m) lands on row 60 + 160 tan(0.35 - atan(0.5 / 4)) = 96.7 (95.6 at 3.8 m), its
+    # bottom below the window's last row 112: 15.3 rows (16.4). lo = 14.02 * 13.3 = 186,
+    # hi = 18.02 * 18.4 = 331: levels 1..2, 300..400 DPS, where the level camera's 532..795
+    # (level 3) allows 200 only.
+    traj = _traj([(True, 0.0, 300, 300), (True, 0.0, 200, 200)])
+    level = envelope_metrics(traj, DEFAULT, GEOM)
+    assert level["approach_speed_violation_fraction"] == 0.5
+    traj["camera_tilt"] = np.full(2, 0.35)
+    assert envelope_metrics(traj, DEFAULT, GEOM)["approach_speed_violation_fraction"] == 0.5
+    traj["motor_left"] = traj["motor_right"] = np.array([300.0, 400.0])
+    assert envelope_metrics(traj, DEFAULT, GEOM)["approach_speed_violation_fraction"] == 0.0
+
+
 def test_turn_law_default_and_changed_gain():
     # Target 0.4 m to the left at 4 m: bearing atan(0.1); silhouette columns
     # 80 - 160 tan(bearing +- asin(0.2 / 4.02)): centre column 63.97, e = 63.97 - 0.5 - 80

@@ -32,7 +32,7 @@ with the 3D renderer (its people are bodies, not cylinders of bands).
 """
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -62,7 +62,8 @@ class EnvelopeGeometry:
     """What the bands need to know of the camera and the target.
 
     width, height, hfov : the image and its horizontal field of view (rad).
-    mount_height, mount_forward, tilt : the camera on the robot (m, m, rad); ``yaw``: its
+    mount_height, mount_forward, tilt : the camera on the robot (m, m, rad; a frame's tilt
+        on a ramp adds the slope's pitch, the trajectory's ``camera_tilt``); ``yaw``: its
         yaw off the heading (rad, left positive).
     radius : the target's radius (m).
     bands_sure, bands_maybe : per colour code, the ``(z0, z1)`` of the target's bands that
@@ -342,6 +343,8 @@ def envelope_metrics(traj, params, geom):
     fwd, turn = (ml + mr) / 2, (ml - mr) / 2
     dist, bearing = _camera_view(traj, geom)
     codes = np.asarray(traj["color_sel"], np.int64)
+    # On a ramp the camera pitches with the robot: each frame's rows are drawn at its tilt.
+    tilts = np.asarray(traj.get("camera_tilt", np.full(len(codes), geom.tilt)), float)
     w, centred_px = geom.width, geom.width * CENTRED_PX_FRACTION
     speed, reverse, steer = [], [], []
     stop = stop_distance_m(geom, params, int(codes[0])) if len(codes) else None
@@ -351,7 +354,8 @@ def envelope_metrics(traj, params, geom):
         if not math.isfinite(dist[k]):
             continue
         code = int(codes[k])
-        bounds = count_bounds(float(dist[k]), float(bearing[k]), code, geom, params)
+        frame_geom = geom if tilts[k] == geom.tilt else replace(geom, tilt=float(tilts[k]))
+        bounds = count_bounds(float(dist[k]), float(bearing[k]), code, frame_geom, params)
         if bounds is None:
             continue
         levels = range(

@@ -74,6 +74,7 @@ TRAJECTORY_FIELDS = (
     "target_column",
     "target_left",
     "target_right",
+    "camera_tilt",
 )
 
 
@@ -354,6 +355,7 @@ class ClosedLoop:
         row["target_distance"][k], row["target_in_view"][k] = dist, visible
         row["target_column"][k] = column
         row["target_left"][k], row["target_right"][k] = edges
+        row["camera_tilt"][k] = pose.tilt  # the mount's tilt plus the slope's pitch
         return (None if target is None else dist), visible
 
     def store_outputs(self, k, result):
