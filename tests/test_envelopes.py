@@ -180,6 +180,36 @@ def test_turn_law_default_and_changed_gain():
     )
 
 
+def test_turn_law_of_a_suit_whose_shaded_side_may_drop_out():
+    # The band matches only in some light (lower bound 0): only a lit strip may match, so the
+    # centroid may lie anywhere across the silhouette, columns 71.49..87.51 at 4 m straight
+    # ahead: e = -0.5 +- (2 + 16.02 / 2), turn 3e in [-33, 30]. The lit right edge's centroid
+    # at 87 (e = 7, turn 21, beyond a quarter of the width's 18) keeps the law.
+    shaded = dataclasses.replace(GEOM, bands_sure={c: [] for c in range(8)})
+    traj = _traj([(True, 0.0, 221, 179), (True, 0.0, 230, 170), (True, 0.0, 231, 169)])
+    assert envelope_metrics(traj, DEFAULT, shaded)["turn_law_violation_fraction"] == 1 / 3
+
+
+def test_a_suit_matching_only_between_the_darkest_and_brightest_light():
+    """A salmon suit in bright light matches the red filter from shade 0.8 to 1.7 only, not
+    in ambient alone (0.5) nor in the brightest light (1.8: R saturates, G goes on rising):
+    the bounds count it, and the design's approach keeps the law."""
+    s = load_scenario(
+        "approach",
+        [
+            "people.0.shirt_color=[0.85,0.35,0.3]",
+            "people.0.trousers_color=[0.85,0.35,0.3]",
+            "lighting.ambient=0.5",
+            "lighting.intensity=1.3",
+            "sim.duration=1",
+            "checks={}",
+        ],
+    )
+    m = run_scenario(s, backend="model").summary
+    assert m["found_fraction"] == 1.0
+    assert m["approach_speed_violation_fraction"] == 0.0
+
+
 def test_search_law_default_and_changed_search():
     # Seen on the right (y < 0), then lost: lost frames 1..14 hold (152, 248 here), frame 15
     # on turns right in place at 250 DPS: left +250, right -250.

@@ -14,11 +14,13 @@ those bands. Stated tolerances (nothing tuned to a run):
   inside the window the fewest (lower bound) and the most (upper bound) the band covers at
   any depth from the body's point nearest the camera to its axis (a band cut by the window's
   top or bottom row covers more rows further away); a band counts towards the lower bound
-  only if its colour matches in the darkest light of the scenario (ambient alone) and in its
-  brightest, towards the upper one if in either;
+  only if its colour matches at every shade from the darkest light of the scenario (ambient
+  alone) to its brightest (ambient plus the light's intensity), towards the upper one if at
+  any (the filter is not monotone in brightness);
 - centroid error ``e``: +-2 pixels (the centroid's floor and the half-pixel of the column),
-  plus a quarter of the silhouette's width when a band that may count does not match in
-  ambient light alone (its shaded side then drops out and the centroid moves to the lit side);
+  plus half the silhouette's width when a band that may count does not match at every shade
+  (then only a lit strip may match, up to the silhouette's edge, and the centroid is its
+  middle);
 - with the camera's sensor model (``camera.sensor``) no band matches surely (exposure and
   white balance move its colour) and the turn's smear over a frame's exposure adds half its
   length to the centroid's tolerance;
@@ -31,6 +33,7 @@ The envelopes read the default laws (``motor_law = "p_control"``, ``lost_motion 
 with the 3D renderer (its people are bodies, not cylinders of bands).
 """
 
+import itertools
 import math
 from dataclasses import dataclass, replace
 
@@ -100,6 +103,22 @@ def _band_matches(color, shades, code, params):
     return out
 
 
+def _shades(color, darkest, brightest):
+    """Shades from ``darkest`` to ``brightest`` that give a band of albedo ``color`` each of
+    the RGB444 colours it takes in that range: the ends and one shade between each pair of
+    neighbouring level changes (the filter is not monotone in brightness: a channel that
+    saturates stops rising while the others go on)."""
+    changes = {
+        (16 * level - 0.5) / (255.0 * c)
+        for c in color
+        if c > 0
+        for level in range(1, 16)
+        if darkest < (16 * level - 0.5) / (255.0 * c) < brightest
+    }
+    edges = [darkest, *sorted(changes), brightest]
+    return [darkest, brightest] + [(a + b) / 2 for a, b in itertools.pairwise(edges)]
+
+
 def envelope_geometry(scenario, world_config, camera):
     """The ``EnvelopeGeometry`` of a run (``scenario``, its ``WorldConfig``, its
     ``CameraConnector``), or why there is none (a string): no target person, or a renderer
@@ -116,11 +135,11 @@ def envelope_geometry(scenario, world_config, camera):
     ambients = [light.ambient] + [k[1] for k in light.keyframes]
     brights = [light.ambient + light.intensity] + [k[1] + k[2] for k in light.keyframes]
     darkest, brightest = min(ambients), max(brights)
-    shades = (darkest, brightest)
     sure, maybe = {}, {}
     for code in range(8):
         sure[code], maybe[code] = [], []
         for band in person_bands(target):
+            shades = _shades(band.color, darkest, brightest)
             ok = _band_matches(band.color, shades, code, scenario.params)
             if all(ok):
                 sure[code].append((band.z0, band.z1))
@@ -366,7 +385,8 @@ def envelope_metrics(traj, params, geom):
         column = (left + right) / 2 - 0.5  # the pixel index the centre falls on
         tol = E_TOLERANCE_PX
         if geom.bands_maybe[code] != geom.bands_sure[code]:
-            tol += (right - left) / 4
+            # Only a lit strip may match, anywhere up to the silhouette's edge.
+            tol += (right - left) / 2
         if geom.exposure_s and "w" in traj:  # half the smear of a turn during the exposure
             tol += abs(float(traj["w"][k])) * geom.exposure_s * geom.focal / 2
         e = column - w // 2
