@@ -405,6 +405,24 @@ def test_search_side_tolerates_the_smear_of_a_turn():
         assert m["search_law_violation_fraction"] == judged_wrong / (14 + judged_wrong)
 
 
+def test_camera_noise_beyond_the_bounds_slack_leaves_the_envelopes_na():
+    """lost_target's shaded suit at noise 10 loses enough pixels to the filter that its count
+    leaves the bounds (the correct design's level 5 where they allow 6): n/a with the
+    reason; the robustness campaign's noise 8 is judged."""
+    base = ["sim.duration=0.2", "checks={}"]
+    m = run_scenario(
+        load_scenario("lost_target", [*base, "camera.noise_std=10"]), backend="model"
+    ).summary
+    assert m["approach_speed_violation_fraction"] is None
+    assert "noise_std 8" in m["envelope_reason"] and "noise_std = 10" in m["envelope_reason"]
+    (c,) = evaluate_checks({"max_approach_speed_violation_fraction": 0.0}, m)
+    assert c["status"] == "n/a"
+    m = run_scenario(
+        load_scenario("lost_target", [*base, "camera.noise_std=8"]), backend="model"
+    ).summary
+    assert m["envelope_reason"] is None
+
+
 def test_a_design_without_a_found_output_leaves_the_envelopes_na():
     """A design of one's own without ``found`` records NaN there: no frame counts as a
     sighting (NaN is not True), whatever its wheels do."""
