@@ -103,6 +103,29 @@ def test_the_centroid_metrics_judge_a_cut_target_by_its_part_inside_the_window()
     assert [c["passed"] for c in checks] == [None, None]
 
 
+def test_a_lit_strip_is_judged_by_the_part_of_the_silhouette_inside():
+    """A suit that matches only where lit: the centroid of the matching pixels lies anywhere
+    in the part of the silhouette inside the window, and is judged by its distance from it."""
+    traj = _traj(column=[80, 80, 20], left=[70, 70, -10], right=[90, 90, 50], centroid=[88, 93, 14])
+    lit = np.array([True, True, True])
+    # Frame 0 inside 70..90: 0; frame 1 3 px beyond its right edge; frame 2 cut on the left
+    # (16..50 inside), 2 px beyond it. Against the middles: 8, 13, 19.
+    m = compute_metrics(traj, [], {}, 1 / 30, width=W, margin_x=16, lit_strip=lit)
+    assert m["mean_centroid_error_px"] == pytest.approx(5 / 3)
+    m = compute_metrics(traj, [], {}, 1 / 30, width=W, margin_x=16)
+    assert m["mean_centroid_error_px"] == pytest.approx(40 / 3)
+
+
+def test_a_darker_suit_lit_from_one_side_passes_with_the_golden_model():
+    # A darker red matches only on its lit side: the design's centroid sits ~5 px off the
+    # person's axis, within the silhouette.
+    dark = ["people.0.shirt_color=[0.5,0.1,0.1]", "people.0.trousers_color=[0.5,0.1,0.1]"]
+    s = load_scenario("approach", [*dark, "sim.duration=0.5"])
+    m = run_scenario(s, backend="model").summary
+    assert m["mean_centroid_error_px"] <= 2.0
+    assert "mean_centroid_error_max_px" not in _failed(m)
+
+
 #: A parked robot (no forward speed at any level, no turn, no search) at (1, 3) looking along
 #: +x; the only red thing in the room, the target, walks across 0.9 m in front of it, from its
 #: left (y = 4.5) to its right (y = 1.5), leaving the view on both sides.

@@ -53,6 +53,7 @@ __all__ = [
     "envelope_geometry",
     "envelope_metrics",
     "law_band",
+    "lit_strip_frames",
     "stop_distance_m",
     "sure_side",
 ]
@@ -94,6 +95,9 @@ class EnvelopeGeometry:
     #: The longest exposure (s) over which a turning robot smears the image sideways (the
     #: sensor model's motion blur; 0 for the plain camera, which has none).
     exposure_s: float = 0.0
+    #: The colour codes for which a band of the target matches in some light but not in all:
+    #: its shaded side may drop out and only a lit strip match (``lit_strip_frames``).
+    lit_strip_codes: frozenset = frozenset()
 
     @property
     def focal(self):
@@ -158,6 +162,7 @@ def envelope_geometry(scenario, world_config, camera):
                 sure[code].append((band.z0, band.z1))
             if any(ok):
                 maybe[code].append((band.z0, band.z1))
+    lit_strip = frozenset(code for code in range(8) if sure[code] != maybe[code])
     cam = scenario.camera
     exposure = 0.0
     if cam.sensor != "plain":
@@ -177,7 +182,16 @@ def envelope_geometry(scenario, world_config, camera):
         maybe,
         yaw=getattr(camera, "yaw_offset", 0.0),
         exposure_s=exposure,
+        lit_strip_codes=lit_strip,
     )
+
+
+def lit_strip_frames(traj, geom):
+    """Per frame, whether the colour selected (``color_sel``) may match only a lit strip of
+    the target's suit (``EnvelopeGeometry.lit_strip_codes``); None without a geometry."""
+    if isinstance(geom, str) or "color_sel" not in traj:
+        return None
+    return np.isin(np.asarray(traj["color_sel"], np.int64), list(geom.lit_strip_codes))
 
 
 def _row(z, depth, geom):

@@ -277,7 +277,9 @@ SHIPPED_CHECKS = (
             "mean distance of the design's centroid from the target's image column (with the "
             "target partly beyond the tracking window's edge, from the middle of its part "
             "inside; frames found with the target's centre in view) at most this; with the "
-            "target straight ahead, the centroid's distance from the image centre"
+            "target straight ahead, the centroid's distance from the image centre; with a "
+            "suit whose colour matches in some light but not in all (only a lit strip may "
+            "match), the distance from the part of its silhouette inside the window"
         ),
         lambda v, limit, m: (
             f"centroid {_num(v, limit, 2)} px from the target's image column on average "

@@ -11,7 +11,7 @@ import numpy as np
 
 from fpga_robotics.checks.check import DESIGN_OUTPUTS
 from fpga_robotics.checks.registry import CHECK_OUTPUTS, CHECKS, evaluate_checks, verdict
-from fpga_robotics.checks.window import visible_middle, whole_in_window
+from fpga_robotics.checks.window import visible_middle, whole_in_window, window_columns
 
 __all__ = [
     "CHECKS",
@@ -115,6 +115,7 @@ def compute_metrics(
     margin_x=None,
     collision_summary=None,
     camera_mount=None,
+    lit_strip=None,
 ):
     """Reduce a run to numbers.
 
@@ -145,6 +146,10 @@ def compute_metrics(
     camera_mount : fpga_robotics.loop.connectors.base.Mount, optional
         Where the camera sits on the robot and its yaw off the heading (the heading
         overshoot is measured from the camera's axis); default the robot's centre and heading.
+    lit_strip : numpy bool array, optional
+        Per frame, whether the target's suit may match the colour filter only where it is
+        lit (``envelopes.lit_strip_frames``): the mean centroid error there is measured from
+        the part of the silhouette inside the window, not from its middle.
     """
     absent = [name for name in DESIGN_OUTPUTS if name in set(absent)]
     if absent:
@@ -161,6 +166,7 @@ def compute_metrics(
             margin_x=margin_x,
             collision_summary=collision_summary,
             camera_mount=camera_mount,
+            lit_strip=lit_strip,
         )
         for name, needs in _METRIC_OUTPUTS.items():
             if any(o in absent for o in needs):
@@ -214,7 +220,7 @@ def compute_metrics(
         "tip_overs": len(tipped),
         "max_wheel_command_step_dps": _max_command_step(traj),
         "oscillation_hz": _oscillation(traj, width, n * frame_period),
-        **_off_target(traj, width, margin_x),
+        **_off_target(traj, width, margin_x, lit_strip),
         "led_wrong_side_fraction": _led_wrong_side(traj, width),
         "led_misplaced_fraction": _led_misplaced(traj, width, margin_x),
         "peak_wheel_command_dps": _peak_command(traj),
@@ -269,13 +275,16 @@ def _aim_error(traj, mount):
     return (bearing + np.pi) % (2 * np.pi) - np.pi
 
 
-def _off_target(traj, width, margin_x=None):
+def _off_target(traj, width, margin_x=None, lit_strip=None):
     """How far the design's centroid is from where it should see the target, over the frames
     in which it reports found with the target's centre in view: the target's image column
     (``target_column``) with its silhouette (``target_left`` .. ``target_right``) wholly
     inside the tracking window's columns, else the middle of the part inside (the tracker
     counts only the pixels there; ``visible_middle``; a frame with no part inside is left
-    out). The fraction of those frames with an error above ``OFF_TARGET_FRACTION * width``,
+    out). The mean error of the ``lit_strip`` frames is from the nearest point of the part
+    inside (only a lit strip of the suit may match, its centroid anywhere there; the
+    fraction, which catches another object taken for the target, keeps the middle). The
+    fraction of those frames with an error above ``OFF_TARGET_FRACTION * width``,
     and the mean error (pixels). None without such frames or fields."""
     none = {"off_target_fraction": None, "mean_centroid_error_px": None}
     if width is None or "target_column" not in traj or "centroid_x" not in traj:
@@ -290,13 +299,19 @@ def _off_target(traj, width, margin_x=None):
             column,
             visible_middle(left, right, width, margin_x),
         )
+    centroid = np.asarray(traj["centroid_x"], dtype=float)
     ok = traj["found"] & ~np.isnan(column) & ~np.isnan(expected)
     if not ok.any():
         return none
-    err = np.abs(np.asarray(traj["centroid_x"], dtype=float)[ok] - expected[ok])
+    err = np.abs(centroid - expected)
+    mean_err = err
+    if lit_strip is not None and "target_left" in traj and "target_right" in traj:
+        lo, hi = window_columns(width, margin_x)
+        nearest = np.clip(centroid, np.maximum(left, lo), np.minimum(right, hi))
+        mean_err = np.where(lit_strip, np.abs(centroid - nearest), err)
     return {
-        "off_target_fraction": float((err > OFF_TARGET_FRACTION * width).mean()),
-        "mean_centroid_error_px": float(err.mean()),
+        "off_target_fraction": float((err[ok] > OFF_TARGET_FRACTION * width).mean()),
+        "mean_centroid_error_px": float(mean_err[ok].mean()),
     }
 
 

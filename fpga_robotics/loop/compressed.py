@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from fpga_robotics.checks.envelopes import envelope_geometry, envelope_metrics
+from fpga_robotics.checks.envelopes import envelope_geometry, envelope_metrics, lit_strip_frames
 from fpga_robotics.checks.sensor_metrics import obstacle_metrics
 from fpga_robotics.checks.summary import (
     DESIGN_OUTPUTS,
@@ -524,6 +524,9 @@ class ClosedLoop:
             absent=self.absent,
             margin_x=scenario.params.margin_x,
             camera_mount=self.camera.mount,
+            lit_strip=lit_strip_frames(
+                self.traj, envelope_geometry(scenario, self.world.config, self.camera)
+            ),
         )
         metrics.update(self.extra_metrics())
         checks = evaluate_checks(scenario.checks, metrics)  # on the unrounded metrics
