@@ -115,7 +115,7 @@ JUDGED_IF = {
         3.0,
         2.9,
         {"heading_overshoot_deg": None},
-        "no heading to compare",
+        "the target's centre was never in view",
     ),
     "reacquired_within_s": (
         2.0,

@@ -370,7 +370,7 @@ SHIPPED_CHECKS = (
             f"turned {_num(v, limit, 1)} deg past the target (limit <= {limit} deg)"
         ),
         limits=(0, 180, "deg"),
-        precondition=measured("heading_overshoot_deg", "no heading to compare"),
+        precondition=measured("heading_overshoot_deg", "the target's centre was never in view"),
     ),
     _collisions("wall", "at most this many collisions with a wall"),
     _collisions("furniture", "at most this many collisions with furniture"),
