@@ -62,6 +62,7 @@ JUDGEABLE = {
     "off_line_s": 0.5,
     "obstacle_removed_at_s": 12.0,
     "resumed_after_s": 2.4,
+    "run_after_removal_s": 18.0,
     "measured_frames": {"front": 30},
     "measured_frames_min": 30,
     "silent_sensors": [],

@@ -131,8 +131,22 @@ def _found_fraction(v, limit, m):
     return m["acquired_at_s"] is not None and v >= limit
 
 
+def _resumed(v, limit, m):
+    """Resumed within the limit: a pass; never, in a run that went on for the limit after the
+    removal: a fail. A run that ended sooner leaves nothing to judge (None): the run was cut
+    short, not the design."""
+    if v is not None:
+        return v <= limit
+    return False if m["run_after_removal_s"] >= limit else None
+
+
 def _resumed_text(v, limit, m):
     t_r = m["obstacle_removed_at_s"]
+    if _resumed(v, limit, m) is None:
+        return (
+            f"the run ended {_num(m['run_after_removal_s'], limit, 2)} s after the obstacle "
+            f"left at {t_r:.2f} s, before the {limit} s limit: no resumption to judge"
+        )
     if v is None:
         return (
             f"the robot never drove {RESUME_CLOSING_M} m towards the target after the "
@@ -467,6 +481,7 @@ SHIPPED_CHECKS = (
             "obstacle_removed_at_s",
             "no furniture was removed during the run (room.furniture.present_until)",
         ),
+        passes=_resumed,
     ),
     Check(
         "min_measured_frames",
