@@ -159,7 +159,7 @@ JUDGED_IF = {
     "max_stop_overshoot_m": (
         0.05,
         0.04,
-        {"stop_overshoot_m": None},
+        {"stop_overshoot_m": None, "stop_reason": "the robot never came near the stop distance"},
         "the robot never came near the stop distance",
     ),
     "max_turn_law_violation_fraction": (

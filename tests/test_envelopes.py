@@ -264,6 +264,43 @@ def test_stop_overshoot_counts_the_robots_own_driving_inside(robot_x, target_x, 
     )
 
 
+def test_stop_overshoot_uses_the_colour_followed_in_each_frame():
+    # The first case above, but the first frame follows green (no green band: no stop
+    # distance) before the design switches to red: the same 0.23 m inside red's stop distance.
+    traj = _on_the_axis([0.0, 0.3, 0.6, 0.7, 0.6], [2.0] * 5)
+    traj["color_sel"][0] = 0b010
+    m = envelope_metrics(traj, DEFAULT, GEOM)
+    assert m["stop_overshoot_m"] == pytest.approx(0.23, abs=1e-9)
+    assert (m["stop_distance_m"], m["stop_closest_m"]) == (NEAR, pytest.approx(1.3))
+
+
+@pytest.mark.parametrize(
+    "params, colour, reason",
+    [
+        (
+            DEFAULT.replace(base_dps=(0, 400, 300, 200, 150, 100, 100, 100)),
+            RED,
+            "the law never stops (no base_dps <= 0)",
+        ),
+        (
+            DEFAULT,
+            0b010,
+            (
+                "the law never stops for the colour followed (its count never reaches the "
+                "stopping level's threshold)"
+            ),
+        ),
+        (DEFAULT, RED, "the robot never came near the stop distance"),
+    ],
+)
+def test_stop_overshoot_na_says_why(params, colour, reason):
+    # Driving from 3 m to 2.7 m, beyond red's stop distance (surely driving on past 1.745 m).
+    traj = _on_the_axis([0.0, 0.1, 0.2, 0.3], [3.0] * 4)
+    traj["color_sel"][:] = colour
+    (c,) = evaluate_checks({"max_stop_overshoot_m": 0.05}, envelope_metrics(traj, params, GEOM))
+    assert c["status"] == "n/a" and c["reason"] == reason
+
+
 def test_stop_overshoot_of_a_robot_put_inside_the_stop_distance():
     """approach with the person 1.0 m ahead (centres): the camera, 0.1 m ahead of the
     centre, starts 0.9 m from them, inside the 1.14 m stop distance, and the design backs

@@ -311,6 +311,7 @@ _NAMES = (
     "stop_overshoot_m",
     "stop_distance_m",
     "stop_closest_m",
+    "stop_reason",
     "envelope_reason",
 )
 
@@ -319,8 +320,9 @@ def envelope_metrics(traj, params, geom):
     """The envelope metrics of a run (``geom``: ``envelope_geometry``'s answer): fractions of
     the judged frames outside each band (None when no frame could be judged), the stop
     overshoot (m) with the stop distance and the closest judged distance it is measured
-    against (camera to the target's centre, m), and ``envelope_reason`` (why nothing could be
-    judged at all, else None)."""
+    against (camera to the target's centre, m; each frame's stop distance is the one of the
+    colour it follows), ``stop_reason`` (why there is no stop overshoot, else None) and
+    ``envelope_reason`` (why nothing could be judged at all, else None)."""
     out = dict.fromkeys(_NAMES)
     why = geom if isinstance(geom, str) else _supported(params)
     need = ("found", "motor_left", "motor_right", "target_x", "color_sel", "heading")
@@ -344,9 +346,12 @@ def envelope_metrics(traj, params, geom):
     codes = np.asarray(traj["color_sel"], np.int64)
     w, centred_px = geom.width, geom.width * CENTRED_PX_FRACTION
     speed, reverse, steer = [], [], []
-    stop = stop_distance_m(geom, params, int(codes[0])) if len(codes) else None
-    own = _own_depth(traj, dist, stop[0]) if stop is not None else None
-    closest = overshoot = None
+    # The stop distance of the colour each frame follows (None: that colour never stops).
+    stops = {c: stop_distance_m(geom, params, c) for c in {int(c) for c in codes[found]}}
+    near = np.array([(stops.get(int(c)) or (math.nan,))[0] for c in codes])
+    far = np.array([(stops.get(int(c)) or (math.nan, math.nan))[1] for c in codes])
+    own = _own_depth(traj, dist, near)
+    came_near, judged_stop = False, []
     for k in np.flatnonzero(found):
         if not math.isfinite(dist[k]):
             continue
@@ -372,10 +377,9 @@ def envelope_metrics(traj, params, geom):
         if f_lo >= 0:
             reverse.append(fwd[k] < 0)
         steer.append(not t_lo <= turn[k] <= t_hi)
-        if abs(bearing[k]) < geom.hfov / 2:
-            closest = dist[k] if closest is None else min(closest, dist[k])
-            if own is not None:
-                overshoot = own[k] if overshoot is None else max(overshoot, own[k])
+        if abs(bearing[k]) < geom.hfov / 2 and math.isfinite(near[k]):
+            judged_stop.append(k)
+            came_near = came_near or dist[k] <= far[k]
     out["approach_speed_violation_fraction"] = _fraction(speed)
     out["reverse_when_far_fraction"] = _fraction(reverse)
     out["turn_law_violation_fraction"] = _fraction(steer)
@@ -387,14 +391,28 @@ def envelope_metrics(traj, params, geom):
     out["search_law_violation_fraction"] = _fraction(
         _search_judged(found, ml, mr, dist, bearing, geom, params, side_tol)
     )
-    if stop is not None and closest is not None and closest <= stop[1]:
-        out["stop_overshoot_m"] = float(overshoot)
-        out["stop_distance_m"], out["stop_closest_m"] = stop[0], float(closest)
+    if came_near:
+        # Reported against the stop distance of the deepest frame's colour.
+        deepest = max(judged_stop, key=lambda k: own[k])
+        same = [k for k in judged_stop if codes[k] == codes[deepest]]
+        out["stop_overshoot_m"] = float(own[deepest])
+        out["stop_distance_m"] = float(near[deepest])
+        out["stop_closest_m"] = float(min(dist[same]))
+    elif _stop_level(params) is None:
+        out["stop_reason"] = "the law never stops (no base_dps <= 0)"
+    elif stops and not any(stops.values()):
+        out["stop_reason"] = (
+            "the law never stops for the colour followed (its count never reaches the "
+            "stopping level's threshold)"
+        )
+    else:
+        out["stop_reason"] = "the robot never came near the stop distance"
     return out
 
 
 def _own_depth(traj, dist, near):
-    """Per frame, how far inside the stop distance ``near`` (m) the robot's own driving has
+    """Per frame, how far inside the stop distance ``near`` (m, per frame; NaN where there is
+    none) the robot's own driving has
     taken it: its centre's closing on the target (held where it stood the frame before; a
     turn in place closes nothing) adds up while the camera is inside, never below 0 nor
     beyond the camera's depth there. The rest of the depth is not the robot's doing: it

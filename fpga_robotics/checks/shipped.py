@@ -555,7 +555,7 @@ SHIPPED_CHECKS = (
         ),
         limits=(0, 100, "m"),
         outputs=_WHEELS,
-        precondition=_envelope("stop_overshoot_m", "the robot never came near the stop distance"),
+        precondition=lambda m: _envelope("stop_overshoot_m", m.get("stop_reason"))(m),
     ),
     Check(
         "max_turn_law_violation_fraction",
