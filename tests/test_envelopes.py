@@ -314,6 +314,22 @@ def test_stop_overshoot_of_a_robot_put_inside_the_stop_distance():
     assert m["stop_overshoot_m"] == 0.0
 
 
+def test_frames_the_interlock_holds_are_not_judged():
+    # follow_target_safe: at 4 m the law says 200 forward (level 3); with ``obstacle`` 1 the
+    # interlock holds the wheels at 0, which is right. The loss that begins after it holds the
+    # inner design's command (200), not the 0 shown: its hold is not judged.
+    traj = _traj(
+        [(True, 0.0, 200, 200), (True, 0.0, 0, 0), (False, 0.0, 200, 200), (True, 0.0, 200, 200)]
+    )
+    m = envelope_metrics(traj, DEFAULT, GEOM)
+    assert m["approach_speed_violation_fraction"] == pytest.approx(1 / 3)
+    assert m["search_law_violation_fraction"] == 1.0
+    traj["design.obstacle"] = np.array([0.0, 1.0, 0.0, 0.0])
+    m = envelope_metrics(traj, DEFAULT, GEOM)
+    assert m["approach_speed_violation_fraction"] == 0.0
+    assert m["search_law_violation_fraction"] is None
+
+
 def test_other_laws_leave_the_envelopes_na():
     traj = _traj([(True, 0.0, 200, 200)])
     m = envelope_metrics(traj, FollowTargetParams.published(), GEOM)

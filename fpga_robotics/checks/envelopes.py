@@ -342,6 +342,9 @@ def envelope_metrics(traj, params, geom):
         out["envelope_reason"] = "the design has no wheel command outputs"
         return out
     fwd, turn = (ml + mr) / 2, (ml - mr) / 2
+    # An obstacle interlock (follow_target_safe's ``obstacle`` output) holding the wheels at 0
+    # overrides the law in those frames: they are not judged.
+    interlocked = np.asarray(traj.get("design.obstacle", np.zeros(len(found))), float) == 1
     dist, bearing = _camera_view(traj, geom)
     codes = np.asarray(traj["color_sel"], np.int64)
     w, centred_px = geom.width, geom.width * CENTRED_PX_FRACTION
@@ -372,11 +375,12 @@ def envelope_metrics(traj, params, geom):
             tol += abs(float(traj["w"][k])) * geom.exposure_s * geom.focal / 2
         e = column - w // 2
         f_lo, f_hi, t_lo, t_hi = law_band(levels, e - tol, e + tol, params)
-        if abs(column + 0.5 - w / 2) <= centred_px:
-            speed.append(not f_lo <= fwd[k] <= f_hi)
-        if f_lo >= 0:
-            reverse.append(fwd[k] < 0)
-        steer.append(not t_lo <= turn[k] <= t_hi)
+        if not interlocked[k]:
+            if abs(column + 0.5 - w / 2) <= centred_px:
+                speed.append(not f_lo <= fwd[k] <= f_hi)
+            if f_lo >= 0:
+                reverse.append(fwd[k] < 0)
+            steer.append(not t_lo <= turn[k] <= t_hi)
         if abs(bearing[k]) < geom.hfov / 2 and math.isfinite(near[k]):
             judged_stop.append(k)
             came_near = came_near or dist[k] <= far[k]
@@ -389,7 +393,7 @@ def envelope_metrics(traj, params, geom):
     if geom.exposure_s and "w" in traj:
         side_tol += np.abs(np.asarray(traj["w"], float)) * geom.exposure_s * geom.focal / 2
     out["search_law_violation_fraction"] = _fraction(
-        _search_judged(found, ml, mr, dist, bearing, geom, params, side_tol)
+        _search_judged(found, ml, mr, dist, bearing, geom, params, side_tol, interlocked)
     )
     if came_near:
         # Reported against the stop distance of the deepest frame's colour.
@@ -429,11 +433,13 @@ def _own_depth(traj, dist, near):
     return own
 
 
-def _search_judged(found, ml, mr, dist, bearing, geom, params, side_tol):
+def _search_judged(found, ml, mr, dist, bearing, geom, params, side_tol, interlocked):
     """Per judged lost frame, whether the design broke the lost law: hold the last command
     for lost frames 1..lost_frames-1, then turn in place at ``search_dps`` towards the side the
     target was last seen on (left after reset). A sighting within ``E_TOLERANCE_PX`` of the
-    image centre has no sure side (``sure_side``): its search frames are not judged."""
+    image centre has no sure side (``sure_side``): its search frames are not judged, nor are
+    the ``interlocked`` frames, nor the hold of a loss that began with the interlock holding
+    the wheels (the command held is then not the one seen)."""
     out = []
     lost, side, held = 0, -1, (0.0, 0.0)  # side: -1 left, +1 right, 0 unknown
     for k in range(len(found)):
@@ -442,10 +448,16 @@ def _search_judged(found, ml, mr, dist, bearing, geom, params, side_tol):
             side = sure_side(float(dist[k]), float(bearing[k]), geom, params, side_tol[k])
             continue
         if lost == 0:  # the command shown when the loss began is the one to hold
-            held = (ml[k - 1], mr[k - 1]) if k else (0.0, 0.0)
+            if k == 0:
+                held = (0.0, 0.0)
+            else:
+                held = None if interlocked[k - 1] else (ml[k - 1], mr[k - 1])
         lost = min(lost + 1, params.lost_frames)
+        if interlocked[k]:
+            continue
         if lost < params.lost_frames:
-            out.append((ml[k], mr[k]) != held)
+            if held is not None:
+                out.append((ml[k], mr[k]) != held)
         elif side:
             s = params.search_dps * side
             out.append((ml[k], mr[k]) != (s, -s))
