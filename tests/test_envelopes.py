@@ -330,6 +330,35 @@ def test_frames_the_interlock_holds_are_not_judged():
     assert m["search_law_violation_fraction"] is None
 
 
+def test_a_failing_envelope_names_its_frames_and_the_first_violation():
+    # At 4 m every count is level 3: 200 forward, no turn straight ahead. Frame 2 (t = 2/30 s)
+    # is the first of two at 300; then the target is lost: frame 4 holds (300, 300), frame 5
+    # does not.
+    traj = _traj(
+        [
+            (True, 0.0, 200, 200),
+            (True, 0.0, 200, 200),
+            (True, 0.0, 300, 300),
+            (True, 0.0, 300, 300),
+            (False, 0.0, 300, 300),
+            (False, 0.0, 0, 0),
+        ]
+    )
+    m = envelope_metrics(traj, DEFAULT, GEOM)
+    (speed, search) = evaluate_checks(
+        {"max_approach_speed_violation_fraction": 0.0, "max_search_law_violation_fraction": 0.0},
+        m,
+    )
+    assert speed["text"] == (
+        "forward speed outside the approach law in 2 of 4 centred frames (50.0%), first at "
+        "0.07 s (frame 2): 300 DPS, law 200..200 (levels 3..3 at 4.00 m) (limit <= 0%)"
+    )
+    assert search["text"] == (
+        "lost/search command off the law in 1 of 2 lost frames judged (50.0%), first at 0.17 s "
+        "(frame 5): wheels 0, 0 DPS, law 300, 300 (limit <= 0%)"
+    )
+
+
 def test_other_laws_leave_the_envelopes_na():
     traj = _traj([(True, 0.0, 200, 200)])
     m = envelope_metrics(traj, FollowTargetParams.published(), GEOM)

@@ -313,6 +313,10 @@ _NAMES = (
     "stop_closest_m",
     "stop_reason",
     "envelope_reason",
+    "approach_speed_frames",
+    "reverse_when_far_frames",
+    "turn_law_frames",
+    "search_law_frames",
 )
 
 
@@ -322,7 +326,9 @@ def envelope_metrics(traj, params, geom):
     overshoot (m) with the stop distance and the closest judged distance it is measured
     against (camera to the target's centre, m; each frame's stop distance is the one of the
     colour it follows), ``stop_reason`` (why there is no stop overshoot, else None) and
-    ``envelope_reason`` (why nothing could be judged at all, else None)."""
+    ``envelope_reason`` (why nothing could be judged at all, else None). Each law's
+    ``..._frames`` (``_frames_judged``) says how many frames it judged and what the first
+    one outside the law commanded against what the law allowed."""
     out = dict.fromkeys(_NAMES)
     why = geom if isinstance(geom, str) else _supported(params)
     need = ("found", "motor_left", "motor_right", "target_x", "color_sel", "heading")
@@ -376,25 +382,30 @@ def envelope_metrics(traj, params, geom):
         e = column - w // 2
         f_lo, f_hi, t_lo, t_hi = law_band(levels, e - tol, e + tol, params)
         if not interlocked[k]:
+            where = {"levels": [int(levels[0]), int(levels[-1])], "distance_m": float(dist[k])}
             if abs(column + 0.5 - w / 2) <= centred_px:
-                speed.append(not f_lo <= fwd[k] <= f_hi)
+                bad = not f_lo <= fwd[k] <= f_hi
+                speed.append((k, bad, fwd[k], [f_lo, f_hi], where))
             if f_lo >= 0:
-                reverse.append(fwd[k] < 0)
-            steer.append(not t_lo <= turn[k] <= t_hi)
+                reverse.append((k, fwd[k] < 0, fwd[k], [f_lo, f_hi], where))
+            steer.append((k, not t_lo <= turn[k] <= t_hi, turn[k], [t_lo, t_hi], where))
         if abs(bearing[k]) < geom.hfov / 2 and math.isfinite(near[k]):
             judged_stop.append(k)
             came_near = came_near or dist[k] <= far[k]
-    out["approach_speed_violation_fraction"] = _fraction(speed)
-    out["reverse_when_far_fraction"] = _fraction(reverse)
-    out["turn_law_violation_fraction"] = _fraction(steer)
     # A sighting's side, like the centroid error, gets half the smear of a turn during the
     # exposure on top of E_TOLERANCE_PX.
     side_tol = np.full(len(found), E_TOLERANCE_PX)
     if geom.exposure_s and "w" in traj:
         side_tol += np.abs(np.asarray(traj["w"], float)) * geom.exposure_s * geom.focal / 2
-    out["search_law_violation_fraction"] = _fraction(
-        _search_judged(found, ml, mr, dist, bearing, geom, params, side_tol, interlocked)
-    )
+    search = _search_judged(found, ml, mr, dist, bearing, geom, params, side_tol, interlocked)
+    for name, fraction, judged in (
+        ("approach_speed", "approach_speed_violation_fraction", speed),
+        ("reverse_when_far", "reverse_when_far_fraction", reverse),
+        ("turn_law", "turn_law_violation_fraction", steer),
+        ("search_law", "search_law_violation_fraction", search),
+    ):
+        out[fraction] = _fraction([row[1] for row in judged])
+        out[f"{name}_frames"] = _frames_judged(judged, traj["t"])
     if came_near:
         # Reported against the stop distance of the deepest frame's colour.
         deepest = max(judged_stop, key=lambda k: own[k])
@@ -434,7 +445,8 @@ def _own_depth(traj, dist, near):
 
 
 def _search_judged(found, ml, mr, dist, bearing, geom, params, side_tol, interlocked):
-    """Per judged lost frame, whether the design broke the lost law: hold the last command
+    """Per judged lost frame ``(frame, broke the law, [L, R] seen, [L, R] the law's)``, the
+    lost law being: hold the last command
     for lost frames 1..lost_frames-1, then turn in place at ``search_dps`` towards the side the
     target was last seen on (left after reset). A sighting within ``E_TOLERANCE_PX`` of the
     image centre has no sure side (``sure_side``): its search frames are not judged, nor are
@@ -457,10 +469,10 @@ def _search_judged(found, ml, mr, dist, bearing, geom, params, side_tol, interlo
             continue
         if lost < params.lost_frames:
             if held is not None:
-                out.append((ml[k], mr[k]) != held)
+                out.append((k, (ml[k], mr[k]) != held, [ml[k], mr[k]], list(held), {}))
         elif side:
             s = params.search_dps * side
-            out.append((ml[k], mr[k]) != (s, -s))
+            out.append((k, (ml[k], mr[k]) != (s, -s), [ml[k], mr[k]], [s, -s], {}))
     return out
 
 
@@ -493,6 +505,25 @@ def sure_side(distance, bearing, geom, params, tol=E_TOLERANCE_PX):
     if hi < centre - tol:
         return -1
     return 0
+
+
+def _frames_judged(judged, t):
+    """``judged``: rows ``(frame, broke the law, commanded, allowed, where)``. The number of
+    frames judged and outside the law, and the first of those: its frame, time (s), the
+    command seen and the law's (DPS), and ``where`` (levels and distance, for the laws of
+    the target's count)."""
+    bad = [row for row in judged if row[1]]
+    first = None
+    if bad:
+        k, _, commanded, allowed, where = bad[0]
+        first = {
+            "frame": int(k),
+            "t": float(t[k]),
+            "commanded": np.asarray(commanded, float).tolist(),
+            "allowed": np.asarray(allowed, float).tolist(),
+            **where,
+        }
+    return {"judged": len(judged), "violated": len(bad), "first": first}
 
 
 def _fraction(flags):

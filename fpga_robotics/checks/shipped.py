@@ -168,6 +168,28 @@ def _measured_text(v, limit, m):
     return f"every sensor measured in at least {v} frame(s) (limit >= {limit})"
 
 
+def _judged_text(v, limit, judged, noun):
+    """``n of N <noun> (p%)``, then the first frame outside the law: its time and frame, the
+    command seen against the law's (``judged``: an ``envelopes`` ``..._frames`` metric; the
+    percentage alone without it)."""
+    if not judged:
+        return f"{_pct(v, limit, 1)} of the {noun}"
+    text = f"{judged['violated']} of {judged['judged']} {noun} ({_pct(v, limit, 1)})"
+    first = judged["first"]
+    if first is None:
+        return text
+    seen, law = first["commanded"], first["allowed"]
+    if isinstance(seen, list):  # the lost/search law: both wheels
+        what = f"wheels {seen[0]:g}, {seen[1]:g} DPS, law {law[0]:g}, {law[1]:g}"
+    else:
+        lo, hi = first["levels"]
+        what = (
+            f"{seen:g} DPS, law {law[0]:g}..{law[1]:g} (levels {lo}..{hi} at "
+            f"{first['distance_m']:.2f} m)"
+        )
+    return f"{text}, first at {first['t']:.2f} s (frame {first['frame']}): {what}"
+
+
 def _envelope(metric, no_frames):
     """A precondition: the envelopes read this design's laws and the run judged a frame."""
 
@@ -509,8 +531,9 @@ SHIPPED_CHECKS = (
             f"levels its pixel count can reach there) in at most this fraction of the frames {_BAND}"
         ),
         lambda v, limit, m: (
-            f"forward speed outside the approach law in {_pct(v, limit, 1)} of the "
-            f"centred frames (limit <= {_limit_pct(limit)})"
+            "forward speed outside the approach law in "
+            f"{_judged_text(v, limit, m.get('approach_speed_frames'), 'centred frames')} "
+            f"(limit <= {_limit_pct(limit)})"
         ),
         limits=_FRACTION,
         outputs=_WHEELS,
@@ -529,8 +552,9 @@ SHIPPED_CHECKS = (
             f"{_BAND}"
         ),
         lambda v, limit, m: (
-            f"reversing with the target beyond the reversing distance in "
-            f"{_pct(v, limit, 1)} of those frames (limit <= {_limit_pct(limit)})"
+            "reversing with the target beyond the reversing distance in "
+            f"{_judged_text(v, limit, m.get('reverse_when_far_frames'), 'frames found there')} "
+            f"(limit <= {_limit_pct(limit)})"
         ),
         limits=_FRACTION,
         outputs=_WHEELS,
@@ -567,7 +591,9 @@ SHIPPED_CHECKS = (
             f"in at most this fraction of the frames {_BAND}"
         ),
         lambda v, limit, m: (
-            f"turn outside the steering law in {_pct(v, limit, 1)} of the frames judged (limit <= {_limit_pct(limit)})"
+            "turn outside the steering law in "
+            f"{_judged_text(v, limit, m.get('turn_law_frames'), 'frames judged')} "
+            f"(limit <= {_limit_pct(limit)})"
         ),
         limits=_FRACTION,
         outputs=_WHEELS,
@@ -585,8 +611,9 @@ SHIPPED_CHECKS = (
             f"seen on, in all but at most this fraction of the lost frames {_BAND}"
         ),
         lambda v, limit, m: (
-            f"lost/search command off the law in {_pct(v, limit, 1)} of the lost "
-            f"frames judged (limit <= {_limit_pct(limit)})"
+            "lost/search command off the law in "
+            f"{_judged_text(v, limit, m.get('search_law_frames'), 'lost frames judged')} "
+            f"(limit <= {_limit_pct(limit)})"
         ),
         limits=_FRACTION,
         outputs=_WHEELS,
