@@ -62,6 +62,7 @@ JUDGEABLE = {
     "off_line_s": 0.5,
     "obstacle_removed_at_s": 12.0,
     "resumed_after_s": 2.4,
+    "run_after_removal_s": 18.0,
     "measured_frames": {"front": 30},
     "measured_frames_min": 30,
     "silent_sensors": [],
@@ -115,7 +116,7 @@ JUDGED_IF = {
         3.0,
         2.9,
         {"heading_overshoot_deg": None},
-        "no heading to compare",
+        "the target's centre was never in view",
     ),
     "reacquired_within_s": (
         2.0,
@@ -158,7 +159,7 @@ JUDGED_IF = {
     "max_stop_overshoot_m": (
         0.05,
         0.04,
-        {"stop_overshoot_m": None},
+        {"stop_overshoot_m": None, "stop_reason": "the robot never came near the stop distance"},
         "the robot never came near the stop distance",
     ),
     "max_turn_law_violation_fraction": (

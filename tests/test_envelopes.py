@@ -309,6 +309,43 @@ def test_stop_overshoot_counts_the_robots_own_driving_inside(robot_x, target_x, 
     )
 
 
+def test_stop_overshoot_uses_the_colour_followed_in_each_frame():
+    # The first case above, but the first frame follows green (no green band: no stop
+    # distance) before the design switches to red: the same 0.23 m inside red's stop distance.
+    traj = _on_the_axis([0.0, 0.3, 0.6, 0.7, 0.6], [2.0] * 5)
+    traj["color_sel"][0] = 0b010
+    m = envelope_metrics(traj, DEFAULT, GEOM)
+    assert m["stop_overshoot_m"] == pytest.approx(0.23, abs=1e-9)
+    assert (m["stop_distance_m"], m["stop_closest_m"]) == (NEAR, pytest.approx(1.3))
+
+
+@pytest.mark.parametrize(
+    "params, colour, reason",
+    [
+        (
+            DEFAULT.replace(base_dps=(0, 400, 300, 200, 150, 100, 100, 100)),
+            RED,
+            "the law never stops (no base_dps <= 0)",
+        ),
+        (
+            DEFAULT,
+            0b010,
+            (
+                "the law never stops for the colour followed (its count never reaches the "
+                "stopping level's threshold)"
+            ),
+        ),
+        (DEFAULT, RED, "the robot never came near the stop distance"),
+    ],
+)
+def test_stop_overshoot_na_says_why(params, colour, reason):
+    # Driving from 3 m to 2.7 m, beyond red's stop distance (surely driving on past 1.745 m).
+    traj = _on_the_axis([0.0, 0.1, 0.2, 0.3], [3.0] * 4)
+    traj["color_sel"][:] = colour
+    (c,) = evaluate_checks({"max_stop_overshoot_m": 0.05}, envelope_metrics(traj, params, GEOM))
+    assert c["status"] == "n/a" and c["reason"] == reason
+
+
 def test_stop_overshoot_of_a_robot_put_inside_the_stop_distance():
     """approach with the person 1.0 m ahead (centres): the camera, 0.1 m ahead of the
     centre, starts 0.9 m from them, inside the 1.14 m stop distance, and the design backs
@@ -320,6 +357,51 @@ def test_stop_overshoot_of_a_robot_put_inside_the_stop_distance():
     assert m["stop_distance_m"] > 1.0
     assert m["stop_closest_m"] == pytest.approx(0.9, abs=1e-6)
     assert m["stop_overshoot_m"] == 0.0
+
+
+def test_frames_the_interlock_holds_are_not_judged():
+    # follow_target_safe: at 4 m the law says 200 forward (level 3); with ``obstacle`` 1 the
+    # interlock holds the wheels at 0, which is right. The loss that begins after it holds the
+    # inner design's command (200), not the 0 shown: its hold is not judged.
+    traj = _traj(
+        [(True, 0.0, 200, 200), (True, 0.0, 0, 0), (False, 0.0, 200, 200), (True, 0.0, 200, 200)]
+    )
+    m = envelope_metrics(traj, DEFAULT, GEOM)
+    assert m["approach_speed_violation_fraction"] == pytest.approx(1 / 3)
+    assert m["search_law_violation_fraction"] == 1.0
+    traj["design.obstacle"] = np.array([0.0, 1.0, 0.0, 0.0])
+    m = envelope_metrics(traj, DEFAULT, GEOM)
+    assert m["approach_speed_violation_fraction"] == 0.0
+    assert m["search_law_violation_fraction"] is None
+
+
+def test_a_failing_envelope_names_its_frames_and_the_first_violation():
+    # At 4 m every count is level 3: 200 forward, no turn straight ahead. Frame 2 (t = 2/30 s)
+    # is the first of two at 300; then the target is lost: frame 4 holds (300, 300), frame 5
+    # does not.
+    traj = _traj(
+        [
+            (True, 0.0, 200, 200),
+            (True, 0.0, 200, 200),
+            (True, 0.0, 300, 300),
+            (True, 0.0, 300, 300),
+            (False, 0.0, 300, 300),
+            (False, 0.0, 0, 0),
+        ]
+    )
+    m = envelope_metrics(traj, DEFAULT, GEOM)
+    (speed, search) = evaluate_checks(
+        {"max_approach_speed_violation_fraction": 0.0, "max_search_law_violation_fraction": 0.0},
+        m,
+    )
+    assert speed["text"] == (
+        "forward speed outside the approach law in 2 of 4 centred frames (50.0%), first at "
+        "0.07 s (frame 2): 300 DPS, law 200..200 (levels 3..3 at 4.00 m) (limit <= 0%)"
+    )
+    assert search["text"] == (
+        "lost/search command off the law in 1 of 2 lost frames judged (50.0%), first at 0.17 s "
+        "(frame 5): wheels 0, 0 DPS, law 300, 300 (limit <= 0%)"
+    )
 
 
 def test_other_laws_leave_the_envelopes_na():

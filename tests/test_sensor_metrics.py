@@ -41,8 +41,8 @@ def test_a_person_walking_up_to_a_robot_that_stays_put_is_not_a_resumption():
     t = [1.0, 1.5, 2.0, 2.5, 3.0]
     m = obstacle_metrics(_traj(t, [1.0] * 5, [3.0, 2.75, 2.5, 2.25, 2.0]), REMOVED)
     assert m["resumed_after_s"] is None
-    ok, text = sensor_check("resumes_within_s", 5.0, m)
-    assert not ok and text.startswith("the robot never drove 0.2 m towards the target")
+    ok, text = sensor_check("resumes_within_s", 1.5, m)
+    assert ok is False and text.startswith("the robot never drove 0.2 m towards the target")
     # Following a person who walks away as fast: the distance stays 2 m, the robot drives
     # 0.25 m a row towards them: 0.25 >= 0.2 after the first step, at 1.5 s.
     walk = [1.0, 1.25, 1.5, 1.75, 2.0]
@@ -51,6 +51,22 @@ def test_a_person_walking_up_to_a_robot_that_stays_put_is_not_a_resumption():
     assert sensor_check("resumes_within_s", 1.0, m)[1] == (
         "drove 0.2 m towards the target 0.50 s after the obstacle left (limit 1.0 s)"
     )
+
+
+def test_a_run_that_ends_before_the_limit_has_passed_is_not_judged():
+    # Removed at 1.0 s, the robot standing still, the run's last row at 3.0 s: 2 s after the
+    # removal, so a limit of 3 s cannot have been missed yet, while one of 2 s has.
+    t = [1.0, 1.5, 2.0, 2.5, 3.0]
+    m = obstacle_metrics(_traj(t, [1.0] * 5, [3.0] * 5), REMOVED)
+    assert m["resumed_after_s"] is None and m["run_after_removal_s"] == pytest.approx(2.0)
+    assert sensor_check("resumes_within_s", 3.0, m) == (
+        None,
+        (
+            "the run ended 2.00 s after the obstacle left at 1.00 s, before the 3.0 s limit: "
+            "no resumption to judge"
+        ),
+    )
+    assert sensor_check("resumes_within_s", 2.0, m)[0] is False
 
 
 def test_only_the_motion_along_the_direction_to_the_target_counts():
@@ -94,7 +110,7 @@ def test_lateral_error_and_time_off_a_straight_line_by_hand():
         _rows([1.0, 1.1, 1.2], [1.0, 1.005, 0.97], [0.0] * 3), [tape], [Mount(forward=0.1)], 0.1
     )
     assert m["lateral_error_max_m"] == pytest.approx(0.03)
-    assert m["lateral_error_mean_m"] == pytest.approx(round(0.035 / 3, 4))
+    assert m["lateral_error_mean_m"] == pytest.approx(0.035 / 3)
     assert m["off_line_s"] == pytest.approx(0.1)  # one row of 0.1 s off the tape
     assert m["laps"] is None  # an open line has no laps
     # Two sensors 10 mm either side: their centre is the robot's line; the one row with the
@@ -107,6 +123,11 @@ def test_lateral_error_and_time_off_a_straight_line_by_hand():
     )
     assert m["off_line_s"] == pytest.approx(0.1)
     assert m["lateral_error_max_m"] == pytest.approx(0.03)
+    # The checks judge the exact error: 0.03004 m exceeds a limit of 0.03 m, though it shows
+    # as 0.03 to 4 decimals.
+    m = line_metrics(_rows([1.0], [1.03004], [0.0]), [tape], [Mount(forward=0.1)], 0.1)
+    assert m["lateral_error_max_m"] == pytest.approx(0.03004)
+    assert sensor_check("max_lateral_error_m", 0.03, m)[0] is False
 
 
 def test_laps_count_the_net_progress_around_a_closed_line():

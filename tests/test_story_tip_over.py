@@ -208,6 +208,29 @@ def test_heading_overshoot_is_the_far_side_error_after_the_first_crossing():
     assert not c["passed"] and c["text"] == "turned 7.0 deg past the target (limit <= 5.0 deg)"
 
 
+def test_heading_overshoot_is_na_when_the_target_was_never_in_view():
+    # The robot turns through the target's bearing, but its centre is never in view: there is
+    # no heading response to judge, so no overshoot of 0.
+    headings = np.radians([-20, 10, -10])
+    n = len(headings)
+    traj = {
+        "t": np.arange(n) / 30,
+        "x": np.zeros(n),
+        "y": np.zeros(n),
+        "heading": headings,
+        "found": np.zeros(n, bool),
+        "target_x": np.ones(n),
+        "target_y": np.zeros(n),
+        "target_distance": np.ones(n),
+        "target_in_view": np.zeros(n, bool),
+        "target_column": np.full(n, np.nan),
+    }
+    m = compute_metrics(traj, [], {}, 1 / 30)
+    assert m["heading_overshoot_deg"] is None
+    (c,) = evaluate_checks({"max_heading_overshoot_deg": 5.0}, m)
+    assert c["status"] == "n/a" and c["reason"] == "the target's centre was never in view"
+
+
 def _turning_in_place(headings_deg):
     """The robot at the origin turning through ``headings_deg``, the target standing at
     (1, 0) with its centre in view in every frame."""

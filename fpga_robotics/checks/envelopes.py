@@ -358,7 +358,12 @@ _NAMES = (
     "stop_overshoot_m",
     "stop_distance_m",
     "stop_closest_m",
+    "stop_reason",
     "envelope_reason",
+    "approach_speed_frames",
+    "reverse_when_far_frames",
+    "turn_law_frames",
+    "search_law_frames",
 )
 
 
@@ -366,8 +371,11 @@ def envelope_metrics(traj, params, geom):
     """The envelope metrics of a run (``geom``: ``envelope_geometry``'s answer): fractions of
     the judged frames outside each band (None when no frame could be judged), the stop
     overshoot (m) with the stop distance and the closest judged distance it is measured
-    against (camera to the target's centre, m), and ``envelope_reason`` (why nothing could be
-    judged at all, else None)."""
+    against (camera to the target's centre, m; each frame's stop distance is the one of the
+    colour it follows), ``stop_reason`` (why there is no stop overshoot, else None) and
+    ``envelope_reason`` (why nothing could be judged at all, else None). Each law's
+    ``..._frames`` (``_frames_judged``) says how many frames it judged and what the first
+    one outside the law commanded against what the law allowed."""
     out = dict.fromkeys(_NAMES)
     why = geom if isinstance(geom, str) else _supported(params)
     need = ("found", "motor_left", "motor_right", "target_x", "color_sel", "heading")
@@ -387,15 +395,21 @@ def envelope_metrics(traj, params, geom):
         out["envelope_reason"] = "the design has no wheel command outputs"
         return out
     fwd, turn = (ml + mr) / 2, (ml - mr) / 2
+    # An obstacle interlock (follow_target_safe's ``obstacle`` output) holding the wheels at 0
+    # overrides the law in those frames: they are not judged.
+    interlocked = np.asarray(traj.get("design.obstacle", np.zeros(len(found))), float) == 1
     dist, bearing = _camera_view(traj, geom)
     codes = np.asarray(traj["color_sel"], np.int64)
     # On a ramp the camera pitches with the robot: each frame's rows are drawn at its tilt.
     tilts = np.asarray(traj.get("camera_tilt", np.full(len(codes), geom.tilt)), float)
     w, centred_px = geom.width, geom.width * CENTRED_PX_FRACTION
     speed, reverse, steer = [], [], []
-    stop = stop_distance_m(geom, params, int(codes[0])) if len(codes) else None
-    own = _own_depth(traj, dist, stop[0]) if stop is not None else None
-    closest = overshoot = None
+    # The stop distance of the colour each frame follows (None: that colour never stops).
+    stops = {c: stop_distance_m(geom, params, c) for c in {int(c) for c in codes[found]}}
+    near = np.array([(stops.get(int(c)) or (math.nan,))[0] for c in codes])
+    far = np.array([(stops.get(int(c)) or (math.nan, math.nan))[1] for c in codes])
+    own = _own_depth(traj, dist, near)
+    came_near, judged_stop = False, []
     for k in np.flatnonzero(found):
         if not math.isfinite(dist[k]):
             continue
@@ -418,34 +432,53 @@ def envelope_metrics(traj, params, geom):
             tol += abs(float(traj["w"][k])) * geom.exposure_s * geom.focal / 2
         e = column - w // 2
         f_lo, f_hi, t_lo, t_hi = law_band(levels, e - tol, e + tol, params)
-        if abs(column + 0.5 - w / 2) <= centred_px:
-            speed.append(not f_lo <= fwd[k] <= f_hi)
-        if f_lo >= 0:
-            reverse.append(fwd[k] < 0)
-        steer.append(not t_lo <= turn[k] <= t_hi)
-        if abs(bearing[k]) < geom.hfov / 2:
-            closest = dist[k] if closest is None else min(closest, dist[k])
-            if own is not None:
-                overshoot = own[k] if overshoot is None else max(overshoot, own[k])
-    out["approach_speed_violation_fraction"] = _fraction(speed)
-    out["reverse_when_far_fraction"] = _fraction(reverse)
-    out["turn_law_violation_fraction"] = _fraction(steer)
+        if not interlocked[k]:
+            where = {"levels": [int(levels[0]), int(levels[-1])], "distance_m": float(dist[k])}
+            if abs(column + 0.5 - w / 2) <= centred_px:
+                bad = not f_lo <= fwd[k] <= f_hi
+                speed.append((k, bad, fwd[k], [f_lo, f_hi], where))
+            if f_lo >= 0:
+                reverse.append((k, fwd[k] < 0, fwd[k], [f_lo, f_hi], where))
+            steer.append((k, not t_lo <= turn[k] <= t_hi, turn[k], [t_lo, t_hi], where))
+        if abs(bearing[k]) < geom.hfov / 2 and math.isfinite(near[k]):
+            judged_stop.append(k)
+            came_near = came_near or dist[k] <= far[k]
     # A sighting's side, like the centroid error, gets half the smear of a turn during the
     # exposure on top of E_TOLERANCE_PX.
     side_tol = np.full(len(found), E_TOLERANCE_PX)
     if geom.exposure_s and "w" in traj:
         side_tol += np.abs(np.asarray(traj["w"], float)) * geom.exposure_s * geom.focal / 2
-    out["search_law_violation_fraction"] = _fraction(
-        _search_judged(found, ml, mr, dist, bearing, geom, params, side_tol)
-    )
-    if stop is not None and closest is not None and closest <= stop[1]:
-        out["stop_overshoot_m"] = float(overshoot)
-        out["stop_distance_m"], out["stop_closest_m"] = stop[0], float(closest)
+    search = _search_judged(found, ml, mr, dist, bearing, geom, params, side_tol, interlocked)
+    for name, fraction, judged in (
+        ("approach_speed", "approach_speed_violation_fraction", speed),
+        ("reverse_when_far", "reverse_when_far_fraction", reverse),
+        ("turn_law", "turn_law_violation_fraction", steer),
+        ("search_law", "search_law_violation_fraction", search),
+    ):
+        out[fraction] = _fraction([row[1] for row in judged])
+        out[f"{name}_frames"] = _frames_judged(judged, traj["t"])
+    if came_near:
+        # Reported against the stop distance of the deepest frame's colour.
+        deepest = max(judged_stop, key=lambda k: own[k])
+        same = [k for k in judged_stop if codes[k] == codes[deepest]]
+        out["stop_overshoot_m"] = float(own[deepest])
+        out["stop_distance_m"] = float(near[deepest])
+        out["stop_closest_m"] = float(min(dist[same]))
+    elif _stop_level(params) is None:
+        out["stop_reason"] = "the law never stops (no base_dps <= 0)"
+    elif stops and not any(stops.values()):
+        out["stop_reason"] = (
+            "the law never stops for the colour followed (its count never reaches the "
+            "stopping level's threshold)"
+        )
+    else:
+        out["stop_reason"] = "the robot never came near the stop distance"
     return out
 
 
 def _own_depth(traj, dist, near):
-    """Per frame, how far inside the stop distance ``near`` (m) the robot's own driving has
+    """Per frame, how far inside the stop distance ``near`` (m, per frame; NaN where there is
+    none) the robot's own driving has
     taken it: its centre's closing on the target (held where it stood the frame before; a
     turn in place closes nothing) adds up while the camera is inside, never below 0 nor
     beyond the camera's depth there. The rest of the depth is not the robot's doing: it
@@ -462,11 +495,14 @@ def _own_depth(traj, dist, near):
     return own
 
 
-def _search_judged(found, ml, mr, dist, bearing, geom, params, side_tol):
-    """Per judged lost frame, whether the design broke the lost law: hold the last command
+def _search_judged(found, ml, mr, dist, bearing, geom, params, side_tol, interlocked):
+    """Per judged lost frame ``(frame, broke the law, [L, R] seen, [L, R] the law's)``, the
+    lost law being: hold the last command
     for lost frames 1..lost_frames-1, then turn in place at ``search_dps`` towards the side the
     target was last seen on (left after reset). A sighting within ``E_TOLERANCE_PX`` of the
-    image centre has no sure side (``sure_side``): its search frames are not judged."""
+    image centre has no sure side (``sure_side``): its search frames are not judged, nor are
+    the ``interlocked`` frames, nor the hold of a loss that began with the interlock holding
+    the wheels (the command held is then not the one seen)."""
     out = []
     lost, side, held = 0, -1, (0.0, 0.0)  # side: -1 left, +1 right, 0 unknown
     for k in range(len(found)):
@@ -475,13 +511,19 @@ def _search_judged(found, ml, mr, dist, bearing, geom, params, side_tol):
             side = sure_side(float(dist[k]), float(bearing[k]), geom, params, side_tol[k])
             continue
         if lost == 0:  # the command shown when the loss began is the one to hold
-            held = (ml[k - 1], mr[k - 1]) if k else (0.0, 0.0)
+            if k == 0:
+                held = (0.0, 0.0)
+            else:
+                held = None if interlocked[k - 1] else (ml[k - 1], mr[k - 1])
         lost = min(lost + 1, params.lost_frames)
+        if interlocked[k]:
+            continue
         if lost < params.lost_frames:
-            out.append((ml[k], mr[k]) != held)
+            if held is not None:
+                out.append((k, (ml[k], mr[k]) != held, [ml[k], mr[k]], list(held), {}))
         elif side:
             s = params.search_dps * side
-            out.append((ml[k], mr[k]) != (s, -s))
+            out.append((k, (ml[k], mr[k]) != (s, -s), [ml[k], mr[k]], [s, -s], {}))
     return out
 
 
@@ -514,6 +556,25 @@ def sure_side(distance, bearing, geom, params, tol=E_TOLERANCE_PX):
     if hi < centre - tol:
         return -1
     return 0
+
+
+def _frames_judged(judged, t):
+    """``judged``: rows ``(frame, broke the law, commanded, allowed, where)``. The number of
+    frames judged and outside the law, and the first of those: its frame, time (s), the
+    command seen and the law's (DPS), and ``where`` (levels and distance, for the laws of
+    the target's count)."""
+    bad = [row for row in judged if row[1]]
+    first = None
+    if bad:
+        k, _, commanded, allowed, where = bad[0]
+        first = {
+            "frame": int(k),
+            "t": float(t[k]),
+            "commanded": np.asarray(commanded, float).tolist(),
+            "allowed": np.asarray(allowed, float).tolist(),
+            **where,
+        }
+    return {"judged": len(judged), "violated": len(bad), "first": first}
 
 
 def _fraction(flags):

@@ -53,23 +53,29 @@ def line_metrics(traj, lines, mounts, period):
         steps = (steps + length / 2) % length - length / 2  # across the start: the short way
         laps = int(abs(float(steps.sum())) // length)
     return {
-        "lateral_error_max_m": round(float(errors.max()), 4),
-        "lateral_error_mean_m": round(float(errors.mean()), 4),
-        "off_line_s": round(off * period, 4),
+        "lateral_error_max_m": float(errors.max()),
+        "lateral_error_mean_m": float(errors.mean()),
+        "off_line_s": off * period,
         "laps": laps,
     }
 
 
 def obstacle_metrics(traj, events):
-    """``obstacle_removed_at_s`` (the last furniture removal) and ``resumed_after_s`` (from
-    then until the robot has driven ``RESUME_CLOSING_M`` towards the target; None if never).
+    """``obstacle_removed_at_s`` (the last furniture removal), ``resumed_after_s`` (from
+    then until the robot has driven ``RESUME_CLOSING_M`` towards the target; None if never)
+    and ``run_after_removal_s`` (from then to the run's last row: a run that ends before a
+    limit has passed cannot show that the robot failed to resume within it).
 
     Only the robot's own motion counts: each step's displacement along the direction from the
     robot to the target at the step's start, summed. A person walking up to a robot that
     stays put brings them closer without the robot resuming anything."""
     removed = [t for _, t, text in events if is_removal_event(text)]
     if not removed:
-        return {"obstacle_removed_at_s": None, "resumed_after_s": None}
+        return {
+            "obstacle_removed_at_s": None,
+            "resumed_after_s": None,
+            "run_after_removal_s": None,
+        }
     t_r = max(removed)
     t = traj["t"]
     after = np.flatnonzero(t >= t_r - 1e-9)
@@ -79,8 +85,12 @@ def obstacle_metrics(traj, events):
     # NaN without a target person: never resumed.
     progress = np.cumsum(step / np.maximum(np.hypot(to_x, to_y), 1e-9))
     reached = np.flatnonzero(progress >= RESUME_CLOSING_M)
-    resumed = round(float(t[after[reached[0] + 1]] - t_r), 4) if len(reached) else None
-    return {"obstacle_removed_at_s": round(t_r, 6), "resumed_after_s": resumed}
+    resumed = float(t[after[reached[0] + 1]] - t_r) if len(reached) else None
+    return {
+        "obstacle_removed_at_s": round(t_r, 6),
+        "resumed_after_s": resumed,
+        "run_after_removal_s": float(t[-1] - t_r),
+    }
 
 
 def measurement_metrics(columns, sensors, frames):

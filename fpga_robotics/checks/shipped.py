@@ -131,8 +131,22 @@ def _found_fraction(v, limit, m):
     return m["acquired_at_s"] is not None and v >= limit
 
 
+def _resumed(v, limit, m):
+    """Resumed within the limit: a pass; never, in a run that went on for the limit after the
+    removal: a fail. A run that ended sooner leaves nothing to judge (None): the run was cut
+    short, not the design."""
+    if v is not None:
+        return v <= limit
+    return False if m["run_after_removal_s"] >= limit else None
+
+
 def _resumed_text(v, limit, m):
     t_r = m["obstacle_removed_at_s"]
+    if _resumed(v, limit, m) is None:
+        return (
+            f"the run ended {_num(m['run_after_removal_s'], limit, 2)} s after the obstacle "
+            f"left at {t_r:.2f} s, before the {limit} s limit: no resumption to judge"
+        )
     if v is None:
         return (
             f"the robot never drove {RESUME_CLOSING_M} m towards the target after the "
@@ -152,6 +166,28 @@ def _measured_text(v, limit, m):
             f"(limit >= {limit} frame(s) with a measurement)"
         )
     return f"every sensor measured in at least {v} frame(s) (limit >= {limit})"
+
+
+def _judged_text(v, limit, judged, noun):
+    """``n of N <noun> (p%)``, then the first frame outside the law: its time and frame, the
+    command seen against the law's (``judged``: an ``envelopes`` ``..._frames`` metric; the
+    percentage alone without it)."""
+    if not judged:
+        return f"{_pct(v, limit, 1)} of the {noun}"
+    text = f"{judged['violated']} of {judged['judged']} {noun} ({_pct(v, limit, 1)})"
+    first = judged["first"]
+    if first is None:
+        return text
+    seen, law = first["commanded"], first["allowed"]
+    if isinstance(seen, list):  # the lost/search law: both wheels
+        what = f"wheels {seen[0]:g}, {seen[1]:g} DPS, law {law[0]:g}, {law[1]:g}"
+    else:
+        lo, hi = first["levels"]
+        what = (
+            f"{seen:g} DPS, law {law[0]:g}..{law[1]:g} (levels {lo}..{hi} at "
+            f"{first['distance_m']:.2f} m)"
+        )
+    return f"{text}, first at {first['t']:.2f} s (frame {first['frame']}): {what}"
 
 
 def _envelope(metric, no_frames):
@@ -372,7 +408,7 @@ SHIPPED_CHECKS = (
             f"turned {_num(v, limit, 1)} deg past the target (limit <= {limit} deg)"
         ),
         limits=(0, 180, "deg"),
-        precondition=measured("heading_overshoot_deg", "no heading to compare"),
+        precondition=measured("heading_overshoot_deg", "the target's centre was never in view"),
     ),
     _collisions("wall", "at most this many collisions with a wall"),
     _collisions("furniture", "at most this many collisions with furniture"),
@@ -469,6 +505,7 @@ SHIPPED_CHECKS = (
             "obstacle_removed_at_s",
             "no furniture was removed during the run (room.furniture.present_until)",
         ),
+        passes=_resumed,
     ),
     Check(
         "min_measured_frames",
@@ -496,8 +533,9 @@ SHIPPED_CHECKS = (
             f"levels its pixel count can reach there) in at most this fraction of the frames {_BAND}"
         ),
         lambda v, limit, m: (
-            f"forward speed outside the approach law in {_pct(v, limit, 1)} of the "
-            f"centred frames (limit <= {_limit_pct(limit)})"
+            "forward speed outside the approach law in "
+            f"{_judged_text(v, limit, m.get('approach_speed_frames'), 'centred frames')} "
+            f"(limit <= {_limit_pct(limit)})"
         ),
         limits=_FRACTION,
         outputs=_WHEELS,
@@ -516,8 +554,9 @@ SHIPPED_CHECKS = (
             f"{_BAND}"
         ),
         lambda v, limit, m: (
-            f"reversing with the target beyond the reversing distance in "
-            f"{_pct(v, limit, 1)} of those frames (limit <= {_limit_pct(limit)})"
+            "reversing with the target beyond the reversing distance in "
+            f"{_judged_text(v, limit, m.get('reverse_when_far_frames'), 'frames found there')} "
+            f"(limit <= {_limit_pct(limit)})"
         ),
         limits=_FRACTION,
         outputs=_WHEELS,
@@ -542,7 +581,7 @@ SHIPPED_CHECKS = (
         ),
         limits=(0, 100, "m"),
         outputs=_WHEELS,
-        precondition=_envelope("stop_overshoot_m", "the robot never came near the stop distance"),
+        precondition=lambda m: _envelope("stop_overshoot_m", m.get("stop_reason"))(m),
     ),
     Check(
         "max_turn_law_violation_fraction",
@@ -554,7 +593,9 @@ SHIPPED_CHECKS = (
             f"in at most this fraction of the frames {_BAND}"
         ),
         lambda v, limit, m: (
-            f"turn outside the steering law in {_pct(v, limit, 1)} of the frames judged (limit <= {_limit_pct(limit)})"
+            "turn outside the steering law in "
+            f"{_judged_text(v, limit, m.get('turn_law_frames'), 'frames judged')} "
+            f"(limit <= {_limit_pct(limit)})"
         ),
         limits=_FRACTION,
         outputs=_WHEELS,
@@ -572,8 +613,9 @@ SHIPPED_CHECKS = (
             f"seen on, in all but at most this fraction of the lost frames {_BAND}"
         ),
         lambda v, limit, m: (
-            f"lost/search command off the law in {_pct(v, limit, 1)} of the lost "
-            f"frames judged (limit <= {_limit_pct(limit)})"
+            "lost/search command off the law in "
+            f"{_judged_text(v, limit, m.get('search_law_frames'), 'lost frames judged')} "
+            f"(limit <= {_limit_pct(limit)})"
         ),
         limits=_FRACTION,
         outputs=_WHEELS,

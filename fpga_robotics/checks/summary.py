@@ -238,13 +238,17 @@ def _heading_overshoot(traj, mount=None):
     ``connectors.base.Mount``, or at the robot's centre along its heading without one), so a
     camera yawed on its mount is on the target when the robot's body is not. Meaningful with a
     standing target (a step response, e.g. ``approach`` with ``robot.heading_deg=20``); a
-    walking target crossing the robot's axis counts too. None without the fields."""
+    walking target crossing the robot's axis counts too. None without the fields, or when the
+    target's centre was never in view (no heading response to judge)."""
     need = ("x", "y", "heading", "target_x", "target_y", "target_column")
     if any(k not in traj for k in need) or len(traj["x"]) == 0:
         return None
+    in_view = ~np.isnan(np.asarray(traj["target_column"], dtype=float))
+    if not in_view.any():
+        return None
     b = np.degrees(_aim_error(traj, mount))
     best, last, crossed = 0.0, 0.0, False
-    for bk, seen in zip(b, ~np.isnan(np.asarray(traj["target_column"], dtype=float))):
+    for bk, seen in zip(b, in_view):
         if not seen:
             last, crossed = 0.0, False
             continue
