@@ -57,7 +57,7 @@ from fpga_robotics.sim.files import check_output_dir, write_atomic, write_json_a
 from fpga_robotics.sim.mutation import MAX_MUTANT_SEED, MutationError, list_mutants, mutant_cones
 from fpga_robotics.sim.pins import PinError
 from fpga_robotics.sweep import load_campaign_file, runner
-from fpga_robotics.sweep.engine import check_scheduler_address, open_client
+from fpga_robotics.sweep.engine import check_cluster_options, open_client
 
 __all__ = ["main"]
 
@@ -497,13 +497,7 @@ def _check(args):
             "--workers, --scheduler, --resume and --fork/--no-fork go with --campaign "
             "(the robot judge)"
         )
-    if args.workers is not None and args.scheduler is not None:
-        raise UsageError(
-            "--workers sizes the embedded cluster; with --scheduler the cluster "
-            "has the workers you started (`dask worker ADDRESS`)"
-        )
-    if args.scheduler is not None:
-        check_scheduler_address(args.scheduler)
+    check_cluster_options(args.workers, args.scheduler)
     args.fork = True if args.fork is None else args.fork
 
 

@@ -18,7 +18,7 @@ from fpga_robotics.sweep.campaign import (
     read_campaign_file,
     shipped_campaigns,
 )
-from fpga_robotics.sweep.engine import RECORD_LOG_EVERY, check_scheduler_address
+from fpga_robotics.sweep.engine import RECORD_LOG_EVERY, check_cluster_options
 from fpga_robotics.sweep.plan import make_plan
 from fpga_robotics.sweep.report import campaign_passed, format_report
 from fpga_robotics.sweep.results import load_rows
@@ -231,13 +231,7 @@ def _check_options(args):
         raise UsageError(
             "--log-every shapes the recordings: it needs --record failing (the default) or all"
         )
-    if args.workers is not None and args.scheduler is not None:
-        raise UsageError(
-            "--workers sizes the embedded cluster; with --scheduler the cluster "
-            "has the workers you started (`dask worker ADDRESS`)"
-        )
-    if args.scheduler is not None:
-        check_scheduler_address(args.scheduler)
+    check_cluster_options(args.workers, args.scheduler)
 
 
 def _dry_run(campaign, args):

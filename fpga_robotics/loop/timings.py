@@ -53,31 +53,19 @@ def run_scenario(
         Live control inputs (``fpga_robotics.ros.controls``): colour select, the target
         driven by hand, pause and step; applied just after each frame's capture.
     """
+    options = {
+        "seed": seed,
+        "recorder": recorder,
+        "progress": progress,
+        "realtime": realtime,
+        "on_frame": on_frame,
+        "shadow": shadow,
+        "shadow_label": shadow_label,
+        "controls": controls,
+    }
     own = scenario.top not in TOPS and scenario.sim.timing == "compressed"
     if own and isinstance(backend, str):
         # A camera-only design of one's own: frame by frame on its pin backend, closed after.
         with open_pin_frames(backend, scenario) as design:
-            return run_compressed(
-                scenario,
-                seed=seed,
-                backend=design,
-                recorder=recorder,
-                progress=progress,
-                realtime=realtime,
-                on_frame=on_frame,
-                shadow=shadow,
-                shadow_label=shadow_label,
-                controls=controls,
-            )
-    return TIMINGS[scenario.sim.timing](
-        scenario,
-        seed=seed,
-        backend=backend,
-        recorder=recorder,
-        progress=progress,
-        realtime=realtime,
-        on_frame=on_frame,
-        shadow=shadow,
-        shadow_label=shadow_label,
-        controls=controls,
-    )
+            return run_compressed(scenario, backend=design, **options)
+    return TIMINGS[scenario.sim.timing](scenario, backend=backend, **options)

@@ -30,6 +30,7 @@ __all__ = [
     "MIN_TIMEOUT_S",
     "RECORD_LOG_EVERY",
     "build_all",
+    "check_cluster_options",
     "check_scheduler_address",
     "kept_to_record",
     "open_client",
@@ -64,6 +65,19 @@ def check_scheduler_address(address):
             f"--scheduler must be a Dask scheduler address tcp://HOST:PORT (e.g. "
             f"tcp://127.0.0.1:8786), got {address!r} ({exc})"
         ) from None
+
+
+def check_cluster_options(workers, scheduler):
+    """``--workers`` and ``--scheduler`` as sweep and mutate take them: not both (the
+    embedded cluster's size means nothing with a cluster of one's own), and a scheduler
+    address Dask can dial; ``UsageError`` otherwise."""
+    if workers is not None and scheduler is not None:
+        raise UsageError(
+            "--workers sizes the embedded cluster; with --scheduler the cluster "
+            "has the workers you started (`dask worker ADDRESS`)"
+        )
+    if scheduler is not None:
+        check_scheduler_address(scheduler)
 
 
 @contextlib.contextmanager
