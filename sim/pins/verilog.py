@@ -84,10 +84,6 @@ class VerilogPinSource:
             {"fr_wrapper.v": d.wrapper, **d.sources}, self.verilog_top, d.includes
         )
 
-    #: Whether every output is a flip-flop is not known for a foreign design: the harness
-    #: evaluates twice per edge (the edge, then the settling on the next edge's inputs).
-    registered_outputs = False
-
     @property
     def digest(self):
         return hashlib.sha256(self.design.digest().encode()).hexdigest()
