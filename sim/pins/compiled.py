@@ -142,8 +142,8 @@ def verilator_plan(source):
     outputs = [p.name for p in source.ports.values() if p.direction == "out"]
     if hasattr(source, "verilog_files"):  # a foreign Verilog design
         files, compiled = source.verilog_files()
-        # Whether every output is registered: Yosys reads the files when the model is built.
-        top, registered = source.verilog_top, None
+        # None: whether every output is registered is found when the model is built.
+        top, registered = source.verilog_top, source.registered_outputs
     else:
         files, compiled = {"follow_target.v": source.verilog}, ["follow_target.v"]
         top = "follow_target"
@@ -179,7 +179,7 @@ def verilator_plan(source):
             path.write_text(body)
         if registered is None:
             (directory / "pin_design.h").write_text(
-                verilator_accessors(source, source.design.registered_outputs())
+                verilator_accessors(source, source.registered_when_built())
             )
         else:
             (directory / "pin_design.h").write_text(accessors)
