@@ -280,3 +280,13 @@ def test_write_json_atomic_leaves_nothing_behind_on_failure(tmp_path):
         write_json_atomic(path, {"a": object()})
     assert path.read_text().strip().replace(" ", "").replace("\n", "") == '{"a":1}'
     assert list(tmp_path.iterdir()) == [path]
+
+
+def test_the_target_line_never_rounds_onto_0_or_100_percent():
+    m = compute_metrics(trajectory([1, 1], [1.0, 1.0]), [], {}, PERIOD)
+    # 299 frames of 300 in view, 1 of 300 found: neither is all, nor none.
+    m = {**m, "target_in_view_fraction": 299 / 300, "found_fraction": 1 / 300}
+    text = format_summary(summary_of(m, []))
+    assert ", in view 99.7%, found 0.3%," in text
+    m = {**m, "target_in_view_fraction": 1.0, "found_fraction": 0.5}
+    assert ", in view 100%, found 50%," in format_summary(summary_of(m, []))

@@ -2,6 +2,7 @@
 design outputs it needs, when it cannot judge (its precondition) and what it says."""
 
 from fpga_robotics.checks.check import Check, measured
+from fpga_robotics.checks.percent import limit_percent, percent
 from fpga_robotics.checks.sensor_metrics import RESUME_CLOSING_M
 from fpga_robotics.sim.world.config import MAX_TIME
 
@@ -11,26 +12,6 @@ _DAY = MAX_TIME  # s
 _COUNT = (0, 10**6, "")
 _FRACTION = (0, 1, "")
 _NO_TARGET = "no target person: no distance to compare"
-
-
-def _pct(v, limit=None, least_digits=0):
-    """A fraction as a whole percentage, but never 0% or 100% for what is not exactly that
-    (0.9967 is 99.7%, not 100%), and with a ``limit`` never shown equal to it, or on its
-    other side, when it is not (0.4004 against 40% is 40.04%); ``least_digits`` decimals
-    at least."""
-    if limit is not None and v == limit:
-        return _limit_pct(limit)  # as the limit reads: 40.67% against 40.67%, not 41%
-    for digits in range(least_digits, 7):
-        text = f"{v:.{digits}%}"
-        shown = float(text[:-1])
-        if (shown == 100 and v < 1) or (shown == 0 and v > 0):
-            continue
-        if limit is not None and v != limit:
-            bound = float(_limit_pct(limit)[:-1])
-            if (shown > bound) != (v > limit) or shown == bound:
-                continue
-        return text
-    return text
 
 
 def _decimals(v, limit, least_digits):
@@ -52,11 +33,6 @@ def _num(v, limit, least_digits):
 def _metres(v, limit):
     """A distance to at most 4 decimals (1.0, 3.0058), more only as ``_decimals`` needs."""
     return round(v, _decimals(v, limit, 4))
-
-
-def _limit_pct(limit):
-    """A check's fraction limit as a percentage, as set (0.1595 is 15.95%, 0.02 is 2%)."""
-    return f"{round(limit * 100, 6):g}%"
 
 
 def _never_found(m):
@@ -173,8 +149,8 @@ def _judged_text(v, limit, judged, noun):
     command seen against the law's (``judged``: an ``envelopes`` ``..._frames`` metric; the
     percentage alone without it)."""
     if not judged:
-        return f"{_pct(v, limit, 1)} of the {noun}"
-    text = f"{judged['violated']} of {judged['judged']} {noun} ({_pct(v, limit, 1)})"
+        return f"{percent(v, limit, 1)} of the {noun}"
+    text = f"{judged['violated']} of {judged['judged']} {noun} ({percent(v, limit, 1)})"
     first = judged["first"]
     if first is None:
         return text
@@ -296,8 +272,8 @@ SHIPPED_CHECKS = (
             "the target)"
         ),
         lambda v, limit, m: (
-            f"centroid away from the target in {_pct(v, limit)} of the frames with "
-            f"the target found and in view (limit <= {_limit_pct(limit)})"
+            f"centroid away from the target in {percent(v, limit)} of the frames with "
+            f"the target found and in view (limit <= {limit_percent(limit)})"
         ),
         limits=_FRACTION,
         outputs=("found", "centroid_x"),
@@ -338,8 +314,8 @@ SHIPPED_CHECKS = (
             "with the target in view (led_wrong_side_fraction)"
         ),
         lambda v, limit, m: (
-            f"centroid LEDs point the wrong way in {_pct(v, limit)} of the frames "
-            f"judged (limit <= {_limit_pct(limit)})"
+            f"centroid LEDs point the wrong way in {percent(v, limit)} of the frames "
+            f"judged (limit <= {limit_percent(limit)})"
         ),
         limits=_FRACTION,
         outputs=("found", "centroid_leds"),
@@ -359,8 +335,8 @@ SHIPPED_CHECKS = (
             "(led_misplaced_fraction)"
         ),
         lambda v, limit, m: (
-            f"the lit LEDs are not the one above the target in {_pct(v, limit, 1)} of "
-            f"the frames judged (limit <= {_limit_pct(limit)})"
+            f"the lit LEDs are not the one above the target in {percent(v, limit, 1)} of "
+            f"the frames judged (limit <= {limit_percent(limit)})"
         ),
         limits=_FRACTION,
         outputs=("found", "centroid_leds"),
@@ -418,7 +394,7 @@ SHIPPED_CHECKS = (
         "min",
         "the target is in the camera's view this often",
         lambda v, limit, m: (
-            f"target in view {_pct(v, limit)} of frames (limit >= {_limit_pct(limit)})"
+            f"target in view {percent(v, limit)} of frames (limit >= {limit_percent(limit)})"
         ),
         limits=_FRACTION,
     ),
@@ -428,10 +404,10 @@ SHIPPED_CHECKS = (
         "min",
         "after first acquisition, the design reports found this often",
         lambda v, limit, m: (
-            f"{_never_found(m)} (limit >= {_limit_pct(limit)} of the frames after it is)"
+            f"{_never_found(m)} (limit >= {limit_percent(limit)} of the frames after it is)"
             if m["acquired_at_s"] is None
-            else f"found in {_pct(v, limit)} of frames after acquisition "
-            f"(limit >= {_limit_pct(limit)})"
+            else f"found in {percent(v, limit)} of frames after acquisition "
+            f"(limit >= {limit_percent(limit)})"
         ),
         limits=_FRACTION,
         outputs=("found",),
@@ -535,7 +511,7 @@ SHIPPED_CHECKS = (
         lambda v, limit, m: (
             "forward speed outside the approach law in "
             f"{_judged_text(v, limit, m.get('approach_speed_frames'), 'centred frames')} "
-            f"(limit <= {_limit_pct(limit)})"
+            f"(limit <= {limit_percent(limit)})"
         ),
         limits=_FRACTION,
         outputs=_WHEELS,
@@ -556,7 +532,7 @@ SHIPPED_CHECKS = (
         lambda v, limit, m: (
             "reversing with the target beyond the reversing distance in "
             f"{_judged_text(v, limit, m.get('reverse_when_far_frames'), 'frames found there')} "
-            f"(limit <= {_limit_pct(limit)})"
+            f"(limit <= {limit_percent(limit)})"
         ),
         limits=_FRACTION,
         outputs=_WHEELS,
@@ -595,7 +571,7 @@ SHIPPED_CHECKS = (
         lambda v, limit, m: (
             "turn outside the steering law in "
             f"{_judged_text(v, limit, m.get('turn_law_frames'), 'frames judged')} "
-            f"(limit <= {_limit_pct(limit)})"
+            f"(limit <= {limit_percent(limit)})"
         ),
         limits=_FRACTION,
         outputs=_WHEELS,
@@ -615,7 +591,7 @@ SHIPPED_CHECKS = (
         lambda v, limit, m: (
             "lost/search command off the law in "
             f"{_judged_text(v, limit, m.get('search_law_frames'), 'lost frames judged')} "
-            f"(limit <= {_limit_pct(limit)})"
+            f"(limit <= {limit_percent(limit)})"
         ),
         limits=_FRACTION,
         outputs=_WHEELS,
@@ -630,7 +606,7 @@ SHIPPED_CHECKS = (
             "its target in view this often (the least of them)"
         ),
         lambda v, limit, m: (
-            f"a camera's target in view {_pct(v, limit)} of frames (limit >= {_limit_pct(limit)})"
+            f"a camera's target in view {percent(v, limit)} of frames (limit >= {limit_percent(limit)})"
         ),
         limits=_FRACTION,
         precondition=measured("camera_target_in_view_fraction", "no further camera has a target"),
@@ -644,7 +620,7 @@ SHIPPED_CHECKS = (
             "this often (the least of them): a pan camera keeps its target centred"
         ),
         lambda v, limit, m: (
-            f"a camera's target centred in {_pct(v, limit)} of frames (limit >= {_limit_pct(limit)})"
+            f"a camera's target centred in {percent(v, limit)} of frames (limit >= {limit_percent(limit)})"
         ),
         limits=_FRACTION,
         precondition=measured("camera_target_centred_fraction", "no further camera has a target"),

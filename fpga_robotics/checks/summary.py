@@ -10,6 +10,7 @@ the human version printed by the runner.
 import numpy as np
 
 from fpga_robotics.checks.check import DESIGN_OUTPUTS
+from fpga_robotics.checks.percent import percent
 from fpga_robotics.checks.registry import CHECK_OUTPUTS, CHECKS, evaluate_checks, verdict
 from fpga_robotics.checks.window import visible_middle, whole_in_window, window_columns
 
@@ -490,7 +491,7 @@ def format_summary(s):
         lines.append(f"  wheel outputs absent (no wheels bound: 0 DPS): {', '.join(wheels)}")
     acq = s["acquired_at_s"]
     found = (
-        f"{s['found_fraction']:.0%}"
+        percent(s["found_fraction"])
         if s["found_fraction"] is not None
         else "n/a (no tracker `found` output)"
     )
@@ -512,7 +513,7 @@ def format_summary(s):
                 if s["found_fraction"] is not None
                 else "acquisition n/a"
             )
-            + f", in view {s['target_in_view_fraction']:.0%}, found {found}"
+            + f", in view {percent(s['target_in_view_fraction'])}, found {found}"
             + f", {searches} search(es)"
         )
         lines.append(

