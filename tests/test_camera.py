@@ -644,6 +644,14 @@ def test_benchmark_cli_prints_a_line_per_size(capsys):
             "fpga-robotics bench camera: error: --frames must be 1..1000000, got 0",
         ),
         (
+            ["--sizes", "160x120,4x1000"],
+            (
+                "fpga-robotics bench camera: error: a size 4x1000 is too tall for the camera's hfov "
+                "1.047 rad: the renderer draws at most 0.3947 rad at that size (the top and bottom "
+                "rows would look straight up or down); keep the height at most 86.6 times the width"
+            ),
+        ),
+        (
             ["--noise", "1e300"],
             "fpga-robotics bench camera: error: --noise must be a number of 8-bit levels in 0..64, got 1e+300",
         ),
