@@ -379,6 +379,29 @@ def test_a_further_cameras_field_of_view_is_checked_at_load():
         load_scenario("turret", ['robot.sensors[0].resolution="16x1000"', *wide])
 
 
+def test_the_sensor_model_is_the_body_cameras_and_the_scenario_says_so():
+    plain = load_scenario("turret", ["sim.duration=0.05"])
+    ov7670 = load_scenario("turret", ["sim.duration=0.05", "camera.sensor=ov7670"])
+    assert not any("camera.sensor" in w for w in plain.warnings)
+    assert ov7670.warnings == (
+        (
+            'camera.sensor = "ov7670" models the body camera only; the further camera(s) '
+            "'turret' give the rendered frame plus their own noise_std"
+        ),
+    )
+    # As it warns: the body camera's frame is the sensor's RGB444 (low nibbles 0), the pan
+    # camera's is the same rendered frame with or without the sensor model.
+    frames = {}
+    for name, scenario in (("plain", plain), ("ov7670", ov7670)):
+        records = []
+        run_scenario(scenario, backend="model", on_frame=records.append)
+        frames[name] = records[0]
+    assert not np.any(frames["ov7670"].camera_rgb & 0x0F)
+    assert np.any(frames["plain"].camera_rgb & 0x0F)
+    turret = [frames[n].cameras["turret"].rgb for n in ("plain", "ov7670")]
+    assert np.array_equal(*turret)
+
+
 def test_any_number_of_cameras_each_on_its_own_mount(tmp_path):
     # A third camera on the body, looking left (yaw 90 degrees), filming only, watching blue:
     # from (1.5, 3.0) the blue person at (4.55, 4.0) is atan2(1.0, 3.05) - 90 = -71.8 degrees
