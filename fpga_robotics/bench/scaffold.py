@@ -76,8 +76,8 @@ def parse_sizes(text, what="a size", *, hfov=None):
     sizes = [parse_size(item, what) for item in text.split(",") if item.strip()]
     if not sizes:
         raise UsageError(f"{what} list is empty; write WIDTHxHEIGHT[,WIDTHxHEIGHT...]")
-    for w, h in sizes if hfov is not None else ():
-        if max_hfov(w, h) < hfov:
+    for w, h in sizes:
+        if hfov is not None and max_hfov(w, h) < hfov:
             tallest = math.tan(math.pi / 2 - VERTICAL_MARGIN) / math.tan(hfov / 2)
             raise UsageError(
                 f"{what} {w}x{h} is too tall for the camera's hfov {hfov:g} rad: the renderer "

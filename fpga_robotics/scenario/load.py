@@ -822,9 +822,10 @@ def _check_further_field_of_view(spec, slope, on_slope):
     vfov = vertical_fov(w, h, p.hfov)
     limit = max_tilt(w, h, p.hfov) - slope
     if limit < 0:
+        widest = _floor(math.degrees(max_hfov(w, h, slope)), 2)
         raise ScenarioError(
-            f"{spec.where}.hfov_deg must be at most {_floor(math.degrees(max_hfov(w, h, slope)), 2)}"
-            f" deg at its resolution {w}x{h}{on_slope}, got {math.degrees(p.hfov):g} (a "
+            f"{spec.where}.hfov_deg must be at most {widest} deg at its resolution "
+            f"{w}x{h}{on_slope}, got {math.degrees(p.hfov):g} (a "
             f"vertical field of view of {math.degrees(vfov):.1f} deg: the top and bottom rows "
             "would look straight up or down)"
         )
