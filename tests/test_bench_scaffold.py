@@ -35,6 +35,23 @@ def test_sizes():
     assert scaffold.parse_sizes("160x120, 640X480") == [(160, 120), (640, 480)]
 
 
+def test_sizes_too_tall_for_the_cameras_hfov_are_usage_errors():
+    # At hfov 1.047 the rows stay 0.02 rad off vertical while H/W <= cot(0.02) / tan(1.047/2)
+    # = 49.9933 / 0.57711 = 86.6: 1x86 is drawn, 1x87 and 4x1000 (250 times) are not.
+    assert scaffold.parse_sizes("1x86,160x120", hfov=1.047) == [(1, 86), (160, 120)]
+    for text in ("1x87", "160x120,4x1000"):
+        with pytest.raises(UsageError, match=r"too tall for the camera's hfov 1.047 rad.* 86.6 "):
+            scaffold.parse_sizes(text, hfov=1.047)
+    assert scaffold.parse_sizes("4x1000") == [(4, 1000)]  # no camera: any shape
+
+
+def test_the_render3d_benchmark_refuses_a_size_its_camera_cannot_draw():
+    from fpga_robotics.bench.render3d import main
+
+    with pytest.raises(UsageError, match="a size 4x1000 is too tall"):
+        main(["--sizes", "4x1000", "--frames", "1", "--repeats", "1", "--seconds", "0"])
+
+
 def test_absolute_times_and_their_ratios():
     figures = {
         "results": [

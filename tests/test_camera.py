@@ -555,6 +555,19 @@ def test_tilt_and_field_of_view_limits_by_hand():
     assert max_tilt(160, 120, max_hfov(160, 120, 0.5)) == pytest.approx(0.5)
 
 
+def test_the_package_hands_out_the_names_the_docs_use():
+    # docs/camera.md and docs/scenarios.md name these as fpga_robotics.sim.camera.<name>.
+    import fpga_robotics.sim.camera as package
+    from fpga_robotics.sim.camera import raster, scene
+
+    for name in ("VERTICAL_MARGIN", "max_tilt", "max_hfov", "vertical_fov", "CameraRenderer"):
+        assert getattr(package, name) is getattr(raster, name)
+    assert package.CameraPose is scene.CameraPose
+    assert sorted(package.__all__) == sorted(package._HOMES)
+    with pytest.raises(AttributeError, match="no attribute 'NEAR'"):
+        package.NEAR  # noqa: B018 - a name of raster the package does not hand out
+
+
 @pytest.mark.parametrize("w,h,hfov", [(160, 120, 1.047), (32, 24, 2.0), (20, 40, 1.0)])
 def test_the_renderer_draws_exactly_up_to_max_tilt(w, h, hfov):
     r = CameraRenderer(w, h, hfov)
@@ -629,6 +642,14 @@ def test_benchmark_cli_prints_a_line_per_size(capsys):
         (
             ["--frames", "0"],
             "fpga-robotics bench camera: error: --frames must be 1..1000000, got 0",
+        ),
+        (
+            ["--sizes", "160x120,4x1000"],
+            (
+                "fpga-robotics bench camera: error: a size 4x1000 is too tall for the camera's hfov "
+                "1.047 rad: the renderer draws at most 0.3947 rad at that size (the top and bottom "
+                "rows would look straight up or down); keep the height at most 86.6 times the width"
+            ),
         ),
         (
             ["--noise", "1e300"],

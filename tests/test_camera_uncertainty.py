@@ -17,9 +17,11 @@ def test_the_yaw_offset_turns_the_camera_and_the_pitch_adds_to_the_tilt():
     cam = CameraConnector(
         160, 120, 1.047, mount_height=0.3, mount_forward=0.1, tilt=0.05, yaw_offset=math.radians(10)
     )
-    pose = cam.pose((1.0, 2.0, 0.3), pitch=0.02)
+    faced = []
+    pose = cam.pose((1.0, 2.0, 0.3), lambda heading: faced.append(heading) or 0.02)
     assert pose.heading == pytest.approx(0.3 + math.radians(10))
     assert pose.tilt == pytest.approx(0.07)
+    assert faced == [pose.heading]  # the slope's pitch along the way the camera faces
     # The mount stays where it is on the robot: only the direction turns.
     assert (pose.x, pose.y) == pytest.approx((1.0 + 0.1 * math.cos(0.3), 2.0 + 0.1 * math.sin(0.3)))
 

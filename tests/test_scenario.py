@@ -5,6 +5,7 @@ import math
 import pytest
 
 from fpga_robotics.cli.errors import UsageError
+from fpga_robotics.loop.timings import run_scenario
 from fpga_robotics.scenario.load import (
     ScenarioError,
     load_scenario,
@@ -383,6 +384,29 @@ def test_the_printed_tilt_limit_can_be_used():
     limit = float(str(info.value).split("at most ")[1].split()[0])
     assert 65 < limit < 66
     load_scenario("follow_person", [f"robot.camera_tilt_deg={limit!r}"])
+
+
+def test_the_tilt_leaves_room_for_the_steepest_slope():
+    # ramp: a 9 degree ramp; at 160x120, hfov 1.047 the renderer draws |tilt| <= 65.44 deg, so
+    # a robot facing up or down the ramp pitches by 9 more and the mount may tilt 56.44.
+    with pytest.raises(ScenarioError) as info:
+        load_scenario("ramp", ["robot.camera_tilt_deg=62"])
+    message = str(info.value)
+    assert "|robot.camera_tilt_deg| must be at most 56.44 deg" in message
+    assert "the 9 deg slope of room.terrain 'ramp'" in message
+    with pytest.raises(ScenarioError, match=r"\|camera.tilt\| must be at most 0.9851 rad"):
+        load_scenario("ramp", ["camera.tilt=-1.0"])
+    with pytest.raises(ScenarioError, match="camera.hfov must be at most 2.8747 rad"):
+        load_scenario("ramp", ["camera.hfov=3.0"])  # drawn on the level: max_hfov 3.1116
+    load_scenario("follow_person", ["robot.camera_tilt_deg=62"])  # no slope: 65.44
+    # The limit holds on the ramp itself: standing on it facing uphill, the camera pitches
+    # up by the full 9 degrees, and the frames render.
+    scenario = load_scenario(
+        "ramp", ["robot.camera_tilt_deg=56.44", "robot.start=[4.0, 3.0]", "sim.duration=0.1"]
+    )
+    poses = []
+    run_scenario(scenario, backend="model", on_frame=lambda r: poses.append(r.camera_pose))
+    assert poses[0].tilt == pytest.approx(math.radians(56.44 + 9))
 
 
 def test_the_camera_must_be_below_the_ceiling():

@@ -356,6 +356,52 @@ def test_bad_camera_and_servo_keys_are_named(tmp_path, old, new, message):
         load_scenario(write(tmp_path, text.replace(old, new)))
 
 
+def test_a_further_cameras_field_of_view_is_checked_at_load():
+    from fpga_robotics.scenario.load import ScenarioError
+
+    # 170 degrees wide at 160x120: f = 80 / tan(85 deg) = 7.0 px, half the vertical field of
+    # view atan(60 / f) = 83.35 deg, so the rows stay 0.02 rad (1.15 deg) off vertical while
+    # |tilt| <= 90 - 1.15 - 83.35 = 5.5 deg.
+    wide = ["robot.sensors[0].hfov_deg=170", "sim.duration=0.1"]
+    with pytest.raises(ScenarioError) as info:
+        load_scenario("turret", [*wide, "robot.sensors[0].tilt_deg=10"])
+    assert str(info.value).startswith(
+        "|robot.sensors[0].tilt_deg| must be at most 5.5 deg with its hfov_deg 170 at 160x120"
+    )
+    # At the printed limit the renderer draws every frame (it refused mid-run before).
+    result = run_scenario(
+        load_scenario("turret", [*wide, "robot.sensors[0].tilt_deg=-5.5"]), backend="model"
+    )
+    assert result.summary["cameras"]["turret"]["frames"] == 2  # at 15 frames a second
+    # 16x1000: even level, the rows stay off vertical only while hfov <= 2 atan(16 / 1000 *
+    # cot(0.02)) = 77.32 deg.
+    with pytest.raises(ScenarioError, match=r"robot.sensors\[0\].hfov_deg must be at most 77.31"):
+        load_scenario("turret", ['robot.sensors[0].resolution="16x1000"', *wide])
+
+
+def test_the_sensor_model_is_the_body_cameras_and_the_scenario_says_so():
+    plain = load_scenario("turret", ["sim.duration=0.05"])
+    ov7670 = load_scenario("turret", ["sim.duration=0.05", "camera.sensor=ov7670"])
+    assert not any("camera.sensor" in w for w in plain.warnings)
+    assert ov7670.warnings == (
+        (
+            'camera.sensor = "ov7670" models the body camera only; the further camera(s) '
+            "'turret' give the rendered frame plus their own noise_std"
+        ),
+    )
+    # As it warns: the body camera's frame is the sensor's RGB444 (low nibbles 0), the pan
+    # camera's is the same rendered frame with or without the sensor model.
+    frames = {}
+    for name, scenario in (("plain", plain), ("ov7670", ov7670)):
+        records = []
+        run_scenario(scenario, backend="model", on_frame=records.append)
+        frames[name] = records[0]
+    assert not np.any(frames["ov7670"].camera_rgb & 0x0F)
+    assert np.any(frames["plain"].camera_rgb & 0x0F)
+    turret = [frames[n].cameras["turret"].rgb for n in ("plain", "ov7670")]
+    assert np.array_equal(*turret)
+
+
 def test_any_number_of_cameras_each_on_its_own_mount(tmp_path):
     # A third camera on the body, looking left (yaw 90 degrees), filming only, watching blue:
     # from (1.5, 3.0) the blue person at (4.55, 4.0) is atan2(1.0, 3.05) - 90 = -71.8 degrees

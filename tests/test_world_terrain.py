@@ -112,6 +112,35 @@ def test_the_camera_pitches_with_the_slope(heading_deg, expected_deg):
     assert math.degrees(pose.tilt - TURTLEBOT2.camera_tilt) == pytest.approx(expected_deg)
 
 
+def test_each_camera_pitches_along_the_way_it_faces():
+    from fpga_robotics.loop.timings import run_scenario
+    from fpga_robotics.scenario.load import load_scenario
+
+    # On the shipped 9 degree ramp (rising towards +x), facing uphill: the body camera turned
+    # 45 degrees left pitches atan(tan 9 cos 45) = 6.39 degrees, a rear camera faces downhill
+    # (-9), a side camera across the slope (0, only its own tilt).
+    cameras = (
+        '[{kind="camera", name="rear", height=0.4, yaw_deg=180.0},'
+        ' {kind="camera", name="side", height=0.4, yaw_deg=90.0, tilt_deg=-5.0}]'
+    )
+    scenario = load_scenario(
+        "ramp",
+        [
+            "robot.start=[4.0, 3.0]",
+            "sim.duration=0.05",
+            "camera.yaw_offset_deg=45",
+            f"robot.sensors={cameras}",
+        ],
+    )
+    records = []
+    run_scenario(scenario, backend="model", on_frame=records.append)
+    first = records[0]
+    oblique = math.degrees(math.atan(math.tan(9 * DEG) * math.cos(45 * DEG)))
+    assert math.degrees(first.camera_pose.tilt - TURTLEBOT2.camera_tilt) == pytest.approx(oblique)
+    assert math.degrees(first.cameras["rear"].pose.tilt) == pytest.approx(-9.0)
+    assert math.degrees(first.cameras["side"].pose.tilt) == pytest.approx(-5.0)
+
+
 def _top_row(rgb, col, color):
     """The first row from the top of column ``col`` where the shirt's colour is."""
     c = rgb[:, col].astype(int)

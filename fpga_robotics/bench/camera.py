@@ -189,7 +189,7 @@ def _options(parser):
 def _check(args):
     if not (math.isfinite(args.noise) and 0 <= args.noise <= 64):
         raise UsageError(f"--noise must be a number of 8-bit levels in 0..64, got {args.noise}")
-    args.sizes = scaffold.parse_sizes(args.sizes)
+    args.sizes = scaffold.parse_sizes(args.sizes, hfov=DEFAULT_HFOV)
 
 
 def run(args):

@@ -143,7 +143,7 @@ def _check(args):
             f"--backend {args.backend!r} is not a backend; choose one of: auto, "
             f"{', '.join(BACKEND_NAMES)}"
         )
-    args.sizes = scaffold.parse_sizes(args.sizes)
+    args.sizes = scaffold.parse_sizes(args.sizes, hfov=load_scenario("divider_3d").camera.hfov)
 
 
 def run(args):

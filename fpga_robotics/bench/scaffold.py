@@ -26,6 +26,7 @@ from fpga_robotics.bench.timing import Spread, Times, gc_paused, stopwatch  # no
 from fpga_robotics.cli.errors import UsageError
 from fpga_robotics.sim.backends import BackendError
 from fpga_robotics.sim.backends.toolchain import find_compiler
+from fpga_robotics.sim.camera.raster import VERTICAL_MARGIN, max_hfov
 from fpga_robotics.sim.files import check_output_path, write_json_atomic
 
 __all__ = [
@@ -68,11 +69,22 @@ def parse_size(text, what="a size"):
     return w, h
 
 
-def parse_sizes(text, what="a size"):
-    """``"160x120,640x480"`` -> ``[(160, 120), (640, 480)]``."""
+def parse_sizes(text, what="a size", *, hfov=None):
+    """``"160x120,640x480"`` -> ``[(160, 120), (640, 480)]``. With ``hfov`` (rad, the
+    camera's that renders them) also refuses a size so tall that its top and bottom rows
+    would look straight up or down (``sim.camera.max_hfov``), which the renderer refuses."""
     sizes = [parse_size(item, what) for item in text.split(",") if item.strip()]
     if not sizes:
         raise UsageError(f"{what} list is empty; write WIDTHxHEIGHT[,WIDTHxHEIGHT...]")
+    for w, h in sizes:
+        if hfov is not None and max_hfov(w, h) < hfov:
+            tallest = math.tan(math.pi / 2 - VERTICAL_MARGIN) / math.tan(hfov / 2)
+            raise UsageError(
+                f"{what} {w}x{h} is too tall for the camera's hfov {hfov:g} rad: the renderer "
+                f"draws at most {max_hfov(w, h):.4f} rad at that size (the top and bottom rows "
+                f"would look straight up or down); keep the height at most "
+                f"{math.floor(tallest * 10) / 10:g} times the width"
+            )
     return sizes
 
 

@@ -58,7 +58,8 @@ class RigCamera:
 
     def pose(self, world):
         """The camera's pose now: the body's pose, the servo's mount and angle if it is on
-        one, then its own mount (relative to the horn, or to the body)."""
+        one, then its own mount (relative to the horn, or to the body); on a slope it pitches
+        along the way it faces."""
         x, y, heading = world.robot_pose()
         if self.servo is not None:
             x, y, heading = self.servo.mount.world_pose(x, y, heading)
@@ -70,7 +71,7 @@ class RigCamera:
             y=y + m.forward * s + m.left * c,
             heading=heading + m.yaw,
             height=m.height,
-            tilt=self.params.tilt + world.camera_pitch(),
+            tilt=self.params.tilt + world.camera_pitch(heading + m.yaw),
         )
 
 

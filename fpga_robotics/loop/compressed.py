@@ -282,7 +282,7 @@ class ClosedLoop:
     def capture(self, t):
         """The camera image at time ``t``, with the events since the last frame."""
         # On a ramp the camera pitches with the robot (sim/world/terrain.py).
-        pose = self.camera.pose(self.world.robot_pose(), pitch=self.world.camera_pitch())
+        pose = self.camera.pose(self.world.robot_pose(), self.world.camera_pitch)
         self.scene, self.pose = self.world.scene(), pose  # kept for the viewer's 3D world
         rgb = self.camera.capture(self.scene, pose)
         events = list(self.world.drain_events())

@@ -478,7 +478,7 @@ class RealClockLoop(ClosedLoop):
         if self.top.camera or self.want_records:
             pose, rgb, events = self.capture(t)
         else:
-            pose = self.camera.pose(self.world.robot_pose(), pitch=self.world.camera_pitch())
+            pose = self.camera.pose(self.world.robot_pose(), self.world.camera_pitch)
             events = list(self.world.drain_events())
         events += self.apply_controls(k, t)
         if self.top.camera:

@@ -739,23 +739,37 @@ def _sensor_params(table):
     return OV7670Params.from_dict(values)
 
 
+def _steepest_slope(room):
+    """``(slope, text)``: the steepest terrain patch's slope (rad, 0 without one) and the words
+    that name it in a message. A camera on a patch pitches by up to its slope
+    (``sim.world.terrain.slope_pitch``), so its tilt may use only the room that leaves."""
+    patch = max(room.terrain, key=lambda p: p.slope, default=None)
+    if patch is None or patch.slope == 0.0:
+        return 0.0, ""
+    return patch.slope, (
+        f" and the {math.degrees(patch.slope):g} deg slope of room.terrain {patch.name!r}"
+    )
+
+
 def _check_camera_geometry(camera, world):
     """The mount and the field of view the renderer will be asked to draw: between floor and
-    ceiling, and no ray looking straight up or down (``sim.camera.max_tilt``)."""
+    ceiling, and no ray looking straight up or down (``sim.camera.max_tilt``), even on the
+    steepest terrain patch."""
     ceiling = world.room.height
     if camera.mount_height is not None and not camera.mount_height < ceiling:
         raise ScenarioError(
             f"camera.mount_height must be below the ceiling (room.height = "
             f"{ceiling:g} m), got {camera.mount_height:g}"
         )
+    slope, on_slope = _steepest_slope(world.room)
     w, h, hfov = camera.width, camera.height, camera.hfov
     vfov = vertical_fov(w, h, hfov)
-    limit = max_tilt(w, h, hfov)
+    limit = max_tilt(w, h, hfov) - slope
     if limit < 0:
         raise ScenarioError(
-            f"camera.hfov must be at most {_floor(max_hfov(w, h), 4)} rad at camera.resolution "
-            f"{w}x{h}, got {hfov:g} (a vertical field of view of {vfov:.3f} rad: the top and "
-            f"bottom rows would look straight up or down)"
+            f"camera.hfov must be at most {_floor(max_hfov(w, h, slope), 4)} rad at "
+            f"camera.resolution {w}x{h}{on_slope}, got {hfov:g} (a vertical field of view of "
+            f"{vfov:.3f} rad: the top and bottom rows would look straight up or down)"
         )
     if camera.tilt is not None:
         tilt, key, shown, unit = camera.tilt, "camera.tilt", _floor(limit, 4), "rad"
@@ -766,15 +780,17 @@ def _check_camera_geometry(camera, world):
         got = tilt if unit == "rad" else math.degrees(tilt)
         raise ScenarioError(
             f"|{key}| must be at most {shown} {unit} with camera.hfov {hfov:g} rad at "
-            f"{w}x{h} (vertical field of view {vfov:.3f} rad; beyond it rows would look "
-            f"straight up or down), got {got:g}"
+            f"{w}x{h}{on_slope} (vertical field of view {vfov:.3f} rad; beyond it rows would "
+            f"look straight up or down), got {got:g}"
         )
 
 
 def _check_further_cameras(connectors, sim, world):
-    """Each ``[[robot.sensors]]`` camera, as the body camera: between floor and ceiling, and
-    at most one frame a physics step (the rig captures at physics steps)."""
+    """Each ``[[robot.sensors]]`` camera, as the body camera: between floor and ceiling, its
+    field of view one the renderer draws (even on the steepest terrain patch), and at most
+    one frame a physics step (the rig captures at physics steps)."""
     ceiling, dt = world.room.height, sim.physics_dt
+    slope, on_slope = _steepest_slope(world.room)
     for spec in connectors:
         if spec.kind != "camera":
             continue
@@ -789,12 +805,51 @@ def _check_further_cameras(connectors, sim, world):
                 f"{spec.where}.height {height:g} m must be below the ceiling (room.height "
                 f"{ceiling:g} m)"
             )
+        _check_further_field_of_view(spec, slope, on_slope)
         if dt > spec.params.frame_period:
             raise ScenarioError(
                 f"{spec.where}.fps {fps:g} is more than one frame a physics step "
                 f"(sim.physics_dt {dt:g} s: at most {1 / dt:g}); lower it or shorten "
                 "sim.physics_dt"
             )
+
+
+def _check_further_field_of_view(spec, slope, on_slope):
+    """A further camera's ``hfov_deg`` and ``tilt_deg`` against its resolution, as
+    ``_check_camera_geometry`` checks the body camera's."""
+    p = spec.params
+    w, h = p.width, p.height
+    vfov = vertical_fov(w, h, p.hfov)
+    limit = max_tilt(w, h, p.hfov) - slope
+    if limit < 0:
+        widest = _floor(math.degrees(max_hfov(w, h, slope)), 2)
+        raise ScenarioError(
+            f"{spec.where}.hfov_deg must be at most {widest} deg at its resolution "
+            f"{w}x{h}{on_slope}, got {math.degrees(p.hfov):g} (a "
+            f"vertical field of view of {math.degrees(vfov):.1f} deg: the top and bottom rows "
+            "would look straight up or down)"
+        )
+    if abs(p.tilt) > limit:
+        raise ScenarioError(
+            f"|{spec.where}.tilt_deg| must be at most {_floor(math.degrees(limit), 2)} deg "
+            f"with its hfov_deg {math.degrees(p.hfov):g} at {w}x{h}{on_slope} (vertical field "
+            f"of view {math.degrees(vfov):.1f} deg; beyond it rows would look straight up or "
+            f"down), got {math.degrees(p.tilt):g}"
+        )
+
+
+def _sensor_warnings(camera, connectors):
+    """The sensor model (``camera.sensor``) is the body camera's alone: a further camera's
+    frames stay the rendered ones plus its own ``noise_std``, which the scenario may not
+    expect (docs/turret.md)."""
+    further = [repr(s.name) for s in connectors if s.kind == "camera"]
+    if camera.sensor == "plain" or not further:
+        return ()
+    warning = (
+        f'camera.sensor = "{camera.sensor}" models the body camera only; the further '
+        f"camera(s) {', '.join(further)} give the rendered frame plus their own noise_std"
+    )
+    return (warning,)
 
 
 def _sim(data, camera):
@@ -1142,5 +1197,6 @@ def _build(data, source, overrides):
         design_tables=tables,
         design_params=design_params,
         connectors=connectors,
-        warnings=tuple(scenario_warnings(world_config, checks)),
+        warnings=tuple(scenario_warnings(world_config, checks))
+        + _sensor_warnings(camera, connectors),
     )

@@ -7,8 +7,9 @@ slope (a ramp rising towards ``slope_dir``). While the robot's centre is on a pa
 - gravity's component along the slope, ``m g sin(slope)``, pushes the robot downhill; the
   wheels hold it with their (scaled) traction, so a robot parked on a ramp slides when
   ``m g sin(slope) > friction * traction_force`` and holds otherwise;
-- the camera pitches with the slope along the robot's heading,
-  ``atan(tan(slope) cos(heading - slope_dir))`` (facing uphill it looks up).
+- a camera pitches with the slope along the way it faces,
+  ``atan(tan(slope) cos(heading - slope_dir))`` with its own heading (facing uphill it looks
+  up, across the slope it does not pitch).
 
 The floor is drawn flat (a ramp's height is not modelled, only its tilt); overlapping patches:
 the last one listed wins.

@@ -407,9 +407,11 @@ class World:
         """The terrain patch under the robot's centre (``terrain.TerrainPatch``), or None."""
         return self._patch
 
-    def camera_pitch(self):
-        """The camera's extra pitch from the slope under the robot, rad (positive looks up)."""
-        return slope_pitch(self._patch, self.robot_body.angle)
+    def camera_pitch(self, heading=None):
+        """The extra pitch the slope under the robot gives a camera on it facing ``heading``
+        (rad, world; default the robot's own), rad (positive looks up): a camera facing
+        across the slope does not pitch, one facing downhill looks down."""
+        return slope_pitch(self._patch, self.robot_body.angle if heading is None else heading)
 
     def _advance_time(self, h):
         y = h - self._time_error

@@ -323,15 +323,16 @@ class CameraConnector(Connector):
         """Where the camera sits (``base.Mount``), from the constructor's fields."""
         return Mount(forward=self.mount_forward, height=self.mount_height, yaw=self.yaw_offset)
 
-    def pose(self, robot_pose, pitch=0.0):
-        """The camera's pose on a robot at ``robot_pose``; ``pitch`` (rad) adds to the
-        mount's tilt (the slope under the robot)."""
+    def pose(self, robot_pose, pitch_at=None):
+        """The camera's pose on a robot at ``robot_pose``; ``pitch_at(heading)`` (rad, e.g.
+        ``World.camera_pitch``: the slope under the robot) adds to the mount's tilt for the
+        heading the camera faces, its yaw offset included."""
         pose = camera_pose(
-            robot_pose, height=self.mount_height, forward=self.mount_forward, tilt=self.tilt + pitch
+            robot_pose, height=self.mount_height, forward=self.mount_forward, tilt=self.tilt
         )
-        if self.yaw_offset:
-            pose = replace(pose, heading=pose.heading + self.yaw_offset)
-        return pose
+        heading = pose.heading + self.yaw_offset
+        pitch = pitch_at(heading) if pitch_at is not None else 0.0
+        return replace(pose, heading=heading, tilt=pose.tilt + pitch)
 
     def capture(self, scene, pose):
         """The RGB888 frame (height, width, 3) of ``scene`` seen from ``pose``."""
