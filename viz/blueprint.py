@@ -35,6 +35,8 @@ _CAMERA_NAMES = {
     "rgb444": "Camera (RGB444, as the design receives it)",
     "rgb888": "Camera (RGB888)",
 }
+#: The camera's view for a design without a camera input: it films the run, nothing more.
+FILMING_CAMERA_NAME = "Camera (films the run; not a design input)"
 
 
 def default_blueprint(
@@ -73,12 +75,9 @@ def default_blueprint(
         rrb.TimeSeriesView(origin=P.TWIST_W, name="W rad/s (commanded, measured)"),
     )
     if not frame_outputs:
+        filming = rrb.Spatial2DView(origin=P.CAMERA_RAW, name=FILMING_CAMERA_NAME)
         board = rrb.Vertical(
-            rrb.Horizontal(
-                rrb.Spatial2DView(origin=P.CAMERA_RAW, name=_CAMERA_NAMES[camera]), *further
-            )
-            if further
-            else rrb.Spatial2DView(origin=P.CAMERA_RAW, name=_CAMERA_NAMES[camera]),
+            rrb.Horizontal(filming, *further) if further else filming,
             plots,
             row_shares=[4, 3],
             name="Board",
