@@ -113,6 +113,28 @@ def test_no_opengl_is_one_line_too():
     assert "OpenGL" in r.stderr and "libegl1" in r.stderr
 
 
+def test_a_missing_gl_library_is_one_line_too(tmp_path):
+    # As PyOpenGL fails on MUJOCO_GL=osmesa without libOSMesa, during ``import mujoco``.
+    (tmp_path / "mujoco.py").write_text(
+        "raise AttributeError(\"'NoneType' object has no attribute 'glGetError'\")\n"
+    )
+    env = {**os.environ, "PYTHONPATH": str(tmp_path), "MUJOCO_GL": "osmesa"}
+    r = _run(
+        "--set",
+        "camera.renderer=mujoco",
+        "--duration",
+        "0.1",
+        "--rerun",
+        "off",
+        "--backend",
+        "model",
+        env=env,
+    )
+    assert r.returncode == 2
+    assert len(r.stderr.strip().splitlines()) == 1
+    assert "no off-screen OpenGL context" in r.stderr and "MUJOCO_GL=osmesa" in r.stderr
+
+
 @mujoco_missing
 def test_the_closed_loop_runs_in_3d_and_repeats_with_the_seed():
     scenario = load_scenario("follow_person", ["camera.renderer=mujoco", "sim.duration=1.0"])

@@ -47,7 +47,9 @@ def load_mujoco():
         import mujoco  # lazy: optional (realistic extra), after MUJOCO_GL is set
     except ImportError:
         raise Render3DUnavailable(f"the 3D renderer needs MuJoCo; {INSTALL_HINT}") from None
-    except RuntimeError as exc:  # MuJoCo refuses an unknown MUJOCO_GL
+    # An unknown MUJOCO_GL raises RuntimeError; a missing GL library whatever its platform's
+    # binding raises (PyOpenGL without libOSMesa: AttributeError).
+    except Exception as exc:  # noqa: BLE001
         raise _no_context(exc) from None
     return mujoco
 
