@@ -55,6 +55,10 @@ def test_lamps_and_options_are_read():
             "camera.lamps=[{pos = [1, 2, 2], aim = [1, 2, 0], colour = [1, 1, 1]}]",
             "unknown key camera.lamps[0].colour",
         ),
+        (
+            "camera.lamps=[" + ", ".join(["{pos = [1, 2, 2], aim = [1, 2, 0]}"] * 7) + "]",
+            "camera.lamps must hold at most 6 lamps",
+        ),
     ],
 )
 def test_bad_values_are_named(override, message):
