@@ -48,3 +48,27 @@ def test_the_last_lamp_allowed_is_drawn():
     # The spot: levels well above the ambient-only wall (albedo 0.8 x 0.2 x 255 = 41).
     assert without.max() <= 42
     assert lit.max() > without.max() + 40
+
+
+@mujoco_missing
+def test_light_summing_over_1_is_as_bright_as_the_raster_draws_it():
+    # Ambient 0.8 and a directional light of 0.5 from (1, 0.5, -1): the floor and the back
+    # wall (facing -x) each get 0.8 + 0.5 * 2/3, so red = albedo * 1.133 * 255 (the floor's
+    # albedo 0.55, the wall's 0.8), not the albedo alone.
+    image = _render(0.8, 0.5, ()).astype(float)
+    floor, wall = image[H - 10 :, 40:120, 0], image[H // 2 - 15 : H // 2 - 5, 40:120, 0]
+    assert floor.mean() == pytest.approx(0.55 * (0.8 + 0.5 * 2 / 3) * 255, abs=2)
+    assert wall.mean() == pytest.approx(0.8 * (0.8 + 0.5 * 2 / 3) * 255, abs=2)
+
+
+@mujoco_missing
+def test_a_lamps_light_grows_with_its_color():
+    dark = _render(0.2, 0.0, ()).astype(int)
+
+    def added(level):
+        lamp = dataclasses.replace(SPOT, color=(level,) * 3)
+        return (_render(0.2, 0.0, (lamp,)).astype(int) - dark)[..., 0].max()
+
+    # Where the spot is brightest: albedo 0.8 x the lamp's level x 255 (less its cone's fall).
+    assert added(0.5) > 80
+    assert added(1.0) == pytest.approx(2 * added(0.5), abs=4)
