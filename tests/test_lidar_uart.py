@@ -160,3 +160,23 @@ def test_the_uart_takes_the_runs_clock_and_baud():
 def test_a_uart_off_the_runs_clock_or_baud_is_refused(sets, message):
     with pytest.raises(ScenarioError, match=re.escape(message)):
         load_scenario("corridor_uart", sets)
+
+
+@pytest.mark.parametrize(
+    "clock_hz, accepted",
+    [
+        (250_000, False),  # 2.5 cycles a bit: the connector's one edge a bit, not the receiver's 4
+        (383_000, False),  # rounded to 4, 4.4% off: the stop bit sampled 42% off its middle
+        (384_000, True),
+        (417_000, True),
+        (418_000, False),
+        (1_200_000, True),  # 12 cycles a bit
+    ],
+)
+def test_the_receivers_cycles_a_bit_are_as_documented(clock_hz, accepted):
+    """docs/lidar.md: at least 4 cycles a bit, within 4% of a whole number of cycles."""
+    if accepted:
+        assert UartParams(clock_hz=clock_hz, baud=100_000).bit_cycles == round(clock_hz / 100_000)
+    else:
+        with pytest.raises(ValueError):
+            UartParams(clock_hz=clock_hz, baud=100_000)

@@ -47,6 +47,7 @@ def test_shadows_change_the_frame_but_not_where_the_person_is():
     plain = MujocoRenderer(W, H, HFOV, Render3DOptions(shadows=False)).render(scene, POSE)
     shaded = MujocoRenderer(W, H, HFOV, Render3DOptions(shadows=True)).render(scene, POSE)
     assert (plain != shaded).any(axis=2).sum() > 100  # the walls' and the person's shadows
-    # Shadows darken: hardly a pixel gets brighter (a few at the person's outline).
-    assert (shaded.astype(int) > plain.astype(int) + 1).any(axis=2).mean() < 0.002
+    # Shadows darken: hardly a pixel gets brighter (a few at the person's outline) by more than
+    # OpenGL's rounding, one level times the light's gain (ambient 0.6 + intensity 0.5: 1.1).
+    assert (shaded.astype(int) > plain.astype(int) + 2).any(axis=2).mean() < 0.002
     assert abs(red_pixels(shaded)[1] - red_pixels(plain)[1]) <= 2.0

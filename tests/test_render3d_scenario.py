@@ -55,6 +55,10 @@ def test_lamps_and_options_are_read():
             "camera.lamps=[{pos = [1, 2, 2], aim = [1, 2, 0], colour = [1, 1, 1]}]",
             "unknown key camera.lamps[0].colour",
         ),
+        (
+            "camera.lamps=[" + ", ".join(["{pos = [1, 2, 2], aim = [1, 2, 0]}"] * 7) + "]",
+            "camera.lamps must hold at most 6 lamps",
+        ),
     ],
 )
 def test_bad_values_are_named(override, message):
@@ -111,6 +115,28 @@ def test_no_opengl_is_one_line_too():
     assert r.returncode == 2
     assert len(r.stderr.strip().splitlines()) == 1
     assert "OpenGL" in r.stderr and "libegl1" in r.stderr
+
+
+def test_a_missing_gl_library_is_one_line_too(tmp_path):
+    # As PyOpenGL fails on MUJOCO_GL=osmesa without libOSMesa, during ``import mujoco``.
+    (tmp_path / "mujoco.py").write_text(
+        "raise AttributeError(\"'NoneType' object has no attribute 'glGetError'\")\n"
+    )
+    env = {**os.environ, "PYTHONPATH": str(tmp_path), "MUJOCO_GL": "osmesa"}
+    r = _run(
+        "--set",
+        "camera.renderer=mujoco",
+        "--duration",
+        "0.1",
+        "--rerun",
+        "off",
+        "--backend",
+        "model",
+        env=env,
+    )
+    assert r.returncode == 2
+    assert len(r.stderr.strip().splitlines()) == 1
+    assert "no off-screen OpenGL context" in r.stderr and "MUJOCO_GL=osmesa" in r.stderr
 
 
 @mujoco_missing

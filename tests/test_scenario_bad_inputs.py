@@ -318,10 +318,28 @@ CASES = [
         "servo-on-no-channel",
         [*TURRET, "--set", SERVO.format("centroid_x")],
         (
+            # Only the channel outputs a servo can take are offered.
             "in compressed timing a servo hears an output of a further camera's channel of "
-            "design 'turret_tracker' (servo_angle, turret_centroid_x, turret_found), not "
+            "design 'turret_tracker', signed and at most 10 bits (servo_angle), not "
             "'centroid_x'"
         ),
+    ),
+    (
+        "servo-on-a-design-without-one",
+        [*TURRET, "--set", 'design.top="follow_target"', "--set", "robot.sensors.0.ports={}"],
+        (
+            "the servo connector 'pan': design 'follow_target' drives no servo (it binds no "
+            "output to pin 'angle'); bind one with ports = {angle = \"PORT\"}"
+        ),
+    ),
+    (
+        "servo-on-a-design-without-one-real-clock",
+        [
+            *TURRET,
+            *("--set", 'sim.timing="real_clock"', "--set", 'design.top="follow_target"'),
+            *("--set", "robot.sensors.0.ports={}"),
+        ],
+        "the servo connector 'pan': design 'follow_target' drives no servo",
     ),
     # one table drives a design input
     (

@@ -147,32 +147,44 @@ def _check_servo(scenario, spec, top, registered):
     """A servo's port: in compressed timing an output of one of the design's further-camera
     channels (nothing else runs then), and an output of the servo's 10 bits, signed."""
     port = spec.ports.get("angle") or top.bindings.get("servo", {}).get("angle")
-    if port is None:
-        return  # a servo the design does not drive stays at rest
+    if port is None:  # it would never move
+        raise UsageError(
+            f"the servo connector {spec.name!r}: design {top.name!r} drives no servo (it binds "
+            f"no output to pin 'angle'); bind one with ports = {{angle = \"PORT\"}} in its "
+            "[[robot.actuators]] table, or leave the servo out"
+        )
+    design = None  # a Verilog design's ports are known once it is built (RealClockLoop)
+    if scenario.foreign is None:
+        design = resolve_design(scenario.top, scenario.design_params)
     if scenario.sim.timing == "compressed":
         channels = registered.frame_channels if registered is not None else {}
-        outputs = sorted(
-            {
-                name
-                for bundle in channels
-                for name in _channel_class(registered, bundle).output_ports
-            }
-        )
+        outputs = {
+            name for bundle in channels for name in _channel_class(registered, bundle).output_ports
+        }
         if port not in outputs:
+            # Offer only the outputs that would pass the pin's test below.
+            fitting = sorted(
+                name
+                for name in outputs
+                if design is not None and _servo_misfit(spec, top, design, name) is None
+            )
             raise UsageError(
                 f"the servo connector {spec.name!r}: in compressed timing a servo hears an "
-                f"output of a further camera's channel of design {top.name!r} "
-                f"({', '.join(outputs) or 'it has none'}), not {port!r}; bind it to one, or "
-                'run sim.timing = "real_clock"'
+                f"output of a further camera's channel of design {top.name!r}, signed and at "
+                f"most 10 bits ({', '.join(fitting) or 'it has none'}), not {port!r}; bind it "
+                'to one, or run sim.timing = "real_clock"'
             )
-    if scenario.foreign is not None:
-        return  # a Verilog design's ports are known once it is built (RealClockLoop)
-    design = resolve_design(scenario.top, scenario.design_params)
+    if design is None:
+        return
     if port not in design.ports:
         raise no_port("servo", spec.name, top, "angle", port, design.ports)
-    direction, width = design.ports[port]
-    misfit = port_misfit(
-        "servo", spec.name, top, "angle", Port(port, width, direction, port in design.signed)
-    )
+    misfit = _servo_misfit(spec, top, design, port)
     if misfit is not None:
         raise UsageError(misfit)
+
+
+def _servo_misfit(spec, top, design, port):
+    direction, width = design.ports[port]
+    return port_misfit(
+        "servo", spec.name, top, "angle", Port(port, width, direction, port in design.signed)
+    )

@@ -28,7 +28,7 @@ from fpga_robotics.hw.params import (
     FollowTargetParams,
 )
 from fpga_robotics.hw.pixel import COLOR_SELECT
-from fpga_robotics.sim.camera.render3d.options import FLOORS
+from fpga_robotics.sim.camera.render3d.options import FLOORS, MAX_LAMPS
 from fpga_robotics.sim.camera.sensor import PARAMS as SENSOR_PARAMS
 from fpga_robotics.sim.world.keys import MAX_TIME
 from fpga_robotics.sim.world.schema import (
@@ -149,6 +149,11 @@ class LampKeys(ScenarioKeys):
 def _lamps(value):
     if not isinstance(value, list):
         fail(f"must be an array of tables ([[camera.lamps]]), got {value!r}")
+    if len(value) > MAX_LAMPS:
+        fail(
+            f"must hold at most {MAX_LAMPS} lamps (the 3D renderer draws 8 lights, two of them "
+            f"the scenario's [lighting]), got {len(value)}"
+        )
     for i, item in enumerate(value):
         if not isinstance(item, dict):
             fail(

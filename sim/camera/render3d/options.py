@@ -5,10 +5,15 @@ Plain data, filled from a scenario's ``[camera]`` keys by the application (docs/
 
 from dataclasses import dataclass
 
-__all__ = ["FLOORS", "Lamp", "Render3DOptions"]
+__all__ = ["FLOORS", "MAX_LAMPS", "Lamp", "Render3DOptions"]
 
 #: Floor textures (kinds of ``textures.KINDS``).
 FLOORS = ("planks", "tiles", "plain")
+
+#: Lamps MuJoCo draws: its OpenGL renderer lights with at most 8 lights, and the headlight
+#: (the ambient light) and the scene's directional light take two; further ones would be
+#: dropped without a word.
+MAX_LAMPS = 6
 
 
 @dataclass(frozen=True)
@@ -41,7 +46,7 @@ class Render3DOptions:
     shine : float
         Specular strength of clothes and wood, 0..1 (highlights; 0: matte as the raster).
     lamps : tuple of Lamp
-        Spot lamps added to the scene's light.
+        Spot lamps added to the scene's light, at most ``MAX_LAMPS``.
     seed : int
         Seeds the textures.
     """
@@ -61,3 +66,5 @@ class Render3DOptions:
             raise ValueError(f"shine must be in 0..1, got {self.shine!r}")
         if not 64 <= self.shadow_size <= 8192:
             raise ValueError(f"shadow_size must be 64..8192 pixels, got {self.shadow_size!r}")
+        if len(self.lamps) > MAX_LAMPS:
+            raise ValueError(f"at most {MAX_LAMPS} lamps are drawn, got {len(self.lamps)}")

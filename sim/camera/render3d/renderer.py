@@ -4,7 +4,8 @@ OSMesa), with textures, lights, shadows and people with bodies.
 Same call as ``sim.camera.CameraRenderer``: ``render(scene, pose, noise_std, rng)`` returns
 an RGB888 (height, width, 3) uint8 image, with the same pinhole (focal length
 ``(W/2) / tan(hfov/2)``, square pixels, optical axis through the image centre) and the same
-light model for the scene's light: ``albedo * (ambient + intensity * max(0, -n.d))``. The
+light model for the scene's light: ``albedo * (ambient + intensity * max(0, -n.d))``, bright
+light beyond 1 included (drawn scaled down and the frame multiplied back). The
 model is built from the scene's layout once (``mjcf.build_model_xml``) and rebuilt only when
 the walls or the people change; every frame then moves the camera and the people (mocap
 bodies, the gait's joint angles from ``body.gait_angles``) and sets the light levels.
@@ -47,7 +48,9 @@ def load_mujoco():
         import mujoco  # lazy: optional (realistic extra), after MUJOCO_GL is set
     except ImportError:
         raise Render3DUnavailable(f"the 3D renderer needs MuJoCo; {INSTALL_HINT}") from None
-    except RuntimeError as exc:  # MuJoCo refuses an unknown MUJOCO_GL
+    # An unknown MUJOCO_GL raises RuntimeError; a missing GL library whatever its platform's
+    # binding raises (PyOpenGL without libOSMesa: AttributeError).
+    except Exception as exc:  # noqa: BLE001
         raise _no_context(exc) from None
     return mujoco
 
@@ -166,23 +169,34 @@ class MujocoRenderer:
             qadr = [model.jnt_qposadr[model.joint(joints[j]).id] for j in joints]
             self._people.append((mocap, list(joints), qadr))
         self._sky = None
+        # The lights' strengths as the model gives them, scaled down each frame (_set_lights).
+        self._lamp_diffuse = model.light_diffuse[1:].copy()
+        self._specular = model.light_specular.copy()
         self._key = self._layout_key(scene)
 
     # -- the frame -----------------------------------------------------------------------------
 
     def _set_lights(self, lighting):
+        """Set the frame's light levels, divided by ``self._gain``, the most they can sum to
+        (at least 1): OpenGL clips the summed light at 1 before it scales a surface's colour,
+        so a brighter light is drawn dimmer and ``render`` multiplies the frame back."""
         m = self.model
+        lamps = self._lamp_diffuse.sum(axis=0).max() if len(self._lamp_diffuse) else 0.0
+        gain = max(1.0, lighting.ambient + lighting.intensity + lamps)
+        self._gain = gain
         d = np.asarray(lighting.direction, dtype=float)
         d = d / np.linalg.norm(d)
         m.light_dir[0] = d
         # The shadow map's box is centred on the light's axis: through the room's centre.
         m.light_pos[0] = self._centre - 2.0 * m.stat.extent * d
-        m.light_diffuse[0] = lighting.intensity
+        m.light_diffuse[0] = lighting.intensity / gain
+        m.light_diffuse[1:] = self._lamp_diffuse / gain
+        m.light_specular[:] = self._specular / gain
         # Ambient light comes from the headlight (diffuse 0): a light's own ambient term
         # would vanish in its shadows, leaving them black.
-        m.vis.headlight.ambient = (lighting.ambient,) * 3
+        m.vis.headlight.ambient = (lighting.ambient / gain,) * 3
         # The ceiling is lit by the ambient light only (the raster's ceiling).
-        sky = (self._scene_ceiling * lighting.ambient).clip(0.0, 1.0)
+        sky = (self._scene_ceiling * lighting.ambient).clip(0.0, 1.0) / gain
         if self._sky is None or not np.array_equal(sky, self._sky):
             adr = m.tex_adr[self._sky_id]
             n = m.tex_width[self._sky_id] * m.tex_height[self._sky_id] * 3
@@ -237,6 +251,8 @@ class MujocoRenderer:
         r = self._renderer
         r.update_scene(self.data, camera="eye")
         image = r.render()
+        if self._gain > 1.0:  # the light drawn divided by the gain (_set_lights)
+            image = np.minimum(np.rint(image * self._gain), 255).astype(np.uint8)
         if noise_std:
             self._raster._add_noise(image, noise_std, rng)
         return image
