@@ -154,6 +154,25 @@ def test_the_run_command_reports_the_call_in_one_line_and_runs_again(tmp_path, c
     assert "design output count: last 10000" in captured.out  # 1 s at 10 kHz: every edge
 
 
+@pytest.mark.slow
+def test_a_shadow_design_that_calls_finish_is_named_not_the_primary(tmp_path, capsys):
+    # The shadow is stopper.v held at which = 1 ($finish at edge 5500); the primary, the same
+    # design at which = 0, never calls anything.
+    scenario = tmp_path / "stopper.toml"
+    scenario.write_text(STOPPER_SCENARIO)
+    shadow_ports = tmp_path / "finishing_ports.toml"
+    shadow_ports.write_text(STOPPER_PORTS.read_text().replace("which = 0", "which = 1"))
+    argv = ["--scenario", str(scenario), "--design", f"verilog:{STOPPER}"]
+    argv += ["--ports", str(STOPPER_PORTS), "--rerun", "off", "--quiet"]
+    argv += ["--shadow", f"verilog:{STOPPER}", "--shadow-ports", str(shadow_ports)]
+    code, captured = _run(argv, capsys)
+    assert code == 2
+    assert captured.err.splitlines() == [
+        f"fpga-robotics run: error: --shadow: {STOPPER}: frame 5: the shadow design called "
+        + f"{CALLS[1]} (edge {CALL_EDGE}, 0.55 s)"
+    ]
+
+
 def _late_run(pins, tmp_path, wait_cycles=0, silent=0):
     path = tmp_path / "late.toml"
     path.write_text(LATE_SCENARIO)

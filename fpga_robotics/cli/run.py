@@ -49,7 +49,7 @@ from fpga_robotics.sim.backends.foreign_choice import FOREIGN_BACKENDS, open_for
 from fpga_robotics.sim.backends.port_map import load_port_map
 from fpga_robotics.sim.camera.render3d.renderer import Render3DUnavailable, load_mujoco
 from fpga_robotics.sim.files import check_output_path, check_paths_apart, write_json_atomic
-from fpga_robotics.sim.pins import DesignError, PinError
+from fpga_robotics.sim.pins import DesignError, PinError, ShadowDesignError
 from fpga_robotics.sim.world.config import parse_world_config
 
 __all__ = ["TARGET_CLOTHING", "PortMapUnpaired", "Progress", "build_parser", "main"]
@@ -1083,6 +1083,8 @@ def main(argv=None, prog="fpga-robotics run"):
         if progress is not None:
             progress.finish()
         completed = True
+    except ShadowDesignError as exc:  # the shadow's own doing, named as --shadow gave it
+        raise UsageError(f"--shadow: {exc}") from None
     except DesignError as exc:  # real-clock timing: as _UserDesign reports it on frames
         raise UsageError(f"--design: {exc}") from None
     finally:

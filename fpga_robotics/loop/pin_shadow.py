@@ -12,8 +12,9 @@ from dataclasses import dataclass, field
 
 from fpga_robotics.designs.builtin import TOPS
 from fpga_robotics.designs.reference import entry_point_designs
+from fpga_robotics.sim.pins import DesignStopped
 
-__all__ = ["MirroredPins", "PinComparison", "is_design_reference"]
+__all__ = ["MirroredPins", "PinComparison", "ShadowStopped", "is_design_reference"]
 
 
 def is_design_reference(spec):
@@ -23,6 +24,10 @@ def is_design_reference(spec):
     if "=" in spec or ";" in spec:
         return False
     return ":" in spec or spec in TOPS or spec in entry_point_designs()
+
+
+class ShadowStopped(DesignStopped):
+    """The shadow design (not the primary) called ``$finish``, ``$stop`` or ``$fatal``."""
 
 
 class MirroredPins:
@@ -89,7 +94,10 @@ class MirroredPins:
     def run(self, cycles):
         stop = self.primary.run(cycles)
         while self.shadow.cycle < self.primary.cycle:  # it watches nothing: one call, usually
-            self.shadow.run(self.primary.cycle - self.shadow.cycle)
+            try:
+                self.shadow.run(self.primary.cycle - self.shadow.cycle)
+            except DesignStopped as exc:  # the shadow's own call, not the primary's
+                raise ShadowStopped(exc.call, exc.cycle) from None
         return stop
 
     def close(self):

@@ -39,7 +39,7 @@ from fpga_robotics.loop.bindings import (
 )
 from fpga_robotics.loop.compressed import ClosedLoop, run_loop
 from fpga_robotics.loop.connectors import CONNECTORS, PinIO
-from fpga_robotics.loop.pin_shadow import MirroredPins, PinComparison
+from fpga_robotics.loop.pin_shadow import MirroredPins, PinComparison, ShadowStopped
 from fpga_robotics.sim.backends.base import FrameResult
 from fpga_robotics.sim.backends.foreign import ForeignDesign
 from fpga_robotics.sim.backends.port_map import load_port_map
@@ -48,6 +48,7 @@ from fpga_robotics.sim.pins import (
     DesignError,
     DesignStopped,
     PinDesignSource,
+    ShadowDesignError,
     VerilogPinSource,
     get_pin_backend,
 )
@@ -388,9 +389,11 @@ class RealClockLoop(ClosedLoop):
             try:
                 stop = self.pins.run(min(edge, due, deadline) - self.pins.cycle)
             except DesignStopped as exc:
-                raise DesignError(
-                    f"{self._design_name}: frame {max(0, self.frames_done - 1)}: the design "
-                    f"called {exc.call} (edge {exc.cycle}, {exc.cycle / self.clock_hz:.6g} s)"
+                shadow = isinstance(exc, ShadowStopped)
+                raise (ShadowDesignError if shadow else DesignError)(
+                    f"{self._shadow_name if shadow else self._design_name}: frame "
+                    f"{max(0, self.frames_done - 1)}: the {'shadow ' * shadow}design called "
+                    f"{exc.call} (edge {exc.cycle}, {exc.cycle / self.clock_hz:.6g} s)"
                 ) from None
             if self.pins.cycle == due:
                 for conn, io in sampled:
@@ -415,6 +418,11 @@ class RealClockLoop(ClosedLoop):
     def _design_name(self):
         """The design as its errors name it: a Verilog design by its top module."""
         return self.top.name.removeprefix("verilog:")
+
+    @property
+    def _shadow_name(self):
+        """The shadow design as its errors name it: as ``--shadow`` gave it."""
+        return self.comparison.label.removeprefix("verilog:")
 
     def _check_strobe_timeout(self):
         """The oldest frame awaiting its result strobe has not had it by its last edge: the

@@ -10,6 +10,7 @@ from .base import (
     PinError,
     PixelTiming,
     Port,
+    ShadowDesignError,
     Stop,
     StopLimit,
 )
@@ -30,6 +31,7 @@ __all__ = [
     "PinError",
     "PixelTiming",
     "Port",
+    "ShadowDesignError",
     "Stop",
     "StopLimit",
     "VerilogPinSource",

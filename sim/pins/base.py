@@ -35,6 +35,7 @@ __all__ = [
     "PinError",
     "PixelTiming",
     "Port",
+    "ShadowDesignError",
     "Stop",
     "StopLimit",
 ]
@@ -47,6 +48,10 @@ class PinError(UserError, RuntimeError):
 class DesignError(PinError):
     """The design itself ended a run: it called ``$finish``, ``$stop`` or ``$fatal``
     (``DesignStopped``), or its result strobe never rose (the real-clock loop)."""
+
+
+class ShadowDesignError(DesignError):
+    """The shadow design, not the primary, ended the run (real-clock timing)."""
 
 
 class DesignStopped(DesignError):
