@@ -31,6 +31,7 @@ from fpga_robotics.hw.board.ulx3s_user_top import (
 )
 from fpga_robotics.hw.errors import UserError
 from fpga_robotics.hw.params import FollowTargetParams
+from fpga_robotics.loop.pin_frames import SETTLE_EDGES
 from fpga_robotics.sim.files import write_atomic
 
 __all__ = [
@@ -230,17 +231,22 @@ def _user_factory(spec):
                     )
                 platform.add_file(name, text)
             design = VerilogOnBoard(spec.port_map, servo=wiring["servo"], header=wiring["header"])
+            # The simulation reads the outputs the map's latency after its strobe.
+            update_delay = spec.port_map.latency
         else:
             design = spec.build()
             bound = {**wiring["wheels"], **wiring["camera_pins"]}
             if any(pin != port for pin, port in bound.items()):
                 design = _BoundPorts(design, bound)
+            # As compressed timing reads the wheels: SETTLE_EDGES after frame_done.
+            update_delay = SETTLE_EDGES
         return platform, ULX3SUserDesign(
             design,
             header=wiring["header"],
             camera=wiring["camera"],
             turret_camera=wiring.get("turret_camera", False),
             servo=wiring["servo"],
+            update_delay=update_delay,
         )
 
     return factory
