@@ -716,3 +716,30 @@ def test_the_board_sends_the_wheels_when_the_simulation_reads_them(tmp_path):
     assert update_delay(RED_COUNT[1], RED_COUNT[3]) == 2
     assert update_delay("follow_target_safe") == SETTLE_EDGES == 1024
     assert update_delay(f"{DESIGNS}/red_frames.py:RedFrames") == SETTLE_EDGES
+
+
+def test_a_new_top_replaces_an_earlier_designs_build(tmp_path, capsys):
+    """Every top is ulx3s_follow_target: an earlier design's bitstream, reports and netlist
+    go when another design's top is written into the folder; other files stay."""
+    out = tmp_path / "b"
+    out.mkdir()
+    earlier = [
+        "ulx3s_follow_target.bit",
+        "ulx3s_follow_target.rpt",
+        "ulx3s_follow_target.tim",
+        "ulx3s_follow_target.json",
+        "ulx3s_follow_target.report.json",
+        "build_ulx3s_follow_target.bat.orig",
+    ]
+    for name in [*earlier, "notes.txt"]:
+        (out / name).write_text("the earlier design's\n")
+    code, _, _ = _cli(["board", *BUMP_STOP, "-o", str(out)], capsys)
+    assert code == 0
+    assert not [name for name in earlier if (out / name).exists()]
+    assert (out / "notes.txt").read_text() == "the earlier design's\n"
+    assert "bump_stop" in (out / "ulx3s_follow_target.v").read_text()
+    # A design the board cannot serve deletes nothing.
+    (out / "ulx3s_follow_target.bit").write_text("kept\n")
+    code, _, _ = _cli(["board", "--design", f"{DATA}/no_such.py:D", "-o", str(out)], capsys)
+    assert code == 2
+    assert (out / "ulx3s_follow_target.bit").read_text() == "kept\n"

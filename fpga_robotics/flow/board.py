@@ -291,12 +291,27 @@ def _write_plan(plan, out_dir, *, rename_verilog=True):
     return written
 
 
+def _remove_earlier_build(out_dir):
+    """Delete an earlier build's files in ``out_dir`` (``<name>.*``, ``build_<name>.*``): every
+    design's top has the same name, so a new top never sits beside another design's
+    bitstream, netlist or reports."""
+    if not os.path.isdir(out_dir):
+        return
+    for name in os.listdir(out_dir):
+        path = os.path.join(out_dir, name)
+        if name.startswith((f"{DESIGN_NAME}.", f"build_{DESIGN_NAME}.")) and os.path.isfile(path):
+            os.unlink(path)
+
+
 def export_board(board, out_dir, params=None, design=None):
     """Write the board top's Verilog (``<name>.v``), pin constraints (``<name>.lpf``) and the
-    rest of the build plan (RTLIL, Yosys script, build script) into ``out_dir``; ``design``
-    (a ``DesignSpec``) puts a design of one's own on the board instead of FollowTarget."""
+    rest of the build plan (RTLIL, Yosys script, build script) into ``out_dir``, in place of
+    an earlier build's files; ``design`` (a ``DesignSpec``) puts a design of one's own on the
+    board instead of FollowTarget."""
     params = FollowTargetParams() if params is None else params
-    return _write_plan(_plan(board, params, verilog=True, design=design), out_dir)
+    plan = _plan(board, params, verilog=True, design=design)
+    _remove_earlier_build(out_dir)
+    return _write_plan(plan, out_dir)
 
 
 @dataclass(frozen=True)
@@ -401,12 +416,9 @@ def build_bitstream(board, out_dir, params=None, *, seed=1, log=print, design=No
         nextpnr_opts=(f"--seed {int(seed)}", f"--report {report_name}", "--timing-allow-fail"),
         design=design,
     )
+    _remove_earlier_build(out_dir)  # never report an old run's results
     os.makedirs(out_dir, exist_ok=True)
     _write_plan(plan, out_dir, rename_verilog=False)
-    for stale in (report_name, f"{DESIGN_NAME}.bit"):  # never report an old run's results
-        path = os.path.join(out_dir, stale)
-        if os.path.exists(path):
-            os.unlink(path)
 
     env = dict(os.environ, **tools)
     script = f"build_{DESIGN_NAME}.sh"
