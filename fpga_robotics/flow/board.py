@@ -262,6 +262,11 @@ def header_pins(spec):
 
 def _plan(board, params, nextpnr_opts=(), *, verilog=False, design=None):
     factory = board_factory(board) if design is None else _user_factory(design)
+    # A Verilog design's files are read as the simulation and formal read them:
+    # SystemVerilog, whatever their names (Amaranth's plan reads only .sv names so).
+    overrides = (
+        {"read_verilog_opts": "-sv"} if design is not None and design.kind == "verilog" else {}
+    )
     try:
         platform, top = factory(params)
         return platform.build(
@@ -270,6 +275,7 @@ def _plan(board, params, nextpnr_opts=(), *, verilog=False, design=None):
             do_build=False,
             debug_verilog=verilog,
             nextpnr_opts=" ".join(nextpnr_opts),
+            **overrides,
         )
     except ValueError as exc:  # e.g. a geometry the camera set-up cannot produce
         raise UserError(str(exc)) from None
