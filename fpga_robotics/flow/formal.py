@@ -123,15 +123,24 @@ def sby_script(check, depth):
 def _summary(output):
     """The lines of SymbiYosys's summary that say what failed, where (``file:line``): a failed
     assertion names its statement on its own line, the unreached covers come as a list, one
-    indented line each, under the line "unreached cover statements:"."""
+    indented line each, under the line "unreached cover statements:". The assertions listed
+    under "counterexample trace [induction]" are left out: the induction starts from any
+    state, reachable or not, so they are no failure from reset (a prove whose base case
+    holds is ``unknown`` for them)."""
     wanted = ("failed assertion", "failed assumption")
     found = []
-    in_unreached = False
+    in_unreached = in_induction = False
     for line in output.splitlines():
         text = line.split("summary:", 1)[1] if "summary:" in line else ""
+        if "counterexample trace" in text:
+            in_induction = "[induction]" in text
+        elif not text.startswith("  "):  # the trace's list of statements has ended
+            in_induction = False
         listed = in_unreached and text.startswith("  ")
         in_unreached = listed or "unreached cover statements:" in text
         text = re.sub(r"\S*_witness_\.\S+ at ", "", text.strip())
+        if in_induction:
+            continue
         if listed:  # a statement, or "and 3 further properties" after the first five
             found.append(text if text.startswith("and ") else f"unreached cover statement {text}")
         elif any(w in text for w in wanted) and not any(f.startswith(text) for f in found):
