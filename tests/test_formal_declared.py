@@ -286,3 +286,48 @@ def test_verilog_yosys_cannot_read_or_a_missing_top_is_one_line(tmp_path):
         UsageError, match=r"no module bump_stop_noreset \(the port map's top\); its modules: "
     ):
         formal.design_checks(f"verilog:{path}", ports=str(ports))
+
+
+# Stops on a bump; its registers have no initial value, only a synchronous active-low reset.
+RESET_ONLY = """\
+module bump_rst (
+  input clk, input rst_n, input bump_i,
+  output reg signed [11:0] left_dps, output reg signed [11:0] right_dps
+);
+  always @(posedge clk)
+    if (!rst_n) begin left_dps <= 12'sd300; right_dps <= 12'sd300; end
+    else if (bump_i) begin left_dps <= 0; right_dps <= 0; end
+`ifdef FORMAL
+  always @(posedge clk) if (rst_n) assert(left_dps == 0 || left_dps == 12'sd300);
+`endif
+endmodule
+"""
+
+RESET_ONLY_PORTS = """\
+top = "bump_rst"
+clock = { port = "clk" }
+reset = { port = "rst_n", active_low = true }
+
+[outputs]
+motor_left = { port = "left_dps", width = 12, signed = true }
+motor_right = { port = "right_dps", width = 12, signed = true }
+
+[connectors.bumper]
+pressed = "bump_i"
+"""
+
+
+@pytest.mark.formal
+def test_a_port_maps_reset_is_held_in_the_first_cycle(tmp_path):
+    """As in every simulator run, the reset is active in the first cycle: the registers start
+    from their reset values, and the assertion holds. Without the map they start anywhere."""
+    path = tmp_path / "bump_rst.v"
+    path.write_text(RESET_ONLY)
+    ports = tmp_path / "ports.toml"
+    ports.write_text(RESET_ONLY_PORTS)
+    (check,) = formal.design_checks(f"verilog:{path}", ports=str(ports))
+    assert check.name == "bump_rst.asserts"
+    assert formal.run_check(check).status == "pass"
+    (free,) = formal.design_checks(f"verilog:{path}")
+    result = formal.run_check(free)
+    assert result.status == "FAIL" and "bump_rst.v:9." in result.detail
