@@ -331,3 +331,29 @@ def test_a_port_maps_reset_is_held_in_the_first_cycle(tmp_path):
     (free,) = formal.design_checks(f"verilog:{path}")
     result = formal.run_check(free)
     assert result.status == "FAIL" and "bump_rst.v:9." in result.detail
+
+
+@pytest.mark.formal
+def test_param_sets_the_designs_parameters(capsys):
+    """Full is reached after limit cycles of up: within the cover's 12 cycles at the default
+    limit (10), not at --param limit=20."""
+    argv = ["formal", "--design", SATURATING, "--only", "Saturating.covers"]
+    code, out, _ = _cli([*argv, "--param", "limit=20"], capsys)
+    assert code == 1 and "unreached cover statement" in out
+    code, out, _ = _cli([*argv, "--param", "limit=10"], capsys)
+    assert code == 0, out
+
+
+def test_param_errors_name_the_param_option(tmp_path, capsys):
+    path = tmp_path / "req.py"
+    path.write_text((DESIGNS / "counters.py").read_text().replace("limit: int = 10", "limit: int"))
+    code, out, err = _cli(["formal", "--design", f"{path}:Saturating", "--list"], capsys)
+    assert (code, out) == (2, "") and err.count("\n") == 1
+    assert err.endswith("parameter 'limit' has no default; give it as --param limit=VALUE\n")
+    code, out, _ = _cli(
+        ["formal", "--design", f"{path}:Saturating", "--param", "limit=4", "--list"], capsys
+    )
+    assert code == 0 and out.startswith("Saturating.properties")
+    code, out, err = _cli(["formal", "--param", "limit=4", "--list"], capsys)
+    assert (code, out) == (2, "")
+    assert "--param sets a parameter of a --design REF" in err

@@ -481,14 +481,20 @@ def design_checks(reference=None, params=None, ports=None):
     None) has the project's own list, ``hw.formal.CHECKS``; a design of one's own the
     properties it declares (``formal_properties``/``formal_covers``, docs/formal.md); a
     Verilog one (``verilog:FILES``, its top from the port map ``ports`` when given) the
-    assert and cover statements it holds (``verilog_checks``). A design that declares none is
-    a ``UsageError``."""
+    assert and cover statements it holds (``verilog_checks``). ``params`` (``--param``) are
+    those of a design of one's own. A design that declares none is a ``UsageError``."""
     if ports is not None and (reference is None or not reference.startswith("verilog:")):
         raise UsageError("--ports is the port map of a Verilog design: it goes with verilog:FILES")
     if reference is None or reference == "follow_target":
+        if params:
+            raise UsageError("--param sets a parameter of a --design REF (a design of your own)")
         return list(CHECKS)
 
     if reference.startswith("verilog:"):
+        if params:
+            raise UsageError(
+                "--param: a Verilog design takes no parameters here; set them in the Verilog"
+            )
         files = [f for f in reference[len("verilog:") :].split(",") if f.strip()]
         if not files:
             raise UsageError(f"--design {reference}: name the Verilog files, verilog:TOP.v")
@@ -499,7 +505,7 @@ def design_checks(reference=None, params=None, ports=None):
             except PortMapError as exc:
                 raise UsageError(f"--ports {ports}: {exc}") from None
         return verilog_checks(files, port_map=port_map)
-    spec = resolve_design(reference, params)
+    spec = resolve_design(reference, params, option="--param")
     name = reference if spec.kind == "builtin" else spec.reference.rpartition(":")[2]
     checks = declared_checks(name, spec.build)
     if not checks:
