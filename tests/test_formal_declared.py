@@ -201,6 +201,10 @@ def test_assumptions_that_contradict_each_other_are_said_so(tmp_path):
             "formal_properties raised ValueError: boom (mine.py:LINE)",
         ),
         (
+            "def formal_properties(self, m):\n    __import__('sys').exit(0)  # raises",
+            "formal_properties raised SystemExit: 0 (mine.py:LINE)",
+        ),
+        (
             "def formal_properties(self, m):\n    m.d.comb += self.full.eq(1)",
             "formal_properties raised DriverConflict: Signal (sig full) bit 0 driven from",
         ),

@@ -359,7 +359,19 @@ BAD = [
         "an elaborate that raises",
         "unelaborated.py:ElaborateRaises",
         {},
-        "does not elaborate: ValueError: no such speed table (unelaborated.py:17)",
+        "does not elaborate: ValueError: no such speed table (unelaborated.py:19)",
+    ),
+    (
+        "an elaborate that calls sys.exit",
+        "unelaborated.py:ElaborateExits",
+        {},
+        "does not elaborate: SystemExit: 0 (unelaborated.py:",
+    ),
+    (
+        "a file that calls sys.exit",
+        "exits.py:Design",
+        {},
+        "loading exits.py (line 2) raised SystemExit: 0",
     ),
     (
         "a signal driven from two domains",
@@ -397,6 +409,7 @@ def test_bad_references_are_one_line_errors(
     shutil.copy(DESIGNS / "broken.py", tmp_path / "broken.py")
     shutil.copy(DESIGNS / "unelaborated.py", tmp_path / "unelaborated.py")
     (tmp_path / "syntax_error.py").write_text("class Broken(\n")  # never closed
+    (tmp_path / "exits.py").write_text("import sys\nsys.exit(0)  # argparse on a wrong argv, say\n")
     with pytest.raises(DesignError, match=message.replace("(", r"\(").replace(")", r"\)")):
         resolve_design(reference, params, base=tmp_path)
     # The same through the command line: exit 2, one line, nothing written.

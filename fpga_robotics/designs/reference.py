@@ -35,7 +35,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from fpga_robotics.designs.builtin import TOPS, Top, build_component, design_tables, foreign_top
-from fpga_robotics.hw.errors import UsageError
+from fpga_robotics.hw.errors import USER_CODE_ERRORS, UsageError
 from fpga_robotics.hw.params import FollowTargetParams
 from fpga_robotics.loop.connectors import CONNECTORS
 
@@ -378,7 +378,7 @@ def _check_elaborates(component, target, reference):
         with warnings.catch_warnings(record=True) as said:
             warnings.simplefilter("always")
             text = rtlil.convert(component, ports=ports)
-    except Exception as exc:  # noqa: BLE001 - the user's elaborate may raise anything
+    except USER_CODE_ERRORS as exc:  # the user's elaborate may raise anything
         # The modules its elaborate made are never used now: no warning for each at exit.
         warnings.filterwarnings("ignore", category=UnusedElaboratable)
         # What Amaranth said on the way ("elaborate() returned None; missing return?").
@@ -432,7 +432,7 @@ def _load_target(reference):
                 f"design {reference!r}: no module {exc.name!r}; install the "
                 f"package or give the file as path/to/file.py:{name}"
             ) from None
-        except Exception as exc:  # noqa: BLE001 - the user's module may raise anything
+        except USER_CODE_ERRORS as exc:  # the user's module may raise anything
             raise DesignError(
                 f"design {reference!r}: importing {where} raised "
                 f"{type(exc).__name__}: {_first_line(exc)}"
@@ -478,7 +478,7 @@ def _load_file(path, reference):
     try:
         with _importing_beside(path):
             spec.loader.exec_module(module)
-    except Exception as exc:  # noqa: BLE001 - the user's file may raise anything
+    except USER_CODE_ERRORS as exc:  # the user's file may raise anything
         sys.modules.pop(name, None)
         line = _error_line(exc, path)
         raise DesignError(
@@ -645,7 +645,7 @@ def _call(target, params, reference):
     values = {k: tuple(v) if isinstance(v, list) else v for k, v in params.items()}
     try:
         component = target(**values)
-    except Exception as exc:  # noqa: BLE001 - the user's constructor may raise anything
+    except USER_CODE_ERRORS as exc:  # the user's constructor may raise anything
         raise DesignError(
             f"design {reference!r}: building it raised {type(exc).__name__}: {_first_line(exc)}"
         ) from None
