@@ -463,6 +463,29 @@ def test_a_design_without_a_clock_is_refused_where_it_would_be_simulated(
     ]
 
 
+def test_a_design_with_an_instance_is_refused_where_it_would_be_simulated(
+    tmp_path, capsys, monkeypatch
+):
+    # No simulator has my_ip: pysim would read its output as 0 and pass, the compiled
+    # backends fail inside Yosys. Export (and so the board) takes it as it is.
+    shutil.copy(DESIGNS / "unelaborated.py", tmp_path / "unelaborated.py")
+    spec = resolve_design("unelaborated.py:BlackBox", {}, base=tmp_path)
+    assert spec.black_boxes == ("my_ip",)
+    # Submodules of its own are no black boxes.
+    assert resolve_design(str(DESIGNS / "wall_stop.py") + ":WallStop", {}).black_boxes == ()
+    message = "instantiates 'my_ip' (an Instance), which the simulators here cannot run"
+    monkeypatch.chdir(tmp_path)
+    for argv in (
+        ["run", "--scenario", str(WALL_STOP), "--design", "unelaborated.py:BlackBox",
+         "--backend", "pysim", "--rerun", "off", "--set", "design.params={}"],
+        ["mutate", "--design", "unelaborated.py:BlackBox", "--mutants", "2", "--quiet"],
+    ):  # fmt: skip
+        code, _, err = _cli(argv, capsys)
+        assert code == 2 and len(err.strip().splitlines()) == 1 and message in err, err
+    code, _, _ = _cli(["export", "--design", "unelaborated.py:BlackBox", "-o", "bb.v"], capsys)
+    assert code == 0 and "my_ip ip (" in (tmp_path / "bb.v").read_text()
+
+
 def test_a_scenario_names_its_design_relative_to_its_folder(tmp_path):
     shutil.copy(DESIGNS / "wall_stop.py", tmp_path / "mine.py")
     text = WALL_STOP.read_text().replace("wall_stop.py:WallStop", "mine.py:WallStop")
