@@ -293,9 +293,10 @@ def test_verilog_yosys_cannot_read_or_a_missing_top_is_one_line(tmp_path):
 
 
 # Stops on a bump; its registers have no initial value, only a synchronous active-low reset.
+# Its ports "first" and "design" are names a harness around it might take for its own.
 RESET_ONLY = """\
 module bump_rst (
-  input clk, input rst_n, input bump_i,
+  input clk, input rst_n, input bump_i, input first, input design,
   output reg signed [11:0] left_dps, output reg signed [11:0] right_dps
 );
   always @(posedge clk)

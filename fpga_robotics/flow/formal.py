@@ -357,21 +357,20 @@ def _reset_harness(top, ports, port_map):
         f"  {direction} [{width - 1}:0] {_verilog_name(name)}"
         for name, (direction, width) in ports.items()
     ]
-    active = (
-        f"!{_verilog_name(port_map.reset)}"
-        if port_map.reset_active_low
-        else (_verilog_name(port_map.reset))
-    )
+    reset = _verilog_name(port_map.reset)
+    active = f"!{reset}" if port_map.reset_active_low else reset
     connected = ", ".join(f".{_verilog_name(n)}({_verilog_name(n)})" for n in ports)
+    # Names of its own, beside the design's port names (a stream's "first", say).
+    first, design = f"{RESET_HARNESS}_cycle0", f"{RESET_HARNESS}_design"
     return "\n".join(
         [
             f"module {RESET_HARNESS}(",
             ",\n".join(declared),
             ");",
-            "  reg first = 1'b1;",
-            f"  always @(posedge {_verilog_name(port_map.clock)}) first <= 1'b0;",
-            f"  always @(*) if (first) assume ({active});",
-            f"  {_verilog_name(top)} design ({connected});",
+            f"  reg {first} = 1'b1;",
+            f"  always @(posedge {_verilog_name(port_map.clock)}) {first} <= 1'b0;",
+            f"  always @(*) if ({first}) assume ({active});",
+            f"  {_verilog_name(top)} {design} ({connected});",
             "endmodule",
             "",
         ]
