@@ -6,7 +6,7 @@ keeps its traceback. It lives in the lowest layer so that the gateware, the simu
 viewer can all raise it without importing the application.
 """
 
-__all__ = ["ParamError", "UsageError", "UserError"]
+__all__ = ["USER_CODE_ERRORS", "ParamError", "UsageError", "UserError"]
 
 
 class UserError(Exception):
@@ -21,3 +21,9 @@ class ParamError(UserError, ValueError):
 class UsageError(UserError):
     """A bad argument or input the user gave (a command-line option, a scenario or campaign
     value, a design reference): the message says what is wrong and how to fix it."""
+
+
+#: What a user's design code (its module, constructor, ``elaborate``, formal hooks) may raise
+#: and a command reports as an error of that design: ``sys.exit()`` too (argparse at import,
+#: say), which would otherwise end the command with its code, 0 included, and nothing said.
+USER_CODE_ERRORS = (Exception, SystemExit)

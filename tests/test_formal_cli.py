@@ -119,3 +119,19 @@ def test_an_induction_that_does_not_close_is_unknown_not_pass(tmp_path):
     assert "did not close at depth 2" in result.detail and "--depth" in result.detail
     deeper = formal.run_check(check, depth=17, dut=bad(FULL_SIZES["160x120"]), trace_dir=tmp_path)
     assert deeper.status == "FAIL" and deeper.trace.exists()
+
+
+def test_an_induction_counterexample_is_no_failed_assertion():
+    """SymbiYosys's summary of a prove whose base case fails at line 57 while the induction,
+    from an unreachable state, breaks line 58 too: only line 57 fails from reset."""
+    output = "\n".join(
+        "SBY 22:49:20 [check] summary: " + text
+        for text in [
+            "engine_0 (smtbmc yices) returned FAIL for basecase",
+            "counterexample trace [basecase]: check/engine_0/trace.vcd",
+            "  failed assertion blob._witness_.check_assert_57 at blob.v:57.7-57.25 step 12",
+            "counterexample trace [induction]: check/engine_0/trace_induct.vcd",
+            "  failed assertion blob._witness_.check_assert_58 at blob.v:58.7-58.55",
+        ]
+    )
+    assert formal._summary(output) == "failed assertion blob.v:57.7-57.25 step 12"

@@ -201,6 +201,10 @@ def test_assumptions_that_contradict_each_other_are_said_so(tmp_path):
             "formal_properties raised ValueError: boom (mine.py:LINE)",
         ),
         (
+            "def formal_properties(self, m):\n    __import__('sys').exit(0)  # raises",
+            "formal_properties raised SystemExit: 0 (mine.py:LINE)",
+        ),
+        (
             "def formal_properties(self, m):\n    m.d.comb += self.full.eq(1)",
             "formal_properties raised DriverConflict: Signal (sig full) bit 0 driven from",
         ),
@@ -286,3 +290,75 @@ def test_verilog_yosys_cannot_read_or_a_missing_top_is_one_line(tmp_path):
         UsageError, match=r"no module bump_stop_noreset \(the port map's top\); its modules: "
     ):
         formal.design_checks(f"verilog:{path}", ports=str(ports))
+
+
+# Stops on a bump; its registers have no initial value, only a synchronous active-low reset.
+# Its ports "first" and "design" are names a harness around it might take for its own.
+RESET_ONLY = """\
+module bump_rst (
+  input clk, input rst_n, input bump_i, input first, input design,
+  output reg signed [11:0] left_dps, output reg signed [11:0] right_dps
+);
+  always @(posedge clk)
+    if (!rst_n) begin left_dps <= 12'sd300; right_dps <= 12'sd300; end
+    else if (bump_i) begin left_dps <= 0; right_dps <= 0; end
+`ifdef FORMAL
+  always @(posedge clk) if (rst_n) assert(left_dps == 0 || left_dps == 12'sd300);
+`endif
+endmodule
+"""
+
+RESET_ONLY_PORTS = """\
+top = "bump_rst"
+clock = { port = "clk" }
+reset = { port = "rst_n", active_low = true }
+
+[outputs]
+motor_left = { port = "left_dps", width = 12, signed = true }
+motor_right = { port = "right_dps", width = 12, signed = true }
+
+[connectors.bumper]
+pressed = "bump_i"
+"""
+
+
+@pytest.mark.formal
+def test_a_port_maps_reset_is_held_in_the_first_cycle(tmp_path):
+    """As in every simulator run, the reset is active in the first cycle: the registers start
+    from their reset values, and the assertion holds. Without the map they start anywhere."""
+    path = tmp_path / "bump_rst.v"
+    path.write_text(RESET_ONLY)
+    ports = tmp_path / "ports.toml"
+    ports.write_text(RESET_ONLY_PORTS)
+    (check,) = formal.design_checks(f"verilog:{path}", ports=str(ports))
+    assert check.name == "bump_rst.asserts"
+    assert formal.run_check(check).status == "pass"
+    (free,) = formal.design_checks(f"verilog:{path}")
+    result = formal.run_check(free)
+    assert result.status == "FAIL" and "bump_rst.v:9." in result.detail
+
+
+@pytest.mark.formal
+def test_param_sets_the_designs_parameters(capsys):
+    """Full is reached after limit cycles of up: within the cover's 12 cycles at the default
+    limit (10), not at --param limit=20."""
+    argv = ["formal", "--design", SATURATING, "--only", "Saturating.covers"]
+    code, out, _ = _cli([*argv, "--param", "limit=20"], capsys)
+    assert code == 1 and "unreached cover statement" in out
+    code, out, _ = _cli([*argv, "--param", "limit=10"], capsys)
+    assert code == 0, out
+
+
+def test_param_errors_name_the_param_option(tmp_path, capsys):
+    path = tmp_path / "req.py"
+    path.write_text((DESIGNS / "counters.py").read_text().replace("limit: int = 10", "limit: int"))
+    code, out, err = _cli(["formal", "--design", f"{path}:Saturating", "--list"], capsys)
+    assert (code, out) == (2, "") and err.count("\n") == 1
+    assert err.endswith("parameter 'limit' has no default; give it as --param limit=VALUE\n")
+    code, out, _ = _cli(
+        ["formal", "--design", f"{path}:Saturating", "--param", "limit=4", "--list"], capsys
+    )
+    assert code == 0 and out.startswith("Saturating.properties")
+    code, out, err = _cli(["formal", "--param", "limit=4", "--list"], capsys)
+    assert (code, out) == (2, "")
+    assert "--param sets a parameter of a --design REF" in err

@@ -359,7 +359,19 @@ BAD = [
         "an elaborate that raises",
         "unelaborated.py:ElaborateRaises",
         {},
-        "does not elaborate: ValueError: no such speed table (unelaborated.py:17)",
+        "does not elaborate: ValueError: no such speed table (unelaborated.py:19)",
+    ),
+    (
+        "an elaborate that calls sys.exit",
+        "unelaborated.py:ElaborateExits",
+        {},
+        "does not elaborate: SystemExit: 0 (unelaborated.py:",
+    ),
+    (
+        "a file that calls sys.exit",
+        "exits.py:Design",
+        {},
+        "loading exits.py (line 2) raised SystemExit: 0",
     ),
     (
         "a signal driven from two domains",
@@ -397,6 +409,7 @@ def test_bad_references_are_one_line_errors(
     shutil.copy(DESIGNS / "broken.py", tmp_path / "broken.py")
     shutil.copy(DESIGNS / "unelaborated.py", tmp_path / "unelaborated.py")
     (tmp_path / "syntax_error.py").write_text("class Broken(\n")  # never closed
+    (tmp_path / "exits.py").write_text("import sys\nsys.exit(0)  # argparse on a wrong argv, say\n")
     with pytest.raises(DesignError, match=message.replace("(", r"\(").replace(")", r"\)")):
         resolve_design(reference, params, base=tmp_path)
     # The same through the command line: exit 2, one line, nothing written.
@@ -448,6 +461,29 @@ def test_a_design_without_a_clock_is_refused_where_it_would_be_simulated(
     assert sorted(p.name for p in tmp_path.iterdir() if p.name != "__pycache__") == [
         "unelaborated.py"
     ]
+
+
+def test_a_design_with_an_instance_is_refused_where_it_would_be_simulated(
+    tmp_path, capsys, monkeypatch
+):
+    # No simulator has my_ip: pysim would read its output as 0 and pass, the compiled
+    # backends fail inside Yosys. Export (and so the board) takes it as it is.
+    shutil.copy(DESIGNS / "unelaborated.py", tmp_path / "unelaborated.py")
+    spec = resolve_design("unelaborated.py:BlackBox", {}, base=tmp_path)
+    assert spec.black_boxes == ("my_ip",)
+    # Submodules of its own are no black boxes.
+    assert resolve_design(str(DESIGNS / "wall_stop.py") + ":WallStop", {}).black_boxes == ()
+    message = "instantiates 'my_ip' (an Instance), which the simulators here cannot run"
+    monkeypatch.chdir(tmp_path)
+    for argv in (
+        ["run", "--scenario", str(WALL_STOP), "--design", "unelaborated.py:BlackBox",
+         "--backend", "pysim", "--rerun", "off", "--set", "design.params={}"],
+        ["mutate", "--design", "unelaborated.py:BlackBox", "--mutants", "2", "--quiet"],
+    ):  # fmt: skip
+        code, _, err = _cli(argv, capsys)
+        assert code == 2 and len(err.strip().splitlines()) == 1 and message in err, err
+    code, _, _ = _cli(["export", "--design", "unelaborated.py:BlackBox", "-o", "bb.v"], capsys)
+    assert code == 0 and "my_ip ip (" in (tmp_path / "bb.v").read_text()
 
 
 def test_a_scenario_names_its_design_relative_to_its_folder(tmp_path):

@@ -1,4 +1,4 @@
-"""``fpga-robotics formal [--only NAME] [--depth N]``: prove the gateware's promises.
+"""``fpga-robotics formal [--design REF [--param NAME=VALUE ...]] [--only NAME] [--depth N]``: prove the gateware's promises.
 
 One row a check (its name, mode, depth, result and time) as each is done; a failed check's
 counterexample VCD goes to ``--trace-dir`` and its row says where. The checks run in
@@ -10,6 +10,7 @@ from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 from fpga_robotics.cli.errors import UsageError
+from fpga_robotics.cli.mutate import _design_params
 from fpga_robotics.cli.parser import CommandParser
 from fpga_robotics.flow.formal import (
     default_trace_dir,
@@ -73,6 +74,13 @@ def build_parser(prog="fpga-robotics formal"):
         "of FollowTarget's",
     )
     parser.add_argument(
+        "--param",
+        action="append",
+        default=[],
+        metavar="NAME=VALUE",
+        help="with --design: one of its parameters (a TOML value; repeatable)",
+    )
+    parser.add_argument(
         "--ports",
         "--port-map",
         dest="ports",
@@ -89,7 +97,7 @@ def main(argv=None, prog="fpga-robotics formal"):
     if args.jobs < 1:
         raise UsageError(f"--jobs must be at least 1, got {args.jobs}")
 
-    checks = select(design_checks(args.design, ports=args.ports), args.only)
+    checks = select(design_checks(args.design, _design_params(args.param), args.ports), args.only)
     if args.list:
         width = max(len(c.name) for c in checks)
         for c in checks:

@@ -422,6 +422,7 @@ def _main_design(args):
     else:
         spec = resolve_design(args.design, _design_params(args.param), option="--param")
         spec.require_clock()
+        spec.require_no_black_boxes()
         name = spec.reference.rpartition(":")[2]
     campaign = _campaign(args.campaign) if args.campaign is not None else None
     out = args.out or os.path.join("runs", "mutation", f"{name}-n{args.mutants}-s{args.seed}")

@@ -35,7 +35,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from fpga_robotics.designs.builtin import TOPS, Top, build_component, design_tables, foreign_top
-from fpga_robotics.hw.errors import UsageError
+from fpga_robotics.hw.errors import USER_CODE_ERRORS, UsageError
 from fpga_robotics.hw.params import FollowTargetParams
 from fpga_robotics.loop.connectors import CONNECTORS
 
@@ -114,6 +114,9 @@ class DesignSpec:
         A Verilog design's port map as read (``sim.backends.port_map.PortMap``).
     clocked : bool
         Whether it has a clock (an Amaranth design of one's own may have none).
+    black_boxes : tuple
+        The modules an Amaranth design of one's own instantiates (``Instance``) without
+        defining them: Verilog or vendor cells no simulator here has.
     signed : frozenset
         The names of its ports of a signed shape (``ports`` has direction and width).
     netlist_digest : str
@@ -131,6 +134,7 @@ class DesignSpec:
     top: Top = None
     port_map: object = None
     clocked: bool = True
+    black_boxes: tuple = ()
     signed: frozenset = frozenset()
     netlist_digest: str = ""
 
@@ -164,6 +168,16 @@ class DesignSpec:
                 f"design {self.reference!r} has no clock: nothing in its sync domain "
                 "(m.d.sync). The simulators here clock the design, so give it at least one "
                 "register"
+            )
+
+    def require_no_black_boxes(self):
+        """``DesignError`` for a design with an ``Instance`` of a module it does not define:
+        no simulator here has that module (pysim would read its outputs as 0)."""
+        if self.black_boxes:
+            raise DesignError(
+                f"design {self.reference!r} instantiates {self.black_boxes[0]!r} (an "
+                "Instance), which the simulators here cannot run: only export and board "
+                "take it"
             )
 
     def build(self):
@@ -327,7 +341,7 @@ def _amaranth_spec(reference, frozen_params, _stamp):
     _check_params(target, params, reference)
     factory = functools.partial(_call, target, params, reference)
     component = factory()
-    clocked, netlist_digest = _check_elaborates(component, target, reference)
+    clocked, black_boxes, netlist_digest = _check_elaborates(component, target, reference)
     signed = signed_ports(component)
     ports = component_ports(component)
     _check_port_names(ports, reference.rpartition(":")[2])
@@ -357,6 +371,7 @@ def _amaranth_spec(reference, frozen_params, _stamp):
         params,
         top,
         clocked=clocked,
+        black_boxes=black_boxes,
         signed=signed,
         netlist_digest=netlist_digest,
     )
@@ -367,7 +382,8 @@ def _check_elaborates(component, target, reference):
     elaborate to a netlist: its ``elaborate`` raises or returns nothing, or it drives a
     signal from two places, or defines its own ``sync`` domain. Found here, before any
     simulator is built for it. Returns whether it has a clock (anything in its ``sync``
-    domain) and the netlist's sha256."""
+    domain), the modules it instantiates without defining them (its ``Instance``s) and the
+    netlist's sha256."""
     from amaranth.back import rtlil  # lazy: only a design of one's own is converted here
     from amaranth.hdl import Fragment, UnusedElaboratable  # lazy: as rtlil
 
@@ -381,7 +397,7 @@ def _check_elaborates(component, target, reference):
             fragment = Fragment.get(component, None)
             own_sync = _defines_sync(fragment)  # before the conversion adds the outer one
             text = rtlil.convert(fragment, ports=ports)
-    except Exception as exc:  # noqa: BLE001 - the user's elaborate may raise anything
+    except USER_CODE_ERRORS as exc:  # the user's elaborate may raise anything
         # The modules its elaborate made are never used now: no warning for each at exit.
         warnings.filterwarnings("ignore", category=UnusedElaboratable)
         # What Amaranth said on the way ("elaborate() returned None; missing return?").
@@ -400,7 +416,11 @@ def _check_elaborates(component, target, reference):
             "reset): leave the definition out and use m.d.sync"
         )
     clocked = bool(re.search(r"^  wire .*\binput \d+ +\\clk$", text, re.MULTILINE))
-    return clocked, hashlib.sha256(text.encode()).hexdigest()
+    # Cells of a type that is no $ primitive and no module of its own netlist.
+    defined = set(re.findall(r"^module \\(\S+)$", text, re.MULTILINE))
+    used = re.findall(r"^ +cell \\(\S+) ", text, re.MULTILINE)
+    black_boxes = tuple(dict.fromkeys(name for name in used if name not in defined))
+    return clocked, black_boxes, hashlib.sha256(text.encode()).hexdigest()
 
 
 def _defines_sync(fragment):
@@ -450,7 +470,7 @@ def _load_target(reference):
                 f"design {reference!r}: no module {exc.name!r}; install the "
                 f"package or give the file as path/to/file.py:{name}"
             ) from None
-        except Exception as exc:  # noqa: BLE001 - the user's module may raise anything
+        except USER_CODE_ERRORS as exc:  # the user's module may raise anything
             raise DesignError(
                 f"design {reference!r}: importing {where} raised "
                 f"{type(exc).__name__}: {_first_line(exc)}"
@@ -496,7 +516,7 @@ def _load_file(path, reference):
     try:
         with _importing_beside(path):
             spec.loader.exec_module(module)
-    except Exception as exc:  # noqa: BLE001 - the user's file may raise anything
+    except USER_CODE_ERRORS as exc:  # the user's file may raise anything
         sys.modules.pop(name, None)
         line = _error_line(exc, path)
         raise DesignError(
@@ -663,7 +683,7 @@ def _call(target, params, reference):
     values = {k: tuple(v) if isinstance(v, list) else v for k, v in params.items()}
     try:
         component = target(**values)
-    except Exception as exc:  # noqa: BLE001 - the user's constructor may raise anything
+    except USER_CODE_ERRORS as exc:  # the user's constructor may raise anything
         raise DesignError(
             f"design {reference!r}: building it raised {type(exc).__name__}: {_first_line(exc)}"
         ) from None

@@ -123,15 +123,24 @@ def sby_script(check, depth):
 def _summary(output):
     """The lines of SymbiYosys's summary that say what failed, where (``file:line``): a failed
     assertion names its statement on its own line, the unreached covers come as a list, one
-    indented line each, under the line "unreached cover statements:"."""
+    indented line each, under the line "unreached cover statements:". The assertions listed
+    under "counterexample trace [induction]" are left out: the induction starts from any
+    state, reachable or not, so they are no failure from reset (a prove whose base case
+    holds is ``unknown`` for them)."""
     wanted = ("failed assertion", "failed assumption")
     found = []
-    in_unreached = False
+    in_unreached = in_induction = False
     for line in output.splitlines():
         text = line.split("summary:", 1)[1] if "summary:" in line else ""
+        if "counterexample trace" in text:
+            in_induction = "[induction]" in text
+        elif not text.startswith("  "):  # the trace's list of statements has ended
+            in_induction = False
         listed = in_unreached and text.startswith("  ")
         in_unreached = listed or "unreached cover statements:" in text
         text = re.sub(r"\S*_witness_\.\S+ at ", "", text.strip())
+        if in_induction:
+            continue
         if listed:  # a statement, or "and 3 further properties" after the first five
             found.append(text if text.startswith("and ") else f"unreached cover statement {text}")
         elif any(w in text for w in wanted) and not any(f.startswith(text) for f in found):
@@ -226,7 +235,8 @@ def _trace_name(name):
 class VerilogCheck:
     """The immediate ``assert``/``assume``/``cover`` statements of a Verilog design, as
     ``read_verilog -formal`` reads them: one run proves the assertions (``prove``) or reaches
-    the covers (``cover``). ``sources``: file name -> text; ``top`` the top module."""
+    the covers (``cover``). ``sources``: file name -> text; ``top`` the module checked: the
+    design's top, or the harness that resets it (``_reset_harness``)."""
 
     name: str
     mode: str
@@ -266,6 +276,7 @@ class _VerilogModule:
     instances: set
     statements: set
     marked_top: bool
+    ports: dict  # name -> (direction, width), in the module's order
 
 
 def _formal_kind(cell):
@@ -304,6 +315,7 @@ def _verilog_modules(sources, env):
             instances={c["type"] for c in module["cells"].values() if c["type"][0] != "$"},
             statements={_formal_kind(c) for c in module["cells"].values()} - {None},
             marked_top="top" in module["attributes"],
+            ports={n: (p["direction"], len(p["bits"])) for n, p in module["ports"].items()},
         )
         for name, module in design["modules"].items()
     }
@@ -328,11 +340,50 @@ def _verilog_top(names, modules):
     )
 
 
-def verilog_checks(files, top=None, depth=20, env=None):
-    """The ``VerilogCheck``s of Verilog ``files`` (top module ``top``, e.g. a port map's, else
-    the one ``_verilog_top`` finds): ``<top>.asserts`` when the top or a module under it
-    asserts anything, ``<top>.covers`` when one covers anything. A file that cannot be read,
-    an unknown or ambiguous top, or a top without either statement, are a ``UsageError``."""
+#: The file and module of the harness that holds a port map's reset in the first cycle.
+RESET_HARNESS = "fpga_robotics_reset_first"
+
+
+def _verilog_name(name):
+    """``name`` as a Verilog identifier: escaped unless it is a plain one."""
+    return name if re.fullmatch(r"[A-Za-z_][A-Za-z0-9_$]*", name) else f"\\{name} "
+
+
+def _reset_harness(top, ports, port_map):
+    """Verilog of a module with the ports of ``top`` around it that assumes the port map's
+    reset active in the first cycle, as every simulator run holds it: registers without an
+    initial value start from their reset values, not from any value at all."""
+    declared = [
+        f"  {direction} [{width - 1}:0] {_verilog_name(name)}"
+        for name, (direction, width) in ports.items()
+    ]
+    reset = _verilog_name(port_map.reset)
+    active = f"!{reset}" if port_map.reset_active_low else reset
+    connected = ", ".join(f".{_verilog_name(n)}({_verilog_name(n)})" for n in ports)
+    # Names of its own, beside the design's port names (a stream's "first", say).
+    first, design = f"{RESET_HARNESS}_cycle0", f"{RESET_HARNESS}_design"
+    return "\n".join(
+        [
+            f"module {RESET_HARNESS}(",
+            ",\n".join(declared),
+            ");",
+            f"  reg {first} = 1'b1;",
+            f"  always @(posedge {_verilog_name(port_map.clock)}) {first} <= 1'b0;",
+            f"  always @(*) if ({first}) assume ({active});",
+            f"  {_verilog_name(top)} {design} ({connected});",
+            "endmodule",
+            "",
+        ]
+    )
+
+
+def verilog_checks(files, top=None, depth=20, env=None, port_map=None):
+    """The ``VerilogCheck``s of Verilog ``files`` (top module ``top``, or ``port_map``'s,
+    else the one ``_verilog_top`` finds): ``<top>.asserts`` when the top or a module under it
+    asserts anything, ``<top>.covers`` when one covers anything. A port map that names a
+    reset has it held active in the first cycle (``_reset_harness``). A file that cannot be
+    read, an unknown or ambiguous top, or a top without either statement, are a
+    ``UsageError``."""
     sources = {}
     for f in files:
         path = Path(f)
@@ -346,6 +397,8 @@ def verilog_checks(files, top=None, depth=20, env=None):
         raise UsageError("two Verilog files have the same name")
     names = ", ".join(files)
     modules = _verilog_modules(sources, formal_env() if env is None else env)
+    if port_map is not None:
+        top = port_map.top
     if top is None:
         top = _verilog_top(names, modules)
     elif top not in modules:
@@ -359,13 +412,20 @@ def verilog_checks(files, top=None, depth=20, env=None):
             seen.add(name)
             statements |= modules[name].statements
             todo += modules[name].instances
+    checked = top
+    if port_map is not None and port_map.reset:
+        sources = {
+            **sources,
+            f"{RESET_HARNESS}.v": _reset_harness(top, modules[top].ports, port_map),
+        }
+        checked = RESET_HARNESS
     checks = []
     if "assert" in statements:
         promise = "every assert statement of the Verilog holds (assume statements assumed)"
-        checks.append(VerilogCheck(f"{top}.asserts", "prove", depth, promise, sources, top))
+        checks.append(VerilogCheck(f"{top}.asserts", "prove", depth, promise, sources, checked))
     if "cover" in statements:
         promise = "every cover statement of the Verilog is reachable"
-        checks.append(VerilogCheck(f"{top}.covers", "cover", depth, promise, sources, top))
+        checks.append(VerilogCheck(f"{top}.covers", "cover", depth, promise, sources, checked))
     if not checks:
         raise UsageError(
             f"{names}: no assert or cover statement to check in module {top} or under it; "
@@ -420,25 +480,31 @@ def design_checks(reference=None, params=None, ports=None):
     None) has the project's own list, ``hw.formal.CHECKS``; a design of one's own the
     properties it declares (``formal_properties``/``formal_covers``, docs/formal.md); a
     Verilog one (``verilog:FILES``, its top from the port map ``ports`` when given) the
-    assert and cover statements it holds (``verilog_checks``). A design that declares none is
-    a ``UsageError``."""
+    assert and cover statements it holds (``verilog_checks``). ``params`` (``--param``) are
+    those of a design of one's own. A design that declares none is a ``UsageError``."""
     if ports is not None and (reference is None or not reference.startswith("verilog:")):
         raise UsageError("--ports is the port map of a Verilog design: it goes with verilog:FILES")
     if reference is None or reference == "follow_target":
+        if params:
+            raise UsageError("--param sets a parameter of a --design REF (a design of your own)")
         return list(CHECKS)
 
     if reference.startswith("verilog:"):
+        if params:
+            raise UsageError(
+                "--param: a Verilog design takes no parameters here; set them in the Verilog"
+            )
         files = [f for f in reference[len("verilog:") :].split(",") if f.strip()]
         if not files:
             raise UsageError(f"--design {reference}: name the Verilog files, verilog:TOP.v")
-        top = None
+        port_map = None
         if ports is not None:
             try:
-                top = load_port_map(ports).top
+                port_map = load_port_map(ports)
             except PortMapError as exc:
                 raise UsageError(f"--ports {ports}: {exc}") from None
-        return verilog_checks(files, top)
-    spec = resolve_design(reference, params)
+        return verilog_checks(files, port_map=port_map)
+    spec = resolve_design(reference, params, option="--param")
     name = reference if spec.kind == "builtin" else spec.reference.rpartition(":")[2]
     checks = declared_checks(name, spec.build)
     if not checks:

@@ -26,6 +26,7 @@ def scenario_top(scenario):
         return foreign_top(port_map)
     spec = resolve_design(scenario.top, scenario.design_params)
     spec.require_clock()
+    spec.require_no_black_boxes()
     return spec.top
 
 

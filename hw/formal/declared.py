@@ -26,7 +26,7 @@ from amaranth.back import rtlil
 from amaranth.hdl import Fragment, UnusedElaboratable
 from amaranth.lib.wiring import In
 
-from ..errors import UsageError
+from ..errors import USER_CODE_ERRORS, UsageError
 from .harness import FormalCheck, Harness
 
 __all__ = ["COVER_HOOK", "DEFAULT_DEPTH", "PROPERTY_HOOK", "DeclaredHarness", "declared_checks"]
@@ -115,7 +115,7 @@ def _converted(name, cls, hook, harness):
     any check runs (the checks convert it again, each in its own worker)."""
     try:
         return rtlil.convert(harness, ports=harness.ports())
-    except Exception as exc:  # noqa: BLE001 - the design's own code may raise anything
+    except USER_CODE_ERRORS as exc:  # the design's own code may raise anything
         # The harness and design are never used now: no warning for each when collected.
         warnings.filterwarnings("ignore", category=UnusedElaboratable)
         source = inspect.getsourcefile(getattr(cls, hook))

@@ -1,7 +1,9 @@
-"""Designs that build but do not elaborate, or have no clock: each is one clear line
-(tests/test_user_designs.py)."""
+"""Designs that build but do not elaborate, have no clock or instantiate a module they do not
+define: each is one clear line (tests/test_user_designs.py)."""
 
-from amaranth import Module, signed
+import sys
+
+from amaranth import ClockSignal, Instance, Module, Signal, signed
 from amaranth.lib import wiring
 from amaranth.lib.wiring import In, Out
 
@@ -15,6 +17,11 @@ class _Wheels(wiring.Component):
 class ElaborateRaises(_Wheels):
     def elaborate(self, platform):
         raise ValueError("no such speed table")
+
+
+class ElaborateExits(_Wheels):
+    def elaborate(self, platform):
+        sys.exit(0)  # a helper giving up: still a design that does not elaborate
 
 
 class DrivenTwice(_Wheels):
@@ -34,4 +41,16 @@ class NoClock(_Wheels):
     def elaborate(self, platform):
         m = Module()
         m.d.comb += [self.motor_left.eq(self.line * 100), self.motor_right.eq(100)]
+        return m
+
+
+class BlackBox(_Wheels):
+    """A vendor or Verilog module by Instance: hardware for the board, unknown to simulators."""
+
+    def elaborate(self, platform):
+        m = Module()
+        speed, toggle = Signal(16), Signal()
+        m.d.sync += toggle.eq(~toggle)
+        m.submodules.ip = Instance("my_ip", i_clk=ClockSignal(), i_a=self.line, o_y=speed)
+        m.d.comb += [self.motor_left.eq(speed), self.motor_right.eq(speed)]
         return m
