@@ -57,9 +57,7 @@ def test_a_verilog_design_in_its_own_scenario(tmp_path, capsys):
 
 
 @pytest.mark.slow  # compiled pin models of the design
-def test_relative_verilog_files_are_taken_from_the_current_folder(
-    tmp_path, monkeypatch, capsys
-):
+def test_relative_verilog_files_are_taken_from_the_current_folder(tmp_path, monkeypatch, capsys):
     # The files in the current folder only, the scenario in another (docs/your_design.md).
     (tmp_path / "mine.v").write_text((DATA / "bump_stop.v").read_text())
     (tmp_path / "mine_ports.toml").write_text((DATA / "bump_stop_ports.toml").read_text())

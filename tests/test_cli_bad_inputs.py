@@ -347,6 +347,23 @@ CASES = [
     ),
     ("bench json to a folder", ["bench", "--backends", "model", "--json", "{dir}"], "is a folder"),
     ("pysim bench zero frames", ["bench", "pysim", "--frames", "0"], "--frames"),
+    # benches that build FollowTarget's frame models, on a scenario of another design
+    (
+        "bench loop of a real-clock scenario",
+        ["bench", "loop", "--scenario", "line_track"],
+        "real_clock",
+    ),
+    ("bench loop of another design", ["bench", "loop", "--scenario", "turret"], "turret_tracker"),
+    (
+        "bench shadow of a real-clock scenario",
+        ["bench", "shadow", "--scenario", "corridor"],
+        "corridor_follow",
+    ),
+    (
+        "bench mutant_replay of a real-clock scenario",
+        ["bench", "mutant_replay", "--scenario", "obstacle_between"],
+        "follow_target_safe",
+    ),
 ]
 
 

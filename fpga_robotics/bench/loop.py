@@ -220,10 +220,15 @@ def _check(args):
 
 def run(args):
     figures = []
-    for w, h in args.resolutions:
-        scenario = load_scenario(
+    scenarios = [
+        load_scenario(
             args.scenario, [f'camera.resolution="{w}x{h}"', f"sim.duration={args.duration}"]
         )
+        for w, h in args.resolutions
+    ]
+    for scenario in scenarios:
+        scaffold.check_follow_target_scenario(scenario, "loop")
+    for (w, h), scenario in zip(args.resolutions, scenarios, strict=True):
         try:
             design = make_backend(args.backend, scenario.params)
         except BackendError as exc:

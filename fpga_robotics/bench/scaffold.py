@@ -33,6 +33,7 @@ __all__ = [
     "Spread",
     "add_follow_target_design",
     "check_follow_target_design",
+    "check_follow_target_scenario",
     "check_json_path",
     "command",
     "gc_paused",
@@ -114,6 +115,20 @@ def check_follow_target_design(args, subject):
             f"a design of your own ({args.design}) is timed by fpga-robotics bench "
             f"user_verilog --design REF (--ports MAP for verilog:FILES)"
         )
+
+
+def check_follow_target_scenario(scenario, subject):
+    """One line when ``scenario`` runs anything but FollowTarget in compressed timing: this
+    subject builds FollowTarget's frame models, whatever the scenario's design is."""
+    own_design = scenario.top != "follow_target" or scenario.foreign is not None
+    if not own_design and scenario.sim.timing == "compressed":
+        return
+    design = "its own Verilog design" if scenario.foreign is not None else scenario.top
+    raise UsageError(
+        f"bench {subject} times follow_target in compressed timing only; scenario "
+        f"{scenario.name!r} runs {design} in {scenario.sim.timing} timing (other designs "
+        f"are timed by fpga-robotics bench user_verilog --design REF --scenario NAME)"
+    )
 
 
 def check_json_path(path):
