@@ -347,6 +347,17 @@ CASES = [
     ),
     ("bench json to a folder", ["bench", "--backends", "model", "--json", "{dir}"], "is a folder"),
     ("pysim bench zero frames", ["bench", "pysim", "--frames", "0"], "--frames"),
+    ("bench pins infinite seconds", ["bench", "pins", "--seconds", "inf"], "--seconds"),
+    ("bench pins endless seconds", ["bench", "pins", "--seconds", "1e30"], "--seconds"),
+    ("bench pins infinite step", ["bench", "pins", "--step", "inf"], "--step"),
+    ("bench pins infinite clock", ["bench", "pins", "--clock-hz", "inf"], "--clock-hz"),
+    ("bench pins zero pysim seconds", ["bench", "pins", "--pysim-seconds", "0"], "--pysim-seconds"),
+    (
+        "bench pins negative pysim seconds",
+        ["bench", "pins", "--pysim-seconds", "-1"],
+        "--pysim-seconds",
+    ),
+    ("bench pins empty backends", ["bench", "pins", "--backends", ","], "--backends"),
     # benches that build FollowTarget's frame models, on a scenario of another design
     (
         "bench loop of a real-clock scenario",
