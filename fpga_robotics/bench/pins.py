@@ -180,7 +180,10 @@ def _options(parser):
         type=lambda text: scaffold.parse_size(text, "--resolution"),
     )
     parser.add_argument(
-        "--seconds", type=float, default=1.0, help="simulated seconds per compiled run (default 1, at most 60)"
+        "--seconds",
+        type=float,
+        default=1.0,
+        help="simulated seconds per compiled run (default 1, at most 60)",
     )
     parser.add_argument(
         "--pysim-seconds",
