@@ -347,6 +347,7 @@ CASES = [
     ),
     ("bench json to a folder", ["bench", "--backends", "model", "--json", "{dir}"], "is a folder"),
     ("pysim bench zero frames", ["bench", "pysim", "--frames", "0"], "--frames"),
+    ("bench cameras unknown backend", ["bench", "cameras", "--backend", "foo"], "--backend"),
     ("bench pins infinite seconds", ["bench", "pins", "--seconds", "inf"], "--seconds"),
     ("bench pins endless seconds", ["bench", "pins", "--seconds", "1e30"], "--seconds"),
     ("bench pins infinite step", ["bench", "pins", "--step", "inf"], "--step"),
