@@ -36,6 +36,7 @@ __all__ = [
     "check_follow_target_scenario",
     "check_json_path",
     "command",
+    "figure_against",
     "gc_paused",
     "parse_size",
     "parse_sizes",
@@ -129,6 +130,21 @@ def check_follow_target_scenario(scenario, subject):
         f"{scenario.name!r} runs {design} in {scenario.sim.timing} timing (other designs "
         f"are timed by fpga-robotics bench user_verilog --design REF --scenario NAME)"
     )
+
+
+def figure_against(value, limit, decimals):
+    """``value`` with ``decimals`` decimals, or as many more as it takes for the printed figure
+    to sit on the same side of ``limit`` as ``value`` (4.498 against 4.5 prints 4.498, not
+    4.50: a target line must not show a figure on the limit and call it missed)."""
+
+    def side(x):
+        return (x > limit) - (x < limit)
+
+    text = f"{value:.{decimals}f}"
+    while side(float(text)) != side(value) and decimals < 15:
+        decimals += 1
+        text = f"{value:.{decimals}f}"
+    return text
 
 
 def check_json_path(path):
