@@ -5,8 +5,8 @@ A subject module declares its own options and its measurement, and gets the rest
     main = command(run, __doc__, name="camera", options=add_options, repeats=5, frames=60)
 
 ``command`` builds ``main(argv, prog)``: the common options (``--repeats``, ``--frames``,
-``--min-seconds`` where the subject takes them, ``--json PATH`` and ``--calibrate`` always),
-their checks, and bad arguments as ``UsageError`` (one line ``prog: error: ...``, exit 2, from
+``--min-seconds`` where the subject takes them, ``--json PATH`` always, ``--calibrate`` where
+its figures hold times), their checks, and bad arguments as ``UsageError`` (one line ``prog: error: ...``, exit 2, from
 ``run_cli``). ``run(args)`` prints its figures as it measures and returns them as a dict;
 ``--json`` writes that dict atomically with the machine's description, and ``--calibrate``
 times the calibration design in the same run and prints every absolute time of the dict
@@ -35,6 +35,7 @@ __all__ = [
     "check_follow_target_design",
     "check_follow_target_scenario",
     "check_json_path",
+    "check_not_given",
     "command",
     "figure_against",
     "gc_paused",
@@ -234,7 +235,7 @@ def ratios_to(figures, reference_ms, cpu_reference_ms=None):
     ]
 
 
-def _add_common(parser, repeats, frames, min_seconds):
+def _add_common(parser, repeats, frames, min_seconds, calibrate):
     if repeats is not None:
         parser.add_argument(
             "--repeats",
@@ -254,12 +255,15 @@ def _add_common(parser, repeats, frames, min_seconds):
             help=f"repeat the frames until each case has run this long (default {min_seconds:g})",
         )
     parser.add_argument("--json", metavar="PATH", help="also write the figures to PATH")
-    parser.add_argument(
-        "--calibrate",
-        action="store_true",
-        help="also time the calibration design (bench calibrate) in this run "
-        "and print every time as a multiple of it",
-    )
+    if calibrate:
+        parser.add_argument(
+            "--calibrate",
+            action="store_true",
+            help="also time the calibration design (bench calibrate) in this run "
+            "and print every time as a multiple of it",
+        )
+    else:
+        parser.set_defaults(calibrate=False)
 
 
 def _check_common(args):
@@ -274,20 +278,51 @@ def _check_common(args):
         check_json_path(args.json)
 
 
+def _given(parser, argv):
+    """The destinations of the options ``argv`` gives (not left at their defaults)."""
+    defaults = [(action, action.default) for action in parser._actions]
+    try:
+        for action, _ in defaults:
+            action.default = argparse.SUPPRESS
+        return frozenset(vars(parser.parse_args(argv)))
+    finally:
+        for action, default in defaults:
+            action.default = default
+
+
+def check_not_given(args, dests, reason):
+    """One line when the command line gives any of the options ``dests``: they cannot
+    apply, for ``reason`` ("with --figures DIR (...)"), and are refused, not ignored."""
+    given = [dest for dest in dests if dest in args.given]
+    if given:
+        raise UsageError(f"--{given[0].replace('_', '-')} does not apply {reason}")
+
+
 def command(
-    run, doc, *, name, options=None, repeats=None, frames=None, min_seconds=None, check=None
+    run,
+    doc,
+    *,
+    name,
+    options=None,
+    repeats=None,
+    frames=None,
+    min_seconds=None,
+    check=None,
+    calibrate=True,
 ):
     """``main(argv=None, prog=...)`` of a benchmark: parse (common options, then the
-    subject's ``options(parser)``), check (common, then ``check(args)``), ``run(args)`` ->
-    figures, then the calibration and ``--json`` if asked for."""
+    subject's ``options(parser)``; ``args.given`` the options the command line gives),
+    check (common, then ``check(args)``), ``run(args)`` -> figures, then the calibration and
+    ``--json`` if asked for. ``calibrate=False``: figures with no times, no ``--calibrate``."""
     description = doc.strip().split("\n\n")[0].replace("``", "")  # no RST in --help
 
     def main(argv=None, prog=f"fpga-robotics bench {name}"):
         parser = BenchParser(prog=prog, description=description)
         if options is not None:
             options(parser)
-        _add_common(parser, repeats, frames, min_seconds)
+        _add_common(parser, repeats, frames, min_seconds, calibrate)
         args = parser.parse_args(argv)
+        args.given = _given(parser, argv)
         _check_common(args)
         if check is not None:
             check(args)
@@ -309,14 +344,15 @@ def command(
 def print_calibrated(figures, calibration):
     """Each absolute time of ``figures`` next to the same run's calibration frame time."""
     ref, cpu_ref = calibration["frame_ms"].median, calibration["cpu_ms"].median
-    print(
-        f"calibration ({calibration['what']}): {calibration['frame_ms']:.4f} ms/frame, "
-        f"CPU {calibration['cpu_ms']:.4f} (median, min-max of {calibration['frame_ms'].n}); "
-        f"the times above in calibration frames (CPU times in its CPU time):"
-    )
     rows = [
         (name, f"{ms:.4g} ms", f"{ratio:.3g}x")
         for name, ms, ratio in ratios_to(figures, ref, cpu_ref)
     ]
+    in_frames = "; the times above in calibration frames (CPU times in its CPU time):"
+    print(
+        f"calibration ({calibration['what']}): {calibration['frame_ms']:.4f} ms/frame, "
+        f"CPU {calibration['cpu_ms']:.4f} (median, min-max of {calibration['frame_ms'].n})"
+        f"{in_frames if rows else ''}"
+    )
     if rows:
         print_table(("figure", "time", "x calibration"), rows)
