@@ -211,7 +211,7 @@ def _options(parser):
 #: figure), at most the most (bounding the run: seconds x clock are the cycles simulated).
 _BOUNDS = {
     "seconds": (0, 60),
-    "pysim_seconds": (0, 0.1),  # pysim: some 40 000 cycles a second, 0.1 s minutes at 50 MHz
+    "pysim_seconds": (0, 0.1),  # pysim runs some 40 000 cycles a second: 0.1 s is minutes
     "step": (0, 1),
     "clock_hz": (0, 1e9),
 }

@@ -6,8 +6,8 @@ A subject module declares its own options and its measurement, and gets the rest
 
 ``command`` builds ``main(argv, prog)``: the common options (``--repeats``, ``--frames``,
 ``--min-seconds`` where the subject takes them, ``--json PATH`` always, ``--calibrate`` where
-its figures hold times), their checks, and bad arguments as ``UsageError`` (one line ``prog: error: ...``, exit 2, from
-``run_cli``). ``run(args)`` prints its figures as it measures and returns them as a dict;
+its figures hold times), their checks, and bad arguments as ``UsageError`` (one line
+``prog: error: ...``, exit 2, from ``run_cli``). ``run(args)`` prints its figures as it measures and returns them as a dict;
 ``--json`` writes that dict atomically with the machine's description, and ``--calibrate``
 times the calibration design in the same run and prints every absolute time of the dict
 (a key that names milliseconds: ``frame_ms``, ``ms_per_frame``) as a multiple of it: the
