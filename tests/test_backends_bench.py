@@ -5,6 +5,7 @@ import json
 import pytest
 
 from fpga_robotics.bench import design as bench
+from fpga_robotics.bench import scaffold
 from fpga_robotics.cli.errors import UsageError
 
 
@@ -116,6 +117,39 @@ def test_summary_takes_the_fraction_from_the_paired_measurement():
         for line in lines
     )
     assert any("0.3" in line and "<= 0.4 ms: met" in line for line in lines)
+
+
+def test_target_lines_never_round_a_figure_onto_its_limit():
+    def row(design, ms, rate):
+        return {
+            "backend": "cxxrtl",
+            "design": design,
+            "width": 160,
+            "height": 120,
+            "ms_per_frame": ms,
+            "cycles_per_second": rate,
+        }
+
+    # 0.498 of the trivial rate misses 0.5; 0.40002 ms misses 0.4 ms; 0.5 exactly meets it.
+    lines = bench.summary([row("follow_target", 0.40002, 49.8e6), row("passthrough", 0.1, 100e6)])
+    assert any("0.498 of the trivial" in line and line.endswith("MISSED") for line in lines)
+    assert any("0.40002 ms <= 0.4 ms: MISSED" in line for line in lines)
+    lines = bench.summary([row("follow_target", 0.3, 50e6), row("passthrough", 0.1, 100e6)])
+    assert any("0.50 of the trivial" in line and line.endswith("met") for line in lines)
+
+
+@pytest.mark.parametrize(
+    "value, limit, decimals, shown",
+    [
+        (4.497964, 4.5, 2, "4.498"),  # under the limit: never "4.50"
+        (4.5, 4.5, 2, "4.50"),  # on it
+        (4.5004, 4.5, 2, "4.5004"),  # over it
+        (4.43, 4.5, 2, "4.43"),  # clear of it: as asked
+        (999.6, 1000.0, 0, "999.6"),
+    ],
+)
+def test_figure_against_a_limit_keeps_its_side(value, limit, decimals, shown):
+    assert scaffold.figure_against(value, limit, decimals) == shown
 
 
 def test_paired_measurement_gives_the_ratio_of_cycle_rates(monkeypatch):

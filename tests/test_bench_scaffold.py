@@ -109,6 +109,33 @@ def test_common_options_and_their_checks(tmp_path):
         _command([])(["--frames", "3"])
 
 
+def test_options_given_on_the_command_line_are_told_from_defaults():
+    runs = []
+    main = _command(runs, repeats=3, frames=10)
+    main(["--frames", "10", "--json", "f.json"])
+    main([])
+    assert runs[0].given == {"frames", "json"} and runs[1].given == set()
+    args = runs[0]
+    with pytest.raises(UsageError, match=r"^--frames does not apply with --x \(why\)$"):
+        scaffold.check_not_given(args, ("repeats", "frames"), "with --x (why)")
+    scaffold.check_not_given(args, ("repeats", "calibrate"), "with --x (why)")
+
+
+def test_a_calibration_with_no_times_to_convert_promises_none(capsys):
+    reference = {
+        "what": "test",
+        "frame_ms": scaffold.Spread.of([0.25]),
+        "cpu_ms": scaffold.Spread.of([0.125]),
+    }
+    scaffold.print_calibrated({"ratio": 2.0, "size": "160x120"}, reference)
+    out = capsys.readouterr().out
+    line = (
+        "calibration (test): 0.2500 (0.2500-0.2500) ms/frame, CPU 0.1250 (0.1250-0.1250) "
+        "(median, min-max of 1)"
+    )
+    assert out.splitlines() == [line]
+
+
 def test_json_holds_the_figures_and_the_machine(tmp_path, capsys):
     path = tmp_path / "f.json"
     assert _command([])(["--json", str(path)], prog="fpga-robotics bench test") == 0
@@ -154,7 +181,8 @@ def test_calibration_on_the_model_backend(tmp_path, capsys):
     cal = json.loads(path.read_text())["figures"]["calibration"]
     frame = cal["frame_ms"]
     assert frame["n"] == 3 and 0 < frame["min"] <= frame["median"] <= frame["max"]
-    with pytest.raises(UsageError, match="this command is the calibration"):
+    # It is the calibration: no --calibrate.
+    with pytest.raises(UsageError, match="unrecognized arguments: --calibrate"):
         calibrate.main(["--calibrate"])
     with pytest.raises(UsageError, match="unknown backend 'gpu'"):
         calibrate.main(["--backend", "gpu"])
@@ -172,7 +200,9 @@ def test_every_benchmark_is_a_subcommand_on_the_scaffold(capsys):
             module.main(["--help"], prog=f"fpga-robotics bench {what}")
         out = capsys.readouterr().out
         assert exit_.value.code == 0 and f"usage: fpga-robotics bench {what}" in out
-        assert "--json PATH" in out and "--calibrate" in out, what
+        assert "--json PATH" in out, what
+        # --calibrate where the figures hold times: not on the calibration, not on fork's.
+        assert ("--calibrate" in out) == (what not in ("calibrate", "fork")), what
     # The ways in are fpga-robotics bench and python -m fpga_robotics.bench, nothing else.
     folder = Path(scaffold.__file__).parent
     own = [

@@ -56,6 +56,19 @@ def test_a_verilog_design_in_its_own_scenario(tmp_path, capsys):
     _check_rates(out, figures, 100_000)
 
 
+@pytest.mark.slow  # compiled pin models of the design
+def test_relative_verilog_files_are_taken_from_the_current_folder(tmp_path, monkeypatch, capsys):
+    # The files in the current folder only, the scenario in another (docs/your_design.md).
+    (tmp_path / "mine.v").write_text((DATA / "bump_stop.v").read_text())
+    (tmp_path / "mine_ports.toml").write_text((DATA / "bump_stop_ports.toml").read_text())
+    monkeypatch.chdir(tmp_path)
+    argv = ["--design", "verilog:mine.v", "--ports", "mine_ports.toml"]
+    argv += ["--scenario", str(DATA / "bump_wall.toml"), "--clock-hz", "1e6"]
+    out, figures = _bench(argv, tmp_path, capsys)
+    assert "(bump_wall), 0.1 s at 1 MHz (0.1 M cycles)" in out
+    _check_rates(out, figures, 100_000)
+
+
 @pytest.mark.parametrize(
     "argv, message",
     [

@@ -347,6 +347,58 @@ CASES = [
     ),
     ("bench json to a folder", ["bench", "--backends", "model", "--json", "{dir}"], "is a folder"),
     ("pysim bench zero frames", ["bench", "pysim", "--frames", "0"], "--frames"),
+    # bench options that cannot apply to the mode asked for
+    (
+        "bench camera noise of the sensor table",
+        ["bench", "camera", "--sensor", "--noise", "3"],
+        "--noise",
+    ),
+    (
+        "bench camera stage images with figures",
+        ["bench", "camera", "--stage-images", "st", "--json", "st.json"],
+        "--json",
+    ),
+    (
+        "bench camera stage images calibrated",
+        ["bench", "camera", "--stage-images", "st", "--calibrate"],
+        "--calibrate",
+    ),
+    (
+        "bench render3d figures with timing options",
+        ["bench", "render3d", "--figures", "fig", "--sizes", "160x120"],
+        "--sizes",
+    ),
+    ("bench fork calibrated", ["bench", "fork", "--calibrate"], "--calibrate"),
+    ("bench calibrate calibrated", ["bench", "calibrate", "--calibrate"], "--calibrate"),
+    ("bench cameras unknown backend", ["bench", "cameras", "--backend", "foo"], "--backend"),
+    ("bench pins infinite seconds", ["bench", "pins", "--seconds", "inf"], "--seconds"),
+    ("bench pins endless seconds", ["bench", "pins", "--seconds", "1e30"], "--seconds"),
+    ("bench pins infinite step", ["bench", "pins", "--step", "inf"], "--step"),
+    ("bench pins infinite clock", ["bench", "pins", "--clock-hz", "inf"], "--clock-hz"),
+    ("bench pins zero pysim seconds", ["bench", "pins", "--pysim-seconds", "0"], "--pysim-seconds"),
+    (
+        "bench pins negative pysim seconds",
+        ["bench", "pins", "--pysim-seconds", "-1"],
+        "--pysim-seconds",
+    ),
+    ("bench pins empty backends", ["bench", "pins", "--backends", ","], "--backends"),
+    # benches that build FollowTarget's frame models, on a scenario of another design
+    (
+        "bench loop of a real-clock scenario",
+        ["bench", "loop", "--scenario", "line_track"],
+        "real_clock",
+    ),
+    ("bench loop of another design", ["bench", "loop", "--scenario", "turret"], "turret_tracker"),
+    (
+        "bench shadow of a real-clock scenario",
+        ["bench", "shadow", "--scenario", "corridor"],
+        "corridor_follow",
+    ),
+    (
+        "bench mutant_replay of a real-clock scenario",
+        ["bench", "mutant_replay", "--scenario", "obstacle_between"],
+        "follow_target_safe",
+    ),
 ]
 
 

@@ -75,3 +75,13 @@ def test_the_command_prints_the_breakdown_and_a_profile(capsys):
 def test_bad_options_are_usage_errors(argv, message):
     with pytest.raises(UsageError, match=message):
         loop_bench.main(argv)
+
+
+def test_the_shadow_bench_names_the_backend_that_ran(monkeypatch, capsys):
+    from fpga_robotics.bench import shadow as shadow_bench
+
+    # "auto" is the fastest backend here: the header names it, not "auto".
+    monkeypatch.setattr(shadow_bench, "fastest_backend_name", lambda: "model")
+    assert shadow_bench.main(["--backend", "auto", "--duration", "0.2", "--repeats", "1"]) == 0
+    first = capsys.readouterr().out.splitlines()[0]
+    assert first.startswith("follow_person, model backend, shadow diff_min=5"), first

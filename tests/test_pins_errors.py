@@ -197,7 +197,7 @@ def test_real_clock_timing():
         (["--resolution", "16x12"], "--resolution: the window width"),
         (["--clock-hz", "1e5"], "too few for 160 pixels; lower the resolution or fps"),
         (["--repeats", "0"], "--repeats must be 1..1000"),
-        (["--step", "0"], "must be positive"),
+        (["--step", "0"], "--step must be more than 0"),
     ],
 )
 def test_pin_bench_bad_arguments(argv, message):

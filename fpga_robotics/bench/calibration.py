@@ -1,5 +1,5 @@
 """This machine's calibration frame time (``fpga-robotics bench calibrate``, ``--calibrate`` on
-any benchmark): the published FPGA-Robotics design as a preset of this project's gateware at
+a benchmark): the published FPGA-Robotics design as a preset of this project's gateware at
 160x120 on the fastest compiled backend here, milliseconds per frame of seeded synthetic
 frames. An absolute time divided by it, both measured in one run, compares across machines."""
 

@@ -187,6 +187,16 @@ def _options(parser):
 
 
 def _check(args):
+    if args.stage_images is not None:
+        scaffold.check_not_given(
+            args,
+            ("sensor", "noise", "sizes", "frames", "repeats", "json", "calibrate"),
+            "with --stage-images DIR (it writes one frame's stage images, no figures)",
+        )
+    if args.sensor:
+        scaffold.check_not_given(
+            args, ("noise",), "with --sensor (it times the sensor model's stages, no noise)"
+        )
     if not (math.isfinite(args.noise) and 0 <= args.noise <= 64):
         raise UsageError(f"--noise must be a number of 8-bit levels in 0..64, got {args.noise}")
     args.sizes = scaffold.parse_sizes(args.sizes, hfov=DEFAULT_HFOV)

@@ -18,6 +18,8 @@ from fpga_robotics.bench import scaffold
 from fpga_robotics.cli.errors import UsageError
 from fpga_robotics.loop.timings import run_scenario
 from fpga_robotics.scenario.load import load_scenario
+from fpga_robotics.sim.backends import BACKEND_NAMES, BackendError
+from fpga_robotics.sim.pins import PinError
 
 __all__ = ["main"]
 
@@ -45,7 +47,12 @@ def _options(ap):
     ap.add_argument(
         "--seconds", type=float, default=4.0, help="simulated seconds of each run (default 4)"
     )
-    ap.add_argument("--backend", default="model", help="the design's backend (default model)")
+    ap.add_argument(
+        "--backend",
+        default="model",
+        choices=("auto", *BACKEND_NAMES),
+        help="the design's backend (default model)",
+    )
 
 
 def _check(args):
@@ -55,12 +62,17 @@ def _check(args):
 
 def run(args):
     runs = _scenarios(args.seconds)
+    try:
+        for scenario in _scenarios(WARM_UP_S).values():
+            run_scenario(scenario, backend=args.backend)
+    except (BackendError, PinError) as exc:
+        raise UsageError(
+            f"the {args.backend} backend cannot run here: {exc}".splitlines()[0]
+        ) from None
     print(
         f"turret scenario, {args.seconds:g} s simulated, backend {args.backend}; median of "
         f"{args.repeats}: ms per body-camera frame (wall / CPU of this process)"
     )
-    for scenario in _scenarios(WARM_UP_S).values():
-        run_scenario(scenario, backend=args.backend)
     figures = {}
     for name, scenario in runs.items():
         walls, cpus = [], []

@@ -291,16 +291,18 @@ def summary(results, paired=()):
         if compiled:
             best = min(compiled, key=lambda r: r["ms_per_frame"])
             verdict = "met" if best["ms_per_frame"] <= target else "MISSED"
+            ms = scaffold.figure_against(best["ms_per_frame"], target, 3)
             lines.append(
                 f"target {w}x{h}: fastest compiled ({best['backend']}) "
-                f"{best['ms_per_frame']:.3f} ms <= {target} ms: {verdict}"
+                f"{ms} ms <= {target} ms: {verdict}"
             )
             if "python_us_per_frame" in best:
                 frac = best["python_us_per_frame"] / 1e3 / best["loop_ms_per_frame"]
                 verdict = "met" if frac <= TARGET_PYTHON_FRACTION else "MISSED"
+                times = scaffold.figure_against(1 + frac, 1 + TARGET_PYTHON_FRACTION, 3)
                 lines.append(
                     f"target {w}x{h}: {best['backend']} process_frame(RGB888) takes "
-                    f"{1 + frac:.3f}x its C++ loop alone (Python side "
+                    f"{times}x its C++ loop alone (Python side "
                     f"{best['python_us_per_frame']:.1f} us; <= {1 + TARGET_PYTHON_FRACTION:.2f}x)"
                     f": {verdict}"
                 )
@@ -319,17 +321,16 @@ def summary(results, paired=()):
                     frac = best["cycles_per_second"] / trivial["cycles_per_second"]
                     how = "from the two rows above"
                 verdict = "met" if frac >= TARGET_TRIVIAL_FRACTION else "MISSED"
+                shown = scaffold.figure_against(frac, TARGET_TRIVIAL_FRACTION, 2)
                 lines.append(
-                    f"target {w}x{h}: {best['backend']} runs at {frac:.2f} of the trivial "
+                    f"target {w}x{h}: {best['backend']} runs at {shown} of the trivial "
                     f"design's cycle rate (>= {TARGET_TRIVIAL_FRACTION}; {how}): {verdict}"
                 )
     pysim = by.get(("pysim", "follow_target", 160, 120))
     if pysim:
         verdict = "met" if pysim["ms_per_frame"] <= TARGET_PYSIM_MS_160 else "MISSED"
-        lines.append(
-            f"target 160x120: pysim {pysim['ms_per_frame']:.0f} ms <= "
-            f"{TARGET_PYSIM_MS_160:.0f} ms: {verdict}"
-        )
+        ms = scaffold.figure_against(pysim["ms_per_frame"], TARGET_PYSIM_MS_160, 0)
+        lines.append(f"target 160x120: pysim {ms} ms <= {TARGET_PYSIM_MS_160:.0f} ms: {verdict}")
     return lines
 
 
@@ -431,8 +432,9 @@ def run(args):
             f"{r['frames']} each)",
             flush=True,
         )
+        ratio = scaffold.figure_against(r["ratio"], PUBLISHED_TARGET_RATIO, 2)
         notes.append(
-            f"target 160x120: {name} process_frame(RGB888) {r['ratio']:.2f}x as fast as the "
+            f"target 160x120: {name} process_frame(RGB888) {ratio}x as fast as the "
             f"published RTL (>= {PUBLISHED_TARGET_RATIO}x): "
             f"{'met' if r['ratio'] >= PUBLISHED_TARGET_RATIO else 'MISSED'}"
         )

@@ -115,4 +115,11 @@ def run(args):
     return {"full_over_forked": full / forked, "variants": len(variants), "parted": parted}
 
 
-main = scaffold.command(run, __doc__, name="fork", options=_options, check=_check)
+main = scaffold.command(
+    run,
+    __doc__,
+    name="fork",
+    options=_options,
+    check=_check,
+    calibrate=False,  # no times
+)

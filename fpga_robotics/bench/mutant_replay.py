@@ -70,6 +70,7 @@ def run(args):
     scenario = load_scenario(
         args.scenario, [f"sim.duration={args.duration!r}", f'camera.resolution="{w}x{h}"']
     )
+    scaffold.check_follow_target_scenario(scenario, "mutant_replay")  # FollowTarget mutants
     params = scenario.params
     mutants = list_mutants(params, args.mutants, args.seed)
     with tempfile.TemporaryDirectory(prefix="fr-bench-mutants-") as folder:

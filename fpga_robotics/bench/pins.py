@@ -14,6 +14,7 @@ over as many cycles after each run, for the ratio of the pin path to the frame p
 """
 
 import contextlib
+import math
 import statistics
 import time
 
@@ -179,13 +180,16 @@ def _options(parser):
         type=lambda text: scaffold.parse_size(text, "--resolution"),
     )
     parser.add_argument(
-        "--seconds", type=float, default=1.0, help="simulated seconds per compiled run (default 1)"
+        "--seconds",
+        type=float,
+        default=1.0,
+        help="simulated seconds per compiled run (default 1, at most 60)",
     )
     parser.add_argument(
         "--pysim-seconds",
         type=float,
         default=PYSIM_SECONDS,
-        help=f"simulated seconds per pysim run (default {PYSIM_SECONDS})",
+        help=f"simulated seconds per pysim run (default {PYSIM_SECONDS}, at most 0.1)",
     )
     parser.add_argument("--clock-hz", type=float, default=50e6)
     parser.add_argument("--fps", type=float, default=30.0)
@@ -203,7 +207,17 @@ def _options(parser):
     )
 
 
-def run(args):
+#: ``--OPTION``: (least, most) of its value; finite, more than the least (a run of none is no
+#: figure), at most the most (bounding the run: seconds x clock are the cycles simulated).
+_BOUNDS = {
+    "seconds": (0, 60),
+    "pysim_seconds": (0, 0.1),  # pysim runs some 40 000 cycles a second: 0.1 s is minutes
+    "step": (0, 1),
+    "clock_hz": (0, 1e9),
+}
+
+
+def _check(args):
     scaffold.check_follow_target_design(args, "pins")
     names = [n for n in args.backends.split(",") if n]
     unknown = sorted(set(names) - set(BACKENDS))
@@ -211,8 +225,21 @@ def run(args):
         raise UsageError(
             f"unknown backend(s) {', '.join(unknown)}; choose from {', '.join(BACKENDS)}"
         )
-    if args.toggle_every < 1 or not (args.seconds > 0 and args.step > 0):
-        raise UsageError("--toggle-every, --seconds and --step must be positive")
+    if not names:
+        raise UsageError(f"--backends is empty; give some of {', '.join(BACKENDS)}")
+    args.backends = list(dict.fromkeys(names))  # each backend once
+    if args.toggle_every < 1:
+        raise UsageError(f"--toggle-every must be positive, got {args.toggle_every}")
+    for key, (least, most) in _BOUNDS.items():
+        value = getattr(args, key)
+        if not (math.isfinite(value) and least < value <= most):
+            option = "--" + key.replace("_", "-")
+            raise UsageError(
+                f"{option} must be more than {least:g} and at most {most:g}, got {value:g}"
+            )
+
+
+def run(args):
     width, height = args.resolution
     try:
         params = FollowTargetParams(width=width, height=height)
@@ -229,7 +256,7 @@ def run(args):
         f"physics step {args.step * 1e3:.3g} ms, median of {args.repeats} runs"
     )
     figures = []
-    for name in names:
+    for name in args.backends:
         seconds = args.pysim_seconds if name == "pysim" else args.seconds
         try:
             pin_rates, frame_rates, runs = benchmark(
@@ -267,4 +294,4 @@ def run(args):
     return {"backends": figures}
 
 
-main = scaffold.command(run, __doc__, name="pins", options=_options, repeats=5)
+main = scaffold.command(run, __doc__, name="pins", options=_options, check=_check, repeats=5)

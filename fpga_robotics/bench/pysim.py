@@ -45,8 +45,15 @@ def benchmark(params=None, *, frames=7, line_blank=0, frame_blank=0, seed=0):
 
 
 def _options(parser):
-    parser.add_argument("--line-blank", type=int, default=0)
-    parser.add_argument("--frame-blank", type=int, default=0)
+    parser.add_argument(
+        "--line-blank", type=int, default=0, help="idle cycles after each line (default 0)"
+    )
+    parser.add_argument(
+        "--frame-blank",
+        type=int,
+        default=0,
+        help="idle cycles after each frame, at least (default 0)",
+    )
     add_param_arguments(parser)
 
 

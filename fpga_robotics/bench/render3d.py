@@ -138,6 +138,12 @@ def _check(args):
         raise UsageError(f"--seconds must be 0..3600, got {args.seconds}")
     if args.viewer and args.figures is None:
         raise UsageError("--viewer goes with --figures DIR")
+    if args.figures is not None:
+        scaffold.check_not_given(
+            args,
+            ("seconds", "sizes", "backend", "frames", "repeats", "json", "calibrate"),
+            "with --figures DIR (it writes the figures of docs/render3d.md, no timings)",
+        )
     if args.backend not in ("auto", *BACKEND_NAMES):
         raise UsageError(
             f"--backend {args.backend!r} is not a backend; choose one of: auto, "

@@ -5,9 +5,9 @@ A subject module declares its own options and its measurement, and gets the rest
     main = command(run, __doc__, name="camera", options=add_options, repeats=5, frames=60)
 
 ``command`` builds ``main(argv, prog)``: the common options (``--repeats``, ``--frames``,
-``--min-seconds`` where the subject takes them, ``--json PATH`` and ``--calibrate`` always),
-their checks, and bad arguments as ``UsageError`` (one line ``prog: error: ...``, exit 2, from
-``run_cli``). ``run(args)`` prints its figures as it measures and returns them as a dict;
+``--min-seconds`` where the subject takes them, ``--json PATH`` always, ``--calibrate`` where
+its figures hold times), their checks, and bad arguments as ``UsageError`` (one line
+``prog: error: ...``, exit 2, from ``run_cli``). ``run(args)`` prints its figures as it measures and returns them as a dict;
 ``--json`` writes that dict atomically with the machine's description, and ``--calibrate``
 times the calibration design in the same run and prints every absolute time of the dict
 (a key that names milliseconds: ``frame_ms``, ``ms_per_frame``) as a multiple of it: the
@@ -34,8 +34,11 @@ __all__ = [
     "Spread",
     "add_follow_target_design",
     "check_follow_target_design",
+    "check_follow_target_scenario",
     "check_json_path",
+    "check_not_given",
     "command",
+    "figure_against",
     "gc_paused",
     "parse_size",
     "parse_sizes",
@@ -128,6 +131,35 @@ def check_follow_target_design(args, subject):
         )
 
 
+def check_follow_target_scenario(scenario, subject):
+    """One line when ``scenario`` runs anything but FollowTarget in compressed timing: this
+    subject builds FollowTarget's frame models, whatever the scenario's design is."""
+    own_design = scenario.top != "follow_target" or scenario.foreign is not None
+    if not own_design and scenario.sim.timing == "compressed":
+        return
+    design = "its own Verilog design" if scenario.foreign is not None else scenario.top
+    raise UsageError(
+        f"bench {subject} times follow_target in compressed timing only; scenario "
+        f"{scenario.name!r} runs {design} in {scenario.sim.timing} timing (other designs "
+        f"are timed by fpga-robotics bench user_verilog --design REF --scenario NAME)"
+    )
+
+
+def figure_against(value, limit, decimals):
+    """``value`` with ``decimals`` decimals, or as many more as it takes for the printed figure
+    to sit on the same side of ``limit`` as ``value`` (4.498 against 4.5 prints 4.498, not
+    4.50: a target line must not show a figure on the limit and call it missed)."""
+
+    def side(x):
+        return (x > limit) - (x < limit)
+
+    text = f"{value:.{decimals}f}"
+    while side(float(text)) != side(value) and decimals < 15:
+        decimals += 1
+        text = f"{value:.{decimals}f}"
+    return text
+
+
 def check_json_path(path):
     """Checked before measuring, not after minutes of it."""
     directory = os.path.dirname(os.path.abspath(path))
@@ -215,7 +247,7 @@ def ratios_to(figures, reference_ms, cpu_reference_ms=None):
     ]
 
 
-def _add_common(parser, repeats, frames, min_seconds):
+def _add_common(parser, repeats, frames, min_seconds, calibrate):
     if repeats is not None:
         parser.add_argument(
             "--repeats",
@@ -235,12 +267,15 @@ def _add_common(parser, repeats, frames, min_seconds):
             help=f"repeat the frames until each case has run this long (default {min_seconds:g})",
         )
     parser.add_argument("--json", metavar="PATH", help="also write the figures to PATH")
-    parser.add_argument(
-        "--calibrate",
-        action="store_true",
-        help="also time the calibration design (bench calibrate) in this run "
-        "and print every time as a multiple of it",
-    )
+    if calibrate:
+        parser.add_argument(
+            "--calibrate",
+            action="store_true",
+            help="also time the calibration design (bench calibrate) in this run "
+            "and print every time as a multiple of it",
+        )
+    else:
+        parser.set_defaults(calibrate=False)
 
 
 def _check_common(args):
@@ -255,20 +290,51 @@ def _check_common(args):
         check_json_path(args.json)
 
 
+def _given(parser, argv):
+    """The destinations of the options ``argv`` gives (not left at their defaults)."""
+    defaults = [(action, action.default) for action in parser._actions]
+    try:
+        for action, _ in defaults:
+            action.default = argparse.SUPPRESS
+        return frozenset(vars(parser.parse_args(argv)))
+    finally:
+        for action, default in defaults:
+            action.default = default
+
+
+def check_not_given(args, dests, reason):
+    """One line when the command line gives any of the options ``dests``: they cannot
+    apply, for ``reason`` ("with --figures DIR (...)"), and are refused, not ignored."""
+    given = [dest for dest in dests if dest in args.given]
+    if given:
+        raise UsageError(f"--{given[0].replace('_', '-')} does not apply {reason}")
+
+
 def command(
-    run, doc, *, name, options=None, repeats=None, frames=None, min_seconds=None, check=None
+    run,
+    doc,
+    *,
+    name,
+    options=None,
+    repeats=None,
+    frames=None,
+    min_seconds=None,
+    check=None,
+    calibrate=True,
 ):
     """``main(argv=None, prog=...)`` of a benchmark: parse (common options, then the
-    subject's ``options(parser)``), check (common, then ``check(args)``), ``run(args)`` ->
-    figures, then the calibration and ``--json`` if asked for."""
+    subject's ``options(parser)``; ``args.given`` the options the command line gives),
+    check (common, then ``check(args)``), ``run(args)`` -> figures, then the calibration and
+    ``--json`` if asked for. ``calibrate=False``: figures with no times, no ``--calibrate``."""
     description = doc.strip().split("\n\n")[0].replace("``", "")  # no RST in --help
 
     def main(argv=None, prog=f"fpga-robotics bench {name}"):
         parser = BenchParser(prog=prog, description=description)
         if options is not None:
             options(parser)
-        _add_common(parser, repeats, frames, min_seconds)
+        _add_common(parser, repeats, frames, min_seconds, calibrate)
         args = parser.parse_args(argv)
+        args.given = _given(parser, argv)
         _check_common(args)
         if check is not None:
             check(args)
@@ -290,14 +356,15 @@ def command(
 def print_calibrated(figures, calibration):
     """Each absolute time of ``figures`` next to the same run's calibration frame time."""
     ref, cpu_ref = calibration["frame_ms"].median, calibration["cpu_ms"].median
-    print(
-        f"calibration ({calibration['what']}): {calibration['frame_ms']:.4f} ms/frame, "
-        f"CPU {calibration['cpu_ms']:.4f} (median, min-max of {calibration['frame_ms'].n}); "
-        f"the times above in calibration frames (CPU times in its CPU time):"
-    )
     rows = [
         (name, f"{ms:.4g} ms", f"{ratio:.3g}x")
         for name, ms, ratio in ratios_to(figures, ref, cpu_ref)
     ]
+    in_frames = "; the times above in calibration frames (CPU times in its CPU time):"
+    print(
+        f"calibration ({calibration['what']}): {calibration['frame_ms']:.4f} ms/frame, "
+        f"CPU {calibration['cpu_ms']:.4f} (median, min-max of {calibration['frame_ms'].n})"
+        f"{in_frames if rows else ''}"
+    )
     if rows:
         print_table(("figure", "time", "x calibration"), rows)

@@ -17,7 +17,7 @@ from fpga_robotics.cli.run import _shadow_params
 from fpga_robotics.loop.compressed import make_backend
 from fpga_robotics.loop.timings import run_scenario
 from fpga_robotics.scenario.load import load_scenario
-from fpga_robotics.sim.backends import BACKEND_NAMES
+from fpga_robotics.sim.backends import BACKEND_NAMES, fastest_backend_name
 
 __all__ = ["main", "measure"]
 
@@ -80,11 +80,14 @@ def _check(args):
 
 def run(args):
     scenario = load_scenario(args.scenario, [f"sim.duration={args.duration!r}"])
+    scaffold.check_follow_target_scenario(scenario, "shadow")
     shadow_params = _shadow_params(scenario, args.shadow)
-    alone, shadowed, own = measure(scenario, args.backend, shadow_params, args.repeats)
+    # The backend that runs, named in the header ("auto" is the fastest one here).
+    backend = fastest_backend_name() if args.backend == "auto" else args.backend
+    alone, shadowed, own = measure(scenario, backend, shadow_params, args.repeats)
     extra = shadowed - alone
     print(
-        f"{scenario.name}, {args.backend} backend, shadow {args.shadow}, "
+        f"{scenario.name}, {backend} backend, shadow {args.shadow}, "
         f"medians of {args.repeats} turns (CPU ms per frame)"
     )
     print(f"  closed loop alone           {alone:8.3f}")

@@ -157,7 +157,9 @@ def design_overrides(reference, ports):
     ``ports``), after checking it resolves (``UsageError``: one line)."""
     spec = resolve_design(reference, ports=ports)
     if spec.kind == "verilog":
-        files = spec.reference[len("verilog:") :].split(",")
+        # Relative to the current folder, as every path on the command line (the scenario
+        # would take them from its own folder).
+        files = [str(Path(f).resolve()) for f in spec.reference[len("verilog:") :].split(",")]
         return [
             f"design.verilog={json.dumps(files)}",
             f"design.ports={json.dumps(str(Path(ports).resolve()))}",
