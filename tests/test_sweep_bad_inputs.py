@@ -33,6 +33,7 @@ CASES = {
     "bad override value": (GOOD + '[grid]\n"design.diff_min" = [4, -3]\n', "diff_min"),
     "bad backend": (GOOD.replace('"model"', '"fpga"'), "backend must be one of"),
     "malformed toml": (GOOD + "grid = [\n", "malformed TOML"),
+    "description not a string": (GOOD + "description = 5\n", "description must be a string, got 5"),
     "not a list": (GOOD + '[grid]\n"design.diff_min" = 4\n', "must be a list of values"),
     "a parameter shadow in real-clock timing": (
         'scenarios = ["line_track"]\nduration = 1.0\nshadow = "published"\n',

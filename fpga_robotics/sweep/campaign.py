@@ -507,6 +507,7 @@ def load_campaign(data, *, source="", command_line=None):
         name = _typed(data, "name", str, "a string") or "campaign"
         # The name makes the default results folder: a plain file name.
         name = re.sub(r"[^A-Za-z0-9_.-]", "_", name).lstrip(".-")[:64] or "campaign"
+        description = _typed(data, "description", str, "a string") or ""
         scenarios = data.get("scenarios")
         if isinstance(scenarios, str):
             scenarios = [scenarios]
@@ -559,7 +560,7 @@ def load_campaign(data, *, source="", command_line=None):
         raise CampaignError(f"{where}{exc}") from None
     return Campaign(
         name=name,
-        description=data.get("description", ""),
+        description=description,
         runs=runs,
         axes=axes,
         timeout=timeout,
