@@ -297,10 +297,25 @@ def _flatten_values(table, prefix):
     return out
 
 
+class _Table(dict):
+    """An inline table of an override value (a piece of furniture, a person) that can be
+    hashed, as a run's overrides must be; never changed once made. ``toml_value`` writes it
+    back as an inline table and the results as a JSON object, as a dict."""
+
+    __slots__ = ()
+
+    def __hash__(self):
+        return hash(frozenset(self.items()))
+
+
 def _hashable(value):
-    """A list value (a colour, a start position, waypoints) as tuples, all the way down: a
-    run's overrides are hashable."""
-    return tuple(_hashable(v) for v in value) if isinstance(value, list) else value
+    """A list value (a colour, a start position, waypoints) as tuples and an inline table as
+    a ``_Table``, all the way down: a run's overrides are hashable."""
+    if isinstance(value, list):
+        return tuple(_hashable(v) for v in value)
+    if isinstance(value, dict):
+        return _Table((k, _hashable(v)) for k, v in value.items())
+    return value
 
 
 #: Override keys that choose the design, which a campaign's ``design`` chooses for every run.
