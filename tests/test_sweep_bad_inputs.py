@@ -52,6 +52,22 @@ CASES = {
         GOOD + 'set = ["robot.mass=12"]\n[[sets]]\n"robot.mass" = 10.0\n',
         'set item "robot.mass=12" gives every run its robot.mass, and sets[0] varies it',
     ),
+    # run's --duration and --resolution: set items of these keys after the runs' own.
+    "duration on a sim.duration axis": (
+        GOOD + '[grid]\n"sim.duration" = [0.5, 2.0]\n',
+        (
+            "c.toml: duration = 1.0 gives every run its sim.duration, and the [grid] axis "
+            "sim.duration varies it"
+        ),
+    ),
+    "resolution in a set": (
+        GOOD + '[[sets]]\n"camera.resolution" = "80x60"\n',
+        'resolution = "40x24" gives every run its camera.resolution, and sets[0] varies it',
+    ),
+    "duration and a sim.duration set item": (
+        GOOD + 'set = ["sim.duration=2.0"]\n',
+        'duration = 1.0 gives every run its sim.duration, and set item "sim.duration=2.0"',
+    ),
     "a design and a design.top axis": (
         GOOD + 'design = "mine.py:Mine"\n[grid]\n"design.top" = ["follow_target"]\n',
         (
@@ -214,6 +230,16 @@ GIVEN_TWICE = {
             'set item "design.diff_min=5" gives every run its design.diff_min, and --grid '
             "design.diff_min varies it"
         ),
+    ),
+    "--resolution on a camera.resolution set": (
+        '[[sets]]\n"camera.resolution" = "80x60"\n',
+        ["--resolution", "320x240"],
+        "--resolution 320x240 gives every run its camera.resolution, and sets[0] varies it",
+    ),
+    "--duration on a sim.duration axis": (
+        "",
+        ["--duration", "3", "--grid", "sim.duration=[1.0, 2.0]"],
+        "--duration 3.0 gives every run its sim.duration, and --grid sim.duration varies it",
     ),
     "--design on a design.top axis": (
         '[grid]\n"design.top" = ["follow_target", "follow_line"]\n',

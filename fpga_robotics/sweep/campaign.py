@@ -323,12 +323,20 @@ DESIGN_CHOICE_KEYS = ("design.top", "design.verilog")
 
 
 def _given_once(data, fixed, command_line):
-    """Refuse a value the campaign gives every run (a ``set`` item; ``design``, and with it
-    ``ports``) that the runs' overrides give too (a grid axis, a ``[[sets]]`` table, a ``set``
+    """Refuse a value the campaign gives every run (a ``set`` item; ``duration``,
+    ``resolution``; ``design``, and with it ``ports``) that the runs' overrides give too (a grid axis, a ``[[sets]]`` table, a ``set``
     item): a run takes one of them (run's last ``--set``, its ``--design``) while its row
     would be labelled with the other. Each is named as it was given: by its option when the
     command line gave it, else in the file's words."""
     every = {}  # key -> how the campaign gives it to every run
+    # run's --duration and --resolution are --set items of these keys, after the runs' own.
+    for key, option in (("sim.duration", "duration"), ("camera.resolution", "resolution")):
+        if data.get(option) is not None:
+            every[key] = (
+                f"--{option} {data[option]}"
+                if command_line.get(option)
+                else f"{option} = {toml_value(data[option])}"
+            )
     if data.get("design") is not None:
         how = (
             f"--design {data['design']}"
@@ -514,7 +522,8 @@ def load_campaign(data, *, source="", command_line=None):
     """The ``Campaign`` of a checked table (``read_campaign_file`` plus command-line
     options merged in). Scenarios and overrides are checked by ``plan.make_plan``.
     ``command_line``: what of ``data`` the command line gave, ``{"scenarios": True,
-    "design": True, "ports": True, "set": [ITEM, ...], "grid": [KEY, ...]}`` (any left
+    "duration": True, "resolution": True, "design": True, "ports": True, "set": [ITEM, ...],
+    "grid": [KEY, ...]}`` (any left
     out), so that messages name those values by their options."""
     where = f"{source}: " if source else ""
     command_line = command_line or {}
