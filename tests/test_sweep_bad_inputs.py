@@ -68,6 +68,16 @@ CASES = {
         GOOD + 'set = ["sim.duration=2.0"]\n',
         'duration = 1.0 gives every run its sim.duration, and set item "sim.duration=2.0"',
     ),
+    # run's --seed, which the campaign's seeds give every run, wins over a seed override.
+    "a seed axis": (
+        GOOD + "[grid]\nseed = [1, 2]\n",
+        (
+            "c.toml: the [grid] axis seed sets the scenario's seed, which the campaign's seeds "
+            "give every run: list the seeds there"
+        ),
+    ),
+    "a seed in a set": (GOOD + "[[sets]]\nseed = 3\n", "sets[0] sets the scenario's seed"),
+    "a seed set item": (GOOD + 'set = ["seed=3"]\n', 'set item "seed=3" sets the scenario'),
     "a design and a design.top axis": (
         GOOD + 'design = "mine.py:Mine"\n[grid]\n"design.top" = ["follow_target"]\n',
         (

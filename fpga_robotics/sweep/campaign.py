@@ -323,7 +323,7 @@ DESIGN_CHOICE_KEYS = ("design.top", "design.verilog")
 
 
 def _given_once(data, fixed, command_line):
-    """Refuse a value the campaign gives every run (a ``set`` item; ``duration``,
+    """Refuse a value the campaign gives every run (a ``set`` item; its seeds, ``duration``,
     ``resolution``; ``design``, and with it ``ports``) that the runs' overrides give too (a grid axis, a ``[[sets]]`` table, a ``set``
     item): a run takes one of them (run's last ``--set``, its ``--design``) while its row
     would be labelled with the other. Each is named as it was given: by its option when the
@@ -364,6 +364,11 @@ def _given_once(data, fixed, command_line):
     for i, table in enumerate(data.get("sets") or []):
         given += [(key, f"sets[{i}]", True) for key, _ in _flatten_values(table, "")]
     for key, how, varied in given:
+        if key == "seed":  # run's --seed, which the campaign gives every run, wins
+            raise CampaignError(
+                f"{how} sets the scenario's seed, which the campaign's seeds give every run: "
+                f"list the seeds there (e.g. seeds = [1, 2], or --seeds 1,2)"
+            )
         if key in every:
             raise CampaignError(
                 f"{every[key]} gives every run its {key}, and {how} "
