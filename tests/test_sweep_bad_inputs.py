@@ -52,6 +52,25 @@ CASES = {
         GOOD + 'set = ["robot.mass=12"]\n[[sets]]\n"robot.mass" = 10.0\n',
         'set item "robot.mass=12" gives every run its robot.mass, and sets[0] varies it',
     ),
+    # A run given twice: the results would hold one row of it.
+    "a grid value twice": (
+        GOOD + '[grid]\n"design.diff_min" = [4, 6, 4]\n',
+        "c.toml: grid key 'design.diff_min' lists 4 twice: give each value once",
+    ),
+    "a set equal to a grid run": (
+        GOOD + '[grid]\n"design.diff_min" = [4, 6]\n[[sets]]\n"design.diff_min" = 6\n',
+        "c.toml: sets[0] repeats the grid run design.diff_min=6: give each run once",
+    ),
+    "two equal sets": (
+        GOOD
+        + '[[sets]]\n"design.diff_min" = 6\n"robot.mass" = 10.0\n'
+        + '[[sets]]\n"robot.mass" = 10.0\n"design.diff_min" = 6\n',
+        "c.toml: sets[1] repeats sets[0]: give each run once",
+    ),
+    "a scenario twice": (
+        GOOD.replace('["approach"]', '["approach", "divider", "approach"]'),
+        "c.toml: scenarios lists approach twice: give each scenario once",
+    ),
     # run's --duration and --resolution: set items of these keys after the runs' own.
     "duration on a sim.duration axis": (
         GOOD + '[grid]\n"sim.duration" = [0.5, 2.0]\n',
@@ -251,6 +270,16 @@ GIVEN_TWICE = {
         ["--duration", "3", "--grid", "sim.duration=[1.0, 2.0]"],
         "--duration 3.0 gives every run its sim.duration, and --grid sim.duration varies it",
     ),
+    "--scenarios naming one twice": (
+        "",
+        ["--scenarios", "approach,approach"],
+        "--scenarios lists approach twice: give each scenario once",
+    ),
+    "--grid listing a value twice": (
+        "",
+        ["--grid", "design.diff_min=[5, 5]"],
+        "--grid design.diff_min lists 5 twice: give each value once",
+    ),
     "--design on a design.top axis": (
         '[grid]\n"design.top" = ["follow_target", "follow_line"]\n',
         ["--design", "mine.py:Mine"],
@@ -305,6 +334,27 @@ def test_a_known_limit_of_a_scenario_not_run_is_an_error_unless_scenarios_is_giv
     assert main(["c.toml", "--scenarios", "divider", "--dry-run"]) == 0
 
 
+def test_one_scenario_by_two_paths_or_two_copies_is_an_error_naming_both(
+    tmp_path, monkeypatch, capsys
+):
+    # Rows go by the run's identity (the scenario's content): these runs would be one row.
+    (tmp_path / "s.toml").write_text('[sim]\nduration = 1.0\n[camera]\nresolution = "40x24"\n')
+    (tmp_path / "copy.toml").write_text((tmp_path / "s.toml").read_text())
+    (tmp_path / "c.toml").write_text('backend = "model"\nscenarios = ["s.toml"]\n')
+    monkeypatch.chdir(tmp_path)
+    for scenarios, second in (("s.toml,./s.toml", "./s.toml"), ("s.toml,copy.toml", "copy.toml")):
+        with pytest.raises(SystemExit) as exit_info:
+            argv = ["c.toml", "--scenarios", scenarios, "--dry-run"]
+            run_cli(main, argv, prog="fpga-robotics sweep")
+        assert exit_info.value.code == 2
+        captured = capsys.readouterr()
+        assert captured.err.strip() == (
+            f"fpga-robotics sweep: error: c.toml: run of s.toml and run of {second} (seed 0) "
+            "are one run (the same scenario content, seed and overrides): give each run once"
+        )
+        assert captured.out == ""
+
+
 def test_two_scenario_files_of_one_name_are_an_error_naming_both(tmp_path, monkeypatch, capsys):
     from fpga_robotics.scenario.load import load_scenario
 
@@ -324,9 +374,11 @@ def test_two_scenario_files_of_one_name_are_an_error_naming_both(tmp_path, monke
         'one of them another name = "..."'
     )
     assert not (tmp_path / "out").exists()
-    # The same file twice (by name and by path) is one scenario: no error.
+    # The same file twice (by name and by path) is not two files of one name: it is each of
+    # its runs given twice.
     (tmp_path / "c.toml").write_text(GOOD.replace('["approach"]', f'["approach", "{shipped}"]'))
-    assert main(["c.toml", "--dry-run"]) == 0
+    with pytest.raises(UsageError, match=r"^c.toml: run of approach and run of .* are one run"):
+        main(["c.toml", "--dry-run"])
 
 
 #: A port nothing listens on: Dask gives up on it after its 10 s connect timeout.

@@ -255,8 +255,19 @@ def _set_items(items, where):
     return tuple(items)
 
 
-def _combos(data):
-    """The override sets: the grid's cartesian product, then the explicit sets."""
+def _twice(values):
+    """The first value of ``values`` that an earlier one equals, else None."""
+    return next((v for i, v in enumerate(values) if v in values[:i]), None)
+
+
+def _shown_combo(combo):
+    return " ".join(f"{k}={toml_value(v)}" for k, v in combo)
+
+
+def _combos(data, command_line):
+    """The override sets: the grid's cartesian product, then the explicit sets. A run given
+    twice (a value listed twice on an axis, a set equal to a grid run or to another set) is
+    an error: its rows would be merged into one."""
     combos = []
     axes = []
     if "grid" in data:
@@ -267,6 +278,13 @@ def _combos(data):
                 '(e.g. [grid] "design.diff_min" = [4, 6, 8]), or leave it out'
             )
         pairs = _flatten(grid, "", "grid key")
+        for key, vs in pairs:
+            twice = _twice([toml_value(v) for v in vs])
+            if twice is not None:
+                how = (
+                    f"--grid {key}" if key in command_line.get("grid", ()) else f"grid key {key!r}"
+                )
+                raise CampaignError(f"{how} lists {twice} twice: give each value once")
         axes = [k for k, _ in pairs]
         values = [[_hashable(v) for v in vs] for _, vs in pairs]
         combos = [tuple(zip(axes, combo)) for combo in itertools.product(*values)]
@@ -276,15 +294,25 @@ def _combos(data):
             raise CampaignError(
                 "sets must be a non-empty list of tables ([[sets]] with KEY = VALUE lines)"
             )
+        # A run as its overrides, in any order (a table's keys have none).
+        runs = {_run_of(combo): f"the grid run {_shown_combo(combo)}" for combo in combos}
         for i, s in enumerate(sets):
             if not s:
                 raise CampaignError(f"sets[{i}] is empty: give at least one KEY = VALUE")
             items = tuple(_flatten_values(s, ""))
+            run = _run_of(items)
+            if run in runs:
+                raise CampaignError(f"sets[{i}] repeats {runs[run]}: give each run once")
+            runs[run] = f"sets[{i}]"
             for k, _ in items:
                 if k not in axes:
                     axes.append(k)
             combos.append(items)
     return combos or [()], axes
+
+
+def _run_of(combo):
+    return frozenset((k, toml_value(v)) for k, v in combo)
 
 
 def _flatten_values(table, prefix):
@@ -548,6 +576,10 @@ def load_campaign(data, *, source="", command_line=None):
             raise CampaignError(
                 "scenarios must be a non-empty list of shipped scenario names or .toml paths"
             )
+        twice = _twice(scenarios)
+        if twice is not None:
+            how = "--scenarios" if command_line.get("scenarios") else "scenarios"
+            raise CampaignError(f"{how} lists {twice} twice: give each scenario once")
         seeds = parse_seeds(data.get("seeds", "0"))
         backend = _typed(data, "backend", str, "a backend name") or "auto"
         resolution = _typed(data, "resolution", str, '"WxH"')
@@ -558,7 +590,7 @@ def load_campaign(data, *, source="", command_line=None):
         if timeout is not None and not 0 < timeout < math.inf:
             raise CampaignError(f"timeout must be > 0 seconds, got {timeout}")
         fixed = _set_items(data.get("set", []), "set")
-        combos, axes = _combos(data)
+        combos, axes = _combos(data, command_line)
         _given_once(data, fixed, command_line)
         known_limits = _known_limits(data, axes, combos, command_line.get("grid", ()))
         base = RunSpec(
