@@ -29,8 +29,30 @@ CASES = {
     "seed not a number": (GOOD.replace('"0-1"', '"a-b"'), "seeds must be"),
     "negative seed": (GOOD.replace('"0-1"', "[-4]"), "out of range"),
     "unknown scenario": (GOOD.replace('"approach"', '"aproach"'), "unknown scenario 'aproach'"),
-    "unknown override key": (GOOD + '[grid]\n"design.dif_min" = [4]\n', "design.dif_min"),
-    "bad override value": (GOOD + '[grid]\n"design.diff_min" = [4, -3]\n', "diff_min"),
+    # A bad override value: named as the file gives it, with the run.
+    "unknown override key": (
+        GOOD + '[grid]\n"design.dif_min" = [4]\n',
+        (
+            "c.toml: the [grid] axis design.dif_min, in the run of approach with design.dif_min=4: "
+            "unknown scenario key 'design.dif_min'"
+        ),
+    ),
+    "bad override value": (
+        GOOD + '[grid]\n"design.diff_min" = [4, -3]\n',
+        "c.toml: the [grid] axis design.diff_min, in the run of approach with design.diff_min=-3: ",
+    ),
+    "a bad value in a set": (
+        GOOD + '[[sets]]\n"robot.mass" = 10.0\n[[sets]]\n"robot.mass" = -1.0\n',
+        "c.toml: sets[1], in the run of approach with robot.mass=-1.0: robot.mass must be >= ",
+    ),
+    "a bad set item": (
+        GOOD + 'set = ["robot.mass=-1.0"]\n',
+        'c.toml: set item "robot.mass=-1.0", in the run of approach with robot.mass=-1.0: ',
+    ),
+    "a bad resolution": (
+        GOOD.replace('"40x24"', '"0x0"'),
+        'c.toml: resolution = "0x0", in the run of approach: resolution must look like WIDTHxHEIGHT',
+    ),
     "bad backend": (GOOD.replace('"model"', '"fpga"'), "backend must be one of"),
     "malformed toml": (GOOD + "grid = [\n", "malformed TOML"),
     "description not a string": (GOOD + "description = 5\n", "description must be a string, got 5"),
@@ -221,6 +243,18 @@ BAD_OPTION_VALUES = {
     "--grid": (["--grid", "design.diff_min=[]"], "--grid needs KEY=[V1, V2, ...]"),
     "--duration": (["--duration", "-1"], "--duration must be > 0 seconds"),
     "--scenarios": (["--scenarios", ","], "--scenarios needs scenario names"),
+    "--set value": (
+        ["--set", "robot.mass=-3"],
+        "--set robot.mass=-3, in the run of approach with robot.mass=-3: robot.mass must be >= ",
+    ),
+    "--grid value": (
+        ["--grid", "design.nokey=[1]"],
+        "--grid design.nokey, in the run of approach with design.nokey=1: unknown scenario key",
+    ),
+    "--resolution": (
+        ["--resolution", "0x0"],
+        "--resolution 0x0, in the run of approach: resolution must look like WIDTHxHEIGHT",
+    ),
     "--scheduler": (
         ["--scheduler", "notaurl"],
         "--scheduler must be a Dask scheduler address tcp://HOST:PORT",

@@ -107,6 +107,9 @@ class RunSpec:
     design: str | None = None
     ports: str | None = None
     fixed: tuple = ()  # the campaign's fixed ``set`` items (KEY=VALUE text)
+    #: How each of ``set_items()``, then the resolution and the duration, was given (the
+    #: campaign file's words or the option), for messages.
+    origins: tuple = field(default=(), compare=False)
 
     def set_items(self):
         return [*self.fixed, *(f"{k}={toml_value(v)}" for k, v in self.overrides)]
@@ -264,11 +267,27 @@ def _shown_combo(combo):
     return " ".join(f"{k}={toml_value(v)}" for k, v in combo)
 
 
+def _how_axis(key, command_line):
+    return f"--grid {key}" if key in command_line.get("grid", ()) else f"the [grid] axis {key}"
+
+
+def _how_set_item(item, command_line):
+    return (
+        f"--set {item}" if item in command_line.get("set", ()) else f"set item {toml_value(item)}"
+    )
+
+
+def _how_option(option, value, command_line):
+    """A value the campaign gives every run (``duration``, ``design``...) as it was given."""
+    return f"--{option} {value}" if command_line.get(option) else f"{option} = {toml_value(value)}"
+
+
 def _combos(data, command_line):
-    """The override sets: the grid's cartesian product, then the explicit sets. A run given
-    twice (a value listed twice on an axis, a set equal to a grid run or to another set) is
-    an error: its rows would be merged into one."""
+    """The override sets: the grid's cartesian product, then the explicit sets, and how each
+    override of each was given. A run given twice (a value listed twice on an axis, a set
+    equal to a grid run or to another set) is an error: its rows would be merged into one."""
     combos = []
+    origins = []
     axes = []
     if "grid" in data:
         grid = data["grid"]
@@ -288,6 +307,7 @@ def _combos(data, command_line):
         axes = [k for k, _ in pairs]
         values = [[_hashable(v) for v in vs] for _, vs in pairs]
         combos = [tuple(zip(axes, combo)) for combo in itertools.product(*values)]
+        origins = [tuple(_how_axis(k, command_line) for k in axes)] * len(combos)
     if "sets" in data:
         sets = data["sets"]
         if not isinstance(sets, list) or not sets or not all(isinstance(s, dict) for s in sets):
@@ -304,11 +324,12 @@ def _combos(data, command_line):
             if run in runs:
                 raise CampaignError(f"sets[{i}] repeats {runs[run]}: give each run once")
             runs[run] = f"sets[{i}]"
+            origins.append((f"sets[{i}]",) * len(items))
             for k, _ in items:
                 if k not in axes:
                     axes.append(k)
             combos.append(items)
-    return combos or [()], axes
+    return combos or [()], origins or [()], axes
 
 
 def _run_of(combo):
@@ -360,35 +381,17 @@ def _given_once(data, fixed, command_line):
     # run's --duration and --resolution are --set items of these keys, after the runs' own.
     for key, option in (("sim.duration", "duration"), ("camera.resolution", "resolution")):
         if data.get(option) is not None:
-            every[key] = (
-                f"--{option} {data[option]}"
-                if command_line.get(option)
-                else f"{option} = {toml_value(data[option])}"
-            )
+            every[key] = _how_option(option, data[option], command_line)
     if data.get("design") is not None:
-        how = (
-            f"--design {data['design']}"
-            if command_line.get("design")
-            else f"design = {toml_value(data['design'])}"
-        )
+        how = _how_option("design", data["design"], command_line)
         every.update(dict.fromkeys(DESIGN_CHOICE_KEYS, how))
         if data.get("ports") is not None:  # run's --ports replaces the design's design.ports
-            every["design.ports"] = (
-                f"--ports {data['ports']}"
-                if command_line.get("ports")
-                else f"ports = {toml_value(data['ports'])}"
-            )
+            every["design.ports"] = _how_option("ports", data["ports"], command_line)
     given = []  # (key, how, varied) of each override
     for item in fixed:
-        how = (
-            f"--set {item}"
-            if item in command_line.get("set", ())
-            else f"set item {toml_value(item)}"
-        )
-        given.append((item.partition("=")[0].strip(), how, False))
+        given.append((item.partition("=")[0].strip(), _how_set_item(item, command_line), False))
     for key, _ in _flatten(data.get("grid") or {}, "", "grid key"):
-        how = f"--grid {key}" if key in command_line.get("grid", ()) else f"the [grid] axis {key}"
-        given.append((key, how, True))
+        given.append((key, _how_axis(key, command_line), True))
     for i, table in enumerate(data.get("sets") or []):
         given += [(key, f"sets[{i}]", True) for key, _ in _flatten_values(table, "")]
     for key, how, varied in given:
@@ -590,7 +593,7 @@ def load_campaign(data, *, source="", command_line=None):
         if timeout is not None and not 0 < timeout < math.inf:
             raise CampaignError(f"timeout must be > 0 seconds, got {timeout}")
         fixed = _set_items(data.get("set", []), "set")
-        combos, axes = _combos(data, command_line)
+        combos, origins, axes = _combos(data, command_line)
         _given_once(data, fixed, command_line)
         known_limits = _known_limits(data, axes, combos, command_line.get("grid", ()))
         base = RunSpec(
@@ -610,7 +613,20 @@ def load_campaign(data, *, source="", command_line=None):
         count = len(scenarios) * len(seeds) * len(combos)
         if count > MAX_RUNS:
             raise CampaignError(f"the campaign has {count} runs; at most {MAX_RUNS}")
-        shapes = [_with_ports(replace(base, overrides=combo)) for combo in combos]
+        fixed_how = tuple(_how_set_item(item, command_line) for item in fixed)
+        options_how = tuple(
+            _how_option(option, data[option], command_line)
+            for option in ("resolution", "duration")
+            if data.get(option) is not None
+        )
+        ports_how = base.ports and _how_option("ports", base.ports, command_line)
+        shapes = [
+            _with_ports(
+                replace(base, overrides=combo, origins=(*fixed_how, *how, *options_how)),
+                ports_how,
+            )
+            for combo, how in zip(combos, origins)
+        ]
         runs = [
             replace(shape, scenario=sc, seed=seed)
             for sc in scenarios
@@ -631,11 +647,12 @@ def load_campaign(data, *, source="", command_line=None):
     )
 
 
-def _with_ports(spec):
+def _with_ports(spec, ports_how):
     """The campaign's ``ports`` go with every Verilog design of its runs: with no campaign
     ``design``, a run whose overrides make ``design.top`` a ``verilog:`` design gets them as
     ``design.ports`` (unless it sets that itself), and a run whose overrides name another
-    design, or give the scenario's own Verilog design its ``design.ports``, takes none."""
+    design, or give the scenario's own Verilog design its ``design.ports``, takes none.
+    ``ports_how``: how the campaign gave its ports (for messages)."""
     if spec.ports is None or spec.design is not None:
         return spec
     from fpga_robotics.scenario.load import _parse_value  # lazy: the run stack (~1 s)
@@ -653,7 +670,9 @@ def _with_ports(spec):
     if not (isinstance(top, str) and top.startswith("verilog:")) or "design.ports" in overrides:
         return replace(spec, ports=None)
     ports = f"design.ports={toml_value(os.path.abspath(spec.ports))}"
-    return replace(spec, ports=None, fixed=(*spec.fixed, ports))
+    n = len(spec.fixed)
+    origins = (*spec.origins[:n], ports_how, *spec.origins[n:])
+    return replace(spec, ports=None, fixed=(*spec.fixed, ports), origins=origins)
 
 
 def run_identity(spec, scenario_source, design_digest=""):

@@ -66,7 +66,13 @@ def make_plan(campaign):
             except UsageError as exc:
                 if isinstance(exc, PortMapUnpaired):
                     exc = _port_map_unpaired(spec, campaign.command_line) or exc
-                raise UsageError(f"{_run_named(spec)}: {exc}") from None
+                    raise UsageError(f"{_run_named(spec)}: {exc}") from None
+                how = _given_as(spec, str(exc))
+                if how is None:  # the scenario's own values, or its design
+                    raise UsageError(f"{_run_named(spec)}: {exc}") from None
+                # Named as given: an option, or the campaign file's words with the file.
+                file = "" if how.startswith("--") else where
+                raise UsageError(f"{file}{how}, in the {_run_named(spec)}: {exc}") from None
             # A shadow design's scenario (None: no shadow, or FollowTarget parameters).
             shadow = shadow_params if hasattr(shadow_params, "sim") else None
             # Loading depends on the backend only for a Verilog design, where auto stays:
@@ -102,6 +108,32 @@ def make_plan(campaign):
     _each_run_once(plan, where)
     _limits_name_run_scenarios(campaign, set(files_named), where)
     return plan
+
+
+def _first_values(spec, n):
+    """``spec`` with only the first ``n`` of its values, in the order run applies them: its
+    ``--set`` items, then its resolution, then its duration."""
+    options = [o for o in ("resolution", "duration") if getattr(spec, o) is not None]
+    past_items = max(0, n - len(spec.fixed) - len(spec.overrides))
+    return replace(
+        spec,
+        fixed=spec.fixed[:n],
+        overrides=spec.overrides[: max(0, n - len(spec.fixed))],
+        **dict.fromkeys(options[past_items:]),
+    )
+
+
+def _given_as(spec, message):
+    """How the value a run fails to load with was given (``spec.origins``): the first value
+    with which the run, loaded with the values up to it, fails with ``message``; None when it
+    fails so with none of them (its scenario, its design)."""
+    for n in range(len(spec.origins) + 1):
+        try:
+            load_run(_first_values(spec, n).argv())
+        except UsageError as exc:
+            if str(exc) == message:
+                return spec.origins[n - 1] if n else None
+    return None
 
 
 def _run_named(spec):
