@@ -77,7 +77,7 @@ CASES = {
     # A run given twice: the results would hold one row of it.
     "a grid value twice": (
         GOOD + '[grid]\n"design.diff_min" = [4, 6, 4]\n',
-        "c.toml: grid key 'design.diff_min' lists 4 twice: give each value once",
+        "c.toml: the [grid] axis design.diff_min lists 4 twice: give each value once",
     ),
     "a set equal to a grid run": (
         GOOD + '[grid]\n"design.diff_min" = [4, 6]\n[[sets]]\n"design.diff_min" = 6\n',

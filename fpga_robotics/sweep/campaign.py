@@ -300,10 +300,9 @@ def _combos(data, command_line):
         for key, vs in pairs:
             twice = _twice([toml_value(v) for v in vs])
             if twice is not None:
-                how = (
-                    f"--grid {key}" if key in command_line.get("grid", ()) else f"grid key {key!r}"
+                raise CampaignError(
+                    f"{_how_axis(key, command_line)} lists {twice} twice: give each value once"
                 )
-                raise CampaignError(f"{how} lists {twice} twice: give each value once")
         axes = [k for k, _ in pairs]
         values = [[_hashable(v) for v in vs] for _, vs in pairs]
         combos = [tuple(zip(axes, combo)) for combo in itertools.product(*values)]
@@ -373,10 +372,11 @@ DESIGN_CHOICE_KEYS = ("design.top", "design.verilog")
 
 def _given_once(data, fixed, command_line):
     """Refuse a value the campaign gives every run (a ``set`` item; its seeds, ``duration``,
-    ``resolution``; ``design``, and with it ``ports``) that the runs' overrides give too (a grid axis, a ``[[sets]]`` table, a ``set``
-    item): a run takes one of them (run's last ``--set``, its ``--design``) while its row
-    would be labelled with the other. Each is named as it was given: by its option when the
-    command line gave it, else in the file's words."""
+    ``resolution``; ``design``, and with it ``ports``) that the runs' overrides give too (a
+    grid axis, a ``[[sets]]`` table, a ``set`` item): a run takes one of them (run's last
+    ``--set``, its ``--seed``, ``--design``) while its row would be labelled with the other.
+    Each is named as it was given: by its option when the command line gave it, else in the
+    file's words."""
     every = {}  # key -> how the campaign gives it to every run
     # run's --duration and --resolution are --set items of these keys, after the runs' own.
     for key, option in (("sim.duration", "duration"), ("camera.resolution", "resolution")):
@@ -559,8 +559,8 @@ def load_campaign(data, *, source="", command_line=None):
     options merged in). Scenarios and overrides are checked by ``plan.make_plan``.
     ``command_line``: what of ``data`` the command line gave, ``{"scenarios": True,
     "duration": True, "resolution": True, "design": True, "ports": True, "set": [ITEM, ...],
-    "grid": [KEY, ...]}`` (any left
-    out), so that messages name those values by their options."""
+    "grid": [KEY, ...]}`` (any left out), so that messages name those values by their
+    options."""
     where = f"{source}: " if source else ""
     command_line = command_line or {}
     try:
