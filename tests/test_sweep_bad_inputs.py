@@ -51,7 +51,7 @@ CASES = {
     ),
     "a bad resolution": (
         GOOD.replace('"40x24"', '"0x0"'),
-        'c.toml: resolution = "0x0", in the run of approach: resolution must look like WIDTHxHEIGHT',
+        'c.toml: resolution = "0x0", in the run of approach: resolution must look like W',
     ),
     "bad backend": (GOOD.replace('"model"', '"fpga"'), "backend must be one of"),
     "malformed toml": (GOOD + "grid = [\n", "malformed TOML"),
