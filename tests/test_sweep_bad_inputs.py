@@ -29,10 +29,33 @@ CASES = {
     "seed not a number": (GOOD.replace('"0-1"', '"a-b"'), "seeds must be"),
     "negative seed": (GOOD.replace('"0-1"', "[-4]"), "out of range"),
     "unknown scenario": (GOOD.replace('"approach"', '"aproach"'), "unknown scenario 'aproach'"),
-    "unknown override key": (GOOD + '[grid]\n"design.dif_min" = [4]\n', "design.dif_min"),
-    "bad override value": (GOOD + '[grid]\n"design.diff_min" = [4, -3]\n', "diff_min"),
+    # A bad override value: named as the file gives it, with the run.
+    "unknown override key": (
+        GOOD + '[grid]\n"design.dif_min" = [4]\n',
+        (
+            "c.toml: the [grid] axis design.dif_min, in the run of approach with design.dif_min=4: "
+            "unknown scenario key 'design.dif_min'"
+        ),
+    ),
+    "bad override value": (
+        GOOD + '[grid]\n"design.diff_min" = [4, -3]\n',
+        "c.toml: the [grid] axis design.diff_min, in the run of approach with design.diff_min=-3: ",
+    ),
+    "a bad value in a set": (
+        GOOD + '[[sets]]\n"robot.mass" = 10.0\n[[sets]]\n"robot.mass" = -1.0\n',
+        "c.toml: sets[1], in the run of approach with robot.mass=-1.0: robot.mass must be >= ",
+    ),
+    "a bad set item": (
+        GOOD + 'set = ["robot.mass=-1.0"]\n',
+        'c.toml: set item "robot.mass=-1.0", in the run of approach with robot.mass=-1.0: ',
+    ),
+    "a bad resolution": (
+        GOOD.replace('"40x24"', '"0x0"'),
+        'c.toml: resolution = "0x0", in the run of approach: resolution must look like W',
+    ),
     "bad backend": (GOOD.replace('"model"', '"fpga"'), "backend must be one of"),
     "malformed toml": (GOOD + "grid = [\n", "malformed TOML"),
+    "description not a string": (GOOD + "description = 5\n", "description must be a string, got 5"),
     "not a list": (GOOD + '[grid]\n"design.diff_min" = 4\n', "must be a list of values"),
     "a parameter shadow in real-clock timing": (
         'scenarios = ["line_track"]\nduration = 1.0\nshadow = "published"\n',
@@ -51,6 +74,51 @@ CASES = {
         GOOD + 'set = ["robot.mass=12"]\n[[sets]]\n"robot.mass" = 10.0\n',
         'set item "robot.mass=12" gives every run its robot.mass, and sets[0] varies it',
     ),
+    # A run given twice: the results would hold one row of it.
+    "a grid value twice": (
+        GOOD + '[grid]\n"design.diff_min" = [4, 6, 4]\n',
+        "c.toml: the [grid] axis design.diff_min lists 4 twice: give each value once",
+    ),
+    "a set equal to a grid run": (
+        GOOD + '[grid]\n"design.diff_min" = [4, 6]\n[[sets]]\n"design.diff_min" = 6\n',
+        "c.toml: sets[0] repeats the grid run design.diff_min=6: give each run once",
+    ),
+    "two equal sets": (
+        GOOD
+        + '[[sets]]\n"design.diff_min" = 6\n"robot.mass" = 10.0\n'
+        + '[[sets]]\n"robot.mass" = 10.0\n"design.diff_min" = 6\n',
+        "c.toml: sets[1] repeats sets[0]: give each run once",
+    ),
+    "a scenario twice": (
+        GOOD.replace('["approach"]', '["approach", "divider", "approach"]'),
+        "c.toml: scenarios lists approach twice: give each scenario once",
+    ),
+    # run's --duration and --resolution: set items of these keys after the runs' own.
+    "duration on a sim.duration axis": (
+        GOOD + '[grid]\n"sim.duration" = [0.5, 2.0]\n',
+        (
+            "c.toml: duration = 1.0 gives every run its sim.duration, and the [grid] axis "
+            "sim.duration varies it"
+        ),
+    ),
+    "resolution in a set": (
+        GOOD + '[[sets]]\n"camera.resolution" = "80x60"\n',
+        'resolution = "40x24" gives every run its camera.resolution, and sets[0] varies it',
+    ),
+    "duration and a sim.duration set item": (
+        GOOD + 'set = ["sim.duration=2.0"]\n',
+        'duration = 1.0 gives every run its sim.duration, and set item "sim.duration=2.0"',
+    ),
+    # run's --seed, which the campaign's seeds give every run, wins over a seed override.
+    "a seed axis": (
+        GOOD + "[grid]\nseed = [1, 2]\n",
+        (
+            "c.toml: the [grid] axis seed sets the scenario's seed, which the campaign's seeds "
+            "give every run: list the seeds there"
+        ),
+    ),
+    "a seed in a set": (GOOD + "[[sets]]\nseed = 3\n", "sets[0] sets the scenario's seed"),
+    "a seed set item": (GOOD + 'set = ["seed=3"]\n', 'set item "seed=3" sets the scenario'),
     "a design and a design.top axis": (
         GOOD + 'design = "mine.py:Mine"\n[grid]\n"design.top" = ["follow_target"]\n',
         (
@@ -175,6 +243,18 @@ BAD_OPTION_VALUES = {
     "--grid": (["--grid", "design.diff_min=[]"], "--grid needs KEY=[V1, V2, ...]"),
     "--duration": (["--duration", "-1"], "--duration must be > 0 seconds"),
     "--scenarios": (["--scenarios", ","], "--scenarios needs scenario names"),
+    "--set value": (
+        ["--set", "robot.mass=-3"],
+        "--set robot.mass=-3, in the run of approach with robot.mass=-3: robot.mass must be >= ",
+    ),
+    "--grid value": (
+        ["--grid", "design.nokey=[1]"],
+        "--grid design.nokey, in the run of approach with design.nokey=1: unknown scenario key",
+    ),
+    "--resolution": (
+        ["--resolution", "0x0"],
+        "--resolution 0x0, in the run of approach: resolution must look like WIDTHxHEIGHT",
+    ),
     "--scheduler": (
         ["--scheduler", "notaurl"],
         "--scheduler must be a Dask scheduler address tcp://HOST:PORT",
@@ -213,6 +293,26 @@ GIVEN_TWICE = {
             'set item "design.diff_min=5" gives every run its design.diff_min, and --grid '
             "design.diff_min varies it"
         ),
+    ),
+    "--resolution on a camera.resolution set": (
+        '[[sets]]\n"camera.resolution" = "80x60"\n',
+        ["--resolution", "320x240"],
+        "--resolution 320x240 gives every run its camera.resolution, and sets[0] varies it",
+    ),
+    "--duration on a sim.duration axis": (
+        "",
+        ["--duration", "3", "--grid", "sim.duration=[1.0, 2.0]"],
+        "--duration 3.0 gives every run its sim.duration, and --grid sim.duration varies it",
+    ),
+    "--scenarios naming one twice": (
+        "",
+        ["--scenarios", "approach,approach"],
+        "--scenarios lists approach twice: give each scenario once",
+    ),
+    "--grid listing a value twice": (
+        "",
+        ["--grid", "design.diff_min=[5, 5]"],
+        "--grid design.diff_min lists 5 twice: give each value once",
     ),
     "--design on a design.top axis": (
         '[grid]\n"design.top" = ["follow_target", "follow_line"]\n',
@@ -268,6 +368,27 @@ def test_a_known_limit_of_a_scenario_not_run_is_an_error_unless_scenarios_is_giv
     assert main(["c.toml", "--scenarios", "divider", "--dry-run"]) == 0
 
 
+def test_one_scenario_by_two_paths_or_two_copies_is_an_error_naming_both(
+    tmp_path, monkeypatch, capsys
+):
+    # Rows go by the run's identity (the scenario's content): these runs would be one row.
+    (tmp_path / "s.toml").write_text('[sim]\nduration = 1.0\n[camera]\nresolution = "40x24"\n')
+    (tmp_path / "copy.toml").write_text((tmp_path / "s.toml").read_text())
+    (tmp_path / "c.toml").write_text('backend = "model"\nscenarios = ["s.toml"]\n')
+    monkeypatch.chdir(tmp_path)
+    for scenarios, second in (("s.toml,./s.toml", "./s.toml"), ("s.toml,copy.toml", "copy.toml")):
+        with pytest.raises(SystemExit) as exit_info:
+            argv = ["c.toml", "--scenarios", scenarios, "--dry-run"]
+            run_cli(main, argv, prog="fpga-robotics sweep")
+        assert exit_info.value.code == 2
+        captured = capsys.readouterr()
+        assert captured.err.strip() == (
+            f"fpga-robotics sweep: error: c.toml: run of s.toml and run of {second} (seed 0) "
+            "are one run (the same scenario content, seed and overrides): give each run once"
+        )
+        assert captured.out == ""
+
+
 def test_two_scenario_files_of_one_name_are_an_error_naming_both(tmp_path, monkeypatch, capsys):
     from fpga_robotics.scenario.load import load_scenario
 
@@ -287,9 +408,11 @@ def test_two_scenario_files_of_one_name_are_an_error_naming_both(tmp_path, monke
         'one of them another name = "..."'
     )
     assert not (tmp_path / "out").exists()
-    # The same file twice (by name and by path) is one scenario: no error.
+    # The same file twice (by name and by path) is not two files of one name: it is each of
+    # its runs given twice.
     (tmp_path / "c.toml").write_text(GOOD.replace('["approach"]', f'["approach", "{shipped}"]'))
-    assert main(["c.toml", "--dry-run"]) == 0
+    with pytest.raises(UsageError, match=r"^c.toml: run of approach and run of .* are one run"):
+        main(["c.toml", "--dry-run"])
 
 
 #: A port nothing listens on: Dask gives up on it after its 10 s connect timeout.

@@ -2,6 +2,7 @@
 ``--set`` text of every value read back as the value itself."""
 
 import itertools
+import json
 import tomllib
 
 from hypothesis import given
@@ -97,3 +98,34 @@ seeds = "0"
         [0.9, 0.5],
         [[3.0, 2.0], [4.0, 2.0]],
     ]
+
+
+def test_an_array_of_tables_as_a_grid_axis_or_in_a_set_plans_a_run_for_each_value():
+    """Furniture (an array of tables) as a grid axis, in a set and in a known limit: each run
+    loads the furniture given (the planner crashed: a table is not hashable), and its row
+    cell is the value as JSON."""
+    from fpga_robotics.sweep.plan import make_plan
+    from fpga_robotics.sweep.report import known_limit
+    from fpga_robotics.sweep.results import make_row
+    from fpga_robotics.sweep.runner import load_run
+
+    data = tomllib.loads("""
+scenarios = ["follow_person"]
+seeds = "0"
+[grid]
+"room.furniture" = [[{center = [4.0, 1.0]}], []]
+[[sets]]
+"room.furniture" = [{center = [2.0, 4.0], size = [0.5, 0.5]}]
+[[known_limits]]
+check = "found_min_fraction"
+when = {"room.furniture" = [{center = [4.0, 1.0]}]}
+reason = "the desk hides the target"
+""")
+    campaign = load_campaign(data)
+    plan = make_plan(campaign)
+    expected = [[{"center": [4.0, 1.0]}], [], [{"center": [2.0, 4.0], "size": [0.5, 0.5]}]]
+    assert [load_run(spec.argv())[1].data["room"]["furniture"] for spec in plan.runs] == expected
+    rows = [make_row(spec, "id", "follow_person", {"status": "pass"}) for spec in plan.runs]
+    assert [json.loads(row["room.furniture"]) for row in rows] == expected
+    limits = [known_limit(row, "found_min_fraction", campaign.known_limits) for row in rows]
+    assert [entry is not None for entry in limits] == [True, False, False]

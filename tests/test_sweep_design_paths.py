@@ -58,7 +58,7 @@ def test_a_design_reference_on_a_grid_axis_is_relative_to_the_campaign_file(tree
     campaign = _campaign(
         tree,
         '[grid]\n"design.top" = ["../designs/bump_watch.py:BumpWatch", "follow_target"]\n'
-        '[[sets]]\n"design.top" = "../designs/bump_watch.py:BumpWatch"\n',
+        '[[sets]]\n"design.top" = "../designs/bump_watch.py:BumpWatch"\n"robot.mass" = 12.0\n',
     )
     tops = [dict(spec.overrides)["design.top"] for spec in campaign.runs]
     assert tops == [f"{watch}:BumpWatch", "follow_target", f"{watch}:BumpWatch"]

@@ -194,7 +194,11 @@ def _merge_options(data, args):
             )
         grid = data.get("grid") if isinstance(data.get("grid"), dict) else {}
         data["grid"] = {**grid, key.strip(): values}
-    given = {k: True for k in ("scenarios", "design", "ports") if getattr(args, k) is not None}
+    given = {
+        k: True
+        for k in ("scenarios", "duration", "resolution", "design", "ports")
+        if getattr(args, k) is not None
+    }
     grid = [item.partition("=")[0].strip() for item in args.grid]
     return {**given, "set": args.fixed or [], "grid": grid}
 

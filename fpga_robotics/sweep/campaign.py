@@ -107,6 +107,9 @@ class RunSpec:
     design: str | None = None
     ports: str | None = None
     fixed: tuple = ()  # the campaign's fixed ``set`` items (KEY=VALUE text)
+    #: How each of ``set_items()``, then the resolution and the duration, was given (the
+    #: campaign file's words or the option), for messages.
+    origins: tuple = field(default=(), compare=False)
 
     def set_items(self):
         return [*self.fixed, *(f"{k}={toml_value(v)}" for k, v in self.overrides)]
@@ -255,9 +258,36 @@ def _set_items(items, where):
     return tuple(items)
 
 
-def _combos(data):
-    """The override sets: the grid's cartesian product, then the explicit sets."""
+def _twice(values):
+    """The first value of ``values`` that an earlier one equals, else None."""
+    return next((v for i, v in enumerate(values) if v in values[:i]), None)
+
+
+def _shown_combo(combo):
+    return " ".join(f"{k}={toml_value(v)}" for k, v in combo)
+
+
+def _how_axis(key, command_line):
+    return f"--grid {key}" if key in command_line.get("grid", ()) else f"the [grid] axis {key}"
+
+
+def _how_set_item(item, command_line):
+    return (
+        f"--set {item}" if item in command_line.get("set", ()) else f"set item {toml_value(item)}"
+    )
+
+
+def _how_option(option, value, command_line):
+    """A value the campaign gives every run (``duration``, ``design``...) as it was given."""
+    return f"--{option} {value}" if command_line.get(option) else f"{option} = {toml_value(value)}"
+
+
+def _combos(data, command_line):
+    """The override sets: the grid's cartesian product, then the explicit sets, and how each
+    override of each was given. A run given twice (a value listed twice on an axis, a set
+    equal to a grid run or to another set) is an error: its rows would be merged into one."""
     combos = []
+    origins = []
     axes = []
     if "grid" in data:
         grid = data["grid"]
@@ -267,24 +297,42 @@ def _combos(data):
                 '(e.g. [grid] "design.diff_min" = [4, 6, 8]), or leave it out'
             )
         pairs = _flatten(grid, "", "grid key")
+        for key, vs in pairs:
+            twice = _twice([toml_value(v) for v in vs])
+            if twice is not None:
+                raise CampaignError(
+                    f"{_how_axis(key, command_line)} lists {twice} twice: give each value once"
+                )
         axes = [k for k, _ in pairs]
         values = [[_hashable(v) for v in vs] for _, vs in pairs]
         combos = [tuple(zip(axes, combo)) for combo in itertools.product(*values)]
+        origins = [tuple(_how_axis(k, command_line) for k in axes)] * len(combos)
     if "sets" in data:
         sets = data["sets"]
         if not isinstance(sets, list) or not sets or not all(isinstance(s, dict) for s in sets):
             raise CampaignError(
                 "sets must be a non-empty list of tables ([[sets]] with KEY = VALUE lines)"
             )
+        # A run as its overrides, in any order (a table's keys have none).
+        runs = {_run_of(combo): f"the grid run {_shown_combo(combo)}" for combo in combos}
         for i, s in enumerate(sets):
             if not s:
                 raise CampaignError(f"sets[{i}] is empty: give at least one KEY = VALUE")
             items = tuple(_flatten_values(s, ""))
+            run = _run_of(items)
+            if run in runs:
+                raise CampaignError(f"sets[{i}] repeats {runs[run]}: give each run once")
+            runs[run] = f"sets[{i}]"
+            origins.append((f"sets[{i}]",) * len(items))
             for k, _ in items:
                 if k not in axes:
                     axes.append(k)
             combos.append(items)
-    return combos or [()], axes
+    return combos or [()], origins or [()], axes
+
+
+def _run_of(combo):
+    return frozenset((k, toml_value(v)) for k, v in combo)
 
 
 def _flatten_values(table, prefix):
@@ -297,10 +345,25 @@ def _flatten_values(table, prefix):
     return out
 
 
+class _Table(dict):
+    """An inline table of an override value (a piece of furniture, a person) that can be
+    hashed, as a run's overrides must be; never changed once made. ``toml_value`` writes it
+    back as an inline table and the results as a JSON object, as a dict."""
+
+    __slots__ = ()
+
+    def __hash__(self):
+        return hash(frozenset(self.items()))
+
+
 def _hashable(value):
-    """A list value (a colour, a start position, waypoints) as tuples, all the way down: a
-    run's overrides are hashable."""
-    return tuple(_hashable(v) for v in value) if isinstance(value, list) else value
+    """A list value (a colour, a start position, waypoints) as tuples and an inline table as
+    a ``_Table``, all the way down: a run's overrides are hashable."""
+    if isinstance(value, list):
+        return tuple(_hashable(v) for v in value)
+    if isinstance(value, dict):
+        return _Table((k, _hashable(v)) for k, v in value.items())
+    return value
 
 
 #: Override keys that choose the design, which a campaign's ``design`` chooses for every run.
@@ -308,39 +371,35 @@ DESIGN_CHOICE_KEYS = ("design.top", "design.verilog")
 
 
 def _given_once(data, fixed, command_line):
-    """Refuse a value the campaign gives every run (a ``set`` item; ``design``, and with it
-    ``ports``) that the runs' overrides give too (a grid axis, a ``[[sets]]`` table, a ``set``
-    item): a run takes one of them (run's last ``--set``, its ``--design``) while its row
-    would be labelled with the other. Each is named as it was given: by its option when the
-    command line gave it, else in the file's words."""
+    """Refuse a value the campaign gives every run (a ``set`` item; its seeds, ``duration``,
+    ``resolution``; ``design``, and with it ``ports``) that the runs' overrides give too (a
+    grid axis, a ``[[sets]]`` table, a ``set`` item): a run takes one of them (run's last
+    ``--set``, its ``--seed``, ``--design``) while its row would be labelled with the other.
+    Each is named as it was given: by its option when the command line gave it, else in the
+    file's words."""
     every = {}  # key -> how the campaign gives it to every run
+    # run's --duration and --resolution are --set items of these keys, after the runs' own.
+    for key, option in (("sim.duration", "duration"), ("camera.resolution", "resolution")):
+        if data.get(option) is not None:
+            every[key] = _how_option(option, data[option], command_line)
     if data.get("design") is not None:
-        how = (
-            f"--design {data['design']}"
-            if command_line.get("design")
-            else f"design = {toml_value(data['design'])}"
-        )
+        how = _how_option("design", data["design"], command_line)
         every.update(dict.fromkeys(DESIGN_CHOICE_KEYS, how))
         if data.get("ports") is not None:  # run's --ports replaces the design's design.ports
-            every["design.ports"] = (
-                f"--ports {data['ports']}"
-                if command_line.get("ports")
-                else f"ports = {toml_value(data['ports'])}"
-            )
+            every["design.ports"] = _how_option("ports", data["ports"], command_line)
     given = []  # (key, how, varied) of each override
     for item in fixed:
-        how = (
-            f"--set {item}"
-            if item in command_line.get("set", ())
-            else f"set item {toml_value(item)}"
-        )
-        given.append((item.partition("=")[0].strip(), how, False))
+        given.append((item.partition("=")[0].strip(), _how_set_item(item, command_line), False))
     for key, _ in _flatten(data.get("grid") or {}, "", "grid key"):
-        how = f"--grid {key}" if key in command_line.get("grid", ()) else f"the [grid] axis {key}"
-        given.append((key, how, True))
+        given.append((key, _how_axis(key, command_line), True))
     for i, table in enumerate(data.get("sets") or []):
         given += [(key, f"sets[{i}]", True) for key, _ in _flatten_values(table, "")]
     for key, how, varied in given:
+        if key == "seed":  # run's --seed, which the campaign gives every run, wins
+            raise CampaignError(
+                f"{how} sets the scenario's seed, which the campaign's seeds give every run: "
+                f"list the seeds there (e.g. seeds = [1, 2], or --seeds 1,2)"
+            )
         if key in every:
             raise CampaignError(
                 f"{every[key]} gives every run its {key}, and {how} "
@@ -499,14 +558,16 @@ def load_campaign(data, *, source="", command_line=None):
     """The ``Campaign`` of a checked table (``read_campaign_file`` plus command-line
     options merged in). Scenarios and overrides are checked by ``plan.make_plan``.
     ``command_line``: what of ``data`` the command line gave, ``{"scenarios": True,
-    "design": True, "ports": True, "set": [ITEM, ...], "grid": [KEY, ...]}`` (any left
-    out), so that messages name those values by their options."""
+    "duration": True, "resolution": True, "design": True, "ports": True, "set": [ITEM, ...],
+    "grid": [KEY, ...]}`` (any left out), so that messages name those values by their
+    options."""
     where = f"{source}: " if source else ""
     command_line = command_line or {}
     try:
         name = _typed(data, "name", str, "a string") or "campaign"
         # The name makes the default results folder: a plain file name.
         name = re.sub(r"[^A-Za-z0-9_.-]", "_", name).lstrip(".-")[:64] or "campaign"
+        description = _typed(data, "description", str, "a string") or ""
         scenarios = data.get("scenarios")
         if isinstance(scenarios, str):
             scenarios = [scenarios]
@@ -518,6 +579,10 @@ def load_campaign(data, *, source="", command_line=None):
             raise CampaignError(
                 "scenarios must be a non-empty list of shipped scenario names or .toml paths"
             )
+        twice = _twice(scenarios)
+        if twice is not None:
+            how = "--scenarios" if command_line.get("scenarios") else "scenarios"
+            raise CampaignError(f"{how} lists {twice} twice: give each scenario once")
         seeds = parse_seeds(data.get("seeds", "0"))
         backend = _typed(data, "backend", str, "a backend name") or "auto"
         resolution = _typed(data, "resolution", str, '"WxH"')
@@ -528,7 +593,7 @@ def load_campaign(data, *, source="", command_line=None):
         if timeout is not None and not 0 < timeout < math.inf:
             raise CampaignError(f"timeout must be > 0 seconds, got {timeout}")
         fixed = _set_items(data.get("set", []), "set")
-        combos, axes = _combos(data)
+        combos, origins, axes = _combos(data, command_line)
         _given_once(data, fixed, command_line)
         known_limits = _known_limits(data, axes, combos, command_line.get("grid", ()))
         base = RunSpec(
@@ -548,7 +613,20 @@ def load_campaign(data, *, source="", command_line=None):
         count = len(scenarios) * len(seeds) * len(combos)
         if count > MAX_RUNS:
             raise CampaignError(f"the campaign has {count} runs; at most {MAX_RUNS}")
-        shapes = [_with_ports(replace(base, overrides=combo)) for combo in combos]
+        fixed_how = tuple(_how_set_item(item, command_line) for item in fixed)
+        options_how = tuple(
+            _how_option(option, data[option], command_line)
+            for option in ("resolution", "duration")
+            if data.get(option) is not None
+        )
+        ports_how = base.ports and _how_option("ports", base.ports, command_line)
+        shapes = [
+            _with_ports(
+                replace(base, overrides=combo, origins=(*fixed_how, *how, *options_how)),
+                ports_how,
+            )
+            for combo, how in zip(combos, origins)
+        ]
         runs = [
             replace(shape, scenario=sc, seed=seed)
             for sc in scenarios
@@ -559,7 +637,7 @@ def load_campaign(data, *, source="", command_line=None):
         raise CampaignError(f"{where}{exc}") from None
     return Campaign(
         name=name,
-        description=data.get("description", ""),
+        description=description,
         runs=runs,
         axes=axes,
         timeout=timeout,
@@ -569,11 +647,12 @@ def load_campaign(data, *, source="", command_line=None):
     )
 
 
-def _with_ports(spec):
+def _with_ports(spec, ports_how):
     """The campaign's ``ports`` go with every Verilog design of its runs: with no campaign
     ``design``, a run whose overrides make ``design.top`` a ``verilog:`` design gets them as
     ``design.ports`` (unless it sets that itself), and a run whose overrides name another
-    design, or give the scenario's own Verilog design its ``design.ports``, takes none."""
+    design, or give the scenario's own Verilog design its ``design.ports``, takes none.
+    ``ports_how``: how the campaign gave its ports (for messages)."""
     if spec.ports is None or spec.design is not None:
         return spec
     from fpga_robotics.scenario.load import _parse_value  # lazy: the run stack (~1 s)
@@ -591,7 +670,9 @@ def _with_ports(spec):
     if not (isinstance(top, str) and top.startswith("verilog:")) or "design.ports" in overrides:
         return replace(spec, ports=None)
     ports = f"design.ports={toml_value(os.path.abspath(spec.ports))}"
-    return replace(spec, ports=None, fixed=(*spec.fixed, ports))
+    n = len(spec.fixed)
+    origins = (*spec.origins[:n], ports_how, *spec.origins[n:])
+    return replace(spec, ports=None, fixed=(*spec.fixed, ports), origins=origins)
 
 
 def run_identity(spec, scenario_source, design_digest=""):

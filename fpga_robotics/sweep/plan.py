@@ -53,6 +53,7 @@ def make_plan(campaign):
     checked = {}
     digests = {}  # design key -> design_digest
     files_named = {}  # scenario name -> {resolved file: (as the campaign gives it, file)}
+    where = f"{campaign.source}: " if campaign.source else ""
     for spec in campaign.runs:
         if spec.backend not in ("auto", *BACKEND_NAMES):
             raise UsageError(
@@ -63,12 +64,15 @@ def make_plan(campaign):
             try:
                 args, scenario, shadow_params = load_run(spec.argv())
             except UsageError as exc:
-                what = " ".join(spec.set_items())
                 if isinstance(exc, PortMapUnpaired):
                     exc = _port_map_unpaired(spec, campaign.command_line) or exc
-                raise UsageError(
-                    f"run of {spec.scenario}{' with ' + what if what else ''}: {exc}"
-                ) from None
+                    raise UsageError(f"{_run_named(spec)}: {exc}") from None
+                how = _given_as(spec, str(exc))
+                if how is None:  # the scenario's own values, or its design
+                    raise UsageError(f"{_run_named(spec)}: {exc}") from None
+                # Named as given: an option, or the campaign file's words with the file.
+                file = "" if how.startswith("--") else where
+                raise UsageError(f"{file}{how}, in the {_run_named(spec)}: {exc}") from None
             # A shadow design's scenario (None: no shadow, or FollowTarget parameters).
             shadow = shadow_params if hasattr(shadow_params, "sim") else None
             # Loading depends on the backend only for a Verilog design, where auto stays:
@@ -100,10 +104,42 @@ def make_plan(campaign):
         plan.ids[spec] = run_identity(spec, scenario.source, digest)
         plan.names[spec] = scenario.name
         plan.frames[spec] = (frames, pixels)
-    where = f"{campaign.source}: " if campaign.source else ""
     _one_file_per_name(files_named, where)
+    _each_run_once(plan, where)
     _limits_name_run_scenarios(campaign, set(files_named), where)
     return plan
+
+
+def _first_values(spec, n):
+    """``spec`` with only the first ``n`` of its values, in the order run applies them: its
+    ``--set`` items, then its resolution, then its duration."""
+    options = [o for o in ("resolution", "duration") if getattr(spec, o) is not None]
+    past_items = max(0, n - len(spec.fixed) - len(spec.overrides))
+    return replace(
+        spec,
+        fixed=spec.fixed[:n],
+        overrides=spec.overrides[: max(0, n - len(spec.fixed))],
+        **dict.fromkeys(options[past_items:]),
+    )
+
+
+def _given_as(spec, message):
+    """How the value a run fails to load with was given (``spec.origins``): the first value
+    with which the run, loaded with the values up to it, fails with ``message``; None when it
+    fails so with none of them (its scenario, its design)."""
+    for n in range(len(spec.origins) + 1):
+        try:
+            load_run(_first_values(spec, n).argv())
+        except UsageError as exc:
+            if str(exc) == message:
+                return spec.origins[n - 1] if n else None
+    return None
+
+
+def _run_named(spec):
+    """A run in a message: its scenario as the campaign gives it, and its overrides."""
+    what = " ".join(spec.set_items())
+    return f"run of {spec.scenario}{' with ' + what if what else ''}"
 
 
 def _port_map_unpaired(spec, command_line):
@@ -139,6 +175,19 @@ def _one_file_per_name(files_named, where):
                 f"{where}scenarios {_shown(a, sa)} and {_shown(b, sb)} are two files with the "
                 f"same name {name!r} (results are grouped by name): give one of them another "
                 f'name = "..."'
+            )
+
+
+def _each_run_once(plan, where):
+    """Rows go by a run's identity: one scenario file given by two paths (or two copies of
+    it) would make one row of two runs."""
+    spec_of_identity = {}
+    for spec in plan.runs:
+        twin = spec_of_identity.setdefault(plan.ids[spec], spec)
+        if twin is not spec:
+            raise UsageError(
+                f"{where}{_run_named(twin)} and {_run_named(spec)} (seed {spec.seed}) are one "
+                f"run (the same scenario content, seed and overrides): give each run once"
             )
 
 
