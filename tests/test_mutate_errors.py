@@ -158,10 +158,7 @@ def test_a_campaign_resolution_is_the_one_its_runs_take(tmp_path):
     from fpga_robotics.sweep import load_campaign_file
 
     campaign = tmp_path / "c.toml"
-    campaign.write_text(
-        'scenarios = ["follow_person"]\nseeds = "0"\nresolution = "80x60"\n'
-        'set = ["camera.resolution=[80, 60]"]\n'
-    )
+    campaign.write_text('scenarios = ["follow_person"]\nseeds = "0"\nresolution = "80x60"\n')
     plan = check_campaign(load_campaign_file(str(campaign)), "80x60")  # the netlist's: kept
     (argv,) = [spec.argv() for spec in plan.runs]
     # FollowTarget's netlist sets the resolution; a design of one's own runs at the campaign's.
