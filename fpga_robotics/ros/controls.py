@@ -18,6 +18,7 @@ import time
 from fpga_robotics.hw.errors import UsageError
 
 from ..hw.pixel import COLOR_SELECT, color_select_value
+from ..sim.world.world import MAX_TARGET_SPEED
 
 __all__ = [
     "INPUT_KINDS",
@@ -35,8 +36,8 @@ TELEOP_SPEED = 0.5
 #: What an input can be: kind -> what its value is.
 INPUT_KINDS = {
     "color": "a colour select name (" + ", ".join(COLOR_SELECT) + ")",
-    "target_velocity": "[vx, vy] m/s in the world frame, or null to hand the target back "
-    "to its script",
+    "target_velocity": f"[vx, vy] m/s in the world frame (at most {MAX_TARGET_SPEED:g} m/s), "
+    "or null to hand the target back to its script",
     "pause": "null",
     "resume": "null",
     "step": "null",
@@ -62,8 +63,10 @@ def check_input(kind, value):
         if not isinstance(value, (list, tuple)) or len(value) != 2:
             raise ValueError(f"target_velocity must be [vx, vy] or null, got {value!r}")
         vx, vy = (float(v) for v in value)
-        if not (math.isfinite(vx) and math.isfinite(vy)):
-            raise ValueError(f"target_velocity must be finite, got {value!r}")
+        if not math.hypot(vx, vy) <= MAX_TARGET_SPEED:  # NaN fails too
+            raise ValueError(
+                f"target_velocity must be at most {MAX_TARGET_SPEED:g} m/s fast, got {value!r}"
+            )
         return kind, [vx, vy]
     if kind == "speed":
         speed = float(value)
