@@ -311,6 +311,49 @@ def test_an_encoding_not_read_after_the_first_image_is_refused_before_anything_i
     assert len(run_bag(f"bag:{bag}", tmp_path, "--max-frames", "4")) == 4
 
 
+@pytest.mark.parametrize("empty_frame, encoding", [(1, "rgb8"), (0, "bgr8")])
+def test_an_image_without_pixels_is_refused_before_anything_is_written(
+    empty_frame, encoding, tmp_path, capsys
+):
+    bag = tmp_path / "zero"
+    with Writer2(bag, version=9, storage_plugin=StoragePlugin.MCAP) as writer:
+        conn = writer.add_connection("/camera/image_raw", "sensor_msgs/msg/Image", typestore=ROS2)
+        for k, rgb in enumerate(frames()[:3]):
+            _, msg = image_msg(ROS2, rgb, k, encoding)
+            if k == empty_frame:  # a driver's 0x0 placeholder for a dropped frame
+                msg.height = msg.width = msg.step = 0
+                msg.data = np.zeros(0, np.uint8)
+            writer.write(
+                conn, T0_NS + k * PERIOD_NS, ROS2.serialize_cdr(msg, "sensor_msgs/msg/Image")
+            )
+    out = tmp_path / "out"
+    out.mkdir()
+    with pytest.raises(SystemExit) as info:
+        run_cli(
+            run_main,
+            [
+                "--source",
+                f"bag:{bag}",
+                "--backend",
+                "model",
+                "--resolution",
+                f"{W}x{H}",
+                "--quiet",
+                "--rerun",
+                f"save:{out / 'r.rrd'}",
+                "--summary",
+                str(out / "s.json"),
+                "--bag",
+                str(out / "b"),
+            ],
+        )
+    err = capsys.readouterr().err
+    assert info.value.code == 2
+    assert f"frame {empty_frame}: a 0x0 image holds no pixels" in err
+    assert "Traceback" not in err
+    assert list(out.iterdir()) == []  # nothing written
+
+
 def test_a_compressed_image_that_does_not_decode_ends_the_run_naming_its_frame(tmp_path, capsys):
     images = frames()
     bag = tmp_path / "damaged"
