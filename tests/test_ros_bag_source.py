@@ -239,6 +239,32 @@ def test_bad_bags_are_usage_errors(tmp_path):
     assert Path(bag).is_dir()
 
 
+@pytest.mark.parametrize(
+    "storage", [StoragePlugin.MCAP, StoragePlugin.SQLITE3], ids=["mcap", "db3"]
+)
+def test_a_bags_file_is_read_alone_not_its_folder(storage, tmp_path):
+    images = frames()
+    bag = tmp_path / "b"
+    with Writer2(bag, version=9, storage_plugin=storage) as writer:
+        conn = writer.add_connection("/camera/image_raw", "sensor_msgs/msg/Image", typestore=ROS2)
+        for k, rgb in enumerate(images):
+            _, msg = image_msg(ROS2, rgb, k, "rgb8")
+            writer.write(
+                conn, T0_NS + k * PERIOD_NS, ROS2.serialize_cdr(msg, "sensor_msgs/msg/Image")
+            )
+    (data,) = [f for f in bag.iterdir() if f.name != "metadata.yaml"]
+    # Copied out alone (no metadata.yaml beside it), and beside another bag's metadata.
+    lone = tmp_path / "lone" / f"robot{data.suffix}"
+    lone.parent.mkdir()
+    lone.write_bytes(data.read_bytes())
+    write_bag(tmp_path / "other", images[:2], "rgb8")
+    mixed = tmp_path / "other" / f"mine{data.suffix}"
+    mixed.write_bytes(data.read_bytes())
+    expected = model_outputs(images)
+    assert run_bag(f"bag:{lone}", tmp_path) == expected
+    assert run_bag(f"bag:{mixed}", tmp_path) == expected  # 6 frames, not the folder's 2
+
+
 def test_the_recordings_commanded_twist_is_the_bags_cmd_vel(tmp_path):
     from fpga_robotics.viz.readback import read_rrd  # lazy: rerun, for this test only
 

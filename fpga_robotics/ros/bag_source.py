@@ -115,8 +115,9 @@ class BagSource:
                 f"--source {self.spec!r}: no such bag (give a ROS 2 bag folder, "
                 f"its .mcap/.db3 file, or a ROS 1 .bag file)"
             )
-        if path.is_file() and path.suffix in (".mcap", ".db3"):
-            path = path.parent  # a ROS 2 bag is its folder
+        # A ROS 2 bag's .mcap/.db3 file is read alone (it holds its own topics and types), not
+        # with its folder: a copied-out file has no metadata.yaml, and the folder may hold
+        # another bag.
         try:
             self._reader = AnyReader([path], default_typestore=get_typestore(Stores.ROS2_HUMBLE))
             self._reader.open()
