@@ -297,6 +297,37 @@ def test_replayed_inputs_give_the_same_run(tmp_path):
     assert "inputs" not in plain
 
 
+def test_a_replay_onto_another_run_or_past_its_end_is_said(tmp_path, capsys):
+    """Inputs replayed onto another scenario, seed or overrides than the run they steered
+    are a warning naming both; inputs at frames the run never reaches are counted."""
+    inputs = [
+        {"frame": 2, "kind": "color", "value": "green"},
+        {"frame": 9, "kind": "color", "value": "red"},
+        {"frame": 40, "kind": "color", "value": "blue"},
+    ]
+    (tmp_path / "inputs.json").write_text(json.dumps(inputs))
+    base = ["--backend", "model", "--resolution", "80x60", "--rerun", "off", "--quiet"]
+    steered = str(tmp_path / "steered.json")
+    replay = ["--replay-inputs", str(tmp_path / "inputs.json")]
+    assert run_main(base + ["--duration", "0.3", "--summary", steered] + replay) in (0, 1)
+    out, err = capsys.readouterr()
+    assert "warning" not in err  # a bare list says nothing of the run it steered
+    assert "--replay-inputs: 2 input(s) after the run's last frame 8 were not applied" in out
+    assert run_main(base + ["--duration", "0.3", "--replay-inputs", steered]) in (0, 1)
+    out, err = capsys.readouterr()
+    assert "warning" not in err and "not applied" not in out  # the same run: only frame 2
+    assert run_main(base + ["--duration", "0.2", "--seed", "4", "--replay-inputs", steered]) in (
+        0,
+        1,
+    )
+    out, err = capsys.readouterr()
+    assert (
+        f"warning: --replay-inputs {steered!r} was steered on follow_person (seed 0, --set "
+        f'camera.resolution="80x60", --set sim.duration=0.3); this run is follow_person '
+        f'(seed 4, --set camera.resolution="80x60", --set sim.duration=0.2)'
+    ) in err
+
+
 @pytest.mark.parametrize(
     "topic, schema, fields, expected",
     [

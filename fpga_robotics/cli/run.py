@@ -1012,6 +1012,9 @@ def main(argv=None, prog="fpga-robotics run"):
         return _run_source(args, scenario, ros)
     if args.max_frames is not None:
         raise UsageError("--max-frames only applies with --source (use --duration)")
+    replay_warning = ros.replay_warning(scenario, args.seed)
+    if replay_warning is not None:
+        print(replay_warning, file=sys.stderr)
     shadow_scenario, params_scenario = shadow_designs(args, scenario)
     shadow_args = None if shadow_scenario is None else _shadow_args(args, shadow_scenario)
     if shadow_scenario is not None and args.shadow_backend == "model":

@@ -28,6 +28,7 @@ __all__ = [
     "apply_inputs",
     "check_input",
     "load_inputs",
+    "replay_mismatch",
 ]
 
 #: Speed of the target person driven by the terminal's arrows and the layout's teleop pad, m/s.
@@ -194,23 +195,55 @@ class ReplayControls:
 
     def __init__(self, inputs):
         self.log = []
+        self.last_frame = None  # the last frame the run reached
         self._by_frame = {}
         for item in inputs:
             self._by_frame.setdefault(item["frame"], []).append((item["kind"], item["value"]))
 
     def inputs_for(self, frame, t):
+        self.last_frame = frame
         inputs = self._by_frame.get(frame, [])
         for kind, value in inputs:
             self.log.append({"frame": frame, "t": round(t, 6), "kind": kind, "value": value})
         return inputs
 
+    def unreached(self):
+        """How many inputs are at frames after the last one the run reached."""
+        last = -1 if self.last_frame is None else self.last_frame
+        return sum(len(inputs) for frame, inputs in self._by_frame.items() if frame > last)
+
     def close(self):
         pass
 
 
+#: What a summary says of its run that decides where its inputs act.
+_STEERED_RUN = ("scenario", "seed", "overrides")
+
+
+def replay_mismatch(path, steered, scenario, seed, overrides):
+    """The warning for replaying the inputs of the run ``steered`` (the summary's
+    ``_STEERED_RUN`` items, or None for a bare list) onto another run, or None."""
+    if steered is None:
+        return None
+    this = {"scenario": scenario, "seed": seed, "overrides": list(overrides)}
+    if all(steered.get(key) == this[key] for key in _STEERED_RUN):
+        return None
+
+    def run(items):
+        sets = "".join(f", --set {o}" for o in items.get("overrides") or ())
+        return f"{items.get('scenario')} (seed {items.get('seed')}{sets})"
+
+    return (
+        f"warning: --replay-inputs {str(path)!r} was steered on {run(steered)}; this run is "
+        f"{run(this)}, so its inputs act on another run"
+    )
+
+
 def load_inputs(path):
-    """The inputs recorded in ``path``: a run's summary JSON (its ``inputs``) or a JSON list of
-    ``{"frame", "kind", "value"}``; ``UsageError`` naming what is wrong."""
+    """``(inputs, steered)``: the inputs recorded in ``path``, a run's summary JSON (its
+    ``inputs``) or a JSON list of ``{"frame", "kind", "value"}``, and for a summary the run
+    they steered (its ``scenario``, ``seed`` and ``overrides``; None for a list);
+    ``UsageError`` naming what is wrong."""
     what = f"--replay-inputs {str(path)!r}"
     try:
         with open(path) as f:
@@ -221,7 +254,9 @@ def load_inputs(path):
         ) from None
     except (OSError, ValueError) as exc:
         raise UsageError(f"{what}: not readable JSON ({exc})") from None
+    steered = None
     if isinstance(data, dict):
+        steered = {key: data[key] for key in _STEERED_RUN if key in data} or None
         if "inputs" not in data:
             raise UsageError(
                 f"{what}: the summary has no 'inputs' (it was not a run with "
@@ -242,4 +277,4 @@ def load_inputs(path):
         except (ValueError, TypeError) as exc:
             raise UsageError(f"{what}: input {i}: {exc}") from None
         out.append({"frame": frame, "kind": kind, "value": value})
-    return out
+    return out, steered

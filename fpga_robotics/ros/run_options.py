@@ -8,7 +8,7 @@ writer, the Foxglove server and the controls; ``on_frame`` is the per-frame call
 
 from fpga_robotics.hw.errors import UsageError
 
-from .controls import LiveControls, ReplayControls, load_inputs
+from .controls import LiveControls, ReplayControls, load_inputs, replay_mismatch
 from .interactive import TerminalControls, check_terminal
 
 __all__ = ["RosOutputs", "add_ros_arguments"]
@@ -70,7 +70,8 @@ class RosOutputs:
                     "--live or --interactive"
                 )
 
-            self.replay = load_inputs(args.replay_inputs)
+            self.replay, self._steered = load_inputs(args.replay_inputs)
+            self._replay_path = args.replay_inputs
         if self.interactive:
             check_terminal()
         self.live_control = self.port is not None or self.interactive
@@ -87,6 +88,19 @@ class RosOutputs:
             raise UsageError("--interactive controls the closed loop (not with --source)")
         if self.replay is not None:
             raise UsageError("--replay-inputs replays a closed-loop run (not with --source)")
+
+    def replay_warning(self, scenario, seed):
+        """The warning when ``--replay-inputs`` replays a summary's inputs onto a run with
+        another scenario, seed or overrides (``seed`` None: the scenario's), or None."""
+        if self.replay is None:
+            return None
+        return replay_mismatch(
+            self._replay_path,
+            self._steered,
+            scenario.name,
+            scenario.seed if seed is None else seed,
+            scenario.overrides,
+        )
 
     @property
     def active(self):
@@ -152,6 +166,12 @@ class RosOutputs:
                     f"{len(self.controls.log)} live input(s) applied; the "
                     f"summary's 'inputs' replay them (--summary PATH, then "
                     f"--replay-inputs PATH)"
+                )
+            unreached = self.controls.unreached() if self.replay is not None else 0
+            if completed and unreached:
+                notices.append(
+                    f"--replay-inputs: {unreached} input(s) after the run's last frame "
+                    f"{self.controls.last_frame} were not applied"
                 )
         for sink in self._sinks:
             if sink is self._bag and not completed:
