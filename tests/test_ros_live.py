@@ -328,6 +328,35 @@ def test_a_replay_onto_another_run_or_past_its_end_is_said(tmp_path, capsys):
     ) in err
 
 
+def test_time_held_paused_is_not_the_runs_speed():
+    """A run held paused (``--paused``, a client's ``/sim/pause``) reports its speed without
+    the pause, and the pause beside it."""
+    from fpga_robotics.checks.summary import format_summary
+    from fpga_robotics.loop.timings import run_scenario
+    from fpga_robotics.ros.controls import LiveControls
+    from fpga_robotics.scenario.load import load_scenario
+
+    hold = 1.5
+
+    class HeldControls(LiveControls):
+        """Paused at the first frame; resumed ``hold`` seconds later."""
+
+        def inputs_for(self, frame, t):
+            if frame == 0:
+                threading.Timer(hold, self.submit, ("resume",)).start()
+            return super().inputs_for(frame, t)
+
+    controls = HeldControls(speed=None, paused=True)
+    scenario = load_scenario("follow_person", ['camera.resolution="80x60"', "sim.duration=0.1"])
+    result = run_scenario(scenario, backend="model", controls=controls)
+    assert controls.paused_s >= hold
+    summary = result.summary
+    assert summary["wall_time_s"] < hold  # three frames of the model, not the pause
+    assert summary["realtime_factor"] > 0.1 / hold
+    line = format_summary({**summary, "paused_s": round(controls.paused_s, 3)}).splitlines()[1]
+    assert f"paused {controls.paused_s:.1f} s besides" in line
+
+
 @pytest.mark.parametrize(
     "topic, schema, fields, expected",
     [

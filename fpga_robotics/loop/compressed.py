@@ -479,7 +479,8 @@ class ClosedLoop:
             self.traj = {name: a[: self.frames_done] for name, a in self.traj.items()}
         for name in self.absent:
             self.traj[name] = np.full(len(self.traj[name]), np.nan)
-        wall = time.perf_counter() - wall_start
+        # The time a user held the run paused (live controls) is not the run's speed.
+        wall = time.perf_counter() - wall_start - getattr(self.controls, "paused_s", 0.0)
         cpu = time.process_time() - cpu_start
         return RunResult(
             summary=self.summarise(wall, cpu), trajectory=self.traj, events=self.events

@@ -130,6 +130,8 @@ class LiveControls:
         self._steps = 0
         self._closed = False
         self._anchor = None  # (wall, sim) the pacing counts from
+        #: Wall time the run was held paused, s: the user's, not the machine's speed.
+        self.paused_s = 0.0
 
     @property
     def paused(self):
@@ -160,12 +162,15 @@ class LiveControls:
         frame per ``step``) and paces to ``speed``."""
         with self._cond:
             waited = False
+            held_from = time.perf_counter()
             while self._paused and not self._closed:
                 if self._steps > 0:
                     self._steps -= 1
                     break
                 waited = True
                 self._cond.wait(0.1)
+            if waited:
+                self.paused_s += time.perf_counter() - held_from
             # What came while paused acts on the frame that goes on (a colour, then a step).
             inputs, self._queue = self._queue, []
         for kind, value in inputs:
@@ -195,6 +200,7 @@ class ReplayControls:
 
     def __init__(self, inputs):
         self.log = []
+        self.paused_s = 0.0  # a replay never waits
         self.last_frame = None  # the last frame the run reached
         self._by_frame = {}
         for item in inputs:

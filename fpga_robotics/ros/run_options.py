@@ -146,9 +146,12 @@ class RosOutputs:
             sink.log_frame(record)
 
     def summary_items(self):
-        """``{"inputs": [...]}`` when the run had live or replayed inputs, and with a live
-        server that took client messages, ``"refused_inputs"``: those it could not use."""
+        """``{"inputs": [...]}`` when the run had live or replayed inputs (with live ones
+        ``"paused_s"``, the wall time it was held paused), and with a live server that took
+        client messages, ``"refused_inputs"``: those it could not use."""
         items = {} if self.controls is None else {"inputs": list(self.controls.log)}
+        if isinstance(self.controls, LiveControls):
+            items["paused_s"] = round(self.controls.paused_s, 3)
         if self._live is not None and self._live.controls is not None:
             items["refused_inputs"] = self._live.refused_inputs()
         return items
