@@ -921,7 +921,9 @@ def _run_source(args, scenario, ros):
             f"{scenario.top!r}, sensors on pins): run it without --source"
         )
     params = scenario.params
-    source = open_source(args.source, params.width, params.height, args.max_frames)
+    source = open_source(
+        args.source, params.width, params.height, args.max_frames, fps=scenario.camera.fps
+    )
     try:
         design = _open_design(args, scenario)
         recorder = None
