@@ -913,7 +913,7 @@ def _list_scenarios():
 
 
 def _run_source(args, scenario, ros):
-    ros.check_closed_loop_only()
+    ros.check_closed_loop_only(args.source)
     if scenario.sim.timing == "real_clock":
         raise UsageError(
             f"--source feeds camera frames to the design; scenario "

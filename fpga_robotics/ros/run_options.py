@@ -82,12 +82,22 @@ class RosOutputs:
         self._sinks = []  # bag writer, live publisher: each has log_frame and close
         self._bag = self._terminal = self._live = None
 
-    def check_closed_loop_only(self):
-        """With ``--source`` (no simulation) there is nothing to control."""
+    def check_closed_loop_only(self, source):
+        """With ``--source SPEC`` (no simulation) there is nothing to control, and only a
+        camera's frames come at the pace of real time."""
         if self.interactive:
             raise UsageError("--interactive controls the closed loop (not with --source)")
         if self.replay is not None:
             raise UsageError("--replay-inputs replays a closed-loop run (not with --source)")
+        if self.start_paused:
+            raise UsageError("--paused pauses the closed loop (not with --source)")
+        if self.port is not None and not str(source).startswith("camera:"):
+            # A file is read as fast as the design goes: done before a client could connect.
+            raise UsageError(
+                "--live streams a run as it goes; with --source only a camera (camera:N) "
+                "does: write the outputs of a video, folder or bag with --bag and open "
+                "that in Foxglove"
+            )
 
     def replay_warning(self, scenario, seed):
         """The warning when ``--replay-inputs`` replays a summary's inputs onto a run with
