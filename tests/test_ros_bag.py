@@ -114,6 +114,8 @@ def test_images_are_the_frames_the_design_saw(recorded):
 
 
 def test_design_outputs_and_twist_from_the_dps(recorded):
+    """The outputs and the twist they command, on the bag's topics and in the frame records
+    the viewer logs."""
     scenario, _, records, messages, _ = recorded
     spec = parse_world_config(scenario.world).robot.spec
     r_wheel, sep = spec.wheel_radius, spec.wheel_separation
@@ -129,8 +131,11 @@ def test_design_outputs_and_twist_from_the_dps(recorded):
         wl, wr = math.radians(res.motor_left), math.radians(res.motor_right)
         assert twist.linear.x == pytest.approx(r_wheel * (wl + wr) / 2, abs=1e-12)
         assert twist.angular.z == pytest.approx(r_wheel * (wr - wl) / sep, abs=1e-12)
+        # The viewer's commanded twist is the same frame's (not the command in force).
+        assert (r.cmd_v, r.cmd_w) == (twist.linear.x, twist.angular.z)
         moving += twist.linear.x != 0
     assert moving > 0
+    assert records[0].cmd_v != 0  # the first frame's command, before it acts
 
 
 def test_odometry_tf_and_people(recorded):
