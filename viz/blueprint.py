@@ -34,6 +34,7 @@ def _trail_range():
 _CAMERA_NAMES = {
     "rgb444": "Camera (RGB444, as the design receives it)",
     "rgb888": "Camera (RGB888)",
+    None: "Camera (filming the run; not a design input)",
 }
 
 
@@ -47,7 +48,8 @@ def default_blueprint(
     cameras=(),
 ):
     """The layout sent to the viewer; ``bounds`` ``(xmin, ymin, xmax, ymax)`` frame the map;
-    ``camera`` (``rgb444`` or ``rgb888``, how the camera frame is recorded) names its view;
+    ``camera`` (``rgb444`` or ``rgb888``, how the camera frame is recorded, or None: the
+    design takes no camera, which only films the run) names its view;
     ``shadow`` adds a second LED row and the shadow design's wheel speeds; ``world3d`` puts
     the world in 3D (``viz.world3d``) beside the map; ``sensors`` (series entity paths,
     ``viz.sensors``) come first among the plots under the map, one tab each; ``cameras``
