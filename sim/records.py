@@ -76,6 +76,9 @@ class FrameRecord:
     # Further cameras ([[robot.sensors]] kind = "camera"): {name: CameraView}, each its
     # latest capture at this frame's instant.
     cameras: dict = field(default_factory=dict)
+    # Whether the design takes the camera's frames (False: a design without a camera port,
+    # the camera only films the run for the viewer).
+    camera_input: bool = True
 
 
 @dataclass(frozen=True)

@@ -222,6 +222,12 @@ CASES = [
         "does not go with",
     ),
     ("interactive with source", ["run", "--source", "{frames}", "--interactive"], "--interactive"),
+    ("live with a file source", ["run", "--source", "{frames}", "--live", "foxglove:0"], "camera"),
+    (
+        "paused with source",
+        ["run", "--source", "{frames}", "--live", "foxglove:0", "--paused"],
+        "--paused",
+    ),
     ("paused alone", ["run", "--paused"], "--paused"),
     ("bag out where nothing can be written", ["run", "--bag", "/proc/bag"], "cannot write"),
     ("interactive without a terminal", ["run", "--interactive"], "needs a terminal"),

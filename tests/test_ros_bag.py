@@ -88,8 +88,9 @@ def test_stamps_are_sim_time_and_monotonic(recorded):
     assert all(b > a for a, b in itertools.pairwise(expected))
     for topic, items in messages.items():
         assert [stamp for stamp, _ in items] == expected, topic
-    for _, msg in messages["/camera/image_raw"]:
-        assert msg.header.frame_id == "camera_link"
+    for topic in ("/camera/image_raw", "/camera/camera_info", "/fpga/filtered/image"):
+        for _, msg in messages[topic]:
+            assert msg.header.frame_id == "camera_optical_link", topic
     clock = [m.clock.sec * 10**9 + m.clock.nanosec for _, m in messages["/clock"]]
     assert clock == expected
     # frame k is captured at k / fps
@@ -114,6 +115,8 @@ def test_images_are_the_frames_the_design_saw(recorded):
 
 
 def test_design_outputs_and_twist_from_the_dps(recorded):
+    """The outputs and the twist they command, on the bag's topics and in the frame records
+    the viewer logs."""
     scenario, _, records, messages, _ = recorded
     spec = parse_world_config(scenario.world).robot.spec
     r_wheel, sep = spec.wheel_radius, spec.wheel_separation
@@ -129,8 +132,11 @@ def test_design_outputs_and_twist_from_the_dps(recorded):
         wl, wr = math.radians(res.motor_left), math.radians(res.motor_right)
         assert twist.linear.x == pytest.approx(r_wheel * (wl + wr) / 2, abs=1e-12)
         assert twist.angular.z == pytest.approx(r_wheel * (wr - wl) / sep, abs=1e-12)
+        # The viewer's commanded twist is the same frame's (not the command in force).
+        assert (r.cmd_v, r.cmd_w) == (twist.linear.x, twist.angular.z)
         moving += twist.linear.x != 0
     assert moving > 0
+    assert records[0].cmd_v != 0  # the first frame's command, before it acts
 
 
 def test_odometry_tf_and_people(recorded):
@@ -147,6 +153,7 @@ def test_odometry_tf_and_people(recorded):
         assert [(t.header.frame_id, t.child_frame_id) for t in tf] == [
             ("odom", "base_link"),
             ("base_link", "camera_link"),
+            ("camera_link", "camera_optical_link"),
         ]
         assert tf[1].transform.translation.x == pytest.approx(spec.camera_forward)
         assert tf[1].transform.translation.z == pytest.approx(spec.camera_height)
@@ -255,3 +262,24 @@ def test_camera_link_is_tilted_as_the_camera():
     # x axis rotated by q = (x, y, z, w): first column of the rotation matrix.
     forward = (1 - 2 * (q.y**2 + q.z**2), 2 * (q.x * q.y + q.w * q.z), 2 * (q.x * q.z - q.w * q.y))
     assert forward == pytest.approx((math.cos(tilt), 0.0, math.sin(tilt)))
+
+
+def test_images_are_in_the_cameras_optical_frame(recorded):
+    """REP 103's optical frame under camera_link: x right (-y of the link), y down (-z),
+    z into the image (+x, the camera's forward), so that CameraInfo projects ahead."""
+    messages = recorded[3]
+    for _, msg in messages["/tf"]:
+        (optical,) = [t for t in msg.transforms if t.child_frame_id == "camera_optical_link"]
+        assert optical.header.frame_id == "camera_link"
+        q = optical.transform.rotation
+        x, y, z, w = q.x, q.y, q.z, q.w
+        columns = [  # the optical axes in camera_link: the rotation matrix's columns
+            (1 - 2 * (y * y + z * z), 2 * (x * y + w * z), 2 * (x * z - w * y)),
+            (2 * (x * y - w * z), 1 - 2 * (x * x + z * z), 2 * (y * z + w * x)),
+            (2 * (x * z + w * y), 2 * (y * z - w * x), 1 - 2 * (x * x + y * y)),
+        ]
+        assert columns == [
+            pytest.approx((0.0, -1.0, 0.0)),
+            pytest.approx((0.0, 0.0, -1.0)),
+            pytest.approx((1.0, 0.0, 0.0)),
+        ]

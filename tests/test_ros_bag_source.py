@@ -239,6 +239,32 @@ def test_bad_bags_are_usage_errors(tmp_path):
     assert Path(bag).is_dir()
 
 
+@pytest.mark.parametrize(
+    "storage", [StoragePlugin.MCAP, StoragePlugin.SQLITE3], ids=["mcap", "db3"]
+)
+def test_a_bags_file_is_read_alone_not_its_folder(storage, tmp_path):
+    images = frames()
+    bag = tmp_path / "b"
+    with Writer2(bag, version=9, storage_plugin=storage) as writer:
+        conn = writer.add_connection("/camera/image_raw", "sensor_msgs/msg/Image", typestore=ROS2)
+        for k, rgb in enumerate(images):
+            _, msg = image_msg(ROS2, rgb, k, "rgb8")
+            writer.write(
+                conn, T0_NS + k * PERIOD_NS, ROS2.serialize_cdr(msg, "sensor_msgs/msg/Image")
+            )
+    (data,) = [f for f in bag.iterdir() if f.name != "metadata.yaml"]
+    # Copied out alone (no metadata.yaml beside it), and beside another bag's metadata.
+    lone = tmp_path / "lone" / f"robot{data.suffix}"
+    lone.parent.mkdir()
+    lone.write_bytes(data.read_bytes())
+    write_bag(tmp_path / "other", images[:2], "rgb8")
+    mixed = tmp_path / "other" / f"mine{data.suffix}"
+    mixed.write_bytes(data.read_bytes())
+    expected = model_outputs(images)
+    assert run_bag(f"bag:{lone}", tmp_path) == expected
+    assert run_bag(f"bag:{mixed}", tmp_path) == expected  # 6 frames, not the folder's 2
+
+
 def test_the_recordings_commanded_twist_is_the_bags_cmd_vel(tmp_path):
     from fpga_robotics.viz.readback import read_rrd  # lazy: rerun, for this test only
 
@@ -309,6 +335,49 @@ def test_an_encoding_not_read_after_the_first_image_is_refused_before_anything_i
     assert list(out.iterdir()) == []  # nothing written
     # The frames before it run.
     assert len(run_bag(f"bag:{bag}", tmp_path, "--max-frames", "4")) == 4
+
+
+@pytest.mark.parametrize("empty_frame, encoding", [(1, "rgb8"), (0, "bgr8")])
+def test_an_image_without_pixels_is_refused_before_anything_is_written(
+    empty_frame, encoding, tmp_path, capsys
+):
+    bag = tmp_path / "zero"
+    with Writer2(bag, version=9, storage_plugin=StoragePlugin.MCAP) as writer:
+        conn = writer.add_connection("/camera/image_raw", "sensor_msgs/msg/Image", typestore=ROS2)
+        for k, rgb in enumerate(frames()[:3]):
+            _, msg = image_msg(ROS2, rgb, k, encoding)
+            if k == empty_frame:  # a driver's 0x0 placeholder for a dropped frame
+                msg.height = msg.width = msg.step = 0
+                msg.data = np.zeros(0, np.uint8)
+            writer.write(
+                conn, T0_NS + k * PERIOD_NS, ROS2.serialize_cdr(msg, "sensor_msgs/msg/Image")
+            )
+    out = tmp_path / "out"
+    out.mkdir()
+    with pytest.raises(SystemExit) as info:
+        run_cli(
+            run_main,
+            [
+                "--source",
+                f"bag:{bag}",
+                "--backend",
+                "model",
+                "--resolution",
+                f"{W}x{H}",
+                "--quiet",
+                "--rerun",
+                f"save:{out / 'r.rrd'}",
+                "--summary",
+                str(out / "s.json"),
+                "--bag",
+                str(out / "b"),
+            ],
+        )
+    err = capsys.readouterr().err
+    assert info.value.code == 2
+    assert f"frame {empty_frame}: a 0x0 image holds no pixels" in err
+    assert "Traceback" not in err
+    assert list(out.iterdir()) == []  # nothing written
 
 
 def test_a_compressed_image_that_does_not_decode_ends_the_run_naming_its_frame(tmp_path, capsys):

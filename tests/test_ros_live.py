@@ -297,6 +297,66 @@ def test_replayed_inputs_give_the_same_run(tmp_path):
     assert "inputs" not in plain
 
 
+def test_a_replay_onto_another_run_or_past_its_end_is_said(tmp_path, capsys):
+    """Inputs replayed onto another scenario, seed or overrides than the run they steered
+    are a warning naming both; inputs at frames the run never reaches are counted."""
+    inputs = [
+        {"frame": 2, "kind": "color", "value": "green"},
+        {"frame": 9, "kind": "color", "value": "red"},
+        {"frame": 40, "kind": "color", "value": "blue"},
+    ]
+    (tmp_path / "inputs.json").write_text(json.dumps(inputs))
+    base = ["--backend", "model", "--resolution", "80x60", "--rerun", "off", "--quiet"]
+    steered = str(tmp_path / "steered.json")
+    replay = ["--replay-inputs", str(tmp_path / "inputs.json")]
+    assert run_main(base + ["--duration", "0.3", "--summary", steered] + replay) in (0, 1)
+    out, err = capsys.readouterr()
+    assert "warning" not in err  # a bare list says nothing of the run it steered
+    assert "--replay-inputs: 2 input(s) after the run's last frame 8 were not applied" in out
+    assert run_main(base + ["--duration", "0.3", "--replay-inputs", steered]) in (0, 1)
+    out, err = capsys.readouterr()
+    assert "warning" not in err and "not applied" not in out  # the same run: only frame 2
+    assert run_main(base + ["--duration", "0.2", "--seed", "4", "--replay-inputs", steered]) in (
+        0,
+        1,
+    )
+    out, err = capsys.readouterr()
+    assert (
+        f"warning: --replay-inputs {steered!r} was steered on follow_person (seed 0, --set "
+        f'camera.resolution="80x60", --set sim.duration=0.3); this run is follow_person '
+        f'(seed 4, --set camera.resolution="80x60", --set sim.duration=0.2)'
+    ) in err
+
+
+def test_time_held_paused_is_not_the_runs_speed():
+    """A run held paused (``--paused``, a client's ``/sim/pause``) reports its speed without
+    the pause, and the pause beside it."""
+    from fpga_robotics.checks.summary import format_summary
+    from fpga_robotics.loop.timings import run_scenario
+    from fpga_robotics.ros.controls import LiveControls
+    from fpga_robotics.scenario.load import load_scenario
+
+    hold = 1.5
+
+    class HeldControls(LiveControls):
+        """Paused at the first frame; resumed ``hold`` seconds later."""
+
+        def inputs_for(self, frame, t):
+            if frame == 0:
+                threading.Timer(hold, self.submit, ("resume",)).start()
+            return super().inputs_for(frame, t)
+
+    controls = HeldControls(speed=None, paused=True)
+    scenario = load_scenario("follow_person", ['camera.resolution="80x60"', "sim.duration=0.1"])
+    result = run_scenario(scenario, backend="model", controls=controls)
+    assert controls.paused_s >= hold
+    summary = result.summary
+    assert summary["wall_time_s"] < hold  # three frames of the model, not the pause
+    assert summary["realtime_factor"] > 0.1 / hold
+    line = format_summary({**summary, "paused_s": round(controls.paused_s, 3)}).splitlines()[1]
+    assert f"paused {controls.paused_s:.1f} s besides" in line
+
+
 @pytest.mark.parametrize(
     "topic, schema, fields, expected",
     [

@@ -97,6 +97,39 @@ def test_run_source_matches_the_golden_model_frame_by_frame(folder):
     assert out["frames"] == 5 and out["found_fraction"] == 0.8
 
 
+def test_frames_are_stamped_at_the_sources_frame_rate(folder, tmp_path):
+    """A video's frames at the rate it states, a folder's at the rate given (the scenario's
+    camera.fps), so a run of the same input is stamped the same every time."""
+    clip = tmp_path / "clip25.avi"
+    writer = cv2.VideoWriter(str(clip), cv2.VideoWriter_fourcc(*"MJPG"), 25, (640, 480))
+    for k in range(5):
+        writer.write(scene_bgr(k))
+    writer.release()
+    params = FollowTargetParams(width=W, height=H)
+    for spec, fps in ((clip, 25), (folder, 20)):
+        records = []
+        run_source(
+            open_source(str(spec), W, H, fps=20), ModelBackend(params), on_frame=records.append
+        )
+        assert [r.sim_time for r in records] == [k / fps for k in range(5)], spec
+
+
+def test_cli_stamps_a_folders_bag_at_the_scenarios_frame_rate(folder, tmp_path):
+    from rosbags.highlevel import AnyReader  # lazy: rosbags, for this test only
+
+    assert (
+        main(
+            ["--source", str(folder), "--backend", "model", "--rerun", "off", "--quiet"]
+            + ["--set", "camera.fps=10", "--bag", str(tmp_path / "b")]
+        )
+        == 0
+    )
+    with AnyReader([tmp_path / "b"]) as reader:
+        (clock,) = [c for c in reader.connections if c.topic == "/clock"]
+        stamps = [t for _, t, _ in reader.messages([clock])]
+    assert stamps == [k * 100_000_000 for k in range(5)]
+
+
 def test_max_frames_stops_early(video):
     params = FollowTargetParams(width=W, height=H)
     out = run_source(open_source(str(video), W, H), ModelBackend(params), max_frames=2)
@@ -213,7 +246,7 @@ def test_cli_video_cut_off_exits_as_interrupted_and_writes_no_summary(
 ):
     monkeypatch.setattr(
         "fpga_robotics.cli.run.open_source",
-        lambda *args: _CutOff(open_source(*args), interrupt),
+        lambda *args, **kwargs: _CutOff(open_source(*args, **kwargs), interrupt),
     )
     summary, recording = tmp_path / "s.json", tmp_path / "r.rrd"
     with pytest.raises(SystemExit) as info:

@@ -274,7 +274,7 @@ def test_the_bag_has_each_camera_once_per_capture(tmp_path):
     images = out["/cameras/turret/image_raw"]
     assert [stamp for stamp, _ in images] == [0, 200_000_000, 400_000_000] == sorted(views)
     for stamp, msg in images:
-        assert msg.header.frame_id == "turret_link"
+        assert msg.header.frame_id == "turret_optical_link"
         assert msg.data.tobytes() == views[stamp].rgb.tobytes()
     info = out["/cameras/turret/camera_info"][0][1]
     assert info.k[0] == pytest.approx(80 / math.tan(math.radians(30)))

@@ -28,8 +28,8 @@ def test_a_camera_design_sees_the_frame_as_it_receives_it():
 
 
 def test_a_design_without_a_camera_input_is_not_said_to_receive_the_frame():
-    blueprint = default_blueprint(frame_outputs=False)
-    assert _camera_views(blueprint) == ["Camera (films the run; not a design input)"]
+    blueprint = default_blueprint(frame_outputs=False, camera=None)
+    assert _camera_views(blueprint) == ["Camera (filming the run; not a design input)"]
     assert not [v for v in _views(blueprint) if v[2] == "camera/filtered"]
 
 

@@ -10,6 +10,7 @@ import os
 import cv2
 import numpy as np
 import pytest
+import rerun.blueprint as rrb
 
 from fpga_robotics.cli.readback import main as readback_main
 from fpga_robotics.sim.backends.base import FrameResult
@@ -451,3 +452,56 @@ def test_a_frame_cut_short_by_ctrl_c_is_neither_kept_nor_counted(tmp_path, monke
         assert data.entities[entity].frames == [0, 1, 2], entity
     assert rec.frames_logged == 3 and rec.images_logged == 3
     assert "saved 3 frames (3 with images)" in rec.close()
+
+
+def _view_names(container):
+    """The names of the views in a blueprint container, depth first."""
+    names = []
+    for item in container.contents:
+        if isinstance(item, rrb.Container):
+            names += _view_names(item)
+        else:
+            names.append(item.name)
+    return names
+
+
+@pytest.mark.parametrize(
+    "camera_input, title",
+    [
+        (True, "Camera (RGB444, as the design receives it)"),
+        (False, "Camera (filming the run; not a design input)"),
+    ],
+)
+def test_the_camera_view_says_whether_the_design_takes_its_frames(
+    tmp_path, monkeypatch, camera_input, title
+):
+    """A design without frame outputs may still take the camera (a camera design of one's
+    own) or not (corridor_follow, follow_line: it films the run for the viewer only)."""
+    import fpga_robotics.viz.recorder as recorder_module
+
+    layouts = []
+    original = recorder_module.default_blueprint
+
+    def capture(*args, **kwargs):
+        layouts.append(original(*args, **kwargs))
+        return layouts[-1]
+
+    monkeypatch.setattr(recorder_module, "default_blueprint", capture)
+    no_outputs = FrameResult(
+        found=None,
+        proximity=None,
+        centroid_x=None,
+        centroid_leds=None,
+        motor_left=10,
+        motor_right=10,
+        filtered=None,
+        cycles=None,
+    )
+    frames = [
+        FrameRecord(**{**f.__dict__, "result": no_outputs, "camera_input": camera_input})
+        for f in make_frames(2)
+    ]
+    record(tmp_path / "c.rrd", frames)
+    names = _view_names(layouts[-1].root_container)
+    assert title in names
+    assert "Filtered (design output)" not in names

@@ -34,9 +34,8 @@ def _trail_range():
 _CAMERA_NAMES = {
     "rgb444": "Camera (RGB444, as the design receives it)",
     "rgb888": "Camera (RGB888)",
+    None: "Camera (filming the run; not a design input)",
 }
-#: The camera's view for a design without a camera input: it films the run, nothing more.
-FILMING_CAMERA_NAME = "Camera (films the run; not a design input)"
 
 
 def default_blueprint(
@@ -49,7 +48,8 @@ def default_blueprint(
     cameras=(),
 ):
     """The layout sent to the viewer; ``bounds`` ``(xmin, ymin, xmax, ymax)`` frame the map;
-    ``camera`` (``rgb444`` or ``rgb888``, how the camera frame is recorded) names its view;
+    ``camera`` (``rgb444`` or ``rgb888``, how the camera frame is recorded, or None: the
+    design takes no camera, which only films the run) names its view;
     ``shadow`` adds a second LED row and the shadow design's wheel speeds; ``world3d`` puts
     the world in 3D (``viz.world3d``) beside the map; ``sensors`` (series entity paths,
     ``viz.sensors``) come first among the plots under the map, one tab each; ``cameras``
@@ -75,9 +75,12 @@ def default_blueprint(
         rrb.TimeSeriesView(origin=P.TWIST_W, name="W rad/s (commanded, measured)"),
     )
     if not frame_outputs:
-        filming = rrb.Spatial2DView(origin=P.CAMERA_RAW, name=FILMING_CAMERA_NAME)
         board = rrb.Vertical(
-            rrb.Horizontal(filming, *further) if further else filming,
+            rrb.Horizontal(
+                rrb.Spatial2DView(origin=P.CAMERA_RAW, name=_CAMERA_NAMES[camera]), *further
+            )
+            if further
+            else rrb.Spatial2DView(origin=P.CAMERA_RAW, name=_CAMERA_NAMES[camera]),
             plots,
             row_shares=[4, 3],
             name="Board",

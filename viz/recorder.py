@@ -193,6 +193,7 @@ class Recorder:
         # Whether the design has a filtered image or LEDs (follow_line has neither): the
         # first frame tells.
         self._frame_outputs = True
+        self._camera_input = True  # the design takes the camera's frames: the first frame tells
         self._first_frame_seen = False
         self._last_robot = None
         self._last_target = None
@@ -270,7 +271,7 @@ class Recorder:
                     world3d=self._world3d is not None,
                     sensors=tuple(self._sensors.series),
                     frame_outputs=self._frame_outputs,
-                    camera=self.camera,
+                    camera=self.camera if self._camera_input else None,
                     cameras=tuple(self._cameras.names),
                 )
             )
@@ -358,6 +359,9 @@ class Recorder:
             self._first_frame_seen = True
             if res.filtered is None and res.proximity is None and res.centroid_leds is None:
                 self._frame_outputs = False
+                self._layout_stale = True
+            if not getattr(record, "camera_input", True):
+                self._camera_input = False
                 self._layout_stale = True
 
         def add(path, row):

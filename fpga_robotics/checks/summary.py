@@ -57,6 +57,7 @@ TIMING_FIELDS = (
     "cpu_ms_per_frame",
     "backend_setup_s",
     "cycles_per_wall_s",
+    "paused_s",
 )
 
 
@@ -463,7 +464,8 @@ def format_summary(s):
         f"scenario {s['scenario']}  backend {s['backend']}  {s['resolution']}  seed {s['seed']}",
         (
             f"  {s['frames']} frames, {s['sim_time_s']:.1f} s simulated in {s['wall_time_s']:.2f} s"
-            f" ({s['ms_per_frame']:.2f} ms/frame, "
+            + (f", paused {s['paused_s']:.1f} s besides" if s.get("paused_s") else "")
+            + f" ({s['ms_per_frame']:.2f} ms/frame, "
             f"{f'{rtf:.1f}x' if rtf is not None else 'n/a'} real time)"
         ),
     ]

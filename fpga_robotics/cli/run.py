@@ -913,7 +913,7 @@ def _list_scenarios():
 
 
 def _run_source(args, scenario, ros):
-    ros.check_closed_loop_only()
+    ros.check_closed_loop_only(args.source)
     if scenario.sim.timing == "real_clock":
         raise UsageError(
             f"--source feeds camera frames to the design; scenario "
@@ -921,7 +921,9 @@ def _run_source(args, scenario, ros):
             f"{scenario.top!r}, sensors on pins): run it without --source"
         )
     params = scenario.params
-    source = open_source(args.source, params.width, params.height, args.max_frames)
+    source = open_source(
+        args.source, params.width, params.height, args.max_frames, fps=scenario.camera.fps
+    )
     try:
         design = _open_design(args, scenario)
         recorder = None
@@ -1012,6 +1014,9 @@ def main(argv=None, prog="fpga-robotics run"):
         return _run_source(args, scenario, ros)
     if args.max_frames is not None:
         raise UsageError("--max-frames only applies with --source (use --duration)")
+    replay_warning = ros.replay_warning(scenario, args.seed)
+    if replay_warning is not None:
+        print(replay_warning, file=sys.stderr)
     shadow_scenario, params_scenario = shadow_designs(args, scenario)
     shadow_args = None if shadow_scenario is None else _shadow_args(args, shadow_scenario)
     if shadow_scenario is not None and args.shadow_backend == "model":

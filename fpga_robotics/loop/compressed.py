@@ -37,7 +37,7 @@ from fpga_robotics.ros.controls import apply_inputs
 from fpga_robotics.sim.backends import fastest_backend_name, get_backend
 from fpga_robotics.sim.camera.raster import focal_length, silhouette_columns
 from fpga_robotics.sim.records import FrameRecord
-from fpga_robotics.sim.world import World, is_removal_event
+from fpga_robotics.sim.world import World, dps_to_twist, is_removal_event
 
 __all__ = [
     "TRAJECTORY_FIELDS",
@@ -376,6 +376,15 @@ class ClosedLoop:
         """Hand the frame to the viewer and the ``on_frame`` callback; ``extra`` are more
         ``FrameRecord`` fields (``sensors``, ``design_extra``)."""
         row = self.traj
+        # The twist this frame's wheel command means (as a bag's /cmd_vel), not the one in
+        # force at its capture (the trajectory's cmd_v), which lags it by the actuation delay.
+        spec = self.world.robot_spec
+        cmd_v, cmd_w = dps_to_twist(
+            _dps(result.motor_left),
+            _dps(result.motor_right),
+            spec.wheel_radius,
+            spec.wheel_separation,
+        )
         record = FrameRecord(
             frame=k,
             sim_time=t,
@@ -387,8 +396,8 @@ class ClosedLoop:
             robot_heading=row["heading"][k],
             robot_v=row["v"][k],
             robot_w=row["w"][k],
-            cmd_v=row["cmd_v"][k],
-            cmd_w=row["cmd_w"][k],
+            cmd_v=cmd_v,
+            cmd_w=cmd_w,
             camera_hfov=self.scenario.camera.hfov,
             people=self.world.people_states(),
             target_distance=distance,
@@ -479,7 +488,8 @@ class ClosedLoop:
             self.traj = {name: a[: self.frames_done] for name, a in self.traj.items()}
         for name in self.absent:
             self.traj[name] = np.full(len(self.traj[name]), np.nan)
-        wall = time.perf_counter() - wall_start
+        # The time a user held the run paused (live controls) is not the run's speed.
+        wall = time.perf_counter() - wall_start - getattr(self.controls, "paused_s", 0.0)
         cpu = time.process_time() - cpu_start
         return RunResult(
             summary=self.summarise(wall, cpu), trajectory=self.traj, events=self.events

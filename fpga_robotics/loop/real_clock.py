@@ -582,6 +582,7 @@ class RealClockLoop(ClosedLoop):
                 sensors=row.readings,
                 design_extra=extra,
                 cameras=row.cameras,
+                camera_input=bool(self.top.camera),
                 **shadow,
             )
 

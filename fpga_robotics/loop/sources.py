@@ -6,6 +6,7 @@ with ``cv2.resize`` (``INTER_LINEAR``) and converted from OpenCV's BGR order. ``
 runs the design on each frame (no physics) and reports what it found.
 """
 
+import math
 import time
 from itertools import islice
 from pathlib import Path
@@ -37,19 +38,24 @@ class FrameSource:
         ``camera:N`` (OpenCV device N), a video file, or a folder of images.
     width, height : int
         The design's resolution; every frame is resized to it.
+    fps : float, optional
+        The frame rate of a folder of images and of a video that states none; frames are
+        stamped ``k / fps`` (``frame_time``), a video's at the rate it states.
     """
 
-    def __init__(self, spec, width, height):
+    def __init__(self, spec, width, height, fps=None):
         self.spec = str(spec)
         self.width, self.height = width, height
         self.kind = None
         self._cap = None
         self._files = None
+        self._fps = fps
         if self.spec.startswith("camera:"):
             index = self.spec[len("camera:") :]
             if not index.isdigit():
                 raise UsageError(f"--source camera:N needs a device number, got {self.spec!r}")
             self.kind = "camera"
+            self._fps = None  # a camera's frames come when they come: stamped as read
             # OpenCV's own warnings would print before our message; keep only its errors.
             cv2.utils.logging.setLogLevel(cv2.utils.logging.LOG_LEVEL_ERROR)
             self._cap = cv2.VideoCapture(int(index))
@@ -85,6 +91,14 @@ class FrameSource:
             self._cap.release()
             raise UsageError(f"cannot read video {self.spec!r}: OpenCV cannot decode it")
         self._first = first
+        stated = self._cap.get(cv2.CAP_PROP_FPS)
+        if stated > 0 and math.isfinite(stated):
+            self._fps = stated
+
+    def frame_time(self, k):
+        """Seconds from the first frame to frame ``k`` (``k / fps``); None for a camera,
+        or without a frame rate."""
+        return None if self._fps is None else k / self._fps
 
     def _convert(self, bgr):
         return to_design_rgb(bgr, self.width, self.height)
@@ -112,15 +126,16 @@ class FrameSource:
             self._cap = None
 
 
-def open_source(spec, width, height, max_frames=None):
+def open_source(spec, width, height, max_frames=None, fps=None):
     """Open ``spec`` (``camera:N``, a video file, a folder of images, ``bag:PATH[:TOPIC]``) at
     ``width`` x ``height``; ``UsageError`` when it cannot be opened. A bag's images are all
-    checked now (the first ``max_frames`` of them, when given)."""
+    checked now (the first ``max_frames`` of them, when given); ``fps`` is the frame rate of
+    a folder of images and of a video that states none."""
     if str(spec).startswith("bag:"):  # a ROS bag (fpga_robotics.ros.bag_source)
         from fpga_robotics.ros.bag_source import BagSource  # lazy: rosbags (~30 ms), for bags only
 
         return BagSource(spec, width, height, max_frames)
-    return FrameSource(spec, width, height)
+    return FrameSource(spec, width, height, fps)
 
 
 def run_source(
@@ -140,8 +155,8 @@ def run_source(
 
     Returns a JSON-ready dict: the source, frame count, timing, how often the target was
     found, and the per-frame outputs (``results``). ``on_frame(FrameRecord)`` is called for
-    every frame; a source with recorded times (a bag: ``frame_time(k)``) stamps the frames
-    with them, others with the wall time since the start. The frames' commanded twist
+    every frame; a source with frame times (``frame_time(k)``: a bag's, a video's or a
+    folder's) stamps the frames with them, a camera with the wall time since the start. The frames' commanded twist
     (``cmd_v``, ``cmd_w``) is the design's DPS through ``robot``'s wheels (a ``RobotSpec``:
     the scenario's robot, as ``/cmd_vel`` in a bag); nothing moves, so the measured one is 0.
     """
@@ -175,11 +190,9 @@ def run_source(
                 }
             )
             if recorder is not None or on_frame is not None:
-                stamp = (
-                    source.frame_time(k)
-                    if hasattr(source, "frame_time")
-                    else time.perf_counter() - start
-                )
+                stamp = source.frame_time(k) if hasattr(source, "frame_time") else None
+                if stamp is None:  # a camera: the time it was read
+                    stamp = time.perf_counter() - start
                 cmd_v, cmd_w = dps_to_twist(
                     int(result.motor_left or 0),
                     int(result.motor_right or 0),

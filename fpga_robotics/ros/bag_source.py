@@ -54,8 +54,8 @@ def parse_bag_spec(spec):
 
 
 def check_image(msg, msgtype):
-    """``UsageError`` for a raw image whose encoding is not read or whose size does not fit
-    its data (a CompressedImage shows whether it can be read only when it is decoded)."""
+    """``UsageError`` for a raw image whose encoding is not read, that has no pixels, or
+    whose size does not fit its data (a CompressedImage shows whether it can be read only when it is decoded)."""
     if msgtype.endswith("CompressedImage"):
         return
     enc = msg.encoding.lower()
@@ -64,6 +64,8 @@ def check_image(msg, msgtype):
             f"image encoding {msg.encoding!r} is not read; use one of " + ", ".join(ENCODINGS)
         )
     h, w, size = msg.height, msg.width, len(msg.data)
+    if h == 0 or w == 0:  # a driver's placeholder for a dropped frame; nothing to resize
+        raise UsageError(f"a {w}x{h} image holds no pixels")
     if msg.step < w * _CHANNELS.get(enc, 2) or size != h * msg.step:
         raise UsageError(
             f"a {w}x{h} {enc} image with step {msg.step} cannot hold "
@@ -113,8 +115,9 @@ class BagSource:
                 f"--source {self.spec!r}: no such bag (give a ROS 2 bag folder, "
                 f"its .mcap/.db3 file, or a ROS 1 .bag file)"
             )
-        if path.is_file() and path.suffix in (".mcap", ".db3"):
-            path = path.parent  # a ROS 2 bag is its folder
+        # A ROS 2 bag's .mcap/.db3 file is read alone (it holds its own topics and types), not
+        # with its folder: a copied-out file has no metadata.yaml, and the folder may hold
+        # another bag.
         try:
             self._reader = AnyReader([path], default_typestore=get_typestore(Stores.ROS2_HUMBLE))
             self._reader.open()

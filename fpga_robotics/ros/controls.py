@@ -18,6 +18,7 @@ import time
 from fpga_robotics.hw.errors import UsageError
 
 from ..hw.pixel import COLOR_SELECT, color_select_value
+from ..sim.world.world import MAX_TARGET_SPEED
 
 __all__ = [
     "INPUT_KINDS",
@@ -27,6 +28,7 @@ __all__ = [
     "apply_inputs",
     "check_input",
     "load_inputs",
+    "replay_mismatch",
 ]
 
 #: Speed of the target person driven by the terminal's arrows and the layout's teleop pad, m/s.
@@ -35,8 +37,8 @@ TELEOP_SPEED = 0.5
 #: What an input can be: kind -> what its value is.
 INPUT_KINDS = {
     "color": "a colour select name (" + ", ".join(COLOR_SELECT) + ")",
-    "target_velocity": "[vx, vy] m/s in the world frame, or null to hand the target back "
-    "to its script",
+    "target_velocity": f"[vx, vy] m/s in the world frame (at most {MAX_TARGET_SPEED:g} m/s), "
+    "or null to hand the target back to its script",
     "pause": "null",
     "resume": "null",
     "step": "null",
@@ -62,8 +64,10 @@ def check_input(kind, value):
         if not isinstance(value, (list, tuple)) or len(value) != 2:
             raise ValueError(f"target_velocity must be [vx, vy] or null, got {value!r}")
         vx, vy = (float(v) for v in value)
-        if not (math.isfinite(vx) and math.isfinite(vy)):
-            raise ValueError(f"target_velocity must be finite, got {value!r}")
+        if not math.hypot(vx, vy) <= MAX_TARGET_SPEED:  # NaN fails too
+            raise ValueError(
+                f"target_velocity must be at most {MAX_TARGET_SPEED:g} m/s fast, got {value!r}"
+            )
         return kind, [vx, vy]
     if kind == "speed":
         speed = float(value)
@@ -126,6 +130,8 @@ class LiveControls:
         self._steps = 0
         self._closed = False
         self._anchor = None  # (wall, sim) the pacing counts from
+        #: Wall time the run was held paused, s: the user's, not the machine's speed.
+        self.paused_s = 0.0
 
     @property
     def paused(self):
@@ -156,12 +162,15 @@ class LiveControls:
         frame per ``step``) and paces to ``speed``."""
         with self._cond:
             waited = False
+            held_from = time.perf_counter()
             while self._paused and not self._closed:
                 if self._steps > 0:
                     self._steps -= 1
                     break
                 waited = True
                 self._cond.wait(0.1)
+            if waited:
+                self.paused_s += time.perf_counter() - held_from
             # What came while paused acts on the frame that goes on (a colour, then a step).
             inputs, self._queue = self._queue, []
         for kind, value in inputs:
@@ -191,23 +200,56 @@ class ReplayControls:
 
     def __init__(self, inputs):
         self.log = []
+        self.paused_s = 0.0  # a replay never waits
+        self.last_frame = None  # the last frame the run reached
         self._by_frame = {}
         for item in inputs:
             self._by_frame.setdefault(item["frame"], []).append((item["kind"], item["value"]))
 
     def inputs_for(self, frame, t):
+        self.last_frame = frame
         inputs = self._by_frame.get(frame, [])
         for kind, value in inputs:
             self.log.append({"frame": frame, "t": round(t, 6), "kind": kind, "value": value})
         return inputs
 
+    def unreached(self):
+        """How many inputs are at frames after the last one the run reached."""
+        last = -1 if self.last_frame is None else self.last_frame
+        return sum(len(inputs) for frame, inputs in self._by_frame.items() if frame > last)
+
     def close(self):
         pass
 
 
+#: What a summary says of its run that decides where its inputs act.
+_STEERED_RUN = ("scenario", "seed", "overrides")
+
+
+def replay_mismatch(path, steered, scenario, seed, overrides):
+    """The warning for replaying the inputs of the run ``steered`` (the summary's
+    ``_STEERED_RUN`` items, or None for a bare list) onto another run, or None."""
+    if steered is None:
+        return None
+    this = {"scenario": scenario, "seed": seed, "overrides": list(overrides)}
+    if all(steered.get(key) == this[key] for key in _STEERED_RUN):
+        return None
+
+    def run(items):
+        sets = "".join(f", --set {o}" for o in items.get("overrides") or ())
+        return f"{items.get('scenario')} (seed {items.get('seed')}{sets})"
+
+    return (
+        f"warning: --replay-inputs {str(path)!r} was steered on {run(steered)}; this run is "
+        f"{run(this)}, so its inputs act on another run"
+    )
+
+
 def load_inputs(path):
-    """The inputs recorded in ``path``: a run's summary JSON (its ``inputs``) or a JSON list of
-    ``{"frame", "kind", "value"}``; ``UsageError`` naming what is wrong."""
+    """``(inputs, steered)``: the inputs recorded in ``path``, a run's summary JSON (its
+    ``inputs``) or a JSON list of ``{"frame", "kind", "value"}``, and for a summary the run
+    they steered (its ``scenario``, ``seed`` and ``overrides``; None for a list);
+    ``UsageError`` naming what is wrong."""
     what = f"--replay-inputs {str(path)!r}"
     try:
         with open(path) as f:
@@ -218,7 +260,9 @@ def load_inputs(path):
         ) from None
     except (OSError, ValueError) as exc:
         raise UsageError(f"{what}: not readable JSON ({exc})") from None
+    steered = None
     if isinstance(data, dict):
+        steered = {key: data[key] for key in _STEERED_RUN if key in data} or None
         if "inputs" not in data:
             raise UsageError(
                 f"{what}: the summary has no 'inputs' (it was not a run with "
@@ -239,4 +283,4 @@ def load_inputs(path):
         except (ValueError, TypeError) as exc:
             raise UsageError(f"{what}: input {i}: {exc}") from None
         out.append({"frame": frame, "kind": kind, "value": value})
-    return out
+    return out, steered

@@ -5,11 +5,12 @@ triples: the same bytes go into a bag (``bag_writer``) and out on the live Foxgl
 (``foxglove_live``). Everything is stamped in simulated time (nanoseconds from the run's
 start). Frames: ``odom`` (the world: x, y on the floor, z up, headings counter-clockwise
 from +x, as in ROS REP 103), ``base_link`` (the robot), ``camera_link`` (the camera on its
-mount, x forward, pitched by the camera's tilt). An output the design lacks (None) is not
+mount, x forward, pitched by the camera's tilt) and its child ``camera_optical_link`` (x
+right, y down, z into the image: the frame of the images and CameraInfo). An output the design lacks (None) is not
 published for that frame. Each further camera (``FrameRecord.cameras``) has its own topics,
 ``/cameras/<name>/image_raw`` and ``camera_info`` (``camera_topics``), stamped at its own
-capture instant and written once per capture, in its frame ``<name>_link`` (placed in
-``odom`` on ``/tf``: on a servo it turns with the horn).
+capture instant and written once per capture, in its frame ``<name>_optical_link``, a child
+of ``<name>_link`` (placed in ``odom`` on ``/tf``: on a servo it turns with the horn).
 """
 
 import math
@@ -110,6 +111,28 @@ del _codes, _i, _shift
 _TARGET_RGBA = (1.0, 0.25, 0.25, 1.0)
 _PERSON_RGBA = (0.65, 0.65, 0.75, 1.0)
 _PERSON_HEIGHT = 1.75  # the marker's height, m (drawn standing on the floor)
+
+# A camera's optical frame (REP 103: x right, y down, z into the image) in its link frame
+# (x forward, z up): Image and CameraInfo are stamped with it, as tools that project with
+# CameraInfo expect.
+_OPTICAL = _T["geometry_msgs/msg/Transform"](
+    translation=_Vector3(x=0.0, y=0.0, z=0.0),
+    rotation=_Quaternion(x=-0.5, y=0.5, z=-0.5, w=0.5),
+)
+
+
+def _optical(stamp, link):
+    """The ``/tf`` transform from the camera frame ``link`` to its optical frame."""
+    return _T["geometry_msgs/msg/TransformStamped"](
+        header=_Header(stamp=stamp, frame_id=link),
+        child_frame_id=_optical_frame(link),
+        transform=_OPTICAL,
+    )
+
+
+def _optical_frame(link):
+    """``camera_link`` -> ``camera_optical_link``."""
+    return link.removesuffix("_link") + "_optical_link"
 
 
 def msgdef(msgtype):
@@ -230,7 +253,7 @@ class FrameMessages:
             self._captured[name] = view.sim_time
             self.topic_types.update(camera_topics(name))
             stamp = _stamp(round(view.sim_time * 1e9))
-            header = _Header(stamp=stamp, frame_id=f"{name}_link")
+            header = _Header(stamp=stamp, frame_id=_optical_frame(f"{name}_link"))
             h, w = view.rgb.shape[:2]
             p = view.pose
             # Yaw about z, then the tilt about the camera's y (a positive tilt looks up).
@@ -248,7 +271,12 @@ class FrameMessages:
             out += [
                 (f"/cameras/{name}/image_raw", self._image(header, view.rgb)),
                 (f"/cameras/{name}/camera_info", self._info_of(header, w, h, view.hfov)),
-                ("/tf", _T["tf2_msgs/msg/TFMessage"](transforms=[place])),
+                (
+                    "/tf",
+                    _T["tf2_msgs/msg/TFMessage"](
+                        transforms=[place, _optical(stamp, f"{name}_link")]
+                    ),
+                ),
             ]
         return out
 
@@ -257,7 +285,7 @@ class FrameMessages:
         ns = round(record.sim_time * 1e9)
         stamp = _stamp(ns)
         ser, T, g = self._ser, _T, self.geometry
-        cam_header = _Header(stamp=stamp, frame_id="camera_link")
+        cam_header = _Header(stamp=stamp, frame_id=_optical_frame("camera_link"))
         odom_header = _Header(stamp=stamp, frame_id="odom")
         out = [
             ("/clock", T["rosgraph_msgs/msg/Clock"](clock=stamp)),
@@ -353,6 +381,7 @@ class FrameMessages:
                             child_frame_id="camera_link",
                             transform=self._mount,
                         ),
+                        _optical(stamp, "camera_link"),
                     ]
                 ),
             )

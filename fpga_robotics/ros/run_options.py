@@ -8,7 +8,7 @@ writer, the Foxglove server and the controls; ``on_frame`` is the per-frame call
 
 from fpga_robotics.hw.errors import UsageError
 
-from .controls import LiveControls, ReplayControls, load_inputs
+from .controls import LiveControls, ReplayControls, load_inputs, replay_mismatch
 from .interactive import TerminalControls, check_terminal
 
 __all__ = ["RosOutputs", "add_ros_arguments"]
@@ -70,7 +70,8 @@ class RosOutputs:
                     "--live or --interactive"
                 )
 
-            self.replay = load_inputs(args.replay_inputs)
+            self.replay, self._steered = load_inputs(args.replay_inputs)
+            self._replay_path = args.replay_inputs
         if self.interactive:
             check_terminal()
         self.live_control = self.port is not None or self.interactive
@@ -81,12 +82,35 @@ class RosOutputs:
         self._sinks = []  # bag writer, live publisher: each has log_frame and close
         self._bag = self._terminal = self._live = None
 
-    def check_closed_loop_only(self):
-        """With ``--source`` (no simulation) there is nothing to control."""
+    def check_closed_loop_only(self, source):
+        """With ``--source SPEC`` (no simulation) there is nothing to control, and only a
+        camera's frames come at the pace of real time."""
         if self.interactive:
             raise UsageError("--interactive controls the closed loop (not with --source)")
         if self.replay is not None:
             raise UsageError("--replay-inputs replays a closed-loop run (not with --source)")
+        if self.start_paused:
+            raise UsageError("--paused pauses the closed loop (not with --source)")
+        if self.port is not None and not str(source).startswith("camera:"):
+            # A file is read as fast as the design goes: done before a client could connect.
+            raise UsageError(
+                "--live streams a run as it goes; with --source only a camera (camera:N) "
+                "does: write the outputs of a video, folder or bag with --bag and open "
+                "that in Foxglove"
+            )
+
+    def replay_warning(self, scenario, seed):
+        """The warning when ``--replay-inputs`` replays a summary's inputs onto a run with
+        another scenario, seed or overrides (``seed`` None: the scenario's), or None."""
+        if self.replay is None:
+            return None
+        return replay_mismatch(
+            self._replay_path,
+            self._steered,
+            scenario.name,
+            scenario.seed if seed is None else seed,
+            scenario.overrides,
+        )
 
     @property
     def active(self):
@@ -132,9 +156,12 @@ class RosOutputs:
             sink.log_frame(record)
 
     def summary_items(self):
-        """``{"inputs": [...]}`` when the run had live or replayed inputs, and with a live
-        server that took client messages, ``"refused_inputs"``: those it could not use."""
+        """``{"inputs": [...]}`` when the run had live or replayed inputs (with live ones
+        ``"paused_s"``, the wall time it was held paused), and with a live server that took
+        client messages, ``"refused_inputs"``: those it could not use."""
         items = {} if self.controls is None else {"inputs": list(self.controls.log)}
+        if isinstance(self.controls, LiveControls):
+            items["paused_s"] = round(self.controls.paused_s, 3)
         if self._live is not None and self._live.controls is not None:
             items["refused_inputs"] = self._live.refused_inputs()
         return items
@@ -152,6 +179,12 @@ class RosOutputs:
                     f"{len(self.controls.log)} live input(s) applied; the "
                     f"summary's 'inputs' replay them (--summary PATH, then "
                     f"--replay-inputs PATH)"
+                )
+            unreached = self.controls.unreached() if self.replay is not None else 0
+            if completed and unreached:
+                notices.append(
+                    f"--replay-inputs: {unreached} input(s) after the run's last frame "
+                    f"{self.controls.last_frame} were not applied"
                 )
         for sink in self._sinks:
             if sink is self._bag and not completed:

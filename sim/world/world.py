@@ -24,10 +24,18 @@ from .motors import DriveMotors
 from .people import PersonPath, person_bands
 from .robots import G
 from .room import add_static_shapes, map_data, scene_walls
+from .sanity import segment_distance
 from .terrain import TerrainMap, slope_pitch
 from .uncertainty import MotorUncertainty
 
-__all__ = ["AT_FAULT_SPEED", "MAX_SUBSTEP", "World", "is_removal_event", "removal_event"]
+__all__ = [
+    "AT_FAULT_SPEED",
+    "MAX_SUBSTEP",
+    "MAX_TARGET_SPEED",
+    "World",
+    "is_removal_event",
+    "removal_event",
+]
 
 
 def removal_event(name):
@@ -42,6 +50,9 @@ def is_removal_event(text):
 
 #: ``step(dt)`` splits longer steps into equal sub-steps no longer than this, s.
 MAX_SUBSTEP = 0.01
+
+#: Fastest a person may be driven by hand (``World.set_target_velocity``), m/s: a run.
+MAX_TARGET_SPEED = 3.0
 
 _ROBOT, _WALL, _FURNITURE, _PERSON = 1, 2, 3, 4
 _KINDS = ("person", "wall", "furniture")
@@ -337,9 +348,10 @@ class World:
         for person in self.people:
             if person.teleop is not None:  # driven by hand: the script waits, the offset grows
                 person.waited += h
-                ox, oy = person.offset
-                person.offset = (ox + person.teleop[0] * h, oy + person.teleop[1] * h)
-            sx, sy = person.path.position(t1 - person.waited)
+                sx, sy = person.path.position(t1 - person.waited)
+                person.offset = self._driven_offset(person, sx, sy, h)
+            else:
+                sx, sy = person.path.position(t1 - person.waited)
             x, y = sx + person.offset[0], sy + person.offset[1]
             px, py = person.body.position
             before.append((px, py))
@@ -365,6 +377,34 @@ class World:
         self.time = t1
         if self._removals and self._removals[0][0] <= t1:
             self._remove_due()
+
+    def _driven_offset(self, person, sx, sy, h):
+        """A hand-driven person's offset after a sub-step: the person is kinematic, so
+        nothing in the physics stops them; each axis stops where it would take them into a
+        wall or furniture, so they slide along it."""
+        ox, oy = person.offset
+        vx, vy = person.teleop
+        if self._person_fits(sx + ox + vx * h, sy + oy, person, sx + ox, sy + oy):
+            ox += vx * h
+        if self._person_fits(sx + ox, sy + oy + vy * h, person, sx + ox, sy + oy):
+            oy += vy * h
+        return ox, oy
+
+    def _person_fits(self, x, y, person, old_x, old_y):
+        """Whether ``person`` may step to ``(x, y)`` from ``(old_x, old_y)``: clear of the
+        walls and furniture there, or already overlapping them (so that they can get out)."""
+        return self._clear_of_room(x, y, person.config.radius) or not self._clear_of_room(
+            old_x, old_y, person.config.radius
+        )
+
+    def _clear_of_room(self, x, y, radius):
+        room = self.config.room
+        if not (radius <= x <= room.width - radius and radius <= y <= room.depth - radius):
+            return False
+        return all(
+            segment_distance((x, y), (x, y), f.corners()) >= radius
+            for f in self.present_furniture()
+        )
 
     def _remove_due(self):
         """Take the furniture whose ``present_until`` has come out of the physics, the
@@ -422,14 +462,17 @@ class World:
     def set_target_velocity(self, velocity):
         """Drive the target person by hand (as one drags a person in Gazebo): ``(vx, vy)``
         in m/s in the world frame from the next step on, its script paused; None hands it
-        back to its script, which goes on from where the person was left. Raises
-        ``ValueError`` when there is no target or a value is not finite."""
+        back to its script, which goes on from where the person was left. The person stops
+        (slides) at walls and furniture. Raises ``ValueError`` when there is no target or
+        the speed is not finite or above ``MAX_TARGET_SPEED``."""
         if self._target is None:
             raise ValueError("the world has no target person to drive")
         if velocity is not None:
             vx, vy = (float(v) for v in velocity)
-            if not (math.isfinite(vx) and math.isfinite(vy)):
-                raise ValueError(f"target velocity must be finite, got {velocity!r}")
+            if not math.hypot(vx, vy) <= MAX_TARGET_SPEED:  # NaN fails too
+                raise ValueError(
+                    f"target speed must be at most {MAX_TARGET_SPEED:g} m/s, got {velocity!r}"
+                )
             velocity = (vx, vy)
         self._target.teleop = velocity
 
