@@ -326,24 +326,29 @@ def test_an_unreachable_scheduler_leaves_earlier_results_as_they_were(tmp_path, 
     assert (out / "results.jsonl").read_text() == journal
 
 
-@pytest.mark.skipif("cxxrtl" not in available_backends(), reason="no CXXRTL toolchain")
-def test_a_design_that_does_not_build_leaves_no_results_folder(tmp_path, monkeypatch, capsys):
-    # The folder is made once the cluster is up; the build fails after it: the folder this
-    # command made goes again, as no run finished.
-    (tmp_path / "top.v").write_text(
+def _campaign_that_does_not_build(folder):
+    """c.toml in ``folder``: a Verilog design that loads (its port map fits line_track) and
+    does not build (a syntax error)."""
+    (folder / "top.v").write_text(
         "module top(input clock, input [2:0] sens, output [15:0] wl, output [15:0] wr);\n"
         "wire oops = ;\nendmodule\n"
     )
-    (tmp_path / "ports.toml").write_text(  # a map that fits line_track: the build fails
+    (folder / "ports.toml").write_text(
         'top = "top"\nclock = { port = "clock" }\n[outputs]\n'
         'motor_left = { port = "wl", width = 16, signed = true }\n'
         'motor_right = { port = "wr", width = 16, signed = true }\n'
         '[connectors.line_sensors]\nline = "sens"\n'
     )
-    (tmp_path / "c.toml").write_text(
+    (folder / "c.toml").write_text(
         'scenarios = ["line_track"]\nbackend = "cxxrtl"\nduration = 0.1\n'
         'design = "verilog:top.v"\nports = "ports.toml"\n'
     )
+
+
+@pytest.mark.skipif("cxxrtl" not in available_backends(), reason="no CXXRTL toolchain")
+def test_a_design_that_does_not_build_leaves_no_results_folder(tmp_path, monkeypatch, capsys):
+    # The build fails before any run: the folder is never made.
+    _campaign_that_does_not_build(tmp_path)
     monkeypatch.chdir(tmp_path)
     with pytest.raises(SystemExit) as exit_info:
         run_cli(
@@ -355,3 +360,33 @@ def test_a_design_that_does_not_build_leaves_no_results_folder(tmp_path, monkeyp
     lines = capsys.readouterr().err.strip().splitlines()
     assert len(lines) == 1 and "building the design of" in lines[0], lines
     assert not (tmp_path / "new").exists()
+
+
+@pytest.mark.skipif("cxxrtl" not in available_backends(), reason="no CXXRTL toolchain")
+def test_a_design_that_does_not_build_leaves_earlier_results_as_they_were(
+    tmp_path, monkeypatch, capsys
+):
+    # An earlier campaign's results, recording and report: a campaign refused at its build
+    # step ran nothing, so it must not replace them (nor describe itself in campaign.json).
+    _campaign_that_does_not_build(tmp_path)
+    out = tmp_path / "out"
+    (out / "recordings").mkdir(parents=True)
+    earlier = {
+        "results.jsonl": json.dumps({"run_id": "0123abcd", "status": "fail", "seed": 0}) + "\n",
+        "campaign.json": json.dumps({"name": "earlier", "runs": 1, "missing": 0}),
+        "report.html": "<html>earlier</html>",
+        "recordings/0123abcd.rrd": "rrd",
+    }
+    for name, text in earlier.items():
+        (out / name).write_text(text)
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(SystemExit) as exit_info:
+        run_cli(
+            main,
+            ["c.toml", "--workers", "1", "--out", "out", "--quiet"],
+            prog="fpga-robotics sweep",
+        )
+    assert exit_info.value.code == 2
+    assert "building the design of" in capsys.readouterr().err
+    now = {str(p.relative_to(out)): p.read_text() for p in out.rglob("*") if p.is_file()}
+    assert now == earlier

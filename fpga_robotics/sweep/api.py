@@ -74,8 +74,14 @@ def run_campaign(
             else open_client(scheduler=scheduler, workers=workers)
         ) as c:
             wait_for_a_worker(c, scheduler)
-            # The folder only once the cluster is there: an unreachable scheduler writes
-            # nothing.
+            t_build = time.perf_counter()
+            builds = build_all(c, plan)
+            meta["build_s"] = round(time.perf_counter() - t_build, 3)
+            meta["build_s_each"] = [round(b, 3) for b in builds]
+            say(f"built or loaded {len(builds)} design(s) in {meta['build_s']:.1f} s")
+            # The folder only once the cluster is there and every design built: an
+            # unreachable scheduler, a design that does not build or a Ctrl-C before the
+            # runs leave the folder as it was.
             store = ResultStore(out_dir, resume=resume, run_ids=run_ids)
             if store.dropped:
                 say(
@@ -83,11 +89,6 @@ def run_campaign(
                     f"(errors, timeouts, and runs this campaign no longer makes: an edited "
                     f"scenario or design file, another option or package version)"
                 )
-            t_build = time.perf_counter()
-            builds = build_all(c, plan)
-            meta["build_s"] = round(time.perf_counter() - t_build, 3)
-            meta["build_s_each"] = [round(b, 3) for b in builds]
-            say(f"built or loaded {len(builds)} design(s) in {meta['build_s']:.1f} s")
             done = store.done_ids()
             already = len({plan.ids[s] for s in plan.runs} & done)
             if already:
