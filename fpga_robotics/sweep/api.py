@@ -83,7 +83,7 @@ def run_campaign(
             # unreachable scheduler, a design that does not build or a Ctrl-C before the
             # runs leave the folder as it was.
             store = ResultStore(out_dir, resume=resume, run_ids=run_ids)
-            if store.dropped:
+            if resume and store.dropped:
                 say(
                     f"--resume: {store.dropped} earlier row(s) in {out_dir} not kept "
                     f"(errors, timeouts, and runs this campaign no longer makes: an edited "
@@ -133,6 +133,8 @@ def run_campaign(
             write_meta(out_dir, meta)
             if store.rows:
                 _write_report(out_dir, store.rows, campaign.axes, meta)
+            else:  # an earlier campaign's report would describe rows no longer there
+                (out_dir / "report.html").unlink(missing_ok=True)
     return store.rows
 
 
