@@ -65,6 +65,10 @@ CASES = {
             '"design.top=\\"follow_line\\"" gives it too'
         ),
     ),
+    "a design on pins on the model backend": (
+        GOOD.replace('"approach"', '"line_track"'),
+        "run of line_track: the model backend runs whole frames",
+    ),
     "a Verilog design without its port map": (
         GOOD + 'design = "verilog:top.v"\n',
         'run of approach: design = "verilog:top.v" needs ports = "PORTS.toml" (its port map)',
@@ -109,6 +113,11 @@ def test_bad_campaign_file_is_one_line_and_exit_2(case, tmp_path, monkeypatch, c
         (["--record", "none", "--bag", "--dry-run"], "--bag writes the recorded runs"),
         (["--record", "none", "--log-every", "3", "--dry-run"], "--log-every shapes"),
         (["--resume", "--out", "c.toml", "--dry-run"], "--out 'c.toml' exists and is not a"),
+        # A scenario in real-clock timing on a backend that runs whole frames.
+        (
+            ["--scenarios", "line_track", "--dry-run"],
+            "run of line_track: the model backend runs whole frames",
+        ),
     ],
 )
 def test_bad_options_are_one_line_and_exit_2(argv, message, tmp_path):

@@ -87,6 +87,7 @@ def load_run(argv):
     ``--shadow``'s FollowTarget parameters, or for a shadow design (``--shadow REF``,
     real-clock timing) the scenario that runs it; None without a shadow."""
     from fpga_robotics.cli import run  # lazy: the run stack (~1 s)
+    from fpga_robotics.loop.real_clock import check_pin_backend  # lazy: the run stack (~1 s)
     from fpga_robotics.scenario.load import (  # lazy: the run stack (~1 s)
         MAX_SEED,
     )
@@ -104,6 +105,7 @@ def load_run(argv):
         shadow_params = params_scenario.params
     run._design_files(args, scenario.foreign)
     if scenario.sim.timing == "real_clock":  # the pin design is the scenario's foreign one
+        check_pin_backend(args.backend)  # the build would refuse it: a dry run too
         scenario = run._with_design_files(args, scenario)
     return args, scenario, shadow_params
 
