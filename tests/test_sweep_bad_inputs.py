@@ -137,6 +137,37 @@ def test_bad_options_are_one_line_and_exit_2(argv, message, tmp_path):
     assert len(lines) == 1 and message in lines[0], lines
 
 
+#: ``--bench`` measures runs of its own: what it would ignore is refused (each case would run
+#: a short benchmark if it were not).
+SHORT_BENCH = ["--bench-runs", "1", "--bench-repeats", "1", "--duration", "0.1", "--workers", "1"]
+BENCH_MISUSE = {
+    "a campaign": (["c.toml", "--bench", *SHORT_BENCH], "not a campaign: leave out c.toml"),
+    "--dry-run": (["--bench", "--dry-run", *SHORT_BENCH], "--dry-run does not apply to it"),
+    "--set": (["--bench", "--set", "robot.mass=12", *SHORT_BENCH], "--set does not apply"),
+    "--out": (["--bench", "--out", "out", *SHORT_BENCH], "--out does not apply to it"),
+    "two scenarios": (
+        ["--bench", "--scenarios", "approach,divider", *SHORT_BENCH],
+        "--bench measures one scenario, got --scenarios approach,divider",
+    ),
+    "--bench-runs without --bench": (["c.toml", "--bench-runs", "5"], "goes with --bench"),
+    "--bench-repeats without --bench": (["c.toml", "--bench-repeats", "2"], "goes with --bench"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(BENCH_MISUSE))
+def test_what_bench_would_ignore_is_refused(case, tmp_path, monkeypatch, capsys):
+    argv, message = BENCH_MISUSE[case]
+    (tmp_path / "c.toml").write_text(GOOD)
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(SystemExit) as exit_info:
+        run_cli(main, [*argv, "--dry-run"] if "--bench" not in argv else argv, prog="x")
+    assert exit_info.value.code == 2
+    captured = capsys.readouterr()
+    lines = captured.err.strip().splitlines()
+    assert len(lines) == 1 and message in lines[0], lines
+    assert captured.out == "" and sorted(p.name for p in tmp_path.iterdir()) == ["c.toml"]
+
+
 def test_dry_run_counts_and_shows_commands(tmp_path):
     (tmp_path / "c.toml").write_text(GOOD + '[grid]\n"design.diff_min" = [4, 5, 6]\n')
     proc = subprocess.run(
