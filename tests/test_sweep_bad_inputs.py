@@ -133,6 +133,10 @@ CASES = {
             '"design.top=\\"follow_line\\"" gives it too'
         ),
     ),
+    "a design on pins on the model backend": (
+        GOOD.replace('"approach"', '"line_track"'),
+        "run of line_track: the model backend runs whole frames",
+    ),
     "a Verilog design without its port map": (
         GOOD + 'design = "verilog:top.v"\n',
         'run of approach: design = "verilog:top.v" needs ports = "PORTS.toml" (its port map)',
@@ -177,6 +181,11 @@ def test_bad_campaign_file_is_one_line_and_exit_2(case, tmp_path, monkeypatch, c
         (["--record", "none", "--bag", "--dry-run"], "--bag writes the recorded runs"),
         (["--record", "none", "--log-every", "3", "--dry-run"], "--log-every shapes"),
         (["--resume", "--out", "c.toml", "--dry-run"], "--out 'c.toml' exists and is not a"),
+        # A scenario in real-clock timing on a backend that runs whole frames.
+        (
+            ["--scenarios", "line_track", "--dry-run"],
+            "run of line_track: the model backend runs whole frames",
+        ),
     ],
 )
 def test_bad_options_are_one_line_and_exit_2(argv, message, tmp_path):
@@ -194,6 +203,37 @@ def test_bad_options_are_one_line_and_exit_2(argv, message, tmp_path):
     assert proc.returncode == 2, proc.stderr
     lines = proc.stderr.strip().splitlines()
     assert len(lines) == 1 and message in lines[0], lines
+
+
+#: ``--bench`` measures runs of its own: what it would ignore is refused (each case would run
+#: a short benchmark if it were not).
+SHORT_BENCH = ["--bench-runs", "1", "--bench-repeats", "1", "--duration", "0.1", "--workers", "1"]
+BENCH_MISUSE = {
+    "a campaign": (["c.toml", "--bench", *SHORT_BENCH], "not a campaign: leave out c.toml"),
+    "--dry-run": (["--bench", "--dry-run", *SHORT_BENCH], "--dry-run does not apply to it"),
+    "--set": (["--bench", "--set", "robot.mass=12", *SHORT_BENCH], "--set does not apply"),
+    "--out": (["--bench", "--out", "out", *SHORT_BENCH], "--out does not apply to it"),
+    "two scenarios": (
+        ["--bench", "--scenarios", "approach,divider", *SHORT_BENCH],
+        "--bench measures one scenario, got --scenarios approach,divider",
+    ),
+    "--bench-runs without --bench": (["c.toml", "--bench-runs", "5"], "goes with --bench"),
+    "--bench-repeats without --bench": (["c.toml", "--bench-repeats", "2"], "goes with --bench"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(BENCH_MISUSE))
+def test_what_bench_would_ignore_is_refused(case, tmp_path, monkeypatch, capsys):
+    argv, message = BENCH_MISUSE[case]
+    (tmp_path / "c.toml").write_text(GOOD)
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(SystemExit) as exit_info:
+        run_cli(main, [*argv, "--dry-run"] if "--bench" not in argv else argv, prog="x")
+    assert exit_info.value.code == 2
+    captured = capsys.readouterr()
+    lines = captured.err.strip().splitlines()
+    assert len(lines) == 1 and message in lines[0], lines
+    assert captured.out == "" and sorted(p.name for p in tmp_path.iterdir()) == ["c.toml"]
 
 
 def test_dry_run_counts_and_shows_commands(tmp_path):
@@ -449,24 +489,29 @@ def test_an_unreachable_scheduler_leaves_earlier_results_as_they_were(tmp_path, 
     assert (out / "results.jsonl").read_text() == journal
 
 
-@pytest.mark.skipif("cxxrtl" not in available_backends(), reason="no CXXRTL toolchain")
-def test_a_design_that_does_not_build_leaves_no_results_folder(tmp_path, monkeypatch, capsys):
-    # The folder is made once the cluster is up; the build fails after it: the folder this
-    # command made goes again, as no run finished.
-    (tmp_path / "top.v").write_text(
+def _campaign_that_does_not_build(folder):
+    """c.toml in ``folder``: a Verilog design that loads (its port map fits line_track) and
+    does not build (a syntax error)."""
+    (folder / "top.v").write_text(
         "module top(input clock, input [2:0] sens, output [15:0] wl, output [15:0] wr);\n"
         "wire oops = ;\nendmodule\n"
     )
-    (tmp_path / "ports.toml").write_text(  # a map that fits line_track: the build fails
+    (folder / "ports.toml").write_text(
         'top = "top"\nclock = { port = "clock" }\n[outputs]\n'
         'motor_left = { port = "wl", width = 16, signed = true }\n'
         'motor_right = { port = "wr", width = 16, signed = true }\n'
         '[connectors.line_sensors]\nline = "sens"\n'
     )
-    (tmp_path / "c.toml").write_text(
+    (folder / "c.toml").write_text(
         'scenarios = ["line_track"]\nbackend = "cxxrtl"\nduration = 0.1\n'
         'design = "verilog:top.v"\nports = "ports.toml"\n'
     )
+
+
+@pytest.mark.skipif("cxxrtl" not in available_backends(), reason="no CXXRTL toolchain")
+def test_a_design_that_does_not_build_leaves_no_results_folder(tmp_path, monkeypatch, capsys):
+    # The build fails before any run: the folder is never made.
+    _campaign_that_does_not_build(tmp_path)
     monkeypatch.chdir(tmp_path)
     with pytest.raises(SystemExit) as exit_info:
         run_cli(
@@ -478,3 +523,33 @@ def test_a_design_that_does_not_build_leaves_no_results_folder(tmp_path, monkeyp
     lines = capsys.readouterr().err.strip().splitlines()
     assert len(lines) == 1 and "building the design of" in lines[0], lines
     assert not (tmp_path / "new").exists()
+
+
+@pytest.mark.skipif("cxxrtl" not in available_backends(), reason="no CXXRTL toolchain")
+def test_a_design_that_does_not_build_leaves_earlier_results_as_they_were(
+    tmp_path, monkeypatch, capsys
+):
+    # An earlier campaign's results, recording and report: a campaign refused at its build
+    # step ran nothing, so it must not replace them (nor describe itself in campaign.json).
+    _campaign_that_does_not_build(tmp_path)
+    out = tmp_path / "out"
+    (out / "recordings").mkdir(parents=True)
+    earlier = {
+        "results.jsonl": json.dumps({"run_id": "0123abcd", "status": "fail", "seed": 0}) + "\n",
+        "campaign.json": json.dumps({"name": "earlier", "runs": 1, "missing": 0}),
+        "report.html": "<html>earlier</html>",
+        "recordings/0123abcd.rrd": "rrd",
+    }
+    for name, text in earlier.items():
+        (out / name).write_text(text)
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(SystemExit) as exit_info:
+        run_cli(
+            main,
+            ["c.toml", "--workers", "1", "--out", "out", "--quiet"],
+            prog="fpga-robotics sweep",
+        )
+    assert exit_info.value.code == 2
+    assert "building the design of" in capsys.readouterr().err
+    now = {str(p.relative_to(out)): p.read_text() for p in out.rglob("*") if p.is_file()}
+    assert now == earlier

@@ -49,3 +49,28 @@ def test_forked_rows_are_the_full_runs_rows(tmp_path):
     # The designs did part: not every run of a seed drove the same path.
     paths = {(r["seed"], r["path_length_m"]) for r in a.values()}
     assert len(paths) > 2
+
+
+def test_a_worker_death_in_a_group_loses_only_the_run_in_progress(tmp_path, monkeypatch):
+    # The runs with search_dps 250 end their worker process: in the group of one seed's four
+    # designs, the second and the fourth. The first finished before the death and keeps its
+    # row; the third, never started, is run after it; each dying run alone is an error, as
+    # when every run is made in full.
+    monkeypatch.setenv("FPGA_ROBOTICS_SWEEP_FAULT", "exit@0+design.search_dps=250")
+    grid_only = {k: v for k, v in CAMPAIGN.items() if k != "sets"}
+    campaign = load_campaign({**grid_only, "seeds": [0], "duration": 3.0})
+    plan = make_plan(campaign)
+    assert [len(g) for g in fork_groups(plan.runs, plan.worlds)] == [4]
+    forked = run_campaign(campaign, tmp_path / "forked", workers=1, record="none")
+    full = run_campaign(campaign, tmp_path / "full", workers=1, record="none", fork=False)
+
+    def by_id(rows):
+        return {r["run_id"]: {k: v for k, v in r.items() if k not in TIMES} for r in rows}
+
+    a, b = by_id(forked), by_id(full)
+    assert a == b
+    died = sorted(r["design.search_dps"] for r in a.values() if r["status"] == "error")
+    assert died == [250, 250]
+    assert {r["message"] for r in a.values() if r["status"] == "error"} == {
+        "the worker running it died (a crash or a kill)"
+    }

@@ -85,6 +85,8 @@ def test_two_workers_give_the_summaries_of_runs_made_one_by_one(small_campaign):
     assert len((out / "results.csv").read_text().splitlines()) == len(rows) + 1
     html = (out / "report.html").read_text()
     assert "data:image/png;base64," in html and "<script" not in html
+    # No run sets both design.diff_min (the grid) and robot.mass (the set): no heatmap.
+    assert "design.diff_min x robot.mass" not in html
     # The report names every axis, with the runs of the other kind as "(not set)".
     summary = report_dir(out)
     assert "pass rate per design.diff_min:" in summary and "pass rate per robot.mass:" in summary
@@ -217,3 +219,45 @@ def test_a_campaign_with_a_shadow_design_on_pins_runs_it_as_run_does(tmp_path, m
             ).summary
         assert not any(direct["shadow"]["differing_frames"].values())
         _assert_row_matches(row, direct)
+
+
+def _report_row(scenario, status, **overrides):
+    return {
+        "run_id": f"{len(overrides)}{status}{sorted(overrides.items())}",
+        "scenario": scenario,
+        "seed": 0,
+        "status": status,
+        "message": "",
+        "failed_checks": "found_min_fraction" if status == "fail" else "",
+        "na_checks": "",
+        "replay": "python -m fpga_robotics.run",
+        "recording": "",
+        **overrides,
+    }
+
+
+def test_the_report_maps_pass_rates_only_of_runs_that_set_both_axes(tmp_path):
+    from fpga_robotics.sweep.report import write_html
+
+    def heatmaps(rows):
+        """How many maps the report of ``rows`` (axes a and b) draws under their heading."""
+        write_html(tmp_path / "report.html", rows, ["a", "b"], {"name": "t"})
+        page = (tmp_path / "report.html").read_text()
+        if "<h2>a x b</h2>" not in page:
+            return 0
+        section = page[page.index("<h2>a x b</h2>") : page.index("<h2>Metric distributions")]
+        return section.count("<img ")
+
+    # A grid of two axes: one map per scenario.
+    grid = [
+        _report_row(s, "pass" if a == 4 else "fail", a=a, b=b)
+        for s in ("one", "two")
+        for a in (4, 8)
+        for b in (0.5, 1.0)
+    ]
+    assert heatmaps(grid) == 2
+    # [[sets]] tables of one key each (robustness's shape): no run sets both, no map.
+    sets = [_report_row("one", "pass", a=4), _report_row("one", "fail", b=1.0)]
+    assert heatmaps(sets) == 0
+    # Only the scenario whose runs set both gets a map.
+    assert heatmaps(sets + grid[4:]) == 1

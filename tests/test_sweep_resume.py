@@ -10,7 +10,9 @@ import subprocess
 import sys
 from pathlib import Path
 
-from fpga_robotics.sweep import load_campaign, run_campaign
+import pytest
+
+from fpga_robotics.sweep import api, load_campaign, run_campaign
 from fpga_robotics.sweep.results import load_rows
 
 DATA = Path(__file__).parent / "data"
@@ -140,6 +142,59 @@ def test_resume_records_the_kept_runs_the_new_record_option_asks_for(tmp_path):
     # holds the two kept rows, no line was added).
     run_campaign(campaign, out, workers=1, resume=True, record="all", bag=True)
     assert len((out / "results.jsonl").read_text().splitlines()) == 2
+
+
+def test_a_campaign_without_resume_drops_the_earlier_recordings_and_bags_with_their_rows(
+    tmp_path, monkeypatch
+):
+    """Without ``--resume`` the earlier rows go, and so do their recordings, bags and
+    report: each file in the folder describes a row that is there."""
+    scenario = tmp_path / "walkaway.toml"
+    out = tmp_path / "out"
+    scenario.write_text(SCENARIO.format(limit=2.5))  # the slow target passes, the fast fails
+    campaign = load_campaign(
+        {
+            "scenarios": [str(scenario)],
+            "seeds": [0],
+            "backend": "model",
+            "resolution": "40x24",
+            "duration": 2.0,
+            "grid": {"people.0.speed": [0.2, 1.0]},
+        }
+    )
+    first = run_campaign(campaign, out, workers=1, record="all", bag=True)
+    assert len(list((out / "recordings").iterdir())) == 2
+    assert len(list((out / "bags").iterdir())) == 2
+    assert (out / "report.html").is_file()
+
+    # Interrupted before its first run finished: no row, so no file of the earlier runs.
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    with monkeypatch.context() as m:
+        m.setattr(api, "run_plan", interrupted)
+        with pytest.raises(KeyboardInterrupt):
+            run_campaign(campaign, out, workers=1, record="failing")
+    assert load_rows(out) == []
+    assert sorted(p.name for p in out.iterdir()) == [
+        "bags",
+        "campaign.json",
+        "recordings",
+        "results.csv",
+        "results.jsonl",
+        "results.parquet",
+    ]
+    assert list((out / "recordings").iterdir()) == list((out / "bags").iterdir()) == []
+    assert json.loads((out / "campaign.json").read_text())["missing"] == 2
+
+    # The same runs again, recording the failing one only: its recording is the only file.
+    rows = run_campaign(campaign, out, workers=1, record="failing")
+    assert {r["run_id"] for r in rows} == {r["run_id"] for r in first}
+    [failing] = [r for r in rows if r["status"] == "fail"]
+    named = {r["recording"] for r in load_rows(out) if r["recording"]}
+    assert named == {f"recordings/{failing['run_id']}.rrd"}
+    assert {f"recordings/{p.name}" for p in (out / "recordings").iterdir()} == named
+    assert list((out / "bags").iterdir()) == []
 
 
 #: A campaign's run identities, printed by a fresh interpreter: a design's imports are modules

@@ -23,7 +23,11 @@ from fpga_robotics.sweep.api import run_campaign
 from fpga_robotics.sweep.campaign import load_campaign
 from fpga_robotics.sweep.results import read_meta
 
-__all__ = ["bench", "main", "measure"]
+__all__ = ["REPEATS", "RUNS", "bench", "main", "measure"]
+
+#: Runs per measurement and measurements each way, by default.
+RUNS = 40
+REPEATS = 3
 
 
 def _campaign(runs, args):
@@ -56,7 +60,15 @@ def _once(runs, workers, args):
 
 def bench(args):
     """``python -m fpga_robotics.sweep --bench``: print the figures; exit code 0."""
-    measure(args)
+    measure(
+        SimpleNamespace(
+            **{
+                **vars(args),
+                "bench_runs": args.bench_runs or RUNS,
+                "bench_repeats": args.bench_repeats or REPEATS,
+            }
+        )
+    )
     return 0
 
 
@@ -64,10 +76,11 @@ def measure(args):
     """Print the figures and return them: per worker count, the medians."""
     n = args.workers or os.cpu_count() or 1
     runs, repeats = args.bench_runs, args.bench_repeats
+    compared = f"1 and {n} workers alternately" if n > 1 else "1 worker"
     print(
         f"campaign benchmark: {runs} runs of {args.scenarios or 'follow_person'}, "
         f"{args.resolution or '160x120'}, {args.duration or 10.0} s simulated, backend "
-        f"{args.backend or 'model'}; 1 and {n} workers alternately, {repeats} times; "
+        f"{args.backend or 'model'}; {compared}, {repeats} times; "
         f"load average {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores"
     )
     counts = sorted({1, n})
@@ -105,7 +118,9 @@ def measure(args):
 
 
 def _options(parser):
-    parser.add_argument("--runs", type=int, default=40, help="runs per measurement (default 40)")
+    parser.add_argument(
+        "--runs", type=int, default=RUNS, help=f"runs per measurement (default {RUNS})"
+    )
     parser.add_argument("--workers", type=int, help="N (default: the machine's cores)")
     parser.add_argument("--scenario", help="the scenario (default follow_person)")
     parser.add_argument("--backend", help="the design's backend (default model)")
@@ -135,4 +150,4 @@ def run(args):
     return figures
 
 
-main = scaffold.command(run, __doc__, name="sweep", options=_options, check=_check, repeats=3)
+main = scaffold.command(run, __doc__, name="sweep", options=_options, check=_check, repeats=REPEATS)

@@ -134,19 +134,20 @@ def build_parser(prog=PROG):
     e.add_argument(
         "--bench",
         action="store_true",
-        help="benchmark: the same runs on 1 worker and on N (--workers) workers",
+        help="benchmark: the same runs of one scenario (--scenarios, --backend, "
+        "--resolution, --duration) on 1 worker and on N (--workers) workers; no CAMPAIGN",
     )
     e.add_argument(
         "--bench-runs",
         type=int,
-        default=40,
+        default=None,
         metavar="N",
         help="with --bench: runs per measurement (default 40)",
     )
     e.add_argument(
         "--bench-repeats",
         type=int,
-        default=3,
+        default=None,
         metavar="N",
         help="with --bench: measurements each way (default 3; medians)",
     )
@@ -238,6 +239,44 @@ def _check_options(args):
     check_cluster_options(args.workers, args.scheduler)
 
 
+#: The options ``--bench`` takes: what its runs are and the workers it compares; it runs no
+#: campaign and writes no results.
+BENCH_OPTIONS = (
+    "bench",
+    "workers",
+    "scenarios",
+    "backend",
+    "resolution",
+    "duration",
+    "bench_runs",
+    "bench_repeats",
+)
+
+
+def _check_bench_options(args, parser):
+    """``--bench`` with what it does not use, or ``--bench-*`` without it: ``UsageError``
+    naming the option (it would be ignored)."""
+    if not args.bench:
+        for name in ("bench_runs", "bench_repeats"):
+            if getattr(args, name) is not None:
+                raise UsageError(f"--{name.replace('_', '-')} goes with --bench")
+        return
+    if args.campaign is not None:
+        raise UsageError(
+            f"--bench measures runs of its own (--scenarios NAME, --backend, --resolution, "
+            f"--duration), not a campaign: leave out {args.campaign}"
+        )
+    for action in parser._actions:  # the options as given against their defaults
+        given = getattr(args, action.dest, action.default) != action.default
+        if given and action.option_strings and action.dest not in BENCH_OPTIONS:
+            raise UsageError(
+                f"--bench runs no campaign and writes no results: {action.option_strings[0]} "
+                f"does not apply to it"
+            )
+    if args.scenarios is not None and "," in args.scenarios:
+        raise UsageError(f"--bench measures one scenario, got --scenarios {args.scenarios}")
+
+
 def _dry_run(campaign, args):
     plan = make_plan(campaign)
     if args.max_runs:
@@ -271,8 +310,10 @@ def main(argv=None, prog=PROG):
     argv = list(sys.argv[1:] if argv is None else argv)
     if argv[:1] == ["report"]:
         return _report(argv[1:], prog)
-    args = build_parser(prog).parse_args(argv)
+    parser = build_parser(prog)
+    args = parser.parse_args(argv)
     _check_options(args)
+    _check_bench_options(args, parser)
     if args.bench:
         from fpga_robotics.bench.sweep import bench  # lazy: the run stack (~1 s)
 

@@ -57,6 +57,7 @@ from fpga_robotics.sim.records import SensorReading
 
 __all__ = [
     "RealClockLoop",
+    "check_pin_backend",
     "format_extra_outputs",
     "make_pin_backend",
     "pin_design_source",
@@ -112,14 +113,20 @@ def _result_strobe(scenario):
     return pm.strobe, pm.latency, pm.timeout
 
 
-def make_pin_backend(name, scenario, *, on_build=None):
-    """A pin-level backend by name ("auto": the fastest compiled one) for the scenario."""
+def check_pin_backend(name):
+    """``UsageError`` for a backend by name that cannot run a design on pins (the model
+    backend), checked before anything is built."""
     if name == "model":
         raise UsageError(
             'the model backend runs whole frames; sim.timing = "real_clock" '
             "needs a backend that simulates every clock: --backend auto, "
             "cxxrtl, verilator or pysim"
         )
+
+
+def make_pin_backend(name, scenario, *, on_build=None):
+    """A pin-level backend by name ("auto": the fastest compiled one) for the scenario."""
+    check_pin_backend(name)
     kwargs = {"on_build": on_build} if on_build is not None else {}
     backend = get_pin_backend(name, pin_design_source(scenario), **kwargs)
     top = scenario_top(scenario)

@@ -74,20 +74,21 @@ def run_campaign(
             else open_client(scheduler=scheduler, workers=workers)
         ) as c:
             wait_for_a_worker(c, scheduler)
-            # The folder only once the cluster is there: an unreachable scheduler writes
-            # nothing.
-            store = ResultStore(out_dir, resume=resume, run_ids=run_ids)
-            if store.dropped:
-                say(
-                    f"--resume: {store.dropped} earlier row(s) in {out_dir} not kept "
-                    f"(errors, timeouts, and runs this campaign no longer makes: an edited "
-                    f"scenario or design file, another option or package version)"
-                )
             t_build = time.perf_counter()
             builds = build_all(c, plan)
             meta["build_s"] = round(time.perf_counter() - t_build, 3)
             meta["build_s_each"] = [round(b, 3) for b in builds]
             say(f"built or loaded {len(builds)} design(s) in {meta['build_s']:.1f} s")
+            # The folder only once the cluster is there and every design built: an
+            # unreachable scheduler, a design that does not build or a Ctrl-C before the
+            # runs leave the folder as it was.
+            store = ResultStore(out_dir, resume=resume, run_ids=run_ids)
+            if resume and store.dropped:
+                say(
+                    f"--resume: {store.dropped} earlier row(s) in {out_dir} not kept "
+                    f"(errors, timeouts, and runs this campaign no longer makes: an edited "
+                    f"scenario or design file, another option or package version)"
+                )
             done = store.done_ids()
             already = len({plan.ids[s] for s in plan.runs} & done)
             if already:
@@ -132,6 +133,8 @@ def run_campaign(
             write_meta(out_dir, meta)
             if store.rows:
                 _write_report(out_dir, store.rows, campaign.axes, meta)
+            else:  # an earlier campaign's report would describe rows no longer there
+                (out_dir / "report.html").unlink(missing_ok=True)
     return store.rows
 
 

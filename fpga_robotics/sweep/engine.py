@@ -3,11 +3,14 @@ thread each) or an existing scheduler; builds first, then the runs, results as t
 
 A run's outcome comes back as a row; a run whose worker died (a crash, or the watchdog that
 ends a worker stuck inside one frame) comes back as Dask's ``KilledWorker`` and is recorded as
-``timeout`` (when it was out for longer than its timeout) or ``error``. Ctrl-C cancels what is
-queued, closes the client and stops an embedded cluster's workers; the rows so far are kept.
+``timeout`` (when the watchdog said so) or ``error``. In a fork group only the run in progress
+is: the runs before it keep the outcomes they published, the runs after it are run again.
+Ctrl-C cancels what is queued, closes the client and stops an embedded cluster's workers; the
+rows so far are kept.
 """
 
 import contextlib
+import json
 import logging
 import os
 import shutil
@@ -250,7 +253,7 @@ def run_plan(
     # (specs, recording pass), the last first: the new runs, then the kept runs' recordings.
     pending = [([spec], True) for spec in reversed(to_record)]
     pending += [(group, False) for group in reversed(groups)]
-    running = {}  # future -> (specs, submitted at, timeout, recording pass)
+    running = {}  # future -> (specs, submitted at, their timeouts, recording pass)
     # Failing runs waiting for their recording pass: a run's row is stored once, with its
     # recording (results.jsonl holds one line per run). Kept runs to record wait with their
     # kept rows.
@@ -279,7 +282,7 @@ def run_plan(
                 key=key,
                 bag=bool(bag and rec),
             )
-        running[fut] = (specs, time.monotonic(), sum(limits), recording)
+        running[fut] = (specs, time.monotonic(), limits, recording)
         completed.add(fut)
 
     def top_up():
@@ -314,18 +317,23 @@ def run_plan(
     try:
         top_up()
         for fut in completed:
-            specs, _submitted, limit, recording = running.pop(fut)
-            outcome = _outcome(client, fut, limit)
+            specs, _submitted, limits, recording = running.pop(fut)
+            outcome = _outcome(client, fut, limits)
             if recording:  # the recording pass of a failing run: its row, with the .rrd
                 row = awaiting.pop(plan.ids[specs[0]], None)
                 if row is not None:  # (a recording pass that failed: the row without one)
                     keep(row, outcome)
                 top_up()
                 continue
-            # A group's task gives one outcome per run (or one for all: its worker died).
+            # A group's task gives one outcome per run (None: not run, its worker died
+            # before), or one for all (it never ran: a lost connection, a cancelled task).
             outcomes = outcome if isinstance(outcome, list) else [outcome] * len(specs)
             for spec, each in zip(specs, outcomes, strict=True):
-                finished(spec, each)
+                if each is not None:
+                    finished(spec, each)
+            not_run = [spec for spec, each in zip(specs, outcomes, strict=True) if each is None]
+            if not_run:  # next, as a group of their own
+                pending.append((not_run, False))
             top_up()
     finally:
         if running:
@@ -355,35 +363,59 @@ def kept_to_record(plan, store, record, bag):
     return list(missing.values())
 
 
-def _timed_out(client, key):
-    """Whether a worker said it ended itself because run ``key`` was stuck."""
+def _timed_out(client, tag):
+    """Whether a worker said it ended itself because run ``tag`` was stuck."""
     end = time.monotonic() + 3.0  # the event may arrive just after the worker's death
     while True:
         events = client.get_events(runner.TIMEOUT_TOPIC)
-        # A group's runs are tagged KEY-<index> (fork_groups.execute_group).
-        tags = [str(msg.get("tag")) for _t, msg in events]
-        if any(tag == key or tag.startswith(f"{key}-") for tag in tags):
+        if any(str(msg.get("tag")) == tag for _t, msg in events):
             return True
         if time.monotonic() > end:
             return False
         time.sleep(0.1)
 
 
-def _outcome(client, fut, limit):
+def _outcome(client, fut, limits):
+    """The outcome of a task of ``len(limits)`` runs (their timeouts): one run's, or a
+    group's list (``_group_outcomes`` when its worker died)."""
     from distributed import KilledWorker  # lazy: Dask costs ~1 s; only a run needs it
 
     try:
         return fut.result()
     except KilledWorker:
-        if _timed_out(client, fut.key):
-            return {
-                "status": "timeout",
-                "message": f"no result within the per-run timeout of {limit:.3g} s: the "
-                f"run stopped making progress and its worker was ended",
-            }
-        return {"status": "error", "message": "the worker running it died (a crash or a kill)"}
+        if len(limits) > 1:
+            return _group_outcomes(client, fut.key, limits)
+        return _died(client, fut.key, limits[0])
     except Exception as exc:  # noqa: BLE001 (a lost connection, a cancelled task: recorded)
         return {"status": "error", "message": f"{type(exc).__name__}: {exc}".splitlines()[0]}
+
+
+def _died(client, tag, limit):
+    """The outcome of run ``tag``, whose worker died while running it."""
+    if _timed_out(client, tag):
+        return {
+            "status": "timeout",
+            "message": f"no result within the per-run timeout of {limit:.3g} s: the "
+            f"run stopped making progress and its worker was ended",
+        }
+    return {"status": "error", "message": "the worker running it died (a crash or a kill)"}
+
+
+def _group_outcomes(client, key, limits):
+    """The outcomes of a fork group whose worker died: those its runs published
+    (fork_groups.MEMBER_TOPIC; they run in order, tagged KEY-<index>), the death for the run
+    after the last of them, None for the runs after it (never run)."""
+    tags = [f"{key}-{i}" for i in range(len(limits))]
+    published = {
+        msg.get("tag"): json.loads(msg["outcome"])
+        for _t, msg in client.get_events(fork_groups.MEMBER_TOPIC)
+        if msg.get("tag") in tags
+    }
+    outcomes = [published.get(tag) for tag in tags]
+    dying = max((i + 1 for i, each in enumerate(outcomes) if each is not None), default=0)
+    if dying < len(tags):
+        outcomes[dying] = _died(client, tags[dying], limits[dying])
+    return outcomes
 
 
 def _save_bag(out_dir, run_id, files):

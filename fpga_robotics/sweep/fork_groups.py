@@ -16,7 +16,12 @@ from fpga_robotics.loop.fork import VARIANT_SECTIONS
 
 from . import runner
 
-__all__ = ["execute_group", "fork_groups", "world_key"]
+__all__ = ["MEMBER_TOPIC", "execute_group", "fork_groups", "world_key"]
+
+#: The Dask event topic under which a group's task publishes each run's outcome (JSON text,
+#: tagged as the run) as soon as it has it: when the worker dies later in the group, the
+#: campaign keeps the runs that finished.
+MEMBER_TOPIC = "fpga-robotics-sweep-group-runs"
 
 
 def world_key(args, scenario, shadow_params):
@@ -50,16 +55,17 @@ def fork_groups(specs, worlds):
 def execute_group(argvs, timeouts, tags):
     """Run a group's runs (``run`` argument lists of one world), the first that completes
     as the reference, the others forked from it; returns one outcome per run as
-    ``runner.execute`` does."""
+    ``runner.execute`` does, each also published as it comes (``MEMBER_TOPIC``)."""
     from fpga_robotics.loop.pin_fork import reference_run  # lazy: the run stack (~1 s)
     from fpga_robotics.loop.timings import run_scenario  # lazy: the run stack (~1 s)
 
     outcomes, reference = [], None
+    worker = runner._current_worker()
     for argv, timeout, tag in zip(argvs, timeouts, tags, strict=True):
         with runner.RunOutcome() as outcome:
             args, scenario, _shadow = runner._loaded(argv)
             design, _ = runner._designs_for(args, scenario, None)
-            outcome.deadline = deadline = runner._Deadline(timeout, runner._fault(args.seed), tag)
+            outcome.deadline = deadline = runner._Deadline(timeout, runner._fault(args), tag)
             with outcome.running():
                 if reference is None:
                     reference = reference_run(
@@ -75,4 +81,6 @@ def execute_group(argvs, timeouts, tags):
                         )
             outcome.record(result)
         outcomes.append(outcome.out)
+        if worker is not None:
+            worker.log_event(MEMBER_TOPIC, {"tag": tag, "outcome": json.dumps(outcome.out)})
     return outcomes

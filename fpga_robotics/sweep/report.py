@@ -299,9 +299,9 @@ def _recording(row):
 
 
 def write_html(path, rows, axes, meta):
-    """``report.html``: pass rates, the heatmap of the first two grid axes, metric
-    distributions, the failing runs grouped by check, each with its replay command, and the
-    checks that could not judge some runs (n/a), with their reasons. ``meta``: the campaign's
+    """``report.html``: pass rates, the heatmap of the first two axes (of the runs that set
+    both), metric distributions, the failing runs grouped by check, each with its replay
+    command, and the checks that could not judge some runs (n/a), with their reasons. ``meta``: the campaign's
     ``campaign.json`` (``missing``: how many of its runs never ran)."""
     import matplotlib  # lazy: pyplot costs ~1.5 s; only plots need it
 
@@ -341,9 +341,17 @@ def write_html(path, rows, axes, meta):
         )
         for axis in axes:
             parts.append(f"<img src='{_bar_figure(_by(rows, axis), f'per {axis}', axis)}'>")
-        if len(axes) >= 2:  # one map per scenario: each has its own conditions
-            parts.append(f"<h2>{esc(axes[0])} x {esc(axes[1])}</h2>")
+        # One map per scenario (each has its own conditions), of the runs that set both
+        # keys: [[sets]] tables that each vary one key would give empty maps.
+        maps = {}
+        if len(axes) >= 2:
             for name, group in _by(rows, "scenario").items():
+                both = [r for r in group if None not in (r.get(axes[0]), r.get(axes[1]))]
+                if both:
+                    maps[name] = both
+        if maps:
+            parts.append(f"<h2>{esc(axes[0])} x {esc(axes[1])}</h2>")
+            for name, group in maps.items():
                 parts.append(f"<img src='{_heatmap(group, axes[0], axes[1], name)}'>")
         parts.append("<h2>Metric distributions</h2>")
         for column, label in METRICS:

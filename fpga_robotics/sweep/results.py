@@ -147,22 +147,23 @@ def _table(rows):
 class ResultStore:
     """The results folder of a campaign. ``resume``: keep the rows already there that are
     finished runs of the campaign: ``run_ids``, the identities of its runs (None: every
-    finished run). ``dropped``: how many rows already there were not kept."""
+    finished run); without it none is kept. ``dropped``: how many rows already there were
+    not kept."""
 
     FLUSH_EVERY_S = 2.0
 
     def __init__(self, out_dir, *, resume=False, run_ids=None):
         self.dir = Path(out_dir)
         self.dir.mkdir(parents=True, exist_ok=True)
-        rows = load_rows(self.dir) if resume else []
+        rows = load_rows(self.dir)
         # Runs to do again (errors, timeouts) are dropped from the journal too, and so are
         # rows of runs the campaign no longer makes (a scenario or design file edited, an
-        # option or the package version changed: the identity differs), with their
-        # recordings: the campaign's run under its new identity replaces them.
+        # option or the package version changed: the identity differs), and every row
+        # without resume, each with its recording and bag: no file is left that no row names.
         self._rows = {
             r["run_id"]: r
             for r in rows
-            if r.get("status") in DONE and (run_ids is None or r["run_id"] in run_ids)
+            if resume and r.get("status") in DONE and (run_ids is None or r["run_id"] in run_ids)
         }
         stale = [r["run_id"] for r in rows if r["run_id"] not in self._rows]
         self.dropped = len(stale)

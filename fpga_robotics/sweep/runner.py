@@ -9,8 +9,9 @@ process keeps the designs it opened (a compiled model is loaded once, reset befo
 
 Test hook (not a user option): ``FPGA_ROBOTICS_SWEEP_FAULT="raise@SEED,exit@SEED,hang@SEED"``
 in a worker's environment makes the run of that seed raise, end its worker process, or stop
-making progress, at its first frame; the test suite uses it to check that a campaign records
-such runs and goes on.
+making progress, at its first frame (``exit@SEED+KEY=VALUE``: only the runs of that seed
+with that ``--set`` item); the test suite uses it to check that a campaign records such runs
+and goes on.
 """
 
 import argparse
@@ -86,6 +87,7 @@ def load_run(argv):
     ``--shadow``'s FollowTarget parameters, or for a shadow design (``--shadow REF``,
     real-clock timing) the scenario that runs it; None without a shadow."""
     from fpga_robotics.cli import run  # lazy: the run stack (~1 s)
+    from fpga_robotics.loop.real_clock import check_pin_backend  # lazy: the run stack (~1 s)
     from fpga_robotics.scenario.load import (  # lazy: the run stack (~1 s)
         MAX_SEED,
     )
@@ -103,6 +105,7 @@ def load_run(argv):
         shadow_params = params_scenario.params
     run._design_files(args, scenario.foreign)
     if scenario.sim.timing == "real_clock":  # the pin design is the scenario's foreign one
+        check_pin_backend(args.backend)  # the build would refuse it: a dry run too
         scenario = run._with_design_files(args, scenario)
     return args, scenario, shadow_params
 
@@ -209,11 +212,12 @@ def build_designs(argv):
     return time.perf_counter() - t0
 
 
-def _fault(seed):
+def _fault(args):
     spec = os.environ.get("FPGA_ROBOTICS_SWEEP_FAULT", "")
     for item in filter(None, (s.strip() for s in spec.split(","))):
         kind, _, at = item.partition("@")
-        if at.strip() == str(seed):
+        seed, _, override = at.partition("+")
+        if seed.strip() == str(args.seed) and (not override or override in args.overrides):
             return kind.strip()
     return None
 
@@ -351,7 +355,7 @@ def execute(argv, timeout=None, record=False, tag=None, bag=False, stop_limit=No
         if getattr(args, "runtime", None):  # a kept design gets this run's [runtime] values
             run.apply_runtime(design, args)
         set_stop_limit(design, stop_limit)  # a kept design: this run's, or none
-        outcome.deadline = deadline = _Deadline(timeout, _fault(args.seed), tag)
+        outcome.deadline = deadline = _Deadline(timeout, _fault(args), tag)
         recorder, rrd = (None, None)
         if record:
             recorder, rrd = _recorder(args, scenario.name, int(record))
