@@ -73,8 +73,8 @@ def test_vcd_holds_the_ports_and_only_the_requested_frames(name, tmp_path):
     names, changes, times = read_vcd(path)
     all_names = set().union(*names.values())
     assert PORTS <= all_names, f"ports missing from the VCD: {PORTS - all_names}"
-    # Time counts half clock cycles from construction: frame 0 (and its final settle) came
-    # before the trace, frames 1 and 2 are in it, frame 3 is not.
+    # Time counts half clock cycles from construction: frame 0 came before the trace, frames
+    # 1 and 2 are in it, frame 3 is not.
     start = 2 * cycles[0] + 1
     assert min(times) >= start
     assert max(times) - min(times) <= 2 * (cycles[1] + cycles[2]) + 2
@@ -83,6 +83,13 @@ def test_vcd_holds_the_ports_and_only_the_requested_frames(name, tmp_path):
     code = next(c for c, n in names.items() if "frame_done" in n)
     rises = [t for t, v in changes[code] if v == "1"]
     assert len(rises) == 2
+    # The clock rises every two half cycles, frame boundaries included, so the two traced
+    # frames' strobes lie as many clock cycles apart as a frame takes.
+    clock = next(c for c, n in names.items() if "clk" in n)
+    edges = [t for t, v in changes[clock] if v == "1"]
+    assert np.diff(edges).tolist() == [2] * (len(edges) - 1)
+    assert len(edges) == cycles[1] + cycles[2]
+    assert rises[1] - rises[0] == 2 * cycles[1]
 
 
 def test_untraced_build_has_no_tracing():

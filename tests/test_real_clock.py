@@ -190,3 +190,24 @@ def test_compressed_timing_refuses_a_design_with_pins():
 def test_the_model_backend_cannot_run_real_clock():
     with pytest.raises(UsageError, match="needs a backend that simulates every clock"):
         run_scenario(load_scenario("line_track", ["sim.duration=0.1"]), backend="model")
+
+
+def test_a_pin_design_is_generated_once_per_process(monkeypatch):
+    import collections
+
+    from fpga_robotics.loop.real_clock import pin_design_source
+    from fpga_robotics.sim.pins import design
+
+    monkeypatch.setattr(design, "_KEPT", collections.OrderedDict())
+    generated = []
+    generate = design.generate_cxxrtl
+    monkeypatch.setattr(design, "generate_cxxrtl", lambda c: generated.append(c) or generate(c))
+    first = pin_design_source(load_scenario("obstacle_between", ["design.diff_min=7"]))
+    # Another run of the same design (its world changed) reuses the generated text.
+    again = load_scenario("obstacle_between", ["design.diff_min=7", "robot.start=[1.0, 2.0]"])
+    assert pin_design_source(again).cxxrtl == first.cxxrtl
+    assert len(generated) == 1
+    # Other parameters are another design.
+    other = pin_design_source(load_scenario("obstacle_between", ["design.diff_min=8"]))
+    assert other.cxxrtl != first.cxxrtl
+    assert len(generated) == 2

@@ -359,6 +359,21 @@ CASES = [
         [*TURRET, "--set", TWO_CAMERAS, "--set", 'sim.timing="real_clock"'],
         TWO_CAMERAS_SAY,
     ),
+    # FollowTarget's keys on a design that reads none of them: refused, as export does
+    (
+        "preset-on-follow-line",
+        ["--scenario", "line_track", "--set", "design.preset=published"],
+        (
+            "design.preset applies to a design with FollowTarget or a camera "
+            "(follow_target, follow_target_safe, turret_tracker), not to design.top = "
+            "'follow_line'"
+        ),
+    ),
+    (
+        "follow-target-keys-on-corridor",
+        ["--scenario", "corridor", "--set", "design.diff_min=0", "--set", "design.max_dps=10"],
+        "design.diff_min, design.max_dps apply to a design with FollowTarget or a camera",
+    ),
 ]
 
 

@@ -15,7 +15,8 @@ def test_prints_a_line_per_world(capsys):
     lines = capsys.readouterr().out.strip().splitlines()
     assert lines[0].startswith("8 steps of 4.17 ms per frame, 3 frames, median of 1 runs")
     assert [ln[2:34].strip() for ln in lines[1:-1]] == list(WORLDS)
-    assert all(float(ln.split()[-8]) > 0 for ln in lines[1:-1])  # ms/frame
+    assert all(float(ln.split()[-10]) > 0 for ln in lines[1:-1])  # ms/frame
+    assert all(float(ln.split()[-7].rstrip(")")) > 0 for ln in lines[1:-1])  # its CPU time
     # The cost of the terrain world's lookup and noise alone, after the worlds.
     assert lines[-1][2:34].strip() == "of which terrain and noise alone"
     assert float(lines[-1].split()[6]) > 0

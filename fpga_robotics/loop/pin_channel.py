@@ -18,7 +18,7 @@ import numpy as np
 
 from fpga_robotics.designs.builtin import build_component
 from fpga_robotics.sim.camera.frames import to_rgb444
-from fpga_robotics.sim.pins import PinDesignSource, PixelTiming, get_pin_backend
+from fpga_robotics.sim.pins import PinDesignSource, PixelTiming, get_pin_backend, kept_source
 
 __all__ = ["PIN_CHANNEL_BACKENDS", "PinFrameChannel"]
 
@@ -44,11 +44,15 @@ class PinFrameChannel:
         described = f"{top.name}:{port}:{params!r}:{sorted(tables.items())!r}"
         name = re.sub(r"[^A-Za-z0-9_]", "_", top.name)[:32]
         key = f"{name}-{port}-{hashlib.sha256(described.encode()).hexdigest()[:16]}"
-        source = PinDesignSource(
-            lambda: build_component(top, params, tables),
+        source = kept_source(
             key,
-            pixels=(f"{port}__valid", f"{port}__payload"),
-            frame_size=self.frame_size,
+            top,
+            lambda: PinDesignSource(
+                lambda: build_component(top, params, tables),
+                key,
+                pixels=(f"{port}__valid", f"{port}__payload"),
+                frame_size=self.frame_size,
+            ),
         )
         kwargs = {"on_build": on_build} if on_build is not None else {}
         self.pins = get_pin_backend(backend, source, **kwargs)

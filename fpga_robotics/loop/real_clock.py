@@ -51,6 +51,7 @@ from fpga_robotics.sim.pins import (
     ShadowDesignError,
     VerilogPinSource,
     get_pin_backend,
+    kept_source,
 )
 from fpga_robotics.sim.pins.timing import real_clock_timing
 from fpga_robotics.sim.records import SensorReading
@@ -99,7 +100,11 @@ def pin_design_source(scenario):
         ports = resolve_design(scenario.top, scenario.design_params).ports
         if ports.get("filtered__valid", ("",))[0] == "out" and "filtered__payload" in ports:
             extra["filtered"] = ("filtered__valid", "filtered__payload")
-    return PinDesignSource(lambda: build_component(top, params, tables), key, **extra)
+    return kept_source(
+        key,
+        top,
+        lambda: PinDesignSource(lambda: build_component(top, params, tables), key, **extra),
+    )
 
 
 def _result_strobe(scenario):

@@ -13,7 +13,8 @@ A scenario file has two kinds of sections. The world's sections (``room``, ``rob
 - ``[color]``: ``initial`` colour and ``changes = [{at = seconds, color = "..."}, ...]``;
 - ``[design]``: any ``FollowTargetParams`` field except ``width``/``height`` (those come from
   the camera resolution), and ``preset`` (``"published"``: ``FollowTargetParams.published()``
-  at the camera's resolution, applied first, the other ``design`` keys on top);
+  at the camera's resolution, applied first, the other ``design`` keys on top); an error on a
+  design that reads none of them (no FollowTarget inside, no camera);
 - ``[checks]``: the pass criteria of the scenario (see ``fpga_robotics.checks.summary.CHECKS``).
 
 Top-level keys: ``name``, ``description``, ``seed`` (default seed of a run).
@@ -1050,6 +1051,26 @@ def _top(design, source):
         raise ScenarioError(str(exc)) from None
 
 
+def _check_follow_target_keys_read(design, top, design_params):
+    """FollowTarget's ``[design]`` keys (and ``preset``) on a design that reads none: no
+    FollowTarget inside and no camera whose checks hold it to their law (docs/your_design.md)
+    would run the scenario as if they were not given, so they are an error, as ``export``
+    makes them."""
+    given = [k for k in design if k not in _FOREIGN_KEYS + _TOP_DESIGN_KEYS]
+    if not given:
+        return
+    spec = resolve_design(top, design_params)
+    if spec.top.camera or spec.top.takes_follow_target_params:
+        return
+    readers = [t.name for t in TOPS.values() if t.camera or t.takes_follow_target_params]
+    keys = ", ".join(f"design.{k}" for k in given)
+    raise ScenarioError(
+        f"{keys} {'applies' if len(given) == 1 else 'apply'} to a design with FollowTarget "
+        f"or a camera ({', '.join(readers)}), not to design.top = {spec.top.name!r}, which "
+        "reads none of them"
+    )
+
+
 def _run_uart(design, sim, connectors):
     """``[design]`` with the UART of a built-in design that has one (``[design.uart]``) on
     the run's clock and LIDAR link: a key left out takes ``sim.clock_hz`` or the
@@ -1172,6 +1193,8 @@ def _build(data, source, overrides):
     world = {s: copy.deepcopy(data[s]) for s in WORLD_SECTIONS if s in data}
     connectors = _connectors(world)
     top, tables, design_params = _top(_run_uart(data["design"], sim, connectors), source)
+    if foreign is None:
+        _check_follow_target_keys_read(data["design"], top, design_params)
     checks = _checks(data)
     sim = _resolve_timing(sim, camera, top, design_params, connectors, foreign)
     world_config = _check_world(world)

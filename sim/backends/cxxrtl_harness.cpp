@@ -71,11 +71,12 @@ struct Sim : TraceBase {
 #endif
     }
     inline void set_rst(bool on) { top.p_rst.set<bool>(on); }
-    inline void settle() {
+    inline void settle(bool record = true) {
 #ifndef FR_ONE_EVAL
         fr_cxxrtl::step_settle(top);
 #endif
-        sample();
+        if (record)
+            sample();
     }
     inline void edge() {
 #ifdef FR_ONE_EVAL

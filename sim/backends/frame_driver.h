@@ -10,6 +10,8 @@
 //   set_inputs(valid, payload, color_sel), set_rst(bool)
 //   settle()   clock low, evaluate: outputs show the state after the last edge and the
 //              combinational response to the inputs that the next edge samples
+//   settle(false)  the same, not recorded in a waveform (sample() records it later)
+//   sample()   record the half cycle in a waveform (traced builds; nothing otherwise)
 //   edge()     clock high, evaluate: one rising edge
 //   filtered_valid(), filtered_payload(), frame_done(), and the result outputs.
 //
@@ -106,10 +108,12 @@ public:
             for (int64_t i = 0; i < line_blank; ++i)
                 cycle(false, 0);
         }
-        // Idle until frame_blank has passed and the motors show the frame's values.
+        // Idle until frame_blank has passed and the motors show the frame's values. The
+        // settle that ends the frame is not a half cycle of its own in a waveform: the next
+        // frame's (or reset's) first settle is the same one, with its inputs.
         for (;;) {
             sim.set_inputs(false, 0, color_sel);
-            sim.settle();
+            sim.settle(false);
             if (done_edge < 0 && edges >= last_pixel_edge && sim.frame_done())
                 done_edge = edges;
             if (done_edge >= 0 && edges >= min_edges && edges >= done_edge + motor_latency)
@@ -118,6 +122,7 @@ public:
                 status = NO_FRAME_DONE;
                 break;
             }
+            sim.sample();
             observe();
             sim.edge();
             ++edges;

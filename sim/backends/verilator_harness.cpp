@@ -95,12 +95,13 @@ struct Sim : TraceBase {
         Vfollow_target___024root___eval(top->rootp);
 #endif
     }
-    inline void settle() {
+    inline void settle(bool record = true) {
         if (ONE_EVAL)
             return;
         top->clk = 0;
         eval();
-        sample();
+        if (record)
+            sample();
     }
     inline void edge() {
         if (ONE_EVAL)

@@ -15,7 +15,13 @@ from .base import (
     StopLimit,
 )
 from .compiled import CxxrtlPins, VerilatorPins
-from .design import FILTERED_PORTS, PIXEL_PORTS, PinDesignSource, follow_target_source
+from .design import (
+    FILTERED_PORTS,
+    PIXEL_PORTS,
+    PinDesignSource,
+    follow_target_source,
+    kept_source,
+)
 from .pysim import PysimPins
 from .timing import real_clock_timing
 from .verilog import VerilogPinSource
@@ -37,6 +43,7 @@ __all__ = [
     "VerilogPinSource",
     "follow_target_source",
     "get_pin_backend",
+    "kept_source",
     "real_clock_timing",
 ]
 

@@ -6,6 +6,7 @@ per ``run``, ``poke``, ``peek``, ``schedule``, ``watch`` and ``stream_frame``.
 
 import contextlib
 import ctypes
+import functools
 import os
 import re
 from pathlib import Path
@@ -82,6 +83,18 @@ def _sources(*names):
     return read_sources(names, SOURCE_DIR, HARNESS_DIR)
 
 
+@functools.lru_cache(maxsize=16)
+def _fast_model(model, outputs):
+    """``(model, output expressions, commit)``: the CXXRTL text with the outputs read from
+    flip-flops where they can be (``output_exprs``/``commit`` None where not). Kept per
+    process: reading a large model takes a tenth of a second, on every run of the design."""
+    exprs = output_sources(model, list(outputs))
+    if exprs is None:
+        return model, None, None
+    commit = fast_commit(model)
+    return with_wire_copies_inlined(without_port_copies(model, list(outputs))), exprs, commit
+
+
 def cxxrtl_plan(source):
     """The ``BuildPlan`` of a ``PinDesignSource`` (Amaranth's CXXRTL output) or a
     ``VerilogPinSource`` (its files read by Yosys) with CXXRTL."""
@@ -89,12 +102,8 @@ def cxxrtl_plan(source):
     foreign = hasattr(source, "verilog_files")
     # Each model compiles against the runtime headers of the Yosys that wrote it.
     include = runtime_include_dir() if foreign else cxxrtl_include_dir()
-    model = source.cxxrtl
-    outputs = [p.name for p in source.ports.values() if p.direction == "out"]
-    exprs = output_sources(model, outputs)
-    commit = fast_commit(model) if exprs is not None else None
-    if exprs is not None:
-        model = with_wire_copies_inlined(without_port_copies(model, outputs))
+    outputs = tuple(p.name for p in source.ports.values() if p.direction == "out")
+    model, exprs, commit = _fast_model(source.cxxrtl, outputs)
     accessors = cxxrtl_accessors(source, exprs, commit)
     harness = _sources("pin_cxxrtl.cpp", _DRIVER, "cxxrtl_clock.h")
     flags = list(CXXRTL_FLAGS)

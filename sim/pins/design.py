@@ -5,6 +5,7 @@ CXXRTL name them: a member path joined with ``__`` (``pixels.valid`` is ``pixels
 The clock ``clk`` and the reset ``rst`` are Amaranth's defaults and not ports here.
 """
 
+import collections
 import contextlib
 import functools
 
@@ -16,7 +17,13 @@ from ...hw.top import FollowTarget
 from ...hw.verilog import generate_cxxrtl, generate_verilog, verilog_ports
 from .base import PinError, Port
 
-__all__ = ["FILTERED_PORTS", "PIXEL_PORTS", "PinDesignSource", "follow_target_source"]
+__all__ = [
+    "FILTERED_PORTS",
+    "PIXEL_PORTS",
+    "PinDesignSource",
+    "follow_target_source",
+    "kept_source",
+]
 
 #: The default stream bindings: (valid, payload) of the pixel input and the filtered output.
 PIXEL_PORTS = ("pixels__valid", "pixels__payload")
@@ -25,6 +32,9 @@ FILTERED_PORTS = ("filtered__valid", "filtered__payload")
 PAYLOAD_BITS = 14
 #: Ports per design the compiled drivers address by one bit of a 64-bit mask.
 MAX_PORTS = 64
+#: Design sources ``kept_source`` keeps per process: key -> (owner, PinDesignSource).
+_KEPT = collections.OrderedDict()
+_KEPT_MAX = 16
 
 
 class PinDesignSource:
@@ -134,6 +144,23 @@ class PinDesignSource:
 
     def __repr__(self):
         return f"PinDesignSource({self.key!r}, {len(self.ports)} ports)"
+
+
+def kept_source(key, owner, make):
+    """The ``PinDesignSource`` ``make()`` returns for design ``key``, kept per process while
+    the design is built from the same ``owner`` (its ``Top``): its generated Verilog and
+    CXXRTL (Amaranth and Yosys, about a second) then serve every later run of the design,
+    as the frame backends' sources do. ``key`` must name everything else the design is
+    built from (its parameters and tables)."""
+    kept = _KEPT.get(key)
+    if kept is not None and kept[0] is owner:
+        _KEPT.move_to_end(key)
+        return kept[1]
+    source = make()
+    _KEPT[key] = (owner, source)
+    if len(_KEPT) > _KEPT_MAX:
+        _KEPT.popitem(last=False)
+    return source
 
 
 def follow_target_source(params=None):
