@@ -13,6 +13,7 @@ of a few minutes.
 """
 
 import os
+import signal
 import sys
 from pathlib import Path
 
@@ -39,6 +40,23 @@ def _fast_tier_builds_nothing_slow(request, monkeypatch):
     monkeypatch.setenv("FPGA_ROBOTICS_FAST_TIER", test)
     path = os.environ.get("PYTHONPATH")
     monkeypatch.setenv("PYTHONPATH", os.pathsep.join(filter(None, [str(FAST_TIER_DIR), path])))
+
+
+@pytest.fixture(autouse=True)
+def _interrupts_as_found():
+    """Each test leaves Ctrl-C and SIGTERM as it found them, handlers and signal mask alike:
+    a process a later test starts inherits an ignored or blocked signal (the Ctrl-C tests
+    then never see their run stop), so one test's leftover must not reach another's."""
+    handlers = {s: signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)}
+    mask = signal.pthread_sigmask(signal.SIG_BLOCK, [])
+    yield
+    changed = [s.name for s, h in handlers.items() if signal.getsignal(s) is not h]
+    if signal.pthread_sigmask(signal.SIG_SETMASK, mask) != mask:
+        changed.append("mask")
+    for s, h in handlers.items():
+        signal.signal(s, h)
+    if changed:  # said, for whoever reads the log; the next test starts clean either way
+        print(f"signal handling left changed ({', '.join(changed)}): restored", file=sys.stderr)
 
 
 #: The documentation's own command and Python blocks run end to end (closed-loop runs,
