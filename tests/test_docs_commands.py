@@ -49,6 +49,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from terminal_signals import FROM_A_TERMINAL
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -1570,6 +1571,7 @@ def run_server(command, cwd, *, within=60.0):
             stdout=out,
             stderr=subprocess.STDOUT,
             start_new_session=True,
+            **FROM_A_TERMINAL,
         )
     try:
         status = None

@@ -9,6 +9,7 @@ import time
 from pathlib import Path
 
 import pytest
+from terminal_signals import FROM_A_TERMINAL
 
 from fpga_robotics.sim.backends import available_backends
 
@@ -60,6 +61,7 @@ def test_signal_mid_run_keeps_the_recording(sig, code, tmp_path):
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
+        **FROM_A_TERMINAL,
     )
     try:
         # Frames are being written once the recording holds data.
@@ -98,6 +100,7 @@ def test_sigterm_during_a_compile_ends_the_compiler(tmp_path):
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
+        **FROM_A_TERMINAL,
     )
     try:
         # The compiler proper (cc1plus, started by the g++ driver) is at work in the cache.

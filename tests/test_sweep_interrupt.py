@@ -9,6 +9,7 @@ import sys
 import time
 
 import pytest
+from terminal_signals import FROM_A_TERMINAL
 
 from fpga_robotics.sweep import report_dir
 from fpga_robotics.sweep.results import load_rows
@@ -65,6 +66,7 @@ def test_ctrl_c_keeps_finished_runs_and_resume_runs_the_rest(tmp_path):
         stderr=subprocess.PIPE,
         text=True,
         start_new_session=True,
+        **FROM_A_TERMINAL,
     )
     try:
         end = time.monotonic() + 120

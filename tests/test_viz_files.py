@@ -11,6 +11,7 @@ import time
 
 import numpy as np
 import pytest
+from terminal_signals import FROM_A_TERMINAL
 
 from fpga_robotics.sim.backends.base import FrameResult
 from fpga_robotics.sim.records import FrameRecord
@@ -212,7 +213,7 @@ def test_ctrl_c_keeps_the_recording_under_its_real_name(tmp_path):
     proc = subprocess.Popen(
         [sys.executable, "-m", "fpga_robotics.run", "--backend", "model", "--duration", "120",
          "--realtime", "--quiet", "--rerun", f"save:{rrd}"],
-        cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+        cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, **FROM_A_TERMINAL
     )  # fmt: skip
     wait_for_frames(rrd.parent, proc)
     proc.send_signal(signal.SIGINT)
@@ -255,7 +256,7 @@ def test_a_signal_mid_run_keeps_the_recording(tmp_path, signum):
     script = SCRIPT.format(tests=os.path.join(ROOT, "tests"), mode="save", default=str(default))
     proc = subprocess.Popen(
         [sys.executable, "-c", script], cwd=tmp_path,
-        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, **FROM_A_TERMINAL
     )  # fmt: skip
     wait_for_frames(default.parent, proc)
     proc.send_signal(signum)

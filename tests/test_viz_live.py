@@ -19,6 +19,7 @@ import time
 
 import numpy as np
 import pytest
+from terminal_signals import FROM_A_TERMINAL
 
 from fpga_robotics.sim.backends.base import FrameResult
 from fpga_robotics.sim.records import FrameRecord
@@ -216,7 +217,7 @@ def viewer_process():
     port = free_port()
     proc = subprocess.Popen(
         [*viewer_command(port), "--serve-grpc"],
-        stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+        stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, **FROM_A_TERMINAL
     )  # fmt: skip
     try:
         for _ in range(600):
@@ -317,6 +318,7 @@ def test_ctrl_c_while_closing_on_a_stalled_viewer(stalled_viewer, tmp_path):
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
+        **FROM_A_TERMINAL,
     )
     try:
         assert proc.stdout.readline().strip() == "closing", proc.stderr.read()
