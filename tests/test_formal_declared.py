@@ -362,3 +362,19 @@ def test_param_errors_name_the_param_option(tmp_path, capsys):
     code, out, err = _cli(["formal", "--param", "limit=4", "--list"], capsys)
     assert (code, out) == (2, "")
     assert "--param sets a parameter of a --design REF" in err
+
+
+def test_symbiyosys_lines_read_the_same_at_any_hour():
+    from fpga_robotics.flow.formal import _error
+
+    # SymbiYosys pads a one-digit hour with a space: "SBY  0:25:42" after midnight.
+    def output(clock):
+        return (
+            f"SBY {clock} [check] engine_0: ##   0:00:00  Checking assumptions in step 0..\n"
+            f"SBY {clock} [check] engine_0: ##   0:00:00  Assumptions are unsatisfiable!\n"
+        )
+
+    said = {_error(output(clock)) for clock in (" 0:25:42", "10:25:42", "23:59:59")}
+    assert len(said) == 1
+    (text,) = said
+    assert text.endswith("(SymbiYosys: engine_0: Assumptions are unsatisfiable!)"), text

@@ -152,7 +152,8 @@ def _error(output):
     """Why SymbiYosys ended in an error, in its own words: assumptions that no input meets
     (a design's own ``Assume``s that contradict each other), else the first ``ERROR:`` line
     (Yosys cannot read the design), else the solver's last message."""
-    lines = [re.sub(r"^SBY \S+ \[\S+\] ", "", line) for line in output.strip().splitlines()]
+    # "SBY 10:25:42 [task] ...", and before 10 o'clock "SBY  0:25:42 [task] ...".
+    lines = [re.sub(r"^SBY\s+\S+\s+\[\S+\]\s", "", line) for line in output.strip().splitlines()]
     said = [re.sub(r"##\s+\d+:\d\d:\d\d\s+", "", line) for line in lines if ": ##" in line]
     for i, line in enumerate(said):
         if "Assumptions are unsatisfiable" in line:
