@@ -9,6 +9,7 @@ from fpga_robotics.cli.designs import checked_verilog
 from fpga_robotics.cli.errors import UsageError
 from fpga_robotics.cli.mutate import _design_params
 from fpga_robotics.cli.param_options import (
+    add_design_param_argument,
     add_param_arguments,
     given_followtarget_options,
     params_from_args,
@@ -128,13 +129,7 @@ def main(argv=None, prog="fpga-robotics board"):
         metavar="MAP",
         help="with --design verilog:FILES: the design's port map (docs/foreign.md)",
     )
-    parser.add_argument(
-        "--param",
-        action="append",
-        default=[],
-        metavar="NAME=VALUE",
-        help="with --design: one of its parameters (a TOML value; repeatable)",
-    )
+    add_design_param_argument(parser)
     add_param_arguments(parser)
     args = parser.parse_args(argv)
     params = params_from_args(args)

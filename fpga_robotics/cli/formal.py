@@ -11,6 +11,7 @@ from pathlib import Path
 
 from fpga_robotics.cli.errors import UsageError
 from fpga_robotics.cli.mutate import _design_params
+from fpga_robotics.cli.param_options import add_design_param_argument
 from fpga_robotics.cli.parser import CommandParser
 from fpga_robotics.flow.formal import (
     default_trace_dir,
@@ -73,13 +74,7 @@ def build_parser(prog="fpga-robotics formal"):
         "verilog:FILES, its assert and cover statements) instead "
         "of FollowTarget's",
     )
-    parser.add_argument(
-        "--param",
-        action="append",
-        default=[],
-        metavar="NAME=VALUE",
-        help="with --design: one of its parameters (a TOML value; repeatable)",
-    )
+    add_design_param_argument(parser)
     parser.add_argument(
         "--ports",
         "--port-map",

@@ -17,6 +17,7 @@ import tomllib
 
 from fpga_robotics.cli.errors import UsageError
 from fpga_robotics.cli.param_options import (
+    add_design_param_argument,
     add_param_arguments,
     params_from_args,
     refuse_followtarget_options,
@@ -306,13 +307,7 @@ def build_parser(prog="fpga-robotics mutate"):
         help="with --design, a camera design's unit judge streams frames of this size "
         "(default 160x120)",
     )
-    p.add_argument(
-        "--param",
-        action="append",
-        default=[],
-        metavar="NAME=VALUE",
-        help="with --design: one of its parameters (a TOML value; repeatable)",
-    )
+    add_design_param_argument(p)
     p.add_argument(
         "--ports",
         "--port-map",

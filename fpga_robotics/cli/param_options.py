@@ -66,6 +66,17 @@ def add_param_arguments(parser):
             )
 
 
+def add_design_param_argument(parser):
+    """``--param NAME=VALUE`` (repeatable): a parameter of the ``--design`` of one's own."""
+    parser.add_argument(
+        "--param",
+        action="append",
+        default=[],
+        metavar="NAME=VALUE",
+        help="with --design: one of its parameters (a TOML value; repeatable)",
+    )
+
+
 def _default_text(f):
     if f.name == "sx_bits":
         return "the full width, wide enough for any frame"
