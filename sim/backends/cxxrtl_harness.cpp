@@ -83,6 +83,11 @@ struct Sim : TraceBase {
         fr_cxxrtl::one_eval_edge(top);
 #else
         fr_cxxrtl::step_edge(top);
+#ifdef FR_TRACE
+        // CXXRTL computes an output port in eval() from the state before the edge: settle
+        // once more, so that the waveform shows a port change at the edge, as Verilator's does.
+        top.step();
+#endif
 #endif
         sample();
     }
