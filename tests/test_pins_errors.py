@@ -206,3 +206,22 @@ def test_pin_bench_bad_arguments(argv, message):
 
     with pytest.raises(UsageError, match=message):
         main(argv)
+
+
+@pytest.mark.parametrize("name", ["cxxrtl", pytest.param("verilator", marks=pytest.mark.slow)])
+def test_compiled_pins_after_close(name):
+    # Before, a call after close() handed the harness a freed model: a segmentation fault.
+    backend = get_pin_backend(name, SOURCE)
+    backend.poke("x", 5)
+    backend.run(3)
+    assert backend.peek("y") == 5
+    backend.close()
+    backend.close()  # twice is fine
+    for call in (
+        lambda p: p.peek("y"),
+        lambda p: p.poke("x", 1),
+        lambda p: p.run(1),
+        lambda p: p.reset(),
+    ):
+        with pytest.raises(PinError, match=f"^{name}: the pins are closed; open new ones"):
+            call(backend)

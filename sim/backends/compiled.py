@@ -94,6 +94,15 @@ class HarnessFrames:
     and passed to ``fr_run_frame``. Subclasses implement ``_run_harness(entry, frame,
     color_sel, filtered)``: one call of ``entry`` and the ``FrameResult``."""
 
+    def _live(self):
+        """The model's handle for a call into the harness; ``BackendError`` once ``close()``
+        has freed the model (the harness would dereference a null model and crash Python)."""
+        if self._handle is None:
+            raise BackendError(
+                f"{self.name}: the backend is closed; open a new one to run the design again"
+            )
+        return self._handle
+
     def _init_harness(self):
         p = self.params
         self._shape = (p.height, p.width)
@@ -238,7 +247,7 @@ class CompiledBackend(HarnessFrames, DesignBackend):
         return self._library.evals_per_cycle
 
     def _reset(self):
-        self._library.lib.fr_reset(self._handle)
+        self._library.lib.fr_reset(self._live())
 
     def _run_harness(self, entry, frame, color_sel, filtered):
         index = self.frames_processed
@@ -247,10 +256,10 @@ class CompiledBackend(HarnessFrames, DesignBackend):
             if tracing and self._trace_state == "idle":
                 self._open_trace()
             if self._trace_state == "open":
-                self._library.lib.fr_trace_enable(self._handle, int(tracing))
+                self._library.lib.fr_trace_enable(self._live(), int(tracing))
         self._args[2] = color_sel
         status = entry(
-            self._handle, _address(frame), self._args_address, _address(filtered), self._out_address
+            self._live(), _address(frame), self._args_address, _address(filtered), self._out_address
         )
         if self.waveform is not None and tracing and index >= self.waveform.last_frame:
             self._finish_trace()
@@ -269,7 +278,7 @@ class CompiledBackend(HarnessFrames, DesignBackend):
     def _open_trace(self):
         # Written under a temporary name and renamed when complete.
         self._trace_tmp = PendingOutput(self.waveform.path, what="waveform")
-        if self._library.lib.fr_trace_open(self._handle, str(self._trace_tmp.tmp).encode()) != 0:
+        if self._library.lib.fr_trace_open(self._live(), str(self._trace_tmp.tmp).encode()) != 0:
             self._trace_tmp.discard()
             raise BackendError(f"cannot write the waveform {self.waveform.path}")
         self._trace_state = "open"
@@ -277,7 +286,7 @@ class CompiledBackend(HarnessFrames, DesignBackend):
     def _finish_trace(self):
         if self._trace_state != "open":
             return
-        self._library.lib.fr_trace_close(self._handle)
+        self._library.lib.fr_trace_close(self._live())
         self._trace_tmp.commit()
         self._trace_state = "done"
 

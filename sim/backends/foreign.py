@@ -775,7 +775,7 @@ class ForeignVerilatorBackend(HarnessFrames, DesignBackend):
     def _reset(self):
         self._apply_runtime()
         self._watch_known = 0
-        self._library.lib.fr_reset(self._handle)
+        self._library.lib.fr_reset(self._live())
 
     def watch_risen(self):
         """The bits of the ``[watch]`` output that were high at a clock edge since the last
@@ -787,7 +787,7 @@ class ForeignVerilatorBackend(HarnessFrames, DesignBackend):
         if pm.watch is None:
             return None
         words = np.zeros((self.design.ports[pm.watch][1] + 31) // 32, np.uint32)
-        self._library.lib.fr_watch_read(self._handle, words.ctypes.data, words.size)
+        self._library.lib.fr_watch_read(self._live(), words.ctypes.data, words.size)
         now = int.from_bytes(words.astype("<u4").tobytes(), "little")
         new, self._watch_known = now & ~self._watch_known, self._watch_known | now
         return [bit for bit in range(new.bit_length()) if new >> bit & 1]
@@ -805,7 +805,7 @@ class ForeignVerilatorBackend(HarnessFrames, DesignBackend):
             self._apply_runtime()
         out = self._out
         status = entry(
-            self._handle, _address(frame), self._args_address, _address(filtered), self._out_address
+            self._live(), _address(frame), self._args_address, _address(filtered), self._out_address
         )
         index = self.frames_processed
         stopped = self._stop()

@@ -274,6 +274,15 @@ class CompiledPins(HostPins):
         #: Simulator evaluations per clock cycle (1 when every output is a flip-flop).
         self.evals_per_cycle = self._lib.pin_evals_per_cycle()
 
+    def _live(self):
+        """The model's handle for a call into the harness; ``PinError`` once ``close()`` has
+        freed the model (the harness would dereference a null model and crash Python)."""
+        if self._handle is None:
+            raise PinError(
+                f"{self.name}: the pins are closed; open new ones to run the design again"
+            )
+        return self._handle
+
     def _build_and_load(self):
         self.cache_entry, lib = load_built(
             type(self).plan(self.source), LIBRARY_NAME, _load, on_build=self._notice, error=PinError
@@ -288,16 +297,16 @@ class CompiledPins(HostPins):
             )
 
     def _raw_reset(self):
-        self._lib.pin_reset(self._handle)
+        self._lib.pin_reset(self._live())
 
     def _raw_poke(self, index, raw):
-        self._lib.pin_poke(self._handle, index, raw)
+        self._lib.pin_poke(self._live(), index, raw)
 
     def _raw_peek(self, index):
-        return self._lib.pin_peek(self._handle, index)
+        return self._lib.pin_peek(self._live(), index)
 
     def _raw_schedule(self, edge, index, raw):
-        self._lib.pin_schedule(self._handle, edge, index, raw)
+        self._lib.pin_schedule(self._live(), edge, index, raw)
 
     def _raw_schedule_many(self, index, edges, raws):
         if edges[0] == self._cycle + 1:  # that edge's inputs are on already: a poke
@@ -305,7 +314,7 @@ class CompiledPins(HostPins):
             edges, raws = edges[1:], raws[1:]
         edges, raws = np.ascontiguousarray(edges), np.ascontiguousarray(raws)
         self._lib.pin_schedule_many(
-            self._handle, index, _address(edges), _address(raws), len(edges)
+            self._live(), index, _address(edges), _address(raws), len(edges)
         )
 
     def _raw_record(self, cycles):
@@ -313,7 +322,7 @@ class CompiledPins(HostPins):
         buffer = np.zeros((_RECORD_CHUNK, 3), np.int64)
         while True:
             status = self._lib.pin_record(
-                self._handle, end - self._cycle, _address(buffer), _RECORD_CHUNK, self._out_address
+                self._live(), end - self._cycle, _address(buffer), _RECORD_CHUNK, self._out_address
             )
             cycle, _port, _value, captured, _pending, bad, recorded = self._out.tolist()
             if status:
@@ -328,13 +337,13 @@ class CompiledPins(HostPins):
 
     def _raw_watch(self, indices):
         order = np.array(indices, np.int32)
-        self._lib.pin_watch(self._handle, _address(order), len(order))
+        self._lib.pin_watch(self._live(), _address(order), len(order))
 
     def _raw_stream(self, frame, timing, capture):
         height, width = frame.shape
         self._geometry[:] = (width, height, timing.start, timing.line_period, timing.pixel_period)
         status = self._lib.pin_stream(
-            self._handle,
+            self._live(),
             _address(frame),
             _address(self._geometry),
             None if capture is None else _address(capture),
@@ -344,7 +353,7 @@ class CompiledPins(HostPins):
 
     def _raw_run(self, cycles):
         out = self._out
-        status = self._run_entry(self._handle, cycles, self._out_address)
+        status = self._run_entry(self._live(), cycles, self._out_address)
         cycle, port, value, captured, _pending, bad, _recorded = out.tolist()  # enum Out
         if status:
             self._cycle = cycle
@@ -355,7 +364,7 @@ class CompiledPins(HostPins):
         """The error of a run that ended with ``status``."""
         if status != _STOPPED:
             return capture_error(status == _TOO_MANY_FILTERED, bad)
-        text = (self._lib.pin_stop_message(self._handle) or b"").decode(errors="replace")
+        text = (self._lib.pin_stop_message(self._live()) or b"").decode(errors="replace")
         # The file as the user named it, not its copy in the build folder.
         return DesignStopped(re.sub(r" at (?:\S*/)?src/", " at ", text), self._cycle)
 
