@@ -3,7 +3,7 @@
     from fpga_robotics.testing import run
 
     def test_stops_before_the_wall():
-        result = run("wall_stop.toml", design="wall_stop.py:WallStop", params={"speed": 200})
+        result = run("wall_stop.toml", design="wall_stop.py:WallStop", params={"speed": 450})
         result.assert_passes()                       # every check of the scenario
         assert result.check("max_wall_collisions").status == "pass"
         assert result.trajectory["design.stopped"][-1] == 1

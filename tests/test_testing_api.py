@@ -54,3 +54,23 @@ def test_bad_arguments_are_one_line_errors():
         run(DESIGNS / "wall_stop.toml", params={"nope": 1})
     with pytest.raises(UsageError, match="needs ports="):
         run(DESIGNS / "wall_stop.toml", design="verilog:x.v")
+
+
+def test_the_module_docstring_example_runs_as_written(tmp_path, monkeypatch):
+    # The example an engineer copies into a test: the module's docstring, verbatim, beside the
+    # wall_stop files of docs/your_design.md.
+    import textwrap
+
+    from fpga_robotics import testing
+
+    lines = testing.__doc__.splitlines()
+    first = next(i for i, line in enumerate(lines) if line.startswith("    "))
+    end = next(i for i in range(first, len(lines)) if lines[i] and not lines[i].startswith(" "))
+    example = textwrap.dedent("\n".join(lines[first:end]))
+    assert "def test_stops_before_the_wall" in example
+    for name in ("wall_stop.py", "wall_stop.toml"):
+        (tmp_path / name).write_text((DESIGNS / name).read_text())
+    monkeypatch.chdir(tmp_path)
+    namespace = {}
+    exec(compile(example, "fpga_robotics.testing docstring", "exec"), namespace)  # noqa: S102
+    namespace["test_stops_before_the_wall"]()
