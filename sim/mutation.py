@@ -275,30 +275,74 @@ def list_mutants(
 ):
     """``n`` mutants of ``FollowTarget(params)`` (or of the design ``rtlil_text``, from
     ``component_rtlil``, or of the Verilog design ``verilog``, ``{file name: text}`` with
-    its top module ``top`` and the files it `include, ``includes``) chosen by Yosys with ``seed`` (the same arguments give the same
-    list). Yosys may return fewer when the design has fewer places."""
+    its top module ``top`` and the files it `include, ``includes``) chosen by Yosys with
+    ``seed`` (the same arguments give the same list). Yosys may return fewer when the design
+    has fewer places.
+
+    Yosys also lists places on a memory's ports that must stay constant (its initial data,
+    an asynchronous read port's reset), where a mutant cannot be built: such a mutant is left
+    out and the next place Yosys lists with a longer list takes its place (a design without
+    memories gets ``mutate -list`` as it is)."""
     params = params if params is not None else FollowTargetParams()
     if not 1 <= int(n) <= 100_000:
         raise ValueError(f"the number of mutants must be 1..100000, got {n}")
-    with tempfile.TemporaryDirectory(prefix="fr-mutate-") as work:
-        read = _read_design(work, params, rtlil_text, verilog, includes)
-        _yosys(
-            [
-                *read,
-                *(s.format(top=top) for s in _PREPARE),
-                f"mutate -list {int(n)} -seed {int(seed)} -o mutants.ys",
-            ],
-            work,
-        )
-        with open(os.path.join(work, "mutants.ys")) as f:
-            lines = [line for line in f.read().splitlines() if line.strip()]
+    design = {"rtlil_text": rtlil_text, "verilog": verilog, "top": top, "includes": includes}
+    lines, memories = _mutate_list(params, int(n), seed, design)
     if not lines:
         raise MutationError(
             f"Yosys found nothing to mutate in {top if verilog is not None else 'the design'}: "
             "its netlist has no cell or flip-flop left (outputs tied to constants are "
             "optimised away); a design needs logic to have mutants"
         )
-    return [_parse(k + 1, line) for k, line in enumerate(lines)]
+    kept, seen, asked = [], set(), int(n)
+    while True:
+        fresh = [line for line in lines if line not in seen]
+        seen.update(fresh)
+        on_memories = [l for l in fresh if _parse(0, l).cell.lstrip("\\") in memories]
+        # One build of them all; one each only when that fails.
+        if on_memories and not _builds(params, on_memories, design):
+            broken = {line for line in on_memories if not _builds(params, [line], design)}
+            fresh = [line for line in fresh if line not in broken]
+        kept += fresh[: n - len(kept)]
+        if len(kept) == n or len(lines) < asked or asked >= 100_000:
+            break  # enough, or Yosys has no more places
+        asked = min(100_000, 2 * asked)
+        lines, _ = _mutate_list(params, asked, seed, design)
+    return [_parse(k + 1, line) for k, line in enumerate(kept)]
+
+
+def _mutate_list(params, n, seed, design):
+    """``(mutate -list lines, names of the memory cells)`` of ``design`` (list_mutants'
+    keyword arguments)."""
+    with tempfile.TemporaryDirectory(prefix="fr-mutate-") as work:
+        read = _read_design(
+            work, params, design["rtlil_text"], design["verilog"], design["includes"]
+        )
+        _yosys(
+            [
+                *read,
+                *(s.format(top=design["top"]) for s in _PREPARE),
+                "select -write memories.txt t:$mem*",
+                f"mutate -list {n} -seed {int(seed)} -o mutants.ys",
+            ],
+            work,
+        )
+        with open(os.path.join(work, "mutants.ys")) as f:
+            lines = [line.strip() for line in f.read().splitlines() if line.strip()]
+        with open(os.path.join(work, "memories.txt")) as f:
+            memories = {e.strip().partition("/")[2].lstrip("\\") for e in f if e.strip()}
+    return lines, memories
+
+
+def _builds(params, lines, design):
+    """Whether Yosys builds the mutant netlist of the mutants ``lines``."""
+    try:
+        mutant_netlist(
+            params, [_parse(k + 1, line) for k, line in enumerate(lines)], watch=False, **design
+        )
+    except MutationError:
+        return False
+    return True
 
 
 _MUTATE = re.compile(r"^mutate\s")

@@ -11,6 +11,10 @@ import re
 from pathlib import Path
 
 import pytest
+from amaranth import Module
+from amaranth.lib import wiring
+from amaranth.lib.memory import Memory
+from amaranth.lib.wiring import In, Out
 
 from fpga_robotics import cli
 from fpga_robotics.designs.reference import resolve_design
@@ -547,3 +551,62 @@ def test_a_campaign_the_robot_judge_cannot_run_is_refused_first(
     code, _, err = _cli([*argv, "--out", "m"], capsys)
     assert code == 2 and message in err and err.count("\n") == 1, err
     assert not (tmp_path / "m").exists()
+
+
+class _Histogram(wiring.Component):
+    """A memory with initial data, written every cycle and read combinationally: Yosys's
+    ``mutate -list`` names places on its constant ports (the initial data, the read port's
+    reset), where no mutant can be built."""
+
+    x: In(4)
+    y: Out(8)
+
+    def elaborate(self, platform):
+        m = Module()
+        m.submodules.mem = mem = Memory(shape=8, depth=4, init=[3, 1, 4, 1])
+        wp, rp = mem.write_port(), mem.read_port(domain="comb")
+        m.d.comb += [wp.addr.eq(self.x[:2]), wp.data.eq(self.x), wp.en.eq(self.x[3])]
+        m.d.comb += rp.addr.eq(self.x[2:])
+        m.d.sync += self.y.eq(rp.data + self.x)
+        return m
+
+
+@pytest.mark.slow
+def test_mutants_on_a_memorys_constant_ports_are_replaced():
+    from fpga_robotics.hw.params import FollowTargetParams
+    from fpga_robotics.sim.mutation import (
+        MutationError,
+        _builds,
+        _mutate_list,
+        _parse,
+        mutant_netlist,
+    )
+
+    design = {
+        "rtlil_text": component_rtlil(_Histogram()),
+        "verilog": None,
+        "top": "follow_target",
+        "includes": None,
+    }
+    params = FollowTargetParams()
+    # The first seed whose raw list holds a mutant Yosys cannot build (there is one).
+    for seed in range(1, 20):
+        lines, memories = _mutate_list(params, 12, seed, design)
+        on_memories = [line for line in lines if any(f"-cell {c} " in line for c in memories)]
+        bad = [line for line in on_memories if not _builds(params, [line], design)]
+        if bad:
+            break
+    else:
+        pytest.fail("no seed lists a mutant on the memory's constant ports")
+    with pytest.raises(MutationError):  # the raw list, as mutate took it before
+        mutant_netlist(params, [_parse(1, bad[0])], **design)
+    mutants = list_mutants(params, 12, seed, rtlil_text=design["rtlil_text"])
+    commands = [m.command for m in mutants]
+    assert len(mutants) == 12 and [m.index for m in mutants] == list(range(1, 13))
+    assert not set(bad) & set(commands)
+    # The buildable ones of the raw list keep their order; the rest come after.
+    good = [line for line in lines if line not in bad]
+    assert commands[: len(good)] == good
+    mutant_netlist(params, mutants, **design)  # every mutant together builds
+    again = list_mutants(params, 12, seed, rtlil_text=design["rtlil_text"])
+    assert again == mutants  # the same arguments, the same list
