@@ -380,6 +380,12 @@ BAD = [
         "does not elaborate: SyntaxError: Driver-driver conflict",
     ),
     (
+        "a combinational loop: its signals on the line, and the fix",
+        "unelaborated.py:LoopsBack",
+        {},
+        "unelaborated.py:38: signal a bit 0; break the loop with a register (m.d.sync)",
+    ),
+    (
         "an elaborate that returns nothing",
         "unelaborated.py:NoReturn",
         {},

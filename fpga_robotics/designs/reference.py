@@ -402,6 +402,8 @@ def _check_elaborates(component, target, reference):
         warnings.filterwarnings("ignore", category=UnusedElaboratable)
         # What Amaranth said on the way ("elaborate() returned None; missing return?").
         hint = next((f"; {w.message}" for w in said if w.category is UserWarning), "")
+        if type(exc).__name__ == "CombinationalCycle":
+            hint += "; break the loop with a register (m.d.sync) on one of its signals"
         raise DesignError(
             f"design {reference!r} does not elaborate: {type(exc).__name__}: "
             f"{_first_line(exc)}{_user_line(exc, target)}{hint}"
@@ -558,8 +560,14 @@ def _error_line(exc, path):
 
 
 def _first_line(exc):
-    text = str(exc).strip()
-    return text.splitlines()[0] if text else "(no message)"
+    """The first line of ``exc``'s message; a first line that ends with a colon introduces a
+    list (Amaranth's combinational cycle, signal by signal), which is kept on the line."""
+    lines = [line.strip() for line in str(exc).strip().splitlines() if line.strip()]
+    if not lines:
+        return "(no message)"
+    if lines[0].endswith(":") and len(lines) > 1:
+        return f"{lines[0]} {'; '.join(lines[1:])}"
+    return lines[0]
 
 
 def _is_factory(value):

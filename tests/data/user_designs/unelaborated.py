@@ -32,6 +32,16 @@ class DrivenTwice(_Wheels):
         return m
 
 
+class LoopsBack(_Wheels):
+    def elaborate(self, platform):
+        m = Module()
+        a = Signal()
+        b = Signal()
+        m.d.comb += [a.eq(~b), b.eq(a)]  # a combinational loop through a and b
+        m.d.comb += self.motor_left.eq(a)
+        return m
+
+
 class NoReturn(_Wheels):
     def elaborate(self, platform):
         Module()
