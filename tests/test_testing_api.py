@@ -74,3 +74,10 @@ def test_the_module_docstring_example_runs_as_written(tmp_path, monkeypatch):
     namespace = {}
     exec(compile(example, "fpga_robotics.testing docstring", "exec"), namespace)  # noqa: S102
     namespace["test_stops_before_the_wall"]()
+
+
+@pytest.mark.parametrize("seed", ["1", 1.5, 2.0, True, -1])
+def test_a_seed_that_is_not_a_whole_number_is_refused(seed):
+    # int() would have run seed 1 for "1", 1.5 and True: another run than asked for.
+    with pytest.raises(ValueError, match=r"seed must be a non-negative integer, got "):
+        run(DESIGNS / "wall_stop.toml", seed=seed, backend="model")

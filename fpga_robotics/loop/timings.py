@@ -4,6 +4,7 @@ from fpga_robotics.designs.builtin import TOPS
 from fpga_robotics.loop.compressed import run_compressed
 from fpga_robotics.loop.pin_frames import open_pin_frames
 from fpga_robotics.loop.real_clock import run_real_clock
+from fpga_robotics.sim.world.world import check_seed
 
 __all__ = ["TIMINGS", "run_scenario"]
 
@@ -53,6 +54,8 @@ def run_scenario(
         Live control inputs (``fpga_robotics.ros.controls``): colour select, the target
         driven by hand, pause and step; applied just after each frame's capture.
     """
+    if seed is not None:
+        check_seed(seed)  # before int() would turn 1.5 or "1" into another seed
     options = {
         "seed": seed,
         "recorder": recorder,

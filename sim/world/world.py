@@ -33,6 +33,7 @@ __all__ = [
     "MAX_SUBSTEP",
     "MAX_TARGET_SPEED",
     "World",
+    "check_seed",
     "is_removal_event",
     "removal_event",
 ]
@@ -105,6 +106,13 @@ def _first_facing(waypoints):
     return 0.0
 
 
+def check_seed(seed):
+    """``ValueError`` unless ``seed`` is a whole number 0 or more (a bool, a float or a
+    string would run another seed than the one asked for)."""
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
+        raise ValueError(f"seed must be a non-negative integer, got {seed!r}")
+
+
 class World:
     """A room with a robot and walking people, advanced in fixed steps.
 
@@ -128,8 +136,7 @@ class World:
     """
 
     def __init__(self, config, seed=0):
-        if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
-            raise ValueError(f"seed must be a non-negative integer, got {seed!r}")
+        check_seed(seed)
         self.config = config
         self.seed = int(seed)
         self.time = 0.0
