@@ -610,3 +610,98 @@ def test_mutants_on_a_memorys_constant_ports_are_replaced():
     mutant_netlist(params, mutants, **design)  # every mutant together builds
     again = list_mutants(params, 12, seed, rtlil_text=design["rtlil_text"])
     assert again == mutants  # the same arguments, the same list
+
+
+FB_COUNT_V = """\
+// Framebuffer style: counts the red pixels written; at each new frame, motor_left = 16 * count.
+module fb_count (input clk, input we, input [5:0] addr, input [11:0] data, input nf,
+                 output reg [15:0] ml = 16'd0, output reg [15:0] mr = 16'd0,
+                 output reg done = 1'b0);
+  reg [5:0] n = 6'd0;
+  wire red = we && data[11:8] >= 4'd8;
+  always @(posedge clk) begin
+    done <= nf;
+    if (nf) begin
+      ml <= {6'd0, n, 4'd0};
+      mr <= 16'd100;
+      n <= red ? 6'd1 : 6'd0;
+    end else if (red)
+      n <= n + 6'd1;
+  end
+endmodule
+"""
+FB_COUNT_MAP = """\
+style = "framebuffer"
+top = "fb_count"
+clock = { port = "clk" }
+pixels = { write_enable = "we", address = "addr", data = "data", new_frame = "nf" }
+result = { strobe = "done", latency = 1, timeout = 1000 }
+[outputs]
+motor_left = { port = "ml", width = 16 }
+motor_right = { port = "mr", width = 16 }
+"""
+
+
+@pytest.mark.slow  # a Verilator build of the mutant netlist
+def test_a_framebuffer_design_is_mutated_at_its_own_frame_size(tmp_path, capsys):
+    """A 6-bit address (48 pixels: the 8x6 frames asked for, not 160x120's 19,200): the
+    wrapper addresses and ends the frames at the size given. Before, the port map was checked
+    at 160x120 (refused), and with a wider address no frame ever ended in the unit judge."""
+    from fpga_robotics.designs.builtin import connector_kinds
+    from fpga_robotics.sim.backends.foreign import ForeignDesign
+    from fpga_robotics.sim.pins.compiled import VerilatorPins
+    from fpga_robotics.sim.pins.verilog import VerilogPinSource
+
+    (tmp_path / "fb_count.v").write_text(FB_COUNT_V)
+    (tmp_path / "fb_count.toml").write_text(FB_COUNT_MAP)
+    out, cycles, (width, height) = tmp_path / "m", 400, (8, 6)
+    argv = ["mutate", "--design", f"verilog:{tmp_path / 'fb_count.v'}", "--ports"]
+    argv += [str(tmp_path / "fb_count.toml"), "--mutants", "6", "--seed", "3"]
+    argv += ["--cycles", str(cycles), "--resolution", f"{width}x{height}"]
+    code, text, err = _cli([*argv, "--out", str(out)], capsys)
+    assert code == 0, err
+    # Its frames ended in the unit judge: no "nothing changed" note.
+    assert "no output of the unmutated design changed" not in text
+    result = json.loads((out / "mutants.json").read_text())
+    assert result["stimulus"]["outputs_changed"] is True
+    assert result["stimulus"]["frame"] == [width, height]
+    design = ForeignDesign(
+        [out / "mutants.v"], out / "mutants_ports.toml", pins=True,
+        connector_kinds=connector_kinds(), frame_size=(width, height),
+    )  # fmt: skip
+    backend = VerilatorPins(VerilogPinSource(design, stream=False))
+    try:
+        ports = {p: port for p, port in backend.ports.items() if p != "mutsel"}
+        stimulus = pin_stimulus(ports, cycles, 0, (width, height))
+        pixels = [v for _, p, v in sorted(stimulus) if p == "pixels__payload"]
+        frames = len(pixels) // (width * height)
+        assert frames >= 2
+        # Each whole frame's count of red pixels (red nibble >= 8), shown as 16 * count.
+        counts = [
+            sum((v >> 8) & 0xF >= 8 for v in pixels[k * width * height : (k + 1) * width * height])
+            for k in range(frames)
+        ]
+        trace = pin_trace(backend, 0, stimulus, cycles, ["motor_left"])["motor_left"]
+        shown = [value for _, value in trace]
+        expected = [0]
+        for count in counts:
+            if 16 * count != expected[-1]:
+                expected.append(16 * count)
+        assert shown[: len(expected)] == expected
+    finally:
+        backend.close()
+
+
+@pytest.mark.slow  # a Verilator build of the mutant netlist
+def test_a_stimulus_that_changes_no_output_is_said(tmp_path, capsys):
+    (tmp_path / "fb_count.v").write_text(FB_COUNT_V)
+    (tmp_path / "fb_count.toml").write_text(FB_COUNT_MAP)
+    # Frames of 8x8 = 64 pixels, a pixel a cycle: 40 cycles end none, so no output changes.
+    argv = ["mutate", "--design", f"verilog:{tmp_path / 'fb_count.v'}", "--ports"]
+    argv += [str(tmp_path / "fb_count.toml"), "--mutants", "4", "--cycles", "40"]
+    argv += ["--resolution", "8x8", "--out", str(tmp_path / "m")]
+    code, out, err = _cli(argv, capsys)
+    assert code == 0, err
+    assert "note: no output of the unmutated design changed in the 40 cycles" in out
+    result = json.loads((tmp_path / "m" / "mutants.json").read_text())
+    assert result["stimulus"]["outputs_changed"] is False

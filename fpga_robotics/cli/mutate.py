@@ -457,6 +457,12 @@ def _main_design(args):
         f"unit judge (against the unmutated design): {score['caught']} caught, "
         f"{score['equivalent']} equivalent on these inputs: score {_percent(score['score'])}"
     )
+    if not result["stimulus"]["outputs_changed"]:
+        print(
+            f"note: no output of the unmutated design changed in the {cycles} cycles, so only "
+            "a mutant that changes a constant output is caught: give more --cycles, or check "
+            "that the design takes the stimulus (its reset, its frames' size: --resolution)"
+        )
     _print_modules(modules, campaign is not None and not _exit_code(result["baseline"]))
     if campaign is not None:
         _report_robot(

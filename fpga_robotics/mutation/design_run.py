@@ -153,7 +153,11 @@ def mutate_verilog_design(
     stream's and colour select's ports; ``[runtime]`` inputs aside)."""
 
     t0 = time.perf_counter()
-    design = ForeignDesign(files, ports_path, pins=True, connector_kinds=connector_kinds())
+    # The frames' size: a framebuffer design's address and new-frame pulse are made for it.
+    kinds, frame_size = connector_kinds(), tuple(frame)
+    design = ForeignDesign(
+        files, ports_path, pins=True, connector_kinds=kinds, frame_size=frame_size
+    )
     top = design.port_map.top
     sources = {"verilog": design.sources, "top": top, "includes": design.includes}
     mutants = list_mutants(None, n, seed, **sources)
@@ -173,7 +177,9 @@ def mutate_verilog_design(
         write_atomic(watch_map, watched, what="port map")
     prebuilt = _prebuild(campaign, robot, netlist, watch_map)
     # The pixel ports driven as any input, each edge at random (as an Amaranth design's).
-    mutant_design = ForeignDesign([netlist], port_map, pins=True, connector_kinds=connector_kinds())
+    mutant_design = ForeignDesign(
+        [netlist], port_map, pins=True, connector_kinds=kinds, frame_size=frame_size
+    )
     source = VerilogPinSource(mutant_design, stream=False)
     backend = VerilatorPins(source, on_build=lambda t: say(f"{t} ..."))
     build_s = time.perf_counter() - t0
@@ -302,6 +308,9 @@ def _judge(
             ],
             # The pixel stream's frames (width, height), for a camera design.
             "frame": list(frame) if framed else None,
+            # Whether any output of the unmutated design changed: if none did, only a mutant
+            # that changes a constant output can be caught (a stimulus the design ignored).
+            "outputs_changed": any(len(changes) > 1 for changes in reference.values()),
         },
         "build_and_list_s": round(build_s, 2),
         "unit_judge_s": round(unit_s, 2),

@@ -85,8 +85,13 @@ class ForeignDesign:
     frame backend drives no connector.
     """
 
-    def __init__(self, files, port_map, params=None, *, pins=False, connector_kinds=None):
+    def __init__(
+        self, files, port_map, params=None, *, pins=False, connector_kinds=None, frame_size=None
+    ):
         self.params = params if params is not None else FollowTargetParams()
+        #: (width, height) of the frames the wrapper addresses and ends: ``params``' unless
+        #: ``frame_size`` says otherwise (a unit judge's frames, smaller than any camera's).
+        self.frame_size = frame_size or (self.params.width, self.params.height)
         if isinstance(files, (str, os.PathLike)):
             files = [files]
         self.files = [Path(f) for f in files]
@@ -135,7 +140,7 @@ class ForeignDesign:
             )
         self.pins = pins
         self.ports = design_ports(self.sources, self.port_map.top, self.includes)
-        check_widths(self.port_map, self.ports, self.params.width * self.params.height)
+        check_widths(self.port_map, self.ports, self.frame_size[0] * self.frame_size[1])
         if connector_kinds is not None:
             check_connectors(self.port_map, self.ports, connector_kinds)
         for key in ("motor_left", "motor_right"):
@@ -147,9 +152,7 @@ class ForeignDesign:
             and self.ports[self.port_map.outputs["found"].port][1] != 1
         ):
             raise PortMapError("port map: outputs.found must be a 1-bit port")
-        self.wrapper = wrapper_verilog(
-            self.port_map, self.ports, self.params.width, self.params.height, pins=pins
-        )
+        self.wrapper = wrapper_verilog(self.port_map, self.ports, *self.frame_size, pins=pins)
 
     def registered_outputs(self):
         """Whether no output of the wrapper around the design depends on an input but
@@ -158,8 +161,7 @@ class ForeignDesign:
         wrapper = wrapper_verilog(
             self.port_map,
             self.ports,
-            self.params.width,
-            self.params.height,
+            *self.frame_size,
             pins=self.pins,
             runtime_dpi=False,
         )

@@ -61,8 +61,7 @@ class VerilogPinSource:
             self.key += "-unstreamed"
         self.pixels = PIXEL_PORTS if streamed else None
         self.filtered = FILTERED_PORTS if pm.filtered_valid and streamed else None
-        params = design.params
-        self.frame_size = (params.width, params.height) if streamed else None
+        self.frame_size = design.frame_size if streamed else None
 
     def verilog_files(self):
         """``(files, compiled)``: every file to write (relative path -> text, the design's
