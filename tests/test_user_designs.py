@@ -203,6 +203,46 @@ def test_a_camera_only_design_drives_in_compressed_timing_and_records_its_output
     assert [s[0] for s in scalars] == list(traj["design.red_sum"])
 
 
+def test_a_ready_backend_of_another_design_is_refused_before_the_run():
+    """A ready FollowTarget backend for a design of one's own ran FollowTarget under the
+    scenario's name; a design's ready backend runs only a scenario of that design."""
+    from fpga_robotics.loop.pin_frames import open_pin_frames
+    from fpga_robotics.sim.backends import get_backend
+
+    own = load_scenario(str(RED_FRAMES), ["sim.duration=0.3"])
+    builtin = load_scenario("follow_person", ["sim.duration=0.3", 'camera.resolution="40x30"'])
+    with get_backend("model", own.params) as follow_target:
+        with pytest.raises(ValueError, match=r"runs FollowTarget; scenario 'red_frames' runs "):
+            run_scenario(own, backend=follow_target)
+        line = load_scenario("line_track", ["sim.duration=0.3"])
+        with pytest.raises(TypeError, match='"real_clock": its design runs on a pin backend'):
+            run_scenario(line, backend=follow_target)
+    with pytest.raises(TypeError, match="a backend name .* or a ready backend, got 42"):
+        run_scenario(own, backend=42)
+    with open_pin_frames("cxxrtl", own) as design:
+        with pytest.raises(ValueError, match="scenario 'follow_person' runs FollowTarget"):
+            run_scenario(builtin, backend=design)
+        faster = own.with_overrides(["design.params.speed=200"])
+        with pytest.raises(ValueError, match="with other design.params than scenario"):
+            run_scenario(faster, backend=design)
+        assert run_scenario(own, backend=design).trajectory["motor_left"][0] == 400
+
+
+def test_a_verilog_design_by_name_runs_itself_in_compressed_timing():
+    """A backend name for a camera-only Verilog design in compressed timing opened
+    FollowTarget: red_count has none of its tracker outputs and drives by its own rule."""
+    data = Path(__file__).parent / "data" / "red_count"
+    items = [
+        f'design.top="verilog:{data / "red_count.v"}"',
+        f'design.ports="{data / "red_count_ports.toml"}"',
+        "sim.duration=0.3",
+    ]
+    scenario = load_scenario("follow_person", items)
+    assert scenario.sim.timing == "compressed"
+    result = run_scenario(scenario, backend="cxxrtl")
+    assert result.summary["absent_outputs"] == ["found", "proximity", "centroid_x", "centroid_leds"]
+
+
 def test_an_unchanged_copy_of_follow_target_runs_as_the_built_in_does():
     """follow_target_copy.py, FollowTarget as a design of one's own, runs frame by frame on
     its pin backend: every column of the built-in's compressed run, bit for bit."""

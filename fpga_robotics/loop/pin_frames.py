@@ -57,6 +57,7 @@ class PinFrames(DesignBackend):
         self.name = pins.name
         top = scenario_top(scenario)
         self.label = top.name
+        self.top, self.design_params = scenario.top, dict(scenario.design_params)
         self.color_port = top.bindings["camera"].get("color_sel")
         self.frame_outputs = [n for n in FRAME_OUTPUTS if n in pins.ports]
         self.wheels = top.bindings.get("wheels", {})
