@@ -6,6 +6,7 @@ A stream transfer carries one pixel plus two framing flags, as AXI4-Stream video
 The stream cannot be stalled (``always_ready``): a camera does not wait.
 """
 
+import numbers
 from types import MappingProxyType
 
 from amaranth.lib import data, enum, stream
@@ -54,7 +55,7 @@ COLOR_SELECT = MappingProxyType({color.name.lower(): color.value for color in Ta
 
 def color_select_value(color):
     """Return the 3-bit ``color_sel`` code (an int) for a colour name, a ``TargetColor`` or an
-    int 0..7."""
+    integer 0..7 (numpy's too: a run's recorded ``color_sel`` column)."""
     if isinstance(color, TargetColor):
         return color.value
     if isinstance(color, str):
@@ -64,6 +65,6 @@ def color_select_value(color):
             raise ParamError(
                 f"unknown colour {color!r}; choose one of: {', '.join(COLOR_SELECT)}"
             ) from None
-    if isinstance(color, bool) or not isinstance(color, int) or not 0 <= color <= 7:
+    if isinstance(color, bool) or not isinstance(color, numbers.Integral) or not 0 <= color <= 7:
         raise ParamError(f"color_sel must be a colour name or an int 0..7, not {color!r}")
-    return color
+    return int(color)

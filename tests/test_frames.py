@@ -33,6 +33,8 @@ def test_round_trip_is_c_shifted_left_by_four():
         (np.zeros((120, 160, 3), np.float32), "must be uint8"),
         (np.zeros((240, 320, 3), np.uint8), "shape (120, 160, 3)"),
         (np.zeros((120, 160), np.int16), "unsigned integer"),
+        # A greyscale image: its 192 would be read as the green pixel 0x0C0.
+        (np.full((120, 160), 192, np.uint8), "must be uint16 (12-bit pixels), got uint8"),
         (np.full((120, 160), 0x1000, np.uint16), "above 0xFFF"),
         (np.zeros((120, 160, 4), np.uint8), "shape (120, 160, 3)"),
         (np.zeros(5, np.uint8), "got shape (5,)"),

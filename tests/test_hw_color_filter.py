@@ -50,6 +50,16 @@ def test_target_color_codes_are_the_contract_bits():
         color_select_value("teal")
 
 
+def test_numpy_integers_are_colour_codes_and_bools_are_not():
+    # A run's recorded color_sel column is int64: replaying it takes its values as they are.
+    for value in (np.int64(4), np.uint8(4)):
+        code = color_select_value(value)
+        assert code == 4 and type(code) is int
+    for value in (True, np.bool_(True), np.int64(8), 4.0):
+        with pytest.raises(ValueError, match="an int 0..7"):
+            color_select_value(value)
+
+
 def test_color_sel_port_is_the_enum_on_three_bits():
     for dut in (ColorFilter(FollowTargetParams()), FollowTarget()):
         assert dut.color_sel.shape() is TargetColor

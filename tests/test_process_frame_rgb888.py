@@ -117,3 +117,23 @@ def test_a_read_only_out_is_refused():
     out.flags.writeable = False
     with get_backend("cxxrtl", P) as b, pytest.raises(FrameError, match="writable"):
         b.process_frame(frames(5, 1)[0][0], out=out)
+
+
+@pytest.mark.parametrize("name", ["model", "cxxrtl"])
+def test_a_greyscale_frame_is_refused_not_read_as_packed_rgb444(name):
+    # 192 = 0x0C0 would be the green pixel (0, 12, 0): a grey block "found" as green.
+    grey = np.full((P.height, P.width), 50, np.uint8)
+    grey[4:12, 10:30] = 192
+    with get_backend(name, P) as b:
+        with pytest.raises(FrameError, match=r"got uint8 \(16, 40\): a greyscale image\?"):
+            b.process_frame(grey, "green")
+        assert b.frames_processed == 0
+
+
+@pytest.mark.parametrize("name", ["model", "cxxrtl"])
+def test_a_recorded_numpy_colour_select_runs_as_its_int(name):
+    seq = frames(6, 2)[:2]
+    ref = expected(seq)
+    codes = np.array([4, 2], np.int64)  # a run's color_sel column, red then green
+    with get_backend(name, P) as b:
+        assert [b.process_frame(f, c) for (f, _), c in zip(seq, codes, strict=True)] == ref

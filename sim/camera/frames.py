@@ -20,7 +20,7 @@ def to_rgb444(frame, width, height):
     """Return ``frame`` as a contiguous (height, width) uint16 array of packed RGB444.
 
     Accepts an RGB888 image (height, width, 3) of uint8, or an already packed RGB444 array
-    (height, width) of an unsigned integer dtype with values below 4096.
+    (height, width) of uint16 (or a wider unsigned dtype) with values below 4096.
     """
     if not isinstance(frame, np.ndarray):
         raise FrameError(f"a frame must be a numpy array, not {type(frame).__name__}")
@@ -41,9 +41,18 @@ def to_rgb444(frame, width, height):
                 f"a packed RGB444 frame must have shape ({height}, {width}) for a "
                 f"{width}x{height} design, got {frame.shape}"
             )
+        if frame.dtype == np.uint8:
+            # 8 bits cannot hold a 12-bit pixel: a greyscale image, whose 192 would read as
+            # green 12 (0x0C0).
+            raise FrameError(
+                f"a packed RGB444 frame must be uint16 (12-bit pixels), got uint8 {frame.shape}: "
+                f"a greyscale image? give RGB888 ({height}, {width}, 3) uint8 instead "
+                f"(cv2.cvtColor(image, cv2.COLOR_GRAY2RGB))"
+            )
         if frame.dtype.kind != "u":
             raise FrameError(
-                f"a packed RGB444 frame must have an unsigned integer dtype, got {frame.dtype}"
+                f"a packed RGB444 frame must have an unsigned integer dtype (uint16), "
+                f"got {frame.dtype}"
             )
         if frame.size and int(frame.max()) > 0xFFF:
             raise FrameError("a packed RGB444 frame holds 12-bit values; found one above 0xFFF")
