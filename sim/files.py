@@ -14,6 +14,7 @@ import json
 import os
 import stat
 import tempfile
+import weakref
 from contextlib import contextmanager
 from pathlib import Path
 
@@ -159,7 +160,8 @@ def check_paths_apart(outputs, inputs=()):
 class PendingOutput:
     """A hidden temporary file next to ``path`` (``.tmp``), for output written over a while
     by a writer that opens files itself (a simulator tracing frames): ``commit()`` makes it
-    ``path``, ``discard()`` removes it. The path is checked on construction."""
+    ``path``, ``discard()`` removes it, as does dropping it uncommitted (its owner dropped
+    without finishing, or the interpreter's exit). The path is checked on construction."""
 
     def __init__(self, path, *, what="output file", suffix=None):
         self.path = check_output_path(path, what=what)
@@ -171,12 +173,14 @@ class PendingOutput:
         )
         os.close(fd)
         self.tmp = Path(tmp)
+        self._cleanup = weakref.finalize(self, self.tmp.unlink, missing_ok=True)
 
     def commit(self):
         _replace(self.tmp, self.path, self.what)
+        self._cleanup.detach()
 
     def discard(self):
-        self.tmp.unlink(missing_ok=True)
+        self._cleanup()
 
 
 @contextmanager

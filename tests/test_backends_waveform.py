@@ -1,6 +1,8 @@
 """Waveforms on demand from the compiled backends: only the requested frames, every port in
 the file, and nothing traced (a different build) when no waveform is asked for."""
 
+import gc
+import os
 import struct
 
 import numpy as np
@@ -145,6 +147,24 @@ def test_cxxrtl_and_verilator_waveforms_show_the_ports_change_at_the_same_times(
     assert [v for _, v in seen["cxxrtl"]["frame_done"]].count(1) == 3
     for port in sorted(PORTS):
         assert seen["cxxrtl"][port] == seen["verilator"][port], port
+
+
+@pytest.mark.parametrize("name", ["model", "cxxrtl"])
+def test_a_backend_dropped_before_its_last_frame_leaves_no_waveform(name, tmp_path):
+    # Frames 0..5 requested, 2 done, then the backend dropped without close() (a script
+    # ended by an exception): no half waveform under the real name, no temporary file.
+    frame = np.zeros((PARAMS.height, PARAMS.width, 3), np.uint8)
+    request = WaveformRequest(str(tmp_path / "w.vcd"), first_frame=0, last_frame=5)
+    backend = get_backend(name, PARAMS, waveform=request)
+    backend.process_frame(frame)
+    backend.process_frame(frame)
+    del backend
+    gc.collect()
+    assert os.listdir(tmp_path) == []
+    # close() writes out the frames done so far, as before.
+    with get_backend(name, PARAMS, waveform=request) as backend:
+        backend.process_frame(frame)
+    assert os.listdir(tmp_path) == ["w.vcd"]
 
 
 def test_untraced_build_has_no_tracing():

@@ -301,4 +301,10 @@ class CompiledBackend(HarnessFrames, DesignBackend):
     def __del__(self):
         # Interpreter shutdown may have torn down ctypes or os already: nothing to save then.
         with contextlib.suppress(AttributeError, TypeError, OSError, BackendError):
+            # Dropped without close() before its last requested frame: the waveform lacks
+            # frames, and goes (close() writes out the frames done).
+            if getattr(self, "_trace_state", None) == "open":
+                self._library.lib.fr_trace_close(self._live())
+                self._trace_tmp.discard()
+                self._trace_state = "done"
             self.close()

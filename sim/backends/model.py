@@ -40,7 +40,8 @@ class ModelBackend(DesignBackend):
         Idle cycles after every line / after the frame; they only change ``cycles``.
     waveform : WaveformRequest, optional
         Writes a ``.vcd`` of the ports for the requested frames. The file appears when the
-        last requested frame is done, or at ``close()``/``reset()`` with the frames done so far.
+        last requested frame is done, or at ``close()``/``reset()`` with the frames done so far;
+        a backend dropped before then leaves no file.
     """
 
     name = "model"
