@@ -315,6 +315,11 @@ def test_a_design_file_imports_the_modules_beside_it(tmp_path, monkeypatch, caps
         Fragment.get(component, None)  # used: Amaranth warns of a component never elaborated
         assert sys.modules[type(component).__module__].SPEED == speed, version
     assert sys.path == path and "helper" not in sys.modules
+    # An edit of the helper alone, the design file unchanged, is seen in the same process.
+    (tmp_path / "v1" / "helper.py").write_text("SPEED = 1250\n")
+    component = resolve_design("../v1/top.py:Top", base=elsewhere).build()
+    Fragment.get(component, None)
+    assert sys.modules[type(component).__module__].SPEED == 1250
     code, out, err = _cli(["designs", "../v1/top.py:Top"], capsys)
     assert code == 0 and "connectors: bumper (pressed=pressed); wheels" in out, err
 

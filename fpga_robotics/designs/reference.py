@@ -228,10 +228,20 @@ def resolve_design(reference, params=None, *, ports=None, base=None, option=None
         return _builtin_spec(TOPS[reference])
     reference = _own_reference(reference, base)
     frozen = tuple(sorted((k, _freeze(v)) for k, v in params.items()))
+    key = (reference, frozen)
+    cached = _OWN_SPECS.get(key)
+    if cached is not None and _stamps(cached[0]) == cached[1]:
+        return cached[2]
     try:
-        return _amaranth_spec(reference, frozen, _stamp(reference))
+        spec = _amaranth_spec(reference, frozen)
     except _ParamError as exc:
         raise DesignError(exc.said_for(option)) from None
+    files = _design_files(reference)
+    _OWN_SPECS.pop(key, None)
+    _OWN_SPECS[key] = (files, _stamps(files), spec)
+    if len(_OWN_SPECS) > _OWN_SPECS_KEPT:
+        del _OWN_SPECS[next(iter(_OWN_SPECS))]  # the least recently resolved
+    return spec
 
 
 def design_parameters(reference, base=None):
@@ -277,15 +287,35 @@ def _freeze(value):
     return tuple(map(_freeze, value)) if isinstance(value, list) else value
 
 
-def _stamp(reference):
-    """What makes a cached resolution stale: the design file's modification time."""
+#: (reference, frozen params) of a design of one's own -> (the files its resolution read,
+#: their ``_stamps`` then, its ``DesignSpec``): resolved again when any of them changed.
+_OWN_SPECS = {}
+_OWN_SPECS_KEPT = 64
+#: A design file's path -> the files of the modules its last load imported beside it.
+_IMPORTED_BESIDE = {}
+
+
+def _design_files(reference):
+    """The files a design of one's own was loaded from: its file and the modules it imported
+    beside it (none for an installed design's module)."""
     where = reference.rpartition(":")[0]
-    if where.endswith(".py"):
+    if not where.endswith(".py"):
+        return ()
+    where = str(Path(where))
+    return (where, *_IMPORTED_BESIDE.get(where, ()))
+
+
+def _stamps(files):
+    """What makes a cached resolution stale: its files' modification times and sizes (None:
+    gone)."""
+    stamps = []
+    for file in files:
         try:
-            return Path(where).stat().st_mtime_ns
+            stat = Path(file).stat()
+            stamps.append((stat.st_mtime_ns, stat.st_size))
         except OSError:
-            return None
-    return None
+            stamps.append(None)
+    return tuple(stamps)
 
 
 # Built-in designs ------------------------------------------------------------------------
@@ -334,8 +364,7 @@ def _builtin_spec(registered):
 # Amaranth designs of one's own ------------------------------------------------------------
 
 
-@functools.lru_cache(maxsize=64)
-def _amaranth_spec(reference, frozen_params, _stamp):
+def _amaranth_spec(reference, frozen_params):
     params = {k: list(v) if isinstance(v, tuple) else v for k, v in frozen_params}
     target = _load_target(reference)
     _check_params(target, params, reference)
@@ -537,6 +566,7 @@ def _importing_beside(path):
     folder = path.parent
     known = {name.partition(".")[0] for name in sys.modules}
     sys.path.insert(0, str(folder))
+    imported = []
     try:
         yield
     finally:
@@ -545,6 +575,9 @@ def _importing_beside(path):
             origin = getattr(getattr(module, "__spec__", None), "origin", None)
             if name.partition(".")[0] not in known and origin and folder in Path(origin).parents:
                 del sys.modules[name]
+                imported.append(origin)
+        # An edit of one of them makes the design's cached resolution stale (_OWN_SPECS).
+        _IMPORTED_BESIDE[str(path)] = tuple(imported)
 
 
 def _error_line(exc, path):
