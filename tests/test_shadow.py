@@ -1,5 +1,7 @@
 """Shadow runs: a second design on the same frames, in lockstep, never driving the robot."""
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -31,6 +33,20 @@ def test_the_design_shadowed_by_itself_never_differs():
     assert sh["frames"] == r.summary["frames"]
     assert sh["first_divergence"] is None
     assert sh["differing_frames"] == dict.fromkeys(COMPARED_OUTPUTS, 0)
+
+
+def test_a_shadow_of_another_resolution_is_refused_before_the_run():
+    # It was a FrameError at frame 0 telling the caller to resize frames they never see.
+    s = load_scenario("divider", ["sim.duration=1"])
+    frames = []
+    wrong = dataclasses.replace(s.params, width=320, height=240)
+    with ModelBackend(wrong) as shadow, pytest.raises(ValueError) as info:
+        run_scenario(s, backend="model", shadow=shadow, on_frame=frames.append)
+    assert str(info.value) == (
+        "the shadow backend is 320x240, the scenario's camera 160x120: build the shadow for "
+        "the scenario's resolution"
+    )
+    assert frames == []
 
 
 def test_shadow_does_not_drive_the_robot():

@@ -652,6 +652,15 @@ def run_compressed(
     if isinstance(backend, str) and scenario.top not in TOPS:
         # A backend name opens FollowTarget; run_scenario opens a design of one's own.
         raise ValueError("a design of one's own runs on a ready backend (loop.pin_frames)")
+    shadow_params = getattr(shadow, "params", None)
+    camera = (scenario.camera.width, scenario.camera.height)
+    if shadow_params is not None and (shadow_params.width, shadow_params.height) != camera:
+        # Found here, not at the first frame as a frame of the wrong shape for the shadow.
+        raise ValueError(
+            f"the shadow backend is {shadow_params.width}x{shadow_params.height}, the "
+            f"scenario's camera {camera[0]}x{camera[1]}: build the shadow for the scenario's "
+            f"resolution"
+        )
     return run_loop(
         backend,
         lambda name: make_backend(name, scenario.params),
