@@ -21,7 +21,7 @@ from pathlib import Path
 
 from fpga_robotics.hw.errors import UsageError
 from fpga_robotics.loop.timings import run_scenario
-from fpga_robotics.scenario.load import load_scenario
+from fpga_robotics.scenario.load import load_scenario, override_items
 
 __all__ = ["Check", "Result", "run"]
 
@@ -165,6 +165,6 @@ def run(
     recorder : optional
         A viewer recorder (``fpga_robotics.viz.open_recorder``), not closed here.
     """
-    items = [*_design_overrides(design, params, ports), *overrides]
+    items = [*_design_overrides(design, params, ports), *override_items(overrides)]
     loaded = load_scenario(str(scenario), items)
     return Result(run_scenario(loaded, seed=seed, backend=backend, recorder=recorder), loaded)

@@ -103,6 +103,20 @@ def test_with_overrides_keeps_earlier_ones():
     assert s.overrides == ("sim.duration=3", "design.kp_num=1")
 
 
+def test_overrides_given_as_one_string_are_refused_as_such():
+    # It was taken a character at a time: "--set needs KEY=VALUE ..., got 's'".
+    expected = (
+        'overrides must be a list of "KEY=VALUE" strings, got the string '
+        "'sim.duration=2'; write ['sim.duration=2']"
+    )
+    with pytest.raises(ScenarioError) as info:
+        load_scenario("follow_person", "sim.duration=2")
+    assert str(info.value) == expected
+    with pytest.raises(ScenarioError) as info:
+        load_scenario("follow_person").with_overrides("sim.duration=2")
+    assert str(info.value) == expected
+
+
 def test_colour_changes_take_effect_at_their_time(tmp_path):
     s = load_scenario(
         write(

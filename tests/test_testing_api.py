@@ -54,6 +54,8 @@ def test_bad_arguments_are_one_line_errors():
         run(DESIGNS / "wall_stop.toml", params={"nope": 1})
     with pytest.raises(UsageError, match="needs ports="):
         run(DESIGNS / "wall_stop.toml", design="verilog:x.v")
+    with pytest.raises(UsageError, match=r"got the string 'sim.duration=1'; write \['sim"):
+        run(DESIGNS / "wall_stop.toml", overrides="sim.duration=1")
 
 
 def test_the_module_docstring_example_runs_as_written(tmp_path, monkeypatch):

@@ -88,6 +88,7 @@ __all__ = [
     "ScenarioError",
     "SimConfig",
     "load_scenario",
+    "override_items",
     "parse_resolution",
     "shipped_scenarios",
 ]
@@ -292,7 +293,7 @@ class Scenario:
     def with_overrides(self, overrides):
         """A new scenario: this one's data with more ``KEY=VALUE`` overrides applied."""
         data = copy.deepcopy(self.data)
-        overrides = tuple(overrides)
+        overrides = override_items(overrides)
         _drop_replaced_design(data, overrides)  # as loading with them does
         _apply_overrides(data, overrides)
         return _finish(data, self.source, tuple(self.overrides) + overrides)
@@ -394,10 +395,21 @@ def load_scenario(name_or_path, overrides=()):
     if "name" not in data:
         data["name"] = _default_name(path)
     _fill_defaults(data)
-    overrides = tuple(overrides or ())
+    overrides = override_items(overrides)
     _drop_replaced_design(data, overrides)
     _apply_overrides(data, overrides)
     return _finish(data, str(path), overrides)
+
+
+def override_items(overrides):
+    """``overrides`` (a list of ``"KEY=VALUE"``, or None) as a tuple; ``ScenarioError`` for
+    one string, which would otherwise be taken a character at a time."""
+    if isinstance(overrides, str | bytes):
+        raise ScenarioError(
+            f'overrides must be a list of "KEY=VALUE" strings, got the string {overrides!r}; '
+            f"write [{overrides!r}]"
+        )
+    return tuple(overrides or ())
 
 
 def _drop_replaced_design(data, overrides):
