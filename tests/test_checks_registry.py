@@ -580,6 +580,36 @@ def test_a_check_declared_through_the_registry_shows_everywhere(path_check):
         register_check(path_check)
 
 
+def test_a_registered_check_reads_a_design_of_ones_own_outputs():
+    # The metrics a check saw lacked extra_outputs: its value was None, the check failed.
+    designs = Path(__file__).parent / "data" / "user_designs"
+    check = register_check(
+        Check(
+            name="max_red_count",
+            metric=lambda m: m["extra_outputs"]["red_count"]["max"],
+            compare="max",
+            meaning="the design counts at most this many red pixels in a frame",
+            message=lambda v, limit, m: f"red count max {v} (limit <= {limit})",
+            kind=int,
+            limits=(0, 4800, ""),
+            precondition=lambda m: None if "red_count" in m["extra_outputs"] else "no red_count",
+        )
+    )
+    try:
+        s = load_scenario(
+            str(designs / "red_frames.toml"), ["sim.duration=0.5", "checks={max_red_count = 4800}"]
+        )
+        r = run_scenario(s, backend="cxxrtl")
+        (c,) = r.summary["checks"]
+        assert c["status"] == "pass"
+        assert c["value"] == r.summary["extra_outputs"]["red_count"]["max"] > 0
+        assert _one("max_red_count", 0, {**r.summary, "extra_outputs": {}})["reason"] == (
+            "no red_count"
+        )
+    finally:
+        unregister_check(check.name)
+
+
 def test_the_loader_checks_the_new_key():
     with pytest.raises(ScenarioError, match=r"checks.min_measured_frames must be an integer"):
         load_scenario("follow_person", [*SMALL, "checks.min_measured_frames=1.5"])

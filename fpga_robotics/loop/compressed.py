@@ -539,14 +539,16 @@ class ClosedLoop:
             ),
         )
         metrics.update(self.extra_metrics())
-        checks = evaluate_checks(scenario.checks, metrics)  # on the unrounded metrics
-        shadow = {"shadow": self.comparison.summary()} if self.comparison is not None else {}
         # The last, smallest and largest value of each output no connector reads.
         extra = {
             name.removeprefix("design."): extra_output_stats(column)
             for name, column in self.traj.items()
             if name.startswith("design.")
         }
+        # On the unrounded metrics; a registered check of a design of one's own reads its
+        # outputs as the summary has them.
+        checks = evaluate_checks(scenario.checks, {**metrics, "extra_outputs": extra})
+        shadow = {"shadow": self.comparison.summary()} if self.comparison is not None else {}
         return {
             "scenario": scenario.name,
             "backend": self.design.name,
