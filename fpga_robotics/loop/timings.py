@@ -112,7 +112,14 @@ def check_ready_backend(backend, scenario):
     (frames in compressed timing, pins in real-clock timing); ``ValueError`` for a ready
     backend of another design than the scenario's (a FollowTarget backend would otherwise
     run in place of a design of one's own)."""
-    names = '"auto", "model", "pysim", "cxxrtl", "verilator"'
+    # The names that run the scenario's design: the model is FollowTarget's, and a Verilog
+    # design runs on the compiled simulators only.
+    if scenario.foreign is not None:
+        names = '"auto", "cxxrtl", "verilator"'
+    elif scenario.top not in TOPS or scenario.sim.timing == "real_clock":
+        names = '"auto", "cxxrtl", "verilator", "pysim"'
+    else:
+        names = '"auto", "model", "pysim", "cxxrtl", "verilator"'
     if not (hasattr(backend, "ports") or callable(getattr(backend, "process_frame", None))):
         raise TypeError(
             f"backend must be a backend name ({names}) or a ready backend, got {backend!r}"
