@@ -19,7 +19,7 @@ from ..camera.scene import CameraPose, Cylinder, Scene
 from ..records import PersonState, WorldMap
 from .collisions import AT_FAULT_SPEED, CollisionLog, MotionHistory, closing_speeds
 from .config import WorldConfigError, parse_world_config
-from .lighting import LightingSchedule
+from .lighting import SCHEDULE_SLACK, LightingSchedule
 from .motors import DriveMotors
 from .people import PersonPath, person_bands
 from .robots import G
@@ -382,7 +382,7 @@ class World:
         self._now = t1
         self.space.step(h)
         self.time = t1
-        if self._removals and self._removals[0][0] <= t1:
+        if self._removals and self._removals[0][0] <= t1 + SCHEDULE_SLACK:
             self._remove_due()
 
     def _driven_offset(self, person, sx, sy, h):
@@ -416,7 +416,7 @@ class World:
     def _remove_due(self):
         """Take the furniture whose ``present_until`` has come out of the physics, the
         camera's scene and the map."""
-        while self._removals and self._removals[0][0] <= self.time:
+        while self._removals and self._removals[0][0] <= self.time + SCHEDULE_SLACK:
             _, name = self._removals.pop(0)
             shape = self._furniture_shapes[name]
             self._collisions.separate("furniture", name, shape, self.time)
