@@ -233,7 +233,7 @@ class World:
         self._now = 0.0  # the end of the physics step under way: when its contacts happen
         #: ``(time_s, reason)`` once the robot has tipped over, else None.
         self.tipped = None
-        self._motor_v = 0.0  # the wheels' forward speed at the last sub-step, m/s
+        self._motor_v = 0.0  # the motors' forward speed at the last sub-step, m/s
         self._events = []
         for ctype in (_WALL, _FURNITURE, _PERSON):
             space.on_collision(
@@ -327,6 +327,7 @@ class World:
         body = self.robot_body
         rx, ry = body.position  # unchanged until space.step (one read: pymunk's are slow)
         wl, wr = self.motors.step(h)
+        drive_v = spec.wheel_radius * (wl + wr) * 0.5  # the motors' speed, before the noise
         if self.uncertainty is not None:
             wl, wr, slip = self.uncertainty.step(h, wl, wr, self.time)
             if self.uncertainty.events:
@@ -335,16 +336,17 @@ class World:
                 self._apply_terrain(slip, rx, ry)
         elif self.terrain:
             self._apply_terrain(1.0, rx, ry)
-        r = spec.wheel_radius
-        v = r * (wl + wr) * 0.5
         if self.tipped is None:
-            # The body follows the wheels at most at traction_force / mass.
-            accel = min(abs(v - self._motor_v) / h, spec.traction_force / spec.mass)
+            # The body follows the motors' ramp (the speed noise is the wheels' jitter, not
+            # a push) at most as fast as the traction in force lets it.
+            accel = min(abs(drive_v - self._motor_v) / h, self._traction_accel())
             if accel > spec.tip_accel:
                 self._tip(
                     f"longitudinal acceleration {accel:.2f} m/s^2 > {spec.tip_accel:.2f} m/s^2"
                 )
-        self._motor_v = v
+        self._motor_v = drive_v
+        r = spec.wheel_radius
+        v = r * (wl + wr) * 0.5
         w = r * (wr - wl) / spec.wheel_separation
         a = body.angle
         control = self.control_body
@@ -487,18 +489,33 @@ class World:
 
     def set_wheel_dps(self, left_dps, right_dps):
         """Wheel speed targets in degrees per second (the design's SET_MOTOR_DPS values).
-        A jump of either wheel's command beyond ``robot_spec.tip_step_dps`` (when the spec
-        has a ``motor_step_response``) tips the robot over; a tipped robot's wheels stay
-        still."""
+        A jump of either wheel's speed beyond ``robot_spec.tip_step_dps`` (when the spec has
+        a ``motor_step_response``) tips the robot over, unless the traction in force cannot
+        push the body at ``tip_accel``; a tipped robot's wheels stay still."""
         if self.tipped is not None:
             return
-        old_l, old_r = self.motors.command_dps
-        jump = max(abs(left_dps - old_l), abs(right_dps - old_r))
-        limit = self.robot_spec.tip_step_dps
-        if limit is not None and jump > limit:
-            self._tip(f"wheel command jumped {jump:g} DPS > {limit:.0f} DPS")
-            return
+        spec = self.robot_spec
+        limit = spec.tip_step_dps
+        if limit is not None and self._traction_accel() > spec.tip_accel:
+            # The motors clamp a command to max_wheel_dps: they jump by the clamped change.
+            top = spec.max_wheel_dps
+
+            def clamped(dps):
+                return max(-top, min(top, dps))
+
+            old_l, old_r = self.motors.command_dps
+            jump = max(
+                abs(clamped(left_dps) - clamped(old_l)), abs(clamped(right_dps) - clamped(old_r))
+            )
+            if jump > limit:
+                self._tip(f"wheel command jumped {jump:g} DPS > {limit:.0f} DPS")
+                return
         self.motors.set_wheel_dps(left_dps, right_dps)
+
+    def _traction_accel(self):
+        """The largest acceleration the wheels can give the body now, m/s^2: the robot's
+        traction times the floor's (a terrain patch's friction, a slip's factor)."""
+        return self.robot_spec.traction_force * self._traction / self.robot_spec.mass
 
     def _tip(self, reason):
         """The robot falls: its wheels stop (the body is braked by the drive's traction)."""
