@@ -60,6 +60,11 @@ _KINDS = ("person", "wall", "furniture")
 _FRICTION = 0.5
 
 
+def _terrain_event(patch):
+    """The event of the robot's centre coming onto ``patch`` (None: off every patch)."""
+    return f"terrain: on {patch.name!r}" if patch is not None else "terrain: off the patches"
+
+
 def _speed(v):
     """A speed with two decimals, never "-0.00"."""
     return f"{round(v, 2) + 0.0:.2f}"
@@ -235,6 +240,8 @@ class World:
         self.tipped = None
         self._motor_v = 0.0  # the motors' forward speed at the last sub-step, m/s
         self._events = []
+        if self._patch is not None:  # the log says where the robot starts, as it changes
+            self._events.append(_terrain_event(self._patch))
         for ctype in (_WALL, _FURNITURE, _PERSON):
             space.on_collision(
                 _ROBOT,
@@ -435,9 +442,7 @@ class World:
         patch = self.terrain.at(x, y) if self.terrain else None
         if patch is not self._patch:
             self._patch = patch
-            self._events.append(
-                f"terrain: on {patch.name!r}" if patch is not None else "terrain: off the patches"
-            )
+            self._events.append(_terrain_event(patch))
         factor = slip * (patch.friction if patch is not None else 1.0)
         if factor != self._traction:
             self._traction = factor
