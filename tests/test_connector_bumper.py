@@ -60,6 +60,14 @@ def test_the_pin_is_poked_only_when_it_changes():
     [
         ({"kind": "bumper", "margin": -1}, "robot.sensors[0].margin must be a number in 0..0.1"),
         ({"kind": "bumper", "colour": 1}, "unknown key 'colour' for a bumper"),
+        # The mount keys it names are the ones a bumper takes (yaw_deg, not yaw).
+        (
+            {"kind": "bumper", "yaw": 10},
+            (
+                "unknown key 'yaw' for a bumper; its keys: margin, arc_deg "
+                "(and the mount: forward, left, height, yaw_deg)"
+            ),
+        ),
         ({"kind": "bumpr"}, "unknown connector kind 'bumpr'"),
         (
             {"kind": "servo"},

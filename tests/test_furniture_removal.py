@@ -50,6 +50,20 @@ def test_the_box_leaves_at_its_time_with_one_event():
     assert world.drain_events() == []
 
 
+def test_the_box_leaves_at_a_frame_whose_clock_reads_just_below_its_time():
+    # 888 steps of 1/240 s add up to 3.6999999999999997 s: the frame at 3.7 s has no box.
+    world = World.from_config(
+        {"room": {"furniture": [dict(BOX, present_until=3.7)]}, "robot": {"start": [1.0, 3.0]}}
+    )
+    for _ in range(887):
+        world.step(1 / 240)
+    assert world.drain_events() == [] and len(world.present_furniture()) == 1
+    world.step(1 / 240)
+    assert world.time < 3.7
+    assert world.drain_events() == ["furniture 'crate' removed"]
+    assert world.present_furniture() == []
+
+
 def test_the_robot_drives_through_where_the_box_was_and_counts_stay():
     world = _world(start=[1.4, 3.0])
     world.set_wheel_dps(400, 400)

@@ -9,6 +9,7 @@ from fpga_robotics.hw.sensor_params import DISTANCE_NONE, UltrasoundParams
 from fpga_robotics.hw.ultrasound import UltrasoundDriver
 from fpga_robotics.hw.variants import variant_params
 from fpga_robotics.sim.models.ultrasound_driver import Measurement, UltrasoundModel, echo_cycles_of
+from fpga_robotics.sim.world.ultrasound import HCSR04Module, HCSR04Params
 
 #: A 1 MHz clock and a 2.4 ms period keep pysim fast: T = 12, W = 500, M = 1749 cycles.
 SMALL = {"clock_hz": 1_000_000, "period_us": 2400, "wait_us": 500, "max_range_mm": 300}
@@ -179,6 +180,25 @@ def test_narrow_counter_at_50_mhz_by_hand():
     assert p.distance_of(cycles) == 103
     # The 38 ms time-out pulse: 1,900,000 - 2**20 = 851,424 cycles -> 2920 mm, not no echo.
     assert p.distance_of(1_900_000) == 2920
+
+
+def test_narrow_counter_in_the_world_at_20_c():
+    # The world's HC-SR04 sends sound at 331.3 + 0.606 * 20 = 343.42 m/s (docs/sensor_designs.md
+    # quotes the narrow counter's band at that speed): the count wraps from 3.601 m on, a wall
+    # at 3.7 m reads 98 mm, and readings stay below stop_mm = 300 up to 3.90 m.
+    p = variant_params("us_echo_counter_narrow")
+    world = HCSR04Module(HCSR04Params(noise_std=0.0))
+    clock = p.clock_hz
+
+    def reads(d):
+        return p.distance_of(world.echo_width(d, clock))
+
+    c = 331.3 + 0.606 * 20
+    assert 2**20 / clock * c / 2 == pytest.approx(3.601, abs=5e-4)
+    assert reads(3.6) > 3500 and reads(3.602) < 5
+    assert reads(3.7) == 98
+    assert reads(3.9) < 300 <= reads(3.905)
+    assert reads(1.0) == 998  # 0.12 % short of the design's 343 m/s
 
 
 def test_inverted_echo_variant_never_measures():

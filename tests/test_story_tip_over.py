@@ -74,23 +74,15 @@ def test_traction_limits_the_acceleration_that_tips():
     assert world.tipped is None
 
 
-def _gopigo(step_response=0.05):
-    return World.from_config(
-        {
-            "robot": {
-                "model": "gopigo3",
-                "start": [1.0, 3.0],
-                "motor_step_response": step_response,
-            },
-            "people": [],
-        },
-        0,
-    )
+def _gopigo(traction_force=7.8, **robot):
+    # 7.8 N (the tyres' grip, as in scenario erratic): the body can take tip_accel * 0.8 kg.
+    robot = {"model": "gopigo3", "start": [1.0, 3.0], "traction_force": traction_force, **robot}
+    return World.from_config({"robot": robot, "people": []}, 0)
 
 
 def test_a_jump_of_the_command_beyond_the_step_limit_tips_the_gopigo3():
     # 7.8453 m/s^2 * 0.05 s / 0.03325 m = 11.80 rad/s = 675.9 DPS.
-    world = _gopigo()
+    world = _gopigo(motor_step_response=0.05)
     limit = world.robot_spec.tip_step_dps
     assert limit == pytest.approx(GOPIGO3.tip_accel * 0.05 / (0.03325 * DEG))
     assert 675 < limit < 676
@@ -106,6 +98,58 @@ def test_a_jump_of_the_command_beyond_the_step_limit_tips_the_gopigo3():
     _run(world, 1.0)
     assert world.wheel_speeds() == (0.0, 0.0)
     assert world.robot_velocity()[0] == pytest.approx(0.0, abs=1e-6)
+
+
+def test_a_jump_tips_only_a_robot_whose_traction_can_give_tip_accel():
+    # The preset's 1.39 N push the 0.8 kg body at 1.74 m/s^2 at most: the wheels spin.
+    world = _gopigo(traction_force=GOPIGO3.traction_force, motor_step_response=0.05)
+    world.set_wheel_dps(-500, -500)
+    _run(world, 1.0)
+    world.set_wheel_dps(500, 500)  # 1000 DPS
+    assert world.tipped is None
+
+
+@pytest.mark.parametrize("command", [600, 700, 1000])
+def test_a_jump_is_judged_after_the_motors_clamp_it(command):
+    # The wheels reach at most max_wheel_dps = 512: from standstill they jump 512 DPS at
+    # most, below the 676 DPS limit, however far beyond it the command goes.
+    world = _gopigo(motor_step_response=0.05)
+    world.set_wheel_dps(command, command)
+    _run(world, 1.0)
+    assert world.tipped is None
+    assert world.wheel_speeds() == pytest.approx((512 * DEG, 512 * DEG))
+    world.set_wheel_dps(-command, -command)  # 1024 DPS of the wheels: falls
+    assert world.drain_events() == ["tipped over: wheel command jumped 1024 DPS > 676 DPS"]
+
+
+@pytest.mark.parametrize("friction, tips", [(1.0, True), (0.2, False), (0.05, False)])
+def test_a_slippery_floor_keeps_the_acceleration_below_tipping(friction, tips):
+    # The ramp asks 0.035 m * 100000 deg/s^2 = 61 m/s^2; the traction gives the TurtleBot2
+    # friction * 50 N / 6.3 kg: 7.94 m/s^2 on a dry floor (> 5.64: tips), 1.59 and 0.40 on
+    # the patch.
+    cfg = {
+        "room": {
+            "width": 8,
+            "depth": 6,
+            "terrain": [{"name": "ice", "center": [4, 3], "size": [8, 6], "friction": friction}],
+        },
+        "people": [],
+        "robot": {"start": [2, 3], "traction_force": 50.0, "wheel_accel_dps2": 100000},
+    }
+    world = World.from_config(cfg, 0)
+    world.set_wheel_dps(600, 600)
+    _run(world, 0.5)
+    assert (world.tipped is not None) == tips
+
+
+def test_motor_noise_does_not_tip_the_robot_at_a_fine_physics_step():
+    # 20 DPS of speed noise with a 0.1 s correlation time is a jitter of 0.012 m/s: its
+    # per-step change grows as 1 / sqrt(step) (10 m/s^2 at 0.2 ms), the body's does not.
+    world = _gopigo(traction_force=8.0, motor_noise_dps=20)
+    world.set_wheel_dps(200, 200)
+    for _ in range(500):
+        world.step(0.0002)
+    assert world.tipped is None
 
 
 def _traj(cmd_w, centroid_x, found=None):

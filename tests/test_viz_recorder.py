@@ -4,6 +4,7 @@ Frames are built here with known values (no dependence on the closed loop); the 
 back with ``rerun.chunk.RrdReader`` (through ``viz.readback``) and compared with them.
 """
 
+import dataclasses
 import math
 import os
 
@@ -15,6 +16,7 @@ import rerun.blueprint as rrb
 from fpga_robotics.cli.readback import main as readback_main
 from fpga_robotics.sim.backends.base import FrameResult
 from fpga_robotics.sim.camera.frames import rgb444_to_rgb888
+from fpga_robotics.sim.camera.scene import CameraPose
 from fpga_robotics.sim.records import FrameRecord, PersonState, WorldMap
 from fpga_robotics.viz import ViewerError, open_recorder
 from fpga_robotics.viz import paths as P
@@ -240,6 +242,25 @@ def test_events_are_text_at_their_frame(saved):
             (5, "colour select changed to green", "INFO"),
         ]
     )
+
+
+def test_map_field_of_view_is_drawn_from_the_camera_on_its_mount(tmp_path):
+    # A camera 0.1 m ahead of the centre, yawed 30 deg left: the wedge's apex is the camera,
+    # its rays at 0 and 60 deg (the body heads at 0 deg).
+    frames = make_frames(2)
+    frames[1] = dataclasses.replace(
+        frames[1], robot_heading=0.0, camera_pose=CameraPose(1.12, 2.01, math.radians(30))
+    )
+    record(tmp_path / "run.rrd", frames)
+    data = read_rrd(str(tmp_path / "run.rrd"))
+    left, apex, right = single(data.entities[P.MAP_FOV].values["LineStrips2D:strips"])[1]
+    np.testing.assert_allclose(apex, [1.12, -2.01], atol=1e-6)
+    ang_left = math.atan2(-(left[1] - apex[1]), left[0] - apex[0])
+    ang_right = math.atan2(-(right[1] - apex[1]), right[0] - apex[0])
+    assert ang_left == pytest.approx(math.radians(30) + 0.5, abs=1e-5)
+    assert ang_right == pytest.approx(math.radians(30) - 0.5, abs=1e-5)
+    origin = single(data.entities[P.MAP_ROBOT].values["Arrows2D:origins"])[1]
+    np.testing.assert_allclose(origin, [1.02, -2.01], atol=1e-5)  # the body stays put
 
 
 def test_map_robot_people_and_trails(saved):

@@ -9,7 +9,12 @@ import math
 import pytest
 
 from fpga_robotics.sim.world import TURTLEBOT2, World
-from fpga_robotics.sim.world.collisions import EPISODE_GAP, CollisionLog
+from fpga_robotics.sim.world.collisions import (
+    EPISODE_GAP,
+    FAULT_WINDOW,
+    CollisionLog,
+    MotionHistory,
+)
 
 DT = 1 / 200
 CONTACT = 0.2 + TURTLEBOT2.body_radius  # centres of a person and the robot when they touch
@@ -91,6 +96,44 @@ def test_a_creeping_robot_hit_by_a_walking_person_is_not_at_fault():
             "not the robot's fault)"
         )
     ]
+    assert world.at_fault_collisions() == 0
+
+
+@pytest.mark.parametrize("h", [1 / 240, 0.0005, 0.0002])
+def test_fault_velocities_average_over_the_window_at_any_physics_step(h):
+    # A person walks at 1 m/s until 0.2 s, then stands: over the 0.1 s before 0.25 s they
+    # moved 0.05 m, 0.5 m/s on average, whatever the step the positions were recorded at.
+    history = MotionHistory()
+    n = round(0.25 / h)
+    for k in range(n):
+        t = k * h
+        history.record(t, (0.0, 0.0), ((min(t, 0.2), 0.0),))
+    robot_v, (person_v,) = history.mean_velocities(n * h, (0.0, 0.0), ((0.2, 0.0),))
+    assert robot_v == (0.0, 0.0)
+    assert person_v[0] == pytest.approx(0.05 / FAULT_WINDOW, abs=h / FAULT_WINDOW)
+
+
+@pytest.mark.parametrize("dt", [1 / 240, 0.0005])
+def test_the_fault_of_a_touch_does_not_depend_on_the_physics_step(dt):
+    # The robot creeps at 0.06 m/s; the person walks at 0.6 m/s towards it and stops about
+    # 80 ms before the touch: over the last 0.1 s they still closed faster than the robot.
+    cfg = {
+        "room": {"width": 8, "depth": 6},
+        "robot": {"start": [1, 3]},
+        "people": [{"waypoints": [[3, 3], [1.527, 3]], "speed": 0.6, "loop": False}],
+    }
+    world = World.from_config(cfg, 0)
+    world.set_wheel_dps(_dps(0.06), _dps(0.06))
+    events = []
+    while not events:
+        world.step(dt)
+        events = world.drain_events()
+    assert world.time == pytest.approx(2.53, abs=0.01)
+    (event,) = events
+    assert event.endswith("not the robot's fault)")
+    # The person's 0.1 s average: 0.6 m/s for about 20 ms of it.
+    person = float(event.split("person ")[-1].split(" m/s")[0])
+    assert 0.1 <= person <= 0.2
     assert world.at_fault_collisions() == 0
 
 

@@ -57,6 +57,15 @@ BAD = [
         "robot.camera_height must be below the ceiling (room.height = 0.25 m), got 0.3",
     ),
     ({"robot": {"camera_height": 2.5}}, "robot.camera_height must be below the ceiling"),
+    # Nothing stands taller than the room: the two renderers would disagree about it.
+    (
+        {"room": {"height": 1.0}, "people": [{"waypoints": [[4, 3]]}]},
+        "people[0].height must be at most the ceiling's (room.height = 1 m), got 1.75",
+    ),
+    (
+        {"room": {"height": 0.5, "furniture": [{"center": [4, 3], "height": 1.5}]}},
+        "room.furniture[0].height must be at most the ceiling's (room.height = 0.5 m), got 1.5",
+    ),
     ({"robot": {"camera_tilt_deg": 90}}, "robot.camera_tilt_deg must be <= 85, got 90"),
     ({"robot": {"mass": True}}, "robot.mass must be a number"),
     ({"robot": {"mass": float("nan")}}, "robot.mass must be a number"),

@@ -48,3 +48,18 @@ def test_scene_lighting_follows_world_time():
     light = world.scene().lighting
     assert (light.ambient, light.intensity) == pytest.approx((0.35, 0.3))
     assert light.direction == (1.0, 0.5, -1.0)
+
+
+def test_a_step_keyframe_acts_at_a_frame_whose_clock_reads_just_below_it():
+    # 888 steps of 1/240 s add up to 3.6999999999999997 s, the clock of the frame at 3.7 s
+    # (30 fps): the keyframe at 3.7 s is in force there, as a colour change at 3.7 s is.
+    cfg = {
+        "people": [],
+        "lighting": {"keyframes": [[0, 0.6, 0.5], [3.7, 0.9, 0.2]], "interpolation": "step"},
+    }
+    world = World.from_config(cfg, seed=0)
+    for _ in range(888):
+        world.step(1 / 240)
+    assert world.time < 3.7 and world.time == pytest.approx(3.7)
+    light = world.scene().lighting
+    assert (light.ambient, light.intensity) == (0.9, 0.2)

@@ -321,3 +321,29 @@ def test_the_map_shows_the_terrain(tmp_path):
     # The wet strip's outline, closed (5 points), in the viewer's coordinates (y down).
     assert sorted({round(p[0], 4) for p in strip}) == [2.6, 4.6]
     assert sorted({round(abs(p[1]), 4) for p in strip}) == [0.0, 6.0] and len(strip) == 5
+
+
+def test_a_robot_starting_on_a_patch_logs_it_first():
+    cfg = {
+        "room": {
+            "width": 8,
+            "depth": 6,
+            "terrain": [
+                {"name": "carpet", "center": [2, 3], "size": [2, 2], "friction": 0.5},
+                {"name": "wet", "center": [5, 3], "size": [1, 2], "friction": 0.3},
+            ],
+        },
+        "robot": {"start": [2, 3]},
+        "people": [],
+    }
+    world = World.from_config(cfg, 0)
+    assert world.drain_events() == ["terrain: on 'carpet'"]
+    world.set_wheel_dps(600, 600)
+    events = []
+    for _ in range(240 * 8):
+        world.step(1 / 240)
+        events += world.drain_events()
+    # It leaves the carpet (x = 3 m) and reaches the wet patch (x = 4.5 m) within 8 s.
+    assert events == ["terrain: off the patches", "terrain: on 'wet'"]
+    # A start off every patch logs nothing.
+    assert World.from_config(dict(cfg, robot={"start": [1, 1]}), 0).drain_events() == []

@@ -452,10 +452,14 @@ class Recorder:
         # Heading (world, counter-clockwise) -> viewer direction (cos h, -sin h).
         c, s = math.cos(h), math.sin(h)
         add(P.MAP_ROBOT, (x, y, 0.4 * reach * c, -0.4 * reach * s))
+        # The field of view from the camera on its mount (ahead of the centre, maybe yawed),
+        # as the frames and the 3D view see it; from the body without a camera pose.
+        pose = record.camera_pose
+        (cx, cy), ch = ((x, y), h) if pose is None else (_xy(pose.x, pose.y), float(pose.heading))
         half = 0.5 * float(record.camera_hfov)
-        left = (x + reach * math.cos(h + half), y - reach * math.sin(h + half))
-        right = (x + reach * math.cos(h - half), y - reach * math.sin(h - half))
-        add(P.MAP_FOV, (left, (x, y), right))
+        left = (cx + reach * math.cos(ch + half), cy - reach * math.sin(ch + half))
+        right = (cx + reach * math.cos(ch - half), cy - reach * math.sin(ch - half))
+        add(P.MAP_FOV, (left, (cx, cy), right))
 
         target = None
         if record.people:

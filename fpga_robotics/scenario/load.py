@@ -71,6 +71,7 @@ from fpga_robotics.sim.camera.sensor import OV7670Params
 from fpga_robotics.sim.world import World, WorldConfigError
 from fpga_robotics.sim.world.config import WORLD_SECTIONS, default_people
 from fpga_robotics.sim.world.keys import WORLD_KEY_MODELS
+from fpga_robotics.sim.world.lighting import SCHEDULE_SLACK
 from fpga_robotics.sim.world.schema import Number, check_of, validate
 
 __all__ = [
@@ -269,7 +270,7 @@ class Scenario:
         """The colour select in force at simulated time ``t``."""
         color = self.color_initial
         for at, c in self.color_changes:
-            if at <= t + 1e-12:
+            if at <= t + SCHEDULE_SLACK:
                 color = c
         return color
 

@@ -146,12 +146,16 @@ class MotionHistory:
     """The robot's and the people's positions at the start of the last sub-steps (the world
     records one before each physics step), for averaged velocities."""
 
-    def __init__(self, window=FAULT_WINDOW, size=64):
+    def __init__(self, window=FAULT_WINDOW):
         self.window = window
-        self._rows = deque(maxlen=size)  # (t, robot_xy, people_xy tuple)
+        self._rows = deque()  # (t, robot_xy, people_xy tuple), oldest first
 
     def record(self, t, robot_xy, people_xy):
-        self._rows.append((t, robot_xy, people_xy))
+        # Rows leave by age, not by count: the window is the same at any physics step.
+        rows = self._rows
+        while rows and t - rows[0][0] > self.window + 1e-12:
+            rows.popleft()
+        rows.append((t, robot_xy, people_xy))
 
     def mean_velocities(self, t, robot_xy, people_xy):
         """``(robot_v, [person_v, ...])`` averaged from the oldest row within the window

@@ -268,6 +268,7 @@ def _parse_room(section):
                 f"room.furniture[{i}].center {_fmt(f.center)} is outside "
                 f"the room (0..{k.width:g} x 0..{k.depth:g} m)"
             )
+        _check_below_ceiling(f"room.furniture[{i}].height", f.height, k.height)
     return RoomConfig(
         k.width,
         k.depth,
@@ -362,8 +363,18 @@ def default_people(room):
     ]
 
 
+def _check_below_ceiling(key, height, ceiling):
+    """Nothing may stand taller than the room: the raster renderer cuts it at the ceiling,
+    the 3D one would draw it through, and the two would see different images."""
+    if height > ceiling:
+        raise WorldConfigError(
+            f"{key} must be at most the ceiling's (room.height = {ceiling:g} m), got {height:g}"
+        )
+
+
 def _parse_person(item, path, index, room):
     k = _keys(PersonKeys, item, path)
+    _check_below_ceiling(f"{path}.height", k.height, room.height)
     waypoints = k.waypoints
     if isinstance(k.pause, tuple):
         if len(k.pause) != len(waypoints):

@@ -10,7 +10,12 @@ import bisect
 
 from ..camera.scene import Lighting
 
-__all__ = ["LightingSchedule"]
+__all__ = ["SCHEDULE_SLACK", "LightingSchedule"]
+
+#: A scheduled instant (a keyframe, a colour change, a removal) is reached when the clock is
+#: within this of it, s: the clock is a float sum of physics steps, so a frame at 3.7 s may
+#: read 3.6999999999999997.
+SCHEDULE_SLACK = 1e-9
 
 
 class LightingSchedule:
@@ -33,14 +38,14 @@ class LightingSchedule:
         keys = self.keyframes
         if not keys:
             return self.config.ambient, self.config.intensity
-        i = bisect.bisect_right(self._times, t)  # keys[:i] have time <= t
+        i = bisect.bisect_right(self._times, t + SCHEDULE_SLACK)  # keys[:i] are reached
         if i == 0:
             return keys[0][1], keys[0][2]
         if i == len(keys) or self.config.interpolation == "step":
             return keys[i - 1][1], keys[i - 1][2]
         t0, a0, b0 = keys[i - 1]
         t1, a1, b1 = keys[i]
-        f = (t - t0) / (t1 - t0)  # t1 > t >= t0 here, so t1 > t0
+        f = max(0.0, (t - t0) / (t1 - t0))  # t1 > t >= t0 (within the slack): t1 > t0
         return a0 + f * (a1 - a0), b0 + f * (b1 - b0)
 
     def at(self, t):

@@ -61,7 +61,9 @@ class RobotSpec:
 
     The robot tips over (quasi-statically) when its longitudinal acceleration exceeds
     ``tip_accel = g * support_half_length / com_height``: the inertial force at the centre of
-    mass then has a larger moment about the support edge than the weight.
+    mass then has a larger moment about the support edge than the weight. The body gets at
+    most ``traction_force / mass`` (times the floor's factor), so a robot whose traction is
+    below ``tip_accel * mass`` never tips.
     """
 
     name: str

@@ -19,7 +19,7 @@ from ..camera.scene import CameraPose, Cylinder, Scene
 from ..records import PersonState, WorldMap
 from .collisions import AT_FAULT_SPEED, CollisionLog, MotionHistory, closing_speeds
 from .config import WorldConfigError, parse_world_config
-from .lighting import LightingSchedule
+from .lighting import SCHEDULE_SLACK, LightingSchedule
 from .motors import DriveMotors
 from .people import PersonPath, person_bands
 from .robots import G
@@ -58,6 +58,11 @@ MAX_TARGET_SPEED = 3.0
 _ROBOT, _WALL, _FURNITURE, _PERSON = 1, 2, 3, 4
 _KINDS = ("person", "wall", "furniture")
 _FRICTION = 0.5
+
+
+def _terrain_event(patch):
+    """The event of the robot's centre coming onto ``patch`` (None: off every patch)."""
+    return f"terrain: on {patch.name!r}" if patch is not None else "terrain: off the patches"
 
 
 def _speed(v):
@@ -233,8 +238,10 @@ class World:
         self._now = 0.0  # the end of the physics step under way: when its contacts happen
         #: ``(time_s, reason)`` once the robot has tipped over, else None.
         self.tipped = None
-        self._motor_v = 0.0  # the wheels' forward speed at the last sub-step, m/s
+        self._motor_v = 0.0  # the motors' forward speed at the last sub-step, m/s
         self._events = []
+        if self._patch is not None:  # the log says where the robot starts, as it changes
+            self._events.append(_terrain_event(self._patch))
         for ctype in (_WALL, _FURNITURE, _PERSON):
             space.on_collision(
                 _ROBOT,
@@ -327,6 +334,7 @@ class World:
         body = self.robot_body
         rx, ry = body.position  # unchanged until space.step (one read: pymunk's are slow)
         wl, wr = self.motors.step(h)
+        drive_v = spec.wheel_radius * (wl + wr) * 0.5  # the motors' speed, before the noise
         if self.uncertainty is not None:
             wl, wr, slip = self.uncertainty.step(h, wl, wr, self.time)
             if self.uncertainty.events:
@@ -335,16 +343,17 @@ class World:
                 self._apply_terrain(slip, rx, ry)
         elif self.terrain:
             self._apply_terrain(1.0, rx, ry)
-        r = spec.wheel_radius
-        v = r * (wl + wr) * 0.5
         if self.tipped is None:
-            # The body follows the wheels at most at traction_force / mass.
-            accel = min(abs(v - self._motor_v) / h, spec.traction_force / spec.mass)
+            # The body follows the motors' ramp (the speed noise is the wheels' jitter, not
+            # a push) at most as fast as the traction in force lets it.
+            accel = min(abs(drive_v - self._motor_v) / h, self._traction_accel())
             if accel > spec.tip_accel:
                 self._tip(
                     f"longitudinal acceleration {accel:.2f} m/s^2 > {spec.tip_accel:.2f} m/s^2"
                 )
-        self._motor_v = v
+        self._motor_v = drive_v
+        r = spec.wheel_radius
+        v = r * (wl + wr) * 0.5
         w = r * (wr - wl) / spec.wheel_separation
         a = body.angle
         control = self.control_body
@@ -382,7 +391,7 @@ class World:
         self._now = t1
         self.space.step(h)
         self.time = t1
-        if self._removals and self._removals[0][0] <= t1:
+        if self._removals and self._removals[0][0] <= t1 + SCHEDULE_SLACK:
             self._remove_due()
 
     def _driven_offset(self, person, sx, sy, h):
@@ -416,7 +425,7 @@ class World:
     def _remove_due(self):
         """Take the furniture whose ``present_until`` has come out of the physics, the
         camera's scene and the map."""
-        while self._removals and self._removals[0][0] <= self.time:
+        while self._removals and self._removals[0][0] <= self.time + SCHEDULE_SLACK:
             _, name = self._removals.pop(0)
             shape = self._furniture_shapes[name]
             self._collisions.separate("furniture", name, shape, self.time)
@@ -433,9 +442,7 @@ class World:
         patch = self.terrain.at(x, y) if self.terrain else None
         if patch is not self._patch:
             self._patch = patch
-            self._events.append(
-                f"terrain: on {patch.name!r}" if patch is not None else "terrain: off the patches"
-            )
+            self._events.append(_terrain_event(patch))
         factor = slip * (patch.friction if patch is not None else 1.0)
         if factor != self._traction:
             self._traction = factor
@@ -487,18 +494,33 @@ class World:
 
     def set_wheel_dps(self, left_dps, right_dps):
         """Wheel speed targets in degrees per second (the design's SET_MOTOR_DPS values).
-        A jump of either wheel's command beyond ``robot_spec.tip_step_dps`` (when the spec
-        has a ``motor_step_response``) tips the robot over; a tipped robot's wheels stay
-        still."""
+        A jump of either wheel's speed beyond ``robot_spec.tip_step_dps`` (when the spec has
+        a ``motor_step_response``) tips the robot over, unless the traction in force cannot
+        push the body at ``tip_accel``; a tipped robot's wheels stay still."""
         if self.tipped is not None:
             return
-        old_l, old_r = self.motors.command_dps
-        jump = max(abs(left_dps - old_l), abs(right_dps - old_r))
-        limit = self.robot_spec.tip_step_dps
-        if limit is not None and jump > limit:
-            self._tip(f"wheel command jumped {jump:g} DPS > {limit:.0f} DPS")
-            return
+        spec = self.robot_spec
+        limit = spec.tip_step_dps
+        if limit is not None and self._traction_accel() > spec.tip_accel:
+            # The motors clamp a command to max_wheel_dps: they jump by the clamped change.
+            top = spec.max_wheel_dps
+
+            def clamped(dps):
+                return max(-top, min(top, dps))
+
+            old_l, old_r = self.motors.command_dps
+            jump = max(
+                abs(clamped(left_dps) - clamped(old_l)), abs(clamped(right_dps) - clamped(old_r))
+            )
+            if jump > limit:
+                self._tip(f"wheel command jumped {jump:g} DPS > {limit:.0f} DPS")
+                return
         self.motors.set_wheel_dps(left_dps, right_dps)
+
+    def _traction_accel(self):
+        """The largest acceleration the wheels can give the body now, m/s^2: the robot's
+        traction times the floor's (a terrain patch's friction, a slip's factor)."""
+        return self.robot_spec.traction_force * self._traction / self.robot_spec.mass
 
     def _tip(self, reason):
         """The robot falls: its wheels stop (the body is braked by the drive's traction)."""

@@ -11,7 +11,13 @@ from typing import ClassVar
 
 import pymunk
 
-from fpga_robotics.loop.connectors.base import Connector, ConnectorError, Pin, register
+from fpga_robotics.loop.connectors.base import (
+    MOUNT_KEYS,
+    Connector,
+    ConnectorError,
+    Pin,
+    register,
+)
 
 __all__ = ["BumperConnector", "BumperParams"]
 
@@ -39,8 +45,7 @@ class BumperConnector(Connector):
             if key not in limits:
                 raise ConnectorError(
                     f"{where}: unknown key {key!r} for a bumper; its keys: "
-                    f"{', '.join(limits)} (and the mount: forward, left, "
-                    f"height, yaw)"
+                    f"{', '.join(limits)} (and the mount: {', '.join(MOUNT_KEYS)})"
                 )
             lo, hi = limits[key]
             if (
