@@ -168,3 +168,27 @@ def test_a_campaign_resolution_is_the_one_its_runs_take(tmp_path):
     assert ft.count("--resolution") == 1
     assert own[own.index("--resolution") :][:2] == ["--resolution", "80x60"]
     assert own.count("--resolution") == 1
+
+
+def test_an_interrupted_rerun_leaves_no_earlier_results_beside_its_netlist(tmp_path, monkeypatch):
+    # An earlier run's mutants.json, report and recordings describe its own mutants: beside
+    # the new netlist their replay commands would run other mutants.
+    from fpga_robotics.mutation import design_run
+
+    designs = os.path.join(os.path.dirname(__file__), "data", "user_designs")
+    out = tmp_path / "m"
+    (out / "recordings").mkdir(parents=True)
+    earlier = ["mutants.json", "report.html", "robot.jsonl", "recordings/mutant1.rrd"]
+    for name in [*earlier, "mutants.v"]:
+        (out / name).write_text("the earlier run's\n")
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(design_run, "_prebuild", interrupted)  # right after the netlist
+    argv = ["--design", f"verilog:{designs}/bump_stop_noreset.v"]
+    argv += ["--ports", f"{designs}/bump_stop_noreset_ports.toml", "--mutants", "3"]
+    with pytest.raises((SystemExit, KeyboardInterrupt)):
+        run_cli(main, [*argv, "--out", str(out), "--quiet"], "mutate")
+    assert (out / "mutants.v").read_text() != "the earlier run's\n"
+    assert [name for name in earlier if (out / name).exists()] == []

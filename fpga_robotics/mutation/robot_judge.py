@@ -16,6 +16,7 @@ import hashlib
 import json
 import os
 import shlex
+import shutil
 import threading
 import time
 import tomllib
@@ -37,6 +38,7 @@ __all__ = [
     "campaign_runs_key",
     "check_campaign",
     "check_resume",
+    "clear_earlier_run",
     "closest_to_failing",
     "judge_runs",
     "judge_runs_forked",
@@ -55,6 +57,21 @@ _LOWER = ("min_distance_min_m", "target_in_view_min_fraction", "found_min_fracti
 
 #: The robot judge's journal in the output folder (what ``--resume`` keeps).
 JOURNAL_NAME = "robot.jsonl"
+#: What a run leaves in its output folder beside the netlist, its port maps and the journal.
+_RESULTS = ("mutants.json", "report.html", "recordings")
+
+
+def clear_earlier_run(out_dir, resume=False):
+    """Remove an earlier run's results from ``out_dir`` before this run writes its netlist
+    there, so that a run that fails or is interrupted leaves none of them beside the new
+    netlist (whose mutants they do not describe); the journal too unless ``resume`` (checked
+    by ``check_resume`` to hold this run's verdicts)."""
+    for name in (*_RESULTS, *(() if resume else (JOURNAL_NAME,))):
+        path = os.path.join(out_dir, name)
+        if os.path.isdir(path):
+            shutil.rmtree(path)
+        elif os.path.exists(path):
+            os.remove(path)
 
 
 def _asked_resolutions(spec):
