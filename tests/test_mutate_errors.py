@@ -192,3 +192,23 @@ def test_an_interrupted_rerun_leaves_no_earlier_results_beside_its_netlist(tmp_p
         run_cli(main, [*argv, "--out", str(out), "--quiet"], "mutate")
     assert (out / "mutants.v").read_text() != "the earlier run's\n"
     assert [name for name in earlier if (out / name).exists()] == []
+
+
+def test_a_mutant_s_failed_run_says_what_failed_not_the_exception_or_netlist_name():
+    # The run's own error, as `run` would print it for the mutant netlist; the verdict drops
+    # the exception's class (nothing was a usage error) and follow_target (not the
+    # user's design's name: the generated netlist's top).
+    from fpga_robotics.hw.errors import UsageError
+    from fpga_robotics.mutation.robot_judge import judge_runs
+    from fpga_robotics.sweep.runner import RunOutcome
+
+    timeout = "frame 0: timeout: the result strobe 'frame_done' never rose within 9 cycles"
+
+    def execute(i, argv, limit):
+        with RunOutcome() as run:
+            raise UsageError(f"--design: follow_target: {timeout}")
+        return run.out
+
+    verdict = judge_runs([["run"]], execute=execute)
+    assert verdict["caught"] and verdict["status"] == "error"
+    assert verdict["message"] == timeout

@@ -23,6 +23,7 @@ import tomllib
 
 from fpga_robotics.hw.errors import UsageError
 
+from ..hw.verilog import TOP_NAME
 from ..scenario.load import parse_resolution
 from ..sim.files import write_atomic
 from ..sweep import runner
@@ -278,10 +279,18 @@ def _failed_checks(outcome):
     return [c["name"] for c in checks if c.get("passed") is False]
 
 
+def _run_message(outcome):
+    """A run's error or timeout as its user reads it: without the class name of a usage
+    error (its text is the user's already) and without the ``--design: follow_target: `` that
+    names the mutant netlist's generated top, which every run of the robot judge runs."""
+    message = (outcome.get("message") or "").removeprefix("UsageError: ")
+    return message.removeprefix(f"--design: {TOP_NAME}: ")
+
+
 def _why_not_passed(outcome):
     """Why a run did not pass: its error or timeout, else its failed checks ("" if none)."""
     failed = _failed_checks(outcome)
-    return outcome.get("message") or (f"failed checks: {', '.join(failed)}" if failed else "")
+    return _run_message(outcome) or (f"failed checks: {', '.join(failed)}" if failed else "")
 
 
 def judge_runs(argvs, limits=None, execute=None):
@@ -312,7 +321,7 @@ def judge_runs(argvs, limits=None, execute=None):
                 "caught": True,
                 "run": i,
                 "status": o["status"],
-                "message": o["message"],
+                "message": _run_message(o),
                 "failed_checks": _failed_checks(o),
                 "closest": None,
                 "runs": i + 1,
