@@ -11,6 +11,7 @@ import pytest
 
 from fpga_robotics import cli
 from fpga_robotics.designs.reference import DesignError, resolve_design, stream_ports
+from fpga_robotics.loop.pin_frames import SETTLE_EDGES
 from fpga_robotics.loop.timings import run_scenario
 from fpga_robotics.mutation.design import design_mutant_port_map
 from fpga_robotics.mutation.design_run import design_ports
@@ -285,3 +286,12 @@ def test_an_output_named_as_an_input_pin_is_an_output_of_its_own(tmp_path):
     spec = resolve_design(f"{tmp_path / 'partial.py'}:outputs_named_as_input_pins")
     assert list(spec.bindings) == ["wheels"]
     assert spec.extra_outputs == ("echo", "valid", "pixels")
+
+
+def test_the_mutant_map_reads_the_wheels_when_run_reads_them():
+    # `run` reads a camera design's wheels SETTLE_EDGES edges after frame_done (and counts a
+    # filtered pixel shown with it); a strobe with latency 0 ended the frame at frame_done,
+    # so a registered stream's last pixel was lost and the unmutated design failed its runs.
+    spec = resolve_design(f"{DESIGNS / 'red_frames.py'}:RedFrames")
+    result = tomllib.loads(design_mutant_port_map(spec, design_ports(spec)))["result"]
+    assert result["strobe"] == "frame_done" and result["latency"] == SETTLE_EDGES

@@ -168,3 +168,47 @@ def test_a_campaign_resolution_is_the_one_its_runs_take(tmp_path):
     assert ft.count("--resolution") == 1
     assert own[own.index("--resolution") :][:2] == ["--resolution", "80x60"]
     assert own.count("--resolution") == 1
+
+
+def test_an_interrupted_rerun_leaves_no_earlier_results_beside_its_netlist(tmp_path, monkeypatch):
+    # An earlier run's mutants.json, report and recordings describe its own mutants: beside
+    # the new netlist their replay commands would run other mutants.
+    from fpga_robotics.mutation import design_run
+
+    designs = os.path.join(os.path.dirname(__file__), "data", "user_designs")
+    out = tmp_path / "m"
+    (out / "recordings").mkdir(parents=True)
+    earlier = ["mutants.json", "report.html", "robot.jsonl", "recordings/mutant1.rrd"]
+    for name in [*earlier, "mutants.v"]:
+        (out / name).write_text("the earlier run's\n")
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(design_run, "_prebuild", interrupted)  # right after the netlist
+    argv = ["--design", f"verilog:{designs}/bump_stop_noreset.v"]
+    argv += ["--ports", f"{designs}/bump_stop_noreset_ports.toml", "--mutants", "3"]
+    with pytest.raises((SystemExit, KeyboardInterrupt)):
+        run_cli(main, [*argv, "--out", str(out), "--quiet"], "mutate")
+    assert (out / "mutants.v").read_text() != "the earlier run's\n"
+    assert [name for name in earlier if (out / name).exists()] == []
+
+
+def test_a_mutant_s_failed_run_says_what_failed_not_the_exception_or_netlist_name():
+    # The run's own error, as `run` would print it for the mutant netlist; the verdict drops
+    # the exception's class (nothing was a usage error) and follow_target (not the
+    # user's design's name: the generated netlist's top).
+    from fpga_robotics.hw.errors import UsageError
+    from fpga_robotics.mutation.robot_judge import judge_runs
+    from fpga_robotics.sweep.runner import RunOutcome
+
+    timeout = "frame 0: timeout: the result strobe 'frame_done' never rose within 9 cycles"
+
+    def execute(i, argv, limit):
+        with RunOutcome() as run:
+            raise UsageError(f"--design: follow_target: {timeout}")
+        return run.out
+
+    verdict = judge_runs([["run"]], execute=execute)
+    assert verdict["caught"] and verdict["status"] == "error"
+    assert verdict["message"] == timeout

@@ -73,6 +73,15 @@ MODULES = {
             "  always @(posedge clk) begin m[ad] <= a; q <= m[ad]; end\nendmodule"
         ),
     ),
+    # A clock through logic (as the mutant netlist multiplexes a mutated clock port): an
+    # evaluation with the clock held high never edges it.
+    "derived clock": (
+        False,
+        (
+            f"module t({_PORTS}, output reg [3:0] q);\n  wire c = ad[0] ? 1'b0 : clk;\n"
+            "  always @(posedge c) q <= a;\nendmodule"
+        ),
+    ),
     # Yosys cannot read it: the safe answer.
     "unreadable": (False, f"module t({_PORTS}, output q);\n  assign q = ;\nendmodule"),
 }

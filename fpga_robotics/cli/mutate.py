@@ -41,6 +41,7 @@ from fpga_robotics.mutation.robot_judge import (
     JOURNAL_NAME,
     check_campaign,
     check_resume,
+    clear_earlier_run,
     mutants_key,
     robot_judge,
     start_prebuild,
@@ -141,18 +142,6 @@ def _report_robot(out, results, robot_s, recordings, say, *, title, inputs):
             )
     path = write_report(out, results, recorded, title=title, inputs=inputs)
     print(f"report: {path}")
-
-
-def _forget_earlier_run(out, campaign):
-    """Remove what an earlier run left in ``out`` beside the new ``mutants.json``: its
-    report.html and recordings (this run writes them again only where the robot judge has a
-    run to judge by) and, without ``campaign``, its robot judge's journal."""
-    for name in ("report.html", "recordings", *((JOURNAL_NAME,) if campaign is None else ())):
-        path = os.path.join(out, name)
-        if os.path.isdir(path):
-            shutil.rmtree(path)
-        elif os.path.exists(path):
-            os.remove(path)
 
 
 def _cone_note(verdict):
@@ -445,7 +434,6 @@ def _main_design(args):
                 result = mutate_design(spec, args.mutants, args.seed, cycles, out, **judged)
     except (MutationError, BackendError, PinError) as exc:
         raise UsageError(_one_line(exc)) from None
-    _forget_earlier_run(out, campaign)
     score, modules = result["unit"], result["modules"]
     print(
         f"{score['total']} mutants of {name} (seed {args.seed}), {cycles} cycles of random "
@@ -545,6 +533,7 @@ def _mutate_follow_target(args, params, campaign, out):
     key = mutants_key(repr(params), mutants)
     if args.resume and campaign is not None:
         check_resume(out, key, campaign)
+    clear_earlier_run(out, args.resume and campaign is not None)
     netlist, ports = write_mutant_design(params, mutants, out)
     watch_ports = os.path.join(out, WATCH_PORTS_NAME)
     resolution = f"{params.width}x{params.height}"
@@ -648,7 +637,6 @@ def _mutate_follow_target(args, params, campaign, out):
         ],
     }
     write_json_atomic(os.path.join(out, "mutants.json"), results, what="mutation results")
-    _forget_earlier_run(out, campaign)
 
     print(
         f"{len(mutants)} mutants of follow_target {params.width}x{params.height} "

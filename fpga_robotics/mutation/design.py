@@ -8,6 +8,7 @@ import tomllib
 
 from ..designs.reference import stream_ports
 from ..hw.verilog import TOP_NAME
+from ..loop.pin_frames import SETTLE_EDGES
 from ..sim.backends.foreign import ForeignVerilatorBackend
 from ..sim.backends.port_map import follow_target_port_map
 from ..sim.files import write_atomic
@@ -88,7 +89,10 @@ def design_mutant_port_map(spec, ports, *, reset=True, select=MUTATION_SELECT, w
         if camera.get("color_sel"):
             lines.append(f"color = {{ port = {q(camera['color_sel'])} }}")
         if ports.get("frame_done") is not None and ports["frame_done"].direction == "out":
-            lines.append('result = { strobe = "frame_done", timeout = 100000 }')
+            # The wheels are read SETTLE_EDGES edges after frame_done, as `run` reads them.
+            lines.append(
+                f'result = {{ strobe = "frame_done", latency = {SETTLE_EDGES}, timeout = 100000 }}'
+            )
         else:
             lines.append("result = { after_cycles = 1 }")
         if "filtered__valid" in ports and "filtered__payload" in ports:

@@ -42,7 +42,13 @@ from .pin_judge import (
     streams_frames,
 )
 from .reasons import pin_blind_spot_reason
-from .robot_judge import check_resume, mutants_key, robot_judge, start_prebuild
+from .robot_judge import (
+    check_resume,
+    clear_earlier_run,
+    mutants_key,
+    robot_judge,
+    start_prebuild,
+)
 from .scores import blind_spots, by_module, robot_score, unit_score
 
 __all__ = [
@@ -99,6 +105,7 @@ def mutate_design(
     source = MutantPinSource(rtlil_text, ports, mutants, name)
     # The netlist and its port map as a Verilog design the closed loop runs (the robot
     # judge: one build, ``--runtime mutsel=K`` picks the mutant).
+    clear_earlier_run(out, robot.get("resume"))
     netlist = os.path.join(out, NETLIST_NAME)
     write_atomic(netlist, source.verilog, what="mutant netlist")
     port_map, watch_map = os.path.join(out, PORTS_NAME), os.path.join(out, WATCH_PORTS_NAME)
@@ -162,9 +169,10 @@ def mutate_verilog_design(
     sources = {"verilog": design.sources, "top": top, "includes": design.includes}
     mutants = list_mutants(None, n, seed, **sources)
     robot = _keyed(robot, out, mutants_key(design.digest(), mutants), campaign)
-    os.makedirs(out, exist_ok=True)
-    netlist = os.path.join(out, NETLIST_NAME)
     verilog = mutant_netlist(None, mutants, **sources)
+    os.makedirs(out, exist_ok=True)
+    clear_earlier_run(out, robot.get("resume"))
+    netlist = os.path.join(out, NETLIST_NAME)
     write_atomic(netlist, verilog, what="mutant netlist")
     port_map, watch_map = os.path.join(out, PORTS_NAME), os.path.join(out, WATCH_PORTS_NAME)
     with open(ports_path) as f:

@@ -16,12 +16,14 @@ import hashlib
 import json
 import os
 import shlex
+import shutil
 import threading
 import time
 import tomllib
 
 from fpga_robotics.hw.errors import UsageError
 
+from ..hw.verilog import TOP_NAME
 from ..scenario.load import parse_resolution
 from ..sim.files import write_atomic
 from ..sweep import runner
@@ -37,6 +39,7 @@ __all__ = [
     "campaign_runs_key",
     "check_campaign",
     "check_resume",
+    "clear_earlier_run",
     "closest_to_failing",
     "judge_runs",
     "judge_runs_forked",
@@ -55,6 +58,21 @@ _LOWER = ("min_distance_min_m", "target_in_view_min_fraction", "found_min_fracti
 
 #: The robot judge's journal in the output folder (what ``--resume`` keeps).
 JOURNAL_NAME = "robot.jsonl"
+#: What a run leaves in its output folder beside the netlist, its port maps and the journal.
+_RESULTS = ("mutants.json", "report.html", "recordings")
+
+
+def clear_earlier_run(out_dir, resume=False):
+    """Remove an earlier run's results from ``out_dir`` before this run writes its netlist
+    there, so that a run that fails or is interrupted leaves none of them beside the new
+    netlist (whose mutants they do not describe); the journal too unless ``resume`` (checked
+    by ``check_resume`` to hold this run's verdicts)."""
+    for name in (*_RESULTS, *(() if resume else (JOURNAL_NAME,))):
+        path = os.path.join(out_dir, name)
+        if os.path.isdir(path):
+            shutil.rmtree(path)
+        elif os.path.exists(path):
+            os.remove(path)
 
 
 def _asked_resolutions(spec):
@@ -261,10 +279,18 @@ def _failed_checks(outcome):
     return [c["name"] for c in checks if c.get("passed") is False]
 
 
+def _run_message(outcome):
+    """A run's error or timeout as its user reads it: without the class name of a usage
+    error (its text is the user's already) and without the ``--design: follow_target: `` that
+    names the mutant netlist's generated top, which every run of the robot judge runs."""
+    message = (outcome.get("message") or "").removeprefix("UsageError: ")
+    return message.removeprefix(f"--design: {TOP_NAME}: ")
+
+
 def _why_not_passed(outcome):
     """Why a run did not pass: its error or timeout, else its failed checks ("" if none)."""
     failed = _failed_checks(outcome)
-    return outcome.get("message") or (f"failed checks: {', '.join(failed)}" if failed else "")
+    return _run_message(outcome) or (f"failed checks: {', '.join(failed)}" if failed else "")
 
 
 def judge_runs(argvs, limits=None, execute=None):
@@ -295,7 +321,7 @@ def judge_runs(argvs, limits=None, execute=None):
                 "caught": True,
                 "run": i,
                 "status": o["status"],
-                "message": o["message"],
+                "message": _run_message(o),
                 "failed_checks": _failed_checks(o),
                 "closest": None,
                 "runs": i + 1,

@@ -7,7 +7,8 @@ its CXXRTL netlist (cxxrtl_netlist.output_sources); for Verilog of one's own (a 
 design, the mutant netlist) Yosys reads the files, and a walk of its netlist from every input
 bit through every cell but a flip-flop's clocked inputs finds whether any output bit is
 reached. Whatever the walk does not know (a memory's port it cannot place, an unknown cell, a
-latch, an asynchronous reset) passes through, so the answer may be "not registered" for a
+latch, an asynchronous reset, a flip-flop clocked by anything but an input port, such as the
+mutant netlist's multiplexed clock, which a held clock never edges) passes through, so the answer may be "not registered" for a
 registered design, never the reverse: two evaluations are always right.
 """
 
@@ -24,7 +25,7 @@ from .verilog_cxxrtl import yosys_executable
 __all__ = ["REGISTERED_ANALYSIS", "outputs_registered", "reaches_outputs"]
 
 #: The version of this analysis, part of the build keys of the models it decides.
-REGISTERED_ANALYSIS = 1
+REGISTERED_ANALYSIS = 2
 
 #: Flip-flops whose outputs change only at a clock edge, with the inputs sampled there: the
 #: walk stops at them. Asynchronous resets and loads ($adff, $aldff, $dffsr ...), latches and
@@ -37,10 +38,16 @@ def reaches_outputs(module):
     ``flatten`` and ``memory_collect``) that some input bit reaches without a clock edge in
     between, as ``(port, bit)``."""
     succ = defaultdict(list)  # bit -> the bits one cell further on
+    input_bits = {
+        b
+        for info in module["ports"].values()
+        if info["direction"] in ("input", "inout")
+        for b in info["bits"]
+    }
     for cell in module["cells"].values():
         kind, params = cell["type"], cell.get("parameters", {})
         dirs, conns = cell.get("port_directions", {}), cell["connections"]
-        if kind in _EDGE_FLOPS:
+        if kind in _EDGE_FLOPS and all(b in input_bits for b in conns.get("CLK", ())):
             continue
         if kind == "$mem_v2":
             _memory_paths(conns, params, succ)
