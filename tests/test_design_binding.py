@@ -285,3 +285,89 @@ def test_an_output_named_as_an_input_pin_is_an_output_of_its_own(tmp_path):
     spec = resolve_design(f"{tmp_path / 'partial.py'}:outputs_named_as_input_pins")
     assert list(spec.bindings) == ["wheels"]
     assert spec.extra_outputs == ("echo", "valid", "pixels")
+
+
+# FollowTarget's per-frame outputs in a camera design ------------------------------------
+
+FRAME_OUTPUTS = """
+from amaranth import signed
+from amaranth.lib.wiring import In, Out
+
+from fpga_robotics.hw.pixel import pixel_stream_signature
+from partial import WHEELS, Ports
+
+CAMERA = {**WHEELS, "pixels": In(pixel_stream_signature()), "frame_done": Out(1)}
+
+
+def two_bit_found():
+    return Ports({**CAMERA, "found": Out(2)})
+
+
+def wide_proximity():
+    return Ports({**CAMERA, "proximity": Out(5)})
+
+
+def wide_leds():
+    return Ports({**CAMERA, "centroid_leds": Out(12)})
+
+
+def signed_centroid():
+    return Ports({**CAMERA, "centroid_x": Out(signed(9))})
+
+
+def contract_shapes():
+    shapes = {"found": Out(1), "proximity": Out(3), "centroid_x": Out(10), "centroid_leds": Out(8)}
+    return Ports({**CAMERA, **shapes})
+
+
+def no_camera():
+    return Ports({**WHEELS, "found": Out(2)})
+"""
+
+
+@pytest.mark.parametrize(
+    "name, message",
+    [
+        ("two_bit_found", "port 'found' is unsigned(2); the per-frame output found is Out(1)"),
+        (
+            "wide_proximity",
+            "port 'proximity' is unsigned(5); the per-frame output proximity is Out(3)",
+        ),
+        (
+            "wide_leds",
+            "port 'centroid_leds' is unsigned(12); the per-frame output centroid_leds is Out(8)",
+        ),
+        (
+            "signed_centroid",
+            "port 'centroid_x' is signed(9); the per-frame output centroid_x is unsigned",
+        ),
+    ],
+)
+def test_frame_outputs_of_another_shape_are_one_line_errors(name, message, tmp_path, capsys):
+    # The runs read them by name as the contract's numbers: a 2-bit found of 3 was "found",
+    # a centroid_x of -5 a column left of the image, judged by the checks.
+    (tmp_path / "partial.py").write_text(PARTIAL)
+    (tmp_path / "frames.py").write_text(FRAME_OUTPUTS)
+    reference = f"{tmp_path / 'frames.py'}:{name}"
+    with pytest.raises(DesignError, match=re.escape(f"design Ports: {message}")):
+        resolve_design(reference)
+    (tmp_path / "s.toml").write_text(STRAIGHT.format(top=reference))
+    for command in (
+        ["designs", reference],
+        ["run", "--scenario", str(tmp_path / "s.toml"), "--rerun", "off"],
+    ):
+        with pytest.raises(SystemExit) as info:
+            cli.main(command)
+        err = capsys.readouterr().err
+        assert info.value.code == 2 and len(err.strip().splitlines()) == 1, err
+        assert message in err
+
+
+def test_frame_outputs_of_the_contract_shapes_or_without_a_camera_are_taken(tmp_path):
+    (tmp_path / "partial.py").write_text(PARTIAL)
+    (tmp_path / "frames.py").write_text(FRAME_OUTPUTS)
+    spec = resolve_design(f"{tmp_path / 'frames.py'}:contract_shapes")
+    assert spec.camera and spec.extra_outputs == ()
+    # Without a camera a 2-bit found is no per-frame output: an output of its own.
+    spec = resolve_design(f"{tmp_path / 'frames.py'}:no_camera")
+    assert not spec.camera and spec.extra_outputs == ("found",)

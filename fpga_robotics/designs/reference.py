@@ -807,6 +807,8 @@ def bindings_of(component, ports, given=None):
                 _refuse_partial(name, kind, present, [p for p in pins if p not in ports])
     if "wheels" in bindings:
         _check_wheels(component, bindings["wheels"])
+    if "camera" in bindings:
+        _check_frame_outputs(component)
     return bindings
 
 
@@ -860,6 +862,31 @@ def _check_wheels(component, wheels):
                 f"{'an output' if direction == 'o' else 'an input'} of {kind}; the wheels "
                 f"take a signed output of at most {spec.width} bits, e.g. "
                 f"Out(signed({spec.width}))"
+            )
+
+
+#: The shapes of FollowTarget's per-frame outputs (docs/contract.md): name -> width (None:
+#: any), all unsigned. The runs read them by name, as these numbers.
+FRAME_OUTPUT_WIDTHS = {"found": 1, "proximity": 3, "centroid_x": None, "centroid_leds": 8}
+
+
+def _check_frame_outputs(component):
+    """``DesignError`` unless each per-frame output a camera design has is of its contract
+    shape: a run would judge a 2-bit ``found`` or a signed ``centroid_x`` as the contract's."""
+    from fpga_robotics.hw.verilog import verilog_ports  # lazy: Amaranth (~0.3 s)
+
+    found = verilog_ports(component)
+    for name, width in FRAME_OUTPUT_WIDTHS.items():
+        if name not in found or found[name][1] != "o":
+            continue
+        shape = found[name][0].shape()
+        if shape.signed or (width is not None and shape.width != width):
+            kind = f"{'signed' if shape.signed else 'unsigned'}({shape.width})"
+            wanted = f"Out({width})" if width is not None else "unsigned, Out(N)"
+            raise DesignError(
+                f"design {type(component).__name__}: port {name!r} is {kind}; the per-frame "
+                f"output {name} is {wanted} (docs/contract.md): change its shape, or rename "
+                "it to record it as an output of its own"
             )
 
 
