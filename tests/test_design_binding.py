@@ -106,6 +106,45 @@ def test_a_camera_declared_under_its_own_port_name_is_streamed_to(tmp_path):
     assert set(result.summary["extra_outputs"]) == {"near", "red_count"}
 
 
+STREAM_ONLY = """
+from amaranth import Module, signed
+from amaranth.lib import wiring
+from amaranth.lib.wiring import In, Out
+
+from fpga_robotics.hw.pixel import pixel_stream_signature
+
+
+class StreamOnly(wiring.Component):
+    connectors = {"camera": {"pixels": "cam"}}
+    cam: In(pixel_stream_signature())
+    color_sel: In(3)
+    motor_left: Out(signed(16))
+    motor_right: Out(signed(16))
+    seen: Out(3)
+
+    def elaborate(self, platform):
+        m = Module()
+        m.d.sync += self.seen.eq(self.color_sel)
+        return m
+"""
+
+
+def test_a_camera_declared_by_its_stream_only_takes_color_sel_by_name(tmp_path):
+    # As docs/your_design.md reads: the run refused it ("nothing drives its input
+    # 'color_sel'"), though a shadow of it ran.
+    (tmp_path / "stream_only.py").write_text(STREAM_ONLY)
+    reference = f"{tmp_path / 'stream_only.py'}:StreamOnly"
+    assert resolve_design(reference).bindings["camera"] == {
+        "pixels": "cam",
+        "color_sel": "color_sel",
+    }
+    items = [f'design.top="{reference}"', "design.params={}", 'color.initial="green"']
+    scenario = load_scenario(str(DESIGNS / "near_red.toml"), [*items, "sim.duration=0.3"])
+    traj = run_scenario(scenario, backend="pysim").trajectory
+    # Green is colour select code 0b010 (docs/contract.md).
+    assert list(traj["design.seen"][1:]) == [2] * (len(traj["design.seen"]) - 1)
+
+
 def test_a_declared_stream_that_is_no_stream_input_is_one_line_error(capsys):
     message = "connectors['camera']['pixels']: 'wheel_l' is no pixel stream input of NearRedCam"
     with pytest.raises(DesignError, match=re.escape(message)):

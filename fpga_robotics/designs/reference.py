@@ -736,9 +736,10 @@ def _connector_pins():
 
 
 def bindings_of(component, ports, given=None):
-    """Connector kind -> {pin: port}: ``given`` and the component's declared ``connectors``,
-    then every kind whose pins are all ports of the same names (the camera: ``pixels`` a
-    stream input, ``color_sel`` when it has one)."""
+    """Connector kind -> {pin: port}: ``given`` and the component's declared ``connectors``
+    (a declared camera without ``color_sel`` takes an input of that name), then every kind
+    whose pins are all ports of the same names (the camera: ``pixels`` a stream input,
+    ``color_sel`` when it has one)."""
     name = type(component).__name__
     declared = getattr(component, "connectors", None) or {}
     if not isinstance(declared, dict):
@@ -779,6 +780,14 @@ def bindings_of(component, ports, given=None):
                     f"no port {port!r}; its ports: {', '.join(ports)}"
                 )
         bindings[kind] = dict(pins)
+    camera = bindings.get("camera")
+    if (
+        camera is not None
+        and "color_sel" not in camera
+        and ports.get("color_sel", ("",))[0] == "in"
+    ):
+        # A declaration that names the stream only: color_sel binds by its name all the same.
+        camera["color_sel"] = "color_sel"
     for kind, pins in kinds.items():
         if kind in bindings:
             continue
