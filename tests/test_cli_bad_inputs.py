@@ -125,6 +125,30 @@ CASES = [
         ["run", "--scenario", os.path.join(DESIGNS, "wall_stop.toml"), "--shadow", "published"],
         "--shadow published: a preset or KEY=VALUE items shadow FollowTarget",
     ),
+    # Beside a design of one's own the shadow would be FollowTarget, not that design: under
+    # auto the reason was an untrue "runs in real-clock timing", compressed compared silently.
+    *(
+        (
+            f"preset shadow beside a camera design of one's own ({timing})",
+            [
+                "run",
+                "--scenario",
+                os.path.join(DESIGNS, "red_frames.toml"),
+                "--shadow",
+                "published;diff_min=5",
+                *sets,
+            ],
+            (
+                "--shadow published;diff_min=5: a preset or KEY=VALUE items shadow FollowTarget "
+                "with other parameters; the design here is "
+                + os.path.join(DESIGNS, "red_frames.py")
+                + ":RedFrames: shadow it with a design reference, --shadow "
+                + os.path.join(DESIGNS, "red_frames.py")
+                + ":RedFrames --shadow-param NAME=VALUE"
+            ),
+        )
+        for timing, sets in (("auto", []), ("compressed", ["--set", 'sim.timing="compressed"']))
+    ),
     (
         "shadow design file missing",
         ["run", "--scenario", os.path.join(DESIGNS, "wall_stop.toml"), "--shadow", "no.py:X"],

@@ -107,6 +107,45 @@ def test_a_camera_declared_under_its_own_port_name_is_streamed_to(tmp_path):
     assert set(result.summary["extra_outputs"]) == {"near", "red_count"}
 
 
+STREAM_ONLY = """
+from amaranth import Module, signed
+from amaranth.lib import wiring
+from amaranth.lib.wiring import In, Out
+
+from fpga_robotics.hw.pixel import pixel_stream_signature
+
+
+class StreamOnly(wiring.Component):
+    connectors = {"camera": {"pixels": "cam"}}
+    cam: In(pixel_stream_signature())
+    color_sel: In(3)
+    motor_left: Out(signed(16))
+    motor_right: Out(signed(16))
+    seen: Out(3)
+
+    def elaborate(self, platform):
+        m = Module()
+        m.d.sync += self.seen.eq(self.color_sel)
+        return m
+"""
+
+
+def test_a_camera_declared_by_its_stream_only_takes_color_sel_by_name(tmp_path):
+    # As docs/your_design.md reads: the run refused it ("nothing drives its input
+    # 'color_sel'"), though a shadow of it ran.
+    (tmp_path / "stream_only.py").write_text(STREAM_ONLY)
+    reference = f"{tmp_path / 'stream_only.py'}:StreamOnly"
+    assert resolve_design(reference).bindings["camera"] == {
+        "pixels": "cam",
+        "color_sel": "color_sel",
+    }
+    items = [f'design.top="{reference}"', "design.params={}", 'color.initial="green"']
+    scenario = load_scenario(str(DESIGNS / "near_red.toml"), [*items, "sim.duration=0.3"])
+    traj = run_scenario(scenario, backend="pysim").trajectory
+    # Green is colour select code 0b010 (docs/contract.md).
+    assert list(traj["design.seen"][1:]) == [2] * (len(traj["design.seen"]) - 1)
+
+
 def test_a_declared_stream_that_is_no_stream_input_is_one_line_error(capsys):
     message = "connectors['camera']['pixels']: 'wheel_l' is no pixel stream input of NearRedCam"
     with pytest.raises(DesignError, match=re.escape(message)):
@@ -295,3 +334,89 @@ def test_the_mutant_map_reads_the_wheels_when_run_reads_them():
     spec = resolve_design(f"{DESIGNS / 'red_frames.py'}:RedFrames")
     result = tomllib.loads(design_mutant_port_map(spec, design_ports(spec)))["result"]
     assert result["strobe"] == "frame_done" and result["latency"] == SETTLE_EDGES
+
+
+# FollowTarget's per-frame outputs in a camera design ------------------------------------
+
+FRAME_OUTPUTS = """
+from amaranth import signed
+from amaranth.lib.wiring import In, Out
+
+from fpga_robotics.hw.pixel import pixel_stream_signature
+from partial import WHEELS, Ports
+
+CAMERA = {**WHEELS, "pixels": In(pixel_stream_signature()), "frame_done": Out(1)}
+
+
+def two_bit_found():
+    return Ports({**CAMERA, "found": Out(2)})
+
+
+def wide_proximity():
+    return Ports({**CAMERA, "proximity": Out(5)})
+
+
+def wide_leds():
+    return Ports({**CAMERA, "centroid_leds": Out(12)})
+
+
+def signed_centroid():
+    return Ports({**CAMERA, "centroid_x": Out(signed(9))})
+
+
+def contract_shapes():
+    shapes = {"found": Out(1), "proximity": Out(3), "centroid_x": Out(10), "centroid_leds": Out(8)}
+    return Ports({**CAMERA, **shapes})
+
+
+def no_camera():
+    return Ports({**WHEELS, "found": Out(2)})
+"""
+
+
+@pytest.mark.parametrize(
+    "name, message",
+    [
+        ("two_bit_found", "port 'found' is unsigned(2); the per-frame output found is Out(1)"),
+        (
+            "wide_proximity",
+            "port 'proximity' is unsigned(5); the per-frame output proximity is Out(3)",
+        ),
+        (
+            "wide_leds",
+            "port 'centroid_leds' is unsigned(12); the per-frame output centroid_leds is Out(8)",
+        ),
+        (
+            "signed_centroid",
+            "port 'centroid_x' is signed(9); the per-frame output centroid_x is unsigned",
+        ),
+    ],
+)
+def test_frame_outputs_of_another_shape_are_one_line_errors(name, message, tmp_path, capsys):
+    # The runs read them by name as the contract's numbers: a 2-bit found of 3 was "found",
+    # a centroid_x of -5 a column left of the image, judged by the checks.
+    (tmp_path / "partial.py").write_text(PARTIAL)
+    (tmp_path / "frames.py").write_text(FRAME_OUTPUTS)
+    reference = f"{tmp_path / 'frames.py'}:{name}"
+    with pytest.raises(DesignError, match=re.escape(f"design Ports: {message}")):
+        resolve_design(reference)
+    (tmp_path / "s.toml").write_text(STRAIGHT.format(top=reference))
+    for command in (
+        ["designs", reference],
+        ["run", "--scenario", str(tmp_path / "s.toml"), "--rerun", "off"],
+    ):
+        with pytest.raises(SystemExit) as info:
+            cli.main(command)
+        err = capsys.readouterr().err
+        assert info.value.code == 2 and len(err.strip().splitlines()) == 1, err
+        assert message in err
+
+
+def test_frame_outputs_of_the_contract_shapes_or_without_a_camera_are_taken(tmp_path):
+    (tmp_path / "partial.py").write_text(PARTIAL)
+    (tmp_path / "frames.py").write_text(FRAME_OUTPUTS)
+    spec = resolve_design(f"{tmp_path / 'frames.py'}:contract_shapes")
+    assert spec.camera and spec.extra_outputs == ()
+    # Without a camera a 2-bit found is no per-frame output: an output of its own.
+    spec = resolve_design(f"{tmp_path / 'frames.py'}:no_camera")
+    assert not spec.camera and spec.extra_outputs == ("found",)

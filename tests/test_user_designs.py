@@ -285,6 +285,26 @@ def test_compressed_timing_names_what_keeps_a_design_on_the_real_clock(tmp_path,
     assert "frame 0: frame_done did not rise within 20,000 edges" in err
 
 
+def test_a_frame_done_that_never_rises_is_one_line_in_real_clock_timing_too(capsys):
+    """As in compressed timing: else the run passed with found and the centroid never read,
+    its checks "not measured", and adding --shadow (auto: real-clock) made a failing run
+    pass."""
+    # The design counts 31 rows of 30: frame_done never rises. 200 kHz / 10 fps.
+    argv = ["run", "--scenario", str(RED_FRAMES), "--duration", "0.3", "--rerun", "off"]
+    argv += ["--quiet", '--set=sim.timing="real_clock"']
+    code, out, err = _cli([*argv, "--set", "design.params.height=31"], capsys)
+    assert (code, out) == (2, "") and err.count("\n") == 1, err
+    assert "frame 0: frame_done did not rise within 20,000 edges" in err
+    assert "the per-frame outputs are read when it rises: raise it once a frame" in err
+    # A shadow of it beside it, which makes auto real-clock timing, does not hide it.
+    shadow = ["--shadow", f"{DESIGNS}/red_frames.py:RedFrames"]
+    code, out, err = _cli([*argv[:-1], "--set", "design.params.height=31", *shadow], capsys)
+    assert code == 2 and "frame 0: frame_done did not rise within 20,000 edges" in err, err
+    # One that rises runs as before.
+    code, out, err = _cli(argv, capsys)
+    assert code == 0, err
+
+
 def test_a_design_file_imports_the_modules_beside_it(tmp_path, monkeypatch, capsys):
     """Wherever the command runs: two versions of a design, each with a helper.py of its
     own, each get theirs."""

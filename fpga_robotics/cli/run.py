@@ -400,6 +400,14 @@ def shadow_designs(args, scenario):
         return None, None
     if reference:
         return _shadow_scenario(scenario, spec, args.shadow_ports, args.shadow_param), None
+    if scenario.top not in TOPS and scenario.foreign is None:
+        # Whatever the timing, the shadow would be FollowTarget, not the design changed.
+        raise UsageError(
+            f"--shadow {spec}: a preset or KEY=VALUE items shadow FollowTarget with other "
+            f"parameters; the design here is {scenario.top}: shadow it with a design "
+            f"reference, --shadow {scenario.top} --shadow-param NAME=VALUE (or its previous "
+            f"version's FILE.py:Name)"
+        )
     if scenario.sim.timing == "real_clock":
         raise UsageError(
             f"--shadow {spec}: a preset or KEY=VALUE items shadow FollowTarget with other "

@@ -769,9 +769,10 @@ def _connector_pins():
 
 
 def bindings_of(component, ports, given=None):
-    """Connector kind -> {pin: port}: ``given`` and the component's declared ``connectors``,
-    then every kind whose pins are all ports of the same names (the camera: ``pixels`` a
-    stream input, ``color_sel`` when it has one)."""
+    """Connector kind -> {pin: port}: ``given`` and the component's declared ``connectors``
+    (a declared camera without ``color_sel`` takes an input of that name), then every kind
+    whose pins are all ports of the same names (the camera: ``pixels`` a stream input,
+    ``color_sel`` when it has one)."""
     name = type(component).__name__
     declared = getattr(component, "connectors", None) or {}
     if not isinstance(declared, dict):
@@ -812,6 +813,14 @@ def bindings_of(component, ports, given=None):
                     f"no port {port!r}; its ports: {', '.join(ports)}"
                 )
         bindings[kind] = dict(pins)
+    camera = bindings.get("camera")
+    if (
+        camera is not None
+        and "color_sel" not in camera
+        and ports.get("color_sel", ("",))[0] == "in"
+    ):
+        # A declaration that names the stream only: color_sel binds by its name all the same.
+        camera["color_sel"] = "color_sel"
     for kind, pins in kinds.items():
         if kind in bindings:
             continue
@@ -840,6 +849,8 @@ def bindings_of(component, ports, given=None):
                 _refuse_partial(name, kind, present, [p for p in pins if p not in ports])
     if "wheels" in bindings:
         _check_wheels(component, bindings["wheels"])
+    if "camera" in bindings:
+        _check_frame_outputs(component)
     return bindings
 
 
@@ -893,6 +904,31 @@ def _check_wheels(component, wheels):
                 f"{'an output' if direction == 'o' else 'an input'} of {kind}; the wheels "
                 f"take a signed output of at most {spec.width} bits, e.g. "
                 f"Out(signed({spec.width}))"
+            )
+
+
+#: The shapes of FollowTarget's per-frame outputs (docs/contract.md): name -> width (None:
+#: any), all unsigned. The runs read them by name, as these numbers.
+FRAME_OUTPUT_WIDTHS = {"found": 1, "proximity": 3, "centroid_x": None, "centroid_leds": 8}
+
+
+def _check_frame_outputs(component):
+    """``DesignError`` unless each per-frame output a camera design has is of its contract
+    shape: a run would judge a 2-bit ``found`` or a signed ``centroid_x`` as the contract's."""
+    from fpga_robotics.hw.verilog import verilog_ports  # lazy: Amaranth (~0.3 s)
+
+    found = verilog_ports(component)
+    for name, width in FRAME_OUTPUT_WIDTHS.items():
+        if name not in found or found[name][1] != "o":
+            continue
+        shape = found[name][0].shape()
+        if shape.signed or (width is not None and shape.width != width):
+            kind = f"{'signed' if shape.signed else 'unsigned'}({shape.width})"
+            wanted = f"Out({width})" if width is not None else "unsigned, Out(N)"
+            raise DesignError(
+                f"design {type(component).__name__}: port {name!r} is {kind}; the per-frame "
+                f"output {name} is {wanted} (docs/contract.md): change its shape, or rename "
+                "it to record it as an output of its own"
             )
 
 

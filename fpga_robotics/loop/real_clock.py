@@ -265,9 +265,16 @@ class RealClockLoop(ClosedLoop):
         if "obstacle" in self.top.extra_outputs.values():  # the interlock's events
             self.watched.setdefault("obstacle", (None, "obstacle"))
         self.last = {}  # watched port -> last value seen
-        # A Verilog design's result strobe: (port, latency, timeout) of its map, whose frames
-        # each await it, oldest first: [(frame, last edge its strobe may rise at)].
+        # A Verilog design's result strobe: (port, latency, timeout) of its map.
         self.strobe = _result_strobe(scenario) if self.top.camera else None
+        # An Amaranth design's frame_done must rise within a frame period of the design clock
+        # after the frame's last pixel, as in compressed timing (loop/pin_frames.py): else its
+        # per-frame outputs are never read and the checks made of them not measured.
+        self.frame_watchdog = None
+        if self.top.camera and scenario.foreign is None and _FRAME_STROBE in design.ports:
+            self.frame_watchdog = round(self.clock_hz / scenario.camera.fps)
+        # The frames awaiting their results, oldest first: [(frame, last edge they may
+        # come out at)].
         self.awaited = deque()
         self.pending = None  # the frame whose outputs are awaited: [k, t, rgb, events, result]
         self.frame_outputs = {}
@@ -440,12 +447,21 @@ class RealClockLoop(ClosedLoop):
         """The oldest frame awaiting its result strobe has not had it by its last edge: the
         timeout of compressed timing (``result.timeout`` cycles after the frame's last
         pixel), named the same way."""
-        if self.awaited and self.pins.cycle >= self.awaited[0][1]:
-            port, _latency, timeout = self.strobe
+        if not self.awaited or self.pins.cycle < self.awaited[0][1]:
+            return
+        frame = self.awaited[0][0]
+        if self.strobe is None:
             raise DesignError(
-                f"{self._design_name}: frame {self.awaited[0][0]}: timeout: the result strobe "
-                f"{port!r} never rose within {timeout} cycles (result.timeout) after the frame"
+                f"{self._design_name}: frame {frame}: frame_done did not rise within "
+                f"{self.frame_watchdog:,} edges (a frame period at sim.clock_hz) after the "
+                "frame's last pixel; the per-frame outputs are read when it rises: raise it "
+                "once a frame"
             )
+        port, _latency, timeout = self.strobe
+        raise DesignError(
+            f"{self._design_name}: frame {frame}: timeout: the result strobe "
+            f"{port!r} never rose within {timeout} cycles (result.timeout) after the frame"
+        )
 
     def design_output_changed(self, port, value, t):
         if port == _FRAME_STROBE:
@@ -552,10 +568,13 @@ class RealClockLoop(ClosedLoop):
                 "lower camera.fps or raise sim.clock_hz"
             )
         self.pins.stream_frame(to_rgb444(rgb, p.width, p.height), timing)
+        last_pixel = timing.last_edge(p.width, p.height)
         if self.strobe is not None:
             # frame_done follows the strobe by the map's latency (the pin wrapper).
             _port, latency, timeout = self.strobe
-            self.awaited.append((k, timing.last_edge(p.width, p.height) + timeout + latency))
+            self.awaited.append((k, last_pixel + timeout + latency))
+        elif self.frame_watchdog is not None:
+            self.awaited.append((k, last_pixel + self.frame_watchdog))
 
     def finish_row(self):
         """Complete the pending row: its outputs, the wheel pins now, events, the record."""
