@@ -399,7 +399,14 @@ def shadow_designs(args, scenario):
     if spec is None:
         return None, None
     if reference:
-        return _shadow_scenario(scenario, spec, args.shadow_ports, args.shadow_param), None
+        shadow = _shadow_scenario(
+            scenario,
+            spec,
+            args.shadow_ports,
+            args.shadow_param,
+            _file_design_params(args, scenario),
+        )
+        return shadow, None
     if scenario.sim.timing == "real_clock":
         raise UsageError(
             f"--shadow {spec}: a preset or KEY=VALUE items shadow FollowTarget with other "
@@ -408,6 +415,14 @@ def shadow_designs(args, scenario):
             f"(FILE.py:Name, a built-in design's name, verilog:FILE.v)"
         )
     return None, _shadow_params_scenario(scenario, spec)
+
+
+def _file_design_params(args, scenario):
+    """The scenario's ``[design.params]`` as its file (and ``--set``) give them: those a
+    primary ``--design verilog:...`` dropped (it takes none) are still the shadow's."""
+    if not _is_verilog(args) or args.scenario is None:
+        return scenario.design_params
+    return load_scenario(args.scenario, scenario.overrides).design_params
 
 
 def _shadow_params(scenario, spec):
@@ -434,9 +449,9 @@ def _shadow_params_scenario(scenario, spec):
     return shadow
 
 
-def _shadow_scenario(scenario, spec, ports, params):
+def _shadow_scenario(scenario, spec, ports, params, design_params):
     """With ``--shadow REF`` (a design reference): the scenario running that design instead,
-    with the scenario's ``[design.params]`` that its signature takes and ``params``
+    with those of ``design_params`` (the scenario's) that its signature takes and ``params``
     (``--shadow-param NAME=VALUE``) on top; a Verilog one, ``verilog:FILES`` with ``ports``,
     takes none."""
     if scenario.sim.timing != "real_clock":
@@ -446,7 +461,10 @@ def _shadow_scenario(scenario, spec, ports, params):
             f"(compare FollowTarget parameters there: --shadow KEY=VALUE)"
         )
     if not spec.startswith("verilog:"):
-        overrides = [design_override(spec), *_shadow_param_overrides(scenario, spec, params)]
+        overrides = [
+            design_override(spec),
+            *_shadow_param_overrides(design_params, spec, params),
+        ]
         try:
             return scenario.with_overrides(overrides)
         except ScenarioError as exc:
@@ -479,9 +497,9 @@ def _shadow_scenario(scenario, spec, ports, params):
         raise UsageError(f"--shadow-ports {ports}: {exc}") from None
 
 
-def _shadow_param_overrides(scenario, spec, params):
+def _shadow_param_overrides(design_params, spec, params):
     """The overrides that give the shadow design ``spec`` its ``[design.params]``: those of
-    the scenario its signature takes (a previous version may lack a newer parameter), then
+    ``design_params`` (the scenario's) its signature takes (a previous version may lack a newer parameter), then
     ``params`` (``NAME=VALUE`` items, values as ``--set`` takes them)."""
     try:
         takes = design_parameters(spec)
@@ -503,7 +521,7 @@ def _shadow_param_overrides(scenario, spec, params):
                 f"it takes: {', '.join(takes) or 'none'}"
             )
         given[name] = value
-    kept = {n: v for n, v in scenario.design_params.items() if takes is None or n in takes}
+    kept = {n: v for n, v in design_params.items() if takes is None or n in takes}
     missing = [n for n, required in (takes or {}).items() if required and n not in kept]
     missing = [n for n in missing if n not in given]
     if missing:
