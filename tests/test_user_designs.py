@@ -243,6 +243,8 @@ def test_compressed_timing_names_what_keeps_a_design_on_the_real_clock(tmp_path,
     code, out, err = _cli([*argv, "--duration", "0.2", "--rerun", "off", "--quiet"], capsys)
     assert (code, out) == (2, "") and err.count("\n") == 1, err
     assert "frame 0: frame_done did not rise within 20,000 edges" in err
+    # Named as the scenario names the design: no --design was given.
+    assert err.startswith("fpga-robotics run: error: design.top: RedFrames: frame 0: "), err
 
 
 def test_a_design_file_imports_the_modules_beside_it(tmp_path, monkeypatch, capsys):

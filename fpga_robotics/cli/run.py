@@ -306,7 +306,15 @@ def _verilog_overrides(args, items):
 
 def take_design_reference(args, scenario):
     """After loading: a ``--design`` reference other than ``verilog:`` is the scenario's
-    ``design.top`` now (``_overrides``); ``args.design`` keeps only Verilog files."""
+    ``design.top`` now (``_overrides``); ``args.design`` keeps only Verilog files.
+    ``args.design_option`` names the design in its errors as the user gave it: ``--design``,
+    else the scenario's key."""
+    if args.design is not None:
+        args.design_option = "--design"
+    elif scenario.data["design"].get("verilog") is not None:
+        args.design_option = "design.verilog"
+    else:
+        args.design_option = "design.top"
     if args.design is None or args.design.startswith("verilog:"):
         return
     args.design = None  # the scenario's Verilog files went with its design (load)
@@ -625,9 +633,11 @@ def _open_backend(name, params, quiet=False):
         raise UsageError(f"backend {name!r} cannot run here: {exc}") from None
 
 
-def _open_pin_design(args, scenario, option="--design"):
+def _open_pin_design(args, scenario, option=None):
     """The scenario's design on a pin-level backend (real-clock timing); ``option`` names
-    the design in an error of its Verilog (``--shadow REF`` for a shadow design)."""
+    the design in an error of its Verilog (``--shadow REF`` for a shadow design; default
+    ``args.design_option``)."""
+    option = option or args.design_option
 
     def tell(text):
         if not args.quiet:
@@ -721,12 +731,14 @@ def _open_design(args, scenario):
             args.backend, params, files=files, port_map=ports, on_build=tell
         )
     except BackendError as exc:
-        raise UsageError(f"--design: {exc}".splitlines()[0]) from None
+        raise UsageError(f"{args.design_option}: {exc}".splitlines()[0]) from None
     missing = [k for k in ("motor_left", "motor_right") if k not in backend.design.port_map.outputs]
     if missing:
         backend.close()
-        raise UsageError(f"--design: the closed loop needs outputs.{missing[0]} in the port map")
-    design = _UserDesign(backend)
+        raise UsageError(
+            f"{args.design_option}: the closed loop needs outputs.{missing[0]} in the port map"
+        )
+    design = _UserDesign(backend, args.design_option)
     try:
         apply_runtime(design, args)
     except UsageError:
@@ -770,16 +782,18 @@ def apply_runtime(design, args):
 
 class _UserDesign:
     """A foreign design whose per-frame errors (a named timeout, a broken stream) are the
-    user's to fix: reported as one line and exit 2, like a bad port map."""
+    user's to fix: reported as one line and exit 2, like a bad port map, after ``option``
+    (how the design was given: ``--design``, ``design.verilog``)."""
 
-    def __init__(self, backend):
+    def __init__(self, backend, option):
         self._backend = backend
+        self._option = option
 
     def process_frame(self, frame, color_sel="red"):
         try:
             return self._backend.process_frame(frame, color_sel)
         except BackendError as exc:
-            raise UsageError(f"--design: {exc}") from None
+            raise UsageError(f"{self._option}: {exc}") from None
 
     def __getattr__(self, name):
         return getattr(self._backend, name)
@@ -1109,7 +1123,7 @@ def main(argv=None, prog="fpga-robotics run"):
     except ShadowDesignError as exc:  # the shadow's own doing, named as --shadow gave it
         raise UsageError(f"--shadow: {exc}") from None
     except DesignError as exc:  # real-clock timing: as _UserDesign reports it on frames
-        raise UsageError(f"--design: {exc}") from None
+        raise UsageError(f"{args.design_option}: {exc}") from None
     finally:
         design.close()
         if shadow is not None:
