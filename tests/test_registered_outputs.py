@@ -11,6 +11,7 @@ from test_foreign_verilog import PARAMS, _frames
 
 from fpga_robotics.loop.timings import run_scenario
 from fpga_robotics.sim.backends import BackendError
+from fpga_robotics.sim.backends.comb_loops import combinational_loop
 from fpga_robotics.sim.backends.foreign import ForeignDesign, ForeignVerilatorBackend
 from fpga_robotics.sim.backends.registered_outputs import outputs_registered
 from fpga_robotics.sim.backends.verilog_cxxrtl import yosys_version
@@ -184,3 +185,23 @@ def test_verilog_on_pins_evaluates_once_a_cycle_only_when_registered(tmp_path, t
         assert (runs[0].trajectory[key] == runs[1].trajectory[key]).all(), key
     assert runs[0].summary["sim_cycles"] == runs[1].summary["sim_cycles"]
     assert runs[0].trajectory["bumper.pressed"].any()  # it did reach the wall
+
+
+@pytest.mark.parametrize(
+    "body, loop",
+    [
+        # Each bit of c from the one below it through one vector: no loop.
+        ("assign c[0] = g[0];\n  assign c[3:1] = g[3:1] | (p[3:1] & c[2:0]);", None),
+        ("assign c = {c[2:0], g[0]} ^ p;", None),
+        ("assign c = {c[2:0] ^ p[3:1], c[3]};", (["c"], "t.v:2")),
+        # Through an asynchronous memory read: its address from its own data.
+        (
+            "reg [3:0] m [0:15];\n  always @(posedge clk) m[g] <= p;\n  assign c = m[c ^ g];",
+            (["c"], "t.v:2"),
+        ),
+    ],
+)
+def test_a_combinational_loop_is_found_bit_by_bit(body, loop):
+    ports = "input clk, input [3:0] g, input [3:0] p, output [3:0] c"
+    text = f"module t({ports});\n  {body}\nendmodule\n"
+    assert combinational_loop({"t.v": text}, "t") == loop

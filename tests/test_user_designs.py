@@ -283,6 +283,8 @@ def test_compressed_timing_names_what_keeps_a_design_on_the_real_clock(tmp_path,
     code, out, err = _cli([*argv, "--duration", "0.2", "--rerun", "off", "--quiet"], capsys)
     assert (code, out) == (2, "") and err.count("\n") == 1, err
     assert "frame 0: frame_done did not rise within 20,000 edges" in err
+    # Named as the scenario names the design: no --design was given.
+    assert err.startswith("fpga-robotics run: error: design.top: RedFrames: frame 0: "), err
 
 
 def test_a_frame_done_that_never_rises_is_one_line_in_real_clock_timing_too(capsys):
@@ -1094,3 +1096,22 @@ def test_a_design_defining_its_own_sync_domain_is_refused_by_every_command(
         assert code == 2 and out == "" and len(err.strip().splitlines()) == 1, (argv, err)
         assert message in err, err
     assert sorted(p.name for p in tmp_path.iterdir() if p.name != "__pycache__") == ["own_sync.py"]
+
+
+def test_a_shadow_beside_a_verilog_design_keeps_the_scenario_s_params(tmp_path):
+    """A primary --design verilog:... takes no [design.params]; a shadow design reference
+    still gets the scenario's (docs/your_design.md), not its own defaults."""
+    from fpga_robotics.cli import run
+
+    scenario = tmp_path / "wall_stop.toml"
+    scenario.write_text(WALL_STOP.read_text().replace("stop_mm = 250", "stop_mm = 120"))
+    shutil.copy(DESIGNS / "wall_stop.py", tmp_path)
+    verilog = DESIGNS / "bump_stop_noreset.v"
+    argv = ["--scenario", str(scenario), "--design", f"verilog:{verilog}", "--backend", "cxxrtl"]
+    argv += ["--ports", str(DESIGNS / "bump_stop_noreset_ports.toml")]
+    argv += ["--shadow", f"{DESIGNS}/wall_stop.py:WallStop", "--shadow-param", "speed=200"]
+    args = run.build_parser().parse_args(argv)
+    primary = run.load_run_scenario(args)
+    assert primary.design_params == {}
+    shadow, _ = run.shadow_designs(args, primary)
+    assert shadow.design_params == {"speed": 200, "stop_mm": 120}

