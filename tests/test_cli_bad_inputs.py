@@ -23,9 +23,13 @@ from fpga_robotics import cli
 DESIGNS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "data", "user_designs")
 
 #: (case id, argv, a word the message must contain). ``{dir}``, ``{file}``, ``{frames}`` are
-#: an existing folder, an existing regular file and a folder of two PNG frames.
+#: an existing folder, an existing regular file and a folder of two PNG frames; ``{latin1}`` a
+#: TOML file with a Latin-1 byte in a comment.
 CASES = [
     ("no command", [], "command"),
+    ("port map not UTF-8", ["ports", "{latin1}"], "not UTF-8 text (byte 0xe9 at position 5)"),
+    ("scenario not UTF-8", ["run", "--scenario", "{latin1}"], "not UTF-8"),
+    ("campaign not UTF-8", ["sweep", "{latin1}", "--dry-run"], "not UTF-8"),
     ("unknown command", ["fly"], "unknown command"),
     ("unknown benchmark", ["bench", "gpu"], "unknown benchmark"),
     ("formal ports without a design", ["formal", "--ports", "{file}"], "--ports"),
@@ -463,6 +467,7 @@ def test_bad_input_is_one_line_and_exit_2(
 
     (tmp_path / "folder").mkdir()
     (tmp_path / "file").write_text("keep me\n")
+    (tmp_path / "latin1.toml").write_bytes(b"# caf\xe9\n")
     frames = tmp_path / "frames"
     frames.mkdir()
     for i in range(2):
@@ -470,6 +475,7 @@ def test_bad_input_is_one_line_and_exit_2(
     names = {
         "dir": str(tmp_path / "folder"),
         "file": str(tmp_path / "file"),
+        "latin1": str(tmp_path / "latin1.toml"),
         "frames": str(frames),
         "bag": str(_float_image_bag(tmp_path / "bag", 2)),
         "emptybag": str(_float_image_bag(tmp_path / "emptybag", 0)),

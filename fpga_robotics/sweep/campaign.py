@@ -51,6 +51,7 @@ from importlib import resources
 from pathlib import Path
 
 from fpga_robotics.hw.errors import UsageError
+from fpga_robotics.sim.files import NotTextError, read_user_text
 
 from .. import __version__
 
@@ -537,10 +538,10 @@ def read_campaign_file(name_or_path):
     """The campaign file's table (checked for unknown keys) and its path."""
     path = _resolve(name_or_path)
     try:
-        data = tomllib.loads(path.read_text())
+        data = tomllib.loads(read_user_text(path))
     except tomllib.TOMLDecodeError as exc:
         raise CampaignError(f"{path}: malformed TOML: {exc}") from None
-    except (OSError, UnicodeDecodeError) as exc:
+    except (OSError, NotTextError) as exc:
         raise CampaignError(f"cannot read campaign file {path}: {exc}") from None
     unknown = [k for k in data if k not in KEYS]
     if unknown:
