@@ -307,6 +307,16 @@ CASES = [
     ("3D scenario without the realistic extra", ["run", "--scenario", "divider_3d"], "MuJoCo"),
     # export
     ("export seed without board", ["export", "--seed", "3"], "--seed"),
+    (
+        "board seed nextpnr refuses",
+        ["board", "-o", "out", "--bitstream", "--seed", "99999999999999999999"],
+        "--seed must be from -2**63",
+    ),
+    (
+        "export board seed nextpnr refuses",
+        ["export", "--board", "ulx3s-85f", "--bitstream", "--seed", str(-(2**63) - 1)],
+        "--seed must be from -2**63",
+    ),
     ("export bitstream without board", ["export", "--bitstream"], "--board"),
     ("export to a device", ["export", "-o", "/dev/full"], "not a regular file"),
     ("export to a folder", ["export", "-o", "{dir}"], "is a directory"),
