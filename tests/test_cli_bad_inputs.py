@@ -39,6 +39,11 @@ CASES = [
         "--ports",
     ),
     ("mutate fork without a campaign", ["mutate", "--mutants", "2", "--no-fork"], "--campaign"),
+    (
+        "mutate recordings without a campaign",
+        ["mutate", "--mutants", "2", "--recordings", "3"],
+        "--recordings go with --campaign",
+    ),
     ("bench negative seed", ["bench", "design", "--backends", "model", "--seed", "-1"], "--seed"),
     ("bench empty backends", ["bench", "design", "--backends", ","], "--backends"),
     (
