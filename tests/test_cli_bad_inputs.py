@@ -33,6 +33,12 @@ CASES = [
     ("unknown command", ["fly"], "unknown command"),
     ("unknown benchmark", ["bench", "gpu"], "unknown benchmark"),
     ("formal ports without a design", ["formal", "--ports", "{file}"], "--ports"),
+    ("formal list with a depth", ["formal", "--list", "--depth", "3"], "got --depth"),
+    (
+        "list scenarios with run options",
+        ["run", "--list-scenarios", "--duration", "-5", "--summary", "ls.json"],
+        "--list-scenarios takes no other option; got --duration, --summary",
+    ),
     (
         "designs ports of an Amaranth design",
         ["designs", "follow_target", "--ports", "{file}"],

@@ -971,8 +971,13 @@ def _run_source(args, scenario, ros):
 
 
 def main(argv=None, prog="fpga-robotics run"):
-    args = build_parser(prog).parse_args(argv)
+    parser = build_parser(prog)
+    args = parser.parse_args(argv)
     if args.list_scenarios:
+        # Nothing runs: an option beside it would be ignored, a bad value unnoticed.
+        others = parser.given_options(args, ignore={"list_scenarios"})
+        if others:
+            raise UsageError(f"--list-scenarios takes no other option; got {', '.join(others)}")
         return _list_scenarios()
 
     inputs = _input_paths(args)  # before --design's file is taken into the scenario
