@@ -21,6 +21,7 @@ from pathlib import Path
 from fpga_robotics.hw.errors import UserError
 
 __all__ = [
+    "NotTextError",
     "OutputPathError",
     "PendingOutput",
     "atomic_output",
@@ -30,6 +31,7 @@ __all__ = [
     "check_paths_apart",
     "default_dir_mode",
     "default_file_mode",
+    "read_user_text",
     "write_atomic",
     "write_json_atomic",
 ]
@@ -37,6 +39,27 @@ __all__ = [
 
 class OutputPathError(UserError, ValueError):
     """An output path that cannot be written; the message names the path and the fix."""
+
+
+class NotTextError(UserError, ValueError):
+    """A user's file that is not UTF-8 text; the message names the file, the byte and the fix."""
+
+
+def read_user_text(path, *, any_bytes=False):
+    """The text of a file the user wrote (scenario, campaign, port map, Verilog, ...): UTF-8,
+    a leading byte-order mark dropped (Windows editors add one). A file that is not UTF-8 is a
+    ``NotTextError``, or with ``any_bytes`` (Verilog: Yosys and Verilator take any byte, e.g. a
+    Latin-1 comment) read as Latin-1, one character per byte. ``OSError`` is the caller's."""
+    data = Path(path).read_bytes()
+    try:
+        return data.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        if any_bytes:
+            return data.decode("latin-1")
+        raise NotTextError(
+            f"not UTF-8 text (byte {data[exc.start]:#04x} at position {exc.start}): "
+            "save it as UTF-8"
+        ) from None
 
 
 def _umask():

@@ -23,18 +23,33 @@ from fpga_robotics import cli
 DESIGNS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "data", "user_designs")
 
 #: (case id, argv, a word the message must contain). ``{dir}``, ``{file}``, ``{frames}`` are
-#: an existing folder, an existing regular file and a folder of two PNG frames.
+#: an existing folder, an existing regular file and a folder of two PNG frames; ``{latin1}`` a
+#: TOML file with a Latin-1 byte in a comment.
 CASES = [
     ("no command", [], "command"),
+    ("port map not UTF-8", ["ports", "{latin1}"], "not UTF-8 text (byte 0xe9 at position 5)"),
+    ("scenario not UTF-8", ["run", "--scenario", "{latin1}"], "not UTF-8"),
+    ("campaign not UTF-8", ["sweep", "{latin1}", "--dry-run"], "not UTF-8"),
     ("unknown command", ["fly"], "unknown command"),
     ("unknown benchmark", ["bench", "gpu"], "unknown benchmark"),
     ("formal ports without a design", ["formal", "--ports", "{file}"], "--ports"),
+    ("formal list with a depth", ["formal", "--list", "--depth", "3"], "got --depth"),
+    (
+        "list scenarios with run options",
+        ["run", "--list-scenarios", "--duration", "-5", "--summary", "ls.json"],
+        "--list-scenarios takes no other option; got --duration, --summary",
+    ),
     (
         "designs ports of an Amaranth design",
         ["designs", "follow_target", "--ports", "{file}"],
         "--ports",
     ),
     ("mutate fork without a campaign", ["mutate", "--mutants", "2", "--no-fork"], "--campaign"),
+    (
+        "mutate recordings without a campaign",
+        ["mutate", "--mutants", "2", "--recordings", "3"],
+        "--recordings go with --campaign",
+    ),
     ("bench negative seed", ["bench", "design", "--backends", "model", "--seed", "-1"], "--seed"),
     ("bench empty backends", ["bench", "design", "--backends", ","], "--backends"),
     (
@@ -327,6 +342,16 @@ CASES = [
     ("3D scenario without the realistic extra", ["run", "--scenario", "divider_3d"], "MuJoCo"),
     # export
     ("export seed without board", ["export", "--seed", "3"], "--seed"),
+    (
+        "board seed nextpnr refuses",
+        ["board", "-o", "out", "--bitstream", "--seed", "99999999999999999999"],
+        "--seed must be from -2**63",
+    ),
+    (
+        "export board seed nextpnr refuses",
+        ["export", "--board", "ulx3s-85f", "--bitstream", "--seed", str(-(2**63) - 1)],
+        "--seed must be from -2**63",
+    ),
     ("export bitstream without board", ["export", "--bitstream"], "--board"),
     ("export to a device", ["export", "-o", "/dev/full"], "not a regular file"),
     ("export to a folder", ["export", "-o", "{dir}"], "is a directory"),
@@ -487,6 +512,7 @@ def test_bad_input_is_one_line_and_exit_2(
 
     (tmp_path / "folder").mkdir()
     (tmp_path / "file").write_text("keep me\n")
+    (tmp_path / "latin1.toml").write_bytes(b"# caf\xe9\n")
     frames = tmp_path / "frames"
     frames.mkdir()
     for i in range(2):
@@ -494,6 +520,7 @@ def test_bad_input_is_one_line_and_exit_2(
     names = {
         "dir": str(tmp_path / "folder"),
         "file": str(tmp_path / "file"),
+        "latin1": str(tmp_path / "latin1.toml"),
         "frames": str(frames),
         "bag": str(_float_image_bag(tmp_path / "bag", 2)),
         "emptybag": str(_float_image_bag(tmp_path / "emptybag", 0)),

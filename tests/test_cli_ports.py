@@ -86,6 +86,18 @@ def test_a_map_is_checked_against_the_design_it_names(tmp_path, capsys):
     assert out.splitlines()[0] == f"{path}: matches {design} (5 ports)"
 
 
+def test_a_bom_map_and_a_latin1_verilog_file_are_read(tmp_path, capsys):
+    # Windows editors start UTF-8 with a byte-order mark; older Verilog carries Latin-1
+    # comments, which Yosys and Verilator read.
+    path, _ = _noreset(tmp_path)
+    path.write_bytes(b"\xef\xbb\xbf" + path.read_bytes())
+    verilog = tmp_path / "latin1.v"
+    verilog.write_bytes(b"// (c) caf\xe9\n" + (_USER / "bump_stop_noreset.v").read_bytes())
+    code, out, err = _ports([str(path), "--design", f"verilog:{verilog}"], capsys)
+    assert code == 0, err
+    assert out.splitlines()[0] == f"{path}: matches verilog:{verilog} (5 ports)"
+
+
 @pytest.mark.parametrize(
     "edit, message",
     [

@@ -395,6 +395,22 @@ def test_a_verilog_design_that_includes_a_header_is_mutated(tmp_path, capsys):
 
 
 @pytest.mark.slow  # a Verilator build of the mutant netlist
+def test_a_bom_port_map_and_a_latin1_verilog_file_are_mutated(tmp_path, capsys):
+    """A port map saved with a UTF-8 byte-order mark (Windows editors) and Verilog with a
+    Latin-1 comment are read as Yosys reads them; the copied map has no mark."""
+    data = Path(__file__).parent / "data"
+    ports, verilog = tmp_path / "ports.toml", tmp_path / "bump_stop.v"
+    ports.write_bytes(b"\xef\xbb\xbf" + (data / "bump_stop_ports.toml").read_bytes())
+    verilog.write_bytes(b"// (c) caf\xe9\n" + (data / "bump_stop.v").read_bytes())
+    out = tmp_path / "m"
+    argv = ["--design", f"verilog:{verilog}", "--ports", str(ports), "--mutants", "2"]
+    code, _, err = _cli(["mutate", *argv, "--cycles", "500", "--out", str(out)], capsys)
+    assert code == 0, err
+    assert len(json.loads((out / "mutants.json").read_text())["mutants"]) == 2
+    assert not (out / "mutants_ports.toml").read_bytes().startswith(b"\xef\xbb\xbf")
+
+
+@pytest.mark.slow  # a Verilator build of the mutant netlist
 def test_a_verilog_camera_design_s_unit_judge_streams_frames(tmp_path, capsys):
     """red_count.v counts a frame's red pixels at the last pixel of its 120th line: only a
     stream framed as the camera frames it (first, last of each line) ever gives it a count.

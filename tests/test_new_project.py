@@ -88,8 +88,15 @@ def test_a_non_empty_folder_is_refused(tmp_path, capsys, monkeypatch):
     )
     assert [p.name for p in (tmp_path / "taken").iterdir()] == ["notes.txt"]
     assert sorted(p.name for p in tmp_path.iterdir()) == ["taken"]
-    code, _, err = _cli(["new", "bad name!"], capsys)
-    assert code == 2 and "must be ASCII letters" in err and len(err.splitlines()) == 1
+    for bad in ("bad name!", "my-robot", "v1.2", "3rd"):
+        code, _, err = _cli(["new", bad], capsys)
+        assert code == 2 and "must be a Python name" in err and len(err.splitlines()) == 1, bad
+    # A project folder named after a module hides it from Python run in the folder above.
+    for module in ("fpga_robotics", "amaranth", "numpy", "test", "json"):
+        code, _, err = _cli(["new", module], capsys)
+        assert code == 2 and len(err.splitlines()) == 1, module
+        assert f"would hide the module {module}" in err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["taken"]
     # An empty folder is taken.
     (tmp_path / "empty").mkdir()
     assert _cli(["new", "empty"], capsys)[0] == 0

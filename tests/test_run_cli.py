@@ -264,6 +264,18 @@ def test_target_color_dresses_the_target_and_follows_it(color, tmp_path, capsys)
     assert s["color"] == color  # --target-color sets the colour select last
 
 
+@pytest.mark.parametrize("order", [0, 1])
+def test_color_is_the_select_when_the_target_wears_another(order, tmp_path, capsys):
+    # The target in blue, the design looking for green: it does not see the target.
+    path = tmp_path / "s.json"
+    options = [["--target-color", "blue"], ["--color", "green"]]
+    argv = ["--backend", "model", "--duration", "1", "--rerun", "off", "--quiet"]
+    run([*argv, *options[order], *options[1 - order], "--summary", str(path)], capsys)
+    s = json.loads(path.read_text())
+    assert s["color"] == "green" and s["found_fraction"] == 0.0
+    assert [o for o in s["overrides"] if o.startswith("color.")] == ['color.initial="green"']
+
+
 def test_target_color_red_clothes_are_invisible_to_green(tmp_path, capsys):
     path = tmp_path / "s.json"
     code, _out, _err = run(

@@ -23,6 +23,14 @@ def test_shadow_spec_becomes_design_overrides():
     ]
     with pytest.raises(ValueError, match="preset name"):
         shadow_overrides(" ; ")
+    # A key or preset named twice: the later one would win while the label shows both.
+    for spec, what in [
+        ("diff_min=15;diff_min=6", "diff_min"),
+        ("diff_min=15;design.diff_min=6", "diff_min"),
+        ("published;published", "a preset"),
+    ]:
+        with pytest.raises(ValueError, match=f"^{what} is given twice: give it once$"):
+            shadow_overrides(spec)
 
 
 def test_the_design_shadowed_by_itself_never_differs():

@@ -53,7 +53,15 @@ CASES = {
         GOOD.replace('"40x24"', '"0x0"'),
         'c.toml: resolution = "0x0", in the run of approach: resolution must look like W',
     ),
-    "bad backend": (GOOD.replace('"model"', '"fpga"'), "backend must be one of"),
+    "bad backend": (
+        GOOD.replace('"model"', '"fpga"'),
+        'c.toml: backend = "fpga": the backend must be one of',
+    ),
+    "a bad shadow": (
+        GOOD + 'shadow = "frob=1"\n',
+        "c.toml: shadow = \"frob=1\", in the run of approach: unknown scenario key 'design.frob'",
+    ),
+    "an endless timeout": (GOOD + "timeout = inf\n", "timeout must be a finite number"),
     "malformed toml": (GOOD + "grid = [\n", "malformed TOML"),
     "description not a string": (GOOD + "description = 5\n", "description must be a string, got 5"),
     "not a list": (GOOD + '[grid]\n"design.diff_min" = 4\n', "must be a list of values"),
@@ -281,7 +289,16 @@ BAD_OPTION_VALUES = {
     "--seeds range": (["--seeds", "5-1"], "--seeds range '5-1' is empty"),
     "--set": (["--set", "robot.mass"], "--set needs KEY=VALUE (e.g. robot.mass=12)"),
     "--grid": (["--grid", "design.diff_min=[]"], "--grid needs KEY=[V1, V2, ...]"),
-    "--duration": (["--duration", "-1"], "--duration must be > 0 seconds"),
+    "--duration": (["--duration", "-1"], "--duration must be a finite number of seconds > 0"),
+    "--timeout": (
+        ["--timeout", "inf"],
+        "--timeout must be a finite number of seconds > 0, got inf",
+    ),
+    "--backend": (["--backend", "cxxrt"], "--backend cxxrt: the backend must be one of"),
+    "--shadow": (
+        ["--shadow", "frob=1"],
+        "run of approach: --shadow frob=1: unknown scenario key 'design.frob'",
+    ),
     "--scenarios": (["--scenarios", ","], "--scenarios needs scenario names"),
     "--set value": (
         ["--set", "robot.mass=-3"],

@@ -51,10 +51,20 @@ def add_board_arguments(parser):
     )
 
 
+#: The placement seeds nextpnr takes (it reads ``--seed`` as a signed 64-bit integer).
+SEEDS = range(-(2**63), 2**63)
+
+
 def run_board(args, params, out_dir, prog="fpga-robotics board", design=None):
     """Export (and optionally build) ``args.board`` into ``out_dir`` (with ``design``, a
     ``DesignSpec``, on it instead of FollowTarget); returns an exit code."""
     board_factory(args.board)
+    if args.seed is not None and not args.bitstream:
+        raise UsageError("--seed is nextpnr's placement seed: it needs --bitstream")
+    if args.seed is not None and args.seed not in SEEDS:
+        raise UsageError(
+            f"--seed must be from -2**63 to 2**63-1 (nextpnr's placement seeds); got {args.seed}"
+        )
     if design is not None:
         board_ports(design)  # a port the board cannot serve: one line, nothing written
         if design.kind == "verilog":
@@ -63,8 +73,6 @@ def run_board(args, params, out_dir, prog="fpga-robotics board", design=None):
             # the design, is one line here, before anything is written.
             design = checked_verilog(design, args.ports)
             check_yosys_reads(design)  # the board's synthesiser reads it too
-    if args.seed is not None and not args.bitstream:
-        raise UsageError("--seed is nextpnr's placement seed: it needs --bitstream")
     seed = 1 if args.seed is None else args.seed
     check_output_dir(out_dir, what="board output folder")
     if not args.bitstream:

@@ -86,7 +86,15 @@ def build_parser(prog="fpga-robotics formal"):
 
 
 def main(argv=None, prog="fpga-robotics formal"):
-    args = build_parser(prog).parse_args(argv)
+    parser = build_parser(prog)
+    args = parser.parse_args(argv)
+    if args.list:
+        # The list shows which checks and their own depths: what runs them is ignored.
+        others = parser.given_options(args, ignore={"list", "design", "param", "ports", "only"})
+        if others:
+            raise UsageError(
+                f"--list takes only --design, --param, --ports and --only; got {', '.join(others)}"
+            )
     if args.depth is not None and args.depth < 1:
         raise UsageError(f"--depth must be at least 1, got {args.depth}")
     if args.jobs < 1:

@@ -261,7 +261,7 @@ def build_parser(prog="fpga-robotics mutate"):
     p.add_argument(
         "--recordings",
         type=int,
-        default=5,
+        default=None,  # 5 with --campaign; None tells _check it was not given
         metavar="N",
         help="robot judge: record the closest-to-failing run of the first N blind "
         "spots (default 5)",
@@ -478,15 +478,20 @@ def _check(args):
         raise UsageError(f"--seed must be 0..{MAX_SEED}, got {args.seed}")
     if args.workers is not None and not 1 <= args.workers <= 256:
         raise UsageError(f"--workers must be 1..256, got {args.workers}")
-    if args.recordings < 0:
+    if args.recordings is not None and args.recordings < 0:
         raise UsageError(f"--recordings must be >= 0, got {args.recordings}")
     if args.campaign is None and (
-        args.workers or args.scheduler or args.resume or args.fork is not None
+        args.workers
+        or args.scheduler
+        or args.resume
+        or args.fork is not None
+        or args.recordings is not None
     ):
         raise UsageError(
-            "--workers, --scheduler, --resume and --fork/--no-fork go with --campaign "
-            "(the robot judge)"
+            "--workers, --scheduler, --resume, --fork/--no-fork and --recordings go with "
+            "--campaign (the robot judge)"
         )
+    args.recordings = 5 if args.recordings is None else args.recordings
     check_cluster_options(args.workers, args.scheduler)
     args.fork = True if args.fork is None else args.fork
 

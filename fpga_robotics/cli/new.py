@@ -11,8 +11,9 @@ import os
 import re
 import shutil
 import string
+import sys
 import tempfile
-from importlib import resources
+from importlib import metadata, resources
 from pathlib import Path
 
 from fpga_robotics.cli.errors import UsageError
@@ -21,8 +22,17 @@ from fpga_robotics.sim.files import default_dir_mode
 __all__ = ["main", "write_project"]
 
 _TEMPLATES = ("design.py", "scenario.toml", "README.md", "pyproject.toml", "tests/test_scenario.py")
-#: A scenario name (it names the run's recording): letters, digits, '_', '-', '.'.
-_NAME = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.-]{0,63}")
+#: A project's name: a Python name (the folder is importable from the folder above, as
+#: ``python -m`` runs there), and a scenario name (it names the run's recording).
+_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]{0,63}")
+
+
+def _shadowed_module(name):
+    """The installed or standard module a folder called ``name`` would hide from Python run in
+    the folder above it (``python -m`` puts that folder first on the path), or None."""
+    installed = {"fpga_robotics", "test", *sys.stdlib_module_names}
+    installed.update(metadata.packages_distributions())
+    return name if name in installed else None
 
 
 def _template(relative):
@@ -37,9 +47,13 @@ def write_project(folder):
     name = folder.resolve().name
     if not _NAME.fullmatch(name):
         raise UsageError(
-            f"{str(folder)!r}: the project's name {name!r} must be ASCII letters, "
-            f"digits, '_', '-' and '.' (at most 64), starting with a letter, a "
-            f"digit or '_'"
+            f"{str(folder)!r}: the project's name {name!r} must be a Python name: ASCII "
+            f"letters, digits and '_' (at most 64), not starting with a digit"
+        )
+    if _shadowed_module(name):
+        raise UsageError(
+            f"{str(folder)!r}: a project named {name!r} would hide the module {name} from "
+            f"Python run in the folder above it (python -m fpga_robotics...); choose another name"
         )
     if folder.exists():
         if not folder.is_dir():

@@ -31,5 +31,16 @@ class CommandParser(argparse.ArgumentParser):
         kwargs.setdefault("formatter_class", DefaultsFormatter)
         super().__init__(*args, **kwargs)
 
+    def given_options(self, args, ignore=()):
+        """The options ``args`` gives other than their defaults (as ``--name``), but those
+        whose ``dest`` is in ``ignore``."""
+        return [
+            action.option_strings[0]
+            for action in self._actions
+            if action.option_strings
+            and action.dest not in ignore
+            and getattr(args, action.dest, action.default) != action.default
+        ]
+
     def error(self, message):
         self.exit(USAGE_EXIT, f"{self.prog}: error: {message}\n")

@@ -112,8 +112,8 @@ def build_parser(prog="fpga-robotics run"):
         "--target-color",
         choices=tuple(TARGET_CLOTHING),
         metavar="C",
-        help="dress the target person in C and follow C (colour select); one of "
-        + ", ".join(TARGET_CLOTHING),
+        help="dress the target person in C and follow C (colour select, unless --color "
+        "gives another); one of " + ", ".join(TARGET_CLOTHING),
     )
     p.add_argument(
         "--duration",
@@ -614,20 +614,15 @@ def _format_continued(s, label):
     return lines + ["  " + line for line in format_summary(s).splitlines()]
 
 
-def _dress_target(scenario, color):
-    """The scenario with its target person dressed in ``color`` and the design's colour
-    select set to it (later colour changes of the scenario are kept)."""
+def _dress_target(scenario, color, select=True):
+    """The scenario with its target person dressed in ``color`` and, with ``select``, the
+    design's colour select set to it (later colour changes of the scenario are kept)."""
     scenario, index = scenario.target_person()
     if index is None:
         raise UsageError(f"--target-color: scenario {scenario.name!r} has no target person")
     rgb = "[" + ", ".join(str(c) for c in TARGET_CLOTHING[color]) + "]"
-    return scenario.with_overrides(
-        [
-            f"people.{index}.shirt_color={rgb}",
-            f"people.{index}.trousers_color={rgb}",
-            f'color.initial="{color}"',
-        ]
-    )
+    dress = [f"people.{index}.shirt_color={rgb}", f"people.{index}.trousers_color={rgb}"]
+    return scenario.with_overrides(dress + ([f'color.initial="{color}"'] if select else []))
 
 
 def _open_backend(name, params, quiet=False):
@@ -1016,8 +1011,13 @@ def _run_source(args, scenario, ros):
 
 
 def main(argv=None, prog="fpga-robotics run"):
-    args = build_parser(prog).parse_args(argv)
+    parser = build_parser(prog)
+    args = parser.parse_args(argv)
     if args.list_scenarios:
+        # Nothing runs: an option beside it would be ignored, a bad value unnoticed.
+        others = parser.given_options(args, ignore={"list_scenarios"})
+        if others:
+            raise UsageError(f"--list-scenarios takes no other option; got {', '.join(others)}")
         return _list_scenarios()
 
     inputs = _input_paths(args)  # before --design's file is taken into the scenario
@@ -1031,7 +1031,8 @@ def main(argv=None, prog="fpga-robotics run"):
     take_design_reference(args, scenario)
     _check_color_option(args, scenario)
     if args.target_color is not None:
-        scenario = _dress_target(scenario, args.target_color)
+        # An explicit --color is the design's select: the target wears another colour.
+        scenario = _dress_target(scenario, args.target_color, select=args.color is None)
     report_warnings(scenario, args.strict, sys.stderr, UsageError)
     recording = _check_recording(args, _recording_name(args, scenario))
     # One output written over another, or over an input, would lose it: refused now.

@@ -176,7 +176,7 @@ def _merge_options(data, args):
         )
         parse_seeds(data["seeds"], where="--seeds", forms="A-B (e.g. 0-19) or A,B,C")
     if args.duration is not None and not 0 < args.duration < math.inf:
-        raise UsageError(f"--duration must be > 0 seconds, got {args.duration}")
+        raise UsageError(f"--duration must be a finite number of seconds > 0, got {args.duration}")
     for key in ("backend", "resolution", "duration", "shadow", "design", "ports", "timeout"):
         value = getattr(args, key)
         if value is not None:
@@ -197,7 +197,7 @@ def _merge_options(data, args):
         data["grid"] = {**grid, key.strip(): values}
     given = {
         k: True
-        for k in ("scenarios", "duration", "resolution", "design", "ports")
+        for k in ("scenarios", "backend", "duration", "resolution", "shadow", "design", "ports")
         if getattr(args, k) is not None
     }
     grid = [item.partition("=")[0].strip() for item in args.grid]
@@ -225,8 +225,8 @@ def _check_options(args):
         value = getattr(args, name)
         if value is not None and value < 1:
             raise UsageError(f"--{name.replace('_', '-')} must be >= 1, got {value}")
-    if args.timeout is not None and not args.timeout > 0:
-        raise UsageError(f"--timeout must be > 0 seconds, got {args.timeout}")
+    if args.timeout is not None and not 0 < args.timeout < math.inf:
+        raise UsageError(f"--timeout must be a finite number of seconds > 0, got {args.timeout}")
     if args.bag and args.record == "none":
         raise UsageError(
             "--bag writes the recorded runs as ROS 2 bags: it needs --record "

@@ -18,6 +18,7 @@ from amaranth.hdl import signed as signed_shape
 
 from fpga_robotics.hw.errors import UserError
 from fpga_robotics.hw.pixel import COLOR_SELECT
+from fpga_robotics.sim.files import read_user_text
 from fpga_robotics.sim.processes import run_captured
 
 __all__ = ["VerilogOnBoard", "check_yosys_reads", "verilog_board_ports", "verilog_files"]
@@ -155,8 +156,8 @@ def check_yosys_reads(spec):
 
 def _read(path, top):
     try:
-        return path.read_text()
-    except (OSError, UnicodeDecodeError) as exc:
+        return read_user_text(path, any_bytes=True)
+    except OSError as exc:
         raise UserError(
             f"design {top}: cannot read {path}: {getattr(exc, 'strerror', None) or exc}"
         ) from None

@@ -28,7 +28,7 @@ from fpga_robotics.hw.errors import UsageError, UserError
 from fpga_robotics.hw.formal import CHECKS
 from fpga_robotics.hw.formal.declared import PROPERTY_HOOK, declared_checks
 from fpga_robotics.sim.backends.port_map import PortMapError, load_port_map
-from fpga_robotics.sim.files import atomic_path
+from fpga_robotics.sim.files import atomic_path, read_user_text
 
 __all__ = [
     "CheckResult",
@@ -389,8 +389,8 @@ def verilog_checks(files, top=None, depth=20, env=None, port_map=None):
     for f in files:
         path = Path(f)
         try:
-            sources[path.name] = path.read_text()
-        except (OSError, UnicodeDecodeError) as exc:
+            sources[path.name] = read_user_text(path, any_bytes=True)
+        except OSError as exc:
             raise UsageError(
                 f"cannot read the Verilog file {f}: {getattr(exc, 'strerror', None) or exc}"
             ) from None

@@ -38,7 +38,8 @@ def shadow_overrides(spec):
 
     ``SPEC`` is a preset name (``published``), ``KEY=VALUE`` items separated by ``;``
     (``diff_min=5;kp_num=2``; ``design.`` may be written or left out), or both
-    (``published;max_dps=400``: the preset first, the items on top).
+    (``published;max_dps=400``: the preset first, the items on top). A key (or a preset)
+    given twice is a ``ValueError``: the last would win unseen.
     """
     items = [part.strip() for part in str(spec).split(";") if part.strip()]
     if not items:
@@ -46,15 +47,15 @@ def shadow_overrides(spec):
             "--shadow needs a preset name or KEY=VALUE items, e.g. "
             "--shadow published or --shadow 'diff_min=5;kp_num=2'"
         )
-    out = []
+    out = {}
     for item in items:
-        if "=" not in item:
-            out.append(f'design.preset="{item}"')
-            continue
-        key, value = item.split("=", 1)
-        key = key.strip()
-        out.append(f"{key if key.startswith('design.') else 'design.' + key}={value.strip()}")
-    return out
+        key, value = item.split("=", 1) if "=" in item else ("preset", f'"{item}"')
+        key = key.strip().removeprefix("design.")
+        if key in out:
+            what = "a preset" if key == "preset" else key
+            raise ValueError(f"{what} is given twice: give it once")
+        out[key] = f"design.{key}={value.strip()}"
+    return list(out.values())
 
 
 def output_value(result, name):

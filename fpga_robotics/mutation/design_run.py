@@ -12,7 +12,7 @@ from ..designs.reference import stream_ports
 from ..hw.verilog import verilog_ports
 from ..sim.backends.foreign import ForeignDesign
 from ..sim.backends.port_map import load_port_map
-from ..sim.files import write_atomic, write_json_atomic
+from ..sim.files import read_user_text, write_atomic, write_json_atomic
 from ..sim.mutation import (
     MUTATION_SELECT,
     MutationError,
@@ -175,8 +175,7 @@ def mutate_verilog_design(
     netlist = os.path.join(out, NETLIST_NAME)
     write_atomic(netlist, verilog, what="mutant netlist")
     port_map, watch_map = os.path.join(out, PORTS_NAME), os.path.join(out, WATCH_PORTS_NAME)
-    with open(ports_path) as f:
-        text = f.read()
+    text = read_user_text(ports_path)  # already checked by ForeignDesign
     write_atomic(port_map, with_mutant_select(text), what="port map")
     watched = with_mutant_select(text, watch=True)
     if watched is None:  # the map watches an output of its own: no mutant watch

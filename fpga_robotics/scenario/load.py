@@ -68,6 +68,7 @@ from fpga_robotics.sim.backends.port_map import PortMapError, load_port_map
 from fpga_robotics.sim.camera.raster import max_hfov, max_tilt, vertical_fov
 from fpga_robotics.sim.camera.render3d.options import Lamp, Render3DOptions
 from fpga_robotics.sim.camera.sensor import OV7670Params
+from fpga_robotics.sim.files import NotTextError, read_user_text
 from fpga_robotics.sim.world import World, WorldConfigError
 from fpga_robotics.sim.world.config import WORLD_SECTIONS, default_people
 from fpga_robotics.sim.world.keys import WORLD_KEY_MODELS
@@ -387,10 +388,10 @@ def load_scenario(name_or_path, overrides=()):
                 f"scenario file {str(path)!r} is {size} bytes; a scenario is at "
                 f"most {MAX_FILE_BYTES} bytes"
             )
-        data = tomllib.loads(path.read_text())
+        data = tomllib.loads(read_user_text(path))
     except tomllib.TOMLDecodeError as exc:
         raise ScenarioError(f"{path}: malformed TOML: {exc}") from None
-    except (OSError, UnicodeDecodeError) as exc:
+    except (OSError, NotTextError) as exc:
         raise ScenarioError(f"cannot read scenario file {path}: {exc}") from None
     _check_sections(data, path)
     if "name" not in data:

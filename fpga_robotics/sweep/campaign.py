@@ -51,6 +51,7 @@ from importlib import resources
 from pathlib import Path
 
 from fpga_robotics.hw.errors import UsageError
+from fpga_robotics.sim.files import NotTextError, read_user_text
 
 from .. import __version__
 
@@ -537,10 +538,10 @@ def read_campaign_file(name_or_path):
     """The campaign file's table (checked for unknown keys) and its path."""
     path = _resolve(name_or_path)
     try:
-        data = tomllib.loads(path.read_text())
+        data = tomllib.loads(read_user_text(path))
     except tomllib.TOMLDecodeError as exc:
         raise CampaignError(f"{path}: malformed TOML: {exc}") from None
-    except (OSError, UnicodeDecodeError) as exc:
+    except (OSError, NotTextError) as exc:
         raise CampaignError(f"cannot read campaign file {path}: {exc}") from None
     unknown = [k for k in data if k not in KEYS]
     if unknown:
@@ -558,7 +559,8 @@ def load_campaign(data, *, source="", command_line=None):
     """The ``Campaign`` of a checked table (``read_campaign_file`` plus command-line
     options merged in). Scenarios and overrides are checked by ``plan.make_plan``.
     ``command_line``: what of ``data`` the command line gave, ``{"scenarios": True,
-    "duration": True, "resolution": True, "design": True, "ports": True, "set": [ITEM, ...],
+    "backend": True, "duration": True, "resolution": True, "shadow": True, "design": True,
+    "ports": True, "set": [ITEM, ...],
     "grid": [KEY, ...]}`` (any left out), so that messages name those values by their
     options."""
     where = f"{source}: " if source else ""
@@ -588,10 +590,10 @@ def load_campaign(data, *, source="", command_line=None):
         resolution = _typed(data, "resolution", str, '"WxH"')
         duration = _typed(data, "duration", (int, float), "a number of seconds")
         if duration is not None and not 0 < duration < math.inf:
-            raise CampaignError(f"duration must be > 0 seconds, got {duration}")
+            raise CampaignError(f"duration must be a finite number of seconds > 0, got {duration}")
         timeout = _typed(data, "timeout", (int, float), "a number of seconds")
         if timeout is not None and not 0 < timeout < math.inf:
-            raise CampaignError(f"timeout must be > 0 seconds, got {timeout}")
+            raise CampaignError(f"timeout must be a finite number of seconds > 0, got {timeout}")
         fixed = _set_items(data.get("set", []), "set")
         combos, origins, axes = _combos(data, command_line)
         _given_once(data, fixed, command_line)

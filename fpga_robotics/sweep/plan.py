@@ -6,7 +6,7 @@ from pathlib import Path
 
 from fpga_robotics.hw.errors import UsageError
 
-from .campaign import run_identity, toml_value
+from .campaign import _how_option, run_identity, toml_value
 from .fork_groups import world_key
 from .runner import _design_key, design_digest, load_run
 
@@ -56,8 +56,10 @@ def make_plan(campaign):
     where = f"{campaign.source}: " if campaign.source else ""
     for spec in campaign.runs:
         if spec.backend not in ("auto", *BACKEND_NAMES):
+            how = _how_option("backend", spec.backend, campaign.command_line)
+            file = "" if how.startswith("--") else where
             raise UsageError(
-                f"backend must be one of auto, {', '.join(BACKEND_NAMES)}; got {spec.backend!r}"
+                f"{file}{how}: the backend must be one of auto, {', '.join(BACKEND_NAMES)}"
             )
         shape = replace(spec, seed=0)
         if shape not in checked:
@@ -67,6 +69,13 @@ def make_plan(campaign):
                 if isinstance(exc, PortMapUnpaired):
                     exc = _port_map_unpaired(spec, campaign.command_line) or exc
                     raise UsageError(f"{_run_named(spec)}: {exc}") from None
+                shadow = f"--shadow {spec.shadow}"
+                if str(exc).startswith(shadow) and not campaign.command_line.get("shadow"):
+                    # run names its option; the campaign file gave the value
+                    how = f"{where}shadow = {toml_value(spec.shadow)}"
+                    raise UsageError(
+                        f"{how}, in the {_run_named(spec)}{str(exc)[len(shadow) :]}"
+                    ) from None
                 how = _given_as(spec, str(exc))
                 if how is None:  # the scenario's own values, or its design
                     raise UsageError(f"{_run_named(spec)}: {exc}") from None

@@ -28,6 +28,7 @@ import numpy as np
 
 from ...hw.params import FollowTargetParams
 from ...hw.pixel import COLOR_SELECT
+from ..files import read_user_text
 from ..processes import run_captured
 from . import build_cache
 from .base import BackendError, DesignBackend, FrameResult
@@ -110,8 +111,8 @@ class ForeignDesign:
         self.sources = {}
         for f in self.files:
             try:
-                self.sources[f.name] = f.read_text()
-            except (OSError, UnicodeDecodeError) as exc:
+                self.sources[f.name] = read_user_text(f, any_bytes=True)
+            except OSError as exc:
                 raise PortMapError(
                     f"cannot read the Verilog file {f}: {getattr(exc, 'strerror', None) or exc}"
                 ) from None
@@ -213,8 +214,8 @@ def verilog_includes(files):
     while todo:
         path, folder = todo.pop()
         try:
-            text = path.read_text()
-        except (OSError, UnicodeDecodeError):
+            text = read_user_text(path, any_bytes=True)
+        except OSError:
             continue
         for name in _INCLUDE.findall(text):
             if name in found or Path(name).is_absolute() or ".." in Path(name).parts:
@@ -223,8 +224,8 @@ def verilog_includes(files):
                 candidate = base / name
                 if candidate.is_file():
                     try:
-                        found[name] = candidate.read_text()
-                    except (OSError, UnicodeDecodeError) as exc:
+                        found[name] = read_user_text(candidate, any_bytes=True)
+                    except OSError as exc:
                         raise PortMapError(
                             f"cannot read the included file {candidate}: "
                             f"{getattr(exc, 'strerror', None) or exc}"

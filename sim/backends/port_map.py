@@ -24,6 +24,7 @@ from fpga_robotics.hw.errors import UserError
 
 from ...hw.params import FollowTargetParams
 from ...hw.pixel import COLOR_SELECT
+from ..files import NotTextError, read_user_text
 from ..world.schema import Flag, Integer, KeyModel, Text, fail, validate
 from .base import BackendError
 
@@ -521,9 +522,11 @@ def load_port_map(path):
     """Read and check the TOML port map at ``path``."""
     path = Path(path)
     try:
-        text = path.read_text()
+        text = read_user_text(path)
     except OSError as exc:
         raise PortMapError(f"cannot read the port map {path}: {exc.strerror or exc}") from None
+    except NotTextError as exc:
+        raise PortMapError(f"cannot read the port map {path}: {exc}") from None
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
