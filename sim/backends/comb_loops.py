@@ -9,12 +9,9 @@ Verilator, which reads more, then reports a loop while it runs.
 
 import functools
 import re
-import tempfile
-from pathlib import Path
 
-from ..processes import run_captured
 from .base import BackendError
-from .verilog_cxxrtl import yosys_executable
+from .verilog_cxxrtl import yosys_executable, yosys_on_sources
 
 __all__ = ["combinational_loop"]
 
@@ -39,19 +36,11 @@ def _loop(sources, top, includes):
         yosys = yosys_executable()
     except BackendError:
         return None
-    with tempfile.TemporaryDirectory(prefix="fr-loops-") as tmp:
-        src = Path(tmp) / "src"
-        for name, text in (*includes, *sources):
-            path = src / name
-            path.parent.mkdir(parents=True, exist_ok=True)
-            path.write_text(text)
-        names = " ".join(f"src/{name}" for name, _ in sources)
-        script = f"read_verilog -sv -Isrc {names}; " + _SCRIPT.format(top=top)
-        # Yosys runs sandboxed in the folder it starts in: every path relative to it.
-        code, _ = run_captured([yosys, "-q", "-p", script], cwd=tmp)
-        if code != 0:
-            return None
-        report = (Path(tmp) / "check.txt").read_text()
+    code, _, report = yosys_on_sources(
+        sources, includes, _SCRIPT.format(top=top), "check.txt", yosys
+    )
+    if code != 0 or report is None:
+        return None
     if _LOOP not in report:
         return None
     wires, where = [], None

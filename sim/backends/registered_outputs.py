@@ -14,13 +14,10 @@ registered design, never the reverse: two evaluations are always right.
 
 import functools
 import json
-import tempfile
 from collections import defaultdict
-from pathlib import Path
 
-from ..processes import run_captured
 from .base import BackendError
-from .verilog_cxxrtl import yosys_executable
+from .verilog_cxxrtl import yosys_executable, yosys_on_sources
 
 __all__ = ["REGISTERED_ANALYSIS", "outputs_registered", "reaches_outputs"]
 
@@ -129,18 +126,9 @@ def _registered(sources, top, includes, yosys):
             yosys = yosys_executable()
         except BackendError:
             return False
-    with tempfile.TemporaryDirectory(prefix="fr-registered-") as tmp:
-        src = Path(tmp) / "src"
-        for name, text in (*includes, *sources):
-            path = src / name
-            path.parent.mkdir(parents=True, exist_ok=True)
-            path.write_text(text)
-        names = " ".join(f"src/{name}" for name, _ in sources)
-        script = f"read_verilog -sv -Isrc {names}; " + _SCRIPT.format(top=top)
-        # Yosys runs sandboxed in the folder it starts in: every path relative to it.
-        code, _ = run_captured([yosys, "-q", "-p", script], cwd=tmp)
-        if code != 0:
-            return False
-        netlist = json.loads((Path(tmp) / "n.json").read_text())
+    code, _, text = yosys_on_sources(sources, includes, _SCRIPT.format(top=top), "n.json", yosys)
+    if code != 0 or text is None:
+        return False
+    netlist = json.loads(text)
     module = netlist["modules"].get(top)
     return module is not None and not reaches_outputs(module)

