@@ -212,3 +212,43 @@ def test_a_mutant_s_failed_run_says_what_failed_not_the_exception_or_netlist_nam
     verdict = judge_runs([["run"]], execute=execute)
     assert verdict["caught"] and verdict["status"] == "error"
     assert verdict["message"] == timeout
+
+
+DATA = os.path.join(os.path.dirname(__file__), "data")
+
+
+def test_a_campaign_that_cannot_drive_the_design_is_refused_before_the_build(tmp_path, capsys):
+    # bump_stop.v declares a bumper on bump_i; follow_person has no bumper table, so run
+    # refuses it with exit 2: mutate says the same before building any mutant.
+    campaign = tmp_path / "c.toml"
+    campaign.write_text('scenarios = ["follow_person"]\nseeds = "0"\n')
+    out = tmp_path / "m"
+    argv = ["--design", f"verilog:{DATA}/bump_stop.v", "--ports", f"{DATA}/bump_stop_ports.toml"]
+    argv += ["--mutants", "4", "--campaign", str(campaign), "--out", str(out)]
+    with pytest.raises(SystemExit) as exc:
+        run_cli(main, argv, "mutate")
+    err = capsys.readouterr().err
+    assert exc.value.code == 2 and len(err.strip().splitlines()) == 1
+    assert "the campaign's run of follow_person" in err
+    assert "nothing drives its input 'bump_i'" in err and 'kind = "bumper"' in err
+    assert not out.exists()
+
+
+def test_a_usage_error_of_an_unmutated_run_refuses_the_campaign():
+    from fpga_robotics.hw.errors import UsageError
+    from fpga_robotics.mutation.robot_judge import _refuse_usage_errors
+    from fpga_robotics.sweep.runner import RunOutcome
+
+    outcomes = []
+    for exc in (None, RuntimeError("the design stopped"), UsageError("no port 'x'")):
+        with RunOutcome() as outcome:
+            if exc is not None:
+                raise exc
+            outcome.out["status"] = "pass"
+        outcomes.append(outcome.out)
+    assert [o.get("usage_error", False) for o in outcomes] == [False, False, True]
+    argvs = [["--scenario", name] for name in ("a", "b", "c")]
+    # A run that fails on its own (b) is left to the judge; a usage error (c) is the user's.
+    _refuse_usage_errors(argvs[:2], outcomes[:2])
+    with pytest.raises(UsageError, match=r"^the campaign's run of c: no port 'x'$"):
+        _refuse_usage_errors(argvs, outcomes)

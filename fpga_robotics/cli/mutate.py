@@ -40,6 +40,7 @@ from fpga_robotics.mutation.report import write_report
 from fpga_robotics.mutation.robot_judge import (
     JOURNAL_NAME,
     check_campaign,
+    check_design_bindings,
     check_resume,
     clear_earlier_run,
     mutants_key,
@@ -112,11 +113,14 @@ def _report_robot(out, results, robot_s, recordings, say, *, title, inputs):
     rs, baseline = results["robot"], results["baseline"]
     robot_verdicts = {m["index"]: m["robot"] for m in results["mutants"] if m["robot"]}
     n_runs, n_pass = len(baseline["runs"]), len(baseline["passing"])
-    print(
-        f"robot judge (campaign {results['campaign']}: {n_pass} of {n_runs} runs pass "
-        f"unmutated): {rs['caught']} of {rs['judged']} unit-caught mutants caught: score "
-        f"{_percent(rs['score'])}; {_robot_rate(baseline, robot_s)}" + _settled(robot_verdicts)
-    )
+    head = f"robot judge (campaign {results['campaign']}: {n_pass} of {n_runs} runs pass unmutated)"
+    if not n_pass:  # no score of no run
+        print(f"{head}: no mutant judged")
+    else:
+        print(
+            f"{head}: {rs['caught']} of {rs['judged']} unit-caught mutants caught: score "
+            f"{_percent(rs['score'])}; {_robot_rate(baseline, robot_s)}" + _settled(robot_verdicts)
+        )
     forked = _fork_line(robot_verdicts)
     if forked:
         print(forked)
@@ -178,8 +182,6 @@ def _robot_rate(baseline, seconds):
     """The robot judge's rate: the mutants it judged in this run (not those ``--resume``
     kept) per minute of its wall time, the baseline runs included."""
     judged_here = baseline["judged_here"]
-    if not baseline["passing"]:
-        return "no mutant judged"
     if not judged_here:
         return "no mutant judged in this run (all kept by --resume)"
     return f"{60 * judged_here / max(seconds, 1e-9):.0f} mutants/min"
@@ -408,7 +410,11 @@ def _main_design(args):
         spec.require_clock()
         spec.require_no_black_boxes()
         name = spec.reference.rpartition(":")[2]
-    campaign = _campaign(args.campaign) if args.campaign is not None else None
+    campaign = None
+    if args.campaign is not None:
+        campaign = load_campaign_file(args.campaign)
+        design_argv = ["--design", args.design, *(["--ports", args.ports] if verilog else [])]
+        check_design_bindings(check_campaign(campaign), design_argv)
     out = args.out or os.path.join("runs", "mutation", f"{name}-n{args.mutants}-s{args.seed}")
     check_output_dir(out, what="output folder")
     _reach_scheduler(args.scheduler)

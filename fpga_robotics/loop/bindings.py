@@ -33,10 +33,13 @@ def scenario_top(scenario):
 def check_bindings(scenario):
     """``UsageError`` for a connector binding the scenario's design cannot take, from the
     design's declarations and the port map, before a model is built: a sensor pin bound to
-    no port, a design input two tables drive, a servo's port of the wrong kind."""
+    no port, a design input two tables drive, a servo's port of the wrong kind, in
+    real-clock timing a sensor the design declares but the scenario leaves out."""
+    top = scenario_top(scenario)
+    if scenario.sim.timing == "real_clock":
+        _check_declared_sensors(scenario, top)
     if not scenario.connectors:
         return
-    top = scenario_top(scenario)
     for spec in scenario.connectors:
         if spec.kind in ("camera", "servo"):  # the rig's (loop/camera_rig.py)
             continue
@@ -49,6 +52,22 @@ def check_bindings(scenario):
     for spec in scenario.connectors:
         if spec.kind == "servo":
             _check_servo(scenario, spec, top, registered)
+
+
+def _check_declared_sensors(scenario, top):
+    """A sensor kind the design binds input pins of (its port map's ``[connectors.KIND]``,
+    its Amaranth declarations) with no table of that kind in the scenario: nothing would
+    drive those inputs (the real-clock loop refuses that once the model is built)."""
+    present = {spec.kind for spec in scenario.connectors}
+    for kind, binding in top.bindings.items():
+        if kind == "camera" or kind in present or kind not in CONNECTORS:
+            continue
+        inputs = [binding[pin] for pin in _input_pins(kind) if binding.get(pin) is not None]
+        if inputs:
+            raise UsageError(
+                f"design {top.name!r}: nothing drives its input {inputs[0]!r}; declare a "
+                f'[[robot.sensors]] table with kind = "{kind}"'
+            )
 
 
 def unbound(kind, name, top, pin):

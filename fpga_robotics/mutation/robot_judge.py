@@ -131,6 +131,37 @@ def check_campaign(campaign, resolution=None):
     return plan
 
 
+def check_design_bindings(plan, design_argv):
+    """``UsageError`` when a run of the campaign (``plan``: ``check_campaign``'s) cannot
+    drive the design ``design_argv`` names (``--design REF`` and its ``--ports``): its
+    scenario's sensors against the design's pins, checked as ``run`` checks them before a
+    model is built, so before the mutants are."""
+    from ..loop.bindings import check_bindings  # lazy: the run stack (~1 s)
+
+    seen = set()
+    for spec in plan.runs:
+        argv = [*spec.argv(), *design_argv]
+        if tuple(argv) in seen:
+            continue
+        seen.add(tuple(argv))
+        try:
+            _, scenario, _ = runner.load_run(argv)
+            check_bindings(scenario)
+        except UsageError as exc:
+            raise UsageError(f"the campaign's run of {spec.scenario}: {exc}") from None
+
+
+def _refuse_usage_errors(argvs, outcomes):
+    """A run of the unmutated design that ended in a usage error (its scenario cannot run the
+    design at all, as ``run`` would say with exit 2): the campaign is the user's to fix, not
+    a run to judge without."""
+    for argv, outcome in zip(argvs, outcomes, strict=True):
+        if outcome.get("usage_error"):
+            scenario = argv[argv.index("--scenario") + 1]
+            message = outcome["message"].removeprefix("UsageError: ")
+            raise UsageError(f"the campaign's run of {scenario}: {message}")
+
+
 def start_prebuild(campaign, netlist, ports, resolution):
     """Build, in a thread of this process, the model the robot judge's unmutated runs open
     (``netlist`` with ``ports``, its watch map: a model of its own), while the unit judge
@@ -433,6 +464,7 @@ def robot_judge(
         wait_for_a_worker(client, scheduler)
         say(f"robot judge: {len(base)} campaign runs with the unmutated design first")
         outcomes, shared = _baseline(client, base, tick, fork)
+        _refuse_usage_errors(base, outcomes)
         passing = [i for i, o in enumerate(outcomes) if o["status"] == "pass"]
         statuses = [o["status"] for o in outcomes]
         messages = [_why_not_passed(o) for o in outcomes]

@@ -316,6 +316,8 @@ class RunOutcome:
             self.out.update(status="timeout", message=str(exc))
         elif isinstance(exc, Exception):
             self.out.update(status="error", message=f"{type(exc).__name__}: {exc}".splitlines()[0])
+            if isinstance(exc, UsageError):  # the run's own arguments or files: not the design's
+                self.out["usage_error"] = True
         if self.deadline is not None:
             self.deadline.cancel()
         self.out["wall_s"] = time.perf_counter() - self._wall0
