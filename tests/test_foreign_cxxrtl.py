@@ -124,6 +124,7 @@ def test_what_yosys_cannot_read_runs_on_verilator(files):
         open_foreign_frames("cxxrtl", PARAMS, files=paths, port_map=files / "sv.toml")
     message = str(info.value)
     assert "\n" not in message and "Yosys cannot read the design" in message
+    assert "(top sv_top)" in message  # the port map's top, not the generated wrapper's
     assert "sv_top.v:4" in message and "--backend verilator" in message
     with open_foreign_frames("auto", PARAMS, files=paths, port_map=files / "sv.toml") as design:
         assert isinstance(design, ForeignVerilatorBackend)

@@ -394,3 +394,35 @@ def test_a_camera_and_ultrasound_design_in_verilog_stops_as_follow_target_safe(t
     assert ours.trajectory["motor_left"][-1] == 0 == ours.trajectory["motor_right"][-1]
     for key in ("x", "y", "heading", "motor_left", "motor_right", "found", "front.echo_edges"):
         assert np.array_equal(theirs.trajectory[key], ours.trajectory[key], equal_nan=True), key
+
+
+def test_verilog_yosys_cannot_read_names_the_user_s_top_and_the_option_to_change(tmp_path, capsys):
+    from fpga_robotics.cli import run
+    from fpga_robotics.hw.errors import UsageError
+    from fpga_robotics.sweep import runner
+
+    # SystemVerilog's `inside`: Verilator reads it, Yosys does not (docs/foreign.md).
+    text = VERILOG.read_text().replace("module bump_stop", "module bump_sv")
+    text = text.replace("else if (bump_i)", "else if (bump_i inside {1'b1})")
+    (tmp_path / "bump_sv.sv").write_text(text)
+    (tmp_path / "bump_sv.toml").write_text(
+        PORTS.read_text().replace('top = "bump_stop"', 'top = "bump_sv"')
+    )
+    scenario = tmp_path / "bump.toml"
+    design = (
+        f'[design]\nverilog = "{tmp_path / "bump_sv.sv"}"\nports = "{tmp_path / "bump_sv.toml"}"'
+    )
+    scenario.write_text(SCENARIO.format(duration=0.1, design=design))
+    argv = ["--scenario", str(scenario), "--backend", "cxxrtl", "--rerun", "off"]
+    code, err = _run_cli(argv, capsys)
+    assert code == 2 and len(err.strip().splitlines()) == 1
+    # The port map's top, not the generated wrapper's; the option that picks its backend.
+    assert "Yosys cannot read the design for CXXRTL (top bump_sv): bump_sv.sv:" in err
+    assert err.rstrip().endswith("run it on the Verilator backend (--backend verilator)")
+    # As a shadow design, its backend is --shadow-backend's.
+    args, loaded, _ = runner.load_run(argv)
+    with pytest.raises(UsageError) as info:
+        run._open_pin_design(args, loaded, "--shadow verilog:bump_sv.sv", "--shadow-backend")
+    message = str(info.value)
+    assert message.startswith("--shadow verilog:bump_sv.sv: ") and "(top bump_sv)" in message
+    assert message.endswith("(--shadow-backend verilator)")

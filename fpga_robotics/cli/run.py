@@ -636,10 +636,10 @@ def _open_backend(name, params, quiet=False):
         raise UsageError(f"backend {name!r} cannot run here: {exc}") from None
 
 
-def _open_pin_design(args, scenario, option=None):
+def _open_pin_design(args, scenario, option=None, backend_option="--backend"):
     """The scenario's design on a pin-level backend (real-clock timing); ``option`` names
     the design in an error of its Verilog (``--shadow REF`` for a shadow design; default
-    ``args.design_option``)."""
+    ``args.design_option``), ``backend_option`` the option that picks its backend."""
     option = option or args.design_option
 
     def tell(text):
@@ -650,7 +650,8 @@ def _open_pin_design(args, scenario, option=None):
         try:
             design = make_pin_backend(args.backend, scenario, on_build=tell)
         except (BackendError, PinError) as exc:
-            raise UsageError(f"{option}: {exc}".splitlines()[0]) from None
+            text = str(exc).replace("--backend verilator", f"{backend_option} verilator")
+            raise UsageError(f"{option}: {text}".splitlines()[0]) from None
         try:
             apply_runtime(design, args)  # held from every reset on
         except UsageError:
@@ -1092,7 +1093,9 @@ def main(argv=None, prog="fpga-robotics run"):
     completed = False
     try:
         if shadow_scenario is not None:
-            shadow = _open_pin_design(shadow_args, shadow_scenario, f"--shadow {args.shadow}")
+            shadow = _open_pin_design(
+                shadow_args, shadow_scenario, f"--shadow {args.shadow}", "--shadow-backend"
+            )
         if shadow_params is not None:
             shadow = _open_backend(args.shadow_backend or args.backend, shadow_params, args.quiet)
         setup = time.perf_counter() - t0

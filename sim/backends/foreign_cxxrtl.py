@@ -23,7 +23,9 @@ class _YosysSource:
 
     def cxxrtl(self):
         d = self._foreign
-        return verilog_to_cxxrtl({"fr_wrapper.v": d.wrapper, **d.sources}, WRAPPER, d.includes)
+        return verilog_to_cxxrtl(
+            {"fr_wrapper.v": d.wrapper, **d.sources}, WRAPPER, d.includes, d.port_map.top
+        )
 
 
 def foreign_cxxrtl_plan(design):

@@ -84,11 +84,12 @@ def runtime_include_dir():
     return include
 
 
-def verilog_to_cxxrtl(sources, top, includes=None):
+def verilog_to_cxxrtl(sources, top, includes=None, name=None):
     """CXXRTL C++ text (class ``p_follow__target``) of module ``top`` in ``sources`` (file
     name -> Verilog text, read in order); ``includes`` (name -> text) are found by
-    `include from a folder ``src`` next to them."""
-    return _convert(tuple(sources.items()), top, tuple((includes or {}).items()))
+    `include from a folder ``src`` next to them. ``name``: the design's top as its user
+    knows it, for errors (default ``top``; a generated wrapper's top is not)."""
+    return _convert(tuple(sources.items()), top, tuple((includes or {}).items()), name or top)
 
 
 def yosys_on_sources(sources, includes, script, output, yosys=None):
@@ -116,7 +117,7 @@ def yosys_on_sources(sources, includes, script, output, yosys=None):
 
 
 @functools.lru_cache(maxsize=16)
-def _convert(sources, top, includes):
+def _convert(sources, top, includes, name):
     yosys_version()
     code, output, design = yosys_on_sources(
         sources, includes, YOSYS_SCRIPT.format(top=top), "design.cc"
@@ -126,7 +127,7 @@ def _convert(sources, top, includes):
         first = (errors or output.strip().splitlines() or ["(no output)"])[0]
         first = first.replace("src/", "")
         raise BackendError(
-            f"Yosys cannot read the design for CXXRTL (top {top}): {first}; "
+            f"Yosys cannot read the design for CXXRTL (top {name}): {first}; "
             "run it on the Verilator backend (--backend verilator)"
         )
     return design

@@ -80,7 +80,7 @@ class VerilogPinSource:
         by Yosys; ``BackendError`` for what Yosys cannot read."""
         d = self.design
         return verilog_to_cxxrtl(
-            {"fr_wrapper.v": d.wrapper, **d.sources}, self.verilog_top, d.includes
+            {"fr_wrapper.v": d.wrapper, **d.sources}, self.verilog_top, d.includes, d.port_map.top
         )
 
     #: Whether every output is a flip-flop (one evaluation per edge, else two): None, found
