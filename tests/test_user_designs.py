@@ -453,6 +453,21 @@ BAD = [
         "unelaborated.py:38: signal a bit 0; break the loop with a register (m.d.sync)",
     ),
     (
+        "an input port the design drives: its line, and the fix",
+        "unelaborated.py:DrivesItsInput",
+        {},
+        (
+            "drives its input port 'line' (unelaborated.py:78): an In port is driven by its "
+            "connector; declare it Out(...) or drive another signal"
+        ),
+    ),
+    (
+        "an input port an Instance drives",
+        "unelaborated.py:DrivesItsInputByInstance",
+        {},
+        "does not elaborate: DriverConflict: Bit 0 of signal (sig line) has multiple drivers",
+    ),
+    (
         "an elaborate that returns nothing",
         "unelaborated.py:NoReturn",
         {},

@@ -420,23 +420,30 @@ def _amaranth_spec(reference, params):
 def _check_elaborates(component, target, reference):
     """``DesignError`` (one line) if ``component``, made by the user's ``target``, does not
     elaborate to a netlist: its ``elaborate`` raises or returns nothing, or it drives a
-    signal from two places, or defines its own ``sync`` domain. Found here, before any
+    signal from two places or one of its input ports, or defines its own ``sync`` domain.
+    Found here, before any
     simulator is built for it. Returns whether it has a clock (anything in its ``sync``
     domain), the modules it instantiates without defining them (its ``Instance``s) and the
     netlist's sha256."""
     from amaranth.back import rtlil  # lazy: only a design of one's own is converted here
     from amaranth.hdl import Fragment, UnusedElaboratable  # lazy: as rtlil
 
-    from fpga_robotics.hw.verilog import verilog_ports  # lazy: as rtlil
+    from fpga_robotics.hw.verilog import directed_ports, verilog_ports  # lazy: as rtlil
 
-    # Its ports as the generated Verilog has them (constant members are none).
-    ports = {name: (value, None) for name, (value, _) in verilog_ports(component).items()}
+    # Its ports as export and the board have them: each in its declared direction, so that
+    # an input the design drives is a conflict here too, not only when exported.
+    ports = directed_ports(component)
+    inputs = {
+        id(value): name for name, (value, flow) in verilog_ports(component).items() if flow == "i"
+    }
     try:
         with warnings.catch_warnings(record=True) as said:
             warnings.simplefilter("always")
             fragment = Fragment.get(component, None)
             own_sync = _defines_sync(fragment)  # before the conversion adds the outer one
-            text = rtlil.convert(fragment, ports=ports)
+            driven = _driven_input(fragment, inputs)
+            if driven is None:
+                text = rtlil.convert(fragment, ports=ports)
     except USER_CODE_ERRORS as exc:  # the user's elaborate may raise anything
         # The modules its elaborate made are never used now: no warning for each at exit.
         warnings.filterwarnings("ignore", category=UnusedElaboratable)
@@ -448,6 +455,12 @@ def _check_elaborates(component, target, reference):
             f"design {reference!r} does not elaborate: {type(exc).__name__}: "
             f"{_first_line(exc)}{_user_line(exc, target)}{hint}"
         ) from None
+    if driven is not None:
+        port, (file, line) = driven
+        raise DesignError(
+            f"design {reference!r} drives its input port {port!r} ({Path(file).name}:{line}): "
+            "an In port is driven by its connector; declare it Out(...) or drive another signal"
+        )
     for w in said:  # a design that elaborates keeps its warnings
         warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
     if own_sync:
@@ -463,6 +476,33 @@ def _check_elaborates(component, target, reference):
     used = re.findall(r"^ +cell \\(\S+) ", text, re.MULTILINE)
     black_boxes = tuple(dict.fromkeys(name for name in used if name not in defined))
     return clocked, black_boxes, hashlib.sha256(text.encode()).hexdigest()
+
+
+def _driven_input(fragment, inputs):
+    """``(port, src_loc)``: the first assignment in ``fragment`` or a module below it to an
+    input port (``inputs``, ``{id(signal): port}``), with its line; None if none."""
+    for statements in fragment.statements.values():
+        for statement in _assignments(statements):
+            for signal in statement._lhs_signals():
+                if id(signal) in inputs:
+                    return inputs[id(signal)], statement.src_loc
+    for subfragment, _, _ in fragment.subfragments:
+        found = _driven_input(subfragment, inputs)
+        if found is not None:
+            return found
+    return None
+
+
+def _assignments(statements):
+    """The statements of a list, those inside ``m.If``/``m.Switch`` cases in their place."""
+    from amaranth.hdl._ast import Switch  # lazy: as rtlil
+
+    for statement in statements:
+        if isinstance(statement, Switch):
+            for _, case, _ in statement.cases:
+                yield from _assignments(case)
+        else:
+            yield statement
 
 
 def _defines_sync(fragment):
