@@ -182,6 +182,11 @@ class DesignSpec:
                 "take it"
             )
 
+    def source_files(self):
+        """The files a design of one's own was loaded from: its file, then the modules it
+        imported beside it; none for a built-in, an installed or a Verilog design."""
+        return _design_files(self.reference) if self.kind == "amaranth" else ()
+
     def build(self):
         """A new Amaranth component of the design (a built-in one at its default
         parameters); not for Verilog designs, which Verilator builds."""
