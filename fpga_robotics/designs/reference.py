@@ -426,10 +426,9 @@ def _check_elaborates(component, target, reference):
     """``DesignError`` (one line) if ``component``, made by the user's ``target``, does not
     elaborate to a netlist: its ``elaborate`` raises or returns nothing, or it drives a
     signal from two places or one of its input ports, or defines its own ``sync`` domain.
-    Found here, before any
-    simulator is built for it. Returns whether it has a clock (anything in its ``sync``
-    domain), the modules it instantiates without defining them (its ``Instance``s) and the
-    netlist's sha256."""
+    Found here, before any simulator is built for it. Returns whether it has a clock
+    (anything in its ``sync`` domain), the modules it instantiates without defining them (its
+    ``Instance``s) and the netlist's sha256."""
     from amaranth.back import rtlil  # lazy: only a design of one's own is converted here
     from amaranth.hdl import Fragment, UnusedElaboratable  # lazy: as rtlil
 
