@@ -110,7 +110,7 @@ def _absolute(reference):
     return reference
 
 
-def _design_overrides(design, params, ports):
+def _design_overrides(design, ports):
     items = []
     if design is not None:
         if not isinstance(design, str):
@@ -129,9 +129,19 @@ def _design_overrides(design, params, ports):
         raise UsageError(
             "ports= is the port map of a Verilog design: it goes with design='verilog:FILE.v'"
         )
-    for name, value in (params or {}).items():
-        items.append(f"design.params.{name}={json.dumps(value)}")
     return items
+
+
+def _checked_params(params):
+    """``params`` as ``load_scenario`` takes them: a dict of keyword-argument names."""
+    if params is None:
+        return None
+    if not isinstance(params, dict):
+        raise UsageError(f"params must be a dict of the design's keyword arguments, got {params!r}")
+    for name in params:
+        if not (isinstance(name, str) and name.isidentifier()):
+            raise UsageError(f"params: {name!r} is not a keyword-argument name")
+    return params
 
 
 def run(
@@ -154,7 +164,9 @@ def run(
         ``"my_design.py:MyDesign"``, ``"package.module:Name"``, a built-in name, or
         ``"verilog:top.v"`` with ``ports="ports.toml"``.
     params : dict, optional
-        ``[design.params]`` values (the design's keyword arguments).
+        ``[design.params]`` values (the design's keyword arguments) as Python values:
+        ``None``, an enum member or a dict reach the design as given, each checked against
+        its signature as ``[design.params]`` are.
     overrides : list of str
         ``KEY=VALUE`` items, as ``--set`` takes them (``"sim.duration=5"``).
     seed : int, optional
@@ -165,6 +177,6 @@ def run(
     recorder : optional
         A viewer recorder (``fpga_robotics.viz.open_recorder``), not closed here.
     """
-    items = [*_design_overrides(design, params, ports), *override_items(overrides)]
-    loaded = load_scenario(str(scenario), items)
+    items = [*_design_overrides(design, ports), *override_items(overrides)]
+    loaded = load_scenario(str(scenario), items, design_params=_checked_params(params))
     return Result(run_scenario(loaded, seed=seed, backend=backend, recorder=recorder), loaded)

@@ -131,8 +131,32 @@ def test_the_output_may_not_be_the_design_s_own_file(tmp_path, capsys, monkeypat
         ["export", "--design", "./wall_stop.py:WallStop", "-o", str(source)], capsys
     )
     assert code == 2 and text == "" and err.count("\n") == 1
-    assert f"-o {str(source)!r} is the same path as the input --design 'wall_stop.py'" in err
+    assert f"-o {str(source)!r} is the same path as the input --design {str(source)!r}" in err
     assert source.read_bytes() == (DESIGNS / "wall_stop.py").read_bytes()
+
+
+def test_the_output_may_not_be_a_module_the_design_imports(tmp_path, capsys, monkeypatch):
+    # The design's folder is first on its path: a helper module beside it is its source too.
+    (tmp_path / "speeds.py").write_text("SPEED = 200\n")
+    (tmp_path / "design.py").write_text(
+        "from amaranth import Module, signed\n"
+        "from amaranth.lib import wiring\n"
+        "from amaranth.lib.wiring import Out\n"
+        "from speeds import SPEED\n\n\n"
+        "class D(wiring.Component):\n"
+        "    motor_left: Out(signed(16))\n"
+        "    motor_right: Out(signed(16))\n\n"
+        "    def elaborate(self, platform):\n"
+        "        m = Module()\n"
+        "        m.d.sync += [self.motor_left.eq(SPEED), self.motor_right.eq(SPEED)]\n"
+        "        return m\n"
+    )
+    monkeypatch.chdir(tmp_path)
+    code, text, err = _cli(["export", "--design", "design.py:D", "-o", "speeds.py"], capsys)
+    assert code == 2 and text == "" and err.count("\n") == 1
+    helper = str(tmp_path / "speeds.py")
+    assert f"-o 'speeds.py' is the same path as the input --design's module {helper!r}" in err
+    assert (tmp_path / "speeds.py").read_text() == "SPEED = 200\n"
 
 
 @pytest.mark.parametrize(

@@ -83,3 +83,71 @@ def test_a_seed_that_is_not_a_whole_number_is_refused(seed):
     # int() would have run seed 1 for "1", 1.5 and True: another run than asked for.
     with pytest.raises(ValueError, match=r"seed must be a non-negative integer, got "):
         run(DESIGNS / "wall_stop.toml", seed=seed, backend="model")
+
+
+PYTHON_PARAMS = """
+import enum
+
+from amaranth import Module, signed
+from amaranth.lib import wiring
+from amaranth.lib.wiring import Out
+
+
+class Mode(enum.Enum):
+    FORWARD = 1
+    REVERSE = -1
+
+
+class Lim(wiring.Component):
+    motor_left: Out(signed(16))
+    motor_right: Out(signed(16))
+
+    def __init__(self, limit=None, gains: dict = None, mode: Mode = Mode.FORWARD):
+        left = 300 if limit is None else limit
+        right = 100 * gains["kp"] if gains is not None else 0
+        self.speeds = left * mode.value, right * mode.value
+        super().__init__()
+
+    def elaborate(self, platform):
+        m = Module()
+        m.d.sync += [self.motor_left.eq(self.speeds[0]), self.motor_right.eq(self.speeds[1])]
+        return m
+"""
+
+BARE = """
+people = []
+[sim]
+duration = 0.1
+clock_hz = 100000.0
+[room]
+width = 2.5
+depth = 1.0
+[robot]
+model = "gopigo3"
+start = [0.5, 0.5]
+"""
+
+
+def test_params_from_python_reach_the_design_as_given(tmp_path, monkeypatch):
+    # None, a dict and an enum member (of the user's own import of the design's file) are
+    # keyword arguments as they are: no text on the way ("null", a JSON string).
+    import importlib.util
+
+    (tmp_path / "lim.py").write_text(PYTHON_PARAMS)
+    (tmp_path / "bare.toml").write_text(BARE)
+    monkeypatch.chdir(tmp_path)
+    spec = importlib.util.spec_from_file_location("users_lim", tmp_path / "lim.py")
+    users_lim = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(users_lim)
+    result = run(
+        "bare.toml",
+        design="lim.py:Lim",
+        params={"limit": None, "gains": {"kp": 2}, "mode": users_lim.Mode.REVERSE},
+        backend="pysim",
+    )
+    assert (result.trajectory["motor_left"][-1], result.trajectory["motor_right"][-1]) == (
+        -300,
+        -200,
+    )
+    with pytest.raises(UsageError, match=r"params must be a dict .*, got \['limit'\]"):
+        run("bare.toml", design="lim.py:Lim", params=["limit"])

@@ -453,6 +453,21 @@ BAD = [
         "unelaborated.py:38: signal a bit 0; break the loop with a register (m.d.sync)",
     ),
     (
+        "an input port the design drives: its line, and the fix",
+        "unelaborated.py:DrivesItsInput",
+        {},
+        (
+            "drives its input port 'line' (unelaborated.py:78): an In port is driven by its "
+            "connector; declare it Out(...) or drive another signal"
+        ),
+    ),
+    (
+        "an input port an Instance drives",
+        "unelaborated.py:DrivesItsInputByInstance",
+        {},
+        "does not elaborate: DriverConflict: Bit 0 of signal (sig line) has multiple drivers",
+    ),
+    (
         "an elaborate that returns nothing",
         "unelaborated.py:NoReturn",
         {},
@@ -1025,6 +1040,81 @@ def test_a_bad_parameter_is_told_as_the_command_takes_it(tmp_path, capsys, monke
     assert code == 2
     assert "give it in [design.params] (or --set design.params.speed=VALUE)" in err
     assert sorted(p.name for p in tmp_path.iterdir() if p.name != "__pycache__") == ["p.py"]
+
+
+TYPED_PARAMS = """
+import enum
+
+from amaranth import Module, signed
+from amaranth.lib import wiring
+from amaranth.lib.wiring import Out
+
+
+class Mode(enum.Enum):
+    STOP = 0
+    REVERSE = 1
+
+
+class Typed(wiring.Component):
+    motor_left: Out(signed(16))
+    motor_right: Out(signed(16))
+
+    def __init__(self, mode: Mode = Mode.STOP, taps: list = [1, 2], pair=(3, 4), gain=1.5):
+        self.mode, self.taps, self.pair, self.gain = mode, taps, pair, gain
+        super().__init__()
+
+    def elaborate(self, platform):
+        m = Module()
+        m.d.sync += self.motor_left.eq(self.taps[0])
+        return m
+"""
+
+
+def _built(reference, params):
+    component = resolve_design(reference, params).build()
+    Fragment.get(component, None)  # used: Amaranth warns of a component never elaborated
+    return component
+
+
+def test_parameters_reach_the_design_as_their_annotation_or_default_types(tmp_path):
+    (tmp_path / "typed.py").write_text(TYPED_PARAMS)
+    reference = f"{tmp_path}/typed.py:Typed"
+    for given in ("REVERSE", "Mode.REVERSE"):
+        design = _built(reference, {"mode": given})
+        assert type(design.mode).__name__ == "Mode" and design.mode.name == "REVERSE"
+    # TOML has arrays and integers only: each arrives as its parameter's list, tuple, float.
+    design = _built(reference, {"taps": [5, 6], "pair": [7, 8], "gain": 2})
+    assert (design.taps, design.pair, design.gain) == ([5, 6], (7, 8), 2.0)
+    assert (type(design.taps), type(design.pair), type(design.gain)) == (list, tuple, float)
+    for bad in ("bogus", 1):
+        with pytest.raises(DesignError) as info:
+            resolve_design(reference, {"mode": bad})
+        assert str(info.value) == (
+            f"design.params.mode must be one of STOP, REVERSE (a parameter of Typed), got {bad!r}"
+        )
+
+
+def test_a_bad_enum_parameter_is_one_line_from_the_command_line(tmp_path, capsys, monkeypatch):
+    (tmp_path / "typed.py").write_text(TYPED_PARAMS)
+    monkeypatch.chdir(tmp_path)
+    code, out, err = _cli(["designs", "typed.py:Typed", "--param", "mode=bogus"], capsys)
+    assert (code, out) == (2, "") and err.count("\n") == 1
+    assert "--param mode must be one of STOP, REVERSE (a parameter of Typed), got 'bogus'" in err
+    code, _, err = _cli(
+        [
+            "run",
+            "--scenario",
+            str(WALL_STOP),
+            "--design",
+            "typed.py:Typed",
+            "--set",
+            "design.params={}",
+            "--set",
+            "design.params.mode=nonsense",
+        ],
+        capsys,
+    )
+    assert code == 2 and "design.params.mode must be one of STOP, REVERSE" in err
 
 
 @pytest.mark.slow

@@ -21,7 +21,6 @@ the top does not read prints what is wrong and exits with code 2.
 
 import os
 from dataclasses import fields
-from pathlib import Path
 
 from fpga_robotics.cli.board import add_board_arguments, run_board
 from fpga_robotics.cli.designs import _params
@@ -286,11 +285,13 @@ def _export_design(args):
             )
     if args.variant is not None:
         raise UsageError("--variant names a seeded bug of a built-in top: it goes without --design")
-    if args.output is not None:  # Verilog written over the design's own file would lose it
-        check_paths_apart([("-o", args.output)], _design_file(args.design))
     spec = resolve_design(args.design, _params(args.design_params), option="--param")
     name = spec.reference.rpartition(":")[2]
     output = args.output if args.output is not None else os.path.join("build", f"{name}.v")
+    # Verilog written over the design's file, or a module it imports beside it, would lose it.
+    files = spec.source_files()
+    labels = ["--design", *["--design's module"] * (len(files) - 1)]
+    check_paths_apart([("-o", output)], list(zip(labels, files, strict=False)))
     if os.path.isdir(output):
         raise UsageError(
             f"{output} is a directory; give the Verilog file's path, e.g. "
@@ -301,9 +302,3 @@ def _export_design(args):
     write_atomic(output, text, what="Verilog file")
     print(f"wrote {output} (module {name}, {len(spec.ports)} ports)")
     return 0
-
-
-def _design_file(reference):
-    """``[("--design", FILE.py)]`` of a ``FILE.py:Name`` reference, else ``[]``."""
-    path = Path(reference.strip().rpartition(":")[0]).expanduser()
-    return [("--design", path)] if path.is_file() else []

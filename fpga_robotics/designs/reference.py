@@ -21,6 +21,7 @@ per-frame outputs, is an extra output: recorded under its own name.
 """
 
 import contextlib
+import enum
 import functools
 import hashlib
 import importlib
@@ -30,6 +31,7 @@ import inspect
 import re
 import sys
 import traceback
+import typing
 import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -180,6 +182,11 @@ class DesignSpec:
                 "take it"
             )
 
+    def source_files(self):
+        """The files a design of one's own was loaded from: its file, then the modules it
+        imported beside it; none for a built-in, an installed or a Verilog design."""
+        return _design_files(self.reference) if self.kind == "amaranth" else ()
+
     def build(self):
         """A new Amaranth component of the design (a built-in one at its default
         parameters); not for Verilog designs, which Verilator builds."""
@@ -233,7 +240,7 @@ def resolve_design(reference, params=None, *, ports=None, base=None, option=None
     if cached is not None and _stamps(cached[0]) == cached[1]:
         return cached[2]
     try:
-        spec = _amaranth_spec(reference, frozen)
+        spec = _amaranth_spec(reference, params)
     except _ParamError as exc:
         raise DesignError(exc.said_for(option)) from None
     files = _design_files(reference)
@@ -284,7 +291,17 @@ def _own_reference(reference, base):
 
 
 def _freeze(value):
-    return tuple(map(_freeze, value)) if isinstance(value, list) else value
+    """``value`` as part of a cache key: hashable, and unequal for values a design takes
+    differently (``1``, ``1.0`` and ``True``; ``[1]`` and ``(1,)``)."""
+    if isinstance(value, list | tuple):
+        return type(value), tuple(map(_freeze, value))
+    if isinstance(value, dict):
+        return dict, tuple((k, _freeze(v)) for k, v in value.items())
+    try:
+        hash(value)
+    except TypeError:  # an object from Python: the spec cached for it keeps it alive
+        return type(value), id(value)
+    return type(value), value
 
 
 #: (reference, frozen params) of a design of one's own -> (the files its resolution read,
@@ -364,11 +381,10 @@ def _builtin_spec(registered):
 # Amaranth designs of one's own ------------------------------------------------------------
 
 
-def _amaranth_spec(reference, frozen_params):
-    params = {k: list(v) if isinstance(v, tuple) else v for k, v in frozen_params}
+def _amaranth_spec(reference, params):
     target = _load_target(reference)
-    _check_params(target, params, reference)
-    factory = functools.partial(_call, target, params, reference)
+    values = _check_params(target, params, reference)
+    factory = functools.partial(_call, target, values, reference)
     component = factory()
     clocked, black_boxes, netlist_digest = _check_elaborates(component, target, reference)
     signed = signed_ports(component)
@@ -409,23 +425,29 @@ def _amaranth_spec(reference, frozen_params):
 def _check_elaborates(component, target, reference):
     """``DesignError`` (one line) if ``component``, made by the user's ``target``, does not
     elaborate to a netlist: its ``elaborate`` raises or returns nothing, or it drives a
-    signal from two places, or defines its own ``sync`` domain. Found here, before any
-    simulator is built for it. Returns whether it has a clock (anything in its ``sync``
-    domain), the modules it instantiates without defining them (its ``Instance``s) and the
-    netlist's sha256."""
+    signal from two places or one of its input ports, or defines its own ``sync`` domain.
+    Found here, before any simulator is built for it. Returns whether it has a clock
+    (anything in its ``sync`` domain), the modules it instantiates without defining them (its
+    ``Instance``s) and the netlist's sha256."""
     from amaranth.back import rtlil  # lazy: only a design of one's own is converted here
     from amaranth.hdl import Fragment, UnusedElaboratable  # lazy: as rtlil
 
-    from fpga_robotics.hw.verilog import verilog_ports  # lazy: as rtlil
+    from fpga_robotics.hw.verilog import directed_ports, verilog_ports  # lazy: as rtlil
 
-    # Its ports as the generated Verilog has them (constant members are none).
-    ports = {name: (value, None) for name, (value, _) in verilog_ports(component).items()}
+    # Its ports as export and the board have them: each in its declared direction, so that
+    # an input the design drives is a conflict here too, not only when exported.
+    ports = directed_ports(component)
+    inputs = {
+        id(value): name for name, (value, flow) in verilog_ports(component).items() if flow == "i"
+    }
     try:
         with warnings.catch_warnings(record=True) as said:
             warnings.simplefilter("always")
             fragment = Fragment.get(component, None)
             own_sync = _defines_sync(fragment)  # before the conversion adds the outer one
-            text = rtlil.convert(fragment, ports=ports)
+            driven = _driven_input(fragment, inputs)
+            if driven is None:
+                text = rtlil.convert(fragment, ports=ports)
     except USER_CODE_ERRORS as exc:  # the user's elaborate may raise anything
         # The modules its elaborate made are never used now: no warning for each at exit.
         warnings.filterwarnings("ignore", category=UnusedElaboratable)
@@ -437,6 +459,12 @@ def _check_elaborates(component, target, reference):
             f"design {reference!r} does not elaborate: {type(exc).__name__}: "
             f"{_first_line(exc)}{_user_line(exc, target)}{hint}"
         ) from None
+    if driven is not None:
+        port, (file, line) = driven
+        raise DesignError(
+            f"design {reference!r} drives its input port {port!r} ({Path(file).name}:{line}): "
+            "an In port is driven by its connector; declare it Out(...) or drive another signal"
+        )
     for w in said:  # a design that elaborates keeps its warnings
         warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
     if own_sync:
@@ -452,6 +480,33 @@ def _check_elaborates(component, target, reference):
     used = re.findall(r"^ +cell \\(\S+) ", text, re.MULTILINE)
     black_boxes = tuple(dict.fromkeys(name for name in used if name not in defined))
     return clocked, black_boxes, hashlib.sha256(text.encode()).hexdigest()
+
+
+def _driven_input(fragment, inputs):
+    """``(port, src_loc)``: the first assignment in ``fragment`` or a module below it to an
+    input port (``inputs``, ``{id(signal): port}``), with its line; None if none."""
+    for statements in fragment.statements.values():
+        for statement in _assignments(statements):
+            for signal in statement._lhs_signals():
+                if id(signal) in inputs:
+                    return inputs[id(signal)], statement.src_loc
+    for subfragment, _, _ in fragment.subfragments:
+        found = _driven_input(subfragment, inputs)
+        if found is not None:
+            return found
+    return None
+
+
+def _assignments(statements):
+    """The statements of a list, those inside ``m.If``/``m.Switch`` cases in their place."""
+    from amaranth.hdl._ast import Switch  # lazy: as rtlil
+
+    for statement in statements:
+        if isinstance(statement, Switch):
+            for _, case, _ in statement.cases:
+                yield from _assignments(case)
+        else:
+            yield statement
 
 
 def _defines_sync(fragment):
@@ -625,9 +680,12 @@ def _is_component_class(value):
 
 def _check_params(target, params, reference):
     """``params`` against the signature of ``target``: known names, required ones given,
-    each value of its annotation's (or default's) type."""
+    each value of its annotation's (or default's) type. Returns them as the design takes
+    them: an enum member by its name, an array as the list or tuple its parameter is, an
+    integer as a float parameter's float."""
     known, takes_any = _signature_parameters(target)
     name = reference.rpartition(":")[2]
+    values = dict(params)
     for key, value in params.items():
         if key not in known:
             if takes_any:
@@ -638,17 +696,30 @@ def _check_params(target, params, reference):
                 f"{', '.join(known) or 'none'}",
             )
         expected = _expected_type(known[key])
-        if expected is not None and not _fits(value, expected):
+        if expected is None:
+            continue
+        if issubclass(expected, enum.Enum):
+            values[key] = _enum_member(value, expected)
+            if values[key] is None:
+                raise _ParamError(
+                    key,
+                    f"{{where}} must be one of {', '.join(expected.__members__)} (a parameter "
+                    f"of {name}), got {value!r}",
+                )
+        elif not _fits(value, expected):
             raise _ParamError(
                 key,
                 f"{{where}} must be {_type_name(expected)} (a parameter of {name}), got {value!r}",
             )
+        elif expected in (list, tuple, float):
+            values[key] = expected(value)
     missing = [n for n, p in known.items() if p.default is p.empty and n not in params]
     if missing:
         raise _ParamError(
             missing[0],
             f"design {reference!r}: parameter {missing[0]!r} has no default; give it {{how}}",
         )
+    return values
 
 
 def _signature_parameters(target):
@@ -656,9 +727,14 @@ def _signature_parameters(target):
     inspect.Parameter}) and whether it takes any other (``**kwargs``, or a signature
     Python cannot read)."""
     try:
-        signature = inspect.signature(target)
-    except (TypeError, ValueError):
-        return {}, True
+        # Annotations written as text (``from __future__ import annotations``) as the types
+        # they name, where the design's module can name them.
+        signature = inspect.signature(target, eval_str=True)
+    except USER_CODE_ERRORS:  # evaluating them runs the user's code
+        try:
+            signature = inspect.signature(target)
+        except (TypeError, ValueError):
+            return {}, True
     from amaranth.lib import wiring  # lazy: Amaranth (~0.3 s)
 
     if inspect.isclass(target) and target.__init__ is wiring.Component.__init__:
@@ -684,13 +760,32 @@ def _expected_type(parameter):
             "list": list,
             "tuple": tuple,
         }.get(annotation)
-    if annotation in (int, float, bool, str, list, tuple):
+    annotation = typing.get_origin(annotation) or annotation  # list[int] is a list
+    if annotation in (int, float, bool, str, list, tuple) or _is_enum(annotation):
         return annotation
     default = parameter.default
     if default is not parameter.empty and default is not None:
         kind = type(default)
-        if kind in (int, float, bool, str, list, tuple):
+        if kind in (int, float, bool, str, list, tuple) or _is_enum(kind):
             return kind
+    return None
+
+
+def _is_enum(kind):
+    return inspect.isclass(kind) and issubclass(kind, enum.Enum)
+
+
+def _enum_member(value, kind):
+    """The member of the enum ``kind`` that ``value`` is or names (``NAME`` or
+    ``Kind.NAME``); None if none."""
+    if isinstance(value, kind):
+        return value
+    if isinstance(value, enum.Enum) and type(value).__qualname__ == kind.__qualname__:
+        # The same enum from the user's own import of the design's file (a module apart
+        # from the one loaded here): its member of the same name.
+        return kind.__members__.get(value.name)
+    if isinstance(value, str):
+        return kind.__members__.get(value.removeprefix(f"{kind.__name__}."))
     return None
 
 
@@ -721,9 +816,8 @@ def _call(target, params, reference):
     """``target(**params)``, the component it returns (an error names what went wrong)."""
     from amaranth.lib import wiring  # lazy: Amaranth (~0.3 s)
 
-    values = {k: tuple(v) if isinstance(v, list) else v for k, v in params.items()}
     try:
-        component = target(**values)
+        component = target(**params)
     except USER_CODE_ERRORS as exc:  # the user's constructor may raise anything
         raise DesignError(
             f"design {reference!r}: building it raised {type(exc).__name__}: {_first_line(exc)}"

@@ -363,7 +363,7 @@ def _default_name(path):
     return name or "scenario"
 
 
-def load_scenario(name_or_path, overrides=()):
+def load_scenario(name_or_path, overrides=(), *, design_params=None):
     """Load a shipped scenario by name, or a TOML file by path, and apply overrides.
 
     Parameters
@@ -373,6 +373,9 @@ def load_scenario(name_or_path, overrides=()):
     overrides : list of str
         ``"dotted.key=value"`` items; the value is parsed as TOML (bare words are strings).
         Array items are chosen by index, ``people.0.speed`` or ``people[0].speed``.
+    design_params : dict, optional
+        ``[design.params]`` values from Python, given to the design as they are (any
+        Python value its signature takes), over the file's and under the overrides.
 
     Raises
     ------
@@ -397,6 +400,10 @@ def load_scenario(name_or_path, overrides=()):
     if "name" not in data:
         data["name"] = _default_name(path)
     _fill_defaults(data)
+    if design_params:
+        table = data["design"].setdefault("params", {})
+        if isinstance(table, dict):  # else the file's error is said when it is resolved
+            table.update(design_params)
     overrides = override_items(overrides)
     _drop_replaced_design(data, overrides)
     _apply_overrides(data, overrides)

@@ -64,3 +64,25 @@ class BlackBox(_Wheels):
         m.submodules.ip = Instance("my_ip", i_clk=ClockSignal(), i_a=self.line, o_y=speed)
         m.d.comb += [self.motor_left.eq(speed), self.motor_right.eq(speed)]
         return m
+
+
+class DrivesItsInput(_Wheels):
+    """A port declared In that the design drives, in a submodule's m.If."""
+
+    def elaborate(self, platform):
+        m = Module()
+        m.submodules.inner = inner = Module()
+        tick = Signal()
+        m.d.sync += tick.eq(~tick)
+        with inner.If(tick):
+            inner.d.comb += self.line.eq(3)
+        return m
+
+
+class DrivesItsInputByInstance(_Wheels):
+    def elaborate(self, platform):
+        m = Module()
+        tick = Signal()
+        m.d.sync += tick.eq(~tick)
+        m.submodules.ip = Instance("my_ip", i_clk=ClockSignal(), o_y=self.line)
+        return m
