@@ -285,6 +285,12 @@ def test_compressed_timing_names_what_keeps_a_design_on_the_real_clock(tmp_path,
     assert "frame 0: frame_done did not rise within 20,000 edges" in err
     # Named as the scenario names the design: no --design was given.
     assert err.startswith("fpga-robotics run: error: design.top: RedFrames: frame 0: "), err
+    # One that rises before the frame's last pixel (after line 28 of 30, as a design raising
+    # it on the stream's last flag, which ends every line, does) is one line too.
+    argv = ["run", "--scenario", str(RED_FRAMES), "--set", "design.params.height=29"]
+    code, out, err = _cli([*argv, "--duration", "0.3", "--rerun", "off", "--quiet"], capsys)
+    assert (code, out) == (2, "") and err.count("\n") == 1, err
+    assert "frame 0: frame_done rose at edge 1,160, before the frame's last pixel" in err
 
 
 def test_a_frame_done_that_never_rises_is_one_line_in_real_clock_timing_too(capsys):
