@@ -407,7 +407,7 @@ BAD = [
         "a function that raises",
         "broken.py:raises",
         {},
-        "building it raised ValueError: width 4 is not supported",
+        "building it raised ValueError: width 4 is not supported (broken.py:16)",
     ),
     (
         "a function returning no component",

@@ -726,7 +726,8 @@ def _call(target, params, reference):
         component = target(**values)
     except USER_CODE_ERRORS as exc:  # the user's constructor may raise anything
         raise DesignError(
-            f"design {reference!r}: building it raised {type(exc).__name__}: {_first_line(exc)}"
+            f"design {reference!r}: building it raised {type(exc).__name__}: "
+            f"{_first_line(exc)}{_user_line(exc, target)}"
         ) from None
     if not isinstance(component, wiring.Component):
         raise DesignError(
