@@ -471,6 +471,12 @@ BAD = [
         "design 'ClkPort' has a port named 'clk', the name of the clock domain's own clock",
     ),
     (
+        "a port wider than the simulators take (listed as recorded, run refused the backend)",
+        f"{DESIGNS / 'port_cases.py'}:WidePort",
+        {},
+        "design 'WidePort': port 'huge' is 128 bits; the simulators take ports of at most 64",
+    ),
+    (
         "no file or module before the colon",
         ":WallStop",
         {},
