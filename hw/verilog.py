@@ -4,7 +4,9 @@
 backend compiles; ``port_values`` is the port list every back-end conversion uses.
 """
 
-from amaranth.back import cxxrtl, verilog
+import re
+
+from amaranth.back import cxxrtl, rtlil, verilog
 from amaranth.hdl import Const, Value, ValueCastable
 from amaranth.hdl._ir import PortDirection  # no public name in Amaranth 0.5; its back-ends use it
 from amaranth.lib import wiring
@@ -65,16 +67,32 @@ def generate_verilog(params=None, component=None):
     """Verilog text of ``FollowTarget(params)`` (or of ``component``), top module
     ``follow_target``. Ports: ``clk rst pixels__valid pixels__payload color_sel
     filtered__valid filtered__payload frame_done found proximity centroid_x centroid_leds
-    motor_left motor_right``."""
+    motor_left motor_right``. Without the design's ``Assert``/``Assume``/``Cover``: only
+    pysim checks those in a run (``fpga-robotics formal`` proves them)."""
     if component is None:
         component = FollowTarget(FollowTargetParams() if params is None else params)
         # Direction None: Amaranth infers it (driven inside the design = output).
         ports = {name: (value, None) for name, (value, _) in verilog_ports(component).items()}
     else:
         ports = port_values(component)
-    return verilog.convert(component, name=TOP_NAME, ports=ports, emit_src=False)
+    # The private conversion step of verilog.convert: no public one takes RTLIL text.
+    return verilog._convert_rtlil_text(_rtlil_without_checks(component, ports))
 
 
 def generate_cxxrtl(component):
-    """CXXRTL C++ text of ``component``, top class ``p_follow__target``."""
-    return cxxrtl.convert(component, name=TOP_NAME, ports=port_values(component), emit_src=False)
+    """CXXRTL C++ text of ``component``, top class ``p_follow__target``, without its
+    ``Assert``/``Assume``/``Cover`` (as ``generate_verilog``)."""
+    text = _rtlil_without_checks(component, port_values(component))
+    return cxxrtl._convert_rtlil_text(text, None)
+
+
+#: An RTLIL ``$check`` cell (an Assert, Assume or Cover): its block up to its own ``end``.
+_CHECK_CELL = re.compile(r"^( *)cell \$check \S+\n.*?^\1end\n", re.MULTILINE | re.DOTALL)
+
+
+def _rtlil_without_checks(component, ports):
+    """RTLIL text of ``component`` without its formal checks: the compiled simulators would
+    print a failing ``Assert`` (Verilator on every clock, CXXRTL once) and run on; only
+    pysim stops at one. ``$check`` cells drive nothing, so nothing else changes."""
+    text = rtlil.convert(component, name=TOP_NAME, ports=ports, emit_src=False)
+    return _CHECK_CELL.sub("", text)

@@ -57,6 +57,18 @@ def test_a_verilog_design_in_its_own_scenario(tmp_path, capsys):
 
 
 @pytest.mark.slow  # compiled pin models of the design
+def test_a_camera_design_whose_scenario_runs_in_compressed_timing(tmp_path, capsys):
+    # red_frames raises frame_done: its scenario's "auto" is compressed timing; the bench
+    # times it in real-clock timing (it raised a TypeError about pin backends).
+    frames = DATA / "user_designs"
+    argv = ["--design", f"{frames}/red_frames.py:RedFrames"]
+    argv += ["--scenario", str(frames / "red_frames.toml"), "--clock-hz", "2e5"]
+    out, figures = _bench(argv, tmp_path, capsys)
+    assert "in real-clock timing (red_frames), 0.1 s at 0.2 MHz (0.0 M cycles)" in out
+    _check_rates(out, figures, 20_000)
+
+
+@pytest.mark.slow  # compiled pin models of the design
 def test_relative_verilog_files_are_taken_from_the_current_folder(tmp_path, monkeypatch, capsys):
     # The files in the current folder only, the scenario in another (docs/your_design.md).
     (tmp_path / "mine.v").write_text((DATA / "bump_stop.v").read_text())

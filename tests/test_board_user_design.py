@@ -75,6 +75,52 @@ def test_a_camera_design_gets_the_camera_and_the_switches(tmp_path, capsys):
     assert "switch_0__io" in lpf
 
 
+NESTED_DESIGN = """
+from amaranth import Module, Signal, signed
+from amaranth.lib import wiring
+from amaranth.lib.wiring import In, Out
+
+Wheels = wiring.Signature({"left": Out(signed(16)), "right": Out(signed(16))})
+Sonar = wiring.Signature({"trig": Out(1), "echo": In(1)})
+
+
+class Nested(wiring.Component):
+    connectors = {
+        "wheels": {"motor_left": "wheels__left", "motor_right": "wheels__right"},
+        "ultrasound": {"trig": "sonar__trig", "echo": "sonar__echo"},
+    }
+    wheels: Out(Wheels)
+    sonar: Out(Sonar)
+
+    def elaborate(self, platform):
+        m = Module()
+        t = Signal(16)
+        m.d.sync += t.eq(t + 1)
+        m.d.comb += self.sonar.trig.eq(t < 12)
+        m.d.comb += [self.wheels.left.eq(250), self.wheels.right.eq(-7)]
+        return m
+"""
+
+
+def test_ports_inside_interfaces_go_to_the_board_by_their_bound_names(
+    tmp_path, capsys, monkeypatch
+):
+    # Bound by the names designs prints (wheels__left): the wheels were an AttributeError
+    # traceback, the sonar's 1-bit pins refused as "1 bits; the header takes 1-bit ports".
+    (tmp_path / "nested.py").write_text(NESTED_DESIGN)
+    monkeypatch.chdir(tmp_path)
+    code, text, err = _cli(["board", "--design", "nested.py:Nested", "-o", "b"], capsys)
+    assert code == 0, err
+    assert text.splitlines()[:2] == [
+        "sonar__trig: header gpio 7+ (site A6)",
+        "sonar__echo: header gpio 7- (site B6)",
+    ]
+    verilog = (tmp_path / "b" / "ulx3s_follow_target.v").read_text()
+    assert _direction(verilog, "fr_header_0__io") == "output"
+    assert _direction(verilog, "fr_header_1__io") == "input"
+    assert "16'h00fa" in verilog and "16'hfff9" in verilog  # the wheels' 250 and -7
+
+
 PAN_DESIGN = """
 from amaranth import Module, signed
 from amaranth.lib import wiring

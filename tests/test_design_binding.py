@@ -420,3 +420,35 @@ def test_frame_outputs_of_the_contract_shapes_or_without_a_camera_are_taken(tmp_
     # Without a camera a 2-bit found is no per-frame output: an output of its own.
     spec = resolve_design(f"{tmp_path / 'frames.py'}:no_camera")
     assert not spec.camera and spec.extra_outputs == ("found",)
+
+
+WIDE_OUTPUTS = """
+from amaranth import Module, Signal, signed
+from amaranth.lib import wiring
+from amaranth.lib.wiring import Out
+
+
+class Wide(wiring.Component):
+    motor_left: Out(signed(16))
+    motor_right: Out(signed(16))
+    big: Out(60)
+    neg: Out(signed(64))
+
+    def elaborate(self, platform):
+        m = Module()
+        tick = Signal()
+        m.d.sync += tick.eq(~tick)
+        m.d.comb += [self.big.eq((1 << 59) + 1), self.neg.eq(-(1 << 62) - 1)]
+        return m
+"""
+
+
+def test_outputs_wider_than_a_float_s_53_bits_are_summarised_exactly(tmp_path):
+    # The summary's last/min/max came from the float64 trajectory column, rounded.
+    (tmp_path / "wide.py").write_text(WIDE_OUTPUTS)
+    (tmp_path / "s.toml").write_text(STRAIGHT.format(top=f"{tmp_path / 'wide.py'}:Wide"))
+    scenario = load_scenario(str(tmp_path / "s.toml"), ["sim.duration=0.2"])
+    extra = run_scenario(scenario, backend="cxxrtl").summary["extra_outputs"]
+    big, neg = 2**59 + 1, -(2**62) - 1
+    assert extra["big"] == {"last": big, "min": big, "max": big}
+    assert extra["neg"] == {"last": neg, "min": neg, "max": neg}

@@ -285,6 +285,12 @@ def test_compressed_timing_names_what_keeps_a_design_on_the_real_clock(tmp_path,
     assert "frame 0: frame_done did not rise within 20,000 edges" in err
     # Named as the scenario names the design: no --design was given.
     assert err.startswith("fpga-robotics run: error: design.top: RedFrames: frame 0: "), err
+    # One that rises before the frame's last pixel (after line 28 of 30, as a design raising
+    # it on the stream's last flag, which ends every line, does) is one line too.
+    argv = ["run", "--scenario", str(RED_FRAMES), "--set", "design.params.height=29"]
+    code, out, err = _cli([*argv, "--duration", "0.3", "--rerun", "off", "--quiet"], capsys)
+    assert (code, out) == (2, "") and err.count("\n") == 1, err
+    assert "frame 0: frame_done rose at edge 1,160, before the frame's last pixel" in err
 
 
 def test_a_frame_done_that_never_rises_is_one_line_in_real_clock_timing_too(capsys):
@@ -401,7 +407,7 @@ BAD = [
         "a function that raises",
         "broken.py:raises",
         {},
-        "building it raised ValueError: width 4 is not supported",
+        "building it raised ValueError: width 4 is not supported (broken.py:16)",
     ),
     (
         "a function returning no component",
@@ -478,6 +484,12 @@ BAD = [
         f"{DESIGNS / 'port_cases.py'}:ClkPort",
         {},
         "design 'ClkPort' has a port named 'clk', the name of the clock domain's own clock",
+    ),
+    (
+        "a port wider than the simulators take (listed as recorded, run refused the backend)",
+        f"{DESIGNS / 'port_cases.py'}:WidePort",
+        {},
+        "design 'WidePort': port 'huge' is 128 bits; the simulators take ports of at most 64",
     ),
     (
         "no file or module before the colon",
@@ -1205,3 +1217,46 @@ def test_a_shadow_beside_a_verilog_design_keeps_the_scenario_s_params(tmp_path):
     assert primary.design_params == {}
     shadow, _ = run.shadow_designs(args, primary)
     assert shadow.design_params == {"speed": 200, "stop_mm": 120}
+
+
+ASSERTS = """
+from amaranth import Module, Signal, signed
+from amaranth.hdl import Assert
+from amaranth.lib import wiring
+from amaranth.lib.wiring import In, Out
+
+
+class Asserts(wiring.Component):
+    trig: Out(1)
+    echo: In(1)
+    motor_left: Out(signed(16))
+    motor_right: Out(signed(16))
+
+    def elaborate(self, platform):
+        m = Module()
+        t = Signal(16)
+        m.d.sync += t.eq(t + 1)
+        m.d.comb += Assert(t < 100, "t too big")
+        return m
+"""
+
+
+@pytest.mark.parametrize("backend", ["cxxrtl", "verilator"])
+def test_a_failing_assert_is_left_out_by_the_compiled_backends(backend, tmp_path, capfd):
+    """As the docs say: they printed it instead, Verilator on every clock (1.8 MB in 0.2 s
+    of a run), CXXRTL once, and ran on; pysim stops at it."""
+    (tmp_path / "asserts.py").write_text(ASSERTS)
+    argv = ["run", "--scenario", str(WALL_STOP), "--design", f"{tmp_path}/asserts.py:Asserts"]
+    argv += ["--set", "design.params={}", "--duration", "0.05", "--rerun", "off", "--quiet"]
+    argv.append("--backend")
+    with pytest.raises(SystemExit) as info:
+        cli.main([*argv, backend])
+    out, err = capfd.readouterr()
+    if info.value.code == 2 and "cannot run here" in err:
+        pytest.skip(err)
+    assert info.value.code == 0, err
+    assert "too big" not in out + err
+    with pytest.raises(SystemExit) as info:
+        cli.main([*argv, "pysim"])
+    out, err = capfd.readouterr()
+    assert info.value.code == 2 and "Assertion violated: t too big" in err, err

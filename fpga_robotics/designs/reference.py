@@ -390,6 +390,7 @@ def _amaranth_spec(reference, params):
     signed = signed_ports(component)
     ports = component_ports(component)
     _check_port_names(ports, reference.rpartition(":")[2])
+    _check_port_widths(ports, reference.rpartition(":")[2])
     bindings = bindings_of(component, ports)
     extra = extra_outputs_of(ports, bindings)
     # Its own docstring only: a class without one would show wiring.Component's.
@@ -525,6 +526,21 @@ def _check_port_names(ports, name):
         raise DesignError(
             f"design {name!r} has a port named {taken[0]!r}, the name of the clock domain's "
             f"own {'clock' if taken[0] == 'clk' else 'reset'}; rename the port"
+        )
+
+
+#: The widest port the pin backends (and so every run) take: a C++ uint64_t.
+MAX_PORT_WIDTH = 64
+
+
+def _check_port_widths(ports, name):
+    """``DesignError`` if a port of design ``name`` is wider than ``MAX_PORT_WIDTH``: no run
+    could take the design, so every command says so when it resolves it."""
+    wide = next(((port, w) for port, (_, w) in ports.items() if w > MAX_PORT_WIDTH), None)
+    if wide:
+        raise DesignError(
+            f"design {name!r}: port {wide[0]!r} is {wide[1]} bits; the simulators take ports "
+            f"of at most {MAX_PORT_WIDTH} bits: split it into narrower ports"
         )
 
 
@@ -820,7 +836,8 @@ def _call(target, params, reference):
         component = target(**params)
     except USER_CODE_ERRORS as exc:  # the user's constructor may raise anything
         raise DesignError(
-            f"design {reference!r}: building it raised {type(exc).__name__}: {_first_line(exc)}"
+            f"design {reference!r}: building it raised {type(exc).__name__}: "
+            f"{_first_line(exc)}{_user_line(exc, target)}"
         ) from None
     if not isinstance(component, wiring.Component):
         raise DesignError(

@@ -174,7 +174,7 @@ def board_ports(spec, board="ulx3s-85f"):
             continue
         if port in pins_of:
             kind, pin = pins_of[port]
-            if width != 1 or "__" in port:
+            if width != 1:
                 raise UserError(
                     f"design {name}: port {port!r} (the {kind} connector's {pin}) is "
                     f"{width} bits; the board's header pins take 1-bit ports"
@@ -204,14 +204,18 @@ def board_ports(spec, board="ulx3s-85f"):
 class _BoundPorts(Elaboratable):
     """``design`` as the board top reads it: the ports its wheels and camera bindings name
     (the bindings a run uses, ``DesignSpec.bindings``) as ``motor_left``/``motor_right``,
-    ``pixels`` and ``color_sel``, every other member its own."""
+    ``pixels`` and ``color_sel``, every other member its own; a port inside an interface
+    by its Verilog name (``sonar__trig``: ``design.sonar.trig``)."""
 
     def __init__(self, design, bound):
         self._design, self._bound = design, dict(bound)
 
     def __getattr__(self, name):
         bound = self.__dict__.get("_bound", {})
-        return getattr(self.__dict__["_design"], bound.get(name, name))
+        value = self.__dict__["_design"]
+        for part in bound.get(name, name).split("__"):
+            value = value[int(part)] if part.isdigit() else getattr(value, part)
+        return value
 
     def elaborate(self, platform):
         return self._design
@@ -235,9 +239,7 @@ def _user_factory(spec):
             update_delay = spec.port_map.latency
         else:
             design = spec.build()
-            bound = {**wiring["wheels"], **wiring["camera_pins"]}
-            if any(pin != port for pin, port in bound.items()):
-                design = _BoundPorts(design, bound)
+            design = _BoundPorts(design, {**wiring["wheels"], **wiring["camera_pins"]})
             # As compressed timing reads the wheels: SETTLE_EDGES after frame_done.
             update_delay = SETTLE_EDGES
         return platform, ULX3SUserDesign(

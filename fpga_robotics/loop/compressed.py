@@ -114,14 +114,14 @@ def make_backend(name, params, *, on_build=None):
     return get_backend(name, params, on_build=on_build)
 
 
-def extra_output_stats(column):
-    """``{"last", "min", "max"}`` of an extra output's trajectory column (None where no row
-    holds a value)."""
-    values = np.asarray(column, float)
-    values = values[np.isfinite(values)]
-    if not len(values):
+def extra_output_stats(column, exact):
+    """``{"last", "min", "max"}`` (None where no row holds a value) of an extra output from
+    ``exact`` (row -> int), its rows of the trajectory ``column``: the column is float64,
+    which rounds an output of more than 53 bits."""
+    values = [value for k, value in sorted(exact.items()) if k < len(column)]
+    if not values:
         return {"last": None, "min": None, "max": None}
-    return {"last": int(values[-1]), "min": int(values.min()), "max": int(values.max())}
+    return {"last": values[-1], "min": min(values), "max": max(values)}
 
 
 def frame_count(duration_steps, frame_period, physics_dt):
@@ -200,6 +200,7 @@ class ClosedLoop:
         self.ended_early = None  # why the run stopped before its end (a tip-over), else None
         self.traj = _empty_trajectory(self.n_frames)
         self.absent = set()  # DESIGN_OUTPUTS the design does not produce
+        self.exact_extra = {}  # extra output -> {row: int}, for the summary
         self.events = []  # (frame, time_s, text)
         self.cycles = 0  # design clock edges simulated
         self.design_events = _DesignEvents(scenario.params.lost_frames)
@@ -371,6 +372,7 @@ class ClosedLoop:
                 self.traj[name][k] = value
         for name, value in (result.extra or {}).items():
             self.traj.setdefault(f"design.{name}", np.full(self.n_frames, np.nan))[k] = value
+            self.exact_extra.setdefault(name, {})[k] = int(value)
 
     def record(self, k, t, rgb, result, distance, visible, events, shadow_result=None, **extra):
         """Hand the frame to the viewer and the ``on_frame`` callback; ``extra`` are more
@@ -541,9 +543,8 @@ class ClosedLoop:
         metrics.update(self.extra_metrics())
         # The last, smallest and largest value of each output no connector reads.
         extra = {
-            name.removeprefix("design."): extra_output_stats(column)
-            for name, column in self.traj.items()
-            if name.startswith("design.")
+            name: extra_output_stats(self.traj[f"design.{name}"], self.exact_extra.get(name, {}))
+            for name in (c.removeprefix("design.") for c in self.traj if c.startswith("design."))
         }
         # On the unrounded metrics; a registered check of a design of one's own reads its
         # outputs as the summary has them.

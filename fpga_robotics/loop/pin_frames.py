@@ -75,7 +75,8 @@ class PinFrames(DesignBackend):
         timing = PixelTiming(start=start + 1, line_period=p.width)
         pins.stream_frame(packed, timing)
         pins.watch([_FRAME_STROBE])
-        deadline = timing.last_edge(p.width, p.height) + self.watchdog
+        last_pixel = timing.last_edge(p.width, p.height)
+        deadline = last_pixel + self.watchdog
         while True:
             stop = pins.run(deadline - pins.cycle)
             if stop.port is None:
@@ -84,6 +85,17 @@ class PinFrames(DesignBackend):
                     f"within {self.watchdog:,} edges (a frame period at sim.clock_hz) after "
                     f"the frame's last pixel; compressed timing reads a frame's results when "
                     f'it rises: raise it once a frame, or set sim.timing = "real_clock"'
+                )
+            if stop.value and stop.cycle < last_pixel:
+                # Read now, the results would be the last frame's, and the next frame would
+                # start while this one streams (a "last" flag rise ends every line).
+                raise DesignError(
+                    f"{self.label}: frame {self.frames_processed}: frame_done rose at edge "
+                    f"{stop.cycle - start:,}, before the frame's last pixel (edge "
+                    f"{last_pixel - start:,}); compressed timing reads a frame's results when "
+                    f"it rises: raise it once a frame, after the last pixel of line "
+                    f"{p.height - 1} (the stream's last flag ends every line), or set "
+                    f'sim.timing = "real_clock"'
                 )
             if stop.value:
                 break

@@ -595,6 +595,7 @@ class RealClockLoop(ClosedLoop):
         for name, port in self.top.extra_outputs.items():
             extra[name] = self.pins.peek(port)
             self.extra[name][row.k] = float(extra[name])
+            self.exact_extra.setdefault(name, {})[row.k] = extra[name]
         shadow = {}
         if self.shadow_pins is not None:
             events += self.compare_shadow(row)

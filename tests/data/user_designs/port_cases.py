@@ -1,5 +1,6 @@
 """Designs whose ports an export must keep as declared: outputs never driven, a port named
-after the clock, wheels under names of their own (bound by a ``connectors`` declaration)."""
+after the clock, wheels under names of their own (bound by a ``connectors`` declaration), an
+output wider than the simulators' 64 bits."""
 
 from amaranth import Module, Signal, signed
 from amaranth.lib import wiring
@@ -44,4 +45,17 @@ class OwnWheelNames(wiring.Component):
     def elaborate(self, platform):
         m = Module()
         m.d.sync += [self.wheel_l.eq(300), self.wheel_r.eq(-300)]
+        return m
+
+
+class WidePort(wiring.Component):
+    """A 128-bit debug output beside the wheels."""
+
+    motor_left: Out(signed(16))
+    motor_right: Out(signed(16))
+    huge: Out(128)
+
+    def elaborate(self, platform):
+        m = Module()
+        m.d.sync += self.huge.eq(self.huge + 1)
         return m
