@@ -346,6 +346,24 @@ def test_stop_overshoot_na_says_why(params, colour, reason):
     assert c["status"] == "n/a" and c["reason"] == reason
 
 
+@pytest.mark.parametrize(
+    "exposure_s, unsure",
+    [
+        (0.0, "the suit's colour is not sure to match at every shade of the scenario's light"),
+        (1 / 30, "camera.sensor's exposure and white balance move the suit's colour"),
+    ],
+)
+def test_stop_overshoot_na_when_no_band_is_sure_to_match(exposure_s, unsure):
+    # Red may match (the upper bound reaches the stopping level within 1.745 m) but no band
+    # surely does: the law may well stop, only not at a distance the bounds can say.
+    geom = dataclasses.replace(GEOM, bands_sure={c: [] for c in range(8)}, exposure_s=exposure_s)
+    assert stop_distance_m(geom, DEFAULT, RED) == (None, stop_distance_m(GEOM, DEFAULT, RED)[1])
+    traj = _on_the_axis([0.0, 0.3, 0.6, 0.7, 0.6], [2.0] * 5)
+    (c,) = evaluate_checks({"max_stop_overshoot_m": 0.05}, envelope_metrics(traj, DEFAULT, geom))
+    assert c["status"] == "n/a"
+    assert c["reason"] == f"the stop distance cannot be bounded: {unsure}"
+
+
 def test_stop_overshoot_of_a_robot_put_inside_the_stop_distance():
     """approach with the person 1.0 m ahead (centres): the camera, 0.1 m ahead of the
     centre, starts 0.9 m from them, inside the 1.14 m stop distance, and the design backs

@@ -311,7 +311,8 @@ _STOP_DISTANCES = {}
 def stop_distance_m(geom, params, code):
     """``(near, far)``: within ``near`` m (camera to the target's centre, target straight
     ahead) the law surely says stop or reverse; beyond ``far`` it surely drives forward.
-    None when the law never stops or the bounds never reach its level."""
+    None when the law never stops or the count may never reach its level; ``near`` None when
+    the count may reach it but nowhere surely (no band of the colour sure to match)."""
     key = (repr(geom), params, code)
     if key not in _STOP_DISTANCES:
         if len(_STOP_DISTANCES) >= 256:
@@ -334,9 +335,9 @@ def _stop_distance(geom, params, code):
             near = float(d)
         if b[1] >= threshold:
             far = float(d)
-    if near is None or far is None:
+    if far is None:
         return None
-    return round(near, 3), round(far, 3)
+    return (None if near is None else round(near, 3)), round(far, 3)
 
 
 def _camera_view(traj, geom):
@@ -406,7 +407,7 @@ def envelope_metrics(traj, params, geom):
     speed, reverse, steer = [], [], []
     # The stop distance of the colour each frame follows (None: that colour never stops).
     stops = {c: stop_distance_m(geom, params, c) for c in {int(c) for c in codes[found]}}
-    near = np.array([(stops.get(int(c)) or (math.nan,))[0] for c in codes])
+    near = np.array([_or_nan((stops.get(int(c)) or (None,))[0]) for c in codes])
     far = np.array([(stops.get(int(c)) or (math.nan, math.nan))[1] for c in codes])
     own = _own_depth(traj, dist, near)
     came_near, judged_stop = False, []
@@ -471,9 +472,22 @@ def envelope_metrics(traj, params, geom):
             "the law never stops for the colour followed (its count never reaches the "
             "stopping level's threshold)"
         )
+    elif stops and not any(s and s[0] for s in stops.values()):
+        # The count may reach the stopping level, but no band is sure to count: where the
+        # law stops depends on how much of the suit matches, which the bounds cannot say.
+        unsure = (
+            "camera.sensor's exposure and white balance move the suit's colour"
+            if geom.exposure_s
+            else "the suit's colour is not sure to match at every shade of the scenario's light"
+        )
+        out["stop_reason"] = f"the stop distance cannot be bounded: {unsure}"
     else:
         out["stop_reason"] = "the robot never came near the stop distance"
     return out
+
+
+def _or_nan(x):
+    return math.nan if x is None else x
 
 
 def _own_depth(traj, dist, near):
