@@ -505,6 +505,25 @@ def test_search_side_tolerates_the_smear_of_a_turn():
         assert m["search_law_violation_fraction"] == judged_wrong / (14 + judged_wrong)
 
 
+def test_search_side_of_a_lit_strip_is_sure_only_off_the_silhouette():
+    # 1 m ahead, 0.05 m left: half-angle asin(0.2) = 0.2014 rad around a bearing of 0.05 rad,
+    # columns 80 - 160 tan(0.2514) = 38.9 to 80 + 160 tan(0.1514) = 104.4, middle 71.6 (left
+    # of the centre). With every band sure to match the search turns left; with red matching
+    # only in some light, a lit strip may be anywhere on 38.9..104.4, across the centre: no
+    # sure side. 4 m ahead, 0.3 m left (columns 59.9..76.1) it is left either way.
+    strip = dataclasses.replace(GEOM, bands_sure={c: [] for c in range(8)})
+    for distance, y, geom, judged_wrong in (
+        (1.0, 0.05, GEOM, 5),
+        (1.0, 0.05, strip, 0),
+        (4.0, 0.3, strip, 5),
+    ):
+        wrong = [(True, y, 0, 0)] + [(False, y, 0, 0)] * 14 + [(False, y, 250, -250)] * 5
+        traj = _traj(wrong)
+        traj["target_x"][:] = distance
+        m = envelope_metrics(traj, DEFAULT, geom)
+        assert m["search_law_violation_fraction"] == judged_wrong / (14 + judged_wrong)
+
+
 def test_camera_noise_beyond_the_bounds_slack_leaves_the_envelopes_na():
     """lost_target's shaded suit at noise 10 loses enough pixels to the filter that its count
     leaves the bounds (the correct design's level 5 where they allow 6): n/a with the

@@ -449,7 +449,12 @@ def envelope_metrics(traj, params, geom):
     side_tol = np.full(len(found), E_TOLERANCE_PX)
     if geom.exposure_s and "w" in traj:
         side_tol += np.abs(np.asarray(traj["w"], float)) * geom.exposure_s * geom.focal / 2
-    search = _search_judged(found, ml, mr, dist, bearing, geom, params, side_tol, interlocked)
+    # A sighting of a colour that may match only a lit strip of the suit puts the centroid
+    # anywhere on the silhouette, as for the turn law above.
+    lit_strip = np.array([geom.bands_maybe[int(c)] != geom.bands_sure[int(c)] for c in codes])
+    search = _search_judged(
+        found, ml, mr, dist, bearing, geom, params, side_tol, lit_strip, interlocked
+    )
     for name, fraction, judged in (
         ("approach_speed", "approach_speed_violation_fraction", speed),
         ("reverse_when_far", "reverse_when_far_fraction", reverse),
@@ -509,12 +514,13 @@ def _own_depth(traj, dist, near):
     return own
 
 
-def _search_judged(found, ml, mr, dist, bearing, geom, params, side_tol, interlocked):
+def _search_judged(found, ml, mr, dist, bearing, geom, params, side_tol, lit_strip, interlocked):
     """Per judged lost frame ``(frame, broke the law, [L, R] seen, [L, R] the law's)``, the
     lost law being: hold the last command
     for lost frames 1..lost_frames-1, then turn in place at ``search_dps`` towards the side the
     target was last seen on (left after reset). A sighting within ``E_TOLERANCE_PX`` of the
-    image centre has no sure side (``sure_side``): its search frames are not judged, nor are
+    image centre, or of a ``lit_strip`` colour with the silhouette across the centre, has no
+    sure side (``sure_side``): its search frames are not judged, nor are
     the ``interlocked`` frames, nor the hold of a loss that began with the interlock holding
     the wheels (the command held is then not the one seen)."""
     out = []
@@ -522,7 +528,9 @@ def _search_judged(found, ml, mr, dist, bearing, geom, params, side_tol, interlo
     for k in range(len(found)):
         if found[k]:
             lost = 0
-            side = sure_side(float(dist[k]), float(bearing[k]), geom, params, side_tol[k])
+            side = sure_side(
+                float(dist[k]), float(bearing[k]), geom, params, side_tol[k], lit_strip[k]
+            )
             continue
         if lost == 0:  # the command shown when the loss began is the one to hold
             if k == 0:
@@ -541,15 +549,16 @@ def _search_judged(found, ml, mr, dist, bearing, geom, params, side_tol, interlo
     return out
 
 
-def sure_side(distance, bearing, geom, params, tol=E_TOLERANCE_PX):
+def sure_side(distance, bearing, geom, params, tol=E_TOLERANCE_PX, lit_strip=False):
     """The side of the image centre the design's centroid surely falls on with the target
     at ``distance`` (m) and ``bearing`` (rad, left positive): +1 right, -1 left, 0 not sure.
 
     The centroid is the mean column of the target's pixels inside the window's columns. With
     the whole silhouette there it lies within ``tol`` pixels of the silhouette's middle;
     with part of the silhouette beyond the window's edge (a target leaving the view, the
-    usual last sighting before a loss) it lies somewhere in the part inside, so the side is
-    sure only when all of that part is on one side."""
+    usual last sighting before a loss), or with only a lit strip of the suit matching
+    (``lit_strip``), it lies somewhere in the part inside, so the side is sure only when all
+    of that part is on one side."""
     if not math.isfinite(distance) or distance <= geom.radius:
         return 0
     if abs(bearing) + math.asin(geom.radius / distance) >= math.pi / 2 - 1e-6:
@@ -557,7 +566,7 @@ def sure_side(distance, bearing, geom, params, tol=E_TOLERANCE_PX):
     left, right = silhouette(distance, bearing, geom)
     edge_lo, edge_hi = window_columns(geom.width, params.margin_x)
     centre = geom.width / 2
-    if whole_in_window(left, right, geom.width, params.margin_x):
+    if whole_in_window(left, right, geom.width, params.margin_x) and not lit_strip:
         offset = (left + right) / 2 - centre
         if abs(offset) <= tol:
             return 0
