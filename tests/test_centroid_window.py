@@ -125,6 +125,10 @@ def test_a_lit_strip_is_away_only_off_the_part_of_the_silhouette_inside():
     assert m["off_target_fraction"] == pytest.approx(1 / 3)
     m = compute_metrics(traj, [], {}, 1 / 30, width=W, margin_x=16)
     assert m["off_target_fraction"] == 1.0
+    # The same with part of the suit hidden behind furniture or a person instead.
+    traj["target_hidden"] = np.ones(3, bool)
+    m = compute_metrics(traj, [], {}, 1 / 30, width=W, margin_x=16)
+    assert m["off_target_fraction"] == pytest.approx(1 / 3)
 
 
 def test_a_darker_suit_lit_from_one_side_passes_with_the_golden_model():

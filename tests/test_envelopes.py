@@ -524,6 +524,61 @@ def test_search_side_of_a_lit_strip_is_sure_only_off_the_silhouette():
         assert m["search_law_violation_fraction"] == judged_wrong / (14 + judged_wrong)
 
 
+def test_a_partly_hidden_target_leaves_the_count_and_centroid_unsure():
+    # At 4 m straight ahead the count allows level 3 only (200 DPS forward, no turn). With
+    # part of the target hidden (``target_hidden``) any count up to the upper bound may be
+    # seen: levels 0..3, 0..400 DPS forward; the centroid anywhere on the silhouette
+    # (72.0..88.0, e -8..8 +- 2 px): turns of 3 * -10 .. 3 * 10 DPS allowed, not only
+    # 3 * -2 .. 3 * 2.
+    frames = [(True, 0.0, 320, 280), (True, 0.0, 150, 150), (True, 0.0, 400, 400)]
+    traj = _traj(frames)
+    m = envelope_metrics(traj, DEFAULT, GEOM)
+    assert m["approach_speed_violation_fraction"] == 1.0
+    assert m["turn_law_violation_fraction"] == 1 / 3
+    traj["target_hidden"] = np.ones(3, bool)
+    m = envelope_metrics(traj, DEFAULT, GEOM)
+    assert m["approach_speed_violation_fraction"] == 0.0
+    assert m["turn_law_violation_fraction"] == 0.0
+    # Reversing while far is still judged: a hidden part only lowers the count.
+    traj = _traj([(True, 0.0, -100, -100)])
+    traj["target_hidden"] = np.ones(1, bool)
+    assert envelope_metrics(traj, DEFAULT, GEOM)["reverse_when_far_fraction"] == 1.0
+
+
+CABINET = (
+    "room.furniture=[{name='cabinet', type='box', center=[3.5, 3.0], size=[0.6, 1.2], height=1.8}]"
+)
+
+
+def test_a_target_passing_behind_a_cabinet_is_not_judged_by_its_hidden_part():
+    """The robot faces a 1.8 m tall cabinet (x 3.2..3.8, y 2.4..3.6) with the target standing
+    behind it, then walking out along x = 5.5: the envelopes judge the frames in which the
+    cabinet's corner eats into the target's silhouette with the count and centroid unsure,
+    and the default design keeps its laws."""
+    s = load_scenario(
+        "approach",
+        [
+            CABINET,
+            "people.0.waypoints=[[5.5, 3.0], [5.5, 5.0]]",
+            "people.0.speed=0.4",
+            "people.0.start_delay=4.0",
+            "people.0.pause=3.0",
+            "sim.duration=15",
+            "checks.max_approach_speed_violation_fraction=0.0",
+            "checks.max_turn_law_violation_fraction=0.0",
+        ],
+    )
+    r = run_scenario(s, backend="model")
+    hidden, t = r.trajectory["target_hidden"], r.trajectory["t"]
+    # Straight behind the cabinet, taller than the camera, while the robot looks at it from
+    # about 1.6 m (its face 0.36 rad either side of the axis, the target's silhouette 0.05).
+    assert hidden[t < 1.0].all()
+    assert not hidden.all()
+    checks = {c["name"]: c for c in r.summary["checks"]}
+    assert checks["max_approach_speed_violation_fraction"]["passed"]
+    assert checks["max_turn_law_violation_fraction"]["passed"]
+
+
 def test_camera_noise_beyond_the_bounds_slack_leaves_the_envelopes_na():
     """lost_target's shaded suit at noise 10 loses enough pixels to the filter that its count
     leaves the bounds (the correct design's level 5 where they allow 6): n/a with the

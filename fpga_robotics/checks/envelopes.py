@@ -25,8 +25,12 @@ those bands. Stated tolerances (nothing tuned to a run):
   white balance move its colour) and the turn's smear over a frame's exposure adds half its
   length to the centroid's tolerance;
 - only frames with the whole silhouette inside the window's columns are judged, with the
-  target assumed the only thing of its colour in view and not hidden (another adds pixels,
-  an occluder removes them: the robustness campaign's known limits show where that fails).
+  target assumed the only thing of its colour in view (another adds pixels: the robustness
+  campaign's known limits show where that fails);
+- in a frame where furniture, a divider or another person hides part of the target (the
+  trajectory's ``target_hidden``) the count may be anything from 0 to its upper bound and
+  the centroid anywhere on the silhouette, as for a lit strip; such a frame does not judge
+  the stop distance.
 
 The bounds do not model the plain camera's noise: it is small enough for their slack up to
 ``NOISE_STD_MODELLED``, and beyond it the envelopes are n/a.
@@ -403,6 +407,9 @@ def envelope_metrics(traj, params, geom):
     codes = np.asarray(traj["color_sel"], np.int64)
     # On a ramp the camera pitches with the robot: each frame's rows are drawn at its tilt.
     tilts = np.asarray(traj.get("camera_tilt", np.full(len(codes), geom.tilt)), float)
+    # Furniture or a person between the camera and part of the target (``target_hidden``)
+    # takes pixels off the count and moves the centroid anywhere on the silhouette.
+    hidden = np.asarray(traj.get("target_hidden", np.zeros(len(codes))), bool)
     w, centred_px = geom.width, geom.width * CENTRED_PX_FRACTION
     speed, reverse, steer = [], [], []
     # The stop distance of the colour each frame follows (None: that colour never stops).
@@ -419,6 +426,8 @@ def envelope_metrics(traj, params, geom):
         bounds = count_bounds(float(dist[k]), float(bearing[k]), code, frame_geom, params)
         if bounds is None:
             continue
+        if hidden[k]:
+            bounds = (0, bounds[1])
         levels = range(
             proximity_level(bounds[0], params.proximity_thresholds),
             proximity_level(bounds[1], params.proximity_thresholds) + 1,
@@ -426,8 +435,9 @@ def envelope_metrics(traj, params, geom):
         left, right = silhouette(float(dist[k]), float(bearing[k]), geom)
         column = (left + right) / 2 - 0.5  # the pixel index the centre falls on
         tol = E_TOLERANCE_PX
-        if geom.bands_maybe[code] != geom.bands_sure[code]:
-            # Only a lit strip may match, anywhere up to the silhouette's edge.
+        if geom.bands_maybe[code] != geom.bands_sure[code] or hidden[k]:
+            # Only a lit strip, or the part not hidden, may match, anywhere up to the
+            # silhouette's edge.
             tol += (right - left) / 2
         if geom.exposure_s and "w" in traj:  # half the smear of a turn during the exposure
             tol += abs(float(traj["w"][k])) * geom.exposure_s * geom.focal / 2
@@ -441,7 +451,7 @@ def envelope_metrics(traj, params, geom):
             if f_lo >= 0:
                 reverse.append((k, fwd[k] < 0, fwd[k], [f_lo, f_hi], where))
             steer.append((k, not t_lo <= turn[k] <= t_hi, turn[k], [t_lo, t_hi], where))
-        if abs(bearing[k]) < geom.hfov / 2 and math.isfinite(near[k]):
+        if abs(bearing[k]) < geom.hfov / 2 and math.isfinite(near[k]) and not hidden[k]:
             judged_stop.append(k)
             came_near = came_near or dist[k] <= far[k]
     # A sighting's side, like the centroid error, gets half the smear of a turn during the
@@ -452,6 +462,7 @@ def envelope_metrics(traj, params, geom):
     # A sighting of a colour that may match only a lit strip of the suit puts the centroid
     # anywhere on the silhouette, as for the turn law above.
     lit_strip = np.array([geom.bands_maybe[int(c)] != geom.bands_sure[int(c)] for c in codes])
+    lit_strip |= hidden
     search = _search_judged(
         found, ml, mr, dist, bearing, geom, params, side_tol, lit_strip, interlocked
     )

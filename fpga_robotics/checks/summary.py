@@ -151,8 +151,14 @@ def compute_metrics(
     lit_strip : numpy bool array, optional
         Per frame, whether the target's suit may match the colour filter only where it is
         lit (``envelopes.lit_strip_frames``): the centroid checks there measure from the
-        part of the silhouette inside the window, not from its middle.
+        part of the silhouette inside the window, not from its middle; so do they in the
+        frames in which the trajectory's ``target_hidden`` says something hides part of it.
     """
+    if "target_hidden" in traj:
+        # Part of the target hidden behind furniture or a person: the centroid of what is
+        # seen lies anywhere on the silhouette, as for a lit strip.
+        hidden = np.asarray(traj["target_hidden"], bool)
+        lit_strip = hidden if lit_strip is None else np.asarray(lit_strip, bool) | hidden
     absent = [name for name in DESIGN_OUTPUTS if name in set(absent)]
     if absent:
         present = {k: v for k, v in traj.items() if k not in absent}
