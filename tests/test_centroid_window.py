@@ -116,6 +116,21 @@ def test_a_lit_strip_is_judged_by_the_part_of_the_silhouette_inside():
     assert m["mean_centroid_error_px"] == pytest.approx(40 / 3)
 
 
+def test_a_lit_strip_is_away_only_off_the_part_of_the_silhouette_inside():
+    # A suit 80 px wide (40..120): the centroid of its lit side 35 px right of its middle,
+    # of the other side 35 px left, both on the suit; then 25 px beyond its right edge,
+    # more than an eighth of the width (20 px) off the suit: another object's pixels.
+    traj = _traj(column=[80] * 3, left=[40] * 3, right=[120] * 3, centroid=[115, 45, 145])
+    m = compute_metrics(traj, [], {}, 1 / 30, width=W, margin_x=16, lit_strip=np.ones(3, bool))
+    assert m["off_target_fraction"] == pytest.approx(1 / 3)
+    m = compute_metrics(traj, [], {}, 1 / 30, width=W, margin_x=16)
+    assert m["off_target_fraction"] == 1.0
+    # The same with part of the suit hidden behind furniture or a person instead.
+    traj["target_hidden"] = np.ones(3, bool)
+    m = compute_metrics(traj, [], {}, 1 / 30, width=W, margin_x=16)
+    assert m["off_target_fraction"] == pytest.approx(1 / 3)
+
+
 def test_a_darker_suit_lit_from_one_side_passes_with_the_golden_model():
     # A darker red matches only on its lit side: the design's centroid sits ~5 px off the
     # person's axis, within the silhouette.
@@ -244,18 +259,24 @@ def test_the_divider_taken_for_the_person_still_fails():
     assert "max_off_target_fraction" in _failed(s)
 
 
-def test_the_wood_taken_for_a_person_cut_by_the_window_still_fails():
+def test_a_lit_strip_of_a_person_cut_by_the_window_is_not_off_target():
     # A loose filter in dim light (filter_tuning's cell diff_min 5, ambient 0.25, seed 3): at
     # the end of the run the person stands 0.8 m away, cut by the window's right edge (the part
-    # inside is about columns 65..144, its middle about 104), while the design's centroid sits
-    # near column 75, pulled to the wood. Those frames count: leaving cut sightings out would
-    # pass this run (under 5% off target in the whole ones).
+    # inside about columns 65..144, its middle about 104), and the design's centroid sits near
+    # column 75. That is the suit's lit side, not the wooden divider: without the divider the
+    # run is the same frame for frame. Only a lit strip of the suit matches in this light, so
+    # a centroid on the part inside is not away.
     overrides = ["lighting.keyframes=[]", "design.diff_min=5", "lighting.ambient=0.25"]
     r = run_scenario(load_scenario("divider", overrides), seed=3, backend="model")
+    bare = run_scenario(
+        load_scenario("divider", [*overrides, "room.furniture=[]"]), seed=3, backend="model"
+    )
     traj, s = r.trajectory, r.summary
+    np.testing.assert_array_equal(traj["centroid_x"], bare.trajectory["centroid_x"])
     seen, whole = _sightings(traj)
     cut = seen & ~whole
     late = cut & (np.arange(len(cut)) > len(cut) - 40)
     assert late.sum() >= 20 and (traj["centroid_x"][late] < 80).all()
-    assert s["off_target_fraction"] > 0.05
-    assert "max_off_target_fraction" in _failed(s)
+    assert (traj["centroid_x"][late] > traj["target_left"][late]).all()
+    assert s["off_target_fraction"] == 0.0
+    assert "max_off_target_fraction" not in _failed(s)

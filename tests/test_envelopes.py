@@ -346,6 +346,24 @@ def test_stop_overshoot_na_says_why(params, colour, reason):
     assert c["status"] == "n/a" and c["reason"] == reason
 
 
+@pytest.mark.parametrize(
+    "exposure_s, unsure",
+    [
+        (0.0, "the suit's colour is not sure to match at every shade of the scenario's light"),
+        (1 / 30, "camera.sensor's exposure and white balance move the suit's colour"),
+    ],
+)
+def test_stop_overshoot_na_when_no_band_is_sure_to_match(exposure_s, unsure):
+    # Red may match (the upper bound reaches the stopping level within 1.745 m) but no band
+    # surely does: the law may well stop, only not at a distance the bounds can say.
+    geom = dataclasses.replace(GEOM, bands_sure={c: [] for c in range(8)}, exposure_s=exposure_s)
+    assert stop_distance_m(geom, DEFAULT, RED) == (None, stop_distance_m(GEOM, DEFAULT, RED)[1])
+    traj = _on_the_axis([0.0, 0.3, 0.6, 0.7, 0.6], [2.0] * 5)
+    (c,) = evaluate_checks({"max_stop_overshoot_m": 0.05}, envelope_metrics(traj, DEFAULT, geom))
+    assert c["status"] == "n/a"
+    assert c["reason"] == f"the stop distance cannot be bounded: {unsure}"
+
+
 def test_stop_overshoot_of_a_robot_put_inside_the_stop_distance():
     """approach with the person 1.0 m ahead (centres): the camera, 0.1 m ahead of the
     centre, starts 0.9 m from them, inside the 1.14 m stop distance, and the design backs
@@ -485,6 +503,80 @@ def test_search_side_tolerates_the_smear_of_a_turn():
         traj["w"] = np.full(len(wrong), w)
         m = envelope_metrics(traj, DEFAULT, sensor)
         assert m["search_law_violation_fraction"] == judged_wrong / (14 + judged_wrong)
+
+
+def test_search_side_of_a_lit_strip_is_sure_only_off_the_silhouette():
+    # 1 m ahead, 0.05 m left: half-angle asin(0.2) = 0.2014 rad around a bearing of 0.05 rad,
+    # columns 80 - 160 tan(0.2514) = 38.9 to 80 + 160 tan(0.1514) = 104.4, middle 71.6 (left
+    # of the centre). With every band sure to match the search turns left; with red matching
+    # only in some light, a lit strip may be anywhere on 38.9..104.4, across the centre: no
+    # sure side. 4 m ahead, 0.3 m left (columns 59.9..76.1) it is left either way.
+    strip = dataclasses.replace(GEOM, bands_sure={c: [] for c in range(8)})
+    for distance, y, geom, judged_wrong in (
+        (1.0, 0.05, GEOM, 5),
+        (1.0, 0.05, strip, 0),
+        (4.0, 0.3, strip, 5),
+    ):
+        wrong = [(True, y, 0, 0)] + [(False, y, 0, 0)] * 14 + [(False, y, 250, -250)] * 5
+        traj = _traj(wrong)
+        traj["target_x"][:] = distance
+        m = envelope_metrics(traj, DEFAULT, geom)
+        assert m["search_law_violation_fraction"] == judged_wrong / (14 + judged_wrong)
+
+
+def test_a_partly_hidden_target_leaves_the_count_and_centroid_unsure():
+    # At 4 m straight ahead the count allows level 3 only (200 DPS forward, no turn). With
+    # part of the target hidden (``target_hidden``) any count up to the upper bound may be
+    # seen: levels 0..3, 0..400 DPS forward; the centroid anywhere on the silhouette
+    # (72.0..88.0, e -8..8 +- 2 px): turns of 3 * -10 .. 3 * 10 DPS allowed, not only
+    # 3 * -2 .. 3 * 2.
+    frames = [(True, 0.0, 320, 280), (True, 0.0, 150, 150), (True, 0.0, 400, 400)]
+    traj = _traj(frames)
+    m = envelope_metrics(traj, DEFAULT, GEOM)
+    assert m["approach_speed_violation_fraction"] == 1.0
+    assert m["turn_law_violation_fraction"] == 1 / 3
+    traj["target_hidden"] = np.ones(3, bool)
+    m = envelope_metrics(traj, DEFAULT, GEOM)
+    assert m["approach_speed_violation_fraction"] == 0.0
+    assert m["turn_law_violation_fraction"] == 0.0
+    # Reversing while far is still judged: a hidden part only lowers the count.
+    traj = _traj([(True, 0.0, -100, -100)])
+    traj["target_hidden"] = np.ones(1, bool)
+    assert envelope_metrics(traj, DEFAULT, GEOM)["reverse_when_far_fraction"] == 1.0
+
+
+CABINET = (
+    "room.furniture=[{name='cabinet', type='box', center=[3.5, 3.0], size=[0.6, 1.2], height=1.8}]"
+)
+
+
+def test_a_target_passing_behind_a_cabinet_is_not_judged_by_its_hidden_part():
+    """The robot faces a 1.8 m tall cabinet (x 3.2..3.8, y 2.4..3.6) with the target standing
+    behind it, then walking out along x = 5.5: the envelopes judge the frames in which the
+    cabinet's corner eats into the target's silhouette with the count and centroid unsure,
+    and the default design keeps its laws."""
+    s = load_scenario(
+        "approach",
+        [
+            CABINET,
+            "people.0.waypoints=[[5.5, 3.0], [5.5, 5.0]]",
+            "people.0.speed=0.4",
+            "people.0.start_delay=4.0",
+            "people.0.pause=3.0",
+            "sim.duration=15",
+            "checks.max_approach_speed_violation_fraction=0.0",
+            "checks.max_turn_law_violation_fraction=0.0",
+        ],
+    )
+    r = run_scenario(s, backend="model")
+    hidden, t = r.trajectory["target_hidden"], r.trajectory["t"]
+    # Straight behind the cabinet, taller than the camera, while the robot looks at it from
+    # about 1.6 m (its face 0.36 rad either side of the axis, the target's silhouette 0.05).
+    assert hidden[t < 1.0].all()
+    assert not hidden.all()
+    checks = {c["name"]: c for c in r.summary["checks"]}
+    assert checks["max_approach_speed_violation_fraction"]["passed"]
+    assert checks["max_turn_law_violation_fraction"]["passed"]
 
 
 def test_camera_noise_beyond_the_bounds_slack_leaves_the_envelopes_na():

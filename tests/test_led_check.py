@@ -46,6 +46,20 @@ def test_leds_on_the_other_half_or_outer_leds_at_the_centre_are_wrong():
     assert not c["passed"]
 
 
+def test_a_lit_strip_across_the_centre_has_no_side():
+    # Suits whose columns 102 and 58 are 22 px off the centre, of which only a lit strip may
+    # match: one spanning 60..144 (across the centre, so a left LED is no fault) and one
+    # 4..52 cut by the window at 16 (wholly left: a right LED is wrong); a suit 72..88 at the
+    # centre, its centroid within 8 px: an outer LED is wrong.
+    traj = _traj([102, 102, 58, 82], [0b1, 0b1000_0000, 0b1000_0000, 0b1000_0000])
+    traj["target_left"] = np.array([60.0, 60.0, 4.0, 72.0])
+    traj["target_right"] = np.array([144.0, 144.0, 52.0, 88.0])
+    m = compute_metrics(traj, [], {}, 1 / 30, width=W, lit_strip=np.ones(4, bool))
+    assert m["led_wrong_side_fraction"] == 1.0  # the last two, judged; the first two not
+    m = compute_metrics(traj, [], {}, 1 / 30, width=W)
+    assert m["led_wrong_side_fraction"] == 3 / 4  # by the middle: the first one is wrong
+
+
 def test_not_judged_without_found_frames_or_without_the_leds():
     m = compute_metrics(_traj([120, 30], [0b1, 0b1], found=False), [], {}, 1 / 30, width=W)
     assert m["led_wrong_side_fraction"] is None

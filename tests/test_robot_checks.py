@@ -71,6 +71,20 @@ def test_the_lit_led_must_be_the_one_above_the_target():
     assert not c["passed"] and "50.0% of the frames judged" in c["text"]
 
 
+def test_a_lit_strip_may_light_the_led_above_any_column_of_the_suit():
+    # A suit from column 40 to 100 (middle 70, bin 3) of which only a lit strip may match:
+    # the centroid anywhere on it, so bits 1 (32..47) to 5 (96..111) are right, and the
+    # middle pair (the centre, 80, is on it); bit 6 (112..127, 12 px beyond its edge) is not.
+    traj = _traj([70] * 5, [0b10, 0b10_0000, 0b1_1000, 0b100_0000, 0b1])
+    traj["target_left"], traj["target_right"] = np.full(5, 40.0), np.full(5, 100.0)
+    lit = np.ones(5, bool)
+    m = compute_metrics(traj, [], {}, 1 / 30, width=W, lit_strip=lit)
+    assert m["led_misplaced_fraction"] == pytest.approx(2 / 5)
+    # Judged by the suit's middle, as when every band matches surely: only bit 3 is right.
+    m = compute_metrics(traj, [], {}, 1 / 30, width=W)
+    assert m["led_misplaced_fraction"] == 1.0
+
+
 def test_the_led_bins_follow_the_design_window():
     # margin 32: the window is 32..127, bins of 12 columns; column 40 is in bin 0 (32..43),
     # 4 px from the border at 44: bit 0 or bit 1; column 62 is in bin 2 (56..67), 6 px from

@@ -25,8 +25,12 @@ those bands. Stated tolerances (nothing tuned to a run):
   white balance move its colour) and the turn's smear over a frame's exposure adds half its
   length to the centroid's tolerance;
 - only frames with the whole silhouette inside the window's columns are judged, with the
-  target assumed the only thing of its colour in view and not hidden (another adds pixels,
-  an occluder removes them: the robustness campaign's known limits show where that fails).
+  target assumed the only thing of its colour in view (another adds pixels: the robustness
+  campaign's known limits show where that fails);
+- in a frame where furniture, a divider or another person hides part of the target (the
+  trajectory's ``target_hidden``) the count may be anything from 0 to its upper bound and
+  the centroid anywhere on the silhouette, as for a lit strip; such a frame does not judge
+  the stop distance.
 
 The bounds do not model the plain camera's noise: it is small enough for their slack up to
 ``NOISE_STD_MODELLED``, and beyond it the envelopes are n/a.
@@ -311,7 +315,8 @@ _STOP_DISTANCES = {}
 def stop_distance_m(geom, params, code):
     """``(near, far)``: within ``near`` m (camera to the target's centre, target straight
     ahead) the law surely says stop or reverse; beyond ``far`` it surely drives forward.
-    None when the law never stops or the bounds never reach its level."""
+    None when the law never stops or the count may never reach its level; ``near`` None when
+    the count may reach it but nowhere surely (no band of the colour sure to match)."""
     key = (repr(geom), params, code)
     if key not in _STOP_DISTANCES:
         if len(_STOP_DISTANCES) >= 256:
@@ -334,9 +339,9 @@ def _stop_distance(geom, params, code):
             near = float(d)
         if b[1] >= threshold:
             far = float(d)
-    if near is None or far is None:
+    if far is None:
         return None
-    return round(near, 3), round(far, 3)
+    return (None if near is None else round(near, 3)), round(far, 3)
 
 
 def _camera_view(traj, geom):
@@ -402,11 +407,14 @@ def envelope_metrics(traj, params, geom):
     codes = np.asarray(traj["color_sel"], np.int64)
     # On a ramp the camera pitches with the robot: each frame's rows are drawn at its tilt.
     tilts = np.asarray(traj.get("camera_tilt", np.full(len(codes), geom.tilt)), float)
+    # Furniture or a person between the camera and part of the target (``target_hidden``)
+    # takes pixels off the count and moves the centroid anywhere on the silhouette.
+    hidden = np.asarray(traj.get("target_hidden", np.zeros(len(codes))), bool)
     w, centred_px = geom.width, geom.width * CENTRED_PX_FRACTION
     speed, reverse, steer = [], [], []
     # The stop distance of the colour each frame follows (None: that colour never stops).
     stops = {c: stop_distance_m(geom, params, c) for c in {int(c) for c in codes[found]}}
-    near = np.array([(stops.get(int(c)) or (math.nan,))[0] for c in codes])
+    near = np.array([_or_nan((stops.get(int(c)) or (None,))[0]) for c in codes])
     far = np.array([(stops.get(int(c)) or (math.nan, math.nan))[1] for c in codes])
     own = _own_depth(traj, dist, near)
     came_near, judged_stop = False, []
@@ -418,6 +426,8 @@ def envelope_metrics(traj, params, geom):
         bounds = count_bounds(float(dist[k]), float(bearing[k]), code, frame_geom, params)
         if bounds is None:
             continue
+        if hidden[k]:
+            bounds = (0, bounds[1])
         levels = range(
             proximity_level(bounds[0], params.proximity_thresholds),
             proximity_level(bounds[1], params.proximity_thresholds) + 1,
@@ -425,8 +435,9 @@ def envelope_metrics(traj, params, geom):
         left, right = silhouette(float(dist[k]), float(bearing[k]), geom)
         column = (left + right) / 2 - 0.5  # the pixel index the centre falls on
         tol = E_TOLERANCE_PX
-        if geom.bands_maybe[code] != geom.bands_sure[code]:
-            # Only a lit strip may match, anywhere up to the silhouette's edge.
+        if geom.bands_maybe[code] != geom.bands_sure[code] or hidden[k]:
+            # Only a lit strip, or the part not hidden, may match, anywhere up to the
+            # silhouette's edge.
             tol += (right - left) / 2
         if geom.exposure_s and "w" in traj:  # half the smear of a turn during the exposure
             tol += abs(float(traj["w"][k])) * geom.exposure_s * geom.focal / 2
@@ -440,7 +451,7 @@ def envelope_metrics(traj, params, geom):
             if f_lo >= 0:
                 reverse.append((k, fwd[k] < 0, fwd[k], [f_lo, f_hi], where))
             steer.append((k, not t_lo <= turn[k] <= t_hi, turn[k], [t_lo, t_hi], where))
-        if abs(bearing[k]) < geom.hfov / 2 and math.isfinite(near[k]):
+        if abs(bearing[k]) < geom.hfov / 2 and math.isfinite(near[k]) and not hidden[k]:
             judged_stop.append(k)
             came_near = came_near or dist[k] <= far[k]
     # A sighting's side, like the centroid error, gets half the smear of a turn during the
@@ -448,7 +459,13 @@ def envelope_metrics(traj, params, geom):
     side_tol = np.full(len(found), E_TOLERANCE_PX)
     if geom.exposure_s and "w" in traj:
         side_tol += np.abs(np.asarray(traj["w"], float)) * geom.exposure_s * geom.focal / 2
-    search = _search_judged(found, ml, mr, dist, bearing, geom, params, side_tol, interlocked)
+    # A sighting of a colour that may match only a lit strip of the suit puts the centroid
+    # anywhere on the silhouette, as for the turn law above.
+    lit_strip = np.array([geom.bands_maybe[int(c)] != geom.bands_sure[int(c)] for c in codes])
+    lit_strip |= hidden
+    search = _search_judged(
+        found, ml, mr, dist, bearing, geom, params, side_tol, lit_strip, interlocked
+    )
     for name, fraction, judged in (
         ("approach_speed", "approach_speed_violation_fraction", speed),
         ("reverse_when_far", "reverse_when_far_fraction", reverse),
@@ -471,9 +488,22 @@ def envelope_metrics(traj, params, geom):
             "the law never stops for the colour followed (its count never reaches the "
             "stopping level's threshold)"
         )
+    elif stops and not any(s and s[0] for s in stops.values()):
+        # The count may reach the stopping level, but no band is sure to count: where the
+        # law stops depends on how much of the suit matches, which the bounds cannot say.
+        unsure = (
+            "camera.sensor's exposure and white balance move the suit's colour"
+            if geom.exposure_s
+            else "the suit's colour is not sure to match at every shade of the scenario's light"
+        )
+        out["stop_reason"] = f"the stop distance cannot be bounded: {unsure}"
     else:
         out["stop_reason"] = "the robot never came near the stop distance"
     return out
+
+
+def _or_nan(x):
+    return math.nan if x is None else x
 
 
 def _own_depth(traj, dist, near):
@@ -495,12 +525,13 @@ def _own_depth(traj, dist, near):
     return own
 
 
-def _search_judged(found, ml, mr, dist, bearing, geom, params, side_tol, interlocked):
+def _search_judged(found, ml, mr, dist, bearing, geom, params, side_tol, lit_strip, interlocked):
     """Per judged lost frame ``(frame, broke the law, [L, R] seen, [L, R] the law's)``, the
     lost law being: hold the last command
     for lost frames 1..lost_frames-1, then turn in place at ``search_dps`` towards the side the
     target was last seen on (left after reset). A sighting within ``E_TOLERANCE_PX`` of the
-    image centre has no sure side (``sure_side``): its search frames are not judged, nor are
+    image centre, or of a ``lit_strip`` colour with the silhouette across the centre, has no
+    sure side (``sure_side``): its search frames are not judged, nor are
     the ``interlocked`` frames, nor the hold of a loss that began with the interlock holding
     the wheels (the command held is then not the one seen)."""
     out = []
@@ -508,7 +539,9 @@ def _search_judged(found, ml, mr, dist, bearing, geom, params, side_tol, interlo
     for k in range(len(found)):
         if found[k]:
             lost = 0
-            side = sure_side(float(dist[k]), float(bearing[k]), geom, params, side_tol[k])
+            side = sure_side(
+                float(dist[k]), float(bearing[k]), geom, params, side_tol[k], lit_strip[k]
+            )
             continue
         if lost == 0:  # the command shown when the loss began is the one to hold
             if k == 0:
@@ -527,15 +560,16 @@ def _search_judged(found, ml, mr, dist, bearing, geom, params, side_tol, interlo
     return out
 
 
-def sure_side(distance, bearing, geom, params, tol=E_TOLERANCE_PX):
+def sure_side(distance, bearing, geom, params, tol=E_TOLERANCE_PX, lit_strip=False):
     """The side of the image centre the design's centroid surely falls on with the target
     at ``distance`` (m) and ``bearing`` (rad, left positive): +1 right, -1 left, 0 not sure.
 
     The centroid is the mean column of the target's pixels inside the window's columns. With
     the whole silhouette there it lies within ``tol`` pixels of the silhouette's middle;
     with part of the silhouette beyond the window's edge (a target leaving the view, the
-    usual last sighting before a loss) it lies somewhere in the part inside, so the side is
-    sure only when all of that part is on one side."""
+    usual last sighting before a loss), or with only a lit strip of the suit matching
+    (``lit_strip``), it lies somewhere in the part inside, so the side is sure only when all
+    of that part is on one side."""
     if not math.isfinite(distance) or distance <= geom.radius:
         return 0
     if abs(bearing) + math.asin(geom.radius / distance) >= math.pi / 2 - 1e-6:
@@ -543,7 +577,7 @@ def sure_side(distance, bearing, geom, params, tol=E_TOLERANCE_PX):
     left, right = silhouette(distance, bearing, geom)
     edge_lo, edge_hi = window_columns(geom.width, params.margin_x)
     centre = geom.width / 2
-    if whole_in_window(left, right, geom.width, params.margin_x):
+    if whole_in_window(left, right, geom.width, params.margin_x) and not lit_strip:
         offset = (left + right) / 2 - centre
         if abs(offset) <= tol:
             return 0

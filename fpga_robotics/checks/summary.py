@@ -150,9 +150,15 @@ def compute_metrics(
         overshoot is measured from the camera's axis); default the robot's centre and heading.
     lit_strip : numpy bool array, optional
         Per frame, whether the target's suit may match the colour filter only where it is
-        lit (``envelopes.lit_strip_frames``): the mean centroid error there is measured from
-        the part of the silhouette inside the window, not from its middle.
+        lit (``envelopes.lit_strip_frames``): the centroid checks there measure from the
+        part of the silhouette inside the window, not from its middle; so do they in the
+        frames in which the trajectory's ``target_hidden`` says something hides part of it.
     """
+    if "target_hidden" in traj:
+        # Part of the target hidden behind furniture or a person: the centroid of what is
+        # seen lies anywhere on the silhouette, as for a lit strip.
+        hidden = np.asarray(traj["target_hidden"], bool)
+        lit_strip = hidden if lit_strip is None else np.asarray(lit_strip, bool) | hidden
     absent = [name for name in DESIGN_OUTPUTS if name in set(absent)]
     if absent:
         present = {k: v for k, v in traj.items() if k not in absent}
@@ -223,8 +229,8 @@ def compute_metrics(
         "max_wheel_command_step_dps": _max_command_step(traj),
         "oscillation_hz": _oscillation(traj, width, n * frame_period),
         **_off_target(traj, width, margin_x, lit_strip),
-        "led_wrong_side_fraction": _led_wrong_side(traj, width),
-        "led_misplaced_fraction": _led_misplaced(traj, width, margin_x),
+        "led_wrong_side_fraction": _led_wrong_side(traj, width, margin_x, lit_strip),
+        "led_misplaced_fraction": _led_misplaced(traj, width, margin_x, lit_strip),
         "peak_wheel_command_dps": _peak_command(traj),
         "search_travel_m": _search_travel(traj, events),
         "heading_overshoot_deg": _heading_overshoot(traj, camera_mount),
@@ -287,11 +293,11 @@ def _off_target(traj, width, margin_x=None, lit_strip=None):
     (``target_column``) with its silhouette (``target_left`` .. ``target_right``) wholly
     inside the tracking window's columns, else the middle of the part inside (the tracker
     counts only the pixels there; ``visible_middle``; a frame with no part inside is left
-    out). The mean error of the ``lit_strip`` frames is from the nearest point of the part
-    inside (only a lit strip of the suit may match, its centroid anywhere there; the
-    fraction, which catches another object taken for the target, keeps the middle). The
-    fraction of those frames with an error above ``OFF_TARGET_FRACTION * width``,
-    and the mean error (pixels). None without such frames or fields."""
+    out). In the ``lit_strip`` frames only a lit strip of the suit may match, its centroid
+    anywhere on the part inside: the error there is from the nearest point of that part
+    (another object's pixels beside the target still pull the centroid off it). The
+    fraction of those frames with an error above ``OFF_TARGET_FRACTION * width``, and the
+    mean error (pixels). None without such frames or fields."""
     none = {"off_target_fraction": None, "mean_centroid_error_px": None}
     if width is None or "target_column" not in traj or "centroid_x" not in traj:
         return none
@@ -310,15 +316,28 @@ def _off_target(traj, width, margin_x=None, lit_strip=None):
     if not ok.any():
         return none
     err = np.abs(centroid - expected)
-    mean_err = err
     if lit_strip is not None and "target_left" in traj and "target_right" in traj:
         lo, hi = window_columns(width, margin_x)
         nearest = np.clip(centroid, np.maximum(left, lo), np.minimum(right, hi))
-        mean_err = np.where(lit_strip, np.abs(centroid - nearest), err)
+        err = np.where(lit_strip, np.abs(centroid - nearest), err)
     return {
         "off_target_fraction": float((err[ok] > OFF_TARGET_FRACTION * width).mean()),
-        "mean_centroid_error_px": float(mean_err[ok].mean()),
+        "mean_centroid_error_px": float(err[ok].mean()),
     }
+
+
+def _centroid_span(traj, width, margin_x, lit_strip):
+    """Per frame, ``(lo, hi)``: the columns the design's centroid of the target may lie
+    between: its image column, or in a ``lit_strip`` frame (only a lit strip of the suit may
+    match) anywhere on the part of its silhouette inside the tracking window."""
+    column = np.asarray(traj["target_column"], dtype=float)
+    if lit_strip is None or "target_left" not in traj or "target_right" not in traj:
+        return column, column
+    lo, hi = window_columns(width, margin_x)
+    left = np.maximum(np.asarray(traj["target_left"], dtype=float), lo)
+    right = np.minimum(np.asarray(traj["target_right"], dtype=float), hi)
+    strip = np.asarray(lit_strip, bool) & (right > left)
+    return np.where(strip, left, column), np.where(strip, right, column)
 
 
 #: The target is on one side when its image column is at least this fraction of the image
@@ -326,20 +345,25 @@ def _off_target(traj, width, margin_x=None, lit_strip=None):
 LED_SIDE_FRACTION = 0.125
 
 
-def _led_wrong_side(traj, width):
+def _led_wrong_side(traj, width, margin_x=None, lit_strip=None):
     """How often the centroid LEDs point the wrong way, over the frames found with the
     target's centre in view: at least ``LED_SIDE_FRACTION`` of the width to one side, an LED of
     the other half is lit (bits 0-3 are the left half, 4-7 the right); within half that of the
     centre, one of the two outermost LEDs of a side is lit (bits 0, 1, 6, 7: they light only
-    when half the target's pixels are in the outer quarter of the window). None without such
-    frames or fields."""
+    when half the target's pixels are in the outer quarter of the window). In a
+    ``lit_strip`` frame the whole part of the silhouette in the window must lie that far to a
+    side or that near the centre (``_centroid_span``). None without such frames or fields."""
     if width is None or "target_column" not in traj or "centroid_leds" not in traj:
         return None
     column = np.asarray(traj["target_column"], dtype=float)
+    lo, hi = _centroid_span(traj, width, margin_x, lit_strip)
     offset = column - width / 2
     seen = traj["found"] & ~np.isnan(column)
-    side = seen & (np.abs(offset) >= LED_SIDE_FRACTION * width)
-    centre = seen & (np.abs(offset) <= LED_SIDE_FRACTION * width / 2)
+    near = np.minimum(np.abs(lo - width / 2), np.abs(hi - width / 2))
+    far = np.maximum(np.abs(lo - width / 2), np.abs(hi - width / 2))
+    one_side = np.sign(lo - width / 2) == np.sign(hi - width / 2)
+    side = seen & one_side & (near >= LED_SIDE_FRACTION * width)
+    centre = seen & (far <= LED_SIDE_FRACTION * width / 2)
     judged = side | centre
     if not judged.any():
         return None
@@ -358,14 +382,16 @@ LED_BORDER_FRACTION = 1 / 32
 LED_CENTRED = 0b0001_1000
 
 
-def _led_misplaced(traj, width, margin_x=None):
+def _led_misplaced(traj, width, margin_x=None, lit_strip=None):
     """How often the lit LEDs are not the one above the target, over the frames found with
     the target's centre inside the tracking window's columns (``margin_x`` from each side;
     default ``width // 10``): LED k sits above the window's k-th eighth (from the left); the
     right code is that LED alone, or, with the column within ``LED_BORDER_FRACTION`` of the
     width from a border between eighths, the LED on either side of it, or, that close to the
-    image centre, the middle pair too. Any other code (no LED, two LEDs, the wrong one) is
-    misplaced. None without such frames or fields."""
+    image centre, the middle pair too. In a ``lit_strip`` frame the centroid may lie anywhere
+    on the part of the silhouette in the window (``_centroid_span``): the LED above any
+    column of it is right. Any other code (no LED, two LEDs, the wrong one) is misplaced.
+    None without such frames or fields."""
     if width is None or "target_column" not in traj or "centroid_leds" not in traj:
         return None
     margin = width // 10 if margin_x is None else margin_x
@@ -377,15 +403,15 @@ def _led_misplaced(traj, width, margin_x=None):
     judged &= (column >= margin) & (column < width - margin)
     if not judged.any():
         return None
-    col = column[judged]
+    lo, hi = (a[judged] for a in _centroid_span(traj, width, margin, lit_strip))
     leds = np.asarray(traj["centroid_leds"], dtype=np.int64)[judged]
     tol = LED_BORDER_FRACTION * width
-    bins = np.clip(((col - margin) // bin_width).astype(np.int64), 0, 7)
-    allowed = np.left_shift(1, bins)
-    left = np.clip(((col - tol - margin) // bin_width).astype(np.int64), 0, 7)
-    right = np.clip(((col + tol - margin) // bin_width).astype(np.int64), 0, 7)
-    ok = (leds == allowed) | (leds == np.left_shift(1, left)) | (leds == np.left_shift(1, right))
-    ok |= (np.abs(col - width / 2) <= tol) & (leds == LED_CENTRED)
+    first = np.clip(((lo - tol - margin) // bin_width).astype(np.int64), 0, 7)
+    last = np.clip(((hi + tol - margin) // bin_width).astype(np.int64), 0, 7)
+    single = (leds > 0) & ((leds & (leds - 1)) == 0)
+    lit = np.log2(np.maximum(leds, 1)).astype(np.int64)  # the one LED lit, if single
+    ok = single & (first <= lit) & (lit <= last)
+    ok |= (lo - tol <= width / 2) & (width / 2 <= hi + tol) & (leds == LED_CENTRED)
     return float((~ok).mean())
 
 

@@ -74,6 +74,7 @@ TRAJECTORY_FIELDS = (
     "target_column",
     "target_left",
     "target_right",
+    "target_hidden",
     "camera_tilt",
 )
 
@@ -344,10 +345,11 @@ class ClosedLoop:
             )
             column = target_column(pose, self.scenario.camera, tx, ty)
             edges = target_silhouette(pose, self.scenario.camera, tx, ty, self.target_radius)
+            hidden = visible and target_hidden(pose, self.world, self.scenario.camera)
         else:
             tx = ty = dist = column = math.nan
             edges = (math.nan, math.nan)
-            visible = False
+            visible = hidden = False
         row = self.traj
         row["t"][k], row["x"][k], row["y"][k], row["heading"][k] = t, rx, ry, heading
         row["v"][k], row["w"][k], row["cmd_v"][k], row["cmd_w"][k] = v, w, cmd_v, cmd_w
@@ -356,6 +358,7 @@ class ClosedLoop:
         row["target_distance"][k], row["target_in_view"][k] = dist, visible
         row["target_column"][k] = column
         row["target_left"][k], row["target_right"][k] = edges
+        row["target_hidden"][k] = hidden
         row["camera_tilt"][k] = pose.tilt  # the mount's tilt plus the slope's pitch
         return (None if target is None else dist), visible
 
@@ -602,6 +605,59 @@ def target_silhouette(pose, cam, x, y, radius):
     return silhouette_columns(distance, bearing, radius, cam.width, cam.hfov)
 
 
+def target_hidden(pose, world, cam):
+    """Whether furniture, a divider or another person hides part of the target from a camera
+    at ``pose`` in ``world``: in a ray across the target's silhouette (one per image column
+    it covers), something stands nearer than the target's surface and tall enough to cover
+    the lowest of its bands seen past it. The target's pixel count and centroid are then not
+    the whole silhouette's."""
+    target = next(p for p in world.people if p.config.target)
+    tx, ty = target.body.position
+    radius = target.config.radius
+    dx, dy = tx - pose.x, ty - pose.y
+    distance = math.hypot(dx, dy)
+    if distance <= radius:
+        return False
+    half = math.asin(radius / distance)
+    rays = max(3, math.ceil(2 * half * focal_length(cam.width, cam.hfov)))
+    offsets = (np.arange(rays) + 0.5) / rays * 2 * half - half  # inside the tangents
+    angles = math.atan2(dy, dx) + offsets
+    ux, uy = np.cos(angles), np.sin(angles)
+    surface = distance * np.cos(offsets) - np.sqrt(
+        np.maximum(0.0, radius**2 - (distance * np.sin(offsets)) ** 2)
+    )
+    lowest = min(band.z0 for band in target.bands)
+    nearest = []  # per obstacle: (depth along each ray, inf where missed), its height
+    for wall in world.scene().walls:
+        if wall.kind == "room":
+            continue  # the room's walls stand behind everyone in it
+        ex, ey = wall.x1 - wall.x0, wall.y1 - wall.y0
+        qx, qy = wall.x0 - pose.x, wall.y0 - pose.y
+        with np.errstate(divide="ignore", invalid="ignore"):
+            denom = ux * ey - uy * ex
+            t = (qx * ey - qy * ex) / denom
+            along = (qx * uy - qy * ux) / denom
+        hit = (denom != 0) & (along >= 0) & (along <= 1) & (t > 0)
+        nearest.append((np.where(hit, t, np.inf), wall.height))
+    for person in world.people:
+        if person is target:
+            continue
+        px, py = person.body.position
+        qx, qy = pose.x - px, pose.y - py
+        b = ux * qx + uy * qy
+        disc = b * b - (qx * qx + qy * qy - person.config.radius**2)
+        t = -b - np.sqrt(np.maximum(disc, 0.0))
+        hit = (disc >= 0) & (t > 0)
+        nearest.append((np.where(hit, t, np.inf), max(band.z1 for band in person.bands)))
+    for depth, height in nearest:
+        # The ray from the camera to the target's lowest band at its surface passes under
+        # the obstacle's top where the obstacle stands.
+        sight = pose.height + (lowest - pose.height) * depth / surface
+        if np.any((depth < surface) & (sight < height)):
+            return True
+    return False
+
+
 def _dps(command):
     """A wheel command as the motors take it: an absent one (None) is 0 DPS."""
     return 0 if command is None else command
@@ -609,7 +665,7 @@ def _dps(command):
 
 def _empty_trajectory(n_frames):
     traj = {name: np.zeros(n_frames) for name in TRAJECTORY_FIELDS}
-    for name in ("found", "target_in_view"):
+    for name in ("found", "target_in_view", "target_hidden"):
         traj[name] = np.zeros(n_frames, bool)
     for name in (
         "proximity",
