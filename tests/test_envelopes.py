@@ -105,6 +105,8 @@ def _traj(frames):
         "t": np.arange(n) / 30,
         "x": np.zeros(n),
         "y": np.zeros(n),
+        "driven_x": np.zeros(n),
+        "driven_y": np.zeros(n),
         "heading": np.zeros(n),
         "found": np.array([f[0] for f in frames], bool),
         "target_x": np.full(n, 4.0),
@@ -270,7 +272,7 @@ def _on_the_axis(robot_x, target_x):
     robot facing it (+x) and the target found in every frame (GEOM: the camera at the
     robot's centre)."""
     traj = _traj([(True, 0.0, 0, 0)] * len(robot_x))
-    traj["x"] = np.array(robot_x, float)
+    traj["x"] = traj["driven_x"] = np.array(robot_x, float)
     traj["target_x"] = np.array(target_x, float)
     return traj
 
@@ -307,6 +309,58 @@ def test_stop_overshoot_counts_the_robots_own_driving_inside(robot_x, target_x, 
         f"drove {overshoot:.3f} m inside the stop distance (stop distance 1.530 m, closest "
         f"{closest:.3f} m, camera to the target's centre; limit <= 0.05 m)"
     )
+
+
+@pytest.mark.parametrize(
+    "driven_x, overshoot",
+    [
+        # Backing off 2 cm a frame while a person shoves it in from 2 m to 1.3 m: it drove
+        # nothing inside.
+        ([0.0, -0.02, -0.04, -0.06], 0.0),
+        # Creeping in 5 cm a frame while shoved in 0.3 m a frame: its own two steps inside
+        # (to 1.4 m and 1.3 m) count, the push does not.
+        ([0.0, 0.05, 0.10, 0.15], 0.10),
+    ],
+)
+def test_stop_overshoot_leaves_out_a_push(driven_x, overshoot):
+    traj = _on_the_axis([0.0, 0.3, 0.6, 0.7], [2.0] * 4)
+    traj["driven_x"] = np.array(driven_x, float)
+    m = envelope_metrics(traj, DEFAULT, GEOM)
+    assert m["stop_overshoot_m"] == pytest.approx(overshoot, abs=1e-9)
+    assert m["stop_closest_m"] == pytest.approx(1.3)
+
+
+def test_stop_overshoot_of_a_robot_a_passer_by_shoves_towards_the_target(tmp_path):
+    """The robot starts 1.9 m from the red target (stop distance 1.14 m) and obeys the law;
+    a passer-by walks into it from behind at 0.8 m/s and pushes it to 0.49 m (camera to the
+    target's centre): it drove (next to) nothing inside."""
+    path = tmp_path / "pushed.toml"
+    path.write_text(
+        """
+[sim]
+duration = 5.0
+[robot]
+start = [1.6, 3.0]
+[[people]]
+shirt_color = [0.85, 0.1, 0.1]
+trousers_color = [0.8, 0.1, 0.1]
+waypoints = [[3.5, 3.0]]
+[[people]]
+name = "blue"
+target = false
+shirt_color = [0.2, 0.3, 0.8]
+waypoints = [[0.4, 3.0], [2.4, 3.0]]
+speed = 0.8
+loop = false
+start_delay = 1.0
+[checks]
+max_stop_overshoot_m = 0.05
+"""
+    )
+    m = run_scenario(load_scenario(str(path)), backend="model").summary
+    assert m["stop_closest_m"] < 0.6
+    assert m["stop_overshoot_m"] < 0.005  # the old measure: 0.65 m
+    assert m["verdict"] == "pass"
 
 
 def test_stop_overshoot_uses_the_colour_followed_in_each_frame():

@@ -23,6 +23,8 @@ def trajectory(found, dist, in_view=None, x=None):
         "t": np.arange(n) * PERIOD,
         "x": np.zeros(n) if x is None else np.asarray(x, float),
         "y": np.zeros(n),
+        "driven_x": np.zeros(n) if x is None else np.asarray(x, float),
+        "driven_y": np.zeros(n),
         "found": np.asarray(found, bool),
         "target_distance": np.asarray(dist, float),
         "target_in_view": np.ones(n, bool) if in_view is None else np.asarray(in_view, bool),

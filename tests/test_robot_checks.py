@@ -19,6 +19,8 @@ def _traj(columns, leds, found=True, motors=(0, 0), x=None):
         "t": np.arange(n) / 30,
         "x": np.zeros(n) if x is None else np.asarray(x, float),
         "y": np.zeros(n),
+        "driven_x": np.zeros(n) if x is None else np.asarray(x, float),
+        "driven_y": np.zeros(n),
         "found": np.broadcast_to(np.asarray(found), (n,)).copy(),
         "target_distance": np.ones(n),
         "target_in_view": np.ones(n, bool),
@@ -144,13 +146,23 @@ def test_the_robot_travels_little_while_it_searches():
     m = compute_metrics(traj, events, {}, 1 / 30, width=W)
     assert m["search_travel_m"] == pytest.approx(0.15)
     c = _check("max_search_travel_m", 0.1, m)
-    assert not c["passed"] and "travelled 0.15 m during a search" in c["text"]
+    assert not c["passed"] and "drove 0.15 m during a search" in c["text"]
     assert _check("max_search_travel_m", 0.2, m)["passed"]
     # Never searched: nothing to judge, the check is n/a.
     m = compute_metrics(traj, events[:1], {}, 1 / 30, width=W)
     assert m["search_travel_m"] is None
     c = _check("max_search_travel_m", 0.1, m)
     assert c["text"] == "the design never searched" and c["status"] == "n/a"
+
+
+def test_a_push_during_a_search_is_not_the_robots_travel():
+    # A person shoves the robot 0.1 m a frame through a search (frames 2..6) while its own
+    # driving moves it 0.02 m a frame: 4 x 0.02 m of its own.
+    traj = _traj([80] * 8, [0] * 8, x=np.arange(8) * 0.1)
+    traj["driven_x"] = np.arange(8) * 0.02
+    events = [(2, 2 / 30, "search started"), (6, 6 / 30, "target found")]
+    m = compute_metrics(traj, events, {}, 1 / 30, width=W)
+    assert m["search_travel_m"] == pytest.approx(0.08)
 
 
 def test_the_new_checks_are_declared_with_their_outputs():

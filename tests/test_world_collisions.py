@@ -107,9 +107,11 @@ def test_fault_velocities_average_over_the_window_at_any_physics_step(h):
     n = round(0.25 / h)
     for k in range(n):
         t = k * h
-        history.record(t, (0.0, 0.0), ((min(t, 0.2), 0.0),))
-    robot_v, (person_v,) = history.mean_velocities(n * h, (0.0, 0.0), ((0.2, 0.0),))
-    assert robot_v == (0.0, 0.0)
+        history.record(t, (0.0, 0.0), (0.0, 0.0), ((min(t, 0.2), 0.0),))
+    robot_v, driven_v, (person_v,) = history.mean_velocities(
+        n * h, (0.0, 0.0), (0.0, 0.0), ((0.2, 0.0),)
+    )
+    assert robot_v == driven_v == (0.0, 0.0)
     assert person_v[0] == pytest.approx(0.05 / FAULT_WINDOW, abs=h / FAULT_WINDOW)
 
 
@@ -135,6 +137,39 @@ def test_the_fault_of_a_touch_does_not_depend_on_the_physics_step(dt):
     person = float(event.split("person ")[-1].split(" m/s")[0])
     assert 0.1 <= person <= 0.2
     assert world.at_fault_collisions() == 0
+
+
+def test_a_robot_shoved_into_a_standing_person_is_not_at_fault_nor_shot_out():
+    # The robot is parked (wheels at 0) between green, standing 0.65 m ahead, and blue, who
+    # walks into it from behind at 0.8 m/s and stops 0.65 m from green: blue shoves it into
+    # green (it drove nothing: not its fault), then squeezes it out sideways, at no more
+    # than blue's 0.8 m/s (rigid people would shoot it out at several m/s, into the wall).
+    green = {"name": "green", "waypoints": [[3.65, 3.0]]}
+    blue = {"name": "blue", "waypoints": [[1.0, 3.05], [3.0, 3.05]], "speed": 0.8, "loop": False}
+    world = _world({"start": [3.0, 3.0]}, [green, blue])
+    events, fastest = [], 0.0
+    for _ in range(round(6.0 / DT)):
+        world.step(DT)
+        events += world.drain_events()
+        fastest = max(fastest, world.robot_body.velocity.length)
+    assert [e.split(" (")[0] for e in events] == [
+        "collision with person 'blue'",
+        "collision with person 'green'",
+    ]
+    assert world.at_fault_collisions() == 0
+    assert fastest <= 0.8 + 1e-9
+    assert world.driven_position() == (3.0, 3.0)
+
+
+def test_the_driven_position_follows_a_robot_driving_unhindered():
+    # Ramping up to 300 DPS, turning, ramping down: nothing but its wheels moves it.
+    world = _world({"start": [2.0, 3.0]})
+    for left, right in [(300, 300), (300, 200), (0, 0)]:
+        world.set_wheel_dps(left, right)
+        _run(world, 1.5)
+    x, y, _ = world.robot_pose()
+    assert math.dist(world.driven_position(), (x, y)) < 0.002
+    assert math.dist((x, y), (2.0, 3.0)) > 0.4
 
 
 def _touch_time(dps, distance):

@@ -510,13 +510,20 @@ def _own_depth(traj, dist, near):
     """Per frame, how far inside the stop distance ``near`` (m, per frame; NaN where there is
     none) the robot's own driving has
     taken it: its centre's closing on the target (held where it stood the frame before; a
-    turn in place closes nothing) adds up while the camera is inside, never below 0 nor
-    beyond the camera's depth there. The rest of the depth is not the robot's doing: it
-    started there, or the target walked up to it (the law then reverses at most)."""
+    turn in place closes nothing), but no more than its own driving closed (``driven_x``,
+    ``driven_y``: a push by a person closes nothing), adds up while the camera is inside,
+    never below 0 nor beyond the camera's depth there. The rest of the depth is not the
+    robot's doing: it started there, the target walked up to it (the law then reverses at
+    most), or someone pushed it in."""
     x, y = np.asarray(traj["x"], float), np.asarray(traj["y"], float)
     tx, ty = np.asarray(traj["target_x"], float), np.asarray(traj["target_y"], float)
     before = np.hypot(tx[:-1] - x[:-1], ty[:-1] - y[:-1])
-    closing = before - np.hypot(tx[:-1] - x[1:], ty[:-1] - y[1:])
+    body = before - np.hypot(tx[:-1] - x[1:], ty[:-1] - y[1:])
+    # The same frame's own driving, from where the body was.
+    driven_dx = np.diff(np.asarray(traj["driven_x"], float))
+    driven_dy = np.diff(np.asarray(traj["driven_y"], float))
+    driven = before - np.hypot(tx[:-1] - x[:-1] - driven_dx, ty[:-1] - y[:-1] - driven_dy)
+    closing = np.clip(body, np.minimum(driven, 0.0), np.maximum(driven, 0.0))
     depth = np.maximum(0.0, near - dist)
     own = np.zeros(len(dist))
     for k in range(1, len(dist)):

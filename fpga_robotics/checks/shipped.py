@@ -363,10 +363,11 @@ SHIPPED_CHECKS = (
         "max",
         (
             "while the design searches (from a search started to the target found again) the "
-            "robot's centre travels at most this far: it turns in place (search_travel_m)"
+            "robot's own driving moves its centre at most this far: it turns in place "
+            "(search_travel_m; a push by a person is not its driving)"
         ),
         lambda v, limit, m: (
-            f"the robot travelled {_num(v, limit, 2)} m during a search (limit <= {limit} m)"
+            f"the robot drove {_num(v, limit, 2)} m during a search (limit <= {limit} m)"
         ),
         limits=(0, 1000, "m"),
         outputs=("found",),

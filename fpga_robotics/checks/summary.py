@@ -425,12 +425,12 @@ def _peak_command(traj):
 
 
 def _search_travel(traj, events):
-    """The longest distance the robot's centre travelled during one search: from a "search
-    started" event's frame to the next "target found" (or the last frame), metres. None
-    without a search."""
-    starts, longest = None, None
-    x, y = np.asarray(traj["x"], dtype=float), np.asarray(traj["y"], dtype=float)
-    episodes = []
+    """The longest distance the robot's centre travelled by its own driving during one
+    search: from a "search started" event's frame to the next "target found" (or the last
+    frame), metres; each frame's step no longer than its own driving's (``driven_x``,
+    ``driven_y``), so a person pushing it adds nothing. None without a search."""
+    last = len(traj["x"]) - 1
+    starts, episodes = None, []
     for frame, _time, text in events:
         if text == "search started" and starts is None:
             starts = frame
@@ -438,12 +438,15 @@ def _search_travel(traj, events):
             episodes.append((starts, frame))
             starts = None
     if starts is not None:
-        episodes.append((starts, len(x) - 1))
-    for a, b in episodes:
-        seg = slice(a, min(b, len(x) - 1) + 1)
-        travel = float(np.hypot(np.diff(x[seg]), np.diff(y[seg])).sum())
-        longest = travel if longest is None else max(longest, travel)
-    return _float(longest)
+        episodes.append((starts, last))
+    if not episodes:
+        return None
+
+    def steps(xs, ys):
+        return np.hypot(np.diff(np.asarray(xs, float)), np.diff(np.asarray(ys, float)))
+
+    own = np.minimum(steps(traj["x"], traj["y"]), steps(traj["driven_x"], traj["driven_y"]))
+    return _float(max(float(own[a : min(b, last)].sum()) for a, b in episodes))
 
 
 def _max_command_step(traj):

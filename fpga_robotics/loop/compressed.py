@@ -56,6 +56,8 @@ TRAJECTORY_FIELDS = (
     "x",
     "y",
     "heading",
+    "driven_x",
+    "driven_y",
     "v",
     "w",
     "cmd_v",
@@ -352,6 +354,7 @@ class ClosedLoop:
             visible = hidden = False
         row = self.traj
         row["t"][k], row["x"][k], row["y"][k], row["heading"][k] = t, rx, ry, heading
+        row["driven_x"][k], row["driven_y"][k] = self.world.driven_position()
         row["v"][k], row["w"][k], row["cmd_v"][k], row["cmd_w"][k] = v, w, cmd_v, cmd_w
         row["color_sel"][k] = self.color_code
         row["target_x"][k], row["target_y"][k] = tx, ty

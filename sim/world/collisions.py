@@ -7,8 +7,10 @@ the same body (the same person, the same piece of furniture, the walls) within
 
 Fault is decided at the first touch of an episode by which body closed the gap: each one's
 velocity component towards the other, averaged over the last ``FAULT_WINDOW`` before the
-touch (a person's from their scripted path: their body follows it exactly). The robot is at
-fault when it closed faster than the other body and faster than ``AT_FAULT_SPEED``.
+touch (a person's from their scripted path: their body follows it exactly; the robot's no
+more than its own driving, so a robot shoved into someone did not close the gap). The
+robot is at fault when it closed faster than the other body and faster than
+``AT_FAULT_SPEED``.
 """
 
 import math
@@ -143,33 +145,35 @@ class CollisionLog:
 
 
 class MotionHistory:
-    """The robot's and the people's positions at the start of the last sub-steps (the world
-    records one before each physics step), for averaged velocities."""
+    """The robot's, its own driving's (``World.driven_position``) and the people's positions
+    at the start of the last sub-steps (the world records one before each physics step), for
+    averaged velocities."""
 
     def __init__(self, window=FAULT_WINDOW):
         self.window = window
-        self._rows = deque()  # (t, robot_xy, people_xy tuple), oldest first
+        self._rows = deque()  # (t, robot_xy, driven_xy, people_xy tuple), oldest first
 
-    def record(self, t, robot_xy, people_xy):
+    def record(self, t, robot_xy, driven_xy, people_xy):
         # Rows leave by age, not by count: the window is the same at any physics step.
         rows = self._rows
         while rows and t - rows[0][0] > self.window + 1e-12:
             rows.popleft()
-        rows.append((t, robot_xy, people_xy))
+        rows.append((t, robot_xy, driven_xy, people_xy))
 
-    def mean_velocities(self, t, robot_xy, people_xy):
-        """``(robot_v, [person_v, ...])`` averaged from the oldest row within the window
-        before ``t`` (at least the last one: the sub-step under way) up to the positions
-        now."""
+    def mean_velocities(self, t, robot_xy, driven_xy, people_xy):
+        """``(robot_v, driven_v, [person_v, ...])`` averaged from the oldest row within the
+        window before ``t`` (at least the last one: the sub-step under way) up to the
+        positions now."""
         start = self._rows[-1]
         for row in self._rows:
             if t - row[0] <= self.window + 1e-12:
                 start = row
                 break
-        t0, r0, p0 = start
+        t0, r0, d0, p0 = start
         span = t - t0
 
         def velocity(a, b):
             return ((b[0] - a[0]) / span, (b[1] - a[1]) / span)
 
-        return velocity(r0, robot_xy), [velocity(a, b) for a, b in zip(p0, people_xy)]
+        people_v = [velocity(a, b) for a, b in zip(p0, people_xy)]
+        return velocity(r0, robot_xy), velocity(d0, driven_xy), people_v

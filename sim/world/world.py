@@ -196,6 +196,7 @@ class World:
         gear.max_bias = 0.0
         gear.max_force = spec.traction_torque
         self._pivot, self._gear = pivot, gear
+        self._robot_speed = 0.0  # the body's speed after the last sub-step, m/s
         space.add(body, shape, control, pivot, gear)
         self._patch = self.terrain.at(*config.robot.start) if self.terrain else None
 
@@ -239,6 +240,10 @@ class World:
         #: ``(time_s, reason)`` once the robot has tipped over, else None.
         self.tipped = None
         self._motor_v = 0.0  # the motors' forward speed at the last sub-step, m/s
+        # Where the robot's own driving alone would have taken its centre, and at what speed
+        # (``driven_position``): motion it drove, not pushes by others.
+        self._driven_xy = tuple(config.robot.start)
+        self._driven_v = 0.0
         self._events = []
         if self._patch is not None:  # the log says where the robot starts, as it changes
             self._events.append(_terrain_event(self._patch))
@@ -301,13 +306,19 @@ class World:
 
     def _closing_speeds(self, person_shape):
         """The robot's and the person's speeds towards each other at a first touch, m/s,
-        averaged over ``collisions.FAULT_WINDOW``."""
+        averaged over ``collisions.FAULT_WINDOW``. The robot's is what its own driving
+        closed (``driven_position``): its body's closing, but no more (a robot shoved into
+        the person closed only what it drove)."""
         robot_xy = tuple(self.robot_body.position)
         people_xy = [tuple(p.body.position) for p in self.people]
         i = next(i for i, p in enumerate(self.people) if p.shape is person_shape)
         towards = (people_xy[i][0] - robot_xy[0], people_xy[i][1] - robot_xy[1])
-        robot_v, people_v = self._history.mean_velocities(self._now, robot_xy, people_xy)
-        return closing_speeds(robot_v, people_v[i], towards)
+        robot_v, driven_v, people_v = self._history.mean_velocities(
+            self._now, robot_xy, self._driven_xy, people_xy
+        )
+        robot_c, person_c = closing_speeds(robot_v, people_v[i], towards)
+        driven_c, _ = closing_speeds(driven_v, people_v[i], towards)
+        return min(robot_c, driven_c), person_c
 
     def _on_post_solve(self, arbiter, space, data):
         kind, _ = self._names[arbiter.shapes[1]]
@@ -359,6 +370,13 @@ class World:
         control = self.control_body
         control.velocity = (v * math.cos(a), v * math.sin(a))
         control.angular_velocity = w
+        driven_x, driven_y = self._driven_xy
+        step = self._traction_accel() * h
+        self._driven_v += max(-step, min(step, v - self._driven_v))
+        self._driven_xy = (
+            driven_x + self._driven_v * h * math.cos(a),
+            driven_y + self._driven_v * h * math.sin(a),
+        )
         t1 = self._advance_time(h)
         before = []  # the people's positions at the start of the sub-step
         for person in self.people:
@@ -387,12 +405,32 @@ class World:
             if step > 0.0:
                 person.walked += step
                 person.facing = math.atan2(y - py, x - px)
-        self._history.record(self.time, (rx, ry), before)
+        self._history.record(self.time, (rx, ry), (driven_x, driven_y), before)
+        top_speed = self._top_speed(abs(v), h)
         self._now = t1
         self.space.step(h)
+        self._limit_robot_speed(top_speed)
         self.time = t1
         if self._removals and self._removals[0][0] <= t1 + SCHEDULE_SLACK:
             self._remove_due()
+
+    def _top_speed(self, wheel_speed, h):
+        """The fastest the robot's body can move after a sub-step of ``h`` s, m/s: its
+        wheels' speed plus the fastest person's (a person pushes it at most at their own
+        speed), or its speed now plus what a slope's gravity adds in ``h`` (the traction only
+        pulls it towards the wheels' speed). Rigid people squeezing it against another body
+        would otherwise shoot it out at any speed."""
+        pushed = wheel_speed + max((p.body.velocity.length for p in self.people), default=0.0)
+        downhill = self.robot_body.force.length / self.robot_spec.mass
+        return max(pushed, self._robot_speed + downhill * h)
+
+    def _limit_robot_speed(self, top_speed):
+        """Slow the robot's body (the velocity the next step moves it at) to ``top_speed``."""
+        body = self.robot_body
+        speed = body.velocity.length
+        if speed > top_speed:
+            body.velocity = body.velocity * (top_speed / speed)
+        self._robot_speed = min(speed, top_speed)
 
     def _driven_offset(self, person, sx, sy, h):
         """A hand-driven person's offset after a sub-step: the person is kinematic, so
@@ -528,6 +566,13 @@ class World:
         self._events.append(f"tipped over: {reason}")
         self.motors.set_wheel_dps(0.0, 0.0)
         self.motors.left.speed = self.motors.right.speed = 0.0
+
+    def driven_position(self):
+        """``(x, y)``, m: where the robot's own driving alone would have taken its centre
+        from its start: the wheels' speed along the body's heading, reached no faster than
+        the traction allows (as the body follows them when nothing else touches it). The
+        body's motion beyond it is others' doing: a push, a squeeze, a slope."""
+        return self._driven_xy
 
     def commanded_twist(self):
         """``(v, w)`` of the current DPS command by the real kinematics."""
