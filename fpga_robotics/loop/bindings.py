@@ -36,8 +36,13 @@ def check_bindings(scenario):
     no port, a design input two tables drive, a servo's port of the wrong kind, in
     real-clock timing a sensor the design declares but the scenario leaves out."""
     top = scenario_top(scenario)
+    _check_tables(scenario, top)
     if scenario.sim.timing == "real_clock":
         _check_declared_sensors(scenario, top)
+
+
+def _check_tables(scenario, top):
+    """The scenario's connector tables against the design's ports."""
     if not scenario.connectors:
         return
     for spec in scenario.connectors:
