@@ -130,9 +130,16 @@ def test_distance_checks_decided_by_the_bodies_and_the_room(tmp_path):
             "apart in the room: it always fails"
         )
     ]
+    # Frame 0 is fixed by the file: the target stands at [5, 3], 3.5 m from robot.start.
+    assert _warnings(tmp_path, person + "[checks]\nmin_distance_min_m = 3.6\n") == [
+        (
+            "checks.min_distance_min_m = 3.6 m is beyond 3.50 m, the target's first waypoint "
+            "from robot.start: it always fails"
+        )
+    ]
     assert (
         _warnings(
-            tmp_path, person + "[checks]\nmin_distance_min_m = 9.4\nmean_distance_max_m = 0.4\n"
+            tmp_path, person + "[checks]\nmin_distance_min_m = 3.4\nmean_distance_max_m = 0.4\n"
         )
         == []
     )
