@@ -330,3 +330,18 @@ def test_target_color_refuses_a_scenario_whose_first_person_is_not_the_target(tm
         ["--scenario", str(scenario), "--target-color", "green", "--rerun", "off"], capsys
     )
     assert "has no target person" in err
+
+
+@pytest.mark.parametrize(
+    "shorthand,item",
+    [
+        (["--duration", "2"], "sim.duration=3"),
+        (["--resolution", "320x240"], "camera.resolution=80x60"),
+        (["--color", "green"], "color.initial=blue"),
+    ],
+)
+def test_a_shorthand_beside_a_set_of_its_key_is_refused(shorthand, item, capsys):
+    # Either order: the shorthand used to win silently over the --set.
+    for argv in ([*shorthand, "--set", item], ["--set", item, *shorthand]):
+        err = usage_error([*argv, "--rerun", "off"], capsys)
+        assert f"{shorthand[0]} and --set {item} both set {item.split('=')[0]}" in err

@@ -90,6 +90,15 @@ def test_a_path_across_the_robots_start(tmp_path):
     ]
     # 0.4 m: they pass clear of it.
     assert _warnings(tmp_path, robot + _person([(0.5, 3.4), (4.0, 3.4)])) == []
+    # With yield_gap 0.3 the person stops 0.3 m short: 0.4 < 0.377 + 0.3 blocks them.
+    yielding = _person([(0.5, 3.4), (4.0, 3.4)], extra="yield_gap = 0.3\n")
+    assert _warnings(tmp_path, robot + yielding) == [
+        (
+            "people[0].waypoints[0] -> [1] passes 0.40 m from robot.start [1.5, 3]: the person "
+            "(radius 0.2 m) is blocked by the robot (radius 0.177 m) where it starts: they wait "
+            "(yield_gap 0.3 m) until it moves out of the way"
+        )
+    ]
 
 
 def test_distance_checks_without_a_target(tmp_path):
@@ -130,9 +139,16 @@ def test_distance_checks_decided_by_the_bodies_and_the_room(tmp_path):
             "apart in the room: it always fails"
         )
     ]
+    # Frame 0 is fixed by the file: the target stands at [5, 3], 3.5 m from robot.start.
+    assert _warnings(tmp_path, person + "[checks]\nmin_distance_min_m = 3.6\n") == [
+        (
+            "checks.min_distance_min_m = 3.6 m is beyond 3.50 m, the target's first waypoint "
+            "from robot.start: it always fails"
+        )
+    ]
     assert (
         _warnings(
-            tmp_path, person + "[checks]\nmin_distance_min_m = 9.4\nmean_distance_max_m = 0.4\n"
+            tmp_path, person + "[checks]\nmin_distance_min_m = 3.4\nmean_distance_max_m = 0.4\n"
         )
         == []
     )

@@ -359,8 +359,21 @@ def _check_color_option(args, scenario):
     )
 
 
+#: ``run``'s shorthand options and the ``--set`` key each one sets.
+_SHORTHANDS = {
+    "duration": "sim.duration",
+    "resolution": "camera.resolution",
+    "color": "color.initial",
+}
+
+
 def _overrides(args):
     items = list(args.overrides)
+    # Both given, one would silently win while the summary recorded the two values.
+    for option, key in _SHORTHANDS.items():
+        given = [item for item in items if item.split("=", 1)[0].strip() == key]
+        if getattr(args, option) is not None and given:
+            raise UsageError(f"--{option} and --set {given[0]} both set {key}: give one of them")
     if args.design is not None and not args.design.startswith("verilog:"):
         if args.ports is not None:
             raise UsageError(

@@ -56,6 +56,14 @@ def _check_warnings(world, checks):
             f"checks.min_distance_min_m = {limit:g} m is beyond {farthest:.2f} m, the "
             f"farthest the centres can be apart in the room: it always fails"
         )
+    elif limit is not None and limit > (
+        start_gap := math.dist(world.robot.start, target.waypoints[0])
+    ):
+        # Frame 0's distance is fixed by the file: the target stands at its first waypoint.
+        out.append(
+            f"checks.min_distance_min_m = {limit:g} m is beyond {start_gap:.2f} m, the "
+            f"target's first waypoint from robot.start: it always fails"
+        )
     return out
 
 

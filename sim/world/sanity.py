@@ -97,10 +97,16 @@ def world_warnings(config):
                 ):
                     warnings.append(f"{path}[{j}] -> [{k}] walks through furniture {name!r}")
             d = _point_segment(start, a, b)
-            if a != b and d < robot_radius + person.radius:
+            # A yielding person stops yield_gap short of the robot instead of walking into it.
+            if a != b and d < robot_radius + person.radius + person.yield_gap:
+                outcome = (
+                    f"is blocked by the robot (radius {robot_radius:g} m) where it starts: "
+                    f"they wait (yield_gap {person.yield_gap:g} m) until it moves out of the way"
+                    if person.yield_gap > 0
+                    else f"walks into the robot (radius {robot_radius:g} m) where it starts"
+                )
                 warnings.append(
                     f"{path}[{j}] -> [{k}] passes {d:.2f} m from robot.start {_fmt(start)}: "
-                    f"the person (radius {person.radius:g} m) walks into the robot (radius "
-                    f"{robot_radius:g} m) where it starts"
+                    f"the person (radius {person.radius:g} m) {outcome}"
                 )
     return warnings
