@@ -97,6 +97,11 @@ def test_a_non_empty_folder_is_refused(tmp_path, capsys, monkeypatch):
         assert code == 2 and len(err.splitlines()) == 1, module
         assert f"would hide the module {module}" in err
     assert sorted(p.name for p in tmp_path.iterdir()) == ["taken"]
+    # An empty name was the current folder: "folder '.' exists and is not empty".
+    code, _, err = _cli(["new", ""], capsys)
+    assert code == 2 and err.strip() == (
+        "fpga-robotics new: error: the project's folder NAME is empty; give one, e.g. my_robot"
+    )
     # An empty folder is taken.
     (tmp_path / "empty").mkdir()
     assert _cli(["new", "empty"], capsys)[0] == 0

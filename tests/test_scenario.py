@@ -103,6 +103,13 @@ def test_with_overrides_keeps_earlier_ones():
     assert s.overrides == ("sim.duration=3", "design.kp_num=1")
 
 
+def test_override_without_a_key_says_what_set_needs():
+    # It said "unknown scenario key ''".
+    with pytest.raises(ScenarioError) as info:
+        load_scenario("follow_person", ["=3"])
+    assert str(info.value) == "--set needs KEY=VALUE (e.g. robot.mass=12), got '=3'"
+
+
 def test_overrides_given_as_one_string_are_refused_as_such():
     # It was taken a character at a time: "--set needs KEY=VALUE ..., got 's'".
     expected = (

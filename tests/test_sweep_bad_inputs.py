@@ -149,6 +149,11 @@ CASES = {
         GOOD + 'design = "verilog:top.v"\n',
         'run of approach: design = "verilog:top.v" needs ports = "PORTS.toml" (its port map)',
     ),
+    # An empty key reached every run as "unknown scenario key ''".
+    "an empty grid key": (
+        GOOD + '[grid]\n"" = [1, 2]\n',
+        "c.toml: grid key '' is empty: name a scenario key (e.g. robot.mass)",
+    ),
     "a port map without a Verilog design": (
         GOOD + 'ports = "top_ports.toml"\n',
         (

@@ -43,6 +43,9 @@ def _template(relative):
 
 def write_project(folder):
     """Write the skeleton into ``folder`` (absent or empty); return the files written."""
+    # Path("") is '.', which would be refused as "folder '.' exists and is not empty".
+    if not str(folder).strip():
+        raise UsageError("the project's folder NAME is empty; give one, e.g. my_robot")
     folder = Path(folder)
     name = folder.resolve().name
     if not _NAME.fullmatch(name):

@@ -558,7 +558,8 @@ def _known_paths(data):
 
 def _apply_overrides(data, overrides):
     for item in overrides:
-        if not isinstance(item, str) or "=" not in item:
+        # '=3' has no key: say what --set wants, not "unknown scenario key ''".
+        if not isinstance(item, str) or "=" not in item or not item.partition("=")[0].strip():
             raise ScenarioError(f"--set needs KEY=VALUE (e.g. robot.mass=12), got {item!r}")
         key, text = item.split("=", 1)
         key = key.strip()

@@ -234,6 +234,9 @@ def _flatten(table, prefix, where):
     out = []
     for key, value in table.items():
         path = f"{prefix}{key}"
+        # "" = [...] names no scenario key; the runs would fail on "unknown scenario key ''".
+        if not key.strip():
+            raise CampaignError(f"{where} {path!r} is empty: name a scenario key (e.g. robot.mass)")
         if isinstance(value, dict):
             out += _flatten(value, f"{path}.", where)
         elif isinstance(value, list):
