@@ -39,6 +39,7 @@ STATE = (
     "ended_early",
     "traj",
     "absent",
+    "exact_extra",
     "events",
     "cycles",
     "design_events",

@@ -258,6 +258,7 @@ def _rewrite_extra(loop, ref, extra, before):
         if i < before:
             k, name = ref.extra_reads[i]
             loop.extra[name][k] = float(value)
+            loop.exact_extra.setdefault(name, {})[k] = value
 
 
 def _restore(loop, saved):
