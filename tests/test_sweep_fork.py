@@ -74,3 +74,25 @@ def test_a_worker_death_in_a_group_loses_only_the_run_in_progress(tmp_path, monk
     assert {r["message"] for r in a.values() if r["status"] == "error"} == {
         "the worker running it died (a crash or a kill)"
     }
+
+
+def test_runs_whose_designs_resolve_to_two_timings_share_no_world():
+    # sim.timing = "auto" is resolved by the design: one camera design on frames, another on
+    # pins share every scenario section, yet cannot be forked from one another.
+    import dataclasses
+
+    import pytest
+
+    from fpga_robotics.loop.fork import check_same_world
+    from fpga_robotics.scenario.load import load_scenario
+    from fpga_robotics.sweep import runner
+    from fpga_robotics.sweep.fork_groups import world_key
+
+    args, frames, shadow = runner.load_run(["--scenario", "follow_person"])
+    assert frames.sim.timing == "compressed"
+    pins = dataclasses.replace(frames, sim=dataclasses.replace(frames.sim, timing="real_clock"))
+    assert world_key(args, frames, shadow) != world_key(args, pins, shadow)
+    same = load_scenario("follow_person")
+    check_same_world(frames, same)  # the same timing: forkable
+    with pytest.raises(ValueError, match="a variant runs in real_clock timing, the reference"):
+        check_same_world(frames, pins)

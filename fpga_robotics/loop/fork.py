@@ -455,6 +455,7 @@ def _rewrite_design_part(loop, outputs, ref):
 
 
 def check_same_world(reference, variant):
+    """``ValueError`` unless ``variant`` runs in ``reference``'s world and timing."""
     if reference is variant:
         return
     a = {k: v for k, v in reference.data.items() if k not in VARIANT_SECTIONS}
@@ -463,4 +464,10 @@ def check_same_world(reference, variant):
         raise ValueError(
             "a variant's scenario may differ from the reference's only in its "
             f"{', '.join(VARIANT_SECTIONS)} sections"
+        )
+    # The design resolves sim.timing = "auto": equal sections may still run in two timings.
+    if variant.sim.timing != reference.sim.timing:
+        raise ValueError(
+            f"a variant runs in {variant.sim.timing} timing, the reference in "
+            f"{reference.sim.timing} timing"
         )

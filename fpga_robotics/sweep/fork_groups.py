@@ -32,6 +32,8 @@ def world_key(args, scenario, shadow_params):
     if scenario.sim.timing not in ("compressed", "real_clock"):
         return None
     world = {k: v for k, v in scenario.data.items() if k not in VARIANT_SECTIONS}
+    # The design resolves sim.timing = "auto": runs in two timings share no world.
+    world["resolved timing"] = scenario.sim.timing
     return json.dumps(world, sort_keys=True, default=repr)
 
 
