@@ -1,9 +1,11 @@
 """Campaign runs that differ only in their design are grouped by world and run as one
 reference run and forked variants: the rows are those of the runs made in full."""
 
+from pathlib import Path
+
 from fpga_robotics.checks.summary import TIMING_FIELDS
-from fpga_robotics.sweep import load_campaign, run_campaign
-from fpga_robotics.sweep.fork_groups import fork_groups
+from fpga_robotics.sweep import load_campaign, run_campaign, runner
+from fpga_robotics.sweep.fork_groups import execute_group, fork_groups
 from fpga_robotics.sweep.plan import make_plan
 
 #: Two seeds, four designs each (when to search and which way), and a heavier robot (another
@@ -18,6 +20,9 @@ CAMPAIGN = {
     "grid": {"design.lost_frames": [5, 15], "design.search_dps": [-300, 250]},
     "sets": [{"robot.mass": 8.0, "design.lost_frames": 5}],
 }
+
+#: A design of one's own that ``sim.timing = "auto"`` runs in real-clock timing.
+NEAR_RED = Path(__file__).parent / "data" / "user_designs" / "near_red.py"
 
 #: Row fields that measure the machine, not the run.
 TIMES = {"wall_s", "cpu_s", "run_s", *TIMING_FIELDS}
@@ -96,3 +101,57 @@ def test_runs_whose_designs_resolve_to_two_timings_share_no_world():
     check_same_world(frames, same)  # the same timing: forkable
     with pytest.raises(ValueError, match="a variant runs in real_clock timing, the reference"):
         check_same_world(frames, pins)
+
+
+def test_designs_resolved_to_two_timings_are_not_forked_from_one_another(tmp_path):
+    # One world for both designs, but "auto" runs FollowTarget in compressed timing and
+    # NearRed in real-clock timing: neither can be a variant of the other.
+    campaign = load_campaign(
+        {
+            "name": "timings",
+            "scenarios": ["lost_target"],
+            "seeds": [0],
+            "duration": 1.0,
+            "resolution": "40x30",
+            "set": ["sim.clock_hz=200000", "camera.fps=10"],
+            "grid": {"design.top": ["follow_target", f"{NEAR_RED}:NearRed"]},
+        }
+    )
+    plan = make_plan(campaign)
+    assert [len(g) for g in fork_groups(plan.runs, plan.worlds)] == [1, 1]
+    forked = run_campaign(campaign, tmp_path / "forked", workers=1, record="none")
+    full = run_campaign(campaign, tmp_path / "full", workers=1, record="none", fork=False)
+
+    def by_id(rows):
+        return {r["run_id"]: {k: v for k, v in r.items() if k not in TIMES} for r in rows}
+
+    assert by_id(forked) == by_id(full)
+    assert {r["status"] for r in forked} <= {"pass", "fail"}
+
+
+def test_a_run_in_another_timing_than_the_reference_is_run_in_full():
+    # A group given runs in two timings (FollowTarget compressed, NearRed real clock): the
+    # second is no variant of the first, and gets the row of its own full run.
+    scenario = str(NEAR_RED.with_suffix(".toml"))
+    run = ["--scenario", scenario, "--seed", "0", "--duration", "1.0"]
+    argvs = [
+        [
+            *run,
+            "--backend",
+            "model",
+            "--set",
+            'design.top="follow_target"',
+            "--set",
+            "design.params={}",
+        ],
+        [*run, "--backend", "cxxrtl"],
+    ]
+    grouped = execute_group(argvs, [None, None], ["follow_target", "near_red"])
+    for argv, outcome in zip(argvs, grouped, strict=True):
+        alone = runner.execute(argv)
+        assert outcome["status"] == alone["status"] != "error", outcome["message"]
+        mine, theirs = (
+            {k: v for k, v in o["summary"].items() if k not in TIMING_FIELDS}
+            for o in (outcome, alone)
+        )
+        assert mine == theirs

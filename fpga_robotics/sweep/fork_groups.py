@@ -1,8 +1,8 @@
 """Campaign runs that share a world, run as one reference run and forked variants.
 
 Runs of one scenario and seed whose scenarios differ only in their design or checks (a
-parameter sweep, design references) see the same world until their designs drive
-differently: such a group is one Dask task that runs its first member in full as a fork
+parameter sweep, design references), in one timing, see the same world until their designs
+drive differently: such a group is one Dask task that runs its first member in full as a fork
 reference (fpga_robotics.loop.fork, pin_fork) and every other as a variant of it, each
 re-simulated in the world only from where it parts. Every member's row is the row its own
 full run gives (the times excepted). Runs with a shadow design or ``[runtime]`` values, and
