@@ -90,7 +90,7 @@ JUDGED_IF = {
         0.05,
         0.04,
         {"off_target_fraction": None},
-        "the design never reported the target found with it in view",
+        "the design never reported the target found with its centre in view, nor with it out of view",
     ),
     "mean_centroid_error_max_px": (
         1.5,

@@ -271,17 +271,19 @@ SHIPPED_CHECKS = (
             "the design's centroid is more than an eighth of the image width from the target's "
             "image column (with the target partly beyond the tracking window's edge, from the "
             "middle of its part inside) in at most this fraction of the frames in which it "
-            "reports found with the target's centre in view (a non-target object taken for "
-            "the target)"
+            "reports found with the target's centre in view or with none of the target in "
+            "view, these all away (a non-target object taken for the target)"
         ),
         lambda v, limit, m: (
-            f"centroid away from the target in {percent(v, limit)} of the frames with "
-            f"the target found and in view (limit <= {limit_percent(limit)})"
+            f"centroid away from the target, or the target out of view, in {percent(v, limit)} "
+            f"of the frames found (limit <= {limit_percent(limit)})"
         ),
         limits=_FRACTION,
         outputs=("found", "centroid_x"),
         precondition=measured(
-            "off_target_fraction", "the design never reported the target found with it in view"
+            "off_target_fraction",
+            "the design never reported the target found with its centre in view, nor with "
+            "it out of view",
         ),
     ),
     Check(
