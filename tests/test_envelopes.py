@@ -379,7 +379,7 @@ def test_stop_overshoot_uses_the_colour_followed_in_each_frame():
         (
             DEFAULT.replace(base_dps=(0, 400, 300, 200, 150, 100, 100, 100)),
             RED,
-            "the law never stops (no base_dps <= 0)",
+            "the law never stops near the target (no base_dps <= 0 at proximity levels 1..7)",
         ),
         (
             DEFAULT,

@@ -196,6 +196,39 @@ def test_reacquisition_needs_a_search_that_ended():
     assert c["status"] == "fail" and "not found again for 2.00 s" in c["text"]
 
 
+def test_a_loss_longer_than_the_limit_fails_though_the_design_never_searched():
+    """A design that never searches (lost_frames beyond the loss) and loses the target for
+    longer than the limit fails: the loss is what is judged, not the search."""
+    tr = trajectory([1] * 100, [1.0] * 100)  # 10 s
+    hidden = compute_metrics(tr, events((0.0, "target found"), (1.2, "target lost")), {}, PERIOD)
+    assert hidden["searched_losses"] == 0 and hidden["unrecovered_losses_s"] == [8.8]
+    (c,) = evaluate_checks({"reacquired_within_s": 4.0}, hidden)
+    assert c["status"] == "fail" and c["text"] == (
+        "target lost and not found again for 8.80 s (limit 4.0 s)"
+    )
+    came_back = compute_metrics(
+        tr, events((0.0, "target found"), (1.0, "target lost"), (6.0, "target found")), {}, PERIOD
+    )
+    (c,) = evaluate_checks({"reacquired_within_s": 4.0}, came_back)
+    assert c["status"] == "fail" and c["value"] == 5.0
+    # Within the limit and never searched: nothing to judge, as before.
+    (c,) = evaluate_checks({"reacquired_within_s": 6.0}, came_back)
+    assert c["status"] == "n/a"
+    assert c["reason"] == "the target was never lost long enough for the design to search"
+
+
+def test_reacquisition_says_why_there_was_no_loss():
+    tr = trajectory([0] * 30 + [1] * 70, [1.0] * 100)
+    # Found after a search from the start (a robot facing away): searched, never lost.
+    m = compute_metrics(tr, events((1.5, "search started"), (3.0, "target found")), {}, PERIOD)
+    assert m["searches"] == 1 and m["losses"] == 0
+    (c,) = evaluate_checks({"reacquired_within_s": 4.0}, m)
+    assert (c["status"], c["reason"]) == ("n/a", "the target was never lost")
+    never = compute_metrics(trajectory([0] * 100, [1.0] * 100), [], {}, PERIOD)
+    (c,) = evaluate_checks({"reacquired_within_s": 4.0}, never)
+    assert (c["status"], c["reason"]) == ("n/a", "the target was never found, so never lost")
+
+
 def test_each_check_compares_with_its_limit():
     m = compute_metrics(
         trajectory([1, 1, 1, 1], [1.0, 0.8, 0.6, 1.4], in_view=[1, 1, 1, 0]),

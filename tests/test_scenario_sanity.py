@@ -90,6 +90,14 @@ def test_a_path_across_the_robots_start(tmp_path):
     ]
     # 0.4 m: they pass clear of it.
     assert _warnings(tmp_path, robot + _person([(0.5, 3.4), (4.0, 3.4)])) == []
+    # The same start by default: the warning says it is the default, which the file lacks.
+    assert _warnings(tmp_path, _person([(0.5, 3.3), (4.0, 3.3)])) == [
+        (
+            "people[0].waypoints[0] -> [1] passes 0.30 m from the default robot.start (the "
+            "scenario sets none) [1.5, 3]: the person (radius 0.2 m) walks into the robot "
+            "(radius 0.177 m) where it starts"
+        )
+    ]
     # With yield_gap 0.3 the person stops 0.3 m short: 0.4 < 0.377 + 0.3 blocks them.
     yielding = _person([(0.5, 3.4), (4.0, 3.4)], extra="yield_gap = 0.3\n")
     assert _warnings(tmp_path, robot + yielding) == [
@@ -139,11 +147,11 @@ def test_distance_checks_decided_by_the_bodies_and_the_room(tmp_path):
             "apart in the room: it always fails"
         )
     ]
-    # Frame 0 is fixed by the file: the target stands at [5, 3], 3.5 m from robot.start.
+    # Frame 0 is fixed by the file: the target stands at [5, 3], 3.5 m from the default start.
     assert _warnings(tmp_path, person + "[checks]\nmin_distance_min_m = 3.6\n") == [
         (
             "checks.min_distance_min_m = 3.6 m is beyond 3.50 m, the target's first waypoint "
-            "from robot.start: it always fails"
+            "from the default robot.start (the scenario sets none): it always fails"
         )
     ]
     assert (

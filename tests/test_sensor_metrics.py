@@ -28,7 +28,7 @@ def test_resumed_after_is_the_first_row_the_robot_has_driven_the_margin_towards_
     # enough), 0.25 m by 1.6 s.
     t = [0.0, 0.5, 1.0, 1.2, 1.4, 1.6, 1.8]
     x = [0.5, 1.0, 1.0, 1.0, 1.1, 1.25, 1.5]
-    m = obstacle_metrics(_traj(t, x, [3.0] * 7), REMOVED)
+    m = obstacle_metrics(_traj(t, x, [3.0] * 7), REMOVED, 0.2)
     assert m["obstacle_removed_at_s"] == 1.0
     assert 0.1 < RESUME_CLOSING_M < 0.25
     assert m["resumed_after_s"] == pytest.approx(0.6)
@@ -39,14 +39,14 @@ def test_resumed_after_is_the_first_row_the_robot_has_driven_the_margin_towards_
 def test_a_person_walking_up_to_a_robot_that_stays_put_is_not_a_resumption():
     # The robot stands at x = 1 while the person walks from 3 to 2: 1 m closer, robot 0 m.
     t = [1.0, 1.5, 2.0, 2.5, 3.0]
-    m = obstacle_metrics(_traj(t, [1.0] * 5, [3.0, 2.75, 2.5, 2.25, 2.0]), REMOVED)
+    m = obstacle_metrics(_traj(t, [1.0] * 5, [3.0, 2.75, 2.5, 2.25, 2.0]), REMOVED, 0.5)
     assert m["resumed_after_s"] is None
     ok, text = sensor_check("resumes_within_s", 1.5, m)
     assert ok is False and text.startswith("the robot never drove 0.2 m towards the target")
     # Following a person who walks away as fast: the distance stays 2 m, the robot drives
     # 0.25 m a row towards them: 0.25 >= 0.2 after the first step, at 1.5 s.
     walk = [1.0, 1.25, 1.5, 1.75, 2.0]
-    m = obstacle_metrics(_traj(t, walk, [w + 2.0 for w in walk]), REMOVED)
+    m = obstacle_metrics(_traj(t, walk, [w + 2.0 for w in walk]), REMOVED, 0.5)
     assert m["resumed_after_s"] == pytest.approx(0.5)
     assert sensor_check("resumes_within_s", 1.0, m)[1] == (
         "drove 0.2 m towards the target 0.50 s after the obstacle left (limit 1.0 s)"
@@ -54,19 +54,20 @@ def test_a_person_walking_up_to_a_robot_that_stays_put_is_not_a_resumption():
 
 
 def test_a_run_that_ends_before_the_limit_has_passed_is_not_judged():
-    # Removed at 1.0 s, the robot standing still, the run's last row at 3.0 s: 2 s after the
-    # removal, so a limit of 3 s cannot have been missed yet, while one of 2 s has.
+    # Removed at 1.0 s, the robot standing still, the run's last row at 3.0 s, a row every
+    # 0.5 s: the run ends at 3.5 s, 2.5 s after the removal, so a limit of 3 s cannot have
+    # been missed yet, while one of 2.5 s has (the run went on that long).
     t = [1.0, 1.5, 2.0, 2.5, 3.0]
-    m = obstacle_metrics(_traj(t, [1.0] * 5, [3.0] * 5), REMOVED)
-    assert m["resumed_after_s"] is None and m["run_after_removal_s"] == pytest.approx(2.0)
+    m = obstacle_metrics(_traj(t, [1.0] * 5, [3.0] * 5), REMOVED, 0.5)
+    assert m["resumed_after_s"] is None and m["run_after_removal_s"] == pytest.approx(2.5)
     assert sensor_check("resumes_within_s", 3.0, m) == (
         None,
         (
-            "the run ended 2.00 s after the obstacle left at 1.00 s, before the 3.0 s limit: "
+            "the run ended 2.50 s after the obstacle left at 1.00 s, before the 3.0 s limit: "
             "no resumption to judge"
         ),
     )
-    assert sensor_check("resumes_within_s", 2.0, m)[0] is False
+    assert sensor_check("resumes_within_s", 2.5, m)[0] is False
 
 
 def test_only_the_motion_along_the_direction_to_the_target_counts():
@@ -74,18 +75,18 @@ def test_only_the_motion_along_the_direction_to_the_target_counts():
     # Along the direction to the target at each step's start: (0, 0.3) . (2, 0) / 2 = 0, then
     # (0, 0.3) . (2, -0.3) / 2.0224 = -0.0445 (away), then less still: never 0.2 m towards it.
     t = [1.0, 1.5, 2.0, 2.5]
-    m = obstacle_metrics(_traj(t, [1.0] * 4, [3.0] * 4, robot_y=[0.0, 0.3, 0.6, 0.9]), REMOVED)
+    m = obstacle_metrics(_traj(t, [1.0] * 4, [3.0] * 4, robot_y=[0.0, 0.3, 0.6, 0.9]), REMOVED, 0.5)
     assert m["resumed_after_s"] is None
     # The same path along +x, straight at the target: 0.3 m by the first step, at 1.5 s.
-    m = obstacle_metrics(_traj(t, [1.0, 1.3, 1.6, 1.9], [3.0] * 4), REMOVED)
+    m = obstacle_metrics(_traj(t, [1.0, 1.3, 1.6, 1.9], [3.0] * 4), REMOVED, 0.5)
     assert m["resumed_after_s"] == pytest.approx(0.5)
 
 
 def test_never_removed_is_not_judged_and_no_target_never_resumes():
-    m = obstacle_metrics(_traj([0, 1], [1.0, 2.0], [3.0, 3.0]), [])
+    m = obstacle_metrics(_traj([0, 1], [1.0, 2.0], [3.0, 3.0]), [], 1.0)
     ok, text = sensor_check("resumes_within_s", 5.0, m)
     assert not ok and "no furniture was removed" in text
-    m = obstacle_metrics(_traj([1.0, 2.0], [1.0, 2.0], [np.nan] * 2), REMOVED)
+    m = obstacle_metrics(_traj([1.0, 2.0], [1.0, 2.0], [np.nan] * 2), REMOVED, 1.0)
     assert m["resumed_after_s"] is None
 
 
@@ -146,3 +147,31 @@ def test_laps_count_the_net_progress_around_a_closed_line():
     # The same way back: still one whole lap (net progress, either direction).
     m = line_metrics(_rows(xs[::-1], ys[::-1], np.zeros_like(s)), [square], [Mount()], 0.1)
     assert m["laps"] == 1
+
+
+@pytest.mark.timeout(120)
+def test_a_run_that_lasts_the_limit_after_the_removal_is_judged(tmp_path):
+    """The box leaves at 1 s of a 2 s run and the robot never moves (every base_dps 0): the
+    run went on the whole 1 s limit after the removal (its last frame is at 1.967 s, the run
+    ends at 2 s), so the robot failed to resume: a fail, not n/a."""
+    from fpga_robotics.loop import run_scenario
+    from fpga_robotics.scenario import load_scenario
+
+    path = tmp_path / "still.toml"
+    path.write_text(
+        "[sim]\nduration = 2.0\n"
+        "[design]\nbase_dps = [0, 0, 0, 0, 0, 0, 0, 0]\n"
+        '[[room.furniture]]\nname = "box"\ncenter = [3.0, 1.0]\npresent_until = 1.0\n'
+        "[[people]]\nwaypoints = [[4.0, 3.0]]\n"
+        "[checks]\nresumes_within_s = 1.0\n"
+    )
+    r = run_scenario(load_scenario(str(path)), backend="model")
+    assert r.summary["sim_time_s"] == 2.0 and r.summary["run_after_removal_s"] == 1.0
+    (c,) = r.summary["checks"]
+    assert (c["status"], c["text"]) == (
+        "fail",
+        (
+            "the robot never drove 0.2 m towards the target after the obstacle left at 1.00 s "
+            "(limit 1.0 s)"
+        ),
+    )

@@ -59,8 +59,36 @@ def test_off_target_fraction_counts_frames_found_with_the_target_in_view():
     (c,) = evaluate_checks({"max_off_target_fraction": 0.05}, m)
     assert not c["passed"]
     assert c["text"] == (
-        "centroid away from the target in 33% of the frames with the target "
-        "found and in view (limit <= 5%)"
+        "centroid away from the target, or the target out of view, in 33% of the frames found "
+        "(limit <= 5%)"
+    )
+
+
+def test_frames_found_with_the_target_out_of_view_are_away():
+    """A design that reports found while none of the target is in view has taken something
+    else for it (a red passer-by it follows while the target, in blue, is behind): those
+    frames count as away, so a design that locks on such a decoy fails instead of being n/a."""
+    # Two frames found on the target (error 0), two found with the target out of view: 2 of 4.
+    tr = _traj([80, 80, 40, 120], [80, 80, math.nan, math.nan], [True] * 4)
+    tr["target_in_view"] = np.array([True, True, False, False])
+    m = compute_metrics(tr, [], {}, 1 / 30, width=160)
+    assert m["off_target_fraction"] == 0.5 and m["mean_centroid_error_px"] == 0.0
+    # Found only on the decoy: all away; the mean error has no frame to judge.
+    tr["target_in_view"][:] = False
+    tr["target_column"][:] = math.nan
+    m = compute_metrics(tr, [], {}, 1 / 30, width=160)
+    assert m["off_target_fraction"] == 1.0 and m["mean_centroid_error_px"] is None
+    off, mean = evaluate_checks(
+        {"max_off_target_fraction": 0.05, "mean_centroid_error_max_px": 3.0}, m
+    )
+    assert off["status"] == "fail" and mean["status"] == "n/a"
+    # Never found: nothing to judge.
+    tr["found"][:] = False
+    m = compute_metrics(tr, [], {}, 1 / 30, width=160)
+    (off,) = evaluate_checks({"max_off_target_fraction": 0.05}, m)
+    assert off["status"] == "n/a" and off["reason"] == (
+        "the design never reported the target found with its centre in view, nor with it out "
+        "of view"
     )
 
 

@@ -198,6 +198,45 @@ def test_robot_starting_on_a_person_is_an_error():
         World.from_config(cfg, seed=0)
 
 
+def test_an_error_names_the_default_start_and_what_to_set():
+    """The user who wrote no robot.start is told it is the default and which key to set."""
+    desk = {"room": {"furniture": [{"name": "desk", "center": [1.5, 3.0]}]}}
+    default = r"the default robot\.start \(the scenario sets none\) \[1\.5, 3\] overlaps"
+    with pytest.raises(WorldConfigError, match=default + " the furniture 'desk'; set robot.start"):
+        World.from_config(desk, seed=0)
+    # Written by the user: named as written, no advice.
+    desk["robot"] = {"start": [1.5, 3.0]}
+    with pytest.raises(WorldConfigError, match=r"^robot\.start \[1\.5, 3\] overlaps[^;]*$"):
+        World.from_config(desk, seed=0)
+    # A robot too wide to stand beside the default person (0.5 m apart at any width).
+    with pytest.raises(
+        WorldConfigError,
+        match=r"default robot\.start .*\[1\.5, 3\] overlaps the person 'target' \(at \[2, 3\]\); "
+        "set robot.start",
+    ):
+        World.from_config({"room": {"width": 4.0}, "robot": {"body_radius": 0.4}}, seed=0)
+    with pytest.raises(
+        WorldConfigError,
+        match=r"default robot\.start .* \[0\.1, 3\] puts the robot .* set robot\.start$",
+    ):
+        World.from_config({"room": {"width": 1.2}}, seed=0)
+    with pytest.raises(WorldConfigError, match=r"^the default person \(the scenario has no"):
+        World.from_config({"room": {"width": 8.0, "depth": 0.7}}, seed=0)
+
+
+@pytest.mark.parametrize("width", [1.4, 2.0, 3.0, 3.7, 3.9, 5.0, 8.0, 30.0])
+def test_the_default_placement_fits_a_narrow_room(width):
+    """The default robot starts 1.5 m in, or half a metre short of mid-room in a room narrower
+    than 4 m; the default person stands mid-room ahead of it: clear of each other (their bodies
+    touch 0.377 m apart) in any room 1.4 m wide or more."""
+    world = World.from_config({"room": {"width": width, "depth": 8.0}}, seed=0)
+    x, y = world.config.robot.start
+    assert (x, y) == (min(1.5, width / 2 - 0.5), 4.0)
+    (person,) = world.config.people
+    px, py = person.waypoints[0]
+    assert py == y and px - x >= world.config.robot.spec.body_radius + person.radius
+
+
 def test_seed_must_be_a_non_negative_integer():
     with pytest.raises(ValueError, match="seed"):
         World.from_config({}, seed=-1)

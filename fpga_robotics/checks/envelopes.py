@@ -482,7 +482,9 @@ def envelope_metrics(traj, params, geom):
         out["stop_distance_m"] = float(near[deepest])
         out["stop_closest_m"] = float(min(dist[same]))
     elif _stop_level(params) is None:
-        out["stop_reason"] = "the law never stops (no base_dps <= 0)"
+        out["stop_reason"] = (
+            "the law never stops near the target (no base_dps <= 0 at proximity levels 1..7)"
+        )
     elif stops and not any(stops.values()):
         out["stop_reason"] = (
             "the law never stops for the colour followed (its count never reaches the "

@@ -60,11 +60,12 @@ def line_metrics(traj, lines, mounts, period):
     }
 
 
-def obstacle_metrics(traj, events):
+def obstacle_metrics(traj, events, frame_period):
     """``obstacle_removed_at_s`` (the last furniture removal), ``resumed_after_s`` (from
     then until the robot has driven ``RESUME_CLOSING_M`` towards the target; None if never)
-    and ``run_after_removal_s`` (from then to the run's last row: a run that ends before a
-    limit has passed cannot show that the robot failed to resume within it).
+    and ``run_after_removal_s`` (from then to the end of the run, a frame period after its
+    last row, as for the loss episodes: a run that ends before a limit has passed cannot show
+    that the robot failed to resume within it).
 
     Only the robot's own motion counts: each step's displacement along the direction from the
     robot to the target at the step's start, summed. A person walking up to a robot that
@@ -89,7 +90,7 @@ def obstacle_metrics(traj, events):
     return {
         "obstacle_removed_at_s": round(t_r, 6),
         "resumed_after_s": resumed,
-        "run_after_removal_s": float(t[-1] - t_r),
+        "run_after_removal_s": float(t[-1] + frame_period - t_r),
     }
 
 

@@ -77,9 +77,10 @@ def _late(m, limit):
 
 def _reacquired(v, limit, m):
     """No loss took longer than the limit to end, none still open at the end is older than
-    it, and a searched loss ended with the target found: a pass. With the only searched loss
-    still open, younger than the limit, when the run ended there is nothing to judge (None):
-    the run was cut short, not the design."""
+    it, and a searched loss ended with the target found: a pass. A loss longer than the limit
+    fails whether or not the design searched (one that never searches must not escape). With
+    no loss searched, or the only searched loss still open, younger than the limit, when the
+    run ended, there is nothing to judge (None): the run was cut short, not the design."""
     if any(x > limit for x in m["reacquire_times_s"]) or _late(m, limit):
         return False
     return True if m["searched_reacquisitions"] >= 1 else None
@@ -92,6 +93,8 @@ def _reacquired_text(v, limit, m):
             f"target lost and not found again for {_num(max(late), limit, 2)} s (limit {limit} s)"
         )
     if _reacquired(v, limit, m) is None:
+        if m["searched_losses"] == 0:
+            return "the target was never lost long enough for the design to search"
         return (
             f"the run ended {_num(m['unrecovered_losses_s'][-1], limit, 2)} s after the target "
             f"was lost, the design still searching, within the {limit} s limit: no "
@@ -268,17 +271,19 @@ SHIPPED_CHECKS = (
             "the design's centroid is more than an eighth of the image width from the target's "
             "image column (with the target partly beyond the tracking window's edge, from the "
             "middle of its part inside) in at most this fraction of the frames in which it "
-            "reports found with the target's centre in view (a non-target object taken for "
-            "the target)"
+            "reports found with the target's centre in view or with none of the target in "
+            "view, these all away (a non-target object taken for the target)"
         ),
         lambda v, limit, m: (
-            f"centroid away from the target in {percent(v, limit)} of the frames with "
-            f"the target found and in view (limit <= {limit_percent(limit)})"
+            f"centroid away from the target, or the target out of view, in {percent(v, limit)} "
+            f"of the frames found (limit <= {limit_percent(limit)})"
         ),
         limits=_FRACTION,
         outputs=("found", "centroid_x"),
         precondition=measured(
-            "off_target_fraction", "the design never reported the target found with it in view"
+            "off_target_fraction",
+            "the design never reported the target found with its centre in view, nor with "
+            "it out of view",
         ),
     ),
     Check(
@@ -426,9 +431,11 @@ SHIPPED_CHECKS = (
         limits=(0, _DAY, "s"),
         outputs=("found",),
         precondition=lambda m: (
-            "the target was never lost long enough for the design to search"
-            if m.get("searched_losses") == 0
-            else None
+            None
+            if m["reacquire_times_s"] or m["unrecovered_losses_s"]
+            else "the target was never found, so never lost"
+            if m["acquired_at_s"] is None
+            else "the target was never lost"
         ),
         passes=_reacquired,
     ),

@@ -296,11 +296,14 @@ def _off_target(traj, width, margin_x=None, lit_strip=None):
     out). In the ``lit_strip`` frames only a lit strip of the suit may match, its centroid
     anywhere on the part inside: the error there is from the nearest point of that part
     (another object's pixels beside the target still pull the centroid off it). The
-    fraction of those frames with an error above ``OFF_TARGET_FRACTION * width``, and the
-    mean error (pixels). None without such frames or fields."""
+    fraction of those frames with an error above ``OFF_TARGET_FRACTION * width``, the frames
+    found with no part of the target in view counted too, as away (whatever the design found
+    there is not the target); and the mean error (pixels) over the first. None without such
+    frames or fields."""
     none = {"off_target_fraction": None, "mean_centroid_error_px": None}
     if width is None or "target_column" not in traj or "centroid_x" not in traj:
         return none
+    elsewhere = int(np.count_nonzero(traj["found"] & ~np.asarray(traj["target_in_view"], bool)))
     column = np.asarray(traj["target_column"], dtype=float)
     expected = column
     if "target_left" in traj and "target_right" in traj:
@@ -314,14 +317,15 @@ def _off_target(traj, width, margin_x=None, lit_strip=None):
     centroid = np.asarray(traj["centroid_x"], dtype=float)
     ok = traj["found"] & ~np.isnan(column) & ~np.isnan(expected)
     if not ok.any():
-        return none
+        return {**none, "off_target_fraction": 1.0} if elsewhere else none
     err = np.abs(centroid - expected)
     if lit_strip is not None and "target_left" in traj and "target_right" in traj:
         lo, hi = window_columns(width, margin_x)
         nearest = np.clip(centroid, np.maximum(left, lo), np.minimum(right, hi))
         err = np.where(lit_strip, np.abs(centroid - nearest), err)
+    away = np.count_nonzero(err[ok] > OFF_TARGET_FRACTION * width) + elsewhere
     return {
-        "off_target_fraction": float((err[ok] > OFF_TARGET_FRACTION * width).mean()),
+        "off_target_fraction": float(away / (np.count_nonzero(ok) + elsewhere)),
         "mean_centroid_error_px": float(err[ok].mean()),
     }
 

@@ -513,7 +513,7 @@ class ClosedLoop:
         geometry = envelope_geometry(self.scenario, self.world.config, self.camera)
         rig = self.rig.metrics(self.frames_done) if self.rig is not None else {}
         return {
-            **obstacle_metrics(self.traj, self.events),
+            **obstacle_metrics(self.traj, self.events, self.period),
             **envelope_metrics(self.traj, self.scenario.params, geometry),
             **rig,
         }

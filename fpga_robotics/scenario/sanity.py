@@ -7,6 +7,7 @@ them before they start; with ``--strict`` they are usage errors.
 
 import math
 
+from fpga_robotics.sim.world.config import start_name
 from fpga_robotics.sim.world.sanity import world_warnings
 
 __all__ = ["report_warnings", "scenario_warnings"]
@@ -62,7 +63,8 @@ def _check_warnings(world, checks):
         # Frame 0's distance is fixed by the file: the target stands at its first waypoint.
         out.append(
             f"checks.min_distance_min_m = {limit:g} m is beyond {start_gap:.2f} m, the "
-            f"target's first waypoint from robot.start: it always fails"
+            f"target's first waypoint from {start_name(world.robot.default_start)}: it always "
+            "fails"
         )
     return out
 

@@ -50,6 +50,7 @@ __all__ = [
     "WorldConfig",
     "WorldConfigError",
     "parse_world_config",
+    "start_name",
 ]
 
 #: The scenario sections that describe the world.
@@ -118,6 +119,7 @@ class RobotConfig:
     start: tuple  # (x, y), m
     heading: float  # rad
     uncertainty: Uncertainty = Uncertainty()
+    default_start: bool = False  # the scenario sets no robot.start: errors must say so
 
 
 @dataclass(frozen=True)
@@ -310,10 +312,17 @@ _SPEC_KEYS = (
 )
 
 
+def start_name(default):
+    """How an error names the robot's start: a default the user never wrote is said to be one."""
+    return "the default robot.start (the scenario sets none)" if default else "robot.start"
+
+
 def _parse_robot(section, room):
     k = _keys(RobotKeys, section, "robot")
     base = ROBOT_MODELS[k.model]
-    start = k.start or (min(1.5, room.width / 2), room.depth / 2)
+    # Half a metre short of mid-room at most: the default person's first waypoint, mid-room,
+    # stays ahead of the robot, clear of it, in a narrow room too.
+    start = k.start or (min(1.5, room.width / 2 - 0.5), room.depth / 2)
     fields = {
         key: getattr(base, key) if getattr(k, key) is None else getattr(k, key)
         for key in _SPEC_KEYS
@@ -341,10 +350,11 @@ def _parse_robot(section, room):
     spec = base.with_overrides(**fields)
     if not _inside(start, spec.body_radius, room):
         raise WorldConfigError(
-            f"robot.start {_fmt(start)} puts the robot (radius {spec.body_radius:g} m) outside "
-            f"the room (0..{room.width:g} x 0..{room.depth:g} m)"
+            f"{start_name(k.start is None)} {_fmt(start)} puts the robot (radius "
+            f"{spec.body_radius:g} m) outside the room (0..{room.width:g} x 0..{room.depth:g} m)"
+            + ("; set robot.start" if k.start is None else "")
         )
-    return RobotConfig(spec, tuple(start), k.heading_deg * DEG, uncertainty)
+    return RobotConfig(spec, tuple(start), k.heading_deg * DEG, uncertainty, k.start is None)
 
 
 def default_people(room):
@@ -411,7 +421,14 @@ def _parse_person(item, path, index, room):
 
 def _parse_people(section, room):
     if section is None:
-        section = default_people(room)
+        try:
+            return _parse_people(default_people(room), room)
+        except WorldConfigError as e:
+            raise WorldConfigError(
+                f"the default person (the scenario has no [[people]]) does not fit the "
+                f"{room.width:g} x {room.depth:g} m room: {e}; give [[people]] with waypoints "
+                "inside it"
+            ) from None
     if not isinstance(section, list):
         raise WorldConfigError(
             f"people must be an array of tables ([[people]]), got {show(section)}"

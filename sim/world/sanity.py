@@ -10,6 +10,8 @@ a path through the place it stood may be the point of the scenario.
 
 import math
 
+from .config import start_name
+
 __all__ = ["point_in_polygon", "segment_distance", "world_warnings"]
 
 
@@ -106,7 +108,8 @@ def world_warnings(config):
                     else f"walks into the robot (radius {robot_radius:g} m) where it starts"
                 )
                 warnings.append(
-                    f"{path}[{j}] -> [{k}] passes {d:.2f} m from robot.start {_fmt(start)}: "
+                    f"{path}[{j}] -> [{k}] passes {d:.2f} m from "
+                    f"{start_name(config.robot.default_start)} {_fmt(start)}: "
                     f"the person (radius {person.radius:g} m) {outcome}"
                 )
     return warnings

@@ -18,7 +18,7 @@ import pymunk
 from ..camera.scene import CameraPose, Cylinder, Scene
 from ..records import PersonState, WorldMap
 from .collisions import AT_FAULT_SPEED, CollisionLog, MotionHistory, closing_speeds
-from .config import WorldConfigError, parse_world_config
+from .config import WorldConfigError, parse_world_config, start_name
 from .lighting import SCHEDULE_SLACK, LightingSchedule
 from .motors import DriveMotors
 from .people import PersonPath, person_bands
@@ -231,8 +231,14 @@ class World:
         for hit in space.shape_query(shape):
             kind, name = self._names[hit.shape]
             what = f"{kind} {name!r}" if name else kind
+            if kind == "person":  # where they stand at t = 0: their first waypoint
+                what += f" (at [{hit.shape.body.position.x:g}, {hit.shape.body.position.y:g}])"
             x, y = config.robot.start
-            raise WorldConfigError(f"robot.start [{x:g}, {y:g}] overlaps the {what}")
+            default = config.robot.default_start
+            raise WorldConfigError(
+                f"{start_name(default)} [{x:g}, {y:g}] overlaps the {what}"
+                + ("; set robot.start to a place clear of it" if default else "")
+            )
 
         self._collisions = CollisionLog(_KINDS)
         self._history = MotionHistory()
