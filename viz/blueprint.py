@@ -46,13 +46,14 @@ def default_blueprint(
     frame_outputs=True,
     camera="rgb444",
     cameras=(),
+    wall_height=0.0,
 ):
     """The layout sent to the viewer; ``bounds`` ``(xmin, ymin, xmax, ymax)`` frame the map;
     ``camera`` (``rgb444`` or ``rgb888``, how the camera frame is recorded, or None: the
     design takes no camera, which only films the run) names its view;
     ``shadow`` adds a second LED row and the shadow design's wheel speeds; ``world3d`` puts
-    the world in 3D (``viz.world3d``) beside the map; ``sensors`` (series entity paths,
-    ``viz.sensors``) come first among the plots under the map, one tab each; ``cameras``
+    the world in 3D (``viz.world3d``) beside the map, its eye over walls ``wall_height``
+    high; ``sensors`` (series entity paths, ``viz.sensors``) come first among the plots under the map, one tab each; ``cameras``
     (further cameras' names, ``viz.cameras``) get a panel each beside the camera's."""
     further = [
         rrb.Spatial2DView(origin=f"{CAMERAS}/{name}/image", name=f"Camera {name}")
@@ -85,7 +86,7 @@ def default_blueprint(
             row_shares=[4, 3],
             name="Board",
         )
-        return _blueprint(board, bounds, map_kwargs, world3d, sensors)
+        return _blueprint(board, bounds, map_kwargs, world3d, sensors, wall_height)
     board = rrb.Vertical(
         rrb.Horizontal(
             rrb.Spatial2DView(origin=P.CAMERA_RAW, name=_CAMERA_NAMES[camera]),
@@ -116,10 +117,10 @@ def default_blueprint(
         row_shares=[4, 1, 1, 3] if shadow else [4, 1, 3],
         name="Board",
     )
-    return _blueprint(board, bounds, map_kwargs, world3d, sensors)
+    return _blueprint(board, bounds, map_kwargs, world3d, sensors, wall_height)
 
 
-def _blueprint(board, bounds, map_kwargs, world3d, sensors):
+def _blueprint(board, bounds, map_kwargs, world3d, sensors, wall_height):
     """The whole layout: ``board`` on the left, the world on the right."""
     top_down = rrb.Spatial2DView(
         origin=P.MAP,
@@ -128,7 +129,7 @@ def _blueprint(board, bounds, map_kwargs, world3d, sensors):
         **map_kwargs,
     )
     world = rrb.Vertical(
-        rrb.Horizontal(top_down, world3d_view(bounds)) if world3d else top_down,
+        rrb.Horizontal(top_down, world3d_view(bounds, wall_height)) if world3d else top_down,
         rrb.Horizontal(
             rrb.Tabs(
                 *(rrb.TimeSeriesView(origin=path, name=path.split("/", 1)[1]) for path in sensors),

@@ -273,6 +273,7 @@ class Recorder:
                     frame_outputs=self._frame_outputs,
                     camera=self.camera if self._camera_input else None,
                     cameras=tuple(self._cameras.names),
+                    wall_height=0.0 if self._world3d is None else self._world3d.wall_height,
                 )
             )
         self._sensor_series = len(self._sensors.series)

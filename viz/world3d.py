@@ -106,20 +106,31 @@ def _limbs(cyl):
     return (strips, radii, cols), head
 
 
-def world3d_view(bounds=None):
+def eye_position(bounds, wall_height=0.0):
+    """Where the 3D view's eye starts and what it looks at, for a room of ``bounds``
+    ``(xmin, ymin, xmax, ymax)`` with walls ``wall_height`` high: above and in front of the
+    room (over its near wall), looking at its middle, high enough that the near wall hides at
+    most a tenth of the room's depth (from a fixed height, a 2.5 m wall hides all of a small
+    room)."""
+    xmin, ymin, xmax, ymax = (float(v) for v in bounds)
+    cx, cy = (xmin + xmax) / 2, (ymin + ymax) / 2
+    depth = ymax - ymin
+    size = max(xmax - xmin, depth)
+    back = 0.2 * size
+    # The line of sight over the wall's top meets the floor back * H / (z - H) behind it.
+    z = max(0.75 * size, wall_height * (1 + back / (0.1 * depth)))
+    return (cx, ymin - back, z), (cx, cy, 0.0)
+
+
+def world3d_view(bounds=None, wall_height=0.0):
     """The viewer's 3D view: the world and the camera frame on its pinhole (not the other
     images under the camera, such as the filtered frame). With the room's ``bounds``
-    ``(xmin, ymin, xmax, ymax)`` the eye starts above and in front of the room (over its
-    near wall), looking at its middle."""
+    ``(xmin, ymin, xmax, ymax)`` and its walls' height the eye starts above and in front of
+    the room (over its near wall), looking at its middle (``eye_position``)."""
     eye = None
     if bounds is not None:
-        xmin, ymin, xmax, ymax = (float(v) for v in bounds)
-        cx, cy, size = (xmin + xmax) / 2, (ymin + ymax) / 2, max(xmax - xmin, ymax - ymin)
-        eye = rrb.EyeControls3D(
-            position=(cx, ymin - 0.45 * size, 0.75 * size),
-            look_target=(cx, cy, 0.0),
-            eye_up=(0.0, 0.0, 1.0),
-        )
+        position, target = eye_position(bounds, wall_height)
+        eye = rrb.EyeControls3D(position=position, look_target=target, eye_up=(0.0, 0.0, 1.0))
     return rrb.Spatial3DView(
         origin="/",
         name="World (3D)",
@@ -136,12 +147,15 @@ class World3D:
         self._stream = stream
         self._walls = None
         self._pinhole = None
+        #: The room's walls' height as drawn, for the view's eye (``eye_position``).
+        self.wall_height = 0.0
 
     def _log_static(self, scene):
         log = self._stream.log
         log(WORLD3D, rr.ViewCoordinates.RIGHT_HAND_Z_UP, static=True)
         room = [w for w in scene.walls if w.kind == "room"]
         rest = [w for w in scene.walls if w.kind != "room"]
+        self.wall_height = max((w.height for w in room), default=0.0)
         for path, walls in ((ROOM, room), (FURNITURE, rest)):
             if walls:
                 centers, halves, quats, colors = _wall_boxes(walls)
