@@ -116,9 +116,10 @@ def eye_position(bounds, wall_height=0.0):
     cx, cy = (xmin + xmax) / 2, (ymin + ymax) / 2
     depth = ymax - ymin
     size = max(xmax - xmin, depth)
-    back = 0.2 * size
-    # The line of sight over the wall's top meets the floor back * H / (z - H) behind it.
-    z = max(0.75 * size, wall_height * (1 + back / (0.1 * depth)))
+    back = 0.1 * depth
+    # Over the near wall's top the line of sight meets the floor back * H / (z - H) inside
+    # the room: from z = 2.5 H, a fifteenth of its depth.
+    z = max(1.2 * size, 2.5 * wall_height)  # and far enough to take in the whole room
     return (cx, ymin - back, z), (cx, cy, 0.0)
 
 
