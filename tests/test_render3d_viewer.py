@@ -31,8 +31,9 @@ def test_the_room_and_the_divider_are_boxes_of_their_size(recorded):
     halves = sorted(tuple(round(v, 4) for v in h) for h in room["Boxes3D:half_sizes"])
     # 8 x 6 m room, 2.5 m high: two walls 4 m and two 3 m half long, 1.25 m half high.
     assert halves == [(3.0, 0.025, 1.25)] * 2 + [(4.0, 0.025, 1.25)] * 2
-    furniture = data.static["world3d/furniture"]
-    centers = furniture["Boxes3D:centers"]
+    furniture = data.entities["world3d/furniture"]
+    assert furniture.frames == [0]  # on the timeline: a piece may leave the room
+    (centers,) = furniture.values["Boxes3D:centers"]
     assert len(centers) == 2  # the divider's two faces
     for c in centers:
         assert c[2] == pytest.approx(1.8 / 2)  # its height, 1.8 m
@@ -86,6 +87,21 @@ def test_camera_rotation_maps_the_camera_axes():
     assert m[:, 2] == pytest.approx([0.0, math.cos(0.1), math.sin(0.1)])
     assert m[:, 1] == pytest.approx([0.0, math.sin(0.1), -math.cos(0.1)])  # down
     assert np.linalg.det(m) == pytest.approx(1.0)
+
+
+def test_a_piece_of_furniture_that_leaves_the_room_leaves_the_3d_view_then(tmp_path):
+    """The divider taken away at 0.2 s: drawn in the frames before, gone from frame 6 on, as
+    on the map and in the camera's frames."""
+    path = tmp_path / "gone.rrd"
+    scenario = load_scenario("divider", ["sim.duration=0.4", "room.furniture.0.present_until=0.2"])
+    with open_recorder(f"save:{path}", default_path=str(path)) as rec:
+        run_scenario(scenario, backend="model", recorder=rec)
+    data = read_rrd(str(path))
+    assert "world3d/furniture" not in data.static
+    furniture = data.entities["world3d/furniture"]
+    assert furniture.frames == data.entities["map/furniture"].frames == [0, 6]
+    assert len(furniture.values["Boxes3D:centers"][0]) == 2  # the divider's two faces
+    assert furniture.values["Clear:is_recursive"][1] == [False]  # none left from frame 6
 
 
 def _sees_the_floor_over_the_near_wall(eye, bounds, wall_height):

@@ -2,11 +2,11 @@
 and the robot's camera as a pinhole with its frustum and the current frame on it.
 
 Fed by ``FrameRecord.scene`` and ``camera_pose`` (a record without them logs nothing here).
-World coordinates as the physics has them (x, y on the floor, z up, metres). The static
-geometry (walls, furniture, floor) is logged once, static; the robot, the people and the
-camera's pose every frame. The camera's pinhole sits at ``camera``, the parent of the camera
-frame ``camera/raw`` that the recorder logs, so the frame appears on the frustum without
-being logged twice.
+World coordinates as the physics has them (x, y on the floor, z up, metres). The walls and
+floor are logged once, static; the furniture at the first frame and again when a piece
+leaves the room; the robot, the people and the camera's pose every frame. The camera's
+pinhole sits at ``camera``, the parent of the camera frame ``camera/raw`` that the recorder
+logs, so the frame appears on the frustum without being logged twice.
 """
 
 import math
@@ -151,13 +151,16 @@ class World3D:
         #: The room's walls' height as drawn, for the view's eye (``eye_position``).
         self.wall_height = 0.0
 
-    def _log_static(self, scene):
+    def _log_walls(self, scene):
         log = self._stream.log
         log(WORLD3D, rr.ViewCoordinates.RIGHT_HAND_Z_UP, static=True)
         room = [w for w in scene.walls if w.kind == "room"]
         rest = [w for w in scene.walls if w.kind != "room"]
         self.wall_height = max((w.height for w in room), default=0.0)
-        for path, walls in ((ROOM, room), (FURNITURE, rest)):
+        # The room stays; the furniture is on the timeline (set by the caller), since a piece
+        # may leave the room during the run: static, it would stay drawn, or vanish from the
+        # frames before its removal too.
+        for path, walls, static in ((ROOM, room, True), (FURNITURE, rest, False)):
             if walls:
                 centers, halves, quats, colors = _wall_boxes(walls)
                 log(
@@ -169,8 +172,10 @@ class World3D:
                         colors=colors,
                         fill_mode="solid",
                     ),
-                    static=True,
+                    static=static,
                 )
+            elif not static:
+                log(path, rr.Clear(recursive=False))
         xs = [v for w in room for v in (w.x0, w.x1)] or [0.0, 1.0]
         ys = [v for w in room for v in (w.y0, w.y1)] or [0.0, 1.0]
         log(
@@ -206,14 +211,14 @@ class World3D:
         scene, pose = record.scene, record.camera_pose
         if scene is None or pose is None:
             return
-        if scene.walls is not self._walls:
-            self._log_static(scene)
-        height, width = record.camera_rgb.shape[:2]
-        if self._pinhole != (width, height, record.camera_hfov):
-            self._log_pinhole(width, height, float(record.camera_hfov))
         s = self._stream
         s.set_time("frame", sequence=frame)
         s.set_time("sim_time", duration=t)
+        if scene.walls is not self._walls:
+            self._log_walls(scene)
+        height, width = record.camera_rgb.shape[:2]
+        if self._pinhole != (width, height, record.camera_hfov):
+            self._log_pinhole(width, height, float(record.camera_hfov))
         s.log(
             CAMERA,
             rr.Transform3D(
