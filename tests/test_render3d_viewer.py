@@ -6,13 +6,14 @@ import math
 
 import numpy as np
 import pytest
+from rerun.chunk import RrdReader
 
 from fpga_robotics.loop.timings import run_scenario
 from fpga_robotics.scenario.load import load_scenario
 from fpga_robotics.sim.world.robots import ROBOT_MODELS
 from fpga_robotics.viz import open_recorder
 from fpga_robotics.viz.readback import read_rrd
-from fpga_robotics.viz.world3d import CAMERA, camera_rotation
+from fpga_robotics.viz.world3d import CAMERA, camera_rotation, world3d_view
 
 
 @pytest.fixture(scope="module")
@@ -30,8 +31,9 @@ def test_the_room_and_the_divider_are_boxes_of_their_size(recorded):
     halves = sorted(tuple(round(v, 4) for v in h) for h in room["Boxes3D:half_sizes"])
     # 8 x 6 m room, 2.5 m high: two walls 4 m and two 3 m half long, 1.25 m half high.
     assert halves == [(3.0, 0.025, 1.25)] * 2 + [(4.0, 0.025, 1.25)] * 2
-    furniture = data.static["world3d/furniture"]
-    centers = furniture["Boxes3D:centers"]
+    furniture = data.entities["world3d/furniture"]
+    assert furniture.frames == [0]  # on the timeline: a piece may leave the room
+    (centers,) = furniture.values["Boxes3D:centers"]
     assert len(centers) == 2  # the divider's two faces
     for c in centers:
         assert c[2] == pytest.approx(1.8 / 2)  # its height, 1.8 m
@@ -85,3 +87,85 @@ def test_camera_rotation_maps_the_camera_axes():
     assert m[:, 2] == pytest.approx([0.0, math.cos(0.1), math.sin(0.1)])
     assert m[:, 1] == pytest.approx([0.0, math.sin(0.1), -math.cos(0.1)])  # down
     assert np.linalg.det(m) == pytest.approx(1.0)
+
+
+def test_a_piece_of_furniture_that_leaves_the_room_leaves_the_3d_view_then(tmp_path):
+    """The divider taken away at 0.2 s: drawn in the frames before, gone from frame 6 on, as
+    on the map and in the camera's frames."""
+    path = tmp_path / "gone.rrd"
+    scenario = load_scenario("divider", ["sim.duration=0.4", "room.furniture.0.present_until=0.2"])
+    with open_recorder(f"save:{path}", default_path=str(path)) as rec:
+        run_scenario(scenario, backend="model", recorder=rec)
+    data = read_rrd(str(path))
+    assert "world3d/furniture" not in data.static
+    furniture = data.entities["world3d/furniture"]
+    assert furniture.frames == data.entities["map/furniture"].frames == [0, 6]
+    assert len(furniture.values["Boxes3D:centers"][0]) == 2  # the divider's two faces
+    assert furniture.values["Clear:is_recursive"][1] == [False]  # none left from frame 6
+
+
+def _sees_the_floor_over_the_near_wall(eye, bounds, wall_height):
+    """Whether the line from ``eye`` to every floor point more than 15% of the room's depth
+    inside the near wall (y = ymin, along the whole room) passes above that wall's inner
+    face."""
+    _, ymin, _, ymax = bounds
+    _, ey, ez = eye
+    wall = ymin + 0.025  # the wall's inner face (5 cm thick, centred on its line)
+    for py in np.linspace(ymin + 0.15 * (ymax - ymin), ymax, 9):
+        t = (wall - ey) / (py - ey)  # where the line crosses the wall's face
+        if ez * (1 - t) <= wall_height:
+            return False
+    return True
+
+
+def _eye(view):
+    eye = view.properties["EyeControls3D"]
+    return (
+        tuple(eye.position.as_arrow_array().to_pylist()[0]),
+        tuple(eye.look_target.as_arrow_array().to_pylist()[0]),
+    )
+
+
+@pytest.mark.parametrize(
+    "bounds, wall_height",
+    [
+        ((0.0, 0.0, 3.6, 2.8), 2.5),  # line_track's room: hidden entirely from a low eye
+        ((0.0, 0.0, 8.0, 6.0), 2.5),
+        ((0.0, 0.0, 2.0, 10.0), 2.5),
+        ((0.0, 0.0, 12.0, 3.0), 3.0),
+        ((0.0, 0.0, 6.0, 1.0), 2.5),  # corridor's
+        ((-1.0, -2.0, 3.0, 1.0), 1.0),
+    ],
+)
+def test_the_3d_views_eye_sees_the_room_over_its_near_wall(bounds, wall_height):
+    xmin, ymin, xmax, ymax = bounds
+    eye, target = _eye(world3d_view(bounds, wall_height))
+    assert eye[1] < ymin and eye[2] > wall_height  # in front of the room, above its wall
+    assert target == pytest.approx(((xmin + xmax) / 2, (ymin + ymax) / 2, 0.0))
+    assert _sees_the_floor_over_the_near_wall(eye, bounds, wall_height)
+
+
+def test_a_small_rooms_recording_opens_on_the_room_not_its_wall(tmp_path):
+    path = tmp_path / "small.rrd"
+    overrides = [
+        "sim.duration=0.1",
+        "room.width=4.0",
+        "room.depth=3.0",
+        "room.height=3.0",
+        "robot.start=[0.8, 1.5]",
+        "people.0.waypoints=[[2.8, 1.5]]",
+    ]
+    with open_recorder(f"save:{path}", default_path=str(path)) as rec:
+        run_scenario(load_scenario("approach", overrides), backend="model", recorder=rec)
+    halves = read_rrd(str(path)).static["world3d/room"]["Boxes3D:half_sizes"]
+    wall_height = 2 * max(h[2] for h in halves)
+    assert wall_height == pytest.approx(3.0)
+    reader = RrdReader(str(path))
+    eyes = [
+        chunk.to_record_batch().column("EyeControls3D:position").to_pylist()[-1][0]
+        for store in reader.blueprints()
+        for chunk in reader.stream(store=store)
+        if chunk.entity_path.endswith("/EyeControls3D")
+    ]
+    assert eyes  # the layout with the 3D view, sent once its first frame came
+    assert _sees_the_floor_over_the_near_wall(eyes[-1], (0.0, 0.0, 4.0, 3.0), wall_height)

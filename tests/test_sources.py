@@ -6,6 +6,7 @@ import json
 import cv2
 import numpy as np
 import pytest
+from rerun.chunk import RrdReader
 
 from fpga_robotics.cli.errors import Terminated, UsageError, run_cli
 from fpga_robotics.cli.run import main
@@ -14,6 +15,7 @@ from fpga_robotics.loop.sources import open_source, run_source
 from fpga_robotics.sim.backends.model import ModelBackend
 from fpga_robotics.sim.models.follow_target import FollowTargetModel
 from fpga_robotics.sim.world.robots import GOPIGO3
+from fpga_robotics.viz.readback import read_rrd
 
 W, H = 160, 120
 
@@ -283,3 +285,26 @@ def test_frames_carry_the_twist_the_design_commands_on_the_robots_wheels(folder)
         assert record.cmd_w == pytest.approx(r * (right - left) / sep)
         assert (record.robot_v, record.robot_w) == (0.0, 0.0)  # nothing moves
     assert any(record.cmd_v > 0 for record in records)  # the design drives towards the block
+
+
+def test_a_recording_of_real_frames_has_no_map_of_a_world_it_never_saw(folder, tmp_path):
+    """Real frames have no world: no robot parked at 0, 0 with its field of view, no map view
+    in the layout; the frames, the design's outputs and the commanded twist are there."""
+    path = tmp_path / "src.rrd"
+    argv = ["--source", str(folder), "--backend", "model", "--rerun", f"save:{path}", "--quiet"]
+    with pytest.raises(SystemExit) as info:
+        run_cli(main, argv)
+    assert info.value.code == 0
+    data = read_rrd(str(path))
+    for entity in (*data.entities, *data.static):
+        assert not entity.startswith("map"), entity
+    assert len(data.entities["camera/raw"]) == len(data.entities["design/tracking"]) == 5
+    assert len(data.entities["twist/v"]) == 5
+    reader = RrdReader(str(path))
+    views = [
+        chunk.to_record_batch().column("ViewBlueprint:display_name").to_pylist()[-1][0]
+        for chunk in reader.stream(store=reader.blueprints()[-1])
+        if "ViewBlueprint:display_name" in chunk.to_record_batch().schema.names
+    ]
+    assert "Filtered (design output)" in views and "Events" in views
+    assert "World (top-down)" not in views

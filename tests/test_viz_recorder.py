@@ -457,6 +457,7 @@ def test_a_frame_cut_short_by_ctrl_c_is_neither_kept_nor_counted(tmp_path, monke
         pytest.raises(KeyboardInterrupt),
         open_recorder(f"save:{path}", default_path=str(path)) as rec,
     ):
+        rec.log_world_map(WORLD)  # a closed-loop run's: the map is drawn every frame
         for f in frames[:3]:
             rec.log_frame(f)
         original = getattr(rec, where)

@@ -46,14 +46,18 @@ def default_blueprint(
     frame_outputs=True,
     camera="rgb444",
     cameras=(),
+    wall_height=0.0,
+    world_map=True,
 ):
     """The layout sent to the viewer; ``bounds`` ``(xmin, ymin, xmax, ymax)`` frame the map;
     ``camera`` (``rgb444`` or ``rgb888``, how the camera frame is recorded, or None: the
     design takes no camera, which only films the run) names its view;
     ``shadow`` adds a second LED row and the shadow design's wheel speeds; ``world3d`` puts
-    the world in 3D (``viz.world3d``) beside the map; ``sensors`` (series entity paths,
-    ``viz.sensors``) come first among the plots under the map, one tab each; ``cameras``
-    (further cameras' names, ``viz.cameras``) get a panel each beside the camera's."""
+    the world in 3D (``viz.world3d``) beside the map, its eye over walls ``wall_height``
+    high; ``sensors`` (series entity paths, ``viz.sensors``) come first among the plots
+    under the map, one tab each; ``cameras`` (further cameras' names, ``viz.cameras``) get a
+    panel each beside the camera's; without ``world_map`` (real frames: no world) the map is
+    left out."""
     further = [
         rrb.Spatial2DView(origin=f"{CAMERAS}/{name}/image", name=f"Camera {name}")
         for name in cameras
@@ -85,7 +89,7 @@ def default_blueprint(
             row_shares=[4, 3],
             name="Board",
         )
-        return _blueprint(board, bounds, map_kwargs, world3d, sensors)
+        return _blueprint(board, bounds, map_kwargs, world3d, sensors, wall_height, world_map)
     board = rrb.Vertical(
         rrb.Horizontal(
             rrb.Spatial2DView(origin=P.CAMERA_RAW, name=_CAMERA_NAMES[camera]),
@@ -116,11 +120,23 @@ def default_blueprint(
         row_shares=[4, 1, 1, 3] if shadow else [4, 1, 3],
         name="Board",
     )
-    return _blueprint(board, bounds, map_kwargs, world3d, sensors)
+    return _blueprint(board, bounds, map_kwargs, world3d, sensors, wall_height, world_map)
 
 
-def _blueprint(board, bounds, map_kwargs, world3d, sensors):
+def _blueprint(board, bounds, map_kwargs, world3d, sensors, wall_height, world_map):
     """The whole layout: ``board`` on the left, the world on the right."""
+    outputs = rrb.Horizontal(
+        rrb.Tabs(
+            *(rrb.TimeSeriesView(origin=path, name=path.split("/", 1)[1]) for path in sensors),
+            rrb.TimeSeriesView(origin=P.DESIGN_TRACKING, name="found, proximity"),
+            rrb.TimeSeriesView(origin=P.DESIGN_CENTROID_X, name="centroid_x"),
+            rrb.TimeSeriesView(origin=P.TARGET_DISTANCE, name="target distance m"),
+        ),
+        rrb.TextLogView(origin=P.EVENTS, name="Events"),
+        name="Outputs",
+    )
+    if not world_map:  # real frames (run --source): no world to draw
+        return _with_panels(rrb.Horizontal(board, outputs, column_shares=[1, 1]))
     top_down = rrb.Spatial2DView(
         origin=P.MAP,
         name="World (top-down)",
@@ -128,21 +144,17 @@ def _blueprint(board, bounds, map_kwargs, world3d, sensors):
         **map_kwargs,
     )
     world = rrb.Vertical(
-        rrb.Horizontal(top_down, world3d_view(bounds)) if world3d else top_down,
-        rrb.Horizontal(
-            rrb.Tabs(
-                *(rrb.TimeSeriesView(origin=path, name=path.split("/", 1)[1]) for path in sensors),
-                rrb.TimeSeriesView(origin=P.DESIGN_TRACKING, name="found, proximity"),
-                rrb.TimeSeriesView(origin=P.DESIGN_CENTROID_X, name="centroid_x"),
-                rrb.TimeSeriesView(origin=P.TARGET_DISTANCE, name="target distance m"),
-            ),
-            rrb.TextLogView(origin=P.EVENTS, name="Events"),
-        ),
+        rrb.Horizontal(top_down, world3d_view(bounds, wall_height)) if world3d else top_down,
+        outputs,
         row_shares=[3, 1],
         name="World",
     )
+    return _with_panels(rrb.Horizontal(board, world, column_shares=[1, 1]))
+
+
+def _with_panels(root):
     return rrb.Blueprint(
-        rrb.Horizontal(board, world, column_shares=[1, 1]),
+        root,
         # The views get the room: the blueprint tree and selection panels start collapsed.
         rrb.BlueprintPanel(state="collapsed"),
         rrb.SelectionPanel(state="collapsed"),

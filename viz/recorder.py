@@ -185,6 +185,7 @@ class Recorder:
         self._ray = _DEFAULT_RAY
         self._blueprint_sent = False
         self._bounds = None  # the map's, kept for a blueprint sent again
+        self._world_map = False  # a world to draw on the map: log_world_map tells
         self._shadow_seen = False  # a shadow design's first frame re-lays out the board
         self._world3d = None  # viz.world3d.World3D, made at the first record with a scene
         self._layout_stale = False  # the layout sent lacks a view that is now needed
@@ -250,15 +251,6 @@ class Recorder:
                 width=img.shape[1], height=img.shape[0], color_model="RGB", channel_datatype="U8"
             )
             log(path, rr.Image.from_fields(format=fmt), static=True)
-        if shadow:
-            return
-        log(P.MAP_ROBOT, rr.Arrows2D.from_fields(colors=_ROBOT_COLOR, radii=0.03), static=True)
-        log(P.MAP_FOV, rr.LineStrips2D.from_fields(colors=_FOV_COLOR, radii=0.01), static=True)
-        for path, color in (
-            (P.TRAIL_ROBOT, _TRAIL_ROBOT_COLOR),
-            (P.TRAIL_TARGET, _TRAIL_TARGET_COLOR),
-        ):
-            log(path, rr.LineStrips2D.from_fields(colors=color, radii=0.01), static=True)
 
     def _send_blueprint(self, bounds=None, shadow=False):
         if bounds is not None:
@@ -273,6 +265,8 @@ class Recorder:
                     frame_outputs=self._frame_outputs,
                     camera=self.camera if self._camera_input else None,
                     cameras=tuple(self._cameras.names),
+                    wall_height=0.0 if self._world3d is None else self._world3d.wall_height,
+                    world_map=self._world_map,
                 )
             )
         self._sensor_series = len(self._sensors.series)
@@ -288,11 +282,19 @@ class Recorder:
         with self._guard:
             self._log_map_geometry(world_map)
         xmin, ymin, xmax, ymax = world_map.bounds
+        self._world_map = True
         self._ray = 0.25 * max(xmax - xmin, ymax - ymin)
         self._send_blueprint(world_map.bounds)
 
     def _log_map_geometry(self, world_map):
         log = self._stream.log
+        log(P.MAP_ROBOT, rr.Arrows2D.from_fields(colors=_ROBOT_COLOR, radii=0.03), static=True)
+        log(P.MAP_FOV, rr.LineStrips2D.from_fields(colors=_FOV_COLOR, radii=0.01), static=True)
+        for path, color in (
+            (P.TRAIL_ROBOT, _TRAIL_ROBOT_COLOR),
+            (P.TRAIL_TARGET, _TRAIL_TARGET_COLOR),
+        ):
+            log(path, rr.LineStrips2D.from_fields(colors=color, radii=0.01), static=True)
         walls = [[_xy(*a), _xy(*b)] for a, b in world_map.walls]
         if walls:
             log(P.MAP_WALLS, rr.LineStrips2D(walls, colors=_WALL_COLOR, radii=0.02), static=True)
@@ -396,7 +398,8 @@ class Recorder:
         add(P.TWIST_W, (float(record.cmd_w), float(record.robot_w)))
         if record.target_distance is not None:
             add(P.TARGET_DISTANCE, (float(record.target_distance),))
-        self._add_map(record, add)
+        if self._world_map:  # real frames (run --source) have no world: a robot at 0, 0
+            self._add_map(record, add)
         with self._guard:
             self._sensors.log(record, add)
             self._cameras.log(

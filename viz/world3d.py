@@ -2,11 +2,11 @@
 and the robot's camera as a pinhole with its frustum and the current frame on it.
 
 Fed by ``FrameRecord.scene`` and ``camera_pose`` (a record without them logs nothing here).
-World coordinates as the physics has them (x, y on the floor, z up, metres). The static
-geometry (walls, furniture, floor) is logged once, static; the robot, the people and the
-camera's pose every frame. The camera's pinhole sits at ``camera``, the parent of the camera
-frame ``camera/raw`` that the recorder logs, so the frame appears on the frustum without
-being logged twice.
+World coordinates as the physics has them (x, y on the floor, z up, metres). The walls and
+floor are logged once, static; the furniture at the first frame and again when a piece
+leaves the room; the robot, the people and the camera's pose every frame. The camera's
+pinhole sits at ``camera``, the parent of the camera frame ``camera/raw`` that the recorder
+logs, so the frame appears on the frustum without being logged twice.
 """
 
 import math
@@ -106,20 +106,32 @@ def _limbs(cyl):
     return (strips, radii, cols), head
 
 
-def world3d_view(bounds=None):
+def eye_position(bounds, wall_height=0.0):
+    """Where the 3D view's eye starts and what it looks at, for a room of ``bounds``
+    ``(xmin, ymin, xmax, ymax)`` with walls ``wall_height`` high: above and in front of the
+    room (over its near wall), looking at its middle, high enough that the near wall hides at
+    most a tenth of the room's depth (from a fixed height, a 2.5 m wall hides all of a small
+    room)."""
+    xmin, ymin, xmax, ymax = (float(v) for v in bounds)
+    cx, cy = (xmin + xmax) / 2, (ymin + ymax) / 2
+    depth = ymax - ymin
+    size = max(xmax - xmin, depth)
+    back = 0.1 * depth
+    # Over the near wall's top the line of sight meets the floor back * H / (z - H) inside
+    # the room: from z = 2.5 H, a fifteenth of its depth.
+    z = max(1.2 * size, 2.5 * wall_height)  # and far enough to take in the whole room
+    return (cx, ymin - back, z), (cx, cy, 0.0)
+
+
+def world3d_view(bounds=None, wall_height=0.0):
     """The viewer's 3D view: the world and the camera frame on its pinhole (not the other
     images under the camera, such as the filtered frame). With the room's ``bounds``
-    ``(xmin, ymin, xmax, ymax)`` the eye starts above and in front of the room (over its
-    near wall), looking at its middle."""
+    ``(xmin, ymin, xmax, ymax)`` and its walls' height the eye starts above and in front of
+    the room (over its near wall), looking at its middle (``eye_position``)."""
     eye = None
     if bounds is not None:
-        xmin, ymin, xmax, ymax = (float(v) for v in bounds)
-        cx, cy, size = (xmin + xmax) / 2, (ymin + ymax) / 2, max(xmax - xmin, ymax - ymin)
-        eye = rrb.EyeControls3D(
-            position=(cx, ymin - 0.45 * size, 0.75 * size),
-            look_target=(cx, cy, 0.0),
-            eye_up=(0.0, 0.0, 1.0),
-        )
+        position, target = eye_position(bounds, wall_height)
+        eye = rrb.EyeControls3D(position=position, look_target=target, eye_up=(0.0, 0.0, 1.0))
     return rrb.Spatial3DView(
         origin="/",
         name="World (3D)",
@@ -136,13 +148,19 @@ class World3D:
         self._stream = stream
         self._walls = None
         self._pinhole = None
+        #: The room's walls' height as drawn, for the view's eye (``eye_position``).
+        self.wall_height = 0.0
 
-    def _log_static(self, scene):
+    def _log_walls(self, scene):
         log = self._stream.log
         log(WORLD3D, rr.ViewCoordinates.RIGHT_HAND_Z_UP, static=True)
         room = [w for w in scene.walls if w.kind == "room"]
         rest = [w for w in scene.walls if w.kind != "room"]
-        for path, walls in ((ROOM, room), (FURNITURE, rest)):
+        self.wall_height = max((w.height for w in room), default=0.0)
+        # The room stays; the furniture is on the timeline (set by the caller), since a piece
+        # may leave the room during the run: static, it would stay drawn, or vanish from the
+        # frames before its removal too.
+        for path, walls, static in ((ROOM, room, True), (FURNITURE, rest, False)):
             if walls:
                 centers, halves, quats, colors = _wall_boxes(walls)
                 log(
@@ -154,8 +172,10 @@ class World3D:
                         colors=colors,
                         fill_mode="solid",
                     ),
-                    static=True,
+                    static=static,
                 )
+            elif not static:
+                log(path, rr.Clear(recursive=False))
         xs = [v for w in room for v in (w.x0, w.x1)] or [0.0, 1.0]
         ys = [v for w in room for v in (w.y0, w.y1)] or [0.0, 1.0]
         log(
@@ -191,14 +211,14 @@ class World3D:
         scene, pose = record.scene, record.camera_pose
         if scene is None or pose is None:
             return
-        if scene.walls is not self._walls:
-            self._log_static(scene)
-        height, width = record.camera_rgb.shape[:2]
-        if self._pinhole != (width, height, record.camera_hfov):
-            self._log_pinhole(width, height, float(record.camera_hfov))
         s = self._stream
         s.set_time("frame", sequence=frame)
         s.set_time("sim_time", duration=t)
+        if scene.walls is not self._walls:
+            self._log_walls(scene)
+        height, width = record.camera_rgb.shape[:2]
+        if self._pinhole != (width, height, record.camera_hfov):
+            self._log_pinhole(width, height, float(record.camera_hfov))
         s.log(
             CAMERA,
             rr.Transform3D(
