@@ -429,6 +429,12 @@ BAD = [
     ),
     ("a syntax error", "syntax_error.py:Broken", {}, "loading syntax_error.py (line 1)"),
     (
+        "a constructor that forgets super().__init__()",
+        "unelaborated.py:NoSuperInit",
+        {},
+        "NoSuperInit has no signature: its __init__ must call super().__init__()",
+    ),
+    (
         "an elaborate that raises",
         "unelaborated.py:ElaborateRaises",
         {},

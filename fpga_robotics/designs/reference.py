@@ -844,6 +844,15 @@ def _call(target, params, reference):
             f"design {reference!r}: it returned {type(component).__name__}, "
             f"not an Amaranth wiring.Component"
         )
+    if not hasattr(component, "signature"):  # made by wiring.Component.__init__
+        from amaranth.hdl import UnusedElaboratable  # lazy: Amaranth (~0.3 s)
+
+        # It is never elaborated now: no warning for it at exit.
+        warnings.filterwarnings("ignore", category=UnusedElaboratable)
+        raise DesignError(
+            f"design {reference!r}: {type(component).__name__} has no signature: its "
+            "__init__ must call super().__init__() (wiring.Component's), which makes its ports"
+        )
     return component
 
 
