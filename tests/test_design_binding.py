@@ -371,6 +371,16 @@ def contract_shapes():
 
 def no_camera():
     return Ports({**WHEELS, "found": Out(2)})
+
+
+def two_bit_strobe():
+    return Ports({**CAMERA, "frame_done": Out(2), "found": Out(1)})
+
+
+def no_strobe():
+    # frame_done misspelt: found and centroid_x were never read, and the run passed.
+    shapes = {"frame_dne": Out(1), "found": Out(1), "centroid_x": Out(8)}
+    return Ports({**WHEELS, "pixels": In(pixel_stream_signature()), **shapes})
 """
 
 
@@ -389,6 +399,17 @@ def no_camera():
         (
             "signed_centroid",
             "port 'centroid_x' is signed(9); the per-frame output centroid_x is unsigned",
+        ),
+        (
+            "two_bit_strobe",
+            "port 'frame_done' is unsigned(2); the frame strobe frame_done is Out(1)",
+        ),
+        (
+            "no_strobe",
+            (
+                "it has found, centroid_x but no frame_done output: the runs read the per-frame "
+                "outputs when it rises; add frame_done: Out(1)"
+            ),
         ),
     ],
 )

@@ -1034,11 +1034,18 @@ FRAME_OUTPUT_WIDTHS = {"found": 1, "proximity": 3, "centroid_x": None, "centroid
 
 def _check_frame_outputs(component):
     """``DesignError`` unless each per-frame output a camera design has is of its contract
-    shape: a run would judge a 2-bit ``found`` or a signed ``centroid_x`` as the contract's."""
+    shape, and comes with the 1-bit ``frame_done`` at which the runs read it: a run would
+    judge a 2-bit ``found`` or a signed ``centroid_x`` as the contract's, and without the
+    strobe never read them at all (their checks not measured, the run passing)."""
     from fpga_robotics.hw.verilog import verilog_ports  # lazy: Amaranth (~0.3 s)
 
     found = verilog_ports(component)
-    for name, width in FRAME_OUTPUT_WIDTHS.items():
+    design = type(component).__name__
+    shapes = {
+        "frame_done": (1, "the frame strobe"),
+        **{name: (width, "the per-frame output") for name, width in FRAME_OUTPUT_WIDTHS.items()},
+    }
+    for name, (width, role) in shapes.items():
         if name not in found or found[name][1] != "o":
             continue
         shape = found[name][0].shape()
@@ -1046,10 +1053,18 @@ def _check_frame_outputs(component):
             kind = f"{'signed' if shape.signed else 'unsigned'}({shape.width})"
             wanted = f"Out({width})" if width is not None else "unsigned, Out(N)"
             raise DesignError(
-                f"design {type(component).__name__}: port {name!r} is {kind}; the per-frame "
-                f"output {name} is {wanted} (docs/contract.md): change its shape, or rename "
-                "it to record it as an output of its own"
+                f"design {design}: port {name!r} is {kind}; {role} {name} is {wanted} "
+                "(docs/contract.md): change its shape, or rename it to record it as an output "
+                "of its own"
             )
+    outputs = [n for n in FRAME_OUTPUT_WIDTHS if n in found and found[n][1] == "o"]
+    if outputs and found.get("frame_done", (None, ""))[1] != "o":
+        raise DesignError(
+            f"design {design}: it has {', '.join(outputs)} but no frame_done output: the runs read "
+            "the per-frame outputs when it rises; add frame_done: Out(1), high for one cycle "
+            "when a frame's results are out, or rename them to record them as outputs of "
+            "their own"
+        )
 
 
 def stream_ports(bindings):
