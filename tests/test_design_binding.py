@@ -260,6 +260,11 @@ def plain_pixels():
 
 def outputs_named_as_input_pins():
     return Ports({**WHEELS, "echo": Out(1), "valid": Out(1), "pixels": Out(14)})
+
+
+def output_pixel_stream():
+    # The camera's stream with its direction turned: the run passed, the design seeing nothing.
+    return Ports({**WHEELS, "pixels": Out(pixel_stream_signature()), "frame_done": Out(1)})
 """
 
 
@@ -297,6 +302,13 @@ def outputs_named_as_input_pins():
                 "pixels__valid of 1 bit and pixels__payload of 14 bits, "
                 "In(fpga_robotics.hw.pixel.pixel_stream_signature())); its ports: motor_left, "
                 "motor_right, pixels"
+            ),
+        ),
+        (
+            "output_pixel_stream",
+            (
+                "design Ports: port 'pixels' is an output stream; the camera streams its frames "
+                "into an input, pixels: In(fpga_robotics.hw.pixel.pixel_stream_signature())"
             ),
         ),
     ],

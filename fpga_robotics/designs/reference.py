@@ -957,6 +957,14 @@ def bindings_of(component, ports, given=None):
                     ports,
                     f"design {name}: port 'pixels' is not the camera's pixel stream",
                 )
+            elif all(ports.get(p, ("",))[0] == "out" for p in CAMERA_PORTS):
+                # pixels: Out(stream), the direction turned: the run would pass, seeing nothing.
+                raise DesignError(
+                    f"design {name}: port 'pixels' is an output stream; the camera streams "
+                    "its frames into an input, pixels: "
+                    "In(fpga_robotics.hw.pixel.pixel_stream_signature()): declare it In, or "
+                    "give an output stream of its own another name"
+                )
             elif ports.get("color_sel", ("",))[0] == "in":
                 _refuse_partial(name, kind, ["color_sel"], ["pixels"])
         elif pins and all(p in ports for p in pins):
