@@ -63,6 +63,31 @@ def test_connector_pins_go_to_header_pins(tmp_path, capsys):
     assert _direction(verilog, "fr_header_1__io") == "input"
 
 
+def test_line_sensor_bits_go_to_header_pins_of_their_own(tmp_path, capsys):
+    # A KY-033 is one wire a sensor: follow_line's 3-bit line was refused as "3 bits; the
+    # board's header pins take 1-bit ports", so no line-sensor design reached the board.
+    out = tmp_path / "b"
+    code, text, err = _cli(["board", "--design", "follow_line", "-o", str(out)], capsys)
+    assert code == 0, err
+    assert text.splitlines()[:3] == [
+        "line[0]: header gpio 7+ (site A6)",
+        "line[1]: header gpio 7- (site B6)",
+        "line[2]: header gpio 8+ (site A4)",
+    ]
+    lpf = (out / "ulx3s_follow_target.lpf").read_text()
+    verilog = (out / "ulx3s_follow_target.v").read_text()
+    for k, site in enumerate(("A6", "B6", "A4")):
+        assert f'LOCATE COMP "fr_header_{k}__io" SITE "{site}";' in lpf
+        assert _direction(verilog, f"fr_header_{k}__io") == "input"
+        # Header pin k's input buffer drives bit k of the design's line, and only that one.
+        net = re.search(
+            rf"fr_header_{k}_buffer\s*\(\s*\.fr_header_{k}__io\(fr_header_{k}__io\),"
+            rf"\s*\.i\(([^)]*?)\s*\)",
+            verilog,
+        ).group(1)
+        assert re.findall(rf"assign line\[(\d)\] = {re.escape(net)}\s*;", verilog) == [str(k)]
+
+
 def test_a_camera_design_gets_the_camera_and_the_switches(tmp_path, capsys):
     out = tmp_path / "b"
     code, text, _ = _cli(
