@@ -1042,7 +1042,8 @@ def test_a_bad_parameter_is_told_as_the_command_takes_it(tmp_path, capsys, monke
     (tmp_path / "p.py").write_text(NEEDS_SPEED)
     monkeypatch.chdir(tmp_path)
     missing = "parameter 'speed' has no default; give it as --param speed=VALUE"
-    unknown = "--param spd: P takes no parameter 'spd'; it takes: speed"
+    # A typo is answered with the name it misspells.
+    unknown = "--param spd: P takes no parameter 'spd' (did you mean 'speed'?); it takes: speed"
     for command in (
         ["designs", "p.py:P"],
         ["export", "--design", "p.py:P", "-o", "p.v"],

@@ -21,6 +21,7 @@ per-frame outputs, is an extra output: recorded under its own name.
 """
 
 import contextlib
+import difflib
 import enum
 import functools
 import hashlib
@@ -706,9 +707,11 @@ def _check_params(target, params, reference):
         if key not in known:
             if takes_any:
                 continue
+            close = difflib.get_close_matches(str(key), list(known), n=1, cutoff=0.7)
+            hint = f" (did you mean {close[0]!r}?)" if close else ""
             raise _ParamError(
                 key,
-                f"{{where}}: {name} takes no parameter {key!r}; it takes: "
+                f"{{where}}: {name} takes no parameter {key!r}{hint}; it takes: "
                 f"{', '.join(known) or 'none'}",
             )
         expected = _expected_type(known[key])
