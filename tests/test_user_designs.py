@@ -435,6 +435,12 @@ BAD = [
         "NoSuperInit has no signature: its __init__ must call super().__init__()",
     ),
     (
+        "an elaborate without the platform argument",
+        "unelaborated.py:NoPlatform",
+        {},
+        "Amaranth calls elaborate(self, platform): add the platform argument",
+    ),
+    (
         "an elaborate that raises",
         "unelaborated.py:ElaborateRaises",
         {},

@@ -424,6 +424,15 @@ def _amaranth_spec(reference, params):
     )
 
 
+def _takes_platform(component):
+    """Whether the component's ``elaborate`` can be called as Amaranth calls it."""
+    try:
+        inspect.signature(component.elaborate).bind(None)
+    except TypeError:
+        return False
+    return True
+
+
 def _check_elaborates(component, target, reference):
     """``DesignError`` (one line) if ``component``, made by the user's ``target``, does not
     elaborate to a netlist: its ``elaborate`` raises or returns nothing, or it drives a
@@ -457,6 +466,8 @@ def _check_elaborates(component, target, reference):
         hint = next((f"; {w.message}" for w in said if w.category is UserWarning), "")
         if type(exc).__name__ == "CombinationalCycle":
             hint += "; break the loop with a register (m.d.sync) on one of its signals"
+        if isinstance(exc, TypeError) and not _takes_platform(component):
+            hint += "; Amaranth calls elaborate(self, platform): add the platform argument"
         raise DesignError(
             f"design {reference!r} does not elaborate: {type(exc).__name__}: "
             f"{_first_line(exc)}{_user_line(exc, target)}{hint}"

@@ -96,3 +96,10 @@ class NoSuperInit(_Wheels):
 
     def elaborate(self, platform):
         return Module()
+
+
+class NoPlatform(_Wheels):
+    """Its elaborate forgets the platform argument."""
+
+    def elaborate(self):
+        return Module()
