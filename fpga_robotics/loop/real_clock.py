@@ -457,11 +457,12 @@ class RealClockLoop(ClosedLoop):
             return
         frame = self.awaited[0][0]
         if self.strobe is None:
+            p = self.scenario.params  # the size, for a design that counts its own
             raise DesignError(
                 f"{self._design_name}: frame {frame}: frame_done did not rise within "
                 f"{self.frame_watchdog:,} edges (a frame period at sim.clock_hz) after the "
-                "frame's last pixel; the per-frame outputs are read when it rises: raise it "
-                "once a frame"
+                f"frame's last pixel (a {p.width}x{p.height} frame, camera.resolution); the "
+                "per-frame outputs are read when it rises: raise it once a frame"
             )
         port, _latency, timeout = self.strobe
         raise DesignError(
