@@ -1026,6 +1026,8 @@ def _run_source(args, scenario, ros):
         )
     else:
         print("  no frames")
+    for line in format_extra_outputs(out):
+        print(line)
     for line in notices:
         print(line)
     if args.summary:
