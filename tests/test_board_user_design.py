@@ -63,6 +63,31 @@ def test_connector_pins_go_to_header_pins(tmp_path, capsys):
     assert _direction(verilog, "fr_header_1__io") == "input"
 
 
+def test_line_sensor_bits_go_to_header_pins_of_their_own(tmp_path, capsys):
+    # A KY-033 is one wire a sensor: follow_line's 3-bit line was refused as "3 bits; the
+    # board's header pins take 1-bit ports", so no line-sensor design reached the board.
+    out = tmp_path / "b"
+    code, text, err = _cli(["board", "--design", "follow_line", "-o", str(out)], capsys)
+    assert code == 0, err
+    assert text.splitlines()[:3] == [
+        "line[0]: header gpio 7+ (site A6)",
+        "line[1]: header gpio 7- (site B6)",
+        "line[2]: header gpio 8+ (site A4)",
+    ]
+    lpf = (out / "ulx3s_follow_target.lpf").read_text()
+    verilog = (out / "ulx3s_follow_target.v").read_text()
+    for k, site in enumerate(("A6", "B6", "A4")):
+        assert f'LOCATE COMP "fr_header_{k}__io" SITE "{site}";' in lpf
+        assert _direction(verilog, f"fr_header_{k}__io") == "input"
+        # Header pin k's input buffer drives bit k of the design's line, and only that one.
+        net = re.search(
+            rf"fr_header_{k}_buffer\s*\(\s*\.fr_header_{k}__io\(fr_header_{k}__io\),"
+            rf"\s*\.i\(([^)]*?)\s*\)",
+            verilog,
+        ).group(1)
+        assert re.findall(rf"assign line\[(\d)\] = {re.escape(net)}\s*;", verilog) == [str(k)]
+
+
 def test_a_camera_design_gets_the_camera_and_the_switches(tmp_path, capsys):
     out = tmp_path / "b"
     code, text, _ = _cli(
@@ -322,20 +347,60 @@ BAD_MAPS = {
         'top = "bump_stop"\nclock = { port = "clk" }\n[connectors.bumper]\npressed = "bump_i"\n',
         "the board drives the GoPiGo3 wheels from [outputs] motor_left and motor_right",
     ),
-    "wide_pin": (
-        (
-            'top = "bump_stop"\nclock = { port = "clk" }\n'
-            "[outputs]\n"
-            'motor_left = { port = "left_dps", width = 12, signed = true }\n'
-            'motor_right = { port = "right_dps", width = 12, signed = true }\n'
-            '[connectors.line_sensors]\nline = "bump_i"\n'
-        ),
-        (
-            "connectors.line_sensors.line ('bump_i') is 3 bits; the board's header pins "
-            "take 1-bit connector pins"
-        ),
-    ),
 }
+
+
+LINE3 = """
+module line3(input clk, input rst, input [2:0] line,
+             output reg signed [15:0] left, output reg signed [15:0] right);
+  always @(posedge clk) begin
+    left <= rst ? 16'sd0 : (line[0] ? 16'sd100 : 16'sd200);
+    right <= rst ? 16'sd0 : (line[2] ? 16'sd100 : 16'sd200);
+  end
+endmodule
+"""
+
+LINE3_PORTS = """
+top = "line3"
+clock = { port = "clk" }
+reset = { port = "rst" }
+[outputs]
+motor_left = { port = "left", width = 16, signed = true }
+motor_right = { port = "right", width = 16, signed = true }
+[connectors.line_sensors]
+line = "line"
+"""
+
+
+def test_a_verilog_designs_line_sensors_go_to_a_header_pin_a_bit(tmp_path, capsys):
+    # Refused as "is 3 bits; the board's header pins take 1-bit connector pins" (a KY-033 is
+    # one wire a sensor); a one-sensor line, 1 bit, was refused the same way.
+    (tmp_path / "line3.v").write_text(LINE3)
+    (tmp_path / "ports.toml").write_text(LINE3_PORTS)
+    out = tmp_path / "b"
+    argv = ["--design", f"verilog:{tmp_path}/line3.v", "--ports", str(tmp_path / "ports.toml")]
+    code, text, err = _cli(["board", *argv, "-o", str(out)], capsys)
+    assert code == 0, err
+    assert text.splitlines()[:3] == [
+        "line[0]: header gpio 7+ (site A6)",
+        "line[1]: header gpio 7- (site B6)",
+        "line[2]: header gpio 8+ (site A4)",
+    ]
+    verilog = (out / "ulx3s_follow_target.v").read_text()
+    for k in range(3):
+        assert _direction(verilog, f"fr_header_{k}__io") == "input"
+    ports, holder = _instance(verilog, "line3")
+    assert re.search(rf"input \[2:0\] {re.escape(ports['line'])}\s*;", holder)
+    code, log = _hierarchy_check(out, ["ulx3s_follow_target.v", "line3.v"])
+    assert code == 0, log
+    # One sensor: its 1-bit pin on one header pin.
+    one = LINE3.replace("[2:0] line", "line").replace("line[0]", "line").replace("line[2]", "line")
+    (tmp_path / "line1.v").write_text(one)
+    argv = ["--design", f"verilog:{tmp_path}/line1.v", "--ports", str(tmp_path / "ports.toml")]
+    code, text, err = _cli(["board", *argv, "-o", str(tmp_path / "b1")], capsys)
+    assert code == 0, err
+    assert text.splitlines()[0] == "line: header gpio 7+ (site A6)"
+    assert not text.splitlines()[1].startswith("line")
 
 
 @pytest.mark.parametrize("case", sorted(BAD_MAPS))

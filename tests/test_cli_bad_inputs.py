@@ -81,6 +81,11 @@ CASES = [
         "no camera input",
     ),
     (
+        "colour of a camera design without a colour select (it was ignored)",
+        ["run", "--scenario", os.path.join(DESIGNS, "red_frames.toml"), "--color", "green"],
+        "RedFrames (scenario 'red_frames') has none (a color_sel input; in a port map, [color])",
+    ),
+    (
         "colour of a Verilog design without a camera",
         [
             "run",

@@ -46,6 +46,12 @@ def test_example_is_not_written_for_a_design(tmp_path, capsys):
     assert (code, out, err.count("\n")) == (2, "", 1)
     assert "--example writes the exported follow_target's port map, not one for --design" in err
     assert not path.exists()
+    # For an Amaranth design the hint named a check (ports PATH --design mine.py:Mine) that
+    # refuses it: the one line says why there is no map to check.
+    code, out, err = _ports(["--example", str(path), "--design", "mine.py:Mine"], capsys)
+    assert (code, out, err.count("\n")) == (2, "", 1)
+    assert "--design must be a Verilog design" in err and "needs no port map" in err
+    assert "then check it with" not in err and not path.exists()
 
 
 @pytest.mark.parametrize(

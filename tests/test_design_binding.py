@@ -260,6 +260,15 @@ def plain_pixels():
 
 def outputs_named_as_input_pins():
     return Ports({**WHEELS, "echo": Out(1), "valid": Out(1), "pixels": Out(14)})
+
+
+def misnamed_stream():
+    return Ports({**WHEELS, "pixel": In(pixel_stream_signature()), "frame_done": Out(1)})
+
+
+def output_pixel_stream():
+    # The camera's stream with its direction turned: the run passed, the design seeing nothing.
+    return Ports({**WHEELS, "pixels": Out(pixel_stream_signature()), "frame_done": Out(1)})
 """
 
 
@@ -299,6 +308,13 @@ def outputs_named_as_input_pins():
                 "motor_right, pixels"
             ),
         ),
+        (
+            "output_pixel_stream",
+            (
+                "design Ports: port 'pixels' is an output stream; the camera streams its frames "
+                "into an input, pixels: In(fpga_robotics.hw.pixel.pixel_stream_signature())"
+            ),
+        ),
     ],
 )
 def test_part_of_a_connector_by_name_is_a_one_line_error(name, message, tmp_path, capsys):
@@ -318,6 +334,22 @@ def test_part_of_a_connector_by_name_is_a_one_line_error(name, message, tmp_path
         err = capsys.readouterr().err
         assert info.value.code == 2 and len(err.strip().splitlines()) == 1, err
         assert message in err
+
+
+def test_a_misnamed_pixel_stream_is_told_how_the_camera_streams_to_it(tmp_path, capsys):
+    # It said "bind a connector pin to it with ports = {...}", the way of a sensor's pin.
+    (tmp_path / "partial.py").write_text(PARTIAL)
+    reference = f"{tmp_path / 'partial.py'}:misnamed_stream"
+    (tmp_path / "s.toml").write_text(STRAIGHT.format(top=reference))
+    argv = ["run", "--scenario", str(tmp_path / "s.toml"), "--backend", "pysim", "--rerun", "off"]
+    with pytest.raises(SystemExit) as info:
+        cli.main(argv)
+    err = capsys.readouterr().err
+    assert info.value.code == 2 and len(err.strip().splitlines()) == 1, err
+    assert (
+        "nothing drives its input 'pixel__payload'; to stream the camera to it, name it "
+        'pixels or declare connectors = {"camera": {"pixels": "pixel"}}'
+    ) in err
 
 
 def test_an_output_named_as_an_input_pin_is_an_output_of_its_own(tmp_path):
@@ -371,6 +403,16 @@ def contract_shapes():
 
 def no_camera():
     return Ports({**WHEELS, "found": Out(2)})
+
+
+def two_bit_strobe():
+    return Ports({**CAMERA, "frame_done": Out(2), "found": Out(1)})
+
+
+def no_strobe():
+    # frame_done misspelt: found and centroid_x were never read, and the run passed.
+    shapes = {"frame_dne": Out(1), "found": Out(1), "centroid_x": Out(8)}
+    return Ports({**WHEELS, "pixels": In(pixel_stream_signature()), **shapes})
 """
 
 
@@ -389,6 +431,17 @@ def no_camera():
         (
             "signed_centroid",
             "port 'centroid_x' is signed(9); the per-frame output centroid_x is unsigned",
+        ),
+        (
+            "two_bit_strobe",
+            "port 'frame_done' is unsigned(2); the frame strobe frame_done is Out(1)",
+        ),
+        (
+            "no_strobe",
+            (
+                "it has found, centroid_x but no frame_done output: the runs read the per-frame "
+                "outputs when it rises; add frame_done: Out(1)"
+            ),
         ),
     ],
 )

@@ -2,6 +2,7 @@
 
 import itertools
 import json
+from pathlib import Path
 
 import cv2
 import numpy as np
@@ -169,6 +170,42 @@ def test_cli_runs_a_video_and_writes_the_results(video, tmp_path, capsys):
     s = json.loads(path.read_text())
     assert s["frames"] == 5 and s["found_frames"] == 4 and s["source_kind"] == "video"
     assert "found in 4 frames" in out
+
+
+def test_a_design_of_ones_own_reports_its_other_outputs_from_real_frames(folder, tmp_path, capsys):
+    # Its outputs no connector reads (RedFrames' red_count and red_sum) were missing from
+    # --source's summary and terminal lines, which a closed-loop run has.
+    scenario = Path(__file__).parent / "data" / "user_designs" / "red_frames.toml"
+    path = tmp_path / "src.json"
+    argv = ["--scenario", str(scenario), "--source", str(folder), "--backend", "pysim"]
+    with pytest.raises(SystemExit) as info:
+        run_cli(main, [*argv, "--rerun", "off", "--summary", str(path), "--quiet"])
+    out, _ = capsys.readouterr()
+    assert info.value.code == 0
+    # The design's rule on each frame as the design sees it (40x30, RGB444).
+    counts = []
+    for k in range(5):
+        rgb = (
+            cv2.cvtColor(
+                cv2.resize(scene_bgr(k), (40, 30), interpolation=cv2.INTER_LINEAR),
+                cv2.COLOR_BGR2RGB,
+            ).astype(int)
+            >> 4
+        )
+        red = (rgb[..., 0] >= 8) & (rgb[..., 1] < 5) & (rgb[..., 2] < 5)
+        counts.append(int(red.sum()))
+    assert counts[3] == 0 and min(counts[:3]) > 0  # frame 3 is empty
+    s = json.loads(path.read_text())
+    assert [r["extra"]["red_count"] for r in s["results"]] == counts
+    # red_sum: the last four frames' counts, added up after frame_done.
+    sums = [sum(counts[max(0, k - 3) : k + 1]) for k in range(5)]
+    assert [r["extra"]["red_sum"] for r in s["results"]] == sums
+    assert s["extra_outputs"]["red_count"] == {
+        "last": counts[-1],
+        "min": min(counts),
+        "max": max(counts),
+    }
+    assert f"design output red_sum: last {sums[-1]}, min {min(sums)}, max {max(sums)}" in out
 
 
 def test_cli_folder_at_another_resolution(folder, tmp_path, capsys):

@@ -283,6 +283,8 @@ def test_compressed_timing_names_what_keeps_a_design_on_the_real_clock(tmp_path,
     code, out, err = _cli([*argv, "--duration", "0.2", "--rerun", "off", "--quiet"], capsys)
     assert (code, out) == (2, "") and err.count("\n") == 1, err
     assert "frame 0: frame_done did not rise within 20,000 edges" in err
+    # The size streamed, for a design that counts its own rows and columns.
+    assert "after the frame's last pixel (a 40x30 frame, camera.resolution)" in err
     # Named as the scenario names the design: no --design was given.
     assert err.startswith("fpga-robotics run: error: design.top: RedFrames: frame 0: "), err
     # One that rises before the frame's last pixel (after line 28 of 30, as a design raising
@@ -303,7 +305,7 @@ def test_a_frame_done_that_never_rises_is_one_line_in_real_clock_timing_too(caps
     code, out, err = _cli([*argv, "--set", "design.params.height=31"], capsys)
     assert (code, out) == (2, "") and err.count("\n") == 1, err
     assert "frame 0: frame_done did not rise within 20,000 edges" in err
-    assert "the per-frame outputs are read when it rises: raise it once a frame" in err
+    assert "(a 40x30 frame, camera.resolution); the per-frame outputs are read when it" in err
     # A shadow of it beside it, which makes auto real-clock timing, does not hide it.
     shadow = ["--shadow", f"{DESIGNS}/red_frames.py:RedFrames"]
     code, out, err = _cli([*argv[:-1], "--set", "design.params.height=31", *shadow], capsys)
@@ -428,6 +430,18 @@ BAD = [
         "Sized takes no parameter 'depth'; it takes: width",
     ),
     ("a syntax error", "syntax_error.py:Broken", {}, "loading syntax_error.py (line 1)"),
+    (
+        "a constructor that forgets super().__init__()",
+        "unelaborated.py:NoSuperInit",
+        {},
+        "NoSuperInit has no signature: its __init__ must call super().__init__()",
+    ),
+    (
+        "an elaborate without the platform argument",
+        "unelaborated.py:NoPlatform",
+        {},
+        "Amaranth calls elaborate(self, platform): add the platform argument",
+    ),
     (
         "an elaborate that raises",
         "unelaborated.py:ElaborateRaises",
@@ -1036,7 +1050,8 @@ def test_a_bad_parameter_is_told_as_the_command_takes_it(tmp_path, capsys, monke
     (tmp_path / "p.py").write_text(NEEDS_SPEED)
     monkeypatch.chdir(tmp_path)
     missing = "parameter 'speed' has no default; give it as --param speed=VALUE"
-    unknown = "--param spd: P takes no parameter 'spd'; it takes: speed"
+    # A typo is answered with the name it misspells.
+    unknown = "--param spd: P takes no parameter 'spd' (did you mean 'speed'?); it takes: speed"
     for command in (
         ["designs", "p.py:P"],
         ["export", "--design", "p.py:P", "-o", "p.v"],

@@ -40,6 +40,12 @@ def build_parser(prog="fpga-robotics ports"):
 
 def main(argv=None, prog="fpga-robotics ports"):
     args = build_parser(prog).parse_args(argv)
+    if args.design is not None and not args.design.startswith("verilog:"):
+        # Before the --example hint, which names a check that takes Verilog only.
+        raise DesignError(
+            f"--design must be a Verilog design, verilog:TOP.v[,MORE.v], got "
+            f"{args.design!r} (an Amaranth design needs no port map)"
+        )
     if args.example and args.design is not None:
         # The example is follow_target's map: written "for" a design of one's own it would
         # name ports that design does not have.
@@ -63,10 +69,5 @@ def main(argv=None, prog="fpga-robotics ports"):
 
 def _check_against_design(reference, path):
     """Raise a one-line ``DesignError`` at the first way the map and the design disagree."""
-    if not reference.startswith("verilog:"):
-        raise DesignError(
-            f"--design must be a Verilog design, verilog:TOP.v[,MORE.v], got "
-            f"{reference!r} (an Amaranth design needs no port map)"
-        )
     spec = checked_verilog(resolve_design(reference, {}, ports=path), path)
     print(f"{path}: matches {reference} ({len(spec.ports)} ports)")

@@ -346,17 +346,26 @@ def _is_verilog(args):
 def _check_color_option(args, scenario):
     """``--color`` sets a camera design's colour select: a design without a camera input
     (FollowLine, a design of one's own or a Verilog port map without a pixel stream) has
-    none to set."""
+    none to set, nor has a camera design without one (no ``color_sel`` input, a port map
+    without ``[color]``): the option would be ignored."""
     if args.color is None:
         return
     top = scenario_top(scenario) if scenario.foreign is not None else TOPS.get(scenario.top)
     top = top or scenario_top(scenario)
-    if top.camera:
-        return
-    raise UsageError(
-        f"--color sets the colour select of a camera design; {top.name} (scenario "
-        f"{scenario.name!r}) has no camera input"
-    )
+    if not top.camera:
+        raise UsageError(
+            f"--color sets the colour select of a camera design; {top.name} (scenario "
+            f"{scenario.name!r}) has no camera input"
+        )
+    if scenario.foreign is not None:
+        select = load_port_map(scenario.foreign.ports).color_port is not None
+    else:  # a built-in camera design has one; a design of one's own binds its color_sel
+        select = "color_sel" in top.bindings.get("camera", {"color_sel": None})
+    if not select:
+        raise UsageError(
+            f"--color sets the colour select of a camera design; {top.name} (scenario "
+            f"{scenario.name!r}) has none (a color_sel input; in a port map, [color])"
+        )
 
 
 #: ``run``'s shorthand options and the ``--set`` key each one sets.
@@ -1017,6 +1026,8 @@ def _run_source(args, scenario, ros):
         )
     else:
         print("  no frames")
+    for line in format_extra_outputs(out):
+        print(line)
     for line in notices:
         print(line)
     if args.summary:

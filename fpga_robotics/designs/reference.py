@@ -21,6 +21,7 @@ per-frame outputs, is an extra output: recorded under its own name.
 """
 
 import contextlib
+import difflib
 import enum
 import functools
 import hashlib
@@ -423,6 +424,15 @@ def _amaranth_spec(reference, params):
     )
 
 
+def _takes_platform(component):
+    """Whether the component's ``elaborate`` can be called as Amaranth calls it."""
+    try:
+        inspect.signature(component.elaborate).bind(None)
+    except TypeError:
+        return False
+    return True
+
+
 def _check_elaborates(component, target, reference):
     """``DesignError`` (one line) if ``component``, made by the user's ``target``, does not
     elaborate to a netlist: its ``elaborate`` raises or returns nothing, or it drives a
@@ -456,6 +466,8 @@ def _check_elaborates(component, target, reference):
         hint = next((f"; {w.message}" for w in said if w.category is UserWarning), "")
         if type(exc).__name__ == "CombinationalCycle":
             hint += "; break the loop with a register (m.d.sync) on one of its signals"
+        if isinstance(exc, TypeError) and not _takes_platform(component):
+            hint += "; Amaranth calls elaborate(self, platform): add the platform argument"
         raise DesignError(
             f"design {reference!r} does not elaborate: {type(exc).__name__}: "
             f"{_first_line(exc)}{_user_line(exc, target)}{hint}"
@@ -706,9 +718,11 @@ def _check_params(target, params, reference):
         if key not in known:
             if takes_any:
                 continue
+            close = difflib.get_close_matches(str(key), list(known), n=1, cutoff=0.7)
+            hint = f" (did you mean {close[0]!r}?)" if close else ""
             raise _ParamError(
                 key,
-                f"{{where}}: {name} takes no parameter {key!r}; it takes: "
+                f"{{where}}: {name} takes no parameter {key!r}{hint}; it takes: "
                 f"{', '.join(known) or 'none'}",
             )
         expected = _expected_type(known[key])
@@ -844,6 +858,15 @@ def _call(target, params, reference):
             f"design {reference!r}: it returned {type(component).__name__}, "
             f"not an Amaranth wiring.Component"
         )
+    if not hasattr(component, "signature"):  # made by wiring.Component.__init__
+        from amaranth.hdl import UnusedElaboratable  # lazy: Amaranth (~0.3 s)
+
+        # It is never elaborated now: no warning for it at exit.
+        warnings.filterwarnings("ignore", category=UnusedElaboratable)
+        raise DesignError(
+            f"design {reference!r}: {type(component).__name__} has no signature: its "
+            "__init__ must call super().__init__() (wiring.Component's), which makes its ports"
+        )
     return component
 
 
@@ -948,6 +971,14 @@ def bindings_of(component, ports, given=None):
                     ports,
                     f"design {name}: port 'pixels' is not the camera's pixel stream",
                 )
+            elif all(ports.get(p, ("",))[0] == "out" for p in CAMERA_PORTS):
+                # pixels: Out(stream), the direction turned: the run would pass, seeing nothing.
+                raise DesignError(
+                    f"design {name}: port 'pixels' is an output stream; the camera streams "
+                    "its frames into an input, pixels: "
+                    "In(fpga_robotics.hw.pixel.pixel_stream_signature()): declare it In, or "
+                    "give an output stream of its own another name"
+                )
             elif ports.get("color_sel", ("",))[0] == "in":
                 _refuse_partial(name, kind, ["color_sel"], ["pixels"])
         elif pins and all(p in ports for p in pins):
@@ -1025,11 +1056,18 @@ FRAME_OUTPUT_WIDTHS = {"found": 1, "proximity": 3, "centroid_x": None, "centroid
 
 def _check_frame_outputs(component):
     """``DesignError`` unless each per-frame output a camera design has is of its contract
-    shape: a run would judge a 2-bit ``found`` or a signed ``centroid_x`` as the contract's."""
+    shape, and comes with the 1-bit ``frame_done`` at which the runs read it: a run would
+    judge a 2-bit ``found`` or a signed ``centroid_x`` as the contract's, and without the
+    strobe never read them at all (their checks not measured, the run passing)."""
     from fpga_robotics.hw.verilog import verilog_ports  # lazy: Amaranth (~0.3 s)
 
     found = verilog_ports(component)
-    for name, width in FRAME_OUTPUT_WIDTHS.items():
+    design = type(component).__name__
+    shapes = {
+        "frame_done": (1, "the frame strobe"),
+        **{name: (width, "the per-frame output") for name, width in FRAME_OUTPUT_WIDTHS.items()},
+    }
+    for name, (width, role) in shapes.items():
         if name not in found or found[name][1] != "o":
             continue
         shape = found[name][0].shape()
@@ -1037,10 +1075,18 @@ def _check_frame_outputs(component):
             kind = f"{'signed' if shape.signed else 'unsigned'}({shape.width})"
             wanted = f"Out({width})" if width is not None else "unsigned, Out(N)"
             raise DesignError(
-                f"design {type(component).__name__}: port {name!r} is {kind}; the per-frame "
-                f"output {name} is {wanted} (docs/contract.md): change its shape, or rename "
-                "it to record it as an output of its own"
+                f"design {design}: port {name!r} is {kind}; {role} {name} is {wanted} "
+                "(docs/contract.md): change its shape, or rename it to record it as an output "
+                "of its own"
             )
+    outputs = [n for n in FRAME_OUTPUT_WIDTHS if n in found and found[n][1] == "o"]
+    if outputs and found.get("frame_done", (None, ""))[1] != "o":
+        raise DesignError(
+            f"design {design}: it has {', '.join(outputs)} but no frame_done output: the runs read "
+            "the per-frame outputs when it rises; add frame_done: Out(1), high for one cycle "
+            "when a frame's results are out, or rename them to record them as outputs of "
+            "their own"
+        )
 
 
 def stream_ports(bindings):

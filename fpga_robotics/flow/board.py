@@ -107,8 +107,8 @@ def board_ports(spec, board="ulx3s-85f"):
     ``motor_left``/``motor_right`` or bound as such (signed, at most 16 bits), a servo's angle
     an output of at most 10 bits (sent with the wheels over SPI, one servo), the camera a
     pixel stream, its colour select 3 bits, ``centroid_leds`` at most 8 bits, every other
-    input a 1-bit pin of a connector (it goes to a header pin), and there are
-    ``len(HEADER_SITES)`` header pins."""
+    input a pin of a connector (it goes to a header pin, each bit of a wider one to a pin of
+    its own, ``"line[2]"``), and there are ``len(HEADER_SITES)`` header pins."""
 
     board_factory(board)
     if spec.kind == "verilog":
@@ -173,13 +173,10 @@ def board_ports(spec, board="ulx3s-85f"):
         if turret and port in _TURRET_INPUTS:
             continue
         if port in pins_of:
-            kind, pin = pins_of[port]
-            if width != 1:
-                raise UserError(
-                    f"design {name}: port {port!r} (the {kind} connector's {pin}) is "
-                    f"{width} bits; the board's header pins take 1-bit ports"
-                )
-            header.append((port, "i" if direction == "in" else "o"))
+            # A wider connector pin is one wire a bit (the line sensors: one a sensor), each
+            # bit on a header pin of its own, named port[k].
+            bits = [port] if width == 1 else [f"{port}[{k}]" for k in range(width)]
+            header += [(bit, "i" if direction == "in" else "o") for bit in bits]
         elif direction == "in":
             raise UserError(
                 f"design {name}: input {port!r} is no pin of the board: it takes the "

@@ -66,12 +66,11 @@ def verilog_board_ports(spec, kinds, header_sites):
             continue
         for pin, port in pins.items():
             direction, width = kinds[kind][pin]
-            if width != 1:
-                raise UserError(
-                    f"design {name}: connectors.{kind}.{pin} ({port!r}) is {width} bits; the "
-                    f"board's header pins take 1-bit connector pins"
-                )
-            header.append((port, "i" if direction == "in" else "o"))
+            # The port's own width once Verilator has read it (the line sensors: one bit a
+            # sensor), else the pin's widest; each bit on a header pin of its own, port[k].
+            width = spec.ports.get(port, (direction, width))[1]
+            bits = [port] if width == 1 else [f"{port}[{k}]" for k in range(width)]
+            header += [(bit, "i" if direction == "in" else "o") for bit in bits]
     if len(header) > len(header_sites):
         raise UserError(
             f"design {name}: {len(header)} connector pins, the board's header has "
@@ -186,9 +185,14 @@ class VerilogOnBoard(Elaboratable):
             self._members["frame_done"] = Signal()
         if servo is not None:
             self._members[servo] = Signal(signed_shape(10))
-        for port, _direction in header:
-            self._members[port] = Signal()
-        self._servo, self._header = servo, list(header)
+        # A port of several bits has an entry a bit (``line[2]``): one member, as wide.
+        self._header = {}
+        for entry, direction in header:
+            port, _, bit = entry.partition("[")
+            width = int(bit.rstrip("]")) + 1 if bit else 1
+            self._header[port] = direction
+            self._members[port] = Signal(max(width, len(self._members.get(port, ()))))
+        self._servo = servo
 
     def __getattr__(self, name):
         members = self.__dict__.get("_members", {})
@@ -229,7 +233,7 @@ class VerilogOnBoard(Elaboratable):
             ports[f"o_{pm.strobe}"] = self._members["frame_done"]
         if self._servo is not None:
             ports[f"o_{self._servo}"] = self._members[self._servo]
-        for port, direction in self._header:
+        for port, direction in self._header.items():
             ports[f"{direction}_{port}"] = self._members[port]
         for port, value in {**pm.runtime, **pm.constants}.items():
             ports[f"i_{port}"] = Const(value)

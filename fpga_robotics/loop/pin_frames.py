@@ -83,8 +83,9 @@ class PinFrames(DesignBackend):
                 raise DesignError(
                     f"{self.label}: frame {self.frames_processed}: frame_done did not rise "
                     f"within {self.watchdog:,} edges (a frame period at sim.clock_hz) after "
-                    f"the frame's last pixel; compressed timing reads a frame's results when "
-                    f'it rises: raise it once a frame, or set sim.timing = "real_clock"'
+                    f"the frame's last pixel (a {p.width}x{p.height} frame, "
+                    f"camera.resolution); compressed timing reads a frame's results when it "
+                    f'rises: raise it once a frame, or set sim.timing = "real_clock"'
                 )
             if stop.value and stop.cycle < last_pixel:
                 # Read now, the results would be the last frame's, and the next frame would

@@ -365,11 +365,17 @@ class RealClockLoop(ClosedLoop):
         for name, port in sorted(self.pins.ports.items()):
             if port.direction == "in" and name not in driven:
                 kinds = [k for k, b in self.top.bindings.items() if name in b.values()]
-                hint = (
-                    f'declare a [[robot.sensors]] table with kind = "{kinds[0]}"'
-                    if kinds
-                    else "bind a connector pin to it with ports = {...}"
-                )
+                stream = re.fullmatch(r"(.+)__(valid|payload)", name)
+                if kinds:
+                    hint = f'declare a [[robot.sensors]] table with kind = "{kinds[0]}"'
+                elif stream and not self.top.camera:
+                    # A pixel stream under another name (pixel: In(...)): the camera's.
+                    hint = (
+                        f"to stream the camera to it, name it pixels or declare connectors = "
+                        f'{{"camera": {{"pixels": "{stream.group(1)}"}}}}'
+                    )
+                else:
+                    hint = "bind a connector pin to it with ports = {...}"
                 raise UsageError(
                     f"design {self.top.name!r}: nothing drives its input {name!r}; {hint}"
                 )
@@ -451,11 +457,12 @@ class RealClockLoop(ClosedLoop):
             return
         frame = self.awaited[0][0]
         if self.strobe is None:
+            p = self.scenario.params  # the size, for a design that counts its own
             raise DesignError(
                 f"{self._design_name}: frame {frame}: frame_done did not rise within "
                 f"{self.frame_watchdog:,} edges (a frame period at sim.clock_hz) after the "
-                "frame's last pixel; the per-frame outputs are read when it rises: raise it "
-                "once a frame"
+                f"frame's last pixel (a {p.width}x{p.height} frame, camera.resolution); the "
+                "per-frame outputs are read when it rises: raise it once a frame"
             )
         port, _latency, timeout = self.strobe
         raise DesignError(

@@ -179,16 +179,17 @@ def run_source(
                 events.append("target found" if result.found else "target lost")
                 was_found = bool(result.found)
             # An output the design lacks (a design of one's own, a port map) is None.
-            results.append(
-                {
-                    "frame": k,
-                    "found": bool(result.found),
-                    **{
-                        name: None if getattr(result, name) is None else int(getattr(result, name))
-                        for name in _OUTPUTS
-                    },
-                }
-            )
+            row = {
+                "frame": k,
+                "found": bool(result.found),
+                **{
+                    name: None if getattr(result, name) is None else int(getattr(result, name))
+                    for name in _OUTPUTS
+                },
+            }
+            if result.extra:  # a design of one's own: its outputs no connector reads
+                row["extra"] = {name: int(value) for name, value in result.extra.items()}
+            results.append(row)
             if recorder is not None or on_frame is not None:
                 stamp = source.frame_time(k) if hasattr(source, "frame_time") else None
                 if stamp is None:  # a camera: the time it was read
@@ -214,6 +215,7 @@ def run_source(
                     cmd_w=cmd_w,
                     camera_hfov=hfov,
                     events=events,
+                    design_extra=result.extra or {},
                 )
                 if recorder is not None:
                     recorder.log_frame(record)
@@ -230,6 +232,12 @@ def run_source(
     n = len(results)
     found = sum(r["found"] for r in results)
     proximity = [r["proximity"] for r in results if r["proximity"] is not None]
+    # The last, smallest and largest value of each, as a closed-loop run's summary has them.
+    seen = {}
+    for r in results:
+        for name, value in r.get("extra", {}).items():
+            seen.setdefault(name, []).append(value)
+    extra = {name: {"last": v[-1], "min": min(v), "max": max(v)} for name, v in seen.items()}
     return {
         "source": source.spec,
         "source_kind": source.kind,
@@ -243,5 +251,6 @@ def run_source(
         "found_frames": found,
         "found_fraction": round(found / n, 4) if n else 0.0,
         "mean_proximity": round(sum(proximity) / len(proximity), 4) if proximity else None,
+        **({"extra_outputs": extra} if extra else {}),
         "results": results,
     }

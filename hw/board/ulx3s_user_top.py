@@ -91,8 +91,8 @@ def header_resources(ports, turret_camera=False):
 class ULX3SUserDesign(Elaboratable):
     """Board top around ``design`` (an Amaranth component already checked on the host).
 
-    ``header``: ``[(port, "i"|"o")]`` the design's 1-bit connector ports, on the header pins
-    in order; ``camera``: whether ``pixels`` is a stream input; ``servo``: the output port of
+    ``header``: ``[(port, "i"|"o")]`` the design's 1-bit connector ports (``"line[2]"``: a
+    bit of a wider one), on the header pins in order; ``camera``: whether ``pixels`` is a stream input; ``servo``: the output port of
     the servo's angle, or None; ``update_s``: the wheel update period of a design without
     ``frame_done``; ``update_delay``: the cycles after ``frame_done`` when its wheels are
     valid.
@@ -242,7 +242,10 @@ class ULX3SUserDesign(Elaboratable):
 
         for k, (name, direction) in enumerate(self.header):
             buf = pin("fr_header", k, direction)
+            name, _, bit = name.partition("[")  # "line[2]": bit 2 of a wider port
             value = getattr(design, name)
+            if bit:
+                value = value[int(bit.rstrip("]"))]
             if direction == "i":
                 m.d.comb += value.eq(buf.i)
             else:

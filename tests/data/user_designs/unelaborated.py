@@ -1,5 +1,5 @@
 """Designs that build but do not elaborate, have no clock or instantiate a module they do not
-define: each is one clear line (tests/test_user_designs.py)."""
+define, or forget super().__init__(): each is one clear line (tests/test_user_designs.py)."""
 
 import sys
 
@@ -86,3 +86,20 @@ class DrivesItsInputByInstance(_Wheels):
         m.d.sync += tick.eq(~tick)
         m.submodules.ip = Instance("my_ip", i_clk=ClockSignal(), o_y=self.line)
         return m
+
+
+class NoSuperInit(_Wheels):
+    """Its __init__ keeps a parameter and forgets super().__init__()."""
+
+    def __init__(self, speed: int = 300):
+        self.speed = speed
+
+    def elaborate(self, platform):
+        return Module()
+
+
+class NoPlatform(_Wheels):
+    """Its elaborate forgets the platform argument."""
+
+    def elaborate(self):
+        return Module()
