@@ -392,6 +392,24 @@ CASES = [
         "takes no parameters",
     ),
     ("mutate port map without design", ["mutate", "--ports", "p.toml"], "--ports"),
+    # an empty output path is refused, never taken for the default folder
+    ("mutate empty out", ["mutate", "--mutants", "1", "--out", ""], "the path is empty"),
+    (
+        "mutate design empty out",
+        ["mutate", "--design", f"{DESIGNS}/counters.py:Saturating", "--out", ""],
+        "the path is empty",
+    ),
+    ("board empty output", ["board", "-o", ""], "the path is empty"),
+    (
+        "sweep empty out",
+        ["sweep", "--scenarios", "approach", "--out", "", "--dry-run"],
+        "--out: the path is empty",
+    ),
+    (
+        "formal empty trace folder",
+        ["formal", "--only", "color_filter.table@zero", "--trace-dir", ""],
+        "the path is empty",
+    ),
     # bench
     ("bench negative min-seconds", ["bench", "--min-seconds", "-5"], "--min-seconds"),
     ("bench nan min-seconds", ["bench", "design", "--min-seconds", "nan"], "--min-seconds"),

@@ -160,9 +160,9 @@ def main(argv=None, prog="fpga-robotics board"):
             f"{'--param' if args.param else '--ports'} goes with --design REF (a design of "
             f"your own)"
         )
-    return run_board(
-        args, params, args.output or os.path.join("build", args.board), prog, design=design
-    )
+    # An empty -o is refused by run_board's check, not replaced by the default.
+    out = args.output if args.output is not None else os.path.join("build", args.board)
+    return run_board(args, params, out, prog, design=design)
 
 
 def _refuse_builtin_parameters(args, name):

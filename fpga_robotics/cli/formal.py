@@ -7,7 +7,6 @@ counterexample VCD goes to ``--trace-dir`` and its row says where. The checks ru
 
 import os
 from concurrent.futures import ThreadPoolExecutor
-from pathlib import Path
 
 from fpga_robotics.cli.errors import UsageError
 from fpga_robotics.cli.mutate import _design_params
@@ -58,7 +57,6 @@ def build_parser(prog="fpga-robotics formal"):
     )
     parser.add_argument(
         "--trace-dir",
-        type=Path,
         default=None,
         metavar="DIR",
         help="where counterexample VCDs go (default: "
@@ -106,8 +104,10 @@ def main(argv=None, prog="fpga-robotics formal"):
         for c in checks:
             print(f"{c.name:<{width}}  {c.mode:<5}  {c.depth:>3}  {c.promise}")
         return 0
+    # An empty --trace-dir is refused by the check, not taken for the default.
     trace_dir = check_output_dir(
-        args.trace_dir or default_trace_dir(), what="counterexample folder"
+        args.trace_dir if args.trace_dir is not None else default_trace_dir(),
+        what="counterexample folder",
     )
     env = formal_env()
     widths = (max(len(c.name) for c in checks), 5, 5, 7, 7)

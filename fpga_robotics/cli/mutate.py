@@ -375,6 +375,12 @@ def _removed_on_error(out, campaign):
         raise
 
 
+def _out(args, name):
+    """``--out``, else ``runs/mutation/NAME``; an empty ``--out`` is given, and refused by
+    ``check_output_dir``, not taken for the default."""
+    return args.out if args.out is not None else os.path.join("runs", "mutation", name)
+
+
 def _reach_scheduler(address):
     """With ``--scheduler``, connect to it once before anything is built: one that cannot be
     reached is refused in seconds, not after the build and the unit judge (its workers may
@@ -415,7 +421,7 @@ def _main_design(args):
         campaign = load_campaign_file(args.campaign)
         design_argv = ["--design", args.design, *(["--ports", args.ports] if verilog else [])]
         check_design_bindings(check_campaign(campaign), design_argv)
-    out = args.out or os.path.join("runs", "mutation", f"{name}-n{args.mutants}-s{args.seed}")
+    out = _out(args, f"{name}-n{args.mutants}-s{args.seed}")
     check_output_dir(out, what="output folder")
     _reach_scheduler(args.scheduler)
 
@@ -521,7 +527,7 @@ def main(argv=None, prog="fpga-robotics mutate"):
     # The mutant netlist is built for this frame size: every robot judge run takes it.
     resolution = f"{params.width}x{params.height}"
     campaign = _campaign(args.campaign, resolution) if args.campaign is not None else None
-    out = args.out or os.path.join("runs", "mutation", f"n{args.mutants}-s{args.seed}")
+    out = _out(args, f"n{args.mutants}-s{args.seed}")
     check_output_dir(out, what="output folder")
     _reach_scheduler(args.scheduler)
 

@@ -322,8 +322,12 @@ def main(argv=None, prog=PROG):
     from fpga_robotics.sweep.sanity import report_campaign_warnings  # lazy: the run stack (~1 s)
 
     report_campaign_warnings(campaign, args.strict, sys.stderr, UsageError)
-    out = Path(args.out) if args.out else Path("runs") / "sweeps" / campaign.name
-    check_output_dir(out, what="--out")  # --dry-run too: it says the command would run
+    # --dry-run too: it says the command would run. An empty --out is refused, not taken
+    # for the default (Path("") would be the current folder).
+    out = check_output_dir(
+        args.out if args.out is not None else Path("runs") / "sweeps" / campaign.name,
+        what="--out",
+    )
     if args.dry_run:
         return _dry_run(campaign, args)
 
