@@ -271,9 +271,15 @@ def test_dry_run_counts_and_shows_commands(tmp_path):
 
 def test_report_of_a_folder_without_results_is_one_line_and_exit_2(tmp_path):
     (tmp_path / "empty").mkdir()
+    # A results table cut short (a full disk, a copy stopped) or not Parquet at all.
+    for name, data in (("torn", b""), ("text", b"run_id,status\n")):
+        (tmp_path / name).mkdir()
+        (tmp_path / name / "results.parquet").write_bytes(data)
     for folder, message in (
         ("empty", "holds no campaign results"),
         ("missing", "is not a folder of campaign results"),
+        ("torn", "torn/results.parquet is not a readable results table"),
+        ("text", "text/results.parquet is not a readable results table"),
     ):
         proc = subprocess.run(
             SWEEP + ["report", folder],
