@@ -235,6 +235,29 @@ BENCH_MISUSE = {
 }
 
 
+#: ``--bench`` values checked as a campaign's are, before the first line: none is replaced
+#: by its default (each case would run a short benchmark if it were).
+BENCH_BAD_VALUES = {
+    "zero duration": (["--duration", "0"], "--duration must be a finite number of seconds > 0"),
+    "empty scenario": (["--scenarios", ""], "scenarios must be a non-empty list"),
+    "empty backend": (["--backend", ""], 'backend = "": the backend must be one of'),
+    "empty resolution": (["--resolution", ""], "resolution must look like WIDTHxHEIGHT"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(BENCH_BAD_VALUES))
+def test_bench_values_are_checked_not_replaced_by_defaults(case, tmp_path, monkeypatch, capsys):
+    argv, message = BENCH_BAD_VALUES[case]
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(SystemExit) as exit_info:
+        run_cli(main, ["--bench", *SHORT_BENCH, *argv], prog="x")
+    assert exit_info.value.code == 2
+    captured = capsys.readouterr()
+    lines = captured.err.strip().splitlines()
+    assert len(lines) == 1 and message in lines[0], lines
+    assert captured.out == "" and list(tmp_path.iterdir()) == []
+
+
 @pytest.mark.parametrize("case", sorted(BENCH_MISUSE))
 def test_what_bench_would_ignore_is_refused(case, tmp_path, monkeypatch, capsys):
     argv, message = BENCH_MISUSE[case]
@@ -306,6 +329,8 @@ BAD_OPTION_VALUES = {
         "--timeout must be a finite number of seconds > 0, got inf",
     ),
     "--backend": (["--backend", "cxxrt"], "--backend cxxrt: the backend must be one of"),
+    # An empty value is checked, never taken for the default (auto).
+    "--backend empty": (["--backend", ""], "--backend : the backend must be one of"),
     "--shadow": (
         ["--shadow", "frob=1"],
         "run of approach: --shadow frob=1: unknown scenario key 'design.frob'",

@@ -175,8 +175,6 @@ def _merge_options(data, args):
             else text
         )
         parse_seeds(data["seeds"], where="--seeds", forms="A-B (e.g. 0-19) or A,B,C")
-    if args.duration is not None and not 0 < args.duration < math.inf:
-        raise UsageError(f"--duration must be a finite number of seconds > 0, got {args.duration}")
     for key in ("backend", "resolution", "duration", "shadow", "design", "ports", "timeout"):
         value = getattr(args, key)
         if value is not None:
@@ -225,6 +223,9 @@ def _check_options(args):
         value = getattr(args, name)
         if value is not None and value < 1:
             raise UsageError(f"--{name.replace('_', '-')} must be >= 1, got {value}")
+    # Here, not with the campaign: --bench takes --duration too.
+    if args.duration is not None and not 0 < args.duration < math.inf:
+        raise UsageError(f"--duration must be a finite number of seconds > 0, got {args.duration}")
     if args.timeout is not None and not 0 < args.timeout < math.inf:
         raise UsageError(f"--timeout must be a finite number of seconds > 0, got {args.timeout}")
     if args.bag and args.record == "none":

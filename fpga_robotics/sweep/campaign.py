@@ -589,7 +589,8 @@ def load_campaign(data, *, source="", command_line=None):
             how = "--scenarios" if command_line.get("scenarios") else "scenarios"
             raise CampaignError(f"{how} lists {twice} twice: give each scenario once")
         seeds = parse_seeds(data.get("seeds", "0"))
-        backend = _typed(data, "backend", str, "a backend name") or "auto"
+        backend = _typed(data, "backend", str, "a backend name")
+        backend = "auto" if backend is None else backend  # "" is checked, not taken for auto
         resolution = _typed(data, "resolution", str, '"WxH"')
         duration = _typed(data, "duration", (int, float), "a number of seconds")
         if duration is not None and not 0 < duration < math.inf:
