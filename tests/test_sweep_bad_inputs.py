@@ -184,7 +184,9 @@ def test_bad_campaign_file_is_one_line_and_exit_2(case, tmp_path, monkeypatch, c
 @pytest.mark.parametrize(
     "argv, message",
     [
-        (["--workers", "0"], "--workers must be >= 1"),
+        (["--workers", "0"], "--workers must be 1..256, got 0"),
+        # as mutate's: not a process per run of a large campaign
+        (["--workers", "100000", "--dry-run"], "--workers must be 1..256, got 100000"),
         (["--grid", "design.diff_min=4"], "--grid needs KEY=[V1, V2, ...]"),
         (["--seeds", "5-1"], "is empty"),
         (["--scheduler", "tcp://127.0.0.1:9", "--workers", "2"], "--workers sizes"),

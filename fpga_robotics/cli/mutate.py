@@ -488,8 +488,6 @@ def _check(args):
         raise UsageError(f"--mutants must be 1..{MAX_MUTANTS}, got {args.mutants}")
     if not 0 <= args.seed <= MAX_SEED:
         raise UsageError(f"--seed must be 0..{MAX_SEED}, got {args.seed}")
-    if args.workers is not None and not 1 <= args.workers <= 256:
-        raise UsageError(f"--workers must be 1..256, got {args.workers}")
     if args.recordings is not None and args.recordings < 0:
         raise UsageError(f"--recordings must be >= 0, got {args.recordings}")
     if args.campaign is None and (

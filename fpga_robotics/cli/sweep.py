@@ -80,7 +80,8 @@ def build_parser(prog=PROG):
         "--workers",
         type=int,
         metavar="N",
-        help="embedded cluster: N worker processes, one thread each (default: the machine's cores)",
+        help="embedded cluster: N worker processes (1..256), one thread each (default: the "
+        "machine's cores)",
     )
     e.add_argument(
         "--scheduler",
@@ -219,7 +220,7 @@ def _campaign(args):
 
 
 def _check_options(args):
-    for name in ("workers", "max_runs", "bench_runs", "bench_repeats", "log_every"):
+    for name in ("max_runs", "bench_runs", "bench_repeats", "log_every"):
         value = getattr(args, name)
         if value is not None and value < 1:
             raise UsageError(f"--{name.replace('_', '-')} must be >= 1, got {value}")
