@@ -392,6 +392,18 @@ CASES = [
         "takes no parameters",
     ),
     ("mutate port map without design", ["mutate", "--ports", "p.toml"], "--ports"),
+    # an empty input path is named as empty, not read as the current folder
+    ("empty port map", ["ports", ""], "the port map's path is empty"),
+    (
+        "empty port map of a design",
+        ["designs", f"verilog:{DESIGNS}/bump_stop_noreset.v", "--ports", ""],
+        "the port map's path is empty",
+    ),
+    ("empty scenario", ["run", "--scenario", ""], "the scenario is empty"),
+    ("empty campaign", ["sweep", "", "--dry-run"], "the campaign is empty"),
+    ("mutate empty campaign", ["mutate", "--campaign", ""], "the campaign is empty"),
+    ("empty results folder", ["sweep", "report", ""], "'' is not a folder of campaign results"),
+    ("empty recording", ["readback", ""], "no recording at ''"),
     # an empty output path is refused, never taken for the default folder
     ("mutate empty out", ["mutate", "--mutants", "1", "--out", ""], "the path is empty"),
     (

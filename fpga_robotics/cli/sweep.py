@@ -301,8 +301,8 @@ def _report(argv, prog):
     p.add_argument("dir", metavar="DIR", help="the campaign's results folder")
     args = p.parse_args(argv)
 
-    if not Path(args.dir).is_dir():
-        raise UsageError(f"{args.dir} is not a folder of campaign results")
+    if not args.dir.strip() or not Path(args.dir).is_dir():
+        raise UsageError(f"{args.dir!r} is not a folder of campaign results")
     print(report_dir(args.dir))
     print(f"report: {Path(args.dir) / 'report.html'}")
     return 0

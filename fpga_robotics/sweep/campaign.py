@@ -523,6 +523,8 @@ def shipped_campaigns():
 
 def _resolve(name_or_path):
     text = str(name_or_path)
+    if not text.strip():  # Path("") would be the current folder
+        raise CampaignError("the campaign is empty; give a shipped name or a .toml file")
     path = Path(text)
     if path.is_file():
         return path
