@@ -392,6 +392,24 @@ CASES = [
         "takes no parameters",
     ),
     ("mutate port map without design", ["mutate", "--ports", "p.toml"], "--ports"),
+    (
+        "mutate resolution of a design without a camera",
+        ["mutate", "--design", f"{DESIGNS}/counters.py:Saturating", "--resolution", "40x8"],
+        "--resolution sizes the frames of a camera design's unit judge; Saturating has no",
+    ),
+    (
+        "mutate resolution of a Verilog design without a camera",
+        [
+            "mutate",
+            "--design",
+            f"verilog:{DESIGNS}/bump_stop_noreset.v",
+            "--ports",
+            f"{DESIGNS}/bump_stop_noreset_ports.toml",
+            "--resolution",
+            "40x8",
+        ],
+        "bump_stop_noreset has no camera input",
+    ),
     # an empty input path is named as empty, not read as the current folder
     ("empty port map", ["ports", ""], "the port map's path is empty"),
     (

@@ -416,6 +416,12 @@ def _main_design(args):
         spec.require_clock()
         spec.require_no_black_boxes()
         name = spec.reference.rpartition(":")[2]
+    if args.resolution is not None and not spec.camera:
+        # Its unit judge streams no frames: the option would do nothing.
+        raise UsageError(
+            f"--resolution sizes the frames of a camera design's unit judge; {name} has no "
+            "camera input"
+        )
     campaign = None
     if args.campaign is not None:
         campaign = load_campaign_file(args.campaign)
