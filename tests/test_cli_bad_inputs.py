@@ -410,6 +410,21 @@ CASES = [
         ],
         "bump_stop_noreset has no camera input",
     ),
+    # a design parameter given twice: one parser for every command, no silent last value
+    *(
+        (
+            f"{command} parameter given twice",
+            [command, *ref, "--param", "limit=3", "--param", " limit =4", *rest],
+            "--param limit is given twice; give each parameter once",
+        )
+        for command, ref, rest in (
+            ("designs", [f"{DESIGNS}/counters.py:Saturating"], []),
+            ("mutate", ["--design", f"{DESIGNS}/counters.py:Saturating"], []),
+            ("export", ["--design", f"{DESIGNS}/counters.py:Saturating"], ["-o", "x.v"]),
+            ("board", ["--design", f"{DESIGNS}/counters.py:Saturating"], ["-o", "out"]),
+            ("formal", ["--design", f"{DESIGNS}/counters.py:Saturating"], ["--list"]),
+        )
+    ),
     # an empty input path is named as empty, not read as the current folder
     ("empty port map", ["ports", ""], "the port map's path is empty"),
     (

@@ -9,8 +9,7 @@ import os
 from concurrent.futures import ThreadPoolExecutor
 
 from fpga_robotics.cli.errors import UsageError
-from fpga_robotics.cli.mutate import _design_params
-from fpga_robotics.cli.param_options import add_design_param_argument
+from fpga_robotics.cli.param_options import add_design_param_argument, design_params_from_items
 from fpga_robotics.cli.parser import CommandParser
 from fpga_robotics.flow.formal import (
     default_trace_dir,
@@ -98,7 +97,9 @@ def main(argv=None, prog="fpga-robotics formal"):
     if args.jobs < 1:
         raise UsageError(f"--jobs must be at least 1, got {args.jobs}")
 
-    checks = select(design_checks(args.design, _design_params(args.param), args.ports), args.only)
+    checks = select(
+        design_checks(args.design, design_params_from_items(args.param), args.ports), args.only
+    )
     if args.list:
         width = max(len(c.name) for c in checks)
         for c in checks:

@@ -13,12 +13,12 @@ import os
 import shutil
 import sys
 import time
-import tomllib
 
 from fpga_robotics.cli.errors import UsageError
 from fpga_robotics.cli.param_options import (
     add_design_param_argument,
     add_param_arguments,
+    design_params_from_items,
     params_from_args,
     refuse_followtarget_options,
 )
@@ -317,20 +317,6 @@ def build_parser(prog="fpga-robotics mutate"):
     return p
 
 
-def _design_params(items):
-    """``--param NAME=VALUE`` items as a dict (values parsed as TOML, else text)."""
-    params = {}
-    for item in items:
-        name, sep, text = item.partition("=")
-        if not sep or not name.strip().isidentifier():
-            raise UsageError(f"--param must be NAME=VALUE, got {item!r}")
-        try:
-            params[name.strip()] = tomllib.loads(f"v = {text}")["v"]
-        except tomllib.TOMLDecodeError:
-            params[name.strip()] = text
-    return params
-
-
 def _resolution(text):
     """``WxH`` as (width, height); ``UsageError`` otherwise."""
     w, x, h = text.lower().partition("x")
@@ -412,7 +398,7 @@ def _main_design(args):
         files = spec.reference[len("verilog:") :].split(",")
         name = os.path.splitext(os.path.basename(files[0]))[0]
     else:
-        spec = resolve_design(args.design, _design_params(args.param), option="--param")
+        spec = resolve_design(args.design, design_params_from_items(args.param), option="--param")
         spec.require_clock()
         spec.require_no_black_boxes()
         name = spec.reference.rpartition(":")[2]
