@@ -325,6 +325,10 @@ BAD_OPTION_VALUES = {
     "--seeds range": (["--seeds", "5-1"], "--seeds range '5-1' is empty"),
     "--set": (["--set", "robot.mass"], "--set needs KEY=VALUE (e.g. robot.mass=12)"),
     "--grid": (["--grid", "design.diff_min=[]"], "--grid needs KEY=[V1, V2, ...]"),
+    "--grid twice": (
+        ["--grid", "design.diff_min=[4]", "--grid", " design.diff_min=[5, 6]"],
+        "--grid design.diff_min is given twice: give all its values in one list",
+    ),
     "--duration": (["--duration", "-1"], "--duration must be a finite number of seconds > 0"),
     "--timeout": (
         ["--timeout", "inf"],

@@ -185,6 +185,7 @@ def _merge_options(data, args):
             if not item.partition("=")[0].strip() or "=" not in item:
                 raise UsageError(f"--set needs KEY=VALUE (e.g. robot.mass=12), got {item!r}")
         data["set"] = list(data.get("set", [])) + args.fixed
+    given_axes = set()
     for item in args.grid:
         key, sep, text = item.partition("=")
         values = _parse_value(text) if sep else None
@@ -192,6 +193,12 @@ def _merge_options(data, args):
             raise UsageError(
                 f"--grid needs KEY=[V1, V2, ...] (a TOML list of at least one value), got {item!r}"
             )
+        # A second --grid of one key would replace the first's values unseen.
+        if key.strip() in given_axes:
+            raise UsageError(
+                f"--grid {key.strip()} is given twice: give all its values in one list"
+            )
+        given_axes.add(key.strip())
         grid = data.get("grid") if isinstance(data.get("grid"), dict) else {}
         data["grid"] = {**grid, key.strip(): values}
     given = {
