@@ -75,6 +75,19 @@ def test_a_failed_command_removes_only_the_folder_it_made(
     assert os.path.exists(out) == kept
 
 
+@pytest.mark.parametrize("failure", [BackendError, KeyboardInterrupt])
+def test_a_failed_command_removes_the_parent_folders_it_made_too(tmp_path, failure):
+    # The default --out is runs/mutation/n<N>-s<S>: in a fresh folder runs/ and
+    # runs/mutation/ are made for it, and go with it; a folder that was there stays.
+    (tmp_path / "kept").mkdir()
+    for made, out in (("runs", "runs/mutation/n1-s1"), ("kept/a", "kept/a/b")):
+        with pytest.raises(failure), _removed_on_error(str(tmp_path / out), None):
+            os.makedirs(tmp_path / out)
+            raise failure("the build failed")
+        assert not (tmp_path / made).exists()
+    assert sorted(os.listdir(tmp_path)) == ["kept"] and not os.listdir(tmp_path / "kept")
+
+
 def test_an_interrupted_robot_judge_says_what_it_kept(tmp_path, capsys):
     out = tmp_path / "m"
     rows = [{"index": 2, "caught": True}, {"index": 5, "caught": False}]

@@ -344,12 +344,17 @@ def _removed_on_error(out, campaign):
     --resume, and so is a folder that was there before). Interrupted with verdicts in the
     journal of a robot judge (``campaign``), say how many and how to go on."""
     existed = os.path.exists(out)
+    # The highest folder this command makes (runs/ of runs/mutation/n100-s1): its parents
+    # made for it go too.
+    made = out
+    while not existed and os.path.dirname(made) and not os.path.exists(os.path.dirname(made)):
+        made = os.path.dirname(made)
     try:
         yield
     except (Exception, KeyboardInterrupt) as exc:
         journal = os.path.join(out, JOURNAL_NAME)
         if not existed and not os.path.exists(journal):
-            shutil.rmtree(out, ignore_errors=True)
+            shutil.rmtree(made, ignore_errors=True)
         elif isinstance(exc, KeyboardInterrupt) and campaign is not None:
             kept = len(journal_rows(journal)) if os.path.exists(journal) else 0
             if kept:
