@@ -247,6 +247,29 @@ def test_a_campaign_that_cannot_drive_the_design_is_refused_before_the_build(tmp
     assert not out.exists()
 
 
+def test_a_campaign_of_another_design_is_refused_before_follow_target_s_build(
+    tmp_path, capsys, monkeypatch
+):
+    # line_track runs FollowLine on line sensors FollowTarget has no pins for: refused with
+    # run's message before the mutants are listed (it was, after the build and unit judge).
+    from fpga_robotics.cli import mutate
+
+    def listed(*args, **kwargs):
+        raise AssertionError("the mutants were listed before the campaign was checked")
+
+    monkeypatch.setattr(mutate, "list_mutants", listed)
+    campaign = tmp_path / "c.toml"
+    campaign.write_text('scenarios = ["approach", "line_track"]\nseeds = "0"\n')
+    out = tmp_path / "m"
+    with pytest.raises(SystemExit) as exc:
+        run_cli(main, ["--mutants", "2", "--campaign", str(campaign), "--out", str(out)], "m")
+    err = capsys.readouterr().err
+    assert exc.value.code == 2 and len(err.strip().splitlines()) == 1, err
+    assert "the campaign's run of line_track: the line_sensors connector 'line'" in err
+    assert "design 'follow_target' has no port for its pin 'line'" in err
+    assert not out.exists()
+
+
 def test_a_usage_error_of_an_unmutated_run_refuses_the_campaign():
     from fpga_robotics.hw.errors import UsageError
     from fpga_robotics.mutation.robot_judge import _refuse_usage_errors

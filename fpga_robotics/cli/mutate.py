@@ -69,7 +69,9 @@ def _campaign(name, resolution=None):
     """The campaign ``name`` with every run checked (``check_campaign``, with the mutant
     netlist's ``resolution``): a typo fails here, before anything is built or written."""
     campaign = load_campaign_file(name)
-    check_campaign(campaign, resolution)
+    # Its scenarios' sensors against FollowTarget's pins too: a campaign of another design
+    # (sensor_designs) fails here, not after the build and the unit judge.
+    check_design_bindings(check_campaign(campaign, resolution), ["--design", "follow_target"])
     return campaign
 
 
