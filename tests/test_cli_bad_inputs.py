@@ -397,6 +397,69 @@ CASES = [
         "takes no parameters",
     ),
     ("mutate port map without design", ["mutate", "--ports", "p.toml"], "--ports"),
+    (
+        "mutate resolution of a design without a camera",
+        ["mutate", "--design", f"{DESIGNS}/counters.py:Saturating", "--resolution", "40x8"],
+        "--resolution sizes the frames of a camera design's unit judge; Saturating has no",
+    ),
+    (
+        "mutate resolution of a Verilog design without a camera",
+        [
+            "mutate",
+            "--design",
+            f"verilog:{DESIGNS}/bump_stop_noreset.v",
+            "--ports",
+            f"{DESIGNS}/bump_stop_noreset_ports.toml",
+            "--resolution",
+            "40x8",
+        ],
+        "bump_stop_noreset has no camera input",
+    ),
+    # a design parameter given twice: one parser for every command, no silent last value
+    *(
+        (
+            f"{command} parameter given twice",
+            [command, *ref, "--param", "limit=3", "--param", " limit =4", *rest],
+            "--param limit is given twice; give each parameter once",
+        )
+        for command, ref, rest in (
+            ("designs", [f"{DESIGNS}/counters.py:Saturating"], []),
+            ("mutate", ["--design", f"{DESIGNS}/counters.py:Saturating"], []),
+            ("export", ["--design", f"{DESIGNS}/counters.py:Saturating"], ["-o", "x.v"]),
+            ("board", ["--design", f"{DESIGNS}/counters.py:Saturating"], ["-o", "out"]),
+            ("formal", ["--design", f"{DESIGNS}/counters.py:Saturating"], ["--list"]),
+        )
+    ),
+    # an empty input path is named as empty, not read as the current folder
+    ("empty port map", ["ports", ""], "the port map's path is empty"),
+    (
+        "empty port map of a design",
+        ["designs", f"verilog:{DESIGNS}/bump_stop_noreset.v", "--ports", ""],
+        "the port map's path is empty",
+    ),
+    ("empty scenario", ["run", "--scenario", ""], "the scenario is empty"),
+    ("empty campaign", ["sweep", "", "--dry-run"], "the campaign is empty"),
+    ("mutate empty campaign", ["mutate", "--campaign", ""], "the campaign is empty"),
+    ("empty results folder", ["sweep", "report", ""], "'' is not a folder of campaign results"),
+    ("empty recording", ["readback", ""], "no recording at ''"),
+    # an empty output path is refused, never taken for the default folder
+    ("mutate empty out", ["mutate", "--mutants", "1", "--out", ""], "the path is empty"),
+    (
+        "mutate design empty out",
+        ["mutate", "--design", f"{DESIGNS}/counters.py:Saturating", "--out", ""],
+        "the path is empty",
+    ),
+    ("board empty output", ["board", "-o", ""], "the path is empty"),
+    (
+        "sweep empty out",
+        ["sweep", "--scenarios", "approach", "--out", "", "--dry-run"],
+        "--out: the path is empty",
+    ),
+    (
+        "formal empty trace folder",
+        ["formal", "--only", "color_filter.table@zero", "--trace-dir", ""],
+        "the path is empty",
+    ),
     # bench
     ("bench negative min-seconds", ["bench", "--min-seconds", "-5"], "--min-seconds"),
     ("bench nan min-seconds", ["bench", "design", "--min-seconds", "nan"], "--min-seconds"),

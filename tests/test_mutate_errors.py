@@ -75,6 +75,19 @@ def test_a_failed_command_removes_only_the_folder_it_made(
     assert os.path.exists(out) == kept
 
 
+@pytest.mark.parametrize("failure", [BackendError, KeyboardInterrupt])
+def test_a_failed_command_removes_the_parent_folders_it_made_too(tmp_path, failure):
+    # The default --out is runs/mutation/n<N>-s<S>: in a fresh folder runs/ and
+    # runs/mutation/ are made for it, and go with it; a folder that was there stays.
+    (tmp_path / "kept").mkdir()
+    for made, out in (("runs", "runs/mutation/n1-s1"), ("kept/a", "kept/a/b")):
+        with pytest.raises(failure), _removed_on_error(str(tmp_path / out), None):
+            os.makedirs(tmp_path / out)
+            raise failure("the build failed")
+        assert not (tmp_path / made).exists()
+    assert sorted(os.listdir(tmp_path)) == ["kept"] and not os.listdir(tmp_path / "kept")
+
+
 def test_an_interrupted_robot_judge_says_what_it_kept(tmp_path, capsys):
     out = tmp_path / "m"
     rows = [{"index": 2, "caught": True}, {"index": 5, "caught": False}]
@@ -231,6 +244,29 @@ def test_a_campaign_that_cannot_drive_the_design_is_refused_before_the_build(tmp
     assert exc.value.code == 2 and len(err.strip().splitlines()) == 1
     assert "the campaign's run of follow_person" in err
     assert "nothing drives its input 'bump_i'" in err and 'kind = "bumper"' in err
+    assert not out.exists()
+
+
+def test_a_campaign_of_another_design_is_refused_before_follow_target_s_build(
+    tmp_path, capsys, monkeypatch
+):
+    # line_track runs FollowLine on line sensors FollowTarget has no pins for: refused with
+    # run's message before the mutants are listed (it was, after the build and unit judge).
+    from fpga_robotics.cli import mutate
+
+    def listed(*args, **kwargs):
+        raise AssertionError("the mutants were listed before the campaign was checked")
+
+    monkeypatch.setattr(mutate, "list_mutants", listed)
+    campaign = tmp_path / "c.toml"
+    campaign.write_text('scenarios = ["approach", "line_track"]\nseeds = "0"\n')
+    out = tmp_path / "m"
+    with pytest.raises(SystemExit) as exc:
+        run_cli(main, ["--mutants", "2", "--campaign", str(campaign), "--out", str(out)], "m")
+    err = capsys.readouterr().err
+    assert exc.value.code == 2 and len(err.strip().splitlines()) == 1, err
+    assert "the campaign's run of line_track: the line_sensors connector 'line'" in err
+    assert "design 'follow_target' has no port for its pin 'line'" in err
     assert not out.exists()
 
 

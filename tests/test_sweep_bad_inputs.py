@@ -184,7 +184,9 @@ def test_bad_campaign_file_is_one_line_and_exit_2(case, tmp_path, monkeypatch, c
 @pytest.mark.parametrize(
     "argv, message",
     [
-        (["--workers", "0"], "--workers must be >= 1"),
+        (["--workers", "0"], "--workers must be 1..256, got 0"),
+        # as mutate's: not a process per run of a large campaign
+        (["--workers", "100000", "--dry-run"], "--workers must be 1..256, got 100000"),
         (["--grid", "design.diff_min=4"], "--grid needs KEY=[V1, V2, ...]"),
         (["--seeds", "5-1"], "is empty"),
         (["--scheduler", "tcp://127.0.0.1:9", "--workers", "2"], "--workers sizes"),
@@ -235,6 +237,29 @@ BENCH_MISUSE = {
 }
 
 
+#: ``--bench`` values checked as a campaign's are, before the first line: none is replaced
+#: by its default (each case would run a short benchmark if it were).
+BENCH_BAD_VALUES = {
+    "zero duration": (["--duration", "0"], "--duration must be a finite number of seconds > 0"),
+    "empty scenario": (["--scenarios", ""], "scenarios must be a non-empty list"),
+    "empty backend": (["--backend", ""], 'backend = "": the backend must be one of'),
+    "empty resolution": (["--resolution", ""], "resolution must look like WIDTHxHEIGHT"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(BENCH_BAD_VALUES))
+def test_bench_values_are_checked_not_replaced_by_defaults(case, tmp_path, monkeypatch, capsys):
+    argv, message = BENCH_BAD_VALUES[case]
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(SystemExit) as exit_info:
+        run_cli(main, ["--bench", *SHORT_BENCH, *argv], prog="x")
+    assert exit_info.value.code == 2
+    captured = capsys.readouterr()
+    lines = captured.err.strip().splitlines()
+    assert len(lines) == 1 and message in lines[0], lines
+    assert captured.out == "" and list(tmp_path.iterdir()) == []
+
+
 @pytest.mark.parametrize("case", sorted(BENCH_MISUSE))
 def test_what_bench_would_ignore_is_refused(case, tmp_path, monkeypatch, capsys):
     argv, message = BENCH_MISUSE[case]
@@ -271,9 +296,15 @@ def test_dry_run_counts_and_shows_commands(tmp_path):
 
 def test_report_of_a_folder_without_results_is_one_line_and_exit_2(tmp_path):
     (tmp_path / "empty").mkdir()
+    # A results table cut short (a full disk, a copy stopped) or not Parquet at all.
+    for name, data in (("torn", b""), ("text", b"run_id,status\n")):
+        (tmp_path / name).mkdir()
+        (tmp_path / name / "results.parquet").write_bytes(data)
     for folder, message in (
         ("empty", "holds no campaign results"),
         ("missing", "is not a folder of campaign results"),
+        ("torn", "torn/results.parquet is not a readable results table"),
+        ("text", "text/results.parquet is not a readable results table"),
     ):
         proc = subprocess.run(
             SWEEP + ["report", folder],
@@ -294,12 +325,18 @@ BAD_OPTION_VALUES = {
     "--seeds range": (["--seeds", "5-1"], "--seeds range '5-1' is empty"),
     "--set": (["--set", "robot.mass"], "--set needs KEY=VALUE (e.g. robot.mass=12)"),
     "--grid": (["--grid", "design.diff_min=[]"], "--grid needs KEY=[V1, V2, ...]"),
+    "--grid twice": (
+        ["--grid", "design.diff_min=[4]", "--grid", " design.diff_min=[5, 6]"],
+        "--grid design.diff_min is given twice: give all its values in one list",
+    ),
     "--duration": (["--duration", "-1"], "--duration must be a finite number of seconds > 0"),
     "--timeout": (
         ["--timeout", "inf"],
         "--timeout must be a finite number of seconds > 0, got inf",
     ),
     "--backend": (["--backend", "cxxrt"], "--backend cxxrt: the backend must be one of"),
+    # An empty value is checked, never taken for the default (auto).
+    "--backend empty": (["--backend", ""], "--backend : the backend must be one of"),
     "--shadow": (
         ["--shadow", "frob=1"],
         "run of approach: --shadow frob=1: unknown scenario key 'design.frob'",

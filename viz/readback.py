@@ -69,7 +69,7 @@ def _row_values(column):
 def read_rrd(path):
     """Read the first recording in ``path``; returns a ``Recording``."""
     if not os.path.isfile(path):
-        raise FileNotFoundError(f"no recording at {path}")
+        raise FileNotFoundError(f"no recording at {str(path)!r}")
     try:
         with warnings.catch_warnings():
             # Said of a cut-off file too, which then fails below with one line of its own;

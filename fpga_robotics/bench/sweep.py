@@ -21,6 +21,7 @@ from fpga_robotics.bench import scaffold
 from fpga_robotics.cli.errors import UsageError
 from fpga_robotics.sweep.api import run_campaign
 from fpga_robotics.sweep.campaign import load_campaign
+from fpga_robotics.sweep.plan import make_plan
 from fpga_robotics.sweep.results import read_meta
 
 __all__ = ["REPEATS", "RUNS", "bench", "main", "measure"]
@@ -30,16 +31,28 @@ RUNS = 40
 REPEATS = 3
 
 
+#: What a run is when an option does not say.
+DEFAULTS = {
+    "scenarios": "follow_person",
+    "backend": "model",
+    "resolution": "160x120",
+    "duration": 10.0,
+}
+
+
+def _run_options(args):
+    """The options that shape a run, each defaulted only when not given: an empty or zero
+    value is checked with the campaign, not replaced."""
+    return {
+        k: default if getattr(args, k) is None else getattr(args, k)
+        for k, default in DEFAULTS.items()
+    }
+
+
 def _campaign(runs, args):
+    options = _run_options(args)
     return load_campaign(
-        {
-            "name": "bench",
-            "scenarios": [args.scenarios or "follow_person"],
-            "seeds": [*range(runs)],
-            "backend": args.backend or "model",
-            "resolution": args.resolution or "160x120",
-            "duration": args.duration or 10.0,
-        }
+        {"name": "bench", **options, "scenarios": [options["scenarios"]], "seeds": [*range(runs)]}
     )
 
 
@@ -76,11 +89,13 @@ def measure(args):
     """Print the figures and return them: per worker count, the medians."""
     n = args.workers or os.cpu_count() or 1
     runs, repeats = args.bench_runs, args.bench_repeats
+    make_plan(_campaign(runs, args))  # every run checked before the first line
+    options = _run_options(args)
     compared = f"1 and {n} workers alternately" if n > 1 else "1 worker"
     print(
-        f"campaign benchmark: {runs} runs of {args.scenarios or 'follow_person'}, "
-        f"{args.resolution or '160x120'}, {args.duration or 10.0} s simulated, backend "
-        f"{args.backend or 'model'}; {compared}, {repeats} times; "
+        f"campaign benchmark: {runs} runs of {options['scenarios']}, "
+        f"{options['resolution']}, {options['duration']} s simulated, backend "
+        f"{options['backend']}; {compared}, {repeats} times; "
         f"load average {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores"
     )
     counts = sorted({1, n})

@@ -7,10 +7,10 @@ import sys
 
 from fpga_robotics.cli.designs import checked_verilog
 from fpga_robotics.cli.errors import UsageError
-from fpga_robotics.cli.mutate import _design_params
 from fpga_robotics.cli.param_options import (
     add_design_param_argument,
     add_param_arguments,
+    design_params_from_items,
     given_followtarget_options,
     params_from_args,
     refuse_followtarget_options,
@@ -153,16 +153,16 @@ def main(argv=None, prog="fpga-robotics board"):
         # The board top's own options would be silently ignored with a design of one's own.
         refuse_followtarget_options(args, "--design REF puts a design of your own on the board")
         design = resolve_design(
-            args.design, _design_params(args.param), ports=args.ports, option="--param"
+            args.design, design_params_from_items(args.param), ports=args.ports, option="--param"
         )
     elif args.param or args.ports:
         raise UsageError(
             f"{'--param' if args.param else '--ports'} goes with --design REF (a design of "
             f"your own)"
         )
-    return run_board(
-        args, params, args.output or os.path.join("build", args.board), prog, design=design
-    )
+    # An empty -o is refused by run_board's check, not replaced by the default.
+    out = args.output if args.output is not None else os.path.join("build", args.board)
+    return run_board(args, params, out, prog, design=design)
 
 
 def _refuse_builtin_parameters(args, name):

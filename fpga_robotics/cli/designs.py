@@ -5,9 +5,9 @@ connectors they bind and the outputs recorded under their own names."""
 import argparse
 import dataclasses
 import sys
-import tomllib
 
 from fpga_robotics.cli.errors import UsageError, run_cli
+from fpga_robotics.cli.param_options import design_params_from_items
 from fpga_robotics.designs.builtin import TOPS, connector_kinds
 from fpga_robotics.designs.reference import DesignError, entry_point_designs, resolve_design
 
@@ -37,19 +37,6 @@ def build_parser(prog):
     )
     p.add_argument("--ports", metavar="PORTS.toml", help="the port map of a verilog: REF")
     return p
-
-
-def _params(items):
-    params = {}
-    for item in items:
-        name, sep, text = item.partition("=")
-        if not sep or not name.strip().isidentifier():
-            raise UsageError(f"--param needs NAME=VALUE, got {item!r}")
-        try:
-            params[name.strip()] = tomllib.loads(f"v = {text}")["v"]
-        except tomllib.TOMLDecodeError:
-            params[name.strip()] = text.strip()
-    return params
 
 
 def describe(spec, origin):
@@ -92,7 +79,7 @@ def checked_verilog(spec, ports):
 
 def main(argv=None, prog="fpga-robotics designs"):
     args = build_parser(prog).parse_args(argv)
-    params = _params(args.params)
+    params = design_params_from_items(args.params)
     if args.reference is None:
         if params or args.ports:
             raise UsageError("--param and --ports describe a design REF: give one")

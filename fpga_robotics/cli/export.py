@@ -23,10 +23,10 @@ import os
 from dataclasses import fields
 
 from fpga_robotics.cli.board import add_board_arguments, run_board
-from fpga_robotics.cli.designs import _params
 from fpga_robotics.cli.errors import UsageError
 from fpga_robotics.cli.param_options import (
     add_param_arguments,
+    design_params_from_items,
     params_from_args,
     refuse_followtarget_options,
 )
@@ -285,7 +285,9 @@ def _export_design(args):
             )
     if args.variant is not None:
         raise UsageError("--variant names a seeded bug of a built-in top: it goes without --design")
-    spec = resolve_design(args.design, _params(args.design_params), option="--param")
+    spec = resolve_design(
+        args.design, design_params_from_items(args.design_params), option="--param"
+    )
     name = spec.reference.rpartition(":")[2]
     output = args.output if args.output is not None else os.path.join("build", f"{name}.v")
     # Verilog written over the design's file, or a module it imports beside it, would lose it.

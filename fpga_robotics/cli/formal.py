@@ -7,11 +7,9 @@ counterexample VCD goes to ``--trace-dir`` and its row says where. The checks ru
 
 import os
 from concurrent.futures import ThreadPoolExecutor
-from pathlib import Path
 
 from fpga_robotics.cli.errors import UsageError
-from fpga_robotics.cli.mutate import _design_params
-from fpga_robotics.cli.param_options import add_design_param_argument
+from fpga_robotics.cli.param_options import add_design_param_argument, design_params_from_items
 from fpga_robotics.cli.parser import CommandParser
 from fpga_robotics.flow.formal import (
     default_trace_dir,
@@ -58,7 +56,6 @@ def build_parser(prog="fpga-robotics formal"):
     )
     parser.add_argument(
         "--trace-dir",
-        type=Path,
         default=None,
         metavar="DIR",
         help="where counterexample VCDs go (default: "
@@ -100,14 +97,18 @@ def main(argv=None, prog="fpga-robotics formal"):
     if args.jobs < 1:
         raise UsageError(f"--jobs must be at least 1, got {args.jobs}")
 
-    checks = select(design_checks(args.design, _design_params(args.param), args.ports), args.only)
+    checks = select(
+        design_checks(args.design, design_params_from_items(args.param), args.ports), args.only
+    )
     if args.list:
         width = max(len(c.name) for c in checks)
         for c in checks:
             print(f"{c.name:<{width}}  {c.mode:<5}  {c.depth:>3}  {c.promise}")
         return 0
+    # An empty --trace-dir is refused by the check, not taken for the default.
     trace_dir = check_output_dir(
-        args.trace_dir or default_trace_dir(), what="counterexample folder"
+        args.trace_dir if args.trace_dir is not None else default_trace_dir(),
+        what="counterexample folder",
     )
     env = formal_env()
     widths = (max(len(c.name) for c in checks), 5, 5, 7, 7)

@@ -13,12 +13,12 @@ import os
 import shutil
 import sys
 import time
-import tomllib
 
 from fpga_robotics.cli.errors import UsageError
 from fpga_robotics.cli.param_options import (
     add_design_param_argument,
     add_param_arguments,
+    design_params_from_items,
     params_from_args,
     refuse_followtarget_options,
 )
@@ -69,7 +69,9 @@ def _campaign(name, resolution=None):
     """The campaign ``name`` with every run checked (``check_campaign``, with the mutant
     netlist's ``resolution``): a typo fails here, before anything is built or written."""
     campaign = load_campaign_file(name)
-    check_campaign(campaign, resolution)
+    # Its scenarios' sensors against FollowTarget's pins too: a campaign of another design
+    # (sensor_designs) fails here, not after the build and the unit judge.
+    check_design_bindings(check_campaign(campaign, resolution), ["--design", "follow_target"])
     return campaign
 
 
@@ -317,20 +319,6 @@ def build_parser(prog="fpga-robotics mutate"):
     return p
 
 
-def _design_params(items):
-    """``--param NAME=VALUE`` items as a dict (values parsed as TOML, else text)."""
-    params = {}
-    for item in items:
-        name, sep, text = item.partition("=")
-        if not sep or not name.strip().isidentifier():
-            raise UsageError(f"--param must be NAME=VALUE, got {item!r}")
-        try:
-            params[name.strip()] = tomllib.loads(f"v = {text}")["v"]
-        except tomllib.TOMLDecodeError:
-            params[name.strip()] = text
-    return params
-
-
 def _resolution(text):
     """``WxH`` as (width, height); ``UsageError`` otherwise."""
     w, x, h = text.lower().partition("x")
@@ -358,12 +346,17 @@ def _removed_on_error(out, campaign):
     --resume, and so is a folder that was there before). Interrupted with verdicts in the
     journal of a robot judge (``campaign``), say how many and how to go on."""
     existed = os.path.exists(out)
+    # The highest folder this command makes (runs/ of runs/mutation/n100-s1): its parents
+    # made for it go too.
+    made = out
+    while not existed and os.path.dirname(made) and not os.path.exists(os.path.dirname(made)):
+        made = os.path.dirname(made)
     try:
         yield
     except (Exception, KeyboardInterrupt) as exc:
         journal = os.path.join(out, JOURNAL_NAME)
         if not existed and not os.path.exists(journal):
-            shutil.rmtree(out, ignore_errors=True)
+            shutil.rmtree(made, ignore_errors=True)
         elif isinstance(exc, KeyboardInterrupt) and campaign is not None:
             kept = len(journal_rows(journal)) if os.path.exists(journal) else 0
             if kept:
@@ -373,6 +366,12 @@ def _removed_on_error(out, campaign):
                     file=sys.stderr,
                 )
         raise
+
+
+def _out(args, name):
+    """``--out``, else ``runs/mutation/NAME``; an empty ``--out`` is given, and refused by
+    ``check_output_dir``, not taken for the default."""
+    return args.out if args.out is not None else os.path.join("runs", "mutation", name)
 
 
 def _reach_scheduler(address):
@@ -406,16 +405,22 @@ def _main_design(args):
         files = spec.reference[len("verilog:") :].split(",")
         name = os.path.splitext(os.path.basename(files[0]))[0]
     else:
-        spec = resolve_design(args.design, _design_params(args.param), option="--param")
+        spec = resolve_design(args.design, design_params_from_items(args.param), option="--param")
         spec.require_clock()
         spec.require_no_black_boxes()
         name = spec.reference.rpartition(":")[2]
+    if args.resolution is not None and not spec.camera:
+        # Its unit judge streams no frames: the option would do nothing.
+        raise UsageError(
+            f"--resolution sizes the frames of a camera design's unit judge; {name} has no "
+            "camera input"
+        )
     campaign = None
     if args.campaign is not None:
         campaign = load_campaign_file(args.campaign)
         design_argv = ["--design", args.design, *(["--ports", args.ports] if verilog else [])]
         check_design_bindings(check_campaign(campaign), design_argv)
-    out = args.out or os.path.join("runs", "mutation", f"{name}-n{args.mutants}-s{args.seed}")
+    out = _out(args, f"{name}-n{args.mutants}-s{args.seed}")
     check_output_dir(out, what="output folder")
     _reach_scheduler(args.scheduler)
 
@@ -482,8 +487,6 @@ def _check(args):
         raise UsageError(f"--mutants must be 1..{MAX_MUTANTS}, got {args.mutants}")
     if not 0 <= args.seed <= MAX_SEED:
         raise UsageError(f"--seed must be 0..{MAX_SEED}, got {args.seed}")
-    if args.workers is not None and not 1 <= args.workers <= 256:
-        raise UsageError(f"--workers must be 1..256, got {args.workers}")
     if args.recordings is not None and args.recordings < 0:
         raise UsageError(f"--recordings must be >= 0, got {args.recordings}")
     if args.campaign is None and (
@@ -521,7 +524,7 @@ def main(argv=None, prog="fpga-robotics mutate"):
     # The mutant netlist is built for this frame size: every robot judge run takes it.
     resolution = f"{params.width}x{params.height}"
     campaign = _campaign(args.campaign, resolution) if args.campaign is not None else None
-    out = args.out or os.path.join("runs", "mutation", f"n{args.mutants}-s{args.seed}")
+    out = _out(args, f"n{args.mutants}-s{args.seed}")
     check_output_dir(out, what="output folder")
     _reach_scheduler(args.scheduler)
 

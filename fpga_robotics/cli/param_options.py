@@ -3,12 +3,19 @@ benchmarks: ``--preset NAME`` and one option per ``FollowTargetParams`` field
 (``--diff-min 5``, ``--base-dps 0,400,...``, ``--found-rule gt``)."""
 
 import argparse
+import tomllib
 from dataclasses import fields
 
 from fpga_robotics.cli.errors import UsageError
 from fpga_robotics.hw.params import CHOICES, PRESETS, FollowTargetParams
 
-__all__ = ["add_param_arguments", "params_from_args", "refuse_followtarget_options"]
+__all__ = [
+    "add_design_param_argument",
+    "add_param_arguments",
+    "design_params_from_items",
+    "params_from_args",
+    "refuse_followtarget_options",
+]
 
 #: Parameters given as a comma-separated list of ints on the command line.
 _TUPLE_PARAMS = ("proximity_thresholds", "base_dps", "steer_dps")
@@ -75,6 +82,24 @@ def add_design_param_argument(parser):
         metavar="NAME=VALUE",
         help="with --design: one of its parameters (a TOML value; repeatable)",
     )
+
+
+def design_params_from_items(items):
+    """``--param NAME=VALUE`` items as a dict (values read as TOML, else as text). A name
+    given twice is a ``UsageError``: which value would the design get?"""
+    params = {}
+    for item in items:
+        name, sep, text = item.partition("=")
+        name = name.strip()
+        if not sep or not name.isidentifier():
+            raise UsageError(f"--param must be NAME=VALUE, got {item!r}")
+        if name in params:
+            raise UsageError(f"--param {name} is given twice; give each parameter once")
+        try:
+            params[name] = tomllib.loads(f"v = {text}")["v"]
+        except tomllib.TOMLDecodeError:
+            params[name] = text.strip()
+    return params
 
 
 def _default_text(f):

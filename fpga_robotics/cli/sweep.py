@@ -80,7 +80,8 @@ def build_parser(prog=PROG):
         "--workers",
         type=int,
         metavar="N",
-        help="embedded cluster: N worker processes, one thread each (default: the machine's cores)",
+        help="embedded cluster: N worker processes (1..256), one thread each (default: the "
+        "machine's cores)",
     )
     e.add_argument(
         "--scheduler",
@@ -175,8 +176,6 @@ def _merge_options(data, args):
             else text
         )
         parse_seeds(data["seeds"], where="--seeds", forms="A-B (e.g. 0-19) or A,B,C")
-    if args.duration is not None and not 0 < args.duration < math.inf:
-        raise UsageError(f"--duration must be a finite number of seconds > 0, got {args.duration}")
     for key in ("backend", "resolution", "duration", "shadow", "design", "ports", "timeout"):
         value = getattr(args, key)
         if value is not None:
@@ -186,6 +185,7 @@ def _merge_options(data, args):
             if not item.partition("=")[0].strip() or "=" not in item:
                 raise UsageError(f"--set needs KEY=VALUE (e.g. robot.mass=12), got {item!r}")
         data["set"] = list(data.get("set", [])) + args.fixed
+    given_axes = set()
     for item in args.grid:
         key, sep, text = item.partition("=")
         values = _parse_value(text) if sep else None
@@ -193,6 +193,12 @@ def _merge_options(data, args):
             raise UsageError(
                 f"--grid needs KEY=[V1, V2, ...] (a TOML list of at least one value), got {item!r}"
             )
+        # A second --grid of one key would replace the first's values unseen.
+        if key.strip() in given_axes:
+            raise UsageError(
+                f"--grid {key.strip()} is given twice: give all its values in one list"
+            )
+        given_axes.add(key.strip())
         grid = data.get("grid") if isinstance(data.get("grid"), dict) else {}
         data["grid"] = {**grid, key.strip(): values}
     given = {
@@ -221,10 +227,13 @@ def _campaign(args):
 
 
 def _check_options(args):
-    for name in ("workers", "max_runs", "bench_runs", "bench_repeats", "log_every"):
+    for name in ("max_runs", "bench_runs", "bench_repeats", "log_every"):
         value = getattr(args, name)
         if value is not None and value < 1:
             raise UsageError(f"--{name.replace('_', '-')} must be >= 1, got {value}")
+    # Here, not with the campaign: --bench takes --duration too.
+    if args.duration is not None and not 0 < args.duration < math.inf:
+        raise UsageError(f"--duration must be a finite number of seconds > 0, got {args.duration}")
     if args.timeout is not None and not 0 < args.timeout < math.inf:
         raise UsageError(f"--timeout must be a finite number of seconds > 0, got {args.timeout}")
     if args.bag and args.record == "none":
@@ -299,8 +308,8 @@ def _report(argv, prog):
     p.add_argument("dir", metavar="DIR", help="the campaign's results folder")
     args = p.parse_args(argv)
 
-    if not Path(args.dir).is_dir():
-        raise UsageError(f"{args.dir} is not a folder of campaign results")
+    if not args.dir.strip() or not Path(args.dir).is_dir():
+        raise UsageError(f"{args.dir!r} is not a folder of campaign results")
     print(report_dir(args.dir))
     print(f"report: {Path(args.dir) / 'report.html'}")
     return 0
@@ -322,8 +331,12 @@ def main(argv=None, prog=PROG):
     from fpga_robotics.sweep.sanity import report_campaign_warnings  # lazy: the run stack (~1 s)
 
     report_campaign_warnings(campaign, args.strict, sys.stderr, UsageError)
-    out = Path(args.out) if args.out else Path("runs") / "sweeps" / campaign.name
-    check_output_dir(out, what="--out")  # --dry-run too: it says the command would run
+    # --dry-run too: it says the command would run. An empty --out is refused, not taken
+    # for the default (Path("") would be the current folder).
+    out = check_output_dir(
+        args.out if args.out is not None else Path("runs") / "sweeps" / campaign.name,
+        what="--out",
+    )
     if args.dry_run:
         return _dry_run(campaign, args)
 

@@ -323,6 +323,8 @@ def shipped_scenarios():
 
 def _resolve(name_or_path):
     text = str(name_or_path)
+    if not text.strip():  # Path("") would be the current folder
+        raise ScenarioError("the scenario is empty; give a shipped name or a .toml file")
     path = Path(text)
     if not (text.endswith(".toml") or "/" in text or "\\" in text):
         # A bare word: a file of that name here, else a shipped scenario.

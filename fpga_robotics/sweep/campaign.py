@@ -523,6 +523,8 @@ def shipped_campaigns():
 
 def _resolve(name_or_path):
     text = str(name_or_path)
+    if not text.strip():  # Path("") would be the current folder
+        raise CampaignError("the campaign is empty; give a shipped name or a .toml file")
     path = Path(text)
     if path.is_file():
         return path
@@ -589,7 +591,8 @@ def load_campaign(data, *, source="", command_line=None):
             how = "--scenarios" if command_line.get("scenarios") else "scenarios"
             raise CampaignError(f"{how} lists {twice} twice: give each scenario once")
         seeds = parse_seeds(data.get("seeds", "0"))
-        backend = _typed(data, "backend", str, "a backend name") or "auto"
+        backend = _typed(data, "backend", str, "a backend name")
+        backend = "auto" if backend is None else backend  # "" is checked, not taken for auto
         resolution = _typed(data, "resolution", str, '"WxH"')
         duration = _typed(data, "duration", (int, float), "a number of seconds")
         if duration is not None and not 0 < duration < math.inf:

@@ -70,10 +70,16 @@ def check_scheduler_address(address):
         ) from None
 
 
+#: The most worker processes an embedded cluster starts (``--workers``).
+MAX_WORKERS = 256
+
+
 def check_cluster_options(workers, scheduler):
-    """``--workers`` and ``--scheduler`` as sweep and mutate take them: not both (the
-    embedded cluster's size means nothing with a cluster of one's own), and a scheduler
-    address Dask can dial; ``UsageError`` otherwise."""
+    """``--workers`` and ``--scheduler`` as sweep and mutate take them: a worker count in
+    1..``MAX_WORKERS``, not both (the embedded cluster's size means nothing with a cluster
+    of one's own), and a scheduler address Dask can dial; ``UsageError`` otherwise."""
+    if workers is not None and not 1 <= workers <= MAX_WORKERS:
+        raise UsageError(f"--workers must be 1..{MAX_WORKERS}, got {workers}")
     if workers is not None and scheduler is not None:
         raise UsageError(
             "--workers sizes the embedded cluster; with --scheduler the cluster "

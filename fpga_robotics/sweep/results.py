@@ -15,6 +15,7 @@ import shutil
 import time
 from pathlib import Path
 
+from ..hw.errors import UsageError
 from ..sim.files import atomic_path, write_atomic, write_json_atomic
 
 __all__ = ["STATUSES", "ResultStore", "load_rows", "make_row", "read_meta"]
@@ -253,9 +254,16 @@ def load_rows(out_dir):
         return list({r["run_id"]: r for r in rows}.values())
     parquet = out_dir / PARQUET
     if parquet.is_file():
-        import pyarrow.parquet as pq  # lazy: ~0.3 s the workers need not pay
+        import pyarrow as pa  # lazy: ~0.3 s the workers need not pay
+        import pyarrow.parquet as pq
 
-        return pq.read_table(parquet).to_pylist()
+        try:
+            return pq.read_table(parquet).to_pylist()
+        except (pa.ArrowException, OSError) as exc:  # truncated, or not a table we wrote
+            raise UsageError(
+                f"{parquet} is not a readable results table ({exc}); run the campaign "
+                "again, or remove the file"
+            ) from None
     return []
 
 

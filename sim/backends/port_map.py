@@ -520,6 +520,8 @@ def parse_port_map(data):
 
 def load_port_map(path):
     """Read and check the TOML port map at ``path``."""
+    if not str(path).strip():  # Path("") would read the current folder
+        raise PortMapError("the port map's path is empty; give its PORTS.toml file")
     path = Path(path)
     try:
         text = read_user_text(path)
