@@ -90,6 +90,20 @@ def test_a_trigger_schedules_the_echo_on_its_exact_edges():
     assert len(backend.scheduled) == 4
 
 
+@pytest.mark.parametrize("delay, clock_hz", [(0.0, F), (0.0005, 1000.0)])
+def test_an_echo_delay_under_half_an_edge_rises_on_the_next_edge(delay, clock_hz):
+    # No delay, or 0.5 ms on a 1 kHz clock (half an edge): ECHO cannot rise on the edge TRIG
+    # fell at, which the design has already simulated; it rises on the next one.
+    params = UltrasoundConnector.parse({"noise_std": 0.0, "echo_delay_s": delay}, "us")
+    conn = UltrasoundConnector("us", Mount(height=0.1), params, world=_world(), rng=None)
+    backend = _Backend()
+    io = PinIO(backend, {"trig": "t", "echo": "e"}, clock_hz)
+    fall = max(1, round(12e-6 * clock_hz))  # a 12 us TRIG pulse
+    _pulse(conn, backend, io, 0, fall)
+    width = round(2 * 3.0 / (331.3 + 0.606 * 20.0) * clock_hz)  # 3 m to the wall
+    assert backend.scheduled == [(fall + 1, "e", 1), (fall + 1 + width, "e", 0)]
+
+
 def test_nothing_in_range_is_the_time_out_pulse():
     params = UltrasoundConnector.parse({"noise_std": 0.0, "max_range": 2.0}, "us")
     conn = UltrasoundConnector("us", Mount(height=0.1), params, world=_world(), rng=None)
