@@ -26,6 +26,28 @@ FILES = {
     "camera_int": "camera = 5\n[sim]\nduration = 0.5\n",
     "ov7670_unknown": '[sim]\nduration = 0.5\n[camera]\nsensor = "ov7670"\n'
     "[camera.ov7670]\nmax_gian = 8\n",
+    "servo_unsigned": "people = []\n[sim]\nduration = 0.5\nclock_hz = 10000.0\n[design]\n"
+    'top = "pan.py:Pan"\n[[robot.actuators]]\nkind = "servo"\nname = "pan"\n',
+}
+#: Design files beside them, ``{in}/NAME``.
+DESIGNS = {
+    # The servo's width, unsigned: its -100 would be read as 924, the end stop.
+    "pan.py": """
+from amaranth import Module, signed
+from amaranth.lib import wiring
+from amaranth.lib.wiring import Out
+
+
+class Pan(wiring.Component):
+    motor_left: Out(signed(16))
+    motor_right: Out(signed(16))
+    angle: Out(10)
+
+    def elaborate(self, platform):
+        m = Module()
+        m.d.sync += self.angle.eq(-100)
+        return m
+""",
 }
 
 #: The shipped turret, short; its servo bound to a port, and a second camera on the pan one's bundle.
@@ -315,6 +337,14 @@ CASES = [
         "port 'turret_centroid_x' of design 'turret_tracker' is out 8 bit(s);",
     ),
     (
+        "servo-on-an-unsigned-output-of-its-width",
+        ["--scenario", "{in}/servo_unsigned.toml"],
+        (
+            "the servo connector 'pan': pin 'angle' is out 10 bit(s) signed but port 'angle' "
+            "of design 'Pan' is out 10 bit(s); it takes a signed output of at most 10 bits"
+        ),
+    ),
+    (
         "servo-on-no-channel",
         [*TURRET, "--set", SERVO.format("centroid_x")],
         (
@@ -396,6 +426,8 @@ def test_bad_input_is_one_line_exit_2_and_leaves_nothing(
     inputs.mkdir()
     for name, text in FILES.items():
         (inputs / f"{name}.toml").write_text(text)
+    for name, text in DESIGNS.items():
+        (inputs / name).write_text(text)
     cwd = tmp_path / "work" / "here"  # runs/../../escape would land in tmp_path
     cwd.mkdir(parents=True)
     monkeypatch.chdir(cwd)

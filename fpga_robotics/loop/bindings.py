@@ -92,16 +92,16 @@ def no_port(kind, name, top, pin, port, ports):
 def port_misfit(kind, name, top, pin, port, spec=None):
     """Why design ``port`` (a ``sim.pins.Port``) cannot be connector pin ``pin`` of the
     ``kind`` connector ``name``, or None when it can: of the pin's direction and width, or
-    for a signed output pin (the wheels' DPS, a servo's angle) a narrower signed output, which
-    the backends read sign-extended. ``spec``: the connector's own ``Pin`` where its width is
-    set per connector (a line_sensors table's sensors), else the kind's."""
+    for a signed output pin (the wheels' DPS, a servo's angle) a signed output of at most its
+    width, which the backends read sign-extended. ``spec``: the connector's own ``Pin`` where
+    its width is set per connector (a line_sensors table's sensors), else the kind's."""
     spec = spec or CONNECTORS[kind].pins[pin]
-    fits = port.width == spec.width or (
-        spec.direction == "out" and spec.signed and port.signed and port.width < spec.width
-    )
+    extended = spec.direction == "out" and spec.signed
+    # An unsigned port of a signed pin's width would be read as a positive number: -100 as
+    # 924 turns a servo to its end stop.
+    fits = port.signed and port.width <= spec.width if extended else port.width == spec.width
     if port.direction == spec.direction and fits:
         return None
-    extended = spec.direction == "out" and spec.signed
     if kind == "line_sensors":
         hint = (
             "; the line_sensors table must list as many sensors as the design's line input "
@@ -109,7 +109,10 @@ def port_misfit(kind, name, top, pin, port, spec=None):
         )
     else:
         hint = (
-            f"; a signed output of at most {spec.width} bits is sign-extended" if extended else ""
+            f"; it takes a signed output of at most {spec.width} bits (a narrower one is "
+            "sign-extended)"
+            if extended
+            else ""
         )
     return (
         f"the {kind} connector {name!r}: pin {pin!r} is {spec.direction} {spec.width} bit(s)"
