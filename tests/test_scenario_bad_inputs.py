@@ -317,6 +317,27 @@ CASES = [
         ],
         "robot.sensors[0].fps 150 is more than one frame a physics step (sim.physics_dt 0.01 s",
     ),
+    # a further camera's servo, target and port bundle: refused before the recorder opens
+    (
+        "camera-on-no-servo",
+        [*TURRET, "--rerun", "save", "--set", 'robot.sensors.0.on="tilt"'],
+        "camera 'turret': on = 'tilt' names no servo; declare [[robot.actuators]]",
+    ),
+    (
+        "camera-target-in-an-empty-room",
+        [*TURRET, "--rerun", "save", "--set", "people=[]"],
+        "camera 'turret': target = 'watcher' names no person; the room has no people",
+    ),
+    (
+        "camera-on-no-channel",
+        [*TURRET, "--rerun", "save", "--set", 'robot.sensors.0.ports={pixels="nope"}'],
+        "design 'turret_tracker' has no frame channel on pixels = 'nope'",
+    ),
+    (
+        "camera-of-another-size-than-its-channel",
+        [*TURRET, "--rerun", "save", "--set", 'robot.sensors.0.resolution="80x60"'],
+        "its resolution 80x60 differs from the 160x120 frames design 'turret_tracker' takes",
+    ),
     # a servo's port: a 10-bit signed output, and in compressed timing a channel's
     (
         "servo-on-an-input",

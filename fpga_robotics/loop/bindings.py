@@ -9,6 +9,7 @@ import importlib
 from fpga_robotics.designs.builtin import TOPS, connector_kinds, foreign_top
 from fpga_robotics.designs.reference import resolve_design
 from fpga_robotics.hw.errors import UsageError
+from fpga_robotics.loop.camera_rig import frame_channel
 from fpga_robotics.loop.connectors import CONNECTORS
 from fpga_robotics.sim.backends.port_map import check_connector_names, load_port_map
 from fpga_robotics.sim.pins import Port
@@ -33,8 +34,9 @@ def scenario_top(scenario):
 def check_bindings(scenario):
     """``UsageError`` for a connector binding the scenario's design cannot take, from the
     design's declarations and the port map, before a model is built: a sensor pin bound to
-    no port, a design input two tables drive, a servo's port of the wrong kind, in
-    real-clock timing a sensor the design declares but the scenario leaves out."""
+    no port, a design input two tables drive, a servo's port of the wrong kind, a camera's
+    port bundle no channel of the design takes, in real-clock timing a sensor the design
+    declares but the scenario leaves out."""
     top = scenario_top(scenario)
     _check_tables(scenario, top)
     if scenario.sim.timing == "real_clock":
@@ -45,14 +47,16 @@ def _check_tables(scenario, top):
     """The scenario's connector tables against the design's ports."""
     if not scenario.connectors:
         return
+    registered = TOPS.get(scenario.top) if scenario.foreign is None else None
     for spec in scenario.connectors:
-        if spec.kind in ("camera", "servo"):  # the rig's (loop/camera_rig.py)
+        if spec.kind == "camera":  # the rig's (loop/camera_rig.py), as it will build it
+            frame_channel(scenario, spec, TOPS.get(scenario.top))
+        if spec.kind in ("camera", "servo"):
             continue
         binding = {**top.bindings.get(spec.kind, {}), **spec.ports}
         for pin in CONNECTORS[spec.kind].pins:
             if binding.get(pin) is None:
                 raise unbound(spec.kind, spec.name, top, pin)
-    registered = TOPS.get(scenario.top) if scenario.foreign is None else None
     _check_single_drivers(scenario, top, registered)
     for spec in scenario.connectors:
         if spec.kind == "servo":

@@ -811,12 +811,24 @@ def _check_camera_geometry(camera, world):
 def _check_further_cameras(connectors, sim, world):
     """Each ``[[robot.sensors]]`` camera, as the body camera: between floor and ceiling, its
     field of view one the renderer draws (even on the steepest terrain patch), and at most
-    one frame a physics step (the rig captures at physics steps)."""
+    one frame a physics step (the rig captures at physics steps); its ``on`` a servo of the
+    scenario, its ``target`` one of its people."""
     ceiling, dt = world.room.height, sim.physics_dt
     slope, on_slope = _steepest_slope(world.room)
+    servos = {spec.name for spec in connectors if spec.kind == "servo"}
+    people = [person.name for person in world.people]
     for spec in connectors:
         if spec.kind != "camera":
             continue
+        where, p = f"camera {spec.name!r}", spec.params
+        if p.on is not None and p.on not in servos:
+            raise ScenarioError(
+                f"{where}: on = {p.on!r} names no servo; declare [[robot.actuators]] "
+                f'kind = "servo", name = {p.on!r}, or mount the camera on the body (no on)'
+            )
+        if p.target is not None and p.target not in people:
+            among = f"the people: {', '.join(people)}" if people else "the room has no people"
+            raise ScenarioError(f"{where}: target = {p.target!r} names no person; {among}")
         height, fps = spec.mount.height, spec.params.fps
         if height <= 0:
             raise ScenarioError(
