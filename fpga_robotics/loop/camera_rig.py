@@ -27,6 +27,7 @@ import numpy as np
 from fpga_robotics.hw.errors import UsageError
 from fpga_robotics.hw.pixel import color_select_value
 from fpga_robotics.loop.connectors import CONNECTORS, CameraConnector, in_view
+from fpga_robotics.loop.connectors.camera import make_sensor
 from fpga_robotics.loop.pin_channel import PinFrameChannel
 from fpga_robotics.sim.camera.frames import to_rgb444
 from fpga_robotics.sim.camera.scene import CameraPose
@@ -55,6 +56,11 @@ class RigCamera:
         self.outputs = {}
         self.view = None  # the latest CameraView
         self.streaming_until = None  # real-clock timing: the edge after its frame's last pixel
+
+    def turn_rate(self, world):
+        """How fast the camera turns now, rad/s: the body's turn and the horn's it is on."""
+        horn = self.servo.model.rate if self.servo is not None else 0.0
+        return world.robot_velocity()[1] + horn
 
     def pose(self, world):
         """The camera's pose now: the body's pose, the servo's mount and angle if it is on
@@ -156,7 +162,7 @@ class CameraRig:
 
     def _capture(self, cam, step, world):
         pose = cam.pose(world)
-        rgb = cam.connector.capture(world.scene(), pose)
+        rgb = cam.connector.capture(world.scene(), pose, cam.turn_rate(world))
         if self.pins is not None:
             if cam.channel is not None:
                 self._stream(cam, rgb)
@@ -353,6 +359,8 @@ def _camera(scenario, spec, index, seed, top, servos):
         mount_height=spec.mount.height,
         noise_std=p.noise_std,
         rng=np.random.default_rng([seed, _CAMERA_STREAM, index]),
+        # camera.sensor = "ov7670": the body camera's sensor model, at this camera's size.
+        sensor=make_sensor(scenario.camera, seed, (index, p)),
         renderer=scenario.camera.renderer,
         render3d=scenario.camera.render3d,
     )

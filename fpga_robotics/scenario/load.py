@@ -873,20 +873,6 @@ def _check_further_field_of_view(spec, slope, on_slope):
         )
 
 
-def _sensor_warnings(camera, connectors):
-    """The sensor model (``camera.sensor``) is the body camera's alone: a further camera's
-    frames stay the rendered ones plus its own ``noise_std``, which the scenario may not
-    expect (docs/turret.md)."""
-    further = [repr(s.name) for s in connectors if s.kind == "camera"]
-    if camera.sensor == "plain" or not further:
-        return ()
-    warning = (
-        f'camera.sensor = "{camera.sensor}" models the body camera only; the further '
-        f"camera(s) {', '.join(further)} give the rendered frame plus their own noise_std"
-    )
-    return (warning,)
-
-
 def _sim(data, camera):
     k = _keys(SimKeys, data["sim"], "sim")
     period = camera.frame_period
@@ -1254,6 +1240,5 @@ def _build(data, source, overrides):
         design_tables=tables,
         design_params=design_params,
         connectors=connectors,
-        warnings=tuple(scenario_warnings(world_config, checks))
-        + _sensor_warnings(camera, connectors),
+        warnings=tuple(scenario_warnings(world_config, checks)),
     )
