@@ -78,6 +78,12 @@ def test_a_trigger_schedules_the_echo_on_its_exact_edges():
     rise = 1500 + round(0.0005 * F)
     fall = rise + round(2 * 2.9 / c * F)
     assert backend.scheduled == [(rise, "us_echo", 1), (fall, "us_echo", 0)]
+    # A row shows the echo once ECHO has fallen, not while the design still waits for it.
+    backend.cycle = fall - 1
+    conn.after_step(io, io.time_of(fall - 1))
+    assert conn.measurement() == {}
+    backend.cycle = fall
+    conn.after_step(io, io.time_of(fall))
     m = conn.measurement()
     assert m["echo_edges"] == fall - rise and m["timeout"] == 0.0
     assert m["range_m"] == pytest.approx(2.9)
@@ -111,6 +117,8 @@ def test_nothing_in_range_is_the_time_out_pulse():
     _pulse(conn, backend, io, 0, 500)
     (r, _, _), (f, _, _) = backend.scheduled
     assert f - r == round(0.038 * F)
+    backend.cycle = f
+    conn.after_step(io, io.time_of(f))
     m = conn.measurement()
     assert m["timeout"] == 1.0 and math.isnan(m["range_m"])
 
