@@ -338,6 +338,31 @@ CASES = [
         [*TURRET, "--rerun", "save", "--set", 'robot.sensors.0.resolution="80x60"'],
         "its resolution 80x60 differs from the 160x120 frames design 'turret_tracker' takes",
     ),
+    # real-clock timing: a clock too slow for a line of a streaming camera's pixels
+    (
+        "body-camera-pixels-beyond-the-clock",
+        [
+            *("--scenario", "obstacle_between", "--duration", "0.2", "--rerun", "save"),
+            *("--set", "sim.clock_hz=100000"),
+        ],
+        (
+            "camera: a 100000 Hz clock has 26 cycles per line at 30 fps, too few for 160 "
+            "pixels; lower the resolution or fps (camera.resolution, camera.fps), or raise "
+            "sim.clock_hz"
+        ),
+    ),
+    (
+        "further-camera-pixels-beyond-the-clock",
+        [
+            *(*TURRET, "--rerun", "save", "--set", 'sim.timing="real_clock"'),
+            *("--set", "sim.clock_hz=1000000", "--set", "robot.sensors.0.fps=120"),
+        ],
+        (
+            "camera 'turret': a 1e+06 Hz clock has 65 cycles per line at 120 fps, too few for "
+            "160 pixels; lower the resolution or fps (robot.sensors[0].resolution, "
+            "robot.sensors[0].fps), or raise sim.clock_hz"
+        ),
+    ),
     # a servo's port: a 10-bit signed output, and in compressed timing a channel's
     (
         "servo-on-an-input",

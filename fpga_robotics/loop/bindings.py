@@ -12,7 +12,8 @@ from fpga_robotics.hw.errors import UsageError
 from fpga_robotics.loop.camera_rig import frame_channel
 from fpga_robotics.loop.connectors import CONNECTORS
 from fpga_robotics.sim.backends.port_map import check_connector_names, load_port_map
-from fpga_robotics.sim.pins import Port
+from fpga_robotics.sim.pins import PinError, Port
+from fpga_robotics.sim.pins.timing import real_clock_timing
 
 __all__ = ["check_bindings", "port_misfit", "scenario_top", "unbound"]
 
@@ -41,6 +42,7 @@ def check_bindings(scenario):
     _check_tables(scenario, top)
     if scenario.sim.timing == "real_clock":
         _check_declared_sensors(scenario, top)
+        _check_pixel_rates(scenario, top)
 
 
 def _check_tables(scenario, top):
@@ -77,6 +79,27 @@ def _check_declared_sensors(scenario, top):
                 f"design {top.name!r}: nothing drives its input {inputs[0]!r}; declare a "
                 f'[[robot.sensors]] table with kind = "{kind}"'
             )
+
+
+def _check_pixel_rates(scenario, top):
+    """Each camera that streams into the design gets a line of pixels in a line period of the
+    clock (``real_clock_timing``, as an OV7670): a clock too slow for that is refused now, with
+    the keys to change, rather than at the camera's first frame."""
+    streams = []
+    if top.camera:
+        cam = scenario.camera
+        streams.append(("camera", cam.width, cam.height, cam.fps, "camera"))
+    for spec in scenario.connectors:
+        if spec.kind == "camera" and spec.ports.get("pixels") is not None:
+            p = spec.params
+            streams.append((f"camera {spec.name!r}", p.width, p.height, p.fps, spec.where))
+    for name, width, height, fps, where in streams:
+        try:
+            real_clock_timing(width, height, fps, scenario.sim.clock_hz, 0)
+        except PinError as exc:
+            raise UsageError(
+                f"{name}: {exc} ({where}.resolution, {where}.fps), or raise sim.clock_hz"
+            ) from None
 
 
 def unbound(kind, name, top, pin):
