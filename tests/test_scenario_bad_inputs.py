@@ -363,6 +363,27 @@ CASES = [
             "robot.sensors[0].fps), or raise sim.clock_hz"
         ),
     ),
+    (
+        # Captures at steps 0, 2, 5, 7 ... (2.4 steps a frame): 8.3 ms for 9.4 ms of pixels.
+        "body-camera-frames-closer-than-their-pixels",
+        [
+            *("--scenario", "obstacle_between", "--duration", "0.2", "--rerun", "save"),
+            *("--set", "camera.fps=100"),
+        ],
+        (
+            "camera: camera.fps 100 on physics steps of 0.00416667 s: its captures fall on "
+            "steps as little as 8.333 ms apart, less than its pixels take on the clock "
+            "(9.357 ms); give it a frame period of whole physics steps (80 or 120 fps)"
+        ),
+    ),
+    (
+        "further-camera-frames-closer-than-their-pixels",
+        [
+            *(*TURRET, "--rerun", "save", "--set", 'sim.timing="real_clock"'),
+            *("--set", "robot.sensors.0.fps=160"),
+        ],
+        "camera 'turret': robot.sensors[0].fps 160 on physics steps of 0.00416667 s",
+    ),
     # a servo's port: a 10-bit signed output, and in compressed timing a channel's
     (
         "servo-on-an-input",

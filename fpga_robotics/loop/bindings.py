@@ -5,6 +5,7 @@ only then).
 """
 
 import importlib
+import math
 
 from fpga_robotics.designs.builtin import TOPS, connector_kinds, foreign_top
 from fpga_robotics.designs.reference import resolve_design
@@ -83,8 +84,11 @@ def _check_declared_sensors(scenario, top):
 
 def _check_pixel_rates(scenario, top):
     """Each camera that streams into the design gets a line of pixels in a line period of the
-    clock (``real_clock_timing``, as an OV7670): a clock too slow for that is refused now, with
-    the keys to change, rather than at the camera's first frame."""
+    clock (``real_clock_timing``, as an OV7670), and each frame's pixels before its next
+    capture, which falls on a physics step (as little as a whole number of steps below the
+    frame period after the last): a camera that cannot is refused now, with the keys to
+    change, rather than at its first frames."""
+    sim = scenario.sim
     streams = []
     if top.camera:
         cam = scenario.camera
@@ -95,11 +99,22 @@ def _check_pixel_rates(scenario, top):
             streams.append((f"camera {spec.name!r}", p.width, p.height, p.fps, spec.where))
     for name, width, height, fps, where in streams:
         try:
-            real_clock_timing(width, height, fps, scenario.sim.clock_hz, 0)
+            timing = real_clock_timing(width, height, fps, sim.clock_hz, 0)
         except PinError as exc:
             raise UsageError(
                 f"{name}: {exc} ({where}.resolution, {where}.fps), or raise sim.clock_hz"
             ) from None
+        steps = math.floor(1 / (fps * sim.physics_dt) + 1e-9)
+        gap, last = steps * sim.physics_dt, timing.last_edge(width, height)
+        # Two edges of slack: the captures' and the stream's own rounding to an edge.
+        if last + 2 > math.floor(gap * sim.clock_hz) - 1:
+            near = " or ".join(f"{1 / (n * sim.physics_dt):.4g}" for n in (steps + 1, steps))
+            raise UsageError(
+                f"{name}: {where}.fps {fps:g} on physics steps of {sim.physics_dt:g} s: its "
+                f"captures fall on steps as little as {1000 * gap:.4g} ms apart, less than its "
+                f"pixels take on the clock ({1000 * last / sim.clock_hz:.4g} ms); give it a "
+                f"frame period of whole physics steps ({near} fps) or a shorter sim.physics_dt"
+            )
 
 
 def unbound(kind, name, top, pin):
