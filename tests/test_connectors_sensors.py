@@ -20,6 +20,8 @@ from fpga_robotics.loop.connectors.base import (
 )
 from fpga_robotics.loop.connectors.line_sensors import LineSensorsConnector
 from fpga_robotics.loop.connectors.ultrasound import UltrasoundConnector
+from fpga_robotics.scenario.errors import ScenarioError
+from fpga_robotics.scenario.load import load_scenario
 from fpga_robotics.sim.world import World
 
 F = 50e6
@@ -212,3 +214,14 @@ def test_the_documented_sensor_tables_parse():
             table["name"], mount, params, world=_world(), rng=np.random.default_rng(0)
         )
         assert conn.mount.height == table["height"]
+
+
+def test_an_ultrasound_above_the_ceiling_is_refused_at_load():
+    # Its beam would pass over the walls, which end at the ceiling (as a LIDAR's scan plane).
+    with pytest.raises(
+        ScenarioError,
+        match=re.escape(
+            "robot.sensors[0].height must be below the ceiling (room.height = 2 m), got 2.1"
+        ),
+    ):
+        load_scenario("obstacle_between", ["room.height=2.0", "robot.sensors.0.height=2.1"])

@@ -64,6 +64,15 @@ class UltrasoundConnector(Connector):
             )
         return HCSR04Params(**values)
 
+    @classmethod
+    def check_run(cls, params, mount, where, sim, room):
+        # Above the ceiling the beam would pass over the walls.
+        if not mount.height < room.height:
+            raise ConnectorError(
+                f"{where}.height must be below the ceiling (room.height = {room.height:g} m), "
+                f"got {mount.height:g}"
+            )
+
     def start(self, io):
         self._rise, self._last, self._echo = None, None, None
         self.module.busy_until = -1
