@@ -20,6 +20,8 @@ from fpga_robotics.loop.connectors.base import (
 )
 from fpga_robotics.loop.connectors.line_sensors import LineSensorsConnector
 from fpga_robotics.loop.connectors.ultrasound import UltrasoundConnector
+from fpga_robotics.scenario.errors import ScenarioError
+from fpga_robotics.scenario.load import load_scenario
 from fpga_robotics.sim.world import World
 
 F = 50e6
@@ -78,6 +80,12 @@ def test_a_trigger_schedules_the_echo_on_its_exact_edges():
     rise = 1500 + round(0.0005 * F)
     fall = rise + round(2 * 2.9 / c * F)
     assert backend.scheduled == [(rise, "us_echo", 1), (fall, "us_echo", 0)]
+    # A row shows the echo once ECHO has fallen, not while the design still waits for it.
+    backend.cycle = fall - 1
+    conn.after_step(io, io.time_of(fall - 1))
+    assert conn.measurement() == {}
+    backend.cycle = fall
+    conn.after_step(io, io.time_of(fall))
     m = conn.measurement()
     assert m["echo_edges"] == fall - rise and m["timeout"] == 0.0
     assert m["range_m"] == pytest.approx(2.9)
@@ -90,6 +98,20 @@ def test_a_trigger_schedules_the_echo_on_its_exact_edges():
     assert len(backend.scheduled) == 4
 
 
+@pytest.mark.parametrize("delay, clock_hz", [(0.0, F), (0.0005, 1000.0)])
+def test_an_echo_delay_under_half_an_edge_rises_on_the_next_edge(delay, clock_hz):
+    # No delay, or 0.5 ms on a 1 kHz clock (half an edge): ECHO cannot rise on the edge TRIG
+    # fell at, which the design has already simulated; it rises on the next one.
+    params = UltrasoundConnector.parse({"noise_std": 0.0, "echo_delay_s": delay}, "us")
+    conn = UltrasoundConnector("us", Mount(height=0.1), params, world=_world(), rng=None)
+    backend = _Backend()
+    io = PinIO(backend, {"trig": "t", "echo": "e"}, clock_hz)
+    fall = max(1, round(12e-6 * clock_hz))  # a 12 us TRIG pulse
+    _pulse(conn, backend, io, 0, fall)
+    width = round(2 * 3.0 / (331.3 + 0.606 * 20.0) * clock_hz)  # 3 m to the wall
+    assert backend.scheduled == [(fall + 1, "e", 1), (fall + 1 + width, "e", 0)]
+
+
 def test_nothing_in_range_is_the_time_out_pulse():
     params = UltrasoundConnector.parse({"noise_std": 0.0, "max_range": 2.0}, "us")
     conn = UltrasoundConnector("us", Mount(height=0.1), params, world=_world(), rng=None)
@@ -97,6 +119,8 @@ def test_nothing_in_range_is_the_time_out_pulse():
     _pulse(conn, backend, io, 0, 500)
     (r, _, _), (f, _, _) = backend.scheduled
     assert f - r == round(0.038 * F)
+    backend.cycle = f
+    conn.after_step(io, io.time_of(f))
     m = conn.measurement()
     assert m["timeout"] == 1.0 and math.isnan(m["range_m"])
 
@@ -190,3 +214,14 @@ def test_the_documented_sensor_tables_parse():
             table["name"], mount, params, world=_world(), rng=np.random.default_rng(0)
         )
         assert conn.mount.height == table["height"]
+
+
+def test_an_ultrasound_above_the_ceiling_is_refused_at_load():
+    # Its beam would pass over the walls, which end at the ceiling (as a LIDAR's scan plane).
+    with pytest.raises(
+        ScenarioError,
+        match=re.escape(
+            "robot.sensors[0].height must be below the ceiling (room.height = 2 m), got 2.1"
+        ),
+    ):
+        load_scenario("obstacle_between", ["room.height=2.0", "robot.sensors.0.height=2.1"])

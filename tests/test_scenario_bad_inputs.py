@@ -26,6 +26,28 @@ FILES = {
     "camera_int": "camera = 5\n[sim]\nduration = 0.5\n",
     "ov7670_unknown": '[sim]\nduration = 0.5\n[camera]\nsensor = "ov7670"\n'
     "[camera.ov7670]\nmax_gian = 8\n",
+    "servo_unsigned": "people = []\n[sim]\nduration = 0.5\nclock_hz = 10000.0\n[design]\n"
+    'top = "pan.py:Pan"\n[[robot.actuators]]\nkind = "servo"\nname = "pan"\n',
+}
+#: Design files beside them, ``{in}/NAME``.
+DESIGNS = {
+    # The servo's width, unsigned: its -100 would be read as 924, the end stop.
+    "pan.py": """
+from amaranth import Module, signed
+from amaranth.lib import wiring
+from amaranth.lib.wiring import Out
+
+
+class Pan(wiring.Component):
+    motor_left: Out(signed(16))
+    motor_right: Out(signed(16))
+    angle: Out(10)
+
+    def elaborate(self, platform):
+        m = Module()
+        m.d.sync += self.angle.eq(-100)
+        return m
+""",
 }
 
 #: The shipped turret, short; its servo bound to a port, and a second camera on the pan one's bundle.
@@ -295,6 +317,73 @@ CASES = [
         ],
         "robot.sensors[0].fps 150 is more than one frame a physics step (sim.physics_dt 0.01 s",
     ),
+    # a further camera's servo, target and port bundle: refused before the recorder opens
+    (
+        "camera-on-no-servo",
+        [*TURRET, "--rerun", "save", "--set", 'robot.sensors.0.on="tilt"'],
+        "camera 'turret': on = 'tilt' names no servo; declare [[robot.actuators]]",
+    ),
+    (
+        "camera-target-in-an-empty-room",
+        [*TURRET, "--rerun", "save", "--set", "people=[]"],
+        "camera 'turret': target = 'watcher' names no person; the room has no people",
+    ),
+    (
+        "camera-on-no-channel",
+        [*TURRET, "--rerun", "save", "--set", 'robot.sensors.0.ports={pixels="nope"}'],
+        "design 'turret_tracker' has no frame channel on pixels = 'nope'",
+    ),
+    (
+        "camera-of-another-size-than-its-channel",
+        [*TURRET, "--rerun", "save", "--set", 'robot.sensors.0.resolution="80x60"'],
+        "its resolution 80x60 differs from the 160x120 frames design 'turret_tracker' takes",
+    ),
+    # real-clock timing: a clock too slow for a line of a streaming camera's pixels
+    (
+        "body-camera-pixels-beyond-the-clock",
+        [
+            *("--scenario", "obstacle_between", "--duration", "0.2", "--rerun", "save"),
+            *("--set", "sim.clock_hz=100000"),
+        ],
+        (
+            "camera: a 100000 Hz clock has 26 cycles per line at 30 fps, too few for 160 "
+            "pixels; lower the resolution or fps (camera.resolution, camera.fps), or raise "
+            "sim.clock_hz"
+        ),
+    ),
+    (
+        "further-camera-pixels-beyond-the-clock",
+        [
+            *(*TURRET, "--rerun", "save", "--set", 'sim.timing="real_clock"'),
+            *("--set", "sim.clock_hz=1000000", "--set", "robot.sensors.0.fps=120"),
+        ],
+        (
+            "camera 'turret': a 1e+06 Hz clock has 65 cycles per line at 120 fps, too few for "
+            "160 pixels; lower the resolution or fps (robot.sensors[0].resolution, "
+            "robot.sensors[0].fps), or raise sim.clock_hz"
+        ),
+    ),
+    (
+        # Captures at steps 0, 2, 5, 7 ... (2.4 steps a frame): 8.3 ms for 9.4 ms of pixels.
+        "body-camera-frames-closer-than-their-pixels",
+        [
+            *("--scenario", "obstacle_between", "--duration", "0.2", "--rerun", "save"),
+            *("--set", "camera.fps=100"),
+        ],
+        (
+            "camera: camera.fps 100 on physics steps of 0.00416667 s: its captures fall on "
+            "steps as little as 8.333 ms apart, less than its pixels take on the clock "
+            "(9.357 ms); give it a frame period of whole physics steps (80 or 120 fps)"
+        ),
+    ),
+    (
+        "further-camera-frames-closer-than-their-pixels",
+        [
+            *(*TURRET, "--rerun", "save", "--set", 'sim.timing="real_clock"'),
+            *("--set", "robot.sensors.0.fps=160"),
+        ],
+        "camera 'turret': robot.sensors[0].fps 160 on physics steps of 0.00416667 s",
+    ),
     # a servo's port: a 10-bit signed output, and in compressed timing a channel's
     (
         "servo-on-an-input",
@@ -313,6 +402,14 @@ CASES = [
         "servo-on-an-unsigned-output",
         [*TURRET, "--set", SERVO.format("turret_centroid_x")],
         "port 'turret_centroid_x' of design 'turret_tracker' is out 8 bit(s);",
+    ),
+    (
+        "servo-on-an-unsigned-output-of-its-width",
+        ["--scenario", "{in}/servo_unsigned.toml"],
+        (
+            "the servo connector 'pan': pin 'angle' is out 10 bit(s) signed but port 'angle' "
+            "of design 'Pan' is out 10 bit(s); it takes a signed output of at most 10 bits"
+        ),
     ),
     (
         "servo-on-no-channel",
@@ -396,6 +493,8 @@ def test_bad_input_is_one_line_exit_2_and_leaves_nothing(
     inputs.mkdir()
     for name, text in FILES.items():
         (inputs / f"{name}.toml").write_text(text)
+    for name, text in DESIGNS.items():
+        (inputs / name).write_text(text)
     cwd = tmp_path / "work" / "here"  # runs/../../escape would land in tmp_path
     cwd.mkdir(parents=True)
     monkeypatch.chdir(cwd)

@@ -30,3 +30,16 @@ def test_commands_map_to_angles_and_clip_at_the_range():
     assert math.degrees(command_to_angle(-100)) == pytest.approx(-18.0)
     assert math.degrees(command_to_angle(511)) == pytest.approx(90.0)  # beyond the end stop
     assert math.degrees(command_to_angle(-512)) == pytest.approx(-90.0)
+
+
+def test_the_horn_turns_at_full_speed_until_it_is_there():
+    # Its rate is the pan camera's turn on top of the body's (the sensor model's motion blur).
+    servo = ServoModel()
+    assert servo.rate == 0.0
+    servo.command(-50)  # -9 degrees: 3.6 steps of 2.5 degrees
+    for _ in range(3):
+        assert math.degrees(servo.rate) == pytest.approx(-600.0)
+        servo.step(1 / 240)
+    assert math.degrees(servo.rate) == pytest.approx(-600.0)  # 1.5 degrees still to go
+    servo.step(1 / 240)
+    assert math.degrees(servo.angle) == pytest.approx(-9.0) and servo.rate == 0.0

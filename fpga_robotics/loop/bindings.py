@@ -5,13 +5,16 @@ only then).
 """
 
 import importlib
+import math
 
 from fpga_robotics.designs.builtin import TOPS, connector_kinds, foreign_top
 from fpga_robotics.designs.reference import resolve_design
 from fpga_robotics.hw.errors import UsageError
+from fpga_robotics.loop.camera_rig import frame_channel
 from fpga_robotics.loop.connectors import CONNECTORS
 from fpga_robotics.sim.backends.port_map import check_connector_names, load_port_map
-from fpga_robotics.sim.pins import Port
+from fpga_robotics.sim.pins import PinError, Port
+from fpga_robotics.sim.pins.timing import real_clock_timing
 
 __all__ = ["check_bindings", "port_misfit", "scenario_top", "unbound"]
 
@@ -33,26 +36,30 @@ def scenario_top(scenario):
 def check_bindings(scenario):
     """``UsageError`` for a connector binding the scenario's design cannot take, from the
     design's declarations and the port map, before a model is built: a sensor pin bound to
-    no port, a design input two tables drive, a servo's port of the wrong kind, in
-    real-clock timing a sensor the design declares but the scenario leaves out."""
+    no port, a design input two tables drive, a servo's port of the wrong kind, a camera's
+    port bundle no channel of the design takes, in real-clock timing a sensor the design
+    declares but the scenario leaves out."""
     top = scenario_top(scenario)
     _check_tables(scenario, top)
     if scenario.sim.timing == "real_clock":
         _check_declared_sensors(scenario, top)
+        _check_pixel_rates(scenario, top)
 
 
 def _check_tables(scenario, top):
     """The scenario's connector tables against the design's ports."""
     if not scenario.connectors:
         return
+    registered = TOPS.get(scenario.top) if scenario.foreign is None else None
     for spec in scenario.connectors:
-        if spec.kind in ("camera", "servo"):  # the rig's (loop/camera_rig.py)
+        if spec.kind == "camera":  # the rig's (loop/camera_rig.py), as it will build it
+            frame_channel(scenario, spec, TOPS.get(scenario.top))
+        if spec.kind in ("camera", "servo"):
             continue
         binding = {**top.bindings.get(spec.kind, {}), **spec.ports}
         for pin in CONNECTORS[spec.kind].pins:
             if binding.get(pin) is None:
                 raise unbound(spec.kind, spec.name, top, pin)
-    registered = TOPS.get(scenario.top) if scenario.foreign is None else None
     _check_single_drivers(scenario, top, registered)
     for spec in scenario.connectors:
         if spec.kind == "servo":
@@ -75,6 +82,41 @@ def _check_declared_sensors(scenario, top):
             )
 
 
+def _check_pixel_rates(scenario, top):
+    """Each camera that streams into the design gets a line of pixels in a line period of the
+    clock (``real_clock_timing``, as an OV7670), and each frame's pixels before its next
+    capture, which falls on a physics step (as little as a whole number of steps below the
+    frame period after the last): a camera that cannot is refused now, with the keys to
+    change, rather than at its first frames."""
+    sim = scenario.sim
+    streams = []
+    if top.camera:
+        cam = scenario.camera
+        streams.append(("camera", cam.width, cam.height, cam.fps, "camera"))
+    for spec in scenario.connectors:
+        if spec.kind == "camera" and spec.ports.get("pixels") is not None:
+            p = spec.params
+            streams.append((f"camera {spec.name!r}", p.width, p.height, p.fps, spec.where))
+    for name, width, height, fps, where in streams:
+        try:
+            timing = real_clock_timing(width, height, fps, sim.clock_hz, 0)
+        except PinError as exc:
+            raise UsageError(
+                f"{name}: {exc} ({where}.resolution, {where}.fps), or raise sim.clock_hz"
+            ) from None
+        steps = math.floor(1 / (fps * sim.physics_dt) + 1e-9)
+        gap, last = steps * sim.physics_dt, timing.last_edge(width, height)
+        # Two edges of slack: the captures' and the stream's own rounding to an edge.
+        if last + 2 > math.floor(gap * sim.clock_hz) - 1:
+            near = " or ".join(f"{1 / (n * sim.physics_dt):.4g}" for n in (steps + 1, steps))
+            raise UsageError(
+                f"{name}: {where}.fps {fps:g} on physics steps of {sim.physics_dt:g} s: its "
+                f"captures fall on steps as little as {1000 * gap:.4g} ms apart, less than its "
+                f"pixels take on the clock ({1000 * last / sim.clock_hz:.4g} ms); give it a "
+                f"frame period of whole physics steps ({near} fps) or a shorter sim.physics_dt"
+            )
+
+
 def unbound(kind, name, top, pin):
     return UsageError(
         f"the {kind} connector {name!r}: design {top.name!r} has no port for its pin "
@@ -92,16 +134,16 @@ def no_port(kind, name, top, pin, port, ports):
 def port_misfit(kind, name, top, pin, port, spec=None):
     """Why design ``port`` (a ``sim.pins.Port``) cannot be connector pin ``pin`` of the
     ``kind`` connector ``name``, or None when it can: of the pin's direction and width, or
-    for a signed output pin (the wheels' DPS, a servo's angle) a narrower signed output, which
-    the backends read sign-extended. ``spec``: the connector's own ``Pin`` where its width is
-    set per connector (a line_sensors table's sensors), else the kind's."""
+    for a signed output pin (the wheels' DPS, a servo's angle) a signed output of at most its
+    width, which the backends read sign-extended. ``spec``: the connector's own ``Pin`` where
+    its width is set per connector (a line_sensors table's sensors), else the kind's."""
     spec = spec or CONNECTORS[kind].pins[pin]
-    fits = port.width == spec.width or (
-        spec.direction == "out" and spec.signed and port.signed and port.width < spec.width
-    )
+    extended = spec.direction == "out" and spec.signed
+    # An unsigned port of a signed pin's width would be read as a positive number: -100 as
+    # 924 turns a servo to its end stop.
+    fits = port.signed and port.width <= spec.width if extended else port.width == spec.width
     if port.direction == spec.direction and fits:
         return None
-    extended = spec.direction == "out" and spec.signed
     if kind == "line_sensors":
         hint = (
             "; the line_sensors table must list as many sensors as the design's line input "
@@ -109,7 +151,10 @@ def port_misfit(kind, name, top, pin, port, spec=None):
         )
     else:
         hint = (
-            f"; a signed output of at most {spec.width} bits is sign-extended" if extended else ""
+            f"; it takes a signed output of at most {spec.width} bits (a narrower one is "
+            "sign-extended)"
+            if extended
+            else ""
         )
     return (
         f"the {kind} connector {name!r}: pin {pin!r} is {spec.direction} {spec.width} bit(s)"

@@ -27,13 +27,14 @@ import numpy as np
 from fpga_robotics.hw.errors import UsageError
 from fpga_robotics.hw.pixel import color_select_value
 from fpga_robotics.loop.connectors import CONNECTORS, CameraConnector, in_view
+from fpga_robotics.loop.connectors.camera import make_sensor
 from fpga_robotics.loop.pin_channel import PinFrameChannel
 from fpga_robotics.sim.camera.frames import to_rgb444
 from fpga_robotics.sim.camera.scene import CameraPose
 from fpga_robotics.sim.pins.timing import real_clock_timing
 from fpga_robotics.sim.records import CameraView, SensorReading
 
-__all__ = ["CameraRig", "RigCamera"]
+__all__ = ["CameraRig", "RigCamera", "frame_channel"]
 
 #: A further camera's noise stream: ``default_rng([seed, _CAMERA_STREAM, index])``.
 _CAMERA_STREAM = 0xCA3F
@@ -55,6 +56,11 @@ class RigCamera:
         self.outputs = {}
         self.view = None  # the latest CameraView
         self.streaming_until = None  # real-clock timing: the edge after its frame's last pixel
+
+    def turn_rate(self, world):
+        """How fast the camera turns now, rad/s: the body's turn and the horn's it is on."""
+        horn = self.servo.model.rate if self.servo is not None else 0.0
+        return world.robot_velocity()[1] + horn
 
     def pose(self, world):
         """The camera's pose now: the body's pose, the servo's mount and angle if it is on
@@ -135,7 +141,7 @@ class CameraRig:
             servos[spec.name] = servo
         people = [p.name for p in world.people_states()]
         cameras = [
-            _camera(scenario, spec, i, seed, top, servos, people)
+            _camera(scenario, spec, i, seed, top, servos)
             for i, spec in enumerate(s for s in specs if s.kind == "camera")
         ]
         delay = round(scenario.sim.actuation_delay / scenario.sim.physics_dt)
@@ -156,7 +162,7 @@ class CameraRig:
 
     def _capture(self, cam, step, world):
         pose = cam.pose(world)
-        rgb = cam.connector.capture(world.scene(), pose)
+        rgb = cam.connector.capture(world.scene(), pose, cam.turn_rate(world))
         if self.pins is not None:
             if cam.channel is not None:
                 self._stream(cam, rgb)
@@ -311,42 +317,41 @@ def angle_off_axis(pose, x, y):
     return math.degrees((bearing + math.pi) % (2 * math.pi) - math.pi)
 
 
-def _camera(scenario, spec, index, seed, top, servos, people):
-    """A further camera from its ``[[robot.sensors]]`` spec; a ``UsageError`` naming what is
-    wrong (no servo of that name, no port bundle, a size the channel does not take)."""
+def frame_channel(scenario, spec, top):
+    """The design's channel a further camera's frames go through (its ``ports`` bundle), or
+    None for a camera that films only; a ``UsageError`` naming what is wrong (no channel on
+    that bundle, a size the channel does not take). Its ``on`` and ``target`` are checked
+    at load (fpga_robotics.scenario)."""
     p, where = spec.params, f"camera {spec.name!r}"
-    servo = None
-    if p.on is not None:
-        servo = servos.get(p.on)
-        if servo is None:
-            raise UsageError(
-                f"{where}: on = {p.on!r} names no servo; declare [[robot.actuators]] "
-                f'kind = "servo", name = {p.on!r}, or mount the camera on the body (no on)'
-            )
-    if p.target is not None and p.target not in people:
-        raise UsageError(
-            f"{where}: target = {p.target!r} names no person; the people: {', '.join(people)}"
-        )
     port = spec.ports.get("pixels")
-    channel = color_port = None
-    if port is not None:
-        channels = top.frame_channels if top is not None else {}
-        where_to = channels.get(port)
-        if where_to is None:
-            name = top.name if top is not None else scenario.top
-            raise UsageError(
-                f"{where}: design {name!r} has no frame channel on pixels = {port!r}; "
-                f"its channels: {', '.join(channels) or 'none'}"
-            )
-        module, name = where_to
-        channel = getattr(importlib.import_module(module), name)(scenario.design_tables)
-        if channel.frame_size != (p.width, p.height):
-            w, h = channel.frame_size
-            raise UsageError(
-                f"{where}: its resolution {p.width}x{p.height} differs from the {w}x{h} "
-                f"frames design {top.name!r} takes on {port!r}"
-            )
-        color_port = spec.ports.get("color_sel", channel.color_port)
+    if port is None:
+        return None
+    channels = top.frame_channels if top is not None else {}
+    where_to = channels.get(port)
+    if where_to is None:
+        name = top.name if top is not None else scenario.top
+        raise UsageError(
+            f"{where}: design {name!r} has no frame channel on pixels = {port!r}; "
+            f"its channels: {', '.join(channels) or 'none'}"
+        )
+    module, name = where_to
+    channel = getattr(importlib.import_module(module), name)(scenario.design_tables)
+    if channel.frame_size != (p.width, p.height):
+        w, h = channel.frame_size
+        raise UsageError(
+            f"{where}: its resolution {p.width}x{p.height} differs from the {w}x{h} "
+            f"frames design {top.name!r} takes on {port!r}"
+        )
+    return channel
+
+
+def _camera(scenario, spec, index, seed, top, servos):
+    """A further camera from its ``[[robot.sensors]]`` spec."""
+    p = spec.params
+    servo = servos[p.on] if p.on is not None else None
+    channel = frame_channel(scenario, spec, top)
+    color_port = None if channel is None else spec.ports.get("color_sel", channel.color_port)
+    port = spec.ports.get("pixels")
     connector = CameraConnector(
         p.width,
         p.height,
@@ -354,6 +359,8 @@ def _camera(scenario, spec, index, seed, top, servos, people):
         mount_height=spec.mount.height,
         noise_std=p.noise_std,
         rng=np.random.default_rng([seed, _CAMERA_STREAM, index]),
+        # camera.sensor = "ov7670": the body camera's sensor model, at this camera's size.
+        sensor=make_sensor(scenario.camera, seed, (index, p)),
         renderer=scenario.camera.renderer,
         render3d=scenario.camera.render3d,
     )

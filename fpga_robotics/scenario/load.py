@@ -813,12 +813,24 @@ def _check_camera_geometry(camera, world):
 def _check_further_cameras(connectors, sim, world):
     """Each ``[[robot.sensors]]`` camera, as the body camera: between floor and ceiling, its
     field of view one the renderer draws (even on the steepest terrain patch), and at most
-    one frame a physics step (the rig captures at physics steps)."""
+    one frame a physics step (the rig captures at physics steps); its ``on`` a servo of the
+    scenario, its ``target`` one of its people."""
     ceiling, dt = world.room.height, sim.physics_dt
     slope, on_slope = _steepest_slope(world.room)
+    servos = {spec.name for spec in connectors if spec.kind == "servo"}
+    people = [person.name for person in world.people]
     for spec in connectors:
         if spec.kind != "camera":
             continue
+        where, p = f"camera {spec.name!r}", spec.params
+        if p.on is not None and p.on not in servos:
+            raise ScenarioError(
+                f"{where}: on = {p.on!r} names no servo; declare [[robot.actuators]] "
+                f'kind = "servo", name = {p.on!r}, or mount the camera on the body (no on)'
+            )
+        if p.target is not None and p.target not in people:
+            among = f"the people: {', '.join(people)}" if people else "the room has no people"
+            raise ScenarioError(f"{where}: target = {p.target!r} names no person; {among}")
         height, fps = spec.mount.height, spec.params.fps
         if height <= 0:
             raise ScenarioError(
@@ -861,20 +873,6 @@ def _check_further_field_of_view(spec, slope, on_slope):
             f"of view {math.degrees(vfov):.1f} deg; beyond it rows would look straight up or "
             f"down), got {math.degrees(p.tilt):g}"
         )
-
-
-def _sensor_warnings(camera, connectors):
-    """The sensor model (``camera.sensor``) is the body camera's alone: a further camera's
-    frames stay the rendered ones plus its own ``noise_std``, which the scenario may not
-    expect (docs/turret.md)."""
-    further = [repr(s.name) for s in connectors if s.kind == "camera"]
-    if camera.sensor == "plain" or not further:
-        return ()
-    warning = (
-        f'camera.sensor = "{camera.sensor}" models the body camera only; the further '
-        f"camera(s) {', '.join(further)} give the rendered frame plus their own noise_std"
-    )
-    return (warning,)
 
 
 def _sim(data, camera):
@@ -1244,6 +1242,5 @@ def _build(data, source, overrides):
         design_tables=tables,
         design_params=design_params,
         connectors=connectors,
-        warnings=tuple(scenario_warnings(world_config, checks))
-        + _sensor_warnings(camera, connectors),
+        warnings=tuple(scenario_warnings(world_config, checks)),
     )

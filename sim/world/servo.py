@@ -55,6 +55,15 @@ class ServoModel:
         """A new command (the 10-bit signed value the design sends)."""
         self.target = command_to_angle(command, self.range_deg)
 
+    @property
+    def rate(self):
+        """The horn's angular speed now, rad/s (left positive): full speed until it is there."""
+        return (
+            0.0
+            if self.angle == self.target
+            else math.copysign(self.speed, self.target - self.angle)
+        )
+
     def step(self, dt):
         """Move for ``dt`` seconds at most ``speed * dt`` towards the target."""
         error = self.target - self.angle

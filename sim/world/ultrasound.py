@@ -233,7 +233,8 @@ class HCSR04Module:
             return None
         if rise_edge < self.busy_until:
             return None
-        rise = fall_edge + round(p.echo_delay_s * clock_hz)
+        # ECHO rises after TRIG's fall, on a later edge even with no delay (or a slow clock).
+        rise = fall_edge + max(1, round(p.echo_delay_s * clock_hz))
         fall = rise + max(1, self.echo_width(distance, clock_hz))
         self.busy_until = fall
         return rise, fall

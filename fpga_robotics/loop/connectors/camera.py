@@ -73,23 +73,30 @@ class ExposureDrift:
         )
 
 
-#: The sensor model's random stream is ``default_rng([seed, SENSOR_STREAM])``: its own, so that
-#: it shifts neither the world's randomness nor the plain path's noise.
+#: The sensor model's random stream is ``default_rng([seed, SENSOR_STREAM])`` (a further
+#: camera's ``[seed, SENSOR_STREAM, index]``): its own, so that it shifts neither the world's
+#: randomness nor the plain path's noise.
 SENSOR_STREAM = 0x5E45
 
 
-def make_sensor(cam, seed):
-    """The sensor model a scenario's ``CameraConfig`` asks for (``None``: the plain path)."""
+def make_sensor(cam, seed, further=None):
+    """The sensor model a scenario's ``CameraConfig`` asks for (``None``: the plain path);
+    ``further = (index, CameraParams)``: the same model for the rig's further camera
+    ``index``, at its own size, frame rate and field of view."""
     if cam.sensor == "plain":
         return None
-
+    stream, size = [seed, SENSOR_STREAM], (cam.width, cam.height, cam.hfov, cam.frame_period)
+    if further is not None:
+        index, p = further
+        stream, size = [*stream, index], (p.width, p.height, p.hfov, p.frame_period)
+    width, height, hfov, frame_period = size
     return OV7670Sensor(
-        cam.width,
-        cam.height,
+        width,
+        height,
         cam.ov7670,
-        rng=np.random.default_rng([seed, SENSOR_STREAM]),
-        frame_period=cam.frame_period,
-        focal_px=focal_length(cam.width, cam.hfov),
+        rng=np.random.default_rng(stream),
+        frame_period=frame_period,
+        focal_px=focal_length(width, hfov),
     )
 
 
@@ -334,17 +341,17 @@ class CameraConnector(Connector):
         pitch = pitch_at(heading) if pitch_at is not None else 0.0
         return replace(pose, heading=heading, tilt=pose.tilt + pitch)
 
-    def capture(self, scene, pose):
-        """The RGB888 frame (height, width, 3) of ``scene`` seen from ``pose``."""
+    def capture(self, scene, pose, turn_rate=None):
+        """The RGB888 frame (height, width, 3) of ``scene`` seen from ``pose``; ``turn_rate``:
+        the camera's (rad/s, the sensor model's motion blur), else the callback's."""
         if self.sensor is not None:  # the drift is in the light that reaches the sensor
             rendered = self.renderer.render(scene, pose)
-            return self._sense(rendered if self.drift is None else self.drift.apply(rendered))
+            if turn_rate is None:
+                turn_rate = self.turn_rate() if self.turn_rate is not None else 0.0
+            light = rendered if self.drift is None else self.drift.apply(rendered)
+            return self.sensor.process(light, turn_rate)
         rgb = self.renderer.render(scene, pose, noise_std=self.noise_std, rng=self.rng)
         return rgb if self.drift is None else self.drift.apply(rgb)
-
-    def _sense(self, rgb):
-        """The sensor model's frame of the rendered (noise-free) ``rgb``."""
-        return self.sensor.process(rgb, self.turn_rate() if self.turn_rate is not None else 0.0)
 
     def sensor_state(self):
         """The sensor model's exposure, gain and white-balance gains; None on the plain path."""

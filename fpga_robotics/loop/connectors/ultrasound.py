@@ -50,6 +50,7 @@ class UltrasoundConnector(Connector):
         #: Triggers the module ignored (too short, or during a measurement).
         self.ignored = 0
         self._last = None  # (echo width in edges, true range or None, clock_hz)
+        self._echo = None  # (ECHO's fall edge, its _last): the echo scheduled, not yet over
 
     @classmethod
     def parse(cls, table, where):
@@ -63,8 +64,17 @@ class UltrasoundConnector(Connector):
             )
         return HCSR04Params(**values)
 
+    @classmethod
+    def check_run(cls, params, mount, where, sim, room):
+        # Above the ceiling the beam would pass over the walls.
+        if not mount.height < room.height:
+            raise ConnectorError(
+                f"{where}.height must be below the ceiling (room.height = {room.height:g} m), "
+                f"got {mount.height:g}"
+            )
+
     def start(self, io):
-        self._rise, self._last = None, None
+        self._rise, self._last, self._echo = None, None, None
         self.module.busy_until = -1
 
     def sensor_pose(self):
@@ -74,6 +84,7 @@ class UltrasoundConnector(Connector):
     def on_change(self, io, pin, value, t):
         if pin != "trig":
             return
+        self._echo_over(io.cycle)
         if value:
             self._rise = io.cycle
             return
@@ -88,13 +99,22 @@ class UltrasoundConnector(Connector):
             return
         io.schedule(echo[0], "echo", 1)
         io.schedule(echo[1], "echo", 0)
-        self._last = (echo[1] - echo[0], distance, io.clock_hz)
+        self._echo = (echo[1], (echo[1] - echo[0], distance, io.clock_hz))
+
+    def after_step(self, io, t):
+        self._echo_over(io.cycle)
+
+    def _echo_over(self, cycle):
+        """The scheduled echo is the last one once ECHO has fallen (by edge ``cycle``): a row
+        shows no echo the design has not had yet."""
+        if self._echo is not None and self._echo[0] <= cycle:
+            self._last, self._echo = self._echo[1], None
 
     def measurement(self):
-        """The last ECHO: its width in edges (``echo_edges``), the distance it encodes
-        (``echo_m``, half the round trip at the module's speed of sound), the true range
-        (``range_m``, NaN when nothing was in range) and ``timeout`` (1 when the module gave
-        its time-out pulse); empty before the first echo."""
+        """The last ECHO that has fallen: its width in edges (``echo_edges``), the distance it
+        encodes (``echo_m``, half the round trip at the module's speed of sound), the true
+        range when TRIG fell (``range_m``, NaN when nothing was in range) and ``timeout`` (1
+        when the module gave its time-out pulse); empty before the first echo."""
         if self._last is None:
             return {}
         width, distance, clock_hz = self._last
