@@ -255,7 +255,7 @@ def load_rows(out_dir):
     parquet = out_dir / PARQUET
     if parquet.is_file():
         import pyarrow as pa  # lazy: ~0.3 s the workers need not pay
-        import pyarrow.parquet as pq
+        import pyarrow.parquet as pq  # lazy: as above
 
         try:
             return pq.read_table(parquet).to_pylist()
