@@ -280,9 +280,10 @@ def list_mutants(
     has fewer places.
 
     Yosys also lists places on a memory's ports that must stay constant (its initial data,
-    an asynchronous read port's reset), where a mutant cannot be built: such a mutant is left
-    out and the next place Yosys lists with a longer list takes its place (a design without
-    memories gets ``mutate -list`` as it is)."""
+    an asynchronous read port's reset), where a mutant cannot be built, and places on a
+    cell's clock input, where its select mux would delay the clock for every mutant: such a
+    mutant is left out and the next place Yosys lists with a longer list takes its place (a
+    design without memories or such places gets ``mutate -list`` as it is)."""
     params = params if params is not None else FollowTargetParams()
     if not 1 <= int(n) <= 100_000:
         raise ValueError(f"the number of mutants must be 1..100000, got {n}")
@@ -298,6 +299,9 @@ def list_mutants(
     while True:
         fresh = [line for line in lines if line not in seen]
         seen.update(fresh)
+        # A mux in a flip-flop's clock makes it take its input a delta cycle late in the
+        # simulators, at every mutsel: the netlist would not be the design for any mutant.
+        fresh = [line for line in fresh if _parse(0, line).port not in _CLOCK_PORTS]
         on_memories = [l for l in fresh if _parse(0, l).cell.lstrip("\\") in memories]
         # One build of them all; one each only when that fails.
         if on_memories and not _builds(params, on_memories, design):
@@ -309,6 +313,10 @@ def list_mutants(
         asked = min(100_000, 2 * asked)
         lines, _ = _mutate_list(params, asked, seed, design)
     return [_parse(k + 1, line) for k, line in enumerate(kept)]
+
+
+#: The ports of Yosys's cells that take a clock (flip-flops, memory ports, $print/$check).
+_CLOCK_PORTS = frozenset({"CLK", "RD_CLK", "WR_CLK", "TRG"})
 
 
 def _mutate_list(params, n, seed, design):

@@ -122,6 +122,40 @@ def _toolchain():
     return None
 
 
+def test_no_mutant_sits_on_a_clock_input():
+    """Yosys lists places on flip-flops' clocks (seed 2 at 80x60: #34, the clock of
+    tracker.counter.active inverted); the list leaves them out, the rest in Yosys's order."""
+    design = {"rtlil_text": None, "verilog": None, "top": mutation.TOP_NAME, "includes": None}
+    lines, _ = mutation._mutate_list(PARAMS, 40, 2, design)
+    clocked = [k for k, line in enumerate(lines) if " -port CLK " in line]
+    assert clocked, "seed 2's first 40 places have a clock"
+    listed = mutation.list_mutants(PARAMS, 40, seed=2)
+    assert len(listed) == 40 and not any(m.port == "CLK" for m in listed)
+    others = [line for line in lines if " -port CLK " not in line]
+    assert [m.command for m in listed][: len(others)] == others
+
+
+@pytest.mark.skipif(_toolchain() is not None, reason="no Verilator toolchain")
+@pytest.mark.slow
+def test_the_netlist_of_a_seed_with_a_clock_place_is_the_design_at_mutsel_0(tmp_path):
+    """With a clock place among them, the mutants' select mux delayed that flip-flop's clock
+    at every mutsel: the netlist at mutsel 0 timed out on the first unit frame, and every
+    mutant was caught."""
+    from fpga_robotics.loop.shadow import differing_outputs
+    from fpga_robotics.mutation.design import open_mutant_design, write_mutant_design
+    from fpga_robotics.mutation.unit_judge import golden_results, judge_frames, reference_results
+
+    netlist, ports = write_mutant_design(PARAMS, mutation.list_mutants(PARAMS, 40, 2), tmp_path)
+    frames = judge_frames(PARAMS)[:12]
+    design = open_mutant_design(PARAMS, netlist, ports)
+    try:
+        got = reference_results(design, frames)
+    finally:
+        design.close()
+    for k, (g, w) in enumerate(zip(got, golden_results(PARAMS, frames), strict=True)):
+        assert not differing_outputs(w, g), k
+
+
 @pytest.mark.skipif(_toolchain() is not None, reason="no Verilator toolchain")
 @pytest.mark.slow
 def test_one_build_runs_the_design_and_each_mutant(tmp_path):

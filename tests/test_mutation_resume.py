@@ -12,17 +12,21 @@ SAME = ("caught", "run", "status", "failed_checks", "closest")
 
 
 def _mutate(out, seed, capsys, *more, duration=3.0):
+    code, _, err = _mutate_printing(out, seed, capsys, *more, duration=duration)
+    return code, err
+
+
+def _mutate_printing(out, seed, capsys, *more, duration=3.0):
     campaign = out.parent / "bump.toml"
     campaign.write_text(
         f'scenarios = ["{DATA / "bump_wall.toml"}"]\nseeds = "0"\nduration = {duration}\n'
     )
-    code, _, err = mutate_bump_stop(
+    return mutate_bump_stop(
         out,
         capsys,
         *("--mutants", "6", "--seed", str(seed), "--campaign", str(campaign)),
         *("--workers", "1", "--recordings", "0", *more),
     )
-    return code, err
 
 
 def _rows(out):
@@ -84,3 +88,23 @@ def test_a_torn_last_line_of_the_journal_is_not_a_verdict(tmp_path):
     (tmp_path / "robot.jsonl").write_text(text + json.dumps({"index": 7, "caught": True})[:12])
     assert journal_rows(tmp_path / "robot.jsonl") == rows
     assert read_journal(tmp_path) == {3: rows[0], 5: rows[1]}
+
+
+@pytest.mark.slow  # Verilator builds of the mutant netlist, a Dask worker
+def test_a_resumed_run_in_full_prints_no_forked_runs_of_the_verdicts_it_kept(tmp_path, capsys):
+    # Forked first; two verdicts kept, the others judged again in full (--no-fork): the
+    # forked runs of the kept ones are not this run's, so no line counts them.
+    out = tmp_path / "m"
+    code, printed, err = _mutate_printing(out, 1, capsys)
+    assert code == 0, err
+    assert "forked runs:" in printed
+    rows = _rows(out)
+    assert len(rows) >= 3 and any(r.get("forks") for r in rows.values())
+    kept = sorted(rows)[:2]
+    (out / "robot.jsonl").write_text("".join(json.dumps(rows[k]) + "\n" for k in kept))
+    code, printed, err = _mutate_printing(out, 1, capsys, "--resume", "--no-fork")
+    assert code == 0, err
+    assert "forked runs:" not in printed and "settled by their fan-out cone" not in printed
+    result = json.loads((out / "mutants.json").read_text())
+    assert result["baseline"]["kept"] == kept
+    assert result["baseline"]["judged_here"] == len(rows) - 2

@@ -103,6 +103,14 @@ def test_with_overrides_keeps_earlier_ones():
     assert s.overrides == ("sim.duration=3", "design.kp_num=1")
 
 
+def test_with_overrides_lists_each_key_once_with_the_value_in_force():
+    base = load_scenario("follow_person", ["design.kp_num=2", "people[0].speed=0.2"])
+    s = base.with_overrides(["design.kp_num=5", "people=[]"])
+    assert s.overrides == ("design.kp_num=5", "people=[]")
+    # Loaded again from its own list, it is the same scenario.
+    assert load_scenario("follow_person", s.overrides).params == s.params
+
+
 def test_override_without_a_key_says_what_set_needs():
     # It said "unknown scenario key ''".
     with pytest.raises(ScenarioError) as info:

@@ -2,6 +2,7 @@
 differently, equals its full run; an identical shadow's equals the primary's."""
 
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -156,3 +157,37 @@ def test_the_recording_holds_the_shadow_path(tmp_path, capsys):
     )
     x, y = full.trajectory["x"], full.trajectory["y"]
     assert np.allclose(points.reshape(-1, 2), np.column_stack([x, -y]).astype(np.float32))
+
+
+def _continued_summary(tmp_path, argv):
+    path = tmp_path / "s.json"
+    run_main([*argv, "--shadow-continue", "--rerun", "off", "--quiet", "--summary", str(path)])
+    return json.loads(path.read_text())
+
+
+def test_each_design_s_summary_lists_its_own_overrides(tmp_path, capsys):
+    # --set gives the primary 20 lost frames, --shadow the shadow 5: the shadow's list names
+    # 5 alone, and loading the scenario with it gives the shadow's design.
+    argv = ["--scenario", "lost_target", "--backend", "model", "--duration", "1"]
+    argv += ["--set", "design.lost_frames=20", "--shadow", "lost_frames=5"]
+    saved = _continued_summary(tmp_path, argv)
+    capsys.readouterr()
+    assert saved["overrides"] == ["design.lost_frames=20", "sim.duration=1.0"]
+    own = saved["shadow_continued"]["overrides"]
+    assert sorted(own) == ["design.lost_frames=5", "sim.duration=1.0"]
+    assert load_scenario("lost_target", own).params.lost_frames == 5
+
+
+def test_a_pin_shadow_s_summary_lists_its_own_parameters(tmp_path, capsys):
+    # wall_stop.toml gives stop_mm = 250; --shadow-param gives the shadow 100.
+    data = Path(__file__).parent / "data" / "user_designs"
+    argv = ["--scenario", str(data / "wall_stop.toml"), "--backend", "cxxrtl"]
+    argv += ["--duration", "0.2", "--shadow", f"{data}/wall_stop.py:WallStop"]
+    saved = _continued_summary(tmp_path, [*argv, "--shadow-param", "stop_mm=100"])
+    capsys.readouterr()
+    own = saved["shadow_continued"]["overrides"]
+    assert not any("250" in item for item in own), own
+    keys = [item.partition("=")[0] for item in own]
+    assert len(keys) == len(set(keys)), own
+    shadow = load_scenario(data / "wall_stop.toml", own)
+    assert shadow.design_params == {"speed": 300, "stop_mm": 100}

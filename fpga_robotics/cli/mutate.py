@@ -114,6 +114,8 @@ def _report_robot(out, results, robot_s, recordings, say, *, title, inputs):
     ``title`` and ``inputs`` as ``write_report`` takes them)."""
     rs, baseline = results["robot"], results["baseline"]
     robot_verdicts = {m["index"]: m["robot"] for m in results["mutants"] if m["robot"]}
+    # How they were judged is this run's: not that of the verdicts --resume kept.
+    judged_here = {k: v for k, v in robot_verdicts.items() if k not in baseline["kept"]}
     n_runs, n_pass = len(baseline["runs"]), len(baseline["passing"])
     head = f"robot judge (campaign {results['campaign']}: {n_pass} of {n_runs} runs pass unmutated)"
     if not n_pass:  # no score of no run
@@ -121,9 +123,9 @@ def _report_robot(out, results, robot_s, recordings, say, *, title, inputs):
     else:
         print(
             f"{head}: {rs['caught']} of {rs['judged']} unit-caught mutants caught: score "
-            f"{_percent(rs['score'])}; {_robot_rate(baseline, robot_s)}" + _settled(robot_verdicts)
+            f"{_percent(rs['score'])}; {_robot_rate(baseline, robot_s)}" + _settled(judged_here)
         )
-    forked = _fork_line(robot_verdicts)
+    forked = _fork_line(judged_here)
     if forked:
         print(forked)
     if _no_run_passes(baseline):

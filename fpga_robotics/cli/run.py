@@ -567,8 +567,19 @@ def _shadow_param_overrides(design_params, spec, params):
             f"--shadow {spec}: parameter {missing[0]!r} has no default and the scenario "
             f"does not give it; give it with --shadow-param {missing[0]}=VALUE"
         )
-    table = ", ".join(f"{n} = {json.dumps(v)}" for n, v in kept.items())
-    return [f"design.params={{{table}}}", *(f"design.params.{n}={v}" for n, v in given.items())]
+    # One table, each parameter once with the shadow's value (its summary lists its own).
+    values = {n: json.dumps(v) for n, v in kept.items()}
+    values.update((n, _toml_text(v)) for n, v in given.items())
+    return ["design.params={" + ", ".join(f"{n} = {v}" for n, v in values.items()) + "}"]
+
+
+def _toml_text(text):
+    """A ``--set`` value as TOML text: a bare word is a string, as ``--set`` reads it."""
+    try:
+        tomllib.loads(f"v = {text}")
+    except tomllib.TOMLDecodeError:
+        return json.dumps(text.strip())
+    return text.strip()
 
 
 def _shadow_args(args, shadow_scenario):

@@ -417,8 +417,8 @@ def robot_judge(
 
     Returns ``(baseline, verdicts)``: ``baseline`` is ``{"runs": [argv at mutsel 0, ...],
     "passing": [their indices], "statuses": [...], "messages": [why each did not pass, or
-    ""], "judged_here": how many mutants this call judged (the others were kept from the
-    journal)}``; ``verdicts`` is ``{index: judge_runs result}`` (with the replay command of
+    ""], "judged_here": how many mutants this call judged, "kept": the indices of the others,
+    kept from the journal}``; ``verdicts`` is ``{index: judge_runs result}`` (with the replay command of
     the run that caught it, or of the closest run; empty when no run passes unmutated).
     Verdicts are appended to ``out_dir/robot.jsonl`` as they come (``resume`` keeps the
     ones there). With ``fork`` each mutant's run is forked from the unmutated design's
@@ -477,6 +477,7 @@ def robot_judge(
                     "statuses": statuses,
                     "messages": messages,
                     "judged_here": 0,
+                    "kept": [],
                 },
                 {},
             )
@@ -551,6 +552,7 @@ def robot_judge(
             "statuses": statuses,
             "messages": messages,
             "judged_here": len(todo),
+            "kept": sorted(set(indices) - set(todo)),
         },
         verdicts,
     )

@@ -298,7 +298,15 @@ class Scenario:
         overrides = override_items(overrides)
         _drop_replaced_design(data, overrides)  # as loading with them does
         _apply_overrides(data, overrides)
-        return _finish(data, self.source, tuple(self.overrides) + overrides)
+        # The record lists each key once, with the value in force (a shadow's summary
+        # names its own values, not the primary's it replaced).
+        keys = [_override_key(o) for o in overrides]
+        kept = tuple(
+            o
+            for o in self.overrides
+            if not any(k == _override_key(o) or _override_key(o).startswith(k + ".") for k in keys)
+        )
+        return _finish(data, self.source, kept + overrides)
 
 
 # Loading ------------------------------------------------------------------------------------
@@ -558,6 +566,11 @@ def _known_paths(data):
     return sorted(set(out))
 
 
+def _override_key(item):
+    """The dotted key an override sets (``people[0].speed`` as ``people.0.speed``)."""
+    return re.sub(r"\[(\d+)\]", r".\1", item.partition("=")[0].strip())
+
+
 def _apply_overrides(data, overrides):
     for item in overrides:
         # '=3' has no key: say what --set wants, not "unknown scenario key ''".
@@ -567,7 +580,7 @@ def _apply_overrides(data, overrides):
         key = key.strip()
         value = _parse_value(text)
         # people[0].speed, as the world's messages write it, is people.0.speed.
-        _set_path(data, re.sub(r"\[(\d+)\]", r".\1", key), value, key)
+        _set_path(data, _override_key(item), value, key)
 
 
 def _set_path(data, key, value, shown):
