@@ -18,6 +18,7 @@ from amaranth.hdl import signed as signed_shape
 
 from fpga_robotics.hw.errors import UserError
 from fpga_robotics.hw.pixel import COLOR_SELECT
+from fpga_robotics.sim.backends.foreign import verilog_includes
 from fpga_robotics.sim.files import read_user_text
 from fpga_robotics.sim.processes import run_captured
 
@@ -83,7 +84,8 @@ def verilog_board_ports(spec, kinds, header_sites):
 def verilog_files(spec):
     """``[(name in the build folder, text)]``: the design's files and every file they
     ``include`` (looked for next to the including file, then next to each listed file, as
-    the simulation looks), each once; an absolute include name is left to Yosys."""
+    the simulation looks) or reads with ``$readmemh``/``$readmemb``, each once; an absolute
+    name is left to Yosys."""
     files = [Path(f) for f in spec.reference[len("verilog:") :].split(",")]
     top = spec.port_map.top
     out, seen = [], {}
@@ -123,6 +125,11 @@ def verilog_files(spec):
             included = _read(found, top)
             out.append((name, included))
             pending.append((found, included))
+    # The data files of a $readmemh/$readmemb, found as the simulation finds them (a missing
+    # one was refused with the design's check): Yosys reads them next to the files.
+    data = {}
+    texts = verilog_includes(files, data)
+    out += [(name, texts[name]) for name in sorted(data) if name not in seen]
     return out
 
 

@@ -118,9 +118,11 @@ class ForeignDesign:
                 ) from None
         if len(self.sources) != len(self.files):
             raise PortMapError("two Verilog files have the same name")
-        #: Files named by `include, found next to the including file or a listed one: copied
-        #: next to the sources and part of the build's cache key.
-        self.includes = verilog_includes(self.files)
+        #: Files named by `include or a $readmemh/$readmemb, found next to the including
+        #: file or a listed one: copied next to the sources and part of the build's cache key.
+        #: ``data_paths``: where each data file is, for Verilator (``verilator_text``).
+        self.data_paths = {}
+        self.includes = verilog_includes(self.files, self.data_paths)
         self.port_map = (
             port_map if not isinstance(port_map, (str, os.PathLike)) else load_port_map(port_map)
         )
@@ -180,8 +182,20 @@ class ForeignDesign:
         )
         return outputs_registered({"fr_wrapper.v": wrapper, **self.sources}, WRAPPER, self.includes)
 
+    def verilator_text(self, text):
+        """``text`` with each data file its $readmemh/$readmemb names at its absolute path:
+        Verilator's model reads the file when it starts, relative to the process's folder."""
+        return _READMEM.sub(
+            lambda m: (
+                f'{m[1]}"{self.data_paths[m[2]].as_posix()}"' if m[2] in self.data_paths else m[0]
+            ),
+            text,
+        )
+
     def digest(self):
         h = hashlib.sha256()
+        for name in sorted(self.data_paths):  # where the Verilator model reads them
+            h.update(b"data\0" + name.encode() + b"\0" + str(self.data_paths[name]).encode())
         for name in sorted(self.sources):
             h.update(name.encode() + b"\0" + self.sources[name].encode() + b"\0")
         for name in sorted(self.includes):
@@ -203,12 +217,18 @@ def _refuse_loop(sources, top, includes):
 
 
 _INCLUDE = re.compile(r'`include\s+"([^"]+)"')
+#: A memory's data file named by a literal path: ``$readmemh("table.hex", mem)``.
+_READMEM = re.compile(r'(\$readmem[hb]\s*\(\s*)"([^"]+)"')
+_COMMENTS = re.compile(r"/\*.*?\*/|//[^\n]*", re.DOTALL)
 
 
-def verilog_includes(files):
+def verilog_includes(files, data_paths=None):
     """``include name -> text`` of every file the sources `include (recursively) that is
-    found relative to the including file's folder or a listed file's folder; one that is not
-    found is left to Verilator to report."""
+    found relative to the including file's folder or a listed file's folder, and of every
+    data file a $readmemh/$readmemb names (found there too, or in the current folder, where
+    Verilator and Yosys look themselves); an include not found is left to Verilator to
+    report, a data file not found is a ``PortMapError``. ``data_paths`` (a dict) gets each
+    data file's path."""
     folders = [f.parent for f in files]
     found, todo = {}, [(f, f.parent) for f in files]
     while todo:
@@ -217,22 +237,40 @@ def verilog_includes(files):
             text = read_user_text(path, any_bytes=True)
         except OSError:
             continue
+        for _, name in _READMEM.findall(_COMMENTS.sub("", text)):
+            if name in found or Path(name).is_absolute() or ".." in Path(name).parts:
+                continue
+            candidate = next(
+                (b / name for b in (folder, *folders, Path.cwd()) if (b / name).is_file()), None
+            )
+            if candidate is None:
+                raise PortMapError(
+                    f"{path.name} reads the data file {name!r} ($readmem), which is not next "
+                    f"to it, next to a listed file, nor in the current folder: put it beside "
+                    f"{path.name}"
+                )
+            found[name] = _read_included(candidate)
+            if data_paths is not None:
+                data_paths[name] = candidate.resolve()
         for name in _INCLUDE.findall(text):
             if name in found or Path(name).is_absolute() or ".." in Path(name).parts:
                 continue
             for base in (folder, *folders):
                 candidate = base / name
                 if candidate.is_file():
-                    try:
-                        found[name] = read_user_text(candidate, any_bytes=True)
-                    except OSError as exc:
-                        raise PortMapError(
-                            f"cannot read the included file {candidate}: "
-                            f"{getattr(exc, 'strerror', None) or exc}"
-                        ) from None
+                    found[name] = _read_included(candidate)
                     todo.append((candidate, candidate.parent))
                     break
     return found
+
+
+def _read_included(path):
+    try:
+        return read_user_text(path, any_bytes=True)
+    except OSError as exc:
+        raise PortMapError(
+            f"cannot read the included file {path}: {getattr(exc, 'strerror', None) or exc}"
+        ) from None
 
 
 def _write_sources(directory, sources, includes=None):
@@ -632,7 +670,11 @@ def foreign_build_plan(design):
     watched = design.port_map.watch is not None
 
     def build(directory):
-        paths = _write_sources(directory, design.sources, design.includes)
+        paths = _write_sources(
+            directory,
+            {name: design.verilator_text(text) for name, text in design.sources.items()},
+            {name: design.verilator_text(text) for name, text in design.includes.items()},
+        )
         (directory / "fr_wrapper.v").write_text(design.wrapper)
         (directory / "fr_foreign_hooks.cpp").write_text(_HOOKS)
         (directory / "fr_ports.h").write_text(
