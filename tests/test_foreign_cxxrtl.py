@@ -19,6 +19,7 @@ from test_foreign_verilog import (
     _frames,
 )
 
+from fpga_robotics import cli
 from fpga_robotics.hw.verilog import generate_verilog
 from fpga_robotics.loop.timings import run_scenario
 from fpga_robotics.scenario.load import load_scenario
@@ -217,3 +218,22 @@ def test_a_readmemh_file_beside_the_design_is_read_from_any_folder(tmp_path, mon
     message = str(info.value)
     assert "\n" not in message and "'data/speeds.hex'" in message
     assert "put it beside table_top.v" in message
+
+
+def test_a_missing_include_on_cxxrtl_names_the_step_and_the_fix(tmp_path, capsys):
+    (tmp_path / "inc_top.v").write_text('`include "lib/defs.vh"\n' + TABLE_TOP)
+    (tmp_path / "data").mkdir()
+    (tmp_path / "data" / "speeds.hex").write_text("0\n0\n0\n0\n")
+    (tmp_path / "inc.toml").write_text(TABLE_MAP)
+    argv = ["run", "--design", f"verilog:{tmp_path / 'inc_top.v'}", "--ports"]
+    argv += [str(tmp_path / "inc.toml"), "--backend", "cxxrtl", "--rerun", "off"]
+    with pytest.raises(SystemExit) as info:
+        cli.main(argv)
+    err = capsys.readouterr().err
+    assert info.value.code == 2 and err.count("\n") == 1, err
+    # The port-reading step runs Verilator whatever the backend: the line says so.
+    assert "Verilator cannot read the design (top table_top) for its ports, which every " in err
+    assert "Cannot find include file: 'lib/defs.vh'" in err
+    assert err.rstrip().endswith(
+        "put that file next to the file that includes it or next to a listed file"
+    )

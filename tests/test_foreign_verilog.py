@@ -327,8 +327,10 @@ def test_cli_runs_a_foreign_design_in_closed_loop(files, capsys, top, ports):
         (
             ["--design", "verilog:{dir}/never.v", "--ports", "{dir}/ft.toml"],
             (
-                "--design: Verilator cannot read the design (top follow_target): %Error: Specified "
-                "--top-module 'follow_target' was not found"
+                "--design: Verilator cannot read the design (top follow_target) for its ports, "
+                "which every backend reads first: %Error: Specified --top-module "
+                "'follow_target' was not found in design; the port map's top must name a module of the "
+                "design's files"
             ),
         ),
         pytest.param(

@@ -322,9 +322,13 @@ def design_ports(sources, top, includes=None):
         if code != 0:
             errors = [line for line in output.splitlines() if line.startswith("%Error")]
             first = (errors or output.strip().splitlines() or ["(no output)"])[0]
+            first = first.replace(str(Path(tmp) / "src") + "/", "")
+            if _read_hint(first):
+                first = first.rstrip(".") + _read_hint(first)
+            # Named as the step it is: the CXXRTL backend reads the ports with Verilator too.
             raise PortMapError(
-                f"Verilator cannot read the design (top {top}): "
-                f"{first.replace(str(Path(tmp) / 'src') + '/', '')}"
+                f"Verilator cannot read the design (top {top}) for its ports, which every "
+                f"backend reads first: {first}"
             )
         tree = json.loads(next((Path(tmp) / "obj").glob("*.tree.json")).read_text())
     dtypes = _dtypes(tree, {})
@@ -353,6 +357,17 @@ def design_ports(sources, top, includes=None):
         name = var.get("verilogName", var["name"])
         ports[name] = (direction, width, bool(dtype.get("signed")))
     return ports
+
+
+def _read_hint(error):
+    """What to do about Verilator's first ``error`` on reading the design, when it says."""
+    if "Cannot find include file" in error:
+        return "; put that file next to the file that includes it or next to a listed file"
+    if "Cannot find file containing module" in error:
+        return "; list the file that defines that module with the design's files"
+    if "--top-module" in error:
+        return "; the port map's top must name a module of the design's files"
+    return ""
 
 
 def wrapper_verilog(pm, ports, width, height, pins=False, runtime_dpi=True):
