@@ -253,8 +253,17 @@ def verilog_includes(files, data_paths=None):
             if data_paths is not None:
                 data_paths[name] = candidate.resolve()
         for name in _INCLUDE.findall(text):
-            if name in found or Path(name).is_absolute() or ".." in Path(name).parts:
+            if name in found or Path(name).is_absolute():
                 continue
+            if ".." in Path(name).parts:
+                if not (folder / name).is_file():
+                    continue  # left to Verilator, as any include not found
+                # Its copy would land outside the folder the design is copied to.
+                raise PortMapError(
+                    f"{path.name} includes {name!r}: an included file is copied with the "
+                    f"design, under its name: move it next to {path.name} (or a listed "
+                    f"file) and include it without '..'"
+                )
             for base in (folder, *folders):
                 candidate = base / name
                 if candidate.is_file():
