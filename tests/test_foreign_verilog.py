@@ -327,8 +327,10 @@ def test_cli_runs_a_foreign_design_in_closed_loop(files, capsys, top, ports):
         (
             ["--design", "verilog:{dir}/never.v", "--ports", "{dir}/ft.toml"],
             (
-                "--design: Verilator cannot read the design (top follow_target): %Error: Specified "
-                "--top-module 'follow_target' was not found"
+                "--design: Verilator cannot read the design (top follow_target) for its ports, "
+                "which every backend reads first: %Error: Specified --top-module "
+                "'follow_target' was not found in design; the port map's top must name a module of the "
+                "design's files"
             ),
         ),
         pytest.param(
@@ -737,3 +739,19 @@ def test_the_shipped_map_of_the_published_design_reads():
         {"addrout": 0},
     )
     assert set(pm.outputs) == {"centroid_leds", "proximity", "motor_left", "motor_right"}
+
+
+def test_an_include_outside_the_design_folders_says_to_move_it(tmp_path):
+    # rtl/ beside include/: `include "../include/defs.vh" exists, but its copy under that name
+    # would land outside the folder the design is copied to. One line saying what to do.
+    (tmp_path / "rtl").mkdir()
+    (tmp_path / "include").mkdir()
+    (tmp_path / "include" / "defs.vh").write_text("`define SPEED 16'sd300\n")
+    top = tmp_path / "rtl" / "top.v"
+    top.write_text('`include "../include/defs.vh"\n' + generate_verilog(PARAMS))
+    with pytest.raises(PortMapError) as info:
+        foreign.ForeignDesign([top], _map_with(tmp_path, STREAM_MAP % {"latency": 1}))
+    assert str(info.value) == (
+        "top.v includes '../include/defs.vh': an included file is copied with the design, "
+        "under its name: move it next to top.v (or a listed file) and include it without '..'"
+    )

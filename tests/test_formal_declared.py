@@ -101,6 +101,25 @@ def test_the_assertions_of_a_verilog_design_are_proved_and_a_broken_one_fails(ca
     assert "$enddefinitions" in (tmp_path / "traces" / "bump_stop_formal.asserts.vcd").read_text()
 
 
+def test_a_verilog_designs_include_is_read_from_any_folder(capsys, tmp_path, monkeypatch):
+    # The wheel speed in a header in a subfolder, `included: the 300 DPS the asserts expect.
+    (tmp_path / "rtl" / "inc").mkdir(parents=True)
+    design = tmp_path / "rtl" / "bump_stop_formal.v"
+    design.write_text(
+        '`include "inc/speed.vh"\n' + VERILOG.read_text().replace("12'sd300;", "`SPEED;")
+    )
+    header = tmp_path / "rtl" / "inc" / "speed.vh"
+    header.write_text("`define SPEED 12'sd300\n")
+    monkeypatch.chdir(tmp_path)  # not the design's folder
+    argv = ["formal", "--design", "verilog:rtl/bump_stop_formal.v"]
+    code, out, err = _cli([*argv, "--only", "bump_stop_formal.asserts"], capsys)
+    assert code == 0, out + err
+    assert out.splitlines()[1].split()[:4] == ["bump_stop_formal.asserts", "prove", "20", "pass"]
+    header.write_text("`define SPEED 12'sd301\n")  # not a speed the asserts allow
+    code, out, _ = _cli([*argv, "--only", "bump_stop_formal.asserts"], capsys)
+    assert code == 1 and out.splitlines()[1].split()[3] == "FAIL"
+
+
 @pytest.mark.formal
 def test_a_true_property_is_proved_and_its_cover_reached(capsys, tmp_path):
     code, out, _ = _cli(["formal", "--design", SATURATING, "--trace-dir", str(tmp_path)], capsys)

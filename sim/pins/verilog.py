@@ -69,8 +69,9 @@ class VerilogPinSource:
         found under ``src``."""
         d = self.design
         files = {"fr_wrapper.v": d.wrapper}
-        files.update({f"src/{name}": text for name, text in d.includes.items()})
-        files.update({f"src/{name}": text for name, text in d.sources.items()})
+        # The data files of $readmemh/$readmemb at their absolute paths (verilator_text).
+        files.update({f"src/{name}": d.verilator_text(text) for name, text in d.includes.items()})
+        files.update({f"src/{name}": d.verilator_text(text) for name, text in d.sources.items()})
         compiled = ["fr_wrapper.v", *(f"src/{name}" for name in d.sources)]
         return files, compiled
 
