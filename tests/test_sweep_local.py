@@ -157,6 +157,24 @@ def test_raising_hanging_and_dying_runs_are_recorded_and_the_rest_complete(tmp_p
         _assert_row_matches(by_seed[seed], _direct("approach", seed, 4))
 
 
+def test_the_campaign_files_timeout_limits_each_run(tmp_path, monkeypatch):
+    # A run that hangs is ended after the file's `timeout`, not the default (at least 30 s).
+    monkeypatch.setenv("FPGA_ROBOTICS_SWEEP_FAULT", "hang@1")
+    grid_only = {k: v for k, v in SMALL.items() if k != "sets"}
+    campaign = load_campaign(
+        {
+            **grid_only,
+            "scenarios": ["approach"],
+            "seeds": [1],
+            "timeout": 2.0,
+            "grid": {"design.diff_min": [4]},
+        }
+    )
+    [row] = run_campaign(campaign, tmp_path, workers=1, record="none")
+    assert row["status"] == "timeout"
+    assert "per-run timeout of 2 s" in row["message"], row["message"]
+
+
 def test_a_campaign_with_a_shadow_design_reports_where_it_differs(tmp_path):
     from fpga_robotics.cli.run import _shadow_params
     from fpga_robotics.loop.compressed import make_backend

@@ -72,7 +72,8 @@ def build_parser(prog=PROG):
         "--timeout",
         type=float,
         metavar="S",
-        help="per-run timeout (default 10x the run's expected time, at least 30 s)",
+        help="per-run timeout (default: the campaign file's timeout, else 10x the run's "
+        "expected time, at least 30 s)",
     )
     g.add_argument("--max-runs", type=int, metavar="N", help="only the first N runs")
     e = p.add_argument_group("where and how")

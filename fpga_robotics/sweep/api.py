@@ -44,6 +44,8 @@ def run_campaign(
     run and forked variants (fork_groups; the same rows), False runs each in full.
     """
     say = echo or (lambda text: None)
+    if timeout is None:  # the campaign file's `timeout`, unless the caller gives one
+        timeout = campaign.timeout
     plan = make_plan(campaign)
     # --resume keeps the finished runs of the whole campaign (--max-runs limits what runs now).
     run_ids = set(plan.ids.values())
