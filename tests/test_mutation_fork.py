@@ -30,6 +30,12 @@ def test_forked_mutant_runs_equal_their_full_runs(tmp_path):
     picks = [
         next(m for m in listed if (m.signal, m.bit, m.mode) == ("motor_left", 12, "inv")),
         next(m for m in listed if m.signal == "filtered__payload" and m.mode == "const1"),
+        # A design that stops: its frame never ends (a run that does not pass, on any list).
+        next(m for m in listed if (m.signal, m.mode) == ("frame_done", "const0")),
+        # A wheel's bit 13 or 14 held at 0: 0 in every forward command; neither wheel
+        # reverses in this run, so these mutants never act.
+        next(m for m in listed if (m.signal, m.bit, m.mode) == ("motor_left", 13, "const0")),
+        next(m for m in listed if (m.signal, m.bit, m.mode) == ("motor_right", 14, "const0")),
     ]
     picks += [m for m in listed if m not in picks][::300][:6]
     chosen = [mutation.Mutant(**{**m.__dict__, "index": i}) for i, m in enumerate(picks, 1)]
