@@ -212,6 +212,15 @@ class MountKeys(KeyModel):
     yaw_deg: Number(ge=-360, le=360, style="bounds") = 0.0
 
 
+def refuse_above_ceiling(mount, where, room):
+    """A ranging sensor mounted at or above the ceiling would look over the walls."""
+    if not mount.height < room.height:
+        raise ConnectorError(
+            f"{where}.height must be below the ceiling (room.height = {room.height:g} m), "
+            f"got {mount.height:g}"
+        )
+
+
 def check_number(table, key, default, where, *, lo, hi, unit="", lo_open=False, note=""):
     """``table[key]`` (or ``default``) as a float within ``lo..hi`` (``lo`` excluded with
     ``lo_open``); a ``ConnectorError`` naming ``where.key`` otherwise (with ``note``, why

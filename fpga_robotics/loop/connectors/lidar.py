@@ -26,6 +26,7 @@ from fpga_robotics.loop.connectors.base import (
     ConnectorError,
     Pin,
     check_numbers,
+    refuse_above_ceiling,
     refuse_unknown_keys,
     register,
 )
@@ -118,12 +119,7 @@ class _LidarBase(Connector):
 
     @classmethod
     def check_run(cls, params, mount, where, sim, room):
-        # Above the ceiling the scan plane would pass over the walls.
-        if not mount.height < room.height:
-            raise ConnectorError(
-                f"{where}.height must be below the ceiling (room.height = {room.height:g} m), "
-                f"got {mount.height:g}"
-            )
+        refuse_above_ceiling(mount, where, room)
 
     def sensor_pose(self):
         """``(x, y, heading)`` of the sensor in the world now."""

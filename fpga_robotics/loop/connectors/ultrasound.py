@@ -15,6 +15,7 @@ from fpga_robotics.loop.connectors.base import (
     ConnectorError,
     Pin,
     check_numbers,
+    refuse_above_ceiling,
     refuse_unknown_keys,
     register,
 )
@@ -66,12 +67,7 @@ class UltrasoundConnector(Connector):
 
     @classmethod
     def check_run(cls, params, mount, where, sim, room):
-        # Above the ceiling the beam would pass over the walls.
-        if not mount.height < room.height:
-            raise ConnectorError(
-                f"{where}.height must be below the ceiling (room.height = {room.height:g} m), "
-                f"got {mount.height:g}"
-            )
+        refuse_above_ceiling(mount, where, room)
 
     def start(self, io):
         self._rise, self._last, self._echo = None, None, None
