@@ -73,7 +73,12 @@ _WRAPPER_PORTS = (
     "frame_done",
     *OUTPUTS,
 )
-_HARNESS_FILES = ("verilator_harness.cpp", "frame_driver.h", "verilator_clock.h")
+_HARNESS_FILES = (
+    "verilator_harness.cpp",
+    "frame_driver.h",
+    "verilator_clock.h",
+    "verilator_fatal.h",
+)
 _LINT_FLAGS = ("-Wno-fatal", "-Wno-lint", "-Wno-style")
 
 
@@ -655,20 +660,7 @@ void vl_stop(const char *filename, int linenum, const char *) {
 void vl_finish(const char *filename, int linenum, const char *) {
     fr_record("$finish", filename, linenum);
 }
-// Verilator's own fatal errors (built with VL_USER_FATAL): one line and exit code 2, as the
-// command line's errors are, rather than Verilator's "%Error ... Aborting..." and exit code 1.
-// A settle region that does not converge is a combinational loop that no model settles.
-void vl_fatal(const char *, int, const char *, const char *msg) {
-    const bool loop = std::strstr(msg, "converge") != nullptr;
-    std::fflush(stdout);
-    std::fprintf(stderr, "fpga-robotics: error: the design stopped in Verilator: %s%s\\n", msg,
-                 loop ? ": a combinational loop (logic that feeds its own input without a "
-                        "flip-flop) never settles; break the loop with a register "
-                        "(always @(posedge clk))"
-                      : "");
-    std::fflush(stderr);
-    std::_Exit(2);
-}
+#include "verilator_fatal.h"
 extern "C" __attribute__((visibility("default"))) const char *fr_foreign_stop() {
     return fr_stopped ? fr_stop_message : nullptr;
 }

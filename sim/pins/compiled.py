@@ -162,7 +162,7 @@ def verilator_plan(source):
     compiled = [*compiled, "fr_pin_top.v"]
     text = "".join(f"{name}\0{body}\0" for name, body in files.items())
     accessors = verilator_accessors(source, bool(registered))
-    harness = _sources("pin_verilator.cpp", _DRIVER, "verilator_clock.h")
+    harness = _sources("pin_verilator.cpp", _DRIVER, "verilator_clock.h", "verilator_fatal.h")
     # $finish, $stop and $fatal reach the harness's hooks (pin_verilator.cpp), not the
     # process's exit; Verilator's own fatal errors are one line and exit code 2.
     flags = ("-DVL_USER_STOP", "-DVL_USER_FINISH", "-DVL_USER_FATAL")
