@@ -5,29 +5,18 @@ Distances in millimetres, angles in degrees clockwise from the sensor's forward 
 RPLIDAR's sense).
 """
 
-from dataclasses import dataclass, fields, replace
+from dataclasses import dataclass
 
 from .errors import ParamError
-from .validate import check_int
+from .params_base import ParamsBase
 
 __all__ = ["CorridorParams", "NearestParams", "UartParams"]
 
 _INT16_MAX = (1 << 15) - 1
 
 
-class _Params:
-    def replace(self, **changes):
-        return replace(self, **changes)
-
-    def as_dict(self):
-        return {f.name: getattr(self, f.name) for f in fields(self)}
-
-    def _check(self, name, lo=None, hi=None):
-        object.__setattr__(self, name, check_int(name, getattr(self, name), lo, hi))
-
-
 @dataclass(frozen=True)
-class NearestParams(_Params):
+class NearestParams(ParamsBase):
     """Which samples ``NearestObstacle`` counts: a valid return (``distance_q2 > 0``) of at
     least ``min_quality`` and at least ``min_mm`` away (nearer ones are the robot itself)."""
 
@@ -40,7 +29,7 @@ class NearestParams(_Params):
 
 
 @dataclass(frozen=True)
-class CorridorParams(_Params):
+class CorridorParams(ParamsBase):
     """The corridor follower's control law (``hw/corridor_follow.py``), wheel speeds in DPS.
 
     Per revolution, with ``d`` the nearest distance and ``b`` its bearing (clockwise, 0 ahead):
@@ -78,7 +67,7 @@ class CorridorParams(_Params):
 
 
 @dataclass(frozen=True)
-class UartParams(_Params):
+class UartParams(ParamsBase):
     """The serial receiver of ``CorridorFollowUart``: the design's clock and the LIDAR's baud
     rate (8N1). A bit lasts ``bit_cycles = round(clock_hz / baud)`` cycles; the receiver
     samples each bit in its middle counted from the start bit's fall, so the rounding may shift

@@ -9,10 +9,10 @@ millimetres; the clock-cycle figures the gateware uses are derived properties, c
 with integer arithmetic so that the models and the gateware agree exactly.
 """
 
-from dataclasses import dataclass, fields, replace
+from dataclasses import dataclass
 
 from .errors import ParamError
-from .validate import check_int
+from .params_base import ParamsBase
 
 __all__ = ["FOLLOW_LINE_PRESETS", "FollowLineParams", "InterlockParams", "UltrasoundParams"]
 
@@ -29,22 +29,8 @@ def _check_bool(name, value):
         raise TypeError(f"{name} must be True or False, not {type(value).__name__} {value!r}")
 
 
-class _Params:
-    """What the three parameter classes share: ``replace`` and ``as_dict``."""
-
-    def replace(self, **changes):
-        """A copy with some parameters changed (validated again)."""
-        return replace(self, **changes)
-
-    def as_dict(self):
-        return {f.name: getattr(self, f.name) for f in fields(self)}
-
-    def _check(self, name, lo=None, hi=None):
-        object.__setattr__(self, name, check_int(name, getattr(self, name), lo, hi))
-
-
 @dataclass(frozen=True)
-class UltrasoundParams(_Params):
+class UltrasoundParams(ParamsBase):
     """Every elaboration-time parameter of ``UltrasoundDriver`` (HC-SR04).
 
     The defaults follow the HC-SR04 datasheet: a trigger pulse of at least 10 us (12 us
@@ -164,7 +150,7 @@ class UltrasoundParams(_Params):
 
 
 @dataclass(frozen=True)
-class InterlockParams(_Params):
+class InterlockParams(ParamsBase):
     """Thresholds of the obstacle interlock of ``FollowTargetSafe`` (with hysteresis): a
     measurement nearer than ``stop_mm`` stops the wheels; one at ``resume_mm`` or farther, or
     no echo, releases them."""
@@ -192,7 +178,7 @@ EDGE_SIDES = ("left", "right")
 
 
 @dataclass(frozen=True)
-class FollowLineParams(_Params):
+class FollowLineParams(ParamsBase):
     """Every elaboration-time parameter of ``FollowLine``.
 
     Wheel commands (DPS, ``left, right``) of the control law (``hw/follow_line.py``):

@@ -6,10 +6,10 @@ Plain Python (no Amaranth import), like ``params.py``: the gateware, the numpy m
 (``sim/models/turret.py``) and the scenarios share these objects.
 """
 
-from dataclasses import dataclass, fields, replace
+from dataclasses import dataclass
 
 from .params import FollowTargetParams
-from .validate import check_int
+from .params_base import ParamsBase
 
 __all__ = ["ANGLE_BITS", "TurretParams"]
 
@@ -18,7 +18,7 @@ ANGLE_BITS = 10
 
 
 @dataclass(frozen=True)
-class TurretParams:
+class TurretParams(ParamsBase):
     """The turret channel: a colour filter and tracker on the pan camera's frames, then the
     servo angle ``a`` updated once a found frame as ``a -= sign * ((kp_num * e) >>
     kp_shift)``, ``e = centroid_x - width // 2`` (pixels, right positive), saturating at
@@ -64,7 +64,7 @@ class TurretParams:
             ("lost_frames", 1, 255),
             ("search_step", 0, 255),
         ):
-            object.__setattr__(self, name, check_int(name, getattr(self, name), lo, hi))
+            self._check(name, lo, hi)
         if not isinstance(self.inverted, bool):
             raise TypeError(f"inverted must be True or False, not {self.inverted!r}")
         _ = self.tracker_params  # the frame geometry must suit the tracker (window of 8 bins)
@@ -73,9 +73,3 @@ class TurretParams:
     def tracker_params(self):
         """The ``FollowTargetParams`` of the channel's colour filter and tracker."""
         return FollowTargetParams(width=self.width, height=self.height)
-
-    def replace(self, **changes):
-        return replace(self, **changes)
-
-    def as_dict(self):
-        return {f.name: getattr(self, f.name) for f in fields(self)}
