@@ -267,6 +267,22 @@ def test_the_same_seed_gives_the_same_run_and_the_ideal_robot_is_unchanged():
         ),
         ({"terrain": [{"points": [[0, 0], [1, 1], [2, 2]]}]}, "encloses no area"),
         (
+            # A bow tie: its lobes' signed areas cancel, but its points are not on a line.
+            {"terrain": [{"points": [[1, 1], [3, 3], [3, 1], [1, 3]]}]},
+            (
+                "room.terrain[0].points cross themselves: the edge points[0] -> [1] crosses "
+                "points[2] -> [3]"
+            ),
+        ),
+        (
+            {"terrain": [{"points": [[2, 1], [5, 4], [5, 1], [2, 5]]}]},
+            "room.terrain[0].points cross themselves",
+        ),
+        (
+            {"terrain": [{"points": [[1, 1], [4, 1], [4, 3], [2, 3], [2, 0.5], [1, 2]]}]},
+            "the edge points[0] -> [1] crosses points[3] -> [4]",
+        ),
+        (
             {"terrain": [{"center": [1, 1], "slope_deg": 60}]},
             "room.terrain[0].slope_deg must be <= 45",
         ),
