@@ -364,10 +364,19 @@ class World:
         if self.tipped is None:
             # The body follows the motors' ramp (the speed noise is the wheels' jitter, not
             # a push) at most as fast as the traction in force lets it.
-            accel = min(abs(drive_v - self._motor_v) / h, self._traction_accel())
-            if accel > spec.tip_accel:
+            most = self._traction_accel()
+            accel = max(-most, min(most, (drive_v - self._motor_v) / h))
+            # On a ramp, facing uphill, gravity leans the centre of mass back over the rear
+            # support as a forward acceleration does, and the floor holds it with g cos.
+            pitch = slope_pitch(self._patch, body.angle)
+            load, limit = abs(accel + G * math.sin(pitch)), spec.tip_accel * math.cos(pitch)
+            if load > limit:
+                slope = f" on a {math.degrees(pitch):+.1f} deg slope" if pitch else ""
                 self._tip(
-                    f"longitudinal acceleration {accel:.2f} m/s^2 > {spec.tip_accel:.2f} m/s^2"
+                    f"longitudinal acceleration {accel:.2f} m/s^2{slope} "
+                    f"({load:.2f} m/s^2 with gravity) > {limit:.2f} m/s^2"
+                    if pitch
+                    else f"longitudinal acceleration {abs(accel):.2f} m/s^2 > {limit:.2f} m/s^2"
                 )
         self._motor_v = drive_v
         r = spec.wheel_radius
