@@ -96,3 +96,25 @@ def test_source_runs_the_design_on_the_saved_clip(tmp_path, monkeypatch, capsys)
     assert code == 0, err
     s = json.loads((tmp_path / "s.json").read_text())
     assert s["frames"] == 60 and s["found_frames"] >= 57
+
+
+@pytest.mark.parametrize("suffix", [".mp4", ".avi"])
+@pytest.mark.parametrize("width, height", [(168, 97), (41, 30)])
+def test_a_frame_of_odd_size_keeps_its_last_row_and_column(suffix, width, height, tmp_path):
+    # The codecs take even sizes; OpenCV dropped the odd last row (168x97 came back 168x96).
+    import cv2
+
+    from fpga_robotics.loop.video_out import CameraVideo
+
+    frame = np.zeros((height, width, 3), np.uint8)
+    frame[-1, :] = frame[:, -1] = 255  # a white last row and column on black
+    path = tmp_path / f"odd{suffix}"
+    with CameraVideo(path, 10) as video:
+        for _ in range(3):
+            video.write(frame)
+    ok, bgr = cv2.VideoCapture(str(path)).read()
+    assert ok
+    assert bgr.shape == (height + height % 2, width + width % 2, 3)
+    assert bgr[height - 1, : width // 2].mean() > 200  # the last row, white
+    assert bgr[: height // 2, width - 1].mean() > 200  # the last column, white
+    assert bgr[: height // 2, : width // 2].mean() < 30  # the rest, black

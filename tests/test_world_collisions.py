@@ -161,6 +161,27 @@ def test_a_robot_shoved_into_a_standing_person_is_not_at_fault_nor_shot_out():
     assert world.driven_position() == (3.0, 3.0)
 
 
+def test_people_squeezing_past_a_parked_robot_spin_it_no_faster_than_its_rim_slides():
+    # Two people pass a parked GoPiGo3 on either side in opposite directions at 1 m/s, their
+    # paths 0.5 m apart where the robot and they need 0.62 m: they squeeze it. It moves at
+    # most at 1 m/s (the fastest person's speed), so its rim slides past what touches it at
+    # most 1 + 1 m/s and friction spins it at most at 2 m/s / body_radius (18.2 rad/s; the
+    # rigid people's solver spun it at 26 rad/s), and the traction stops the turn afterwards.
+    left = {"name": "a", "waypoints": [[0.5, 2.25], [5.5, 2.25]], "speed": 1.0, "loop": False}
+    right = {"name": "b", "waypoints": [[5.5, 1.75], [0.5, 1.75]], "speed": 1.0, "loop": False}
+    world = _world(
+        {"model": "gopigo3", "start": [3.0, 2.0]}, [left, right], {"width": 6, "depth": 4}
+    )
+    fastest = 0.0
+    for _ in range(round(3.0 / DT)):
+        world.step(DT)
+        fastest = max(fastest, abs(world.robot_velocity()[1]))
+    assert fastest > 5.0  # they did spin it
+    assert fastest <= 2.0 / world.robot_spec.body_radius + 1e-9
+    _run(world, 3.0)  # they are gone; the wheels stand
+    assert world.robot_velocity()[1] == pytest.approx(0.0, abs=1e-6)
+
+
 def test_the_driven_position_follows_a_robot_driving_unhindered():
     # Ramping up to 300 DPS, turning, ramping down: nothing but its wheels moves it.
     world = _world({"start": [2.0, 3.0]})

@@ -14,7 +14,7 @@ import pytest
 from fpga_robotics.sim.camera.raster import CameraRenderer, focal_length
 from fpga_robotics.sim.world import World
 from fpga_robotics.sim.world.config import Uncertainty, WorldConfigError
-from fpga_robotics.sim.world.robots import TURTLEBOT2, G
+from fpga_robotics.sim.world.robots import ROBOT_MODELS, TURTLEBOT2, G
 from fpga_robotics.sim.world.terrain import TerrainPatch, polygon_contains, slope_pitch
 from fpga_robotics.sim.world.uncertainty import NOISE_TAU, MotorUncertainty
 
@@ -91,6 +91,28 @@ def test_a_parked_robot_slides_exactly_when_gravity_beats_traction(slope_deg):
         expected = 0.5 * excess / m * 1.0**2
         assert 3.0 - y == pytest.approx(expected, rel=0.05)
         assert abs(x - 4.0) < 1e-3  # straight downhill
+
+
+@pytest.mark.parametrize("model", ["turtlebot2", "gopigo3"])
+@pytest.mark.parametrize("heading_deg", [90.0, -90.0, 0.0])  # uphill, downhill, across
+@pytest.mark.parametrize("margin_deg", [-1.0, 1.0])
+def test_a_robot_parked_on_a_steep_ramp_tips_when_its_centre_of_mass_leaves_the_support(
+    model, heading_deg, margin_deg
+):
+    # The ramp's grip (friction 10) holds the robot; facing up or down the slope it falls
+    # over once its centre of mass, com_height above the floor, leans past the support edge
+    # support_half_length from it: tan(slope) > support_half_length / com_height (TurtleBot2
+    # 29.9 deg, GoPiGo3 38.7 deg). Across the slope it does not pitch, so it stands.
+    spec = ROBOT_MODELS[model]
+    slope = math.degrees(math.atan(spec.support_half_length / spec.com_height)) + margin_deg
+    world = ramp_world(
+        slope, friction=10.0, slope_dir_deg=90.0, robot={"model": model, "heading_deg": heading_deg}
+    )
+    run(world, 0.5)
+    tips = heading_deg != 0.0 and margin_deg > 0
+    assert (world.tipped is not None) == tips
+    if tips:
+        assert f"on a {'+' if heading_deg > 0 else '-'}{slope:.1f} deg slope" in world.tipped[1]
 
 
 def test_driving_uphill_keeps_the_wheels_speed_while_traction_holds():
@@ -266,6 +288,22 @@ def test_the_same_seed_gives_the_same_run_and_the_ideal_robot_is_unchanged():
             ("room.terrain[0].points must be an array of at least 3 points"),
         ),
         ({"terrain": [{"points": [[0, 0], [1, 1], [2, 2]]}]}, "encloses no area"),
+        (
+            # A bow tie: its lobes' signed areas cancel, but its points are not on a line.
+            {"terrain": [{"points": [[1, 1], [3, 3], [3, 1], [1, 3]]}]},
+            (
+                "room.terrain[0].points cross themselves: the edge points[0] -> [1] crosses "
+                "points[2] -> [3]"
+            ),
+        ),
+        (
+            {"terrain": [{"points": [[2, 1], [5, 4], [5, 1], [2, 5]]}]},
+            "room.terrain[0].points cross themselves",
+        ),
+        (
+            {"terrain": [{"points": [[1, 1], [4, 1], [4, 3], [2, 3], [2, 0.5], [1, 2]]}]},
+            "the edge points[0] -> [1] crosses points[3] -> [4]",
+        ),
         (
             {"terrain": [{"center": [1, 1], "slope_deg": 60}]},
             "room.terrain[0].slope_deg must be <= 45",

@@ -1,14 +1,16 @@
 """The camera frames of a closed-loop run written as a video, so that ``run --source`` can be
 tried on footage at once (``run --save-video clip.mp4``, then ``run --source clip.mp4``).
 
-Written under a hidden temporary name and renamed when the run ends; an interrupted or failed
-run leaves no file. Video codecs are lossy: the design on the replayed clip sees nearly, not
-exactly, the frames of the run.
+A frame of an odd width or height gets its last column or row twice (the codecs take even
+sizes). Written under a hidden temporary name and renamed when the run ends; an interrupted
+or failed run leaves no file. Video codecs are lossy: the design on the replayed clip sees
+nearly, not exactly, the frames of the run.
 """
 
 from contextlib import ExitStack
 
 import cv2
+import numpy as np
 
 from fpga_robotics.hw.errors import UserError
 from fpga_robotics.sim.files import atomic_path, check_output_path
@@ -48,8 +50,13 @@ class CameraVideo:
         return self
 
     def write(self, rgb):
-        if self._writer is None:  # the size is known with the first frame
+        # The codecs take even sizes only (OpenCV would drop an odd last row or column):
+        # repeat the last one instead, so that the video holds every pixel of the frame.
+        height, width = rgb.shape[:2]
+        if height % 2 or width % 2:
+            rgb = np.pad(rgb, ((0, height % 2), (0, width % 2), (0, 0)), mode="edge")
             height, width = rgb.shape[:2]
+        if self._writer is None:  # the size is known with the first frame
             fourcc = cv2.VideoWriter_fourcc(*VIDEO_CODECS[self.path.suffix.lower()])
             self._writer = cv2.VideoWriter(str(self._tmp), fourcc, self.fps, (width, height))
             if not self._writer.isOpened():

@@ -211,6 +211,23 @@ def _point(value, path):
         raise WorldConfigError(f"{path}{exc.context.get('sub', '')} {exc.message()}") from None
 
 
+def _side(p, q, r):
+    return (q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0])
+
+
+def _crossing_edges(polygon):
+    """``(i, j)``: the first two edges of the closed ``polygon`` (edge i from point i to the
+    next) that cross each other, or None for a simple polygon."""
+    n = len(polygon)
+    edges = [(polygon[i], polygon[(i + 1) % n]) for i in range(n)]
+    for i, (a, b) in enumerate(edges):
+        for j in range(i + 2, n - 1 if i == 0 else n):  # not a neighbour: they share a corner
+            c, d = edges[j]
+            if _side(a, b, c) * _side(a, b, d) < 0 and _side(c, d, a) * _side(c, d, b) < 0:
+                return i, j
+    return None
+
+
 def _parse_terrain(item, path, index, room):
     k = _keys(TerrainKeys, item, path)
     has_points = k.points is not None
@@ -221,6 +238,17 @@ def _parse_terrain(item, path, index, room):
         )
     if has_points:
         polygon = k.points
+        crossing = _crossing_edges(polygon)
+        if crossing is not None:
+            # The physics and the raster would take it by the even-odd rule, the 3D
+            # renderer's triangles as something else: only a simple polygon means one patch.
+            n = len(polygon)
+            i, j = crossing
+            raise WorldConfigError(
+                f"{path}.points cross themselves: the edge points[{i}] -> [{(i + 1) % n}] "
+                f"crosses points[{j}] -> [{(j + 1) % n}]; list the corners in order round "
+                f"the patch"
+            )
         area = 0.5 * abs(
             sum(x0 * y1 - x1 * y0 for (x0, y0), (x1, y1) in zip(polygon, polygon[1:] + polygon[:1]))
         )

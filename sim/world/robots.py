@@ -63,7 +63,8 @@ class RobotSpec:
     ``tip_accel = g * support_half_length / com_height``: the inertial force at the centre of
     mass then has a larger moment about the support edge than the weight. The body gets at
     most ``traction_force / mass`` (times the floor's factor), so a robot whose traction is
-    below ``tip_accel * mass`` never tips.
+    below ``tip_accel * mass`` never tips on level floor. On a ramp pitching it by ``p``
+    along its heading it tips when ``|a + g sin(p)| > tip_accel * cos(p)``.
     """
 
     name: str

@@ -197,6 +197,7 @@ class World:
         gear.max_force = spec.traction_torque
         self._pivot, self._gear = pivot, gear
         self._robot_speed = 0.0  # the body's speed after the last sub-step, m/s
+        self._robot_turn = 0.0  # and its turn rate's size, rad/s
         space.add(body, shape, control, pivot, gear)
         self._patch = self.terrain.at(*config.robot.start) if self.terrain else None
 
@@ -363,10 +364,19 @@ class World:
         if self.tipped is None:
             # The body follows the motors' ramp (the speed noise is the wheels' jitter, not
             # a push) at most as fast as the traction in force lets it.
-            accel = min(abs(drive_v - self._motor_v) / h, self._traction_accel())
-            if accel > spec.tip_accel:
+            most = self._traction_accel()
+            accel = max(-most, min(most, (drive_v - self._motor_v) / h))
+            # On a ramp, facing uphill, gravity leans the centre of mass back over the rear
+            # support as a forward acceleration does, and the floor holds it with g cos.
+            pitch = slope_pitch(self._patch, body.angle)
+            load, limit = abs(accel + G * math.sin(pitch)), spec.tip_accel * math.cos(pitch)
+            if load > limit:
+                slope = f" on a {math.degrees(pitch):+.1f} deg slope" if pitch else ""
                 self._tip(
-                    f"longitudinal acceleration {accel:.2f} m/s^2 > {spec.tip_accel:.2f} m/s^2"
+                    f"longitudinal acceleration {accel:.2f} m/s^2{slope} "
+                    f"({load:.2f} m/s^2 with gravity) > {limit:.2f} m/s^2"
+                    if pitch
+                    else f"longitudinal acceleration {abs(accel):.2f} m/s^2 > {limit:.2f} m/s^2"
                 )
         self._motor_v = drive_v
         r = spec.wheel_radius
@@ -415,7 +425,7 @@ class World:
         top_speed = self._top_speed(abs(v), h)
         self._now = t1
         self.space.step(h)
-        self._limit_robot_speed(top_speed)
+        self._limit_robot_speed(top_speed, abs(w))
         self.time = t1
         if self._removals and self._removals[0][0] <= t1 + SCHEDULE_SLACK:
             self._remove_due()
@@ -430,13 +440,32 @@ class World:
         downhill = self.robot_body.force.length / self.robot_spec.mass
         return max(pushed, self._robot_speed + downhill * h)
 
-    def _limit_robot_speed(self, top_speed):
-        """Slow the robot's body (the velocity the next step moves it at) to ``top_speed``."""
+    def _limit_robot_speed(self, top_speed, wheel_turn):
+        """Slow the robot's body (the velocity the next step moves it at) to ``top_speed``,
+        and its turn to ``wheel_turn`` (rad/s) plus what the friction of its contacts can
+        give it: a rim spun by a wall or a person turns no faster than it slides past it
+        (or keeps the turn it had: the traction only pulls it towards the wheels'). People
+        squeezing it would otherwise spin it at any rate."""
         body = self.robot_body
         speed = body.velocity.length
         if speed > top_speed:
             body.velocity = body.velocity * (top_speed / speed)
         self._robot_speed = min(speed, top_speed)
+        slides = [0.0]
+
+        def slide(arbiter):
+            a, b = arbiter.shapes
+            other = b if a is self.robot_shape else a
+            rel = other.body.velocity - body.velocity
+            n = arbiter.normal
+            slides.append(abs(rel.y * n.x - rel.x * n.y))  # along the rim
+
+        body.each_arbiter(slide)
+        top_turn = max(wheel_turn + max(slides) / self.robot_spec.body_radius, self._robot_turn)
+        turn = body.angular_velocity
+        if abs(turn) > top_turn:
+            body.angular_velocity = math.copysign(top_turn, turn)
+        self._robot_turn = min(abs(turn), top_turn)
 
     def _driven_offset(self, person, sx, sy, h):
         """A hand-driven person's offset after a sub-step: the person is kinematic, so
