@@ -203,6 +203,23 @@ def test_a_camera_only_design_drives_in_compressed_timing_and_records_its_output
     assert [s[0] for s in scalars] == list(traj["design.red_sum"])
 
 
+def test_a_robot_spinning_in_place_fails_lost_target_though_it_finds_the_person_again():
+    # Spinner turns in place whatever it sees: it re-finds the standing person every turn
+    # (reacquired_within_s alone passed it) but faces them a fraction of the time: about
+    # (hfov + the person's width) / 360 degrees of each turn, under 30%.
+    top = f"design.top={json.dumps(str(DESIGNS / 'spinner.py') + ':Spinner')}"
+    result = run_scenario(load_scenario("lost_target", [top]), backend="cxxrtl")
+    s, traj = result.summary, result.trajectory
+    by = {c["name"]: c for c in s["checks"]}
+    assert np.ptp(traj["x"]) < 0.01 and np.ptp(traj["y"]) < 0.01  # it never drove
+    assert abs(np.ptp(np.unwrap(traj["heading"]))) > 4 * np.pi  # it turned and turned
+    assert by["reacquired_within_s"]["status"] == "pass"
+    assert by["target_in_view_min_fraction"]["status"] == "fail"
+    assert by["target_in_view_min_fraction"]["value"] < 0.3
+    assert by["found_min_fraction"]["status"] == "fail"
+    assert s["verdict"] == "fail"
+
+
 def test_a_ready_backend_of_another_design_is_refused_before_the_run():
     """A ready FollowTarget backend for a design of one's own ran FollowTarget under the
     scenario's name; a design's ready backend runs only a scenario of that design."""
