@@ -168,24 +168,28 @@ def _traj(cmd_w, centroid_x, found=None):
     }
 
 
-def test_oscillation_counts_sign_changes_of_w_while_centred():
-    # 30 frames (1 s) at 30 fps, all centred (80 +- 20 of 160 px): W flips at 6 places
-    # (-1, 0, 0, 1 is one flip: straight ahead keeps the last sign).
+def test_oscillation_counts_sign_changes_of_w_while_found():
+    # 30 frames (1 s) at 30 fps, all found: W flips at 6 places (-1, 0, 0, 1 is one flip:
+    # straight ahead keeps the last sign), wherever the centroid is: a swing that carries the
+    # target off-centre (10 px of 160) counts as much as one about the centre.
     w = [1, -1, 1, -1, 0, 0, 1, 1, -1, -1, 1] + [1] * 19
-    m = compute_metrics(_traj(w, [80] * 30), [], {}, 1 / 30, width=160)
-    assert m["oscillation_hz"] == pytest.approx(6.0)
-    # Frames off-centre (centroid 10 px, the first 4) neither count nor add time: from frame
-    # 4 on the signs are 0, 0, 1, 1, -1, -1, 1, ...: 2 flips in 26 frames (26/30 s).
-    m = compute_metrics(_traj(w, [10] * 4 + [80] * 26), [], {}, 1 / 30, width=160)
+    for centroid in ([80] * 30, [10, 150] * 15):
+        m = compute_metrics(_traj(w, centroid), [], {}, 1 / 30, width=160)
+        assert m["oscillation_hz"] == pytest.approx(6.0)
+    # Frames without the target (the first 4) neither count nor add time: from frame 4 on the
+    # signs are 0, 0, 1, 1, -1, -1, 1, ...: 2 flips in 26 frames (26/30 s).
+    m = compute_metrics(_traj(w, [80] * 30, [False] * 4 + [True] * 26), [], {}, 1 / 30, width=160)
     assert m["oscillation_hz"] == pytest.approx(2 / (26 / 30))
     assert m["max_wheel_command_step_dps"] == 150  # left 100 -> -50
     (c,) = evaluate_checks({"max_oscillation_hz": 1.0}, m)
-    assert not c["passed"] and "2.31 times per second" in c["text"]
-    # Never centred: no value, nothing to judge: the check is n/a.
-    m = compute_metrics(_traj(w, [10] * 30), [], {}, 1 / 30, width=160)
+    assert not c["passed"] and c["text"] == (
+        "W changes sign 2.31 times per second with the target found (limit 1.0)"
+    )
+    # Never found: no value, nothing to judge: the check is n/a.
+    m = compute_metrics(_traj(w, [80] * 30, [False] * 30), [], {}, 1 / 30, width=160)
     assert m["oscillation_hz"] is None
     (c,) = evaluate_checks({"max_oscillation_hz": 1.0}, m)
-    assert c["status"] == "n/a" and c["text"] == "the target was never centred"
+    assert c["status"] == "n/a" and c["text"] == "the target was never found"
 
 
 def test_tip_over_check_reads_the_event():
