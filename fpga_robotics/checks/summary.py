@@ -237,8 +237,10 @@ def compute_metrics(
 
 def _heading_overshoot(traj, mount=None):
     """How far the robot turns past the target, degrees: the largest bearing error on the far
-    side once the error has changed sign, over frames with the target's centre in view (a
-    frame out of view starts afresh). The bearing error is the turn in place that would put
+    side once the error has changed sign, over frames with the target's centre in view and the
+    frames out of view in which the robot goes on turning away from the target (a turn that
+    carries the target out of the image on the far side is the largest overshoot, not none);
+    any other frame out of view starts afresh. The bearing error is the turn in place that would put
     the target on the camera's axis (``_aim_error``; the camera at ``mount``, a
     ``connectors.base.Mount``, or at the robot's centre along its heading without one), so a
     camera yawed on its mount is on the target when the robot's body is not. Meaningful with a
@@ -252,9 +254,12 @@ def _heading_overshoot(traj, mount=None):
     if not in_view.any():
         return None
     b = np.degrees(_aim_error(traj, mount))
+    # The robot's own turn since the last frame, left positive: it turns away from the target
+    # when that turn is against the error's sign (the error grows by it).
+    turn = np.diff(np.unwrap(np.asarray(traj["heading"], dtype=float)), prepend=np.nan)
     best, last, crossed = 0.0, 0.0, False
-    for bk, seen in zip(b, in_view):
-        if not seen:
+    for bk, seen, tk in zip(b, in_view, turn):
+        if not seen and not (crossed and tk * bk < 0):
             last, crossed = 0.0, False
             continue
         sign = np.sign(bk)
