@@ -240,8 +240,8 @@ def _heading_overshoot(traj, mount=None):
     side once the error has changed sign, over frames with the target's centre in view and the
     frames out of view in which the robot goes on turning away from the target (a turn that
     carries the target out of the image on the far side is the largest overshoot, not none);
-    any other frame out of view starts afresh. The bearing error is the turn in place that would put
-    the target on the camera's axis (``_aim_error``; the camera at ``mount``, a
+    any other frame out of view starts afresh. The bearing error is the turn in place that
+    would put the target on the camera's axis (``_aim_error``; the camera at ``mount``, a
     ``connectors.base.Mount``, or at the robot's centre along its heading without one), so a
     camera yawed on its mount is on the target when the robot's body is not. Meaningful with a
     standing target (a step response, e.g. ``approach`` with ``robot.heading_deg=20``); a
