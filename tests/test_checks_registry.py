@@ -85,7 +85,7 @@ _NO_LINE = "not measured: the run has no floor line or no line sensors"
 #: Checks with a precondition: name -> (a limit the JUDGEABLE run passes, one it fails, the
 #: metrics that leave the check nothing to judge, the reason it then gives).
 JUDGED_IF = {
-    "max_oscillation_hz": (0.5, 0.4, {"oscillation_hz": None}, "the target was never centred"),
+    "max_oscillation_hz": (0.5, 0.4, {"oscillation_hz": None}, "the target was never found"),
     "max_off_target_fraction": (
         0.05,
         0.04,

@@ -2,6 +2,7 @@
 
 import math
 
+import numpy as np
 import pytest
 
 from fpga_robotics.cli.errors import UsageError
@@ -527,3 +528,20 @@ def test_an_array_the_scenario_leaves_out_is_set_whole_then_by_index():
         "follow_person", ["room.furniture=[{center = [4, 3]}]", "room.furniture.0.height=1"]
     )
     assert s.world["room"]["furniture"] == [{"center": [4, 3], "height": 1}]
+
+
+@pytest.mark.parametrize("name", ["approach", "slippery"])
+def test_a_robot_that_stands_still_fails_a_scenario_that_asks_it_to_move(name):
+    # FollowTarget with every speed 0 sees the person and never moves: approach (a person
+    # standing 2 m ahead) and slippery (a person walking away over a wet strip) passed it on
+    # their collision, distance and tracking checks alone.
+    still = ["design.base_dps=[0,0,0,0,0,0,0,0]", "design.kp_num=0", "design.search_dps=0"]
+    r = run_scenario(load_scenario(name, still), backend="model")
+    assert r.summary["path_length_m"] == 0.0
+    by = {c["name"]: c for c in r.summary["checks"]}
+    assert by["mean_distance_max_m"]["status"] == "fail", by["mean_distance_max_m"]["text"]
+    # The mean distance, from the trajectory: the robot's centre to the person's, every frame.
+    t = r.trajectory
+    mean = np.hypot(t["target_x"] - t["x"], t["target_y"] - t["y"]).mean()
+    assert by["mean_distance_max_m"]["value"] == pytest.approx(mean)
+    assert r.summary["verdict"] == "fail"

@@ -168,24 +168,28 @@ def _traj(cmd_w, centroid_x, found=None):
     }
 
 
-def test_oscillation_counts_sign_changes_of_w_while_centred():
-    # 30 frames (1 s) at 30 fps, all centred (80 +- 20 of 160 px): W flips at 6 places
-    # (-1, 0, 0, 1 is one flip: straight ahead keeps the last sign).
+def test_oscillation_counts_sign_changes_of_w_while_found():
+    # 30 frames (1 s) at 30 fps, all found: W flips at 6 places (-1, 0, 0, 1 is one flip:
+    # straight ahead keeps the last sign), wherever the centroid is: a swing that carries the
+    # target off-centre (10 px of 160) counts as much as one about the centre.
     w = [1, -1, 1, -1, 0, 0, 1, 1, -1, -1, 1] + [1] * 19
-    m = compute_metrics(_traj(w, [80] * 30), [], {}, 1 / 30, width=160)
-    assert m["oscillation_hz"] == pytest.approx(6.0)
-    # Frames off-centre (centroid 10 px, the first 4) neither count nor add time: from frame
-    # 4 on the signs are 0, 0, 1, 1, -1, -1, 1, ...: 2 flips in 26 frames (26/30 s).
-    m = compute_metrics(_traj(w, [10] * 4 + [80] * 26), [], {}, 1 / 30, width=160)
+    for centroid in ([80] * 30, [10, 150] * 15):
+        m = compute_metrics(_traj(w, centroid), [], {}, 1 / 30, width=160)
+        assert m["oscillation_hz"] == pytest.approx(6.0)
+    # Frames without the target (the first 4) neither count nor add time: from frame 4 on the
+    # signs are 0, 0, 1, 1, -1, -1, 1, ...: 2 flips in 26 frames (26/30 s).
+    m = compute_metrics(_traj(w, [80] * 30, [False] * 4 + [True] * 26), [], {}, 1 / 30, width=160)
     assert m["oscillation_hz"] == pytest.approx(2 / (26 / 30))
     assert m["max_wheel_command_step_dps"] == 150  # left 100 -> -50
     (c,) = evaluate_checks({"max_oscillation_hz": 1.0}, m)
-    assert not c["passed"] and "2.31 times per second" in c["text"]
-    # Never centred: no value, nothing to judge: the check is n/a.
-    m = compute_metrics(_traj(w, [10] * 30), [], {}, 1 / 30, width=160)
+    assert not c["passed"] and c["text"] == (
+        "W changes sign 2.31 times per second with the target found (limit 1.0)"
+    )
+    # Never found: no value, nothing to judge: the check is n/a.
+    m = compute_metrics(_traj(w, [80] * 30, [False] * 30), [], {}, 1 / 30, width=160)
     assert m["oscillation_hz"] is None
     (c,) = evaluate_checks({"max_oscillation_hz": 1.0}, m)
-    assert c["status"] == "n/a" and c["text"] == "the target was never centred"
+    assert c["status"] == "n/a" and c["text"] == "the target was never found"
 
 
 def test_tip_over_check_reads_the_event():
@@ -228,28 +232,40 @@ def test_story_c_the_default_design_stays_upright_and_steady():
     assert r.summary["tipped_over_at_s"] is None and r.summary["oscillation_hz"] < 1.0
 
 
-def test_heading_overshoot_is_the_far_side_error_after_the_first_crossing():
-    # Robot at the origin, target at (1, 0): bearing error = -heading. Headings (deg):
-    # -20, -5, 4 (crossed: 4), 7 (7), 2, -1 (crossed back: 1), out of view, 3 (afresh: 0).
-    headings = np.radians([-20, -5, 4, 7, 2, -1, 30, 3])
-    n = len(headings)
-    column = np.where(np.arange(n) == 6, np.nan, 80.0)
-    traj = {
+def _turning(headings_deg, out_of_view=()):
+    """The robot at the origin turning through ``headings_deg``, the target standing at
+    (1, 0) (bearing error = -heading), its centre out of view in the frames ``out_of_view``."""
+    n = len(headings_deg)
+    return {
         "t": np.arange(n) / 30,
         "x": np.zeros(n),
         "y": np.zeros(n),
-        "heading": headings,
+        "heading": np.radians(headings_deg),
         "found": np.ones(n, bool),
         "target_x": np.ones(n),
         "target_y": np.zeros(n),
         "target_distance": np.ones(n),
         "target_in_view": np.ones(n, bool),
-        "target_column": column,
+        "target_column": np.where(np.isin(np.arange(n), out_of_view), np.nan, 80.0),
     }
-    m = compute_metrics(traj, [], {}, 1 / 30)
+
+
+def test_heading_overshoot_is_the_far_side_error_after_the_first_crossing():
+    # Headings (deg): -20, -5, 4 (crossed: 4), 7 (7), 2, -1 (crossed back: 1), out of view
+    # while turning back towards the target (-0.5), 3 (afresh: 0).
+    m = compute_metrics(_turning([-20, -5, 4, 7, 2, -1, -0.5, 3], [6]), [], {}, 1 / 30)
     assert m["heading_overshoot_deg"] == pytest.approx(7.0)
     (c,) = evaluate_checks({"max_heading_overshoot_deg": 5.0}, m)
     assert not c["passed"] and c["text"] == "turned 7.0 deg past the target (limit <= 5.0 deg)"
+
+
+def test_heading_overshoot_counts_a_turn_that_carries_the_target_out_of_view():
+    # The turn goes on past the target until it leaves the image (35, 50 deg: turning away,
+    # out of view), then comes back (40, out of view: afresh) and settles (10): 50 deg past,
+    # not the 7 deg seen while the target was still in the image.
+    headings = [-20, -5, 4, 7, 35, 50, 40, 10]
+    m = compute_metrics(_turning(headings, [4, 5, 6]), [], {}, 1 / 30)
+    assert m["heading_overshoot_deg"] == pytest.approx(50.0)
 
 
 def test_heading_overshoot_is_na_when_the_target_was_never_in_view():
@@ -344,6 +360,10 @@ def test_a_yawed_camera_centred_on_a_standing_person_is_no_overshoot(tmp_path, y
     [
         ([], (0.0, 0.0)),  # the default gain turns onto the person
         (["design.kp_num=16"], (8.0, 14.0)),  # a high gain swings past them
+        # On the nimbler GoPiGo3 the same gain swings about 50 deg past them, far out of the
+        # image (half the field of view is 30 deg): it measured 28.5 when only the frames
+        # with the person in the image counted.
+        (['robot.model="gopigo3"', "design.kp_num=16"], (45.0, 55.0)),
     ],
 )
 def test_turning_onto_a_standing_person(overrides, overshoot):
@@ -351,3 +371,10 @@ def test_turning_onto_a_standing_person(overrides, overshoot):
     r = run_scenario(s, backend="model")
     lo, hi = overshoot
     assert lo <= r.summary["heading_overshoot_deg"] <= hi
+    # By hand: the robot's bearing to the person, from its centre, on the far side of the
+    # start's (within 3 deg: the camera sits ahead of the centre).
+    t = r.trajectory
+    bearing = np.degrees(np.arctan2(t["target_y"] - t["y"], t["target_x"] - t["x"]) - t["heading"])
+    bearing = (bearing + 180) % 360 - 180
+    far = bearing[np.sign(bearing) == -np.sign(bearing[0])]
+    assert r.summary["heading_overshoot_deg"] == pytest.approx(np.abs(far).max(initial=0), abs=3)

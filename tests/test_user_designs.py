@@ -203,6 +203,47 @@ def test_a_camera_only_design_drives_in_compressed_timing_and_records_its_output
     assert [s[0] for s in scalars] == list(traj["design.red_sum"])
 
 
+def test_a_robot_spinning_in_place_fails_lost_target_though_it_finds_the_person_again():
+    # Spinner turns in place whatever it sees: it re-finds the standing person every turn
+    # (reacquired_within_s alone passed it) but faces them a fraction of the time: about
+    # (hfov + the person's width) / 360 degrees of each turn, under 30%.
+    top = f"design.top={json.dumps(str(DESIGNS / 'spinner.py') + ':Spinner')}"
+    result = run_scenario(load_scenario("lost_target", [top]), backend="cxxrtl")
+    s, traj = result.summary, result.trajectory
+    by = {c["name"]: c for c in s["checks"]}
+    assert np.ptp(traj["x"]) < 0.01 and np.ptp(traj["y"]) < 0.01  # it never drove
+    assert abs(np.ptp(np.unwrap(traj["heading"]))) > 4 * np.pi  # it turned and turned
+    assert by["reacquired_within_s"]["status"] == "pass"
+    assert by["target_in_view_min_fraction"]["status"] == "fail"
+    assert by["target_in_view_min_fraction"]["value"] < 0.3
+    assert by["found_min_fraction"]["status"] == "fail"
+    assert s["verdict"] == "fail"
+
+
+def test_a_steering_that_swings_the_person_off_centre_fails_the_oscillation_check():
+    # Swing turns 400 DPS left for 20 frames, then right: the robot swings tens of degrees
+    # about the person, who leaves the image centre at each swing. Counting only the centred
+    # frames saw almost none of it (0.3 sign changes a second): every found frame counts.
+    top = f"design.top={json.dumps(str(DESIGNS / 'swing.py') + ':Swing')}"
+    items = [top, "sim.duration=10", "checks.max_oscillation_hz=1.0"]
+    result = run_scenario(load_scenario("follow_person", items), backend="cxxrtl")
+    traj, s = result.trajectory, result.summary
+    heading = np.degrees(np.unwrap(traj["heading"]))
+    assert np.ptp(heading[30:90]) > 20  # a swing, not a jitter
+    # W's sign changes within each stretch of found frames, per second found, counted here
+    # from the trajectory.
+    found = traj["found"].astype(bool)
+    flips, cuts = 0, np.flatnonzero(np.diff(found)) + 1
+    for w, seen in zip(np.split(np.sign(traj["cmd_w"]), cuts), np.split(found, cuts)):
+        signs = w[w != 0] if seen[0] else w[:0]
+        flips += np.count_nonzero(signs[1:] != signs[:-1])
+    assert s["oscillation_hz"] == pytest.approx(flips / (10.0 * found.mean()), abs=1e-4)
+    assert s["oscillation_hz"] > 1.0
+    (c,) = [c for c in s["checks"] if c["name"] == "max_oscillation_hz"]
+    assert c["status"] == "fail", c["text"]
+    assert c["text"].startswith(f"W changes sign {s['oscillation_hz']:.2f} times per second")
+
+
 def test_a_ready_backend_of_another_design_is_refused_before_the_run():
     """A ready FollowTarget backend for a design of one's own ran FollowTarget under the
     scenario's name; a design's ready backend runs only a scenario of that design."""

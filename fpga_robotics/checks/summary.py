@@ -37,7 +37,7 @@ _METRIC_OUTPUTS = {
     "searched_reacquisitions": ("found",),
     "reacquire_times_s": ("found",),
     "unrecovered_losses_s": ("found",),
-    "oscillation_hz": ("found", "centroid_x"),
+    "oscillation_hz": ("found",),
     "off_target_fraction": ("found", "centroid_x"),
     "mean_centroid_error_px": ("found", "centroid_x"),
     "led_wrong_side_fraction": ("found", "centroid_leds"),
@@ -100,9 +100,6 @@ def _rounded(value, name):
 #: The design's centroid points away from the target when it is further than this fraction of
 #: the image width from the target's column.
 OFF_TARGET_FRACTION = 0.125
-#: The target is centred when the design's centroid is within this fraction of the image
-#: width from the centre (for the oscillation metric).
-CENTRED_FRACTION = 0.125
 
 
 def compute_metrics(
@@ -134,8 +131,8 @@ def compute_metrics(
     at_fault_collisions : int
         Collisions with a person the robot drove into (``World.at_fault_collisions``).
     width : int, optional
-        The image width, pixels: the oscillation metric needs the centre of the image
-        (without it, or without ``cmd_w``/``centroid_x``, the metric is None).
+        The image width, pixels: the centroid and LED metrics need it (without it they are
+        None).
     absent : collection of str
         ``DESIGN_OUTPUTS`` the design does not produce (their trajectory entries are NaN): the
         metrics made of them are None, and ``absent_outputs`` lists them.
@@ -227,7 +224,7 @@ def compute_metrics(
         "tipped_over_at_s": _time(tipped[0][0]) if tipped else None,
         "tip_overs": len(tipped),
         "max_wheel_command_step_dps": _max_command_step(traj),
-        "oscillation_hz": _oscillation(traj, width, n * frame_period),
+        "oscillation_hz": _oscillation(traj, n * frame_period),
         **_off_target(traj, width, margin_x, lit_strip),
         "led_wrong_side_fraction": _led_wrong_side(traj, width, margin_x, lit_strip),
         "led_misplaced_fraction": _led_misplaced(traj, width, margin_x, lit_strip),
@@ -240,9 +237,11 @@ def compute_metrics(
 
 def _heading_overshoot(traj, mount=None):
     """How far the robot turns past the target, degrees: the largest bearing error on the far
-    side once the error has changed sign, over frames with the target's centre in view (a
-    frame out of view starts afresh). The bearing error is the turn in place that would put
-    the target on the camera's axis (``_aim_error``; the camera at ``mount``, a
+    side once the error has changed sign, over frames with the target's centre in view and the
+    frames out of view in which the robot goes on turning away from the target (a turn that
+    carries the target out of the image on the far side is the largest overshoot, not none);
+    any other frame out of view starts afresh. The bearing error is the turn in place that
+    would put the target on the camera's axis (``_aim_error``; the camera at ``mount``, a
     ``connectors.base.Mount``, or at the robot's centre along its heading without one), so a
     camera yawed on its mount is on the target when the robot's body is not. Meaningful with a
     standing target (a step response, e.g. ``approach`` with ``robot.heading_deg=20``); a
@@ -255,9 +254,12 @@ def _heading_overshoot(traj, mount=None):
     if not in_view.any():
         return None
     b = np.degrees(_aim_error(traj, mount))
+    # The robot's own turn since the last frame, left positive: it turns away from the target
+    # when that turn is against the error's sign (the error grows by it).
+    turn = np.diff(np.unwrap(np.asarray(traj["heading"], dtype=float)), prepend=np.nan)
     best, last, crossed = 0.0, 0.0, False
-    for bk, seen in zip(b, in_view):
-        if not seen:
+    for bk, seen, tk in zip(b, in_view, turn):
+        if not seen and not (crossed and tk * bk < 0):
             last, crossed = 0.0, False
             continue
         sign = np.sign(bk)
@@ -463,31 +465,30 @@ def _max_command_step(traj):
     return int(max(steps))
 
 
-def _oscillation(traj, width, seconds):
+def _oscillation(traj, seconds):
     """Sign changes of the commanded turn rate W per second while the design reports the
-    target found within ``CENTRED_FRACTION`` of the image width from the centre: a steering
-    that swings left-right-left around a centred target. Frames with W = 0 (straight ahead)
-    keep the last sign, so left-straight-right counts once; a frame off-centre starts the
-    count afresh. Per second of centred time; None if the target was never centred, or
-    without the fields."""
-    if width is None or "cmd_w" not in traj or "centroid_x" not in traj or seconds <= 0:
+    target found: a steering that swings left-right-left about the target. Frames with W = 0
+    (straight ahead) keep the last sign, so left-straight-right counts once; a frame without
+    the target starts the count afresh (a search turns one way). Every found frame counts,
+    wherever the centroid is: a swing wide enough to carry the target off-centre is the worst
+    oscillation, not none (a tracker's W points to the target's side off-centre, so it flips
+    only as the target crosses the centre). Per second of found time; None if the target was
+    never found, or without ``cmd_w``."""
+    if "cmd_w" not in traj or seconds <= 0:
         return None
-    w = np.asarray(traj["cmd_w"], dtype=float)
-    centred = traj["found"] & (
-        np.abs(np.asarray(traj["centroid_x"]) - width / 2) <= CENTRED_FRACTION * width
-    )
-    if not centred.any():
+    found = np.asarray(traj["found"], bool)
+    if not found.any():
         return None
     flips, last = 0, 0.0
-    for wk, ck in zip(np.sign(w), centred):
-        if not ck:
+    for wk, fk in zip(np.sign(np.asarray(traj["cmd_w"], dtype=float)), found):
+        if not fk:
             last = 0.0
         elif wk != 0:
             flips += bool(last * wk < 0)
             last = wk
-    # Sign changes over the centred frames' time: to 1e-6 Hz, free of the float noise of
-    # the frame period (3 in 3 s is 1 Hz, at a limit of 1 Hz).
-    return round(flips / (seconds * centred.mean()), 6)
+    # Sign changes over the found frames' time: to 1e-6 Hz, free of the float noise of the
+    # frame period (3 in 3 s is 1 Hz, at a limit of 1 Hz).
+    return round(flips / (seconds * found.mean()), 6)
 
 
 def format_summary(s):
