@@ -185,8 +185,11 @@ class DesignSpec:
 
     def source_files(self):
         """The files a design of one's own was loaded from: its file, then the modules it
-        imported beside it; none for a built-in, an installed or a Verilog design."""
-        return _design_files(self.reference) if self.kind == "amaranth" else ()
+        imported beside it (a ``package.module:Name`` design: its module's file, then those of
+        its package); none for a built-in or a Verilog design."""
+        if self.kind != "amaranth":
+            return ()
+        return _design_files(self.reference) or _module_files(self.reference)
 
     def build(self):
         """A new Amaranth component of the design (a built-in one at its default
@@ -321,6 +324,29 @@ def _design_files(reference):
         return ()
     where = str(Path(where))
     return (where, *_IMPORTED_BESIDE.get(where, ()))
+
+
+def _module_files(reference):
+    """The files of a ``package.module:Name`` design: its module's, then those of the other
+    modules loaded from its package's folder (a flat module's: its own folder), which it may
+    import; a file written over them would lose the design's source."""
+    module = sys.modules.get(reference.rpartition(":")[0])
+    own = getattr(module, "__file__", None)
+    if own is None:
+        return ()
+    root = sys.modules.get(module.__name__.partition(".")[0])
+    top = getattr(root, "__file__", None) or own
+    # A package's folder holds its __init__.py; a flat module's folder holds the module.
+    folder = Path(top).parent
+    others = sorted(
+        {
+            file
+            for m in list(sys.modules.values())
+            if (file := getattr(m, "__file__", None)) and folder in Path(file).parents
+        }
+        - {own}
+    )
+    return (own, *others)
 
 
 def _stamps(files):
