@@ -187,9 +187,7 @@ class DesignSpec:
         """The files a design of one's own was loaded from: its file, then the modules it
         imported beside it (a ``package.module:Name`` design: its module's file, then those of
         its package); none for a built-in or a Verilog design."""
-        if self.kind != "amaranth":
-            return ()
-        return _design_files(self.reference) or _module_files(self.reference)
+        return design_source_files(self.reference) if self.kind == "amaranth" else ()
 
     def build(self):
         """A new Amaranth component of the design (a built-in one at its default
@@ -324,6 +322,15 @@ def _design_files(reference):
         return ()
     where = str(Path(where))
     return (where, *_IMPORTED_BESIDE.get(where, ()))
+
+
+def design_source_files(reference):
+    """The source files of a resolved design of one's own (``DesignSpec.reference``, a
+    scenario's ``top``): its file, then the modules it imported beside it, or a
+    ``package.module:Name`` design's module, then its package's; none for a built-in name."""
+    if reference in TOPS or reference.startswith("verilog:"):
+        return ()
+    return _design_files(reference) or _module_files(reference)
 
 
 def _module_files(reference):
