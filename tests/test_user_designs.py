@@ -552,6 +552,56 @@ def test_bad_references_are_one_line_errors(
     assert sorted(p.name for p in tmp_path.iterdir() if p.name != "__pycache__") == before
 
 
+def _package(folder, name):
+    """A package ``name`` in ``folder``: ``top.D`` drives at ``parts.SPEED``, imported
+    relatively."""
+    package = folder / name
+    package.mkdir()
+    (package / "__init__.py").write_text("")
+    (package / "parts.py").write_text("SPEED = 210\n")
+    (package / "top.py").write_text(
+        "from amaranth import Module, signed\n"
+        "from amaranth.lib import wiring\n"
+        "from amaranth.lib.wiring import Out\n\n"
+        "from .parts import SPEED\n\n\n"
+        "class D(wiring.Component):\n"
+        "    motor_left: Out(signed(16))\n"
+        "    motor_right: Out(signed(16))\n\n"
+        "    def elaborate(self, platform):\n"
+        "        m = Module()\n"
+        "        m.d.sync += [self.motor_left.eq(SPEED), self.motor_right.eq(-SPEED)]\n"
+        "        return m\n"
+    )
+    return package
+
+
+def test_a_package_module_reference_is_found_in_the_current_folder(tmp_path, monkeypatch):
+    # As python -m fpga_robotics finds it: the fpga-robotics script's path has no current
+    # folder, and this session's path has no tmp_path.
+    name = f"ud_pkg_{tmp_path.name}"
+    _package(tmp_path, name)
+    assert str(tmp_path) not in sys.path
+    monkeypatch.chdir(tmp_path)
+    try:
+        spec = resolve_design(f"{name}.top:D")
+        assert spec.ports == {"motor_left": ("out", 16), "motor_right": ("out", 16)}
+        assert str(tmp_path) not in sys.path  # put back after the import
+    finally:
+        for module in [m for m in sys.modules if m.partition(".")[0] == name]:
+            del sys.modules[module]
+
+
+def test_a_package_s_file_named_as_a_file_says_how_to_name_it(tmp_path):
+    package = _package(tmp_path, "ud_pkg_as_file")
+    with pytest.raises(DesignError) as info:
+        resolve_design(f"{package}/top.py:D")
+    assert str(info.value).endswith(
+        "ImportError: attempted relative import with no known parent package; top.py is a "
+        f"module of the package 'ud_pkg_as_file': name it ud_pkg_as_file.top:D, running in "
+        f"{str(tmp_path)!r} (or install the package)"
+    )
+
+
 def test_a_design_without_a_clock_is_refused_where_it_would_be_simulated(
     tmp_path, capsys, monkeypatch
 ):

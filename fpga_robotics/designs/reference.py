@@ -611,11 +611,12 @@ def _load_target(reference):
         module = _load_file(Path(where), reference)
     else:
         try:
-            module = importlib.import_module(where)
+            module = _import_module(where)
         except ModuleNotFoundError as exc:
             raise DesignError(
-                f"design {reference!r}: no module {exc.name!r}; install the "
-                f"package or give the file as path/to/file.py:{name}"
+                f"design {reference!r}: no module {exc.name!r} in the current folder or the "
+                f"installed packages; install the package, run in the folder that holds it, "
+                f"or give the file as path/to/file.py:{name}"
             ) from None
         except USER_CODE_ERRORS as exc:  # the user's module may raise anything
             raise DesignError(
@@ -648,6 +649,21 @@ def _load_target(reference):
     return target
 
 
+def _import_module(name):
+    """Import the module of a ``package.module:Name`` reference as ``python -m fpga_robotics``
+    finds it, with the current folder on the path: the ``fpga-robotics`` script's path lacks
+    it. Last on the path, so that nothing installed is hidden by a folder of the same name."""
+    folder = str(Path.cwd())
+    added = folder not in sys.path and "" not in sys.path
+    if added:
+        sys.path.append(folder)
+    try:
+        return importlib.import_module(name)
+    finally:
+        if added:
+            sys.path.remove(folder)
+
+
 def _load_file(path, reference):
     if not path.is_file():
         raise DesignError(
@@ -669,8 +685,27 @@ def _load_file(path, reference):
         raise DesignError(
             f"design {reference!r}: loading {path.name}{line} raised "
             f"{type(exc).__name__}: {_first_line(exc)}"
+            f"{_package_hint(exc, path, reference.rpartition(':')[2])}"
         ) from None
     return module
+
+
+def _package_hint(exc, path, name):
+    """How to name a file of a package that imports relatively (``from .parts import X``):
+    loaded as a file, it has no package."""
+    if not (isinstance(exc, ImportError) and "relative import" in str(exc)):
+        return ""
+    parts = [path.stem]
+    folder = path.parent
+    while (folder / "__init__.py").is_file():
+        parts.insert(0, folder.name)
+        folder = folder.parent
+    if len(parts) == 1:
+        return ""
+    return (
+        f"; {path.name} is a module of the package {parts[0]!r}: name it "
+        f"{'.'.join(parts)}:{name}, running in {str(folder)!r} (or install the package)"
+    )
 
 
 @contextlib.contextmanager
