@@ -1194,6 +1194,62 @@ def test_a_bad_enum_parameter_is_one_line_from_the_command_line(tmp_path, capsys
     assert code == 2 and "design.params.mode must be one of STOP, REVERSE" in err
 
 
+GENERIC_PARAMS = """
+from typing import Literal, Optional
+
+from amaranth import Module, signed
+from amaranth.lib import wiring
+from amaranth.lib.wiring import Out
+
+
+class Generic(wiring.Component):
+    motor_left: Out(signed(16))
+    motor_right: Out(signed(16))
+
+    def __init__(self, limit: Optional[int] = None, cap: float | None = 2.0,
+                 side: Literal["left", "right"] = "left", taps: tuple[int, ...] = (1,),
+                 gains: list[float] = [1.0], pair: tuple[int, str] = (1, "a"),
+                 either: int | str = 0):
+        self.limit, self.cap, self.side, self.taps = limit, cap, side, taps
+        self.gains, self.pair, self.either = gains, pair, either
+        super().__init__()
+
+    def elaborate(self, platform):
+        m = Module()
+        m.d.sync += self.motor_left.eq(1)
+        return m
+"""
+
+
+def test_generic_annotations_check_what_they_say(tmp_path):
+    # Optional, Literal and the items of list[X] and tuple[...], by their annotation's words.
+    (tmp_path / "generic.py").write_text(GENERIC_PARAMS)
+    reference = f"{tmp_path}/generic.py:Generic"
+    design = _built(
+        reference,
+        {"limit": 7, "cap": None, "side": "right", "taps": [3, 4], "gains": [2], "either": "x"},
+    )
+    assert (design.limit, design.cap, design.side) == (7, None, "right")
+    assert (design.taps, design.gains, design.either) == ((3, 4), [2.0], "x")
+    assert type(design.gains[0]) is float
+    assert _built(reference, {"limit": None, "pair": [2, "b"]}).pair == (2, "b")
+    for key, bad, words in (
+        ("limit", "x", "an integer"),
+        ("cap", "high", "a number"),
+        ("side", "up", "one of 'left', 'right'"),
+        ("side", 1, "one of 'left', 'right'"),
+        ("taps", [1.5], "an array of integers"),
+        ("gains", [1, "a"], "an array of numbers"),
+        ("pair", [1, 2], "an array of 2 items (an integer, a string)"),
+        ("pair", [1], "an array of 2 items (an integer, a string)"),
+    ):
+        with pytest.raises(DesignError) as info:
+            resolve_design(reference, {key: bad})
+        assert str(info.value) == (
+            f"design.params.{key} must be {words} (a parameter of Generic), got {bad!r}"
+        )
+
+
 @pytest.mark.slow
 def test_the_exported_verilog_drives_as_its_amaranth_design(tmp_path, capsys):
     """Round trip: wall_stop.py exported, run as Verilog through a port map, gives the

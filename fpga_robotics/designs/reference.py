@@ -32,6 +32,7 @@ import inspect
 import re
 import sys
 import traceback
+import types
 import typing
 import warnings
 from dataclasses import dataclass, field
@@ -793,7 +794,21 @@ def _check_params(target, params, reference):
                 f"{{where}}: {name} takes no parameter {key!r}{hint}; it takes: "
                 f"{', '.join(known) or 'none'}",
             )
-        expected = _expected_type(known[key])
+        parameter = known[key]
+        annotation, optional = _annotation(parameter)
+        if value is None and (optional or parameter.default is None):
+            continue
+        if typing.get_origin(annotation) is typing.Literal:
+            choices = typing.get_args(annotation)
+            # 1 is not True, nor 1.0 a choice of 1: the value's type is the choice's.
+            if not any(type(value) is type(c) and value == c for c in choices):
+                raise _ParamError(
+                    key,
+                    f"{{where}} must be one of {', '.join(map(repr, choices))} (a parameter "
+                    f"of {name}), got {value!r}",
+                )
+            continue
+        expected = _expected_type(parameter)
         if expected is None:
             continue
         if issubclass(expected, enum.Enum):
@@ -809,8 +824,17 @@ def _check_params(target, params, reference):
                 key,
                 f"{{where}} must be {_type_name(expected)} (a parameter of {name}), got {value!r}",
             )
-        elif expected in (list, tuple, float):
-            values[key] = expected(value)
+        elif expected is float:
+            values[key] = float(value)
+        elif expected in (list, tuple):
+            items = _items(annotation, value)
+            if items is None:
+                raise _ParamError(
+                    key,
+                    f"{{where}} must be {_items_name(annotation)} (a parameter of {name}), "
+                    f"got {value!r}",
+                )
+            values[key] = expected(items)
     missing = [n for n, p in known.items() if p.default is p.empty and n not in params]
     if missing:
         raise _ParamError(
@@ -847,7 +871,9 @@ def _signature_parameters(target):
     return known, takes_any
 
 
-def _expected_type(parameter):
+def _annotation(parameter):
+    """``(annotation, optional)``: the parameter's annotation without ``None`` (of
+    ``Optional[X]``, ``X | None``) and whether it takes ``None``."""
     annotation = parameter.annotation
     if isinstance(annotation, str):  # from __future__ import annotations
         annotation = {
@@ -858,6 +884,49 @@ def _expected_type(parameter):
             "list": list,
             "tuple": tuple,
         }.get(annotation)
+    if typing.get_origin(annotation) in (typing.Union, types.UnionType):
+        args = typing.get_args(annotation)
+        others = [a for a in args if a is not type(None)]
+        if len(others) == 1:
+            return others[0], len(others) < len(args)
+        return typing.Any, type(None) in args  # a union of several types: not checked
+    return annotation, False
+
+
+def _items(annotation, value):
+    """The items of the array ``value`` as ``list[X]``, ``tuple[X, ...]`` or ``tuple[X, Y]``
+    take them (a float item's integer as a float), or None when one does not fit; any items
+    for a bare ``list`` or ``tuple`` or an item type that is not checked."""
+    args = typing.get_args(annotation)
+    if not args:
+        return list(value)
+    if typing.get_origin(annotation) is tuple and not (len(args) == 2 and args[1] is ...):
+        if len(args) != len(value):
+            return None
+        kinds = args
+    else:
+        kinds = [args[0]] * len(value)
+    items = []
+    for item, kind in zip(value, kinds, strict=True):
+        if kind in (int, float, bool, str) and not _fits(item, kind):
+            return None
+        items.append(float(item) if kind is float else item)
+    return items
+
+
+def _items_name(annotation):
+    args = typing.get_args(annotation)
+    names = {int: "integers", float: "numbers", bool: "true or false values", str: "strings"}
+    if typing.get_origin(annotation) is tuple and not (len(args) == 2 and args[1] is ...):
+        kinds = [_type_name(a) if a in names else getattr(a, "__name__", str(a)) for a in args]
+        return f"an array of {len(args)} items ({', '.join(kinds)})"
+    return f"an array of {names[args[0]]}"
+
+
+def _expected_type(parameter):
+    annotation = _annotation(parameter)[0]
+    if annotation is typing.Any:
+        return None
     annotation = typing.get_origin(annotation) or annotation  # list[int] is a list
     if annotation in (int, float, bool, str, list, tuple) or _is_enum(annotation):
         return annotation
