@@ -269,6 +269,12 @@ def misnamed_stream():
 def output_pixel_stream():
     # The camera's stream with its direction turned: the run passed, the design seeing nothing.
     return Ports({**WHEELS, "pixels": Out(pixel_stream_signature()), "frame_done": Out(1)})
+
+
+def stallable_output_stream():
+    from amaranth.lib import stream
+
+    return Ports({**WHEELS, "events": Out(stream.Signature(8))})
 """
 
 
@@ -349,6 +355,24 @@ def test_a_misnamed_pixel_stream_is_told_how_the_camera_streams_to_it(tmp_path, 
     assert (
         "nothing drives its input 'pixel__payload'; to stream the camera to it, name it "
         'pixels or declare connectors = {"camera": {"pixels": "pixel"}}'
+    ) in err
+
+
+def test_an_output_stream_s_ready_is_told_to_go(tmp_path, capsys):
+    # Nothing takes a stream from the design: its ready input, undriven, was told to be
+    # bound to a connector pin, which no connector has.
+    (tmp_path / "partial.py").write_text(PARTIAL)
+    reference = f"{tmp_path / 'partial.py'}:stallable_output_stream"
+    (tmp_path / "s.toml").write_text(STRAIGHT.format(top=reference))
+    argv = ["run", "--scenario", str(tmp_path / "s.toml"), "--backend", "pysim", "--rerun", "off"]
+    with pytest.raises(SystemExit) as info:
+        cli.main(argv)
+    err = capsys.readouterr().err
+    assert info.value.code == 2 and len(err.strip().splitlines()) == 1, err
+    assert (
+        "nothing drives its input 'events__ready'; it is the ready of its output stream "
+        "'events', which nothing here takes (its valid and payload are recorded); declare it "
+        "stream.Signature(..., always_ready=True)"
     ) in err
 
 
