@@ -271,6 +271,20 @@ def output_pixel_stream():
     return Ports({**WHEELS, "pixels": Out(pixel_stream_signature()), "frame_done": Out(1)})
 
 
+def narrow_pixel_stream():
+    from amaranth.lib import stream
+
+    return Ports({**WHEELS, "pixels": In(stream.Signature(8, always_ready=True))})
+
+
+def stallable_pixel_stream():
+    from amaranth.lib import stream
+
+    from fpga_robotics.hw.pixel import FramedPixel
+
+    return Ports({**WHEELS, "pixels": In(stream.Signature(FramedPixel)), "frame_done": Out(1)})
+
+
 def stallable_output_stream():
     from amaranth.lib import stream
 
@@ -312,6 +326,25 @@ def stallable_output_stream():
                 "pixels__valid of 1 bit and pixels__payload of 14 bits, "
                 "In(fpga_robotics.hw.pixel.pixel_stream_signature())); its ports: motor_left, "
                 "motor_right, pixels"
+            ),
+        ),
+        (
+            # A stream of another payload: bound, it was refused only by a run's backend.
+            "narrow_pixel_stream",
+            (
+                "design Ports: port 'pixels' is not the camera's pixel stream (ports "
+                "pixels__valid of 1 bit and pixels__payload of 14 bits, "
+                "In(fpga_robotics.hw.pixel.pixel_stream_signature())); its ports: motor_left, "
+                "motor_right, pixels__payload, pixels__valid"
+            ),
+        ),
+        (
+            # A stream with ready: the camera streamed on, the pixels not taken were lost.
+            "stallable_pixel_stream",
+            (
+                "design Ports: port 'pixels' is not the camera's pixel stream: it has a ready "
+                "output, pixels__ready, and a camera does not wait; declare it "
+                "In(fpga_robotics.hw.pixel.pixel_stream_signature()), a stream always ready"
             ),
         ),
         (

@@ -1097,6 +1097,11 @@ def bindings_of(component, ports, given=None):
             continue
         if kind == "camera":
             if all(ports.get(p, ("",))[0] == "in" for p in CAMERA_PORTS):
+                _check_stream(
+                    "pixels",
+                    ports,
+                    f"design {name}: port 'pixels' is not the camera's pixel stream",
+                )
                 bindings[kind] = {
                     "pixels": "pixels",
                     **({"color_sel": "color_sel"} if "color_sel" in ports else {}),
@@ -1240,9 +1245,16 @@ def _check_stream(port, ports, problem):
     """``DesignError`` saying ``problem`` unless ``port`` names a pixel stream input of the
     design: a 1-bit ``PORT__valid`` and a 14-bit ``PORT__payload``
     (``In(pixel_stream_signature())``)."""
-    valid, payload = f"{port}__valid", f"{port}__payload"
+    valid, payload, ready = f"{port}__valid", f"{port}__payload", f"{port}__ready"
     if ports.get(valid) == ("in", 1) and ports.get(payload) == ("in", 14):
-        return
+        if ready not in ports:
+            return
+        # The camera streams a pixel a clock whatever the design says: pixels it is not
+        # ready for would be lost without a word.
+        raise DesignError(
+            f"{problem}: it has a ready output, {ready}, and a camera does not wait; declare "
+            "it In(fpga_robotics.hw.pixel.pixel_stream_signature()), a stream always ready"
+        )
     raise DesignError(
         f"{problem} (ports {valid} of 1 bit and {payload} of 14 bits, "
         f"In(fpga_robotics.hw.pixel.pixel_stream_signature())); its ports: {', '.join(ports)}"
