@@ -285,6 +285,10 @@ def stallable_pixel_stream():
     return Ports({**WHEELS, "pixels": In(stream.Signature(FramedPixel)), "frame_done": Out(1)})
 
 
+def narrow_color_sel():
+    return Ports({**WHEELS, "pixels": In(pixel_stream_signature()), "color_sel": In(2)})
+
+
 def stallable_output_stream():
     from amaranth.lib import stream
 
@@ -345,6 +349,14 @@ def stallable_output_stream():
                 "design Ports: port 'pixels' is not the camera's pixel stream: it has a ready "
                 "output, pixels__ready, and a camera does not wait; declare it "
                 "In(fpga_robotics.hw.pixel.pixel_stream_signature()), a stream always ready"
+            ),
+        ),
+        (
+            # Red (4) did not fit: a run stopped at its first frame, green ran as green.
+            "narrow_color_sel",
+            (
+                "design Ports: port 'color_sel' (the camera's color_sel) is input of 2 bits; "
+                "the colour select is 3 bits: In(3) or In(fpga_robotics.hw.pixel.TargetColor)"
             ),
         ),
         (

@@ -1135,6 +1135,14 @@ def bindings_of(component, ports, given=None):
         _check_wheels(component, bindings["wheels"])
     if "camera" in bindings:
         _check_frame_outputs(component)
+        select = bindings["camera"].get("color_sel")
+        if select is not None and ports[select] != ("in", 3):
+            # A narrower port lost the colour's high bits (red, 4, was refused mid-run).
+            raise DesignError(
+                f"design {name}: port {select!r} (the camera's color_sel) is "
+                f"{ports[select][0]}put of {ports[select][1]} bits; the colour select is 3 "
+                "bits: In(3) or In(fpga_robotics.hw.pixel.TargetColor) (docs/contract.md)"
+            )
     return bindings
 
 
