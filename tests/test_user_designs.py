@@ -650,6 +650,54 @@ def test_a_design_with_an_instance_is_refused_where_it_would_be_simulated(
     assert code == 0 and "my_ip ip (" in (tmp_path / "bb.v").read_text()
 
 
+UNDEFINED_DOMAIN = """
+from amaranth import Module, Signal, signed
+from amaranth.lib import wiring
+from amaranth.lib.wiring import In, Out
+
+
+class Fast(wiring.Component):
+    pressed: In(1)
+    ext_clk: In(1)  # a port of its own whose name ends as a domain's clock does
+    motor_left: Out(signed(16))
+    motor_right: Out(signed(16))
+
+    def elaborate(self, platform):
+        m = Module()
+        seen = Signal()
+        m.d.fast += seen.eq(self.pressed | self.ext_clk)
+        m.d.sync += self.motor_left.eq(seen)
+        return m
+"""
+
+
+def test_a_domain_used_and_not_defined_is_refused_where_nothing_would_clock_it(
+    tmp_path, capsys, monkeypatch
+):
+    # Amaranth made it a fast_clk input: a run passed with its flip-flops never clocked, the
+    # board stopped with a traceback. Export writes it with that input, for a top of one's own.
+    (tmp_path / "fast.py").write_text(UNDEFINED_DOMAIN)
+    spec = resolve_design(f"{tmp_path}/fast.py:Fast", {})
+    assert spec.free_domains == ("fast",)
+    assert resolve_design(str(DESIGNS / "wall_stop.py") + ":WallStop", {}).free_domains == ()
+    message = (
+        "uses clock domain 'fast' (m.d.fast) without defining it, so nothing here clocks it "
+        "(Amaranth makes it an input fast_clk): use m.d.sync, or define it (m.domains.fast = "
+        "ClockDomain(...)) and drive its clock in the design"
+    )
+    monkeypatch.chdir(tmp_path)
+    for argv in (
+        ["run", "--scenario", str(WALL_STOP), "--design", "fast.py:Fast",
+         "--backend", "pysim", "--rerun", "off", "--set", "design.params={}"],
+        ["mutate", "--design", "fast.py:Fast", "--mutants", "2", "--quiet"],
+        ["board", "--design", "fast.py:Fast", "-o", "board"],
+    ):  # fmt: skip
+        code, _, err = _cli(argv, capsys)
+        assert code == 2 and len(err.strip().splitlines()) == 1 and message in err, err
+    code, _, _ = _cli(["export", "--design", "fast.py:Fast", "-o", "fast.v"], capsys)
+    assert code == 0 and "input fast_clk;" in (tmp_path / "fast.v").read_text()
+
+
 def test_a_scenario_names_its_design_relative_to_its_folder(tmp_path):
     shutil.copy(DESIGNS / "wall_stop.py", tmp_path / "mine.py")
     text = WALL_STOP.read_text().replace("wall_stop.py:WallStop", "mine.py:WallStop")

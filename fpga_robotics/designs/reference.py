@@ -121,6 +121,9 @@ class DesignSpec:
     black_boxes : tuple
         The modules an Amaranth design of one's own instantiates (``Instance``) without
         defining them: Verilog or vendor cells no simulator here has.
+    free_domains : tuple
+        The clock domains an Amaranth design of one's own uses (``m.d.fast``) without defining
+        them: Amaranth makes each an input clock ``fast_clk`` that nothing here drives.
     signed : frozenset
         The names of its ports of a signed shape (``ports`` has direction and width).
     netlist_digest : str
@@ -139,6 +142,7 @@ class DesignSpec:
     port_map: object = None
     clocked: bool = True
     black_boxes: tuple = ()
+    free_domains: tuple = ()
     signed: frozenset = frozenset()
     netlist_digest: str = ""
 
@@ -182,6 +186,18 @@ class DesignSpec:
                 f"design {self.reference!r} instantiates {self.black_boxes[0]!r} (an "
                 "Instance), which the simulators here cannot run: only export and board "
                 "take it"
+            )
+
+    def require_defined_domains(self):
+        """``DesignError`` for a design that uses a clock domain it does not define: no
+        simulator or board here drives its clock, so its registers would never change."""
+        if self.free_domains:
+            name = self.free_domains[0]
+            raise DesignError(
+                f"design {self.reference!r} uses clock domain {name!r} (m.d.{name}) without "
+                f"defining it, so nothing here clocks it (Amaranth makes it an input "
+                f"{name}_clk): use m.d.sync, or define it (m.domains.{name} = "
+                f"ClockDomain(...)) and drive its clock in the design"
             )
 
     def source_files(self):
@@ -421,7 +437,9 @@ def _amaranth_spec(reference, params):
     values = _check_params(target, params, reference)
     factory = functools.partial(_call, target, values, reference)
     component = factory()
-    clocked, black_boxes, netlist_digest = _check_elaborates(component, target, reference)
+    clocked, black_boxes, free_domains, netlist_digest = _check_elaborates(
+        component, target, reference
+    )
     signed = signed_ports(component)
     ports = component_ports(component)
     _check_port_names(ports, reference.rpartition(":")[2])
@@ -453,6 +471,7 @@ def _amaranth_spec(reference, params):
         top,
         clocked=clocked,
         black_boxes=black_boxes,
+        free_domains=free_domains,
         signed=signed,
         netlist_digest=netlist_digest,
     )
@@ -482,9 +501,8 @@ def _check_elaborates(component, target, reference):
     # Its ports as export and the board have them: each in its declared direction, so that
     # an input the design drives is a conflict here too, not only when exported.
     ports = directed_ports(component)
-    inputs = {
-        id(value): name for name, (value, flow) in verilog_ports(component).items() if flow == "i"
-    }
+    declared = verilog_ports(component)
+    inputs = {id(value): name for name, (value, flow) in declared.items() if flow == "i"}
     try:
         with warnings.catch_warnings(record=True) as said:
             warnings.simplefilter("always")
@@ -526,7 +544,14 @@ def _check_elaborates(component, target, reference):
     defined = set(re.findall(r"^module \\(\S+)$", text, re.MULTILINE))
     used = re.findall(r"^ +cell \\(\S+) ", text, re.MULTILINE)
     black_boxes = tuple(dict.fromkeys(name for name in used if name not in defined))
-    return clocked, black_boxes, hashlib.sha256(text.encode()).hexdigest()
+    # A domain used and defined nowhere: Amaranth makes its clock an input NAME_clk of the top.
+    top = text[: text.index("\nend\n")]
+    free = tuple(
+        name.removesuffix("_clk")
+        for name in re.findall(r"^  wire width 1 input \d+ +\\(\S+_clk)$", top, re.MULTILINE)
+        if name not in declared
+    )
+    return clocked, black_boxes, free, hashlib.sha256(text.encode()).hexdigest()
 
 
 def _driven_input(fragment, inputs):
