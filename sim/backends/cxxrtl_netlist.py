@@ -13,6 +13,7 @@ __all__ = [
     "OUTPUTS",
     "commit_wires",
     "fast_commit",
+    "internal_clocks",
     "mangle",
     "model_header",
     "output_sources",
@@ -39,6 +40,19 @@ _IDENT = re.compile(r"\b([pi]_\w+)\b(\.curr\b|\.next\b)?")
 def mangle(name):
     """CXXRTL's C++ name of a simple identifier: ``p_`` and every ``_`` doubled."""
     return "p_" + name.replace("_", "__")
+
+
+#: An edge detector on a wire of the model (``p_div.curr`` against ``p_div.next``), not on an
+#: input port (``prev_p_clk``): a clock the design drives itself.
+_WIRE_EDGE = re.compile(r"bool (?:pos|neg)edge_(\w+)\(\) const \{\s*return !?\1\.curr\b")
+
+
+def internal_clocks(source):
+    """The model's wires (C++ names) that clock flip-flops: clocks the design derives itself
+    (a divider's register, ``ClockSignal("half")`` driven by logic). CXXRTL tests such an edge
+    at the start of ``eval()``, before the edge that makes it, and never sees it (Yosys issue
+    #3549): those flip-flops never change."""
+    return _WIRE_EDGE.findall(source)
 
 
 def _eval_span(source):
