@@ -18,8 +18,8 @@ from ..backends.base import BackendError
 from ..backends.compiled import HARNESS_DIR
 from ..backends.cxxrtl import CXX_FLAGS as CXXRTL_FLAGS
 from ..backends.cxxrtl_netlist import (
+    check_clocks,
     fast_commit,
-    internal_clocks,
     output_sources,
     with_wire_copies_inlined,
     without_port_copies,
@@ -104,14 +104,7 @@ def cxxrtl_plan(source):
     # Each model compiles against the runtime headers of the Yosys that wrote it.
     include = runtime_include_dir() if foreign else cxxrtl_include_dir()
     outputs = tuple(p.name for p in source.ports.values() if p.direction == "out")
-    clocks = internal_clocks(source.cxxrtl)
-    if clocks:
-        # Its flip-flops on that clock would hold their initial values: a wrong run.
-        raise BackendError(
-            f"{source.key} clocks flip-flops from a signal of its own ({clocks[0]} in the "
-            "CXXRTL model), whose edges CXXRTL misses (Yosys issue #3549): run it with "
-            "--backend verilator or pysim"
-        )
+    check_clocks(source.cxxrtl, source.key, "verilator or pysim")
     model, exprs, commit = _fast_model(source.cxxrtl, outputs)
     accessors = cxxrtl_accessors(source, exprs, commit)
     harness = _sources("pin_cxxrtl.cpp", _DRIVER, "cxxrtl_clock.h")
