@@ -918,6 +918,18 @@ def test_a_shadow_parameter_without_default_is_asked_for_by_shadow_param(tmp_pat
     assert "give it with --shadow-param gap=VALUE" in err
 
 
+def test_a_bad_shadow_param_value_is_told_as_that_option(tmp_path, capsys):
+    # It was said as design.params.stop_mm, a key the scenario file has with a good value.
+    argv = ["run", "--scenario", str(WALL_STOP), "--rerun", "off"]
+    argv += ["--shadow", f"{DESIGNS}/wall_stop.py:WallStop", "--shadow-param", "stop_mm=near"]
+    code, _, err = _cli(argv, capsys)
+    assert code == 2
+    assert err == (
+        "fpga-robotics run: error: --shadow-param stop_mm must be an integer (a parameter of "
+        "WallStop), got 'near'\n"
+    )
+
+
 _BUMP_STOP_AMARANTH = """
 from amaranth import Module, Signal, signed
 from amaranth.lib import wiring

@@ -506,7 +506,14 @@ def _shadow_scenario(scenario, spec, ports, params, design_params):
         try:
             return scenario.with_overrides(overrides)
         except ScenarioError as exc:
-            raise UsageError(f"--shadow {spec}: {exc}") from None
+            text = str(exc)
+            for name in (item.partition("=")[0].strip() for item in params):
+                # A value given as --shadow-param is that option's, not [design.params]'.
+                if text.startswith(f"design.params.{name} "):
+                    raise UsageError(
+                        f"--shadow-param {name}{text[len(f'design.params.{name}') :]}"
+                    ) from None
+            raise UsageError(f"--shadow {spec}: {text}") from None
     if params:
         raise UsageError(
             f"--shadow-param: a Verilog shadow design ({spec}) takes no parameters; "
