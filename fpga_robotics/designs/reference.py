@@ -352,25 +352,26 @@ def design_source_files(reference):
 
 def _module_files(reference):
     """The files of a ``package.module:Name`` design: its module's, then those of the other
-    modules loaded from its package's folder (a flat module's: its own folder), which it may
-    import; a file written over them would lose the design's source."""
+    modules loaded from its package's folder (a flat module's: the modules beside it), which
+    it may import; a file written over them would lose the design's source."""
     module = sys.modules.get(reference.rpartition(":")[0])
     own = getattr(module, "__file__", None)
     if own is None:
         return ()
     root = sys.modules.get(module.__name__.partition(".")[0])
-    top = getattr(root, "__file__", None) or own
-    # A package's folder holds its __init__.py; a flat module's folder holds the module.
-    folder = Path(top).parent
-    others = sorted(
-        {
-            file
-            for m in list(sys.modules.values())
-            if (file := getattr(m, "__file__", None)) and folder in Path(file).parents
-        }
-        - {own}
-    )
-    return (own, *others)
+    if hasattr(root, "__path__") and getattr(root, "__file__", None):
+        folder = Path(root.__file__).parent  # the package's, with its subpackages
+
+        def mine(file):
+            return folder in Path(file).parents
+    else:
+        folder = Path(own).parent  # a flat module's, without the folders below it
+
+        def mine(file):
+            return Path(file).parent == folder
+
+    files = {f for m in list(sys.modules.values()) if (f := getattr(m, "__file__", None))}
+    return (own, *sorted(f for f in files - {own} if mine(f)))
 
 
 def _stamps(files):
