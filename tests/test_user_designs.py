@@ -591,15 +591,24 @@ def test_a_package_module_reference_is_found_in_the_current_folder(tmp_path, mon
             del sys.modules[module]
 
 
-def test_a_package_s_file_named_as_a_file_says_how_to_name_it(tmp_path):
+def test_a_package_s_file_named_as_a_file_says_how_to_name_it(tmp_path, monkeypatch):
     package = _package(tmp_path, "ud_pkg_as_file")
-    with pytest.raises(DesignError) as info:
-        resolve_design(f"{package}/top.py:D")
-    assert str(info.value).endswith(
+    hint = (
         "ImportError: attempted relative import with no known parent package; top.py is a "
         f"module of the package 'ud_pkg_as_file': name it ud_pkg_as_file.top:D, running in "
         f"{str(tmp_path)!r} (or install the package)"
     )
+    with pytest.raises(DesignError) as info:
+        resolve_design(f"{package}/top.py:D")
+    assert str(info.value).endswith(hint)
+    # Named as a module from inside the package's folder: the same advice.
+    monkeypatch.chdir(package)
+    try:
+        with pytest.raises(DesignError) as info:
+            resolve_design("top:D")
+        assert str(info.value).endswith(hint)
+    finally:
+        sys.modules.pop("top", None)
 
 
 def test_a_design_without_a_clock_is_refused_where_it_would_be_simulated(

@@ -646,9 +646,12 @@ def _load_target(reference):
                 f"or give the file as path/to/file.py:{name}"
             ) from None
         except USER_CODE_ERRORS as exc:  # the user's module may raise anything
+            # A module of a package named from inside the package's folder (top:Name).
+            file = Path.cwd() / f"{where.replace('.', '/')}.py"
+            hint = _package_hint(exc, file, name) if file.is_file() else ""
             raise DesignError(
                 f"design {reference!r}: importing {where} raised "
-                f"{type(exc).__name__}: {_first_line(exc)}"
+                f"{type(exc).__name__}: {_first_line(exc)}{hint}"
             ) from None
     target = getattr(module, name, None)
     if target is None:
