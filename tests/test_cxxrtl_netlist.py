@@ -144,3 +144,38 @@ def test_rewritten_build_matches_the_waveform_build(tmp_path):
     assert any(r.found for r in fast) and any(not r.found for r in fast)
     assert len({r.motor_left for r in fast}) > 2
     assert np.any(fast[-2].filtered)
+
+
+def test_a_clock_the_design_drives_is_refused_by_the_cxxrtl_frame_build():
+    # A divider's register clocking a counter (a Verilog design on the CXXRTL frame
+    # backend): CXXRTL never sees its edges (Yosys issue #3549), the counter would stay 0.
+    from amaranth import ClockDomain, ClockSignal, Module, Signal
+    from amaranth.lib import wiring
+    from amaranth.lib.wiring import Out
+
+    from fpga_robotics.hw.verilog import generate_cxxrtl
+    from fpga_robotics.sim.backends.base import BackendError
+    from fpga_robotics.sim.backends.cxxrtl import cxxrtl_build_plan
+
+    class HalfClock(wiring.Component):
+        ticks: Out(8)
+
+        def elaborate(self, platform):
+            m = Module()
+            m.domains.half = ClockDomain()
+            divider = Signal()
+            m.d.sync += divider.eq(~divider)
+            m.d.comb += ClockSignal("half").eq(divider)
+            m.d.half += self.ticks.eq(self.ticks + 1)
+            return m
+
+    class Source:
+        design, params = "half_clock", None
+
+        def cxxrtl(self):
+            return generate_cxxrtl(HalfClock())
+
+    with pytest.raises(BackendError, match=r"^half_clock clocks flip-flops from a signal of "):
+        cxxrtl_build_plan(Source(), "plain")
+    # FollowTarget clocks everything from its clk input: built as ever.
+    assert cxxrtl_build_plan(DesignSource(FollowTargetParams()), "plain") is not None

@@ -269,6 +269,30 @@ def misnamed_stream():
 def output_pixel_stream():
     # The camera's stream with its direction turned: the run passed, the design seeing nothing.
     return Ports({**WHEELS, "pixels": Out(pixel_stream_signature()), "frame_done": Out(1)})
+
+
+def narrow_pixel_stream():
+    from amaranth.lib import stream
+
+    return Ports({**WHEELS, "pixels": In(stream.Signature(8, always_ready=True))})
+
+
+def stallable_pixel_stream():
+    from amaranth.lib import stream
+
+    from fpga_robotics.hw.pixel import FramedPixel
+
+    return Ports({**WHEELS, "pixels": In(stream.Signature(FramedPixel)), "frame_done": Out(1)})
+
+
+def narrow_color_sel():
+    return Ports({**WHEELS, "pixels": In(pixel_stream_signature()), "color_sel": In(2)})
+
+
+def stallable_output_stream():
+    from amaranth.lib import stream
+
+    return Ports({**WHEELS, "events": Out(stream.Signature(8))})
 """
 
 
@@ -306,6 +330,33 @@ def output_pixel_stream():
                 "pixels__valid of 1 bit and pixels__payload of 14 bits, "
                 "In(fpga_robotics.hw.pixel.pixel_stream_signature())); its ports: motor_left, "
                 "motor_right, pixels"
+            ),
+        ),
+        (
+            # A stream of another payload: bound, it was refused only by a run's backend.
+            "narrow_pixel_stream",
+            (
+                "design Ports: port 'pixels' is not the camera's pixel stream (ports "
+                "pixels__valid of 1 bit and pixels__payload of 14 bits, "
+                "In(fpga_robotics.hw.pixel.pixel_stream_signature())); its ports: motor_left, "
+                "motor_right, pixels__payload, pixels__valid"
+            ),
+        ),
+        (
+            # A stream with ready: the camera streamed on, the pixels not taken were lost.
+            "stallable_pixel_stream",
+            (
+                "design Ports: port 'pixels' is not the camera's pixel stream: it has a ready "
+                "output, pixels__ready, and a camera does not wait; declare it "
+                "In(fpga_robotics.hw.pixel.pixel_stream_signature()), a stream always ready"
+            ),
+        ),
+        (
+            # Red (4) did not fit: a run stopped at its first frame, green ran as green.
+            "narrow_color_sel",
+            (
+                "design Ports: port 'color_sel' (the camera's color_sel) is input of 2 bits; "
+                "the colour select is 3 bits: In(3) or In(fpga_robotics.hw.pixel.TargetColor)"
             ),
         ),
         (
@@ -349,6 +400,24 @@ def test_a_misnamed_pixel_stream_is_told_how_the_camera_streams_to_it(tmp_path, 
     assert (
         "nothing drives its input 'pixel__payload'; to stream the camera to it, name it "
         'pixels or declare connectors = {"camera": {"pixels": "pixel"}}'
+    ) in err
+
+
+def test_an_output_stream_s_ready_is_told_to_go(tmp_path, capsys):
+    # Nothing takes a stream from the design: its ready input, undriven, was told to be
+    # bound to a connector pin, which no connector has.
+    (tmp_path / "partial.py").write_text(PARTIAL)
+    reference = f"{tmp_path / 'partial.py'}:stallable_output_stream"
+    (tmp_path / "s.toml").write_text(STRAIGHT.format(top=reference))
+    argv = ["run", "--scenario", str(tmp_path / "s.toml"), "--backend", "pysim", "--rerun", "off"]
+    with pytest.raises(SystemExit) as info:
+        cli.main(argv)
+    err = capsys.readouterr().err
+    assert info.value.code == 2 and len(err.strip().splitlines()) == 1, err
+    assert (
+        "nothing drives its input 'events__ready'; it is the ready of its output stream "
+        "'events', which nothing here takes (its valid and payload are recorded); declare it "
+        "stream.Signature(..., always_ready=True)"
     ) in err
 
 

@@ -159,6 +159,68 @@ def test_the_output_may_not_be_a_module_the_design_imports(tmp_path, capsys, mon
     assert (tmp_path / "speeds.py").read_text() == "SPEED = 200\n"
 
 
+@pytest.mark.parametrize("target", ["top.py", "parts.py", "__init__.py"])
+def test_the_output_may_not_be_a_file_of_the_design_s_package(
+    target, tmp_path, capsys, monkeypatch
+):
+    # A package.module:Name design's source is its package: its module, the modules it
+    # imports from it (relatively) and its __init__.py.
+    package = tmp_path / f"ud_export_pkg_{target.partition('.')[0].strip('_')}"
+    package.mkdir()
+    (package / "__init__.py").write_text("")
+    (package / "parts.py").write_text("SPEED = 200\n")
+    (package / "top.py").write_text(
+        "from amaranth import Module, signed\n"
+        "from amaranth.lib import wiring\n"
+        "from amaranth.lib.wiring import Out\n"
+        "from .parts import SPEED\n\n\n"
+        "class D(wiring.Component):\n"
+        "    motor_left: Out(signed(16))\n"
+        "    motor_right: Out(signed(16))\n\n"
+        "    def elaborate(self, platform):\n"
+        "        m = Module()\n"
+        "        m.d.sync += [self.motor_left.eq(SPEED), self.motor_right.eq(SPEED)]\n"
+        "        return m\n"
+    )
+    before = {f: f.read_bytes() for f in package.iterdir() if f.is_file()}
+    monkeypatch.syspath_prepend(str(tmp_path))
+    monkeypatch.chdir(tmp_path)
+    output = f"{package.name}/{target}"
+    code, text, err = _cli(["export", "--design", f"{package.name}.top:D", "-o", output], capsys)
+    assert code == 2 and text == "" and err.count("\n") == 1
+    assert f"-o {output!r} is the same path as the input --design" in err
+    assert str(package / target) in err
+    assert {f: f.read_bytes() for f in package.iterdir() if f.is_file()} == before
+
+
+def test_the_output_may_not_be_a_module_beside_a_flat_module_design(tmp_path, capsys, monkeypatch):
+    # module:Name of a module of no package (found in the current folder): the modules it
+    # imports beside it are its source; a file in a folder below is not.
+    (tmp_path / "ud_flat_speeds.py").write_text("SPEED = 200\n")
+    (tmp_path / "ud_flat_design.py").write_text(
+        "from amaranth import Module, signed\n"
+        "from amaranth.lib import wiring\n"
+        "from amaranth.lib.wiring import Out\n"
+        "from ud_flat_speeds import SPEED\n\n\n"
+        "class D(wiring.Component):\n"
+        "    motor_left: Out(signed(16))\n"
+        "    motor_right: Out(signed(16))\n\n"
+        "    def elaborate(self, platform):\n"
+        "        m = Module()\n"
+        "        m.d.sync += [self.motor_left.eq(SPEED), self.motor_right.eq(SPEED)]\n"
+        "        return m\n"
+    )
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.syspath_prepend(str(tmp_path))
+    argv = ["export", "--design", "ud_flat_design:D", "-o", "ud_flat_speeds.py"]
+    code, text, err = _cli(argv, capsys)
+    assert code == 2 and text == "" and err.count("\n") == 1
+    assert f"the input --design's module {str(tmp_path / 'ud_flat_speeds.py')!r}" in err
+    assert (tmp_path / "ud_flat_speeds.py").read_text() == "SPEED = 200\n"
+    code, _, _ = _cli(["export", "--design", "ud_flat_design:D", "-o", "out/D.v"], capsys)
+    assert code == 0 and (tmp_path / "out" / "D.v").is_file()
+
+
 @pytest.mark.parametrize(
     "options",
     [

@@ -3,7 +3,7 @@ leave the backend usable; ``real_clock_timing`` gives the hand-computed OV7670-l
 
 import numpy as np
 import pytest
-from amaranth import Module, signed
+from amaranth import ClockDomain, ClockSignal, Module, Signal, signed
 from amaranth.lib import wiring
 from amaranth.lib.wiring import In, Out
 
@@ -170,6 +170,46 @@ def test_unknown_backend():
         r"pysim, cxxrtl, verilator",
     ):
         get_pin_backend("fast", SOURCE)
+
+
+class HalfClock(wiring.Component):
+    """``ticks`` counts the edges of a clock domain the design drives itself: half the clock."""
+
+    ticks: Out(8)
+
+    def elaborate(self, platform):
+        m = Module()
+        m.domains.half = ClockDomain()
+        divider = Signal()
+        m.d.sync += divider.eq(~divider)
+        m.d.comb += ClockSignal("half").eq(divider)
+        m.d.half += self.ticks.eq(self.ticks + 1)
+        return m
+
+
+HALF = PinDesignSource(HalfClock, "test_pins_errors_half_clock")
+
+
+def test_a_clock_the_design_drives_is_refused_by_cxxrtl():
+    # CXXRTL never saw its edges (Yosys issue #3549): ticks stayed 0 where pysim counts.
+    with pytest.raises(
+        PinError,
+        match=r"^cxxrtl: test_pins_errors_half_clock clocks flip-flops from a signal of its "
+        r"own \(p_divider in the CXXRTL model\), whose edges CXXRTL misses \(Yosys issue "
+        r"#3549\): run it with --backend verilator or pysim$",
+    ):
+        get_pin_backend("cxxrtl", HALF)
+    with get_pin_backend("pysim", HALF) as pins:
+        pins.run(20)
+        assert pins.peek("ticks") == 10
+
+
+@pytest.mark.slow
+def test_auto_runs_a_clock_the_design_drives_on_verilator():
+    with get_pin_backend("auto", HALF) as pins:
+        assert pins.name == "verilator"
+        pins.run(20)
+        assert pins.peek("ticks") == 10
 
 
 def test_auto_is_a_compiled_backend():

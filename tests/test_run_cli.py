@@ -4,6 +4,7 @@ import json
 import subprocess
 import sys
 from importlib import resources
+from pathlib import Path
 
 import pytest
 
@@ -110,6 +111,24 @@ def test_a_summary_over_the_scenario_file_is_refused(tmp_path, capsys):
     assert "is the same path as the input --scenario" in err and len(err.splitlines()) == 1
     assert scenario.read_text() == text
     assert [p.name for p in tmp_path.iterdir()] == ["mine.toml"]
+
+
+@pytest.mark.parametrize("target", ["wall_stop.py", "speeds.py"])
+def test_a_summary_over_the_scenario_s_design_source_is_refused(target, tmp_path, capsys):
+    # The scenario names the design (no --design): its file, and a module it imports beside
+    # it, are inputs as the scenario is.
+    data = Path(__file__).parent / "data" / "user_designs"
+    (tmp_path / "speeds.py").write_text("SPEED = 300\n")
+    design = (data / "wall_stop.py").read_text()
+    (tmp_path / "wall_stop.py").write_text("from speeds import SPEED  # noqa: F401\n" + design)
+    (tmp_path / "wall_stop.toml").write_text((data / "wall_stop.toml").read_text())
+    before = {f.name: f.read_text() for f in tmp_path.iterdir()}
+    argv = ["--scenario", str(tmp_path / "wall_stop.toml"), "--duration", "0.1", "--rerun", "off"]
+    err = usage_error([*argv, "--summary", str(tmp_path / target)], capsys)
+    assert len(err.splitlines()) == 1
+    source = "design.top" if target == "wall_stop.py" else "design.top's module"
+    assert f"is the same path as the input {source} {str(tmp_path / target)!r}" in err
+    assert {f.name: f.read_text() for f in tmp_path.iterdir()} == before
 
 
 def test_list_scenarios(capsys):

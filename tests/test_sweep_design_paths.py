@@ -70,6 +70,22 @@ def test_a_design_reference_on_a_grid_axis_is_relative_to_the_campaign_file(tree
     assert main([str(tree / "camp" / "c.toml"), "--dry-run"]) == 0
 
 
+def test_a_shadow_design_reference_is_relative_to_the_campaign_file(tree):
+    # It was taken from the current folder: a campaign started elsewhere found no file. (One
+    # folder deeper than the current one: ../designs from here is not the campaign's.)
+    watch = tree / "designs" / "bump_watch.py"
+    path = tree / "camp" / "deep" / "c.toml"
+    path.parent.mkdir()
+    path.write_text(
+        'scenarios = ["../../scen/bump_wall.toml"]\nbackend = "cxxrtl"\nduration = 0.5\n'
+        'design = "../../designs/bump_watch.py:BumpWatch"\n'
+        'shadow = "../../designs/bump_watch.py:BumpWatch"\n'
+    )
+    shadow = load_campaign_file(str(path)).runs[0].shadow
+    assert Path(shadow.rpartition(":")[0]).resolve() == watch
+    assert main([str(path), "--dry-run"]) == 0
+
+
 def test_the_campaign_ports_go_with_every_verilog_design_of_a_grid_axis(tree):
     verilog = tree / "designs" / "bump_stop_noreset.v"
     ports = tree / "designs" / "ports.toml"

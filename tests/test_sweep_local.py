@@ -254,6 +254,19 @@ def _report_row(scenario, status, **overrides):
     }
 
 
+def test_the_pass_rates_show_axis_values_as_the_campaign_writes_them():
+    from fpga_robotics.sweep.report import format_report
+
+    rows = [
+        # A list is its JSON text in a row (results._cell), a bool a bool.
+        _report_row("one", "pass", **{"design.params.reverse": True, "design.params.t": "[1, 2]"}),
+        _report_row("one", "fail", **{"design.params.reverse": False, "design.params.t": None}),
+    ]
+    text = format_report(rows, ["design.params.reverse", "design.params.t"])
+    assert "  true " in text and "  false " in text and "True" not in text
+    assert "  [1, 2] " in text and "  (not set) " in text
+
+
 def test_the_report_maps_pass_rates_only_of_runs_that_set_both_axes(tmp_path):
     from fpga_robotics.sweep.report import write_html
 

@@ -1,6 +1,8 @@
 """The public test API (fpga_robotics.testing): a scenario run for a design reference, its
 checks by name, a readable assertion message."""
 
+import gc
+import warnings
 from pathlib import Path
 
 import pytest
@@ -65,6 +67,18 @@ def test_bad_arguments_are_one_line_errors():
             ports=data / "bump_stop_ports.toml",
             params={"speed": 100},
         )
+
+
+@pytest.mark.parametrize("scenario", ["red_frames.toml", "wall_stop.toml"])
+def test_an_unknown_backend_is_refused_before_the_design_is_built(scenario):
+    # It was a PinError (no UsageError) after the component was made, which Amaranth then
+    # warned of as never elaborated.
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        with pytest.raises(UsageError, match=r"unknown backend 'fast'; choose one of: auto, "):
+            run(DESIGNS / scenario, backend="fast")
+        gc.collect()
+    assert [str(w.message) for w in caught] == []
 
 
 def test_the_module_docstring_example_runs_as_written(tmp_path, monkeypatch):

@@ -593,6 +593,65 @@ def test_bad_references_are_one_line_errors(
     assert sorted(p.name for p in tmp_path.iterdir() if p.name != "__pycache__") == before
 
 
+def _package(folder, name):
+    """A package ``name`` in ``folder``: ``top.D`` drives at ``parts.SPEED``, imported
+    relatively."""
+    package = folder / name
+    package.mkdir()
+    (package / "__init__.py").write_text("")
+    (package / "parts.py").write_text("SPEED = 210\n")
+    (package / "top.py").write_text(
+        "from amaranth import Module, signed\n"
+        "from amaranth.lib import wiring\n"
+        "from amaranth.lib.wiring import Out\n\n"
+        "from .parts import SPEED\n\n\n"
+        "class D(wiring.Component):\n"
+        "    motor_left: Out(signed(16))\n"
+        "    motor_right: Out(signed(16))\n\n"
+        "    def elaborate(self, platform):\n"
+        "        m = Module()\n"
+        "        m.d.sync += [self.motor_left.eq(SPEED), self.motor_right.eq(-SPEED)]\n"
+        "        return m\n"
+    )
+    return package
+
+
+def test_a_package_module_reference_is_found_in_the_current_folder(tmp_path, monkeypatch):
+    # As python -m fpga_robotics finds it: the fpga-robotics script's path has no current
+    # folder, and this session's path has no tmp_path.
+    name = f"ud_pkg_{tmp_path.name}"
+    _package(tmp_path, name)
+    assert str(tmp_path) not in sys.path
+    monkeypatch.chdir(tmp_path)
+    try:
+        spec = resolve_design(f"{name}.top:D")
+        assert spec.ports == {"motor_left": ("out", 16), "motor_right": ("out", 16)}
+        assert str(tmp_path) not in sys.path  # put back after the import
+    finally:
+        for module in [m for m in sys.modules if m.partition(".")[0] == name]:
+            del sys.modules[module]
+
+
+def test_a_package_s_file_named_as_a_file_says_how_to_name_it(tmp_path, monkeypatch):
+    package = _package(tmp_path, "ud_pkg_as_file")
+    hint = (
+        "ImportError: attempted relative import with no known parent package; top.py is a "
+        f"module of the package 'ud_pkg_as_file': name it ud_pkg_as_file.top:D, running in "
+        f"{str(tmp_path)!r} (or install the package)"
+    )
+    with pytest.raises(DesignError) as info:
+        resolve_design(f"{package}/top.py:D")
+    assert str(info.value).endswith(hint)
+    # Named as a module from inside the package's folder: the same advice.
+    monkeypatch.chdir(package)
+    try:
+        with pytest.raises(DesignError) as info:
+            resolve_design("top:D")
+        assert str(info.value).endswith(hint)
+    finally:
+        sys.modules.pop("top", None)
+
+
 def test_a_design_without_a_clock_is_refused_where_it_would_be_simulated(
     tmp_path, capsys, monkeypatch
 ):
@@ -639,6 +698,54 @@ def test_a_design_with_an_instance_is_refused_where_it_would_be_simulated(
         assert code == 2 and len(err.strip().splitlines()) == 1 and message in err, err
     code, _, _ = _cli(["export", "--design", "unelaborated.py:BlackBox", "-o", "bb.v"], capsys)
     assert code == 0 and "my_ip ip (" in (tmp_path / "bb.v").read_text()
+
+
+UNDEFINED_DOMAIN = """
+from amaranth import Module, Signal, signed
+from amaranth.lib import wiring
+from amaranth.lib.wiring import In, Out
+
+
+class Fast(wiring.Component):
+    pressed: In(1)
+    ext_clk: In(1)  # a port of its own whose name ends as a domain's clock does
+    motor_left: Out(signed(16))
+    motor_right: Out(signed(16))
+
+    def elaborate(self, platform):
+        m = Module()
+        seen = Signal()
+        m.d.fast += seen.eq(self.pressed | self.ext_clk)
+        m.d.sync += self.motor_left.eq(seen)
+        return m
+"""
+
+
+def test_a_domain_used_and_not_defined_is_refused_where_nothing_would_clock_it(
+    tmp_path, capsys, monkeypatch
+):
+    # Amaranth made it a fast_clk input: a run passed with its flip-flops never clocked, the
+    # board stopped with a traceback. Export writes it with that input, for a top of one's own.
+    (tmp_path / "fast.py").write_text(UNDEFINED_DOMAIN)
+    spec = resolve_design(f"{tmp_path}/fast.py:Fast", {})
+    assert spec.free_domains == ("fast",)
+    assert resolve_design(str(DESIGNS / "wall_stop.py") + ":WallStop", {}).free_domains == ()
+    message = (
+        "uses clock domain 'fast' (m.d.fast) without defining it, so nothing here clocks it "
+        "(Amaranth makes it an input fast_clk): use m.d.sync, or define it (m.domains.fast = "
+        "ClockDomain(...)) and drive its clock in the design"
+    )
+    monkeypatch.chdir(tmp_path)
+    for argv in (
+        ["run", "--scenario", str(WALL_STOP), "--design", "fast.py:Fast",
+         "--backend", "pysim", "--rerun", "off", "--set", "design.params={}"],
+        ["mutate", "--design", "fast.py:Fast", "--mutants", "2", "--quiet"],
+        ["board", "--design", "fast.py:Fast", "-o", "board"],
+    ):  # fmt: skip
+        code, _, err = _cli(argv, capsys)
+        assert code == 2 and len(err.strip().splitlines()) == 1 and message in err, err
+    code, _, _ = _cli(["export", "--design", "fast.py:Fast", "-o", "fast.v"], capsys)
+    assert code == 0 and "input fast_clk;" in (tmp_path / "fast.v").read_text()
 
 
 def test_a_scenario_names_its_design_relative_to_its_folder(tmp_path):
@@ -859,6 +966,18 @@ def test_a_shadow_parameter_without_default_is_asked_for_by_shadow_param(tmp_pat
     assert code == 2 and len(err.strip().splitlines()) == 1, err
     assert "parameter 'gap' has no default" in err
     assert "give it with --shadow-param gap=VALUE" in err
+
+
+def test_a_bad_shadow_param_value_is_told_as_that_option(tmp_path, capsys):
+    # It was said as design.params.stop_mm, a key the scenario file has with a good value.
+    argv = ["run", "--scenario", str(WALL_STOP), "--rerun", "off"]
+    argv += ["--shadow", f"{DESIGNS}/wall_stop.py:WallStop", "--shadow-param", "stop_mm=near"]
+    code, _, err = _cli(argv, capsys)
+    assert code == 2
+    assert err == (
+        "fpga-robotics run: error: --shadow-param stop_mm must be an integer (a parameter of "
+        "WallStop), got 'near'\n"
+    )
 
 
 _BUMP_STOP_AMARANTH = """
@@ -1183,6 +1302,62 @@ def test_a_bad_enum_parameter_is_one_line_from_the_command_line(tmp_path, capsys
         capsys,
     )
     assert code == 2 and "design.params.mode must be one of STOP, REVERSE" in err
+
+
+GENERIC_PARAMS = """
+from typing import Literal, Optional
+
+from amaranth import Module, signed
+from amaranth.lib import wiring
+from amaranth.lib.wiring import Out
+
+
+class Generic(wiring.Component):
+    motor_left: Out(signed(16))
+    motor_right: Out(signed(16))
+
+    def __init__(self, limit: Optional[int] = None, cap: float | None = 2.0,
+                 side: Literal["left", "right"] = "left", taps: tuple[int, ...] = (1,),
+                 gains: list[float] = [1.0], pair: tuple[int, str] = (1, "a"),
+                 either: int | str = 0):
+        self.limit, self.cap, self.side, self.taps = limit, cap, side, taps
+        self.gains, self.pair, self.either = gains, pair, either
+        super().__init__()
+
+    def elaborate(self, platform):
+        m = Module()
+        m.d.sync += self.motor_left.eq(1)
+        return m
+"""
+
+
+def test_generic_annotations_check_what_they_say(tmp_path):
+    # Optional, Literal and the items of list[X] and tuple[...], by their annotation's words.
+    (tmp_path / "generic.py").write_text(GENERIC_PARAMS)
+    reference = f"{tmp_path}/generic.py:Generic"
+    design = _built(
+        reference,
+        {"limit": 7, "cap": None, "side": "right", "taps": [3, 4], "gains": [2], "either": "x"},
+    )
+    assert (design.limit, design.cap, design.side) == (7, None, "right")
+    assert (design.taps, design.gains, design.either) == ((3, 4), [2.0], "x")
+    assert type(design.gains[0]) is float
+    assert _built(reference, {"limit": None, "pair": [2, "b"]}).pair == (2, "b")
+    for key, bad, words in (
+        ("limit", "x", "an integer"),
+        ("cap", "high", "a number"),
+        ("side", "up", "one of 'left', 'right'"),
+        ("side", 1, "one of 'left', 'right'"),
+        ("taps", [1.5], "an array of integers"),
+        ("gains", [1, "a"], "an array of numbers"),
+        ("pair", [1, 2], "an array of 2 items (an integer, a string)"),
+        ("pair", [1], "an array of 2 items (an integer, a string)"),
+    ):
+        with pytest.raises(DesignError) as info:
+            resolve_design(reference, {key: bad})
+        assert str(info.value) == (
+            f"design.params.{key} must be {words} (a parameter of Generic), got {bad!r}"
+        )
 
 
 @pytest.mark.slow

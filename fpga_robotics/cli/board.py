@@ -155,6 +155,7 @@ def main(argv=None, prog="fpga-robotics board"):
         design = resolve_design(
             args.design, design_params_from_items(args.param), ports=args.ports, option="--param"
         )
+        design.require_defined_domains()  # the board drives the sync domain's clock only
     elif args.param or args.ports:
         raise UsageError(
             f"{'--param' if args.param else '--ports'} goes with --design REF (a design of "

@@ -410,6 +410,7 @@ def _main_design(args):
         spec = resolve_design(args.design, design_params_from_items(args.param), option="--param")
         spec.require_clock()
         spec.require_no_black_boxes()
+        spec.require_defined_domains()
         name = spec.reference.rpartition(":")[2]
     if args.resolution is not None and not spec.camera:
         # Its unit judge streams no frames: the option would do nothing.

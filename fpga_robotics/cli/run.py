@@ -21,7 +21,7 @@ from fpga_robotics.checks.summary import format_summary
 from fpga_robotics.cli.errors import UsageError
 from fpga_robotics.cli.parser import CommandParser
 from fpga_robotics.designs.builtin import TOPS
-from fpga_robotics.designs.reference import design_parameters
+from fpga_robotics.designs.reference import design_parameters, design_source_files
 from fpga_robotics.hw.pixel import COLOR_SELECT
 from fpga_robotics.loop.bindings import check_bindings, scenario_top
 from fpga_robotics.loop.compressed import make_backend
@@ -506,7 +506,14 @@ def _shadow_scenario(scenario, spec, ports, params, design_params):
         try:
             return scenario.with_overrides(overrides)
         except ScenarioError as exc:
-            raise UsageError(f"--shadow {spec}: {exc}") from None
+            text = str(exc)
+            for name in (item.partition("=")[0].strip() for item in params):
+                # A value given as --shadow-param is that option's, not [design.params]'.
+                if text.startswith(f"design.params.{name} "):
+                    raise UsageError(
+                        f"--shadow-param {name}{text[len(f'design.params.{name}') :]}"
+                    ) from None
+            raise UsageError(f"--shadow {spec}: {text}") from None
     if params:
         raise UsageError(
             f"--shadow-param: a Verilog shadow design ({spec}) takes no parameters; "
@@ -883,6 +890,18 @@ def _input_paths(args):
     return paths
 
 
+def _design_inputs(args, scenario):
+    """The loaded scenario's design files, as ``(option, path)``: a design of one's own's
+    source (the modules it imports beside it, its package) and a scenario's Verilog."""
+    files = design_source_files(scenario.top)
+    option = args.design_option
+    paths = [(option if i == 0 else f"{option}'s module", Path(f)) for i, f in enumerate(files)]
+    if scenario.foreign is not None:
+        paths += [("design.verilog", Path(f)) for f in scenario.foreign.verilog]
+        paths.append(("design.ports", Path(scenario.foreign.ports)))
+    return paths
+
+
 def _output_paths(args, recording):
     """The files and folders the run writes, as ``(option, path)``; ``recording`` is the
     ``--rerun`` mode's file."""
@@ -1065,6 +1084,7 @@ def main(argv=None, prog="fpga-robotics run"):
     ros = RosOutputs(args)  # --bag, --live ...: checked now, not after a long run
     scenario = load_run_scenario(args)
     take_design_reference(args, scenario)
+    inputs += _design_inputs(args, scenario)
     _check_color_option(args, scenario)
     if args.target_color is not None:
         # An explicit --color is the design's select: the target wears another colour.

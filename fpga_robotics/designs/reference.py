@@ -32,6 +32,7 @@ import inspect
 import re
 import sys
 import traceback
+import types
 import typing
 import warnings
 from dataclasses import dataclass, field
@@ -120,6 +121,9 @@ class DesignSpec:
     black_boxes : tuple
         The modules an Amaranth design of one's own instantiates (``Instance``) without
         defining them: Verilog or vendor cells no simulator here has.
+    free_domains : tuple
+        The clock domains an Amaranth design of one's own uses (``m.d.fast``) without defining
+        them: Amaranth makes each an input clock ``fast_clk`` that nothing here drives.
     signed : frozenset
         The names of its ports of a signed shape (``ports`` has direction and width).
     netlist_digest : str
@@ -138,6 +142,7 @@ class DesignSpec:
     port_map: object = None
     clocked: bool = True
     black_boxes: tuple = ()
+    free_domains: tuple = ()
     signed: frozenset = frozenset()
     netlist_digest: str = ""
 
@@ -183,10 +188,23 @@ class DesignSpec:
                 "take it"
             )
 
+    def require_defined_domains(self):
+        """``DesignError`` for a design that uses a clock domain it does not define: no
+        simulator or board here drives its clock, so its registers would never change."""
+        if self.free_domains:
+            name = self.free_domains[0]
+            raise DesignError(
+                f"design {self.reference!r} uses clock domain {name!r} (m.d.{name}) without "
+                f"defining it, so nothing here clocks it (Amaranth makes it an input "
+                f"{name}_clk): use m.d.sync, or define it (m.domains.{name} = "
+                f"ClockDomain(...)) and drive its clock in the design"
+            )
+
     def source_files(self):
         """The files a design of one's own was loaded from: its file, then the modules it
-        imported beside it; none for a built-in, an installed or a Verilog design."""
-        return _design_files(self.reference) if self.kind == "amaranth" else ()
+        imported beside it (a ``package.module:Name`` design: its module's file, then those of
+        its package); none for a built-in or a Verilog design."""
+        return design_source_files(self.reference) if self.kind == "amaranth" else ()
 
     def build(self):
         """A new Amaranth component of the design (a built-in one at its default
@@ -323,6 +341,39 @@ def _design_files(reference):
     return (where, *_IMPORTED_BESIDE.get(where, ()))
 
 
+def design_source_files(reference):
+    """The source files of a resolved design of one's own (``DesignSpec.reference``, a
+    scenario's ``top``): its file, then the modules it imported beside it, or a
+    ``package.module:Name`` design's module, then its package's; none for a built-in name."""
+    if reference in TOPS or reference.startswith("verilog:"):
+        return ()
+    return _design_files(reference) or _module_files(reference)
+
+
+def _module_files(reference):
+    """The files of a ``package.module:Name`` design: its module's, then those of the other
+    modules loaded from its package's folder (a flat module's: the modules beside it), which
+    it may import; a file written over them would lose the design's source."""
+    module = sys.modules.get(reference.rpartition(":")[0])
+    own = getattr(module, "__file__", None)
+    if own is None:
+        return ()
+    root = sys.modules.get(module.__name__.partition(".")[0])
+    if hasattr(root, "__path__") and getattr(root, "__file__", None):
+        folder = Path(root.__file__).parent  # the package's, with its subpackages
+
+        def mine(file):
+            return folder in Path(file).parents
+    else:
+        folder = Path(own).parent  # a flat module's, without the folders below it
+
+        def mine(file):
+            return Path(file).parent == folder
+
+    files = {f for m in list(sys.modules.values()) if (f := getattr(m, "__file__", None))}
+    return (own, *sorted(f for f in files - {own} if mine(f)))
+
+
 def _stamps(files):
     """What makes a cached resolution stale: its files' modification times and sizes (None:
     gone)."""
@@ -387,7 +438,9 @@ def _amaranth_spec(reference, params):
     values = _check_params(target, params, reference)
     factory = functools.partial(_call, target, values, reference)
     component = factory()
-    clocked, black_boxes, netlist_digest = _check_elaborates(component, target, reference)
+    clocked, black_boxes, free_domains, netlist_digest = _check_elaborates(
+        component, target, reference
+    )
     signed = signed_ports(component)
     ports = component_ports(component)
     _check_port_names(ports, reference.rpartition(":")[2])
@@ -419,6 +472,7 @@ def _amaranth_spec(reference, params):
         top,
         clocked=clocked,
         black_boxes=black_boxes,
+        free_domains=free_domains,
         signed=signed,
         netlist_digest=netlist_digest,
     )
@@ -448,9 +502,8 @@ def _check_elaborates(component, target, reference):
     # Its ports as export and the board have them: each in its declared direction, so that
     # an input the design drives is a conflict here too, not only when exported.
     ports = directed_ports(component)
-    inputs = {
-        id(value): name for name, (value, flow) in verilog_ports(component).items() if flow == "i"
-    }
+    declared = verilog_ports(component)
+    inputs = {id(value): name for name, (value, flow) in declared.items() if flow == "i"}
     try:
         with warnings.catch_warnings(record=True) as said:
             warnings.simplefilter("always")
@@ -492,7 +545,14 @@ def _check_elaborates(component, target, reference):
     defined = set(re.findall(r"^module \\(\S+)$", text, re.MULTILINE))
     used = re.findall(r"^ +cell \\(\S+) ", text, re.MULTILINE)
     black_boxes = tuple(dict.fromkeys(name for name in used if name not in defined))
-    return clocked, black_boxes, hashlib.sha256(text.encode()).hexdigest()
+    # A domain used and defined nowhere: Amaranth makes its clock an input NAME_clk of the top.
+    top = text[: text.index("\nend\n")]
+    free = tuple(
+        name.removesuffix("_clk")
+        for name in re.findall(r"^  wire width 1 input \d+ +\\(\S+_clk)$", top, re.MULTILINE)
+        if name not in declared
+    )
+    return clocked, black_boxes, free, hashlib.sha256(text.encode()).hexdigest()
 
 
 def _driven_input(fragment, inputs):
@@ -578,16 +638,20 @@ def _load_target(reference):
         module = _load_file(Path(where), reference)
     else:
         try:
-            module = importlib.import_module(where)
+            module = _import_module(where)
         except ModuleNotFoundError as exc:
             raise DesignError(
-                f"design {reference!r}: no module {exc.name!r}; install the "
-                f"package or give the file as path/to/file.py:{name}"
+                f"design {reference!r}: no module {exc.name!r} in the current folder or the "
+                f"installed packages; install the package, run in the folder that holds it, "
+                f"or give the file as path/to/file.py:{name}"
             ) from None
         except USER_CODE_ERRORS as exc:  # the user's module may raise anything
+            # A module of a package named from inside the package's folder (top:Name).
+            file = Path.cwd() / f"{where.replace('.', '/')}.py"
+            hint = _package_hint(exc, file, name) if file.is_file() else ""
             raise DesignError(
                 f"design {reference!r}: importing {where} raised "
-                f"{type(exc).__name__}: {_first_line(exc)}"
+                f"{type(exc).__name__}: {_first_line(exc)}{hint}"
             ) from None
     target = getattr(module, name, None)
     if target is None:
@@ -615,6 +679,21 @@ def _load_target(reference):
     return target
 
 
+def _import_module(name):
+    """Import the module of a ``package.module:Name`` reference as ``python -m fpga_robotics``
+    finds it, with the current folder on the path: the ``fpga-robotics`` script's path lacks
+    it. Last on the path, so that nothing installed is hidden by a folder of the same name."""
+    folder = str(Path.cwd())
+    added = folder not in sys.path and "" not in sys.path
+    if added:
+        sys.path.append(folder)
+    try:
+        return importlib.import_module(name)
+    finally:
+        if added:
+            sys.path.remove(folder)
+
+
 def _load_file(path, reference):
     if not path.is_file():
         raise DesignError(
@@ -636,8 +715,27 @@ def _load_file(path, reference):
         raise DesignError(
             f"design {reference!r}: loading {path.name}{line} raised "
             f"{type(exc).__name__}: {_first_line(exc)}"
+            f"{_package_hint(exc, path, reference.rpartition(':')[2])}"
         ) from None
     return module
+
+
+def _package_hint(exc, path, name):
+    """How to name a file of a package that imports relatively (``from .parts import X``):
+    loaded as a file, it has no package."""
+    if not (isinstance(exc, ImportError) and "relative import" in str(exc)):
+        return ""
+    parts = [path.stem]
+    folder = path.parent
+    while (folder / "__init__.py").is_file():
+        parts.insert(0, folder.name)
+        folder = folder.parent
+    if len(parts) == 1:
+        return ""
+    return (
+        f"; {path.name} is a module of the package {parts[0]!r}: name it "
+        f"{'.'.join(parts)}:{name}, running in {str(folder)!r} (or install the package)"
+    )
 
 
 @contextlib.contextmanager
@@ -725,7 +823,21 @@ def _check_params(target, params, reference):
                 f"{{where}}: {name} takes no parameter {key!r}{hint}; it takes: "
                 f"{', '.join(known) or 'none'}",
             )
-        expected = _expected_type(known[key])
+        parameter = known[key]
+        annotation, optional = _annotation(parameter)
+        if value is None and (optional or parameter.default is None):
+            continue
+        if typing.get_origin(annotation) is typing.Literal:
+            choices = typing.get_args(annotation)
+            # 1 is not True, nor 1.0 a choice of 1: the value's type is the choice's.
+            if not any(type(value) is type(c) and value == c for c in choices):
+                raise _ParamError(
+                    key,
+                    f"{{where}} must be one of {', '.join(map(repr, choices))} (a parameter "
+                    f"of {name}), got {value!r}",
+                )
+            continue
+        expected = _expected_type(parameter)
         if expected is None:
             continue
         if issubclass(expected, enum.Enum):
@@ -741,8 +853,17 @@ def _check_params(target, params, reference):
                 key,
                 f"{{where}} must be {_type_name(expected)} (a parameter of {name}), got {value!r}",
             )
-        elif expected in (list, tuple, float):
-            values[key] = expected(value)
+        elif expected is float:
+            values[key] = float(value)
+        elif expected in (list, tuple):
+            items = _items(annotation, value)
+            if items is None:
+                raise _ParamError(
+                    key,
+                    f"{{where}} must be {_items_name(annotation)} (a parameter of {name}), "
+                    f"got {value!r}",
+                )
+            values[key] = expected(items)
     missing = [n for n, p in known.items() if p.default is p.empty and n not in params]
     if missing:
         raise _ParamError(
@@ -779,7 +900,9 @@ def _signature_parameters(target):
     return known, takes_any
 
 
-def _expected_type(parameter):
+def _annotation(parameter):
+    """``(annotation, optional)``: the parameter's annotation without ``None`` (of
+    ``Optional[X]``, ``X | None``) and whether it takes ``None``."""
     annotation = parameter.annotation
     if isinstance(annotation, str):  # from __future__ import annotations
         annotation = {
@@ -790,6 +913,49 @@ def _expected_type(parameter):
             "list": list,
             "tuple": tuple,
         }.get(annotation)
+    if typing.get_origin(annotation) in (typing.Union, types.UnionType):
+        args = typing.get_args(annotation)
+        others = [a for a in args if a is not type(None)]
+        if len(others) == 1:
+            return others[0], len(others) < len(args)
+        return typing.Any, type(None) in args  # a union of several types: not checked
+    return annotation, False
+
+
+def _items(annotation, value):
+    """The items of the array ``value`` as ``list[X]``, ``tuple[X, ...]`` or ``tuple[X, Y]``
+    take them (a float item's integer as a float), or None when one does not fit; any items
+    for a bare ``list`` or ``tuple`` or an item type that is not checked."""
+    args = typing.get_args(annotation)
+    if not args:
+        return list(value)
+    if typing.get_origin(annotation) is tuple and not (len(args) == 2 and args[1] is ...):
+        if len(args) != len(value):
+            return None
+        kinds = args
+    else:
+        kinds = [args[0]] * len(value)
+    items = []
+    for item, kind in zip(value, kinds, strict=True):
+        if kind in (int, float, bool, str) and not _fits(item, kind):
+            return None
+        items.append(float(item) if kind is float else item)
+    return items
+
+
+def _items_name(annotation):
+    args = typing.get_args(annotation)
+    names = {int: "integers", float: "numbers", bool: "true or false values", str: "strings"}
+    if typing.get_origin(annotation) is tuple and not (len(args) == 2 and args[1] is ...):
+        kinds = [_type_name(a) if a in names else getattr(a, "__name__", str(a)) for a in args]
+        return f"an array of {len(args)} items ({', '.join(kinds)})"
+    return f"an array of {names[args[0]]}"
+
+
+def _expected_type(parameter):
+    annotation = _annotation(parameter)[0]
+    if annotation is typing.Any:
+        return None
     annotation = typing.get_origin(annotation) or annotation  # list[int] is a list
     if annotation in (int, float, bool, str, list, tuple) or _is_enum(annotation):
         return annotation
@@ -960,6 +1126,11 @@ def bindings_of(component, ports, given=None):
             continue
         if kind == "camera":
             if all(ports.get(p, ("",))[0] == "in" for p in CAMERA_PORTS):
+                _check_stream(
+                    "pixels",
+                    ports,
+                    f"design {name}: port 'pixels' is not the camera's pixel stream",
+                )
                 bindings[kind] = {
                     "pixels": "pixels",
                     **({"color_sel": "color_sel"} if "color_sel" in ports else {}),
@@ -993,6 +1164,14 @@ def bindings_of(component, ports, given=None):
         _check_wheels(component, bindings["wheels"])
     if "camera" in bindings:
         _check_frame_outputs(component)
+        select = bindings["camera"].get("color_sel")
+        if select is not None and ports[select] != ("in", 3):
+            # A narrower port lost the colour's high bits (red, 4, was refused mid-run).
+            raise DesignError(
+                f"design {name}: port {select!r} (the camera's color_sel) is "
+                f"{ports[select][0]}put of {ports[select][1]} bits; the colour select is 3 "
+                "bits: In(3) or In(fpga_robotics.hw.pixel.TargetColor) (docs/contract.md)"
+            )
     return bindings
 
 
@@ -1103,9 +1282,16 @@ def _check_stream(port, ports, problem):
     """``DesignError`` saying ``problem`` unless ``port`` names a pixel stream input of the
     design: a 1-bit ``PORT__valid`` and a 14-bit ``PORT__payload``
     (``In(pixel_stream_signature())``)."""
-    valid, payload = f"{port}__valid", f"{port}__payload"
+    valid, payload, ready = f"{port}__valid", f"{port}__payload", f"{port}__ready"
     if ports.get(valid) == ("in", 1) and ports.get(payload) == ("in", 14):
-        return
+        if ready not in ports:
+            return
+        # The camera streams a pixel a clock whatever the design says: pixels it is not
+        # ready for would be lost without a word.
+        raise DesignError(
+            f"{problem}: it has a ready output, {ready}, and a camera does not wait; declare "
+            "it In(fpga_robotics.hw.pixel.pixel_stream_signature()), a stream always ready"
+        )
     raise DesignError(
         f"{problem} (ports {valid} of 1 bit and {payload} of 14 bits, "
         f"In(fpga_robotics.hw.pixel.pixel_stream_signature())); its ports: {', '.join(ports)}"

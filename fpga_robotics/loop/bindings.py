@@ -30,6 +30,7 @@ def scenario_top(scenario):
     spec = resolve_design(scenario.top, scenario.design_params)
     spec.require_clock()
     spec.require_no_black_boxes()
+    spec.require_defined_domains()
     return spec.top
 
 

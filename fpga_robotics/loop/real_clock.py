@@ -366,6 +366,8 @@ class RealClockLoop(ClosedLoop):
             if port.direction == "in" and name not in driven:
                 kinds = [k for k, b in self.top.bindings.items() if name in b.values()]
                 stream = re.fullmatch(r"(.+)__(valid|payload)", name)
+                ready = re.fullmatch(r"(.+)__ready", name)
+                valid = ready and self.pins.ports.get(f"{ready.group(1)}__valid")
                 if kinds:
                     hint = f'declare a [[robot.sensors]] table with kind = "{kinds[0]}"'
                 elif stream and not self.top.camera:
@@ -373,6 +375,13 @@ class RealClockLoop(ClosedLoop):
                     hint = (
                         f"to stream the camera to it, name it pixels or declare connectors = "
                         f'{{"camera": {{"pixels": "{stream.group(1)}"}}}}'
+                    )
+                elif valid and valid.direction == "out":
+                    # No connector takes a stream from the design: nothing can say ready.
+                    hint = (
+                        f"it is the ready of its output stream {ready.group(1)!r}, which nothing "
+                        "here takes (its valid and payload are recorded); declare it "
+                        "stream.Signature(..., always_ready=True)"
                     )
                 else:
                     hint = "bind a connector pin to it with ports = {...}"

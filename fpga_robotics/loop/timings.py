@@ -1,9 +1,11 @@
 """``run_scenario``: one scenario in the loop timing it asks for (``sim.timing``)."""
 
 from fpga_robotics.designs.builtin import TOPS
+from fpga_robotics.hw.errors import UsageError
 from fpga_robotics.loop.compressed import run_compressed
 from fpga_robotics.loop.pin_frames import PinFrames, open_pin_frames
 from fpga_robotics.loop.real_clock import run_real_clock
+from fpga_robotics.sim.backends import BACKEND_NAMES
 from fpga_robotics.sim.backends.foreign import ForeignDesign
 from fpga_robotics.sim.backends.foreign_choice import open_foreign_frames
 from fpga_robotics.sim.backends.port_map import load_port_map
@@ -62,6 +64,11 @@ def run_scenario(
     """
     if seed is not None:
         check_seed(seed)  # before int() would turn 1.5 or "1" into another seed
+    if isinstance(backend, str) and backend not in ("auto", *BACKEND_NAMES):
+        # Said before the design is built (a component built and never simulated).
+        raise UsageError(
+            f"unknown backend {backend!r}; choose one of: auto, {', '.join(BACKEND_NAMES)}"
+        )
     options = {
         "seed": seed,
         "recorder": recorder,

@@ -808,9 +808,11 @@ def _file_paths(data, base):
         data["scenarios"] = [_near(data["scenarios"], base)]
     if isinstance(data.get("ports"), str):
         data["ports"] = _near(data["ports"], base)
-    if isinstance(data.get("design"), str) and data["design"].startswith("verilog:"):
-        files = data["design"][len("verilog:") :].split(",")
-        data["design"] = "verilog:" + ",".join(_near(f, base) for f in files if f)
-    elif isinstance(data.get("design"), str) and ".py:" in data["design"]:
-        where, _, name = data["design"].rpartition(":")
-        data["design"] = f"{_near(where, base)}:{name}"
+    for key in ("design", "shadow"):  # design references, as run --design and --shadow
+        value = data.get(key)
+        if isinstance(value, str) and value.startswith("verilog:"):
+            files = value[len("verilog:") :].split(",")
+            data[key] = "verilog:" + ",".join(_near(f, base) for f in files if f)
+        elif isinstance(value, str) and ".py:" in value:
+            where, _, name = value.rpartition(":")
+            data[key] = f"{_near(where, base)}:{name}"

@@ -39,7 +39,11 @@ def _value_key(v):
 
 
 def _shown(v):
-    return "(not set)" if v is None else str(v)
+    """An axis value as the campaign file, the replay commands and results.csv write it
+    (``true``, ``{"a": 1}``), not as Python prints it."""
+    if v is None:
+        return "(not set)"
+    return v if isinstance(v, str) else json.dumps(v)
 
 
 def _by(rows, column):

@@ -6,7 +6,12 @@ C++ harness (cxxrtl_harness.cpp + frame_driver.h) through ctypes.
 from . import build_cache
 from .base import BackendError
 from .compiled import ABI_VERSION, HARNESS_DIR, LIBRARY_NAME, CompiledBackend
-from .cxxrtl_netlist import model_header, with_wire_copies_inlined, without_port_copies
+from .cxxrtl_netlist import (
+    check_clocks,
+    model_header,
+    with_wire_copies_inlined,
+    without_port_copies,
+)
 from .lifecycle import BuildPlan, digest, read_sources
 from .toolchain import cxxrtl_include_dir, find_compiler, run_tool
 
@@ -30,6 +35,7 @@ def cxxrtl_build_plan(design, variant, flags=None, include=None):
     source = design.cxxrtl()
     if "struct p_follow__target" not in source:
         raise BackendError("the CXXRTL output has no p_follow__target module")
+    check_clocks(source, design.design, "verilator")
     header = model_header(source)
     flags = list(CXX_FLAGS if flags is None else flags)
     if variant == "plain":

@@ -9,8 +9,11 @@ expected shape, each function returns ``None`` and the harness uses CXXRTL's gen
 
 import re
 
+from .base import BackendError
+
 __all__ = [
     "OUTPUTS",
+    "check_clocks",
     "commit_wires",
     "fast_commit",
     "mangle",
@@ -39,6 +42,26 @@ _IDENT = re.compile(r"\b([pi]_\w+)\b(\.curr\b|\.next\b)?")
 def mangle(name):
     """CXXRTL's C++ name of a simple identifier: ``p_`` and every ``_`` doubled."""
     return "p_" + name.replace("_", "__")
+
+
+#: An edge detector on a wire of the model (``p_div.curr`` against ``p_div.next``), not on an
+#: input port (``prev_p_clk``): a clock the design drives itself.
+_WIRE_EDGE = re.compile(r"bool (?:pos|neg)edge_(\w+)\(\) const \{\s*return !?\1\.curr\b")
+
+
+def check_clocks(source, design, instead):
+    """``BackendError`` when the model clocks flip-flops from one of its wires: a clock the
+    design derives itself (a divider's register, ``ClockSignal("half")`` driven by logic).
+    CXXRTL tests such an edge at the start of ``eval()``, before the edge that makes it, and
+    never sees it (Yosys issue #3549): those flip-flops would hold their initial values, a
+    wrong run. ``design`` names it, ``instead`` the backends to run it on."""
+    clocks = _WIRE_EDGE.findall(source)
+    if clocks:
+        raise BackendError(
+            f"{design} clocks flip-flops from a signal of its own ({clocks[0]} in the CXXRTL "
+            f"model), whose edges CXXRTL misses (Yosys issue #3549): run it with --backend "
+            f"{instead}"
+        )
 
 
 def _eval_span(source):

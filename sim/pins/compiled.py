@@ -18,6 +18,7 @@ from ..backends.base import BackendError
 from ..backends.compiled import HARNESS_DIR
 from ..backends.cxxrtl import CXX_FLAGS as CXXRTL_FLAGS
 from ..backends.cxxrtl_netlist import (
+    check_clocks,
     fast_commit,
     output_sources,
     with_wire_copies_inlined,
@@ -103,6 +104,7 @@ def cxxrtl_plan(source):
     # Each model compiles against the runtime headers of the Yosys that wrote it.
     include = runtime_include_dir() if foreign else cxxrtl_include_dir()
     outputs = tuple(p.name for p in source.ports.values() if p.direction == "out")
+    check_clocks(source.cxxrtl, source.key, "verilator or pysim")
     model, exprs, commit = _fast_model(source.cxxrtl, outputs)
     accessors = cxxrtl_accessors(source, exprs, commit)
     harness = _sources("pin_cxxrtl.cpp", _DRIVER, "cxxrtl_clock.h")
