@@ -183,6 +183,22 @@ def test_a_campaign_resolution_is_the_one_its_runs_take(tmp_path):
     assert own.count("--resolution") == 1
 
 
+@pytest.mark.parametrize(
+    "asks", ["set = [\"camera.resolution = '80x60'\"]", '[grid]\n"camera.resolution" = ["80x60"]']
+)
+def test_a_campaign_that_sets_the_netlist_s_resolution_runs_at_it(tmp_path, asks):
+    # run refuses --resolution beside a --set camera.resolution: the runs take the set alone.
+    from fpga_robotics.mutation.robot_judge import check_campaign, mutant_argv
+    from fpga_robotics.sweep import load_campaign_file, runner
+
+    campaign = tmp_path / "c.toml"
+    campaign.write_text(f'scenarios = ["follow_person"]\nseeds = "0"\n{asks}\n')
+    plan = check_campaign(load_campaign_file(str(campaign)), "80x60")
+    (argv,) = [spec.argv() for spec in plan.runs]
+    _, scenario, _ = runner.load_run(mutant_argv(argv, "mutants.v", "ports.toml", 1, "80x60"))
+    assert (scenario.camera.width, scenario.camera.height) == (80, 60)
+
+
 def test_an_interrupted_rerun_leaves_no_earlier_results_beside_its_netlist(tmp_path, monkeypatch):
     # An earlier run's mutants.json, report and recordings describe its own mutants: beside
     # the new netlist their replay commands would run other mutants.

@@ -20,6 +20,7 @@ import shutil
 import threading
 import time
 import tomllib
+from itertools import pairwise
 
 from fpga_robotics.hw.errors import UsageError
 
@@ -235,11 +236,17 @@ def mutant_argv(argv, netlist, ports, index, resolution):
             skip = True
             continue
         out.append(a)
+    # A run's own camera.resolution set is the netlist's (check_campaign): run refuses
+    # --resolution beside it.
+    sets_it = any(
+        a == "--set" and b.partition("=")[0].strip() == "camera.resolution"
+        for a, b in pairwise(out)
+    )
     return [
         *out,
         "--backend",
         "verilator",
-        *(("--resolution", resolution) if resolution is not None else ()),
+        *(("--resolution", resolution) if resolution is not None and not sets_it else ()),
         "--design",
         f"verilog:{netlist}",
         "--ports",
