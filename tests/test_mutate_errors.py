@@ -304,3 +304,65 @@ def test_a_usage_error_of_an_unmutated_run_refuses_the_campaign():
     _refuse_usage_errors(argvs[:2], outcomes[:2])
     with pytest.raises(UsageError, match=r"^the campaign's run of c: no port 'x'$"):
         _refuse_usage_errors(argvs, outcomes)
+
+
+@pytest.mark.parametrize(
+    "options",
+    [
+        ["--lost-frames", "5", "--search-dps", "120", "--kp-num", "2"],
+        ["--preset", "published", "--diff-min", "5"],
+        [],
+    ],
+)
+def test_the_robot_judge_s_runs_take_the_mutated_design_s_values(tmp_path, options):
+    # The runs' behaviour envelopes read their scenario's design values: they must be the
+    # values the netlist is built with (they were the defaults, whatever mutate was given).
+    from fpga_robotics.cli.mutate import build_parser
+    from fpga_robotics.cli.param_options import params_from_args
+    from fpga_robotics.hw.params import FollowTargetParams
+    from fpga_robotics.mutation.robot_judge import (
+        check_campaign,
+        check_design_values,
+        design_sets,
+        mutant_argv,
+    )
+    from fpga_robotics.sweep import load_campaign_file, runner
+
+    params = params_from_args(
+        build_parser("m").parse_args([*options, "--width", "80", "--height", "60"])
+    )
+    campaign = tmp_path / "c.toml"
+    campaign.write_text('scenarios = ["lost_target", "follow_person"]\nseeds = [0, 3]\n')
+    plan = check_campaign(load_campaign_file(str(campaign)), "80x60")
+    check_design_values(plan, params)  # no scenario of its own values: taken
+    for spec in plan.runs:
+        argv = mutant_argv(spec.argv(), "m.v", "p.toml", 1, "80x60", design_sets(params))
+        _, scenario, _ = runner.load_run(argv)
+        assert scenario.params == params
+    expected = FollowTargetParams.preset("published", width=80, height=60, diff_min=5)
+    assert ("published" not in options) or params == expected
+
+
+def test_a_scenario_with_design_values_of_its_own_is_refused_before_the_build(
+    tmp_path, capsys, monkeypatch
+):
+    from fpga_robotics.cli import mutate
+
+    def listed(*args, **kwargs):
+        raise AssertionError("the mutants were listed before the campaign was checked")
+
+    monkeypatch.setattr(mutate, "list_mutants", listed)
+    (tmp_path / "own.toml").write_text(
+        'name = "own"\n[sim]\nduration = 2.0\n[design]\nlost_frames = 4\n'
+    )
+    campaign = tmp_path / "c.toml"
+    campaign.write_text('scenarios = ["own.toml"]\n')
+    out = tmp_path / "m"
+    argv = ["--mutants", "4", "--lost-frames", "6", "--campaign", str(campaign)]
+    with pytest.raises(SystemExit) as exc:
+        run_cli(main, [*argv, "--out", str(out)], "mutate")
+    err = capsys.readouterr().err
+    assert exc.value.code == 2 and len(err.strip().splitlines()) == 1
+    assert "the campaign's run of " in err and "own.toml: its scenario's design values" in err
+    assert "(lost_frames = 4) are not the mutated design's (lost_frames = 6)" in err
+    assert not out.exists()

@@ -20,15 +20,18 @@ import shutil
 import threading
 import time
 import tomllib
+from dataclasses import fields, replace
 from itertools import pairwise
 
 from fpga_robotics.hw.errors import UsageError
+from fpga_robotics.hw.params import FollowTargetParams
 
 from ..hw.verilog import TOP_NAME
 from ..scenario.load import parse_resolution
 from ..sim.files import write_atomic
 from ..sweep import runner
 from ..sweep.api import wait_for_a_worker
+from ..sweep.campaign import toml_value
 from ..sweep.engine import open_client
 from ..sweep.plan import make_plan
 from .cone import cone_verdict, settled_by_cone
@@ -39,9 +42,11 @@ __all__ = [
     "JOURNAL_NAME",
     "campaign_runs_key",
     "check_campaign",
+    "check_design_values",
     "check_resume",
     "clear_earlier_run",
     "closest_to_failing",
+    "design_sets",
     "judge_runs",
     "judge_runs_forked",
     "mutant_argv",
@@ -163,7 +168,7 @@ def _refuse_usage_errors(argvs, outcomes):
             raise UsageError(f"the campaign's run of {scenario}: {message}")
 
 
-def start_prebuild(campaign, netlist, ports, resolution):
+def start_prebuild(campaign, netlist, ports, resolution, design=()):
     """Build, in a thread of this process, the model the robot judge's unmutated runs open
     (``netlist`` with ``ports``, its watch map: a model of its own), while the unit judge
     runs; returns the thread, for ``robot_judge(prebuilt=...)`` to wait for. A build that
@@ -172,7 +177,9 @@ def start_prebuild(campaign, netlist, ports, resolution):
     def build():
         for spec in make_plan(campaign).runs:
             try:
-                runner.build_designs(mutant_argv(spec.argv(), netlist, ports, 0, resolution))
+                runner.build_designs(
+                    mutant_argv(spec.argv(), netlist, ports, 0, resolution, design)
+                )
             except Exception:  # noqa: BLE001 - the run reports it
                 return
 
@@ -220,10 +227,57 @@ def check_resume(out_dir, key, campaign):
         )
 
 
-def mutant_argv(argv, netlist, ports, index, resolution):
-    """A campaign run's arguments with mutant ``index`` of the netlist as the design (at
-    ``resolution``; when None, a design of one's own, at the run's: the campaign's or its
-    scenario's)."""
+def design_sets(params):
+    """The ``--set design.NAME=VALUE`` items that give a run FollowTarget's ``params``: those
+    that differ from the defaults at its frame size. A run of the mutant netlist is judged by
+    its scenario's design values (the behaviour envelopes' laws, the stop distance): with
+    these they are the values the netlist was built with."""
+    default = FollowTargetParams(width=params.width, height=params.height)
+    return [
+        f"design.{f.name}={toml_value(getattr(params, f.name))}"
+        for f in fields(FollowTargetParams)
+        if f.init
+        and f.name not in ("width", "height")
+        and getattr(params, f.name) != getattr(default, f.name)
+    ]
+
+
+def check_design_values(plan, params):
+    """``UsageError`` when a run of ``plan`` (``check_campaign``'s) has design values of its
+    own, in its scenario's ``[design]``, other than those FollowTarget's mutants are built
+    with (``params``, which ``design_sets`` gives every run). Call it before anything is
+    built."""
+    resolution = f"{params.width}x{params.height}"
+    default = FollowTargetParams(width=params.width, height=params.height)
+    seen = set()
+    for spec in plan.runs:
+        shape = replace(spec, seed=0)
+        if shape in seen:
+            continue
+        seen.add(shape)
+        argv = _with_netlist_values(spec.argv(), resolution)
+        own = runner.load_run([*argv, "--design", "follow_target"])[1].params
+        differ = [
+            f.name
+            for f in fields(FollowTargetParams)
+            if f.init
+            and getattr(own, f.name) not in (getattr(default, f.name), getattr(params, f.name))
+        ]
+        if differ:
+            theirs, ours = (
+                ", ".join(f"{n} = {toml_value(getattr(p, n))}" for n in differ)
+                for p in (own, params)
+            )
+            raise UsageError(
+                f"the campaign's run of {spec.scenario}: its scenario's design values "
+                f"({theirs}) are not the mutated design's ({ours}): the mutants are of one "
+                "design (give its parameters to mutate instead)"
+            )
+
+
+def _with_netlist_values(argv, resolution, design=()):
+    """A campaign run's arguments without a design and backend of their own, at
+    ``resolution`` (None: the run's own) and with ``design``, ``design_sets`` items."""
     replaced = ("--backend", "--design", "--ports", "--runtime")
     if resolution is not None:
         replaced += ("--resolution",)
@@ -244,9 +298,19 @@ def mutant_argv(argv, netlist, ports, index, resolution):
     )
     return [
         *out,
+        *(("--resolution", resolution) if resolution is not None and not sets_it else ()),
+        *(x for item in design for x in ("--set", item)),
+    ]
+
+
+def mutant_argv(argv, netlist, ports, index, resolution, design=()):
+    """A campaign run's arguments with mutant ``index`` of the netlist as the design (at
+    ``resolution``; when None, a design of one's own, at the run's: the campaign's or its
+    scenario's), FollowTarget's with its parameters (``design``: ``design_sets``)."""
+    return [
+        *_with_netlist_values(argv, resolution, design),
         "--backend",
         "verilator",
-        *(("--resolution", resolution) if resolution is not None and not sets_it else ()),
         "--design",
         f"verilog:{netlist}",
         "--ports",
@@ -419,6 +483,7 @@ def robot_judge(
     watch_ports=None,
     mutants=None,
     prebuilt=None,
+    design=(),
 ):
     """Judge the mutants ``indices`` by ``campaign``'s closed-loop runs.
 
@@ -439,7 +504,7 @@ def robot_judge(
     (``resume`` keeps only rows of the same mutants and runs, and of ``indices``: the journal
     is written again with those alone; ``check_resume`` refuses others before anything is
     written). ``prebuilt``: the ``start_prebuild`` thread to wait for
-    before the runs."""
+    before the runs. ``design``: FollowTarget's parameters for every run (``design_sets``)."""
     from distributed import as_completed  # lazy: Dask costs ~1 s; only a run needs it
 
     tick = progress or (lambda n: None)
@@ -447,7 +512,8 @@ def robot_judge(
     runs_key = campaign_runs_key(plan)
     watch_ports = watch_ports if fork else None
     base = [
-        mutant_argv(spec.argv(), netlist, watch_ports or ports, 0, resolution) for spec in plan.runs
+        mutant_argv(spec.argv(), netlist, watch_ports or ports, 0, resolution, design)
+        for spec in plan.runs
     ]
     journal = os.path.join(out_dir, JOURNAL_NAME)
     verdicts = {}
@@ -506,7 +572,7 @@ def robot_judge(
         futures = {}
         for k in (k for k in todo if k not in settled):
             argvs = [
-                mutant_argv(spec.argv(), netlist, ports, k, resolution)
+                mutant_argv(spec.argv(), netlist, ports, k, resolution, design)
                 for spec in (plan.runs[i] for i in passing)
             ]
             if fork:
@@ -523,7 +589,7 @@ def robot_judge(
             for k, reached in settled.items():
                 v = cone_verdict(reached, closest)
                 at = plan.runs[passing[closest]].argv() if closest is not None else None
-                v["argv"] = at and mutant_argv(at, netlist, ports, k, resolution)
+                v["argv"] = at and mutant_argv(at, netlist, ports, k, resolution, design)
                 v["replay"] = replay(v["argv"]) if at else None
                 v["index"], v["mutants"], v["campaign_runs"] = k, mutants, runs_key
                 verdicts[k] = v
