@@ -23,6 +23,7 @@ import tomllib
 from dataclasses import fields, replace
 from itertools import pairwise
 
+from fpga_robotics.checks.registry import CHECKS, check_named
 from fpga_robotics.hw.errors import UsageError
 from fpga_robotics.hw.params import FollowTargetParams
 
@@ -57,9 +58,6 @@ __all__ = [
     "run_margin",
     "start_prebuild",
 ]
-
-#: Checks whose limit is a lower bound (the value must be at least the limit).
-_LOWER = ("min_distance_min_m", "target_in_view_min_fraction", "found_min_fraction")
 
 
 #: The robot judge's journal in the output folder (what ``--resume`` keeps).
@@ -336,10 +334,11 @@ def run_margin(summary):
             or isinstance(v, bool)
             or not isinstance(v, (int, float))
             or not isinstance(limit, (int, float))
+            or c.get("name") not in CHECKS  # which way it fails is unknown here
         ):
             continue
         scale = max(abs(float(limit)), 1e-9)
-        if c["name"] in _LOWER:
+        if check_named(c["name"]).compare == "min":  # the value must be at least the limit
             margins.append((float(v) - float(limit)) / scale)
         else:
             margins.append((float(limit) - float(v)) / scale)
