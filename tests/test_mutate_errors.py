@@ -366,3 +366,41 @@ def test_a_scenario_with_design_values_of_its_own_is_refused_before_the_build(
     assert "the campaign's run of " in err and "own.toml: its scenario's design values" in err
     assert "(lost_frames = 4) are not the mutated design's (lost_frames = 6)" in err
     assert not out.exists()
+
+
+def test_a_scenario_that_builds_another_design_of_one_s_own_is_refused_before_the_build(
+    tmp_path, capsys, monkeypatch
+):
+    # near_red.toml builds NearRed with speed = 400, near_pixels = 300; the mutant netlist
+    # takes no parameters, so its runs would drive NearRed's defaults (200, 60) in it.
+    from fpga_robotics.cli import mutate
+    from fpga_robotics.designs.reference import resolve_design
+    from fpga_robotics.mutation.robot_judge import check_campaign, check_design_params
+    from fpga_robotics.sweep import load_campaign_file
+
+    def built(*args, **kwargs):
+        raise AssertionError("the mutants were built before the campaign was checked")
+
+    monkeypatch.setattr(mutate, "mutate_design", built)
+    designs = os.path.join(DATA, "user_designs")
+    campaign = tmp_path / "c.toml"
+    campaign.write_text(f'scenarios = ["{designs}/near_red.toml"]\n')
+    out = tmp_path / "m"
+    argv = ["--design", f"{designs}/near_red.py:NearRed", "--campaign", str(campaign)]
+    with pytest.raises(SystemExit) as exc:
+        run_cli(main, [*argv, "--mutants", "4", "--out", str(out)], "mutate")
+    err = capsys.readouterr().err
+    assert exc.value.code == 2 and len(err.strip().splitlines()) == 1
+    assert "near_red.toml: its [design.params] (speed = 400, near_pixels = 300)" in err
+    assert "another NearRed than the one mutated (no --param;" in err
+    assert not out.exists()
+    # The same values as --param are the same design; so are a design's defaults spelled
+    # out (wall_stop.toml gives WallStop's speed = 300, stop_mm = 250).
+    for toml, ref, params in [
+        ("near_red.toml", "near_red.py:NearRed", {"speed": 400, "near_pixels": 300}),
+        ("wall_stop.toml", "wall_stop.py:WallStop", {}),
+    ]:
+        campaign.write_text(f'scenarios = ["{designs}/{toml}"]\n')
+        design = f"{designs}/{ref}"
+        plan = check_campaign(load_campaign_file(str(campaign)))
+        check_design_params(plan, ["--design", design], resolve_design(design, params))

@@ -41,6 +41,7 @@ from fpga_robotics.mutation.robot_judge import (
     JOURNAL_NAME,
     check_campaign,
     check_design_bindings,
+    check_design_params,
     check_design_values,
     check_resume,
     clear_earlier_run,
@@ -426,7 +427,10 @@ def _main_design(args):
     if args.campaign is not None:
         campaign = load_campaign_file(args.campaign)
         design_argv = ["--design", args.design, *(["--ports", args.ports] if verilog else [])]
-        check_design_bindings(check_campaign(campaign), design_argv)
+        plan = check_campaign(campaign)
+        check_design_bindings(plan, design_argv)
+        if not verilog:  # a Verilog design takes no parameters
+            check_design_params(plan, design_argv, spec)
     out = _out(args, f"{name}-n{args.mutants}-s{args.seed}")
     check_output_dir(out, what="output folder")
     _reach_scheduler(args.scheduler)

@@ -43,6 +43,7 @@ __all__ = [
     "JOURNAL_NAME",
     "campaign_runs_key",
     "check_campaign",
+    "check_design_params",
     "check_design_values",
     "check_resume",
     "clear_earlier_run",
@@ -270,6 +271,35 @@ def check_design_values(plan, params):
                 f"the campaign's run of {spec.scenario}: its scenario's design values "
                 f"({theirs}) are not the mutated design's ({ours}): the mutants are of one "
                 "design (give its parameters to mutate instead)"
+            )
+
+
+def check_design_params(plan, design_argv, spec):
+    """``UsageError`` when a run of ``plan`` (``check_campaign``'s) gives the design of
+    one's own that ``design_argv`` names (``--design REF``) other ``[design.params]`` than
+    the mutants are built with (``spec``, its ``DesignSpec`` with ``--param``): the mutant
+    netlist takes none, so the run would judge another design than its scenario asks for.
+    Compared by elaborated netlist, so a value given as its default is the same design.
+    Call it before anything is built."""
+    from ..designs.reference import resolve_design  # lazy: Amaranth (~0.5 s)
+
+    seen = set()
+    for run in plan.runs:
+        shape = replace(run, seed=0)
+        if shape in seen:
+            continue
+        seen.add(shape)
+        scenario = runner.load_run([*run.argv(), *design_argv])[1]
+        theirs = scenario.design_params
+        if resolve_design(scenario.top, theirs).netlist_digest != spec.netlist_digest:
+            name = spec.reference.rpartition(":")[2]
+            ours = ", ".join(f"{k} = {toml_value(v)}" for k, v in spec.params.items())
+            given = ", ".join(f"{k} = {toml_value(v)}" for k, v in theirs.items())
+            raise UsageError(
+                f"the campaign's run of {run.scenario}: its [design.params] ({given or 'none'})"
+                f" make another {name} than the one mutated ({ours or 'no --param'}; a parameter"
+                " not given takes its default): the mutants are of one design (give its "
+                "parameters to mutate as --param NAME=VALUE)"
             )
 
 
