@@ -472,24 +472,29 @@ def judge_runs(argvs, limits=None, execute=None):
     }
 
 
-def _baseline(client, argvs, progress, fork):
-    """The campaign with the unmutated design: ``([outcome] in order, shared)``. With
-    ``fork``, ``shared`` are the futures of the runs' ``reference_share`` results, kept in
-    the cluster for the mutants' tasks (each reference run once); else None."""
+def _baseline(client, argvs, progress, fork, timeout=None):
+    """The campaign with the unmutated design: ``([outcome] in order, shared)``, each run
+    limited to ``timeout`` seconds (the campaign file's). With ``fork``, ``shared`` are the
+    futures of the runs' ``reference_share`` results, kept in the cluster for the mutants'
+    tasks (each reference run once); else None."""
     from distributed import as_completed  # lazy: Dask costs ~1 s; only a run needs it
 
     shared = None
     if fork:
-        shared = [client.submit(reference_share, a, pure=False) for a in argvs]
+        shared = [client.submit(reference_share, a, timeout, pure=False) for a in argvs]
         # The outcomes come on their own: the references stay on the workers.
         futures = {client.submit(outcome_of, s, pure=False): i for i, s in enumerate(shared)}
     else:
         futures = {
-            client.submit(runner.execute, a, None, pure=False): i for i, a in enumerate(argvs)
+            client.submit(runner.execute, a, timeout, pure=False): i for i, a in enumerate(argvs)
         }
     out = [None] * len(argvs)
     for fut in as_completed(futures):
-        out[futures[fut]] = fut.result()
+        try:
+            out[futures[fut]] = fut.result()
+        except Exception as exc:  # noqa: BLE001 (its worker ended it: a frame hung past the timeout)
+            message = f"{type(exc).__name__}: {exc}".splitlines()[0]
+            out[futures[fut]] = {"status": "error", "message": message, "summary": None}
         progress(1)
     return out, shared
 
@@ -565,7 +570,7 @@ def robot_judge(
     with open_client(scheduler=scheduler, workers=workers) as client:
         wait_for_a_worker(client, scheduler)
         say(f"robot judge: {len(base)} campaign runs with the unmutated design first")
-        outcomes, shared = _baseline(client, base, tick, fork)
+        outcomes, shared = _baseline(client, base, tick, fork, campaign.timeout)
         _refuse_usage_errors(base, outcomes)
         passing = [i for i, o in enumerate(outcomes) if o["status"] == "pass"]
         statuses = [o["status"] for o in outcomes]
