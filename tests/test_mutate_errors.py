@@ -404,3 +404,23 @@ def test_a_scenario_that_builds_another_design_of_one_s_own_is_refused_before_th
         design = f"{designs}/{ref}"
         plan = check_campaign(load_campaign_file(str(campaign)))
         check_design_params(plan, ["--design", design], resolve_design(design, params))
+
+
+def test_a_failed_build_of_follow_target_s_netlist_is_one_line(tmp_path, capsys, monkeypatch):
+    # As --design says it (and run): the tool's first error line, exit 2, no traceback.
+    from fpga_robotics.cli import mutate
+
+    def build(*args, **kwargs):
+        raise BackendError(
+            "building the Verilator model of follow_target failed (exit 2):\n"
+            "make: Entering directory 'obj'\ng++: error: Vfollow_target__pch.h.fast: not found\n"
+        )
+
+    monkeypatch.setattr(mutate, "open_mutant_design", build)
+    out = tmp_path / "m"
+    with pytest.raises(SystemExit) as exc:
+        run_cli(main, ["--mutants", "2", "--width", "80", "--height", "60", "--out", str(out)])
+    err = capsys.readouterr().err
+    assert exc.value.code == 2 and len(err.strip().splitlines()) == 1
+    assert "failed (exit 2): g++: error: Vfollow_target__pch.h.fast" in err
+    assert not out.exists()

@@ -540,7 +540,10 @@ def main(argv=None, prog="fpga-robotics mutate"):
     _reach_scheduler(args.scheduler)
 
     with _removed_on_error(out, campaign):
-        return _mutate_follow_target(args, params, campaign, out)
+        try:
+            return _mutate_follow_target(args, params, campaign, out)
+        except BackendError as exc:  # the netlist's build: one line, as --design says it
+            raise UsageError(_one_line(exc)) from None
 
 
 def _mutate_follow_target(args, params, campaign, out):
