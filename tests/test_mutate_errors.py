@@ -183,6 +183,22 @@ def test_a_campaign_resolution_is_the_one_its_runs_take(tmp_path):
     assert own.count("--resolution") == 1
 
 
+@pytest.mark.parametrize(
+    "asks", ["set = [\"camera.resolution = '80x60'\"]", '[grid]\n"camera.resolution" = ["80x60"]']
+)
+def test_a_campaign_that_sets_the_netlist_s_resolution_runs_at_it(tmp_path, asks):
+    # run refuses --resolution beside a --set camera.resolution: the runs take the set alone.
+    from fpga_robotics.mutation.robot_judge import check_campaign, mutant_argv
+    from fpga_robotics.sweep import load_campaign_file, runner
+
+    campaign = tmp_path / "c.toml"
+    campaign.write_text(f'scenarios = ["follow_person"]\nseeds = "0"\n{asks}\n')
+    plan = check_campaign(load_campaign_file(str(campaign)), "80x60")
+    (argv,) = [spec.argv() for spec in plan.runs]
+    _, scenario, _ = runner.load_run(mutant_argv(argv, "mutants.v", "ports.toml", 1, "80x60"))
+    assert (scenario.camera.width, scenario.camera.height) == (80, 60)
+
+
 def test_an_interrupted_rerun_leaves_no_earlier_results_beside_its_netlist(tmp_path, monkeypatch):
     # An earlier run's mutants.json, report and recordings describe its own mutants: beside
     # the new netlist their replay commands would run other mutants.
@@ -288,3 +304,125 @@ def test_a_usage_error_of_an_unmutated_run_refuses_the_campaign():
     _refuse_usage_errors(argvs[:2], outcomes[:2])
     with pytest.raises(UsageError, match=r"^the campaign's run of c: no port 'x'$"):
         _refuse_usage_errors(argvs, outcomes)
+
+
+@pytest.mark.parametrize(
+    "options",
+    [
+        ["--lost-frames", "5", "--search-dps", "120", "--kp-num", "2"],
+        ["--preset", "published", "--diff-min", "5"],
+        [],
+    ],
+)
+def test_the_robot_judge_s_runs_take_the_mutated_design_s_values(tmp_path, options):
+    # The runs' behaviour envelopes read their scenario's design values: they must be the
+    # values the netlist is built with (they were the defaults, whatever mutate was given).
+    from fpga_robotics.cli.mutate import build_parser
+    from fpga_robotics.cli.param_options import params_from_args
+    from fpga_robotics.hw.params import FollowTargetParams
+    from fpga_robotics.mutation.robot_judge import (
+        check_campaign,
+        check_design_values,
+        design_sets,
+        mutant_argv,
+    )
+    from fpga_robotics.sweep import load_campaign_file, runner
+
+    params = params_from_args(
+        build_parser("m").parse_args([*options, "--width", "80", "--height", "60"])
+    )
+    campaign = tmp_path / "c.toml"
+    campaign.write_text('scenarios = ["lost_target", "follow_person"]\nseeds = [0, 3]\n')
+    plan = check_campaign(load_campaign_file(str(campaign)), "80x60")
+    check_design_values(plan, params)  # no scenario of its own values: taken
+    for spec in plan.runs:
+        argv = mutant_argv(spec.argv(), "m.v", "p.toml", 1, "80x60", design_sets(params))
+        _, scenario, _ = runner.load_run(argv)
+        assert scenario.params == params
+    expected = FollowTargetParams.preset("published", width=80, height=60, diff_min=5)
+    assert ("published" not in options) or params == expected
+
+
+def test_a_scenario_with_design_values_of_its_own_is_refused_before_the_build(
+    tmp_path, capsys, monkeypatch
+):
+    from fpga_robotics.cli import mutate
+
+    def listed(*args, **kwargs):
+        raise AssertionError("the mutants were listed before the campaign was checked")
+
+    monkeypatch.setattr(mutate, "list_mutants", listed)
+    (tmp_path / "own.toml").write_text(
+        'name = "own"\n[sim]\nduration = 2.0\n[design]\nlost_frames = 4\n'
+    )
+    campaign = tmp_path / "c.toml"
+    campaign.write_text('scenarios = ["own.toml"]\n')
+    out = tmp_path / "m"
+    argv = ["--mutants", "4", "--lost-frames", "6", "--campaign", str(campaign)]
+    with pytest.raises(SystemExit) as exc:
+        run_cli(main, [*argv, "--out", str(out)], "mutate")
+    err = capsys.readouterr().err
+    assert exc.value.code == 2 and len(err.strip().splitlines()) == 1
+    assert "the campaign's run of " in err and "own.toml: its scenario's design values" in err
+    assert "(lost_frames = 4) are not the mutated design's (lost_frames = 6)" in err
+    assert not out.exists()
+
+
+def test_a_scenario_that_builds_another_design_of_one_s_own_is_refused_before_the_build(
+    tmp_path, capsys, monkeypatch
+):
+    # near_red.toml builds NearRed with speed = 400, near_pixels = 300; the mutant netlist
+    # takes no parameters, so its runs would drive NearRed's defaults (200, 60) in it.
+    from fpga_robotics.cli import mutate
+    from fpga_robotics.designs.reference import resolve_design
+    from fpga_robotics.mutation.robot_judge import check_campaign, check_design_params
+    from fpga_robotics.sweep import load_campaign_file
+
+    def built(*args, **kwargs):
+        raise AssertionError("the mutants were built before the campaign was checked")
+
+    monkeypatch.setattr(mutate, "mutate_design", built)
+    designs = os.path.join(DATA, "user_designs")
+    campaign = tmp_path / "c.toml"
+    campaign.write_text(f'scenarios = ["{designs}/near_red.toml"]\n')
+    out = tmp_path / "m"
+    argv = ["--design", f"{designs}/near_red.py:NearRed", "--campaign", str(campaign)]
+    with pytest.raises(SystemExit) as exc:
+        run_cli(main, [*argv, "--mutants", "4", "--out", str(out)], "mutate")
+    err = capsys.readouterr().err
+    assert exc.value.code == 2 and len(err.strip().splitlines()) == 1
+    assert "near_red.toml: its [design.params] (speed = 400, near_pixels = 300)" in err
+    assert "another NearRed than the one mutated (no --param;" in err
+    assert not out.exists()
+    # The same values as --param are the same design; so are a design's defaults spelled
+    # out (wall_stop.toml gives WallStop's speed = 300, stop_mm = 250).
+    for toml, ref, params in [
+        ("near_red.toml", "near_red.py:NearRed", {"speed": 400, "near_pixels": 300}),
+        ("wall_stop.toml", "wall_stop.py:WallStop", {}),
+    ]:
+        campaign.write_text(f'scenarios = ["{designs}/{toml}"]\n')
+        design = f"{designs}/{ref}"
+        plan = check_campaign(load_campaign_file(str(campaign)))
+        check_design_params(plan, ["--design", design], resolve_design(design, params))
+
+
+def test_a_failed_build_of_follow_target_s_netlist_is_one_line(tmp_path, capsys, monkeypatch):
+    # As --design says it (and run): the tool's first error line, exit 2, no traceback.
+    from fpga_robotics.cli import mutate
+
+    def build(*args, **kwargs):
+        raise BackendError(
+            "building the Verilator model of follow_target failed (exit 2):\n"
+            "make: Entering directory 'obj'\ng++: error: Vfollow_target__pch.h.fast: not found\n"
+        )
+
+    monkeypatch.setattr(mutate, "list_mutants", lambda *args: [])  # no Yosys: the build fails
+    monkeypatch.setattr(mutate, "write_mutant_design", lambda *args: ("m.v", "p.toml"))
+    monkeypatch.setattr(mutate, "open_mutant_design", build)
+    out = tmp_path / "m"
+    with pytest.raises(SystemExit) as exc:
+        run_cli(main, ["--mutants", "2", "--width", "80", "--height", "60", "--out", str(out)])
+    err = capsys.readouterr().err
+    assert exc.value.code == 2 and len(err.strip().splitlines()) == 1
+    assert "failed (exit 2): g++: error: Vfollow_target__pch.h.fast" in err
+    assert not out.exists()

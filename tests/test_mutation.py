@@ -242,6 +242,36 @@ def test_scores_by_hand():
     }
 
 
+def test_the_closest_run_is_the_one_nearest_a_limit_either_way():
+    from fpga_robotics.checks.registry import register_check, unregister_check
+    from fpga_robotics.mutation.robot_judge import closest_to_failing, run_margin
+
+    def run(**checks):
+        rows = [
+            {"name": n, "passed": True, "value": v, "limit": limit}
+            for n, (v, limit) in checks.items()
+        ]
+        return {"status": "pass", "summary": {"checks": rows}}
+
+    # At least the limit: 0.95 of 0.8 is 0.15/0.8 from failing, 0.81 is 0.01/0.8.
+    far = run(camera_target_centred_min_fraction=(0.95, 0.8), max_wall_collisions=(0, 1))
+    near = run(camera_target_centred_min_fraction=(0.81, 0.8), max_wall_collisions=(0, 1))
+    assert run_margin(far["summary"]) == pytest.approx(0.15 / 0.8)
+    assert run_margin(near["summary"]) == pytest.approx(0.01 / 0.8)
+    assert closest_to_failing([far, near]) == 1
+    # At most the limit: 2 collisions of 3 allowed is 1/3 from failing.
+    assert run_margin(run(max_wall_collisions=(2, 3))["summary"]) == pytest.approx(1 / 3)
+    # A check of the user's own, and one of a name no longer registered (no direction).
+    register_check(
+        name="min_user_laps", metric="laps", compare="min", meaning="m", message=lambda *a: ""
+    )
+    try:
+        assert run_margin(run(min_user_laps=(12, 10))["summary"]) == pytest.approx(0.2)
+    finally:
+        unregister_check("min_user_laps")
+    assert run_margin(run(min_user_laps=(12, 10))["summary"]) is None
+
+
 def test_bad_arguments_are_one_line_errors(tmp_path, monkeypatch):
     import subprocess
     import sys

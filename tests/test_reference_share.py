@@ -211,3 +211,16 @@ def test_two_workers_judge_against_the_same_references(tmp_path):
     assert len(tokens[0]) == 2
     assert differing_verdicts(judged[True], judged[False]) == []
     assert {v["caught"] for v in judged[True].values()} == {True, False}
+
+
+def test_a_reference_run_over_its_timeout_is_a_timeout_and_shares_nothing():
+    # The robot judge's unmutated runs take the campaign file's timeout (it was ignored).
+    from fpga_robotics.mutation.forked_runs import reference_share
+
+    argv = ["--scenario", "lost_target", "--backend", "model", "--resolution", "80x60"]
+    argv += ["--duration", "1.0"]
+    for run in (argv, [*argv, "--shadow", "lost_frames=5"]):  # forked, and run in full
+        shared = reference_share(run, 1e-6)
+        assert shared["outcome"]["status"] == "timeout" and shared["reference"] is None
+        assert "per-run timeout" in shared["outcome"]["message"]
+        assert reference_share(run)["outcome"]["status"] != "timeout"

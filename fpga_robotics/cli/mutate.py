@@ -41,8 +41,11 @@ from fpga_robotics.mutation.robot_judge import (
     JOURNAL_NAME,
     check_campaign,
     check_design_bindings,
+    check_design_params,
+    check_design_values,
     check_resume,
     clear_earlier_run,
+    design_sets,
     mutants_key,
     robot_judge,
     start_prebuild,
@@ -65,13 +68,16 @@ from fpga_robotics.sweep.engine import check_cluster_options, open_client
 __all__ = ["main"]
 
 
-def _campaign(name, resolution=None):
+def _campaign(name, params):
     """The campaign ``name`` with every run checked (``check_campaign``, with the mutant
-    netlist's ``resolution``): a typo fails here, before anything is built or written."""
+    netlist's resolution and design values ``params``): a typo fails here, before anything
+    is built or written."""
     campaign = load_campaign_file(name)
+    plan = check_campaign(campaign, f"{params.width}x{params.height}")
     # Its scenarios' sensors against FollowTarget's pins too: a campaign of another design
     # (sensor_designs) fails here, not after the build and the unit judge.
-    check_design_bindings(check_campaign(campaign, resolution), ["--design", "follow_target"])
+    check_design_bindings(plan, ["--design", "follow_target"])
+    check_design_values(plan, params)
     return campaign
 
 
@@ -422,7 +428,10 @@ def _main_design(args):
     if args.campaign is not None:
         campaign = load_campaign_file(args.campaign)
         design_argv = ["--design", args.design, *(["--ports", args.ports] if verilog else [])]
-        check_design_bindings(check_campaign(campaign), design_argv)
+        plan = check_campaign(campaign)
+        check_design_bindings(plan, design_argv)
+        if not verilog:  # a Verilog design takes no parameters
+            check_design_params(plan, design_argv, spec)
     out = _out(args, f"{name}-n{args.mutants}-s{args.seed}")
     check_output_dir(out, what="output folder")
     _reach_scheduler(args.scheduler)
@@ -524,15 +533,18 @@ def main(argv=None, prog="fpga-robotics mutate"):
             "your own; FollowTarget's frame size is --width and --height)"
         )
     params = params_from_args(args)
-    # The mutant netlist is built for this frame size: every robot judge run takes it.
-    resolution = f"{params.width}x{params.height}"
-    campaign = _campaign(args.campaign, resolution) if args.campaign is not None else None
+    # The mutant netlist is built for this frame size and these values: every robot judge
+    # run takes them.
+    campaign = _campaign(args.campaign, params) if args.campaign is not None else None
     out = _out(args, f"n{args.mutants}-s{args.seed}")
     check_output_dir(out, what="output folder")
     _reach_scheduler(args.scheduler)
 
     with _removed_on_error(out, campaign):
-        return _mutate_follow_target(args, params, campaign, out)
+        try:
+            return _mutate_follow_target(args, params, campaign, out)
+        except BackendError as exc:  # the netlist's build: one line, as --design says it
+            raise UsageError(_one_line(exc)) from None
 
 
 def _mutate_follow_target(args, params, campaign, out):
@@ -555,8 +567,9 @@ def _mutate_follow_target(args, params, campaign, out):
     watch_ports = os.path.join(out, WATCH_PORTS_NAME)
     resolution = f"{params.width}x{params.height}"
     # The references' model (with the watch) builds while the unit judge runs.
+    sets = design_sets(params)
     prebuilt = (
-        start_prebuild(campaign, netlist, watch_ports, resolution)
+        start_prebuild(campaign, netlist, watch_ports, resolution, sets)
         if campaign is not None and args.fork
         else None
     )
@@ -611,6 +624,7 @@ def _mutate_follow_target(args, params, campaign, out):
             watch_ports=watch_ports,
             mutants=key,
             prebuilt=prebuilt,
+            design=sets,
         )
         robot_s = time.perf_counter() - t2
     robot = {k: v["caught"] for k, v in robot_verdicts.items()}

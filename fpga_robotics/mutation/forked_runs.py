@@ -30,15 +30,20 @@ _KEEP = 16
 _references = {}
 
 
-def _build(ref_argv):
+def _build(ref_argv, outcome=None, timeout=None):
     """The reference run of the unmutated design for ``ref_argv`` (a ``ReferenceRun``, or a
     ``PinReferenceRun`` in real-clock timing), run here, and the watched changes its design
-    stopped at (``runner.stops_of``)."""
+    stopped at (``runner.stops_of``). With ``outcome`` (its ``runner.RunOutcome``) the run,
+    not the design's build, is limited to ``timeout`` seconds, as ``runner.execute`` limits
+    it."""
     args, scenario, shadow_params = runner.load_run(list(ref_argv))
     design, _ = runner._designs_for(args, scenario, shadow_params)
     run.apply_runtime(design, args)
     runner.set_stop_limit(design, None)  # a kept design may carry a mutant's budget
-    reference = reference_run(scenario, design=design, seed=args.seed)
+    deadline = None
+    if outcome is not None:
+        outcome.deadline = deadline = runner._Deadline(timeout, None)
+    reference = reference_run(scenario, design=design, seed=args.seed, progress=deadline)
     return reference, runner.stops_of(design)
 
 
@@ -71,17 +76,18 @@ def _forkable(argv):
     return shadow_params is None and scenario.sim.timing in ("compressed", "real_clock")
 
 
-def reference_share(ref_argv):
+def reference_share(ref_argv, timeout=None):
     """A run with the unmutated design (the robot judge's baseline): ``{"outcome":
-    runner.execute(ref_argv)'s dict, "reference": its ReferenceData (PinReferenceData in
-    real-clock timing), "token": naming this reference}`` (reference None for a run that is
-    not forked or erred). This worker keeps the reference opened from that data."""
+    runner.execute(ref_argv, timeout)'s dict, "reference": its ReferenceData
+    (PinReferenceData in real-clock timing), "token": naming this reference}`` (reference
+    None for a run that is not forked, erred or timed out). This worker keeps the reference
+    opened from that data."""
     if not _forkable(ref_argv):
-        return {"outcome": runner.execute(ref_argv), "reference": None, "token": None}
+        return {"outcome": runner.execute(ref_argv, timeout), "reference": None, "token": None}
     shared = {"outcome": None, "reference": None, "token": uuid.uuid4().hex}
     with runner.RunOutcome() as outcome:
         with outcome.running():
-            reference, stops = _build(ref_argv)
+            reference, stops = _build(ref_argv, outcome, timeout)
         shared["reference"] = reference.portable()
         # Kept as opened from the data: its images (journal) are the data's, not a copy.
         _reference(ref_argv, shared)

@@ -20,14 +20,19 @@ import shutil
 import threading
 import time
 import tomllib
+from dataclasses import fields, replace
+from itertools import pairwise
 
+from fpga_robotics.checks.registry import CHECKS, check_named
 from fpga_robotics.hw.errors import UsageError
+from fpga_robotics.hw.params import FollowTargetParams
 
 from ..hw.verilog import TOP_NAME
 from ..scenario.load import parse_resolution
 from ..sim.files import write_atomic
 from ..sweep import runner
 from ..sweep.api import wait_for_a_worker
+from ..sweep.campaign import toml_value
 from ..sweep.engine import open_client
 from ..sweep.plan import make_plan
 from .cone import cone_verdict, settled_by_cone
@@ -38,9 +43,12 @@ __all__ = [
     "JOURNAL_NAME",
     "campaign_runs_key",
     "check_campaign",
+    "check_design_params",
+    "check_design_values",
     "check_resume",
     "clear_earlier_run",
     "closest_to_failing",
+    "design_sets",
     "judge_runs",
     "judge_runs_forked",
     "mutant_argv",
@@ -51,9 +59,6 @@ __all__ = [
     "run_margin",
     "start_prebuild",
 ]
-
-#: Checks whose limit is a lower bound (the value must be at least the limit).
-_LOWER = ("min_distance_min_m", "target_in_view_min_fraction", "found_min_fraction")
 
 
 #: The robot judge's journal in the output folder (what ``--resume`` keeps).
@@ -162,7 +167,7 @@ def _refuse_usage_errors(argvs, outcomes):
             raise UsageError(f"the campaign's run of {scenario}: {message}")
 
 
-def start_prebuild(campaign, netlist, ports, resolution):
+def start_prebuild(campaign, netlist, ports, resolution, design=()):
     """Build, in a thread of this process, the model the robot judge's unmutated runs open
     (``netlist`` with ``ports``, its watch map: a model of its own), while the unit judge
     runs; returns the thread, for ``robot_judge(prebuilt=...)`` to wait for. A build that
@@ -171,7 +176,9 @@ def start_prebuild(campaign, netlist, ports, resolution):
     def build():
         for spec in make_plan(campaign).runs:
             try:
-                runner.build_designs(mutant_argv(spec.argv(), netlist, ports, 0, resolution))
+                runner.build_designs(
+                    mutant_argv(spec.argv(), netlist, ports, 0, resolution, design)
+                )
             except Exception:  # noqa: BLE001 - the run reports it
                 return
 
@@ -219,10 +226,86 @@ def check_resume(out_dir, key, campaign):
         )
 
 
-def mutant_argv(argv, netlist, ports, index, resolution):
-    """A campaign run's arguments with mutant ``index`` of the netlist as the design (at
-    ``resolution``; when None, a design of one's own, at the run's: the campaign's or its
-    scenario's)."""
+def design_sets(params):
+    """The ``--set design.NAME=VALUE`` items that give a run FollowTarget's ``params``: those
+    that differ from the defaults at its frame size. A run of the mutant netlist is judged by
+    its scenario's design values (the behaviour envelopes' laws, the stop distance): with
+    these they are the values the netlist was built with."""
+    default = FollowTargetParams(width=params.width, height=params.height)
+    return [
+        f"design.{f.name}={toml_value(getattr(params, f.name))}"
+        for f in fields(FollowTargetParams)
+        if f.init
+        and f.name not in ("width", "height")
+        and getattr(params, f.name) != getattr(default, f.name)
+    ]
+
+
+def check_design_values(plan, params):
+    """``UsageError`` when a run of ``plan`` (``check_campaign``'s) has design values of its
+    own, in its scenario's ``[design]``, other than those FollowTarget's mutants are built
+    with (``params``, which ``design_sets`` gives every run). Call it before anything is
+    built."""
+    resolution = f"{params.width}x{params.height}"
+    default = FollowTargetParams(width=params.width, height=params.height)
+    seen = set()
+    for spec in plan.runs:
+        shape = replace(spec, seed=0)
+        if shape in seen:
+            continue
+        seen.add(shape)
+        argv = _with_netlist_values(spec.argv(), resolution)
+        own = runner.load_run([*argv, "--design", "follow_target"])[1].params
+        differ = [
+            f.name
+            for f in fields(FollowTargetParams)
+            if f.init
+            and getattr(own, f.name) not in (getattr(default, f.name), getattr(params, f.name))
+        ]
+        if differ:
+            theirs, ours = (
+                ", ".join(f"{n} = {toml_value(getattr(p, n))}" for n in differ)
+                for p in (own, params)
+            )
+            raise UsageError(
+                f"the campaign's run of {spec.scenario}: its scenario's design values "
+                f"({theirs}) are not the mutated design's ({ours}): the mutants are of one "
+                "design (give its parameters to mutate instead)"
+            )
+
+
+def check_design_params(plan, design_argv, spec):
+    """``UsageError`` when a run of ``plan`` (``check_campaign``'s) gives the design of
+    one's own that ``design_argv`` names (``--design REF``) other ``[design.params]`` than
+    the mutants are built with (``spec``, its ``DesignSpec`` with ``--param``): the mutant
+    netlist takes none, so the run would judge another design than its scenario asks for.
+    Compared by elaborated netlist, so a value given as its default is the same design.
+    Call it before anything is built."""
+    from ..designs.reference import resolve_design  # lazy: Amaranth (~0.5 s)
+
+    seen = set()
+    for run in plan.runs:
+        shape = replace(run, seed=0)
+        if shape in seen:
+            continue
+        seen.add(shape)
+        scenario = runner.load_run([*run.argv(), *design_argv])[1]
+        theirs = scenario.design_params
+        if resolve_design(scenario.top, theirs).netlist_digest != spec.netlist_digest:
+            name = spec.reference.rpartition(":")[2]
+            ours = ", ".join(f"{k} = {toml_value(v)}" for k, v in spec.params.items())
+            given = ", ".join(f"{k} = {toml_value(v)}" for k, v in theirs.items())
+            raise UsageError(
+                f"the campaign's run of {run.scenario}: its [design.params] ({given or 'none'})"
+                f" make another {name} than the one mutated ({ours or 'no --param'}; a parameter"
+                " not given takes its default): the mutants are of one design (give its "
+                "parameters to mutate as --param NAME=VALUE)"
+            )
+
+
+def _with_netlist_values(argv, resolution, design=()):
+    """A campaign run's arguments without a design and backend of their own, at
+    ``resolution`` (None: the run's own) and with ``design``, ``design_sets`` items."""
     replaced = ("--backend", "--design", "--ports", "--runtime")
     if resolution is not None:
         replaced += ("--resolution",)
@@ -235,11 +318,27 @@ def mutant_argv(argv, netlist, ports, index, resolution):
             skip = True
             continue
         out.append(a)
+    # A run's own camera.resolution set is the netlist's (check_campaign): run refuses
+    # --resolution beside it.
+    sets_it = any(
+        a == "--set" and b.partition("=")[0].strip() == "camera.resolution"
+        for a, b in pairwise(out)
+    )
     return [
         *out,
+        *(("--resolution", resolution) if resolution is not None and not sets_it else ()),
+        *(x for item in design for x in ("--set", item)),
+    ]
+
+
+def mutant_argv(argv, netlist, ports, index, resolution, design=()):
+    """A campaign run's arguments with mutant ``index`` of the netlist as the design (at
+    ``resolution``; when None, a design of one's own, at the run's: the campaign's or its
+    scenario's), FollowTarget's with its parameters (``design``: ``design_sets``)."""
+    return [
+        *_with_netlist_values(argv, resolution, design),
         "--backend",
         "verilator",
-        *(("--resolution", resolution) if resolution is not None else ()),
         "--design",
         f"verilog:{netlist}",
         "--ports",
@@ -265,10 +364,11 @@ def run_margin(summary):
             or isinstance(v, bool)
             or not isinstance(v, (int, float))
             or not isinstance(limit, (int, float))
+            or c.get("name") not in CHECKS  # which way it fails is unknown here
         ):
             continue
         scale = max(abs(float(limit)), 1e-9)
-        if c["name"] in _LOWER:
+        if check_named(c["name"]).compare == "min":  # the value must be at least the limit
             margins.append((float(v) - float(limit)) / scale)
         else:
             margins.append((float(limit) - float(v)) / scale)
@@ -372,24 +472,29 @@ def judge_runs(argvs, limits=None, execute=None):
     }
 
 
-def _baseline(client, argvs, progress, fork):
-    """The campaign with the unmutated design: ``([outcome] in order, shared)``. With
-    ``fork``, ``shared`` are the futures of the runs' ``reference_share`` results, kept in
-    the cluster for the mutants' tasks (each reference run once); else None."""
+def _baseline(client, argvs, progress, fork, timeout=None):
+    """The campaign with the unmutated design: ``([outcome] in order, shared)``, each run
+    limited to ``timeout`` seconds (the campaign file's). With ``fork``, ``shared`` are the
+    futures of the runs' ``reference_share`` results, kept in the cluster for the mutants'
+    tasks (each reference run once); else None."""
     from distributed import as_completed  # lazy: Dask costs ~1 s; only a run needs it
 
     shared = None
     if fork:
-        shared = [client.submit(reference_share, a, pure=False) for a in argvs]
+        shared = [client.submit(reference_share, a, timeout, pure=False) for a in argvs]
         # The outcomes come on their own: the references stay on the workers.
         futures = {client.submit(outcome_of, s, pure=False): i for i, s in enumerate(shared)}
     else:
         futures = {
-            client.submit(runner.execute, a, None, pure=False): i for i, a in enumerate(argvs)
+            client.submit(runner.execute, a, timeout, pure=False): i for i, a in enumerate(argvs)
         }
     out = [None] * len(argvs)
     for fut in as_completed(futures):
-        out[futures[fut]] = fut.result()
+        try:
+            out[futures[fut]] = fut.result()
+        except Exception as exc:  # noqa: BLE001 (its worker ended it: a frame hung past the timeout)
+            message = f"{type(exc).__name__}: {exc}".splitlines()[0]
+            out[futures[fut]] = {"status": "error", "message": message, "summary": None}
         progress(1)
     return out, shared
 
@@ -412,6 +517,7 @@ def robot_judge(
     watch_ports=None,
     mutants=None,
     prebuilt=None,
+    design=(),
 ):
     """Judge the mutants ``indices`` by ``campaign``'s closed-loop runs.
 
@@ -432,7 +538,7 @@ def robot_judge(
     (``resume`` keeps only rows of the same mutants and runs, and of ``indices``: the journal
     is written again with those alone; ``check_resume`` refuses others before anything is
     written). ``prebuilt``: the ``start_prebuild`` thread to wait for
-    before the runs."""
+    before the runs. ``design``: FollowTarget's parameters for every run (``design_sets``)."""
     from distributed import as_completed  # lazy: Dask costs ~1 s; only a run needs it
 
     tick = progress or (lambda n: None)
@@ -440,7 +546,8 @@ def robot_judge(
     runs_key = campaign_runs_key(plan)
     watch_ports = watch_ports if fork else None
     base = [
-        mutant_argv(spec.argv(), netlist, watch_ports or ports, 0, resolution) for spec in plan.runs
+        mutant_argv(spec.argv(), netlist, watch_ports or ports, 0, resolution, design)
+        for spec in plan.runs
     ]
     journal = os.path.join(out_dir, JOURNAL_NAME)
     verdicts = {}
@@ -463,7 +570,7 @@ def robot_judge(
     with open_client(scheduler=scheduler, workers=workers) as client:
         wait_for_a_worker(client, scheduler)
         say(f"robot judge: {len(base)} campaign runs with the unmutated design first")
-        outcomes, shared = _baseline(client, base, tick, fork)
+        outcomes, shared = _baseline(client, base, tick, fork, campaign.timeout)
         _refuse_usage_errors(base, outcomes)
         passing = [i for i, o in enumerate(outcomes) if o["status"] == "pass"]
         statuses = [o["status"] for o in outcomes]
@@ -499,7 +606,7 @@ def robot_judge(
         futures = {}
         for k in (k for k in todo if k not in settled):
             argvs = [
-                mutant_argv(spec.argv(), netlist, ports, k, resolution)
+                mutant_argv(spec.argv(), netlist, ports, k, resolution, design)
                 for spec in (plan.runs[i] for i in passing)
             ]
             if fork:
@@ -516,7 +623,7 @@ def robot_judge(
             for k, reached in settled.items():
                 v = cone_verdict(reached, closest)
                 at = plan.runs[passing[closest]].argv() if closest is not None else None
-                v["argv"] = at and mutant_argv(at, netlist, ports, k, resolution)
+                v["argv"] = at and mutant_argv(at, netlist, ports, k, resolution, design)
                 v["replay"] = replay(v["argv"]) if at else None
                 v["index"], v["mutants"], v["campaign_runs"] = k, mutants, runs_key
                 verdicts[k] = v
