@@ -288,3 +288,47 @@ def test_a_usage_error_of_an_unmutated_run_refuses_the_campaign():
     _refuse_usage_errors(argvs[:2], outcomes[:2])
     with pytest.raises(UsageError, match=r"^the campaign's run of c: no port 'x'$"):
         _refuse_usage_errors(argvs, outcomes)
+
+
+COUNTER = """
+from amaranth import Module
+from amaranth.lib import wiring
+from amaranth.lib.wiring import Out
+
+
+class Counter(wiring.Component):
+    count: Out(8)
+
+    def elaborate(self, platform):
+        m = Module()
+        m.d.sync += self.count.eq(self.count + 1)
+        return m
+"""
+
+
+@pytest.mark.parametrize(
+    ("design", "message"),
+    [
+        # Its inputs up and clear bound to no connector: nothing in a run drives them.
+        ("counters.py:Saturating", "no connector pin drives Saturating's input 'up'"),
+        # No input, outputs no run acts on or checks: every mutant would be a blind spot.
+        ("counter.py:Counter", "no run can catch a mutant of Counter: it binds no wheels"),
+    ],
+)
+def test_a_design_no_campaign_run_can_judge_is_refused_before_the_build(
+    tmp_path, capsys, monkeypatch, design, message
+):
+    def listed(*args, **kwargs):
+        raise AssertionError("the mutants were listed before the design was checked")
+
+    monkeypatch.setattr("fpga_robotics.mutation.design_run.list_mutants", listed)
+    (tmp_path / "counter.py").write_text(COUNTER)
+    folder = tmp_path if design.startswith("counter.py") else f"{DATA}/user_designs"
+    out = tmp_path / "m"
+    argv = ["--design", f"{folder}/{design}", "--mutants", "2"]
+    with pytest.raises(SystemExit) as exc:
+        run_cli(main, [*argv, "--campaign", "mutation", "--out", str(out)], "mutate")
+    err = capsys.readouterr().err
+    assert exc.value.code == 2 and len(err.strip().splitlines()) == 1
+    assert message in err and "leave out --campaign" in err
+    assert not out.exists()

@@ -385,6 +385,32 @@ def _reach_scheduler(address):
             pass
 
 
+#: The connector kinds whose pins a run acts on or a check reads: wheels and a servo move
+#: the robot, a camera design's results are checked.
+_JUDGED_KINDS = ("wheels", "servo", "camera")
+
+
+def _refuse_unjudgeable(spec, name):
+    """``UsageError`` before any build when no run of a campaign can run or judge the
+    Amaranth design ``spec`` (``name``): an input no connector pin binds (nothing in the
+    closed loop drives it) or no output a run acts on or checks."""
+    bound = {port for pins in spec.bindings.values() for port in pins.values()}
+    for port, (direction, _) in spec.ports.items():
+        # A stream's ports (pixels__valid) are bound by the stream's name.
+        if direction == "in" and port not in bound and port.split("__")[0] not in bound:
+            raise UsageError(
+                f"--campaign: no connector pin drives {name}'s input {port!r}, so no run can "
+                "run it; bind it to a connector pin (docs/your_design.md), or leave out "
+                "--campaign for the unit judge alone"
+            )
+    if not any(kind in spec.bindings for kind in _JUDGED_KINDS):
+        raise UsageError(
+            f"--campaign: no run can catch a mutant of {name}: it binds no wheels, servo or "
+            "camera, so nothing in a run acts on its outputs and no check reads them; "
+            "leave out --campaign for the unit judge alone"
+        )
+
+
 def _main_design(args):
     """``--design REF``: the mutants of a design of one's own against itself."""
     refuse_followtarget_options(
@@ -419,6 +445,8 @@ def _main_design(args):
         )
     campaign = None
     if args.campaign is not None:
+        if not verilog:  # a Verilog design's port map maps every input (checked above)
+            _refuse_unjudgeable(spec, name)
         campaign = load_campaign_file(args.campaign)
         design_argv = ["--design", args.design, *(["--ports", args.ports] if verilog else [])]
         check_design_bindings(check_campaign(campaign), design_argv)
