@@ -332,3 +332,33 @@ def test_a_design_no_campaign_run_can_judge_is_refused_before_the_build(
     assert exc.value.code == 2 and len(err.strip().splitlines()) == 1
     assert message in err and "leave out --campaign" in err
     assert not out.exists()
+
+
+class _HungDesign:
+    """A mutant netlist whose unmutated design never raises ``frame_done``."""
+
+    def set_runtime(self, name, value):
+        pass
+
+    def reset(self):
+        pass
+
+    def process_frame(self, frame, color):
+        raise BackendError("follow_target: frame 0: timeout: frame_done never rose")
+
+    def close(self):
+        pass
+
+
+def test_against_design_with_a_broken_unmutated_design_is_one_line(tmp_path, capsys, monkeypatch):
+    at = "fpga_robotics.cli.mutate."
+    monkeypatch.setattr(at + "list_mutants", lambda *a, **k: [])
+    monkeypatch.setattr(at + "write_mutant_design", lambda p, m, out: ("mutants.v", "ports.toml"))
+    monkeypatch.setattr(at + "open_mutant_design", lambda *a, **k: _HungDesign())
+    out = tmp_path / "m"
+    with pytest.raises(SystemExit) as exc:
+        run_cli(main, ["--mutants", "2", "--against", "design", "--out", str(out)], "mutate")
+    err = capsys.readouterr().err
+    assert exc.value.code == 2 and len(err.strip().splitlines()) == 1
+    assert "--against design: the unmutated design fails" in err and "frame_done never" in err
+    assert not out.exists()

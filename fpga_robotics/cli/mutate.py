@@ -558,8 +558,11 @@ def main(argv=None, prog="fpga-robotics mutate"):
     check_output_dir(out, what="output folder")
     _reach_scheduler(args.scheduler)
 
-    with _removed_on_error(out, campaign):
-        return _mutate_follow_target(args, params, campaign, out)
+    try:
+        with _removed_on_error(out, campaign):
+            return _mutate_follow_target(args, params, campaign, out)
+    except BackendError as exc:  # the netlist failed to build, or its reference to run
+        raise UsageError(_one_line(exc)) from None
 
 
 def _mutate_follow_target(args, params, campaign, out):
@@ -591,11 +594,14 @@ def _mutate_follow_target(args, params, campaign, out):
     build_s = time.perf_counter() - t0
     try:
         frames = judge_frames(params)
-        golden = (
-            golden_results(params, frames)
-            if args.against == "model"
-            else reference_results(design, frames)
-        )
+        try:
+            golden = (
+                golden_results(params, frames)
+                if args.against == "model"
+                else reference_results(design, frames)
+            )
+        except BackendError as exc:
+            raise BackendError(f"--against design: the unmutated design fails: {exc}") from None
         t1 = time.perf_counter()
         verdicts = []
         for k, m in enumerate(mutants, start=1):
