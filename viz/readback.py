@@ -11,6 +11,7 @@ pixels, whichever way they were logged (``viz.images``).
 """
 
 import os
+import sys
 import warnings
 from dataclasses import dataclass, field
 
@@ -183,3 +184,14 @@ def summary_lines(rec, name):
         f"  {path:22s} static: {', '.join(sorted(rec.static[path]))}" for path in sorted(rec.static)
     ]
     return lines
+
+
+if __name__ == "__main__":
+    # A library module: the command that reads a recording is the application layer's, which
+    # this layer does not import. Without this, `python -m` ran nothing and exited 0.
+    print(
+        "python -m fpga_robotics.viz.readback: error: a library module; read a recording "
+        "with: fpga-robotics readback FILE.rrd",
+        file=sys.stderr,
+    )
+    sys.exit(2)
