@@ -362,3 +362,40 @@ def test_against_design_with_a_broken_unmutated_design_is_one_line(tmp_path, cap
     assert exc.value.code == 2 and len(err.strip().splitlines()) == 1
     assert "--against design: the unmutated design fails" in err and "frame_done never" in err
     assert not out.exists()
+
+
+NAMED = '''
+from amaranth import Module, signed
+from amaranth.lib import wiring
+from amaranth.lib.wiring import In, Out
+
+
+class Named(wiring.Component):
+    """A port named as the mutant netlist's select or watch."""
+
+    {name}: {direction}(4)
+    motor_left: Out(signed(16))
+    motor_right: Out(signed(16))
+
+    def elaborate(self, platform):
+        m = Module()
+        m.d.sync += self.motor_left.eq(self.{name} + 1)
+        m.d.comb += self.motor_right.eq(self.motor_left)
+        return m
+'''
+
+
+@pytest.mark.parametrize(("name", "direction"), [("mutsel", "In"), ("mutinf", "Out")])
+def test_a_design_with_a_port_named_as_the_mutant_select_is_one_clear_line(
+    tmp_path, capsys, name, direction
+):
+    # Yosys failed on them: an assertion in mutate.cc, a redefinition of wire \mutinf.
+    (tmp_path / "named.py").write_text(NAMED.format(name=name, direction=direction))
+    out = tmp_path / "m"
+    argv = ["--design", f"{tmp_path}/named.py:Named", "--mutants", "2", "--out", str(out)]
+    with pytest.raises(SystemExit) as exc:
+        run_cli(main, argv, "mutate")
+    err = capsys.readouterr().err
+    assert exc.value.code == 2 and len(err.strip().splitlines()) == 1
+    assert f"the design has a signal named {name!r}, a name the mutant netlist adds" in err
+    assert "rename it" in err and not out.exists()

@@ -608,7 +608,7 @@ def test_mutants_on_a_memorys_constant_ports_are_replaced():
     params = FollowTargetParams()
     # The first seed whose raw list holds a mutant Yosys cannot build (there is one).
     for seed in range(1, 20):
-        lines, memories = _mutate_list(params, 12, seed, design)
+        lines, memories, _ = _mutate_list(params, 12, seed, design)
         on_memories = [line for line in lines if any(f"-cell {c} " in line for c in memories)]
         bad = [line for line in on_memories if not _builds(params, [line], design)]
         if bad:
