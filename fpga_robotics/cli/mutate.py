@@ -547,8 +547,9 @@ def main(argv=None, prog="fpga-robotics mutate"):
     args.against = args.against or "model"
     if args.param or args.cycles is not None or args.ports is not None or args.resolution:
         raise UsageError(
-            "--param, --ports, --cycles and --resolution go with --design REF (a design of "
-            "your own; FollowTarget's frame size is --width and --height)"
+            "--param, --ports, --cycles and --resolution go with --design REF, a design of "
+            "your own, not FollowTarget (the default, and --design follow_target), whose "
+            "frame size is --width and --height"
         )
     params = params_from_args(args)
     # The mutant netlist is built for this frame size: every robot judge run takes it.
