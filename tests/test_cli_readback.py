@@ -7,6 +7,7 @@ import warnings
 
 import pytest
 import rerun as rr
+import rerun.blueprint as rrb
 
 from fpga_robotics import cli
 
@@ -90,3 +91,12 @@ def test_the_library_module_run_as_a_command_points_at_the_command(tmp_path):
     )
     assert (done.returncode, done.stdout) == (2, "")
     assert done.stderr.count("\n") == 1 and "fpga-robotics readback FILE.rrd" in done.stderr
+
+
+def test_a_file_of_only_a_viewer_layout_is_one_line(tmp_path, capsys):
+    # A saved blueprint (.rbl) holds no recording store: rerun raised ValueError, a traceback.
+    layout = tmp_path / "layout.rrd"
+    rrb.Blueprint(rrb.Spatial2DView()).save("app", str(layout))
+    code, out, err = _readback([str(layout)], capsys)
+    assert (code, out) == (2, "")
+    assert err.count("\n") == 1 and "layout.rrd holds no recording" in err

@@ -82,6 +82,10 @@ def read_rrd(path):
         raise ViewerError(
             f"{path} is not a rerun recording (.rrd): {str(exc).splitlines()[0]}"
         ) from None
+    except ValueError as exc:  # an .rrd with only a blueprint (a saved layout, .rbl)
+        raise ViewerError(
+            f"{path} holds no recording (a viewer layout at most): {str(exc).splitlines()[0]}"
+        ) from None
     entities, static = {}, {}
     for chunk in chunks:
         name = chunk.entity_path.lstrip("/")
