@@ -399,3 +399,23 @@ def test_a_design_with_a_port_named_as_the_mutant_select_is_one_clear_line(
     assert exc.value.code == 2 and len(err.strip().splitlines()) == 1
     assert f"the design has a signal named {name!r}, a name the mutant netlist adds" in err
     assert "rename it" in err and not out.exists()
+
+
+def test_a_verilog_design_no_campaign_run_can_judge_is_refused_before_the_build(tmp_path, capsys):
+    (tmp_path / "cnt.v").write_text(
+        "module cnt(input clk, input rst, output reg [7:0] count);\n"
+        "  always @(posedge clk) if (rst) count <= 0; else count <= count + 1;\n"
+        "endmodule\n"
+    )
+    (tmp_path / "cnt.toml").write_text(
+        'top = "cnt"\nclock = { port = "clk" }\nreset = { port = "rst" }\n'
+        '[extra_outputs]\ncount = "count"\n'
+    )
+    out = tmp_path / "m"
+    argv = ["--design", f"verilog:{tmp_path}/cnt.v", "--ports", str(tmp_path / "cnt.toml")]
+    with pytest.raises(SystemExit) as exc:
+        run_cli(main, [*argv, "--campaign", "mutation", "--out", str(out)], "mutate")
+    err = capsys.readouterr().err
+    assert exc.value.code == 2 and len(err.strip().splitlines()) == 1
+    assert "no run can catch a mutant of cnt: it binds no wheels, servo or camera" in err
+    assert not out.exists()

@@ -391,10 +391,11 @@ _JUDGED_KINDS = ("wheels", "servo", "camera")
 
 
 def _refuse_unjudgeable(spec, name):
-    """``UsageError`` before any build when no run of a campaign can run or judge the
-    Amaranth design ``spec`` (``name``): an input no connector pin binds (nothing in the
-    closed loop drives it) or no output a run acts on or checks."""
+    """``UsageError`` before any build when no run of a campaign can run or judge the design
+    ``spec`` (``name``): an input no connector pin binds (nothing in the closed loop drives
+    it) or no output a run acts on or checks."""
     bound = {port for pins in spec.bindings.values() for port in pins.values()}
+    # A Verilog design's ports are known once built; its port map maps every input.
     for port, (direction, _) in spec.ports.items():
         # A stream's ports (pixels__valid) are bound by the stream's name.
         if direction == "in" and port not in bound and port.split("__")[0] not in bound:
@@ -445,8 +446,7 @@ def _main_design(args):
         )
     campaign = None
     if args.campaign is not None:
-        if not verilog:  # a Verilog design's port map maps every input (checked above)
-            _refuse_unjudgeable(spec, name)
+        _refuse_unjudgeable(spec, name)
         campaign = load_campaign_file(args.campaign)
         design_argv = ["--design", args.design, *(["--ports", args.ports] if verilog else [])]
         check_design_bindings(check_campaign(campaign), design_argv)
