@@ -718,3 +718,9 @@ def _mutate_follow_target(args, params, campaign, out):
             print(f"  {m.describe()}")
     print(f"wrote {os.path.join(out, 'mutants.json')}")
     return _exit_code(baseline)
+
+
+if __name__ == "__main__":  # python -m fpga_robotics.cli.mutate: as fpga-robotics mutate
+    from fpga_robotics.cli import run_command
+
+    run_command("mutate")

@@ -1196,3 +1196,9 @@ def main(argv=None, prog="fpga-robotics run"):
     if args.summary:
         write_json_atomic(args.summary, summary, what="--summary")
     return 0 if summary["verdict"] == "pass" else 1
+
+
+if __name__ == "__main__":  # python -m fpga_robotics.cli.run: as fpga-robotics run
+    from fpga_robotics.cli import run_command
+
+    run_command("run")
