@@ -401,7 +401,13 @@ def test_a_design_with_a_port_named_as_the_mutant_select_is_one_clear_line(
     assert "rename it" in err and not out.exists()
 
 
-def test_a_verilog_design_no_campaign_run_can_judge_is_refused_before_the_build(tmp_path, capsys):
+def test_a_verilog_design_no_campaign_run_can_judge_is_refused_before_the_build(
+    tmp_path, capsys, monkeypatch
+):
+    def listed(*args, **kwargs):
+        raise AssertionError("the mutants were listed before the design was checked")
+
+    monkeypatch.setattr("fpga_robotics.mutation.design_run.list_mutants", listed)
     (tmp_path / "cnt.v").write_text(
         "module cnt(input clk, input rst, output reg [7:0] count);\n"
         "  always @(posedge clk) if (rst) count <= 0; else count <= count + 1;\n"
