@@ -100,3 +100,11 @@ def test_a_file_of_only_a_viewer_layout_is_one_line(tmp_path, capsys):
     code, out, err = _readback([str(layout)], capsys)
     assert (code, out) == (2, "")
     assert err.count("\n") == 1 and "layout.rrd holds no recording" in err
+
+
+def test_a_folder_is_named_as_a_folder(tmp_path, capsys):
+    # It said "no recording at 'runs.rrd'", as of a path with nothing there.
+    (tmp_path / "runs.rrd").mkdir()
+    code, out, err = _readback([str(tmp_path / "runs.rrd")], capsys)
+    assert (code, out) == (2, "")
+    assert err.count("\n") == 1 and "runs.rrd is a folder, not a recording (.rrd)" in err

@@ -69,6 +69,8 @@ def _row_values(column):
 
 def read_rrd(path):
     """Read the first recording in ``path``; returns a ``Recording``."""
+    if os.path.isdir(path):
+        raise ViewerError(f"{path} is a folder, not a recording (.rrd)")
     if not os.path.isfile(path):
         raise FileNotFoundError(f"no recording at {str(path)!r}")
     try:
