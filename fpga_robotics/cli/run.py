@@ -18,7 +18,7 @@ from importlib import resources
 from pathlib import Path
 
 from fpga_robotics.checks.summary import format_summary
-from fpga_robotics.cli.errors import UsageError
+from fpga_robotics.cli.errors import UsageError, run_cli
 from fpga_robotics.cli.parser import CommandParser
 from fpga_robotics.designs.builtin import TOPS
 from fpga_robotics.designs.reference import design_parameters
@@ -1199,6 +1199,4 @@ def main(argv=None, prog="fpga-robotics run"):
 
 
 if __name__ == "__main__":  # python -m fpga_robotics.cli.run: as fpga-robotics run
-    from fpga_robotics.cli import run_command
-
-    run_command("run")
+    run_cli(main, sys.argv[1:], prog="fpga-robotics run")
