@@ -288,7 +288,14 @@ def list_mutants(
     if not 1 <= int(n) <= 100_000:
         raise ValueError(f"the number of mutants must be 1..100000, got {n}")
     design = {"rtlil_text": rtlil_text, "verilog": verilog, "top": top, "includes": includes}
-    lines, memories = _mutate_list(params, int(n), seed, design)
+    lines, memories, taken = _mutate_list(params, int(n), seed, design)
+    if taken:
+        name = top if verilog is not None else "the design"
+        raise MutationError(
+            f"{name} has a signal named {min(taken)!r}, a name the mutant netlist adds "
+            f"({MUTATION_SELECT!r}, its mutant select, and {WATCH_PORT!r}, its watch): "
+            "rename it"
+        )
     if not lines:
         raise MutationError(
             f"Yosys found nothing to mutate in {top if verilog is not None else 'the design'}: "
@@ -311,7 +318,7 @@ def list_mutants(
         if len(kept) == n or len(lines) < asked or asked >= 100_000:
             break  # enough, or Yosys has no more places
         asked = min(100_000, 2 * asked)
-        lines, _ = _mutate_list(params, asked, seed, design)
+        lines, _, _ = _mutate_list(params, asked, seed, design)
     return [_parse(k + 1, line) for k, line in enumerate(kept)]
 
 
@@ -320,8 +327,8 @@ _CLOCK_PORTS = frozenset({"CLK", "RD_CLK", "WR_CLK", "TRG"})
 
 
 def _mutate_list(params, n, seed, design):
-    """``(mutate -list lines, names of the memory cells)`` of ``design`` (list_mutants'
-    keyword arguments)."""
+    """``(mutate -list lines, names of the memory cells, the names of its top's wires the
+    mutant netlist adds itself)`` of ``design`` (list_mutants' keyword arguments)."""
     with tempfile.TemporaryDirectory(prefix="fr-mutate-") as work:
         read = _read_design(
             work, params, design["rtlil_text"], design["verilog"], design["includes"]
@@ -331,6 +338,7 @@ def _mutate_list(params, n, seed, design):
                 *read,
                 *(s.format(top=design["top"]) for s in _PREPARE),
                 "select -write memories.txt t:$mem*",
+                f"select -write taken.txt w:{MUTATION_SELECT} w:{WATCH_PORT}",
                 f"mutate -list {n} -seed {int(seed)} -o mutants.ys",
             ],
             work,
@@ -339,7 +347,9 @@ def _mutate_list(params, n, seed, design):
             lines = [line.strip() for line in f.read().splitlines() if line.strip()]
         with open(os.path.join(work, "memories.txt")) as f:
             memories = {e.strip().partition("/")[2].lstrip("\\") for e in f if e.strip()}
-    return lines, memories
+        with open(os.path.join(work, "taken.txt")) as f:
+            taken = {e.strip().partition("/")[2].lstrip("\\") for e in f if e.strip()}
+    return lines, memories, taken
 
 
 def _builds(params, lines, design):

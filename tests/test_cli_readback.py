@@ -1,10 +1,13 @@
 """``fpga-robotics readback``: the frames of any design's recording (whatever entities it
 logs), ``--help``, and a file that is not a recording as one line with exit code 2."""
 
+import subprocess
+import sys
 import warnings
 
 import pytest
 import rerun as rr
+import rerun.blueprint as rrb
 
 from fpga_robotics import cli
 
@@ -74,3 +77,34 @@ def test_a_cut_off_recording_is_one_line(tmp_path, capsys):
         code, out, err = _readback([str(cut)], capsys)
     assert (code, out) == (2, "") and [str(w.message) for w in said] == []
     assert err.count("\n") == 1 and "is not a rerun recording" in err, err
+
+
+def test_the_library_module_run_as_a_command_points_at_the_command(tmp_path):
+    # `python -m fpga_robotics.viz.readback FILE` ran nothing, printed nothing and exited 0.
+    path = _recording(tmp_path / "r.rrd", {"design/found": range(3)})
+    done = subprocess.run(
+        [sys.executable, "-m", "fpga_robotics.viz.readback", str(path)],
+        check=False,
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert (done.returncode, done.stdout) == (2, "")
+    assert done.stderr.count("\n") == 1 and "fpga-robotics readback FILE.rrd" in done.stderr
+
+
+def test_a_file_of_only_a_viewer_layout_is_one_line(tmp_path, capsys):
+    # A saved blueprint (.rbl) holds no recording store: rerun raised ValueError, a traceback.
+    layout = tmp_path / "layout.rrd"
+    rrb.Blueprint(rrb.Spatial2DView()).save("app", str(layout))
+    code, out, err = _readback([str(layout)], capsys)
+    assert (code, out) == (2, "")
+    assert err.count("\n") == 1 and "layout.rrd holds no recording" in err
+
+
+def test_a_folder_is_named_as_a_folder(tmp_path, capsys):
+    # It said "no recording at 'runs.rrd'", as of a path with nothing there.
+    (tmp_path / "runs.rrd").mkdir()
+    code, out, err = _readback([str(tmp_path / "runs.rrd")], capsys)
+    assert (code, out) == (2, "")
+    assert err.count("\n") == 1 and "runs.rrd is a folder, not a recording (.rrd)" in err

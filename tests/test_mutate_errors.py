@@ -425,4 +425,140 @@ def test_a_failed_build_of_follow_target_s_netlist_is_one_line(tmp_path, capsys,
     err = capsys.readouterr().err
     assert exc.value.code == 2 and len(err.strip().splitlines()) == 1
     assert "failed (exit 2): g++: error: Vfollow_target__pch.h.fast" in err
+
+
+COUNTER = """
+from amaranth import Module
+from amaranth.lib import wiring
+from amaranth.lib.wiring import Out
+
+
+class Counter(wiring.Component):
+    count: Out(8)
+
+    def elaborate(self, platform):
+        m = Module()
+        m.d.sync += self.count.eq(self.count + 1)
+        return m
+"""
+
+
+@pytest.mark.parametrize(
+    ("design", "message"),
+    [
+        # Its inputs up and clear bound to no connector: nothing in a run drives them.
+        ("counters.py:Saturating", "no connector pin drives Saturating's input 'up'"),
+        # No input, outputs no run acts on or checks: every mutant would be a blind spot.
+        ("counter.py:Counter", "no run can catch a mutant of Counter: it binds no wheels"),
+    ],
+)
+def test_a_design_no_campaign_run_can_judge_is_refused_before_the_build(
+    tmp_path, capsys, monkeypatch, design, message
+):
+    def listed(*args, **kwargs):
+        raise AssertionError("the mutants were listed before the design was checked")
+
+    monkeypatch.setattr("fpga_robotics.mutation.design_run.list_mutants", listed)
+    (tmp_path / "counter.py").write_text(COUNTER)
+    folder = tmp_path if design.startswith("counter.py") else f"{DATA}/user_designs"
+    out = tmp_path / "m"
+    argv = ["--design", f"{folder}/{design}", "--mutants", "2"]
+    with pytest.raises(SystemExit) as exc:
+        run_cli(main, [*argv, "--campaign", "mutation", "--out", str(out)], "mutate")
+    err = capsys.readouterr().err
+    assert exc.value.code == 2 and len(err.strip().splitlines()) == 1
+    assert message in err and "leave out --campaign" in err
+    assert not out.exists()
+
+
+class _HungDesign:
+    """A mutant netlist whose unmutated design never raises ``frame_done``."""
+
+    def set_runtime(self, name, value):
+        pass
+
+    def reset(self):
+        pass
+
+    def process_frame(self, frame, color):
+        raise BackendError("follow_target: frame 0: timeout: frame_done never rose")
+
+    def close(self):
+        pass
+
+
+def test_against_design_with_a_broken_unmutated_design_is_one_line(tmp_path, capsys, monkeypatch):
+    at = "fpga_robotics.cli.mutate."
+    monkeypatch.setattr(at + "list_mutants", lambda *a, **k: [])
+    monkeypatch.setattr(at + "write_mutant_design", lambda p, m, out: ("mutants.v", "ports.toml"))
+    monkeypatch.setattr(at + "open_mutant_design", lambda *a, **k: _HungDesign())
+    out = tmp_path / "m"
+    with pytest.raises(SystemExit) as exc:
+        run_cli(main, ["--mutants", "2", "--against", "design", "--out", str(out)], "mutate")
+    err = capsys.readouterr().err
+    assert exc.value.code == 2 and len(err.strip().splitlines()) == 1
+    assert "--against design: the unmutated design fails" in err and "frame_done never" in err
+    assert not out.exists()
+
+
+NAMED = '''
+from amaranth import Module, signed
+from amaranth.lib import wiring
+from amaranth.lib.wiring import In, Out
+
+
+class Named(wiring.Component):
+    """A port named as the mutant netlist's select or watch."""
+
+    {name}: {direction}(4)
+    motor_left: Out(signed(16))
+    motor_right: Out(signed(16))
+
+    def elaborate(self, platform):
+        m = Module()
+        m.d.sync += self.motor_left.eq(self.{name} + 1)
+        m.d.comb += self.motor_right.eq(self.motor_left)
+        return m
+'''
+
+
+@pytest.mark.parametrize(("name", "direction"), [("mutsel", "In"), ("mutinf", "Out")])
+def test_a_design_with_a_port_named_as_the_mutant_select_is_one_clear_line(
+    tmp_path, capsys, name, direction
+):
+    # Yosys failed on them: an assertion in mutate.cc, a redefinition of wire \mutinf.
+    (tmp_path / "named.py").write_text(NAMED.format(name=name, direction=direction))
+    out = tmp_path / "m"
+    argv = ["--design", f"{tmp_path}/named.py:Named", "--mutants", "2", "--out", str(out)]
+    with pytest.raises(SystemExit) as exc:
+        run_cli(main, argv, "mutate")
+    err = capsys.readouterr().err
+    assert exc.value.code == 2 and len(err.strip().splitlines()) == 1
+    assert f"the design has a signal named {name!r}, a name the mutant netlist adds" in err
+    assert "rename it" in err and not out.exists()
+
+
+def test_a_verilog_design_no_campaign_run_can_judge_is_refused_before_the_build(
+    tmp_path, capsys, monkeypatch
+):
+    def listed(*args, **kwargs):
+        raise AssertionError("the mutants were listed before the design was checked")
+
+    monkeypatch.setattr("fpga_robotics.mutation.design_run.list_mutants", listed)
+    (tmp_path / "cnt.v").write_text(
+        "module cnt(input clk, input rst, output reg [7:0] count);\n"
+        "  always @(posedge clk) if (rst) count <= 0; else count <= count + 1;\n"
+        "endmodule\n"
+    )
+    (tmp_path / "cnt.toml").write_text(
+        'top = "cnt"\nclock = { port = "clk" }\nreset = { port = "rst" }\n'
+        '[extra_outputs]\ncount = "count"\n'
+    )
+    out = tmp_path / "m"
+    argv = ["--design", f"verilog:{tmp_path}/cnt.v", "--ports", str(tmp_path / "cnt.toml")]
+    with pytest.raises(SystemExit) as exc:
+        run_cli(main, [*argv, "--campaign", "mutation", "--out", str(out)], "mutate")
+    err = capsys.readouterr().err
+    assert exc.value.code == 2 and len(err.strip().splitlines()) == 1
+    assert "no run can catch a mutant of cnt: it binds no wheels, servo or camera" in err
     assert not out.exists()

@@ -231,6 +231,10 @@ def test_robot_judge_of_a_users_design_matches_its_runs(tmp_path, capsys):
         (["--design", "wall_stop.py:WallStop", "--param", "nope"], "--param must be NAME=VALUE"),
         (["--cycles", "5"], "--param, --ports, --cycles and --resolution go with --design REF"),
         (
+            ["--design", "follow_target", "--param", "x=1"],
+            "not FollowTarget (the default, and --design follow_target)",
+        ),
+        (
             ["--design", "wall_stop.py:WallStop", "--width", "80", "--kp-num", "5"],
             "--width, --kp-num: FollowTarget's options",
         ),
@@ -608,7 +612,7 @@ def test_mutants_on_a_memorys_constant_ports_are_replaced():
     params = FollowTargetParams()
     # The first seed whose raw list holds a mutant Yosys cannot build (there is one).
     for seed in range(1, 20):
-        lines, memories = _mutate_list(params, 12, seed, design)
+        lines, memories, _ = _mutate_list(params, 12, seed, design)
         on_memories = [line for line in lines if any(f"-cell {c} " in line for c in memories)]
         bad = [line for line in on_memories if not _builds(params, [line], design)]
         if bad:

@@ -169,3 +169,37 @@ def test_a_small_rooms_recording_opens_on_the_room_not_its_wall(tmp_path):
     ]
     assert eyes  # the layout with the 3D view, sent once its first frame came
     assert _sees_the_floor_over_the_near_wall(eyes[-1], (0.0, 0.0, 4.0, 3.0), wall_height)
+
+
+def test_a_tape_line_on_the_floor_is_drawn_in_the_3d_view(tmp_path):
+    # The map and the camera showed a [[room.lines]] track; the 3D view's floor was bare.
+    path = tmp_path / "tape.rrd"
+    tape = 'room.lines=[{name="tape", points=[[1.0, 1.5], [3.0, 1.5]], width=0.02, color=[0.05, 0.05, 0.05]}]'
+    scenario = load_scenario("divider", ["sim.duration=0.1", tape])
+    with open_recorder(f"save:{path}", default_path=str(path)) as rec:
+        run_scenario(scenario, backend="model", recorder=rec)
+    marks = read_rrd(str(path)).static["world3d/floor/marks"]
+    v = np.array(marks["Mesh3D:vertex_positions"])
+    triangles = marks["Mesh3D:triangle_indices"]
+    # A 2 cm band along the tape (round ends, as the map draws it), just above the floor.
+    assert v[:, 2] == pytest.approx(0.002)
+    assert (v[:, 0].min(), v[:, 0].max()) == pytest.approx((0.99, 3.01), abs=1e-4)
+    assert (v[:, 1].min(), v[:, 1].max()) == pytest.approx((1.49, 1.51), abs=1e-4)
+
+    def cross(o, p, q):  # > 0: q left of the line from o to p
+        return (p[0] - o[0]) * (q[1] - o[1]) - (p[1] - o[1]) * (q[0] - o[0])
+
+    def covered(x, y):
+        for tri in triangles:
+            a, b, c = (v[k, :2] for k in tri)
+            d = [cross(a, b, (x, y)), cross(b, c, (x, y)), cross(c, a, (x, y))]
+            if min(d) >= -1e-9 or max(d) <= 1e-9:
+                return True
+        return False
+
+    assert all(covered(x, y) for x in (1.0, 1.7, 3.0) for y in (1.495, 1.5, 1.505))
+    assert not any(covered(x, y) for x, y in ((2.0, 1.52), (2.0, 1.48), (3.02, 1.5)))
+    colors = {
+        tuple(int(b) for b in int(c).to_bytes(4, "big")) for c in marks["Mesh3D:vertex_colors"]
+    }
+    assert colors == {(13, 13, 13, 255)}

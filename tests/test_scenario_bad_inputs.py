@@ -404,6 +404,15 @@ CASES = [
         "port 'turret_centroid_x' of design 'turret_tracker' is out 8 bit(s);",
     ),
     (
+        # The run's width, not the default resolution's (8 bits at 160x120).
+        "servo-on-an-unsigned-output-at-640x480",
+        [
+            *(*TURRET, "--set", 'sim.timing="real_clock"', "--set", SERVO.format("centroid_x")),
+            *("--set", "camera.resolution=640x480"),
+        ],
+        "port 'centroid_x' of design 'turret_tracker' is out 10 bit(s);",
+    ),
+    (
         "servo-on-an-unsigned-output-of-its-width",
         ["--scenario", "{in}/servo_unsigned.toml"],
         (

@@ -9,7 +9,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from fpga_robotics.scenario.load import _parse_value
-from fpga_robotics.sweep import load_campaign
+from fpga_robotics.sweep import load_campaign, load_campaign_file
 from fpga_robotics.sweep.campaign import parse_seeds, toml_value
 
 SCALARS = (
@@ -129,3 +129,18 @@ reason = "the desk hides the target"
     assert [json.loads(row["room.furniture"]) for row in rows] == expected
     limits = [known_limit(row, "found_min_fraction", campaign.known_limits) for row in rows]
     assert [entry is not None for entry in limits] == [True, False, False]
+
+
+def test_an_absolute_scenario_path_stays_as_given(tmp_path, monkeypatch):
+    # It became a path from the current folder (../../work/x.toml from /tmp/a/b), which the
+    # replay commands printed.
+    scenario = tmp_path / "s" / "mine.toml"
+    scenario.parent.mkdir()
+    scenario.write_text('name = "mine"\n')
+    campaign = tmp_path / "c" / "c.toml"
+    campaign.parent.mkdir()
+    campaign.write_text(f'scenarios = ["{scenario}", "../s/mine.toml"]\nseeds = "0"\n')
+    (tmp_path / "here").mkdir()
+    monkeypatch.chdir(tmp_path / "here")
+    runs = load_campaign_file(str(campaign)).runs
+    assert [r.scenario for r in runs] == [str(scenario), "../s/mine.toml"]

@@ -11,6 +11,7 @@ pixels, whichever way they were logged (``viz.images``).
 """
 
 import os
+import sys
 import warnings
 from dataclasses import dataclass, field
 
@@ -68,6 +69,8 @@ def _row_values(column):
 
 def read_rrd(path):
     """Read the first recording in ``path``; returns a ``Recording``."""
+    if os.path.isdir(path):
+        raise ViewerError(f"{path} is a folder, not a recording (.rrd)")
     if not os.path.isfile(path):
         raise FileNotFoundError(f"no recording at {str(path)!r}")
     try:
@@ -80,6 +83,10 @@ def read_rrd(path):
     except RuntimeError as exc:  # rerun's word for a file that is not a recording
         raise ViewerError(
             f"{path} is not a rerun recording (.rrd): {str(exc).splitlines()[0]}"
+        ) from None
+    except ValueError as exc:  # an .rrd with only a blueprint (a saved layout, .rbl)
+        raise ViewerError(
+            f"{path} holds no recording (a viewer layout at most): {str(exc).splitlines()[0]}"
         ) from None
     entities, static = {}, {}
     for chunk in chunks:
@@ -183,3 +190,14 @@ def summary_lines(rec, name):
         f"  {path:22s} static: {', '.join(sorted(rec.static[path]))}" for path in sorted(rec.static)
     ]
     return lines
+
+
+if __name__ == "__main__":
+    # A library module: the command that reads a recording is the application layer's, which
+    # this layer does not import. Without this, `python -m` ran nothing and exited 0.
+    print(
+        "python -m fpga_robotics.viz.readback: error: a library module; read a recording "
+        "with: fpga-robotics readback FILE.rrd",
+        file=sys.stderr,
+    )
+    sys.exit(2)

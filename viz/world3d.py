@@ -22,6 +22,7 @@ from fpga_robotics.sim.camera.render3d.body import (
     gait_angles,
     person_height,
 )
+from fpga_robotics.sim.camera.render3d.floor_patches import LIFT, triangulate
 
 from . import paths as P
 
@@ -31,6 +32,8 @@ WORLD3D = "world3d"
 ROOM = "world3d/room"
 FURNITURE = "world3d/furniture"
 FLOOR = "world3d/floor"
+#: What is painted or taped on the floor (``Scene.floor_patches``: terrain, line tracks).
+FLOOR_MARKS = "world3d/floor/marks"
 PEOPLE = "world3d/people"
 ROBOT = "world3d/robot"
 #: The pinhole: the parent of the camera frame (``viz.paths.CAMERA_RAW``).
@@ -67,6 +70,18 @@ def _wall_boxes(walls):
         quats.append(rr.Quaternion(xyzw=(0.0, 0.0, math.sin(a / 2), math.cos(a / 2))))
         colors.append(_u8(w.color))
     return centers, halves, quats, colors
+
+
+def _floor_marks(patches):
+    """One mesh of the floor's patches (``[(polygon, colour)]``), each cut into triangles,
+    just above the floor as the 3D renderer lays them."""
+    vertices, triangles, colors = [], [], []
+    for polygon, color in patches:
+        for tri in triangulate(polygon):
+            triangles.append(range(len(vertices), len(vertices) + 3))
+            vertices += [(x, y, LIFT) for x, y in tri]
+            colors += [_u8(color)] * 3
+    return rr.Mesh3D(vertex_positions=vertices, triangle_indices=triangles, vertex_colors=colors)
 
 
 def _limbs(cyl):
@@ -188,6 +203,8 @@ class World3D:
             ),
             static=True,
         )
+        if scene.floor_patches:
+            log(FLOOR_MARKS, _floor_marks(scene.floor_patches), static=True)
         self._walls = scene.walls
 
     def _log_pinhole(self, width, height, hfov):

@@ -184,3 +184,9 @@ def _refuse_builtin_parameters(args, name):
         f"with others, export its Verilog (fpga-robotics export --top {name} ...) and give "
         "that as --design verilog:FILE.v --ports MAP"
     )
+
+
+if __name__ == "__main__":  # python -m fpga_robotics.cli.board: as fpga-robotics board
+    from fpga_robotics.cli import run_command
+
+    run_command("board")

@@ -304,3 +304,9 @@ def _export_design(args):
     write_atomic(output, text, what="Verilog file")
     print(f"wrote {output} (module {name}, {len(spec.ports)} ports)")
     return 0
+
+
+if __name__ == "__main__":  # python -m fpga_robotics.cli.export: as fpga-robotics export
+    from fpga_robotics.cli import run_command
+
+    run_command("export")

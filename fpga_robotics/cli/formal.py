@@ -143,3 +143,9 @@ def main(argv=None, prog="fpga-robotics formal"):
         f"({total:.1f}s of solver time)"
     )
     return 1 if failed else 0
+
+
+if __name__ == "__main__":  # python -m fpga_robotics.cli.formal: as fpga-robotics formal
+    from fpga_robotics.cli import run_command
+
+    run_command("formal")

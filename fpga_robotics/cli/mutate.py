@@ -391,6 +391,33 @@ def _reach_scheduler(address):
             pass
 
 
+#: The connector kinds whose pins a run acts on or a check reads: wheels and a servo move
+#: the robot, a camera design's results are checked.
+_JUDGED_KINDS = ("wheels", "servo", "camera")
+
+
+def _refuse_unjudgeable(spec, name):
+    """``UsageError`` before any build when no run of a campaign can run or judge the design
+    ``spec`` (``name``): an input no connector pin binds (nothing in the closed loop drives
+    it) or no output a run acts on or checks."""
+    bound = {port for pins in spec.bindings.values() for port in pins.values()}
+    # A Verilog design's ports are known once built; its port map maps every input.
+    for port, (direction, _) in spec.ports.items():
+        # A stream's ports (pixels__valid) are bound by the stream's name.
+        if direction == "in" and port not in bound and port.split("__")[0] not in bound:
+            raise UsageError(
+                f"--campaign: no connector pin drives {name}'s input {port!r}, so no run can "
+                "run it; bind it to a connector pin (docs/your_design.md), or leave out "
+                "--campaign for the unit judge alone"
+            )
+    if not any(kind in spec.bindings for kind in _JUDGED_KINDS):
+        raise UsageError(
+            f"--campaign: no run can catch a mutant of {name}: it binds no wheels, servo or "
+            "camera, so nothing in a run acts on its outputs and no check reads them; "
+            "leave out --campaign for the unit judge alone"
+        )
+
+
 def _main_design(args):
     """``--design REF``: the mutants of a design of one's own against itself."""
     refuse_followtarget_options(
@@ -426,6 +453,7 @@ def _main_design(args):
         )
     campaign = None
     if args.campaign is not None:
+        _refuse_unjudgeable(spec, name)
         campaign = load_campaign_file(args.campaign)
         design_argv = ["--design", args.design, *(["--ports", args.ports] if verilog else [])]
         plan = check_campaign(campaign)
@@ -529,8 +557,9 @@ def main(argv=None, prog="fpga-robotics mutate"):
     args.against = args.against or "model"
     if args.param or args.cycles is not None or args.ports is not None or args.resolution:
         raise UsageError(
-            "--param, --ports, --cycles and --resolution go with --design REF (a design of "
-            "your own; FollowTarget's frame size is --width and --height)"
+            "--param, --ports, --cycles and --resolution go with --design REF, a design of "
+            "your own, not FollowTarget (the default, and --design follow_target), whose "
+            "frame size is --width and --height"
         )
     params = params_from_args(args)
     # The mutant netlist is built for this frame size and these values: every robot judge
@@ -540,11 +569,11 @@ def main(argv=None, prog="fpga-robotics mutate"):
     check_output_dir(out, what="output folder")
     _reach_scheduler(args.scheduler)
 
-    with _removed_on_error(out, campaign):
-        try:
+    try:
+        with _removed_on_error(out, campaign):
             return _mutate_follow_target(args, params, campaign, out)
-        except BackendError as exc:  # the netlist's build: one line, as --design says it
-            raise UsageError(_one_line(exc)) from None
+    except BackendError as exc:  # the netlist failed to build, or its reference to run
+        raise UsageError(_one_line(exc)) from None
 
 
 def _mutate_follow_target(args, params, campaign, out):
@@ -577,11 +606,14 @@ def _mutate_follow_target(args, params, campaign, out):
     build_s = time.perf_counter() - t0
     try:
         frames = judge_frames(params)
-        golden = (
-            golden_results(params, frames)
-            if args.against == "model"
-            else reference_results(design, frames)
-        )
+        try:
+            golden = (
+                golden_results(params, frames)
+                if args.against == "model"
+                else reference_results(design, frames)
+            )
+        except BackendError as exc:
+            raise BackendError(f"--against design: the unmutated design fails: {exc}") from None
         t1 = time.perf_counter()
         verdicts = []
         for k, m in enumerate(mutants, start=1):
@@ -698,3 +730,9 @@ def _mutate_follow_target(args, params, campaign, out):
             print(f"  {m.describe()}")
     print(f"wrote {os.path.join(out, 'mutants.json')}")
     return _exit_code(baseline)
+
+
+if __name__ == "__main__":  # python -m fpga_robotics.cli.mutate: as fpga-robotics mutate
+    from fpga_robotics.cli import run_command
+
+    run_command("mutate")

@@ -71,3 +71,9 @@ def _check_against_design(reference, path):
     """Raise a one-line ``DesignError`` at the first way the map and the design disagree."""
     spec = checked_verilog(resolve_design(reference, {}, ports=path), path)
     print(f"{path}: matches {reference} ({len(spec.ports)} ports)")
+
+
+if __name__ == "__main__":  # python -m fpga_robotics.cli.ports: as fpga-robotics ports
+    from fpga_robotics.cli import run_command
+
+    run_command("ports")

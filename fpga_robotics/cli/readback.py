@@ -21,3 +21,9 @@ def main(argv=None, prog="fpga-robotics readback"):
     for line in summary_lines(read_rrd(args.path), args.path):
         print(line)
     return 0
+
+
+if __name__ == "__main__":  # python -m fpga_robotics.cli.readback: as fpga-robotics readback
+    from fpga_robotics.cli import run_command
+
+    run_command("readback")

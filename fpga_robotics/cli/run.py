@@ -18,7 +18,7 @@ from importlib import resources
 from pathlib import Path
 
 from fpga_robotics.checks.summary import format_summary
-from fpga_robotics.cli.errors import UsageError
+from fpga_robotics.cli.errors import UsageError, run_cli
 from fpga_robotics.cli.parser import CommandParser
 from fpga_robotics.designs.builtin import TOPS
 from fpga_robotics.designs.reference import design_parameters, design_source_files
@@ -1216,3 +1216,7 @@ def main(argv=None, prog="fpga-robotics run"):
     if args.summary:
         write_json_atomic(args.summary, summary, what="--summary")
     return 0 if summary["verdict"] == "pass" else 1
+
+
+if __name__ == "__main__":  # python -m fpga_robotics.cli.run: as fpga-robotics run
+    run_cli(main, sys.argv[1:], prog="fpga-robotics run")

@@ -381,3 +381,9 @@ def main(argv=None, prog=PROG):
     )
     # A failure a [[known_limits]] entry explains is a limit of the design, not a regression.
     return 0 if campaign_passed(rows, campaign.known_limits) else 1
+
+
+if __name__ == "__main__":  # python -m fpga_robotics.cli.sweep: as fpga-robotics sweep
+    from fpga_robotics.cli import run_command
+
+    run_command("sweep")

@@ -7,8 +7,8 @@ only then).
 import importlib
 import math
 
-from fpga_robotics.designs.builtin import TOPS, connector_kinds, foreign_top
-from fpga_robotics.designs.reference import resolve_design
+from fpga_robotics.designs.builtin import TOPS, build_component, connector_kinds, foreign_top
+from fpga_robotics.designs.reference import component_ports, resolve_design, signed_ports
 from fpga_robotics.hw.errors import UsageError
 from fpga_robotics.loop.camera_rig import frame_channel
 from fpga_robotics.loop.connectors import CONNECTORS
@@ -226,7 +226,7 @@ def _check_servo(scenario, spec, top, registered):
         )
     design = None  # a Verilog design's ports are known once it is built (RealClockLoop)
     if scenario.foreign is None:
-        design = resolve_design(scenario.top, scenario.design_params)
+        design = _run_ports(scenario, registered)
     if scenario.sim.timing == "compressed":
         channels = registered.frame_channels if registered is not None else {}
         outputs = {
@@ -247,15 +247,29 @@ def _check_servo(scenario, spec, top, registered):
             )
     if design is None:
         return
-    if port not in design.ports:
-        raise no_port("servo", spec.name, top, "angle", port, design.ports)
+    ports, _ = design
+    if port not in ports:
+        raise no_port("servo", spec.name, top, "angle", port, ports)
     misfit = _servo_misfit(spec, top, design, port)
     if misfit is not None:
         raise UsageError(misfit)
 
 
+def _run_ports(scenario, registered):
+    """``(ports, signed)`` of the design as this run builds it: name -> (direction, width),
+    and the signed ports' names. A built-in design is built with the run's resolution and
+    tables: its resolved spec has the defaults' widths (centroid_x is 8 bits at 160x120, 10
+    at 640x480)."""
+    if registered is None:
+        design = resolve_design(scenario.top, scenario.design_params)
+        return design.ports, design.signed
+    component = build_component(registered, scenario.params, scenario.design_tables)
+    return component_ports(component), signed_ports(component)
+
+
 def _servo_misfit(spec, top, design, port):
-    direction, width = design.ports[port]
+    ports, signed = design
+    direction, width = ports[port]
     return port_misfit(
-        "servo", spec.name, top, "angle", Port(port, width, direction, port in design.signed)
+        "servo", spec.name, top, "angle", Port(port, width, direction, port in signed)
     )

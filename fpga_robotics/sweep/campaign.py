@@ -701,7 +701,8 @@ def run_identity(spec, scenario_source, design_digest=""):
 
 def _near(value, base):
     """A path given in a campaign file, relative to the file's folder, as a path from here
-    (so that replay commands work where the campaign was started)."""
+    (so that replay commands work where the campaign was started); an absolute one as given
+    (it works from any folder, as the user wrote it)."""
     if (
         not isinstance(value, str)
         or "/" not in value
@@ -709,10 +710,11 @@ def _near(value, base):
     ):
         return value
     path = Path(value)
-    if not path.is_absolute():
-        candidate = base / path
-        if candidate.exists() or not path.exists():
-            path = candidate
+    if path.is_absolute():
+        return value
+    candidate = base / path
+    if candidate.exists() or not path.exists():
+        path = candidate
     try:
         return os.path.relpath(path)
     except ValueError:
