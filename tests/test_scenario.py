@@ -48,6 +48,17 @@ def test_the_five_scenarios_are_shipped_and_load():
         assert s.params.width == s.camera.width and s.params.height == s.camera.height
 
 
+def test_the_readme_names_every_shipped_scenario():
+    """The README's "Scenarios (...) are TOML files" reads as the full list."""
+    import re
+    from pathlib import Path
+
+    readme = (Path(__file__).resolve().parent.parent / "README.md").read_text()
+    listing = re.search(r"Scenarios \((.*?)\)\s+are TOML files", readme, re.DOTALL)
+    assert listing, "README.md lost its list of scenarios"
+    assert set(re.findall(r"`(\w+)`", listing.group(1))) == set(shipped_scenarios())
+
+
 def test_defaults_fill_the_application_sections(tmp_path):
     s = load_scenario(write(tmp_path, MINIMAL))
     assert s.name == "mini" and s.seed == 0
