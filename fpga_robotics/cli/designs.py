@@ -2,12 +2,12 @@
 the ``fpga_robotics.designs`` entry points, or the reference given), with their ports, the
 connectors they bind and the outputs recorded under their own names."""
 
-import argparse
 import dataclasses
 import sys
 
 from fpga_robotics.cli.errors import UsageError, run_cli
 from fpga_robotics.cli.param_options import design_params_from_items
+from fpga_robotics.cli.parser import CommandParser
 from fpga_robotics.designs.builtin import TOPS, connector_kinds
 from fpga_robotics.designs.reference import DesignError, entry_point_designs, resolve_design
 
@@ -15,7 +15,7 @@ __all__ = ["describe", "main"]
 
 
 def build_parser(prog):
-    p = argparse.ArgumentParser(
+    p = CommandParser(
         prog=prog,
         description="List the designs a scenario's design.top (or run --design) can "
         "name, with their ports and the connectors they bind.",

@@ -6,7 +6,6 @@ They are written into a hidden folder next to NAME first and moved into place at
 a failure leaves nothing behind; an existing folder that is not empty is refused.
 """
 
-import argparse
 import os
 import re
 import shutil
@@ -17,6 +16,7 @@ from importlib import metadata, resources
 from pathlib import Path
 
 from fpga_robotics.cli.errors import UsageError
+from fpga_robotics.cli.parser import CommandParser
 from fpga_robotics.sim.files import default_dir_mode
 
 __all__ = ["main", "write_project"]
@@ -98,7 +98,7 @@ def write_project(folder):
 
 
 def main(argv=None, prog="fpga-robotics new"):
-    p = argparse.ArgumentParser(
+    p = CommandParser(
         prog=prog,
         description="Write a project skeleton: an Amaranth design (design.py), a "
         "scenario it passes (scenario.toml), a pytest test of it and a README. "
