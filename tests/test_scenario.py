@@ -267,6 +267,22 @@ def test_a_world_section_the_file_lacks_can_be_set():
         load_scenario("follow_person", ["lighting.ambiant=0.3"])
 
 
+@pytest.mark.parametrize("key", ["lighting.ambient", "lighting.intensity"])
+def test_a_light_level_the_keyframes_would_replace_is_refused(key):
+    # `lighting` dims by its keyframes: a constant level set over them changed nothing.
+    with pytest.raises(ScenarioError, match=rf"^{key} is not used: the scenario's lighting\.keyf"):
+        load_scenario("lighting", [f"{key}=0.1"])
+    with pytest.raises(ScenarioError, match=rf"^{key} is not used"):
+        load_scenario("follow_person", ["lighting.keyframes=[[0, 0.5, 0.5]]", f"{key}=0.1"])
+    # With the keyframes gone (in either order) the level is the light.
+    for overrides in (
+        ["lighting.keyframes=[]", f"{key}=0.1"],
+        [f"{key}=0.1", "lighting.keyframes=[]"],
+    ):
+        lighting = load_scenario("lighting", overrides).world["lighting"]
+        assert lighting[key.split(".")[1]] == 0.1 and lighting["keyframes"] == []
+
+
 # -- limits, names, types and the camera's geometry (issue 11) --------------------------------
 
 

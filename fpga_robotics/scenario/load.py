@@ -583,6 +583,17 @@ def _apply_overrides(data, overrides):
         value = _parse_value(text)
         # people[0].speed, as the world's messages write it, is people.0.speed.
         _set_path(data, _override_key(item), value, key)
+    # With keyframes the light follows them and ambient and intensity are never read: an
+    # override of either would change nothing, silently.
+    lighting = data.get("lighting")
+    if isinstance(lighting, dict) and lighting.get("keyframes"):
+        for key in ("lighting.ambient", "lighting.intensity"):
+            if any(_override_key(o) == key for o in overrides):
+                raise ScenarioError(
+                    f"{key} is not used: the scenario's lighting.keyframes set the light over "
+                    f"time; set lighting.keyframes=[] as well for a constant light, or change "
+                    f"the keyframes"
+                )
 
 
 def _set_path(data, key, value, shown):
