@@ -283,6 +283,22 @@ def test_a_light_level_the_keyframes_would_replace_is_refused(key):
         assert lighting[key.split(".")[1]] == 0.1 and lighting["keyframes"] == []
 
 
+def test_a_camera_value_the_other_sensor_path_reads_is_refused():
+    # noise_std is the plain path's, [camera.ov7670] the sensor model's: set on the other
+    # path, it changed nothing.
+    with pytest.raises(
+        ScenarioError, match=r'^camera\.noise_std is not used: with camera\.sensor = "ov7670"'
+    ):
+        load_scenario("follow_person", ["camera.sensor=ov7670", "camera.noise_std=8"])
+    with pytest.raises(
+        ScenarioError, match=r'^camera\.ov7670\.max_gain is not used: camera\.sensor is "plain"'
+    ):
+        load_scenario("follow_person", ["camera.ov7670.max_gain=2"])
+    assert load_scenario("follow_person", ["camera.noise_std=8"]).camera.noise_std == 8
+    s = load_scenario("follow_person", ["camera.ov7670.max_gain=2", "camera.sensor=ov7670"])
+    assert s.camera.sensor == "ov7670" and s.camera.ov7670.max_gain == 2
+
+
 # -- limits, names, types and the camera's geometry (issue 11) --------------------------------
 
 
