@@ -588,6 +588,10 @@ def _apply_overrides(data, overrides):
         _set_path(data, _override_key(item), value, key)
 
 
+#: The ``[camera]`` keys only the 3D renderer reads (docs/render3d.md).
+_RENDER3D_KEYS = ("shadows", "shadow_size", "textures", "floor", "shine", "lamps")
+
+
 def _refuse_unread_overrides(data, keys):
     """An override of a value the scenario as set never reads would change nothing, silently:
     ``ScenarioError`` saying what does set it."""
@@ -613,6 +617,15 @@ def _refuse_unread_overrides(data, keys):
                 raise ScenarioError(
                     f'{key} is not used: camera.sensor is "{sensor}"; set '
                     f"camera.sensor=ov7670 as well for the sensor model"
+                )
+    renderer = camera.get("renderer", "raster") if isinstance(camera, dict) else "raster"
+    if renderer != "mujoco":
+        for key in keys:
+            section, _, rest = key.partition(".")
+            if section == "camera" and rest.split(".")[0] in _RENDER3D_KEYS:
+                raise ScenarioError(
+                    f'{key} is not used: camera.renderer is "{renderer}" and only the 3D '
+                    f"renderer reads it; set camera.renderer=mujoco as well (docs/render3d.md)"
                 )
 
 
