@@ -107,6 +107,11 @@ def test_version_is_the_installed_package_version(capsys):
         ["formal", "--depth", "deep"],
         ["mutate", "--mutants", "many"],
         ["board", "--seed", "x"],
+        ["new"],
+        ["new", "a", "b"],
+        ["designs", "--no-such-option"],
+        *[[name, "--no-such-option"] for name in cli.COMMANDS if name != "bench"],
+        ["bench", "design", "--no-such-option"],
     ],
 )
 def test_a_bad_argument_is_one_line_naming_the_command(argv, capsys):
@@ -117,6 +122,14 @@ def test_a_bad_argument_is_one_line_naming_the_command(argv, capsys):
     assert err.count("\n") == 1, err
     assert err.startswith(f"fpga-robotics {' '.join(argv[:1])}"), err
     assert "error:" in err
+
+
+def test_a_missing_argument_is_named_as_the_usage_names_it(capsys):
+    with pytest.raises(SystemExit):
+        cli.main(["ports"])
+    assert capsys.readouterr().err == (
+        "fpga-robotics ports: error: the following arguments are required: PORTS.toml\n"
+    )
 
 
 def test_run_help_shows_the_default_scenario_values(capsys):

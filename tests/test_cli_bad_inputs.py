@@ -70,6 +70,9 @@ CASES = [
     ("nan duration", ["run", "--duration", "nan"], "--duration"),
     ("max-frames without source", ["run", "--max-frames", "5"], "--source"),
     ("duration with source", ["run", "--source", "{frames}", "--duration", "1"], "--duration"),
+    # the simulated world's options, which real frames would take and drop
+    ("seed with source", ["run", "--source", "{frames}", "--seed", "3"], "--seed fixes the"),
+    ("realtime with source", ["run", "--source", "{frames}", "--realtime"], "--realtime paces"),
     (
         "colour of a design without a camera",
         ["run", "--scenario", "line_track", "--color", "green"],

@@ -135,3 +135,50 @@ def test_a_reader_that_goes_away_stops_the_command_quietly():
     stderr = proc.stderr.read().decode()
     assert proc.wait(timeout=60) == 141
     assert "Traceback" not in stderr and "BrokenPipe" not in stderr, stderr
+
+
+def _into_a_closed_pipe(args):
+    """Run ``python args`` with stdout a pipe whose reader has gone (``| head`` after its
+    lines), stdout buffered as in a user's shell: (exit code, stderr)."""
+    import os
+    import subprocess
+    import sys
+
+    read_end, write_end = os.pipe()
+    os.close(read_end)
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONUNBUFFERED"}
+    try:
+        proc = subprocess.run(
+            [sys.executable, *args],
+            check=False,
+            stdout=write_end,
+            stderr=subprocess.PIPE,
+            env=env,
+            timeout=120,
+            text=True,
+        )
+    finally:
+        os.close(write_end)
+    return proc.returncode, proc.stderr
+
+
+_RUN_CLI = "from fpga_robotics.cli.errors import run_cli\nimport argparse\n"
+
+
+@pytest.mark.parametrize(
+    "args",
+    [
+        # a command's short output, held in the buffer until exit, and argparse's --help
+        ["-c", _RUN_CLI + "run_cli(lambda a: print('x'))"],
+        ["-c", _RUN_CLI + "run_cli(lambda a: argparse.ArgumentParser().parse_args(['-h']))"],
+        # the top level's own listings
+        ["-m", "fpga_robotics", "--version"],
+        ["-m", "fpga_robotics", "--help"],
+        ["-m", "fpga_robotics", "bench", "--list"],
+        ["-m", "fpga_robotics", "bench", "--help"],
+    ],
+)
+def test_a_reader_gone_before_the_output_is_written_stops_it_quietly(args):
+    code, stderr = _into_a_closed_pipe(args)
+    assert code == 141, stderr
+    assert "Traceback" not in stderr and "BrokenPipe" not in stderr, stderr

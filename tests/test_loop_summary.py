@@ -125,6 +125,15 @@ def test_a_run_without_a_target_person_says_so():
     )
 
 
+def test_a_run_without_a_target_person_or_a_found_output_says_so_plainly():
+    # A design of one's own without a camera (`fpga-robotics new`'s): nothing to report found.
+    absent = ("found", "proximity", "centroid_x", "centroid_leds")
+    m = compute_metrics(trajectory([0, 0], [np.nan, np.nan]), [], {}, PERIOD, absent=absent)
+    text = format_summary(summary_of(m, [], absent_outputs=list(absent)))
+    assert "  target: none in the scenario, and no tracker `found` output\n" in text
+    assert "n/a" not in text.split("  target:")[1].split("\n")[0]
+
+
 def test_a_run_too_fast_to_time_still_prints():
     m = compute_metrics(trajectory([1, 1], [1.0, 1.0]), [], {}, PERIOD)
     text = format_summary(summary_of(m, [], wall_time_s=0.0, realtime_factor=None))

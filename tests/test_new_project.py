@@ -28,7 +28,7 @@ def test_the_skeleton_passes_its_own_test(tmp_path, capsys, monkeypatch):
         "design.py",
         "pyproject.toml",
         "scenario.toml",
-        "tests/test_scenario.py",
+        "tests/test_rover.py",
     ]
     assert 'name = "rover"' in (project / "scenario.toml").read_text()
     assert not [p for p in tmp_path.iterdir() if p.name != "rover"]  # no staging folder left
@@ -44,6 +44,29 @@ def test_the_skeleton_passes_its_own_test(tmp_path, capsys, monkeypatch):
     )
     assert done.returncode == 0, done.stdout + done.stderr
     assert "1 passed" in done.stdout
+
+
+def test_two_projects_collect_in_one_pytest_session(tmp_path, capsys, monkeypatch):
+    # From a folder above both (a repository of several designs): each test module is named
+    # after its project, or pytest would refuse the second `test_scenario` module.
+    monkeypatch.chdir(tmp_path)
+    for name in ("rover", "crawler"):
+        assert _cli(["new", name], capsys)[0] == 0
+    env = {k: v for k, v in os.environ.items() if k != "PYTEST_ADDOPTS"}
+    done = subprocess.run(
+        [sys.executable, "-m", "pytest", "--collect-only", "-q", "-p", "no:cacheprovider"]
+        + ["rover", "crawler"],
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=300,
+        env=env,
+        check=False,
+    )
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert "test_rover.py::test_stops_at_the_wall" in done.stdout
+    assert "test_crawler.py::test_stops_at_the_wall" in done.stdout
+    assert "2 tests collected" in done.stdout
 
 
 def test_the_project_folder_gets_the_mode_of_a_plain_mkdir(tmp_path, capsys, monkeypatch):

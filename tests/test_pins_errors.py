@@ -163,6 +163,21 @@ def test_missing_compiler(monkeypatch, name):
         get_pin_backend(name, SOURCE)
 
 
+def test_auto_without_a_compiler_says_it_once_and_names_the_way_out(monkeypatch):
+    monkeypatch.setenv("CXX", "no-such-compiler-here")
+    with pytest.raises(PinError) as info:
+        get_pin_backend("auto", SOURCE)
+    message = str(info.value)
+    assert message.startswith(
+        "no compiled pin backend works here (cxxrtl and verilator: the C++ compiler "
+        "'no-such-compiler-here' named by the CXX environment variable was not found; "
+    )
+    assert message.count("no-such-compiler-here") == 1
+    assert message.endswith("; --backend pysim (Amaranth's simulator, slower) needs none")
+    with get_pin_backend("pysim", SOURCE) as pins:  # and it does
+        assert pins.name == "pysim"
+
+
 def test_unknown_backend():
     with pytest.raises(
         PinError,

@@ -28,6 +28,7 @@ def test_lamps_and_options_are_read():
     cam = load_scenario(
         "follow_person",
         [
+            "camera.renderer=mujoco",
             "camera.shadows=false",
             "camera.shadow_size=512",
             "camera.floor=tiles",
@@ -38,6 +39,18 @@ def test_lamps_and_options_are_read():
     o = cam.render3d
     assert (o.shadows, o.shadow_size, o.floor, o.shine) == (False, 512, "tiles", 0.4)
     assert o.lamps == (Lamp((7.0, 3.0, 2.4), (7.3, 3.0, 1.0), (1.0, 0.6, 0.3), 45.0, True),)
+
+
+def test_a_3d_key_set_for_the_raster_is_refused():
+    # The raster reads none of them: set without the 3D renderer, it changed nothing.
+    with pytest.raises(
+        ScenarioError, match=r'^camera\.shine is not used: camera\.renderer is "raster"'
+    ):
+        load_scenario("follow_person", ["camera.shine=0.4"])
+    with pytest.raises(ScenarioError, match=r"^camera\.lamps is not used"):
+        load_scenario("follow_person", ["camera.lamps=[{pos = [1, 2, 2], aim = [1, 2, 0]}]"])
+    # A 3D scenario's own keys stay when its renderer is switched to the raster.
+    assert load_scenario("divider_3d", ["camera.renderer=raster"]).camera.renderer == "raster"
 
 
 @pytest.mark.parametrize(

@@ -63,3 +63,28 @@ def test_layout_shows_published_topics_and_sends_controls():
         }
         twist[kind][axis] = value
         assert control_input("/target/cmd_vel", twist) == ("target_velocity", expected)
+
+
+def _layout_command(*argv):
+    import subprocess
+    import sys
+
+    return subprocess.run(
+        [sys.executable, "-m", "fpga_robotics.ros.layout", *argv],
+        capture_output=True,
+        text=True,
+        check=False,
+        timeout=120,
+    )
+
+
+def test_the_rewrite_command_answers_help_and_refuses_arguments_without_writing():
+    before = layout_path().stat().st_mtime_ns
+    helped = _layout_command("--help")
+    assert helped.returncode == 0 and "usage: python -m fpga_robotics.ros.layout" in helped.stdout
+    refused = _layout_command("--bogus")
+    assert refused.returncode == 2
+    assert refused.stderr == (
+        "python -m fpga_robotics.ros.layout: error: unrecognized arguments: --bogus\n"
+    )
+    assert layout_path().stat().st_mtime_ns == before  # neither rewrote the shipped file

@@ -364,3 +364,18 @@ def test_a_shorthand_beside_a_set_of_its_key_is_refused(shorthand, item, capsys)
     for argv in ([*shorthand, "--set", item], ["--set", item, *shorthand]):
         err = usage_error([*argv, "--rerun", "off"], capsys)
         assert f"{shorthand[0]} and --set {item} both set {item.split('=')[0]}" in err
+
+
+def test_the_options_table_of_running_md_has_a_row_per_option():
+    """docs/running.md's "Options" table is the reference a user reads: every option of
+    `run --help` has its row there, and every row is an option."""
+    import re
+    from pathlib import Path
+
+    from fpga_robotics.cli.run import build_parser
+
+    page = (Path(__file__).resolve().parent.parent / "docs" / "running.md").read_text()
+    table = page.split("\n## Options\n", 1)[1].split("\n\n", 1)[0]
+    documented = set(re.findall(r"^\| `(--[\w-]+)", table, re.MULTILINE))
+    options = {a.option_strings[-1] for a in build_parser()._actions if a.option_strings}
+    assert documented == options - {"--help"}

@@ -49,6 +49,17 @@ def test_the_five_scenarios_are_shipped_and_load():
         assert s.params.width == s.camera.width and s.params.height == s.camera.height
 
 
+def test_the_readme_names_every_shipped_scenario():
+    """The README's "Scenarios (...) are TOML files" reads as the full list."""
+    import re
+    from pathlib import Path
+
+    readme = (Path(__file__).resolve().parent.parent / "README.md").read_text()
+    listing = re.search(r"Scenarios \((.*?)\)\s+are TOML files", readme, re.DOTALL)
+    assert listing, "README.md lost its list of scenarios"
+    assert set(re.findall(r"`(\w+)`", listing.group(1))) == set(shipped_scenarios())
+
+
 def test_defaults_fill_the_application_sections(tmp_path):
     s = load_scenario(write(tmp_path, MINIMAL))
     assert s.name == "mini" and s.seed == 0
@@ -255,6 +266,38 @@ def test_a_world_section_the_file_lacks_can_be_set():
     assert s.world["lighting"] == {"ambient": 0.3}
     with pytest.raises(ScenarioError, match="did you mean 'ambient'"):
         load_scenario("follow_person", ["lighting.ambiant=0.3"])
+
+
+@pytest.mark.parametrize("key", ["lighting.ambient", "lighting.intensity"])
+def test_a_light_level_the_keyframes_would_replace_is_refused(key):
+    # `lighting` dims by its keyframes: a constant level set over them changed nothing.
+    with pytest.raises(ScenarioError, match=rf"^{key} is not used: the scenario's lighting\.keyf"):
+        load_scenario("lighting", [f"{key}=0.1"])
+    with pytest.raises(ScenarioError, match=rf"^{key} is not used"):
+        load_scenario("follow_person", ["lighting.keyframes=[[0, 0.5, 0.5]]", f"{key}=0.1"])
+    # With the keyframes gone (in either order) the level is the light.
+    for overrides in (
+        ["lighting.keyframes=[]", f"{key}=0.1"],
+        [f"{key}=0.1", "lighting.keyframes=[]"],
+    ):
+        lighting = load_scenario("lighting", overrides).world["lighting"]
+        assert lighting[key.split(".")[1]] == 0.1 and lighting["keyframes"] == []
+
+
+def test_a_camera_value_the_other_sensor_path_reads_is_refused():
+    # noise_std is the plain path's, [camera.ov7670] the sensor model's: set on the other
+    # path, it changed nothing.
+    with pytest.raises(
+        ScenarioError, match=r'^camera\.noise_std is not used: with camera\.sensor = "ov7670"'
+    ):
+        load_scenario("follow_person", ["camera.sensor=ov7670", "camera.noise_std=8"])
+    with pytest.raises(
+        ScenarioError, match=r'^camera\.ov7670\.max_gain is not used: camera\.sensor is "plain"'
+    ):
+        load_scenario("follow_person", ["camera.ov7670.max_gain=2"])
+    assert load_scenario("follow_person", ["camera.noise_std=8"]).camera.noise_std == 8
+    s = load_scenario("follow_person", ["camera.ov7670.max_gain=2", "camera.sensor=ov7670"])
+    assert s.camera.sensor == "ov7670" and s.camera.ov7670.max_gain == 2
 
 
 # -- limits, names, types and the camera's geometry (issue 11) --------------------------------

@@ -535,8 +535,12 @@ def format_summary(s):
     # Without a target person every distance is missing (the trajectory holds NaN).
     if s["min_distance_m"] is None:
         lines.append(
-            f"  target: none in the scenario (the design reported found in "
-            f"{found} of frames, {searches} search(es))"
+            "  target: none in the scenario"
+            + (
+                f" (the design reported found in {found} of frames, {searches} search(es))"
+                if s["found_fraction"] is not None
+                else ", and no tracker `found` output"
+            )
         )
         lines.append(f"  distance: n/a (no target person); path {s['path_length_m']:.1f} m")
     else:

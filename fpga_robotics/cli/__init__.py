@@ -179,15 +179,19 @@ def _call(module_name, argv, prog, own_process=False):
     return run_cli(main, argv, prog=prog)
 
 
+def _print_and_exit(text):
+    """Print ``text`` and exit 0, through ``run_cli`` as every command's output goes: a reader
+    that went away (``| head``) ends it quietly, not in a traceback."""
+    run_cli(lambda _argv: print(text), prog=PROG)
+
+
 def main(argv=None):
     own_process = argv is None
     argv = list(sys.argv[1:] if argv is None else argv)
     if argv[:1] in (["-h"], ["--help"]):
-        print(_usage())
-        sys.exit(0)
+        _print_and_exit(_usage())
     if argv[:1] == ["--version"]:
-        print(f"{PROG} {version()}")
-        sys.exit(0)
+        _print_and_exit(f"{PROG} {version()}")
     if not argv:
         print(_usage(), file=sys.stderr)
         print(f"{PROG}: error: a command is needed", file=sys.stderr)
@@ -201,10 +205,8 @@ def main(argv=None):
         sys.exit(USAGE_EXIT)
     if command == "bench":
         if rest[:1] in (["--list"], ["-h"], ["--help"]):
-            print(_bench_list())
-            if rest[0] != "--list":
-                print(f"\n{PROG} bench WHAT --help gives a benchmark's options.")
-            sys.exit(0)
+            hint = f"\n\n{PROG} bench WHAT --help gives a benchmark's options."
+            _print_and_exit(_bench_list() + ("" if rest[0] == "--list" else hint))
         what = rest[0] if rest and not rest[0].startswith("-") else "design"
         if what not in BENCHMARKS:
             print(

@@ -35,7 +35,13 @@ def run_cli(main, argv=None, prog=None):
     name = prog or "fpga-robotics"
     previous = signal.signal(signal.SIGTERM, _raise_terminated)
     try:
-        code = main(argv)
+        try:
+            code = main(argv)
+        except SystemExit as exc:  # argparse's --help and usage errors, a main's own exit
+            code = exc.code
+        # Flushed here, not at exit: a reader gone by then would get Python's "Exception
+        # ignored ... BrokenPipeError" and exit 120 instead of the quiet stop below.
+        sys.stdout.flush()
     except KeyboardInterrupt as exc:
         print(
             f"{name}: {'terminated' if isinstance(exc, Terminated) else 'interrupted'}",

@@ -21,7 +21,16 @@ from fpga_robotics.sim.files import default_dir_mode
 
 __all__ = ["main", "write_project"]
 
-_TEMPLATES = ("design.py", "scenario.toml", "README.md", "pyproject.toml", "tests/test_scenario.py")
+#: Template (in ``templates/new/``, plus ``.tmpl``) -> the file it becomes. The test module is
+#: named after the project: two projects' tests in one pytest session (from a folder above
+#: both) would otherwise be two modules ``test_scenario``, which pytest refuses to collect.
+_TEMPLATES = {
+    "design.py": "design.py",
+    "scenario.toml": "scenario.toml",
+    "README.md": "README.md",
+    "pyproject.toml": "pyproject.toml",
+    "tests/test_scenario.py": "tests/test_${name}.py",
+}
 #: A project's name: a Python name (the folder is importable from the folder above, as
 #: ``python -m`` runs there), and a scenario name (it names the run's recording).
 _NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]{0,63}")
@@ -70,10 +79,11 @@ def write_project(folder):
         raise UsageError(f"no folder {str(parent)!r} to create {name!r} in; create it first")
     if not os.access(parent, os.W_OK):
         raise UsageError(f"folder {str(parent)!r} is not writable")
+    written = [string.Template(t).substitute(name=name) for t in _TEMPLATES.values()]
     staging = Path(tempfile.mkdtemp(prefix=f".{name}.", dir=parent))
     try:
-        for relative in _TEMPLATES:
-            text = string.Template(_template(relative)).safe_substitute(name=name)
+        for template, relative in zip(_TEMPLATES, written, strict=True):
+            text = string.Template(_template(template)).safe_substitute(name=name)
             target = staging / relative
             target.parent.mkdir(parents=True, exist_ok=True)
             target.write_text(text, encoding="utf-8")
@@ -84,7 +94,7 @@ def write_project(folder):
     except BaseException:
         shutil.rmtree(staging, ignore_errors=True)
         raise
-    return [folder / r for r in _TEMPLATES]
+    return [folder / r for r in written]
 
 
 def main(argv=None, prog="fpga-robotics new"):

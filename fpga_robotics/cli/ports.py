@@ -23,11 +23,11 @@ def build_parser(prog="fpga-robotics ports"):
         description="Write the port map of the exported "
         "follow_target (--example) or check a port map file.",
     )
-    parser.add_argument("path", help="the port map (TOML)")
+    parser.add_argument("path", metavar="PORTS.toml", help="the port map (TOML)")
     parser.add_argument(
         "--example",
         action="store_true",
-        help="write the exported follow_target's map to PATH (not replacing a file); "
+        help="write the exported follow_target's map to PORTS.toml (not replacing a file); "
         "without --design",
     )
     parser.add_argument(

@@ -1103,6 +1103,14 @@ def main(argv=None, prog="fpga-robotics run"):
             )
         if args.max_frames is not None and args.max_frames < 1:
             raise UsageError(f"--max-frames must be >= 1, got {args.max_frames}")
+        # Both act on the simulated world only: taken and dropped, they would mislead.
+        if args.seed is not None:
+            raise UsageError("--seed fixes the simulated world's random choices; --source has none")
+        if args.realtime:
+            raise UsageError(
+                "--realtime paces the simulated world to the clock; with --source the "
+                "frames go as fast as the design takes them (a camera's as it delivers them)"
+            )
         if args.duration is not None:
             raise UsageError(
                 "--duration is the closed loop's length; with --source the frames decide "

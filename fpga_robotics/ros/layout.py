@@ -152,8 +152,18 @@ def layout_json():
 if __name__ == "__main__":
     from pathlib import Path
 
+    from ..cli.errors import run_cli
+    from ..cli.parser import CommandParser
     from ..sim.files import write_atomic
 
-    target = Path(__file__).with_name("foxglove_layout.json")
-    write_atomic(target, layout_json(), what="layout")
-    print(f"wrote {target}", file=sys.stderr)
+    PROG = "python -m fpga_robotics.ros.layout"
+
+    def _main(argv):
+        target = Path(__file__).with_name("foxglove_layout.json")
+        # No options; --help or a stray argument must not rewrite the shipped file.
+        parser = CommandParser(prog=PROG, description=f"Write {target} again from its builder.")
+        parser.parse_args(argv)
+        write_atomic(target, layout_json(), what="layout")
+        print(f"wrote {target}", file=sys.stderr)
+
+    run_cli(_main, prog=PROG)

@@ -470,7 +470,10 @@ def _finish(data, source, overrides):
     # the keys it left out with their defaults (as a file that gives the table would).
     _check_sections(data, None)
     _fill_defaults(data)
-    return _build(data, source, overrides)
+    scenario = _build(data, source, overrides)
+    # After the checks of every value: a bad one is the first thing to say.
+    _refuse_unread_overrides(data, [_override_key(o) for o in overrides])
+    return scenario
 
 
 def _check_sections(data, path):
@@ -583,6 +586,47 @@ def _apply_overrides(data, overrides):
         value = _parse_value(text)
         # people[0].speed, as the world's messages write it, is people.0.speed.
         _set_path(data, _override_key(item), value, key)
+
+
+#: The ``[camera]`` keys only the 3D renderer reads (docs/render3d.md).
+_RENDER3D_KEYS = ("shadows", "shadow_size", "textures", "floor", "shine", "lamps")
+
+
+def _refuse_unread_overrides(data, keys):
+    """An override of a value the scenario as set never reads would change nothing, silently:
+    ``ScenarioError`` saying what does set it."""
+    lighting = data.get("lighting")
+    if isinstance(lighting, dict) and lighting.get("keyframes"):
+        for key in ("lighting.ambient", "lighting.intensity"):
+            if key in keys:
+                raise ScenarioError(
+                    f"{key} is not used: the scenario's lighting.keyframes set the light over "
+                    f"time; set lighting.keyframes=[] as well for a constant light, or change "
+                    f"the keyframes"
+                )
+    camera = data.get("camera")
+    sensor = camera.get("sensor", "plain") if isinstance(camera, dict) else "plain"
+    if sensor == "ov7670" and "camera.noise_std" in keys:
+        raise ScenarioError(
+            'camera.noise_std is not used: with camera.sensor = "ov7670" the sensor model '
+            "makes the noise (its [camera.ov7670] shot and read noise)"
+        )
+    if sensor != "ov7670":
+        for key in keys:
+            if key == "camera.ov7670" or key.startswith("camera.ov7670."):
+                raise ScenarioError(
+                    f'{key} is not used: camera.sensor is "{sensor}"; set '
+                    f"camera.sensor=ov7670 as well for the sensor model"
+                )
+    renderer = camera.get("renderer", "raster") if isinstance(camera, dict) else "raster"
+    if renderer != "mujoco":
+        for key in keys:
+            section, _, rest = key.partition(".")
+            if section == "camera" and rest.split(".")[0] in _RENDER3D_KEYS:
+                raise ScenarioError(
+                    f'{key} is not used: camera.renderer is "{renderer}" and only the 3D '
+                    f"renderer reads it; set camera.renderer=mujoco as well (docs/render3d.md)"
+                )
 
 
 def _set_path(data, key, value, shown):

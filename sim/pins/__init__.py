@@ -90,10 +90,14 @@ def get_pin_backend(name, source, **kwargs):
         if name == "pysim":
             kwargs.pop("on_build", None)
         return _backend_class(name)(source, **kwargs)
-    errors = []
+    errors = {}  # reason -> the backends it stopped (no compiler stops both: said once)
     for candidate in _AUTO_ORDER:
         try:
             return _backend_class(candidate)(source, **kwargs)
         except PinError as exc:
-            errors.append(str(exc))
-    raise PinError("no compiled pin backend works here: " + "; ".join(errors))
+            errors.setdefault(str(exc).removeprefix(f"{candidate}: "), []).append(candidate)
+    reasons = "; ".join(f"{' and '.join(names)}: {why}" for why, names in errors.items())
+    raise PinError(
+        f"no compiled pin backend works here ({reasons}); --backend pysim (Amaranth's "
+        "simulator, slower) needs none"
+    )
