@@ -201,7 +201,7 @@ CASES = [
             "--shadow-param",
             "stop_mm=near",
         ],
-        "design.params.stop_mm must be an integer",
+        "--shadow-param stop_mm must be an integer",
     ),
     (
         "shadow param of a built-in shadow",
