@@ -49,10 +49,12 @@ from .port_map import OUTPUTS, PortMapError, check_connectors, check_widths, loa
 from .registered_outputs import REGISTERED_ANALYSIS, outputs_registered
 from .toolchain import find_compiler, find_make, run_tool, verilator_root, verilator_version
 from .verilator import CXX_FLAGS, MAKE_FLAGS, VERILATOR_FLAGS
+from .verilog_params import VerilogOverrides
 
 __all__ = [
     "ForeignDesign",
     "ForeignVerilatorBackend",
+    "design_parameters",
     "design_ports",
     "pin_ports",
     "verilog_includes",
@@ -85,7 +87,8 @@ class ForeignDesign:
     ``connector_kinds`` (kind -> {pin: (direction, max width)}) checks them
     (``port_map.check_connectors``). Without ``pins`` a map with connectors is refused: the
     frame backend drives no connector. A combinational loop is refused (``refuse_loops``):
-    no model of it settles.
+    no model of it settles. ``overrides`` (``VerilogOverrides``): the parameters of the top
+    and the `define macros it is built with.
     """
 
     def __init__(
@@ -98,7 +101,10 @@ class ForeignDesign:
         connector_kinds=None,
         frame_size=None,
         refuse_loops=True,
+        overrides=None,
     ):
+        #: The design's parameters and `define macros (``VerilogOverrides``).
+        self.overrides = overrides or VerilogOverrides()
         self.params = params if params is not None else FollowTargetParams()
         #: (width, height) of the frames the wrapper addresses and ends: ``params``' unless
         #: ``frame_size`` says otherwise (a unit judge's frames, smaller than any camera's).
@@ -152,7 +158,7 @@ class ForeignDesign:
                 "it in the design"
             )
         self.pins = pins
-        self.ports = design_ports(self.sources, self.port_map.top, self.includes)
+        self.ports = design_ports(self.sources, self.port_map.top, self.includes, self.overrides)
         check_widths(self.port_map, self.ports, self.frame_size[0] * self.frame_size[1])
         if connector_kinds is not None:
             check_connectors(self.port_map, self.ports, connector_kinds)
@@ -166,8 +172,10 @@ class ForeignDesign:
         ):
             raise PortMapError("port map: outputs.found must be a 1-bit port")
         if refuse_loops:
-            _refuse_loop(self.sources, self.port_map.top, self.includes)
-        self.wrapper = wrapper_verilog(self.port_map, self.ports, *self.frame_size, pins=pins)
+            _refuse_loop(self.sources, self.port_map.top, self.includes, self.overrides)
+        self.wrapper = wrapper_verilog(
+            self.port_map, self.ports, *self.frame_size, pins=pins, overrides=self.overrides
+        )
 
     def registered_outputs(self):
         """Whether no output of the wrapper around the design depends on an input but
@@ -179,6 +187,7 @@ class ForeignDesign:
             *self.frame_size,
             pins=self.pins,
             runtime_dpi=False,
+            overrides=self.overrides,
         )
         return outputs_registered({"fr_wrapper.v": wrapper, **self.sources}, WRAPPER, self.includes)
 
@@ -204,8 +213,8 @@ class ForeignDesign:
         return h.hexdigest()
 
 
-def _refuse_loop(sources, top, includes):
-    loop = combinational_loop(sources, top, includes)
+def _refuse_loop(sources, top, includes, overrides):
+    loop = combinational_loop(sources, top, includes, overrides)
     if loop is not None:
         wires, where = loop
         through = f" through {', '.join(wires)}" if wires else ""
@@ -308,11 +317,22 @@ def _dtypes(node, acc):
     return acc
 
 
-def design_ports(sources, top, includes=None):
-    """Ports of module ``top`` as Verilator elaborates it: name -> (direction, width, signed)."""
+def design_ports(sources, top, includes=None, overrides=None):
+    """Ports of module ``top`` as Verilator elaborates it (with ``overrides``, a
+    ``VerilogOverrides``): name -> (direction, width, signed)."""
+    ports, _ = _elaborate(sources, top, includes, overrides or VerilogOverrides())
+    return ports
+
+
+def design_parameters(sources, top, includes=None, overrides=None):
+    """The names of the parameters of module ``top`` a ``--param`` may set, in order."""
+    return _elaborate(sources, top, includes, overrides or VerilogOverrides())[1]
+
+
+def _elaborate(sources, top, includes, overrides):
     root = verilator_root()
     with tempfile.TemporaryDirectory(prefix="fr-foreign-") as tmp:
-        paths = _write_sources(tmp, sources, includes)
+        paths = _write_sources(tmp, overrides.with_defines(sources), includes)
         code, output = run_captured(
             [
                 root / "bin" / "verilator",
@@ -320,6 +340,7 @@ def design_ports(sources, top, includes=None):
                 *_LINT_FLAGS,
                 "--top-module",
                 top,
+                *overrides.verilator_flags(),
                 f"-I{Path(tmp) / 'src'}",
                 "--Mdir",
                 Path(tmp) / "obj",
@@ -331,6 +352,8 @@ def design_ports(sources, top, includes=None):
         if code != 0:
             errors = [line for line in output.splitlines() if line.startswith("%Error")]
             first = (errors or output.strip().splitlines() or ["(no output)"])[0]
+            if "Parameters from the command line were not found" in first:
+                _refuse_parameters(sources, top, includes, overrides)
             first = first.replace(str(Path(tmp) / "src") + "/", "")
             if _read_hint(first):
                 first = first.rstrip(".") + _read_hint(first)
@@ -365,7 +388,23 @@ def design_ports(sources, top, includes=None):
             width = abs(left - right) + 1
         name = var.get("verilogName", var["name"])
         ports[name] = (direction, width, bool(dtype.get("signed")))
-    return ports
+    parameters = [
+        var.get("verilogName", var["name"])
+        for var in module.get("stmtsp", [])
+        if var.get("type") == "VAR" and var.get("isGParam")
+    ]
+    return ports, parameters
+
+
+def _refuse_parameters(sources, top, includes, overrides):
+    """A ``PortMapError`` naming the ``--param`` names ``top`` does not have, and those it has."""
+    plain = VerilogOverrides((), overrides.defines)
+    known = _elaborate(sources, top, includes, plain)[1]
+    unknown = [n for n, _ in overrides.parameters if n not in known]
+    raise PortMapError(
+        f"the design {top} has no parameter {unknown[0]!r} to set (its parameters: "
+        f"{', '.join(known) if known else 'none'})"
+    )
 
 
 def _read_hint(error):
@@ -379,7 +418,7 @@ def _read_hint(error):
     return ""
 
 
-def wrapper_verilog(pm, ports, width, height, pins=False, runtime_dpi=True):
+def wrapper_verilog(pm, ports, width, height, pins=False, runtime_dpi=True, overrides=None):
     """A module ``fr_foreign_top`` with the ports of docs/contract.md around ``pm.top``, for
     frames of ``width`` x ``height``.
 
@@ -388,7 +427,10 @@ def wrapper_verilog(pm, ports, width, height, pins=False, runtime_dpi=True):
     through under their own names, ``[runtime]`` inputs too (the pin backend holds them at
     their values, ``HostPins.set_runtime``). ``runtime_dpi=False``: the frames' ``[runtime]``
     registers keep their value instead of loading it through DPI (the same wrapper for
-    Yosys, which reads no DPI: ``registered_outputs``)."""
+    Yosys, which reads no DPI: ``registered_outputs``). ``overrides`` (``VerilogOverrides``):
+    the top's parameters, set on its instance, and the `define lines, first: the wrapper is
+    the first file every tool reads."""
+    overrides = overrides or VerilogOverrides()
     conns = [f".{pm.clock}(clk)"]
     if pm.reset:
         conns.append(f".{pm.reset}({'~rst' if pm.reset_active_low else 'rst'})")
@@ -519,9 +561,12 @@ def wrapper_verilog(pm, ports, width, height, pins=False, runtime_dpi=True):
         body.append("  assign filtered__valid = 1'b0;\n  assign filtered__payload = 14'd0;")
     conn_text = ",\n    ".join(conns)
     if pins:
-        return _pin_wrapper(pm, ports, header, decls, body, conns)
+        return overrides.define_text() + _pin_wrapper(
+            pm, ports, header, decls, body, conns, overrides.instance()
+        )
     watch_port = f",\n  output [{ports[pm.watch][1] - 1}:0] fr_watch_any" if pm.watch else ""
-    return f"""// Generated by fpga_robotics.sim.backends.foreign: {pm.top} with the ports of
+    instance = overrides.instance()
+    return f"""{overrides.define_text()}// Generated by fpga_robotics.sim.backends.foreign: {pm.top} with the ports of
 // docs/contract.md, for the Verilator harness.
 module {WRAPPER} (
   input clk, input rst,
@@ -532,7 +577,7 @@ module {WRAPPER} (
 );
 {chr(10).join(decls)}
 {chr(10).join(body)}
-  {pm.top} fr_design (
+  {pm.top} {instance}fr_design (
     {conn_text}
   );
 endmodule
@@ -555,7 +600,7 @@ def _watch_verilog(width, declare=False):
     )
 
 
-def _pin_wrapper(pm, ports, outputs, decls, body, conns):
+def _pin_wrapper(pm, ports, outputs, decls, body, conns, instance):
     header = ["input clk", "input rst"]
     if pm.has_pixels:
         header += [
@@ -584,7 +629,7 @@ module {WRAPPER} (
 );
 {chr(10).join(decls)}
 {chr(10).join(body)}
-  {pm.top} fr_design (
+  {pm.top} {instance}fr_design (
     {conn_text}
   );
 endmodule
@@ -763,7 +808,8 @@ def foreign_build_plan(design):
 
 class ForeignVerilatorBackend(HarnessFrames, DesignBackend):
     """A foreign Verilog design (``ForeignDesign``, or ``files`` and ``port_map``) on
-    Verilator. ``params`` gives the frame size; the design is the user's.
+    Verilator. ``params`` gives the frame size; the design is the user's, built with
+    ``overrides`` (``VerilogOverrides``: its parameters and `define macros).
 
     Raises ``BackendError`` (``PortMapError``) for a bad map, and per frame when the design
     does not raise its result strobe within ``result.timeout`` cycles after the frame.
@@ -785,11 +831,16 @@ class ForeignVerilatorBackend(HarnessFrames, DesignBackend):
         waveform=None,
         on_build=None,
         fill_absent=False,
+        overrides=None,
     ):
         super().__init__(params, line_blank=line_blank, frame_blank=frame_blank)
         if waveform is not None:
             raise BackendError("the foreign Verilog backend writes no waveforms yet")
-        self.design = design if design is not None else ForeignDesign(files, port_map, self.params)
+        self.design = (
+            design
+            if design is not None
+            else ForeignDesign(files, port_map, self.params, overrides=overrides)
+        )
         if (self.design.params.width, self.design.params.height) != (
             self.params.width,
             self.params.height,
