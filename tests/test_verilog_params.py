@@ -15,6 +15,7 @@ from fpga_robotics.sim.backends.foreign import ForeignVerilatorBackend
 from fpga_robotics.sim.backends.foreign_cxxrtl import ForeignCxxrtlBackend
 from fpga_robotics.sim.backends.verilog_cxxrtl import yosys_version
 from fpga_robotics.sim.backends.verilog_params import VerilogOverrides
+from fpga_robotics.sweep import load_campaign, run_campaign
 from fpga_robotics.testing import run
 
 #: Wheel speeds set by two parameters and a macro: left = (SPEED << SHIFT) + N, right =
@@ -127,3 +128,35 @@ def test_values_as_verilog_text():
     assert o.instance() == '#(.B(1), .I(-3), .L(8\'hff), .T("abc")) '
     assert o.define_text() == "`define F \n"
     assert o.verilator_flags() == ["-GB=1", "-GI=-3", "-GL=8'hff", '-GT="abc"']
+
+
+def test_a_define_no_file_uses_is_one_line(design, capsys):
+    argv = ["run", "--design", f"verilog:{design / 'ptop.v'}", "--ports"]
+    argv += [str(design / "ptop.toml"), "--define", "SHIFTT=1", "--rerun", "off"]
+    with pytest.raises(SystemExit) as info:
+        cli.main(argv)
+    err = capsys.readouterr().err
+    assert info.value.code == 2 and err.count("\n") == 1, err
+    assert "--define SHIFTT: no file of the design uses the macro `SHIFTT (the macros it " in err
+    assert err.rstrip().endswith("uses: SHIFT)")
+
+
+@pytest.mark.slow  # builds models
+@pytest.mark.timeout(900)
+def test_a_campaign_grid_over_a_parameter_and_a_macro(design, tmp_path):
+    campaign = load_campaign(
+        {
+            "scenarios": ["follow_person"],
+            "duration": 0.1,
+            "backend": "verilator",
+            "design": f"verilog:{design / 'ptop.v'}",
+            "ports": str(design / "ptop.toml"),
+            "grid": {"design.params.SPEED": [10, 30], "design.defines.SHIFT": [0, 1]},
+        }
+    )
+    rows = run_campaign(campaign, tmp_path / "out", workers=1, record="none")
+    got = {
+        (r["design.params.SPEED"], r["design.defines.SHIFT"]): r["peak_wheel_command_dps"]
+        for r in rows
+    }
+    assert got == {(s, h): (s << h) + 2 for s in (10, 30) for h in (0, 1)}

@@ -129,6 +129,7 @@ class ForeignDesign:
         #: ``data_paths``: where each data file is, for Verilator (``verilator_text``).
         self.data_paths = {}
         self.includes = verilog_includes(self.files, self.data_paths)
+        _refuse_unused_defines(self.overrides, [*self.sources.values(), *self.includes.values()])
         self.port_map = (
             port_map if not isinstance(port_map, (str, os.PathLike)) else load_port_map(port_map)
         )
@@ -211,6 +212,52 @@ class ForeignDesign:
             h.update(b"include\0" + name.encode() + b"\0" + self.includes[name].encode() + b"\0")
         h.update(self.wrapper.encode())
         return h.hexdigest()
+
+
+#: Compiler directives: any other `NAME is a use of the macro NAME.
+_DIRECTIVES = frozenset(
+    [
+        "define",
+        "undef",
+        "ifdef",
+        "ifndef",
+        "elsif",
+        "else",
+        "endif",
+        "include",
+        "timescale",
+        "default_nettype",
+        "resetall",
+        "celldefine",
+        "endcelldefine",
+        "line",
+        "begin_keywords",
+        "end_keywords",
+        "pragma",
+        "unconnected_drive",
+        "nounconnected_drive",
+        "undefineall",
+        "__FILE__",
+        "__LINE__",
+    ]
+)
+
+
+def _refuse_unused_defines(overrides, texts):
+    """A ``PortMapError`` for a ``--define`` no file of the design uses (a misspelt name
+    would be defined for nothing and the design built with its own default)."""
+    used = set()
+    for text in texts:
+        text = _COMMENTS.sub("", text)
+        used.update(re.findall(r"`(?:ifdef|ifndef|elsif|undef)\s+(\w+)", text))
+        used.update(n for n in re.findall(r"`(\w+)", text) if n not in _DIRECTIVES)
+    unused = [name for name, _ in overrides.defines if name not in used]
+    if unused:
+        known = ", ".join(sorted(used)) or "none"
+        raise PortMapError(
+            f"--define {unused[0]}: no file of the design uses the macro `{unused[0]} (the "
+            f"macros it uses: {known})"
+        )
 
 
 def _refuse_loop(sources, top, includes, overrides):
