@@ -248,12 +248,15 @@ def _located_outside_stdlib():
         tracer.get_src_loc = original
 
 
-def _read_design(work, params, rtlil_text, verilog, includes=None):
+def _read_design(work, params, rtlil_text, verilog, includes=None, overrides=None, top=None):
     """Yosys lines that read the design into ``work``: ``verilog`` (``{file name: text}``,
     then ``read_verilog``; ``includes``, ``{name: text}``, the files they `include, written
-    next to them and not read on their own), else ``rtlil_text`` or ``FollowTarget(params)``'s
-    RTLIL."""
+    next to them and not read on their own; ``overrides``, a ``VerilogOverrides``: the
+    `define macros read first, the parameters of the module ``top`` set after), else
+    ``rtlil_text`` or ``FollowTarget(params)``'s RTLIL."""
     if verilog is not None:
+        if overrides:
+            verilog = overrides.with_defines(verilog)
         for name, text in (includes or {}).items():
             path = os.path.join(work, name)
             os.makedirs(os.path.dirname(path), exist_ok=True)
@@ -264,6 +267,8 @@ def _read_design(work, params, rtlil_text, verilog, includes=None):
             with open(os.path.join(work, name), "w") as f:
                 f.write(text)
             lines.append(f"read_verilog -sv {name}")
+        if overrides and overrides.parameters:
+            lines += [f"chparam -set {n} {t} {top}" for n, t in overrides.parameters]
         return lines
     with open(os.path.join(work, "design.il"), "w") as f:
         f.write(_rtlil(params) if rtlil_text is None else rtlil_text)
@@ -271,11 +276,20 @@ def _read_design(work, params, rtlil_text, verilog, includes=None):
 
 
 def list_mutants(
-    params=None, n=100, seed=1, *, rtlil_text=None, verilog=None, top=TOP_NAME, includes=None
+    params=None,
+    n=100,
+    seed=1,
+    *,
+    rtlil_text=None,
+    verilog=None,
+    top=TOP_NAME,
+    includes=None,
+    overrides=None,
 ):
     """``n`` mutants of ``FollowTarget(params)`` (or of the design ``rtlil_text``, from
     ``component_rtlil``, or of the Verilog design ``verilog``, ``{file name: text}`` with
-    its top module ``top`` and the files it `include, ``includes``) chosen by Yosys with
+    its top module ``top``, the files it `include, ``includes``, and its parameters and
+    macros, ``overrides``) chosen by Yosys with
     ``seed`` (the same arguments give the same list). Yosys may return fewer when the design
     has fewer places.
 
@@ -287,7 +301,13 @@ def list_mutants(
     params = params if params is not None else FollowTargetParams()
     if not 1 <= int(n) <= 100_000:
         raise ValueError(f"the number of mutants must be 1..100000, got {n}")
-    design = {"rtlil_text": rtlil_text, "verilog": verilog, "top": top, "includes": includes}
+    design = {
+        "rtlil_text": rtlil_text,
+        "verilog": verilog,
+        "top": top,
+        "includes": includes,
+        "overrides": overrides,
+    }
     lines, memories = _mutate_list(params, int(n), seed, design)
     if not lines:
         raise MutationError(
@@ -324,11 +344,17 @@ def _mutate_list(params, n, seed, design):
     keyword arguments)."""
     with tempfile.TemporaryDirectory(prefix="fr-mutate-") as work:
         read = _read_design(
-            work, params, design["rtlil_text"], design["verilog"], design["includes"]
+            work,
+            params,
+            design["rtlil_text"],
+            design["verilog"],
+            design["includes"],
+            design["overrides"],
+            design["top"],
         )
         _yosys(
             [
-                *read,
+                *(r.format(top=design["top"]) for r in read),
                 *(s.format(top=design["top"]) for s in _PREPARE),
                 "select -write memories.txt t:$mem*",
                 f"mutate -list {n} -seed {int(seed)} -o mutants.ys",
@@ -357,7 +383,15 @@ _MUTATE = re.compile(r"^mutate\s")
 
 
 def mutant_netlist(
-    params, mutants, *, rtlil_text=None, verilog=None, top=TOP_NAME, includes=None, watch=True
+    params,
+    mutants,
+    *,
+    rtlil_text=None,
+    verilog=None,
+    top=TOP_NAME,
+    includes=None,
+    overrides=None,
+    watch=True,
 ):
     """Verilog of ``FollowTarget(params)`` (or of the design ``rtlil_text``, from
     ``component_rtlil``) with every mutant behind ``mutsel`` (``select_width(len(mutants))``
@@ -368,8 +402,8 @@ def mutant_netlist(
     params = params if params is not None else FollowTargetParams()
     width = select_width(_max_index(mutants))
     with tempfile.TemporaryDirectory(prefix="fr-mutate-") as work:
-        read = _read_design(work, params, rtlil_text, verilog, includes)
-        lines = [*read, *(s.format(top=top) for s in _PREPARE)]
+        read = _read_design(work, params, rtlil_text, verilog, includes, overrides, top)
+        lines = [*(r.format(top=top) for r in read), *(s.format(top=top) for s in _PREPARE)]
         for m in mutants:
             lines.append(
                 _MUTATE.sub(f"mutate -ctrl {MUTATION_SELECT} {width} {m.index} ", m.command)
@@ -407,7 +441,16 @@ _EFFECT_CELLS = ("$print", "$check", "$assert", "$assume", "$cover", "$live", "$
 _CONE_CTRL = "fr_cone_{}"
 
 
-def mutant_cones(params, mutants, *, rtlil_text=None, verilog=None, top=TOP_NAME, includes=None):
+def mutant_cones(
+    params,
+    mutants,
+    *,
+    rtlil_text=None,
+    verilog=None,
+    top=TOP_NAME,
+    includes=None,
+    overrides=None,
+):
     """The fan-out cone of each mutant's fault: ``{index: frozenset}`` of the top-level output
     bits it reaches through any cells, flip-flops included, as ``(port, bit)``, and of the
     cells with an effect beyond the outputs it reaches (``$print``, ``$check``, ... or a cell
@@ -424,8 +467,8 @@ def mutant_cones(params, mutants, *, rtlil_text=None, verilog=None, top=TOP_NAME
     if not mutants:
         return {}
     with tempfile.TemporaryDirectory(prefix="fr-cone-") as work:
-        read = _read_design(work, params, rtlil_text, verilog, includes)
-        lines = [*read, *(s.format(top=top) for s in _PREPARE)]
+        read = _read_design(work, params, rtlil_text, verilog, includes, overrides, top)
+        lines = [*(r.format(top=top) for r in read), *(s.format(top=top) for s in _PREPARE)]
         for m in mutants:
             ctrl = _CONE_CTRL.format(m.index)
             lines.append(_MUTATE.sub(f"mutate -ctrl {ctrl} 1 1 ", m.command))

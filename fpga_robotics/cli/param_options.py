@@ -10,6 +10,7 @@ from fpga_robotics.cli.errors import UsageError
 from fpga_robotics.hw.params import CHOICES, PRESETS, FollowTargetParams
 
 __all__ = [
+    "add_define_argument",
     "add_design_param_argument",
     "add_param_arguments",
     "defines_from_items",
@@ -82,6 +83,17 @@ def add_design_param_argument(parser):
         default=[],
         metavar="NAME=VALUE",
         help="with --design: one of its parameters (a TOML value; repeatable)",
+    )
+
+
+def add_define_argument(parser):
+    """``--define NAME[=VALUE]`` (repeatable): a `define macro of a Verilog ``--design``."""
+    parser.add_argument(
+        "--define",
+        action="append",
+        default=[],
+        metavar="NAME[=VALUE]",
+        help="with --design verilog:...: a `define macro read before its files (repeatable)",
     )
 
 
