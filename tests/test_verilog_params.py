@@ -174,3 +174,23 @@ def test_mutants_are_of_the_design_with_its_parameters(design):
     netlist = mutant_netlist(None, mutants, **sources)
     assert "assign left = 16'h0052;" in netlist
     assert "assign right = 16'hffb0;" in netlist
+
+
+def test_the_board_top_sets_them(design, tmp_path, capsys):
+    out = tmp_path / "board"
+    argv = ["board", "--design", f"verilog:{design / 'ptop.v'}", "--ports"]
+    argv += [str(design / "ptop.toml"), "--param", "SPEED=40", "--param", "N=3"]
+    argv += ["--define", "SHIFT=1", "-o", str(out)]
+    with pytest.raises(SystemExit) as info:
+        cli.main(argv)
+    assert info.value.code == 0, capsys.readouterr().err
+    top = next(out.glob("*_follow_target.v")).read_text()
+    assert "ptop #(\n    .N(32'd3),\n    .SPEED(32'd40)\n  )" in top
+    assert (out / "fr_defines.v").read_text() == "`define SHIFT 1\n"
+    script = next(out.glob("*_follow_target.ys")).read_text()
+    assert script.index("fr_defines.v") < script.index("ptop.v")  # the macros first
+    argv[argv.index("SPEED=40")] = "SPEDE=40"
+    with pytest.raises(SystemExit) as info:
+        cli.main(argv)
+    err = capsys.readouterr().err
+    assert info.value.code == 2 and "has no parameter 'SPEDE' to set" in err, err

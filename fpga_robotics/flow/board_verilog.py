@@ -19,6 +19,7 @@ from amaranth.hdl import signed as signed_shape
 from fpga_robotics.hw.errors import UserError
 from fpga_robotics.hw.pixel import COLOR_SELECT
 from fpga_robotics.sim.backends.foreign import verilog_includes
+from fpga_robotics.sim.backends.verilog_params import DEFINES_FILE
 from fpga_robotics.sim.files import read_user_text
 from fpga_robotics.sim.processes import run_captured
 
@@ -84,10 +85,13 @@ def verilog_files(spec):
     """``[(name in the build folder, text)]``: the design's files and every file they
     ``include`` (looked for next to the including file, then next to each listed file, as
     the simulation looks) or reads with ``$readmemh``/``$readmemb``, each once; an absolute
-    name is left to Yosys."""
+    name is left to Yosys. The `define macros (``spec.overrides``) come first, a file of
+    their own."""
     files = [Path(f) for f in spec.reference[len("verilog:") :].split(",")]
     top = spec.port_map.top
     out, seen = [], {}
+    if spec.overrides and spec.overrides.defines:
+        out.append((DEFINES_FILE, spec.overrides.define_text()))
     for path in files:
         if path.name in seen:
             raise UserError(
@@ -96,7 +100,7 @@ def verilog_files(spec):
             )
         seen[path.name] = path
         out.append((path.name, _read(path, top)))
-    pending = [(path, text) for (_, text), path in zip(out, files)]
+    pending = [(path, text) for (_, text), path in zip(out[-len(files) :], files)]
     while pending:
         path, text = pending.pop(0)
         for name in _INCLUDE.findall(text):
@@ -152,7 +156,8 @@ def check_yosys_reads(spec):
             path.write_text(text)
         read = " ".join(name for name, _ in files if name.endswith((".v", ".sv")))
         # Yosys runs sandboxed in the folder it starts in: every path relative to it.
-        script = f"read_verilog -sv {read}; hierarchy -top {top}"
+        chparam = spec.overrides.chparam(top) if spec.overrides else ""
+        script = f"read_verilog -sv {read}; {chparam}hierarchy -top {top}"
         code, output = run_captured([yosys, "-q", "-p", script], cwd=folder, timeout=600)
     if code != 0:
         errors = [line.strip() for line in output.splitlines() if "ERROR" in line]
@@ -193,8 +198,10 @@ class VerilogOnBoard(Elaboratable):
     ``frame_done``, the servo's and the connector pins' ports), wired to the module's ports
     as the port map says."""
 
-    def __init__(self, port_map, *, servo=None, header=()):
+    def __init__(self, port_map, *, servo=None, header=(), overrides=None):
         pm = self.port_map = port_map
+        #: The top's parameters (``VerilogOverrides``), set on its instance.
+        self._params = overrides.amaranth_params() if overrides else {}
         self._members = {}
         if pm.has_pixels:
             # payload: data[11:0], first[12], last[13], as the board's capture gives it
@@ -262,5 +269,5 @@ class VerilogOnBoard(Elaboratable):
             ports[f"{direction}_{port}"] = self._members[port]
         for port, value in {**pm.runtime, **pm.constants}.items():
             ports[f"i_{port}"] = Const(value)
-        m.submodules.design = Instance(pm.top, **ports)
+        m.submodules.design = Instance(pm.top, **self._params, **ports)
         return m

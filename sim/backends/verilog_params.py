@@ -92,6 +92,34 @@ class VerilogOverrides:
         """Yosys's commands setting the parameters of ``top`` (before ``hierarchy``)."""
         return "".join(f"chparam -set {n} {t} {top}; " for n, t in self.parameters)
 
+    def amaranth_params(self):
+        """The parameters as ``Instance`` keyword arguments (``p_NAME``): an integer, a
+        ``Const`` of a sized literal, a float or a text."""
+        from amaranth.hdl import Const  # lazy: only the board build instantiates the top
+
+        params = {}
+        for name, text in self.parameters:
+            literal = re.fullmatch(r"(\d*)\s*'([sS]?)([bodhBODH])\s*([0-9a-fA-F_]+)", text)
+            if text.startswith('"'):
+                value = text[1:-1]
+            elif literal:
+                width, _, base, digits = literal.groups()
+                number = int(
+                    digits.replace("_", ""), {"b": 2, "o": 8, "d": 10, "h": 16}[base.lower()]
+                )
+                value = Const(number, int(width or 32))
+            elif re.fullmatch(r"-?\d+", text):
+                value = int(text)
+            else:
+                try:
+                    value = float(text)
+                except ValueError:
+                    raise PortMapError(
+                        f"--param {name}={text}: the board build cannot set this value"
+                    ) from None
+            params[f"p_{name}"] = value
+        return params
+
     def describe(self):
         """``SPEED=50, N=3; defines FAST`` for messages and summaries."""
         parts = [", ".join(f"{n}={t}" for n, t in self.parameters)] if self.parameters else []
