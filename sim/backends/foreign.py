@@ -49,6 +49,7 @@ from .port_map import OUTPUTS, PortMapError, check_connectors, check_widths, loa
 from .registered_outputs import REGISTERED_ANALYSIS, outputs_registered
 from .toolchain import find_compiler, find_make, run_tool, verilator_root, verilator_version
 from .verilator import CXX_FLAGS, MAKE_FLAGS, VERILATOR_FLAGS
+from .verilog_cxxrtl import DESIGN_DIR
 from .verilog_params import VerilogOverrides
 
 __all__ = [
@@ -56,8 +57,10 @@ __all__ = [
     "ForeignVerilatorBackend",
     "design_parameters",
     "design_ports",
+    "include_dirs",
     "pin_ports",
     "verilog_includes",
+    "verilog_layout",
     "watch_chunks",
     "wrapper_verilog",
 ]
@@ -114,21 +117,22 @@ class ForeignDesign:
         self.files = [Path(f) for f in files]
         if not self.files:
             raise PortMapError("no Verilog file given")
-        self.sources = {}
         for f in self.files:
             try:
-                self.sources[f.name] = read_user_text(f, any_bytes=True)
+                read_user_text(f, any_bytes=True)
             except OSError as exc:
                 raise PortMapError(
                     f"cannot read the Verilog file {f}: {getattr(exc, 'strerror', None) or exc}"
                 ) from None
-        if len(self.sources) != len(self.files):
-            raise PortMapError("two Verilog files have the same name")
-        #: Files named by `include or a $readmemh/$readmemb, found next to the including
-        #: file or a listed one: copied next to the sources and part of the build's cache key.
+        #: The files (``sources``) and those named by `include or a $readmemh/$readmemb,
+        #: found next to the including file or a listed one (``includes``), by their paths
+        #: from the folder that holds them all: copied so into the build folder (an include
+        #: of "../inc/defs.vh" finds its file) and part of the build's cache key.
         #: ``data_paths``: where each data file is, for Verilator (``verilator_text``).
         self.data_paths = {}
-        self.includes = verilog_includes(self.files, self.data_paths)
+        self.sources, self.includes = verilog_layout(self.files, self.data_paths)
+        if len(self.sources) != len(self.files):
+            raise PortMapError("a Verilog file is listed twice")
         _refuse_unused_defines(self.overrides, [*self.sources.values(), *self.includes.values()])
         self.port_map = (
             port_map if not isinstance(port_map, (str, os.PathLike)) else load_port_map(port_map)
@@ -279,25 +283,39 @@ _COMMENTS = re.compile(r"/\*.*?\*/|//[^\n]*", re.DOTALL)
 
 
 def verilog_includes(files, data_paths=None):
-    """``include name -> text`` of every file the sources `include (recursively) that is
-    found relative to the including file's folder or a listed file's folder, and of every
-    data file a $readmemh/$readmemb names (found there too, or in the current folder, where
-    Verilator and Yosys look themselves); an include not found is left to Verilator to
-    report, a data file not found is a ``PortMapError``. ``data_paths`` (a dict) gets each
-    data file's path."""
+    """The included and data files of ``verilog_layout``: ``{path: text}``."""
+    return verilog_layout(files, data_paths)[1]
+
+
+def verilog_layout(files, data_paths=None):
+    """``(sources, includes)``: the text of each of ``files`` and of every file they `include
+    (recursively) that is found relative to the including file's folder or a listed file's
+    folder, and of every data file a $readmemh/$readmemb names (found there too, or in the
+    current folder, where Verilator and Yosys look themselves), each by its path from the
+    folder that holds them all (their layout kept, so that an include of "../inc/defs.vh"
+    finds its file where the tools look; a data file beside the file that reads it). An
+    include not found is left to Verilator to report, a data file not found is a
+    ``PortMapError``. ``data_paths`` (a dict) gets each data file's path by its name."""
+    files = [Path(os.path.abspath(f)) for f in files]
     folders = [f.parent for f in files]
-    found, todo = {}, [(f, f.parent) for f in files]
+    texts, data = {}, {}  # absolute path -> text; data file's place -> its path
+    todo = list(files)
     while todo:
-        path, folder = todo.pop()
-        try:
-            text = read_user_text(path, any_bytes=True)
-        except OSError:
+        path = todo.pop(0)
+        if path in texts:
             continue
+        try:
+            texts[path] = text = read_user_text(path, any_bytes=True)
+        except OSError:
+            if path in files:
+                raise
+            raise PortMapError(f"cannot read the included file {path}") from None
         for _, name in _READMEM.findall(_COMMENTS.sub("", text)):
-            if name in found or Path(name).is_absolute() or ".." in Path(name).parts:
+            if Path(name).is_absolute() or ".." in Path(name).parts:
                 continue
             candidate = next(
-                (b / name for b in (folder, *folders, Path.cwd()) if (b / name).is_file()), None
+                (b / name for b in (path.parent, *folders, Path.cwd()) if (b / name).is_file()),
+                None,
             )
             if candidate is None:
                 raise PortMapError(
@@ -305,28 +323,30 @@ def verilog_includes(files, data_paths=None):
                     f"to it, next to a listed file, nor in the current folder: put it beside "
                     f"{path.name}"
                 )
-            found[name] = _read_included(candidate)
+            data.setdefault(path.parent / name, candidate)
             if data_paths is not None:
-                data_paths[name] = candidate.resolve()
+                data_paths.setdefault(name, candidate.resolve())
         for name in _INCLUDE.findall(text):
-            if name in found or Path(name).is_absolute():
+            if Path(name).is_absolute():
                 continue
-            if ".." in Path(name).parts:
-                if not (folder / name).is_file():
-                    continue  # left to Verilator, as any include not found
-                # Its copy would land outside the folder the design is copied to.
-                raise PortMapError(
-                    f"{path.name} includes {name!r}: an included file is copied with the "
-                    f"design, under its name: move it next to {path.name} (or a listed "
-                    f"file) and include it without '..'"
-                )
-            for base in (folder, *folders):
-                candidate = base / name
-                if candidate.is_file():
-                    found[name] = _read_included(candidate)
-                    todo.append((candidate, candidate.parent))
-                    break
-    return found
+            found = next((b / name for b in (path.parent, *folders) if (b / name).is_file()), None)
+            if found is not None:
+                todo.append(Path(os.path.normpath(found)))
+    places = [*texts, *data]
+    root = Path(os.path.commonpath([p.parent for p in places]))
+    sources = {p.relative_to(root).as_posix(): texts[p] for p in files}
+    includes = {p.relative_to(root).as_posix(): t for p, t in texts.items() if p not in files}
+    for place, path in data.items():
+        includes[place.relative_to(root).as_posix()] = _read_included(path)
+    return sources, includes
+
+
+def include_dirs(directory, *files):
+    """Verilator's ``-I`` options for ``files`` (dicts by path, the sources first) written
+    under ``directory / DESIGN_DIR``: the folder of each, where an include next to a listed
+    file, or next to the included file that includes it, is found."""
+    folders = dict.fromkeys(Path(name).parent for names in files for name in names)
+    return [f"-I{Path(directory) / DESIGN_DIR / folder}" for folder in folders]
 
 
 def _read_included(path):
@@ -340,12 +360,12 @@ def _read_included(path):
 
 def _write_sources(directory, sources, includes=None):
     for name, text in (includes or {}).items():
-        path = Path(directory) / "src" / name
+        path = Path(directory) / DESIGN_DIR / name
         path.parent.mkdir(parents=True, exist_ok=True)
         path.write_text(text)
     paths = []
     for name, text in sources.items():
-        path = Path(directory) / "src" / name
+        path = Path(directory) / DESIGN_DIR / name
         path.parent.mkdir(parents=True, exist_ok=True)
         path.write_text(text)
         paths.append(path)
@@ -388,7 +408,7 @@ def _elaborate(sources, top, includes, overrides):
                 "--top-module",
                 top,
                 *overrides.verilator_flags(),
-                f"-I{Path(tmp) / 'src'}",
+                *include_dirs(tmp, sources, includes or {}),
                 "--Mdir",
                 Path(tmp) / "obj",
                 *paths,
@@ -401,7 +421,7 @@ def _elaborate(sources, top, includes, overrides):
             first = (errors or output.strip().splitlines() or ["(no output)"])[0]
             if "Parameters from the command line were not found" in first:
                 _refuse_parameters(sources, top, includes, overrides)
-            first = first.replace(str(Path(tmp) / "src") + "/", "")
+            first = first.replace(str(Path(tmp) / DESIGN_DIR) + "/", "")
             if _read_hint(first):
                 first = first.rstrip(".") + _read_hint(first)
             # Named as the step it is: the CXXRTL backend reads the ports with Verilator too.
@@ -825,7 +845,7 @@ def foreign_build_plan(design):
                 *VERILATOR_FLAGS,
                 "-j",
                 "2",
-                f"-I{directory / 'src'}",
+                *include_dirs(directory, design.sources, design.includes),
                 "--top-module",
                 WRAPPER,
                 "--prefix",
@@ -1020,7 +1040,7 @@ class ForeignVerilatorBackend(HarnessFrames, DesignBackend):
         if stopped:
             self._library.lib.fr_foreign_clear()
             # The file as the user named it, not its copy in the build folder.
-            where = re.sub(r" at .*/src/", " at ", stopped.decode(errors="replace"))
+            where = re.sub(rf" at .*/{DESIGN_DIR}/", " at ", stopped.decode(errors="replace"))
             raise BackendError(f"{pm.top}: frame {index}: the design called {where}")
         if status == 1:
             raise BackendError(
