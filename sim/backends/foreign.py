@@ -810,6 +810,8 @@ def foreign_build_plan(design):
             "flow": "verilator-foreign",
             "abi": ABI_VERSION,
             "source": design.digest(),
+            # The folder the files are built in: the model's $stop messages name it.
+            "layout": DESIGN_DIR,
             "hooks": digest(_HOOKS),
             # Built once per clock edge where Yosys finds the outputs registered.
             "registered": REGISTERED_ANALYSIS,

@@ -172,6 +172,8 @@ def verilator_plan(source):
         {
             "flow": "pins-verilator",
             "abi": ABI_VERSION,
+            # The folder the files are built in: the model's $stop messages name it.
+            "layout": DESIGN_DIR,
             "design": source.key,
             "source": digest(text + accessors),
             "registered": REGISTERED_ANALYSIS if registered is None else registered,
