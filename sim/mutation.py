@@ -103,6 +103,7 @@ class Mutant:
             "cnot1": f"XOR {self.port}[{self.ctrlbit}]",
         }
         cell = self.cell.rpartition(".")[2] if self.cell.startswith("$flatten") else self.cell
+        cell = cell.replace(f"${DESIGN_DIR}/", "$")  # a Verilog design's file, as the user has it
         where = (
             f"{self.signal}[{self.bit}]"
             if self.signal is not None

