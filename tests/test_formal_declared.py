@@ -137,6 +137,34 @@ def test_an_include_outside_the_designs_folder_is_read(capsys, tmp_path, monkeyp
     assert out.splitlines()[2].strip().startswith("failed assertion lib/core/bump_stop_formal.v:")
 
 
+_PARAM_COUNTER = """\
+`ifndef LIMIT
+`define LIMIT 4'd9
+`endif
+module g #(parameter MAX = 9) (input clk, input rst, output reg [3:0] n);
+  initial n = 0;
+  always @(posedge clk) n <= (rst || n == MAX) ? 4'd0 : n + 4'd1;
+`ifdef FORMAL
+  always @(posedge clk) assert (n <= `LIMIT);
+`endif
+endmodule
+"""
+
+
+def test_a_verilog_designs_parameters_and_macros(capsys, tmp_path):
+    # n counts to MAX: at MAX = 12 it passes the default LIMIT 9 (a counterexample at
+    # step 11, n = 10), and holds again with LIMIT 12.
+    (tmp_path / "g.v").write_text(_PARAM_COUNTER)
+    argv = ["formal", "--design", f"verilog:{tmp_path / 'g.v'}", "--depth", "12"]
+    for given, code in (([], 0), (["--param", "MAX=12"], 1)):
+        got, out, err = _cli([*argv, *given], capsys)
+        assert got == code, out + err
+    got, out, err = _cli([*argv, "--param", "MAX=12", "--define", "LIMIT=12"], capsys)
+    assert got == 0, out + err
+    got, out, err = _cli([*argv, "--param", "MAXX=1"], capsys)
+    assert got == 2 and "the design g has no parameter 'MAXX' to set (its parameters: MAX)" in err
+
+
 @pytest.mark.formal
 def test_a_true_property_is_proved_and_its_cover_reached(capsys, tmp_path):
     code, out, _ = _cli(["formal", "--design", SATURATING, "--trace-dir", str(tmp_path)], capsys)
