@@ -93,10 +93,13 @@ def main(argv=None, prog="fpga-robotics formal"):
     args = parser.parse_args(argv)
     if args.list:
         # The list shows which checks and their own depths: what runs them is ignored.
-        others = parser.given_options(args, ignore={"list", "design", "param", "ports", "only"})
+        others = parser.given_options(
+            args, ignore={"list", "design", "param", "define", "ports", "only"}
+        )
         if others:
             raise UsageError(
-                f"--list takes only --design, --param, --ports and --only; got {', '.join(others)}"
+                f"--list takes only --design, --param, --define, --ports and --only; got "
+                f"{', '.join(others)}"
             )
     if args.depth is not None and args.depth < 1:
         raise UsageError(f"--depth must be at least 1, got {args.depth}")
