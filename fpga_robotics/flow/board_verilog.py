@@ -131,8 +131,8 @@ def verilog_files(spec):
     # The data files of a $readmemh/$readmemb, found as the simulation finds them (a missing
     # one was refused with the design's check): Yosys reads them next to the files.
     data = {}
-    texts = verilog_includes(files, data)
-    out += [(name, texts[name]) for name in sorted(data) if name not in seen]
+    verilog_includes(files, data)
+    out += [(name, _read(data[name], top)) for name in sorted(data) if name not in seen]
     return out
 
 
