@@ -18,7 +18,8 @@ from amaranth.hdl import signed as signed_shape
 
 from fpga_robotics.hw.errors import UserError
 from fpga_robotics.hw.pixel import COLOR_SELECT
-from fpga_robotics.sim.backends.foreign import verilog_includes
+from fpga_robotics.sim.backends.foreign import verilog_layout
+from fpga_robotics.sim.backends.port_map import PortMapError
 from fpga_robotics.sim.backends.verilog_params import DEFINES_FILE
 from fpga_robotics.sim.files import read_user_text
 from fpga_robotics.sim.processes import run_captured
@@ -84,33 +85,20 @@ def verilog_board_ports(spec, kinds, header_sites):
 def verilog_files(spec):
     """``[(name in the build folder, text)]``: the design's files and every file they
     ``include`` (looked for next to the including file, then next to each listed file, as
-    the simulation looks) or reads with ``$readmemh``/``$readmemb``, each once; an absolute
-    name is left to Yosys. The `define macros (``spec.overrides``) come first, a file of
-    their own."""
+    the simulation looks) or reads with ``$readmemh``/``$readmemb``, each once, by their
+    places from the folder that holds them all (``verilog_layout``: an include of
+    "../inc/defs.vh" finds its file); an absolute name is left to Yosys. The `define macros
+    (``spec.overrides``) come first, a file of their own."""
     files = [Path(f) for f in spec.reference[len("verilog:") :].split(",")]
     top = spec.port_map.top
-    out, seen = [], {}
-    if spec.overrides and spec.overrides.defines:
-        out.append((DEFINES_FILE, spec.overrides.define_text()))
-    for path in files:
-        if path.name in seen:
-            raise UserError(
-                f"design {top}: two files named {path.name!r} ({seen[path.name]}, {path}); "
-                f"the board build puts them in one folder"
-            )
-        seen[path.name] = path
-        out.append((path.name, _read(path, top)))
-    pending = [(path, text) for (_, text), path in zip(out[-len(files) :], files)]
-    while pending:
-        path, text = pending.pop(0)
+    texts = [(path, _read(path, top)) for path in files]
+    seen = set()
+    while texts:  # every include found, as the simulation finds it
+        path, text = texts.pop(0)
         for name in _INCLUDE.findall(text):
-            if name in seen or Path(name).is_absolute():
+            if Path(name).is_absolute() or (path.parent, name) in seen:
                 continue
-            if ".." in Path(name).parts:
-                raise UserError(
-                    f"design {top}: {path.name} includes {name!r}; the board build writes "
-                    f"included files next to the top: name them without '..'"
-                )
+            seen.add((path.parent, name))
             found = next(
                 (
                     b / name
@@ -124,15 +112,14 @@ def verilog_files(spec):
                     f"design {top}: included file {name!r} not found (looked next to "
                     f"{path.name} and the listed files)"
                 )
-            seen[name] = found
-            included = _read(found, top)
-            out.append((name, included))
-            pending.append((found, included))
-    # The data files of a $readmemh/$readmemb, found as the simulation finds them (a missing
-    # one was refused with the design's check): Yosys reads them next to the files.
-    data = {}
-    verilog_includes(files, data)
-    out += [(name, _read(data[name], top)) for name in sorted(data) if name not in seen]
+            texts.append((found, _read(found, top)))
+    try:
+        sources, includes = verilog_layout(files)
+    except PortMapError as exc:
+        raise UserError(f"design {top}: {exc}") from None
+    out = [*sources.items(), *includes.items()]
+    if spec.overrides and spec.overrides.defines:
+        out.insert(0, (DEFINES_FILE, spec.overrides.define_text()))
     return out
 
 
