@@ -149,6 +149,7 @@ def run(
     *,
     design=None,
     params=None,
+    defines=None,
     overrides=(),
     seed=None,
     backend="auto",
@@ -166,7 +167,11 @@ def run(
     params : dict, optional
         ``[design.params]`` values (the design's keyword arguments) as Python values:
         ``None``, an enum member or a dict reach the design as given, each checked against
-        its signature as ``[design.params]`` are.
+        its signature as ``[design.params]`` are; a Verilog design's top-module
+        parameters (numbers, booleans, text; checked against the design's own).
+    defines : dict, optional
+        A Verilog design's `define macros (``[design.defines]``; ``True``: defined without a
+        value).
     overrides : list of str
         ``KEY=VALUE`` items, as ``--set`` takes them (``"sim.duration=5"``).
     seed : int, optional
@@ -178,5 +183,9 @@ def run(
         A viewer recorder (``fpga_robotics.viz.open_recorder``), not closed here.
     """
     items = [*_design_overrides(design, ports), *override_items(overrides)]
+    if defines is not None:
+        if not isinstance(defines, dict):
+            raise UsageError(f"defines must be a dict of macro names, got {defines!r}")
+        items += [f"design.defines.{n}={json.dumps(v)}" for n, v in defines.items()]
     loaded = load_scenario(str(scenario), items, design_params=_checked_params(params))
     return Result(run_scenario(loaded, seed=seed, backend=backend, recorder=recorder), loaded)

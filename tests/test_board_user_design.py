@@ -392,6 +392,26 @@ def test_an_include_under_a_folder_named_as_one_of_root_says_to_rename_it(tmp_pa
     assert not out.exists()
 
 
+def test_an_include_outside_the_designs_folder_is_written_in_its_layout(tmp_path, capsys):
+    # rtl/bump_stop.v includes ../include/defs.vh: the board folder gets both at their
+    # places, and Yosys reads the top with them as the build will.
+    (tmp_path / "rtl").mkdir()
+    (tmp_path / "include").mkdir()
+    (tmp_path / "include" / "defs.vh").write_text("`define SPEED 12'sd300\n")
+    design = tmp_path / "rtl" / "bump_stop.v"
+    design.write_text(
+        '`include "../include/defs.vh"\n'
+        + (DATA / "bump_stop.v").read_text().replace("12'sd300;", "`SPEED;")
+    )
+    out = tmp_path / "b"
+    argv = ["board", "--design", f"verilog:{design}", "--ports", str(DATA / "bump_stop_ports.toml")]
+    code, _, err = _cli([*argv, "-o", str(out)], capsys)
+    assert code == 0, err
+    assert (out / "include" / "defs.vh").read_text() == "`define SPEED 12'sd300\n"
+    code, log = _hierarchy_check(out, ["ulx3s_follow_target.v", "rtl/bump_stop.v"])
+    assert code == 0, log
+
+
 BAD_MAPS = {
     "no_wheels": (
         'top = "bump_stop"\nclock = { port = "clk" }\n[connectors.bumper]\npressed = "bump_i"\n',

@@ -396,8 +396,16 @@ CASES = [
     ),
     (
         "mutate Verilog with a parameter",
-        ["mutate", "--design", f"verilog:{DESIGNS}/bump_stop_noreset.v", "--param", "a=1"],
-        "takes no parameters",
+        [
+            "mutate",
+            "--design",
+            f"verilog:{DESIGNS}/bump_stop_noreset.v",
+            "--ports",
+            f"{DESIGNS}/bump_stop_noreset_ports.toml",
+            "--param",
+            "a=1",
+        ],
+        "has no parameter 'a' to set",
     ),
     ("mutate port map without design", ["mutate", "--ports", "p.toml"], "--ports"),
     (

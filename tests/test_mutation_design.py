@@ -229,7 +229,10 @@ def test_robot_judge_of_a_users_design_matches_its_runs(tmp_path, capsys):
             "unknown campaign 'nosuch'",
         ),
         (["--design", "wall_stop.py:WallStop", "--param", "nope"], "--param must be NAME=VALUE"),
-        (["--cycles", "5"], "--param, --ports, --cycles and --resolution go with --design REF"),
+        (
+            ["--cycles", "5"],
+            "--param, --define, --ports, --cycles and --resolution go with --design REF",
+        ),
         (
             ["--design", "follow_target", "--param", "x=1"],
             "not FollowTarget (the default, and --design follow_target)",

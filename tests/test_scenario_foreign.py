@@ -82,9 +82,13 @@ def test_paths_are_relative_to_the_scenario_file(files, monkeypatch):
         (
             (
                 '[design]\nverilog = ["rtl/follow_target.v"]\nports = "rtl/ft.toml"\n'
-                "[design.params]\ngain = 4\n"
+                "[design.params]\ngain = [4]\n"
             ),
-            "design.params: a Verilog design takes no parameters here",
+            "design.params.gain: give a number, a boolean, a literal such as 8'hff or a text",
+        ),
+        (
+            '[design]\ntop = "follow_target"\n[design.defines]\nFAST = true\n',
+            "design.defines sets `define macros of a Verilog design (design.verilog)",
         ),
     ],
 )
@@ -208,7 +212,7 @@ def test_a_scenario_runs_its_foreign_design_in_closed_loop(files, capsys):
 def test_run_design_verilog_replaces_the_scenarios_own_design(tmp_path):
     """``run --design verilog:FILES --ports MAP`` on a scenario whose design is one's own
     (with [design.params]): the Verilog design is the scenario's (its files, no parameters of
-    the design it replaces); a --set design.params is refused, not ignored."""
+    the design it replaces); a --set design.params is the Verilog design's own."""
     from fpga_robotics.cli import run
 
     data = Path(__file__).parent / "data"
@@ -230,6 +234,7 @@ def test_run_design_verilog_replaces_the_scenarios_own_design(tmp_path):
     assert scenario.design_params == {}
     assert scenario.foreign.verilog == (str(lf / "lf_top.v"), str(lf / "lf_core.v"))
     assert scenario.foreign.ports == str(lf / "lf_ports.toml")
+    assert not scenario.foreign.overrides
     args.overrides = ["design.params.speed=100"]
-    with pytest.raises(UsageError, match="a Verilog design .* takes no parameters"):
-        run.load_run_scenario(args)
+    scenario = run.load_run_scenario(args)
+    assert scenario.foreign.overrides.parameters == (("speed", "100"),)

@@ -8,6 +8,7 @@ from pathlib import Path
 import pytest
 
 from fpga_robotics.cli.errors import UsageError
+from fpga_robotics.hw.errors import UserError
 from fpga_robotics.testing import run
 
 DESIGNS = Path(__file__).parent / "data" / "user_designs"
@@ -58,9 +59,9 @@ def test_bad_arguments_are_one_line_errors():
         run(DESIGNS / "wall_stop.toml", design="verilog:x.v")
     with pytest.raises(UsageError, match=r"got the string 'sim.duration=1'; write \['sim"):
         run(DESIGNS / "wall_stop.toml", overrides="sim.duration=1")
-    # A Verilog design in place of the scenario's takes no params: refused, not dropped.
+    # A Verilog design in place of the scenario's takes its own params: refused, not dropped.
     data = DESIGNS.parent
-    with pytest.raises(UsageError, match="a Verilog design takes no parameters here"):
+    with pytest.raises(UserError, match="the design bump_stop has no parameter 'speed' to set"):
         run(
             data / "bump_wall.toml",
             design=f"verilog:{data / 'bump_stop.v'}",

@@ -8,8 +8,10 @@ import sys
 from fpga_robotics.cli.designs import checked_verilog
 from fpga_robotics.cli.errors import UsageError
 from fpga_robotics.cli.param_options import (
+    add_define_argument,
     add_design_param_argument,
     add_param_arguments,
+    defines_from_items,
     design_params_from_items,
     given_followtarget_options,
     params_from_args,
@@ -138,6 +140,7 @@ def main(argv=None, prog="fpga-robotics board"):
         help="with --design verilog:FILES: the design's port map (docs/foreign.md)",
     )
     add_design_param_argument(parser)
+    add_define_argument(parser)
     add_param_arguments(parser)
     args = parser.parse_args(argv)
     params = params_from_args(args)
@@ -152,15 +155,19 @@ def main(argv=None, prog="fpga-robotics board"):
             _refuse_builtin_parameters(args, reference)
         # The board top's own options would be silently ignored with a design of one's own.
         refuse_followtarget_options(args, "--design REF puts a design of your own on the board")
+        if args.define and not reference.startswith("verilog:"):
+            raise UsageError("--define sets `define macros of a Verilog design (verilog:FILES)")
         design = resolve_design(
-            args.design, design_params_from_items(args.param), ports=args.ports, option="--param"
+            args.design,
+            design_params_from_items(args.param),
+            ports=args.ports,
+            option="--param",
+            defines=defines_from_items(args.define),
         )
         design.require_defined_domains()  # the board drives the sync domain's clock only
-    elif args.param or args.ports:
-        raise UsageError(
-            f"{'--param' if args.param else '--ports'} goes with --design REF (a design of "
-            f"your own)"
-        )
+    elif args.param or args.ports or args.define:
+        given = "--param" if args.param else "--define" if args.define else "--ports"
+        raise UsageError(f"{given} goes with --design REF (a design of your own)")
     # An empty -o is refused by run_board's check, not replaced by the default.
     out = args.output if args.output is not None else os.path.join("build", args.board)
     return run_board(args, params, out, prog, design=design)

@@ -67,7 +67,13 @@ def checked_verilog(spec, ports):
     port_map = load_port_map(ports)
     pins = bool(port_map.connectors or port_map.extra_outputs or not port_map.has_pixels)
     try:
-        design = ForeignDesign(files, port_map, pins=pins, connector_kinds=connector_kinds())
+        design = ForeignDesign(
+            files,
+            port_map,
+            pins=pins,
+            connector_kinds=connector_kinds(),
+            overrides=spec.overrides,
+        )
     except BackendError as exc:
         raise DesignError(f"{ports}: {exc}".splitlines()[0]) from None
     found = {

@@ -9,7 +9,12 @@ import os
 from concurrent.futures import ThreadPoolExecutor
 
 from fpga_robotics.cli.errors import UsageError
-from fpga_robotics.cli.param_options import add_design_param_argument, design_params_from_items
+from fpga_robotics.cli.param_options import (
+    add_define_argument,
+    add_design_param_argument,
+    defines_from_items,
+    design_params_from_items,
+)
 from fpga_robotics.cli.parser import CommandParser
 from fpga_robotics.flow.formal import (
     default_trace_dir,
@@ -72,6 +77,7 @@ def build_parser(prog="fpga-robotics formal"):
         "of FollowTarget's",
     )
     add_design_param_argument(parser)
+    add_define_argument(parser)
     parser.add_argument(
         "--ports",
         "--port-map",
@@ -87,10 +93,13 @@ def main(argv=None, prog="fpga-robotics formal"):
     args = parser.parse_args(argv)
     if args.list:
         # The list shows which checks and their own depths: what runs them is ignored.
-        others = parser.given_options(args, ignore={"list", "design", "param", "ports", "only"})
+        others = parser.given_options(
+            args, ignore={"list", "design", "param", "define", "ports", "only"}
+        )
         if others:
             raise UsageError(
-                f"--list takes only --design, --param, --ports and --only; got {', '.join(others)}"
+                f"--list takes only --design, --param, --define, --ports and --only; got "
+                f"{', '.join(others)}"
             )
     if args.depth is not None and args.depth < 1:
         raise UsageError(f"--depth must be at least 1, got {args.depth}")
@@ -98,7 +107,13 @@ def main(argv=None, prog="fpga-robotics formal"):
         raise UsageError(f"--jobs must be at least 1, got {args.jobs}")
 
     checks = select(
-        design_checks(args.design, design_params_from_items(args.param), args.ports), args.only
+        design_checks(
+            args.design,
+            design_params_from_items(args.param),
+            args.ports,
+            defines_from_items(args.define),
+        ),
+        args.only,
     )
     if args.list:
         width = max(len(c.name) for c in checks)

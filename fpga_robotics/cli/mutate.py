@@ -16,8 +16,10 @@ import time
 
 from fpga_robotics.cli.errors import UsageError
 from fpga_robotics.cli.param_options import (
+    add_define_argument,
     add_design_param_argument,
     add_param_arguments,
+    defines_from_items,
     design_params_from_items,
     params_from_args,
     refuse_followtarget_options,
@@ -59,6 +61,8 @@ from fpga_robotics.mutation.unit_judge import (
     reference_results,
 )
 from fpga_robotics.sim.backends.base import BackendError
+from fpga_robotics.sim.backends.port_map import PortMapError
+from fpga_robotics.sim.backends.verilog_params import VerilogOverrides
 from fpga_robotics.sim.files import check_output_dir, write_atomic, write_json_atomic
 from fpga_robotics.sim.mutation import MAX_MUTANT_SEED, MutationError, list_mutants, mutant_cones
 from fpga_robotics.sim.pins import PinError
@@ -309,6 +313,7 @@ def build_parser(prog="fpga-robotics mutate"):
         "(default 160x120)",
     )
     add_design_param_argument(p)
+    add_define_argument(p)
     p.add_argument(
         "--ports",
         "--port-map",
@@ -424,10 +429,16 @@ def _main_design(args):
         args, "with --design REF the mutants are judged against the unmutated design"
     )
     verilog = args.design.startswith("verilog:")
-    if verilog and args.param:
-        raise UsageError(
-            "--param: a Verilog design takes no parameters here; set them in the Verilog"
-        )
+    overrides = None
+    if verilog:
+        try:
+            overrides = VerilogOverrides.of(
+                design_params_from_items(args.param), defines_from_items(args.define)
+            )
+        except PortMapError as exc:
+            raise UsageError(str(exc)) from None
+    elif args.define:
+        raise UsageError("--define sets `define macros of a Verilog design (verilog:FILES)")
     if not verilog and args.ports is not None:
         raise UsageError("--ports is the port map of a Verilog design: it goes with verilog:FILES")
     frame = _resolution(args.resolution) if args.resolution is not None else DEFAULT_FRAME
@@ -479,7 +490,14 @@ def _main_design(args):
         with _removed_on_error(out, campaign):
             if verilog:
                 result = mutate_verilog_design(
-                    files, args.ports, args.mutants, args.seed, cycles, out, **judged
+                    files,
+                    args.ports,
+                    args.mutants,
+                    args.seed,
+                    cycles,
+                    out,
+                    overrides=overrides,
+                    **judged,
                 )
             else:
                 result = mutate_design(spec, args.mutants, args.seed, cycles, out, **judged)
@@ -555,11 +573,12 @@ def main(argv=None, prog="fpga-robotics mutate"):
     if args.design is not None and args.design != "follow_target":
         return _main_design(args)
     args.against = args.against or "model"
-    if args.param or args.cycles is not None or args.ports is not None or args.resolution:
+    given = args.param or args.define or args.cycles is not None or args.ports is not None
+    if given or args.resolution:
         raise UsageError(
-            "--param, --ports, --cycles and --resolution go with --design REF, a design of "
-            "your own, not FollowTarget (the default, and --design follow_target), whose "
-            "frame size is --width and --height"
+            "--param, --define, --ports, --cycles and --resolution go with --design REF, a "
+            "design of your own, not FollowTarget (the default, and --design follow_target), "
+            "whose frame size is --width and --height"
         )
     params = params_from_args(args)
     # The mutant netlist is built for this frame size and these values: every robot judge

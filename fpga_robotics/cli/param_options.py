@@ -10,8 +10,10 @@ from fpga_robotics.cli.errors import UsageError
 from fpga_robotics.hw.params import CHOICES, PRESETS, FollowTargetParams
 
 __all__ = [
+    "add_define_argument",
     "add_design_param_argument",
     "add_param_arguments",
+    "defines_from_items",
     "design_params_from_items",
     "params_from_args",
     "refuse_followtarget_options",
@@ -84,7 +86,18 @@ def add_design_param_argument(parser):
     )
 
 
-def design_params_from_items(items):
+def add_define_argument(parser):
+    """``--define NAME[=VALUE]`` (repeatable): a `define macro of a Verilog ``--design``."""
+    parser.add_argument(
+        "--define",
+        action="append",
+        default=[],
+        metavar="NAME[=VALUE]",
+        help="with --design verilog:...: a `define macro read before its files (repeatable)",
+    )
+
+
+def design_params_from_items(items, option="--param"):
     """``--param NAME=VALUE`` items as a dict (values read as TOML, else as text). A name
     given twice is a ``UsageError``: which value would the design get?"""
     params = {}
@@ -92,14 +105,30 @@ def design_params_from_items(items):
         name, sep, text = item.partition("=")
         name = name.strip()
         if not sep or not name.isidentifier():
-            raise UsageError(f"--param must be NAME=VALUE, got {item!r}")
+            raise UsageError(f"{option} must be NAME=VALUE, got {item!r}")
         if name in params:
-            raise UsageError(f"--param {name} is given twice; give each parameter once")
+            raise UsageError(f"{option} {name} is given twice; give each parameter once")
         try:
             params[name] = tomllib.loads(f"v = {text}")["v"]
         except tomllib.TOMLDecodeError:
             params[name] = text.strip()
     return params
+
+
+def defines_from_items(items):
+    """``--define NAME[=VALUE]`` items (a Verilog design's `define macros) as a dict, values
+    read as ``--param``'s; a name alone is ``True``: defined, without a value."""
+    names = [item.partition("=")[0].strip() for item in items]
+    twice = next((n for n in names if names.count(n) > 1), None)
+    if twice is not None:
+        raise UsageError(f"--define {twice} is given twice; give each macro once")
+    valued = [item for item in items if "=" in item]
+    defines = {name: True for name in names if name and name.isidentifier()}
+    bad = next((i for i in items if not i.partition("=")[0].strip().isidentifier()), None)
+    if bad is not None:
+        raise UsageError(f"--define must be NAME or NAME=VALUE, got {bad!r}")
+    defines.update(design_params_from_items(valued, option="--define"))
+    return defines
 
 
 def _default_text(f):

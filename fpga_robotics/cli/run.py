@@ -19,6 +19,7 @@ from pathlib import Path
 
 from fpga_robotics.checks.summary import format_summary
 from fpga_robotics.cli.errors import UsageError, run_cli
+from fpga_robotics.cli.param_options import defines_from_items, design_params_from_items
 from fpga_robotics.cli.parser import CommandParser
 from fpga_robotics.designs.builtin import TOPS
 from fpga_robotics.designs.reference import design_parameters, design_source_files
@@ -207,6 +208,22 @@ def build_parser(prog="fpga-robotics run"):
         "--ports", metavar="PORTS.toml", help="with --design: the port map of the Verilog design"
     )
     p.add_argument(
+        "--param",
+        action="append",
+        default=[],
+        metavar="NAME=VALUE",
+        help="a parameter of the design (--set design.params.NAME=VALUE; a Verilog "
+        "design's top-module parameter; repeatable)",
+    )
+    p.add_argument(
+        "--define",
+        action="append",
+        default=[],
+        metavar="NAME[=VALUE]",
+        help="with a Verilog design: a `define macro read before its files "
+        "(--set design.defines.NAME=VALUE; repeatable)",
+    )
+    p.add_argument(
         "--runtime",
         action="append",
         default=[],
@@ -287,12 +304,6 @@ def _verilog_overrides(args, items):
     """``--design verilog:FILES`` (and ``--ports``) as the scenario's ``design.top`` (and
     ``design.ports``), paths made absolute: the scenario is loaded with the Verilog design
     in place of its own (its timing, no parameters of the design it replaces)."""
-    given = [i.split("=", 1)[0].strip() for i in items]
-    if any(key.startswith("design.params") for key in given):
-        raise UsageError(
-            "design.params: a Verilog design (--design verilog:...) takes no parameters; "
-            "set them in the Verilog (or tie inputs in its port map's [constants])"
-        )
     files = [f for f in args.design[len("verilog:") :].split(",") if f.strip()]
     paths = [Path(f).expanduser() for f in [*files, args.ports or ""]]
     if not files or args.ports is None or not all(p.is_file() for p in paths):
@@ -378,6 +389,14 @@ _SHORTHANDS = {
 
 def _overrides(args):
     items = list(args.overrides)
+    items += [
+        f"design.params.{name}={json.dumps(value)}"
+        for name, value in design_params_from_items(getattr(args, "param", [])).items()
+    ]
+    items += [
+        f"design.defines.{name}={json.dumps(value)}"
+        for name, value in defines_from_items(getattr(args, "define", [])).items()
+    ]
     # Both given, one would silently win while the summary recorded the two values.
     for option, key in _SHORTHANDS.items():
         given = [item for item in items if item.split("=", 1)[0].strip() == key]
@@ -714,7 +733,10 @@ def _with_design_files(args, scenario):
         return scenario
 
     files, ports = design_files
-    return dataclasses.replace(scenario, foreign=ForeignDesignFiles(tuple(files), str(ports)))
+    overrides = scenario.foreign.overrides if scenario.foreign is not None else None
+    return dataclasses.replace(
+        scenario, foreign=ForeignDesignFiles(tuple(files), str(ports), overrides)
+    )
 
 
 class PortMapUnpaired(UsageError):
@@ -772,7 +794,12 @@ def _open_design(args, scenario):
     try:
         # Outputs the map does not name stay None: absent in the summary and the viewer.
         backend = open_foreign_frames(
-            args.backend, params, files=files, port_map=ports, on_build=tell
+            args.backend,
+            params,
+            files=files,
+            port_map=ports,
+            on_build=tell,
+            overrides=scenario.foreign.overrides if scenario.foreign is not None else None,
         )
     except BackendError as exc:
         raise UsageError(f"{args.design_option}: {exc}".splitlines()[0]) from None

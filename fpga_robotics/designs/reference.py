@@ -145,6 +145,8 @@ class DesignSpec:
     free_domains: tuple = ()
     signed: frozenset = frozenset()
     netlist_digest: str = ""
+    #: A Verilog design's parameters and `define macros (``VerilogOverrides``).
+    overrides: object = None
 
     @property
     def camera(self):
@@ -225,13 +227,14 @@ def entry_point_designs():
     return {ep.name: ep.value for ep in importlib.metadata.entry_points(group=ENTRY_POINT_GROUP)}
 
 
-def resolve_design(reference, params=None, *, ports=None, base=None, option=None):
+def resolve_design(reference, params=None, *, ports=None, base=None, option=None, defines=None):
     """The ``DesignSpec`` of ``reference`` built with ``params`` (``[design.params]``).
 
     ``ports`` is the port map of a ``verilog:`` reference; ``base`` the folder relative file
     paths are taken from (a scenario file's; default the current folder); ``option`` the
     command-line option ``params`` came from (``"--param"``; None: a scenario's
-    ``[design.params]``), which errors about them name. Raises ``DesignError`` (one line:
+    ``[design.params]``), which errors about them name; ``defines`` a Verilog design's
+    `define macros (``--define``). Raises ``DesignError`` (one line:
     what is wrong and how to fix it)."""
     if not isinstance(reference, str) or not reference.strip():
         raise DesignError(
@@ -242,7 +245,7 @@ def resolve_design(reference, params=None, *, ports=None, base=None, option=None
     params = dict(params or {})
     reference = reference.strip()
     if reference.startswith("verilog:"):
-        return _verilog_spec(reference, ports, base, params, option)
+        return _verilog_spec(reference, ports, base, params, option, defines)
     if reference in TOPS:
         if params:
             given = option or "design.params"
@@ -1314,23 +1317,22 @@ def extra_outputs_of(ports, bindings):
 # Verilog designs ------------------------------------------------------------------------
 
 
-def _verilog_spec(reference, ports, base, params, option):
+def _verilog_spec(reference, ports, base, params, option, defines):
     from fpga_robotics.sim.backends.port_map import (  # lazy: the simulator (~0.5 s)
         PortMapError,
         load_port_map,
     )
+    from fpga_robotics.sim.backends.verilog_params import VerilogOverrides  # lazy: as above
 
     files = [f for f in reference[len("verilog:") :].split(",") if f.strip()]
     if not files:
         raise DesignError(
             f"design {reference!r}: name the Verilog files, verilog:TOP.v[,MORE.v...]"
         )
-    if params:
-        raise DesignError(
-            f"{option or 'design.params'}: a Verilog design takes no parameters here; set "
-            "its parameters in the Verilog (or tie inputs in the port map's "
-            "[constants])"
-        )
+    try:  # the names are checked against the design when Verilator reads it
+        overrides = VerilogOverrides.of(params, defines)
+    except PortMapError as exc:
+        raise DesignError(str(exc)) from None
     resolved = []
     for text in files:
         path = Path(text).expanduser()
@@ -1376,4 +1378,5 @@ def _verilog_spec(reference, ports, base, params, option):
         {},
         top,
         port_map,
+        overrides=overrides,
     )

@@ -231,7 +231,12 @@ def _user_factory(spec):
                         f"writes its own files as {DESIGN_NAME}.*"
                     )
                 platform.add_file(name, text)
-            design = VerilogOnBoard(spec.port_map, servo=wiring["servo"], header=wiring["header"])
+            design = VerilogOnBoard(
+                spec.port_map,
+                servo=wiring["servo"],
+                header=wiring["header"],
+                overrides=spec.overrides,
+            )
             # The simulation reads the outputs the map's latency after its strobe.
             update_delay = spec.port_map.latency
         else:

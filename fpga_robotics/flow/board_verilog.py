@@ -18,7 +18,9 @@ from amaranth.hdl import signed as signed_shape
 
 from fpga_robotics.hw.errors import UserError
 from fpga_robotics.hw.pixel import COLOR_SELECT
-from fpga_robotics.sim.backends.foreign import verilog_includes
+from fpga_robotics.sim.backends.foreign import verilog_layout
+from fpga_robotics.sim.backends.port_map import PortMapError
+from fpga_robotics.sim.backends.verilog_params import DEFINES_FILE
 from fpga_robotics.sim.files import read_user_text
 from fpga_robotics.sim.processes import run_captured
 
@@ -83,30 +85,20 @@ def verilog_board_ports(spec, kinds, header_sites):
 def verilog_files(spec):
     """``[(name in the build folder, text)]``: the design's files and every file they
     ``include`` (looked for next to the including file, then next to each listed file, as
-    the simulation looks) or reads with ``$readmemh``/``$readmemb``, each once; an absolute
-    name is left to Yosys."""
+    the simulation looks) or reads with ``$readmemh``/``$readmemb``, each once, by their
+    places from the folder that holds them all (``verilog_layout``: an include of
+    "../inc/defs.vh" finds its file); an absolute name is left to Yosys. The `define macros
+    (``spec.overrides``) come first, a file of their own."""
     files = [Path(f) for f in spec.reference[len("verilog:") :].split(",")]
     top = spec.port_map.top
-    out, seen = [], {}
-    for path in files:
-        if path.name in seen:
-            raise UserError(
-                f"design {top}: two files named {path.name!r} ({seen[path.name]}, {path}); "
-                f"the board build puts them in one folder"
-            )
-        seen[path.name] = path
-        out.append((path.name, _read(path, top)))
-    pending = [(path, text) for (_, text), path in zip(out, files)]
-    while pending:
-        path, text = pending.pop(0)
+    texts = [(path, _read(path, top)) for path in files]
+    seen = set()
+    while texts:  # every include found, as the simulation finds it
+        path, text = texts.pop(0)
         for name in _INCLUDE.findall(text):
-            if name in seen or Path(name).is_absolute():
+            if Path(name).is_absolute() or (path.parent, name) in seen:
                 continue
-            if ".." in Path(name).parts:
-                raise UserError(
-                    f"design {top}: {path.name} includes {name!r}; the board build writes "
-                    f"included files next to the top: name them without '..'"
-                )
+            seen.add((path.parent, name))
             found = next(
                 (
                     b / name
@@ -120,15 +112,14 @@ def verilog_files(spec):
                     f"design {top}: included file {name!r} not found (looked next to "
                     f"{path.name} and the listed files)"
                 )
-            seen[name] = found
-            included = _read(found, top)
-            out.append((name, included))
-            pending.append((found, included))
-    # The data files of a $readmemh/$readmemb, found as the simulation finds them (a missing
-    # one was refused with the design's check): Yosys reads them next to the files.
-    data = {}
-    texts = verilog_includes(files, data)
-    out += [(name, texts[name]) for name in sorted(data) if name not in seen]
+            texts.append((found, _read(found, top)))
+    try:
+        sources, includes = verilog_layout(files)
+    except PortMapError as exc:
+        raise UserError(f"design {top}: {exc}") from None
+    out = [*sources.items(), *includes.items()]
+    if spec.overrides and spec.overrides.defines:
+        out.insert(0, (DEFINES_FILE, spec.overrides.define_text()))
     return out
 
 
@@ -152,7 +143,8 @@ def check_yosys_reads(spec):
             path.write_text(text)
         read = " ".join(name for name, _ in files if name.endswith((".v", ".sv")))
         # Yosys runs sandboxed in the folder it starts in: every path relative to it.
-        script = f"read_verilog -sv {read}; hierarchy -top {top}"
+        chparam = spec.overrides.chparam(top) if spec.overrides else ""
+        script = f"read_verilog -sv {read}; {chparam}hierarchy -top {top}"
         code, output = run_captured([yosys, "-q", "-p", script], cwd=folder, timeout=600)
     if code != 0:
         errors = [line.strip() for line in output.splitlines() if "ERROR" in line]
@@ -193,8 +185,10 @@ class VerilogOnBoard(Elaboratable):
     ``frame_done``, the servo's and the connector pins' ports), wired to the module's ports
     as the port map says."""
 
-    def __init__(self, port_map, *, servo=None, header=()):
+    def __init__(self, port_map, *, servo=None, header=(), overrides=None):
         pm = self.port_map = port_map
+        #: The top's parameters (``VerilogOverrides``), set on its instance.
+        self._params = overrides.amaranth_params() if overrides else {}
         self._members = {}
         if pm.has_pixels:
             # payload: data[11:0], first[12], last[13], as the board's capture gives it
@@ -262,5 +256,5 @@ class VerilogOnBoard(Elaboratable):
             ports[f"{direction}_{port}"] = self._members[port]
         for port, value in {**pm.runtime, **pm.constants}.items():
             ports[f"i_{port}"] = Const(value)
-        m.submodules.design = Instance(pm.top, **ports)
+        m.submodules.design = Instance(pm.top, **self._params, **ports)
         return m

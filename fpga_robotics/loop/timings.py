@@ -90,7 +90,11 @@ def run_scenario(
         # A Verilog design's own frame backend (a backend name alone opens FollowTarget).
         files = scenario.foreign
         with open_foreign_frames(
-            backend, scenario.params, files=files.verilog, port_map=files.ports
+            backend,
+            scenario.params,
+            files=files.verilog,
+            port_map=files.ports,
+            overrides=files.overrides,
         ) as design:
             return run_compressed(scenario, backend=design, **options)
     return TIMINGS[scenario.sim.timing](scenario, backend=backend, **options)

@@ -152,8 +152,10 @@ def mutate_verilog_design(
     campaign=None,
     robot=None,
     frame=DEFAULT_FRAME,
+    overrides=None,
 ):
-    """``mutate_design`` for a Verilog design: ``files`` with its port map ``ports_path``.
+    """``mutate_design`` for a Verilog design: ``files`` with its port map ``ports_path``,
+    built with ``overrides`` (``VerilogOverrides``: its parameters and `define macros).
     Yosys reads the files (``read_verilog``) and mutates the map's top module; the mutant
     netlist's port map is the design's with ``mutsel`` a ``[runtime]`` input, and the unit
     judge drives every input the map gives the pin backend (its connector pins, the pixel
@@ -163,10 +165,20 @@ def mutate_verilog_design(
     # The frames' size: a framebuffer design's address and new-frame pulse are made for it.
     kinds, frame_size = connector_kinds(), tuple(frame)
     design = ForeignDesign(
-        files, ports_path, pins=True, connector_kinds=kinds, frame_size=frame_size
+        files,
+        ports_path,
+        pins=True,
+        connector_kinds=kinds,
+        frame_size=frame_size,
+        overrides=overrides,
     )
     top = design.port_map.top
-    sources = {"verilog": design.sources, "top": top, "includes": design.includes}
+    sources = {
+        "verilog": design.sources,
+        "top": top,
+        "includes": design.includes,
+        "overrides": design.overrides,
+    }
     mutants = list_mutants(None, n, seed, **sources)
     robot = _keyed(robot, out, mutants_key(design.digest(), mutants), campaign)
     verilog = mutant_netlist(None, mutants, **sources)

@@ -98,7 +98,7 @@ __all__ = [
 _TOP_KEYS = tuple(TopKeys.key_names())  # name, description, seed
 _APP_SECTIONS = ("sim", "camera", "color", "design", "checks")
 #: A foreign Verilog design instead of FollowTarget (docs/foreign.md): its files and port map.
-_FOREIGN_KEYS = ("verilog", "ports")
+_FOREIGN_KEYS = ("verilog", "ports", "defines")
 #: ``design.top`` (fpga_robotics.designs), a buggy ``variant``, and the tops' parameter tables.
 _TOP_TABLES = tuple(dict.fromkeys(key for top in TOPS.values() for key in top.tables))
 #: ``design.params``: the keyword arguments of a design of one's own (designs/reference.py).
@@ -204,6 +204,8 @@ class ForeignDesignFiles:
 
     verilog: tuple
     ports: str
+    #: ``[design.params]`` and ``[design.defines]`` (``sim.backends.verilog_params``).
+    overrides: object = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -676,7 +678,11 @@ def _set_path(data, key, value, shown):
         if last:
             node[part] = _coerce(node.get(part), value)
             return
-        if part not in node and parts[:i] == ["design"] and part in (*_TOP_TABLES, "params"):
+        if (
+            part not in node
+            and parts[:i] == ["design"]
+            and part in (*_TOP_TABLES, "params", "defines")
+        ):
             node[part] = {}  # a design parameter table the file does not give
         node = node[part]
 
@@ -687,8 +693,8 @@ _WORLD_ARRAYS = frozenset(path for path in WORLD_KEY_MODELS if "." in path)
 
 
 class _AnyName:
-    """Every name: the keys of ``design.params`` are the design's own (checked against its
-    signature when it is resolved)."""
+    """Every name: the keys of ``design.params`` (and a Verilog design's ``design.defines``)
+    are the design's own (checked against its signature when it is resolved)."""
 
     def __contains__(self, name):
         return True
@@ -696,7 +702,7 @@ class _AnyName:
 
 def _optional_keys(parents):
     """Keys that may be set although the file does not give them."""
-    if parents == ["design", "params"]:
+    if parents in (["design", "params"], ["design", "defines"]):
         return _AnyName()
     if len(parents) == 2 and parents[0] == "design" and parents[1] in _TOP_TABLES:
         return table_fields(parents[1])
@@ -987,6 +993,7 @@ def _foreign(design, source):
     "verilog:FILES"`` with ``ports``: a ``ForeignDesignFiles`` or None; relative paths from
     the scenario file's folder."""
     verilog, ports = design.pop("verilog", None), design.pop("ports", None)
+    defines = design.pop("defines", None)
     top = design.get("top")
     if isinstance(top, str) and top.startswith("verilog:"):
         if verilog is not None:
@@ -1001,6 +1008,10 @@ def _foreign(design, source):
                 f"(the design's port map, docs/foreign.md)"
             )
     if verilog is None and ports is None:
+        if defines is not None:
+            raise ScenarioError(
+                "design.defines sets `define macros of a Verilog design (design.verilog)"
+            )
         return None
     if verilog is None:
         raise ScenarioError('design.ports goes with design.verilog = ["top.v", ...]')
@@ -1031,8 +1042,34 @@ def _foreign(design, source):
         return str(path)
 
     return ForeignDesignFiles(
-        tuple(existing("verilog", f) for f in verilog), existing("ports", ports)
+        tuple(existing("verilog", f) for f in verilog),
+        existing("ports", ports),
+        _verilog_overrides(design.get("params", {}), defines),
     )
+
+
+def _verilog_overrides(params, defines):
+    """``[design.params]`` and ``[design.defines]`` of a Verilog design as a
+    ``VerilogOverrides`` (None without either); the names are checked against the design
+    when it is read."""
+    if not params and not defines:
+        return None
+    from fpga_robotics.sim.backends.port_map import PortMapError  # lazy: the simulator
+    from fpga_robotics.sim.backends.verilog_params import VerilogOverrides
+
+    for key, table in (("params", params), ("defines", defines or {})):
+        if not isinstance(table, dict):
+            raise ScenarioError(
+                f"design.{key} must be a table ([design.{key}] in a file, "
+                f"--set design.{key}.NAME=VALUE), got {table!r}"
+            )
+    try:
+        return VerilogOverrides.of(params, defines)
+    except PortMapError as exc:
+        text = (
+            str(exc).replace("--param ", "design.params.").replace("--define ", "design.defines.")
+        )
+        raise ScenarioError(text) from None
 
 
 def _design(data, width, height):
@@ -1077,11 +1114,7 @@ def _top(design, source):
     verilog = design.get("verilog") is not None and "top" not in design
     if verilog or (isinstance(top, str) and top.startswith("verilog:")):
         top = "follow_target"  # the design is the scenario's foreign one (design.ports)
-        if params:
-            raise ScenarioError(
-                "design.params: a Verilog design takes no parameters here; "
-                "set them in the Verilog (or tie inputs in [constants])"
-            )
+        params = {}  # the Verilog design's (ForeignDesignFiles.overrides)
         if not verilog:
             # design.top = "verilog:..." replaces the scenario's design, as run --design
             # does: the built-in design's tables (a line_track's [design.line]) go with it.

@@ -345,6 +345,7 @@ DESIGN_OTHER_KEYS = (
     *dict.fromkeys(key for top in TOPS.values() for key in top.tables),
     "verilog",
     "ports",
+    "defines",
 )
 
 

@@ -127,7 +127,8 @@ def _design_key(args, scenario):
 
 def design_digest(args, scenario, shadow=None):
     """sha256 of a run's designs as they are built, for the run's identity: a Verilog
-    design's files, port map and the files they `include (as the build cache hashes them); a
+    design's files, port map, the files they `include (as the build cache hashes them) and
+    its parameters and macros; a
     design of one's own: its file and its netlist as elaborated (whatever its file imports or
     reads). A built-in design is the package's: its version names it. ``shadow``: the
     scenario of a shadow design."""
@@ -148,6 +149,8 @@ def design_digest(args, scenario, shadow=None):
                 h.update(_content(path))
             for name, text in sorted(verilog_includes(paths).items()):
                 h.update(f"{name}\0{text}\0".encode())
+            # Its parameters and macros: another build of the same files.
+            h.update(repr(of.foreign.overrides if of.foreign else None).encode())
         elif not is_builtin(of.top):
             # Its file, as a Verilog design's (any edit makes another run), and its netlist:
             # what the modules it imports and the files it reads make of it.

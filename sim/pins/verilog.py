@@ -12,7 +12,7 @@ import functools
 import hashlib
 
 from ..backends.foreign import WRAPPER, pin_ports, watch_chunks
-from ..backends.verilog_cxxrtl import verilog_to_cxxrtl
+from ..backends.verilog_cxxrtl import DESIGN_DIR, verilog_to_cxxrtl
 from .base import PinError, Port
 from .design import FILTERED_PORTS, MAX_PORTS, PIXEL_PORTS
 
@@ -66,13 +66,17 @@ class VerilogPinSource:
     def verilog_files(self):
         """``(files, compiled)``: every file to write (relative path -> text, the design's
         `include files too) and the ones Verilator compiles, in order; the includes are
-        found under ``src``."""
+        found under ``DESIGN_DIR`` in their layout."""
         d = self.design
         files = {"fr_wrapper.v": d.wrapper}
         # The data files of $readmemh/$readmemb at their absolute paths (verilator_text).
-        files.update({f"src/{name}": d.verilator_text(text) for name, text in d.includes.items()})
-        files.update({f"src/{name}": d.verilator_text(text) for name, text in d.sources.items()})
-        compiled = ["fr_wrapper.v", *(f"src/{name}" for name in d.sources)]
+        files.update(
+            {f"{DESIGN_DIR}/{name}": d.verilator_text(text) for name, text in d.includes.items()}
+        )
+        files.update(
+            {f"{DESIGN_DIR}/{name}": d.verilator_text(text) for name, text in d.sources.items()}
+        )
+        compiled = ["fr_wrapper.v", *(f"{DESIGN_DIR}/{name}" for name in d.sources)]
         return files, compiled
 
     @functools.cached_property
