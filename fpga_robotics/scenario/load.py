@@ -65,6 +65,7 @@ from fpga_robotics.scenario.schema import (
     ov7670_keys,
 )
 from fpga_robotics.sim.backends.port_map import PortMapError, load_port_map
+from fpga_robotics.sim.backends.verilog_params import VerilogOverrides
 from fpga_robotics.sim.camera.raster import max_hfov, max_tilt, vertical_fov
 from fpga_robotics.sim.camera.render3d.options import Lamp, Render3DOptions
 from fpga_robotics.sim.camera.sensor import OV7670Params
@@ -1054,9 +1055,6 @@ def _verilog_overrides(params, defines):
     when it is read."""
     if not params and not defines:
         return None
-    from fpga_robotics.sim.backends.port_map import PortMapError  # lazy: the simulator
-    from fpga_robotics.sim.backends.verilog_params import VerilogOverrides
-
     for key, table in (("params", params), ("defines", defines or {})):
         if not isinstance(table, dict):
             raise ScenarioError(
