@@ -125,7 +125,13 @@ def _toolchain():
 def test_no_mutant_sits_on_a_clock_input():
     """Yosys lists places on flip-flops' clocks (seed 2 at 80x60: #34, the clock of
     tracker.counter.active inverted); the list leaves them out, the rest in Yosys's order."""
-    design = {"rtlil_text": None, "verilog": None, "top": mutation.TOP_NAME, "includes": None}
+    design = {
+        "rtlil_text": None,
+        "verilog": None,
+        "top": mutation.TOP_NAME,
+        "includes": None,
+        "overrides": None,
+    }
     lines, _, _ = mutation._mutate_list(PARAMS, 40, 2, design)
     clocked = [k for k, line in enumerate(lines) if " -port CLK " in line]
     assert clocked, "seed 2's first 40 places have a clock"

@@ -611,6 +611,7 @@ def test_mutants_on_a_memorys_constant_ports_are_replaced():
         "verilog": None,
         "top": "follow_target",
         "includes": None,
+        "overrides": None,
     }
     params = FollowTargetParams()
     # The first seed whose raw list holds a mutant Yosys cannot build (there is one).
