@@ -118,16 +118,15 @@ def design_params_from_items(items, option="--param"):
 def defines_from_items(items):
     """``--define NAME[=VALUE]`` items (a Verilog design's `define macros) as a dict, values
     read as ``--param``'s; a name alone is ``True``: defined, without a value."""
-    names = [item.partition("=")[0].strip() for item in items]
-    twice = next((n for n in names if names.count(n) > 1), None)
-    if twice is not None:
-        raise UsageError(f"--define {twice} is given twice; give each macro once")
-    valued = [item for item in items if "=" in item]
-    defines = {name: True for name in names if name and name.isidentifier()}
-    bad = next((i for i in items if not i.partition("=")[0].strip().isidentifier()), None)
-    if bad is not None:
-        raise UsageError(f"--define must be NAME or NAME=VALUE, got {bad!r}")
-    defines.update(design_params_from_items(valued, option="--define"))
+    defines = {}
+    for item in items:
+        name, sep, _ = item.partition("=")
+        name = name.strip()
+        if not name.isidentifier():
+            raise UsageError(f"--define must be NAME or NAME=VALUE, got {item!r}")
+        if name in defines:
+            raise UsageError(f"--define {name} is given twice; give each macro once")
+        defines[name] = design_params_from_items([item], option="--define")[name] if sep else True
     return defines
 
 
