@@ -46,6 +46,29 @@ def _never_found(m):
     return "the target was never found"
 
 
+def _mean_distance(v, limit, m):
+    """At most the limit: a pass. Above it in a run too short for a robot at its top speed
+    from its start to get the mean under it (``checks.reach``): nothing to judge (None)."""
+    if v is None:
+        return False
+    if v <= limit:
+        return True
+    floor = m.get("mean_distance_floor_m")
+    return None if floor is not None and floor > limit else False
+
+
+def _mean_distance_text(v, limit, m):
+    if v is None:
+        return f"{_NO_TARGET} (limit <= {limit} m)"
+    if _mean_distance(v, limit, m) is None:
+        return (
+            f"mean distance {_metres(v, limit)} m, but no robot could have kept it under "
+            f"{limit} m in this run (at its top speed from its start, at best "
+            f"{_metres(m['mean_distance_floor_m'], limit)} m): too short to judge"
+        )
+    return f"mean distance {_metres(v, limit)} m (limit <= {limit} m)"
+
+
 def _collisions(kind, meaning):
     return Check(
         f"max_{kind}_collisions",
@@ -205,13 +228,13 @@ SHIPPED_CHECKS = (
         "mean_distance_max_m",
         "mean_distance_m",
         "max",
-        "mean robot-to-target distance (centres) at most this",
-        lambda v, limit, m: (
-            f"mean distance {_metres(v, limit)} m (limit <= {limit} m)"
-            if v is not None
-            else f"{_NO_TARGET} (limit <= {limit} m)"
+        (
+            "mean robot-to-target distance (centres) at most this; n/a when the run is too short "
+            "for any robot to get the mean under it (mean_distance_floor_m)"
         ),
+        _mean_distance_text,
         limits=(0, 1000, "m"),
+        passes=_mean_distance,
     ),
     Check(
         "min_distance_min_m",

@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from fpga_robotics.checks.envelopes import envelope_geometry, envelope_metrics, lit_strip_frames
+from fpga_robotics.checks.reach import mean_distance_floor
 from fpga_robotics.checks.sensor_metrics import obstacle_metrics
 from fpga_robotics.checks.summary import (
     DESIGN_OUTPUTS,
@@ -515,6 +516,7 @@ class ClosedLoop:
         return {
             **obstacle_metrics(self.traj, self.events, self.period),
             **envelope_metrics(self.traj, self.scenario.params, geometry),
+            **mean_distance_floor(self.traj, self.world.config.robot),
             **rig,
         }
 
