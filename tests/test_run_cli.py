@@ -187,7 +187,7 @@ def test_a_failing_check_exits_1(tmp_path, capsys):
             "off",
             "--quiet",
             "--set",
-            "checks.mean_distance_max_m=0.5",
+            "checks.max_wheel_command_dps=1",
             "--summary",
             str(path),
         ],
@@ -196,8 +196,8 @@ def test_a_failing_check_exits_1(tmp_path, capsys):
     assert code == 1
     s = json.loads(path.read_text())
     bad = [c for c in s["checks"] if not c["passed"]]
-    assert s["verdict"] == "fail" and [c["name"] for c in bad] == ["mean_distance_max_m"]
-    assert "[FAIL] mean_distance_max_m" in out
+    assert s["verdict"] == "fail" and [c["name"] for c in bad] == ["max_wheel_command_dps"]
+    assert "[FAIL] max_wheel_command_dps" in out
 
 
 def test_saves_a_recording_where_asked(tmp_path, capsys):
