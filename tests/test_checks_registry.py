@@ -52,6 +52,7 @@ JUDGEABLE = {
     "peak_wheel_command_dps": 400,
     "search_travel_m": 0.05,
     "heading_overshoot_deg": 3.0,
+    "mean_aim_error_deg": 4.0,
     "searched_losses": 1,
     "searched_reacquisitions": 1,
     "reacquire_times_s": [2.0],
@@ -117,6 +118,12 @@ JUDGED_IF = {
         2.9,
         {"heading_overshoot_deg": None},
         "the target's centre was never in view",
+    ),
+    "max_mean_aim_error_deg": (
+        4.0,
+        3.9,
+        {"mean_aim_error_deg": None},
+        "no target person: no aim to judge",
     ),
     "reacquired_within_s": (
         2.0,

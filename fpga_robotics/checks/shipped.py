@@ -415,6 +415,22 @@ SHIPPED_CHECKS = (
         limits=(0, 180, "deg"),
         precondition=measured("heading_overshoot_deg", "the target's centre was never in view"),
     ),
+    Check(
+        "max_mean_aim_error_deg",
+        "mean_aim_error_deg",
+        "max",
+        (
+            "on average over the frames with a target, the camera points at most this far off "
+            "it, in view or not (mean_aim_error_deg): the robot turns to keep the target "
+            "centred"
+        ),
+        lambda v, limit, m: (
+            f"the camera pointed {_num(v, limit, 1)} deg off the target on average "
+            f"(limit <= {limit} deg)"
+        ),
+        limits=(0, 180, "deg"),
+        precondition=measured("mean_aim_error_deg", "no target person: no aim to judge"),
+    ),
     _collisions("wall", "at most this many collisions with a wall"),
     _collisions("furniture", "at most this many collisions with furniture"),
     Check(

@@ -75,6 +75,7 @@ def _time(x):
 SHOWN_DECIMALS = {
     "mean_centroid_error_px": 2,
     "heading_overshoot_deg": 2,
+    "mean_aim_error_deg": 2,
     "max_abs_bearing_deg": 2,
     "obstacle_removed_at_s": 6,
 }
@@ -231,6 +232,7 @@ def compute_metrics(
         "peak_wheel_command_dps": _peak_command(traj),
         "search_travel_m": _search_travel(traj, events),
         "heading_overshoot_deg": _heading_overshoot(traj, camera_mount),
+        "mean_aim_error_deg": _mean_aim_error(traj, camera_mount),
         "absent_outputs": [],
     }
 
@@ -270,6 +272,19 @@ def _heading_overshoot(traj, mount=None):
             best = max(best, abs(float(bk)))
         last = sign
     return best
+
+
+def _mean_aim_error(traj, mount=None):
+    """The mean, over the frames with a target, of how far the camera points off it, degrees
+    (``_aim_error`` unsigned, in or out of view: a robot that lets the target drift to the
+    image's edge or out of it, or turns to something else, aims badly whatever it reports).
+    None without the fields or a target."""
+    need = ("x", "y", "heading", "target_x", "target_y")
+    if any(k not in traj for k in need) or len(traj["x"]) == 0:
+        return None
+    err = np.abs(np.degrees(_aim_error(traj, mount)))
+    valid = ~np.isnan(err)
+    return float(err[valid].mean()) if valid.any() else None
 
 
 def _aim_error(traj, mount):
