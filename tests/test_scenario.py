@@ -194,7 +194,7 @@ def test_unknown_keys_are_errors_with_close_matches(item, expect):
         ("sim.duration", "KEY=VALUE"),
         ("sim.duration=-1", "sim.duration must be > 0"),
         ("sim.physics_dt=0.5", "sim.physics_dt 0.5 s is longer than a camera frame period"),
-        ("camera.resolution=abc", "WIDTHxHEIGHT"),
+        ("camera.resolution=abc", "camera.resolution must look like WIDTHxHEIGHT"),
         ("color.initial=purple", "color.initial must be one of"),
         ("design.kp_num=1.5", "kp_num must be an int"),
         (

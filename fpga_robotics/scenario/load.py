@@ -140,8 +140,9 @@ _NAME = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.-]*")
 MAX_FILE_BYTES = 1 << 20
 
 
-def parse_resolution(text):
-    """``"160x120"`` (or ``[160, 120]``) → ``(160, 120)``; ``ScenarioError`` when malformed."""
+def parse_resolution(text, where="resolution"):
+    """``"160x120"`` (or ``[160, 120]``) → ``(160, 120)``; ``ScenarioError`` naming ``where``
+    (the key or option that gave it) when malformed."""
     if isinstance(text, (list, tuple)) and len(text) == 2:
         w, h = text
     elif isinstance(text, str) and text.lower().count("x") == 1:
@@ -156,8 +157,7 @@ def parse_resolution(text):
         w = h = None
     if not (isinstance(w, int) and isinstance(h, int) and w > 0 and h > 0):
         raise ScenarioError(
-            f"resolution must look like WIDTHxHEIGHT, e.g. 160x120, 320x240 or 640x480; "
-            f"got {text!r}"
+            f"{where} must look like WIDTHxHEIGHT, e.g. 160x120, 320x240 or 640x480; got {text!r}"
         )
     return w, h
 
@@ -782,7 +782,7 @@ def _check_name(name):
 
 def _camera(data):
     k = _keys(CameraKeys, data["camera"], "camera")
-    width, height = parse_resolution(k.resolution)
+    width, height = parse_resolution(k.resolution, "camera.resolution")
     if not (
         WIDTH_RANGE[0] <= width <= WIDTH_RANGE[1] and HEIGHT_RANGE[0] <= height <= HEIGHT_RANGE[1]
     ):
