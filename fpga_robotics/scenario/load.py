@@ -90,6 +90,7 @@ __all__ = [
     "Scenario",
     "ScenarioError",
     "SimConfig",
+    "check_clock_is_used",
     "load_scenario",
     "override_items",
     "parse_resolution",
@@ -188,6 +189,9 @@ class CameraConfig:
 #: actuation delay is only the command's trip to the motor controller (one SPI message), s.
 REAL_CLOCK_ACTUATION_DELAY = 0.001
 
+#: The design's clock when ``sim.clock_hz`` is unset, Hz.
+DEFAULT_CLOCK_HZ = 50e6
+
 
 @dataclass(frozen=True)
 class SimConfig:
@@ -195,7 +199,7 @@ class SimConfig:
     physics_dt: float
     actuation_delay: float
     timing: str = "compressed"  # "compressed" or "real_clock" (never "auto" once loaded)
-    clock_hz: float = 50e6
+    clock_hz: float = DEFAULT_CLOCK_HZ
 
 
 @dataclass(frozen=True)
@@ -966,7 +970,7 @@ def _sim(data, camera):
         physics_dt=dt,
         actuation_delay=k.actuation_delay,
         timing=k.timing,
-        clock_hz=k.clock_hz,
+        clock_hz=DEFAULT_CLOCK_HZ if k.clock_hz is None else k.clock_hz,
     )
     steps = max(1, round(duration / dt))  # as the closed loop counts them
     if steps > MAX_PHYSICS_STEPS:
@@ -1282,6 +1286,24 @@ def _resolve_timing(sim, camera, top, design_params, connectors, foreign):
     if delay is None:
         delay = REAL_CLOCK_ACTUATION_DELAY if timing == "real_clock" else camera.frame_period
     return replace(sim, timing=timing, actuation_delay=delay)
+
+
+def check_clock_is_used(scenario):
+    """``ScenarioError`` when the scenario gives ``sim.clock_hz`` (its file or an override)
+    and nothing of its run reads it: compressed timing clocks a built-in or Verilog design
+    only while its pixels flow, at no rate (a design of one's own reads it there: a frame's
+    budget of edges, loop/pin_frames.py). A campaign, whose ``set`` reaches rows of either
+    timing, does not call this."""
+    if scenario.data["sim"].get("clock_hz") is None or scenario.sim.timing != "compressed":
+        return
+    if scenario.top not in TOPS:
+        return
+    design = "the Verilog design" if scenario.foreign is not None else f"design {scenario.top!r}"
+    raise ScenarioError(
+        f"sim.clock_hz {scenario.sim.clock_hz:g} would change nothing: {design} runs in "
+        f"compressed timing, clocked only while the pixels flow, at no clock rate; set "
+        f'sim.timing = "real_clock" to run it on that clock, or leave sim.clock_hz out'
+    )
 
 
 def _checks(data):
