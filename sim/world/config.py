@@ -336,6 +336,7 @@ _SPEC_KEYS = (
     "camera_forward",
     "com_height",
     "support_half_length",
+    "support_half_width",
     "motor_step_response",
 )
 

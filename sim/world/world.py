@@ -25,7 +25,7 @@ from .people import PersonPath, person_bands
 from .robots import G
 from .room import add_static_shapes, map_data, scene_walls
 from .sanity import segment_distance
-from .terrain import TerrainMap, slope_pitch
+from .terrain import TerrainMap, slope_pitch, slope_roll
 from .uncertainty import MotorUncertainty
 
 __all__ = [
@@ -370,6 +370,11 @@ class World:
             # support as a forward acceleration does, and the floor holds it with g cos.
             pitch = slope_pitch(self._patch, body.angle)
             load, limit = abs(accel + G * math.sin(pitch)), spec.tip_accel * math.cos(pitch)
+            # Across the slope gravity leans it sideways, no harder than the traction holds
+            # it there (sliding sideways, the floor pushes back with the traction alone).
+            roll = slope_roll(self._patch, body.angle)
+            side = min(G * abs(math.sin(roll)), most)
+            side_limit = spec.tip_accel_sideways * math.cos(roll)
             if load > limit:
                 slope = f" on a {math.degrees(pitch):+.1f} deg slope" if pitch else ""
                 self._tip(
@@ -377,6 +382,12 @@ class World:
                     f"({load:.2f} m/s^2 with gravity) > {limit:.2f} m/s^2"
                     if pitch
                     else f"longitudinal acceleration {abs(accel):.2f} m/s^2 > {limit:.2f} m/s^2"
+                )
+            elif side > side_limit:
+                self._tip(
+                    f"on its {'right' if roll > 0 else 'left'} side: rolled "
+                    f"{math.degrees(abs(roll)):.1f} deg across a slope, sideways load "
+                    f"{side:.2f} m/s^2 > {side_limit:.2f} m/s^2"
                 )
         self._motor_v = drive_v
         r = spec.wheel_radius
