@@ -67,3 +67,49 @@ def test_run_refuses_it_in_one_line_with_exit_2(tmp_path, capsys):
 def test_the_testing_api_refuses_it_too():
     with pytest.raises(ScenarioError, match="would change nothing"):
         testing.run("follow_person", overrides=["sim.clock_hz=1e6"], backend="model")
+
+
+# A design's tables that count time on the run's clock ----------------------------------------
+
+
+def test_the_ultrasound_driver_counts_on_the_runs_clock():
+    # obstacle_between at 2 MHz: the driver's clock_hz left out is the run's, so an echo of
+    # the HC-SR04's width for 1.5 m (2 d / 343 m/s at 2 MHz: 17,493 edges) reads 1500 mm.
+    # Before, the driver kept its 50 MHz default and read the same echo as 60 mm.
+    s = load_scenario("obstacle_between", ["sim.clock_hz=2e6"])
+    us = s.design_tables["ultrasound"]
+    assert us.clock_hz == 2_000_000
+    edges = round(2 * 1.5 / 343.0 * 2e6)
+    assert us.distance_of(edges) == pytest.approx(1500, abs=1)
+    default = load_scenario("obstacle_between")
+    assert default.design_tables["ultrasound"].clock_hz == 50_000_000
+
+
+@pytest.mark.parametrize(
+    "items,message",
+    [
+        (
+            ["sim.clock_hz=2e6", "design.ultrasound.clock_hz=50000000"],
+            (
+                "design.ultrasound.clock_hz 50000000 does not match sim.clock_hz 2000000; "
+                "leave design.ultrasound.clock_hz out to take it"
+            ),
+        ),
+        (
+            ["sim.clock_hz=20000", "camera.fps=1", 'camera.resolution="16x4"', "design.margin_x=0"],
+            (
+                "design.ultrasound: clock_hz=20000 is too slow for trigger_us=12 and "
+                "wait_us=10000: they must last at least 1 and 2 cycles (clock_hz is sim.clock_hz)"
+            ),
+        ),
+    ],
+)
+def test_an_ultrasound_clock_against_the_runs_is_refused(items, message):
+    with pytest.raises(ScenarioError) as info:
+        load_scenario("obstacle_between", items)
+    assert str(info.value) == message
+
+
+def test_an_ultrasound_clock_that_matches_the_runs_is_kept():
+    s = load_scenario("obstacle_between", ["sim.clock_hz=2e5", "design.ultrasound.clock_hz=200000"])
+    assert s.design_tables["ultrasound"].clock_hz == 200_000

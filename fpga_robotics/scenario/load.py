@@ -38,10 +38,9 @@ from pathlib import Path
 from pydantic_core import PydanticCustomError
 
 from fpga_robotics.checks.summary import CHECKS
-from fpga_robotics.designs.builtin import TOPS, design_tables, table_fields
+from fpga_robotics.designs.builtin import TOPS, design_tables, table_class, table_fields
 from fpga_robotics.designs.reference import DesignError, resolve_design
 from fpga_robotics.hw.errors import ParamError
-from fpga_robotics.hw.lidar_params import UartParams
 from fpga_robotics.hw.params import (
     PRESETS,
     FollowTargetParams,
@@ -1187,37 +1186,45 @@ def _check_follow_target_keys_read(design, top, design_params):
     )
 
 
-def _run_uart(design, sim, connectors):
-    """``[design]`` with the UART of a built-in design that has one (``[design.uart]``) on
-    the run's clock and LIDAR link: a key left out takes ``sim.clock_hz`` or the
-    ``lidar_uart`` table's ``baud``; a different value is refused, since the receiver would
-    time every bit wrong and never decode a byte."""
-    top, uart = design.get("top"), design.get("uart", {})
-    if not (top in TOPS and "uart" in TOPS[top].tables and isinstance(uart, dict)):
+def _run_clock(design, sim, connectors):
+    """``[design]`` with the tables of a built-in design that count time on the run's clock
+    (``[design.ultrasound]``, ``[design.uart]``: a ``clock_hz`` field) made to agree with
+    it: a key left out takes ``sim.clock_hz`` (and a UART's ``baud`` the ``lidar_uart``
+    table's); a different value is refused, since the design would time everything wrong
+    (an echo's width read as another distance, every bit of a byte at another length)."""
+    top = design.get("top")
+    if not (isinstance(top, str) and top in TOPS):
         return design
-    run = {"clock_hz": (round(sim.clock_hz), "sim.clock_hz")}
     sensors = [c for c in connectors if c.role == "sensor"]
     links = [i for i, c in enumerate(sensors) if c.kind == "lidar_uart"]
-    if links:
-        run["baud"] = (sensors[links[0]].params.baud, f"robot.sensors[{links[0]}].baud")
-    for key, (value, source) in run.items():
-        given = uart.get(key, value)
-        if isinstance(given, int | float) and not isinstance(given, bool) and given != value:
-            raise ScenarioError(
-                f"design.uart.{key} {given:.15g} does not match {source} {value}; leave "
-                f"design.uart.{key} out to take it"
-            )
-    taken = {key: value for key, (value, _) in run.items() if key not in uart}
-    if taken:
+    out = dict(design)
+    for key in TOPS[top].tables:
+        table, fields = design.get(key, {}), table_fields(key)
+        if not isinstance(table, dict) or "clock_hz" not in fields:
+            continue
+        run = {"clock_hz": (round(sim.clock_hz), "sim.clock_hz")}
+        if "baud" in fields and links:
+            run["baud"] = (sensors[links[0]].params.baud, f"robot.sensors[{links[0]}].baud")
+        for name, (value, source) in run.items():
+            given = table.get(name, value)
+            if isinstance(given, int | float) and not isinstance(given, bool) and given != value:
+                raise ScenarioError(
+                    f"design.{key}.{name} {given:.15g} does not match {source} {value}; leave "
+                    f"design.{key}.{name} out to take it"
+                )
+        taken = {name: value for name, (value, _) in run.items() if name not in table}
+        if not taken:
+            continue
         # Say where a value the user did not write comes from.
         try:
-            UartParams(**{**uart, **taken})
+            table_class(key)(**{**table, **taken})
         except ParamError as exc:
-            sources = ", ".join(f"{key} is {run[key][1]}" for key in taken)
-            raise ScenarioError(f"design.uart: {exc} ({sources})") from None
+            sources = ", ".join(f"{name} is {run[name][1]}" for name in taken)
+            raise ScenarioError(f"design.{key}: {exc} ({sources})") from None
         except TypeError:
             pass  # a value of the wrong type or name: design_tables says so
-    return {**design, "uart": {**uart, **taken}}
+        out[key] = {**table, **taken}
+    return out
 
 
 def _connectors(world):
@@ -1326,7 +1333,7 @@ def _build(data, source, overrides):
     foreign = _foreign(dict(data["design"]), source)
     world = {s: copy.deepcopy(data[s]) for s in WORLD_SECTIONS if s in data}
     connectors = _connectors(world)
-    top, tables, design_params = _top(_run_uart(data["design"], sim, connectors), source)
+    top, tables, design_params = _top(_run_clock(data["design"], sim, connectors), source)
     if foreign is None:
         _check_follow_target_keys_read(data["design"], top, design_params)
     checks = _checks(data)
