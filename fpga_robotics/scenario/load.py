@@ -691,9 +691,14 @@ def _set_path(data, key, value, shown):
         node = node[part]
 
 
-#: The world's arrays of tables inside a section (``room.furniture`` ...): a scenario may
-#: leave one out, and ``--set`` then cannot index it.
-_WORLD_ARRAYS = frozenset(path for path in WORLD_KEY_MODELS if "." in path)
+#: The world's arrays inside a section (``room.furniture``, ``robot.sensors``,
+#: ``lighting.keyframes`` ...): a scenario may leave one out, and ``--set`` then cannot
+#: index it.
+_WORLD_ARRAYS = frozenset(path for path in WORLD_KEY_MODELS if "." in path) | {
+    "robot.sensors",
+    "robot.actuators",
+    "lighting.keyframes",
+}
 
 
 class _AnyName:
@@ -1324,7 +1329,12 @@ def _build(data, source, overrides):
     description, seed = top_keys.description, data.get("seed", 0)
     for section in WORLD_SECTIONS:
         if section in data and not isinstance(data[section], (dict, list)):
-            raise ScenarioError(f"[{section}] must be a table")
+            if section == "people":
+                raise ScenarioError(
+                    f"people must be an array of tables ([[people]] in a file, --set "
+                    f"'people=[{{waypoints = [[4, 3]]}}]'), got {data[section]!r}"
+                )
+            raise ScenarioError(f"[{section}] must be a table, got {data[section]!r}")
 
     camera = _camera(data)
     sim = _sim(data, camera)
