@@ -151,7 +151,7 @@ class RobotKeys(KeyModel):
     """``None``: the robot model's value."""
 
     model: Text(choices=tuple(ROBOT_MODELS)) = "turtlebot2"
-    start: Point = None  # (min(1.5, room.width / 2), room.depth / 2)
+    start: Point = None  # (min(1.5, room.width / 2 - 0.5), room.depth / 2)
     heading_deg: Angle = 0.0
     mass: Number(ge=0.05, le=1000, unit="kg") = None
     body_radius: Number(ge=0.02, le=2, unit="m") = None
