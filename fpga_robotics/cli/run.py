@@ -411,7 +411,7 @@ def _overrides(args):
             )
         items.append(design_override(args.design))
     if args.resolution is not None:
-        w, h = parse_resolution(args.resolution, "--resolution")
+        w, h = parse_resolution(args.resolution)
         items.append(f'camera.resolution="{w}x{h}"')
     if args.duration is not None:
         if not args.duration > 0:
