@@ -113,38 +113,3 @@ def test_an_ultrasound_clock_against_the_runs_is_refused(items, message):
 def test_an_ultrasound_clock_that_matches_the_runs_is_kept():
     s = load_scenario("obstacle_between", ["sim.clock_hz=2e5", "design.ultrasound.clock_hz=200000"])
     assert s.design_tables["ultrasound"].clock_hz == 200_000
-
-
-# A campaign ---------------------------------------------------------------------------------
-
-
-def _campaign_check(scenarios, items):
-    import io
-
-    from fpga_robotics.hw.errors import UsageError
-    from fpga_robotics.sweep.campaign import load_campaign
-    from fpga_robotics.sweep.sanity import report_campaign_warnings
-
-    campaign = load_campaign(
-        {"name": "c", "scenarios": scenarios, "seeds": [0], "duration": 0.5, "set": items}
-    )
-    report_campaign_warnings(campaign, False, io.StringIO(), UsageError)
-
-
-def test_a_campaign_clock_that_no_run_reads_is_refused():
-    from fpga_robotics.hw.errors import UsageError
-
-    with pytest.raises(UsageError) as info:
-        _campaign_check(["follow_person", "divider"], ["sim.clock_hz=1e6"])
-    assert str(info.value) == (
-        "scenario 'follow_person': sim.clock_hz 1e+06 would change nothing: design "
-        "'follow_target' runs in compressed timing, clocked only while the pixels flow, at no "
-        'clock rate; set sim.timing = "real_clock" to run it on that clock, or leave '
-        "sim.clock_hz out (in every run of the campaign)"
-    )
-
-
-def test_a_campaign_clock_that_some_runs_read_is_theirs():
-    # obstacle_between runs in real-clock timing at that clock; follow_person leaves it.
-    _campaign_check(["follow_person", "obstacle_between"], ["sim.clock_hz=1e6"])
-    _campaign_check(["follow_person"], [])

@@ -1,14 +1,12 @@
 """A campaign's scenario warnings (``fpga_robotics.scenario.sanity``), before any run starts:
-each scenario is loaded once per distinct set of overrides the campaign gives it; and a
-``sim.clock_hz`` that none of its runs reads is refused, as ``run`` refuses it."""
+each scenario is loaded once per distinct set of overrides the campaign gives it."""
 
 from argparse import Namespace
 from dataclasses import replace
 
 from fpga_robotics.cli import run
 from fpga_robotics.hw.errors import UsageError
-from fpga_robotics.scenario.errors import ScenarioError
-from fpga_robotics.scenario.load import check_clock_is_used, load_scenario
+from fpga_robotics.scenario.load import load_scenario
 from fpga_robotics.scenario.sanity import report_warnings
 
 __all__ = ["report_campaign_warnings"]
@@ -16,12 +14,8 @@ __all__ = ["report_campaign_warnings"]
 
 def report_campaign_warnings(campaign, strict, stream, error):
     """Print the warnings of every scenario the campaign runs (each line once); with
-    ``strict`` raise ``error`` with the first instead. Raise ``error`` when the campaign
-    gives ``sim.clock_hz`` and none of its runs reads it (each one's own ``run`` would refuse
-    it; a clock that some rows read, real-clock timing, is theirs)."""
+    ``strict`` raise ``error`` with the first instead."""
     seen = set()
-    unread = None  # the first refusal of a clock given to a run that does not read it
-    read = False
     for spec in campaign.runs:
         key = (spec.scenario, spec.resolution, spec.duration, tuple(spec.set_items()))
         if key in seen:
@@ -40,18 +34,10 @@ def report_campaign_warnings(campaign, strict, stream, error):
             scenario = load_scenario(spec.scenario, run._overrides(args))
         except UsageError:  # the run reports it as its own failure
             continue
-        if scenario.data["sim"].get("clock_hz") is not None:
-            try:
-                check_clock_is_used(scenario)
-                read = True
-            except ScenarioError as exc:
-                unread = unread or f"scenario {scenario.name!r}: {exc}"
         fresh = tuple(w for w in scenario.warnings if (scenario.name, w) not in seen)
         seen.update((scenario.name, w) for w in fresh)
         if fresh:
             report_warnings(_with_warnings(scenario, fresh), strict, stream, error)
-    if unread is not None and not read:
-        raise error(f"{unread} (in every run of the campaign)")
 
 
 def _with_warnings(scenario, warnings):
