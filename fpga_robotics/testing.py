@@ -21,7 +21,7 @@ from pathlib import Path
 
 from fpga_robotics.hw.errors import UsageError
 from fpga_robotics.loop.timings import run_scenario
-from fpga_robotics.scenario.load import check_clock_is_used, load_scenario, override_items
+from fpga_robotics.scenario.load import load_scenario, override_items
 
 __all__ = ["Check", "Result", "run"]
 
@@ -188,5 +188,4 @@ def run(
             raise UsageError(f"defines must be a dict of macro names, got {defines!r}")
         items += [f"design.defines.{n}={json.dumps(v)}" for n, v in defines.items()]
     loaded = load_scenario(str(scenario), items, design_params=_checked_params(params))
-    check_clock_is_used(loaded)
     return Result(run_scenario(loaded, seed=seed, backend=backend, recorder=recorder), loaded)

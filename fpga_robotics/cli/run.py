@@ -39,7 +39,6 @@ from fpga_robotics.scenario.errors import ScenarioError
 from fpga_robotics.scenario.load import (
     MAX_SEED,
     ForeignDesignFiles,
-    check_clock_is_used,
     load_scenario,
     parse_resolution,
     shipped_scenarios,
@@ -346,7 +345,6 @@ def load_run_scenario(args):
         # design too.
         items.append('sim.timing="real_clock"')
         scenario = load_scenario(args.scenario, [*items, *verilog])
-    check_clock_is_used(scenario)
     if not verilog:
         return scenario
     return dataclasses.replace(scenario, overrides=tuple(items))

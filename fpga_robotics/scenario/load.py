@@ -89,7 +89,6 @@ __all__ = [
     "Scenario",
     "ScenarioError",
     "SimConfig",
-    "check_clock_is_used",
     "load_scenario",
     "override_items",
     "parse_resolution",
@@ -1300,22 +1299,20 @@ def _resolve_timing(sim, camera, top, design_params, connectors, foreign):
     return replace(sim, timing=timing, actuation_delay=delay)
 
 
-def check_clock_is_used(scenario):
-    """``ScenarioError`` when the scenario gives ``sim.clock_hz`` (its file or an override)
-    and nothing of its run reads it: compressed timing clocks a built-in or Verilog design
-    only while its pixels flow, at no rate (a design of one's own reads it there: a frame's
-    budget of edges, loop/pin_frames.py). A campaign, whose ``set`` reaches rows of either
-    timing, does not call this."""
-    if scenario.data["sim"].get("clock_hz") is None or scenario.sim.timing != "compressed":
-        return
-    if scenario.top not in TOPS:
-        return
-    design = "the Verilog design" if scenario.foreign is not None else f"design {scenario.top!r}"
-    raise ScenarioError(
-        f"sim.clock_hz {scenario.sim.clock_hz:g} would change nothing: {design} runs in "
-        f"compressed timing, clocked only while the pixels flow, at no clock rate; set "
-        f'sim.timing = "real_clock" to run it on that clock, or leave sim.clock_hz out'
+def _clock_warnings(data, sim, top):
+    """A warning when the scenario gives ``sim.clock_hz`` (its file or an override) and its
+    run does not read it: compressed timing clocks a built-in or Verilog design only while
+    its pixels flow, at no rate (a design of one's own reads it there: a frame's budget of
+    edges, loop/pin_frames.py). A warning, not an error: a file's clock may be for the design
+    an override replaced, and a campaign's ``set`` reaches rows of either timing."""
+    if data["sim"].get("clock_hz") is None or sim.timing != "compressed" or top not in TOPS:
+        return ()
+    warning = (
+        f"sim.clock_hz {sim.clock_hz:g} changes nothing: the design runs in compressed "
+        f"timing, clocked only while the pixels flow, at no clock rate; set sim.timing = "
+        f'"real_clock" to run it on that clock, or leave sim.clock_hz out'
     )
+    return (warning,)
 
 
 def _checks(data):
@@ -1371,5 +1368,8 @@ def _build(data, source, overrides):
         design_tables=tables,
         design_params=design_params,
         connectors=connectors,
-        warnings=tuple(scenario_warnings(world_config, checks)),
+        warnings=(
+            *scenario_warnings(world_config, checks),
+            *_clock_warnings(data, sim, top),
+        ),
     )
