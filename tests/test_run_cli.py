@@ -73,7 +73,7 @@ def test_bad_set_value_names_the_key(capsys):
 @pytest.mark.parametrize("res", ["160", "160x", "x120", "axb", "0x120"])
 def test_bad_resolution(res, capsys):
     err = usage_error(["--resolution", res, "--rerun", "off"], capsys)
-    assert "WIDTHxHEIGHT" in err
+    assert "resolution must look like WIDTHxHEIGHT" in err
 
 
 def test_resolution_the_design_cannot_take_is_a_clear_error(capsys):

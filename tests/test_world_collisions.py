@@ -161,6 +161,39 @@ def test_a_robot_shoved_into_a_standing_person_is_not_at_fault_nor_shot_out():
     assert world.driven_position() == (3.0, 3.0)
 
 
+def test_only_the_people_touching_the_robot_bound_how_fast_a_squeeze_moves_it():
+    # A person walks at 0.5 m/s almost head-on into a parked robot against the wall (1 cm off
+    # its centre line) and squeezes it out sideways; a runner at 5 m/s crosses the far side
+    # of the room, never near it. The body moves at most at the squeezer's 0.5 m/s, and the
+    # runner changes nothing (before, the fastest person anywhere set the bound: 5 m/s, and
+    # the robot shot across the room).
+    squeezer = {
+        "name": "squeezer",
+        "waypoints": [[2.01, 2.0], [2.01, 0.3]],
+        "speed": 0.5,
+        "loop": False,
+        "radius": 0.3,
+    }
+    runner = {
+        "name": "runner",
+        "target": False,
+        "waypoints": [[1.0, 5.5], [7.0, 5.5]],
+        "speed": 5.0,
+        "pause": 0.0,
+    }
+    ends = []
+    for people in ([squeezer], [squeezer, runner]):
+        world = _world({"start": [2.0, 0.18]}, people)
+        fastest = 0.0
+        for _ in range(round(6.0 / DT)):
+            world.step(DT)
+            fastest = max(fastest, world.robot_body.velocity.length)
+        assert 0.4 < fastest <= 0.5 + 1e-9  # it was pushed, at no more than 0.5 m/s
+        ends.append(world.robot_pose())
+    assert ends[0] == pytest.approx(ends[1], abs=1e-9)
+    assert math.dist(ends[0][:2], (2.0, 0.18)) > 0.2  # squeezed out along the wall
+
+
 def test_people_squeezing_past_a_parked_robot_spin_it_no_faster_than_its_rim_slides():
     # Two people pass a parked GoPiGo3 on either side in opposite directions at 1 m/s, their
     # paths 0.5 m apart where the robot and they need 0.62 m: they squeeze it. It moves at

@@ -102,17 +102,60 @@ def test_a_robot_parked_on_a_steep_ramp_tips_when_its_centre_of_mass_leaves_the_
     # The ramp's grip (friction 10) holds the robot; facing up or down the slope it falls
     # over once its centre of mass, com_height above the floor, leans past the support edge
     # support_half_length from it: tan(slope) > support_half_length / com_height (TurtleBot2
-    # 29.9 deg, GoPiGo3 38.7 deg). Across the slope it does not pitch, so it stands.
+    # 29.9 deg, GoPiGo3 38.7 deg). Across the slope it does not pitch: it falls on its side
+    # where tan(slope) > support_half_width / com_height (29.9 and 23.1 deg), as below.
     spec = ROBOT_MODELS[model]
     slope = math.degrees(math.atan(spec.support_half_length / spec.com_height)) + margin_deg
     world = ramp_world(
         slope, friction=10.0, slope_dir_deg=90.0, robot={"model": model, "heading_deg": heading_deg}
     )
     run(world, 0.5)
-    tips = heading_deg != 0.0 and margin_deg > 0
+    if heading_deg == 0.0:
+        sideways = math.tan(slope * DEG) > spec.support_half_width / spec.com_height
+        assert (world.tipped is not None) == sideways
+        return
+    tips = margin_deg > 0
     assert (world.tipped is not None) == tips
     if tips:
         assert f"on a {'+' if heading_deg > 0 else '-'}{slope:.1f} deg slope" in world.tipped[1]
+
+
+@pytest.mark.parametrize("model", ["turtlebot2", "gopigo3"])
+@pytest.mark.parametrize("heading_deg", [0.0, 180.0])  # the slope rising to its left, right
+@pytest.mark.parametrize("margin_deg", [-1.0, 1.0])
+def test_a_robot_parked_across_a_steep_ramp_falls_on_its_downhill_side(
+    model, heading_deg, margin_deg
+):
+    # Across the slope the centre of mass leans sideways towards the downhill wheel: it falls
+    # once tan(slope) > support_half_width / com_height (TurtleBot2: the wheel contact 0.115 m
+    # out, 29.9 deg; GoPiGo3: the edge from a wheel to the rear caster 0.032 m out, 23.1 deg),
+    # while the ramp's grip (friction 10) holds it there.
+    spec = ROBOT_MODELS[model]
+    critical = math.degrees(math.atan(spec.support_half_width / spec.com_height))
+    assert critical == pytest.approx({"turtlebot2": 29.9, "gopigo3": 23.1}[model], abs=0.05)
+    world = ramp_world(
+        critical + margin_deg,
+        friction=10.0,
+        slope_dir_deg=90.0,
+        robot={"model": model, "heading_deg": heading_deg},
+    )
+    run(world, 0.5)
+    assert (world.tipped is not None) == (margin_deg > 0)
+    if margin_deg > 0:
+        # Facing +x the ramp rises to its left: it falls to its right, and the other way.
+        side = "right" if heading_deg == 0.0 else "left"
+        assert world.tipped[0] < 0.01
+        assert f"on its {side} side: rolled {critical + margin_deg:.1f} deg" in world.tipped[1]
+
+
+def test_a_robot_sliding_sideways_down_a_ramp_does_not_fall():
+    # A GoPiGo3 across a 30 deg ramp on a plain floor: gravity's sideways pull, g sin 30 =
+    # 4.9 m/s^2, beats its traction (1.39 N / 0.8 kg = 1.74 m/s^2), so it slides, and the
+    # floor leans it only by what the traction gives, below g * 0.032 / 0.075 * cos 30 = 3.6.
+    world = ramp_world(30.0, slope_dir_deg=90.0, robot={"model": "gopigo3"})
+    run(world, 0.5)
+    assert world.tipped is None
+    assert world.robot_pose()[1] < 3.0 - 0.05  # it slid downhill
 
 
 def test_driving_uphill_keeps_the_wheels_speed_while_traction_holds():

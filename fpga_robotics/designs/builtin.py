@@ -172,10 +172,16 @@ def _load(where):
 
 def table_fields(key):
     """The parameter names of design sub-table ``key`` (any top's)."""
+    cls = table_class(key)
+    return () if cls is None else tuple(f.name for f in dataclasses.fields(cls) if f.init)
+
+
+def table_class(key):
+    """The parameters class of design sub-table ``key`` (any top's), or None."""
     for top in TOPS.values():
         if key in top.tables:
-            return tuple(f.name for f in dataclasses.fields(_load(top.tables[key])) if f.init)
-    return ()
+            return _load(top.tables[key])
+    return None
 
 
 def design_tables(top, tables, variant=None):

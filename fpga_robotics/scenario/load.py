@@ -38,10 +38,9 @@ from pathlib import Path
 from pydantic_core import PydanticCustomError
 
 from fpga_robotics.checks.summary import CHECKS
-from fpga_robotics.designs.builtin import TOPS, design_tables, table_fields
+from fpga_robotics.designs.builtin import TOPS, design_tables, table_class, table_fields
 from fpga_robotics.designs.reference import DesignError, resolve_design
 from fpga_robotics.hw.errors import ParamError
-from fpga_robotics.hw.lidar_params import UartParams
 from fpga_robotics.hw.params import (
     PRESETS,
     FollowTargetParams,
@@ -140,8 +139,9 @@ _NAME = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.-]*")
 MAX_FILE_BYTES = 1 << 20
 
 
-def parse_resolution(text):
-    """``"160x120"`` (or ``[160, 120]``) → ``(160, 120)``; ``ScenarioError`` when malformed."""
+def parse_resolution(text, where="resolution"):
+    """``"160x120"`` (or ``[160, 120]``) → ``(160, 120)``; ``ScenarioError`` naming ``where``
+    (the key or option that gave it) when malformed."""
     if isinstance(text, (list, tuple)) and len(text) == 2:
         w, h = text
     elif isinstance(text, str) and text.lower().count("x") == 1:
@@ -156,8 +156,7 @@ def parse_resolution(text):
         w = h = None
     if not (isinstance(w, int) and isinstance(h, int) and w > 0 and h > 0):
         raise ScenarioError(
-            f"resolution must look like WIDTHxHEIGHT, e.g. 160x120, 320x240 or 640x480; "
-            f"got {text!r}"
+            f"{where} must look like WIDTHxHEIGHT, e.g. 160x120, 320x240 or 640x480; got {text!r}"
         )
     return w, h
 
@@ -188,6 +187,9 @@ class CameraConfig:
 #: actuation delay is only the command's trip to the motor controller (one SPI message), s.
 REAL_CLOCK_ACTUATION_DELAY = 0.001
 
+#: The design's clock when ``sim.clock_hz`` is unset, Hz.
+DEFAULT_CLOCK_HZ = 50e6
+
 
 @dataclass(frozen=True)
 class SimConfig:
@@ -195,7 +197,7 @@ class SimConfig:
     physics_dt: float
     actuation_delay: float
     timing: str = "compressed"  # "compressed" or "real_clock" (never "auto" once loaded)
-    clock_hz: float = 50e6
+    clock_hz: float = DEFAULT_CLOCK_HZ
 
 
 @dataclass(frozen=True)
@@ -688,9 +690,14 @@ def _set_path(data, key, value, shown):
         node = node[part]
 
 
-#: The world's arrays of tables inside a section (``room.furniture`` ...): a scenario may
-#: leave one out, and ``--set`` then cannot index it.
-_WORLD_ARRAYS = frozenset(path for path in WORLD_KEY_MODELS if "." in path)
+#: The world's arrays inside a section (``room.furniture``, ``robot.sensors``,
+#: ``lighting.keyframes`` ...): a scenario may leave one out, and ``--set`` then cannot
+#: index it.
+_WORLD_ARRAYS = frozenset(path for path in WORLD_KEY_MODELS if "." in path) | {
+    "robot.sensors",
+    "robot.actuators",
+    "lighting.keyframes",
+}
 
 
 class _AnyName:
@@ -782,7 +789,7 @@ def _check_name(name):
 
 def _camera(data):
     k = _keys(CameraKeys, data["camera"], "camera")
-    width, height = parse_resolution(k.resolution)
+    width, height = parse_resolution(k.resolution, "camera.resolution")
     if not (
         WIDTH_RANGE[0] <= width <= WIDTH_RANGE[1] and HEIGHT_RANGE[0] <= height <= HEIGHT_RANGE[1]
     ):
@@ -966,7 +973,7 @@ def _sim(data, camera):
         physics_dt=dt,
         actuation_delay=k.actuation_delay,
         timing=k.timing,
-        clock_hz=k.clock_hz,
+        clock_hz=DEFAULT_CLOCK_HZ if k.clock_hz is None else k.clock_hz,
     )
     steps = max(1, round(duration / dt))  # as the closed loop counts them
     if steps > MAX_PHYSICS_STEPS:
@@ -1183,37 +1190,45 @@ def _check_follow_target_keys_read(design, top, design_params):
     )
 
 
-def _run_uart(design, sim, connectors):
-    """``[design]`` with the UART of a built-in design that has one (``[design.uart]``) on
-    the run's clock and LIDAR link: a key left out takes ``sim.clock_hz`` or the
-    ``lidar_uart`` table's ``baud``; a different value is refused, since the receiver would
-    time every bit wrong and never decode a byte."""
-    top, uart = design.get("top"), design.get("uart", {})
-    if not (top in TOPS and "uart" in TOPS[top].tables and isinstance(uart, dict)):
+def _run_clock(design, sim, connectors):
+    """``[design]`` with the tables of a built-in design that count time on the run's clock
+    (``[design.ultrasound]``, ``[design.uart]``: a ``clock_hz`` field) made to agree with
+    it: a key left out takes ``sim.clock_hz`` (and a UART's ``baud`` the ``lidar_uart``
+    table's); a different value is refused, since the design would time everything wrong
+    (an echo's width read as another distance, every bit of a byte at another length)."""
+    top = design.get("top")
+    if not (isinstance(top, str) and top in TOPS):
         return design
-    run = {"clock_hz": (round(sim.clock_hz), "sim.clock_hz")}
     sensors = [c for c in connectors if c.role == "sensor"]
     links = [i for i, c in enumerate(sensors) if c.kind == "lidar_uart"]
-    if links:
-        run["baud"] = (sensors[links[0]].params.baud, f"robot.sensors[{links[0]}].baud")
-    for key, (value, source) in run.items():
-        given = uart.get(key, value)
-        if isinstance(given, int | float) and not isinstance(given, bool) and given != value:
-            raise ScenarioError(
-                f"design.uart.{key} {given:.15g} does not match {source} {value}; leave "
-                f"design.uart.{key} out to take it"
-            )
-    taken = {key: value for key, (value, _) in run.items() if key not in uart}
-    if taken:
+    out = dict(design)
+    for key in TOPS[top].tables:
+        table, fields = design.get(key, {}), table_fields(key)
+        if not isinstance(table, dict) or "clock_hz" not in fields:
+            continue
+        run = {"clock_hz": (round(sim.clock_hz), "sim.clock_hz")}
+        if "baud" in fields and links:
+            run["baud"] = (sensors[links[0]].params.baud, f"robot.sensors[{links[0]}].baud")
+        for name, (value, source) in run.items():
+            given = table.get(name, value)
+            if isinstance(given, int | float) and not isinstance(given, bool) and given != value:
+                raise ScenarioError(
+                    f"design.{key}.{name} {given:.15g} does not match {source} {value}; leave "
+                    f"design.{key}.{name} out to take it"
+                )
+        taken = {name: value for name, (value, _) in run.items() if name not in table}
+        if not taken:
+            continue
         # Say where a value the user did not write comes from.
         try:
-            UartParams(**{**uart, **taken})
+            table_class(key)(**{**table, **taken})
         except ParamError as exc:
-            sources = ", ".join(f"{key} is {run[key][1]}" for key in taken)
-            raise ScenarioError(f"design.uart: {exc} ({sources})") from None
+            sources = ", ".join(f"{name} is {run[name][1]}" for name in taken)
+            raise ScenarioError(f"design.{key}: {exc} ({sources})") from None
         except TypeError:
             pass  # a value of the wrong type or name: design_tables says so
-    return {**design, "uart": {**uart, **taken}}
+        out[key] = {**table, **taken}
+    return out
 
 
 def _connectors(world):
@@ -1284,6 +1299,22 @@ def _resolve_timing(sim, camera, top, design_params, connectors, foreign):
     return replace(sim, timing=timing, actuation_delay=delay)
 
 
+def _clock_warnings(data, sim, top):
+    """A warning when the scenario gives ``sim.clock_hz`` (its file or an override) and its
+    run does not read it: compressed timing clocks a built-in or Verilog design only while
+    its pixels flow, at no rate (a design of one's own reads it there: a frame's budget of
+    edges, loop/pin_frames.py). A warning, not an error: a file's clock may be for the design
+    an override replaced, and a campaign's ``set`` reaches rows of either timing."""
+    if data["sim"].get("clock_hz") is None or sim.timing != "compressed" or top not in TOPS:
+        return ()
+    warning = (
+        f"sim.clock_hz {sim.clock_hz:g} changes nothing: the design runs in compressed "
+        f"timing, clocked only while the pixels flow, at no clock rate; set sim.timing = "
+        f'"real_clock" to run it on that clock, or leave sim.clock_hz out'
+    )
+    return (warning,)
+
+
 def _checks(data):
     _keys(checks_keys(), data["checks"], "checks")
     return dict(data["checks"])
@@ -1295,7 +1326,12 @@ def _build(data, source, overrides):
     description, seed = top_keys.description, data.get("seed", 0)
     for section in WORLD_SECTIONS:
         if section in data and not isinstance(data[section], (dict, list)):
-            raise ScenarioError(f"[{section}] must be a table")
+            if section == "people":
+                raise ScenarioError(
+                    f"people must be an array of tables ([[people]] in a file, --set "
+                    f"'people=[{{waypoints = [[4, 3]]}}]'), got {data[section]!r}"
+                )
+            raise ScenarioError(f"[{section}] must be a table, got {data[section]!r}")
 
     camera = _camera(data)
     sim = _sim(data, camera)
@@ -1304,7 +1340,7 @@ def _build(data, source, overrides):
     foreign = _foreign(dict(data["design"]), source)
     world = {s: copy.deepcopy(data[s]) for s in WORLD_SECTIONS if s in data}
     connectors = _connectors(world)
-    top, tables, design_params = _top(_run_uart(data["design"], sim, connectors), source)
+    top, tables, design_params = _top(_run_clock(data["design"], sim, connectors), source)
     if foreign is None:
         _check_follow_target_keys_read(data["design"], top, design_params)
     checks = _checks(data)
@@ -1332,5 +1368,8 @@ def _build(data, source, overrides):
         design_tables=tables,
         design_params=design_params,
         connectors=connectors,
-        warnings=tuple(scenario_warnings(world_config, checks)),
+        warnings=(
+            *scenario_warnings(world_config, checks),
+            *_clock_warnings(data, sim, top),
+        ),
     )

@@ -112,8 +112,11 @@ class SimKeys(ScenarioKeys):
         '"real_clock" (docs/running.md)',
     ) = "auto"
     clock_hz: _scenario_number(
-        ge=1e3, le=1e9, unit="Hz", doc="the design's clock in real-clock timing"
-    ) = 50e6
+        ge=1e3,
+        le=1e9,
+        unit="Hz",
+        doc="the design's clock in real-clock timing; unset: 5e7 (50 MHz)",
+    ) = None
 
 
 def _vector3(lo, hi):

@@ -51,14 +51,20 @@ def patch_index(polygons, x, y):
         if idx.size == 0:
             continue
         sx, sy = flat_x[idx], flat_y[idx]
+        # An edge can only be crossed by the points level with it, lo <= y < hi: sorted by
+        # y, they are one slice, so a polygon of many short edges (a round carpet of
+        # thousands of corners) costs its edges' slices, not every point for every edge.
+        order = np.argsort(sy, kind="stable")
+        by_y = sy[order]
         inside = np.zeros(idx.shape, dtype=bool)
         for i in range(len(poly)):
             x0, y0, x1, y1 = px[i - 1], py[i - 1], px[i], py[i]
             if y0 == y1:
                 continue
-            crosses = (y1 > sy) != (y0 > sy)
-            xs = (x0 - x1) * (sy - y1) / (y0 - y1) + x1
-            inside ^= crosses & (sx < xs)
+            lo, hi = (y0, y1) if y0 < y1 else (y1, y0)
+            band = order[np.searchsorted(by_y, lo, "left") : np.searchsorted(by_y, hi, "left")]
+            xs = (x0 - x1) * (sy[band] - y1) / (y0 - y1) + x1
+            inside[band] ^= sx[band] < xs
         flat_found[idx[inside]] = k
     return found
 

@@ -11,6 +11,7 @@ import difflib
 import math
 from dataclasses import dataclass
 
+import numpy as np
 from pydantic_core import PydanticCustomError
 
 from fpga_robotics.hw.errors import UserError
@@ -211,20 +212,29 @@ def _point(value, path):
         raise WorldConfigError(f"{path}{exc.context.get('sub', '')} {exc.message()}") from None
 
 
-def _side(p, q, r):
-    return (q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0])
-
-
 def _crossing_edges(polygon):
     """``(i, j)``: the first two edges of the closed ``polygon`` (edge i from point i to the
-    next) that cross each other, or None for a simple polygon."""
+    next) that cross each other, or None for a simple polygon. Each edge is tested against
+    all the later ones at once (a polygon of thousands of corners in well under a second)."""
     n = len(polygon)
-    edges = [(polygon[i], polygon[(i + 1) % n]) for i in range(n)]
-    for i, (a, b) in enumerate(edges):
-        for j in range(i + 2, n - 1 if i == 0 else n):  # not a neighbour: they share a corner
-            c, d = edges[j]
-            if _side(a, b, c) * _side(a, b, d) < 0 and _side(c, d, a) * _side(c, d, b) < 0:
-                return i, j
+    a = np.asarray(polygon, dtype=float)
+    b = np.roll(a, -1, axis=0)  # edge i runs from a[i] to b[i]
+
+    def side(p, q, r):  # the sign of r's side of the line p -> q
+        return (q[..., 0] - p[..., 0]) * (r[..., 1] - p[..., 1]) - (q[..., 1] - p[..., 1]) * (
+            r[..., 0] - p[..., 0]
+        )
+
+    for i in range(n - 2):
+        j = np.arange(i + 2, n - 1 if i == 0 else n)  # not a neighbour: they share a corner
+        if j.size == 0:
+            continue
+        c, d = a[j], b[j]
+        hit = (side(a[i], b[i], c) * side(a[i], b[i], d) < 0) & (
+            side(c, d, a[i]) * side(c, d, b[i]) < 0
+        )
+        if hit.any():
+            return i, int(j[np.argmax(hit)])
     return None
 
 
@@ -336,6 +346,7 @@ _SPEC_KEYS = (
     "camera_forward",
     "com_height",
     "support_half_length",
+    "support_half_width",
     "motor_step_response",
 )
 

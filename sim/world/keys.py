@@ -151,7 +151,7 @@ class RobotKeys(KeyModel):
     """``None``: the robot model's value."""
 
     model: Text(choices=tuple(ROBOT_MODELS)) = "turtlebot2"
-    start: Point = None  # (min(1.5, room.width / 2), room.depth / 2)
+    start: Point = None  # (min(1.5, room.width / 2 - 0.5), room.depth / 2)
     heading_deg: Angle = 0.0
     mass: Number(ge=0.05, le=1000, unit="kg") = None
     body_radius: Number(ge=0.02, le=2, unit="m") = None
@@ -166,6 +166,7 @@ class RobotKeys(KeyModel):
     camera_tilt_deg: Number(ge=-85, le=85, unit="deg") = None
     com_height: Number(gt=0, le=5, unit="m") = None
     support_half_length: Number(gt=0, le=5, unit="m") = None
+    support_half_width: Number(gt=0, le=5, unit="m") = None
     motor_step_response: Number(gt=0, le=10, unit="s") = None
     motor_gain_error: Number(ge=0, le=0.9) = 0.0
     motor_noise_dps: Number(ge=0, le=10000, unit="deg/s") = 0.0

@@ -53,6 +53,9 @@ class RobotSpec:
     support_half_length : float
         Horizontal distance from the centre of mass to the nearest edge of the support
         polygon along the direction of travel (the wheel axle or a caster's contact), m.
+    support_half_width : float
+        Horizontal distance from the centre of mass to the edge of the support polygon
+        straight across the direction of travel, m (sideways tipping on a slope).
     motor_step_response : float or None
         None (the presets): the motor controller ramps every command at ``wheel_accel_dps2``,
         so a jump of the command never tips the robot. A number: the motors follow a jump of
@@ -64,7 +67,10 @@ class RobotSpec:
     mass then has a larger moment about the support edge than the weight. The body gets at
     most ``traction_force / mass`` (times the floor's factor), so a robot whose traction is
     below ``tip_accel * mass`` never tips on level floor. On a ramp pitching it by ``p``
-    along its heading it tips when ``|a + g sin(p)| > tip_accel * cos(p)``.
+    along its heading it tips when ``|a + g sin(p)| > tip_accel * cos(p)``; rolled by ``q``
+    across it, when the sideways load, ``g sin(q)`` but no more than the traction holds, exceeds
+    ``tip_accel_sideways * cos(q)``, ``tip_accel_sideways = g * support_half_width /
+    com_height``.
     """
 
     name: str
@@ -82,11 +88,18 @@ class RobotSpec:
     com_height: float = 0.2
     support_half_length: float = 0.1
     motor_step_response: float | None = None
+    support_half_width: float = 0.1
 
     @property
     def tip_accel(self):
         """Longitudinal acceleration that tips the robot over, m/s^2 (quasi-static)."""
         return G * self.support_half_length / self.com_height
+
+    @property
+    def tip_accel_sideways(self):
+        """Sideways acceleration (or gravity's sideways part on a slope) that tips the robot
+        over onto its side, m/s^2 (quasi-static)."""
+        return G * self.support_half_width / self.com_height
 
     @property
     def tip_step_dps(self):
@@ -145,6 +158,10 @@ TURTLEBOT2 = RobotSpec(
     # URDF's masses are placeholders). tip_accel = 9.81 * 0.115 / 0.20 = 5.6 m/s^2.
     com_height=0.20,
     support_half_length=0.115,
+    # Sideways the centre of mass, on the axle between the wheels (the casters are on the
+    # centre line), leaves the support over a wheel's contact, half the wheel separation away:
+    # a robot parked across a slope falls on its side beyond atan(0.115 / 0.20) = 29.9 deg.
+    support_half_width=0.115,
 )
 
 # GoPiGo3: wheel diameter 66.5 mm, wheel base 117 mm, about 0.8 kg with batteries. The
@@ -172,6 +189,11 @@ GOPIGO3 = RobotSpec(
     # robot.motor_step_response (docs/stories.md, story c).
     com_height=0.075,
     support_half_length=0.06,
+    # Sideways the support is the triangle of the wheels (0.0585 m either side of the axle's
+    # middle) and the caster 0.132 m behind it: straight across from the centre of mass, 0.06 m
+    # behind the axle, its edge lies 0.0585 * (1 - 0.06 / 0.132) = 0.032 m away, so parked
+    # across a slope it falls on its side beyond atan(0.032 / 0.075) = 23.1 deg.
+    support_half_width=0.032,
 )
 
 ROBOT_MODELS = {spec.name: spec for spec in (TURTLEBOT2, GOPIGO3)}

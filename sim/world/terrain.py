@@ -61,6 +61,14 @@ def slope_pitch(patch, heading):
     return math.atan(math.tan(patch.slope) * math.cos(heading - patch.slope_dir))
 
 
+def slope_roll(patch, heading):
+    """The robot's roll on ``patch`` facing ``heading``, rad (positive: its left side up,
+    the slope rising to its left)."""
+    if patch is None or patch.slope == 0.0:
+        return 0.0
+    return math.atan(math.tan(patch.slope) * math.sin(patch.slope_dir - heading))
+
+
 #: The lookup grid has at most this many cells (its cell is at least ``MIN_CELL`` m).
 MAX_CELLS = 1_000_000
 MIN_CELL = 0.02

@@ -25,7 +25,7 @@ from .people import PersonPath, person_bands
 from .robots import G
 from .room import add_static_shapes, map_data, scene_walls
 from .sanity import segment_distance
-from .terrain import TerrainMap, slope_pitch
+from .terrain import TerrainMap, slope_pitch, slope_roll
 from .uncertainty import MotorUncertainty
 
 __all__ = [
@@ -370,6 +370,11 @@ class World:
             # support as a forward acceleration does, and the floor holds it with g cos.
             pitch = slope_pitch(self._patch, body.angle)
             load, limit = abs(accel + G * math.sin(pitch)), spec.tip_accel * math.cos(pitch)
+            # Across the slope gravity leans it sideways, no harder than the traction holds
+            # it there (sliding sideways, the floor pushes back with the traction alone).
+            roll = slope_roll(self._patch, body.angle)
+            side = min(G * abs(math.sin(roll)), most)
+            side_limit = spec.tip_accel_sideways * math.cos(roll)
             if load > limit:
                 slope = f" on a {math.degrees(pitch):+.1f} deg slope" if pitch else ""
                 self._tip(
@@ -377,6 +382,12 @@ class World:
                     f"({load:.2f} m/s^2 with gravity) > {limit:.2f} m/s^2"
                     if pitch
                     else f"longitudinal acceleration {abs(accel):.2f} m/s^2 > {limit:.2f} m/s^2"
+                )
+            elif side > side_limit:
+                self._tip(
+                    f"on its {'right' if roll > 0 else 'left'} side: rolled "
+                    f"{math.degrees(abs(roll)):.1f} deg across a slope, sideways load "
+                    f"{side:.2f} m/s^2 > {side_limit:.2f} m/s^2"
                 )
         self._motor_v = drive_v
         r = spec.wheel_radius
@@ -422,23 +433,31 @@ class World:
                 person.walked += step
                 person.facing = math.atan2(y - py, x - px)
         self._history.record(self.time, (rx, ry), (driven_x, driven_y), before)
-        top_speed = self._top_speed(abs(v), h)
+        downhill = self.robot_body.force.length / spec.mass  # pymunk clears it in the step
         self._now = t1
         self.space.step(h)
-        self._limit_robot_speed(top_speed, abs(w))
+        self._limit_robot_speed(self._top_speed(abs(v), downhill, h), abs(w))
         self.time = t1
         if self._removals and self._removals[0][0] <= t1 + SCHEDULE_SLACK:
             self._remove_due()
 
-    def _top_speed(self, wheel_speed, h):
-        """The fastest the robot's body can move after a sub-step of ``h`` s, m/s: its
-        wheels' speed plus the fastest person's (a person pushes it at most at their own
-        speed), or its speed now plus what a slope's gravity adds in ``h`` (the traction only
-        pulls it towards the wheels' speed). Rigid people squeezing it against another body
-        would otherwise shoot it out at any speed."""
-        pushed = wheel_speed + max((p.body.velocity.length for p in self.people), default=0.0)
-        downhill = self.robot_body.force.length / self.robot_spec.mass
-        return max(pushed, self._robot_speed + downhill * h)
+    def _top_speed(self, wheel_speed, downhill, h):
+        """The fastest the robot's body can move after the sub-step of ``h`` s just taken,
+        m/s: its wheels' speed plus the fastest of the people touching it in that step (a
+        person pushes it at most at their own speed; one elsewhere in the room does not push
+        it at all), or its speed before plus what a slope's gravity (``downhill``, m/s^2)
+        adds in ``h`` (the traction only pulls it towards the wheels' speed). Rigid people
+        squeezing it against another body would otherwise shoot it out at any speed."""
+        pushers = [0.0]
+
+        def touching(arbiter):
+            a, b = arbiter.shapes
+            other = b if a is self.robot_shape else a
+            if self._names.get(other, ("",))[0] == "person":
+                pushers.append(other.body.velocity.length)
+
+        self.robot_body.each_arbiter(touching)
+        return max(wheel_speed + max(pushers), self._robot_speed + downhill * h)
 
     def _limit_robot_speed(self, top_speed, wheel_turn):
         """Slow the robot's body (the velocity the next step moves it at) to ``top_speed``,
