@@ -42,7 +42,7 @@ from .columns import (
     time_ns,
 )
 from .errors import ViewerError
-from .frame_calls import FrameCalls
+from .frame_calls import FrameCalls, signals_held
 from .images import (
     as_received,
     check_camera_format,
@@ -424,12 +424,13 @@ class Recorder:
             log_scans_3d(direct, record, frame, t)
         if self._layout_stale:
             self._send_blueprint(shadow=self._shadow_seen)
-        if direct:
-            with self._guard:
-                direct.replay(self._stream)
-        self.frames_logged += 1
-        self.images_logged += frame % self.log_every == 0
-        self._open_frame = None
+        with signals_held():  # the frame whole, or (Ctrl-C before this) none of it
+            if direct:
+                with self._guard:
+                    direct.replay(self._stream)
+            self.frames_logged += 1
+            self.images_logged += frame % self.log_every == 0
+            self._open_frame = None
         self._columns.end_frame()
 
     def _add_shadow(self, res, add):
