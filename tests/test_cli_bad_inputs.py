@@ -533,27 +533,6 @@ CASES = [
         ["bench", "mutant_replay", "--scenario", "obstacle_between"],
         "follow_target_safe",
     ),
-    # An option given two values was argparse's last-wins, silently: which was meant?
-    (
-        "run duration given twice",
-        ["run", "--duration", "5", "--rerun", "off", "--duration", "50"],
-        "--duration is given twice (--duration 5.0, then --duration 50.0); give it once",
-    ),
-    (
-        "export output given twice under its two names",
-        ["export", "-o", "a.v", "--output", "b.v"],
-        "--output is given twice (-o a.v, then --output b.v); give it once",
-    ),
-    (
-        "bench frames given twice",
-        ["bench", "design", "--backends", "model", "--frames", "3", "--frames", "4"],
-        "--frames is given twice",
-    ),
-    (
-        "sweep out given twice",
-        ["sweep", "regression", "--out", "a", "--out", "b"],
-        "--out is given twice",
-    ),
 ]
 
 
@@ -685,11 +664,3 @@ def _forbid_builds(monkeypatch):
     for module in (foreign, foreign_choice):
         monkeypatch.setattr(module, "ForeignVerilatorBackend", refuse("ForeignVerilatorBackend"))
     return builds
-
-
-def test_an_option_given_twice_with_one_value_is_taken():
-    # Only two different values are a conflict: a script that repeats an option is not wrong.
-    from fpga_robotics.cli.run import build_parser
-
-    args = build_parser().parse_args(["--duration", "5", "--duration", "5.0", "--rerun", "off"])
-    assert args.duration == 5.0 and args.rerun == "off"

@@ -24,7 +24,6 @@ from dataclasses import asdict
 from fpga_robotics.bench.calibration import measure_calibration
 from fpga_robotics.bench.timing import Spread, Times, gc_paused, stopwatch  # noqa: F401 (the scaffold's names)
 from fpga_robotics.cli.errors import UsageError
-from fpga_robotics.cli.parser import OnceParserMixin
 from fpga_robotics.sim.backends import BackendError
 from fpga_robotics.sim.backends.toolchain import find_compiler
 from fpga_robotics.sim.camera.raster import VERTICAL_MARGIN, max_hfov
@@ -55,13 +54,8 @@ MAX_REPEATS = 1000
 MAX_FRAMES = 10**6
 
 
-class BenchParser(OnceParserMixin, argparse.ArgumentParser):
-    """An ``ArgumentParser`` whose errors are ``UsageError``: one line, exit code 2; an
-    option given twice with two values is one too (``StoreOnce``)."""
-
-    def __init__(self, *args, **kwargs):
-        super().__init__(*args, **kwargs)
-        self.track_once()
+class BenchParser(argparse.ArgumentParser):
+    """An ``ArgumentParser`` whose errors are ``UsageError``: one line, exit code 2."""
 
     def error(self, message):
         raise UsageError(message)
