@@ -1,5 +1,6 @@
 """``fpga-robotics readback``: the frames of any design's recording (whatever entities it
-logs), ``--help``, and a file that is not a recording as one line with exit code 2."""
+logs), ``--help``, and a file that is not a recording, or not a whole one, as one line with
+exit code 2."""
 
 import subprocess
 import sys
@@ -76,7 +77,27 @@ def test_a_cut_off_recording_is_one_line(tmp_path, capsys):
         warnings.simplefilter("always")
         code, out, err = _readback([str(cut)], capsys)
     assert (code, out) == (2, "") and [str(w.message) for w in said] == []
-    assert err.count("\n") == 1 and "is not a rerun recording" in err, err
+    # It is a recording, only not whole: said so, and how to get a whole one.
+    assert err.count("\n") == 1 and "is a cut-off or damaged rerun recording" in err, err
+    assert "is not a rerun recording" not in err and "'saved ...'" in err
+
+
+@pytest.mark.parametrize("keep", [8, 40])  # inside the file's header; inside its first message
+def test_a_recording_cut_near_its_start_is_still_called_cut_off(keep, tmp_path, capsys):
+    path = _recording(tmp_path / "r.rrd", {"design/found": range(50)})
+    cut = tmp_path / "cut.rrd"
+    cut.write_bytes(path.read_bytes()[:keep])
+    code, out, err = _readback([str(cut)], capsys)
+    assert (code, out) == (2, "")
+    assert err.count("\n") == 1 and "is a cut-off or damaged rerun recording" in err, err
+
+
+def test_an_empty_file_is_called_empty(tmp_path, capsys):
+    empty = tmp_path / "empty.rrd"
+    empty.write_bytes(b"")
+    code, out, err = _readback([str(empty)], capsys)
+    assert (code, out) == (2, "")
+    assert err == f"fpga-robotics readback: error: {empty} is empty, not a rerun recording (.rrd)\n"
 
 
 def test_the_library_module_run_as_a_command_points_at_the_command(tmp_path):

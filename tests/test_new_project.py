@@ -129,3 +129,20 @@ def test_a_non_empty_folder_is_refused(tmp_path, capsys, monkeypatch):
     (tmp_path / "empty").mkdir()
     assert _cli(["new", "empty"], capsys)[0] == 0
     assert (tmp_path / "empty" / "design.py").is_file()
+
+
+def test_a_folder_that_refuses_the_project_is_one_line(tmp_path, capsys, monkeypatch):
+    # os.access says a folder is writable to root, where a read-only mount or /sys still
+    # refuses: the staging folder's mkdir raised PermissionError with a traceback (exit 1).
+    def refuse(**kwargs):
+        raise PermissionError(1, "Operation not permitted", kwargs["dir"])
+
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setattr("fpga_robotics.cli.new.tempfile.mkdtemp", refuse)
+    code, out, err = _cli(["new", "rover"], capsys)
+    assert (code, out) == (2, "")
+    assert err == (
+        f"fpga-robotics new: error: cannot write in {str(tmp_path.resolve())!r} (Operation not "
+        "permitted); choose another place\n"
+    )
+    assert list(tmp_path.iterdir()) == []

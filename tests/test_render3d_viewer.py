@@ -203,3 +203,33 @@ def test_a_tape_line_on_the_floor_is_drawn_in_the_3d_view(tmp_path):
         tuple(int(b) for b in int(c).to_bytes(4, "big")) for c in marks["Mesh3D:vertex_colors"]
     }
     assert colors == {(13, 13, 13, 255)}
+
+
+def test_a_frame_cut_short_by_ctrl_c_leaves_nothing_of_its_3d_world(tmp_path, monkeypatch):
+    """Ctrl-C while the 3D world of a frame is computed (after its camera pose and robot
+    were drawn, before its people): the 3D entities were logged straight to the stream, so
+    the file held that frame in part (camera and robot one frame more than the rest)."""
+    from fpga_robotics.viz import world3d
+
+    calls = {"n": 0}
+    limbs = world3d._limbs
+
+    def interrupted(*args, **kwargs):
+        calls["n"] += 1
+        if calls["n"] == 5:  # a person of frame 2 or later (one or two people a frame)
+            raise KeyboardInterrupt
+        return limbs(*args, **kwargs)
+
+    monkeypatch.setattr(world3d, "_limbs", interrupted)
+    path = tmp_path / "cut.rrd"
+    scenario = load_scenario("divider", ["sim.duration=0.5"])
+    with (
+        pytest.raises(KeyboardInterrupt),
+        open_recorder(f"save:{path}", default_path=str(path)) as rec,
+    ):
+        run_scenario(scenario, backend="model", recorder=rec)
+    data = read_rrd(str(path))
+    kept = list(range(rec.frames_logged))
+    assert 1 <= len(kept) < 15
+    for entity in ("camera", "world3d/robot", "world3d/people/bodies", "motors/dps", "camera/raw"):
+        assert data.entities[entity].frames == kept, entity

@@ -2,6 +2,9 @@
 
 import itertools
 import json
+import os
+import subprocess
+import sys
 from pathlib import Path
 
 import cv2
@@ -137,6 +140,50 @@ def test_max_frames_stops_early(video):
     params = FollowTargetParams(width=W, height=H)
     out = run_source(open_source(str(video), W, H), ModelBackend(params), max_frames=2)
     assert out["frames"] == 2
+
+
+def test_one_image_is_one_frame_of_its_own_kind(tmp_path):
+    # A single image was opened as a video ("source x.png (video)"): it is one frame, read as
+    # a folder's images are, and the summary calls it an image.
+    for k in range(3):  # numbered like frames of a sequence: still only the one named
+        cv2.imwrite(str(tmp_path / f"f{k:03d}.png"), scene_bgr(k))
+    src = open_source(str(tmp_path / "f001.png"), W, H)
+    frames = list(src)
+    assert src.kind == "image" and len(frames) == 1
+    assert np.array_equal(frames[0], expected_rgb(scene_bgr(1)))
+
+
+def test_an_image_that_does_not_decode_is_said_so_when_opened(tmp_path):
+    bad = tmp_path / "photo.png"
+    bad.write_bytes(b"\x00" * 100)
+    with pytest.raises(UsageError, match=r"cannot read image '.*photo\.png': OpenCV cannot decode"):
+        open_source(str(bad), W, H)
+
+
+@pytest.mark.slow  # a fresh Python process (about a second)
+def test_a_video_that_does_not_decode_is_one_line_with_nothing_of_ffmpegs(tmp_path):
+    # FFmpeg printed "[mov,mp4,...] moov atom not found" before the one-line error. FFmpeg's
+    # log level is set once a process, so a fresh one opens it.
+    bad = tmp_path / "clip.mp4"
+    bad.write_bytes(b"\x00" * 1000)
+    code = (
+        "import sys\n"
+        "from fpga_robotics.loop.sources import open_source\n"
+        "try:\n"
+        f"    open_source({str(bad)!r}, 160, 120)\n"
+        "except Exception as exc:\n"
+        "    print(exc, file=sys.stderr)\n"
+    )
+    env = {k: v for k, v in os.environ.items() if k != "OPENCV_FFMPEG_LOGLEVEL"}
+    done = subprocess.run(
+        [sys.executable, "-c", code],
+        check=False,
+        capture_output=True,
+        text=True,
+        env=env,
+        timeout=120,
+    )
+    assert done.stderr == f"cannot read video {str(bad)!r}: OpenCV cannot decode it\n"
 
 
 def test_empty_folder_and_bad_specs_are_usage_errors(tmp_path):

@@ -32,12 +32,15 @@ class CameraPanels:
         self._columns = columns
         self.names = []  # cameras seen, in first-seen order (the layout's panels)
 
-    def log(self, record, add, *, images, jpeg_quality, reach, frame, t, camera="rgb444"):
+    def log(
+        self, record, add, *, images, jpeg_quality, reach, frame, t, camera="rgb444", stream=None
+    ):
         """``images``: this frame logs camera images (``log_every``); ``reach``: the map's
         field-of-view length, m; ``frame``, ``t``: the record's frame and time (ns);
         ``camera``: how images are recorded, as the body camera's (``rgb444``: as a design
-        receives them, ``rgb888``: the render)."""
-        s = self._stream
+        receives them, ``rgb888``: the render); ``stream``: where the rows not ``add``ed go
+        (default the recorder's; ``viz.frame_calls``)."""
+        s = self._stream if stream is None else stream
         for name, view in (getattr(record, "cameras", None) or {}).items():
             h, w = view.rgb.shape[:2]
             if name not in self.names:

@@ -25,6 +25,7 @@ from .images import decode_image
 __all__ = ["EntityRows", "Recording", "images", "read_rrd", "summary_lines"]
 
 _INDEX_COLUMNS = ("frame", "sim_time", "log_time", "log_tick")
+_RRD_MAGIC = b"RRF"
 
 
 @dataclass
@@ -67,12 +68,20 @@ def _row_values(column):
     return out
 
 
+def _has_rrd_header(path):
+    """Whether the file starts as every rerun recording does (its FourCC, ``RRF`` + version)."""
+    with open(path, "rb") as f:
+        return f.read(3) == _RRD_MAGIC
+
+
 def read_rrd(path):
     """Read the first recording in ``path``; returns a ``Recording``."""
     if os.path.isdir(path):
         raise ViewerError(f"{path} is a folder, not a recording (.rrd)")
     if not os.path.isfile(path):
         raise FileNotFoundError(f"no recording at {str(path)!r}")
+    if os.path.getsize(path) == 0:
+        raise ViewerError(f"{path} is empty, not a rerun recording (.rrd)")
     try:
         with warnings.catch_warnings():
             # Said of a cut-off file too, which then fails below with one line of its own;
@@ -80,10 +89,14 @@ def read_rrd(path):
             warnings.filterwarnings("ignore", message="RRD file has no footer")
             reader = RrdReader(path)
         chunks = list(reader.stream())
-    except RuntimeError as exc:  # rerun's word for a file that is not a recording
-        raise ViewerError(
-            f"{path} is not a rerun recording (.rrd): {str(exc).splitlines()[0]}"
-        ) from None
+    except RuntimeError as exc:  # rerun's word for a file it cannot decode
+        said = str(exc).splitlines()[0]
+        if _has_rrd_header(path):  # a recording's start, not its end: cut off or damaged
+            raise ViewerError(
+                f"{path} is a cut-off or damaged rerun recording ({said}); a recording is "
+                "whole once its run has printed 'saved ...': wait for that, or copy it again"
+            ) from None
+        raise ViewerError(f"{path} is not a rerun recording (.rrd): {said}") from None
     except ValueError as exc:  # an .rrd with only a blueprint (a saved layout, .rbl)
         raise ViewerError(
             f"{path} holds no recording (a viewer layout at most): {str(exc).splitlines()[0]}"

@@ -42,6 +42,7 @@ from .columns import (
     time_ns,
 )
 from .errors import ViewerError
+from .frame_calls import FrameCalls, signals_held
 from .images import (
     as_received,
     check_camera_format,
@@ -379,13 +380,14 @@ class Recorder:
             if res.filtered is not None:  # a design without a filtered stream: no image
                 kind, data = encode_rgb444(res.filtered, q)
                 add((P.CAMERA_FILTERED, kind), data)
+        # Calls made straight to the stream wait for the frame's end: a frame cut short by
+        # Ctrl-C leaves none of its rows (viz.frame_calls), as the buffered ones are dropped.
+        direct = FrameCalls()
         if record.events:
-            s = self._stream
-            s.set_time("frame", sequence=frame)
-            s.set_time("sim_time", duration=t)
-            with self._guard:
-                for text in record.events:
-                    s.log(P.EVENTS, rr.TextLog(str(text), level=_event_level(str(text))))
+            direct.set_time("frame", sequence=frame)
+            direct.set_time("sim_time", duration=t)
+            for text in record.events:
+                direct.log(P.EVENTS, rr.TextLog(str(text), level=_event_level(str(text))))
 
         self._add_outputs(res, add, P.LEDS_PROXIMITY, P.LEDS_CENTROID, P.MOTORS_DPS)
         if res.found is not None or res.proximity is not None:
@@ -411,20 +413,24 @@ class Recorder:
                 frame=frame,
                 t=t,
                 camera=self.camera,
+                stream=direct,
             )
         if len(self._sensors.series) != self._sensor_series:
             self._layout_stale = True
         if len(self._cameras.names) != self._camera_panels:
             self._layout_stale = True
         if self._world3d is not None and record.scene is not None:
-            with self._guard:
-                self._world3d.log_frame(record, frame, t)
-                log_scans_3d(self._stream, record, frame, t)
+            self._world3d.log_frame(record, frame, t, stream=direct)
+            log_scans_3d(direct, record, frame, t)
         if self._layout_stale:
             self._send_blueprint(shadow=self._shadow_seen)
-        self.frames_logged += 1
-        self.images_logged += frame % self.log_every == 0
-        self._open_frame = None
+        with signals_held():  # the frame whole, or (Ctrl-C before this) none of it
+            if direct:
+                with self._guard:
+                    direct.replay(self._stream)
+            self.frames_logged += 1
+            self.images_logged += frame % self.log_every == 0
+            self._open_frame = None
         self._columns.end_frame()
 
     def _add_shadow(self, res, add):

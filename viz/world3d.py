@@ -166,8 +166,8 @@ class World3D:
         #: The room's walls' height as drawn, for the view's eye (``eye_position``).
         self.wall_height = 0.0
 
-    def _log_walls(self, scene):
-        log = self._stream.log
+    def _log_walls(self, scene, stream):
+        log = stream.log
         log(WORLD3D, rr.ViewCoordinates.RIGHT_HAND_Z_UP, static=True)
         room = [w for w in scene.walls if w.kind == "room"]
         rest = [w for w in scene.walls if w.kind != "room"]
@@ -207,9 +207,9 @@ class World3D:
             log(FLOOR_MARKS, _floor_marks(scene.floor_patches), static=True)
         self._walls = scene.walls
 
-    def _log_pinhole(self, width, height, hfov):
+    def _log_pinhole(self, width, height, hfov, stream):
         f = (width / 2) / math.tan(hfov / 2)
-        self._stream.log(
+        stream.log(
             CAMERA,
             rr.Pinhole(
                 focal_length=f,
@@ -222,20 +222,20 @@ class World3D:
         )
         self._pinhole = (width, height, hfov)
 
-    def log_frame(self, record, frame, t):
+    def log_frame(self, record, frame, t, stream=None):
         """Log ``record``'s robot, people and camera pose at ``frame`` and sim time ``t``
-        (``viz.columns.time_ns``)."""
+        (``viz.columns.time_ns``), to ``stream`` when given (``viz.frame_calls``)."""
         scene, pose = record.scene, record.camera_pose
         if scene is None or pose is None:
             return
-        s = self._stream
+        s = self._stream if stream is None else stream
         s.set_time("frame", sequence=frame)
         s.set_time("sim_time", duration=t)
         if scene.walls is not self._walls:
-            self._log_walls(scene)
+            self._log_walls(scene, s)
         height, width = record.camera_rgb.shape[:2]
         if self._pinhole != (width, height, record.camera_hfov):
-            self._log_pinhole(width, height, float(record.camera_hfov))
+            self._log_pinhole(width, height, float(record.camera_hfov), s)
         s.log(
             CAMERA,
             rr.Transform3D(

@@ -80,7 +80,12 @@ def write_project(folder):
     if not os.access(parent, os.W_OK):
         raise UsageError(f"folder {str(parent)!r} is not writable")
     written = [string.Template(t).substitute(name=name) for t in _TEMPLATES.values()]
-    staging = Path(tempfile.mkdtemp(prefix=f".{name}.", dir=parent))
+    try:  # os.access says yes to root, where a read-only mount or /sys still refuses
+        staging = Path(tempfile.mkdtemp(prefix=f".{name}.", dir=parent))
+    except OSError as exc:
+        raise UsageError(
+            f"cannot write in {str(parent)!r} ({exc.strerror}); choose another place"
+        ) from None
     try:
         for template, relative in zip(_TEMPLATES, written, strict=True):
             text = string.Template(_template(template)).safe_substitute(name=name)

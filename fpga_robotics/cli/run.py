@@ -156,7 +156,7 @@ def build_parser(prog="fpga-robotics run"):
     )
     p.add_argument(
         "--source",
-        metavar="camera:N|VIDEO|FOLDER|bag:PATH[:TOPIC]",
+        metavar="camera:N|VIDEO|FOLDER|IMAGE|bag:PATH[:TOPIC]",
         help="run the design on real frames instead of the simulation (no physics)",
     )
     p.add_argument("--max-frames", type=int, metavar="N", help="with --source: stop after N")

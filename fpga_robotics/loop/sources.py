@@ -7,6 +7,7 @@ runs the design on each frame (no physics) and reports what it found.
 """
 
 import math
+import os
 import time
 from itertools import islice
 from pathlib import Path
@@ -25,6 +26,8 @@ __all__ = ["IMAGE_SUFFIXES", "FrameSource", "open_source", "run_source", "to_des
 
 #: Files of a folder source that are read as frames (in sorted name order).
 IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff", ".ppm", ".pgm")
+#: FFmpeg's log level that prints nothing (AV_LOG_QUIET).
+_AV_LOG_QUIET = -8
 #: The per-frame outputs ``run_source`` reports besides ``found``.
 _OUTPUTS = ("proximity", "centroid_x", "centroid_leds", "motor_left", "motor_right")
 
@@ -35,7 +38,7 @@ class FrameSource:
     Parameters
     ----------
     spec : str
-        ``camera:N`` (OpenCV device N), a video file, or a folder of images.
+        ``camera:N`` (OpenCV device N), a video file, a folder of images or one image.
     width, height : int
         The design's resolution; every frame is resized to it.
     fps : float, optional
@@ -82,7 +85,17 @@ class FrameSource:
                 f"--source {self.spec!r}: no such file or folder (give camera:N, a video file "
                 f"or a folder of images)"
             )
+        if path.suffix.lower() in IMAGE_SUFFIXES:  # one image: one frame, read as a folder's
+            self.kind = "image"
+            self._files = [path]
+            if cv2.imread(str(path), cv2.IMREAD_UNCHANGED) is None:
+                raise UsageError(f"cannot read image {self.spec!r}: OpenCV cannot decode it")
+            return
         self.kind = "video"
+        # FFmpeg would print its own complaint ("moov atom not found") on stderr before the
+        # one line below says the file cannot be read; OPENCV_FFMPEG_LOGLEVEL set by the user
+        # (to debug a codec) stays theirs. Read once, when OpenCV first starts FFmpeg.
+        os.environ.setdefault("OPENCV_FFMPEG_LOGLEVEL", str(_AV_LOG_QUIET))
         self._cap = cv2.VideoCapture(str(path))
         ok = self._cap.isOpened()
         if ok:
@@ -104,7 +117,7 @@ class FrameSource:
         return to_design_rgb(bgr, self.width, self.height)
 
     def __iter__(self):
-        if self.kind == "folder":
+        if self.kind in ("folder", "image"):
             for p in self._files:
                 img = cv2.imread(str(p), cv2.IMREAD_UNCHANGED)
                 if img is None:
@@ -127,10 +140,10 @@ class FrameSource:
 
 
 def open_source(spec, width, height, max_frames=None, fps=None):
-    """Open ``spec`` (``camera:N``, a video file, a folder of images, ``bag:PATH[:TOPIC]``) at
-    ``width`` x ``height``; ``UsageError`` when it cannot be opened. A bag's images are all
-    checked now (the first ``max_frames`` of them, when given); ``fps`` is the frame rate of
-    a folder of images and of a video that states none."""
+    """Open ``spec`` (``camera:N``, a video file, a folder of images, one image,
+    ``bag:PATH[:TOPIC]``) at ``width`` x ``height``; ``UsageError`` when it cannot be opened.
+    A bag's images are all checked now (the first ``max_frames`` of them, when given); ``fps``
+    is the frame rate of a folder of images and of a video that states none."""
     if str(spec).startswith("bag:"):  # a ROS bag (fpga_robotics.ros.bag_source)
         from fpga_robotics.ros.bag_source import BagSource  # lazy: rosbags (~30 ms), for bags only
 
