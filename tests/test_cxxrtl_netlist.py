@@ -179,3 +179,32 @@ def test_a_clock_the_design_drives_is_refused_by_the_cxxrtl_frame_build():
         cxxrtl_build_plan(Source(), "plain")
     # FollowTarget clocks everything from its clk input: built as ever.
     assert cxxrtl_build_plan(DesignSource(FollowTargetParams()), "plain") is not None
+
+
+@pytest.mark.parametrize("bit", [0, 1, 3])
+def test_a_clock_from_one_bit_of_a_wider_register_is_refused_too(bit):
+    # ClockSignal("slow") = divider[bit]: CXXRTL names the edge after the wire and the bit
+    # (posedge_p_divider_1) and misses it as it misses a 1-bit divider's; the run would keep
+    # the slow domain's counter at 0 on CXXRTL while pysim and Verilator count.
+    from amaranth import ClockDomain, ClockSignal, Module, Signal
+    from amaranth.lib import wiring
+    from amaranth.lib.wiring import Out
+
+    from fpga_robotics.hw.verilog import generate_cxxrtl
+    from fpga_robotics.sim.backends.base import BackendError
+    from fpga_robotics.sim.backends.cxxrtl_netlist import check_clocks
+
+    class BitClock(wiring.Component):
+        ticks: Out(8)
+
+        def elaborate(self, platform):
+            m = Module()
+            m.domains.slow = ClockDomain(local=True)
+            divider = Signal(4)
+            m.d.sync += divider.eq(divider + 1)
+            m.d.comb += ClockSignal("slow").eq(divider[bit])
+            m.d.slow += self.ticks.eq(self.ticks + 1)
+            return m
+
+    with pytest.raises(BackendError, match=r"^bit_clock clocks flip-flops from a signal of its "):
+        check_clocks(generate_cxxrtl(BitClock()), "bit_clock", "verilator")

@@ -652,11 +652,9 @@ def test_a_package_s_file_named_as_a_file_says_how_to_name_it(tmp_path, monkeypa
         sys.modules.pop("top", None)
 
 
-def test_a_design_without_a_clock_is_refused_where_it_would_be_simulated(
-    tmp_path, capsys, monkeypatch
-):
-    # Combinational logic only: it resolves (it may be exported for a board), but nothing
-    # here can clock it, so run and mutate say so in one line.
+def test_a_design_without_a_clock_is_refused_by_mutate(tmp_path, capsys, monkeypatch):
+    # Combinational logic only: it resolves (it may be exported for a board) and runs in the
+    # loop (below), but the mutation judges compare netlists cycle by cycle through its clock.
     shutil.copy(DESIGNS / "unelaborated.py", tmp_path / "unelaborated.py")
     spec = resolve_design("unelaborated.py:NoClock", {}, base=tmp_path)
     assert not spec.clocked
@@ -665,16 +663,33 @@ def test_a_design_without_a_clock_is_refused_where_it_would_be_simulated(
     assert resolve_design(str(DESIGNS / "wall_stop.py") + ":WallStop", {}).clocked
     message = "has no clock: nothing in its sync domain (m.d.sync)"
     monkeypatch.chdir(tmp_path)
-    for argv in (
-        ["run", "--scenario", str(WALL_STOP), "--design", "unelaborated.py:NoClock",
-         "--rerun", "off", "--set", "design.params={}"],
-        ["mutate", "--design", "unelaborated.py:NoClock", "--mutants", "2", "--quiet"],
-    ):  # fmt: skip
-        code, _, err = _cli(argv, capsys)
-        assert code == 2 and len(err.strip().splitlines()) == 1 and message in err, err
+    code, _, err = _cli(
+        ["mutate", "--design", "unelaborated.py:NoClock", "--mutants", "2", "--quiet"], capsys
+    )
+    assert code == 2 and len(err.strip().splitlines()) == 1 and message in err, err
     assert sorted(p.name for p in tmp_path.iterdir() if p.name != "__pycache__") == [
         "unelaborated.py"
     ]
+
+
+@pytest.mark.parametrize("backend", ["pysim", "cxxrtl"])
+def test_a_purely_combinational_design_runs_in_the_loop(tmp_path, backend):
+    # comb_stop.py has nothing in m.d.sync: the wheels are 300 DPS until the bumper closes,
+    # 0 while it is closed, in the same cycle. The robot drives at the wall 1.5 m ahead,
+    # stops on it and stays pressed there.
+    shutil.copy(DESIGNS / "comb_stop.py", tmp_path / "comb_stop.py")
+    text = (Path(__file__).parent / "data" / "bump_wall.toml").read_text()
+    text += '\n[design]\ntop = "comb_stop.py:CombStop"\n[design.params]\nspeed = 300\n'
+    (tmp_path / "comb.toml").write_text(text)
+    assert not resolve_design(str(tmp_path / "comb_stop.py") + ":CombStop", {}).clocked
+    result = run_scenario(load_scenario(str(tmp_path / "comb.toml")), backend=backend)
+    traj = result.trajectory
+    pressed = traj["design.pressed_seen"]
+    assert pressed[0] == 0 and pressed[-1] == 1
+    # The wheel law, combinational: at every row, 300 DPS unless pressed, then 0.
+    assert list(traj["motor_left"]) == [0.0 if p else 300.0 for p in pressed]
+    assert (traj["motor_right"] == traj["motor_left"]).all()
+    assert result.summary["verdict"] == "pass"
 
 
 def test_a_design_with_an_instance_is_refused_where_it_would_be_simulated(

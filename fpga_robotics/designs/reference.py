@@ -171,13 +171,14 @@ class DesignSpec:
         return None
 
     def require_clock(self):
-        """``DesignError`` for a design without a clock (nothing in its ``sync`` domain): a
-        simulator here clocks it (an exported design need not have one)."""
+        """``DesignError`` for a design without a clock (nothing in its ``sync`` domain), which
+        ``mutate`` cannot judge (a run clocks it through loop/bindings.py's wrapper; an exported
+        design need not have one)."""
         if not self.clocked:
             raise DesignError(
                 f"design {self.reference!r} has no clock: nothing in its sync domain "
-                "(m.d.sync). The simulators here clock the design, so give it at least one "
-                "register"
+                "(m.d.sync). The mutation judges run the mutants through the design's clock, "
+                "so give it at least one register"
             )
 
     def require_no_black_boxes(self):

@@ -4,6 +4,8 @@ real-clock loop applies again to the ports of the built design (a Verilog design
 only then).
 """
 
+import dataclasses
+import functools
 import importlib
 import math
 
@@ -28,10 +30,20 @@ def scenario_top(scenario):
         check_connector_names(port_map, connector_kinds())  # before its bindings are read
         return foreign_top(port_map)
     spec = resolve_design(scenario.top, scenario.design_params)
-    spec.require_clock()
     spec.require_no_black_boxes()
     spec.require_defined_domains()
+    if not spec.clocked:  # purely combinational: the simulators clock it through a wrapper
+        return dataclasses.replace(
+            spec.top, component=functools.partial(_clocked, spec.top.component)
+        )
     return spec.top
+
+
+def _clocked(factory):
+    """The combinational design ``factory`` builds, with the clock a simulator drives."""
+    from fpga_robotics.designs.clocked import ClockedCombinational  # lazy: Amaranth
+
+    return ClockedCombinational(factory())
 
 
 def check_bindings(scenario):

@@ -45,8 +45,10 @@ def mangle(name):
 
 
 #: An edge detector on a wire of the model (``p_div.curr`` against ``p_div.next``), not on an
-#: input port (``prev_p_clk``): a clock the design drives itself.
-_WIRE_EDGE = re.compile(r"bool (?:pos|neg)edge_(\w+)\(\) const \{\s*return !?\1\.curr\b")
+#: input port (``prev_p_clk``): a clock the design drives itself. Its name is the wire's, with
+#: the bit's index when the clock is one bit of a wider register (``posedge_p_div_1`` reads
+#: ``p_div.curr.slice<1>()``).
+_WIRE_EDGE = re.compile(r"bool (?:pos|neg)edge_(\w+)\(\) const \{\s*return !?\w+\.curr\b")
 
 
 def check_clocks(source, design, instead):
