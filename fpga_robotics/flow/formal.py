@@ -132,6 +132,17 @@ def _summary(output):
     holds is ``unknown`` for them)."""
     wanted = ("failed assertion", "failed assumption")
     found = []
+    # SymbiYosys names no step for a failure in step 0 (the first cycle): its BMC's own
+    # lines say which step it was checking when it failed.
+    checking = None
+    for line in output.splitlines():
+        if ".induction:" in line:  # the induction's steps count from an unreachable state
+            continue
+        step = re.search(r"Checking assertions in step (\d+)", line)
+        if step:
+            checking = step[1]
+        elif "BMC failed" in line:
+            break
     in_unreached = in_induction = False
     for line in output.splitlines():
         text = line.split("summary:", 1)[1] if "summary:" in line else ""
@@ -148,6 +159,8 @@ def _summary(output):
         if listed:  # a statement, or "and 3 further properties" after the first five
             found.append(text if text.startswith("and ") else f"unreached cover statement {text}")
         elif any(w in text for w in wanted) and not any(f.startswith(text) for f in found):
+            if checking is not None and not re.search(r" step \d+$", text):
+                text = f"{text} step {checking}"
             found.append(text)  # once, with its step
     return "; ".join(found)
 
