@@ -27,7 +27,11 @@ from fpga_robotics.designs.reference import resolve_design
 from fpga_robotics.hw.errors import UsageError, UserError
 from fpga_robotics.hw.formal import CHECKS
 from fpga_robotics.hw.formal.declared import PROPERTY_HOOK, declared_checks
-from fpga_robotics.sim.backends.foreign import design_ports, verilog_layout
+from fpga_robotics.sim.backends.foreign import (
+    design_ports,
+    refuse_ignored_defines,
+    verilog_layout,
+)
 from fpga_robotics.sim.backends.port_map import PortMapError, load_port_map
 from fpga_robotics.sim.backends.verilog_cxxrtl import DESIGN_DIR
 from fpga_robotics.sim.backends.verilog_params import VerilogOverrides
@@ -447,6 +451,11 @@ def verilog_checks(files, top=None, depth=20, env=None, port_map=None, overrides
     if port_map is not None:
         top = port_map.top
     prelude = ()
+    if overrides and overrides.defines:
+        try:  # a macro the design does not use, or defines over ours, would change nothing
+            refuse_ignored_defines(*layout, overrides, extra=("FORMAL",))
+        except PortMapError as exc:
+            raise UsageError(str(exc)) from None
     if overrides and overrides.parameters:
         if top is None:  # the top as read without them
             plain = ({f"{DESIGN_DIR}/{n}": t for n, t in part.items()} for part in layout)

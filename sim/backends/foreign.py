@@ -59,6 +59,7 @@ __all__ = [
     "design_ports",
     "include_dirs",
     "pin_ports",
+    "refuse_ignored_defines",
     "verilog_includes",
     "verilog_layout",
     "watch_chunks",
@@ -267,6 +268,34 @@ def _refuse_unused_defines(overrides, texts):
             f"--define {unused[0]}: no file of the design uses the macro `{unused[0]} (the "
             f"macros it uses: {known})"
         )
+
+
+def refuse_ignored_defines(sources, includes, overrides, extra=()):
+    """A ``PortMapError`` for a ``--define`` that would change nothing: one no file of the
+    design uses, or one the design's own `define replaces (read after ours), as Verilator's
+    preprocessor finds it, with the macros ``extra`` (``("FORMAL",)``) defined as the tool
+    that reads the design defines them. For the flows that read the design without
+    elaborating it in Verilator (``formal``), which checks both when it reads the ports."""
+    _refuse_unused_defines(overrides, [*sources.values(), *(includes or {}).values()])
+    if not overrides.defines:
+        return
+    root = verilator_root()
+    with tempfile.TemporaryDirectory(prefix="fr-foreign-") as tmp:
+        paths = _write_sources(tmp, overrides.with_defines(sources), includes)
+        _, output = run_captured(
+            [
+                root / "bin" / "verilator",
+                "-E",
+                "-P",
+                *(f"+define+{name}" for name in extra),
+                *include_dirs(tmp, sources, includes or {}),
+                *paths,
+            ],
+            cwd=tmp,
+            env=dict(os.environ, VERILATOR_ROOT=str(root)),
+        )
+        output = output.replace(str(Path(tmp) / DESIGN_DIR) + "/", "")
+    _refuse_redefined(overrides, output, {**(includes or {}), **sources})
 
 
 def _refuse_loop(sources, top, includes, overrides):
