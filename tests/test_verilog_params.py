@@ -186,7 +186,7 @@ def test_the_board_top_sets_them(design, tmp_path, capsys):
     assert info.value.code == 0, capsys.readouterr().err
     top = next(out.glob("*_follow_target.v")).read_text()
     assert "ptop #(\n    .N(32'd3),\n    .SPEED(32'd40)\n  )" in top
-    assert (out / "fr_defines.v").read_text() == "`define SHIFT 1\n"
+    assert (out / "fr_design" / "fr_defines.v").read_text() == "`define SHIFT 1\n"
     script = next(out.glob("*_follow_target.ys")).read_text()
     assert script.index("fr_defines.v") < script.index("ptop.v")  # the macros first
     argv[argv.index("SPEED=40")] = "SPEDE=40"
