@@ -3,6 +3,7 @@ the ``fpga_robotics.designs`` entry points, or the reference given), with their 
 connectors they bind and the outputs recorded under their own names."""
 
 import dataclasses
+import re
 import sys
 
 from fpga_robotics.cli.errors import UsageError, run_cli
@@ -52,7 +53,33 @@ def describe(spec, origin):
     )
     lines.append(f"  connectors: {binds or 'none'}")
     lines.append(f"  recorded outputs: {', '.join(spec.extra_outputs) or 'none'}")
+    undriven = _undriven_inputs(spec)
+    if undriven:
+        lines.append(
+            f"  undriven inputs: {', '.join(undriven)} (no connector binds them: a run refuses "
+            'the design unless a [[robot.sensors]] table binds each, ports = {PIN = "PORT"})'
+        )
     return lines
+
+
+def _undriven_inputs(spec):
+    """The inputs of an Amaranth design that no connector it binds drives (a run refuses
+    them: nothing would drive them). A Verilog design's port map must drive every input,
+    which ``checked_verilog`` checks."""
+    if spec.kind == "verilog":
+        return []
+    bound = set()
+    for pins in spec.bindings.values():
+        for port in pins.values():  # a stream binds PORT__valid and PORT__payload
+            bound |= {port, f"{port}__valid", f"{port}__payload"}
+    names = []
+    for name, (direction, _) in spec.ports.items():
+        if direction == "in" and name not in bound:
+            # A pixel stream's two ports by the stream's name, as a camera table binds it.
+            name = re.sub(r"__(valid|payload)$", "", name)
+            if name not in names:
+                names.append(name)
+    return names
 
 
 def checked_verilog(spec, ports):
