@@ -7,7 +7,11 @@ import re
 import sys
 
 from fpga_robotics.cli.errors import UsageError, run_cli
-from fpga_robotics.cli.param_options import design_params_from_items
+from fpga_robotics.cli.param_options import (
+    add_define_argument,
+    defines_from_items,
+    design_params_from_items,
+)
 from fpga_robotics.cli.parser import CommandParser
 from fpga_robotics.designs.builtin import TOPS, connector_kinds
 from fpga_robotics.designs.reference import DesignError, entry_point_designs, resolve_design
@@ -37,6 +41,7 @@ def build_parser(prog):
         help="a parameter of REF (repeatable; TOML values)",
     )
     p.add_argument("--ports", metavar="PORTS.toml", help="the port map of a verilog: REF")
+    add_define_argument(p)
     return p
 
 
@@ -114,8 +119,8 @@ def main(argv=None, prog="fpga-robotics designs"):
     args = build_parser(prog).parse_args(argv)
     params = design_params_from_items(args.params)
     if args.reference is None:
-        if params or args.ports:
-            raise UsageError("--param and --ports describe a design REF: give one")
+        if params or args.ports or args.define:
+            raise UsageError("--param, --define and --ports describe a design REF: give one")
         for name in TOPS:
             print("\n".join(describe(resolve_design(name), "built-in")))
         for name, target in entry_point_designs().items():
@@ -123,7 +128,15 @@ def main(argv=None, prog="fpga-robotics designs"):
         return 0
     if args.ports is not None and not args.reference.startswith("verilog:"):
         raise UsageError("--ports is the port map of a Verilog design: it goes with verilog:FILES")
-    spec = resolve_design(args.reference, params, ports=args.ports, option="--param")
+    if args.define and not args.reference.startswith("verilog:"):
+        raise UsageError("--define sets `define macros of a Verilog design (verilog:FILES)")
+    spec = resolve_design(
+        args.reference,
+        params,
+        ports=args.ports,
+        option="--param",
+        defines=defines_from_items(args.define),
+    )
     if spec.kind == "verilog":
         spec = checked_verilog(spec, args.ports)
     origin = {"builtin": "built-in", "amaranth": "Amaranth", "verilog": "Verilog"}[spec.kind]
