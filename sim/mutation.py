@@ -148,7 +148,16 @@ def _yosys(script_lines, work, timeout=600):
     # Relative names: the WebAssembly Yosys sees the working folder, not the whole file system.
     code, out = run_captured([find_yosys(), "-q", "-s", "run.ys"], cwd=work, timeout=timeout)
     if code != 0:
-        tail = "\n".join(out.strip().splitlines()[-5:])
+        lines = out.strip().splitlines()
+        error = next((line for line in lines if "ERROR:" in line), None)
+        if error is not None and error.startswith(DESIGN_DIR + "/"):
+            # A Verilog design Yosys does not read (SystemVerilog beyond synthesis, say):
+            # its file as the user has it, first in the message.
+            raise MutationError(
+                f"Yosys cannot read the design to mutate it: {error[len(DESIGN_DIR) + 1 :]} "
+                "(mutate needs Verilog Yosys reads; run takes it on --backend verilator)"
+            )
+        tail = "\n".join(lines[-5:])
         raise MutationError(f"yosys failed (exit {code}):\n{tail}")
 
 

@@ -220,3 +220,50 @@ def test_docs_list_every_connector_kind_a_port_map_binds():
     ]
     for kind in connector_kinds():
         assert f"`{kind}`" in section, kind
+
+
+PW = """\
+`ifndef SPEED
+`define SPEED 300
+`endif
+module pw #(parameter W = 16) (input clk, input bump_i,
+    output signed [W-1:0] left_dps, output signed [W-1:0] right_dps);
+  reg hit = 1'b0;
+  always @(posedge clk) if (bump_i) hit <= 1'b1;
+  assign left_dps = hit ? 0 : `SPEED;
+  assign right_dps = left_dps;
+endmodule
+"""
+PW_MAP = """\
+top = "pw"
+clock = { port = "clk" }
+[outputs]
+motor_left = { port = "left_dps", width = 12, signed = true }
+motor_right = { port = "right_dps", width = 12, signed = true }
+[connectors.bumper]
+pressed = "bump_i"
+"""
+
+
+def test_a_map_is_checked_against_the_design_at_its_parameters(tmp_path, capsys):
+    """A port width set by a parameter: the map of the 12-bit build is checked against that
+    build (--param, as a run sets it), and --define reaches the design as in a run."""
+    (tmp_path / "pw.v").write_text(PW)
+    (tmp_path / "pw.toml").write_text(PW_MAP)
+    argv = [str(tmp_path / "pw.toml"), "--design", f"verilog:{tmp_path / 'pw.v'}"]
+    code, _, err = _ports(argv, capsys)
+    assert code == 2 and "port 'left_dps' of pw is 16 bits wide, the map expects 12" in err
+    code, out, err = _ports([*argv, "--param", "W=12", "--define", "SPEED=200"], capsys)
+    assert code == 0 and "matches" in out, err
+    code, _, err = _ports([*argv, "--param", "WW=12"], capsys)
+    assert code == 2 and "the design pw has no parameter 'WW' to set (its parameters: W)" in err
+    code, _, err = _ports([*argv, "--param", "W=12", "--define", "SPEEDD=1"], capsys)
+    assert code == 2 and "--define SPEEDD: no file of the design uses the macro" in err
+    code, _, err = _ports([str(tmp_path / "pw.toml"), "--param", "W=12"], capsys)
+    assert code == 2 and "--param sets a parameter or macro of the --design" in err
+    # designs takes the macros too.
+    design = ["designs", f"verilog:{tmp_path / 'pw.v'}", "--ports", str(tmp_path / "pw.toml")]
+    with pytest.raises(SystemExit) as info:
+        cli.main([*design, "--param", "W=12", "--define", "SPEEDD=1"])
+    assert info.value.code == 2
+    assert "--define SPEEDD: no file of the design uses" in capsys.readouterr().err

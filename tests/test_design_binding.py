@@ -574,3 +574,43 @@ def test_outputs_wider_than_a_float_s_53_bits_are_summarised_exactly(tmp_path):
     big, neg = 2**59 + 1, -(2**62) - 1
     assert extra["big"] == {"last": big, "min": big, "max": big}
     assert extra["neg"] == {"last": neg, "min": neg, "max": neg}
+
+
+# Inputs no connector drives ----------------------------------------------------------------
+
+MODEY = """\
+from amaranth import Module, Signal, signed
+from amaranth.lib import wiring
+from amaranth.lib.wiring import In, Out
+
+
+class Modey(wiring.Component):
+    pressed: In(1)
+    mode: In(2)
+    cam: In(2)
+    motor_left: Out(signed(16))
+    motor_right: Out(signed(16))
+
+    def elaborate(self, platform):
+        m = Module()
+        hit = Signal()
+        with m.If(self.pressed):
+            m.d.sync += hit.eq(1)
+        m.d.comb += [self.motor_left.eq(300 - 100 * self.mode), self.motor_right.eq(self.cam)]
+        return m
+"""
+
+
+def test_designs_names_the_inputs_no_connector_drives(tmp_path, capsys):
+    """designs lists an input no connector binds (a run refuses it: nothing drives it), and
+    none of a design whose connectors drive every input."""
+    (tmp_path / "modey.py").write_text(MODEY)
+    with pytest.raises(SystemExit) as info:
+        cli.main(["designs", f"{tmp_path / 'modey.py'}:Modey"])
+    out = capsys.readouterr().out
+    assert info.value.code == 0
+    undriven = [line for line in out.splitlines() if "undriven inputs" in line]
+    assert len(undriven) == 1 and undriven[0].startswith("  undriven inputs: mode, cam (no "), out
+    with pytest.raises(SystemExit) as info:
+        cli.main(["designs", "follow_target"])
+    assert info.value.code == 0 and "undriven" not in capsys.readouterr().out

@@ -855,7 +855,7 @@ PLANS = {
         files=(
             "build/bump_stop/ulx3s_follow_target.v",
             "build/bump_stop/ulx3s_follow_target.lpf",
-            "build/bump_stop/bump_stop.v",
+            "build/bump_stop/fr_design/bump_stop.v",
         ),
     ),
     "fpga-robotics board --design turret_tracker -o build/turret": Plan(

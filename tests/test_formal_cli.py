@@ -135,3 +135,26 @@ def test_an_induction_counterexample_is_no_failed_assertion():
         ]
     )
     assert formal._summary(output) == "failed assertion blob.v:57.7-57.25 step 12"
+
+
+def test_a_failure_in_the_first_step_names_step_0():
+    """SymbiYosys's summary names no step for a base case that fails in step 0 (here an
+    assertion on a register that only the first cycle's reset sets): the BMC's own lines say
+    which step it was checking, and the detail names it as it names any other."""
+    output = "\n".join(
+        "SBY 16:32:02 [check] " + text
+        for text in [
+            "engine_0.induction: ##   0:00:00  Trying induction in step 20..",
+            "engine_0.basecase: ##   0:00:00  Checking assumptions in step 0..",
+            "engine_0.basecase: ##   0:00:00  Checking assertions in step 0..",
+            "engine_0.basecase: ##   0:00:00  BMC failed!",
+            "engine_0.induction: ##   0:00:00  Trying induction in step 19..",
+            "summary: engine_0 (smtbmc yices) returned FAIL for basecase",
+            "summary: counterexample trace [basecase]: check/engine_0/trace.vcd",
+            (
+                "summary:   failed assertion top._witness_.check_assert_fr_design_fd_v_24_12 "
+                "at fr_design/fd.v:24.15-24.31"
+            ),
+        ]
+    )
+    assert formal._summary(output) == "failed assertion fd.v:24.15-24.31 step 0"

@@ -165,6 +165,24 @@ def test_a_verilog_designs_parameters_and_macros(capsys, tmp_path):
     assert got == 2 and "the design g has no parameter 'MAXX' to set (its parameters: MAX)" in err
 
 
+def test_a_define_that_would_change_nothing_is_one_line(capsys, tmp_path):
+    """formal refuses, as run does, a --define no file uses and one the design's own
+    unconditional `define (here inside `ifdef FORMAL, which formal defines) replaces: the
+    proof would otherwise be of the design's value, not the one given."""
+    (tmp_path / "g.v").write_text(
+        _PARAM_COUNTER.replace("`ifdef FORMAL\n", "`ifdef FORMAL\n`define CAP 4'd9\n").replace(
+            "assert (n <= `LIMIT)", "assert (n <= `LIMIT && n <= `CAP)"
+        )
+    )
+    argv = ["formal", "--design", f"verilog:{tmp_path / 'g.v'}", "--depth", "12"]
+    got, out, err = _cli([*argv, "--define", "CAP=12"], capsys)
+    assert got == 2 and err.count("\n") == 1, out + err
+    assert "--define CAP: the design's own `define CAP (g.v:8) replaces the value given" in err
+    got, out, err = _cli([*argv, "--define", "LIMITT=12"], capsys)
+    assert got == 2 and err.count("\n") == 1, out + err
+    assert "--define LIMITT: no file of the design uses the macro `LIMITT" in err
+
+
 @pytest.mark.formal
 def test_a_true_property_is_proved_and_its_cover_reached(capsys, tmp_path):
     code, out, _ = _cli(["formal", "--design", SATURATING, "--trace-dir", str(tmp_path)], capsys)

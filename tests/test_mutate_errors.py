@@ -562,3 +562,31 @@ def test_a_verilog_design_no_campaign_run_can_judge_is_refused_before_the_build(
     assert exc.value.code == 2 and len(err.strip().splitlines()) == 1
     assert "no run can catch a mutant of cnt: it binds no wheels, servo or camera" in err
     assert not out.exists()
+
+
+def test_verilog_yosys_cannot_read_is_one_line_naming_the_users_file(tmp_path, capsys):
+    # `inside` (SystemVerilog Verilator takes, Yosys does not): the line names the file as
+    # the user has it, not as mutate copied it (fr_design/...), and says what runs it.
+    (tmp_path / "sv.v").write_text(
+        "module sv (input clk, input rst, input bump_i, input [2:0] line,\n"
+        "           output reg signed [11:0] left_dps, output signed [11:0] right_dps);\n"
+        "  always @(posedge clk)\n"
+        "    if (rst || bump_i) left_dps <= 12'sd0;\n"
+        "    else if (line inside {3'b001, 3'b100}) left_dps <= 12'sd100;\n"
+        "  assign right_dps = left_dps;\n"
+        "endmodule\n"
+    )
+    (tmp_path / "sv.toml").write_text(
+        'top = "sv"\nclock = { port = "clk" }\nreset = { port = "rst" }\n[outputs]\n'
+        'motor_left = { port = "left_dps", width = 12, signed = true }\n'
+        'motor_right = { port = "right_dps", width = 12, signed = true }\n'
+        '[connectors.bumper]\npressed = "bump_i"\n[connectors.line_sensors]\nline = "line"\n'
+    )
+    out = tmp_path / "m"
+    argv = ["--design", f"verilog:{tmp_path}/sv.v", "--ports", str(tmp_path / "sv.toml")]
+    with pytest.raises(SystemExit) as exc:
+        run_cli(main, [*argv, "--mutants", "3", "--out", str(out)], "mutate")
+    err = capsys.readouterr().err
+    assert exc.value.code == 2 and err.count("\n") == 1, err
+    assert "Yosys cannot read the design to mutate it: sv.v:5: ERROR: syntax error" in err
+    assert "fr_design" not in err and not out.exists()

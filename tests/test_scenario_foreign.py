@@ -86,6 +86,13 @@ def test_paths_are_relative_to_the_scenario_file(files, monkeypatch):
             ),
             "design.params.gain: give a number, a boolean, a literal such as 8'hff or a text",
         ),
+        (  # two designs: the Verilog one ran, or the Amaranth one, without a word
+            (
+                '[design]\ntop = "follow_target"\nverilog = ["rtl/follow_target.v"]\n'
+                'ports = "rtl/ft.toml"\n'
+            ),
+            "design.top = 'follow_target' and design.verilog name two designs: give one",
+        ),
         (
             '[design]\ntop = "follow_target"\n[design.defines]\nFAST = true\n',
             "design.defines sets `define macros of a Verilog design (design.verilog)",

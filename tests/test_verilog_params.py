@@ -186,7 +186,7 @@ def test_the_board_top_sets_them(design, tmp_path, capsys):
     assert info.value.code == 0, capsys.readouterr().err
     top = next(out.glob("*_follow_target.v")).read_text()
     assert "ptop #(\n    .N(32'd3),\n    .SPEED(32'd40)\n  )" in top
-    assert (out / "fr_defines.v").read_text() == "`define SHIFT 1\n"
+    assert (out / "fr_design" / "fr_defines.v").read_text() == "`define SHIFT 1\n"
     script = next(out.glob("*_follow_target.ys")).read_text()
     assert script.index("fr_defines.v") < script.index("ptop.v")  # the macros first
     argv[argv.index("SPEED=40")] = "SPEDE=40"
@@ -217,3 +217,23 @@ def test_mutant_descriptions_name_the_users_files(tmp_path):
 def _map_in(folder):
     (folder / "ptop.toml").write_text(PTOP_MAP)
     return folder / "ptop.toml"
+
+
+def test_a_define_the_design_redefines_is_one_line(tmp_path, capsys):
+    """An unconditional `define in the design's own file would replace --define's value
+    silently: refused, naming the file and line of the design's `define."""
+    (tmp_path / "inc").mkdir()
+    (tmp_path / "inc" / "defs.vh").write_text("// speeds\n`define SHIFT 2\n")
+    (tmp_path / "ptop.v").write_text('`include "inc/defs.vh"\n' + PTOP)
+    (tmp_path / "ptop.toml").write_text(PTOP_MAP)
+    argv = ["run", "--design", f"verilog:{tmp_path / 'ptop.v'}", "--ports"]
+    argv += [str(tmp_path / "ptop.toml"), "--define", "SHIFT=1", "--rerun", "off"]
+    with pytest.raises(SystemExit) as info:
+        cli.main(argv)
+    err = capsys.readouterr().err
+    assert info.value.code == 2 and err.count("\n") == 1, err
+    assert "--define SHIFT: the design's own `define SHIFT (inc/defs.vh:2) replaces" in err
+    # The same value as the design's own changes nothing: taken.
+    same = VerilogOverrides.of(defines={"SHIFT": 2})
+    design = ForeignDesign([tmp_path / "ptop.v"], tmp_path / "ptop.toml", overrides=same)
+    assert design.ports["left"] == ("output", 16, True)

@@ -3,10 +3,15 @@ the ``fpga_robotics.designs`` entry points, or the reference given), with their 
 connectors they bind and the outputs recorded under their own names."""
 
 import dataclasses
+import re
 import sys
 
 from fpga_robotics.cli.errors import UsageError, run_cli
-from fpga_robotics.cli.param_options import design_params_from_items
+from fpga_robotics.cli.param_options import (
+    add_define_argument,
+    defines_from_items,
+    design_params_from_items,
+)
 from fpga_robotics.cli.parser import CommandParser
 from fpga_robotics.designs.builtin import TOPS, connector_kinds
 from fpga_robotics.designs.reference import DesignError, entry_point_designs, resolve_design
@@ -36,6 +41,7 @@ def build_parser(prog):
         help="a parameter of REF (repeatable; TOML values)",
     )
     p.add_argument("--ports", metavar="PORTS.toml", help="the port map of a verilog: REF")
+    add_define_argument(p)
     return p
 
 
@@ -52,7 +58,33 @@ def describe(spec, origin):
     )
     lines.append(f"  connectors: {binds or 'none'}")
     lines.append(f"  recorded outputs: {', '.join(spec.extra_outputs) or 'none'}")
+    undriven = _undriven_inputs(spec)
+    if undriven:
+        lines.append(
+            f"  undriven inputs: {', '.join(undriven)} (no connector binds them: a run refuses "
+            'the design unless a [[robot.sensors]] table binds each, ports = {PIN = "PORT"})'
+        )
     return lines
+
+
+def _undriven_inputs(spec):
+    """The inputs of an Amaranth design that no connector it binds drives (a run refuses
+    them: nothing would drive them). A Verilog design's port map must drive every input,
+    which ``checked_verilog`` checks."""
+    if spec.kind == "verilog":
+        return []
+    bound = set()
+    for pins in spec.bindings.values():
+        for port in pins.values():  # a stream binds PORT__valid and PORT__payload
+            bound |= {port, f"{port}__valid", f"{port}__payload"}
+    names = []
+    for name, (direction, _) in spec.ports.items():
+        if direction == "in" and name not in bound:
+            # A pixel stream's two ports by the stream's name, as a camera table binds it.
+            name = re.sub(r"__(valid|payload)$", "", name)
+            if name not in names:
+                names.append(name)
+    return names
 
 
 def checked_verilog(spec, ports):
@@ -87,8 +119,8 @@ def main(argv=None, prog="fpga-robotics designs"):
     args = build_parser(prog).parse_args(argv)
     params = design_params_from_items(args.params)
     if args.reference is None:
-        if params or args.ports:
-            raise UsageError("--param and --ports describe a design REF: give one")
+        if params or args.ports or args.define:
+            raise UsageError("--param, --define and --ports describe a design REF: give one")
         for name in TOPS:
             print("\n".join(describe(resolve_design(name), "built-in")))
         for name, target in entry_point_designs().items():
@@ -96,7 +128,15 @@ def main(argv=None, prog="fpga-robotics designs"):
         return 0
     if args.ports is not None and not args.reference.startswith("verilog:"):
         raise UsageError("--ports is the port map of a Verilog design: it goes with verilog:FILES")
-    spec = resolve_design(args.reference, params, ports=args.ports, option="--param")
+    if args.define and not args.reference.startswith("verilog:"):
+        raise UsageError("--define sets `define macros of a Verilog design (verilog:FILES)")
+    spec = resolve_design(
+        args.reference,
+        params,
+        ports=args.ports,
+        option="--param",
+        defines=defines_from_items(args.define),
+    )
     if spec.kind == "verilog":
         spec = checked_verilog(spec, args.ports)
     origin = {"builtin": "built-in", "amaranth": "Amaranth", "verilog": "Verilog"}[spec.kind]

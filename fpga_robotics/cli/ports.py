@@ -5,6 +5,11 @@ driven, the connectors' pins)."""
 
 from fpga_robotics.cli.designs import checked_verilog
 from fpga_robotics.cli.errors import UsageError
+from fpga_robotics.cli.param_options import (
+    add_define_argument,
+    defines_from_items,
+    design_params_from_items,
+)
 from fpga_robotics.cli.parser import CommandParser
 from fpga_robotics.designs.builtin import connector_kinds
 from fpga_robotics.designs.reference import DesignError, resolve_design
@@ -35,6 +40,15 @@ def build_parser(prog="fpga-robotics ports"):
         metavar="verilog:TOP.v[,MORE.v]",
         help="check the map against this design's real ports",
     )
+    parser.add_argument(
+        "--param",
+        dest="params",
+        action="append",
+        default=[],
+        metavar="NAME=VALUE",
+        help="with --design: a parameter of its top, as a run sets it (repeatable)",
+    )
+    add_define_argument(parser)
     return parser
 
 
@@ -54,6 +68,10 @@ def main(argv=None, prog="fpga-robotics ports"):
             "write your design's map from it (docs/foreign.md), then check it with "
             f"fpga-robotics ports {args.path} --design {args.design}"
         )
+    if (args.params or args.define) and args.design is None:
+        # The widths they size are the design's: without it there is nothing to set.
+        given = "--param" if args.params else "--define"
+        raise UsageError(f"{given} sets a parameter or macro of the --design verilog:FILES")
     if args.example:
         write_follow_target_port_map(args.path)
         print(f"wrote {args.path}")
@@ -61,15 +79,18 @@ def main(argv=None, prog="fpga-robotics ports"):
     port_map = load_port_map(args.path)
     check_connector_names(port_map, connector_kinds())  # the connector kinds need no design
     if args.design is not None:
-        _check_against_design(args.design, args.path)
+        params = design_params_from_items(args.params)
+        _check_against_design(args.design, args.path, params, defines_from_items(args.define))
     connectors = "".join(f", connectors.{kind}" for kind in port_map.connectors)
     print(f"{args.path}: {port_map.top}, outputs {', '.join(port_map.outputs)}{connectors}")
     return 0
 
 
-def _check_against_design(reference, path):
-    """Raise a one-line ``DesignError`` at the first way the map and the design disagree."""
-    spec = checked_verilog(resolve_design(reference, {}, ports=path), path)
+def _check_against_design(reference, path, params, defines):
+    """Raise a one-line ``DesignError`` at the first way the map and the design, built with
+    ``params`` and ``defines`` (``--param``, ``--define``), disagree."""
+    spec = resolve_design(reference, params, ports=path, option="--param", defines=defines)
+    spec = checked_verilog(spec, path)
     print(f"{path}: matches {reference} ({len(spec.ports)} ports)")
 
 

@@ -224,12 +224,7 @@ def _user_factory(spec):
         platform = ulx3s_user_platform(wiring["header"], wiring.get("turret_camera", False))
         if spec.kind == "verilog":
             # Yosys reads the design's files (and those they include) with the generated top.
-            for name, text in verilog_files(spec):
-                if name.startswith(DESIGN_NAME + "."):
-                    raise UserError(
-                        f"design {spec.port_map.top}: rename {name!r}: the board build "
-                        f"writes its own files as {DESIGN_NAME}.*"
-                    )
+            for name, text in verilog_files(spec):  # under fr_design/: no clash with ours
                 platform.add_file(name, text)
             design = VerilogOnBoard(
                 spec.port_map,

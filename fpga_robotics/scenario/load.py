@@ -1015,6 +1015,12 @@ def _foreign(design, source):
                 f'design.top = {top!r} needs design.ports = "ports.toml" '
                 f"(the design's port map, docs/foreign.md)"
             )
+    elif top is not None and verilog is not None:
+        # Two designs named in the file: which one would run?
+        raise ScenarioError(
+            f"design.top = {top!r} and design.verilog name two designs: give one (the "
+            f'Verilog one as design.verilog, or design.top = "verilog:..."; docs/foreign.md)'
+        )
     if verilog is None and ports is None:
         if defines is not None:
             raise ScenarioError(

@@ -59,6 +59,7 @@ __all__ = [
     "design_ports",
     "include_dirs",
     "pin_ports",
+    "refuse_ignored_defines",
     "verilog_includes",
     "verilog_layout",
     "watch_chunks",
@@ -269,6 +270,34 @@ def _refuse_unused_defines(overrides, texts):
         )
 
 
+def refuse_ignored_defines(sources, includes, overrides, extra=()):
+    """A ``PortMapError`` for a ``--define`` that would change nothing: one no file of the
+    design uses, or one the design's own `define replaces (read after ours), as Verilator's
+    preprocessor finds it, with the macros ``extra`` (``("FORMAL",)``) defined as the tool
+    that reads the design defines them. For the flows that read the design without
+    elaborating it in Verilator (``formal``), which checks both when it reads the ports."""
+    _refuse_unused_defines(overrides, [*sources.values(), *(includes or {}).values()])
+    if not overrides.defines:
+        return
+    root = verilator_root()
+    with tempfile.TemporaryDirectory(prefix="fr-foreign-") as tmp:
+        paths = _write_sources(tmp, overrides.with_defines(sources), includes)
+        _, output = run_captured(
+            [
+                root / "bin" / "verilator",
+                "-E",
+                "-P",
+                *(f"+define+{name}" for name in extra),
+                *include_dirs(tmp, sources, includes or {}),
+                *paths,
+            ],
+            cwd=tmp,
+            env=dict(os.environ, VERILATOR_ROOT=str(root)),
+        )
+        output = output.replace(str(Path(tmp) / DESIGN_DIR) + "/", "")
+    _refuse_redefined(overrides, output, {**(includes or {}), **sources})
+
+
 def _refuse_loop(sources, top, includes, overrides):
     loop = combinational_loop(sources, top, includes, overrides)
     if loop is not None:
@@ -421,6 +450,11 @@ def _elaborate(sources, top, includes, overrides):
             cwd=tmp,
             env=dict(os.environ, VERILATOR_ROOT=str(root)),
         )
+        _refuse_redefined(
+            overrides,
+            output.replace(str(Path(tmp) / DESIGN_DIR) + "/", ""),
+            {**(includes or {}), **sources},
+        )
         if code != 0:
             errors = [line for line in output.splitlines() if line.startswith("%Error")]
             first = (errors or output.strip().splitlines() or ["(no output)"])[0]
@@ -466,6 +500,38 @@ def _elaborate(sources, top, includes, overrides):
         if var.get("type") == "VAR" and var.get("isGParam")
     ]
     return ports, parameters
+
+
+#: Verilator's warning for a `define of a name already defined with another value.
+_REDEFINED = re.compile(
+    r"%Warning-REDEFMACRO: (\S+?):(\d+):\d+: Redefining existing define: '(\w+)'"
+)
+
+
+def _refuse_redefined(overrides, output, texts):
+    """A ``PortMapError`` for a ``--define`` the design's own `define of the same name
+    overrides (its file read after ours): the value given would be dropped without a word.
+    ``output``: Verilator's; ``texts``: the design's files by path, to find the `define's
+    line (Verilator names the line after it)."""
+    given = {name for name, _ in overrides.defines}
+    for where, after, name in _REDEFINED.findall(output):
+        if name not in given:
+            continue
+        where = os.path.normpath(where)
+        lines = texts.get(where, "").splitlines()[: int(after)]
+        line = next(
+            (
+                n
+                for n in range(len(lines), 0, -1)
+                if re.search(rf"`define\s+{name}\b", lines[n - 1])
+            ),
+            int(after),
+        )
+        raise PortMapError(
+            f"--define {name}: the design's own `define {name} ({where}:{line}) replaces "
+            f"the value given; put that `define between `ifndef {name} and `endif so that "
+            "--define can set it"
+        )
 
 
 def _refuse_parameters(sources, top, includes, overrides):
