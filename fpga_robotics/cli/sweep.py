@@ -2,6 +2,7 @@
 
 Exit status: 0 when every run passed, 1 when some did not, 2 for a usage error (bad option,
 malformed campaign file, unknown scenario or key, bad override value, unreachable scheduler).
+``report DIR`` exits as the campaign did (1 also when runs are missing), or 0 with --exit-zero.
 """
 
 import math
@@ -11,7 +12,7 @@ from pathlib import Path
 from fpga_robotics.cli.errors import UsageError
 from fpga_robotics.cli.parser import CommandParser
 from fpga_robotics.sim.files import check_output_dir
-from fpga_robotics.sweep.api import report_dir, run_campaign
+from fpga_robotics.sweep.api import dir_passed, report_dir, run_campaign
 from fpga_robotics.sweep.campaign import (
     load_campaign,
     parse_seeds,
@@ -304,16 +305,24 @@ def _dry_run(campaign, args):
 
 def _report(argv, prog):
     p = CommandParser(
-        prog=f"{prog} report", description="Rebuild report.html from a campaign's results."
+        prog=f"{prog} report",
+        description="Rebuild report.html from a campaign's results. Exit status: 0 when every "
+        "run passed, 1 when some did not or never ran, 2 for a usage error.",
     )
     p.add_argument("dir", metavar="DIR", help="the campaign's results folder")
+    p.add_argument(
+        "--exit-zero",
+        action="store_true",
+        help="exit 0 whatever the runs' results (a usage error still exits 2)",
+    )
     args = p.parse_args(argv)
 
     if not args.dir.strip() or not Path(args.dir).is_dir():
         raise UsageError(f"{args.dir!r} is not a folder of campaign results")
     print(report_dir(args.dir))
     print(f"report: {Path(args.dir) / 'report.html'}")
-    return 0
+    # As the campaign's own exit code: a CI step that only rebuilds the report still fails.
+    return 0 if args.exit_zero or dir_passed(args.dir) else 1
 
 
 def main(argv=None, prog=PROG):
