@@ -5,6 +5,7 @@ malformed campaign file, unknown scenario or key, bad override value, unreachabl
 ``report DIR`` exits as the campaign did (1 also when runs are missing), or 0 with --exit-zero.
 """
 
+import argparse
 import math
 import sys
 from pathlib import Path
@@ -108,10 +109,11 @@ def build_parser(prog=PROG):
         help="also write each recorded run as a ROS 2 bag, OUT/bags/RUN_ID/ (docs/ros.md)",
     )
     e.add_argument(
-        "--no-fork",
-        action="store_true",
-        help="run every run in full (default: runs that differ only in their design are "
-        "forked from one reference run, with the same results)",
+        "--fork",
+        action=argparse.BooleanOptionalAction,
+        default=True,
+        help="fork runs that differ only in their design from one reference run, with the "
+        "same results (default), or, with --no-fork, run every run in full",
     )
     e.add_argument(
         "--log-every",
@@ -280,9 +282,13 @@ def _check_bench_options(args, parser):
     for action in parser._actions:  # the options as given against their defaults
         given = getattr(args, action.dest, action.default) != action.default
         if given and action.option_strings and action.dest not in BENCH_OPTIONS:
+            name = action.option_strings[0]
+            if isinstance(action, argparse.BooleanOptionalAction) and not getattr(
+                args, action.dest
+            ):  # the option as given: --no-fork, not --fork
+                name = "--no-" + name.removeprefix("--")
             raise UsageError(
-                f"--bench runs no campaign and writes no results: {action.option_strings[0]} "
-                f"does not apply to it"
+                f"--bench runs no campaign and writes no results: {name} does not apply to it"
             )
     if args.scenarios is not None and "," in args.scenarios:
         raise UsageError(f"--bench measures one scenario, got --scenarios {args.scenarios}")
@@ -368,7 +374,7 @@ def main(argv=None, prog=PROG):
             echo=echo,
             log_every=args.log_every or RECORD_LOG_EVERY,
             bag=args.bag,
-            fork=not args.no_fork,
+            fork=args.fork,
         )
     except KeyboardInterrupt:
         kept = len(load_rows(out))
