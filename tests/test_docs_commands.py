@@ -593,6 +593,21 @@ PLANS = {
         ),
         out=(r"2 runs: 2 pass", r"pass rate per scenario:"),
     ),
+    # Two variants, 2 s: the page quotes the whole campaign's measured figures.
+    "fpga-robotics sweep --scenarios lost_target --backend model --duration 10 --grid "
+    '"design.lost_frames=[5,6,7,8,9,10,11,12,13,14,15,16,17,18,19,20,21,22,23,24]" --workers 2 --record none '
+    "--out runs/sweeps/fork": Plan(
+        shorter=(("--duration", "2"), ("--grid", "design.lost_frames=[5,24]")),
+        files=("runs/sweeps/fork/report.html",),
+        out=(r"2 runs: ",),
+    ),
+    "fpga-robotics sweep --scenarios lost_target --backend model --duration 10 --grid "
+    '"design.lost_frames=[5,6,7,8,9,10,11,12,13,14,15,16,17,18,19,20,21,22,23,24]" --workers 2 --record none '
+    "--out runs/sweeps/no-fork --no-fork": Plan(
+        shorter=(("--duration", "2"), ("--grid", "design.lost_frames=[5,24]")),
+        files=("runs/sweeps/no-fork/report.html",),
+        out=(r"2 runs: ",),
+    ),
     "python -m fpga_robotics.sweep report runs/sweeps/regression": Plan(
         files=("runs/sweeps/regression/report.html",),
         out=(r"2 runs: 2 pass",),

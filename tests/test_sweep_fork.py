@@ -5,7 +5,7 @@ from pathlib import Path
 
 from fpga_robotics.checks.summary import TIMING_FIELDS
 from fpga_robotics.sweep import load_campaign, run_campaign, runner
-from fpga_robotics.sweep.fork_groups import execute_group, fork_groups
+from fpga_robotics.sweep.fork_groups import execute_group, fork_groups, spread
 from fpga_robotics.sweep.plan import make_plan
 
 #: Two seeds, four designs each (when to search and which way), and a heavier robot (another
@@ -155,3 +155,30 @@ def test_a_run_in_another_timing_than_the_reference_is_run_in_full():
             for o in (outcome, alone)
         )
         assert mine == theirs
+
+
+def test_spread_cuts_groups_for_idle_workers_keeping_every_run_once_in_order():
+    one = list(range(20))
+    assert spread([one], 2) == [one[:10], one[10:]]
+    assert [len(g) for g in spread([one], 3)] == [7, 7, 6]
+    # The largest pieces are cut first; a run alone cannot be cut.
+    assert [len(g) for g in spread([one, ["a"]], 4)] == [7, 7, 6, 1]
+    assert spread([["a"], ["b"]], 4) == [["a"], ["b"]]
+    # Enough groups already: none is cut (each cut costs a reference run).
+    assert spread([one[:4], one[4:]], 2) == [one[:4], one[4:]]
+    assert [r for g in spread([one, ["a", "b"]], 5) for r in g] == [*one, "a", "b"]
+
+
+def test_a_single_world_is_forked_on_every_worker_with_the_full_runs_rows(tmp_path):
+    # One seed, four designs: one world, cut in two for two workers (a reference each).
+    grid_only = {k: v for k, v in CAMPAIGN.items() if k != "sets"}
+    campaign = load_campaign({**grid_only, "seeds": [0], "duration": 3.0})
+    plan = make_plan(campaign)
+    assert [len(g) for g in spread(fork_groups(plan.runs, plan.worlds), 2)] == [2, 2]
+    forked = run_campaign(campaign, tmp_path / "forked", workers=2, record="none")
+    full = run_campaign(campaign, tmp_path / "full", workers=2, record="none", fork=False)
+
+    def by_id(rows):
+        return {r["run_id"]: {k: v for k, v in r.items() if k not in TIMES} for r in rows}
+
+    assert len(forked) == 4 and by_id(forked) == by_id(full)

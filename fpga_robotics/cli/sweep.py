@@ -2,8 +2,10 @@
 
 Exit status: 0 when every run passed, 1 when some did not, 2 for a usage error (bad option,
 malformed campaign file, unknown scenario or key, bad override value, unreachable scheduler).
+``report DIR`` exits as the campaign did (1 also when runs are missing), or 0 with --exit-zero.
 """
 
+import argparse
 import math
 import sys
 from pathlib import Path
@@ -11,7 +13,7 @@ from pathlib import Path
 from fpga_robotics.cli.errors import UsageError
 from fpga_robotics.cli.parser import CommandParser
 from fpga_robotics.sim.files import check_output_dir
-from fpga_robotics.sweep.api import report_dir, run_campaign
+from fpga_robotics.sweep.api import dir_passed, report_dir, run_campaign
 from fpga_robotics.sweep.campaign import (
     load_campaign,
     parse_seeds,
@@ -107,10 +109,11 @@ def build_parser(prog=PROG):
         help="also write each recorded run as a ROS 2 bag, OUT/bags/RUN_ID/ (docs/ros.md)",
     )
     e.add_argument(
-        "--no-fork",
-        action="store_true",
-        help="run every run in full (default: runs that differ only in their design are "
-        "forked from one reference run, with the same results)",
+        "--fork",
+        action=argparse.BooleanOptionalAction,
+        default=True,
+        help="fork runs that differ only in their design from one reference run, with the "
+        "same results (default), or, with --no-fork, run every run in full",
     )
     e.add_argument(
         "--log-every",
@@ -279,9 +282,13 @@ def _check_bench_options(args, parser):
     for action in parser._actions:  # the options as given against their defaults
         given = getattr(args, action.dest, action.default) != action.default
         if given and action.option_strings and action.dest not in BENCH_OPTIONS:
+            name = action.option_strings[0]
+            if isinstance(action, argparse.BooleanOptionalAction) and not getattr(
+                args, action.dest
+            ):  # the option as given: --no-fork, not --fork
+                name = "--no-" + name.removeprefix("--")
             raise UsageError(
-                f"--bench runs no campaign and writes no results: {action.option_strings[0]} "
-                f"does not apply to it"
+                f"--bench runs no campaign and writes no results: {name} does not apply to it"
             )
     if args.scenarios is not None and "," in args.scenarios:
         raise UsageError(f"--bench measures one scenario, got --scenarios {args.scenarios}")
@@ -304,16 +311,24 @@ def _dry_run(campaign, args):
 
 def _report(argv, prog):
     p = CommandParser(
-        prog=f"{prog} report", description="Rebuild report.html from a campaign's results."
+        prog=f"{prog} report",
+        description="Rebuild report.html from a campaign's results. Exit status: 0 when every "
+        "run passed, 1 when some did not or never ran, 2 for a usage error.",
     )
     p.add_argument("dir", metavar="DIR", help="the campaign's results folder")
+    p.add_argument(
+        "--exit-zero",
+        action="store_true",
+        help="exit 0 whatever the runs' results (a usage error still exits 2)",
+    )
     args = p.parse_args(argv)
 
     if not args.dir.strip() or not Path(args.dir).is_dir():
         raise UsageError(f"{args.dir!r} is not a folder of campaign results")
     print(report_dir(args.dir))
     print(f"report: {Path(args.dir) / 'report.html'}")
-    return 0
+    # As the campaign's own exit code: a CI step that only rebuilds the report still fails.
+    return 0 if args.exit_zero or dir_passed(args.dir) else 1
 
 
 def main(argv=None, prog=PROG):
@@ -359,7 +374,7 @@ def main(argv=None, prog=PROG):
             echo=echo,
             log_every=args.log_every or RECORD_LOG_EVERY,
             bag=args.bag,
-            fork=not args.no_fork,
+            fork=args.fork,
         )
     except KeyboardInterrupt:
         kept = len(load_rows(out))

@@ -10,10 +10,10 @@ from fpga_robotics.hw.errors import UsageError
 from .. import __version__
 from .engine import RECORD_LOG_EVERY, build_all, kept_to_record, open_client, run_plan
 from .plan import make_plan
-from .report import format_report, write_html
+from .report import campaign_passed, format_report, write_html
 from .results import ResultStore, load_rows, read_meta, write_meta
 
-__all__ = ["report_dir", "run_campaign", "wait_for_a_worker"]
+__all__ = ["dir_passed", "report_dir", "run_campaign", "wait_for_a_worker"]
 
 
 def run_campaign(
@@ -203,3 +203,13 @@ def report_dir(out_dir):
     )
     write_html(out_dir / "report.html", rows, axes, meta)
     return format_report(rows, axes, meta.get("known_limits") or (), meta.get("missing", 0))
+
+
+def dir_passed(out_dir):
+    """Whether the campaign in ``out_dir`` passed: every one of its runs is there (none
+    missing from an interruption) and passed, or failed only where a known limit explains it
+    (the exit code of ``sweep report``, as of the campaign itself)."""
+    out_dir = Path(out_dir)
+    meta = read_meta(out_dir)
+    rows = load_rows(out_dir)
+    return not meta.get("missing", 0) and campaign_passed(rows, meta.get("known_limits") or ())

@@ -253,7 +253,9 @@ def run_plan(
     timeouts = _Timeouts(timeout)
     window = max(2, 2 * sum(client.nthreads().values()) or 2)
     if fork and record != "all":
-        groups = fork_groups.fork_groups(todo, plan.worlds)
+        groups = fork_groups.spread(
+            fork_groups.fork_groups(todo, plan.worlds), sum(client.nthreads().values())
+        )
     else:
         groups = [[spec] for spec in todo]
     # (specs, recording pass), the last first: the new runs, then the kept runs' recordings.

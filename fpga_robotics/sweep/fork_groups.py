@@ -16,7 +16,7 @@ from fpga_robotics.loop.fork import VARIANT_SECTIONS
 
 from . import runner
 
-__all__ = ["MEMBER_TOPIC", "execute_group", "fork_groups", "world_key"]
+__all__ = ["MEMBER_TOPIC", "execute_group", "fork_groups", "spread", "world_key"]
 
 #: The Dask event topic under which a group's task publishes each run's outcome (JSON text,
 #: tagged as the run) as soon as it has it: when the worker dies later in the group, the
@@ -52,6 +52,30 @@ def fork_groups(specs, worlds):
             groups.append([])
         groups[index[key]].append(spec)
     return groups
+
+
+def spread(groups, workers):
+    """``groups`` cut into at least ``workers`` groups where they have the runs for it: a
+    group is one task on one worker, so a campaign of fewer groups than workers (a grid over
+    design values only, one seed) would leave workers idle. Each piece costs one more reference
+    run, and ends sooner; the pieces of a group are near-equal runs of its order, the largest
+    pieces cut first."""
+    pieces = [1] * len(groups)
+    while sum(pieces) < workers:
+        can = [i for i, g in enumerate(groups) if pieces[i] < len(g)]
+        if not can:
+            break
+        i = max(can, key=lambda k: -(-len(groups[k]) // pieces[k]))
+        pieces[i] += 1
+    out = []
+    for group, n in zip(groups, pieces, strict=True):
+        size, extra = divmod(len(group), n)
+        start = 0
+        for k in range(n):
+            end = start + size + (k < extra)
+            out.append(group[start:end])
+            start = end
+    return out
 
 
 def execute_group(argvs, timeouts, tags):
