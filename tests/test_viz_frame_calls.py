@@ -23,6 +23,15 @@ class _Stream:
         self.calls.append(("log", args, kwargs))
 
 
+@pytest.fixture
+def python_ctrl_c():
+    """Python's own SIGINT handler (KeyboardInterrupt) for the test, whatever an earlier test
+    in this process left in force."""
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    yield
+    signal.signal(signal.SIGINT, previous)
+
+
 def test_calls_are_made_in_their_order_on_replay_only():
     calls = FrameCalls()
     assert not calls
@@ -40,7 +49,7 @@ def test_calls_are_made_in_their_order_on_replay_only():
     assert not calls  # made once
 
 
-def test_ctrl_c_inside_the_block_takes_effect_at_its_end():
+def test_ctrl_c_inside_the_block_takes_effect_at_its_end(python_ctrl_c):
     before = signal.getsignal(signal.SIGINT)
     done = []
     with pytest.raises(KeyboardInterrupt), signals_held():
@@ -62,7 +71,9 @@ def test_sigterm_inside_the_block_reaches_the_handler_in_force_at_its_end():
         signal.signal(signal.SIGTERM, previous)
 
 
-def test_ctrl_c_while_a_frames_rows_are_made_keeps_that_frame_whole(tmp_path, monkeypatch):
+def test_ctrl_c_while_a_frames_rows_are_made_keeps_that_frame_whole(
+    tmp_path, monkeypatch, python_ctrl_c
+):
     """Ctrl-C between two of frame 3's direct calls (rerun's log runs a good deal of Python,
     so it lands there often): the frame is finished, counted, and the run stops after it."""
     replay = FrameCalls.replay
