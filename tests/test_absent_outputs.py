@@ -112,7 +112,7 @@ def test_checks_that_need_an_absent_output_are_na_and_left_out_of_the_verdict(ru
         "acquired_within_s": 1.0,
         "found_min_fraction": 0.9,
         "max_off_target_fraction": 0.1,
-        "mean_distance_max_m": 0.01,
+        "min_distance_min_m": 100.0,
     }
     checks = evaluate_checks(limits, m)
     by = {c["name"]: c for c in checks}
@@ -121,13 +121,13 @@ def test_checks_that_need_an_absent_output_are_na_and_left_out_of_the_verdict(ru
             "not measured: the design has no"
         )
     assert "`found`" in by["acquired_within_s"]["text"]
-    # The measurable check still decides: 1 cm mean distance is impossible.
-    assert by["mean_distance_max_m"]["passed"] is False
+    # The measurable check still decides: keeping 100 m from the person is impossible.
+    assert by["min_distance_min_m"]["passed"] is False
     assert verdict(checks) == "fail"
     # Without it every check set is n/a: no check could judge, which is no pass.
-    assert verdict([c for c in checks if c["name"] != "mean_distance_max_m"]) == "n/a"
+    assert verdict([c for c in checks if c["name"] != "min_distance_min_m"]) == "n/a"
     assert (
-        verdict([c for c in checks if c["name"] in ("mean_distance_max_m", "acquired_within_s")])
+        verdict([c for c in checks if c["name"] in ("min_distance_min_m", "acquired_within_s")])
         == "fail"
     )
     text = format_summary({**part.summary, "checks": checks})

@@ -544,7 +544,7 @@ def test_the_exported_follow_target_as_a_verilog_design_on_the_board(tmp_path, c
     ]
     assert "switch_0__io" in (tmp_path / "b" / "ulx3s_follow_target.lpf").read_text()
     script = (
-        f"{_ECP5_CELLS}; read_verilog ulx3s_follow_target.v follow_target.v; "
+        f"{_ECP5_CELLS}; read_verilog ulx3s_follow_target.v fr_design/follow_target.v; "
         "hierarchy -check -top ulx3s_follow_target"
     )
     proc = subprocess.run(

@@ -383,8 +383,7 @@ def test_a_camera_and_ultrasound_design_in_verilog_stops_as_follow_target_safe(t
         "obstacle_between",
         [
             *scene,
-            'design.top="follow_target"',
-            f'design.verilog="{tmp_path}/safe.v"',
+            f'design.top="verilog:{tmp_path}/safe.v"',
             f'design.ports="{tmp_path}/safe.toml"',
         ],
     )

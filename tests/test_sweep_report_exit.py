@@ -6,7 +6,7 @@ import json
 
 from fpga_robotics.cli import sweep as cli
 
-#: follow_person for 1 s: too short to acquire the person, so both checks below fail.
+#: follow_person for 1 s: too short to acquire the person, so the checks below fail.
 CAMPAIGN = """scenarios = ["follow_person"]
 seeds = [0, 1]
 backend = "model"
@@ -20,6 +20,10 @@ reason = "1 s is too short"
 [[known_limits]]
 check = "found_min_fraction"
 reason = "1 s is too short"
+
+[[known_limits]]
+check = "max_mean_aim_error_deg"
+reason = "1 s is too short to turn to the person"
 """
 
 
@@ -32,7 +36,7 @@ def test_report_exit_code_follows_the_runs(tmp_path, monkeypatch, capsys):
 
     meta_path = tmp_path / "out" / "campaign.json"
     meta = json.loads(meta_path.read_text())
-    assert len(meta["known_limits"]) == 2
+    assert len(meta["known_limits"]) == 3
     # One failed check no longer explained: both runs count as failures.
     meta_path.write_text(json.dumps({**meta, "known_limits": meta["known_limits"][:1]}))
     assert cli.main(["report", "out"]) == 1
