@@ -8,6 +8,7 @@ import time
 import numpy as np
 import pytest
 
+from fpga_robotics.sim.camera import floor_patches
 from fpga_robotics.sim.camera.floor_patches import patch_index
 from fpga_robotics.sim.world import World
 from fpga_robotics.sim.world.config import WorldConfigError, _crossing_edges
@@ -37,15 +38,24 @@ def _first_crossing(polygon):
     return None
 
 
-def test_patch_index_is_the_even_odd_rule_of_each_point():
+@pytest.mark.parametrize("banded_from", [1, floor_patches.BANDED_FROM, 10**9])
+def test_patch_index_is_the_even_odd_rule_of_each_point(banded_from, monkeypatch):
+    """Both ways of testing the points, every point against every edge and the sorted
+    slices level with each edge, and the default's choice between them (40 and 7 corners
+    below it, 100 above)."""
+    monkeypatch.setattr(floor_patches, "BANDED_FROM", banded_from)
     rng = np.random.default_rng(3)
-    polygons = [_star(rng, 40, 4, 3, 0.5, 2.5), _star(rng, 7, 5, 3, 0.2, 1.5)]
+    polygons = [
+        _star(rng, 40, 4, 3, 0.5, 2.5),
+        _star(rng, 7, 5, 3, 0.2, 1.5),
+        _star(rng, 100, 2, 4, 0.3, 1.2),
+    ]
     x, y = rng.uniform(0, 8, 3000), rng.uniform(0, 6, 3000)
     got = patch_index(polygons, x.reshape(60, 50), y.reshape(60, 50)).ravel()
     for px, py, k in zip(x, y, got):
         inside = [i for i, poly in enumerate(polygons) if polygon_contains(poly, px, py)]
         assert k == (inside[-1] if inside else -1)  # the last polygon that holds it
-    assert (got == 0).sum() > 100 and (got == 1).sum() > 100
+    assert (got == 0).sum() > 100 and (got == 1).sum() > 100 and (got == 2).sum() > 100
 
 
 @pytest.mark.parametrize("seed", range(6))

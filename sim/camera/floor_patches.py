@@ -30,6 +30,13 @@ def floor_points(renderer, pose, rows, cols):
     return pose.x + depth * c + right * s, pose.y + depth * s - right * c
 
 
+#: From this many corners on, a polygon's points are sorted by y once and each edge tests only
+#: the slice level with it; below, every point is tested against every edge, which costs less
+#: than the sort (19,200 points: 4 corners 0.31 ms every point against 0.71 sorted, 48 corners
+#: 0.98 against 1.36, 200 corners 4.2 against 2.8).
+BANDED_FROM = 64
+
+
 def patch_index(polygons, x, y):
     """For each point, the index of the last polygon that holds it, or -1 (even-odd rule)."""
     x = np.asarray(x, dtype=float)
@@ -50,21 +57,7 @@ def patch_index(polygons, x, y):
         idx = np.flatnonzero(box)
         if idx.size == 0:
             continue
-        sx, sy = flat_x[idx], flat_y[idx]
-        # An edge can only be crossed by the points level with it, lo <= y < hi: sorted by
-        # y, they are one slice, so a polygon of many short edges (a round carpet of
-        # thousands of corners) costs its edges' slices, not every point for every edge.
-        order = np.argsort(sy, kind="stable")
-        by_y = sy[order]
-        inside = np.zeros(idx.shape, dtype=bool)
-        for i in range(len(poly)):
-            x0, y0, x1, y1 = px[i - 1], py[i - 1], px[i], py[i]
-            if y0 == y1:
-                continue
-            lo, hi = (y0, y1) if y0 < y1 else (y1, y0)
-            band = order[np.searchsorted(by_y, lo, "left") : np.searchsorted(by_y, hi, "left")]
-            xs = (x0 - x1) * (sy[band] - y1) / (y0 - y1) + x1
-            inside[band] ^= sx[band] < xs
+        inside = _inside(px, py, flat_x[idx], flat_y[idx])
         flat_found[idx[inside]] = k
     return found
 
@@ -98,3 +91,25 @@ def paint_floor_patches(renderer, scene, pose, shade):
     rgb = np.clip(albedo * shade * 255.0 + 0.5, 0.0, 255.0).astype(np.uint8)
     image[rows[hit], cols[hit]] = rgb[index[hit]]
     return image
+
+
+def _inside(px, py, sx, sy):
+    """Which of the points ``(sx, sy)`` the polygon of corners ``(px, py)`` holds (even-odd):
+    an edge is crossed by the points level with it, ``lo <= y < hi``, left of it."""
+    inside = np.zeros(sx.shape, dtype=bool)
+    banded = len(px) >= BANDED_FROM
+    if banded:  # level with an edge: one slice of the points sorted by y
+        order = np.argsort(sy, kind="stable")
+        by_y = sy[order]
+    for i in range(len(px)):
+        x0, y0, x1, y1 = px[i - 1], py[i - 1], px[i], py[i]
+        if y0 == y1:
+            continue
+        if not banded:
+            crosses = (y1 > sy) != (y0 > sy)
+            inside ^= crosses & (sx < (x0 - x1) * (sy - y1) / (y0 - y1) + x1)
+            continue
+        lo, hi = (y0, y1) if y0 < y1 else (y1, y0)
+        band = order[np.searchsorted(by_y, lo, "left") : np.searchsorted(by_y, hi, "left")]
+        inside[band] ^= sx[band] < (x0 - x1) * (sy[band] - y1) / (y0 - y1) + x1
+    return inside
