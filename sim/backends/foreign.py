@@ -294,8 +294,7 @@ def refuse_ignored_defines(sources, includes, overrides, extra=()):
             cwd=tmp,
             env=dict(os.environ, VERILATOR_ROOT=str(root)),
         )
-        output = output.replace(str(Path(tmp) / DESIGN_DIR) + "/", "")
-    _refuse_redefined(overrides, output, {**(includes or {}), **sources})
+        _refuse_redefined(overrides, _unprefixed(output, tmp), sources, includes)
 
 
 def _refuse_loop(sources, top, includes, overrides):
@@ -450,17 +449,13 @@ def _elaborate(sources, top, includes, overrides):
             cwd=tmp,
             env=dict(os.environ, VERILATOR_ROOT=str(root)),
         )
-        _refuse_redefined(
-            overrides,
-            output.replace(str(Path(tmp) / DESIGN_DIR) + "/", ""),
-            {**(includes or {}), **sources},
-        )
+        _refuse_redefined(overrides, _unprefixed(output, tmp), sources, includes)
         if code != 0:
             errors = [line for line in output.splitlines() if line.startswith("%Error")]
             first = (errors or output.strip().splitlines() or ["(no output)"])[0]
             if "Parameters from the command line were not found" in first:
                 _refuse_parameters(sources, top, includes, overrides)
-            first = first.replace(str(Path(tmp) / DESIGN_DIR) + "/", "")
+            first = _unprefixed(first, tmp)
             if _read_hint(first):
                 first = first.rstrip(".") + _read_hint(first)
             # Named as the step it is: the CXXRTL backend reads the ports with Verilator too.
@@ -508,11 +503,18 @@ _REDEFINED = re.compile(
 )
 
 
-def _refuse_redefined(overrides, output, texts):
+def _unprefixed(text, tmp):
+    """Verilator's ``text`` with the design's files named by their own paths, not by their
+    copies' in the temporary folder ``tmp``."""
+    return text.replace(str(Path(tmp) / DESIGN_DIR) + "/", "")
+
+
+def _refuse_redefined(overrides, output, sources, includes):
     """A ``PortMapError`` for a ``--define`` the design's own `define of the same name
     overrides (its file read after ours): the value given would be dropped without a word.
-    ``output``: Verilator's; ``texts``: the design's files by path, to find the `define's
-    line (Verilator names the line after it)."""
+    ``output``: Verilator's (``_unprefixed``); ``sources`` and ``includes``: the design's
+    files by path, to find the `define's line (Verilator names the line after it)."""
+    texts = {**(includes or {}), **sources}
     given = {name for name, _ in overrides.defines}
     for where, after, name in _REDEFINED.findall(output):
         if name not in given:
