@@ -2,6 +2,7 @@
 its top speed could keep (checks.reach) is computed by hand, and a run whose floor is above
 the limit leaves the check n/a instead of failing the design."""
 
+import dataclasses
 import math
 from types import SimpleNamespace
 
@@ -11,6 +12,7 @@ import pytest
 from fpga_robotics.checks.reach import mean_distance_floor, reach
 from fpga_robotics.checks.summary import evaluate_checks
 from fpga_robotics.sim.world.config import Uncertainty
+from fpga_robotics.sim.world.robots import TURTLEBOT2
 from fpga_robotics.testing import run
 
 
@@ -21,7 +23,9 @@ def test_reach_speeds_up_then_cruises():
 
 
 def _robot(start=(0.0, 0.0), dps=1146.0, accel_dps2=1637.0, r=0.035, gain=0.0, noise=0.0):
-    spec = SimpleNamespace(max_wheel_dps=dps, wheel_accel_dps2=accel_dps2, wheel_radius=r)
+    spec = dataclasses.replace(
+        TURTLEBOT2, max_wheel_dps=dps, wheel_accel_dps2=accel_dps2, wheel_radius=r
+    )
     return SimpleNamespace(
         spec=spec,
         start=start,

@@ -22,15 +22,13 @@ def reach(t, speed, accel):
 
 
 def _top_speed_accel(robot):
-    """The fastest the robot's centre can move, m/s, and speed up, m/s^2: the wheels' limits
-    at the largest gain error, plus three standard deviations of the speed noise."""
+    """The fastest the robot's centre can move, m/s, and speed up, m/s^2: the spec's
+    ``max_speed`` and ``motor_accel`` at the largest gain error, plus three standard
+    deviations of the wheel speed noise."""
     spec, u = robot.spec, robot.uncertainty
     gain = 1.0 + u.motor_gain_error
-    dps = spec.max_wheel_dps * gain + _NOISE_SIGMAS * u.motor_noise_dps
-    return (
-        math.radians(dps) * spec.wheel_radius,
-        math.radians(spec.wheel_accel_dps2 * gain) * spec.wheel_radius,
-    )
+    noise = math.radians(_NOISE_SIGMAS * u.motor_noise_dps) * spec.wheel_radius
+    return spec.max_speed * gain + noise, spec.motor_accel * gain
 
 
 def mean_distance_floor(traj, robot):
